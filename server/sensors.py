@@ -1,0 +1,327 @@
+"""Device instances: what a controller enables and reads, and how each turns rays into values.
+
+A device *plans* the rays it needs at the end-of-step pose (``plan``), the simulation casts every
+device's rays of a step in as few batched calls as possible, and the device *reduces* its slice of
+the hits to values (``finish``). Devices never read the clock: the simulation passes times in and
+decides who is due (``Schedule``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import distance as dmath
+from sensorium.server.devices import lidar as lmath
+from sensorium.server.devices import light as light_math
+from sensorium.server.devices.lookup import LookupTable, quantize_sensor
+from sensorium.server.devices.noise import device_rng
+from sensorium.server.geometry import Pose
+from sensorium.server.raycast import RayHits, RayKind
+from sensorium.server.world.poses import pose_from_model
+
+
+@dataclass(slots=True)
+class RayRequest:
+    """Rays of one device for one measurement, in world coordinates (float64)."""
+
+    origins: np.ndarray
+    directions: np.ndarray
+    t_near: np.ndarray | float
+    t_far: np.ndarray | float
+    kind: RayKind
+    exclude_owner: int
+    skip_transparent: bool = False
+    tag: str = ""              # counter bucket: "light", "distance", "lidar"
+
+    def __len__(self) -> int:
+        return len(self.origins)
+
+
+@dataclass(slots=True)
+class Schedule:
+    """Webots' sensor timing (devices.md §1.1): measure when (t - last_update) >= period."""
+
+    period_ms: int = 0          # requested sampling period; 0 = disabled
+    last_update_ms: int = 0
+
+    def enable(self, period_ms: int, now_ms: int) -> None:
+        self.period_ms = period_ms
+        self.last_update_ms = now_ms
+
+    def due(self, now_ms: int) -> bool:
+        return self.period_ms > 0 and now_ms - self.last_update_ms >= self.period_ms
+
+
+def _check_period(period_ms: object) -> int:
+    if isinstance(period_ms, bool) or not isinstance(period_ms, (int, np.integer)):
+        raise ValueError(f"sampling period must be an integer number of milliseconds, got {period_ms!r}")
+    if period_ms < 0:
+        raise ValueError(f"sampling period must be >= 0 ms, got {period_ms}")
+    return int(period_ms)
+
+
+@dataclass(eq=False)
+class Device:
+    """Common state: name, owner robot, local pose, schedule, random stream (created on first use)."""
+
+    config: wm.LightSensor | wm.DistanceSensor | wm.Lidar
+    robot_index: int
+    robot_name: str
+    self_collision: bool
+    world_seed: int
+    clock: Callable[[], int]        # the simulation's current time (ms); enable() starts counting from it
+    schedule: Schedule = field(default_factory=Schedule)
+    measurements: int = 0           # how many values were produced (publishers watch it)
+    measured_at_ms: int = -1        # simulated time of the latest value
+    _rng: np.random.Generator | None = None
+
+    def __post_init__(self) -> None:
+        self.local_pose: Pose = pose_from_model(self.config.pose)
+
+    @property
+    def name(self) -> str:
+        return self.config.name
+
+    @property
+    def path(self) -> str:
+        return f"{self.robot_name}/{self.config.name}"
+
+    @property
+    def kind(self) -> str:
+        return self.config.device
+
+    @property
+    def rng(self) -> np.random.Generator:
+        # lazily: a device whose noise is zero never creates (nor advances) a stream
+        if self._rng is None:
+            self._rng = device_rng(self.world_seed, self.path)
+        return self._rng
+
+    def enable(self, period_ms: int) -> None:
+        """Webots' ``enable``: 0 disables; the first value comes one sampling period later and
+        values then refresh every ceil(period / basic step) basic steps (devices.md §1.1)."""
+        self.schedule.enable(_check_period(period_ms), self.clock())
+
+    def disable(self) -> None:
+        self.schedule.enable(0, self.clock())
+
+    @property
+    def sampling_period(self) -> int:
+        return self.schedule.period_ms
+
+    @property
+    def enabled(self) -> bool:
+        return self.schedule.period_ms > 0
+
+    def world_pose(self, robot_pose: Pose) -> Pose:
+        return robot_pose.compose(self.local_pose)
+
+    def exclude_self(self) -> int:
+        return -1 if self.self_collision else self.robot_index
+
+    def _mark(self, now_ms: int) -> None:
+        self.measurements += 1
+        self.measured_at_ms = now_ms
+
+
+class LightSensor(Device):
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.table = LookupTable(self.config.lookup_table)
+        self.value = math.nan
+        self._pending: tuple | None = None
+
+    def plan(self, robot_pose: Pose, lights: light_math.LightArrays) -> list[RayRequest]:
+        pose = self.world_pose(robot_pose)
+        p = pose.translation
+        normal = pose.rotation[:, 0]
+        self._pending = (p, normal)
+        if not self.config.occlusion or lights.count == 0:
+            return []
+        # occlusion rays only toward lights whose direct term is non-zero: an occluded light that
+        # contributes nothing directly would not change the value
+        direct = light_math.direct_mask(p, normal, lights)
+        origins, dirs, lengths = light_math.occlusion_segments(p, lights)
+        idx = np.flatnonzero(direct)
+        self._pending = (p, normal, idx)
+        if idx.size == 0:
+            return []
+        return [RayRequest(origins[idx], dirs[idx], 0.0, lengths[idx], RayKind.BOUNDING,
+                           self.exclude_self(), tag="light")]
+
+    def finish(self, hits: list[RayHits], lights: light_math.LightArrays, now_ms: int) -> None:
+        occluded = None
+        if len(self._pending) == 3 and hits:
+            p, normal, idx = self._pending
+            occluded = np.zeros(lights.count, dtype=bool)
+            occluded[idx] = np.isfinite(hits[0].distance)
+        else:
+            p, normal = self._pending[:2]
+        e = light_math.irradiance(p, normal, lights, occluded, np.asarray(self.config.color_filter, dtype=np.float64))
+        v = float(self.table.lookup(np.array([e]), self.rng if self.table.has_noise else None)[0])
+        self.value = float(quantize_sensor(v, self.config.resolution))
+        self._pending = None
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"value": self.value}
+
+
+class DistanceSensor(Device):
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        c = self.config
+        self.table = LookupTable(c.lookup_table)
+        self.type_code = dmath.SENSOR_TYPES[c.type]
+        self.directions_local = dmath.ray_directions(c.number_of_rays, c.aperture)
+        self.weights = dmath.ray_weights(c.number_of_rays, c.aperture, c.gaussian_width)
+        self.lut_max_range = float(c.lookup_table[-1][0]) if c.lookup_table else math.inf
+        self.value = math.nan
+        self._dirs_world: np.ndarray | None = None
+
+    def plan(self, robot_pose: Pose) -> list[RayRequest]:
+        if not self.config.lookup_table:
+            return []  # empty table: value 0, no ray matters (§3.1)
+        pose = self.world_pose(robot_pose)
+        dirs = pose.apply_dirs(self.directions_local)
+        self._dirs_world = dirs
+        origins = np.broadcast_to(pose.translation, dirs.shape)
+        infra_red = self.type_code == dmath.SENSOR_TYPES["infra-red"]
+        return [RayRequest(
+            np.ascontiguousarray(origins), dirs, 0.0, self.lut_max_range,
+            RayKind.VISUAL if infra_red else RayKind.BOUNDING,
+            # infra-red sees the robot's own visual shapes (Webots); ODE rays skip them
+            -1 if infra_red else self.exclude_self(),
+            skip_transparent=self.type_code == dmath.SENSOR_TYPES["laser"],
+            tag="distance",
+        )]
+
+    def finish(self, hits: list[RayHits], scene_red: np.ndarray, scene_roughness: np.ndarray, now_ms: int) -> None:
+        if not self.config.lookup_table:
+            self.value = 0.0
+            self._mark(now_ms)
+            return
+        h = hits[0]
+        reflection = None
+        if self.type_code == dmath.SENSOR_TYPES["infra-red"]:
+            # colour lookups only for infra-red; shape -1 picks the trailing "no hit" entry
+            reflection = dmath.reflection_factor(scene_red[h.shape], scene_roughness[h.shape])
+            reflection = np.where(h.shape >= 0, reflection, 1.0)
+        d = dmath.combine_distance(self.type_code, h.distance, self._dirs_world, h.normal, self.weights,
+                                   self.lut_max_range, reflection, self.config.red_color_sensitivity)
+        v = float(self.table.lookup(np.array([d]), self.rng if self.table.has_noise else None)[0])
+        self.value = float(quantize_sensor(v, self.config.resolution))
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"value": self.value}
+
+
+class Lidar(Device):
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        c = self.config
+        self.params = lmath.LidarParams(
+            horizontal_resolution=c.horizontal_resolution, number_of_layers=c.number_of_layers,
+            field_of_view=c.field_of_view, vertical_field_of_view=c.vertical_field_of_view,
+            tilt_angle=c.tilt_angle, near=c.near, min_range=c.min_range, max_range=c.max_range,
+            type=c.type, projection=c.projection, noise=c.noise, resolution=c.resolution,
+            default_frequency=c.default_frequency, min_frequency=c.min_frequency, max_frequency=c.max_frequency,
+        )
+        self.rotating = c.type == "rotating"
+        self.frequency = float(c.default_frequency)
+        self.head_angle = 0.0
+        self.point_cloud_enabled = False
+        L, W = c.number_of_layers, c.horizontal_resolution
+        # before the first measurement the image and cloud are all zeros (Webots)
+        self.range_image = np.zeros((L, W), dtype=np.float32)
+        self.point_cloud = np.zeros(L * W, dtype=lmath.POINT_DTYPE)
+        self._all_dirs = lmath.ray_directions(self.params)               # (L, W, 3) lidar frame
+        # planar lidars store depth along +x: rays must reach max_range in depth, not in length
+        x = self._all_dirs[..., 0]
+        self._t_far = (self.params.max_range / np.where(x > 0, x, np.inf) if c.projection == "planar"
+                       else np.full(x.shape, self.params.max_range))
+        self._columns: np.ndarray | None = None
+        self._column_times: np.ndarray | None = None
+
+    # -- controller API
+    def set_frequency(self, f: float) -> None:
+        c = self.config
+        if not (isinstance(f, (int, float)) and math.isfinite(f) and c.min_frequency <= f <= c.max_frequency):
+            raise ValueError(f"frequency {f!r} outside [{c.min_frequency}, {c.max_frequency}] Hz")
+        self.frequency = float(f)
+
+    def enable_point_cloud(self) -> None:
+        self.point_cloud_enabled = True
+
+    def disable_point_cloud(self) -> None:
+        self.point_cloud_enabled = False
+
+    def layer_range_image(self, layer: int) -> np.ndarray:
+        if not 0 <= layer < self.config.number_of_layers:
+            raise ValueError(f"layer {layer} outside [0, {self.config.number_of_layers - 1}]")
+        return self.range_image[layer].copy()
+
+    def layer_point_cloud(self, layer: int) -> np.ndarray:
+        if not 0 <= layer < self.config.number_of_layers:
+            raise ValueError(f"layer {layer} outside [0, {self.config.number_of_layers - 1}]")
+        W = self.config.horizontal_resolution
+        return self.point_cloud[layer * W:(layer + 1) * W].copy()
+
+    # -- measurement
+    def due(self, now_ms: int) -> bool:
+        # a rotating head turns (and sweeps its sector) every basic step while enabled
+        return self.enabled if self.rotating else self.schedule.due(now_ms)
+
+    def plan(self, robot_pose: Pose, dt_ms: int) -> list[RayRequest]:
+        if self.rotating:
+            cols, self.head_angle_next = lmath.rotating_sector(self.params, self.head_angle, self.frequency, dt_ms)
+            self._columns = np.asarray(cols, dtype=np.int64)
+            if self._columns.size == 0:
+                return []
+            dirs_local = self._all_dirs[:, self._columns, :]
+            t_far = self._t_far[:, self._columns]
+        else:
+            self._columns = None
+            dirs_local = self._all_dirs
+            t_far = self._t_far
+        pose = self.world_pose(robot_pose)
+        dirs = pose.apply_dirs(dirs_local.reshape(-1, 3))
+        origins = np.broadcast_to(pose.translation, dirs.shape)
+        return [RayRequest(origins, dirs, self.params.near, t_far.reshape(-1), RayKind.VISUAL, -1, tag="lidar")]
+
+    def finish(self, hits: list[RayHits], now_ms: int, dt_ms: int, counters: dict[str, int]) -> None:
+        L = self.config.number_of_layers
+        if self.rotating:
+            self.head_angle = self.head_angle_next
+            cols = self._columns
+            if cols is None or cols.size == 0:
+                return
+            dist = hits[0].distance.reshape(L, cols.size)
+            ranges = lmath.ranges_from_hits(self.params, dist, self._all_dirs[:, cols, :], self._noise_rng())
+            self.range_image[:, cols] = ranges
+        else:
+            dist = hits[0].distance.reshape(L, self.config.horizontal_resolution)
+            self.range_image = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
+        if self.point_cloud_enabled:
+            period_ms = dt_ms if self.rotating else self.schedule.period_ms
+            self.point_cloud = lmath.point_cloud(self.params, self.range_image, now_ms / 1000.0, period_ms / 1000.0)
+            counters["points_built"] += self.point_cloud.size
+        self._mark(now_ms)
+
+    def _noise_rng(self) -> np.random.Generator | None:
+        return self.rng if self.params.noise > 0 else None
+
+    def readings(self) -> dict:
+        out: dict = {"range_image": self.range_image}
+        if self.point_cloud_enabled:
+            out["point_cloud"] = self.point_cloud
+        return out
+
+
+DEVICE_CLASSES = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar}
