@@ -138,30 +138,24 @@ class LightSensor(Device):
 
     def plan(self, robot_pose: Pose, lights: light_math.LightArrays) -> list[RayRequest]:
         pose = self.world_pose(robot_pose)
-        p = pose.translation
-        normal = pose.rotation[:, 0]
-        self._pending = (p, normal)
-        if not self.config.occlusion or lights.count == 0:
+        p, normal = pose.translation, pose.rotation[:, 0]   # the sensor looks along its +x axis
+        occluding = np.zeros(0, dtype=np.int64)
+        if self.config.occlusion and lights.count:
+            # occlusion rays only toward lights that light the sensor directly: ambient is never
+            # occluded, so a light with no direct term cannot change the value
+            occluding = np.flatnonzero(light_math.direct_mask(p, normal, lights))
+        self._pending = (p, normal, occluding)
+        if occluding.size == 0:
             return []
-        # occlusion rays only toward lights whose direct term is non-zero: an occluded light that
-        # contributes nothing directly would not change the value
-        direct = light_math.direct_mask(p, normal, lights)
         origins, dirs, lengths = light_math.occlusion_segments(p, lights)
-        idx = np.flatnonzero(direct)
-        self._pending = (p, normal, idx)
-        if idx.size == 0:
-            return []
-        return [RayRequest(origins[idx], dirs[idx], 0.0, lengths[idx], RayKind.BOUNDING,
+        return [RayRequest(origins[occluding], dirs[occluding], 0.0, lengths[occluding], RayKind.BOUNDING,
                            self.exclude_self(), tag="light")]
 
     def finish(self, hits: list[RayHits], lights: light_math.LightArrays, now_ms: int) -> None:
-        occluded = None
-        if len(self._pending) == 3 and hits:
-            p, normal, idx = self._pending
-            occluded = np.zeros(lights.count, dtype=bool)
-            occluded[idx] = np.isfinite(hits[0].distance)
-        else:
-            p, normal = self._pending[:2]
+        p, normal, occluding = self._pending
+        occluded = np.zeros(lights.count, dtype=bool)
+        if occluding.size:
+            occluded[occluding] = np.isfinite(hits[0].distance)
         e = light_math.irradiance(p, normal, lights, occluded, np.asarray(self.config.color_filter, dtype=np.float64))
         v = float(self.table.lookup(np.array([e]), self.rng if self.table.has_noise else None)[0])
         self.value = float(quantize_sensor(v, self.config.resolution))
@@ -242,12 +236,11 @@ class Lidar(Device):
         self.range_image = np.zeros((L, W), dtype=np.float32)
         self.point_cloud = np.zeros(L * W, dtype=lmath.POINT_DTYPE)
         self._all_dirs = lmath.ray_directions(self.params)               # (L, W, 3) lidar frame
-        # planar lidars store depth along +x: rays must reach max_range in depth, not in length
-        x = self._all_dirs[..., 0]
-        self._t_far = (self.params.max_range / np.where(x > 0, x, np.inf) if c.projection == "planar"
-                       else np.full(x.shape, self.params.max_range))
-        self._columns: np.ndarray | None = None
-        self._column_times: np.ndarray | None = None
+        # planar lidars store depth: a ray must reach max_range in depth, not in length
+        factor = lmath.value_factors(self.params, self._all_dirs)
+        with np.errstate(divide="ignore"):
+            self._t_far = np.where(factor > 0, self.params.max_range / np.where(factor > 0, factor, 1.0), 0.0)
+        self._sweep: lmath.RotatingSweep | None = None
 
     # -- controller API
     def set_frequency(self, f: float) -> None:
@@ -278,16 +271,16 @@ class Lidar(Device):
         # a rotating head turns (and sweeps its sector) every basic step while enabled
         return self.enabled if self.rotating else self.schedule.due(now_ms)
 
-    def plan(self, robot_pose: Pose, dt_ms: int) -> list[RayRequest]:
+    def plan(self, robot_pose: Pose, now_ms: int, dt_ms: int) -> list[RayRequest]:
         if self.rotating:
-            cols, self.head_angle_next = lmath.rotating_sector(self.params, self.head_angle, self.frequency, dt_ms)
-            self._columns = np.asarray(cols, dtype=np.int64)
-            if self._columns.size == 0:
+            # only the sector the head sweeps during this step (devices.md §4.9)
+            self._sweep = lmath.rotating_sweep(self.params, self.head_angle, self.frequency, dt_ms, now_ms / 1000.0)
+            cols = self._sweep.columns
+            if cols.size == 0:
                 return []
-            dirs_local = self._all_dirs[:, self._columns, :]
-            t_far = self._t_far[:, self._columns]
+            dirs_local = self._all_dirs[:, cols, :]
+            t_far = self._t_far[:, cols]
         else:
-            self._columns = None
             dirs_local = self._all_dirs
             t_far = self._t_far
         pose = self.world_pose(robot_pose)
@@ -295,23 +288,30 @@ class Lidar(Device):
         origins = np.broadcast_to(pose.translation, dirs.shape)
         return [RayRequest(origins, dirs, self.params.near, t_far.reshape(-1), RayKind.VISUAL, -1, tag="lidar")]
 
-    def finish(self, hits: list[RayHits], now_ms: int, dt_ms: int, counters: dict[str, int]) -> None:
+    def finish(self, hits: list[RayHits], now_ms: int, counters: dict[str, int]) -> None:
         L = self.config.number_of_layers
         if self.rotating:
-            self.head_angle = self.head_angle_next
-            cols = self._columns
-            if cols is None or cols.size == 0:
+            sweep = self._sweep
+            self.head_angle = sweep.head_angle_after
+            cols = sweep.columns
+            if cols.size == 0:
                 return
             dist = hits[0].distance.reshape(L, cols.size)
             ranges = lmath.ranges_from_hits(self.params, dist, self._all_dirs[:, cols, :], self._noise_rng())
             self.range_image[:, cols] = ranges
+            if self.point_cloud_enabled:
+                # point times follow the sweep: when the head passed each column
+                pts = lmath.point_cloud(self.params, ranges, 0.0, 0.0, columns=cols, times=sweep.times)
+                index = (np.arange(L)[:, None] * self.config.horizontal_resolution + cols[None, :]).reshape(-1)
+                self.point_cloud[index] = pts
+                counters["points_built"] += pts.size
         else:
             dist = hits[0].distance.reshape(L, self.config.horizontal_resolution)
             self.range_image = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
-        if self.point_cloud_enabled:
-            period_ms = dt_ms if self.rotating else self.schedule.period_ms
-            self.point_cloud = lmath.point_cloud(self.params, self.range_image, now_ms / 1000.0, period_ms / 1000.0)
-            counters["points_built"] += self.point_cloud.size
+            if self.point_cloud_enabled:
+                period_s = self.schedule.period_ms / 1000.0
+                self.point_cloud = lmath.point_cloud(self.params, self.range_image, now_ms / 1000.0, period_s)
+                counters["points_built"] += self.point_cloud.size
         self._mark(now_ms)
 
     def _noise_rng(self) -> np.random.Generator | None:

@@ -29,6 +29,25 @@ from sensorium.server.world.poses import pose_from_values
 from sensorium.server.world.scene import Scene
 
 
+def lights_from_models(models: list) -> light_math.LightArrays:
+    """The lights that are on, as arrays in world coordinates (lights that are off contribute nothing)."""
+    kinds = {"PointLight": light_math.LightKind.POINT, "SpotLight": light_math.LightKind.SPOT,
+             "DirectionalLight": light_math.LightKind.DIRECTIONAL}
+    out = []
+    for m in models:
+        if not m.on:
+            continue
+        fields = dict(kind=kinds[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity, color=m.color)
+        if m.type != "DirectionalLight":
+            fields.update(position=m.location, attenuation=m.attenuation)
+        if m.type != "PointLight":
+            fields.update(direction=m.direction)
+        if m.type == "SpotLight":
+            fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
+        out.append(light_math.Light(**fields))
+    return light_math.LightArrays.from_lights(out)
+
+
 class RobotState:
     """A robot: its devices by name and its pose."""
 
@@ -84,7 +103,7 @@ class Simulation:
         self.time_ms = 0
         self.step_count = 0
         self.scene = Scene(self.world, loaded.base_dir, precision)
-        self.lights = light_math.LightArrays.from_models(self.world.lights)
+        self.lights = lights_from_models(self.world.lights)
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._counters: Counter[str] = Counter()
 
@@ -145,7 +164,7 @@ class Simulation:
             for dev in robot.devices.values():
                 if isinstance(dev, Lidar):
                     if dev.due(now):
-                        due.append((dev, dev.plan(pose, dt)))
+                        due.append((dev, dev.plan(pose, now, dt)))
                 elif dev.schedule.due(now):
                     if isinstance(dev, LightSensor):
                         due.append((dev, dev.plan(pose, self.lights)))
@@ -159,7 +178,7 @@ class Simulation:
             if isinstance(dev, LightSensor):
                 dev.finish(mine, self.lights, now)
             elif isinstance(dev, Lidar):
-                dev.finish(mine, now, dt, self._counters)
+                dev.finish(mine, now, self._counters)
             else:
                 dev.finish(mine, self.scene.red, self.scene.roughness, now)
             if not isinstance(dev, Lidar) or not dev.rotating:

@@ -1,0 +1,222 @@
+"""DistanceSensor mathematics (spec §3) — ray layout, weights and the per-type reduction.
+
+Pipeline (the simulation drives it): ``ray_directions`` in the sensor frame (+x = sensing axis) →
+world → cast with length ``lut_max_range`` (the table's last input) → ``combine_distance`` →
+``distance_value`` (lookup with noise, then resolution).
+
+Per-ray inputs to the reductions: ``distances`` (``+inf`` = no hit; a hit farther than
+``lut_max_range`` is also treated as no hit, so rays may be cast longer), world ``directions``
+(unit), contact ``normals`` (unit, facing the ray origin, as the ray engine returns them).
+"""
+
+from __future__ import annotations
+
+import math
+from enum import IntEnum
+
+import numpy as np
+
+from .lookup import LookupTable, sensor_output
+
+__all__ = [
+    "DistanceSensorType",
+    "SENSOR_TYPES",
+    "SONAR_MAX_INCIDENCE",
+    "parse_sensor_type",
+    "effective_number_of_rays",
+    "ray_layout",
+    "ray_directions",
+    "ray_weights",
+    "reflection_factor",
+    "combine_distance",
+    "combine_distance_batch",
+    "distance_value",
+]
+
+
+class DistanceSensorType(IntEnum):
+    """Values returned by ``get_type``."""
+
+    GENERIC = 0
+    INFRA_RED = 1
+    SONAR = 2
+    LASER = 3
+
+
+SENSOR_TYPES = {"generic": 0, "infra-red": 1, "sonar": 2, "laser": 3}
+
+SONAR_MAX_INCIDENCE = 0.392699082
+"""A sonar echo counts only when the incidence angle is below this (π/8, as Webots writes it)."""
+
+
+def parse_sensor_type(name: str) -> DistanceSensorType:
+    """The ``type`` field (case-insensitive; ``"infrared"`` is accepted like Webots). Unknown names
+    raise ``ValueError`` (Webots silently makes them sonar; this project rejects them)."""
+    key = name.strip().lower()
+    key = "infra-red" if key == "infrared" else key
+    if key not in SENSOR_TYPES:
+        raise ValueError(f"unknown DistanceSensor type {name!r}; expected one of {sorted(SENSOR_TYPES)}")
+    return DistanceSensorType(SENSOR_TYPES[key])
+
+
+def effective_number_of_rays(number_of_rays: int, aperture: float) -> int:
+    """``numberOfRays`` after the ``aperture == 0`` rule (several rays at zero aperture → one ray)."""
+    n = int(number_of_rays)
+    if n < 1:
+        raise ValueError("numberOfRays must be >= 1")
+    return 1 if aperture == 0.0 else n
+
+
+_TWO_PI = 2.0 * math.pi
+
+# Predefined layouts (spec §3.2), as (alpha, t) pairs.
+_RING5 = [(k * math.pi / 3.0, 1.0) for k in range(1, 6)]
+_LAYOUTS: dict[int, list[tuple[float, float]]] = {
+    1: [(0.0, 0.0)],
+    2: [(math.pi / 2.0, 1.0), (-math.pi / 2.0, 1.0)],
+    3: [(0.0, 1.0), (2.0 * math.pi / 3.0, 1.0), (-2.0 * math.pi / 3.0, 1.0)],
+    4: [(0.0, 0.0), (0.0, 1.0), (2.0 * math.pi / 3.0, 1.0), (-2.0 * math.pi / 3.0, 1.0)],
+    5: [(0.0, 0.0), (0.0, 1.0), (math.pi / 2.0, 1.0), (math.pi, 1.0), (-math.pi / 2.0, 1.0)],
+    6: [(0.0, 0.0), (0.0, 1.0)] + [(k * 2.0 * math.pi / 5.0, 1.0) for k in range(1, 5)],
+    7: [(0.0, 0.0), (0.0, 1.0)] + _RING5,
+    8: [(0.0, 0.0), (0.0, 1.0)] + [(k * 2.0 * math.pi / 7.0, 1.0) for k in range(1, 7)],
+    9: [(0.0, 0.3), (2.0 * math.pi / 3.0, 0.3), (-2.0 * math.pi / 3.0, 0.3), (0.0, 1.0)] + _RING5,
+    10: [(0.0, 0.0), (0.0, 0.5), (2.0 * math.pi / 3.0, 0.5), (-2.0 * math.pi / 3.0, 0.5),
+         (0.0, 1.0)] + _RING5,
+}
+
+
+def ray_layout(number_of_rays: int, aperture: float) -> tuple[np.ndarray, np.ndarray]:
+    """Polar ray parameters ``(alpha, t)`` of spec §3.2; the ray's angle to +x is ``t * aperture/2``.
+
+    N <= 10: the predefined table. N > 10: concentric cones ``c = 0, 1, …`` of capacity ``3c + 1``,
+    cone c gets ``m_c = min(remaining, 3c + 1)`` rays, ``t = c/(C - 1)`` (C cones used) and the ray
+    with *global* running index ``s`` gets ``alpha = s * 2π / m_c`` (Webots' quirk, kept).
+    """
+    n = effective_number_of_rays(number_of_rays, aperture)
+    if n in _LAYOUTS:
+        pairs = np.array(_LAYOUTS[n], dtype=np.float64)
+        return pairs[:, 0].copy(), pairs[:, 1].copy()
+    sizes = []
+    remaining, cone = n, 0
+    while remaining > 0:
+        capacity = 3 * cone + 1
+        sizes.append(min(remaining, capacity))
+        remaining -= capacity
+        cone += 1
+    cones = len(sizes)
+    alpha = np.empty(n)
+    t = np.empty(n)
+    s = 0
+    for c, m in enumerate(sizes):
+        for _ in range(m):
+            alpha[s] = s * _TWO_PI / m
+            t[s] = c / (cones - 1)
+            s += 1
+    return alpha, t
+
+
+def ray_directions(number_of_rays: int, aperture: float) -> np.ndarray:
+    """Unit ray directions (N,3) in the sensor frame:
+    ``(cos θ, sin θ sin α, sin θ cos α)``, ``θ = t·aperture/2`` (α = 0 up, +π/2 left)."""
+    alpha, t = ray_layout(number_of_rays, aperture)
+    theta = t * (float(aperture) / 2.0)
+    return np.stack([np.cos(theta), np.sin(theta) * np.sin(alpha), np.sin(theta) * np.cos(alpha)], axis=1)
+
+
+def ray_weights(number_of_rays: int, aperture: float, gaussian_width: float) -> np.ndarray:
+    """Normalised Gaussian weights (N,) of spec §3.3: ``exp(-(θ/(aperture·g))²)`` with
+    ``θ = t·aperture/2``, i.e. ``exp(-(t/(2g))²)``; a single ray has weight 1."""
+    alpha, t = ray_layout(number_of_rays, aperture)
+    if len(t) == 1:
+        return np.ones(1)
+    g = float(gaussian_width)
+    if not g > 0.0:
+        raise ValueError("gaussianWidth must be > 0")
+    w = np.exp(-((t / (2.0 * g)) ** 2))
+    return w / w.sum()
+
+
+def reflection_factor(red, roughness, occlusion=0.0) -> np.ndarray:
+    """Infra-red reflection factor ``0.2 + 0.8·red·(1 - 0.5·roughness)·(1 - 0.5·occlusion)``."""
+    red = np.asarray(red, dtype=np.float64)
+    return 0.2 + 0.8 * red * (1.0 - 0.5 * np.asarray(roughness, dtype=np.float64)) \
+        * (1.0 - 0.5 * np.asarray(occlusion, dtype=np.float64))
+
+
+def combine_distance_batch(sensor_type, distances, directions, normals, weights, lut_max_range,
+                           reflection=None, red_color_sensitivity=1.0) -> np.ndarray:
+    """Distance ``D`` (S,) of S sensors with N rays each (spec §3.4).
+
+    ``sensor_type`` scalar or (S,); ``distances`` (S,N); ``directions``/``normals`` (S,N,3) (only
+    read for sonar); ``weights`` (N,) or (S,N); ``lut_max_range`` scalar or (S,); ``reflection``
+    (S,N) or None (= factor 1, a white surface); ``red_color_sensitivity`` scalar or (S,).
+    Sensors with fewer rays can be padded with rays of distance ``inf`` and weight 0.
+
+    * generic: ``Σ w·(r or Rmax)``; laser: ray 0 (``r or Rmax``);
+    * sonar: the nearest hit whose incidence angle (between the ray and ``-normal``) is below
+      π/8, else ``Rmax``; each ray only has its nearest contact, so a grazing nearest hit discards
+      the ray; weights are ignored;
+    * infra-red: ``D = Σ w·(r or Rmax)``, ``F = Σ w·(f or 1)``, ``D + (D/F - D)·sensitivity``.
+    """
+    r = np.asarray(distances, dtype=np.float64)
+    if r.ndim != 2:
+        raise ValueError("distances must be (S, N)")
+    S, N = r.shape
+    rmax = np.broadcast_to(np.asarray(lut_max_range, dtype=np.float64), (S,))[:, None]
+    hit = np.isfinite(r) & (r <= rmax)
+    r_or_max = np.where(hit, r, rmax)
+    w = np.broadcast_to(np.asarray(weights, dtype=np.float64), (S, N))
+    types = np.broadcast_to(np.asarray(sensor_type, dtype=np.int64), (S,))
+    known = np.isin(types, [int(t) for t in DistanceSensorType])
+    if not np.all(known):
+        raise ValueError(f"unknown sensor type(s) {np.unique(types[~known]).tolist()}")
+    out = np.empty(S)
+
+    average = np.einsum("sn,sn->s", w, r_or_max)
+    out[:] = average  # generic
+
+    m = types == DistanceSensorType.LASER
+    if np.any(m):
+        out[m] = r_or_max[m, 0]
+
+    m = types == DistanceSensorType.SONAR
+    if np.any(m):
+        u = np.asarray(directions, dtype=np.float64).reshape(S, N, 3)[m]
+        nrm = np.asarray(normals, dtype=np.float64).reshape(S, N, 3)[m]
+        beta = np.arctan2(np.linalg.norm(np.cross(u, -nrm), axis=2), np.einsum("snk,snk->sn", u, -nrm))
+        echo = hit[m] & (beta < SONAR_MAX_INCIDENCE)
+        out[m] = np.minimum(np.where(echo, r[m], np.inf).min(axis=1), rmax[m, 0])
+
+    m = types == DistanceSensorType.INFRA_RED
+    if np.any(m):
+        f = np.ones((S, N)) if reflection is None else np.asarray(reflection, dtype=np.float64).reshape(S, N)
+        factor = np.einsum("sn,sn->s", w, np.where(hit, f, 1.0))[m]
+        d = average[m]
+        sens = np.broadcast_to(np.asarray(red_color_sensitivity, dtype=np.float64), (S,))[m]
+        out[m] = d + (d / factor - d) * sens
+
+    return out
+
+
+def combine_distance(sensor_type: int, distances, directions, normals, weights, lut_max_range: float,
+                     reflection=None, red_color_sensitivity: float = 1.0) -> float:
+    """Distance ``D`` of one sensor (N rays); see :func:`combine_distance_batch`."""
+    r = np.asarray(distances, dtype=np.float64).reshape(1, -1)
+    N = r.shape[1]
+    return float(combine_distance_batch(
+        sensor_type, r,
+        None if directions is None else np.asarray(directions, dtype=np.float64).reshape(1, N, 3),
+        None if normals is None else np.asarray(normals, dtype=np.float64).reshape(1, N, 3),
+        np.asarray(weights, dtype=np.float64).reshape(1, N), lut_max_range,
+        None if reflection is None else np.asarray(reflection, dtype=np.float64).reshape(1, N),
+        red_color_sensitivity)[0])
+
+
+def distance_value(table: LookupTable, distance: float, rng: np.random.Generator | None,
+                   resolution: float) -> float:
+    """DistanceSensor value: lookup (with relative noise) then resolution rounding (§9.3).
+    An empty table gives 0 (Webots casts no meaningful ray then)."""
+    if len(table) == 0:
+        return 0.0
+    return sensor_output(table, distance, rng, resolution)

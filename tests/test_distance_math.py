@@ -1,0 +1,210 @@
+"""DistanceSensor layout, weights and per-type reduction (spec §3)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from sensorium.server.devices.distance import (
+    SENSOR_TYPES,
+    DistanceSensorType,
+    combine_distance,
+    combine_distance_batch,
+    distance_value,
+    parse_sensor_type,
+    ray_directions,
+    ray_layout,
+    ray_weights,
+    reflection_factor,
+)
+from sensorium.server.devices.lookup import LookupTable
+
+PI = math.pi
+RING5 = [(k * PI / 3, 1.0) for k in range(1, 6)]
+LAYOUTS = {
+    1: [(0, 0)],
+    2: [(PI / 2, 1), (-PI / 2, 1)],
+    3: [(0, 1), (2 * PI / 3, 1), (-2 * PI / 3, 1)],
+    4: [(0, 0), (0, 1), (2 * PI / 3, 1), (-2 * PI / 3, 1)],
+    5: [(0, 0), (0, 1), (PI / 2, 1), (PI, 1), (-PI / 2, 1)],
+    6: [(0, 0), (0, 1), (2 * PI / 5, 1), (4 * PI / 5, 1), (6 * PI / 5, 1), (8 * PI / 5, 1)],
+    7: [(0, 0), (0, 1)] + RING5,
+    8: [(0, 0), (0, 1)] + [(k * 2 * PI / 7, 1) for k in range(1, 7)],
+    9: [(0, 0.3), (2 * PI / 3, 0.3), (-2 * PI / 3, 0.3), (0, 1)] + RING5,
+    10: [(0, 0), (0, 0.5), (2 * PI / 3, 0.5), (-2 * PI / 3, 0.5), (0, 1)] + RING5,
+    20: [(0, 0)] + [(s * PI / 2, 1 / 3) for s in range(1, 5)] + [(s * 2 * PI / 7, 2 / 3) for s in range(5, 12)]
+        + [(s * PI / 4, 1) for s in range(12, 20)],
+}
+GENERIC, IR, SONAR, LASER = (int(t) for t in DistanceSensorType)
+
+
+@pytest.mark.parametrize("n", sorted(LAYOUTS))
+def test_layouts(n):
+    alpha, t = ray_layout(n, 1.5708)
+    expected = np.array(LAYOUTS[n], dtype=float)
+    np.testing.assert_allclose(alpha, expected[:, 0], rtol=1e-15, atol=0)
+    np.testing.assert_allclose(t, expected[:, 1], rtol=1e-15, atol=0)
+
+
+def test_concentric_cones_for_eleven_rays():
+    alpha, t = ray_layout(11, 1.0)        # cones 1, 4, 6
+    np.testing.assert_allclose(t, [0] + [0.5] * 4 + [1] * 6)
+    np.testing.assert_allclose(alpha[5:], [s * 2 * PI / 6 for s in range(5, 11)])
+
+
+def test_zero_aperture_gives_a_single_ray():
+    for n in (1, 2, 7, 20):
+        alpha, t = ray_layout(n, 0.0)
+        assert len(t) == 1 and t[0] == 0
+        np.testing.assert_array_equal(ray_directions(n, 0.0), [[1, 0, 0]])
+        np.testing.assert_array_equal(ray_weights(n, 0.0, 1.0), [1.0])
+
+
+def test_directions():
+    a = 1.2
+    np.testing.assert_array_equal(ray_directions(1, a), [[1, 0, 0]])
+    np.testing.assert_allclose(ray_directions(2, a), [[math.cos(a / 2), math.sin(a / 2), 0],
+                                                      [math.cos(a / 2), -math.sin(a / 2), 0]], atol=1e-16)
+    d5 = ray_directions(5, a)   # centre, up, left, down, right
+    s, c = math.sin(a / 2), math.cos(a / 2)
+    np.testing.assert_allclose(d5, [[1, 0, 0], [c, 0, s], [c, s, 0], [c, 0, -s], [c, -s, 0]], atol=1e-16)
+    for n in range(1, 25):
+        d = ray_directions(n, a)
+        np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, rtol=1e-15)
+        _, t = ray_layout(n, a)
+        np.testing.assert_allclose(np.arccos(np.clip(d[:, 0], -1, 1)), t * a / 2, atol=1e-7)
+
+
+def test_weights_match_spec_examples():
+    w = ray_weights(10, 1.5708, 0.5)
+    np.testing.assert_allclose(w.round(6), [0.180386] + [0.140484] * 3 + [0.066360] * 6, atol=0)
+    w = ray_weights(20, 1.5708, 1.0)
+    np.testing.assert_allclose(w.round(6), [0.057522] + [0.055946] * 4 + [0.051473] * 7 + [0.044798] * 8, atol=0)
+    for n in range(1, 30):
+        assert ray_weights(n, 0.7, 0.8).sum() == pytest.approx(1.0, rel=1e-15)
+    np.testing.assert_allclose(ray_weights(3, 1.0, 1.0), [1 / 3] * 3)   # all on the rim
+    with pytest.raises(ValueError):
+        ray_weights(3, 1.0, 0.0)
+
+
+def test_reflection_factor():
+    np.testing.assert_allclose(reflection_factor([1, 0, 1, 1, 0.5], [0, 0, 1, 0, 0.5], [0, 0, 0, 1, 1]),
+                               [1.0, 0.2, 0.6, 0.6, 0.2 + 0.8 * 0.5 * 0.75 * 0.5])
+
+
+def single(sensor_type, r, weights=None, rmax=0.5, directions=None, normals=None, reflection=None, sens=1.0):
+    r = np.asarray(r, dtype=float)
+    n = len(r)
+    directions = np.tile([1.0, 0, 0], (n, 1)) if directions is None else directions
+    normals = np.tile([-1.0, 0, 0], (n, 1)) if normals is None else normals
+    weights = np.full(n, 1 / n) if weights is None else weights
+    return combine_distance(sensor_type, r, directions, normals, weights, rmax, reflection, sens)
+
+
+def test_generic_weighted_average_with_no_hit_at_max_range():
+    w = np.array([0.5, 0.3, 0.2])
+    assert single(GENERIC, [0.1, 0.2, 0.3], w) == pytest.approx(0.05 + 0.06 + 0.06)
+    assert single(GENERIC, [0.1, math.inf, 0.3], w) == pytest.approx(0.05 + 0.15 + 0.06)
+    assert single(GENERIC, [math.inf] * 3, w) == pytest.approx(0.5)
+    assert single(GENERIC, [0.1, 0.7, 0.3], w) == pytest.approx(0.05 + 0.15 + 0.06)   # beyond Rmax: no hit
+    assert single(GENERIC, [0.5], [1.0]) == 0.5                                         # exactly Rmax: a hit
+
+
+def test_laser_uses_the_first_ray():
+    assert single(LASER, [0.25], [1.0]) == 0.25
+    assert single(LASER, [math.inf], [1.0]) == 0.5
+
+
+def incidence(beta_deg):
+    """Ray along +x hitting a surface whose normal (facing the origin) is tilted by beta."""
+    b = math.radians(beta_deg)
+    return np.array([[-math.cos(b), math.sin(b), 0.0]])
+
+
+@pytest.mark.parametrize("beta, expected", [(0.0, 0.3), (22.4, 0.3), (22.6, 0.5), (60.0, 0.5), (89.0, 0.5)])
+def test_sonar_incidence_rule(beta, expected):
+    assert single(SONAR, [0.3], [1.0], normals=incidence(beta)) == expected
+
+
+def test_sonar_nearest_qualifying_echo():
+    normals = np.concatenate([incidence(40), incidence(10), incidence(0), incidence(5)])
+    # ray 0 is nearest but grazing (discarded); ray 3 misses
+    d = single(SONAR, [0.1, 0.35, 0.2, math.inf], [0.7, 0.1, 0.1, 0.1], normals=normals)
+    assert d == 0.2
+    # a ray whose nearest contact is grazing is lost even if it is the only hit
+    assert single(SONAR, [0.1, math.inf], normals=np.concatenate([incidence(30), incidence(0)])) == 0.5
+    # hits beyond Rmax do not count; weights are ignored
+    assert single(SONAR, [0.6, 0.45], [1.0, 0.0], normals=np.concatenate([incidence(0), incidence(0)])) == 0.45
+
+
+def test_sonar_incidence_uses_world_directions():
+    u = np.array([[0.0, 0.0, -1.0]])                # pointing down onto a floor
+    floor = np.array([[0.0, 0.0, 1.0]])
+    assert single(SONAR, [0.2], [1.0], directions=u, normals=floor) == 0.2
+    tilted = np.array([[0.0, math.sin(0.5), -math.cos(0.5)]])   # 28.6 degrees off the floor normal
+    assert single(SONAR, [0.2], [1.0], directions=tilted, normals=floor) == 0.5
+
+
+@pytest.mark.parametrize("red, rough, sens, expected", [
+    (1.0, 0.0, 1.0, 0.2),           # red: f = 1
+    (0.0, 0.0, 1.0, 0.2 / 0.2),     # black: f = 0.2
+    (1.0, 1.0, 1.0, 0.2 / 0.6),     # rough red: f = 0.6
+    (0.0, 0.0, 0.0, 0.2),           # sensitivity 0: colour ignored
+    (0.0, 0.0, 0.5, 0.2 + (1.0 - 0.2) * 0.5),
+])
+def test_infra_red_colour(red, rough, sens, expected):
+    f = reflection_factor([red], [rough])
+    assert single(IR, [0.2], [1.0], reflection=f, rmax=2.0, sens=sens) == pytest.approx(expected, rel=1e-14)
+
+
+def test_infra_red_no_hit_rays_have_factor_one_and_max_range():
+    w = np.array([0.5, 0.5])
+    f = np.array([0.2, 0.2])                      # the factor of a no-hit ray is ignored
+    D, F = 0.5 * 0.1 + 0.5 * 1.0, 0.5 * 0.2 + 0.5 * 1.0
+    assert single(IR, [0.1, math.inf], w, rmax=1.0, reflection=f) == pytest.approx(D / F, rel=1e-15)
+    assert single(IR, [math.inf, math.inf], w, rmax=1.0, reflection=f) == 1.0
+    assert single(IR, [0.1, 0.3], w, rmax=1.0) == pytest.approx(0.2)    # no colour info: white
+
+
+def test_batch_mixed_types_and_padding():
+    rng = np.random.default_rng(0)
+    S, N = 8, 5
+    r = rng.uniform(0, 1.2, (S, N))
+    r[rng.uniform(size=(S, N)) < 0.3] = np.inf
+    u = rng.normal(size=(S, N, 3))
+    u /= np.linalg.norm(u, axis=2, keepdims=True)
+    nrm = -u + 0.3 * rng.normal(size=(S, N, 3))
+    nrm /= np.linalg.norm(nrm, axis=2, keepdims=True)
+    w = rng.uniform(size=(S, N))
+    w /= w.sum(axis=1, keepdims=True)
+    refl = rng.uniform(0.2, 1, (S, N))
+    types = np.array([GENERIC, IR, SONAR, LASER] * 2)
+    rmax = rng.uniform(0.5, 1.0, S)
+    sens = rng.uniform(0, 1, S)
+    batch = combine_distance_batch(types, r, u, nrm, w, rmax, refl, sens)
+    for s in range(S):
+        assert batch[s] == pytest.approx(
+            combine_distance(types[s], r[s], u[s], nrm[s], w[s], rmax[s], refl[s], sens[s]), rel=1e-15)
+    # a 2-ray sensor padded to 3 rays (inf distance, weight 0) gives the same value
+    for t in (GENERIC, IR, SONAR, LASER):
+        plain = single(t, [0.1, 0.3], [0.6, 0.4], reflection=[0.5, 0.7])
+        padded = single(t, [0.1, 0.3, math.inf], [0.6, 0.4, 0.0], reflection=[0.5, 0.7, 0.9])
+        assert padded == pytest.approx(plain, rel=1e-15)
+    with pytest.raises(ValueError):
+        combine_distance_batch([7], np.ones((1, 1)), None, None, [1.0], 1.0)
+
+
+def test_sensor_types():
+    assert SENSOR_TYPES == {"generic": 0, "infra-red": 1, "sonar": 2, "laser": 3}
+    assert parse_sensor_type("Infrared") == DistanceSensorType.INFRA_RED
+    assert parse_sensor_type("SONAR") == 2
+    with pytest.raises(ValueError):
+        parse_sensor_type("radar")
+
+
+def test_distance_value():
+    table = LookupTable([[0, 0, 0], [0.1, 1000, 0]])
+    assert distance_value(table, 0.05, None, -1) == pytest.approx(500.0)
+    assert distance_value(table, 0.0512345, None, 1) == 512.0
+    assert distance_value(table, 0.5, None, -1) == 1000.0
+    assert distance_value(LookupTable([]), 0.3, None, -1) == 0.0
