@@ -108,7 +108,7 @@ def test_sanitising_warns() -> None:
     assert (d.aperture, d.number_of_rays, d.gaussian_width, d.resolution, d.red_color_sensitivity) == (0.5, 1, 1.0, -1.0, 2)
     assert laser.number_of_rays == 1
     assert li.near == 0.1 and li.max_range == pytest.approx(1.1)
-    assert len(loaded.warnings) == 12
+    assert len(loaded.warnings) == 11
     assert any("lights[1].ambient_intensity" in x for x in loaded.warnings)
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -17,6 +18,18 @@ import yaml
 from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
+
+class _Yaml12Loader(yaml.SafeLoader):
+    """YAML 1.2 booleans: only true/false. YAML 1.1 would turn Webots' field name ``on`` (and
+    yes/no/off) into booleans."""
+
+
+_Yaml12Loader.yaml_implicit_resolvers = {
+    k: [(tag, rx) for tag, rx in v if tag != "tag:yaml.org,2002:bool"]
+    for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+_Yaml12Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "worlds" / "arena.yaml"
 
@@ -66,7 +79,7 @@ def load_world(path: str | Path) -> LoadedWorld:
         if path.suffix.lower() == ".json":
             data = json.loads(text)
         else:
-            data = yaml.safe_load(text)
+            data = yaml.load(text, Loader=_Yaml12Loader)  # noqa: S506 (a safe loader)
     except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise WorldError(source, [Problem("", f"not valid YAML/JSON: {exc}")]) from None
     return parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
