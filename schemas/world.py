@@ -270,6 +270,25 @@ class Lidar(_Device):
 Device = Annotated[Union[LightSensor, DistanceSensor, Lidar], Field(discriminator="device")]
 
 
+# ---------------------------------------------------------------- motion
+
+class DifferentialDrive(Strict):
+    """Kinematic two-wheel drive (no physics, no collision response): the robot moves in the world
+    xy-plane from its two wheel motors, controlled with Webots' motor API."""
+
+    wheel_radius: float = Field(default=0.0205, gt=0)
+    axle_length: float = Field(default=0.052, gt=0, description="distance between the wheels")
+    max_wheel_speed: float = Field(default=6.28, gt=0, description="rad/s, Webots maxVelocity")
+    left_motor: str = Field(default="left wheel motor", min_length=1)
+    right_motor: str = Field(default="right wheel motor", min_length=1)
+
+    @model_validator(mode="after")
+    def _distinct(self) -> DifferentialDrive:
+        if self.left_motor == self.right_motor:
+            raise ValueError("left_motor and right_motor must have different names")
+        return self
+
+
 # ---------------------------------------------------------------- robots and world
 
 class Robot(Strict):
@@ -278,6 +297,7 @@ class Robot(Strict):
     synchronization: bool = True
     self_collision: bool = False
     body: Shape | None = None
+    differential_drive: DifferentialDrive | None = None
     devices: list[Device] = []
 
 

@@ -22,6 +22,7 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.geometry import Pose
+from sensorium.server.motion import DifferentialDrive, WheelMotor
 from sensorium.server.raycast import Precision, RayHits
 from sensorium.server.sensors import DEVICE_CLASSES, Device, Lidar, LightSensor, RayRequest
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
@@ -63,14 +64,26 @@ class RobotState:
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
                                        clock=lambda: sim.time_ms)
+        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index])
+                      if model.differential_drive is not None else None)
+        self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
 
     @property
     def pose(self) -> Pose:
         return self._sim.scene.robot_poses[self.index]
 
     def set_pose(self, translation, rotation=None, quaternion=None) -> None:
-        """Move the robot (kinematically); the next measurement sees it there."""
-        self._sim.scene.set_robot_pose(self.index, pose_from_values(translation, rotation, quaternion))
+        """Move the robot (supervisor-style, kinematically); the next measurement sees it there."""
+        pose = pose_from_values(translation, rotation, quaternion)
+        self._sim.scene.set_robot_pose(self.index, pose)
+        if self.drive is not None:
+            self.drive.reset(pose)
+
+    def motor(self, name: str) -> WheelMotor:
+        try:
+            return self.motors[name]
+        except KeyError:
+            raise KeyError(f"robot {self.name!r} has no motor {name!r} (motors: {', '.join(self.motors) or 'none'})") from None
 
     def device(self, name: str) -> Device:
         try:
@@ -105,6 +118,7 @@ class Simulation:
         self.scene = Scene(self.world, loaded.base_dir, precision)
         self.lights = lights_from_models(self.world.lights)
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
+        self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._counters: Counter[str] = Counter()
 
     @classmethod
@@ -158,6 +172,10 @@ class Simulation:
         self.step_count += 1
         now = self.time_ms
         dt = self.basic_time_step
+        for robot in self._driven:
+            pose = robot.drive.step(dt)
+            if pose is not None:
+                self.scene.set_robot_pose(robot.index, pose)
         due: list[tuple[Device, list[RayRequest]]] = []
         for robot in self.robots.values():
             pose = robot.pose

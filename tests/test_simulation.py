@@ -462,3 +462,70 @@ def test_probe_rejects_bad_enable() -> None:
     res = subprocess.run([sys.executable, "-m", "sensorium.cli", "probe", "--enable", "epuck/nope:32"],
                          capture_output=True, text=True, timeout=120)
     assert res.returncode == 2 and "no device 'nope'" in res.stderr
+
+
+# ------------------------------------------------------------------ kinematic drive
+
+def _driven(**drive) -> Simulation:
+    data = {"world_info": {"basic_time_step": 16},
+            "robots": [{"name": "r", "pose": {"translation": [1.0, 2.0, 0.0], "rotation": [0, 0, 1, 0.5]},
+                        "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 10, **drive}}]}
+    return Simulation(parse_world(data))
+
+
+def test_drive_straight_and_turn_in_place() -> None:
+    sim = _driven()
+    r = sim.robot("r")
+    left, right = r.motor("left wheel motor"), r.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(5.0)
+    sim.run(100)                                   # 1.6 s at 0.1 m/s
+    np.testing.assert_allclose(r.pose.translation, [1 + 0.16 * math.cos(0.5), 2 + 0.16 * math.sin(0.5), 0], atol=1e-12)
+    left.set_velocity(-5.0)
+    sim.run(10)                                    # turn in place: w = 0.02*10/0.05 = 4 rad/s for 0.16 s
+    fwd = r.pose.rotation[:, 0]
+    assert math.atan2(fwd[1], fwd[0]) == pytest.approx(0.5 + 0.64, abs=1e-12)
+    np.testing.assert_allclose(r.pose.translation[:2], [1 + 0.16 * math.cos(0.5), 2 + 0.16 * math.sin(0.5)], atol=1e-12)
+
+
+def test_velocity_clamped_and_position_control_stops_at_target() -> None:
+    sim = _driven()
+    m = sim.robot("r").motor("left wheel motor")
+    m.set_velocity(100.0)
+    assert m.velocity == 10.0
+    m.set_position(1.0)                            # position control at speed 10 rad/s
+    sim.run(20)
+    assert m.position == pytest.approx(1.0, abs=1e-12)
+    with pytest.raises(ValueError, match="finite"):
+        m.set_velocity(math.nan)
+    with pytest.raises(KeyError, match="no motor 'x'"):
+        sim.robot("r").motor("x")
+
+
+def test_circle_stays_on_circle_for_a_million_steps() -> None:
+    from sensorium.server.motion import arc_step
+
+    v, w, dt = 0.1, 0.7, 0.016            # radius v/w around the centre (0, v/w) from the origin
+    x = y = yaw = 0.0
+    for _ in range(1_000_000):
+        x, y, yaw = arc_step(x, y, yaw, v, w, dt)
+    assert math.hypot(x, y - v / w) == pytest.approx(v / w, abs=1e-9)
+    # and it is where the closed form says after 16,000 s
+    phase = w * 16_000.0
+    assert x == pytest.approx((v / w) * math.sin(phase), abs=1e-6)
+
+
+def test_driving_changes_sensor_readings() -> None:
+    data = {"world_info": {"basic_time_step": 32},
+            "solids": [{"name": "wall", "pose": {"translation": [1.0, 0, 0]}, "geometry": {"type": "box", "size": [0.1, 4, 1]}}],
+            "robots": [{"name": "r", "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.1},
+                        "devices": [{"device": "DistanceSensor", "name": "d", "lookup_table": [[0, 0, 0], [2, 2, 0]]}]}]}
+    sim = Simulation(parse_world(data))
+    r = sim.robot("r")
+    for m in r.motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(2.0)                         # 0.1 m/s
+    sim.device("r/d").enable(32)
+    sim.run(10)
+    assert sim.device("r/d").value == pytest.approx(0.95 - 0.1 * 0.32, abs=1e-12)

@@ -159,7 +159,11 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
         rp = f"robots[{r_i}]"
         if robot.body is not None:
             problems += _check_geometry(robot.body.geometry, f"{rp}.body.geometry", base_dir)
-        unique([(f"{rp}.devices[{d_i}].name", d.name) for d_i, d in enumerate(robot.devices)], "device")
+        names = [(f"{rp}.devices[{d_i}].name", d.name) for d_i, d in enumerate(robot.devices)]
+        if robot.differential_drive is not None:
+            names += [(f"{rp}.differential_drive.left_motor", robot.differential_drive.left_motor),
+                      (f"{rp}.differential_drive.right_motor", robot.differential_drive.right_motor)]
+        unique(names, "device")
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"
             table = getattr(dev, "lookup_table", None)
