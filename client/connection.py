@@ -1,0 +1,423 @@
+"""The client's only ZeroMQ module: controller URLs, request/reply correlation, heartbeats.
+
+    conn = Connection("tcp://127.0.0.1:5560")
+    info = conn.call("get_info")                    # one round trip
+    rid = conn.send("/epuck/robot/step", {"duration": 32})   # pipelined: send now ...
+    reply = conn.wait(rid, timeout=None)            # ... read the reply later
+
+A :class:`Connection` owns one ``DEALER`` socket (not thread-safe: use it from one thread). A
+:class:`Heartbeat` thread owns a second socket and sends ``ping {session}`` every
+``heartbeat_ms`` so that a controller computing for a long time between steps stays attached; it
+also tells the connection when the server stopped answering, so a blocked step raises
+:class:`ConnectionLost` instead of hanging forever. Errors the server sends back raise
+:class:`SensoriumError` with the protocol's code (PROTOCOL.md §3.2).
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import stat
+import threading
+import time
+from dataclasses import dataclass
+from enum import IntEnum
+from typing import Any
+from urllib.parse import quote, unquote
+
+import msgpack
+import zmq
+
+DEFAULT_RPC_ENDPOINT = "tcp://127.0.0.1:5560"
+DEFAULT_PUB_ENDPOINT = "tcp://127.0.0.1:5561"
+DEFAULT_PORT = 5560
+ENV_URL = "SENSORIUM_CONTROLLER_URL"
+WEBOTS_ENV_URL = "WEBOTS_CONTROLLER_URL"
+DEFAULT_TIMEOUT = 10.0          # seconds for a non-step request (the server may still be starting)
+
+_NO_TIMEOUT = object()
+
+
+class ErrorCode(IntEnum):
+    """Server error codes (PROTOCOL.md §3.2) and, from 1000 up, errors found by the client itself."""
+
+    BAD_REQUEST = 1
+    UNKNOWN_SERVICE = 2
+    UNKNOWN_ROBOT = 3
+    UNKNOWN_DEVICE = 4
+    INVALID_ARGUMENT = 5
+    NOT_ATTACHED = 6
+    ROBOT_TAKEN = 7
+    TOO_LARGE = 8
+    SHUTTING_DOWN = 9
+    WRONG_STATE = 10
+    INTERNAL = 99
+    # client side
+    TIMEOUT = 1000
+    CONNECTION_LOST = 1001
+    BAD_REPLY = 1002
+    BAD_URL = 1003
+
+
+class SensoriumError(Exception):
+    """An error reply from the server (``code`` from PROTOCOL.md §3.2) or a client-side failure."""
+
+    def __init__(self, code: int, message: str):
+        self.code = int(code)
+        self.message = str(message)
+        super().__init__(self.code, self.message)
+
+    @property
+    def name(self) -> str:
+        try:
+            return ErrorCode(self.code).name
+        except ValueError:
+            return f"ERROR_{self.code}"
+
+    def __str__(self) -> str:
+        return f"{self.name}: {self.message}"
+
+
+class ServiceTimeout(SensoriumError, TimeoutError):
+    def __init__(self, message: str):
+        super().__init__(ErrorCode.TIMEOUT, message)
+
+
+class ConnectionLost(SensoriumError, ConnectionError):
+    def __init__(self, message: str):
+        super().__init__(ErrorCode.CONNECTION_LOST, message)
+
+
+# ---------------------------------------------------------------------- URLs
+
+@dataclass(frozen=True, slots=True)
+class ControllerURL:
+    """Where a controller connects: the RPC ``endpoint`` (a ZeroMQ address) and the ``robot``
+    (``None``: the world's only robot, like Webots' URL without a robot name)."""
+
+    endpoint: str
+    robot: str | None = None
+
+    def __str__(self) -> str:
+        if self.robot is None:
+            return self.endpoint
+        return f"{self.endpoint}/{quote(self.robot, safe='')}"
+
+    def with_robot(self, robot: str | None) -> ControllerURL:
+        return ControllerURL(self.endpoint, robot)
+
+
+def _bad_url(url: str, why: str) -> SensoriumError:
+    return SensoriumError(ErrorCode.BAD_URL, f"controller URL {url!r}: {why}")
+
+
+def _robot_part(url: str, part: str) -> str | None:
+    part = part.strip("/")
+    if not part:
+        return None
+    if "/" in part:
+        raise _bad_url(url, f"robot name {part!r} contains '/'; percent-encode it (%2F)")
+    return unquote(part)
+
+
+def _is_socket(path: str) -> bool:
+    try:
+        return stat.S_ISSOCK(os.stat(path).st_mode)
+    except OSError:
+        return False
+
+
+def parse_controller_url(url: str | None, default_endpoint: str = DEFAULT_RPC_ENDPOINT) -> ControllerURL:
+    """Parse a controller URL, in Webots' ``WEBOTS_CONTROLLER_URL`` forms:
+
+    ==================================  ==============================================
+    unset or empty                      the only robot at ``default_endpoint``
+    ``NAME``                            robot NAME at ``default_endpoint``
+    ``tcp://HOST[:PORT][/NAME]``        robot NAME (or the only robot); port 5560
+    ``ipc://PATH/NAME``                 robot NAME at ``ipc://PATH``
+    ``ipc://PATH/``                     the only robot at ``ipc://PATH``
+    ==================================  ==============================================
+
+    Robot names are percent-decoded. For ``ipc://`` the last path component is the robot unless
+    the whole path is an existing socket file.
+    """
+    if url is None or not url.strip():
+        return ControllerURL(default_endpoint, None)
+    url = url.strip()
+    scheme, sep, rest = url.partition("://")
+    if not sep:
+        return ControllerURL(default_endpoint, _robot_part(url, url))
+    scheme = scheme.lower()
+    if scheme == "tcp":
+        hostport, _, path = rest.partition("/")
+        if not hostport:
+            raise _bad_url(url, "no host")
+        if hostport.startswith("["):                     # IPv6 literal: [::1]:5560
+            close = hostport.find("]")
+            if close < 0:
+                raise _bad_url(url, "unterminated IPv6 address")
+            host, port = hostport[:close + 1], hostport[close + 1:].lstrip(":")
+        else:
+            host, _, port = hostport.partition(":")
+        if not host:
+            raise _bad_url(url, "no host")
+        if port:
+            if not port.isdigit() or not 0 < int(port) < 65536:
+                raise _bad_url(url, f"bad port {port!r}")
+        else:
+            port = str(DEFAULT_PORT)
+        return ControllerURL(f"tcp://{host}:{port}", _robot_part(url, path))
+    if scheme in ("ipc", "inproc"):
+        if not rest:
+            raise _bad_url(url, "no path")
+        if rest.endswith("/"):
+            return ControllerURL(f"{scheme}://{rest.rstrip('/')}", None)
+        if scheme == "ipc" and _is_socket(rest):
+            return ControllerURL(url, None)
+        head, slash, tail = rest.rpartition("/")
+        if not slash or not head:
+            return ControllerURL(url, None)
+        return ControllerURL(f"{scheme}://{head}", _robot_part(url, tail))
+    raise _bad_url(url, f"unsupported scheme {scheme!r} (use tcp://, ipc:// or a robot name)")
+
+
+def controller_url_from_env(environ: dict[str, str] | None = None) -> ControllerURL:
+    """The controller URL from ``SENSORIUM_CONTROLLER_URL``, else Webots' ``WEBOTS_CONTROLLER_URL``."""
+    env = os.environ if environ is None else environ
+    return parse_controller_url(env.get(ENV_URL) or env.get(WEBOTS_ENV_URL) or None)
+
+
+# ---------------------------------------------------------------------- encoding
+
+def pack(obj: Any) -> bytes:
+    return msgpack.packb(obj, use_bin_type=True)
+
+
+def unpack(data: bytes) -> Any:
+    return msgpack.unpackb(data, raw=False, strict_map_key=False)
+
+
+def _error_from(reply: dict) -> SensoriumError:
+    err = reply.get("error")
+    if not isinstance(err, dict):
+        return SensoriumError(ErrorCode.BAD_REPLY, f"error reply without an error map: {reply!r}")
+    return SensoriumError(int(err.get("code", ErrorCode.INTERNAL)), str(err.get("message", "")))
+
+
+# ---------------------------------------------------------------------- connection
+
+class Connection:
+    """One DEALER socket to the RPC endpoint: numbered requests, replies matched by ``id``.
+
+    ``timeout`` (seconds, ``None`` = forever) is the default wait for a reply; ``send`` + ``wait``
+    pipeline requests (a step reply may arrive after later requests' replies)."""
+
+    def __init__(self, endpoint: str, *, timeout: float | None = DEFAULT_TIMEOUT,
+                 context: zmq.Context | None = None):
+        self.endpoint = endpoint
+        self.timeout = timeout
+        self._context = context or zmq.Context.instance()
+        self._socket = self._context.socket(zmq.DEALER)
+        self._socket.setsockopt(zmq.LINGER, 0)
+        self._socket.connect(endpoint)
+        self._poller = zmq.Poller()
+        self._poller.register(self._socket, zmq.POLLIN)
+        self._ids = itertools.count(1)
+        self._outstanding: dict[int, str] = {}      # id -> service, for messages
+        self._replies: dict[int, dict] = {}
+        self.heartbeat: Heartbeat | None = None
+        self.closed = False
+
+    # -- requests
+    def send(self, service: str, args: dict | None = None) -> int:
+        """Send a request; return its id (for :meth:`wait`)."""
+        if self.closed:
+            raise SensoriumError(ErrorCode.WRONG_STATE, f"connection to {self.endpoint} is closed")
+        rid = next(self._ids)
+        self._socket.send(pack({"id": rid, "service": service, "args": args or {}}))
+        self._outstanding[rid] = service
+        return rid
+
+    def wait(self, rid: int, timeout: Any = _NO_TIMEOUT) -> dict:
+        """The ``result`` of request ``rid``; raise :class:`SensoriumError` for an error reply,
+        :class:`ServiceTimeout` after ``timeout`` seconds, :class:`ConnectionLost` if the
+        heartbeat found the server gone or the session dropped."""
+        if timeout is _NO_TIMEOUT:
+            timeout = self.timeout
+        service = self._outstanding.get(rid, "?")
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while rid not in self._replies:
+            if rid not in self._outstanding:
+                raise SensoriumError(ErrorCode.WRONG_STATE, f"request {rid} is not outstanding")
+            slice_ms = 250
+            if deadline is not None:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    del self._outstanding[rid]
+                    raise ServiceTimeout(
+                        f"no reply to {service!r} from {self.endpoint} within {timeout:g} s "
+                        f"(is `sensorium serve` running there?)")
+                slice_ms = max(1, min(slice_ms, int(left * 1000) + 1))
+            if self._poller.poll(slice_ms):
+                self._drain()
+            elif self.heartbeat is not None:
+                problem = self.heartbeat.problem()
+                if problem is not None:
+                    self._outstanding.pop(rid, None)
+                    raise ConnectionLost(f"while waiting for {service!r}: {problem}")
+        del self._outstanding[rid]
+        reply = self._replies.pop(rid)
+        if reply.get("ok") is True:
+            result = reply.get("result")
+            return result if isinstance(result, dict) else {}
+        raise _error_from(reply)
+
+    def call(self, service: str, args: dict | None = None, timeout: Any = _NO_TIMEOUT) -> dict:
+        """``send`` then ``wait``."""
+        return self.wait(self.send(service, args), timeout)
+
+    def discard(self, rid: int) -> None:
+        """Forget an outstanding request: its reply, if it comes, is dropped."""
+        self._outstanding.pop(rid, None)
+        self._replies.pop(rid, None)
+
+    def _drain(self) -> None:
+        while True:
+            try:
+                frames = self._socket.recv_multipart(zmq.NOBLOCK)
+            except zmq.Again:
+                return
+            try:
+                reply = unpack(frames[-1])
+            except Exception as exc:  # noqa: BLE001 - any decoding failure is a bad reply
+                raise SensoriumError(ErrorCode.BAD_REPLY, f"undecodable reply from {self.endpoint}: {exc}") from None
+            if not isinstance(reply, dict):
+                raise SensoriumError(ErrorCode.BAD_REPLY, f"reply is not a map: {reply!r}")
+            rid = reply.get("id")
+            if rid is None and reply.get("ok") is False:
+                raise _error_from(reply)          # the server could not read one of our requests
+            if rid in self._outstanding:
+                self._replies[rid] = reply
+            # else: the reply to a request we gave up on (timeout, discard): drop it
+
+    @property
+    def outstanding(self) -> int:
+        return len(self._outstanding)
+
+    # -- lifecycle
+    def start_heartbeat(self, session: str, interval_ms: int, lost_after_s: float | None = None) -> Heartbeat:
+        self.stop_heartbeat()
+        self.heartbeat = Heartbeat(self.endpoint, session, interval_ms, self._context, lost_after_s)
+        self.heartbeat.start()
+        return self.heartbeat
+
+    def stop_heartbeat(self) -> None:
+        if self.heartbeat is not None:
+            self.heartbeat.stop()
+            self.heartbeat = None
+
+    def close(self) -> None:
+        if self.closed:
+            return
+        self.stop_heartbeat()
+        self.closed = True
+        self._socket.close(linger=0)
+
+    def __enter__(self) -> Connection:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class Heartbeat(threading.Thread):
+    """Sends ``ping {session}`` every ``interval_ms`` on its own socket and watches the replies.
+
+    :meth:`problem` says why the connection is unusable: no reply for ``lost_after_s`` seconds
+    (default: 5 heartbeats, at least 2 s), or the server answered that the session is gone."""
+
+    def __init__(self, endpoint: str, session: str, interval_ms: int, context: zmq.Context,
+                 lost_after_s: float | None = None):
+        super().__init__(name="sensorium-heartbeat", daemon=True)
+        self.endpoint = endpoint
+        self.session = session
+        self.interval = max(1, int(interval_ms)) / 1000.0
+        self.lost_after = lost_after_s if lost_after_s is not None else max(2.0, 5 * self.interval)
+        self._context = context
+        self._stop_event = threading.Event()
+        self._problem: str | None = None
+        self.last_reply = time.monotonic()
+        self.pings = 0
+        self.replies = 0
+
+    def problem(self) -> str | None:
+        if self._problem is not None:
+            return self._problem
+        silent = time.monotonic() - self.last_reply
+        if silent > self.lost_after:
+            return f"no answer from {self.endpoint} for {silent:.1f} s (server gone?)"
+        return None
+
+    def stop(self) -> None:
+        self._stop_event.set()
+        if self.is_alive() and threading.current_thread() is not self:
+            self.join(timeout=2.0)
+
+    def run(self) -> None:
+        sock = self._context.socket(zmq.DEALER)
+        sock.setsockopt(zmq.LINGER, 0)
+        try:
+            sock.connect(self.endpoint)
+            ids = itertools.count(1)
+            next_ping = time.monotonic()
+            while not self._stop_event.is_set():
+                now = time.monotonic()
+                if now >= next_ping:
+                    sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
+                    self.pings += 1
+                    next_ping = now + self.interval
+                wait_ms = int(min(next_ping - time.monotonic(), 0.05) * 1000)
+                if sock.poll(max(wait_ms, 1), zmq.POLLIN):
+                    while True:
+                        try:
+                            reply = unpack(sock.recv_multipart(zmq.NOBLOCK)[-1])
+                        except zmq.Again:
+                            break
+                        except Exception:  # noqa: BLE001 - a garbled pong is no pong
+                            continue
+                        self.last_reply = time.monotonic()
+                        self.replies += 1
+                        if isinstance(reply, dict) and reply.get("ok") is False:
+                            err = _error_from(reply)
+                            self._problem = f"the server dropped session {self.session!r} ({err})"
+        except zmq.ContextTerminated:
+            pass
+        finally:
+            sock.close(linger=0)
+
+
+class SubSocket:
+    """A SUB socket on a topic endpoint, for :mod:`sensorium.client.topics` (which stays zmq-free)."""
+
+    def __init__(self, endpoint: str, *, context: zmq.Context | None = None, rcvhwm: int = 1000):
+        self.endpoint = endpoint
+        self._socket = (context or zmq.Context.instance()).socket(zmq.SUB)
+        self._socket.setsockopt(zmq.LINGER, 0)
+        self._socket.setsockopt(zmq.RCVHWM, rcvhwm)
+        self._socket.connect(endpoint)
+
+    def subscribe(self, prefix: bytes) -> None:
+        self._socket.setsockopt(zmq.SUBSCRIBE, prefix)
+
+    def unsubscribe(self, prefix: bytes) -> None:
+        self._socket.setsockopt(zmq.UNSUBSCRIBE, prefix)
+
+    def poll(self, timeout_ms: int | None) -> bool:
+        """Whether a message is ready within ``timeout_ms`` (``None``: wait for one)."""
+        return bool(self._socket.poll(timeout_ms, zmq.POLLIN))
+
+    def recv_frames(self) -> list[bytes]:
+        return self._socket.recv_multipart()
+
+    def close(self) -> None:
+        self._socket.close(linger=0)

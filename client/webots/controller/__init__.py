@@ -1,0 +1,14 @@
+"""Webots' Python controller API on Sensorium: ``from controller import Robot`` works unchanged
+once ``sensorium controller`` (or ``PYTHONPATH=<sensorium.client>/webots``) puts this package on
+the path. State lives in :mod:`sensorium.client.wb`, so importing this package under both names
+(``controller`` and ``sensorium.client.webots.controller``) still drives one robot."""
+
+from sensorium.client.connection import SensoriumError
+
+from .device import Device, Sensor
+from .distance_sensor import DistanceSensor
+from .lidar import Lidar, LidarPoint
+from .light_sensor import LightSensor
+from .robot import Robot
+
+__all__ = ["Device", "DistanceSensor", "Lidar", "LidarPoint", "LightSensor", "Robot", "Sensor", "SensoriumError"]

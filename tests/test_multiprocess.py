@@ -1,0 +1,308 @@
+"""Real processes: a ``sensorium serve`` subprocess and several controller processes.
+
+* three controllers (different robots, different step durations) in lockstep see values that are
+  bit-identical to an in-process ``Simulation`` of the same world, seed, enables and steps;
+* a controller SIGKILLed mid-run does not block the others, and a new process can take its robot;
+* Webots-style controllers (the examples) run through ``sensorium controller``, and ``sensorium
+  topics`` / ``echo`` work against the live server.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import queue
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from sensorium.client.connection import Connection
+
+REPO = Path(__file__).resolve().parents[1]
+TRIO = REPO / "tests" / "worlds" / "trio.yaml"
+ARENA = REPO / "worlds" / "arena.yaml"
+CONTROLLERS = REPO / "tests" / "controllers"
+EXAMPLES = REPO / "client" / "examples"
+ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints and signals")
+
+
+class Proc:
+    """A subprocess whose stdout lines are collected by a thread (stderr kept for messages)."""
+
+    def __init__(self, args: list[str], env: dict | None = None):
+        self.args = args
+        self.p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                  env={**ENV, **(env or {})}, cwd=str(REPO))
+        self.lines: queue.Queue[str] = queue.Queue()
+        self.out: list[str] = []
+        self.err: list[str] = []
+        threading.Thread(target=self._pump, args=(self.p.stdout, self.lines), daemon=True).start()
+        threading.Thread(target=self._pump, args=(self.p.stderr, None), daemon=True).start()
+
+    def _pump(self, stream, q) -> None:
+        for line in stream:
+            line = line.rstrip("\n")
+            if q is not None:
+                self.out.append(line)
+                q.put(line)
+            else:
+                self.err.append(line)
+
+    def line(self, timeout: float = 20.0) -> str:
+        try:
+            return self.lines.get(timeout=timeout)
+        except queue.Empty:
+            raise AssertionError(f"no output from {self.args[-4:]} in {timeout} s; stderr:\n" + "\n".join(self.err)) from None
+
+    def wait(self, timeout: float = 20.0) -> int:
+        try:
+            return self.p.wait(timeout)
+        except subprocess.TimeoutExpired:
+            raise AssertionError(f"{self.args} still running; stderr:\n" + "\n".join(self.err)) from None
+
+    def stderr(self) -> str:
+        return "\n".join(self.err)
+
+    def kill(self) -> None:
+        if self.p.poll() is None:
+            self.p.kill()
+            self.p.wait(5)
+
+
+def sensorium(*args: str) -> list[str]:
+    return [sys.executable, "-m", "sensorium.cli", *args]
+
+
+class Server:
+    def __init__(self, world: Path, tmp: Path, *extra: str):
+        self.rpc, self.pub = f"ipc://{tmp}/rpc", f"ipc://{tmp}/pub"
+        self.proc = Proc(sensorium("serve", str(world), "--rpc", self.rpc, "--pub", self.pub, *extra))
+        ready = self.proc.line(timeout=60)
+        assert ready.startswith("sensorium: serving world"), ready
+        assert f"rpc={self.rpc}" in ready and f"pub={self.pub}" in ready, ready
+        self.conn = Connection(self.rpc, timeout=5.0)
+
+    def url(self, robot: str) -> str:
+        return f"{self.rpc}/{robot}"
+
+    def info(self) -> dict:
+        return self.conn.call("get_info")
+
+    def wait_attached(self, robots: set[str], timeout: float = 30.0) -> None:
+        deadline = time.monotonic() + timeout
+        while True:
+            attached = {r["name"] for r in self.info()["robots"] if r["attached"]}
+            if robots <= attached:
+                return
+            assert time.monotonic() < deadline, f"attached {attached}, waiting for {robots}"
+            time.sleep(0.02)
+
+    def stop(self) -> int:
+        self.conn.close()
+        if self.proc.p.poll() is None:
+            self.proc.p.send_signal(signal.SIGINT)
+        try:
+            return self.proc.wait(15)
+        finally:
+            self.proc.kill()
+
+
+@pytest.fixture
+def servers():
+    started: list[Server] = []
+    procs: list[Proc] = []
+    yield started, procs
+    for p in procs:
+        p.kill()
+    for s in started:
+        s.stop()
+
+
+# ====================================================================== bit identity
+
+# robot -> (step duration ms, steps, device specs NAME:PERIOD[:pc]); 12*16 = 6*32 = 4*48 = 192 ms
+PLANS = {
+    "ant": (16, 12, ["ir:16", "eye:32"]),
+    "bee": (32, 6, ["lidar:32:pc", "sonar:48"]),
+    "cat": (48, 4, ["eye:16", "front:64"]),
+}
+
+
+def reference_run() -> dict[str, list[dict]]:
+    """What each controller must see, from the in-process simulation of the same world."""
+    from sensorium.server.simulation import Simulation
+
+    sim = Simulation.from_file(TRIO)
+    for robot, (_, _, specs) in PLANS.items():
+        for spec in specs:
+            name, period, *flags = spec.split(":")
+            dev = sim.device(f"{robot}/{name}")
+            dev.enable(int(period))
+            if "pc" in flags:
+                dev.enable_point_cloud()
+    expected: dict[str, list[dict]] = {robot: [] for robot in PLANS}
+    end = max(d * n for d, n, _ in PLANS.values())
+    while sim.time_ms < end:
+        sim.step()
+        for robot, (duration, steps, specs) in PLANS.items():
+            if sim.time_ms % duration or len(expected[robot]) >= steps:
+                continue
+            values = {}
+            for spec in specs:
+                name, _, *flags = spec.split(":")
+                dev = sim.device(f"{robot}/{name}")
+                if dev.kind == "Lidar":
+                    values[name] = {"range": dev.range_image.astype("<f4").tobytes().hex()}
+                    if "pc" in flags:
+                        values[name]["cloud"] = dev.point_cloud.tobytes().hex()
+                else:
+                    values[name] = {"value": float(dev.value).hex()}
+            expected[robot].append({"t": sim.time_ms, "status": 0, "values": values})
+    return expected
+
+
+def test_three_controllers_in_lockstep_match_the_in_process_simulation(servers, tmp_path):
+    started, procs = servers
+    server = Server(TRIO, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
+    started.append(server)
+    for robot, (duration, steps, specs) in PLANS.items():
+        procs.append(Proc(sensorium("controller", str(CONTROLLERS / "record.py"), "--url", server.url(robot),
+                                    str(duration), str(steps), *specs)))
+    server.wait_attached(set(PLANS))
+    assert server.conn.call("set_mode", {"mode": "fast"})["mode"] == "fast"
+    for p in procs:
+        assert p.wait(60) == 0, p.stderr()
+    seen = {robot: [json.loads(line) for line in p.out] for robot, p in zip(PLANS, procs)}
+    expected = reference_run()
+    for robot in PLANS:
+        assert [s["t"] for s in seen[robot]] == [e["t"] for e in expected[robot]]
+        for got, want in zip(seen[robot], expected[robot]):
+            assert got == want, f"{robot} at t={want['t']} ms differs"
+    # the devices really produced different values over time (the comparison is not vacuous)
+    assert len({s["values"]["ir"]["value"] for s in seen["ant"]}) > 6
+    assert len({s["values"]["lidar"]["range"] for s in seen["bee"]}) == 6
+    assert math.isnan(float.fromhex(seen["cat"][0]["values"]["front"]["value"]))   # first value due at 64 ms
+    assert server.stop() == 0
+
+
+# ====================================================================== crash and re-attach
+
+def _stepper(server: Server, robot: str, duration: int, steps: int, device: str) -> Proc:
+    return Proc([sys.executable, str(CONTROLLERS / "stepper.py"), str(duration), str(steps), device],
+                env={"SENSORIUM_CONTROLLER_URL": server.url(robot)})
+
+
+def _times_until(proc: Proc, predicate, timeout: float = 20.0) -> list[tuple[int, int, float]]:
+    rows = []
+    deadline = time.monotonic() + timeout
+    while True:
+        t, status, value = proc.line(max(0.1, deadline - time.monotonic())).split()
+        rows.append((int(t), int(status), float(value)))
+        if predicate(rows[-1]):
+            return rows
+        assert time.monotonic() < deadline, rows[-3:]
+
+
+def test_killed_controller_blocks_nobody_and_its_robot_can_be_attached_again(servers, tmp_path):
+    started, procs = servers
+    server = Server(TRIO, tmp_path, "--mode", "pause", "--heartbeat-ms", "200")
+    started.append(server)
+    ant = _stepper(server, "ant", 16, 0, "ir")
+    bee = _stepper(server, "bee", 32, 0, "sonar")
+    cat = _stepper(server, "cat", 48, 0, "front")
+    procs += [ant, bee, cat]
+    for p in (ant, bee, cat):
+        assert p.line() == "attached"
+    server.conn.call("set_mode", {"mode": "fast"})
+    _times_until(bee, lambda row: row[0] >= 320)
+    ant.p.send_signal(signal.SIGKILL)
+    ant.p.wait(5)
+    killed_at = server.info()["time_ms"]
+    # the others keep stepping once the server has dropped the dead session (3 x 200 ms)
+    rows = _times_until(bee, lambda row: row[0] >= killed_at + 50 * 32, timeout=15)
+    assert all(status == 0 for _, status, _ in rows)
+    _times_until(cat, lambda row: row[0] >= killed_at + 20 * 48, timeout=15)
+    # a new process takes the robot (refused with ROBOT_TAKEN until the old session expired)
+    deadline = time.monotonic() + 10
+    while True:
+        again = _stepper(server, "ant", 16, 5, "ir")
+        procs.append(again)
+        code = again.wait(20)
+        if code == 0:
+            break
+        assert "ROBOT_TAKEN" in again.stderr(), again.stderr()
+        assert time.monotonic() < deadline, "the dead controller's robot was never released"
+        time.sleep(0.1)
+    rows = [line.split() for line in again.out[1:]]
+    assert len(rows) == 5 and all(int(t) > killed_at and s == "0" for t, s, _ in rows)
+    assert [int(t) for t, _, _ in rows] == sorted(int(t) for t, _, _ in rows)
+    assert not any(v == "nan" for _, _, v in rows[1:])
+    # quitting the server ends the remaining controllers' loops with -1
+    assert server.stop() == 0
+    for p in (bee, cat):
+        assert p.wait(10) == 0, p.stderr()
+        assert p.out[-1].split()[1] == "-1"
+
+
+def test_heartbeat_keeps_a_slow_controller_attached(servers, tmp_path):
+    """Computing for many heartbeat periods between steps does not lose the robot (pings come
+    from the client's background thread), while a peer that stops pinging is dropped."""
+    from sensorium.client.wb import RobotClient
+
+    started, _ = servers
+    server = Server(TRIO, tmp_path, "--heartbeat-ms", "100")
+    started.append(server)
+    with RobotClient(server.url("ant")) as ant:
+        ant.enable(ant.by_name["ir"], 16, "test")
+        assert ant.step() == 0
+        time.sleep(1.0)                                   # 10 heartbeats, 3 would drop a silent peer
+        assert {r["name"]: r["attached"] for r in server.info()["robots"]}["ant"]
+        assert ant.step(32) == 0 and ant.time_ms == 48
+        silent = Connection(server.rpc, timeout=5.0)      # attaches, then never pings
+        silent.call("attach", {"robot": "bee"})
+        time.sleep(0.6)
+        assert ant.step() == 0                            # not blocked by the silent peer...
+        assert not {r["name"]: r["attached"] for r in server.info()["robots"]}["bee"]   # ...it was dropped
+        silent.close()
+
+
+# ====================================================================== Webots-style examples, CLI
+
+def test_examples_through_the_launcher_with_topics_and_echo(servers, tmp_path):
+    started, procs = servers
+    server = Server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "200")
+    started.append(server)
+    topics = subprocess.run(sensorium("topics", "--url", server.rpc), capture_output=True, text=True,
+                            timeout=30, cwd=str(REPO))
+    assert topics.returncode == 0, topics.stderr
+    listed = dict(line.split() for line in topics.stdout.splitlines())
+    assert listed["/scout/lidar/laser_scan"] == "sensor_msgs/msg/LaserScan"
+    assert listed["/epuck/ps0/value"] == "sensor_msgs/msg/Range"
+    echo = Proc(sensorium("echo", "/epuck/ls0/value", "--url", server.pub, "--count", "2", "--timeout", "30"))
+    procs.append(echo)
+    deadline = time.monotonic() + 20
+    while not any(p.startswith(b"/epuck/ls0/value") for p in server.conn.call("get_counters")["subscriptions"]):
+        assert time.monotonic() < deadline, "echo never subscribed"
+        time.sleep(0.05)
+    braitenberg = Proc(sensorium("controller", str(EXAMPLES / "braitenberg.py"), "--robot", "epuck",
+                                 "--url", server.rpc, "5"))
+    wanderer = Proc(sensorium("controller", str(EXAMPLES / "wanderer.py"), "--url", server.url("scout"), "3"))
+    procs += [braitenberg, wanderer]
+    server.wait_attached({"epuck", "scout"})
+    server.conn.call("set_mode", {"mode": "fast"})
+    assert braitenberg.wait(60) == 0, braitenberg.stderr()
+    assert wanderer.wait(60) == 0, wanderer.stderr()
+    assert len(braitenberg.out) == 5 and "ls0=" in braitenberg.out[0] and "wheels" in braitenberg.out[-1]
+    assert "nan" not in braitenberg.out[0]
+    assert len(wanderer.out) == 3 and "lidar front=" in wanderer.out[0] and "->" in wanderer.out[0]
+    assert echo.wait(30) == 0, echo.stderr()
+    assert len(echo.out) == 2 and echo.out[0].startswith("/epuck/ls0/value [sensor_msgs/msg/Illuminance]")
+    assert server.stop() == 0
