@@ -1,0 +1,142 @@
+"""Topic payloads (PROTOCOL.md §4): ROS 2 message shapes as pydantic models.
+
+Field names and order are those of ``sensor_msgs``/``std_msgs``/``builtin_interfaces``/
+``rosgraph_msgs`` (wire.md §1); arrays travel as little-endian raw bytes (``bytes`` fields, dtype
+named in each field's description). The server builds plain dicts in this order on its hot path;
+these models are the contract (JSON Schema export, tests, clients that want validation).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from pydantic import BaseModel, ConfigDict, Field
+
+
+class Msg(BaseModel):
+    """Base: unknown fields are errors; NaN/±inf are valid values (REP-117 special ranges)."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+class Time(Msg):
+    """``builtin_interfaces/msg/Time``."""
+
+    sec: int = Field(ge=-(1 << 31), lt=1 << 31)
+    nanosec: int = Field(ge=0, lt=1_000_000_000)
+
+
+class Header(Msg):
+    """``std_msgs/msg/Header``: stamp = simulated time of the measurement; frame_id = ``robot/device``."""
+
+    stamp: Time
+    frame_id: str
+
+
+class Illuminance(Msg):
+    """``sensor_msgs/msg/Illuminance`` for a LightSensor: the lookup-table output, variance 0."""
+
+    header: Header
+    illuminance: float
+    variance: float = 0.0
+
+
+class Range(Msg):
+    """``sensor_msgs/msg/Range`` (Iron and later, with ``variance``) for a DistanceSensor."""
+
+    ULTRASOUND: ClassVar[int] = 0
+    INFRARED: ClassVar[int] = 1
+
+    header: Header
+    radiation_type: int = Field(ge=0, le=255, description="0 sonar (and generic, laser), 1 infra-red")
+    field_of_view: float = Field(description="rad: the sensor's aperture")
+    min_range: float = Field(description="minimum of the lookup table's output column")
+    max_range: float = Field(description="maximum of the lookup table's output column")
+    range: float = Field(description="the lookup-table output (the controller's value)")
+    variance: float = 0.0
+
+
+class Image(Msg):
+    """``sensor_msgs/msg/Image``; a lidar range image is ``32FC1``, one row per layer."""
+
+    header: Header
+    height: int = Field(ge=0, lt=1 << 32)
+    width: int = Field(ge=0, lt=1 << 32)
+    encoding: str
+    is_bigendian: int = Field(ge=0, le=1)
+    step: int = Field(ge=0, lt=1 << 32, description="bytes per row")
+    data: bytes = Field(description="height x step bytes; 32FC1 = little-endian float32")
+
+
+class LaserScan(Msg):
+    """``sensor_msgs/msg/LaserScan`` for a one-layer cylindrical lidar, ranges left to right."""
+
+    header: Header
+    angle_min: float = Field(description="rad: azimuth of ranges[0] (the leftmost column)")
+    angle_max: float = Field(description="rad: azimuth of the last range")
+    angle_increment: float = Field(description="rad, negative: ranges go left to right")
+    time_increment: float = Field(description="s between two measurements")
+    scan_time: float = Field(description="s between scans")
+    range_min: float
+    range_max: float
+    ranges: bytes = Field(description="little-endian float32[]")
+    intensities: bytes = Field(default=b"", description="little-endian float32[]; empty")
+
+
+class ChannelFloat32(Msg):
+    """``sensor_msgs/msg/ChannelFloat32``."""
+
+    name: str
+    values: bytes = Field(description="little-endian float32[], one per point")
+
+
+class PointCloud(Msg):
+    """``sensor_msgs/msg/PointCloud``. Extension: ``points`` is one bin of N x 3 little-endian
+    float32 (x, y, z) instead of a list of Point32 maps."""
+
+    header: Header
+    points: bytes = Field(description="little-endian float32[N][3]: x, y, z in the device frame (m)")
+    channels: list[ChannelFloat32] = Field(description='[{"name": "layer", "values": layer index per point}]')
+
+
+class Clock(Msg):
+    """``rosgraph_msgs/msg/Clock``: the simulated time after each basic step."""
+
+    clock: Time
+
+
+class Envelope(Msg):
+    """The second frame of every topic message."""
+
+    type: str = Field(description="ROS type name, e.g. sensor_msgs/msg/Range")
+    seq: int = Field(ge=0, lt=1 << 64, description="per topic, from 0; a gap means dropped messages")
+    stamp_ns: int = Field(description="simulated time of the data (ns)")
+
+
+ILLUMINANCE = "sensor_msgs/msg/Illuminance"
+RANGE = "sensor_msgs/msg/Range"
+IMAGE = "sensor_msgs/msg/Image"
+LASER_SCAN = "sensor_msgs/msg/LaserScan"
+POINT_CLOUD = "sensor_msgs/msg/PointCloud"
+CLOCK = "rosgraph_msgs/msg/Clock"
+
+MESSAGE_TYPES: dict[str, type[Msg]] = {
+    ILLUMINANCE: Illuminance,
+    RANGE: Range,
+    IMAGE: Image,
+    LASER_SCAN: LaserScan,
+    POINT_CLOUD: PointCloud,
+    CLOCK: Clock,
+}
+"""ROS type name → model, for every topic the server publishes."""
+
+
+def field_order(model: type[Msg]) -> list[str]:
+    """The wire keys of a message, in order."""
+    return list(model.model_fields)
+
+
+def validate(type_name: str, body: dict) -> Msg:
+    """Validate a decoded topic body against its model (raises ``KeyError`` for an unknown type,
+    ``pydantic.ValidationError`` for a bad body)."""
+    return MESSAGE_TYPES[type_name].model_validate(body)

@@ -1,0 +1,309 @@
+"""Webots lockstep as a pure state machine (PROTOCOL.md §3.3, §3.7; wire.md §2.2, §5.3).
+
+No sockets, no clock: the driver passes wall time (``now``, seconds, monotonic) into every call
+that needs it and does the I/O. The machine decides:
+
+* who is attached to which robot, and who is still alive (last heard + 3 heartbeats);
+* whether the world may advance one basic step now (every attached synchronous controller has a
+  step pending, at least one step is pending, the mode allows it, real-time pacing allows it);
+* which pending steps are answered after a basic step (wake time reached), and with which status
+  (0; -1 on shutdown; the lateness ``dt`` for asynchronous robots).
+
+    ls = Lockstep({"epuck": True}, basic_time_step=32)
+    s = ls.attach("epuck", peer=b"A", now=0.0)
+    ls.request_step(s, reply_to="r1", duration=64, now=0.0)
+    while ls.next_advance(now) is not None and ls.next_advance(now) <= now:
+        sim.step(); done = ls.advanced(now)     # -> [StepDone(...)] once 64 ms have passed
+"""
+
+from __future__ import annotations
+
+import secrets
+from collections import deque
+from collections.abc import Callable, Hashable, Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from sensorium.schemas.wire import ErrorCode
+
+__all__ = ["Lockstep", "LockstepError", "Session", "PendingStep", "StepDone", "MODES"]
+
+MODES = ("fast", "realtime", "pause")
+STATUS_QUIT = -1
+RTF_WINDOW_S = 1.0
+
+
+class LockstepError(Exception):
+    """A request the machine refuses; ``code`` is the protocol error code to answer with."""
+
+    def __init__(self, code: ErrorCode, message: str):
+        super().__init__(f"{code.name}: {message}")
+        self.code = code
+        self.message = message
+
+
+@dataclass(slots=True)
+class PendingStep:
+    reply_to: Any            # opaque to the machine: what the driver needs to answer
+    kind: str                # "step" or "time_step"
+    duration_ms: int
+    requested_ms: int        # simulated time when the request arrived
+    wake_ms: int             # requested_ms + duration_ms
+
+
+@dataclass(slots=True, eq=False)
+class Session:
+    token: str
+    robot: str
+    peer: Hashable           # the ROUTER identity of the attached socket
+    synchronous: bool
+    last_heard: float
+    pending: PendingStep | None = None
+    last_reply_ms: int | None = None     # simulated time of the previous step reply (async dt)
+    alive: bool = True
+
+
+@dataclass(frozen=True, slots=True)
+class StepDone:
+    """A pending step to answer now: ``status`` 0, -1 (quit) or the asynchronous lateness."""
+
+    session: Session
+    step: PendingStep
+    status: int
+    time_ms: int
+
+
+class Lockstep:
+    """Sessions, pending steps, run mode and pacing of one world.
+
+    ``robots`` maps each robot name to its ``synchronization`` flag. ``new_token`` makes session
+    tokens (default: 16 random hex digits); tests inject a deterministic one."""
+
+    def __init__(self, robots: Mapping[str, bool], basic_time_step: int, *, heartbeat_ms: int = 1000,
+                 mode: str = "fast", time_ms: int = 0, new_token: Callable[[], str] | None = None):
+        if basic_time_step <= 0:
+            raise ValueError("basic_time_step must be > 0")
+        if heartbeat_ms <= 0:
+            raise ValueError("heartbeat_ms must be > 0")
+        self.robots = dict(robots)
+        self.basic_time_step = int(basic_time_step)
+        self.heartbeat_ms = int(heartbeat_ms)
+        self.time_ms = int(time_ms)
+        self.steps = 0
+        self.mode = self._check_mode(mode)
+        self.shutting_down = False
+        self._new_token = new_token or (lambda: secrets.token_hex(8))
+        self._by_robot: dict[str, Session] = {}
+        self._by_token: dict[str, Session] = {}
+        self._rt_next: float | None = None          # realtime: earliest wall time of the next step
+        self._rtf: deque[tuple[float, int]] = deque()
+
+    # ------------------------------------------------------------------ sessions
+    @property
+    def liveness_s(self) -> float:
+        """A session not heard from for longer than this is dropped (3 heartbeats)."""
+        return 3 * self.heartbeat_ms / 1000.0
+
+    @property
+    def sessions(self) -> list[Session]:
+        return list(self._by_robot.values())
+
+    def session_for(self, robot: str) -> Session | None:
+        return self._by_robot.get(robot)
+
+    def session(self, token: str) -> Session:
+        s = self._by_token.get(token)
+        if s is None:
+            raise LockstepError(ErrorCode.NOT_ATTACHED, "no such session (detached, dropped after missing "
+                                                        "heartbeats, or never attached)")
+        return s
+
+    def attach(self, robot: str, peer: Hashable, now: float) -> Session:
+        if self.shutting_down:
+            raise LockstepError(ErrorCode.SHUTTING_DOWN, "the server is quitting")
+        if robot not in self.robots:
+            raise LockstepError(ErrorCode.UNKNOWN_ROBOT, f"no robot {robot!r} (robots: {', '.join(self.robots) or 'none'})")
+        current = self._by_robot.get(robot)
+        if current is not None:
+            if now - current.last_heard <= self.liveness_s:
+                raise LockstepError(ErrorCode.ROBOT_TAKEN, f"robot {robot!r} already has a live controller attached")
+            self._remove(current)                 # dead but not yet collected: replace it
+        token = self._new_token()
+        while token in self._by_token:
+            token = self._new_token()
+        s = Session(token, robot, peer, self.robots[robot], now)
+        self._by_robot[robot] = s
+        self._by_token[token] = s
+        return s
+
+    def detach(self, token: str) -> tuple[Session, StepDone | None]:
+        """Release a robot; a pending step is answered with -1 (the controller is leaving)."""
+        s = self.session(token)
+        done = None
+        if s.pending is not None:
+            done = StepDone(s, s.pending, STATUS_QUIT, self.time_ms)
+        self._remove(s)
+        return s, done
+
+    def heard(self, peer: Hashable, now: float) -> None:
+        """Any request arrived from ``peer``: its sessions are alive."""
+        for s in self._by_robot.values():
+            if s.peer == peer:
+                s.last_heard = now
+
+    def ping(self, token: str, now: float) -> Session:
+        s = self.session(token)
+        s.last_heard = now
+        return s
+
+    def expire(self, now: float) -> list[Session]:
+        """Drop sessions not heard from for :attr:`liveness_s`; their pending steps are discarded."""
+        dead = [s for s in self._by_robot.values() if now - s.last_heard > self.liveness_s]
+        for s in dead:
+            self._remove(s)
+        return dead
+
+    def _remove(self, s: Session) -> None:
+        s.alive = False
+        s.pending = None
+        self._by_robot.pop(s.robot, None)
+        self._by_token.pop(s.token, None)
+
+    # ------------------------------------------------------------------ steps
+    def check_duration(self, duration: int | None, kind: str = "step") -> int:
+        """The step duration in ms: ``None`` (and 0 for ``time_step``) is one basic step; otherwise a
+        positive multiple of the basic time step, else :class:`LockstepError` INVALID_ARGUMENT."""
+        if duration is None or (kind == "time_step" and duration == 0):
+            return self.basic_time_step
+        if isinstance(duration, bool) or not isinstance(duration, int) or duration <= 0:
+            raise LockstepError(ErrorCode.INVALID_ARGUMENT, f"duration must be a positive integer (ms), got {duration!r}")
+        if duration % self.basic_time_step:
+            raise LockstepError(ErrorCode.INVALID_ARGUMENT,
+                                f"duration {duration} ms is not a multiple of the basic time step ({self.basic_time_step} ms)")
+        return duration
+
+    def request_step(self, session: Session, reply_to: Any, duration: int | None, now: float,
+                     kind: str = "step") -> StepDone | None:
+        """Queue a step; returns a :class:`StepDone` to answer at once (status -1 while quitting),
+        else ``None`` (answered by a later :meth:`advanced`)."""
+        if not session.alive:
+            raise LockstepError(ErrorCode.NOT_ATTACHED, f"session for robot {session.robot!r} was dropped")
+        d = self.check_duration(duration, kind)
+        if session.pending is not None:
+            raise LockstepError(ErrorCode.WRONG_STATE, f"robot {session.robot!r} already has a step pending "
+                                                       f"(wake at {session.pending.wake_ms} ms)")
+        session.last_heard = now
+        step = PendingStep(reply_to, kind, d, self.time_ms, self.time_ms + d)
+        if self.shutting_down:
+            return StepDone(session, step, STATUS_QUIT, self.time_ms)
+        session.pending = step
+        return None
+
+    def blocking(self) -> list[str]:
+        """Attached synchronous robots without a pending step (the world waits for them)."""
+        return [s.robot for s in self._by_robot.values() if s.synchronous and s.pending is None]
+
+    def can_advance(self) -> bool:
+        """Lockstep rule alone (no mode, no pacing): some step pending and no synchronous
+        controller without one."""
+        if self.shutting_down:
+            return False
+        any_pending = False
+        for s in self._by_robot.values():
+            if s.pending is None:
+                if s.synchronous:
+                    return False
+            else:
+                any_pending = True
+        return any_pending
+
+    def next_advance(self, now: float) -> float | None:
+        """Wall time at which the next basic step may run (``<= now``: run it now), or ``None``
+        while blocked or paused."""
+        if self.mode == "pause" or not self.can_advance():
+            return None
+        if self.mode == "fast":
+            return now
+        dt = self.basic_time_step / 1000.0
+        if self._rt_next is None or self._rt_next < now - dt:
+            self._rt_next = now                     # idle or late by more than a step: no catch-up burst
+        return self._rt_next
+
+    def advanced(self, now: float) -> list[StepDone]:
+        """The driver ran one basic step: advance the clock, return the steps to answer now (in
+        attach order, deterministic)."""
+        self.time_ms += self.basic_time_step
+        self.steps += 1
+        if self.mode == "realtime":
+            base = self._rt_next if self._rt_next is not None else now
+            self._rt_next = base + self.basic_time_step / 1000.0
+        self._rtf.append((now, self.time_ms))
+        while len(self._rtf) > 2 and self._rtf[1][0] < now - RTF_WINDOW_S:
+            self._rtf.popleft()
+        done = []
+        for s in self._by_robot.values():
+            p = s.pending
+            if p is not None and p.wake_ms <= self.time_ms:
+                done.append(StepDone(s, p, self._status(s, p), self.time_ms))
+                s.pending = None
+                s.last_reply_ms = self.time_ms
+        return done
+
+    def _status(self, s: Session, p: PendingStep) -> int:
+        if s.synchronous:
+            return 0
+        # asynchronous: simulated ms that passed between the previous reply and this request
+        return 0 if s.last_reply_ms is None else max(0, p.requested_ms - s.last_reply_ms)
+
+    # ------------------------------------------------------------------ mode, shutdown, timing
+    @staticmethod
+    def _check_mode(mode: str) -> str:
+        if mode not in MODES:
+            raise LockstepError(ErrorCode.INVALID_ARGUMENT, f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+        return mode
+
+    def set_mode(self, mode: str) -> str:
+        self.mode = self._check_mode(mode)
+        self._rt_next = None
+        return self.mode
+
+    def shutdown(self) -> list[StepDone]:
+        """Quit: every pending step is answered with -1; later steps too (:meth:`request_step`)."""
+        self.shutting_down = True
+        done = []
+        for s in self._by_robot.values():
+            if s.pending is not None:
+                done.append(StepDone(s, s.pending, STATUS_QUIT, self.time_ms))
+                s.pending = None
+        return done
+
+    def cancel_pending(self) -> list[StepDone]:
+        """Take every pending step out (the driver answers them with an error), e.g. after the
+        world failed to step. Status is -1."""
+        done = []
+        for s in self._by_robot.values():
+            if s.pending is not None:
+                done.append(StepDone(s, s.pending, STATUS_QUIT, self.time_ms))
+                s.pending = None
+        return done
+
+    def real_time_factor(self, now: float) -> float:
+        """Simulated seconds per wall second over about the last second (0 when no step ran)."""
+        while len(self._rtf) > 1 and self._rtf[1][0] < now - RTF_WINDOW_S:
+            self._rtf.popleft()
+        if not self._rtf or now - self._rtf[-1][0] > RTF_WINDOW_S:
+            return 0.0
+        wall0, sim0 = self._rtf[0]
+        if now <= wall0:
+            return 0.0
+        return (self.time_ms - sim0) / 1000.0 / (now - wall0)
+
+    def next_deadline(self, now: float) -> float | None:
+        """The next wall time at which something happens without a new message: a session expiry
+        or a paced step. ``None``: nothing scheduled."""
+        times: Iterable[float] = [s.last_heard + self.liveness_s for s in self._by_robot.values()]
+        t = min(times, default=None)
+        nxt = self.next_advance(now)
+        if nxt is not None:
+            t = nxt if t is None else min(t, nxt)
+        return t

@@ -1,0 +1,362 @@
+"""Topics (PROTOCOL.md §4): names, demand, message building, sequence numbers, recorder hook.
+
+Demand decides what is computed. A device is measured while its controller enabled it *or* one
+of its topics is demanded — covered by an XPUB subscription prefix (a prefix covers a topic when
+``topic + "\\0"`` starts with it; the empty prefix covers everything) or recorded by the recorder.
+A demanded device whose controller has not enabled it runs at the basic time step; the
+controller's own ``enable`` always wins and is never altered (its period, phase and
+``get_sampling_period`` stay exactly as requested). A lidar builds its point cloud only while the
+controller enabled it or its ``point_cloud`` topic is demanded.
+
+After each basic step :meth:`Topics.publish` builds the messages of every demanded topic whose
+device produced a new value (plus ``/clock``) as ready-to-send frames, calls the recorder with the
+very same bytes, and counts ``seq`` per topic. This module does no I/O.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import messages as msgs
+from sensorium.schemas.wire import pack, stamp, topic_frame
+
+__all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "laser_scan_angles"]
+
+POINT_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer_id", "<i4"), ("time", "<f4")])
+"""A WbLidarPoint on the wire (20 bytes, little-endian)."""
+
+Recorder = Callable[[str, str, bytes, bytes, int, int], None]
+"""``recorder(topic, type, envelope_bytes, body_bytes, stamp_ns, seq)``."""
+
+CLOCK = "/clock"
+_INFRA_RED = 1
+_SONAR = 2
+
+
+@dataclass(frozen=True, slots=True)
+class Topic:
+    name: str
+    type: str
+    kind: str                # value | range_image | laser_scan | point_cloud | clock
+    path: str | None         # "robot/device", None for /clock
+    frame: bytes             # name + NUL
+
+
+@dataclass(eq=False)
+class Control:
+    """One device as the server drives it: the controller's requests, the demand, publishing state."""
+
+    robot: str
+    device: Any
+    kind: str                                  # LightSensor | DistanceSensor | Lidar
+    topics: list[Topic]
+    frame_id: str
+    controller_period: int = 0                 # what the controller asked (get_sampling_period)
+    controller_point_cloud: bool = False       # what the controller asked (is_point_cloud_enabled)
+    demanded: set[str] = field(default_factory=set)   # kinds of this device's demanded topics
+    seen: int = 0                              # device.measurements at the last publish pass
+    _cache_m: int = -1
+    _range: bytes = b""
+    _cloud: bytes | None = None
+
+    @property
+    def path(self) -> str:
+        return f"{self.robot}/{self.device.name}"
+
+    # -- lidar bytes, built once per measurement and shared by topics and step replies
+    def range_bytes(self) -> bytes:
+        self._refresh()
+        return self._range
+
+    def cloud_bytes(self) -> bytes:
+        self._refresh()
+        if self._cloud is None:
+            self._cloud = _cloud_records(self.device.point_cloud)
+        return self._cloud
+
+    def _refresh(self) -> None:
+        m = self.device.measurements
+        if m != self._cache_m:
+            self._cache_m = m
+            self._range = np.ascontiguousarray(self.device.range_image, dtype="<f4").tobytes()
+            self._cloud = None
+
+
+def _cloud_records(pc: np.ndarray) -> bytes:
+    if pc.dtype != POINT_DTYPE:
+        pc = pc.astype(POINT_DTYPE)
+    return np.ascontiguousarray(pc).tobytes()
+
+
+# ---------------------------------------------------------------------- message builders
+
+def header(frame_id: str, ms: int) -> dict:
+    return {"stamp": stamp(max(ms, 0) * 1_000_000), "frame_id": frame_id}
+
+
+def image_msg(hdr: dict, height: int, width: int, data: bytes) -> dict:
+    """``sensor_msgs/Image`` 32FC1 (lidar range image)."""
+    return {"header": hdr, "height": height, "width": width, "encoding": "32FC1", "is_bigendian": 0,
+            "step": 4 * width, "data": data}
+
+
+def point_cloud_msg(hdr: dict, pc: np.ndarray) -> dict:
+    """``sensor_msgs/PointCloud`` from WbLidarPoint records: points N×3 ``<f4`` and a ``layer`` channel."""
+    if pc.dtype != POINT_DTYPE:
+        pc = pc.astype(POINT_DTYPE)
+    pc = np.ascontiguousarray(pc)
+    raw = pc.view(np.uint8).reshape(len(pc), POINT_DTYPE.itemsize)
+    points = raw[:, :12].tobytes()
+    layers = pc["layer_id"].astype("<f4").tobytes()
+    return {"header": hdr, "points": points, "channels": [{"name": "layer", "values": layers}]}
+
+
+def laser_scan_angles(cfg: Any) -> tuple[float, float, float] | None:
+    """(angle_min, angle_max, angle_increment) of ranges in range-image order (left to right), or
+    ``None`` when the lidar gets no LaserScan (several layers, or planar: unequal angles)."""
+    if cfg.number_of_layers != 1 or cfg.projection != "cylindrical":
+        return None
+    w = cfg.horizontal_resolution
+    if cfg.type == "rotating":
+        first, inc = math.pi, -2.0 * math.pi / w            # θ_j = π - j·2π/W
+    else:
+        fov = cfg.field_of_view
+        first, inc = fov / 2 - fov / (2 * w), -fov / w      # θ_j = Φ/2 - (j+½)·Φ/W
+    return first, first + (w - 1) * inc, inc
+
+
+def _device_topics(robot: str, name: str, kind: str, cfg: Any) -> list[Topic]:
+    base = f"/{robot}/{name}/"
+    path = f"{robot}/{name}"
+    out: list[tuple[str, str, str]] = []
+    if kind == "LightSensor":
+        out.append(("value", msgs.ILLUMINANCE, "value"))
+    elif kind == "DistanceSensor":
+        out.append(("value", msgs.RANGE, "value"))
+    elif kind == "Lidar":
+        out.append(("range_image", msgs.IMAGE, "range_image"))
+        if laser_scan_angles(cfg) is not None:
+            out.append(("laser_scan", msgs.LASER_SCAN, "laser_scan"))
+        out.append(("point_cloud", msgs.POINT_CLOUD, "point_cloud"))
+    return [Topic(base + item, t, k, path, topic_frame(base + item)) for item, t, k in out]
+
+
+# ---------------------------------------------------------------------- the topic table
+
+class Topics:
+    """All topics of a world, what is demanded, and the controller-vs-subscriber device control."""
+
+    def __init__(self, sim: Any):
+        self.sim = sim
+        self.basic_time_step = int(sim.basic_time_step)
+        self.controls: dict[str, Control] = {}
+        self.topics: list[Topic] = [Topic(CLOCK, msgs.CLOCK, "clock", None, topic_frame(CLOCK))]
+        for robot_name, robot in sim.robots.items():
+            for dev_name, dev in robot.devices.items():
+                kind = dev.config.device
+                ts = _device_topics(robot_name, dev_name, kind, dev.config)
+                self.topics.extend(ts)
+                self.controls[f"{robot_name}/{dev_name}"] = Control(robot_name, dev, kind, ts,
+                                                                    f"{robot_name}/{dev_name}", seen=dev.measurements)
+        self.by_name = {t.name: t for t in self.topics}
+        self.seq: dict[str, int] = {t.name: 0 for t in self.topics}
+        self.prefixes: set[bytes] = set()
+        self.subscribed: set[str] = set()
+        self.recorded: set[str] = set()
+        self._recorder: Recorder | None = None
+        self._rec_wants: Callable[[str], bool] | None = None
+        self._rec_demands: Callable[[str], bool] | None = None
+        self.recorder_demanded: set[str] = set()
+        self._active: list[Control] = []             # controls with a demanded topic
+        self._clock_demanded = False
+
+    # ------------------------------------------------------------------ demand
+    @property
+    def demanded(self) -> set[str]:
+        """Topics computed and published: subscribed, or demanded by the recorder."""
+        return self.subscribed | self.recorder_demanded
+
+    def subscription(self, event: bytes) -> bool:
+        """An XPUB event (``\\x01`` + prefix subscribes, ``\\x00`` + prefix unsubscribes).
+        Returns whether the demanded set changed."""
+        if not event or event[0] not in (0, 1):
+            return False
+        prefix = bytes(event[1:])
+        if event[0] == 1:
+            self.prefixes.add(prefix)
+        else:
+            self.prefixes.discard(prefix)
+        return self._recompute()
+
+    def set_recorder(self, recorder: Recorder | Any | None, topics: Iterable[str] | None = None) -> None:
+        """Attach (``None``: detach) the recorder: a callable ``(topic, type, envelope, body,
+        stamp_ns, seq)`` or an object with such a ``record`` method. It receives exactly the
+        published bytes of every topic it records.
+
+        Which topics it records: the object's ``wants(topic)`` if it has one, else ``topics``
+        (names or prefixes, matched like subscriptions: ``name + "\\0"`` starts with it; ``None`` =
+        all). Which of them count as demanded (computed even without a subscriber): the object's
+        ``demands(topic)`` if it has one, else every recorded topic."""
+        if recorder is None:
+            self._recorder = None
+            self._rec_wants = self._rec_demands = None
+        else:
+            self._recorder = getattr(recorder, "record", recorder)
+            if not callable(self._recorder):
+                raise TypeError("recorder must be callable or have a record() method")
+            prefixes = (b"",) if topics is None else tuple(t.encode("utf-8") for t in topics)
+            wants = getattr(recorder, "wants", None) or (lambda name: (name.encode("utf-8") + b"\0").startswith(prefixes))
+            self._rec_wants = wants
+            self._rec_demands = getattr(recorder, "demands", None) or wants
+        self._recompute(force=True)
+
+    def _recompute(self, force: bool = False) -> bool:
+        subscribed = {t.name for t in self.topics if any(t.frame.startswith(p) for p in self.prefixes)}
+        if not force and subscribed == self.subscribed:
+            return False
+        self.subscribed = subscribed
+        if force:
+            rw, rd = self._rec_wants, self._rec_demands
+            self.recorded = {t.name for t in self.topics if rw(t.name)} if rw else set()
+            self.recorder_demanded = {t.name for t in self.topics if rd(t.name)} if rd else set()
+        demanded = self.demanded
+        self._clock_demanded = CLOCK in demanded
+        self._active = []
+        for ctl in self.controls.values():
+            was = bool(ctl.demanded)
+            ctl.demanded = {t.kind for t in ctl.topics if t.name in demanded}
+            if ctl.demanded:
+                if not was:
+                    ctl.seen = ctl.device.measurements     # publish new values only, never a stale one
+                self._active.append(ctl)
+            self._apply(ctl)
+        return True
+
+    # ------------------------------------------------------------------ controller requests
+    def control(self, path: str) -> Control:
+        return self.controls[path]
+
+    def controller_enable(self, path: str, period_ms: int) -> None:
+        """The attached controller's ``enable(period)`` (0 disables): applied exactly as asked; if
+        it disables a demanded device, the device keeps running at the basic step for the topics."""
+        ctl = self.controls[path]
+        ctl.controller_period = int(period_ms)
+        if period_ms > 0:
+            ctl.device.enable(int(period_ms))
+        else:
+            self._apply(ctl, controller_disabled=True)
+
+    def controller_point_cloud(self, path: str, on: bool) -> None:
+        ctl = self.controls[path]
+        ctl.controller_point_cloud = bool(on)
+        self._apply(ctl)
+
+    def release_robot(self, robot: str) -> None:
+        """The robot's controller left (detached or dropped): forget its requests."""
+        for ctl in self.controls.values():
+            if ctl.robot == robot and (ctl.controller_period or ctl.controller_point_cloud):
+                had = ctl.controller_period
+                ctl.controller_period = 0
+                ctl.controller_point_cloud = False
+                self._apply(ctl, controller_disabled=bool(had))
+
+    def _apply(self, ctl: Control, controller_disabled: bool = False) -> None:
+        dev = ctl.device
+        if ctl.controller_period == 0:
+            if ctl.demanded:
+                if controller_disabled or dev.sampling_period != self.basic_time_step:
+                    dev.enable(self.basic_time_step)
+            elif dev.sampling_period != 0:
+                dev.disable()
+        if ctl.kind == "Lidar":
+            want = ctl.controller_point_cloud or "point_cloud" in ctl.demanded
+            if want != dev.point_cloud_enabled:
+                if want:
+                    dev.enable_point_cloud()
+                else:
+                    dev.disable_point_cloud()
+
+    # ------------------------------------------------------------------ publishing
+    def publish(self, time_ms: int) -> list[list[bytes]]:
+        """After a basic step: the frames of every demanded topic with a new value, ``/clock``
+        first. The recorder gets the same bytes."""
+        out: list[list[bytes]] = []
+        if self._clock_demanded:
+            self._emit(self.by_name[CLOCK], time_ms, {"clock": stamp(time_ms * 1_000_000)}, out)
+        for ctl in self._active:
+            m = ctl.device.measurements
+            if m == ctl.seen:
+                continue
+            ctl.seen = m
+            at = ctl.device.measured_at_ms
+            for t in ctl.topics:
+                if t.kind in ctl.demanded:
+                    body = self.build(ctl, t.kind, at)
+                    if body is not None:
+                        self._emit(t, at, body, out)
+        return out
+
+    def _emit(self, t: Topic, ms: int, body: dict, out: list[list[bytes]]) -> None:
+        seq = self.seq[t.name]
+        self.seq[t.name] = seq + 1
+        ns = max(ms, 0) * 1_000_000
+        env = pack({"type": t.type, "seq": seq, "stamp_ns": ns})
+        data = pack(body)
+        if t.name in self.subscribed:
+            out.append([t.frame, env, data])
+        if self._recorder is not None and t.name in self.recorded:
+            self._recorder(t.name, t.type, env, data, ns, seq)
+
+    def build(self, ctl: Control, kind: str, at_ms: int) -> dict | None:
+        """The body of one of ``ctl``'s topics from the device's current state."""
+        dev = ctl.device
+        hdr = header(ctl.frame_id, at_ms)
+        if ctl.kind == "LightSensor":
+            return {"header": hdr, "illuminance": float(dev.value), "variance": 0.0}
+        if ctl.kind == "DistanceSensor":
+            code = int(dev.type_code)
+            return {"header": hdr,
+                    "radiation_type": 1 if code == _INFRA_RED else 0,
+                    "field_of_view": float(dev.config.aperture),
+                    "min_range": float(dev.table.min_value),
+                    "max_range": float(dev.table.max_value),
+                    "range": float(dev.value),
+                    "variance": 0.0}
+        cfg = dev.config
+        if kind == "range_image":
+            return image_msg(hdr, cfg.number_of_layers, cfg.horizontal_resolution, ctl.range_bytes())
+        if kind == "laser_scan":
+            angles = laser_scan_angles(cfg)
+            if angles is None:
+                return None
+            if cfg.type == "rotating":
+                scan = 1.0 / float(dev.frequency)
+                t_inc = scan / cfg.horizontal_resolution
+            else:
+                p = dev.sampling_period
+                scan = math.ceil(p / self.basic_time_step) * self.basic_time_step / 1000.0
+                t_inc = 0.0          # every ray of a fixed lidar is cast at the same instant
+            return {"header": hdr, "angle_min": angles[0], "angle_max": angles[1], "angle_increment": angles[2],
+                    "time_increment": t_inc, "scan_time": scan,
+                    "range_min": float(cfg.min_range), "range_max": float(cfg.max_range),
+                    "ranges": ctl.range_bytes()[: 4 * cfg.horizontal_resolution], "intensities": b""}
+        if kind == "point_cloud":
+            if not dev.point_cloud_enabled:
+                return None
+            return point_cloud_msg(hdr, dev.point_cloud)
+        return None
+
+    # ------------------------------------------------------------------ step-reply readings
+    def reading(self, ctl: Control) -> dict:
+        """The device's latest reading for a step reply (PROTOCOL §3.6)."""
+        if ctl.kind == "Lidar":
+            out = {"range_image": ctl.range_bytes()}
+            if ctl.controller_point_cloud:
+                out["point_cloud"] = ctl.cloud_bytes()
+            return out
+        return {"value": float(ctl.device.value)}

@@ -1,0 +1,266 @@
+"""Precision far from the origin, and watertightness.
+
+Measured and asserted error bounds (distance error vs a float64 closed form computed from the same
+float64 inputs; scene extent ~20 m):
+
+    world offset    EXACT (asserted / measured)      FAST (asserted / measured)
+    0               1e-12 m  / ~2e-15 m              2e-6 m  / ~8e-7 m   (flat faces)
+    1e5 m           1e-12 m  / ~2e-15 m              2e-6 m  / ~9e-7 m
+    1e6 m           1e-12 m  / ~2e-15 m              2e-6 m  / ~9e-7 m
+FAST does not degrade far away because every scene is anchored at its own centre (and rays are
+clipped to the scene's bounding sphere before the float32 conversion).  Curved shapes in FAST
+carry the tessellation gap instead (sphere level 3: <= 0.5 % of the radius).
+
+In the lidar-in-a-room test the reference is computed in the room's LOCAL frame, so the error
+also includes the float64 rounding of the world-frame inputs at 1e6 m (ulp 1.2e-10 m): EXACT is
+asserted within 1e-9 m there.
+
+Watertightness: >= 10,000 rays aimed exactly at vertices and edge midpoints of closed meshes
+(icosphere, box), from inside and outside.  EXACT must report the true first hit for every ray
+(0 leaks); FAST's leak count is measured and reported, not asserted.
+"""
+
+import numpy as np
+import pytest
+import trimesh
+
+from sensorium.server.geometry import Box, Capsule, Cylinder, Mesh, Plane, Pose, Sphere, tessellate
+from sensorium.server.raycast import Precision, RayEngine, RayKind, ShapeEntry
+
+BOTH = [Precision.FAST, Precision.EXACT]
+OFFSETS = [0.0, 1e5, 1e6]
+BOUND = {Precision.EXACT: 1e-12, Precision.FAST: 2e-6}
+
+
+def at(x, y, z, axis=(0, 0, 1), angle=0.0):
+    return Pose.from_axis_angle(axis, angle, [x, y, z])
+
+
+def entry(p, pose=Pose.identity()):
+    return ShapeEntry(p, pose, True, True)
+
+
+def _unit(v):
+    return v / np.linalg.norm(v, axis=1)[:, None]
+
+
+def _shell_gap(p) -> float:
+    """How far the circumscribed tessellation reaches outside the true surface."""
+    v, _ = tessellate(p)
+    if isinstance(p, Sphere):
+        return float(np.linalg.norm(v, axis=1).max() - p.radius)
+    if isinstance(p, Cylinder):
+        return float(np.hypot(v[:, 0], v[:, 1]).max() - p.radius)
+    q = v.copy()
+    q[:, 2] = np.sign(q[:, 2]) * np.maximum(np.abs(q[:, 2]) - p.height / 2, 0.0)
+    return float(np.linalg.norm(q, axis=1).max() - p.radius)
+
+
+@pytest.mark.parametrize("prec", BOTH)
+@pytest.mark.parametrize("offset", OFFSETS)
+def test_translated_scene_error_bounds(prec, offset):
+    base = np.array([offset, -offset / 3, offset / 7])
+    e = RayEngine(prec)
+    e.add_body([entry(Box((2, 1, 0.5)))], at(*(base + [5, 0, 0])))
+    e.add_body([entry(Sphere(1.3))], at(*(base + [0, 5, 0])))
+    e.add_body([entry(Box((20, 20, 0.2)))], at(*(base + [0, 0, -3])))
+    e.add_body([entry(Cylinder(0.5, 2.0))], at(*(base + [0, -5, 0])))
+    e.add_body([entry(Capsule(0.5, 1.0))], at(*(base + [-5, 0, 0])))
+    e.add_body([entry(Plane())], at(*(base + [0, 0, 10])))
+    rng = np.random.default_rng(0)
+    n = 1000
+    o = base + rng.uniform(-1, 1, (n, 3))
+    # box face x = 4 (flat: both modes)
+    T = base + np.c_[np.full(n, 4.0), rng.uniform(-0.45, 0.45, n), rng.uniform(-0.2, 0.2, n)]
+    d = T - o
+    L = np.linalg.norm(d, axis=1)
+    h = e.cast(o, d / L[:, None])
+    assert np.all(h.shape == 0)
+    assert np.abs(h.distance - L).max() <= BOUND[prec]
+    assert np.allclose(h.normal, [-1, 0, 0], atol=1e-12)
+    # floor top z = -2.9 and the plane z = 10 (analytic, float64 in both modes)
+    d = _unit(np.c_[rng.normal(size=(n, 2)) * 0.3, -np.ones(n)])
+    h = e.cast(o, d)
+    assert np.all(h.shape == 2)
+    assert np.abs(h.distance - (base[2] - 2.9 - o[:, 2]) / d[:, 2]).max() <= BOUND[prec]
+    h = e.cast(o, -d)
+    assert np.all(h.shape == 5)
+    assert np.abs(h.distance - (base[2] + 10 - o[:, 2]) / -d[:, 2]).max() <= 1e-12 * (1 + offset / 1e3)
+    # curved: rays at the centre (sphere), at the axis (cylinder side, capsule side)
+    for shape, centre, r, gap in ((1, [0, 5, 0], 1.3, _shell_gap(Sphere(1.3))),
+                                  (3, [0, -5, 0], 0.5, _shell_gap(Cylinder(0.5, 2.0))),
+                                  (4, [-5, 0, 0], 0.5, _shell_gap(Capsule(0.5, 1.0)))):
+        c = base + centre
+        oc = o.copy()
+        if shape != 1:  # horizontal rays at the axis, within the straight part
+            oc[:, 2] = base[2] + rng.uniform(-0.45, 0.45, n)
+        d = c - oc
+        d[:, 2] = 0.0 if shape != 1 else d[:, 2]
+        L = np.linalg.norm(d, axis=1)
+        h = e.cast(oc, d / L[:, None])
+        assert np.all(h.shape == shape)
+        err = h.distance - (L - r)
+        if prec == Precision.EXACT:
+            assert np.abs(err).max() <= 1e-12
+        else:
+            # shell gap + the few-ulp inflation that keeps float32 rounding outside the surface
+            assert err.max() <= BOUND[prec] and err.min() >= -gap - 1e-5
+
+
+def _slab(o, d, lo, hi):
+    """Float64 ray/AABB entry distance (inf if missed), for many boxes at once: (n, k)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t1 = (lo[None] - o[:, None]) / d[:, None]
+        t2 = (hi[None] - o[:, None]) / d[:, None]
+    tn = np.nanmax(np.minimum(t1, t2), axis=2)
+    tf = np.nanmin(np.maximum(t1, t2), axis=2)
+    return np.where((tn <= tf) & (tn > 0), tn, np.inf)
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e6])
+@pytest.mark.parametrize("prec", BOTH)
+def test_lidar_in_room_far_from_origin(prec, offset):
+    rng = np.random.default_rng(5)
+    boxes = [((20, 20, 0.2), (0, 0, -0.1)), ((20, 20, 0.2), (0, 0, 3.1)),
+             ((0.2, 20.4, 3.4), (10.1, 0, 1.5)), ((0.2, 20.4, 3.4), (-10.1, 0, 1.5)),
+             ((20, 0.2, 3), (0, 10.1, 1.5)), ((20, 0.2, 3), (0, -10.1, 1.5))]
+    while len(boxes) < 40:  # furniture, not overlapping the lidar
+        size = rng.uniform(0.3, 1.5, 3)
+        c = np.r_[rng.uniform(-8, 8, 2), size[2] / 2 + rng.uniform(0, 1.0)]
+        if np.linalg.norm(c[:2]) > 2.0:
+            boxes.append((tuple(size), tuple(c)))
+    base = np.array([offset, offset / 2, 0.0])
+    e = RayEngine(prec)
+    for size, c in boxes:
+        e.add_body([entry(Box(size))], at(*(base + c)))
+    az = np.linspace(0, 2 * np.pi, 3600, endpoint=False) + 0.0123
+    el = np.linspace(-0.3, 0.3, 5)
+    A, E = np.meshgrid(az, el)
+    d = np.stack([np.cos(A) * np.cos(E), np.sin(A) * np.cos(E), np.sin(E)], -1).reshape(-1, 3)
+    lidar = np.array([0.31, -0.17, 1.23])
+    h = e.cast(np.tile(base + lidar, (len(d), 1)), d, kind=RayKind.VISUAL)
+    lo = np.array([np.subtract(c, np.divide(s, 2)) for s, c in boxes])
+    hi = np.array([np.add(c, np.divide(s, 2)) for s, c in boxes])
+    t_all = _slab(np.tile(lidar, (len(d), 1)), d, lo, hi)
+    ref = np.argmin(t_all, axis=1)
+    t_ref = t_all[np.arange(len(d)), ref]
+    srt = np.sort(t_all, axis=1)
+    clear = srt[:, 1] - srt[:, 0] > 1e-6  # not at a corner where two boxes meet
+    assert clear.mean() > 0.98
+    assert np.all(np.isfinite(h.distance))
+    bound = {Precision.EXACT: 1e-9, Precision.FAST: 2e-5}[prec]
+    if prec == Precision.EXACT:
+        assert np.array_equal(h.shape[clear], ref[clear])  # the right surface, every ray
+    else:
+        assert (h.shape[clear] == ref[clear]).mean() > 0.999
+    assert np.abs(h.distance - t_ref).max() <= bound
+
+
+# ---------------------------------------------------------------------------------------------
+# watertightness
+
+
+def _adversarial_rays(vertices, edges, rng, reps):
+    """Rays through vertices and edge midpoints of a convex closed mesh centred at the origin,
+    from inside (exit there) and from outside (enter there); true first-hit distance known."""
+    targets = np.vstack([vertices, vertices[edges].mean(1)])
+    scale = np.abs(vertices).max(0)
+    os, ds, ts = [], [], []
+    for _ in range(reps):
+        inner = rng.uniform(-0.4, 0.4, targets.shape) * scale
+        d = targets - inner
+        ts.append(np.linalg.norm(d, axis=1))
+        ds.append(d / ts[-1][:, None])
+        os.append(inner)
+        inner = rng.uniform(-0.4, 0.4, targets.shape) * scale  # outside: continue toward inside
+        d = _unit(inner - targets)
+        dist = rng.uniform(0.5, 3.0, len(targets)) * scale.max()
+        os.append(targets - d * dist[:, None])
+        ds.append(d)
+        ts.append(dist)
+    return np.vstack(os), np.vstack(ds), np.concatenate(ts)
+
+
+def _leaks(prec, mesh, offset, reps, rng, perturb=0.0):
+    """(leaks, rays, repairs, worst error of the non-leaking rays).  A leak = the reported hit is
+    not the true first hit (missed, or farther by more than 1e-6 relative)."""
+    e = RayEngine(prec)
+    base = np.array([offset, 0.0, 0.0])
+    e.add_body([entry(Mesh(mesh.vertices, mesh.faces, closed=bool(mesh.is_watertight)))], at(*base))
+    o, d, t = _adversarial_rays(mesh.vertices, mesh.edges_unique, rng, reps)
+    if perturb:  # aim 1e-8 (relative) beside the vertex/edge: robust traversal alone can leak there
+        target = o + d * t[:, None] + rng.normal(size=o.shape) * perturb * np.abs(mesh.vertices).max()
+        d = target - o
+        t = np.linalg.norm(d, axis=1)
+        d /= t[:, None]
+    h = e.cast(o + base, d)
+    err = np.abs(h.distance - t)
+    leaked = ~(err <= 1e-6 * (1 + t))
+    return int(leaked.sum()), len(t), e.counters["leak_repairs"], float(err[~leaked].max() / (1 + t.max()))
+
+
+WATERTIGHT_CASES = [  # name, mesh, world offset, repetitions, perturbation
+    ("icosphere", lambda: trimesh.creation.icosphere(subdivisions=3, radius=1.7), 0.0, 2, 0.0),
+    ("icosphere~1e-8", lambda: trimesh.creation.icosphere(subdivisions=3, radius=1.7), 0.0, 1, 1e-8),
+    ("box", lambda: trimesh.creation.box(extents=(1.0, 2.0, 3.0)), 0.0, 100, 0.0),
+    ("box~1e-8", lambda: trimesh.creation.box(extents=(1.0, 2.0, 3.0)), 0.0, 50, 1e-8),
+    ("icosphere@1e5", lambda: trimesh.creation.icosphere(subdivisions=2, radius=0.9), 1e5, 2, 0.0),
+]
+
+
+def test_watertight_exact_zero_leaks_fast_reported(record_property):
+    rng = np.random.default_rng(2024)
+    total = {p: [0, 0, 0] for p in BOTH}
+    for name, make, offset, reps, perturb in WATERTIGHT_CASES:
+        mesh = make()
+        assert mesh.is_watertight
+        for prec in BOTH:
+            leaks, n, repairs, worst = _leaks(prec, mesh, offset, reps, np.random.default_rng(rng.integers(1 << 30)), perturb)
+            total[prec][0] += leaks
+            total[prec][1] += n
+            total[prec][2] += repairs
+            record_property(f"{name}-{prec.value}", f"{leaks} leaks / {n} rays, {repairs} repairs, worst {worst:.1e}")
+            if prec == Precision.EXACT and not perturb:
+                # every EXACT hit is float64-accurate (plus the rounding of the offset vertices)
+                assert worst <= 1e-12 + 4 * np.spacing(offset)
+    n_rays = total[Precision.EXACT][1]
+    assert n_rays >= 10_000
+    record_property("fast_leaks", f"{total[Precision.FAST][0]} / {n_rays}")
+    record_property("exact_leaks", f"{total[Precision.EXACT][0]} / {n_rays} ({total[Precision.EXACT][2]} repaired)")
+    print(f"\nwatertightness over {n_rays} adversarial rays: FAST {total[Precision.FAST][0]} leaks, "
+          f"EXACT {total[Precision.EXACT][0]} leaks ({total[Precision.EXACT][2]} repairs)")
+    assert total[Precision.EXACT][0] == 0
+
+
+def test_leak_repair_alone_on_a_plain_bvh(monkeypatch):
+    """The offset-copy repair on its own (EXACT forced onto a non-robust BVH, which leaks ~5% of
+    these rays): it must catch at least 99% of the leaks and count them."""
+    from sensorium.server import raycast
+    plain = raycast._Tier.scene
+    monkeypatch.setattr(raycast._Tier, "scene", lambda self, robust: plain(self, False))
+    mesh = trimesh.creation.icosphere(subdivisions=3, radius=1.7)
+    fast_leaks, n, _, _ = _leaks(Precision.FAST, mesh, 0.0, 1, np.random.default_rng(4))
+    leaks, n, repairs, _ = _leaks(Precision.EXACT, mesh, 0.0, 1, np.random.default_rng(4))
+    assert fast_leaks > 100
+    assert repairs >= fast_leaks - leaks and leaks <= 0.01 * fast_leaks
+
+
+def test_watertight_sphere_primitive_exact():
+    """Rays through the circumscribed shell's vertices and edge midpoints must still find the
+    TRUE sphere (EXACT): a leak through the shell would lose the hit."""
+    sph = Sphere(1.1, 2)
+    v, f = tessellate(sph)
+    m = trimesh.Trimesh(v, f, process=False)
+    rng = np.random.default_rng(9)
+    e = RayEngine(Precision.EXACT)
+    e.add_body([entry(sph)], Pose.identity())
+    o, d, _ = _adversarial_rays(v, m.edges_unique, rng, 1)
+    h = e.cast(o, d)
+    b = (o * d).sum(1)
+    c = (o * o).sum(1) - 1.1 ** 2
+    disc = b * b - c
+    t_ref = np.where(c < 0, -b + np.sqrt(np.maximum(disc, 0)), -b - np.sqrt(np.maximum(disc, 0)))
+    t_ref = np.where(disc >= 0, t_ref, np.inf)
+    hit_ref = np.isfinite(t_ref) & (t_ref > 0)
+    assert np.array_equal(hit_ref, h.shape == 0)
+    assert np.abs(h.distance[hit_ref] - t_ref[hit_ref]).max() <= 1e-12

@@ -1,0 +1,350 @@
+"""Replay: the frames of a live server on an XPUB, rate/filters/clock/loop, lockstep, and
+``sensorium record --connect`` against a replay (0 gaps when keeping up, exact loss count when not)."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import threading
+import time
+from contextlib import contextmanager
+
+import msgpack
+import pytest
+import zmq
+from _recdata import STEP_NS, TOPICS, make_recording, published
+
+from sensorium.server.cli_recording import LiveRecorder, subscription_prefixes
+from sensorium.server.recording import McapRecorder, Recording, pack_envelope
+from sensorium.server.replay import Replayer
+
+PY = sys.executable
+ANY = "tcp://127.0.0.1:*"
+
+
+@pytest.fixture(scope="module")
+def rec_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("replay") / "rec.mcap"
+    items = make_recording(path, steps=32)  # 32 ms .. 1024 ms of simulation time
+    return path, items
+
+
+@pytest.fixture
+def ctx():
+    c = zmq.Context()
+    yield c
+    c.destroy(linger=0)
+
+
+@contextmanager
+def running(path, ctx, **kw):
+    kw.setdefault("pub", ANY)
+    kw.setdefault("rpc", ANY)
+    r = Replayer(str(path), context=ctx, **kw)
+    r.bind()
+    th = threading.Thread(target=r.run, daemon=True)
+    try:
+        yield r, th
+    finally:
+        r.stop()
+        if th.is_alive():
+            th.join(10)
+        r.close()
+
+
+def subscriber(ctx, endpoint, *prefixes):
+    s = ctx.socket(zmq.SUB)
+    s.setsockopt(zmq.LINGER, 0)
+    for p in prefixes or (b"",):
+        s.setsockopt(zmq.SUBSCRIBE, p)
+    s.connect(endpoint)
+    return s
+
+
+def drain(sock, idle=0.5, limit=100000):
+    out = []
+    while len(out) < limit and sock.poll(int(idle * 1000)):
+        out.append((time.monotonic(), sock.recv_multipart()))
+    return out
+
+
+def call(ctx, endpoint, service, args=None, rid=1):
+    s = ctx.socket(zmq.DEALER)
+    s.setsockopt(zmq.LINGER, 0)
+    s.connect(endpoint)
+    try:
+        s.send(msgpack.packb({"id": rid, "service": service, "args": args or {}}))
+        assert s.poll(5000), f"no reply to {service}"
+        return msgpack.unpackb(s.recv())
+    finally:
+        s.close()
+
+
+def frames_of(items):
+    return [[i[0].encode() + b"\0", i[2], i[3]] for i in items]
+
+
+def test_frames_identical_to_the_live_server(rec_path, ctx):
+    path, items = rec_path
+    with running(path, ctx, rate=0, wait_subscriber=True) as (r, th):
+        sub = subscriber(ctx, r.pub_endpoint)
+        th.start()
+        got = [f for _t, f in drain(sub)]
+    assert got == frames_of(items)
+    assert r.emitted == len(items)
+
+
+def test_rate_scaling(rec_path, ctx):
+    path, items = rec_path
+    span = (items[-1][4] - items[0][4]) / 1e9  # 0.992 s
+    for rate in (4.0, 1.5):
+        with running(path, ctx, rate=rate, wait_subscriber=True, topics=["/epuck/ls0"]) as (r, th):
+            sub = subscriber(ctx, r.pub_endpoint)
+            th.start()
+            got = drain(sub, idle=1.0)
+        assert len(got) == 32
+        elapsed = got[-1][0] - got[0][0]
+        assert span / rate * 0.8 < elapsed < span / rate * 1.5 + 0.1, (rate, elapsed)
+        # spacing is kept: the middle message comes about half way
+        mid = got[16][0] - got[0][0]
+        assert abs(mid - elapsed * 16 / 31) < 0.15
+
+
+def test_start_end_topics_filters(rec_path, ctx):
+    path, items = rec_path
+    with running(path, ctx, rate=0, wait_subscriber=True, topics=["/epuck", "/scout/lidar/point_*"],
+                 start_s=0.32, end_s=0.64) as (r, th):
+        sub = subscriber(ctx, r.pub_endpoint)
+        th.start()
+        got = [f for _t, f in drain(sub)]
+    want = [i for i in items if (i[0].startswith("/epuck/") or i[0] == "/scout/lidar/point_cloud")
+            and 320_000_000 <= i[4] <= 640_000_000]
+    assert got == frames_of(want) and want
+
+
+def test_clock_replaces_the_recorded_clock(rec_path, ctx):
+    path, items = rec_path
+    with running(path, ctx, rate=0, wait_subscriber=True, clock_hz=40.0, topics=["/epuck/ps0", "/clock"]) as (r, th):
+        sub = subscriber(ctx, r.pub_endpoint)
+        th.start()
+        got = [f for _t, f in drain(sub)]
+    clocks = [f for f in got if f[0] == b"/clock\0"]
+    others = [f for f in got if f[0] != b"/clock\0"]
+    assert others == frames_of([i for i in items if i[0] == "/epuck/ps0/value"])
+    # one /clock before each new stamp, our own sequence, recorded /clock not replayed
+    assert len(clocks) == 32
+    for k, (_t, env, body) in enumerate(clocks):
+        e, b = msgpack.unpackb(env), msgpack.unpackb(body)
+        assert e == {"type": "rosgraph_msgs/msg/Clock", "seq": k, "stamp_ns": (k + 1) * STEP_NS}
+        assert b == {"clock": {"sec": 0 if k < 31 else 1, "nanosec": ((k + 1) * STEP_NS) % 1_000_000_000}}
+    assert got.index(clocks[0]) < got.index(others[0])
+
+
+def test_loop_and_quit(rec_path, ctx):
+    path, items = rec_path
+    n = sum(1 for i in items if i[0] == "/epuck/ls0/value")
+    with running(path, ctx, rate=0, loop=True, wait_subscriber=True, topics=["/epuck/ls0"]) as (r, th):
+        sub = subscriber(ctx, r.pub_endpoint)
+        th.start()
+        got = drain(sub, idle=0.5, limit=3 * n)
+        assert call(ctx, r.rpc_endpoint, "/replay/quit")["ok"]
+        th.join(5)
+        assert not th.is_alive()
+    seqs = [msgpack.unpackb(f[1])["seq"] for _t, f in got]
+    assert seqs == list(range(n)) * 3
+
+
+def test_free_running_services(rec_path, ctx):
+    path, items = rec_path
+    with running(path, ctx, rate=1.0, wait_subscriber=True, topics=["/epuck/ls0"]) as (r, th):
+        sub = subscriber(ctx, r.pub_endpoint)
+        th.start()
+        info = call(ctx, r.rpc_endpoint, "get_info")["result"]
+        assert info["mode"] == "replay" and info["pub_endpoint"] == r.pub_endpoint
+        assert info["basic_time_step"] == 32 and info["topics"] == [{"name": "/epuck/ls0/value",
+                                                                     "type": "sensor_msgs/msg/Illuminance"}]
+        paused = call(ctx, r.rpc_endpoint, "/replay/pause")["result"]
+        assert paused["paused"] is True
+        before = drain(sub, idle=0.1)
+        assert not sub.poll(300)  # nothing while paused
+        state = call(ctx, r.rpc_endpoint, "/replay/set_rate", {"value": 0})["result"]
+        assert state["rate"] == 0 and state["time_ms"] == paused["time_ms"]
+        err = call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 32})
+        assert err["ok"] is False and err["error"]["code"] == 10  # WRONG_STATE
+        bad = call(ctx, r.rpc_endpoint, "/replay/set_rate", {"value": -1})
+        assert bad["error"]["code"] == 5
+        assert call(ctx, r.rpc_endpoint, "nope")["error"]["code"] == 2
+        call(ctx, r.rpc_endpoint, "/replay/resume")  # the rest as fast as possible, then the replay ends
+        rest = drain(sub, idle=0.5)
+        th.join(5)
+        assert not th.is_alive() and r.done
+    seqs = [msgpack.unpackb(f[1])["seq"] for _t, f in before + rest]
+    assert seqs == list(range(32))
+
+
+def test_lockstep(rec_path, ctx):
+    path, items = rec_path
+    with running(path, ctx, lockstep=True) as (r, th):
+        sub = subscriber(ctx, r.pub_endpoint)
+        th.start()
+        deadline = time.monotonic() + 5
+        while not call(ctx, r.rpc_endpoint, "/replay/get_state")["result"]["subscriptions"]:
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        assert not sub.poll(200)  # nothing moves until a step
+        info = call(ctx, r.rpc_endpoint, "get_info")["result"]
+        assert info["mode"] == "lockstep" and "/replay/step" in info["services"]
+        t = 0
+        received = []
+        for duration in (32, 64, 96, 320, 1000):
+            reply = call(ctx, r.rpc_endpoint, "/replay/step", {"duration": duration})
+            assert reply["ok"], reply
+            t += duration
+            res = reply["result"]
+            want = [i for i in items if t - duration < i[4] / 1e6 <= t]
+            assert res["time_ms"] == t and res["emitted"] == len(want) and res["status"] == 0
+            got = [sub.recv_multipart() for _ in want] if want else []
+            assert got == frames_of(want)
+            received += got
+            assert not sub.poll(50)  # nothing beyond the step's end
+        assert res["done"] is True and received == frames_of(items)
+        # seek back and step again; default duration is the recording's basic time step
+        assert call(ctx, r.rpc_endpoint, "/replay/seek", {"time_ms": 320})["ok"]
+        res = call(ctx, r.rpc_endpoint, "/replay/step")["result"]
+        want = [i for i in items if i[4] == 352_000_000]
+        assert res["time_ms"] == 352 and [sub.recv_multipart() for _ in want] == frames_of(want)
+        assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 0})["error"]["code"] == 5
+
+
+def test_cli_replay_announces_and_finishes(rec_path, ctx):
+    path, items = rec_path
+    proc = subprocess.Popen([PY, "-m", "sensorium.cli", "replay", str(path), "--pub", ANY, "--rpc", ANY,
+                             "--rate", "0", "--wait", "--topics", "/epuck/ps1", "--progress"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()
+        assert line.startswith(f"sensorium: replaying {path} pub=tcp://127.0.0.1:"), line
+        pub = line.split("pub=")[1].split()[0]
+        rpc = line.split("rpc=")[1].split()[0]
+        assert call(ctx, rpc, "get_info")["result"]["pub_endpoint"] == pub
+        sub = subscriber(ctx, pub)
+        got = [f for _t, f in drain(sub)]
+        proc.wait(10)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0
+    assert got == frames_of([i for i in items if i[0] == "/epuck/ps1/value"])
+    err = proc.stderr.read()
+    assert "replay" in err and "100.0%" in err and "replay finished: 16 messages" in err
+
+
+# ---------------------------------------------------------------- record --connect
+
+
+def test_subscription_prefixes():
+    assert subscription_prefixes(None) == [b""]
+    assert subscription_prefixes(["/epuck/ps1"]) == [b"/epuck/ps1\0", b"/epuck/ps1/"]
+    assert subscription_prefixes(["/epuck/"]) == [b"/epuck/"]
+    assert subscription_prefixes(["/epuck/ps*"]) == [b"/epuck/ps"]
+
+
+def test_record_connect_keeps_up_zero_gaps(rec_path, ctx, tmp_path):
+    path, items = rec_path
+    out = tmp_path / "sub.mcap"
+    with running(path, ctx, rate=4.0, wait_subscriber=True) as (r, th):
+        th.start()  # serves get_info, waits for the first subscription
+        live = LiveRecorder(out, connect=r.rpc_endpoint, context=ctx)
+        live.open()
+        assert live.pub_endpoint == r.pub_endpoint
+        live.run(duration=10, max_messages=len(items))
+        summary = live.close()
+    assert summary["received"] == len(items) and summary["gaps"] == 0 and summary["lost"] == 0
+    with Recording(out) as rec:
+        got = [(m.topic, m.ros_type, m.seq, m.stamp_ns, m.data) for m in rec.messages()]
+        meta = rec.metadata()
+    assert got == [(i[0], i[1], i[5], i[4], i[3]) for i in items]  # the same bytes as the server's
+    assert meta["record"]["gaps"] == "0" and meta["session"]["mode"] == "subscriber"
+    assert meta["sensorium"]["basic_time_step_ms"] == "32"
+
+
+def _burst_recording(path, n=300, size=64 * 1024):
+    """n big messages 1 ms apart, then one more 400 ms later (so the last one is never dropped)."""
+    body = msgpack.packb({"data": b"\x01" * size})
+    with McapRecorder(path, chunk_size=1 << 20) as rec:
+        for k in range(n + 1):
+            t = (k + 1) * 1_000_000 + (400_000_000 if k == n else 0)
+            rec.record("/big/blob/data", "std_msgs/msg/ByteMultiArray",
+                       pack_envelope("std_msgs/msg/ByteMultiArray", k, t), body, t, k)
+    return n + 1
+
+
+def test_record_connect_counts_exactly_what_it_lost(ctx, tmp_path):
+    src = tmp_path / "burst.mcap"
+    total = _burst_recording(src)
+    out = tmp_path / "lossy.mcap"
+    with running(src, ctx, rate=1.0, wait_subscriber=True, sndhwm=2) as (r, th):
+        th.start()
+        live = LiveRecorder(out, connect=r.rpc_endpoint, rcvhwm=2, context=ctx,
+                            on_message=lambda topic, seq: time.sleep(0.004) if seq < total - 1 else None,
+                            log=lambda text: None)
+        live.open()
+        last = {}
+
+        def watch(topic, seq, _slow=live.on_message):
+            last["seq"] = seq
+            _slow(topic, seq)
+            if seq == total - 1:
+                live.stop()
+
+        live.on_message = watch
+        live.run(duration=15)
+        summary = live.close()
+    assert last["seq"] == total - 1  # first and last arrive; everything between is accounted for
+    with Recording(out) as rec:
+        seqs = [m.seq for m in rec.messages()]
+    assert seqs[0] == 0 and seqs[-1] == total - 1
+    assert summary["received"] == len(seqs)
+    assert summary["lost"] == total - len(seqs) > 0
+    assert summary["gaps"] == sum(1 for a, b in zip(seqs, seqs[1:]) if b > a + 1)
+    assert summary["lost_by_topic"] == {"/big/blob/data": total - len(seqs)}
+
+
+def test_cli_record_sigint_finishes_and_reports(rec_path, ctx, tmp_path):
+    path, items = rec_path
+    out = tmp_path / "cli.mcap"
+    with running(path, ctx, rate=0, wait_subscriber=True) as (r, th):
+        th.start()
+        proc = subprocess.Popen([PY, "-m", "sensorium.cli", "record", str(out), "--connect", r.rpc_endpoint,
+                                 "--topics", "/epuck", "/scout/lidar/laser_scan"],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            line = proc.stdout.readline()
+            assert line.startswith(f"sensorium: recording {out} from pub={r.pub_endpoint}"), (line, proc.stderr.read())
+            th.join(10)
+            want = [i for i in items if i[0].startswith("/epuck/") or i[0] == "/scout/lidar/laser_scan"]
+            deadline = time.monotonic() + 10
+            while time.monotonic() < deadline:  # the file is flushed at least once a second
+                time.sleep(0.2)
+                try:
+                    with Recording(out) as rec:
+                        if sum(1 for _ in rec.messages()) == len(want):
+                            break
+                except Exception:
+                    pass
+            proc.send_signal(signal.SIGINT)
+            stdout, stderr = proc.communicate(timeout=10)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+    assert proc.returncode == 0, stderr
+    assert f"recorded {len(want)} messages on 4 topics" in stdout and "0 gaps, 0 messages lost" in stdout
+    with Recording(out) as rec:
+        assert not rec.truncated
+        assert [m.data for m in rec.messages()] == [i[3] for i in want]
+
+
+def test_published_helper_is_deterministic():
+    assert list(published(5)) == list(published(5))
+    assert set(TOPICS) >= {t for t, *_ in published(4)}
