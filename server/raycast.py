@@ -251,7 +251,7 @@ class _Tier:
             faces.append(f + nv)
             tri_shape.append(np.full(len(f), sid, dtype=np.int64))
             if isinstance(prim, (Sphere, Cylinder, Capsule)):
-                curved.append((sid, prim, pose, len(verts) - 1))
+                curved.append((sid, prim, pose, len(verts) - 1, v))
             nv += len(v)
         self.empty = nv == 0
         if self.empty:
@@ -265,18 +265,23 @@ class _Tier:
         self.anchor = centre if self.anchored else np.zeros(3)
         self.res = _ulp32(half + float(np.linalg.norm(self.anchor - centre)))
         self.eps = max(1e-6, 8.0 * self.res)
-        # inflate curved shells by a few float32 ulps so rounding cannot cut into the true surface
+        # Inflate curved shells by a = 4 float32 ulps so rounding cannot cut into the true
+        # surface.  Scaling the shape frame by (1 + a/r) radially and (1 + a/half-length) along z
+        # maps the true shape onto a superset of the true shape grown by a (checked for sphere,
+        # cylinder and capsule), so the scaled shell still circumscribes with a margin >= a.
+        a = 4.0 * self.res
         c_code, c_r, c_h, c_rot, c_pos, c_shape, c_bound = [], [], [], [], [], [], []
-        for sid, prim, pose, k in curved:
+        for sid, prim, pose, k, v_local in curved:
             if isinstance(prim, Sphere):
-                code, r, h, inner = _SPHERE, prim.radius, 0.0, prim.radius
+                code, r, h, axial = _SPHERE, prim.radius, 0.0, prim.radius
             elif isinstance(prim, Cylinder):
                 code, r, h = _CYLINDER, prim.radius, prim.height / 2.0
-                inner = min(r, h)
+                axial = h
             else:
-                code, r, h, inner = _CAPSULE, prim.radius, prim.height / 2.0, prim.radius
+                code, r, h = _CAPSULE, prim.radius, prim.height / 2.0
+                axial = h + r
+            verts[k] = pose.apply(v_local * np.array([1.0 + a / r, 1.0 + a / r, 1.0 + a / axial]))
             centre = pose.translation
-            verts[k] = centre + (verts[k] - centre) * (1.0 + 4.0 * self.res / inner)
             c_code.append(code)
             c_r.append(r)
             c_h.append(h)
@@ -653,6 +658,13 @@ class RayEngine:
         else:
             o32 = O.astype(_F32)
         d32 = D.astype(_F32)
+        pre = None
+        if tier.has_curved:  # origins inside a curved shell: analytic first (see the pre-pass)
+            pre = (np.full(m, _INF), np.full(m, -1, dtype=np.int64), np.zeros((m, 3)))
+            if self._contained_prepass(tier, O - tier.anchor, D, np.maximum(t_near, ctx.eps64), lim, excl, *pre):
+                lim = np.minimum(lim, pre[0])
+            else:
+                pre = None
         start = t_near
         dead = None
         if len(o32) and max(-float(o32.min()), float(o32.max())) * 1.7321 > tier.radius:
@@ -712,6 +724,14 @@ class RayEngine:
             special |= back & np.take(tier.tri_curved, prim)
         if tier.owned and not (np.isscalar(excl) and excl < 0):
             special |= np.take(tier.tri_owner, prim) == excl
+        if pre is not None:  # analytic hits of the pre-pass (normals oriented below)
+            take = np.flatnonzero(pre[0] <= t)
+            t[take], shape[take] = pre[0][take], pre[1][take]
+            nrm = pre[2][take]
+            flip = _dot(nrm, D[take]) > 0.0
+            nrm[flip] *= -1.0
+            normal[take] = nrm
+            special[take] = False
         rows = np.flatnonzero(special)
         if len(rows):
             t2, s2, n2 = self._trace_loop(tier, ctx, O[rows], D[rows], _take(t_near, rows), _take(lim, rows),
@@ -738,8 +758,7 @@ class RayEngine:
         seg = np.maximum(np.maximum(eps, np.asarray(t_near) - eps), -b - half)
         alive = (q2 <= tier.radius ** 2) & (-b + half >= lo) & (seg <= lim + eps)
 
-        if exact and tier.has_curved and not tier.c_isolated.all():
-            self._contained_prepass(tier, Ot, D, lo, lim, excl_arr, best_t, best_s, best_n)
+        if self._contained_prepass(tier, Ot, D, lo, lim, excl_arr, best_t, best_s, best_n):
             np.minimum(lim, best_t, out=lim)
 
         act = np.flatnonzero(alive)
@@ -891,20 +910,31 @@ class RayEngine:
                 t[g], n_loc[g] = _analytic_local(code, p[g], d[g], tier.c_r[s], tier.c_h[s], lo[g], hi[g])
         return t, np.einsum("nij,nj->ni", R, n_loc)
 
-    def _contained_prepass(self, tier: _Tier, Ot, D, lo, lim, excl, best_t, best_s, best_n) -> None:
-        """EXACT: rays starting inside the shell of a non-isolated curved shape may reach its true
-        surface before any Embree-visible crossing of that shell; test those pairs analytically."""
-        start = Ot + lo[:, None] * D
-        for slot in np.flatnonzero(~tier.c_isolated):
+    def _contained_prepass(self, tier: _Tier, Ot, D, lo, lim, excl, best_t, best_s, best_n) -> bool:
+        """Rays starting inside a curved shell may reach the true surface before any crossing of
+        that shell that the cast will see (the exit can lie beyond t_far or a nearer hit found
+        elsewhere), so those (ray, shape) pairs are intersected analytically up front.  Only
+        shells overlapping the bounding box of all start points are tested.  True if any hit."""
+        if not tier.has_curved:
+            return False
+        start = Ot + np.asarray(lo, dtype=np.float64).reshape(-1, 1) * D
+        box_lo = np.array([start[:, k].min() for k in range(3)])
+        box_hi = np.array([start[:, k].max() for k in range(3)])
+        nearest = np.clip(tier.c_pos, box_lo, box_hi)
+        found = False
+        for slot in np.flatnonzero(((tier.c_pos - nearest) ** 2).sum(1) <= tier.c_bound ** 2):
             rel = start - tier.c_pos[slot]
             rows = np.flatnonzero(_dot(rel, rel) <= tier.c_bound[slot] ** 2)
             owner = tier.c_owner[slot]
             if owner >= 0 and len(rows):
-                rows = rows[excl[rows] != owner]
+                rows = rows[np.broadcast_to(excl, (len(Ot),))[rows] != owner]
             if len(rows) == 0:
                 continue
-            slots = np.full(len(rows), slot)
-            ta, na = self._analytic(tier, slots, Ot[rows], D[rows], lo[rows], lim[rows])
+            lo_r = np.broadcast_to(lo, (len(Ot),))[rows]
+            hi_r = np.broadcast_to(lim, (len(Ot),))[rows]
+            ta, na = self._analytic(tier, np.full(len(rows), slot), Ot[rows], D[rows], lo_r, hi_r)
             better = ta < best_t[rows]
             r = rows[better]
             best_t[r], best_s[r], best_n[r] = ta[better], tier.c_shape[slot], na[better]
+            found |= bool(better.any())
+        return found

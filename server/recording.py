@@ -40,7 +40,6 @@ from mcap.exceptions import McapError
 from mcap.reader import SeekingReader
 from mcap.records import (
     Attachment,
-    AttachmentIndex,
     Channel,
     Chunk,
     DataEnd,
@@ -220,8 +219,10 @@ class McapRecorder:
                 data = world_text.encode() if isinstance(world_text, str) else bytes(world_text)
                 self._writer.add_attachment(create_time=0, log_time=0, name=world_name or "world",
                                             media_type=_media_type(world_name or ""), data=data)
-            meta = {"version": _version(), "format": "1", "log_time": "simulation time in ns since the simulation started",
-                    "message_encoding": MESSAGE_ENCODING, "envelope": "msgpack {type: schema name, seq: sequence, stamp_ns: log_time}"}
+            meta = {"version": _version(), "format": "1",
+                    "log_time": "simulation time in ns since the simulation started",
+                    "message_encoding": MESSAGE_ENCODING,
+                    "envelope": "msgpack {type: schema name, seq: sequence, stamp_ns: log_time}"}
             if world_name:
                 meta["world_file"] = world_name
             meta.update({str(k): str(v) for k, v in (metadata or {}).items()})

@@ -240,7 +240,13 @@ class Core:
         done = self.lockstep.advanced(now)
         if self.sim.time_ms != self.lockstep.time_ms:
             raise RuntimeError(f"clock mismatch: simulation {self.sim.time_ms} ms, lockstep {self.lockstep.time_ms} ms")
-        pubs = self.topics.publish(self.sim.time_ms)
+        try:
+            pubs = self.topics.publish(self.sim.time_ms)
+        except Exception as exc:  # noqa: BLE001 - a publishing bug must not stop the lockstep
+            self.errors += 1
+            if self.errors <= 10:
+                self.log(f"internal error while publishing: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
+            pubs = []
         return [self._step_reply(d) for d in done], pubs
 
     def expire(self, now: float) -> None:

@@ -36,6 +36,12 @@ pose_st = st.builds(lambda t, a, ang: (t, a, ang),
                     fl(0, 2 * math.pi))
 scene_st = st.lists(st.tuples(shape_st, pose_st), min_size=1, max_size=5)
 offset_st = st.sampled_from([0.0, 1e3, 1e6])
+small_shape_st = st.one_of(
+    st.builds(lambda s: Box(s), st.tuples(fl(0.1, 3), fl(0.1, 3), fl(0.1, 3))),
+    st.builds(lambda r, k: Sphere(r, k), fl(0.1, 2), st.integers(0, 2)),
+    st.builds(lambda r, h, k: Cylinder(r, h, k), fl(0.1, 2), fl(0.1, 3), st.integers(6, 24)),
+)
+small_scene_st = st.lists(st.tuples(small_shape_st, pose_st), min_size=1, max_size=4)
 
 
 def _build(scene, offset, prec):
@@ -141,7 +147,8 @@ def _analytic_reference(scene, poses, o, d, t_min):
     rows = np.arange(len(o))
     t0, t1 = T[rows, order[:, 0]], T[rows, order[:, 1]]
     shape = np.where(np.isfinite(t0), S[rows, order[:, 0]], -1)
-    margin = np.where(np.isfinite(t0), np.minimum(M[rows, order[:, 0]], t1 - t0), np.inf)
+    with np.errstate(invalid="ignore"):
+        margin = np.where(np.isfinite(t0), np.minimum(M[rows, order[:, 0]], t1 - t0), np.inf)
     # a near-miss (tangent / just beside an edge) is ill-conditioned too
     near = np.min(np.where(np.isinf(T), M, np.inf), axis=1)
     return t0, shape, np.minimum(margin, near)
@@ -170,7 +177,7 @@ def _triangle_reference(scene, poses, o, d, t_min):
     best_s = np.full(len(o), -1)
     margin = np.full(len(o), np.inf)
     cos = np.ones(len(o))
-    all_t = []
+    per_shape = []
     for k, ((prim, _), pose) in enumerate(zip(scene, poses)):
         v, f = tessellate(prim)
         tri = pose.apply(v)[f]
@@ -187,9 +194,9 @@ def _triangle_reference(scene, poses, o, d, t_min):
             t = (e2[None] * q).sum(2) / det
         inside = (u >= 0) & (w >= 0) & (u + w <= 1) & (t >= t_min)
         tt = np.where(inside, t, np.inf)
-        all_t.append(tt)
         j = np.argmin(tt, axis=1)
         tk = tt[np.arange(len(o)), j]
+        per_shape.append(tk)
         bary = np.minimum(np.minimum(u, w), 1 - u - w)[np.arange(len(o)), j]
         edge = bary * np.minimum(np.linalg.norm(e1, axis=1), np.linalg.norm(e2, axis=1))[j]
         # near misses of any triangle of this shape also make the answer fragile
@@ -200,11 +207,10 @@ def _triangle_reference(scene, poses, o, d, t_min):
         margin = np.where(better, edge, margin)
         cos = np.where(better, np.abs((n[j] * d).sum(1)), cos)
         margin = np.minimum(margin, near * 0.1)
-    T = np.concatenate(all_t, axis=1)
-    T.sort(axis=1)
-    # same-shape neighbours sharing the hit edge give the same t: compare distinct surfaces only
-    second = np.where(T[:, 1] - T[:, 0] > 1e-9, T[:, 1], T[:, 2] if T.shape[1] > 2 else np.inf)
-    margin = np.minimum(margin, second - best_t)
+    # another shape's surface just as near (coincident or touching shapes) is ambiguous
+    T = np.sort(np.stack(per_shape + [np.full(len(o), np.inf)], axis=1), axis=1)
+    with np.errstate(invalid="ignore"):
+        margin = np.where(np.isfinite(best_t), np.minimum(margin, T[:, 1] - T[:, 0]), margin)
     return best_t, best_s, margin, cos
 
 
@@ -219,7 +225,7 @@ def _outside_shells(scene, poses, o):
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(scene=scene_st, offset=offset_st, seed=st.integers(0, 2 ** 32 - 1))
+@given(scene=small_scene_st, offset=offset_st, seed=st.integers(0, 2 ** 32 - 1))
 def test_fast_matches_tessellation_within_float32_bound(scene, offset, seed):
     e, poses = _build(scene, offset, Precision.FAST)
     o, d = _rays(seed, scene, poses, offset)

@@ -4,6 +4,7 @@ PROTOCOL.md alone (no sensorium client code)."""
 from __future__ import annotations
 
 import itertools
+import math
 import os
 import select
 import signal
@@ -13,6 +14,7 @@ import time
 from pathlib import Path
 
 import msgpack
+import numpy as np
 import pytest
 import zmq
 
@@ -343,13 +345,9 @@ def test_subscriber_gets_every_topic_type(client, ctx, server):
     img = got["/bot/lidar2/range_image"][-1][1]
     assert (img["height"], img["width"], img["step"], img["encoding"], len(img["data"])) == (2, 8, 32, "32FC1", 64)
     scan = got["/bot/lidar/laser_scan"][-1][1]
-    import math
-
     assert scan["angle_increment"] == pytest.approx(-3.14159 / 16)
     assert scan["angle_min"] == pytest.approx(3.14159 / 2 - 3.14159 / 32)
     assert scan["angle_max"] == pytest.approx(-scan["angle_min"])
-    import numpy as np
-
     ranges = np.frombuffer(scan["ranges"], "<f4")
     assert len(ranges) == 16 and scan["intensities"] == b""
     ahead = ranges[7:9]                                          # the two columns around straight ahead
