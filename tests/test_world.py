@@ -257,3 +257,13 @@ def test_cli_info_default_world() -> None:
     assert "epuck" in res.stdout and "scout" in res.stdout
     data = json.loads(_cli("info", "--json").stdout)
     assert data["triangles"] > 0 and len(data["lights"]) == 3
+
+
+def test_names_that_would_break_topic_paths_rejected() -> None:
+    probs = _problems({"robots": [{"name": "a/b"}, {"name": "c", "devices": [{"device": "LightSensor", "name": "robot"},
+                                                                           {"device": "LightSensor", "name": "x\0y"}]}]})
+    assert probs == [
+        ("robots[0].name", "name 'a/b' must not contain '/' or NUL (names are used in topic paths)"),
+        ("robots[1].devices[0].name", "name 'robot' is reserved (robot-level services live under /<robot>/robot/)"),
+        ("robots[1].devices[1].name", "name 'x\\x00y' must not contain '/' or NUL (names are used in topic paths)"),
+    ]

@@ -149,6 +149,17 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
             else:
                 first[name] = path
 
+    def name_ok(path: str, name: str, reserved: tuple[str, ...] = ()) -> None:
+        # names become topic and service paths (/<robot>/<device>/value)
+        if "/" in name or "\0" in name:
+            problems.append(Problem(path, f"name {name!r} must not contain '/' or NUL (names are used in topic paths)"))
+        elif name in reserved:
+            problems.append(Problem(path, f"name {name!r} is reserved (robot-level services live under /<robot>/robot/)"))
+
+    for i, r in enumerate(world.robots):
+        name_ok(f"robots[{i}].name", r.name)
+        for d_i, d in enumerate(r.devices):
+            name_ok(f"robots[{i}].devices[{d_i}].name", d.name, ("robot",))
     unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
     unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
     unique([(f"lights[{i}].name", lt.name) for i, lt in enumerate(world.lights)], "light")
