@@ -152,6 +152,16 @@ def _schemas_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--check", action="store_true", help="write nothing; exit 1 if the files in DIR are out of date")
 
 
+@command("demo", "run the server, two example controllers and a recording on the default world",
+         "sensorium.server.demo:main")
+def _demo_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("world", nargs="?", help="world file (default: the embedded arena world)")
+    p.add_argument("--duration", type=float, default=60.0, metavar="S", help="simulated seconds (default 60)")
+    p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go")
+    p.add_argument("--precision", choices=["fast", "exact"], default="exact")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sensorium", description="Headless sensor simulator with Webots device semantics.")
     from sensorium import __version__

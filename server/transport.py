@@ -46,8 +46,10 @@ class Transport:
 
     def __init__(self, core: Core, rpc: str = DEFAULT_RPC, pub: str = DEFAULT_PUB, *,
                  hard_limit: int = HARD_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
-                 context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic):
+                 context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic,
+                 stop_at_ms: int | None = None):
         self.core = core
+        self.stop_at_ms = stop_at_ms          # quit (steps answer -1) once simulated time reaches it
         self.clock = clock
         self.grace_s = grace_s
         self._own_context = context is None
@@ -170,6 +172,9 @@ class Transport:
             for frames in pubs:
                 self.xpub.send_multipart(frames, copy=False)
             self._send_replies(replies)
+            if self.stop_at_ms is not None and core.sim.time_ms >= self.stop_at_ms:
+                self.stop()
+                return
             if self.clock() - start > STEP_BUDGET_S:
                 return                                  # let the sockets be served
 

@@ -1,0 +1,1 @@
+"""Example Webots-style controllers (run with `sensorium controller`)."""
