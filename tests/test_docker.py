@@ -1,0 +1,73 @@
+"""docker/: no Docker engine here, so run the compose services' exact commands and environment
+variables as plain processes on loopback (hosts and ports rewritten, nothing else)."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+COMPOSE = yaml.safe_load((ROOT / "docker" / "compose.yaml").read_text())
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _localise(arg: str, ports: dict[str, int]) -> str:
+    for port, local in ports.items():
+        arg = arg.replace(f"0.0.0.0:{port}", f"127.0.0.1:{local}").replace(f"server:{port}", f"127.0.0.1:{local}")
+    return arg.replace("/app/", f"{ROOT}/")
+
+
+def test_dockerfile_copies_what_exists() -> None:
+    text = (ROOT / "docker" / "Dockerfile").read_text()
+    for src in re.findall(r"^COPY (.+) \S+$", text, flags=re.M):
+        for part in src.split():
+            assert (ROOT / part).exists(), part
+    assert 'ENTRYPOINT ["sensorium"]' in text
+
+
+def test_compose_services_run_as_processes(tmp_path: Path) -> None:
+    (tmp_path / "recordings").mkdir()
+    services = COMPOSE["services"]
+    assert set(services) == {"server", "braitenberg", "wanderer", "recorder"}
+    ports = {"5560": _free_port(), "5561": _free_port()}
+    cli = [sys.executable, "-m", "sensorium.cli"]
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    server_cmd = [_localise(a, ports) for a in services["server"]["command"]] + ["--until", "1500"]
+    server = subprocess.Popen(cli + server_cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    procs = []
+    try:
+        assert "serving world" in server.stdout.readline()
+        for name in ("braitenberg", "wanderer", "recorder"):
+            svc = services[name]
+            penv = dict(env, **{k: _localise(v, ports) for k, v in svc.get("environment", {}).items()})
+            procs.append((name, subprocess.Popen(cli + [_localise(a, ports) for a in svc["command"]], cwd=tmp_path,
+                                                 env=penv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)))
+        assert server.wait(timeout=60) == 0, server.stderr.read()
+        for name, p in procs:
+            if name == "recorder":
+                time.sleep(0.5)
+                p.send_signal(signal.SIGINT)
+            out = p.communicate(timeout=60)[0]
+            assert p.returncode == 0, f"{name}: {out}"
+    finally:
+        for p in [server, *(p for _, p in procs)]:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+    from sensorium.server.recording import summarize
+
+    summary = summarize(tmp_path / "recordings" / "run.mcap")
+    assert summary["messages"] > 0 and not summary["truncated"]
