@@ -70,7 +70,7 @@ def main(args: argparse.Namespace) -> int:
     if getattr(args, "record", None):                # recording (server/recording.py)
         from sensorium.server.recording import recorder_for_server
         try:
-            recorder = recorder_for_server(args.record, core, args.topics)
+            recorder = recorder_for_server(args.record, core, getattr(args, "topics", None))
         except OSError as exc:
             transport.close()
             print(f"sensorium serve: cannot record: {exc}", file=sys.stderr)

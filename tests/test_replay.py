@@ -109,7 +109,7 @@ def test_rate_scaling(rec_path, ctx):
             got = drain(sub, idle=1.0, limit=32)
         assert len(got) == 32
         elapsed = got[-1][0] - got[0][0]
-        assert span / rate * 0.8 < elapsed < span / rate * 1.5 + 0.1, (rate, elapsed)
+        assert span / rate * 0.6 < elapsed < span / rate * 2 + 0.2, (rate, elapsed)
         # spacing is kept: the middle message comes about half way
         mid = got[16][0] - got[0][0]
         assert abs(mid - elapsed * 16 / 31) < 0.15
