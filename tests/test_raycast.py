@@ -191,9 +191,8 @@ def test_planes_bounding_infinite_two_sided_visual_one_sided_finite(prec):
     for kind in (RayKind.BOUNDING, RayKind.VISUAL):
         # from the +z side, inside the finite size: both kinds hit
         t, n, s = ray(e, (0, 0, 0), (0, 0, -1), kind=kind)
-        t_ref = 1.0 / nz[2] * nz[2]  # plane through (0,0,-1): hit where n.(x - p) = 0
-        t_ref = np.dot(nz, [0, 0, -1]) / np.dot(nz, [0, 0, -1])
-        assert s == 0 and abs(t - t_ref) <= EXACT_TOL and np.allclose(n, nz, atol=1e-12)
+        # the plane passes through (0, 0, -1), which is on the ray: t = 1 whatever the tilt
+        assert s == 0 and abs(t - 1.0) <= EXACT_TOL and np.allclose(n, nz, atol=1e-12)
     # outside the finite size: BOUNDING ignores the size (ODE), VISUAL misses
     o, d = np.array([5.0, 0.0, 0.0]), np.array([0.0, 0.0, -1.0])
     t_ref = np.dot(nz, [0, 0, -1] - o) / np.dot(nz, d)
@@ -504,3 +503,40 @@ def test_normals_face_the_origin_and_are_unit(prec):
     assert np.allclose(np.linalg.norm(h.normal[hit], axis=1), 1.0, atol=1e-12)
     assert np.all((h.normal[hit] * d[hit]).sum(1) <= 1e-12)
     assert np.all(h.normal[~hit] == 0) and np.all(np.isinf(h.distance[~hit]))
+
+
+@pytest.mark.parametrize("prec", BOTH)
+@pytest.mark.parametrize("movable", [False, True])
+def test_origin_in_shell_gap_heading_inward_with_short_range(prec, movable):
+    """Regression: an origin between the circumscribed shell and the true surface, aimed into the
+    shape, must hit the true surface even when t_far (or a nearer hit elsewhere) ends the cast
+    before the shell's far side."""
+    cyl = Cylinder(1.875, 2.0, 8)  # coarse: the shell reaches ~8 % outside the surface
+    e = RayEngine(prec)
+    e.add_body([entry(cyl)], I, movable=movable)
+    e.add_body([entry(Box((0.2, 4, 4)))], at(-1.5, 0, 0))  # inside the cylinder, face x = -1.4
+    # toward a shell vertex (angle 0) the shell reaches r / cos(pi/8) = 1.08 r: rho = 1.03 r is
+    # in the gap, outside the true surface but inside the shell
+    o = np.array([[1.875 * 1.03, 0.0, 0.3]])
+    d = -o / np.linalg.norm(o)
+    d[0, 2] = 0.0
+    d /= np.linalg.norm(d)
+    rho = float(np.hypot(o[0, 0], o[0, 1]))
+    for t_far in (np.inf, 0.5):
+        h = e.cast(o, d, t_far=t_far)
+        assert h.shape[0] == 0
+        assert abs(h.distance[0] - (rho - 1.875)) <= 1e-12
+        assert np.allclose(h.normal[0], -d[0], atol=1e-12)
+
+
+@pytest.mark.parametrize("prec", BOTH)
+def test_plane_carried_by_a_mover(prec):
+    e = RayEngine(prec)
+    body = e.add_body([entry(Plane((1.0, 1.0)), at(0, 0, 0.1))], at(0, 0, 0), movable=True)
+    for z in (-1.0, -2.5):
+        e.set_body_pose(body, at(0.2, 0, z))
+        t, n, s = ray(e, (0, 0, 0), (0, 0, -1), kind=RayKind.VISUAL)
+        assert s == 0 and abs(t - (-z - 0.1)) <= EXACT_TOL and np.allclose(n, [0, 0, 1])
+    e.set_body_pose(body, at(3.0, 0, -1))   # finite visual plane moved aside: missed visually
+    assert ray(e, (0, 0, 0), (0, 0, -1), kind=RayKind.VISUAL)[2] == -1
+    assert ray(e, (0, 0, 0), (0, 0, -1), kind=RayKind.BOUNDING)[2] == 0   # infinite for ODE
