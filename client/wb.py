@@ -11,10 +11,15 @@ As in libController, readings arrive with the step reply (PROTOCOL.md §3.6) and
 a ``get_value`` costs no round trip, reads NaN before the first measurement and keeps the last
 value after a ``disable``. ``enable``/``disable``/``set_frequency`` are RPCs. Constant getters
 (lookup tables, ranges, resolutions…) come from the device descriptions of the ``attach`` reply.
+Motor commands (``wb_motor_set_position``/``_velocity``) cost no round trip either: like
+libController they are buffered and travel with the next step request (PROTOCOL.md §3.4), and
+the motor getters answer from the client's copy.
 
 Differences from Webots' C library, all on error paths: an invalid tag, a negative sampling
-period, an out-of-range layer or frequency raise :class:`SensoriumError` instead of printing and
-carrying on; reads of a disabled device print Webots' message to stderr once per disable.
+period, an out-of-range layer or frequency, a NaN motor command or a negative velocity in position
+control raise :class:`SensoriumError` instead of printing and carrying on; reads of a disabled
+device print Webots' message to stderr once per disable. A velocity above ``maxVelocity`` is
+clamped here with Webots' warning (Webots clamps in the simulator).
 One process drives one robot through these functions; :class:`RobotClient` is the same thing as
 an object, for programs (and tests) that want several.
 """
@@ -44,9 +49,13 @@ WB_DISTANCE_SENSOR_SONAR = 2
 WB_DISTANCE_SENSOR_LASER = 3
 _DISTANCE_TYPES = {"generic": 0, "infra-red": 1, "infra_red": 1, "sonar": 2, "laser": 3}
 
+WB_ROTATIONAL = 0
+WB_LINEAR = 1
+
 LIGHT_SENSOR = "LightSensor"
 DISTANCE_SENSOR = "DistanceSensor"
 LIDAR = "Lidar"
+ROTATIONAL_MOTOR = "RotationalMotor"
 
 # Constant getters: local name -> (keys tried in the attach description, fallback service, its field).
 _CONSTANTS: dict[str, tuple[tuple[str, ...], str, str]] = {
@@ -77,11 +86,16 @@ def _flat_table(table: Any) -> list[float]:
     return out
 
 
+def _float(v: Any, default: float) -> float:
+    return default if v is None else float(v)
+
+
 class DeviceState:
     """What the client knows about one device: its description, enable state and latest reading."""
 
     __slots__ = ("tag", "index", "name", "kind", "desc", "sampling_period", "value", "range_bytes",
-                 "cloud_bytes", "point_cloud_enabled", "_consts", "_range", "_cloud", "_warned")
+                 "cloud_bytes", "point_cloud_enabled", "max_velocity", "target_position", "velocity",
+                 "_consts", "_range", "_cloud", "_warned")
 
     def __init__(self, index: int, desc: dict):
         self.index = index
@@ -94,6 +108,10 @@ class DeviceState:
         self.range_bytes: bytes | None = None
         self.cloud_bytes: bytes | None = None
         self.point_cloud_enabled = bool(desc.get("point_cloud_enabled", desc.get("pointCloudEnabled", False)))
+        # motors: the commands as last set (the server's at attach, then this controller's)
+        self.max_velocity = _float(desc.get("maxVelocity", desc.get("max_velocity")), 10.0)   # Webots' default
+        self.target_position = _float(desc.get("targetPosition", desc.get("target_position")), 0.0)
+        self.velocity = _float(desc.get("velocity"), self.max_velocity)       # libController starts at maxVelocity
         self._consts: dict[str, Any] = {}
         self._range: Any = None                  # decoded forms, rebuilt when new bytes arrive
         self._cloud: Any = None
@@ -141,6 +159,7 @@ class RobotClient:
         self.heartbeat_ms = int(heartbeat_ms or reply.get("heartbeat_ms") or 1000)
         self.devices = [DeviceState(i, d) for i, d in enumerate(reply.get("devices", []))]
         self.by_name = {d.name: d for d in self.devices}
+        self.motor_commands: dict[str, dict[str, float]] = {}   # sent with the next step request
         self._prefix = f"/{self.name}/"
         self.conn.start_heartbeat(self.session, self.heartbeat_ms, lost_after_s)
 
@@ -165,7 +184,10 @@ class RobotClient:
                 duration = int(duration)
             else:
                 raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be an integer (ms), got {duration!r}")
-        self.pending = self.conn.send(self._prefix + "robot/step", {"duration": duration})
+        args: dict[str, Any] = {"duration": duration}
+        if self.motor_commands:
+            args["motors"], self.motor_commands = self.motor_commands, {}
+        self.pending = self.conn.send(self._prefix + "robot/step", args)
         return 0
 
     def step_end(self) -> int:
@@ -277,6 +299,36 @@ class RobotClient:
         if not self.terminated:
             self._expect_success(self.rpc(dev, "set_frequency", {"value": float(frequency)}), func)
         dev._consts["frequency"] = float(frequency)
+
+    # -- motors: buffered, sent with the next step request
+    @staticmethod
+    def _number(value: Any, what: str, func: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): '{what}' must be a number, got {value!r}")
+        value = float(value)
+        if math.isnan(value):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}() called with an invalid '{what}' argument (NaN)")
+        return value
+
+    def set_motor_position(self, dev: DeviceState, position: float, func: str) -> None:
+        """Webots' ``setPosition``: a target (rad), or ±inf for velocity control."""
+        position = self._number(position, "position", func)
+        dev.target_position = position
+        self.motor_commands.setdefault(dev.name, {})["position"] = position
+
+    def set_motor_velocity(self, dev: DeviceState, velocity: float, func: str) -> None:
+        """Webots' ``setVelocity``: clamped to ``maxVelocity`` with Webots' warning."""
+        velocity = self._number(velocity, "velocity", func)
+        if velocity < 0.0 and not math.isinf(dev.target_position):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}() called with negative 'velocity' argument in "
+                                                             f"position control mode ({dev.target_position:g})")
+        limit = dev.max_velocity
+        if abs(velocity) > limit:
+            print(f"WARNING: {dev.kind} \"{dev.name}\": The requested velocity {velocity:g} exceeds "
+                  f"'maxVelocity' = {limit:g}.", file=sys.stderr)
+            velocity = math.copysign(limit, velocity)
+        dev.velocity = velocity
+        self.motor_commands.setdefault(dev.name, {})["velocity"] = velocity
 
     @staticmethod
     def _expect_success(result: dict, func: str) -> None:
@@ -414,7 +466,8 @@ def wb_device_get_name(tag: int) -> str:
 
 
 def wb_device_get_type_name(tag: int) -> str:
-    """Sensorium extension: the device's node type name ("LightSensor", "DistanceSensor", "Lidar")."""
+    """Sensorium extension: the device's node type name ("LightSensor", "DistanceSensor", "Lidar",
+    "RotationalMotor")."""
     return current().device(tag, None, "wb_device_get_type_name").kind
 
 
@@ -676,6 +729,56 @@ def wb_lidar_get_min_frequency(tag: int) -> float:
 
 def wb_lidar_get_max_frequency(tag: int) -> float:
     return _lidar_constant(tag, "max_frequency", "wb_lidar_get_max_frequency")
+
+
+
+# ---------------------------------------------------------------------- motor
+
+def _motor(tag: int, func: str) -> DeviceState:
+    return current().device(tag, ROTATIONAL_MOTOR, func)
+
+
+def wb_motor_set_position(tag: int, position: float) -> None:
+    """Target position (rad) sent with the next step; ``float('inf')`` selects velocity control."""
+    current().set_motor_position(_motor(tag, "wb_motor_set_position"), position, "wb_motor_set_position")
+
+
+def wb_motor_set_velocity(tag: int, velocity: float) -> None:
+    """Velocity (rad/s) sent with the next step: the wheel speed in velocity control, the speed
+    limit in position control. Above ``maxVelocity`` it is clamped (with Webots' warning)."""
+    current().set_motor_velocity(_motor(tag, "wb_motor_set_velocity"), velocity, "wb_motor_set_velocity")
+
+
+def wb_motor_get_velocity(tag: int) -> float:
+    return _motor(tag, "wb_motor_get_velocity").velocity
+
+
+def wb_motor_get_max_velocity(tag: int) -> float:
+    return _motor(tag, "wb_motor_get_max_velocity").max_velocity
+
+
+def wb_motor_get_target_position(tag: int) -> float:
+    return _motor(tag, "wb_motor_get_target_position").target_position
+
+
+def wb_motor_get_min_position(tag: int) -> float:
+    """0 with :func:`wb_motor_get_max_position` 0: no position limits (a wheel)."""
+    return _float(_motor(tag, "wb_motor_get_min_position").desc.get("minPosition"), 0.0)
+
+
+def wb_motor_get_max_position(tag: int) -> float:
+    return _float(_motor(tag, "wb_motor_get_max_position").desc.get("maxPosition"), 0.0)
+
+
+def wb_motor_get_type(tag: int) -> int:
+    _motor(tag, "wb_motor_get_type")
+    return WB_ROTATIONAL
+
+
+def wb_motor_get_position_sensor(tag: int) -> int:
+    """0: Sensorium's wheels have no PositionSensor."""
+    _motor(tag, "wb_motor_get_position_sensor")
+    return 0
 
 
 __all__ = [n for n in list(globals()) if n.startswith(("wb_", "WB_"))] + ["SensoriumError", "RobotClient"]

@@ -1,7 +1,7 @@
 """Topic payloads (PROTOCOL.md §4): ROS 2 message shapes as pydantic models.
 
 Field names and order are those of ``sensor_msgs``/``std_msgs``/``builtin_interfaces``/
-``rosgraph_msgs`` (wire.md §1); arrays travel as little-endian raw bytes (``bytes`` fields, dtype
+``rosgraph_msgs``/``geometry_msgs`` (wire.md §1); arrays travel as little-endian raw bytes (``bytes`` fields, dtype
 named in each field's description). The server builds plain dicts in this order on its hot path;
 these models are the contract (JSON Schema export, tests, clients that want validation).
 """
@@ -27,7 +27,8 @@ class Time(Msg):
 
 
 class Header(Msg):
-    """``std_msgs/msg/Header``: stamp = simulated time of the measurement; frame_id = ``robot/device``."""
+    """``std_msgs/msg/Header``: stamp = simulated time of the measurement; frame_id = ``robot/device``
+    (``world`` for a robot's pose)."""
 
     stamp: Time
     frame_id: str
@@ -99,6 +100,38 @@ class PointCloud(Msg):
     channels: list[ChannelFloat32] = Field(description='[{"name": "layer", "values": layer index per point}]')
 
 
+class Point(Msg):
+    """``geometry_msgs/msg/Point`` (float64)."""
+
+    x: float
+    y: float
+    z: float
+
+
+class Quaternion(Msg):
+    """``geometry_msgs/msg/Quaternion`` (float64, ROS order x, y, z, w)."""
+
+    x: float
+    y: float
+    z: float
+    w: float
+
+
+class Pose(Msg):
+    """``geometry_msgs/msg/Pose``."""
+
+    position: Point
+    orientation: Quaternion
+
+
+class PoseStamped(Msg):
+    """``geometry_msgs/msg/PoseStamped``: a robot's pose in the world frame (``frame_id`` ``world``),
+    stamped with the simulated time after each basic step."""
+
+    header: Header
+    pose: Pose
+
+
 class Clock(Msg):
     """``rosgraph_msgs/msg/Clock``: the simulated time after each basic step."""
 
@@ -118,6 +151,7 @@ RANGE = "sensor_msgs/msg/Range"
 IMAGE = "sensor_msgs/msg/Image"
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
 POINT_CLOUD = "sensor_msgs/msg/PointCloud"
+POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 CLOCK = "rosgraph_msgs/msg/Clock"
 
 MESSAGE_TYPES: dict[str, type[Msg]] = {
@@ -126,6 +160,7 @@ MESSAGE_TYPES: dict[str, type[Msg]] = {
     IMAGE: Image,
     LASER_SCAN: LaserScan,
     POINT_CLOUD: PointCloud,
+    POSE_STAMPED: PoseStamped,
     CLOCK: Clock,
 }
 """ROS type name → model, for every topic the server publishes."""

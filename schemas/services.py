@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from sensorium.schemas.messages import Image, PointCloud
 from sensorium.schemas.wire import PROTOCOL_VERSION, ErrorCode
@@ -23,7 +23,7 @@ __all__ = ["ErrorCode", "PROTOCOL_VERSION", "SERVICES", "ServiceSpec", "service_
 
 MAX_PERIOD_MS = (1 << 31) - 1
 Mode = Literal["fast", "realtime", "pause"]
-DeviceType = Literal["LightSensor", "DistanceSensor", "Lidar"]
+DeviceType = Literal["LightSensor", "DistanceSensor", "Lidar", "RotationalMotor"]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
 
@@ -91,9 +91,35 @@ class SetModeArgs(Args):
     mode: Mode
 
 
+class MotorCommand(Args):
+    """One motor's commands with a step request (Webots: what ``setPosition``/``setVelocity`` set
+    since the previous step). Either key may be left out."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=True, frozen=True)
+
+    position: float | None = Field(default=None, description="target position (rad); +inf/-inf = velocity control")
+    velocity: float | None = Field(default=None, description="rad/s, finite; clamped to maxVelocity")
+
+    @field_validator("position")
+    @classmethod
+    def _not_nan(cls, v: float | None) -> float | None:
+        if v is not None and v != v:
+            raise ValueError("position must not be NaN")
+        return v
+
+    @field_validator("velocity")
+    @classmethod
+    def _finite(cls, v: float | None) -> float | None:
+        if v is not None and (v != v or v in (float("inf"), float("-inf"))):
+            raise ValueError("velocity must be finite")
+        return v
+
+
 class StepArgs(Args):
     duration: int | None = Field(default=None, gt=0, le=MAX_PERIOD_MS,
                                  description="ms, a positive multiple of the basic time step; default: one basic step")
+    motors: dict[str, MotorCommand] | None = Field(
+        default=None, description="motor name -> commands, applied when the request arrives (before the world advances)")
 
 
 class TimeStepArgs(Args):
@@ -120,6 +146,23 @@ class FrequencyArgs(Args):
 
 class LayerArgs(Args):
     layer: int = Field(ge=0, lt=1 << 31)
+
+
+class MotorPositionArgs(Args):
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=True, frozen=True)
+
+    value: float = Field(description="target position (rad); +inf/-inf = velocity control")
+
+    @field_validator("value")
+    @classmethod
+    def _not_nan(cls, v: float) -> float:
+        if v != v:
+            raise ValueError("position must not be NaN")
+        return v
+
+
+class MotorVelocityArgs(Args):
+    value: float = Field(description="rad/s, finite; clamped to maxVelocity")
 
 
 # ---------------------------------------------------------------------- results
@@ -192,7 +235,18 @@ class LidarDescription(Result):
     point_cloud_enabled: bool
 
 
-DeviceDescription = Annotated[Union[LightSensorDescription, DistanceSensorDescription, LidarDescription],
+class MotorDescription(Result):
+    name: str
+    type: Literal["RotationalMotor"]
+    maxVelocity: float = Field(description="rad/s")
+    minPosition: float = Field(description="rad; minPosition = maxPosition = 0: no limits (Webots)")
+    maxPosition: float
+    targetPosition: float = Field(description="rad, inf in velocity control (the motor's current command)")
+    velocity: float = Field(description="rad/s (the motor's current command)")
+
+
+DeviceDescription = Annotated[Union[LightSensorDescription, DistanceSensorDescription, LidarDescription,
+                                    MotorDescription],
                               Field(discriminator="type")]
 
 
@@ -309,7 +363,8 @@ class ServiceSpec:
     devices: frozenset[str] = frozenset()
 
 
-_ALL = frozenset({"LightSensor", "DistanceSensor", "Lidar"})
+_ALL = frozenset({"LightSensor", "DistanceSensor", "Lidar"})          # sensors
+_M = frozenset({"RotationalMotor"})
 _LD = frozenset({"LightSensor", "DistanceSensor"})
 _D = frozenset({"DistanceSensor"})
 _L = frozenset({"Lidar"})
@@ -343,6 +398,11 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("set_frequency", "device", FrequencyArgs, SuccessResult, attached=True, devices=_L),
     ServiceSpec("get_layer_range_image", "device", LayerArgs, LayerRangeImageResult, devices=_L),
     ServiceSpec("get_layer_point_cloud", "device", LayerArgs, LayerPointCloudResult, devices=_L),
+    ServiceSpec("set_position", "device", MotorPositionArgs, SuccessResult, attached=True, devices=_M),
+    ServiceSpec("set_velocity", "device", MotorVelocityArgs, SuccessResult, attached=True, devices=_M),
+    ServiceSpec("get_velocity", "device", NoArgs, FloatValue, devices=_M),
+    ServiceSpec("get_max_velocity", "device", NoArgs, FloatValue, devices=_M),
+    ServiceSpec("get_target_position", "device", NoArgs, FloatValue, devices=_M),
 )
 
 
@@ -354,7 +414,8 @@ def spec(scope: str, item: str) -> ServiceSpec:
 
 
 def service_names(robots: dict[str, dict[str, str]]) -> dict[str, ServiceSpec]:
-    """Every concrete service name of a world: ``robots`` maps robot → {device: device type}."""
+    """Every concrete service name of a world: ``robots`` maps robot → {device: device type}
+    (motors included, type ``RotationalMotor``)."""
     out: dict[str, ServiceSpec] = {}
     for s in SERVICES:
         if s.scope == "server":

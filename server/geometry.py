@@ -153,6 +153,17 @@ class Pose:
         object.__setattr__(self, "rotation", r)
         object.__setattr__(self, "translation", t)
 
+    @classmethod
+    def _owned(cls, rotation: np.ndarray, translation: np.ndarray) -> Pose:
+        """Pose from fresh float64 (3,3) and (3,) arrays that nobody else references: no copy, no
+        checks (``compose`` runs per device and step; the validating constructor costs ~3x more)."""
+        p = object.__new__(cls)
+        rotation.flags.writeable = False
+        translation.flags.writeable = False
+        object.__setattr__(p, "rotation", rotation)
+        object.__setattr__(p, "translation", translation)
+        return p
+
     @staticmethod
     def identity() -> Pose:
         return Pose(np.eye(3), np.zeros(3))
@@ -175,11 +186,11 @@ class Pose:
         return Pose(r, translation)
 
     def compose(self, other: Pose) -> Pose:
-        return Pose(self.rotation @ other.rotation, self.rotation @ other.translation + self.translation)
+        return Pose._owned(self.rotation @ other.rotation, self.rotation @ other.translation + self.translation)
 
     def inverse(self) -> Pose:
-        rt = self.rotation.T
-        return Pose(rt, -(rt @ self.translation))
+        rt = self.rotation.T.copy()
+        return Pose._owned(rt, -(rt @ self.translation))
 
     def apply(self, points) -> np.ndarray:
         return np.asarray(points, dtype=np.float64) @ self.rotation.T + self.translation

@@ -28,9 +28,17 @@ class WheelMotor:
 
     name: str
     max_velocity: float
-    target_position: float = 0.0        # Webots' default: position control at 0
-    velocity: float = 0.0
+    target_position: float = 0.0        # Webots' default: position control at 0 ...
+    velocity: float = math.nan          # ... at maxVelocity (set in __post_init__)
     position: float = 0.0               # wheel angle (rad), integrated
+
+    def __post_init__(self) -> None:
+        if math.isnan(self.velocity):
+            self.velocity = self.max_velocity
+
+    def hold(self) -> None:
+        """Stop where the wheel is (position control at its current angle)."""
+        self.target_position = self.position
 
     def set_position(self, value: float) -> None:
         if not isinstance(value, (int, float)) or math.isnan(value):

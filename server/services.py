@@ -17,7 +17,6 @@ that fails gets exactly one error reply with a protocol code; the core never rai
 
 from __future__ import annotations
 
-import math
 import sys
 import traceback
 from collections.abc import Callable
@@ -31,7 +30,7 @@ from sensorium.schemas.wire import (
     SOFT_LIMIT, ErrorCode, RequestError, error_reply, ok_reply, parse_request,
 )
 from sensorium.server.lockstep import Lockstep, LockstepError, Session, StepDone
-from sensorium.server.topics import Control, Topics, header, image_msg, point_cloud_msg
+from sensorium.server.topics import Control, Topics, header, image_msg, point_cloud_msg, pose_quaternion
 
 __all__ = ["Core", "ServiceError"]
 
@@ -57,6 +56,7 @@ class Call:
     args: Any                 # the spec's pydantic Args model
     robot: str | None
     ctl: Control | None
+    motor: Any                # the WheelMotor of a motor service, else None
     now: float
     extra: list[Frames]       # more replies to send (e.g. a step answered by detach)
 
@@ -66,10 +66,12 @@ class Route:
     spec: S.ServiceSpec
     handler: Callable[[Call], dict | None]
     robot: str | None
-    device: str | None        # "robot/device" path
+    device: str | None        # "robot/device" path of a sensor
+    motor: str | None = None  # motor name of a motor service
 
 
 _DEFERRED = None              # a handler returning None answers later (step)
+MOTOR = "RotationalMotor"
 
 
 def _arg_errors(exc: ValidationError) -> str:
@@ -83,28 +85,6 @@ def _arg_errors(exc: ValidationError) -> str:
         else:
             parts.append(f"argument {loc!r}: {e['msg']} (got {e.get('input')!r})")
     return "; ".join(parts)
-
-
-def _quaternion(pose: Any) -> list[float]:
-    """(x, y, z, w) of a pose (its own ``quaternion`` if it has one, else from its 3×3 rotation)."""
-    q = getattr(pose, "quaternion", None)
-    if q is not None:
-        return [float(v) for v in q]
-    m = pose.rotation
-    tr = m[0][0] + m[1][1] + m[2][2]
-    if tr > 0:
-        s = math.sqrt(tr + 1.0) * 2
-        w, x, y, z = 0.25 * s, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s
-    elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
-        s = math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2]) * 2
-        w, x, y, z = (m[2][1] - m[1][2]) / s, 0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s
-    elif m[1][1] > m[2][2]:
-        s = math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2]) * 2
-        w, x, y, z = (m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s
-    else:
-        s = math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]) * 2
-        w, x, y, z = (m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s
-    return [float(x), float(y), float(z), float(w)]
 
 
 class Core:
@@ -143,6 +123,11 @@ class Core:
                     if spec.scope == "device" and kind in spec.devices:
                         routes[f"/{robot_name}/{dev_name}/{spec.item}"] = Route(
                             spec, getattr(self, f"_dev_{spec.item}"), robot_name, path)
+            for motor_name in robot.motors:
+                for spec in S.SERVICES:
+                    if spec.scope == "device" and MOTOR in spec.devices:
+                        routes[f"/{robot_name}/{motor_name}/{spec.item}"] = Route(
+                            spec, getattr(self, f"_motor_{spec.item}"), robot_name, None, motor_name)
             for spec in S.SERVICES:
                 if spec.scope == "robot":
                     routes[f"/{robot_name}/robot/{spec.item}"] = Route(spec, getattr(self, f"_robot_{spec.item}"), robot_name, None)
@@ -162,14 +147,13 @@ class Core:
                                 f"no robot {name!r} (robots: {', '.join(self.sim.robots) or 'none'})")
         robot = robots[0]
         rest = service[len(robot) + 2:]
-        devices = self.sim.robots[robot].devices
+        devices = self._device_kinds(robot)
         if rest.startswith("robot/"):
             return ServiceError(ErrorCode.UNKNOWN_SERVICE, f"no robot service {rest[6:]!r}")
         for dev in sorted(devices, key=len, reverse=True):
             if rest.startswith(dev + "/"):
-                kind = devices[dev].config.device
                 return ServiceError(ErrorCode.UNKNOWN_DEVICE,
-                                    f"{kind} {robot}/{dev} has no service {rest[len(dev) + 1:]!r}")
+                                    f"{devices[dev]} {robot}/{dev} has no service {rest[len(dev) + 1:]!r}")
         dev = rest.split("/", 1)[0]
         return ServiceError(ErrorCode.UNKNOWN_DEVICE,
                             f"robot {robot!r} has no device {dev!r} (devices: {', '.join(devices) or 'none'})")
@@ -201,7 +185,8 @@ class Core:
                                        f"{req.service} needs the caller to be {route.robot!r}'s attached controller"
                                        + ("" if s is None else " (another socket is)"))
             ctl = self.topics.controls[route.device] if route.device else None
-            call = Call(envelope, peer, rid, args, route.robot, ctl, now, [])
+            motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
+            call = Call(envelope, peer, rid, args, route.robot, ctl, motor, now, [])
             result = route.handler(call)
             if result is _DEFERRED:
                 return call.extra
@@ -261,6 +246,10 @@ class Core:
     def _released(self, s: Session) -> None:
         self._seen.pop(s.token, None)
         self.topics.release_robot(s.robot)
+        # a robot without a controller stops: with no collision response it would otherwise
+        # drive through walls while the world steps for the others (Webots keeps the commands)
+        for motor in self.sim.robots[s.robot].motors.values():
+            motor.hold()
 
     def _step_reply(self, d: StepDone) -> Frames:
         envelope, rid = d.step.reply_to
@@ -284,6 +273,13 @@ class Core:
     def _robot_controls(self, robot: str) -> list[Control]:
         return self._controls_by_robot[robot]
 
+    def _device_kinds(self, robot: str) -> dict[str, str]:
+        """Every device of a robot → its type: sensors first (world order), then motors."""
+        r = self.sim.robots[robot]
+        out = {name: dev.config.device for name, dev in r.devices.items()}
+        out.update((name, MOTOR) for name in r.motors)
+        return out
+
     # ------------------------------------------------------------------ server services
     def _srv_get_info(self, c: Call) -> dict:
         return {
@@ -297,7 +293,7 @@ class Core:
             "pub_endpoint": self.pub_endpoint,
             "robots": [{"name": name, "synchronization": bool(r.synchronization),
                         "attached": self.lockstep.session_for(name) is not None,
-                        "devices": [{"name": d, "type": dev.config.device} for d, dev in r.devices.items()]}
+                        "devices": [{"name": d, "type": kind} for d, kind in self._device_kinds(name).items()]}
                        for name, r in self.sim.robots.items()],
             "topics": [{"name": t.name, "type": t.type} for t in self.topics.topics],
         }
@@ -310,7 +306,8 @@ class Core:
         return {"session": s.token, "robot": s.robot, "basic_time_step": self.sim.basic_time_step,
                 "time_ms": self.sim.time_ms, "synchronization": bool(robot.synchronization),
                 "heartbeat_ms": self.lockstep.heartbeat_ms,
-                "devices": [self._describe(ctl) for ctl in self._robot_controls(s.robot)]}
+                "devices": [self._describe(ctl) for ctl in self._robot_controls(s.robot)]
+                + [self._describe_motor(m) for m in robot.motors.values()]}
 
     def _srv_detach(self, c: Call) -> dict:
         s, done = self.lockstep.detach(c.args.session)
@@ -327,8 +324,11 @@ class Core:
         return {"mode": self.lockstep.set_mode(c.args.mode)}
 
     def _srv_get_counters(self, c: Call) -> dict:
+        counters = dict(self.sim.counters)
+        counters.update(self.topics.work)
+        counters.setdefault("poses_built", 0)
         return {"time_ms": self.sim.time_ms, "steps": self.lockstep.steps,
-                "counters": {k: int(v) for k, v in sorted(self.sim.counters.items())},
+                "counters": {k: int(v) for k, v in sorted(counters.items())},
                 "measurements": {p: int(ctl.device.measurements) for p, ctl in self.topics.controls.items()},
                 "demanded": sorted(self.topics.demanded),
                 "subscriptions": sorted(self.topics.prefixes)}
@@ -340,10 +340,32 @@ class Core:
         return s
 
     def _robot_step(self, c: Call) -> dict | None:
+        commands = self._motor_commands(c.robot, c.args.motors) if c.args.motors else []
         done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.duration, c.now)
         if done is not None:                                 # quitting: -1 at once
             return {"status": done.status, "time_ms": done.time_ms, "values": {}}
+        # the world has not advanced since the request arrived: Webots' "at the start of the step"
+        for motor, cmd in commands:
+            if cmd.position is not None:
+                motor.set_position(cmd.position)
+            if cmd.velocity is not None:
+                motor.set_velocity(cmd.velocity)
         return _DEFERRED
+
+    def _motor_commands(self, robot: str, motors: dict[str, Any]) -> list[tuple[Any, Any]]:
+        """Resolve every named motor first, so that a bad name applies none of the commands."""
+        r = self.sim.robots[robot]
+        out = []
+        for name, cmd in motors.items():
+            motor = r.motors.get(name)
+            if motor is None:
+                if name in r.devices:
+                    raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: {robot}/{name} is a "
+                                                                 f"{r.devices[name].config.device}, not a motor")
+                raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: robot {robot!r} has no motor {name!r} "
+                                                             f"(motors: {', '.join(r.motors) or 'none'})")
+            out.append((motor, cmd))
+        return out
 
     def _robot_time_step(self, c: Call) -> dict | None:
         done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.value, c.now, kind="time_step")
@@ -358,10 +380,10 @@ class Core:
         return {"value": float(self.sim.basic_time_step)}
 
     def _robot_get_device_list(self, c: Call) -> dict:
-        return {"list": list(self.sim.robots[c.robot].devices)}
+        return {"list": list(self._device_kinds(c.robot))}
 
     def _robot_get_number_of_devices(self, c: Call) -> dict:
-        return {"value": len(self.sim.robots[c.robot].devices)}
+        return {"value": len(self._device_kinds(c.robot))}
 
     def _robot_set_pose(self, c: Call) -> dict:
         a = c.args
@@ -375,7 +397,7 @@ class Core:
 
     def _robot_get_pose(self, c: Call) -> dict:
         pose = self.sim.robots[c.robot].pose
-        return {"translation": [float(v) for v in pose.translation], "quaternion": _quaternion(pose)}
+        return {"translation": [float(v) for v in pose.translation], "quaternion": pose_quaternion(pose)}
 
     # ------------------------------------------------------------------ device services
     def _describe(self, ctl: Control) -> dict:
@@ -391,6 +413,11 @@ class Core:
             out.update(self._frequency_info(dev))
             out["point_cloud_enabled"] = ctl.controller_point_cloud
         return out
+
+    @staticmethod
+    def _describe_motor(m: Any) -> dict:
+        return {"name": m.name, "type": MOTOR, "maxVelocity": float(m.max_velocity), "minPosition": 0.0,
+                "maxPosition": 0.0, "targetPosition": float(m.target_position), "velocity": float(m.velocity)}
 
     @staticmethod
     def _lookup_table(dev: Any) -> list[float]:
@@ -476,3 +503,21 @@ class Core:
         layer = self._layer(c)
         dev = c.ctl.device
         return {"pointCloud": point_cloud_msg(header(c.ctl.frame_id, dev.measured_at_ms), dev.layer_point_cloud(layer))}
+
+    # ------------------------------------------------------------------ motor services
+    def _motor_set_position(self, c: Call) -> dict:
+        c.motor.set_position(c.args.value)
+        return {"success": True}
+
+    def _motor_set_velocity(self, c: Call) -> dict:
+        c.motor.set_velocity(c.args.value)
+        return {"success": True}
+
+    def _motor_get_velocity(self, c: Call) -> dict:
+        return {"value": float(c.motor.velocity)}
+
+    def _motor_get_max_velocity(self, c: Call) -> dict:
+        return {"value": float(c.motor.max_velocity)}
+
+    def _motor_get_target_position(self, c: Call) -> dict:
+        return {"value": float(c.motor.target_position)}

@@ -9,13 +9,16 @@ controller's own ``enable`` always wins and is never altered (its period, phase 
 controller enabled it or its ``point_cloud`` topic is demanded.
 
 After each basic step :meth:`Topics.publish` builds the messages of every demanded topic whose
-device produced a new value (plus ``/clock``) as ready-to-send frames, calls the recorder with the
-very same bytes, and counts ``seq`` per topic. This module does no I/O.
+device produced a new value (plus ``/clock`` and each demanded ``/<robot>/pose``) as ready-to-send
+frames, calls the recorder with the very same bytes, and counts ``seq`` per topic. A robot's pose
+is read and packed only while its pose topic is demanded (``work["poses_built"]`` counts them).
+This module does no I/O.
 """
 
 from __future__ import annotations
 
 import math
+from collections import Counter
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
@@ -25,7 +28,8 @@ import numpy as np
 from sensorium.schemas import messages as msgs
 from sensorium.schemas.wire import pack, stamp, topic_frame
 
-__all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "laser_scan_angles"]
+__all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "laser_scan_angles",
+           "pose_quaternion", "pose_msg"]
 
 POINT_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer_id", "<i4"), ("time", "<f4")])
 """A WbLidarPoint on the wire (20 bytes, little-endian)."""
@@ -34,6 +38,7 @@ Recorder = Callable[[str, str, bytes, bytes, int, int], None]
 """``recorder(topic, type, envelope_bytes, body_bytes, stamp_ns, seq)``."""
 
 CLOCK = "/clock"
+WORLD_FRAME = "world"
 _INFRA_RED = 1
 _SONAR = 2
 
@@ -42,8 +47,8 @@ _SONAR = 2
 class Topic:
     name: str
     type: str
-    kind: str                # value | range_image | laser_scan | point_cloud | clock
-    path: str | None         # "robot/device", None for /clock
+    kind: str                # value | range_image | laser_scan | point_cloud | clock | pose
+    path: str | None         # "robot/device"; the robot's name for pose; None for /clock
     frame: bytes             # name + NUL
 
 
@@ -116,6 +121,37 @@ def point_cloud_msg(hdr: dict, pc: np.ndarray) -> dict:
     return {"header": hdr, "points": points, "channels": [{"name": "layer", "values": layers}]}
 
 
+def pose_quaternion(pose: Any) -> list[float]:
+    """(x, y, z, w) of a pose: its own ``quaternion`` if it has one, else from its 3×3 rotation."""
+    q = getattr(pose, "quaternion", None)
+    if q is not None:
+        return [float(v) for v in q]
+    m = pose.rotation
+    tr = m[0][0] + m[1][1] + m[2][2]
+    if tr > 0:
+        s = math.sqrt(tr + 1.0) * 2
+        w, x, y, z = 0.25 * s, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s
+    elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
+        s = math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2]) * 2
+        w, x, y, z = (m[2][1] - m[1][2]) / s, 0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s
+    elif m[1][1] > m[2][2]:
+        s = math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2]) * 2
+        w, x, y, z = (m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s
+    else:
+        s = math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]) * 2
+        w, x, y, z = (m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s
+    return [float(x), float(y), float(z), float(w)]
+
+
+def pose_msg(hdr: dict, pose: Any) -> dict:
+    """``geometry_msgs/PoseStamped`` of a robot pose (float64; same numbers as ``get_pose``)."""
+    t = [float(v) for v in pose.translation]
+    q = pose_quaternion(pose)
+    return {"header": hdr,
+            "pose": {"position": {"x": t[0], "y": t[1], "z": t[2]},
+                     "orientation": {"x": q[0], "y": q[1], "z": q[2], "w": q[3]}}}
+
+
 def laser_scan_angles(cfg: Any) -> tuple[float, float, float] | None:
     """(angle_min, angle_max, angle_increment) of ranges in range-image order (left to right), or
     ``None`` when the lidar gets no LaserScan (several layers, or planar: unequal angles)."""
@@ -156,6 +192,7 @@ class Topics:
         self.basic_time_step = int(sim.basic_time_step)
         self.controls: dict[str, Control] = {}
         self.topics: list[Topic] = [Topic(CLOCK, msgs.CLOCK, "clock", None, topic_frame(CLOCK))]
+        self.pose_topics: dict[str, Topic] = {}      # robot -> its /<robot>/pose topic
         for robot_name, robot in sim.robots.items():
             for dev_name, dev in robot.devices.items():
                 kind = dev.config.device
@@ -163,6 +200,10 @@ class Topics:
                 self.topics.extend(ts)
                 self.controls[f"{robot_name}/{dev_name}"] = Control(robot_name, dev, kind, ts,
                                                                     f"{robot_name}/{dev_name}", seen=dev.measurements)
+            name = f"/{robot_name}/pose"
+            pose_topic = Topic(name, msgs.POSE_STAMPED, "pose", robot_name, topic_frame(name))
+            self.topics.append(pose_topic)
+            self.pose_topics[robot_name] = pose_topic
         self.by_name = {t.name: t for t in self.topics}
         self.seq: dict[str, int] = {t.name: 0 for t in self.topics}
         self.prefixes: set[bytes] = set()
@@ -174,6 +215,8 @@ class Topics:
         self.recorder_demanded: set[str] = set()
         self._active: list[Control] = []             # controls with a demanded topic
         self._clock_demanded = False
+        self._poses: list[Topic] = []                # demanded pose topics
+        self.work: Counter[str] = Counter()          # what publishing computed (poses_built)
 
     # ------------------------------------------------------------------ demand
     @property
@@ -226,6 +269,7 @@ class Topics:
             self.recorder_demanded = {t.name for t in self.topics if rd(t.name)} if rd else set()
         demanded = self.demanded
         self._clock_demanded = CLOCK in demanded
+        self._poses = [t for t in self.pose_topics.values() if t.name in demanded]
         self._active = []
         for ctl in self.controls.values():
             was = bool(ctl.demanded)
@@ -284,10 +328,16 @@ class Topics:
     # ------------------------------------------------------------------ publishing
     def publish(self, time_ms: int) -> list[list[bytes]]:
         """After a basic step: the frames of every demanded topic with a new value, ``/clock``
-        first. The recorder gets the same bytes."""
+        first, then the demanded robot poses, then the devices' topics. The recorder gets the same
+        bytes."""
         out: list[list[bytes]] = []
         if self._clock_demanded:
             self._emit(self.by_name[CLOCK], time_ms, {"clock": stamp(time_ms * 1_000_000)}, out)
+        if self._poses:
+            hdr = header(WORLD_FRAME, time_ms)
+            for t in self._poses:
+                self._emit(t, time_ms, pose_msg(hdr, self.sim.robots[t.path].pose), out)
+            self.work["poses_built"] += len(self._poses)
         for ctl in self._active:
             m = ctl.device.measurements
             if m == ctl.seen:

@@ -3,6 +3,7 @@ PROTOCOL.md §3 for a toy world, with knobs to delay, silence or shut the lockst
 
 Readings are simple functions of the measurement time so tests can predict them:
 light = 100 + t_s, distance = t_ms / 2, lidar range[i] = t_s + i / 4 (2 layers x 4 columns).
+Robot r2 also has two wheel motors; motor commands arrive in the step requests' args (see ``log``).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import zmq
 
 BASIC = 32
 LAYERS, COLUMNS = 2, 4
+MAX_VELOCITY = 6.28
 
 
 def light_value(t_ms: int) -> float:
@@ -49,7 +51,11 @@ def descriptions(full: bool) -> dict[str, list[dict]]:
         lidar.update(horizontalResolution=COLUMNS, numberOfLayers=LAYERS, fov=1.5, verticalFov=0.2,
                      minRange=0.05, maxRange=6.0, frequency=10.0, minFrequency=1.0, maxFrequency=25.0,
                      sampling_period=0, point_cloud_enabled=False)
-    return {"r1": [light, dist, lidar], "r2": [dict(dist)]}
+    motors = [{"name": n, "type": "RotationalMotor", "maxVelocity": MAX_VELOCITY, "minPosition": 0.0, "maxPosition": 0.0,
+               "targetPosition": 0.0, "velocity": 0.0} for n in ("left wheel motor", "right wheel motor")]
+    if not full:
+        motors = [{"name": m["name"], "type": m["type"]} for m in motors]
+    return {"r1": [light, dist, lidar], "r2": [dict(dist), *motors]}
 
 
 class _Dev:

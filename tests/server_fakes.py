@@ -14,6 +14,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.motion import DifferentialDrive
 
 POINT_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer_id", "<i4"), ("time", "<f4")])
 
@@ -154,11 +155,16 @@ class FakeRobot:
         self.synchronization = model.synchronization
         self.devices = {d.name: CLASSES[d.device](sim, model.name, d) for d in model.devices}
         self.pose = SimpleNamespace(translation=(0.0, 0.0, 0.0), rotation=np.eye(3))
+        # the real kinematic drive (motors and pose integration are cheap and exact)
+        self.drive = DifferentialDrive(model.differential_drive, self.pose) if model.differential_drive else None
+        self.motors = self.drive.motors if self.drive else {}
 
     def set_pose(self, translation, rotation=None, quaternion=None):
         if rotation is not None and math.hypot(*rotation[:3]) == 0:
             raise ValueError("rotation axis must not be zero")
         self.pose = SimpleNamespace(translation=tuple(translation), rotation=np.eye(3))
+        if self.drive is not None:
+            self.drive.reset(self.pose)
 
 
 class FakeSim:
@@ -175,6 +181,8 @@ class FakeSim:
             raise RuntimeError("boom")
         self.time_ms += self.basic_time_step
         for r in self.robots.values():
+            if r.drive is not None and (pose := r.drive.step(self.basic_time_step)) is not None:
+                r.pose = pose
             for d in r.devices.values():
                 if d.due(self.time_ms):
                     d.measure(self.time_ms)

@@ -467,6 +467,125 @@ def test_controller_classes(global_robot, capsys):
     assert robot.stepBegin(32) == 0 and robot.stepEnd() == 0
 
 
+# ====================================================================== motors
+
+LEFT, RIGHT = "left wheel motor", "right wheel motor"
+
+
+def _step_args(server) -> list[dict]:
+    with server.lock:
+        return [args for service, args in server.log if service.endswith("/robot/step")]
+
+
+def _requests(server) -> list[str]:
+    """Services called, heartbeat pings left out."""
+    return [s for s in server.services() if s != "ping"]
+
+
+def test_motor_commands_are_buffered_and_sent_with_the_step(server, capsys):
+    with wb.RobotClient(server.endpoint, robot="r2", timeout=2.0) as r2:
+        left, right = r2.by_name[LEFT], r2.by_name[RIGHT]
+        assert (left.kind, left.max_velocity, left.target_position, left.velocity) == ("RotationalMotor", 6.28, 0.0, 0.0)
+        n = len(_requests(server))
+        r2.set_motor_position(left, math.inf, "test")
+        r2.set_motor_velocity(left, 2.0, "test")
+        r2.set_motor_velocity(left, 3, "test")                 # the last command wins
+        r2.set_motor_position(right, float("-inf"), "test")
+        assert len(_requests(server)) == n                     # no round trip
+        assert r2.step() == 0
+        assert _step_args(server)[-1] == {"duration": BASIC, "motors": {LEFT: {"position": math.inf, "velocity": 3.0},
+                                                                        RIGHT: {"position": -math.inf}}}
+        assert len(_requests(server)) == n + 1
+        assert r2.step() == 0
+        assert _step_args(server)[-1] == {"duration": BASIC}     # nothing new: no motors key
+        # clamped locally, with Webots' warning
+        r2.set_motor_velocity(right, -10.0, "test")
+        assert right.velocity == -6.28
+        assert capsys.readouterr().err == ('WARNING: RotationalMotor "right wheel motor": The requested velocity -10 '
+                                           "exceeds 'maxVelocity' = 6.28.\n")
+        r2.set_motor_velocity(left, math.inf, "test")            # Webots clamps inf too
+        assert left.velocity == 6.28
+        # commands set while a step is pending go with the next one
+        server.hold = True
+        r2.step_begin()
+        r2.set_motor_velocity(left, 1.0, "test")
+        _until(lambda: len(_step_args(server)) == 3)
+        assert _step_args(server)[-1]["motors"] == {RIGHT: {"velocity": -6.28}, LEFT: {"velocity": 6.28}}
+        server.release()
+        assert r2.step_end() == 0
+        r2.step()
+        assert _step_args(server)[-1]["motors"] == {LEFT: {"velocity": 1.0}}
+        # error paths raise (Webots prints and ignores); nothing is buffered
+        for bad in (math.nan, "fast", True, None):
+            with pytest.raises(SensoriumError) as err:
+                r2.set_motor_velocity(left, bad, "wb_motor_set_velocity")
+            assert err.value.code == ErrorCode.INVALID_ARGUMENT and "wb_motor_set_velocity()" in str(err.value)
+        with pytest.raises(SensoriumError, match="NaN"):
+            r2.set_motor_position(left, math.nan, "wb_motor_set_position")
+        r2.set_motor_position(left, 1.5, "test")
+        with pytest.raises(SensoriumError, match="negative 'velocity' argument in position control mode"):
+            r2.set_motor_velocity(left, -1.0, "wb_motor_set_velocity")
+        assert r2.motor_commands == {LEFT: {"position": 1.5}}
+
+
+def test_motor_description_defaults_follow_libcontroller(minimal_server):
+    with wb.RobotClient(minimal_server.endpoint, robot="r2", timeout=2.0) as r2:
+        left = r2.by_name[LEFT]                                  # description with name and type only
+        assert (left.max_velocity, left.velocity, left.target_position) == (10.0, 10.0, 0.0)
+
+
+def test_flat_motor_api(server, monkeypatch, capsys):
+    monkeypatch.setenv("SENSORIUM_CONTROLLER_URL", f"{server.endpoint}/r2")
+    try:
+        wb.wb_robot_init()
+        assert wb.wb_robot_get_number_of_devices() == 3
+        left, right = wb.wb_robot_get_device(LEFT), wb.wb_robot_get_device(RIGHT)
+        assert (left, right) == (2, 3) and wb.wb_device_get_type_name(left) == "RotationalMotor"
+        assert wb.wb_motor_get_max_velocity(left) == 6.28 and wb.wb_motor_get_velocity(left) == 0.0
+        wb.wb_motor_set_position(left, math.inf)
+        wb.wb_motor_set_velocity(left, 7.0)
+        assert "exceeds 'maxVelocity' = 6.28" in capsys.readouterr().err
+        assert (wb.wb_motor_get_target_position(left), wb.wb_motor_get_velocity(left)) == (math.inf, 6.28)
+        assert (wb.wb_motor_get_min_position(left), wb.wb_motor_get_max_position(left)) == (0.0, 0.0)
+        assert wb.wb_motor_get_type(left) == wb.WB_ROTATIONAL and wb.wb_motor_get_position_sensor(left) == 0
+        with pytest.raises(SensoriumError) as err:
+            wb.wb_motor_set_velocity(wb.wb_robot_get_device("ds"), 1.0)
+        assert "DistanceSensor, not a RotationalMotor" in str(err.value)
+        with pytest.raises(SensoriumError):
+            wb.wb_distance_sensor_enable(left, 32)
+        assert wb.wb_robot_step(64) == 0
+        assert _step_args(server)[-1] == {"duration": 64, "motors": {LEFT: {"position": math.inf, "velocity": 6.28}}}
+    finally:
+        wb.wb_robot_cleanup()
+
+
+def test_motor_class(server, monkeypatch, capsys):
+    controller = _controller_module()
+    monkeypatch.setenv("SENSORIUM_CONTROLLER_URL", f"{server.endpoint}/r2")
+    try:
+        robot = controller.Robot()
+        left = robot.getDevice(LEFT)
+        right = robot.getMotor(RIGHT)
+        assert "DEPRECATION: Robot.getMotor is deprecated" in capsys.readouterr().err
+        assert isinstance(left, controller.RotationalMotor) and isinstance(right, controller.Motor)
+        assert robot.devices[LEFT] is left and robot.getDeviceByIndex(2) is right and left.getName() == LEFT
+        assert left.getPositionSensor() is None and left.position_sensor is None and left.getBrake() is None
+        assert left.getType() == controller.Motor.ROTATIONAL == left.type
+        assert (left.getMaxVelocity(), left.max_velocity, left.getMinPosition(), left.max_position) == (6.28, 6.28, 0.0, 0.0)
+        for m in (left, right):
+            m.setPosition(float("inf"))
+        left.setVelocity(1.25)
+        right.target_velocity = -2.5                             # Webots' property spelling
+        assert (left.getVelocity(), right.target_velocity, left.getTargetPosition(), right.target_position) == (
+            1.25, -2.5, math.inf, math.inf)
+        assert robot.step() == 0
+        assert _step_args(server)[-1]["motors"] == {LEFT: {"position": math.inf, "velocity": 1.25},
+                                                    RIGHT: {"position": math.inf, "velocity": -2.5}}
+    finally:
+        wb.wb_robot_cleanup()
+        controller.Robot.created = None
+
+
 # ====================================================================== topics
 
 def _frames(topic: str, msg_type: str, seq: int, body: dict) -> list[bytes]:
@@ -564,7 +683,7 @@ def test_client_imports_with_pyzmq_and_msgpack_only():
         import sensorium.client, sensorium.client.connection, sensorium.client.wb, sensorium.client.topics
         import sensorium.client.cli, sensorium.client.webots.controller
         sys.path.insert(0, {str(WEBOTS_DIR)!r})
-        from controller import Robot, LightSensor, DistanceSensor, Lidar, LidarPoint
+        from controller import Robot, LightSensor, DistanceSensor, Lidar, LidarPoint, Motor, RotationalMotor
         bad = [m for m in sys.modules if m.split(".")[0] in HEAVY
                or m.startswith(("sensorium.server", "sensorium.schemas"))]
         assert not bad, bad

@@ -4,7 +4,9 @@
   bit-identical to an in-process ``Simulation`` of the same world, seed, enables and steps;
 * a controller SIGKILLed mid-run does not block the others, and a new process can take its robot;
 * Webots-style controllers (the examples) run through ``sensorium controller``, and ``sensorium
-  topics`` / ``echo`` work against the live server.
+  topics`` / ``echo`` work against the live server;
+* a controller driving the e-puck's wheel motors ends at exactly the pose (and passes exactly the
+  poses, on the ``/epuck/pose`` topic) of the in-process simulation; the examples really drive.
 """
 
 from __future__ import annotations
@@ -305,4 +307,84 @@ def test_examples_through_the_launcher_with_topics_and_echo(servers, tmp_path):
     assert len(wanderer.out) == 3 and "lidar front=" in wanderer.out[0] and "->" in wanderer.out[0]
     assert echo.wait(30) == 0, echo.stderr()
     assert len(echo.out) == 2 and echo.out[0].startswith("/epuck/ls0/value [sensor_msgs/msg/Illuminance]")
+    assert server.stop() == 0
+
+
+# ====================================================================== wheel motors, poses
+
+def _pose_values(pose) -> list[float]:
+    from sensorium.server.topics import pose_quaternion
+
+    return [float(v) for v in pose.translation] + pose_quaternion(pose)
+
+
+def _message_pose(body: dict) -> list[float]:
+    p, q = body["pose"]["position"], body["pose"]["orientation"]
+    return [p["x"], p["y"], p["z"], q["x"], q["y"], q["z"], q["w"]]
+
+
+def test_driven_epuck_matches_the_in_process_simulation(servers, tmp_path):
+    from sensorium.client.topics import Subscriber
+    from sensorium.server.simulation import Simulation
+
+    steps, switch_at, speeds, later = 60, 40, (5.0, 5.0), (2.0, 6.0)     # straight, then a left arc
+    started, procs = servers
+    server = Server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
+    started.append(server)
+    start_pose = server.conn.call("/epuck/robot/get_pose")
+    with Subscriber(server.pub, "/epuck/pose") as sub:
+        deadline = time.monotonic() + 20
+        while b"/epuck/pose\0" not in server.conn.call("get_counters")["subscriptions"]:
+            assert time.monotonic() < deadline, "the subscription never arrived"
+            time.sleep(0.02)
+        drive = Proc(sensorium("controller", str(CONTROLLERS / "drive.py"), "--url", server.url("epuck"), str(steps),
+                               *map(str, speeds), str(switch_at), *map(str, later)))
+        procs.append(drive)
+        server.wait_attached({"epuck"})
+        server.conn.call("set_mode", {"mode": "fast"})
+        assert drive.wait(60) == 0, drive.stderr()
+        assert drive.out == [str(32 * steps)]
+        got = server.conn.call("/epuck/robot/get_pose")
+        messages = []
+        while len(messages) < steps and (msg := sub.recv(timeout=10)) is not None:
+            messages.append(msg)
+    # the same commands in process: applied before the first step, the turn before step 41
+    sim = Simulation.from_file(ARENA)
+    epuck = sim.robot("epuck")
+    expected = []
+    for n in range(steps):
+        for motor, speed in zip(("left wheel motor", "right wheel motor"), later if n == switch_at else speeds):
+            if n in (0, switch_at):
+                epuck.motor(motor).set_position(math.inf)
+                epuck.motor(motor).set_velocity(speed)
+        sim.step()
+        expected.append((sim.time_ms, _pose_values(epuck.pose)))
+    assert got["translation"] + got["quaternion"] == expected[-1][1]            # bit-identical floats
+    assert [(m.stamp_ns // 1_000_000, m.seq, _message_pose(m.body)) for m in messages] == [
+        (t, i, pose) for i, (t, pose) in enumerate(expected)]
+    assert all(m.body["header"]["frame_id"] == "world" and m.type == "geometry_msgs/msg/PoseStamped" for m in messages)
+    # it really drove: 40 steps straight at 5 rad/s x 0.0205 m, then turned left
+    travelled = math.dist(start_pose["translation"][:2], got["translation"][:2])
+    assert 0.13 < travelled < 0.2
+    assert got["quaternion"] != start_pose["quaternion"]
+    assert server.stop() == 0
+
+
+def test_examples_drive_their_robots(servers, tmp_path):
+    started, procs = servers
+    server = Server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
+    started.append(server)
+    before = {r: server.conn.call(f"/{r}/robot/get_pose") for r in ("epuck", "scout")}
+    braitenberg = Proc(sensorium("controller", str(EXAMPLES / "braitenberg.py"), "--url", server.url("epuck"), "300"))
+    wanderer = Proc(sensorium("controller", str(EXAMPLES / "wanderer.py"), "--url", server.url("scout"), "100"))
+    procs += [braitenberg, wanderer]
+    server.wait_attached({"epuck", "scout"})
+    server.conn.call("set_mode", {"mode": "fast"})
+    assert braitenberg.wait(120) == 0, braitenberg.stderr()
+    assert wanderer.wait(120) == 0, wanderer.stderr()
+    assert len(braitenberg.out) == 300 and len(wanderer.out) == 100
+    after = {r: server.conn.call(f"/{r}/robot/get_pose") for r in ("epuck", "scout")}
+    moved = {r: math.dist(before[r]["translation"][:2], after[r]["translation"][:2]) for r in before}
+    assert moved["epuck"] > 0.1, moved          # ~9.6 s at about half the e-puck's top speed
+    assert moved["scout"] > 0.05 or after["scout"]["quaternion"] != before["scout"]["quaternion"], moved
     assert server.stop() == 0

@@ -117,7 +117,7 @@ def test_serve_record_and_determinism(server_factory, tmp_path):
     def run(k: int) -> None:
         server = servers[k].ready()
         drive(server, 25, move_at=10)
-        assert "recorded 450 messages" in server.stop(signal.SIGTERM if k == 0 else signal.SIGINT)
+        assert "recorded 500 messages" in server.stop(signal.SIGTERM if k == 0 else signal.SIGINT)
 
     threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
     for t in threads:
@@ -127,7 +127,8 @@ def test_serve_record_and_determinism(server_factory, tmp_path):
     a, b = (messages(tmp_path / f"run{k}.mcap") for k in range(2))
     assert a == b
     topics = {m[0] for m in a}  # no subscriber at all: the recorder's demand computed every topic
-    assert len(topics) == 18 and "/scout/lidar/point_cloud" in topics and "/epuck/ps0/value" in topics and "/clock" in topics
+    assert len(topics) == 20 and "/scout/lidar/point_cloud" in topics and "/epuck/ps0/value" in topics and "/clock" in topics
+    assert "/epuck/pose" in topics and "/scout/pose" in topics
     for topic in topics:  # every topic, every step, seq from 0 without a hole
         seqs = [m[2] for m in a if m[0] == topic]
         assert seqs == list(range(25)), topic
@@ -152,14 +153,14 @@ def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):
     th = threading.Thread(target=live.run, kwargs={"duration": 30}, daemon=True)
     th.start()
     server.wait_subscribed()
-    drive(server, 30)  # 8 distance + 2 light sensors: 300 messages
+    drive(server, 30)  # 8 distance + 2 light sensors + the pose: 330 messages
     deadline = time.monotonic() + 10
-    while live.gaps.total_received < 300 and time.monotonic() < deadline:
+    while live.gaps.total_received < 330 and time.monotonic() < deadline:
         time.sleep(0.02)
     live.stop()
     th.join(5)
     summary = live.close()
-    assert summary["received"] == 300 and summary["gaps"] == 0 and summary["lost"] == 0
+    assert summary["received"] == 330 and summary["gaps"] == 0 and summary["lost"] == 0
     with Recording(out) as rec:
         assert rec.metadata()["sensorium"]["basic_time_step_ms"] == "32"
         subscribed = [(m.topic, m.seq, m.data) for m in rec.messages()]
@@ -168,7 +169,7 @@ def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):
     while time.monotonic() < deadline:
         try:
             with Recording(path) as rec:
-                if sum(1 for _ in rec.messages()) == 300:
+                if sum(1 for _ in rec.messages()) == 330:
                     break
         except Exception:
             pass
@@ -180,7 +181,7 @@ def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):
         recorded = [(m.topic, m.seq, m.data) for m in rec.messages()]
     assert recorded == subscribed  # nothing lost on either side: the exact published bytes
     info = subprocess.run([PY, "-m", "sensorium.cli", "info", str(path)], capture_output=True, text=True, timeout=30)
-    assert "Truncated:         YES" in info.stdout and "Messages:          300" in info.stdout
+    assert "Truncated:         YES" in info.stdout and "Messages:          330" in info.stdout
 
 
 def test_record_connect_reports_exact_loss(server_factory, tmp_path):

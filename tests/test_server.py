@@ -299,6 +299,46 @@ def test_realtime_mode_paces_and_reports_rtf(client):
     assert 0.5 < rtf < 1.5
 
 
+def test_motors_over_the_wire_match_the_in_process_simulation(client):
+    from sensorium.server.simulation import Simulation
+    from sensorium.server.topics import pose_quaternion
+
+    c = client()
+    res = c.attach("rover")
+    assert res["devices"] == [
+        {"name": n, "type": "RotationalMotor", "maxVelocity": 8.0, "minPosition": 0.0, "maxPosition": 0.0,
+         "targetPosition": 0.0, "velocity": 8.0} for n in ("left wheel motor", "right wheel motor")]
+    t0 = res["time_ms"]
+    assert error_code(c.call("/rover/robot/step", {"motors": {"left wheel motor": {"position": math.nan}}})) == 5
+    assert error_code(c.call("/rover/robot/step", {"motors": {"left wheel motor": {"velocity": math.inf}}})) == 5
+    assert error_code(c.call("/rover/robot/step", {"motors": {"wheel": {"velocity": 1.0}}})) == 4
+    plan = [({"left wheel motor": {"position": math.inf, "velocity": 5.0},
+              "right wheel motor": {"position": math.inf, "velocity": 5}}, 6),
+            ({"left wheel motor": {"velocity": 2.5}, "right wheel motor": {"velocity": 9.0}}, 5)]   # 9 -> 8 (clamped)
+    for motors, steps in plan:
+        assert c.ok("/rover/robot/step", {"motors": motors})["status"] == 0
+        for _ in range(steps - 1):
+            c.ok("/rover/robot/step")
+    assert c.ok("/rover/left wheel motor/get_target_position") == {"value": math.inf}     # inf survives msgpack
+    assert c.ok("/rover/right wheel motor/get_velocity") == {"value": 8.0}
+    got = c.ok("/rover/robot/get_pose")
+    # the same commands at the same times, in process
+    sim = Simulation.from_file(WORLD, precision="fast")
+    sim.run(t0 // BASIC)
+    rover = sim.robot("rover")
+    for motors, steps in plan:
+        for name, cmd in motors.items():
+            if "position" in cmd:
+                rover.motor(name).set_position(cmd["position"])
+            rover.motor(name).set_velocity(cmd["velocity"])
+        sim.run(steps)
+    assert got["translation"] == [float(v) for v in rover.pose.translation]
+    assert got["quaternion"] == pose_quaternion(rover.pose) and got["quaternion"][2] != 0.0     # it turned
+    assert got["translation"] != [0.5, -1.0, 0.0]
+    c.ok("/rover/left wheel motor/set_velocity", {"value": 0.0})       # leave it parked for the other tests
+    c.ok("/rover/right wheel motor/set_velocity", {"value": 0.0})
+
+
 # ---------------------------------------------------------------------- topics and demand
 
 def counters(c: Raw) -> dict:
@@ -318,7 +358,7 @@ def test_subscriber_gets_every_topic_type(client, ctx, server):
             c.ok("/bot2/robot/step")
         got: dict[str, list] = {}
         deadline = time.monotonic() + 5
-        while len(got) < 9 and time.monotonic() < deadline:
+        while len(got) < 13 and time.monotonic() < deadline:
             if sub.poll(100):
                 frames = sub.recv_multipart()
                 assert len(frames) == 3 and frames[0].endswith(b"\0")
@@ -327,7 +367,8 @@ def test_subscriber_gets_every_topic_type(client, ctx, server):
     finally:
         sub.close(0)
     assert set(got) == {"/clock", "/bot/ls/value", "/bot/ds/value", "/bot/lidar/range_image", "/bot/lidar/laser_scan",
-                        "/bot/lidar/point_cloud", "/bot/lidar2/range_image", "/bot/lidar2/point_cloud", "/free/ls/value"}
+                        "/bot/lidar/point_cloud", "/bot/lidar2/range_image", "/bot/lidar2/point_cloud", "/free/ls/value",
+                        "/bot/pose", "/free/pose", "/bot2/pose", "/rover/pose"}
     for topic, msgs in got.items():
         seqs = [env["seq"] for env, _ in msgs]
         assert seqs == list(range(seqs[0], seqs[0] + len(seqs)))
@@ -338,7 +379,10 @@ def test_subscriber_gets_every_topic_type(client, ctx, server):
             if topic != "/clock":
                 st = body["header"]["stamp"]
                 assert st["sec"] * 10**9 + st["nanosec"] == env["stamp_ns"] and env["stamp_ns"] % (BASIC * 10**6) == 0
-                assert body["header"]["frame_id"] == topic.split("/")[1] + "/" + topic.split("/")[2]
+                if topic.endswith("/pose"):
+                    assert body["header"]["frame_id"] == "world" and env["type"] == M.POSE_STAMPED
+                else:
+                    assert body["header"]["frame_id"] == topic.split("/")[1] + "/" + topic.split("/")[2]
     assert got["/bot/ls/value"][0][0]["type"] == M.ILLUMINANCE
     rng = got["/bot/ds/value"][-1][1]
     assert (rng["radiation_type"], rng["min_range"], rng["max_range"]) == (0, 0.0, 2000.0)
@@ -357,6 +401,8 @@ def test_subscriber_gets_every_topic_type(client, ctx, server):
     assert np.frombuffer(pc["channels"][0]["values"], "<f4").tolist() == [0.0] * 8 + [1.0] * 8
     assert got["/clock"][-1][1]["clock"]["nanosec"] % (BASIC * 10**6) == 0
     assert not math.isnan(got["/bot/ls/value"][-1][1]["illuminance"])
+    pose = got["/bot2/pose"][-1][1]["pose"]
+    assert pose == {"position": {"x": -1.0, "y": 1.0, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}
 
 
 def test_unsubscribed_topics_are_not_computed(client, ctx, server):

@@ -19,8 +19,8 @@ A, B = b"peer-A", b"peer-B"
 
 
 class Harness:
-    def __init__(self, **kw):
-        self.sim = FakeSim(small_world())
+    def __init__(self, world=None, **kw):
+        self.sim = FakeSim(world or small_world())
         self.logs = []
         counter = itertools.count()
         self.core = Core(self.sim, new_token=lambda: f"s{next(counter)}", log=self.logs.append, **kw)
@@ -282,3 +282,175 @@ def test_nan_value_before_first_measurement_is_not_sent(h):
     h.run()
     assert ok(h.reply(rid))["values"] == {}
     assert math.isnan(ok(h.call(A, "get_info"))["real_time_factor"]) is False
+
+
+# ====================================================================== motors and poses
+
+DRIVE = {"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 10.0}
+LEFT, RIGHT = "left wheel motor", "right wheel motor"
+
+
+@pytest.fixture
+def hm():
+    """``bot`` with a differential drive (two wheel motors)."""
+    return Harness(small_world(differential_drive=DRIVE))
+
+
+def test_motors_are_devices_after_the_sensors(hm):
+    info = S.InfoResult.model_validate(ok(hm.call(A, "get_info")))
+    assert [(d.name, d.type) for d in info.robots[0].devices][-3:] == [
+        ("lidar2", "Lidar"), (LEFT, "RotationalMotor"), (RIGHT, "RotationalMotor")]
+    assert "/bot/pose" in [t.name for t in info.topics] and "/free/pose" in [t.name for t in info.topics]
+    res = S.AttachResult.model_validate(ok(hm.call(A, "attach", {"robot": "bot"})))
+    assert [d.name for d in res.devices] == ["ls", "ds", "lidar", "lidar2", LEFT, RIGHT]
+    assert res.devices[4].model_dump() == {"name": LEFT, "type": "RotationalMotor", "maxVelocity": 10.0,
+                                           "minPosition": 0.0, "maxPosition": 0.0, "targetPosition": 0.0,
+                                           "velocity": 10.0}
+    assert ok(hm.call(B, "/bot/robot/get_device_list")) == {"list": ["ls", "ds", "lidar", "lidar2", LEFT, RIGHT]}
+    assert ok(hm.call(B, "/bot/robot/get_number_of_devices")) == {"value": 6}
+    assert ok(hm.call(B, "/free/robot/get_number_of_devices")) == {"value": 1}      # no drive, no motors
+
+
+def test_motor_commands_travel_with_the_step_and_apply_at_once(hm):
+    ok(hm.call(A, "attach", {"robot": "bot"}))
+    left, right = (hm.sim.robots["bot"].motors[n] for n in (LEFT, RIGHT))
+    rid = hm.send(A, "/bot/robot/step", {"duration": 64, "motors": {
+        LEFT: {"position": math.inf, "velocity": 4.0}, RIGHT: {"position": math.inf, "velocity": 4}}})
+    assert hm.out == []                                                  # deferred, but already applied:
+    assert (left.target_position, left.velocity, right.velocity) == (math.inf, 4.0, 4.0)
+    assert hm.sim.time_ms == 0
+    hm.run()
+    assert ok(hm.reply(rid))["time_ms"] == 64
+    pose = ok(hm.call(B, "/bot/robot/get_pose"))
+    assert pose["translation"] == pytest.approx([0.05 * 4.0 * 0.064, 0.0, 0.0], abs=1e-15)   # 2 basic steps straight
+    assert pose["quaternion"] == [0.0, 0.0, 0.0, 1.0]
+    # one key only; the other keeps its value; a clamped velocity; -inf is velocity control too
+    rid = hm.send(A, "/bot/robot/step", {"motors": {LEFT: {"velocity": 99.0}, RIGHT: {"position": -math.inf}}})
+    assert (left.velocity, left.target_position, right.velocity, right.target_position) == (10.0, math.inf, 4.0, -math.inf)
+    hm.run()
+    ok(hm.reply(rid))
+    assert ok(hm.call(B, f"/bot/{LEFT}/get_velocity")) == {"value": 10.0}
+    assert ok(hm.call(B, f"/bot/{RIGHT}/get_target_position")) == {"value": -math.inf}
+    # position control: the wheel turns toward the target at |velocity| and stops there
+    start_left, start_right = left.position, right.position
+    rid = hm.send(A, "/bot/robot/step", {"motors": {LEFT: {"position": start_left + 0.5, "velocity": 10.0},
+                                                    RIGHT: {"position": start_right, "velocity": 1.0}}})
+    hm.run()
+    ok(hm.reply(rid))
+    assert left.position == pytest.approx(start_left + 10.0 * 0.032) and right.position == start_right
+    for _ in range(2):
+        rid = hm.send(A, "/bot/robot/step", {})
+        hm.run()
+        ok(hm.reply(rid))
+    assert left.position == pytest.approx(start_left + 0.5)
+
+
+@pytest.mark.parametrize("motors, code, words", [
+    ({"ghost motor": {"velocity": 1.0}}, ErrorCode.UNKNOWN_DEVICE, "ghost motor"),
+    ({"ds": {"velocity": 1.0}}, ErrorCode.UNKNOWN_DEVICE, "not a motor"),
+    ({LEFT: {"velocity": 1.0}, "nope": {"velocity": 1.0}}, ErrorCode.UNKNOWN_DEVICE, "nope"),   # nothing applied
+    ({LEFT: {"position": math.nan}}, ErrorCode.INVALID_ARGUMENT, "NaN"),
+    ({LEFT: {"velocity": math.nan}}, ErrorCode.INVALID_ARGUMENT, "velocity"),
+    ({LEFT: {"velocity": math.inf}}, ErrorCode.INVALID_ARGUMENT, "finite"),
+    ({LEFT: {"velocity": -math.inf}}, ErrorCode.INVALID_ARGUMENT, "finite"),
+    ({LEFT: {"velocity": "fast"}}, ErrorCode.INVALID_ARGUMENT, "velocity"),
+    ({LEFT: {"velocity": True}}, ErrorCode.INVALID_ARGUMENT, "velocity"),
+    ({LEFT: {"torque": 1.0}}, ErrorCode.INVALID_ARGUMENT, "torque"),
+    ({LEFT: 1.0}, ErrorCode.INVALID_ARGUMENT, LEFT),
+    ([1.0], ErrorCode.INVALID_ARGUMENT, "motors"),
+])
+def test_motor_command_validation(hm, motors, code, words):
+    ok(hm.call(A, "attach", {"robot": "bot"}))
+    left = hm.sim.robots["bot"].motors[LEFT]
+    assert words in err(hm.call(A, "/bot/robot/step", {"motors": motors}), code)
+    assert (left.target_position, left.velocity) == (0.0, left.max_velocity)   # a refused request applies nothing
+    assert hm.core.lockstep.session_for("bot").pending is None
+
+
+def test_refused_step_applies_no_motor_command(hm):
+    ok(hm.call(A, "attach", {"robot": "bot"}))
+    left = hm.sim.robots["bot"].motors[LEFT]
+    err(hm.call(A, "/bot/robot/step", {"duration": 33, "motors": {LEFT: {"velocity": 1.0}}}), ErrorCode.INVALID_ARGUMENT)
+    hm.send(A, "/bot/robot/step", {"motors": {LEFT: {"velocity": 1.0}}})
+    err(hm.call(A, "/bot/robot/step", {"motors": {LEFT: {"velocity": 2.0}}}), ErrorCode.WRONG_STATE)
+    assert left.velocity == 1.0
+    err(hm.call(B, "/bot/robot/step", {"motors": {LEFT: {"velocity": 3.0}}}), ErrorCode.NOT_ATTACHED)
+    assert left.velocity == 1.0
+
+
+def test_motor_services(hm):
+    m = f"/bot/{LEFT}/"
+    err(hm.call(A, m + "set_velocity", {"value": 1.0}), ErrorCode.NOT_ATTACHED)       # setters: the controller only
+    err(hm.call(A, m + "set_position", {"value": 1.0}), ErrorCode.NOT_ATTACHED)
+    assert ok(hm.call(B, m + "get_max_velocity")) == {"value": 10.0}                   # getters: anyone
+    ok(hm.call(A, "attach", {"robot": "bot"}))
+    assert ok(hm.call(A, m + "set_position", {"value": math.inf})) == {"success": True}
+    assert ok(hm.call(A, m + "set_velocity", {"value": -12})) == {"success": True}
+    assert ok(hm.call(B, m + "get_target_position")) == {"value": math.inf}
+    assert ok(hm.call(B, m + "get_velocity")) == {"value": -10.0}                      # clamped
+    assert "NaN" in err(hm.call(A, m + "set_position", {"value": math.nan}), ErrorCode.INVALID_ARGUMENT)
+    err(hm.call(A, m + "set_velocity", {"value": math.inf}), ErrorCode.INVALID_ARGUMENT)
+    err(hm.call(A, m + "set_velocity", {}), ErrorCode.INVALID_ARGUMENT)
+    assert "RotationalMotor bot/left wheel motor has no service 'enable'" in err(
+        hm.call(A, m + "enable", {"value": 32}), ErrorCode.UNKNOWN_DEVICE)
+    err(hm.call(A, "/bot/ls/set_velocity", {"value": 1.0}), ErrorCode.UNKNOWN_DEVICE)
+    err(hm.call(A, "/free/left wheel motor/get_velocity"), ErrorCode.UNKNOWN_DEVICE)
+    rid = hm.send(A, "/bot/robot/step", {})
+    hm.run()
+    ok(hm.reply(rid))
+    assert ok(hm.call(B, "/bot/robot/get_pose"))["translation"][0] != 0.0             # turning backwards on the spot
+    # released, the robot stops: its wheels hold where they are; a new controller sees that
+    angle = hm.sim.robots["bot"].motors[LEFT].position
+    assert angle < 0.0
+    ok(hm.call(A, "detach", {"session": "s0"}))
+    desc = ok(hm.call(B, "attach", {"robot": "bot"}))["devices"][4]
+    assert (desc["targetPosition"], desc["velocity"]) == (angle, -10.0)
+
+
+def test_set_pose_resets_the_drive(hm):
+    ok(hm.call(A, "attach", {"robot": "bot"}))
+    motors = {LEFT: {"position": math.inf, "velocity": 2.0}, RIGHT: {"position": math.inf, "velocity": 2.0}}
+    rid = hm.send(A, "/bot/robot/step", {"motors": motors})
+    hm.run()
+    ok(hm.reply(rid))
+    assert ok(hm.call(B, "/bot/robot/set_pose", {"translation": [1.0, 2.0, 0.5], "quaternion": [0, 0, 0, 1]}))["success"]
+    rid = hm.send(A, "/bot/robot/step", {})
+    hm.run()
+    ok(hm.reply(rid))
+    pose = ok(hm.call(B, "/bot/robot/get_pose"))
+    assert pose["translation"] == pytest.approx([1.0 + 0.05 * 2.0 * 0.032, 2.0, 0.5], abs=1e-15)   # on from the new pose
+
+
+def test_pose_topic_is_lazy_in_counters(hm):
+    ok(hm.call(A, "attach", {"robot": "bot"}))
+    rid = hm.send(A, "/bot/robot/step", {"duration": 64})
+    assert hm.run() == []
+    ok(hm.reply(rid))
+    assert ok(hm.call(A, "get_counters"))["counters"]["poses_built"] == 0
+    hm.core.subscription(b"\x01/bot/pose\0")
+    assert ok(hm.call(A, "get_counters"))["demanded"] == ["/bot/pose"]
+    rid = hm.send(A, "/bot/robot/step", {"duration": 96, "motors": {LEFT: {"position": math.inf, "velocity": 1.0}}})
+    pubs = hm.run()
+    ok(hm.reply(rid))
+    assert ok(hm.call(A, "get_counters"))["counters"]["poses_built"] == 3
+    assert [f[0] for f in pubs] == [b"/bot/pose\0"] * 3
+    last = msgpack.unpackb(pubs[-1][2])
+    pose = ok(hm.call(B, "/bot/robot/get_pose"))
+    p, q = last["pose"]["position"], last["pose"]["orientation"]
+    assert [p["x"], p["y"], p["z"]] == pose["translation"] and [q["x"], q["y"], q["z"], q["w"]] == pose["quaternion"]
+    assert last["header"] == {"stamp": {"sec": 0, "nanosec": 160_000_000}, "frame_id": "world"}
+    hm.core.subscription(b"\x00/bot/pose\0")
+    rid = hm.send(A, "/bot/robot/step", {})
+    assert hm.run() == []
+    assert ok(hm.call(A, "get_counters"))["counters"]["poses_built"] == 3
+
+
+def test_motor_routes_counted():
+    core = Harness(small_world(differential_drive=DRIVE)).core
+    names = S.service_names({"bot": {**{d: k for d, k in [("ls", "LightSensor"), ("ds", "DistanceSensor"),
+                                                          ("lidar", "Lidar"), ("lidar2", "Lidar")]},
+                                     LEFT: "RotationalMotor", RIGHT: "RotationalMotor"},
+                             "free": {"ls": "LightSensor"}})
+    assert set(core.routes) == set(names)
+    assert {n for n in names if n.startswith(f"/bot/{LEFT}/")} == {
+        f"/bot/{LEFT}/{i}" for i in ("set_position", "set_velocity", "get_velocity", "get_max_velocity", "get_target_position")}

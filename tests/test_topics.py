@@ -45,14 +45,19 @@ def test_topic_names_and_types():
         ("/bot/lidar/point_cloud", M.POINT_CLOUD),
         ("/bot/lidar2/range_image", M.IMAGE),             # two layers: no LaserScan
         ("/bot/lidar2/point_cloud", M.POINT_CLOUD),
+        ("/bot/pose", M.POSE_STAMPED),                    # every robot: its pose after each basic step
         ("/free/ls/value", M.ILLUMINANCE),
+        ("/free/pose", M.POSE_STAMPED),
     ]
 
 
 @pytest.mark.parametrize("prefixes, demanded", [
     ([], set()),
     ([b""], {"/clock", "/bot/ls/value", "/bot/ds/value", "/bot/lidar/range_image", "/bot/lidar/laser_scan",
-             "/bot/lidar/point_cloud", "/bot/lidar2/range_image", "/bot/lidar2/point_cloud", "/free/ls/value"}),
+             "/bot/lidar/point_cloud", "/bot/lidar2/range_image", "/bot/lidar2/point_cloud", "/bot/pose",
+             "/free/ls/value", "/free/pose"}),
+    ([b"/bot/pose\0"], {"/bot/pose"}),
+    ([b"/bot/pose/"], set()),
     ([b"/bot/lidar/"], {"/bot/lidar/range_image", "/bot/lidar/laser_scan", "/bot/lidar/point_cloud"}),
     ([b"/bot/lidar"], {"/bot/lidar/range_image", "/bot/lidar/laser_scan", "/bot/lidar/point_cloud",
                        "/bot/lidar2/range_image", "/bot/lidar2/point_cloud"}),
@@ -141,6 +146,7 @@ def test_messages_shapes_order_and_seq():
     msgs = decoded(step(sim, t, 2))
     names = [n for n, _, _ in msgs]
     assert names[0] == "/clock" and names.count("/clock") == 2
+    assert names[1:3] == ["/bot/pose", "/free/pose"] and names.count("/bot/pose") == 2
     assert names.count("/bot/ls/value") == 2 and names.count("/free/ls/value") == 1
     seqs: dict[str, list[int]] = {}
     for name, env, body in msgs:
@@ -149,7 +155,9 @@ def test_messages_shapes_order_and_seq():
         assert list(body) == M.field_order(model)              # ROS field order
         assert list(env) == ["type", "seq", "stamp_ns"]
         seqs.setdefault(name, []).append(env["seq"])
-        if name != "/clock":
+        if name.endswith("/pose"):
+            assert body["header"]["frame_id"] == "world"
+        elif name != "/clock":
             robot, dev = name.split("/")[1:3]
             assert body["header"]["frame_id"] == f"{robot}/{dev}"
             st = body["header"]["stamp"]
@@ -173,6 +181,36 @@ def test_messages_shapes_order_and_seq():
     assert (scan["angle_min"], scan["angle_max"], scan["angle_increment"]) == pytest.approx((0.375, -0.375, -0.25))
     assert (scan["range_min"], scan["range_max"], scan["scan_time"], scan["time_increment"]) == pytest.approx((0.01, 5.0, 0.032, 0.0))
     assert len(scan["ranges"]) == 16 and scan["intensities"] == b""
+
+
+def test_pose_topic_every_basic_step_only_when_demanded():
+    world = small_world(differential_drive={"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 10.0})
+    sim = FakeSim(world)
+    t = Topics(sim)
+    bot = sim.robots["bot"]
+    for m in bot.motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(2.0)                                    # 0.1 m/s straight ahead
+    assert step(sim, t, 3) == [] and t.work["poses_built"] == 0  # nobody asked: never read or packed
+    t.subscription(SUB + b"/bot/pose\0")
+    msgs = decoded(step(sim, t, 2))
+    assert [(n, e["type"], e["seq"], e["stamp_ns"]) for n, e, _ in msgs] == [
+        ("/bot/pose", M.POSE_STAMPED, 0, 128_000_000), ("/bot/pose", M.POSE_STAMPED, 1, 160_000_000)]
+    assert t.work["poses_built"] == 2
+    body = msgs[-1][2]
+    M.PoseStamped.model_validate(body)
+    assert list(body) == ["header", "pose"] and list(body["pose"]) == ["position", "orientation"]
+    assert body["header"] == {"stamp": {"sec": 0, "nanosec": 160_000_000}, "frame_id": "world"}
+    pos, q = body["pose"]["position"], body["pose"]["orientation"]
+    assert list(pos) == ["x", "y", "z"] and list(q) == ["x", "y", "z", "w"]
+    assert pos == {"x": bot.pose.translation[0], "y": 0.0, "z": 0.0} and pos["x"] == pytest.approx(0.1 * 0.160)
+    assert q == {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}
+    t.subscription(UNSUB + b"/bot/pose\0")
+    assert step(sim, t, 2) == [] and t.work["poses_built"] == 2
+    rec = []
+    t.set_recorder(lambda *a: rec.append(a[0]), topics=["/free/pose"])   # the recorder demands it too
+    step(sim, t, 2)
+    assert rec == ["/free/pose"] * 2 and t.work["poses_built"] == 4
 
 
 def cfg(**kw):

@@ -5,9 +5,9 @@
 
 The light sensors ls0 (forward-left) and ls1 (forward-right) drive the opposite wheels harder
 (vehicle 2b, "aggression": it turns toward the light), and the eight infra-red proximity
-sensors ps0..ps7 push it away from obstacles. Sensorium has no motors yet, so the controller
-computes the wheel speeds and prints them with the readings; the motor section below starts
-working unchanged once the robot has wheel motors.
+sensors ps0..ps7 push it away from obstacles. The wheel speeds go to the e-puck's two wheel
+motors (velocity control) and are printed with the readings. Sensorium's drive is kinematic: the
+robot does not collide, so the infra-red avoidance is what keeps it off the walls.
 """
 
 import sys
@@ -30,7 +30,7 @@ proximity = [robot.getDevice(f"ps{i}") for i in range(8)]
 for sensor in eyes + proximity:
     sensor.enable(timestep)
 
-# ---- motors (absent in Sensorium for now: robot.devices has only the sensors)
+# ---- motors (looked up softly, so the controller still runs on a robot without a drive)
 left_motor = robot.devices.get("left wheel motor")
 right_motor = robot.devices.get("right wheel motor")
 for motor in (left_motor, right_motor):

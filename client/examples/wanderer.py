@@ -5,8 +5,7 @@
 
 A 360-degree one-layer lidar gives the free space ahead, left and right; four sonars watch the
 close range. The controller picks a motion (forward, turn left/right, back up) each control
-step and prints it with a summary of what it sees. Sensorium has no motors yet: the drive
-section starts working unchanged once the robot has wheel motors.
+step, sets the two wheel motors accordingly and prints it with a summary of what it sees.
 """
 
 import math
@@ -31,7 +30,7 @@ for sonar in sonars.values():
 resolution = lidar.getHorizontalResolution()
 fov = lidar.getFov()
 
-# ---- motors (absent in Sensorium for now)
+# ---- motors (looked up softly, so the controller still runs on a robot without a drive)
 left_motor = robot.devices.get("left wheel motor")
 right_motor = robot.devices.get("right wheel motor")
 for motor in (left_motor, right_motor):

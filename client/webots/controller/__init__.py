@@ -9,6 +9,8 @@ from .device import Device, Sensor
 from .distance_sensor import DistanceSensor
 from .lidar import Lidar, LidarPoint
 from .light_sensor import LightSensor
+from .motor import Motor, RotationalMotor
 from .robot import Robot
 
-__all__ = ["Device", "DistanceSensor", "Lidar", "LidarPoint", "LightSensor", "Robot", "Sensor", "SensoriumError"]
+__all__ = ["Device", "DistanceSensor", "Lidar", "LidarPoint", "LightSensor", "Motor", "Robot", "RotationalMotor",
+           "Sensor", "SensoriumError"]

@@ -10,11 +10,13 @@ from .device import Device
 from .distance_sensor import DistanceSensor
 from .lidar import Lidar
 from .light_sensor import LightSensor
+from .motor import RotationalMotor
 
 _CLASSES: dict[str, type[Device]] = {
     wb.LIGHT_SENSOR: LightSensor,
     wb.DISTANCE_SENSOR: DistanceSensor,
     wb.LIDAR: Lidar,
+    wb.ROTATIONAL_MOTOR: RotationalMotor,
 }
 
 
@@ -76,6 +78,9 @@ class Robot:
 
     def getLidar(self, name: str) -> Device | None:
         return self._deprecated("getLidar", name)
+
+    def getMotor(self, name: str) -> Device | None:
+        return self._deprecated("getMotor", name)
 
     # -- robot information
     def getTime(self) -> float:
