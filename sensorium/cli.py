@@ -162,16 +162,6 @@ def _demo_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
-# --- benchmarks: bench (benchmarks/, installed as sensorium.benchmarks) ---
-@command("bench", "measure accuracy vs time of every knob, scaling, peers and transport; write docs/benchmarks.md",
-         "sensorium.benchmarks.cli:main")
-def _bench_args(p: argparse.ArgumentParser) -> None:
-    from sensorium.benchmarks.cli import add_arguments
-
-    add_arguments(p)
-# --- end benchmarks ---
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sensorium", description="Headless sensor simulator with Webots device semantics.")
     from sensorium import __version__
