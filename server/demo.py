@@ -201,7 +201,8 @@ def _draw(result: DemoResult, world, path: Path) -> None:
 def main(args: argparse.Namespace) -> int:
     out = Path(args.out)
     try:
-        result = run_demo(args.world, args.duration, out, precision=args.precision)
+        result = run_demo(args.world, args.duration, out, precision=args.precision,
+                          log=lambda text: print(text, file=sys.stderr, flush=True))
     except (RuntimeError, subprocess.TimeoutExpired) as exc:
         print(f"demo: failed: {exc}", file=sys.stderr)
         return 1
