@@ -425,7 +425,8 @@ class Replayer:
                 if self.rate > 0 or self._paused:
                     now = time.monotonic()
                     if clock_period is not None and self.rate > 0 and now >= next_clock:
-                        self._publish_clock(max(self._playhead(now), self._base_ns))
+                        # never ahead of the next unpublished message: /clock must not go backwards
+                        self._publish_clock(max(min(self._playhead(now), self._next.stamp_ns), self._base_ns))
                         next_clock = now + clock_period
                     if self._paused:
                         self._service(0.05 if clock_period is None else min(0.05, clock_period))
@@ -457,7 +458,7 @@ class Replayer:
                 self._show_progress()
             if self._stop:
                 break
-            if self.clock_hz is not None and self.time_ns != self._last_clock_ns:
+            if self.clock_hz is not None and (self._last_clock_ns is None or self.time_ns > self._last_clock_ns):
                 self._publish_clock(self.time_ns)
             if not self.loop:
                 break
