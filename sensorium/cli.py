@@ -162,6 +162,18 @@ def _demo_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
+# --- benchmarks: bench (benchmarks/, installed as sensorium.benchmarks) ---
+@command("bench", "measure accuracy vs time of every knob, scaling, peers and transport; write docs/benchmarks.md",
+         "sensorium.benchmarks.cli:main")
+def _bench_args(p: argparse.ArgumentParser) -> None:
+    try:
+        from sensorium.benchmarks.cli import add_arguments
+    except ImportError:      # benchmarks/ not installed: keep every other command working
+        return
+    add_arguments(p)
+# --- end benchmarks ---
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sensorium", description="Headless sensor simulator with Webots device semantics.")
     from sensorium import __version__

@@ -1,0 +1,13 @@
+"""Sensorium's benchmark suite: ``sensorium bench`` (or ``python -m sensorium.benchmarks``).
+
+One module per section, each ``run(cfg) -> Section``:
+
+* :mod:`.accuracy`  — every knob that trades accuracy for speed, error vs an exact reference and time;
+* :mod:`.scaling`   — time per step vs rays, triangles, lights, devices, robots, with the measured growth;
+* :mod:`.peers`     — the same scene and rays through raw embreex, Open3D, MuJoCo, PyBullet, trimesh;
+* :mod:`.transport` — lockstep round trips and steps/s over loopback against a raw pyzmq floor;
+
+and :mod:`.report` writes ``benchmarks.md``, ``benchmarks.json`` and the PNG plots.
+"""
+
+SECTIONS = ("transport", "accuracy", "scaling", "peers")   # run order: peers last (its libraries start thread pools)
