@@ -1,9 +1,9 @@
 """Device instances: what a controller enables and reads, and how each turns rays into values.
 
-A device *plans* the rays it needs at the end-of-step pose (``plan``), the simulation casts every
-device's rays of a step in as few batched calls as possible, and the device *reduces* its slice of
-the hits to values (``finish``). Devices never read the clock: the simulation passes times in and
-decides who is due (``Schedule``).
+Rays are *planned* at the end-of-step pose, the simulation casts every device's rays of a step in
+as few batched calls as possible, and the hits are *reduced* to values: per lidar here, and for
+all light and distance sensors of a step together in ``batches.py``. Devices never read the clock:
+the simulation passes times in and decides who is due (``Schedule``).
 """
 
 from __future__ import annotations
@@ -17,8 +17,7 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import lidar as lmath
-from sensorium.server.devices import light as light_math
-from sensorium.server.devices.lookup import LookupTable, quantize_sensor
+from sensorium.server.devices.lookup import LookupTable
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.geometry import Pose
 from sensorium.server.raycast import RayHits, RayKind
@@ -34,7 +33,7 @@ class RayRequest:
     t_near: np.ndarray | float
     t_far: np.ndarray | float
     kind: RayKind
-    exclude_owner: int
+    exclude_owner: int | np.ndarray   # per request or per ray
     skip_transparent: bool = False
     tag: str = ""              # counter bucket: "light", "distance", "lidar"
 
@@ -134,33 +133,6 @@ class LightSensor(Device):
         super().__post_init__()
         self.table = LookupTable(self.config.lookup_table)
         self.value = math.nan
-        self._pending: tuple | None = None
-
-    def plan(self, robot_pose: Pose, lights: light_math.LightArrays) -> list[RayRequest]:
-        pose = self.world_pose(robot_pose)
-        p, normal = pose.translation, pose.rotation[:, 0]   # the sensor looks along its +x axis
-        occluding = np.zeros(0, dtype=np.int64)
-        if self.config.occlusion and lights.count:
-            # occlusion rays only toward lights that light the sensor directly: ambient is never
-            # occluded, so a light with no direct term cannot change the value
-            occluding = np.flatnonzero(light_math.direct_mask(p, normal, lights))
-        self._pending = (p, normal, occluding)
-        if occluding.size == 0:
-            return []
-        origins, dirs, lengths = light_math.occlusion_segments(p, lights)
-        return [RayRequest(origins[occluding], dirs[occluding], 0.0, lengths[occluding], RayKind.BOUNDING,
-                           self.exclude_self(), tag="light")]
-
-    def finish(self, hits: list[RayHits], lights: light_math.LightArrays, now_ms: int) -> None:
-        p, normal, occluding = self._pending
-        occluded = np.zeros(lights.count, dtype=bool)
-        if occluding.size:
-            occluded[occluding] = np.isfinite(hits[0].distance)
-        e = light_math.irradiance(p, normal, lights, occluded, np.asarray(self.config.color_filter, dtype=np.float64))
-        v = float(self.table.lookup(np.array([e]), self.rng if self.table.has_noise else None)[0])
-        self.value = float(quantize_sensor(v, self.config.resolution))
-        self._pending = None
-        self._mark(now_ms)
 
     def readings(self) -> dict:
         return {"value": self.value}
@@ -176,41 +148,6 @@ class DistanceSensor(Device):
         self.weights = dmath.ray_weights(c.number_of_rays, c.aperture, c.gaussian_width)
         self.lut_max_range = float(c.lookup_table[-1][0]) if c.lookup_table else math.inf
         self.value = math.nan
-        self._dirs_world: np.ndarray | None = None
-
-    def plan(self, robot_pose: Pose) -> list[RayRequest]:
-        if not self.config.lookup_table:
-            return []  # empty table: value 0, no ray matters (§3.1)
-        pose = self.world_pose(robot_pose)
-        dirs = pose.apply_dirs(self.directions_local)
-        self._dirs_world = dirs
-        origins = np.broadcast_to(pose.translation, dirs.shape)
-        infra_red = self.type_code == dmath.SENSOR_TYPES["infra-red"]
-        return [RayRequest(
-            np.ascontiguousarray(origins), dirs, 0.0, self.lut_max_range,
-            RayKind.VISUAL if infra_red else RayKind.BOUNDING,
-            # infra-red sees the robot's own visual shapes (Webots); ODE rays skip them
-            -1 if infra_red else self.exclude_self(),
-            skip_transparent=self.type_code == dmath.SENSOR_TYPES["laser"],
-            tag="distance",
-        )]
-
-    def finish(self, hits: list[RayHits], scene_red: np.ndarray, scene_roughness: np.ndarray, now_ms: int) -> None:
-        if not self.config.lookup_table:
-            self.value = 0.0
-            self._mark(now_ms)
-            return
-        h = hits[0]
-        reflection = None
-        if self.type_code == dmath.SENSOR_TYPES["infra-red"]:
-            # colour lookups only for infra-red; shape -1 picks the trailing "no hit" entry
-            reflection = dmath.reflection_factor(scene_red[h.shape], scene_roughness[h.shape])
-            reflection = np.where(h.shape >= 0, reflection, 1.0)
-        d = dmath.combine_distance(self.type_code, h.distance, self._dirs_world, h.normal, self.weights,
-                                   self.lut_max_range, reflection, self.config.red_color_sensitivity)
-        v = float(self.table.lookup(np.array([d]), self.rng if self.table.has_noise else None)[0])
-        self.value = float(quantize_sensor(v, self.config.resolution))
-        self._mark(now_ms)
 
     def readings(self) -> dict:
         return {"value": self.value}

@@ -24,7 +24,8 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.geometry import Pose
 from sensorium.server.motion import DifferentialDrive, WheelMotor
 from sensorium.server.raycast import Precision, RayHits
-from sensorium.server.sensors import DEVICE_CLASSES, Device, Lidar, LightSensor, RayRequest
+from sensorium.server.batches import DistanceBatch, LightBatch
+from sensorium.server.sensors import DEVICE_CLASSES, Device, DistanceSensor, Lidar, LightSensor, RayRequest
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
 from sensorium.server.world.scene import Scene
@@ -176,33 +177,40 @@ class Simulation:
             pose = robot.drive.step(dt)
             if pose is not None:
                 self.scene.set_robot_pose(robot.index, pose)
-        due: list[tuple[Device, list[RayRequest]]] = []
+        poses = self.scene.robot_poses
+        lights: list[LightSensor] = []
+        distances: list[DistanceSensor] = []
+        lidars: list[Lidar] = []
         for robot in self.robots.values():
-            pose = robot.pose
             for dev in robot.devices.values():
                 if isinstance(dev, Lidar):
                     if dev.due(now):
-                        due.append((dev, dev.plan(pose, now, dt)))
+                        lidars.append(dev)
                 elif dev.schedule.due(now):
-                    if isinstance(dev, LightSensor):
-                        due.append((dev, dev.plan(pose, self.lights)))
-                    else:
-                        due.append((dev, dev.plan(pose)))
-        hits = self._cast_batched([req for _, reqs in due for req in reqs])
+                    (lights if isinstance(dev, LightSensor) else distances).append(dev)
+        work: list[tuple[object, list[RayRequest]]] = []
+        if lights:
+            batch = LightBatch(lights, poses, self.lights)
+            work.append((batch, batch.plan()))
+        if distances:
+            batch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness)
+            work.append((batch, batch.plan()))
+        for lidar in lidars:
+            work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt)))
+        hits = self._cast_batched([req for _, reqs in work for req in reqs])
         k = 0
-        for dev, reqs in due:
+        for item, reqs in work:
             mine = hits[k:k + len(reqs)]
             k += len(reqs)
-            if isinstance(dev, LightSensor):
-                dev.finish(mine, self.lights, now)
-            elif isinstance(dev, Lidar):
-                dev.finish(mine, now, self._counters)
+            if isinstance(item, Lidar):
+                item.finish(mine, now, self._counters)
             else:
-                dev.finish(mine, self.scene.red, self.scene.roughness, now)
-            if not isinstance(dev, Lidar) or not dev.rotating:
-                dev.schedule.last_update_ms = now
-        self._counters["measurements"] += len(due)
-        return StepReport(now, [d for d, _ in due])
+                item.finish(mine, now)
+        for dev in (*lights, *distances, *(x for x in lidars if not x.rotating)):
+            dev.schedule.last_update_ms = now
+        measured = [*lights, *distances, *lidars]
+        self._counters["measurements"] += len(measured)
+        return StepReport(now, measured)
 
     def run(self, steps: int) -> None:
         for _ in range(steps):
@@ -226,7 +234,7 @@ class Simulation:
             dirs = np.concatenate([r.directions for r in reqs])
             t_near = np.concatenate([np.broadcast_to(np.asarray(r.t_near, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
             t_far = np.concatenate([np.broadcast_to(np.asarray(r.t_far, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
-            owners = np.concatenate([np.full(n, r.exclude_owner, dtype=np.int64) for r, n in zip(reqs, sizes)])
+            owners = np.concatenate([np.broadcast_to(np.asarray(r.exclude_owner, dtype=np.int64), (n,)) for r, n in zip(reqs, sizes)])
             hits = engine.cast(origins, dirs, t_near, t_far, kind=kind, exclude_owner=owners, skip_transparent=skip)
             self._counters["cast_calls"] += 1
             start = 0

@@ -204,10 +204,26 @@ def irradiance_many(positions: np.ndarray, normals: np.ndarray, lights: LightArr
     ``occluded`` (S,n) bool or None, colour filters (S,3) or (3,)."""
     P = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
-    S, n = len(P), len(lights)
+    if len(lights) == 0:
+        return np.zeros(len(P))
+    att, direct = _terms(P, N, lights)
+    return irradiance_from_terms(att, direct, lights, occluded, color_filters)
+
+
+def light_terms(positions: np.ndarray, normals: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Attenuation (S,n) and un-occluded direct term (S,n) of S sensors, to compute once and use
+    both for choosing occlusion rays and for :func:`irradiance_from_terms`."""
+    return _terms(np.asarray(positions, dtype=np.float64).reshape(-1, 3),
+                  np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights)
+
+
+def irradiance_from_terms(att: np.ndarray, direct: np.ndarray, lights: LightArrays,
+                          occluded: np.ndarray | None = None,
+                          color_filters: np.ndarray = (1.0, 1.0, 1.0)) -> np.ndarray:
+    """Irradiance ``E`` (S,) from :func:`light_terms` (see :func:`irradiance_many`)."""
+    S, n = att.shape
     if n == 0:
         return np.zeros(S)
-    att, direct = _terms(P, N, lights)
     if occluded is not None:
         direct = np.where(np.asarray(occluded, dtype=bool).reshape(S, n), 0.0, direct)
     F = np.broadcast_to(np.asarray(color_filters, dtype=np.float64), (S, 3))
@@ -252,3 +268,11 @@ def occlusion_segments(p: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, 
 def light_value(table: LookupTable, e: float, rng: np.random.Generator | None, resolution: float) -> float:
     """LightSensor value: lookup (with relative noise) then resolution rounding (§9.2)."""
     return sensor_output(table, e, rng, resolution)
+
+
+def occlusion_segments_many(positions: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions (S,n,3) and lengths (S,n) of the occlusion segments of S sensors (see
+    :func:`occlusion_segments`; a sensor exactly at a light gets direction (1, 0, 0), length 0)."""
+    _, _, unit, d = _vectors(np.asarray(positions, dtype=np.float64).reshape(-1, 3), lights)
+    unit = np.where((d > 0.0)[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
+    return unit, d

@@ -29,7 +29,7 @@ class LookupTable:
     ``n != 0``. The noisy result is not clamped. An empty table is the identity.
     """
 
-    __slots__ = ("_x", "_y", "_n", "_rows", "_has_noise")
+    __slots__ = ("_x", "_y", "_n", "_rows", "_has_noise", "_increasing")
 
     def __init__(self, rows: Sequence[Sequence[float]]) -> None:
         if any(len(row) != 3 for row in rows):
@@ -42,6 +42,7 @@ class LookupTable:
         self._n = _frozen(table[:, 2])
         self._rows = tuple(tuple(float(c) for c in row) for row in table)
         self._has_noise = bool(np.any(self._n != 0.0))
+        self._increasing = bool(np.all(np.diff(self._x) > 0.0))
 
     # ------------------------------------------------------------------ getters
     @property
@@ -103,13 +104,31 @@ class LookupTable:
         table has no noise. ``rng=None`` evaluates the noise-free value (no draw).
         """
         v = np.asarray(values, dtype=np.float64)
-        m = len(self._x)
-        if m == 0:
+        if len(self._x) == 0:
             return v.copy()
+        out_y, out_n = self.interpolate(v)
+        if self._has_noise and rng is not None:
+            noisy = out_n != 0.0
+            count = int(np.count_nonzero(noisy))
+            if count:
+                out_y = np.array(out_y, dtype=np.float64)
+                out_y[noisy] = out_y[noisy] * (1.0 + out_n[noisy] * gaussian(rng, count))
+        return np.asarray(out_y, dtype=np.float64)
+
+    def interpolate(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Noise-free output ``y`` and interpolated relative noise ``n`` for each value (the table
+        must not be empty): clamping and Webots' bisection. :meth:`lookup` adds the noise; the
+        simulation calls this directly to reduce many sensors sharing a table at once and then
+        draws each sensor's noise from its own stream."""
+        v = np.asarray(values, dtype=np.float64)
+        m = len(self._x)
         x, y, n = self._x, self._y, self._n
         if m == 1:
-            out_y = np.full(v.shape, y[0])
-            out_n = np.full(v.shape, n[0])
+            return np.full(v.shape, y[0]), np.full(v.shape, n[0])
+        if self._increasing:
+            # sorted inputs: Webots' bisection lands on the bracket searchsorted finds
+            lo = np.clip(np.searchsorted(x, v, side="right") - 1, 0, m - 2)
+            hi = lo + 1
         else:
             lo = np.zeros(v.shape, dtype=np.intp)
             hi = np.full(v.shape, m - 1, dtype=np.intp)
@@ -120,22 +139,14 @@ class LookupTable:
                 hi = np.where(active & below, mid, hi)
                 lo = np.where(active & ~below, mid, lo)
                 active = lo + 1 < hi
-            span = x[hi] - x[lo]
-            with np.errstate(invalid="ignore", divide="ignore"):  # clamped entries are replaced below
-                u = np.where(span != 0.0, (v - x[lo]) / np.where(span != 0.0, span, 1.0), 0.0)
-                out_y = (1.0 - u) * y[lo] + u * y[hi]
-                out_n = (1.0 - u) * n[lo] + u * n[hi]
-            low = v <= x[0]
-            high = v >= x[-1]
-            out_y = np.where(low, y[0], np.where(high, y[-1], out_y))
-            out_n = np.where(low, n[0], np.where(high, n[-1], out_n))
-        if self._has_noise and rng is not None:
-            noisy = out_n != 0.0
-            count = int(np.count_nonzero(noisy))
-            if count:
-                out_y = np.array(out_y, dtype=np.float64)
-                out_y[noisy] = out_y[noisy] * (1.0 + out_n[noisy] * gaussian(rng, count))
-        return np.asarray(out_y, dtype=np.float64)
+        span = x[hi] - x[lo]
+        with np.errstate(invalid="ignore", divide="ignore"):  # clamped entries are replaced below
+            u = np.where(span != 0.0, (v - x[lo]) / np.where(span != 0.0, span, 1.0), 0.0)
+            out_y = (1.0 - u) * y[lo] + u * y[hi]
+            out_n = (1.0 - u) * n[lo] + u * n[hi]
+        low = v <= x[0]
+        high = v >= x[-1]
+        return np.where(low, y[0], np.where(high, y[-1], out_y)), np.where(low, n[0], np.where(high, n[-1], out_n))
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
