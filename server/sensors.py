@@ -221,7 +221,7 @@ class Lidar(Device):
             dirs_local = self._all_dirs
             t_far = self._t_far
         pose = self.world_pose(robot_pose)
-        dirs = pose.apply_dirs(dirs_local.reshape(-1, 3))
+        dirs = _rotate(pose.rotation, dirs_local.reshape(-1, 3))
         origins = np.broadcast_to(pose.translation, dirs.shape)
         return [RayRequest(origins, dirs, self.params.near, t_far.reshape(-1), RayKind.VISUAL, -1, tag="lidar")]
 
@@ -259,6 +259,15 @@ class Lidar(Device):
         if self.point_cloud_enabled:
             out["point_cloud"] = self.point_cloud
         return out
+
+
+def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """``vectors @ rotation.T`` by columns: a BLAS matmul here lets OpenBLAS threads stall for tens
+    of milliseconds when the other core is busy (measured), for no gain on (N, 3) arrays."""
+    out = vectors[:, 0:1] * rotation[:, 0]
+    out += vectors[:, 1:2] * rotation[:, 1]
+    out += vectors[:, 2:3] * rotation[:, 2]
+    return out
 
 
 DEVICE_CLASSES = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar}
