@@ -291,30 +291,33 @@ def _raw_embreex_same_rays(sim) -> float:
     from embreex import rtcore_scene as rts
     from embreex.mesh_construction import TriangleMesh
 
-    from sensorium.server.sensors import DistanceSensor
-
     from .common import merge_triangles, world_triangles
 
     V, F = merge_triangles(world_triangles(sim))
     scene = rts.EmbreeScene(rtc.EmbreeDevice())
     TriangleMesh(scene, V.astype(np.float32), F.astype(np.int32))
-    reqs = [r for robot in sim.robots.values() for dev in robot.devices.values() if isinstance(dev, DistanceSensor)
-            for r in dev.plan(robot.pose)]
+    reqs = _distance_requests(sim, per_device=False)
     o = np.concatenate([r.origins for r in reqs]).astype(np.float32)
     d = np.concatenate([r.directions for r in reqs]).astype(np.float32)
-    far = np.concatenate([np.full(len(r), r.t_far, dtype=np.float32) for r in reqs])
+    far = np.concatenate([np.broadcast_to(np.asarray(r.t_far, dtype=np.float32), (len(r),)) for r in reqs])
     return timed(lambda: scene.run(o, d, dists=far.copy(), query="DISTANCE"), 20, warmup=2, min_total_s=0.05)
+
+
+def _distance_requests(sim, per_device: bool) -> list:
+    """The distance sensors' ray requests at the current poses: one per sensor, or batched as a step does."""
+    from sensorium.server.batches import DistanceBatch
+    from sensorium.server.sensors import DistanceSensor
+
+    devs = [dev for robot in sim.robots.values() for dev in robot.devices.values() if isinstance(dev, DistanceSensor)]
+    poses, red, rough = sim.scene.robot_poses, sim.scene.red, sim.scene.roughness
+    if per_device:
+        return [r for dev in devs for r in DistanceBatch([dev], poses, red, rough).plan()]
+    return DistanceBatch(devs, poses, red, rough).plan()
 
 
 def _unbatched_ray_time(sim, cfg: Config) -> float:
     """Cast the rays of every distance sensor of the current state one sensor per engine call."""
-    from sensorium.server.sensors import DistanceSensor
-
-    reqs = []
-    for robot in sim.robots.values():
-        for dev in robot.devices.values():
-            if isinstance(dev, DistanceSensor):
-                reqs += dev.plan(robot.pose)
+    reqs = _distance_requests(sim, per_device=True)
     eng = sim.scene.engine
     cast = getattr(eng.cast, "fn", eng.cast)
 
