@@ -220,8 +220,10 @@ class Connection:
         self._socket = self._context.socket(zmq.DEALER)
         self._socket.setsockopt(zmq.LINGER, 0)
         self._socket.connect(endpoint)
-        self._poller = zmq.Poller()
+        self._poller = zmq.Poller()                  # kept for callers that poll the socket themselves
         self._poller.register(self._socket, zmq.POLLIN)
+        self._rcvtimeo: zmq.Socket | None = None     # the socket whose RCVTIMEO is _rcvtimeo_ms
+        self._rcvtimeo_ms = -1
         self._ids = itertools.count(1)
         self._outstanding: dict[int, str] = {}      # id -> service, for messages
         self._replies: dict[int, dict] = {}
@@ -246,7 +248,8 @@ class Connection:
             timeout = self.timeout
         service = self._outstanding.get(rid, "?")
         deadline = None if timeout is None else time.monotonic() + timeout
-        while rid not in self._replies:
+        replies = self._replies
+        while rid not in replies:
             if rid not in self._outstanding:
                 raise SensoriumError(ErrorCode.WRONG_STATE, f"request {rid} is not outstanding")
             slice_ms = 250
@@ -258,13 +261,21 @@ class Connection:
                         f"no reply to {service!r} from {self.endpoint} within {timeout:g} s "
                         f"(is `sensorium serve` running there?)")
                 slice_ms = max(1, min(slice_ms, int(left * 1000) + 1))
-            if self._poller.poll(slice_ms):
-                self._drain()
-            elif self.heartbeat is not None:
-                problem = self.heartbeat.problem()
-                if problem is not None:
-                    self._outstanding.pop(rid, None)
-                    raise ConnectionLost(f"while waiting for {service!r}: {problem}")
+            # one blocking receive (RCVTIMEO = the slice) instead of poll + non-blocking drain
+            sock = self._socket
+            if self._rcvtimeo is not sock or self._rcvtimeo_ms != slice_ms:
+                sock.setsockopt(zmq.RCVTIMEO, slice_ms)
+                self._rcvtimeo, self._rcvtimeo_ms = sock, slice_ms
+            try:
+                frames = sock.recv_multipart()
+            except zmq.Again:
+                if self.heartbeat is not None:
+                    problem = self.heartbeat.problem()
+                    if problem is not None:
+                        self._outstanding.pop(rid, None)
+                        raise ConnectionLost(f"while waiting for {service!r}: {problem}") from None
+                continue
+            self._accept(frames)
         del self._outstanding[rid]
         reply = self._replies.pop(rid)
         if reply.get("ok") is True:
@@ -282,23 +293,29 @@ class Connection:
         self._replies.pop(rid, None)
 
     def _drain(self) -> None:
-        while True:
+        """Take every reply already received (non-blocking)."""
+        sock = self._socket
+        while sock.getsockopt(zmq.EVENTS) & zmq.POLLIN:
             try:
-                frames = self._socket.recv_multipart(zmq.NOBLOCK)
+                frames = sock.recv_multipart(zmq.NOBLOCK)
             except zmq.Again:
                 return
-            try:
-                reply = unpack(frames[-1])
-            except Exception as exc:  # noqa: BLE001 - any decoding failure is a bad reply
-                raise SensoriumError(ErrorCode.BAD_REPLY, f"undecodable reply from {self.endpoint}: {exc}") from None
-            if not isinstance(reply, dict):
-                raise SensoriumError(ErrorCode.BAD_REPLY, f"reply is not a map: {reply!r}")
-            rid = reply.get("id")
-            if rid is None and reply.get("ok") is False:
-                raise _error_from(reply)          # the server could not read one of our requests
-            if rid in self._outstanding:
-                self._replies[rid] = reply
-            # else: the reply to a request we gave up on (timeout, discard): drop it
+            self._accept(frames)
+
+    def _accept(self, frames: list[bytes]) -> None:
+        """One received reply: keep it if its request is outstanding, else drop it."""
+        try:
+            reply = unpack(frames[-1])
+        except Exception as exc:  # noqa: BLE001 - any decoding failure is a bad reply
+            raise SensoriumError(ErrorCode.BAD_REPLY, f"undecodable reply from {self.endpoint}: {exc}") from None
+        if not isinstance(reply, dict):
+            raise SensoriumError(ErrorCode.BAD_REPLY, f"reply is not a map: {reply!r}")
+        rid = reply.get("id")
+        if rid is None and reply.get("ok") is False:
+            raise _error_from(reply)          # the server could not read one of our requests
+        if rid in self._outstanding:
+            self._replies[rid] = reply
+        # else: the reply to a request we gave up on (timeout, discard): drop it
 
     @property
     def outstanding(self) -> int:

@@ -166,7 +166,7 @@ class Core:
         self.lockstep.heard(peer, now)
         rid: int | None = None
         try:
-            size = sum(len(f) for f in frames[1:])
+            size = len(body) if len(frames) == 2 else sum(len(f) for f in frames[1:])
             if size > self.max_request:
                 raise RequestError(ErrorCode.TOO_LARGE, f"request of {size} bytes exceeds the limit of {self.max_request} bytes")
             req = parse_request(body, self.max_request)

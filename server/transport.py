@@ -31,6 +31,9 @@ DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
 STEP_BUDGET_S = 0.005          # at most this long stepping before looking at the sockets again
 MAX_IDLE_WAIT_S = 1.0
+MAX_IDLE_WAIT_MS = int(MAX_IDLE_WAIT_S * 1000)
+EXPIRE_EVERY_S = 0.01           # session expiry scan at most this often while messages flow
+ZERO_COPY_MIN = 64 * 1024       # replies at least this large are sent zero-copy
 
 
 def _bindable(url: str) -> str:
@@ -105,26 +108,44 @@ class Transport:
     # ------------------------------------------------------------------ loop
     def run(self) -> None:
         core = self.core
+        clock = self.clock
+        router, xpub = self.router, self.xpub
+        poll = self.poller.poll
+        POLLIN, EVENTS = zmq.POLLIN, zmq.EVENTS
         quit_at: float | None = None
+        next_expire = 0.0
         try:
             while True:
-                now = self.clock()
                 if self._stop_requested and quit_at is None:
                     self._send_replies(core.shutdown())
-                    quit_at = now + self.grace_s
+                    quit_at = clock() + self.grace_s
+                # fast path: a request already queued (e.g. the next step) is served without polling
+                if router.getsockopt(EVENTS) & POLLIN:
+                    self._drain_router()
+                    if xpub.getsockopt(EVENTS) & POLLIN:
+                        self._drain_xpub()
+                    timed_out = False
+                else:
+                    now = clock()
+                    if quit_at is not None and now >= quit_at:
+                        break
+                    events = poll(self._timeout(now, quit_at))
+                    timed_out = not events
+                    for sock, _ in events:
+                        if sock is router:
+                            self._drain_router()
+                        elif sock is xpub:
+                            self._drain_xpub()
+                        else:
+                            self._drain_wake()
+                now = clock()
                 if quit_at is not None and now >= quit_at:
                     break
-                timeout = self._timeout(now, quit_at)
-                events = dict(self.poller.poll(timeout))
-                if self.router in events:
-                    self._drain_router()
-                if self.xpub in events:
-                    self._drain_xpub()
-                if self._wake_r.fileno() in events:
-                    self._drain_wake()
-                now = self.clock()
-                core.expire(now)
-                self._run_steps()
+                # session expiry: when a deadline woke us, else at most every EXPIRE_EVERY_S
+                if timed_out or now >= next_expire:
+                    core.expire(now)
+                    next_expire = now + EXPIRE_EVERY_S
+                self._run_steps(now)
         finally:
             self.close()
 
@@ -133,22 +154,28 @@ class Transport:
         if quit_at is not None:
             deadline = quit_at if deadline is None else min(deadline, quit_at)
         if deadline is None:
-            return int(MAX_IDLE_WAIT_S * 1000)
-        return max(0, min(int(MAX_IDLE_WAIT_S * 1000), int((deadline - now) * 1000 + 0.999)))
+            return MAX_IDLE_WAIT_MS
+        return max(0, min(MAX_IDLE_WAIT_MS, int((deadline - now) * 1000 + 0.999)))
 
     def _drain_router(self, limit: int = 1000) -> None:
-        core = self.core
+        core, router, clock = self.core, self.router, self.clock
+        recv, EVENTS, POLLIN, NOBLOCK = router.recv_multipart, zmq.EVENTS, zmq.POLLIN, zmq.NOBLOCK
         for _ in range(limit):
+            if not router.getsockopt(EVENTS) & POLLIN:   # cheaper than a recv raising zmq.Again
+                return
             try:
-                frames = self.router.recv_multipart(zmq.NOBLOCK, copy=True)
+                frames = recv(NOBLOCK, copy=True)
             except zmq.Again:
                 return
-            self._send_replies(core.handle(frames, self.clock()))
+            self._send_replies(core.handle(frames, clock()))
 
     def _drain_xpub(self, limit: int = 1000) -> None:
+        xpub = self.xpub
         for _ in range(limit):
+            if not xpub.getsockopt(zmq.EVENTS) & zmq.POLLIN:
+                return
             try:
-                event = self.xpub.recv(zmq.NOBLOCK)
+                event = xpub.recv(zmq.NOBLOCK)
             except zmq.Again:
                 return
             self.core.subscription(event)
@@ -160,11 +187,10 @@ class Transport:
         except (BlockingIOError, OSError):
             pass
 
-    def _run_steps(self) -> None:
-        core = self.core
-        start = self.clock()
+    def _run_steps(self, now: float | None = None) -> None:
+        core, clock = self.core, self.clock
+        start = now = clock() if now is None else now
         while True:
-            now = self.clock()
             t = core.next_advance(now)
             if t is None or t > now:
                 return
@@ -175,13 +201,16 @@ class Transport:
             if self.stop_at_ms is not None and core.sim.time_ms >= self.stop_at_ms:
                 self.stop()
                 return
-            if self.clock() - start > STEP_BUDGET_S:
+            now = clock()
+            if now - start > STEP_BUDGET_S:
                 return                                  # let the sockets be served
 
     def _send_replies(self, replies: list[list[bytes]]) -> None:
+        send = self.router.send_multipart
         for frames in replies:
             try:
-                self.router.send_multipart(frames, copy=False)
+                # small frames: copying is cheaper than zero-copy bookkeeping
+                send(frames, copy=len(frames[-1]) < ZERO_COPY_MIN)
             except zmq.ZMQError:
                 pass                                     # peer gone: ROUTER drops, never raises upward
 
