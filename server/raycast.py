@@ -647,6 +647,15 @@ class _Tier:
         self.normal2 = np.vstack([self.normal, -self.normal])
         self.n_rows = len(self.normal)
         self.ng_max = float(np.linalg.norm(np.cross(self.e1, self.e2), axis=1).max())
+        # dual basis of (e1, e2) in each triangle's plane: barycentrics u = (P - v0).g1, v = (P - v0).g2
+        g11, g12, g22 = _dot(self.e1, self.e1), _dot(self.e1, self.e2), _dot(self.e2, self.e2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            inv = 1.0 / (g11 * g22 - g12 * g12)
+        inv = np.where(np.isfinite(inv), inv, 0.0)[:, None]
+        self.g1 = np.vstack([(g22[:, None] * self.e1 - g12[:, None] * self.e2) * inv, np.zeros((1, 3))])
+        self.g2 = np.vstack([(g11[:, None] * self.e2 - g12[:, None] * self.e1) * inv, np.zeros((1, 3))])
+        tv = V[F]
+        self.t_lo, self.t_hi = tv.min(1), tv.max(1)   # per-triangle boxes (float64)
         owners = owner_of[self.tri_shape[:-1]]
         self.owned = bool((owners >= 0).any())
         # -2 marks "no owner" so it never equals an exclude_owner value (>= -1)
@@ -1436,9 +1445,23 @@ class RayEngine:
                         if repaired is not None:
                             near_edge |= repaired[hf]
                         edge = near_edge.nonzero()[0]
+                        # float64 barycentrics of the plane hit: in a coarse float32 frame Embree
+                        # can report comfortable barycentrics on the adjacent face's triangle
+                        P = _rows(Ot, rows) + tx[:, None] * Dr - np.take(tier.v0, tri, axis=0)
+                        bu = _dot(P, np.take(tier.g1, tri, axis=0))
+                        bv = _dot(P, np.take(tier.g2, tri, axis=0))
+                        near_edge |= ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
+                        edge = near_edge.nonzero()[0]
                         if len(edge):
                             r = rows[edge]
                             ok_e, t_x, tri_e = self._refine_triangles(tier, Ot[r], D[r], tri[edge], lo[r], lim[r])
+                            miss = (~ok_e).nonzero()[0]
+                            if len(miss):   # not the hit triangle nor a vertex neighbour: nearby triangles
+                                rm = r[miss]
+                                ok_n, t_n, tri_n = self._nearby_triangles(
+                                    tier, Ot[rm], D[rm], t_e[hf[edge[miss]]], lo[rm], lim[rm],
+                                    None if excl_arr is None else excl_arr[rm])
+                                ok_e[miss], t_x[miss], tri_e[miss] = ok_n, t_n, tri_n
                             ok[edge], tx[edge], tri[edge] = ok_e, t_x, tri_e
                             nrm[edge] = tier.normal[tri_e]
                             dn[edge] = _dot(D[r], nrm[edge])
@@ -1529,6 +1552,41 @@ class RayEngine:
             t[bad[got]] = best[got]
             tri[bad[got]] = btri[got]
             ok[bad[got]] = True
+        return ok, t, tri
+
+    def _nearby_triangles(self, tier: _Tier, Ot, D, t_e, lo, hi, excl):
+        """Float64 hit of the ORIGINAL rays on the flat triangles whose box, grown by float32
+        uncertainty, contains the Embree hit point (a coarse float32 frame can report a triangle
+        of a neighbouring face or shape).  Only hits up to t_e + eps count: beyond, a surface not
+        among the candidates could come first (the ray is continued instead).  (ok, t, triangle)."""
+        n = len(Ot)
+        grow = tier.eps + 8.0 * tier.res
+        P = Ot + np.minimum(t_e, 1e300)[:, None] * D
+        t = np.full(n, _INF)
+        tri = np.full(n, -1, dtype=np.int64)
+        flat = ~tier.tri_curved[:-1]
+        step = max(1, 4_000_000 // max(1, len(tier.F)))
+        for a in range(0, n, step):
+            b = min(n, a + step)
+            near = np.all((P[a:b, None, :] >= tier.t_lo[None] - grow) & (P[a:b, None, :] <= tier.t_hi[None] + grow), axis=2)
+            near &= flat[None]
+            ray, cand = near.nonzero()
+            ray = ray + a
+            if excl is not None:
+                keep = tier.tri_owner[cand] != excl[ray]
+                ray, cand = ray[keep], cand[keep]
+            if not len(ray):
+                continue
+            okc, tc = _moller_trumbore(Ot[ray], D[ray], tier.v0[cand], tier.e1[cand], tier.e2[cand])
+            okc &= (tc >= lo[ray]) & (tc <= np.minimum(hi[ray], t_e[ray] + tier.eps))
+            tc = np.where(okc, tc, _INF)
+            order = np.lexsort((tc, ray))   # per ray, nearest first
+            ray, cand, tc = ray[order], cand[order], tc[order]
+            first = np.r_[True, ray[1:] != ray[:-1]]
+            ray, cand, tc = ray[first], cand[first], tc[first]
+            t[ray], tri[ray] = tc, cand
+        ok = np.isfinite(t)
+        tri[~ok] = -1
         return ok, t, tri
 
     def _analytic(self, tier: _Tier, slots, Ot, D, lo, hi):

@@ -264,3 +264,52 @@ def test_watertight_sphere_primitive_exact():
     hit_ref = np.isfinite(t_ref) & (t_ref > 0)
     assert np.array_equal(hit_ref, h.shape == 0)
     assert np.abs(h.distance[hit_ref] - t_ref[hit_ref]).max() <= 1e-12
+
+
+# ---------------------------------------------------------------------------------------------
+# one static world spanning a huge extent: coarse float32 frame, EXACT must stay exact
+
+
+def _fibonacci_sphere(n):
+    i = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * i / n
+    r = np.sqrt(1.0 - z * z)
+    phi = i * np.pi * (3.0 - np.sqrt(5.0))
+    return np.c_[r * np.cos(phi), r * np.sin(phi), z]
+
+
+@pytest.mark.parametrize("far", [1e4, pytest.param(1e6, marks=pytest.mark.xfail(
+    reason="open: at 3 cm float32 resolution Embree can miss a nearer shape's edge outright and hit a "
+           "farther shape whose float64 refinement succeeds (~46 of 65,536 rays)", strict=False))])
+def test_exact_room_in_huge_static_world(far):
+    """A ~10 m room at (far, far/2, 0) plus one box at the origin: ONE static tier spans both, so
+    its anchored float32 frame has a resolution of ~1 mm (1e4 m) / ~3 cm (1e6 m) at the room.  Near box edges float32 Embree can
+    pick the neighbouring face's triangle; EXACT must still give the float64 answer on the right
+    box (before the float64 barycentric check: up to 1.8 mm / 1.4 cm off on 5-30 rays)."""
+    boxes = [((10, 10, 0.2), (0, 0, -0.1)), ((10, 10, 0.2), (0, 0, 3.1)),
+             ((0.2, 10.4, 3.4), (5.1, 0, 1.5)), ((0.2, 10.4, 3.4), (-5.1, 0, 1.5)),
+             ((10, 0.2, 3), (0, 5.1, 1.5)), ((10, 0.2, 3), (0, -5.1, 1.5)),
+             ((1.0, 0.6, 0.8), (2.0, 1.5, 0.4)), ((0.7, 1.3, 1.1), (-2.5, -1.0, 0.55)),
+             ((0.5, 0.5, 2.0), (1.0, -3.0, 1.0))]
+    base = np.array([far, far / 2, 0.0])
+    e = RayEngine(Precision.EXACT)
+    for size, c in boxes:
+        e.add_body([entry(Box(size))], at(*(base + c)))
+    e.add_body([entry(Box((1, 1, 1)))], at(0, 0, 0))   # landmark: the tier spans 0..far
+    d = _fibonacci_sphere(65536)
+    lidar = np.array([0.31, -0.17, 1.23])
+    o = np.tile(lidar, (len(d), 1))   # reference in the room's frame (world inputs round by ~1e-10 m)
+    h = e.cast(o + base, d)
+    lo = np.array([np.subtract(c, np.divide(s, 2)) for s, c in boxes])
+    hi = np.array([np.add(c, np.divide(s, 2)) for s, c in boxes])
+    t_all = _slab(o, d, lo, hi)
+    ref = np.argmin(t_all, axis=1)
+    t_ref = t_all[np.arange(len(d)), ref]
+    srt = np.sort(t_all, axis=1)
+    # not at a seam where two boxes meet within float32 resolution (a documented limit)
+    clear = srt[:, 1] - srt[:, 0] > 1e-2
+    assert clear.mean() > 0.98
+    assert np.all(np.isfinite(t_ref)) and np.all(np.isfinite(h.distance))
+    err = np.abs(h.distance - t_ref)
+    assert np.array_equal(h.shape[clear], ref[clear]), int((h.shape[clear] != ref[clear]).sum())
+    assert err[clear].max() <= 1e-9, (float(err[clear].max()), int((err[clear] > 1e-9).sum()))
