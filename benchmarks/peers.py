@@ -180,16 +180,19 @@ class PyBullet(Peer):
         self.p.disconnect(self.cid)
 
 
-class TrimeshEmbree(Peer):
-    name = "trimesh ray_pyembree (intersects_location)"
+class _Trimesh(Peer):
+    """trimesh's ray engines share one interface; subclasses name the intersector module."""
+
     threads = "1"
+    module = ""
 
     def build(self):
+        import importlib
+
         import trimesh
-        from trimesh.ray.ray_pyembree import RayMeshIntersector
 
         self.mesh = trimesh.Trimesh(self.V, self.F, process=False)
-        self.rmi = RayMeshIntersector(self.mesh)
+        self.rmi = importlib.import_module(self.module).RayMeshIntersector(self.mesh)
         self.rmi.intersects_first(self.O[:1], self.D[:1])
 
     def cast(self):
@@ -199,26 +202,21 @@ class TrimeshEmbree(Peer):
         return np.where(t < MAX_RANGE, t, np.inf)
 
 
-class TrimeshTriangle(Peer):
+class TrimeshEmbree(_Trimesh):
+    name = "trimesh ray_pyembree (intersects_location)"
+    module = "trimesh.ray.ray_pyembree"
+
+
+class TrimeshTriangle(_Trimesh):
     name = "trimesh ray_triangle (numpy + rtree)"
-    threads = "1"
+    module = "trimesh.ray.ray_triangle"
     rays_subset = 512
     note = "one sample: about 60 rays/s on this scene (long rays make rtree return most triangles)"
 
     def build(self):
         import rtree  # noqa: F401 - trimesh's pure-numpy engine needs it
-        import trimesh
-        from trimesh.ray.ray_triangle import RayMeshIntersector
 
-        self.mesh = trimesh.Trimesh(self.V, self.F, process=False)
-        self.rmi = RayMeshIntersector(self.mesh)
-        self.rmi.intersects_first(self.O[:1], self.D[:1])
-
-    def cast(self):
-        loc, ray, _ = self.rmi.intersects_location(self.O, self.D, multiple_hits=False)
-        t = np.full(len(self.O), np.inf)
-        t[ray] = np.linalg.norm(loc - self.O[ray], axis=1)
-        return np.where(t < MAX_RANGE, t, np.inf)
+        super().build()
 
 
 PEERS = [Open3D, MuJoCo, PyBullet, TrimeshEmbree, TrimeshTriangle]
