@@ -15,8 +15,7 @@ import numpy as np
 
 from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import light as light_math
-from sensorium.server.devices.lookup import quantize_sensor
-from sensorium.server.devices.noise import gaussian
+from sensorium.server.devices.lookup import add_noise, quantize_sensor
 from sensorium.server.geometry import Pose
 from sensorium.server.raycast import RayHits, RayKind
 from sensorium.server.sensors import DistanceSensor, LightSensor, RayRequest
@@ -43,10 +42,10 @@ def _output(devices: list, measured: np.ndarray, now_ms: int) -> None:
         y, n = table.interpolate(measured[idx])
         for k, i in enumerate(idx):
             d = devices[i]
-            v = float(y[k])
+            v = y[k:k + 1]
             if n[k] != 0.0:   # noise drawn only when non-zero, from the device's own stream
-                v *= 1.0 + float(n[k]) * float(gaussian(d.rng, 1)[0])
-            d.value = float(quantize_sensor(v, d.config.resolution))
+                v = add_noise(v, n[k:k + 1], d.rng)
+            d.value = float(quantize_sensor(float(v[0]), d.config.resolution))
             d._mark(now_ms)
 
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from .noise import gaussian
 
-__all__ = ["LookupTable", "quantize_sensor", "quantize_lidar", "sensor_output", "RESOLUTION_OFF"]
+__all__ = ["LookupTable", "add_noise", "quantize_sensor", "quantize_lidar", "sensor_output", "RESOLUTION_OFF"]
 
 RESOLUTION_OFF = -1.0
 """The ``resolution`` field value that disables rounding."""
@@ -108,11 +108,7 @@ class LookupTable:
             return v.copy()
         out_y, out_n = self.interpolate(v)
         if self._has_noise and rng is not None:
-            noisy = out_n != 0.0
-            count = int(np.count_nonzero(noisy))
-            if count:
-                out_y = np.array(out_y, dtype=np.float64)
-                out_y[noisy] = out_y[noisy] * (1.0 + out_n[noisy] * gaussian(rng, count))
+            out_y = add_noise(out_y, out_n, rng)
         return np.asarray(out_y, dtype=np.float64)
 
     def interpolate(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -183,6 +179,18 @@ def _round(to_integer, v, resolution: float):
         return v
     q = to_integer(np.asarray(v, dtype=np.float64) / res + 0.5) * res + 0.0  # + 0.0: no -0.0
     return q if np.ndim(v) else float(q)
+
+
+def add_noise(y: np.ndarray, n: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Relative Gaussian noise ``y·(1 + n·G)`` where ``n != 0``: one standard normal per such entry,
+    in C order, from ``rng``; nothing is drawn for the others."""
+    noisy = n != 0.0
+    count = int(np.count_nonzero(noisy))
+    if not count:
+        return y
+    out = np.array(y, dtype=np.float64)
+    out[noisy] = out[noisy] * (1.0 + n[noisy] * gaussian(rng, count))
+    return out
 
 
 def sensor_output(table: LookupTable, measured, rng: np.random.Generator | None, resolution: float):
