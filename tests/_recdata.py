@@ -8,7 +8,7 @@ import math
 import msgpack
 import numpy as np
 
-from sensorium.server.recording import McapRecorder, pack_envelope
+from sensorium.server.recording.mcapfile import McapRecorder, pack_envelope
 
 WORLD = b"world_info: {name: synthetic, basic_time_step: 32, random_seed: 7}\n"
 STEP_NS = 32_000_000

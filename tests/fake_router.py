@@ -225,7 +225,7 @@ class FakeServer(threading.Thread):
     def _advance(self) -> None:
         while self.pending and all(r in self.pending for r in self.attached):
             self.time_ms += BASIC
-            for robot, devs in self.robots.items():
+            for devs in self.robots.values():
                 for dev in devs.values():
                     if dev.period > 0 and self.time_ms - dev.last >= dev.period:
                         dev.last = self.time_ms

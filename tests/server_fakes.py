@@ -1,4 +1,4 @@
-"""A fake simulation with the public surface of ``sensorium.server.simulation.Simulation`` that the
+"""A fake simulation with the public surface of ``sensorium.server.sim.simulation.Simulation`` that the
 server core uses (robots, devices, schedule, readings, counters), with readings that are simple
 functions of time, so the sans-IO server tests need no ray engine.
 
@@ -14,7 +14,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from sensorium.schemas import world as wm
-from sensorium.server.motion import DifferentialDrive
+from sensorium.server.sim.motion import DifferentialDrive
 
 POINT_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer_id", "<i4"), ("time", "<f4")])
 

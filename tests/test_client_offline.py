@@ -32,7 +32,7 @@ from sensorium.client.connection import (
 from sensorium.client.topics import Subscriber, decode_frames, subscription_prefix
 
 REPO = Path(__file__).resolve().parents[1]
-WEBOTS_DIR = REPO / "client" / "webots"
+WEBOTS_DIR = REPO / "sensorium" / "client" / "webots"
 
 
 @pytest.fixture
@@ -681,7 +681,7 @@ def _run(code: str, env: dict | None = None, timeout: float = 30) -> subprocess.
 def test_client_imports_with_pyzmq_and_msgpack_only():
     code = BLOCKER + textwrap.dedent(f"""
         import sensorium.client, sensorium.client.connection, sensorium.client.wb, sensorium.client.topics
-        import sensorium.client.cli, sensorium.client.webots.controller
+        import sensorium.cli.client, sensorium.client.webots.controller
         sys.path.insert(0, {str(WEBOTS_DIR)!r})
         from controller import Robot, LightSensor, DistanceSensor, Lidar, LidarPoint, Motor, RotationalMotor
         bad = [m for m in sys.modules if m.split(".")[0] in HEAVY
@@ -727,7 +727,7 @@ def test_controller_without_numpy_end_to_end(server):
 
 
 def _sensorium(*args: str, env: dict | None = None, timeout: float = 30) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "sensorium.cli", *args], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "sensorium", *args], capture_output=True, text=True,
                           timeout=timeout, env={**os.environ, **(env or {})}, cwd=str(REPO))
 
 
@@ -773,7 +773,7 @@ def test_cli_echo():
     pub = zmq.Context.instance().socket(zmq.XPUB)
     pub.bind("tcp://127.0.0.1:*")
     url = pub.getsockopt_string(zmq.LAST_ENDPOINT)
-    proc = subprocess.Popen([sys.executable, "-m", "sensorium.cli", "echo", "/r1/lid/laser_scan", "--url", url,
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "echo", "/r1/lid/laser_scan", "--url", url,
                              "--count", "2", "--timeout", "10"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, cwd=str(REPO))
     try:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 def test_demo_light_follower_gets_closer_and_recording_replays(tmp_path: Path) -> None:
     out = tmp_path / "demo"
-    res = subprocess.run([sys.executable, "-m", "sensorium.cli", "demo", "--duration", "20", "--out", str(out), "--json"],
+    res = subprocess.run([sys.executable, "-m", "sensorium", "demo", "--duration", "20", "--out", str(out), "--json"],
                          capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stderr + "".join((out / n).read_text() for n in ("server.log", "epuck.log", "scout.log")
                                                       if (out / n).exists())
@@ -26,7 +26,7 @@ def test_demo_light_follower_gets_closer_and_recording_replays(tmp_path: Path) -
     assert summary["messages"]["/scout/lidar/laser_scan"] > 0
     assert (out / "arena.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     # the recording replays: every message republished, as fast as possible
-    replay = subprocess.run([sys.executable, "-m", "sensorium.cli", "replay", str(out / "demo.mcap"), "--rate", "0",
+    replay = subprocess.run([sys.executable, "-m", "sensorium", "replay", str(out / "demo.mcap"), "--rate", "0",
                              "--pub", "tcp://127.0.0.1:0", "--rpc", "tcp://127.0.0.1:0"],
                             capture_output=True, text=True, timeout=120)
     assert replay.returncode == 0, replay.stderr

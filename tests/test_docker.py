@@ -43,7 +43,7 @@ def test_compose_services_run_as_processes(tmp_path: Path) -> None:
     services = COMPOSE["services"]
     assert set(services) == {"server", "braitenberg", "wanderer", "recorder"}
     ports = {"5560": _free_port(), "5561": _free_port()}
-    cli = [sys.executable, "-m", "sensorium.cli"]
+    cli = [sys.executable, "-m", "sensorium"]
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     server_cmd = [_localise(a, ports) for a in services["server"]["command"]] + ["--until", "1500"]
     server = subprocess.Popen(cli + server_cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
@@ -67,7 +67,7 @@ def test_compose_services_run_as_processes(tmp_path: Path) -> None:
             if p.poll() is None:
                 p.kill()
                 p.wait()
-    from sensorium.server.recording import summarize
+    from sensorium.server.recording.mcapfile import summarize
 
     summary = summarize(tmp_path / "recordings" / "run.mcap")
     assert summary["messages"] > 0 and not summary["truncated"]

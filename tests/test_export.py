@@ -19,7 +19,7 @@ from mcap.reader import make_reader  # noqa: E402
 from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 from rosbags.highlevel import AnyReader  # noqa: E402
 
-from sensorium.server.export import ExportError, export_ros2  # noqa: E402
+from sensorium.server.recording.export import ExportError, export_ros2  # noqa: E402
 
 F32_FIELDS = {"field_of_view", "min_range", "max_range", "range", "angle_min", "angle_max", "angle_increment",
               "time_increment", "scan_time", "range_min", "range_max", "x", "y", "z"}
@@ -178,7 +178,7 @@ def test_refuses_to_overwrite_and_unknown_distro(recording, tmp_path):
 def test_cli_export(recording, tmp_path):
     src, items = recording
     out = tmp_path / "cli_bag"
-    proc = subprocess.run([sys.executable, "-m", "sensorium.cli", "export", str(src), str(out), "--ros2",
+    proc = subprocess.run([sys.executable, "-m", "sensorium", "export", str(src), str(out), "--ros2",
                            "--distro", "humble", "--topics", "/epuck"], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert "exported" in proc.stdout

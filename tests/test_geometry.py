@@ -6,8 +6,17 @@ import numpy as np
 import pytest
 import trimesh
 
-from sensorium.server.geometry import (
-    Box, Capsule, Cylinder, Mesh, Plane, Pose, Sphere, capsule_segments, tessellate, triangle_count,
+from sensorium.server.world.geometry import (
+    Box,
+    Capsule,
+    Cylinder,
+    Mesh,
+    Plane,
+    Pose,
+    Sphere,
+    capsule_segments,
+    tessellate,
+    triangle_count,
     valid_faces,
 )
 

@@ -7,7 +7,7 @@ import itertools
 import pytest
 
 from sensorium.schemas.wire import ErrorCode
-from sensorium.server.lockstep import Lockstep, LockstepError
+from sensorium.server.daemon.lockstep import Lockstep, LockstepError
 
 BASIC = 32
 

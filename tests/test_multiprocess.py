@@ -28,9 +28,9 @@ from sensorium.client.connection import Connection
 
 REPO = Path(__file__).resolve().parents[1]
 TRIO = REPO / "tests" / "worlds" / "trio.yaml"
-ARENA = REPO / "worlds" / "arena.yaml"
+ARENA = REPO / "sensorium" / "worlds" / "arena.yaml"
 CONTROLLERS = REPO / "tests" / "controllers"
-EXAMPLES = REPO / "client" / "examples"
+EXAMPLES = REPO / "sensorium" / "client" / "examples"
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints and signals")
@@ -80,7 +80,7 @@ class Proc:
 
 
 def sensorium(*args: str) -> list[str]:
-    return [sys.executable, "-m", "sensorium.cli", *args]
+    return [sys.executable, "-m", "sensorium", *args]
 
 
 class Server:
@@ -140,7 +140,7 @@ PLANS = {
 
 def reference_run() -> dict[str, list[dict]]:
     """What each controller must see, from the in-process simulation of the same world."""
-    from sensorium.server.simulation import Simulation
+    from sensorium.server.sim.simulation import Simulation
 
     sim = Simulation.from_file(TRIO)
     for robot, (_, _, specs) in PLANS.items():
@@ -313,7 +313,7 @@ def test_examples_through_the_launcher_with_topics_and_echo(servers, tmp_path):
 # ====================================================================== wheel motors, poses
 
 def _pose_values(pose) -> list[float]:
-    from sensorium.server.topics import pose_quaternion
+    from sensorium.server.daemon.topics import pose_quaternion
 
     return [float(v) for v in pose.translation] + pose_quaternion(pose)
 
@@ -325,7 +325,7 @@ def _message_pose(body: dict) -> list[float]:
 
 def test_driven_epuck_matches_the_in_process_simulation(servers, tmp_path):
     from sensorium.client.topics import Subscriber
-    from sensorium.server.simulation import Simulation
+    from sensorium.server.sim.simulation import Simulation
 
     steps, switch_at, speeds, later = 60, 40, (5.0, 5.0), (2.0, 6.0)     # straight, then a left arc
     started, procs = servers

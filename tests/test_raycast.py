@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from sensorium.server.geometry import Box, Capsule, Cylinder, Mesh, Plane, Pose, Sphere, tessellate
-from sensorium.server.raycast import Precision, RayEngine, RayHits, RayKind, ShapeEntry
+from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind, ShapeEntry
+from sensorium.server.world.geometry import Box, Capsule, Cylinder, Mesh, Plane, Pose, Sphere, tessellate
 
 EXACT_TOL = 1e-12
 FAST_TOL = 1e-5

@@ -16,9 +16,9 @@ import math
 import numpy as np
 import pytest
 
-from sensorium.server import raycast
-from sensorium.server.geometry import Box, Capsule, Cylinder, Plane, Pose, Sphere
-from sensorium.server.raycast import Precision, RayEngine, RayKind, ShapeEntry
+from sensorium.server.raycast import engine as raycast
+from sensorium.server.raycast.engine import Precision, RayEngine, RayKind, ShapeEntry
+from sensorium.server.world.geometry import Box, Capsule, Cylinder, Plane, Pose, Sphere
 
 BOTH = [Precision.FAST, Precision.EXACT]
 
@@ -270,7 +270,7 @@ def test_random_worlds_single_rays_match_the_batch(seed):
     for prec in BOTH:
         e = RayEngine(prec)
         centres = []
-        for b in range(30):
+        for _b in range(30):
             movable = rng.random() < 0.6
             shapes = protos[rng.integers(0, 3)] if movable and rng.random() < 0.7 else [prim() for _ in range(2)]
             entries = [entry(p, Pose.identity() if rng.random() < 0.5 else pose(0.2), transparent=rng.random() < 0.1)

@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from sensorium.server.geometry import Box, Capsule, Cylinder, Mesh, Plane, Pose, Sphere, tessellate
-from sensorium.server.raycast import Precision, RayEngine, RayKind, ShapeEntry
+from sensorium.server.raycast.engine import Precision, RayEngine, RayKind, ShapeEntry
+from sensorium.server.world.geometry import Box, Capsule, Cylinder, Mesh, Plane, Pose, Sphere, tessellate
 
 BOTH = [Precision.FAST, Precision.EXACT]
 OFFSETS = [0.0, 1e5, 1e6]
@@ -36,7 +36,10 @@ def at(x, y, z, axis=(0, 0, 1), angle=0.0):
     return Pose.from_axis_angle(axis, angle, [x, y, z])
 
 
-def entry(p, pose=Pose.identity()):
+_IDENTITY = Pose.identity()
+
+
+def entry(p, pose=_IDENTITY):
     return ShapeEntry(p, pose, True, True)
 
 
@@ -235,7 +238,7 @@ def test_watertight_exact_zero_leaks_fast_reported(record_property):
 def test_leak_repair_alone_on_a_plain_bvh(monkeypatch):
     """The offset-copy repair on its own (EXACT forced onto a non-robust BVH, which leaks ~5% of
     these rays): it must catch at least 99% of the leaks and count them."""
-    from sensorium.server import raycast
+    from sensorium.server.raycast import engine as raycast
     plain = raycast._Tier.scene
     monkeypatch.setattr(raycast._Tier, "scene", lambda self, robust: plain(self, False))
     mesh = trimesh.creation.icosphere(subdivisions=3, radius=1.7)

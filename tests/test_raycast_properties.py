@@ -19,8 +19,8 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from sensorium.server.geometry import Box, Cylinder, Pose, Sphere, tessellate
-from sensorium.server.raycast import Precision, RayEngine, ShapeEntry
+from sensorium.server.raycast.engine import Precision, RayEngine, ShapeEntry
+from sensorium.server.world.geometry import Box, Cylinder, Pose, Sphere, tessellate
 
 N_RAYS = 64
 SCALE = 10.0  # scene scale (metres): shapes within +-5 m, rays from within +-7 m

@@ -15,8 +15,8 @@ import msgpack
 import pytest
 import zmq
 
-from sensorium.server.cli_recording import LiveRecorder
-from sensorium.server.recording import Recording
+from sensorium.cli.recording import LiveRecorder
+from sensorium.server.recording.mcapfile import Recording
 from sensorium.server.world.loader import default_world_path
 
 PY = sys.executable
@@ -26,7 +26,7 @@ class Server:
     def __init__(self, tmp: Path, *extra: str, name: str = "s"):
         self.rpc_url = f"ipc://{tmp}/{name}-rpc"
         self.pub_url = f"ipc://{tmp}/{name}-pub"
-        self.proc = subprocess.Popen([PY, "-m", "sensorium.cli", "serve", "--rpc", self.rpc_url, "--pub", self.pub_url,
+        self.proc = subprocess.Popen([PY, "-m", "sensorium", "serve", "--rpc", self.rpc_url, "--pub", self.pub_url,
                                       *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.dealer = None
 
@@ -180,7 +180,7 @@ def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):
         assert rec.truncated
         recorded = [(m.topic, m.seq, m.data) for m in rec.messages()]
     assert recorded == subscribed  # nothing lost on either side: the exact published bytes
-    info = subprocess.run([PY, "-m", "sensorium.cli", "info", str(path)], capture_output=True, text=True, timeout=30)
+    info = subprocess.run([PY, "-m", "sensorium", "info", str(path)], capture_output=True, text=True, timeout=30)
     assert "Truncated:         YES" in info.stdout and "Messages:          330" in info.stdout
 
 

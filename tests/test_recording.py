@@ -14,7 +14,7 @@ import pytest
 from _recdata import TOPICS, WORLD, make_recording, published
 from mcap.reader import make_reader
 
-from sensorium.server.recording import McapRecorder, Recording, pack_envelope, print_info, topic_matcher
+from sensorium.server.recording.mcapfile import McapRecorder, Recording, pack_envelope, print_info, topic_matcher
 
 TESTS = Path(__file__).parent
 PY = sys.executable
@@ -123,8 +123,8 @@ WRITER = textwrap.dedent("""
     import sys, time
     sys.path.insert(0, {tests!r})
     from _recdata import published
-    from sensorium.server.recording import McapRecorder
-    from sensorium.server.cli_recording import sigterm_as_interrupt
+    from sensorium.server.recording.mcapfile import McapRecorder
+    from sensorium.cli.recording import sigterm_as_interrupt
     n = 0
     with sigterm_as_interrupt():
         try:
@@ -178,7 +178,7 @@ def test_sigkill_leaves_a_readable_truncated_file(tmp_path, capsys):
     assert summary["metadata"]["sensorium"]["seed"] == "1"
     assert {t["topic"] for t in summary["topics"]} == set(TOPICS)
     # sensorium info says so
-    out = subprocess.run([PY, "-m", "sensorium.cli", "info", str(path)], capture_output=True, text=True, timeout=60)
+    out = subprocess.run([PY, "-m", "sensorium", "info", str(path)], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert "Truncated:         YES" in out.stdout
     assert print_info(path, as_json=True) == 0
@@ -247,7 +247,7 @@ def test_sigkill_truncation_without_flush_calls(tmp_path):
         import sys, os, signal
         sys.path.insert(0, {str(TESTS)!r})
         from _recdata import published
-        from sensorium.server.recording import McapRecorder
+        from sensorium.server.recording.mcapfile import McapRecorder
         rec = McapRecorder({str(path)!r}, chunk_size=1024, flush_interval=None)
         for n, item in enumerate(published(400)):
             rec.record(*item)

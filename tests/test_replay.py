@@ -15,9 +15,9 @@ import pytest
 import zmq
 from _recdata import STEP_NS, TOPICS, make_recording, published
 
-from sensorium.server.cli_recording import LiveRecorder, subscription_prefixes
-from sensorium.server.recording import McapRecorder, Recording, pack_envelope
-from sensorium.server.replay import Replayer
+from sensorium.cli.recording import LiveRecorder, subscription_prefixes
+from sensorium.server.recording.mcapfile import McapRecorder, Recording, pack_envelope
+from sensorium.server.recording.replay import Replayer
 
 PY = sys.executable
 ANY = "tcp://127.0.0.1:*"
@@ -236,7 +236,7 @@ def test_lockstep(rec_path, ctx):
 
 def test_cli_replay_announces_and_finishes(rec_path, ctx):
     path, items = rec_path
-    proc = subprocess.Popen([PY, "-m", "sensorium.cli", "replay", str(path), "--pub", ANY, "--rpc", ANY,
+    proc = subprocess.Popen([PY, "-m", "sensorium", "replay", str(path), "--pub", ANY, "--rpc", ANY,
                              "--rate", "0", "--wait", "--topics", "/epuck/ps1", "--progress"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
@@ -333,7 +333,7 @@ def test_cli_record_sigint_finishes_and_reports(rec_path, ctx, tmp_path):
     out = tmp_path / "cli.mcap"
     with running(path, ctx, rate=0, wait_subscriber=True) as (r, th):
         th.start()
-        proc = subprocess.Popen([PY, "-m", "sensorium.cli", "record", str(out), "--connect", r.rpc_endpoint,
+        proc = subprocess.Popen([PY, "-m", "sensorium", "record", str(out), "--connect", r.rpc_endpoint,
                                  "--topics", "/epuck", "/scout/lidar/laser_scan"],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:

@@ -32,7 +32,7 @@ class Server:
         self.err_path = tmp / f"serve-{os.getpid()}-{id(self)}.err"
         self.err = open(self.err_path, "w")
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "sensorium.cli", "serve", str(WORLD), "--rpc", "tcp://127.0.0.1:0",
+            [sys.executable, "-m", "sensorium", "serve", str(WORLD), "--rpc", "tcp://127.0.0.1:0",
              "--pub", "tcp://127.0.0.1:*", "--heartbeat-ms", str(heartbeat_ms), "--precision", "fast", *extra],
             stdout=subprocess.PIPE, stderr=self.err, text=True)
         self.rpc = self.pub = None
@@ -300,8 +300,8 @@ def test_realtime_mode_paces_and_reports_rtf(client):
 
 
 def test_motors_over_the_wire_match_the_in_process_simulation(client):
-    from sensorium.server.simulation import Simulation
-    from sensorium.server.topics import pose_quaternion
+    from sensorium.server.daemon.topics import pose_quaternion
+    from sensorium.server.sim.simulation import Simulation
 
     c = client()
     res = c.attach("rover")

@@ -13,7 +13,7 @@ from server_fakes import FakeSim, small_world
 
 from sensorium.schemas import services as S
 from sensorium.schemas.wire import SOFT_LIMIT, ErrorCode, from_bin
-from sensorium.server.services import Core
+from sensorium.server.daemon.services import Core
 
 A, B = b"peer-A", b"peer-B"
 

@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from sensorium.server.simulation import Simulation
+from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
 
 WALL_X = 0.05  # the near face of the test wall, in front of the robot at the origin
@@ -196,7 +196,7 @@ def test_infra_red_ignores_fully_transparent_visuals_laser_ignores_transparent_b
 
 
 def test_own_body_ignored_by_bounding_rays_unless_self_collision() -> None:
-    for self_collision, expected in ((False, WALL_X), (True, 0.03)):
+    for self_collision in (False, True):
         data = {"solids": [{"name": "wall", "pose": {"translation": [WALL_X + 0.05, 0, 0]},
                             "geometry": {"type": "box", "size": [0.1, 2, 2]}}],
                 "robots": [{"name": "r", "self_collision": self_collision,
@@ -255,7 +255,7 @@ def test_occlusion_rays_one_per_lit_light() -> None:
 def test_lighting_world_occlusion_on_and_off() -> None:
     from pathlib import Path
 
-    sim = Simulation.from_file(Path(__file__).resolve().parents[1] / "worlds" / "lighting.yaml")
+    sim = Simulation.from_file(Path(__file__).resolve().parents[1] / "sensorium" / "worlds" / "lighting.yaml")
     for d in sim.all_devices():
         d.enable(32)
     sim.step()
@@ -437,7 +437,7 @@ def test_moving_robot_changes_reading_without_bvh_rebuild() -> None:
 def test_all_sensors_of_a_step_share_one_cast_per_ray_kind() -> None:
     from pathlib import Path
 
-    sim = Simulation.from_file(Path(__file__).resolve().parents[1] / "worlds" / "arena.yaml")
+    sim = Simulation.from_file(Path(__file__).resolve().parents[1] / "sensorium" / "worlds" / "arena.yaml")
     for d in sim.all_devices():
         d.enable(32)
     sim.step()
@@ -448,7 +448,7 @@ def test_all_sensors_of_a_step_share_one_cast_per_ray_kind() -> None:
 # ------------------------------------------------------------------ probe command
 
 def test_probe_json_lines() -> None:
-    res = subprocess.run([sys.executable, "-m", "sensorium.cli", "probe", "--steps", "3", "--json",
+    res = subprocess.run([sys.executable, "-m", "sensorium", "probe", "--steps", "3", "--json",
                           "--enable", "epuck/ps0:64", "--enable", "scout/lidar:32"],
                          capture_output=True, text=True, timeout=120)
     assert res.returncode == 0, res.stderr
@@ -459,7 +459,7 @@ def test_probe_json_lines() -> None:
 
 
 def test_probe_rejects_bad_enable() -> None:
-    res = subprocess.run([sys.executable, "-m", "sensorium.cli", "probe", "--enable", "epuck/nope:32"],
+    res = subprocess.run([sys.executable, "-m", "sensorium", "probe", "--enable", "epuck/nope:32"],
                          capture_output=True, text=True, timeout=120)
     assert res.returncode == 2 and "no device 'nope'" in res.stderr
 
@@ -504,7 +504,7 @@ def test_velocity_clamped_and_position_control_stops_at_target() -> None:
 
 
 def test_circle_stays_on_circle_for_a_million_steps() -> None:
-    from sensorium.server.motion import arc_step
+    from sensorium.server.sim.motion import arc_step
 
     v, w, dt = 0.1, 0.7, 0.016            # radius v/w around the centre (0, v/w) from the origin
     x = y = yaw = 0.0

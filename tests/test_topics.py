@@ -12,7 +12,7 @@ from server_fakes import FakeSim, small_world
 from sensorium.schemas import messages as M
 from sensorium.schemas import world as wm
 from sensorium.schemas.wire import from_bin
-from sensorium.server.topics import Topics, laser_scan_angles
+from sensorium.server.daemon.topics import Topics, laser_scan_angles
 
 SUB, UNSUB = b"\x01", b"\x00"
 

@@ -14,7 +14,7 @@ import yaml
 from sensorium.schemas import world as wm
 from sensorium.server.world.loader import WorldError, default_world_path, load_world, parse_world
 
-WORLDS = Path(__file__).resolve().parents[1] / "worlds"
+WORLDS = Path(__file__).resolve().parents[1] / "sensorium" / "worlds"
 
 
 def _robot(devices: list[dict], **extra) -> dict:
@@ -50,7 +50,7 @@ def test_default_world_is_arena() -> None:
 
 
 def test_warehouse_is_lidar_heavy() -> None:
-    from sensorium.server.cli_world import world_summary
+    from sensorium.cli.world import world_summary
 
     s = world_summary(WORLDS / "warehouse.yaml")
     assert s["triangles"] >= 100_000
@@ -235,7 +235,7 @@ def test_quaternion_pose_equals_axis_angle() -> None:
 # ------------------------------------------------------------------ command line
 
 def _cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "sensorium.cli", *args], capture_output=True, text=True, timeout=60)
+    return subprocess.run([sys.executable, "-m", "sensorium", *args], capture_output=True, text=True, timeout=60)
 
 
 def test_cli_validate_ok_and_failure(tmp_path: Path) -> None:

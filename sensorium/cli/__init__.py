@@ -1,0 +1,209 @@
+"""The ``sensorium`` command. Each subcommand imports what it needs only when it runs, so that the
+client-side commands work with pyzmq + msgpack alone."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+
+Handler = Callable[[argparse.Namespace], int]
+_COMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None], str]] = {}
+
+
+def command(name: str, help: str, target: str):
+    """Register a subcommand: ``target`` is 'module:function' taking the parsed args, returning an exit code."""
+
+    def register(add_args: Callable[[argparse.ArgumentParser], None]):
+        _COMMANDS[name] = (help, add_args, target)
+        return add_args
+
+    return register
+
+
+@command("validate", "check a world file; exit 1 listing every problem", "sensorium.cli.world:validate")
+def _validate_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("world", nargs="+", help="world file(s), YAML or JSON")
+
+
+@command("info", "summarise a world file (or a .mcap recording)", "sensorium.cli.world:info")
+def _info_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("path", nargs="?", help="world file or .mcap recording (default: the embedded arena world)")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+
+
+@command("probe", "run a world in-process and print what enabled devices read", "sensorium.cli.world:probe")
+def _probe_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("world", nargs="?", help="world file (default: the embedded arena world)")
+    p.add_argument("--steps", type=int, default=3, help="basic steps to run (default 3)")
+    p.add_argument("--enable", action="append", default=[], metavar="ROBOT/DEVICE:PERIOD",
+                   help="enable a device with a sampling period in ms (repeatable; 'all:PERIOD' enables every device)")
+    p.add_argument("--point-cloud", action="append", default=[], metavar="ROBOT/DEVICE",
+                   help="also enable a lidar's point cloud")
+    p.add_argument("--precision", choices=["fast", "exact"], default="exact")
+    p.add_argument("--json", action="store_true", help="JSON lines: step, time, robot, device, value or array summary")
+
+
+@command("controller", "run a Webots-style Python controller for a robot of a running server",
+         "sensorium.cli.client:controller")
+def _controller_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("script", help="controller script (uses `from controller import Robot`)")
+    p.add_argument("--robot", help="robot name (default: the URL's robot, or the world's only robot)")
+    p.add_argument("--url", help="RPC endpoint or controller URL, e.g. tcp://127.0.0.1:5560 or "
+                   "tcp://host:5560/epuck (default: $SENSORIUM_CONTROLLER_URL, $WEBOTS_CONTROLLER_URL, "
+                   "tcp://127.0.0.1:5560)")
+    p.add_argument("args", nargs=argparse.REMAINDER,
+                   help="arguments for the script (sys.argv[1:]); --robot/--url may also follow SCRIPT, "
+                   "and '--' ends them")
+
+
+@command("echo", "print the messages of a topic (or of every topic under a PREFIX/)", "sensorium.cli.client:echo")
+def _echo_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("topic", help="topic, e.g. /epuck/ps0/value; a name ending in '/' is a prefix, '' is all")
+    p.add_argument("--url", default="tcp://127.0.0.1:5561", help="topic endpoint (default tcp://127.0.0.1:5561)")
+    p.add_argument("--count", type=int, help="stop after N messages")
+    p.add_argument("--timeout", type=float, help="exit 1 if no message comes for this many seconds")
+
+
+@command("topics", "list a running server's topics and their types", "sensorium.cli.client:topics")
+def _topics_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--url", help="RPC endpoint (default tcp://127.0.0.1:5560)")
+    p.add_argument("--timeout", type=float, default=5.0, help="seconds to wait for the server (default 5)")
+
+
+# --- recording: record / replay / export (server/cli_recording.py) ---
+@command("record", "record a running server's topics to MCAP as a subscriber (reports gaps)",
+         "sensorium.cli.recording:record")
+def _record_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="output .mcap file")
+    p.add_argument("--connect", default="tcp://127.0.0.1:5560", metavar="URL",
+                   help="the server's RPC endpoint (its topic endpoint comes from get_info; default tcp://127.0.0.1:5560)")
+    p.add_argument("--pub", metavar="URL", help="subscribe to this topic endpoint instead of asking the server")
+    p.add_argument("--topics", nargs="+", metavar="TOPIC",
+                   help="record only these topics: exact names, path prefixes (/epuck) or globs (/epuck/ps*)")
+    p.add_argument("--world", metavar="FILE", help="world file to attach to the recording")
+    p.add_argument("--duration", type=float, metavar="S", help="stop after S wall-clock seconds")
+    p.add_argument("--max-messages", type=int, metavar="N", help="stop after N messages")
+    p.add_argument("--rcvhwm", type=int, default=1000, help="receive high-water mark, messages (default 1000)")
+    p.add_argument("--chunk-size", type=int, default=1 << 20, help="MCAP chunk size in bytes (default 1 MiB)")
+    p.add_argument("--json", action="store_true", help="print the final summary as JSON")
+
+
+def _seconds(text: str) -> float:
+    value = float(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError("must be >= 0")
+    return value
+
+
+@command("replay", "republish a recording like a live server (free-running or lockstep)",
+         "sensorium.cli.recording:replay_cmd")
+def _replay_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="recording (.mcap)")
+    p.add_argument("--rate", type=_seconds, default=1.0, help="speed factor (default 1; 0 = as fast as possible)")
+    p.add_argument("--loop", action="store_true", help="start over at the end")
+    p.add_argument("--topics", nargs="+", metavar="TOPIC", help="replay only these topics (names, prefixes, globs)")
+    p.add_argument("--start", type=_seconds, metavar="S", help="start at S seconds of simulation time")
+    p.add_argument("--end", type=_seconds, metavar="E", help="stop after E seconds of simulation time")
+    p.add_argument("--clock", type=float, nargs="?", const=40.0, metavar="HZ",
+                   help="publish /clock (rosgraph_msgs/Clock) at HZ wall-clock Hz (default 40) instead of a recorded /clock")
+    p.add_argument("--lockstep", action="store_true",
+                   help="publish only when a client calls /replay/step {duration} (see PROTOCOL.md, Replay)")
+    p.add_argument("--pub", default="tcp://127.0.0.1:5561", help="topic endpoint to bind (default tcp://127.0.0.1:5561)")
+    p.add_argument("--rpc", default="tcp://127.0.0.1:5560", help="service endpoint to bind (default tcp://127.0.0.1:5560)")
+    p.add_argument("--wait", action="store_true", help="wait for a first subscriber before starting")
+    p.add_argument("--delay", type=_seconds, default=0.0, metavar="S", help="wait S seconds before starting (and between loops)")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress line on stderr (default: on a terminal, for long files)")
+    p.add_argument("--sndhwm", type=int, default=1000, help="send high-water mark per subscriber (default 1000)")
+    p.add_argument("--nodrop", action="store_true", help="wait for slow subscribers instead of dropping messages")
+
+
+@command("export", "convert a recording to ROS 2 (CDR, MCAP storage) for ros2 bag play and Foxglove",
+         "sensorium.cli.recording:export_cmd")
+def _export_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="recording (.mcap)")
+    p.add_argument("out", help="output: a rosbag2 directory, or a single file if it ends in .mcap")
+    p.add_argument("--ros2", action="store_true", help="export as ROS 2 messages (CDR)")
+    p.add_argument("--distro", choices=["humble", "jazzy"], default="jazzy",
+                   help="message definitions (humble has no Range.variance; default jazzy)")
+    p.add_argument("--format", choices=["bag", "mcap"], help="bag: rosbag2 directory (rosbags); mcap: one file "
+                   "(mcap-ros2-support); default from OUT's suffix")
+    p.add_argument("--pointcloud2", action="store_true", help="export PointCloud as PointCloud2 (x, y, z, layer)")
+    p.add_argument("--topics", nargs="+", metavar="TOPIC", help="export only these topics")
+    p.add_argument("--start", type=_seconds, metavar="S", help="from S seconds of simulation time")
+    p.add_argument("--end", type=_seconds, metavar="E", help="up to E seconds of simulation time")
+# --- end recording ---
+
+
+# --- server: serve (server/serve.py) and schemas (schemas/export.py) ---
+@command("serve", "serve a world to controllers (services) and subscribers (topics) over ZeroMQ",
+         "sensorium.cli.serve:main")
+def _serve_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.serve import add_arguments
+
+    add_arguments(p)
+
+
+@command("schemas", "write the JSON Schemas of world files, topic messages and services",
+         "sensorium.schemas.export:main")
+def _schemas_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", metavar="DIR", help="output directory (default: the package's schemas/json)")
+    p.add_argument("--check", action="store_true", help="write nothing; exit 1 if the files in DIR are out of date")
+
+
+@command("demo", "run the server, two example controllers and a recording on the default world",
+         "sensorium.cli.demo:main")
+def _demo_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("world", nargs="?", help="world file (default: the embedded arena world)")
+    p.add_argument("--duration", type=float, default=60.0, metavar="S", help="simulated seconds (default 60)")
+    p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go")
+    p.add_argument("--precision", choices=["fast", "exact"], default="exact")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+
+
+# --- benchmarks: bench (benchmarks/, installed as sensorium.benchmarks) ---
+@command("bench", "measure accuracy vs time of every knob, scaling, peers and transport; write docs/benchmarks.md",
+         "sensorium.cli.bench:main")
+def _bench_args(p: argparse.ArgumentParser) -> None:
+    try:
+        from sensorium.cli.bench import add_arguments
+    except ImportError:      # benchmarks/ not installed: keep every other command working
+        return
+    add_arguments(p)
+# --- end benchmarks ---
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="sensorium", description="Headless sensor simulator with Webots device semantics.")
+    from sensorium import __version__
+
+    parser.add_argument("--version", action="version", version=f"sensorium {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, (help_text, add_args, target) in _COMMANDS.items():
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        add_args(p)
+        p.set_defaults(_target=target)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "_target", None):
+        parser.print_help()
+        return 2
+    module_name, func_name = args._target.split(":")
+    import importlib
+
+    func: Handler = getattr(importlib.import_module(module_name), func_name)
+    try:
+        return int(func(args) or 0)
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,151 @@
+"""``sensorium validate``, ``info`` and ``probe``: world files at a terminal."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from sensorium.schemas import world as wm
+from sensorium.server.world.loader import WorldError, default_world_path, load_world
+
+
+def validate(args: argparse.Namespace) -> int:
+    status = 0
+    for path in args.world:
+        try:
+            loaded = load_world(path)
+        except WorldError as exc:
+            print(str(exc), file=sys.stderr)
+            print(f"{path}: INVALID ({len(exc.problems)} problem{'s' if len(exc.problems) != 1 else ''})", file=sys.stderr)
+            status = 1
+            continue
+        for w in loaded.warnings:
+            print(f"{path}: warning: {w}", file=sys.stderr)
+        print(f"{path}: OK")
+    return status
+
+
+def _device_line(d) -> str:
+    if isinstance(d, wm.Lidar):
+        return (f"Lidar {d.type}/{d.projection} {d.horizontal_resolution}x{d.number_of_layers} "
+                f"fov {d.field_of_view:.4g} range [{d.min_range:g}, {d.max_range:g}]")
+    if isinstance(d, wm.DistanceSensor):
+        return f"DistanceSensor {d.type} rays {d.number_of_rays} aperture {d.aperture:g} max {d.lookup_table[-1][0] if d.lookup_table else 0:g} m"
+    return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
+
+
+def world_summary(path: str | Path) -> dict:
+    from sensorium.server.world.scene import Scene
+
+    loaded = load_world(path)
+    w = loaded.world
+    scene = Scene(w, loaded.base_dir)
+    return {
+        "world": w.world_info.name,
+        "file": str(path),
+        "basic_time_step_ms": w.world_info.basic_time_step,
+        "random_seed": w.world_info.random_seed,
+        "solids": [{"name": s.name, "geometry": s.geometry.type, "seen_by": s.seen_by} for s in w.solids],
+        "triangles": scene.triangle_count,
+        "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
+        "robots": [
+            {"name": r.name, "synchronization": r.synchronization,
+             "devices": [{"name": d.name, "device": d.device, "summary": _device_line(d)} for d in r.devices]}
+            for r in w.robots
+        ],
+        "warnings": loaded.warnings,
+    }
+
+
+def info(args: argparse.Namespace) -> int:
+    path = args.path or str(default_world_path())
+    if str(path).endswith(".mcap"):
+        from sensorium.server.recording.mcapfile import print_info  # recordings
+
+        return print_info(path, as_json=args.json)
+    try:
+        s = world_summary(path)
+    except WorldError as exc:
+        print(str(exc), file=sys.stderr)
+        return 1
+    if args.json:
+        print(json.dumps(s, indent=2))
+        return 0
+    print(f"world     {s['world']}  ({s['file']})")
+    print(f"time step {s['basic_time_step_ms']} ms   seed {s['random_seed']}")
+    print(f"solids    {len(s['solids'])}: " + ", ".join(f"{x['name']} ({x['geometry']})" for x in s["solids"]))
+    print(f"triangles {s['triangles']} (infinite planes are analytic and not counted)")
+    print(f"lights    {len(s['lights'])}: " + ", ".join(f"{x['name'] or '-'} ({x['type']}{'' if x['on'] else ', off'})" for x in s["lights"]))
+    print(f"robots    {len(s['robots'])}")
+    for r in s["robots"]:
+        print(f"  {r['name']}{'' if r['synchronization'] else ' (asynchronous)'}: {len(r['devices'])} devices")
+        for d in r["devices"]:
+            print(f"    {d['name']:<14} {d['summary']}")
+    for w in s["warnings"]:
+        print(f"warning: {w}")
+    return 0
+
+
+def _parse_enable(spec: str) -> tuple[str, int]:
+    target, _, period = spec.rpartition(":")
+    if not target or not period.isdigit() or int(period) <= 0:
+        raise SystemExit(f"--enable expects ROBOT/DEVICE:PERIOD with PERIOD a positive integer (ms), got {spec!r}")
+    return target, int(period)
+
+
+def _summary(value) -> object:
+    import numpy as np
+
+    if isinstance(value, float):
+        return None if math.isnan(value) else value
+    arr = np.asarray(value)
+    if arr.dtype.names:
+        xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=-1)
+        finite = np.isfinite(xyz).all(axis=-1)
+        return {"points": int(arr.size), "finite": int(finite.sum())}
+    finite = arr[np.isfinite(arr)]
+    return {"shape": list(arr.shape), "finite": int(finite.size),
+            "min": float(finite.min()) if finite.size else None,
+            "max": float(finite.max()) if finite.size else None,
+            "mean": float(finite.mean()) if finite.size else None}
+
+
+def probe(args: argparse.Namespace) -> int:
+    from sensorium.server.sim.simulation import Simulation
+
+    path = args.world or str(default_world_path())
+    try:
+        sim = Simulation.from_file(path, precision=args.precision)
+    except WorldError as exc:
+        print(str(exc), file=sys.stderr)
+        return 1
+    enabled = []
+    try:
+        for spec in args.enable:
+            target, period = _parse_enable(spec)
+            devices = sim.all_devices() if target == "all" else [sim.device(target)]
+            for dev in devices:
+                dev.enable(period)
+                enabled.append(dev)
+        for target in args.point_cloud:
+            sim.device(target).enable_point_cloud()
+    except KeyError as exc:
+        print(f"probe: {exc.args[0]}", file=sys.stderr)
+        return 2
+    if not enabled:
+        print("probe: nothing enabled; use --enable ROBOT/DEVICE:PERIOD (or all:PERIOD)", file=sys.stderr)
+    for step in range(1, args.steps + 1):
+        sim.step()
+        for dev in enabled:
+            readings = dev.readings()
+            if args.json:
+                row = {"step": step, "time_ms": sim.time_ms, "robot": dev.robot_name, "device": dev.name}
+                row.update({k: _summary(v) for k, v in readings.items()})
+                print(json.dumps(row), flush=True)
+            else:
+                text = ", ".join(f"{k}={_summary(v)}" for k, v in readings.items())
+                print(f"step {step:>4} t={sim.time_ms:>6} ms  {dev.path:<22} {text}", flush=True)
+    return 0

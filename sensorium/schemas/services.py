@@ -1,0 +1,430 @@
+"""Services (PROTOCOL.md §3): request/reply envelopes, error codes, per-service args and results.
+
+Every request and reply shape of the protocol is a model here. :data:`SERVICES` lists each
+service once — name pattern, argument model, result model, which devices offer it and whether
+the caller must be the robot's attached controller — and the server's handler table is checked
+against it, so the protocol page, these models and the server cannot drift apart.
+
+Argument models are strict (no coercion: ``"32"`` is not an int, ``true`` is not 1), refuse
+unknown keys and refuse NaN/inf. Vectors are lists because msgpack has no tuples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+from sensorium.schemas.messages import Image, PointCloud
+from sensorium.schemas.wire import PROTOCOL_VERSION, ErrorCode
+
+__all__ = ["ErrorCode", "PROTOCOL_VERSION", "SERVICES", "ServiceSpec", "service_names"]
+
+MAX_PERIOD_MS = (1 << 31) - 1
+Mode = Literal["fast", "realtime", "pause"]
+DeviceType = Literal["LightSensor", "DistanceSensor", "Lidar", "RotationalMotor"]
+Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
+
+
+class Args(BaseModel):
+    """Base of argument maps."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
+
+
+class Result(BaseModel):
+    """Base of result maps (NaN/inf allowed: sensor values)."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+# ---------------------------------------------------------------------- envelopes
+
+class Request(BaseModel):
+    """``{"id", "service", "args"}``: one frame from a DEALER (REQ: after the empty delimiter)."""
+
+    model_config = ConfigDict(extra="allow", strict=True)
+
+    id: int = Field(ge=0, lt=1 << 64)
+    service: str = Field(min_length=1)
+    args: dict[str, Any]
+
+
+class ErrorInfo(Result):
+    code: int = Field(description="an ErrorCode")
+    message: str
+
+
+class OkReply(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    id: int
+    ok: Literal[True]
+    result: dict[str, Any]
+
+
+class ErrorReply(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+    id: int | None = Field(description="null when the request could not be read")
+    ok: Literal[False]
+    error: ErrorInfo
+
+
+# ---------------------------------------------------------------------- arguments
+
+class NoArgs(Args):
+    pass
+
+
+class AttachArgs(Args):
+    robot: str = Field(min_length=1)
+
+
+class SessionArgs(Args):
+    session: str = Field(min_length=1)
+
+
+class SetModeArgs(Args):
+    mode: Mode
+
+
+class MotorCommand(Args):
+    """One motor's commands with a step request (Webots: what ``setPosition``/``setVelocity`` set
+    since the previous step). Either key may be left out."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=True, frozen=True)
+
+    position: float | None = Field(default=None, description="target position (rad); +inf/-inf = velocity control")
+    velocity: float | None = Field(default=None, description="rad/s, finite; clamped to maxVelocity")
+
+    @field_validator("position")
+    @classmethod
+    def _not_nan(cls, v: float | None) -> float | None:
+        if v is not None and v != v:
+            raise ValueError("position must not be NaN")
+        return v
+
+    @field_validator("velocity")
+    @classmethod
+    def _finite(cls, v: float | None) -> float | None:
+        if v is not None and (v != v or v in (float("inf"), float("-inf"))):
+            raise ValueError("velocity must be finite")
+        return v
+
+
+class StepArgs(Args):
+    duration: int | None = Field(default=None, gt=0, le=MAX_PERIOD_MS,
+                                 description="ms, a positive multiple of the basic time step; default: one basic step")
+    motors: dict[str, MotorCommand] | None = Field(
+        default=None, description="motor name -> commands, applied when the request arrives (before the world advances)")
+
+
+class TimeStepArgs(Args):
+    value: int = Field(ge=0, le=MAX_PERIOD_MS, description="ms, a multiple of the basic time step; 0 = one basic step")
+
+
+class SetPoseArgs(Args):
+    translation: Vec3
+    rotation: Vec4 | None = Field(default=None, description="Webots axis-angle: axis x, y, z, angle (rad)")
+    quaternion: Vec4 | None = Field(default=None, description="x, y, z, w")
+
+
+class EnableArgs(Args):
+    value: int = Field(ge=0, le=MAX_PERIOD_MS, description="sampling period (ms); 0 disables")
+
+
+class BoolArgs(Args):
+    value: bool
+
+
+class FrequencyArgs(Args):
+    value: float = Field(description="Hz, within [minFrequency, maxFrequency]")
+
+
+class LayerArgs(Args):
+    layer: int = Field(ge=0, lt=1 << 31)
+
+
+class MotorPositionArgs(Args):
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=True, frozen=True)
+
+    value: float = Field(description="target position (rad); +inf/-inf = velocity control")
+
+    @field_validator("value")
+    @classmethod
+    def _not_nan(cls, v: float) -> float:
+        if v != v:
+            raise ValueError("position must not be NaN")
+        return v
+
+
+class MotorVelocityArgs(Args):
+    value: float = Field(description="rad/s, finite; clamped to maxVelocity")
+
+
+# ---------------------------------------------------------------------- results
+
+class Empty(Result):
+    pass
+
+
+class DeviceRef(Result):
+    name: str
+    type: DeviceType
+
+
+class RobotInfo(Result):
+    name: str
+    synchronization: bool
+    attached: bool
+    devices: list[DeviceRef]
+
+
+class TopicRef(Result):
+    name: str
+    type: str
+
+
+class InfoResult(Result):
+    protocol: int = PROTOCOL_VERSION
+    version: str
+    world: str
+    basic_time_step: int = Field(description="ms")
+    time_ms: int
+    mode: Mode
+    real_time_factor: float = Field(description="simulated / wall time over the last second (0 while idle)")
+    pub_endpoint: str
+    robots: list[RobotInfo]
+    topics: list[TopicRef]
+
+
+class LightSensorDescription(Result):
+    name: str
+    type: Literal["LightSensor"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class DistanceSensorDescription(Result):
+    name: str
+    type: Literal["DistanceSensor"]
+    sampling_period: int
+    lookup_table: list[float]
+    min_value: float
+    max_value: float
+    aperture: float
+    sensor_type: int = Field(description="get_type: 0 generic, 1 infra-red, 2 sonar, 3 laser")
+
+
+class LidarDescription(Result):
+    name: str
+    type: Literal["Lidar"]
+    sampling_period: int
+    horizontalResolution: int
+    numberOfLayers: int
+    fov: float
+    verticalFov: float
+    minRange: float
+    maxRange: float
+    frequency: float
+    minFrequency: float
+    maxFrequency: float
+    point_cloud_enabled: bool
+
+
+class MotorDescription(Result):
+    name: str
+    type: Literal["RotationalMotor"]
+    maxVelocity: float = Field(description="rad/s")
+    minPosition: float = Field(description="rad; minPosition = maxPosition = 0: no limits (Webots)")
+    maxPosition: float
+    targetPosition: float = Field(description="rad, inf in velocity control (the motor's current command)")
+    velocity: float = Field(description="rad/s (the motor's current command)")
+
+
+DeviceDescription = Annotated[LightSensorDescription | DistanceSensorDescription | LidarDescription | MotorDescription,
+                              Field(discriminator="type")]
+
+
+class AttachResult(Result):
+    session: str
+    robot: str
+    basic_time_step: int
+    time_ms: int
+    synchronization: bool
+    heartbeat_ms: int
+    devices: list[DeviceDescription]
+
+
+class TimeResult(Result):
+    time_ms: int
+
+
+class ModeResult(Result):
+    mode: Mode
+
+
+class ScalarReading(Result):
+    value: float = Field(description="NaN before the first measurement")
+
+
+class LidarReading(Result):
+    range_image: bytes = Field(description="little-endian float32[layers][columns]")
+    point_cloud: bytes | None = Field(default=None, description="20-byte records x, y, z <f4, layer_id <i4, time <f4; "
+                                                                "present while the point cloud is enabled")
+
+
+class StepResult(Result):
+    status: int = Field(description="0; -1 when the server quits; the lateness dt (ms) for asynchronous robots")
+    time_ms: int
+    values: dict[str, ScalarReading | LidarReading]
+
+
+class SuccessResult(Result):
+    success: bool
+
+
+class FloatValue(Result):
+    value: float
+
+
+class IntValue(Result):
+    value: int
+
+
+class FloatArrayValue(Result):
+    value: list[float]
+
+
+class DeviceListResult(Result):
+    list: list[str]
+
+
+class PoseResult(Result):
+    translation: list[float]
+    quaternion: list[float] = Field(description="x, y, z, w")
+
+
+class LidarInfoResult(Result):
+    horizontalResolution: int
+    numberOfLayers: int
+    fov: float
+    verticalFov: float
+    minRange: float
+    maxRange: float
+
+
+class FrequencyInfoResult(Result):
+    frequency: float
+    minFrequency: float
+    maxFrequency: float
+
+
+class StatusResult(Result):
+    status: int
+
+
+class LayerRangeImageResult(Result):
+    image: Image
+
+
+class LayerPointCloudResult(Result):
+    pointCloud: PointCloud
+
+
+class CountersResult(Result):
+    """``get_counters`` (debug): what the simulation computed so far and what is demanded."""
+
+    time_ms: int
+    steps: int
+    counters: dict[str, int] = Field(description="the simulation's work counters (rays per device kind, points built, ...)")
+    measurements: dict[str, int] = Field(description="values produced so far, per 'robot/device'")
+    demanded: list[str] = Field(description="topics covered by a subscription or the recorder")
+    subscriptions: list[bytes] = Field(description="active XPUB subscription prefixes")
+
+
+# ---------------------------------------------------------------------- the table
+
+@dataclass(frozen=True, slots=True)
+class ServiceSpec:
+    """One service: ``scope`` 'server' (name as is), 'robot' (``/<robot>/robot/<item>``) or
+    'device' (``/<robot>/<device>/<item>``, offered by ``devices``); ``attached``: the caller must
+    be the robot's attached controller."""
+
+    item: str
+    scope: Literal["server", "robot", "device"]
+    args: type[Args]
+    result: type[Result]
+    attached: bool = False
+    devices: frozenset[str] = frozenset()
+
+
+_ALL = frozenset({"LightSensor", "DistanceSensor", "Lidar"})          # sensors
+_M = frozenset({"RotationalMotor"})
+_LD = frozenset({"LightSensor", "DistanceSensor"})
+_D = frozenset({"DistanceSensor"})
+_L = frozenset({"Lidar"})
+
+SERVICES: tuple[ServiceSpec, ...] = (
+    ServiceSpec("get_info", "server", NoArgs, InfoResult),
+    ServiceSpec("attach", "server", AttachArgs, AttachResult),
+    ServiceSpec("detach", "server", SessionArgs, Empty),
+    ServiceSpec("ping", "server", SessionArgs, TimeResult),
+    ServiceSpec("set_mode", "server", SetModeArgs, ModeResult),
+    ServiceSpec("get_counters", "server", NoArgs, CountersResult),
+    ServiceSpec("step", "robot", StepArgs, StepResult, attached=True),
+    ServiceSpec("time_step", "robot", TimeStepArgs, SuccessResult, attached=True),
+    ServiceSpec("get_time", "robot", NoArgs, FloatValue),
+    ServiceSpec("get_basic_time_step", "robot", NoArgs, FloatValue),
+    ServiceSpec("get_device_list", "robot", NoArgs, DeviceListResult),
+    ServiceSpec("get_number_of_devices", "robot", NoArgs, IntValue),
+    ServiceSpec("set_pose", "robot", SetPoseArgs, SuccessResult),
+    ServiceSpec("get_pose", "robot", NoArgs, PoseResult),
+    ServiceSpec("enable", "device", EnableArgs, SuccessResult, attached=True, devices=_ALL),
+    ServiceSpec("get_sampling_period", "device", NoArgs, IntValue, devices=_ALL),
+    ServiceSpec("get_lookup_table", "device", NoArgs, FloatArrayValue, devices=_LD),
+    ServiceSpec("get_min_value", "device", NoArgs, FloatValue, devices=_D),
+    ServiceSpec("get_max_value", "device", NoArgs, FloatValue, devices=_D),
+    ServiceSpec("get_aperture", "device", NoArgs, FloatValue, devices=_D),
+    ServiceSpec("get_type", "device", NoArgs, IntValue, devices=_D),
+    ServiceSpec("get_info", "device", NoArgs, LidarInfoResult, devices=_L),
+    ServiceSpec("enable_point_cloud", "device", BoolArgs, SuccessResult, attached=True, devices=_L),
+    ServiceSpec("is_point_cloud_enabled", "device", NoArgs, StatusResult, devices=_L),
+    ServiceSpec("get_frequency_info", "device", NoArgs, FrequencyInfoResult, devices=_L),
+    ServiceSpec("set_frequency", "device", FrequencyArgs, SuccessResult, attached=True, devices=_L),
+    ServiceSpec("get_layer_range_image", "device", LayerArgs, LayerRangeImageResult, devices=_L),
+    ServiceSpec("get_layer_point_cloud", "device", LayerArgs, LayerPointCloudResult, devices=_L),
+    ServiceSpec("set_position", "device", MotorPositionArgs, SuccessResult, attached=True, devices=_M),
+    ServiceSpec("set_velocity", "device", MotorVelocityArgs, SuccessResult, attached=True, devices=_M),
+    ServiceSpec("get_velocity", "device", NoArgs, FloatValue, devices=_M),
+    ServiceSpec("get_max_velocity", "device", NoArgs, FloatValue, devices=_M),
+    ServiceSpec("get_target_position", "device", NoArgs, FloatValue, devices=_M),
+)
+
+
+def spec(scope: str, item: str) -> ServiceSpec:
+    for s in SERVICES:
+        if s.scope == scope and s.item == item:
+            return s
+    raise KeyError(f"no {scope} service {item!r}")
+
+
+def service_names(robots: dict[str, dict[str, str]]) -> dict[str, ServiceSpec]:
+    """Every concrete service name of a world: ``robots`` maps robot → {device: device type}
+    (motors included, type ``RotationalMotor``)."""
+    out: dict[str, ServiceSpec] = {}
+    for s in SERVICES:
+        if s.scope == "server":
+            out[s.item] = s
+    for robot, devices in robots.items():
+        for s in SERVICES:
+            if s.scope == "robot":
+                out[f"/{robot}/robot/{s.item}"] = s
+        for dev, kind in devices.items():
+            for s in SERVICES:
+                if s.scope == "device" and kind in s.devices:
+                    out[f"/{robot}/{dev}/{s.item}"] = s
+    return out

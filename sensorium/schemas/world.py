@@ -1,0 +1,328 @@
+"""World files: the pydantic models that are the contract for YAML/JSON worlds.
+
+Field names are Webots' field names in snake_case, defaults are Webots' node defaults, and the
+sanitising rules are Webots' (devices.md §2.1, §3.1, §4.1) except where the project decided to
+reject instead (attenuation ``0 0 0``, unknown sensor types). Sanitising that changes a value is
+reported as a warning by the loader; anything ambiguous or meaningless is an error.
+
+Conventions: world z-up, devices FLU (x forward, y left, z up); lengths in metres, angles in
+radians, time in integer milliseconds.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+Vec3 = tuple[float, float, float]
+
+
+class Strict(BaseModel):
+    """Base: unknown keys are errors, NaN/inf rejected everywhere, models immutable."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+class Pose(Strict):
+    """Translation plus either a Webots axis-angle rotation or a quaternion (ROS order x, y, z, w)."""
+
+    translation: Vec3 = (0.0, 0.0, 0.0)
+    rotation: tuple[float, float, float, float] | None = Field(
+        default=None, description="Webots axis-angle: axis x, y, z then angle (rad)"
+    )
+    quaternion: tuple[float, float, float, float] | None = Field(
+        default=None, description="unit quaternion in ROS order x, y, z, w"
+    )
+
+    @model_validator(mode="after")
+    def _one_rotation(self) -> Pose:
+        if self.rotation is not None and self.quaternion is not None:
+            raise ValueError("give either 'rotation' (axis-angle) or 'quaternion', not both")
+        if self.rotation is not None and math.hypot(*self.rotation[:3]) == 0.0 and self.rotation[3] != 0.0:
+            raise ValueError("rotation axis must not be zero")
+        if self.quaternion is not None and math.hypot(*self.quaternion) == 0.0:
+            raise ValueError("quaternion must not be zero")
+        return self
+
+
+# ---------------------------------------------------------------- geometry
+
+class Box(Strict):
+    type: Literal["box"]
+    size: Vec3 = (2.0, 2.0, 2.0)
+
+    @field_validator("size")
+    @classmethod
+    def _positive(cls, v: Vec3) -> Vec3:
+        if min(v) <= 0:
+            raise ValueError("every box size component must be > 0")
+        return v
+
+
+class Sphere(Strict):
+    type: Literal["sphere"]
+    radius: float = Field(default=1.0, gt=0)
+    subdivision: int = Field(default=3, ge=0, le=6, description="icosphere level of the triangle mesh")
+
+
+class Cylinder(Strict):
+    """Axis along local z, centred on the origin, closed caps (Webots R2022+)."""
+
+    type: Literal["cylinder"]
+    radius: float = Field(default=1.0, gt=0)
+    height: float = Field(default=2.0, gt=0)
+    subdivision: int = Field(default=36, ge=3, le=1024, description="facets around the axis")
+
+
+class Capsule(Strict):
+    """Cylinder of ``height`` along local z with hemispherical ends of ``radius``."""
+
+    type: Literal["capsule"]
+    radius: float = Field(default=1.0, gt=0)
+    height: float = Field(default=2.0, gt=0)
+    subdivision: int = Field(default=12, ge=2, le=256, description="facets per quarter circle")
+
+
+class Plane(Strict):
+    """Normal along local +z. ``size`` null means infinite.
+
+    As in Webots, bounding-object rays see every plane as infinite and two-sided; visual rays see
+    it one-sided (from +z) and finite when ``size`` is given.
+    """
+
+    type: Literal["plane"]
+    size: tuple[float, float] | None = (1.0, 1.0)
+
+    @field_validator("size")
+    @classmethod
+    def _positive(cls, v: tuple[float, float] | None) -> tuple[float, float] | None:
+        if v is not None and min(v) <= 0:
+            raise ValueError("plane size components must be > 0 (use null for an infinite plane)")
+        return v
+
+
+class Mesh(Strict):
+    """Triangle mesh file (STL, OBJ, PLY, GLB) loaded with trimesh; path relative to the world file."""
+
+    type: Literal["mesh"]
+    url: str
+    scale: Vec3 = (1.0, 1.0, 1.0)
+
+
+Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Mesh, Field(discriminator="type")]
+
+
+class Appearance(Strict):
+    """What infra-red sensors see (PBRAppearance fields). No appearance means white (red = 1)."""
+
+    base_color: Vec3 = (1.0, 1.0, 1.0)
+    transparency: float = Field(default=0.0, ge=0.0, le=1.0)
+    roughness: float = Field(default=0.0, ge=0.0, le=1.0)
+
+    @field_validator("base_color")
+    @classmethod
+    def _unit(cls, v: Vec3) -> Vec3:
+        if min(v) < 0 or max(v) > 1:
+            raise ValueError("colour components must be within [0, 1]")
+        return v
+
+
+SeenBy = Literal["both", "bounding", "visual"]
+
+
+class Shape(Strict):
+    """A geometry as seen by rays: bounding-object rays (generic/sonar/laser distance sensors,
+    light occlusion), visual rays (infra-red distance sensors, lidar), or both."""
+
+    geometry: Geometry
+    appearance: Appearance | None = None
+    seen_by: SeenBy = "both"
+
+
+class Solid(Shape):
+    name: str = Field(min_length=1)
+    pose: Pose = Pose()
+
+
+# ---------------------------------------------------------------- lights
+
+Color = Vec3
+
+
+class _Light(Strict):
+    name: str | None = None
+    ambient_intensity: float = 0.0
+    intensity: float = 1.0
+    color: Color = (1.0, 1.0, 1.0)
+    on: bool = True
+    cast_shadows: bool = False  # rendering only in Webots; kept for file compatibility
+
+
+class _Attenuated(_Light):
+    attenuation: Vec3 = (1.0, 0.0, 0.0)
+    location: Vec3 = (0.0, 0.0, 0.0)
+    radius: float = Field(default=100.0, ge=0.0, description="unused by sensors (Webots)")
+
+    @field_validator("attenuation")
+    @classmethod
+    def _attenuation(cls, v: Vec3) -> Vec3:
+        if min(v) < 0:
+            raise ValueError("attenuation components must be >= 0")
+        if v == (0.0, 0.0, 0.0):
+            raise ValueError("attenuation 0 0 0 would give infinite irradiance; use 1 0 0 for none")
+        return v
+
+
+class PointLight(_Attenuated):
+    type: Literal["PointLight"]
+
+
+class SpotLight(_Attenuated):
+    type: Literal["SpotLight"]
+    direction: Vec3 = (0.0, 0.0, -1.0)
+    beam_width: float = 1.570796
+    cut_off_angle: float = 0.785398
+
+    @field_validator("direction")
+    @classmethod
+    def _nonzero(cls, v: Vec3) -> Vec3:
+        if math.hypot(*v) == 0:
+            raise ValueError("direction must not be the zero vector")
+        return v
+
+
+class DirectionalLight(_Light):
+    type: Literal["DirectionalLight"]
+    direction: Vec3 = (0.0, 0.0, -1.0)
+
+    @field_validator("direction")
+    @classmethod
+    def _nonzero(cls, v: Vec3) -> Vec3:
+        if math.hypot(*v) == 0:
+            raise ValueError("direction must not be the zero vector")
+        return v
+
+
+Light = Annotated[PointLight | SpotLight | DirectionalLight, Field(discriminator="type")]
+
+
+# ---------------------------------------------------------------- devices
+
+LookupRow = tuple[float, float, float]  # input, output, relative noise
+
+
+class _Device(Strict):
+    name: str = Field(min_length=1)
+    pose: Pose = Pose()
+
+
+class LightSensor(_Device):
+    device: Literal["LightSensor"]
+    lookup_table: list[LookupRow] = [(0.0, 0.0, 0.0), (1.0, 1000.0, 0.0)]
+    color_filter: Color = (1.0, 1.0, 1.0)
+    occlusion: bool = False
+    resolution: float = -1.0
+
+
+class DistanceSensor(_Device):
+    device: Literal["DistanceSensor"]
+    lookup_table: list[LookupRow] = [(0.0, 0.0, 0.0), (0.1, 1000.0, 0.0)]
+    type: Literal["generic", "infra-red", "infrared", "sonar", "laser"] = "generic"
+    number_of_rays: int = 1
+    aperture: float = 1.5708
+    gaussian_width: float = 1.0
+    resolution: float = -1.0
+    red_color_sensitivity: float = 1.0
+
+    @field_validator("type", mode="before")
+    @classmethod
+    def _lower(cls, v: object) -> object:
+        return v.lower() if isinstance(v, str) else v
+
+
+class Lidar(_Device):
+    device: Literal["Lidar"]
+    tilt_angle: float = 0.0
+    horizontal_resolution: int = Field(default=512, ge=1, le=1 << 16)
+    field_of_view: float = Field(default=1.5708, gt=0.0, le=2 * math.pi)
+    vertical_field_of_view: float = 0.2
+    number_of_layers: int = Field(default=4, ge=1, le=4096)
+    near: float = Field(default=0.01, ge=0.0)
+    min_range: float = Field(default=0.01, ge=0.0)
+    max_range: float = Field(default=1.0, gt=0.0)
+    type: Literal["fixed", "rotating"] = "fixed"
+    projection: Literal["cylindrical", "planar"] = "cylindrical"
+    noise: float = Field(default=0.0, ge=0.0)
+    resolution: float = -1.0
+    default_frequency: float = Field(default=10.0, gt=0.0)
+    min_frequency: float = Field(default=1.0, gt=0.0)
+    max_frequency: float = Field(default=25.0, gt=0.0)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Lidar:
+        if self.projection == "planar" and self.field_of_view > math.pi:
+            raise ValueError("a planar lidar's field_of_view must be <= pi")
+        return self
+
+
+Device = Annotated[LightSensor | DistanceSensor | Lidar, Field(discriminator="device")]
+
+
+# ---------------------------------------------------------------- motion
+
+class DifferentialDrive(Strict):
+    """Kinematic two-wheel drive (no physics, no collision response): the robot moves in the world
+    xy-plane from its two wheel motors, controlled with Webots' motor API."""
+
+    wheel_radius: float = Field(default=0.0205, gt=0)
+    axle_length: float = Field(default=0.052, gt=0, description="distance between the wheels")
+    max_wheel_speed: float = Field(default=6.28, gt=0, description="rad/s, Webots maxVelocity")
+    left_motor: str = Field(default="left wheel motor", min_length=1)
+    right_motor: str = Field(default="right wheel motor", min_length=1)
+
+    @model_validator(mode="after")
+    def _distinct(self) -> DifferentialDrive:
+        if self.left_motor == self.right_motor:
+            raise ValueError("left_motor and right_motor must have different names")
+        return self
+
+
+# ---------------------------------------------------------------- robots and world
+
+class Robot(Strict):
+    name: str = Field(min_length=1)
+    pose: Pose = Pose()
+    synchronization: bool = True
+    self_collision: bool = False
+    body: Shape | None = None
+    differential_drive: DifferentialDrive | None = None
+    devices: list[Device] = []
+
+
+class WorldInfo(Strict):
+    name: str = "world"
+    basic_time_step: int = Field(default=32, ge=1, le=60_000, description="milliseconds")
+    random_seed: int = Field(default=0, ge=0, lt=2**63)
+
+
+class World(Strict):
+    """A whole world file.
+
+    Checks that relate several fields (sorted lookup tables, unique names, mesh files that exist)
+    live in ``sensorium.server.world.loader.check_world`` so that each problem gets its exact path.
+    """
+
+    world_info: WorldInfo = WorldInfo()
+    solids: list[Solid] = []
+    lights: list[Light] = []
+    robots: list[Robot] = []
+
+
+def json_schema() -> dict:
+    """JSON Schema of a world file, as committed in ``schemas/json/world.schema.json``."""
+    schema = World.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "Sensorium world file"
+    return schema

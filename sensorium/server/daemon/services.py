@@ -1,0 +1,528 @@
+"""The server's sans-IO core: service name → handler table, argument validation, typed errors.
+
+:class:`Core` owns one simulation with its :class:`~sensorium.server.daemon.lockstep.Lockstep` and
+:class:`~sensorium.server.daemon.topics.Topics`. The transport hands it raw ROUTER frames and XPUB
+events and sends back what it returns; no socket or clock is touched here (``now`` is passed in).
+
+    core = Core(sim, pub_endpoint="tcp://127.0.0.1:5561")
+    replies = core.handle([identity, body], now)     # -> [[identity, reply_body], ...]
+    while (t := core.next_advance(now)) is not None and t <= now:
+        replies, publications = core.step_once(now)
+
+Every concrete service name of the world is resolved once, at start, to (spec, handler, robot,
+device): the hot path is one dict lookup, one pydantic validation, one handler call. A request
+that fails gets exactly one error reply with a protocol code; the core never raises out of
+:meth:`Core.handle`.
+"""
+
+from __future__ import annotations
+
+import sys
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from pydantic import ValidationError
+
+from sensorium.schemas import services as S
+from sensorium.schemas.wire import (
+    SOFT_LIMIT,
+    ErrorCode,
+    RequestError,
+    error_reply,
+    ok_reply,
+    parse_request,
+)
+from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
+from sensorium.server.daemon.topics import Control, Topics, header, image_msg, point_cloud_msg, pose_quaternion
+
+__all__ = ["Core", "ServiceError"]
+
+Frames = list[bytes]
+
+
+class ServiceError(Exception):
+    """Raised by a handler: answered with ``code`` and ``message``."""
+
+    def __init__(self, code: ErrorCode, message: str):
+        super().__init__(f"{code.name}: {message}")
+        self.code = code
+        self.message = message
+
+
+@dataclass(slots=True)
+class Call:
+    """One validated request, as a handler sees it."""
+
+    envelope: Frames          # routing frames to echo (identity, REQ delimiter, ...)
+    peer: bytes
+    id: int
+    args: Any                 # the spec's pydantic Args model
+    robot: str | None
+    ctl: Control | None
+    motor: Any                # the WheelMotor of a motor service, else None
+    now: float
+    extra: list[Frames]       # more replies to send (e.g. a step answered by detach)
+
+
+@dataclass(frozen=True, slots=True)
+class Route:
+    spec: S.ServiceSpec
+    handler: Callable[[Call], dict | None]
+    robot: str | None
+    device: str | None        # "robot/device" path of a sensor
+    motor: str | None = None  # motor name of a motor service
+
+
+_DEFERRED = None              # a handler returning None answers later (step)
+MOTOR = "RotationalMotor"
+
+
+def _arg_errors(exc: ValidationError) -> str:
+    parts = []
+    for e in exc.errors(include_url=False):
+        loc = ".".join(str(x) for x in e["loc"]) or "args"
+        if e["type"] == "extra_forbidden":
+            parts.append(f"unknown argument {loc!r}")
+        elif e["type"] == "missing":
+            parts.append(f"missing argument {loc!r}")
+        else:
+            parts.append(f"argument {loc!r}: {e['msg']} (got {e.get('input')!r})")
+    return "; ".join(parts)
+
+
+class Core:
+    """One world served: requests in, replies and publications out."""
+
+    def __init__(self, sim: Any, *, world_name: str | None = None, heartbeat_ms: int = 1000, mode: str = "fast",
+                 pub_endpoint: str = "", version: str | None = None, new_token: Callable[[], str] | None = None,
+                 log: Callable[[str], None] | None = None, max_request: int = SOFT_LIMIT):
+        from sensorium import __version__
+
+        self.sim = sim
+        self.world_name = world_name or getattr(getattr(getattr(sim, "world", None), "world_info", None), "name", "world")
+        self.version = version or __version__
+        self.pub_endpoint = pub_endpoint
+        self.max_request = max_request
+        self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
+        self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
+                                 sim.basic_time_step, heartbeat_ms=heartbeat_ms, mode=mode,
+                                 time_ms=sim.time_ms, new_token=new_token)
+        self.topics = Topics(sim)
+        self._seen: dict[str, dict[str, int]] = {}          # session token -> device path -> measurements
+        self._controls_by_robot: dict[str, list[Control]] = {name: [] for name in sim.robots}
+        for ctl in self.topics.controls.values():
+            self._controls_by_robot[ctl.robot].append(ctl)
+        self.routes = self._routes()
+        self.errors = 0
+
+    # ------------------------------------------------------------------ routing table
+    def _routes(self) -> dict[str, Route]:
+        routes: dict[str, Route] = {}
+        for robot_name, robot in self.sim.robots.items():
+            for dev_name, dev in robot.devices.items():
+                kind = dev.config.device
+                path = f"{robot_name}/{dev_name}"
+                for spec in S.SERVICES:
+                    if spec.scope == "device" and kind in spec.devices:
+                        routes[f"/{robot_name}/{dev_name}/{spec.item}"] = Route(
+                            spec, getattr(self, f"_dev_{spec.item}"), robot_name, path)
+            for motor_name in robot.motors:
+                for spec in S.SERVICES:
+                    if spec.scope == "device" and MOTOR in spec.devices:
+                        routes[f"/{robot_name}/{motor_name}/{spec.item}"] = Route(
+                            spec, getattr(self, f"_motor_{spec.item}"), robot_name, None, motor_name)
+            for spec in S.SERVICES:
+                if spec.scope == "robot":
+                    routes[f"/{robot_name}/robot/{spec.item}"] = Route(spec, getattr(self, f"_robot_{spec.item}"), robot_name, None)
+        for spec in S.SERVICES:
+            if spec.scope == "server":
+                routes[spec.item] = Route(spec, getattr(self, f"_srv_{spec.item}"), None, None)
+        return routes
+
+    def _unknown(self, service: str) -> ServiceError:
+        """The most precise error for a name that is no service: robot, device or item unknown."""
+        if not service.startswith("/"):
+            return ServiceError(ErrorCode.UNKNOWN_SERVICE, f"no service {service!r}")
+        robots = sorted((r for r in self.sim.robots if service.startswith(f"/{r}/")), key=len, reverse=True)
+        if not robots:
+            name = service[1:].split("/", 1)[0]
+            return ServiceError(ErrorCode.UNKNOWN_ROBOT,
+                                f"no robot {name!r} (robots: {', '.join(self.sim.robots) or 'none'})")
+        robot = robots[0]
+        rest = service[len(robot) + 2:]
+        devices = self._device_kinds(robot)
+        if rest.startswith("robot/"):
+            return ServiceError(ErrorCode.UNKNOWN_SERVICE, f"no robot service {rest[6:]!r}")
+        for dev in sorted(devices, key=len, reverse=True):
+            if rest.startswith(dev + "/"):
+                return ServiceError(ErrorCode.UNKNOWN_DEVICE,
+                                    f"{devices[dev]} {robot}/{dev} has no service {rest[len(dev) + 1:]!r}")
+        dev = rest.split("/", 1)[0]
+        return ServiceError(ErrorCode.UNKNOWN_DEVICE,
+                            f"robot {robot!r} has no device {dev!r} (devices: {', '.join(devices) or 'none'})")
+
+    # ------------------------------------------------------------------ requests
+    def handle(self, frames: Frames, now: float) -> list[Frames]:
+        """One ROUTER message ``[identity, (envelope frames...), body]`` → replies to send now."""
+        envelope, body = frames[:-1], frames[-1]
+        peer = frames[0] if len(frames) > 1 else b""
+        self.lockstep.heard(peer, now)
+        rid: int | None = None
+        try:
+            size = len(body) if len(frames) == 2 else sum(len(f) for f in frames[1:])
+            if size > self.max_request:
+                raise RequestError(ErrorCode.TOO_LARGE, f"request of {size} bytes exceeds the limit of {self.max_request} bytes")
+            req = parse_request(body, self.max_request)
+            rid = req.id
+            route = self.routes.get(req.service)
+            if route is None:
+                raise self._unknown(req.service)
+            try:
+                args = route.spec.args.model_validate(req.args)
+            except ValidationError as exc:
+                raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{req.service}: {_arg_errors(exc)}") from None
+            if route.spec.attached:
+                s = self.lockstep.session_for(route.robot)
+                if s is None or s.peer != peer:
+                    raise ServiceError(ErrorCode.NOT_ATTACHED,
+                                       f"{req.service} needs the caller to be {route.robot!r}'s attached controller"
+                                       + ("" if s is None else " (another socket is)"))
+            ctl = self.topics.controls[route.device] if route.device else None
+            motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
+            call = Call(envelope, peer, rid, args, route.robot, ctl, motor, now, [])
+            result = route.handler(call)
+            if result is _DEFERRED:
+                return call.extra
+            return call.extra + [envelope + [ok_reply(rid, result)]]
+        except RequestError as exc:
+            return [envelope + [error_reply(exc.id if exc.id is not None else rid, exc.code, exc.message)]]
+        except (ServiceError, LockstepError) as exc:
+            return [envelope + [error_reply(rid, exc.code, exc.message)]]
+        except Exception as exc:  # noqa: BLE001 - a bug must not stop the server
+            self.errors += 1
+            self.log(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
+            return [envelope + [error_reply(rid, ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}")]]
+
+    def subscription(self, event: bytes) -> None:
+        """An XPUB subscription event."""
+        self.topics.subscription(event)
+
+    # ------------------------------------------------------------------ stepping
+    def next_advance(self, now: float) -> float | None:
+        return self.lockstep.next_advance(now)
+
+    def next_deadline(self, now: float) -> float | None:
+        return self.lockstep.next_deadline(now)
+
+    def step_once(self, now: float) -> tuple[list[Frames], list[Frames]]:
+        """Run one basic step: (step replies, topic messages). The caller checked
+        :meth:`next_advance`. Publications come before replies (PROTOCOL §3.7)."""
+        try:
+            self.sim.step()
+        except Exception as exc:  # noqa: BLE001
+            self.errors += 1
+            self.log(f"the world failed to step; pausing: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
+            self.lockstep.set_mode("pause")
+            return [self._reply_error(d, ErrorCode.INTERNAL, f"the world failed to step: {exc}")
+                    for d in self.lockstep.cancel_pending()], []
+        done = self.lockstep.advanced(now)
+        if self.sim.time_ms != self.lockstep.time_ms:
+            raise RuntimeError(f"clock mismatch: simulation {self.sim.time_ms} ms, lockstep {self.lockstep.time_ms} ms")
+        try:
+            pubs = self.topics.publish(self.sim.time_ms)
+        except Exception as exc:  # noqa: BLE001 - a publishing bug must not stop the lockstep
+            self.errors += 1
+            if self.errors <= 10:
+                self.log(f"internal error while publishing: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
+            pubs = []
+        return [self._step_reply(d) for d in done], pubs
+
+    def expire(self, now: float) -> None:
+        for s in self.lockstep.expire(now):
+            self._released(s)
+            self.log(f"controller of {s.robot!r} silent for {self.lockstep.liveness_s:g} s: session dropped, robot released")
+
+    def shutdown(self) -> list[Frames]:
+        """Quit: answer every pending step with status -1 (later steps too)."""
+        return [self._step_reply(d) for d in self.lockstep.shutdown()]
+
+    def _released(self, s: Session) -> None:
+        self._seen.pop(s.token, None)
+        self.topics.release_robot(s.robot)
+        # a robot without a controller stops: with no collision response it would otherwise
+        # drive through walls while the world steps for the others (Webots keeps the commands)
+        for motor in self.sim.robots[s.robot].motors.values():
+            motor.hold()
+
+    def _step_reply(self, d: StepDone) -> Frames:
+        envelope, rid = d.step.reply_to
+        if d.step.kind == "time_step":
+            return envelope + [ok_reply(rid, {"success": d.status != -1})]
+        values: dict[str, dict] = {}
+        if d.status != -1 and d.session.alive:
+            seen = self._seen.setdefault(d.session.token, {})
+            for ctl in self._robot_controls(d.session.robot):
+                if ctl.controller_period > 0:
+                    m = ctl.device.measurements
+                    if seen.get(ctl.path, 0) != m:
+                        seen[ctl.path] = m
+                        values[ctl.device.name] = self.topics.reading(ctl)
+        return envelope + [ok_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})]
+
+    def _reply_error(self, d: StepDone, code: ErrorCode, message: str) -> Frames:
+        envelope, rid = d.step.reply_to
+        return envelope + [error_reply(rid, code, message)]
+
+    def _robot_controls(self, robot: str) -> list[Control]:
+        return self._controls_by_robot[robot]
+
+    def _device_kinds(self, robot: str) -> dict[str, str]:
+        """Every device of a robot → its type: sensors first (world order), then motors."""
+        r = self.sim.robots[robot]
+        out = {name: dev.config.device for name, dev in r.devices.items()}
+        out.update((name, MOTOR) for name in r.motors)
+        return out
+
+    # ------------------------------------------------------------------ server services
+    def _srv_get_info(self, c: Call) -> dict:
+        return {
+            "protocol": S.PROTOCOL_VERSION,
+            "version": self.version,
+            "world": self.world_name,
+            "basic_time_step": self.sim.basic_time_step,
+            "time_ms": self.sim.time_ms,
+            "mode": self.lockstep.mode,
+            "real_time_factor": self.lockstep.real_time_factor(c.now),
+            "pub_endpoint": self.pub_endpoint,
+            "robots": [{"name": name, "synchronization": bool(r.synchronization),
+                        "attached": self.lockstep.session_for(name) is not None,
+                        "devices": [{"name": d, "type": kind} for d, kind in self._device_kinds(name).items()]}
+                       for name, r in self.sim.robots.items()],
+            "topics": [{"name": t.name, "type": t.type} for t in self.topics.topics],
+        }
+
+    def _srv_attach(self, c: Call) -> dict:
+        s = self.lockstep.attach(c.args.robot, c.peer, c.now)
+        self.topics.release_robot(s.robot)          # a new controller starts from scratch
+        self._seen[s.token] = {}
+        robot = self.sim.robots[s.robot]
+        return {"session": s.token, "robot": s.robot, "basic_time_step": self.sim.basic_time_step,
+                "time_ms": self.sim.time_ms, "synchronization": bool(robot.synchronization),
+                "heartbeat_ms": self.lockstep.heartbeat_ms,
+                "devices": [self._describe(ctl) for ctl in self._robot_controls(s.robot)]
+                + [self._describe_motor(m) for m in robot.motors.values()]}
+
+    def _srv_detach(self, c: Call) -> dict:
+        s, done = self.lockstep.detach(c.args.session)
+        self._released(s)
+        if done is not None:
+            c.extra.append(self._step_reply(done))
+        return {}
+
+    def _srv_ping(self, c: Call) -> dict:
+        self.lockstep.ping(c.args.session, c.now)
+        return {"time_ms": self.sim.time_ms}
+
+    def _srv_set_mode(self, c: Call) -> dict:
+        return {"mode": self.lockstep.set_mode(c.args.mode)}
+
+    def _srv_get_counters(self, c: Call) -> dict:
+        counters = dict(self.sim.counters)
+        counters.update(self.topics.work)
+        counters.setdefault("poses_built", 0)
+        return {"time_ms": self.sim.time_ms, "steps": self.lockstep.steps,
+                "counters": {k: int(v) for k, v in sorted(counters.items())},
+                "measurements": {p: int(ctl.device.measurements) for p, ctl in self.topics.controls.items()},
+                "demanded": sorted(self.topics.demanded),
+                "subscriptions": sorted(self.topics.prefixes)}
+
+    # ------------------------------------------------------------------ robot services
+    def _session(self, c: Call) -> Session:
+        s = self.lockstep.session_for(c.robot)
+        assert s is not None and s.peer == c.peer          # checked by handle()
+        return s
+
+    def _robot_step(self, c: Call) -> dict | None:
+        commands = self._motor_commands(c.robot, c.args.motors) if c.args.motors else []
+        done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.duration, c.now)
+        if done is not None:                                 # quitting: -1 at once
+            return {"status": done.status, "time_ms": done.time_ms, "values": {}}
+        # the world has not advanced since the request arrived: Webots' "at the start of the step"
+        for motor, cmd in commands:
+            if cmd.position is not None:
+                motor.set_position(cmd.position)
+            if cmd.velocity is not None:
+                motor.set_velocity(cmd.velocity)
+        return _DEFERRED
+
+    def _motor_commands(self, robot: str, motors: dict[str, Any]) -> list[tuple[Any, Any]]:
+        """Resolve every named motor first, so that a bad name applies none of the commands."""
+        r = self.sim.robots[robot]
+        out = []
+        for name, cmd in motors.items():
+            motor = r.motors.get(name)
+            if motor is None:
+                if name in r.devices:
+                    raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: {robot}/{name} is a "
+                                                                 f"{r.devices[name].config.device}, not a motor")
+                raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: robot {robot!r} has no motor {name!r} "
+                                                             f"(motors: {', '.join(r.motors) or 'none'})")
+            out.append((motor, cmd))
+        return out
+
+    def _robot_time_step(self, c: Call) -> dict | None:
+        done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.value, c.now, kind="time_step")
+        if done is not None:
+            return {"success": False}
+        return _DEFERRED
+
+    def _robot_get_time(self, c: Call) -> dict:
+        return {"value": self.sim.time_ms / 1000.0}
+
+    def _robot_get_basic_time_step(self, c: Call) -> dict:
+        return {"value": float(self.sim.basic_time_step)}
+
+    def _robot_get_device_list(self, c: Call) -> dict:
+        return {"list": list(self._device_kinds(c.robot))}
+
+    def _robot_get_number_of_devices(self, c: Call) -> dict:
+        return {"value": len(self._device_kinds(c.robot))}
+
+    def _robot_set_pose(self, c: Call) -> dict:
+        a = c.args
+        if a.rotation is not None and a.quaternion is not None:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, "give either 'rotation' (axis-angle) or 'quaternion', not both")
+        try:
+            self.sim.robots[c.robot].set_pose(a.translation, a.rotation, a.quaternion)
+        except (ValueError, ArithmeticError) as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_pose: {exc}") from None
+        return {"success": True}
+
+    def _robot_get_pose(self, c: Call) -> dict:
+        pose = self.sim.robots[c.robot].pose
+        return {"translation": [float(v) for v in pose.translation], "quaternion": pose_quaternion(pose)}
+
+    # ------------------------------------------------------------------ device services
+    def _describe(self, ctl: Control) -> dict:
+        dev = ctl.device
+        out: dict[str, Any] = {"name": dev.name, "type": ctl.kind, "sampling_period": ctl.controller_period}
+        if ctl.kind in ("LightSensor", "DistanceSensor"):
+            out["lookup_table"] = self._lookup_table(dev)
+        if ctl.kind == "DistanceSensor":
+            out.update(min_value=float(dev.table.min_value), max_value=float(dev.table.max_value),
+                       aperture=float(dev.config.aperture), sensor_type=int(dev.type_code))
+        if ctl.kind == "Lidar":
+            out.update(self._lidar_info(dev))
+            out.update(self._frequency_info(dev))
+            out["point_cloud_enabled"] = ctl.controller_point_cloud
+        return out
+
+    @staticmethod
+    def _describe_motor(m: Any) -> dict:
+        return {"name": m.name, "type": MOTOR, "maxVelocity": float(m.max_velocity), "minPosition": 0.0,
+                "maxPosition": 0.0, "targetPosition": float(m.target_position), "velocity": float(m.velocity)}
+
+    @staticmethod
+    def _lookup_table(dev: Any) -> list[float]:
+        flat = getattr(dev.table, "flattened", None)
+        if flat is None:
+            flat = [v for row in dev.config.lookup_table for v in row]
+        return [float(v) for v in flat]
+
+    @staticmethod
+    def _lidar_info(dev: Any) -> dict:
+        cfg = dev.config
+        return {"horizontalResolution": int(cfg.horizontal_resolution), "numberOfLayers": int(cfg.number_of_layers),
+                "fov": float(cfg.field_of_view), "verticalFov": float(cfg.vertical_field_of_view),
+                "minRange": float(cfg.min_range), "maxRange": float(cfg.max_range)}
+
+    @staticmethod
+    def _frequency_info(dev: Any) -> dict:
+        cfg = dev.config
+        return {"frequency": float(dev.frequency), "minFrequency": float(cfg.min_frequency),
+                "maxFrequency": float(cfg.max_frequency)}
+
+    def _dev_enable(self, c: Call) -> dict:
+        self.topics.controller_enable(c.ctl.path, c.args.value)
+        return {"success": True}
+
+    def _dev_get_sampling_period(self, c: Call) -> dict:
+        return {"value": c.ctl.controller_period}
+
+    def _dev_get_lookup_table(self, c: Call) -> dict:
+        return {"value": self._lookup_table(c.ctl.device)}
+
+    def _dev_get_min_value(self, c: Call) -> dict:
+        return {"value": float(c.ctl.device.table.min_value)}
+
+    def _dev_get_max_value(self, c: Call) -> dict:
+        return {"value": float(c.ctl.device.table.max_value)}
+
+    def _dev_get_aperture(self, c: Call) -> dict:
+        return {"value": float(c.ctl.device.config.aperture)}
+
+    def _dev_get_type(self, c: Call) -> dict:
+        return {"value": int(c.ctl.device.type_code)}
+
+    def _dev_get_info(self, c: Call) -> dict:
+        return self._lidar_info(c.ctl.device)
+
+    def _dev_enable_point_cloud(self, c: Call) -> dict:
+        self.topics.controller_point_cloud(c.ctl.path, c.args.value)
+        return {"success": True}
+
+    def _dev_is_point_cloud_enabled(self, c: Call) -> dict:
+        return {"status": int(c.ctl.controller_point_cloud)}
+
+    def _dev_get_frequency_info(self, c: Call) -> dict:
+        return self._frequency_info(c.ctl.device)
+
+    def _dev_set_frequency(self, c: Call) -> dict:
+        try:
+            c.ctl.device.set_frequency(c.args.value)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_frequency: {exc}") from None
+        return {"success": True}
+
+    def _layer(self, c: Call) -> int:
+        n = c.ctl.device.config.number_of_layers
+        if c.args.layer >= n:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"argument 'layer': {c.args.layer} outside [0, {n - 1}]")
+        return c.args.layer
+
+    def _dev_get_layer_range_image(self, c: Call) -> dict:
+        layer = self._layer(c)
+        dev = c.ctl.device
+        row = dev.layer_range_image(layer)
+        w = int(dev.config.horizontal_resolution)
+        import numpy as np
+
+        data = np.ascontiguousarray(row, dtype="<f4").tobytes()
+        return {"image": image_msg(header(c.ctl.frame_id, dev.measured_at_ms), 1, w, data)}
+
+    def _dev_get_layer_point_cloud(self, c: Call) -> dict:
+        if not c.ctl.controller_point_cloud:
+            raise ServiceError(ErrorCode.WRONG_STATE, f"the point cloud of {c.ctl.path} is not enabled (enable_point_cloud)")
+        layer = self._layer(c)
+        dev = c.ctl.device
+        return {"pointCloud": point_cloud_msg(header(c.ctl.frame_id, dev.measured_at_ms), dev.layer_point_cloud(layer))}
+
+    # ------------------------------------------------------------------ motor services
+    def _motor_set_position(self, c: Call) -> dict:
+        c.motor.set_position(c.args.value)
+        return {"success": True}
+
+    def _motor_set_velocity(self, c: Call) -> dict:
+        c.motor.set_velocity(c.args.value)
+        return {"success": True}
+
+    def _motor_get_velocity(self, c: Call) -> dict:
+        return {"value": float(c.motor.velocity)}
+
+    def _motor_get_max_velocity(self, c: Call) -> dict:
+        return {"value": float(c.motor.max_velocity)}
+
+    def _motor_get_target_position(self, c: Call) -> dict:
+        return {"value": float(c.motor.target_position)}

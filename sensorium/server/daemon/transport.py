@@ -1,0 +1,233 @@
+"""The server's only ZeroMQ module: ROUTER + XPUB, the poll loop, signals.
+
+A thin adapter around :class:`sensorium.server.daemon.services.Core` (sans-IO): frames in, frames out.
+
+* ``ROUTER`` (RPC) with ``ZMQ_MAXMSGSIZE`` as the hard cap (libzmq drops the connection of a peer
+  that sends more); the 1 MiB soft limit is the core's and is answered with ``TOO_LARGE``. ZMTP
+  heartbeats detect silently dead TCP peers; session liveness is the lockstep's (heartbeat × 3).
+* ``XPUB`` (topics): subscription events feed the demand; a small ``SNDHWM`` bounds the memory a
+  slow subscriber costs (PUB semantics: excess messages are dropped, ``seq`` shows the gap).
+* Run modes ``fast``/``realtime``/``pause`` are decided by the lockstep; this loop only sleeps
+  until the next event or deadline.
+* SIGINT/SIGTERM: every pending (and later) step is answered with status -1, requests are still
+  served for ``grace_s`` so controllers can clean up, then both sockets close.
+"""
+
+from __future__ import annotations
+
+import signal
+import socket
+import time
+from collections.abc import Callable
+
+import zmq
+
+from sensorium.schemas.wire import HARD_LIMIT
+from sensorium.server.daemon.services import Core
+
+__all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB"]
+
+DEFAULT_RPC = "tcp://127.0.0.1:5560"
+DEFAULT_PUB = "tcp://127.0.0.1:5561"
+STEP_BUDGET_S = 0.005          # at most this long stepping before looking at the sockets again
+MAX_IDLE_WAIT_S = 1.0
+MAX_IDLE_WAIT_MS = int(MAX_IDLE_WAIT_S * 1000)
+EXPIRE_EVERY_S = 0.01           # session expiry scan at most this often while messages flow
+ZERO_COPY_MIN = 64 * 1024       # replies at least this large are sent zero-copy
+
+
+def _bindable(url: str) -> str:
+    """``tcp://host:0`` → ``tcp://host:*`` (an ephemeral port, like the ``*`` form)."""
+    if url.startswith("tcp://") and url.endswith(":0"):
+        return url[:-2] + ":*"
+    return url
+
+
+class Transport:
+    """Bind, serve until stopped, close. ``run()`` blocks; ``stop()`` may be called from a signal
+    handler or another thread."""
+
+    def __init__(self, core: Core, rpc: str = DEFAULT_RPC, pub: str = DEFAULT_PUB, *,
+                 hard_limit: int = HARD_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
+                 context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic,
+                 stop_at_ms: int | None = None):
+        self.core = core
+        self.stop_at_ms = stop_at_ms          # quit (steps answer -1) once simulated time reaches it
+        self.clock = clock
+        self.grace_s = grace_s
+        self._own_context = context is None
+        self.ctx = context or zmq.Context()
+        self.router = self.ctx.socket(zmq.ROUTER)
+        self.xpub = self.ctx.socket(zmq.XPUB)
+        hb = max(1, core.lockstep.heartbeat_ms)
+        for s in (self.router, self.xpub):
+            s.setsockopt(zmq.LINGER, 1000)
+            s.setsockopt(zmq.HEARTBEAT_IVL, hb)
+            s.setsockopt(zmq.HEARTBEAT_TIMEOUT, 3 * hb)
+        self.router.setsockopt(zmq.MAXMSGSIZE, hard_limit)
+        self.router.setsockopt(zmq.SNDHWM, 10_000)
+        self.router.setsockopt(zmq.RCVHWM, 10_000)
+        self.xpub.setsockopt(zmq.SNDHWM, pub_hwm)
+        self.xpub.setsockopt(zmq.MAXMSGSIZE, 64 * 1024)       # subscription messages only
+        try:
+            self.router.bind(_bindable(rpc))
+            self.xpub.bind(_bindable(pub))
+        except zmq.ZMQError:
+            self._close_sockets()
+            raise
+        self.rpc_endpoint = self.router.getsockopt_string(zmq.LAST_ENDPOINT)
+        self.pub_endpoint = self.xpub.getsockopt_string(zmq.LAST_ENDPOINT)
+        core.pub_endpoint = self.pub_endpoint
+        self._stop_requested = False
+        self._wake_r, self._wake_w = socket.socketpair()
+        self._wake_r.setblocking(False)
+        self._wake_w.setblocking(False)
+        self.poller = zmq.Poller()
+        self.poller.register(self.router, zmq.POLLIN)
+        self.poller.register(self.xpub, zmq.POLLIN)
+        self.poller.register(self._wake_r.fileno(), zmq.POLLIN)
+        self.closed = False
+
+    # ------------------------------------------------------------------ control
+    def stop(self) -> None:
+        """Ask the loop to shut down (signal-safe, thread-safe)."""
+        self._stop_requested = True
+        try:
+            self._wake_w.send(b"\0")
+        except OSError:
+            pass
+
+    def install_signal_handlers(self) -> None:
+        """SIGINT/SIGTERM → :meth:`stop` (main thread only)."""
+        def handler(signum, frame):  # noqa: ARG001
+            self.stop()
+
+        signal.signal(signal.SIGINT, handler)
+        signal.signal(signal.SIGTERM, handler)
+
+    # ------------------------------------------------------------------ loop
+    def run(self) -> None:
+        core = self.core
+        clock = self.clock
+        router, xpub = self.router, self.xpub
+        poll = self.poller.poll
+        POLLIN, EVENTS = zmq.POLLIN, zmq.EVENTS
+        quit_at: float | None = None
+        next_expire = 0.0
+        try:
+            while True:
+                if self._stop_requested and quit_at is None:
+                    self._send_replies(core.shutdown())
+                    quit_at = clock() + self.grace_s
+                # fast path: a request already queued (e.g. the next step) is served without polling
+                if router.getsockopt(EVENTS) & POLLIN:
+                    self._drain_router()
+                    if xpub.getsockopt(EVENTS) & POLLIN:
+                        self._drain_xpub()
+                    timed_out = False
+                else:
+                    now = clock()
+                    if quit_at is not None and now >= quit_at:
+                        break
+                    events = poll(self._timeout(now, quit_at))
+                    timed_out = not events
+                    for sock, _ in events:
+                        if sock is router:
+                            self._drain_router()
+                        elif sock is xpub:
+                            self._drain_xpub()
+                        else:
+                            self._drain_wake()
+                now = clock()
+                if quit_at is not None and now >= quit_at:
+                    break
+                # session expiry: when a deadline woke us, else at most every EXPIRE_EVERY_S
+                if timed_out or now >= next_expire:
+                    core.expire(now)
+                    next_expire = now + EXPIRE_EVERY_S
+                self._run_steps(now)
+        finally:
+            self.close()
+
+    def _timeout(self, now: float, quit_at: float | None) -> int:
+        deadline = self.core.next_deadline(now)
+        if quit_at is not None:
+            deadline = quit_at if deadline is None else min(deadline, quit_at)
+        if deadline is None:
+            return MAX_IDLE_WAIT_MS
+        return max(0, min(MAX_IDLE_WAIT_MS, int((deadline - now) * 1000 + 0.999)))
+
+    def _drain_router(self, limit: int = 1000) -> None:
+        core, router, clock = self.core, self.router, self.clock
+        recv, EVENTS, POLLIN, NOBLOCK = router.recv_multipart, zmq.EVENTS, zmq.POLLIN, zmq.NOBLOCK
+        for _ in range(limit):
+            if not router.getsockopt(EVENTS) & POLLIN:   # cheaper than a recv raising zmq.Again
+                return
+            try:
+                frames = recv(NOBLOCK, copy=True)
+            except zmq.Again:
+                return
+            self._send_replies(core.handle(frames, clock()))
+
+    def _drain_xpub(self, limit: int = 1000) -> None:
+        xpub = self.xpub
+        for _ in range(limit):
+            if not xpub.getsockopt(zmq.EVENTS) & zmq.POLLIN:
+                return
+            try:
+                event = xpub.recv(zmq.NOBLOCK)
+            except zmq.Again:
+                return
+            self.core.subscription(event)
+
+    def _drain_wake(self) -> None:
+        try:
+            while self._wake_r.recv(64):
+                pass
+        except (BlockingIOError, OSError):
+            pass
+
+    def _run_steps(self, now: float | None = None) -> None:
+        core, clock = self.core, self.clock
+        start = now = clock() if now is None else now
+        while True:
+            t = core.next_advance(now)
+            if t is None or t > now:
+                return
+            replies, pubs = core.step_once(now)
+            for frames in pubs:
+                self.xpub.send_multipart(frames, copy=False)
+            self._send_replies(replies)
+            if self.stop_at_ms is not None and core.sim.time_ms >= self.stop_at_ms:
+                self.stop()
+                return
+            now = clock()
+            if now - start > STEP_BUDGET_S:
+                return                                  # let the sockets be served
+
+    def _send_replies(self, replies: list[list[bytes]]) -> None:
+        send = self.router.send_multipart
+        for frames in replies:
+            try:
+                # small frames: copying is cheaper than zero-copy bookkeeping
+                send(frames, copy=len(frames[-1]) < ZERO_COPY_MIN)
+            except zmq.ZMQError:
+                pass                                     # peer gone: ROUTER drops, never raises upward
+
+    # ------------------------------------------------------------------ close
+    def _close_sockets(self) -> None:
+        for s in (self.router, self.xpub):
+            if not s.closed:
+                s.close()
+
+    def close(self) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        self._close_sockets()
+        for s in (getattr(self, "_wake_r", None), getattr(self, "_wake_w", None)):
+            if s is not None:
+                s.close()
+        if self._own_context:
+            self.ctx.term()
+

@@ -1,0 +1,278 @@
+"""LightSensor irradiance (spec §2.2) — pure math, world frame, float64.
+
+The simulation builds one :class:`LightArrays` from every light that is ON (lights that are off
+contribute nothing, not even ambient), with positions and directions already in world coordinates
+(the SpotLight ``direction`` rotated as spec §2.2 says). For a sensor at ``p`` with normal ``N``
+(its local +x axis in world), per light:
+
+* point/spot: ``L = (q - p)/d``, ``d = |q - p|``, ``att = 1/(a1 + a2 d + a3 d²)``;
+  directional: ``L = -direction/|direction|``, ``d = 1000``, ``att = 1``;
+* spot factor (spot only): ``alpha`` = angle between ``L`` and ``-axis``; 0 if ``alpha > cutOff``,
+  1 if ``alpha <= beamWidth``, else ``(alpha - cutOff)/(beamWidth - cutOff)``. The tests are in this
+  order, so a ``beamWidth`` above ``cutOff`` (Webots lowers it to ``cutOff`` at load) gives the same
+  factor as the lowered value;
+* direct ``Id = I * c * spot`` with ``c = N·L`` if ``c > 0`` else 0, and 0 when occluded;
+* contribution ``att * (Ia + Id) * C`` (ambient attenuated, never occluded).
+
+``E = F · Σ contributions / 3``. It is evaluated as ``Σ att (Ia + Id) (F·C)/3`` (same value up to
+rounding) so that a zero term stays zero even when ``att`` is infinite (below).
+
+Degenerate cases (decided here):
+
+* Sensor exactly at a point/spot light (``d == 0``): ``L`` is undefined, so ``L = 0``, ``c = 0``
+  and the direct term is 0; the ambient term uses ``att = 1/a1``. When ``a1 == 0`` that is
+  ``+inf``: a term whose ``(Ia + Id)·(F·C)`` is 0 contributes exactly 0 (never NaN), otherwise
+  ``E = +inf`` (the lookup table then clamps). Attenuation ``(0, 0, 0)`` or negative components are
+  rejected when the arrays are built (the world loader rejects them first).
+* A light in the sensor plane: ``c`` is computed as ``N·(q - p)/d``, so when ``N·(q - p)`` is exactly
+  0 (e.g. axis-aligned poses) ``c`` is exactly 0 and the light gives no direct term.
+* Spot angle: ``alpha = atan2(|L × R|, L·R)`` (accurate at every angle, unlike ``arccos``); the
+  factor is continuous at both beam edges, so rounding in ``alpha`` only moves it by ulps.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from enum import IntEnum
+
+import numpy as np
+
+from .lookup import LookupTable, sensor_output
+
+__all__ = [
+    "LightKind",
+    "Light",
+    "LightArrays",
+    "DIRECTIONAL_DISTANCE",
+    "light_vectors",
+    "irradiance",
+    "irradiance_many",
+    "direct_mask",
+    "occlusion_segments",
+    "light_value",
+]
+
+DIRECTIONAL_DISTANCE = 1000.0
+"""Distance used for a DirectionalLight (occlusion segment length)."""
+
+
+class LightKind(IntEnum):
+    POINT = 0
+    SPOT = 1
+    DIRECTIONAL = 2
+
+
+@dataclass(frozen=True, slots=True)
+class Light:
+    """One light that is ON, in world coordinates; defaults are the Webots node defaults.
+
+    ``position`` is ignored for directional lights, ``direction`` for point lights,
+    ``attenuation`` for directional lights, ``beam_width``/``cut_off_angle`` for non-spot lights.
+    """
+
+    kind: LightKind
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    attenuation: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    intensity: float = 1.0
+    ambient_intensity: float = 0.0
+    color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    beam_width: float = 1.570796
+    cut_off_angle: float = 0.785398
+
+
+@dataclass(frozen=True)
+class LightArrays:
+    """All ON lights as read-only float64 arrays (n lights). Build with :meth:`from_lights`, or pass
+    arrays directly (they are converted, validated and frozen). Spot/directional directions are
+    normalised here; they must not be zero."""
+
+    kind: np.ndarray               # (n,) int: 0 point, 1 spot, 2 directional
+    position: np.ndarray           # (n, 3) world
+    direction: np.ndarray          # (n, 3) world, unit (spot axis / directional direction)
+    attenuation: np.ndarray        # (n, 3)
+    intensity: np.ndarray          # (n,)
+    ambient_intensity: np.ndarray  # (n,)
+    color: np.ndarray              # (n, 3)
+    beam_width: np.ndarray         # (n,)
+    cut_off_angle: np.ndarray      # (n,)
+
+    def __post_init__(self) -> None:
+        kind = np.asarray(self.kind, dtype=np.int64).reshape(-1)
+        n = len(kind)
+        if np.any((kind < 0) | (kind > 2)):
+            raise ValueError("light kind must be 0 (point), 1 (spot) or 2 (directional)")
+        vec = {f: np.asarray(getattr(self, f), dtype=np.float64).reshape(n, 3)
+               for f in ("position", "direction", "attenuation", "color")}
+        sca = {f: np.asarray(getattr(self, f), dtype=np.float64).reshape(n)
+               for f in ("intensity", "ambient_intensity", "beam_width", "cut_off_angle")}
+        if not all(np.all(np.isfinite(a)) for a in (*vec.values(), *sca.values())):
+            raise ValueError("light fields must be finite")
+        local = kind != LightKind.DIRECTIONAL
+        att = vec["attenuation"]
+        if np.any(local & (np.any(att < 0.0, axis=1) | np.all(att == 0.0, axis=1))):
+            raise ValueError("point/spot light attenuation must be non-negative and not (0, 0, 0)")
+        norm = np.linalg.norm(vec["direction"], axis=1)
+        oriented = kind != LightKind.POINT
+        if np.any(oriented & (norm == 0.0)):
+            raise ValueError("spot/directional light direction must not be zero")
+        vec["direction"] = np.where(oriented[:, None],
+                                    vec["direction"] / np.where(norm > 0.0, norm, 1.0)[:, None],
+                                    vec["direction"])
+        for name, value in (("kind", kind), *vec.items(), *sca.items()):
+            value.setflags(write=False)
+            object.__setattr__(self, name, value)
+
+    def __len__(self) -> int:
+        return len(self.kind)
+
+    @property
+    def count(self) -> int:
+        """Number of lights."""
+        return len(self.kind)
+
+    @classmethod
+    def from_lights(cls, lights: Iterable[Light]) -> LightArrays:
+        lights = list(lights)
+
+        def col(name: str, shape: tuple[int, ...]) -> np.ndarray:
+            return np.array([getattr(l, name) for l in lights], dtype=np.float64).reshape(shape)
+
+        n = len(lights)
+        return cls(kind=np.array([int(l.kind) for l in lights], dtype=np.int64),
+                   position=col("position", (n, 3)), direction=col("direction", (n, 3)),
+                   attenuation=col("attenuation", (n, 3)), intensity=col("intensity", (n,)),
+                   ambient_intensity=col("ambient_intensity", (n,)), color=col("color", (n, 3)),
+                   beam_width=col("beam_width", (n,)), cut_off_angle=col("cut_off_angle", (n,)))
+
+    @classmethod
+    def empty(cls) -> LightArrays:
+        return cls.from_lights(())
+
+
+def _vectors(points: np.ndarray, lights: LightArrays):
+    """For S points: unnormalised sensor→light vectors v (S,n,3), |v| (S,n), unit L (S,n,3; 0 where
+    |v| = 0) and distances d (S,n; 1000 for directional lights)."""
+    directional = lights.kind == LightKind.DIRECTIONAL
+    v = lights.position[None, :, :] - points[:, None, :]
+    v = np.where(directional[None, :, None], -lights.direction[None, :, :], v)
+    length = np.linalg.norm(v, axis=2)
+    safe = np.where(length > 0.0, length, 1.0)
+    unit = v / safe[:, :, None]
+    d = np.where(directional[None, :], DIRECTIONAL_DISTANCE, length)
+    return v, length, unit, d
+
+
+def light_vectors(p: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Unit sensor→light vectors ``L`` (n,3) and distances ``d`` (n,) for a sensor at ``p``.
+    Directional: ``L = -direction``, ``d = 1000``. A sensor exactly at a light: ``L = 0``, ``d = 0``."""
+    _, _, unit, d = _vectors(np.asarray(p, dtype=np.float64).reshape(1, 3), lights)
+    return unit[0], d[0]
+
+
+def _terms(P: np.ndarray, N: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Attenuation ``att`` (S,n) and un-occluded direct term ``Id = I·c·spot`` (S,n)."""
+    v, length, unit, d = _vectors(P, lights)
+    local = lights.kind != LightKind.DIRECTIONAL
+    a = lights.attenuation
+    with np.errstate(divide="ignore"):
+        att = np.where(local[None, :], 1.0 / (a[:, 0] + a[:, 1] * d + a[:, 2] * d * d), 1.0)
+
+    # c = N·(q - p)/d: exactly 0 when the light is exactly in the sensor plane (and when d = 0).
+    c = np.einsum("sk,snk->sn", N, v) / np.where(length > 0.0, length, 1.0)
+
+    spot = np.ones(c.shape)
+    is_spot = lights.kind == LightKind.SPOT
+    if np.any(is_spot):
+        R = -lights.direction[None, :, :]
+        alpha = np.arctan2(np.linalg.norm(np.cross(unit, R), axis=2), np.einsum("snk,snk->sn", unit, R))
+        bw, co = lights.beam_width[None, :], lights.cut_off_angle[None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            linear = (alpha - co) / (bw - co)
+        factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, linear))
+        spot = np.where(is_spot[None, :], factor, 1.0)
+
+    direct = np.where(c > 0.0, lights.intensity[None, :] * c * spot, 0.0)
+    return att, direct
+
+
+def irradiance_many(positions: np.ndarray, normals: np.ndarray, lights: LightArrays,
+                    occluded: np.ndarray | None = None,
+                    color_filters: np.ndarray = (1.0, 1.0, 1.0)) -> np.ndarray:
+    """Irradiance ``E`` (S,) for S sensors: positions (S,3), unit normals (S,3) (world +x axes),
+    ``occluded`` (S,n) bool or None, colour filters (S,3) or (3,)."""
+    P = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    if len(lights) == 0:
+        return np.zeros(len(P))
+    att, direct = _terms(P, N, lights)
+    return irradiance_from_terms(att, direct, lights, occluded, color_filters)
+
+
+def light_terms(positions: np.ndarray, normals: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Attenuation (S,n) and un-occluded direct term (S,n) of S sensors, to compute once and use
+    both for choosing occlusion rays and for :func:`irradiance_from_terms`."""
+    return _terms(np.asarray(positions, dtype=np.float64).reshape(-1, 3),
+                  np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights)
+
+
+def irradiance_from_terms(att: np.ndarray, direct: np.ndarray, lights: LightArrays,
+                          occluded: np.ndarray | None = None,
+                          color_filters: np.ndarray = (1.0, 1.0, 1.0)) -> np.ndarray:
+    """Irradiance ``E`` (S,) from :func:`light_terms` (see :func:`irradiance_many`)."""
+    S, n = att.shape
+    if n == 0:
+        return np.zeros(S)
+    if occluded is not None:
+        direct = np.where(np.asarray(occluded, dtype=bool).reshape(S, n), 0.0, direct)
+    F = np.broadcast_to(np.asarray(color_filters, dtype=np.float64), (S, 3))
+    weight = (lights.ambient_intensity[None, :] + direct) * (F @ lights.color.T) / 3.0  # (S, n)
+    with np.errstate(invalid="ignore"):
+        terms = np.where(weight == 0.0, 0.0, att * weight)
+    return terms.sum(axis=1)
+
+
+def direct_mask(p: np.ndarray, normal_x: np.ndarray, lights: LightArrays) -> np.ndarray:
+    """(n,) bool: lights whose direct term is non-zero for this sensor — the only ones whose
+    occlusion can change the value, so the only ones that need an occlusion ray."""
+    if len(lights) == 0:
+        return np.zeros(0, dtype=bool)
+    _, direct = _terms(np.asarray(p, dtype=np.float64).reshape(1, 3),
+                       np.asarray(normal_x, dtype=np.float64).reshape(1, 3), lights)
+    return direct[0] > 0.0
+
+
+def irradiance(p: np.ndarray, normal_x: np.ndarray, lights: LightArrays,
+               occluded: np.ndarray | None = None,
+               color_filter: np.ndarray = (1.0, 1.0, 1.0)) -> float:
+    """Irradiance ``E`` of one sensor at ``p`` with world normal ``normal_x`` (unit, its +x axis);
+    ``occluded`` (n,) bool marks lights whose occlusion segment hit something."""
+    occ = None if occluded is None else np.asarray(occluded, dtype=bool).reshape(1, -1)
+    return float(irradiance_many(np.reshape(p, (1, 3)), np.reshape(normal_x, (1, 3)), lights, occ,
+                                 np.reshape(np.asarray(color_filter, dtype=np.float64), (1, 3)))[0])
+
+
+def occlusion_segments(p: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One segment per light, from ``p`` toward it: origins (n,3), unit directions (n,3), lengths (n,).
+
+    Length = sensor–light distance (1000 for directional lights); a hit with ``0 <= t <= length``
+    means occluded. A sensor exactly at a light gets direction (1, 0, 0) and length 0: its direct
+    term is 0 whatever the ray reports."""
+    unit, d = light_vectors(p, lights)
+    unit = np.where((d > 0.0)[:, None], unit, np.array([1.0, 0.0, 0.0]))
+    origins = np.broadcast_to(np.asarray(p, dtype=np.float64).reshape(1, 3), (len(d), 3)).copy()
+    return origins, unit, d
+
+
+def light_value(table: LookupTable, e: float, rng: np.random.Generator | None, resolution: float) -> float:
+    """LightSensor value: lookup (with relative noise) then resolution rounding (§9.2)."""
+    return sensor_output(table, e, rng, resolution)
+
+
+def occlusion_segments_many(positions: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions (S,n,3) and lengths (S,n) of the occlusion segments of S sensors (see
+    :func:`occlusion_segments`; a sensor exactly at a light gets direction (1, 0, 0), length 0)."""
+    _, _, unit, d = _vectors(np.asarray(positions, dtype=np.float64).reshape(-1, 3), lights)
+    unit = np.where((d > 0.0)[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
+    return unit, d

@@ -1,0 +1,350 @@
+"""Export a native (msgpack) recording as ROS 2 data (CDR) for ``ros2 bag play`` and Foxglove.
+
+Two outputs, both MCAP storage with ``profile = "ros2"`` and ``ros2msg`` schemas:
+
+* a **rosbag2 directory** (``metadata.yaml`` + ``<name>.mcap``), written with ``rosbags``
+  (QoS-less connections, RIHS01 type hashes; metadata version 9 for Jazzy, 8 for Humble);
+* a **single ``.mcap`` file**, written with ``mcap-ros2-support`` (what Foxglove opens by drag and
+  drop; ``ros2 bag play`` accepts it too).
+
+Bodies are msgpack maps with ROS field names; typed arrays are little-endian ``bin``
+(``float32[]`` → ``<f4``, ``uint8[]`` → bytes) and a PointCloud's ``points`` is one ``<f4``
+N×3 bin (PROTOCOL.md §4). The conversion is driven by the chosen distro's message definitions
+(from rosbags' type stores): fields the distro lacks are dropped (``Range.variance`` in Humble),
+fields the body lacks are zero. ``pointcloud2=True`` turns ``sensor_msgs/msg/PointCloud`` into
+``sensor_msgs/msg/PointCloud2`` (x, y, z FLOAT32 and one FLOAT32 field per channel, e.g. ``layer``).
+"""
+
+from __future__ import annotations
+
+import array
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import msgpack
+import numpy as np
+
+from sensorium.server.recording.mcapfile import Recording
+
+DISTROS = ("humble", "jazzy")
+POINT_CLOUD = "sensor_msgs/msg/PointCloud"
+POINT_CLOUD2 = "sensor_msgs/msg/PointCloud2"
+FLOAT32 = 7  # sensor_msgs/msg/PointField.FLOAT32
+
+_NP_DTYPES = {
+    "bool": np.bool_, "byte": np.uint8, "char": np.uint8, "int8": np.int8, "uint8": np.uint8,
+    "int16": "<i2", "uint16": "<u2", "int32": "<i4", "uint32": "<u4", "int64": "<i8", "uint64": "<u8",
+    "float32": "<f4", "float64": "<f8",
+}
+_ARRAY_CODES = {"bool": "B", "byte": "B", "char": "b", "int8": "b", "uint8": "B", "int16": "h", "uint16": "H",
+                "int32": "i", "uint32": "I", "int64": "q", "uint64": "Q", "float32": "f", "float64": "d"}
+_INTS = {"byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64"}
+
+
+class ExportError(Exception):
+    pass
+
+
+def typestore_for(distro: str):
+    """The rosbags type store of a ROS 2 distro (``humble`` or ``jazzy``)."""
+    try:
+        from rosbags.typesys import Stores, get_typestore
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ExportError("ROS 2 export needs the 'ros2' extra: pip install 'sensorium[ros2]'") from exc
+    stores = {"humble": Stores.ROS2_HUMBLE, "jazzy": Stores.ROS2_JAZZY}
+    try:
+        return get_typestore(stores[distro])
+    except KeyError:
+        raise ExportError(f"unknown distro {distro!r} (choose from {', '.join(DISTROS)})") from None
+
+
+# --------------------------------------------------------------------------------------------
+# msgpack body -> ROS message (plain dicts with numpy arrays), per the distro's definitions
+
+
+def _base_value(basetype: str, value: Any) -> Any:
+    if basetype == "string" or basetype == "wstring":
+        if value is None:
+            return ""
+        return value.decode() if isinstance(value, (bytes, bytearray)) else str(value)
+    if basetype == "bool":
+        return bool(value) if value is not None else False
+    if basetype in _INTS:
+        return int(value) if value is not None else 0
+    # float32/float64: Python float (float32 rounding happens in CDR)
+    return float(value) if value is not None else 0.0
+
+
+def _base_array(basetype: str, value: Any) -> Any:
+    if basetype in ("string", "wstring"):
+        return [_base_value(basetype, v) for v in (value or [])]
+    dtype = np.dtype(_NP_DTYPES[basetype])
+    if value is None:
+        return np.zeros(0, dtype=dtype)
+    if isinstance(value, (bytes, bytearray, memoryview)):
+        raw = bytes(value)
+        if len(raw) % dtype.itemsize:
+            raise ExportError(f"{len(raw)} bytes is not a whole number of {basetype} items")
+        return np.frombuffer(raw, dtype=dtype).astype(dtype.newbyteorder("="), copy=False)
+    return np.asarray(value, dtype=dtype.newbyteorder("="))
+
+
+def points_from_bin(data: Any) -> np.ndarray:
+    """A PointCloud ``points`` field (N×3 ``<f4`` bin, or a list of {x, y, z}) → float32 (N, 3)."""
+    if isinstance(data, (bytes, bytearray, memoryview)):
+        arr = np.frombuffer(bytes(data), dtype="<f4")
+        if arr.size % 3:
+            raise ExportError(f"points: {arr.size} floats is not a multiple of 3")
+        return arr.reshape(-1, 3).astype(np.float32)
+    return np.array([[p.get("x", 0.0), p.get("y", 0.0), p.get("z", 0.0)] for p in (data or [])],
+                    dtype=np.float32).reshape(-1, 3)
+
+
+def to_ros(typestore, typename: str, body: dict) -> dict:
+    """A msgpack body → nested dicts shaped exactly like ``typename`` in ``typestore`` (extra keys
+    dropped, missing ones zero); primitive arrays become numpy arrays."""
+    if typename == POINT_CLOUD and isinstance(body.get("points"), (bytes, bytearray, memoryview)):
+        pts = points_from_bin(body["points"])
+        body = dict(body, points=[{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in pts.tolist()])
+    return _convert(typestore, typename, body or {})
+
+
+def _convert(typestore, typename: str, value: dict) -> dict:
+    try:
+        _consts, fields = typestore.fielddefs[typename]
+    except KeyError:
+        raise ExportError(f"type {typename!r} is not known to the type store") from None
+    out: dict[str, Any] = {}
+    for name, (kind, spec) in fields:
+        v = value.get(name) if isinstance(value, dict) else None
+        kind = int(kind)
+        if kind == 1:  # BASE
+            out[name] = _base_value(spec[0], v)
+        elif kind == 2:  # NAME
+            out[name] = _convert(typestore, spec, v if isinstance(v, dict) else {})
+        else:  # 3 ARRAY (fixed) / 4 SEQUENCE
+            (sub_kind, sub_spec), size = spec
+            if int(sub_kind) == 1:
+                arr = _base_array(sub_spec[0], v)
+                if kind == 3 and size:
+                    arr = _fit(arr, size, sub_spec[0])
+                out[name] = arr
+            else:
+                items = [_convert(typestore, sub_spec, item if isinstance(item, dict) else {}) for item in (v or [])]
+                if kind == 3 and size:
+                    items = (items + [_convert(typestore, sub_spec, {}) for _ in range(size)])[:size]
+                out[name] = items
+    return out
+
+
+def _fit(arr, size: int, basetype: str):
+    if isinstance(arr, list):
+        return (arr + [_base_value(basetype, None)] * size)[:size]
+    fitted = np.zeros(size, dtype=arr.dtype)
+    fitted[: min(size, arr.size)] = arr[:size]
+    return fitted
+
+
+def pointcloud2_from_body(body: dict) -> tuple[str, dict]:
+    """A PointCloud body → a PointCloud2 message dict: x, y, z and one FLOAT32 field per channel."""
+    pts = points_from_bin(body.get("points"))
+    n = pts.shape[0]
+    channels = [c for c in (body.get("channels") or []) if isinstance(c, dict)]
+    names = ["x", "y", "z"] + [str(c.get("name", f"ch{i}")) for i, c in enumerate(channels)]
+    cols = [pts[:, 0], pts[:, 1], pts[:, 2]]
+    for c in channels:
+        vals = _base_array("float32", c.get("values"))
+        if vals.size != n:
+            raise ExportError(f"channel {c.get('name')!r} has {vals.size} values for {n} points")
+        cols.append(vals)
+    rec = np.empty(n, dtype=np.dtype({"names": names, "formats": ["<f4"] * len(names)}))
+    for nm, col in zip(names, cols):
+        rec[nm] = col
+    step = 4 * len(names)
+    finite = bool(np.isfinite(pts).all()) if n else True
+    msg = {"header": body.get("header", {}), "height": 1, "width": n,
+           "fields": [{"name": nm, "offset": 4 * i, "datatype": FLOAT32, "count": 1} for i, nm in enumerate(names)],
+           "is_bigendian": False, "point_step": step, "row_step": step * n,
+           "data": np.frombuffer(rec.tobytes(), dtype=np.uint8), "is_dense": finite}
+    return POINT_CLOUD2, msg
+
+
+def convert_message(typestore, ros_type: str, body_bytes: bytes, pointcloud2: bool = False) -> tuple[str, dict]:
+    """Recorded body bytes → ``(export type, ROS message dict)``."""
+    body = msgpack.unpackb(body_bytes, raw=False)
+    if not isinstance(body, dict):
+        raise ExportError("body is not a msgpack map")
+    if pointcloud2 and ros_type == POINT_CLOUD:
+        typename, msg = pointcloud2_from_body(body)
+        return typename, _convert(typestore, typename, msg)
+    return ros_type, to_ros(typestore, ros_type, body)
+
+
+# --------------------------------------------------------------------------------------------
+# dict -> rosbags objects / mcap-ros2 values
+
+
+def to_rosbags(typestore, typename: str, msg: dict) -> Any:
+    """A message dict → the type store's dataclass instance (for ``serialize_cdr``)."""
+    _consts, fields = typestore.fielddefs[typename]
+    kwargs = {}
+    for name, (kind, spec) in fields:
+        v = msg[name]
+        kind = int(kind)
+        if kind == 2:
+            kwargs[name] = to_rosbags(typestore, spec, v)
+        elif kind in (3, 4) and int(spec[0][0]) == 2:
+            kwargs[name] = [to_rosbags(typestore, spec[0][1], item) for item in v]
+        else:
+            kwargs[name] = v
+    return typestore.types[typename](**kwargs)
+
+
+def _to_mcap_ros2(typestore, typename: str, msg: dict) -> dict:
+    """A message dict → values mcap-ros2-support's encoder accepts (lists/array.array/bytes)."""
+    _consts, fields = typestore.fielddefs[typename]
+    out = {}
+    for name, (kind, spec) in fields:
+        v = msg[name]
+        kind = int(kind)
+        if kind == 2:
+            out[name] = _to_mcap_ros2(typestore, spec, v)
+        elif kind in (3, 4):
+            (sub_kind, sub_spec), _size = spec
+            if int(sub_kind) == 2:
+                out[name] = [_to_mcap_ros2(typestore, sub_spec, item) for item in v]
+            elif sub_spec[0] in ("string", "wstring"):
+                out[name] = list(v)
+            elif sub_spec[0] in ("uint8", "byte"):
+                out[name] = np.asarray(v, dtype=np.uint8).tobytes()
+            else:
+                code = _ARRAY_CODES[sub_spec[0]]
+                out[name] = array.array(code, np.asarray(v).astype(np.dtype(code).newbyteorder("=")).tobytes())
+        else:
+            out[name] = v
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# export
+
+
+@dataclass
+class ExportReport:
+    out: Path
+    distro: str
+    fmt: str
+    messages: int = 0
+    topics: dict[str, str] = field(default_factory=dict)  # topic -> exported type
+    skipped: dict[str, int] = field(default_factory=dict)  # topic -> messages not exported
+    reasons: dict[str, str] = field(default_factory=dict)
+
+
+def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report: ExportReport,
+                    start_ns: int | None, end_ns: int | None):
+    bad: set[str] = set()
+    for m in rec.messages(topics, start_ns, end_ns):
+        if m.topic in bad:
+            report.skipped[m.topic] = report.skipped.get(m.topic, 0) + 1
+            continue
+        if m.ros_type not in typestore.fielddefs:
+            bad.add(m.topic)
+            report.skipped[m.topic] = report.skipped.get(m.topic, 0) + 1
+            report.reasons[m.topic] = f"type {m.ros_type!r} unknown to ROS 2 {report.distro}"
+            continue
+        try:
+            typename, msg = convert_message(typestore, m.ros_type, m.data, pointcloud2)
+        except Exception as exc:
+            report.skipped[m.topic] = report.skipped.get(m.topic, 0) + 1
+            report.reasons.setdefault(m.topic, f"{type(exc).__name__}: {exc}")
+            continue
+        report.topics.setdefault(m.topic, typename)
+        yield m, typename, msg
+
+
+def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt: str | None = None,
+                pointcloud2: bool = False, topics: list[str] | None = None,
+                start_ns: int | None = None, end_ns: int | None = None) -> ExportReport:
+    """Export ``src`` to ``out``. ``fmt`` is ``"bag"`` (rosbag2 directory, via rosbags) or
+    ``"mcap"`` (single file, via mcap-ros2-support); by default ``.mcap`` outputs are single files."""
+    out = Path(out)
+    if distro not in DISTROS:
+        raise ExportError(f"unknown distro {distro!r} (choose from {', '.join(DISTROS)})")
+    fmt = fmt or ("mcap" if out.suffix == ".mcap" else "bag")
+    if out.exists():
+        raise ExportError(f"{out} exists already; not overwriting")
+    typestore = typestore_for(distro)
+    report = ExportReport(out=out, distro=distro, fmt=fmt)
+    with Recording(src) as rec:
+        meta = rec.metadata().get("sensorium", {})
+        world = rec.world()
+        if fmt == "bag":
+            _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns)
+        elif fmt == "mcap":
+            _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns)
+        else:
+            raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
+    return report
+
+
+def _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns) -> None:
+    try:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+    except ImportError as exc:  # pragma: no cover
+        raise ExportError("rosbag2 export needs rosbags: pip install 'sensorium[ros2]'") from exc
+    writer = Writer(out, version=9 if distro == "jazzy" else 8, storage_plugin=StoragePlugin.MCAP)
+    writer.open()
+    try:
+        for key, value in meta.items():
+            writer.set_custom_data(f"sensorium.{key}", str(value))
+        writer.set_custom_data("sensorium.distro", distro)
+        conns: dict[str, Any] = {}
+        for m, typename, msg in _iter_converted(rec, typestore, topics, pointcloud2, report, start_ns, end_ns):
+            conn = conns.get(m.topic)
+            if conn is None:
+                conn = conns[m.topic] = writer.add_connection(m.topic, typename, typestore=typestore)
+            data = typestore.serialize_cdr(to_rosbags(typestore, typename, msg), typename)
+            writer.write(conn, m.stamp_ns, data)
+            report.messages += 1
+    finally:
+        writer.close()
+
+
+def _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns) -> None:
+    try:
+        from mcap_ros2.writer import Writer as Ros2Writer
+    except ImportError as exc:  # pragma: no cover
+        raise ExportError("single-file export needs mcap-ros2-support: pip install 'sensorium[ros2]'") from exc
+    with open(out, "wb") as f:
+        writer = Ros2Writer(f)
+        try:
+            schemas: dict[str, Any] = {}
+            for m, typename, msg in _iter_converted(rec, typestore, topics, pointcloud2, report, start_ns, end_ns):
+                schema = schemas.get(typename)
+                if schema is None:
+                    text = typestore.generate_msgdef(typename, ros_version=2)[0]
+                    schema = schemas[typename] = writer.register_msgdef(typename, text)
+                writer.write_message(topic=m.topic, schema=schema, message=_to_mcap_ros2(typestore, typename, msg),
+                                     log_time=m.stamp_ns, publish_time=m.stamp_ns, sequence=m.seq % (1 << 32))
+                report.messages += 1
+            if meta:
+                writer.add_metadata("sensorium", dict(meta, distro=distro))
+            if world:
+                name, data = world
+                writer.add_attachment(create_time=0, log_time=0, name=name, media_type="application/yaml"
+                                      if name.endswith((".yaml", ".yml")) else "application/octet-stream", data=data)
+        finally:
+            writer.finish()
+
+
+def print_report(report: ExportReport, file=sys.stdout) -> None:
+    kind = "rosbag2 directory" if report.fmt == "bag" else "ROS 2 MCAP file"
+    print(f"sensorium: exported {report.messages} messages on {len(report.topics)} topics to {kind} "
+          f"{report.out} (ROS 2 {report.distro})", file=file)
+    for topic, typename in sorted(report.topics.items()):
+        print(f"  {topic}  {typename}", file=file)
+    for topic, n in sorted(report.skipped.items()):
+        print(f"  skipped {n} message(s) on {topic}: {report.reasons.get(topic, '?')}", file=file)
+

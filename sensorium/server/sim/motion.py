@@ -1,0 +1,129 @@
+"""Kinematic differential drive: Webots-style wheel motors and exact pose integration.
+
+No physics: wheels never slip and nothing collides. Over a basic step the wheel speeds are
+constant, so the robot follows an exact circular arc (or a straight segment); integrating the arc
+in closed form, in float64, keeps a robot driven in a circle on its circle for millions of steps.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sensorium.server.world.geometry import Pose
+
+_TWO_PI = 2.0 * math.pi
+
+
+@dataclass(slots=True)
+class WheelMotor:
+    """A RotationalMotor as a controller sees it (``setPosition``/``setVelocity``).
+
+    ``position = inf`` is velocity control (the wheel turns at ``velocity``); a finite target makes
+    the wheel turn toward it at ``|velocity|`` and stop there, as Webots' position control does with
+    the velocity as its speed limit.
+    """
+
+    name: str
+    max_velocity: float
+    target_position: float = 0.0        # Webots' default: position control at 0 ...
+    velocity: float = math.nan          # ... at maxVelocity (set in __post_init__)
+    position: float = 0.0               # wheel angle (rad), integrated
+
+    def __post_init__(self) -> None:
+        if math.isnan(self.velocity):
+            self.velocity = self.max_velocity
+
+    def hold(self) -> None:
+        """Stop where the wheel is (position control at its current angle)."""
+        self.target_position = self.position
+
+    def set_position(self, value: float) -> None:
+        if not isinstance(value, (int, float)) or math.isnan(value):
+            raise ValueError(f"motor {self.name!r}: position must be a number or inf, got {value!r}")
+        self.target_position = float(value)
+
+    def set_velocity(self, value: float) -> None:
+        if not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ValueError(f"motor {self.name!r}: velocity must be a finite number, got {value!r}")
+        # Webots clamps to maxVelocity (with a warning)
+        self.velocity = float(min(max(value, -self.max_velocity), self.max_velocity))
+
+    def advance(self, dt_s: float) -> float:
+        """Turn the wheel for one step; returns the wheel's angular speed during it (rad/s)."""
+        if math.isinf(self.target_position):
+            omega = self.velocity
+        else:
+            remaining = self.target_position - self.position
+            speed = min(abs(self.velocity), abs(remaining) / dt_s) if dt_s > 0 else 0.0
+            omega = math.copysign(speed, remaining) if remaining else 0.0
+        self.position += omega * dt_s
+        return omega
+
+
+def arc_step(x: float, y: float, yaw: float, v: float, w: float, dt: float) -> tuple[float, float, float]:
+    """Exact planar pose after moving ``dt`` seconds at linear speed ``v`` and turn rate ``w``."""
+    dyaw = w * dt
+    if abs(dyaw) < 1e-9:
+        # straight (second-order term kept so that tiny turn rates stay continuous)
+        mid = yaw + 0.5 * dyaw
+        return x + v * dt * math.cos(mid), y + v * dt * math.sin(mid), _wrap(yaw + dyaw)
+    r = v / w
+    x += r * (math.sin(yaw + dyaw) - math.sin(yaw))
+    y -= r * (math.cos(yaw + dyaw) - math.cos(yaw))
+    return x, y, _wrap(yaw + dyaw)
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % _TWO_PI - math.pi
+
+
+def _rz(yaw: float) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+class DifferentialDrive:
+    """The drive of one robot: two wheel motors and the robot's planar state (x, y, yaw).
+
+    The robot's rotation is kept as ``Rz(yaw) @ base`` where ``base`` is the part of its initial
+    rotation that is not a turn about world z, so a tilted robot keeps its tilt while driving.
+    """
+
+    def __init__(self, config, pose: Pose):
+        self.wheel_radius = float(config.wheel_radius)
+        self.axle_length = float(config.axle_length)
+        self.left = WheelMotor(config.left_motor, float(config.max_wheel_speed))
+        self.right = WheelMotor(config.right_motor, float(config.max_wheel_speed))
+        self.reset(pose)
+
+    def reset(self, pose: Pose) -> None:
+        """Take over a pose set from outside (initial pose, supervisor set_pose)."""
+        forward = pose.rotation[:, 0]
+        self.yaw = math.atan2(forward[1], forward[0])
+        self.base = _rz(-self.yaw) @ pose.rotation
+        self.x, self.y, self.z = (float(v) for v in pose.translation)
+
+    @property
+    def motors(self) -> dict[str, WheelMotor]:
+        return {self.left.name: self.left, self.right.name: self.right}
+
+    @property
+    def moving(self) -> bool:
+        return any(m.velocity != 0.0 for m in (self.left, self.right))
+
+    def step(self, dt_ms: int) -> Pose | None:
+        """Advance one basic step; the new pose, or None when the wheels did not turn."""
+        dt = dt_ms / 1000.0
+        wl, wr = self.left.advance(dt), self.right.advance(dt)
+        if wl == 0.0 and wr == 0.0:
+            return None
+        v = self.wheel_radius * (wl + wr) / 2.0
+        w = self.wheel_radius * (wr - wl) / self.axle_length
+        self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
+        return self.pose()
+
+    def pose(self) -> Pose:
+        return Pose(rotation=_rz(self.yaw) @ self.base, translation=np.array([self.x, self.y, self.z]))

@@ -1,0 +1,245 @@
+"""In-process simulation: integer clock, due-device schedule, one batched ray cast per step.
+
+    sim = Simulation.from_file("worlds/arena.yaml")
+    ps0 = sim.device("epuck/ps0"); ps0.enable(32)
+    sim.step(); print(ps0.value)
+
+Each ``step()`` advances the clock by one basic time step (integer milliseconds, never a float
+sum), applies pending pose changes, asks every *due* device for its rays at the end-of-step pose,
+casts all of them in one call per ray kind, and lets each device reduce its hits to values.
+Nothing is computed for a device that is disabled.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import light as light_math
+from sensorium.server.raycast.engine import Precision, RayHits
+from sensorium.server.sim.batches import DistanceBatch, LightBatch
+from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
+from sensorium.server.sim.sensors import DEVICE_CLASSES, Device, DistanceSensor, Lidar, LightSensor, RayRequest
+from sensorium.server.world.geometry import Pose
+from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
+from sensorium.server.world.poses import pose_from_values
+from sensorium.server.world.scene import Scene
+
+
+def lights_from_models(models: list) -> light_math.LightArrays:
+    """The lights that are on, as arrays in world coordinates (lights that are off contribute nothing)."""
+    kinds = {"PointLight": light_math.LightKind.POINT, "SpotLight": light_math.LightKind.SPOT,
+             "DirectionalLight": light_math.LightKind.DIRECTIONAL}
+    out = []
+    for m in models:
+        if not m.on:
+            continue
+        fields = dict(kind=kinds[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity, color=m.color)
+        if m.type != "DirectionalLight":
+            fields.update(position=m.location, attenuation=m.attenuation)
+        if m.type != "PointLight":
+            fields.update(direction=m.direction)
+        if m.type == "SpotLight":
+            fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
+        out.append(light_math.Light(**fields))
+    return light_math.LightArrays.from_lights(out)
+
+
+class RobotState:
+    """A robot: its devices by name and its pose."""
+
+    def __init__(self, sim: Simulation, index: int, model: wm.Robot):
+        self._sim = sim
+        self.index = index
+        self.model = model
+        self.name = model.name
+        self.synchronization = model.synchronization
+        self.devices: dict[str, Device] = {}
+        for d in model.devices:
+            cls = DEVICE_CLASSES[d.device]
+            self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
+                                       self_collision=model.self_collision, world_seed=sim.seed,
+                                       clock=lambda: sim.time_ms)
+        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index])
+                      if model.differential_drive is not None else None)
+        self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
+
+    @property
+    def pose(self) -> Pose:
+        return self._sim.scene.robot_poses[self.index]
+
+    def set_pose(self, translation, rotation=None, quaternion=None) -> None:
+        """Move the robot (supervisor-style, kinematically); the next measurement sees it there."""
+        pose = pose_from_values(translation, rotation, quaternion)
+        self._sim.scene.set_robot_pose(self.index, pose)
+        if self.drive is not None:
+            self.drive.reset(pose)
+
+    def motor(self, name: str) -> WheelMotor:
+        try:
+            return self.motors[name]
+        except KeyError:
+            raise KeyError(f"robot {self.name!r} has no motor {name!r} (motors: {', '.join(self.motors) or 'none'})") from None
+
+    def device(self, name: str) -> Device:
+        try:
+            return self.devices[name]
+        except KeyError:
+            raise KeyError(f"robot {self.name!r} has no device {name!r} (devices: {', '.join(self.devices)})") from None
+
+
+@dataclass
+class StepReport:
+    time_ms: int
+    measured: list[Device]
+
+
+class Simulation:
+    def __init__(self, world: LoadedWorld | wm.World, precision: Precision | str = Precision.EXACT,
+                 base_dir: Path | None = None):
+        if isinstance(world, wm.World):
+            problems = check_world(world, base_dir or Path.cwd())
+            if problems:
+                raise WorldError("<memory>", problems)
+            world, _ = sanitize(world)
+            loaded = LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
+        else:
+            loaded = world
+        self.loaded = loaded
+        self.world = loaded.world
+        self.basic_time_step = self.world.world_info.basic_time_step
+        self.seed = self.world.world_info.random_seed
+        self.time_ms = 0
+        self.step_count = 0
+        self.scene = Scene(self.world, loaded.base_dir, precision)
+        self.lights = lights_from_models(self.world.lights)
+        self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
+        self._driven = [r for r in self.robots.values() if r.drive is not None]
+        self._counters: Counter[str] = Counter()
+
+    @classmethod
+    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT) -> Simulation:
+        return cls(load_world(path), precision)
+
+    # ------------------------------------------------------------------ access
+    @property
+    def precision(self) -> Precision:
+        return self.scene.engine.precision
+
+    def robot(self, name: str) -> RobotState:
+        try:
+            return self.robots[name]
+        except KeyError:
+            raise KeyError(f"no robot {name!r} (robots: {', '.join(self.robots)})") from None
+
+    def device(self, path: str) -> Device:
+        """A device by ``robot/device`` path."""
+        robot, sep, name = path.partition("/")
+        if not sep:
+            raise KeyError(f"device path must be ROBOT/DEVICE, got {path!r}")
+        return self.robot(robot).device(name)
+
+    def all_devices(self) -> Iterator[Device]:
+        for robot in self.robots.values():
+            yield from robot.devices.values()
+
+    def set_solid_pose(self, name: str, translation, rotation=None, quaternion=None) -> None:
+        try:
+            self.scene.set_solid_pose(name, pose_from_values(translation, rotation, quaternion))
+        except KeyError:
+            raise KeyError(f"no solid {name!r}") from None
+
+    @property
+    def counters(self) -> dict[str, int]:
+        """Work done so far: rays per device kind, ray-engine calls, BVH builds, points built…"""
+        out = dict(self._counters)
+        eng = self.scene.engine.counters
+        out["bvh_builds"] = eng["bvh_builds"]
+        out["embree_calls"] = eng["embree_calls"]
+        out["engine_rays"] = eng["rays_cast"]
+        for key in ("rays_light", "rays_distance", "rays_lidar", "cast_calls", "points_built", "measurements"):
+            out.setdefault(key, 0)
+        return out
+
+    # ------------------------------------------------------------------ stepping
+    def step(self) -> StepReport:
+        """Advance one basic time step and measure every due device at the end-of-step pose."""
+        self.time_ms += self.basic_time_step
+        self.step_count += 1
+        now = self.time_ms
+        dt = self.basic_time_step
+        for robot in self._driven:
+            pose = robot.drive.step(dt)
+            if pose is not None:
+                self.scene.set_robot_pose(robot.index, pose)
+        poses = self.scene.robot_poses
+        lights: list[LightSensor] = []
+        distances: list[DistanceSensor] = []
+        lidars: list[Lidar] = []
+        for robot in self.robots.values():
+            for dev in robot.devices.values():
+                if isinstance(dev, Lidar):
+                    if dev.due(now):
+                        lidars.append(dev)
+                elif dev.schedule.due(now):
+                    (lights if isinstance(dev, LightSensor) else distances).append(dev)
+        work: list[tuple[object, list[RayRequest]]] = []
+        if lights:
+            batch = LightBatch(lights, poses, self.lights)
+            work.append((batch, batch.plan()))
+        if distances:
+            batch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness)
+            work.append((batch, batch.plan()))
+        for lidar in lidars:
+            work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt)))
+        hits = self._cast_batched([req for _, reqs in work for req in reqs])
+        k = 0
+        for item, reqs in work:
+            mine = hits[k:k + len(reqs)]
+            k += len(reqs)
+            if isinstance(item, Lidar):
+                item.finish(mine, now, self._counters)
+            else:
+                item.finish(mine, now)
+        for dev in (*lights, *distances, *(x for x in lidars if not x.rotating)):
+            dev.schedule.last_update_ms = now
+        measured = [*lights, *distances, *lidars]
+        self._counters["measurements"] += len(measured)
+        return StepReport(now, measured)
+
+    def run(self, steps: int) -> None:
+        for _ in range(steps):
+            self.step()
+
+    def _cast_batched(self, requests: list[RayRequest]) -> list[RayHits]:
+        """All rays of a step: one engine call per (ray kind, transparency rule)."""
+        results: list[RayHits | None] = [None] * len(requests)
+        groups: dict[tuple, list[int]] = {}
+        for i, r in enumerate(requests):
+            self._counters[f"rays_{r.tag}"] += len(r)
+            if len(r):
+                groups.setdefault((int(r.kind), r.skip_transparent), []).append(i)
+            else:
+                results[i] = RayHits(np.empty(0), np.empty((0, 3)), np.empty(0, dtype=np.int64))
+        engine = self.scene.engine
+        for (kind, skip), idx in groups.items():
+            reqs = [requests[i] for i in idx]
+            sizes = [len(r) for r in reqs]
+            origins = np.concatenate([r.origins for r in reqs])
+            dirs = np.concatenate([r.directions for r in reqs])
+            t_near = np.concatenate([np.broadcast_to(np.asarray(r.t_near, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
+            t_far = np.concatenate([np.broadcast_to(np.asarray(r.t_far, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
+            owners = np.concatenate([np.broadcast_to(np.asarray(r.exclude_owner, dtype=np.int64), (n,)) for r, n in zip(reqs, sizes)])
+            hits = engine.cast(origins, dirs, t_near, t_far, kind=kind, exclude_owner=owners, skip_transparent=skip)
+            self._counters["cast_calls"] += 1
+            start = 0
+            for i, n in zip(idx, sizes):
+                sl = slice(start, start + n)
+                results[i] = RayHits(hits.distance[sl], hits.normal[sl], hits.shape[sl])
+                start += n
+        return results  # type: ignore[return-value]

@@ -1,0 +1,283 @@
+"""World file → validated model, with one precise message per problem.
+
+Every problem names the file, the path to the field (``robots[0].devices[2].lookup_table[1]``)
+and what was expected. Webots' sanitising rules that silently change a value are applied here and
+reported as warnings, so a world behaves as it would in Webots and the user is told why.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import ValidationError
+
+from sensorium.schemas import world as wm
+
+
+class _Yaml12Loader(yaml.SafeLoader):
+    """YAML 1.2 booleans: only true/false. YAML 1.1 would turn Webots' field name ``on`` (and
+    yes/no/off) into booleans."""
+
+
+_Yaml12Loader.yaml_implicit_resolvers = {
+    k: [(tag, rx) for tag, rx in v if tag != "tag:yaml.org,2002:bool"]
+    for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+_Yaml12Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
+
+DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "worlds" / "arena.yaml"
+
+
+def default_world_path() -> Path:
+    """The embedded default world (``worlds/arena.yaml``), also when installed as a package."""
+    if DEFAULT_WORLD.exists():
+        return DEFAULT_WORLD
+    from importlib.resources import files
+
+    return Path(str(files("sensorium.worlds") / "arena.yaml"))
+
+
+@dataclass(frozen=True, slots=True)
+class Problem:
+    path: str
+    message: str
+
+
+class WorldError(Exception):
+    """A world file that cannot be used; ``problems`` lists every problem found."""
+
+    def __init__(self, source: str, problems: list[Problem]):
+        self.source = source
+        self.problems = problems
+        lines = [f"{source}: {p.path}: {p.message}" if p.path else f"{source}: {p.message}" for p in problems]
+        super().__init__("\n".join(lines))
+
+
+@dataclass(frozen=True)
+class LoadedWorld:
+    world: wm.World
+    source: str                      # file path or "<memory>"
+    base_dir: Path                   # mesh urls are relative to it
+    text: bytes = b""                # the file as read (recordings attach it)
+    warnings: list[str] = field(default_factory=list)
+
+
+def load_world(path: str | Path) -> LoadedWorld:
+    path = Path(path)
+    source = str(path)
+    try:
+        text = path.read_bytes()
+    except OSError as exc:
+        raise WorldError(source, [Problem("", f"cannot read world file: {exc.strerror or exc}")]) from None
+    try:
+        if path.suffix.lower() == ".json":
+            data = json.loads(text)
+        else:
+            data = yaml.load(text, Loader=_Yaml12Loader)  # noqa: S506 (a safe loader)
+    except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise WorldError(source, [Problem("", f"not valid YAML/JSON: {exc}")]) from None
+    return parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
+
+
+def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"") -> LoadedWorld:
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise WorldError(source, [Problem("", f"a world must be a mapping, got {type(data).__name__}")])
+    try:
+        world = wm.World.model_validate(data)
+    except ValidationError as exc:
+        raise WorldError(source, [_problem_from_pydantic(e) for e in exc.errors()]) from None
+    base = base_dir or Path.cwd()
+    problems = check_world(world, base)
+    if problems:
+        raise WorldError(source, problems)
+    world, warnings = sanitize(world)
+    return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings)
+
+
+_TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "mesh", "PointLight", "SpotLight",
+         "DirectionalLight", "LightSensor", "DistanceSensor", "Lidar"}
+
+
+def format_path(loc: tuple[Any, ...]) -> str:
+    out = ""
+    for i, part in enumerate(loc):
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif part in _TAGS and i > 0 and not isinstance(loc[i - 1], str):
+            continue  # pydantic puts the discriminator value in the location; users never wrote it
+        elif part in _TAGS and i > 0 and loc[i - 1] in ("geometry",):
+            continue
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def _problem_from_pydantic(err: dict[str, Any]) -> Problem:
+    loc = tuple(err.get("loc", ()))
+    msg = err.get("msg", "invalid")
+    kind = err.get("type", "")
+    if kind == "extra_forbidden":
+        msg = "unknown key (check spelling; field names are Webots' names in snake_case)"
+    elif kind in ("finite_number",):
+        msg = f"expected a finite number, got {err.get('input')!r}"
+    elif "input" in err and kind not in ("missing", "union_tag_invalid", "union_tag_not_found") and not isinstance(err["input"], (dict, list)):
+        msg = f"{msg} (got {err['input']!r})"
+    if msg.startswith("Value error, "):
+        msg = msg[len("Value error, "):]
+    return Problem(format_path(loc), msg)
+
+
+def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
+    """Checks that relate several fields or the file system; one problem per finding."""
+    problems: list[Problem] = []
+
+    def unique(items: list[tuple[str, str | None]], what: str) -> None:
+        first: dict[str, str] = {}
+        for path, name in items:
+            if name is None:
+                continue
+            if name in first:
+                problems.append(Problem(path, f"duplicate {what} name {name!r} (first used at {first[name]})"))
+            else:
+                first[name] = path
+
+    def name_ok(path: str, name: str, reserved: tuple[str, ...] = ()) -> None:
+        # names become topic and service paths (/<robot>/<device>/value)
+        if "/" in name or "\0" in name:
+            problems.append(Problem(path, f"name {name!r} must not contain '/' or NUL (names are used in topic paths)"))
+        elif name in reserved:
+            problems.append(Problem(path, f"name {name!r} is reserved (robot-level services live under /<robot>/robot/)"))
+
+    for i, r in enumerate(world.robots):
+        name_ok(f"robots[{i}].name", r.name)
+        for d_i, d in enumerate(r.devices):
+            name_ok(f"robots[{i}].devices[{d_i}].name", d.name, ("robot",))
+    unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
+    unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
+    unique([(f"lights[{i}].name", lt.name) for i, lt in enumerate(world.lights)], "light")
+
+    for i, s in enumerate(world.solids):
+        problems += _check_geometry(s.geometry, f"solids[{i}].geometry", base_dir)
+    for r_i, robot in enumerate(world.robots):
+        rp = f"robots[{r_i}]"
+        if robot.body is not None:
+            problems += _check_geometry(robot.body.geometry, f"{rp}.body.geometry", base_dir)
+        names = [(f"{rp}.devices[{d_i}].name", d.name) for d_i, d in enumerate(robot.devices)]
+        if robot.differential_drive is not None:
+            names += [(f"{rp}.differential_drive.left_motor", robot.differential_drive.left_motor),
+                      (f"{rp}.differential_drive.right_motor", robot.differential_drive.right_motor)]
+        unique(names, "device")
+        for d_i, dev in enumerate(robot.devices):
+            dp = f"{rp}.devices[{d_i}]"
+            table = getattr(dev, "lookup_table", None)
+            if table is not None:
+                for k in range(1, len(table)):
+                    if not table[k][0] > table[k - 1][0]:
+                        problems.append(Problem(
+                            f"{dp}.lookup_table[{k}]",
+                            f"lookup table inputs must be strictly increasing: input {table[k][0]} "
+                            f"follows {table[k - 1][0]}"))
+            if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
+                pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
+    return problems
+
+
+def _check_geometry(geom: Any, path: str, base_dir: Path) -> list[Problem]:
+    if not isinstance(geom, wm.Mesh):
+        return []
+    from sensorium.server.world.meshes import MeshFileError, load_mesh
+
+    try:
+        load_mesh(base_dir / geom.url, geom.scale)
+    except MeshFileError as exc:
+        return [Problem(f"{path}.url", str(exc))]
+    return []
+
+
+def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
+    """Apply Webots' field sanitising (devices.md §2.1, §3.1, §4.1); return warnings for each change."""
+    warnings: list[str] = []
+
+    def fix_light(i: int, lt: Any) -> Any:
+        upd: dict[str, Any] = {}
+        p = f"lights[{i}]"
+        if not 0.0 <= lt.ambient_intensity <= 1.0:
+            upd["ambient_intensity"] = 1.0 if lt.ambient_intensity > 1 else 0.0
+            warnings.append(f"{p}.ambient_intensity: {lt.ambient_intensity} outside [0, 1], reset to {upd['ambient_intensity']}")
+        if lt.intensity < 0:
+            upd["intensity"] = 1.0
+            warnings.append(f"{p}.intensity: negative, reset to 1")
+        amb = upd.get("ambient_intensity", lt.ambient_intensity)
+        if isinstance(lt, (wm.PointLight, wm.SpotLight)) and tuple(lt.attenuation) != (1.0, 0.0, 0.0) and amb != 0:
+            upd["ambient_intensity"] = 0.0
+            warnings.append(f"{p}.ambient_intensity: forced to 0 because attenuation is not 1 0 0 (Webots rule)")
+        if isinstance(lt, wm.SpotLight):
+            cut = lt.cut_off_angle
+            if not 0.0 <= cut <= math.pi / 2:
+                cut = math.pi / 2
+                upd["cut_off_angle"] = cut
+                warnings.append(f"{p}.cut_off_angle: outside [0, pi/2], reset to pi/2")
+            if lt.beam_width > cut:
+                upd["beam_width"] = cut
+                warnings.append(f"{p}.beam_width: {lt.beam_width} > cut_off_angle, set to {cut}")
+        return lt.model_copy(update=upd) if upd else lt
+
+    def fix_device(p: str, dev: Any) -> Any:
+        upd: dict[str, Any] = {}
+        res = getattr(dev, "resolution", -1.0)
+        if res <= 0 and res != -1:
+            upd["resolution"] = -1.0
+            warnings.append(f"{p}.resolution: {res} <= 0, reset to -1 (off)")
+        if isinstance(dev, wm.DistanceSensor):
+            if dev.type == "infrared":
+                upd["type"] = "infra-red"
+            if dev.aperture < 0:
+                upd["aperture"] = -dev.aperture
+                warnings.append(f"{p}.aperture: negative, using its absolute value")
+            if dev.number_of_rays < 1:
+                upd["number_of_rays"] = 1
+                warnings.append(f"{p}.number_of_rays: < 1, reset to 1")
+            if dev.gaussian_width <= 0:
+                upd["gaussian_width"] = 1.0
+                warnings.append(f"{p}.gaussian_width: <= 0, reset to 1")
+            if dev.red_color_sensitivity < 0:
+                upd["red_color_sensitivity"] = -dev.red_color_sensitivity
+                warnings.append(f"{p}.red_color_sensitivity: negative, using its absolute value")
+            if dev.type == "laser" and upd.get("number_of_rays", dev.number_of_rays) > 1:
+                upd["number_of_rays"] = 1
+                warnings.append(f"{p}.number_of_rays: a laser sensor has a single ray, reset to 1")
+        if isinstance(dev, wm.Lidar):
+            if dev.near > dev.min_range:
+                upd["near"] = dev.min_range
+                warnings.append(f"{p}.near: greater than min_range, set to min_range {dev.min_range}")
+            if dev.max_range <= dev.min_range:
+                upd["max_range"] = dev.min_range + 1.0
+                warnings.append(f"{p}.max_range: not greater than min_range, set to min_range + 1")
+            if not 0.0 < dev.vertical_field_of_view <= math.pi:
+                upd["vertical_field_of_view"] = min(max(dev.vertical_field_of_view, 1e-6), math.pi)
+                warnings.append(f"{p}.vertical_field_of_view: outside (0, pi], clamped")
+            lo, hi = dev.min_frequency, dev.max_frequency
+            if lo > hi:
+                upd["min_frequency"], upd["max_frequency"] = hi, lo
+                lo, hi = hi, lo
+                warnings.append(f"{p}.min_frequency/max_frequency: swapped to be ordered")
+            if not lo <= dev.default_frequency <= hi:
+                upd["default_frequency"] = min(max(dev.default_frequency, lo), hi)
+                warnings.append(f"{p}.default_frequency: outside [min_frequency, max_frequency], clamped")
+        return dev.model_copy(update=upd) if upd else dev
+
+    lights = [fix_light(i, lt) for i, lt in enumerate(world.lights)]
+    robots = []
+    for r_i, robot in enumerate(world.robots):
+        devices = [fix_device(f"robots[{r_i}].devices[{d_i}]", d) for d_i, d in enumerate(robot.devices)]
+        robots.append(robot.model_copy(update={"devices": devices}))
+    return world.model_copy(update={"lights": lights, "robots": robots}), warnings

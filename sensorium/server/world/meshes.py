@@ -1,0 +1,52 @@
+"""Mesh files (STL, OBJ, PLY, GLB) → float64 triangle arrays, via trimesh.
+
+Loaded meshes are cached by (resolved path, modification time, scale): validating a world and then
+building its scene reads each file once.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+SUPPORTED = {".stl", ".obj", ".ply", ".glb", ".gltf", ".off"}
+
+
+class MeshFileError(Exception):
+    """A mesh file that is missing, unreadable or not a triangle mesh."""
+
+
+def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)):
+    path = Path(path).resolve()
+    if not path.is_file():
+        raise MeshFileError(f"mesh file not found: {path}")
+    if path.suffix.lower() not in SUPPORTED:
+        raise MeshFileError(f"unsupported mesh format {path.suffix!r} (expected one of {sorted(SUPPORTED)})")
+    return _load(str(path), path.stat().st_mtime_ns, tuple(float(s) for s in scale))
+
+
+@lru_cache(maxsize=64)
+def _load(path: str, _mtime: int, scale: tuple[float, float, float]):
+    import trimesh
+
+    from sensorium.server.world.geometry import Mesh
+
+    try:
+        loaded = trimesh.load(path, force="mesh", process=False)
+    except Exception as exc:  # trimesh raises many types for bad files
+        raise MeshFileError(f"cannot read mesh {path}: {exc}") from None
+    vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
+    faces = np.asarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
+    if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0:
+        raise MeshFileError(f"mesh {path} has no triangles")
+    if not np.isfinite(vertices).all():
+        raise MeshFileError(f"mesh {path} has non-finite vertex coordinates")
+    if faces.min() < 0 or faces.max() >= len(vertices):
+        raise MeshFileError(f"mesh {path} has face indices outside its vertex list")
+    vertices = vertices * np.asarray(scale, dtype=np.float64)
+    # merge coincident vertices so that watertightness can be judged on the topology
+    merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
+    closed = bool(merged.is_watertight)
+    return Mesh(vertices=np.ascontiguousarray(vertices), faces=np.ascontiguousarray(faces), closed=closed)

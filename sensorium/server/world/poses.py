@@ -1,0 +1,88 @@
+"""World-file poses (axis-angle or quaternion) → float64 rotation matrices and back."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sensorium.server.world.geometry import Pose
+
+
+def axis_angle_matrix(axis: tuple[float, float, float] | np.ndarray, angle: float) -> np.ndarray:
+    a = np.asarray(axis, dtype=np.float64)
+    n = float(np.linalg.norm(a))
+    if n == 0.0:
+        return np.eye(3)
+    x, y, z = a / n
+    c, s = math.cos(angle), math.sin(angle)
+    t = 1.0 - c
+    return np.array([
+        [t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+        [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+        [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
+    ])
+
+
+def quaternion_matrix(q: tuple[float, float, float, float] | np.ndarray) -> np.ndarray:
+    """Quaternion in ROS order (x, y, z, w), normalised here."""
+    x, y, z, w = np.asarray(q, dtype=np.float64) / float(np.linalg.norm(q))
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def matrix_quaternion(r: np.ndarray) -> tuple[float, float, float, float]:
+    """Rotation matrix → unit quaternion (x, y, z, w) with w >= 0."""
+    m = np.asarray(r, dtype=np.float64)
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0:
+        s = math.sqrt(tr + 1.0) * 2
+        w, x, y, z = 0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
+        w, x, y, z = (m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
+    elif m[1, 1] > m[2, 2]:
+        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
+        w, x, y, z = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s
+    else:
+        s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
+        w, x, y, z = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s
+    q = np.array([x, y, z, w])
+    q /= np.linalg.norm(q)
+    if q[3] < 0:
+        q = -q
+    return tuple(float(v) for v in q)  # type: ignore[return-value]
+
+
+def pose_from_model(p) -> Pose:
+    """``schemas.world.Pose`` → float64 ``Pose``."""
+    if p.quaternion is not None:
+        r = quaternion_matrix(p.quaternion)
+    elif p.rotation is not None:
+        r = axis_angle_matrix(p.rotation[:3], p.rotation[3])
+    else:
+        r = np.eye(3)
+    return Pose(rotation=r, translation=np.asarray(p.translation, dtype=np.float64))
+
+
+def pose_from_values(translation, rotation=None, quaternion=None) -> Pose:
+    """Pose from plain sequences (services, tests): axis-angle ``rotation`` or ``quaternion`` (x, y, z, w)."""
+    t = np.asarray(translation, dtype=np.float64).reshape(3)
+    if not np.isfinite(t).all():
+        raise ValueError("translation must be finite")
+    if quaternion is not None:
+        q = np.asarray(quaternion, dtype=np.float64).reshape(4)
+        if not np.isfinite(q).all() or not np.linalg.norm(q) > 0:
+            raise ValueError("quaternion must be finite and non-zero")
+        r = quaternion_matrix(q)
+    elif rotation is not None:
+        a = np.asarray(rotation, dtype=np.float64).reshape(4)
+        if not np.isfinite(a).all():
+            raise ValueError("rotation must be finite")
+        r = axis_angle_matrix(a[:3], float(a[3]))
+    else:
+        r = np.eye(3)
+    return Pose(rotation=r, translation=t)
