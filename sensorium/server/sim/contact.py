@@ -270,7 +270,7 @@ class Contact:
         primitive or None, initial pose) in world order."""
         self.prims = {name: prim for name, prim, _, bounding in solids if bounding}
         self.solids: dict[str, Obstacle] = {}
-        for name, prim, pose, bounding in solids:
+        for name, _, pose, bounding in solids:
             if bounding:
                 self.update_solid(name, pose)
         self.feet: list[Footprint | None] = [footprint(b) if b is not None else None for b, _ in robots]
