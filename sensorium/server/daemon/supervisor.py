@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.server.world.poses import matrix_quaternion
+
 MODES = ("pause", "realtime", "fast")     # Webots WB_SUPERVISOR_SIMULATION_MODE_PAUSE = 0, REAL_TIME, FAST
 
 
@@ -55,24 +57,13 @@ def _pose(sim: Any, node: Node) -> Any:
 
 
 def matrix_axis_angle(r: np.ndarray) -> list[float]:
-    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, pi]); identity → 0 0 1 0."""
-    m = np.asarray(r, dtype=np.float64)
-    c = max(-1.0, min(1.0, (m[0, 0] + m[1, 1] + m[2, 2] - 1.0) / 2.0))
-    angle = math.acos(c)
-    if angle < 1e-12:
+    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, pi]); identity → 0 0 1 0.
+    Through the unit quaternion, which stays accurate near half turns."""
+    x, y, z, w = matrix_quaternion(r)             # w >= 0
+    n = math.sqrt(x * x + y * y + z * z)
+    if n < 1e-300:
         return [0.0, 0.0, 1.0, 0.0]
-    if math.pi - angle < 1e-6:
-        # near a half turn: the axis from the diagonal (sin(angle) ~ 0 makes the skew part useless)
-        xx, yy, zz = (max((m[i, i] + 1.0) / 2.0, 0.0) for i in range(3))
-        axis = np.sqrt([xx, yy, zz])
-        k = int(np.argmax(axis))
-        for j in range(3):
-            if j != k:
-                axis[j] = math.copysign(axis[j], m[k, j] + m[j, k])
-    else:
-        axis = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
-    axis = axis / np.linalg.norm(axis)
-    return [float(axis[0]), float(axis[1]), float(axis[2]), float(angle)]
+    return [x / n, y / n, z / n, 2.0 * math.atan2(n, w)]
 
 
 def get_field(sim: Any, node: Node, field: str) -> list[float]:
