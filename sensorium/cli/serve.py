@@ -30,6 +30,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--precision", choices=["fast", "exact"], default="exact", help="ray engine precision")
     p.add_argument("--heartbeat-ms", type=int, default=1000, metavar="N",
                    help="controllers not heard from for 3*N ms are released (default 1000)")
+    p.add_argument("--no-contact", action="store_true",
+                   help="robots drive through solids and each other (overrides world_info.contact)")
     p.add_argument("--until", type=int, metavar="MS",
                    help="quit when the simulated time reaches MS milliseconds (pending steps get -1)")
     p.add_argument("--record", metavar="FILE.mcap",
@@ -47,7 +49,8 @@ def build(args: argparse.Namespace):
     from sensorium.server.world.loader import default_world_path
 
     path = Path(args.world) if args.world else default_world_path()
-    sim = Simulation.from_file(path, precision=args.precision)
+    sim = Simulation.from_file(path, precision=args.precision,
+                               contact=False if getattr(args, "no_contact", False) else None)
     core = Core(sim, heartbeat_ms=args.heartbeat_ms, mode=args.mode)
     return core, Transport(core, args.rpc, args.pub, stop_at_ms=getattr(args, "until", None))
 

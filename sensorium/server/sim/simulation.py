@@ -190,8 +190,9 @@ class Simulation:
         self._counters["resets"] += 1
 
     @classmethod
-    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT) -> Simulation:
-        return cls(load_world(path), precision)
+    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT,
+                  contact: bool | None = None) -> Simulation:
+        return cls(load_world(path), precision, contact=contact)
 
     # ------------------------------------------------------------------ access
     @property
