@@ -24,11 +24,11 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, LightBatch
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
+from sensorium.server.sim.scene import Scene
 from sensorium.server.sim.sensors import DEVICE_CLASSES, Device, DistanceSensor, Lidar, LightSensor, RayRequest
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
-from sensorium.server.world.scene import Scene
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:
