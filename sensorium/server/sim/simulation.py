@@ -25,6 +25,7 @@ from sensorium.server.raycast.engine import Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, LightBatch
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
+from sensorium.server.sim.scene import Scene, primitive_from_model
 from sensorium.server.sim.sensors import (
     DEVICE_CLASSES,
     LED,
@@ -38,7 +39,6 @@ from sensorium.server.sim.sensors import (
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
-from sensorium.server.world.scene import Scene, primitive_from_model
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:
