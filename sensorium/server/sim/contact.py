@@ -224,14 +224,14 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
     if ob.normal is not None:                        # two-sided wall line
         dist = float(ob.normal @ p) + ob.offset
         side = 1.0 if dist >= 0.0 else -1.0
-        n = side * ob.normal
+        nrm = side * ob.normal
         gap = abs(dist) - rho
-        rate = float(n @ d)
+        rate = float(nrm @ d)
         if gap <= EPS:
-            return (0.0, n) if rate < 0.0 else (math.inf, None)
+            return (0.0, nrm) if rate < 0.0 else (math.inf, None)
         if rate >= 0.0 or gap + rate > 0.0:
             return math.inf, None
-        return gap / -rate, n
+        return gap / -rate, nrm
     pts = ob.points
     rad = ob.radius + rho
     dist, normal = _closest_on_hull(p, pts)
@@ -240,7 +240,8 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
             return 0.0, normal
         end_dist, _ = _closest_on_hull(p + d, pts)
         return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
-    best, best_n = math.inf, None
+    best: float = math.inf
+    best_n: np.ndarray | None = None
     n = len(pts)
     for i in range(n):
         s = _ray_circle(p, d, pts[i], rad)
