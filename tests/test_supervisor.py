@@ -212,3 +212,14 @@ def test_matrix_axis_angle_round_trip(axis, angle):
     aa = matrix_axis_angle(axis_angle_matrix(axis, angle))
     assert axis_angle_matrix(aa[:3], aa[3]) == pytest.approx(axis_angle_matrix(axis, angle), abs=1e-7)
     assert 0.0 <= aa[3] <= math.pi and math.hypot(*aa[:3]) == pytest.approx(1.0)
+
+
+def test_info_summary_lists_encoders_leds_and_supervisor():
+    from sensorium.server.sim.summary import world_summary
+
+    s = world_summary(WORLD)
+    pioneer = s["robots"][0]
+    assert pioneer["supervisor"] is True and s["robots"][1]["supervisor"] is False
+    lines = {d["name"]: d["summary"] for d in pioneer["devices"]}
+    assert lines["left wheel sensor"] == "PositionSensor on 'left wheel motor' noise 0 resolution -1"
+    assert lines["led0"] == "LED 2 colours" and lines["rgb"] == "LED gradual"

@@ -42,7 +42,7 @@ def find_node(sim: Any, name: str) -> Node | None:
 def node_by_id(sim: Any, node: int) -> Node:
     nodes = _nodes(sim)
     if not 1 <= node <= len(nodes):
-        raise KeyError(f"no node with id {node} (ids 1..{len(nodes)})")
+        raise ValueError(f"no node with id {node} (ids 1..{len(nodes)})")
     return nodes[node - 1]
 
 
@@ -92,3 +92,33 @@ def node_pose(sim: Any, node: Node) -> dict:
     pose = _pose(sim, node)
     return {"position": [float(v) for v in pose.translation],
             "orientation": [float(v) for v in np.asarray(pose.rotation).reshape(9)]}
+
+
+# ---------------------------------------------------------------------- the services
+# handler(sim, lockstep, calling robot, validated args) -> result; ValueError = INVALID_ARGUMENT
+
+def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    set_field(sim, node_by_id(sim, a.node), a.field, a.value)
+    return {"success": True}
+
+
+def _reset(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    sim.reset()
+    return {"success": True}
+
+
+def _set_mode(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    ls.set_mode(MODES[a.mode])
+    return {"success": True}
+
+
+HANDLERS = {
+    "get_from_def": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, a.name)),
+    "get_self": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, robot)),
+    "get_field": lambda sim, ls, robot, a: {"value": get_field(sim, node_by_id(sim, a.node), a.field)},
+    "set_field": _set_field,
+    "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
+    "simulation_reset": _reset,
+    "simulation_set_mode": _set_mode,
+    "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},
+}

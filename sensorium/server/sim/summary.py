@@ -18,6 +18,10 @@ def device_line(d) -> str:
                 f"fov {d.field_of_view:.4g} range [{d.min_range:g}, {d.max_range:g}]")
     if isinstance(d, wm.DistanceSensor):
         return f"DistanceSensor {d.type} rays {d.number_of_rays} aperture {d.aperture:g} max {d.lookup_table[-1][0] if d.lookup_table else 0:g} m"
+    if isinstance(d, wm.PositionSensor):
+        return f"PositionSensor on {d.motor!r} noise {d.noise:g} resolution {d.resolution:g}"
+    if isinstance(d, wm.LED):
+        return f"LED {'gradual' if d.gradual else f'{len(d.color)} colours'}"
     return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
 
 
@@ -34,7 +38,7 @@ def world_summary(path: str | Path) -> dict:
         "triangles": scene.triangle_count,
         "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
         "robots": [
-            {"name": r.name, "synchronization": r.synchronization,
+            {"name": r.name, "synchronization": r.synchronization, "supervisor": r.supervisor,
              "devices": [{"name": d.name, "device": d.device, "summary": device_line(d)} for d in r.devices]}
             for r in w.robots
         ],
