@@ -275,6 +275,10 @@ class Contact:
             if bounding:
                 self.update_solid(name, pose)
         self.feet: list[Footprint | None] = [footprint(b) if b is not None else None for b, _ in robots]
+        nan = math.nan                            # robots without a footprint never match the broad phase
+        self._radius = np.array([f.radius if f else nan for f in self.feet], dtype=np.float64)
+        self._z_low = np.array([f.z_low if f else nan for f in self.feet], dtype=np.float64)
+        self._z_high = np.array([f.z_high if f else nan for f in self.feet], dtype=np.float64)
         self.centres = np.array([[p.translation[0], p.translation[1]] for _, p in robots], dtype=np.float64).reshape(-1, 2)
         self.heights = np.array([p.translation[2] for _, p in robots], dtype=np.float64)
         self.contacts = 0                         # robot-steps whose motion was clipped
@@ -298,31 +302,85 @@ class Contact:
         self._obs = obs
         self._lo = np.array([o.lo for o in obs]).reshape(-1, 2)
         self._hi = np.array([o.hi for o in obs]).reshape(-1, 2)
+        self._zlo = np.array([o.z_range[0] for o in obs], dtype=np.float64)
+        self._zhi = np.array([o.z_range[1] for o in obs], dtype=np.float64)
 
     def place(self, index: int, pose: Pose) -> None:
         """A robot was moved from outside (set_pose, reset): no contact check, as in Webots."""
         self.centres[index] = pose.translation[:2]
         self.heights[index] = pose.translation[2]
 
-    def resolve(self, index: int, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, bool]:
+    def resolve(self, index: int, start, end) -> tuple[np.ndarray, bool]:
         """Clip robot ``index``'s move from ``start`` to ``end`` (xy): ``(final xy, clipped)``."""
-        foot = self.feet[index]
-        if foot is None:
-            self.centres[index] = end
-            return end, False
-        low, high = self.heights[index] + foot.z_low, self.heights[index] + foot.z_high
-        R = foot.radius
-        p = np.array(start, dtype=np.float64)
-        d = np.array(end, dtype=np.float64) - p
-        candidates = self._candidates(index, p, d, R, low, high)
+        return self.resolve_all([index], np.asarray([start], dtype=np.float64),
+                                np.asarray([end], dtype=np.float64))[0]
+
+    def resolve_all(self, indices: list[int], starts: np.ndarray, ends: np.ndarray) -> list[tuple[np.ndarray, bool]]:
+        """Clip the moves of several robots (one basic step), in order: each sees the others where
+        they are when its turn comes. One vectorised broad phase for all of them: a move (with its
+        slides) never leaves the disc of radius |end - start| around its start."""
+        k = len(indices)
+        idx = np.asarray(indices, dtype=np.int64)
+        reach = np.hypot(*(ends - starts).T) + EPS
+        R = self._radius[idx]
+        box_lo = starts - (reach + R)[:, None]
+        box_hi = starts + (reach + R)[:, None]
+        band_lo = self.heights[idx] + self._z_low[idx]
+        band_hi = self.heights[idx] + self._z_high[idx]
+        if len(self._obs):
+            solid_hit = (np.all((self._lo[None] <= box_hi[:, None]) & (self._hi[None] >= box_lo[:, None]), axis=2)
+                         & (self._zhi[None] > band_lo[:, None] + EPS) & (self._zlo[None] < band_hi[:, None] - EPS))
+        robot_hit = None
+        if len(self.feet) > 1:
+            # where every robot may be during this step: its disc, grown by its own move if it moves
+            grow = np.zeros(len(self.feet))
+            grow[idx] = reach
+            r_all = self._radius + grow
+            c = self.centres
+            a_lo, a_hi = self.heights + self._z_low, self.heights + self._z_high
+            robot_hit = ((c[None, :, 0] + r_all[None] >= box_lo[:, None, 0]) & (c[None, :, 0] - r_all[None] <= box_hi[:, None, 0])
+                         & (c[None, :, 1] + r_all[None] >= box_lo[:, None, 1]) & (c[None, :, 1] - r_all[None] <= box_hi[:, None, 1])
+                         & (a_hi[None] > band_lo[:, None] + EPS) & (a_lo[None] < band_hi[:, None] - EPS))
+            robot_hit[np.arange(k), idx] = False
+        out = []
+        for m in range(k):
+            i = int(idx[m])
+            if self.feet[i] is None:
+                self.centres[i] = ends[m]
+                out.append((ends[m].copy(), False))
+                continue
+            cands: list[Obstacle] = []
+            if len(self._obs):
+                for j in np.flatnonzero(solid_hit[m]):
+                    cands.append(self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m])))
+            if robot_hit is not None:
+                for j in np.flatnonzero(robot_hit[m]):
+                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[j][None, :].copy(), float(self._radius[j]),
+                                          (float(self.heights[j] + self._z_low[j]), float(self.heights[j] + self._z_high[j]))))
+            p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], float(R[m]), cands)
+            self.centres[i] = p
+            out.append((p, clipped))
+        return out
+
+    def _in_band(self, ob: Obstacle, low: float, high: float) -> Obstacle:
+        prim = self.prims.get(ob.name)
+        if isinstance(prim, geo.Sphere):
+            cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
+            return Obstacle(ob.name, -1, ob.points, sphere_radius_in_band(ob, cz, prim.radius, low, high), ob.z_range)
+        return ob
+
+    def _clip(self, p: np.ndarray, d: np.ndarray, R: float, cands: list[Obstacle]) -> tuple[np.ndarray, bool]:
+        """The narrow phase: stop at the first contact, slide on, at most MAX_SLIDES times."""
+        if not cands:
+            return p + d, False
         clipped = False
         for _ in range(MAX_SLIDES + 1):
             if not (d[0] or d[1]):
                 break
             best, best_n = math.inf, None
-            for ob, rho_extra in candidates:
+            for ob in cands:
                 self.checks += 1
-                s, n = time_of_impact(p, d, ob, R + rho_extra)
+                s, n = time_of_impact(p, d, ob, R)
                 if s < best:
                     best, best_n = s, n
             if best_n is None:
@@ -335,39 +393,6 @@ class Contact:
             rest = (1.0 - s) * d
             into = float(rest @ best_n)
             d = rest - into * best_n if into < 0.0 else rest
-        else:
-            pass                                  # out of slides: stay where the last one ended
         if clipped:
             self.contacts += 1
-        self.centres[index] = p
         return p, clipped
-
-    def _candidates(self, index: int, p: np.ndarray, d: np.ndarray, R: float, low: float,
-                    high: float) -> list[tuple[Obstacle, float]]:
-        """Obstacles whose inflated AABB meets the move's AABB and whose height band meets the robot's."""
-        lo = np.minimum(p, p + d) - R - EPS
-        hi = np.maximum(p, p + d) + R + EPS
-        out: list[tuple[Obstacle, float]] = []
-        if len(self._obs):
-            hit = np.all((self._lo <= hi) & (self._hi >= lo), axis=1)
-            for i in np.flatnonzero(hit):
-                ob = self._obs[i]
-                if ob.z_range[1] <= low + EPS or ob.z_range[0] >= high - EPS:
-                    continue
-                prim = self.prims.get(ob.name)
-                if isinstance(prim, geo.Sphere):
-                    cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
-                    rr = sphere_radius_in_band(ob, cz, prim.radius, low, high)
-                    out.append((Obstacle(ob.name, -1, ob.points, rr, ob.z_range), 0.0))
-                else:
-                    out.append((ob, 0.0))
-        for j, foot in enumerate(self.feet):
-            if j == index or foot is None:
-                continue
-            lo_j, hi_j = self.heights[j] + foot.z_low, self.heights[j] + foot.z_high
-            if hi_j <= low + EPS or lo_j >= high - EPS:
-                continue
-            c = self.centres[j]
-            if np.all(c + foot.radius >= lo) and np.all(c - foot.radius <= hi):
-                out.append((Obstacle(f"robot {j}", j, c[None, :].copy(), foot.radius, (lo_j, hi_j)), 0.0))
-        return out
