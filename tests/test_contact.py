@@ -170,3 +170,47 @@ def test_deterministic():
         sim.run(300)
         return xy(sim, "a").tolist() + xy(sim, "b").tolist()
     assert run() == run()
+
+
+def _rect_distance(p, centre, yaw, half):
+    """Distance from point p to an upright box's footprint (a rotated rectangle)."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    d = np.asarray(p) - np.asarray(centre)
+    local = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
+    q = np.abs(local) - np.asarray(half)
+    return float(np.hypot(max(q[0], 0.0), max(q[1], 0.0)) + min(max(q[0], q[1]), 0.0))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_random_crowds_never_penetrate(seed):
+    """Random upright boxes and posts, robots with random curvy drives and big steps: after every
+    step no robot overlaps an obstacle or another robot by more than 1e-9 m."""
+    rng = np.random.default_rng(seed)
+    boxes, posts, robots = [], [], []
+    for i in range(10):
+        boxes.append((rng.uniform(-2, 2, 2), rng.uniform(0, math.pi), rng.uniform(0.05, 0.5, 2)))
+        posts.append((rng.uniform(-2, 2, 2), rng.uniform(0.03, 0.2)))
+    while len(robots) < 6:
+        p, r = rng.uniform(-2, 2, 2), rng.uniform(0.05, 0.15)
+        if all(_rect_distance(p, c, y, h) > r for c, y, h in boxes) and all(np.hypot(*(p - c)) > r + pr for c, pr in posts) \
+                and all(np.hypot(*(p - q)) > r + qr for q, qr, _ in robots):
+            robots.append((p, r, rng.uniform(0, 2 * math.pi)))
+    solids = [{"name": f"b{i}", "pose": {"translation": [*c, 0.25], "rotation": [0, 0, 1, y]},
+               "geometry": {"type": "box", "size": [2 * h[0], 2 * h[1], 0.5]}} for i, (c, y, h) in enumerate(boxes)]
+    solids += [{"name": f"p{i}", "pose": {"translation": [*c, 0.25]},
+                "geometry": {"type": "cylinder", "radius": r, "height": 0.5}} for i, (c, r) in enumerate(posts)]
+    sim = world(solids, [robot(f"r{i}", *p, yaw=yaw, radius=r) for i, (p, r, yaw) in enumerate(robots)], step=200)
+    for i in range(len(robots)):
+        drive(sim, f"r{i}", rng.uniform(5, 40), rng.uniform(5, 40))       # up to 0.8 m per step
+    for _ in range(60):
+        sim.step()
+        pos = [xy(sim, f"r{i}") for i in range(len(robots))]
+        for (p0, r, _), p in zip(robots, pos):
+            for c, y, h in boxes:
+                assert _rect_distance(p, c, y, h) >= r - 1e-9
+            for c, pr in posts:
+                assert np.hypot(*(p - c)) >= r + pr - 1e-9
+        for i in range(len(robots)):
+            for j in range(i + 1, len(robots)):
+                assert np.hypot(*(pos[i] - pos[j])) >= robots[i][1] + robots[j][1] - 1e-9
+    assert sim.counters["contacts"] > 0
