@@ -187,7 +187,7 @@ def test_random_crowds_never_penetrate(seed):
     step no robot overlaps an obstacle or another robot by more than 1e-9 m."""
     rng = np.random.default_rng(seed)
     boxes, posts, robots = [], [], []
-    for i in range(10):
+    for _ in range(10):
         boxes.append((rng.uniform(-2, 2, 2), rng.uniform(0, math.pi), rng.uniform(0.05, 0.5, 2)))
         posts.append((rng.uniform(-2, 2, 2), rng.uniform(0.03, 0.2)))
     while len(robots) < 6:
@@ -205,7 +205,7 @@ def test_random_crowds_never_penetrate(seed):
     for _ in range(60):
         sim.step()
         pos = [xy(sim, f"r{i}") for i in range(len(robots))]
-        for (p0, r, _), p in zip(robots, pos):
+        for (_, r, _), p in zip(robots, pos):
             for c, y, h in boxes:
                 assert _rect_distance(p, c, y, h) >= r - 1e-9
             for c, pr in posts:
