@@ -157,37 +157,38 @@ def sphere_radius_in_band(ob: Obstacle, center_z: float, radius: float, low: flo
 
 def _closest_on_hull(p: np.ndarray, pts: np.ndarray) -> tuple[float, np.ndarray]:
     """Signed distance from ``p`` to the convex hull ``pts`` (negative inside) and the outward
-    unit normal at the closest feature."""
-    n = len(pts)
+    unit normal at the closest feature. Scalar float64 arithmetic: hulls have a few vertices."""
+    px, py = float(p[0]), float(p[1])
+    v = pts.tolist()
+    n = len(v)
     if n == 1:
-        d = p - pts[0]
-        L = math.hypot(d[0], d[1])
-        return L, (d / L if L > 0 else np.array([1.0, 0.0]))
-    best = math.inf
-    best_n = np.array([1.0, 0.0])
+        dx, dy = px - v[0][0], py - v[0][1]
+        L = math.hypot(dx, dy)
+        return L, (np.array([dx / L, dy / L]) if L > 0 else np.array([1.0, 0.0]))
+    best, best_n = math.inf, (1.0, 0.0)
     inside = n >= 3
-    deepest = -math.inf
-    deep_n = best_n
-    for i in range(n if n >= 3 else 1):
-        a, b = pts[i], pts[(i + 1) % n]
-        e = b - a
-        ee = float(e @ e)
-        s = min(max(float((p - a) @ e) / ee, 0.0), 1.0)
-        q = a + s * e
-        d = p - q
-        L = math.hypot(d[0], d[1])
+    deepest, deep_n = -math.inf, (1.0, 0.0)
+    for i in range(n if n >= 3 else 1):            # edges a -> b, counter-clockwise
+        ax, ay = v[i]
+        bx, by = v[(i + 1) % n]
+        ex, ey = bx - ax, by - ay
+        el = math.hypot(ex, ey)
+        ox, oy = ey / el, -ex / el                  # outward normal
+        rx, ry = px - ax, py - ay
+        t = min(max((rx * ex + ry * ey) / (el * el), 0.0), 1.0)
+        dx, dy = rx - t * ex, ry - t * ey
+        L = math.hypot(dx, dy)
         if L < best:
-            best, best_n = L, (d / L if L > 0 else np.array([e[1], -e[0]]) / math.sqrt(ee))
+            best, best_n = L, ((dx / L, dy / L) if L > 0 else (ox, oy))
         if n >= 3:
-            out = np.array([e[1], -e[0]]) / math.sqrt(ee)       # outward for counter-clockwise
-            side = float((p - a) @ out)
-            if side > 0:
+            side = rx * ox + ry * oy
+            if side > 0.0:
                 inside = False
             if side > deepest:
-                deepest, deep_n = side, out
+                deepest, deep_n = side, (ox, oy)
     if inside:
-        return deepest, deep_n
-    return best, best_n
+        return deepest, np.array(deep_n)
+    return best, np.array(best_n)
 
 
 def _ray_circle(p: np.ndarray, d: np.ndarray, c: np.ndarray, rho: float) -> float:
@@ -342,6 +343,14 @@ class Contact:
                          & (c[None, :, 1] + r_all[None] >= box_lo[:, None, 1]) & (c[None, :, 1] - r_all[None] <= box_hi[:, None, 1])
                          & (a_hi[None] > band_lo[:, None] + EPS) & (a_lo[None] < band_hi[:, None] - EPS))
             robot_hit[np.arange(k), idx] = False
+        near_solids: list[list[int]] = [[] for _ in range(k)]
+        near_robots: list[list[int]] = [[] for _ in range(k)]
+        if len(self._obs):
+            for m, j in zip(*(x.tolist() for x in np.nonzero(solid_hit))):
+                near_solids[m].append(j)
+        if robot_hit is not None:
+            for m, j in zip(*(x.tolist() for x in np.nonzero(robot_hit))):
+                near_robots[m].append(j)
         out = []
         for m in range(k):
             i = int(idx[m])
@@ -349,12 +358,10 @@ class Contact:
                 self.centres[i] = ends[m]
                 out.append((ends[m].copy(), False))
                 continue
-            cands: list[Obstacle] = []
-            if len(self._obs):
-                for j in np.flatnonzero(solid_hit[m]):
-                    cands.append(self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m])))
-            if robot_hit is not None:
-                for j in np.flatnonzero(robot_hit[m]):
+            cands: list[Obstacle] = [self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m]))
+                                     for j in near_solids[m]]
+            if near_robots[m]:
+                for j in near_robots[m]:
                     cands.append(Obstacle(f"robot {j}", int(j), self.centres[j][None, :].copy(), float(self._radius[j]),
                                           (float(self.heights[j] + self._z_low[j]), float(self.heights[j] + self._z_high[j]))))
             p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], float(R[m]), cands)
