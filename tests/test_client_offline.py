@@ -522,11 +522,13 @@ def test_motor_commands_are_buffered_and_sent_with_the_step(server, capsys):
             with pytest.raises(SensoriumError) as err:
                 r2.set_motor_velocity(left, bad, "wb_motor_set_velocity")
             assert err.value.code == ErrorCode.INVALID_ARGUMENT and "wb_motor_set_velocity()" in str(err.value)
-        with pytest.raises(SensoriumError, match="NaN"):
-            r2.set_motor_position(left, math.nan, "wb_motor_set_position")
+        capsys.readouterr()
+        before = left.target_position
+        r2.set_motor_position(left, math.nan, "wb_motor_set_position")          # Webots prints and ignores
+        assert "invalid 'position' argument (NaN)" in capsys.readouterr().err
+        assert left.target_position == before and r2.motor_commands == {}
         r2.set_motor_position(left, 1.5, "test")
         # Webots prints and ignores a NaN velocity and a negative one in position control
-        capsys.readouterr()
         r2.set_motor_velocity(left, math.nan, "wb_motor_set_velocity")
         r2.set_motor_velocity(left, -1.0, "wb_motor_set_velocity")
         err_text = capsys.readouterr().err
