@@ -147,7 +147,7 @@ def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle
     return Obstacle(name, owner, _hull(world[:, :2]), 0.0, (float(world[:, 2].min()), float(world[:, 2].max())))
 
 
-def sphere_radius_in_band(ob: Obstacle, center_z: float, radius: float, low: float, high: float) -> float:
+def sphere_radius_in_band(center_z: float, radius: float, low: float, high: float) -> float:
     """The widest horizontal section of a sphere within the height band [low, high]."""
     dz = 0.0 if low <= center_z <= high else min(abs(center_z - low), abs(center_z - high))
     return math.sqrt(max(radius * radius - dz * dz, 0.0))
@@ -373,7 +373,7 @@ class Contact:
         prim = self.prims.get(ob.name)
         if isinstance(prim, geo.Sphere):
             cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
-            return Obstacle(ob.name, -1, ob.points, sphere_radius_in_band(ob, cz, prim.radius, low, high), ob.z_range)
+            return Obstacle(ob.name, -1, ob.points, sphere_radius_in_band(cz, prim.radius, low, high), ob.z_range)
         return ob
 
     def _clip(self, p: np.ndarray, d: np.ndarray, R: float, cands: list[Obstacle]) -> tuple[np.ndarray, bool]:
