@@ -9,6 +9,7 @@ import math
 import msgpack
 import numpy as np
 import pytest
+from test_webots_api import WORLD
 
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.daemon.services import Core
@@ -16,7 +17,6 @@ from sensorium.server.daemon.supervisor import matrix_axis_angle
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world, parse_world
 from sensorium.server.world.poses import axis_angle_matrix
-from tests.test_webots_api import WORLD
 
 A, B = b"A", b"B"
 

@@ -11,9 +11,9 @@ import sys
 import time
 
 import pytest
+from test_multiprocess import CONTROLLERS, REPO, Proc, Server, sensorium
 
 from sensorium.client.topics import Subscriber
-from tests.test_multiprocess import CONTROLLERS, REPO, Proc, Server, sensorium
 
 WORLD = REPO / "tests" / "worlds" / "webots_api.yaml"
 STEP = 0.016            # m per basic step at 5 rad/s, wheel radius 0.1, 32 ms
