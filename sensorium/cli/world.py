@@ -37,6 +37,17 @@ def _device_line(d) -> str:
     return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
 
 
+def _geometry_line(s: wm.Solid) -> str:
+    kinds = [s.geometry.type] if s.geometry is not None else []
+    kinds += [p.geometry.type for p in s.shapes]
+    text = "+".join(kinds) or "no shape"
+    if s.children:
+        text += f", {len(s.children)} child solid{'s' if len(s.children) != 1 else ''}"
+    if s.lights:
+        text += f", {len(s.lights)} light{'s' if len(s.lights) != 1 else ''}"
+    return text
+
+
 def world_summary(path: str | Path) -> dict:
     from sensorium.server.world.scene import Scene
 
@@ -48,7 +59,7 @@ def world_summary(path: str | Path) -> dict:
         "file": str(path),
         "basic_time_step_ms": w.world_info.basic_time_step,
         "random_seed": w.world_info.random_seed,
-        "solids": [{"name": s.name, "geometry": s.geometry.type, "seen_by": s.seen_by} for s in w.solids],
+        "solids": [{"name": s.name, "geometry": _geometry_line(s), "seen_by": s.seen_by} for s in w.solids],
         "triangles": scene.triangle_count,
         "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
         "robots": [

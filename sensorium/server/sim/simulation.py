@@ -65,7 +65,8 @@ class RobotState:
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
                                        clock=lambda: sim.time_ms)
-        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index])
+        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index],
+                                        up=sim.world.world_info.coordinate_system)
                       if model.differential_drive is not None else None)
         self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
 
@@ -117,7 +118,8 @@ class Simulation:
         self.time_ms = 0
         self.step_count = 0
         self.scene = Scene(self.world, loaded.base_dir, precision)
-        self.lights = lights_from_models(self.world.lights)
+        self.lights = lights_from_models(self.scene.world_lights())
+        self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._counters: Counter[str] = Counter()
@@ -190,6 +192,9 @@ class Simulation:
                     (lights if isinstance(dev, LightSensor) else distances).append(dev)
         work: list[tuple[object, list[RayRequest]]] = []
         if lights:
+            if self._lights_version != self.scene.lights_version:  # a light moved with its owner
+                self.lights = lights_from_models(self.scene.world_lights())
+                self._lights_version = self.scene.lights_version
             batch = LightBatch(lights, poses, self.lights)
             work.append((batch, batch.plan()))
         if distances:
