@@ -227,7 +227,8 @@ class Solid(Strict):
     ``geometry`` (with ``appearance``/``seen_by``) is the solid's own shape at its origin;
     ``shapes`` adds further shapes each with its own offset; ``children`` are solids fixed to this
     one (poses relative to it, nested to any depth, moving with it); ``lights`` are lights fixed to
-    it (``location`` and ``direction`` in its frame).
+    it (``location`` and a SpotLight's ``direction`` in its frame; a DirectionalLight's direction
+    stays in world axes, as in Webots).
     """
 
     name: str = Field(min_length=1)

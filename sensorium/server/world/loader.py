@@ -10,8 +10,8 @@ from __future__ import annotations
 import json
 import math
 import re
-from dataclasses import dataclass, field
 from collections.abc import Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -73,6 +73,8 @@ class LoadedWorld:
 def load_world(path: str | Path) -> LoadedWorld:
     path = Path(path)
     source = str(path)
+    if path.suffix.lower() == ".wbt":
+        return load_wbt(path)
     try:
         text = path.read_bytes()
     except OSError as exc:
@@ -85,6 +87,39 @@ def load_world(path: str | Path) -> LoadedWorld:
     except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise WorldError(source, [Problem("", f"not valid YAML/JSON: {exc}")]) from None
     return parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
+
+
+def load_wbt(path: Path) -> LoadedWorld:
+    """A Webots world, converted (``sensorium.server.world.wbt``); problems point at its lines.
+
+    ``LoadedWorld.text`` is the converted world as YAML (what recordings attach and replays read)."""
+    from sensorium.server.world.wbt import WbtSyntaxError, wbt_to_dict
+
+    source = str(path)
+    try:
+        data, warnings, origin = wbt_to_dict(path)
+    except WbtSyntaxError as exc:
+        where = f"line {exc.line}, column {exc.col}" if exc.line else ""
+        raise WorldError(source, [Problem(where, exc.message)]) from None
+    text = yaml.safe_dump(data, sort_keys=False).encode()
+    try:
+        loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
+    except WorldError as exc:
+        raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
+    return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
+                       warnings=[*warnings, *loaded.warnings])
+
+
+def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem:
+    """A problem of the converted world, placed at the .wbt node it came from."""
+    best = ""
+    for key in origin:
+        if len(key) > len(best) and (p.path == key or p.path.startswith(key + ".") or p.path.startswith(key + "[")):
+            best = key
+    if not best:
+        return p
+    line, col, kind = origin[best]
+    return Problem(f"line {line}, column {col} ({kind}, converted as {p.path})", p.message)
 
 
 def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"") -> LoadedWorld:

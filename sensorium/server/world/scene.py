@@ -98,11 +98,14 @@ def robot_parts(robot: wm.Robot) -> Iterator[tuple[str, Pose, wm.Shape]]:
 
 
 def place_light(model, pose: Pose):
-    """A light model with ``location``/``direction`` moved from its owner's frame to the world."""
+    """A light model with ``location``/``direction`` moved from its owner's frame to the world.
+
+    A DirectionalLight's direction stays in world axes wherever it is attached (as in Webots, whose
+    renderer ignores a directional light's parent transform)."""
     upd: dict = {}
     if hasattr(model, "location"):
         upd["location"] = tuple(float(v) for v in pose.apply(np.asarray(model.location)))
-    if hasattr(model, "direction"):
+    if model.type == "SpotLight":
         upd["direction"] = tuple(float(v) for v in pose.apply_dirs(np.asarray(model.direction)))
     return model.model_copy(update=upd)
 
