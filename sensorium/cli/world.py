@@ -8,6 +8,7 @@ import argparse
 import json
 import math
 import sys
+from typing import Any
 
 from sensorium.server.sim.summary import world_summary
 from sensorium.server.world.loader import WorldError, default_world_path, load_world
@@ -83,6 +84,7 @@ def _summary(value) -> object:
 
 
 def probe(args: argparse.Namespace) -> int:
+    from sensorium.server.sim.sensors import Lidar
     from sensorium.server.sim.simulation import Simulation
 
     path = args.world or str(default_world_path())
@@ -91,7 +93,7 @@ def probe(args: argparse.Namespace) -> int:
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1
-    enabled = []
+    enabled: list[Any] = []        # sensors.LightSensor | DistanceSensor | Lidar: each has readings()
     try:
         for spec in args.enable:
             target, period = _parse_enable(spec)
@@ -100,7 +102,11 @@ def probe(args: argparse.Namespace) -> int:
                 dev.enable(period)
                 enabled.append(dev)
         for target in args.point_cloud:
-            sim.device(target).enable_point_cloud()
+            lidar = sim.device(target)
+            if not isinstance(lidar, Lidar):
+                print(f"probe: --point-cloud {target}: not a lidar ({lidar.kind})", file=sys.stderr)
+                return 2
+            lidar.enable_point_cloud()
     except KeyError as exc:
         print(f"probe: {exc.args[0]}", file=sys.stderr)
         return 2

@@ -30,9 +30,9 @@ def numpy_module() -> Any:
         else:
             try:
                 import numpy
+                _numpy = numpy
             except ImportError:
-                numpy = None
-            _numpy = numpy
+                _numpy = None
     return _numpy
 
 

@@ -16,6 +16,7 @@ from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -174,6 +175,7 @@ class Simulation:
         now = self.time_ms
         dt = self.basic_time_step
         for robot in self._driven:
+            assert robot.drive is not None
             pose = robot.drive.step(dt)
             if pose is not None:
                 self.scene.set_robot_pose(robot.index, pose)
@@ -187,14 +189,17 @@ class Simulation:
                     if dev.due(now):
                         lidars.append(dev)
                 elif dev.schedule.due(now):
-                    (lights if isinstance(dev, LightSensor) else distances).append(dev)
-        work: list[tuple[object, list[RayRequest]]] = []
+                    if isinstance(dev, LightSensor):
+                        lights.append(dev)
+                    elif isinstance(dev, DistanceSensor):
+                        distances.append(dev)
+        work: list[tuple[Any, list[RayRequest]]] = []
         if lights:
             batch = LightBatch(lights, poses, self.lights)
             work.append((batch, batch.plan()))
         if distances:
-            batch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness)
-            work.append((batch, batch.plan()))
+            dbatch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness)
+            work.append((dbatch, dbatch.plan()))
         for lidar in lidars:
             work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt)))
         hits = self._cast_batched([req for _, reqs in work for req in reqs])

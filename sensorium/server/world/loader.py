@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -121,7 +122,7 @@ def format_path(loc: tuple[Any, ...]) -> str:
     return out
 
 
-def _problem_from_pydantic(err: dict[str, Any]) -> Problem:
+def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
     loc = tuple(err.get("loc", ()))
     msg = err.get("msg", "invalid")
     kind = err.get("type", "")
@@ -140,7 +141,7 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
     """Checks that relate several fields or the file system; one problem per finding."""
     problems: list[Problem] = []
 
-    def unique(items: list[tuple[str, str | None]], what: str) -> None:
+    def unique(items: Sequence[tuple[str, str | None]], what: str) -> None:
         first: dict[str, str] = {}
         for path, name in items:
             if name is None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import struct
+from typing import cast
 
 from sensorium.client import arrays, wb
 
@@ -58,11 +59,12 @@ class Lidar(Sensor):
     def getRangeImage(self, data_type: str = "list") -> list[float] | bytes:
         """Ranges left to right, first layer to last: a list of floats, or with
         ``data_type='buffer'`` the raw little-endian float32 bytes."""
-        return _floats(wb.lidar_range_bytes(self._tag, None, "getRangeImage"), data_type)
+        # never None: without a layer the whole cached image is returned
+        return cast("list[float] | bytes", _floats(wb.lidar_range_bytes(self._tag, None, "getRangeImage"), data_type))
 
     def getRangeImageArray(self) -> list[list[float]]:
         """The range image as ``[layer][column]`` lists."""
-        flat = self.getRangeImage()
+        flat = cast("list[float]", self.getRangeImage())
         w = self.getHorizontalResolution()
         return [flat[i:i + w] for i in range(0, len(flat), w)] if w else []
 
