@@ -154,6 +154,16 @@ def test_no_hit_rays_count_as_table_max() -> None:
     assert d.value == 4.0
 
 
+def test_empty_lookup_table_reads_zero() -> None:
+    # devices.md §3.1: an empty table gives the value 0 whatever the rays hit
+    sim = world([{"device": "DistanceSensor", "name": "d", "lookup_table": []},
+                 {"device": "DistanceSensor", "name": "e", "type": "infra-red", "lookup_table": []}])
+    for name in ("d", "e"):
+        sim.device(f"r/{name}").enable(32)
+    sim.step()
+    assert sim.device("r/d").value == 0.0 and sim.device("r/e").value == 0.0
+
+
 @pytest.mark.parametrize("tilt_deg,expect_echo", [(20.0, True), (24.0, False)])
 def test_sonar_incidence_on_tilted_wall(tilt_deg: float, expect_echo: bool) -> None:
     tilt = math.radians(tilt_deg)
