@@ -171,3 +171,12 @@ def test_error_code_tables_agree() -> None:
     assert all(v < 1000 for v in server.values())
     table = dict(re.findall(r"^\| (\d+) \| `([A-Z_]+)` \|", (ROOT / "PROTOCOL.md").read_text(), re.M))
     assert {name: int(num) for num, name in table.items()} == server
+
+
+def test_slow_marker_finds_tests_that_start_processes(request: pytest.FixtureRequest) -> None:
+    from conftest import _spawning_functions
+
+    found = _spawning_functions(ROOT / "tests" / "test_world.py")
+    assert {"_cli", "test_cli_validate_ok_and_failure", "test_cli_info_default_world"} <= found  # via the helper
+    assert "test_infrared_spelling_normalised" not in found
+    assert request.node.get_closest_marker("slow") is None           # this test is not
