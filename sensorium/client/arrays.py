@@ -29,10 +29,10 @@ def numpy_module() -> Any:
             _numpy = None
         else:
             try:
-                import numpy
-                _numpy = numpy
+                import numpy as found
             except ImportError:
-                _numpy = None
+                found = None  # type: ignore[assignment]
+            _numpy = found
     return _numpy
 
 

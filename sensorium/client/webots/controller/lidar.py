@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import struct
-from typing import cast
 
 from sensorium.client import arrays, wb
 
@@ -25,6 +24,11 @@ class LidarPoint:
     @classmethod
     def from_bytes(cls, data: bytes, index: int = 0) -> LidarPoint:
         return cls(*struct.unpack_from(arrays.POINT_FORMAT, data, index * arrays.POINT_SIZE))
+
+    @property
+    def layer(self) -> int:
+        """Webots' Python spelling of ``layer_id``."""
+        return self.layer_id
 
     def __repr__(self) -> str:
         return f"LidarPoint(x={self.x}, y={self.y}, z={self.z}, layer_id={self.layer_id}, time={self.time})"
@@ -56,15 +60,16 @@ class Lidar(Sensor):
     _get_sampling_period = staticmethod(wb.wb_lidar_get_sampling_period)
 
     # -- images
-    def getRangeImage(self, data_type: str = "list") -> list[float] | bytes:
+    def getRangeImage(self, data_type: str = "list") -> list[float] | bytes | None:
         """Ranges left to right, first layer to last: a list of floats, or with
         ``data_type='buffer'`` the raw little-endian float32 bytes."""
-        # never None: without a layer the whole cached image is returned
-        return cast("list[float] | bytes", _floats(wb.lidar_range_bytes(self._tag, None, "getRangeImage"), data_type))
+        return _floats(wb.lidar_range_bytes(self._tag, None, "getRangeImage"), data_type)
 
     def getRangeImageArray(self) -> list[list[float]]:
         """The range image as ``[layer][column]`` lists."""
-        flat = cast("list[float]", self.getRangeImage())
+        flat = self.getRangeImage()
+        if not isinstance(flat, list):
+            return []
         w = self.getHorizontalResolution()
         return [flat[i:i + w] for i in range(0, len(flat), w)] if w else []
 
