@@ -250,6 +250,17 @@ def test_point_light_irradiance_and_occlusion() -> None:
     assert sim.device("r/shaded").value == pytest.approx(0.75, abs=1e-12)
 
 
+def test_light_sensor_with_an_empty_lookup_table_reads_the_irradiance() -> None:
+    # devices.md §1.2: an empty table returns its input unchanged (the world used to pass validate
+    # and then fail every step)
+    lights = [{"type": "PointLight", "location": [2.0, 0, 0], "intensity": 3.0, "attenuation": [0, 0, 1]}]
+    sim = world([{"device": "LightSensor", "name": "raw", "lookup_table": [], "resolution": 0.25}], solids=[],
+                lights=lights)
+    sim.device("r/raw").enable(32)
+    sim.step()
+    assert sim.device("r/raw").value == 0.75                                    # 3/2² = 0.75, a multiple of 0.25
+
+
 def test_occlusion_rays_one_per_lit_light() -> None:
     lights = [{"type": "PointLight", "location": [2.0, y, 0.0]} for y in (-1.0, 0.0, 1.0)]
     lights.append({"type": "PointLight", "location": [-2.0, 0.0, 0.0]})          # behind: no direct term

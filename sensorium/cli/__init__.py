@@ -23,7 +23,10 @@ def command(name: str, help: str, target: str):
 
 @command("validate", "check a world file; exit 1 listing every problem", "sensorium.cli.world:validate")
 def _validate_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.serve import add_world_options
+
     p.add_argument("world", nargs="+", help="world file(s), YAML or JSON")
+    add_world_options(p)
 
 
 @command("info", "summarise a world file (or a .mcap recording)", "sensorium.cli.world:info")
@@ -42,6 +45,9 @@ def _probe_args(p: argparse.ArgumentParser) -> None:
                    help="also enable a lidar's point cloud")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="JSON lines: step, time, robot, device, value or array summary")
+    from sensorium.cli.serve import add_world_options
+
+    add_world_options(p)
 
 
 @command("controller", "run a Webots-style Python controller for a robot of a running server",

@@ -14,11 +14,19 @@ from sensorium.server.sim.summary import world_summary
 from sensorium.server.world.loader import WorldError, default_world_path, load_world
 
 
+def world_options(args: argparse.Namespace) -> dict[str, Any]:
+    """``--allow-large``/``--allow-outside-meshes`` → keyword arguments of ``load_world``."""
+    from sensorium.server.world.limits import WorldLimits
+
+    return {"limits": WorldLimits.large() if getattr(args, "allow_large", False) else WorldLimits(),
+            "allow_outside_meshes": getattr(args, "allow_outside_meshes", False)}
+
+
 def validate(args: argparse.Namespace) -> int:
     status = 0
     for path in args.world:
         try:
-            loaded = load_world(path)
+            loaded = load_world(path, **world_options(args))
         except WorldError as exc:
             print(str(exc), file=sys.stderr)
             print(f"{path}: INVALID ({len(exc.problems)} problem{'s' if len(exc.problems) != 1 else ''})", file=sys.stderr)
@@ -89,7 +97,7 @@ def probe(args: argparse.Namespace) -> int:
 
     path = args.world or str(default_world_path())
     try:
-        sim = Simulation.from_file(path, precision=args.precision)
+        sim = Simulation.from_file(path, precision=args.precision, **world_options(args))
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1

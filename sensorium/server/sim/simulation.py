@@ -38,6 +38,7 @@ from sensorium.server.sim.sensors import (
     RayRequest,
 )
 from sensorium.server.world.geometry import Pose
+from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
 
@@ -192,8 +193,10 @@ class Simulation:
         self._counters["resets"] += 1
 
     @classmethod
-    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT) -> Simulation:
-        return cls(load_world(path), precision)
+    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT, *,
+                  limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> Simulation:
+        """``limits``/``allow_outside_meshes``: see :func:`sensorium.server.world.loader.load_world`."""
+        return cls(load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes), precision)
 
     # ------------------------------------------------------------------ access
     @property
