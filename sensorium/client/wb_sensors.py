@@ -200,7 +200,7 @@ def wb_lidar_get_range_image(tag: int) -> Any:
     buf = lidar_range_bytes(tag)
     assert buf is not None                      # without a layer: always the whole image
     if arrays.numpy_module() is None:
-        return arrays.float32s(buf)
+        return arrays.float32s(buf or b"")
     r = current()
     return r.range_image(r.devices[tag - 1])
 
