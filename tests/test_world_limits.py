@@ -312,8 +312,10 @@ def test_fuzz_mutated_valid_world(path, value) -> None:
 @given(text=st.one_of(st.binary(max_size=200),
                       st.lists(st.sampled_from(["[", "]", "{", "}", ":", ",", "-", " ", "\n", "&a", "*a", "!!",
                                                 "robots", "name", "'", '"', "#", "?", "|", ">", "\t", "1e400",
-                                                "~", "null", ".nan", "2001-13-45"]), max_size=60).map("".join)),
-       suffix=st.sampled_from([".yaml", ".json"]))
+                                                "~", "null", ".nan", "2001-13-45", "#VRML_SIM R2023b utf8\n",
+                                                "Solid", "Robot", "Lidar", "children", "translation", "DEF", "USE",
+                                                "PROTO"]), max_size=60).map("".join)),
+       suffix=st.sampled_from([".yaml", ".json", ".wbt"]))
 def test_fuzz_text(text, suffix) -> None:
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / f"w{suffix}"
