@@ -4,15 +4,18 @@
  *   script OP... with OP one of
  *     enable NAME PERIOD | disable NAME | pc NAME | nopc NAME | pos NAME RAD | vel NAME RAD_S
  *     step DURATION COUNT            (COUNT steps; one line each)
+ *     sleep MS                       (compute for MS wall-clock ms: the heartbeat keeps the session)
  *
  * A line: "T STATUS" then, for every sensor enabled so far (in order of first enable),
  * " NAME=<float64 bits, 16 hex digits>" or, for a lidar, " NAME.range=<hex bytes>" and, while its
  * point cloud is enabled, " NAME.cloud=<hex of the 20-byte records>". After status -1 it stops. */
+#define _POSIX_C_SOURCE 200809L
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include <webots/device.h>
 #include <webots/distance_sensor.h>
@@ -120,6 +123,12 @@ int main(int argc, char **argv) {
       else
         wb_motor_set_velocity(device(argv[i + 1]), v);
       i += 2;
+    } else if (strcmp(op, "sleep") == 0) {
+      need(argc, i, 1, op);
+      long ms = atol(argv[i + 1]);
+      struct timespec ts = {ms / 1000, (ms % 1000) * 1000000L};
+      nanosleep(&ts, NULL);
+      i += 1;
     } else if (strcmp(op, "step") == 0) {
       need(argc, i, 2, op);
       int duration = atoi(argv[i + 1]), count = atoi(argv[i + 2]);

@@ -1,7 +1,7 @@
 """Scripted Python controller, the twin of tests/c/script.c (same ops, same output lines):
 
     script.py OP...   enable NAME PERIOD | disable NAME | pc NAME | nopc NAME | pos NAME RAD |
-                      vel NAME RAD_S | step DURATION COUNT
+                      vel NAME RAD_S | step DURATION COUNT | sleep MS
 
 A line per step: "T STATUS" then " NAME=<float64 bits, 16 hex>" per sensor enabled so far, or for a
 lidar " NAME.range=<hex>" and, while its point cloud is enabled, " NAME.cloud=<hex>".
@@ -9,6 +9,7 @@ lidar " NAME.range=<hex>" and, while its point cloud is enabled, " NAME.cloud=<h
 
 import struct
 import sys
+import time
 
 from sensorium.client import wb
 
@@ -60,6 +61,9 @@ while i < len(args):
     elif op in ("pos", "vel"):
         (wb.wb_motor_set_position if op == "pos" else wb.wb_motor_set_velocity)(device(args[i + 1]), float(args[i + 2]))
         i += 3
+    elif op == "sleep":
+        time.sleep(int(args[i + 1]) / 1000)
+        i += 2
     elif op == "step":
         duration, count = int(args[i + 1]), int(args[i + 2])
         for _ in range(count):
