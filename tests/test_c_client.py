@@ -6,10 +6,12 @@ their session while computing, and fail with one clear line on a bad URL or a mi
 
 from __future__ import annotations
 
+import math
 import os
 import queue
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 import threading
@@ -29,7 +31,9 @@ SCRIPT_PY = REPO / "tests" / "controllers" / "script.py"
 BRAITENBERG_PY = REPO / "sensorium" / "client" / "examples" / "braitenberg.py"
 SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
-CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg"]
+CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
+ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
+CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check"]
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -52,7 +56,7 @@ def cbin(tmp_path_factory) -> dict[str, str]:
         exe = build / name
         cmd = ["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
                "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", f"-I{TESTS_C}", str(src), "-o", str(exe),
-               str(build / "libController.a"), *libs]
+               str(build / "libController.a"), *libs, "-lm"]
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
         out[name] = str(exe)
@@ -304,8 +308,60 @@ def test_every_getter_matches_the_python_client(cbin, servers):
         assert got["error.no_device"] == got["error.by_index"] == "0"
         assert got["error.bad_tag_value"] == got["error.bad_tag_name"] == got["error.wrong_kind"] == "1"
         assert got["error.bad_step"] == "-1" and got["robot.step"] == "0"
-        assert "not a multiple of the basic time step" in err and "invalid device tag 9999" in err
+        assert "step duration must be >= 0 ms" in err and "invalid device tag 9999" in err
         assert float(got["robot.time_after"]) * 1000 == pytest.approx(want["robot.basic_time_step"])
+
+
+def test_braitenberg_with_encoders_matches_python_and_the_wheel_angles(cbin, servers):
+    c_lines = run([cbin["encoders"], "60"], servers(CDEVICES).url("rover"))
+    py_lines = run([sys.executable, "-m", "sensorium", "controller", "--url", servers(CDEVICES).url("rover"),
+                    str(ENCODERS_PY), "60"])
+    assert c_lines == py_lines and len(c_lines) == 60
+    rows = [fields(x) for x in c_lines]
+    f = lambda bits: struct.unpack("<d", bytes.fromhex(bits)[::-1])[0]  # noqa: E731
+    # the first 10 steps at 2.0 / 1.0 rad/s: the noiseless left encoder reads 2.0 rad/s x t exactly
+    for k, row in enumerate(rows[:10], start=1):
+        assert f(row["left"]) == pytest.approx(2.0 * 0.016 * k, abs=1e-12)
+        assert f(row["right"]) == pytest.approx(1.0 * 0.016 * k, abs=0.005)          # noise 0.001 rad
+    assert f(rows[0]["ls0"]) != f(rows[0]["ls0"]) and f(rows[1]["ls0"]) == f(rows[1]["ls0"])   # period 32: NaN at 16
+    speeds = {round(f(b["left"]) - f(a["left"]), 9) for a, b in zip(rows[10:], rows[11:])}
+    assert len(speeds) > 5                                            # the driver steers from its readings
+
+
+def test_robot_extras_led_keyboard_and_supervisor(cbin, servers):
+    server = servers(CDEVICES, "--mode", "pause")
+    rover = start([cbin["supervisor_check"]], server.url("rover"))
+    buddy = start([cbin["supervisor_check"]], server.url("buddy"))
+    server.wait_attached({"rover", "buddy"})
+    server.conn.call("set_mode", {"mode": "fast"})
+    (code_r, out_r, err_r), (code_b, out_b, err_b) = finish(rover), finish(buddy)
+    assert code_r == 0 and code_b == 0, err_r + err_b
+    got = dict(line.split(" ", 1) for line in out_r)
+    assert got["model"] == "C-rover" and got["custom_data"] == "gain=2" and got["supervisor"] == "1"
+    assert got["custom_data_after"] == "gain=3;from C" and got["mode"] == "0" and got["buddy_null"] == "0"
+    assert got["led0_initial"] == "0" and got["led0"] == f"2 rgb {0x336699}"
+    assert "value 3 out of range [0, 2] for LED 'led0'" in err_r
+    assert got["keyboard_disabled_key"] == "-1" and got["keyboard"] == "16 -1" and got["keyboard_after"] == "0"
+    assert got["self_null"] == "0 missing_null 1 same_ref 1"
+    assert got["fields"] == "5 translation 6 rotation bogus_null 1"
+    assert [float(v) for v in got["buddy_translation"].split()] == [-0.4, -0.4, 0.0]
+    assert [float(v) for v in got["buddy_translation_after"].split()] == [0.25, -0.5, 0.0]
+    assert [float(v) for v in got["buddy_rotation_after"].split()] == pytest.approx([0, 0, 1, math.pi / 2])
+    assert [float(v) for v in got["buddy_position"].split()] == [0.25, -0.5, 0.0]
+    assert [float(v) for v in got["buddy_orientation"].split()] == pytest.approx([0, -1, 0, 1, 0, 0, 0, 0, 1], abs=1e-12)
+    assert [float(v) for v in got["self_position"].split()] == [0.0, 0.0, 0.01]
+    assert got["sim_mode"] == "2" and got["sim_mode_after"] == "1"
+    assert [float(v) for v in got["buddy_translation_reset"].split()] == [-0.4, -0.4, 0.0]
+    assert got["led0_reset"] == "0"
+    assert "field 'mass' is not supported" in err_r and "wrong type (rotation)" in err_r
+    # the plain robot: supervisor calls refused with Webots' message
+    assert dict(line.split(" ", 1) for line in out_b)["buddy_null"] == "1"
+    assert "illegal call to wb_supervisor_node_get_from_def() in a 'Robot' controller" in err_b
+    # what the C controller set is the server's state: a Python controller attaching next sees it
+    from sensorium.client.wb import RobotClient
+    with RobotClient(server.url("rover")) as py:
+        assert py.custom_data == "after reset" and py.model == "C-rover"
+        assert py.by_name["led0"].desc["value"] == 1
 
 
 # ====================================================================== lockstep with Python

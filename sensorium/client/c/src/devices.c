@@ -34,6 +34,8 @@ WbNodeType wb_device_get_node_type(WbDeviceTag tag) {
     case SN_DISTANCE: return WB_NODE_DISTANCE_SENSOR;
     case SN_LIDAR: return WB_NODE_LIDAR;
     case SN_MOTOR: return WB_NODE_ROTATIONAL_MOTOR;
+    case SN_POSITION: return WB_NODE_POSITION_SENSOR;
+    case SN_LED: return WB_NODE_LED;
     default: return WB_NODE_NO_NODE;
   }
 }

@@ -96,7 +96,7 @@ void sn_conn_stop_heartbeat(sn_conn *c);
 const char *sn_conn_endpoint(const sn_conn *c);
 
 /* ------------------------------------------------------------------ robot.c */
-typedef enum { SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_OTHER } sn_kind;
+typedef enum { SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_OTHER } sn_kind;
 
 typedef struct {
   WbDeviceTag tag;
@@ -117,6 +117,10 @@ typedef struct {
   bool point_cloud_enabled;
   float *range_image;         /* layers * width, zeros before the first measurement */
   WbLidarPoint *point_cloud;  /* layers * width */
+  /* position sensor: its wheel motor's name; LED: value, colours, gradual */
+  char *motor_name;
+  int led_value, led_colors;
+  bool led_gradual;
   /* motor */
   double max_velocity, min_position, max_position, target_position, velocity;
   bool cmd_position, cmd_velocity; /* to send with the next step */
@@ -134,6 +138,9 @@ typedef struct {
   bool synchronization;
   bool supervisor;
   bool terminated;
+  bool warned_duration;
+  int keyboard_period;
+  void *nodes, *fields; /* supervisor handles handed out (supervisor.c) */
   uint64_t pending; /* id of the pending step, 0 if none */
   int n_devices;
   sn_device *devices;
@@ -149,6 +156,10 @@ sn_device *sn_device_get(WbDeviceTag tag, sn_kind kind, const char *func);
 typedef void (*sn_arg_fn)(sn_req *r, const void *arg);
 int sn_device_call(sn_robot *rb, const sn_device *dev, const char *item, sn_arg_fn add_value,
                    const void *arg, const char *func, sn_reply *out);
+/* The general form: service "/<robot>/<item>"; add_args packs nargs key/value pairs. */
+int sn_robot_call(sn_robot *rb, const char *item, uint32_t nargs, sn_arg_fn add_args, const void *arg,
+                  const char *func, sn_reply *out);
+void sn_supervisor_free(sn_robot *rb);
 void sn_arg_int(sn_req *r, const void *arg);
 void sn_arg_bool(sn_req *r, const void *arg);
 void sn_arg_double(sn_req *r, const void *arg);

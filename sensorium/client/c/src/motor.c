@@ -2,6 +2,7 @@
  * next step request (PROTOCOL.md 3.4); the getters answer from this copy. */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <webots/motor.h>
 
@@ -26,13 +27,13 @@ void wb_motor_set_velocity(WbDeviceTag tag, double velocity) {
   if (d == NULL)
     return;
   if (isnan(velocity)) {
-    fprintf(stderr, "Error: wb_motor_set_velocity() called with an invalid 'velocity' argument (NaN)\n");
+    fprintf(stderr, "Error: wb_motor_set_velocity() called with an invalid 'velocity' argument (NaN).\n");
     return;
   }
   if (velocity < 0.0 && !isinf(d->target_position)) {
     fprintf(stderr,
-            "Error: wb_motor_set_velocity() called with negative 'velocity' argument in position control mode (%g)\n",
-            d->target_position);
+            "Error: wb_motor_set_velocity() called with negative 'velocity' argument in position control mode (%g).\n",
+            velocity);
     return;
   }
   if (fabs(velocity) > d->max_velocity) {
@@ -77,6 +78,19 @@ WbJointType wb_motor_get_type(WbDeviceTag tag) {
 
 WbDeviceTag wb_motor_get_position_sensor(WbDeviceTag tag) {
   MOTOR("wb_motor_get_position_sensor");
+  if (d == NULL)
+    return 0;
+  sn_robot *rb = sn_robot_get("wb_motor_get_position_sensor");
+  for (int i = 0; i < rb->n_devices; i++) {
+    const sn_device *p = &rb->devices[i];
+    if (p->kind == SN_POSITION && p->motor_name != NULL && strcmp(p->motor_name, d->name) == 0)
+      return p->tag;
+  }
+  return 0;
+}
+
+WbDeviceTag wb_motor_get_brake(WbDeviceTag tag) {
+  MOTOR("wb_motor_get_brake");
   (void)d;
   return 0;
 }

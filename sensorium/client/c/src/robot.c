@@ -52,6 +52,10 @@ static sn_kind kind_of(const char *type) {
     return SN_LIDAR;
   if (strcmp(type, "RotationalMotor") == 0)
     return SN_MOTOR;
+  if (strcmp(type, "PositionSensor") == 0)
+    return SN_POSITION;
+  if (strcmp(type, "LED") == 0)
+    return SN_LED;
   return SN_OTHER;
 }
 
@@ -120,6 +124,10 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
     if (d->range_image == NULL || d->point_cloud == NULL)
       return -1;
   }
+  d->motor_name = sn_strdup_obj(sn_get(desc, "motor"));
+  d->led_value = (int)sn_int_or(desc, "value", 0);
+  d->led_colors = count_leaves(sn_get(desc, "color")) / 3;
+  d->led_gradual = sn_bool_or(desc, "gradual", false);
   d->max_velocity = sn_double_or(desc, "maxVelocity", 10.0);
   d->min_position = sn_double_or(desc, "minPosition", 0.0);
   d->max_position = sn_double_or(desc, "maxPosition", 0.0);
@@ -138,7 +146,9 @@ static void free_robot(sn_robot *rb) {
     free(d->lookup_table);
     free(d->range_image);
     free(d->point_cloud);
+    free(d->motor_name);
   }
+  sn_supervisor_free(rb);
   free(rb->devices);
   free(rb->name);
   free(rb->session);
@@ -311,8 +321,11 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
     if (dev == NULL)
       continue;
     double x;
-    if (sn_as_double(sn_get(v, "value"), &x))
+    if (sn_as_double(sn_get(v, "value"), &x)) {
       dev->value = x;
+      if (dev->kind == SN_LED && isfinite(x))
+        dev->led_value = (int)x;
+    }
     if (dev->kind != SN_LIDAR)
       continue;
     size_t n = (size_t)dev->width * (size_t)dev->layers;
@@ -350,6 +363,16 @@ int wb_robot_step_begin(int duration) {
   }
   if (rb->terminated)
     return -1;
+  if (duration < 0) {
+    fprintf(stderr, "Error: wb_robot_step(): step duration must be >= 0 ms, got %d\n", duration);
+    return -1;
+  }
+  if (duration % rb->basic_time_step && !rb->warned_duration) {
+    /* Webots warns once and wakes the controller at the first basic step that ends after it */
+    rb->warned_duration = true;
+    fprintf(stderr, "Warning: the step duration %d ms of robot '%s' is not a multiple of the basic time step (%d ms); "
+            "the server rounds it up.\n", duration, rb->name, rb->basic_time_step);
+  }
   int motors = 0;
   for (int i = 0; i < rb->n_devices; i++)
     motors += rb->devices[i].kind == SN_MOTOR && (rb->devices[i].cmd_position || rb->devices[i].cmd_velocity);
@@ -447,9 +470,21 @@ bool wb_robot_get_supervisor(void) { return sn_robot_get("wb_robot_get_superviso
 
 const char *wb_robot_get_custom_data(void) { return sn_robot_get("wb_robot_get_custom_data")->custom_data; }
 
+static void arg_str(sn_req *r, const void *arg) { sn_req_str(r, (const char *)arg); }
+
 void wb_robot_set_custom_data(const char *data) {
   sn_robot *rb = sn_robot_get("wb_robot_set_custom_data");
-  char *copy = strdup(data ? data : "");
+  if (data == NULL) {
+    fprintf(stderr, "Error: wb_robot_set_custom_data() called with a NULL 'data' argument\n");
+    return;
+  }
+  if (!rb->terminated) {
+    sn_reply rep;
+    if (sn_device_call(rb, NULL, "robot/set_custom_data", arg_str, data, "wb_robot_set_custom_data", &rep) != 0)
+      return;
+    sn_reply_free(&rep);
+  }
+  char *copy = strdup(data);
   if (copy == NULL)
     return;
   free(rb->custom_data);
@@ -511,17 +546,15 @@ void sn_arg_bool(sn_req *r, const void *arg) {
 
 void sn_arg_double(sn_req *r, const void *arg) { msgpack_pack_double(&r->pk, *(const double *)arg); }
 
-int sn_device_call(sn_robot *rb, const sn_device *dev, const char *item, sn_arg_fn add_value, const void *arg,
-                   const char *func, sn_reply *out) {
+int sn_robot_call(sn_robot *rb, const char *item, uint32_t nargs, sn_arg_fn add_args, const void *arg,
+                  const char *func, sn_reply *out) {
   char service[1024];
-  snprintf(service, sizeof service, "%s%s%s%s", rb->prefix, dev ? dev->name : "", dev ? "/" : "", item);
+  snprintf(service, sizeof service, "%s%s", rb->prefix, item);
   sn_req r;
   uint64_t id = sn_conn_next_id(rb->conn);
-  sn_req_begin(&r, id, service, add_value ? 1 : 0);
-  if (add_value) {
-    sn_req_key(&r, "value");
-    add_value(&r, arg);
-  }
+  sn_req_begin(&r, id, service, nargs);
+  if (add_args)
+    add_args(&r, arg);
   if (call(rb->conn, &r, id, g_timeout_ms, out) != 0) {
     fprintf(stderr, "Error: %s(): %s: %s\n", func, sn_error_name(out->code), out->message);
     sn_reply_free(out);
@@ -534,6 +567,25 @@ int sn_device_call(sn_robot *rb, const sn_device *dev, const char *item, sn_arg_
     return -1;
   }
   return 0;
+}
+
+typedef struct {
+  sn_arg_fn add_value;
+  const void *arg;
+} value_arg;
+
+static void add_value_arg(sn_req *r, const void *p) {
+  const value_arg *v = p;
+  sn_req_key(r, "value");
+  v->add_value(r, v->arg);
+}
+
+int sn_device_call(sn_robot *rb, const sn_device *dev, const char *item, sn_arg_fn add_value, const void *arg,
+                   const char *func, sn_reply *out) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s%s%s", dev ? dev->name : "", dev ? "/" : "", item);
+  value_arg v = {add_value, arg};
+  return sn_robot_call(rb, path, add_value ? 1 : 0, add_value ? add_value_arg : NULL, &v, func, out);
 }
 
 void sn_device_enable(sn_device *dev, int period, const char *func) {

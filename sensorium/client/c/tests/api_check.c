@@ -7,9 +7,11 @@
 #include <webots/device.h>
 #include <webots/distance_sensor.h>
 #include <webots/lidar.h>
+#include <webots/led.h>
 #include <webots/light_sensor.h>
 #include <webots/motor.h>
 #include <webots/nodes.h>
+#include <webots/position_sensor.h>
 #include <webots/robot.h>
 #include <webots/types.h>
 
@@ -75,10 +77,20 @@ int main(void) {
         printf("%s.max_position %.17g\n", name, wb_motor_get_max_position(tag));
         printf("%s.type %d\n", name, (int)wb_motor_get_type(tag));
         printf("%s.position_sensor %d\n", name, (int)wb_motor_get_position_sensor(tag));
+        printf("%s.brake %d\n", name, (int)wb_motor_get_brake(tag));
         wb_motor_set_position(tag, INFINITY);
         wb_motor_set_velocity(tag, 2.0 * wb_motor_get_max_velocity(tag)); /* clamped, with a warning */
         printf("%s.clamped_velocity %.17g\n", name, wb_motor_get_velocity(tag));
         printf("%s.new_target %.17g\n", name, wb_motor_get_target_position(tag));
+        break;
+      case WB_NODE_POSITION_SENSOR:
+        printf("%s.sampling_period %d\n", name, wb_position_sensor_get_sampling_period(tag));
+        printf("%s.type %d\n", name, (int)wb_position_sensor_get_type(tag));
+        printf("%s.motor %d\n", name, (int)wb_position_sensor_get_motor(tag));
+        printf("%s.brake %d\n", name, (int)wb_position_sensor_get_brake(tag));
+        break;
+      case WB_NODE_LED:
+        printf("%s.led %d\n", name, wb_led_get(tag));
         break;
       default:
         printf("%s.unknown_type\n", name);
@@ -93,7 +105,7 @@ int main(void) {
   printf("error.wrong_kind %d\n", wb_device_get_node_type(first) == WB_NODE_LIDAR
                                       ? wb_light_sensor_get_lookup_table(first) == NULL
                                       : wb_lidar_get_range_image(first) == NULL);
-  int status = wb_robot_step(wb_robot_get_basic_time_step() + 1); /* not a multiple: refused */
+  int status = wb_robot_step(-32); /* negative: refused */
   printf("error.bad_step %d\n", status);
   printf("robot.step %d\n", wb_robot_step((int)wb_robot_get_basic_time_step()));
   printf("robot.time_after %.17g\n", wb_robot_get_time());

@@ -19,6 +19,7 @@ double wb_motor_get_velocity(WbDeviceTag tag);
 double wb_motor_get_max_velocity(WbDeviceTag tag);
 WbJointType wb_motor_get_type(WbDeviceTag tag);
 WbDeviceTag wb_motor_get_position_sensor(WbDeviceTag tag);     /* 0 if the wheel has none */
+WbDeviceTag wb_motor_get_brake(WbDeviceTag tag);               /* 0: no Brake devices */
 
 #ifdef __cplusplus
 }
