@@ -6,6 +6,7 @@ their session while computing, and fail with one clear line on a bad URL or a mi
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import queue
@@ -362,6 +363,15 @@ def test_robot_extras_led_keyboard_and_supervisor(cbin, servers):
     with RobotClient(server.url("rover")) as py:
         assert py.custom_data == "after reset" and py.model == "C-rover"
         assert py.by_name["led0"].desc["value"] == 1
+
+
+def test_c_client_replays_the_conformance_session(cbin, servers):
+    """sensorium/schemas/conformance/session.json: expected lines computed from the simulation."""
+    session = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "session.json").read_text())
+    server = servers(REPO / "sensorium" / "schemas" / "conformance" / session["world"])
+    lines = run([sys.executable, "-m", "sensorium", "controller", "--url", server.url(session["robot"]), cbin["script"],
+                 *session["script"]])
+    assert lines == session["lines"]
 
 
 # ====================================================================== lockstep with Python

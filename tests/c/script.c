@@ -22,6 +22,7 @@
 #include <webots/lidar.h>
 #include <webots/light_sensor.h>
 #include <webots/motor.h>
+#include <webots/position_sensor.h>
 #include <webots/robot.h>
 
 static WbDeviceTag seen[256];
@@ -72,7 +73,9 @@ static void print_line(int status) {
         }
       }
     } else {
-      double v = type == WB_NODE_LIGHT_SENSOR ? wb_light_sensor_get_value(tag) : wb_distance_sensor_get_value(tag);
+      double v = type == WB_NODE_LIGHT_SENSOR      ? wb_light_sensor_get_value(tag)
+                 : type == WB_NODE_POSITION_SENSOR ? wb_position_sensor_get_value(tag)
+                                                   : wb_distance_sensor_get_value(tag);
       uint64_t bits;
       memcpy(&bits, &v, sizeof bits);
       printf(" %s=%016" PRIx64, name, bits);
@@ -104,6 +107,9 @@ int main(int argc, char **argv) {
           on ? wb_distance_sensor_enable(tag, period) : wb_distance_sensor_disable(tag);
           break;
         case WB_NODE_LIDAR: on ? wb_lidar_enable(tag, period) : wb_lidar_disable(tag); break;
+        case WB_NODE_POSITION_SENSOR:
+          on ? wb_position_sensor_enable(tag, period) : wb_position_sensor_disable(tag);
+          break;
         default: fprintf(stderr, "script: '%s' is not a sensor\n", argv[i + 1]); return 2;
       }
       remember(tag);

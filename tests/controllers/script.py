@@ -33,14 +33,16 @@ def line(status: int) -> str:
             if wb.wb_lidar_is_point_cloud_enabled(tag) and wb.wb_lidar_get_sampling_period(tag) > 0:
                 out.append(f"{name}.cloud={wb.lidar_cloud_bytes(tag).hex()}")
         else:
-            get = wb.wb_light_sensor_get_value if kind == "LightSensor" else wb.wb_distance_sensor_get_value
+            get = {"LightSensor": wb.wb_light_sensor_get_value,
+                   "PositionSensor": wb.wb_position_sensor_get_value}.get(kind, wb.wb_distance_sensor_get_value)
             out.append(f"{name}={struct.unpack('<Q', struct.pack('<d', get(tag)))[0]:016x}")
     return " ".join(out)
 
 
 ENABLE = {"LightSensor": (wb.wb_light_sensor_enable, wb.wb_light_sensor_disable),
           "DistanceSensor": (wb.wb_distance_sensor_enable, wb.wb_distance_sensor_disable),
-          "Lidar": (wb.wb_lidar_enable, wb.wb_lidar_disable)}
+          "Lidar": (wb.wb_lidar_enable, wb.wb_lidar_disable),
+          "PositionSensor": (wb.wb_position_sensor_enable, wb.wb_position_sensor_disable)}
 args = sys.argv[1:]
 i = 0
 while i < len(args):
