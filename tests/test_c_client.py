@@ -34,7 +34,8 @@ SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
 CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
-CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check"]
+CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
+               "wire_vectors"]
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -372,6 +373,54 @@ def test_c_client_replays_the_conformance_session(cbin, servers):
     lines = run([sys.executable, "-m", "sensorium", "controller", "--url", server.url(session["robot"]), cbin["script"],
                  *session["script"]])
     assert lines == session["lines"]
+
+
+def test_c_codec_replays_the_request_vectors(cbin, servers):
+    """sensorium/schemas/conformance/requests.json through the library's own transport and msgpack
+    decoding (tests/c/wire_vectors.c): ids, ok, error codes, result keys and scalar results."""
+    import msgpack
+
+    from sensorium.server import conformance
+
+    vectors = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "requests.json").read_text())
+    server = servers(REPO / "sensorium" / "schemas" / "conformance" / vectors["world"])
+    p = subprocess.Popen([cbin["wire_vectors"], server.rpc], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=ENV)
+    saved: dict[str, str] = {}
+    try:
+        for case in vectors["cases"]:
+            data = (bytes.fromhex(case["request_hex"]) if "request_hex" in case else
+                    msgpack.packb(conformance.decode_value(case["request"], saved), use_bin_type=True))
+            p.stdin.write(data.hex() + "\n")
+            p.stdin.flush()
+            line = p.stdout.readline().rstrip("\n")
+            head, _, rest = line.partition(" keys=")
+            got = dict(item.split("=", 1) for item in head.split())
+            keys, *scalars = rest.split(" ")
+            result = dict(item.split("=", 1) for item in scalars)
+            expect = case["expect"]
+            assert got["id"] == ("nil" if "id" in expect else str(case["request"]["id"])), (case["name"], line)
+            assert got["ok"] == str(int(expect["ok"])), (case["name"], line)
+            if not expect["ok"]:
+                assert got["code"] == str(expect["code"]), (case["name"], line)
+                continue
+            names = set(keys.split(",")) - {""}
+            want = conformance.decode_value(expect.get("result", {}))
+            assert {k.split(".")[0] for k in expect.get("result_has", [])} | set(want) <= names, (case["name"], line)
+            for key, value in want.items():
+                if isinstance(value, bool):
+                    assert result[key] == str(value).lower(), (case["name"], key)
+                elif isinstance(value, (int, float)):
+                    assert float(result[key]) == value, (case["name"], key)
+                elif isinstance(value, str):
+                    assert result[key] == value, (case["name"], key)
+            if "save" in expect:
+                saved[expect["save"]] = result[expect["save"]]
+    finally:
+        p.stdin.close()
+        code = p.wait(60)
+        err = p.stderr.read()
+    assert code == 0 and "Sanitizer" not in err and "runtime error" not in err, err
 
 
 # ====================================================================== lockstep with Python

@@ -495,6 +495,32 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
   }
 }
 
+int sn_conn_wait_any(sn_conn *c, int timeout_ms, sn_reply *out) {
+  zmq_pollitem_t item = {c->sock, 0, ZMQ_POLLIN, 0};
+  if (zmq_poll(&item, 1, timeout_ms) <= 0) {
+    client_error(out, SN_TIMEOUT, "no reply from %s%s", c->endpoint, "");
+    return -1;
+  }
+  zmq_msg_t msg;
+  zmq_msg_init(&msg);
+  if (zmq_msg_recv(&msg, c->sock, 0) < 0) {
+    zmq_msg_close(&msg);
+    client_error(out, SN_CONNECTION_LOST, "receiving from %s%s", c->endpoint, "");
+    return -1;
+  }
+  size_t size = zmq_msg_size(&msg);
+  char *data = malloc(size ? size : 1);
+  if (data == NULL) {
+    zmq_msg_close(&msg);
+    client_error(out, SN_BAD_REPLY, "out of memory for a reply%s%s", "", "");
+    return -1;
+  }
+  memcpy(data, zmq_msg_data(&msg), size);
+  zmq_msg_close(&msg);
+  uint64_t got;
+  return decode_reply(data, size, out, &got);
+}
+
 /* ------------------------------------------------------------------ heartbeat */
 
 static void *heartbeat_main(void *arg) {

@@ -91,6 +91,8 @@ int sn_conn_send(sn_conn *c, sn_req *r, uint64_t id);
  * client-side error in out->code/out->message. */
 int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out);
 void sn_conn_discard(sn_conn *c, uint64_t id);
+/* The next reply, whatever its id (for raw replays such as the conformance vectors). */
+int sn_conn_wait_any(sn_conn *c, int timeout_ms, sn_reply *out);
 int sn_conn_start_heartbeat(sn_conn *c, const char *session, int interval_ms);
 void sn_conn_stop_heartbeat(sn_conn *c);
 const char *sn_conn_endpoint(const sn_conn *c);
