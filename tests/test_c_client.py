@@ -62,6 +62,13 @@ def cbin(tmp_path_factory) -> dict[str, str]:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
         out[name] = str(exe)
+    exe = build / "braitenberg_cpp"                     # the header-only C++ layer
+    cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+           f"-I{CLIB / 'include'}", str(TESTS_C / "braitenberg_cpp.cpp"), "-o", str(exe), str(build / "libController.a"),
+           *libs]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    out["braitenberg_cpp"] = str(exe)
     return out
 
 
@@ -248,6 +255,8 @@ def test_braitenberg_in_c_drives_exactly_like_the_python_example(cbin, servers):
     assert len(c_lines) == 40 and c_lines == py_lines
     wheels = {line.split("wheels")[1] for line in c_lines}
     assert len(wheels) > 5 and all("+0.00 +0.00" not in w for w in wheels)       # it really steers
+    cpp_lines = run([cbin["braitenberg_cpp"], "40"], servers().url("epuck"))      # the C++ layer, too
+    assert cpp_lines == py_lines
 
 
 def test_every_getter_matches_the_python_client(cbin, servers):
