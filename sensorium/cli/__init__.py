@@ -58,10 +58,11 @@ def _probe_args(p: argparse.ArgumentParser) -> None:
     add_world_options(p)
 
 
-@command("controller", "run a Webots-style Python controller for a robot of a running server",
+@command("controller", "run a Webots-style controller (Python script or compiled binary) for a robot of a running server",
          "sensorium.cli.client:controller")
 def _controller_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("script", help="controller script (uses `from controller import Robot`)")
+    p.add_argument("script", help="controller: a Python script (uses `from controller import Robot`) or an executable "
+                   "(e.g. a C controller linked against sensorium/client/c)")
     p.add_argument("--robot", help="robot name (default: the URL's robot, or the world's only robot)")
     p.add_argument("--url", help="RPC endpoint or controller URL, e.g. tcp://127.0.0.1:5560 or "
                    "tcp://host:5560/epuck (default: $SENSORIUM_CONTROLLER_URL, $WEBOTS_CONTROLLER_URL, "
