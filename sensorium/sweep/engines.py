@@ -1,0 +1,97 @@
+"""Where runs execute: a local process pool, or Ray tasks (local or on a cluster). Both call the
+same :func:`sensorium.sweep.run.run_one` and yield ``(index, row)`` as runs finish; the caller
+orders the rows. No scheduling of our own: Ray (or the pool) places the tasks.
+
+Ray on one machine is started bound to loopback (``_node_ip_address="127.0.0.1"``, no dashboard,
+``num_cpus`` = the workers asked for, default all CPUs). With ``address`` the sweep joins an
+existing cluster instead (``"auto"``, ``"ray://head:10001"`` or ``"head:6379"``); an already
+initialised Ray in the calling process is reused as is.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from collections.abc import Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from typing import Any
+
+from sensorium.sweep.run import run_one
+from sensorium.sweep.spec import RunSpec
+
+__all__ = ["ENGINES", "available", "local_pool", "ray_tasks", "init_ray", "default_workers"]
+
+ENGINES = ("auto", "local", "ray")
+
+
+def default_workers() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:   # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def available(engine: str) -> bool:
+    if engine == "ray":
+        try:
+            import ray  # noqa: F401
+        except ImportError:
+            return False
+    return True
+
+
+def _failed(run: RunSpec, exc: BaseException) -> dict:
+    """The row of a run whose worker died (the run itself never raises)."""
+    return {"run": run.index, "world": run.world, "seed": run.seed, "controller": run.controller_name,
+            **{f"param:{k}": v for k, v in run.parameters}, "status": "error",
+            "error": f"worker failed: {type(exc).__name__}: {exc}".splitlines()[0][:2000],
+            "recording": run.recording or ""}
+
+
+def local_pool(runs: Sequence[RunSpec], workers: int | None = None) -> Iterator[tuple[int, dict]]:
+    """Runs on a pool of ``workers`` fresh processes (spawned: nothing inherited but the runs)."""
+    workers = max(1, min(workers or default_workers(), len(runs) or 1))
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        pending = {pool.submit(run_one, r): r for r in runs}
+        while pending:
+            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in done:
+                run = pending.pop(fut)
+                try:
+                    yield run.index, fut.result()
+                except Exception as exc:   # a crashed worker (e.g. killed): that run's row says so
+                    yield run.index, _failed(run, exc)
+
+
+def init_ray(address: str | None = None, workers: int | None = None, **kwargs: Any):
+    """Connect to Ray: reuse an initialised session, join ``address``, or start a local one bound
+    to 127.0.0.1. Returns the ``ray`` module."""
+    import ray
+
+    if ray.is_initialized():
+        return ray
+    if address:
+        ray.init(address=address, log_to_driver=False, **kwargs)
+    else:
+        opts: dict[str, Any] = dict(num_cpus=workers or default_workers(), include_dashboard=False,
+                                    _node_ip_address="127.0.0.1", log_to_driver=False, configure_logging=False)
+        opts.update(kwargs)
+        ray.init(**opts)
+    return ray
+
+
+def ray_tasks(runs: Sequence[RunSpec], workers: int | None = None, address: str | None = None,
+              **ray_init: Any) -> Iterator[tuple[int, dict]]:
+    """Runs as Ray tasks, one CPU each; rows come back through the object store as they finish."""
+    ray = init_ray(address, workers, **ray_init)
+    task = ray.remote(num_cpus=1, max_retries=0)(run_one)
+    refs = {task.remote(r): r for r in runs}
+    while refs:
+        done, _ = ray.wait(list(refs), num_returns=1)
+        for ref in done:
+            run = refs.pop(ref)
+            try:
+                yield run.index, ray.get(ref)
+            except Exception as exc:   # worker crash / lost node
+                yield run.index, _failed(run, exc)
