@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -194,3 +195,46 @@ def test_vector_envs_step_in_lockstep_with_single_envs(vector_cls):
             o, r, *_ = env.step(a[i])
             assert r == vrew[i]
             assert all(o[k].tobytes() == vobs[k][i].tobytes() for k in o)
+
+
+def two_robot_room() -> wm.World:
+    w = room().model_dump(mode="json", exclude_none=True)
+    other = json.loads(json.dumps(w["robots"][0]))
+    other.update(name="bot2", pose={"translation": [0.0, 0.5, 0.05], "rotation": [0, 0, 1, math.pi]})
+    w["robots"].append(other)
+    return wm.World.model_validate(w)
+
+
+def test_pettingzoo_parallel_env_passes_the_api_test_and_moves_each_robot_exactly():
+    pytest.importorskip("pettingzoo")
+    from pettingzoo.test import parallel_api_test
+
+    from sensorium.gym import SensoriumParallelEnv
+
+    tasks = {"bot": Task(observations=[], max_steps=30), "bot2": Task(observations=[], max_steps=20)}
+    env = SensoriumParallelEnv(two_robot_room(), tasks)
+    parallel_api_test(env, num_cycles=40)
+    obs, infos = env.reset(seed=4)
+    assert env.agents == ["bot", "bot2"]
+    step_m = 3.0 * 0.0205 * 0.032
+    for _ in range(20):
+        obs, rewards, terms, truncs, infos = env.step({"bot": np.array([3.0, 3.0], np.float32),
+                                                       "bot2": np.array([-3.0, -3.0], np.float32)})
+    # bot drives +x; bot2 faces -x and reverses, so it also moves +x
+    assert infos["bot"]["pose"][0] == pytest.approx(20 * step_m, abs=1e-12)
+    assert infos["bot2"]["pose"][0] == pytest.approx(20 * step_m, abs=1e-12)
+    assert truncs["bot2"] and not truncs["bot"] and env.agents == ["bot"]
+    obs, rewards, terms, truncs, infos = env.step({"bot": np.array([3.0, 3.0], np.float32)})
+    assert env.sim.robot("bot2").pose.translation[0] == pytest.approx(20 * step_m, abs=1e-12)   # stopped
+    assert infos["bot"]["pose"][0] == pytest.approx(21 * step_m, abs=1e-12)
+
+
+def test_example_loop_reports_steps_per_second_and_is_deterministic():
+    from sensorium.gym.examples.random_policy import run
+
+    single = run("sensorium/ReachLight-v0", 0, 6, policy="scripted")
+    sync = run("sensorium/ReachLight-v0", 1, 6, "sync", policy="scripted")
+    assert single["env_steps"] == 6 and single["env_steps_per_s"] > 0
+    assert sync["mean_reward"] == single["mean_reward"]       # same seed, same policy, same episode
+    two = run("sensorium/ReachLight-v0", 2, 3, "sync", policy="random")
+    assert two["env_steps"] == 6

@@ -8,6 +8,7 @@
 Registered ids (all on the embedded arena world): ``sensorium/ReachLight-v0`` (e-puck, light and
 infra-red sensors, drive to the lamp), ``sensorium/AvoidObstacles-v0`` (e-puck, infra-red sensors,
 explore without contact), ``sensorium/LidarAvoid-v0`` (scout, 360-ray lidar + sonars).
+``SensoriumParallelEnv`` (PettingZoo) runs several robots of one world as agents.
 """
 
 from __future__ import annotations
@@ -18,8 +19,18 @@ from sensorium.gym.env import SensoriumEnv
 from sensorium.gym.task import AvoidObstacles, ReachLight, Task, clearance, never, random_start
 from sensorium.gym.tasks import avoid_obstacles, lidar_avoid, reach_light
 
-__all__ = ["SensoriumEnv", "Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start",
+__all__ = ["SensoriumEnv", "SensoriumParallelEnv", "Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start",
            "reach_light", "avoid_obstacles", "lidar_avoid"]
+
+
+
+def __getattr__(name: str):
+    if name == "SensoriumParallelEnv":      # needs pettingzoo (the [gym] extra); imported on first use
+        from sensorium.gym.multi import SensoriumParallelEnv
+
+        return SensoriumParallelEnv
+    raise AttributeError(f"module 'sensorium.gym' has no attribute {name!r}")
+
 
 for _id, _fn in (("sensorium/ReachLight-v0", "reach_light"),
                          ("sensorium/AvoidObstacles-v0", "avoid_obstacles"),
