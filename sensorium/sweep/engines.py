@@ -14,12 +14,13 @@ import multiprocessing
 import os
 from collections.abc import Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 from sensorium.sweep.run import run_one
 from sensorium.sweep.spec import RunSpec
 
-__all__ = ["ENGINES", "available", "local_pool", "ray_tasks", "init_ray", "default_workers"]
+__all__ = ["ENGINES", "available", "local_pool", "shutdown_pools", "ray_tasks", "init_ray", "default_workers"]
 
 ENGINES = ("auto", "local", "ray")
 
@@ -48,12 +49,36 @@ def _failed(run: RunSpec, exc: BaseException) -> dict:
             "recording": run.recording or ""}
 
 
+_POOLS: dict[int, ProcessPoolExecutor] = {}
+
+
+def _pool(workers: int) -> ProcessPoolExecutor:
+    """A spawned pool of ``workers`` processes, kept for the next sweep of this process (like a
+    Ray session keeps its workers); ``shutdown_pools()`` ends them (also done at exit)."""
+    pool = _POOLS.get(workers)
+    if pool is None:
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+        _POOLS[workers] = pool
+    return pool
+
+
+def shutdown_pools() -> None:
+    while _POOLS:
+        _, pool = _POOLS.popitem()
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
 def local_pool(runs: Sequence[RunSpec], workers: int | None = None) -> Iterator[tuple[int, dict]]:
-    """Runs on a pool of ``workers`` fresh processes (spawned: nothing inherited but the runs)."""
-    workers = max(1, min(workers or default_workers(), len(runs) or 1))
-    ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+    """Runs on a pool of ``workers`` spawned processes (nothing inherited but the runs)."""
+    workers = max(1, workers or default_workers())
+    pool = _pool(workers)
+    try:
         pending = {pool.submit(run_one, r): r for r in runs}
+    except BrokenProcessPool:
+        _POOLS.pop(workers, None)
+        pool = _pool(workers)
+        pending = {pool.submit(run_one, r): r for r in runs}
+    try:
         while pending:
             done, _ = wait(pending, return_when=FIRST_COMPLETED)
             for fut in done:
@@ -61,7 +86,12 @@ def local_pool(runs: Sequence[RunSpec], workers: int | None = None) -> Iterator[
                 try:
                     yield run.index, fut.result()
                 except Exception as exc:   # a crashed worker (e.g. killed): that run's row says so
+                    if isinstance(exc, BrokenProcessPool):
+                        _POOLS.pop(workers, None)
                     yield run.index, _failed(run, exc)
+    finally:
+        for fut in pending:
+            fut.cancel()
 
 
 def init_ray(address: str | None = None, workers: int | None = None, **kwargs: Any):

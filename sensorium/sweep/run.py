@@ -27,13 +27,40 @@ __all__ = ["run_one", "build_world", "fixed_columns"]
 fixed_columns = ["run", "world", "seed", "controller"]
 
 
+_LOADED: dict[tuple, Any] = {}
+
+
+def _load(path: Path):
+    """``load_world`` once per file version and worker process: a sweep runs the same few worlds
+    many times, and parsing + validating a file costs more than building its simulation."""
+    from sensorium.server.world.loader import WorldError, load_world
+
+    try:
+        st = path.stat()
+    except OSError:
+        return load_world(path)       # raises the loader's own error
+    key = (str(path.resolve()), st.st_mtime_ns, st.st_size)
+    hit = _LOADED.get(key)
+    if hit is None:
+        try:
+            hit = load_world(path)
+        except WorldError as exc:
+            hit = exc
+        if len(_LOADED) >= 64:
+            _LOADED.clear()
+        _LOADED[key] = hit
+    if isinstance(hit, Exception):
+        raise hit
+    return hit
+
+
 def build_world(world: str, seed: int, parameters) -> tuple[Any, bytes, str]:
     """(LoadedWorld, world text to attach, world name) for one run: the file with the parameters
     set and ``world_info.random_seed = seed``."""
-    from sensorium.server.world.loader import default_world_path, load_world, parse_world
+    from sensorium.server.world.loader import default_world_path, parse_world
 
     path = default_world_path() if world == "default" else Path(world)
-    base = load_world(path)
+    base = _load(path)
     if not parameters:
         w = base.world.model_copy(update={"world_info": base.world.world_info.model_copy(update={"random_seed": seed})})
         return type(base)(world=w, source=base.source, base_dir=base.base_dir, text=base.text), base.text, path.name

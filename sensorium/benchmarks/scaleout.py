@@ -1,0 +1,141 @@
+"""Scale-out: Gymnasium environment steps/s for 1, 2, 4, 8 vectorised environments (sync vs async),
+sweep throughput (simulated seconds per wall second) on the local process pool vs Ray with the same
+CPUs, and what each engine costs per run and per sweep.
+
+Needs the ``[gym]`` and ``[ray]`` extras; a part whose library is missing is reported as skipped.
+Ray is started bound to 127.0.0.1 with ``num_cpus`` = this machine's CPUs and shut down afterwards.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+
+from .common import Config, Plot, Section, Series, Table
+
+ENV_ID = "sensorium/ReachLight-v0"
+
+
+def _gym_part(cfg: Config, sec: Section) -> None:
+    try:
+        from sensorium.gym.examples.random_policy import run
+    except ImportError as exc:
+        sec.findings.append(f"Gymnasium part skipped: {exc} (pip install 'sensorium[gym]').")
+        return
+    steps = cfg.pick(200, 20)
+    sizes = [1, 2, 4, 8]
+    single = run(ENV_ID, 0, steps, policy="random")
+    rows = [["single (no vector env)", 1, f"{single['env_steps_per_s']:.0f}", "-"]]
+    series: dict[str, list[float]] = {"sync": [], "async": []}
+    for n in sizes:
+        for mode in ("sync", "async"):
+            r = run(ENV_ID, n, max(steps // n, 5), mode, "random")
+            series[mode].append(r["env_steps_per_s"])
+            cfg.log(f"  scaleout: {mode} x{n}: {r['env_steps_per_s']:.0f} env steps/s")
+            rows.append([mode, n, f"{r['env_steps_per_s']:.0f}", f"{r['env_steps_per_s'] / single['env_steps_per_s']:.2f}"])
+    sec.tables.append(Table("vector_envs", f"Environment steps/s, {ENV_ID} (random actions; one env step = 64 ms "
+                            "simulated = 2 basic steps, 10 devices)", ["vector env", "envs", "env steps/s", "vs single"],
+                            rows, notes=[f"{steps} env steps per single-env measurement, about as many per vector "
+                                         "size; async = one subprocess per environment."]))
+    sec.plots.append(Plot("vector_envs", "Env steps/s vs vectorised environments", "environments", "env steps/s",
+                          [Series(k, [float(n) for n in sizes], v) for k, v in series.items()], logx=True, logy=False))
+    sec.data["single_env_steps_per_s"] = single["env_steps_per_s"]
+    sec.data["vector"] = {k: dict(zip(sizes, v)) for k, v in series.items()}
+    best = max(max(v) for v in series.values())
+    sec.findings.append(f"Gymnasium: {single['env_steps_per_s']:.0f} env steps/s for one {ENV_ID} environment; "
+                        f"the best vectorised setting reached {best:.0f} env steps/s "
+                        f"({best / single['env_steps_per_s']:.1f}x) on {_cpus()} CPUs.")
+
+
+def _cpus() -> int:
+    from sensorium.sweep.engines import default_workers
+
+    return default_workers()
+
+
+def _sweep_part(cfg: Config, sec: Section) -> None:
+    from sensorium.sweep import run_sweep
+    from sensorium.sweep.engines import available, init_ray
+    from sensorium.sweep.run import run_one
+    from sensorium.sweep.spec import RunSpec
+
+    workers = _cpus()
+    duration = cfg.pick(2000, 320)
+    runs = cfg.pick(4, 2) * workers
+    heavy = {"worlds": ["default"], "seeds": {"start": 0, "count": runs}, "duration_ms": duration,
+             "controllers": ["circle"]}
+    tiny_n = cfg.pick(8, 4) * workers
+    tiny = {"worlds": ["default"], "seeds": {"start": 0, "count": tiny_n}, "duration_ms": 32, "controllers": ["idle"],
+            "record": False}
+    # the floor: one tiny run in this process (imports already done by a first call)
+    run_one(RunSpec(0, "default", 0, (), "idle", 32, None))
+    t0 = time.perf_counter()
+    for i in range(5):
+        run_one(RunSpec(i, "default", i, (), "idle", 32, None))
+    in_process = (time.perf_counter() - t0) / 5
+    engines = ["local"] + (["ray"] if available("ray") else [])
+    rows = []
+    started_ray = False
+    results: dict[str, dict] = {}
+    try:
+        for engine in engines:
+            extra = 0.0
+            if engine == "ray":
+                import ray
+
+                started_ray = not ray.is_initialized()
+                t0 = time.perf_counter()
+                init_ray(None, workers)
+                extra = time.perf_counter() - t0
+            with tempfile.TemporaryDirectory() as tmp:
+                first = run_sweep(tiny, None, engine=engine, workers=workers, progress=False)   # starts workers
+                again = run_sweep(tiny, None, engine=engine, workers=workers, progress=False)
+                big = run_sweep(heavy, Path(tmp) / "out", engine=engine, workers=workers, progress=False,
+                                formats=("csv",))
+            bad = [r for r in (*first.rows, *again.rows, *big.rows) if r["status"] != "ok"]
+            if bad:
+                raise RuntimeError(f"{engine}: run failed: {bad[0]['error']}")
+            per_run = again.wall_s * workers / tiny_n
+            thr = big.sim_time_s / big.wall_s
+            results[engine] = {"startup_s": extra + first.wall_s, "tiny_sweep_s": again.wall_s, "per_run_s": per_run,
+                               "throughput": thr, "big_wall_s": big.wall_s, "sim_s": big.sim_time_s}
+            cfg.log(f"  scaleout: {engine}: {thr:.2f} simulated s / wall s, {per_run * 1000:.0f} ms per run")
+            rows.append([engine, workers, f"{extra + first.wall_s:.1f}", f"{again.wall_s:.2f}",
+                         f"{per_run * 1000:.0f}", f"{big.wall_s:.1f}", f"{thr:.2f}"])
+    finally:
+        from sensorium.sweep.engines import shutdown_pools
+
+        shutdown_pools()
+        if started_ray:
+            import ray
+
+            ray.shutdown()
+    sec.tables.append(Table("sweep_engines", "Sweep engines on this machine", [
+        "engine", "workers", "first sweep incl. startup (s)", f"{tiny_n} one-step runs (s)",
+        "cost per run (ms CPU)", f"{runs} x {duration / 1000:g} s arena runs (s)", "simulated s per wall s"], rows, notes=[
+        f"One-step runs: the arena world, 32 ms, no recording; cost per run = wall x workers / runs. The same run "
+        f"in this process takes {in_process * 1000:.0f} ms: the rest is the engine's per-run overhead.",
+        "Arena runs: both robots driving circles, every topic recorded to MCAP (all devices measured every step).",
+        "Both engines keep their workers between sweeps of one Python process: the first column is paid once "
+        "(`sensorium sweep` pays it on every command).",
+    ]))
+    sec.data["sweep"] = results
+    sec.data["in_process_run_s"] = in_process
+    if "ray" in results:
+        lo, ra = results["local"], results["ray"]
+        sec.findings.append(
+            f"Sweeps: {lo['throughput']:.2f} (pool) vs {ra['throughput']:.2f} (Ray) simulated s per wall s on "
+            f"{workers} CPUs; per-run cost {lo['per_run_s'] * 1000:.0f} ms (pool) vs {ra['per_run_s'] * 1000:.0f} ms (Ray) "
+            f"against {in_process * 1000:.0f} ms in-process; first sweep incl. startup {lo['startup_s']:.1f} s (pool) vs "
+            f"{ra['startup_s']:.1f} s (Ray).")
+
+
+def run(cfg: Config) -> Section:
+    sec = Section("scaleout", "Scale-out: vectorised Gymnasium environments and sweeps on Ray", intro=(
+        "How many environment steps per second Gymnasium's vector environments get out of this machine, and "
+        "what running many simulations costs on the local process pool and on Ray with the same CPUs "
+        "(`sensorium sweep`). Reproduce: `sensorium bench --only scaleout`."))
+    _gym_part(cfg, sec)
+    _sweep_part(cfg, sec)
+    return sec
