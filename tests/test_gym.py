@@ -238,3 +238,15 @@ def test_example_loop_reports_steps_per_second_and_is_deterministic():
     assert sync["mean_reward"] == single["mean_reward"]       # same seed, same policy, same episode
     two = run("sensorium/ReachLight-v0", 2, 3, "sync", policy="random")
     assert two["env_steps"] == 6
+
+
+def test_wheel_encoders_are_observed_and_leds_are_not():
+    devices = [{"device": "PositionSensor", "name": "enc", "motor": "left wheel motor"},
+               {"device": "LED", "name": "led"}]
+    env = SensoriumEnv(room(devices=devices), Task(control_period_ms=32))
+    assert list(env.observation_space.spaces) == ["enc"]
+    env.reset(seed=0)
+    obs, *_ = env.step(np.array([2.0, 2.0], dtype=np.float32))
+    assert obs["enc"][0] == np.float32(2.0 * 0.032)              # rad turned by the left wheel in one step
+    with pytest.raises(ValueError, match="not a sensor"):
+        SensoriumEnv(room(devices=devices), Task(observations=["led"]))

@@ -4,11 +4,11 @@
     obs, info = env.reset(seed=1)
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
 
-Observation: a ``Dict`` with one ``Box`` per observed device. A light or distance sensor is a
-float32 ``(1,)`` box bounded by its lookup table's output column (values are clipped into it:
+Observation: a ``Dict`` with one ``Box`` per observed sensor (LEDs are not observations). A light
+or distance sensor is a float32 ``(1,)`` box bounded by its lookup table's output column (values are clipped into it:
 relative lookup noise is Gaussian and could leave it); a lidar is its float32 ``(layers,
 width)`` range image bounded by ``[0, max_range]``, with "no hit" (``inf`` in Webots) given as
-``max_range``. Action: float32 ``(2,)`` = left, right wheel velocity (rad/s), bounded by the
+``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians. Action: float32 ``(2,)`` = left, right wheel velocity (rad/s), bounded by the
 drive's max wheel speed. One action lasts ``control_period_ms``.
 
 ``reset(seed=s)`` rebuilds the simulation from the world model with world seed drawn from the
@@ -74,7 +74,8 @@ class Agent:
             raise ValueError(f"task control_period_ms={ctrl} must be a positive multiple of the world's "
                              f"basic_time_step ({basic} ms)")
         self.control_period_ms = int(ctrl)
-        devices = {d.name: d for d in model.devices}
+        devices = {d.name: d for d in model.devices if d.device in OBSERVABLE}
+        actuators = {d.name for d in model.devices if d.device not in OBSERVABLE}
         obs = task.observations
         if obs is None:
             periods = {n: self.control_period_ms for n in devices}
@@ -83,9 +84,11 @@ class Agent:
         else:
             periods = {str(n): self.control_period_ms for n in obs}
         for n, p in periods.items():
+            if n in actuators:
+                raise ValueError(f"task observation {n!r}: robot {name!r}'s {n} is not a sensor")
             if n not in devices:
                 raise ValueError(f"task observation {n!r}: robot {name!r} has no such device "
-                                 f"(devices: {', '.join(devices) or 'none'})")
+                                 f"(sensors: {', '.join(devices) or 'none'})")
             if p <= 0:
                 raise ValueError(f"task observation {n!r}: sampling period must be > 0 ms, got {p}")
         self.periods = periods
@@ -131,7 +134,7 @@ class Agent:
                 img = np.nan_to_num(dev.range_image, nan=box.high.flat[0], posinf=box.high.flat[0])
                 out[n] = np.clip(img, box.low, box.high).astype(np.float32)
             else:
-                v = dev.value if math.isfinite(dev.value) else box.low[0]
+                v = dev.value if math.isfinite(dev.value) else (box.low[0] if np.isfinite(box.low[0]) else 0.0)
                 out[n] = np.clip(np.array([v], dtype=np.float32), box.low, box.high)
         return out
 
@@ -149,7 +152,12 @@ class Agent:
                 "pose": np.array([pose.translation[0], pose.translation[1], math.atan2(fwd[1], fwd[0])])}
 
 
+OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
+
+
 def _space(cfg) -> spaces.Box:
+    if cfg.device == "PositionSensor":          # a wheel angle (rad): unbounded
+        return spaces.Box(-np.inf, np.inf, shape=(1,), dtype=np.float32)
     if cfg.device == "Lidar":
         return spaces.Box(0.0, np.float32(cfg.max_range), shape=(cfg.number_of_layers, cfg.horizontal_resolution),
                           dtype=np.float32)

@@ -13,9 +13,9 @@ import math
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.world.geometry import Plane, tessellate
 from sensorium.server.world.poses import pose_from_model
-from sensorium.server.world.scene import primitive_from_model
 
 BACKGROUND = (40, 40, 46)
 
