@@ -146,7 +146,15 @@ def run_sweep(spec: SweepSpec | Mapping | str | Path, output: str | Path | None 
     bar = _progress(len(runs), progress)
     t0 = time.perf_counter()
     rows: dict[int, dict] = {}
-    source = ray_tasks(runs, workers, address, **(ray_init or {})) if engine == "ray" else local_pool(runs, workers)
+    if engine == "ray":
+        from sensorium.sweep.engines import init_ray
+
+        ray = init_ray(address, workers, **(ray_init or {}))
+        if address:                     # a cluster: report its CPUs, not this machine's
+            workers = int(ray.cluster_resources().get("CPU", workers))
+        source = ray_tasks(runs, workers, address)
+    else:
+        source = local_pool(runs, workers)
     failed = 0
     try:
         for index, row in source:
