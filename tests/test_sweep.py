@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from sensorium.server.recording.mcapfile import Recording
+from sensorium.server.recording.reader import Recording
 from sensorium.sweep import SpecError, parse_spec, run_sweep
 from sensorium.sweep.run import build_world, run_one
 from sensorium.sweep.spec import RunSpec, parse_path, set_path

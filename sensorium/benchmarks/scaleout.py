@@ -12,7 +12,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from .common import Config, Plot, Section, Series, Table, median
+from .common import Config, Plot, Section, Series, Table, interleaved, median, pct
 
 ENV_ID = "sensorium/ReachLight-v0"
 
@@ -40,6 +40,25 @@ def _gym_part(cfg: Config, sec: Section) -> None:
                                          "size; async = one subprocess per environment."]))
     sec.plots.append(Plot("vector_envs", "Env steps/s vs vectorised environments", "environments", "env steps/s",
                           [Series(k, [float(n) for n in sizes], v) for k, v in series.items()], logx=True, logy=False))
+    # what the Gymnasium wrapper adds to the simulation it steps (alternated, same machine load)
+    import numpy as np
+
+    from sensorium.gym.tasks import reach_light
+
+    env = reach_light()
+    env.reset(seed=0)
+    act = np.array([3.0, 3.0], dtype=np.float32)
+    times = interleaved({"env": lambda: env.step(act), "sim": lambda: env.sim.run(env.steps_per_action)},
+                        rounds=cfg.pick(200, 20))
+    env_ms, sim_ms = median(times["env"]) * 1e3, median(times["sim"]) * 1e3
+    env_q, sim_q = pct(times["env"], 25) * 1e3, pct(times["sim"], 25) * 1e3
+    sec.tables.append(Table("wrapper", "Gymnasium wrapper overhead per env step", ["", "median (ms)", "25th pct (ms)"], [
+        ["env.step (action, 2 basic steps, observation, reward, termination)", f"{env_ms:.2f}", f"{env_q:.2f}"],
+        ["sim.run(2) alone", f"{sim_ms:.2f}", f"{sim_q:.2f}"],
+        ["wrapper overhead", f"{env_ms - sim_ms:+.2f}", f"{env_q - sim_q:+.2f}"]],
+        notes=["Driving straight from the world pose; both timed in alternation. On a loaded machine the 25th "
+               "percentile is closer to the undisturbed cost than the median."]))
+    sec.data["wrapper_ms"] = {"env_step": env_ms, "sim_run": sim_ms, "env_step_p25": env_q, "sim_run_p25": sim_q}
     sec.data["single_env_steps_per_s"] = single["env_steps_per_s"]
     sec.data["vector"] = {k: dict(zip(sizes, v)) for k, v in series.items()}
     best = max(max(v) for v in series.values())

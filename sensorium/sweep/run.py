@@ -121,7 +121,7 @@ def run_one(run: RunSpec) -> dict:
 
 def _simulate(run: RunSpec, row: dict) -> None:
     from sensorium.server.daemon.topics import Topics
-    from sensorium.server.recording.mcapfile import McapRecorder
+    from sensorium.server.recording.writer import McapRecorder
     from sensorium.server.sim.sensors import Lidar
     from sensorium.server.sim.simulation import Simulation
     from sensorium.sweep.controllers import resolve
