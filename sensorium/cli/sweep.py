@@ -29,9 +29,6 @@ def main(args: argparse.Namespace) -> int:
     except SpecError as exc:
         print(f"sensorium sweep: {exc}", file=sys.stderr)
         return 2
-    except ConnectionError as exc:     # Ray address unreachable
-        print(f"sensorium sweep: cannot reach the Ray cluster {args.address!r}: {exc}".splitlines()[0], file=sys.stderr)
-        return 2
     failed = result.failed
     summary = {"runs": len(result.rows), "failed": len(failed), "engine": result.engine, "workers": result.workers,
                "wall_s": round(result.wall_s, 3), "simulated_s": result.sim_time_s,

@@ -149,7 +149,12 @@ def run_sweep(spec: SweepSpec | Mapping | str | Path, output: str | Path | None 
     if engine == "ray":
         from sensorium.sweep.engines import init_ray
 
-        ray = init_ray(address, workers, **(ray_init or {}))
+        try:
+            ray = init_ray(address, workers, **(ray_init or {}))
+        except Exception as exc:         # unreachable cluster, bad options, Ray failing to start
+            where = f"join the Ray cluster at {address!r}" if address else "start a local Ray"
+            first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+            raise SpecError(f"cannot {where}: {type(exc).__name__}: {first}") from None
         if address:                     # a cluster: report its CPUs, not this machine's
             workers = int(ray.cluster_resources().get("CPU", workers))
         source = ray_tasks(runs, workers, address)
