@@ -185,3 +185,15 @@ def test_cli_sweep_exit_codes_and_no_silent_overwrite(tmp_path):
     spec.write_text("seeds: [-1]\n")
     p = subprocess.run(cmd + ["--overwrite"], capture_output=True, text=True, env=env, timeout=300)
     assert p.returncode == 2 and p.stderr.count("\n") == 1 and "seeds" in p.stderr
+
+
+def test_cli_unreachable_ray_cluster_is_one_line_not_a_hang(tmp_path):
+    spec = tmp_path / "spec.yaml"
+    spec.write_text("seeds: [0]\nduration_ms: 32\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).resolve().parents[1]),
+                                                        os.environ.get("PYTHONPATH", "")])}
+    p = subprocess.run([sys.executable, "-m", "sensorium", "sweep", str(spec), "--out", str(tmp_path / "o"),
+                        "--engine", "ray", "--address", "127.0.0.1:1"], capture_output=True, text=True, env=env,
+                       timeout=120)
+    assert p.returncode == 2
+    assert p.stderr.strip().count("\n") == 0 and "cannot join the Ray cluster at '127.0.0.1:1'" in p.stderr

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import socket
 from collections.abc import Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -94,6 +95,19 @@ def local_pool(runs: Sequence[RunSpec], workers: int | None = None) -> Iterator[
             fut.cancel()
 
 
+def _reachable(address: str, timeout: float = 5.0) -> None:
+    """Fail fast on a ``host:port`` / ``ray://host:port`` nobody listens on (Ray itself retries
+    for minutes). ``auto`` and other forms are left to Ray."""
+    hostport = address[len("ray://"):] if address.startswith("ray://") else address
+    host, sep, port = hostport.rpartition(":")
+    if not sep or not port.isdigit() or not host:
+        return
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout).close()
+    except OSError as exc:
+        raise ConnectionError(f"nothing answers at {address} ({exc.strerror or exc})") from None
+
+
 def init_ray(address: str | None = None, workers: int | None = None, **kwargs: Any):
     """Connect to Ray: reuse an initialised session, join ``address``, or start a local one bound
     to 127.0.0.1. Returns the ``ray`` module."""
@@ -102,6 +116,7 @@ def init_ray(address: str | None = None, workers: int | None = None, **kwargs: A
     if ray.is_initialized():
         return ray
     if address:
+        _reachable(address)
         ray.init(address=address, log_to_driver=False, **kwargs)
     else:
         opts: dict[str, Any] = dict(num_cpus=workers or default_workers(), include_dashboard=False,
