@@ -251,3 +251,27 @@ def test_wheel_encoders_are_observed_and_leds_are_not():
     assert obs["enc"][0] == np.float32(2.0 * 0.032)              # rad turned by the left wheel in one step
     with pytest.raises(ValueError, match="not a sensor"):
         SensoriumEnv(room(devices=devices), Task(observations=["led"]))
+
+
+def test_nested_solids_attached_lights_and_multi_shape_bodies_are_rendered_and_targeted():
+    w = room().model_dump(mode="json", exclude_none=True)
+    w["lights"] = []
+    w["solids"].append({"name": "post", "pose": {"translation": [-0.5, 0.5, 0.0], "rotation": [0, 0, 1, math.pi / 2]},
+                        "children": [{"name": "cap", "pose": {"translation": [0.2, 0.0, 0.1]},
+                                      "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]},
+                                      "appearance": {"base_color": [1.0, 0.0, 1.0]}}],
+                        "lights": [{"type": "PointLight", "name": "beacon", "location": [0.4, 0.0, 0.1]}]})
+    w["robots"][0]["shapes"] = [{"name": "mast", "pose": {"translation": [-0.1, 0.0, 0.0]},
+                                 "geometry": {"type": "box", "size": [0.04, 0.04, 0.04]},
+                                 "appearance": {"base_color": [0.0, 0.0, 1.0]}}]
+    goal = ReachLight("beacon")
+    env = SensoriumEnv(wm.World.model_validate(w), Task(observations=[], reward=goal), render_mode="rgb_array",
+                       render_size=300)
+    env.reset(seed=0)
+    # the post turns its frame by 90 degrees: its child sits at (-0.5, 0.7), its light at (-0.5, 0.9)
+    np.testing.assert_allclose(goal.target(env.sim), [-0.5, 0.9], atol=1e-12)
+    img = env.render()
+    r = env._renderer
+    for xy, colour in (((-0.5, 0.7), (255, 0, 255)), ((-0.5, 0.9), (255, 230, 40)), ((-0.1, 0.0), (0, 0, 255))):
+        col, row = r._px(np.array([xy]))[0]
+        assert tuple(img[int(row), int(col)]) == colour, xy

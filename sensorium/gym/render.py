@@ -1,6 +1,6 @@
 """Top-down RGB picture of a simulation (``env.render()``): numpy only, no GUI, no OpenGL.
 
-Every shape is drawn as the convex hull of its tessellation projected on the world's xy plane,
+Every shape (of solids, their nested children and multi-shape bodies) is drawn as the convex hull of its tessellation projected on the world's xy plane,
 filled with its ``base_color``, lowest top first (so a tall wall covers the floor); sized planes
 (floors) are drawn first. Robots are drawn on top with a white heading line, lights as yellow
 dots. The view covers the bounding box of everything drawn plus a margin; image row 0 is +y.
@@ -13,8 +13,8 @@ import math
 import numpy as np
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.scene import primitive_from_model
-from sensorium.server.world.geometry import Plane, tessellate
+from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
+from sensorium.server.world.geometry import Plane, Pose, tessellate
 from sensorium.server.world.poses import pose_from_model
 
 BACKGROUND = (40, 40, 46)
@@ -43,7 +43,7 @@ def _hull(points: np.ndarray) -> np.ndarray:
     return np.array(lower[:-1] + upper[:-1])
 
 
-def _color(shape: wm.Shape) -> tuple[int, int, int]:
+def _color(shape: wm.Shape | wm.Solid) -> tuple[int, int, int]:
     c = shape.appearance.base_color if shape.appearance is not None else (1.0, 1.0, 1.0)
     if shape.appearance is not None and shape.appearance.transparency >= 1.0:
         c = (0.6, 0.8, 1.0)   # glass: a pale blue so it stays visible
@@ -51,7 +51,8 @@ def _color(shape: wm.Shape) -> tuple[int, int, int]:
 
 
 class TopDown:
-    """Renders ``sim`` at ``size`` x ``size`` pixels; the static part is drawn once."""
+    """Renders ``sim`` at ``size`` x ``size`` pixels; the solids are drawn once (at their poses when
+    the renderer is made), robots and lights (which may ride on them) at every call."""
 
     def __init__(self, sim, size: int = 256, margin: float = 0.1):
         self.sim = sim
@@ -60,28 +61,32 @@ class TopDown:
         static: list[tuple[float, np.ndarray, tuple[int, int, int]]] = []   # (top z, hull, colour)
         floors: list[tuple[np.ndarray, tuple[int, int, int]]] = []
         for solid in sim.world.solids:
-            prim = primitive_from_model(solid.geometry, base)
-            pose = pose_from_model(solid.pose)
-            if isinstance(prim, Plane):
-                if prim.size is None:
+            frame = sim.scene.solid_poses.get(solid.name) or pose_from_model(solid.pose)
+            for _, local, shape in solid_parts(solid, Pose.identity()):
+                prim = primitive_from_model(shape.geometry, base)
+                pose = frame.compose(local)
+                if isinstance(prim, Plane):
+                    if prim.size is None:
+                        continue
+                    sx, sy = prim.size[0] / 2.0, prim.size[1] / 2.0
+                    corners = pose.apply(np.array([[-sx, -sy, 0], [sx, -sy, 0], [sx, sy, 0], [-sx, sy, 0]], float))
+                    floors.append((corners[:, :2], _color(shape)))
                     continue
-                sx, sy = prim.size[0] / 2.0, prim.size[1] / 2.0
-                corners = pose.apply(np.array([[-sx, -sy, 0], [sx, -sy, 0], [sx, sy, 0], [-sx, sy, 0]], float))
-                floors.append((corners[:, :2], _color(solid)))
-                continue
-            v, _ = tessellate(prim)
-            w = pose.apply(v)
-            static.append((float(w[:, 2].max()), _hull(w[:, :2]), _color(solid)))
+                w = pose.apply(tessellate(prim)[0])
+                static.append((float(w[:, 2].max()), _hull(w[:, :2]), _color(shape)))
         static.sort(key=lambda item: item[0])
-        self._robot_local = []
+        # each robot: its body shapes' vertices in the robot frame, with their colours
+        self._robot_parts: list[list[tuple[np.ndarray, tuple[int, int, int]]]] = []
         for r in sim.world.robots:
-            if r.body is None or isinstance(r.body.geometry, wm.Plane):
-                self._robot_local.append(None)
-            else:
-                self._robot_local.append((tessellate(primitive_from_model(r.body.geometry, base))[0], _color(r.body)))
+            parts = []
+            for _, local, shape in robot_parts(r):
+                prim = primitive_from_model(shape.geometry, base)
+                if not isinstance(prim, Plane):
+                    parts.append((local.apply(tessellate(prim)[0]), _color(shape)))
+            self._robot_parts.append(parts)
         pts = [h for _, h, _ in static] + [f for f, _ in floors]
         pts += [np.asarray(rb.pose.translation[:2])[None, :] for rb in sim.robots.values()]
-        pts += [np.array([lt.location[:2]]) for lt in sim.world.lights if lt.type != "DirectionalLight"]
+        pts += [np.array([lt.location[:2]]) for lt in sim.scene.world_lights() if lt.type != "DirectionalLight"]
         allp = np.concatenate(pts) if pts else np.zeros((1, 2))
         lo, hi = allp.min(axis=0), allp.max(axis=0)
         span = float(max(hi[0] - lo[0], hi[1] - lo[1], 1e-3)) * (1.0 + 2.0 * margin)
@@ -93,9 +98,6 @@ class TopDown:
             self._fill(img, _hull(poly), col)
         for _, poly, col in static:
             self._fill(img, poly, col)
-        for lt in sim.world.lights:
-            if lt.type != "DirectionalLight" and lt.on:
-                self._disc(img, np.asarray(lt.location[:2]), 4, (255, 230, 40))
         self._static = img
 
     # -------------------------------------------------------------------------------- drawing
@@ -136,15 +138,18 @@ class TopDown:
 
     def render(self) -> np.ndarray:
         img = self._static.copy()
-        for rb, local in zip(self.sim.robots.values(), self._robot_local):
+        for lt in self.sim.scene.world_lights():
+            if lt.type != "DirectionalLight" and lt.on:
+                self._disc(img, np.asarray(lt.location[:2]), 4, (255, 230, 40))
+        for rb, parts in zip(self.sim.robots.values(), self._robot_parts):
             pose = rb.pose
-            if local is not None:
-                v, col = local
-                self._fill(img, _hull(pose.apply(v)[:, :2]), col)
-                reach = max(float(np.abs(v[:, :2]).max()), 2.0 / self.scale)
+            reach = 4.0 / self.scale
+            if parts:
+                for v, col in parts:
+                    self._fill(img, _hull(pose.apply(v)[:, :2]), col)
+                reach = max(max(float(np.abs(v[:, :2]).max()) for v, _ in parts), 2.0 / self.scale)
             else:
                 self._disc(img, pose.translation[:2], 3, (200, 200, 200))
-                reach = 4.0 / self.scale
             fwd = pose.rotation[:2, 0]
             norm = math.hypot(*fwd) or 1.0
             self._line(img, pose.translation[:2], pose.translation[:2] + fwd / norm * reach * 1.4, (255, 255, 255))

@@ -83,16 +83,18 @@ def clearance(sim, robot, rays: int = 32, max_distance: float = 1.0) -> float:
     return float(d.min()) if d.size else float(max_distance)
 
 
-def body_radius(robot) -> float:
-    """Horizontal radius of the robot's body (0 without a body): cylinder/sphere/capsule radius, half
-    the diagonal of a box."""
-    body = robot.model.body
-    if body is None:
-        return 0.0
-    g = body.geometry
-    if g.type == "box":
-        return 0.5 * math.hypot(g.size[0], g.size[1])
-    return float(getattr(g, "radius", 0.0))
+def body_radius(robot, base_dir=None) -> float:
+    """Horizontal radius of the disc about the robot's origin that contains its body shapes, as the
+    kinematic contact sees it (0 without a body)."""
+    from pathlib import Path
+
+    from sensorium.server.sim.contact import robot_footprint
+    from sensorium.server.sim.scene import primitive_from_model, robot_parts
+
+    base = Path(base_dir) if base_dir is not None else Path.cwd()
+    parts = [(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(robot.model)]
+    foot = robot_footprint(parts)
+    return float(foot.radius) if foot is not None else 0.0
 
 
 class random_start:
@@ -128,7 +130,7 @@ class ReachLight:
         self._previous = math.inf
 
     def target(self, sim) -> np.ndarray:
-        for lt in sim.world.lights:
+        for lt in sim.scene.world_lights():          # also lights carried by solids and robots, placed
             if lt.type == "DirectionalLight":
                 continue
             if self.light is None or lt.name == self.light:
@@ -170,12 +172,17 @@ class AvoidObstacles:
         self.near = near
         self.contact_distance = contact_distance
         self.contact_penalty = contact_penalty
+        self._radius_key: tuple | None = None
+        self._radius = 0.0
 
     def reset(self, sim, robot) -> None:
-        pass
+        self._radius_key = None
 
     def _gap(self, sim, robot) -> float:
-        r = body_radius(robot)
+        key = (id(sim), robot.index)
+        if self._radius_key != key:
+            self._radius_key, self._radius = key, body_radius(robot, sim.loaded.base_dir)
+        r = self._radius
         return clearance(sim, robot, max_distance=r + max(self.near, self.contact_distance) + 1e-6) - r
 
     def reward(self, sim, robot, obs) -> float:
