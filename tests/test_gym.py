@@ -275,3 +275,14 @@ def test_nested_solids_attached_lights_and_multi_shape_bodies_are_rendered_and_t
     for xy, colour in (((-0.5, 0.7), (255, 0, 255)), ((-0.5, 0.9), (255, 230, 40)), ((-0.1, 0.0), (0, 0, 255))):
         col, row = r._px(np.array([xy]))[0]
         assert tuple(img[int(row), int(col)]) == colour, xy
+
+
+def test_flattened_observations_for_libraries_that_need_one_box():
+    from gymnasium.wrappers import FlattenObservation
+
+    env = FlattenObservation(reach_light())
+    assert env.observation_space.shape == (10,)          # ls0, ls1, ps0..ps7 in key order
+    check_env(env.unwrapped)
+    obs, _ = env.reset(seed=2)
+    raw, _ = env.unwrapped.reset(seed=2)
+    np.testing.assert_array_equal(obs, np.concatenate([raw[k] for k in sorted(raw)]))
