@@ -262,3 +262,58 @@ def test_nested_solid_children_compose_and_move_together() -> None:
     sim.set_solid_pose("base", [1.5, 0.0, 0.0])
     sim.step()
     assert d.value == pytest.approx(1000 * 1.4, abs=1e-9)
+
+
+def test_builtin_protos(tmp_path: Path) -> None:
+    p = write(tmp_path, 'WorldInfo { }\nTexturedBackgroundLight { texture "noon_sunny_empty" luminosity 2 }\n'
+                        'SolidBox { }\nWoodenBox { translation 1 0 0.1 size 0.2 5 0.2 }\nRobot { }\nRobot { }\n')
+    w = load_world(p).world
+    (sun,) = w.lights
+    # the PROTO's NUE direction (0.9, -0.59, 0.28) in ENU axes; ambient 1; luminosity scales the intensity
+    assert (sun.type, sun.direction, sun.intensity, sun.ambient_intensity) == ("DirectionalLight", (0.28, 0.9, -0.59), 2.0, 1.0)
+    box, wooden = w.solids
+    assert box.name == "box" and box.pose.translation == (0.0, 0.0, 1.0)
+    assert box.shapes[0].geometry == wm.Box(type="box", size=(2.0, 2.0, 2.0)) and box.shapes[0].seen_by == "both"
+    assert box.shapes[0].appearance.roughness == 0.5
+    assert wooden.name == "wooden box" and wooden.shapes[0].geometry.size == (0.2, 3.0, 0.2)   # clamped like the PROTO
+    assert [r.name for r in w.robots] == ["robot", "robot(1)"]
+
+
+def test_serve_a_wbt_world(tmp_path: Path) -> None:
+    import os
+    import select
+    import subprocess
+    import sys
+    import time
+
+    import msgpack
+    import zmq
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(HERE / "full.wbt"), "--rpc",
+                             "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:*", "--precision", "fast"],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+    ctx = zmq.Context()
+    try:
+        rpc = None
+        deadline = time.monotonic() + 60
+        while rpc is None and time.monotonic() < deadline and proc.poll() is None:
+            if select.select([proc.stdout], [], [], 0.2)[0]:
+                line = proc.stdout.readline()
+                if line.startswith("sensorium: serving world"):
+                    rpc = dict(f.split("=", 1) for f in line.split() if "=" in f)["rpc"]
+        assert rpc is not None, "server did not start"
+        sock = ctx.socket(zmq.DEALER)
+        sock.setsockopt(zmq.LINGER, 0)
+        sock.connect(rpc)
+        sock.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": "bot"}}))
+        assert sock.poll(30_000)
+        reply = msgpack.unpackb(sock.recv_multipart()[-1], raw=False)
+        assert reply["ok"], reply
+        assert {"ir", "sonar", "lidar", "ls"} <= {d["name"] for d in reply["result"]["devices"]}
+        sock.close(0)
+    finally:
+        proc.terminate()
+        proc.wait(30)
+        proc.stdout.close()
+        ctx.destroy(linger=0)

@@ -29,7 +29,7 @@ from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
 MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 
-SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "TexturedBackgroundLight", "Fog", "Camera",
+SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Camera",
            "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS", "Compass",
            "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger", "Connector", "Radar",
            "Altimeter", "VacuumGripper", "Physics", "ImmersionProperties", "ContactProperties", "Damping",
@@ -102,6 +102,7 @@ class Converter:
         self.count = 0
         self.origin: dict[str, tuple[int, int, str]] = {}     # converted path → (line, col, node type)
         self.solid_names: Counter[str] = Counter()
+        self.robot_names: Counter[str] = Counter()
         self.robot_fields = set(wm.Robot.model_fields)
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
 
@@ -135,6 +136,12 @@ class Converter:
     def unique_name(self, name: str) -> str:
         self.solid_names[name] += 1
         n = self.solid_names[name]
+        return name if n == 1 else f"{name}({n - 1})"
+
+    def unique_robot(self, name: str) -> str:
+        """Robot names address topics and services, so they must differ (Webots only warns)."""
+        self.robot_names[name] += 1
+        n = self.robot_names[name]
         return name if n == 1 else f"{name}({n - 1})"
 
     def world_info(self, node: Node) -> None:
@@ -186,7 +193,8 @@ class Converter:
         elif t in JOINTS:
             self.joint(node, frame, owner)
         elif t in BUILTIN_PROTOS:
-            self.visit(BUILTIN_PROTOS[t](node, self.source), frame, owner, top)
+            system = self.world["world_info"].get("coordinate_system", "ENU")
+            self.visit(BUILTIN_PROTOS[t](node, f, system), frame, owner, top)
         elif t in GEOMETRIES:
             self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
         else:
@@ -330,7 +338,11 @@ class Converter:
     def robot(self, node: Node, frame: Frame) -> None:
         f = self.fields(node)
         inner = self.child_frame(node, frame)
-        data: dict[str, Any] = {"name": f.str("name", "robot"), "pose": inner.pose(),
+        name = f.str("name", "robot")
+        unique = self.unique_robot(name)
+        if unique != name:
+            self.warn(node, f"robot name {name!r} used before: renamed {unique!r}")
+        data: dict[str, Any] = {"name": unique, "pose": inner.pose(),
                                 "synchronization": f.bool("synchronization", True), "devices": []}
         extras = {"controller": f.str("controller", "<extern>"), "supervisor": f.bool("supervisor", False),
                   "custom_data": f.str("customData", ""), "model": f.str("model", "")}
