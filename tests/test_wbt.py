@@ -317,3 +317,12 @@ def test_serve_a_wbt_world(tmp_path: Path) -> None:
         proc.wait(30)
         proc.stdout.close()
         ctx.destroy(linger=0)
+
+
+def test_def_use_expansion_is_bounded(tmp_path: Path) -> None:
+    """Each level USEs the previous one twice: 2**25 boxes if expanded; the converter stops early."""
+    levels = ["DEF L0 Group { children [ Shape { geometry Box { } } ] }"]
+    levels += [f"DEF L{i} Group {{ children [ USE L{i - 1} USE L{i - 1} ] }}" for i in range(1, 26)]
+    p = write(tmp_path, "Solid { children [\n" + "\n".join(levels) + "\n] }\n")
+    with pytest.raises(WorldError, match="more than 200000 shapes, devices and lights after DEF/USE expansion"):
+        load_world(p)

@@ -58,6 +58,7 @@ class Frame:
     def then(self, translation, rotation, scale: float = 1.0) -> Frame:
         r2 = axis_angle_matrix(rotation[:3], rotation[3]) if rotation[3] != 0.0 else np.eye(3)
         t = self.rotation @ (self.scale * np.asarray(translation, dtype=np.float64)) + self.translation
+        aa: tuple[float, ...] | None
         if self.aa is not None and self.aa[3] == 0.0:
             aa = tuple(rotation)
         elif rotation[3] == 0.0:
@@ -149,15 +150,15 @@ class Converter:
         step = f.num("basicTimeStep", 32.0)
         if step != int(step) or step < 1:
             raise f.error("basicTimeStep", f"must be a whole number of milliseconds >= 1 here, got {step}")
-        seed = f.int("randomSeed", 0)
+        seed = f.integer("randomSeed", 0)
         if seed < 0:
             raise f.error("randomSeed", "a negative (time-based) seed is not supported: runs here are reproducible")
-        system = f.str("coordinateSystem", "ENU")
+        system = f.string("coordinateSystem", "ENU")
         if system not in ("ENU", "NUE"):
             raise f.error("coordinateSystem", f"{system!r} is not supported (ENU or NUE)")
         info = {"basic_time_step": int(step), "random_seed": seed, "coordinate_system": system}
-        if f.str("title", ""):
-            info["name"] = f.str("title", "")
+        if f.string("title", ""):
+            info["name"] = f.string("title", "")
         self.world["world_info"] = info
 
     # ------------------------------------------------------------ the walk
@@ -263,13 +264,13 @@ class Converter:
         if t == "Sphere":
             return {"type": "sphere", "radius": f.num("radius", 1.0) * s}
         if t in ("Cylinder", "Capsule"):
-            if not all(f.bool(k, True) for k in ("bottom", "side", "top")):
+            if not all(f.flag(k, True) for k in ("bottom", "side", "top")):
                 self.warn(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
             return {"type": t.lower(), "radius": f.num("radius", 1.0) * s, "height": f.num("height", 2.0) * s}
         if t == "Plane":
             return {"type": "plane", "size": [v * s for v in f.vec("size", (1.0, 1.0))]}
         if t == "Mesh":
-            urls = f.strs("url")
+            urls = f.strings("url")
             if not urls:
                 raise f.error("url", "a Mesh needs a url")
             if "://" in urls[0]:
@@ -311,7 +312,7 @@ class Converter:
             return
         if frame.scale != 1.0:
             raise self.error(node, "a Solid inside a scaled Transform is not supported")
-        name = f.str("name", "solid")
+        name = f.string("name", "solid")
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
@@ -338,14 +339,14 @@ class Converter:
     def robot(self, node: Node, frame: Frame) -> None:
         f = self.fields(node)
         inner = self.child_frame(node, frame)
-        name = f.str("name", "robot")
+        name = f.string("name", "robot")
         unique = self.unique_robot(name)
         if unique != name:
             self.warn(node, f"robot name {name!r} used before: renamed {unique!r}")
         data: dict[str, Any] = {"name": unique, "pose": inner.pose(),
-                                "synchronization": f.bool("synchronization", True), "devices": []}
-        extras = {"controller": f.str("controller", "<extern>"), "supervisor": f.bool("supervisor", False),
-                  "custom_data": f.str("customData", ""), "model": f.str("model", "")}
+                                "synchronization": f.flag("synchronization", True), "devices": []}
+        extras = {"controller": f.string("controller", "<extern>"), "supervisor": f.flag("supervisor", False),
+                  "custom_data": f.string("customData", ""), "model": f.string("model", "")}
         defaults = {"controller": "<extern>", "supervisor": False, "custom_data": "", "model": ""}
         for key, value in extras.items():
             if key in self.robot_fields:
@@ -376,7 +377,7 @@ class Converter:
         if node.type not in self.device_kinds:
             self.warn(node, f"{node.type}: device kind not supported by this version; skipped")
         else:
-            data = {"name": f.str("name", fx.DEVICE_NAMES[node.type]), "pose": inner.pose(), **fx.device(node, f)}
+            data = {"name": f.string("name", fx.DEVICE_NAMES[node.type]), "pose": inner.pose(), **fx.device(node, f)}
             data["_at"] = (node.line, node.col, node.type)
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
@@ -394,7 +395,7 @@ class Converter:
             axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
             anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
             m = self.fields(motors[0])
-            owner.wheels.append({"node": node, "motor": m.str("name", "rotational motor"),
+            owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"),
                                  "max_velocity": m.num("maxVelocity", 10.0),
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                  "end": end, "frame": frame, "sensors": sensors})
@@ -422,7 +423,7 @@ class Converter:
             for w in wheels:
                 for s in w["sensors"]:
                     sf = self.fields(s)
-                    robot.data["devices"].append({"name": sf.str("name", "position sensor"), "device": "PositionSensor",
+                    robot.data["devices"].append({"name": sf.string("name", "position sensor"), "device": "PositionSensor",
                                                   "motor": w["motor"], "noise": sf.num("noise", 0.0),
                                                   "resolution": sf.num("resolution", -1.0),
                                                   "_at": (s.line, s.col, s.type)})

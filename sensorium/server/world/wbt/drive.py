@@ -58,14 +58,14 @@ def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     if abs(mid[0]) > TOL or abs(mid[1]) > TOL:
         return None, (f"the axle midpoint is at x={mid[0]:g}, y={mid[1]:g} in the robot frame, not under the robot's "
                       "origin (the kinematic drive turns about the origin)")
-    radii = [wheel_radius(w["end"], conv) for w in wheels]
-    if radii[0] is None or radii[1] is None:
+    r0, r1 = (wheel_radius(w["end"], conv) for w in wheels)
+    if r0 is None or r1 is None:
         return None, "a wheel end point has no cylinder or sphere to take the wheel radius from"
-    if abs(radii[0] - radii[1]) > TOL * max(radii):
-        return None, f"the wheels have different radii ({radii[0]:g} and {radii[1]:g})"
+    if abs(r0 - r1) > TOL * max(r0, r1):
+        return None, f"the wheels have different radii ({r0:g} and {r1:g})"
     left, right = (wheels[0], wheels[1]) if a0[1] > a1[1] else (wheels[1], wheels[0])
     speeds = {w["max_velocity"] for w in wheels}
     if len(speeds) > 1:
         conv.warn(wheels[0]["node"], f"wheel motors have different maxVelocity {sorted(speeds)}: using the smaller")
-    return {"wheel_radius": radii[0], "axle_length": float(abs(a0[1] - a1[1])), "max_wheel_speed": min(speeds),
+    return {"wheel_radius": r0, "axle_length": float(abs(a0[1] - a1[1])), "max_wheel_speed": min(speeds),
             "left_motor": left["motor"], "right_motor": right["motor"]}, ""

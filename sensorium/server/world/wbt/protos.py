@@ -28,7 +28,7 @@ def _solid(at: Node, f: Fields, name: str, items: list, translation=(0.0, 0.0, 0
         if bound:
             bounding.append(_node("Pose", at, translation=t, children=[geometry]))
     return _node("Solid", at, translation=f.vec("translation", translation),
-                 rotation=f.vec("rotation", (0.0, 0.0, 1.0, 0.0)), name=f.str("name", name),
+                 rotation=f.vec("rotation", (0.0, 0.0, 1.0, 0.0)), name=f.string("name", name),
                  children=visual, boundingObject=_node("Group", at, children=bounding))
 
 
@@ -67,7 +67,7 @@ def solid_box(node: Node, f: Fields, system: str) -> Node:
     size = _positive(f, "size", (2.0, 2.0, 2.0))
     default = _node("PBRAppearance", node, roughness=0.5, metalness=0.0)   # its textured default, untextured
     return _solid(node, f, "box", [((0.0, 0.0, 0.0), _node("Box", node, size=size), _appearance(f, "appearance", default),
-                                    f.bool("enableBoundingObject", True))], translation=(0.0, 0.0, 1.0))
+                                    f.flag("enableBoundingObject", True))], translation=(0.0, 0.0, 1.0))
 
 
 def wooden_box(node: Node, f: Fields, system: str) -> Node:
@@ -102,7 +102,7 @@ _SKY = {
 
 
 def textured_background_light(node: Node, f: Fields, system: str) -> Node:
-    texture = f.str("texture", "mountains")
+    texture = f.string("texture", "mountains")
     if texture not in _SKY:
         raise f.error("texture", f"unknown background {texture!r} (one of {', '.join(sorted(_SKY))})")
     d, colour, intensity, on = _SKY[texture]
