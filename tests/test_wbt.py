@@ -319,10 +319,13 @@ def test_serve_a_wbt_world(tmp_path: Path) -> None:
         ctx.destroy(linger=0)
 
 
-def test_def_use_expansion_is_bounded(tmp_path: Path) -> None:
+def test_def_use_expansion_is_bounded(tmp_path: Path, monkeypatch) -> None:
     """Each level USEs the previous one twice: 2**25 boxes if expanded; the converter stops early."""
+    from sensorium.server.world.wbt import convert
+
+    monkeypatch.setattr(convert, "MAX_PARTS", 2000)
     levels = ["DEF L0 Group { children [ Shape { geometry Box { } } ] }"]
     levels += [f"DEF L{i} Group {{ children [ USE L{i - 1} USE L{i - 1} ] }}" for i in range(1, 26)]
     p = write(tmp_path, "Solid { children [\n" + "\n".join(levels) + "\n] }\n")
-    with pytest.raises(WorldError, match="more than 200000 shapes, devices and lights after DEF/USE expansion"):
+    with pytest.raises(WorldError, match="more than 2000 shapes, devices and lights after DEF/USE expansion"):
         load_world(p)
