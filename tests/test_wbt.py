@@ -329,3 +329,24 @@ def test_def_use_expansion_is_bounded(tmp_path: Path, monkeypatch) -> None:
     p = write(tmp_path, "Solid { children [\n" + "\n".join(levels) + "\n] }\n")
     with pytest.raises(WorldError, match="more than 2000 shapes, devices and lights after DEF/USE expansion"):
         load_world(p)
+
+
+def test_contact_with_multi_shape_bodies() -> None:
+    """A robot whose body is an offset cylinder (radius 0.05) drives +x into a solid made of two
+    shapes; it stops where its disc touches the wall's face: x = 0.95 - 0.05."""
+    w = parse_world({
+        "solids": [{"name": "wall", "pose": {"translation": [1.0, 0.0, 0.0]},
+                    "shapes": [{"pose": {"translation": [0.0, 0.0, 0.1]}, "geometry": {"type": "box", "size": [0.1, 2.0, 0.2]}},
+                               {"pose": {"translation": [0.0, 3.0, 0.1]}, "geometry": {"type": "sphere", "radius": 0.1}}]}],
+        "robots": [{"name": "r", "shapes": [{"pose": {"translation": [0.0, 0.0, 0.05]},
+                                             "geometry": {"type": "cylinder", "radius": 0.05, "height": 0.1}}],
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.1, "max_wheel_speed": 10}}],
+    }).world
+    sim = Simulation(w)
+    r = sim.robot("r")
+    for m in r.motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(10.0)
+    sim.run(100)   # 0.5 m/s for 3.2 s: far past the wall without contact
+    assert r.pose.translation[0] == pytest.approx(0.9, abs=1e-9)
+    assert r.pose.translation[0] < 0.9

@@ -106,20 +106,30 @@ def load_wbt(path: Path) -> LoadedWorld:
         loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
     except WorldError as exc:
         raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
+    placed = []
+    for w in loaded.warnings:   # sanitising warnings start with the converted path: add the .wbt line
+        path, _, message = w.partition(": ")
+        at = _origin_of(path, origin)
+        placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({path}): {message}" if at else w)
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
-                       warnings=[*warnings, *loaded.warnings])
+                       warnings=[*warnings, *placed])
+
+
+def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:
+    """(line, column, node type) of the .wbt node a converted world path came from."""
+    best = ""
+    for key in origin:
+        if len(key) > len(best) and (path == key or path.startswith(key + ".") or path.startswith(key + "[")):
+            best = key
+    return origin[best] if best else None
 
 
 def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem:
     """A problem of the converted world, placed at the .wbt node it came from."""
-    best = ""
-    for key in origin:
-        if len(key) > len(best) and (p.path == key or p.path.startswith(key + ".") or p.path.startswith(key + "[")):
-            best = key
-    if not best:
+    at = _origin_of(p.path, origin)
+    if at is None:
         return p
-    line, col, kind = origin[best]
-    return Problem(f"line {line}, column {col} ({kind}, converted as {p.path})", p.message)
+    return Problem(f"line {at[0]}, column {at[1]} ({at[2]}, converted as {p.path})", p.message)
 
 
 def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"") -> LoadedWorld:
@@ -140,7 +150,7 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
 
 
 _TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "triangles", "mesh", "PointLight", "SpotLight",
-         "DirectionalLight", "LightSensor", "DistanceSensor", "Lidar"}
+         "DirectionalLight", "LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED"}
 
 
 def format_path(loc: tuple[Any, ...]) -> str:
@@ -220,6 +230,13 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
                             f"{dp}.lookup_table[{k}]",
                             f"lookup table inputs must be strictly increasing: input {table[k][0]} "
                             f"follows {table[k - 1][0]}"))
+            if isinstance(dev, wm.PositionSensor):
+                drive = robot.differential_drive
+                motors = (drive.left_motor, drive.right_motor) if drive is not None else ()
+                if dev.motor not in motors:
+                    problems.append(Problem(
+                        f"{dp}.motor", f"{dev.motor!r} is not a wheel motor of this robot's differential_drive "
+                                       f"(motors: {', '.join(repr(m) for m in motors) or 'none: no differential_drive'})"))
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
     return problems
