@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import select
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +21,7 @@ from sensorium.server.world.loader import WorldError, load_world, parse_world
 from sensorium.server.world.wbt.parser import MAX_DEPTH
 
 HERE = Path(__file__).parent / "worlds" / "wbt"
+ROOT = Path(__file__).resolve().parents[1]
 HEADER = "#VRML_SIM R2023b utf8\n"
 
 
@@ -279,21 +286,13 @@ def test_builtin_protos(tmp_path: Path) -> None:
     assert [r.name for r in w.robots] == ["robot", "robot(1)"]
 
 
-def test_serve_a_wbt_world(tmp_path: Path) -> None:
-    import os
-    import select
-    import subprocess
-    import sys
-    import time
-
-    import msgpack
-    import zmq
-
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(HERE / "full.wbt"), "--rpc",
-                             "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:*", "--precision", "fast"],
+@contextlib.contextmanager
+def serving(world: Path, *extra: str):
+    """``sensorium serve WORLD`` in a subprocess on free loopback ports; yields its RPC endpoint."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", "tcp://127.0.0.1:0",
+                             "--pub", "tcp://127.0.0.1:*", "--precision", "fast", *extra],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
-    ctx = zmq.Context()
     try:
         rpc = None
         deadline = time.monotonic() + 60
@@ -303,20 +302,49 @@ def test_serve_a_wbt_world(tmp_path: Path) -> None:
                 if line.startswith("sensorium: serving world"):
                     rpc = dict(f.split("=", 1) for f in line.split() if "=" in f)["rpc"]
         assert rpc is not None, "server did not start"
-        sock = ctx.socket(zmq.DEALER)
-        sock.setsockopt(zmq.LINGER, 0)
-        sock.connect(rpc)
-        sock.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": "bot"}}))
-        assert sock.poll(30_000)
-        reply = msgpack.unpackb(sock.recv_multipart()[-1], raw=False)
-        assert reply["ok"], reply
-        assert {"ir", "sonar", "lidar", "ls"} <= {d["name"] for d in reply["result"]["devices"]}
-        sock.close(0)
+        yield rpc
     finally:
         proc.terminate()
         proc.wait(30)
         proc.stdout.close()
+
+
+def test_serve_a_wbt_world() -> None:
+    import msgpack
+    import zmq
+
+    ctx = zmq.Context()
+    try:
+        with serving(HERE / "full.wbt") as rpc:
+            sock = ctx.socket(zmq.DEALER)
+            sock.setsockopt(zmq.LINGER, 0)
+            sock.connect(rpc)
+            sock.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": "bot"}}))
+            assert sock.poll(30_000)
+            reply = msgpack.unpackb(sock.recv_multipart()[-1], raw=False)
+            assert reply["ok"], reply
+            assert {"ir", "sonar", "lidar", "ls", "led0", "left wheel sensor"} <= {d["name"] for d in reply["result"]["devices"]}
+            sock.close(0)
+    finally:
         ctx.destroy(linger=0)
+
+
+def test_example_wbt_world_runs_the_braitenberg_controller() -> None:
+    """The shipped Webots-style world and the example Webots controller, unchanged."""
+    world = ROOT / "sensorium" / "worlds" / "epuck.wbt"
+    loaded = load_world(world)
+    assert [w for w in loaded.warnings if "skipped nodes" not in w] == []
+    assert loaded.world.robots[0].differential_drive is not None
+    script = ROOT / "sensorium" / "client" / "examples" / "braitenberg.py"
+    with serving(world) as rpc:
+        out = subprocess.run([sys.executable, "-m", "sensorium", "controller", str(script), "--robot", "epuck",
+                              "--url", f"{rpc}/epuck", "60"], capture_output=True, text=True, timeout=300,
+                             env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert out.returncode == 0, out.stderr
+    lines = [x for x in out.stdout.splitlines() if x.startswith("t=")]
+    assert len(lines) == 60
+    light = [float(x.split("ls0=")[1].split()[0]) for x in lines]
+    assert all(v > 0 for v in light[1:]) and len(set(light)) > 5   # it sees the lamp, and it moves
 
 
 def test_def_use_expansion_is_bounded(tmp_path: Path, monkeypatch) -> None:
