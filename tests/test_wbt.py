@@ -378,3 +378,17 @@ def test_contact_with_multi_shape_bodies() -> None:
     sim.run(100)   # 0.5 m/s for 3.2 s: far past the wall without contact
     assert r.pose.translation[0] == pytest.approx(0.9, abs=1e-9)
     assert r.pose.translation[0] < 0.9
+
+
+def test_robot_inside_groups_gets_the_composed_pose(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Pose { translation 1 0 0 rotation 0 0 1 1.5707963267948966 children [\n'
+                        '  Group { children [ Robot { translation 0 2 0 rotation 0 0 1 1.5707963267948966 name "r" } ] } ] }\n'
+                        'Solid { children [ Robot { name "inner" } ] }\n')
+    w = load_world(p)
+    (r,) = w.world.robots
+    from sensorium.server.world.poses import pose_from_model
+
+    pose = pose_from_model(r.pose)
+    assert pose.translation == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)      # (0, 2) turned a quarter, plus (1, 0)
+    assert pose.rotation[:, 0] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)   # two quarter turns: facing -x
+    assert f"{p}:4:20: a Robot inside a Solid or another Robot is not supported: skipped" in w.warnings

@@ -183,8 +183,10 @@ class Converter:
         elif t in LIGHTS:
             self.light(node, frame, owner)
         elif t == "Robot":
-            if owner.kind != "world" or frame.aa is None or frame.scale != 1.0:
-                self.warn(node, "a Robot inside another node is not supported: skipped")
+            if owner.kind != "world":
+                self.warn(node, "a Robot inside a Solid or another Robot is not supported: skipped")
+            elif frame.scale != 1.0:
+                self.warn(node, "a Robot inside a scaled Transform is not supported: skipped")
             else:
                 self.robot(node, frame)
         elif t == "Solid":
