@@ -392,3 +392,13 @@ def test_robot_inside_groups_gets_the_composed_pose(tmp_path: Path) -> None:
     assert pose.translation == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)      # (0, 2) turned a quarter, plus (1, 0)
     assert pose.rotation[:, 0] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)   # two quarter turns: facing -x
     assert f"{p}:4:20: a Robot inside a Solid or another Robot is not supported: skipped" in w.warnings
+
+
+def test_unsimulated_devices_keep_their_shapes(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" children [ Camera { translation 0.1 0 0 children [\n'
+                        '  Shape { geometry Box { size 0.01 0.02 0.03 } } ] } GPS { } ] }\n')
+    w = load_world(p)
+    (part,) = w.world.robots[0].shapes
+    assert part.geometry == wm.Box(type="box", size=(0.01, 0.02, 0.03)) and part.pose.translation == (0.1, 0.0, 0.0)
+    assert part.seen_by == "visual"
+    assert f"{p}: skipped nodes that do not matter to these sensors: Camera, GPS" in w.warnings

@@ -29,11 +29,12 @@ from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
 MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 
-SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Camera",
-           "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS", "Compass",
-           "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger", "Connector", "Radar",
-           "Altimeter", "VacuumGripper", "Physics", "ImmersionProperties", "ContactProperties", "Damping",
-           "Brake", "Muscle", "Propeller", "Track", "Skin", "CadShape", "Radio"}
+SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "ImmersionProperties",
+           "ContactProperties", "Damping", "Brake", "Muscle", "Propeller", "Skin", "CadShape"}
+# devices not simulated here; they are Solids, so their shapes stay part of the robot's body
+OTHER_DEVICES = {"Camera", "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
+                 "Compass", "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger",
+                 "Connector", "Radar", "Altimeter", "VacuumGripper", "Radio", "Track"}
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh"}
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED"}
@@ -171,6 +172,10 @@ class Converter:
             self.world_info(node)
         elif t in SKIPPED:
             self.skipped[t] += 1
+        elif t in OTHER_DEVICES:
+            self.skipped[t] += 1
+            if owner.kind == "robot":
+                self.solid_contents(node, self.child_frame(node, frame), owner)
         elif t == "Group":
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
