@@ -402,3 +402,13 @@ def test_unsimulated_devices_keep_their_shapes(tmp_path: Path) -> None:
     assert part.geometry == wm.Box(type="box", size=(0.01, 0.02, 0.03)) and part.pose.translation == (0.1, 0.0, 0.0)
     assert part.seen_by == "visual"
     assert f"{p}: skipped nodes that do not matter to these sensors: Camera, GPS" in w.warnings
+
+
+def test_named_controllers_become_extern(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" controller "e-puck_avoid_collision" }\n')
+    w = load_world(p)
+    assert w.world.robots[0].name == "r"
+    assert (f"{p}:2:1: Robot 'r': controller 'e-puck_avoid_collision' is not started here; run it with "
+            "`sensorium controller` (the robot is an <extern> robot)") in w.warnings
+    if "controller" in wm.Robot.model_fields:
+        assert w.world.robots[0].controller == "<extern>"

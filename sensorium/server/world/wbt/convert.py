@@ -352,7 +352,12 @@ class Converter:
             self.warn(node, f"robot name {name!r} used before: renamed {unique!r}")
         data: dict[str, Any] = {"name": unique, "pose": inner.pose(),
                                 "synchronization": f.flag("synchronization", True), "devices": []}
-        extras = {"controller": f.string("controller", "<extern>"), "supervisor": f.flag("supervisor", False),
+        controller = f.string("controller", "<extern>")
+        if controller not in ("<extern>", "<none>"):
+            self.warn(node, f"Robot {unique!r}: controller {controller!r} is not started here; run it with "
+                            f"`sensorium controller` (the robot is an <extern> robot)")
+            controller = "<extern>"
+        extras = {"controller": controller, "supervisor": f.flag("supervisor", False),
                   "custom_data": f.string("customData", ""), "model": f.string("model", "")}
         defaults = {"controller": "<extern>", "supervisor": False, "custom_data": "", "model": ""}
         for key, value in extras.items():
