@@ -309,13 +309,15 @@ def serving(world: Path, *extra: str):
         proc.stdout.close()
 
 
-def test_serve_a_wbt_world() -> None:
+def test_serve_a_wbt_world(tmp_path: Path) -> None:
     import msgpack
     import zmq
 
+    from sensorium.server.recording.reader import Recording
+
     ctx = zmq.Context()
     try:
-        with serving(HERE / "full.wbt") as rpc:
+        with serving(HERE / "full.wbt", "--record", str(tmp_path / "run.mcap")) as rpc:
             sock = ctx.socket(zmq.DEALER)
             sock.setsockopt(zmq.LINGER, 0)
             sock.connect(rpc)
@@ -327,6 +329,8 @@ def test_serve_a_wbt_world() -> None:
             sock.close(0)
     finally:
         ctx.destroy(linger=0)
+    with Recording(tmp_path / "run.mcap") as rec:   # the world attached as the user wrote it
+        assert rec.world() == ("full.wbt", (HERE / "full.wbt").read_bytes())
 
 
 def test_example_wbt_world_runs_the_braitenberg_controller() -> None:

@@ -91,8 +91,7 @@ def load_world(path: str | Path) -> LoadedWorld:
 
 def load_wbt(path: Path) -> LoadedWorld:
     """A Webots world, converted (``sensorium.server.world.wbt``); problems point at its lines.
-
-    ``LoadedWorld.text`` is the converted world as YAML (what recordings attach and replays read)."""
+    ``LoadedWorld.text`` is the .wbt file as read (recordings attach it under its own name)."""
     from sensorium.server.world.wbt import WbtSyntaxError, wbt_to_dict
 
     source = str(path)
@@ -101,8 +100,8 @@ def load_wbt(path: Path) -> LoadedWorld:
     except WbtSyntaxError as exc:
         where = f"line {exc.line}, column {exc.col}" if exc.line else ""
         raise WorldError(source, [Problem(where, exc.message)]) from None
-    text = yaml.safe_dump(data, sort_keys=False).encode()
     try:
+        text = path.read_bytes()
         loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
     except WorldError as exc:
         raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None

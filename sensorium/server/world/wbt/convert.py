@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -126,6 +127,7 @@ class Converter:
     # ------------------------------------------------------------ top level
     def run(self) -> dict:
         world = Owner("world", {})
+        self.world["world_info"] = {"name": Path(self.source).stem}
         for node in self.wbt.nodes:
             self.visit(node, Frame.identity(), world, top=True)
         if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
@@ -157,9 +159,8 @@ class Converter:
         system = f.string("coordinateSystem", "ENU")
         if system not in ("ENU", "NUE"):
             raise f.error("coordinateSystem", f"{system!r} is not supported (ENU or NUE)")
-        info = {"basic_time_step": int(step), "random_seed": seed, "coordinate_system": system}
-        if f.string("title", ""):
-            info["name"] = f.string("title", "")
+        info = {"name": f.string("title", "") or Path(self.source).stem, "basic_time_step": int(step),
+                "random_seed": seed, "coordinate_system": system}
         self.world["world_info"] = info
 
     # ------------------------------------------------------------ the walk
