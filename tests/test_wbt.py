@@ -416,3 +416,24 @@ def test_named_controllers_become_extern(tmp_path: Path) -> None:
             "`sensorium controller` (the robot is an <extern> robot)") in w.warnings
     if "controller" in wm.Robot.model_fields:
         assert w.world.robots[0].controller == "<extern>"
+
+
+def test_mesh_and_scale_problems_point_at_lines(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.dae" ] } }\n  ]\n}\n')
+    (tmp_path / "robot.dae").write_text("<COLLADA/>")
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value).startswith(f"{p}: line 4, column 22 (Mesh, converted as solids[0].shapes[0].geometry.url): "
+                                     "unsupported mesh format '.dae'")
+    p = write(tmp_path, 'Transform {\n  scale 1 2 1\n  children [ Shape { geometry Box { } } ]\n}\n')
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value) == f"{p}: line 3, column 3: Transform.scale: only a uniform positive scale is supported, got 1.0 2.0 1.0"
+
+
+def test_scaled_transform_scales_geometry(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid { name "s" children [ Transform { translation 0 0 1 scale 2 2 2 children [\n'
+                        '  Pose { translation 0.5 0 0 children [ Shape { geometry Cylinder { radius 0.1 height 0.3 } } ] } ] } ] }\n')
+    (part,) = load_world(p).world.solids[0].shapes
+    assert part.pose.translation == (1.0, 0.0, 1.0)     # the child's offset is scaled too
+    assert (part.geometry.radius, part.geometry.height) == (0.2, 0.6)
