@@ -361,7 +361,8 @@ class Robot(Strict):
     self_collision: bool = False
     body: Shape | None = None
     shapes: list[Part] = Field(default=[], description="further body shapes, each with its pose in the robot frame")
-    lights: list[Light] = Field(default=[], description="lights carried by the robot (location and a SpotLight's direction in its frame)")
+    lights: list[Light] = Field(
+        default=[], description="lights carried by the robot (location and a SpotLight's direction in its frame)")
     differential_drive: DifferentialDrive | None = None
     devices: list[Device] = []
 
