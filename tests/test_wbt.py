@@ -437,3 +437,13 @@ def test_scaled_transform_scales_geometry(tmp_path: Path) -> None:
     (part,) = load_world(p).world.solids[0].shapes
     assert part.pose.translation == (1.0, 0.0, 1.0)     # the child's offset is scaled too
     assert (part.geometry.radius, part.geometry.height) == (0.2, 0.6)
+
+
+def test_field_typos_are_reported(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid {\n  translaton 1 0 0\n  rotationStep 0.1\n  children [ Shape { geometry Box { sise 1 1 1 } '
+                        'appearance PBRAppearance { basecolor 1 0 0 } } ]\n}\n')
+    w = load_world(p)
+    typos = [x for x in w.warnings if "did you mean" in x]
+    assert typos == [f"{p}:3:3: Solid.translaton: not a Solid field, ignored (did you mean translation?)",
+                     f"{p}:5:37: Box.sise: not a Box field, ignored (did you mean size?)",
+                     f"{p}:5:77: PBRAppearance.basecolor: not a PBRAppearance field, ignored (did you mean baseColor?)"]

@@ -106,6 +106,7 @@ class Converter:
         self.origin: dict[str, tuple[int, int, str]] = {}     # converted path → (line, col, node type)
         self.solid_names: Counter[str] = Counter()
         self.robot_names: Counter[str] = Counter()
+        self.checked: set[int] = set()     # nodes whose field names were checked
         self.robot_fields = set(wm.Robot.model_fields)
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
 
@@ -167,6 +168,7 @@ class Converter:
     def visit(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
         t = node.type
         f = self.fields(node)
+        self.typos(node)
         if t == "WorldInfo":
             if not top:
                 raise self.error(node, "WorldInfo must be a top-level node")
@@ -210,6 +212,15 @@ class Converter:
             self.warn(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
                             f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
 
+    def typos(self, node: Node) -> None:
+        if id(node) in self.checked:
+            return
+        self.checked.add(id(node))
+        for name, meant in fx.field_typos(node):
+            line, col = node.field_pos.get(name, (node.line, node.col))
+            self.warnings.append(f"{self.source}:{line}:{col}: {node.type}.{name}: not a {node.type} field, "
+                                 f"ignored (did you mean {meant}?)")
+
     def child_frame(self, node: Node, frame: Frame) -> Frame:
         f = self.fields(node)
         rotation = f.vec("rotation", (0.0, 0.0, 1.0, 0.0))
@@ -234,6 +245,12 @@ class Converter:
                              "IndexedFaceSet, Mesh): ignored")
             return
         self.tick(gnode)
+        for checked in (node, gnode, f.node_("appearance") if node.type == "Shape" else None):
+            if checked is not None:
+                self.typos(checked)
+                material = checked.fields.get("material") if checked.type == "Appearance" else None
+                if isinstance(material, Node):
+                    self.typos(material)
         geometry = self.geometry(gnode, frame.scale)
         key = (id(gnode), frame.key())
         if seen_by == "bounding" and key in owner.keys:   # the same geometry seen by both kinds of ray
@@ -404,6 +421,8 @@ class Converter:
         sensors = [d for d in f.nodes("device") if d.type == "PositionSensor"]
         if owner.kind == "robot" and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
+            if params is not None:
+                self.typos(params)
             pf = self.fields(params) if params is not None else None
             axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
             anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)

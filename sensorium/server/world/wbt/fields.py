@@ -197,3 +197,66 @@ def appearance(node: Node | None, source: str, warn) -> dict | None:
         return {"base_color": colour, "transparency": m.num("transparency", 0.0)}
     warn(node, f"appearance {node.type}: not built in (a PROTO?); taken as white")
     return None
+
+
+# ---------------------------------------------------------------- typo check
+
+_SOLID = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
+          "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection", "recognitionColors",
+          "translationStep", "rotationStep", "linearVelocity", "angularVelocity"}
+_ROBOT = _SOLID | {"controller", "controllerArgs", "customData", "supervisor", "synchronization", "battery",
+                   "cpuConsumption", "selfCollision", "window", "remoteControl", "showWindow", "data"}
+_ROUND = {"bottom", "height", "radius", "side", "top", "subdivision"}
+_LIGHT = {"ambientIntensity", "color", "intensity", "on", "castShadows"}
+WEBOTS_FIELDS: dict[str, set[str]] = {
+    "Solid": _SOLID, "Robot": _ROBOT,
+    "Pose": {"translation", "rotation", "children", "translationStep", "rotationStep"},
+    "Transform": {"translation", "rotation", "scale", "children", "translationStep", "rotationStep"},
+    "Group": {"children"},
+    "Shape": {"appearance", "geometry", "castShadows", "isPickable"},
+    "Box": {"size"}, "Sphere": {"radius", "subdivision", "ico"}, "Cylinder": _ROUND, "Capsule": _ROUND,
+    "Plane": {"size"}, "Mesh": {"url", "ccw", "name", "materialIndex"},
+    "IndexedFaceSet": {"coord", "normal", "texCoord", "solid", "ccw", "convex", "normalPerVertex", "coordIndex",
+                       "normalIndex", "texCoordIndex", "creaseAngle"},
+    "Appearance": {"material", "texture", "textureTransform", "name"},
+    "Material": {"ambientIntensity", "diffuseColor", "emissiveColor", "shininess", "specularColor", "transparency"},
+    "PBRAppearance": {"baseColor", "baseColorMap", "transparency", "roughness", "roughnessMap", "metalness",
+                      "metalnessMap", "IBLStrength", "normalMap", "normalMapFactor", "occlusionMap",
+                      "occlusionMapStrength", "emissiveColor", "emissiveColorMap", "emissiveIntensity",
+                      "textureTransform", "name"},
+    "PointLight": _LIGHT | {"attenuation", "location", "radius"},
+    "SpotLight": _LIGHT | {"attenuation", "location", "radius", "beamWidth", "cutOffAngle", "direction"},
+    "DirectionalLight": _LIGHT | {"direction"},
+    "DistanceSensor": _SOLID | {"lookupTable", "type", "numberOfRays", "aperture", "gaussianWidth", "resolution",
+                                "redColorSensitivity"},
+    "LightSensor": _SOLID | {"lookupTable", "colorFilter", "occlusion", "resolution"},
+    "Lidar": _SOLID | {"tiltAngle", "horizontalResolution", "fieldOfView", "verticalFieldOfView", "numberOfLayers",
+                       "near", "minRange", "maxRange", "type", "projection", "noise", "resolution",
+                       "defaultFrequency", "minFrequency", "maxFrequency", "rotatingHead"},
+    "LED": _SOLID | {"color", "gradual"},
+    "PositionSensor": {"name", "noise", "resolution"},
+    "RotationalMotor": {"name", "acceleration", "consumptionFactor", "controlPID", "minPosition", "maxPosition",
+                        "maxVelocity", "multiplier", "sound", "muscles", "maxTorque"},
+    "HingeJoint": {"jointParameters", "device", "endPoint"},
+    "HingeJointParameters": {"position", "axis", "anchor", "minStop", "maxStop", "springConstant",
+                             "dampingConstant", "staticFriction", "suspensionSpringConstant",
+                             "suspensionDampingConstant", "suspensionAxis", "stopERP", "stopCFM"},
+    "Coordinate": {"point"},
+}
+
+
+def field_typos(node: Node) -> list[tuple[str, str]]:
+    """(field, likely meant) for each field of a known node type that is not one of its Webots fields
+    but is close to one: hand-edited worlds' typos, which Webots would reject."""
+    import difflib
+
+    known = WEBOTS_FIELDS.get(node.type)
+    if known is None:
+        return []
+    out = []
+    for name in node.fields:
+        if name not in known:
+            close = difflib.get_close_matches(name, sorted(known), n=1, cutoff=0.75)
+            if close:
+                out.append((name, close[0]))
+    return out
