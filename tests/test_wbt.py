@@ -447,3 +447,19 @@ def test_field_typos_are_reported(tmp_path: Path) -> None:
     assert typos == [f"{p}:3:3: Solid.translaton: not a Solid field, ignored (did you mean translation?)",
                      f"{p}:5:37: Box.sise: not a Box field, ignored (did you mean size?)",
                      f"{p}:5:77: PBRAppearance.basecolor: not a PBRAppearance field, ignored (did you mean baseColor?)"]
+
+
+def test_supervisor_finds_nodes_by_def_name() -> None:
+    from sensorium.server.daemon.supervisor import find_node
+
+    sim = Simulation(load_world(ROOT / "sensorium" / "worlds" / "epuck.wbt"))
+    assert find_node(sim, "EPUCK").name == "epuck" and find_node(sim, "EPUCK").type == "Robot"
+    assert find_node(sim, "LAMP").name == "lamp" and find_node(sim, "LAMP").type == "Solid"
+    assert find_node(sim, "epuck").name == "epuck"      # a name still works
+    assert find_node(sim, "NOPE") is None
+
+
+def test_duplicate_def_names_rejected_in_world_files() -> None:
+    with pytest.raises(WorldError, match=r"solids\[0\].def_name: duplicate DEF name 'A' \(first used at robots\[0\].def_name\)"):
+        parse_world({"robots": [{"name": "r", "def_name": "A"}],
+                     "solids": [{"name": "s", "def_name": "A", "geometry": {"type": "box"}}]})

@@ -232,6 +232,7 @@ class Solid(Strict):
     """
 
     name: str = Field(min_length=1)
+    def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
     pose: Pose = Pose()
     geometry: Geometry | None = None
     appearance: Appearance | None = None
@@ -353,6 +354,7 @@ class DifferentialDrive(Strict):
 
 class Robot(Strict):
     name: str = Field(min_length=1)
+    def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
     pose: Pose = Pose()
     synchronization: bool = True
     supervisor: bool = Field(default=False, description="its controller may use the Supervisor services (Webots)")

@@ -209,6 +209,8 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
     unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
     unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
     unique([(p, lt.name) for p, lt in all_lights(world)], "light")
+    unique([(f"robots[{i}].def_name", r.def_name) for i, r in enumerate(world.robots)]
+           + [(f"solids[{i}].def_name", s.def_name) for i, s in enumerate(world.solids)], "DEF")
 
     for p, geom in all_geometries(world):
         problems += _check_geometry(geom, p, base_dir)

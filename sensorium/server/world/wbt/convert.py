@@ -107,6 +107,7 @@ class Converter:
         self.solid_names: Counter[str] = Counter()
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
+        self.defs: set[str] = set()        # DEF names kept (def_name)
         self.robot_fields = set(wm.Robot.model_fields)
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
 
@@ -205,12 +206,20 @@ class Converter:
             self.joint(node, frame, owner)
         elif t in BUILTIN_PROTOS:
             system = self.world["world_info"].get("coordinate_system", "ENU")
-            self.visit(BUILTIN_PROTOS[t](node, f, system), frame, owner, top)
+            expanded = BUILTIN_PROTOS[t](node, f, system)
+            expanded.def_name = node.def_name
+            self.visit(expanded, frame, owner, top)
         elif t in GEOMETRIES:
             self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
         else:
             self.warn(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
                             f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
+
+    def def_name(self, node: Node, data: dict) -> None:
+        """Keep a robot's or top-level solid's DEF (getFromDef); a DEF reused later keeps its first node."""
+        if node.def_name is not None and node.def_name not in self.defs:
+            self.defs.add(node.def_name)
+            data["def_name"] = node.def_name
 
     def typos(self, node: Node) -> None:
         if id(node) in self.checked:
@@ -339,6 +348,8 @@ class Converter:
             raise self.error(node, "a Solid inside a scaled Transform is not supported")
         name = f.string("name", "solid")
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
+        if owner.kind == "world":
+            self.def_name(node, data)
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data)
@@ -370,6 +381,7 @@ class Converter:
             self.warn(node, f"robot name {name!r} used before: renamed {unique!r}")
         data: dict[str, Any] = {"name": unique, "pose": inner.pose(),
                                 "synchronization": f.flag("synchronization", True), "devices": []}
+        self.def_name(node, data)
         controller = f.string("controller", "<extern>")
         if controller not in ("<extern>", "<none>"):
             self.warn(node, f"Robot {unique!r}: controller {controller!r} is not started here; run it with "
