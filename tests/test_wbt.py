@@ -463,3 +463,13 @@ def test_duplicate_def_names_rejected_in_world_files() -> None:
     with pytest.raises(WorldError, match=r"solids\[0\].def_name: duplicate DEF name 'A' \(first used at robots\[0\].def_name\)"):
         parse_world({"robots": [{"name": "r", "def_name": "A"}],
                      "solids": [{"name": "s", "def_name": "A", "geometry": {"type": "box"}}]})
+
+
+def test_drive_from_wheel_end_points_when_anchors_coincide(tmp_path: Path) -> None:
+    """As in Webots' e-puck: both hinge anchors at the axle's centre, the wheels placed by their end points."""
+    wheel = ('HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 0 0.02 }} '
+             'device [ RotationalMotor {{ name "{0} wheel motor" maxVelocity 6.28 }} ] endPoint Solid {{ translation 0 {1} 0.02 '
+             'boundingObject Transform {{ rotation 1 0 0 1.570796 children [ Cylinder {{ height 0.005 radius 0.02 }} ] }} }} }}\n')
+    p = write(tmp_path, 'Robot { name "e" children [\n' + wheel.format("left", 0.026) + wheel.format("right", -0.026) + "] }\n")
+    dd = load_world(p).world.robots[0].differential_drive
+    assert dd == wm.DifferentialDrive(wheel_radius=0.02, axle_length=0.052, max_wheel_speed=6.28)

@@ -439,9 +439,13 @@ class Converter:
             axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
             anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
             m = self.fields(motors[0])
+            centre = anchor
+            if end is not None and end.type == "Solid":
+                centre = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
             owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"),
                                  "max_velocity": m.num("maxVelocity", 10.0),
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
+                                 "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
         elif motors:
             self.warn(node, f"{node.type} motor(s) not part of a wheel: skipped (joints do not move here)")

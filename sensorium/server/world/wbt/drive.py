@@ -3,7 +3,8 @@
 The kinematic drive turns the robot about its origin, x forward, wheels on the robot's y axis, and
 a positive wheel speed drives forward. A Webots robot maps onto it when it clearly is such a robot:
 exactly two motorised hinges, both axes along the robot's +y, both anchors on one line parallel to
-y whose midpoint is under the robot's origin, and wheels of one radius. Anything else gets one
+y, the two wheels (their end points' origins) on either side of the robot's origin (their midpoint
+under it), and wheels of one radius. Anything else gets one
 sentence saying which of these failed.
 """
 
@@ -54,6 +55,10 @@ def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     a0, a1 = wheels[0]["anchor"], wheels[1]["anchor"]
     if abs(a0[0] - a1[0]) > TOL or abs(a0[2] - a1[2]) > TOL:
         return None, "the two wheel anchors are not on one axle parallel to the robot's y axis"
+    # where the wheels are along the axle: their end points' origins (an anchor may be anywhere on it)
+    a0, a1 = wheels[0]["centre"], wheels[1]["centre"]
+    if abs(a0[1] - a1[1]) <= TOL:
+        return None, "both wheels are at the same place on the axle"
     mid = (a0 + a1) / 2.0
     if abs(mid[0]) > TOL or abs(mid[1]) > TOL:
         return None, (f"the axle midpoint is at x={mid[0]:g}, y={mid[1]:g} in the robot frame, not under the robot's "
