@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 MAX_FILE_BYTES = 64 * 1024 * 1024
-MAX_DEPTH = 200
+MAX_DEPTH = 100
 MAX_NODES = 1_000_000
 
 _HEADER = re.compile(r"#VRML_SIM\s+R(\d{4})([a-z])\b")
@@ -26,7 +26,7 @@ _TOKEN = re.compile(r"""
     (?P<ws>[\s,]+)
   | (?P<comment>\#[^\n]*)
   | (?P<num>[+-]?(?:0[xX][0-9a-fA-F]+|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(?![A-Za-z_]))
-  | (?P<str>"(?:[^"\\\n]|\\.)*")
+  | (?P<str>"(?:[^"\\]|\\.)*")
   | (?P<punct>[{}\[\]])
   | (?P<name>[^\s,"#'.\[\]{}\\+\-0-9][^\s,"#'\[\]{}\\]*)
 """, re.VERBOSE)
