@@ -473,3 +473,14 @@ def test_drive_from_wheel_end_points_when_anchors_coincide(tmp_path: Path) -> No
     p = write(tmp_path, 'Robot { name "e" children [\n' + wheel.format("left", 0.026) + wheel.format("right", -0.026) + "] }\n")
     dd = load_world(p).world.robots[0].differential_drive
     assert dd == wm.DifferentialDrive(wheel_radius=0.02, axle_length=0.052, max_wheel_speed=6.28)
+
+
+def test_textures_summarised_once(tmp_path: Path) -> None:
+    shape = ('Shape { appearance PBRAppearance { baseColor 0.5 0.2 0.2 baseColorMap ImageTexture { url [ "a.png" ] } } '
+             'geometry Box { } }')
+    p = write(tmp_path, f"Solid {{ name \"a\" children [ {shape} ] }}\nSolid {{ name \"b\" children [ {shape} ] }}\n")
+    w = load_world(p)
+    assert w.world.solids[0].shapes[0].appearance.base_color == (0.5, 0.2, 0.2)
+    notes = [x for x in w.warnings if "textures are not sampled" in x]
+    assert notes == [f"{p}:2:48: textures are not sampled (2 appearances): a PBRAppearance reads as its baseColor, "
+                     "a textured Appearance as white"]

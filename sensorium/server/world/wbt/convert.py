@@ -108,6 +108,7 @@ class Converter:
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.defs: set[str] = set()        # DEF names kept (def_name)
+        self.textured: dict[int, tuple[int, int]] = {}   # appearances with a texture → (line, column)
         self.robot_fields = set(wm.Robot.model_fields)
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
 
@@ -134,6 +135,11 @@ class Converter:
             self.visit(node, Frame.identity(), world, top=True)
         if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
             self.world["solids"].append(self.solid_dict(world, {"name": self.unique_name("shapes")}))
+        if self.textured:
+            line, col = min(self.textured.values())
+            n = len(self.textured)
+            self.warnings.append(f"{self.source}:{line}:{col}: textures are not sampled ({n} appearance{'s' if n > 1 else ''}"
+                                 "): a PBRAppearance reads as its baseColor, a textured Appearance as white")
         if self.skipped:
             listed = ", ".join(f"{k} x{v}" if v > 1 else k for k, v in sorted(self.skipped.items()))
             self.warnings.append(f"{self.source}: skipped nodes that do not matter to these sensors: {listed}")
@@ -215,6 +221,13 @@ class Converter:
             self.warn(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
                             f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
 
+    def appearance_note(self, node: Node, message: str) -> None:
+        if message == "texture":   # one summary line for all textures
+            if id(node) not in self.textured:
+                self.textured[id(node)] = (node.line, node.col)
+        else:
+            self.warn(node, message)
+
     def def_name(self, node: Node, data: dict) -> None:
         """Keep a robot's or top-level solid's DEF (getFromDef); a DEF reused later keeps its first node."""
         if node.def_name is not None and node.def_name not in self.defs:
@@ -267,7 +280,7 @@ class Converter:
             return
         part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
         if seen_by == "visual":
-            app = fx.appearance(f.node_("appearance"), self.source, self.warn)
+            app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note)
             if app is not None:
                 part["appearance"] = app
             owner.keys[key] = part

@@ -175,21 +175,23 @@ DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light senso
 # ---------------------------------------------------------------- appearance
 
 def appearance(node: Node | None, source: str, warn) -> dict | None:
-    """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read)."""
+    """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read).
+    ``warn(node, "texture")`` notes a texture that is not sampled: a PBRAppearance keeps its
+    baseColor, an Appearance reads white (Webots replaces the material's diffuse colour by the
+    texture's)."""
     if node is None:
         return None
     f = Fields(node, source)
     if node.type == "PBRAppearance":
         if f.node_("baseColorMap") is not None:
-            warn(node, "PBRAppearance.baseColorMap: textures are not sampled; using baseColor alone")
+            warn(node, "texture")
         return {"base_color": list(f.vec("baseColor", (1.0, 1.0, 1.0))),
                 "transparency": f.num("transparency", 0.0), "roughness": f.num("roughness", 0.0)}
     if node.type == "Appearance":
         material = f.node_("material")
         textured = f.node_("texture") is not None
         if textured:
-            warn(node, "Appearance.texture: textures are not sampled; the colour is taken as white (Webots replaces "
-                       "the material's diffuse colour by the texture's)")
+            warn(node, "texture")
         if material is None:
             return {"base_color": [1.0, 1.0, 1.0]}
         m = Fields(material, source)
