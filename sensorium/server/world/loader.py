@@ -107,9 +107,9 @@ def load_wbt(path: Path) -> LoadedWorld:
         raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
     placed = []
     for w in loaded.warnings:   # sanitising warnings start with the converted path: add the .wbt line
-        path, _, message = w.partition(": ")
-        at = _origin_of(path, origin)
-        placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({path}): {message}" if at else w)
+        where, _, message = w.partition(": ")
+        at = _origin_of(where, origin)
+        placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w)
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
                        warnings=[*warnings, *placed])
 
