@@ -484,3 +484,29 @@ def test_textures_summarised_once(tmp_path: Path) -> None:
     notes = [x for x in w.warnings if "textures are not sampled" in x]
     assert notes == [f"{p}:2:48: textures are not sampled (2 appearances): a PBRAppearance reads as its baseColor, "
                      "a textured Appearance as white"]
+
+
+def test_mangled_worlds_fail_cleanly(tmp_path: Path) -> None:
+    """Cut, garbled and truncated copies of full.wbt: each loads or raises WorldError, nothing else."""
+    import random
+
+    src = (HERE / "full.wbt").read_text()
+    rng = random.Random(11)
+    junk = ["{", "}", "[", "]", '"', "USE OB", "DEF X", "NULL", "TRUE", "-1", "1e400", "0", "Solid {", "Robot {",
+            "#", "\n", ",", "HingeJoint {", "E-puck {}", "size", "Box {}", "'"]
+    p = tmp_path / "m.wbt"
+    outcomes = set()
+    for _ in range(150):
+        s = src
+        for _ in range(rng.randint(1, 3)):
+            k = rng.randrange(len(s)) if s else 0
+            op = rng.random()
+            s = s[:k] + s[k + rng.randint(1, 20):] if op < 0.35 else s[:k] + f" {rng.choice(junk)} " + s[k:] if op < 0.8 else s[:k]
+        p.write_text(s)
+        try:
+            load_world(p)
+            outcomes.add("ok")
+        except WorldError as exc:
+            assert str(exc).startswith(f"{p}: ") and "\n" not in str(exc).split(": ", 1)[0]
+            outcomes.add("error")
+    assert outcomes == {"ok", "error"}
