@@ -373,11 +373,11 @@ class WorldInfo(Strict):
     name: str = "world"
     basic_time_step: int = Field(default=32, ge=1, le=60_000, description="milliseconds")
     random_seed: int = Field(default=0, ge=0, lt=2**63)
+    contact: bool = Field(default=True, description="kinematic contact: a robot's body stops at solids and other "
+                                                    "robots' bodies (README 'Kinematic contact'); false = pass through")
     coordinate_system: Literal["ENU", "NUE"] = Field(
         default="ENU", description="world axes: ENU = x east, y north, z up; NUE = x north, y up, z east. "
         "Only the up axis matters here: differential drives move in the plane normal to it")
-    contact: bool = Field(default=True, description="kinematic contact: a robot's body stops at solids and other "
-                                                    "robots' bodies (README 'Kinematic contact'); false = pass through")
 
 
 class World(Strict):

@@ -54,7 +54,6 @@ class Obstacle:
     offset: float = 0.0
     lo: np.ndarray = field(default_factory=lambda: np.zeros(2))
     hi: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    prim: geo.Primitive | None = None       # the shape it was made from (solids)
 
     def __post_init__(self) -> None:
         if self.normal is not None:
@@ -118,34 +117,23 @@ def footprint(prim: geo.Primitive) -> Footprint | None:
     return None                                  # a plane body: no footprint
 
 
-def body_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None:
-    """The disc (about the robot's origin) containing a body made of several shapes, each at its pose
-    in the robot frame: exact for boxes and upright cylinders, capsules and spheres, else from the
-    shape's circumscribed tessellation (conservative)."""
-    if len(parts) == 1 and not parts[0][1].translation.any() and np.array_equal(parts[0][1].rotation, np.eye(3)):
-        return footprint(parts[0][0])
-    radius, low, high = 0.0, math.inf, -math.inf
+def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None:
+    """The disc (about the robot's origin) containing every body shape, each at its offset in the
+    robot frame: conservative for off-centre shapes, exact for one centred upright shape."""
+    feet = []
     for prim, local in parts:
-        if isinstance(prim, geo.Plane):
+        f = footprint(prim)
+        if f is None:
             continue
-        t = local.translation
-        if isinstance(prim, (geo.Cylinder, geo.Capsule, geo.Sphere)) and abs(local.rotation[2, 2]) >= UPRIGHT:
-            fp = footprint(prim)                 # upright round part: exact disc around its axis
-            assert fp is not None
-            radius = max(radius, math.hypot(t[0], t[1]) + fp.radius)
-            low, high = min(low, t[2] + fp.z_low), max(high, t[2] + fp.z_high)
-            continue
-        if isinstance(prim, geo.Box):
-            sx, sy, sz = (v / 2.0 for v in prim.size)
-            v = np.array([[x, y, z] for x in (-sx, sx) for y in (-sy, sy) for z in (-sz, sz)])
-        else:
-            v, _ = geo.tessellate(prim)          # circumscribed: conservative
-        if len(v) == 0:
-            continue
-        w = local.apply(v)
-        radius = max(radius, float(np.max(np.hypot(w[:, 0], w[:, 1]))))
-        low, high = min(low, float(w[:, 2].min())), max(high, float(w[:, 2].max()))
-    return Footprint(radius, low, high) if high >= low else None
+        x, y, z = (float(v) for v in local.translation)
+        if not np.allclose(local.rotation, np.eye(3)):
+            # a tilted shape: bound it by its circumscribed sphere
+            r = math.hypot(f.radius, max(abs(f.z_low), abs(f.z_high)))
+            f = Footprint(r, -r, r)
+        feet.append(Footprint(math.hypot(x, y) + f.radius, z + f.z_low, z + f.z_high))
+    if not feet:
+        return None
+    return Footprint(max(f.radius for f in feet), min(f.z_low for f in feet), max(f.z_high for f in feet))
 
 
 def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle | None:
@@ -295,24 +283,22 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
 class Contact:
     """The world's static obstacles plus the robots' discs; :meth:`resolve` clips one robot's move."""
 
-    def __init__(self, solids: list[tuple[str, geo.Primitive, Pose, bool]] | list[tuple[str, geo.Primitive, Pose, bool, Pose]],
-                 robots: list[tuple[geo.Primitive | list[tuple[geo.Primitive, Pose]] | None, Pose]]):
-        """``solids``: (name, primitive, world pose of the solid, seen by bounding rays[, the shape's
-        pose in the solid]) — a solid made of several shapes repeats its name; ``robots``: (body
-        primitive, or list of (primitive, pose in the robot frame), or None; initial pose) in world order."""
-        self.parts: dict[str, list[tuple[geo.Primitive, Pose]]] = {}
-        poses: dict[str, Pose] = {}
-        for entry in solids:
-            name, prim, pose, bounding = entry[:4]
-            local = entry[4] if len(entry) > 4 else Pose.identity()  # type: ignore[misc]
+    def __init__(self, solids: list[tuple[str, geo.Primitive, Pose, Pose, bool]],
+                 robots: list[tuple[list[tuple[geo.Primitive, Pose]], Pose]]):
+        """``solids``: one entry per shape — (solid name, primitive, pose in the solid's frame, the
+        solid's world pose, seen by bounding rays); a solid made of several shapes (or with nested
+        children) gives several entries under one name, moved together. ``robots``: (body shapes
+        with their poses in the robot frame, initial pose) in world order."""
+        self.prims: dict[str, list[tuple[geo.Primitive, Pose]]] = {}
+        first_pose: dict[str, Pose] = {}
+        for name, prim, local, pose, bounding in solids:
             if bounding:
-                self.parts.setdefault(name, []).append((prim, local))
-                poses[name] = pose
-        self.solids: dict[str, list[Obstacle]] = {}
-        for name, pose in poses.items():
+                self.prims.setdefault(name, []).append((prim, local))
+                first_pose.setdefault(name, pose)
+        self.solids: dict[tuple[str, int], Obstacle] = {}
+        for name, pose in first_pose.items():
             self.update_solid(name, pose)
-        self.feet: list[Footprint | None] = [
-            None if b is None else body_footprint(b) if isinstance(b, list) else footprint(b) for b, _ in robots]
+        self.feet: list[Footprint | None] = [robot_footprint(parts) for parts, _ in robots]
         self.centres = np.array([[p.translation[0], p.translation[1]] for _, p in robots], dtype=np.float64).reshape(-1, 2)
         self.heights = np.array([p.translation[2] for _, p in robots], dtype=np.float64)
         self.contacts = 0                         # robot-steps whose motion was clipped
@@ -320,24 +306,17 @@ class Contact:
         self._rebuild()
 
     def update_solid(self, name: str, pose: Pose) -> None:
-        parts = self.parts.get(name)
-        if parts is None:
-            return
-        obs = []
-        for prim, local in parts:
+        for i, (prim, local) in enumerate(self.prims.get(name, ())):
             ob = obstacle(name, -1, prim, pose.compose(local))
-            if ob is not None:
-                ob.prim = prim
-                obs.append(ob)
-        if obs:
-            self.solids[name] = obs
-        else:
-            self.solids.pop(name, None)
+            if ob is None:
+                self.solids.pop((name, i), None)
+            else:
+                self.solids[(name, i)] = ob
         if hasattr(self, "feet"):
             self._rebuild()
 
     def _rebuild(self) -> None:
-        obs = [ob for group in self.solids.values() for ob in group]
+        obs = list(self.solids.values())
         self._obs = obs
         self._lo = np.array([o.lo for o in obs]).reshape(-1, 2)
         self._hi = np.array([o.hi for o in obs]).reshape(-1, 2)
@@ -397,7 +376,7 @@ class Contact:
                 ob = self._obs[i]
                 if ob.z_range[1] <= low + EPS or ob.z_range[0] >= high - EPS:
                     continue
-                prim = ob.prim
+                prim = self.prims.get(ob.name)
                 if isinstance(prim, geo.Sphere):
                     cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
                     rr = sphere_radius_in_band(ob, cz, prim.radius, low, high)

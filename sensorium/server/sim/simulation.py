@@ -156,14 +156,12 @@ class Simulation:
 
     def _build_contact(self) -> Contact:
         base = self.loaded.base_dir
-        solids = [(s.name, primitive_from_model(shape.geometry, base), self.scene.solid_poses[s.name],
-                   shape.seen_by in ("both", "bounding"), local)
+        solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
+                   shape.seen_by in ("both", "bounding"))
                   for s in self.world.solids for _, local, shape in solid_parts(s, Pose.identity())]
-        robots = []
-        for i, r in enumerate(self.world.robots):
-            parts = [(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(r)
-                     if shape.seen_by in ("both", "bounding")]
-            robots.append((parts or None, self.scene.robot_poses[i]))
+        robots = [([(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(r)
+                    if shape.seen_by in ("both", "bounding")], self.scene.robot_poses[i])
+                  for i, r in enumerate(self.world.robots)]
         return Contact(solids, robots)
 
     def place_robot(self, index: int, pose: Pose) -> None:

@@ -9,7 +9,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.scene import Scene
 from sensorium.server.world.loader import load_world
 
-__all__ = ["world_summary", "device_line", "geometry_line"]
+__all__ = ["world_summary", "device_line"]
 
 
 def device_line(d) -> str:
@@ -20,15 +20,12 @@ def device_line(d) -> str:
         return f"DistanceSensor {d.type} rays {d.number_of_rays} aperture {d.aperture:g} max {d.lookup_table[-1][0] if d.lookup_table else 0:g} m"
     if isinstance(d, wm.LightSensor):
         return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
-    if d.device == "PositionSensor":
-        return f"PositionSensor of motor {d.motor!r}"
-    if d.device == "LED":
-        return f"LED {len(d.color)} colour{'s' if len(d.color) != 1 else ''}{' gradual' if d.gradual else ''}"
+    if isinstance(d, wm.PositionSensor):
+        return f"PositionSensor of {d.motor!r}"
     return d.device
 
 
-def geometry_line(s: wm.Solid) -> str:
-    """What a solid is made of: its shapes' geometry types, child solids and lights."""
+def _geometry_line(s: wm.Solid) -> str:
     kinds = [s.geometry.type] if s.geometry is not None else []
     kinds += [p.geometry.type for p in s.shapes]
     text = "+".join(kinds) or "no shape"
@@ -48,7 +45,7 @@ def world_summary(path: str | Path) -> dict:
         "file": str(path),
         "basic_time_step_ms": w.world_info.basic_time_step,
         "random_seed": w.world_info.random_seed,
-        "solids": [{"name": s.name, "geometry": geometry_line(s), "seen_by": s.seen_by} for s in w.solids],
+        "solids": [{"name": s.name, "geometry": _geometry_line(s), "seen_by": s.seen_by} for s in w.solids],
         "triangles": scene.triangle_count,
         "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
         "robots": [
