@@ -510,3 +510,12 @@ def test_mangled_worlds_fail_cleanly(tmp_path: Path) -> None:
             assert str(exc).startswith(f"{p}: ") and "\n" not in str(exc).split(": ", 1)[0]
             outcomes.add("error")
     assert outcomes == {"ok", "error"}
+
+
+def test_repeated_device_names_get_a_suffix(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" children [ DistanceSensor { } DistanceSensor { translation 0 0 0.1 }\n'
+                        '  LightSensor { name "distance sensor(1)" } ] }\n')
+    w = load_world(p)
+    # the third name was taken by the rename of the second: it moves on in turn
+    assert [d.name for d in w.world.robots[0].devices] == ["distance sensor", "distance sensor(1)", "distance sensor(1)(1)"]
+    assert f"{p}:2:48: device name 'distance sensor' used before in robot 'r': renamed 'distance sensor(1)'" in w.warnings

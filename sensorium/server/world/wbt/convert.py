@@ -415,9 +415,28 @@ class Converter:
         self.drive(node, mine)
         if mine.parts:
             data["shapes"] = [_clean_part(p) for p in mine.parts]
+        self.unique_devices(data)
         if not data["devices"]:
             del data["devices"]
         self.world["robots"].append(data)
+
+    def unique_devices(self, robot: dict) -> None:
+        """Device names address topics and services, so a repeated one gets a suffix (Webots warns
+        and its getDevice returns the first); the wheel motors' names count too."""
+        drive = robot.get("differential_drive") or {}
+        seen: Counter[str] = Counter(v for k, v in drive.items() if k in ("left_motor", "right_motor"))
+        for dev in robot["devices"]:
+            name = dev["name"]
+            seen[name] += 1
+            if seen[name] > 1:
+                new, k = name, seen[name] - 1
+                while new in seen:
+                    new, k = f"{name}({k})", k + 1
+                seen[new] += 1
+                dev["name"] = new
+                line, col, _ = dev["_at"]
+                self.warnings.append(f"{self.source}:{line}:{col}: device name {name!r} used before in robot "
+                                     f"{robot['name']!r}: renamed {new!r}")
 
     def device(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
