@@ -519,3 +519,16 @@ def test_repeated_device_names_get_a_suffix(tmp_path: Path) -> None:
     # the third name was taken by the rename of the second: it moves on in turn
     assert [d.name for d in w.world.robots[0].devices] == ["distance sensor", "distance sensor(1)", "distance sensor(1)(1)"]
     assert f"{p}:2:48: device name 'distance sensor' used before in robot 'r': renamed 'distance sensor(1)'" in w.warnings
+
+
+def test_def_use_walk_is_bounded_without_shapes(tmp_path: Path, monkeypatch) -> None:
+    from sensorium.server.world.wbt import convert
+
+    monkeypatch.setattr(convert, "MAX_VISITS", 5000)
+    levels = ["DEF L0 Group { }"] + [f"DEF L{i} Group {{ children [ USE L{i - 1} USE L{i - 1} ] }}" for i in range(1, 40)]
+    with pytest.raises(WorldError, match="more than 5000 nodes to walk after DEF/USE expansion"):
+        load_world(write(tmp_path, "\n".join(levels) + "\n"))
+    # the same inside a boundingObject (walked by another path)
+    bomb = "Solid { boundingObject Group { children [\n" + "\n".join(levels) + "\n] } }\n"
+    with pytest.raises(WorldError, match="more than 5000 nodes to walk"):
+        load_world(write(tmp_path, bomb))

@@ -29,6 +29,7 @@ from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
 MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
+MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
 SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "ImmersionProperties",
            "ContactProperties", "Damping", "Brake", "Muscle", "Propeller", "Skin", "CadShape"}
@@ -103,7 +104,7 @@ class Converter:
         self.warnings: list[str] = []
         self.skipped: Counter[str] = Counter()
         self.count = 0
-        self.origin: dict[str, tuple[int, int, str]] = {}     # converted path → (line, col, node type)
+        self.visits = 0
         self.solid_names: Counter[str] = Counter()
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
@@ -121,6 +122,12 @@ class Converter:
 
     def error(self, node: Node, message: str) -> WbtSyntaxError:
         return WbtSyntaxError(self.source, node.line, node.col, message)
+
+    def walk(self, node: Node) -> None:
+        """Count a node walked (DEF/USE can make a small file a huge tree)."""
+        self.visits += 1
+        if self.visits > MAX_VISITS:
+            raise self.error(node, f"more than {MAX_VISITS} nodes to walk after DEF/USE expansion")
 
     def tick(self, node: Node) -> None:
         self.count += 1
@@ -173,6 +180,7 @@ class Converter:
 
     # ------------------------------------------------------------ the walk
     def visit(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
+        self.walk(node)
         t = node.type
         f = self.fields(node)
         self.typos(node)
@@ -290,6 +298,7 @@ class Converter:
     def bounding(self, node: Node | None, frame: Frame, owner: Owner) -> None:
         if node is None:
             return
+        self.walk(node)
         f = self.fields(node)
         if node.type in GEOMETRIES or node.type == "Shape":
             self.shape(node, frame, owner, seen_by="bounding")

@@ -26,6 +26,7 @@ def wheel_radius(end: Node | None, conv) -> float | None:
     def find(node: Node | None, scale: float) -> float | None:
         if node is None:
             return None
+        conv.walk(node)
         if node.type in ("Cylinder", "Sphere", "Capsule"):
             return conv.fields(node).num("radius", 1.0) * scale
         nf = conv.fields(node)
