@@ -116,11 +116,13 @@ def load_wbt(path: Path) -> LoadedWorld:
 
 def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:
     """(line, column, node type) of the .wbt node a converted world path came from."""
-    best = ""
-    for key in origin:
-        if len(key) > len(best) and (path == key or path.startswith(key + ".") or path.startswith(key + "[")):
-            best = key
-    return origin[best] if best else None
+    key = path
+    while key:
+        if key in origin:
+            return origin[key]
+        cut = max(key.rfind("."), key.rfind("["))
+        key = key[:cut] if cut > 0 else ""
+    return None
 
 
 def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem:
