@@ -50,6 +50,13 @@ def local_ray():
         r.shutdown()
 
 
+def test_local_ray_runs_on_loopback_only(local_ray):
+    nodes = local_ray.nodes()
+    assert [n["NodeManagerAddress"] for n in nodes] == ["127.0.0.1"]
+    ctx = local_ray.get_runtime_context()
+    assert ctx.gcs_address.startswith("127.0.0.1:")
+
+
 # ------------------------------------------------------------------------------ specs and paths
 
 def test_field_paths_parse_and_set():
@@ -197,3 +204,19 @@ def test_cli_unreachable_ray_cluster_is_one_line_not_a_hang(tmp_path):
                        timeout=120)
     assert p.returncode == 2
     assert p.stderr.strip().count("\n") == 0 and "cannot join the Ray cluster at '127.0.0.1:1'" in p.stderr
+
+
+@pytest.mark.parametrize("engine", ["local", "ray"])
+def test_a_run_that_kills_its_worker_is_an_error_row_and_the_others_complete(tmp_path, engine, request):
+    if engine == "ray":
+        request.getfixturevalue("local_ray")
+    world = room_world(tmp_path / "room.yaml")
+    ctrl = tmp_path / "killer.py"
+    ctrl.write_text("import os\n"
+                    "def make(sim):\n"
+                    "    if sim.seed == 2:\n"
+                    "        os._exit(3)\n")
+    res = run_sweep({"worlds": [str(world)], "seeds": [0, 1, 2, 3], "duration_ms": 64, "controllers": [f"{ctrl}:make"],
+                     "record": False}, None, engine=engine, workers=2, progress=False)
+    assert [r["status"] for r in res.rows] == ["ok", "ok", "error", "ok"]
+    assert "died" in res.rows[2]["error"] or "Crashed" in res.rows[2]["error"] or "exit" in res.rows[2]["error"]
