@@ -18,8 +18,6 @@ from sensorium.sweep import SpecError, parse_spec, run_sweep
 from sensorium.sweep.run import build_world, run_one
 from sensorium.sweep.spec import RunSpec, parse_path, set_path
 
-ray = pytest.importorskip("ray")
-
 R, VMAX, AXLE = 0.0205, 6.28, 0.052
 
 
@@ -41,6 +39,8 @@ def room_world(path: Path, noise: float = 0.05) -> Path:
 
 @pytest.fixture(scope="module")
 def local_ray():
+    """One local Ray (2 CPUs, loopback) for the module's Ray tests: starting Ray takes seconds."""
+    ray = pytest.importorskip("ray")
     from sensorium.sweep.engines import init_ray
 
     started = not ray.is_initialized()
@@ -195,6 +195,7 @@ def test_cli_sweep_exit_codes_and_no_silent_overwrite(tmp_path):
 
 
 def test_cli_unreachable_ray_cluster_is_one_line_not_a_hang(tmp_path):
+    pytest.importorskip("ray")
     spec = tmp_path / "spec.yaml"
     spec.write_text("seeds: [0]\nduration_ms: 32\n")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).resolve().parents[1]),
