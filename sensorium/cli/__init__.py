@@ -23,7 +23,10 @@ def command(name: str, help: str, target: str):
 
 @command("validate", "check a world file; exit 1 listing every problem", "sensorium.cli.world:validate")
 def _validate_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.serve import add_world_options
+
     p.add_argument("world", nargs="+", help="world file(s): YAML, JSON or Webots .wbt")
+    add_world_options(p)
 
 
 @command("convert", "write a Webots world (.wbt) as an equivalent Sensorium world file",
@@ -50,12 +53,16 @@ def _probe_args(p: argparse.ArgumentParser) -> None:
                    help="also enable a lidar's point cloud")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="JSON lines: step, time, robot, device, value or array summary")
+    from sensorium.cli.serve import add_world_options
+
+    add_world_options(p)
 
 
-@command("controller", "run a Webots-style Python controller for a robot of a running server",
+@command("controller", "run a Webots-style controller (Python script or compiled binary) for a robot of a running server",
          "sensorium.cli.client:controller")
 def _controller_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("script", help="controller script (uses `from controller import Robot`)")
+    p.add_argument("script", help="controller: a Python script (uses `from controller import Robot`) or an executable "
+                   "(e.g. a C controller linked against sensorium/client/c)")
     p.add_argument("--robot", help="robot name (default: the URL's robot, or the world's only robot)")
     p.add_argument("--url", help="RPC endpoint or controller URL, e.g. tcp://127.0.0.1:5560 or "
                    "tcp://host:5560/epuck (default: $SENSORIUM_CONTROLLER_URL, $WEBOTS_CONTROLLER_URL, "
