@@ -221,3 +221,13 @@ def test_a_run_that_kills_its_worker_is_an_error_row_and_the_others_complete(tmp
                      "record": False}, None, engine=engine, workers=2, progress=False)
     assert [r["status"] for r in res.rows] == ["ok", "ok", "error", "ok"]
     assert "died" in res.rows[2]["error"] or "Crashed" in res.rows[2]["error"] or "exit" in res.rows[2]["error"]
+
+
+def test_without_ray_auto_uses_the_process_pool_and_ray_is_a_clear_error(tmp_path, monkeypatch):
+    import sensorium.sweep as sweep
+
+    monkeypatch.setattr(sweep, "available", lambda engine: engine != "ray")
+    spec = {"worlds": [str(room_world(tmp_path / "room.yaml"))], "seeds": [0], "duration_ms": 32, "record": False}
+    assert run_sweep(spec, None, engine="auto", workers=1, progress=False).engine == "local"
+    with pytest.raises(SpecError, match=r"needs Ray: pip install 'sensorium\[ray\]'"):
+        run_sweep(spec, None, engine="ray", progress=False)
