@@ -503,6 +503,23 @@ def test_sigkilled_c_controller_releases_its_robot_and_server_quit_ends_steps(cb
     assert fields(lines[-1])["status"] == "-1" and all(fields(x)["status"] == "0" for x in lines[:-1])
 
 
+def test_c_controller_ends_its_loop_when_the_server_dies(cbin, servers):
+    """A server SIGKILLed mid-run: the heartbeat notices, wb_robot_step returns -1, no hang."""
+    server = servers(ARENA, "--heartbeat-ms", "200")
+    p = start([cbin["script"], "enable", "ps0", "32", "step", "32", "100000000"], server.url("epuck"))
+    server.wait_attached({"epuck"})
+    deadline = time.monotonic() + 30
+    while server.conn.call("get_info")["time_ms"] < 320:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    server.p.kill()
+    server.p.wait(10)
+    code, lines, err = finish(p, 60)
+    assert code == 0, err
+    assert fields(lines[-1])["status"] == "-1" and all(fields(x)["status"] == "0" for x in lines[:-1])
+    assert "CONNECTION_LOST" in err and "server gone" in err, err
+
+
 def test_heartbeat_keeps_a_computing_c_controller_attached(cbin, servers):
     server = servers(ARENA, "--heartbeat-ms", "100")
     lines = run([cbin["script"], "enable", "ps0", "32", "step", "32", "1", "sleep", "1500", "step", "32", "2"],
