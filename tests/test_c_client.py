@@ -75,9 +75,9 @@ def cbin(tmp_path_factory) -> dict[str, str]:
 class Server:
     """``sensorium serve`` on 127.0.0.1, free ports; ``url(robot)`` is a controller URL."""
 
-    def __init__(self, world: Path, *extra: str):
-        self.p = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", "tcp://127.0.0.1:0",
-                                   "--pub", "tcp://127.0.0.1:0", *extra], stdout=subprocess.PIPE,
+    def __init__(self, world: Path, *extra: str, rpc: str = "tcp://127.0.0.1:0", pub: str = "tcp://127.0.0.1:0"):
+        self.p = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", rpc,
+                                   "--pub", pub, *extra], stdout=subprocess.PIPE,
                                   stderr=subprocess.PIPE, text=True, env=ENV, cwd=str(REPO))
         lines: queue.Queue[str] = queue.Queue()
         threading.Thread(target=lambda: [lines.put(x) for x in self.p.stdout], daemon=True).start()
@@ -119,8 +119,8 @@ class Server:
 def servers():
     started: list[Server] = []
 
-    def start(world: Path = ARENA, *extra: str) -> Server:
-        started.append(Server(world, *extra))
+    def start(world: Path = ARENA, *extra: str, **endpoints: str) -> Server:
+        started.append(Server(world, *extra, **endpoints))
         return started[-1]
 
     yield start
@@ -540,6 +540,34 @@ def test_bad_urls_give_one_clear_line(cbin, url, words):
     code, out, err = finish(start([cbin["script"], "step", "32", "1"], url))
     assert code == 1 and out == []
     assert len(err.strip().splitlines()) == 1 and all(w in err for w in words), err
+
+
+def test_url_forms_and_variables(cbin, servers, tmp_path):
+    """WEBOTS_CONTROLLER_URL works alone, SENSORIUM_CONTROLLER_URL wins over it, ipc:// URLs name
+    the robot by their last path component, and a URL without a robot takes the only robot."""
+    server = servers(TRIO, "--mode", "pause", rpc=f"ipc://{tmp_path}/rpc", pub=f"ipc://{tmp_path}/pub")
+    assert server.rpc == f"ipc://{tmp_path}/rpc"
+    env = {k: v for k, v in ENV.items() if k not in ("SENSORIUM_CONTROLLER_URL", "WEBOTS_CONTROLLER_URL")}
+    procs = [
+        subprocess.Popen([cbin["script"], "step", "16", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env={**env, "WEBOTS_CONTROLLER_URL": f"{server.rpc}/ant"}),
+        subprocess.Popen([cbin["script"], "step", "16", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env={**env, "WEBOTS_CONTROLLER_URL": "ftp://ignored", "SENSORIUM_CONTROLLER_URL": f"{server.rpc}/bee"}),
+        subprocess.Popen([cbin["script"], "step", "16", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env={**env, "SENSORIUM_CONTROLLER_URL": f" {server.rpc}/cat\n"}),
+    ]
+    server.wait_attached({"ant", "bee", "cat"})
+    server.conn.call("set_mode", {"mode": "fast"})
+    for p in procs:
+        code, lines, err = finish(p)
+        assert code == 0 and [fields(x)["t"] for x in lines] == ["16", "32"], err
+    only = servers(REPO / "sensorium" / "schemas" / "conformance" / "world.yaml")
+    code, _, err = finish(start([cbin["script"], "step", "16", "1"], only.rpc))       # two robots there: ambiguous
+    assert code == 1 and "add '/ROBOT'" in err
+    single = tmp_path / "single.yaml"
+    single.write_text("world_info: {name: single, basic_time_step: 8}\nrobots:\n  - name: solo\n")
+    code, lines, err = finish(start([cbin["script"], "step", "8", "1"], servers(single).rpc))
+    assert code == 0 and lines == ["8 0"], err
 
 
 def test_missing_server_times_out_with_a_message(cbin):
