@@ -321,6 +321,9 @@ def test_every_getter_matches_the_python_client(cbin, servers):
         assert got["error.bad_step"] == "-1" and got["robot.step"] == "0"
         assert "step duration must be >= 0 ms" in err and "invalid device tag 9999" in err
         assert float(got["robot.time_after"]) * 1000 == pytest.approx(want["robot.basic_time_step"])
+        begun, again, status, t = got["pipelined"].split(",")          # a second step_begin is refused
+        assert (begun, again, status) == ("0", "-1", "0") and float(t) * 1000 == pytest.approx(2 * want["robot.basic_time_step"])
+        assert got["no_pending"] == "-1" and "a step is already pending" in err and "no step pending" in err
 
 
 def test_braitenberg_with_encoders_matches_python_and_the_wheel_angles(cbin, servers):
