@@ -392,7 +392,7 @@ def test_c_codec_replays_the_request_vectors(cbin, servers):
     decoding (tests/c/wire_vectors.c): ids, ok, error codes, result keys and scalar results."""
     import msgpack
 
-    from sensorium.server import conformance
+    from sensorium.server.sim import conformance
 
     vectors = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "requests.json").read_text())
     server = servers(REPO / "sensorium" / "schemas" / "conformance" / vectors["world"])

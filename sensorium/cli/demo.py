@@ -90,6 +90,7 @@ def run_demo(world: str | None, duration_s: float, out_dir: Path, precision: str
     procs: dict[str, subprocess.Popen] = {}
     start = time.monotonic()
     try:
+        assert server.stdout is not None
         line = server.stdout.readline()
         if "rpc=" not in line:
             raise RuntimeError(f"the server did not start (see {out_dir / 'server.log'}): {line.strip()}")
@@ -155,6 +156,8 @@ def _draw(result: DemoResult, world, path: Path) -> None:
     canvas = Canvas(-2.2, 2.2, -2.2, 2.2, pixels_per_metre=160)
     for s in world.solids:
         g = s.geometry
+        if g is None:
+            continue
         pose = pose_from_model(s.pose)
         cx, cy = pose.translation[:2]
         yaw = math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])

@@ -198,8 +198,9 @@ def wb_lidar_get_range_image(tag: int) -> Any:
     right, first layer to last): a read-only numpy array, or ``array('f')`` without numpy.
     Zeros before the first measurement."""
     buf = lidar_range_bytes(tag)
+    assert buf is not None                      # without a layer: always the whole image
     if arrays.numpy_module() is None:
-        return arrays.float32s(buf)
+        return arrays.float32s(buf or b"")
     r = current()
     return r.range_image(r.devices[tag - 1])
 

@@ -16,6 +16,7 @@ from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -25,6 +26,7 @@ from sensorium.server.raycast.engine import Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, LightBatch
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
+from sensorium.server.sim.scene import Scene, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
     DEVICE_CLASSES,
     LED,
@@ -36,9 +38,9 @@ from sensorium.server.sim.sensors import (
     RayRequest,
 )
 from sensorium.server.world.geometry import Pose
+from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
-from sensorium.server.sim.scene import Scene, primitive_from_model
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:
@@ -75,12 +77,14 @@ class RobotState:
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
                                        clock=lambda: sim.time_ms)
-        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index])
+        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index],
+                                        up=sim.world.world_info.coordinate_system)
                       if model.differential_drive is not None else None)
         self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
         self.encoders: list[PositionSensor] = []
         for dev in self.devices.values():
             if isinstance(dev, PositionSensor):
+                assert isinstance(dev.config, wm.PositionSensor)
                 dev.wheel = self.motors.get(dev.config.motor)
                 self.encoders.append(dev)
         self.custom_data = model.custom_data
@@ -143,22 +147,24 @@ class Simulation:
         self.time_ms = 0
         self.step_count = 0
         self.scene = Scene(self.world, loaded.base_dir, precision)
-        self.lights = lights_from_models(self.world.lights)
+        self.lights = lights_from_models(self.scene.world_lights())
+        self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._counters: Counter[str] = Counter()
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = self._build_contact() if use_contact and self._driven else None
-        self._initial = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
+        self._initial: dict[str, Any] = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
                          "solids": dict(self.scene.solid_poses)}
 
     def _build_contact(self) -> Contact:
         base = self.loaded.base_dir
-        solids = [(s.name, primitive_from_model(s.geometry, base), self.scene.solid_poses[s.name],
-                   s.seen_by in ("both", "bounding")) for s in self.world.solids]
-        robots = [(primitive_from_model(r.body.geometry, base)
-                   if r.body is not None and r.body.seen_by in ("both", "bounding") else None,
-                   self.scene.robot_poses[i]) for i, r in enumerate(self.world.robots)]
+        solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
+                   shape.seen_by in ("both", "bounding"))
+                  for s in self.world.solids for _, local, shape in solid_parts(s, Pose.identity())]
+        robots = [([(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(r)
+                    if shape.seen_by in ("both", "bounding")], self.scene.robot_poses[i])
+                  for i, r in enumerate(self.world.robots)]
         return Contact(solids, robots)
 
     def place_robot(self, index: int, pose: Pose) -> None:
@@ -190,8 +196,10 @@ class Simulation:
         self._counters["resets"] += 1
 
     @classmethod
-    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT) -> Simulation:
-        return cls(load_world(path), precision)
+    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT, *,
+                  limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> Simulation:
+        """``limits``/``allow_outside_meshes``: see :func:`sensorium.server.world.loader.load_world`."""
+        return cls(load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes), precision)
 
     # ------------------------------------------------------------------ access
     @property
@@ -253,6 +261,7 @@ class Simulation:
         contact = self.contact
         for robot in self._driven:
             drive = robot.drive
+            assert drive is not None
             start = (drive.x, drive.y)
             pose = drive.step(dt)
             if pose is not None:
@@ -272,20 +281,26 @@ class Simulation:
                 if isinstance(dev, Lidar):
                     if dev.due(now):
                         lidars.append(dev)
-                elif isinstance(dev, (LightSensor, DistanceSensor)):
+                elif isinstance(dev, LightSensor):
                     if dev.schedule.due(now):
-                        (lights if isinstance(dev, LightSensor) else distances).append(dev)
+                        lights.append(dev)
+                elif isinstance(dev, DistanceSensor):
+                    if dev.schedule.due(now):
+                        distances.append(dev)
                 elif isinstance(dev, PositionSensor) and dev.schedule.due(now):
                     dev.measure(now)
                     dev.schedule.last_update_ms = now
                     encoders += 1
-        work: list[tuple[object, list[RayRequest]]] = []
+        work: list[tuple[Any, list[RayRequest]]] = []
         if lights:
+            if self._lights_version != self.scene.lights_version:  # a light moved with its owner
+                self.lights = lights_from_models(self.scene.world_lights())
+                self._lights_version = self.scene.lights_version
             batch = LightBatch(lights, poses, self.lights)
             work.append((batch, batch.plan()))
         if distances:
-            batch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness)
-            work.append((batch, batch.plan()))
+            dbatch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness)
+            work.append((dbatch, dbatch.plan()))
         for lidar in lidars:
             work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt)))
         hits = self._cast_batched([req for _, reqs in work for req in reqs])

@@ -3,6 +3,11 @@
 Every problem names the file, the path to the field (``robots[0].devices[2].lookup_table[1]``)
 and what was expected. Webots' sanitising rules that silently change a value are applied here and
 reported as warnings, so a world behaves as it would in Webots and the user is told why.
+
+Untrusted input: the file size, nesting, values and string lengths are bounded before the model is
+built, and the work a world asks for (rays, beams, triangles, robots, ...) afterwards
+(:mod:`.limits`); mesh urls must stay inside the world's folder unless ``allow_outside_meshes``.
+Every failure is a :class:`WorldError`, never another exception.
 """
 
 from __future__ import annotations
@@ -10,6 +15,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -18,6 +24,7 @@ import yaml
 from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
+from sensorium.server.world.limits import LimitError, WorldLimits, check_data, check_work, check_yaml_events, quote
 
 
 class _Yaml12Loader(yaml.SafeLoader):
@@ -69,41 +76,127 @@ class LoadedWorld:
     warnings: list[str] = field(default_factory=list)
 
 
-def load_world(path: str | Path) -> LoadedWorld:
+def read_world_text(path: str | Path, limits: WorldLimits | None = None) -> bytes:
+    """The bytes of a world file, at most ``limits.file_bytes`` of them (else ``WorldError``)."""
+    limits = limits or WorldLimits()
     path = Path(path)
     source = str(path)
     try:
-        text = path.read_bytes()
-    except OSError as exc:
-        raise WorldError(source, [Problem("", f"cannot read world file: {exc.strerror or exc}")]) from None
+        with open(path, "rb") as f:
+            text = f.read(limits.file_bytes + 1)
+    except (OSError, ValueError) as exc:       # ValueError: a NUL byte in the path
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise WorldError(source, [Problem("", f"cannot read world file: {reason}")]) from None
+    if len(text) > limits.file_bytes:
+        raise WorldError(source, [Problem("", f"file larger than the limit of {limits.file_bytes:,} bytes "
+                                              "(raise the limits with --allow-large)")])
+    return text
+
+
+def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: WorldLimits | None = None) -> Any:
+    """YAML (1.2 booleans) or JSON text → plain data, bounded (nesting, alias expansion) before it is
+    built. Any failure is a ``WorldError``."""
+    limits = limits or WorldLimits()
     try:
-        if path.suffix.lower() == ".json":
-            data = json.loads(text)
-        else:
-            data = yaml.load(text, Loader=_Yaml12Loader)  # noqa: S506 (a safe loader)
-    except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise WorldError(source, [Problem("", f"not valid YAML/JSON: {exc}")]) from None
-    return parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
+        if json_format:
+            return json.loads(text)
+        check_yaml_events(text, limits)
+        return yaml.load(text, Loader=_Yaml12Loader)  # noqa: S506 (a safe loader)
+    except LimitError as exc:
+        raise WorldError(source, [Problem(exc.path, exc.message)]) from None
+    except RecursionError:
+        raise WorldError(source, [Problem("", f"nested deeper than {limits.nesting_depth} levels "
+                                              "(raise the limits with --allow-large)")]) from None
+    except Exception as exc:  # noqa: BLE001 - yaml/json raise many types (and constructors ValueError) for bad text
+        detail = str(exc)
+        if len(detail) > 300:
+            detail = detail[:300] + "…"
+        raise WorldError(source, [Problem("", f"not valid YAML/JSON: {detail}")]) from None
 
 
-def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"") -> LoadedWorld:
+def load_world(path: str | Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
+    """Read, parse, validate and sanitise a world file (``WorldError`` listing every problem).
+    ``limits``: the work it may ask for (default ``WorldLimits()``; ``--allow-large`` is
+    ``WorldLimits.large()``); ``allow_outside_meshes``: mesh urls may leave the world's folder."""
+    path = Path(path)
+    source = str(path)
+    if path.suffix.lower() == ".wbt":
+        return load_wbt(path, limits=limits, allow_outside_meshes=allow_outside_meshes)
+    text = read_world_text(path, limits)
+    data = parse_text(text, source, json_format=path.suffix.lower() == ".json", limits=limits)
+    return parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
+                       allow_outside_meshes=allow_outside_meshes)
+
+
+def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
+    """A Webots world, converted (``sensorium.server.world.wbt``); problems point at its lines.
+    ``LoadedWorld.text`` is the .wbt file as read (recordings attach it under its own name)."""
+    from sensorium.server.world.wbt import WbtSyntaxError, wbt_to_dict
+
+    source = str(path)
+    text = read_world_text(path, limits)           # the size limit (and a readable file)
+    try:
+        data, warnings, origin = wbt_to_dict(path)
+    except WbtSyntaxError as exc:
+        where = f"line {exc.line}, column {exc.col}" if exc.line else ""
+        raise WorldError(source, [Problem(where, exc.message)]) from None
+    try:
+        loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
+                             allow_outside_meshes=allow_outside_meshes)
+    except WorldError as exc:
+        raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
+    placed = []
+    for w in loaded.warnings:   # sanitising warnings start with the converted path: add the .wbt line
+        where, _, message = w.partition(": ")
+        at = _origin_of(where, origin)
+        placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w)
+    return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
+                       warnings=[*warnings, *placed])
+
+
+def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:
+    """(line, column, node type) of the .wbt node a converted world path came from."""
+    key = path
+    while key:
+        if key in origin:
+            return origin[key]
+        cut = max(key.rfind("."), key.rfind("["))
+        key = key[:cut] if cut > 0 else ""
+    return None
+
+
+def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem:
+    """A problem of the converted world, placed at the .wbt node it came from."""
+    at = _origin_of(p.path, origin)
+    if at is None:
+        return p
+    return Problem(f"line {at[0]}, column {at[1]} ({at[2]}, converted as {p.path})", p.message)
+
+
+def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"", *,
+                limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
+    limits = limits or WorldLimits()
     if data is None:
         data = {}
     if not isinstance(data, dict):
         raise WorldError(source, [Problem("", f"a world must be a mapping, got {type(data).__name__}")])
     try:
+        check_data(data, limits)
+    except LimitError as exc:
+        raise WorldError(source, [Problem(exc.path, exc.message)]) from None
+    try:
         world = wm.World.model_validate(data)
     except ValidationError as exc:
         raise WorldError(source, [_problem_from_pydantic(e) for e in exc.errors()]) from None
     base = base_dir or Path.cwd()
-    problems = check_world(world, base)
+    problems = check_world(world, base, limits=limits, allow_outside_meshes=allow_outside_meshes)
     if problems:
         raise WorldError(source, problems)
     world, warnings = sanitize(world)
     return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings)
 
 
-_TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "mesh", "PointLight", "SpotLight",
+_TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "triangles", "mesh", "PointLight", "SpotLight",
          "DirectionalLight", "LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED"}
 
 
@@ -121,26 +214,30 @@ def format_path(loc: tuple[Any, ...]) -> str:
     return out
 
 
-def _problem_from_pydantic(err: dict[str, Any]) -> Problem:
+def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
     loc = tuple(err.get("loc", ()))
     msg = err.get("msg", "invalid")
     kind = err.get("type", "")
     if kind == "extra_forbidden":
         msg = "unknown key (check spelling; field names are Webots' names in snake_case)"
     elif kind in ("finite_number",):
-        msg = f"expected a finite number, got {err.get('input')!r}"
+        msg = f"expected a finite number, got {quote(err.get('input'))}"
     elif "input" in err and kind not in ("missing", "union_tag_invalid", "union_tag_not_found") and not isinstance(err["input"], (dict, list)):
-        msg = f"{msg} (got {err['input']!r})"
+        msg = f"{msg} (got {quote(err['input'])})"
+    if len(msg) > 400:
+        msg = msg[:400] + "…"
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
     return Problem(format_path(loc), msg)
 
 
-def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
-    """Checks that relate several fields or the file system; one problem per finding."""
+def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None = None,
+                allow_outside_meshes: bool = False) -> list[Problem]:
+    """Checks that relate several fields or the file system, and the world's limits; one problem
+    per finding."""
     problems: list[Problem] = []
 
-    def unique(items: list[tuple[str, str | None]], what: str) -> None:
+    def unique(items: Sequence[tuple[str, str | None]], what: str) -> None:
         first: dict[str, str] = {}
         for path, name in items:
             if name is None:
@@ -163,14 +260,14 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
             name_ok(f"robots[{i}].devices[{d_i}].name", d.name, ("robot",))
     unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
     unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
-    unique([(f"lights[{i}].name", lt.name) for i, lt in enumerate(world.lights)], "light")
+    unique([(p, lt.name) for p, lt in all_lights(world)], "light")
+    unique([(f"robots[{i}].def_name", r.def_name) for i, r in enumerate(world.robots)]
+           + [(f"solids[{i}].def_name", s.def_name) for i, s in enumerate(world.solids)], "DEF")
 
-    for i, s in enumerate(world.solids):
-        problems += _check_geometry(s.geometry, f"solids[{i}].geometry", base_dir)
+    for p, geom in all_geometries(world):
+        problems += _check_geometry(geom, p, base_dir)
     for r_i, robot in enumerate(world.robots):
         rp = f"robots[{r_i}]"
-        if robot.body is not None:
-            problems += _check_geometry(robot.body.geometry, f"{rp}.body.geometry", base_dir)
         names = [(f"{rp}.devices[{d_i}].name", d.name) for d_i, d in enumerate(robot.devices)]
         if robot.differential_drive is not None:
             names += [(f"{rp}.differential_drive.left_motor", robot.differential_drive.left_motor),
@@ -195,28 +292,90 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
                                        f"(motors: {', '.join(repr(m) for m in motors) or 'none: no differential_drive'})"))
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
+    problems += _check_meshes_and_work(world, base_dir, limits or WorldLimits(), allow_outside_meshes)
     return problems
 
 
-def _check_geometry(geom: Any, path: str, base_dir: Path) -> list[Problem]:
-    if not isinstance(geom, wm.Mesh):
-        return []
-    from sensorium.server.world.meshes import MeshFileError, load_mesh
+def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
+                           allow_outside_meshes: bool) -> list[Problem]:
+    """Every mesh url (confined, readable, bounded) and the work the world asks for."""
+    from sensorium.server.world.limits import _walk
+    from sensorium.server.world.meshes import MeshFileError, load_mesh, resolve_mesh_url
 
-    try:
-        load_mesh(base_dir / geom.url, geom.scale)
-    except MeshFileError as exc:
-        return [Problem(f"{path}.url", str(exc))]
-    return []
+    problems: list[Problem] = []
+    faces: dict[tuple[str, tuple[float, ...]], int] = {}
+    for path, geom in _walk(world):
+        if not isinstance(geom, wm.Mesh):
+            continue
+        key = (geom.url, tuple(geom.scale))
+        if key in faces:
+            continue
+        faces[key] = 0
+        try:
+            file = resolve_mesh_url(geom.url, base_dir, allow_outside=allow_outside_meshes,
+                                    max_bytes=limits.mesh_file_bytes)
+            faces[key] = len(load_mesh(file, geom.scale, display=geom.url).faces)
+        except MeshFileError as exc:
+            problems.append(Problem(f"{path}.url", str(exc)))
+    if problems:
+        return problems
+    for item in check_work(world, limits, lambda g: faces.get((g.url, tuple(g.scale)), 0)):
+        problems.append(Problem(*item) if isinstance(item, tuple) else Problem("", item))
+    return problems
+
+
+def all_solids(world: wm.World) -> Iterator[tuple[str, wm.Solid]]:
+    """Every solid, nested children included, with its path in the file."""
+    def walk(path: str, solid: wm.Solid) -> Iterator[tuple[str, wm.Solid]]:
+        yield path, solid
+        for c_i, child in enumerate(solid.children):
+            yield from walk(f"{path}.children[{c_i}]", child)
+
+    for i, s in enumerate(world.solids):
+        yield from walk(f"solids[{i}]", s)
+
+
+def all_lights(world: wm.World) -> Iterator[tuple[str, Any]]:
+    """Every light (world, solid-attached, robot-attached) with its path in the file."""
+    for i, lt in enumerate(world.lights):
+        yield f"lights[{i}]", lt
+    for path, solid in all_solids(world):
+        for i, lt in enumerate(solid.lights):
+            yield f"{path}.lights[{i}]", lt
+    for r_i, robot in enumerate(world.robots):
+        for i, lt in enumerate(robot.lights):
+            yield f"robots[{r_i}].lights[{i}]", lt
+
+
+def all_geometries(world: wm.World) -> Iterator[tuple[str, Any]]:
+    for path, solid in all_solids(world):
+        if solid.geometry is not None:
+            yield f"{path}.geometry", solid.geometry
+        for i, part in enumerate(solid.shapes):
+            yield f"{path}.shapes[{i}].geometry", part.geometry
+    for r_i, robot in enumerate(world.robots):
+        if robot.body is not None:
+            yield f"robots[{r_i}].body.geometry", robot.body.geometry
+        for i, part in enumerate(robot.shapes):
+            yield f"robots[{r_i}].shapes[{i}].geometry", part.geometry
+
+
+def _check_geometry(geom: Any, path: str, base_dir: Path) -> list[Problem]:
+    if isinstance(geom, wm.Triangles):
+        n = len(geom.vertices)
+        for i, face in enumerate(geom.faces):
+            if min(face) < 0 or max(face) >= n:
+                return [Problem(f"{path}.faces[{i}]", f"vertex index outside 0..{n - 1}: {list(face)}")]
+        return []
+    return []      # mesh files: _check_meshes_and_work (url confined to the world's folder, size, triangles)
 
 
 def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
     """Apply Webots' field sanitising (devices.md §2.1, §3.1, §4.1); return warnings for each change."""
     warnings: list[str] = []
 
-    def fix_light(i: int, lt: Any) -> Any:
+    def fix_light(p: str, lt: Any) -> Any:
         upd: dict[str, Any] = {}
-        p = f"lights[{i}]"
         if not 0.0 <= lt.ambient_intensity <= 1.0:
             upd["ambient_intensity"] = 1.0 if lt.ambient_intensity > 1 else 0.0
             warnings.append(f"{p}.ambient_intensity: {lt.ambient_intensity} outside [0, 1], reset to {upd['ambient_intensity']}")
@@ -282,9 +441,18 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
                 warnings.append(f"{p}.default_frequency: outside [min_frequency, max_frequency], clamped")
         return dev.model_copy(update=upd) if upd else dev
 
-    lights = [fix_light(i, lt) for i, lt in enumerate(world.lights)]
+    def fix_solid(p: str, solid: wm.Solid) -> wm.Solid:
+        if not solid.lights and not solid.children:
+            return solid
+        lights = [fix_light(f"{p}.lights[{i}]", lt) for i, lt in enumerate(solid.lights)]
+        children = [fix_solid(f"{p}.children[{i}]", c) for i, c in enumerate(solid.children)]
+        return solid.model_copy(update={"lights": lights, "children": children})
+
+    lights = [fix_light(f"lights[{i}]", lt) for i, lt in enumerate(world.lights)]
+    solids = [fix_solid(f"solids[{i}]", s) for i, s in enumerate(world.solids)]
     robots = []
     for r_i, robot in enumerate(world.robots):
         devices = [fix_device(f"robots[{r_i}].devices[{d_i}]", d) for d_i, d in enumerate(robot.devices)]
-        robots.append(robot.model_copy(update={"devices": devices}))
-    return world.model_copy(update={"lights": lights, "robots": robots}), warnings
+        r_lights = [fix_light(f"robots[{r_i}].lights[{i}]", lt) for i, lt in enumerate(robot.lights)]
+        robots.append(robot.model_copy(update={"devices": devices, "lights": r_lights}))
+    return world.model_copy(update={"lights": lights, "solids": solids, "robots": robots}), warnings

@@ -1,0 +1,538 @@
+"""Webots worlds (.wbt): parser positions, conversion, twins read bit for bit, convert round trip."""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import select
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.cli import main as cli
+from sensorium.schemas import world as wm
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import WorldError, load_world, parse_world
+from sensorium.server.world.wbt.parser import MAX_DEPTH
+
+HERE = Path(__file__).parent / "worlds" / "wbt"
+ROOT = Path(__file__).resolve().parents[1]
+HEADER = "#VRML_SIM R2023b utf8\n"
+
+
+def write(tmp_path: Path, body: str, name: str = "w.wbt") -> Path:
+    p = tmp_path / name
+    p.write_text(HEADER + body)
+    return p
+
+
+def readings_run(sim: Simulation, steps: int = 40) -> list:
+    """Enable every device, drive 'bot' along an arc, collect every reading of every step."""
+    for dev in sim.all_devices():
+        dev.enable(sim.basic_time_step)
+        if hasattr(dev, "enable_point_cloud"):
+            dev.enable_point_cloud()
+    bot = sim.robot("bot")
+    bot.motor("left wheel motor").set_position(math.inf)
+    bot.motor("right wheel motor").set_position(math.inf)
+    bot.motor("left wheel motor").set_velocity(3.0)
+    bot.motor("right wheel motor").set_velocity(5.0)
+    out = []
+    for _ in range(steps):
+        sim.step()
+        for dev in sim.all_devices():
+            for key, value in dev.readings().items():
+                out.append((dev.path, key, np.array(value, copy=True)))
+    return out
+
+
+def same(a: list, b: list) -> None:
+    assert len(a) == len(b)
+    for (pa, ka, va), (pb, kb, vb) in zip(a, b):
+        assert (pa, ka) == (pb, kb)
+        if va.dtype.names:
+            for f in va.dtype.names:
+                assert np.array_equal(va[f], vb[f], equal_nan=True), (pa, ka, f)
+        else:
+            assert np.array_equal(va, vb, equal_nan=True), (pa, ka)
+
+
+def test_full_wbt_is_its_yaml_twin_bit_for_bit() -> None:
+    wbt, yml = load_world(HERE / "full.wbt"), load_world(HERE / "full.yaml")
+    assert wbt.world == yml.world
+    a, b = readings_run(Simulation(wbt)), readings_run(Simulation(yml))
+    same(a, b)
+    # the readings are real: the infra-red, sonar, lidar and both light sensors all saw something
+    finite = {p for p, k, v in a if v.dtype.names is None and np.isfinite(v).any() and np.any(v != 0)}
+    assert {"bot/ir", "bot/sonar", "bot/lidar", "bot/ls", "watcher/ds", "watcher/ls"} <= finite
+    # the robot drove (the drive was recognised) and the watcher's light sensor saw the robot's lamp move
+    watcher = [float(v) for p, k, v in a if p == "watcher/ls"]
+    assert len(set(watcher)) > 10
+
+
+def test_skipped_nodes_summarised_once() -> None:
+    w = load_world(HERE / "full.wbt")
+    summary = [x for x in w.warnings if "skipped nodes that do not matter" in x]
+    assert summary == [f"{HERE / 'full.wbt'}: skipped nodes that do not matter to these sensors: TexturedBackground, Viewpoint"]
+
+
+def test_convert_round_trip(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "sub" / "full.yaml"
+    out.parent.mkdir()
+    assert cli(["convert", str(HERE / "full.wbt"), str(out)]) == 0
+    # its meshes stay where the .wbt has them, outside OUT's folder: loading it needs the flag
+    with pytest.raises(WorldError, match="leaves the world's folder"):
+        load_world(out)
+    assert "--allow-outside-meshes" in capsys.readouterr().err
+    converted = load_world(out, allow_outside_meshes=True)
+    original = load_world(HERE / "full.wbt")
+    # mesh url rewritten relative to the output; everything else identical
+    mesh = next(s for s in converted.world.solids if s.name == "mesh").shapes[0].geometry
+    assert (out.parent / mesh.url).resolve() == (HERE / "meshes" / "tetra.obj").resolve()
+    same(readings_run(Simulation(converted)), readings_run(Simulation(original)))
+    # never overwrite without --force
+    before = out.read_bytes()
+    assert cli(["convert", str(HERE / "full.wbt"), str(out)]) == 1
+    assert "exists; not overwriting" in capsys.readouterr().err
+    assert out.read_bytes() == before
+    assert cli(["convert", str(HERE / "full.wbt"), str(out), "--force"]) == 0
+
+
+def test_validate_and_info_accept_wbt(capsys) -> None:
+    assert cli(["validate", str(HERE / "full.wbt")]) == 0
+    assert capsys.readouterr().out.strip().endswith("full.wbt: OK")
+    assert cli(["info", str(HERE / "full.wbt")]) == 0
+    assert "obstacle (box+sphere, 1 child solid, 1 light)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("body, line, col, what", [
+    ('Solid { name "oops }\n', 2, 14, "unterminated string"),
+    ("Solid {\n  translation 0 0 0\n  children [ Shape { } \n", 5, 1, "end of file inside the list opened at line 4, column 12"),
+    ("Solid { boundingObject USE NOPE }\n", 2, 28, "USE NOPE: no DEF NOPE before this point"),
+    ("Solid { translation 1 2 3 } }\n", 2, 29, "expected a node, found '}'"),
+    ("Solid { 12 }\n", 2, 9, "expected a field name or '}' in Solid (line 2), found '12'"),
+    ("Solid { name 'x' }\n", 2, 14, "unexpected character \"'\""),
+    ("PROTO X [ ] { }\n", 2, 1, "PROTO definitions inside a world file are not supported"),
+])
+def test_syntax_errors_name_file_line_column(tmp_path: Path, body: str, line: int, col: int, what: str) -> None:
+    p = write(tmp_path, body)
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value) == f"{p}: line {line}, column {col}: {what}"
+
+
+def test_header_required_and_old_versions_refused(tmp_path: Path) -> None:
+    p = tmp_path / "old.wbt"
+    p.write_text("#VRML_SIM R2021b utf8\nWorldInfo { }\n")
+    with pytest.raises(WorldError, match=r"old.wbt: line 1, column 1: Webots R2021b world: only R2022a and later"):
+        load_world(p)
+    p.write_text("WorldInfo { }\n")
+    with pytest.raises(WorldError, match="not a Webots world"):
+        load_world(p)
+
+
+def test_nesting_depth_bounded(tmp_path: Path) -> None:
+    deep = "Group { children [ " * (MAX_DEPTH + 5) + "]  }" * (MAX_DEPTH + 5)
+    with pytest.raises(WorldError, match=f"nested deeper than {MAX_DEPTH} levels"):
+        load_world(write(tmp_path, deep))
+
+
+def test_field_errors_point_at_the_node(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid {\n  children [ Shape { geometry Box { size 1 -2 1 } } ]\n}\nSolid { translation 1 2 }\n')
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value) == f"{p}: line 5, column 9: Solid.translation: expected 3 numbers, got 2 numbers"
+    p = write(tmp_path, 'Solid {\n  children [ Shape { geometry Box { size 1 -2 1 } } ]\n}\n')
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value).startswith(f"{p}: line 3, column 31 (Box, converted as solids[0].shapes[0].geometry.size): ")
+    assert "every box size component must be > 0" in str(exc.value)
+
+
+def test_unknown_proto_is_skipped_with_its_position(tmp_path: Path) -> None:
+    p = write(tmp_path, 'EXTERNPROTO "https://example.org/E-puck.proto"\nE-puck {\n  translation 0 0 0\n}\n'
+                        'Solid { children [ Shape { geometry Sphere { radius 0.1 } } ] }\n')
+    w = load_world(p)
+    assert [s.name for s in w.world.solids] == ["solid"] and w.world.robots == []
+    assert any(x.startswith(f"{p}:3:1: E-puck: not a built-in node or PROTO here; skipped") for x in w.warnings)
+
+
+def test_device_through_nested_rotated_poses_closed_form(tmp_path: Path) -> None:
+    """The robot faces world +y; its sensor sits 0.1 m to its right (world x = 0.1) behind a quarter
+    turn back and two cancelling eighth turns, so it looks along world +x at a wall face at x = 0.45."""
+    p = write(tmp_path, """
+Solid { translation 0.5 0 0.05 children [ Shape { geometry Box { size 0.1 2 0.1 } } ] boundingObject Box { size 0.1 2 0.1 } }
+Robot {
+  rotation 0 0 1 1.5707963267948966
+  name "r"
+  children [
+    Pose { translation 0 -0.1 0.05 rotation 0 0 1 -1.5707963267948966
+      children [ Solid { name "arm" children [ Pose { rotation 0 0 1 0.7853981633974483 children [
+        Pose { rotation 0 0 1 -0.7853981633974483 children [ DistanceSensor { name "d" lookupTable [ 0 0 0, 1 1000 0 ] } ] } ] } ] } ] }
+  ]
+}
+""")
+    loaded = load_world(p)
+    dev = loaded.world.robots[0].devices[0]
+    assert dev.pose.quaternion is not None   # composed of several rotations
+    sim = Simulation(loaded)
+    d = sim.device("r/d")
+    d.enable(32)
+    sim.step()
+    # sensor at world (0.1, 0, 0.05) looking along +x; the wall's near face is at x = 0.45
+    assert d.value == pytest.approx(1000 * 0.35, abs=1e-9)
+
+
+def _two_wheels(axis_left: str = "0 1 0", anchor_x: float = 0.0, extra: str = "") -> str:
+    def wheel(side: str, y: float, axis: str) -> str:
+        return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor {anchor_x} {y} 0.02 }} '
+                f'device [ RotationalMotor {{ name "{side} wheel motor" }} ] '
+                f'endPoint Solid {{ translation {anchor_x} {y} 0.02 children [ Shape {{ geometry Cylinder {{ radius 0.03 height 0.01 }} }} ] }} }}\n')
+    return "Robot { name \"r\" children [\n" + wheel("left", 0.05, axis_left) + wheel("right", -0.05, "0 1 0") + extra + "] }\n"
+
+
+def test_hinge_wheels_become_a_differential_drive(tmp_path: Path) -> None:
+    w = load_world(write(tmp_path, _two_wheels()))
+    dd = w.world.robots[0].differential_drive
+    assert dd == wm.DifferentialDrive(wheel_radius=0.03, axle_length=0.1, max_wheel_speed=10.0,
+                                      left_motor="left wheel motor", right_motor="right wheel motor")
+
+
+@pytest.mark.parametrize("kwargs, why", [
+    (dict(axis_left="0 -1 0"), "wheel axis of motor 'left wheel motor' is [0.0, -1.0, 0.0], not the robot's +y"),
+    (dict(anchor_x=0.02), "the axle midpoint is at x=0.02, y=0 in the robot frame, not under the robot's origin"),
+    (dict(extra='HingeJoint { device [ RotationalMotor { name "third" } ] }\n'),
+     "3 motorised hinge joints; a differential drive needs exactly two wheels"),
+])
+def test_no_drive_says_why(tmp_path: Path, kwargs: dict, why: str) -> None:
+    p = write(tmp_path, _two_wheels(**kwargs))
+    w = load_world(p)
+    assert w.world.robots[0].differential_drive is None
+    assert any(x.startswith(f"{p}:2:1: robot 'r': no differential drive ({why}") and x.endswith("the robot will not move")
+               for x in w.warnings), w.warnings
+
+
+def test_nue_world_drives_on_the_ground_plane(tmp_path: Path) -> None:
+    """NUE: y is up. A robot standing up (its z along world y) drives forward along world x."""
+    p = write(tmp_path, 'WorldInfo { coordinateSystem "NUE" basicTimeStep 10 }\n'
+                        'Robot { rotation 1 0 0 -1.5707963267948966 ' + _two_wheels()[len("Robot { "):])
+    w = load_world(p)
+    assert w.world.world_info.coordinate_system == "NUE"
+    sim = Simulation(w)
+    r = sim.robot("r")
+    for m in ("left wheel motor", "right wheel motor"):
+        r.motor(m).set_position(math.inf)
+        r.motor(m).set_velocity(2.0)
+    sim.run(100)   # 1 s at 2 rad/s on 0.03 m wheels: 0.06 m forward
+    assert r.pose.translation == pytest.approx([0.06, 0.0, 0.0], abs=1e-12)
+    assert r.pose.rotation[:, 2] == pytest.approx([0.0, 1.0, 0.0], abs=1e-12)   # still standing up
+
+
+def _lamp_world(robot_lights: list, world_lights: list, at=(0.0, 0.0, 0.0)) -> wm.World:
+    return parse_world({
+        "lights": world_lights,
+        "robots": [{"name": "lamp", "pose": {"translation": list(at)}, "lights": robot_lights},
+                   {"name": "eye", "pose": {"translation": [1.0, 0.0, 0.0]},
+                    "devices": [{"name": "ls", "device": "LightSensor", "pose": {"rotation": [0, 0, 1, 3.141592653589793]}}]}],
+    }).world
+
+
+def test_light_on_a_robot_moves_with_it() -> None:
+    carried = Simulation(_lamp_world([{"type": "PointLight", "location": [0.0, 0.0, 0.1], "attenuation": [0, 0, 1]}], []))
+    ls = carried.device("eye/ls")
+    ls.enable(32)
+    carried.step()
+    near = ls.value
+    carried.robot("lamp").set_pose([-0.5, 0.0, 0.0])
+    carried.step()
+    moved = ls.value
+    fixed = Simulation(_lamp_world([], [{"type": "PointLight", "location": [-0.5, 0.0, 0.1], "attenuation": [0, 0, 1]}]))
+    fixed.device("eye/ls").enable(32)
+    fixed.step()
+    assert moved == fixed.device("eye/ls").value   # bit for bit
+    assert near > moved > 0
+
+
+def test_nested_solid_children_compose_and_move_together() -> None:
+    w = parse_world({"solids": [{"name": "base", "pose": {"translation": [1.0, 0.0, 0.0]},
+                                 "children": [{"name": "top", "pose": {"translation": [0.0, 0.0, 0.5]},
+                                               "geometry": {"type": "box", "size": [0.2, 0.2, 0.2]}}]}],
+                     "robots": [{"name": "r", "devices": [{"name": "d", "device": "DistanceSensor",
+                                                           "pose": {"translation": [0.0, 0.0, 0.5]},
+                                                           "lookup_table": [[0, 0, 0], [2, 2000, 0]]}]}]}).world
+    sim = Simulation(w)
+    d = sim.device("r/d")
+    d.enable(32)
+    sim.step()
+    assert d.value == pytest.approx(1000 * 0.9, abs=1e-9)   # child box face at x = 0.9
+    sim.set_solid_pose("base", [1.5, 0.0, 0.0])
+    sim.step()
+    assert d.value == pytest.approx(1000 * 1.4, abs=1e-9)
+
+
+def test_builtin_protos(tmp_path: Path) -> None:
+    p = write(tmp_path, 'WorldInfo { }\nTexturedBackgroundLight { texture "noon_sunny_empty" luminosity 2 }\n'
+                        'SolidBox { }\nWoodenBox { translation 1 0 0.1 size 0.2 5 0.2 }\nRobot { }\nRobot { }\n')
+    w = load_world(p).world
+    (sun,) = w.lights
+    # the PROTO's NUE direction (0.9, -0.59, 0.28) in ENU axes; ambient 1; luminosity scales the intensity
+    assert (sun.type, sun.direction, sun.intensity, sun.ambient_intensity) == ("DirectionalLight", (0.28, 0.9, -0.59), 2.0, 1.0)
+    box, wooden = w.solids
+    assert box.name == "box" and box.pose.translation == (0.0, 0.0, 1.0)
+    assert box.shapes[0].geometry == wm.Box(type="box", size=(2.0, 2.0, 2.0)) and box.shapes[0].seen_by == "both"
+    assert box.shapes[0].appearance.roughness == 0.5
+    assert wooden.name == "wooden box" and wooden.shapes[0].geometry.size == (0.2, 3.0, 0.2)   # clamped like the PROTO
+    assert [r.name for r in w.robots] == ["robot", "robot(1)"]
+
+
+@contextlib.contextmanager
+def serving(world: Path, *extra: str):
+    """``sensorium serve WORLD`` in a subprocess on free loopback ports; yields its RPC endpoint."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", "tcp://127.0.0.1:0",
+                             "--pub", "tcp://127.0.0.1:*", "--precision", "fast", *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+    try:
+        rpc = None
+        deadline = time.monotonic() + 60
+        while rpc is None and time.monotonic() < deadline and proc.poll() is None:
+            if select.select([proc.stdout], [], [], 0.2)[0]:
+                line = proc.stdout.readline()
+                if line.startswith("sensorium: serving world"):
+                    rpc = dict(f.split("=", 1) for f in line.split() if "=" in f)["rpc"]
+        assert rpc is not None, "server did not start"
+        yield rpc
+    finally:
+        proc.terminate()
+        proc.wait(30)
+        proc.stdout.close()
+
+
+def test_serve_a_wbt_world(tmp_path: Path) -> None:
+    import msgpack
+    import zmq
+
+    from sensorium.server.recording.reader import Recording
+
+    ctx = zmq.Context()
+    try:
+        with serving(HERE / "full.wbt", "--record", str(tmp_path / "run.mcap")) as rpc:
+            sock = ctx.socket(zmq.DEALER)
+            sock.setsockopt(zmq.LINGER, 0)
+            sock.connect(rpc)
+            sock.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": "bot"}}))
+            assert sock.poll(30_000)
+            reply = msgpack.unpackb(sock.recv_multipart()[-1], raw=False)
+            assert reply["ok"], reply
+            assert {"ir", "sonar", "lidar", "ls", "led0", "left wheel sensor"} <= {d["name"] for d in reply["result"]["devices"]}
+            sock.close(0)
+    finally:
+        ctx.destroy(linger=0)
+    with Recording(tmp_path / "run.mcap") as rec:   # the world attached as the user wrote it
+        assert rec.world() == ("full.wbt", (HERE / "full.wbt").read_bytes())
+
+
+def test_example_wbt_world_runs_the_braitenberg_controller() -> None:
+    """The shipped Webots-style world and the example Webots controller, unchanged."""
+    world = ROOT / "sensorium" / "worlds" / "epuck.wbt"
+    loaded = load_world(world)
+    assert [w for w in loaded.warnings if "skipped nodes" not in w] == []
+    assert loaded.world.robots[0].differential_drive is not None
+    script = ROOT / "sensorium" / "client" / "examples" / "braitenberg.py"
+    with serving(world) as rpc:
+        out = subprocess.run([sys.executable, "-m", "sensorium", "controller", str(script), "--robot", "epuck",
+                              "--url", f"{rpc}/epuck", "60"], capture_output=True, text=True, timeout=300,
+                             env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert out.returncode == 0, out.stderr
+    lines = [x for x in out.stdout.splitlines() if x.startswith("t=")]
+    assert len(lines) == 60
+    light = [float(x.split("ls0=")[1].split()[0]) for x in lines]
+    assert all(v > 0 for v in light[1:]) and len(set(light)) > 5   # it sees the lamp, and it moves
+
+
+def test_def_use_expansion_is_bounded(tmp_path: Path, monkeypatch) -> None:
+    """Each level USEs the previous one twice: 2**25 boxes if expanded; the converter stops early."""
+    from sensorium.server.world.wbt import convert
+
+    monkeypatch.setattr(convert, "MAX_PARTS", 2000)
+    levels = ["DEF L0 Group { children [ Shape { geometry Box { } } ] }"]
+    levels += [f"DEF L{i} Group {{ children [ USE L{i - 1} USE L{i - 1} ] }}" for i in range(1, 26)]
+    p = write(tmp_path, "Solid { children [\n" + "\n".join(levels) + "\n] }\n")
+    with pytest.raises(WorldError, match="more than 2000 shapes, devices and lights after DEF/USE expansion"):
+        load_world(p)
+
+
+def test_contact_with_multi_shape_bodies() -> None:
+    """A robot whose body is an offset cylinder (radius 0.05) drives +x into a solid made of two
+    shapes; it stops where its disc touches the wall's face: x = 0.95 - 0.05."""
+    w = parse_world({
+        "solids": [{"name": "wall", "pose": {"translation": [1.0, 0.0, 0.0]},
+                    "shapes": [{"pose": {"translation": [0.0, 0.0, 0.1]}, "geometry": {"type": "box", "size": [0.1, 2.0, 0.2]}},
+                               {"pose": {"translation": [0.0, 3.0, 0.1]}, "geometry": {"type": "sphere", "radius": 0.1}}]}],
+        "robots": [{"name": "r", "shapes": [{"pose": {"translation": [0.0, 0.0, 0.05]},
+                                             "geometry": {"type": "cylinder", "radius": 0.05, "height": 0.1}}],
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.1, "max_wheel_speed": 10}}],
+    }).world
+    sim = Simulation(w)
+    r = sim.robot("r")
+    for m in r.motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(10.0)
+    sim.run(100)   # 0.5 m/s for 3.2 s: far past the wall without contact
+    assert r.pose.translation[0] == pytest.approx(0.9, abs=1e-9)
+    assert r.pose.translation[0] < 0.9
+
+
+def test_robot_inside_groups_gets_the_composed_pose(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Pose { translation 1 0 0 rotation 0 0 1 1.5707963267948966 children [\n'
+                        '  Group { children [ Robot { translation 0 2 0 rotation 0 0 1 1.5707963267948966 name "r" } ] } ] }\n'
+                        'Solid { children [ Robot { name "inner" } ] }\n')
+    w = load_world(p)
+    (r,) = w.world.robots
+    from sensorium.server.world.poses import pose_from_model
+
+    pose = pose_from_model(r.pose)
+    assert pose.translation == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)      # (0, 2) turned a quarter, plus (1, 0)
+    assert pose.rotation[:, 0] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)   # two quarter turns: facing -x
+    assert f"{p}:4:20: a Robot inside a Solid or another Robot is not supported: skipped" in w.warnings
+
+
+def test_unsimulated_devices_keep_their_shapes(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" children [ Camera { translation 0.1 0 0 children [\n'
+                        '  Shape { geometry Box { size 0.01 0.02 0.03 } } ] } GPS { } ] }\n')
+    w = load_world(p)
+    (part,) = w.world.robots[0].shapes
+    assert part.geometry == wm.Box(type="box", size=(0.01, 0.02, 0.03)) and part.pose.translation == (0.1, 0.0, 0.0)
+    assert part.seen_by == "visual"
+    assert f"{p}: skipped nodes that do not matter to these sensors: Camera, GPS" in w.warnings
+
+
+def test_named_controllers_become_extern(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" controller "e-puck_avoid_collision" }\n')
+    w = load_world(p)
+    assert w.world.robots[0].name == "r"
+    assert (f"{p}:2:1: Robot 'r': controller 'e-puck_avoid_collision' is not started here; run it with "
+            "`sensorium controller` (the robot is an <extern> robot)") in w.warnings
+    if "controller" in wm.Robot.model_fields:
+        assert w.world.robots[0].controller == "<extern>"
+
+
+def test_mesh_and_scale_problems_point_at_lines(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.dae" ] } }\n  ]\n}\n')
+    (tmp_path / "robot.dae").write_text("<COLLADA/>")
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value).startswith(f"{p}: line 4, column 22 (Mesh, converted as solids[0].shapes[0].geometry.url): "
+                                     "unsupported mesh format '.dae'")
+    p = write(tmp_path, 'Transform {\n  scale 1 2 1\n  children [ Shape { geometry Box { } } ]\n}\n')
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value) == f"{p}: line 3, column 3: Transform.scale: only a uniform positive scale is supported, got 1.0 2.0 1.0"
+
+
+def test_scaled_transform_scales_geometry(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid { name "s" children [ Transform { translation 0 0 1 scale 2 2 2 children [\n'
+                        '  Pose { translation 0.5 0 0 children [ Shape { geometry Cylinder { radius 0.1 height 0.3 } } ] } ] } ] }\n')
+    (part,) = load_world(p).world.solids[0].shapes
+    assert part.pose.translation == (1.0, 0.0, 1.0)     # the child's offset is scaled too
+    assert (part.geometry.radius, part.geometry.height) == (0.2, 0.6)
+
+
+def test_field_typos_are_reported(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid {\n  translaton 1 0 0\n  rotationStep 0.1\n  children [ Shape { geometry Box { sise 1 1 1 } '
+                        'appearance PBRAppearance { basecolor 1 0 0 } } ]\n}\n')
+    w = load_world(p)
+    typos = [x for x in w.warnings if "did you mean" in x]
+    assert typos == [f"{p}:3:3: Solid.translaton: not a Solid field, ignored (did you mean translation?)",
+                     f"{p}:5:37: Box.sise: not a Box field, ignored (did you mean size?)",
+                     f"{p}:5:77: PBRAppearance.basecolor: not a PBRAppearance field, ignored (did you mean baseColor?)"]
+
+
+def test_supervisor_finds_nodes_by_def_name() -> None:
+    from sensorium.server.daemon.supervisor import find_node
+
+    sim = Simulation(load_world(ROOT / "sensorium" / "worlds" / "epuck.wbt"))
+    assert find_node(sim, "EPUCK").name == "epuck" and find_node(sim, "EPUCK").type == "Robot"
+    assert find_node(sim, "LAMP").name == "lamp" and find_node(sim, "LAMP").type == "Solid"
+    assert find_node(sim, "epuck").name == "epuck"      # a name still works
+    assert find_node(sim, "NOPE") is None
+
+
+def test_duplicate_def_names_rejected_in_world_files() -> None:
+    with pytest.raises(WorldError, match=r"solids\[0\].def_name: duplicate DEF name 'A' \(first used at robots\[0\].def_name\)"):
+        parse_world({"robots": [{"name": "r", "def_name": "A"}],
+                     "solids": [{"name": "s", "def_name": "A", "geometry": {"type": "box"}}]})
+
+
+def test_drive_from_wheel_end_points_when_anchors_coincide(tmp_path: Path) -> None:
+    """As in Webots' e-puck: both hinge anchors at the axle's centre, the wheels placed by their end points."""
+    wheel = ('HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 0 0.02 }} '
+             'device [ RotationalMotor {{ name "{0} wheel motor" maxVelocity 6.28 }} ] endPoint Solid {{ translation 0 {1} 0.02 '
+             'boundingObject Transform {{ rotation 1 0 0 1.570796 children [ Cylinder {{ height 0.005 radius 0.02 }} ] }} }} }}\n')
+    p = write(tmp_path, 'Robot { name "e" children [\n' + wheel.format("left", 0.026) + wheel.format("right", -0.026) + "] }\n")
+    dd = load_world(p).world.robots[0].differential_drive
+    assert dd == wm.DifferentialDrive(wheel_radius=0.02, axle_length=0.052, max_wheel_speed=6.28)
+
+
+def test_textures_summarised_once(tmp_path: Path) -> None:
+    shape = ('Shape { appearance PBRAppearance { baseColor 0.5 0.2 0.2 baseColorMap ImageTexture { url [ "a.png" ] } } '
+             'geometry Box { } }')
+    p = write(tmp_path, f"Solid {{ name \"a\" children [ {shape} ] }}\nSolid {{ name \"b\" children [ {shape} ] }}\n")
+    w = load_world(p)
+    assert w.world.solids[0].shapes[0].appearance.base_color == (0.5, 0.2, 0.2)
+    notes = [x for x in w.warnings if "textures are not sampled" in x]
+    assert notes == [f"{p}:2:48: textures are not sampled (2 appearances): a PBRAppearance reads as its baseColor, "
+                     "a textured Appearance as white"]
+
+
+def test_mangled_worlds_fail_cleanly(tmp_path: Path) -> None:
+    """Cut, garbled and truncated copies of full.wbt: each loads or raises WorldError, nothing else."""
+    import random
+
+    src = (HERE / "full.wbt").read_text()
+    rng = random.Random(11)
+    junk = ["{", "}", "[", "]", '"', "USE OB", "DEF X", "NULL", "TRUE", "-1", "1e400", "0", "Solid {", "Robot {",
+            "#", "\n", ",", "HingeJoint {", "E-puck {}", "size", "Box {}", "'"]
+    p = tmp_path / "m.wbt"
+    outcomes = set()
+    for _ in range(150):
+        s = src
+        for _ in range(rng.randint(1, 3)):
+            k = rng.randrange(len(s)) if s else 0
+            op = rng.random()
+            s = s[:k] + s[k + rng.randint(1, 20):] if op < 0.35 else s[:k] + f" {rng.choice(junk)} " + s[k:] if op < 0.8 else s[:k]
+        p.write_text(s)
+        try:
+            load_world(p)
+            outcomes.add("ok")
+        except WorldError as exc:
+            assert str(exc).startswith(f"{p}: ") and "\n" not in str(exc).split(": ", 1)[0]
+            outcomes.add("error")
+    assert outcomes == {"ok", "error"}
+
+
+def test_repeated_device_names_get_a_suffix(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" children [ DistanceSensor { } DistanceSensor { translation 0 0 0.1 }\n'
+                        '  LightSensor { name "distance sensor(1)" } ] }\n')
+    w = load_world(p)
+    # the third name was taken by the rename of the second: it moves on in turn
+    assert [d.name for d in w.world.robots[0].devices] == ["distance sensor", "distance sensor(1)", "distance sensor(1)(1)"]
+    assert f"{p}:2:48: device name 'distance sensor' used before in robot 'r': renamed 'distance sensor(1)'" in w.warnings
+
+
+def test_def_use_walk_is_bounded_without_shapes(tmp_path: Path, monkeypatch) -> None:
+    from sensorium.server.world.wbt import convert
+
+    monkeypatch.setattr(convert, "MAX_VISITS", 5000)
+    levels = ["DEF L0 Group { }"] + [f"DEF L{i} Group {{ children [ USE L{i - 1} USE L{i - 1} ] }}" for i in range(1, 40)]
+    with pytest.raises(WorldError, match="more than 5000 nodes to walk after DEF/USE expansion"):
+        load_world(write(tmp_path, "\n".join(levels) + "\n"))
+    # the same inside a boundingObject (walked by another path)
+    bomb = "Solid { boundingObject Group { children [\n" + "\n".join(levels) + "\n] } }\n"
+    with pytest.raises(WorldError, match="more than 5000 nodes to walk"):
+        load_world(write(tmp_path, bomb))
