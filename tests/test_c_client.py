@@ -62,13 +62,14 @@ def cbin(tmp_path_factory) -> dict[str, str]:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
         out[name] = str(exe)
-    exe = build / "braitenberg_cpp"                     # the header-only C++ layer
-    cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
-           f"-I{CLIB / 'include'}", str(TESTS_C / "braitenberg_cpp.cpp"), "-o", str(exe), str(build / "libController.a"),
-           *libs]
-    done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    out["braitenberg_cpp"] = str(exe)
+    for name in ("braitenberg_cpp", "supervisor_cpp"):  # the header-only C++ layer
+        exe = build / name
+        cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+               f"-I{CLIB / 'include'}", str(TESTS_C / f"{name}.cpp"), "-o", str(exe), str(build / "libController.a"),
+               *libs]
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        out[name] = str(exe)
     return out
 
 
@@ -376,6 +377,14 @@ def test_robot_extras_led_keyboard_and_supervisor(cbin, servers):
     with RobotClient(server.url("rover")) as py:
         assert py.custom_data == "after reset" and py.model == "C-rover"
         assert py.by_name["led0"].desc["value"] == 1
+
+
+def test_supervisor_through_the_cpp_classes(cbin, servers):
+    lines = run([cbin["supervisor_cpp"]], servers(CDEVICES).url("rover"))
+    head = lines[0].split()
+    assert head[0] == "C-rover" and head[1] == "5" and [float(v) for v in head[2:5]] == [0.125, 0.25, 0.0]
+    assert head[5:] == ["1", "left", "wheel", "motor", "1", "2"]
+    assert float(lines[1]) == pytest.approx(6.28 * 0.016, abs=1e-12)   # position control at maxVelocity, one step
 
 
 def test_c_client_replays_the_conformance_session(cbin, servers):
