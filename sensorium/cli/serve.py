@@ -39,6 +39,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--precision", choices=["fast", "exact"], default="exact", help="ray engine precision")
     p.add_argument("--heartbeat-ms", type=int, default=1000, metavar="N",
                    help="controllers not heard from for 3*N ms are released (default 1000)")
+    p.add_argument("--no-contact", action="store_true",
+                   help="robots drive through solids and each other (overrides world_info.contact)")
     p.add_argument("--until", type=int, metavar="MS",
                    help="quit when the simulated time reaches MS milliseconds (pending steps get -1)")
     p.add_argument("--record", metavar="FILE.mcap",
@@ -56,7 +58,8 @@ def options(args: argparse.Namespace):
     return ServeOptions(rpc=args.rpc, pub=args.pub, mode=args.mode, precision=args.precision,
                         heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None),
                         allow_large=getattr(args, "allow_large", False),
-                        allow_outside_meshes=getattr(args, "allow_outside_meshes", False))
+                        allow_outside_meshes=getattr(args, "allow_outside_meshes", False),
+                        contact=False if getattr(args, "no_contact", False) else None)
 
 
 def main(args: argparse.Namespace) -> int:
