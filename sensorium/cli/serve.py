@@ -34,6 +34,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="quit when the simulated time reaches MS milliseconds (pending steps get -1)")
     p.add_argument("--record", metavar="FILE.mcap",
                    help="record the published messages from inside the step loop (nothing dropped)")
+    p.add_argument("--foxglove", metavar="[HOST:]PORT",
+                   help="also serve the topics, transforms and the world to Foxglove (WebSocket) on PORT, "
+                   "host 127.0.0.1 unless given; port 0 picks a free port")
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
                    "without subscribers (default: every topic)")
@@ -75,12 +78,27 @@ def main(args: argparse.Namespace) -> int:
             transport.close()
             print(f"sensorium serve: cannot record: {exc}", file=sys.stderr)
             return 1
+    viewer = None
+    if getattr(args, "foxglove", None):
+        from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, parse_address
+        try:
+            host, port = parse_address(args.foxglove)
+            viewer = FoxgloveBridge.for_core(core, transport, host, port)
+        except ViewerError as exc:
+            transport.close()
+            if recorder is not None:
+                recorder.close()
+            print(f"sensorium serve: {exc}", file=sys.stderr)
+            return 1
     transport.install_signal_handlers()
-    print(f"sensorium: serving world '{core.world_name}' rpc={transport.rpc_endpoint} pub={transport.pub_endpoint}",
+    extra = f" foxglove={viewer.url}" if viewer is not None else ""
+    print(f"sensorium: serving world '{core.world_name}' rpc={transport.rpc_endpoint} pub={transport.pub_endpoint}{extra}",
           flush=True)
     try:
         transport.run()
     finally:
+        if viewer is not None:
+            viewer.close()
         if recorder is not None:
             recorder.close()
             print(f"sensorium: recorded {recorder.message_count} messages to {args.record}", file=sys.stderr, flush=True)

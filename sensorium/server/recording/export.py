@@ -348,3 +348,41 @@ def print_report(report: ExportReport, file=sys.stdout) -> None:
     for topic, n in sorted(report.skipped.items()):
         print(f"  skipped {n} message(s) on {topic}: {report.reasons.get(topic, '?')}", file=file)
 
+
+
+# --------------------------------------------------------------------------------------------
+# one message at a time: the CDR bytes Foxglove (live viewer, Foxglove-ready recordings) receives
+
+
+class CdrEncoder:
+    """Recorded/published msgpack bodies → ROS 2 CDR bytes with rosbags' ``serialize_cdr`` (the
+    encoder of the rosbag2 export, so a live viewer, a Foxglove-ready recording and an exported bag
+    carry the same bytes). ``pointcloud2``: ``sensor_msgs/msg/PointCloud`` bodies become
+    ``sensor_msgs/msg/PointCloud2`` (Foxglove's 3D panel draws PointCloud2, not the old PointCloud)."""
+
+    def __init__(self, distro: str = "jazzy", pointcloud2: bool = True):
+        self.distro = distro
+        self.pointcloud2 = pointcloud2
+        self.typestore = typestore_for(distro)
+        self._defs: dict[str, str] = {}
+
+    def export_type(self, ros_type: str) -> str | None:
+        """The type a topic of ``ros_type`` is encoded as, or ``None`` if the distro lacks it."""
+        if self.pointcloud2 and ros_type == POINT_CLOUD:
+            return POINT_CLOUD2
+        return ros_type if ros_type in self.typestore.fielddefs else None
+
+    def msgdef(self, typename: str) -> str:
+        """The ``ros2msg`` schema text (the type, then its dependencies after ``=====`` lines)."""
+        text = self._defs.get(typename)
+        if text is None:
+            text = self._defs[typename] = self.typestore.generate_msgdef(typename, ros_version=2)[0]
+        return text
+
+    def encode(self, ros_type: str, body_bytes: bytes) -> tuple[str, bytes]:
+        """``(export type, CDR bytes)``; raises :class:`ExportError` on a body that does not convert."""
+        if self.export_type(ros_type) is None:
+            raise ExportError(f"type {ros_type!r} unknown to ROS 2 {self.distro}")
+        typename, msg = convert_message(self.typestore, ros_type, body_bytes, self.pointcloud2)
+        data = self.typestore.serialize_cdr(to_rosbags(self.typestore, typename, msg), typename)
+        return typename, bytes(data)
