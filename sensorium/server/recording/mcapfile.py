@@ -15,6 +15,11 @@ publishes, with the bytes it published: nothing is dropped and nothing is re-enc
 * the world file as an attachment; a metadata record ``sensorium`` (seed, time step, version, ...,
   deterministic) and a metadata record ``session`` (wall-clock start/end, not deterministic).
 
+Foxglove-ready recordings (format 2, the default when the ``foxglove`` extra is installed): the
+msgpack bodies go to ``/sensorium/wire<topic>`` channels wrapped as a CDR ``uint8[]`` (still byte
+for byte), next to per-topic ROS 2 CDR views, ``/tf`` and ``/scene`` that Foxglove displays; see
+:mod:`sensorium.server.recording.foxglove_views`. Readers use only the lossless channels.
+
 Reading (``Recording``) streams messages in time order, and summarises a file for ``sensorium info``.
 A file whose writer died without finishing (kill -9, power loss) has no summary or footer: it is
 then read sequentially up to its last complete chunk and reported as ``truncated``.
@@ -52,6 +57,8 @@ from mcap.records import (
 )
 from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType, IndexType, Writer
+
+from sensorium.server.recording import foxglove_views as fxv
 
 PROFILE = "x-sensorium"
 MESSAGE_ENCODING = "msgpack"
@@ -191,8 +198,15 @@ class McapRecorder:
                  topics: list[str] | None = None, chunk_size: int = DEFAULT_CHUNK_SIZE, *,
                  compression: str = "zstd", flush_interval: float | None = 1.0,
                  session: dict[str, str] | None = None, demand: bool = True,
-                 background_flush: bool = True):
+                 background_flush: bool = True, foxglove: bool = True, world: Any = None,
+                 base_dir: str | os.PathLike = "."):
         self.path = Path(path)
+        # Foxglove views (format 2) when asked for and the extra is installed
+        self.foxglove_unavailable = fxv.available() if foxglove else "not requested"
+        self._views = fxv.FoxgloveViews(world, base_dir) if self.foxglove_unavailable is None else None
+        self._view_schemas: dict[str, int] = {}
+        self._view_channels: dict[str, int] = {}
+        self._view_seq: dict[str, int] = {}
         self.topics = list(topics) if topics else None
         self.demand = demand
         self._wants = topic_matcher(self.topics)
@@ -223,6 +237,9 @@ class McapRecorder:
                     "log_time": "simulation time in ns since the simulation started",
                     "message_encoding": MESSAGE_ENCODING,
                     "envelope": "msgpack {type: schema name, seq: sequence, stamp_ns: log_time}"}
+            if self._views is not None:
+                meta.update({"format": "2", "wire_channels": f"{fxv.WIRE_PREFIX}<topic>: msgpack body as CDR "
+                             f"{fxv.WIRE_SCHEMA}; <topic>: ROS 2 CDR view; /tf, /scene: Foxglove"})
             if world_name:
                 meta["world_file"] = world_name
             meta.update({str(k): str(v) for k, v in (metadata or {}).items()})
@@ -233,6 +250,9 @@ class McapRecorder:
                     "started_at_ns": str(time.time_ns()), "pid": str(os.getpid())}
             sess.update({str(k): str(v) for k, v in (session or {}).items()})
             self._writer.add_metadata("session", sess)
+            scene = self._views.scene() if self._views is not None else None
+            if scene is not None:
+                self._add_view(scene, 0)
         except BaseException:
             self._stream.close()
             raise
@@ -275,8 +295,14 @@ class McapRecorder:
             stamp = int(stamp_ns)
             if stamp < 0:
                 raise ValueError(f"{topic}: negative stamp_ns {stamp}")
-            self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
-                                     data=bytes(body), sequence=int(seq) % SEQ_MODULUS)
+            if self._views is None:
+                self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
+                                         data=bytes(body), sequence=int(seq) % SEQ_MODULUS)
+            else:
+                self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
+                                         data=fxv.wire_wrap(bytes(body)), sequence=int(seq) % SEQ_MODULUS)
+                for view in self._views.views(topic, ros_type, bytes(body), stamp):
+                    self._add_view(view, stamp, int(seq) if view[0] == topic else None)
             self.counts[topic] = self.counts.get(topic, 0) + 1
             self.message_count += 1
             self._dirty = True
@@ -287,12 +313,35 @@ class McapRecorder:
 
     __call__ = record
 
+    def _add_view(self, view: tuple[str, str, str, bytes, str, bytes], stamp: int, seq: int | None = None) -> None:
+        """One Foxglove view record (caller holds the lock or is the constructor)."""
+        topic, schema_name, schema_encoding, schema_data, message_encoding, data = view
+        cid = self._view_channels.get(topic)
+        if cid is None:
+            sid = self._view_schemas.get(schema_name)
+            if sid is None:
+                sid = self._view_schemas[schema_name] = self._writer.register_schema(
+                    name=schema_name, encoding=schema_encoding, data=schema_data)
+            cid = self._view_channels[topic] = self._writer.register_channel(
+                topic=topic, message_encoding=message_encoding, schema_id=sid, metadata={"sensorium.view": "1"})
+        if seq is None:
+            seq = self._view_seq.get(topic, 0)
+            self._view_seq[topic] = seq + 1
+        self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp, data=data,
+                                 sequence=seq % SEQ_MODULUS)
+
     def _register(self, topic: str, ros_type: str, envelope: bytes, body: bytes) -> int:
-        sid = self._schemas.get(ros_type)
-        if sid is None:
-            sid = self._writer.register_schema(name=ros_type, encoding="", data=b"")
-            self._schemas[ros_type] = sid
         meta = _topic_parts(topic)
+        if self._views is not None:
+            sid = self._schemas.get(fxv.WIRE_SCHEMA)
+            if sid is None:
+                sid = self._schemas[fxv.WIRE_SCHEMA] = self._writer.register_schema(
+                    name=fxv.WIRE_SCHEMA, encoding="ros2msg", data=fxv.WIRE_MSGDEF.encode())
+        else:
+            sid = self._schemas.get(ros_type)
+            if sid is None:
+                sid = self._writer.register_schema(name=ros_type, encoding="", data=b"")
+                self._schemas[ros_type] = sid
         try:
             decoded = msgpack.unpackb(body, raw=False)
             frame = decoded.get("header", {}).get("frame_id") if isinstance(decoded, dict) else None
@@ -306,8 +355,13 @@ class McapRecorder:
                 meta["envelope_keys"] = ",".join(str(k) for k in env)
         except Exception:
             pass
-        cid = self._writer.register_channel(topic=topic, message_encoding=MESSAGE_ENCODING,
-                                            schema_id=sid, metadata=meta)
+        if self._views is not None:
+            meta.update({"sensorium.topic": topic, "sensorium.type": ros_type})
+            cid = self._writer.register_channel(topic=fxv.WIRE_PREFIX + topic, message_encoding="cdr",
+                                                schema_id=sid, metadata=meta)
+        else:
+            cid = self._writer.register_channel(topic=topic, message_encoding=MESSAGE_ENCODING,
+                                                schema_id=sid, metadata=meta)
         self._channels[topic] = cid
         return cid
 
@@ -382,7 +436,8 @@ def recorder_for_server(path: str | os.PathLike, core: Any, topics: list[str] | 
             "basic_time_step_ms": str(getattr(sim, "basic_time_step", "")),
             "precision": str(getattr(getattr(sim, "precision", None), "value", getattr(sim, "precision", "")))}
     rec = McapRecorder(path, text, Path(source).name if source and source != "<memory>" else "world.yaml", meta,
-                       topics, chunk_size, session={"mode": "server", "world_path": source})
+                       topics, chunk_size, session={"mode": "server", "world_path": source},
+                       world=getattr(sim, "world", None), base_dir=getattr(loaded, "base_dir", "."))
     try:
         base = Path(getattr(loaded, "base_dir", "") or ".")
         seen: set[str] = set()
@@ -441,6 +496,31 @@ class TopicInfo:
         if self.count < 2 or self.first_ns is None or self.last_ns is None or self.last_ns <= self.first_ns:
             return None
         return (self.count - 1) * 1e9 / (self.last_ns - self.first_ns)
+
+
+def _source(topic: str, ros_type: str, encoding: str, metadata: Any) -> tuple[str, str] | None:
+    """A channel that holds published bodies → (topic, ROS type); ``None`` for a Foxglove view."""
+    if topic.startswith(fxv.WIRE_PREFIX) and "sensorium.topic" in metadata:
+        return metadata["sensorium.topic"], metadata.get("sensorium.type", "")
+    if encoding == MESSAGE_ENCODING:
+        return topic, ros_type
+    return None
+
+
+def _body(topic: str, data: bytes) -> bytes:
+    return fxv.wire_unwrap(data) if topic.startswith(fxv.WIRE_PREFIX) else data
+
+
+def _sources(infos: Iterable[TopicInfo]) -> list[TopicInfo]:
+    """The topics of a recording: its source channels under their topic names and ROS types."""
+    out = []
+    for info in infos:
+        src = _source(info.topic, info.ros_type, info.encoding, info.metadata)
+        if src is not None:
+            info.topic, info.ros_type = src
+            info.encoding = MESSAGE_ENCODING
+            out.append(info)
+    return out
 
 
 class _Unwrap:
@@ -577,7 +657,7 @@ class Recording:
                 attachments.append(record)
             elif isinstance(record, (DataEnd, Footer)):
                 complete = True
-        self._scan_cache = {"header": header, "topics": list(topics.values()), "metadata": metadata,
+        self._scan_cache = {"header": header, "topics": _sources(topics.values()), "metadata": metadata,
                             "attachments": attachments, "chunks": stats.get("chunks", 0),
                             "compression": sorted(stats.get("compression", set())),
                             "stopped": stats.get("stopped"), "complete": complete}
@@ -640,7 +720,7 @@ class Recording:
                     info.last_ns = hi if info.last_ns is None else max(info.last_ns, hi)
                     if stats is None:
                         info.count += len(rec.records)
-        return list(infos.values())
+        return _sources(infos.values())
 
     def messages(self, topics: Iterable[str] | Callable[[str], bool] | None = None,
                  start_ns: int | None = None, end_ns: int | None = None) -> Iterator[RecordedMessage]:
@@ -650,7 +730,12 @@ class Recording:
         match = topics if callable(topics) else topic_matcher(topics)
         unwrap = _Unwrap()
         if self._reader is not None:
-            names = [ch.topic for ch in self._summary.channels.values() if match(ch.topic)]
+            names = []
+            for ch in self._summary.channels.values():
+                sch = self._summary.schemas.get(ch.schema_id)
+                src = _source(ch.topic, sch.name if sch else "", ch.message_encoding, ch.metadata)
+                if src is not None and match(src[0]):
+                    names.append(ch.topic)
             kwargs: dict[str, Any] = {"log_time_order": True}
             try:
                 it = self._reader.iter_messages(topics=names, starting_at=start_ns,
@@ -663,8 +748,10 @@ class Recording:
             if first is None:
                 return
             for schema, channel, message in _chain(first, it):
-                yield RecordedMessage(channel.topic, schema.name if schema else "",
-                                      unwrap(channel.id, message.sequence), message.log_time, message.data)
+                topic, ros_type = _source(channel.topic, schema.name if schema else "", channel.message_encoding,
+                                          channel.metadata) or (channel.topic, "")
+                yield RecordedMessage(topic, ros_type, unwrap(channel.id, message.sequence), message.log_time,
+                                      _body(channel.topic, message.data))
             return
         # sequential: file order, which is publication order
         schemas: dict[int, Schema] = {}
@@ -676,14 +763,16 @@ class Recording:
                 channels[record.id] = record
             elif isinstance(record, Message):
                 ch = channels.get(record.channel_id)
-                if ch is None or not match(ch.topic):
+                if ch is None:
+                    continue
+                schema = schemas.get(ch.schema_id)
+                src = _source(ch.topic, schema.name if schema else "", ch.message_encoding, ch.metadata)
+                if src is None or not match(src[0]):
                     continue
                 t = record.log_time
                 if (start_ns is not None and t < start_ns) or (end_ns is not None and t > end_ns):
                     continue
-                schema = schemas.get(ch.schema_id)
-                yield RecordedMessage(ch.topic, schema.name if schema else "",
-                                      unwrap(ch.id, record.sequence), t, record.data)
+                yield RecordedMessage(src[0], src[1], unwrap(ch.id, record.sequence), t, _body(ch.topic, record.data))
 
     def summary(self) -> dict:
         """What ``sensorium info`` prints (also its ``--json`` form)."""

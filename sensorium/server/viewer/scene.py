@@ -40,10 +40,10 @@ from foxglove.messages import (
     SceneEntity,
     SceneUpdate,
     SpherePrimitive,
+    Timestamp,
     TriangleListPrimitive,
     Vector3,
 )
-from foxglove.schemas import Timestamp
 
 from sensorium.schemas import world as wm
 from sensorium.server.world import geometry as geo
