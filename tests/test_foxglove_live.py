@@ -244,3 +244,40 @@ def test_bad_foxglove_address_is_one_line(tmp_path):
                        timeout=60)
     assert r.returncode == 1
     assert r.stderr.strip().splitlines() == ["sensorium serve: --foxglove 'localhost:http': port 'http' is not a number"]
+
+
+def test_replay_serves_foxglove(tmp_path):
+    require_node()
+    from _recdata import make_recording
+
+    from sensorium.server.recording.mcapfile import Recording
+
+    path = tmp_path / "rec.mcap"
+    make_recording(path, steps=20)
+    with Recording(path) as rec:
+        values = {msgpack.unpackb(m.data, raw=False)["illuminance"] for m in rec.messages(["/epuck/ls0/value"])}
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "replay", str(path), "--loop", "--rate", "1",
+                             "--pub", "tcp://127.0.0.1:0", "--rpc", "tcp://127.0.0.1:0", "--foxglove", "127.0.0.1:0",
+                             "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+    node = None
+    try:
+        url = None
+        deadline = time.monotonic() + 60
+        while url is None and time.monotonic() < deadline and proc.poll() is None:
+            if select.select([proc.stdout], [], [], 0.2)[0]:
+                line = proc.stdout.readline()
+                if "Foxglove viewer at " in line:
+                    url = line.split("Foxglove viewer at ", 1)[1].strip()
+        assert url and url.startswith("ws://127.0.0.1:")
+        node = NodeProcess("live_client.js", url)
+        node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+        node.send(cmd="subscribe", topic="/epuck/ls0/value")
+        m = node.wait_for(lambda e: e["event"] == "message" and e["topic"] == "/epuck/ls0/value", what="replayed")
+        assert m["msg"]["illuminance"] in values and m["msg"]["header"]["frame_id"] == "epuck/ls0"
+    finally:
+        if node is not None:
+            node.close()
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(20)
+        proc.stdout.close()

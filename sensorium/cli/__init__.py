@@ -111,6 +111,8 @@ def _replay_args(p: argparse.ArgumentParser) -> None:
                    help="publish only when a client calls /replay/step {duration} (see PROTOCOL.md, Replay)")
     p.add_argument("--pub", default="tcp://127.0.0.1:5561", help="topic endpoint to bind (default tcp://127.0.0.1:5561)")
     p.add_argument("--rpc", default="tcp://127.0.0.1:5560", help="service endpoint to bind (default tcp://127.0.0.1:5560)")
+    p.add_argument("--foxglove", metavar="[HOST:]PORT",
+                   help="also serve the replay to Foxglove (WebSocket) on PORT, host 127.0.0.1 unless given")
     p.add_argument("--wait", action="store_true", help="wait for a first subscriber before starting")
     p.add_argument("--delay", type=_seconds, default=0.0, metavar="S", help="wait S seconds before starting (and between loops)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,

@@ -304,12 +304,23 @@ def replay_cmd(args: argparse.Namespace) -> int:
     except (OSError, ValueError) as exc:
         print(f"sensorium replay: {exc}", file=sys.stderr)
         return 1
+    viewer = None
     try:
         try:
             r.bind()
         except zmq.ZMQError as exc:
             print(f"sensorium replay: cannot bind: {exc}", file=sys.stderr)
             return 1
+        viewer = None
+        if getattr(args, "foxglove", None):
+            from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, parse_address
+            try:
+                host, port = parse_address(args.foxglove)
+                viewer = FoxgloveBridge.for_replay(r, host, port)
+            except ViewerError as exc:
+                print(f"sensorium replay: {exc}", file=sys.stderr)
+                return 1
+            print(f"sensorium: Foxglove viewer at {viewer.url}", flush=True)
         print(r.announce(), flush=True)
         if r.recording.truncated:
             print("sensorium: warning: the recording is truncated; replaying up to its last complete chunk",
@@ -322,6 +333,8 @@ def replay_cmd(args: argparse.Namespace) -> int:
         print(f"sensorium: replay finished: {r.emitted} messages", file=sys.stderr, flush=True)
         return 0
     finally:
+        if viewer is not None:
+            viewer.close()
         r.close()
 
 

@@ -422,7 +422,7 @@ class McapRecorder:
 
 
 def recorder_for_server(path: str | os.PathLike, core: Any, topics: list[str] | None = None,
-                        chunk_size: int = DEFAULT_CHUNK_SIZE) -> McapRecorder:
+                        chunk_size: int = DEFAULT_CHUNK_SIZE, foxglove: bool = True) -> McapRecorder:
     """``sensorium serve --record``: a recorder for ``core`` (``sensorium.server.daemon.services.Core``)
     with the world file (and its meshes) attached and seed/time step/version as metadata, already
     hooked into ``core.topics``. Without ``topics`` every topic is computed and recorded."""
@@ -437,7 +437,8 @@ def recorder_for_server(path: str | os.PathLike, core: Any, topics: list[str] | 
             "precision": str(getattr(getattr(sim, "precision", None), "value", getattr(sim, "precision", "")))}
     rec = McapRecorder(path, text, Path(source).name if source and source != "<memory>" else "world.yaml", meta,
                        topics, chunk_size, session={"mode": "server", "world_path": source},
-                       world=getattr(sim, "world", None), base_dir=getattr(loaded, "base_dir", "."))
+                       world=getattr(sim, "world", None), base_dir=getattr(loaded, "base_dir", "."),
+                       foxglove=foxglove)
     try:
         base = Path(getattr(loaded, "base_dir", "") or ".")
         seen: set[str] = set()

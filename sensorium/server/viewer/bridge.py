@@ -69,6 +69,28 @@ def parse_address(text: str) -> tuple[str, int]:
     return host, port
 
 
+def _recorded_world(recording: Any) -> tuple[wm.World | None, Path]:
+    """The world model attached to a recording (attachments unpacked to a temporary directory so
+    that mesh files resolve), or ``(None, .)`` when it is missing or does not load."""
+    import tempfile
+
+    from sensorium.server.world.loader import WorldError, load_world
+
+    found = recording.world()
+    if found is None:
+        return None, Path(".")
+    tmp = Path(tempfile.mkdtemp(prefix="sensorium-replay-world-"))
+    try:
+        for a in recording.attachments():
+            target = (tmp / a.name).resolve()
+            if tmp.resolve() in target.parents and not target.exists():
+                target.parent.mkdir(parents=True, exist_ok=True)
+                target.write_bytes(a.data)
+        return load_world(tmp / found[0]).world, tmp
+    except (WorldError, OSError, ValueError):
+        return None, Path(".")
+
+
 class _Listener:
     """The SDK's ``ServerListener``: counts subscriptions per topic (SDK thread)."""
 
@@ -171,6 +193,17 @@ class FoxgloveBridge:
                      solid_poses=lambda: dict(sim.scene.solid_poses), **kw)
         topics.set_viewer(bridge.record)
         transport.hooks.append(lambda: bridge.pump(sim.time_ms * 1_000_000))
+        return bridge
+
+    @classmethod
+    def for_replay(cls, replayer: Any, host: str = "127.0.0.1", port: int = DEFAULT_PORT, **kw: Any) -> FoxgloveBridge:
+        """Serve a :class:`~sensorium.server.recording.replay.Replayer`'s messages (every replayed
+        message is offered; demand does not apply to a replay). The scene comes from the world file
+        (and meshes) attached to the recording, when it loads."""
+        world, base = _recorded_world(replayer.recording)
+        bridge = cls(dict(replayer.topic_types), world, base, host=host, port=port,
+                     name=f"sensorium replay {Path(replayer.path).name}", **kw)
+        replayer.viewer = bridge.record
         return bridge
 
     @property
