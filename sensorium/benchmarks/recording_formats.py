@@ -32,14 +32,17 @@ def measure(steps: int, foxglove: bool, out: Path) -> dict:
         spent[0] += time.perf_counter() - t0
 
     topics.set_recorder(timed)
+    t_loop = time.perf_counter()
     for _ in range(steps):
         sim.step()
         topics.publish(sim.time_ms)
+    loop_s = time.perf_counter() - t_loop
     t0 = time.perf_counter()
     rec.close()
     close_s = time.perf_counter() - t0
     return {"format": "2 (foxglove)" if foxglove else "1 (msgpack)", "messages": rec.message_count,
-            "bytes": out.stat().st_size, "record_s": spent[0], "close_s": close_s}
+            "bytes": out.stat().st_size, "record_s": spent[0], "close_s": close_s,
+            "loop_s": loop_s}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -47,10 +50,10 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as d:
         rows = [measure(steps, fg, Path(d) / f"f{int(fg)}.mcap") for fg in (False, True)]
     print(f"{steps} steps of the arena world ({steps * 32 / 1000:g} s simulated), every topic recorded")
-    print(f"{'format':14} {'messages':>9} {'file size':>12} {'recorder time':>14} {'per step':>10}")
+    print(f"{'format':14} {'messages':>9} {'file size':>12} {'recorder time':>14} {'per step':>10} {'share of loop':>14}")
     for r in rows:
         print(f"{r['format']:14} {r['messages']:9d} {r['bytes'] / 1e6:10.2f} MB {r['record_s']:12.2f} s "
-              f"{r['record_s'] / steps * 1e3:7.2f} ms")
+              f"{r['record_s'] / steps * 1e3:7.2f} ms {100 * r['record_s'] / r['loop_s']:12.0f} %")
     return 0
 
 

@@ -18,6 +18,7 @@ fields the body lacks are zero. ``pointcloud2=True`` turns ``sensor_msgs/msg/Poi
 from __future__ import annotations
 
 import array
+import struct
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +27,7 @@ from typing import Any
 import msgpack
 import numpy as np
 
+from sensorium.server.recording import cdr
 from sensorium.server.recording.mcapfile import Recording
 
 DISTROS = ("humble", "jazzy")
@@ -380,9 +382,23 @@ class CdrEncoder:
         return text
 
     def encode(self, ros_type: str, body_bytes: bytes) -> tuple[str, bytes]:
-        """``(export type, CDR bytes)``; raises :class:`ExportError` on a body that does not convert."""
-        if self.export_type(ros_type) is None:
+        """``(export type, CDR bytes)``; raises :class:`ExportError` on a body that does not convert.
+        Sensorium's own types are written directly (:mod:`.cdr`, byte-identical to rosbags), others
+        through the type store."""
+        typename = self.export_type(ros_type)
+        if typename is None:
             raise ExportError(f"type {ros_type!r} unknown to ROS 2 {self.distro}")
+        if typename in cdr.FAST_TYPES:
+            try:
+                body = msgpack.unpackb(body_bytes, raw=False)
+                if typename == POINT_CLOUD2 and ros_type == POINT_CLOUD:
+                    body = pointcloud2_from_body(body)[1]
+                return typename, cdr.encode(typename, body, self.distro)
+            except (KeyError, TypeError, ValueError, OverflowError, AttributeError, struct.error, ExportError):
+                pass                                  # unusual body: the generic path decides
+        return typename, self.encode_generic(ros_type, body_bytes)
+
+    def encode_generic(self, ros_type: str, body_bytes: bytes) -> bytes:
+        """The same bytes through rosbags' type store and ``serialize_cdr`` (the reference)."""
         typename, msg = convert_message(self.typestore, ros_type, body_bytes, self.pointcloud2)
-        data = self.typestore.serialize_cdr(to_rosbags(self.typestore, typename, msg), typename)
-        return typename, bytes(data)
+        return bytes(self.typestore.serialize_cdr(to_rosbags(self.typestore, typename, msg), typename))

@@ -1,0 +1,82 @@
+"""The Foxglove bridge in-process: addresses, demand bookkeeping, and a stalled viewer that cannot
+hold up the step loop (bounded queue, oldest dropped)."""
+
+from __future__ import annotations
+
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("foxglove")
+
+from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, parse_address  # noqa: E402
+from sensorium.server.world.loader import load_world  # noqa: E402
+
+WORLD = Path(__file__).parent / "worlds" / "server.yaml"
+TYPES = {"/bot/ls/value": "sensor_msgs/msg/Illuminance", "/bot/pose": "geometry_msgs/msg/PoseStamped",
+         "/free/pose": "geometry_msgs/msg/PoseStamped", "/weird": "no_such_pkg/msg/Thing"}
+
+
+def test_parse_address():
+    assert parse_address("8765") == ("127.0.0.1", 8765)
+    assert parse_address("0.0.0.0:0") == ("0.0.0.0", 0)
+    assert parse_address("[::1]:9000") == ("::1", 9000)
+    for bad, msg in [("host:x", "is not a number"), ("70000", "0..65535"), (":80", "empty host"), ("[::1]9", "[HOST]:PORT")]:
+        with pytest.raises(ViewerError, match=msg.replace("[", r"\[").replace("]", r"\]")):
+            parse_address(bad)
+
+
+@pytest.fixture()
+def bridge():
+    demands: list[set[str]] = []
+    b = FoxgloveBridge(TYPES, load_world(WORLD).world, WORLD.parent, port=0, on_demand=demands.append,
+                       queue_size=4)
+    b.demands = demands          # type: ignore[attr-defined]
+    yield b
+    b.close()
+
+
+def test_demand_follows_subscriptions(bridge):
+    assert bridge.unsupported == {"/weird": "no_such_pkg/msg/Thing"}
+    assert set(bridge.channels) == {"/bot/ls/value", "/bot/pose", "/free/pose"}
+    bridge.pump()
+    assert bridge.demands == []                       # nothing changed, nothing applied
+    bridge._subscribed(1, "/bot/ls/value", +1)
+    bridge._subscribed(2, "/bot/ls/value", +1)
+    bridge.pump()
+    assert bridge.demands[-1] == {"/bot/ls/value"}
+    bridge._subscribed(1, "/bot/ls/value", -1)
+    bridge._subscribed(1, "/bot/ls/value", -1)        # a second unsubscribe of client 1 is ignored
+    bridge.pump()
+    assert bridge.demands[-1] == {"/bot/ls/value"}    # client 2 still subscribed
+    bridge._subscribed(2, "/tf", +1)                   # transforms need every robot pose
+    bridge._subscribed(2, "/bot/ls/value", -1)
+    bridge.pump()
+    assert bridge.demands[-1] == {"/bot/pose", "/free/pose"}
+    bridge._subscribed(2, "/tf", -1)
+    bridge.pump()
+    assert bridge.demands[-1] == set() and bridge.subscriptions() == {}
+
+
+def test_a_stalled_viewer_never_blocks_record(bridge):
+    inside, release = threading.Event(), threading.Event()
+
+    def stuck(*_args):
+        inside.set()
+        release.wait(30)
+
+    bridge._forward = stuck                           # the worker hangs on its first message
+    bridge.record("/bot/ls/value", TYPES["/bot/ls/value"], b"", b"\x80", 1, 0)
+    assert inside.wait(30)
+    for i in range(10):                               # the step loop goes on publishing
+        bridge.record("/bot/ls/value", TYPES["/bot/ls/value"], b"", b"\x80", 2 + i, i + 1)
+    assert len(bridge._queue) == 4 and bridge.dropped == 6
+    assert [item[3] for item in bridge._queue] == [8, 9, 10, 11]    # the newest are kept
+    release.set()
+    deadline = time.monotonic() + 30
+    while bridge._queue and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert not bridge._queue
+
