@@ -250,7 +250,7 @@ def test_replay_serves_foxglove(tmp_path):
     require_node()
     from _recdata import make_recording
 
-    from sensorium.server.recording.mcapfile import Recording
+    from sensorium.server.recording.reader import Recording
 
     path = tmp_path / "rec.mcap"
     make_recording(path, steps=20)

@@ -18,7 +18,7 @@ from _node import require_node, run_script
 pytest.importorskip("foxglove")
 
 from sensorium.server.recording.foxglove_views import WIRE_PREFIX  # noqa: E402
-from sensorium.server.recording.mcapfile import Recording  # noqa: E402
+from sensorium.server.recording.reader import Recording  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SUPPORTED = {("cdr", "ros2msg"), ("protobuf", "protobuf")}

@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 from sensorium.server.daemon.topics import Topics
-from sensorium.server.recording.mcapfile import McapRecorder
+from sensorium.server.recording.writer import McapRecorder
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import default_world_path
 

@@ -120,7 +120,7 @@ def run_demo(world: str | None, duration_s: float, out_dir: Path, precision: str
 
 
 def _summarise(result: DemoResult, world) -> None:
-    from sensorium.server.recording.mcapfile import iter_messages
+    from sensorium.server.recording.reader import iter_messages
 
     paths: dict[str, list[tuple[float, float]]] = {}
     light: list[float] = []
@@ -149,7 +149,7 @@ def _summarise(result: DemoResult, world) -> None:
 
 def _draw(result: DemoResult, world, path: Path) -> None:
     from sensorium.cli.png import Canvas
-    from sensorium.server.recording.mcapfile import iter_messages
+    from sensorium.server.recording.reader import iter_messages
     from sensorium.server.world.poses import pose_from_model
 
     canvas = Canvas(-2.2, 2.2, -2.2, 2.2, pixels_per_metre=160)

@@ -28,7 +28,7 @@ import msgpack
 import numpy as np
 
 from sensorium.server.recording import cdr
-from sensorium.server.recording.mcapfile import Recording
+from sensorium.server.recording.reader import Recording
 
 DISTROS = ("humble", "jazzy")
 POINT_CLOUD = "sensor_msgs/msg/PointCloud"

@@ -97,7 +97,7 @@ def _triangles(vertices: np.ndarray, faces: np.ndarray, pose: Pose, color: Color
 def shape_primitives(shape: wm.Shape, pose: Pose, base_dir: Path, budget: list[int]) -> dict[str, list[Any]]:
     """The Foxglove primitives drawing one shape at ``pose`` (in its entity's frame), keyed by the
     ``SceneEntity`` field they go in. ``budget`` (one-element list) is the triangles left."""
-    from sensorium.server.world.scene import primitive_from_model
+    from sensorium.server.sim.scene import primitive_from_model
 
     g, color = shape.geometry, _color(shape)
     if isinstance(g, wm.Box):
