@@ -80,3 +80,32 @@ def test_a_stalled_viewer_never_blocks_record(bridge):
         time.sleep(0.01)
     assert not bridge._queue
 
+
+
+def test_moved_solid_resends_the_scene_to_everyone():
+    from sensorium.server.daemon.services import Core
+    from sensorium.server.daemon.transport import Transport
+    from sensorium.server.sim.simulation import Simulation
+
+    sim = Simulation.from_file(WORLD, precision="fast")
+    core = Core(sim)
+    transport = Transport(core, "tcp://127.0.0.1:0", "tcp://127.0.0.1:0")
+    bridge = FoxgloveBridge.for_core(core, transport, "127.0.0.1", 0)
+    try:
+        sent: list[int | None] = []
+        bridge._work = lambda: sent.extend(bridge._scene_for) or bridge._scene_for.clear()  # record, do not send
+        before = bridge.scene_bytes()
+        bridge._subscribed(7, "/scene", +1)
+        transport.hooks[0]()                           # the loop's pass: demand applied, poses noted
+        sim.set_solid_pose("wall", (1.5, 0.0, 0.25))
+        transport.hooks[0]()
+        deadline = time.monotonic() + 30
+        while len(sent) < 2 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert sent == [7, None]                       # the subscriber's own copy, then a broadcast
+        assert bridge.scene_bytes() != before          # the wall is drawn at its new place
+        transport.hooks[0]()                           # pump queues synchronously, so this is final
+        assert sent == [7, None] and not bridge._scene_for   # nothing moved since: nothing resent
+    finally:
+        bridge.close()
+        transport.close()

@@ -158,8 +158,10 @@ class FoxgloveBridge:
         self._subs: Counter[str] = Counter()
         self._clients: Counter[tuple[int, str]] = Counter()
         self._dirty = False
-        self._scene_for: deque[int] = deque()
+        self._scene_for: deque[int | None] = deque()     # client ids to send the scene to (None: all)
         self._scene_bytes: bytes | None = None
+        self._scene_key: Any = None
+        self._seen_poses: list[Any] = []
         # data path
         self._queue: deque[tuple[str, str, bytes, int]] = deque()
         self.queue_size = max(1, int(queue_size))
@@ -245,10 +247,18 @@ class FoxgloveBridge:
 
     # ------------------------------------------------------------------ step-loop thread
     def pump(self, time_ns: int | None = None) -> None:
-        """Apply subscription changes (``on_demand``) and note the simulated time. Cheap when idle."""
+        """Apply subscription changes (``on_demand``), note the simulated time, and resend the scene
+        when a solid was moved (supervisor). Cheap when idle."""
         if time_ns is not None and time_ns != self._time_ns:
             self._time_ns = int(time_ns)
             self._event.set()
+        if self.solid_poses is not None and self._subs.get(SCENE_TOPIC, 0) > 0:
+            poses = list(self.solid_poses().values())
+            if len(poses) != len(self._seen_poses) or any(a is not b for a, b in zip(poses, self._seen_poses)):
+                if self._seen_poses:
+                    self._scene_for.append(None)
+                    self._event.set()
+                self._seen_poses = poses
         if self._dirty:
             with self._lock:
                 self._dirty = False
@@ -282,7 +292,10 @@ class FoxgloveBridge:
     def _work(self) -> None:
         while self._scene_for and self.scene_channel is not None:
             client = self._scene_for.popleft()
-            self.scene_channel.log(self.scene_bytes(), log_time=self._time_ns, sink_id=client)
+            if client is None:
+                self.scene_channel.log(self.scene_bytes(), log_time=self._time_ns)
+            else:
+                self.scene_channel.log(self.scene_bytes(), log_time=self._time_ns, sink_id=client)
         q = self._queue
         while q:
             try:
@@ -323,8 +336,10 @@ class FoxgloveBridge:
         if self.world is None:
             return b""
         poses = self.solid_poses() if self.solid_poses is not None else None
-        if self._scene_bytes is None or poses:
+        key = tuple((n, p.translation.tobytes(), p.rotation.tobytes()) for n, p in (poses or {}).items())
+        if self._scene_bytes is None or key != self._scene_key:
             self._scene_bytes = self._scene_mod.scene_update(self.world, self.base_dir, 0, poses).encode()
+            self._scene_key = key
         return self._scene_bytes
 
     # ------------------------------------------------------------------ close

@@ -54,7 +54,7 @@ __all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "MAX_SCENE_TRIANGLES", "scene_u
 
 WORLD_FRAME = "world"
 INFINITE_PLANE_SIZE = 50.0      # metres: an infinite plane is drawn as a square of this side
-MAX_SCENE_TRIANGLES = 2_000_000  # a mesh beyond this budget is drawn as its bounding box
+MAX_SCENE_TRIANGLES = 200_000    # meshes beyond this budget (whole scene) are drawn as their bounding boxes
 _NO_APPEARANCE = (0.85, 0.85, 0.85)
 _LIGHT_MARK = 0.05               # radius of the sphere drawn at a light's location (m)
 
