@@ -132,6 +132,8 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--format", choices=["bag", "mcap"], help="bag: rosbag2 directory (rosbags); mcap: one file "
                    "(mcap-ros2-support); default from OUT's suffix")
     p.add_argument("--pointcloud2", action="store_true", help="export PointCloud as PointCloud2 (x, y, z, layer)")
+    p.add_argument("--no-views", action="store_true",
+                   help="only the recorded topics (no /tf_static, /tf and /scene from the recorded world)")
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="export only these topics")
     p.add_argument("--start", type=_seconds, metavar="S", help="from S seconds of simulation time")
     p.add_argument("--end", type=_seconds, metavar="E", help="up to E seconds of simulation time")

@@ -126,6 +126,7 @@ def export_cmd(args: argparse.Namespace) -> int:
     try:
         report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
                              pointcloud2=args.pointcloud2, topics=args.topics or None,
+                             views=not getattr(args, "no_views", False),
                              start_ns=None if args.start is None else int(round(args.start * 1e9)),
                              end_ns=None if args.end is None else int(round(args.end * 1e9)))
     except (ExportError, OSError) as exc:

@@ -67,12 +67,13 @@ class FoxgloveViews:
     def __init__(self, world: Any = None, base_dir: str | Path = ".", distro: str = "jazzy"):
         from sensorium.server.recording.export import CdrEncoder
         from sensorium.server.viewer import scene as fxscene
+        from sensorium.server.viewer.frames import mounts
 
         self._scene = fxscene
         self.encoder = CdrEncoder(distro, pointcloud2=True)
         self.world = world
         self.base_dir = Path(base_dir)
-        self.mounts = fxscene.mounts(world) if world is not None else {}
+        self.mounts = mounts(world) if world is not None else {}
         self.errors: dict[str, str] = {}
         from foxglove.messages import FrameTransforms, SceneUpdate
         self._tf_schema = FrameTransforms.get_schema()

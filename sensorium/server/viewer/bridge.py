@@ -69,28 +69,6 @@ def parse_address(text: str) -> tuple[str, int]:
     return host, port
 
 
-def _recorded_world(recording: Any) -> tuple[wm.World | None, Path]:
-    """The world model attached to a recording (attachments unpacked to a temporary directory so
-    that mesh files resolve), or ``(None, .)`` when it is missing or does not load."""
-    import tempfile
-
-    from sensorium.server.world.loader import WorldError, load_world
-
-    found = recording.world()
-    if found is None:
-        return None, Path(".")
-    tmp = Path(tempfile.mkdtemp(prefix="sensorium-replay-world-"))
-    try:
-        for a in recording.attachments():
-            target = (tmp / a.name).resolve()
-            if tmp.resolve() in target.parents and not target.exists():
-                target.parent.mkdir(parents=True, exist_ok=True)
-                target.write_bytes(a.data)
-        return load_world(tmp / found[0]).world, tmp
-    except (WorldError, OSError, ValueError):
-        return None, Path(".")
-
-
 class _Listener:
     """The SDK's ``ServerListener``: counts subscriptions per topic (SDK thread)."""
 
@@ -122,6 +100,7 @@ class FoxgloveBridge:
         except ImportError as exc:  # pragma: no cover - depends on the environment
             raise ViewerError("the Foxglove viewer needs the 'foxglove' extra: pip install 'sensorium[foxglove]'") from exc
         from sensorium.server.viewer import scene as fxscene
+        from sensorium.server.viewer.frames import mounts
 
         self._scene_mod = fxscene
         self.encoder = CdrEncoder(distro, pointcloud2=True)
@@ -144,7 +123,7 @@ class FoxgloveBridge:
             self.types[topic] = typename
         self.pose_robot = {t: t[1:-len("/pose")] for t, ty in topic_types.items()
                            if ty == POSE_TYPE and t.endswith("/pose") and t.count("/") == 2}
-        self.mounts = fxscene.mounts(world) if world is not None else {}
+        self.mounts = mounts(world) if world is not None else {}
         self.tf_channel = None
         if self.pose_robot:
             self.tf_channel = foxglove.Channel(TF_TOPIC, schema=FrameTransforms.get_schema(), message_encoding="protobuf",
@@ -202,7 +181,9 @@ class FoxgloveBridge:
         """Serve a :class:`~sensorium.server.recording.replay.Replayer`'s messages (every replayed
         message is offered; demand does not apply to a replay). The scene comes from the world file
         (and meshes) attached to the recording, when it loads."""
-        world, base = _recorded_world(replayer.recording)
+        from sensorium.server.recording.ros_views import recorded_world
+
+        world, base = recorded_world(replayer.recording)
         bridge = cls(dict(replayer.topic_types), world, base, host=host, port=port,
                      name=f"sensorium replay {Path(replayer.path).name}", **kw)
         replayer.viewer = bridge.record

@@ -46,14 +46,13 @@ from foxglove.messages import (
 )
 
 from sensorium.schemas import world as wm
+from sensorium.server.viewer.frames import INFINITE_PLANE_SIZE, WORLD_FRAME, mounts, quat_from_x
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
 __all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "MAX_SCENE_TRIANGLES", "scene_update", "mounts",
            "frame_transforms", "timestamp"]
 
-WORLD_FRAME = "world"
-INFINITE_PLANE_SIZE = 50.0      # metres: an infinite plane is drawn as a square of this side
 MAX_SCENE_TRIANGLES = 200_000    # meshes beyond this budget (whole scene) are drawn as their bounding boxes
 _NO_APPEARANCE = (0.85, 0.85, 0.85)
 _LIGHT_MARK = 0.05               # radius of the sphere drawn at a light's location (m)
@@ -143,24 +142,11 @@ def _light_entity(i: int, light: Any, stamp_ns: int) -> SceneEntity:
     if direction is not None:
         dvec = np.asarray(direction, dtype=np.float64)
         dvec = dvec / np.linalg.norm(dvec)
-        q = _quat_from_x(dvec)
+        q = quat_from_x(dvec)
         start = loc if loc is not None else (0.0, 0.0, 1.0)      # a directional light has no place: drawn above the origin
         parts["arrows"] = [ArrowPrimitive(pose=_pose(start, q), shaft_length=0.25, shaft_diameter=0.01,
                                           head_length=0.06, head_diameter=0.03, color=color)]
     return _entity(WORLD_FRAME, f"light/{name}", stamp_ns, parts, f"light:{light.type}")
-
-
-def _quat_from_x(d: np.ndarray) -> tuple[float, float, float, float]:
-    """The rotation taking +x onto the unit vector ``d`` (arrows point along their +x)."""
-    x = np.array([1.0, 0.0, 0.0])
-    axis = np.cross(x, d)
-    s, c = float(np.linalg.norm(axis)), float(np.dot(x, d))
-    if s < 1e-12:
-        return (0.0, 0.0, 0.0, 1.0) if c > 0 else (0.0, 0.0, 1.0, 0.0)
-    axis /= s
-    half = np.arctan2(s, c) / 2.0
-    sh = float(np.sin(half))
-    return (float(axis[0]) * sh, float(axis[1]) * sh, float(axis[2]) * sh, float(np.cos(half)))
 
 
 def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
@@ -183,19 +169,6 @@ def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
     for i, light in enumerate(world.lights):
         entities.append(_light_entity(i, light, stamp_ns))
     return SceneUpdate(entities=entities)
-
-
-def mounts(world: wm.World) -> dict[str, list[tuple[str, tuple[float, float, float], tuple[float, float, float, float]]]]:
-    """robot → [(device frame, translation, quaternion xyzw)] of the robot's devices."""
-    out: dict[str, list[tuple[str, tuple[float, float, float], tuple[float, float, float, float]]]] = {}
-    for r in world.robots:
-        items = []
-        for d in r.devices:
-            p = pose_from_model(d.pose)
-            t = tuple(float(v) for v in p.translation)
-            items.append((f"{r.name}/{d.name}", t, matrix_quaternion(p.rotation)))
-        out[r.name] = items     # type: ignore[assignment]
-    return out
 
 
 def frame_transforms(robot: str, stamp_ns: int, translation: Iterable[float], quaternion: Iterable[float],
