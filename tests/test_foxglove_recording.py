@@ -135,3 +135,19 @@ def test_export_carries_scene_and_transforms(demo, tmp_path):
     got = run_script("read_mcap.js", str(tmp_path / "one.mcap"))[0]
     assert got["errors"] == [] and {"/tf", "/tf_static", "/scene"} <= {c["topic"] for c in got["channels"]}
     assert len(got["last"]["/scene"]["msg"]["markers"]) == 17
+
+
+def test_info_says_whether_a_recording_is_foxglove_ready(demo, tmp_path):
+    from _recdata import make_recording
+
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    plain = tmp_path / "plain.mcap"
+    make_recording(plain, steps=3, foxglove=False)
+    out = {}
+    for name, path in (("demo", demo), ("plain", plain)):
+        r = subprocess.run([sys.executable, "-m", "sensorium", "info", str(path)], capture_output=True, text=True,
+                           env=env, timeout=60)
+        assert r.returncode == 0, r.stderr
+        out[name] = next(line for line in r.stdout.splitlines() if line.startswith("Foxglove:"))
+    assert out["demo"].split(None, 1)[1].startswith("ready")
+    assert out["plain"].split(None, 1)[1].startswith("no")

@@ -178,6 +178,8 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
         world = meta.get("world") or meta.get("world_file") or "-"
         lines.append(("World", f"{world}   seed {meta.get('seed', '-')}   time step "
                                f"{meta.get('basic_time_step_ms', '-')} ms   sensorium {meta.get('version', '-')}"))
+        lines.append(("Foxglove", "ready (ROS 2 CDR views, /tf, /scene; bodies kept byte for byte)"
+                      if meta.get("format") == "2" else "no (msgpack only: export with sensorium export --ros2)"))
     if session.get("started_at"):
         lines.append(("Recorded", session["started_at"]))
     for a in s["attachments"]:
