@@ -5,6 +5,7 @@ unsubscribing moves the server's demand."""
 
 from __future__ import annotations
 
+import base64
 import itertools
 import math
 import os
@@ -142,19 +143,25 @@ def test_channels_subscriptions_demand_and_values(live):
     wait_until(lambda: len(rpc.ok("get_counters")["subscriptions"]) == 6, what="zmq subscriptions")
     rpc.session = rpc.ok("attach", {"robot": "bot"})["session"]
     ours: dict[tuple[str, int], dict] = {}
+    raw: dict[tuple[str, int], bytes] = {}
     for _ in range(6):
         rpc.ok("/bot/robot/step")
     deadline = time.monotonic() + 30
     while time.monotonic() < deadline and len(ours) < 6 * 6:
         if sub.poll(100):
             topic, env, body = sub.recv_multipart()
-            ours[(topic[:-1].decode(), msgpack.unpackb(env)["stamp_ns"])] = msgpack.unpackb(body, raw=False)
+            key = (topic[:-1].decode(), msgpack.unpackb(env)["stamp_ns"])
+            ours[key] = msgpack.unpackb(body, raw=False)
+            raw[key] = body
     sub.close(0)
     assert len(ours) == 36
 
     def got(topic: str, ns: int) -> dict:
+        return event(topic, ns)["msg"]
+
+    def event(topic: str, ns: int) -> dict:
         return node.find(lambda e: e["event"] == "message" and e["topic"] == topic and e["log_time"] == ns,
-                             what=f"{topic} at {ns}")["msg"]
+                         what=f"{topic} at {ns}")
 
     last = 6 * 16 * 1_000_000
     # Illuminance: float64 end to end
@@ -205,6 +212,12 @@ def test_channels_subscriptions_demand_and_values(live):
     assert [ents["solid/floor"]["cubes"][0]["size"][k] for k in "xyz"] == [4.0, 4.0, 0.0]
     lamp = ents["light/lamp"]["spheres"][0]
     assert [lamp["pose"]["position"][k] for k in "xyz"] == [0.5, 0.5, 0.5]
+    # the live bytes are the ROS 2 export's bytes (rosbags' serialize_cdr, the rosbag2 exporter's encoder)
+    from sensorium.server.recording.export import CdrEncoder
+
+    enc = CdrEncoder("jazzy", pointcloud2=True)
+    for topic in SENSORS:
+        assert base64.b64decode(event(topic, last)["raw"]) == enc.encode_generic(topics[topic], raw[(topic, last)]), topic
     # simulated time is the server time
     node.find(lambda e: e["event"] == "time" and e["ns"] == last, what="server time")
     assert not [e for e in node.drain() + node.seen if e["event"] == "error"]

@@ -11,7 +11,7 @@ import pytest
 
 pytest.importorskip("foxglove")
 
-from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, parse_address  # noqa: E402
+from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, exposure_warning, parse_address  # noqa: E402
 from sensorium.server.world.loader import load_world  # noqa: E402
 
 WORLD = Path(__file__).parent / "worlds" / "server.yaml"
@@ -26,6 +26,13 @@ def test_parse_address():
     for bad, msg in [("host:x", "is not a number"), ("70000", "0..65535"), (":80", "empty host"), ("[::1]9", "[HOST]:PORT")]:
         with pytest.raises(ViewerError, match=msg.replace("[", r"\[").replace("]", r"\]")):
             parse_address(bad)
+
+
+def test_exposure_warning_only_off_loopback():
+    for host in ("127.0.0.1", "127.8.0.1", "::1", "localhost"):
+        assert exposure_warning(host) is None, host
+    for host in ("0.0.0.0", "::", "192.168.1.5", "simhost.example"):
+        assert "no authentication" in (exposure_warning(host) or ""), host
 
 
 @pytest.fixture()

@@ -89,9 +89,11 @@ def replay_cmd(args: argparse.Namespace) -> int:
             return 1
         viewer = None
         if getattr(args, "foxglove", None):
-            from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, parse_address
+            from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, exposure_warning, parse_address
             try:
                 host, port = parse_address(args.foxglove)
+                if exposure_warning(host):
+                    print(f"sensorium replay: warning: {exposure_warning(host)}", file=sys.stderr)
                 viewer = FoxgloveBridge.for_replay(r, host, port)
             except ViewerError as exc:
                 print(f"sensorium replay: {exc}", file=sys.stderr)

@@ -86,9 +86,11 @@ def main(args: argparse.Namespace) -> int:
             return 1
     viewer = None
     if getattr(args, "foxglove", None):
-        from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, parse_address
+        from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, exposure_warning, parse_address
         try:
             host, port = parse_address(args.foxglove)
+            if exposure_warning(host):
+                print(f"sensorium serve: warning: {exposure_warning(host)}", file=sys.stderr)
             viewer = FoxgloveBridge.for_core(server.core, server.transport, host, port)
         except ViewerError as exc:
             server.close()

@@ -38,7 +38,8 @@ client.on("message", ({ subscriptionId, timestamp, data }) => {
   const entry = byTopic.get(topic);
   try {
     const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
-    out({ event: "message", topic, log_time: Number(timestamp), size: bytes.length, msg: entry.decode(bytes) });
+    out({ event: "message", topic, log_time: Number(timestamp), size: bytes.length, msg: entry.decode(bytes),
+      raw: Buffer.from(bytes).toString("base64") });
   } catch (e) {
     out({ event: "error", topic, message: `decode failed: ${e.message}` });
   }

@@ -35,7 +35,7 @@ import msgpack
 from sensorium.schemas import world as wm
 from sensorium.server.recording.export import CdrEncoder, ExportError
 
-__all__ = ["FoxgloveBridge", "ViewerError", "parse_address", "TF_TOPIC", "SCENE_TOPIC", "POSE_TYPE"]
+__all__ = ["FoxgloveBridge", "ViewerError", "parse_address", "exposure_warning", "TF_TOPIC", "SCENE_TOPIC", "POSE_TYPE"]
 
 TF_TOPIC = "/tf"
 SCENE_TOPIC = "/scene"
@@ -67,6 +67,21 @@ def parse_address(text: str) -> tuple[str, int]:
     if not host:
         raise ViewerError(f"--foxglove {text!r}: empty host")
     return host, port
+
+
+def exposure_warning(host: str) -> str | None:
+    """A warning when ``host`` is not a loopback address (the server has no authentication)."""
+    import ipaddress
+
+    if host == "localhost":
+        return None
+    try:
+        if ipaddress.ip_address(host).is_loopback:
+            return None
+    except ValueError:
+        pass                                   # a host name: it may resolve to anything
+    return (f"the Foxglove server on {host} is reachable from other machines and has no authentication "
+            "(an SSH tunnel to 127.0.0.1 is the safe way: see README, See it in Foxglove)")
 
 
 class _Listener:
