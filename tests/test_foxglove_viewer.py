@@ -116,3 +116,23 @@ def test_moved_solid_resends_the_scene_to_everyone():
     finally:
         bridge.close()
         transport.close()
+
+
+
+def test_meshes_over_the_triangle_budget_are_drawn_as_bounding_boxes():
+    import numpy as np
+
+    from sensorium.server.sim.scene import primitive_from_model
+    from sensorium.server.viewer.scene import fit_budget
+    from sensorium.server.world import geometry as geo
+    from sensorium.server.world.loader import default_world_path
+
+    loaded = load_world(default_world_path())
+    rock = next(s for s in loaded.world.solids if s.name == "rock")
+    v, f = geo.tessellate(primitive_from_model(rock.geometry, loaded.base_dir))
+    budget = [len(f)]
+    assert fit_budget(v, f, budget)[1] is f and budget == [0]          # fits exactly: drawn, budget used up
+    bv, bf = fit_budget(v, f, budget)                                   # nothing left: its bounding box
+    assert len(bf) == 12 and budget == [0]
+    np.testing.assert_allclose(bv.min(axis=0), v.min(axis=0), atol=1e-12)
+    np.testing.assert_allclose(bv.max(axis=0), v.max(axis=0), atol=1e-12)

@@ -28,7 +28,7 @@ import threading
 from collections import Counter, deque
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import msgpack
 
@@ -168,7 +168,7 @@ class FoxgloveBridge:
         self._stop = False
         try:
             self.server = foxglove.start_server(name=name, host=host, port=port, capabilities=[Capability.Time],
-                                                server_listener=_Listener(self), context=self.ctx,
+                                                server_listener=cast(Any, _Listener(self)), context=self.ctx,
                                                 message_backlog_size=backlog)
         except Exception as exc:  # the SDK raises RuntimeError on a busy/bad address
             raise ViewerError(f"cannot start the Foxglove server on {host}:{port}: {exc}") from None

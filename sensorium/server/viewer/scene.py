@@ -112,17 +112,23 @@ def shape_primitives(shape: wm.Shape, pose: Pose, base_dir: Path, budget: list[i
         sx, sy = g.size if g.size is not None else (INFINITE_PLANE_SIZE, INFINITE_PLANE_SIZE)
         return {"cubes": [CubePrimitive(pose=pose, size=Vector3(x=sx, y=sy, z=0.0), color=color)]}
     prim = primitive_from_model(g, base_dir)          # capsule, mesh
-    vertices, faces = geo.tessellate(prim)
-    if len(faces) > budget[0]:
-        lo, hi = vertices.min(axis=0), vertices.max(axis=0)
-        centre, size = (lo + hi) / 2.0, hi - lo       # its bounding box, in the shape's own frame
-        box_v, box_f = geo.tessellate(geo.Box(size=tuple(float(max(s, 1e-6)) for s in size)))
-        return {"triangles": [_triangles(box_v + centre, box_f, pose, color)]}
-    budget[0] -= len(faces)
+    vertices, faces = fit_budget(*geo.tessellate(prim), budget)
     return {"triangles": [_triangles(vertices, faces, pose, color)]}
 
 
-def _entity(frame_id: str, entity_id: str, stamp_ns: int, parts: dict[str, list[Any]], kind: str,
+def fit_budget(vertices: np.ndarray, faces: np.ndarray, budget: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """The triangles to draw: the mesh itself while ``budget[0]`` (triangles left for the scene)
+    allows, else its bounding box (12 triangles, in the shape's own frame; budget unchanged)."""
+    if len(faces) <= budget[0]:
+        budget[0] -= len(faces)
+        return vertices, faces
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    sx, sy, sz = (float(max(s, 1e-6)) for s in hi - lo)
+    box_v, box_f = geo.tessellate(geo.Box(size=(sx, sy, sz)))
+    return box_v + (lo + hi) / 2.0, box_f
+
+
+def _entity(frame_id: str, entity_id: str, stamp_ns: int, parts: dict[str, Any], kind: str,
             frame_locked: bool = False) -> SceneEntity:
     return SceneEntity(timestamp=timestamp(stamp_ns), frame_id=frame_id, id=entity_id, frame_locked=frame_locked,
                        metadata=[KeyValuePair(key="kind", value=kind)], **parts)
