@@ -110,7 +110,9 @@ def live(tmp_path):
             node.close()
         code = srv.stop()
         ctx.destroy(0)
-        assert code == 0, srv.err_path.read_text()
+        err = srv.err_path.read_text()
+        assert code == 0, err
+        assert "sensorium: Foxglove viewer: " in err and "not converted" not in err, err
 
 
 def test_channels_subscriptions_demand_and_values(live):

@@ -151,3 +151,14 @@ def test_info_says_whether_a_recording_is_foxglove_ready(demo, tmp_path):
         out[name] = next(line for line in r.stdout.splitlines() if line.startswith("Foxglove:"))
     assert out["demo"].split(None, 1)[1].startswith("ready")
     assert out["plain"].split(None, 1)[1].startswith("no")
+
+
+def test_a_body_without_a_view_is_still_kept_and_reported(tmp_path):
+    from sensorium.server.recording.writer import McapRecorder
+
+    odd = msgpack.packb([1, 2])                        # not a map: no CDR view can be made of it
+    with McapRecorder(tmp_path / "x.mcap", b"", "w.yaml", {}) as rec:
+        rec.record("/a/b/value", "sensor_msgs/msg/Range", b"", odd, 5, 0)
+    with Recording(tmp_path / "x.mcap") as r:
+        assert [(m.topic, m.data) for m in r.messages()] == [("/a/b/value", odd)]
+        assert r.metadata()["foxglove_view_errors"] == {"/a/b/value": "ExportError: body is not a msgpack map"}

@@ -113,6 +113,7 @@ def replay_cmd(args: argparse.Namespace) -> int:
     finally:
         if viewer is not None:
             viewer.close()
+            print(f"sensorium: {viewer.report()}", file=sys.stderr, flush=True)
         r.close()
 
 

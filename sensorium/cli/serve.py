@@ -102,6 +102,7 @@ def main(args: argparse.Namespace) -> int:
     finally:
         if viewer is not None:
             viewer.close()
+            print(f"sensorium: {viewer.report()}", file=sys.stderr, flush=True)
         if server.recorder is not None:
             print(f"sensorium: recorded {server.recorder.message_count} messages to {args.record}",
                   file=sys.stderr, flush=True)

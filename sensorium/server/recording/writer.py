@@ -316,6 +316,8 @@ class McapRecorder:
                     "ended_at": _dt.datetime.fromtimestamp(end, _dt.timezone.utc).isoformat(),
                     "wall_duration_s": f"{end - self._started_wall:.3f}",
                     "messages": str(self.message_count)})
+                if self._views is not None and self._views.errors:   # bodies kept; only their views missing
+                    self._writer.add_metadata("foxglove_view_errors", dict(self._views.errors))
                 self._writer.finish()
                 self._stream.fsync()
             finally:

@@ -338,6 +338,13 @@ class FoxgloveBridge:
             self._scene_key = key
         return self._scene_bytes
 
+    def report(self) -> str:
+        """One line for the log: what was sent, dropped, and the first error per topic."""
+        line = f"Foxglove viewer: {self.sent} messages sent, {self.dropped} dropped (queue full)"
+        if self.errors:
+            line += "; not converted: " + "; ".join(f"{t}: {e}" for t, e in sorted(self.errors.items()))
+        return line
+
     # ------------------------------------------------------------------ close
     def close(self) -> None:
         self._stop = True
