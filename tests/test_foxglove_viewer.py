@@ -136,3 +136,32 @@ def test_meshes_over_the_triangle_budget_are_drawn_as_bounding_boxes():
     assert len(bf) == 12 and budget == [0]
     np.testing.assert_allclose(bv.min(axis=0), v.min(axis=0), atol=1e-12)
     np.testing.assert_allclose(bv.max(axis=0), v.max(axis=0), atol=1e-12)
+
+
+def test_layout_command(tmp_path):
+    import json
+    import os
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=str(root))
+    out = tmp_path / "layout.json"
+    run = lambda *a: subprocess.run([sys.executable, "-m", "sensorium", "layout", *a], capture_output=True,
+                                    text=True, env=env, timeout=120)
+    r = run(str(WORLD), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    lay = json.loads(out.read_text())
+    three_d, side = lay["content"]["items"][0]["content"], lay["content"]["items"][1]["content"]["items"]
+    assert three_d["panelType"] == "ThreeDee" and three_d["config"]["fixedFrame"] == "world"
+    assert set(three_d["config"]["topics"]) == {"/scene", "/bot/lidar/laser_scan", "/bot/lidar/point_cloud",
+                                                "/bot/lidar2/point_cloud"}
+    panels = {item["content"]["panelType"]: item["content"]["config"] for item in side}
+    assert [p["value"] for p in panels["Plot"]["paths"]] == ["/bot/ds/value.range", "/bot/ls/value.illuminance",
+                                                             "/free/ls/value.illuminance"]
+    assert panels["Image"]["imageMode"]["imageTopic"] == "/bot/lidar/range_image"
+    assert panels["RawMessages"]["topicPath"] == "/clock"
+    again = run(str(WORLD), "-o", str(out))                     # never overwrite without being asked
+    assert again.returncode == 1 and again.stderr.strip().endswith("not overwriting (--force to replace it)")
+    missing = run(str(tmp_path / "nope.mcap"))
+    assert missing.returncode == 1 and missing.stderr.strip() == f"sensorium layout: {tmp_path / 'nope.mcap'}: no such file"

@@ -149,6 +149,14 @@ def _serve_args(p: argparse.ArgumentParser) -> None:
     add_arguments(p)
 
 
+@command("layout", "write a Foxglove layout (3D, plots, image, raw messages) for a recording or world file",
+         "sensorium.cli.viewer:layout_cmd")
+def _layout_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("source", nargs="?", help="a recording (.mcap) or a world file (default: the embedded arena world)")
+    p.add_argument("-o", "--out", metavar="FILE.json", help="write here instead of standard output")
+    p.add_argument("--force", action="store_true", help="replace FILE.json if it exists")
+
+
 @command("schemas", "write the JSON Schemas of world files, topic messages and services",
          "sensorium.schemas.export:main")
 def _schemas_args(p: argparse.ArgumentParser) -> None:

@@ -99,6 +99,8 @@ def replay_cmd(args: argparse.Namespace) -> int:
                 print(f"sensorium replay: {exc}", file=sys.stderr)
                 return 1
             print(f"sensorium: Foxglove viewer at {viewer.url}", flush=True)
+            if viewer.app_url():
+                print(f"sensorium: Foxglove web app: {viewer.app_url()}", file=sys.stderr, flush=True)
         print(r.announce(), flush=True)
         if r.recording.truncated:
             print("sensorium: warning: the recording is truncated; replaying up to its last complete chunk",

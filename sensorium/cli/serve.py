@@ -97,6 +97,8 @@ def main(args: argparse.Namespace) -> int:
             print(f"sensorium serve: {exc}", file=sys.stderr)
             return 1
     print(server.ready_line + (f" foxglove={viewer.url}" if viewer is not None else ""), flush=True)
+    if viewer is not None and viewer.app_url():
+        print(f"sensorium: Foxglove web app: {viewer.app_url()}", file=sys.stderr, flush=True)
     try:
         server.run()
     finally:

@@ -204,6 +204,13 @@ class FoxgloveBridge:
         replayer.viewer = bridge.record
         return bridge
 
+    def app_url(self) -> str | None:
+        """A Foxglove web-app link that opens this server as the data source (the SDK's), if any."""
+        try:
+            return self.server.app_url()
+        except Exception:  # noqa: BLE001 - only a convenience
+            return None
+
     @property
     def url(self) -> str:
         host = f"[{self.host}]" if ":" in self.host else self.host
