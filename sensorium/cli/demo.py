@@ -155,6 +155,8 @@ def _draw(result: DemoResult, world, path: Path) -> None:
     canvas = Canvas(-2.2, 2.2, -2.2, 2.2, pixels_per_metre=160)
     for s in world.solids:
         g = s.geometry
+        if g is None:
+            continue
         pose = pose_from_model(s.pose)
         cx, cy = pose.translation[:2]
         yaw = math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])
