@@ -165,3 +165,49 @@ def test_layout_command(tmp_path):
     assert again.returncode == 1 and again.stderr.strip().endswith("not overwriting (--force to replace it)")
     missing = run(str(tmp_path / "nope.mcap"))
     assert missing.returncode == 1 and missing.stderr.strip() == f"sensorium layout: {tmp_path / 'nope.mcap'}: no such file"
+
+
+def test_grown_world_format_is_drawn_where_rays_see_it():
+    """Nested children, multi-shape solids and robots, attached lights (tests/worlds/wbt/full.yaml):
+    the markers of the ROS export and the Foxglove scene come from the same bodies()/lights()."""
+    import math
+
+    import numpy as np
+
+    from sensorium.server.recording.ros_views import marker_array
+
+    full = Path(__file__).parent / "worlds" / "wbt" / "full.yaml"
+    loaded = load_world(full)
+    markers = marker_array(loaded.world, loaded.base_dir, 0)["markers"]
+    by_ns: dict[str, list] = {}
+    for m in markers:
+        by_ns.setdefault(m["ns"], []).append(m)
+    pos = lambda m: [m["pose"]["position"][k] for k in "xyz"]
+    # obstacle: rotated 0.3 about z at (0.8, 0.3, 0); box 0.1 up, sphere 0.25 up, child cap 0.4 up (one
+    # capsule drawn: its bounding-only twin is Webots' invisible boundingObject)
+    obstacle = by_ns["solid/obstacle"]
+    assert [m["type"] for m in obstacle] == [1, 2, 11]
+    for m, z in zip(obstacle, (0.1, 0.25, 0.4)):
+        np.testing.assert_allclose(pos(m), [0.8, 0.3, z], atol=1e-12)
+    q = obstacle[0]["pose"]["orientation"]
+    assert (q["z"], q["w"]) == (pytest.approx(math.sin(0.15)), pytest.approx(math.cos(0.15)))
+    assert obstacle[1]["color"] == {"r": 0.3, "g": 0.9, "b": 0.1, "a": pytest.approx(0.8)}
+    assert len(by_ns["solid/mesh"]) == 1 and by_ns["solid/mesh"][0]["type"] == 11      # the box is bounding-only
+    assert len(by_ns["solid/faces"][0]["points"]) == 6 * 3                             # six triangles
+    assert [m["type"] for m in by_ns["solid/rectangle arena"]] == [1] * 5             # floor plane + 4 walls
+    # the robot: three shapes in its own frame, moving with it
+    bot = by_ns["robot/bot"]
+    assert len(bot) == 3 and all(m["header"]["frame_id"] == "bot" and m["frame_locked"] for m in bot)
+    np.testing.assert_allclose(pos(bot[1]), [0, 0.026, 0.02], atol=1e-12)
+    # lights: the spot on the obstacle placed and turned with it; the robot's lamp rides in its frame
+    spot = by_ns["light/obstacle/light0"]
+    np.testing.assert_allclose(pos(spot[0]), [0.8, 0.3, 0.5], atol=1e-12)
+    arrow = spot[1]["pose"]["orientation"]                                            # +x turned by 0.3 about z
+    assert (arrow["z"], arrow["w"]) == (pytest.approx(math.sin(0.15)), pytest.approx(math.cos(0.15)))
+    lamp = by_ns["light/bot/light0"][0]
+    assert lamp["header"]["frame_id"] == "bot" and lamp["frame_locked"] and pos(lamp) == [0.05, 0.0, 0.1]
+    assert by_ns["light/light0"][0]["type"] == 0 and by_ns["light/light0"][0]["header"]["frame_id"] == "world"
+    # the Foxglove scene is built from the same bodies and lights (decoded field by field in the Node tests)
+    from sensorium.server.viewer.scene import scene_update
+
+    assert len(scene_update(loaded.world, loaded.base_dir).encode()) > 1000

@@ -125,33 +125,30 @@ def _shape_marker(shape: wm.Shape, frame: str, ns_name: str, mid: int, t, q, sta
 
 
 def marker_array(world: wm.World, base_dir: str | Path, stamp: int) -> dict | None:
-    """The world as markers, or ``None`` for an empty world."""
-    from sensorium.server.viewer.frames import WORLD_FRAME, quat_from_x
-    from sensorium.server.world.poses import matrix_quaternion, pose_from_model
+    """The world as markers (one namespace per solid, robot body or light), or ``None`` if empty."""
+    from sensorium.server.viewer.frames import bodies, lights, quat_from_x
+    from sensorium.server.world.poses import matrix_quaternion
 
     base = Path(base_dir)
     markers = []
-    for i, s in enumerate(world.solids):
-        p = pose_from_model(s.pose)
-        markers.append(_shape_marker(s, WORLD_FRAME, f"solid/{s.name}", i, p.translation,
-                                     matrix_quaternion(p.rotation), stamp, base, False))
-    for i, r in enumerate(world.robots):
-        if r.body is not None:
-            markers.append(_shape_marker(r.body, r.name, f"robot/{r.name}", i, (0, 0, 0), (0, 0, 0, 1), stamp, base, True))
-    for i, light in enumerate(world.lights):
-        name = light.name or f"light{i}"
+    for body in bodies(world):
+        for k, (shape, pose) in enumerate(body.parts):
+            markers.append(_shape_marker(shape, body.frame_id, body.entity_id, k, pose.translation,
+                                         matrix_quaternion(pose.rotation), stamp, base, body.frame_locked))
+    for entity_id, frame_id, locked, light in lights(world):
         c = {"r": float(light.color[0]), "g": float(light.color[1]), "b": float(light.color[2]),
              "a": 1.0 if light.on else 0.3}
-        hdr = {"stamp": _stamp(stamp), "frame_id": WORLD_FRAME}
+        hdr = {"stamp": _stamp(stamp), "frame_id": frame_id}
         loc = getattr(light, "location", None)
         if loc is not None:
-            markers.append({"header": hdr, "ns": f"light/{name}", "id": 0, "type": _SPHERE, "action": 0,
-                            "pose": _ros_pose(loc, (0, 0, 0, 1)), "scale": {"x": 0.1, "y": 0.1, "z": 0.1}, "color": c})
+            markers.append({"header": hdr, "ns": entity_id, "id": 0, "type": _SPHERE, "action": 0,
+                            "pose": _ros_pose(loc, (0, 0, 0, 1)), "scale": {"x": 0.1, "y": 0.1, "z": 0.1}, "color": c,
+                            "frame_locked": locked})
         direction = getattr(light, "direction", None)
         if direction is not None:
             d = np.asarray(direction, dtype=np.float64)
             q = quat_from_x(d / np.linalg.norm(d))
-            markers.append({"header": hdr, "ns": f"light/{name}", "id": 1, "type": _ARROW, "action": 0,
+            markers.append({"header": hdr, "ns": entity_id, "id": 1, "type": _ARROW, "action": 0,
                             "pose": _ros_pose(loc if loc is not None else (0.0, 0.0, 1.0), q),
-                            "scale": {"x": 0.25, "y": 0.02, "z": 0.02}, "color": c})
+                            "scale": {"x": 0.25, "y": 0.02, "z": 0.02}, "color": c, "frame_locked": locked})
     return {"markers": markers} if markers else None

@@ -4,12 +4,17 @@ on its robot by the device's ``pose``."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
-__all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "Mount", "mounts", "quat_from_x"]
+__all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "Mount", "mounts", "quat_from_x", "Body", "bodies", "lights"]
 
 WORLD_FRAME = "world"
 INFINITE_PLANE_SIZE = 50.0      # metres: an infinite plane is drawn as a square of this side
@@ -41,3 +46,61 @@ def quat_from_x(d: np.ndarray) -> tuple[float, float, float, float]:
     half = np.arctan2(s, c) / 2.0
     sh = float(np.sin(half))
     return (float(axis[0]) * sh, float(axis[1]) * sh, float(axis[2]) * sh, float(np.cos(half)))
+
+
+@dataclass(frozen=True)
+class Body:
+    """One drawn object: a top-level solid (all its shapes and children, world poses) or a robot's
+    body (its shapes, poses in the robot frame; ``frame_locked`` so it moves with the robot)."""
+
+    entity_id: str
+    frame_id: str
+    kind: str                                   # solid | robot
+    frame_locked: bool
+    parts: list[tuple[Any, Pose]]               # (a Shape-like model with geometry/appearance, pose in frame_id)
+
+
+def bodies(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Iterator[Body]:
+    """Every solid and robot body to draw: the shapes rays of the visual kind see (``seen_by`` both
+    or visual; a bounding-only shape is Webots' invisible boundingObject). ``solid_poses``
+    overrides where a solid is now."""
+    from sensorium.server.sim.scene import robot_parts, solid_parts
+
+    for s in world.solids:
+        top = (solid_poses or {}).get(s.name) or pose_from_model(s.pose)
+        parts = [(shape, pose) for _n, pose, shape in solid_parts(s, top) if shape.seen_by != "bounding"]
+        if parts:
+            yield Body(f"solid/{s.name}", WORLD_FRAME, "solid", False, parts)
+    for r in world.robots:
+        parts = [(shape, pose) for _n, pose, shape in robot_parts(r) if shape.seen_by != "bounding"]
+        if parts:
+            yield Body(f"robot/{r.name}", r.name, "robot", True, parts)
+
+
+def lights(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Iterator[tuple[str, str, bool, Any]]:
+    """Every light to draw: (entity id, frame, frame_locked, light model with location/direction in
+    that frame). World and solid lights are in ``world``; a robot's lights ride in its frame (a
+    DirectionalLight's direction stays in world axes wherever it is attached, as in Webots)."""
+    from sensorium.server.sim.scene import place_light, solid_lights
+
+    seen: set[str] = set()
+
+    def unique(name: str) -> str:
+        base, n = f"light/{name}", 1
+        out = base
+        while out in seen:
+            n += 1
+            out = f"{base}#{n}"
+        seen.add(out)
+        return out
+
+    for i, lt in enumerate(world.lights):
+        yield unique(lt.name or f"light{i}"), WORLD_FRAME, False, lt
+    for s in world.solids:
+        top = (solid_poses or {}).get(s.name) or pose_from_model(s.pose)
+        for j, (lt, local) in enumerate(solid_lights(s, Pose.identity())):
+            yield unique(lt.name or f"{s.name}/light{j}"), WORLD_FRAME, False, place_light(lt, top.compose(local))
+    for r in world.robots:
+        for j, lt in enumerate(r.lights):
+            frame = WORLD_FRAME if lt.type == "DirectionalLight" else r.name
+            yield unique(lt.name or f"{r.name}/light{j}"), frame, frame != WORLD_FRAME, lt

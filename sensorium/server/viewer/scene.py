@@ -46,9 +46,9 @@ from foxglove.messages import (
 )
 
 from sensorium.schemas import world as wm
-from sensorium.server.viewer.frames import INFINITE_PLANE_SIZE, WORLD_FRAME, mounts, quat_from_x
+from sensorium.server.viewer.frames import INFINITE_PLANE_SIZE, WORLD_FRAME, bodies, lights, mounts, quat_from_x
 from sensorium.server.world import geometry as geo
-from sensorium.server.world.poses import matrix_quaternion, pose_from_model
+from sensorium.server.world.poses import matrix_quaternion
 
 __all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "MAX_SCENE_TRIANGLES", "scene_update", "mounts",
            "frame_transforms", "timestamp"]
@@ -76,11 +76,6 @@ def _pose(translation: Iterable[float], quaternion: Iterable[float]) -> Pose:
     t = [float(v) for v in translation]
     q = [float(v) for v in quaternion]
     return Pose(position=Vector3(x=t[0], y=t[1], z=t[2]), orientation=Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]))
-
-
-def _model_pose(p: wm.Pose) -> Pose:
-    g = pose_from_model(p)
-    return _pose(g.translation, matrix_quaternion(g.rotation))
 
 
 _IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
@@ -134,11 +129,10 @@ def _entity(frame_id: str, entity_id: str, stamp_ns: int, parts: dict[str, Any],
                        metadata=[KeyValuePair(key="kind", value=kind)], **parts)
 
 
-def _light_entity(i: int, light: Any, stamp_ns: int) -> SceneEntity:
+def _light_entity(entity_id: str, frame_id: str, frame_locked: bool, light: Any, stamp_ns: int) -> SceneEntity:
     r, g, b = (float(c) for c in light.color)
     alpha = 1.0 if light.on else 0.3
     color = Color(r=r, g=g, b=b, a=alpha)
-    name = light.name or f"light{i}"
     parts: dict[str, list[Any]] = {}
     loc = getattr(light, "location", None)
     if loc is not None:
@@ -152,28 +146,26 @@ def _light_entity(i: int, light: Any, stamp_ns: int) -> SceneEntity:
         start = loc if loc is not None else (0.0, 0.0, 1.0)      # a directional light has no place: drawn above the origin
         parts["arrows"] = [ArrowPrimitive(pose=_pose(start, q), shaft_length=0.25, shaft_diameter=0.01,
                                           head_length=0.06, head_diameter=0.03, color=color)]
-    return _entity(WORLD_FRAME, f"light/{name}", stamp_ns, parts, f"light:{light.type}")
+    return _entity(frame_id, entity_id, stamp_ns, parts, f"light:{light.type}", frame_locked=frame_locked)
 
 
 def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
                  solid_poses: dict[str, Any] | None = None) -> SceneUpdate:
     """The whole world as one ``SceneUpdate``. ``solid_poses`` (name → geometry ``Pose``) overrides
-    the file's pose of a solid that was moved since loading."""
+    the file's pose of a solid that was moved since loading (its children and lights move with it)."""
     base = Path(base_dir)
     budget = [MAX_SCENE_TRIANGLES]
     entities: list[SceneEntity] = []
-    for s in world.solids:
-        moved = (solid_poses or {}).get(s.name)
-        pose = (_pose(moved.translation, matrix_quaternion(moved.rotation)) if moved is not None
-                else _model_pose(s.pose))
-        entities.append(_entity(WORLD_FRAME, f"solid/{s.name}", stamp_ns, shape_primitives(s, pose, base, budget),
-                                "solid"))
-    for r in world.robots:
-        if r.body is not None:
-            parts = shape_primitives(r.body, _pose(*_IDENTITY), base, budget)
-            entities.append(_entity(r.name, f"robot/{r.name}", stamp_ns, parts, "robot", frame_locked=True))
-    for i, light in enumerate(world.lights):
-        entities.append(_light_entity(i, light, stamp_ns))
+    for body in bodies(world, solid_poses):
+        merged: dict[str, list[Any]] = {}
+        for shape, pose in body.parts:
+            fx_pose = _pose(pose.translation, matrix_quaternion(pose.rotation))
+            for key, prims in shape_primitives(shape, fx_pose, base, budget).items():
+                merged.setdefault(key, []).extend(prims)
+        entities.append(_entity(body.frame_id, body.entity_id, stamp_ns, merged, body.kind,
+                                frame_locked=body.frame_locked))
+    for entity_id, frame_id, locked, light in lights(world, solid_poses):
+        entities.append(_light_entity(entity_id, frame_id, locked, light, stamp_ns))
     return SceneUpdate(entities=entities)
 
 
