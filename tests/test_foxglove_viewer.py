@@ -183,16 +183,18 @@ def test_grown_world_format_is_drawn_where_rays_see_it():
     for m in markers:
         by_ns.setdefault(m["ns"], []).append(m)
     pos = lambda m: [m["pose"]["position"][k] for k in "xyz"]
-    # obstacle: rotated 0.3 about z at (0.8, 0.3, 0); box 0.1 up, sphere 0.25 up, child cap 0.4 up (one
-    # capsule drawn: its bounding-only twin is Webots' invisible boundingObject)
+    # obstacle: rotated 0.3 about z at (0.8, 0.3, 0); box 0.1 up, sphere 0.25 up, child cap 0.4 up (its
+    # visual capsule, and the bounding-only twin, Webots' invisible boundingObject, translucent)
     obstacle = by_ns["solid/obstacle"]
-    assert [m["type"] for m in obstacle] == [1, 2, 11]
-    for m, z in zip(obstacle, (0.1, 0.25, 0.4)):
+    assert [m["type"] for m in obstacle] == [1, 2, 11, 11]
+    assert [m["color"]["a"] for m in obstacle[2:]] == [1.0, 0.25]
+    for m, z in zip(obstacle, (0.1, 0.25, 0.4, 0.4)):
         np.testing.assert_allclose(pos(m), [0.8, 0.3, z], atol=1e-12)
     q = obstacle[0]["pose"]["orientation"]
     assert (q["z"], q["w"]) == (pytest.approx(math.sin(0.15)), pytest.approx(math.cos(0.15)))
     assert obstacle[1]["color"] == {"r": 0.3, "g": 0.9, "b": 0.1, "a": pytest.approx(0.8)}
-    assert len(by_ns["solid/mesh"]) == 1 and by_ns["solid/mesh"][0]["type"] == 11      # the box is bounding-only
+    mesh = by_ns["solid/mesh"]                       # the mesh, and its bounding-only box drawn translucent
+    assert [m["type"] for m in mesh] == [11, 1] and [m["color"]["a"] for m in mesh] == [1.0, 0.25]
     assert len(by_ns["solid/faces"][0]["points"]) == 6 * 3                             # six triangles
     assert [m["type"] for m in by_ns["solid/rectangle arena"]] == [1] * 5             # floor plane + 4 walls
     # the robot: three shapes in its own frame, moving with it

@@ -84,12 +84,10 @@ def tf_pose(robot: str, pose_body: bytes, ns: int) -> dict:
                                (p["orientation"][k] for k in "xyzw"))]}
 
 
-def _color(shape: wm.Shape) -> dict:
-    a = shape.appearance
-    if a is None:
-        return {"r": 0.85, "g": 0.85, "b": 0.85, "a": 1.0}
-    r, g, b = a.base_color
-    return {"r": float(r), "g": float(g), "b": float(b), "a": float(1.0 - a.transparency)}
+def _color(shape: Any, ghost: bool) -> dict:
+    from sensorium.server.viewer.frames import shape_rgba
+
+    return dict(zip("rgba", shape_rgba(shape, ghost)))
 
 
 def _ros_pose(t, q) -> dict:
@@ -97,14 +95,14 @@ def _ros_pose(t, q) -> dict:
 
 
 def _shape_marker(shape: wm.Shape, frame: str, ns_name: str, mid: int, t, q, stamp: int, base_dir: Path,
-                  locked: bool) -> dict:
+                  locked: bool, ghost: bool = False) -> dict:
     from sensorium.server.sim.scene import primitive_from_model
     from sensorium.server.viewer.frames import INFINITE_PLANE_SIZE
     from sensorium.server.world import geometry as geo
 
     g = shape.geometry
     m: dict[str, Any] = {"header": {"stamp": _stamp(stamp), "frame_id": frame}, "ns": ns_name, "id": mid, "action": 0,
-                         "pose": _ros_pose(t, q), "color": _color(shape), "frame_locked": locked,
+                         "pose": _ros_pose(t, q), "color": _color(shape, ghost), "frame_locked": locked,
                          "scale": {"x": 1.0, "y": 1.0, "z": 1.0}}
     if isinstance(g, wm.Box):
         m.update(type=_CUBE, scale=dict(zip("xyz", (float(v) for v in g.size))))
@@ -132,9 +130,9 @@ def marker_array(world: wm.World, base_dir: str | Path, stamp: int) -> dict | No
     base = Path(base_dir)
     markers = []
     for body in bodies(world):
-        for k, (shape, pose) in enumerate(body.parts):
+        for k, (shape, pose, ghost) in enumerate(body.parts):
             markers.append(_shape_marker(shape, body.frame_id, body.entity_id, k, pose.translation,
-                                         matrix_quaternion(pose.rotation), stamp, base, body.frame_locked))
+                                         matrix_quaternion(pose.rotation), stamp, base, body.frame_locked, ghost))
     for entity_id, frame_id, locked, light in lights(world):
         c = {"r": float(light.color[0]), "g": float(light.color[1]), "b": float(light.color[2]),
              "a": 1.0 if light.on else 0.3}

@@ -14,12 +14,28 @@ from sensorium.schemas import world as wm
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
-__all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "Mount", "mounts", "quat_from_x", "Body", "bodies", "lights"]
+__all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "Mount", "mounts", "quat_from_x", "Body", "bodies", "lights",
+           "shape_rgba", "GHOST_ALPHA"]
 
 WORLD_FRAME = "world"
 INFINITE_PLANE_SIZE = 50.0      # metres: an infinite plane is drawn as a square of this side
 
+NO_APPEARANCE = (0.85, 0.85, 0.85)  # a shape without appearance (Webots draws it white: grey shows on a light floor)
+GHOST_ALPHA = 0.25               # bounding-only shapes (invisible in Webots) are drawn this translucent
+
 Mount = tuple[str, tuple[float, float, float], tuple[float, float, float, float]]
+
+
+def shape_rgba(shape: Any, ghost: bool = False) -> tuple[float, float, float, float]:
+    """A shape's drawing colour: ``base_color`` with alpha 1 - transparency (light grey without an
+    appearance); a bounding-only (``ghost``) shape at alpha ``GHOST_ALPHA``, so that even a fully
+    transparent one (a glass pane sonars see) shows."""
+    a = shape.appearance
+    r, g, b = NO_APPEARANCE if a is None else (float(c) for c in a.base_color)
+    alpha = 1.0 if a is None else float(1.0 - a.transparency)
+    if ghost:
+        alpha = GHOST_ALPHA
+    return r, g, b, alpha
 
 
 def mounts(world: wm.World) -> dict[str, list[Mount]]:
@@ -57,22 +73,22 @@ class Body:
     frame_id: str
     kind: str                                   # solid | robot
     frame_locked: bool
-    parts: list[tuple[Any, Pose]]               # (a Shape-like model with geometry/appearance, pose in frame_id)
+    parts: list[tuple[Any, Pose, bool]]         # (Shape-like model, pose in frame_id, ghost: bounding-only)
 
 
 def bodies(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Iterator[Body]:
-    """Every solid and robot body to draw: the shapes rays of the visual kind see (``seen_by`` both
-    or visual; a bounding-only shape is Webots' invisible boundingObject). ``solid_poses``
-    overrides where a solid is now."""
+    """Every solid and robot body to draw, with every shape: ``ghost`` marks a bounding-only shape
+    (Webots' invisible boundingObject, seen only by generic/sonar/laser rays), drawn translucent.
+    ``solid_poses`` overrides where a solid is now."""
     from sensorium.server.sim.scene import robot_parts, solid_parts
 
     for s in world.solids:
         top = (solid_poses or {}).get(s.name) or pose_from_model(s.pose)
-        parts = [(shape, pose) for _n, pose, shape in solid_parts(s, top) if shape.seen_by != "bounding"]
+        parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in solid_parts(s, top)]
         if parts:
             yield Body(f"solid/{s.name}", WORLD_FRAME, "solid", False, parts)
     for r in world.robots:
-        parts = [(shape, pose) for _n, pose, shape in robot_parts(r) if shape.seen_by != "bounding"]
+        parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in robot_parts(r)]
         if parts:
             yield Body(f"robot/{r.name}", r.name, "robot", True, parts)
 

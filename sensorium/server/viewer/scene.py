@@ -46,7 +46,15 @@ from foxglove.messages import (
 )
 
 from sensorium.schemas import world as wm
-from sensorium.server.viewer.frames import INFINITE_PLANE_SIZE, WORLD_FRAME, bodies, lights, mounts, quat_from_x
+from sensorium.server.viewer.frames import (
+    INFINITE_PLANE_SIZE,
+    WORLD_FRAME,
+    bodies,
+    lights,
+    mounts,
+    quat_from_x,
+    shape_rgba,
+)
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.poses import matrix_quaternion
 
@@ -54,7 +62,6 @@ __all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "MAX_SCENE_TRIANGLES", "scene_u
            "frame_transforms", "timestamp"]
 
 MAX_SCENE_TRIANGLES = 200_000    # meshes beyond this budget (whole scene) are drawn as their bounding boxes
-_NO_APPEARANCE = (0.85, 0.85, 0.85)
 _LIGHT_MARK = 0.05               # radius of the sphere drawn at a light's location (m)
 
 
@@ -63,13 +70,9 @@ def timestamp(ns: int) -> Timestamp:
     return Timestamp(ns // 1_000_000_000, ns % 1_000_000_000)
 
 
-def _color(shape: wm.Shape) -> Color:
-    a = shape.appearance
-    if a is None:
-        r, g, b = _NO_APPEARANCE
-        return Color(r=r, g=g, b=b, a=1.0)
-    r, g, b = a.base_color
-    return Color(r=float(r), g=float(g), b=float(b), a=float(1.0 - a.transparency))
+def _color(shape: Any, ghost: bool = False) -> Color:
+    r, g, b, a = shape_rgba(shape, ghost)
+    return Color(r=r, g=g, b=b, a=a)
 
 
 def _pose(translation: Iterable[float], quaternion: Iterable[float]) -> Pose:
@@ -88,12 +91,13 @@ def _triangles(vertices: np.ndarray, faces: np.ndarray, pose: Pose, color: Color
                                  indices=[int(i) for i in np.asarray(faces, dtype=np.int64).reshape(-1).tolist()])
 
 
-def shape_primitives(shape: wm.Shape, pose: Pose, base_dir: Path, budget: list[int]) -> dict[str, list[Any]]:
+def shape_primitives(shape: wm.Shape, pose: Pose, base_dir: Path, budget: list[int],
+                     ghost: bool = False) -> dict[str, list[Any]]:
     """The Foxglove primitives drawing one shape at ``pose`` (in its entity's frame), keyed by the
     ``SceneEntity`` field they go in. ``budget`` (one-element list) is the triangles left."""
     from sensorium.server.sim.scene import primitive_from_model
 
-    g, color = shape.geometry, _color(shape)
+    g, color = shape.geometry, _color(shape, ghost)
     if isinstance(g, wm.Box):
         return {"cubes": [CubePrimitive(pose=pose, size=Vector3(x=g.size[0], y=g.size[1], z=g.size[2]), color=color)]}
     if isinstance(g, wm.Sphere):
@@ -158,9 +162,9 @@ def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
     entities: list[SceneEntity] = []
     for body in bodies(world, solid_poses):
         merged: dict[str, list[Any]] = {}
-        for shape, pose in body.parts:
+        for shape, pose, ghost in body.parts:
             fx_pose = _pose(pose.translation, matrix_quaternion(pose.rotation))
-            for key, prims in shape_primitives(shape, fx_pose, base, budget).items():
+            for key, prims in shape_primitives(shape, fx_pose, base, budget, ghost).items():
                 merged.setdefault(key, []).extend(prims)
         entities.append(_entity(body.frame_id, body.entity_id, stamp_ns, merged, body.kind,
                                 frame_locked=body.frame_locked))
