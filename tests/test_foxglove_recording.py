@@ -162,3 +162,24 @@ def test_a_body_without_a_view_is_still_kept_and_reported(tmp_path):
     with Recording(tmp_path / "x.mcap") as r:
         assert [(m.topic, m.data) for m in r.messages()] == [("/a/b/value", odd)]
         assert r.metadata()["foxglove_view_errors"] == {"/a/b/value": "ExportError: body is not a msgpack map"}
+
+
+def test_subscriber_recording_with_world_file_carries_the_scene(tmp_path):
+    from mcap.reader import make_reader
+
+    from sensorium.server.recording.live import LiveRecorder
+    from sensorium.server.world.loader import default_world_path
+
+    out = tmp_path / "sub.mcap"
+    live = LiveRecorder(out, connect=None, pub="tcp://127.0.0.1:9", world=str(default_world_path()),
+                        log=lambda s: None)
+    live.open()                                         # nothing is published: only the world is written
+    live.close()
+    with open(out, "rb") as f:
+        summary = make_reader(f).get_summary()
+    chans = {c.topic: c for c in summary.channels.values()}
+    assert summary.schemas[chans["/scene"].schema_id].name == "foxglove.SceneUpdate"
+    assert summary.statistics.channel_message_counts[chans["/scene"].id] == 1
+    got = run_script("read_mcap.js", str(out))[0]
+    assert got["errors"] == []
+    assert len(got["last"]["/scene"]["msg"]["entities"]) == 11 + 2 + 3
