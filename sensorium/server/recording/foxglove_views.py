@@ -26,6 +26,8 @@ from typing import Any
 
 import msgpack
 
+from sensorium.server.recording.ros_views import pose_robot
+
 __all__ = ["WIRE_PREFIX", "WIRE_SCHEMA", "WIRE_MSGDEF", "wire_wrap", "wire_unwrap", "available", "FoxgloveViews"]
 
 WIRE_PREFIX = "/sensorium/wire"
@@ -95,8 +97,8 @@ class FoxgloveViews:
             self.errors.setdefault(topic, f"{type(exc).__name__}: {exc}")
         else:
             out.append((topic, typename, "ros2msg", self.encoder.msgdef(typename).encode(), "cdr", data))
-        if ros_type == "geometry_msgs/msg/PoseStamped" and topic.endswith("/pose") and topic.count("/") == 2:
-            robot = topic[1:-len("/pose")]
+        robot = pose_robot(topic, ros_type)
+        if robot is not None:
             try:
                 p = msgpack.unpackb(body, raw=False)["pose"]
                 t = (p["position"]["x"], p["position"]["y"], p["position"]["z"])

@@ -19,7 +19,8 @@ the events are applied by the step-loop thread in :meth:`FoxgloveBridge.pump` (a
 Never slowing the step loop: :meth:`record` (called by ``Topics`` in the step thread) only appends
 the msgpack bytes to a bounded queue (the oldest is dropped when full, ``dropped`` counts it); a
 worker thread encodes CDR/protobuf and hands the bytes to the SDK, whose per-client backlog drops
-the oldest messages of a slow client. Simulated time is broadcast as the server time.
+the oldest messages of a slow client. Simulated time is broadcast as the server time. When a
+supervisor moves a solid, the scene is sent again to every ``/scene`` subscriber.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ import msgpack
 
 from sensorium.schemas import world as wm
 from sensorium.server.recording.export import CdrEncoder, ExportError
+from sensorium.server.recording.ros_views import pose_robot
 
 __all__ = ["FoxgloveBridge", "ViewerError", "parse_address", "exposure_warning", "TF_TOPIC", "SCENE_TOPIC", "POSE_TYPE"]
 
@@ -136,8 +138,7 @@ class FoxgloveBridge:
             schema = foxglove.Schema(name=typename, encoding="ros2msg", data=self.encoder.msgdef(typename).encode())
             self.channels[topic] = foxglove.Channel(topic, schema=schema, message_encoding="cdr", context=self.ctx)
             self.types[topic] = typename
-        self.pose_robot = {t: t[1:-len("/pose")] for t, ty in topic_types.items()
-                           if ty == POSE_TYPE and t.endswith("/pose") and t.count("/") == 2}
+        self.pose_robot = {t: r for t, ty in topic_types.items() if (r := pose_robot(t, ty)) is not None}
         self.mounts = mounts(world) if world is not None else {}
         self.tf_channel = None
         if self.pose_robot:
