@@ -122,8 +122,8 @@ def test_moved_solid_resends_the_scene_to_everyone():
 def test_meshes_over_the_triangle_budget_are_drawn_as_bounding_boxes():
     import numpy as np
 
+    from sensorium.server.recording.scene3d import fit_budget
     from sensorium.server.sim.scene import primitive_from_model
-    from sensorium.server.viewer.scene import fit_budget
     from sensorium.server.world import geometry as geo
     from sensorium.server.world.loader import default_world_path
 
@@ -210,6 +210,6 @@ def test_grown_world_format_is_drawn_where_rays_see_it():
     assert lamp["header"]["frame_id"] == "bot" and lamp["frame_locked"] and pos(lamp) == [0.05, 0.0, 0.1]
     assert by_ns["light/light0"][0]["type"] == 0 and by_ns["light/light0"][0]["header"]["frame_id"] == "world"
     # the Foxglove scene is built from the same bodies and lights (decoded field by field in the Node tests)
-    from sensorium.server.viewer.scene import scene_update
+    from sensorium.server.recording.scene3d import scene_update
 
     assert len(scene_update(loaded.world, loaded.base_dir).encode()) > 1000

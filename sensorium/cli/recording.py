@@ -20,7 +20,7 @@ from sensorium.server.recording.reader import McapError, summarize
 @contextmanager
 def sigterm_as_interrupt():
     """SIGTERM (and SIGHUP) raise KeyboardInterrupt like Ctrl-C, so files get finished."""
-    previous = {}
+    previous: dict = {}
 
     def handler(signum, frame):
         raise KeyboardInterrupt
@@ -38,14 +38,13 @@ def sigterm_as_interrupt():
             signal.signal(sig, h)
 
 
-
 def record(args: argparse.Namespace) -> int:
-    ctx = zmq.Context.instance()
+    ctx: zmq.Context = zmq.Context.instance()
     rec = LiveRecorder(args.file, connect=args.connect, pub=args.pub, topics=args.topics or None, world=args.world,
                        chunk_size=args.chunk_size, rcvhwm=args.rcvhwm, context=ctx)
     try:
         rec.open()
-    except (TimeoutError, RuntimeError, KeyError, OSError, zmq.ZMQError) as exc:
+    except (TimeoutError, RuntimeError, KeyError, ValueError, OSError, zmq.ZMQError) as exc:
         print(f"sensorium record: {exc}", file=sys.stderr)
         return 1
     print(f"sensorium: recording {args.file} from pub={rec.pub_endpoint}"

@@ -19,6 +19,15 @@ DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
 
 
+def add_world_options(p: argparse.ArgumentParser) -> None:
+    """``--allow-large`` and ``--allow-outside-meshes`` (validate, probe, serve)."""
+    p.add_argument("--allow-large", action="store_true",
+                   help="raise the world limits (rays, beams, triangles, robots, file size, ...; README "
+                   "'Security and limits') for a world that deliberately asks for more")
+    p.add_argument("--allow-outside-meshes", action="store_true",
+                   help="let mesh urls leave the world file's folder (absolute paths, '..')")
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("world", nargs="?", help="world file (default: the embedded arena world)")
     p.add_argument("--rpc", default=DEFAULT_RPC, metavar="URL",
@@ -40,6 +49,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--foxglove", metavar="[HOST:]PORT",
                    help="also serve the topics, transforms and the world to Foxglove (WebSocket) on PORT, "
                    "host 127.0.0.1 unless given; port 0 picks a free port")
+    add_world_options(p)
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
                    "without subscribers (default: every topic)")
@@ -50,7 +60,9 @@ def options(args: argparse.Namespace):
     from sensorium.server.daemon.serve import ServeOptions
 
     return ServeOptions(rpc=args.rpc, pub=args.pub, mode=args.mode, precision=args.precision,
-                        heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None))
+                        heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None),
+                        allow_large=getattr(args, "allow_large", False),
+                        allow_outside_meshes=getattr(args, "allow_outside_meshes", False))
 
 
 def main(args: argparse.Namespace) -> int:

@@ -1,6 +1,7 @@
 """The Supervisor subset (sans-IO): node handles, ``translation``/``rotation`` fields, poses.
 
-Nodes are the world's robots and solids, found by name (their DEF names in a converted ``.wbt``).
+Nodes are the world's robots and top-level solids, found by DEF name (``def_name``, set from a
+``.wbt`` world's ``DEF``) or else by name.
 A node's id is stable for the life of the server: robots 1..R in world order, then solids. Field
 values are Webots' ``SFVec3f`` (x, y, z) and ``SFRotation`` (axis x, y, z, angle), in the parent
 frame (the world here: nodes are not nested). Setting one field keeps the other (Webots).
@@ -31,7 +32,15 @@ def _nodes(sim: Any) -> list[Node]:
 
 
 def find_node(sim: Any, name: str) -> Node | None:
-    for n in _nodes(sim):
+    """The robot or top-level solid whose DEF name (``def_name``) is ``name``, else whose name is."""
+    nodes = _nodes(sim)
+    world = getattr(sim, "world", None)
+    if world is not None:
+        defs = [getattr(m, "def_name", None) for m in (*world.robots, *world.solids)]
+        for n, d in zip(nodes, defs):
+            if d == name:
+                return n
+    for n in nodes:
         if n.name == name:
             return n
     return None

@@ -67,9 +67,9 @@ class FoxgloveViews:
     Messages that do not convert are counted in ``errors`` (the wire copy is always kept)."""
 
     def __init__(self, world: Any = None, base_dir: str | Path = ".", distro: str = "jazzy"):
+        from sensorium.server.recording import scene3d as fxscene
         from sensorium.server.recording.export import CdrEncoder
-        from sensorium.server.viewer import scene as fxscene
-        from sensorium.server.viewer.frames import mounts
+        from sensorium.server.recording.frames import mounts
 
         self._scene = fxscene
         self.encoder = CdrEncoder(distro, pointcloud2=True)

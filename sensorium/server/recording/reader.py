@@ -30,6 +30,7 @@ from mcap.records import (
     Schema,
 )
 from mcap.stream_reader import StreamReader, breakup_chunk
+from mcap.summary import Summary
 
 from sensorium.server.recording import foxglove_views as fxv
 from sensorium.server.recording.envelope import MAGIC, MESSAGE_ENCODING, SEQ_MODULUS, pack_envelope, topic_matcher
@@ -144,7 +145,7 @@ class Recording:
             raise McapError(f"{self.path}: not an MCAP file")
         self.truncated = False
         self.error: str | None = None
-        self._summary = None
+        self._summary: Summary | None = None
         self._reader: SeekingReader | None = None
         if _has_footer(self.path):
             try:
@@ -161,6 +162,11 @@ class Recording:
         if self._summary is None or not self._summary.chunk_indexes:
             self._reader = None  # read sequentially (truncated, or finished without a summary)
         self._scan_cache: dict | None = None
+
+    def _indexed(self) -> Summary:
+        """The summary of a finished, indexed file (callers check ``self._reader`` first)."""
+        assert self._summary is not None
+        return self._summary
 
     # ----- context
     def close(self) -> None:
@@ -273,7 +279,7 @@ class Recording:
         """One entry per channel with its count and first/last log time."""
         if self._reader is None:
             return self._scan()["topics"]
-        s = self._summary
+        s = self._indexed()
         stats = s.statistics
         infos: dict[int, TopicInfo] = {}
         for cid, ch in s.channels.items():
@@ -306,9 +312,10 @@ class Recording:
         match = topics if callable(topics) else topic_matcher(topics)
         unwrap = _Unwrap()
         if self._reader is not None:
+            summary = self._indexed()
             names = []
-            for ch in self._summary.channels.values():
-                sch = self._summary.schemas.get(ch.schema_id)
+            for ch in summary.channels.values():
+                sch = summary.schemas.get(ch.schema_id)
                 src = _source(ch.topic, sch.name if sch else "", ch.message_encoding, ch.metadata)
                 if src is not None and match(src[0]):
                     names.append(ch.topic)
@@ -356,7 +363,7 @@ class Recording:
         header = self.header()
         size = self.path.stat().st_size
         if self._reader is not None:
-            s = self._summary
+            s = self._indexed()
             chunks = len(s.chunk_indexes)
             compression = sorted({ci.compression or "none" for ci in s.chunk_indexes})
             stopped = None

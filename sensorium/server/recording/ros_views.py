@@ -71,7 +71,7 @@ def _tf(parent: str, child: str, ns: int, t, q) -> dict:
 
 def tf_static(world: wm.World, ns: int) -> dict | None:
     """Every device mount, or ``None`` if the world has none."""
-    from sensorium.server.viewer.frames import mounts
+    from sensorium.server.recording.frames import mounts
 
     items = [_tf(robot, frame, ns, t, q) for robot, ms in mounts(world).items() for frame, t, q in ms]
     return {"transforms": items} if items else None
@@ -85,7 +85,7 @@ def tf_pose(robot: str, pose_body: bytes, ns: int) -> dict:
 
 
 def _color(shape: Any, ghost: bool) -> dict:
-    from sensorium.server.viewer.frames import shape_rgba
+    from sensorium.server.recording.frames import shape_rgba
 
     return dict(zip("rgba", shape_rgba(shape, ghost)))
 
@@ -96,8 +96,8 @@ def _ros_pose(t, q) -> dict:
 
 def _shape_marker(shape: wm.Shape, frame: str, ns_name: str, mid: int, t, q, stamp: int, base_dir: Path,
                   locked: bool, ghost: bool = False) -> dict:
+    from sensorium.server.recording.frames import INFINITE_PLANE_SIZE
     from sensorium.server.sim.scene import primitive_from_model
-    from sensorium.server.viewer.frames import INFINITE_PLANE_SIZE
     from sensorium.server.world import geometry as geo
 
     g = shape.geometry
@@ -124,7 +124,7 @@ def _shape_marker(shape: wm.Shape, frame: str, ns_name: str, mid: int, t, q, sta
 
 def marker_array(world: wm.World, base_dir: str | Path, stamp: int) -> dict | None:
     """The world as markers (one namespace per solid, robot body or light), or ``None`` if empty."""
-    from sensorium.server.viewer.frames import bodies, lights, quat_from_x
+    from sensorium.server.recording.frames import bodies, lights, quat_from_x
     from sensorium.server.world.poses import matrix_quaternion
 
     base = Path(base_dir)

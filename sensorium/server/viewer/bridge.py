@@ -8,7 +8,7 @@ Channels (all advertised at start):
   (Foxglove's 3D panel does not draw the old ``PointCloud``);
 * ``/tf`` — ``foxglove.FrameTransforms`` (protobuf): ``world → <robot>`` at the robot's pose and
   ``<robot> → <robot>/<device>`` mounts, one message per robot pose;
-* ``/scene`` — ``foxglove.SceneUpdate`` (protobuf): the world (see :mod:`.scene`), sent to each
+* ``/scene`` — ``foxglove.SceneUpdate`` (protobuf): the world (see :mod:`sensorium.server.recording.scene3d`), sent to each
   client when it subscribes (robot bodies follow ``/tf``).
 
 Demand: a client subscribing to a topic's channel makes that topic demanded exactly like a ZeroMQ
@@ -116,8 +116,8 @@ class FoxgloveBridge:
             from foxglove.websocket import Capability
         except ImportError as exc:  # pragma: no cover - depends on the environment
             raise ViewerError("the Foxglove viewer needs the 'foxglove' extra: pip install 'sensorium[foxglove]'") from exc
-        from sensorium.server.viewer import scene as fxscene
-        from sensorium.server.viewer.frames import mounts
+        from sensorium.server.recording import scene3d as fxscene
+        from sensorium.server.recording.frames import mounts
 
         self._scene_mod = fxscene
         self.encoder = CdrEncoder(distro, pointcloud2=True)

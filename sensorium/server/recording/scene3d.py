@@ -1,4 +1,5 @@
-"""The world as Foxglove sees it: a ``foxglove.SceneUpdate`` and ``foxglove.FrameTransforms``.
+"""The world as Foxglove sees it: a ``foxglove.SceneUpdate`` and ``foxglove.FrameTransforms``
+(used by recordings and by the live viewer, sensorium.server.viewer).
 
 Frames (the same names the topics' ``header.frame_id`` use):
 
@@ -46,7 +47,7 @@ from foxglove.messages import (
 )
 
 from sensorium.schemas import world as wm
-from sensorium.server.viewer.frames import (
+from sensorium.server.recording.frames import (
     INFINITE_PLANE_SIZE,
     WORLD_FRAME,
     bodies,
