@@ -260,7 +260,7 @@ def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report
     transform messages of :mod:`.ros_views` (when ``views`` and the recorded world has them)."""
     from sensorium.server.recording import ros_views
 
-    world, base_dir = ros_views.recorded_world(rec) if views else (None, None)
+    world, base_dir = ros_views.recorded_world(rec) if views else (None, Path("."))
     started = False
     tf_seq = 0
     for m, typename, msg in _iter_recorded(rec, typestore, topics, pointcloud2, report, start_ns, end_ns):

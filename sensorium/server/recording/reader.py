@@ -314,11 +314,11 @@ class Recording:
         if self._reader is not None:
             summary = self._indexed()
             names = []
-            for ch in summary.channels.values():
-                sch = summary.schemas.get(ch.schema_id)
-                src = _source(ch.topic, sch.name if sch else "", ch.message_encoding, ch.metadata)
+            for chan in summary.channels.values():
+                sch = summary.schemas.get(chan.schema_id)
+                src = _source(chan.topic, sch.name if sch else "", chan.message_encoding, chan.metadata)
                 if src is not None and match(src[0]):
-                    names.append(ch.topic)
+                    names.append(chan.topic)
             kwargs: dict[str, Any] = {"log_time_order": True}
             try:
                 it = self._reader.iter_messages(topics=names, starting_at=start_ns,

@@ -114,7 +114,7 @@ class McapRecorder:
         self.path = Path(path)
         # Foxglove views (format 2) when asked for and the extra is installed
         self.foxglove_unavailable = fxv.available() if foxglove else "not requested"
-        self._views = fxv.FoxgloveViews(world, base_dir) if self.foxglove_unavailable is None else None
+        self._views = fxv.FoxgloveViews(world, Path(base_dir)) if self.foxglove_unavailable is None else None
         self._view_schemas: dict[str, int] = {}
         self._view_channels: dict[str, int] = {}
         self._view_seq: dict[str, int] = {}
