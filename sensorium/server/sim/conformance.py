@@ -68,6 +68,7 @@ def expected_lines(world: Path = WORLD, robot: str = ROBOT, script: list[str] = 
     period: dict[str, int] = {}
     pc: dict[str, bool] = {}
     lines: list[str] = []
+    dev: Any                                # a sensor of any kind
     i = 0
     while i < len(script):
         op = script[i]

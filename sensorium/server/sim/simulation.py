@@ -261,24 +261,24 @@ class Simulation:
         self.step_count += 1
         now = self.time_ms
         dt = self.basic_time_step
-        moved: list[tuple[int, DifferentialDrive, tuple[float, float], Pose]] = []
+        moved: list[tuple[RobotState, DifferentialDrive, tuple[float, float], Pose]] = []
         for robot in self._driven:
             drive = robot.drive
             assert drive is not None
             start = (drive.x, drive.y)
             pose = drive.step(dt)
             if pose is not None:
-                moved.append((robot.index, drive, start, pose))
+                moved.append((robot, drive, start, pose))
         if self.contact is not None and moved:
-            ends = self.contact.resolve_all([i for i, _, _, _ in moved], np.array([s for _, _, s, _ in moved]),
+            ends = self.contact.resolve_all([r.index for r, _, _, _ in moved], np.array([s for _, _, s, _ in moved]),
                                             np.array([(d.x, d.y) for _, d, _, _ in moved]))
             for k, (end, clipped) in enumerate(ends):
                 if clipped:
-                    index, drive, start, _ = moved[k]
+                    robot, drive, start, _ = moved[k]
                     drive.x, drive.y = float(end[0]), float(end[1])
-                    moved[k] = (index, drive, start, drive.pose())
-        for index, _, _, pose in moved:
-            self.scene.set_robot_pose(index, pose)
+                    moved[k] = (robot, drive, start, drive.pose())
+        for robot, _, _, pose in moved:
+            self.scene.set_robot_pose(robot.index, pose)
         poses = self.scene.robot_poses
         lights: list[LightSensor] = []
         distances: list[DistanceSensor] = []
