@@ -36,6 +36,7 @@ class RayRequest:
     exclude_owner: int | np.ndarray   # per request or per ray
     skip_transparent: bool = False
     tag: str = ""              # counter bucket: "light", "distance", "lidar"
+    mount: np.ndarray | None = None   # per ray: body the ray is rigidly mounted on, -1 none (see RayEngine.cast)
 
     def __len__(self) -> int:
         return len(self.origins)

@@ -97,6 +97,10 @@ class Scene:
         self.red = np.array([s.red for s in self.shapes] + [1.0])
         self.roughness = np.array([s.roughness for s in self.shapes] + [0.0])
 
+    def robot_body(self, index: int) -> int | None:
+        """The engine body of robot ``index`` (None for a robot without a body)."""
+        return self._robot_body.get(index)
+
     def set_robot_pose(self, index: int, pose: Pose) -> None:
         self.robot_poses[index] = pose
         body = self._robot_body.get(index)
