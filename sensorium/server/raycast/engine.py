@@ -278,7 +278,7 @@ class RayEngine(TierTracer):
     # ---- casting ----------------------------------------------------------------------------
 
     def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
-             exclude_owner=-1, skip_transparent=False, mount=None) -> RayHits:
+             exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False) -> RayHits:
         """Nearest hits of rays ``origins + t directions``, t in [t_near, t_far] (scalars or per ray).
 
         ``mount``: optional (n,) body index each ray is rigidly mounted on (-1: none).  Such a ray
@@ -286,7 +286,11 @@ class RayEngine(TierTracer):
         once, in the body frame, with :meth:`cast_local`, and keeps the nearer of the two.  It
         also lets the broad phase skip, in one test per body, the rays of bodies whose rays cannot
         reach any other moving body (the rays of 100 robots' sensors, instead of one grid lookup
-        per ray)."""
+        per ray).
+
+        ``distance_only``: the caller reads only ``distance`` (a lidar); FAST then skips the normals
+        and shape ids (returned as None) and the work that only serves them, with the same
+        distances.  Origins may be a broadcast array (one origin for all rays), never written."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
@@ -310,11 +314,13 @@ class RayEngine(TierTracer):
         if n == 0:
             return RayHits(np.zeros(0), np.zeros((0, 3)), np.zeros(0, dtype=np.int64))
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
-        big = max(map(abs, O.ravel().tolist())) if n <= _SMALL else max(float(O.max()), -float(O.min()))
+        Ou = O[:1] if O.strides[0] == 0 else O   # one origin for all rays (a broadcast array)
+        big = max(map(abs, Ou.ravel().tolist())) if len(Ou) <= _SMALL else max(float(Ou.max()), -float(Ou.min()))
         # one errstate for the whole cast: inf/NaN are handled explicitly (entering the context
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount)
+            return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount,
+                              distance_only and self._precision is Precision.FAST)
 
     def cast_local(self, body: int, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
                    skip_transparent=False) -> RayHits:
@@ -347,29 +353,31 @@ class RayEngine(TierTracer):
             shape = np.where(s >= 0, s + b.first, -1)
         return RayHits(t, normal, shape)
 
-    def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None) -> RayHits:
+    def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
+              distance_only: bool = False) -> RayHits:
         n = len(O)
         exact = self._precision is Precision.EXACT
         eps64 = 1e-9 + 1e-14 * big  # float64 self-hit epsilon: 1e-9 m + ~50 ulps of the largest coordinate
-        hits = self._cast_planes(planes, O, D, t_near, t_far, excl, eps64) if planes is not None else None
+        hits = (cast_planes(planes, self._epoch, O, D, t_near, t_far, excl, eps64, distance_only)
+                if planes is not None else None)
         if static is not None:
             lim = t_far if hits is None else np.minimum(t_far, hits[0])
-            res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big)
+            res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big,
+                              distance_only)
             if res is not None and hits is None:
                 hits = res
+            elif res is not None and distance_only:   # the nearer of plane and mesh (ties: the plane)
+                np.minimum(hits[0], res[0], out=hits[0])
             elif res is not None:
                 t, s, nrm = res
                 better = (t < hits[0]).nonzero()[0]
                 hits[0][better], hits[1][better], hits[2][better] = t[better], s[better], nrm[better]
         if hits is None:
-            hits = (np.full(n, _INF), np.full(n, -1, dtype=np.int64), np.zeros((n, 3)))
+            hits = ((np.full(n, _INF), None, None) if distance_only else
+                    (np.full(n, _INF), np.full(n, -1, dtype=np.int64), np.zeros((n, 3))))
         if movers is not None:
             self._cast_movers(movers, O, D, t_near, t_far, excl, eps64, exact, *hits, mount=mount)
         return RayHits(hits[0], hits[2], hits[1])
-
-    def _cast_planes(self, pl: _Planes, O, D, t_near, t_far, excl, eps64):
-        """(dist, shape, normal) of the nearest plane hits, or None if no ray hits a plane."""
-        return cast_planes(pl, self._epoch, O, D, t_near, t_far, excl, eps64)
 
     def _cast_movers(self, mt: _Movers, O, D, t_near, t_far, excl, eps64, exact, dist, shape, normal,
                      mount=None) -> None:
@@ -455,7 +463,7 @@ class RayEngine(TierTracer):
                     if len(keep) == 0:
                         continue
                     rr, mm, Ob, Db, lim_r = rr[keep], mm[keep], Ob[keep], Db[keep], lim_r[keep]
-            res = self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact)
+            res = self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact, None, shape is None)
             if res is None:
                 continue
             t, s, nb = res
@@ -466,8 +474,9 @@ class RayEngine(TierTracer):
             if not _strictly_increasing(rows):  # a ray near several movers of this tier: nearest wins
                 keep = _best_per_row(rows, t[win])
                 win, rows = win[keep], rows[keep]
-            nb = nb[win]
             mw = mm[win]
             dist[rows] = t[win]
-            shape[rows] = mt.first[mw] + s[win]
-            normal[rows] = _mat(nb, Rb.T) if one else np.einsum("nij,nj->ni", R[mw], nb)
+            if shape is not None:
+                shape[rows] = mt.first[mw] + s[win]
+                nb = nb[win]
+                normal[rows] = _mat(nb, Rb.T) if one else np.einsum("nij,nj->ni", R[mw], nb)

@@ -234,19 +234,26 @@ class Simulation:
         return plan
 
     def _cast_batched(self, requests: list[RayRequest]) -> list[RayHits]:
-        """All rays of a step: one engine call per (ray kind, transparency rule)."""
+        """All rays of a step: one engine call per (ray kind, transparency rule, outputs needed)."""
         results: list[RayHits | None] = [None] * len(requests)
         groups: dict[tuple, list[int]] = {}
         for i, r in enumerate(requests):
             self._counters[f"rays_{r.tag}"] += len(r)
             if len(r):
-                groups.setdefault((int(r.kind), r.skip_transparent), []).append(i)
+                groups.setdefault((int(r.kind), r.skip_transparent, r.distance_only), []).append(i)
             else:
                 results[i] = RayHits(np.empty(0), np.empty((0, 3)), np.empty(0, dtype=np.int64))
         engine = self.scene.engine
-        for (kind, skip), idx in groups.items():
+        for (kind, skip, distance_only), idx in groups.items():
             reqs = [requests[i] for i in idx]
             sizes = [len(r) for r in reqs]
+            self._counters["cast_calls"] += 1
+            if len(reqs) == 1:   # one request (a lidar): its arrays as they are, no copies
+                r = reqs[0]
+                results[idx[0]] = engine.cast(r.origins, r.directions, r.t_near, r.t_far, kind=kind,
+                                              exclude_owner=r.exclude_owner, skip_transparent=skip, mount=r.mount,
+                                              distance_only=distance_only)
+                continue
             origins = np.concatenate([r.origins for r in reqs])
             dirs = np.concatenate([r.directions for r in reqs])
             t_near = np.concatenate([np.broadcast_to(np.asarray(r.t_near, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
@@ -257,11 +264,11 @@ class Simulation:
                 mount = np.concatenate([r.mount if r.mount is not None else np.full(n, -1, dtype=np.int64)
                                         for r, n in zip(reqs, sizes)])
             hits = engine.cast(origins, dirs, t_near, t_far, kind=kind, exclude_owner=owners, skip_transparent=skip,
-                               mount=mount)
-            self._counters["cast_calls"] += 1
+                               mount=mount, distance_only=distance_only)
             start = 0
             for i, n in zip(idx, sizes):
                 sl = slice(start, start + n)
-                results[i] = RayHits(hits.distance[sl], hits.normal[sl], hits.shape[sl])
+                results[i] = RayHits(hits.distance[sl], None if hits.normal is None else hits.normal[sl],
+                                     None if hits.shape is None else hits.shape[sl])
                 start += n
         return results  # type: ignore[return-value]
