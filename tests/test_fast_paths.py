@@ -110,3 +110,27 @@ def test_point_cloud_with_cached_directions_is_bit_identical(kw):
         finite = np.isfinite(xyz[:, 0])
         np.testing.assert_array_equal(np.stack([a["x"], a["y"], a["z"]], 1)[finite], xyz[finite])
         assert a["layer_id"].tolist() == np.repeat(np.arange(8), rng_img.shape[1]).tolist()
+
+
+@pytest.mark.parametrize("precision", [Precision.FAST, Precision.EXACT])
+def test_large_casts_in_chunks_give_the_same_answers(monkeypatch, precision):
+    """A cast larger than the chunk size runs in pieces (bounded temporaries): every output is
+    bit-identical to one pass, with per-ray t_near/t_far/exclusion arrays and mounted rays."""
+    from sensorium.server.raycast import engine as engine_module
+
+    eng, off = _scene(precision)
+    O, D = _lidar_rays(off + np.array((0.1, 0.2, 0.9)), n_az=120, n_el=10)
+    O = np.ascontiguousarray(O) + np.linspace(0.0, 0.2, len(O))[:, None]   # distinct origins
+    rng = np.random.default_rng(2)
+    t_far = rng.uniform(1.0, 6.0, len(O))
+    excl = rng.choice([-1, 0], len(O))
+    mount = np.where(rng.random(len(O)) < 0.3, 7, -1)        # some rays "mounted" on the second mover
+    one = eng.cast(O, D, 0.01, t_far, kind=RayKind.VISUAL, exclude_owner=excl, mount=mount)
+    lean = eng.cast(O, D, 0.01, t_far, kind=RayKind.VISUAL, exclude_owner=excl, mount=mount, distance_only=True)
+    monkeypatch.setattr(engine_module, "_CHUNK", 97)
+    parts = eng.cast(O, D, 0.01, t_far, kind=RayKind.VISUAL, exclude_owner=excl, mount=mount)
+    parts_lean = eng.cast(O, D, 0.01, t_far, kind=RayKind.VISUAL, exclude_owner=excl, mount=mount, distance_only=True)
+    assert np.isfinite(one.distance).mean() > 0.3 and len(set(one.shape.tolist())) > 4
+    for a, b in ((one.distance, parts.distance), (one.normal, parts.normal), (one.shape, parts.shape),
+                 (lean.distance, parts_lean.distance), (one.distance, parts_lean.distance)):
+        assert a.tobytes() == b.tobytes()

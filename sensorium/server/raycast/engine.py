@@ -78,6 +78,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from sensorium.server.raycast.exact import (
+    _CHUNK,
     _DENSE_PAIRS,
     _FEW_MOVERS,
     _INF,
@@ -316,11 +317,27 @@ class RayEngine(TierTracer):
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
         Ou = O[:1] if O.strides[0] == 0 else O   # one origin for all rays (a broadcast array)
         big = max(map(abs, Ou.ravel().tolist())) if len(Ou) <= _SMALL else max(float(Ou.max()), -float(Ou.min()))
+        distance_only = distance_only and self._precision is Precision.FAST
         # one errstate for the whole cast: inf/NaN are handled explicitly (entering the context
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount,
-                              distance_only and self._precision is Precision.FAST)
+            if n <= _CHUNK:
+                return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only)
+            # large batches in chunks: the temporaries (~150 bytes per ray) stay a few MB whatever
+            # the batch, and so in cache; every ray's answer is the same (big is the batch's)
+            dist = np.empty(n)
+            normal = None if distance_only else np.empty((n, 3))
+            shape = None if distance_only else np.empty(n, dtype=np.int64)
+            for a in range(0, n, _CHUNK):
+                sl = slice(a, min(n, a + _CHUNK))
+                m = sl.stop - a
+                h = self._cast(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
+                               _param(_take(t_far, sl), m, np.float64, float), _param(_take(excl, sl), m, np.int64, int),
+                               planes, static, movers, big, None if mount is None else mount[sl], distance_only)
+                dist[sl] = h.distance
+                if not distance_only:
+                    normal[sl], shape[sl] = h.normal, h.shape
+            return RayHits(dist, normal, shape)
 
     def cast_local(self, body: int, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
                    skip_transparent=False) -> RayHits:

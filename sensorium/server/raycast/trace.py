@@ -180,7 +180,10 @@ class TierTracer(Refiner):
         else:
             dots = ng[:, 0] * dh[:, 0] + ng[:, 1] * dh[:, 1] + ng[:, 2] * dh[:, 2]
         back = dots > 0.0
-        nrm = np.take(tier.normal2, ph + back * tier.n_rows, axis=0)   # misses: zero sentinel rows
+        nrm = np.take(tier.normal, ph, axis=0)   # misses (-1): the zero sentinel row
+        # toward the origin (exact negation); misses keep the sign bits they always had (-0.0
+        # unless "back"), so the arrays stay bit-identical to the former [normal; -normal] table
+        nrm[(back ^ (ph < 0)) if every else back] *= -1.0
         grazing = np.abs(dots) < 1e-5 * tier.ng_max
         if every:
             grazing &= ph >= 0
@@ -220,7 +223,7 @@ class TierTracer(Refiner):
         if np.count_nonzero(special):
             sp = special.nonzero()[0]
             tri = ph[sp]
-            gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.v0[tri], tier.normal[tri]))
+            gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.first_vertex(tri), tier.normal[tri]))
             special[sp] = gap <= 2.0 * tier.eps
         if tier.has_curved:                  # leaving a curved shell: the true surface decides
             special |= back & np.take(tier.tri_curved, ph)
