@@ -6,8 +6,9 @@ One module per section, each ``run(cfg) -> Section``:
 * :mod:`.scaling`   — time per step vs rays, triangles, lights, devices, robots, with the measured growth;
 * :mod:`.peers`     — the same scene and rays through raw embreex, Open3D, MuJoCo, PyBullet, trimesh;
 * :mod:`.transport` — lockstep round trips and steps/s over loopback against a raw pyzmq floor;
+* :mod:`.memory`    — bytes per static triangle, transient memory and time per ray of large scans;
 
 and :mod:`.report` writes ``benchmarks.md``, ``benchmarks.json`` and the PNG plots.
 """
 
-SECTIONS = ("transport", "accuracy", "scaling", "peers")   # run order: peers last (its libraries start thread pools)
+SECTIONS = ("transport", "memory", "accuracy", "scaling", "peers")   # run order: peers last (its libraries start thread pools)

@@ -98,13 +98,13 @@ class _Tier:
         owners = owner_of[self.tri_shape[:-1]]
         self.owned = bool((owners >= 0).any())
         # -2 marks "no owner" so it never equals an exclude_owner value (>= -1)
-        self.tri_owner = np.append(np.where(owners >= 0, owners, -2), -2)
+        self.tri_owner = np.append(np.where(owners >= 0, owners, -2), -2).astype(np.int32)   # robot indices
         # curved shapes, indexed by "slot"
         self.has_curved = bool(curved)
         self.c_shape = np.array(c_shape, dtype=np.int64)
         slot_of_shape = np.full(int(self.tri_shape.max()) + 2, -1, dtype=np.int64)
         slot_of_shape[self.c_shape] = np.arange(len(c_shape))
-        self.tri_slot = slot_of_shape[self.tri_shape]  # sentinel row maps to -1 as well
+        self.tri_slot = slot_of_shape[self.tri_shape].astype(np.int32)  # sentinel row maps to -1 as well
         self.tri_curved = self.tri_slot >= 0
         self.c_code = np.array(c_code, dtype=np.int64)
         self.c_r = np.array(c_r, dtype=np.float64)
