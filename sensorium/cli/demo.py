@@ -120,7 +120,7 @@ def run_demo(world: str | None, duration_s: float, out_dir: Path, precision: str
 
 
 def _summarise(result: DemoResult, world) -> None:
-    from sensorium.server.recording.mcapfile import iter_messages
+    from sensorium.server.recording.reader import iter_messages
 
     paths: dict[str, list[tuple[float, float]]] = {}
     light: list[float] = []
@@ -149,12 +149,14 @@ def _summarise(result: DemoResult, world) -> None:
 
 def _draw(result: DemoResult, world, path: Path) -> None:
     from sensorium.cli.png import Canvas
-    from sensorium.server.recording.mcapfile import iter_messages
+    from sensorium.server.recording.reader import iter_messages
     from sensorium.server.world.poses import pose_from_model
 
     canvas = Canvas(-2.2, 2.2, -2.2, 2.2, pixels_per_metre=160)
     for s in world.solids:
         g = s.geometry
+        if g is None:
+            continue
         pose = pose_from_model(s.pose)
         cx, cy = pose.translation[:2]
         yaw = math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])

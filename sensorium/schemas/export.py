@@ -13,6 +13,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 from pydantic.json_schema import models_json_schema
 
@@ -24,7 +25,7 @@ DEFAULT_DIR = Path(__file__).resolve().parent / "json"
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
 
 
-def _bundle(models: list[type], title: str, description: str) -> dict:
+def _bundle(models: list[Any], title: str, description: str) -> dict:
     refs, defs = models_json_schema([(m, "validation") for m in models], ref_template="#/$defs/{model}")
     return {"$schema": DRAFT, "title": title, "description": description,
             "oneOf": [refs[(m, "validation")] for m in models], **defs}
@@ -54,7 +55,7 @@ def services_schema() -> dict:
         {"name": s.item if s.scope == "server" else (f"/<robot>/robot/{s.item}" if s.scope == "robot"
                                                      else f"/<robot>/<device>/{s.item}"),
          "args": f"#/$defs/{s.args.__name__}", "result": f"#/$defs/{s.result.__name__}",
-         "attached": s.attached, "devices": sorted(s.devices)}
+         "attached": s.attached, "supervisor": s.supervisor, "devices": sorted(s.devices)}
         for s in specs
     ]
     return out

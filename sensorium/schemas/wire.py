@@ -47,6 +47,7 @@ class ErrorCode(IntEnum):
     TOO_LARGE = 8
     SHUTTING_DOWN = 9
     WRONG_STATE = 10
+    NOT_SUPERVISOR = 11
     INTERNAL = 99
 
 
@@ -125,6 +126,7 @@ def parse_request(data: bytes | memoryview, max_size: int = SOFT_LIMIT) -> Reque
     if not isinstance(args, dict):
         raise RequestError(ErrorCode.BAD_REQUEST, "request 'args' must be a map"
                            if "args" in msg else "request has no 'args' (send {} for none)", rid)
+    assert isinstance(rid, int)  # _is_uint checked it
     return Request(rid, service, args)
 
 

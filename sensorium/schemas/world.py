@@ -103,6 +103,15 @@ class Plane(Strict):
         return v
 
 
+class Triangles(Strict):
+    """Triangles given inline (Webots' IndexedFaceSet, triangulated): vertex coordinates and index
+    triples into them, in the shape's frame."""
+
+    type: Literal["triangles"]
+    vertices: list[Vec3] = Field(max_length=1_000_000)
+    faces: list[tuple[int, int, int]] = Field(min_length=1, max_length=2_000_000)
+
+
 class Mesh(Strict):
     """Triangle mesh file (STL, OBJ, PLY, GLB) loaded with trimesh; path relative to the world file."""
 
@@ -111,7 +120,7 @@ class Mesh(Strict):
     scale: Vec3 = (1.0, 1.0, 1.0)
 
 
-Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Mesh, Field(discriminator="type")]
+Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Triangles | Mesh, Field(discriminator="type")]
 
 
 class Appearance(Strict):
@@ -141,8 +150,10 @@ class Shape(Strict):
     seen_by: SeenBy = "both"
 
 
-class Solid(Shape):
-    name: str = Field(min_length=1)
+class Part(Shape):
+    """One shape of a body made of several shapes, placed by ``pose`` in its owner's frame."""
+
+    name: str | None = None
     pose: Pose = Pose()
 
 
@@ -208,6 +219,28 @@ class DirectionalLight(_Light):
 Light = Annotated[PointLight | SpotLight | DirectionalLight, Field(discriminator="type")]
 
 
+# ---------------------------------------------------------------- solids
+
+class Solid(Strict):
+    """A static object (movable by a supervisor), seen by rays through its shapes.
+
+    ``geometry`` (with ``appearance``/``seen_by``) is the solid's own shape at its origin;
+    ``shapes`` adds further shapes each with its own offset; ``children`` are solids fixed to this
+    one (poses relative to it, nested to any depth, moving with it); ``lights`` are lights fixed to
+    it (``location`` and a SpotLight's ``direction`` in its frame; a DirectionalLight's direction
+    stays in world axes, as in Webots).
+    """
+
+    name: str = Field(min_length=1)
+    pose: Pose = Pose()
+    geometry: Geometry | None = None
+    appearance: Appearance | None = None
+    seen_by: SeenBy = "both"
+    shapes: list[Part] = []
+    children: list[Solid] = []
+    lights: list[Light] = []
+
+
 # ---------------------------------------------------------------- devices
 
 LookupRow = tuple[float, float, float]  # input, output, relative noise
@@ -267,7 +300,34 @@ class Lidar(_Device):
         return self
 
 
-Device = Annotated[LightSensor | DistanceSensor | Lidar, Field(discriminator="device")]
+class PositionSensor(_Device):
+    """A wheel encoder (Webots PositionSensor on the wheel's HingeJoint): the angle, in radians, of
+    the differential-drive wheel turned by ``motor``. ``pose`` is unused (kept for symmetry)."""
+
+    device: Literal["PositionSensor"]
+    motor: str = Field(min_length=1, description="name of the drive's wheel motor whose joint it measures")
+    noise: float = Field(default=0.0, ge=0.0, description="standard deviation of Gaussian noise (rad)")
+    resolution: float = -1.0
+
+
+class LED(_Device):
+    """Webots LED: ``set(i)`` lights colour ``i`` (1-based, 0 = off) of ``color``; a ``gradual`` LED
+    takes a 0xRRGGBB value instead. Sensors do not see it (no light is emitted)."""
+
+    device: Literal["LED"]
+    color: list[Color] = Field(default=[(1.0, 0.0, 0.0)], max_length=1024)
+    gradual: bool = False
+
+    @field_validator("color")
+    @classmethod
+    def _unit(cls, v: list[Color]) -> list[Color]:
+        for c in v:
+            if min(c) < 0 or max(c) > 1:
+                raise ValueError("colour components must be within [0, 1]")
+        return v
+
+
+Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED, Field(discriminator="device")]
 
 
 # ---------------------------------------------------------------- motion
@@ -295,8 +355,13 @@ class Robot(Strict):
     name: str = Field(min_length=1)
     pose: Pose = Pose()
     synchronization: bool = True
+    supervisor: bool = Field(default=False, description="its controller may use the Supervisor services (Webots)")
+    custom_data: str = Field(default="", max_length=1 << 20, description="Webots customData (get/setCustomData)")
+    model: str = Field(default="", max_length=4096, description="Webots model (getModel)")
     self_collision: bool = False
     body: Shape | None = None
+    shapes: list[Part] = Field(default=[], description="further body shapes, each with its pose in the robot frame")
+    lights: list[Light] = Field(default=[], description="lights carried by the robot (location/direction in its frame)")
     differential_drive: DifferentialDrive | None = None
     devices: list[Device] = []
 
@@ -305,6 +370,11 @@ class WorldInfo(Strict):
     name: str = "world"
     basic_time_step: int = Field(default=32, ge=1, le=60_000, description="milliseconds")
     random_seed: int = Field(default=0, ge=0, lt=2**63)
+    contact: bool = Field(default=True, description="kinematic contact: a robot's body stops at solids and other "
+                                                    "robots' bodies (README 'Kinematic contact'); false = pass through")
+    coordinate_system: Literal["ENU", "NUE"] = Field(
+        default="ENU", description="world axes: ENU = x east, y north, z up; NUE = x north, y up, z east. "
+        "Only the up axis matters here: differential drives move in the plane normal to it")
 
 
 class World(Strict):

@@ -25,6 +25,11 @@ class LidarPoint:
     def from_bytes(cls, data: bytes, index: int = 0) -> LidarPoint:
         return cls(*struct.unpack_from(arrays.POINT_FORMAT, data, index * arrays.POINT_SIZE))
 
+    @property
+    def layer(self) -> int:
+        """Webots' Python spelling of ``layer_id``."""
+        return self.layer_id
+
     def __repr__(self) -> str:
         return f"LidarPoint(x={self.x}, y={self.y}, z={self.z}, layer_id={self.layer_id}, time={self.time})"
 
@@ -55,7 +60,7 @@ class Lidar(Sensor):
     _get_sampling_period = staticmethod(wb.wb_lidar_get_sampling_period)
 
     # -- images
-    def getRangeImage(self, data_type: str = "list") -> list[float] | bytes:
+    def getRangeImage(self, data_type: str = "list") -> list[float] | bytes | None:
         """Ranges left to right, first layer to last: a list of floats, or with
         ``data_type='buffer'`` the raw little-endian float32 bytes."""
         return _floats(wb.lidar_range_bytes(self._tag, None, "getRangeImage"), data_type)
@@ -63,6 +68,8 @@ class Lidar(Sensor):
     def getRangeImageArray(self) -> list[list[float]]:
         """The range image as ``[layer][column]`` lists."""
         flat = self.getRangeImage()
+        if not isinstance(flat, list):
+            return []
         w = self.getHorizontalResolution()
         return [flat[i:i + w] for i in range(0, len(flat), w)] if w else []
 
