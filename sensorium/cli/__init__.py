@@ -23,7 +23,10 @@ def command(name: str, help: str, target: str):
 
 @command("validate", "check a world file; exit 1 listing every problem", "sensorium.cli.world:validate")
 def _validate_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.serve import add_world_options
+
     p.add_argument("world", nargs="+", help="world file(s): YAML, JSON or Webots .wbt")
+    add_world_options(p)
 
 
 @command("convert", "write a Webots world (.wbt) as an equivalent Sensorium world file",
@@ -50,12 +53,16 @@ def _probe_args(p: argparse.ArgumentParser) -> None:
                    help="also enable a lidar's point cloud")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="JSON lines: step, time, robot, device, value or array summary")
+    from sensorium.cli.serve import add_world_options
+
+    add_world_options(p)
 
 
-@command("controller", "run a Webots-style Python controller for a robot of a running server",
+@command("controller", "run a Webots-style controller (Python script or compiled binary) for a robot of a running server",
          "sensorium.cli.client:controller")
 def _controller_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("script", help="controller script (uses `from controller import Robot`)")
+    p.add_argument("script", help="controller: a Python script (uses `from controller import Robot`) or an executable "
+                   "(e.g. a C controller linked against sensorium/client/c)")
     p.add_argument("--robot", help="robot name (default: the URL's robot, or the world's only robot)")
     p.add_argument("--url", help="RPC endpoint or controller URL, e.g. tcp://127.0.0.1:5560 or "
                    "tcp://host:5560/epuck (default: $SENSORIUM_CONTROLLER_URL, $WEBOTS_CONTROLLER_URL, "
@@ -119,6 +126,8 @@ def _replay_args(p: argparse.ArgumentParser) -> None:
                    help="publish only when a client calls /replay/step {duration} (see PROTOCOL.md, Replay)")
     p.add_argument("--pub", default="tcp://127.0.0.1:5561", help="topic endpoint to bind (default tcp://127.0.0.1:5561)")
     p.add_argument("--rpc", default="tcp://127.0.0.1:5560", help="service endpoint to bind (default tcp://127.0.0.1:5560)")
+    p.add_argument("--foxglove", metavar="[HOST:]PORT",
+                   help="also serve the replay to Foxglove (WebSocket) on PORT, host 127.0.0.1 unless given")
     p.add_argument("--wait", action="store_true", help="wait for a first subscriber before starting")
     p.add_argument("--delay", type=_seconds, default=0.0, metavar="S", help="wait S seconds before starting (and between loops)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
@@ -138,6 +147,8 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--format", choices=["bag", "mcap"], help="bag: rosbag2 directory (rosbags); mcap: one file "
                    "(mcap-ros2-support); default from OUT's suffix")
     p.add_argument("--pointcloud2", action="store_true", help="export PointCloud as PointCloud2 (x, y, z, layer)")
+    p.add_argument("--no-views", action="store_true",
+                   help="only the recorded topics (no /tf_static, /tf and /scene from the recorded world)")
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="export only these topics")
     p.add_argument("--start", type=_seconds, metavar="S", help="from S seconds of simulation time")
     p.add_argument("--end", type=_seconds, metavar="E", help="up to E seconds of simulation time")
@@ -151,6 +162,14 @@ def _serve_args(p: argparse.ArgumentParser) -> None:
     from sensorium.cli.serve import add_arguments
 
     add_arguments(p)
+
+
+@command("layout", "write a Foxglove layout (3D, plots, image, raw messages) for a recording or world file",
+         "sensorium.cli.viewer:layout_cmd")
+def _layout_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("source", nargs="?", help="a recording (.mcap) or a world file (default: the embedded arena world)")
+    p.add_argument("-o", "--out", metavar="FILE.json", help="write here instead of standard output")
+    p.add_argument("--force", action="store_true", help="replace FILE.json if it exists")
 
 
 @command("schemas", "write the JSON Schemas of world files, topic messages and services",
@@ -168,6 +187,28 @@ def _demo_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+
+
+# --- sweeps: sweep (sensorium/sweep/) ---
+@command("sweep", "run many simulations (worlds x parameters x controllers x seeds) on Ray or a process pool",
+         "sensorium.cli.sweep:main")
+def _sweep_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("spec", help="sweep spec, YAML or JSON (see README 'Training and sweeps')")
+    p.add_argument("--out", default="sweep-out", metavar="DIR",
+                   help="recordings (DIR/runs/NNNN.mcap) and tables (DIR/summary.csv, .parquet); default sweep-out")
+    p.add_argument("--engine", choices=["auto", "local", "ray"], default="auto",
+                   help="ray: Ray tasks; local: a process pool; auto (default): ray when installed")
+    p.add_argument("--workers", type=int, metavar="N", help="processes / Ray CPUs on this machine (default: all CPUs)")
+    p.add_argument("--address", metavar="ADDR", help="join this Ray cluster ('auto', 'HOST:6379', 'ray://HOST:10001') "
+                   "instead of starting a local Ray bound to 127.0.0.1")
+    p.add_argument("--format", action="append", choices=["csv", "parquet"], metavar="FMT",
+                   help="table format, repeatable (csv, parquet; default both, csv only without pyarrow)")
+    p.add_argument("--no-record", action="store_true", help="no recordings, summary rows only")
+    p.add_argument("--overwrite", action="store_true", help="replace the tables and recordings of an earlier sweep in DIR")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar on stderr (default: on a terminal)")
+    p.add_argument("--json", action="store_true", help="print the sweep summary as JSON")
+# --- end sweeps ---
 
 
 # --- benchmarks: bench (benchmarks/, installed as sensorium.benchmarks) ---

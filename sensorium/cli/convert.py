@@ -41,8 +41,28 @@ def convert(args: argparse.Namespace) -> int:
         sys.stdout.write(text)
         return 0
     tmp = out.with_name(out.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, out)
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, out)
+    except OSError as exc:
+        print(f"{out}: cannot write: {exc.strerror or exc}", file=sys.stderr)
+        return 1
     print(f"{out}: written ({len(data.get('solids', []))} solids, {len(data.get('lights', []))} lights, "
           f"{len(data.get('robots', []))} robots)")
+    outside = sorted({u for u in _mesh_urls(data) if Path(u).is_absolute() or u.startswith("..")})
+    if outside:
+        print(f"note: {len(outside)} mesh url(s) leave {out.parent or '.'} (e.g. {outside[0]}): load the world with "
+              "--allow-outside-meshes, or move the meshes next to it", file=sys.stderr)
     return 0
+
+
+def _mesh_urls(data: object):
+    """Every mesh url of a world-file dict."""
+    if isinstance(data, dict):
+        if data.get("type") == "mesh" and isinstance(data.get("url"), str):
+            yield data["url"]
+        for v in data.values():
+            yield from _mesh_urls(v)
+    elif isinstance(data, list):
+        for v in data:
+            yield from _mesh_urls(v)

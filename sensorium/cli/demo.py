@@ -90,6 +90,7 @@ def run_demo(world: str | None, duration_s: float, out_dir: Path, precision: str
     procs: dict[str, subprocess.Popen] = {}
     start = time.monotonic()
     try:
+        assert server.stdout is not None
         line = server.stdout.readline()
         if "rpc=" not in line:
             raise RuntimeError(f"the server did not start (see {out_dir / 'server.log'}): {line.strip()}")

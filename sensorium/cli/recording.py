@@ -20,7 +20,7 @@ from sensorium.server.recording.reader import McapError, summarize
 @contextmanager
 def sigterm_as_interrupt():
     """SIGTERM (and SIGHUP) raise KeyboardInterrupt like Ctrl-C, so files get finished."""
-    previous = {}
+    previous: dict = {}
 
     def handler(signum, frame):
         raise KeyboardInterrupt
@@ -38,14 +38,13 @@ def sigterm_as_interrupt():
             signal.signal(sig, h)
 
 
-
 def record(args: argparse.Namespace) -> int:
-    ctx = zmq.Context.instance()
+    ctx: zmq.Context = zmq.Context.instance()
     rec = LiveRecorder(args.file, connect=args.connect, pub=args.pub, topics=args.topics or None, world=args.world,
                        chunk_size=args.chunk_size, rcvhwm=args.rcvhwm, context=ctx)
     try:
         rec.open()
-    except (TimeoutError, RuntimeError, KeyError, OSError, zmq.ZMQError) as exc:
+    except (TimeoutError, RuntimeError, KeyError, ValueError, OSError, zmq.ZMQError) as exc:
         print(f"sensorium record: {exc}", file=sys.stderr)
         return 1
     print(f"sensorium: recording {args.file} from pub={rec.pub_endpoint}"
@@ -80,12 +79,27 @@ def replay_cmd(args: argparse.Namespace) -> int:
     except (OSError, ValueError) as exc:
         print(f"sensorium replay: {exc}", file=sys.stderr)
         return 1
+    viewer = None
     try:
         try:
             r.bind()
         except zmq.ZMQError as exc:
             print(f"sensorium replay: cannot bind: {exc}", file=sys.stderr)
             return 1
+        viewer = None
+        if getattr(args, "foxglove", None):
+            from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, exposure_warning, parse_address
+            try:
+                host, port = parse_address(args.foxglove)
+                if exposure_warning(host):
+                    print(f"sensorium replay: warning: {exposure_warning(host)}", file=sys.stderr)
+                viewer = FoxgloveBridge.for_replay(r, host, port)
+            except ViewerError as exc:
+                print(f"sensorium replay: {exc}", file=sys.stderr)
+                return 1
+            print(f"sensorium: Foxglove viewer at {viewer.url}", flush=True)
+            if viewer.app_url():
+                print(f"sensorium: Foxglove web app: {viewer.app_url()}", file=sys.stderr, flush=True)
         print(r.announce(), flush=True)
         if r.recording.truncated:
             print("sensorium: warning: the recording is truncated; replaying up to its last complete chunk",
@@ -98,6 +112,9 @@ def replay_cmd(args: argparse.Namespace) -> int:
         print(f"sensorium: replay finished: {r.emitted} messages", file=sys.stderr, flush=True)
         return 0
     finally:
+        if viewer is not None:
+            viewer.close()
+            print(f"sensorium: {viewer.report()}", file=sys.stderr, flush=True)
         r.close()
 
 
@@ -113,6 +130,7 @@ def export_cmd(args: argparse.Namespace) -> int:
     try:
         report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
                              pointcloud2=args.pointcloud2, topics=args.topics or None,
+                             views=not getattr(args, "no_views", False),
                              start_ns=None if args.start is None else int(round(args.start * 1e9)),
                              end_ns=None if args.end is None else int(round(args.end * 1e9)))
     except (ExportError, OSError) as exc:
@@ -164,6 +182,8 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
         world = meta.get("world") or meta.get("world_file") or "-"
         lines.append(("World", f"{world}   seed {meta.get('seed', '-')}   time step "
                                f"{meta.get('basic_time_step_ms', '-')} ms   sensorium {meta.get('version', '-')}"))
+        lines.append(("Foxglove", "ready (ROS 2 CDR views, /tf, /scene; bodies kept byte for byte)"
+                      if meta.get("format") == "2" else "no (msgpack only: export with sensorium export --ros2)"))
     if session.get("started_at"):
         lines.append(("Recorded", session["started_at"]))
     for a in s["attachments"]:

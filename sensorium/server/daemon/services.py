@@ -21,7 +21,8 @@ import sys
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from functools import partial
+from typing import Any, cast
 
 from pydantic import ValidationError
 
@@ -60,8 +61,8 @@ class Call:
     peer: bytes
     id: int
     args: Any                 # the spec's pydantic Args model
-    robot: str | None
-    ctl: Control | None
+    robot: str                # the robot of a robot/device/motor service ("" for world services)
+    ctl: Control              # the device of a device service (never read by other handlers)
     motor: Any                # the WheelMotor of a motor service, else None
     now: float
     extra: list[Frames]       # more replies to send (e.g. a step answered by detach)
@@ -136,7 +137,9 @@ class Core:
                             spec, getattr(self, f"_motor_{spec.item}"), robot_name, None, motor_name)
             for spec in S.SERVICES:
                 if spec.scope == "robot":
-                    routes[f"/{robot_name}/robot/{spec.item}"] = Route(spec, getattr(self, f"_robot_{spec.item}"), robot_name, None)
+                    handler = (partial(self._supervisor, spec.item) if spec.supervisor
+                               else getattr(self, f"_robot_{spec.item}"))
+                    routes[f"/{robot_name}/robot/{spec.item}"] = Route(spec, handler, robot_name, None)
         for spec in S.SERVICES:
             if spec.scope == "server":
                 routes[spec.item] = Route(spec, getattr(self, f"_srv_{spec.item}"), None, None)
@@ -185,7 +188,7 @@ class Core:
             except ValidationError as exc:
                 raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{req.service}: {_arg_errors(exc)}") from None
             if route.spec.attached:
-                s = self.lockstep.session_for(route.robot)
+                s = self.lockstep.session_for(route.robot) if route.robot else None
                 if s is None or s.peer != peer:
                     raise ServiceError(ErrorCode.NOT_ATTACHED,
                                        f"{req.service} needs the caller to be {route.robot!r}'s attached controller"
@@ -196,7 +199,7 @@ class Core:
                                    f"(set 'supervisor: true' on it in the world file)")
             ctl = self.topics.controls[route.device] if route.device else None
             motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
-            call = Call(envelope, peer, rid, args, route.robot, ctl, motor, now, [])
+            call = Call(envelope, peer, rid, args, route.robot or "", cast(Control, ctl), motor, now, [])
             result = route.handler(call)
             if result is _DEFERRED:
                 return call.extra
@@ -439,41 +442,12 @@ class Core:
         return {"value": self.sim.robots[c.robot].model.model}
 
     # ------------------------------------------------------------------ supervisor services
-    def _robot_get_from_def(self, c: Call) -> dict:
-        return supervisor.node_ref(self.sim, supervisor.find_node(self.sim, c.args.name))
-
-    def _robot_get_self(self, c: Call) -> dict:
-        return supervisor.node_ref(self.sim, supervisor.find_node(self.sim, c.robot))
-
-    def _node(self, c: Call) -> supervisor.Node:
+    def _supervisor(self, item: str, c: Call) -> dict:
+        """Every Supervisor service: :data:`supervisor.HANDLERS` (ValueError → INVALID_ARGUMENT)."""
         try:
-            return supervisor.node_by_id(self.sim, c.args.node)
-        except KeyError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, str(exc.args[0])) from None
-
-    def _robot_get_field(self, c: Call) -> dict:
-        return {"value": supervisor.get_field(self.sim, self._node(c), c.args.field)}
-
-    def _robot_set_field(self, c: Call) -> dict:
-        try:
-            supervisor.set_field(self.sim, self._node(c), c.args.field, c.args.value)
+            return supervisor.HANDLERS[item](self.sim, self.lockstep, c.robot, c.args)
         except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_field: {exc}") from None
-        return {"success": True}
-
-    def _robot_get_node_pose(self, c: Call) -> dict:
-        return supervisor.node_pose(self.sim, self._node(c))
-
-    def _robot_simulation_reset(self, c: Call) -> dict:
-        self.sim.reset()
-        return {"success": True}
-
-    def _robot_simulation_set_mode(self, c: Call) -> dict:
-        self.lockstep.set_mode(supervisor.MODES[c.args.mode])
-        return {"success": True}
-
-    def _robot_simulation_get_mode(self, c: Call) -> dict:
-        return {"value": supervisor.MODES.index(self.lockstep.mode)}
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{item}: {exc}") from None
 
     # ------------------------------------------------------------------ device services
     def _describe(self, ctl: Control) -> dict:

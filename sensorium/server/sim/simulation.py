@@ -16,6 +16,7 @@ from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -37,6 +38,7 @@ from sensorium.server.sim.sensors import (
     RayRequest,
 )
 from sensorium.server.world.geometry import Pose
+from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
 
@@ -82,6 +84,7 @@ class RobotState:
         self.encoders: list[PositionSensor] = []
         for dev in self.devices.values():
             if isinstance(dev, PositionSensor):
+                assert isinstance(dev.config, wm.PositionSensor)
                 dev.wheel = self.motors.get(dev.config.motor)
                 self.encoders.append(dev)
         self.custom_data = model.custom_data
@@ -153,7 +156,7 @@ class Simulation:
         self._distance_plans: dict[tuple[int, ...], DistancePlan] = {}   # by the due sensors (see _distance_plan)
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = self._build_contact() if use_contact and self._driven else None
-        self._initial = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
+        self._initial: dict[str, Any] = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
                          "solids": dict(self.scene.solid_poses)}
 
     def _build_contact(self) -> Contact:
@@ -195,8 +198,13 @@ class Simulation:
         self._counters["resets"] += 1
 
     @classmethod
-    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT) -> Simulation:
-        return cls(load_world(path), precision)
+    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT, *,
+                  limits: WorldLimits | None = None, allow_outside_meshes: bool = False,
+                  contact: bool | None = None) -> Simulation:
+        """``limits``/``allow_outside_meshes``: see :func:`sensorium.server.world.loader.load_world`;
+        ``contact``: kinematic contact on/off (default: the world's ``world_info.contact``)."""
+        return cls(load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes), precision,
+                   contact=contact)
 
     # ------------------------------------------------------------------ access
     @property
@@ -255,18 +263,24 @@ class Simulation:
         self.step_count += 1
         now = self.time_ms
         dt = self.basic_time_step
-        contact = self.contact
+        moved: list[tuple[RobotState, DifferentialDrive, tuple[float, float], Pose]] = []
         for robot in self._driven:
             drive = robot.drive
+            assert drive is not None
             start = (drive.x, drive.y)
             pose = drive.step(dt)
             if pose is not None:
-                if contact is not None:
-                    end, clipped = contact.resolve(robot.index, np.array(start), np.array([drive.x, drive.y]))
-                    if clipped:
-                        drive.x, drive.y = float(end[0]), float(end[1])
-                        pose = drive.pose()
-                self.scene.set_robot_pose(robot.index, pose)
+                moved.append((robot, drive, start, pose))
+        if self.contact is not None and moved:
+            ends = self.contact.resolve_all([r.index for r, _, _, _ in moved], np.array([s for _, _, s, _ in moved]),
+                                            np.array([(d.x, d.y) for _, d, _, _ in moved]))
+            for k, (end, clipped) in enumerate(ends):
+                if clipped:
+                    robot, drive, start, _ = moved[k]
+                    drive.x, drive.y = float(end[0]), float(end[1])
+                    moved[k] = (robot, drive, start, drive.pose())
+        for robot, _, _, pose in moved:
+            self.scene.set_robot_pose(robot.index, pose)
         poses = self.scene.robot_poses
         if self._by_kind is None:   # devices never change after loading: sort them by kind once
             every = list(self.all_devices())
@@ -287,7 +301,7 @@ class Simulation:
                 dev.measure(now)
                 dev.schedule.last_update_ms = now
                 encoders += 1
-        work: list[tuple[object, list[RayRequest]]] = []
+        work: list[tuple[Any, list[RayRequest]]] = []
         if lights:
             if self._lights_version != self.scene.lights_version:  # a light moved with its owner
                 self.lights = lights_from_models(self.scene.world_lights())
@@ -295,9 +309,9 @@ class Simulation:
             batch = LightBatch(lights, poses, self.lights)
             work.append((batch, batch.plan()))
         if distances:
-            batch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness,
-                                  self._distance_plan(distances), self.scene.engine)
-            work.append((batch, batch.plan()))
+            dbatch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness,
+                                   self._distance_plan(distances), self.scene.engine)
+            work.append((dbatch, dbatch.plan()))
         for lidar in lidars:
             work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt)))
         hits = self._cast_batched([req for _, reqs in work for req in reqs])
