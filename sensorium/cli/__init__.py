@@ -160,6 +160,8 @@ def _demo_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar on stderr (default: only on a terminal)")
 
 
 # --- benchmarks: bench (benchmarks/, installed as sensorium.benchmarks) ---
