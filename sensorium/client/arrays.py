@@ -29,10 +29,10 @@ def numpy_module() -> Any:
             _numpy = None
         else:
             try:
-                import numpy
+                import numpy as found
             except ImportError:
-                numpy = None
-            _numpy = numpy
+                found = None  # type: ignore[assignment]
+            _numpy = found
     return _numpy
 
 

@@ -13,6 +13,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 from pydantic.json_schema import models_json_schema
 
@@ -24,7 +25,7 @@ DEFAULT_DIR = Path(__file__).resolve().parent / "json"
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
 
 
-def _bundle(models: list[type], title: str, description: str) -> dict:
+def _bundle(models: list[Any], title: str, description: str) -> dict:
     refs, defs = models_json_schema([(m, "validation") for m in models], ref_template="#/$defs/{model}")
     return {"$schema": DRAFT, "title": title, "description": description,
             "oneOf": [refs[(m, "validation")] for m in models], **defs}

@@ -125,6 +125,7 @@ def parse_request(data: bytes | memoryview, max_size: int = SOFT_LIMIT) -> Reque
     if not isinstance(args, dict):
         raise RequestError(ErrorCode.BAD_REQUEST, "request 'args' must be a map"
                            if "args" in msg else "request has no 'args' (send {} for none)", rid)
+    assert isinstance(rid, int)  # _is_uint checked it
     return Request(rid, service, args)
 
 

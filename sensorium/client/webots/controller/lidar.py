@@ -55,7 +55,7 @@ class Lidar(Sensor):
     _get_sampling_period = staticmethod(wb.wb_lidar_get_sampling_period)
 
     # -- images
-    def getRangeImage(self, data_type: str = "list") -> list[float] | bytes:
+    def getRangeImage(self, data_type: str = "list") -> list[float] | bytes | None:
         """Ranges left to right, first layer to last: a list of floats, or with
         ``data_type='buffer'`` the raw little-endian float32 bytes."""
         return _floats(wb.lidar_range_bytes(self._tag, None, "getRangeImage"), data_type)
@@ -63,6 +63,8 @@ class Lidar(Sensor):
     def getRangeImageArray(self) -> list[list[float]]:
         """The range image as ``[layer][column]`` lists."""
         flat = self.getRangeImage()
+        if not isinstance(flat, list):
+            return []
         w = self.getHorizontalResolution()
         return [flat[i:i + w] for i in range(0, len(flat), w)] if w else []
 
