@@ -178,6 +178,7 @@ class DeviceRef(Result):
 
 class RobotInfo(Result):
     name: str
+    controller: str = "<extern>"
     synchronization: bool
     attached: bool
     devices: list[DeviceRef]

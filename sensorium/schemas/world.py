@@ -294,6 +294,11 @@ class DifferentialDrive(Strict):
 class Robot(Strict):
     name: str = Field(min_length=1)
     pose: Pose = Pose()
+    controller: Literal["<extern>", "<none>"] = Field(
+        default="<extern>",
+        description='"<extern>": driven by a controller you start (sensorium controller, a client); while no '
+                    'synchronous controller is attached the server waits for one. "<none>": never controlled, '
+                    "never waited for (its motors keep their initial state)")
     synchronization: bool = True
     self_collision: bool = False
     body: Shape | None = None
