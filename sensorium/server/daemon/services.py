@@ -361,6 +361,16 @@ class Core:
                 "demanded": sorted(self.topics.demanded),
                 "subscriptions": sorted(self.topics.prefixes)}
 
+    def _srv_get_services(self, c: Call) -> dict:
+        kinds = {r: self._device_kinds(r) for r in self.sim.robots}
+        out = []
+        for name, route in sorted(self.routes.items(), key=lambda kv: kv[1].robot is not None):
+            device = route.device.split("/", 1)[1] if route.device else route.motor
+            out.append({"name": name, "scope": route.spec.scope, "robot": route.robot, "device": device,
+                        "device_type": kinds[route.robot][device] if device else None,
+                        "attached": route.spec.attached, "args": S.arg_types(route.spec.args)})
+        return {"services": out}
+
     # ------------------------------------------------------------------ robot services
     def _session(self, c: Call) -> Session:
         s = self.lockstep.session_for(c.robot)
