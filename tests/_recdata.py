@@ -8,7 +8,8 @@ import math
 import msgpack
 import numpy as np
 
-from sensorium.server.recording.mcapfile import McapRecorder, pack_envelope
+from sensorium.server.recording.envelope import pack_envelope
+from sensorium.server.recording.writer import McapRecorder
 
 WORLD = b"world_info: {name: synthetic, basic_time_step: 32, random_seed: 7}\n"
 STEP_NS = 32_000_000

@@ -67,7 +67,7 @@ def test_compose_services_run_as_processes(tmp_path: Path) -> None:
             if p.poll() is None:
                 p.kill()
                 p.wait()
-    from sensorium.server.recording.mcapfile import summarize
+    from sensorium.server.recording.reader import summarize
 
     summary = summarize(tmp_path / "recordings" / "run.mcap")
     assert summary["messages"] > 0 and not summary["truncated"]

@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from sensorium.server.raycast import engine as raycast
+from sensorium.server.raycast import exact, movers
 from sensorium.server.raycast.engine import Precision, RayEngine, RayKind, ShapeEntry
 from sensorium.server.world.geometry import Box, Capsule, Cylinder, Plane, Pose, Sphere
 
@@ -41,7 +41,7 @@ def _unit(v):
 
 
 @pytest.mark.parametrize("m", [200, 400])    # the vectorised nearest-candidate step differs above 256 rows
-@pytest.mark.parametrize("code", [raycast._SPHERE, raycast._CYLINDER, raycast._CAPSULE])
+@pytest.mark.parametrize("code", [exact._SPHERE, exact._CYLINDER, exact._CAPSULE])
 def test_scalar_analytic_is_bit_identical(code, m):
     rng = np.random.default_rng(code)
     r, h = 0.7, 0.45
@@ -54,9 +54,9 @@ def test_scalar_analytic_is_bit_identical(code, m):
     lo = rng.uniform(0.0, 0.3, m)
     hi = lo + rng.uniform(0.0, 3.0, m)
     with np.errstate(all="ignore"):
-        t, n = raycast._analytic_local(code, p, d, r, h, lo, hi)
+        t, n = exact._analytic_local(code, p, d, r, h, lo, hi)
     for i in range(m):
-        ts, ns = raycast._analytic_one(code, tuple(p[i]), tuple(d[i]), r, h, float(lo[i]), float(hi[i]))
+        ts, ns = exact._analytic_one(code, tuple(p[i]), tuple(d[i]), r, h, float(lo[i]), float(hi[i]))
         assert ts == t[i] or (math.isinf(ts) and math.isinf(t[i])), i
         if math.isfinite(ts):
             assert np.allclose(ns, n[i], rtol=0, atol=1e-15), i
@@ -85,8 +85,8 @@ def test_grid_pairs_equal_dense_pairs():
     excl = rng.integers(-1, 50, n)
     r2 = radius ** 2
     with np.errstate(all="ignore"):
-        dense = raycast._sphere_pairs(C, r2, owner, O, D, t_near, lim, excl)
-        grid = raycast._grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl)
+        dense = movers._sphere_pairs(C, r2, owner, O, D, t_near, lim, excl)
+        grid = movers._grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl)
     # the dense test may also list rays whose segment is empty (lim < t_near): they find nothing
     dense = {(i, j) for i, j in zip(*map(np.ndarray.tolist, dense)) if lim[i] >= t_near[i]}
     assert dense == set(zip(*map(np.ndarray.tolist, grid)))
@@ -98,15 +98,15 @@ def test_tiny_sphere_pairs_equal_vectorised():
     C = rng.normal(size=(3, 3))
     r2 = np.array([0.5, 0.2, 1.0])
     owner = np.array([-1, 2, 3])
-    n = raycast._TINY // 3                       # n x 3 movers: the plain-float path
+    n = exact._TINY // 3                       # n x 3 movers: the plain-float path
     for _ in range(100):
         O = rng.normal(size=(n, 3)) * 2
         D = _unit(rng.normal(size=(n, 3)))
         lim = rng.uniform(0, 4, n)
         excl = rng.integers(-1, 4, n)
         with np.errstate(all="ignore"):
-            tiny = raycast._sphere_pairs(C, r2, owner, O, D, 0.0, lim, excl)
-            big = raycast._sphere_pairs(np.repeat(C, 12, axis=0), np.repeat(r2, 12), np.repeat(owner, 12),
+            tiny = movers._sphere_pairs(C, r2, owner, O, D, 0.0, lim, excl)
+            big = movers._sphere_pairs(np.repeat(C, 12, axis=0), np.repeat(r2, 12), np.repeat(owner, 12),
                                         O, D, 0.0, lim, excl)   # n x 36 > _TINY: vectorised
         assert sorted(zip(tiny[0].tolist(), tiny[1].tolist())) == \
             sorted({(i, j // 12) for i, j in zip(big[0].tolist(), big[1].tolist())})

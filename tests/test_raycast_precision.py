@@ -238,9 +238,9 @@ def test_watertight_exact_zero_leaks_fast_reported(record_property):
 def test_leak_repair_alone_on_a_plain_bvh(monkeypatch):
     """The offset-copy repair on its own (EXACT forced onto a non-robust BVH, which leaks ~5% of
     these rays): it must catch at least 99% of the leaks and count them."""
-    from sensorium.server.raycast import engine as raycast
-    plain = raycast._Tier.scene
-    monkeypatch.setattr(raycast._Tier, "scene", lambda self, robust: plain(self, False))
+    from sensorium.server.raycast import tiers
+    plain = tiers._Tier.scene
+    monkeypatch.setattr(tiers._Tier, "scene", lambda self, robust: plain(self, False))
     mesh = trimesh.creation.icosphere(subdivisions=3, radius=1.7)
     fast_leaks, n, _, _ = _leaks(Precision.FAST, mesh, 0.0, 1, np.random.default_rng(4))
     leaks, n, repairs, _ = _leaks(Precision.EXACT, mesh, 0.0, 1, np.random.default_rng(4))

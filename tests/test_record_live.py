@@ -15,8 +15,8 @@ import msgpack
 import pytest
 import zmq
 
-from sensorium.cli.recording import LiveRecorder
-from sensorium.server.recording.mcapfile import Recording
+from sensorium.server.recording.live import LiveRecorder
+from sensorium.server.recording.reader import Recording
 from sensorium.server.world.loader import default_world_path
 
 PY = sys.executable

@@ -14,7 +14,10 @@ import pytest
 from _recdata import TOPICS, WORLD, make_recording, published
 from mcap.reader import make_reader
 
-from sensorium.server.recording.mcapfile import McapRecorder, Recording, pack_envelope, print_info, topic_matcher
+from sensorium.cli.recording import print_info
+from sensorium.server.recording.envelope import pack_envelope, topic_matcher
+from sensorium.server.recording.reader import Recording
+from sensorium.server.recording.writer import McapRecorder
 
 TESTS = Path(__file__).parent
 PY = sys.executable
@@ -123,7 +126,7 @@ WRITER = textwrap.dedent("""
     import sys, time
     sys.path.insert(0, {tests!r})
     from _recdata import published
-    from sensorium.server.recording.mcapfile import McapRecorder
+    from sensorium.server.recording.writer import McapRecorder
     from sensorium.cli.recording import sigterm_as_interrupt
     n = 0
     with sigterm_as_interrupt():
@@ -247,7 +250,7 @@ def test_sigkill_truncation_without_flush_calls(tmp_path):
         import sys, os, signal
         sys.path.insert(0, {str(TESTS)!r})
         from _recdata import published
-        from sensorium.server.recording.mcapfile import McapRecorder
+        from sensorium.server.recording.writer import McapRecorder
         rec = McapRecorder({str(path)!r}, chunk_size=1024, flush_interval=None)
         for n, item in enumerate(published(400)):
             rec.record(*item)

@@ -15,9 +15,11 @@ import pytest
 import zmq
 from _recdata import STEP_NS, TOPICS, make_recording, published
 
-from sensorium.cli.recording import LiveRecorder, subscription_prefixes
-from sensorium.server.recording.mcapfile import McapRecorder, Recording, pack_envelope
+from sensorium.server.recording.envelope import pack_envelope
+from sensorium.server.recording.live import LiveRecorder, subscription_prefixes
+from sensorium.server.recording.reader import Recording
 from sensorium.server.recording.replay import Replayer
+from sensorium.server.recording.writer import McapRecorder
 
 PY = sys.executable
 ANY = "tcp://127.0.0.1:*"

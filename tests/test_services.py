@@ -121,8 +121,6 @@ def test_undecodable_requests(h, raw, code):
     ("/bot/ls/enable", {"value": 32.0}, ErrorCode.INVALID_ARGUMENT, "value"),
     ("/bot/ls/enable", {"value": True}, ErrorCode.INVALID_ARGUMENT, "value"),
     ("/bot/ls/enable", {"value": 32, "extra": 1}, ErrorCode.INVALID_ARGUMENT, "extra"),
-    ("/bot/robot/step", {"duration": 33}, ErrorCode.INVALID_ARGUMENT, "multiple"),
-    ("/bot/robot/step", {"duration": 0}, ErrorCode.INVALID_ARGUMENT, "duration"),
     ("/bot/robot/step", {"duration": -32}, ErrorCode.INVALID_ARGUMENT, "duration"),
     ("/bot/lidar/set_frequency", {"value": 99.0}, ErrorCode.INVALID_ARGUMENT, "frequency"),
     ("/bot/lidar/set_frequency", {"value": float("nan")}, ErrorCode.INVALID_ARGUMENT, "value"),
@@ -370,7 +368,7 @@ def test_motor_command_validation(hm, motors, code, words):
 def test_refused_step_applies_no_motor_command(hm):
     ok(hm.call(A, "attach", {"robot": "bot"}))
     left = hm.sim.robots["bot"].motors[LEFT]
-    err(hm.call(A, "/bot/robot/step", {"duration": 33, "motors": {LEFT: {"velocity": 1.0}}}), ErrorCode.INVALID_ARGUMENT)
+    err(hm.call(A, "/bot/robot/step", {"duration": -1, "motors": {LEFT: {"velocity": 1.0}}}), ErrorCode.INVALID_ARGUMENT)
     hm.send(A, "/bot/robot/step", {"motors": {LEFT: {"velocity": 1.0}}})
     err(hm.call(A, "/bot/robot/step", {"motors": {LEFT: {"velocity": 2.0}}}), ErrorCode.WRONG_STATE)
     assert left.velocity == 1.0

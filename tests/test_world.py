@@ -50,7 +50,7 @@ def test_default_world_is_arena() -> None:
 
 
 def test_warehouse_is_lidar_heavy() -> None:
-    from sensorium.cli.world import world_summary
+    from sensorium.server.sim.summary import world_summary
 
     s = world_summary(WORLDS / "warehouse.yaml")
     assert s["triangles"] >= 100_000

@@ -503,9 +503,9 @@ def world_triangles(sim, plane_half: float = 100.0) -> list[tuple[str, np.ndarra
     is_plane). Planes (analytic in Sensorium) become two triangles, ``plane_half`` m each way when
     infinite, so that triangle-only engines see the same surfaces."""
     from sensorium.schemas import world as wm
+    from sensorium.server.sim.scene import primitive_from_model
     from sensorium.server.world.geometry import tessellate
     from sensorium.server.world.poses import pose_from_model
-    from sensorium.server.world.scene import primitive_from_model
 
     out = []
     items = [(s.name, s, pose_from_model(s.pose)) for s in sim.world.solids]

@@ -1,13 +1,10 @@
-"""``sensorium bench [--quick] [--out DIR] [--only SECTION]…``: run the sections, write the report."""
+"""``sensorium bench [--quick] [--out DIR] [--only SECTION]…``: the argparse shell over
+:func:`sensorium.benchmarks.suite.run_suite` (run the sections, write the report)."""
 
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
-import importlib
 import sys
-import time
-import traceback
 from pathlib import Path
 
 from sensorium.benchmarks import SECTIONS
@@ -34,56 +31,21 @@ def _command(args: argparse.Namespace) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
-    from sensorium.benchmarks import report
-    from sensorium.benchmarks.common import Config, machine
+    from sensorium.benchmarks.suite import run_suite
 
-    out = Path(args.out)
-    only = list(dict.fromkeys(args.only or SECTIONS))
-    cfg = Config(quick=args.quick, log=lambda line: print(line, file=sys.stderr, flush=True))
-    now = lambda: _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")  # noqa: E731
-    doc = report.load(out) if args.only else {}
-    doc.update({"schema": report.SCHEMA, "generated": now(), "machine": machine(), "quick": args.quick})
-    if not args.only:
-        doc["command"] = _command(args)
-    else:
-        doc.setdefault("command", "sensorium bench --out " + str(args.out))
-    sections = doc.setdefault("sections", {})
-    for s in sections.values():
-        s.pop("_fresh", None)
-    failed = []
-    t_all = time.perf_counter()
-    for name in only:
-        cfg.log(f"sensorium bench: {name} …")
-        t0 = time.perf_counter()
-        try:
-            sec = importlib.import_module(f"sensorium.benchmarks.{name}").run(cfg)
-        except Exception as exc:  # noqa: BLE001 - one broken section must not lose the others
-            failed.append(name)
-            cfg.log(f"sensorium bench: {name} failed: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
-            continue
-        sec.elapsed_s = time.perf_counter() - t0
-        js = sec.to_json()
-        js.update({"measured_at": now(), "quick": args.quick, "command": _command(args), "_fresh": True})
-        sections[name] = js
-        cfg.log(f"sensorium bench: {name} done in {sec.elapsed_s:.0f} s")
-    if not args.only:
-        doc["elapsed_s"] = time.perf_counter() - t_all
-    written = report.write(out, doc, plots=not args.no_plots, log=cfg.log)
-    for s in sections.values():
-        s.pop("_fresh", None)
-    # rewrite the JSON without the run-local flag
-    report.write(out, doc, plots=False, log=cfg.log)
-    for w in written:
+    result = run_suite(Path(args.out), args.only, quick=args.quick, plots=not args.no_plots,
+                       command=_command(args), log=lambda line: print(line, file=sys.stderr, flush=True))
+    for w in result.written:
         print(w)
+    sections = result.doc.get("sections", {})
     for name in SECTIONS:
         for t in sections.get(name, {}).get("targets", []):
             verdict = "PASS" if t["ok"] is True else ("MISS" if t["ok"] is False else "n/a")
             print(f"{verdict:4}  {t['name']}: {t['measured']} (goal {t['target']})")
-    if failed:
-        print(f"sensorium bench: failed sections: {', '.join(failed)}", file=sys.stderr)
+    if result.failed:
+        print(f"sensorium bench: failed sections: {', '.join(result.failed)}", file=sys.stderr)
         return 1
     return 0
-
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(prog="python -m sensorium.benchmarks")

@@ -1,29 +1,20 @@
-"""``sensorium record``, ``replay`` and ``export`` (``info FILE.mcap`` lives in recording.print_info).
-
-``record --connect`` attaches to a running server as an ordinary subscriber. Such a subscriber can
-fall behind (PUB drops at the high-water mark), so it checks every topic's envelope ``seq`` and
-reports each gap and the exact number of messages lost between the ones it received. For a
-recording that cannot lose anything, use ``sensorium serve --record``, which writes from inside
-the server's step loop.
+"""``sensorium record``, ``replay``, ``export`` and ``info FILE.mcap``: argparse shells over
+:mod:`sensorium.server.recording` (live.py, replay.py, export.py, reader.py).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import signal
 import sys
-import time
-from collections.abc import Callable
 from contextlib import contextmanager
-from dataclasses import dataclass, field
-from pathlib import Path
-from urllib.parse import urlsplit
 
-import msgpack
 import zmq
 
-from sensorium.server.recording.mcapfile import DEFAULT_CHUNK_SIZE, McapRecorder, topic_matcher
+from sensorium.server.recording.live import LiveRecorder
+from sensorium.server.recording.reader import McapError, summarize
 
 
 @contextmanager
@@ -46,221 +37,6 @@ def sigterm_as_interrupt():
         for sig, h in previous.items():
             signal.signal(sig, h)
 
-
-# ------------------------------------------------------------------------------------ record
-
-
-def subscription_prefixes(patterns: list[str] | None) -> list[bytes]:
-    """SUB prefixes covering a ``--topics`` list (the exact filter is applied on receipt)."""
-    if not patterns:
-        return [b""]
-    out = []
-    for p in patterns:
-        cut = min([i for i, c in enumerate(p) if c in "*?["] or [len(p)])
-        lit = p[:cut]
-        if cut == len(p) and not p.endswith("/"):
-            out.append(p.encode() + b"\0")  # the exact topic
-            out.append(p.rstrip("/").encode() + b"/")  # and anything below it
-        else:
-            out.append(lit.encode())
-    return sorted(set(out))
-
-
-@dataclass
-class GapTracker:
-    """Per-topic ``seq`` bookkeeping: a jump of k > 1 is a gap of k - 1 lost messages."""
-
-    last: dict[str, int] = field(default_factory=dict)
-    received: dict[str, int] = field(default_factory=dict)
-    lost: dict[str, int] = field(default_factory=dict)
-    gaps: int = 0
-    resets: int = 0
-
-    def see(self, topic: str, seq: int) -> int:
-        """Record ``seq``; returns how many messages were lost just before it."""
-        self.received[topic] = self.received.get(topic, 0) + 1
-        last = self.last.get(topic)
-        self.last[topic] = seq
-        if last is None:
-            return 0
-        if seq > last + 1:
-            n = seq - last - 1
-            self.gaps += 1
-            self.lost[topic] = self.lost.get(topic, 0) + n
-            return n
-        if seq <= last:  # publisher restarted (or a replay looped)
-            self.resets += 1
-        return 0
-
-    @property
-    def total_lost(self) -> int:
-        return sum(self.lost.values())
-
-    @property
-    def total_received(self) -> int:
-        return sum(self.received.values())
-
-
-def _rpc_call(ctx: zmq.Context, url: str, service: str, args: dict | None = None, timeout: float = 5.0) -> dict:
-    sock = ctx.socket(zmq.DEALER)
-    sock.setsockopt(zmq.LINGER, 0)
-    try:
-        sock.connect(url)
-        sock.send(msgpack.packb({"id": 1, "service": service, "args": args or {}}))
-        if not sock.poll(int(timeout * 1000)):
-            raise TimeoutError(f"no answer from {url} within {timeout:g} s (is a server running there?)")
-        reply = msgpack.unpackb(sock.recv(), raw=False)
-    finally:
-        sock.close()
-    if not reply.get("ok"):
-        err = reply.get("error") or {}
-        raise RuntimeError(f"{service} failed: {err.get('message', err)}")
-    return reply.get("result") or {}
-
-
-def _rpc_endpoint(url: str) -> str:
-    """A controller URL (``tcp://host:port/robot``) → its RPC endpoint (``tcp://host:port``)."""
-    parts = urlsplit(url)
-    if parts.scheme == "tcp":
-        return f"tcp://{parts.netloc}"
-    return url
-
-
-def _reachable_pub(pub: str, rpc: str) -> str:
-    """A pub endpoint bound to a wildcard address is reached on the RPC endpoint's host."""
-    p, r = urlsplit(pub), urlsplit(rpc)
-    if p.scheme == "tcp" and r.scheme == "tcp" and p.hostname in ("0.0.0.0", "*", "::", None):
-        return f"tcp://{r.hostname}:{p.port}"
-    return pub
-
-
-class LiveRecorder:
-    """Subscribe to a server's topics and record them. ``on_message(topic, seq)`` is called after
-    each message is stored (tests use it to play a slow reader)."""
-
-    def __init__(self, path: str | Path, *, connect: str | None = "tcp://127.0.0.1:5560",
-                 pub: str | None = None, topics: list[str] | None = None, world: str | None = None,
-                 chunk_size: int = DEFAULT_CHUNK_SIZE, rcvhwm: int = 1000,
-                 on_message: Callable[[str, int], None] | None = None,
-                 log: Callable[[str], None] | None = None, context: zmq.Context | None = None):
-        self.path = Path(path)
-        self.connect = connect
-        self.pub = pub
-        self.topics = topics
-        self.world = world
-        self.chunk_size = chunk_size
-        self.rcvhwm = rcvhwm
-        self.on_message = on_message
-        self.log = log or (lambda text: print(text, file=sys.stderr, flush=True))
-        self.ctx = context or zmq.Context.instance()
-        self.gaps = GapTracker()
-        self.info: dict = {}
-        self._stop = False
-        self.sub: zmq.Socket | None = None
-        self.recorder: McapRecorder | None = None
-        self.pub_endpoint = ""
-        self._gap_lines = 0
-
-    def stop(self) -> None:
-        self._stop = True
-
-    def open(self) -> None:
-        rpc = _rpc_endpoint(self.connect) if self.connect else None
-        if rpc and not self.pub:
-            self.info = _rpc_call(self.ctx, rpc, "get_info")
-            self.pub_endpoint = _reachable_pub(self.info["pub_endpoint"], rpc)
-        else:
-            if rpc:
-                try:
-                    self.info = _rpc_call(self.ctx, rpc, "get_info", timeout=2.0)
-                except Exception:
-                    self.info = {}
-            self.pub_endpoint = self.pub
-        world_text, world_name = b"", ""
-        if self.world:
-            world_text, world_name = Path(self.world).read_bytes(), Path(self.world).name
-        meta = {}
-        rec_meta = self.info.get("recording", {}).get("metadata", {}) if isinstance(self.info.get("recording"), dict) else {}
-        meta.update({k: str(v) for k, v in rec_meta.items() if k in ("seed", "world", "basic_time_step_ms")})
-        if self.info.get("world"):
-            meta["world"] = str(self.info["world"])
-        if self.info.get("basic_time_step") is not None:
-            meta["basic_time_step_ms"] = str(self.info["basic_time_step"])
-        for key in ("seed", "random_seed"):
-            if self.info.get(key) is not None:
-                meta["seed"] = str(self.info[key])
-        if self.info.get("version"):
-            meta["server_version"] = str(self.info["version"])
-        self.sub = self.ctx.socket(zmq.SUB)
-        self.sub.setsockopt(zmq.RCVHWM, self.rcvhwm)
-        self.sub.setsockopt(zmq.LINGER, 0)
-        for prefix in subscription_prefixes(self.topics):
-            self.sub.setsockopt(zmq.SUBSCRIBE, prefix)
-        self.sub.connect(self.pub_endpoint)
-        self.recorder = McapRecorder(self.path, world_text, world_name or "world.yaml", meta, self.topics,
-                                     self.chunk_size,
-                                     session={"mode": "subscriber", "pub_endpoint": self.pub_endpoint,
-                                              "connect": self.connect or ""})
-
-    def run(self, duration: float | None = None, max_messages: int | None = None) -> None:
-        assert self.sub is not None and self.recorder is not None
-        match = topic_matcher(self.topics)
-        deadline = None if duration is None else time.monotonic() + duration
-        n = 0
-        while not self._stop:
-            if deadline is not None and time.monotonic() >= deadline:
-                break
-            if not self.sub.poll(100):
-                self.recorder.maybe_flush()
-                continue
-            while True:
-                try:
-                    frames = self.sub.recv_multipart(zmq.NOBLOCK)
-                except zmq.Again:
-                    break
-                if len(frames) != 3 or not frames[0].endswith(b"\0"):
-                    continue
-                topic = frames[0][:-1].decode("utf-8", "replace")
-                if not match(topic):
-                    continue
-                try:
-                    env = msgpack.unpackb(frames[1], raw=False)
-                    ros_type, seq, stamp_ns = str(env["type"]), int(env["seq"]), int(env["stamp_ns"])
-                except Exception:
-                    continue
-                self.recorder.record(topic, ros_type, frames[1], frames[2], stamp_ns, seq)
-                lost = self.gaps.see(topic, seq)
-                if lost:
-                    self._gap_lines += 1
-                    if self._gap_lines <= 20:
-                        self.log(f"sensorium: gap on {topic}: seq {seq - lost - 1} -> {seq} ({lost} lost)")
-                    elif self._gap_lines == 21:
-                        self.log("sensorium: more gaps; see the summary at the end")
-                if self.on_message is not None:
-                    self.on_message(topic, seq)
-                n += 1
-                if max_messages is not None and n >= max_messages:
-                    return
-                if self._stop:
-                    return
-
-    def close(self) -> dict:
-        """Finish the file; returns the summary (also stored as metadata ``record``)."""
-        summary = self.summary()
-        if self.recorder is not None:
-            self.recorder.add_metadata("record", {"received": str(summary["received"]), "gaps": str(summary["gaps"]),
-                                                  "lost": str(summary["lost"]),
-                                                  "lost_by_topic": json.dumps(summary["lost_by_topic"])})
-            self.recorder.close()
-        if self.sub is not None:
-            self.sub.close()
-        return summary
-
-    def summary(self) -> dict:
-        g = self.gaps
-        return {"file": str(self.path), "received": g.total_received, "topics": len(g.received),
-                "gaps": g.gaps, "lost": g.total_lost, "lost_by_topic": dict(sorted(g.lost.items())),
-                "resets": g.resets}
 
 
 def record(args: argparse.Namespace) -> int:
@@ -343,4 +119,63 @@ def export_cmd(args: argparse.Namespace) -> int:
         print(f"sensorium export: {exc}", file=sys.stderr)
         return 1
     print_report(report)
+    return 0
+
+
+# ------------------------------------------------------------------------------------ info
+
+
+def _human_size(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB"):
+        if n < 1024 or unit == "GiB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n} B"  # pragma: no cover
+
+
+def _secs(ns: int | None) -> str:
+    return "-" if ns is None else f"{ns / 1e9:.3f} s"
+
+
+def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
+    """``sensorium info FILE.mcap``: like ``ros2 bag info``. Exit 0, or 1 if the file is unreadable."""
+    try:
+        s = summarize(path)
+    except (OSError, McapError) as exc:
+        print(f"sensorium info: {path}: {exc}", file=sys.stderr)
+        return 1
+    if as_json:
+        print(json.dumps(s, indent=2))
+        return 0
+    meta = s["metadata"].get("sensorium", {})
+    session = s["metadata"].get("session", {})
+    lines = [
+        ("Files", s["path"]),
+        ("Bag size", _human_size(s["size_bytes"])),
+        ("Storage id", f"mcap (profile {s['profile'] or '-'!s}, {s['library'] or '-'})"),
+        ("Truncated", "YES: " + s.get("note", "") if s["truncated"] else "no"),
+        ("Duration", f"{s['duration_s']:.3f} s"),
+        ("Start", f"{_secs(s['start_ns'])} (simulation time)"),
+        ("End", f"{_secs(s['end_ns'])} (simulation time)"),
+        ("Messages", str(s["messages"])),
+        ("Chunks", f"{s['chunks']} ({', '.join(s['compression']) or '-'})"),
+    ]
+    if meta:
+        world = meta.get("world") or meta.get("world_file") or "-"
+        lines.append(("World", f"{world}   seed {meta.get('seed', '-')}   time step "
+                               f"{meta.get('basic_time_step_ms', '-')} ms   sensorium {meta.get('version', '-')}"))
+    if session.get("started_at"):
+        lines.append(("Recorded", session["started_at"]))
+    for a in s["attachments"]:
+        lines.append(("Attachment", f"{a['name']} ({a['media_type']}, {_human_size(a['size_bytes'])})"))
+    for key, value in lines:
+        print(f"{key + ':':<19}{value}")
+    topics = s["topics"]
+    width = max((len(t["topic"]) for t in topics), default=0)
+    twidth = max((len(t["type"]) for t in topics), default=0)
+    print(f"{'Topic information:':<19}{len(topics)} topic{'s' if len(topics) != 1 else ''}")
+    for t in topics:
+        rate = "-" if t["rate_hz"] is None else f"{t['rate_hz']:.2f} Hz"
+        print(f"  Topic: {t['topic']:<{width}} | Type: {t['type']:<{twidth}} | Count: {t['count']:>7} | "
+              f"Rate: {rate:>10} | Serialization Format: {t['encoding']}")
     return 0

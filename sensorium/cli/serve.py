@@ -1,4 +1,5 @@
-"""``sensorium serve``: load a world, bind the RPC and topic sockets, serve until SIGINT/SIGTERM.
+"""``sensorium serve``: the argparse shell over :mod:`sensorium.server.daemon.serve` (load a world,
+bind the RPC and topic sockets, serve until SIGINT/SIGTERM).
 
 Prints one line when ready, with the endpoints actually bound (port 0 or ``*`` picks a free
 port), so scripts can wait for it::
@@ -10,9 +11,8 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
-__all__ = ["add_arguments", "main", "build"]
+__all__ = ["add_arguments", "main", "options"]
 
 # kept equal to sensorium.server.daemon.transport.DEFAULT_*; not imported so that `sensorium --help` stays light
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
@@ -39,50 +39,47 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "without subscribers (default: every topic)")
 
 
-def build(args: argparse.Namespace):
-    """World → simulation → core → bound transport (raises on a bad world or a busy port)."""
-    from sensorium.server.daemon.services import Core
-    from sensorium.server.daemon.transport import Transport
-    from sensorium.server.sim.simulation import Simulation
-    from sensorium.server.world.loader import default_world_path
+def options(args: argparse.Namespace):
+    """The parsed command line → :class:`sensorium.server.daemon.serve.ServeOptions`."""
+    from sensorium.server.daemon.serve import ServeOptions
 
-    path = Path(args.world) if args.world else default_world_path()
-    sim = Simulation.from_file(path, precision=args.precision)
-    core = Core(sim, heartbeat_ms=args.heartbeat_ms, mode=args.mode)
-    return core, Transport(core, args.rpc, args.pub, stop_at_ms=getattr(args, "until", None))
+    return ServeOptions(rpc=args.rpc, pub=args.pub, mode=args.mode, precision=args.precision,
+                        heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None))
 
 
 def main(args: argparse.Namespace) -> int:
+    from sensorium.server.daemon.serve import Server
     from sensorium.server.world.loader import WorldError
 
-    if args.heartbeat_ms <= 0:
-        print("sensorium serve: --heartbeat-ms must be > 0", file=sys.stderr)
+    try:
+        opts = options(args)
+        opts.check()
+    except ValueError as exc:
+        print(f"sensorium serve: {exc}", file=sys.stderr)
         return 2
     try:
-        core, transport = build(args)
+        server = Server.open(args.world, opts)
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1
     except OSError as exc:          # zmq.ZMQError is an OSError: address in use, bad endpoint
         print(f"sensorium serve: cannot bind: {exc}", file=sys.stderr)
         return 1
-    recorder = None
-    if getattr(args, "record", None):                # recording (server/recording.py)
-        from sensorium.server.recording.mcapfile import recorder_for_server
+    if getattr(args, "record", None):
+        from sensorium.server.recording.writer import recorder_for_server
         try:
-            recorder = recorder_for_server(args.record, core, getattr(args, "topics", None))
+            server.attach_recorder(recorder_for_server(args.record, server.core, getattr(args, "topics", None)))
         except OSError as exc:
-            transport.close()
+            server.close()
             print(f"sensorium serve: cannot record: {exc}", file=sys.stderr)
             return 1
-    transport.install_signal_handlers()
-    print(f"sensorium: serving world '{core.world_name}' rpc={transport.rpc_endpoint} pub={transport.pub_endpoint}",
-          flush=True)
+    print(server.ready_line, flush=True)
     try:
-        transport.run()
+        server.run()
     finally:
-        if recorder is not None:
-            recorder.close()
-            print(f"sensorium: recorded {recorder.message_count} messages to {args.record}", file=sys.stderr, flush=True)
+        if server.recorder is not None:
+            print(f"sensorium: recorded {server.recorder.message_count} messages to {args.record}",
+                  file=sys.stderr, flush=True)
+    core = server.core
     print(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps", file=sys.stderr, flush=True)
     return 0

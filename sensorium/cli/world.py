@@ -1,4 +1,6 @@
-"""``sensorium validate``, ``info`` and ``probe``: world files at a terminal."""
+"""``sensorium validate``, ``info`` and ``probe``: world files at a terminal (printing only; the
+library parts are :mod:`sensorium.server.world.loader`, :mod:`sensorium.server.sim.summary` and
+:class:`sensorium.server.sim.simulation.Simulation`)."""
 
 from __future__ import annotations
 
@@ -6,9 +8,8 @@ import argparse
 import json
 import math
 import sys
-from pathlib import Path
 
-from sensorium.schemas import world as wm
+from sensorium.server.sim.summary import world_summary
 from sensorium.server.world.loader import WorldError, default_world_path, load_world
 
 
@@ -28,42 +29,10 @@ def validate(args: argparse.Namespace) -> int:
     return status
 
 
-def _device_line(d) -> str:
-    if isinstance(d, wm.Lidar):
-        return (f"Lidar {d.type}/{d.projection} {d.horizontal_resolution}x{d.number_of_layers} "
-                f"fov {d.field_of_view:.4g} range [{d.min_range:g}, {d.max_range:g}]")
-    if isinstance(d, wm.DistanceSensor):
-        return f"DistanceSensor {d.type} rays {d.number_of_rays} aperture {d.aperture:g} max {d.lookup_table[-1][0] if d.lookup_table else 0:g} m"
-    return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
-
-
-def world_summary(path: str | Path) -> dict:
-    from sensorium.server.world.scene import Scene
-
-    loaded = load_world(path)
-    w = loaded.world
-    scene = Scene(w, loaded.base_dir)
-    return {
-        "world": w.world_info.name,
-        "file": str(path),
-        "basic_time_step_ms": w.world_info.basic_time_step,
-        "random_seed": w.world_info.random_seed,
-        "solids": [{"name": s.name, "geometry": s.geometry.type, "seen_by": s.seen_by} for s in w.solids],
-        "triangles": scene.triangle_count,
-        "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
-        "robots": [
-            {"name": r.name, "synchronization": r.synchronization,
-             "devices": [{"name": d.name, "device": d.device, "summary": _device_line(d)} for d in r.devices]}
-            for r in w.robots
-        ],
-        "warnings": loaded.warnings,
-    }
-
-
 def info(args: argparse.Namespace) -> int:
     path = args.path or str(default_world_path())
     if str(path).endswith(".mcap"):
-        from sensorium.server.recording.mcapfile import print_info  # recordings
+        from sensorium.cli.recording import print_info  # recordings
 
         return print_info(path, as_json=args.json)
     try:

@@ -36,7 +36,7 @@ def _hull(points: np.ndarray) -> np.ndarray:
 def _footprint(geometry, pose, base_dir: Path) -> np.ndarray | None:
     """The outline, seen from above, of a shape placed at ``pose`` (None for planes)."""
     from sensorium.server.world import geometry as geo
-    from sensorium.server.world.scene import primitive_from_model
+    from sensorium.server.sim.scene import primitive_from_model
 
     prim = primitive_from_model(geometry, base_dir)
     if isinstance(prim, geo.Plane):
@@ -51,7 +51,7 @@ def _yaw(q: dict) -> float:
 
 def _last_scan(recording: Path, robot: str) -> tuple[np.ndarray, float] | None:
     """The robot's last LaserScan as world xy points, placed with the pose recorded at its stamp."""
-    from sensorium.server.recording.mcapfile import iter_messages
+    from sensorium.server.recording.reader import iter_messages
 
     scan, poses = None, {}
     for m in iter_messages(recording, topics=[f"/{robot}/lidar/laser_scan", f"/{robot}/pose"]):

@@ -40,7 +40,7 @@ def smoothness(t_ns: np.ndarray, xy: np.ndarray, every_ns: int = 1_000_000_000) 
 
 def summarise(result: DemoResult, world) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Fill ``result`` from its recording; returns each robot's (stamps ns, xy path)."""
-    from sensorium.server.recording.mcapfile import iter_messages
+    from sensorium.server.recording.reader import iter_messages
 
     stamps: dict[str, list[int]] = {}
     points: dict[str, list[tuple[float, float]]] = {}

@@ -55,7 +55,7 @@ def services_schema() -> dict:
         {"name": s.item if s.scope == "server" else (f"/<robot>/robot/{s.item}" if s.scope == "robot"
                                                      else f"/<robot>/<device>/{s.item}"),
          "args": f"#/$defs/{s.args.__name__}", "result": f"#/$defs/{s.result.__name__}",
-         "attached": s.attached, "devices": sorted(s.devices)}
+         "attached": s.attached, "supervisor": s.supervisor, "devices": sorted(s.devices)}
         for s in specs
     ]
     return out

@@ -138,6 +138,26 @@ class Clock(Msg):
     clock: Time
 
 
+class JointState(Msg):
+    """``sensor_msgs/msg/JointState`` for a PositionSensor: one joint, named after the sensor, its
+    angle (rad) as the controller reads it; velocity and effort empty."""
+
+    header: Header
+    name: list[str]
+    position: bytes = Field(description="<f8[len(name)]: rad")
+    velocity: bytes = Field(default=b"", description="<f8[]: empty")
+    effort: bytes = Field(default=b"", description="<f8[]: empty")
+
+
+class ColorRGBA(Msg):
+    """``std_msgs/msg/ColorRGBA`` for an LED: the colour it shows (all 0 when off); a = 1 when on."""
+
+    r: float
+    g: float
+    b: float
+    a: float
+
+
 class Envelope(Msg):
     """The second frame of every topic message."""
 
@@ -153,6 +173,8 @@ LASER_SCAN = "sensor_msgs/msg/LaserScan"
 POINT_CLOUD = "sensor_msgs/msg/PointCloud"
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 CLOCK = "rosgraph_msgs/msg/Clock"
+JOINT_STATE = "sensor_msgs/msg/JointState"
+COLOR_RGBA = "std_msgs/msg/ColorRGBA"
 
 MESSAGE_TYPES: dict[str, type[Msg]] = {
     ILLUMINANCE: Illuminance,
@@ -162,6 +184,8 @@ MESSAGE_TYPES: dict[str, type[Msg]] = {
     POINT_CLOUD: PointCloud,
     POSE_STAMPED: PoseStamped,
     CLOCK: Clock,
+    JOINT_STATE: JointState,
+    COLOR_RGBA: ColorRGBA,
 }
 """ROS type name → model, for every topic the server publishes."""
 

@@ -24,7 +24,8 @@ __all__ = ["ErrorCode", "PROTOCOL_VERSION", "SERVICES", "ServiceSpec", "service_
 
 MAX_PERIOD_MS = (1 << 31) - 1
 Mode = Literal["fast", "realtime", "pause"]
-DeviceType = Literal["LightSensor", "DistanceSensor", "Lidar", "RotationalMotor"]
+DeviceType = Literal["LightSensor", "DistanceSensor", "Lidar", "RotationalMotor", "PositionSensor", "LED"]
+FieldName = Literal["translation", "rotation"]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
 
@@ -117,18 +118,21 @@ class MotorCommand(Args):
 
 
 class StepArgs(Args):
-    duration: int | None = Field(default=None, gt=0, le=MAX_PERIOD_MS,
-                                 description="ms, a positive multiple of the basic time step; default: one basic step")
+    duration: int | None = Field(default=None, ge=0, le=MAX_PERIOD_MS,
+                                 description="ms; default: one basic step. Not a multiple of the basic step: rounded "
+                                             "up to one (Webots). 0: apply the motor commands and answer at once with "
+                                             "the values not yet delivered, without advancing time (Webots' step(0))")
     motors: dict[str, MotorCommand] | None = Field(
         default=None, description="motor name -> commands, applied when the request arrives (before the world advances)")
 
 
 class TimeStepArgs(Args):
-    value: int = Field(ge=0, le=MAX_PERIOD_MS, description="ms, a multiple of the basic time step; 0 = one basic step")
+    value: int = Field(ge=0, le=MAX_PERIOD_MS, description="ms, rounded up to a multiple of the basic time step; "
+                                                          "0 = one basic step")
 
 
 class SetPoseArgs(Args):
-    translation: Vec3
+    translation: Vec3 | None = Field(default=None, description="left out: keep the current translation")
     rotation: Vec4 | None = Field(default=None, description="Webots axis-angle: axis x, y, z, angle (rad)")
     quaternion: Vec4 | None = Field(default=None, description="x, y, z, w")
 
@@ -164,6 +168,38 @@ class MotorPositionArgs(Args):
 
 class MotorVelocityArgs(Args):
     value: float = Field(description="rad/s, finite; clamped to maxVelocity")
+
+
+class IntArgs(Args):
+    value: int = Field(ge=-(1 << 31), lt=1 << 31)
+
+
+class StringArgs(Args):
+    value: str = Field(max_length=1 << 20)
+
+
+class NodeNameArgs(Args):
+    name: str = Field(min_length=1, max_length=4096, description="a robot's or solid's name (DEF names are the names)")
+
+
+class NodeArgs(Args):
+    node: int = Field(ge=1, lt=1 << 31, description="a node id from get_from_def / get_self")
+
+
+class FieldArgs(Args):
+    node: int = Field(ge=1, lt=1 << 31)
+    field: FieldName
+
+
+class SetFieldArgs(Args):
+    node: int = Field(ge=1, lt=1 << 31)
+    field: FieldName
+    value: list[float] = Field(min_length=3, max_length=4,
+                               description="translation x, y, z (m); rotation axis x, y, z, angle (rad)")
+
+
+class SimulationModeArgs(Args):
+    mode: int = Field(ge=0, le=2, description="Webots WB_SUPERVISOR_SIMULATION_MODE_*: 0 pause, 1 real time, 2 fast")
 
 
 # ---------------------------------------------------------------------- results
@@ -247,8 +283,25 @@ class MotorDescription(Result):
     velocity: float = Field(description="rad/s (the motor's current command)")
 
 
-DeviceDescription = Annotated[LightSensorDescription | DistanceSensorDescription | LidarDescription | MotorDescription,
-                              Field(discriminator="type")]
+class PositionSensorDescription(Result):
+    name: str
+    type: Literal["PositionSensor"]
+    sampling_period: int
+    motor: str = Field(description="the wheel motor on the same joint (Motor.getPositionSensor / getMotor)")
+    noise: float
+    resolution: float
+
+
+class LEDDescription(Result):
+    name: str
+    type: Literal["LED"]
+    value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
+    color: list[float] = Field(description="flat [r0, g0, b0, r1, ...]")
+    gradual: bool
+
+
+DeviceDescription = Annotated[LightSensorDescription | DistanceSensorDescription | LidarDescription | MotorDescription
+                              | PositionSensorDescription | LEDDescription, Field(discriminator="type")]
 
 
 class AttachResult(Result):
@@ -259,6 +312,9 @@ class AttachResult(Result):
     synchronization: bool
     heartbeat_ms: int
     devices: list[DeviceDescription]
+    supervisor: bool = Field(default=False, description="the world lets this robot's controller use Supervisor services")
+    model: str = ""
+    custom_data: str = ""
 
 
 class TimeResult(Result):
@@ -337,6 +393,21 @@ class LayerPointCloudResult(Result):
     pointCloud: PointCloud
 
 
+class StringValue(Result):
+    value: str
+
+
+class NodeResult(Result):
+    node: int = Field(description="node id; 0 = no such node (Webots' NULL)")
+    type: Literal["Robot", "Solid", ""]
+    name: str
+
+
+class NodePoseResult(Result):
+    position: list[float] = Field(description="world x, y, z (m)")
+    orientation: list[float] = Field(description="3x3 rotation matrix, row-major (Webots getOrientation)")
+
+
 class CountersResult(Result):
     """``get_counters`` (debug): what the simulation computed so far and what is demanded."""
 
@@ -402,6 +473,7 @@ class ServiceSpec:
     result: type[Result]
     attached: bool = False
     devices: frozenset[str] = frozenset()
+    supervisor: bool = False       # the robot's world entry must have ``supervisor: true``
 
 
 _ALL = frozenset({"LightSensor", "DistanceSensor", "Lidar"})          # sensors
@@ -409,6 +481,9 @@ _M = frozenset({"RotationalMotor"})
 _LD = frozenset({"LightSensor", "DistanceSensor"})
 _D = frozenset({"DistanceSensor"})
 _L = frozenset({"Lidar"})
+_P = frozenset({"PositionSensor"})
+_LED = frozenset({"LED"})
+_SENSORS = frozenset({"LightSensor", "DistanceSensor", "Lidar", "PositionSensor"})
 
 SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_info", "server", NoArgs, InfoResult),
@@ -426,8 +501,19 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_number_of_devices", "robot", NoArgs, IntValue),
     ServiceSpec("set_pose", "robot", SetPoseArgs, SuccessResult),
     ServiceSpec("get_pose", "robot", NoArgs, PoseResult),
-    ServiceSpec("enable", "device", EnableArgs, SuccessResult, attached=True, devices=_ALL),
-    ServiceSpec("get_sampling_period", "device", NoArgs, IntValue, devices=_ALL),
+    ServiceSpec("get_custom_data", "robot", NoArgs, StringValue),
+    ServiceSpec("set_custom_data", "robot", StringArgs, SuccessResult, attached=True),
+    ServiceSpec("get_model", "robot", NoArgs, StringValue),
+    ServiceSpec("get_from_def", "robot", NodeNameArgs, NodeResult, attached=True, supervisor=True),
+    ServiceSpec("get_self", "robot", NoArgs, NodeResult, attached=True, supervisor=True),
+    ServiceSpec("get_field", "robot", FieldArgs, FloatArrayValue, attached=True, supervisor=True),
+    ServiceSpec("set_field", "robot", SetFieldArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
+    ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),
+    ServiceSpec("enable", "device", EnableArgs, SuccessResult, attached=True, devices=_SENSORS),
+    ServiceSpec("get_sampling_period", "device", NoArgs, IntValue, devices=_SENSORS),
     ServiceSpec("get_lookup_table", "device", NoArgs, FloatArrayValue, devices=_LD),
     ServiceSpec("get_min_value", "device", NoArgs, FloatValue, devices=_D),
     ServiceSpec("get_max_value", "device", NoArgs, FloatValue, devices=_D),
@@ -445,6 +531,9 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_velocity", "device", NoArgs, FloatValue, devices=_M),
     ServiceSpec("get_max_velocity", "device", NoArgs, FloatValue, devices=_M),
     ServiceSpec("get_target_position", "device", NoArgs, FloatValue, devices=_M),
+    ServiceSpec("get_value", "device", NoArgs, FloatValue, devices=_P),
+    ServiceSpec("set", "device", IntArgs, SuccessResult, attached=True, devices=_LED),
+    ServiceSpec("get", "device", NoArgs, IntValue, devices=_LED),
 )
 
 

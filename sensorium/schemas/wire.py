@@ -47,6 +47,7 @@ class ErrorCode(IntEnum):
     TOO_LARGE = 8
     SHUTTING_DOWN = 9
     WRONG_STATE = 10
+    NOT_SUPERVISOR = 11
     INTERNAL = 99
 
 

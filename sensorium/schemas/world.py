@@ -267,7 +267,34 @@ class Lidar(_Device):
         return self
 
 
-Device = Annotated[LightSensor | DistanceSensor | Lidar, Field(discriminator="device")]
+class PositionSensor(_Device):
+    """A wheel encoder (Webots PositionSensor on the wheel's HingeJoint): the angle, in radians, of
+    the differential-drive wheel turned by ``motor``. ``pose`` is unused (kept for symmetry)."""
+
+    device: Literal["PositionSensor"]
+    motor: str = Field(min_length=1, description="name of the drive's wheel motor whose joint it measures")
+    noise: float = Field(default=0.0, ge=0.0, description="standard deviation of Gaussian noise (rad)")
+    resolution: float = -1.0
+
+
+class LED(_Device):
+    """Webots LED: ``set(i)`` lights colour ``i`` (1-based, 0 = off) of ``color``; a ``gradual`` LED
+    takes a 0xRRGGBB value instead. Sensors do not see it (no light is emitted)."""
+
+    device: Literal["LED"]
+    color: list[Color] = Field(default=[(1.0, 0.0, 0.0)], max_length=1024)
+    gradual: bool = False
+
+    @field_validator("color")
+    @classmethod
+    def _unit(cls, v: list[Color]) -> list[Color]:
+        for c in v:
+            if min(c) < 0 or max(c) > 1:
+                raise ValueError("colour components must be within [0, 1]")
+        return v
+
+
+Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED, Field(discriminator="device")]
 
 
 # ---------------------------------------------------------------- motion
@@ -300,6 +327,9 @@ class Robot(Strict):
                     'synchronous controller is attached the server waits for one. "<none>": never controlled, '
                     "never waited for (its motors keep their initial state)")
     synchronization: bool = True
+    supervisor: bool = Field(default=False, description="its controller may use the Supervisor services (Webots)")
+    custom_data: str = Field(default="", max_length=1 << 20, description="Webots customData (get/setCustomData)")
+    model: str = Field(default="", max_length=4096, description="Webots model (getModel)")
     self_collision: bool = False
     body: Shape | None = None
     differential_drive: DifferentialDrive | None = None
@@ -310,6 +340,8 @@ class WorldInfo(Strict):
     name: str = "world"
     basic_time_step: int = Field(default=32, ge=1, le=60_000, description="milliseconds")
     random_seed: int = Field(default=0, ge=0, lt=2**63)
+    contact: bool = Field(default=True, description="kinematic contact: a robot's body stops at solids and other "
+                                                    "robots' bodies (README 'Kinematic contact'); false = pass through")
 
 
 class World(Strict):

@@ -184,15 +184,14 @@ class Lockstep:
     # ------------------------------------------------------------------ steps
     def check_duration(self, duration: int | None, kind: str = "step") -> int:
         """The step duration in ms: ``None`` (and 0 for ``time_step``) is one basic step; otherwise a
-        positive multiple of the basic time step, else :class:`LockstepError` INVALID_ARGUMENT."""
+        positive integer, rounded up to a multiple of the basic time step as Webots does (the
+        controller wakes at the first basic step that ends at or after the requested time), else
+        :class:`LockstepError` INVALID_ARGUMENT."""
         if duration is None or (kind == "time_step" and duration == 0):
             return self.basic_time_step
         if isinstance(duration, bool) or not isinstance(duration, int) or duration <= 0:
             raise LockstepError(ErrorCode.INVALID_ARGUMENT, f"duration must be a positive integer (ms), got {duration!r}")
-        if duration % self.basic_time_step:
-            raise LockstepError(ErrorCode.INVALID_ARGUMENT,
-                                f"duration {duration} ms is not a multiple of the basic time step ({self.basic_time_step} ms)")
-        return duration
+        return -(-duration // self.basic_time_step) * self.basic_time_step
 
     def request_step(self, session: Session, reply_to: Any, duration: int | None, now: float,
                      kind: str = "step") -> StepDone | None:

@@ -34,6 +34,7 @@ from sensorium.schemas.wire import (
     ok_reply,
     parse_request,
 )
+from sensorium.server.daemon import supervisor
 from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
 from sensorium.server.daemon.topics import Control, Topics, header, image_msg, point_cloud_msg, pose_quaternion
 
@@ -192,6 +193,10 @@ class Core:
                     raise ServiceError(ErrorCode.NOT_ATTACHED,
                                        f"{req.service} needs the caller to be {route.robot!r}'s attached controller"
                                        + ("" if s is None else " (another socket is)"))
+            if route.spec.supervisor and not getattr(self.sim.robots[route.robot], "supervisor", False):
+                raise ServiceError(ErrorCode.NOT_SUPERVISOR,
+                                   f"{req.service}: robot {route.robot!r} is not a supervisor "
+                                   f"(set 'supervisor: true' on it in the world file)")
             ctl = self.topics.controls[route.device] if route.device else None
             motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
             call = Call(envelope, peer, rid, args, route.robot, ctl, motor, now, [])
@@ -283,14 +288,20 @@ class Core:
             return envelope + [ok_reply(rid, {"success": d.status != -1})]
         values: dict[str, dict] = {}
         if d.status != -1 and d.session.alive:
-            seen = self._seen.setdefault(d.session.token, {})
-            for ctl in self._robot_controls(d.session.robot):
-                if ctl.controller_period > 0:
-                    m = ctl.device.measurements
-                    if seen.get(ctl.path, 0) != m:
-                        seen[ctl.path] = m
-                        values[ctl.device.name] = self.topics.reading(ctl)
+            values = self._new_values(d.session)
         return envelope + [ok_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})]
+
+    def _new_values(self, session: Session) -> dict[str, dict]:
+        """The readings of the session's enabled devices that it has not received yet."""
+        values: dict[str, dict] = {}
+        seen = self._seen.setdefault(session.token, {})
+        for ctl in self._robot_controls(session.robot):
+            if ctl.controller_period > 0:
+                m = ctl.device.measurements
+                if seen.get(ctl.path, 0) != m:
+                    seen[ctl.path] = m
+                    values[ctl.device.name] = self.topics.reading(ctl)
+        return values
 
     def _reply_error(self, d: StepDone, code: ErrorCode, message: str) -> Frames:
         envelope, rid = d.step.reply_to
@@ -333,7 +344,9 @@ class Core:
         robot = self.sim.robots[s.robot]
         return {"session": s.token, "robot": s.robot, "basic_time_step": self.sim.basic_time_step,
                 "time_ms": self.sim.time_ms, "synchronization": bool(robot.synchronization),
-                "heartbeat_ms": self.lockstep.heartbeat_ms,
+                "heartbeat_ms": self.lockstep.heartbeat_ms, "supervisor": bool(getattr(robot, "supervisor", False)),
+                "model": str(getattr(getattr(robot, "model", None), "model", "")),
+                "custom_data": str(getattr(robot, "custom_data", "")),
                 "devices": [self._describe(ctl) for ctl in self._robot_controls(s.robot)]
                 + [self._describe_motor(m) for m in robot.motors.values()]}
 
@@ -379,16 +392,27 @@ class Core:
 
     def _robot_step(self, c: Call) -> dict | None:
         commands = self._motor_commands(c.robot, c.args.motors) if c.args.motors else []
+        if c.args.duration == 0:
+            # Webots' step(0): deliver the commands and the values not yet read, time stands still
+            s = self._session(c)
+            if s.pending is not None:
+                raise ServiceError(ErrorCode.WRONG_STATE, f"robot {c.robot!r} already has a step pending")
+            self._apply_motor_commands(commands)
+            return {"status": 0, "time_ms": self.sim.time_ms, "values": self._new_values(s)}
         done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.duration, c.now)
         if done is not None:                                 # quitting: -1 at once
             return {"status": done.status, "time_ms": done.time_ms, "values": {}}
         # the world has not advanced since the request arrived: Webots' "at the start of the step"
+        self._apply_motor_commands(commands)
+        return _DEFERRED
+
+    @staticmethod
+    def _apply_motor_commands(commands: list[tuple[Any, Any]]) -> None:
         for motor, cmd in commands:
             if cmd.position is not None:
                 motor.set_position(cmd.position)
             if cmd.velocity is not None:
                 motor.set_velocity(cmd.velocity)
-        return _DEFERRED
 
     def _motor_commands(self, robot: str, motors: dict[str, Any]) -> list[tuple[Any, Any]]:
         """Resolve every named motor first, so that a bad name applies none of the commands."""
@@ -437,6 +461,53 @@ class Core:
         pose = self.sim.robots[c.robot].pose
         return {"translation": [float(v) for v in pose.translation], "quaternion": pose_quaternion(pose)}
 
+    def _robot_get_custom_data(self, c: Call) -> dict:
+        return {"value": self.sim.robots[c.robot].custom_data}
+
+    def _robot_set_custom_data(self, c: Call) -> dict:
+        self.sim.robots[c.robot].custom_data = c.args.value
+        return {"success": True}
+
+    def _robot_get_model(self, c: Call) -> dict:
+        return {"value": self.sim.robots[c.robot].model.model}
+
+    # ------------------------------------------------------------------ supervisor services
+    def _robot_get_from_def(self, c: Call) -> dict:
+        return supervisor.node_ref(self.sim, supervisor.find_node(self.sim, c.args.name))
+
+    def _robot_get_self(self, c: Call) -> dict:
+        return supervisor.node_ref(self.sim, supervisor.find_node(self.sim, c.robot))
+
+    def _node(self, c: Call) -> supervisor.Node:
+        try:
+            return supervisor.node_by_id(self.sim, c.args.node)
+        except KeyError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, str(exc.args[0])) from None
+
+    def _robot_get_field(self, c: Call) -> dict:
+        return {"value": supervisor.get_field(self.sim, self._node(c), c.args.field)}
+
+    def _robot_set_field(self, c: Call) -> dict:
+        try:
+            supervisor.set_field(self.sim, self._node(c), c.args.field, c.args.value)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_field: {exc}") from None
+        return {"success": True}
+
+    def _robot_get_node_pose(self, c: Call) -> dict:
+        return supervisor.node_pose(self.sim, self._node(c))
+
+    def _robot_simulation_reset(self, c: Call) -> dict:
+        self.sim.reset()
+        return {"success": True}
+
+    def _robot_simulation_set_mode(self, c: Call) -> dict:
+        self.lockstep.set_mode(supervisor.MODES[c.args.mode])
+        return {"success": True}
+
+    def _robot_simulation_get_mode(self, c: Call) -> dict:
+        return {"value": supervisor.MODES.index(self.lockstep.mode)}
+
     # ------------------------------------------------------------------ device services
     def _describe(self, ctl: Control) -> dict:
         dev = ctl.device
@@ -450,6 +521,12 @@ class Core:
             out.update(self._lidar_info(dev))
             out.update(self._frequency_info(dev))
             out["point_cloud_enabled"] = ctl.controller_point_cloud
+        if ctl.kind == "PositionSensor":
+            out.update(motor=dev.config.motor, noise=float(dev.config.noise), resolution=float(dev.config.resolution))
+        if ctl.kind == "LED":
+            del out["sampling_period"]
+            out.update(value=int(dev.value), color=[float(v) for rgb in dev.config.color for v in rgb],
+                       gradual=bool(dev.config.gradual))
         return out
 
     @staticmethod
@@ -476,6 +553,19 @@ class Core:
         cfg = dev.config
         return {"frequency": float(dev.frequency), "minFrequency": float(cfg.min_frequency),
                 "maxFrequency": float(cfg.max_frequency)}
+
+    def _dev_get_value(self, c: Call) -> dict:
+        return {"value": float(c.ctl.device.value)}
+
+    def _dev_set(self, c: Call) -> dict:
+        try:
+            c.ctl.device.set(c.args.value, self.sim.time_ms)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set: {exc}") from None
+        return {"success": True}
+
+    def _dev_get(self, c: Call) -> dict:
+        return {"value": int(c.ctl.device.value)}
 
     def _dev_enable(self, c: Call) -> dict:
         self.topics.controller_enable(c.ctl.path, c.args.value)

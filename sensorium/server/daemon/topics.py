@@ -179,6 +179,10 @@ def _device_topics(robot: str, name: str, kind: str, cfg: Any) -> list[Topic]:
         if laser_scan_angles(cfg) is not None:
             out.append(("laser_scan", msgs.LASER_SCAN, "laser_scan"))
         out.append(("point_cloud", msgs.POINT_CLOUD, "point_cloud"))
+    elif kind == "PositionSensor":
+        out.append(("value", msgs.JOINT_STATE, "value"))
+    elif kind == "LED":
+        out.append(("value", msgs.COLOR_RGBA, "value"))
     return [Topic(base + item, t, k, path, topic_frame(base + item)) for item, t, k in out]
 
 
@@ -368,6 +372,12 @@ class Topics:
         hdr = header(ctl.frame_id, at_ms)
         if ctl.kind == "LightSensor":
             return {"header": hdr, "illuminance": float(dev.value), "variance": 0.0}
+        if ctl.kind == "PositionSensor":
+            return {"header": hdr, "name": [dev.name], "position": np.array([dev.value], dtype="<f8").tobytes(),
+                    "velocity": b"", "effort": b""}
+        if ctl.kind == "LED":
+            r, g, b = dev.rgb()
+            return {"r": r, "g": g, "b": b, "a": 1.0 if dev.value else 0.0}
         if ctl.kind == "DistanceSensor":
             code = int(dev.type_code)
             return {"header": hdr,

@@ -26,7 +26,7 @@ from typing import Any
 import msgpack
 import numpy as np
 
-from sensorium.server.recording.mcapfile import Recording
+from sensorium.server.recording.reader import Recording
 
 DISTROS = ("humble", "jazzy")
 POINT_CLOUD = "sensor_msgs/msg/PointCloud"

@@ -35,7 +35,8 @@ from sensorium.schemas.wire import (
     parse_request,
     stamp,
 )
-from sensorium.server.recording.mcapfile import RecordedMessage, Recording, pack_envelope, topic_matcher
+from sensorium.server.recording.envelope import pack_envelope, topic_matcher
+from sensorium.server.recording.reader import RecordedMessage, Recording
 
 CLOCK_TOPIC = "/clock"
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"

@@ -68,7 +68,7 @@ def _check_period(period_ms: object) -> int:
 class Device:
     """Common state: name, owner robot, local pose, schedule, random stream (created on first use)."""
 
-    config: wm.LightSensor | wm.DistanceSensor | wm.Lidar
+    config: wm.LightSensor | wm.DistanceSensor | wm.Lidar | wm.PositionSensor | wm.LED
     robot_index: int
     robot_name: str
     self_collision: bool
@@ -270,4 +270,66 @@ def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     return out
 
 
-DEVICE_CLASSES = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar}
+class PositionSensor(Device):
+    """A wheel encoder: the angle (rad) of the differential-drive wheel turned by ``config.motor``.
+
+    Webots' timing (the first value one sampling period after ``enable``, NaN before), then
+    Gaussian ``noise`` (rad) and ``resolution`` as Webots applies them. The simulation binds
+    :attr:`wheel` to the drive's :class:`~sensorium.server.sim.motion.WheelMotor`.
+    """
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.value = math.nan
+        self.wheel: object | None = None          # the WheelMotor whose ``position`` is read
+
+    def measure(self, now_ms: int) -> None:
+        v = float(self.wheel.position) if self.wheel is not None else 0.0  # type: ignore[attr-defined]
+        noise = float(self.config.noise)
+        if noise > 0.0:
+            v += float(self.rng.normal(0.0, noise))
+        res = float(self.config.resolution)
+        if res > 0.0:
+            v = round(v / res) * res
+        self.value = v
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"value": self.value}
+
+
+class LED(Device):
+    """Webots LED: ``value`` 0 (off) or a colour index 1..n; a gradual LED holds 0xRRGGBB. It emits
+    no light that sensors see. Each ``set`` counts as a new measurement (its topic publishes it)."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.value = 0
+
+    def set(self, value: int, now_ms: int) -> None:
+        c = self.config
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise ValueError(f"LED value must be an integer, got {value!r}")
+        hi = 0xFFFFFF if c.gradual else len(c.color)
+        if not 0 <= value <= hi:
+            what = "a 0xRRGGBB colour" if c.gradual else f"0 (off) or a colour index 1..{len(c.color)}"
+            raise ValueError(f"LED {self.name!r}: value {value} is not {what}")
+        self.value = int(value)
+        self._mark(now_ms)
+
+    def rgb(self) -> tuple[float, float, float]:
+        """The colour shown (0, 0, 0 when off)."""
+        v, c = self.value, self.config
+        if v == 0:
+            return (0.0, 0.0, 0.0)
+        if c.gradual:
+            return (((v >> 16) & 255) / 255.0, ((v >> 8) & 255) / 255.0, (v & 255) / 255.0)
+        return tuple(float(x) for x in c.color[v - 1])  # type: ignore[return-value]
+
+    def readings(self) -> dict:
+        return {"value": self.value}
+
+
+DEVICE_CLASSES = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar,
+                  "PositionSensor": PositionSensor, "LED": LED}
+RAY_DEVICES = (LightSensor, DistanceSensor, Lidar)

@@ -23,12 +23,22 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, LightBatch
+from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
-from sensorium.server.sim.sensors import DEVICE_CLASSES, Device, DistanceSensor, Lidar, LightSensor, RayRequest
+from sensorium.server.sim.scene import Scene, primitive_from_model
+from sensorium.server.sim.sensors import (
+    DEVICE_CLASSES,
+    LED,
+    Device,
+    DistanceSensor,
+    Lidar,
+    LightSensor,
+    PositionSensor,
+    RayRequest,
+)
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
-from sensorium.server.world.scene import Scene
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:
@@ -69,15 +79,30 @@ class RobotState:
         self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index])
                       if model.differential_drive is not None else None)
         self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
+        self.encoders: list[PositionSensor] = []
+        for dev in self.devices.values():
+            if isinstance(dev, PositionSensor):
+                dev.wheel = self.motors.get(dev.config.motor)
+                self.encoders.append(dev)
+        self.custom_data = model.custom_data
+        self.supervisor = model.supervisor
 
     @property
     def pose(self) -> Pose:
         return self._sim.scene.robot_poses[self.index]
 
-    def set_pose(self, translation, rotation=None, quaternion=None) -> None:
-        """Move the robot (supervisor-style, kinematically); the next measurement sees it there."""
-        pose = pose_from_values(translation, rotation, quaternion)
-        self._sim.scene.set_robot_pose(self.index, pose)
+    def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
+        """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
+        setters); the next measurement sees it there. Translation and rotation are independent
+        (Webots): leave one out (``None``) and it keeps its current value."""
+        current = self.pose
+        if translation is None:
+            translation = current.translation
+        if rotation is None and quaternion is None:
+            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
+        else:
+            pose = pose_from_values(translation, rotation, quaternion)
+        self._sim.place_robot(self.index, pose)
         if self.drive is not None:
             self.drive.reset(pose)
 
@@ -102,7 +127,8 @@ class StepReport:
 
 class Simulation:
     def __init__(self, world: LoadedWorld | wm.World, precision: Precision | str = Precision.EXACT,
-                 base_dir: Path | None = None):
+                 base_dir: Path | None = None, contact: bool | None = None):
+        """``contact``: kinematic contact on/off (default: the world's ``world_info.contact``)."""
         if isinstance(world, wm.World):
             problems = check_world(world, base_dir or Path.cwd())
             if problems:
@@ -122,6 +148,47 @@ class Simulation:
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._counters: Counter[str] = Counter()
+        use_contact = self.world.world_info.contact if contact is None else bool(contact)
+        self.contact: Contact | None = self._build_contact() if use_contact and self._driven else None
+        self._initial = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
+                         "solids": dict(self.scene.solid_poses)}
+
+    def _build_contact(self) -> Contact:
+        base = self.loaded.base_dir
+        solids = [(s.name, primitive_from_model(s.geometry, base), self.scene.solid_poses[s.name],
+                   s.seen_by in ("both", "bounding")) for s in self.world.solids]
+        robots = [(primitive_from_model(r.body.geometry, base)
+                   if r.body is not None and r.body.seen_by in ("both", "bounding") else None,
+                   self.scene.robot_poses[i]) for i, r in enumerate(self.world.robots)]
+        return Contact(solids, robots)
+
+    def place_robot(self, index: int, pose: Pose) -> None:
+        """Put a robot somewhere from outside (no contact check)."""
+        self.scene.set_robot_pose(index, pose)
+        if self.contact is not None:
+            self.contact.place(index, pose)
+
+    def reset(self) -> None:
+        """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, wheel
+        motors to their initial commands and angles, LEDs off, custom data as in the world file.
+        The clock keeps running (the lockstep's time never goes back) and devices keep their
+        sampling periods and last values."""
+        for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):
+            robot.custom_data = data
+            if robot.drive is not None:
+                for m in robot.drive.motors.values():
+                    m.target_position, m.velocity, m.position = 0.0, m.max_velocity, 0.0
+            self.place_robot(robot.index, pose)
+            if robot.drive is not None:
+                robot.drive.reset(pose)
+            for dev in robot.devices.values():
+                if isinstance(dev, LED) and dev.value != 0:
+                    dev.set(0, self.time_ms)
+        for name, pose in self._initial["solids"].items():
+            self.scene.set_solid_pose(name, pose)
+            if self.contact is not None:
+                self.contact.update_solid(name, pose)
+        self._counters["resets"] += 1
 
     @classmethod
     def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT) -> Simulation:
@@ -150,10 +217,18 @@ class Simulation:
             yield from robot.devices.values()
 
     def set_solid_pose(self, name: str, translation, rotation=None, quaternion=None) -> None:
-        try:
-            self.scene.set_solid_pose(name, pose_from_values(translation, rotation, quaternion))
-        except KeyError:
-            raise KeyError(f"no solid {name!r}") from None
+        if name not in self.scene.solid_poses:
+            raise KeyError(f"no solid {name!r}")
+        current = self.scene.solid_poses[name]
+        if translation is None:
+            translation = current.translation
+        if rotation is None and quaternion is None:
+            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
+        else:
+            pose = pose_from_values(translation, rotation, quaternion)
+        self.scene.set_solid_pose(name, pose)
+        if self.contact is not None:
+            self.contact.update_solid(name, pose)
 
     @property
     def counters(self) -> dict[str, int]:
@@ -165,6 +240,8 @@ class Simulation:
         out["engine_rays"] = eng["rays_cast"]
         for key in ("rays_light", "rays_distance", "rays_lidar", "cast_calls", "points_built", "measurements"):
             out.setdefault(key, 0)
+        out["contacts"] = self.contact.contacts if self.contact is not None else 0
+        out["contact_checks"] = self.contact.checks if self.contact is not None else 0
         return out
 
     # ------------------------------------------------------------------ stepping
@@ -174,21 +251,35 @@ class Simulation:
         self.step_count += 1
         now = self.time_ms
         dt = self.basic_time_step
+        contact = self.contact
         for robot in self._driven:
-            pose = robot.drive.step(dt)
+            drive = robot.drive
+            start = (drive.x, drive.y)
+            pose = drive.step(dt)
             if pose is not None:
+                if contact is not None:
+                    end, clipped = contact.resolve(robot.index, np.array(start), np.array([drive.x, drive.y]))
+                    if clipped:
+                        drive.x, drive.y = float(end[0]), float(end[1])
+                        pose = drive.pose()
                 self.scene.set_robot_pose(robot.index, pose)
         poses = self.scene.robot_poses
         lights: list[LightSensor] = []
         distances: list[DistanceSensor] = []
         lidars: list[Lidar] = []
+        encoders = 0
         for robot in self.robots.values():
             for dev in robot.devices.values():
                 if isinstance(dev, Lidar):
                     if dev.due(now):
                         lidars.append(dev)
-                elif dev.schedule.due(now):
-                    (lights if isinstance(dev, LightSensor) else distances).append(dev)
+                elif isinstance(dev, (LightSensor, DistanceSensor)):
+                    if dev.schedule.due(now):
+                        (lights if isinstance(dev, LightSensor) else distances).append(dev)
+                elif isinstance(dev, PositionSensor) and dev.schedule.due(now):
+                    dev.measure(now)
+                    dev.schedule.last_update_ms = now
+                    encoders += 1
         work: list[tuple[object, list[RayRequest]]] = []
         if lights:
             batch = LightBatch(lights, poses, self.lights)
@@ -210,7 +301,7 @@ class Simulation:
         for dev in (*lights, *distances, *(x for x in lidars if not x.rotating)):
             dev.schedule.last_update_ms = now
         measured = [*lights, *distances, *lidars]
-        self._counters["measurements"] += len(measured)
+        self._counters["measurements"] += len(measured) + encoders
         return StepReport(now, measured)
 
     def run(self, steps: int) -> None:

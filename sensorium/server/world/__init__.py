@@ -1,5 +1,6 @@
-"""World files → validated model → scene: loading, geometry (poses, shapes), meshes.
+"""World files → validated model: loading, geometry (poses, shapes, tessellation), meshes.
 
-Owns everything about *what the world is* before anything moves. Imports only
-:mod:`sensorium.schemas` (and numpy/trimesh); every other server stage builds on it.
+Owns everything about *what the world is* before anything moves or is cast against. Imports only
+:mod:`sensorium.schemas` (and numpy/trimesh/yaml); every other server stage builds on it. The scene
+built from a validated world (ray-engine bodies, shape metadata) is :mod:`sensorium.server.sim.scene`.
 """

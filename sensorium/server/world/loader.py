@@ -104,7 +104,7 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
 
 
 _TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "mesh", "PointLight", "SpotLight",
-         "DirectionalLight", "LightSensor", "DistanceSensor", "Lidar"}
+         "DirectionalLight", "LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED"}
 
 
 def format_path(loc: tuple[Any, ...]) -> str:
@@ -186,6 +186,13 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
                             f"{dp}.lookup_table[{k}]",
                             f"lookup table inputs must be strictly increasing: input {table[k][0]} "
                             f"follows {table[k - 1][0]}"))
+            if isinstance(dev, wm.PositionSensor):
+                drive = robot.differential_drive
+                motors = (drive.left_motor, drive.right_motor) if drive is not None else ()
+                if dev.motor not in motors:
+                    problems.append(Problem(
+                        f"{dp}.motor", f"{dev.motor!r} is not a wheel motor of this robot's differential_drive "
+                                       f"(motors: {', '.join(repr(m) for m in motors) or 'none: no differential_drive'})"))
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
     return problems

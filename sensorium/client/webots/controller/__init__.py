@@ -7,10 +7,14 @@ from sensorium.client.connection import SensoriumError
 
 from .device import Device, Sensor
 from .distance_sensor import DistanceSensor
+from .keyboard import Keyboard
+from .led import LED
 from .lidar import Lidar, LidarPoint
 from .light_sensor import LightSensor
 from .motor import Motor, RotationalMotor
+from .position_sensor import PositionSensor
 from .robot import Robot
+from .supervisor import Field, Node, Supervisor
 
-__all__ = ["Device", "DistanceSensor", "Lidar", "LidarPoint", "LightSensor", "Motor", "Robot", "RotationalMotor",
-           "Sensor", "SensoriumError"]
+__all__ = ["LED", "Device", "DistanceSensor", "Field", "Keyboard", "Lidar", "LidarPoint", "LightSensor", "Motor",
+           "Node", "PositionSensor", "Robot", "RotationalMotor", "Sensor", "SensoriumError", "Supervisor"]

@@ -25,6 +25,11 @@ class LidarPoint:
     def from_bytes(cls, data: bytes, index: int = 0) -> LidarPoint:
         return cls(*struct.unpack_from(arrays.POINT_FORMAT, data, index * arrays.POINT_SIZE))
 
+    @property
+    def layer(self) -> int:
+        """Webots' Python spelling of ``layer_id``."""
+        return self.layer_id
+
     def __repr__(self) -> str:
         return f"LidarPoint(x={self.x}, y={self.y}, z={self.z}, layer_id={self.layer_id}, time={self.time})"
 

@@ -41,9 +41,11 @@ class Motor(Device):
     def getType(self) -> int:
         return wb.wb_motor_get_type(self._tag)
 
-    def getPositionSensor(self) -> None:
-        """Webots returns the motor's PositionSensor, or ``None`` when it has none (always here)."""
-        return None
+    def getPositionSensor(self):
+        """The PositionSensor on the wheel's joint, ``None`` when it has none."""
+        from .robot import Robot
+
+        return Robot.device_by_tag(wb.wb_motor_get_position_sensor(self._tag))
 
     def getBrake(self) -> None:
         return None

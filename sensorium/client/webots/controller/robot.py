@@ -8,28 +8,51 @@ from sensorium.client import wb
 
 from .device import Device
 from .distance_sensor import DistanceSensor
+from .keyboard import Keyboard
+from .led import LED
 from .lidar import Lidar
 from .light_sensor import LightSensor
 from .motor import RotationalMotor
+from .position_sensor import PositionSensor
 
 _CLASSES: dict[str, type[Device]] = {
     wb.LIGHT_SENSOR: LightSensor,
     wb.DISTANCE_SENSOR: DistanceSensor,
     wb.LIDAR: Lidar,
     wb.ROTATIONAL_MOTOR: RotationalMotor,
+    wb.POSITION_SENSOR: PositionSensor,
+    wb.LED: LED,
 }
 
 
 class Robot:
-    """Attaches to the robot named by ``SENSORIUM_CONTROLLER_URL`` (or ``WEBOTS_CONTROLLER_URL``)."""
+    """Attaches to the robot named by ``SENSORIUM_CONTROLLER_URL`` (or ``WEBOTS_CONTROLLER_URL``).
+
+    As in Webots, a second ``Robot()`` (or ``Supervisor()``) in the same process prints an error;
+    here it then shares the first one's state, so it keeps working."""
 
     created: Robot | None = None
 
+    EVENT_QUIT = wb.WB_EVENT_QUIT
+    EVENT_NO_EVENT = wb.WB_EVENT_NO_EVENT
+    EVENT_MOUSE_CLICK = wb.WB_EVENT_MOUSE_CLICK
+    EVENT_MOUSE_MOVE = wb.WB_EVENT_MOUSE_MOVE
+    EVENT_KEYBOARD = wb.WB_EVENT_KEYBOARD
+    EVENT_JOYSTICK_BUTTON = wb.WB_EVENT_JOYSTICK_BUTTON
+    EVENT_JOYSTICK_AXIS = wb.WB_EVENT_JOYSTICK_AXIS
+    EVENT_JOYSTICK_POV = wb.WB_EVENT_JOYSTICK_POV
+    MODE_SIMULATION = wb.WB_MODE_SIMULATION
+    MODE_CROSS_COMPILATION = wb.WB_MODE_CROSS_COMPILATION
+    MODE_REMOTE_CONTROL = wb.WB_MODE_REMOTE_CONTROL
+
     def __init__(self) -> None:
         if Robot.created is not None:
-            raise RuntimeError("only one Robot instance can be created per controller process")
+            print("Error: only one Robot instance can be created per controller process.", file=sys.stderr)
+            self.__dict__ = Robot.created.__dict__
+            return
         wb.wb_robot_init()
         Robot.created = self
+        self.keyboard = Keyboard()
         self.devices: dict[str, Device] = {}
         for i in range(wb.wb_robot_get_number_of_devices()):
             tag = wb.wb_robot_get_device_by_index(i)
@@ -82,7 +105,40 @@ class Robot:
     def getMotor(self, name: str) -> Device | None:
         return self._deprecated("getMotor", name)
 
+    @classmethod
+    def device_by_tag(cls, tag: int) -> Device | None:
+        robot = cls.created
+        if robot is None or not tag:
+            return None
+        return robot.devices.get(wb.wb_device_get_name(tag))
+
+    def getKeyboard(self) -> Keyboard:
+        return self.keyboard
+
     # -- robot information
+    def getCustomData(self) -> str:
+        return wb.wb_robot_get_custom_data()
+
+    def setCustomData(self, data: str) -> None:
+        wb.wb_robot_set_custom_data(data)
+
+    def getModel(self) -> str:
+        return wb.wb_robot_get_model()
+
+    def getSupervisor(self) -> bool:
+        return wb.wb_robot_get_supervisor()
+
+    def getMode(self) -> int:
+        return wb.wb_robot_get_mode()
+
+    def getType(self) -> str:
+        return wb.wb_robot_get_type()
+
+    def waitForUserInputEvent(self, event_type: int, timeout: int) -> int:
+        """No user input ever arrives headless: steps ``timeout`` ms and answers EVENT_NO_EVENT
+        (EVENT_QUIT when the simulation ends)."""
+        return self.EVENT_QUIT if self.step(max(int(timeout), 0)) == -1 else self.EVENT_NO_EVENT
+
     def getTime(self) -> float:
         return wb.wb_robot_get_time()
 
@@ -100,3 +156,7 @@ class Robot:
     name = property(getName)
     number_of_devices = property(getNumberOfDevices)
     synchronization = property(getSynchronization)
+    custom_data = property(getCustomData, setCustomData)
+    model = property(getModel)
+    supervisor = property(getSupervisor)
+    mode = property(getMode)

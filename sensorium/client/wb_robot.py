@@ -1,0 +1,565 @@
+"""The robot side of Webots' C API on Sensorium: the session (:class:`RobotClient`), the
+process-wide robot of the flat ``wb_robot_*`` functions, and ``wb_device_*``.
+
+:mod:`sensorium.client.wb` re-exports this module and the device families (``wb_sensors``,
+``wb_motor``, ``wb_supervisor``); see it for the overview."""
+
+from __future__ import annotations
+
+import atexit
+import math
+import sys
+from typing import Any
+
+from sensorium.client import arrays
+from sensorium.client.connection import (
+    DEFAULT_TIMEOUT,
+    Connection,
+    ConnectionLost,
+    ControllerURL,
+    ErrorCode,
+    SensoriumError,
+    controller_url_from_env,
+    parse_controller_url,
+)
+
+WB_DISTANCE_SENSOR_GENERIC = 0
+WB_DISTANCE_SENSOR_INFRA_RED = 1
+WB_DISTANCE_SENSOR_SONAR = 2
+WB_DISTANCE_SENSOR_LASER = 3
+_DISTANCE_TYPES = {"generic": 0, "infra-red": 1, "infra_red": 1, "sonar": 2, "laser": 3}
+
+WB_ROTATIONAL = 0
+WB_LINEAR = 1
+
+LIGHT_SENSOR = "LightSensor"
+DISTANCE_SENSOR = "DistanceSensor"
+LIDAR = "Lidar"
+ROTATIONAL_MOTOR = "RotationalMotor"
+POSITION_SENSOR = "PositionSensor"
+LED = "LED"
+
+# wb_robot_get_mode()
+WB_MODE_SIMULATION = 0
+WB_MODE_CROSS_COMPILATION = 1
+WB_MODE_REMOTE_CONTROL = 2
+
+# wb_robot_wait_for_user_input_event()
+WB_EVENT_QUIT = -1
+WB_EVENT_NO_EVENT = 0
+WB_EVENT_MOUSE_CLICK = 1
+WB_EVENT_MOUSE_MOVE = 2
+WB_EVENT_KEYBOARD = 4
+WB_EVENT_JOYSTICK_BUTTON = 8
+WB_EVENT_JOYSTICK_AXIS = 16
+WB_EVENT_JOYSTICK_POV = 32
+
+# webots/keyboard.h
+WB_KEYBOARD_END = 312
+WB_KEYBOARD_HOME = 313
+WB_KEYBOARD_LEFT = 314
+WB_KEYBOARD_UP = 315
+WB_KEYBOARD_RIGHT = 316
+WB_KEYBOARD_DOWN = 317
+WB_KEYBOARD_PAGEUP = 366
+WB_KEYBOARD_PAGEDOWN = 367
+WB_KEYBOARD_NUMPAD_HOME = 375
+WB_KEYBOARD_NUMPAD_LEFT = 376
+WB_KEYBOARD_NUMPAD_UP = 377
+WB_KEYBOARD_NUMPAD_RIGHT = 378
+WB_KEYBOARD_NUMPAD_DOWN = 379
+WB_KEYBOARD_NUMPAD_END = 382
+WB_KEYBOARD_KEY = 0xFFFF
+WB_KEYBOARD_SHIFT = 0x10000
+WB_KEYBOARD_CONTROL = 0x20000
+WB_KEYBOARD_ALT = 0x40000
+
+# Constant getters: local name -> (keys tried in the attach description, fallback service, its field).
+_CONSTANTS: dict[str, tuple[tuple[str, ...], str, str]] = {
+    "lookup_table": (("lookup_table", "lookupTable"), "get_lookup_table", "value"),
+    "min_value": (("min_value", "minValue"), "get_min_value", "value"),
+    "max_value": (("max_value", "maxValue"), "get_max_value", "value"),
+    "aperture": (("aperture",), "get_aperture", "value"),
+    "distance_type": (("distance_type", "sensor_type", "type_code", "typeCode"), "get_type", "value"),
+    "horizontal_resolution": (("horizontal_resolution", "horizontalResolution"), "get_info", "horizontalResolution"),
+    "number_of_layers": (("number_of_layers", "numberOfLayers"), "get_info", "numberOfLayers"),
+    "fov": (("fov", "field_of_view", "fieldOfView"), "get_info", "fov"),
+    "vertical_fov": (("vertical_fov", "verticalFov", "vertical_field_of_view", "verticalFieldOfView"), "get_info", "verticalFov"),
+    "min_range": (("min_range", "minRange"), "get_info", "minRange"),
+    "max_range": (("max_range", "maxRange"), "get_info", "maxRange"),
+    "frequency": (("frequency", "default_frequency", "defaultFrequency"), "get_frequency_info", "frequency"),
+    "min_frequency": (("min_frequency", "minFrequency"), "get_frequency_info", "minFrequency"),
+    "max_frequency": (("max_frequency", "maxFrequency"), "get_frequency_info", "maxFrequency"),
+}
+
+
+def _flat_table(table: Any) -> list[float]:
+    out: list[float] = []
+    for row in table or ():
+        if isinstance(row, (list, tuple)):
+            out.extend(float(v) for v in row)
+        else:
+            out.append(float(row))
+    return out
+
+
+def _float(v: Any, default: float) -> float:
+    return default if v is None else float(v)
+
+
+class DeviceState:
+    """What the client knows about one device: its description, enable state and latest reading."""
+
+    __slots__ = ("tag", "index", "name", "kind", "desc", "sampling_period", "value", "range_bytes",
+                 "cloud_bytes", "point_cloud_enabled", "max_velocity", "target_position", "velocity",
+                 "_consts", "_range", "_cloud", "_warned")
+
+    def __init__(self, index: int, desc: dict):
+        self.index = index
+        self.tag = index + 1                     # 0 is "no device", as in Webots
+        self.name = str(desc.get("name", f"device{index}"))
+        self.kind = str(desc.get("type", ""))
+        self.desc = desc
+        self.sampling_period = int(desc.get("sampling_period", desc.get("samplingPeriod", 0)) or 0)
+        self.value = math.nan
+        self.range_bytes: bytes | None = None
+        self.cloud_bytes: bytes | None = None
+        self.point_cloud_enabled = bool(desc.get("point_cloud_enabled", desc.get("pointCloudEnabled", False)))
+        # motors: the commands as last set (the server's at attach, then this controller's)
+        self.max_velocity = _float(desc.get("maxVelocity", desc.get("max_velocity")), 10.0)   # Webots' default
+        self.target_position = _float(desc.get("targetPosition", desc.get("target_position")), 0.0)
+        self.velocity = _float(desc.get("velocity"), self.max_velocity)       # libController starts at maxVelocity
+        self._consts: dict[str, Any] = {}
+        self._range: Any = None                  # decoded forms, rebuilt when new bytes arrive
+        self._cloud: Any = None
+        self._warned = False
+
+    def __repr__(self) -> str:
+        return f"<{self.kind} {self.name!r} tag={self.tag} period={self.sampling_period}>"
+
+
+class RobotClient:
+    """A controller's session: attach to one robot, step it, cache its readings.
+
+    ``url`` is a controller URL (see :func:`~sensorium.client.connection.parse_controller_url`)
+    or ``None`` for the environment's; ``robot`` overrides the URL's robot name. ``timeout`` is
+    the wait for ordinary replies; steps wait as long as the lockstep needs, but give up with
+    status -1 when the heartbeat finds the server gone."""
+
+    def __init__(self, url: str | ControllerURL | None = None, *, robot: str | None = None,
+                 timeout: float | None = DEFAULT_TIMEOUT, heartbeat_ms: int | None = None,
+                 lost_after_s: float | None = None, context: Any = None):
+        if isinstance(url, ControllerURL):
+            target = url
+        elif url is None:
+            target = controller_url_from_env()
+        else:
+            target = parse_controller_url(url)
+        if robot is not None:
+            target = target.with_robot(robot)
+        self.url = target
+        self.conn = Connection(target.endpoint, timeout=timeout, context=context)
+        self.pending: int | None = None
+        self.terminated = False
+        self.closed = False
+        try:
+            name = target.robot if target.robot is not None else self._only_robot()
+            reply = self.conn.call("attach", {"robot": name})
+        except BaseException:
+            self.conn.close()
+            raise
+        self.name = str(reply.get("robot", name))
+        self.session = str(reply["session"])
+        self.basic_time_step = int(reply["basic_time_step"])
+        self.time_ms = int(reply.get("time_ms", 0))
+        self.synchronization = bool(reply.get("synchronization", True))
+        self.heartbeat_ms = int(heartbeat_ms or reply.get("heartbeat_ms") or 1000)
+        self.supervisor = bool(reply.get("supervisor", False))
+        self.model = str(reply.get("model", ""))
+        self.custom_data = str(reply.get("custom_data", ""))
+        self.keyboard_period = 0
+        self._warned_duration = False
+        self.devices = [DeviceState(i, d) for i, d in enumerate(reply.get("devices", []))]
+        self.by_name = {d.name: d for d in self.devices}
+        self.motor_commands: dict[str, dict[str, float]] = {}   # sent with the next step request
+        self._prefix = f"/{self.name}/"
+        self.conn.start_heartbeat(self.session, self.heartbeat_ms, lost_after_s)
+
+    def _only_robot(self) -> str:
+        robots = [r.get("name") for r in self.conn.call("get_info").get("robots", [])]
+        if len(robots) == 1:
+            return str(robots[0])
+        raise SensoriumError(ErrorCode.BAD_URL,
+                             f"the controller URL names no robot and the world at {self.conn.endpoint} has "
+                             f"{len(robots)} ({', '.join(map(str, robots))}): add '/ROBOT' to the URL")
+
+    # ------------------------------------------------------------------ stepping
+    def step_begin(self, duration: int | None = None) -> int:
+        if self.pending is not None:
+            raise SensoriumError(ErrorCode.WRONG_STATE, "a step is already pending: call wb_robot_step_end() first")
+        if self.terminated:
+            return -1
+        if duration is None:
+            duration = self.basic_time_step
+        if isinstance(duration, bool) or not isinstance(duration, int):
+            if isinstance(duration, float) and duration.is_integer():
+                duration = int(duration)
+            else:
+                raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be an integer (ms), got {duration!r}")
+        if duration < 0:
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be >= 0 ms, got {duration}")
+        if duration % self.basic_time_step and not self._warned_duration:
+            # Webots warns once and wakes the controller at the first basic step that ends after it
+            self._warned_duration = True
+            print(f"Warning: the step duration {duration} ms of robot {self.name!r} is not a multiple of the basic "
+                  f"time step ({self.basic_time_step} ms); the server rounds it up.", file=sys.stderr)
+        args: dict[str, Any] = {"duration": duration}
+        if self.motor_commands:
+            args["motors"], self.motor_commands = self.motor_commands, {}
+        self.pending = self.conn.send(self._prefix + "robot/step", args)
+        return 0
+
+    def step_end(self) -> int:
+        if self.pending is None:
+            if self.terminated:
+                return -1
+            raise SensoriumError(ErrorCode.WRONG_STATE, "no step pending: call wb_robot_step_begin() first")
+        rid, self.pending = self.pending, None
+        try:
+            result = self.conn.wait(rid, timeout=None)
+        except ConnectionLost as exc:
+            print(f"sensorium: {exc}; ending the controller's steps", file=sys.stderr)
+            self.terminated = True
+            return -1
+        except SensoriumError as exc:
+            if exc.code == ErrorCode.SHUTTING_DOWN:
+                self.terminated = True
+                return -1
+            raise
+        status = int(result.get("status", 0))
+        self.time_ms = int(result.get("time_ms", self.time_ms))
+        values = result.get("values")
+        if values:
+            self._apply(values)
+        if status == -1:
+            self.terminated = True
+        return status
+
+    def step(self, duration: int | None = None) -> int:
+        if self.step_begin(duration) == -1:
+            return -1
+        return self.step_end()
+
+    def _apply(self, values: dict) -> None:
+        for name, reading in values.items():
+            dev = self.by_name.get(name)
+            if dev is None or not isinstance(reading, dict):
+                continue
+            if "value" in reading:
+                v = reading["value"]
+                dev.value = math.nan if v is None else float(v)
+            if "range_image" in reading:
+                dev.range_bytes = bytes(reading["range_image"])
+                dev._range = None
+            if "point_cloud" in reading:
+                dev.cloud_bytes = bytes(reading["point_cloud"])
+                dev._cloud = None
+
+    # ------------------------------------------------------------------ devices
+    def device(self, tag: int, kind: str | None, func: str) -> DeviceState:
+        if isinstance(tag, int) and not isinstance(tag, bool) and 1 <= tag <= len(self.devices):
+            dev = self.devices[tag - 1]
+            if kind is None or dev.kind == kind:
+                return dev
+            raise SensoriumError(ErrorCode.UNKNOWN_DEVICE, f"{func}(): device tag {tag} is {dev.name!r}, a {dev.kind}, not a {kind}")
+        raise SensoriumError(ErrorCode.UNKNOWN_DEVICE, f"{func}(): invalid device tag {tag!r}")
+
+    def tag_of(self, name: str) -> int:
+        dev = self.by_name.get(name)
+        return 0 if dev is None else dev.tag
+
+    def rpc(self, dev: DeviceState, item: str, args: dict | None = None) -> dict:
+        return self.conn.call(f"{self._prefix}{dev.name}/{item}", args)
+
+    def constant(self, dev: DeviceState, key: str) -> Any:
+        if key in dev._consts:
+            return dev._consts[key]
+        keys, service, field = _CONSTANTS[key]
+        for k in keys:
+            if k in dev.desc:
+                value = dev.desc[k]
+                break
+        else:
+            value = self.rpc(dev, service).get(field)
+        if key == "lookup_table":
+            value = _flat_table(value)
+        elif key == "distance_type" and isinstance(value, str):
+            value = _DISTANCE_TYPES.get(value.lower(), WB_DISTANCE_SENSOR_GENERIC)
+        elif key in ("distance_type", "horizontal_resolution", "number_of_layers"):
+            value = int(value)
+        else:
+            value = float(value)
+        dev._consts[key] = value
+        return value
+
+    def enable(self, dev: DeviceState, period: int, func: str) -> None:
+        if isinstance(period, bool) or not isinstance(period, int):
+            if isinstance(period, float) and period.is_integer():
+                period = int(period)
+            else:
+                raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer (ms), got {period!r}")
+        if period < 0:
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): negative sampling period {period}")
+        if not self.terminated:
+            self._expect_success(self.rpc(dev, "enable", {"value": period}), func)
+        dev.sampling_period = period
+        dev._warned = False
+
+    def enable_point_cloud(self, dev: DeviceState, on: bool, func: str) -> None:
+        if not self.terminated:
+            self._expect_success(self.rpc(dev, "enable_point_cloud", {"value": bool(on)}), func)
+        dev.point_cloud_enabled = bool(on)
+        dev._warned = False
+
+    def set_frequency(self, dev: DeviceState, frequency: float, func: str) -> None:
+        lo, hi = self.constant(dev, "min_frequency"), self.constant(dev, "max_frequency")
+        if not (isinstance(frequency, (int, float)) and lo <= frequency <= hi):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): frequency {frequency!r} outside [{lo:g}, {hi:g}] Hz")
+        if not self.terminated:
+            self._expect_success(self.rpc(dev, "set_frequency", {"value": float(frequency)}), func)
+        dev._consts["frequency"] = float(frequency)
+
+    # -- motors: buffered, sent with the next step request
+    @staticmethod
+    def _number(value: Any, what: str, func: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): '{what}' must be a number, got {value!r}")
+        value = float(value)
+        if math.isnan(value):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}() called with an invalid '{what}' argument (NaN)")
+        return value
+
+    def set_motor_position(self, dev: DeviceState, position: float, func: str) -> None:
+        """Webots' ``setPosition``: a target (rad), or ±inf for velocity control."""
+        position = self._number(position, "position", func)
+        dev.target_position = position
+        self.motor_commands.setdefault(dev.name, {})["position"] = position
+
+    def set_motor_velocity(self, dev: DeviceState, velocity: float, func: str) -> None:
+        """Webots' ``setVelocity``: clamped to ``maxVelocity`` with Webots' warning; NaN, and a
+        negative velocity in position control, are printed and ignored (Webots)."""
+        if isinstance(velocity, bool) or not isinstance(velocity, (int, float)):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'velocity' must be a number, got {velocity!r}")
+        velocity = float(velocity)
+        if math.isnan(velocity):
+            print(f"Error: {func}() called with an invalid 'velocity' argument (NaN).", file=sys.stderr)
+            return
+        if velocity < 0.0 and not math.isinf(dev.target_position):
+            print(f"Error: {func}() called with negative 'velocity' argument in position control mode "
+                  f"({velocity:g}).", file=sys.stderr)
+            return
+        limit = dev.max_velocity
+        if abs(velocity) > limit:
+            print(f"WARNING: {dev.kind} \"{dev.name}\": The requested velocity {velocity:g} exceeds "
+                  f"'maxVelocity' = {limit:g}.", file=sys.stderr)
+            velocity = math.copysign(limit, velocity)
+        dev.velocity = velocity
+        self.motor_commands.setdefault(dev.name, {})["velocity"] = velocity
+
+    @staticmethod
+    def _expect_success(result: dict, func: str) -> None:
+        if result.get("success", True) is False:
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): refused by the server ({result!r})")
+
+    def warn_disabled(self, dev: DeviceState, func: str, enabler: str, what: str = "a disabled device") -> None:
+        if not dev._warned:
+            dev._warned = True
+            print(f"Error: {func}() called for {what}! Please use: {enabler}().", file=sys.stderr)
+
+    # -- lidar buffers (zeros before the first measurement, as the server's initial image)
+    def range_bytes(self, dev: DeviceState) -> bytes:
+        if dev.range_bytes is None:
+            n = self.constant(dev, "horizontal_resolution") * self.constant(dev, "number_of_layers")
+            return bytes(4 * n)
+        return dev.range_bytes
+
+    def cloud_bytes(self, dev: DeviceState) -> bytes:
+        if dev.cloud_bytes is None:
+            n = self.constant(dev, "horizontal_resolution") * self.constant(dev, "number_of_layers")
+            return bytes(arrays.POINT_SIZE * n)
+        return dev.cloud_bytes
+
+    def range_image(self, dev: DeviceState) -> Any:
+        if dev._range is None:
+            dev._range = arrays.float32s(self.range_bytes(dev))
+        return dev._range
+
+    def point_cloud(self, dev: DeviceState) -> Any:
+        if dev._cloud is None:
+            dev._cloud = arrays.points(self.cloud_bytes(dev))
+        return dev._cloud
+
+    # ------------------------------------------------------------------ lifecycle
+    def close(self) -> None:
+        """Detach (best effort, short wait) and close the sockets. Idempotent."""
+        if self.closed:
+            return
+        self.closed = True
+        self.conn.stop_heartbeat()
+        if self.pending is not None:
+            self.conn.discard(self.pending)
+            self.pending = None
+        try:
+            if not self.conn.closed:
+                self.conn.call("detach", {"session": self.session}, timeout=0.5)
+        except SensoriumError:
+            pass
+        finally:
+            self.conn.close()
+
+    def __enter__(self) -> RobotClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+# ====================================================================== the flat API
+
+_robot: RobotClient | None = None
+_atexit_registered = False
+
+
+def current() -> RobotClient:
+    """The process's robot session (after :func:`wb_robot_init`)."""
+    if _robot is None:
+        raise SensoriumError(ErrorCode.WRONG_STATE, "no robot: call wb_robot_init() first")
+    return _robot
+
+
+def wb_robot_init(url: str | None = None, **options: Any) -> None:
+    """Attach this process to its robot (URL from the environment unless given). Idempotent."""
+    global _robot, _atexit_registered
+    if _robot is not None and not _robot.closed:
+        return
+    _robot = RobotClient(url, **options)
+    if not _atexit_registered:
+        atexit.register(wb_robot_cleanup)
+        _atexit_registered = True
+
+
+def wb_robot_cleanup() -> None:
+    global _robot
+    if _robot is not None:
+        robot, _robot = _robot, None
+        robot.close()
+
+
+def wb_robot_step(duration: int | None = None) -> int:
+    return current().step(duration)
+
+
+def wb_robot_step_begin(duration: int | None = None) -> int:
+    return current().step_begin(duration)
+
+
+def wb_robot_step_end() -> int:
+    return current().step_end()
+
+
+def wb_robot_get_time() -> float:
+    return current().time_ms / 1000.0
+
+
+def wb_robot_get_basic_time_step() -> float:
+    return float(current().basic_time_step)
+
+
+def wb_robot_get_name() -> str:
+    return current().name
+
+
+def wb_robot_get_synchronization() -> bool:
+    return current().synchronization
+
+
+def wb_robot_get_number_of_devices() -> int:
+    return len(current().devices)
+
+
+def wb_robot_get_device(name: str) -> int:
+    """The device's tag, 0 if the robot has no such device."""
+    return current().tag_of(name)
+
+
+def wb_robot_get_device_by_index(index: int) -> int:
+    devices = current().devices
+    return devices[index].tag if 0 <= index < len(devices) else 0
+
+
+def wb_device_get_name(tag: int) -> str:
+    return current().device(tag, None, "wb_device_get_name").name
+
+
+def wb_robot_get_model() -> str:
+    return current().model
+
+
+def wb_robot_get_custom_data() -> str:
+    return current().custom_data
+
+
+def wb_robot_set_custom_data(data: str) -> None:
+    """Stored by the server at once (other clients' ``get_custom_data`` see it)."""
+    if not isinstance(data, str):
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_robot_set_custom_data(): data must be a string, got {data!r}")
+    r = current()
+    if not r.terminated:
+        r.conn.call(f"/{r.name}/robot/set_custom_data", {"value": data})
+    r.custom_data = data
+
+
+def wb_robot_get_supervisor() -> bool:
+    return current().supervisor
+
+
+def wb_robot_get_mode() -> int:
+    """Always ``WB_MODE_SIMULATION`` (no remote control or cross-compilation here)."""
+    current()
+    return WB_MODE_SIMULATION
+
+
+def wb_robot_get_type() -> str:
+    return "Supervisor" if current().supervisor else "Robot"
+
+
+# ---------------------------------------------------------------------- keyboard (no key is ever pressed)
+
+def wb_keyboard_enable(sampling_period: int) -> None:
+    if isinstance(sampling_period, bool) or not isinstance(sampling_period, int) or sampling_period < 0:
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT,
+                             f"wb_keyboard_enable(): sampling period must be an integer >= 0 (ms), got {sampling_period!r}")
+    current().keyboard_period = sampling_period
+
+
+def wb_keyboard_disable() -> None:
+    current().keyboard_period = 0
+
+
+def wb_keyboard_get_sampling_period() -> int:
+    return current().keyboard_period
+
+
+def wb_keyboard_get_key() -> int:
+    """-1: a headless server has no keyboard (Webots' answer when no key is pressed)."""
+    r = current()
+    if r.keyboard_period <= 0:
+        print("Error: wb_keyboard_get_key() called for a disabled device! Please use: wb_keyboard_enable().",
+              file=sys.stderr)
+    return -1
+
+
+def wb_device_get_type_name(tag: int) -> str:
+    """Sensorium extension: the device's node type name ("LightSensor", "DistanceSensor", "Lidar",
+    "RotationalMotor")."""
+    return current().device(tag, None, "wb_device_get_type_name").kind

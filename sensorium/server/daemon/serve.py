@@ -1,0 +1,95 @@
+"""The serve loop as a library: world file → simulation → core → bound transport → run.
+
+``sensorium serve`` (:mod:`sensorium.cli.serve`) is the argparse shell over this module; tests and
+embedding programs can use :func:`build` and :class:`Server` directly. A recorder (``serve
+--record``) is passed in by the caller (:func:`sensorium.server.recording.writer.recorder_for_server`
+builds one): the daemon never imports the recording package.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sensorium.server.daemon.services import Core
+from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import default_world_path
+
+__all__ = ["ServeOptions", "Server", "build"]
+
+
+@dataclass
+class ServeOptions:
+    """What ``sensorium serve`` takes besides the world file (same names as its options)."""
+
+    rpc: str = DEFAULT_RPC
+    pub: str = DEFAULT_PUB
+    mode: str = "fast"                # fast | realtime | pause
+    precision: str = "exact"          # ray engine precision: fast | exact
+    heartbeat_ms: int = 1000          # controllers not heard from for 3 × this are released
+    until: int | None = None          # quit when the simulated time reaches this many ms
+
+    def check(self) -> None:
+        """Raise ValueError naming the first bad option."""
+        if self.heartbeat_ms <= 0:
+            raise ValueError("--heartbeat-ms must be > 0")
+
+
+def build(world: str | Path | None, options: ServeOptions | None = None) -> tuple[Core, Transport]:
+    """World → simulation → core → bound transport. Raises ``WorldError`` on a bad world and
+    ``OSError`` (``zmq.ZMQError``) when an endpoint cannot be bound. ``world=None`` is the
+    embedded arena world."""
+    opts = options or ServeOptions()
+    opts.check()
+    path = Path(world) if world else default_world_path()
+    sim = Simulation.from_file(path, precision=opts.precision)
+    core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode)
+    return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until)
+
+
+class Server:
+    """A built server: ``Server.open(world, options)``, optionally ``attach_recorder(rec)``, then
+    ``run()`` (blocks until SIGINT/SIGTERM or ``stop()`` or ``until``; closes the recorder)."""
+
+    def __init__(self, core: Core, transport: Transport):
+        self.core = core
+        self.transport = transport
+        self.recorder: Any = None
+
+    @classmethod
+    def open(cls, world: str | Path | None, options: ServeOptions | None = None) -> Server:
+        core, transport = build(world, options)
+        return cls(core, transport)
+
+    @property
+    def ready_line(self) -> str:
+        """The line printed when ready, with the endpoints actually bound (scripts wait for it)."""
+        t = self.transport
+        return f"sensorium: serving world '{self.core.world_name}' rpc={t.rpc_endpoint} pub={t.pub_endpoint}"
+
+    def attach_recorder(self, recorder: Any) -> None:
+        """Record from inside the step loop: ``recorder`` gets every published message (see
+        :meth:`sensorium.server.daemon.topics.Topics.set_recorder`); it is closed by :meth:`run`."""
+        self.recorder = recorder
+        self.core.topics.set_recorder(recorder)
+
+    def stop(self) -> None:
+        self.transport.stop()
+
+    def run(self, *, signals: bool = True) -> None:
+        """Serve until stopped. ``signals``: SIGINT/SIGTERM stop the loop (main thread only)."""
+        if signals:
+            self.transport.install_signal_handlers()
+        try:
+            self.transport.run()
+        finally:
+            if self.recorder is not None:
+                self.recorder.close()
+
+    def close(self) -> None:
+        """Release the sockets of a server that was built but not run."""
+        self.transport.close()
+        if self.recorder is not None:
+            self.recorder.close()

@@ -1,0 +1,210 @@
+"""Moving bodies and the broad phase: which (ray, mover) pairs can meet.
+
+A mover is cast against a body-frame tier shared by all movers with the same shapes; per cast,
+the broad phase finds the (ray, mover) pairs whose segment passes within the mover's bounding
+sphere (dense test for few movers or rays, else a uniform grid keyed by segment midpoints).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _take
+from sensorium.server.world.geometry import Pose
+
+
+def _segment_near_sphere(rel_x, rel_y, rel_z, dx, dy, dz, t_lo, t_hi, r2):
+    """Does the segment o + t d, t in [t_lo, t_hi] (unit d), pass within the sphere of squared
+    radius r2 centred at o + rel?  Arguments broadcast.  The squared distance from the centre to
+    the closest segment point is |rel|^2 - tc (2 b - tc) with b = rel.d and tc = b clamped to the
+    segment; the slack covers its rounding (the test only has to be conservative)."""
+    b = rel_x * dx + rel_y * dy + rel_z * dz
+    e2 = rel_x * rel_x + rel_y * rel_y + rel_z * rel_z
+    tc = np.minimum(np.maximum(b, t_lo), t_hi)
+    return e2 - tc * (b + b - tc) <= r2 + 1e-12 * e2
+
+
+def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
+    """(ray, mover) index pairs whose segment [t_near, lim] passes within the mover's bounding
+    sphere (centre C, squared radius r2) and whose owner is not excluded (``owner`` None: no
+    check).  Small tables: one (rays, movers, 3) computation, pairs ordered by ray.  Large batches
+    (a lidar): one mover at a time on contiguous columns, pairs ordered by mover (so the pairs of
+    any one mover are always in ray order)."""
+    n, M = len(O), len(C)
+    if n * M <= _TINY:  # a few rays and movers: plain floats (same test)
+        Cl, Ol, Dl, r2l, hil = C.tolist(), O.tolist(), D.tolist(), r2.tolist(), lim.tolist()
+        lol = t_near.tolist() if isinstance(t_near, np.ndarray) else [t_near] * n
+        exl = excl.tolist() if isinstance(excl, np.ndarray) else [excl] * n
+        own = owner.tolist() if owner is not None else None
+        pr, pm = [], []
+        for i, ((ox, oy, oz), (dx, dy, dz), lo, hi, ex) in enumerate(zip(Ol, Dl, lol, hil, exl)):
+            for j, (cx, cy, cz) in enumerate(Cl):
+                if own is not None and own[j] == ex:
+                    continue
+                rx, ry, rz = cx - ox, cy - oy, cz - oz
+                b = rx * dx + ry * dy + rz * dz
+                e2 = rx * rx + ry * ry + rz * rz
+                tc = min(max(b, lo), hi)
+                if e2 - tc * (b + b - tc) <= r2l[j] + 1e-12 * e2:
+                    pr.append(i)
+                    pm.append(j)
+        return np.array(pr, dtype=np.int64), np.array(pm, dtype=np.int64)
+    if n * M <= _DENSE_PAIRS:
+        tn = t_near[:, None] if isinstance(t_near, np.ndarray) else t_near
+        if n * M <= 256:   # one (rays, movers, 3) table: fewest calls
+            rel = C[None, :, :] - O[:, None, :]
+            b = (rel * D[:, None, :]).sum(axis=2)
+            e2 = (rel * rel).sum(axis=2)
+            tc = np.minimum(np.maximum(b, tn), lim[:, None])
+            sel = e2 - tc * (b + b - tc) <= r2 + 1e-12 * e2
+        else:              # (rays, movers) tables per coordinate: no slow reduction over a length-3 axis
+            sel = _segment_near_sphere(C[:, 0] - O[:, 0:1], C[:, 1] - O[:, 1:2], C[:, 2] - O[:, 2:3],
+                                       D[:, 0:1], D[:, 1:2], D[:, 2:3], tn, lim[:, None], r2)
+        if owner is not None:
+            sel &= owner != (excl[:, None] if isinstance(excl, np.ndarray) else excl)
+        return sel.nonzero()
+    shared = not np.count_nonzero(O != O[0])   # one origin (a lidar): rel = C - o is per mover
+    if not shared:
+        ox, oy, oz, dx, dy, dz = (np.ascontiguousarray(a[:, k]) for a in (O, D) for k in range(3))
+    prs, pms = [], []
+    for j in range(M):
+        if owner is not None and not isinstance(excl, np.ndarray) and owner[j] == excl:
+            continue
+        if shared:
+            rel = C[j] - O[0]
+            b = D @ rel                              # matrix-vector: fast at any size
+            e2 = float(rel @ rel)
+            tc = np.minimum(np.maximum(b, t_near), lim)
+            sel = e2 - tc * (b + b - tc) <= r2[j] + 1e-12 * e2
+        else:
+            sel = _segment_near_sphere(C[j, 0] - ox, C[j, 1] - oy, C[j, 2] - oz, dx, dy, dz, t_near, lim, r2[j])
+        if owner is not None and isinstance(excl, np.ndarray):
+            sel &= excl != owner[j]
+        r = sel.nonzero()[0]
+        prs.append(r)
+        pms.append(np.full(len(r), j, dtype=np.int64))
+    if not prs:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    return np.concatenate(prs), np.concatenate(pms)
+
+
+def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
+    """Same contract as ``_sphere_pairs``, for many movers and many rays.  A segment no longer than
+    ``L_cap`` looks up ONE cell of a uniform grid, the cell of its midpoint; each mover is
+    registered in every cell overlapped by the box of its bounding sphere grown by L_cap / 2.  A
+    segment passing within r of a mover has its midpoint within r + L / 2 of the centre, so the
+    lookup finds every candidate; the exact sphere test then runs on the candidate pairs only.
+    Longer segments (a lidar among short infra-red rays) take the dense test."""
+    n, M = len(O), len(C)
+    L = lim - t_near
+    valid = L >= 0.0                         # a negative segment sees nothing
+    fin = valid & (L < _INF)
+    Lf = L[fin]
+    if len(Lf) == 0:
+        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl)
+    # cell size from the MEDIAN segment length and mover radius (robust to a few long rays and
+    # big movers: a big mover registers in more cells, a long segment takes the dense test)
+    r_med = float(np.partition(radius, M // 2)[M // 2])
+    k = len(Lf) // 2
+    L_cap = max(2.0 * r_med, float(np.partition(Lf, k)[k]))
+    reach = (radius + 0.5 * L_cap)[:, None]
+    g0 = (C - reach).min(0)
+    span = float(((C + reach).max(0) - g0).max())
+    cell = 2.0 * r_med + L_cap               # a typical grown sphere overlaps <= 2 cells per axis
+    if 2.0 * cell >= span:                   # a grid of ~one cell would not prune anything
+        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl)
+    cell = max(cell, span / 2.0 ** 20)       # <= 2^20 + 3 cells per axis: int64 keys G^3 < 2^61
+    inv = 1.0 / cell
+    G = int(span * inv) + 3                  # cells per axis, with an empty border ring (0, G-1)
+    W = np.array([G * G, G, 1], dtype=np.int64)   # key of cell (x, y, z) = (x G + y) G + z
+    # movers -> cells 1 .. G-2 (the slack covers the rounding of the cell arithmetic)
+    slack = 1e-9 * (float(np.abs(C).max()) + span)
+    m0 = np.floor((C - reach - (g0 + slack)) * inv).astype(np.int64) + 1
+    cnt = np.floor((C + reach - (g0 - slack)) * inv).astype(np.int64) + 2 - m0
+    per = cnt[:, 0] * cnt[:, 1] * cnt[:, 2]
+    mov = np.repeat(np.arange(M), per)
+    j = np.arange(len(mov)) - np.repeat(np.cumsum(per) - per, per)   # cell number within the mover's box
+    cy, cz = cnt[mov, 1], cnt[mov, 2]
+    jx = j // (cy * cz)
+    j -= jx * cy * cz
+    jy = j // cz
+    base = m0 @ W
+    mkeys = base[mov] + jx * (G * G) + jy * G + (j - jy * cz)
+    order = np.argsort(mkeys, kind="stable")
+    smov = mov[order]
+    first = np.zeros(G ** 3 + 1, dtype=np.int64) if G ** 3 <= 8 * (len(mkeys) + n) else None
+    # short segments -> the cell of their midpoint (clipped into the empty border ring)
+    short_m = fin & (L <= L_cap)
+    every = bool(short_m.all())
+    short = None if every else short_m.nonzero()[0]
+    Os, Ds, Ls = (O, D, L) if every else (np.take(O, short, axis=0), np.take(D, short, axis=0), L[short])
+    mid = Os + ((t_near if short is None else _take(t_near, short)) + 0.5 * Ls)[:, None] * Ds
+    q = np.floor((mid - g0) * inv) + 1.0
+    np.clip(q, 0.0, G - 1.0, out=q)
+    key = q.astype(np.int64) @ W
+    if first is not None:                    # small grid: direct table, no binary search
+        np.cumsum(np.bincount(mkeys, minlength=G ** 3), out=first[1:])
+        start, stop = first[key], first[key + 1]
+    else:
+        skeys = mkeys[order]
+        start, stop = np.searchsorted(skeys, key, "left"), np.searchsorted(skeys, key, "right")
+    c2 = stop - start
+    pr = np.repeat(np.arange(len(key)) if every else short, c2)
+    pm = smov[np.repeat(start - (np.cumsum(c2) - c2), c2) + np.arange(len(pr))]
+    # exact sphere test on the candidates
+    rel = np.take(C, pm, axis=0) - np.take(O, pr, axis=0)
+    Dp = np.take(D, pr, axis=0)
+    b = np.einsum("ij,ij->i", rel, Dp)
+    e2 = np.einsum("ij,ij->i", rel, rel)
+    tc = np.minimum(np.maximum(b, _take(t_near, pr)), lim[pr])
+    sel = e2 - tc * (b + b - tc) <= r2[pm] + 1e-12 * e2
+    if owner is not None:
+        sel &= owner[pm] != _take(excl, pr)
+    pr, pm = pr[sel], pm[sel]
+    if not every:
+        longs = (valid & ~short_m).nonzero()[0]
+        if len(longs):
+            lp, lm = _sphere_pairs(C, r2, owner, np.take(O, longs, axis=0), np.take(D, longs, axis=0),
+                                   _take(t_near, longs), lim[longs], _take(excl, longs))
+            pr = np.concatenate([pr, longs[lp]])
+            pm = np.concatenate([pm, lm])
+            order = np.argsort(pr, kind="stable")   # back in ray order (callers rely on it per mover)
+            pr, pm = pr[order], pm[order]
+    return pr, pm
+
+
+
+
+@dataclass(slots=True)
+class _Body:
+    shapes: list[int]          # global shape ids: first .. first + len - 1
+    pose: Pose
+    owner: int
+    mover: bool
+    index: int
+    tiers: dict = field(default_factory=dict)  # variant -> shared body-frame _Tier (movers only)
+
+    @property
+    def first(self) -> int:
+        return self.shapes[0] if self.shapes else 0
+
+
+@dataclass(slots=True)
+class _Movers:
+    """The movers one ray variant sees (those with a non-empty tier), as arrays for the broad phase."""
+    index: np.ndarray      # (M,) body index
+    group: np.ndarray      # (M,) index into tiers
+    tiers: list            # shared body-frame tiers
+    anchor: np.ndarray     # (M,3) tier anchor in the body frame
+    anchored: bool
+    radius: np.ndarray     # (M,) bounding sphere of the tier around its anchor
+    r2: np.ndarray
+    owner: np.ndarray      # (M,) owner, -2 for none (never equal to an exclude_owner value)
+    owned: bool            # some mover has an owner
+    first: np.ndarray      # (M,) first global shape id of the body
+    epoch: int = -1        # engine pose epoch of the cached world-frame data below
+    R: np.ndarray | None = None   # (M,3,3) body rotations
+    T: np.ndarray | None = None   # (M,3) body translations
+    C: np.ndarray | None = None   # (M,3) bounding-sphere centres, world

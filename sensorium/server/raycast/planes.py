@@ -1,0 +1,91 @@
+"""Analytic planes: all planes one ray kind sees, intersected in one (rays x planes) float64 pass."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sensorium.server.raycast.exact import _INF, _mat
+from sensorium.server.raycast.kinds import ShapeEntry
+from sensorium.server.raycast.movers import _Body
+
+
+class _Planes:
+    """The analytic planes one ray variant sees.  World-frame data is recomputed only when a body
+    carrying one of them has a new pose."""
+
+    def __init__(self, items: list[tuple[int, _Body]], entries: list[ShapeEntry], owner_of: np.ndarray, visual: bool):
+        self.bodies = [b for _, b in items]
+        self.local = [entries[sid].local_pose for sid, _ in items]
+        self.sid = np.array([sid for sid, _ in items], dtype=np.int64)
+        owner = owner_of[self.sid]
+        self.owned = bool((owner >= 0).any())
+        self.owner = np.where(owner >= 0, owner, -2)   # -2: no owner, never equal to exclude_owner
+        self.visual = visual  # VISUAL rays: one-sided (front = +z side), finite when sized
+        sizes = [entries[sid].primitive.size for sid, _ in items]
+        self.sized = visual and any(s is not None for s in sizes)
+        half = [(s[0] / 2.0, s[1] / 2.0) if s is not None else (_INF, _INF) for s in sizes]
+        self.half = np.array(half).reshape(-1, 2)
+        self._poses: list | None = None
+        self._epoch = -1
+
+    def refresh(self, epoch: int) -> None:
+        """``epoch`` counts the engine's pose changes: unchanged, nothing to check."""
+        if epoch == self._epoch:
+            return
+        self._epoch = epoch
+        poses = [b.pose for b in self.bodies]
+        if self._poses is not None and all(p is q for p, q in zip(poses, self._poses)):
+            return
+        world = [p.compose(loc) for p, loc in zip(poses, self.local)]
+        self.nz = np.array([w.rotation[:, 2] for w in world])
+        self.ax = np.array([w.rotation[:, 0] for w in world])
+        self.ay = np.array([w.rotation[:, 1] for w in world])
+        self.pt = np.array([w.translation for w in world])
+        self.nz_t = np.ascontiguousarray(self.nz.T)
+        self._poses = poses
+
+
+
+def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64):
+    """(dist, shape, normal) of the nearest plane hits, or None if no ray hits a plane."""
+    pl.refresh(epoch)
+    n, P = len(O), len(pl.sid)
+    den = _mat(D, pl.nz_t)                               # (n, P)
+    ok = den < 0.0 if pl.visual else den != 0.0
+    if not np.count_nonzero(ok):  # e.g. horizontal rays over a floor
+        return None
+    lo = np.maximum(t_near, eps64)[:, None] if isinstance(t_near, np.ndarray) else max(t_near, eps64)
+    hi = t_far[:, None] if isinstance(t_far, np.ndarray) else t_far
+    # rel = P - O column by column, then rel . nz: exact far from the origin (no cancellation)
+    r0 = pl.pt[:, 0] - O[:, 0:1]
+    r1 = pl.pt[:, 1] - O[:, 1:2]
+    r2 = pl.pt[:, 2] - O[:, 2:3]
+    nz = pl.nz
+    t = (r0 * nz[:, 0] + r1 * nz[:, 1] + r2 * nz[:, 2]) / den
+    ok &= (t >= lo) & (t <= hi)
+    if pl.sized and np.count_nonzero(ok):  # hit point in the plane frame within the size
+        x0, x1, x2 = t * D[:, 0:1] - r0, t * D[:, 1:2] - r1, t * D[:, 2:3] - r2
+        ax, ay = pl.ax, pl.ay
+        ok &= (np.abs(x0 * ax[:, 0] + x1 * ax[:, 1] + x2 * ax[:, 2]) <= pl.half[:, 0]) & \
+              (np.abs(x0 * ay[:, 0] + x1 * ay[:, 1] + x2 * ay[:, 2]) <= pl.half[:, 1])
+    if pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0):
+        ok &= pl.owner != (excl[:, None] if isinstance(excl, np.ndarray) else excl)
+    if not np.count_nonzero(ok):
+        return None
+    np.copyto(t, _INF, where=~ok)
+    if P == 1:
+        dist = t.reshape(n)
+        col = np.zeros(n, dtype=np.int64)
+        d_hit = den.reshape(n)
+    else:  # nearest plane; ties keep the first (argmin)
+        col = np.argmin(t, axis=1)
+        ar = np.arange(n)
+        dist = t[ar, col]
+        d_hit = den[ar, col]
+    hit = (dist < _INF).nonzero()[0]
+    shape = np.full(n, -1, dtype=np.int64)
+    normal = np.zeros((n, 3))
+    c = col[hit]
+    shape[hit] = pl.sid[c]
+    normal[hit] = nz[c] * (1.0 - 2.0 * (d_hit[hit] > 0.0))[:, None]   # toward the origin
+    return dist, shape, normal

@@ -1,0 +1,248 @@
+"""Float64 refinement around Embree hits: triangle re-tests (hit triangle and its vertex ring,
+or triangles near the hit point), true-surface hits of curved shapes, and the pre-pass for rays
+starting inside a curved shell.  A mixin of :class:`RayEngine` (via :class:`.trace.TierTracer`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sensorium.server.raycast.exact import (
+    _CAPSULE,
+    _CYLINDER,
+    _DENSE_PAIRS,
+    _INF,
+    _SCALAR,
+    _SPHERE,
+    _TINY,
+    _analytic_local,
+    _analytic_one,
+    _best_per_row,
+    _dot,
+    _full,
+    _mat,
+    _minus,
+    _moller_trumbore,
+    _strictly_increasing,
+    _take,
+)
+from sensorium.server.raycast.tiers import _Tier
+
+
+class Refiner:
+    """Refinement methods of :class:`~sensorium.server.raycast.engine.RayEngine`."""
+
+    counters: dict[str, int]
+
+    def _refine_triangles(self, tier: _Tier, Ot, D, tri, lo, hi):
+        """Float64 hit of the ORIGINAL rays on triangle ``tri`` or, failing that, on the triangles
+        sharing one of its vertices (float32 may pick the wrong side of an edge).  Returns
+        (ok, t, triangle)."""
+        ok, t = _moller_trumbore(Ot, D, tier.v0[tri], tier.e1[tri], tier.e2[tri])
+        ok &= (t >= lo) & (t <= hi)
+        t = np.where(ok, t, _INF)
+        tri = tri.copy()
+        bad = (~ok).nonzero()[0]
+        if len(bad):
+            ptr, idx = tier.ring
+            starts = ptr[tri[bad]]
+            counts = ptr[tri[bad] + 1] - starts
+            ray = np.repeat(np.arange(len(bad)), counts)
+            cand = idx[np.repeat(starts - (np.cumsum(counts) - counts), counts) + np.arange(int(counts.sum()))]
+            okc, tc = _moller_trumbore(Ot[bad][ray], D[bad][ray], tier.v0[cand], tier.e1[cand], tier.e2[cand])
+            okc &= (tc >= lo[bad][ray]) & (tc <= hi[bad][ray])
+            tc = np.where(okc, tc, _INF)
+            best = np.full(len(bad), _INF)
+            np.minimum.at(best, ray, tc)
+            won = np.isfinite(tc) & (tc == best[ray])
+            btri = np.full(len(bad), -1, dtype=np.int64)
+            btri[ray[won]] = cand[won]
+            got = np.isfinite(best)
+            t[bad[got]] = best[got]
+            tri[bad[got]] = btri[got]
+            ok[bad[got]] = True
+        return ok, t, tri
+
+    def _nearby_triangles(self, tier: _Tier, Ot, D, t_e, lo, hi, excl):
+        """Float64 hit of the ORIGINAL rays on the flat triangles whose box, grown by float32
+        uncertainty, contains the Embree hit point (a coarse float32 frame can report a triangle
+        of a neighbouring face or shape).  Only hits up to t_e + eps count: beyond, a surface not
+        among the candidates could come first (the ray is continued instead).  (ok, t, triangle)."""
+        n = len(Ot)
+        grow = tier.eps + 8.0 * tier.res
+        P = Ot + np.minimum(t_e, 1e300)[:, None] * D
+        t = np.full(n, _INF)
+        tri = np.full(n, -1, dtype=np.int64)
+        flat = ~tier.tri_curved[:-1]
+        step = max(1, 4_000_000 // max(1, len(tier.F)))
+        for a in range(0, n, step):
+            b = min(n, a + step)
+            near = np.all((P[a:b, None, :] >= tier.t_lo[None] - grow) & (P[a:b, None, :] <= tier.t_hi[None] + grow), axis=2)
+            near &= flat[None]
+            ray, cand = near.nonzero()
+            ray = ray + a
+            if excl is not None:
+                keep = tier.tri_owner[cand] != excl[ray]
+                ray, cand = ray[keep], cand[keep]
+            if not len(ray):
+                continue
+            okc, tc = _moller_trumbore(Ot[ray], D[ray], tier.v0[cand], tier.e1[cand], tier.e2[cand])
+            okc &= (tc >= lo[ray]) & (tc <= np.minimum(hi[ray], t_e[ray] + tier.eps))
+            tc = np.where(okc, tc, _INF)
+            order = np.lexsort((tc, ray))   # per ray, nearest first
+            ray, cand, tc = ray[order], cand[order], tc[order]
+            first = np.r_[True, ray[1:] != ray[:-1]]
+            ray, cand, tc = ray[first], cand[first], tc[first]
+            t[ray], tri[ray] = tc, cand
+        ok = np.isfinite(t)
+        tri[~ok] = -1
+        return ok, t, tri
+
+    def _analytic(self, tier: _Tier, slots, Ot, D, lo, hi):
+        """True-surface hit of curved shapes (tier-frame rays): (t, tier-frame unit normal)."""
+        n = len(slots)
+        lo, hi = _full(lo, n), _full(hi, n)
+        if n and not np.count_nonzero(slots != slots[0]):   # one shape: one matrix
+            s0 = int(slots[0])
+            R = tier.c_rot[s0]
+            p = _mat(_minus(Ot, tier.c_pos[s0]), R)   # R^T (o - c)
+            d = _mat(D, R)
+            t, n_loc = _analytic_local(int(tier.c_code[s0]), p, d, tier.c_r[s0], tier.c_h[s0], lo, hi)
+            return t, _mat(n_loc, R.T)
+        R = tier.c_rot[slots]
+        p = np.einsum("nij,ni->nj", R, Ot - tier.c_pos[slots])  # R^T (o - c)
+        d = np.einsum("nij,ni->nj", R, D)
+        t = np.full(n, _INF)
+        n_loc = np.zeros((n, 3))
+        codes = tier.c_code[slots]
+        for code in (_SPHERE, _CYLINDER, _CAPSULE):
+            g = (codes == code).nonzero()[0]
+            if len(g):
+                s = slots[g]
+                t[g], n_loc[g] = _analytic_local(code, p[g], d[g], tier.c_r[s], tier.c_h[s], lo[g], hi[g])
+        return t, np.einsum("nij,nj->ni", R, n_loc)
+
+    def _contained_prepass(self, tier: _Tier, Ot, D, lo, lim, excl):
+        """Rays starting inside a curved shell may reach the true surface before any crossing of
+        that shell that the cast will see (the exit can lie beyond t_far or a nearer hit found
+        elsewhere), so those (ray, shape) pairs are intersected analytically up front.  Screening
+        of the start points: a few rays in plain floats; many rays against the bounding box of
+        their origins first (a lidar's rays share one origin); then each shell's own extent (or a
+        dense bounding-sphere test against several shells).  So this costs a few numpy calls unless
+        some start point really is inside a shell.  Returns None, or (rows, t, global shape,
+        normal toward the origin) of the hits found."""
+        m = len(Ot)
+        if m == 0:
+            return None
+        cp = tier.c_pos
+        lo_col = lo[:, None] if isinstance(lo, np.ndarray) else lo
+        if m * len(cp) <= (_TINY if len(cp) == 1 else 3 * _TINY):  # a few: plain floats throughout
+            # (several shapes: most pairs fail the first sphere test, which is cheap in Python)
+            S = (Ot + lo_col * D).tolist()
+            pairs = [(i, k) for i, (x, y, z) in enumerate(S) for k, (cx, cy, cz, b2) in enumerate(tier.c_sphere)
+                     if (x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz) <= b2]
+            if not pairs:
+                return None
+            return self._prepass_scalar(tier, pairs, S, Ot.tolist(), D.tolist(), lo, lim, excl)
+        if m * len(cp) > _DENSE_PAIRS:  # many rays: screen their bounding box first (a lidar: a point)
+            # per column: numpy reduces a short inner axis ~10x slower than a contiguous column
+            reach = float(lo.max()) if isinstance(lo, np.ndarray) else lo
+            box_lo = np.array([Ot[:, k].min() for k in range(3)]) - reach
+            box_hi = np.array([Ot[:, k].max() for k in range(3)]) + reach
+            gap = cp - np.minimum(np.maximum(cp, box_lo), box_hi)
+            near = (_dot(gap, gap) <= tier.c_bound2).nonzero()[0].tolist()
+            if not near:
+                return None
+        else:
+            near = None
+        S = Ot + lo_col * D
+        if near is not None or len(cp) == 1:  # shape by shape, each shell's own extent straight away
+            rs, ss = [], []
+            for k in (near if near is not None else [0]):
+                r = self._inside_shell(tier, k, S).nonzero()[0]
+                rs.append(r)
+                ss.append(np.full(len(r), k, dtype=np.int64))
+            rows = np.concatenate(rs) if rs else np.zeros(0, dtype=np.int64)
+            if len(rows) == 0:
+                return None
+            slots = np.concatenate(ss)
+            tight = True
+        else:  # a dense (rays, shapes) bounding-sphere test, then the shells' own extents
+            dx, dy, dz = S[:, 0:1] - cp[:, 0], S[:, 1:2] - cp[:, 1], S[:, 2:3] - cp[:, 2]
+            cand = dx * dx + dy * dy + dz * dz <= tier.c_bound2
+            if not np.count_nonzero(cand):
+                return None
+            rows, slots = cand.nonzero()
+            tight = False
+        if len(rows) <= _SCALAR:
+            pairs = list(zip(rows.tolist(), slots.tolist()))
+            few = sorted({i for i, _ in pairs})
+            rows_of = lambda a: dict(zip(few, a[few].tolist()))  # noqa: E731
+            return self._prepass_scalar(tier, pairs, rows_of(S), rows_of(Ot), rows_of(D), lo, lim, excl)
+        # tighter for cylinders and capsules: the shell's own extent in the shape frame
+        tall = tier.c_code[slots] != _SPHERE
+        if not tight and np.count_nonzero(tall):
+            p = np.einsum("nij,ni->nj", tier.c_rot[slots], S[rows] - cp[slots])
+            inside = ~tall | ((p[:, 0] ** 2 + p[:, 1] ** 2 <= tier.c_rad2[slots])
+                              & (np.abs(p[:, 2]) <= tier.c_ax[slots]))
+            rows, slots = rows[inside], slots[inside]
+        if tier.c_owned and not (not isinstance(excl, np.ndarray) and excl < 0):
+            keep = tier.c_owner[slots] != _take(excl, rows)
+            rows, slots = rows[keep], slots[keep]
+        if len(rows) == 0:
+            return None
+        ta, na = self._analytic(tier, slots, Ot[rows], D[rows], _take(lo, rows), _take(lim, rows))
+        got = (ta < _INF).nonzero()[0]
+        if len(got) == 0:
+            return None
+        rows, slots, ta, na = rows[got], slots[got], ta[got], na[got]
+        if not _strictly_increasing(rows):  # inside several shells: the nearest surface
+            keep = _best_per_row(rows, ta)
+            rows, slots, ta, na = rows[keep], slots[keep], ta[keep], na[keep]
+        na[_dot(na, D[rows]) > 0.0] *= -1.0
+        return rows, ta, tier.c_shape[slots], na
+
+    @staticmethod
+    def _inside_shell(tier: _Tier, k: int, S) -> np.ndarray:
+        """Mask of the points S (tier frame) inside curved slot k's shell extent: its bounding
+        sphere for a sphere, the cylinder (max radius, max |z|) of its vertices otherwise."""
+        p = _minus(S, tier.c_pos[k])
+        if tier.c_code[k] == _SPHERE:
+            return _dot(p, p) <= tier.c_bound2[k]
+        p = _mat(p, tier.c_rot[k])
+        return (p[:, 0] * p[:, 0] + p[:, 1] * p[:, 1] <= tier.c_rad2[k]) & (np.abs(p[:, 2]) <= tier.c_ax[k])
+
+    def _prepass_scalar(self, tier: _Tier, pairs, S, Ot, D, lo, lim, excl):
+        """The pre-pass after screening, for a few candidate (ray, shape) ``pairs``, in Python
+        floats (same tests and answers as the vectorised tail).  S, Ot, D: start points, origins,
+        directions as Python rows indexable by ray."""
+        check_owner = tier.c_owned and not (not isinstance(excl, np.ndarray) and excl < 0)
+        lo_l = lo if isinstance(lo, np.ndarray) else None
+        lim_l = lim if isinstance(lim, np.ndarray) else None
+        found: dict[int, tuple] = {}
+        for i, k in pairs:
+            code, r, h, c0, c1, c2, r0, r1, r2, r3, r4, r5, r6, r7, r8, rad2, ax, sid = tier.c_py[k]
+            if code != _SPHERE:  # start point inside the shell's own extent (shape frame)?
+                si = S[i]
+                sx, sy, sz = si[0] - c0, si[1] - c1, si[2] - c2
+                lx, ly, lz = sx * r0 + sy * r3 + sz * r6, sx * r1 + sy * r4 + sz * r7, sx * r2 + sy * r5 + sz * r8
+                if not (lx * lx + ly * ly <= rad2 and abs(lz) <= ax):
+                    continue
+            if check_owner and tier.c_owner[k] == _take(excl, i):
+                continue
+            oi = Ot[i]
+            ox, oy, oz = oi[0] - c0, oi[1] - c1, oi[2] - c2
+            dx, dy, dz = D[i]
+            t, (nx, ny, nz) = _analytic_one(
+                code, (ox * r0 + oy * r3 + oz * r6, ox * r1 + oy * r4 + oz * r7, ox * r2 + oy * r5 + oz * r8),
+                (dx * r0 + dy * r3 + dz * r6, dx * r1 + dy * r4 + dz * r7, dx * r2 + dy * r5 + dz * r8),
+                r, h, lo if lo_l is None else float(lo_l[i]), lim if lim_l is None else float(lim_l[i]))
+            if t < _INF and (i not in found or t < found[i][0]):
+                n = (r0 * nx + r1 * ny + r2 * nz, r3 * nx + r4 * ny + r5 * nz, r6 * nx + r7 * ny + r8 * nz)
+                if n[0] * dx + n[1] * dy + n[2] * dz > 0.0:   # toward the origin
+                    n = (-n[0], -n[1], -n[2])
+                found[i] = (t, sid, n)
+        if not found:
+            return None
+        keys = sorted(found)
+        return (np.array(keys, dtype=np.int64), np.array([found[i][0] for i in keys]),
+                np.array([found[i][1] for i in keys], dtype=np.int64), np.array([found[i][2] for i in keys]))

@@ -1,0 +1,218 @@
+"""Tiers: one Embree scene of a set of shapes and the float64 data that refines its hits.
+
+The only module of the engine that imports embreex.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from embreex import rtcore as _rtc
+from embreex import rtcore_scene as _rts
+from embreex.mesh_construction import TriangleMesh as _TriangleMesh
+
+from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
+from sensorium.server.world.geometry import Capsule, Cylinder, Mesh, Pose, Primitive, Sphere, tessellate
+
+
+def new_device():
+    """A fresh Embree device (one per engine)."""
+    return _rtc.EmbreeDevice()
+
+
+class _Tier:
+    """Triangles of a set of shapes in one Embree scene.  Tier frame = parent frame (world for the
+    static tier, body frame for a mover) translated by ``-anchor``."""
+
+    def __init__(self, device, items: list[tuple[int, Primitive, Pose]], owner_of: np.ndarray):
+        verts, faces, tri_shape, curved = [], [], [], []
+        nv = 0
+        for sid, prim, pose in items:
+            v, f = tessellate(prim)
+            if len(f) == 0:
+                continue
+            if isinstance(prim, Mesh):  # keep only referenced vertices (they set the tier bounds)
+                used, f = np.unique(f, return_inverse=True)
+                v, f = v[used], f.reshape(-1, 3)
+            verts.append(pose.apply(v))
+            faces.append(f + nv)
+            tri_shape.append(np.full(len(f), sid, dtype=np.int64))
+            if isinstance(prim, (Sphere, Cylinder, Capsule)):
+                curved.append((sid, prim, pose, len(verts) - 1, v))
+            nv += len(v)
+        self.empty = nv == 0
+        if self.empty:
+            return
+        lo = np.min([v.min(0) for v in verts], axis=0)
+        hi = np.max([v.max(0) for v in verts], axis=0)
+        centre, half = (lo + hi) / 2.0, float(np.linalg.norm(hi - lo)) / 2.0
+        # anchor at the bounding-box centre, unless the geometry is already around the origin
+        # (then float32 coordinates lose at most one bit and casts skip a float64 subtraction)
+        self.anchored = bool(np.linalg.norm(centre) > half)
+        self.anchor = centre if self.anchored else np.zeros(3)
+        self.res = _ulp32(half + float(np.linalg.norm(self.anchor - centre)))
+        self.eps = max(1e-6, 8.0 * self.res)
+        # Inflate curved shells by a = 4 float32 ulps so rounding cannot cut into the true
+        # surface.  Scaling the shape frame by (1 + a/r) radially and (1 + a/half-length) along z
+        # maps the true shape onto a superset of the true shape grown by a (checked for sphere,
+        # cylinder and capsule), so the scaled shell still circumscribes with a margin >= a.
+        a = 4.0 * self.res
+        c_code, c_r, c_h, c_rot, c_pos, c_shape, c_bound, c_rad, c_ax = [], [], [], [], [], [], [], [], []
+        for sid, prim, pose, k, v_local in curved:
+            if isinstance(prim, Sphere):
+                code, r, h, axial = _SPHERE, prim.radius, 0.0, prim.radius
+            elif isinstance(prim, Cylinder):
+                code, r, h = _CYLINDER, prim.radius, prim.height / 2.0
+                axial = h
+            else:
+                code, r, h = _CAPSULE, prim.radius, prim.height / 2.0
+                axial = h + r
+            shell = v_local * np.array([1.0 + a / r, 1.0 + a / r, 1.0 + a / axial])
+            verts[k] = pose.apply(shell)
+            c_rad.append(float(np.hypot(shell[:, 0], shell[:, 1]).max()))
+            c_ax.append(float(np.abs(shell[:, 2]).max()))
+            c_code.append(code)
+            c_r.append(r)
+            c_h.append(h)
+            c_rot.append(pose.rotation)
+            c_pos.append(pose.translation - self.anchor)
+            c_shape.append(sid)
+            c_bound.append(float(np.linalg.norm(verts[k] - pose.translation, axis=1).max()))
+        V = np.vstack(verts) - self.anchor
+        F = np.vstack(faces)
+        self.V, self.F = V, F
+        self.radius = float(np.linalg.norm(V, axis=1).max()) + 4.0 * self.res
+        self.tri_shape = np.append(np.concatenate(tri_shape), -1)  # sentinel row for primID = -1
+        self.v0 = V[F[:, 0]]
+        self.e1 = V[F[:, 1]] - self.v0
+        self.e2 = V[F[:, 2]] - self.v0
+        nrm = np.cross(self.e1, self.e2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+        self.normal = np.vstack([np.nan_to_num(nrm), np.zeros((1, 3))])
+        # [normal; -normal]: row prim + (M+1)*back is the normal oriented toward the ray origin
+        self.normal2 = np.vstack([self.normal, -self.normal])
+        self.n_rows = len(self.normal)
+        self.ng_max = float(np.linalg.norm(np.cross(self.e1, self.e2), axis=1).max())
+        # dual basis of (e1, e2) in each triangle's plane: barycentrics u = (P - v0).g1, v = (P - v0).g2
+        g11, g12, g22 = _dot(self.e1, self.e1), _dot(self.e1, self.e2), _dot(self.e2, self.e2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            inv = 1.0 / (g11 * g22 - g12 * g12)
+        inv = np.where(np.isfinite(inv), inv, 0.0)[:, None]
+        self.g1 = np.vstack([(g22[:, None] * self.e1 - g12[:, None] * self.e2) * inv, np.zeros((1, 3))])
+        self.g2 = np.vstack([(g11[:, None] * self.e2 - g12[:, None] * self.e1) * inv, np.zeros((1, 3))])
+        tv = V[F]
+        self.t_lo, self.t_hi = tv.min(1), tv.max(1)   # per-triangle boxes (float64)
+        owners = owner_of[self.tri_shape[:-1]]
+        self.owned = bool((owners >= 0).any())
+        # -2 marks "no owner" so it never equals an exclude_owner value (>= -1)
+        self.tri_owner = np.append(np.where(owners >= 0, owners, -2), -2)
+        # curved shapes, indexed by "slot"
+        self.has_curved = bool(curved)
+        self.c_shape = np.array(c_shape, dtype=np.int64)
+        slot_of_shape = np.full(int(self.tri_shape.max()) + 2, -1, dtype=np.int64)
+        slot_of_shape[self.c_shape] = np.arange(len(c_shape))
+        self.tri_slot = slot_of_shape[self.tri_shape]  # sentinel row maps to -1 as well
+        self.tri_curved = self.tri_slot >= 0
+        self.c_code = np.array(c_code, dtype=np.int64)
+        self.c_r = np.array(c_r, dtype=np.float64)
+        self.c_h = np.array(c_h, dtype=np.float64)
+        self.c_rot = np.array(c_rot, dtype=np.float64).reshape(-1, 3, 3)
+        self.c_pos = np.array(c_pos, dtype=np.float64).reshape(-1, 3)
+        self.c_bound = np.array(c_bound, dtype=np.float64)
+        self.c_rad = np.array(c_rad, dtype=np.float64)   # shell extent in the shape frame:
+        self.c_ax = np.array(c_ax, dtype=np.float64)     # max radial distance and max |z|
+        c_owner = owner_of[self.c_shape]
+        self.c_owned = bool((c_owner >= 0).any())
+        self.c_owner = np.where(c_owner >= 0, c_owner, -2)   # -2: no owner, never excluded
+        self.c_bound2 = self.c_bound ** 2
+        self.c_rad2 = self.c_rad ** 2
+        # the same as Python lists, for the scalar path of small batches
+        self.c_sphere = [(*c, b2) for c, b2 in zip(self.c_pos.tolist(), self.c_bound2.tolist())]
+        self.c_py = [(code, r, h, *c, *rot, rad2, ax, sid) for code, r, h, c, rot, rad2, ax, sid in zip(
+            self.c_code.tolist(), self.c_r.tolist(), self.c_h.tolist(), self.c_pos.tolist(),
+            self.c_rot.reshape(-1, 9).tolist(), self.c_rad2.tolist(), self.c_ax.tolist(), self.c_shape.tolist())]
+        self.c_isolated = self._isolation(verts, tri_shape, c_shape)
+        # tight bound of the whole tier for pruning candidate rays (see ``may_hit``): the shell's own
+        # cylinder for a tier of one cylinder or capsule (a round robot body), else the box of V
+        slack = 16.0 * self.res
+        if len(items) == 1 and len(c_shape) == 1 and c_code[0] != _SPHERE:
+            self.bound = ("cylinder", self.c_rot[0], self.c_pos[0], self.c_rad[0] + slack, self.c_ax[0] + slack)
+        else:
+            self.bound = ("box", V.min(0) - slack, V.max(0) + slack)
+        self._ring: tuple[np.ndarray, np.ndarray] | None = None
+        # Embree keeps pointers into these buffers: hold references for the scenes' lifetime
+        self._v32 = np.ascontiguousarray(V, dtype=_F32)
+        self._f32 = np.ascontiguousarray(F, dtype=np.int32)
+        self._device = device
+        self._scenes: dict[bool, object] = {}
+
+    def may_hit(self, O, D, lo, hi) -> np.ndarray:
+        """Mask of the rays (parent frame) whose segment [lo, hi] may meet ``bound`` (conservative:
+        every triangle of the tier, and every start point inside a shell, lies inside the bound)."""
+        Ot = _minus(O, self.anchor) if self.anchored else O
+        hi = np.minimum(hi, 1e300)          # t * d stays finite (and 0 for d = 0)
+        if self.bound[0] == "cylinder":
+            # two cheap necessary conditions, tested separately: the segment comes within the
+            # radius of the axis, and it overlaps the slab |z| <= half-height
+            _, R, c, rad, ax = self.bound
+            p = _mat(_minus(Ot, c), R)
+            d = _mat(D, R)
+            px, py, pz, dx, dy, dz = p[:, 0], p[:, 1], p[:, 2], d[:, 0], d[:, 1], d[:, 2]
+            # closest approach to the axis (a ray along the axis: any t, 1e-300 avoids 0/0)
+            tc = np.minimum(np.maximum(-(px * dx + py * dy) / (dx * dx + dy * dy + 1e-300), lo), hi)
+            qx, qy = px + tc * dx, py + tc * dy
+            z0, z1 = pz + lo * dz, pz + hi * dz
+            return (qx * qx + qy * qy <= rad * rad) & (np.maximum(z0, z1) >= -ax) & (np.minimum(z0, z1) <= ax)
+        _, blo, bhi = self.bound
+        Dn = np.where(D == 0.0, 1e-300, D)   # parallel to a slab: +-huge (or 0 on its plane), no NaN
+        t_a = (blo - Ot) / Dn
+        t_b = (bhi - Ot) / Dn
+        near, far = np.minimum(t_a, t_b), np.maximum(t_a, t_b)   # per axis; then across axes by column
+        enter = np.maximum(np.maximum(np.maximum(near[:, 0], near[:, 1]), near[:, 2]), lo)
+        leave = np.minimum(np.minimum(np.minimum(far[:, 0], far[:, 1]), far[:, 2]), hi)
+        return enter <= leave
+
+    def scene(self, robust: bool):
+        """(Embree scene, built now?).  FAST uses a plain scene, EXACT a robust one (watertight
+        traversal, ~40% slower in a room where every ray hits); each is built on first use."""
+        sc = self._scenes.get(robust)
+        if sc is not None:
+            return sc, False
+        sc = _rts.EmbreeScene(self._device, robust=robust)
+        _TriangleMesh(sc, self._v32, self._f32)
+        sc.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))  # commit now: this is the build
+        self._scenes[robust] = sc
+        return sc, True
+
+    def _isolation(self, verts, tri_shape, c_shape) -> np.ndarray:
+        """Per curved slot: True if no other shape of the tier overlaps its shell's bounding box.
+        Then nothing can lie between a crossing of that shell and the true surface inside it."""
+        if not c_shape:
+            return np.zeros(0, dtype=bool)
+        ids = np.array([int(t[0]) for t in tri_shape])
+        lo = np.array([v.min(0) for v in verts])
+        hi = np.array([v.max(0) for v in verts])
+        out = np.empty(len(c_shape), dtype=bool)
+        for i, sid in enumerate(c_shape):
+            k = int(np.flatnonzero(ids == sid)[0])
+            overlap = np.all((lo <= hi[k]) & (hi >= lo[k]), axis=1)
+            overlap[k] = False
+            out[i] = not overlap.any()
+        return out
+
+    @property
+    def ring(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (ptr, idx): for each triangle, the triangles sharing one of its vertices (itself
+        included).  Built on first use (EXACT only)."""
+        if self._ring is None:
+            flat = self.F.ravel()
+            tri_of = np.argsort(flat, kind="stable") // 3
+            deg = np.bincount(flat, minlength=len(self.V))
+            vptr = np.concatenate([[0], np.cumsum(deg)])
+            lens = deg[flat]
+            total = int(lens.sum())
+            first = np.repeat(vptr[flat] - (np.cumsum(lens) - lens), lens)
+            idx = tri_of[first + np.arange(total)]
+            ptr = np.concatenate([[0], np.cumsum(lens.reshape(-1, 3).sum(1))])
+            self._ring = (ptr, idx)
+        return self._ring

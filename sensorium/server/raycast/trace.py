@@ -1,0 +1,366 @@
+"""Tracing one tier: the FAST path (one Embree call, vectorised judging) and the general loop
+(judge each hit, refine in EXACT, continue rejected rays).  A mixin of :class:`RayEngine`: the
+methods use its ``counters`` and the pre-pass/refinement methods of :mod:`.refine`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sensorium.server.raycast.exact import (
+    _BARY_TOL,
+    _F32,
+    _INF,
+    _LEAK_OFFSET_ULPS,
+    _MAX_LOOPS,
+    _SMALL,
+    _dot,
+    _full,
+    _minus,
+    _perpendicular,
+    _rows,
+    _take,
+)
+from sensorium.server.raycast.refine import Refiner
+from sensorium.server.raycast.tiers import _Tier
+
+
+class TierTracer(Refiner):
+    """Per-tier tracing methods of :class:`~sensorium.server.raycast.engine.RayEngine`."""
+
+    counters: dict[str, int]
+
+    def _run(self, tier: _Tier, o32, d32, far, robust: bool):
+        scene, built = tier.scene(robust)
+        self.counters["bvh_builds"] += built
+        self.counters["embree_calls"] += 1
+        return scene.run(o32, d32, far, output=1)
+
+    def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None):
+        """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
+        normal oriented toward the origin) with normal in the parent frame's orientation, or None
+        when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
+        for an unanchored tier)."""
+        if exact:
+            res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True)
+            return res if np.count_nonzero(res[0] < _INF) else None
+        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big)
+
+    def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None):
+        """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
+        self-hits, shells left from inside, excluded owners) are redone by the general loop.
+        Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
+        (a lidar in a room) on whole arrays without gathers."""
+        m = len(O)
+        Ot = _minus(O, tier.anchor) if tier.anchored else O
+        pre = None
+        lim_in = lim   # the redo below gets the caller's limit: it runs its own pre-pass, whose
+        # float64 path (scalar or vectorised) may differ from this one's in the last bit
+        if tier.has_curved:  # origins inside a curved shell: analytic first (see the pre-pass)
+            lo = np.maximum(t_near, eps64) if isinstance(t_near, np.ndarray) else max(t_near, eps64)
+            pre = self._contained_prepass(tier, Ot, D, lo, lim, excl)
+            if pre is not None:  # the cast only needs to look before the analytic hits
+                lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, lim)
+                lim[pre[0]] = np.minimum(lim[pre[0]], pre[1])
+        o32 = Ot.astype(_F32)
+        d32 = D.astype(_F32)
+        start = t_near
+        dead = None
+        if big is None:
+            big = max(map(abs, o32.ravel().tolist())) if m <= _SMALL else max(-float(o32.min()), float(o32.max()))
+        if big * 1.7321 > tier.radius:
+            far_rows = (_dot(o32, o32) > _F32(tier.radius * tier.radius)).nonzero()[0]
+            if len(far_rows):  # origin outside the tier's sphere: start at its entry (precision)
+                start = np.array(_full(start, m), dtype=np.float64)
+                Of = Ot[far_rows]
+                Df = D[far_rows]
+                b = _dot(Of, Df)
+                q2 = _dot(Of, Of) - b * b
+                enter = -b - np.sqrt(np.maximum(tier.radius ** 2 - q2, 0.0))
+                start[far_rows] = np.maximum(start[far_rows], enter)
+                dead = far_rows[q2 > tier.radius ** 2]
+                o32 += start[:, None] * d32
+                o32[far_rows] = Of + start[far_rows][:, None] * Df
+        if not isinstance(start, np.ndarray):
+            if start > 0.0:
+                o32 += _F32(start) * d32
+        elif dead is None:
+            o32 += start[:, None] * d32
+        far = (lim - start) * (1.0 + 2.0 ** -20)  # float32 slack so a hit exactly at t_far counts
+        if dead is not None and len(dead):
+            far = np.array(_full(far, m))
+            far[dead] = -1.0
+        if isinstance(far, np.ndarray):
+            far = far.astype(_F32)
+        elif far == _INF:
+            far = None
+        else:
+            far = float(far)
+        res = self._run(tier, o32, d32, far, robust=False)
+        prim = res["primID"]
+        hit = prim >= 0
+        n_hit = np.count_nonzero(hit)
+        if n_hit == 0 and pre is None:
+            return None   # no hit at all (the common case for short sensor rays)
+        if 2 * n_hit >= m:  # mostly hits: whole arrays, misses masked (primID -1 picks the
+            # sentinel rows: shape -1, zero normal)
+            (t, normal), redo = self._judge_fast(tier, Ot, D, d32, res, prim, slice(None), start, lim, excl)
+            shape = np.take(tier.tri_shape, prim)
+            if n_hit < m:
+                t[~hit] = _INF
+        else:
+            h = hit.nonzero()[0]
+            t = np.full(m, _INF)
+            shape = np.full(m, -1, dtype=np.int64)
+            normal = np.zeros((m, 3))
+            redo = None
+            if len(h):
+                (th, nrm), special = self._judge_fast(tier, Ot, D, d32, res, prim[h], h, start, lim, excl)
+                t[h], shape[h], normal[h] = th, np.take(tier.tri_shape, prim[h]), nrm
+                if special is not None:
+                    redo = np.zeros(m, dtype=bool)
+                    redo[h[special]] = True
+        if redo is not None and pre is not None:  # rays the pre-pass settles need no redo
+            redo[pre[0][pre[1] <= t[pre[0]]]] = False
+        if redo is not None and np.count_nonzero(redo):
+            rows = redo.nonzero()[0]
+            t2, s2, n2 = self._trace_loop(tier, O[rows], D[rows], _take(t_near, rows), _take(lim_in, rows),
+                                          _take(excl, rows), eps64, exact=False)
+            t[rows], shape[rows], normal[rows] = t2, s2, n2
+        if pre is not None:  # analytic hits of the pre-pass, unless a nearer hit was found
+            rows, tp, sp, np_ = pre
+            if len(rows) <= _SMALL:  # a few: plain Python (ten numpy calls otherwise)
+                for k, (i, ti) in enumerate(zip(rows.tolist(), tp.tolist())):
+                    if ti <= t[i]:
+                        t[i], shape[i], normal[i] = ti, sp[k], np_[k]
+            else:
+                take = (tp <= t[rows]).nonzero()[0]
+                r = rows[take]
+                t[r], shape[r], normal[r] = tp[take], sp[take], np_[take]
+        return t, shape, normal
+
+    def _judge_fast(self, tier: _Tier, Ot, D, d32, res, ph, rows, start, lim, excl):
+        """FAST hit data of the Embree results at ``rows`` (a slice of all rays, or an index array
+        of hit rays; ``ph`` = their primIDs): ((t, normal toward the origin), special mask or None),
+        special = rays the general loop must redo."""
+        every = isinstance(rows, slice)
+        tf = res["tfar"][rows]
+        t = tf.astype(np.float64)
+        t += start if not isinstance(start, np.ndarray) else start[rows]
+        if isinstance(lim, np.ndarray):
+            np.minimum(t, lim[rows], out=t)
+        elif lim != _INF:
+            np.minimum(t, lim, out=t)
+        dh = d32[rows]
+        ng = res["Ng"][rows]                 # Embree's Ng has our winding: sign = side hit
+        if len(ng) > _SMALL:                 # one pass over the rows
+            dots = np.einsum("ij,ij->i", ng, dh)
+        else:
+            dots = ng[:, 0] * dh[:, 0] + ng[:, 1] * dh[:, 1] + ng[:, 2] * dh[:, 2]
+        back = dots > 0.0
+        nrm = np.take(tier.normal2, ph + back * tier.n_rows, axis=0)   # misses: zero sentinel rows
+        grazing = np.abs(dots) < 1e-5 * tier.ng_max
+        if every:
+            grazing &= ph >= 0
+        grazing = grazing.nonzero()[0]
+        if len(grazing):  # float32 sign unreliable: orient in float64
+            g_nrm = tier.normal[ph[grazing]]
+            flip = _dot(g_nrm, D[grazing if every else rows[grazing]]) > 0.0
+            g_nrm[flip] *= -1.0
+            nrm[grazing] = g_nrm
+            back[grazing] = flip
+        special = tf < tier.eps              # possible self-hit (origin on the surface)
+        if every:
+            special &= ph >= 0
+        if np.count_nonzero(special):
+            sp = special.nonzero()[0]
+            tri = ph[sp]
+            gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.v0[tri], tier.normal[tri]))
+            special[sp] = gap <= 2.0 * tier.eps
+        if tier.has_curved:                  # leaving a curved shell: the true surface decides
+            special |= back & np.take(tier.tri_curved, ph)
+        if tier.owned and not (not isinstance(excl, np.ndarray) and excl < 0):
+            special |= np.take(tier.tri_owner, ph) == (excl[rows] if isinstance(excl, np.ndarray) else excl)
+        return (t, nrm), (special if np.count_nonzero(special) else None)
+
+    def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool):
+        """General path: cast, judge each hit, continue rejected rays past their hit (bounded).
+        Judging: excluded owners are skipped; EXACT refines flat hits in float64 and curved hits
+        on the true surface; FAST keeps Embree's answer except self-hits and shells left from
+        inside.  Returns (t, shape, normal oriented toward the origin)."""
+        m = len(O)
+        eps = tier.eps
+        Ot = _minus(O, tier.anchor) if tier.anchored else O
+        if isinstance(t_near, np.ndarray):       # accepted hits: lo <= t <= lim
+            lo = np.maximum(t_near, eps64)
+            seg = np.maximum(t_near - eps, eps)   # Embree start along the ray
+        else:
+            lo = np.full(m, max(t_near, eps64))
+            seg = np.full(m, max(t_near - eps, eps))
+        lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, float(lim))
+        excl_arr = None
+        if tier.owned:
+            excl_arr = excl if isinstance(excl, np.ndarray) else np.full(m, excl, dtype=np.int64)
+        best_t = np.full(m, _INF)
+        best_s = np.full(m, -1, dtype=np.int64)
+        best_n = np.zeros((m, 3))
+        r2 = tier.radius ** 2
+        if m and max(-float(Ot.min()), float(Ot.max())) * 1.7321 > tier.radius:
+            # some origins outside the tier's sphere: clip to it
+            b = _dot(Ot, D)
+            q2 = _dot(Ot, Ot) - b * b
+            half = np.sqrt(np.maximum(r2 - q2, 0.0))
+            np.maximum(seg, -b - half, out=seg)
+            alive = (q2 <= r2) & (-b + half >= lo) & (seg <= lim + eps)
+        else:
+            alive = seg <= lim + eps
+        if tier.has_curved:
+            pre = self._contained_prepass(tier, Ot, D, lo, lim, excl)
+            if pre is not None:
+                rows, tp, sp, np_ = pre
+                best_t[rows], best_s[rows], best_n[rows] = tp, sp, np_
+                np.minimum(lim, best_t, out=lim)
+
+        act = alive.nonzero()[0]
+        delta = None   # per-ray continuation step, allocated on the first continuation
+        for _ in range(_MAX_LOOPS):
+            if len(act) == 0:
+                break
+            view = slice(None) if len(act) == m else act   # all rays active: views, not copies
+            oa, da, sa = Ot[view], D[view], seg[view]
+            o_seg = oa + sa[:, None] * da
+            d32 = da.astype(_F32)
+            far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)
+            far32 = np.where(far >= 0.0, far, -1.0).astype(_F32)
+            res = self._run(tier, o_seg.astype(_F32), d32, far32.copy() if exact else far32, robust=exact)
+            prim, tf = res["primID"].astype(np.int64), res["tfar"]
+            repaired = fixed = None
+            if exact:
+                # leak repair: a copy offset by a few ulps perpendicular to the ray
+                o2 = (o_seg + _perpendicular(da) * (_LEAK_OFFSET_ULPS * tier.res)).astype(_F32)
+                prim2 = self._run(tier, o2, d32, far32, robust=True)["primID"]
+                sus = ((prim2 >= 0) & (prim2 != prim)).nonzero()[0]
+                if len(sus):
+                    ok, t2, tri2 = self._refine_triangles(tier, oa[sus], da[sus], prim2[sus].astype(np.int64),
+                                                          sa[sus] - eps, lim[view][sus] + eps)
+                    t_sus = np.where(prim[sus] >= 0, sa[sus] + tf[sus], _INF)
+                    fix = ok & ((prim[sus] < 0) | (t2 < t_sus - eps))
+                    if np.count_nonzero(fix):
+                        fixed = (sus[fix], t2[fix])
+                        prim[fixed[0]] = tri2[fix]
+                        repaired = np.zeros(len(prim), dtype=bool)   # Embree's barycentrics no longer apply
+                        repaired[fixed[0]] = True
+                        self.counters["leak_repairs"] += len(fixed[0])
+            h = (prim >= 0).nonzero()[0]
+            if len(h) == 0:  # nothing hit: every active ray is done
+                break
+            t_e = np.where(prim >= 0, sa + tf, _INF)   # Embree distance along the whole ray
+            if fixed is not None:
+                t_e[fixed[0]] = fixed[1]
+            cont = np.zeros(len(act), dtype=bool)   # rays to continue past their hit
+            if len(h):
+                ph = prim[h]
+                rows_h = act[h]
+                rej = np.zeros(len(h), dtype=bool)
+                if excl_arr is not None:
+                    rej |= tier.tri_owner[ph] == excl_arr[rows_h]
+                slot = tier.tri_slot[ph]
+                curved = slot >= 0
+                # --- flat triangles (boxes, meshes)
+                fl = (~curved & ~rej).nonzero()[0]
+                if len(fl):
+                    rows = rows_h[fl]
+                    tri = ph[fl]
+                    nrm = np.take(tier.normal, tri, axis=0)
+                    Dr = _rows(D, rows)
+                    dn = _dot(Dr, nrm)
+                    if exact:
+                        tx = _dot(np.take(tier.v0, tri, axis=0) - _rows(Ot, rows), nrm) / dn
+                        ok = np.isfinite(tx) & (tx >= lo[rows]) & (tx <= lim[rows])
+                        # Embree barycentrics comfortably inside the triangle: float32 cannot have
+                        # picked the wrong one and its float64 plane gives the exact distance; near
+                        # an edge (or repaired), test in float64
+                        hf = h[fl]
+                        u, v = res["u"][hf], res["v"][hf]
+                        near_edge = ~(np.minimum(np.minimum(u, v), 1.0 - u - v) > 1e-4)
+                        if repaired is not None:
+                            near_edge |= repaired[hf]
+                        edge = near_edge.nonzero()[0]
+                        # float64 barycentrics of the plane hit: in a coarse float32 frame Embree
+                        # can report comfortable barycentrics on the adjacent face's triangle
+                        P = _rows(Ot, rows) + tx[:, None] * Dr - np.take(tier.v0, tri, axis=0)
+                        bu = _dot(P, np.take(tier.g1, tri, axis=0))
+                        bv = _dot(P, np.take(tier.g2, tri, axis=0))
+                        near_edge |= ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
+                        edge = near_edge.nonzero()[0]
+                        if len(edge):
+                            r = rows[edge]
+                            ok_e, t_x, tri_e = self._refine_triangles(tier, Ot[r], D[r], tri[edge], lo[r], lim[r])
+                            miss = (~ok_e).nonzero()[0]
+                            if len(miss):   # not the hit triangle nor a vertex neighbour: nearby triangles
+                                rm = r[miss]
+                                ok_n, t_n, tri_n = self._nearby_triangles(
+                                    tier, Ot[rm], D[rm], t_e[hf[edge[miss]]], lo[rm], lim[rm],
+                                    None if excl_arr is None else excl_arr[rm])
+                                ok_e[miss], t_x[miss], tri_e[miss] = ok_n, t_n, tri_n
+                            ok[edge], tx[edge], tri[edge] = ok_e, t_x, tri_e
+                            nrm[edge] = tier.normal[tri_e]
+                            dn[edge] = _dot(D[r], nrm[edge])
+                    else:
+                        tx = np.minimum(t_e[h[fl]], lim[rows])
+                        gap = np.abs(_dot(_rows(Ot, rows) - np.take(tier.v0, tri, axis=0), nrm))
+                        ok = ~((t_e[h[fl]] < seg[rows] + eps) & (gap <= 2.0 * eps))  # self-hit
+                    acc = ok & (tx < best_t[rows])
+                    nrm *= np.where(dn > 0.0, -1.0, 1.0)[:, None]   # toward the origin
+                    if len(rows) == m and acc.all():
+                        best_t[:], best_s[:], best_n[:] = tx, tier.tri_shape[tri], nrm
+                    else:
+                        r = rows[acc]
+                        best_t[r], best_s[r], best_n[r] = tx[acc], tier.tri_shape[tri[acc]], nrm[acc]
+                    rej[fl[~ok]] = True
+                # --- curved shells (sphere, cylinder, capsule)
+                cv = (curved & ~rej).nonzero()[0]
+                if len(cv):
+                    rows = rows_h[cv]
+                    nrm = tier.normal[ph[cv]]
+                    leaving = _dot(nrm, D[rows]) > 0.0
+                    todo = np.ones(len(cv), dtype=bool) if exact else leaving
+                    if not exact:  # FAST trusts the shell it enters
+                        keep = (~todo).nonzero()[0]
+                        r = rows[keep]
+                        tk = np.minimum(t_e[h[cv[keep]]], lim[r])
+                        better = tk < best_t[r]
+                        r, kb = r[better], keep[better]
+                        best_t[r], best_s[r], best_n[r] = tk[better], tier.tri_shape[ph[cv[kb]]], nrm[kb]
+                    tdo = todo.nonzero()[0]
+                    if len(tdo):
+                        rr = rows[tdo]
+                        sl = slot[cv[tdo]]
+                        ta, na = self._analytic(tier, sl, Ot[rr], D[rr], lo[rr], lim[rr])
+                        found = np.isfinite(ta)
+                        better = found & (ta < best_t[rr])
+                        r = rr[better]
+                        na = na[better]
+                        na[_dot(na, D[r]) > 0.0] *= -1.0
+                        best_t[r], best_s[r], best_n[r] = ta[better], tier.c_shape[sl[better]], na
+                        lim[rr] = np.minimum(lim[rr], np.where(found, ta, _INF))
+                        # continue if missed, or if something else could sit between the shell
+                        # crossing and the true surface (shell overlaps another shape)
+                        again = ~found | ((ta > t_e[h[cv[tdo]]] + eps) & ~tier.c_isolated[sl])
+                        rej[cv[tdo[again]]] = True
+                cont[h[rej]] = True
+            if not np.count_nonzero(cont):
+                act = act[:0]
+                break
+            ci = cont.nonzero()[0]
+            rows = act[ci]
+            te = t_e[ci]
+            stuck = te < seg[rows] + eps                  # no progress: widen the step
+            if delta is None:
+                delta = np.full(m, eps)
+            delta[rows] = np.where(stuck, delta[rows] * 4.0, eps)
+            seg[rows] = np.maximum(te, seg[rows]) + delta[rows]
+            act = rows[seg[rows] <= lim[rows] + eps]
+            self.counters["continued_rays"] += int(len(rows))
+        else:
+            self.counters["unresolved_rays"] += int(len(act))
+        return best_t, best_s, best_n

@@ -1,0 +1,372 @@
+"""Kinematic contact: a driven robot's body cannot enter solids (as bounding rays see them) or
+other robots' bodies. No physics engine: a blocked robot *slides* along what it touched.
+
+Robots move in the world xy-plane, so contact is solved in 2D within each robot's height band:
+
+* a robot's footprint is the vertical disc of radius ``R`` around its origin that contains its
+  body (exact for an upright cylinder, capsule or sphere; the circumscribed circle of a box);
+* an obstacle is a convex 2D set ``hull(points) ⊕ disc(radius)``: an upright box is its 4
+  corners, an upright cylinder or capsule a point with its radius, a sphere a point with the
+  radius of its widest section inside the band, anything else the convex hull of its projected
+  vertices (conservative); a vertical infinite plane is a two-sided wall line. Shapes entirely
+  above or below the robot's band (the floor it stands on) are ignored;
+* over one basic step the robot's centre moves along the chord from its start to its end pose
+  (poses are only observed at the end of steps, and the end point is the exact arc end unless
+  contact clips it). The chord is tested against every obstacle near it (an AABB broad phase)
+  in closed form — segment vs. offset edges and vertex circles of ``obstacle ⊕ disc(R)`` — so a
+  fast robot at a grazing angle cannot tunnel, whatever the step length.
+
+On contact the robot stops at the contact point and the rest of its displacement is projected on
+the contact's tangent (slide), up to three times per step (corners). A robot pushed straight into
+a wall therefore stops at the contact distance; one meeting it obliquely keeps the tangential
+part of its motion, as a Webots robot rubbing along a wall does. Its heading change is always
+applied (a disc turns freely), so a blocked robot can always turn away. Deterministic: robots are
+resolved in world order, each against the others' current positions. Float64 throughout.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sensorium.server.world import geometry as geo
+from sensorium.server.world.geometry import Pose
+
+EPS = 1e-9            # m: "touching" tolerance
+BACK_OFF = 1e-12      # m: contact points are placed this far outside, never on or inside
+MAX_SLIDES = 3
+UPRIGHT = 1.0 - 1e-12
+
+
+@dataclass(slots=True)
+class Obstacle:
+    """``hull(points) ⊕ disc(radius)`` in world xy (points counter-clockwise), or a wall line
+    ``normal · p + offset = 0`` when ``normal`` is set."""
+
+    name: str
+    owner: int                              # robot index, -1 for a solid
+    points: np.ndarray                      # (n, 2), n >= 1
+    radius: float
+    z_range: tuple[float, float]
+    normal: np.ndarray | None = None        # wall line
+    offset: float = 0.0
+    lo: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    hi: np.ndarray = field(default_factory=lambda: np.zeros(2))
+
+    def __post_init__(self) -> None:
+        if self.normal is not None:
+            self.lo = np.full(2, -math.inf)
+            self.hi = np.full(2, math.inf)
+        else:
+            self.lo = self.points.min(axis=0) - self.radius
+            self.hi = self.points.max(axis=0) + self.radius
+
+
+@dataclass(slots=True)
+class Footprint:
+    """A robot's disc: radius and height band relative to its origin."""
+
+    radius: float
+    z_low: float
+    z_high: float
+
+
+# ---------------------------------------------------------------------- shapes → 2D
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """Convex hull (counter-clockwise, no collinear points) of 2D points; 1 or 2 points if degenerate."""
+    pts = sorted({(float(x), float(y)) for x, y in points})
+    if len(pts) <= 2:
+        return np.array(pts, dtype=np.float64)
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    upper: list = []
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1], dtype=np.float64)
+
+
+def footprint(prim: geo.Primitive) -> Footprint | None:
+    """The disc containing a robot body (in the robot's frame, robot assumed upright)."""
+    if isinstance(prim, geo.Box):
+        sx, sy, sz = prim.size
+        return Footprint(math.hypot(sx, sy) / 2.0, -sz / 2.0, sz / 2.0)
+    if isinstance(prim, geo.Cylinder):
+        return Footprint(prim.radius, -prim.height / 2.0, prim.height / 2.0)
+    if isinstance(prim, geo.Capsule):
+        h = prim.height / 2.0 + prim.radius
+        return Footprint(prim.radius, -h, h)
+    if isinstance(prim, geo.Sphere):
+        return Footprint(prim.radius, -prim.radius, prim.radius)
+    if isinstance(prim, geo.Mesh):
+        v = prim.vertices
+        if len(v) == 0:
+            return None
+        return Footprint(float(np.max(np.hypot(v[:, 0], v[:, 1]))), float(v[:, 2].min()), float(v[:, 2].max()))
+    return None                                  # a plane body: no footprint
+
+
+def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle | None:
+    """A solid's (or robot body's) 2D obstacle at ``pose``; None for a non-vertical plane."""
+    r, t = pose.rotation, pose.translation
+    upright = abs(r[2, 2]) >= UPRIGHT
+    if isinstance(prim, geo.Plane):
+        n = r[:, 2]
+        if abs(n[2]) > 1e-9:
+            return None                          # floors, ceilings and slopes never block a planar robot
+        n2 = np.array([n[0], n[1]]) / math.hypot(n[0], n[1])
+        return Obstacle(name, owner, np.zeros((1, 2)), 0.0, (-math.inf, math.inf), n2, -float(n2 @ t[:2]))
+    if isinstance(prim, geo.Sphere):
+        return Obstacle(name, owner, t[None, :2].copy(), prim.radius, (t[2] - prim.radius, t[2] + prim.radius))
+    if isinstance(prim, (geo.Cylinder, geo.Capsule)) and upright:
+        h = prim.height / 2.0 + (prim.radius if isinstance(prim, geo.Capsule) else 0.0)
+        return Obstacle(name, owner, t[None, :2].copy(), prim.radius, (t[2] - h, t[2] + h))
+    if isinstance(prim, geo.Capsule):
+        ends = np.array([[0.0, 0.0, -prim.height / 2.0], [0.0, 0.0, prim.height / 2.0]]) @ r.T + t
+        return Obstacle(name, owner, _hull(ends[:, :2]), prim.radius,
+                        (float(ends[:, 2].min()) - prim.radius, float(ends[:, 2].max()) + prim.radius))
+    if isinstance(prim, geo.Box):
+        sx, sy, sz = (s / 2.0 for s in prim.size)
+        local = np.array([[x, y, z] for x in (-sx, sx) for y in (-sy, sy) for z in (-sz, sz)])
+    else:
+        local, _ = geo.tessellate(prim)          # circumscribed: conservative
+    world = local @ r.T + t
+    if len(world) == 0:
+        return None
+    return Obstacle(name, owner, _hull(world[:, :2]), 0.0, (float(world[:, 2].min()), float(world[:, 2].max())))
+
+
+def sphere_radius_in_band(ob: Obstacle, center_z: float, radius: float, low: float, high: float) -> float:
+    """The widest horizontal section of a sphere within the height band [low, high]."""
+    dz = 0.0 if low <= center_z <= high else min(abs(center_z - low), abs(center_z - high))
+    return math.sqrt(max(radius * radius - dz * dz, 0.0))
+
+
+# ---------------------------------------------------------------------- 2D queries
+
+def _closest_on_hull(p: np.ndarray, pts: np.ndarray) -> tuple[float, np.ndarray]:
+    """Signed distance from ``p`` to the convex hull ``pts`` (negative inside) and the outward
+    unit normal at the closest feature."""
+    n = len(pts)
+    if n == 1:
+        d = p - pts[0]
+        L = math.hypot(d[0], d[1])
+        return L, (d / L if L > 0 else np.array([1.0, 0.0]))
+    best = math.inf
+    best_n = np.array([1.0, 0.0])
+    inside = n >= 3
+    deepest = -math.inf
+    deep_n = best_n
+    for i in range(n if n >= 3 else 1):
+        a, b = pts[i], pts[(i + 1) % n]
+        e = b - a
+        ee = float(e @ e)
+        s = min(max(float((p - a) @ e) / ee, 0.0), 1.0)
+        q = a + s * e
+        d = p - q
+        L = math.hypot(d[0], d[1])
+        if L < best:
+            best, best_n = L, (d / L if L > 0 else np.array([e[1], -e[0]]) / math.sqrt(ee))
+        if n >= 3:
+            out = np.array([e[1], -e[0]]) / math.sqrt(ee)       # outward for counter-clockwise
+            side = float((p - a) @ out)
+            if side > 0:
+                inside = False
+            if side > deepest:
+                deepest, deep_n = side, out
+    if inside:
+        return deepest, deep_n
+    return best, best_n
+
+
+def _ray_circle(p: np.ndarray, d: np.ndarray, c: np.ndarray, rho: float) -> float:
+    """First s >= 0 where p + s·d enters the circle (c, rho); inf if never."""
+    f = p - c
+    a = float(d @ d)
+    b = float(f @ d)
+    cc = float(f @ f) - rho * rho
+    if a == 0.0 or b >= 0.0:
+        return math.inf                              # not approaching
+    disc = b * b - a * cc
+    if disc < 0.0:
+        return math.inf
+    return max((-b - math.sqrt(disc)) / a, 0.0)
+
+
+def _ray_segment(p: np.ndarray, d: np.ndarray, a: np.ndarray, b: np.ndarray, n: np.ndarray) -> float:
+    """First s >= 0 where p + s·d crosses the segment (a, b) against its outward normal n."""
+    dn = float(d @ n)
+    if dn >= 0.0:
+        return math.inf
+    s = float((a - p) @ n) / dn
+    if s < 0.0:
+        return math.inf
+    q = p + s * d - a
+    e = b - a
+    u = float(q @ e) / float(e @ e)
+    return s if -1e-12 <= u <= 1.0 + 1e-12 else math.inf
+
+
+def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tuple[float, np.ndarray | None]:
+    """Where the moving point ``p + s·d`` (s in [0, 1]) first touches ``ob ⊕ disc(rho)``:
+    ``(s, outward normal)``; ``(inf, None)`` if it does not (or starts touching and moves away)."""
+    if ob.normal is not None:                        # two-sided wall line
+        dist = float(ob.normal @ p) + ob.offset
+        side = 1.0 if dist >= 0.0 else -1.0
+        n = side * ob.normal
+        gap = abs(dist) - rho
+        rate = float(n @ d)
+        if gap <= EPS:
+            return (0.0, n) if rate < 0.0 else (math.inf, None)
+        if rate >= 0.0 or gap + rate > 0.0:
+            return math.inf, None
+        return gap / -rate, n
+    pts = ob.points
+    rad = ob.radius + rho
+    dist, normal = _closest_on_hull(p, pts)
+    if dist - rad <= EPS:                            # touching (or overlapping) now
+        if float(normal @ d) < 0.0:
+            return 0.0, normal
+        end_dist, _ = _closest_on_hull(p + d, pts)
+        return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
+    best, best_n = math.inf, None
+    n = len(pts)
+    for i in range(n):
+        s = _ray_circle(p, d, pts[i], rad)
+        if s < best:
+            best, best_n = s, (p + s * d - pts[i]) / rad
+    if n >= 2:
+        for i in range(n):                           # a segment (n = 2) gets both sides: a→b and b→a
+            a, b = pts[i], pts[(i + 1) % n]
+            e = b - a
+            out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
+            s = _ray_segment(p, d, a + rad * out, b + rad * out, out)
+            if s < best:
+                best, best_n = s, out
+    if best > 1.0:
+        return math.inf, None
+    return best, best_n
+
+
+# ---------------------------------------------------------------------- the resolver
+
+class Contact:
+    """The world's static obstacles plus the robots' discs; :meth:`resolve` clips one robot's move."""
+
+    def __init__(self, solids: list[tuple[str, geo.Primitive, Pose, bool]],
+                 robots: list[tuple[geo.Primitive | None, Pose]]):
+        """``solids``: (name, primitive, world pose, seen by bounding rays); ``robots``: (body
+        primitive or None, initial pose) in world order."""
+        self.prims = {name: prim for name, prim, _, bounding in solids if bounding}
+        self.solids: dict[str, Obstacle] = {}
+        for name, _, pose, bounding in solids:
+            if bounding:
+                self.update_solid(name, pose)
+        self.feet: list[Footprint | None] = [footprint(b) if b is not None else None for b, _ in robots]
+        self.centres = np.array([[p.translation[0], p.translation[1]] for _, p in robots], dtype=np.float64).reshape(-1, 2)
+        self.heights = np.array([p.translation[2] for _, p in robots], dtype=np.float64)
+        self.contacts = 0                         # robot-steps whose motion was clipped
+        self.checks = 0                           # narrow-phase obstacle tests
+        self._rebuild()
+
+    def update_solid(self, name: str, pose: Pose) -> None:
+        prim = self.prims.get(name)
+        if prim is None:
+            return
+        ob = obstacle(name, -1, prim, pose)
+        if ob is None:
+            self.solids.pop(name, None)
+        else:
+            self.solids[name] = ob
+        if hasattr(self, "feet"):
+            self._rebuild()
+
+    def _rebuild(self) -> None:
+        obs = list(self.solids.values())
+        self._obs = obs
+        self._lo = np.array([o.lo for o in obs]).reshape(-1, 2)
+        self._hi = np.array([o.hi for o in obs]).reshape(-1, 2)
+
+    def place(self, index: int, pose: Pose) -> None:
+        """A robot was moved from outside (set_pose, reset): no contact check, as in Webots."""
+        self.centres[index] = pose.translation[:2]
+        self.heights[index] = pose.translation[2]
+
+    def resolve(self, index: int, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, bool]:
+        """Clip robot ``index``'s move from ``start`` to ``end`` (xy): ``(final xy, clipped)``."""
+        foot = self.feet[index]
+        if foot is None:
+            self.centres[index] = end
+            return end, False
+        low, high = self.heights[index] + foot.z_low, self.heights[index] + foot.z_high
+        R = foot.radius
+        p = np.array(start, dtype=np.float64)
+        d = np.array(end, dtype=np.float64) - p
+        candidates = self._candidates(index, p, d, R, low, high)
+        clipped = False
+        for _ in range(MAX_SLIDES + 1):
+            if not (d[0] or d[1]):
+                break
+            best, best_n = math.inf, None
+            for ob, rho_extra in candidates:
+                self.checks += 1
+                s, n = time_of_impact(p, d, ob, R + rho_extra)
+                if s < best:
+                    best, best_n = s, n
+            if best_n is None:
+                p = p + d
+                break
+            clipped = True
+            length = math.hypot(d[0], d[1])
+            s = max(best - BACK_OFF / length, 0.0) if best > 0.0 else 0.0
+            p = p + s * d
+            rest = (1.0 - s) * d
+            into = float(rest @ best_n)
+            d = rest - into * best_n if into < 0.0 else rest
+        else:
+            pass                                  # out of slides: stay where the last one ended
+        if clipped:
+            self.contacts += 1
+        self.centres[index] = p
+        return p, clipped
+
+    def _candidates(self, index: int, p: np.ndarray, d: np.ndarray, R: float, low: float,
+                    high: float) -> list[tuple[Obstacle, float]]:
+        """Obstacles whose inflated AABB meets the move's AABB and whose height band meets the robot's."""
+        lo = np.minimum(p, p + d) - R - EPS
+        hi = np.maximum(p, p + d) + R + EPS
+        out: list[tuple[Obstacle, float]] = []
+        if len(self._obs):
+            hit = np.all((self._lo <= hi) & (self._hi >= lo), axis=1)
+            for i in np.flatnonzero(hit):
+                ob = self._obs[i]
+                if ob.z_range[1] <= low + EPS or ob.z_range[0] >= high - EPS:
+                    continue
+                prim = self.prims.get(ob.name)
+                if isinstance(prim, geo.Sphere):
+                    cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
+                    rr = sphere_radius_in_band(ob, cz, prim.radius, low, high)
+                    out.append((Obstacle(ob.name, -1, ob.points, rr, ob.z_range), 0.0))
+                else:
+                    out.append((ob, 0.0))
+        for j, foot in enumerate(self.feet):
+            if j == index or foot is None:
+                continue
+            lo_j, hi_j = self.heights[j] + foot.z_low, self.heights[j] + foot.z_high
+            if hi_j <= low + EPS or lo_j >= high - EPS:
+                continue
+            c = self.centres[j]
+            if np.all(c + foot.radius >= lo) and np.all(c - foot.radius <= hi):
+                out.append((Obstacle(f"robot {j}", j, c[None, :].copy(), foot.radius, (lo_j, hi_j)), 0.0))
+        return out

@@ -1,0 +1,42 @@
+"""A world file's summary (``sensorium info WORLD``, also its ``--json`` form): what it contains and
+how much geometry the scene builds from it (hence here, next to :mod:`.scene`, not in world/)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.scene import Scene
+from sensorium.server.world.loader import load_world
+
+__all__ = ["world_summary", "device_line"]
+
+
+def device_line(d) -> str:
+    if isinstance(d, wm.Lidar):
+        return (f"Lidar {d.type}/{d.projection} {d.horizontal_resolution}x{d.number_of_layers} "
+                f"fov {d.field_of_view:.4g} range [{d.min_range:g}, {d.max_range:g}]")
+    if isinstance(d, wm.DistanceSensor):
+        return f"DistanceSensor {d.type} rays {d.number_of_rays} aperture {d.aperture:g} max {d.lookup_table[-1][0] if d.lookup_table else 0:g} m"
+    return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
+
+
+def world_summary(path: str | Path) -> dict:
+    loaded = load_world(path)
+    w = loaded.world
+    scene = Scene(w, loaded.base_dir)
+    return {
+        "world": w.world_info.name,
+        "file": str(path),
+        "basic_time_step_ms": w.world_info.basic_time_step,
+        "random_seed": w.world_info.random_seed,
+        "solids": [{"name": s.name, "geometry": s.geometry.type, "seen_by": s.seen_by} for s in w.solids],
+        "triangles": scene.triangle_count,
+        "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
+        "robots": [
+            {"name": r.name, "synchronization": r.synchronization,
+             "devices": [{"name": d.name, "device": d.device, "summary": device_line(d)} for d in r.devices]}
+            for r in w.robots
+        ],
+        "warnings": loaded.warnings,
+    }
