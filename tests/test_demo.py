@@ -21,26 +21,25 @@ def _sensorium(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "sensorium", *args], capture_output=True, text=True, timeout=timeout)
 
 
-@pytest.mark.slow
 def test_demo_robots_behave_as_described_and_recording_replays(tmp_path: Path) -> None:
     out = tmp_path / "demo"
-    res = _sensorium("demo", "--duration", "50", "--out", str(out), "--json")
+    res = _sensorium("demo", "--duration", "40", "--out", str(out), "--json")
     assert res.returncode == 0, res.stderr + "".join((out / n).read_text() for n in ("server.log", "epuck.log", "scout.log")
                                                       if (out / n).exists())
     summary = json.loads(res.stdout)
     assert summary["exit_codes"] == {"server": 0, "epuck": 0, "scout": 0}
-    steps = 50_000 // 32                              # --until is rounded down to whole basic steps
+    steps = 40_000 // 32                              # --until is rounded down to whole basic steps
     assert summary["simulated_s"] == steps * 32 / 1000
     assert summary["messages"]["/clock"] == steps and summary["messages"]["/epuck/pose"] == steps
     assert summary["messages"]["/scout/lidar/laser_scan"] > 0
     # the light follower reaches the lamp (its sensors saturate ~0.45 m from it) and stays there
     assert summary["lamp_distance_start"] > 3.0
-    assert summary["lamp_reached_s"] is not None and summary["lamp_reached_s"] < 48
-    assert summary["lamp_distance_end"] < 0.55
-    assert summary["lamp_distance_max_after_reached"] < 0.6
+    assert summary["lamp_reached_s"] is not None and summary["lamp_reached_s"] < 35      # ~25 s in this world
+    assert summary["lamp_distance_end"] < 0.6
+    assert summary["lamp_distance_max_after_reached"] <= 0.6
     assert summary["light_end"] > 10 * summary["light_start"]
     # the wanderer keeps exploring: many distinct floor cells, driven distance not back-and-forth
-    assert summary["cells_visited"]["scout"] >= 10
+    assert summary["cells_visited"]["scout"] >= 10                                        # of 64
     assert summary["smoothness"]["scout"] > 0.8 and summary["smoothness"]["epuck"] > 0.8
     assert summary["distance_m"]["scout"] > 6.0
     # the picture: a real PNG of matplotlib's size

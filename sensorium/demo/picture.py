@@ -35,8 +35,8 @@ def _hull(points: np.ndarray) -> np.ndarray:
 
 def _footprint(geometry, pose, base_dir: Path) -> np.ndarray | None:
     """The outline, seen from above, of a shape placed at ``pose`` (None for planes)."""
-    from sensorium.server.world import geometry as geo
     from sensorium.server.sim.scene import primitive_from_model
+    from sensorium.server.world import geometry as geo
 
     prim = primitive_from_model(geometry, base_dir)
     if isinstance(prim, geo.Plane):
@@ -101,6 +101,8 @@ def draw_picture(result: DemoResult, loaded, paths: dict, out: Path,
                                      closed=True, facecolor="0.96", edgecolor="none", zorder=0))
             continue
         transparent = a is not None and a.transparency >= 1.0
+        if min(colour) > 0.75:                       # white walls would vanish on the light floor
+            colour = (0.55, 0.55, 0.55)
         ax.add_patch(Polygon(outline, closed=True, zorder=1, linewidth=1.0,
                              facecolor="none" if transparent else colour, alpha=1.0 if transparent else 0.55,
                              edgecolor="0.25", linestyle="--" if transparent else "-"))

@@ -17,7 +17,7 @@ import numpy as np
 from sensorium.demo.runner import DemoResult
 
 CELL_M = 0.5
-LAMP_NEAR_M = 0.5
+LAMP_NEAR_M = 0.6               # the follower's light sensors saturate ~0.45 m from the arena's lamp
 FOLLOWER = "epuck"
 
 
