@@ -124,6 +124,7 @@ def _record_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rcvhwm", type=int, default=1000, help="receive high-water mark, messages (default 1000)")
     p.add_argument("--chunk-size", type=int, default=1 << 20, help="MCAP chunk size in bytes (default 1 MiB)")
     p.add_argument("--json", action="store_true", help="print the final summary as JSON")
+    p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
 
 
 def _seconds(text: str) -> float:

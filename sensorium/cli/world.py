@@ -8,6 +8,7 @@ import argparse
 import json
 import math
 import sys
+from pathlib import Path
 
 from sensorium.server.sim.summary import world_summary
 from sensorium.server.world.loader import WorldError, default_world_path, load_world
@@ -31,6 +32,10 @@ def validate(args: argparse.Namespace) -> int:
 
 def info(args: argparse.Namespace) -> int:
     path = args.path or str(default_world_path())
+    if Path(path).is_dir():
+        from sensorium.cli.recording import print_bag_info  # a rosbag2 directory (sensorium export)
+
+        return print_bag_info(path, as_json=args.json)
     if str(path).endswith(".mcap"):
         from sensorium.cli.recording import print_info  # recordings
 

@@ -240,6 +240,10 @@ class ExportReport:
     topics: dict[str, str] = field(default_factory=dict)  # topic -> exported type
     skipped: dict[str, int] = field(default_factory=dict)  # topic -> messages not exported
     reasons: dict[str, str] = field(default_factory=dict)
+    truncated: bool = False                                # the source was not finished (writer killed?)
+    readable_bytes: int | None = None                      # ... and only this much of it could be read
+    size_bytes: int = 0
+    last_stamp_ns: int | None = None                       # the last message exported
 
 
 def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report: ExportReport,
@@ -261,6 +265,7 @@ def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report
             report.reasons.setdefault(m.topic, f"{type(exc).__name__}: {exc}")
             continue
         report.topics.setdefault(m.topic, typename)
+        report.last_stamp_ns = m.stamp_ns if report.last_stamp_ns is None else max(report.last_stamp_ns, m.stamp_ns)
         yield m, typename, msg
 
 
@@ -286,6 +291,10 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
             _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns)
         else:
             raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
+        report.size_bytes = rec.path.stat().st_size
+        if rec.truncated:
+            report.truncated = True
+            report.readable_bytes = rec._scan().get("stopped_at")
     return report
 
 
@@ -337,6 +346,17 @@ def _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world,
                                       if name.endswith((".yaml", ".yml")) else "application/octet-stream", data=data)
         finally:
             writer.finish()
+
+
+def truncation_warning(report: ExportReport) -> str | None:
+    """One line saying how much of a truncated recording was exported, or None."""
+    if not report.truncated:
+        return None
+    upto = "no message" if report.last_stamp_ns is None else f"up to t={report.last_stamp_ns / 1e9:.3f} s"
+    part = (f", read from the first {report.readable_bytes} of its {report.size_bytes} bytes"
+            if report.readable_bytes is not None else "")
+    return (f"warning: the recording is truncated (not finished: the writer was killed?): exported "
+            f"{report.messages} messages, {upto}{part}; the rest is lost")
 
 
 def print_report(report: ExportReport, file=sys.stdout) -> None:
