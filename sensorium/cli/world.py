@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from sensorium.server.sim.summary import world_summary
-from sensorium.server.world.loader import WorldError, default_world_path, load_world
+from sensorium.server.world.loader import WorldError, bundled_or_path, default_world_path, load_world
 
 
 def validate(args: argparse.Namespace) -> int:
@@ -31,7 +31,7 @@ def validate(args: argparse.Namespace) -> int:
 
 
 def info(args: argparse.Namespace) -> int:
-    path = args.path or str(default_world_path())
+    path = str(bundled_or_path(args.path)) if args.path else str(default_world_path())
     if Path(path).is_dir():
         from sensorium.cli.recording import print_bag_info  # a rosbag2 directory (sensorium export)
 

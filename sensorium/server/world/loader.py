@@ -70,13 +70,32 @@ class LoadedWorld:
     warnings: list[str] = field(default_factory=list)
 
 
-def load_world(path: str | Path) -> LoadedWorld:
+def bundled_or_path(path: str | Path) -> Path:
+    """``path``, or the bundled world of that bare name (``arena``, ``warehouse.yaml``) when no such
+    file exists here: examples then work from any directory."""
     path = Path(path)
+    if not path.exists() and path.parent == Path("."):
+        from sensorium import worlds
+
+        try:
+            return worlds.world_path(path.name)
+        except FileNotFoundError:
+            pass
+    return path
+
+
+def load_world(path: str | Path) -> LoadedWorld:
+    path = bundled_or_path(path)
     source = str(path)
     try:
         text = path.read_bytes()
     except OSError as exc:
-        raise WorldError(source, [Problem("", f"cannot read world file: {exc.strerror or exc}")]) from None
+        hint = ""
+        if not path.exists() and path.parent == Path("."):
+            from sensorium import worlds
+
+            hint = f" (nor a bundled world: {', '.join(worlds.names())})"
+        raise WorldError(source, [Problem("", f"cannot read world file: {exc.strerror or exc}{hint}")]) from None
     try:
         if path.suffix.lower() == ".json":
             data = json.loads(text)
