@@ -120,3 +120,15 @@ def test_robot_model_rejects_unknown_controller_value_with_its_path():
     with pytest.raises(ValidationError) as e:
         wm.World.model_validate({"robots": [{"name": "r", "controller": ""}]})
     assert "controller" in str(e.value)
+
+
+def test_wbt_controllers_map_to_extern_or_none(tmp_path):
+    from sensorium.server.world.loader import load_world
+
+    wbt = tmp_path / "w.wbt"
+    wbt.write_text('#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 32 }\n'
+                   'Robot { name "a" controller "e-puck_avoid" }\nRobot { name "b" controller "<none>" }\n'
+                   'Robot { name "c" controller "" }\nRobot { name "d" }\n')
+    loaded = load_world(wbt)
+    assert [r.controller for r in loaded.world.robots] == ["<extern>", "<none>", "<none>", "<extern>"]
+    assert any("e-puck_avoid" in w and "sensorium controller" in w for w in loaded.warnings)

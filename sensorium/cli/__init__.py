@@ -23,7 +23,15 @@ def command(name: str, help: str, target: str):
 
 @command("validate", "check a world file; exit 1 listing every problem", "sensorium.cli.world:validate")
 def _validate_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("world", nargs="+", help="world file(s), YAML or JSON")
+    p.add_argument("world", nargs="+", help="world file(s): YAML, JSON or Webots .wbt")
+
+
+@command("convert", "write a Webots world (.wbt) as an equivalent Sensorium world file",
+         "sensorium.cli.convert:convert")
+def _convert_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("world", help="Webots world file (.wbt, R2022a or later)")
+    p.add_argument("out", help="output world file (.yaml, .yml or .json; '-' = YAML on standard output)")
+    p.add_argument("--force", action="store_true", help="overwrite OUT if it exists")
 
 
 @command("info", "summarise a world file (or a .mcap recording)", "sensorium.cli.world:info")

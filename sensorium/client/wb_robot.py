@@ -202,7 +202,7 @@ class RobotClient:
         if duration is None:
             duration = self.basic_time_step
         if isinstance(duration, bool) or not isinstance(duration, int):
-            if isinstance(duration, float) and duration.is_integer():
+            if isinstance(duration, float) and float(duration).is_integer():
                 duration = int(duration)
             else:
                 raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be an integer (ms), got {duration!r}")
@@ -304,7 +304,7 @@ class RobotClient:
 
     def enable(self, dev: DeviceState, period: int, func: str) -> None:
         if isinstance(period, bool) or not isinstance(period, int):
-            if isinstance(period, float) and period.is_integer():
+            if isinstance(period, float) and float(period).is_integer():
                 period = int(period)
             else:
                 raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer (ms), got {period!r}")

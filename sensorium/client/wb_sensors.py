@@ -199,7 +199,7 @@ def wb_lidar_get_range_image(tag: int) -> Any:
     Zeros before the first measurement."""
     buf = lidar_range_bytes(tag)
     if arrays.numpy_module() is None:
-        return arrays.float32s(buf)
+        return arrays.float32s(buf or b"")
     r = current()
     return r.range_image(r.devices[tag - 1])
 

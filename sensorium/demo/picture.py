@@ -45,6 +45,29 @@ def _footprint(geometry, pose, base_dir: Path) -> np.ndarray | None:
     return _hull(pose.apply(vertices)[:, :2])
 
 
+def _draw_shape(ax, Polygon, name: str, shape, pose, base_dir: Path) -> None:
+    """One shape of a solid, seen from above: its outline filled with its colour, its name."""
+    outline = _footprint(shape.geometry, pose, base_dir)
+    a = shape.appearance
+    colour = tuple(a.base_color) if a else (0.7, 0.7, 0.7)
+    if outline is None:                              # a plane (the floor): its extent if finite
+        size = getattr(shape.geometry, "size", None)
+        if size:
+            c = pose.translation
+            corners = [(c[0] + sx * size[0] / 2, c[1] + sy * size[1] / 2) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+            ax.add_patch(Polygon(corners, closed=True, facecolor="0.96", edgecolor="none", zorder=0))
+        return
+    transparent = a is not None and a.transparency >= 1.0
+    if min(colour) > 0.75:                           # white walls would vanish on the light floor
+        colour = (0.55, 0.55, 0.55)
+    ax.add_patch(Polygon(outline, closed=True, zorder=1, linewidth=1.0,
+                         facecolor="none" if transparent else colour, alpha=1.0 if transparent else 0.55,
+                         edgecolor="0.25", linestyle="--" if transparent else "-"))
+    if not name.startswith("wall"):
+        ax.annotate(name + (" (glass)" if transparent else ""), outline.mean(axis=0), xytext=(0, -14),
+                    textcoords="offset points", ha="center", fontsize=7, color="0.3", zorder=6)
+
+
 def _yaw(q: dict) -> float:
     return math.atan2(2 * (q["w"] * q["z"] + q["x"] * q["y"]), 1 - 2 * (q["y"] ** 2 + q["z"] ** 2))
 
@@ -84,40 +107,25 @@ def draw_picture(result: DemoResult, loaded, paths: dict, out: Path,
     except ImportError:
         log("demo: matplotlib is not installed: no picture (pip install matplotlib)")
         return None
+    from sensorium.server.sim.scene import place_light, solid_lights, solid_parts
     from sensorium.server.world.poses import pose_from_model
 
     world = loaded.world
     fig, ax = plt.subplots(figsize=(8.5, 8), dpi=110)
     for s in world.solids:
-        outline = _footprint(s.geometry, pose_from_model(s.pose), loaded.base_dir)
-        a = s.appearance
-        colour = tuple(a.base_color) if a else (0.7, 0.7, 0.7)
-        if outline is None:                          # the floor: a plane, drawn as its extent if finite
-            size = getattr(s.geometry, "size", None)
-            if size:
-                c = pose_from_model(s.pose).translation
-                ax.add_patch(Polygon([(c[0] - size[0] / 2, c[1] - size[1] / 2), (c[0] + size[0] / 2, c[1] - size[1] / 2),
-                                      (c[0] + size[0] / 2, c[1] + size[1] / 2), (c[0] - size[0] / 2, c[1] + size[1] / 2)],
-                                     closed=True, facecolor="0.96", edgecolor="none", zorder=0))
-            continue
-        transparent = a is not None and a.transparency >= 1.0
-        if min(colour) > 0.75:                       # white walls would vanish on the light floor
-            colour = (0.55, 0.55, 0.55)
-        ax.add_patch(Polygon(outline, closed=True, zorder=1, linewidth=1.0,
-                             facecolor="none" if transparent else colour, alpha=1.0 if transparent else 0.55,
-                             edgecolor="0.25", linestyle="--" if transparent else "-"))
-        if not s.name.startswith("wall"):
-            c = outline.mean(axis=0)
-            ax.annotate(s.name + (" (glass)" if transparent else ""), c, xytext=(0, -14), textcoords="offset points",
-                        ha="center", fontsize=7, color="0.3", zorder=6)
-    for lt in world.lights:
+        for name, pose, shape in solid_parts(s, pose_from_model(s.pose)):
+            _draw_shape(ax, Polygon, name, shape, pose, loaded.base_dir)
+    lights = [lt for lt in world.lights]
+    for s in world.solids:
+        lights += [place_light(lt, frame) for lt, frame in solid_lights(s, pose_from_model(s.pose))]
+    for lt in lights:
         if lt.type == "DirectionalLight" or not lt.on:
             continue
         x, y = lt.location[0], lt.location[1]
         ax.plot([x], [y], marker="*", markersize=20, color="gold", markeredgecolor="darkgoldenrod", zorder=5,
                 linestyle="none")
-        ax.annotate(f"{lt.name} ({lt.type})", (x, y), xytext=(8, 8), textcoords="offset points", fontsize=8,
-                    color="darkgoldenrod", zorder=6)
+        ax.annotate(f"{lt.name or 'light'} ({lt.type})", (x, y), xytext=(8, 8), textcoords="offset points",
+                    fontsize=8, color="darkgoldenrod", zorder=6)
     roles = {c.robot: c.role for c in CONTROLLERS}
     for i, robot in enumerate(r.name for r in world.robots):
         if robot not in paths:
@@ -136,9 +144,9 @@ def draw_picture(result: DemoResult, loaded, paths: dict, out: Path,
         xy, t = scan
         ax.scatter(xy[:, 0], xy[:, 1], s=4, color="crimson", zorder=4,
                    label=f"{SCAN_ROBOT}'s last lidar scan (t = {t:.1f} s)")
-    sun = [lt for lt in world.lights if lt.type == "DirectionalLight" and lt.on]
+    sun = [lt for lt in lights if lt.type == "DirectionalLight" and lt.on]
     if sun:
-        ax.plot([], [], linestyle="none", label=", ".join(f"{lt.name}: directional light" for lt in sun))
+        ax.plot([], [], linestyle="none", label=", ".join(f"{lt.name or 'light'}: directional light" for lt in sun))
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")

@@ -103,6 +103,15 @@ class Plane(Strict):
         return v
 
 
+class Triangles(Strict):
+    """Triangles given inline (Webots' IndexedFaceSet, triangulated): vertex coordinates and index
+    triples into them, in the shape's frame."""
+
+    type: Literal["triangles"]
+    vertices: list[Vec3] = Field(max_length=1_000_000)
+    faces: list[tuple[int, int, int]] = Field(min_length=1, max_length=2_000_000)
+
+
 class Mesh(Strict):
     """Triangle mesh file (STL, OBJ, PLY, GLB) loaded with trimesh; path relative to the world file."""
 
@@ -111,7 +120,7 @@ class Mesh(Strict):
     scale: Vec3 = (1.0, 1.0, 1.0)
 
 
-Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Mesh, Field(discriminator="type")]
+Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Triangles | Mesh, Field(discriminator="type")]
 
 
 class Appearance(Strict):
@@ -141,8 +150,10 @@ class Shape(Strict):
     seen_by: SeenBy = "both"
 
 
-class Solid(Shape):
-    name: str = Field(min_length=1)
+class Part(Shape):
+    """One shape of a body made of several shapes, placed by ``pose`` in its owner's frame."""
+
+    name: str | None = None
     pose: Pose = Pose()
 
 
@@ -206,6 +217,28 @@ class DirectionalLight(_Light):
 
 
 Light = Annotated[PointLight | SpotLight | DirectionalLight, Field(discriminator="type")]
+
+
+# ---------------------------------------------------------------- solids
+
+class Solid(Strict):
+    """A static object (movable by a supervisor), seen by rays through its shapes.
+
+    ``geometry`` (with ``appearance``/``seen_by``) is the solid's own shape at its origin;
+    ``shapes`` adds further shapes each with its own offset; ``children`` are solids fixed to this
+    one (poses relative to it, nested to any depth, moving with it); ``lights`` are lights fixed to
+    it (``location`` and a SpotLight's ``direction`` in its frame; a DirectionalLight's direction
+    stays in world axes, as in Webots).
+    """
+
+    name: str = Field(min_length=1)
+    pose: Pose = Pose()
+    geometry: Geometry | None = None
+    appearance: Appearance | None = None
+    seen_by: SeenBy = "both"
+    shapes: list[Part] = []
+    children: list[Solid] = []
+    lights: list[Light] = []
 
 
 # ---------------------------------------------------------------- devices
@@ -332,6 +365,8 @@ class Robot(Strict):
     model: str = Field(default="", max_length=4096, description="Webots model (getModel)")
     self_collision: bool = False
     body: Shape | None = None
+    shapes: list[Part] = Field(default=[], description="further body shapes, each with its pose in the robot frame")
+    lights: list[Light] = Field(default=[], description="lights carried by the robot (location/direction in its frame)")
     differential_drive: DifferentialDrive | None = None
     devices: list[Device] = []
 
@@ -342,6 +377,9 @@ class WorldInfo(Strict):
     random_seed: int = Field(default=0, ge=0, lt=2**63)
     contact: bool = Field(default=True, description="kinematic contact: a robot's body stops at solids and other "
                                                     "robots' bodies (README 'Kinematic contact'); false = pass through")
+    coordinate_system: Literal["ENU", "NUE"] = Field(
+        default="ENU", description="world axes: ENU = x east, y north, z up; NUE = x north, y up, z east. "
+        "Only the up axis matters here: differential drives move in the plane normal to it")
 
 
 class World(Strict):

@@ -117,6 +117,25 @@ def footprint(prim: geo.Primitive) -> Footprint | None:
     return None                                  # a plane body: no footprint
 
 
+def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None:
+    """The disc (about the robot's origin) containing every body shape, each at its offset in the
+    robot frame: conservative for off-centre shapes, exact for one centred upright shape."""
+    feet = []
+    for prim, local in parts:
+        f = footprint(prim)
+        if f is None:
+            continue
+        x, y, z = (float(v) for v in local.translation)
+        if not np.allclose(local.rotation, np.eye(3)):
+            # a tilted shape: bound it by its circumscribed sphere
+            r = math.hypot(f.radius, max(abs(f.z_low), abs(f.z_high)))
+            f = Footprint(r, -r, r)
+        feet.append(Footprint(math.hypot(x, y) + f.radius, z + f.z_low, z + f.z_high))
+    if not feet:
+        return None
+    return Footprint(max(f.radius for f in feet), min(f.z_low for f in feet), max(f.z_high for f in feet))
+
+
 def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle | None:
     """A solid's (or robot body's) 2D obstacle at ``pose``; None for a non-vertical plane."""
     r, t = pose.rotation, pose.translation
@@ -264,16 +283,22 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
 class Contact:
     """The world's static obstacles plus the robots' discs; :meth:`resolve` clips one robot's move."""
 
-    def __init__(self, solids: list[tuple[str, geo.Primitive, Pose, bool]],
-                 robots: list[tuple[geo.Primitive | None, Pose]]):
-        """``solids``: (name, primitive, world pose, seen by bounding rays); ``robots``: (body
-        primitive or None, initial pose) in world order."""
-        self.prims = {name: prim for name, prim, _, bounding in solids if bounding}
-        self.solids: dict[str, Obstacle] = {}
-        for name, _, pose, bounding in solids:
+    def __init__(self, solids: list[tuple[str, geo.Primitive, Pose, Pose, bool]],
+                 robots: list[tuple[list[tuple[geo.Primitive, Pose]], Pose]]):
+        """``solids``: one entry per shape — (solid name, primitive, pose in the solid's frame, the
+        solid's world pose, seen by bounding rays); a solid made of several shapes (or with nested
+        children) gives several entries under one name, moved together. ``robots``: (body shapes
+        with their poses in the robot frame, initial pose) in world order."""
+        self.prims: dict[str, list[tuple[geo.Primitive, Pose]]] = {}
+        first_pose: dict[str, Pose] = {}
+        for name, prim, local, pose, bounding in solids:
             if bounding:
-                self.update_solid(name, pose)
-        self.feet: list[Footprint | None] = [footprint(b) if b is not None else None for b, _ in robots]
+                self.prims.setdefault(name, []).append((prim, local))
+                first_pose.setdefault(name, pose)
+        self.solids: dict[tuple[str, int], Obstacle] = {}
+        for name, pose in first_pose.items():
+            self.update_solid(name, pose)
+        self.feet: list[Footprint | None] = [robot_footprint(parts) for parts, _ in robots]
         self.centres = np.array([[p.translation[0], p.translation[1]] for _, p in robots], dtype=np.float64).reshape(-1, 2)
         self.heights = np.array([p.translation[2] for _, p in robots], dtype=np.float64)
         self.contacts = 0                         # robot-steps whose motion was clipped
@@ -281,14 +306,12 @@ class Contact:
         self._rebuild()
 
     def update_solid(self, name: str, pose: Pose) -> None:
-        prim = self.prims.get(name)
-        if prim is None:
-            return
-        ob = obstacle(name, -1, prim, pose)
-        if ob is None:
-            self.solids.pop(name, None)
-        else:
-            self.solids[name] = ob
+        for i, (prim, local) in enumerate(self.prims.get(name, ())):
+            ob = obstacle(name, -1, prim, pose.compose(local))
+            if ob is None:
+                self.solids.pop((name, i), None)
+            else:
+                self.solids[(name, i)] = ob
         if hasattr(self, "feet"):
             self._rebuild()
 

@@ -85,14 +85,24 @@ def _rz(yaw: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+# world axes → ENU axes (x east, y north, z up) for each supported WorldInfo.coordinate_system
+_TO_ENU = {
+    "ENU": None,
+    "NUE": np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),  # x north, y up, z east
+}
+
+
 class DifferentialDrive:
     """The drive of one robot: two wheel motors and the robot's planar state (x, y, yaw).
 
     The robot's rotation is kept as ``Rz(yaw) @ base`` where ``base`` is the part of its initial
-    rotation that is not a turn about world z, so a tilted robot keeps its tilt while driving.
+    rotation that is not a turn about the up axis, so a tilted robot keeps its tilt while driving.
+    The state is kept in ENU axes; in a NUE world poses are converted on the way in and out, so the
+    robot drives on the ground plane (normal +y) there.
     """
 
-    def __init__(self, config, pose: Pose):
+    def __init__(self, config, pose: Pose, up: str = "ENU"):
+        self._to_enu = _TO_ENU[up]
         self.wheel_radius = float(config.wheel_radius)
         self.axle_length = float(config.axle_length)
         self.left = WheelMotor(config.left_motor, float(config.max_wheel_speed))
@@ -101,6 +111,8 @@ class DifferentialDrive:
 
     def reset(self, pose: Pose) -> None:
         """Take over a pose set from outside (initial pose, supervisor set_pose)."""
+        if self._to_enu is not None:
+            pose = Pose(self._to_enu @ pose.rotation, self._to_enu @ pose.translation)
         forward = pose.rotation[:, 0]
         self.yaw = math.atan2(forward[1], forward[0])
         self.base = _rz(-self.yaw) @ pose.rotation
@@ -126,4 +138,7 @@ class DifferentialDrive:
         return self.pose()
 
     def pose(self) -> Pose:
-        return Pose(rotation=_rz(self.yaw) @ self.base, translation=np.array([self.x, self.y, self.z]))
+        r, t = _rz(self.yaw) @ self.base, np.array([self.x, self.y, self.z])
+        if self._to_enu is not None:
+            r, t = self._to_enu.T @ r, self._to_enu.T @ t
+        return Pose(rotation=r, translation=t)

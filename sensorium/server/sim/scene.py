@@ -1,13 +1,16 @@
 """Validated world → scene: ray-engine bodies, per-shape metadata, lights, robot poses.
 
-Every solid is one static body (until it is moved); every robot is one movable body (its optional
-body geometry). The global shape index returned by the ray engine indexes ``Scene.shapes``, which
+Every top-level solid is one static body (until it is moved) holding its own shapes and those of
+its nested children, poses composed at load time; every robot is one movable body (its body
+shapes). Lights attached to a solid or robot are kept with their local frame and placed in the
+world on demand (``world_lights``). The global shape index returned by the ray engine indexes ``Scene.shapes``, which
 carries what the devices need: owner robot, and the red channel and roughness infra-red sensors
 read.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +20,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.raycast.engine import Precision, RayEngine, ShapeEntry
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
-from sensorium.server.world.meshes import load_mesh
+from sensorium.server.world.meshes import load_mesh, triangles_mesh
 from sensorium.server.world.poses import pose_from_model
 
 
@@ -30,7 +33,8 @@ class ShapeInfo:
     transparency: float
 
 
-def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.Plane | wm.Mesh, base_dir: Path) -> geo.Primitive:
+def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.Plane | wm.Triangles | wm.Mesh,
+                         base_dir: Path) -> geo.Primitive:
     if isinstance(g, wm.Box):
         return geo.Box(size=tuple(g.size))
     if isinstance(g, wm.Sphere):
@@ -43,10 +47,12 @@ def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.P
         return geo.Plane(size=None if g.size is None else tuple(g.size))
     if isinstance(g, wm.Mesh):
         return load_mesh(base_dir / g.url, g.scale)
+    if isinstance(g, wm.Triangles):
+        return triangles_mesh(g.vertices, g.faces)
     raise TypeError(f"unknown geometry {g!r}")
 
 
-def _shape_info(name: str, owner: int, shape: wm.Shape) -> ShapeInfo:
+def _shape_info(name: str, owner: int, shape: wm.Shape | wm.Solid) -> ShapeInfo:
     a = shape.appearance
     if a is None:
         return ShapeInfo(name, owner, red=1.0, roughness=0.0, transparency=0.0)
@@ -54,15 +60,54 @@ def _shape_info(name: str, owner: int, shape: wm.Shape) -> ShapeInfo:
                      transparency=a.transparency)
 
 
-def _entry(shape: wm.Shape, base_dir: Path) -> ShapeEntry:
+def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None) -> ShapeEntry:
     transparent = shape.appearance is not None and shape.appearance.transparency >= 1.0
+    assert shape.geometry is not None
     return ShapeEntry(
         primitive=primitive_from_model(shape.geometry, base_dir),
-        local_pose=Pose.identity(),
+        local_pose=local if local is not None else Pose.identity(),
         bounding=shape.seen_by in ("both", "bounding"),
         visual=shape.seen_by in ("both", "visual"),
         transparent=transparent,
     )
+
+
+def solid_parts(solid: wm.Solid, frame: Pose) -> Iterator[tuple[str, Pose, wm.Shape | wm.Solid]]:
+    """Every shape of a solid and its nested children: (name, pose in ``frame``'s parent, shape)."""
+    if solid.geometry is not None:
+        yield solid.name, frame, solid
+    for part in solid.shapes:
+        yield part.name or solid.name, frame.compose(pose_from_model(part.pose)), part
+    for child in solid.children:
+        yield from solid_parts(child, frame.compose(pose_from_model(child.pose)))
+
+
+def solid_lights(solid: wm.Solid, frame: Pose) -> Iterator[tuple[wm.PointLight | wm.SpotLight | wm.DirectionalLight, Pose]]:
+    """Every light fixed to a solid or its children, with its frame relative to the top solid."""
+    for lt in solid.lights:
+        yield lt, frame
+    for child in solid.children:
+        yield from solid_lights(child, frame.compose(pose_from_model(child.pose)))
+
+
+def robot_parts(robot: wm.Robot) -> Iterator[tuple[str, Pose, wm.Shape]]:
+    if robot.body is not None:
+        yield f"{robot.name}/body", Pose.identity(), robot.body
+    for part in robot.shapes:
+        yield f"{robot.name}/{part.name or 'body'}", pose_from_model(part.pose), part
+
+
+def place_light(model, pose: Pose):
+    """A light model with ``location``/``direction`` moved from its owner's frame to the world.
+
+    A DirectionalLight's direction stays in world axes wherever it is attached (as in Webots, whose
+    renderer ignores a directional light's parent transform)."""
+    upd: dict = {}
+    if hasattr(model, "location"):
+        upd["location"] = tuple(float(v) for v in pose.apply(np.asarray(model.location)))
+    if model.type == "SpotLight":
+        upd["direction"] = tuple(float(v) for v in pose.apply_dirs(np.asarray(model.direction)))
+    return model.model_copy(update=upd)
 
 
 class Scene:
@@ -74,37 +119,62 @@ class Scene:
         self.solid_names = [s.name for s in world.solids]
         self._solid_body: dict[str, int] = {}
         self.solid_poses: dict[str, Pose] = {}
+        self.triangle_count = 0
+        # lights: (model, owner, pose in the owner's frame); owner None = world, str = solid, int = robot
+        self._lights: list[tuple[object, str | int | None, Pose]] = [(lt, None, Pose.identity()) for lt in world.lights]
         for s in world.solids:
             pose = pose_from_model(s.pose)
-            self._solid_body[s.name] = self.engine.add_body([_entry(s, base_dir)], pose, owner=-1, movable=False)
-            self.shapes.append(_shape_info(s.name, -1, s))
             self.solid_poses[s.name] = pose
+            self._lights += [(lt, s.name, f) for lt, f in solid_lights(s, Pose.identity())]
+            parts = list(solid_parts(s, Pose.identity()))
+            if parts:
+                self._solid_body[s.name] = self._add_body(parts, base_dir, pose, owner=-1, movable=False)
         self.robot_names = [r.name for r in world.robots]
         self.robot_poses: list[Pose] = []
         self._robot_body: dict[int, int] = {}
         for i, r in enumerate(world.robots):
             pose = pose_from_model(r.pose)
             self.robot_poses.append(pose)
-            if r.body is not None:
-                self._robot_body[i] = self.engine.add_body([_entry(r.body, base_dir)], pose, owner=i, movable=True)
-                self.shapes.append(_shape_info(f"{r.name}/body", i, r.body))
-        self.triangle_count = sum(
-            geo.triangle_count(primitive_from_model(s.geometry, base_dir))
-            for s in [*world.solids, *[r.body for r in world.robots if r.body is not None]]
-            if not isinstance(s.geometry, wm.Plane)
-        )
+            self._lights += [(lt, i, Pose.identity()) for lt in r.lights]
+            parts = list(robot_parts(r))
+            if parts:
+                self._robot_body[i] = self._add_body(parts, base_dir, pose, owner=i, movable=True)
+        self._attached = {owner for _, owner, _ in self._lights if owner is not None}
+        self.lights_version = 0        # changes whenever a light moves with its owner
         # infra-red reads these per hit shape; -1 (no hit) indexes the trailing "no hit" entry
         self.red = np.array([s.red for s in self.shapes] + [1.0])
         self.roughness = np.array([s.roughness for s in self.shapes] + [0.0])
 
+    def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool) -> int:
+        entries = [_entry(shape, base_dir, local) for _, local, shape in parts]
+        self.triangle_count += sum(geo.triangle_count(e.primitive) for e in entries)
+        self.shapes += [_shape_info(name, owner, shape) for name, _, shape in parts]
+        return self.engine.add_body(entries, pose, owner=owner, movable=movable)
+
+    def world_lights(self) -> list:
+        """Every light model with its location and direction in world coordinates (now)."""
+        out = []
+        for model, owner, local in self._lights:
+            if owner is None:
+                out.append(model)
+            else:
+                frame = self.robot_poses[owner] if isinstance(owner, int) else self.solid_poses[owner]
+                out.append(place_light(model, frame.compose(local)))
+        return out
+
     def set_robot_pose(self, index: int, pose: Pose) -> None:
         self.robot_poses[index] = pose
+        if index in self._attached:
+            self.lights_version += 1
         body = self._robot_body.get(index)
         if body is not None:
             self.engine.set_body_pose(body, pose)
 
     def set_solid_pose(self, name: str, pose: Pose) -> None:
-        if name not in self._solid_body:
+        if name not in self.solid_poses:
             raise KeyError(name)
         self.solid_poses[name] = pose
-        self.engine.set_body_pose(self._solid_body[name], pose)
+        if name in self._attached:
+            self.lights_version += 1
+        if name in self._solid_body:
+            self.engine.set_body_pose(self._solid_body[name], pose)

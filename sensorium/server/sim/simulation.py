@@ -25,7 +25,7 @@ from sensorium.server.raycast.engine import Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, LightBatch
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
-from sensorium.server.sim.scene import Scene, primitive_from_model
+from sensorium.server.sim.scene import Scene, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
     DEVICE_CLASSES,
     LED,
@@ -76,7 +76,8 @@ class RobotState:
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
                                        clock=lambda: sim.time_ms)
-        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index])
+        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index],
+                                        up=sim.world.world_info.coordinate_system)
                       if model.differential_drive is not None else None)
         self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
         self.encoders: list[PositionSensor] = []
@@ -144,7 +145,8 @@ class Simulation:
         self.time_ms = 0
         self.step_count = 0
         self.scene = Scene(self.world, loaded.base_dir, precision)
-        self.lights = lights_from_models(self.world.lights)
+        self.lights = lights_from_models(self.scene.world_lights())
+        self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._counters: Counter[str] = Counter()
@@ -155,11 +157,12 @@ class Simulation:
 
     def _build_contact(self) -> Contact:
         base = self.loaded.base_dir
-        solids = [(s.name, primitive_from_model(s.geometry, base), self.scene.solid_poses[s.name],
-                   s.seen_by in ("both", "bounding")) for s in self.world.solids]
-        robots = [(primitive_from_model(r.body.geometry, base)
-                   if r.body is not None and r.body.seen_by in ("both", "bounding") else None,
-                   self.scene.robot_poses[i]) for i, r in enumerate(self.world.robots)]
+        solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
+                   shape.seen_by in ("both", "bounding"))
+                  for s in self.world.solids for _, local, shape in solid_parts(s, Pose.identity())]
+        robots = [([(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(r)
+                    if shape.seen_by in ("both", "bounding")], self.scene.robot_poses[i])
+                  for i, r in enumerate(self.world.robots)]
         return Contact(solids, robots)
 
     def place_robot(self, index: int, pose: Pose) -> None:
@@ -282,6 +285,9 @@ class Simulation:
                     encoders += 1
         work: list[tuple[object, list[RayRequest]]] = []
         if lights:
+            if self._lights_version != self.scene.lights_version:  # a light moved with its owner
+                self.lights = lights_from_models(self.scene.world_lights())
+                self._lights_version = self.scene.lights_version
             batch = LightBatch(lights, poses, self.lights)
             work.append((batch, batch.plan()))
         if distances:

@@ -18,7 +18,22 @@ def device_line(d) -> str:
                 f"fov {d.field_of_view:.4g} range [{d.min_range:g}, {d.max_range:g}]")
     if isinstance(d, wm.DistanceSensor):
         return f"DistanceSensor {d.type} rays {d.number_of_rays} aperture {d.aperture:g} max {d.lookup_table[-1][0] if d.lookup_table else 0:g} m"
-    return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
+    if isinstance(d, wm.LightSensor):
+        return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
+    if isinstance(d, wm.PositionSensor):
+        return f"PositionSensor of {d.motor!r}"
+    return d.device
+
+
+def _geometry_line(s: wm.Solid) -> str:
+    kinds = [s.geometry.type] if s.geometry is not None else []
+    kinds += [p.geometry.type for p in s.shapes]
+    text = "+".join(kinds) or "no shape"
+    if s.children:
+        text += f", {len(s.children)} child solid{'s' if len(s.children) != 1 else ''}"
+    if s.lights:
+        text += f", {len(s.lights)} light{'s' if len(s.lights) != 1 else ''}"
+    return text
 
 
 def world_summary(path: str | Path) -> dict:
@@ -30,7 +45,7 @@ def world_summary(path: str | Path) -> dict:
         "file": str(path),
         "basic_time_step_ms": w.world_info.basic_time_step,
         "random_seed": w.world_info.random_seed,
-        "solids": [{"name": s.name, "geometry": s.geometry.type, "seen_by": s.seen_by} for s in w.solids],
+        "solids": [{"name": s.name, "geometry": _geometry_line(s), "seen_by": s.seen_by} for s in w.solids],
         "triangles": scene.triangle_count,
         "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
         "robots": [

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -87,6 +88,8 @@ def bundled_or_path(path: str | Path) -> Path:
 def load_world(path: str | Path) -> LoadedWorld:
     path = bundled_or_path(path)
     source = str(path)
+    if path.suffix.lower() == ".wbt":
+        return load_wbt(path)
     try:
         text = path.read_bytes()
     except OSError as exc:
@@ -149,6 +152,37 @@ def with_names(path: str, data: Any) -> str:
                 out += f" ({name})"
         pos = m.end()
     return out
+def load_wbt(path: Path) -> LoadedWorld:
+    """A Webots world, converted (``sensorium.server.world.wbt``); problems point at its lines.
+
+    ``LoadedWorld.text`` is the converted world as YAML (what recordings attach and replays read)."""
+    from sensorium.server.world.wbt import WbtSyntaxError, wbt_to_dict
+
+    source = str(path)
+    try:
+        data, warnings, origin = wbt_to_dict(path)
+    except WbtSyntaxError as exc:
+        where = f"line {exc.line}, column {exc.col}" if exc.line else ""
+        raise WorldError(source, [Problem(where, exc.message)]) from None
+    text = yaml.safe_dump(data, sort_keys=False).encode()
+    try:
+        loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
+    except WorldError as exc:
+        raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
+    return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
+                       warnings=[*warnings, *loaded.warnings])
+
+
+def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem:
+    """A problem of the converted world, placed at the .wbt node it came from."""
+    best = ""
+    for key in origin:
+        if len(key) > len(best) and (p.path == key or p.path.startswith(key + ".") or p.path.startswith(key + "[")):
+            best = key
+    if not best:
+        return p
+    line, col, kind = origin[best]
+    return Problem(f"line {line}, column {col} ({kind}, converted as {p.path})", p.message)
 
 
 def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"") -> LoadedWorld:
@@ -172,7 +206,7 @@ def _named(data: Any, problems: list[Problem]) -> list[Problem]:
     return [Problem(p.path, p.message, with_names(p.path, data)) if p.path else p for p in problems]
 
 
-_TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "mesh", "PointLight", "SpotLight",
+_TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "triangles", "mesh", "PointLight", "SpotLight",
          "DirectionalLight", "LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED"}
 
 
@@ -232,14 +266,12 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
             name_ok(f"robots[{i}].devices[{d_i}].name", d.name, ("robot",))
     unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
     unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
-    unique([(f"lights[{i}].name", lt.name) for i, lt in enumerate(world.lights)], "light")
+    unique([(p, lt.name) for p, lt in all_lights(world)], "light")
 
-    for i, s in enumerate(world.solids):
-        problems += _check_geometry(s.geometry, f"solids[{i}].geometry", base_dir)
+    for p, geom in all_geometries(world):
+        problems += _check_geometry(geom, p, base_dir)
     for r_i, robot in enumerate(world.robots):
         rp = f"robots[{r_i}]"
-        if robot.body is not None:
-            problems += _check_geometry(robot.body.geometry, f"{rp}.body.geometry", base_dir)
         names = [(f"{rp}.devices[{d_i}].name", d.name) for d_i, d in enumerate(robot.devices)]
         if robot.differential_drive is not None:
             names += [(f"{rp}.differential_drive.left_motor", robot.differential_drive.left_motor),
@@ -267,7 +299,49 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
     return problems
 
 
+def all_solids(world: wm.World) -> Iterator[tuple[str, wm.Solid]]:
+    """Every solid, nested children included, with its path in the file."""
+    def walk(path: str, solid: wm.Solid) -> Iterator[tuple[str, wm.Solid]]:
+        yield path, solid
+        for c_i, child in enumerate(solid.children):
+            yield from walk(f"{path}.children[{c_i}]", child)
+
+    for i, s in enumerate(world.solids):
+        yield from walk(f"solids[{i}]", s)
+
+
+def all_lights(world: wm.World) -> Iterator[tuple[str, Any]]:
+    """Every light (world, solid-attached, robot-attached) with its path in the file."""
+    for i, lt in enumerate(world.lights):
+        yield f"lights[{i}]", lt
+    for path, solid in all_solids(world):
+        for i, lt in enumerate(solid.lights):
+            yield f"{path}.lights[{i}]", lt
+    for r_i, robot in enumerate(world.robots):
+        for i, lt in enumerate(robot.lights):
+            yield f"robots[{r_i}].lights[{i}]", lt
+
+
+def all_geometries(world: wm.World) -> Iterator[tuple[str, Any]]:
+    for path, solid in all_solids(world):
+        if solid.geometry is not None:
+            yield f"{path}.geometry", solid.geometry
+        for i, part in enumerate(solid.shapes):
+            yield f"{path}.shapes[{i}].geometry", part.geometry
+    for r_i, robot in enumerate(world.robots):
+        if robot.body is not None:
+            yield f"robots[{r_i}].body.geometry", robot.body.geometry
+        for i, part in enumerate(robot.shapes):
+            yield f"robots[{r_i}].shapes[{i}].geometry", part.geometry
+
+
 def _check_geometry(geom: Any, path: str, base_dir: Path) -> list[Problem]:
+    if isinstance(geom, wm.Triangles):
+        n = len(geom.vertices)
+        for i, face in enumerate(geom.faces):
+            if min(face) < 0 or max(face) >= n:
+                return [Problem(f"{path}.faces[{i}]", f"vertex index outside 0..{n - 1}: {list(face)}")]
+        return []
     if not isinstance(geom, wm.Mesh):
         return []
     from sensorium.server.world.meshes import MeshFileError, load_mesh
@@ -283,9 +357,8 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
     """Apply Webots' field sanitising (devices.md §2.1, §3.1, §4.1); return warnings for each change."""
     warnings: list[str] = []
 
-    def fix_light(i: int, lt: Any) -> Any:
+    def fix_light(p: str, lt: Any) -> Any:
         upd: dict[str, Any] = {}
-        p = f"lights[{i}]"
         if not 0.0 <= lt.ambient_intensity <= 1.0:
             upd["ambient_intensity"] = 1.0 if lt.ambient_intensity > 1 else 0.0
             warnings.append(f"{p}.ambient_intensity: {lt.ambient_intensity} outside [0, 1], reset to {upd['ambient_intensity']}")
@@ -351,9 +424,18 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
                 warnings.append(f"{p}.default_frequency: outside [min_frequency, max_frequency], clamped")
         return dev.model_copy(update=upd) if upd else dev
 
-    lights = [fix_light(i, lt) for i, lt in enumerate(world.lights)]
+    def fix_solid(p: str, solid: wm.Solid) -> wm.Solid:
+        if not solid.lights and not solid.children:
+            return solid
+        lights = [fix_light(f"{p}.lights[{i}]", lt) for i, lt in enumerate(solid.lights)]
+        children = [fix_solid(f"{p}.children[{i}]", c) for i, c in enumerate(solid.children)]
+        return solid.model_copy(update={"lights": lights, "children": children})
+
+    lights = [fix_light(f"lights[{i}]", lt) for i, lt in enumerate(world.lights)]
+    solids = [fix_solid(f"solids[{i}]", s) for i, s in enumerate(world.solids)]
     robots = []
     for r_i, robot in enumerate(world.robots):
         devices = [fix_device(f"robots[{r_i}].devices[{d_i}]", d) for d_i, d in enumerate(robot.devices)]
-        robots.append(robot.model_copy(update={"devices": devices}))
-    return world.model_copy(update={"lights": lights, "robots": robots}), warnings
+        r_lights = [fix_light(f"robots[{r_i}].lights[{i}]", lt) for i, lt in enumerate(robot.lights)]
+        robots.append(robot.model_copy(update={"devices": devices, "lights": r_lights}))
+    return world.model_copy(update={"lights": lights, "solids": solids, "robots": robots}), warnings

@@ -50,3 +50,22 @@ def _load(path: str, _mtime: int, scale: tuple[float, float, float]):
     merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
     closed = bool(merged.is_watertight)
     return Mesh(vertices=np.ascontiguousarray(vertices), faces=np.ascontiguousarray(faces), closed=closed)
+
+
+def triangles_mesh(vertices, faces):
+    """Inline triangles (a world's ``triangles`` geometry) → ``geometry.Mesh``; indices are checked
+    by the loader. Cached on the exact values, like files."""
+    key = (tuple(tuple(float(c) for c in v) for v in vertices), tuple(tuple(int(i) for i in f) for f in faces))
+    return _triangles(key)
+
+
+@lru_cache(maxsize=64)
+def _triangles(key):
+    import trimesh
+
+    from sensorium.server.world.geometry import Mesh
+
+    vertices = np.asarray(key[0], dtype=np.float64).reshape(-1, 3)
+    faces = np.asarray(key[1], dtype=np.int64).reshape(-1, 3)
+    merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
+    return Mesh(vertices=vertices, faces=faces, closed=bool(merged.is_watertight))

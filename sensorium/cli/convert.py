@@ -1,0 +1,48 @@
+"""``sensorium convert WORLD.wbt OUT.yaml``: a Webots world as an editable Sensorium world file."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+from sensorium.server.world.loader import WorldError, load_world
+from sensorium.server.world.wbt.emit import converted_world, dump_yaml
+
+
+def convert(args: argparse.Namespace) -> int:
+    src = Path(args.world)
+    out = None if args.out == "-" else Path(args.out)
+    if src.suffix.lower() != ".wbt":
+        print(f"{src}: expected a Webots world (.wbt)", file=sys.stderr)
+        return 2
+    if out is not None:
+        if out.suffix.lower() not in (".yaml", ".yml", ".json"):
+            print(f"{out}: the output must end in .yaml, .yml or .json", file=sys.stderr)
+            return 2
+        if out.exists() and not args.force:
+            print(f"{out}: exists; not overwriting it (use --force)", file=sys.stderr)
+            return 1
+    try:
+        loaded = load_world(src)   # every check a load makes, with problems at .wbt lines
+    except WorldError as exc:
+        print(str(exc), file=sys.stderr)
+        return 1
+    data = converted_world(src, out.resolve().parent if out is not None else Path.cwd())
+    for w in loaded.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    if out is not None and out.suffix.lower() == ".json":
+        text = json.dumps(data, indent=2) + "\n"
+    else:
+        text = f"# Converted from {src.name} by `sensorium convert` (mesh urls relative to this file).\n" + dump_yaml(data)
+    if out is None:
+        sys.stdout.write(text)
+        return 0
+    tmp = out.with_name(out.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, out)
+    print(f"{out}: written ({len(data.get('solids', []))} solids, {len(data.get('lights', []))} lights, "
+          f"{len(data.get('robots', []))} robots)")
+    return 0

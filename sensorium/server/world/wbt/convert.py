@@ -1,0 +1,443 @@
+"""Parsed .wbt tree → a Sensorium world (a plain dict in the world-file format, then validated).
+
+Flattening happens here: Pose/Transform/Group frames are composed into the poses of shapes,
+devices and lights; a top-level Solid becomes a world solid, a Solid inside it one of its
+``children``; everything inside a Robot (nested Solids, joint end points, device bodies) becomes a
+body shape or a device of the robot, placed relative to the robot. Two motorised HingeJoint wheels
+on one axle become the robot's kinematic ``differential_drive``.
+
+Poses keep the file's exact axis-angle values when only one level rotates (so a converted world
+reads bit for bit like its hand-written twin); a pose composed of several rotations is written as
+a quaternion.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
+from sensorium.server.world.wbt import fields as fx
+from sensorium.server.world.wbt.fields import Fields
+from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
+from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
+
+MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
+
+SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "TexturedBackgroundLight", "Fog", "Camera",
+           "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS", "Compass",
+           "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger", "Connector", "Radar",
+           "Altimeter", "VacuumGripper", "Physics", "ImmersionProperties", "ContactProperties", "Damping",
+           "Brake", "Muscle", "Propeller", "Track", "Skin", "CadShape", "Radio"}
+GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh"}
+LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
+SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED"}
+JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
+MOTORS = {"RotationalMotor", "LinearMotor"}
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Rigid transform with a uniform scale: x_parent = R (s x) + t; ``aa`` = the exact axis-angle
+    of R when known (None once two rotations were composed)."""
+
+    rotation: np.ndarray
+    translation: np.ndarray
+    scale: float = 1.0
+    aa: tuple[float, float, float, float] | None = (0.0, 0.0, 1.0, 0.0)
+
+    @staticmethod
+    def identity() -> Frame:
+        return Frame(np.eye(3), np.zeros(3))
+
+    def then(self, translation, rotation, scale: float = 1.0) -> Frame:
+        r2 = axis_angle_matrix(rotation[:3], rotation[3]) if rotation[3] != 0.0 else np.eye(3)
+        t = self.rotation @ (self.scale * np.asarray(translation, dtype=np.float64)) + self.translation
+        if self.aa is not None and self.aa[3] == 0.0:
+            aa = tuple(rotation)
+        elif rotation[3] == 0.0:
+            aa = self.aa
+        else:
+            aa = None
+        return Frame(self.rotation @ r2, t, self.scale * scale, aa)  # type: ignore[arg-type]
+
+    def apply(self, p) -> list[float]:
+        return [float(v) for v in self.rotation @ (self.scale * np.asarray(p, dtype=np.float64)) + self.translation]
+
+    def pose(self) -> dict:
+        out: dict[str, Any] = {"translation": [float(v) for v in self.translation]}
+        if self.aa is None:
+            out["quaternion"] = list(matrix_quaternion(self.rotation))
+        elif self.aa[3] != 0.0:
+            out["rotation"] = list(self.aa)
+        return out
+
+    def key(self) -> bytes:
+        return self.rotation.tobytes() + self.translation.tobytes() + np.float64(self.scale).tobytes()
+
+
+@dataclass
+class Owner:
+    """What shapes, lights and devices found now belong to: the world, a solid or a robot."""
+
+    kind: str                      # "world", "solid", "robot"
+    data: dict
+    parts: list[dict] = field(default_factory=list)
+    keys: dict[tuple, dict] = field(default_factory=dict)      # visual parts by (geometry, frame)
+    wheels: list[dict] = field(default_factory=list)           # motorised hinges (robots)
+
+
+class Converter:
+    def __init__(self, wbt: WbtFile, source: str):
+        self.wbt = wbt
+        self.source = source
+        self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
+        self.warnings: list[str] = []
+        self.skipped: Counter[str] = Counter()
+        self.count = 0
+        self.origin: dict[str, tuple[int, int, str]] = {}     # converted path → (line, col, node type)
+        self.solid_names: Counter[str] = Counter()
+        self.robot_fields = set(wm.Robot.model_fields)
+        self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
+
+    # ------------------------------------------------------------ messages
+    def warn(self, node: Node, message: str) -> None:
+        self.warnings.append(f"{self.source}:{node.line}:{node.col}: {message}")
+
+    def fields(self, node: Node) -> Fields:
+        return Fields(node, self.source)
+
+    def error(self, node: Node, message: str) -> WbtSyntaxError:
+        return WbtSyntaxError(self.source, node.line, node.col, message)
+
+    def tick(self, node: Node) -> None:
+        self.count += 1
+        if self.count > MAX_PARTS:
+            raise self.error(node, f"more than {MAX_PARTS} shapes, devices and lights after DEF/USE expansion")
+
+    # ------------------------------------------------------------ top level
+    def run(self) -> dict:
+        world = Owner("world", {})
+        for node in self.wbt.nodes:
+            self.visit(node, Frame.identity(), world, top=True)
+        if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
+            self.world["solids"].append(self.solid_dict(world, {"name": self.unique_name("shapes")}))
+        if self.skipped:
+            listed = ", ".join(f"{k} x{v}" if v > 1 else k for k, v in sorted(self.skipped.items()))
+            self.warnings.append(f"{self.source}: skipped nodes that do not matter to these sensors: {listed}")
+        return {k: v for k, v in self.world.items() if v}
+
+    def unique_name(self, name: str) -> str:
+        self.solid_names[name] += 1
+        n = self.solid_names[name]
+        return name if n == 1 else f"{name}({n - 1})"
+
+    def world_info(self, node: Node) -> None:
+        f = self.fields(node)
+        step = f.num("basicTimeStep", 32.0)
+        if step != int(step) or step < 1:
+            raise f.error("basicTimeStep", f"must be a whole number of milliseconds >= 1 here, got {step}")
+        seed = f.int("randomSeed", 0)
+        if seed < 0:
+            raise f.error("randomSeed", "a negative (time-based) seed is not supported: runs here are reproducible")
+        system = f.str("coordinateSystem", "ENU")
+        if system not in ("ENU", "NUE"):
+            raise f.error("coordinateSystem", f"{system!r} is not supported (ENU or NUE)")
+        info = {"basic_time_step": int(step), "random_seed": seed, "coordinate_system": system}
+        if f.str("title", ""):
+            info["name"] = f.str("title", "")
+        self.world["world_info"] = info
+
+    # ------------------------------------------------------------ the walk
+    def visit(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
+        t = node.type
+        f = self.fields(node)
+        if t == "WorldInfo":
+            if not top:
+                raise self.error(node, "WorldInfo must be a top-level node")
+            self.world_info(node)
+        elif t in SKIPPED:
+            self.skipped[t] += 1
+        elif t == "Group":
+            for child in f.nodes("children"):
+                self.visit(child, frame, owner)
+        elif t in ("Pose", "Transform"):
+            inner = self.child_frame(node, frame)
+            for child in f.nodes("children"):
+                self.visit(child, inner, owner)
+        elif t == "Shape":
+            self.shape(node, frame, owner, seen_by="visual")
+        elif t in LIGHTS:
+            self.light(node, frame, owner)
+        elif t == "Robot":
+            if owner.kind != "world" or frame.aa is None or frame.scale != 1.0:
+                self.warn(node, "a Robot inside another node is not supported: skipped")
+            else:
+                self.robot(node, frame)
+        elif t == "Solid":
+            self.solid(node, frame, owner)
+        elif t in SENSORS or t in MOTORS:
+            self.device(node, frame, owner)
+        elif t in JOINTS:
+            self.joint(node, frame, owner)
+        elif t in BUILTIN_PROTOS:
+            self.visit(BUILTIN_PROTOS[t](node, self.source), frame, owner, top)
+        elif t in GEOMETRIES:
+            self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
+        else:
+            self.warn(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
+                            f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
+
+    def child_frame(self, node: Node, frame: Frame) -> Frame:
+        f = self.fields(node)
+        rotation = f.vec("rotation", (0.0, 0.0, 1.0, 0.0))
+        if rotation[3] != 0.0 and math.hypot(*rotation[:3]) == 0.0:
+            raise f.error("rotation", "the rotation axis must not be zero")
+        scale = 1.0
+        if node.type == "Transform":
+            sx, sy, sz = f.vec("scale", (1.0, 1.0, 1.0))
+            if not (sx == sy == sz) or sx <= 0:
+                raise f.error("scale", f"only a uniform positive scale is supported, got {sx} {sy} {sz}")
+            scale = sx
+        return frame.then(f.vec("translation", (0.0, 0.0, 0.0)), rotation, scale)
+
+    # ------------------------------------------------------------ shapes
+    def shape(self, node: Node, frame: Frame, owner: Owner, seen_by: str) -> None:
+        f = self.fields(node)
+        gnode = f.node_("geometry") if node.type == "Shape" else node
+        if gnode is None:
+            return
+        if gnode.type not in GEOMETRIES:
+            self.warn(gnode, f"geometry {gnode.type} is not supported (Box, Sphere, Cylinder, Capsule, Plane, "
+                             "IndexedFaceSet, Mesh): ignored")
+            return
+        self.tick(gnode)
+        geometry = self.geometry(gnode, frame.scale)
+        key = (id(gnode), frame.key())
+        if seen_by == "bounding" and key in owner.keys:   # the same geometry seen by both kinds of ray
+            owner.keys[key]["seen_by"] = "both"
+            return
+        part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
+        if seen_by == "visual":
+            app = fx.appearance(f.node_("appearance"), self.source, self.warn)
+            if app is not None:
+                part["appearance"] = app
+            owner.keys[key] = part
+        part["_at"] = (gnode.line, gnode.col, gnode.type)
+        owner.parts.append(part)
+
+    def bounding(self, node: Node | None, frame: Frame, owner: Owner) -> None:
+        if node is None:
+            return
+        f = self.fields(node)
+        if node.type in GEOMETRIES or node.type == "Shape":
+            self.shape(node, frame, owner, seen_by="bounding")
+        elif node.type == "Group":
+            for child in f.nodes("children"):
+                self.bounding(child, frame, owner)
+        elif node.type in ("Pose", "Transform"):
+            inner = self.child_frame(node, frame)
+            for child in f.nodes("children"):
+                self.bounding(child, inner, owner)
+        else:
+            self.warn(node, f"{node.type} in a boundingObject: ignored")
+
+    def geometry(self, node: Node, s: float) -> dict:
+        f = self.fields(node)
+        t = node.type
+        if t == "Box":
+            return {"type": "box", "size": [v * s for v in f.vec("size", (2.0, 2.0, 2.0))]}
+        if t == "Sphere":
+            return {"type": "sphere", "radius": f.num("radius", 1.0) * s}
+        if t in ("Cylinder", "Capsule"):
+            if not all(f.bool(k, True) for k in ("bottom", "side", "top")):
+                self.warn(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
+            return {"type": t.lower(), "radius": f.num("radius", 1.0) * s, "height": f.num("height", 2.0) * s}
+        if t == "Plane":
+            return {"type": "plane", "size": [v * s for v in f.vec("size", (1.0, 1.0))]}
+        if t == "Mesh":
+            urls = f.strs("url")
+            if not urls:
+                raise f.error("url", "a Mesh needs a url")
+            if "://" in urls[0]:
+                raise f.error("url", f"only local mesh files are supported, got {urls[0]!r}")
+            return {"type": "mesh", "url": urls[0], "scale": [s, s, s]}
+        # IndexedFaceSet: polygons separated by -1, fan-triangulated
+        coord = f.node_("coord")
+        points = self.fields(coord).rows("point", 3, []) if coord is not None else []
+        index = [int(i) for i in f.numbers("coordIndex")]
+        faces: list[list[int]] = []
+        poly: list[int] = []
+        for i in [*index, -1]:
+            if i >= 0:
+                poly.append(i)
+                continue
+            faces += [[poly[0], poly[k], poly[k + 1]] for k in range(1, len(poly) - 1)]
+            poly = []
+        if not faces:
+            raise f.error("coordIndex", "an IndexedFaceSet needs at least one polygon")
+        return {"type": "triangles", "vertices": [[v * s for v in p] for p in points], "faces": faces}
+
+    # ------------------------------------------------------------ lights
+    def light(self, node: Node, frame: Frame, owner: Owner) -> None:
+        self.tick(node)
+        data = fx.light(node, self.fields(node))
+        if "location" in data:
+            data["location"] = frame.apply(data["location"])
+        if node.type == "SpotLight":
+            data["direction"] = [float(v) for v in frame.rotation @ np.asarray(data["direction"])]
+        data["_at"] = (node.line, node.col, node.type)
+        owner.data.setdefault("lights", []).append(data) if owner.kind != "world" else self.world["lights"].append(data)
+
+    # ------------------------------------------------------------ solids and robots
+    def solid(self, node: Node, frame: Frame, owner: Owner) -> None:
+        f = self.fields(node)
+        inner = self.child_frame(node, frame)
+        if owner.kind == "robot":   # part of the robot's body
+            self.solid_contents(node, inner, owner)
+            return
+        if frame.scale != 1.0:
+            raise self.error(node, "a Solid inside a scaled Transform is not supported")
+        name = f.str("name", "solid")
+        data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
+        if owner.kind == "world" and data["name"] != name:
+            self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
+        mine = Owner("solid", data)
+        self.solid_contents(node, Frame.identity(), mine)
+        out = self.solid_dict(mine, data)
+        out["_at"] = (node.line, node.col, node.type)
+        if owner.kind == "world":
+            self.world["solids"].append(out)
+        else:
+            owner.data.setdefault("children", []).append(out)
+
+    def solid_contents(self, node: Node, frame: Frame, owner: Owner) -> None:
+        f = self.fields(node)
+        for child in f.nodes("children"):
+            self.visit(child, frame, owner)
+        self.bounding(f.node_("boundingObject"), frame, owner)
+
+    def solid_dict(self, owner: Owner, data: dict) -> dict:
+        if owner.parts:
+            data["shapes"] = [_clean_part(p) for p in owner.parts]
+        return data
+
+    def robot(self, node: Node, frame: Frame) -> None:
+        f = self.fields(node)
+        inner = self.child_frame(node, frame)
+        data: dict[str, Any] = {"name": f.str("name", "robot"), "pose": inner.pose(),
+                                "synchronization": f.bool("synchronization", True), "devices": []}
+        controller = f.str("controller", "<extern>")
+        if controller in ("", "void", "<none>"):              # Webots' ways of saying "no controller"
+            controller = "<none>"
+        elif controller != "<extern>":                         # a controller Webots would start itself
+            self.warn(node, f"Robot controller {controller!r}: Sensorium starts no controllers; the robot is "
+                            "\"<extern>\" (run it with sensorium controller)")
+            controller = "<extern>"
+        extras = {"controller": controller, "supervisor": f.bool("supervisor", False),
+                  "custom_data": f.str("customData", ""), "model": f.str("model", "")}
+        defaults = {"controller": "<extern>", "supervisor": False, "custom_data": "", "model": ""}
+        for key, value in extras.items():
+            if key in self.robot_fields:
+                if key != "controller" or f.has("controller"):
+                    data[key] = value
+            elif value != defaults[key]:
+                self.warn(node, f"Robot field {key}: not supported by this version; ignored")
+        data["_at"] = (node.line, node.col, node.type)
+        mine = Owner("robot", data)
+        self.solid_contents(node, Frame.identity(), mine)
+        self.drive(node, mine)
+        if mine.parts:
+            data["shapes"] = [_clean_part(p) for p in mine.parts]
+        if not data["devices"]:
+            del data["devices"]
+        self.world["robots"].append(data)
+
+    def device(self, node: Node, frame: Frame, owner: Owner) -> None:
+        f = self.fields(node)
+        if owner.kind != "robot":
+            self.warn(node, f"{node.type} outside a Robot: skipped (devices belong to robots)")
+            return
+        self.tick(node)
+        inner = self.child_frame(node, frame)
+        if node.type in MOTORS:   # a motor outside a joint's device list
+            self.warn(node, f"{node.type} outside a joint: skipped")
+            return
+        if node.type not in self.device_kinds:
+            self.warn(node, f"{node.type}: device kind not supported by this version; skipped")
+        else:
+            data = {"name": f.str("name", fx.DEVICE_NAMES[node.type]), "pose": inner.pose(), **fx.device(node, f)}
+            data["_at"] = (node.line, node.col, node.type)
+            if node.type == "Lidar" and f.node_("rotatingHead") is not None:
+                self.skipped["Lidar.rotatingHead"] += 1
+            owner.data["devices"].append(data)
+        self.solid_contents(node, inner, owner)
+
+    def joint(self, node: Node, frame: Frame, owner: Owner) -> None:
+        f = self.fields(node)
+        end = f.node_("endPoint")
+        motors = [d for d in f.nodes("device") if d.type in MOTORS]
+        sensors = [d for d in f.nodes("device") if d.type == "PositionSensor"]
+        if owner.kind == "robot" and node.type == "HingeJoint" and motors:
+            params = f.node_("jointParameters")
+            pf = self.fields(params) if params is not None else None
+            axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
+            anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
+            m = self.fields(motors[0])
+            owner.wheels.append({"node": node, "motor": m.str("name", "rotational motor"),
+                                 "max_velocity": m.num("maxVelocity", 10.0),
+                                 "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
+                                 "end": end, "frame": frame, "sensors": sensors})
+        elif motors:
+            self.warn(node, f"{node.type} motor(s) not part of a wheel: skipped (joints do not move here)")
+        if sensors and not (owner.kind == "robot" and node.type == "HingeJoint" and motors):
+            self.warn(node, "PositionSensor on a joint without a drive wheel motor: skipped")
+        if end is not None:
+            if end.type == "SolidReference":
+                return
+            self.visit(end, frame, owner)
+
+    def drive(self, node: Node, robot: Owner) -> None:
+        from sensorium.server.world.wbt.drive import differential_drive
+
+        wheels = robot.wheels
+        if not wheels:
+            return
+        drive, why = differential_drive(wheels, self)
+        if drive is None:
+            self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
+            return
+        robot.data["differential_drive"] = drive
+        if "PositionSensor" in self.device_kinds:
+            for w in wheels:
+                for s in w["sensors"]:
+                    sf = self.fields(s)
+                    robot.data["devices"].append({"name": sf.str("name", "position sensor"), "device": "PositionSensor",
+                                                  "motor": w["motor"], "noise": sf.num("noise", 0.0),
+                                                  "resolution": sf.num("resolution", -1.0),
+                                                  "_at": (s.line, s.col, s.type)})
+        elif any(w["sensors"] for w in wheels):
+            self.warn(node, "PositionSensor: device kind not supported by this version; skipped")
+
+
+def _clean_part(p: dict) -> dict:
+    out = dict(p)
+    if out.get("seen_by") == "both":
+        del out["seen_by"]
+    return out
+
+
+def strip_origins(data: Any, path: str, origin: dict[str, tuple[int, int, str]]) -> Any:
+    """Remove the ``_at`` bookkeeping keys, recording converted path → (line, col, node type)."""
+    if isinstance(data, dict):
+        if "_at" in data:
+            origin[path] = data["_at"]
+        return {k: strip_origins(v, f"{path}.{k}" if path else k, origin) for k, v in data.items() if k != "_at"}
+    if isinstance(data, list):
+        return [strip_origins(v, f"{path}[{i}]", origin) for i, v in enumerate(data)]
+    return data

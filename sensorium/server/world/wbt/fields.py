@@ -1,0 +1,199 @@
+"""Typed access to the fields of a parsed .wbt node, and node-to-model pieces that need no context:
+geometry, appearance, lights, devices. Defaults are those of Webots' reference manual; a field of
+the wrong shape is an error naming file, line and column."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sensorium.server.world.wbt.parser import Node, WbtSyntaxError
+
+
+class Fields:
+    """Typed getters on one node; errors point at the field (or the node when it is absent)."""
+
+    def __init__(self, node: Node, source: str):
+        self.node = node
+        self.source = source
+
+    def error(self, name: str | None, message: str) -> WbtSyntaxError:
+        line, col = self.node.field_pos.get(name, (self.node.line, self.node.col)) if name else (self.node.line, self.node.col)
+        where = f"{self.node.type}.{name}" if name else self.node.type
+        return WbtSyntaxError(self.source, line, col, f"{where}: {message}")
+
+    def has(self, name: str) -> bool:
+        return name in self.node.fields
+
+    def num(self, name: str, default: float) -> float:
+        v = self.node.fields.get(name, default)
+        if isinstance(v, bool) or not isinstance(v, float | int):
+            raise self.error(name, f"expected one number, got {_show(v)}")
+        return float(v)
+
+    def int(self, name: str, default: int) -> int:
+        v = self.num(name, default)
+        if v != int(v):
+            raise self.error(name, f"expected an integer, got {v}")
+        return int(v)
+
+    def vec(self, name: str, default: tuple[float, ...]) -> tuple[float, ...]:
+        v = self.node.fields.get(name, default)
+        if isinstance(v, float | int) and not isinstance(v, bool):
+            v = (float(v),)
+        if not isinstance(v, tuple) or len(v) != len(default):
+            raise self.error(name, f"expected {len(default)} numbers, got {_show(v)}")
+        return tuple(float(x) for x in v)
+
+    def bool(self, name: str, default: bool) -> bool:
+        v = self.node.fields.get(name, default)
+        if not isinstance(v, bool):
+            raise self.error(name, f"expected TRUE or FALSE, got {_show(v)}")
+        return v
+
+    def str(self, name: str, default: str) -> str:
+        v = self.node.fields.get(name, default)
+        if isinstance(v, list) and len(v) == 1 and isinstance(v[0], str):
+            v = v[0]
+        if not isinstance(v, str):
+            raise self.error(name, f"expected a string, got {_show(v)}")
+        return v
+
+    def strs(self, name: str) -> list[str]:
+        v = self.node.fields.get(name, [])
+        if isinstance(v, str):
+            v = [v]
+        if not isinstance(v, list) or not all(isinstance(x, str) for x in v):
+            raise self.error(name, f"expected a list of strings, got {_show(v)}")
+        return v
+
+    def node_(self, name: str) -> Node | None:
+        v = self.node.fields.get(name)
+        if v is None:
+            return None
+        if isinstance(v, list) and len(v) == 1 and isinstance(v[0], Node):
+            v = v[0]
+        if not isinstance(v, Node):
+            raise self.error(name, f"expected a node or NULL, got {_show(v)}")
+        return v
+
+    def nodes(self, name: str) -> list[Node]:
+        v = self.node.fields.get(name, [])
+        if isinstance(v, Node):
+            v = [v]
+        if not isinstance(v, list) or not all(isinstance(x, Node) for x in v):
+            raise self.error(name, f"expected a list of nodes, got {_show(v)}")
+        return v
+
+    def numbers(self, name: str) -> list[float]:
+        """An MF field of numbers, flattened (``[ 0 0 0, 1 1 0 ]`` → six numbers)."""
+        v = self.node.fields.get(name, [])
+        out: list[float] = []
+        for x in v if isinstance(v, list) else [v]:
+            if isinstance(x, tuple):
+                out += x
+            elif isinstance(x, float | int) and not isinstance(x, bool):
+                out.append(float(x))
+            else:
+                raise self.error(name, f"expected numbers, got {_show(x)}")
+        return out
+
+    def rows(self, name: str, width: int, default: list[tuple[float, ...]]) -> list[tuple[float, ...]]:
+        if name not in self.node.fields:
+            return default
+        flat = self.numbers(name)
+        if len(flat) % width:
+            raise self.error(name, f"expected groups of {width} numbers, got {len(flat)} numbers")
+        return [tuple(flat[i:i + width]) for i in range(0, len(flat), width)]
+
+
+def _show(v: Any) -> str:
+    if isinstance(v, Node):
+        return f"a {v.type} node"
+    if isinstance(v, tuple):
+        return f"{len(v)} numbers"
+    if isinstance(v, list):
+        return f"a list of {len(v)}"
+    return repr(v)
+
+
+# ---------------------------------------------------------------- lights and devices
+
+def light(node: Node, f: Fields) -> dict:
+    out: dict[str, Any] = {"type": node.type,
+                           "ambient_intensity": f.num("ambientIntensity", 0.0),
+                           "intensity": f.num("intensity", 1.0),
+                           "color": list(f.vec("color", (1.0, 1.0, 1.0))),
+                           "on": f.bool("on", True),
+                           "cast_shadows": f.bool("castShadows", False)}
+    if node.type != "DirectionalLight":
+        out["attenuation"] = list(f.vec("attenuation", (1.0, 0.0, 0.0)))
+        out["location"] = list(f.vec("location", (0.0, 0.0, 0.0)))
+        out["radius"] = f.num("radius", 100.0)
+    if node.type != "PointLight":
+        out["direction"] = list(f.vec("direction", (0.0, 0.0, -1.0)))
+    if node.type == "SpotLight":
+        out["beam_width"] = f.num("beamWidth", 1.570796)
+        out["cut_off_angle"] = f.num("cutOffAngle", 0.785398)
+    return out
+
+
+def device(node: Node, f: Fields) -> dict:
+    """Device fields (not its name or pose) in the world format's names."""
+    t = node.type
+    if t == "DistanceSensor":
+        return {"device": t, "lookup_table": [list(r) for r in f.rows("lookupTable", 3, [(0.0, 0.0, 0.0), (0.1, 1000.0, 0.0)])],
+                "type": f.str("type", "generic"), "number_of_rays": f.int("numberOfRays", 1),
+                "aperture": f.num("aperture", 1.5708), "gaussian_width": f.num("gaussianWidth", 1.0),
+                "resolution": f.num("resolution", -1.0), "red_color_sensitivity": f.num("redColorSensitivity", 1.0)}
+    if t == "LightSensor":
+        return {"device": t, "lookup_table": [list(r) for r in f.rows("lookupTable", 3, [(0.0, 0.0, 0.0), (1.0, 1000.0, 0.0)])],
+                "color_filter": list(f.vec("colorFilter", (1.0, 1.0, 1.0))), "occlusion": f.bool("occlusion", False),
+                "resolution": f.num("resolution", -1.0)}
+    if t == "Lidar":
+        return {"device": t, "tilt_angle": f.num("tiltAngle", 0.0),
+                "horizontal_resolution": f.int("horizontalResolution", 512),
+                "field_of_view": f.num("fieldOfView", 1.5708),
+                "vertical_field_of_view": f.num("verticalFieldOfView", 0.2),
+                "number_of_layers": f.int("numberOfLayers", 4), "near": f.num("near", 0.01),
+                "min_range": f.num("minRange", 0.01), "max_range": f.num("maxRange", 1.0),
+                "type": f.str("type", "fixed"), "projection": f.str("projection", "cylindrical"),
+                "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0),
+                "default_frequency": f.num("defaultFrequency", 10.0), "min_frequency": f.num("minFrequency", 1.0),
+                "max_frequency": f.num("maxFrequency", 25.0)}
+    if t == "PositionSensor":
+        return {"device": t, "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
+    if t == "LED":
+        colours = f.rows("color", 3, [(1.0, 0.0, 0.0)])
+        return {"device": t, "color": [list(c) for c in colours], "gradual": f.bool("gradual", False)}
+    raise AssertionError(t)
+
+
+DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light sensor", "Lidar": "lidar",
+                "PositionSensor": "position sensor", "LED": "led", "RotationalMotor": "rotational motor"}
+
+
+# ---------------------------------------------------------------- appearance
+
+def appearance(node: Node | None, source: str, warn) -> dict | None:
+    """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read)."""
+    if node is None:
+        return None
+    f = Fields(node, source)
+    if node.type == "PBRAppearance":
+        if f.node_("baseColorMap") is not None:
+            warn(node, "PBRAppearance.baseColorMap: textures are not sampled; using baseColor alone")
+        return {"base_color": list(f.vec("baseColor", (1.0, 1.0, 1.0))),
+                "transparency": f.num("transparency", 0.0), "roughness": f.num("roughness", 0.0)}
+    if node.type == "Appearance":
+        material = f.node_("material")
+        textured = f.node_("texture") is not None
+        if textured:
+            warn(node, "Appearance.texture: textures are not sampled; the colour is taken as white (Webots replaces "
+                       "the material's diffuse colour by the texture's)")
+        if material is None:
+            return {"base_color": [1.0, 1.0, 1.0]}
+        m = Fields(material, source)
+        colour = [1.0, 1.0, 1.0] if textured else list(m.vec("diffuseColor", (0.8, 0.8, 0.8)))
+        return {"base_color": colour, "transparency": m.num("transparency", 0.0)}
+    warn(node, f"appearance {node.type}: not built in (a PROTO?); taken as white")
+    return None
