@@ -115,14 +115,26 @@ def export_cmd(args: argparse.Namespace) -> int:
     if not args.ros2:
         print("sensorium export: say which format: --ros2 (the only one so far)", file=sys.stderr)
         return 2
+    from sensorium.cli.progress import bar
+
+    progress = bar(None, "export", "msg")
+
+    def advance(done: int, total: int) -> None:
+        if total and getattr(progress, "total", None) != total:
+            progress.total = total
+        progress.update(1)
+
     try:
         report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
                              pointcloud2=args.pointcloud2, topics=args.topics or None,
                              start_ns=None if args.start is None else int(round(args.start * 1e9)),
-                             end_ns=None if args.end is None else int(round(args.end * 1e9)))
+                             end_ns=None if args.end is None else int(round(args.end * 1e9)),
+                             progress=advance)
     except (ExportError, OSError, McapError) as exc:
+        progress.close()
         print(f"sensorium export: {exc}", file=sys.stderr)
         return 1
+    progress.close()
     warning = truncation_warning(report)
     if warning:
         print(f"sensorium export: {warning}", file=sys.stderr, flush=True)

@@ -111,8 +111,13 @@ def probe(args: argparse.Namespace) -> int:
         return 2
     if not enabled:
         print("probe: nothing enabled; use --enable ROBOT/DEVICE:PERIOD (or all:PERIOD)", file=sys.stderr)
+    from sensorium.cli.progress import bar
+
+    # a progress bar while the lines go to a file or a pipe (on a terminal they show the progress)
+    progress = bar(args.steps, "probe", "step", enabled=sys.stderr.isatty() and not sys.stdout.isatty())
     for step in range(1, args.steps + 1):
         sim.step()
+        progress.update(1)
         for dev in enabled:
             readings = dev.readings()
             if args.json:
@@ -122,4 +127,5 @@ def probe(args: argparse.Namespace) -> int:
             else:
                 text = ", ".join(f"{k}={_summary(v)}" for k, v in readings.items())
                 print(f"step {step:>4} t={sim.time_ms:>6} ms  {dev.path:<22} {text}", flush=True)
+    progress.close()
     return 0

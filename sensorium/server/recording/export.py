@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import array
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -244,12 +245,18 @@ class ExportReport:
     readable_bytes: int | None = None                      # ... and only this much of it could be read
     size_bytes: int = 0
     last_stamp_ns: int | None = None                       # the last message exported
+    progress: Any = None                                   # callback (done, total), or None
+    total: int = 0
+    read: int = 0
 
 
 def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report: ExportReport,
                     start_ns: int | None, end_ns: int | None):
     bad: set[str] = set()
     for m in rec.messages(topics, start_ns, end_ns):
+        if report.progress is not None:
+            report.read += 1
+            report.progress(report.read, report.total)
         if m.topic in bad:
             report.skipped[m.topic] = report.skipped.get(m.topic, 0) + 1
             continue
@@ -271,9 +278,11 @@ def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report
 
 def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt: str | None = None,
                 pointcloud2: bool = False, topics: list[str] | None = None,
-                start_ns: int | None = None, end_ns: int | None = None) -> ExportReport:
+                start_ns: int | None = None, end_ns: int | None = None,
+                progress: Callable[[int, int], None] | None = None) -> ExportReport:
     """Export ``src`` to ``out``. ``fmt`` is ``"bag"`` (rosbag2 directory, via rosbags) or
-    ``"mcap"`` (single file, via mcap-ros2-support); by default ``.mcap`` outputs are single files."""
+    ``"mcap"`` (single file, via mcap-ros2-support); by default ``.mcap`` outputs are single files.
+    ``progress(done, total)`` is called as messages are read (total: the recording's message count)."""
     out = Path(out)
     if distro not in DISTROS:
         raise ExportError(f"unknown distro {distro!r} (choose from {', '.join(DISTROS)})")
@@ -283,6 +292,8 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
     typestore = typestore_for(distro)
     report = ExportReport(out=out, distro=distro, fmt=fmt)
     with Recording(src) as rec:
+        report.progress = progress
+        report.total = sum(t.count for t in rec.topics()) if progress else 0
         meta = rec.metadata().get("sensorium", {})
         world = rec.world()
         if fmt == "bag":
