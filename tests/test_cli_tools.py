@@ -97,6 +97,8 @@ def test_echo_without_a_server_times_out_with_a_message():
     assert res.returncode == 1 and time.monotonic() - t0 < 30
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and "no server answers" in lines[0] and rpc in lines[0]
+    only_pub = cli("echo", "/clock", "--url", pub, "--timeout", "1")        # no --rpc: nobody asked
+    assert only_pub.returncode == 1 and "--rpc" in only_pub.stderr and len(only_pub.stderr.strip().splitlines()) == 1
 
 
 def test_echo_says_why_a_waiting_world_is_silent(arena):

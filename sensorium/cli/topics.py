@@ -102,6 +102,9 @@ def why_silent(view: ServerView) -> str:
 
 
 def no_message(cmd: str, what: str, url: str, waited: float, view: ServerView) -> str:
+    if view.info is None and not view.rpc:
+        return (f"sensorium {cmd}: nothing on {what} from {url} for {waited:g} s (give --rpc to ask the server "
+                "why, or check that a server or replay publishes there)")
     if view.info is None:
         return (f"sensorium {cmd}: nothing on {what} from {url} for {waited:g} s, and no server answers at "
                 f"{view.rpc}: is `sensorium serve` running? (--url and --rpc point elsewhere)")
