@@ -102,3 +102,20 @@ def test_path_measures_tell_exploring_from_jittering() -> None:
                            np.stack([1 - side, 1 + 0 * side], 1), np.stack([0 * side, 1 - side], 1)]) + 0.1
     assert path_length(loop) == pytest.approx(4.0 - 0.01)
     assert cells_visited(loop) == 8                                      # the ring of cells around [0.1, 1.1]^2
+
+
+def test_demo_runs_are_reproducible(tmp_path: Path) -> None:
+    """The server waits paused until both controllers are attached: two runs publish the same bytes."""
+    import hashlib
+
+    from sensorium.server.recording.reader import iter_messages
+
+    digests = []
+    for run in ("a", "b"):
+        res = _sensorium("demo", "--duration", "4", "--out", str(tmp_path / run), "--json")
+        assert res.returncode == 0, res.stderr
+        h = hashlib.sha256()
+        for m in iter_messages(tmp_path / run / "demo.mcap"):
+            h.update(m.topic.encode() + m.stamp_ns.to_bytes(8, "little") + m.data)
+        digests.append(h.hexdigest())
+    assert digests[0] == digests[1]
