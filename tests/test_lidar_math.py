@@ -13,8 +13,6 @@ from sensorium.server.devices.lidar import (
     point_cloud,
     ranges_from_hits,
     ray_directions,
-    rotating_point_times,
-    rotating_sector,
     rotating_sweep,
     value_factors,
 )
@@ -284,10 +282,6 @@ def test_sector_of_one_step_and_times():
     assert s.head_angle_after == pytest.approx(-PI)
     # column 4 at the start of the step, then every 1/80 s
     np.testing.assert_allclose(s.times, [0.95, 0.9625, 0.975, 0.9875], rtol=1e-14)
-    cols, head = rotating_sector(p, 0.0, 10.0, 50)
-    np.testing.assert_array_equal(cols, s.columns)
-    assert head == s.head_angle_after
-    np.testing.assert_array_equal(rotating_point_times(p, 0.0, 10.0, 50, 1.0), s.times)
     nxt = rotating_sweep(p, s.head_angle_after, 10.0, 50, 1.05)
     np.testing.assert_array_equal(nxt.columns, [0, 1, 2, 3])
 

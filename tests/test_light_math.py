@@ -10,14 +10,11 @@ from sensorium.server.devices.light import (
     Light,
     LightArrays,
     LightKind,
-    direct_mask,
-    irradiance,
     irradiance_many,
-    light_value,
-    light_vectors,
-    occlusion_segments,
+    light_terms,
+    occlusion_segments_many,
 )
-from sensorium.server.devices.lookup import LookupTable
+from sensorium.server.devices.lookup import LookupTable, quantize_sensor
 
 ORIGIN = np.zeros(3)
 X = np.array([1.0, 0.0, 0.0])
@@ -25,7 +22,21 @@ UP = np.array([0.0, 0.0, 1.0])
 
 
 def E(lights, p=ORIGIN, n=X, occluded=None, color_filter=(1.0, 1.0, 1.0)):
-    return irradiance(p, n, LightArrays.from_lights(lights), occluded, color_filter)
+    arrays = lights if isinstance(lights, LightArrays) else LightArrays.from_lights(lights)
+    return one(arrays, p, n, occluded, color_filter)
+
+
+def one(lights: LightArrays, p, n, occluded=None, color_filter=(1.0, 1.0, 1.0)) -> float:
+    """The batch irradiance for a batch of one sensor."""
+    occ = None if occluded is None else np.asarray(occluded, dtype=bool).reshape(1, -1)
+    return float(irradiance_many(np.reshape(p, (1, 3)), np.reshape(n, (1, 3)), lights, occ,
+                                 np.reshape(np.asarray(color_filter, dtype=float), (1, 3)))[0])
+
+
+def segments(p, lights: LightArrays):
+    """Occlusion-segment directions (n,3) and lengths (n,) of one sensor at ``p``."""
+    unit, length = occlusion_segments_many(np.reshape(p, (1, 3)), lights)
+    return unit[0], length[0]
 
 
 def point(pos, **kw):
@@ -97,7 +108,7 @@ def test_directional_light_not_attenuated():
     assert E([light], p=np.array([1e4, -3e3, 50.0])) == pytest.approx(0.7, rel=1e-15)
     oblique = Light(LightKind.DIRECTIONAL, direction=(-1, -1, 0))
     assert E([oblique]) == pytest.approx(math.sqrt(0.5), rel=1e-15)
-    L, d = light_vectors(ORIGIN, LightArrays.from_lights([oblique]))
+    L, d = segments(ORIGIN, LightArrays.from_lights([oblique]))
     np.testing.assert_allclose(L, [[math.sqrt(0.5), math.sqrt(0.5), 0]], rtol=1e-15)
     assert d[0] == DIRECTIONAL_DISTANCE
 
@@ -129,13 +140,14 @@ def test_sum_over_lights_and_batch():
     N = np.array([X, UP, [0, math.sqrt(0.5), math.sqrt(0.5)]])
     occ = np.array([[False, True, False], [False, False, False], [True, True, True]])
     batch = irradiance_many(P, N, lights, occ, np.array([[1, 1, 1], [0.5, 1, 1], [1, 0, 0]]))
-    singles = [irradiance(P[s], N[s], lights, occ[s], f) for s, f in enumerate([(1, 1, 1), (0.5, 1, 1), (1, 0, 0)])]
+    singles = [one(lights, P[s], N[s], occ[s], f) for s, f in enumerate([(1, 1, 1), (0.5, 1, 1), (1, 0, 0)])]
     np.testing.assert_allclose(batch, singles, rtol=1e-15)
     assert batch[0] == pytest.approx(1.0 + 0.0 + 0.0)  # directional is perpendicular, spot: c = 0
 
 
 def test_no_lights():
-    assert irradiance(ORIGIN, X, LightArrays.empty()) == 0.0
+    assert E(LightArrays.empty()) == 0.0
+    np.testing.assert_array_equal(irradiance_many(np.zeros((3, 3)), np.tile(X, (3, 1)), LightArrays.empty()), 0.0)
 
 
 def test_sensor_at_the_light_is_finite():
@@ -149,13 +161,9 @@ def test_sensor_at_the_light_is_finite():
     assert E([point((0, 0, 0), attenuation=(0, 0, 1), ambient_intensity=0.1, color=(1, 0, 0))],
              color_filter=(1, 0, 0)) == math.inf
     lights = LightArrays.from_lights([point((0, 0, 0)), point((0, 0, 5))])
-    L, d = light_vectors(ORIGIN, lights)
-    np.testing.assert_array_equal(L[0], [0, 0, 0])
-    assert d[0] == 0.0
-    origins, dirs, lengths = occlusion_segments(ORIGIN, lights)
+    dirs, lengths = segments(ORIGIN, lights)
     np.testing.assert_array_equal(dirs, [[1, 0, 0], [0, 0, 1]])
     np.testing.assert_array_equal(lengths, [0, 5])
-    np.testing.assert_array_equal(origins, 0.0)
     # spot at the sensor: also finite
     s = Light(LightKind.SPOT, position=(1, 2, 3), ambient_intensity=0.4)
     assert E([s], p=np.array([1.0, 2.0, 3.0])) == pytest.approx(0.4)
@@ -171,11 +179,16 @@ def test_light_in_the_sensor_plane_gives_exactly_zero():
 def test_occlusion_segments():
     lights = LightArrays.from_lights([point((3, 4, 0)), Light(LightKind.DIRECTIONAL, direction=(0, 0, -2))])
     p = np.array([0.0, 0.0, 1.0])
-    origins, dirs, lengths = occlusion_segments(p, lights)
-    np.testing.assert_array_equal(origins, [p, p])
+    dirs, lengths = segments(p, lights)
     np.testing.assert_allclose(dirs, [np.array([3, 4, -1]) / math.sqrt(26), [0, 0, 1]], rtol=1e-15)
     np.testing.assert_allclose(lengths, [math.sqrt(26), 1000.0], rtol=1e-15)
-    np.testing.assert_allclose(origins + dirs * lengths[:, None], [[3, 4, 0], [0, 0, 1001]], rtol=1e-14)
+    np.testing.assert_allclose(p + dirs * lengths[:, None], [[3, 4, 0], [0, 0, 1001]], rtol=1e-14)
+    # a batch of sensors: each row is that sensor's segments
+    P = np.array([p, [1.0, 1.0, 0.0]])
+    unit, length = occlusion_segments_many(P, lights)
+    np.testing.assert_allclose(unit[0], dirs, rtol=1e-15)
+    np.testing.assert_allclose(unit[1], [np.array([2, 3, 0]) / math.sqrt(13), [0, 0, 1]], rtol=1e-15)
+    np.testing.assert_allclose(length[1], [math.sqrt(13), 1000.0], rtol=1e-15)
     np.testing.assert_allclose(np.linalg.norm(dirs, axis=1), 1.0, rtol=1e-15)
 
 
@@ -194,11 +207,13 @@ def test_validation():
 
 
 def test_light_value_default_table():
+    # the output stage of every light sensor: lookup, then resolution (sim/batches.py)
     table = LookupTable([[0, 0, 0], [1, 1000, 0]])
+    value = lambda e, res: float(quantize_sensor(float(table.interpolate(np.array([e]))[0][0]), res))
     e = E([point((0, 0, 2), attenuation=(0, 0, 1))], n=UP)
-    assert light_value(table, e, None, -1) == pytest.approx(250.0)
-    assert light_value(table, 5.0, None, -1) == 1000.0
-    assert light_value(table, 0.12345, None, 10) == 120.0
+    assert value(e, -1) == pytest.approx(250.0)
+    assert value(5.0, -1) == 1000.0
+    assert value(0.12345, 10) == 120.0
 
 
 def test_direct_mask_marks_lights_with_a_direct_term():
@@ -209,6 +224,8 @@ def test_direct_mask_marks_lights_with_a_direct_term():
         Light(LightKind.SPOT, position=(3, 0, 0), direction=(0, 0, -1)),   # sensor outside its cone
         point((1, 1, 0), intensity=0.0),                    # no intensity
     ])
-    np.testing.assert_array_equal(direct_mask(ORIGIN, X, lights), [True, False, False, False, False])
+    # the batch's occlusion rays go only where the direct term is > 0 (sim/batches.py LightBatch.plan)
+    direct_mask = lambda lts: light_terms(ORIGIN.reshape(1, 3), X.reshape(1, 3), lts)[1][0] > 0.0
+    np.testing.assert_array_equal(direct_mask(lights), [True, False, False, False, False])
     assert lights.count == len(lights) == 5
-    assert direct_mask(ORIGIN, X, LightArrays.empty()).shape == (0,)
+    assert direct_mask(LightArrays.empty()).shape == (0,)

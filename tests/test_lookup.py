@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from sensorium.server.devices.lookup import LookupTable, quantize_lidar, quantize_sensor, sensor_output
+from sensorium.server.devices.lookup import LookupTable, quantize_lidar, quantize_sensor
 from sensorium.server.devices.noise import device_rng, device_seed
 
 TABLE = LookupTable([[0.1, 10.0, 0.0], [0.5, 50.0, 0.0], [1.0, 20.0, 0.0]])
@@ -168,10 +168,13 @@ def test_quantize_arrays_and_errors():
 
 
 def test_sensor_output_is_lookup_then_rounding():
+    # what sim/batches.py does for every light and distance sensor of a step (noise-free here)
     t = LookupTable([[0, 0, 0], [1, 1000, 0]])
-    assert sensor_output(t, 0.33333, None, 1) == 333.0
-    assert sensor_output(t, 0.33333, None, -1) == pytest.approx(333.33)
-    np.testing.assert_array_equal(sensor_output(t, np.array([0.1, 0.2]), None, 100), [100, 200])
+    y, n = t.interpolate(np.array([0.33333, 0.1, 0.2]))
+    np.testing.assert_array_equal(n, 0.0)
+    assert quantize_sensor(float(y[0]), 1) == 333.0
+    assert quantize_sensor(float(y[0]), -1) == pytest.approx(333.33)
+    np.testing.assert_array_equal(quantize_sensor(y[1:], 100), [100, 200])
 
 
 def test_device_streams_are_deterministic_and_independent():

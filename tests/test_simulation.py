@@ -154,6 +154,16 @@ def test_no_hit_rays_count_as_table_max() -> None:
     assert d.value == 4.0
 
 
+def test_empty_lookup_table_reads_zero() -> None:
+    # devices.md §3.1: an empty table gives the value 0 whatever the rays hit
+    sim = world([{"device": "DistanceSensor", "name": "d", "lookup_table": []},
+                 {"device": "DistanceSensor", "name": "e", "type": "infra-red", "lookup_table": []}])
+    for name in ("d", "e"):
+        sim.device(f"r/{name}").enable(32)
+    sim.step()
+    assert sim.device("r/d").value == 0.0 and sim.device("r/e").value == 0.0
+
+
 @pytest.mark.parametrize("tilt_deg,expect_echo", [(20.0, True), (24.0, False)])
 def test_sonar_incidence_on_tilted_wall(tilt_deg: float, expect_echo: bool) -> None:
     tilt = math.radians(tilt_deg)
@@ -238,6 +248,17 @@ def test_point_light_irradiance_and_occlusion() -> None:
     sim.set_solid_pose("wall", [1.0, 5.0, 0.0])                                 # move the wall away
     sim.step()
     assert sim.device("r/shaded").value == pytest.approx(0.75, abs=1e-12)
+
+
+def test_light_sensor_with_an_empty_lookup_table_reads_the_irradiance() -> None:
+    # devices.md §1.2: an empty table returns its input unchanged (the world used to pass validate
+    # and then fail every step)
+    lights = [{"type": "PointLight", "location": [2.0, 0, 0], "intensity": 3.0, "attenuation": [0, 0, 1]}]
+    sim = world([{"device": "LightSensor", "name": "raw", "lookup_table": [], "resolution": 0.25}], solids=[],
+                lights=lights)
+    sim.device("r/raw").enable(32)
+    sim.step()
+    assert sim.device("r/raw").value == 0.75                                    # 3/2² = 0.75, a multiple of 0.25
 
 
 def test_occlusion_rays_one_per_lit_light() -> None:

@@ -78,7 +78,11 @@ def test_convert_round_trip(tmp_path: Path, capsys) -> None:
     out = tmp_path / "sub" / "full.yaml"
     out.parent.mkdir()
     assert cli(["convert", str(HERE / "full.wbt"), str(out)]) == 0
-    converted = load_world(out)
+    # its meshes stay where the .wbt has them, outside OUT's folder: loading it needs the flag
+    with pytest.raises(WorldError, match="leaves the world's folder"):
+        load_world(out)
+    assert "--allow-outside-meshes" in capsys.readouterr().err
+    converted = load_world(out, allow_outside_meshes=True)
     original = load_world(HERE / "full.wbt")
     # mesh url rewritten relative to the output; everything else identical
     mesh = next(s for s in converted.world.solids if s.name == "mesh").shapes[0].geometry

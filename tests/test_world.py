@@ -174,7 +174,8 @@ def test_unknown_device_and_sensor_type_rejected() -> None:
 
 def test_missing_mesh_file_rejected(tmp_path: Path) -> None:
     probs = _problems({"solids": [{"name": "m", "geometry": {"type": "mesh", "url": "nope.stl"}}]}, tmp_path)
-    assert probs == [("solids[0].geometry.url", f"mesh file not found: {tmp_path / 'nope.stl'}")]
+    # the url as written, never a resolved path (issue 16)
+    assert probs == [("solids[0].geometry.url", "mesh file 'nope.stl' not found (urls are relative to the world file)")]
 
 
 def test_corrupt_mesh_file_rejected(tmp_path: Path) -> None:

@@ -434,11 +434,11 @@ def occlusion_knob(cfg: Config, sec: Section) -> None:
     # exact: the spec's irradiance with exact float64 visibility (segment vs the occluder)
     exact = []
     for p in positions:
-        P = np.asarray(p)
-        o, u, length = light_math.occlusion_segments(P, la)
-        t_hit, _ = exact_cast([occluder], o, u, 0.0, np.inf)
-        occluded = t_hit <= length
-        exact.append(light_math.irradiance(P, np.array([0.0, 0.0, 1.0]), la, occluded))
+        P = np.asarray(p, dtype=np.float64).reshape(1, 3)
+        u, length = light_math.occlusion_segments_many(P, la)
+        t_hit, _ = exact_cast([occluder], np.repeat(P, la.count, axis=0), u[0], 0.0, np.inf)
+        occluded = (t_hit <= length[0]).reshape(1, -1)
+        exact.append(float(light_math.irradiance_many(P, np.array([[0.0, 0.0, 1.0]]), la, occluded)[0]))
     exact = np.asarray(exact)
     shadowed = int(np.sum(np.abs(results[False][0] - exact) > 1e-12))
     for occl in (False, True):

@@ -287,9 +287,11 @@ def machine() -> dict:
 # ----------------------------------------------------------------------------- simulations
 def make_sim(world: dict, precision: str = "exact", base_dir=None):
     from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.limits import WorldLimits
     from sensorium.server.world.loader import parse_world
 
-    return Simulation(parse_world(world, base_dir=base_dir), precision=precision)
+    # benchmark worlds are deliberately large (--allow-large)
+    return Simulation(parse_world(world, base_dir=base_dir, limits=WorldLimits.large()), precision=precision)
 
 
 def identity_table(max_range: float, noise: float = 0.0) -> list[list[float]]:

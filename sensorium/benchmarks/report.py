@@ -9,7 +9,7 @@ import math
 from pathlib import Path
 
 SCHEMA = 1
-ORDER = ("peers", "accuracy", "scaling", "transport")
+ORDER = ("peers", "accuracy", "scaling", "transport", "scaleout")
 
 
 def load(out: Path) -> dict:

@@ -23,7 +23,10 @@ def command(name: str, help: str, target: str):
 
 @command("validate", "check a world file; exit 1 listing every problem", "sensorium.cli.world:validate")
 def _validate_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.serve import add_world_options
+
     p.add_argument("world", nargs="+", help="world file(s): YAML, JSON or Webots .wbt")
+    add_world_options(p)
 
 
 @command("convert", "write a Webots world (.wbt) as an equivalent Sensorium world file",
@@ -50,13 +53,17 @@ def _probe_args(p: argparse.ArgumentParser) -> None:
                    help="also enable a lidar's point cloud")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="JSON lines: step, time, robot, device, value or array summary")
+    from sensorium.cli.serve import add_world_options
+
+    add_world_options(p)
 
 
-@command("controller", "run a Webots-style Python controller for a robot of a running server",
+@command("controller", "run a Webots-style controller (Python script or compiled binary) for a robot of a running server",
          "sensorium.cli.client:controller")
 def _controller_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("script", help="controller script (uses `from controller import Robot`), or example:NAME for a "
-                   "bundled example (example:braitenberg, example:wanderer)")
+    p.add_argument("script", help="controller: a Python script (uses `from controller import Robot`), an executable "
+                   "(e.g. a C controller linked against sensorium/client/c), or example:NAME for a bundled example "
+                   "(example:braitenberg, example:wanderer)")
     p.add_argument("--robot", help="robot name (default: the URL's robot, or the world's only robot)")
     p.add_argument("--url", help="RPC endpoint or controller URL, e.g. tcp://127.0.0.1:5560 or "
                    "tcp://host:5560/epuck (default: $SENSORIUM_CONTROLLER_URL, $WEBOTS_CONTROLLER_URL, "
@@ -208,6 +215,28 @@ def _demo_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar on stderr (default: only on a terminal)")
+
+
+# --- sweeps: sweep (sensorium/sweep/) ---
+@command("sweep", "run many simulations (worlds x parameters x controllers x seeds) on Ray or a process pool",
+         "sensorium.cli.sweep:main")
+def _sweep_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("spec", help="sweep spec, YAML or JSON (see README 'Training and sweeps')")
+    p.add_argument("--out", default="sweep-out", metavar="DIR",
+                   help="recordings (DIR/runs/NNNN.mcap) and tables (DIR/summary.csv, .parquet); default sweep-out")
+    p.add_argument("--engine", choices=["auto", "local", "ray"], default="auto",
+                   help="ray: Ray tasks; local: a process pool; auto (default): ray when installed")
+    p.add_argument("--workers", type=int, metavar="N", help="processes / Ray CPUs on this machine (default: all CPUs)")
+    p.add_argument("--address", metavar="ADDR", help="join this Ray cluster ('auto', 'HOST:6379', 'ray://HOST:10001') "
+                   "instead of starting a local Ray bound to 127.0.0.1")
+    p.add_argument("--format", action="append", choices=["csv", "parquet"], metavar="FMT",
+                   help="table format, repeatable (csv, parquet; default both, csv only without pyarrow)")
+    p.add_argument("--no-record", action="store_true", help="no recordings, summary rows only")
+    p.add_argument("--overwrite", action="store_true", help="replace the tables and recordings of an earlier sweep in DIR")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar on stderr (default: on a terminal)")
+    p.add_argument("--json", action="store_true", help="print the sweep summary as JSON")
+# --- end sweeps ---
 
 
 # --- benchmarks: bench (benchmarks/, installed as sensorium.benchmarks) ---

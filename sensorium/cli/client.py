@@ -77,9 +77,49 @@ def _take_launcher_options(args: argparse.Namespace) -> str | None:
     return None
 
 
+def _is_binary_controller(path: Path) -> bool | None:
+    """False for a Python script, True for an executable (a compiled controller, e.g. against the
+    C library in sensorium/client/c), None for neither."""
+    if path.suffix == ".py":
+        return False
+    if os.access(path, os.X_OK):
+        return True
+    try:
+        with open(path, "rb") as f:
+            head = f.read(64)
+    except OSError:
+        return None
+    # a Python file without the .py suffix (no NUL bytes, not an ELF image) still runs as Python
+    return None if (head.startswith(b"\x7fELF") or b"\0" in head) else False
+
+
+def _run_binary(path: Path, argv: list[str]) -> int:
+    """Run a compiled controller with the URL in its environment, as Webots' launcher does. On
+    POSIX the launcher becomes the controller (exec), so signals reach it directly."""
+    exe = str(path if path.is_absolute() or path.parent != Path() else Path(".") / path)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    if os.name == "posix":
+        try:
+            os.execv(exe, [exe, *argv])
+        except OSError as exc:
+            print(f"sensorium controller: cannot run {path}: {exc.strerror}", file=sys.stderr)
+            return 2
+    import subprocess
+
+    try:
+        return subprocess.call([exe, *argv])
+    except OSError as exc:
+        print(f"sensorium controller: cannot run {path}: {exc.strerror}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
 def controller(args: argparse.Namespace) -> int:
-    """Run a Webots-style Python controller for one robot, as Webots' launcher does: the controller
-    URL in the environment, ``controller`` importable, the script run as ``__main__``."""
+    """Run a Webots-style controller for one robot, as Webots' launcher does: the controller URL in
+    the environment; a Python script runs as ``__main__`` with ``controller`` importable, an
+    executable (a compiled C/C++ controller) is exec'd with the same environment."""
     problem = _take_launcher_options(args)
     if problem:
         print(f"sensorium controller: {problem}", file=sys.stderr)
@@ -89,6 +129,11 @@ def controller(args: argparse.Namespace) -> int:
         print(f"sensorium controller: no such script: {script} (bundled examples: "
               f"{', '.join('example:' + p.stem for p in sorted(EXAMPLES_DIR.glob('[!_]*.py')))})", file=sys.stderr)
         return 2
+    binary = _is_binary_controller(script)
+    if binary is None:
+        print(f"sensorium controller: {script} is neither a Python script (.py) nor an executable "
+              f"(a compiled controller needs chmod +x)", file=sys.stderr)
+        return 2
     try:
         url = parse_controller_url(args.url) if args.url else controller_url_from_env()
     except SensoriumError as exc:
@@ -97,6 +142,8 @@ def controller(args: argparse.Namespace) -> int:
     if args.robot:
         url = url.with_robot(args.robot)
     os.environ[ENV_URL] = str(url)
+    if binary:
+        return _run_binary(script, args.args)
     # ``controller`` importable here and in any process the controller starts
     os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(WEBOTS_DIR), os.environ.get("PYTHONPATH", "")) if p)
     sys.path[:0] = [str(script.resolve().parent), str(WEBOTS_DIR)]

@@ -45,4 +45,20 @@ def convert(args: argparse.Namespace) -> int:
     os.replace(tmp, out)
     print(f"{out}: written ({len(data.get('solids', []))} solids, {len(data.get('lights', []))} lights, "
           f"{len(data.get('robots', []))} robots)")
+    outside = sorted({u for u in _mesh_urls(data) if Path(u).is_absolute() or u.startswith("..")})
+    if outside:
+        print(f"note: {len(outside)} mesh url(s) leave {out.parent or '.'} (e.g. {outside[0]}): load the world with "
+              "--allow-outside-meshes, or move the meshes next to it", file=sys.stderr)
     return 0
+
+
+def _mesh_urls(data: object):
+    """Every mesh url of a world-file dict."""
+    if isinstance(data, dict):
+        if data.get("type") == "mesh" and isinstance(data.get("url"), str):
+            yield data["url"]
+        for v in data.values():
+            yield from _mesh_urls(v)
+    elif isinstance(data, list):
+        for v in data:
+            yield from _mesh_urls(v)

@@ -21,7 +21,7 @@ from sensorium.server.recording.reader import McapError, summarize
 @contextmanager
 def sigterm_as_interrupt():
     """SIGTERM (and SIGHUP) raise KeyboardInterrupt like Ctrl-C, so files get finished."""
-    previous = {}
+    previous: dict = {}
 
     def handler(signum, frame):
         raise KeyboardInterrupt
@@ -39,17 +39,16 @@ def sigterm_as_interrupt():
             signal.signal(sig, h)
 
 
-
 def record(args: argparse.Namespace) -> int:
     if Path(args.file).exists() and not args.force:
         print(f"sensorium record: {args.file} exists already; not overwriting (--force to replace it)", file=sys.stderr)
         return 1
-    ctx = zmq.Context.instance()
+    ctx: zmq.Context = zmq.Context.instance()
     rec = LiveRecorder(args.file, connect=args.connect, pub=args.pub, topics=args.topics or None, world=args.world,
                        chunk_size=args.chunk_size, rcvhwm=args.rcvhwm, context=ctx)
     try:
         rec.open()
-    except (TimeoutError, RuntimeError, KeyError, OSError, zmq.ZMQError) as exc:
+    except (TimeoutError, RuntimeError, KeyError, ValueError, OSError, zmq.ZMQError) as exc:
         print(f"sensorium record: {exc}", file=sys.stderr)
         return 1
     print(f"sensorium: recording {args.file} from pub={rec.pub_endpoint}"

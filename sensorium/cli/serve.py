@@ -21,6 +21,15 @@ DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
 
 
+def add_world_options(p: argparse.ArgumentParser) -> None:
+    """``--allow-large`` and ``--allow-outside-meshes`` (validate, probe, serve)."""
+    p.add_argument("--allow-large", action="store_true",
+                   help="raise the world limits (rays, beams, triangles, robots, file size, ...; README "
+                   "'Security and limits') for a world that deliberately asks for more")
+    p.add_argument("--allow-outside-meshes", action="store_true",
+                   help="let mesh urls leave the world file's folder (absolute paths, '..')")
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("world", nargs="?", help="world file (default: the embedded arena world)")
     p.add_argument("--rpc", default=DEFAULT_RPC, metavar="URL",
@@ -37,6 +46,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--record", metavar="FILE.mcap",
                    help="record the published messages from inside the step loop (nothing dropped)")
     p.add_argument("--force", action="store_true", help="with --record: overwrite FILE if it exists")
+    add_world_options(p)
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
                    "without subscribers (default: every topic)")
@@ -47,7 +57,9 @@ def options(args: argparse.Namespace):
     from sensorium.server.daemon.serve import ServeOptions
 
     return ServeOptions(rpc=args.rpc, pub=args.pub, mode=args.mode, precision=args.precision,
-                        heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None))
+                        heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None),
+                        allow_large=getattr(args, "allow_large", False),
+                        allow_outside_meshes=getattr(args, "allow_outside_meshes", False))
 
 
 def bind_problem(exc: BaseException) -> str:

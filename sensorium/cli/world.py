@@ -9,16 +9,25 @@ import json
 import math
 import sys
 from pathlib import Path
+from typing import Any
 
 from sensorium.server.sim.summary import world_summary
 from sensorium.server.world.loader import WorldError, bundled_or_path, default_world_path, load_world
+
+
+def world_options(args: argparse.Namespace) -> dict[str, Any]:
+    """``--allow-large``/``--allow-outside-meshes`` → keyword arguments of ``load_world``."""
+    from sensorium.server.world.limits import WorldLimits
+
+    return {"limits": WorldLimits.large() if getattr(args, "allow_large", False) else WorldLimits(),
+            "allow_outside_meshes": getattr(args, "allow_outside_meshes", False)}
 
 
 def validate(args: argparse.Namespace) -> int:
     status = 0
     for path in args.world:
         try:
-            loaded = load_world(path)
+            loaded = load_world(path, **world_options(args))
         except WorldError as exc:
             print(str(exc), file=sys.stderr)
             print(f"{path}: INVALID ({len(exc.problems)} problem{'s' if len(exc.problems) != 1 else ''})", file=sys.stderr)
@@ -88,15 +97,16 @@ def _summary(value) -> object:
 
 
 def probe(args: argparse.Namespace) -> int:
+    from sensorium.server.sim.sensors import Lidar
     from sensorium.server.sim.simulation import Simulation
 
     path = args.world or str(default_world_path())
     try:
-        sim = Simulation.from_file(path, precision=args.precision)
+        sim = Simulation.from_file(path, precision=args.precision, **world_options(args))
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1
-    enabled = []
+    enabled: list[Any] = []        # sensors.LightSensor | DistanceSensor | Lidar: each has readings()
     try:
         for spec in args.enable:
             target, period = _parse_enable(spec)
@@ -105,7 +115,11 @@ def probe(args: argparse.Namespace) -> int:
                 dev.enable(period)
                 enabled.append(dev)
         for target in args.point_cloud:
-            sim.device(target).enable_point_cloud()
+            lidar = sim.device(target)
+            if not isinstance(lidar, Lidar):
+                print(f"probe: --point-cloud {target}: not a lidar ({lidar.kind})", file=sys.stderr)
+                return 2
+            lidar.enable_point_cloud()
     except KeyError as exc:
         print(f"probe: {exc.args[0]}", file=sys.stderr)
         return 2

@@ -51,6 +51,7 @@ class ErrorCode(IntEnum):
     TOO_LARGE = 8
     SHUTTING_DOWN = 9
     WRONG_STATE = 10
+    NOT_SUPERVISOR = 11
     INTERNAL = 99
     # client side
     TIMEOUT = 1000

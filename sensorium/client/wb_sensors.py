@@ -198,6 +198,7 @@ def wb_lidar_get_range_image(tag: int) -> Any:
     right, first layer to last): a read-only numpy array, or ``array('f')`` without numpy.
     Zeros before the first measurement."""
     buf = lidar_range_bytes(tag)
+    assert buf is not None                      # without a layer: always the whole image
     if arrays.numpy_module() is None:
         return arrays.float32s(buf or b"")
     r = current()

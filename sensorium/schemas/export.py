@@ -32,7 +32,7 @@ def _bundle(models: list[Any], title: str, description: str) -> dict:
 
 
 def messages_schema() -> dict:
-    models = [messages.Envelope, *messages.MESSAGE_TYPES.values()]
+    models: list[type] = [messages.Envelope, *messages.MESSAGE_TYPES.values()]
     out = _bundle(models, "Sensorium topic messages",
                   "Topic frames are [topic + NUL, envelope, body] (PROTOCOL.md §4); bodies are msgpack maps "
                   "with ROS 2 field names in ROS order, arrays as little-endian bin.")

@@ -114,7 +114,7 @@ def parse_request(data: bytes | memoryview, max_size: int = SOFT_LIMIT) -> Reque
         raise RequestError(ErrorCode.BAD_REQUEST, str(exc)) from None
     if not isinstance(msg, dict):
         raise RequestError(ErrorCode.BAD_REQUEST, f"request must be a msgpack map, got {type(msg).__name__}")
-    rid = msg.get("id")
+    rid: Any = msg.get("id")
     if not _is_uint(rid):
         raise RequestError(ErrorCode.BAD_REQUEST, "request 'id' must be an unsigned integer"
                            if "id" in msg else "request has no 'id'")

@@ -15,6 +15,7 @@ from typing import Any
 from sensorium.server.daemon.services import Core
 from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport
 from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import default_world_path
 
 __all__ = ["ServeOptions", "Server", "build"]
@@ -30,6 +31,8 @@ class ServeOptions:
     precision: str = "exact"          # ray engine precision: fast | exact
     heartbeat_ms: int = 1000          # controllers not heard from for 3 × this are released
     until: int | None = None          # quit when the simulated time reaches this many ms
+    allow_large: bool = False         # raise the world limits (WorldLimits.large())
+    allow_outside_meshes: bool = False  # mesh urls may leave the world's folder
 
     def check(self) -> None:
         """Raise ValueError naming the first bad option."""
@@ -44,7 +47,9 @@ def build(world: str | Path | None, options: ServeOptions | None = None) -> tupl
     opts = options or ServeOptions()
     opts.check()
     path = Path(world) if world else default_world_path()
-    sim = Simulation.from_file(path, precision=opts.precision)
+    sim = Simulation.from_file(path, precision=opts.precision,
+                               limits=WorldLimits.large() if opts.allow_large else WorldLimits(),
+                               allow_outside_meshes=opts.allow_outside_meshes)
     core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode)
     return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until)
 

@@ -21,7 +21,7 @@ import sys
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 from pydantic import ValidationError
 
@@ -60,8 +60,8 @@ class Call:
     peer: bytes
     id: int
     args: Any                 # the spec's pydantic Args model
-    robot: str | None
-    ctl: Control | None
+    robot: str                # the robot of a robot/device/motor service ("" for world services)
+    ctl: Control              # the device of a device service (never read by other handlers)
     motor: Any                # the WheelMotor of a motor service, else None
     now: float
     extra: list[Frames]       # more replies to send (e.g. a step answered by detach)
@@ -188,7 +188,7 @@ class Core:
             except ValidationError as exc:
                 raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{req.service}: {_arg_errors(exc)}") from None
             if route.spec.attached:
-                s = self.lockstep.session_for(route.robot)
+                s = self.lockstep.session_for(route.robot) if route.robot else None
                 if s is None or s.peer != peer:
                     raise ServiceError(ErrorCode.NOT_ATTACHED,
                                        f"{req.service} needs the caller to be {route.robot!r}'s attached controller"
@@ -199,7 +199,7 @@ class Core:
                                    f"(set 'supervisor: true' on it in the world file)")
             ctl = self.topics.controls[route.device] if route.device else None
             motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
-            call = Call(envelope, peer, rid, args, route.robot, ctl, motor, now, [])
+            call = Call(envelope, peer, rid, args, route.robot or "", cast(Control, ctl), motor, now, [])
             result = route.handler(call)
             if result is _DEFERRED:
                 return call.extra

@@ -1,8 +1,9 @@
 """DistanceSensor mathematics (spec §3) — ray layout, weights and the per-type reduction.
 
 Pipeline (the simulation drives it): ``ray_directions`` in the sensor frame (+x = sensing axis) →
-world → cast with length ``lut_max_range`` (the table's last input) → ``combine_distance`` →
-``distance_value`` (lookup with noise, then resolution).
+world → cast with length ``lut_max_range`` (the table's last input) → ``combine_distance_batch``
+(every due sensor at once) → lookup with noise, then resolution (:mod:`.lookup`, driven by
+``sensorium.server.sim.batches``).
 
 Per-ray inputs to the reductions: ``distances`` (``+inf`` = no hit; a hit farther than
 ``lut_max_range`` is also treated as no hit, so rays may be cast longer), world ``directions``
@@ -16,21 +17,16 @@ from enum import IntEnum
 
 import numpy as np
 
-from .lookup import LookupTable, sensor_output
-
 __all__ = [
     "DistanceSensorType",
     "SENSOR_TYPES",
     "SONAR_MAX_INCIDENCE",
-    "parse_sensor_type",
     "effective_number_of_rays",
     "ray_layout",
     "ray_directions",
     "ray_weights",
     "reflection_factor",
-    "combine_distance",
     "combine_distance_batch",
-    "distance_value",
 ]
 
 
@@ -47,16 +43,6 @@ SENSOR_TYPES = {"generic": 0, "infra-red": 1, "sonar": 2, "laser": 3}
 
 SONAR_MAX_INCIDENCE = 0.392699082
 """A sonar echo counts only when the incidence angle is below this (π/8, as Webots writes it)."""
-
-
-def parse_sensor_type(name: str) -> DistanceSensorType:
-    """The ``type`` field (case-insensitive; ``"infrared"`` is accepted like Webots). Unknown names
-    raise ``ValueError`` (Webots silently makes them sonar; this project rejects them)."""
-    key = name.strip().lower()
-    key = "infra-red" if key == "infrared" else key
-    if key not in SENSOR_TYPES:
-        raise ValueError(f"unknown DistanceSensor type {name!r}; expected one of {sorted(SENSOR_TYPES)}")
-    return DistanceSensorType(SENSOR_TYPES[key])
 
 
 def effective_number_of_rays(number_of_rays: int, aperture: float) -> int:
@@ -197,26 +183,3 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
         out[m] = d + (d / factor - d) * sens
 
     return out
-
-
-def combine_distance(sensor_type: int, distances, directions, normals, weights, lut_max_range: float,
-                     reflection=None, red_color_sensitivity: float = 1.0) -> float:
-    """Distance ``D`` of one sensor (N rays); see :func:`combine_distance_batch`."""
-    r = np.asarray(distances, dtype=np.float64).reshape(1, -1)
-    N = r.shape[1]
-    return float(combine_distance_batch(
-        sensor_type, r,
-        None if directions is None else np.asarray(directions, dtype=np.float64).reshape(1, N, 3),
-        None if normals is None else np.asarray(normals, dtype=np.float64).reshape(1, N, 3),
-        np.asarray(weights, dtype=np.float64).reshape(1, N), lut_max_range,
-        None if reflection is None else np.asarray(reflection, dtype=np.float64).reshape(1, N),
-        red_color_sensitivity)[0])
-
-
-def distance_value(table: LookupTable, distance: float, rng: np.random.Generator | None,
-                   resolution: float) -> float:
-    """DistanceSensor value: lookup (with relative noise) then resolution rounding (§9.3).
-    An empty table gives 0 (Webots casts no meaningful ray then)."""
-    if len(table) == 0:
-        return 0.0
-    return sensor_output(table, distance, rng, resolution)

@@ -80,8 +80,6 @@ __all__ = [
     "point_cloud",
     "RotatingSweep",
     "rotating_sweep",
-    "rotating_sector",
-    "rotating_point_times",
     "wrap_angle",
 ]
 
@@ -333,16 +331,3 @@ def rotating_sweep(params: LidarParams, head_angle_before: float, frequency: flo
     x = np.arange(first, math.ceil(h_a), dtype=np.int64)
     times = float(time_end_s) - dt_s * (h_a - x) / (h_a - h_b)
     return RotatingSweep(x % W, times, after)
-
-
-def rotating_sector(params: LidarParams, head_angle_before: float, frequency: float,
-                    dt_ms: int) -> tuple[np.ndarray, float]:
-    """``(columns, head_angle_after)`` of :func:`rotating_sweep`."""
-    sweep = rotating_sweep(params, head_angle_before, frequency, dt_ms)
-    return sweep.columns, sweep.head_angle_after
-
-
-def rotating_point_times(params: LidarParams, head_angle_before: float, frequency: float, dt_ms: int,
-                         time_end_s: float) -> np.ndarray:
-    """Times (C,) of the columns :func:`rotating_sector` returns (same order)."""
-    return rotating_sweep(params, head_angle_before, frequency, dt_ms, time_end_s).times

@@ -38,19 +38,12 @@ from enum import IntEnum
 
 import numpy as np
 
-from .lookup import LookupTable, sensor_output
-
 __all__ = [
     "LightKind",
     "Light",
     "LightArrays",
     "DIRECTIONAL_DISTANCE",
-    "light_vectors",
-    "irradiance",
     "irradiance_many",
-    "direct_mask",
-    "occlusion_segments",
-    "light_value",
 ]
 
 DIRECTIONAL_DISTANCE = 1000.0
@@ -164,13 +157,6 @@ def _vectors(points: np.ndarray, lights: LightArrays):
     return v, length, unit, d
 
 
-def light_vectors(p: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
-    """Unit sensor→light vectors ``L`` (n,3) and distances ``d`` (n,) for a sensor at ``p``.
-    Directional: ``L = -direction``, ``d = 1000``. A sensor exactly at a light: ``L = 0``, ``d = 0``."""
-    _, _, unit, d = _vectors(np.asarray(p, dtype=np.float64).reshape(1, 3), lights)
-    return unit[0], d[0]
-
-
 def _terms(P: np.ndarray, N: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
     """Attenuation ``att`` (S,n) and un-occluded direct term ``Id = I·c·spot`` (S,n)."""
     v, length, unit, d = _vectors(P, lights)
@@ -233,46 +219,11 @@ def irradiance_from_terms(att: np.ndarray, direct: np.ndarray, lights: LightArra
     return terms.sum(axis=1)
 
 
-def direct_mask(p: np.ndarray, normal_x: np.ndarray, lights: LightArrays) -> np.ndarray:
-    """(n,) bool: lights whose direct term is non-zero for this sensor — the only ones whose
-    occlusion can change the value, so the only ones that need an occlusion ray."""
-    if len(lights) == 0:
-        return np.zeros(0, dtype=bool)
-    _, direct = _terms(np.asarray(p, dtype=np.float64).reshape(1, 3),
-                       np.asarray(normal_x, dtype=np.float64).reshape(1, 3), lights)
-    return direct[0] > 0.0
-
-
-def irradiance(p: np.ndarray, normal_x: np.ndarray, lights: LightArrays,
-               occluded: np.ndarray | None = None,
-               color_filter: np.ndarray = (1.0, 1.0, 1.0)) -> float:
-    """Irradiance ``E`` of one sensor at ``p`` with world normal ``normal_x`` (unit, its +x axis);
-    ``occluded`` (n,) bool marks lights whose occlusion segment hit something."""
-    occ = None if occluded is None else np.asarray(occluded, dtype=bool).reshape(1, -1)
-    return float(irradiance_many(np.reshape(p, (1, 3)), np.reshape(normal_x, (1, 3)), lights, occ,
-                                 np.reshape(np.asarray(color_filter, dtype=np.float64), (1, 3)))[0])
-
-
-def occlusion_segments(p: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One segment per light, from ``p`` toward it: origins (n,3), unit directions (n,3), lengths (n,).
-
-    Length = sensor–light distance (1000 for directional lights); a hit with ``0 <= t <= length``
-    means occluded. A sensor exactly at a light gets direction (1, 0, 0) and length 0: its direct
-    term is 0 whatever the ray reports."""
-    unit, d = light_vectors(p, lights)
-    unit = np.where((d > 0.0)[:, None], unit, np.array([1.0, 0.0, 0.0]))
-    origins = np.broadcast_to(np.asarray(p, dtype=np.float64).reshape(1, 3), (len(d), 3)).copy()
-    return origins, unit, d
-
-
-def light_value(table: LookupTable, e: float, rng: np.random.Generator | None, resolution: float) -> float:
-    """LightSensor value: lookup (with relative noise) then resolution rounding (§9.2)."""
-    return sensor_output(table, e, rng, resolution)
-
-
 def occlusion_segments_many(positions: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
-    """Unit directions (S,n,3) and lengths (S,n) of the occlusion segments of S sensors (see
-    :func:`occlusion_segments`; a sensor exactly at a light gets direction (1, 0, 0), length 0)."""
+    """Occlusion segments of S sensors, one per light from each sensor toward it: unit directions
+    (S,n,3) and lengths (S,n) (the sensor–light distance, 1000 for directional lights); a hit with
+    ``0 <= t <= length`` means occluded. A sensor exactly at a light gets direction (1, 0, 0) and
+    length 0: its direct term is 0 whatever the ray reports."""
     _, _, unit, d = _vectors(np.asarray(positions, dtype=np.float64).reshape(-1, 3), lights)
     unit = np.where((d > 0.0)[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
     return unit, d

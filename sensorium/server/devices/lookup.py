@@ -13,7 +13,7 @@ import numpy as np
 
 from .noise import gaussian
 
-__all__ = ["LookupTable", "add_noise", "quantize_sensor", "quantize_lidar", "sensor_output", "RESOLUTION_OFF"]
+__all__ = ["LookupTable", "add_noise", "quantize_sensor", "quantize_lidar", "RESOLUTION_OFF"]
 
 RESOLUTION_OFF = -1.0
 """The ``resolution`` field value that disables rounding."""
@@ -191,10 +191,3 @@ def add_noise(y: np.ndarray, n: np.ndarray, rng: np.random.Generator) -> np.ndar
     out = np.array(y, dtype=np.float64)
     out[noisy] = out[noisy] * (1.0 + n[noisy] * gaussian(rng, count))
     return out
-
-
-def sensor_output(table: LookupTable, measured, rng: np.random.Generator | None, resolution: float):
-    """``quantize_sensor(table.lookup(measured), resolution)``: the last stage of a Light/Distance
-    sensor (§9.2, §9.3). Scalars give a float, arrays an array."""
-    out = quantize_sensor(table.lookup(measured, rng), resolution)
-    return out if np.ndim(measured) else float(out)

@@ -34,7 +34,7 @@ POINT_CLOUD = "sensor_msgs/msg/PointCloud"
 POINT_CLOUD2 = "sensor_msgs/msg/PointCloud2"
 FLOAT32 = 7  # sensor_msgs/msg/PointField.FLOAT32
 
-_NP_DTYPES = {
+_NP_DTYPES: dict[str, Any] = {
     "bool": np.bool_, "byte": np.uint8, "char": np.uint8, "int8": np.int8, "uint8": np.uint8,
     "int16": "<i2", "uint16": "<u2", "int32": "<i4", "uint32": "<u4", "int64": "<i8", "uint64": "<u8",
     "float32": "<f4", "float64": "<f8",
@@ -206,7 +206,7 @@ def to_rosbags(typestore, typename: str, msg: dict) -> Any:
 def _to_mcap_ros2(typestore, typename: str, msg: dict) -> dict:
     """A message dict → values mcap-ros2-support's encoder accepts (lists/array.array/bytes)."""
     _consts, fields = typestore.fielddefs[typename]
-    out = {}
+    out: dict[str, Any] = {}
     for name, (kind, spec) in fields:
         v = msg[name]
         kind = int(kind)

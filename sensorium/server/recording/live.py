@@ -154,6 +154,8 @@ class LiveRecorder:
                     self.info = rpc_call(self.ctx, rpc, "get_info", timeout=2.0)
                 except Exception:
                     self.info = {}
+            if not self.pub:
+                raise ValueError("nothing to record from: give a server (connect) or a topic endpoint (pub)")
             self.pub_endpoint = self.pub
         world_text, world_name = b"", ""
         if self.world:

@@ -30,6 +30,7 @@ from mcap.records import (
     Schema,
 )
 from mcap.stream_reader import StreamReader, breakup_chunk
+from mcap.summary import Summary
 
 from sensorium.server.recording.envelope import MAGIC, SEQ_MODULUS, pack_envelope, topic_matcher
 
@@ -117,7 +118,7 @@ class Recording:
             raise McapError(f"{self.path}: not an MCAP file")
         self.truncated = False
         self.error: str | None = None
-        self._summary = None
+        self._summary: Summary | None = None
         self._reader: SeekingReader | None = None
         if _has_footer(self.path):
             try:
@@ -134,6 +135,11 @@ class Recording:
         if self._summary is None or not self._summary.chunk_indexes:
             self._reader = None  # read sequentially (truncated, or finished without a summary)
         self._scan_cache: dict | None = None
+
+    def _indexed(self) -> Summary:
+        """The summary of a finished, indexed file (callers check ``self._reader`` first)."""
+        assert self._summary is not None
+        return self._summary
 
     # ----- context
     def close(self) -> None:
@@ -251,7 +257,7 @@ class Recording:
         """One entry per channel with its count and first/last log time."""
         if self._reader is None:
             return self._scan()["topics"]
-        s = self._summary
+        s = self._indexed()
         stats = s.statistics
         infos: dict[int, TopicInfo] = {}
         for cid, ch in s.channels.items():
@@ -284,7 +290,7 @@ class Recording:
         match = topics if callable(topics) else topic_matcher(topics)
         unwrap = _Unwrap()
         if self._reader is not None:
-            names = [ch.topic for ch in self._summary.channels.values() if match(ch.topic)]
+            names = [ch.topic for ch in self._indexed().channels.values() if match(ch.topic)]
             kwargs: dict[str, Any] = {"log_time_order": True}
             try:
                 it = self._reader.iter_messages(topics=names, starting_at=start_ns,
@@ -325,7 +331,7 @@ class Recording:
         header = self.header()
         size = self.path.stat().st_size
         if self._reader is not None:
-            s = self._summary
+            s = self._indexed()
             chunks = len(s.chunk_indexes)
             compression = sorted({ci.compression or "none" for ci in s.chunk_indexes})
             stopped = None

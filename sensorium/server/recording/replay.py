@@ -102,7 +102,8 @@ class Replayer:
         self._match = lambda t: match(t) and not (skip_clock and t == CLOCK_TOPIC)
         infos = self.recording.topics()
         self.topic_types = {t.topic: t.ros_type for t in infos if self._match(t.topic)}
-        times = [(t.first_ns, t.last_ns) for t in infos if self._match(t.topic) and t.first_ns is not None]
+        times = [(t.first_ns, t.last_ns) for t in infos
+                 if self._match(t.topic) and t.first_ns is not None and t.last_ns is not None]
         self.first_ns = min((a for a, _ in times), default=0)
         self.last_ns = max((b for _, b in times), default=0)
         if self.start_ns is not None:
@@ -114,7 +115,7 @@ class Replayer:
         self._base_ns = self.time_ns
         self._wall0 = time.monotonic()
         self._paused_at_ns: int | None = None
-        self._iter: Iterator[RecordedMessage] | None = None
+        self._iter: Iterator[RecordedMessage] = iter(())
         self._next: RecordedMessage | None = None
         self.done = False
         self._progress_last = 0.0
@@ -158,6 +159,7 @@ class Replayer:
         self._next = next(self._iter, None)
 
     def _send(self, frames: list[bytes]) -> None:
+        assert self.pub is not None, "bind() first"
         while True:
             try:
                 self.pub.send_multipart(frames, flags=zmq.NOBLOCK if self._nodrop else 0, copy=False)
@@ -195,6 +197,7 @@ class Replayer:
         """Wait up to ``timeout_s`` for requests or subscriptions and handle them."""
         timeout_ms = max(0, int(math.ceil(timeout_s * 1000)))
         events = dict(self._poller.poll(timeout_ms))
+        assert self.pub is not None, "bind() first"
         if self.pub in events:
             while True:
                 try:

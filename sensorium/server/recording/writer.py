@@ -25,7 +25,7 @@ import os
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import IO, Any, cast
 
 import msgpack
 from mcap.writer import CompressionType, IndexType, Writer
@@ -122,7 +122,8 @@ class McapRecorder:
                 "none": CompressionType.NONE, "": CompressionType.NONE}[compression]
         self._stream = _WriteThrough(self.path)
         try:
-            self._writer = Writer(self._stream, chunk_size=max(1024, int(chunk_size)), compression=comp,
+            # _WriteThrough implements the write/tell/flush subset of a binary stream that Writer uses
+            self._writer = Writer(cast(IO[bytes], self._stream), chunk_size=max(1024, int(chunk_size)), compression=comp,
                                   index_types=IndexType.ALL, repeat_channels=True, repeat_schemas=True,
                                   use_chunking=True, use_statistics=True, use_summary_offsets=True,
                                   enable_crcs=True)

@@ -39,7 +39,10 @@ def _output(devices: list, measured: np.ndarray, now_ms: int) -> None:
     for i, d in enumerate(devices):
         by_table[d.table].append(i)
     for table, idx in by_table.items():
-        y, n = table.interpolate(measured[idx])
+        if len(table) == 0:          # devices.md §1.2: an empty table is the identity, without noise
+            y, n = np.asarray(measured[idx], dtype=np.float64), np.zeros(len(idx))
+        else:
+            y, n = table.interpolate(measured[idx])
         for k, i in enumerate(idx):
             d = devices[i]
             v = y[k:k + 1]

@@ -33,8 +33,9 @@ class ShapeInfo:
     transparency: float
 
 
-def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.Plane | wm.Triangles | wm.Mesh,
+def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.Plane | wm.Triangles | wm.Mesh | None,
                          base_dir: Path) -> geo.Primitive:
+    """A validated geometry model → its primitive (``TypeError`` for None or an unknown model)."""
     if isinstance(g, wm.Box):
         return geo.Box(size=tuple(g.size))
     if isinstance(g, wm.Sphere):

@@ -16,6 +16,7 @@ from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -37,6 +38,7 @@ from sensorium.server.sim.sensors import (
     RayRequest,
 )
 from sensorium.server.world.geometry import Pose
+from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
 
@@ -83,6 +85,7 @@ class RobotState:
         self.encoders: list[PositionSensor] = []
         for dev in self.devices.values():
             if isinstance(dev, PositionSensor):
+                assert isinstance(dev.config, wm.PositionSensor)
                 dev.wheel = self.motors.get(dev.config.motor)
                 self.encoders.append(dev)
         self.custom_data = model.custom_data
@@ -152,7 +155,7 @@ class Simulation:
         self._counters: Counter[str] = Counter()
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = self._build_contact() if use_contact and self._driven else None
-        self._initial = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
+        self._initial: dict[str, Any] = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
                          "solids": dict(self.scene.solid_poses)}
 
     def _build_contact(self) -> Contact:
@@ -194,8 +197,10 @@ class Simulation:
         self._counters["resets"] += 1
 
     @classmethod
-    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT) -> Simulation:
-        return cls(load_world(path), precision)
+    def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT, *,
+                  limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> Simulation:
+        """``limits``/``allow_outside_meshes``: see :func:`sensorium.server.world.loader.load_world`."""
+        return cls(load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes), precision)
 
     # ------------------------------------------------------------------ access
     @property
@@ -257,6 +262,7 @@ class Simulation:
         contact = self.contact
         for robot in self._driven:
             drive = robot.drive
+            assert drive is not None
             start = (drive.x, drive.y)
             pose = drive.step(dt)
             if pose is not None:
@@ -276,14 +282,17 @@ class Simulation:
                 if isinstance(dev, Lidar):
                     if dev.due(now):
                         lidars.append(dev)
-                elif isinstance(dev, (LightSensor, DistanceSensor)):
+                elif isinstance(dev, LightSensor):
                     if dev.schedule.due(now):
-                        (lights if isinstance(dev, LightSensor) else distances).append(dev)
+                        lights.append(dev)
+                elif isinstance(dev, DistanceSensor):
+                    if dev.schedule.due(now):
+                        distances.append(dev)
                 elif isinstance(dev, PositionSensor) and dev.schedule.due(now):
                     dev.measure(now)
                     dev.schedule.last_update_ms = now
                     encoders += 1
-        work: list[tuple[object, list[RayRequest]]] = []
+        work: list[tuple[Any, list[RayRequest]]] = []
         if lights:
             if self._lights_version != self.scene.lights_version:  # a light moved with its owner
                 self.lights = lights_from_models(self.scene.world_lights())
@@ -291,8 +300,8 @@ class Simulation:
             batch = LightBatch(lights, poses, self.lights)
             work.append((batch, batch.plan()))
         if distances:
-            batch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness)
-            work.append((batch, batch.plan()))
+            dbatch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness)
+            work.append((dbatch, dbatch.plan()))
         for lidar in lidars:
             work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt)))
         hits = self._cast_batched([req for _, reqs in work for req in reqs])

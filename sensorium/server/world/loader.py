@@ -3,6 +3,11 @@
 Every problem names the file, the path to the field (``robots[0].devices[2].lookup_table[1]``)
 and what was expected. Webots' sanitising rules that silently change a value are applied here and
 reported as warnings, so a world behaves as it would in Webots and the user is told why.
+
+Untrusted input: the file size, nesting, values and string lengths are bounded before the model is
+built, and the work a world asks for (rays, beams, triangles, robots, ...) afterwards
+(:mod:`.limits`); mesh urls must stay inside the world's folder unless ``allow_outside_meshes``.
+Every failure is a :class:`WorldError`, never another exception.
 """
 
 from __future__ import annotations
@@ -10,7 +15,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,6 +24,7 @@ import yaml
 from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
+from sensorium.server.world.limits import LimitError, WorldLimits, check_data, check_work, check_yaml_events, quote
 
 
 class _Yaml12Loader(yaml.SafeLoader):
@@ -71,6 +77,50 @@ class LoadedWorld:
     warnings: list[str] = field(default_factory=list)
 
 
+def read_world_text(path: str | Path, limits: WorldLimits | None = None) -> bytes:
+    """The bytes of a world file, at most ``limits.file_bytes`` of them (else ``WorldError``)."""
+    limits = limits or WorldLimits()
+    path = Path(path)
+    source = str(path)
+    try:
+        with open(path, "rb") as f:
+            text = f.read(limits.file_bytes + 1)
+    except (OSError, ValueError) as exc:       # ValueError: a NUL byte in the path
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        if isinstance(exc, FileNotFoundError) and path.parent == Path("."):
+            from sensorium import worlds
+
+            reason += f" (nor a bundled world: {', '.join(worlds.names())})"
+        raise WorldError(source, [Problem("", f"cannot read world file: {reason}")]) from None
+    if len(text) > limits.file_bytes:
+        raise WorldError(source, [Problem("", f"file larger than the limit of {limits.file_bytes:,} bytes "
+                                              "(raise the limits with --allow-large)")])
+    return text
+
+
+def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: WorldLimits | None = None) -> Any:
+    """YAML (1.2 booleans) or JSON text → plain data, bounded (nesting, alias expansion) before it is
+    built. Any failure is a ``WorldError``."""
+    limits = limits or WorldLimits()
+    try:
+        if json_format:
+            return json.loads(text)
+        check_yaml_events(text, limits)
+        return yaml.load(text, Loader=_Yaml12Loader)  # noqa: S506 (a safe loader)
+    except LimitError as exc:
+        raise WorldError(source, [Problem(exc.path, exc.message)]) from None
+    except RecursionError:
+        raise WorldError(source, [Problem("", f"nested deeper than {limits.nesting_depth} levels "
+                                              "(raise the limits with --allow-large)")]) from None
+    except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise WorldError(source, [Problem("", syntax_problem(exc))]) from None
+    except Exception as exc:  # noqa: BLE001 - yaml/json raise many types (and constructors ValueError) for bad text
+        detail = str(exc)
+        if len(detail) > 300:
+            detail = detail[:300] + "…"
+        raise WorldError(source, [Problem("", f"not valid YAML/JSON: {detail}")]) from None
+
+
 def bundled_or_path(path: str | Path) -> Path:
     """``path``, or the bundled world of that bare name (``arena``, ``warehouse.yaml``) when no such
     file exists here: examples then work from any directory."""
@@ -85,28 +135,19 @@ def bundled_or_path(path: str | Path) -> Path:
     return path
 
 
-def load_world(path: str | Path) -> LoadedWorld:
+def load_world(path: str | Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
+    """Read, parse, validate and sanitise a world file (``WorldError`` listing every problem).
+    ``limits``: the work it may ask for (default ``WorldLimits()``; ``--allow-large`` is
+    ``WorldLimits.large()``); ``allow_outside_meshes``: mesh urls may leave the world's folder.
+    A bare name of a bundled world (``arena``) works from any directory."""
     path = bundled_or_path(path)
     source = str(path)
     if path.suffix.lower() == ".wbt":
-        return load_wbt(path)
-    try:
-        text = path.read_bytes()
-    except OSError as exc:
-        hint = ""
-        if not path.exists() and path.parent == Path("."):
-            from sensorium import worlds
-
-            hint = f" (nor a bundled world: {', '.join(worlds.names())})"
-        raise WorldError(source, [Problem("", f"cannot read world file: {exc.strerror or exc}{hint}")]) from None
-    try:
-        if path.suffix.lower() == ".json":
-            data = json.loads(text)
-        else:
-            data = yaml.load(text, Loader=_Yaml12Loader)  # noqa: S506 (a safe loader)
-    except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise WorldError(source, [Problem("", syntax_problem(exc))]) from None
-    return parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
+        return load_wbt(path, limits=limits, allow_outside_meshes=allow_outside_meshes)
+    text = read_world_text(path, limits)
+    data = parse_text(text, source, json_format=path.suffix.lower() == ".json", limits=limits)
+    return parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
+                       allow_outside_meshes=allow_outside_meshes)
 
 
 def syntax_problem(exc: Exception) -> str:
@@ -152,13 +193,20 @@ def with_names(path: str, data: Any) -> str:
                 out += f" ({name})"
         pos = m.end()
     return out
-def load_wbt(path: Path) -> LoadedWorld:
+
+
+def _named(data: Any, problems: list[Problem]) -> list[Problem]:
+    return [Problem(p.path, p.message, with_names(p.path, data)) if p.path else p for p in problems]
+
+
+def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
     """A Webots world, converted (``sensorium.server.world.wbt``); problems point at its lines.
 
     ``LoadedWorld.text`` is the converted world as YAML (what recordings attach and replays read)."""
     from sensorium.server.world.wbt import WbtSyntaxError, wbt_to_dict
 
     source = str(path)
+    read_world_text(path, limits)                  # the size limit (and a readable file)
     try:
         data, warnings, origin = wbt_to_dict(path)
     except WbtSyntaxError as exc:
@@ -166,7 +214,8 @@ def load_wbt(path: Path) -> LoadedWorld:
         raise WorldError(source, [Problem(where, exc.message)]) from None
     text = yaml.safe_dump(data, sort_keys=False).encode()
     try:
-        loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text)
+        loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
+                             allow_outside_meshes=allow_outside_meshes)
     except WorldError as exc:
         raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
@@ -185,25 +234,27 @@ def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem
     return Problem(f"line {line}, column {col} ({kind}, converted as {p.path})", p.message)
 
 
-def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"") -> LoadedWorld:
+def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"", *,
+                limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
+    limits = limits or WorldLimits()
     if data is None:
         data = {}
     if not isinstance(data, dict):
         raise WorldError(source, [Problem("", f"a world must be a mapping, got {type(data).__name__}")])
     try:
+        check_data(data, limits)
+    except LimitError as exc:
+        raise WorldError(source, [Problem(exc.path, exc.message)]) from None
+    try:
         world = wm.World.model_validate(data)
     except ValidationError as exc:
         raise WorldError(source, _named(data, [_problem_from_pydantic(e) for e in exc.errors()])) from None
     base = base_dir or Path.cwd()
-    problems = check_world(world, base)
+    problems = check_world(world, base, limits=limits, allow_outside_meshes=allow_outside_meshes)
     if problems:
         raise WorldError(source, _named(data, problems))
     world, warnings = sanitize(world)
     return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings)
-
-
-def _named(data: Any, problems: list[Problem]) -> list[Problem]:
-    return [Problem(p.path, p.message, with_names(p.path, data)) if p.path else p for p in problems]
 
 
 _TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "triangles", "mesh", "PointLight", "SpotLight",
@@ -224,26 +275,30 @@ def format_path(loc: tuple[Any, ...]) -> str:
     return out
 
 
-def _problem_from_pydantic(err: dict[str, Any]) -> Problem:
+def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
     loc = tuple(err.get("loc", ()))
     msg = err.get("msg", "invalid")
     kind = err.get("type", "")
     if kind == "extra_forbidden":
         msg = "unknown key (check spelling; field names are Webots' names in snake_case)"
     elif kind in ("finite_number",):
-        msg = f"expected a finite number, got {err.get('input')!r}"
+        msg = f"expected a finite number, got {quote(err.get('input'))}"
     elif "input" in err and kind not in ("missing", "union_tag_invalid", "union_tag_not_found") and not isinstance(err["input"], (dict, list)):
-        msg = f"{msg} (got {err['input']!r})"
+        msg = f"{msg} (got {quote(err['input'])})"
+    if len(msg) > 400:
+        msg = msg[:400] + "…"
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
     return Problem(format_path(loc), msg)
 
 
-def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
-    """Checks that relate several fields or the file system; one problem per finding."""
+def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None = None,
+                allow_outside_meshes: bool = False) -> list[Problem]:
+    """Checks that relate several fields or the file system, and the world's limits; one problem
+    per finding."""
     problems: list[Problem] = []
 
-    def unique(items: list[tuple[str, str | None]], what: str) -> None:
+    def unique(items: Sequence[tuple[str, str | None]], what: str) -> None:
         first: dict[str, str] = {}
         for path, name in items:
             if name is None:
@@ -296,6 +351,35 @@ def check_world(world: wm.World, base_dir: Path) -> list[Problem]:
                                        f"(motors: {', '.join(repr(m) for m in motors) or 'none: no differential_drive'})"))
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
+    problems += _check_meshes_and_work(world, base_dir, limits or WorldLimits(), allow_outside_meshes)
+    return problems
+
+
+def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
+                           allow_outside_meshes: bool) -> list[Problem]:
+    """Every mesh url (confined, readable, bounded) and the work the world asks for."""
+    from sensorium.server.world.limits import _walk
+    from sensorium.server.world.meshes import MeshFileError, load_mesh, resolve_mesh_url
+
+    problems: list[Problem] = []
+    faces: dict[tuple[str, tuple[float, ...]], int] = {}
+    for path, geom in _walk(world):
+        if not isinstance(geom, wm.Mesh):
+            continue
+        key = (geom.url, tuple(geom.scale))
+        if key in faces:
+            continue
+        faces[key] = 0
+        try:
+            file = resolve_mesh_url(geom.url, base_dir, allow_outside=allow_outside_meshes,
+                                    max_bytes=limits.mesh_file_bytes)
+            faces[key] = len(load_mesh(file, geom.scale, display=geom.url).faces)
+        except MeshFileError as exc:
+            problems.append(Problem(f"{path}.url", str(exc)))
+    if problems:
+        return problems
+    for item in check_work(world, limits, lambda g: faces.get((g.url, tuple(g.scale)), 0)):
+        problems.append(Problem(*item) if isinstance(item, tuple) else Problem("", item))
     return problems
 
 
@@ -342,15 +426,7 @@ def _check_geometry(geom: Any, path: str, base_dir: Path) -> list[Problem]:
             if min(face) < 0 or max(face) >= n:
                 return [Problem(f"{path}.faces[{i}]", f"vertex index outside 0..{n - 1}: {list(face)}")]
         return []
-    if not isinstance(geom, wm.Mesh):
-        return []
-    from sensorium.server.world.meshes import MeshFileError, load_mesh
-
-    try:
-        load_mesh(base_dir / geom.url, geom.scale)
-    except MeshFileError as exc:
-        return [Problem(f"{path}.url", str(exc))]
-    return []
+    return []      # mesh files: _check_meshes_and_work (url confined to the world's folder, size, triangles)
 
 
 def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:

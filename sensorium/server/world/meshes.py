@@ -18,13 +18,48 @@ class MeshFileError(Exception):
     """A mesh file that is missing, unreadable or not a triangle mesh."""
 
 
-def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)):
+def resolve_mesh_url(url: str, base_dir: Path, *, allow_outside: bool = False, max_bytes: int | None = None) -> Path:
+    """A world file's mesh ``url`` → the file it names, relative to the world's folder.
+
+    Unless ``allow_outside``, the file (symbolic links followed) must be inside ``base_dir``: an
+    absolute url or one that climbs out with ``..`` is refused. Errors quote the url as written,
+    never a resolved path elsewhere on the machine."""
+    if "\0" in url:
+        raise MeshFileError("mesh url contains a NUL byte")
+    if not url.strip():
+        raise MeshFileError("mesh url is empty")
+    base = Path(base_dir).resolve()
+    try:
+        path = (base / url).resolve()
+    except (OSError, RuntimeError, ValueError) as exc:       # symlink loops, bad names
+        raise MeshFileError(f"mesh url {url!r} cannot be resolved: {exc}") from None
+    if not allow_outside and not path.is_relative_to(base):
+        raise MeshFileError(f"mesh url {url!r} leaves the world's folder (absolute paths and '..' are refused; "
+                            "use --allow-outside-meshes to allow them)")
+    try:
+        if not path.is_file():
+            raise MeshFileError(f"mesh file {url!r} not found (urls are relative to the world file)")
+        size = path.stat().st_size
+    except OSError as exc:
+        raise MeshFileError(f"mesh file {url!r} cannot be read: {exc.strerror or exc}") from None
+    if max_bytes is not None and size > max_bytes:
+        raise MeshFileError(f"mesh file {url!r} is larger than the limit of {max_bytes:,} bytes "
+                            "(raise the limits with --allow-large)")
+    return path
+
+
+def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *, display: str | None = None):
+    """Load and scale a mesh file (cached). ``display``: how errors name the file (default: its path)."""
     path = Path(path).resolve()
+    name = display if display is not None else str(path)
     if not path.is_file():
-        raise MeshFileError(f"mesh file not found: {path}")
+        raise MeshFileError(f"mesh file not found: {name}")
     if path.suffix.lower() not in SUPPORTED:
         raise MeshFileError(f"unsupported mesh format {path.suffix!r} (expected one of {sorted(SUPPORTED)})")
-    return _load(str(path), path.stat().st_mtime_ns, tuple(float(s) for s in scale))
+    try:
+        return _load(str(path), path.stat().st_mtime_ns, tuple(float(s) for s in scale))
+    except MeshFileError as exc:
+        raise MeshFileError(str(exc).replace(str(path), name)) from None
 
 
 @lru_cache(maxsize=64)

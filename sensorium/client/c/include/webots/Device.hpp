@@ -1,0 +1,36 @@
+// Sensorium C++ controller layer: header-only classes over the C functions (Webots' C++ names).
+#ifndef WEBOTS_DEVICE_HPP
+#define WEBOTS_DEVICE_HPP
+
+#include <string>
+
+#include <webots/device.h>
+
+namespace webots {
+
+class Device {
+public:
+  explicit Device(WbDeviceTag tag) : tag_(tag) {}
+  virtual ~Device() {}
+  std::string getName() const {
+    const char *name = wb_device_get_name(tag_);
+    return name ? name : "";
+  }
+  std::string getModel() const {
+    const char *model = wb_device_get_model(tag_);
+    return model ? model : "";
+  }
+  int getNodeType() const { return wb_device_get_node_type(tag_); }
+  WbDeviceTag getTag() const { return tag_; }
+
+protected:
+  WbDeviceTag tag_;
+
+private:
+  Device(const Device &);
+  Device &operator=(const Device &);
+};
+
+}  // namespace webots
+
+#endif

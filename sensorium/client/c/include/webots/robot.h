@@ -1,0 +1,51 @@
+/* Sensorium C controller library: the robot (Webots' wb_robot_* functions).
+ *
+ * wb_robot_init() attaches this process to its robot; the controller URL comes from
+ * SENSORIUM_CONTROLLER_URL, else WEBOTS_CONTROLLER_URL (forms: "NAME", "tcp://HOST[:PORT][/NAME]",
+ * "ipc://PATH/NAME"; default tcp://127.0.0.1:5560 and the world's only robot). A URL that cannot be
+ * parsed, a robot that does not exist or a server that does not answer within
+ * SENSORIUM_CONTROLLER_TIMEOUT seconds (default 10) print one line and exit the process with
+ * status 1. */
+#ifndef WB_ROBOT_H
+#define WB_ROBOT_H
+
+#include "device.h"
+#include "nodes.h"
+#include "types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum { WB_MODE_SIMULATION = 0, WB_MODE_CROSS_COMPILATION, WB_MODE_REMOTE_CONTROL } WbRobotMode;
+
+int wb_robot_init(void);
+void wb_robot_cleanup(void);
+
+/* Advance the simulation by duration ms (a multiple of the basic time step); motor commands set
+ * since the previous step travel with it and sensor readings come back with it. Returns 0 (for an
+ * asynchronous robot: the ms it was late), or -1 once the server quits or is gone. */
+int wb_robot_step(int duration);
+int wb_robot_step_begin(int duration);
+int wb_robot_step_end(void);
+
+double wb_robot_get_time(void);                 /* seconds of simulated time */
+double wb_robot_get_basic_time_step(void);      /* ms */
+const char *wb_robot_get_name(void);
+const char *wb_robot_get_model(void);
+bool wb_robot_get_synchronization(void);
+bool wb_robot_get_supervisor(void);
+const char *wb_robot_get_custom_data(void);
+void wb_robot_set_custom_data(const char *data);
+WbRobotMode wb_robot_get_mode(void);
+void wb_robot_set_mode(WbRobotMode mode, const char *arg);
+
+int wb_robot_get_number_of_devices(void);
+WbDeviceTag wb_robot_get_device(const char *name);       /* 0 if the robot has no such device */
+WbDeviceTag wb_robot_get_device_by_index(int index);     /* 0 if index is out of range */
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* WB_ROBOT_H */

@@ -1,0 +1,106 @@
+/* Sensorium C controller library: PositionSensor (wheel encoders), LED and Keyboard. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <webots/keyboard.h>
+#include <webots/led.h>
+#include <webots/position_sensor.h>
+#include <webots/robot.h>
+
+#include "internal.h"
+
+/* ------------------------------------------------------------------ position sensor */
+
+#define POSITION(func) sn_device *d = sn_device_get(tag, SN_POSITION, func)
+
+void wb_position_sensor_enable(WbDeviceTag tag, int sampling_period) {
+  POSITION("wb_position_sensor_enable");
+  if (d != NULL)
+    sn_device_enable(d, sampling_period, "wb_position_sensor_enable");
+}
+
+void wb_position_sensor_disable(WbDeviceTag tag) {
+  POSITION("wb_position_sensor_disable");
+  if (d != NULL)
+    sn_device_enable(d, 0, "wb_position_sensor_disable");
+}
+
+int wb_position_sensor_get_sampling_period(WbDeviceTag tag) {
+  POSITION("wb_position_sensor_get_sampling_period");
+  return d ? d->sampling_period : 0;
+}
+
+double wb_position_sensor_get_value(WbDeviceTag tag) {
+  POSITION("wb_position_sensor_get_value");
+  if (d == NULL)
+    return NAN;
+  if (d->sampling_period <= 0)
+    sn_warn_disabled(d, "wb_position_sensor_get_value", "wb_position_sensor_enable", NULL);
+  return d->value;
+}
+
+WbJointType wb_position_sensor_get_type(WbDeviceTag tag) {
+  POSITION("wb_position_sensor_get_type");
+  (void)d;
+  return WB_ROTATIONAL;
+}
+
+WbDeviceTag wb_position_sensor_get_motor(WbDeviceTag tag) {
+  POSITION("wb_position_sensor_get_motor");
+  return d && d->motor_name ? wb_robot_get_device(d->motor_name) : 0;
+}
+
+WbDeviceTag wb_position_sensor_get_brake(WbDeviceTag tag) {
+  POSITION("wb_position_sensor_get_brake");
+  (void)d;
+  return 0;
+}
+
+/* ------------------------------------------------------------------ LED */
+
+void wb_led_set(WbDeviceTag tag, int value) {
+  sn_device *d = sn_device_get(tag, SN_LED, "wb_led_set");
+  if (d == NULL)
+    return;
+  int hi = d->led_gradual ? 0xFFFFFF : d->led_colors;
+  if (value < 0 || value > hi) {
+    fprintf(stderr, "Error: wb_led_set(): value %d out of range [0, %d] for LED '%s'.\n", value, hi, d->name);
+    return;
+  }
+  sn_robot *rb = sn_robot_get("wb_led_set");
+  if (!rb->terminated) {
+    sn_reply rep;
+    if (sn_device_call(rb, d, "set", sn_arg_int, &value, "wb_led_set", &rep) != 0)
+      return;
+    sn_reply_free(&rep);
+  }
+  d->led_value = value;
+}
+
+int wb_led_get(WbDeviceTag tag) {
+  sn_device *d = sn_device_get(tag, SN_LED, "wb_led_get");
+  return d ? d->led_value : 0;
+}
+
+/* ------------------------------------------------------------------ keyboard (never a key) */
+
+void wb_keyboard_enable(int sampling_period) {
+  sn_robot *rb = sn_robot_get("wb_keyboard_enable");
+  if (sampling_period < 0) {
+    fprintf(stderr, "Error: wb_keyboard_enable(): negative sampling period %d\n", sampling_period);
+    return;
+  }
+  rb->keyboard_period = sampling_period;
+}
+
+void wb_keyboard_disable(void) { sn_robot_get("wb_keyboard_disable")->keyboard_period = 0; }
+
+int wb_keyboard_get_sampling_period(void) { return sn_robot_get("wb_keyboard_get_sampling_period")->keyboard_period; }
+
+int wb_keyboard_get_key(void) {
+  sn_robot *rb = sn_robot_get("wb_keyboard_get_key");
+  if (rb->keyboard_period <= 0)
+    fprintf(stderr, "Error: wb_keyboard_get_key() called for a disabled device! Please use: wb_keyboard_enable().\n");
+  return -1;
+}

@@ -1,0 +1,172 @@
+/* Sensorium C controller library: internals shared by the source files (not installed).
+ *
+ * conn.c    - the only ZeroMQ code: controller URLs, the DEALER socket, requests matched by id,
+ *             the heartbeat thread;
+ * wire.c    - msgpack helpers (building requests, reading reply maps);
+ * robot.c   - the session: attach, step (motor commands out, readings in), cleanup;
+ * devices.c - light and distance sensors, generic device functions; lidar.c; motor.c.
+ */
+#ifndef SENSORIUM_INTERNAL_H
+#define SENSORIUM_INTERNAL_H
+
+#include <msgpack.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <webots/types.h>
+
+/* ------------------------------------------------------------------ error codes (PROTOCOL.md 3.2) */
+enum {
+  SN_BAD_REQUEST = 1,
+  SN_UNKNOWN_SERVICE = 2,
+  SN_UNKNOWN_ROBOT = 3,
+  SN_UNKNOWN_DEVICE = 4,
+  SN_INVALID_ARGUMENT = 5,
+  SN_NOT_ATTACHED = 6,
+  SN_ROBOT_TAKEN = 7,
+  SN_TOO_LARGE = 8,
+  SN_SHUTTING_DOWN = 9,
+  SN_WRONG_STATE = 10,
+  SN_INTERNAL = 99,
+  /* client side, as the Python client's */
+  SN_TIMEOUT = 1000,
+  SN_CONNECTION_LOST = 1001,
+  SN_BAD_REPLY = 1002,
+  SN_BAD_URL = 1003
+};
+const char *sn_error_name(int code);
+
+/* ------------------------------------------------------------------ wire.c */
+typedef struct {
+  msgpack_sbuffer buf;
+  msgpack_packer pk;
+} sn_req;
+
+/* Start {"id": id, "service": service, "args": {<nargs entries>}}; then add nargs key/values. */
+void sn_req_begin(sn_req *r, uint64_t id, const char *service, uint32_t nargs);
+void sn_req_key(sn_req *r, const char *key);
+void sn_req_str(sn_req *r, const char *s);
+void sn_req_free(sn_req *r);
+
+const msgpack_object *sn_get(const msgpack_object *map, const char *key); /* NULL if absent */
+bool sn_as_double(const msgpack_object *o, double *out);
+bool sn_as_int64(const msgpack_object *o, int64_t *out);
+double sn_double_or(const msgpack_object *map, const char *key, double fallback);
+int64_t sn_int_or(const msgpack_object *map, const char *key, int64_t fallback);
+bool sn_bool_or(const msgpack_object *map, const char *key, bool fallback);
+char *sn_strdup_obj(const msgpack_object *o); /* malloc'ed NUL-terminated copy of a str, NULL otherwise */
+
+/* ------------------------------------------------------------------ conn.c */
+typedef struct {
+  char *endpoint; /* ZeroMQ address of the RPC socket */
+  char *robot;    /* NULL: the world's only robot */
+} sn_url;
+
+/* Parse a controller URL (NULL/empty: default endpoint, only robot). 0 on success, else writes a
+ * one-line reason to err. */
+int sn_parse_url(const char *url, sn_url *out, char *err, size_t errlen);
+void sn_url_free(sn_url *u);
+
+/* A decoded reply: the whole message is kept so that str/bin objects stay valid. */
+typedef struct {
+  msgpack_unpacked unpacked;
+  char *data;
+  size_t size;
+  bool ok;
+  const msgpack_object *result; /* the result map when ok */
+  int code;                     /* error code when !ok */
+  char message[512];            /* error message when !ok */
+} sn_reply;
+void sn_reply_free(sn_reply *r);
+
+typedef struct sn_conn sn_conn;
+sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen);
+void sn_conn_close(sn_conn *c);
+/* Send a built request (consumes nothing: the caller frees r). Returns its id, 0 on failure. */
+uint64_t sn_conn_next_id(sn_conn *c);
+int sn_conn_send(sn_conn *c, sn_req *r, uint64_t id);
+/* Wait for the reply of id: timeout_ms < 0 waits forever (but gives up with SN_CONNECTION_LOST when
+ * the heartbeat finds the server gone). Returns 0 and fills out (ok or error reply), or -1 with a
+ * client-side error in out->code/out->message. */
+int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out);
+void sn_conn_discard(sn_conn *c, uint64_t id);
+/* The next reply, whatever its id (for raw replays such as the conformance vectors). */
+int sn_conn_wait_any(sn_conn *c, int timeout_ms, sn_reply *out);
+int sn_conn_start_heartbeat(sn_conn *c, const char *session, int interval_ms);
+void sn_conn_stop_heartbeat(sn_conn *c);
+const char *sn_conn_endpoint(const sn_conn *c);
+
+/* ------------------------------------------------------------------ robot.c */
+typedef enum { SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_OTHER } sn_kind;
+
+typedef struct {
+  WbDeviceTag tag;
+  char *name;
+  char *type_name;
+  sn_kind kind;
+  int sampling_period;
+  bool warned; /* "disabled device" message printed since the last enable */
+  /* light / distance */
+  double value;
+  double *lookup_table;
+  int lookup_rows;
+  double min_value, max_value, aperture;
+  int sensor_type;
+  /* lidar */
+  int width, layers;
+  double fov, vertical_fov, min_range, max_range, frequency, min_frequency, max_frequency;
+  bool point_cloud_enabled;
+  float *range_image;         /* layers * width, zeros before the first measurement */
+  WbLidarPoint *point_cloud;  /* layers * width */
+  /* position sensor: its wheel motor's name; LED: value, colours, gradual */
+  char *motor_name;
+  int led_value, led_colors;
+  bool led_gradual;
+  /* motor */
+  double max_velocity, min_position, max_position, target_position, velocity;
+  bool cmd_position, cmd_velocity; /* to send with the next step */
+} sn_device;
+
+typedef struct {
+  sn_conn *conn;
+  char *name;
+  char *session;
+  char *model;
+  char *custom_data;
+  char *prefix; /* "/<robot>/" */
+  int basic_time_step;
+  int64_t time_ms;
+  bool synchronization;
+  bool supervisor;
+  bool terminated;
+  bool warned_duration;
+  int keyboard_period;
+  void *nodes, *fields; /* supervisor handles handed out (supervisor.c) */
+  uint64_t pending; /* id of the pending step, 0 if none */
+  int n_devices;
+  sn_device *devices;
+} sn_robot;
+
+/* The process's robot; exits with a message if wb_robot_init() was not called. */
+sn_robot *sn_robot_get(const char *func);
+/* The device of tag if it is of kind (SN_OTHER: any), else prints Webots' error and returns NULL. */
+sn_device *sn_device_get(WbDeviceTag tag, sn_kind kind, const char *func);
+/* A synchronous call to "/<robot>/<device>/<item>" (device NULL: "/<robot>/<item>") with one
+ * argument "value" built by add_value (NULL: no args). Returns 0 on an ok reply (out filled; free
+ * it), else prints "Error: func(): ..." and returns -1. */
+typedef void (*sn_arg_fn)(sn_req *r, const void *arg);
+int sn_device_call(sn_robot *rb, const sn_device *dev, const char *item, sn_arg_fn add_value,
+                   const void *arg, const char *func, sn_reply *out);
+/* The general form: service "/<robot>/<item>"; add_args packs nargs key/value pairs. */
+int sn_robot_call(sn_robot *rb, const char *item, uint32_t nargs, sn_arg_fn add_args, const void *arg,
+                  const char *func, sn_reply *out);
+void sn_supervisor_free(sn_robot *rb);
+void sn_arg_int(sn_req *r, const void *arg);
+void sn_arg_bool(sn_req *r, const void *arg);
+void sn_arg_double(sn_req *r, const void *arg);
+/* enable/disable a sensor (period 0 disables): RPC, then the local state. */
+void sn_device_enable(sn_device *dev, int period, const char *func);
+void sn_warn_disabled(sn_device *dev, const char *func, const char *enabler, const char *what);
+
+#endif /* SENSORIUM_INTERNAL_H */

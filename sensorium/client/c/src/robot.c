@@ -1,0 +1,612 @@
+/* Sensorium C controller library: the robot session (wb_robot_*), as the Python client's
+ * RobotClient: attach, heartbeats, steps carrying motor commands and bringing readings back. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <webots/robot.h>
+
+#include "internal.h"
+
+static sn_robot *g_robot = NULL;
+static bool g_atexit = false;
+static int g_timeout_ms = 10000; /* ordinary replies; steps wait as long as the lockstep needs */
+
+static void fatal(const char *func, int code, const char *message) {
+  fprintf(stderr, "Error: %s(): %s: %s\n", func, sn_error_name(code), message);
+  fflush(stderr);
+  exit(1);
+}
+
+sn_robot *sn_robot_get(const char *func) {
+  if (g_robot == NULL) {
+    fprintf(stderr, "Error: %s(): no robot: call wb_robot_init() first\n", func);
+    exit(1);
+  }
+  return g_robot;
+}
+
+static int timeout_from_env(void) {
+  const char *s = getenv("SENSORIUM_CONTROLLER_TIMEOUT");
+  if (s == NULL || *s == '\0')
+    return 10000;
+  char *end;
+  double v = strtod(s, &end);
+  if (*end != '\0' || !(v > 0) || v > 86400) {
+    fprintf(stderr, "Error: wb_robot_init(): SENSORIUM_CONTROLLER_TIMEOUT='%s' is not a number of seconds > 0\n", s);
+    exit(1);
+  }
+  return (int)(v * 1000);
+}
+
+/* ------------------------------------------------------------------ device descriptions */
+
+static sn_kind kind_of(const char *type) {
+  if (strcmp(type, "LightSensor") == 0)
+    return SN_LIGHT;
+  if (strcmp(type, "DistanceSensor") == 0)
+    return SN_DISTANCE;
+  if (strcmp(type, "Lidar") == 0)
+    return SN_LIDAR;
+  if (strcmp(type, "RotationalMotor") == 0)
+    return SN_MOTOR;
+  if (strcmp(type, "PositionSensor") == 0)
+    return SN_POSITION;
+  if (strcmp(type, "LED") == 0)
+    return SN_LED;
+  return SN_OTHER;
+}
+
+static void flatten(const msgpack_object *o, double *out, int *n, int cap) {
+  if (o == NULL)
+    return;
+  if (o->type == MSGPACK_OBJECT_ARRAY) {
+    for (uint32_t i = 0; i < o->via.array.size; i++)
+      flatten(&o->via.array.ptr[i], out, n, cap);
+  } else if (*n < cap) {
+    double v;
+    if (sn_as_double(o, &v))
+      out[(*n)++] = v;
+  }
+}
+
+static int count_leaves(const msgpack_object *o) {
+  if (o == NULL)
+    return 0;
+  if (o->type != MSGPACK_OBJECT_ARRAY)
+    return 1;
+  int n = 0;
+  for (uint32_t i = 0; i < o->via.array.size; i++)
+    n += count_leaves(&o->via.array.ptr[i]);
+  return n;
+}
+
+static int describe(sn_device *d, int index, const msgpack_object *desc) {
+  memset(d, 0, sizeof *d);
+  d->tag = (WbDeviceTag)(index + 1);
+  d->name = sn_strdup_obj(sn_get(desc, "name"));
+  d->type_name = sn_strdup_obj(sn_get(desc, "type"));
+  if (d->name == NULL || d->type_name == NULL)
+    return -1;
+  d->kind = kind_of(d->type_name);
+  d->sampling_period = (int)sn_int_or(desc, "sampling_period", 0);
+  d->value = NAN;
+  const msgpack_object *table = sn_get(desc, "lookup_table");
+  if (table != NULL) {
+    int cap = count_leaves(table);
+    d->lookup_table = calloc(cap > 0 ? (size_t)cap : 1, sizeof(double));
+    int n = 0;
+    flatten(table, d->lookup_table, &n, cap);
+    d->lookup_rows = n / 3;
+  }
+  d->min_value = sn_double_or(desc, "min_value", 0.0);
+  d->max_value = sn_double_or(desc, "max_value", 0.0);
+  d->aperture = sn_double_or(desc, "aperture", 0.0);
+  d->sensor_type = (int)sn_int_or(desc, "sensor_type", 0);
+  if (d->kind == SN_LIDAR) {
+    d->width = (int)sn_int_or(desc, "horizontalResolution", 0);
+    d->layers = (int)sn_int_or(desc, "numberOfLayers", 0);
+    if (d->width <= 0 || d->layers <= 0 || (int64_t)d->width * d->layers > (1 << 24))
+      return -1;
+    d->fov = sn_double_or(desc, "fov", 0.0);
+    d->vertical_fov = sn_double_or(desc, "verticalFov", 0.0);
+    d->min_range = sn_double_or(desc, "minRange", 0.0);
+    d->max_range = sn_double_or(desc, "maxRange", INFINITY);
+    d->frequency = sn_double_or(desc, "frequency", 0.0);
+    d->min_frequency = sn_double_or(desc, "minFrequency", 0.0);
+    d->max_frequency = sn_double_or(desc, "maxFrequency", 0.0);
+    d->point_cloud_enabled = sn_bool_or(desc, "point_cloud_enabled", false);
+    size_t n = (size_t)d->width * (size_t)d->layers;
+    d->range_image = calloc(n, sizeof(float));
+    d->point_cloud = calloc(n, sizeof(WbLidarPoint));
+    if (d->range_image == NULL || d->point_cloud == NULL)
+      return -1;
+  }
+  d->motor_name = sn_strdup_obj(sn_get(desc, "motor"));
+  d->led_value = (int)sn_int_or(desc, "value", 0);
+  d->led_colors = count_leaves(sn_get(desc, "color")) / 3;
+  d->led_gradual = sn_bool_or(desc, "gradual", false);
+  d->max_velocity = sn_double_or(desc, "maxVelocity", 10.0);
+  d->min_position = sn_double_or(desc, "minPosition", 0.0);
+  d->max_position = sn_double_or(desc, "maxPosition", 0.0);
+  d->target_position = sn_double_or(desc, "targetPosition", 0.0);
+  d->velocity = sn_double_or(desc, "velocity", d->max_velocity);
+  return 0;
+}
+
+static void free_robot(sn_robot *rb) {
+  if (rb == NULL)
+    return;
+  for (int i = 0; i < rb->n_devices; i++) {
+    sn_device *d = &rb->devices[i];
+    free(d->name);
+    free(d->type_name);
+    free(d->lookup_table);
+    free(d->range_image);
+    free(d->point_cloud);
+    free(d->motor_name);
+  }
+  sn_supervisor_free(rb);
+  free(rb->devices);
+  free(rb->name);
+  free(rb->session);
+  free(rb->model);
+  free(rb->custom_data);
+  free(rb->prefix);
+  sn_conn_close(rb->conn);
+  free(rb);
+}
+
+/* ------------------------------------------------------------------ init / cleanup */
+
+static int call(sn_conn *c, sn_req *r, uint64_t id, int timeout_ms, sn_reply *out) {
+  if (sn_conn_send(c, r, id) != 0) {
+    sn_req_free(r);
+    memset(out, 0, sizeof *out);
+    out->code = SN_CONNECTION_LOST;
+    snprintf(out->message, sizeof out->message, "cannot send to %s", sn_conn_endpoint(c));
+    return -1;
+  }
+  sn_req_free(r);
+  if (sn_conn_wait(c, id, timeout_ms, out) != 0 || !out->ok)
+    return -1;
+  return 0;
+}
+
+static char *only_robot(sn_conn *c) {
+  sn_req r;
+  uint64_t id = sn_conn_next_id(c);
+  sn_req_begin(&r, id, "get_info", 0);
+  sn_reply rep;
+  if (call(c, &r, id, g_timeout_ms, &rep) != 0)
+    fatal("wb_robot_init", rep.code, rep.message);
+  const msgpack_object *robots = sn_get(rep.result, "robots");
+  uint32_t n = robots && robots->type == MSGPACK_OBJECT_ARRAY ? robots->via.array.size : 0;
+  if (n != 1) {
+    char names[400] = "";
+    for (uint32_t i = 0; i < n; i++) {
+      const msgpack_object *nm = sn_get(&robots->via.array.ptr[i], "name");
+      if (nm && nm->type == MSGPACK_OBJECT_STR)
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%.*s", i ? ", " : "",
+                 (int)nm->via.str.size, nm->via.str.ptr);
+    }
+    char msg[600];
+    snprintf(msg, sizeof msg, "the controller URL names no robot and the world at %s has %u (%s): add '/ROBOT' to the URL",
+             sn_conn_endpoint(c), n, names);
+    sn_reply_free(&rep);
+    fatal("wb_robot_init", SN_BAD_URL, msg);
+  }
+  char *name = sn_strdup_obj(sn_get(&robots->via.array.ptr[0], "name"));
+  sn_reply_free(&rep);
+  return name;
+}
+
+int wb_robot_init(void) {
+  if (g_robot != NULL)
+    return 1;
+  g_timeout_ms = timeout_from_env();
+  const char *env = getenv("SENSORIUM_CONTROLLER_URL");
+  if (env == NULL || *env == '\0')
+    env = getenv("WEBOTS_CONTROLLER_URL");
+  sn_url url;
+  char err[512];
+  if (sn_parse_url(env, &url, err, sizeof err) != 0)
+    fatal("wb_robot_init", SN_BAD_URL, err);
+  sn_conn *c = sn_conn_open(url.endpoint, err, sizeof err);
+  if (c == NULL)
+    fatal("wb_robot_init", SN_BAD_URL, err);
+  char *name = url.robot ? strdup(url.robot) : only_robot(c);
+  sn_url_free(&url);
+  sn_req r;
+  uint64_t id = sn_conn_next_id(c);
+  sn_req_begin(&r, id, "attach", 1);
+  sn_req_key(&r, "robot");
+  sn_req_str(&r, name ? name : "");
+  sn_reply rep;
+  if (call(c, &r, id, g_timeout_ms, &rep) != 0) {
+    char msg[700];
+    snprintf(msg, sizeof msg, "attaching to robot '%s' at %s: %s", name ? name : "", sn_conn_endpoint(c), rep.message);
+    fatal("wb_robot_init", rep.code, msg);
+  }
+  sn_robot *rb = calloc(1, sizeof *rb);
+  const msgpack_object *res = rep.result;
+  rb->conn = c;
+  rb->name = sn_strdup_obj(sn_get(res, "robot"));
+  if (rb->name == NULL)
+    rb->name = strdup(name ? name : "");
+  free(name);
+  rb->session = sn_strdup_obj(sn_get(res, "session"));
+  rb->model = sn_strdup_obj(sn_get(res, "model"));
+  rb->custom_data = sn_strdup_obj(sn_get(res, "custom_data"));
+  if (rb->model == NULL)
+    rb->model = strdup("");
+  if (rb->custom_data == NULL)
+    rb->custom_data = strdup("");
+  rb->basic_time_step = (int)sn_int_or(res, "basic_time_step", 0);
+  rb->time_ms = sn_int_or(res, "time_ms", 0);
+  rb->synchronization = sn_bool_or(res, "synchronization", true);
+  rb->supervisor = sn_bool_or(res, "supervisor", false);
+  int heartbeat_ms = (int)sn_int_or(res, "heartbeat_ms", 1000);
+  size_t plen = strlen(rb->name) + 3;
+  rb->prefix = malloc(plen);
+  if (rb->prefix != NULL)
+    snprintf(rb->prefix, plen, "/%s/", rb->name);
+  const msgpack_object *devs = sn_get(res, "devices");
+  int n = devs && devs->type == MSGPACK_OBJECT_ARRAY ? (int)devs->via.array.size : 0;
+  if (n > 65535)
+    n = 65535; /* a WbDeviceTag is an unsigned short */
+  rb->devices = calloc(n > 0 ? (size_t)n : 1, sizeof(sn_device));
+  rb->n_devices = n;
+  bool bad = rb->session == NULL || rb->prefix == NULL || rb->basic_time_step <= 0 || rb->devices == NULL;
+  for (int i = 0; !bad && i < n; i++)
+    bad = describe(&rb->devices[i], i, &devs->via.array.ptr[i]) != 0;
+  sn_reply_free(&rep);
+  if (bad) {
+    free_robot(rb);
+    fatal("wb_robot_init", SN_BAD_REPLY, "the attach reply lacks session, basic_time_step or device descriptions");
+  }
+  g_robot = rb;
+  if (sn_conn_start_heartbeat(c, rb->session, heartbeat_ms) != 0)
+    fatal("wb_robot_init", SN_INTERNAL, "cannot start the heartbeat thread");
+  if (!g_atexit) {
+    atexit(wb_robot_cleanup);
+    g_atexit = true;
+  }
+  return 1;
+}
+
+void wb_robot_cleanup(void) {
+  sn_robot *rb = g_robot;
+  if (rb == NULL)
+    return;
+  g_robot = NULL;
+  sn_conn_stop_heartbeat(rb->conn);
+  if (rb->pending != 0) {
+    sn_conn_discard(rb->conn, rb->pending);
+    rb->pending = 0;
+  }
+  sn_req r;
+  uint64_t id = sn_conn_next_id(rb->conn);
+  sn_req_begin(&r, id, "detach", 1);
+  sn_req_key(&r, "session");
+  sn_req_str(&r, rb->session);
+  sn_reply rep;
+  call(rb->conn, &r, id, 500, &rep); /* best effort */
+  sn_reply_free(&rep);
+  free_robot(rb);
+}
+
+/* ------------------------------------------------------------------ stepping */
+
+static float le_float(const unsigned char *p) {
+  uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+  float f;
+  memcpy(&f, &u, sizeof f);
+  return f;
+}
+
+static void apply_values(sn_robot *rb, const msgpack_object *values) {
+  if (values == NULL || values->type != MSGPACK_OBJECT_MAP)
+    return;
+  for (uint32_t i = 0; i < values->via.map.size; i++) {
+    const msgpack_object *k = &values->via.map.ptr[i].key, *v = &values->via.map.ptr[i].val;
+    if (k->type != MSGPACK_OBJECT_STR || v->type != MSGPACK_OBJECT_MAP)
+      continue;
+    sn_device *dev = NULL;
+    for (int j = 0; j < rb->n_devices && dev == NULL; j++)
+      if (strlen(rb->devices[j].name) == k->via.str.size && memcmp(rb->devices[j].name, k->via.str.ptr, k->via.str.size) == 0)
+        dev = &rb->devices[j];
+    if (dev == NULL)
+      continue;
+    double x;
+    if (sn_as_double(sn_get(v, "value"), &x)) {
+      dev->value = x;
+      if (dev->kind == SN_LED && isfinite(x))
+        dev->led_value = (int)x;
+    }
+    if (dev->kind != SN_LIDAR)
+      continue;
+    size_t n = (size_t)dev->width * (size_t)dev->layers;
+    const msgpack_object *img = sn_get(v, "range_image");
+    if (img != NULL && img->type == MSGPACK_OBJECT_BIN && img->via.bin.size == 4 * n) {
+      const unsigned char *p = (const unsigned char *)img->via.bin.ptr;
+      for (size_t j = 0; j < n; j++)
+        dev->range_image[j] = le_float(p + 4 * j);
+    } else if (img != NULL)
+      fprintf(stderr, "Warning: lidar '%s': range image of %u bytes, expected %zu: ignored\n", dev->name,
+              img->type == MSGPACK_OBJECT_BIN ? img->via.bin.size : 0u, 4 * n);
+    const msgpack_object *pc = sn_get(v, "point_cloud");
+    if (pc != NULL && pc->type == MSGPACK_OBJECT_BIN && pc->via.bin.size == 20 * n) {
+      const unsigned char *p = (const unsigned char *)pc->via.bin.ptr;
+      for (size_t j = 0; j < n; j++, p += 20) {
+        WbLidarPoint *q = &dev->point_cloud[j];
+        q->x = le_float(p);
+        q->y = le_float(p + 4);
+        q->z = le_float(p + 8);
+        uint32_t u = (uint32_t)p[12] | (uint32_t)p[13] << 8 | (uint32_t)p[14] << 16 | (uint32_t)p[15] << 24;
+        memcpy(&q->layer_id, &u, sizeof u);
+        q->time = le_float(p + 16);
+      }
+    } else if (pc != NULL)
+      fprintf(stderr, "Warning: lidar '%s': point cloud of %u bytes, expected %zu: ignored\n", dev->name,
+              pc->type == MSGPACK_OBJECT_BIN ? pc->via.bin.size : 0u, 20 * n);
+  }
+}
+
+int wb_robot_step_begin(int duration) {
+  sn_robot *rb = sn_robot_get("wb_robot_step_begin");
+  if (rb->pending != 0) {
+    fprintf(stderr, "Error: wb_robot_step_begin(): a step is already pending: call wb_robot_step_end() first\n");
+    return -1;
+  }
+  if (rb->terminated)
+    return -1;
+  if (duration < 0) {
+    fprintf(stderr, "Error: wb_robot_step(): step duration must be >= 0 ms, got %d\n", duration);
+    return -1;
+  }
+  if (duration % rb->basic_time_step && !rb->warned_duration) {
+    /* Webots warns once and wakes the controller at the first basic step that ends after it */
+    rb->warned_duration = true;
+    fprintf(stderr, "Warning: the step duration %d ms of robot '%s' is not a multiple of the basic time step (%d ms); "
+            "the server rounds it up.\n", duration, rb->name, rb->basic_time_step);
+  }
+  int motors = 0;
+  for (int i = 0; i < rb->n_devices; i++)
+    motors += rb->devices[i].kind == SN_MOTOR && (rb->devices[i].cmd_position || rb->devices[i].cmd_velocity);
+  char service[512];
+  snprintf(service, sizeof service, "%srobot/step", rb->prefix);
+  sn_req r;
+  uint64_t id = sn_conn_next_id(rb->conn);
+  sn_req_begin(&r, id, service, motors ? 2 : 1);
+  sn_req_key(&r, "duration");
+  msgpack_pack_int(&r.pk, duration);
+  if (motors) {
+    sn_req_key(&r, "motors");
+    msgpack_pack_map(&r.pk, (size_t)motors);
+    for (int i = 0; i < rb->n_devices; i++) {
+      sn_device *d = &rb->devices[i];
+      if (d->kind != SN_MOTOR || !(d->cmd_position || d->cmd_velocity))
+        continue;
+      sn_req_str(&r, d->name);
+      msgpack_pack_map(&r.pk, (size_t)d->cmd_position + (size_t)d->cmd_velocity);
+      if (d->cmd_position) {
+        sn_req_key(&r, "position");
+        msgpack_pack_double(&r.pk, d->target_position);
+      }
+      if (d->cmd_velocity) {
+        sn_req_key(&r, "velocity");
+        msgpack_pack_double(&r.pk, d->velocity);
+      }
+      d->cmd_position = d->cmd_velocity = false;
+    }
+  }
+  int rc = sn_conn_send(rb->conn, &r, id);
+  sn_req_free(&r);
+  if (rc != 0) {
+    fprintf(stderr, "sensorium: cannot send the step request to %s; ending the controller's steps\n",
+            sn_conn_endpoint(rb->conn));
+    rb->terminated = true;
+    return -1;
+  }
+  rb->pending = id;
+  return 0;
+}
+
+int wb_robot_step_end(void) {
+  sn_robot *rb = sn_robot_get("wb_robot_step_end");
+  if (rb->pending == 0) {
+    if (!rb->terminated)
+      fprintf(stderr, "Error: wb_robot_step_end(): no step pending: call wb_robot_step_begin() first\n");
+    return -1;
+  }
+  uint64_t id = rb->pending;
+  rb->pending = 0;
+  sn_reply rep;
+  int rc = sn_conn_wait(rb->conn, id, -1, &rep);
+  if (rc != 0 && rep.code == SN_CONNECTION_LOST) {
+    fprintf(stderr, "sensorium: CONNECTION_LOST: %s; ending the controller's steps\n", rep.message);
+    rb->terminated = true;
+    return -1;
+  }
+  if (rc != 0 || !rep.ok) {
+    if (rep.code == SN_SHUTTING_DOWN)
+      rb->terminated = true;
+    else
+      fprintf(stderr, "Error: wb_robot_step(): %s: %s\n", sn_error_name(rep.code), rep.message);
+    sn_reply_free(&rep);
+    return -1;
+  }
+  int status = (int)sn_int_or(rep.result, "status", 0);
+  rb->time_ms = sn_int_or(rep.result, "time_ms", rb->time_ms);
+  apply_values(rb, sn_get(rep.result, "values"));
+  sn_reply_free(&rep);
+  if (status == -1)
+    rb->terminated = true;
+  return status;
+}
+
+int wb_robot_step(int duration) {
+  if (wb_robot_step_begin(duration) == -1)
+    return -1;
+  return wb_robot_step_end();
+}
+
+/* ------------------------------------------------------------------ robot getters */
+
+double wb_robot_get_time(void) { return (double)sn_robot_get("wb_robot_get_time")->time_ms / 1000.0; }
+
+double wb_robot_get_basic_time_step(void) { return (double)sn_robot_get("wb_robot_get_basic_time_step")->basic_time_step; }
+
+const char *wb_robot_get_name(void) { return sn_robot_get("wb_robot_get_name")->name; }
+
+const char *wb_robot_get_model(void) { return sn_robot_get("wb_robot_get_model")->model; }
+
+bool wb_robot_get_synchronization(void) { return sn_robot_get("wb_robot_get_synchronization")->synchronization; }
+
+bool wb_robot_get_supervisor(void) { return sn_robot_get("wb_robot_get_supervisor")->supervisor; }
+
+const char *wb_robot_get_custom_data(void) { return sn_robot_get("wb_robot_get_custom_data")->custom_data; }
+
+static void arg_str(sn_req *r, const void *arg) { sn_req_str(r, (const char *)arg); }
+
+void wb_robot_set_custom_data(const char *data) {
+  sn_robot *rb = sn_robot_get("wb_robot_set_custom_data");
+  if (data == NULL) {
+    fprintf(stderr, "Error: wb_robot_set_custom_data() called with a NULL 'data' argument\n");
+    return;
+  }
+  if (!rb->terminated) {
+    sn_reply rep;
+    if (sn_device_call(rb, NULL, "robot/set_custom_data", arg_str, data, "wb_robot_set_custom_data", &rep) != 0)
+      return;
+    sn_reply_free(&rep);
+  }
+  char *copy = strdup(data);
+  if (copy == NULL)
+    return;
+  free(rb->custom_data);
+  rb->custom_data = copy;
+}
+
+WbRobotMode wb_robot_get_mode(void) {
+  sn_robot_get("wb_robot_get_mode");
+  return WB_MODE_SIMULATION;
+}
+
+void wb_robot_set_mode(WbRobotMode mode, const char *arg) {
+  (void)arg;
+  sn_robot_get("wb_robot_set_mode");
+  if (mode != WB_MODE_SIMULATION)
+    fprintf(stderr, "Error: wb_robot_set_mode(): Sensorium robots are simulated only (mode %d refused)\n", (int)mode);
+}
+
+int wb_robot_get_number_of_devices(void) { return sn_robot_get("wb_robot_get_number_of_devices")->n_devices; }
+
+WbDeviceTag wb_robot_get_device(const char *name) {
+  sn_robot *rb = sn_robot_get("wb_robot_get_device");
+  if (name == NULL)
+    return 0;
+  for (int i = 0; i < rb->n_devices; i++)
+    if (strcmp(rb->devices[i].name, name) == 0)
+      return rb->devices[i].tag;
+  return 0;
+}
+
+WbDeviceTag wb_robot_get_device_by_index(int index) {
+  sn_robot *rb = sn_robot_get("wb_robot_get_device_by_index");
+  return index >= 0 && index < rb->n_devices ? rb->devices[index].tag : 0;
+}
+
+/* ------------------------------------------------------------------ device helpers */
+
+sn_device *sn_device_get(WbDeviceTag tag, sn_kind kind, const char *func) {
+  sn_robot *rb = sn_robot_get(func);
+  if (tag >= 1 && tag <= rb->n_devices) {
+    sn_device *d = &rb->devices[tag - 1];
+    if (kind == SN_OTHER || d->kind == kind)
+      return d;
+    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
+    return NULL;
+  }
+  fprintf(stderr, "Error: %s(): invalid device tag %u\n", func, (unsigned)tag);
+  return NULL;
+}
+
+void sn_arg_int(sn_req *r, const void *arg) { msgpack_pack_int(&r->pk, *(const int *)arg); }
+
+void sn_arg_bool(sn_req *r, const void *arg) {
+  if (*(const bool *)arg)
+    msgpack_pack_true(&r->pk);
+  else
+    msgpack_pack_false(&r->pk);
+}
+
+void sn_arg_double(sn_req *r, const void *arg) { msgpack_pack_double(&r->pk, *(const double *)arg); }
+
+int sn_robot_call(sn_robot *rb, const char *item, uint32_t nargs, sn_arg_fn add_args, const void *arg,
+                  const char *func, sn_reply *out) {
+  char service[1024];
+  snprintf(service, sizeof service, "%s%s", rb->prefix, item);
+  sn_req r;
+  uint64_t id = sn_conn_next_id(rb->conn);
+  sn_req_begin(&r, id, service, nargs);
+  if (add_args)
+    add_args(&r, arg);
+  if (call(rb->conn, &r, id, g_timeout_ms, out) != 0) {
+    fprintf(stderr, "Error: %s(): %s: %s\n", func, sn_error_name(out->code), out->message);
+    sn_reply_free(out);
+    return -1;
+  }
+  const msgpack_object *success = sn_get(out->result, "success");
+  if (success != NULL && success->type == MSGPACK_OBJECT_BOOLEAN && !success->via.boolean) {
+    fprintf(stderr, "Error: %s(): refused by the server\n", func);
+    sn_reply_free(out);
+    return -1;
+  }
+  return 0;
+}
+
+typedef struct {
+  sn_arg_fn add_value;
+  const void *arg;
+} value_arg;
+
+static void add_value_arg(sn_req *r, const void *p) {
+  const value_arg *v = p;
+  sn_req_key(r, "value");
+  v->add_value(r, v->arg);
+}
+
+int sn_device_call(sn_robot *rb, const sn_device *dev, const char *item, sn_arg_fn add_value, const void *arg,
+                   const char *func, sn_reply *out) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s%s%s", dev ? dev->name : "", dev ? "/" : "", item);
+  value_arg v = {add_value, arg};
+  return sn_robot_call(rb, path, add_value ? 1 : 0, add_value ? add_value_arg : NULL, &v, func, out);
+}
+
+void sn_device_enable(sn_device *dev, int period, const char *func) {
+  sn_robot *rb = sn_robot_get(func);
+  if (period < 0) {
+    fprintf(stderr, "Error: %s(): negative sampling period %d\n", func, period);
+    return;
+  }
+  if (!rb->terminated) {
+    sn_reply rep;
+    if (sn_device_call(rb, dev, "enable", sn_arg_int, &period, func, &rep) != 0)
+      return;
+    sn_reply_free(&rep);
+  }
+  dev->sampling_period = period;
+  dev->warned = false;
+}
+
+void sn_warn_disabled(sn_device *dev, const char *func, const char *enabler, const char *what) {
+  if (!dev->warned) {
+    dev->warned = true;
+    fprintf(stderr, "Error: %s() called for %s! Please use: %s().\n", func, what ? what : "a disabled device", enabler);
+  }
+}

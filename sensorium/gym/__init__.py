@@ -1,0 +1,39 @@
+"""Gymnasium environments on Sensorium worlds (``pip install 'sensorium[gym]'``).
+
+    import gymnasium as gym
+    env = gym.make("sensorium.gym:sensorium/ReachLight-v0")        # or build your own:
+    from sensorium.gym import SensoriumEnv, Task, ReachLight
+    env = SensoriumEnv("my_world.yaml", Task(robot="epuck", observations={"ls0": 32}, reward=ReachLight(), ...))
+
+Registered ids (all on the embedded arena world): ``sensorium/ReachLight-v0`` (e-puck, light and
+infra-red sensors, drive to the lamp), ``sensorium/AvoidObstacles-v0`` (e-puck, infra-red sensors,
+explore without contact), ``sensorium/LidarAvoid-v0`` (scout, 360-ray lidar + sonars).
+``SensoriumParallelEnv`` (PettingZoo) runs several robots of one world as agents.
+"""
+
+from __future__ import annotations
+
+from gymnasium.envs.registration import register, registry
+
+from sensorium.gym.env import SensoriumEnv
+from sensorium.gym.task import AvoidObstacles, ReachLight, Task, clearance, never, random_start
+from sensorium.gym.tasks import avoid_obstacles, lidar_avoid, reach_light
+
+__all__ = ["SensoriumEnv", "SensoriumParallelEnv", "Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start",
+           "reach_light", "avoid_obstacles", "lidar_avoid"]
+
+
+
+def __getattr__(name: str):
+    if name == "SensoriumParallelEnv":      # needs pettingzoo (the [gym] extra); imported on first use
+        from sensorium.gym.multi import SensoriumParallelEnv
+
+        return SensoriumParallelEnv
+    raise AttributeError(f"module 'sensorium.gym' has no attribute {name!r}")
+
+
+for _id, _fn in (("sensorium/ReachLight-v0", "reach_light"),
+                         ("sensorium/AvoidObstacles-v0", "avoid_obstacles"),
+                         ("sensorium/LidarAvoid-v0", "lidar_avoid")):
+    if _id not in registry:
+        register(id=_id, entry_point=f"sensorium.gym.tasks:{_fn}")

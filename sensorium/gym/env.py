@@ -1,0 +1,234 @@
+"""``SensoriumEnv``: a Gymnasium environment over the in-process simulation.
+
+    env = SensoriumEnv("sensorium/worlds/arena.yaml", Task(robot="epuck", reward=ReachLight(), ...))
+    obs, info = env.reset(seed=1)
+    obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+
+Observation: a ``Dict`` with one ``Box`` per observed sensor (LEDs are not observations). A light
+or distance sensor is a float32 ``(1,)`` box bounded by its lookup table's output column (values are clipped into it:
+relative lookup noise is Gaussian and could leave it); a lidar is its float32 ``(layers,
+width)`` range image bounded by ``[0, max_range]``, with "no hit" (``inf`` in Webots) given as
+``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians. Action: float32 ``(2,)`` = left, right wheel velocity (rad/s), bounded by the
+drive's max wheel speed. One action lasts ``control_period_ms``.
+
+``reset(seed=s)`` rebuilds the simulation from the world model with world seed drawn from the
+environment's generator seeded with ``s``: every device noise stream, the start pose drawn by
+``Task.start`` and the clock restart exactly, so the same seed and actions give a bit-identical
+episode. Before the first observation the simulation runs until every observed device has a value
+(its longest sampling period), as a Webots controller would wait.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from sensorium.gym.render import TopDown
+from sensorium.gym.task import Task
+from sensorium.schemas import world as wm
+from sensorium.server.sim.sensors import Lidar
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
+
+__all__ = ["SensoriumEnv", "Agent", "load", "rebuild"]
+
+
+def load(world: str | Path | LoadedWorld | wm.World | None) -> LoadedWorld:
+    """A world file path, a loaded world or a world model (None: the embedded arena world)."""
+    if world is None:
+        return load_world(default_world_path())
+    if isinstance(world, LoadedWorld):
+        return world
+    if isinstance(world, wm.World):
+        return LoadedWorld(world=world, source="<memory>", base_dir=Path.cwd())
+    return load_world(world)
+
+
+class Agent:
+    """One acting robot: its task, observed devices and periods, observation and action spaces."""
+
+    def __init__(self, loaded: LoadedWorld, task: Task, default_robot: str | None = None):
+        self.task = task
+        w = loaded.world
+        basic = w.world_info.basic_time_step
+        robots = {r.name: r for r in w.robots}
+        name = task.robot or default_robot
+        if name is None:
+            driven = [r.name for r in w.robots if r.differential_drive is not None]
+            if not driven:
+                raise ValueError(f"{loaded.source}: no robot with a differential_drive to act as the agent")
+            name = driven[0]
+        if name not in robots:
+            raise ValueError(f"{loaded.source}: task robot {name!r} not in the world (robots: {', '.join(robots)})")
+        model = robots[name]
+        if model.differential_drive is None:
+            raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive to act with")
+        self.robot = name
+        ctrl = task.control_period_ms or basic
+        if ctrl <= 0 or ctrl % basic:
+            raise ValueError(f"task control_period_ms={ctrl} must be a positive multiple of the world's "
+                             f"basic_time_step ({basic} ms)")
+        self.control_period_ms = int(ctrl)
+        devices = {d.name: d for d in model.devices if d.device in OBSERVABLE}
+        actuators = {d.name for d in model.devices if d.device not in OBSERVABLE}
+        obs = task.observations
+        if obs is None:
+            periods = {n: self.control_period_ms for n in devices}
+        elif isinstance(obs, dict):
+            periods = {str(k): int(v) for k, v in obs.items()}
+        else:
+            periods = {str(n): self.control_period_ms for n in obs}
+        for n, p in periods.items():
+            if n in actuators:
+                raise ValueError(f"task observation {n!r}: robot {name!r}'s {n} is not a sensor")
+            if n not in devices:
+                raise ValueError(f"task observation {n!r}: robot {name!r} has no such device "
+                                 f"(sensors: {', '.join(devices) or 'none'})")
+            if p <= 0:
+                raise ValueError(f"task observation {n!r}: sampling period must be > 0 ms, got {p}")
+        self.periods = periods
+        self.warmup_steps = max((math.ceil(p / basic) for p in periods.values()), default=0)
+        self.observation_space = spaces.Dict({n: _space(devices[n]) for n in periods})
+        vmax = float(model.differential_drive.max_wheel_speed)
+        self.action_space = spaces.Box(-vmax, vmax, shape=(2,), dtype=np.float32)
+
+    def start(self, sim: Simulation, rng: np.random.Generator) -> None:
+        """After a rebuild: start pose, wheels at rest in velocity control, devices enabled."""
+        robot = sim.robot(self.robot)
+        if self.task.start is not None:
+            self.task.start(sim, robot, rng)
+        for m in robot.motors.values():
+            m.set_position(math.inf)
+            m.set_velocity(0.0)
+        for n, p in self.periods.items():
+            robot.device(n).enable(p)
+
+    def reset_callables(self, sim: Simulation) -> None:
+        robot = sim.robot(self.robot)
+        owners: list = []
+        for fn in (self.task.reward, self.task.terminated):
+            owner = fn if hasattr(fn, "reset") else getattr(fn, "__self__", None)
+            if owner is not None and hasattr(owner, "reset") and not any(o is owner for o in owners):
+                owners.append(owner)
+                owner.reset(sim, robot)
+
+    def act(self, sim: Simulation, action) -> None:
+        a = np.asarray(action, dtype=np.float64).reshape(-1)
+        if a.shape != (2,) or not np.all(np.isfinite(a)):
+            raise ValueError(f"{self.robot}: action must be 2 finite wheel velocities (left, right), got {action!r}")
+        drive = sim.robot(self.robot).drive
+        drive.left.set_velocity(float(a[0]))
+        drive.right.set_velocity(float(a[1]))
+
+    def observe(self, sim: Simulation) -> dict[str, np.ndarray]:
+        robot = sim.robot(self.robot)
+        out = {}
+        for n, box in self.observation_space.spaces.items():
+            dev = robot.device(n)
+            if isinstance(dev, Lidar):
+                img = np.nan_to_num(dev.range_image, nan=box.high.flat[0], posinf=box.high.flat[0])
+                out[n] = np.clip(img, box.low, box.high).astype(np.float32)
+            else:
+                v = dev.value if math.isfinite(dev.value) else (box.low[0] if np.isfinite(box.low[0]) else 0.0)
+                out[n] = np.clip(np.array([v], dtype=np.float32), box.low, box.high)
+        return out
+
+    def outcome(self, sim: Simulation, obs: dict, steps: int) -> tuple[float, bool, bool]:
+        robot = sim.robot(self.robot)
+        reward = float(self.task.reward(sim, robot, obs))
+        terminated = bool(self.task.terminated(sim, robot, obs))
+        truncated = self.task.max_steps is not None and steps >= self.task.max_steps and not terminated
+        return reward, terminated, bool(truncated)
+
+    def info(self, sim: Simulation, steps: int) -> dict[str, Any]:
+        pose = sim.robot(self.robot).pose
+        fwd = pose.rotation[:, 0]
+        return {"time_ms": sim.time_ms, "steps": steps,
+                "pose": np.array([pose.translation[0], pose.translation[1], math.atan2(fwd[1], fwd[0])])}
+
+
+OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
+
+
+def _space(cfg) -> spaces.Box:
+    if cfg.device == "PositionSensor":          # a wheel angle (rad): unbounded
+        return spaces.Box(-np.inf, np.inf, shape=(1,), dtype=np.float32)
+    if cfg.device == "Lidar":
+        return spaces.Box(0.0, np.float32(cfg.max_range), shape=(cfg.number_of_layers, cfg.horizontal_resolution),
+                          dtype=np.float32)
+    out = [row[1] for row in cfg.lookup_table] or [0.0]
+    return spaces.Box(np.float32(min(out)), np.float32(max(out)), shape=(1,), dtype=np.float32)
+
+
+def rebuild(loaded: LoadedWorld, world_seed: int, precision: str) -> Simulation:
+    """A fresh simulation of ``loaded`` with ``world_seed``: clock, poses, motors, device state and
+    noise streams all as at the start."""
+    w = loaded.world
+    w = w.model_copy(update={"world_info": w.world_info.model_copy(update={"random_seed": world_seed})})
+    return Simulation(LoadedWorld(world=w, source=loaded.source, base_dir=loaded.base_dir, text=loaded.text),
+                      precision=precision)
+
+
+class SensoriumEnv(gym.Env):
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None, task: Task | None = None,
+                 render_mode: str | None = None, precision: str = "exact", render_size: int = 256):
+        self.loaded = load(world)
+        self.task = task or Task()
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
+        self.render_mode = render_mode
+        self.precision = precision
+        self.render_size = render_size
+        self.basic_time_step = self.loaded.world.world_info.basic_time_step
+        self.agent = Agent(self.loaded, self.task)
+        self.robot_name = self.agent.robot
+        self.control_period_ms = self.agent.control_period_ms
+        self.steps_per_action = self.control_period_ms // self.basic_time_step
+        self.periods = self.agent.periods
+        self.observation_space = self.agent.observation_space
+        self.action_space = self.agent.action_space
+        self.sim: Simulation | None = None
+        self.steps = 0
+        self._renderer: TopDown | None = None
+
+    # ---------------------------------------------------------------- gymnasium API
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        self.sim = sim = rebuild(self.loaded, int(self.np_random.integers(0, 2**62)), self.precision)
+        self.agent.start(sim, self.np_random)
+        # run until every observed device has measured once (Webots: first value one period later)
+        sim.run(self.agent.warmup_steps)
+        self.steps = 0
+        self.agent.reset_callables(sim)
+        self._renderer = None
+        return self.agent.observe(sim), self.agent.info(sim, 0)
+
+    def step(self, action):
+        if self.sim is None:
+            raise RuntimeError("call reset() before step()")
+        self.agent.act(self.sim, action)
+        self.sim.run(self.steps_per_action)
+        self.steps += 1
+        obs = self.agent.observe(self.sim)
+        reward, terminated, truncated = self.agent.outcome(self.sim, obs, self.steps)
+        return obs, reward, terminated, truncated, self.agent.info(self.sim, self.steps)
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        if self.sim is None:
+            raise RuntimeError("call reset() before render()")
+        if self._renderer is None:
+            self._renderer = TopDown(self.sim, self.render_size)
+        return self._renderer.render()
+
+    def close(self) -> None:
+        self.sim = None
+        self._renderer = None

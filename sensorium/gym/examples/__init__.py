@@ -1,0 +1,1 @@
+"""Runnable examples: ``python -m sensorium.gym.examples.random_policy``."""

@@ -1,0 +1,156 @@
+"""Top-down RGB picture of a simulation (``env.render()``): numpy only, no GUI, no OpenGL.
+
+Every shape (of solids, their nested children and multi-shape bodies) is drawn as the convex hull of its tessellation projected on the world's xy plane,
+filled with its ``base_color``, lowest top first (so a tall wall covers the floor); sized planes
+(floors) are drawn first. Robots are drawn on top with a white heading line, lights as yellow
+dots. The view covers the bounding box of everything drawn plus a margin; image row 0 is +y.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
+from sensorium.server.world.geometry import Plane, Pose, tessellate
+from sensorium.server.world.poses import pose_from_model
+
+BACKGROUND = (40, 40, 46)
+
+
+def _cross(o, a, b) -> float:
+    return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """Convex hull (counter-clockwise) of 2-D points, Andrew's monotone chain."""
+    pts = np.unique(np.round(points, 9), axis=0)
+    if len(pts) < 3:
+        return pts
+
+    def half(seq):
+        out: list = []
+        for p in seq:
+            while len(out) >= 2 and _cross(out[-2], out[-1], p) <= 0:
+                out.pop()
+            out.append(p)
+        return out
+
+    lower = half(pts)
+    upper = half(pts[::-1])
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def _color(shape: wm.Shape | wm.Solid) -> tuple[int, int, int]:
+    c = shape.appearance.base_color if shape.appearance is not None else (1.0, 1.0, 1.0)
+    if shape.appearance is not None and shape.appearance.transparency >= 1.0:
+        c = (0.6, 0.8, 1.0)   # glass: a pale blue so it stays visible
+    return tuple(int(round(255 * min(max(v, 0.0), 1.0))) for v in c)  # type: ignore[return-value]
+
+
+class TopDown:
+    """Renders ``sim`` at ``size`` x ``size`` pixels; the solids are drawn once (at their poses when
+    the renderer is made), robots and lights (which may ride on them) at every call."""
+
+    def __init__(self, sim, size: int = 256, margin: float = 0.1):
+        self.sim = sim
+        self.size = int(size)
+        base = sim.loaded.base_dir
+        static: list[tuple[float, np.ndarray, tuple[int, int, int]]] = []   # (top z, hull, colour)
+        floors: list[tuple[np.ndarray, tuple[int, int, int]]] = []
+        for solid in sim.world.solids:
+            frame = sim.scene.solid_poses.get(solid.name) or pose_from_model(solid.pose)
+            for _, local, shape in solid_parts(solid, Pose.identity()):
+                prim = primitive_from_model(shape.geometry, base)
+                pose = frame.compose(local)
+                if isinstance(prim, Plane):
+                    if prim.size is None:
+                        continue
+                    sx, sy = prim.size[0] / 2.0, prim.size[1] / 2.0
+                    corners = pose.apply(np.array([[-sx, -sy, 0], [sx, -sy, 0], [sx, sy, 0], [-sx, sy, 0]], float))
+                    floors.append((corners[:, :2], _color(shape)))
+                    continue
+                w = pose.apply(tessellate(prim)[0])
+                static.append((float(w[:, 2].max()), _hull(w[:, :2]), _color(shape)))
+        static.sort(key=lambda item: item[0])
+        # each robot: its body shapes' vertices in the robot frame, with their colours
+        self._robot_parts: list[list[tuple[np.ndarray, tuple[int, int, int]]]] = []
+        for r in sim.world.robots:
+            parts = []
+            for _, local, shape in robot_parts(r):
+                prim = primitive_from_model(shape.geometry, base)
+                if not isinstance(prim, Plane):
+                    parts.append((local.apply(tessellate(prim)[0]), _color(shape)))
+            self._robot_parts.append(parts)
+        pts = [h for _, h, _ in static] + [f for f, _ in floors]
+        pts += [np.asarray(rb.pose.translation[:2])[None, :] for rb in sim.robots.values()]
+        pts += [np.array([lt.location[:2]]) for lt in sim.scene.world_lights() if lt.type != "DirectionalLight"]
+        allp = np.concatenate(pts) if pts else np.zeros((1, 2))
+        lo, hi = allp.min(axis=0), allp.max(axis=0)
+        span = float(max(hi[0] - lo[0], hi[1] - lo[1], 1e-3)) * (1.0 + 2.0 * margin)
+        self.center = 0.5 * (lo + hi)
+        self.scale = self.size / span           # pixels per metre
+        img = np.empty((self.size, self.size, 3), dtype=np.uint8)
+        img[:] = BACKGROUND
+        for poly, col in floors:
+            self._fill(img, _hull(poly), col)
+        for _, poly, col in static:
+            self._fill(img, poly, col)
+        self._static = img
+
+    # -------------------------------------------------------------------------------- drawing
+    def _px(self, xy: np.ndarray) -> np.ndarray:
+        """World xy (n, 2) -> pixel coordinates (column, row) as floats."""
+        rel = (np.asarray(xy, dtype=np.float64) - self.center) * self.scale
+        return np.stack([rel[..., 0] + self.size / 2.0, self.size / 2.0 - rel[..., 1]], axis=-1)
+
+    def _fill(self, img: np.ndarray, hull_xy: np.ndarray, color) -> None:
+        if len(hull_xy) < 3:
+            return
+        p = self._px(hull_xy)
+        c0, r0 = np.floor(p.min(axis=0)).astype(int)
+        c1, r1 = np.ceil(p.max(axis=0)).astype(int)
+        c0, r0 = max(c0, 0), max(r0, 0)
+        c1, r1 = min(c1, self.size - 1), min(r1, self.size - 1)
+        if c0 > c1 or r0 > r1:
+            return
+        cols, rows = np.meshgrid(np.arange(c0, c1 + 1) + 0.5, np.arange(r0, r1 + 1) + 0.5)
+        inside = np.ones(cols.shape, dtype=bool)
+        # pixel rows grow downward, which mirrors the polygon: it is clockwise in pixel space
+        for a, b in zip(p, np.roll(p, -1, axis=0)):
+            inside &= (b[0] - a[0]) * (rows - a[1]) - (b[1] - a[1]) * (cols - a[0]) <= 1e-9
+        img[r0:r1 + 1, c0:c1 + 1][inside] = color
+
+    def _disc(self, img: np.ndarray, xy: np.ndarray, radius_px: float, color) -> None:
+        c, r = self._px(xy[None, :])[0]
+        rr, cc = np.ogrid[:self.size, :self.size]
+        img[(rr + 0.5 - r) ** 2 + (cc + 0.5 - c) ** 2 <= radius_px ** 2] = color
+
+    def _line(self, img: np.ndarray, a: np.ndarray, b: np.ndarray, color) -> None:
+        pa, pb = self._px(np.stack([a, b]))
+        n = int(max(abs(pb - pa).max(), 1)) + 1
+        t = np.linspace(0.0, 1.0, n)[:, None]
+        pts = np.floor(pa + t * (pb - pa)).astype(int)
+        ok = (pts >= 0).all(axis=1) & (pts < self.size).all(axis=1)
+        img[pts[ok, 1], pts[ok, 0]] = color
+
+    def render(self) -> np.ndarray:
+        img = self._static.copy()
+        for lt in self.sim.scene.world_lights():
+            if lt.type != "DirectionalLight" and lt.on:
+                self._disc(img, np.asarray(lt.location[:2]), 4, (255, 230, 40))
+        for rb, parts in zip(self.sim.robots.values(), self._robot_parts):
+            pose = rb.pose
+            reach = 4.0 / self.scale
+            if parts:
+                for v, col in parts:
+                    self._fill(img, _hull(pose.apply(v)[:, :2]), col)
+                reach = max(max(float(np.abs(v[:, :2]).max()) for v, _ in parts), 2.0 / self.scale)
+            else:
+                self._disc(img, pose.translation[:2], 3, (200, 200, 200))
+            fwd = pose.rotation[:2, 0]
+            norm = math.hypot(*fwd) or 1.0
+            self._line(img, pose.translation[:2], pose.translation[:2] + fwd / norm * reach * 1.4, (255, 255, 255))
+        return img

@@ -1,0 +1,204 @@
+"""What an environment asks of the agent: the task description and example rewards/terminations.
+
+A :class:`Task` names the agent robot, the devices it observes (and their sampling periods), how
+often it acts, and three callables, each called as ``fn(sim, robot, obs)``:
+
+* ``reward``     -> float, after every action;
+* ``terminated`` -> bool, after every action (the episode ended for a reason inside the world);
+* ``start``      -> None, once per reset with ``(sim, robot, rng)`` (e.g. a random start pose).
+
+A callable that keeps state between steps (the previous distance to a goal, say) may have a
+``reset(sim, robot)`` method: the environment calls it after every reset, before the first action.
+
+Examples (all small, all deterministic given the world):
+
+* :class:`ReachLight`   - progress toward a light plus a bonus on arrival; terminates on arrival;
+* :class:`AvoidObstacles` - forward, straight and far from obstacles (Floreano & Mondada's fitness);
+  terminates on contact (:func:`clearance` below ``contact_distance``);
+* :func:`clearance`     - the free horizontal distance around a robot's centre, by ray casting.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sensorium.server.raycast.engine import RayKind
+
+__all__ = ["Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start"]
+
+StepFn = Callable[[Any, Any, dict], Any]
+
+
+def never(sim, robot, obs) -> bool:
+    """A termination that never happens (episodes end by truncation only)."""
+    return False
+
+
+def zero(sim, robot, obs) -> float:
+    return 0.0
+
+
+@dataclass
+class Task:
+    """The agent's task in a world.
+
+    ``robot``: the agent (default: the first robot with a differential drive).
+    ``observations``: device name -> sampling period in ms, or a list of names (sampled every
+    control period); default: every device of the robot, sampled every control period.
+    ``control_period_ms``: simulated time per action, a multiple of the world's basic step
+    (default: one basic step). ``max_steps``: actions per episode before truncation (None: never).
+    """
+
+    robot: str | None = None
+    observations: Mapping[str, int] | Sequence[str] | None = None
+    control_period_ms: int | None = None
+    max_steps: int | None = 500
+    reward: StepFn = zero
+    terminated: StepFn = never
+    start: Callable[[Any, Any, np.random.Generator], None] | None = None
+
+
+# ------------------------------------------------------------------------------------------ helpers
+
+def _planar(pose) -> tuple[float, float, float]:
+    fwd = pose.rotation[:, 0]
+    return float(pose.translation[0]), float(pose.translation[1]), math.atan2(fwd[1], fwd[0])
+
+
+def clearance(sim, robot, rays: int = 32, max_distance: float = 1.0) -> float:
+    """Smallest distance (m) from the robot's centre to anything seen by bounding rays, over
+    ``rays`` horizontal directions at the centre's height, ignoring the robot's own body; at most
+    ``max_distance``. Obstacles entirely below or above the centre are not seen."""
+    pose = robot.pose
+    angles = np.arange(rays) * (2.0 * math.pi / rays)
+    dirs = np.stack([np.cos(angles), np.sin(angles), np.zeros(rays)], axis=1)
+    origins = np.broadcast_to(pose.translation, dirs.shape)
+    hits = sim.scene.engine.cast(origins, dirs, 0.0, max_distance, kind=RayKind.BOUNDING, exclude_owner=robot.index)
+    d = hits.distance[np.isfinite(hits.distance)]
+    return float(d.min()) if d.size else float(max_distance)
+
+
+def body_radius(robot, base_dir=None) -> float:
+    """Horizontal radius of the disc about the robot's origin that contains its body shapes, as the
+    kinematic contact sees it (0 without a body)."""
+    from pathlib import Path
+
+    from sensorium.server.sim.contact import robot_footprint
+    from sensorium.server.sim.scene import primitive_from_model, robot_parts
+
+    base = Path(base_dir) if base_dir is not None else Path.cwd()
+    parts = [(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(robot.model)]
+    foot = robot_footprint(parts)
+    return float(foot.radius) if foot is not None else 0.0
+
+
+class random_start:
+    """``Task.start``: put the robot at a uniformly random (x, y, yaw) in the given ranges, at its
+    world-file height. Draws from the environment's seeded generator, so a seed fixes the start."""
+
+    def __init__(self, x: tuple[float, float], y: tuple[float, float], yaw: tuple[float, float] = (-math.pi, math.pi)):
+        self.x, self.y, self.yaw = x, y, yaw
+
+    def __call__(self, sim, robot, rng: np.random.Generator) -> None:
+        z = float(robot.pose.translation[2])
+        x = rng.uniform(*self.x)
+        y = rng.uniform(*self.y)
+        yaw = rng.uniform(*self.yaw)
+        robot.set_pose([x, y, z], rotation=[0.0, 0.0, 1.0, yaw])
+
+
+# ------------------------------------------------------------------------------------------ examples
+
+class ReachLight:
+    """Drive to a light: reward ``progress_weight`` x (metres gained toward the light) minus
+    ``step_cost`` per action, plus ``bonus`` on arrival (horizontal distance < ``radius``), which
+    also terminates the episode. Use it for both ``Task.reward`` and ``Task.terminated``."""
+
+    def __init__(self, light: str | None = None, radius: float = 0.2, progress_weight: float = 10.0,
+                 bonus: float = 10.0, step_cost: float = 0.01):
+        self.light = light
+        self.radius = radius
+        self.progress_weight = progress_weight
+        self.bonus = bonus
+        self.step_cost = step_cost
+        self._target: np.ndarray | None = None
+        self._previous = math.inf
+
+    def target(self, sim) -> np.ndarray:
+        for lt in sim.scene.world_lights():          # also lights carried by solids and robots, placed
+            if lt.type == "DirectionalLight":
+                continue
+            if self.light is None or lt.name == self.light:
+                return np.array(lt.location[:2], dtype=np.float64)
+        raise ValueError(f"ReachLight: the world has no point or spot light named {self.light!r}"
+                         if self.light else "ReachLight: the world has no point or spot light")
+
+    def distance(self, sim, robot) -> float:
+        if self._target is None:
+            self._target = self.target(sim)
+        return float(np.hypot(*(robot.pose.translation[:2] - self._target)))
+
+    def reset(self, sim, robot) -> None:
+        self._target = self.target(sim)
+        self._previous = self.distance(sim, robot)
+
+    def reward(self, sim, robot, obs) -> float:
+        d = self.distance(sim, robot)
+        r = self.progress_weight * (self._previous - d) - self.step_cost
+        self._previous = d
+        if d < self.radius:
+            r += self.bonus
+        return float(r)
+
+    __call__ = reward
+
+    def terminated(self, sim, robot, obs) -> bool:
+        return self.distance(sim, robot) < self.radius
+
+
+class AvoidObstacles:
+    """Explore without touching anything: per action, ``v (1 - sqrt(|dv|)) (1 - p)`` with ``v`` the
+    mean wheel speed and ``dv`` the wheel speed difference (both / max wheel speed) and ``p`` the
+    proximity ``1 - clearance / near`` (0 when nothing is within ``near`` m of the body), minus
+    ``contact_penalty`` on contact. Contact (terminates): clearance below the body radius plus
+    ``contact_distance``."""
+
+    def __init__(self, near: float = 0.15, contact_distance: float = 0.005, contact_penalty: float = 10.0):
+        self.near = near
+        self.contact_distance = contact_distance
+        self.contact_penalty = contact_penalty
+        self._radius_key: tuple | None = None
+        self._radius = 0.0
+
+    def reset(self, sim, robot) -> None:
+        self._radius_key = None
+
+    def _gap(self, sim, robot) -> float:
+        key = (id(sim), robot.index)
+        if self._radius_key != key:
+            self._radius_key, self._radius = key, body_radius(robot, sim.loaded.base_dir)
+        r = self._radius
+        return clearance(sim, robot, max_distance=r + max(self.near, self.contact_distance) + 1e-6) - r
+
+    def reward(self, sim, robot, obs) -> float:
+        drive = robot.drive
+        vmax = drive.left.max_velocity
+        wl, wr = drive.left.velocity / vmax, drive.right.velocity / vmax
+        v = 0.5 * (wl + wr)
+        dv = abs(wl - wr) / 2.0
+        gap = self._gap(sim, robot)
+        p = min(max(1.0 - gap / self.near, 0.0), 1.0)
+        r = v * (1.0 - math.sqrt(dv)) * (1.0 - p)
+        if gap < self.contact_distance:
+            r -= self.contact_penalty
+        return float(r)
+
+    __call__ = reward
+
+    def terminated(self, sim, robot, obs) -> bool:
+        return self._gap(sim, robot) < self.contact_distance

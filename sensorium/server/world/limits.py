@@ -1,0 +1,249 @@
+"""Limits on what a world file may ask of the server, checked by the loader (so ``validate``
+accepts exactly the worlds ``serve`` can run).
+
+Two kinds of limits:
+
+* **parsing** — file size, YAML/JSON nesting depth, alias expansion, number of values, string
+  lengths: checked on the raw text and the parsed data *before* the model is validated, so a
+  hostile file costs little time and memory and its error quotes only a short prefix;
+* **work** — robots, devices, rays per distance sensor, beams per lidar, rays per step, triangles,
+  lights, the magnitude of every number: checked on the validated model.
+
+``WorldLimits()`` are the defaults; ``WorldLimits.large()`` (``--allow-large``) raises every limit for
+worlds that deliberately ask for more. The table is in README "Security and limits".
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, fields
+from typing import Any
+
+import yaml
+from pydantic import BaseModel
+
+__all__ = ["WorldLimits", "LimitError", "check_yaml_events", "check_data", "check_work", "quote", "triangle_count"]
+
+MiB = 1 << 20
+
+
+@dataclass(frozen=True)
+class WorldLimits:
+    file_bytes: int = 16 * MiB               # the world file
+    mesh_file_bytes: int = 256 * MiB         # each mesh file
+    nesting_depth: int = 64                  # nested mappings/sequences in the file
+    values: int = 2_000_000                  # scalars + containers after YAML aliases are expanded
+    name_chars: int = 256                    # names become topic paths (/<robot>/<device>/value)
+    string_chars: int = 4096                 # any other string (urls, ...); custom_data has its own cap
+    number_magnitude: float = 1e9            # |x| of every number (0 or in [1e-30, this])
+    robots: int = 256
+    devices_per_robot: int = 256
+    lights: int = 256
+    solids: int = 10_000
+    rays_per_sensor: int = 1024              # DistanceSensor rays (after Webots' sanitising)
+    beams_per_lidar: int = 1 << 20           # horizontal_resolution × number_of_layers
+    rays_per_step: int = 1 << 22             # every device due at once: distance rays + lidar beams + light occlusion rays
+    triangles: int = 4_000_000               # tessellated primitives + meshes (planes are analytic)
+
+    @classmethod
+    def large(cls) -> WorldLimits:
+        """``--allow-large``: every limit raised (parsing limits stay finite)."""
+        return cls(file_bytes=1024 * MiB, mesh_file_bytes=4096 * MiB, nesting_depth=256, values=100_000_000,
+                   name_chars=4096, string_chars=1 * MiB, number_magnitude=1e15, robots=100_000,
+                   devices_per_robot=65_536, lights=65_536, solids=10_000_000, rays_per_sensor=1 << 20,
+                   beams_per_lidar=1 << 28, rays_per_step=1 << 30, triangles=1 << 30)
+
+    def describe(self) -> list[tuple[str, Any]]:
+        return [(f.name, getattr(self, f.name)) for f in fields(self)]
+
+
+class LimitError(ValueError):
+    """Raised by the scans below: ``path`` (field path or "line N") and a message."""
+
+    def __init__(self, path: str, message: str):
+        super().__init__(f"{path}: {message}" if path else message)
+        self.path = path
+        self.message = message
+
+
+RAISE = "(raise the limits with --allow-large)"
+
+
+def quote(value: Any, limit: int = 60) -> str:
+    """``repr`` of a value, cut to a short prefix (errors never echo a huge input)."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit] + f"… ({len(text)} characters)"
+
+
+# ------------------------------------------------------------------------------------ parsing
+
+
+def check_yaml_events(text: bytes | str, limits: WorldLimits) -> None:
+    """Scan YAML without building it: nesting depth and the number of values once aliases are
+    expanded (``&a [*b, *b, …]`` chains grow exponentially). Raises ``LimitError``; YAML syntax
+    errors propagate as ``yaml.YAMLError``."""
+    depth = 0
+    # per open container: the number of values inside it so far, and its anchor
+    stack: list[list[Any]] = [[0, None]]
+    sizes: dict[str, int] = {}
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
+            depth += 1
+            if depth > limits.nesting_depth:
+                raise LimitError(f"line {event.start_mark.line + 1}",
+                                 f"nested deeper than {limits.nesting_depth} levels {RAISE}")
+            stack.append([1, event.anchor])
+        elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
+            depth -= 1
+            count, anchor = stack.pop()
+            if anchor is not None:
+                sizes[anchor] = count
+            stack[-1][0] += count
+        elif isinstance(event, (yaml.ScalarEvent, yaml.AliasEvent)):
+            n = 1 if isinstance(event, yaml.ScalarEvent) else sizes.get(event.anchor, 1)
+            if isinstance(event, yaml.ScalarEvent) and event.anchor is not None:
+                sizes[event.anchor] = 1
+            stack[-1][0] += n
+        else:
+            continue
+        if sum(c for c, _ in stack) > limits.values:
+            mark = event.start_mark
+            raise LimitError(f"line {mark.line + 1}",
+                             f"more than {limits.values} values once aliases are expanded {RAISE}")
+
+
+def _string_limit(key: str, limits: WorldLimits) -> int:
+    if key == "custom_data":
+        return 1 * MiB if limits.string_chars < MiB else limits.string_chars   # Webots customData
+    if key == "name" or key.endswith("motor"):
+        return limits.name_chars
+    return limits.string_chars
+
+
+def check_data(data: Any, limits: WorldLimits) -> None:
+    """The parsed (not yet validated) data: depth, number of values, string lengths. Iterative (a
+    deep structure cannot overflow the stack). Raises ``LimitError`` naming the field path."""
+    todo: list[tuple[Any, str, str, int]] = [(data, "", "", 0)]
+    count = 0
+    while todo:
+        value, path, key, depth = todo.pop()
+        count += 1
+        if count > limits.values:
+            raise LimitError("", f"more than {limits.values} values {RAISE}")
+        if depth > limits.nesting_depth:
+            raise LimitError(path, f"nested deeper than {limits.nesting_depth} levels {RAISE}")
+        if isinstance(value, dict):
+            for k, v in reversed(list(value.items())):
+                if isinstance(k, str) and len(k) > limits.name_chars:
+                    raise LimitError(path, f"key {quote(k)} longer than {limits.name_chars} characters")
+                todo.append((v, f"{path}.{k}" if path else str(k), str(k), depth + 1))
+        elif isinstance(value, (list, tuple)):
+            for i in reversed(range(len(value))):
+                todo.append((value[i], f"{path}[{i}]", key, depth + 1))
+        elif isinstance(value, str):
+            cap = _string_limit(key, limits)
+            if len(value) > cap:
+                raise LimitError(path, f"string of {len(value)} characters, longer than {cap} "
+                                       f"(starts {quote(value[:40])}) {RAISE}")
+
+
+# ------------------------------------------------------------------------------------ work
+
+
+def _walk(model: Any, path: str = "") -> Iterator[tuple[str, Any]]:
+    """Every (path, value) of a validated model: nested models, lists, tuples (iterative)."""
+    todo: list[tuple[str, Any]] = [(path, model)]
+    while todo:
+        p, v = todo.pop()
+        yield p, v
+        if isinstance(v, BaseModel):       # pushed in reverse: yielded in file order
+            todo.extend((f"{p}.{name}" if p else name, getattr(v, name)) for name in reversed(type(v).model_fields))
+        elif isinstance(v, (list, tuple)):
+            todo.extend((f"{p}[{i}]", v[i]) for i in reversed(range(len(v))))
+
+
+def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
+    """Triangles the ray engine builds for a geometry model (closed forms; meshes by their file)."""
+    from sensorium.server.world.geometry import capsule_segments
+
+    kind = getattr(geom, "type", None)
+    if kind == "box":
+        return 12
+    if kind == "sphere":
+        return 20 * 4 ** int(geom.subdivision)
+    if kind == "cylinder":
+        return 4 * int(geom.subdivision)
+    if kind == "capsule":
+        n_az, n_lat = capsule_segments(int(geom.subdivision))
+        return 4 * n_az * n_lat
+    if kind == "plane":
+        return 0
+    if kind == "mesh":
+        return mesh_triangles(geom)
+    faces = getattr(geom, "faces", None)      # explicit triangle lists
+    return len(faces) if faces is not None else 0
+
+
+_GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "plane", "mesh", "triangles"}
+
+
+def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> list[str | tuple[str, str]]:
+    """The work a validated world asks for. Returns problems as ``(path, message)``."""
+    problems: list[str | tuple[str, str]] = []
+
+    def over(path: str, what: str, n: float, cap: float) -> None:
+        num = (lambda x: f"{x:,}") if isinstance(n, int) else (lambda x: f"{x:g}")
+        problems.append((path, f"{what} {num(n)} exceeds the limit of {num(cap)} {RAISE}"))
+
+    triangles = 0
+    lights = 0
+    solids = 0
+    for path, v in _walk(world):
+        if isinstance(v, float):
+            mag = abs(v)
+            if not math.isfinite(v):
+                problems.append((path, f"expected a finite number, got {v!r}"))
+            elif mag > limits.number_magnitude:
+                over(path, "the magnitude of", v, limits.number_magnitude)
+            elif 0.0 < mag < 1e-30:
+                problems.append((path, f"{v!r} is too close to 0 (use 0, or a magnitude of at least 1e-30)"))
+        elif isinstance(v, BaseModel):
+            kind = getattr(v, "type", None)
+            if kind in _GEOMETRY_TYPES and path.endswith("geometry"):
+                triangles += triangle_count(v, mesh_triangles)
+            elif isinstance(kind, str) and kind.endswith("Light"):
+                lights += 1
+            if path.endswith("]") and path.rpartition("[")[0].rpartition(".")[2] in ("solids", "children"):
+                solids += 1
+    if len(world.robots) > limits.robots:
+        over("robots", "robots:", len(world.robots), limits.robots)
+    if lights > limits.lights:
+        over("lights", "lights:", lights, limits.lights)
+    if solids > limits.solids:
+        over("solids", "solids:", solids, limits.solids)
+    if triangles > limits.triangles:
+        over("", "the world's triangles:", triangles, limits.triangles)
+    per_step = 0
+    for r_i, robot in enumerate(world.robots):
+        rp = f"robots[{r_i}]"
+        if len(robot.devices) > limits.devices_per_robot:
+            over(f"{rp}.devices", "devices:", len(robot.devices), limits.devices_per_robot)
+        for d_i, dev in enumerate(robot.devices):
+            dp = f"{rp}.devices[{d_i}]"
+            kind = getattr(dev, "device", "")
+            if kind == "DistanceSensor":
+                n = max(1, int(dev.number_of_rays))       # an upper bound of the rays Webots casts
+                if n > limits.rays_per_sensor:
+                    over(f"{dp}.number_of_rays", "rays:", n, limits.rays_per_sensor)
+                per_step += n
+            elif kind == "Lidar":
+                n = int(dev.horizontal_resolution) * int(dev.number_of_layers)
+                if n > limits.beams_per_lidar:
+                    over(dp, "beams (horizontal_resolution × number_of_layers):", n, limits.beams_per_lidar)
+                per_step += n
+            elif kind == "LightSensor" and getattr(dev, "occlusion", False):
+                per_step += lights
+    if per_step > limits.rays_per_step:
+        over("", "rays in one step (every device due at once):", per_step, limits.rays_per_step)
+    return problems

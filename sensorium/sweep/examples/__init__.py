@@ -1,0 +1,1 @@
+"""Example sweep specs (``ir_noise.yaml``)."""

@@ -1,0 +1,52 @@
+"""The ``slow`` marker: multi-process and subprocess-heavy tests, so that ``pytest -m "not slow"`` is
+a fast local loop (CI runs everything).
+
+A test is slow when its module runs servers and controllers as processes (``SLOW_MODULES``), when
+it starts a subprocess itself or through a helper of its module (found in the module's source:
+a function that mentions ``subprocess``/``Popen``, or calls one that does), or when it is listed
+in ``SLOW_TESTS`` (long single-process runs).
+"""
+
+from __future__ import annotations
+
+import ast
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+SLOW_MODULES = {"test_multiprocess", "test_server", "test_record_live", "test_demo", "test_docker", "test_bench"}
+SLOW_TESTS = {
+    "test_simulation.py::test_million_steps_no_clock_drift",
+    "test_simulation.py::test_circle_stays_on_circle_for_a_million_steps",
+}
+
+
+@cache
+def _spawning_functions(path: Path) -> frozenset[str]:
+    """Names of the module's functions that start a process, directly or through another of them."""
+    source = path.read_text()
+    funcs = {node.name: ast.get_source_segment(source, node) or ""
+             for node in ast.walk(ast.parse(source)) if isinstance(node, ast.FunctionDef)}
+    spawning = {name for name, text in funcs.items() if "subprocess" in text or "Popen" in text}
+    grown = True
+    while grown:
+        grown = False
+        for name, text in funcs.items():
+            if name not in spawning and any(f"{other}(" in text for other in spawning):
+                spawning.add(name)
+                grown = True
+    return frozenset(spawning)
+
+
+def is_slow(item: pytest.Item) -> bool:
+    path = Path(str(item.path))
+    name = getattr(item, "originalname", None) or item.name
+    return (path.stem in SLOW_MODULES or f"{path.name}::{name}" in SLOW_TESTS
+            or name in _spawning_functions(path))
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    for item in items:
+        if is_slow(item):
+            item.add_marker(pytest.mark.slow)

@@ -1,0 +1,550 @@
+"""The C controller library (sensorium/client/c) against a live server, built with AddressSanitizer
+and UBSan: Webots-style C controllers read exactly (bit for bit) what the Python client reads on
+the same world, step in lockstep beside Python controllers, are released when SIGKILLed, keep
+their session while computing, and fail with one clear line on a bad URL or a missing server.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import queue
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from sensorium.client.connection import Connection
+
+REPO = Path(__file__).resolve().parents[1]
+CLIB = REPO / "sensorium" / "client" / "c"
+TESTS_C = REPO / "tests" / "c"
+ARENA = REPO / "sensorium" / "worlds" / "arena.yaml"
+TRIO = REPO / "tests" / "worlds" / "trio.yaml"
+SCRIPT_PY = REPO / "tests" / "controllers" / "script.py"
+BRAITENBERG_PY = REPO / "sensorium" / "client" / "examples" / "braitenberg.py"
+SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
+ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
+CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
+ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
+CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
+               "wire_vectors"]
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
+                                reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
+
+
+def _make(*args: str) -> str:
+    done = subprocess.run(["make", "-s", "-C", str(CLIB), *args], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return done.stdout
+
+
+@pytest.fixture(scope="module")
+def cbin(tmp_path_factory) -> dict[str, str]:
+    """The library built with -fsanitize=address,undefined and the test controllers linked to it."""
+    build = tmp_path_factory.mktemp("cbuild")
+    _make(f"BUILD={build}", "SANITIZE=1")
+    libs = _make("libs").split()
+    out = {}
+    for name, src in [(n, TESTS_C / f"{n}.c") for n in CONTROLLERS] + [("api_check", CLIB / "tests" / "api_check.c")]:
+        exe = build / name
+        cmd = ["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+               "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", f"-I{TESTS_C}", str(src), "-o", str(exe),
+               str(build / "libController.a"), *libs, "-lm"]
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        out[name] = str(exe)
+    exe = build / "braitenberg_cpp"                     # the header-only C++ layer
+    cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+           f"-I{CLIB / 'include'}", str(TESTS_C / "braitenberg_cpp.cpp"), "-o", str(exe), str(build / "libController.a"),
+           *libs]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    out["braitenberg_cpp"] = str(exe)
+    return out
+
+
+class Server:
+    """``sensorium serve`` on 127.0.0.1, free ports; ``url(robot)`` is a controller URL."""
+
+    def __init__(self, world: Path, *extra: str):
+        self.p = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", "tcp://127.0.0.1:0",
+                                   "--pub", "tcp://127.0.0.1:0", *extra], stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True, env=ENV, cwd=str(REPO))
+        lines: queue.Queue[str] = queue.Queue()
+        threading.Thread(target=lambda: [lines.put(x) for x in self.p.stdout], daemon=True).start()
+        self.err: list[str] = []
+        threading.Thread(target=lambda: [self.err.append(x) for x in self.p.stderr], daemon=True).start()
+        try:
+            ready = lines.get(timeout=60)
+        except queue.Empty:
+            self.p.kill()
+            raise AssertionError("server not ready in 60 s: " + "".join(self.err)) from None
+        assert ready.startswith("sensorium: serving world"), ready
+        self.rpc = ready.split("rpc=")[1].split()[0]
+        self.conn = Connection(self.rpc, timeout=10.0)
+
+    def url(self, robot: str) -> str:
+        return f"{self.rpc}/{robot}"
+
+    def attached(self) -> set[str]:
+        return {r["name"] for r in self.conn.call("get_info")["robots"] if r["attached"]}
+
+    def wait_attached(self, robots: set[str], timeout: float = 60.0) -> None:
+        deadline = time.monotonic() + timeout
+        while not robots <= self.attached():
+            assert time.monotonic() < deadline, f"attached {self.attached()}, waiting for {robots}"
+            time.sleep(0.02)
+
+    def stop(self) -> int:
+        self.conn.close()
+        if self.p.poll() is None:
+            self.p.send_signal(signal.SIGINT)
+        try:
+            return self.p.wait(20)
+        finally:
+            if self.p.poll() is None:
+                self.p.kill()
+
+
+@pytest.fixture
+def servers():
+    started: list[Server] = []
+
+    def start(world: Path = ARENA, *extra: str) -> Server:
+        started.append(Server(world, *extra))
+        return started[-1]
+
+    yield start
+    for s in started:
+        s.stop()
+
+
+def start(cmd: list[str], url: str | None = None, **env: str) -> subprocess.Popen:
+    full = {**ENV, **env}
+    if url is not None:
+        full["SENSORIUM_CONTROLLER_URL"] = url
+    return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=full, cwd=str(REPO))
+
+
+def finish(p: subprocess.Popen, timeout: float = 120.0) -> tuple[int, list[str], str]:
+    try:
+        out, err = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        out, err = p.communicate()
+        raise AssertionError(f"{p.args} still running after {timeout} s; stderr:\n{err}") from None
+    assert "Sanitizer" not in err and "runtime error" not in err, err
+    return p.returncode, out.splitlines(), err
+
+
+def run(cmd: list[str], url: str | None = None, **env: str) -> list[str]:
+    code, out, err = finish(start(cmd, url, **env))
+    assert code == 0, f"{cmd[0]} exited {code}:\n{err}"
+    return out
+
+
+def python_script(url: str, *ops: str) -> list[str]:
+    return run([sys.executable, "-m", "sensorium", "controller", "--url", url, str(SCRIPT_PY), *ops])
+
+
+def data(lines: list[str]) -> list[str]:
+    return [line for line in lines if not line.startswith("#")]
+
+
+def fields(line: str) -> dict[str, str]:
+    t, status, *rest = line.split(" ")
+    return {"t": t, "status": status, **dict(item.split("=", 1) for item in rest)}
+
+
+NAN_BITS = "7ff8000000000000"
+
+
+# ====================================================================== build
+
+def test_library_builds_warning_free_as_shared_and_static_and_headers_stand_alone(tmp_path):
+    _make(f"BUILD={tmp_path}", "check")          # -Wall -Wextra -Werror; every header alone, -std=c99 -pedantic
+    assert (tmp_path / "libController.a").is_file() and (tmp_path / "libController.so").is_file()
+    symbols = subprocess.run(["nm", "-D", "--defined-only", str(tmp_path / "libController.so")],
+                             capture_output=True, text=True, check=True).stdout
+    for fn in ("wb_robot_init", "wb_robot_step", "wb_lidar_get_point_cloud", "wb_motor_set_velocity",
+               "wb_distance_sensor_get_lookup_table", "wb_light_sensor_get_value"):
+        assert f" T {fn}\n" in symbols, fn
+
+
+# ====================================================================== readings, bit for bit
+
+def test_light_sequence_follows_webots_sampling_rules_and_matches_python(cbin, servers):
+    c_lines = run([cbin["light_sequence"]], servers().url("epuck"))
+    py_lines = python_script(servers().url("epuck"), "enable", "ls0", "96", "enable", "ls1", "40",
+                             "step", "32", "6", "disable", "ls0", "step", "32", "2")
+    assert data(c_lines) == py_lines
+    rows = [fields(line) for line in py_lines]
+    assert [r["t"] for r in rows] == [str(32 * k) for k in range(1, 9)]
+    ls0 = [r["ls0"] for r in rows]
+    ls1 = [r["ls1"] for r in rows]
+    # enable(96) at 0: NaN after steps 1 and 2, first value after step 3, refreshed at 192
+    assert ls0[0] == ls0[1] == NAN_BITS and ls0[2] != NAN_BITS
+    assert ls0[2] == ls0[3] == ls0[4] and ls0[5] != ls0[4]     # noise makes each measurement new
+    assert ls0[6] == ls0[7] == ls0[5]                          # disabled after step 6: last value kept
+    # enable(40): effective period 64 (rounded up to basic steps): values at 64, 128, 192, 256
+    assert ls1[0] == NAN_BITS and ls1[1] != NAN_BITS
+    assert ls1[1] == ls1[2] != ls1[3] == ls1[4] != ls1[5] == ls1[6] != ls1[7]
+    assert c_lines[-1] == "# periods 0 40 table 2"
+
+
+def test_infra_red_and_sonar_readers_match_python(cbin, servers):
+    server = servers(ARENA, "--mode", "pause")           # both robots attached before the world moves
+    ir = [f"ps{i}" for i in range(8)]
+    sonars = ["sonar_front", "sonar_left", "sonar_right", "sonar_back"]
+    c_epuck = start([cbin["proximity"], *ir], server.url("epuck"), STEPS="6")
+    c_scout = start([cbin["proximity"], *sonars], server.url("scout"), STEPS="6")
+    server.wait_attached({"epuck", "scout"})
+    server.conn.call("set_mode", {"mode": "fast"})
+    outs = [finish(p) for p in (c_epuck, c_scout)]
+    assert all(code == 0 for code, _, _ in outs), [err for _, _, err in outs]
+    (_, epuck, _), (_, scout, _) = outs
+    twin = servers(ARENA, "--mode", "pause")
+    ops = lambda names: [x for n in names for x in ("enable", n, "32")] + ["step", "32", "6"]  # noqa: E731
+    p_epuck = start([sys.executable, "-m", "sensorium", "controller", "--url", twin.url("epuck"), str(SCRIPT_PY),
+                     *ops(ir)])
+    p_scout = start([sys.executable, "-m", "sensorium", "controller", "--url", twin.url("scout"), str(SCRIPT_PY),
+                     *ops(sonars)])
+    twin.wait_attached({"epuck", "scout"})
+    twin.conn.call("set_mode", {"mode": "fast"})
+    py = [finish(p) for p in (p_epuck, p_scout)]
+    assert all(code == 0 for code, _, _ in py), [err for _, _, err in py]
+    assert data(epuck) == py[0][1] and data(scout) == py[1][1]
+    assert len(data(epuck)) == 6 and len({fields(x)["ps0"] for x in data(epuck)}) == 6     # noisy IR: all new
+    assert all(NAN_BITS not in x for x in data(scout))
+    # constants against the world file: type, table output extremes, aperture, the table itself
+    head = {line.split()[1]: line.split()[2:] for line in epuck + scout if line.startswith("# ")}
+    assert head["ps3"][:4] == ["1", "67.189999999999998", "4095", "0.20000000000000001"] and head["ps3"][4] == "10"
+    assert [float(v) for v in head["ps3"][5:8]] == [0.0, 4095.0, 0.002]
+    assert head["sonar_back"][:5] == ["2", "0", "3", "0.40000000000000002", "2"]
+    assert [float(v) for v in head["sonar_back"][5:]] == [0.0, 0.0, 0.0, 3.0, 3.0, 0.0]
+
+
+def test_lidar_range_image_and_point_cloud_reader_matches_python(cbin, servers):
+    c_lines = run([cbin["lidar_reader"], "lidar", "3"], servers().url("scout"))
+    py_lines = python_script(servers().url("scout"), "enable", "lidar", "32", "pc", "lidar", "step", "32", "3")
+    assert data(c_lines) == py_lines
+    row = fields(py_lines[0])
+    assert len(row["lidar.range"]) == 2 * 4 * 360 and len(row["lidar.cloud"]) == 2 * 20 * 360
+    checks = [line.split() for line in c_lines if line.startswith("#")]
+    assert len(checks) == 3
+    for check in checks:
+        got = dict(zip(check[1::2], check[2::2]))
+        assert got == {"points": "360", "layers_ok": "1", "stable": "1", "norm_bad": "0", "null_before": "1",
+                       "bad_layer": "1"}
+
+
+def test_braitenberg_in_c_drives_exactly_like_the_python_example(cbin, servers):
+    c_lines = run([sys.executable, "-m", "sensorium", "controller", "--url", servers().url("epuck"),
+                   cbin["braitenberg"], "40"])
+    py_lines = run([sys.executable, "-m", "sensorium", "controller", "--url", servers().url("epuck"),
+                    str(BRAITENBERG_PY), "40"])
+    assert len(c_lines) == 40 and c_lines == py_lines
+    wheels = {line.split("wheels")[1] for line in c_lines}
+    assert len(wheels) > 5 and all("+0.00 +0.00" not in w for w in wheels)       # it really steers
+    cpp_lines = run([cbin["braitenberg_cpp"], "40"], servers().url("epuck"))      # the C++ layer, too
+    assert cpp_lines == py_lines
+
+
+def test_every_getter_matches_the_python_client(cbin, servers):
+    from sensorium.client import wb
+
+    for robot in ("epuck", "scout"):
+        server = servers()
+        wb.wb_robot_init(server.url(robot))
+        try:
+            want = {"robot.name": wb.wb_robot_get_name(), "robot.basic_time_step": wb.wb_robot_get_basic_time_step(),
+                    "robot.number_of_devices": str(wb.wb_robot_get_number_of_devices())}
+            for i in range(wb.wb_robot_get_number_of_devices()):
+                tag = wb.wb_robot_get_device_by_index(i)
+                name, kind = wb.wb_device_get_name(tag), wb.wb_device_get_type_name(tag)
+                want[f"device {i}"] = f"{name} {kind} 1 |"
+                if kind == "DistanceSensor":
+                    want[f"{name}.min_value"] = wb.wb_distance_sensor_get_min_value(tag)
+                    want[f"{name}.max_value"] = wb.wb_distance_sensor_get_max_value(tag)
+                    want[f"{name}.aperture"] = wb.wb_distance_sensor_get_aperture(tag)
+                    want[f"{name}.type"] = str(wb.wb_distance_sensor_get_type(tag))
+                    want[f"{name}.lookup_table"] = wb.wb_distance_sensor_get_lookup_table(tag)
+                elif kind == "LightSensor":
+                    want[f"{name}.lookup_table"] = wb.wb_light_sensor_get_lookup_table(tag)
+                elif kind == "Lidar":
+                    for key in ("horizontal_resolution", "number_of_layers"):
+                        want[f"{name}.{key}"] = str(getattr(wb, f"wb_lidar_get_{key}")(tag))
+                    for key in ("fov", "vertical_fov", "min_range", "max_range", "frequency", "min_frequency",
+                                "max_frequency"):
+                        want[f"{name}.{key}"] = getattr(wb, f"wb_lidar_get_{key}")(tag)
+                    want[f"{name}.point_cloud_enabled"] = str(int(wb.wb_lidar_is_point_cloud_enabled(tag)))
+                else:
+                    for key in ("max_velocity", "velocity", "target_position", "min_position", "max_position"):
+                        want[f"{name}.{key}"] = getattr(wb, f"wb_motor_get_{key}")(tag)
+                    want[f"{name}.type"] = str(wb.wb_motor_get_type(tag))
+                    want[f"{name}.position_sensor"] = str(wb.wb_motor_get_position_sensor(tag))
+                    want[f"{name}.clamped_velocity"] = wb.wb_motor_get_max_velocity(tag)
+                    want[f"{name}.new_target"] = float("inf")
+        finally:
+            wb.wb_robot_cleanup()
+        code, lines, err = finish(start([cbin["api_check"]], server.url(robot)))
+        assert code == 0, err
+        got = {}
+        for line in lines:
+            if line.startswith("device "):
+                head, index, value = line.split(" ", 2)
+                key = f"{head} {index}"
+            elif ".lookup_table " in line:
+                name, value = line.split(".lookup_table ", 1)
+                key = f"{name}.lookup_table"
+            else:
+                key, _, value = line.rpartition(" ")
+            got[key] = value
+        for key, value in want.items():
+            if isinstance(value, list):
+                assert [float(v) for v in got[key].split()] == value, key
+            elif isinstance(value, float):
+                assert float(got[key]) == value, key
+            else:
+                assert got[key] == value, key
+        assert got["error.no_device"] == got["error.by_index"] == "0"
+        assert got["error.bad_tag_value"] == got["error.bad_tag_name"] == got["error.wrong_kind"] == "1"
+        assert got["error.bad_step"] == "-1" and got["robot.step"] == "0"
+        assert "step duration must be >= 0 ms" in err and "invalid device tag 9999" in err
+        assert float(got["robot.time_after"]) * 1000 == pytest.approx(want["robot.basic_time_step"])
+
+
+def test_braitenberg_with_encoders_matches_python_and_the_wheel_angles(cbin, servers):
+    c_lines = run([cbin["encoders"], "60"], servers(CDEVICES).url("rover"))
+    py_lines = run([sys.executable, "-m", "sensorium", "controller", "--url", servers(CDEVICES).url("rover"),
+                    str(ENCODERS_PY), "60"])
+    assert c_lines == py_lines and len(c_lines) == 60
+    rows = [fields(x) for x in c_lines]
+    f = lambda bits: struct.unpack("<d", bytes.fromhex(bits)[::-1])[0]  # noqa: E731
+    # the first 10 steps at 2.0 / 1.0 rad/s: the noiseless left encoder reads 2.0 rad/s x t exactly
+    for k, row in enumerate(rows[:10], start=1):
+        assert f(row["left"]) == pytest.approx(2.0 * 0.016 * k, abs=1e-12)
+        assert f(row["right"]) == pytest.approx(1.0 * 0.016 * k, abs=0.005)          # noise 0.001 rad
+    assert f(rows[0]["ls0"]) != f(rows[0]["ls0"]) and f(rows[1]["ls0"]) == f(rows[1]["ls0"])   # period 32: NaN at 16
+    speeds = {round(f(b["left"]) - f(a["left"]), 9) for a, b in zip(rows[10:], rows[11:])}
+    assert len(speeds) > 5                                            # the driver steers from its readings
+
+
+def test_robot_extras_led_keyboard_and_supervisor(cbin, servers):
+    server = servers(CDEVICES, "--mode", "pause")
+    rover = start([cbin["supervisor_check"]], server.url("rover"))
+    buddy = start([cbin["supervisor_check"]], server.url("buddy"))
+    server.wait_attached({"rover", "buddy"})
+    server.conn.call("set_mode", {"mode": "fast"})
+    (code_r, out_r, err_r), (code_b, out_b, err_b) = finish(rover), finish(buddy)
+    assert code_r == 0 and code_b == 0, err_r + err_b
+    got = dict(line.split(" ", 1) for line in out_r)
+    assert got["model"] == "C-rover" and got["custom_data"] == "gain=2" and got["supervisor"] == "1"
+    assert got["custom_data_after"] == "gain=3;from C" and got["mode"] == "0" and got["buddy_null"] == "0"
+    assert got["led0_initial"] == "0" and got["led0"] == f"2 rgb {0x336699}"
+    assert "value 3 out of range [0, 2] for LED 'led0'" in err_r
+    assert got["keyboard_disabled_key"] == "-1" and got["keyboard"] == "16 -1" and got["keyboard_after"] == "0"
+    assert got["self_null"] == "0 missing_null 1 same_ref 1"
+    assert got["fields"] == "5 translation 6 rotation bogus_null 1"
+    assert [float(v) for v in got["buddy_translation"].split()] == [-0.4, -0.4, 0.0]
+    assert [float(v) for v in got["buddy_translation_after"].split()] == [0.25, -0.5, 0.0]
+    assert [float(v) for v in got["buddy_rotation_after"].split()] == pytest.approx([0, 0, 1, math.pi / 2])
+    assert [float(v) for v in got["buddy_position"].split()] == [0.25, -0.5, 0.0]
+    assert [float(v) for v in got["buddy_orientation"].split()] == pytest.approx([0, -1, 0, 1, 0, 0, 0, 0, 1], abs=1e-12)
+    assert [float(v) for v in got["self_position"].split()] == [0.0, 0.0, 0.01]
+    assert got["sim_mode"] == "2" and got["sim_mode_after"] == "1"
+    assert [float(v) for v in got["buddy_translation_reset"].split()] == [-0.4, -0.4, 0.0]
+    assert got["led0_reset"] == "0"
+    assert "field 'mass' is not supported" in err_r and "wrong type (rotation)" in err_r
+    # the plain robot: supervisor calls refused with Webots' message
+    assert dict(line.split(" ", 1) for line in out_b)["buddy_null"] == "1"
+    assert "illegal call to wb_supervisor_node_get_from_def() in a 'Robot' controller" in err_b
+    # what the C controller set is the server's state: a Python controller attaching next sees it
+    from sensorium.client.wb import RobotClient
+    with RobotClient(server.url("rover")) as py:
+        assert py.custom_data == "after reset" and py.model == "C-rover"
+        assert py.by_name["led0"].desc["value"] == 1
+
+
+def test_c_client_replays_the_conformance_session(cbin, servers):
+    """sensorium/schemas/conformance/session.json: expected lines computed from the simulation."""
+    session = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "session.json").read_text())
+    server = servers(REPO / "sensorium" / "schemas" / "conformance" / session["world"])
+    lines = run([sys.executable, "-m", "sensorium", "controller", "--url", server.url(session["robot"]), cbin["script"],
+                 *session["script"]])
+    assert lines == session["lines"]
+
+
+def test_c_codec_replays_the_request_vectors(cbin, servers):
+    """sensorium/schemas/conformance/requests.json through the library's own transport and msgpack
+    decoding (tests/c/wire_vectors.c): ids, ok, error codes, result keys and scalar results."""
+    import msgpack
+
+    from sensorium.server import conformance
+
+    vectors = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "requests.json").read_text())
+    server = servers(REPO / "sensorium" / "schemas" / "conformance" / vectors["world"])
+    p = subprocess.Popen([cbin["wire_vectors"], server.rpc], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=ENV)
+    saved: dict[str, str] = {}
+    try:
+        for case in vectors["cases"]:
+            data = (bytes.fromhex(case["request_hex"]) if "request_hex" in case else
+                    msgpack.packb(conformance.decode_value(case["request"], saved), use_bin_type=True))
+            p.stdin.write(data.hex() + "\n")
+            p.stdin.flush()
+            line = p.stdout.readline().rstrip("\n")
+            head, _, rest = line.partition(" keys=")
+            got = dict(item.split("=", 1) for item in head.split())
+            keys, *scalars = rest.split(" ")
+            result = dict(item.split("=", 1) for item in scalars)
+            expect = case["expect"]
+            assert got["id"] == ("nil" if "id" in expect else str(case["request"]["id"])), (case["name"], line)
+            assert got["ok"] == str(int(expect["ok"])), (case["name"], line)
+            if not expect["ok"]:
+                assert got["code"] == str(expect["code"]), (case["name"], line)
+                continue
+            names = set(keys.split(",")) - {""}
+            want = conformance.decode_value(expect.get("result", {}))
+            assert {k.split(".")[0] for k in expect.get("result_has", [])} | set(want) <= names, (case["name"], line)
+            for key, value in want.items():
+                if isinstance(value, bool):
+                    assert result[key] == str(value).lower(), (case["name"], key)
+                elif isinstance(value, (int, float)):
+                    assert float(result[key]) == value, (case["name"], key)
+                elif isinstance(value, str):
+                    assert result[key] == value, (case["name"], key)
+            if "save" in expect:
+                saved[expect["save"]] = result[expect["save"]]
+    finally:
+        p.stdin.close()
+        code = p.wait(60)
+        err = p.stderr.read()
+    assert code == 0 and "Sanitizer" not in err and "runtime error" not in err, err
+
+
+# ====================================================================== lockstep with Python
+
+PLANS = {  # robot -> (language, step ms, steps, device ops); 12*16 = 6*32 = 4*48 = 192 ms
+    "ant": ("c", 16, 12, ["enable", "ir", "16", "enable", "eye", "32"]),
+    "bee": ("py", 32, 6, ["enable", "lidar", "32", "pc", "lidar", "enable", "sonar", "48"]),
+    "cat": ("c", 48, 4, ["enable", "eye", "16", "enable", "front", "64"]),
+}
+
+
+def _run_plans(server: Server, cbin: dict[str, str], languages: dict[str, str]) -> dict[str, list[str]]:
+    procs = {}
+    for robot, (_, duration, steps, ops) in PLANS.items():
+        args = [*ops, "step", str(duration), str(steps)]
+        if languages[robot] == "c":
+            procs[robot] = start([cbin["script"], *args], server.url(robot))
+        else:
+            procs[robot] = start([sys.executable, str(SCRIPT_PY), *args], server.url(robot))
+    server.wait_attached(set(PLANS))
+    assert server.conn.call("set_mode", {"mode": "fast"})["mode"] == "fast"
+    out = {}
+    for robot, p in procs.items():
+        code, lines, err = finish(p)
+        assert code == 0, f"{robot}: {err}"
+        out[robot] = lines
+    return out
+
+
+def test_c_and_python_controllers_step_together_in_lockstep(cbin, servers):
+    mixed = _run_plans(servers(TRIO, "--mode", "pause"), cbin, {r: lang for r, (lang, *_) in PLANS.items()})
+    python = _run_plans(servers(TRIO, "--mode", "pause"), cbin, dict.fromkeys(PLANS, "py"))
+    assert mixed == python
+    for robot, (_, duration, steps, _) in PLANS.items():
+        assert [fields(x)["t"] for x in mixed[robot]] == [str(duration * k) for k in range(1, steps + 1)]
+    assert len({fields(x)["ir"] for x in mixed["ant"]}) == 12                      # noisy: all new values
+    assert fields(mixed["cat"][0])["front"] == NAN_BITS                            # first value due at 64 ms
+
+
+# ====================================================================== liveness
+
+def test_sigkilled_c_controller_releases_its_robot_and_server_quit_ends_steps(cbin, servers):
+    server = servers(TRIO, "--heartbeat-ms", "200")
+    ant = start([cbin["script"], "enable", "ir", "16", "step", "16", "1000000"], server.url("ant"))
+    bee = start([cbin["script"], "enable", "sonar", "32", "step", "32", "1000000"], server.url("bee"))
+    server.wait_attached({"ant", "bee"})
+    before = server.conn.call("get_info")["time_ms"]
+    deadline = time.monotonic() + 30
+    while server.conn.call("get_info")["time_ms"] < before + 320:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    ant.send_signal(signal.SIGKILL)                # mid-run: a step is pending or about to be
+    ant.wait(10)
+    killed_at = server.conn.call("get_info")["time_ms"]
+    deadline = time.monotonic() + 30               # bee goes on once the dead session is dropped (3 x 200 ms)
+    while server.conn.call("get_info")["time_ms"] < killed_at + 100 * 32:
+        assert time.monotonic() < deadline, "the world stopped after the C controller was killed"
+        time.sleep(0.02)
+    deadline = time.monotonic() + 20               # a new C controller takes the robot
+    while True:
+        code, lines, err = finish(start([cbin["script"], "enable", "ir", "16", "step", "16", "3"], server.url("ant")))
+        if code == 0:
+            break
+        assert "ROBOT_TAKEN" in err, err
+        assert time.monotonic() < deadline, "the killed controller's robot was never released"
+        time.sleep(0.1)
+    assert len(lines) == 3 and all(int(fields(x)["t"]) > killed_at for x in lines)
+    assert server.stop() == 0                      # the server quits: bee's loop ends with -1
+    code, lines, err = finish(bee, 30)
+    assert code == 0, err
+    assert fields(lines[-1])["status"] == "-1" and all(fields(x)["status"] == "0" for x in lines[:-1])
+
+
+def test_heartbeat_keeps_a_computing_c_controller_attached(cbin, servers):
+    server = servers(ARENA, "--heartbeat-ms", "100")
+    lines = run([cbin["script"], "enable", "ps0", "32", "step", "32", "1", "sleep", "1500", "step", "32", "2"],
+                server.url("epuck"))
+    assert [fields(x)["t"] for x in lines] == ["32", "64", "96"]
+    assert all(fields(x)["status"] == "0" for x in lines)
+
+
+# ====================================================================== bad input
+
+@pytest.mark.parametrize("url, words", [
+    ("ftp://127.0.0.1/epuck", ["BAD_URL", "unsupported scheme 'ftp'"]),
+    ("tcp://127.0.0.1:99999/epuck", ["BAD_URL", "bad port '99999'"]),
+    ("tcp:///epuck", ["BAD_URL", "no host"]),
+    ("epuck/left", ["BAD_URL", "contains '/'"]),
+])
+def test_bad_urls_give_one_clear_line(cbin, url, words):
+    code, out, err = finish(start([cbin["script"], "step", "32", "1"], url))
+    assert code == 1 and out == []
+    assert len(err.strip().splitlines()) == 1 and all(w in err for w in words), err
+
+
+def test_missing_server_times_out_with_a_message(cbin):
+    t0 = time.monotonic()
+    code, out, err = finish(start([cbin["script"], "step", "32", "1"], "tcp://127.0.0.1:9/epuck",
+                                  SENSORIUM_CONTROLLER_TIMEOUT="1"))
+    assert code == 1 and out == []
+    assert "TIMEOUT" in err and "tcp://127.0.0.1:9" in err and "sensorium serve" in err, err
+    assert time.monotonic() - t0 < 30
+
+
+def test_unknown_robot_and_launcher_errors(cbin, servers, tmp_path):
+    server = servers()
+    code, _, err = finish(start([cbin["script"], "step", "32", "1"], server.url("nobody")))
+    assert code == 1 and "UNKNOWN_ROBOT" in err and "nobody" in err, err
+    code, _, err = finish(start([cbin["script"], "step", "32", "1"], server.rpc))      # two robots, none named
+    assert code == 1 and "add '/ROBOT' to the URL" in err, err
+    blob = tmp_path / "controller"
+    blob.write_bytes(b"\x7fELF\x02\x01\x01\x00" + bytes(64))          # a binary without the execute bit
+    done = subprocess.run([sys.executable, "-m", "sensorium", "controller", str(blob)], capture_output=True, text=True,
+                          env=ENV, cwd=str(REPO), timeout=60)
+    assert done.returncode == 2 and "chmod +x" in done.stderr
+    done = subprocess.run([sys.executable, "-m", "sensorium", "controller", "--url", "ftp://x", cbin["script"]],
+                          capture_output=True, text=True, env=ENV, cwd=str(REPO), timeout=60)
+    assert done.returncode == 2 and "unsupported scheme" in done.stderr
