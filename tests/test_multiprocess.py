@@ -302,9 +302,8 @@ def test_examples_through_the_launcher_with_topics_and_echo(servers, tmp_path):
     server.conn.call("set_mode", {"mode": "fast"})
     assert braitenberg.wait(60) == 0, braitenberg.stderr()
     assert wanderer.wait(60) == 0, wanderer.stderr()
-    readings = [line for line in braitenberg.out if "ls0=" in line]         # plus one line per change of state
-    assert len(readings) == 5 and "wheels" in readings[-1] and "nan" not in readings[0]
-    assert "-> look around" in braitenberg.out[0]
+    assert len(braitenberg.out) == 5 and "ls0=" in braitenberg.out[0] and "wheels" in braitenberg.out[-1]
+    assert "nan" not in braitenberg.out[0]
     decisions = [line for line in wanderer.out if "ahead=" in line]
     assert len(decisions) == 3 and "-> forward" in decisions[0]
     assert echo.wait(30) == 0, echo.stderr()
@@ -385,10 +384,10 @@ def test_examples_drive_their_robots(servers, tmp_path):
     server.conn.call("set_mode", {"mode": "fast"})
     assert braitenberg.wait(120) == 0, braitenberg.stderr()
     assert wanderer.wait(120) == 0, wanderer.stderr()
-    assert len([line for line in braitenberg.out if "ls0=" in line]) == 300    # plus changes of state
+    assert len(braitenberg.out) == 300
     assert len([line for line in wanderer.out if "ahead=" in line]) == 100
     after = {r: server.conn.call(f"/{r}/robot/get_pose") for r in ("epuck", "scout")}
     moved = {r: math.dist(before[r]["translation"][:2], after[r]["translation"][:2]) for r in before}
-    assert moved["epuck"] > 0.1, moved          # 9.6 s: a look around (2.7 s), then toward the light
+    assert moved["epuck"] > 0.1, moved          # ~9.6 s at about half the e-puck's top speed
     assert moved["scout"] > 0.05 or after["scout"]["quaternion"] != before["scout"]["quaternion"], moved
     assert server.stop() == 0

@@ -28,7 +28,7 @@ class DemoController:
 
 
 CONTROLLERS = (
-    DemoController("epuck", "braitenberg.py", "light follower",
+    DemoController("epuck", "light_follower.py", "light follower",
                    {"ls0": "LightSensor", "ls1": "LightSensor", **{f"ps{i}": "DistanceSensor" for i in range(8)}}),
     DemoController("scout", "wanderer.py", "wanderer",
                    {"lidar": "Lidar", **{f"sonar_{s}": "DistanceSensor" for s in ("front", "left", "right", "back")}}),

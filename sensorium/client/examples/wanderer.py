@@ -1,6 +1,6 @@
-"""Obstacle-avoiding wanderer for the scout of worlds/arena.yaml, written as a Webots controller.
+"""Obstacle-avoiding wanderer for the scout of the arena world, written as a Webots controller.
 
-    sensorium serve &
+    sensorium serve arena &
     sensorium controller example:wanderer --robot scout [STEPS]
 
 It keeps exploring: it drives straight, veers away from what is close on its sides, and when the
