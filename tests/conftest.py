@@ -4,7 +4,7 @@ a fast local loop (CI runs everything).
 A test is slow when its module runs servers and controllers as processes (``SLOW_MODULES``), when
 it starts a subprocess itself or through a helper of its module (found in the module's source:
 a function that mentions ``subprocess``/``Popen``, or calls one that does), or when it is listed
-in ``SLOW_TESTS`` (long single-process runs).
+in ``SLOW_TESTS`` (long single-process runs, worker pools).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ SLOW_MODULES = {"test_multiprocess", "test_server", "test_record_live", "test_de
 SLOW_TESTS = {
     "test_simulation.py::test_million_steps_no_clock_drift",
     "test_simulation.py::test_circle_stays_on_circle_for_a_million_steps",
+    "test_sweep.py::test_same_sweep_on_ray_and_on_the_process_pool_gives_identical_results",   # a Ray cluster
 }
 
 

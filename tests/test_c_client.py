@@ -62,22 +62,23 @@ def cbin(tmp_path_factory) -> dict[str, str]:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
         out[name] = str(exe)
-    exe = build / "braitenberg_cpp"                     # the header-only C++ layer
-    cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
-           f"-I{CLIB / 'include'}", str(TESTS_C / "braitenberg_cpp.cpp"), "-o", str(exe), str(build / "libController.a"),
-           *libs]
-    done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    out["braitenberg_cpp"] = str(exe)
+    for name in ("braitenberg_cpp", "supervisor_cpp"):  # the header-only C++ layer
+        exe = build / name
+        cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+               f"-I{CLIB / 'include'}", str(TESTS_C / f"{name}.cpp"), "-o", str(exe), str(build / "libController.a"),
+               *libs]
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        out[name] = str(exe)
     return out
 
 
 class Server:
     """``sensorium serve`` on 127.0.0.1, free ports; ``url(robot)`` is a controller URL."""
 
-    def __init__(self, world: Path, *extra: str):
-        self.p = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", "tcp://127.0.0.1:0",
-                                   "--pub", "tcp://127.0.0.1:0", *extra], stdout=subprocess.PIPE,
+    def __init__(self, world: Path, *extra: str, rpc: str = "tcp://127.0.0.1:0", pub: str = "tcp://127.0.0.1:0"):
+        self.p = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", rpc,
+                                   "--pub", pub, *extra], stdout=subprocess.PIPE,
                                   stderr=subprocess.PIPE, text=True, env=ENV, cwd=str(REPO))
         lines: queue.Queue[str] = queue.Queue()
         threading.Thread(target=lambda: [lines.put(x) for x in self.p.stdout], daemon=True).start()
@@ -119,8 +120,8 @@ class Server:
 def servers():
     started: list[Server] = []
 
-    def start(world: Path = ARENA, *extra: str) -> Server:
-        started.append(Server(world, *extra))
+    def start(world: Path = ARENA, *extra: str, **endpoints: str) -> Server:
+        started.append(Server(world, *extra, **endpoints))
         return started[-1]
 
     yield start
@@ -321,6 +322,9 @@ def test_every_getter_matches_the_python_client(cbin, servers):
         assert got["error.bad_step"] == "-1" and got["robot.step"] == "0"
         assert "step duration must be >= 0 ms" in err and "invalid device tag 9999" in err
         assert float(got["robot.time_after"]) * 1000 == pytest.approx(want["robot.basic_time_step"])
+        begun, again, status, t = got["pipelined"].split(",")          # a second step_begin is refused
+        assert (begun, again, status) == ("0", "-1", "0") and float(t) * 1000 == pytest.approx(2 * want["robot.basic_time_step"])
+        assert got["no_pending"] == "-1" and "a step is already pending" in err and "no step pending" in err
 
 
 def test_braitenberg_with_encoders_matches_python_and_the_wheel_angles(cbin, servers):
@@ -375,6 +379,14 @@ def test_robot_extras_led_keyboard_and_supervisor(cbin, servers):
         assert py.by_name["led0"].desc["value"] == 1
 
 
+def test_supervisor_through_the_cpp_classes(cbin, servers):
+    lines = run([cbin["supervisor_cpp"]], servers(CDEVICES).url("rover"))
+    head = lines[0].split()
+    assert head[0] == "C-rover" and head[1] == "5" and [float(v) for v in head[2:5]] == [0.125, 0.25, 0.0]
+    assert head[5:] == ["1", "left", "wheel", "motor", "1", "2"]
+    assert float(lines[1]) == pytest.approx(6.28 * 0.016, abs=1e-12)   # position control at maxVelocity, one step
+
+
 def test_c_client_replays_the_conformance_session(cbin, servers):
     """sensorium/schemas/conformance/session.json: expected lines computed from the simulation."""
     session = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "session.json").read_text())
@@ -389,7 +401,7 @@ def test_c_codec_replays_the_request_vectors(cbin, servers):
     decoding (tests/c/wire_vectors.c): ids, ok, error codes, result keys and scalar results."""
     import msgpack
 
-    from sensorium.server import conformance
+    from sensorium.server.sim import conformance
 
     vectors = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "requests.json").read_text())
     server = servers(REPO / "sensorium" / "schemas" / "conformance" / vectors["world"])
@@ -503,6 +515,23 @@ def test_sigkilled_c_controller_releases_its_robot_and_server_quit_ends_steps(cb
     assert fields(lines[-1])["status"] == "-1" and all(fields(x)["status"] == "0" for x in lines[:-1])
 
 
+def test_c_controller_ends_its_loop_when_the_server_dies(cbin, servers):
+    """A server SIGKILLed mid-run: the heartbeat notices, wb_robot_step returns -1, no hang."""
+    server = servers(ARENA, "--heartbeat-ms", "200")
+    p = start([cbin["script"], "enable", "ps0", "32", "step", "32", "100000000"], server.url("epuck"))
+    server.wait_attached({"epuck"})
+    deadline = time.monotonic() + 30
+    while server.conn.call("get_info")["time_ms"] < 320:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    server.p.kill()
+    server.p.wait(10)
+    code, lines, err = finish(p, 60)
+    assert code == 0, err
+    assert fields(lines[-1])["status"] == "-1" and all(fields(x)["status"] == "0" for x in lines[:-1])
+    assert "CONNECTION_LOST" in err and "server gone" in err, err
+
+
 def test_heartbeat_keeps_a_computing_c_controller_attached(cbin, servers):
     server = servers(ARENA, "--heartbeat-ms", "100")
     lines = run([cbin["script"], "enable", "ps0", "32", "step", "32", "1", "sleep", "1500", "step", "32", "2"],
@@ -523,6 +552,34 @@ def test_bad_urls_give_one_clear_line(cbin, url, words):
     code, out, err = finish(start([cbin["script"], "step", "32", "1"], url))
     assert code == 1 and out == []
     assert len(err.strip().splitlines()) == 1 and all(w in err for w in words), err
+
+
+def test_url_forms_and_variables(cbin, servers, tmp_path):
+    """WEBOTS_CONTROLLER_URL works alone, SENSORIUM_CONTROLLER_URL wins over it, ipc:// URLs name
+    the robot by their last path component, and a URL without a robot takes the only robot."""
+    server = servers(TRIO, "--mode", "pause", rpc=f"ipc://{tmp_path}/rpc", pub=f"ipc://{tmp_path}/pub")
+    assert server.rpc == f"ipc://{tmp_path}/rpc"
+    env = {k: v for k, v in ENV.items() if k not in ("SENSORIUM_CONTROLLER_URL", "WEBOTS_CONTROLLER_URL")}
+    procs = [
+        subprocess.Popen([cbin["script"], "step", "16", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env={**env, "WEBOTS_CONTROLLER_URL": f"{server.rpc}/ant"}),
+        subprocess.Popen([cbin["script"], "step", "16", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env={**env, "WEBOTS_CONTROLLER_URL": "ftp://ignored", "SENSORIUM_CONTROLLER_URL": f"{server.rpc}/bee"}),
+        subprocess.Popen([cbin["script"], "step", "16", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env={**env, "SENSORIUM_CONTROLLER_URL": f" {server.rpc}/cat\n"}),
+    ]
+    server.wait_attached({"ant", "bee", "cat"})
+    server.conn.call("set_mode", {"mode": "fast"})
+    for p in procs:
+        code, lines, err = finish(p)
+        assert code == 0 and [fields(x)["t"] for x in lines] == ["16", "32"], err
+    only = servers(REPO / "sensorium" / "schemas" / "conformance" / "world.yaml")
+    code, _, err = finish(start([cbin["script"], "step", "16", "1"], only.rpc))       # two robots there: ambiguous
+    assert code == 1 and "add '/ROBOT'" in err
+    single = tmp_path / "single.yaml"
+    single.write_text("world_info: {name: single, basic_time_step: 8}\nrobots:\n  - name: solo\n")
+    code, lines, err = finish(start([cbin["script"], "step", "8", "1"], servers(single).rpc))
+    assert code == 0 and lines == ["8 0"], err
 
 
 def test_missing_server_times_out_with_a_message(cbin):

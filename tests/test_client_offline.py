@@ -455,7 +455,7 @@ def test_controller_classes(global_robot, capsys):
     assert lidar.getLayerRangeImage(1) == expected[COLUMNS:]
     points = lidar.getPointCloud()
     assert len(points) == lidar.getNumberOfPoints() == 8
-    assert isinstance(points[5], controller.LidarPoint) and points[5].layer_id == 1 and points[5].x == 5.0
+    assert isinstance(points[5], controller.LidarPoint) and points[5].layer_id == 1 == points[5].layer and points[5].x == 5.0
     assert len(lidar.getPointCloud(data_type="buffer")) == 8 * 20
     assert [p.x for p in lidar.getLayerPointCloud(1)] == [4.0, 5.0, 6.0, 7.0]
     assert (lidar.getHorizontalResolution(), lidar.getNumberOfLayers(), lidar.getFov()) == (COLUMNS, LAYERS, 1.5)
@@ -522,11 +522,13 @@ def test_motor_commands_are_buffered_and_sent_with_the_step(server, capsys):
             with pytest.raises(SensoriumError) as err:
                 r2.set_motor_velocity(left, bad, "wb_motor_set_velocity")
             assert err.value.code == ErrorCode.INVALID_ARGUMENT and "wb_motor_set_velocity()" in str(err.value)
-        with pytest.raises(SensoriumError, match="NaN"):
-            r2.set_motor_position(left, math.nan, "wb_motor_set_position")
+        capsys.readouterr()
+        before = left.target_position
+        r2.set_motor_position(left, math.nan, "wb_motor_set_position")          # Webots prints and ignores
+        assert "invalid 'position' argument (NaN)" in capsys.readouterr().err
+        assert left.target_position == before and r2.motor_commands == {}
         r2.set_motor_position(left, 1.5, "test")
         # Webots prints and ignores a NaN velocity and a negative one in position control
-        capsys.readouterr()
         r2.set_motor_velocity(left, math.nan, "wb_motor_set_velocity")
         r2.set_motor_velocity(left, -1.0, "wb_motor_set_velocity")
         err_text = capsys.readouterr().err
@@ -806,3 +808,22 @@ def test_heartbeat_thread_stops_on_cleanup(server):
     r1.close()
     assert not hb.is_alive()
     assert not any(t.name == "sensorium-heartbeat" and t.is_alive() for t in threading.enumerate())
+
+
+def test_keyboard_mode_and_supervisor_refusal_offline(global_robot, capsys):
+    controller = _controller_module()
+    robot = controller.Robot()
+    assert robot.getMode() == robot.MODE_SIMULATION == 0 and robot.getSupervisor() is False
+    assert (robot.EVENT_KEYBOARD, robot.EVENT_NO_EVENT, robot.EVENT_QUIT) == (4, 0, -1)
+    kb = robot.getKeyboard()
+    capsys.readouterr()
+    assert kb.getKey() == -1 and "wb_keyboard_enable" in capsys.readouterr().err    # disabled: Webots' message
+    kb.enable(32)
+    assert kb.getSamplingPeriod() == 32 and kb.getKey() == -1 and capsys.readouterr().err == ""
+    assert controller.Keyboard.UP == 315 and controller.Keyboard.CONTROL == 0x20000
+    # a plain robot's controller gets Webots' refusal and NULL answers, without a round trip
+    sup = controller.Supervisor()                       # a second instance: shares the first one's state
+    capsys.readouterr()
+    assert sup.getFromDef("anything") is None and sup.getSelf() is None
+    assert wb.wb_supervisor_node_get_field(1, "translation") is None
+    assert "can only be used in a 'Supervisor' controller" in capsys.readouterr().err

@@ -22,7 +22,7 @@ import pytest
 import zmq
 
 from sensorium.client.connection import Connection, SensoriumError
-from sensorium.server import conformance
+from sensorium.server.sim import conformance
 
 REPO = Path(__file__).resolve().parents[1]
 VECTORS = REPO / "sensorium" / "schemas" / "conformance"

@@ -38,9 +38,10 @@ def test_round_trip_exact_bytes(tmp_path):
 
 
 def test_mcap_layout(tmp_path):
-    """zstd chunks, msgpack channels, ROS type as schema name, log time = publish time = sim time."""
+    """Format 1 (no Foxglove views): zstd chunks, msgpack channels, ROS type as schema name, log
+    time = publish time = sim time."""
     path = tmp_path / "rec.mcap"
-    items = make_recording(path, steps=30)
+    items = make_recording(path, steps=30, foxglove=False)
     with open(path, "rb") as f:
         reader = make_reader(f)
         assert reader.get_header().profile == "x-sensorium"

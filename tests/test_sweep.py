@@ -18,8 +18,6 @@ from sensorium.sweep import SpecError, parse_spec, run_sweep
 from sensorium.sweep.run import build_world, run_one
 from sensorium.sweep.spec import RunSpec, parse_path, set_path
 
-ray = pytest.importorskip("ray")
-
 R, VMAX, AXLE = 0.0205, 6.28, 0.052
 
 
@@ -41,6 +39,8 @@ def room_world(path: Path, noise: float = 0.05) -> Path:
 
 @pytest.fixture(scope="module")
 def local_ray():
+    """One local Ray (2 CPUs, loopback) for the module's Ray tests: starting Ray takes seconds."""
+    ray = pytest.importorskip("ray")
     from sensorium.sweep.engines import init_ray
 
     started = not ray.is_initialized()
@@ -48,6 +48,13 @@ def local_ray():
     yield r
     if started:
         r.shutdown()
+
+
+def test_local_ray_runs_on_loopback_only(local_ray):
+    nodes = local_ray.nodes()
+    assert [n["NodeManagerAddress"] for n in nodes] == ["127.0.0.1"]
+    ctx = local_ray.get_runtime_context()
+    assert ctx.gcs_address.startswith("127.0.0.1:")
 
 
 # ------------------------------------------------------------------------------ specs and paths
@@ -188,6 +195,7 @@ def test_cli_sweep_exit_codes_and_no_silent_overwrite(tmp_path):
 
 
 def test_cli_unreachable_ray_cluster_is_one_line_not_a_hang(tmp_path):
+    pytest.importorskip("ray")
     spec = tmp_path / "spec.yaml"
     spec.write_text("seeds: [0]\nduration_ms: 32\n")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).resolve().parents[1]),
@@ -197,3 +205,29 @@ def test_cli_unreachable_ray_cluster_is_one_line_not_a_hang(tmp_path):
                        timeout=120)
     assert p.returncode == 2
     assert p.stderr.strip().count("\n") == 0 and "cannot join the Ray cluster at '127.0.0.1:1'" in p.stderr
+
+
+@pytest.mark.parametrize("engine", ["local", "ray"])
+def test_a_run_that_kills_its_worker_is_an_error_row_and_the_others_complete(tmp_path, engine, request):
+    if engine == "ray":
+        request.getfixturevalue("local_ray")
+    world = room_world(tmp_path / "room.yaml")
+    ctrl = tmp_path / "killer.py"
+    ctrl.write_text("import os\n"
+                    "def make(sim):\n"
+                    "    if sim.seed == 2:\n"
+                    "        os._exit(3)\n")
+    res = run_sweep({"worlds": [str(world)], "seeds": [0, 1, 2, 3], "duration_ms": 64, "controllers": [f"{ctrl}:make"],
+                     "record": False}, None, engine=engine, workers=2, progress=False)
+    assert [r["status"] for r in res.rows] == ["ok", "ok", "error", "ok"]
+    assert "died" in res.rows[2]["error"] or "Crashed" in res.rows[2]["error"] or "exit" in res.rows[2]["error"]
+
+
+def test_without_ray_auto_uses_the_process_pool_and_ray_is_a_clear_error(tmp_path, monkeypatch):
+    import sensorium.sweep as sweep
+
+    monkeypatch.setattr(sweep, "available", lambda engine: engine != "ray")
+    spec = {"worlds": [str(room_world(tmp_path / "room.yaml"))], "seeds": [0], "duration_ms": 32, "record": False}
+    assert run_sweep(spec, None, engine="auto", workers=1, progress=False).engine == "local"
+    with pytest.raises(SpecError, match=r"needs Ray: pip install 'sensorium\[ray\]'"):
+        run_sweep(spec, None, engine="ray", progress=False)

@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import select
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +21,7 @@ from sensorium.server.world.loader import WorldError, load_world, parse_world
 from sensorium.server.world.wbt.parser import MAX_DEPTH
 
 HERE = Path(__file__).parent / "worlds" / "wbt"
+ROOT = Path(__file__).resolve().parents[1]
 HEADER = "#VRML_SIM R2023b utf8\n"
 
 
@@ -266,3 +273,266 @@ def test_nested_solid_children_compose_and_move_together() -> None:
     sim.set_solid_pose("base", [1.5, 0.0, 0.0])
     sim.step()
     assert d.value == pytest.approx(1000 * 1.4, abs=1e-9)
+
+
+def test_builtin_protos(tmp_path: Path) -> None:
+    p = write(tmp_path, 'WorldInfo { }\nTexturedBackgroundLight { texture "noon_sunny_empty" luminosity 2 }\n'
+                        'SolidBox { }\nWoodenBox { translation 1 0 0.1 size 0.2 5 0.2 }\nRobot { }\nRobot { }\n')
+    w = load_world(p).world
+    (sun,) = w.lights
+    # the PROTO's NUE direction (0.9, -0.59, 0.28) in ENU axes; ambient 1; luminosity scales the intensity
+    assert (sun.type, sun.direction, sun.intensity, sun.ambient_intensity) == ("DirectionalLight", (0.28, 0.9, -0.59), 2.0, 1.0)
+    box, wooden = w.solids
+    assert box.name == "box" and box.pose.translation == (0.0, 0.0, 1.0)
+    assert box.shapes[0].geometry == wm.Box(type="box", size=(2.0, 2.0, 2.0)) and box.shapes[0].seen_by == "both"
+    assert box.shapes[0].appearance.roughness == 0.5
+    assert wooden.name == "wooden box" and wooden.shapes[0].geometry.size == (0.2, 3.0, 0.2)   # clamped like the PROTO
+    assert [r.name for r in w.robots] == ["robot", "robot(1)"]
+
+
+@contextlib.contextmanager
+def serving(world: Path, *extra: str):
+    """``sensorium serve WORLD`` in a subprocess on free loopback ports; yields its RPC endpoint."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", "tcp://127.0.0.1:0",
+                             "--pub", "tcp://127.0.0.1:*", "--precision", "fast", *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+    try:
+        rpc = None
+        deadline = time.monotonic() + 60
+        while rpc is None and time.monotonic() < deadline and proc.poll() is None:
+            if select.select([proc.stdout], [], [], 0.2)[0]:
+                line = proc.stdout.readline()
+                if line.startswith("sensorium: serving world"):
+                    rpc = dict(f.split("=", 1) for f in line.split() if "=" in f)["rpc"]
+        assert rpc is not None, "server did not start"
+        yield rpc
+    finally:
+        proc.terminate()
+        proc.wait(30)
+        proc.stdout.close()
+
+
+def test_serve_a_wbt_world(tmp_path: Path) -> None:
+    import msgpack
+    import zmq
+
+    from sensorium.server.recording.reader import Recording
+
+    ctx = zmq.Context()
+    try:
+        with serving(HERE / "full.wbt", "--record", str(tmp_path / "run.mcap")) as rpc:
+            sock = ctx.socket(zmq.DEALER)
+            sock.setsockopt(zmq.LINGER, 0)
+            sock.connect(rpc)
+            sock.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": "bot"}}))
+            assert sock.poll(30_000)
+            reply = msgpack.unpackb(sock.recv_multipart()[-1], raw=False)
+            assert reply["ok"], reply
+            assert {"ir", "sonar", "lidar", "ls", "led0", "left wheel sensor"} <= {d["name"] for d in reply["result"]["devices"]}
+            sock.close(0)
+    finally:
+        ctx.destroy(linger=0)
+    with Recording(tmp_path / "run.mcap") as rec:   # the world attached as the user wrote it
+        assert rec.world() == ("full.wbt", (HERE / "full.wbt").read_bytes())
+
+
+def test_example_wbt_world_runs_the_braitenberg_controller() -> None:
+    """The shipped Webots-style world and the example Webots controller, unchanged."""
+    world = ROOT / "sensorium" / "worlds" / "epuck.wbt"
+    loaded = load_world(world)
+    assert [w for w in loaded.warnings if "skipped nodes" not in w] == []
+    assert loaded.world.robots[0].differential_drive is not None
+    script = ROOT / "sensorium" / "client" / "examples" / "braitenberg.py"
+    with serving(world) as rpc:
+        out = subprocess.run([sys.executable, "-m", "sensorium", "controller", str(script), "--robot", "epuck",
+                              "--url", f"{rpc}/epuck", "60"], capture_output=True, text=True, timeout=300,
+                             env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert out.returncode == 0, out.stderr
+    lines = [x for x in out.stdout.splitlines() if x.startswith("t=")]
+    assert len(lines) == 60
+    light = [float(x.split("ls0=")[1].split()[0]) for x in lines]
+    assert all(v > 0 for v in light[1:]) and len(set(light)) > 5   # it sees the lamp, and it moves
+
+
+def test_def_use_expansion_is_bounded(tmp_path: Path, monkeypatch) -> None:
+    """Each level USEs the previous one twice: 2**25 boxes if expanded; the converter stops early."""
+    from sensorium.server.world.wbt import convert
+
+    monkeypatch.setattr(convert, "MAX_PARTS", 2000)
+    levels = ["DEF L0 Group { children [ Shape { geometry Box { } } ] }"]
+    levels += [f"DEF L{i} Group {{ children [ USE L{i - 1} USE L{i - 1} ] }}" for i in range(1, 26)]
+    p = write(tmp_path, "Solid { children [\n" + "\n".join(levels) + "\n] }\n")
+    with pytest.raises(WorldError, match="more than 2000 shapes, devices and lights after DEF/USE expansion"):
+        load_world(p)
+
+
+def test_contact_with_multi_shape_bodies() -> None:
+    """A robot whose body is an offset cylinder (radius 0.05) drives +x into a solid made of two
+    shapes; it stops where its disc touches the wall's face: x = 0.95 - 0.05."""
+    w = parse_world({
+        "solids": [{"name": "wall", "pose": {"translation": [1.0, 0.0, 0.0]},
+                    "shapes": [{"pose": {"translation": [0.0, 0.0, 0.1]}, "geometry": {"type": "box", "size": [0.1, 2.0, 0.2]}},
+                               {"pose": {"translation": [0.0, 3.0, 0.1]}, "geometry": {"type": "sphere", "radius": 0.1}}]}],
+        "robots": [{"name": "r", "shapes": [{"pose": {"translation": [0.0, 0.0, 0.05]},
+                                             "geometry": {"type": "cylinder", "radius": 0.05, "height": 0.1}}],
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.1, "max_wheel_speed": 10}}],
+    }).world
+    sim = Simulation(w)
+    r = sim.robot("r")
+    for m in r.motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(10.0)
+    sim.run(100)   # 0.5 m/s for 3.2 s: far past the wall without contact
+    assert r.pose.translation[0] == pytest.approx(0.9, abs=1e-9)
+    assert r.pose.translation[0] < 0.9
+
+
+def test_robot_inside_groups_gets_the_composed_pose(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Pose { translation 1 0 0 rotation 0 0 1 1.5707963267948966 children [\n'
+                        '  Group { children [ Robot { translation 0 2 0 rotation 0 0 1 1.5707963267948966 name "r" } ] } ] }\n'
+                        'Solid { children [ Robot { name "inner" } ] }\n')
+    w = load_world(p)
+    (r,) = w.world.robots
+    from sensorium.server.world.poses import pose_from_model
+
+    pose = pose_from_model(r.pose)
+    assert pose.translation == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)      # (0, 2) turned a quarter, plus (1, 0)
+    assert pose.rotation[:, 0] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)   # two quarter turns: facing -x
+    assert f"{p}:4:20: a Robot inside a Solid or another Robot is not supported: skipped" in w.warnings
+
+
+def test_unsimulated_devices_keep_their_shapes(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" children [ Camera { translation 0.1 0 0 children [\n'
+                        '  Shape { geometry Box { size 0.01 0.02 0.03 } } ] } GPS { } ] }\n')
+    w = load_world(p)
+    (part,) = w.world.robots[0].shapes
+    assert part.geometry == wm.Box(type="box", size=(0.01, 0.02, 0.03)) and part.pose.translation == (0.1, 0.0, 0.0)
+    assert part.seen_by == "visual"
+    assert f"{p}: skipped nodes that do not matter to these sensors: Camera, GPS" in w.warnings
+
+
+def test_named_controllers_become_extern(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" controller "e-puck_avoid_collision" }\n')
+    w = load_world(p)
+    assert w.world.robots[0].name == "r"
+    assert (f"{p}:2:1: Robot 'r': controller 'e-puck_avoid_collision' is not started here; run it with "
+            "`sensorium controller` (the robot is an <extern> robot)") in w.warnings
+    if "controller" in wm.Robot.model_fields:
+        assert w.world.robots[0].controller == "<extern>"
+
+
+def test_mesh_and_scale_problems_point_at_lines(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.dae" ] } }\n  ]\n}\n')
+    (tmp_path / "robot.dae").write_text("<COLLADA/>")
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value).startswith(f"{p}: line 4, column 22 (Mesh, converted as solids[0].shapes[0].geometry.url): "
+                                     "unsupported mesh format '.dae'")
+    p = write(tmp_path, 'Transform {\n  scale 1 2 1\n  children [ Shape { geometry Box { } } ]\n}\n')
+    with pytest.raises(WorldError) as exc:
+        load_world(p)
+    assert str(exc.value) == f"{p}: line 3, column 3: Transform.scale: only a uniform positive scale is supported, got 1.0 2.0 1.0"
+
+
+def test_scaled_transform_scales_geometry(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid { name "s" children [ Transform { translation 0 0 1 scale 2 2 2 children [\n'
+                        '  Pose { translation 0.5 0 0 children [ Shape { geometry Cylinder { radius 0.1 height 0.3 } } ] } ] } ] }\n')
+    (part,) = load_world(p).world.solids[0].shapes
+    assert part.pose.translation == (1.0, 0.0, 1.0)     # the child's offset is scaled too
+    assert (part.geometry.radius, part.geometry.height) == (0.2, 0.6)
+
+
+def test_field_typos_are_reported(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Solid {\n  translaton 1 0 0\n  rotationStep 0.1\n  children [ Shape { geometry Box { sise 1 1 1 } '
+                        'appearance PBRAppearance { basecolor 1 0 0 } } ]\n}\n')
+    w = load_world(p)
+    typos = [x for x in w.warnings if "did you mean" in x]
+    assert typos == [f"{p}:3:3: Solid.translaton: not a Solid field, ignored (did you mean translation?)",
+                     f"{p}:5:37: Box.sise: not a Box field, ignored (did you mean size?)",
+                     f"{p}:5:77: PBRAppearance.basecolor: not a PBRAppearance field, ignored (did you mean baseColor?)"]
+
+
+def test_supervisor_finds_nodes_by_def_name() -> None:
+    from sensorium.server.daemon.supervisor import find_node
+
+    sim = Simulation(load_world(ROOT / "sensorium" / "worlds" / "epuck.wbt"))
+    assert find_node(sim, "EPUCK").name == "epuck" and find_node(sim, "EPUCK").type == "Robot"
+    assert find_node(sim, "LAMP").name == "lamp" and find_node(sim, "LAMP").type == "Solid"
+    assert find_node(sim, "epuck").name == "epuck"      # a name still works
+    assert find_node(sim, "NOPE") is None
+
+
+def test_duplicate_def_names_rejected_in_world_files() -> None:
+    with pytest.raises(WorldError, match=r"solids\[0\].def_name: duplicate DEF name 'A' \(first used at robots\[0\].def_name\)"):
+        parse_world({"robots": [{"name": "r", "def_name": "A"}],
+                     "solids": [{"name": "s", "def_name": "A", "geometry": {"type": "box"}}]})
+
+
+def test_drive_from_wheel_end_points_when_anchors_coincide(tmp_path: Path) -> None:
+    """As in Webots' e-puck: both hinge anchors at the axle's centre, the wheels placed by their end points."""
+    wheel = ('HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 0 0.02 }} '
+             'device [ RotationalMotor {{ name "{0} wheel motor" maxVelocity 6.28 }} ] endPoint Solid {{ translation 0 {1} 0.02 '
+             'boundingObject Transform {{ rotation 1 0 0 1.570796 children [ Cylinder {{ height 0.005 radius 0.02 }} ] }} }} }}\n')
+    p = write(tmp_path, 'Robot { name "e" children [\n' + wheel.format("left", 0.026) + wheel.format("right", -0.026) + "] }\n")
+    dd = load_world(p).world.robots[0].differential_drive
+    assert dd == wm.DifferentialDrive(wheel_radius=0.02, axle_length=0.052, max_wheel_speed=6.28)
+
+
+def test_textures_summarised_once(tmp_path: Path) -> None:
+    shape = ('Shape { appearance PBRAppearance { baseColor 0.5 0.2 0.2 baseColorMap ImageTexture { url [ "a.png" ] } } '
+             'geometry Box { } }')
+    p = write(tmp_path, f"Solid {{ name \"a\" children [ {shape} ] }}\nSolid {{ name \"b\" children [ {shape} ] }}\n")
+    w = load_world(p)
+    assert w.world.solids[0].shapes[0].appearance.base_color == (0.5, 0.2, 0.2)
+    notes = [x for x in w.warnings if "textures are not sampled" in x]
+    assert notes == [f"{p}:2:48: textures are not sampled (2 appearances): a PBRAppearance reads as its baseColor, "
+                     "a textured Appearance as white"]
+
+
+def test_mangled_worlds_fail_cleanly(tmp_path: Path) -> None:
+    """Cut, garbled and truncated copies of full.wbt: each loads or raises WorldError, nothing else."""
+    import random
+
+    src = (HERE / "full.wbt").read_text()
+    rng = random.Random(11)
+    junk = ["{", "}", "[", "]", '"', "USE OB", "DEF X", "NULL", "TRUE", "-1", "1e400", "0", "Solid {", "Robot {",
+            "#", "\n", ",", "HingeJoint {", "E-puck {}", "size", "Box {}", "'"]
+    p = tmp_path / "m.wbt"
+    outcomes = set()
+    for _ in range(150):
+        s = src
+        for _ in range(rng.randint(1, 3)):
+            k = rng.randrange(len(s)) if s else 0
+            op = rng.random()
+            s = s[:k] + s[k + rng.randint(1, 20):] if op < 0.35 else s[:k] + f" {rng.choice(junk)} " + s[k:] if op < 0.8 else s[:k]
+        p.write_text(s)
+        try:
+            load_world(p)
+            outcomes.add("ok")
+        except WorldError as exc:
+            assert str(exc).startswith(f"{p}: ") and "\n" not in str(exc).split(": ", 1)[0]
+            outcomes.add("error")
+    assert outcomes == {"ok", "error"}
+
+
+def test_repeated_device_names_get_a_suffix(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" children [ DistanceSensor { } DistanceSensor { translation 0 0 0.1 }\n'
+                        '  LightSensor { name "distance sensor(1)" } ] }\n')
+    w = load_world(p)
+    # the third name was taken by the rename of the second: it moves on in turn
+    assert [d.name for d in w.world.robots[0].devices] == ["distance sensor", "distance sensor(1)", "distance sensor(1)(1)"]
+    assert f"{p}:2:48: device name 'distance sensor' used before in robot 'r': renamed 'distance sensor(1)'" in w.warnings
+
+
+def test_def_use_walk_is_bounded_without_shapes(tmp_path: Path, monkeypatch) -> None:
+    from sensorium.server.world.wbt import convert
+
+    monkeypatch.setattr(convert, "MAX_VISITS", 5000)
+    levels = ["DEF L0 Group { }"] + [f"DEF L{i} Group {{ children [ USE L{i - 1} USE L{i - 1} ] }}" for i in range(1, 40)]
+    with pytest.raises(WorldError, match="more than 5000 nodes to walk after DEF/USE expansion"):
+        load_world(write(tmp_path, "\n".join(levels) + "\n"))
+    # the same inside a boundingObject (walked by another path)
+    bomb = "Solid { boundingObject Group { children [\n" + "\n".join(levels) + "\n] } }\n"
+    with pytest.raises(WorldError, match="more than 5000 nodes to walk"):
+        load_world(write(tmp_path, bomb))

@@ -164,6 +164,8 @@ def _replay_args(p: argparse.ArgumentParser) -> None:
                    help="publish only when a client calls /replay/step {duration} (see PROTOCOL.md, Replay)")
     p.add_argument("--pub", default="tcp://127.0.0.1:5561", help="topic endpoint to bind (default tcp://127.0.0.1:5561)")
     p.add_argument("--rpc", default="tcp://127.0.0.1:5560", help="service endpoint to bind (default tcp://127.0.0.1:5560)")
+    p.add_argument("--foxglove", metavar="[HOST:]PORT",
+                   help="also serve the replay to Foxglove (WebSocket) on PORT, host 127.0.0.1 unless given")
     p.add_argument("--wait", action="store_true", help="wait for a first subscriber before starting")
     p.add_argument("--delay", type=_seconds, default=0.0, metavar="S", help="wait S seconds before starting (and between loops)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
@@ -183,6 +185,8 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--format", choices=["bag", "mcap"], help="bag: rosbag2 directory (rosbags); mcap: one file "
                    "(mcap-ros2-support); default from OUT's suffix")
     p.add_argument("--pointcloud2", action="store_true", help="export PointCloud as PointCloud2 (x, y, z, layer)")
+    p.add_argument("--no-views", action="store_true",
+                   help="only the recorded topics (no /tf_static, /tf and /scene from the recorded world)")
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="export only these topics")
     p.add_argument("--start", type=_seconds, metavar="S", help="from S seconds of simulation time")
     p.add_argument("--end", type=_seconds, metavar="E", help="up to E seconds of simulation time")
@@ -196,6 +200,14 @@ def _serve_args(p: argparse.ArgumentParser) -> None:
     from sensorium.cli.serve import add_arguments
 
     add_arguments(p)
+
+
+@command("layout", "write a Foxglove layout (3D, plots, image, raw messages) for a recording or world file",
+         "sensorium.cli.viewer:layout_cmd")
+def _layout_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("source", nargs="?", help="a recording (.mcap) or a world file (default: the embedded arena world)")
+    p.add_argument("-o", "--out", metavar="FILE.json", help="write here instead of standard output")
+    p.add_argument("--force", action="store_true", help="replace FILE.json if it exists")
 
 
 @command("schemas", "write the JSON Schemas of world files, topic messages and services",

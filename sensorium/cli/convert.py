@@ -41,8 +41,12 @@ def convert(args: argparse.Namespace) -> int:
         sys.stdout.write(text)
         return 0
     tmp = out.with_name(out.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, out)
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, out)
+    except OSError as exc:
+        print(f"{out}: cannot write: {exc.strerror or exc}", file=sys.stderr)
+        return 1
     print(f"{out}: written ({len(data.get('solids', []))} solids, {len(data.get('lights', []))} lights, "
           f"{len(data.get('robots', []))} robots)")
     outside = sorted({u for u in _mesh_urls(data) if Path(u).is_absolute() or u.startswith("..")})

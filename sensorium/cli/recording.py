@@ -84,12 +84,27 @@ def replay_cmd(args: argparse.Namespace) -> int:
         print(f"sensorium replay: {exc.strerror + ': ' + str(exc.filename) if isinstance(exc, OSError) and exc.strerror else exc}",
               file=sys.stderr)
         return 1
+    viewer = None
     try:
         try:
             r.bind()
         except zmq.ZMQError as exc:
             print(f"sensorium replay: cannot bind: {exc}", file=sys.stderr)
             return 1
+        viewer = None
+        if getattr(args, "foxglove", None):
+            from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, exposure_warning, parse_address
+            try:
+                host, port = parse_address(args.foxglove)
+                if exposure_warning(host):
+                    print(f"sensorium replay: warning: {exposure_warning(host)}", file=sys.stderr)
+                viewer = FoxgloveBridge.for_replay(r, host, port)
+            except ViewerError as exc:
+                print(f"sensorium replay: {exc}", file=sys.stderr)
+                return 1
+            print(f"sensorium: Foxglove viewer at {viewer.url}", flush=True)
+            if viewer.app_url():
+                print(f"sensorium: Foxglove web app: {viewer.app_url()}", file=sys.stderr, flush=True)
         print(r.announce(), flush=True)
         if r.recording.truncated:
             print("sensorium: warning: the recording is truncated; replaying up to its last complete chunk",
@@ -102,6 +117,9 @@ def replay_cmd(args: argparse.Namespace) -> int:
         print(f"sensorium: replay finished: {r.emitted} messages", file=sys.stderr, flush=True)
         return 0
     finally:
+        if viewer is not None:
+            viewer.close()
+            print(f"sensorium: {viewer.report()}", file=sys.stderr, flush=True)
         r.close()
 
 
@@ -126,6 +144,7 @@ def export_cmd(args: argparse.Namespace) -> int:
     try:
         report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
                              pointcloud2=args.pointcloud2, topics=args.topics or None,
+                             views=not getattr(args, "no_views", False),
                              start_ns=None if args.start is None else int(round(args.start * 1e9)),
                              end_ns=None if args.end is None else int(round(args.end * 1e9)),
                              progress=advance)
@@ -183,6 +202,8 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
         world = meta.get("world") or meta.get("world_file") or "-"
         lines.append(("World", f"{world}   seed {meta.get('seed', '-')}   time step "
                                f"{meta.get('basic_time_step_ms', '-')} ms   sensorium {meta.get('version', '-')}"))
+        lines.append(("Foxglove", "ready (ROS 2 CDR views, /tf, /scene; bodies kept byte for byte)"
+                      if meta.get("format") == "2" else "no (msgpack only: export with sensorium export --ros2)"))
     if session.get("started_at"):
         lines.append(("Recorded", session["started_at"]))
     for a in s["attachments"]:

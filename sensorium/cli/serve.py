@@ -41,11 +41,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--precision", choices=["fast", "exact"], default="exact", help="ray engine precision")
     p.add_argument("--heartbeat-ms", type=int, default=1000, metavar="N",
                    help="controllers not heard from for 3*N ms are released (default 1000)")
+    p.add_argument("--no-contact", action="store_true",
+                   help="robots drive through solids and each other (overrides world_info.contact)")
     p.add_argument("--until", type=int, metavar="MS",
                    help="quit when the simulated time reaches MS milliseconds (pending steps get -1)")
     p.add_argument("--record", metavar="FILE.mcap",
                    help="record the published messages from inside the step loop (nothing dropped)")
     p.add_argument("--force", action="store_true", help="with --record: overwrite FILE if it exists")
+    p.add_argument("--record-format", choices=["foxglove", "msgpack"], default="foxglove",
+                   help="with --record: foxglove (default; opens in Foxglove, the published bytes kept losslessly "
+                   "beside ROS 2 CDR views, /tf and /scene) or msgpack (the published bytes only: ~2.4x smaller)")
+    p.add_argument("--foxglove", metavar="[HOST:]PORT",
+                   help="also serve the topics, transforms and the world to Foxglove (WebSocket) on PORT, "
+                   "host 127.0.0.1 unless given; port 0 picks a free port")
     add_world_options(p)
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
@@ -59,7 +67,8 @@ def options(args: argparse.Namespace):
     return ServeOptions(rpc=args.rpc, pub=args.pub, mode=args.mode, precision=args.precision,
                         heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None),
                         allow_large=getattr(args, "allow_large", False),
-                        allow_outside_meshes=getattr(args, "allow_outside_meshes", False))
+                        allow_outside_meshes=getattr(args, "allow_outside_meshes", False),
+                        contact=False if getattr(args, "no_contact", False) else None)
 
 
 def bind_problem(exc: BaseException) -> str:
@@ -100,15 +109,37 @@ def main(args: argparse.Namespace) -> int:
     if getattr(args, "record", None):
         from sensorium.server.recording.writer import recorder_for_server
         try:
-            server.attach_recorder(recorder_for_server(args.record, server.core, getattr(args, "topics", None)))
+            want_views = getattr(args, "record_format", "foxglove") == "foxglove"
+            server.attach_recorder(recorder_for_server(args.record, server.core, getattr(args, "topics", None),
+                                                       foxglove=want_views))
+            if want_views and server.recorder.foxglove_unavailable:
+                print(f"sensorium serve: recording without Foxglove views: {server.recorder.foxglove_unavailable}",
+                      file=sys.stderr)
         except OSError as exc:
             server.close()
             print(f"sensorium serve: cannot record: {exc}", file=sys.stderr)
             return 1
-    print(server.ready_line, flush=True)
+    viewer = None
+    if getattr(args, "foxglove", None):
+        from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, exposure_warning, parse_address
+        try:
+            host, port = parse_address(args.foxglove)
+            if exposure_warning(host):
+                print(f"sensorium serve: warning: {exposure_warning(host)}", file=sys.stderr)
+            viewer = FoxgloveBridge.for_core(server.core, server.transport, host, port)
+        except ViewerError as exc:
+            server.close()
+            print(f"sensorium serve: {exc}", file=sys.stderr)
+            return 1
+    print(server.ready_line + (f" foxglove={viewer.url}" if viewer is not None else ""), flush=True)
+    if viewer is not None and viewer.app_url():
+        print(f"sensorium: Foxglove web app: {viewer.app_url()}", file=sys.stderr, flush=True)
     try:
         server.run()
     finally:
+        if viewer is not None:
+            viewer.close()
+            print(f"sensorium: {viewer.report()}", file=sys.stderr, flush=True)
         if server.recorder is not None:
             print(f"sensorium: recorded {server.recorder.message_count} messages to {args.record}",
                   file=sys.stderr, flush=True)

@@ -110,7 +110,8 @@ def probe(args: argparse.Namespace) -> int:
     try:
         for spec in args.enable:
             target, period = _parse_enable(spec)
-            devices = sim.all_devices() if target == "all" else [sim.device(target)]
+            devices = ([d for d in sim.all_devices() if d.kind != "LED"]      # all sensors: an LED measures nothing
+                       if target == "all" else [sim.device(target)])
             for dev in devices:
                 dev.enable(period)
                 enabled.append(dev)

@@ -16,9 +16,9 @@ libController they are buffered and travel with the next step request (PROTOCOL.
 the motor getters answer from the client's copy.
 
 Differences from Webots' C library, all on error paths: an invalid tag, a negative sampling
-period, an out-of-range layer or frequency or a NaN target position raise :class:`SensoriumError`
-instead of printing and carrying on (a NaN velocity, a negative velocity in position control and
-an out-of-range LED value are printed and ignored, as Webots does); reads of a disabled
+period, an out-of-range layer or frequency raise :class:`SensoriumError` instead of printing and
+carrying on (a NaN position or velocity, a negative velocity in position control and an
+out-of-range LED value are printed and ignored, as Webots does); reads of a disabled
 device print Webots' message to stderr once per disable. A velocity above ``maxVelocity`` is
 clamped here with Webots' warning (Webots clamps in the simulator).
 The functions live in ``wb_robot`` (session, robot, keyboard), ``wb_sensors``, ``wb_motor`` (motors,

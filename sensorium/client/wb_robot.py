@@ -330,18 +330,15 @@ class RobotClient:
         dev._consts["frequency"] = float(frequency)
 
     # -- motors: buffered, sent with the next step request
-    @staticmethod
-    def _number(value: Any, what: str, func: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): '{what}' must be a number, got {value!r}")
-        value = float(value)
-        if math.isnan(value):
-            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}() called with an invalid '{what}' argument (NaN)")
-        return value
-
     def set_motor_position(self, dev: DeviceState, position: float, func: str) -> None:
-        """Webots' ``setPosition``: a target (rad), or ±inf for velocity control."""
-        position = self._number(position, "position", func)
+        """Webots' ``setPosition``: a target (rad), or ±inf for velocity control; NaN is printed
+        and ignored (Webots)."""
+        if isinstance(position, bool) or not isinstance(position, (int, float)):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'position' must be a number, got {position!r}")
+        position = float(position)
+        if math.isnan(position):
+            print(f"Error: {func}() called with an invalid 'position' argument (NaN).", file=sys.stderr)
+            return
         dev.target_position = position
         self.motor_commands.setdefault(dev.name, {})["position"] = position
 

@@ -150,6 +150,7 @@ def wb_supervisor_simulation_reset() -> None:
             if dev.kind == "LED":
                 dev.value = 0
         r.motor_commands.clear()
+        r.custom_data = str(_call(r, "get_custom_data")["value"])     # a field of the robot: reset too
 
 
 def wb_supervisor_simulation_set_mode(mode: int) -> None:

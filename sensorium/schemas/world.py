@@ -232,6 +232,7 @@ class Solid(Strict):
     """
 
     name: str = Field(min_length=1)
+    def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
     pose: Pose = Pose()
     geometry: Geometry | None = None
     appearance: Appearance | None = None
@@ -353,6 +354,7 @@ class DifferentialDrive(Strict):
 
 class Robot(Strict):
     name: str = Field(min_length=1)
+    def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
     pose: Pose = Pose()
     controller: Literal["<extern>", "<none>"] = Field(
         default="<extern>",
@@ -366,7 +368,8 @@ class Robot(Strict):
     self_collision: bool = False
     body: Shape | None = None
     shapes: list[Part] = Field(default=[], description="further body shapes, each with its pose in the robot frame")
-    lights: list[Light] = Field(default=[], description="lights carried by the robot (location/direction in its frame)")
+    lights: list[Light] = Field(
+        default=[], description="lights carried by the robot (location and a SpotLight's direction in its frame)")
     differential_drive: DifferentialDrive | None = None
     devices: list[Device] = []
 

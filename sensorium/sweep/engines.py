@@ -2,8 +2,8 @@
 same :func:`sensorium.sweep.run.run_one` and yield ``(index, row)`` as runs finish; the caller
 orders the rows. No scheduling of our own: Ray (or the pool) places the tasks.
 
-Ray on one machine is started bound to loopback (``_node_ip_address="127.0.0.1"``, no dashboard,
-``num_cpus`` = the workers asked for, default all CPUs). With ``address`` the sweep joins an
+Ray on one machine is started bound to loopback (single-machine mode, see :func:`_loopback_only`;
+no dashboard; ``num_cpus`` = the workers asked for, default all CPUs). With ``address`` the sweep joins an
 existing cluster instead (``"auto"``, ``"ray://head:10001"`` or ``"head:6379"``); an already
 initialised Ray in the calling process is reused as is.
 """
@@ -69,27 +69,51 @@ def shutdown_pools() -> None:
         pool.shutdown(wait=True, cancel_futures=True)
 
 
+def _fresh_pool(workers: int) -> ProcessPoolExecutor:
+    old = _POOLS.pop(workers, None)
+    if old is not None:
+        old.shutdown(wait=False, cancel_futures=True)
+    return _pool(workers)
+
+
 def local_pool(runs: Sequence[RunSpec], workers: int | None = None) -> Iterator[tuple[int, dict]]:
-    """Runs on a pool of ``workers`` spawned processes (nothing inherited but the runs)."""
+    """Runs on a pool of ``workers`` spawned processes (nothing inherited but the runs).
+
+    A worker that dies (a controller calling ``os._exit``, a segfault, the OOM killer) breaks a
+    ``ProcessPoolExecutor`` for every run in flight: those runs are then retried one at a time in
+    a fresh pool, so only the run that kills its worker gets an error row."""
     workers = max(1, workers or default_workers())
     pool = _pool(workers)
     try:
         pending = {pool.submit(run_one, r): r for r in runs}
     except BrokenProcessPool:
-        _POOLS.pop(workers, None)
-        pool = _pool(workers)
+        pool = _fresh_pool(workers)
         pending = {pool.submit(run_one, r): r for r in runs}
+    suspects: list[RunSpec] = []
     try:
         while pending:
             done, _ = wait(pending, return_when=FIRST_COMPLETED)
             for fut in done:
                 run = pending.pop(fut)
                 try:
-                    yield run.index, fut.result()
-                except Exception as exc:   # a crashed worker (e.g. killed): that run's row says so
-                    if isinstance(exc, BrokenProcessPool):
-                        _POOLS.pop(workers, None)
-                    yield run.index, _failed(run, exc)
+                    row = fut.result()
+                except BrokenProcessPool:
+                    suspects.append(run)
+                    continue
+                except Exception as exc:   # e.g. the row could not be sent back
+                    row = _failed(run, exc)
+                yield run.index, row
+        if suspects:
+            pool = _fresh_pool(workers)
+        for run in sorted(suspects, key=lambda r: r.index):
+            try:
+                row = pool.submit(run_one, run).result()
+            except BrokenProcessPool:
+                row = _failed(run, RuntimeError("the worker process died during this run"))
+                pool = _fresh_pool(workers)
+            except Exception as exc:
+                row = _failed(run, exc)
+            yield run.index, row
     finally:
         for fut in pending:
             fut.cancel()
@@ -119,11 +143,29 @@ def init_ray(address: str | None = None, workers: int | None = None, **kwargs: A
         _reachable(address)
         ray.init(address=address, log_to_driver=False, **kwargs)
     else:
+        _loopback_only(ray)
         opts: dict[str, Any] = dict(num_cpus=workers or default_workers(), include_dashboard=False,
                                     _node_ip_address="127.0.0.1", log_to_driver=False, configure_logging=False)
         opts.update(kwargs)
         ray.init(**opts)
     return ray
+
+
+LOOPBACK_ENV = "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"
+
+
+def _loopback_only(ray) -> None:
+    """Make a Ray started here a single-machine Ray on 127.0.0.1.
+
+    Ray (2.60) replaces a loopback ``_node_ip_address`` by the host's network address, and its GCS,
+    raylet and workers then listen there. Its single-machine mode (``RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0``,
+    the default on macOS and Windows) keeps the node address, and every listener, on loopback. Set
+    for this process and the Ray processes it starts, unless the user chose a value."""
+    if os.environ.get(LOOPBACK_ENV) is None:
+        os.environ[LOOPBACK_ENV] = "0"
+        constants = getattr(getattr(ray, "_private", None), "ray_constants", None)
+        if constants is not None and hasattr(constants, "ENABLE_RAY_CLUSTER"):
+            constants.ENABLE_RAY_CLUSTER = False      # read at import: ray may be imported already
 
 
 def ray_tasks(runs: Sequence[RunSpec], workers: int | None = None, address: str | None = None,

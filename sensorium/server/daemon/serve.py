@@ -31,6 +31,7 @@ class ServeOptions:
     precision: str = "exact"          # ray engine precision: fast | exact
     heartbeat_ms: int = 1000          # controllers not heard from for 3 × this are released
     until: int | None = None          # quit when the simulated time reaches this many ms
+    contact: bool | None = None       # kinematic contact; None: the world's world_info.contact
     allow_large: bool = False         # raise the world limits (WorldLimits.large())
     allow_outside_meshes: bool = False  # mesh urls may leave the world's folder
 
@@ -49,7 +50,7 @@ def build(world: str | Path | None, options: ServeOptions | None = None) -> tupl
     path = Path(world) if world else default_world_path()
     sim = Simulation.from_file(path, precision=opts.precision,
                                limits=WorldLimits.large() if opts.allow_large else WorldLimits(),
-                               allow_outside_meshes=opts.allow_outside_meshes)
+                               allow_outside_meshes=opts.allow_outside_meshes, contact=opts.contact)
     core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode)
     return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until)
 

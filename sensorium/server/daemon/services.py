@@ -21,6 +21,7 @@ import sys
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, cast
 
 from pydantic import ValidationError
@@ -139,7 +140,9 @@ class Core:
                             spec, getattr(self, f"_motor_{spec.item}"), robot_name, None, motor_name)
             for spec in S.SERVICES:
                 if spec.scope == "robot":
-                    routes[f"/{robot_name}/robot/{spec.item}"] = Route(spec, getattr(self, f"_robot_{spec.item}"), robot_name, None)
+                    handler = (partial(self._supervisor, spec.item) if spec.supervisor
+                               else getattr(self, f"_robot_{spec.item}"))
+                    routes[f"/{robot_name}/robot/{spec.item}"] = Route(spec, handler, robot_name, None)
         for spec in S.SERVICES:
             if spec.scope == "server":
                 routes[spec.item] = Route(spec, getattr(self, f"_srv_{spec.item}"), None, None)
@@ -472,41 +475,12 @@ class Core:
         return {"value": self.sim.robots[c.robot].model.model}
 
     # ------------------------------------------------------------------ supervisor services
-    def _robot_get_from_def(self, c: Call) -> dict:
-        return supervisor.node_ref(self.sim, supervisor.find_node(self.sim, c.args.name))
-
-    def _robot_get_self(self, c: Call) -> dict:
-        return supervisor.node_ref(self.sim, supervisor.find_node(self.sim, c.robot))
-
-    def _node(self, c: Call) -> supervisor.Node:
+    def _supervisor(self, item: str, c: Call) -> dict:
+        """Every Supervisor service: :data:`supervisor.HANDLERS` (ValueError → INVALID_ARGUMENT)."""
         try:
-            return supervisor.node_by_id(self.sim, c.args.node)
-        except KeyError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, str(exc.args[0])) from None
-
-    def _robot_get_field(self, c: Call) -> dict:
-        return {"value": supervisor.get_field(self.sim, self._node(c), c.args.field)}
-
-    def _robot_set_field(self, c: Call) -> dict:
-        try:
-            supervisor.set_field(self.sim, self._node(c), c.args.field, c.args.value)
+            return supervisor.HANDLERS[item](self.sim, self.lockstep, c.robot, c.args)
         except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_field: {exc}") from None
-        return {"success": True}
-
-    def _robot_get_node_pose(self, c: Call) -> dict:
-        return supervisor.node_pose(self.sim, self._node(c))
-
-    def _robot_simulation_reset(self, c: Call) -> dict:
-        self.sim.reset()
-        return {"success": True}
-
-    def _robot_simulation_set_mode(self, c: Call) -> dict:
-        self.lockstep.set_mode(supervisor.MODES[c.args.mode])
-        return {"success": True}
-
-    def _robot_simulation_get_mode(self, c: Call) -> dict:
-        return {"value": supervisor.MODES.index(self.lockstep.mode)}
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{item}: {exc}") from None
 
     # ------------------------------------------------------------------ device services
     def _describe(self, ctl: Control) -> dict:

@@ -1,6 +1,7 @@
 """The Supervisor subset (sans-IO): node handles, ``translation``/``rotation`` fields, poses.
 
-Nodes are the world's robots and solids, found by name (their DEF names in a converted ``.wbt``).
+Nodes are the world's robots and top-level solids, found by DEF name (``def_name``, set from a
+``.wbt`` world's ``DEF``) or else by name.
 A node's id is stable for the life of the server: robots 1..R in world order, then solids. Field
 values are Webots' ``SFVec3f`` (x, y, z) and ``SFRotation`` (axis x, y, z, angle), in the parent
 frame (the world here: nodes are not nested). Setting one field keeps the other (Webots).
@@ -13,6 +14,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from sensorium.server.world.poses import matrix_quaternion
 
 MODES = ("pause", "realtime", "fast")     # Webots WB_SUPERVISOR_SIMULATION_MODE_PAUSE = 0, REAL_TIME, FAST
 
@@ -31,7 +34,15 @@ def _nodes(sim: Any) -> list[Node]:
 
 
 def find_node(sim: Any, name: str) -> Node | None:
-    for n in _nodes(sim):
+    """The robot or top-level solid whose DEF name (``def_name``) is ``name``, else whose name is."""
+    nodes = _nodes(sim)
+    world = getattr(sim, "world", None)
+    if world is not None:
+        defs = [getattr(m, "def_name", None) for m in (*world.robots, *world.solids)]
+        for n, d in zip(nodes, defs):
+            if d == name:
+                return n
+    for n in nodes:
         if n.name == name:
             return n
     return None
@@ -40,7 +51,7 @@ def find_node(sim: Any, name: str) -> Node | None:
 def node_by_id(sim: Any, node: int) -> Node:
     nodes = _nodes(sim)
     if not 1 <= node <= len(nodes):
-        raise KeyError(f"no node with id {node} (ids 1..{len(nodes)})")
+        raise ValueError(f"no node with id {node} (ids 1..{len(nodes)})")
     return nodes[node - 1]
 
 
@@ -55,24 +66,13 @@ def _pose(sim: Any, node: Node) -> Any:
 
 
 def matrix_axis_angle(r: np.ndarray) -> list[float]:
-    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, pi]); identity → 0 0 1 0."""
-    m = np.asarray(r, dtype=np.float64)
-    c = max(-1.0, min(1.0, (m[0, 0] + m[1, 1] + m[2, 2] - 1.0) / 2.0))
-    angle = math.acos(c)
-    if angle < 1e-12:
+    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, pi]); identity → 0 0 1 0.
+    Through the unit quaternion, which stays accurate near half turns."""
+    x, y, z, w = matrix_quaternion(r)             # w >= 0
+    n = math.sqrt(x * x + y * y + z * z)
+    if n < 1e-300:
         return [0.0, 0.0, 1.0, 0.0]
-    if math.pi - angle < 1e-6:
-        # near a half turn: the axis from the diagonal (sin(angle) ~ 0 makes the skew part useless)
-        xx, yy, zz = (max((m[i, i] + 1.0) / 2.0, 0.0) for i in range(3))
-        axis = np.sqrt([xx, yy, zz])
-        k = int(np.argmax(axis))
-        for j in range(3):
-            if j != k:
-                axis[j] = math.copysign(axis[j], m[k, j] + m[j, k])
-    else:
-        axis = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
-    axis = axis / np.linalg.norm(axis)
-    return [float(axis[0]), float(axis[1]), float(axis[2]), float(angle)]
+    return [x / n, y / n, z / n, 2.0 * math.atan2(n, w)]
 
 
 def get_field(sim: Any, node: Node, field: str) -> list[float]:
@@ -101,3 +101,33 @@ def node_pose(sim: Any, node: Node) -> dict:
     pose = _pose(sim, node)
     return {"position": [float(v) for v in pose.translation],
             "orientation": [float(v) for v in np.asarray(pose.rotation).reshape(9)]}
+
+
+# ---------------------------------------------------------------------- the services
+# handler(sim, lockstep, calling robot, validated args) -> result; ValueError = INVALID_ARGUMENT
+
+def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    set_field(sim, node_by_id(sim, a.node), a.field, a.value)
+    return {"success": True}
+
+
+def _reset(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    sim.reset()
+    return {"success": True}
+
+
+def _set_mode(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    ls.set_mode(MODES[a.mode])
+    return {"success": True}
+
+
+HANDLERS = {
+    "get_from_def": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, a.name)),
+    "get_self": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, robot)),
+    "get_field": lambda sim, ls, robot, a: {"value": get_field(sim, node_by_id(sim, a.node), a.field)},
+    "set_field": _set_field,
+    "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
+    "simulation_reset": _reset,
+    "simulation_set_mode": _set_mode,
+    "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},
+}

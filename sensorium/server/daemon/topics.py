@@ -2,7 +2,8 @@
 
 Demand decides what is computed. A device is measured while its controller enabled it *or* one
 of its topics is demanded — covered by an XPUB subscription prefix (a prefix covers a topic when
-``topic + "\\0"`` starts with it; the empty prefix covers everything) or recorded by the recorder.
+``topic + "\\0"`` starts with it; the empty prefix covers everything), recorded by the recorder, or
+subscribed by a viewer (a Foxglove client, :meth:`Topics.set_viewer_demand`).
 A demanded device whose controller has not enabled it runs at the basic time step; the
 controller's own ``enable`` always wins and is never altered (its period, phase and
 ``get_sampling_period`` stay exactly as requested). A lidar builds its point cloud only while the
@@ -10,7 +11,8 @@ controller enabled it or its ``point_cloud`` topic is demanded.
 
 After each basic step :meth:`Topics.publish` builds the messages of every demanded topic whose
 device produced a new value (plus ``/clock`` and each demanded ``/<robot>/pose``) as ready-to-send
-frames, calls the recorder with the very same bytes, and counts ``seq`` per topic. A robot's pose
+frames, calls the recorder (and the viewer sink, sensorium.server.viewer) with the very same bytes,
+and counts ``seq`` per topic. A robot's pose
 is read and packed only while its pose topic is demanded (``work["poses_built"]`` counts them).
 This module does no I/O.
 """
@@ -217,6 +219,8 @@ class Topics:
         self._rec_wants: Callable[[str], bool] | None = None
         self._rec_demands: Callable[[str], bool] | None = None
         self.recorder_demanded: set[str] = set()
+        self._viewer: Recorder | None = None
+        self.viewer_demanded: set[str] = set()
         self._active: list[Control] = []             # controls with a demanded topic
         self._clock_demanded = False
         self._poses: list[Topic] = []                # demanded pose topics
@@ -225,8 +229,8 @@ class Topics:
     # ------------------------------------------------------------------ demand
     @property
     def demanded(self) -> set[str]:
-        """Topics computed and published: subscribed, or demanded by the recorder."""
-        return self.subscribed | self.recorder_demanded
+        """Topics computed and published: subscribed, demanded by the recorder or by a viewer."""
+        return self.subscribed | self.recorder_demanded | self.viewer_demanded
 
     def subscription(self, event: bytes) -> bool:
         """An XPUB event (``\\x01`` + prefix subscribes, ``\\x00`` + prefix unsubscribes).
@@ -261,6 +265,22 @@ class Topics:
             self._rec_wants = wants
             self._rec_demands = getattr(recorder, "demands", None) or wants
         self._recompute(force=True)
+
+    def set_viewer(self, sink: Recorder | None) -> None:
+        """Attach (``None``: detach, dropping its demand) the viewer sink: called like a recorder,
+        with the published bytes of every topic in :attr:`viewer_demanded`."""
+        self._viewer = sink
+        if sink is None:
+            self.set_viewer_demand(())
+
+    def set_viewer_demand(self, names: Iterable[str]) -> bool:
+        """The topics viewers subscribe to now (unknown names ignored). Returns whether it changed."""
+        demanded = {n for n in names if n in self.by_name}
+        if demanded == self.viewer_demanded:
+            return False
+        self.viewer_demanded = demanded
+        self._recompute(force=True)
+        return True
 
     def _recompute(self, force: bool = False) -> bool:
         subscribed = {t.name for t in self.topics if any(t.frame.startswith(p) for p in self.prefixes)}
@@ -365,6 +385,8 @@ class Topics:
             out.append([t.frame, env, data])
         if self._recorder is not None and t.name in self.recorded:
             self._recorder(t.name, t.type, env, data, ns, seq)
+        if self._viewer is not None and t.name in self.viewer_demanded:
+            self._viewer(t.name, t.type, env, data, ns, seq)
 
     def build(self, ctl: Control, kind: str, at_ms: int) -> dict | None:
         """The body of one of ``ctl``'s topics from the device's current state."""

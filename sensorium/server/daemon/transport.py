@@ -9,6 +9,8 @@ A thin adapter around :class:`sensorium.server.daemon.services.Core` (sans-IO): 
   slow subscriber costs (PUB semantics: excess messages are dropped, ``seq`` shows the gap).
 * Run modes ``fast``/``realtime``/``pause`` are decided by the lockstep; this loop only sleeps
   until the next event or deadline.
+* ``hooks``: callables run by the loop thread once per loop pass, before stepping (the Foxglove
+  viewer applies its subscriptions there); another thread calls :meth:`wake` to get a pass soon.
 * SIGINT/SIGTERM: every pending (and later) step is answered with status -1, requests are still
   served for ``grace_s`` so controllers can clean up, then both sockets close.
 """
@@ -86,6 +88,7 @@ class Transport:
         self.poller.register(self.router, zmq.POLLIN)
         self.poller.register(self.xpub, zmq.POLLIN)
         self.poller.register(self._wake_r.fileno(), zmq.POLLIN)
+        self.hooks: list[Callable[[], None]] = []
         self.closed = False
 
     # ------------------------------------------------------------------ control
@@ -94,6 +97,13 @@ class Transport:
         self._stop_requested = True
         try:
             self._wake_w.send(b"\0")
+        except OSError:
+            pass
+
+    def wake(self) -> None:
+        """Make the loop pass soon (thread-safe): it runs :attr:`hooks` then."""
+        try:
+            self._wake_w.send(b"\1")
         except OSError:
             pass
 
@@ -145,6 +155,8 @@ class Transport:
                 if timed_out or now >= next_expire:
                     core.expire(now)
                     next_expire = now + EXPIRE_EVERY_S
+                for hook in self.hooks:
+                    hook()
                 self._run_steps(now)
         finally:
             self.close()

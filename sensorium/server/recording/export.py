@@ -18,6 +18,7 @@ fields the body lacks are zero. ``pointcloud2=True`` turns ``sensor_msgs/msg/Poi
 from __future__ import annotations
 
 import array
+import struct
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -27,6 +28,7 @@ from typing import Any
 import msgpack
 import numpy as np
 
+from sensorium.server.recording import cdr
 from sensorium.server.recording.reader import Recording
 
 DISTROS = ("humble", "jazzy")
@@ -238,6 +240,7 @@ class ExportReport:
     distro: str
     fmt: str
     messages: int = 0
+    views: int = 0                                         # /tf, /tf_static, /scene messages added
     topics: dict[str, str] = field(default_factory=dict)  # topic -> exported type
     skipped: dict[str, int] = field(default_factory=dict)  # topic -> messages not exported
     reasons: dict[str, str] = field(default_factory=dict)
@@ -250,8 +253,44 @@ class ExportReport:
     read: int = 0
 
 
+@dataclass
+class _Added:
+    """A message the export adds (scene, transforms): what the writers read of a RecordedMessage."""
+
+    topic: str
+    stamp_ns: int
+    seq: int
+
+
 def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report: ExportReport,
-                    start_ns: int | None, end_ns: int | None):
+                    start_ns: int | None, end_ns: int | None, views: bool = True):
+    """``(message, export type, message dict, added)`` in order; ``added`` marks the scene and
+    transform messages of :mod:`.ros_views` (when ``views`` and the recorded world has them)."""
+    from sensorium.server.recording import ros_views
+
+    world, base_dir = ros_views.recorded_world(rec) if views else (None, Path("."))
+    started = False
+    tf_seq = 0
+    for m, typename, msg in _iter_recorded(rec, typestore, topics, pointcloud2, report, start_ns, end_ns):
+        if world is not None and not started:
+            started = True
+            for topic, typ, value in (("/tf_static", ros_views.TF, ros_views.tf_static(world, m.stamp_ns)),
+                                      ("/scene", ros_views.MARKER_ARRAY,
+                                       ros_views.marker_array(world, base_dir, m.stamp_ns))):
+                if value is not None:
+                    report.topics.setdefault(topic, typ)
+                    yield _Added(topic, m.stamp_ns, 0), typ, _convert(typestore, typ, value), True
+        yield m, typename, msg, False
+        robot = ros_views.pose_robot(m.topic, m.ros_type) if world is not None else None
+        if robot is not None:
+            report.topics.setdefault("/tf", ros_views.TF)
+            value = ros_views.tf_pose(robot, m.data, m.stamp_ns)
+            yield _Added("/tf", m.stamp_ns, tf_seq), ros_views.TF, _convert(typestore, ros_views.TF, value), True
+            tf_seq += 1
+
+
+def _iter_recorded(rec: Recording, typestore, topics, pointcloud2: bool, report: ExportReport,
+                   start_ns: int | None, end_ns: int | None):
     bad: set[str] = set()
     for m in rec.messages(topics, start_ns, end_ns):
         if report.progress is not None:
@@ -278,10 +317,11 @@ def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report
 
 def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt: str | None = None,
                 pointcloud2: bool = False, topics: list[str] | None = None,
-                start_ns: int | None = None, end_ns: int | None = None,
+                start_ns: int | None = None, end_ns: int | None = None, views: bool = True,
                 progress: Callable[[int, int], None] | None = None) -> ExportReport:
     """Export ``src`` to ``out``. ``fmt`` is ``"bag"`` (rosbag2 directory, via rosbags) or
     ``"mcap"`` (single file, via mcap-ros2-support); by default ``.mcap`` outputs are single files.
+    ``views``: add ``/tf_static``, ``/tf`` and ``/scene`` from the recorded world (:mod:`.ros_views`).
     ``progress(done, total)`` is called as messages are read (total: the recording's message count)."""
     out = Path(out)
     if distro not in DISTROS:
@@ -297,9 +337,10 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
         meta = rec.metadata().get("sensorium", {})
         world = rec.world()
         if fmt == "bag":
-            _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns)
+            _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns, views)
         elif fmt == "mcap":
-            _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns)
+            _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns,
+                          views)
         else:
             raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
         report.size_bytes = rec.path.stat().st_size
@@ -309,7 +350,7 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
     return report
 
 
-def _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns) -> None:
+def _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns, views) -> None:
     try:
         from rosbags.rosbag2 import StoragePlugin, Writer
     except ImportError as exc:  # pragma: no cover
@@ -321,18 +362,23 @@ def _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, met
             writer.set_custom_data(f"sensorium.{key}", str(value))
         writer.set_custom_data("sensorium.distro", distro)
         conns: dict[str, Any] = {}
-        for m, typename, msg in _iter_converted(rec, typestore, topics, pointcloud2, report, start_ns, end_ns):
+        for m, typename, msg, added in _iter_converted(rec, typestore, topics, pointcloud2, report, start_ns, end_ns,
+                                                       views):
             conn = conns.get(m.topic)
             if conn is None:
                 conn = conns[m.topic] = writer.add_connection(m.topic, typename, typestore=typestore)
             data = typestore.serialize_cdr(to_rosbags(typestore, typename, msg), typename)
             writer.write(conn, m.stamp_ns, data)
-            report.messages += 1
+            if added:
+                report.views += 1
+            else:
+                report.messages += 1
     finally:
         writer.close()
 
 
-def _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns) -> None:
+def _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns,
+                  views) -> None:
     try:
         from mcap_ros2.writer import Writer as Ros2Writer
     except ImportError as exc:  # pragma: no cover
@@ -341,14 +387,18 @@ def _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world,
         writer = Ros2Writer(f)
         try:
             schemas: dict[str, Any] = {}
-            for m, typename, msg in _iter_converted(rec, typestore, topics, pointcloud2, report, start_ns, end_ns):
+            for m, typename, msg, added in _iter_converted(rec, typestore, topics, pointcloud2, report, start_ns,
+                                                           end_ns, views):
                 schema = schemas.get(typename)
                 if schema is None:
                     text = typestore.generate_msgdef(typename, ros_version=2)[0]
                     schema = schemas[typename] = writer.register_msgdef(typename, text)
                 writer.write_message(topic=m.topic, schema=schema, message=_to_mcap_ros2(typestore, typename, msg),
                                      log_time=m.stamp_ns, publish_time=m.stamp_ns, sequence=m.seq % (1 << 32))
-                report.messages += 1
+                if added:
+                    report.views += 1
+                else:
+                    report.messages += 1
             if meta:
                 writer.add_metadata("sensorium", dict(meta, distro=distro))
             if world:
@@ -376,6 +426,60 @@ def print_report(report: ExportReport, file=sys.stdout) -> None:
           f"{report.out} (ROS 2 {report.distro})", file=file)
     for topic, typename in sorted(report.topics.items()):
         print(f"  {topic}  {typename}", file=file)
+    if report.views:
+        print(f"  (+{report.views} scene/transform messages from the recorded world: /tf_static, /tf, /scene)", file=file)
     for topic, n in sorted(report.skipped.items()):
         print(f"  skipped {n} message(s) on {topic}: {report.reasons.get(topic, '?')}", file=file)
 
+
+
+# --------------------------------------------------------------------------------------------
+# one message at a time: the CDR bytes Foxglove (live viewer, Foxglove-ready recordings) receives
+
+
+class CdrEncoder:
+    """Recorded/published msgpack bodies → ROS 2 CDR bytes with rosbags' ``serialize_cdr`` (the
+    encoder of the rosbag2 export, so a live viewer, a Foxglove-ready recording and an exported bag
+    carry the same bytes). ``pointcloud2``: ``sensor_msgs/msg/PointCloud`` bodies become
+    ``sensor_msgs/msg/PointCloud2`` (Foxglove's 3D panel draws PointCloud2, not the old PointCloud)."""
+
+    def __init__(self, distro: str = "jazzy", pointcloud2: bool = True):
+        self.distro = distro
+        self.pointcloud2 = pointcloud2
+        self.typestore = typestore_for(distro)
+        self._defs: dict[str, str] = {}
+
+    def export_type(self, ros_type: str) -> str | None:
+        """The type a topic of ``ros_type`` is encoded as, or ``None`` if the distro lacks it."""
+        if self.pointcloud2 and ros_type == POINT_CLOUD:
+            return POINT_CLOUD2
+        return ros_type if ros_type in self.typestore.fielddefs else None
+
+    def msgdef(self, typename: str) -> str:
+        """The ``ros2msg`` schema text (the type, then its dependencies after ``=====`` lines)."""
+        text = self._defs.get(typename)
+        if text is None:
+            text = self._defs[typename] = self.typestore.generate_msgdef(typename, ros_version=2)[0]
+        return text
+
+    def encode(self, ros_type: str, body_bytes: bytes) -> tuple[str, bytes]:
+        """``(export type, CDR bytes)``; raises :class:`ExportError` on a body that does not convert.
+        Sensorium's own types are written directly (:mod:`.cdr`, byte-identical to rosbags), others
+        through the type store."""
+        typename = self.export_type(ros_type)
+        if typename is None:
+            raise ExportError(f"type {ros_type!r} unknown to ROS 2 {self.distro}")
+        if typename in cdr.FAST_TYPES:
+            try:
+                body = msgpack.unpackb(body_bytes, raw=False)
+                if typename == POINT_CLOUD2 and ros_type == POINT_CLOUD:
+                    body = pointcloud2_from_body(body)[1]
+                return typename, cdr.encode(typename, body, self.distro)
+            except (KeyError, TypeError, ValueError, OverflowError, AttributeError, struct.error, ExportError):
+                pass                                  # unusual body: the generic path decides
+        return typename, self.encode_generic(ros_type, body_bytes)
+
+    def encode_generic(self, ros_type: str, body_bytes: bytes) -> bytes:
+        """The same bytes through rosbags' type store and ``serialize_cdr`` (the reference)."""
+        typename, msg = convert_message(self.typestore, ros_type, body_bytes, self.pointcloud2)
+        return bytes(self.typestore.serialize_cdr(to_rosbags(self.typestore, typename, msg), typename))

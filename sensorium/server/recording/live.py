@@ -158,8 +158,14 @@ class LiveRecorder:
                 raise ValueError("nothing to record from: give a server (connect) or a topic endpoint (pub)")
             self.pub_endpoint = self.pub
         world_text, world_name = b"", ""
+        world_model, base_dir = None, Path(".")
         if self.world:
             world_text, world_name = Path(self.world).read_bytes(), Path(self.world).name
+            try:                        # for the Foxglove /scene; a world that does not load just has none
+                from sensorium.server.world.loader import WorldError, load_world
+                world_model, base_dir = load_world(self.world).world, Path(self.world).resolve().parent
+            except (WorldError, OSError, ValueError):
+                pass
         meta = {}
         rec_meta = self.info.get("recording", {}).get("metadata", {}) if isinstance(self.info.get("recording"), dict) else {}
         meta.update({k: str(v) for k, v in rec_meta.items() if k in ("seed", "world", "basic_time_step_ms")})
@@ -179,7 +185,7 @@ class LiveRecorder:
             self.sub.setsockopt(zmq.SUBSCRIBE, prefix)
         self.sub.connect(self.pub_endpoint)
         self.recorder = McapRecorder(self.path, world_text, world_name or "world.yaml", meta, self.topics,
-                                     self.chunk_size,
+                                     self.chunk_size, world=world_model, base_dir=base_dir,
                                      session={"mode": "subscriber", "pub_endpoint": self.pub_endpoint,
                                               "connect": self.connect or ""})
 

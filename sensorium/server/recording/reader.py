@@ -32,7 +32,8 @@ from mcap.records import (
 from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.summary import Summary
 
-from sensorium.server.recording.envelope import MAGIC, SEQ_MODULUS, pack_envelope, topic_matcher
+from sensorium.server.recording import foxglove_views as fxv
+from sensorium.server.recording.envelope import MAGIC, MESSAGE_ENCODING, SEQ_MODULUS, pack_envelope, topic_matcher
 
 __all__ = ["Recording", "RecordedMessage", "TopicInfo", "iter_messages", "summarize", "McapError"]
 
@@ -90,6 +91,32 @@ class _Unwrap:
                 value += SEQ_MODULUS
         self._last[channel_id] = value
         return value
+
+
+def _source(topic: str, ros_type: str, encoding: str, metadata: Any) -> tuple[str, str] | None:
+    """A channel that holds published bodies → (topic, ROS type); ``None`` for a Foxglove view
+    (format 2 keeps the bodies in ``/sensorium/wire<topic>``, format 1 in msgpack channels)."""
+    if topic.startswith(fxv.WIRE_PREFIX) and "sensorium.topic" in metadata:
+        return metadata["sensorium.topic"], metadata.get("sensorium.type", "")
+    if encoding == MESSAGE_ENCODING:
+        return topic, ros_type
+    return None
+
+
+def _body(topic: str, data: bytes) -> bytes:
+    return fxv.wire_unwrap(data) if topic.startswith(fxv.WIRE_PREFIX) else data
+
+
+def _sources(infos: Iterable[TopicInfo]) -> list[TopicInfo]:
+    """The topics of a recording: its source channels under their topic names and ROS types."""
+    out = []
+    for info in infos:
+        src = _source(info.topic, info.ros_type, info.encoding, info.metadata)
+        if src is not None:
+            info.topic, info.ros_type = src
+            info.encoding = MESSAGE_ENCODING
+            out.append(info)
+    return out
 
 
 def _has_footer(path: Path) -> bool:
@@ -216,7 +243,7 @@ class Recording:
                 attachments.append(record)
             elif isinstance(record, (DataEnd, Footer)):
                 complete = True
-        self._scan_cache = {"header": header, "topics": list(topics.values()), "metadata": metadata,
+        self._scan_cache = {"header": header, "topics": _sources(topics.values()), "metadata": metadata,
                             "attachments": attachments, "chunks": stats.get("chunks", 0),
                             "compression": sorted(stats.get("compression", set())),
                             "stopped": stats.get("stopped"), "stopped_at": stats.get("stopped_at"),
@@ -280,7 +307,7 @@ class Recording:
                     info.last_ns = hi if info.last_ns is None else max(info.last_ns, hi)
                     if stats is None:
                         info.count += len(rec.records)
-        return list(infos.values())
+        return _sources(infos.values())
 
     def messages(self, topics: Iterable[str] | Callable[[str], bool] | None = None,
                  start_ns: int | None = None, end_ns: int | None = None) -> Iterator[RecordedMessage]:
@@ -290,7 +317,13 @@ class Recording:
         match = topics if callable(topics) else topic_matcher(topics)
         unwrap = _Unwrap()
         if self._reader is not None:
-            names = [ch.topic for ch in self._indexed().channels.values() if match(ch.topic)]
+            summary = self._indexed()
+            names = []
+            for chan in summary.channels.values():
+                sch = summary.schemas.get(chan.schema_id)
+                src = _source(chan.topic, sch.name if sch else "", chan.message_encoding, chan.metadata)
+                if src is not None and match(src[0]):
+                    names.append(chan.topic)
             kwargs: dict[str, Any] = {"log_time_order": True}
             try:
                 it = self._reader.iter_messages(topics=names, starting_at=start_ns,
@@ -303,8 +336,10 @@ class Recording:
             if first is None:
                 return
             for schema, channel, message in _chain(first, it):
-                yield RecordedMessage(channel.topic, schema.name if schema else "",
-                                      unwrap(channel.id, message.sequence), message.log_time, message.data)
+                topic, ros_type = _source(channel.topic, schema.name if schema else "", channel.message_encoding,
+                                          channel.metadata) or (channel.topic, "")
+                yield RecordedMessage(topic, ros_type, unwrap(channel.id, message.sequence), message.log_time,
+                                      _body(channel.topic, message.data))
             return
         # sequential: file order, which is publication order
         schemas: dict[int, Schema] = {}
@@ -316,14 +351,16 @@ class Recording:
                 channels[record.id] = record
             elif isinstance(record, Message):
                 ch = channels.get(record.channel_id)
-                if ch is None or not match(ch.topic):
+                if ch is None:
+                    continue
+                schema = schemas.get(ch.schema_id)
+                src = _source(ch.topic, schema.name if schema else "", ch.message_encoding, ch.metadata)
+                if src is None or not match(src[0]):
                     continue
                 t = record.log_time
                 if (start_ns is not None and t < start_ns) or (end_ns is not None and t > end_ns):
                     continue
-                schema = schemas.get(ch.schema_id)
-                yield RecordedMessage(ch.topic, schema.name if schema else "",
-                                      unwrap(ch.id, record.sequence), t, record.data)
+                yield RecordedMessage(src[0], src[1], unwrap(ch.id, record.sequence), t, _body(ch.topic, record.data))
 
     def summary(self) -> dict:
         """What ``sensorium info`` prints (also its ``--json`` form)."""

@@ -85,6 +85,7 @@ class Replayer:
         self.emitted = 0
         self.loops = 0
         self.subscriptions: set[bytes] = set()
+        self.viewer: Any = None                # a recorder-like sink also fed every published message
         self._clock_seq = 0
         self._last_clock_ns: int | None = None
         self.pub: zmq.Socket | None = None
@@ -170,7 +171,10 @@ class Replayer:
                     return
 
     def _publish(self, msg: RecordedMessage) -> None:
-        self._send([msg.topic.encode() + b"\0", msg.envelope(), msg.data])
+        env = msg.envelope()
+        self._send([msg.topic.encode() + b"\0", env, msg.data])
+        if self.viewer is not None:        # the Foxglove bridge (--foxglove): never blocks
+            self.viewer(msg.topic, msg.ros_type, env, msg.data, msg.stamp_ns, msg.seq)
         self.emitted += 1
 
     def _publish_clock(self, t_ns: int) -> None:

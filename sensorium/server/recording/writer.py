@@ -15,6 +15,11 @@ publishes, with the bytes it published: nothing is dropped and nothing is re-enc
 * the world file as an attachment; a metadata record ``sensorium`` (seed, time step, version, ...,
   deterministic) and a metadata record ``session`` (wall-clock start/end, not deterministic).
 
+Foxglove-ready recordings (format 2, the default when the ``foxglove`` extra is installed): the
+msgpack bodies go to ``/sensorium/wire<topic>`` channels wrapped as a CDR ``uint8[]`` (still byte
+for byte), next to per-topic ROS 2 CDR views, ``/tf`` and ``/scene`` that Foxglove displays; see
+:mod:`.foxglove_views`. Readers use only the lossless channels.
+
 Reading is :mod:`.reader`; constants, the envelope and topic filters are :mod:`.envelope`.
 """
 
@@ -30,6 +35,7 @@ from typing import IO, Any, cast
 import msgpack
 from mcap.writer import CompressionType, IndexType, Writer
 
+from sensorium.server.recording import foxglove_views as fxv
 from sensorium.server.recording.envelope import (
     DEFAULT_CHUNK_SIZE,
     MESSAGE_ENCODING,
@@ -103,8 +109,15 @@ class McapRecorder:
                  topics: list[str] | None = None, chunk_size: int = DEFAULT_CHUNK_SIZE, *,
                  compression: str = "zstd", flush_interval: float | None = 1.0,
                  session: dict[str, str] | None = None, demand: bool = True,
-                 background_flush: bool = True):
+                 background_flush: bool = True, foxglove: bool = True, world: Any = None,
+                 base_dir: str | os.PathLike = "."):
         self.path = Path(path)
+        # Foxglove views (format 2) when asked for and the extra is installed
+        self.foxglove_unavailable = fxv.available() if foxglove else "not requested"
+        self._views = fxv.FoxgloveViews(world, Path(base_dir)) if self.foxglove_unavailable is None else None
+        self._view_schemas: dict[str, int] = {}
+        self._view_channels: dict[str, int] = {}
+        self._view_seq: dict[str, int] = {}
         self.topics = list(topics) if topics else None
         self.demand = demand
         self._wants = topic_matcher(self.topics)
@@ -136,6 +149,9 @@ class McapRecorder:
                     "log_time": "simulation time in ns since the simulation started",
                     "message_encoding": MESSAGE_ENCODING,
                     "envelope": "msgpack {type: schema name, seq: sequence, stamp_ns: log_time}"}
+            if self._views is not None:
+                meta.update({"format": "2", "wire_channels": f"{fxv.WIRE_PREFIX}<topic>: msgpack body as CDR "
+                             f"{fxv.WIRE_SCHEMA}; <topic>: ROS 2 CDR view; /tf, /scene: Foxglove"})
             if world_name:
                 meta["world_file"] = world_name
             meta.update({str(k): str(v) for k, v in (metadata or {}).items()})
@@ -146,6 +162,9 @@ class McapRecorder:
                     "started_at_ns": str(time.time_ns()), "pid": str(os.getpid())}
             sess.update({str(k): str(v) for k, v in (session or {}).items()})
             self._writer.add_metadata("session", sess)
+            scene = self._views.scene() if self._views is not None else None
+            if scene is not None:
+                self._add_view(scene, 0)
         except BaseException:
             self._stream.close()
             raise
@@ -188,8 +207,14 @@ class McapRecorder:
             stamp = int(stamp_ns)
             if stamp < 0:
                 raise ValueError(f"{topic}: negative stamp_ns {stamp}")
-            self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
-                                     data=bytes(body), sequence=int(seq) % SEQ_MODULUS)
+            if self._views is None:
+                self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
+                                         data=bytes(body), sequence=int(seq) % SEQ_MODULUS)
+            else:
+                self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
+                                         data=fxv.wire_wrap(bytes(body)), sequence=int(seq) % SEQ_MODULUS)
+                for view in self._views.views(topic, ros_type, bytes(body), stamp):
+                    self._add_view(view, stamp, int(seq) if view[0] == topic else None)
             self.counts[topic] = self.counts.get(topic, 0) + 1
             self.message_count += 1
             self._dirty = True
@@ -200,12 +225,35 @@ class McapRecorder:
 
     __call__ = record
 
+    def _add_view(self, view: tuple[str, str, str, bytes, str, bytes], stamp: int, seq: int | None = None) -> None:
+        """One Foxglove view record (caller holds the lock or is the constructor)."""
+        topic, schema_name, schema_encoding, schema_data, message_encoding, data = view
+        cid = self._view_channels.get(topic)
+        if cid is None:
+            sid = self._view_schemas.get(schema_name)
+            if sid is None:
+                sid = self._view_schemas[schema_name] = self._writer.register_schema(
+                    name=schema_name, encoding=schema_encoding, data=schema_data)
+            cid = self._view_channels[topic] = self._writer.register_channel(
+                topic=topic, message_encoding=message_encoding, schema_id=sid, metadata={"sensorium.view": "1"})
+        if seq is None:
+            seq = self._view_seq.get(topic, 0)
+            self._view_seq[topic] = seq + 1
+        self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp, data=data,
+                                 sequence=seq % SEQ_MODULUS)
+
     def _register(self, topic: str, ros_type: str, envelope: bytes, body: bytes) -> int:
-        sid = self._schemas.get(ros_type)
-        if sid is None:
-            sid = self._writer.register_schema(name=ros_type, encoding="", data=b"")
-            self._schemas[ros_type] = sid
         meta = _topic_parts(topic)
+        if self._views is not None:
+            sid = self._schemas.get(fxv.WIRE_SCHEMA)
+            if sid is None:
+                sid = self._schemas[fxv.WIRE_SCHEMA] = self._writer.register_schema(
+                    name=fxv.WIRE_SCHEMA, encoding="ros2msg", data=fxv.WIRE_MSGDEF.encode())
+        else:
+            sid = self._schemas.get(ros_type)
+            if sid is None:
+                sid = self._writer.register_schema(name=ros_type, encoding="", data=b"")
+                self._schemas[ros_type] = sid
         try:
             decoded = msgpack.unpackb(body, raw=False)
             frame = decoded.get("header", {}).get("frame_id") if isinstance(decoded, dict) else None
@@ -219,8 +267,13 @@ class McapRecorder:
                 meta["envelope_keys"] = ",".join(str(k) for k in env)
         except Exception:
             pass
-        cid = self._writer.register_channel(topic=topic, message_encoding=MESSAGE_ENCODING,
-                                            schema_id=sid, metadata=meta)
+        if self._views is not None:
+            meta.update({"sensorium.topic": topic, "sensorium.type": ros_type})
+            cid = self._writer.register_channel(topic=fxv.WIRE_PREFIX + topic, message_encoding="cdr",
+                                                schema_id=sid, metadata=meta)
+        else:
+            cid = self._writer.register_channel(topic=topic, message_encoding=MESSAGE_ENCODING,
+                                                schema_id=sid, metadata=meta)
         self._channels[topic] = cid
         return cid
 
@@ -264,6 +317,8 @@ class McapRecorder:
                     "ended_at": _dt.datetime.fromtimestamp(end, _dt.timezone.utc).isoformat(),
                     "wall_duration_s": f"{end - self._started_wall:.3f}",
                     "messages": str(self.message_count)})
+                if self._views is not None and self._views.errors:   # bodies kept; only their views missing
+                    self._writer.add_metadata("foxglove_view_errors", dict(self._views.errors))
                 self._writer.finish()
                 self._stream.fsync()
             finally:
@@ -281,7 +336,7 @@ class McapRecorder:
 
 
 def recorder_for_server(path: str | os.PathLike, core: Any, topics: list[str] | None = None,
-                        chunk_size: int = DEFAULT_CHUNK_SIZE) -> McapRecorder:
+                        chunk_size: int = DEFAULT_CHUNK_SIZE, foxglove: bool = True) -> McapRecorder:
     """``sensorium serve --record``: a recorder for ``core`` (``sensorium.server.daemon.services.Core``)
     with the world file (and its meshes) attached and seed/time step/version as metadata, already
     hooked into ``core.topics``. Without ``topics`` every topic is computed and recorded."""
@@ -295,7 +350,9 @@ def recorder_for_server(path: str | os.PathLike, core: Any, topics: list[str] | 
             "basic_time_step_ms": str(getattr(sim, "basic_time_step", "")),
             "precision": str(getattr(getattr(sim, "precision", None), "value", getattr(sim, "precision", "")))}
     rec = McapRecorder(path, text, Path(source).name if source and source != "<memory>" else "world.yaml", meta,
-                       topics, chunk_size, session={"mode": "server", "world_path": source})
+                       topics, chunk_size, session={"mode": "server", "world_path": source},
+                       world=getattr(sim, "world", None), base_dir=getattr(loaded, "base_dir", "."),
+                       foxglove=foxglove)
     try:
         base = Path(getattr(loaded, "base_dir", "") or ".")
         seen: set[str] = set()

@@ -52,6 +52,7 @@ class Obstacle:
     z_range: tuple[float, float]
     normal: np.ndarray | None = None        # wall line
     offset: float = 0.0
+    sphere: bool = False                    # a sphere: its section depends on the height band
     lo: np.ndarray = field(default_factory=lambda: np.zeros(2))
     hi: np.ndarray = field(default_factory=lambda: np.zeros(2))
 
@@ -147,7 +148,8 @@ def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle
         n2 = np.array([n[0], n[1]]) / math.hypot(n[0], n[1])
         return Obstacle(name, owner, np.zeros((1, 2)), 0.0, (-math.inf, math.inf), n2, -float(n2 @ t[:2]))
     if isinstance(prim, geo.Sphere):
-        return Obstacle(name, owner, t[None, :2].copy(), prim.radius, (t[2] - prim.radius, t[2] + prim.radius))
+        return Obstacle(name, owner, t[None, :2].copy(), prim.radius, (t[2] - prim.radius, t[2] + prim.radius),
+                        sphere=True)
     if isinstance(prim, (geo.Cylinder, geo.Capsule)) and upright:
         h = prim.height / 2.0 + (prim.radius if isinstance(prim, geo.Capsule) else 0.0)
         return Obstacle(name, owner, t[None, :2].copy(), prim.radius, (t[2] - h, t[2] + h))
@@ -166,7 +168,7 @@ def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle
     return Obstacle(name, owner, _hull(world[:, :2]), 0.0, (float(world[:, 2].min()), float(world[:, 2].max())))
 
 
-def sphere_radius_in_band(ob: Obstacle, center_z: float, radius: float, low: float, high: float) -> float:
+def sphere_radius_in_band(center_z: float, radius: float, low: float, high: float) -> float:
     """The widest horizontal section of a sphere within the height band [low, high]."""
     dz = 0.0 if low <= center_z <= high else min(abs(center_z - low), abs(center_z - high))
     return math.sqrt(max(radius * radius - dz * dz, 0.0))
@@ -176,37 +178,38 @@ def sphere_radius_in_band(ob: Obstacle, center_z: float, radius: float, low: flo
 
 def _closest_on_hull(p: np.ndarray, pts: np.ndarray) -> tuple[float, np.ndarray]:
     """Signed distance from ``p`` to the convex hull ``pts`` (negative inside) and the outward
-    unit normal at the closest feature."""
-    n = len(pts)
+    unit normal at the closest feature. Scalar float64 arithmetic: hulls have a few vertices."""
+    px, py = float(p[0]), float(p[1])
+    v = pts.tolist()
+    n = len(v)
     if n == 1:
-        d = p - pts[0]
-        L = math.hypot(d[0], d[1])
-        return L, (d / L if L > 0 else np.array([1.0, 0.0]))
-    best = math.inf
-    best_n = np.array([1.0, 0.0])
+        dx, dy = px - v[0][0], py - v[0][1]
+        L = math.hypot(dx, dy)
+        return L, (np.array([dx / L, dy / L]) if L > 0 else np.array([1.0, 0.0]))
+    best, best_n = math.inf, (1.0, 0.0)
     inside = n >= 3
-    deepest = -math.inf
-    deep_n = best_n
-    for i in range(n if n >= 3 else 1):
-        a, b = pts[i], pts[(i + 1) % n]
-        e = b - a
-        ee = float(e @ e)
-        s = min(max(float((p - a) @ e) / ee, 0.0), 1.0)
-        q = a + s * e
-        d = p - q
-        L = math.hypot(d[0], d[1])
+    deepest, deep_n = -math.inf, (1.0, 0.0)
+    for i in range(n if n >= 3 else 1):            # edges a -> b, counter-clockwise
+        ax, ay = v[i]
+        bx, by = v[(i + 1) % n]
+        ex, ey = bx - ax, by - ay
+        el = math.hypot(ex, ey)
+        ox, oy = ey / el, -ex / el                  # outward normal
+        rx, ry = px - ax, py - ay
+        t = min(max((rx * ex + ry * ey) / (el * el), 0.0), 1.0)
+        dx, dy = rx - t * ex, ry - t * ey
+        L = math.hypot(dx, dy)
         if L < best:
-            best, best_n = L, (d / L if L > 0 else np.array([e[1], -e[0]]) / math.sqrt(ee))
+            best, best_n = L, ((dx / L, dy / L) if L > 0 else (ox, oy))
         if n >= 3:
-            out = np.array([e[1], -e[0]]) / math.sqrt(ee)       # outward for counter-clockwise
-            side = float((p - a) @ out)
-            if side > 0:
+            side = rx * ox + ry * oy
+            if side > 0.0:
                 inside = False
             if side > deepest:
-                deepest, deep_n = side, out
+                deepest, deep_n = side, (ox, oy)
     if inside:
-        return deepest, deep_n
-    return best, best_n
+        return deepest, np.array(deep_n)
+    return best, np.array(best_n)
 
 
 def _ray_circle(p: np.ndarray, d: np.ndarray, c: np.ndarray, rho: float) -> float:
@@ -243,14 +246,14 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
     if ob.normal is not None:                        # two-sided wall line
         dist = float(ob.normal @ p) + ob.offset
         side = 1.0 if dist >= 0.0 else -1.0
-        n = side * ob.normal
+        nrm = side * ob.normal
         gap = abs(dist) - rho
-        rate = float(n @ d)
+        rate = float(nrm @ d)
         if gap <= EPS:
-            return (0.0, n) if rate < 0.0 else (math.inf, None)
+            return (0.0, nrm) if rate < 0.0 else (math.inf, None)
         if rate >= 0.0 or gap + rate > 0.0:
             return math.inf, None
-        return gap / -rate, n
+        return gap / -rate, nrm
     pts = ob.points
     rad = ob.radius + rho
     dist, normal = _closest_on_hull(p, pts)
@@ -259,7 +262,8 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
             return 0.0, normal
         end_dist, _ = _closest_on_hull(p + d, pts)
         return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
-    best, best_n = math.inf, None
+    best: float = math.inf
+    best_n: np.ndarray | None = None
     n = len(pts)
     for i in range(n):
         s = _ray_circle(p, d, pts[i], rad)
@@ -299,6 +303,10 @@ class Contact:
         for name, pose in first_pose.items():
             self.update_solid(name, pose)
         self.feet: list[Footprint | None] = [robot_footprint(parts) for parts, _ in robots]
+        nan = math.nan                            # robots without a footprint never match the broad phase
+        self._radius = np.array([f.radius if f else nan for f in self.feet], dtype=np.float64)
+        self._z_low = np.array([f.z_low if f else nan for f in self.feet], dtype=np.float64)
+        self._z_high = np.array([f.z_high if f else nan for f in self.feet], dtype=np.float64)
         self.centres = np.array([[p.translation[0], p.translation[1]] for _, p in robots], dtype=np.float64).reshape(-1, 2)
         self.heights = np.array([p.translation[2] for _, p in robots], dtype=np.float64)
         self.contacts = 0                         # robot-steps whose motion was clipped
@@ -320,31 +328,91 @@ class Contact:
         self._obs = obs
         self._lo = np.array([o.lo for o in obs]).reshape(-1, 2)
         self._hi = np.array([o.hi for o in obs]).reshape(-1, 2)
+        self._zlo = np.array([o.z_range[0] for o in obs], dtype=np.float64)
+        self._zhi = np.array([o.z_range[1] for o in obs], dtype=np.float64)
 
     def place(self, index: int, pose: Pose) -> None:
         """A robot was moved from outside (set_pose, reset): no contact check, as in Webots."""
         self.centres[index] = pose.translation[:2]
         self.heights[index] = pose.translation[2]
 
-    def resolve(self, index: int, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, bool]:
+    def resolve(self, index: int, start, end) -> tuple[np.ndarray, bool]:
         """Clip robot ``index``'s move from ``start`` to ``end`` (xy): ``(final xy, clipped)``."""
-        foot = self.feet[index]
-        if foot is None:
-            self.centres[index] = end
-            return end, False
-        low, high = self.heights[index] + foot.z_low, self.heights[index] + foot.z_high
-        R = foot.radius
-        p = np.array(start, dtype=np.float64)
-        d = np.array(end, dtype=np.float64) - p
-        candidates = self._candidates(index, p, d, R, low, high)
+        return self.resolve_all([index], np.asarray([start], dtype=np.float64),
+                                np.asarray([end], dtype=np.float64))[0]
+
+    def resolve_all(self, indices: list[int], starts: np.ndarray, ends: np.ndarray) -> list[tuple[np.ndarray, bool]]:
+        """Clip the moves of several robots (one basic step), in order: each sees the others where
+        they are when its turn comes. One vectorised broad phase for all of them: a move (with its
+        slides) never leaves the disc of radius |end - start| around its start."""
+        k = len(indices)
+        idx = np.asarray(indices, dtype=np.int64)
+        reach = np.hypot(*(ends - starts).T) + EPS
+        R = self._radius[idx]
+        box_lo = starts - (reach + R)[:, None]
+        box_hi = starts + (reach + R)[:, None]
+        band_lo = self.heights[idx] + self._z_low[idx]
+        band_hi = self.heights[idx] + self._z_high[idx]
+        if len(self._obs):
+            solid_hit = (np.all((self._lo[None] <= box_hi[:, None]) & (self._hi[None] >= box_lo[:, None]), axis=2)
+                         & (self._zhi[None] > band_lo[:, None] + EPS) & (self._zlo[None] < band_hi[:, None] - EPS))
+        robot_hit = None
+        if len(self.feet) > 1:
+            # where every robot may be during this step: its disc, grown by its own move if it moves
+            grow = np.zeros(len(self.feet))
+            grow[idx] = reach
+            r_all = self._radius + grow
+            c = self.centres
+            a_lo, a_hi = self.heights + self._z_low, self.heights + self._z_high
+            robot_hit = ((c[None, :, 0] + r_all[None] >= box_lo[:, None, 0]) & (c[None, :, 0] - r_all[None] <= box_hi[:, None, 0])
+                         & (c[None, :, 1] + r_all[None] >= box_lo[:, None, 1]) & (c[None, :, 1] - r_all[None] <= box_hi[:, None, 1])
+                         & (a_hi[None] > band_lo[:, None] + EPS) & (a_lo[None] < band_hi[:, None] - EPS))
+            robot_hit[np.arange(k), idx] = False
+        near_solids: list[list[int]] = [[] for _ in range(k)]
+        near_robots: list[list[int]] = [[] for _ in range(k)]
+        if len(self._obs):
+            for m, j in zip(*(x.tolist() for x in np.nonzero(solid_hit))):
+                near_solids[m].append(j)
+        if robot_hit is not None:
+            for m, j in zip(*(x.tolist() for x in np.nonzero(robot_hit))):
+                near_robots[m].append(j)
+        out = []
+        for m in range(k):
+            i = int(idx[m])
+            if self.feet[i] is None:
+                self.centres[i] = ends[m]
+                out.append((ends[m].copy(), False))
+                continue
+            cands: list[Obstacle] = [self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m]))
+                                     for j in near_solids[m]]
+            if near_robots[m]:
+                for j in near_robots[m]:
+                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[j][None, :].copy(), float(self._radius[j]),
+                                          (float(self.heights[j] + self._z_low[j]), float(self.heights[j] + self._z_high[j]))))
+            p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], float(R[m]), cands)
+            self.centres[i] = p
+            out.append((p, clipped))
+        return out
+
+    @staticmethod
+    def _in_band(ob: Obstacle, low: float, high: float) -> Obstacle:
+        if ob.sphere:
+            cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
+            return Obstacle(ob.name, -1, ob.points, sphere_radius_in_band(cz, ob.radius, low, high), ob.z_range)
+        return ob
+
+    def _clip(self, p: np.ndarray, d: np.ndarray, R: float, cands: list[Obstacle]) -> tuple[np.ndarray, bool]:
+        """The narrow phase: stop at the first contact, slide on, at most MAX_SLIDES times."""
+        if not cands:
+            return p + d, False
         clipped = False
         for _ in range(MAX_SLIDES + 1):
             if not (d[0] or d[1]):
                 break
             best, best_n = math.inf, None
-            for ob, rho_extra in candidates:
+            for ob in cands:
                 self.checks += 1
-                s, n = time_of_impact(p, d, ob, R + rho_extra)
+                s, n = time_of_impact(p, d, ob, R)
                 if s < best:
                     best, best_n = s, n
             if best_n is None:
@@ -357,39 +425,6 @@ class Contact:
             rest = (1.0 - s) * d
             into = float(rest @ best_n)
             d = rest - into * best_n if into < 0.0 else rest
-        else:
-            pass                                  # out of slides: stay where the last one ended
         if clipped:
             self.contacts += 1
-        self.centres[index] = p
         return p, clipped
-
-    def _candidates(self, index: int, p: np.ndarray, d: np.ndarray, R: float, low: float,
-                    high: float) -> list[tuple[Obstacle, float]]:
-        """Obstacles whose inflated AABB meets the move's AABB and whose height band meets the robot's."""
-        lo = np.minimum(p, p + d) - R - EPS
-        hi = np.maximum(p, p + d) + R + EPS
-        out: list[tuple[Obstacle, float]] = []
-        if len(self._obs):
-            hit = np.all((self._lo <= hi) & (self._hi >= lo), axis=1)
-            for i in np.flatnonzero(hit):
-                ob = self._obs[i]
-                if ob.z_range[1] <= low + EPS or ob.z_range[0] >= high - EPS:
-                    continue
-                prim = self.prims.get(ob.name)
-                if isinstance(prim, geo.Sphere):
-                    cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
-                    rr = sphere_radius_in_band(ob, cz, prim.radius, low, high)
-                    out.append((Obstacle(ob.name, -1, ob.points, rr, ob.z_range), 0.0))
-                else:
-                    out.append((ob, 0.0))
-        for j, foot in enumerate(self.feet):
-            if j == index or foot is None:
-                continue
-            lo_j, hi_j = self.heights[j] + foot.z_low, self.heights[j] + foot.z_high
-            if hi_j <= low + EPS or lo_j >= high - EPS:
-                continue
-            c = self.centres[j]
-            if np.all(c + foot.radius >= lo) and np.all(c - foot.radius <= hi):
-                out.append((Obstacle(f"robot {j}", j, c[None, :].copy(), foot.radius, (lo_j, hi_j)), 0.0))
-        return out

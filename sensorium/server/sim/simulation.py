@@ -198,9 +198,12 @@ class Simulation:
 
     @classmethod
     def from_file(cls, path: str | Path, precision: Precision | str = Precision.EXACT, *,
-                  limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> Simulation:
-        """``limits``/``allow_outside_meshes``: see :func:`sensorium.server.world.loader.load_world`."""
-        return cls(load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes), precision)
+                  limits: WorldLimits | None = None, allow_outside_meshes: bool = False,
+                  contact: bool | None = None) -> Simulation:
+        """``limits``/``allow_outside_meshes``: see :func:`sensorium.server.world.loader.load_world`;
+        ``contact``: kinematic contact on/off (default: the world's ``world_info.contact``)."""
+        return cls(load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes), precision,
+                   contact=contact)
 
     # ------------------------------------------------------------------ access
     @property
@@ -259,19 +262,24 @@ class Simulation:
         self.step_count += 1
         now = self.time_ms
         dt = self.basic_time_step
-        contact = self.contact
+        moved: list[tuple[RobotState, DifferentialDrive, tuple[float, float], Pose]] = []
         for robot in self._driven:
             drive = robot.drive
             assert drive is not None
             start = (drive.x, drive.y)
             pose = drive.step(dt)
             if pose is not None:
-                if contact is not None:
-                    end, clipped = contact.resolve(robot.index, np.array(start), np.array([drive.x, drive.y]))
-                    if clipped:
-                        drive.x, drive.y = float(end[0]), float(end[1])
-                        pose = drive.pose()
-                self.scene.set_robot_pose(robot.index, pose)
+                moved.append((robot, drive, start, pose))
+        if self.contact is not None and moved:
+            ends = self.contact.resolve_all([r.index for r, _, _, _ in moved], np.array([s for _, _, s, _ in moved]),
+                                            np.array([(d.x, d.y) for _, d, _, _ in moved]))
+            for k, (end, clipped) in enumerate(ends):
+                if clipped:
+                    robot, drive, start, _ = moved[k]
+                    drive.x, drive.y = float(end[0]), float(end[1])
+                    moved[k] = (robot, drive, start, drive.pose())
+        for robot, _, _, pose in moved:
+            self.scene.set_robot_pose(robot.index, pose)
         poses = self.scene.robot_poses
         lights: list[LightSensor] = []
         distances: list[DistanceSensor] = []

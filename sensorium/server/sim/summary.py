@@ -21,7 +21,9 @@ def device_line(d) -> str:
     if isinstance(d, wm.LightSensor):
         return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
     if isinstance(d, wm.PositionSensor):
-        return f"PositionSensor of {d.motor!r}"
+        return f"PositionSensor on {d.motor!r} noise {d.noise:g} resolution {d.resolution:g}"
+    if isinstance(d, wm.LED):
+        return f"LED {'gradual' if d.gradual else f'{len(d.color)} colours'}"
     return d.device
 
 
@@ -49,7 +51,7 @@ def world_summary(path: str | Path) -> dict:
         "triangles": scene.triangle_count,
         "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
         "robots": [
-            {"name": r.name, "synchronization": r.synchronization,
+            {"name": r.name, "synchronization": r.synchronization, "supervisor": r.supervisor,
              "devices": [{"name": d.name, "device": d.device, "summary": device_line(d)} for d in r.devices]}
             for r in w.robots
         ],

@@ -201,37 +201,47 @@ def _named(data: Any, problems: list[Problem]) -> list[Problem]:
 
 def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
     """A Webots world, converted (``sensorium.server.world.wbt``); problems point at its lines.
-
-    ``LoadedWorld.text`` is the converted world as YAML (what recordings attach and replays read)."""
+    ``LoadedWorld.text`` is the .wbt file as read (recordings attach it under its own name)."""
     from sensorium.server.world.wbt import WbtSyntaxError, wbt_to_dict
 
     source = str(path)
-    read_world_text(path, limits)                  # the size limit (and a readable file)
+    text = read_world_text(path, limits)           # the size limit (and a readable file)
     try:
         data, warnings, origin = wbt_to_dict(path)
     except WbtSyntaxError as exc:
         where = f"line {exc.line}, column {exc.col}" if exc.line else ""
         raise WorldError(source, [Problem(where, exc.message)]) from None
-    text = yaml.safe_dump(data, sort_keys=False).encode()
     try:
         loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
                              allow_outside_meshes=allow_outside_meshes)
     except WorldError as exc:
         raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
+    placed = []
+    for w in loaded.warnings:   # sanitising warnings start with the converted path: add the .wbt line
+        where, _, message = w.partition(": ")
+        at = _origin_of(where, origin)
+        placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w)
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
-                       warnings=[*warnings, *loaded.warnings])
+                       warnings=[*warnings, *placed])
+
+
+def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:
+    """(line, column, node type) of the .wbt node a converted world path came from."""
+    key = path
+    while key:
+        if key in origin:
+            return origin[key]
+        cut = max(key.rfind("."), key.rfind("["))
+        key = key[:cut] if cut > 0 else ""
+    return None
 
 
 def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem:
     """A problem of the converted world, placed at the .wbt node it came from."""
-    best = ""
-    for key in origin:
-        if len(key) > len(best) and (p.path == key or p.path.startswith(key + ".") or p.path.startswith(key + "[")):
-            best = key
-    if not best:
+    at = _origin_of(p.path, origin)
+    if at is None:
         return p
-    line, col, kind = origin[best]
-    return Problem(f"line {line}, column {col} ({kind}, converted as {p.path})", p.message)
+    return Problem(f"line {at[0]}, column {at[1]} ({at[2]}, converted as {p.path})", p.message)
 
 
 def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"", *,
@@ -322,6 +332,8 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
     unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
     unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
     unique([(p, lt.name) for p, lt in all_lights(world)], "light")
+    unique([(f"robots[{i}].def_name", r.def_name) for i, r in enumerate(world.robots)]
+           + [(f"solids[{i}].def_name", s.def_name) for i, s in enumerate(world.solids)], "DEF")
 
     for p, geom in all_geometries(world):
         problems += _check_geometry(geom, p, base_dir)

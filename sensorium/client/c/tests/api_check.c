@@ -109,6 +109,16 @@ int main(void) {
   printf("error.bad_step %d\n", status);
   printf("robot.step %d\n", wb_robot_step((int)wb_robot_get_basic_time_step()));
   printf("robot.time_after %.17g\n", wb_robot_get_time());
+  /* step_begin, a request while the step is pending (its reply may come first), step_end */
+  int begun = wb_robot_step_begin((int)wb_robot_get_basic_time_step());
+  if (wb_device_get_node_type(first) == WB_NODE_DISTANCE_SENSOR)
+    wb_distance_sensor_enable(first, (int)wb_robot_get_basic_time_step());
+  else
+    wb_lidar_enable(first, (int)wb_robot_get_basic_time_step());
+  int again = wb_robot_step_begin(1); /* refused: one is pending */
+  int ended = wb_robot_step_end();
+  printf("pipelined %d,%d,%d,%.17g\n", begun, again, ended, wb_robot_get_time());
+  printf("no_pending %d\n", wb_robot_step_end());
   wb_robot_cleanup();
   return 0;
 }

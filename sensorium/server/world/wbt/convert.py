@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -28,12 +29,14 @@ from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
 MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
+MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
-SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "TexturedBackgroundLight", "Fog", "Camera",
-           "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS", "Compass",
-           "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger", "Connector", "Radar",
-           "Altimeter", "VacuumGripper", "Physics", "ImmersionProperties", "ContactProperties", "Damping",
-           "Brake", "Muscle", "Propeller", "Track", "Skin", "CadShape", "Radio"}
+SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "ImmersionProperties",
+           "ContactProperties", "Damping", "Brake", "Muscle", "Propeller", "Skin", "CadShape"}
+# devices not simulated here; they are Solids, so their shapes stay part of the robot's body
+OTHER_DEVICES = {"Camera", "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
+                 "Compass", "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger",
+                 "Connector", "Radar", "Altimeter", "VacuumGripper", "Radio", "Track"}
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh"}
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED"}
@@ -58,6 +61,7 @@ class Frame:
     def then(self, translation, rotation, scale: float = 1.0) -> Frame:
         r2 = axis_angle_matrix(rotation[:3], rotation[3]) if rotation[3] != 0.0 else np.eye(3)
         t = self.rotation @ (self.scale * np.asarray(translation, dtype=np.float64)) + self.translation
+        aa: tuple[float, ...] | None
         if self.aa is not None and self.aa[3] == 0.0:
             aa = tuple(rotation)
         elif rotation[3] == 0.0:
@@ -100,8 +104,12 @@ class Converter:
         self.warnings: list[str] = []
         self.skipped: Counter[str] = Counter()
         self.count = 0
-        self.origin: dict[str, tuple[int, int, str]] = {}     # converted path → (line, col, node type)
+        self.visits = 0
         self.solid_names: Counter[str] = Counter()
+        self.robot_names: Counter[str] = Counter()
+        self.checked: set[int] = set()     # nodes whose field names were checked
+        self.defs: set[str] = set()        # DEF names kept (def_name)
+        self.textured: dict[int, tuple[int, int]] = {}   # appearances with a texture → (line, column)
         self.robot_fields = set(wm.Robot.model_fields)
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
 
@@ -115,6 +123,12 @@ class Converter:
     def error(self, node: Node, message: str) -> WbtSyntaxError:
         return WbtSyntaxError(self.source, node.line, node.col, message)
 
+    def walk(self, node: Node) -> None:
+        """Count a node walked (DEF/USE can make a small file a huge tree)."""
+        self.visits += 1
+        if self.visits > MAX_VISITS:
+            raise self.error(node, f"more than {MAX_VISITS} nodes to walk after DEF/USE expansion")
+
     def tick(self, node: Node) -> None:
         self.count += 1
         if self.count > MAX_PARTS:
@@ -123,10 +137,16 @@ class Converter:
     # ------------------------------------------------------------ top level
     def run(self) -> dict:
         world = Owner("world", {})
+        self.world["world_info"] = {"name": Path(self.source).stem}
         for node in self.wbt.nodes:
             self.visit(node, Frame.identity(), world, top=True)
         if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
             self.world["solids"].append(self.solid_dict(world, {"name": self.unique_name("shapes")}))
+        if self.textured:
+            line, col = min(self.textured.values())
+            n = len(self.textured)
+            self.warnings.append(f"{self.source}:{line}:{col}: textures are not sampled ({n} appearance{'s' if n > 1 else ''}"
+                                 "): a PBRAppearance reads as its baseColor, a textured Appearance as white")
         if self.skipped:
             listed = ", ".join(f"{k} x{v}" if v > 1 else k for k, v in sorted(self.skipped.items()))
             self.warnings.append(f"{self.source}: skipped nodes that do not matter to these sensors: {listed}")
@@ -137,32 +157,43 @@ class Converter:
         n = self.solid_names[name]
         return name if n == 1 else f"{name}({n - 1})"
 
+    def unique_robot(self, name: str) -> str:
+        """Robot names address topics and services, so they must differ (Webots only warns)."""
+        self.robot_names[name] += 1
+        n = self.robot_names[name]
+        return name if n == 1 else f"{name}({n - 1})"
+
     def world_info(self, node: Node) -> None:
         f = self.fields(node)
         step = f.num("basicTimeStep", 32.0)
         if step != int(step) or step < 1:
             raise f.error("basicTimeStep", f"must be a whole number of milliseconds >= 1 here, got {step}")
-        seed = f.int("randomSeed", 0)
+        seed = f.integer("randomSeed", 0)
         if seed < 0:
             raise f.error("randomSeed", "a negative (time-based) seed is not supported: runs here are reproducible")
-        system = f.str("coordinateSystem", "ENU")
+        system = f.string("coordinateSystem", "ENU")
         if system not in ("ENU", "NUE"):
             raise f.error("coordinateSystem", f"{system!r} is not supported (ENU or NUE)")
-        info = {"basic_time_step": int(step), "random_seed": seed, "coordinate_system": system}
-        if f.str("title", ""):
-            info["name"] = f.str("title", "")
+        info = {"name": f.string("title", "") or Path(self.source).stem, "basic_time_step": int(step),
+                "random_seed": seed, "coordinate_system": system}
         self.world["world_info"] = info
 
     # ------------------------------------------------------------ the walk
     def visit(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
+        self.walk(node)
         t = node.type
         f = self.fields(node)
+        self.typos(node)
         if t == "WorldInfo":
             if not top:
                 raise self.error(node, "WorldInfo must be a top-level node")
             self.world_info(node)
         elif t in SKIPPED:
             self.skipped[t] += 1
+        elif t in OTHER_DEVICES:
+            self.skipped[t] += 1
+            if owner.kind == "robot":
+                self.solid_contents(node, self.child_frame(node, frame), owner)
         elif t == "Group":
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
@@ -175,8 +206,10 @@ class Converter:
         elif t in LIGHTS:
             self.light(node, frame, owner)
         elif t == "Robot":
-            if owner.kind != "world" or frame.aa is None or frame.scale != 1.0:
-                self.warn(node, "a Robot inside another node is not supported: skipped")
+            if owner.kind != "world":
+                self.warn(node, "a Robot inside a Solid or another Robot is not supported: skipped")
+            elif frame.scale != 1.0:
+                self.warn(node, "a Robot inside a scaled Transform is not supported: skipped")
             else:
                 self.robot(node, frame)
         elif t == "Solid":
@@ -186,12 +219,37 @@ class Converter:
         elif t in JOINTS:
             self.joint(node, frame, owner)
         elif t in BUILTIN_PROTOS:
-            self.visit(BUILTIN_PROTOS[t](node, self.source), frame, owner, top)
+            system = self.world["world_info"].get("coordinate_system", "ENU")
+            expanded = BUILTIN_PROTOS[t](node, f, system)
+            expanded.def_name = node.def_name
+            self.visit(expanded, frame, owner, top)
         elif t in GEOMETRIES:
             self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
         else:
             self.warn(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
                             f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
+
+    def appearance_note(self, node: Node, message: str) -> None:
+        if message == "texture":   # one summary line for all textures
+            if id(node) not in self.textured:
+                self.textured[id(node)] = (node.line, node.col)
+        else:
+            self.warn(node, message)
+
+    def def_name(self, node: Node, data: dict) -> None:
+        """Keep a robot's or top-level solid's DEF (getFromDef); a DEF reused later keeps its first node."""
+        if node.def_name is not None and node.def_name not in self.defs:
+            self.defs.add(node.def_name)
+            data["def_name"] = node.def_name
+
+    def typos(self, node: Node) -> None:
+        if id(node) in self.checked:
+            return
+        self.checked.add(id(node))
+        for name, meant in fx.field_typos(node):
+            line, col = node.field_pos.get(name, (node.line, node.col))
+            self.warnings.append(f"{self.source}:{line}:{col}: {node.type}.{name}: not a {node.type} field, "
+                                 f"ignored (did you mean {meant}?)")
 
     def child_frame(self, node: Node, frame: Frame) -> Frame:
         f = self.fields(node)
@@ -217,6 +275,12 @@ class Converter:
                              "IndexedFaceSet, Mesh): ignored")
             return
         self.tick(gnode)
+        for checked in (node, gnode, f.node_("appearance") if node.type == "Shape" else None):
+            if checked is not None:
+                self.typos(checked)
+                material = checked.fields.get("material") if checked.type == "Appearance" else None
+                if isinstance(material, Node):
+                    self.typos(material)
         geometry = self.geometry(gnode, frame.scale)
         key = (id(gnode), frame.key())
         if seen_by == "bounding" and key in owner.keys:   # the same geometry seen by both kinds of ray
@@ -224,7 +288,7 @@ class Converter:
             return
         part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
         if seen_by == "visual":
-            app = fx.appearance(f.node_("appearance"), self.source, self.warn)
+            app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note)
             if app is not None:
                 part["appearance"] = app
             owner.keys[key] = part
@@ -234,6 +298,7 @@ class Converter:
     def bounding(self, node: Node | None, frame: Frame, owner: Owner) -> None:
         if node is None:
             return
+        self.walk(node)
         f = self.fields(node)
         if node.type in GEOMETRIES or node.type == "Shape":
             self.shape(node, frame, owner, seen_by="bounding")
@@ -255,13 +320,13 @@ class Converter:
         if t == "Sphere":
             return {"type": "sphere", "radius": f.num("radius", 1.0) * s}
         if t in ("Cylinder", "Capsule"):
-            if not all(f.bool(k, True) for k in ("bottom", "side", "top")):
+            if not all(f.flag(k, True) for k in ("bottom", "side", "top")):
                 self.warn(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
             return {"type": t.lower(), "radius": f.num("radius", 1.0) * s, "height": f.num("height", 2.0) * s}
         if t == "Plane":
             return {"type": "plane", "size": [v * s for v in f.vec("size", (1.0, 1.0))]}
         if t == "Mesh":
-            urls = f.strs("url")
+            urls = f.strings("url")
             if not urls:
                 raise f.error("url", "a Mesh needs a url")
             if "://" in urls[0]:
@@ -303,8 +368,10 @@ class Converter:
             return
         if frame.scale != 1.0:
             raise self.error(node, "a Solid inside a scaled Transform is not supported")
-        name = f.str("name", "solid")
+        name = f.string("name", "solid")
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
+        if owner.kind == "world":
+            self.def_name(node, data)
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data)
@@ -330,17 +397,22 @@ class Converter:
     def robot(self, node: Node, frame: Frame) -> None:
         f = self.fields(node)
         inner = self.child_frame(node, frame)
-        data: dict[str, Any] = {"name": f.str("name", "robot"), "pose": inner.pose(),
-                                "synchronization": f.bool("synchronization", True), "devices": []}
-        controller = f.str("controller", "<extern>")
-        if controller in ("", "void", "<none>"):              # Webots' ways of saying "no controller"
+        name = f.string("name", "robot")
+        unique = self.unique_robot(name)
+        if unique != name:
+            self.warn(node, f"robot name {name!r} used before: renamed {unique!r}")
+        data: dict[str, Any] = {"name": unique, "pose": inner.pose(),
+                                "synchronization": f.flag("synchronization", True), "devices": []}
+        self.def_name(node, data)
+        controller = f.string("controller", "<extern>")
+        if controller in ("", "void"):                      # Webots' other ways of saying "no controller"
             controller = "<none>"
-        elif controller != "<extern>":                         # a controller Webots would start itself
-            self.warn(node, f"Robot controller {controller!r}: Sensorium starts no controllers; the robot is "
-                            "\"<extern>\" (run it with sensorium controller)")
+        if controller not in ("<extern>", "<none>"):
+            self.warn(node, f"Robot {unique!r}: controller {controller!r} is not started here; run it with "
+                            f"`sensorium controller` (the robot is an <extern> robot)")
             controller = "<extern>"
-        extras = {"controller": controller, "supervisor": f.bool("supervisor", False),
-                  "custom_data": f.str("customData", ""), "model": f.str("model", "")}
+        extras = {"controller": controller, "supervisor": f.flag("supervisor", False),
+                  "custom_data": f.string("customData", ""), "model": f.string("model", "")}
         defaults = {"controller": "<extern>", "supervisor": False, "custom_data": "", "model": ""}
         for key, value in extras.items():
             if key in self.robot_fields:
@@ -354,9 +426,28 @@ class Converter:
         self.drive(node, mine)
         if mine.parts:
             data["shapes"] = [_clean_part(p) for p in mine.parts]
+        self.unique_devices(data)
         if not data["devices"]:
             del data["devices"]
         self.world["robots"].append(data)
+
+    def unique_devices(self, robot: dict) -> None:
+        """Device names address topics and services, so a repeated one gets a suffix (Webots warns
+        and its getDevice returns the first); the wheel motors' names count too."""
+        drive = robot.get("differential_drive") or {}
+        seen: Counter[str] = Counter(v for k, v in drive.items() if k in ("left_motor", "right_motor"))
+        for dev in robot["devices"]:
+            name = dev["name"]
+            seen[name] += 1
+            if seen[name] > 1:
+                new, k = name, seen[name] - 1
+                while new in seen:
+                    new, k = f"{name}({k})", k + 1
+                seen[new] += 1
+                dev["name"] = new
+                line, col, _ = dev["_at"]
+                self.warnings.append(f"{self.source}:{line}:{col}: device name {name!r} used before in robot "
+                                     f"{robot['name']!r}: renamed {new!r}")
 
     def device(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
@@ -371,7 +462,7 @@ class Converter:
         if node.type not in self.device_kinds:
             self.warn(node, f"{node.type}: device kind not supported by this version; skipped")
         else:
-            data = {"name": f.str("name", fx.DEVICE_NAMES[node.type]), "pose": inner.pose(), **fx.device(node, f)}
+            data = {"name": f.string("name", fx.DEVICE_NAMES[node.type]), "pose": inner.pose(), **fx.device(node, f)}
             data["_at"] = (node.line, node.col, node.type)
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
@@ -385,13 +476,19 @@ class Converter:
         sensors = [d for d in f.nodes("device") if d.type == "PositionSensor"]
         if owner.kind == "robot" and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
+            if params is not None:
+                self.typos(params)
             pf = self.fields(params) if params is not None else None
             axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
             anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
             m = self.fields(motors[0])
-            owner.wheels.append({"node": node, "motor": m.str("name", "rotational motor"),
+            centre = anchor
+            if end is not None and end.type == "Solid":
+                centre = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
+            owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"),
                                  "max_velocity": m.num("maxVelocity", 10.0),
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
+                                 "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
         elif motors:
             self.warn(node, f"{node.type} motor(s) not part of a wheel: skipped (joints do not move here)")
@@ -417,7 +514,7 @@ class Converter:
             for w in wheels:
                 for s in w["sensors"]:
                     sf = self.fields(s)
-                    robot.data["devices"].append({"name": sf.str("name", "position sensor"), "device": "PositionSensor",
+                    robot.data["devices"].append({"name": sf.string("name", "position sensor"), "device": "PositionSensor",
                                                   "motor": w["motor"], "noise": sf.num("noise", 0.0),
                                                   "resolution": sf.num("resolution", -1.0),
                                                   "_at": (s.line, s.col, s.type)})

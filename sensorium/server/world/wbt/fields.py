@@ -30,7 +30,7 @@ class Fields:
             raise self.error(name, f"expected one number, got {_show(v)}")
         return float(v)
 
-    def int(self, name: str, default: int) -> int:
+    def integer(self, name: str, default: int) -> int:
         v = self.num(name, default)
         if v != int(v):
             raise self.error(name, f"expected an integer, got {v}")
@@ -44,13 +44,13 @@ class Fields:
             raise self.error(name, f"expected {len(default)} numbers, got {_show(v)}")
         return tuple(float(x) for x in v)
 
-    def bool(self, name: str, default: bool) -> bool:
+    def flag(self, name: str, default: bool) -> bool:
         v = self.node.fields.get(name, default)
         if not isinstance(v, bool):
             raise self.error(name, f"expected TRUE or FALSE, got {_show(v)}")
         return v
 
-    def str(self, name: str, default: str) -> str:
+    def string(self, name: str, default: str) -> str:
         v = self.node.fields.get(name, default)
         if isinstance(v, list) and len(v) == 1 and isinstance(v[0], str):
             v = v[0]
@@ -58,7 +58,7 @@ class Fields:
             raise self.error(name, f"expected a string, got {_show(v)}")
         return v
 
-    def strs(self, name: str) -> list[str]:
+    def strings(self, name: str) -> list[str]:
         v = self.node.fields.get(name, [])
         if isinstance(v, str):
             v = [v]
@@ -123,8 +123,8 @@ def light(node: Node, f: Fields) -> dict:
                            "ambient_intensity": f.num("ambientIntensity", 0.0),
                            "intensity": f.num("intensity", 1.0),
                            "color": list(f.vec("color", (1.0, 1.0, 1.0))),
-                           "on": f.bool("on", True),
-                           "cast_shadows": f.bool("castShadows", False)}
+                           "on": f.flag("on", True),
+                           "cast_shadows": f.flag("castShadows", False)}
     if node.type != "DirectionalLight":
         out["attenuation"] = list(f.vec("attenuation", (1.0, 0.0, 0.0)))
         out["location"] = list(f.vec("location", (0.0, 0.0, 0.0)))
@@ -142,21 +142,21 @@ def device(node: Node, f: Fields) -> dict:
     t = node.type
     if t == "DistanceSensor":
         return {"device": t, "lookup_table": [list(r) for r in f.rows("lookupTable", 3, [(0.0, 0.0, 0.0), (0.1, 1000.0, 0.0)])],
-                "type": f.str("type", "generic"), "number_of_rays": f.int("numberOfRays", 1),
+                "type": f.string("type", "generic"), "number_of_rays": f.integer("numberOfRays", 1),
                 "aperture": f.num("aperture", 1.5708), "gaussian_width": f.num("gaussianWidth", 1.0),
                 "resolution": f.num("resolution", -1.0), "red_color_sensitivity": f.num("redColorSensitivity", 1.0)}
     if t == "LightSensor":
         return {"device": t, "lookup_table": [list(r) for r in f.rows("lookupTable", 3, [(0.0, 0.0, 0.0), (1.0, 1000.0, 0.0)])],
-                "color_filter": list(f.vec("colorFilter", (1.0, 1.0, 1.0))), "occlusion": f.bool("occlusion", False),
+                "color_filter": list(f.vec("colorFilter", (1.0, 1.0, 1.0))), "occlusion": f.flag("occlusion", False),
                 "resolution": f.num("resolution", -1.0)}
     if t == "Lidar":
         return {"device": t, "tilt_angle": f.num("tiltAngle", 0.0),
-                "horizontal_resolution": f.int("horizontalResolution", 512),
+                "horizontal_resolution": f.integer("horizontalResolution", 512),
                 "field_of_view": f.num("fieldOfView", 1.5708),
                 "vertical_field_of_view": f.num("verticalFieldOfView", 0.2),
-                "number_of_layers": f.int("numberOfLayers", 4), "near": f.num("near", 0.01),
+                "number_of_layers": f.integer("numberOfLayers", 4), "near": f.num("near", 0.01),
                 "min_range": f.num("minRange", 0.01), "max_range": f.num("maxRange", 1.0),
-                "type": f.str("type", "fixed"), "projection": f.str("projection", "cylindrical"),
+                "type": f.string("type", "fixed"), "projection": f.string("projection", "cylindrical"),
                 "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0),
                 "default_frequency": f.num("defaultFrequency", 10.0), "min_frequency": f.num("minFrequency", 1.0),
                 "max_frequency": f.num("maxFrequency", 25.0)}
@@ -164,7 +164,7 @@ def device(node: Node, f: Fields) -> dict:
         return {"device": t, "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
     if t == "LED":
         colours = f.rows("color", 3, [(1.0, 0.0, 0.0)])
-        return {"device": t, "color": [list(c) for c in colours], "gradual": f.bool("gradual", False)}
+        return {"device": t, "color": [list(c) for c in colours], "gradual": f.flag("gradual", False)}
     raise AssertionError(t)
 
 
@@ -175,21 +175,23 @@ DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light senso
 # ---------------------------------------------------------------- appearance
 
 def appearance(node: Node | None, source: str, warn) -> dict | None:
-    """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read)."""
+    """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read).
+    ``warn(node, "texture")`` notes a texture that is not sampled: a PBRAppearance keeps its
+    baseColor, an Appearance reads white (Webots replaces the material's diffuse colour by the
+    texture's)."""
     if node is None:
         return None
     f = Fields(node, source)
     if node.type == "PBRAppearance":
         if f.node_("baseColorMap") is not None:
-            warn(node, "PBRAppearance.baseColorMap: textures are not sampled; using baseColor alone")
+            warn(node, "texture")
         return {"base_color": list(f.vec("baseColor", (1.0, 1.0, 1.0))),
                 "transparency": f.num("transparency", 0.0), "roughness": f.num("roughness", 0.0)}
     if node.type == "Appearance":
         material = f.node_("material")
         textured = f.node_("texture") is not None
         if textured:
-            warn(node, "Appearance.texture: textures are not sampled; the colour is taken as white (Webots replaces "
-                       "the material's diffuse colour by the texture's)")
+            warn(node, "texture")
         if material is None:
             return {"base_color": [1.0, 1.0, 1.0]}
         m = Fields(material, source)
@@ -197,3 +199,66 @@ def appearance(node: Node | None, source: str, warn) -> dict | None:
         return {"base_color": colour, "transparency": m.num("transparency", 0.0)}
     warn(node, f"appearance {node.type}: not built in (a PROTO?); taken as white")
     return None
+
+
+# ---------------------------------------------------------------- typo check
+
+_SOLID = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
+          "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection", "recognitionColors",
+          "translationStep", "rotationStep", "linearVelocity", "angularVelocity"}
+_ROBOT = _SOLID | {"controller", "controllerArgs", "customData", "supervisor", "synchronization", "battery",
+                   "cpuConsumption", "selfCollision", "window", "remoteControl", "showWindow", "data"}
+_ROUND = {"bottom", "height", "radius", "side", "top", "subdivision"}
+_LIGHT = {"ambientIntensity", "color", "intensity", "on", "castShadows"}
+WEBOTS_FIELDS: dict[str, set[str]] = {
+    "Solid": _SOLID, "Robot": _ROBOT,
+    "Pose": {"translation", "rotation", "children", "translationStep", "rotationStep"},
+    "Transform": {"translation", "rotation", "scale", "children", "translationStep", "rotationStep"},
+    "Group": {"children"},
+    "Shape": {"appearance", "geometry", "castShadows", "isPickable"},
+    "Box": {"size"}, "Sphere": {"radius", "subdivision", "ico"}, "Cylinder": _ROUND, "Capsule": _ROUND,
+    "Plane": {"size"}, "Mesh": {"url", "ccw", "name", "materialIndex"},
+    "IndexedFaceSet": {"coord", "normal", "texCoord", "solid", "ccw", "convex", "normalPerVertex", "coordIndex",
+                       "normalIndex", "texCoordIndex", "creaseAngle"},
+    "Appearance": {"material", "texture", "textureTransform", "name"},
+    "Material": {"ambientIntensity", "diffuseColor", "emissiveColor", "shininess", "specularColor", "transparency"},
+    "PBRAppearance": {"baseColor", "baseColorMap", "transparency", "roughness", "roughnessMap", "metalness",
+                      "metalnessMap", "IBLStrength", "normalMap", "normalMapFactor", "occlusionMap",
+                      "occlusionMapStrength", "emissiveColor", "emissiveColorMap", "emissiveIntensity",
+                      "textureTransform", "name"},
+    "PointLight": _LIGHT | {"attenuation", "location", "radius"},
+    "SpotLight": _LIGHT | {"attenuation", "location", "radius", "beamWidth", "cutOffAngle", "direction"},
+    "DirectionalLight": _LIGHT | {"direction"},
+    "DistanceSensor": _SOLID | {"lookupTable", "type", "numberOfRays", "aperture", "gaussianWidth", "resolution",
+                                "redColorSensitivity"},
+    "LightSensor": _SOLID | {"lookupTable", "colorFilter", "occlusion", "resolution"},
+    "Lidar": _SOLID | {"tiltAngle", "horizontalResolution", "fieldOfView", "verticalFieldOfView", "numberOfLayers",
+                       "near", "minRange", "maxRange", "type", "projection", "noise", "resolution",
+                       "defaultFrequency", "minFrequency", "maxFrequency", "rotatingHead"},
+    "LED": _SOLID | {"color", "gradual"},
+    "PositionSensor": {"name", "noise", "resolution"},
+    "RotationalMotor": {"name", "acceleration", "consumptionFactor", "controlPID", "minPosition", "maxPosition",
+                        "maxVelocity", "multiplier", "sound", "muscles", "maxTorque"},
+    "HingeJoint": {"jointParameters", "device", "endPoint"},
+    "HingeJointParameters": {"position", "axis", "anchor", "minStop", "maxStop", "springConstant",
+                             "dampingConstant", "staticFriction", "suspensionSpringConstant",
+                             "suspensionDampingConstant", "suspensionAxis", "stopERP", "stopCFM"},
+    "Coordinate": {"point"},
+}
+
+
+def field_typos(node: Node) -> list[tuple[str, str]]:
+    """(field, likely meant) for each field of a known node type that is not one of its Webots fields
+    but is close to one: hand-edited worlds' typos, which Webots would reject."""
+    import difflib
+
+    known = WEBOTS_FIELDS.get(node.type)
+    if known is None:
+        return []
+    out = []
+    for name in node.fields:
+        if name not in known:
+            close = difflib.get_close_matches(name, sorted(known), n=1, cutoff=0.75)
+            if close:
+                out.append((name, close[0]))
+    return out

@@ -12,13 +12,14 @@ error names the file, line and column (``WbtSyntaxError``).
 
 from __future__ import annotations
 
+import bisect
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 MAX_FILE_BYTES = 64 * 1024 * 1024
-MAX_DEPTH = 200
+MAX_DEPTH = 100
 MAX_NODES = 1_000_000
 
 _HEADER = re.compile(r"#VRML_SIM\s+R(\d{4})([a-z])\b")
@@ -26,10 +27,11 @@ _TOKEN = re.compile(r"""
     (?P<ws>[\s,]+)
   | (?P<comment>\#[^\n]*)
   | (?P<num>[+-]?(?:0[xX][0-9a-fA-F]+|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(?![A-Za-z_]))
-  | (?P<str>"(?:[^"\\\n]|\\.)*")
+  | (?P<str>"(?:[^"\\]|\\.)*")
   | (?P<punct>[{}\[\]])
   | (?P<name>[^\s,"#'.\[\]{}\\+\-0-9][^\s,"#'\[\]{}\\]*)
-""", re.VERBOSE)
+  | (?P<bad>.)
+""", re.VERBOSE | re.DOTALL)
 
 
 class WbtSyntaxError(Exception):
@@ -40,12 +42,33 @@ class WbtSyntaxError(Exception):
         super().__init__(f"{source}:{line}:{col}: {message}" if line else f"{source}: {message}")
 
 
-@dataclass(frozen=True, slots=True)
+class _Lines:
+    """Offset → (line, column), both 1-based, by bisection over the newline offsets."""
+
+    def __init__(self, text: str):
+        self.starts = [0] + [m.end() for m in re.finditer("\n", text)]
+
+    def at(self, pos: int) -> tuple[int, int]:
+        i = bisect.bisect_right(self.starts, pos) - 1
+        return i + 1, pos - self.starts[i] + 1
+
+
 class Token:
-    kind: str      # "num", "str", "name", "{", "}", "[", "]", "eof"
-    text: str
-    line: int
-    col: int
+    """One token: kind ("num", "str", "name", "{", "}", "[", "]", "eof"), text, offset; its line
+    and column are computed when asked (errors and node positions only)."""
+
+    __slots__ = ("kind", "text", "pos", "lines")
+
+    def __init__(self, kind: str, text: str, pos: int, lines: _Lines):
+        self.kind, self.text, self.pos, self.lines = kind, text, pos, lines
+
+    @property
+    def line(self) -> int:
+        return self.lines.at(self.pos)[0]
+
+    @property
+    def col(self) -> int:
+        return self.lines.at(self.pos)[1]
 
 
 @dataclass(eq=False)
@@ -68,26 +91,23 @@ class WbtFile:
 
 
 def tokenize(text: str, source: str) -> list[Token]:
+    lines = _Lines(text)
     tokens: list[Token] = []
-    pos, line, line_start, n = 0, 1, 0, len(text)
-    while pos < n:
-        m = _TOKEN.match(text, pos)
-        if m is None:
-            ch = text[pos]
-            what = "unterminated string" if ch == '"' else f"unexpected character {ch!r}"
-            raise WbtSyntaxError(source, line, pos - line_start + 1, what)
+    append = tokens.append
+    for m in _TOKEN.finditer(text):
         kind = m.lastgroup
+        if kind == "ws" or kind == "comment":
+            continue
         value = m.group()
         if kind == "punct":
-            tokens.append(Token(value, value, line, pos - line_start + 1))
-        elif kind in ("num", "str", "name"):
-            tokens.append(Token(kind, value, line, pos - line_start + 1))
-        newlines = value.count("\n")
-        if newlines:
-            line += newlines
-            line_start = pos + value.rindex("\n") + 1
-        pos = m.end()
-    tokens.append(Token("eof", "", line, pos - line_start + 1))
+            append(Token(value, value, m.start(), lines))
+        elif kind == "bad":
+            line, col = lines.at(m.start())
+            what = "unterminated string" if value == '"' else f"unexpected character {value!r}"
+            raise WbtSyntaxError(source, line, col, what)
+        else:
+            append(Token(kind, value, m.start(), lines))  # type: ignore[arg-type]
+    append(Token("eof", "", len(text), lines))
     return tokens
 
 
@@ -98,6 +118,7 @@ def _unquote(text: str) -> str:
 class _Parser:
     def __init__(self, tokens: list[Token], source: str):
         self.t = tokens
+        self.n = len(tokens)
         self.i = 0
         self.source = source
         self.defs: dict[str, Node] = {}
@@ -107,7 +128,8 @@ class _Parser:
         return WbtSyntaxError(self.source, tok.line, tok.col, message)
 
     def peek(self, k: int = 0) -> Token:
-        return self.t[min(self.i + k, len(self.t) - 1)]
+        j = self.i + k
+        return self.t[j] if j < self.n else self.t[-1]
 
     def take(self) -> Token:
         tok = self.t[self.i]
@@ -157,7 +179,7 @@ class _Parser:
         if self.count > MAX_NODES:
             raise self.error(tok, f"more than {MAX_NODES} nodes")
         self.expect("{", f"'{{' after node type {tok.text}")
-        node = Node(tok.text, {}, tok.line, tok.col, def_name)
+        node = Node(tok.text, {}, *tok.lines.at(tok.pos), def_name)
         while True:
             ftok = self.take()
             if ftok.kind == "}":
@@ -168,7 +190,7 @@ class _Parser:
                 self.expect("name", "a field name after 'hidden'")
                 self.value(depth + 1)
                 continue
-            node.field_pos[ftok.text] = (ftok.line, ftok.col)
+            node.field_pos[ftok.text] = ftok.lines.at(ftok.pos)
             node.fields[ftok.text] = self.value(depth + 1)
         if def_name is not None:
             self.defs[def_name] = node

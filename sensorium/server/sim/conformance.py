@@ -4,8 +4,8 @@ computed from the in-process :class:`~sensorium.server.sim.simulation.Simulation
 do not depend on any client: a client that replays the session's script against ``sensorium serve
 sensorium/schemas/conformance/world.yaml`` must print exactly these lines.
 
-    python -m sensorium.server.conformance            # exit 1 if a vector file is out of date
-    python -m sensorium.server.conformance --write    # regenerate them
+    python -m sensorium.server.sim.conformance            # exit 1 if a vector file is out of date
+    python -m sensorium.server.sim.conformance --write    # regenerate them
 
 The script language and the line format are described in the conformance README. The client
 semantics the lines encode: a sensor's value is NaN (a lidar's buffers zeros) until it has
@@ -68,6 +68,7 @@ def expected_lines(world: Path = WORLD, robot: str = ROBOT, script: list[str] = 
     period: dict[str, int] = {}
     pc: dict[str, bool] = {}
     lines: list[str] = []
+    dev: Any                                # a sensor of any kind
     i = 0
     while i < len(script):
         op = script[i]
@@ -253,7 +254,7 @@ def session_text() -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m sensorium.server.conformance", description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(prog="python -m sensorium.server.sim.conformance", description=__doc__.split("\n\n")[0])
     p.add_argument("--write", action="store_true", help="regenerate session.json and requests.json")
     args = p.parse_args(argv)
     outdated = []
@@ -264,7 +265,7 @@ def main(argv: list[str] | None = None) -> int:
         elif not path.is_file() or path.read_text() != text:
             outdated.append(path)
     for path in outdated:
-        print(f"{path} is out of date: run python -m sensorium.server.conformance --write", file=sys.stderr)
+        print(f"{path} is out of date: run python -m sensorium.server.sim.conformance --write", file=sys.stderr)
     if not args.write and not outdated:
         print(f"{SESSION.name} and {REQUESTS.name} are up to date")
     return 1 if outdated else 0

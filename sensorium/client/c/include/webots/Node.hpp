@@ -1,0 +1,41 @@
+// Sensorium C++ controller layer: a supervisor node (a robot or a solid of the world).
+#ifndef WEBOTS_NODE_HPP
+#define WEBOTS_NODE_HPP
+
+#include <map>
+#include <string>
+
+#include <webots/Field.hpp>
+#include <webots/supervisor.h>
+
+namespace webots {
+
+class Node {
+public:
+  explicit Node(WbNodeRef ref) : ref_(ref) {}
+  ~Node() {
+    for (std::map<WbFieldRef, Field *>::iterator it = fields_.begin(); it != fields_.end(); ++it)
+      delete it->second;
+  }
+  Field *getField(const std::string &name) {
+    WbFieldRef ref = wb_supervisor_node_get_field(ref_, name.c_str());
+    if (ref == 0)
+      return 0;
+    Field *&f = fields_[ref];
+    if (f == 0)
+      f = new Field(ref);
+    return f;
+  }
+  const double *getPosition() const { return wb_supervisor_node_get_position(ref_); }
+  const double *getOrientation() const { return wb_supervisor_node_get_orientation(ref_); }
+
+private:
+  WbNodeRef ref_;
+  std::map<WbFieldRef, Field *> fields_;
+  Node(const Node &);
+  Node &operator=(const Node &);
+};
+
+}  // namespace webots
+
+#endif

@@ -1,0 +1,122 @@
+"""Frame names and fixed transforms shared by the Foxglove scene and the ROS 2 export (no
+foxglove-sdk needed): ``world``; ``<robot>`` placed by the robot's pose; ``<robot>/<device>`` fixed
+on its robot by the device's ``pose``."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.world.geometry import Pose
+from sensorium.server.world.poses import matrix_quaternion, pose_from_model
+
+__all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "Mount", "mounts", "quat_from_x", "Body", "bodies", "lights",
+           "shape_rgba", "GHOST_ALPHA"]
+
+WORLD_FRAME = "world"
+INFINITE_PLANE_SIZE = 50.0      # metres: an infinite plane is drawn as a square of this side
+
+NO_APPEARANCE = (0.85, 0.85, 0.85)  # a shape without appearance (Webots draws it white: grey shows on a light floor)
+GHOST_ALPHA = 0.25               # bounding-only shapes (invisible in Webots) are drawn this translucent
+
+Mount = tuple[str, tuple[float, float, float], tuple[float, float, float, float]]
+
+
+def shape_rgba(shape: Any, ghost: bool = False) -> tuple[float, float, float, float]:
+    """A shape's drawing colour: ``base_color`` with alpha 1 - transparency (light grey without an
+    appearance); a bounding-only (``ghost``) shape at alpha ``GHOST_ALPHA``, so that even a fully
+    transparent one (a glass pane sonars see) shows."""
+    a = shape.appearance
+    r, g, b = NO_APPEARANCE if a is None else (float(c) for c in a.base_color)
+    alpha = 1.0 if a is None else float(1.0 - a.transparency)
+    if ghost:
+        alpha = GHOST_ALPHA
+    return r, g, b, alpha
+
+
+def mounts(world: wm.World) -> dict[str, list[Mount]]:
+    """robot → [(device frame, translation, quaternion xyzw)] of the robot's devices."""
+    out: dict[str, list[Mount]] = {}
+    for r in world.robots:
+        items: list[Mount] = []
+        for d in r.devices:
+            p = pose_from_model(d.pose)
+            t = (float(p.translation[0]), float(p.translation[1]), float(p.translation[2]))
+            items.append((f"{r.name}/{d.name}", t, matrix_quaternion(p.rotation)))
+        out[r.name] = items
+    return out
+
+
+def quat_from_x(d: np.ndarray) -> tuple[float, float, float, float]:
+    """The rotation (x, y, z, w) taking +x onto the unit vector ``d`` (arrows point along +x)."""
+    x = np.array([1.0, 0.0, 0.0])
+    axis = np.cross(x, d)
+    s, c = float(np.linalg.norm(axis)), float(np.dot(x, d))
+    if s < 1e-12:
+        return (0.0, 0.0, 0.0, 1.0) if c > 0 else (0.0, 0.0, 1.0, 0.0)
+    axis /= s
+    half = np.arctan2(s, c) / 2.0
+    sh = float(np.sin(half))
+    return (float(axis[0]) * sh, float(axis[1]) * sh, float(axis[2]) * sh, float(np.cos(half)))
+
+
+@dataclass(frozen=True)
+class Body:
+    """One drawn object: a top-level solid (all its shapes and children, world poses) or a robot's
+    body (its shapes, poses in the robot frame; ``frame_locked`` so it moves with the robot)."""
+
+    entity_id: str
+    frame_id: str
+    kind: str                                   # solid | robot
+    frame_locked: bool
+    parts: list[tuple[Any, Pose, bool]]         # (Shape-like model, pose in frame_id, ghost: bounding-only)
+
+
+def bodies(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Iterator[Body]:
+    """Every solid and robot body to draw, with every shape: ``ghost`` marks a bounding-only shape
+    (Webots' invisible boundingObject, seen only by generic/sonar/laser rays), drawn translucent.
+    ``solid_poses`` overrides where a solid is now."""
+    from sensorium.server.sim.scene import robot_parts, solid_parts
+
+    for s in world.solids:
+        top = (solid_poses or {}).get(s.name) or pose_from_model(s.pose)
+        parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in solid_parts(s, top)]
+        if parts:
+            yield Body(f"solid/{s.name}", WORLD_FRAME, "solid", False, parts)
+    for r in world.robots:
+        parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in robot_parts(r)]
+        if parts:
+            yield Body(f"robot/{r.name}", r.name, "robot", True, parts)
+
+
+def lights(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Iterator[tuple[str, str, bool, Any]]:
+    """Every light to draw: (entity id, frame, frame_locked, light model with location/direction in
+    that frame). World and solid lights are in ``world``; a robot's lights ride in its frame (a
+    DirectionalLight's direction stays in world axes wherever it is attached, as in Webots)."""
+    from sensorium.server.sim.scene import place_light, solid_lights
+
+    seen: set[str] = set()
+
+    def unique(name: str) -> str:
+        base, n = f"light/{name}", 1
+        out = base
+        while out in seen:
+            n += 1
+            out = f"{base}#{n}"
+        seen.add(out)
+        return out
+
+    for i, lt in enumerate(world.lights):
+        yield unique(lt.name or f"light{i}"), WORLD_FRAME, False, lt
+    for s in world.solids:
+        top = (solid_poses or {}).get(s.name) or pose_from_model(s.pose)
+        for j, (lt, local) in enumerate(solid_lights(s, Pose.identity())):
+            yield unique(lt.name or f"{s.name}/light{j}"), WORLD_FRAME, False, place_light(lt, top.compose(local))
+    for r in world.robots:
+        for j, lt in enumerate(r.lights):
+            frame = WORLD_FRAME if lt.type == "DirectionalLight" else r.name
+            yield unique(lt.name or f"{r.name}/light{j}"), frame, frame != WORLD_FRAME, lt

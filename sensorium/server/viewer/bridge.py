@@ -1,0 +1,370 @@
+"""A Foxglove WebSocket server fed by the daemon's topics (or a replay), built on ``foxglove-sdk``.
+
+Channels (all advertised at start):
+
+* every Sensorium topic under its own name, ``cdr`` encoded with its ROS 2 ``ros2msg`` schema —
+  the bytes of :class:`sensorium.server.recording.export.CdrEncoder`, i.e. the same bytes as
+  ``sensorium export``; a lidar's ``point_cloud`` is offered as ``sensor_msgs/msg/PointCloud2``
+  (Foxglove's 3D panel does not draw the old ``PointCloud``);
+* ``/tf`` — ``foxglove.FrameTransforms`` (protobuf): ``world → <robot>`` at the robot's pose and
+  ``<robot> → <robot>/<device>`` mounts, one message per robot pose;
+* ``/scene`` — ``foxglove.SceneUpdate`` (protobuf): the world (see :mod:`sensorium.server.recording.scene3d`), sent to each
+  client when it subscribes (robot bodies follow ``/tf``).
+
+Demand: a client subscribing to a topic's channel makes that topic demanded exactly like a ZeroMQ
+subscriber (``Topics.set_viewer_demand``); ``/tf`` demands every ``/<robot>/pose``; the last
+unsubscription (or a disconnect) stops the work. The SDK calls the listener from its own thread;
+the events are applied by the step-loop thread in :meth:`FoxgloveBridge.pump` (a transport hook).
+
+Never slowing the step loop: :meth:`record` (called by ``Topics`` in the step thread) only appends
+the msgpack bytes to a bounded queue (the oldest is dropped when full, ``dropped`` counts it); a
+worker thread encodes CDR/protobuf and hands the bytes to the SDK, whose per-client backlog drops
+the oldest messages of a slow client. Simulated time is broadcast as the server time. When a
+supervisor moves a solid, the scene is sent again to every ``/scene`` subscriber.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import Counter, deque
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any, cast
+
+import msgpack
+
+from sensorium.schemas import world as wm
+from sensorium.server.recording.export import CdrEncoder, ExportError
+from sensorium.server.recording.ros_views import pose_robot
+
+__all__ = ["FoxgloveBridge", "ViewerError", "parse_address", "exposure_warning", "TF_TOPIC", "SCENE_TOPIC", "POSE_TYPE"]
+
+TF_TOPIC = "/tf"
+SCENE_TOPIC = "/scene"
+POSE_TYPE = "geometry_msgs/msg/PoseStamped"
+DEFAULT_PORT = 8765
+
+
+class ViewerError(Exception):
+    """A bad ``--foxglove`` address, a missing SDK or a port that cannot be bound."""
+
+
+def parse_address(text: str) -> tuple[str, int]:
+    """``PORT``, ``HOST:PORT`` or ``[v6]:PORT`` → (host, port); host defaults to 127.0.0.1."""
+    text = text.strip()
+    host, port_s = "127.0.0.1", text
+    if text.startswith("["):
+        end = text.find("]")
+        if end < 0 or not text[end + 1:].startswith(":"):
+            raise ViewerError(f"--foxglove {text!r}: expected [HOST]:PORT")
+        host, port_s = text[1:end], text[end + 2:]
+    elif ":" in text:
+        host, port_s = text.rsplit(":", 1)
+    try:
+        port = int(port_s)
+    except ValueError:
+        raise ViewerError(f"--foxglove {text!r}: port {port_s!r} is not a number") from None
+    if not 0 <= port <= 65535:
+        raise ViewerError(f"--foxglove {text!r}: port must be within 0..65535 (0 picks a free port)")
+    if not host:
+        raise ViewerError(f"--foxglove {text!r}: empty host")
+    return host, port
+
+
+def exposure_warning(host: str) -> str | None:
+    """A warning when ``host`` is not a loopback address (the server has no authentication)."""
+    import ipaddress
+
+    if host == "localhost":
+        return None
+    try:
+        if ipaddress.ip_address(host).is_loopback:
+            return None
+    except ValueError:
+        pass                                   # a host name: it may resolve to anything
+    return (f"the Foxglove server on {host} is reachable from other machines and has no authentication "
+            "(an SSH tunnel to 127.0.0.1 is the safe way: see README, See it in Foxglove)")
+
+
+class _Listener:
+    """The SDK's ``ServerListener``: counts subscriptions per topic (SDK thread)."""
+
+    def __init__(self, bridge: FoxgloveBridge):
+        self._bridge = bridge
+
+    def on_subscribe(self, client: Any, channel: Any) -> None:
+        self._bridge._subscribed(int(client.id), str(channel.topic), +1)
+
+    def on_unsubscribe(self, client: Any, channel: Any) -> None:
+        self._bridge._subscribed(int(client.id), str(channel.topic), -1)
+
+
+class FoxgloveBridge:
+    """One Foxglove WebSocket server. ``topic_types``: topic → ROS type of its msgpack body;
+    ``world``/``base_dir``: for ``/scene`` and the mounts in ``/tf`` (``None``: no scene);
+    ``on_demand(topics)``: called by :meth:`pump` with the topics viewers demand now;
+    ``wake()``: called from the SDK's thread when :meth:`pump` has something to apply."""
+
+    def __init__(self, topic_types: dict[str, str], world: wm.World | None = None, base_dir: str | Path = ".", *,
+                 host: str = "127.0.0.1", port: int = DEFAULT_PORT, name: str = "sensorium",
+                 on_demand: Callable[[set[str]], None] | None = None, wake: Callable[[], None] | None = None,
+                 solid_poses: Callable[[], dict[str, Any]] | None = None, queue_size: int = 512,
+                 backlog: int = 256, distro: str = "jazzy"):
+        try:
+            import foxglove
+            from foxglove.messages import FrameTransforms, SceneUpdate
+            from foxglove.websocket import Capability
+        except ImportError as exc:  # pragma: no cover - depends on the environment
+            raise ViewerError("the Foxglove viewer needs the 'foxglove' extra: pip install 'sensorium[foxglove]'") from exc
+        from sensorium.server.recording import scene3d as fxscene
+        from sensorium.server.recording.frames import mounts
+
+        self._scene_mod = fxscene
+        self.encoder = CdrEncoder(distro, pointcloud2=True)
+        self.world = world
+        self.base_dir = Path(base_dir)
+        self.on_demand = on_demand
+        self.wake = wake or (lambda: None)
+        self.solid_poses = solid_poses
+        self.ctx = foxglove.Context()
+        self.types: dict[str, str] = {}            # topic -> channel schema name
+        self.unsupported: dict[str, str] = {}      # topic -> its type the distro lacks
+        self.channels: dict[str, Any] = {}
+        for topic, ros_type in topic_types.items():
+            typename = self.encoder.export_type(ros_type)
+            if typename is None:
+                self.unsupported[topic] = ros_type
+                continue
+            schema = foxglove.Schema(name=typename, encoding="ros2msg", data=self.encoder.msgdef(typename).encode())
+            self.channels[topic] = foxglove.Channel(topic, schema=schema, message_encoding="cdr", context=self.ctx)
+            self.types[topic] = typename
+        self.pose_robot = {t: r for t, ty in topic_types.items() if (r := pose_robot(t, ty)) is not None}
+        self.mounts = mounts(world) if world is not None else {}
+        self.tf_channel = None
+        if self.pose_robot:
+            self.tf_channel = foxglove.Channel(TF_TOPIC, schema=FrameTransforms.get_schema(), message_encoding="protobuf",
+                                               context=self.ctx)
+        self.scene_channel = None
+        if world is not None:
+            self.scene_channel = foxglove.Channel(SCENE_TOPIC, schema=SceneUpdate.get_schema(),
+                                                  message_encoding="protobuf", context=self.ctx)
+        # subscription state (SDK thread writes, step thread reads; guarded by _lock)
+        self._lock = threading.Lock()
+        self._subs: Counter[str] = Counter()
+        self._clients: Counter[tuple[int, str]] = Counter()
+        self._dirty = False
+        self._scene_for: deque[int | None] = deque()     # client ids to send the scene to (None: all)
+        self._scene_bytes: bytes | None = None
+        self._scene_key: Any = None
+        self._seen_poses: list[Any] = []
+        # data path
+        self._queue: deque[tuple[str, str, bytes, int]] = deque()
+        self.queue_size = max(1, int(queue_size))
+        self.dropped = 0
+        self.sent = 0
+        self.errors: dict[str, str] = {}
+        self._time_ns = 0
+        self._sent_time_ns = -1
+        self._event = threading.Event()
+        self._stop = False
+        try:
+            self.server = foxglove.start_server(name=name, host=host, port=port, capabilities=[Capability.Time],
+                                                server_listener=cast(Any, _Listener(self)), context=self.ctx,
+                                                message_backlog_size=backlog)
+        except Exception as exc:  # the SDK raises RuntimeError on a busy/bad address
+            raise ViewerError(f"cannot start the Foxglove server on {host}:{port}: {exc}") from None
+        self.host, self.port = host, int(self.server.port)
+        self._worker = threading.Thread(target=self._run, name="foxglove-bridge", daemon=True)
+        self._worker.start()
+
+    # ------------------------------------------------------------------ wiring
+    @classmethod
+    def for_core(cls, core: Any, transport: Any, host: str = "127.0.0.1", port: int = DEFAULT_PORT,
+                 **kw: Any) -> FoxgloveBridge:
+        """Serve ``core``'s topics: demand through ``core.topics``, pumped by ``transport``'s loop."""
+        topics, sim = core.topics, core.sim
+        loaded = getattr(sim, "loaded", None)
+        bridge = cls({t.name: t.type for t in topics.topics}, sim.world, getattr(loaded, "base_dir", "."),
+                     host=host, port=port, name=f"sensorium {core.world_name}",
+                     on_demand=topics.set_viewer_demand, wake=transport.wake,
+                     solid_poses=lambda: dict(sim.scene.solid_poses), **kw)
+        topics.set_viewer(bridge.record)
+        transport.hooks.append(lambda: bridge.pump(sim.time_ms * 1_000_000))
+        return bridge
+
+    @classmethod
+    def for_replay(cls, replayer: Any, host: str = "127.0.0.1", port: int = DEFAULT_PORT, **kw: Any) -> FoxgloveBridge:
+        """Serve a :class:`~sensorium.server.recording.replay.Replayer`'s messages (every replayed
+        message is offered; demand does not apply to a replay). The scene comes from the world file
+        (and meshes) attached to the recording, when it loads."""
+        from sensorium.server.recording.ros_views import recorded_world
+
+        world, base = recorded_world(replayer.recording)
+        bridge = cls(dict(replayer.topic_types), world, base, host=host, port=port,
+                     name=f"sensorium replay {Path(replayer.path).name}", **kw)
+        replayer.viewer = bridge.record
+        return bridge
+
+    def app_url(self) -> str | None:
+        """A Foxglove web-app link that opens this server as the data source (the SDK's), if any."""
+        try:
+            return self.server.app_url()
+        except Exception:  # noqa: BLE001 - only a convenience
+            return None
+
+    @property
+    def url(self) -> str:
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return f"ws://{host}:{self.port}"
+
+    # ------------------------------------------------------------------ SDK thread
+    def _subscribed(self, client: int, topic: str, delta: int) -> None:
+        with self._lock:
+            key = (client, topic)
+            if delta > 0:
+                self._clients[key] += 1
+                self._subs[topic] += 1
+            elif self._clients[key] > 0:
+                self._clients[key] -= 1
+                self._subs[topic] -= 1
+            self._subs += Counter()            # drop zero counts
+            self._clients += Counter()
+            self._dirty = True
+            if delta > 0 and topic == SCENE_TOPIC:
+                self._scene_for.append(client)
+        self._event.set()
+        self.wake()
+
+    def subscriptions(self) -> dict[str, int]:
+        """Channel topic → number of client subscriptions now."""
+        with self._lock:
+            return dict(self._subs)
+
+    def demanded(self) -> set[str]:
+        """The Sensorium topics the current subscriptions demand."""
+        with self._lock:
+            subs = set(self._subs)
+        out = {t for t in subs if t in self.channels}
+        if TF_TOPIC in subs:
+            out.update(self.pose_robot)
+        return out
+
+    # ------------------------------------------------------------------ step-loop thread
+    def pump(self, time_ns: int | None = None) -> None:
+        """Apply subscription changes (``on_demand``), note the simulated time, and resend the scene
+        when a solid was moved (supervisor). Cheap when idle."""
+        if time_ns is not None and time_ns != self._time_ns:
+            self._time_ns = int(time_ns)
+            self._event.set()
+        if self.solid_poses is not None and self._subs.get(SCENE_TOPIC, 0) > 0:
+            poses = list(self.solid_poses().values())
+            if len(poses) != len(self._seen_poses) or any(a is not b for a, b in zip(poses, self._seen_poses)):
+                if self._seen_poses:
+                    self._scene_for.append(None)
+                    self._event.set()
+                self._seen_poses = poses
+        if self._dirty:
+            with self._lock:
+                self._dirty = False
+            if self.on_demand is not None:
+                self.on_demand(self.demanded())
+
+    def record(self, topic: str, ros_type: str, envelope: bytes, body: bytes, stamp_ns: int, seq: int) -> None:
+        """A published message (``Topics``' recorder signature). Never blocks."""
+        q = self._queue
+        if len(q) >= self.queue_size:
+            try:
+                q.popleft()
+                self.dropped += 1
+            except IndexError:
+                pass
+        q.append((topic, ros_type, body, stamp_ns))
+        if stamp_ns > self._time_ns:
+            self._time_ns = stamp_ns
+        self._event.set()
+
+    # ------------------------------------------------------------------ worker thread
+    def _run(self) -> None:
+        while not self._stop:
+            self._event.wait(0.05)
+            self._event.clear()
+            try:
+                self._work()
+            except Exception as exc:  # noqa: BLE001 - the viewer must never take the server down
+                self.errors.setdefault("worker", f"{type(exc).__name__}: {exc}")
+
+    def _work(self) -> None:
+        while self._scene_for and self.scene_channel is not None:
+            client = self._scene_for.popleft()
+            if client is None:
+                self.scene_channel.log(self.scene_bytes(), log_time=self._time_ns)
+            else:
+                self.scene_channel.log(self.scene_bytes(), log_time=self._time_ns, sink_id=client)
+        q = self._queue
+        while q:
+            try:
+                topic, ros_type, body, ns = q.popleft()
+            except IndexError:
+                break
+            self._forward(topic, ros_type, body, ns)
+        if self._time_ns != self._sent_time_ns:
+            self._sent_time_ns = self._time_ns
+            self.server.broadcast_time(self._time_ns)
+
+    def _forward(self, topic: str, ros_type: str, body: bytes, ns: int) -> None:
+        subs = self._subs
+        ch = self.channels.get(topic)
+        if ch is not None and subs.get(topic, 0) > 0:
+            try:
+                _typename, data = self.encoder.encode(ros_type, body)
+            except (ExportError, ValueError, TypeError, KeyError) as exc:
+                self.errors.setdefault(topic, f"{type(exc).__name__}: {exc}")
+            else:
+                ch.log(data, log_time=ns)
+                self.sent += 1
+        robot = self.pose_robot.get(topic)
+        if robot is not None and self.tf_channel is not None and subs.get(TF_TOPIC, 0) > 0:
+            self.tf_channel.log(self.transforms_bytes(robot, body, ns), log_time=ns)
+            self.sent += 1
+
+    def transforms_bytes(self, robot: str, pose_body: bytes, ns: int) -> bytes:
+        """The ``/tf`` message (encoded ``FrameTransforms``) of one PoseStamped body."""
+        msg = msgpack.unpackb(pose_body, raw=False)
+        p = msg["pose"]
+        t = (p["position"]["x"], p["position"]["y"], p["position"]["z"])
+        q = (p["orientation"]["x"], p["orientation"]["y"], p["orientation"]["z"], p["orientation"]["w"])
+        return self._scene_mod.frame_transforms(robot, ns, t, q, self.mounts.get(robot, [])).encode()
+
+    def scene_bytes(self) -> bytes:
+        """The encoded ``SceneUpdate`` of the world (solids at their current poses)."""
+        if self.world is None:
+            return b""
+        poses = self.solid_poses() if self.solid_poses is not None else None
+        key = tuple((n, p.translation.tobytes(), p.rotation.tobytes()) for n, p in (poses or {}).items())
+        if self._scene_bytes is None or key != self._scene_key:
+            self._scene_bytes = self._scene_mod.scene_update(self.world, self.base_dir, 0, poses).encode()
+            self._scene_key = key
+        return self._scene_bytes
+
+    def report(self) -> str:
+        """One line for the log: what was sent, dropped, and the first error per topic."""
+        line = f"Foxglove viewer: {self.sent} messages sent, {self.dropped} dropped (queue full)"
+        if self.errors:
+            line += "; not converted: " + "; ".join(f"{t}: {e}" for t, e in sorted(self.errors.items()))
+        return line
+
+    # ------------------------------------------------------------------ close
+    def close(self) -> None:
+        self._stop = True
+        self._event.set()
+        self._worker.join(timeout=5.0)
+        try:
+            self.server.stop()
+        except Exception:  # noqa: BLE001 - already stopped
+            pass
+
+    def __enter__(self) -> FoxgloveBridge:
+        return self
+
+    def __exit__(self, *exc: Iterable[Any]) -> None:
+        self.close()

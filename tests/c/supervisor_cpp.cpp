@@ -1,0 +1,31 @@
+// The Supervisor C++ classes (tests/worlds/cdevices.yaml, robot rover): move buddy, read it back.
+#include <cstdio>
+
+#include <webots/LED.hpp>
+#include <webots/PositionSensor.hpp>
+#include <webots/Supervisor.hpp>
+
+using namespace webots;
+
+int main() {
+  Supervisor *supervisor = new Supervisor();
+  int dt = static_cast<int>(supervisor->getBasicTimeStep());
+  Node *buddy = supervisor->getFromDef("buddy");
+  if (buddy == 0 || supervisor->getFromDef("buddy") != buddy || supervisor->getFromDef("nobody") != 0)
+    return 3;
+  Field *translation = buddy->getField("translation");
+  const double where[3] = {0.125, 0.25, 0.0};
+  translation->setSFVec3f(where);
+  supervisor->getLED("led0")->set(1);
+  PositionSensor *encoder = supervisor->getPositionSensor("left wheel sensor");
+  encoder->enable(dt);
+  supervisor->getMotor("left wheel motor")->setPosition(1e9);
+  supervisor->step(dt);
+  const double *p = buddy->getPosition();
+  std::printf("%s %d %.17g %.17g %.17g %d %s %d %d\n", supervisor->getModel().c_str(), translation->getType(), p[0],
+              p[1], p[2], supervisor->getLED("led0")->get(), encoder->getMotor()->getName().c_str(),
+              encoder->getMotor()->getPositionSensor() == encoder, supervisor->simulationGetMode());
+  std::printf("%.17g\n", encoder->getValue());
+  delete supervisor;
+  return 0;
+}

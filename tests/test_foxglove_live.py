@@ -1,0 +1,298 @@
+"""`sensorium serve --foxglove`: a Foxglove client we did not write (@foxglove/ws-protocol under Node)
+lists the channels, subscribes, decodes with independent decoders (@foxglove/rosmsg2-serialization,
+protobufjs), and every value is compared with what the server publishes on ZeroMQ; subscribing and
+unsubscribing moves the server's demand."""
+
+from __future__ import annotations
+
+import base64
+import itertools
+import math
+import os
+import select
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import msgpack
+import numpy as np
+import pytest
+import zmq
+from _node import NodeProcess, require_node
+
+pytest.importorskip("foxglove")
+
+WORLD = Path(__file__).parent / "worlds" / "server.yaml"
+ROOT = Path(__file__).resolve().parents[1]
+
+
+class Serve:
+    def __init__(self, tmp: Path, *extra: str):
+        self.err_path = tmp / "serve.err"
+        self.err = open(self.err_path, "w")
+        env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "sensorium", "serve", str(WORLD), "--rpc", "tcp://127.0.0.1:0", "--pub",
+             "tcp://127.0.0.1:0", "--precision", "fast", "--heartbeat-ms", "2000", *extra],
+            stdout=subprocess.PIPE, stderr=self.err, text=True, env=env)
+        deadline = time.monotonic() + 60
+        self.fields: dict[str, str] = {}
+        while time.monotonic() < deadline and self.proc.poll() is None:
+            if select.select([self.proc.stdout], [], [], 0.2)[0]:
+                line = self.proc.stdout.readline()
+                if line.startswith("sensorium: serving world"):
+                    self.fields = dict(f.split("=", 1) for f in line.split() if "=" in f)
+                    return
+        raise AssertionError(f"server did not start: {self.err_path.read_text()}")
+
+    def stop(self) -> int:
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+            try:
+                self.proc.wait(20)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self.proc.stdout.close()
+        self.err.close()
+        return self.proc.returncode
+
+
+class Rpc:
+    ids = itertools.count(1)
+
+    def __init__(self, ctx: zmq.Context, endpoint: str):
+        self.sock = ctx.socket(zmq.DEALER)
+        self.sock.setsockopt(zmq.LINGER, 0)
+        self.sock.connect(endpoint)
+        self.session: str | None = None
+
+    def ok(self, service: str, args: dict | None = None, timeout: float = 30.0):
+        rid = next(self.ids)
+        self.sock.send(msgpack.packb({"id": rid, "service": service, "args": args or {}}))
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.sock.poll(100):
+                r = msgpack.unpackb(self.sock.recv_multipart()[-1], raw=False)
+                if r["id"] == rid:
+                    assert r["ok"] is True, r
+                    return r["result"]
+        raise TimeoutError(service)
+
+
+def wait_until(pred, timeout: float = 30.0, what: str = "condition"):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        v = pred()
+        if v:
+            return v
+        time.sleep(0.02)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+SENSORS = ["/bot/ls/value", "/bot/ds/value", "/bot/lidar/laser_scan", "/bot/lidar/point_cloud", "/bot/lidar/range_image"]
+
+
+@pytest.fixture()
+def live(tmp_path):
+    require_node()
+    srv = Serve(tmp_path, "--foxglove", "127.0.0.1:0")
+    ctx = zmq.Context()
+    node = None
+    try:
+        assert srv.fields["foxglove"].startswith("ws://127.0.0.1:")
+        node = NodeProcess("live_client.js", srv.fields["foxglove"])
+        yield srv, ctx, node
+    finally:
+        if node is not None:
+            node.close()
+        code = srv.stop()
+        ctx.destroy(0)
+        err = srv.err_path.read_text()
+        assert code == 0, err
+        assert "sensorium: Foxglove viewer: " in err and "not converted" not in err, err
+
+
+def test_channels_subscriptions_demand_and_values(live):
+    srv, ctx, node = live
+    rpc = Rpc(ctx, srv.fields["rpc"])
+    adv = node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+    chans = {c["topic"]: c for c in adv["channels"]}
+    # every topic of the server is a channel Foxglove decodes, plus /tf and /scene
+    topics = {t["name"]: t["type"] for t in rpc.ok("get_info")["topics"]}
+    assert set(chans) == set(topics) | {"/tf", "/scene"}
+    for name, typ in topics.items():
+        want = "sensor_msgs/msg/PointCloud2" if typ == "sensor_msgs/msg/PointCloud" else typ
+        assert (chans[name]["encoding"], chans[name]["schemaEncoding"], chans[name]["schemaName"]) == ("cdr", "ros2msg", want)
+    assert (chans["/tf"]["schemaName"], chans["/tf"]["encoding"]) == ("foxglove.FrameTransforms", "protobuf")
+    assert (chans["/scene"]["schemaName"], chans["/scene"]["encoding"]) == ("foxglove.SceneUpdate", "protobuf")
+    assert not [e for e in node.drain() if e["event"] == "error"]
+
+    assert rpc.ok("get_counters")["demanded"] == []
+    for t in [*SENSORS, "/tf", "/scene"]:
+        node.send(cmd="subscribe", topic=t)
+    poses = {"/bot/pose", "/free/pose", "/bot2/pose", "/rover/pose"}
+    wait_until(lambda: set(rpc.ok("get_counters")["demanded"]) == set(SENSORS) | poses, what="viewer demand")
+
+    # the server's own values: a ZeroMQ subscriber to the same topics
+    sub = ctx.socket(zmq.SUB)
+    sub.setsockopt(zmq.LINGER, 0)
+    sub.connect(srv.fields["pub"])
+    for t in [*SENSORS, "/bot/pose"]:
+        sub.setsockopt(zmq.SUBSCRIBE, t.encode() + b"\0")
+    wait_until(lambda: len(rpc.ok("get_counters")["subscriptions"]) == 6, what="zmq subscriptions")
+    rpc.session = rpc.ok("attach", {"robot": "bot"})["session"]
+    ours: dict[tuple[str, int], dict] = {}
+    raw: dict[tuple[str, int], bytes] = {}
+    for _ in range(6):
+        rpc.ok("/bot/robot/step")
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and len(ours) < 6 * 6:
+        if sub.poll(100):
+            topic, env, body = sub.recv_multipart()
+            key = (topic[:-1].decode(), msgpack.unpackb(env)["stamp_ns"])
+            ours[key] = msgpack.unpackb(body, raw=False)
+            raw[key] = body
+    sub.close(0)
+    assert len(ours) == 36
+
+    def got(topic: str, ns: int) -> dict:
+        return event(topic, ns)["msg"]
+
+    def event(topic: str, ns: int) -> dict:
+        return node.find(lambda e: e["event"] == "message" and e["topic"] == topic and e["log_time"] == ns,
+                         what=f"{topic} at {ns}")
+
+    last = 6 * 16 * 1_000_000
+    # Illuminance: float64 end to end
+    b = ours[("/bot/ls/value", last)]
+    m = got("/bot/ls/value", last)
+    assert m["illuminance"] == b["illuminance"] and m["header"]["frame_id"] == "bot/ls"
+    assert m["header"]["stamp"]["sec"] * 10**9 + m["header"]["stamp"]["nanosec"] == last
+    # Range: float32 fields
+    b, m = ours[("/bot/ds/value", last)], got("/bot/ds/value", last)
+    for k in ("range", "min_range", "max_range", "field_of_view"):
+        assert m[k] == float(np.float32(b[k])), k
+    assert m["radiation_type"] == b["radiation_type"] == 0
+    # LaserScan
+    b, m = ours[("/bot/lidar/laser_scan", last)], got("/bot/lidar/laser_scan", last)
+    assert m["ranges"] == np.frombuffer(b["ranges"], "<f4").astype(float).tolist()
+    for k in ("angle_min", "angle_max", "angle_increment", "range_min", "range_max", "scan_time"):
+        assert m[k] == float(np.float32(b[k])), k
+    assert len(m["ranges"]) == 16 and math.isfinite(m["ranges"][8])
+    # PointCloud → PointCloud2: x, y, z, layer as FLOAT32 fields
+    b, m = ours[("/bot/lidar/point_cloud", last)], got("/bot/lidar/point_cloud", last)
+    assert [f["name"] for f in m["fields"]] == ["x", "y", "z", "layer"]
+    assert all(f["datatype"] == 7 for f in m["fields"]) and m["point_step"] == 16 and m["width"] == 16
+    rec = np.frombuffer(bytes(m["data"]), "<f4").reshape(-1, 4)
+    assert np.array_equal(rec[:, :3], np.frombuffer(b["points"], "<f4").reshape(-1, 3), equal_nan=True)
+    assert np.array_equal(rec[:, 3], np.frombuffer(b["channels"][0]["values"], "<f4"))
+    # Image 32FC1
+    b, m = ours[("/bot/lidar/range_image", last)], got("/bot/lidar/range_image", last)
+    assert (m["encoding"], m["width"], m["height"], m["step"]) == ("32FC1", 16, 1, 64)
+    assert bytes(m["data"]) == b["data"]
+    # /tf: world → bot at the published pose, bot → bot/<device> mounts from the world file
+    tf = got("/tf", last)["transforms"]
+    pose = ours[("/bot/pose", last)]["pose"]
+    frames = {(t["parent_frame_id"], t["child_frame_id"]): t for t in tf}
+    w = frames[("world", "bot")]
+    assert [w["translation"][k] for k in "xyz"] == [pose["position"][k] for k in "xyz"]
+    assert [w["rotation"][k] for k in "xyzw"] == [pose["orientation"][k] for k in "xyzw"]
+    assert [frames[("bot", "bot/ds")]["translation"][k] for k in "xyz"] == [0.05, 0.0, 0.1]
+    assert set(frames) == {("world", "bot"), ("bot", "bot/ls"), ("bot", "bot/ds"), ("bot", "bot/lidar"),
+                           ("bot", "bot/lidar2")}
+    # /scene: the floor (4 x 4 plane), the wall box and the lamp, at their places
+    scene = node.find(lambda e: e["event"] == "message" and e["topic"] == "/scene", what="scene")["msg"]
+    ents = {e["id"]: e for e in scene["entities"]}
+    assert set(ents) == {"solid/floor", "solid/wall", "light/lamp"}
+    wall = ents["solid/wall"]["cubes"][0]
+    assert ents["solid/wall"]["frame_id"] == "world"
+    assert [wall["size"][k] for k in "xyz"] == [0.1, 2.0, 0.5]
+    assert [wall["pose"]["position"][k] for k in "xyz"] == [1.0, 0.0, 0.25]
+    assert [ents["solid/floor"]["cubes"][0]["size"][k] for k in "xyz"] == [4.0, 4.0, 0.0]
+    lamp = ents["light/lamp"]["spheres"][0]
+    assert [lamp["pose"]["position"][k] for k in "xyz"] == [0.5, 0.5, 0.5]
+    # the live bytes are the ROS 2 export's bytes (rosbags' serialize_cdr, the rosbag2 exporter's encoder)
+    from sensorium.server.recording.export import CdrEncoder
+
+    enc = CdrEncoder("jazzy", pointcloud2=True)
+    for topic in SENSORS:
+        assert base64.b64decode(event(topic, last)["raw"]) == enc.encode_generic(topics[topic], raw[(topic, last)]), topic
+    # simulated time is the server time
+    node.find(lambda e: e["event"] == "time" and e["ns"] == last, what="server time")
+    assert not [e for e in node.drain() + node.seen if e["event"] == "error"]
+
+    # unsubscribing stops the work: no demand, no measurement while the controller steps on
+    for t in [*SENSORS, "/tf", "/scene"]:
+        node.send(cmd="unsubscribe", topic=t)
+    wait_until(lambda: rpc.ok("get_counters")["demanded"] == [], what="demand gone")
+    before = rpc.ok("get_counters")["measurements"]
+    for _ in range(3):
+        rpc.ok("/bot/robot/step")
+    after = rpc.ok("get_counters")["measurements"]
+    assert after == before
+    # and subscribing again brings it back for that topic only
+    node.send(cmd="subscribe", topic="/bot/ls/value")
+    wait_until(lambda: rpc.ok("get_counters")["demanded"] == ["/bot/ls/value"], what="demand back")
+    rpc.ok("/bot/robot/step")
+    again = rpc.ok("get_counters")["measurements"]
+    assert again["bot/ls"] == after["bot/ls"] + 1 and again["bot/ds"] == after["bot/ds"]
+
+
+def test_disconnect_releases_demand(live):
+    srv, ctx, node = live
+    rpc = Rpc(ctx, srv.fields["rpc"])
+    node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+    node.send(cmd="subscribe", topic="/bot/lidar/point_cloud")
+    wait_until(lambda: rpc.ok("get_counters")["demanded"] == ["/bot/lidar/point_cloud"], what="demand")
+    node.proc.kill()                          # a viewer that vanishes without unsubscribing
+    node.proc.wait()
+    wait_until(lambda: rpc.ok("get_counters")["demanded"] == [], what="demand released")
+
+
+def test_bad_foxglove_address_is_one_line(tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    r = subprocess.run([sys.executable, "-m", "sensorium", "serve", str(WORLD), "--rpc", "tcp://127.0.0.1:0", "--pub",
+                        "tcp://127.0.0.1:0", "--foxglove", "localhost:http"], capture_output=True, text=True, env=env,
+                       timeout=60)
+    assert r.returncode == 1
+    assert r.stderr.strip().splitlines() == ["sensorium serve: --foxglove 'localhost:http': port 'http' is not a number"]
+
+
+def test_replay_serves_foxglove(tmp_path):
+    require_node()
+    from _recdata import make_recording
+
+    from sensorium.server.recording.reader import Recording
+
+    path = tmp_path / "rec.mcap"
+    make_recording(path, steps=20)
+    with Recording(path) as rec:
+        values = {msgpack.unpackb(m.data, raw=False)["illuminance"] for m in rec.messages(["/epuck/ls0/value"])}
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "replay", str(path), "--loop", "--rate", "1",
+                             "--pub", "tcp://127.0.0.1:0", "--rpc", "tcp://127.0.0.1:0", "--foxglove", "127.0.0.1:0",
+                             "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+    node = None
+    try:
+        url = None
+        deadline = time.monotonic() + 60
+        while url is None and time.monotonic() < deadline and proc.poll() is None:
+            if select.select([proc.stdout], [], [], 0.2)[0]:
+                line = proc.stdout.readline()
+                if "Foxglove viewer at " in line:
+                    url = line.split("Foxglove viewer at ", 1)[1].strip()
+        assert url and url.startswith("ws://127.0.0.1:")
+        node = NodeProcess("live_client.js", url)
+        node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+        node.send(cmd="subscribe", topic="/epuck/ls0/value")
+        m = node.wait_for(lambda e: e["event"] == "message" and e["topic"] == "/epuck/ls0/value", what="replayed")
+        assert m["msg"]["illuminance"] in values and m["msg"]["header"]["frame_id"] == "epuck/ls0"
+    finally:
+        if node is not None:
+            node.close()
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(20)
+        proc.stdout.close()
