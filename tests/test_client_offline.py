@@ -688,7 +688,7 @@ def _run(code: str, env: dict | None = None, timeout: float = 30) -> subprocess.
 def test_client_imports_with_pyzmq_and_msgpack_only():
     code = BLOCKER + textwrap.dedent(f"""
         import sensorium.client, sensorium.client.connection, sensorium.client.wb, sensorium.client.topics
-        import sensorium.cli.client, sensorium.client.webots.controller
+        import sensorium.cli.client, sensorium.cli.topics, sensorium.cli.services, sensorium.client.webots.controller
         sys.path.insert(0, {str(WEBOTS_DIR)!r})
         from controller import Robot, LightSensor, DistanceSensor, Lidar, LidarPoint, Motor, RotationalMotor
         bad = [m for m in sys.modules if m.split(".")[0] in HEAVY
@@ -793,9 +793,10 @@ def test_cli_echo():
         proc.kill()
         pub.close(0)
     assert proc.returncode == 0, err
-    lines = out.splitlines()
-    assert len(lines) == 2 and lines[0].startswith("/r1/lid/laser_scan [sensor_msgs/msg/LaserScan] seq=0 t=0.032")
-    assert "ranges: <float32[3] 1..2.5 (1 inf)>" in lines[0]
+    docs = out.split("---\n")
+    assert len(docs) == 3 and docs[2] == ""                   # two YAML documents, each ended by ---
+    assert docs[0].startswith("# /r1/lid/laser_scan [sensor_msgs/msg/LaserScan] seq=0 t=0.032 s\n")
+    assert "range_min: 0.05\n" in docs[0] and "ranges: [1.0, .inf, 2.5]\n" in docs[0]   # short arrays in full
     assert "2 message(s) of /r1/lid/laser_scan lost" in err
 
 

@@ -71,6 +71,7 @@ class RobotState:
         self.model = model
         self.name = model.name
         self.synchronization = model.synchronization
+        self.controller = model.controller
         self.devices: dict[str, Device] = {}
         for d in model.devices:
             cls = DEVICE_CLASSES[d.device]
