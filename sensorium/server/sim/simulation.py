@@ -297,10 +297,10 @@ class Simulation:
                                            and now - s.last_update_ms >= s.period_ms]
         lidars: list[Lidar] = [d for d in all_lidars if d.due(now)]
         encoders = 0
-        for dev in all_encoders:
-            if dev.schedule.due(now):
-                dev.measure(now)
-                dev.schedule.last_update_ms = now
+        for enc in all_encoders:
+            if enc.schedule.due(now):
+                enc.measure(now)
+                enc.schedule.last_update_ms = now
                 encoders += 1
         work: list[tuple[Any, list[RayRequest]]] = []
         if lights:
