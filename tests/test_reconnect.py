@@ -182,3 +182,42 @@ def test_reconnect_timing_is_bounded_by_polling(server) -> None:
         assert core.lockstep.session_for("bot") is None
     finally:
         steady.close()
+
+
+def test_a_stopped_controller_is_told_what_happened(server, tmp_path) -> None:
+    """SIGSTOP for longer than the liveness period, then SIGCONT: the server released the robot
+    meanwhile; the controller says so (not "server gone?") and its step loop ends cleanly."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    core, transport = server
+    script = tmp_path / "ctrl.py"
+    script.write_text(
+        "import sys\n"
+        "from controller import Robot\n"
+        "r = Robot()\n"
+        "n = 0\n"
+        "while r.step(16) != -1:\n"
+        "    n += 1\n"
+        "    if n == 5:\n"
+        "        print('ready', flush=True)\n"
+        "print('ended after', n, flush=True)\n")
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "controller", str(script), "--robot", "bot2",
+                             "--url", transport.rpc_endpoint], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        os.kill(proc.pid, signal.SIGSTOP)
+        deadline = time.monotonic() + 60
+        while core.lockstep.session_for("bot2") is not None and time.monotonic() < deadline:
+            time.sleep(0.05)                               # poll: released after 3 heartbeats (1.5 s)
+        assert core.lockstep.session_for("bot2") is None
+        os.kill(proc.pid, signal.SIGCONT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, err
+    assert "ended after" in out
+    assert "released the robot" in err and "Traceback" not in err and "server gone" not in err, err

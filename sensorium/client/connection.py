@@ -391,13 +391,14 @@ class Heartbeat(threading.Thread):
         self.last_reply = time.monotonic()
         self.pings = 0
         self.replies = 0
+        self.paused_s = 0.0        # longest time this thread did not run (SIGSTOP, a stalled VM)
 
     def problem(self) -> str | None:
         if self._problem is not None:
             return self._problem
         silent = time.monotonic() - self.last_reply
         if silent > self.lost_after:
-            return f"no answer from {self.endpoint} for {silent:.1f} s (server gone?)"
+            return f"no answer from {self.endpoint} for {silent:.1f} s (server gone, or the network down)"
         return None
 
     def stop(self) -> None:
@@ -412,8 +413,16 @@ class Heartbeat(threading.Thread):
             sock.connect(self.endpoint)
             ids = itertools.count(1)
             next_ping = time.monotonic()
+            last_turn = next_ping
             while not self._stop_event.is_set():
                 now = time.monotonic()
+                if now - last_turn > max(1.0, 2 * self.interval):
+                    # this process did not run (stopped, suspended): the server's silence is ours,
+                    # not a sign that it is gone; ask again before judging
+                    self.paused_s = max(self.paused_s, now - last_turn)
+                    self.last_reply = now
+                    next_ping = now
+                last_turn = now
                 if now >= next_ping:
                     sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
                     self.pings += 1
@@ -431,7 +440,10 @@ class Heartbeat(threading.Thread):
                         self.replies += 1
                         if isinstance(reply, dict) and reply.get("ok") is False:
                             err = _error_from(reply)
-                            self._problem = f"the server dropped session {self.session!r} ({err})"
+                            why = (f"after this process did not run for {self.paused_s:.1f} s"
+                                   if self.paused_s else "after it heard nothing from this controller for "
+                                   "3 heartbeats (a network stall?)")
+                            self._problem = f"the server released the robot {why} ({err.name})"
         except zmq.ContextTerminated:
             pass
         finally:
