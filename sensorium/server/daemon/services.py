@@ -99,7 +99,7 @@ class Core(DeviceServices):
         self.version = version or __version__
         self.pub_endpoint = pub_endpoint
         self.max_request = max_request
-        self._log_line = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
+        self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
         self._log_counts: dict[str, int] = {}             # first line of a message -> times seen
         self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
                                  sim.basic_time_step, heartbeat_ms=heartbeat_ms, mode=mode,
@@ -115,19 +115,19 @@ class Core(DeviceServices):
         self.routes = self._routes()
         self.errors = 0
 
-    def log(self, line: str) -> None:
-        """Log a line. The same first line again is printed only the 10th, 100th, 1000th… time,
-        with its count, so a client repeating a failing request cannot flood the log (counting,
-        not timing: the core has no clock)."""
+    def log_error(self, line: str) -> None:
+        """Log an error a client may trigger again and again: the same first line is printed the
+        1st, 10th, 100th… time only, with its count, so a client repeating a failing request
+        cannot flood the log (counting, not timing: the core has no clock)."""
         key = line.split("\n", 1)[0][:200]
         if len(self._log_counts) > 1000 and key not in self._log_counts:
             self._log_counts.clear()
         n = self._log_counts.get(key, 0) + 1
         self._log_counts[key] = n
         if n == 1:
-            self._log_line(line)
+            self.log(line)
         elif n >= 10 and str(n).strip("0") == "1":
-            self._log_line(f"{key} (seen {n} times)")
+            self.log(f"{key} (seen {n} times)")
 
     # ------------------------------------------------------------------ routing table
     def _routes(self) -> dict[str, Route]:
@@ -223,7 +223,7 @@ class Core(DeviceServices):
             return [envelope + [error_reply(rid, exc.code, exc.message)]]
         except Exception as exc:  # noqa: BLE001 - a bug must not stop the server
             self.errors += 1
-            self.log(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
+            self.log_error(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
             return [envelope + [error_reply(rid, ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}")]]
 
     def subscription(self, event: bytes) -> None:
