@@ -7,32 +7,24 @@ well-behaved controller keeps stepping and that what the server holds stays boun
 
 from __future__ import annotations
 
-import threading
 import time
-from pathlib import Path
 
 import msgpack
 import pytest
 import zmq
+from _inproc import WORLD, inproc_server
 
 from sensorium.client.connection import Connection
 from sensorium.schemas.wire import MAX_ERROR_MESSAGE, ErrorCode
 from sensorium.server.daemon.services import Core
-from sensorium.server.daemon.transport import MAX_FRAMES, Transport
+from sensorium.server.daemon.transport import MAX_FRAMES
 from sensorium.server.sim.simulation import Simulation
-
-WORLD = Path(__file__).parent / "worlds" / "server.yaml"
 
 
 @pytest.fixture
 def server():
-    core = Core(Simulation.from_file(WORLD, precision="fast"), heartbeat_ms=1000)
-    transport = Transport(core, "tcp://127.0.0.1:0", "tcp://127.0.0.1:0")
-    thread = threading.Thread(target=transport.run, daemon=True)
-    thread.start()
-    yield core, transport
-    transport.stop()
-    thread.join(timeout=30)
+    with inproc_server(heartbeat_ms=1000) as running:
+        yield running
 
 
 class Dealer:

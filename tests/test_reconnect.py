@@ -11,18 +11,13 @@ from __future__ import annotations
 import socket
 import threading
 import time
-from pathlib import Path
 
 import msgpack
 import pytest
 import zmq
+from _inproc import inproc_server
 
 from sensorium.client.connection import Connection
-from sensorium.server.daemon.services import Core
-from sensorium.server.daemon.transport import Transport
-from sensorium.server.sim.simulation import Simulation
-
-WORLD = Path(__file__).parent / "worlds" / "server.yaml"
 
 
 class ResettingProxy:
@@ -79,13 +74,8 @@ class ResettingProxy:
 
 @pytest.fixture
 def server():
-    core = Core(Simulation.from_file(WORLD, precision="fast"), heartbeat_ms=500)
-    transport = Transport(core, "tcp://127.0.0.1:0", "tcp://127.0.0.1:0")
-    thread = threading.Thread(target=transport.run, daemon=True)
-    thread.start()
-    yield core, transport
-    transport.stop()
-    thread.join(timeout=30)
+    with inproc_server(heartbeat_ms=500) as running:
+        yield running
 
 
 def _port(endpoint: str) -> int:

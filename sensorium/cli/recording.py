@@ -93,14 +93,11 @@ def replay_cmd(args: argparse.Namespace) -> int:
             return 1
         viewer = None
         if getattr(args, "foxglove", None):
-            from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, exposure_warning, parse_address
-            try:
-                host, port = parse_address(args.foxglove)
-                if exposure_warning(host):
-                    print(f"sensorium replay: warning: {exposure_warning(host)}", file=sys.stderr)
-                viewer = FoxgloveBridge.for_replay(r, host, port)
-            except ViewerError as exc:
-                print(f"sensorium replay: {exc}", file=sys.stderr)
+            from sensorium.cli.foxglove_option import start_foxglove
+            from sensorium.server.viewer.bridge import FoxgloveBridge
+
+            viewer = start_foxglove("replay", args.foxglove, lambda host, port: FoxgloveBridge.for_replay(r, host, port))
+            if viewer is None:
                 return 1
             print(f"sensorium: Foxglove viewer at {viewer.url}", flush=True)
             if viewer.app_url():

@@ -121,15 +121,13 @@ def main(args: argparse.Namespace) -> int:
             return 1
     viewer = None
     if getattr(args, "foxglove", None):
-        from sensorium.server.viewer.bridge import FoxgloveBridge, ViewerError, exposure_warning, parse_address
-        try:
-            host, port = parse_address(args.foxglove)
-            if exposure_warning(host):
-                print(f"sensorium serve: warning: {exposure_warning(host)}", file=sys.stderr)
-            viewer = FoxgloveBridge.for_core(server.core, server.transport, host, port)
-        except ViewerError as exc:
+        from sensorium.cli.foxglove_option import start_foxglove
+        from sensorium.server.viewer.bridge import FoxgloveBridge
+
+        viewer = start_foxglove("serve", args.foxglove,
+                                lambda host, port: FoxgloveBridge.for_core(server.core, server.transport, host, port))
+        if viewer is None:
             server.close()
-            print(f"sensorium serve: {exc}", file=sys.stderr)
             return 1
     print(server.ready_line + (f" foxglove={viewer.url}" if viewer is not None else ""), flush=True)
     if viewer is not None and viewer.app_url():
