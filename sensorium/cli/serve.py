@@ -51,6 +51,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--foxglove", metavar="[HOST:]PORT",
                    help="also serve the topics, transforms and the world to Foxglove (WebSocket) on PORT, "
                    "host 127.0.0.1 unless given; port 0 picks a free port")
+    p.add_argument("--controls", choices=["auto", "open", "supervisor"], default="auto",
+                   help="who may use world-wide controls (set_mode): open = any caller; supervisor = only the "
+                   "controller of a robot with 'supervisor: true'; auto (default) = open when --rpc is loopback/ipc, "
+                   "else supervisor")
     add_world_options(p)
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
@@ -65,7 +69,8 @@ def options(args: argparse.Namespace):
                         heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None),
                         allow_large=getattr(args, "allow_large", False),
                         allow_outside_meshes=getattr(args, "allow_outside_meshes", False),
-                        contact=False if getattr(args, "no_contact", False) else None)
+                        contact=False if getattr(args, "no_contact", False) else None,
+                        controls=getattr(args, "controls", "auto"))
 
 
 def main(args: argparse.Namespace) -> int:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sensorium.server.daemon.roles import CONTROLS, open_controls
 from sensorium.server.daemon.services import Core
 from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport
 from sensorium.server.sim.simulation import Simulation
@@ -34,11 +35,14 @@ class ServeOptions:
     contact: bool | None = None       # kinematic contact; None: the world's world_info.contact
     allow_large: bool = False         # raise the world limits (WorldLimits.large())
     allow_outside_meshes: bool = False  # mesh urls may leave the world's folder
+    controls: str = "auto"            # world-wide controls: auto | open | supervisor (daemon/roles.py)
 
     def check(self) -> None:
         """Raise ValueError naming the first bad option."""
         if self.heartbeat_ms <= 0:
             raise ValueError("--heartbeat-ms must be > 0")
+        if self.controls not in CONTROLS:
+            raise ValueError(f"--controls must be one of {', '.join(CONTROLS)}, got {self.controls!r}")
 
 
 def build(world: str | Path | None, options: ServeOptions | None = None) -> tuple[Core, Transport]:
@@ -51,7 +55,8 @@ def build(world: str | Path | None, options: ServeOptions | None = None) -> tupl
     sim = Simulation.from_file(path, precision=opts.precision,
                                limits=WorldLimits.large() if opts.allow_large else WorldLimits(),
                                allow_outside_meshes=opts.allow_outside_meshes, contact=opts.contact)
-    core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode)
+    core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode,
+                open_controls=open_controls(opts.controls, opts.rpc))
     return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until)
 
 

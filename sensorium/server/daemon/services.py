@@ -35,7 +35,7 @@ from sensorium.schemas.wire import (
     ok_reply,
     parse_request,
 )
-from sensorium.server.daemon import supervisor
+from sensorium.server.daemon import roles, supervisor
 from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
 from sensorium.server.daemon.topics import Control, Topics, header, image_msg, point_cloud_msg, pose_quaternion
 
@@ -99,7 +99,8 @@ class Core:
 
     def __init__(self, sim: Any, *, world_name: str | None = None, heartbeat_ms: int = 1000, mode: str = "fast",
                  pub_endpoint: str = "", version: str | None = None, new_token: Callable[[], str] | None = None,
-                 log: Callable[[str], None] | None = None, max_request: int = SOFT_LIMIT):
+                 log: Callable[[str], None] | None = None, max_request: int = SOFT_LIMIT,
+                 open_controls: bool = True):
         from sensorium import __version__
 
         self.sim = sim
@@ -107,6 +108,7 @@ class Core:
         self.version = version or __version__
         self.pub_endpoint = pub_endpoint
         self.max_request = max_request
+        self.open_controls = open_controls       # world-wide controls for any caller (roles.py)
         self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
         self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
                                  sim.basic_time_step, heartbeat_ms=heartbeat_ms, mode=mode,
@@ -197,6 +199,8 @@ class Core:
                 raise ServiceError(ErrorCode.NOT_SUPERVISOR,
                                    f"{req.service}: robot {route.robot!r} is not a supervisor "
                                    f"(set 'supervisor: true' on it in the world file)")
+            if route.robot is None and route.spec.item in roles.WORLD_CONTROLS:
+                self._check_world_control(req.service, peer)
             ctl = self.topics.controls[route.device] if route.device else None
             motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
             call = Call(envelope, peer, rid, args, route.robot or "", cast(Control, ctl), motor, now, [])
@@ -212,6 +216,17 @@ class Core:
             self.errors += 1
             self.log(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
             return [envelope + [error_reply(rid, ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}")]]
+
+    def _check_world_control(self, service: str, peer: bytes) -> None:
+        """World-wide controls need the supervisor role (see :mod:`sensorium.server.daemon.roles`)."""
+        if self.open_controls:
+            return
+        for s in self.lockstep.sessions:
+            if s.peer == peer and getattr(self.sim.robots[s.robot], "supervisor", False):
+                return
+        raise ServiceError(ErrorCode.NOT_SUPERVISOR,
+                           f"{service} changes the world for everyone: attach a robot with 'supervisor: true' "
+                           f"first, or run the server with --controls open")
 
     def subscription(self, event: bytes) -> None:
         """An XPUB subscription event."""
@@ -422,6 +437,7 @@ class Core:
         if a.rotation is not None and a.quaternion is not None:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, "give either 'rotation' (axis-angle) or 'quaternion', not both")
         try:
+            roles.check_pose(a.translation, a.rotation, a.quaternion)
             self.sim.robots[c.robot].set_pose(a.translation, a.rotation, a.quaternion)
         except (ValueError, ArithmeticError) as exc:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_pose: {exc}") from None
