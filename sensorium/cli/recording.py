@@ -1,5 +1,5 @@
-"""``sensorium record``, ``replay``, ``export`` and ``info FILE.mcap``: argparse shells over
-:mod:`sensorium.server.recording` (live.py, replay.py, export.py, reader.py).
+"""``sensorium record``, ``replay``, ``export``, ``recover`` and ``info FILE.mcap``: argparse shells over
+:mod:`sensorium.server.recording` (live.py, replay.py, export.py, recover.py, reader.py).
 """
 
 from __future__ import annotations
@@ -141,6 +141,22 @@ def export_cmd(args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------------------------ info
+
+
+def recover_cmd(args: argparse.Namespace) -> int:
+    """``sensorium recover FILE [OUT]``: exit 0 with a one-line summary, or 1 with one error line."""
+    from sensorium.server.recording.recover import recover
+
+    try:
+        r = recover(args.file, args.out, overwrite=args.force)
+    except (OSError, ValueError, McapError) as exc:
+        print(f"sensorium recover: {exc}", file=sys.stderr)
+        return 1
+    state = f"truncated, read up to its last complete record ({r.stopped})" if r.stopped else (
+        "truncated (no summary or footer)" if r.truncated else "complete")
+    print(f"sensorium: recovered {r.messages} messages on {r.channels} channels, {r.metadata} metadata records, "
+          f"{r.attachments} attachments from {args.file} ({state}) into {r.out}", flush=True)
+    return 0
 
 
 def _human_size(n: float) -> str:
