@@ -164,6 +164,13 @@ def _recover_args(p: argparse.ArgumentParser) -> None:
 
 
 # --- server: serve (server/serve.py) and schemas (schemas/export.py) ---
+@command("keys", "create a CURVE key pair for serve --curve-keys DIR (encrypted, authenticated tcp)",
+         "sensorium.cli.serve:keys")
+def _keys_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("dir", help="directory for server.key (public) and server.key_secret (created if missing)")
+    p.add_argument("--force", action="store_true", help="replace an existing key pair")
+
+
 @command("serve", "serve a world to controllers (services) and subscribers (topics) over ZeroMQ",
          "sensorium.cli.serve:main")
 def _serve_args(p: argparse.ArgumentParser) -> None:

@@ -55,10 +55,35 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="who may use world-wide controls (set_mode): open = any caller; supervisor = only the "
                    "controller of a robot with 'supervisor: true'; auto (default) = open when --rpc is loopback/ipc, "
                    "else supervisor")
+    p.add_argument("--curve-keys", metavar="DIR",
+                   help="encrypt both sockets with CURVE using DIR/server.key_secret (create it with "
+                   "'sensorium keys DIR'); clients need the public key: SENSORIUM_CURVE_SERVERKEY or URL?serverkey=")
     add_world_options(p)
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
                    "without subscribers (default: every topic)")
+
+
+def z85_hex(key: bytes) -> str:
+    """A Z85 key as 64 hex digits: safe to paste into a shell (Z85 has $, &, quotes...)."""
+    import zmq.utils.z85
+
+    return zmq.utils.z85.decode(key).hex()
+
+
+def keys(args: argparse.Namespace) -> int:
+    """``sensorium keys DIR``: a CURVE key pair for ``serve --curve-keys DIR``."""
+    from sensorium.server.daemon.transport import generate_curve_keys
+
+    try:
+        public = generate_curve_keys(args.dir, overwrite=args.force)
+    except (OSError, ValueError) as exc:
+        print(f"sensorium keys: {exc}", file=sys.stderr)
+        return 1
+    print(f"sensorium: wrote {args.dir}/server.key and {args.dir}/server.key_secret (keep it private); "
+          f"serve with --curve-keys {args.dir}; clients need:", flush=True)
+    print(f"SENSORIUM_CURVE_SERVERKEY={z85_hex(public)}", flush=True)
+    return 0
 
 
 def options(args: argparse.Namespace):
@@ -70,7 +95,7 @@ def options(args: argparse.Namespace):
                         allow_large=getattr(args, "allow_large", False),
                         allow_outside_meshes=getattr(args, "allow_outside_meshes", False),
                         contact=False if getattr(args, "no_contact", False) else None,
-                        controls=getattr(args, "controls", "auto"))
+                        controls=getattr(args, "controls", "auto"), curve_keys=getattr(args, "curve_keys", None))
 
 
 def main(args: argparse.Namespace) -> int:
@@ -91,6 +116,11 @@ def main(args: argparse.Namespace) -> int:
     except OSError as exc:          # zmq.ZMQError is an OSError: address in use, bad endpoint
         print(f"sensorium serve: cannot bind: {exc}", file=sys.stderr)
         return 1
+    if server.transport.curve:
+        from sensorium.server.daemon.transport import load_curve_keys
+
+        public = load_curve_keys(args.curve_keys)[0]
+        print(f"sensorium serve: CURVE on; clients need SENSORIUM_CURVE_SERVERKEY={z85_hex(public)}", file=sys.stderr)
     if getattr(args, "record", None):
         from sensorium.server.recording.writer import recorder_for_server
         try:

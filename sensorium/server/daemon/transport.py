@@ -17,17 +17,20 @@ A thin adapter around :class:`sensorium.server.daemon.services.Core` (sans-IO): 
 
 from __future__ import annotations
 
+import os
 import signal
 import socket
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import zmq
+import zmq.auth
 
 from sensorium.schemas.wire import HARD_LIMIT
 from sensorium.server.daemon.services import Core
 
-__all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB"]
+__all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server"]
 
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
@@ -45,6 +48,50 @@ def _bindable(url: str) -> str:
     return url
 
 
+# ---------------------------------------------------------------------- CURVE (serve --curve-keys DIR)
+CURVE_NAME = "server"          # DIR/server.key (public) and DIR/server.key_secret (ZeroMQ certificate files)
+
+
+def generate_curve_keys(directory: str | Path, *, overwrite: bool = False) -> bytes:
+    """Write a fresh server key pair (``zmq.curve_keypair``) to DIR/server.key and
+    DIR/server.key_secret (owner-only); return the public key (Z85) clients need."""
+    d = Path(directory)
+    paths = [d / f"{CURVE_NAME}.key", d / f"{CURVE_NAME}.key_secret"]
+    if not overwrite and any(p.exists() for p in paths):
+        raise FileExistsError(f"{d}: a key pair exists already (--force to replace it)")
+    d.mkdir(parents=True, exist_ok=True)
+    old = os.umask(0o077)
+    try:
+        zmq.auth.create_certificates(d, CURVE_NAME)
+    finally:
+        os.umask(old)
+    os.chmod(paths[1], 0o600)
+    return load_curve_keys(d)[0]
+
+
+def load_curve_keys(directory: str | Path) -> tuple[bytes, bytes]:
+    """(public, secret) Z85 keys from DIR/server.key_secret; ValueError naming the problem."""
+    path = Path(directory) / f"{CURVE_NAME}.key_secret"
+    if not path.is_file():
+        raise ValueError(f"--curve-keys: {path} not found (create a key pair with: sensorium keys {directory})")
+    try:
+        public, secret = zmq.auth.load_certificate(path)
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"--curve-keys: {path}: {exc}") from None
+    if secret is None:
+        raise ValueError(f"--curve-keys: {path} has no secret key")
+    return public, secret
+
+
+def curve_server(sock: zmq.Socket, secret: bytes | None) -> None:
+    """Make ``sock`` a CURVE server (before bind): every connection is encrypted, and only clients
+    that know the server's public key complete the handshake."""
+    if secret is None:
+        return
+    sock.setsockopt(zmq.CURVE_SERVER, 1)
+    sock.setsockopt(zmq.CURVE_SECRETKEY, secret)
+
+
 class Transport:
     """Bind, serve until stopped, close. ``run()`` blocks; ``stop()`` may be called from a signal
     handler or another thread."""
@@ -52,7 +99,7 @@ class Transport:
     def __init__(self, core: Core, rpc: str = DEFAULT_RPC, pub: str = DEFAULT_PUB, *,
                  hard_limit: int = HARD_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
                  context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic,
-                 stop_at_ms: int | None = None):
+                 stop_at_ms: int | None = None, curve_secret: bytes | None = None):
         self.core = core
         self.stop_at_ms = stop_at_ms          # quit (steps answer -1) once simulated time reaches it
         self.clock = clock
@@ -71,6 +118,9 @@ class Transport:
         self.router.setsockopt(zmq.RCVHWM, 10_000)
         self.xpub.setsockopt(zmq.SNDHWM, pub_hwm)
         self.xpub.setsockopt(zmq.MAXMSGSIZE, 64 * 1024)       # subscription messages only
+        self.curve = curve_secret is not None
+        for s in (self.router, self.xpub):
+            curve_server(s, curve_secret)
         try:
             self.router.bind(_bindable(rpc))
             self.xpub.bind(_bindable(pub))
