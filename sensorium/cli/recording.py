@@ -62,7 +62,7 @@ def record(args: argparse.Namespace) -> int:
         lost = "" if not s["lost"] else ", " + ", ".join(f"{t}: {n}" for t, n in s["lost_by_topic"].items())
         print(f"sensorium: recorded {s['received']} messages on {s['topics']} topics to {s['file']}; "
               f"{s['gaps']} gaps, {s['lost']} messages lost{lost}", flush=True)
-    return 0
+    return 1 if rec.recorder is not None and rec.recorder.failed else 0
 
 
 # ------------------------------------------------------------------------------------ replay

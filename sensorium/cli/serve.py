@@ -156,7 +156,8 @@ def main(args: argparse.Namespace) -> int:
             viewer.close()
             print(f"sensorium: {viewer.report()}", file=sys.stderr, flush=True)
         if server.recorder is not None:
-            print(f"sensorium: recorded {server.recorder.message_count} messages to {args.record}",
+            print(f"sensorium: recorded {server.recorder.message_count} messages to {args.record}"
+                  + (f" (stopped early: {server.recorder.failed})" if server.recorder.failed else ""),
                   file=sys.stderr, flush=True)
     core = server.core
     print(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps", file=sys.stderr, flush=True)

@@ -216,6 +216,8 @@ class LiveRecorder:
                 except Exception:
                     continue
                 self.recorder.record(topic, ros_type, frames[1], frames[2], stamp_ns, seq)
+                if self.recorder.failed:                 # disk full: said once by the recorder; stop
+                    return
                 lost = self.gaps.see(topic, seq)
                 if lost:
                     self._gap_lines += 1
