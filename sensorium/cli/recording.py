@@ -61,7 +61,9 @@ def record(args: argparse.Namespace) -> int:
     else:
         lost = "" if not s["lost"] else ", " + ", ".join(f"{t}: {n}" for t, n in s["lost_by_topic"].items())
         print(f"sensorium: recorded {s['received']} messages on {s['topics']} topics to {s['file']}; "
-              f"{s['gaps']} gaps, {s['lost']} messages lost{lost}", flush=True)
+              f"{s['gaps']} gaps, {s['lost']} messages lost{lost}"
+              + (f"; the server restarted {s['restarts']} time(s): files {', '.join(s['files'])}" if s["restarts"] else ""),
+              flush=True)
     return 1 if rec.recorder is not None and rec.recorder.failed else 0
 
 
@@ -202,6 +204,12 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
                       if meta.get("format") == "2" else "no (msgpack only: export with sensorium export --ros2)"))
     if session.get("started_at"):
         lines.append(("Recorded", session["started_at"]))
+    if session.get("previous_file"):
+        lines.append(("Continues from", f"{session['previous_file']} (the server restarted; record --connect)"))
+    restart = s["metadata"].get("server_restart", {})
+    if restart.get("next_file"):
+        lines.append(("Continues in", f"{restart['next_file']} (the server restarted: {restart.get('topic', '?')} "
+                                      f"went back to {_secs(int(restart.get('stamp_ns', 0) or 0))})"))
     for a in s["attachments"]:
         lines.append(("Attachment", f"{a['name']} ({a['media_type']}, {_human_size(a['size_bytes'])})"))
     for key, value in lines:

@@ -18,8 +18,10 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from ipaddress import ip_address
+from typing import Any
 
-__all__ = ["WORLD_CONTROLS", "MAX_COORDINATE_M", "CONTROLS", "open_controls", "is_local_endpoint", "check_pose"]
+__all__ = ["WORLD_CONTROLS", "MAX_COORDINATE_M", "CONTROLS", "open_controls", "is_local_endpoint", "check_pose",
+           "has_supervisor_role", "denied"]
 
 WORLD_CONTROLS = frozenset({"set_mode"})      # server services that change the world for everyone
 MAX_COORDINATE_M = 1e5                        # |x|, |y|, |z| of a pose set by a request (100 km)
@@ -49,6 +51,16 @@ def open_controls(controls: str, rpc_endpoint: str) -> bool:
     if controls == "auto":
         return is_local_endpoint(rpc_endpoint)
     return controls == "open"
+
+
+def has_supervisor_role(sim: Any, lockstep: Any, peer: bytes) -> bool:
+    """Is ``peer`` the attached controller of a robot with ``supervisor: true``?"""
+    return any(s.peer == peer and getattr(sim.robots[s.robot], "supervisor", False) for s in lockstep.sessions)
+
+
+def denied(service: str) -> str:
+    return (f"{service} changes the world for everyone: attach a robot with 'supervisor: true' first, "
+            f"or run the server with --controls open")
 
 
 def check_pose(translation: Iterable[float] | None = None, rotation: Iterable[float] | None = None,

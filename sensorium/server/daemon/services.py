@@ -199,8 +199,9 @@ class Core:
                 raise ServiceError(ErrorCode.NOT_SUPERVISOR,
                                    f"{req.service}: robot {route.robot!r} is not a supervisor "
                                    f"(set 'supervisor: true' on it in the world file)")
-            if route.robot is None and route.spec.item in roles.WORLD_CONTROLS:
-                self._check_world_control(req.service, peer)
+            if route.robot is None and route.spec.item in roles.WORLD_CONTROLS and not self.open_controls \
+                    and not roles.has_supervisor_role(self.sim, self.lockstep, peer):
+                raise ServiceError(ErrorCode.NOT_SUPERVISOR, roles.denied(req.service))
             ctl = self.topics.controls[route.device] if route.device else None
             motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
             call = Call(envelope, peer, rid, args, route.robot or "", cast(Control, ctl), motor, now, [])
@@ -216,17 +217,6 @@ class Core:
             self.errors += 1
             self.log(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
             return [envelope + [error_reply(rid, ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}")]]
-
-    def _check_world_control(self, service: str, peer: bytes) -> None:
-        """World-wide controls need the supervisor role (see :mod:`sensorium.server.daemon.roles`)."""
-        if self.open_controls:
-            return
-        for s in self.lockstep.sessions:
-            if s.peer == peer and getattr(self.sim.robots[s.robot], "supervisor", False):
-                return
-        raise ServiceError(ErrorCode.NOT_SUPERVISOR,
-                           f"{service} changes the world for everyone: attach a robot with 'supervisor: true' "
-                           f"first, or run the server with --controls open")
 
     def subscription(self, event: bytes) -> None:
         """An XPUB subscription event."""
