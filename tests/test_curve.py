@@ -106,7 +106,7 @@ def test_topics_need_the_key_too(curve_server, monkeypatch):
         with Connection(f"{rpc}?serverkey={key}", timeout=30, context=ctx) as c:
             info = c.call("get_info")
             robot = info["robots"][0]["name"]
-            c.call("attach", {"robot": robot})
+            session = c.call("attach", {"robot": robot})["session"]
             frames = None
             deadline = time.monotonic() + 30
             while frames is None and time.monotonic() < deadline:   # until the subscription has arrived
@@ -117,6 +117,7 @@ def test_topics_need_the_key_too(curve_server, monkeypatch):
                 c.call(f"/{robot}/robot/step", {"duration": info["basic_time_step"]})
             assert _first_message(good, 5) is not None
             assert _first_message(bad, 1.5) is None
+            c.call("detach", {"session": session})
         good.close()
         bad.close()
     finally:
@@ -156,3 +157,35 @@ def test_controller_urls_carry_the_server_key():
     assert parse_controller_url(str(u)) == u
     with pytest.raises(SensoriumError):
         parse_controller_url("tcp://127.0.0.1:5560/epuck?serverkey=nope")
+
+
+def test_record_connect_uses_the_key_from_the_environment(curve_server, monkeypatch, tmp_path):
+    rpc, _pub, key = curve_server
+    _no_curve_env(monkeypatch)
+    env = {k: v for k, v in os.environ.items() if not k.startswith("SENSORIUM_CURVE")}
+    out = tmp_path / "curve.mcap"
+    r = subprocess.run([PY, "-m", "sensorium", "record", str(out), "--connect", rpc, "--duration", "1"],
+                       capture_output=True, text=True, timeout=60, env=env)
+    assert r.returncode == 1 and "no answer" in r.stderr and not out.exists()       # no key: no service
+    rec = subprocess.Popen([PY, "-m", "sensorium", "record", str(out), "--connect", rpc, "--topics", "/clock",
+                            "--max-messages", "5", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           text=True, env=dict(env, SENSORIUM_CURVE_SERVERKEY=key))
+    ctx = zmq.Context()
+    try:
+        with Connection(f"{rpc}?serverkey={key}", timeout=30, context=ctx) as c:
+            info = c.call("get_info")
+            robot = next(r["name"] for r in info["robots"] if not r.get("attached"))
+            session = c.call("attach", {"robot": robot})["session"]
+            deadline = time.monotonic() + 60
+            while rec.poll() is None:
+                assert time.monotonic() < deadline, "the recorder got nothing"
+                c.call(f"/{robot}/robot/step", {"duration": info["basic_time_step"]})
+            c.call("detach", {"session": session})
+        out_text, err = rec.communicate(timeout=30)
+        assert rec.returncode == 0, err
+        assert '"received": 5' in out_text
+    finally:
+        if rec.poll() is None:
+            rec.kill()
+            rec.wait()
+        ctx.destroy(linger=0)

@@ -26,11 +26,13 @@ from pathlib import Path
 
 import zmq
 import zmq.auth
+import zmq.utils.z85
 
 from sensorium.schemas.wire import HARD_LIMIT
 from sensorium.server.daemon.services import Core
 
-__all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server"]
+__all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
+           "curve_client_from_env"]
 
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
@@ -89,6 +91,25 @@ def curve_server(sock: zmq.Socket, secret: bytes | None) -> None:
     if secret is None:
         return
     sock.setsockopt(zmq.CURVE_SERVER, 1)
+    sock.setsockopt(zmq.CURVE_SECRETKEY, secret)
+
+
+def curve_client_from_env(sock: zmq.Socket, environ: dict[str, str] | None = None) -> None:
+    """For the server package's own client sockets (``record --connect``): CURVE with the server
+    key ``SENSORIUM_CURVE_SERVERKEY`` (Z85 or hex) and a fresh key pair, like the client library."""
+    key = (os.environ if environ is None else environ).get("SENSORIUM_CURVE_SERVERKEY", "").strip()
+    if not key:
+        return
+    try:
+        z85 = zmq.utils.z85.encode(bytes.fromhex(key)) if len(key) == 64 else key.encode("ascii")
+        zmq.utils.z85.decode(z85)
+    except (ValueError, UnicodeEncodeError, KeyError):
+        raise ValueError("SENSORIUM_CURVE_SERVERKEY: a CURVE key is 40 Z85 or 64 hex characters") from None
+    if len(z85) != 40:
+        raise ValueError("SENSORIUM_CURVE_SERVERKEY: a CURVE key is 40 Z85 or 64 hex characters")
+    public, secret = zmq.curve_keypair()
+    sock.setsockopt(zmq.CURVE_SERVERKEY, z85)
+    sock.setsockopt(zmq.CURVE_PUBLICKEY, public)
     sock.setsockopt(zmq.CURVE_SECRETKEY, secret)
 
 

@@ -23,6 +23,7 @@ from urllib.parse import urlsplit
 import msgpack
 import zmq
 
+from sensorium.server.daemon.transport import curve_client_from_env
 from sensorium.server.recording.envelope import DEFAULT_CHUNK_SIZE, topic_matcher
 from sensorium.server.recording.writer import McapRecorder
 
@@ -84,6 +85,7 @@ def rpc_call(ctx: zmq.Context, url: str, service: str, args: dict | None = None,
     sock = ctx.socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)
     try:
+        curve_client_from_env(sock)
         sock.connect(url)
         sock.send(msgpack.packb({"id": 1, "service": service, "args": args or {}}))
         if not sock.poll(int(timeout * 1000)):
@@ -180,6 +182,7 @@ class LiveRecorder:
         self.sub.setsockopt(zmq.LINGER, 0)
         for prefix in subscription_prefixes(self.topics):
             self.sub.setsockopt(zmq.SUBSCRIBE, prefix)
+        curve_client_from_env(self.sub)
         self.sub.connect(self.pub_endpoint)
         self.recorder = self._new_recorder(self.path)
 
