@@ -153,6 +153,7 @@ class FakeRobot:
     def __init__(self, sim, model: wm.Robot):
         self.name = model.name
         self.synchronization = model.synchronization
+        self.controller = model.controller
         self.devices = {d.name: CLASSES[d.device](sim, model.name, d) for d in model.devices}
         self.pose = SimpleNamespace(translation=(0.0, 0.0, 0.0), rotation=np.eye(3))
         # the real kinematic drive (motors and pose integration are cheap and exact)

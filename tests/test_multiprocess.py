@@ -58,13 +58,13 @@ class Proc:
             else:
                 self.err.append(line)
 
-    def line(self, timeout: float = 20.0) -> str:
+    def line(self, timeout: float = 60.0) -> str:
         try:
             return self.lines.get(timeout=timeout)
         except queue.Empty:
             raise AssertionError(f"no output from {self.args[-4:]} in {timeout} s; stderr:\n" + "\n".join(self.err)) from None
 
-    def wait(self, timeout: float = 20.0) -> int:
+    def wait(self, timeout: float = 60.0) -> int:
         try:
             return self.p.wait(timeout)
         except subprocess.TimeoutExpired:
@@ -76,7 +76,7 @@ class Proc:
     def kill(self) -> None:
         if self.p.poll() is None:
             self.p.kill()
-            self.p.wait(5)
+            self.p.wait(30)
 
 
 def sensorium(*args: str) -> list[str]:
@@ -90,7 +90,7 @@ class Server:
         ready = self.proc.line(timeout=60)
         assert ready.startswith("sensorium: serving world"), ready
         assert f"rpc={self.rpc}" in ready and f"pub={self.pub}" in ready, ready
-        self.conn = Connection(self.rpc, timeout=5.0)
+        self.conn = Connection(self.rpc, timeout=30.0)
 
     def url(self, robot: str) -> str:
         return f"{self.rpc}/{robot}"
@@ -98,7 +98,7 @@ class Server:
     def info(self) -> dict:
         return self.conn.call("get_info")
 
-    def wait_attached(self, robots: set[str], timeout: float = 30.0) -> None:
+    def wait_attached(self, robots: set[str], timeout: float = 60.0) -> None:
         deadline = time.monotonic() + timeout
         while True:
             attached = {r["name"] for r in self.info()["robots"] if r["attached"]}
@@ -112,7 +112,7 @@ class Server:
         if self.proc.p.poll() is None:
             self.proc.p.send_signal(signal.SIGINT)
         try:
-            return self.proc.wait(15)
+            return self.proc.wait(60)
         finally:
             self.proc.kill()
 
@@ -202,7 +202,7 @@ def _stepper(server: Server, robot: str, duration: int, steps: int, device: str)
                 env={"SENSORIUM_CONTROLLER_URL": server.url(robot)})
 
 
-def _times_until(proc: Proc, predicate, timeout: float = 20.0) -> list[tuple[int, int, float]]:
+def _times_until(proc: Proc, predicate, timeout: float = 60.0) -> list[tuple[int, int, float]]:
     rows = []
     deadline = time.monotonic() + timeout
     while True:
@@ -226,18 +226,18 @@ def test_killed_controller_blocks_nobody_and_its_robot_can_be_attached_again(ser
     server.conn.call("set_mode", {"mode": "fast"})
     _times_until(bee, lambda row: row[0] >= 320)
     ant.p.send_signal(signal.SIGKILL)
-    ant.p.wait(5)
+    ant.p.wait(30)
     killed_at = server.info()["time_ms"]
     # the others keep stepping once the server has dropped the dead session (3 x 200 ms)
-    rows = _times_until(bee, lambda row: row[0] >= killed_at + 50 * 32, timeout=15)
+    rows = _times_until(bee, lambda row: row[0] >= killed_at + 50 * 32, timeout=60)
     assert all(status == 0 for _, status, _ in rows)
-    _times_until(cat, lambda row: row[0] >= killed_at + 20 * 48, timeout=15)
+    _times_until(cat, lambda row: row[0] >= killed_at + 20 * 48, timeout=60)
     # a new process takes the robot (refused with ROBOT_TAKEN until the old session expired)
-    deadline = time.monotonic() + 10
+    deadline = time.monotonic() + 60
     while True:
         again = _stepper(server, "ant", 16, 5, "ir")
         procs.append(again)
-        code = again.wait(20)
+        code = again.wait(60)
         if code == 0:
             break
         assert "ROBOT_TAKEN" in again.stderr(), again.stderr()
@@ -250,7 +250,7 @@ def test_killed_controller_blocks_nobody_and_its_robot_can_be_attached_again(ser
     # quitting the server ends the remaining controllers' loops with -1
     assert server.stop() == 0
     for p in (bee, cat):
-        assert p.wait(10) == 0, p.stderr()
+        assert p.wait(60) == 0, p.stderr()
         assert p.out[-1].split()[1] == "-1"
 
 
@@ -304,9 +304,11 @@ def test_examples_through_the_launcher_with_topics_and_echo(servers, tmp_path):
     assert wanderer.wait(60) == 0, wanderer.stderr()
     assert len(braitenberg.out) == 5 and "ls0=" in braitenberg.out[0] and "wheels" in braitenberg.out[-1]
     assert "nan" not in braitenberg.out[0]
-    assert len(wanderer.out) == 3 and "lidar front=" in wanderer.out[0] and "->" in wanderer.out[0]
+    decisions = [line for line in wanderer.out if "ahead=" in line]
+    assert len(decisions) == 3 and "-> forward" in decisions[0]
     assert echo.wait(30) == 0, echo.stderr()
-    assert len(echo.out) == 2 and echo.out[0].startswith("/epuck/ls0/value [sensor_msgs/msg/Illuminance]")
+    heads = [line for line in echo.out if line.startswith("# /epuck/ls0/value [sensor_msgs/msg/Illuminance]")]
+    assert len(heads) == 2 and echo.out.count("---") == 2 and any(line.startswith("illuminance: ") for line in echo.out)
     assert server.stop() == 0
 
 
@@ -382,7 +384,8 @@ def test_examples_drive_their_robots(servers, tmp_path):
     server.conn.call("set_mode", {"mode": "fast"})
     assert braitenberg.wait(120) == 0, braitenberg.stderr()
     assert wanderer.wait(120) == 0, wanderer.stderr()
-    assert len(braitenberg.out) == 300 and len(wanderer.out) == 100
+    assert len(braitenberg.out) == 300
+    assert len([line for line in wanderer.out if "ahead=" in line]) == 100
     after = {r: server.conn.call(f"/{r}/robot/get_pose") for r in ("epuck", "scout")}
     moved = {r: math.dist(before[r]["translation"][:2], after[r]["translation"][:2]) for r in before}
     assert moved["epuck"] > 0.1, moved          # ~9.6 s at about half the e-puck's top speed

@@ -52,7 +52,7 @@ class Server:
         assert reply["ok"], reply
         return reply["result"]
 
-    def wait_subscribed(self, timeout: float = 5.0) -> None:
+    def wait_subscribed(self, timeout: float = 30.0) -> None:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             try:
@@ -70,7 +70,7 @@ class Server:
             self.ctx.term()
         if self.proc.poll() is None:
             self.proc.send_signal(sig)
-        _out, err = self.proc.communicate(timeout=20)
+        _out, err = self.proc.communicate(timeout=60)
         assert self.proc.returncode == 0, err
         return err
 
@@ -154,7 +154,7 @@ def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):
     th.start()
     server.wait_subscribed()
     drive(server, 30)  # 8 distance + 2 light sensors + the pose: 330 messages
-    deadline = time.monotonic() + 10
+    deadline = time.monotonic() + 60
     while live.gaps.total_received < 330 and time.monotonic() < deadline:
         time.sleep(0.02)
     live.stop()
@@ -165,7 +165,7 @@ def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):
         assert rec.metadata()["sensorium"]["basic_time_step_ms"] == "32"
         subscribed = [(m.topic, m.seq, m.data) for m in rec.messages()]
     # the server's own recorder writes its chunk at least once a second, even while idle
-    deadline = time.monotonic() + 5
+    deadline = time.monotonic() + 30
     while time.monotonic() < deadline:
         try:
             with Recording(path) as rec:
@@ -180,7 +180,7 @@ def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):
         assert rec.truncated
         recorded = [(m.topic, m.seq, m.data) for m in rec.messages()]
     assert recorded == subscribed  # nothing lost on either side: the exact published bytes
-    info = subprocess.run([PY, "-m", "sensorium", "info", str(path)], capture_output=True, text=True, timeout=30)
+    info = subprocess.run([PY, "-m", "sensorium", "info", str(path)], capture_output=True, text=True, timeout=120)
     assert "Truncated:         YES" in info.stdout and "Messages:          330" in info.stdout
 
 
@@ -207,7 +207,7 @@ def test_record_connect_reports_exact_loss(server_factory, tmp_path):
             break
         last = live.gaps.total_received
     server.call("/epuck/robot/step", duration=32)  # one more, read by a reader that keeps up
-    deadline = time.monotonic() + 10
+    deadline = time.monotonic() + 60
     while live.gaps.last.get("/scout/lidar/point_cloud") != 200 and time.monotonic() < deadline:
         time.sleep(0.02)
     live.stop()

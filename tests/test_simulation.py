@@ -455,15 +455,16 @@ def test_moving_robot_changes_reading_without_bvh_rebuild() -> None:
     assert sim.counters["bvh_builds"] == builds
 
 
-def test_all_sensors_of_a_step_share_one_cast_per_ray_kind() -> None:
+def test_all_sensors_of_a_step_share_one_cast_per_ray_kind_and_outputs() -> None:
     from pathlib import Path
 
     sim = Simulation.from_file(Path(__file__).resolve().parents[1] / "sensorium" / "worlds" / "arena.yaml")
     for d in sim.all_devices():
         d.enable(32)
     sim.step()
-    # kinds: infra-red + lidar (visual), sonar + light occlusion (bounding)
-    assert sim.counters["cast_calls"] == 2
+    # casts: infra-red (visual, with normals and shapes), lidar (visual, distances only), sonar +
+    # light occlusion (bounding); lidars share one distance-only cast whatever their number
+    assert sim.counters["cast_calls"] == 3
 
 
 # ------------------------------------------------------------------ probe command

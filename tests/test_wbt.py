@@ -464,7 +464,7 @@ def test_supervisor_finds_nodes_by_def_name() -> None:
 
 
 def test_duplicate_def_names_rejected_in_world_files() -> None:
-    with pytest.raises(WorldError, match=r"solids\[0\].def_name: duplicate DEF name 'A' \(first used at robots\[0\].def_name\)"):
+    with pytest.raises(WorldError, match=r"solids\[0\] \(s\).def_name: duplicate DEF name 'A' \(first used at robots\[0\].def_name\)"):
         parse_world({"robots": [{"name": "r", "def_name": "A"}],
                      "solids": [{"name": "s", "def_name": "A", "geometry": {"type": "box"}}]})
 

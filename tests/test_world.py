@@ -217,7 +217,7 @@ def test_not_a_mapping_and_bad_yaml(tmp_path: Path) -> None:
     (tmp_path / "b.yaml").write_text("robots: [unclosed\n")
     with pytest.raises(WorldError, match="a world must be a mapping, got list"):
         load_world(tmp_path / "a.yaml")
-    with pytest.raises(WorldError, match="not valid YAML/JSON"):
+    with pytest.raises(WorldError, match="line 2, column 1: not valid YAML"):
         load_world(tmp_path / "b.yaml")
     with pytest.raises(WorldError, match="cannot read world file"):
         load_world(tmp_path / "missing.yaml")
@@ -247,7 +247,7 @@ def test_cli_validate_ok_and_failure(tmp_path: Path) -> None:
     res = _cli("validate", str(bad))
     assert res.returncode == 1
     assert f"{bad}: lights[0].attenuation: attenuation 0 0 0" in res.stderr
-    assert f"{bad}: robots[0].devices[0]:" in res.stderr
+    assert f"{bad}: robots[0] (r).devices[0] (s):" in res.stderr
     assert "INVALID (2 problems)" in res.stderr
 
 

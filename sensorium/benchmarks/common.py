@@ -167,18 +167,21 @@ class Stopwatch:
     def __init__(self, fn: Callable):
         self.fn = fn
         self.total = 0.0
+        self.cpu = 0.0          # this process's CPU time inside the calls (time.process_time)
         self.calls = 0
 
     def __call__(self, *a, **k):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         try:
             return self.fn(*a, **k)
         finally:
             self.total += time.perf_counter() - t0
+            self.cpu += time.process_time() - c0
             self.calls += 1
 
     def reset(self) -> None:
         self.total = 0.0
+        self.cpu = 0.0
         self.calls = 0
 
 

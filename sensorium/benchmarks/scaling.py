@@ -64,18 +64,25 @@ def run(cfg: Config) -> Section:
     return sec
 
 
-def _step_times(sim, cfg: Config, budget_s: float) -> tuple[float, float]:
-    """(median step time, median ray-work time per step)."""
+def _step_times(sim, cfg: Config, budget_s: float, cpu: list | None = None) -> tuple[float, float]:
+    """(median step time, median ray-work time per step), wall clock.  ``cpu``: gets the medians of
+    this process's CPU time per step and per cast appended (time.process_time: what the step costs,
+    without the time spent waiting for a core that other jobs hold)."""
     sw = wrap_cast(sim)
     sim.step()
-    per = []
+    per, per_cpu, step_cpu = [], [], []
 
     def step():
         sw.reset()
+        c0 = time.process_time()
         sim.step()
+        step_cpu.append(time.process_time() - c0)
         per.append(sw.total)
+        per_cpu.append(sw.cpu)
 
     ts = samples(step, cfg.pick(5, 3), warmup=0, min_total_s=budget_s, max_repeat=200)
+    if cpu is not None:
+        cpu += [float(np.median(step_cpu)), float(np.median(per_cpu))]
     return float(np.median(ts)), float(np.median(per))
 
 
@@ -236,8 +243,8 @@ def devices_sweep(cfg: Config, sec: Section) -> None:
 
 # ---------------------------------------------------------------------------- robots
 def robots_sweep(cfg: Config, sec: Section) -> None:
-    counts = cfg.pick([1, 10, 30, 100, 300], [1, 10, 100])
-    xs, ts, rs, extra = [], [], [], []
+    counts = cfg.pick([1, 10, 30, 100, 300, 1000], [1, 10, 100])
+    xs, ts, rs, extra, tfs, cpus = [], [], [], [], [], []
     target_row = prof_table = None
     shapes = [s for s in room_shapes() if s.kind in ("plane", "box")]
     for n in counts:
@@ -254,9 +261,10 @@ def robots_sweep(cfg: Config, sec: Section) -> None:
         fast = make_sim(world, "fast")
         for d in fast.all_devices():
             d.enable(8)
-        tf, rf = _step_times(fast, cfg, cfg.pick(0.3, 0.1))
-        xs.append(n), ts.append(t), rs.append(r)
-        extra.append([8 * n, 24 * n, fmt_time(rf), fmt_time(unb)])
+        cpu: list[float] = []
+        tf, rf = _step_times(fast, cfg, cfg.pick(0.3, 0.1), cpu)
+        xs.append(n), ts.append(t), rs.append(r), tfs.append(tf), cpus.append(cpu)
+        extra.append([8 * n, 24 * n, fmt_time(tf), fmt_time(cpu[0]), fmt_time(rf), fmt_time(cpu[1]), fmt_time(unb)])
         if n == 100:
             prof = profile_top(fast.step, cfg.pick(5, 2))
             prof_table = profile_table("robots_profile", "Profile of a 100-robot step, FAST (top functions by self time)",
@@ -272,31 +280,69 @@ def robots_sweep(cfg: Config, sec: Section) -> None:
     d = _sweep_table(sec, "robots", "Time per step vs robots (e-puck: body + 8 infra-red sensors, 3 rays each)", "robots",
                      xs, extra, ts, rs, [
                          "Robots on a grid in the benchmark room (walls and floor); each robot body is a moving "
-                         "cylinder, so it has its own Embree scene (mover tier). 'ray work' is EXACT mode, one "
-                         "batched cast per step; 'ray work FAST' the same in FAST mode; 'unbatched' casts the same "
-                         "rays one sensor per call."],
+                         "cylinder (a mover sharing one body-frame Embree scene with the others). 'step' and 'ray "
+                         "work' are EXACT mode, one batched cast per step; 'step FAST' and 'ray work FAST' the same in "
+                         "FAST mode; 'unbatched' casts the same rays one sensor per call. One thread throughout. "
+                         "'CPU' columns: this process's CPU time (time.process_time) per step or cast, medians — "
+                         "what the work costs, without the time spent queuing for a core; the other columns are "
+                         "wall clock. On this shared 2-core machine (load average in the header) the two differ "
+                         "by the queueing, and the targets below are judged on CPU time.",
+                         "Each sensor's rays are rigidly mounted on its robot: whether they meet their own body is "
+                         "decided once in the body frame, and the broad phase pairs bodies (a sorted sweep) before "
+                         "it looks at rays, so a robot with no neighbour within its sensors' reach costs no per-ray "
+                         "broad-phase work. Per-sensor constants are stacked once per set of due sensors."],
                      "Time per step vs robots", "robots",
-                     extra_series=[("sensors", None), ("rays", None), ("ray work FAST", None), ("ray work unbatched", None)])
+                     extra_series=[("sensors", None), ("rays", None), ("step FAST", None), ("step FAST, CPU", None),
+                                   ("ray work FAST", None), ("ray work FAST, CPU", None), ("ray work unbatched", None)])
+    d["step_fast_s"] = tfs
+    d["step_fast_cpu_s"] = [c[0] for c in cpus]
+    d["ray_fast_cpu_s"] = [c[1] for c in cpus]
+    d["growth_step_fast"] = growth(xs, tfs)
     d["target_100"] = target_row
     if prof_table is not None:
         sec.tables.append(prof_table)
     sec.data["robots"] = d
     if target_row is not None:
-        best = min(target_row["ray_s"], target_row["ray_fast_s"])
-        ok = best < 1e-3
-        why = (f"EXACT {fmt_time(target_row['ray_s'])}, FAST {fmt_time(target_row['ray_fast_s'])} of ray work per step "
-               f"(one batched call for 800 sensors / 2,400 rays); unbatched it is {fmt_time(target_row['unbatched_ray_s'])}; "
-               f"raw embreex on the same rays and triangles (bodies baked into one static scene) "
-               f"{fmt_time(target_row['raw_embreex_s'])}. The whole step (ray planning + reductions in Python) is "
-               f"{fmt_time(target_row['step_s'])}.")
-        nob = target_row["ray_fast_no_bodies_s"]
-        why += (f" Without the robots' bodies (no moving shapes) the same rays take {fmt_time(nob)} (FAST): the 100 "
-                f"moving bodies cost {fmt_time(target_row['ray_fast_s'] - nob)} of the ray work.")
+        tr = target_row
+        i100 = xs.index(100)
+        ray, step = cpus[i100][1], cpus[i100][0]
+        ok = ray < 0.6e-3 and step < 4e-3
+        why = (f"FAST, 1 thread, CPU time: {fmt_time(ray)} of ray work in a {fmt_time(step)} step (800 sensors, 2,400 "
+               f"rays, one batched cast); wall clock in this run {fmt_time(tr['ray_fast_s'])} / "
+               f"{fmt_time(tr['step_fast_s'])}; EXACT (wall) {fmt_time(tr['ray_s'])} / {fmt_time(tr['step_s'])}; the same rays cast one sensor "
+               f"per call: {fmt_time(tr['unbatched_ray_s'])}; raw embreex on the same rays with the bodies baked into "
+               f"one static scene {fmt_time(tr['raw_embreex_s'])}; without the robots' bodies "
+               f"{fmt_time(tr['ray_fast_no_bodies_s'])}.")
+        if ray >= 0.6e-3:
+            why += (f" MISS on the ray work by {ray / 0.6e-3:.2f}×: raw embreex needs {fmt_time(tr['raw_embreex_s'])} "
+                    "for the traversal alone; the rest is the engine's fixed numpy passes over the 2,400 rays (the "
+                    "floor plane, judging the static tier's hits, the bodies' sweep and, for the robots close enough, "
+                    "their rays in body frames), each a few µs of call overhead. Native design: the batched cast of "
+                    "small sensors as one C++ call (rays in, rtcIntersect4/8 per sensor group with the planes and "
+                    "the mounted-ray exclusions applied in an Embree filter), expected ≈ raw embreex + 0.05 ms.")
+        if step >= 4e-3:
+            why += (" MISS on the step: per-sensor Python left around the batched arrays (schedules, values and their "
+                    "lookup/noise/rounding per sensor).")
+        sec.targets.append(Target("100 robots × 8 IR sensors: ray work / whole step", "< 0.6 ms / < 4 ms",
+                                  f"{fmt_time(ray)} / {fmt_time(step)} (FAST, CPU)", ok, why))
+    if 1000 in xs:
+        i = xs.index(1000)
+        cpu_steps = [c[0] for c in cpus]
+        t1000 = cpu_steps[i]
+        g = growth(xs, cpu_steps)
+        ok = t1000 < 35e-3 and g["slope_upper"] <= 1.2     # linear within the ±0.2 a shared-machine sweep resolves
+        why = (f"FAST, 1 thread, CPU time: {fmt_time(t1000)} per step for 1,000 robots (8,000 sensors, 24,000 rays; "
+               f"wall clock in this run {fmt_time(tfs[i])}, EXACT {fmt_time(ts[i])}); growth of the FAST step's CPU time over the upper half of the sweep: slope "
+               f"{g['slope_upper']:.2f} ({g['label']}; 1 = linear, read to about ±0.2 on a shared machine).")
         if not ok:
-            why += (f" MISS by {best / 1e-3:.1f}×: the engine's fixed costs around Embree (numpy gathers, per-tier "
-                    f"passes, one pass per moving body) outweigh the {fmt_time(target_row['raw_embreex_s'])} of traversal.")
-        sec.targets.append(Target("100 robots × 8 IR sensors: ray work per step", "< 1 ms",
-                                  f"{fmt_time(best)} ({'FAST' if best == target_row['ray_fast_s'] else 'EXACT'})", ok, why))
+            why += " MISS: see the profile of the 100-robot step for where the per-sensor time goes."
+        sec.targets.append(Target("1,000 robots × 8 IR sensors: whole step", "< 35 ms, growing linearly",
+                                  f"{fmt_time(t1000)} (FAST, CPU), slope {g['slope_upper']:.2f}", ok, why))
+        per_robot = t1000 / 1000
+        sec.findings.append(
+            f"What this means for you: a step costs about {fmt_time(per_robot)} of CPU per e-puck (8 infra-red sensors, "
+            f"FAST, 1,000 robots), so one core keeps about {int(1 / 64 / per_robot):,} e-pucks measuring at 64 Hz in real "
+            f"time (a 15.6 ms budget per step), before any controller or transport cost.")
     sec.findings.append(f"Robots: {d['growth_step']['label']} (slope {d['growth_step']['slope_upper']:.2f}); ray work "
                         f"grows {d['growth_ray']['label']} (slope {d['growth_ray']['slope_upper']:.2f}).")
 

@@ -61,8 +61,9 @@ def _probe_args(p: argparse.ArgumentParser) -> None:
 @command("controller", "run a Webots-style controller (Python script or compiled binary) for a robot of a running server",
          "sensorium.cli.client:controller")
 def _controller_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("script", help="controller: a Python script (uses `from controller import Robot`) or an executable "
-                   "(e.g. a C controller linked against sensorium/client/c)")
+    p.add_argument("script", help="controller: a Python script (uses `from controller import Robot`), an executable "
+                   "(e.g. a C controller linked against sensorium/client/c), or example:NAME for a bundled example "
+                   "(example:light_follower, example:wanderer, example:braitenberg)")
     p.add_argument("--robot", help="robot name (default: the URL's robot, or the world's only robot)")
     p.add_argument("--url", help="RPC endpoint or controller URL, e.g. tcp://127.0.0.1:5560 or "
                    "tcp://host:5560/epuck (default: $SENSORIUM_CONTROLLER_URL, $WEBOTS_CONTROLLER_URL, "
@@ -72,18 +73,54 @@ def _controller_args(p: argparse.ArgumentParser) -> None:
                    "and '--' ends them")
 
 
-@command("echo", "print the messages of a topic (or of every topic under a PREFIX/)", "sensorium.cli.client:echo")
+@command("echo", "print the messages of a topic (or of every topic under a PREFIX/) as YAML",
+         "sensorium.cli.topics:echo")
 def _echo_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.topics import add_endpoint_args
+
     p.add_argument("topic", help="topic, e.g. /epuck/ps0/value; a name ending in '/' is a prefix, '' is all")
-    p.add_argument("--url", default="tcp://127.0.0.1:5561", help="topic endpoint (default tcp://127.0.0.1:5561)")
+    add_endpoint_args(p)
     p.add_argument("--count", type=int, help="stop after N messages")
-    p.add_argument("--timeout", type=float, help="exit 1 if no message comes for this many seconds")
+    p.add_argument("--full", action="store_true", help="print arrays in full (default: summarised)")
+    p.add_argument("--json", action="store_true", help="one JSON object per message (arrays in full)")
 
 
-@command("topics", "list a running server's topics and their types", "sensorium.cli.client:topics")
+@command("hz", "measure the rate of topics (like ros2 topic hz)", "sensorium.cli.topics:hz")
+def _hz_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.topics import add_endpoint_args
+
+    p.add_argument("topics", nargs="+", metavar="TOPIC", help="topics (a name ending in '/' is a prefix)")
+    add_endpoint_args(p)
+    p.add_argument("--window", type=int, default=1000, metavar="N", help="messages per statistic (default 1000)")
+    p.add_argument("--every", type=float, default=1.0, metavar="S", help="report every S seconds (default 1)")
+    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds (default: until Ctrl-C)")
+    p.add_argument("--json", action="store_true", help="one JSON object per topic and report")
+
+
+@command("topics", "list a running server's topics and their types", "sensorium.cli.topics:topics")
 def _topics_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--url", help="RPC endpoint (default tcp://127.0.0.1:5560)")
     p.add_argument("--timeout", type=float, default=5.0, help="seconds to wait for the server (default 5)")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+
+
+@command("services", "list a running server's services with their arguments (like ros2 service list -t)",
+         "sensorium.cli.services:services")
+def _services_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--url", help="RPC endpoint (default tcp://127.0.0.1:5560)")
+    p.add_argument("--robot", help="only this robot's services ('server': the server's own)")
+    p.add_argument("--timeout", type=float, default=5.0, help="seconds to wait for the server (default 5)")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+
+
+@command("call", "call one service of a running server (like ros2 service call)", "sensorium.cli.services:call")
+def _call_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("service", help="service name, e.g. get_info, set_mode, /epuck/robot/get_pose")
+    p.add_argument("args", nargs="?", help="arguments as JSON or YAML flow style, e.g. '{mode: fast}'")
+    p.add_argument("--url", help="RPC endpoint (default tcp://127.0.0.1:5560)")
+    p.add_argument("--timeout", type=float, default=5.0, help="seconds to wait for the reply (default 5)")
+    p.add_argument("--full", action="store_true", help="print arrays in full (default: summarised)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
 # --- recording: record / replay / export (server/cli_recording.py) ---
@@ -102,6 +139,7 @@ def _record_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rcvhwm", type=int, default=1000, help="receive high-water mark, messages (default 1000)")
     p.add_argument("--chunk-size", type=int, default=1 << 20, help="MCAP chunk size in bytes (default 1 MiB)")
     p.add_argument("--json", action="store_true", help="print the final summary as JSON")
+    p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
 
 
 def _seconds(text: str) -> float:
@@ -202,6 +240,8 @@ def _demo_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar on stderr (default: only on a terminal)")
 
 
 # --- sweeps: sweep (sensorium/sweep/) ---

@@ -32,9 +32,26 @@ def _command(args: argparse.Namespace) -> str:
 
 def main(args: argparse.Namespace) -> int:
     from sensorium.benchmarks.suite import run_suite
+    from sensorium.cli.progress import bar
 
-    result = run_suite(Path(args.out), args.only, quick=args.quick, plots=not args.no_plots,
-                       command=_command(args), log=lambda line: print(line, file=sys.stderr, flush=True))
+    progress = bar(len(args.only or SECTIONS), "bench", "section")   # a bar over the sections, on a terminal
+
+    def log(line: str) -> None:
+        write = getattr(progress, "write", None)          # tqdm keeps its bar below the lines
+        if write is not None:
+            write(line, file=sys.stderr)
+        else:
+            print(line, file=sys.stderr, flush=True)
+        if line.endswith("…"):
+            progress.set_postfix_str(line.split(": ", 1)[-1].rstrip(" …"))
+        elif " done in " in line or line.rstrip().endswith("failed") or " failed: " in line:
+            progress.update(1)
+
+    try:
+        result = run_suite(Path(args.out), args.only, quick=args.quick, plots=not args.no_plots,
+                           command=_command(args), log=log)
+    finally:
+        progress.close()
     for w in result.written:
         print(w)
     sections = result.doc.get("sections", {})

@@ -1,26 +1,32 @@
-"""Client subcommands: ``sensorium controller``, ``echo`` and ``topics`` (pyzmq + msgpack only)."""
+"""``sensorium controller``: run a Webots-style Python controller (pyzmq + msgpack only); ``echo``,
+``hz`` and ``topics`` are in topics.py, ``services`` and ``call`` in services.py."""
 
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import runpy
 import sys
 import traceback
 from pathlib import Path
-from typing import Any
 
 from sensorium.client.connection import (
-    DEFAULT_PUB_ENDPOINT,
     ENV_URL,
-    Connection,
     SensoriumError,
     controller_url_from_env,
     parse_controller_url,
 )
 
 WEBOTS_DIR = Path(__file__).resolve().parents[1] / "client" / "webots"
+EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "client" / "examples"
+
+
+def _resolve_script(name: str) -> Path:
+    """A script path, or ``example:NAME`` for a controller bundled in sensorium/client/examples."""
+    if name.startswith("example:"):
+        stem = name[len("example:"):].removesuffix(".py")
+        return EXAMPLES_DIR / f"{stem}.py"
+    return Path(name)
 
 
 # ---------------------------------------------------------------------- controller
@@ -118,9 +124,10 @@ def controller(args: argparse.Namespace) -> int:
     if problem:
         print(f"sensorium controller: {problem}", file=sys.stderr)
         return 2
-    script = Path(args.script)
+    script = _resolve_script(args.script)
     if not script.is_file():
-        print(f"sensorium controller: no such script: {script}", file=sys.stderr)
+        print(f"sensorium controller: no such script: {script} (bundled examples: "
+              f"{', '.join('example:' + p.stem for p in sorted(EXAMPLES_DIR.glob('[!_]*.py')))})", file=sys.stderr)
         return 2
     binary = _is_binary_controller(script)
     if binary is None:
@@ -159,86 +166,3 @@ def controller(args: argparse.Namespace) -> int:
     finally:
         sys.stdout.flush()
         wb.wb_robot_cleanup()
-
-
-# ---------------------------------------------------------------------- echo
-
-def summarize(value: Any) -> Any:
-    """A printable form of a decoded body: arrays become ``<float32[360] 0.12..5.9 (3 inf)>``."""
-    if isinstance(value, dict):
-        return {k: summarize(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [summarize(v) for v in value]
-    if isinstance(value, (bytes, bytearray, memoryview)):
-        return _Raw(f"<bytes[{len(value)}]>")
-    shape = getattr(value, "shape", None)
-    if shape is not None and hasattr(value, "dtype"):                       # numpy
-        flat = value.reshape(-1)
-        dims = "x".join(str(d) for d in shape)
-        return _Raw(_stats(f"{value.dtype}[{dims}]", [float(v) for v in flat] if flat.size <= 200_000 else []))
-    typecode = getattr(value, "typecode", None)
-    if typecode is not None:                                                # array.array
-        return _Raw(_stats(f"float32[{len(value)}]" if typecode == "f" else f"{typecode}[{len(value)}]", list(value)))
-    return value
-
-
-class _Raw(str):
-    def __repr__(self) -> str:
-        return str(self)
-
-
-def _stats(head: str, values: list[float]) -> str:
-    if not values:
-        return f"<{head}>"
-    finite = [v for v in values if math.isfinite(v)]
-    extras = []
-    n_inf = sum(1 for v in values if math.isinf(v))
-    n_nan = len(values) - len(finite) - n_inf
-    if n_inf:
-        extras.append(f"{n_inf} inf")
-    if n_nan:
-        extras.append(f"{n_nan} nan")
-    rng = f" {min(finite):.4g}..{max(finite):.4g}" if finite else ""
-    return f"<{head}{rng}{' (' + ', '.join(extras) + ')' if extras else ''}>"
-
-
-def format_message(msg: Any) -> str:
-    body = dict(msg.body)
-    body.pop("header", None)
-    fields = ", ".join(f"{k}: {summarize(v)!r}" for k, v in body.items())
-    return f"{msg.topic} [{msg.type}] seq={msg.seq} t={msg.stamp_ns / 1e9:.3f} {{{fields}}}"
-
-
-def echo(args: argparse.Namespace) -> int:
-    from sensorium.client.topics import Subscriber
-
-    count = 0
-    with Subscriber(args.url, args.topic) as sub:
-        while args.count is None or count < args.count:
-            msg = sub.recv(timeout=args.timeout)
-            if msg is None:
-                print(f"sensorium echo: nothing on {args.topic!r} from {args.url} for {args.timeout:g} s", file=sys.stderr)
-                return 1
-            if msg.gap:
-                print(f"# {msg.gap} message(s) of {msg.topic} lost before seq {msg.seq}", file=sys.stderr)
-            print(format_message(msg), flush=True)
-            count += 1
-    return 0
-
-
-# ---------------------------------------------------------------------- topics
-
-def topics(args: argparse.Namespace) -> int:
-    try:
-        endpoint = parse_controller_url(args.url).endpoint
-        with Connection(endpoint, timeout=args.timeout) as conn:
-            info = conn.call("get_info")
-    except SensoriumError as exc:
-        print(f"sensorium topics: {exc}", file=sys.stderr)
-        return 1
-    rows = [(str(t.get("name")), str(t.get("type"))) for t in info.get("topics", [])]
-    print(f"# world {info.get('world')!r}, topics on {info.get('pub_endpoint', DEFAULT_PUB_ENDPOINT)}", file=sys.stderr)
-    width = max((len(n) for n, _ in rows), default=0)
-    for name, kind in rows:
-        print(f"{name:<{width}}  {kind}")
-    return 0

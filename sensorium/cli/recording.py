@@ -10,6 +10,7 @@ import os
 import signal
 import sys
 from contextlib import contextmanager
+from pathlib import Path
 
 import zmq
 
@@ -39,6 +40,9 @@ def sigterm_as_interrupt():
 
 
 def record(args: argparse.Namespace) -> int:
+    if Path(args.file).exists() and not args.force:
+        print(f"sensorium record: {args.file} exists already; not overwriting (--force to replace it)", file=sys.stderr)
+        return 1
     ctx: zmq.Context = zmq.Context.instance()
     rec = LiveRecorder(args.file, connect=args.connect, pub=args.pub, topics=args.topics or None, world=args.world,
                        chunk_size=args.chunk_size, rcvhwm=args.rcvhwm, context=ctx)
@@ -78,8 +82,9 @@ def replay_cmd(args: argparse.Namespace) -> int:
                      topics=args.topics or None, start_s=args.start, end_s=args.end, clock_hz=args.clock,
                      lockstep=args.lockstep, progress=args.progress, wait_subscriber=args.wait,
                      delay_s=args.delay, sndhwm=args.sndhwm, nodrop=args.nodrop)
-    except (OSError, ValueError) as exc:
-        print(f"sensorium replay: {exc}", file=sys.stderr)
+    except (OSError, ValueError, McapError) as exc:
+        print(f"sensorium replay: {exc.strerror + ': ' + str(exc.filename) if isinstance(exc, OSError) and exc.strerror else exc}",
+              file=sys.stderr)
         return 1
     viewer = None
     try:
@@ -124,20 +129,35 @@ def replay_cmd(args: argparse.Namespace) -> int:
 
 
 def export_cmd(args: argparse.Namespace) -> int:
-    from sensorium.server.recording.export import ExportError, export_ros2, print_report
+    from sensorium.server.recording.export import ExportError, export_ros2, print_report, truncation_warning
 
     if not args.ros2:
         print("sensorium export: say which format: --ros2 (the only one so far)", file=sys.stderr)
         return 2
+    from sensorium.cli.progress import bar
+
+    progress = bar(None, "export", "msg")
+
+    def advance(done: int, total: int) -> None:
+        if total and getattr(progress, "total", None) != total:
+            progress.total = total
+        progress.update(1)
+
     try:
         report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
                              pointcloud2=args.pointcloud2, topics=args.topics or None,
                              views=not getattr(args, "no_views", False),
                              start_ns=None if args.start is None else int(round(args.start * 1e9)),
-                             end_ns=None if args.end is None else int(round(args.end * 1e9)))
-    except (ExportError, OSError) as exc:
+                             end_ns=None if args.end is None else int(round(args.end * 1e9)),
+                             progress=advance)
+    except (ExportError, OSError, McapError) as exc:
+        progress.close()
         print(f"sensorium export: {exc}", file=sys.stderr)
         return 1
+    progress.close()
+    warning = truncation_warning(report)
+    if warning:
+        print(f"sensorium export: {warning}", file=sys.stderr, flush=True)
     print_report(report)
     return 0
 
@@ -222,4 +242,50 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
         rate = "-" if t["rate_hz"] is None else f"{t['rate_hz']:.2f} Hz"
         print(f"  Topic: {t['topic']:<{width}} | Type: {t['type']:<{twidth}} | Count: {t['count']:>7} | "
               f"Rate: {rate:>10} | Serialization Format: {t['encoding']}")
+    return 0
+
+
+def bag_summary(path: str | os.PathLike) -> dict:
+    """A rosbag2 directory's ``metadata.yaml`` in the shape of a recording summary (raises
+    OSError/ValueError when the directory is no bag)."""
+    import yaml
+
+    meta_path = Path(path) / "metadata.yaml"
+    if not meta_path.is_file():
+        raise ValueError(f"{path} is a directory without metadata.yaml: neither a world file, an MCAP "
+                         "recording nor a rosbag2 bag")
+    try:
+        info = (yaml.safe_load(meta_path.read_text()) or {}).get("rosbag2_bagfile_information")
+    except yaml.YAMLError as exc:
+        raise ValueError(f"{meta_path}: not valid YAML ({str(exc).splitlines()[0]})") from None
+    if not isinstance(info, dict):
+        raise ValueError(f"{meta_path}: no rosbag2_bagfile_information: not a rosbag2 bag")
+    start = (info.get("starting_time") or {}).get("nanoseconds_since_epoch")
+    duration = (info.get("duration") or {}).get("nanoseconds", 0)
+    topics = [{"topic": t["topic_metadata"]["name"], "type": t["topic_metadata"]["type"],
+               "count": t.get("message_count", 0)} for t in info.get("topics_with_message_count", [])]
+    return {"path": str(path), "kind": "rosbag2", "version": info.get("version"),
+            "storage": info.get("storage_identifier"), "files": info.get("relative_file_paths", []),
+            "messages": info.get("message_count", 0), "start_ns": start, "duration_s": duration / 1e9,
+            "topics": sorted(topics, key=lambda t: t["topic"]), "custom_data": info.get("custom_data") or {}}
+
+
+def print_bag_info(path: str | os.PathLike, as_json: bool = False) -> int:
+    """``sensorium info BAG_DIR``: a rosbag2 directory (e.g. what ``sensorium export`` wrote)."""
+    try:
+        s = bag_summary(path)
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        print(f"sensorium info: {exc}", file=sys.stderr)
+        return 1
+    if as_json:
+        print(json.dumps(s, indent=2))
+        return 0
+    print(f"rosbag2   {s['path']}  (ROS 2 bag, storage {s['storage']}, version {s['version']}; "
+          f"play it with ros2 bag play)")
+    print(f"files     {', '.join(s['files'])}")
+    print(f"duration  {s['duration_s']:.3f} s   start {_secs(s['start_ns'])}   messages {s['messages']}")
+    width = max((len(t["topic"]) for t in s["topics"]), default=0)
+    print(f"topics    {len(s['topics'])}")
+    for t in s["topics"]:
+        print(f"  {t['topic']:<{width}}  {t['count']:>7}  {t['type']}")
     return 0

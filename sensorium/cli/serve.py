@@ -10,6 +10,8 @@ port), so scripts can wait for it::
 from __future__ import annotations
 
 import argparse
+import errno
+import os
 import sys
 
 __all__ = ["add_arguments", "main", "options"]
@@ -45,6 +47,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="quit when the simulated time reaches MS milliseconds (pending steps get -1)")
     p.add_argument("--record", metavar="FILE.mcap",
                    help="record the published messages from inside the step loop (nothing dropped)")
+    p.add_argument("--force", action="store_true", help="with --record: overwrite FILE if it exists")
     p.add_argument("--record-format", choices=["foxglove", "msgpack"], default="foxglove",
                    help="with --record: foxglove (default; opens in Foxglove, the published bytes kept losslessly "
                    "beside ROS 2 CDR views, /tf and /scene) or msgpack (the published bytes only: ~2.4x smaller)")
@@ -98,7 +101,20 @@ def options(args: argparse.Namespace):
                         controls=getattr(args, "controls", "auto"), curve_keys=getattr(args, "curve_keys", None))
 
 
+def bind_problem(exc: BaseException) -> str:
+    """One line for a socket that could not be bound, with what to do about it."""
+    text = str(exc)
+    addr = text.split("addr=", 1)[1].strip("')") if "addr=" in text else ""
+    what = text.split(" (addr=")[0]
+    hint = ""
+    if getattr(exc, "errno", None) == errno.EADDRINUSE or "in use" in text:
+        hint = " (another server? choose other --rpc/--pub ports, or port 0 for free ones)"
+    return f"cannot bind {addr or 'the endpoint'}: {what}{hint}"
+
+
 def main(args: argparse.Namespace) -> int:
+    import zmq
+
     from sensorium.server.daemon.serve import Server
     from sensorium.server.world.loader import WorldError
 
@@ -108,13 +124,17 @@ def main(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"sensorium serve: {exc}", file=sys.stderr)
         return 2
+    record = getattr(args, "record", None)
+    if record and os.path.exists(record) and not getattr(args, "force", False):
+        print(f"sensorium serve: {record} exists already; not overwriting (--force to replace it)", file=sys.stderr)
+        return 1
     try:
         server = Server.open(args.world, opts)
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1
-    except OSError as exc:          # zmq.ZMQError is an OSError: address in use, bad endpoint
-        print(f"sensorium serve: cannot bind: {exc}", file=sys.stderr)
+    except (OSError, zmq.ZMQError) as exc:          # address in use, bad endpoint
+        print(f"sensorium serve: {bind_problem(exc)}", file=sys.stderr)
         return 1
     if server.transport.curve:
         from sensorium.server.daemon.transport import load_curve_keys

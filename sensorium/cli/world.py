@@ -8,10 +8,11 @@ import argparse
 import json
 import math
 import sys
+from pathlib import Path
 from typing import Any
 
 from sensorium.server.sim.summary import world_summary
-from sensorium.server.world.loader import WorldError, default_world_path, load_world
+from sensorium.server.world.loader import WorldError, bundled_or_path, default_world_path, load_world
 
 
 def world_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -39,7 +40,11 @@ def validate(args: argparse.Namespace) -> int:
 
 
 def info(args: argparse.Namespace) -> int:
-    path = args.path or str(default_world_path())
+    path = str(bundled_or_path(args.path)) if args.path else str(default_world_path())
+    if Path(path).is_dir():
+        from sensorium.cli.recording import print_bag_info  # a rosbag2 directory (sensorium export)
+
+        return print_bag_info(path, as_json=args.json)
     if str(path).endswith(".mcap"):
         from sensorium.cli.recording import print_info  # recordings
 
@@ -121,8 +126,13 @@ def probe(args: argparse.Namespace) -> int:
         return 2
     if not enabled:
         print("probe: nothing enabled; use --enable ROBOT/DEVICE:PERIOD (or all:PERIOD)", file=sys.stderr)
+    from sensorium.cli.progress import bar
+
+    # a progress bar while the lines go to a file or a pipe (on a terminal they show the progress)
+    progress = bar(args.steps, "probe", "step", enabled=sys.stderr.isatty() and not sys.stdout.isatty())
     for step in range(1, args.steps + 1):
         sim.step()
+        progress.update(1)
         for dev in enabled:
             readings = dev.readings()
             if args.json:
@@ -132,4 +142,5 @@ def probe(args: argparse.Namespace) -> int:
             else:
                 text = ", ".join(f"{k}={_summary(v)}" for k, v in readings.items())
                 print(f"step {step:>4} t={sim.time_ms:>6} ms  {dev.path:<22} {text}", flush=True)
+    progress.close()
     return 0

@@ -12,7 +12,8 @@ unknown keys and refuse NaN/inf. Vectors are lists because msgpack has no tuples
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Any, Literal
+from types import UnionType
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
@@ -214,6 +215,7 @@ class DeviceRef(Result):
 
 class RobotInfo(Result):
     name: str
+    controller: str = "<extern>"
     synchronization: bool
     attached: bool
     devices: list[DeviceRef]
@@ -417,6 +419,46 @@ class CountersResult(Result):
     subscriptions: list[bytes] = Field(description="active XPUB subscription prefixes")
 
 
+class ServiceRef(Result):
+    """One concrete service of the world, as ``get_services`` lists it."""
+
+    name: str
+    scope: Literal["server", "robot", "device"]
+    robot: str | None = None
+    device: str | None = None
+    device_type: str | None = None
+    attached: bool = Field(description="only the robot's attached controller may call it")
+    args: dict[str, str] = Field(description="argument name -> type; a trailing '?' marks an optional one")
+
+
+class ServicesResult(Result):
+    services: list[ServiceRef]
+
+
+def _type_text(t: Any) -> str:
+    origin, params = get_origin(t), get_args(t)
+    if origin is Literal:
+        return "|".join(str(p) for p in params)
+    if origin is Annotated:
+        return _type_text(params[0])
+    if origin in (Union, UnionType):
+        return " | ".join(_type_text(p) for p in params if p is not type(None))
+    if origin in (list, tuple):
+        inner = [p for p in params if p is not Ellipsis]
+        return "[" + ", ".join(_type_text(p) for p in inner) + (", ..." if origin is list or Ellipsis in params else "") + "]"
+    if origin is dict:
+        return "{" + f"{_type_text(params[0])}: {_type_text(params[1])}" + "}"
+    if isinstance(t, type) and issubclass(t, BaseModel):
+        return "{" + ", ".join(f"{k}: {v}" for k, v in arg_types(t).items()) + "}"
+    return getattr(t, "__name__", str(t))
+
+
+def arg_types(model: type[BaseModel]) -> dict[str, str]:
+    """``{name: type}`` of an argument model for people (``get_services``, ``sensorium services``);
+    a trailing ``?`` marks an optional argument."""
+    return {name: _type_text(f.annotation) + ("" if f.is_required() else "?") for name, f in model.model_fields.items()}
+
+
 # ---------------------------------------------------------------------- the table
 
 @dataclass(frozen=True, slots=True)
@@ -450,6 +492,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("ping", "server", SessionArgs, TimeResult),
     ServiceSpec("set_mode", "server", SetModeArgs, ModeResult),
     ServiceSpec("get_counters", "server", NoArgs, CountersResult),
+    ServiceSpec("get_services", "server", NoArgs, ServicesResult),
     ServiceSpec("step", "robot", StepArgs, StepResult, attached=True),
     ServiceSpec("time_step", "robot", TimeStepArgs, SuccessResult, attached=True),
     ServiceSpec("get_time", "robot", NoArgs, FloatValue),

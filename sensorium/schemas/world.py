@@ -356,6 +356,11 @@ class Robot(Strict):
     name: str = Field(min_length=1)
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
     pose: Pose = Pose()
+    controller: Literal["<extern>", "<none>"] = Field(
+        default="<extern>",
+        description='"<extern>": driven by a controller you start (sensorium controller, a client); while no '
+                    'synchronous controller is attached the server waits for one. "<none>": never controlled, '
+                    "never waited for (its motors keep their initial state)")
     synchronization: bool = True
     supervisor: bool = Field(default=False, description="its controller may use the Supervisor services (Webots)")
     custom_data: str = Field(default="", max_length=1 << 20, description="Webots customData (get/setCustomData)")

@@ -1,13 +1,15 @@
-"""Braitenberg vehicle for the e-puck of worlds/arena.yaml, written as a Webots controller.
+"""A plain Braitenberg vehicle for the e-puck of the arena world, written as a Webots controller.
 
-    sensorium serve worlds/arena.yaml &
-    sensorium controller client/examples/braitenberg.py --robot epuck [STEPS]
+    sensorium serve arena &
+    sensorium controller example:braitenberg --robot epuck [STEPS]
 
 The light sensors ls0 (forward-left) and ls1 (forward-right) drive the opposite wheels harder
-(vehicle 2b, "aggression": it turns toward the light), and the eight infra-red proximity
-sensors ps0..ps7 push it away from obstacles. The wheel speeds go to the e-puck's two wheel
-motors (velocity control) and are printed with the readings. Sensorium's drive is kinematic: the
-robot does not collide, so the infra-red avoidance is what keeps it off the walls.
+(vehicle 2b, "aggression": it turns toward the light), and the eight infra-red proximity sensors
+ps0..ps7 push it away from obstacles. It never slows down: it turns toward the brightest light it
+sees and drives past it, which is what this vehicle does. The demo's e-puck runs
+``light_follower.py`` instead, which looks around, drives to the lamp and stops there. This one
+is kept minimal on purpose: tests/c/braitenberg.c and braitenberg_cpp.cpp port it line by line
+and must print exactly what it prints.
 """
 
 import sys

@@ -5,7 +5,9 @@ that needs it and does the I/O. The machine decides:
 
 * who is attached to which robot, and who is still alive (last heard + 3 heartbeats);
 * whether the world may advance one basic step now (every attached synchronous controller has a
-  step pending, at least one step is pending, the mode allows it, real-time pacing allows it);
+  step pending, at least one step is pending, the mode allows it, real-time pacing allows it) - or
+  runs by itself: when no synchronous controller is attached and no robot waits for one (every
+  robot's controller is ``"<none>"`` or asynchronous), as Webots runs robots without a controller;
 * which pending steps are answered after a basic step (wake time reached), and with which status
   (0; -1 on shutdown; the lateness ``dt`` for asynchronous robots).
 
@@ -76,16 +78,23 @@ class StepDone:
 class Lockstep:
     """Sessions, pending steps, run mode and pacing of one world.
 
-    ``robots`` maps each robot name to its ``synchronization`` flag. ``new_token`` makes session
-    tokens (default: 16 random hex digits); tests inject a deterministic one."""
+    ``robots`` maps each robot name to its ``synchronization`` flag; ``uncontrolled`` names the
+    robots whose world-file ``controller`` is ``"<none>"`` (never attached, never waited for).
+    ``new_token`` makes session tokens (default: 16 random hex digits); tests inject a
+    deterministic one."""
 
     def __init__(self, robots: Mapping[str, bool], basic_time_step: int, *, heartbeat_ms: int = 1000,
-                 mode: str = "fast", time_ms: int = 0, new_token: Callable[[], str] | None = None):
+                 mode: str = "fast", time_ms: int = 0, new_token: Callable[[], str] | None = None,
+                 uncontrolled: Iterable[str] = ()):
         if basic_time_step <= 0:
             raise ValueError("basic_time_step must be > 0")
         if heartbeat_ms <= 0:
             raise ValueError("heartbeat_ms must be > 0")
         self.robots = dict(robots)
+        self.uncontrolled = frozenset(uncontrolled)
+        # robots with an "<extern>" synchronous controller: while none of them is attached, the
+        # world waits for one (Webots waits for a synchronous extern controller to connect)
+        self.extern_synchronous = [r for r, sync in self.robots.items() if sync and r not in self.uncontrolled]
         self.basic_time_step = int(basic_time_step)
         self.heartbeat_ms = int(heartbeat_ms)
         self.time_ms = int(time_ms)
@@ -123,6 +132,9 @@ class Lockstep:
             raise LockstepError(ErrorCode.SHUTTING_DOWN, "the server is quitting")
         if robot not in self.robots:
             raise LockstepError(ErrorCode.UNKNOWN_ROBOT, f"no robot {robot!r} (robots: {', '.join(self.robots) or 'none'})")
+        if robot in self.uncontrolled:
+            raise LockstepError(ErrorCode.WRONG_STATE, f"robot {robot!r} has controller \"<none>\" in the world file: "
+                                                       "it takes no controller (set controller: \"<extern>\")")
         current = self._by_robot.get(robot)
         if current is not None:
             if now - current.last_heard <= self.liveness_s:
@@ -203,18 +215,34 @@ class Lockstep:
         return [s.robot for s in self._by_robot.values() if s.synchronous and s.pending is None]
 
     def can_advance(self) -> bool:
-        """Lockstep rule alone (no mode, no pacing): some step pending and no synchronous
-        controller without one."""
+        """Lockstep rule alone (no mode, no pacing): no attached synchronous controller without a
+        step pending, and either some step pending or nobody to wait for (:attr:`free_running`)."""
         if self.shutting_down:
             return False
         any_pending = False
+        any_synchronous = False
         for s in self._by_robot.values():
-            if s.pending is None:
-                if s.synchronous:
+            if s.synchronous:
+                any_synchronous = True
+                if s.pending is None:
                     return False
-            else:
+            if s.pending is not None:
                 any_pending = True
-        return any_pending
+        return any_pending or (not any_synchronous and not self.extern_synchronous)
+
+    @property
+    def free_running(self) -> bool:
+        """The world steps by itself (mode permitting): no synchronous controller is attached and
+        no robot waits for one."""
+        return not self.extern_synchronous and not any(s.synchronous for s in self._by_robot.values())
+
+    def waiting_for(self) -> list[str]:
+        """The robots whose controller the world waits for before it can step again: every
+        ``"<extern>"`` synchronous robot while no controller at all has a step pending and no
+        synchronous one is attached (empty otherwise)."""
+        if self.shutting_down or any(s.synchronous or s.pending is not None for s in self._by_robot.values()):
+            return []
+        return list(self.extern_synchronous)
 
     def next_advance(self, now: float) -> float | None:
         """Wall time at which the next basic step may run (``<= now``: run it now), or ``None``

@@ -112,7 +112,10 @@ class Core:
         self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
         self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
                                  sim.basic_time_step, heartbeat_ms=heartbeat_ms, mode=mode,
-                                 time_ms=sim.time_ms, new_token=new_token)
+                                 time_ms=sim.time_ms, new_token=new_token,
+                                 uncontrolled=[n for n, r in sim.robots.items()
+                                               if getattr(r, "controller", "<extern>") == "<none>"])
+        self._announced = False              # the waiting / running-by-itself line was printed
         self.topics = Topics(sim)
         self._seen: dict[str, dict[str, int]] = {}          # session token -> device path -> measurements
         self._controls_by_robot: dict[str, list[Control]] = {name: [] for name in sim.robots}
@@ -224,7 +227,25 @@ class Core:
 
     # ------------------------------------------------------------------ stepping
     def next_advance(self, now: float) -> float | None:
-        return self.lockstep.next_advance(now)
+        t = self.lockstep.next_advance(now)
+        if not self._announced:
+            self._announce()
+        return t
+
+    def _announce(self) -> None:
+        """Say once (and again after the last controller left) what the world waits for."""
+        ls = self.lockstep
+        waiting = ls.waiting_for()
+        if waiting:
+            names = " or ".join(repr(r) for r in waiting)
+            self.log(f"waiting for a controller to attach to robot {names} (controller \"<extern>\", "
+                     f"synchronization true): the world steps when attached controllers ask it to; "
+                     f"give robots nobody controls controller: \"<none>\" in the world file")
+            self._announced = True
+        elif ls.free_running and not ls.sessions:
+            self.log(f"no robot waits for a controller (each has controller \"<none>\" or synchronization false): "
+                     f"the world steps by itself in {ls.mode} mode")
+            self._announced = True
 
     def next_deadline(self, now: float) -> float | None:
         return self.lockstep.next_deadline(now)
@@ -315,7 +336,8 @@ class Core:
             "mode": self.lockstep.mode,
             "real_time_factor": self.lockstep.real_time_factor(c.now),
             "pub_endpoint": self.pub_endpoint,
-            "robots": [{"name": name, "synchronization": bool(r.synchronization),
+            "robots": [{"name": name, "controller": getattr(r, "controller", "<extern>"),
+                        "synchronization": bool(r.synchronization),
                         "attached": self.lockstep.session_for(name) is not None,
                         "devices": [{"name": d, "type": kind} for d, kind in self._device_kinds(name).items()]}
                        for name, r in self.sim.robots.items()],
@@ -324,6 +346,7 @@ class Core:
 
     def _srv_attach(self, c: Call) -> dict:
         s = self.lockstep.attach(c.args.robot, c.peer, c.now)
+        self._announced = False                     # say it again once the world waits again
         self.topics.release_robot(s.robot)          # a new controller starts from scratch
         self._seen[s.token] = {}
         robot = self.sim.robots[s.robot]
@@ -358,6 +381,16 @@ class Core:
                 "measurements": {p: int(ctl.device.measurements) for p, ctl in self.topics.controls.items()},
                 "demanded": sorted(self.topics.demanded),
                 "subscriptions": sorted(self.topics.prefixes)}
+
+    def _srv_get_services(self, c: Call) -> dict:
+        kinds = {r: self._device_kinds(r) for r in self.sim.robots}
+        out = []
+        for name, route in sorted(self.routes.items(), key=lambda kv: kv[1].robot is not None):
+            device = route.device.split("/", 1)[1] if route.device else route.motor
+            out.append({"name": name, "scope": route.spec.scope, "robot": route.robot, "device": device,
+                        "device_type": kinds[route.robot][device] if device else None,
+                        "attached": route.spec.attached, "args": S.arg_types(route.spec.args)})
+        return {"services": out}
 
     # ------------------------------------------------------------------ robot services
     def _session(self, c: Call) -> Session:

@@ -252,6 +252,11 @@ def ranges_from_hits(params: LidarParams, distances: np.ndarray, directions: np.
     lo, hi = float(params.min_range), float(params.max_range)
     with np.errstate(invalid="ignore"):
         valid = np.isfinite(v) & (v >= lo) & (v < hi)
+    if not (params.noise > 0.0 and rng is not None) and params.resolution == RESOLUTION_OFF:
+        # nothing moves a value: the bounds below would keep exactly the valid ones (same result)
+        out = np.where(valid, v, np.inf).astype(np.float32)
+        out[out >= np.float32(hi)] = np.inf
+        return out
     v = np.where(valid, v, np.inf)
     if params.noise > 0.0 and rng is not None:
         count = int(np.count_nonzero(valid))
@@ -265,30 +270,39 @@ def ranges_from_hits(params: LidarParams, distances: np.ndarray, directions: np.
 
 
 # ---------------------------------------------------------------------------------- point cloud
+def point_cloud_directions(params: LidarParams, columns=None) -> np.ndarray:
+    """Unit directions (L, C, 3) the point cloud places each range along: the beams themselves,
+    except for a planar lidar, whose points lie on equal-angle rays (module docstring)."""
+    j = _columns(params, columns)
+    if params.planar:
+        return _spherical(layer_elevations(params), column_azimuths(params, j))
+    return ray_directions(params, j)
+
+
 def point_cloud(params: LidarParams, range_image: np.ndarray, time_s: float, period_s: float,
-                columns=None, times=None) -> np.ndarray:
+                columns=None, times=None, directions: np.ndarray | None = None) -> np.ndarray:
     """Points (L·C,) of dtype :data:`POINT_DTYPE`, layer-major (index ``i·C + c``).
 
     ``range_image`` is (L, C) for the given ``columns`` (default all W). Times: ``times`` (C,) if
     given (rotating lidar: from :func:`rotating_sweep`), else ``time_s - j·period_s/W`` with j the
-    absolute column index."""
+    absolute column index. ``directions``: :func:`point_cloud_directions` of these columns when
+    the caller keeps them (they never change), else computed here."""
     j = _columns(params, columns)
     L, C = int(params.number_of_layers), len(j)
     r = np.asarray(range_image, dtype=np.float64).reshape(L, C)
-    if params.planar:
-        dirs = _spherical(layer_elevations(params), column_azimuths(params, j))
-    else:
-        dirs = ray_directions(params, j)
-    with np.errstate(invalid="ignore"):
-        xyz = r[:, :, None] * dirs
+    dirs = point_cloud_directions(params, j) if directions is None else directions
     if times is None:
         t = float(time_s) - j * (float(period_s) / int(params.horizontal_resolution))
     else:
         t = np.asarray(times, dtype=np.float64).reshape(C)
+    xyz = np.empty((L, C, 3), dtype=np.float32)
+    with np.errstate(invalid="ignore"):   # float64 products rounded to float32 (inf x 0 = nan)
+        np.multiply(r[:, :, None], dirs, out=xyz, casting="same_kind")
     pts = np.empty((L, C), dtype=POINT_DTYPE)
-    pts["x"], pts["y"], pts["z"] = xyz[..., 0], xyz[..., 1], xyz[..., 2]
-    pts["layer_id"] = np.arange(L, dtype=np.int32)[:, None]
-    pts["time"] = t[None, :]
+    words = pts.view(np.float32).reshape(L, C, 5)    # the 5 fields of each 20-byte point
+    words[:, :, 0:3] = xyz
+    words[:, :, 4] = t[None, :]
+    pts.view(np.int32).reshape(L, C, 5)[:, :, 3] = np.arange(L, dtype=np.int32)[:, None]
     return pts.reshape(L * C)
 
 

@@ -78,6 +78,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from sensorium.server.raycast.exact import (
+    _CHUNK,
     _DENSE_PAIRS,
     _FEW_MOVERS,
     _INF,
@@ -85,6 +86,7 @@ from sensorium.server.raycast.exact import (
     _SMALL,
     _TINY,
     _best_per_row,
+    _full,
     _mat,
     _minus,
     _param,
@@ -92,7 +94,7 @@ from sensorium.server.raycast.exact import (
     _take,
 )
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind, ShapeEntry
-from sensorium.server.raycast.movers import _Body, _grid_pairs, _Movers, _sphere_pairs
+from sensorium.server.raycast.movers import _Body, _grid_pairs, _mounted_pairs, _Movers, _sphere_pairs
 from sensorium.server.raycast.planes import _Planes, cast_planes
 from sensorium.server.raycast.tiers import _Tier, new_device
 from sensorium.server.raycast.trace import TierTracer
@@ -277,7 +279,19 @@ class RayEngine(TierTracer):
     # ---- casting ----------------------------------------------------------------------------
 
     def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
-             exclude_owner=-1, skip_transparent=False) -> RayHits:
+             exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False) -> RayHits:
+        """Nearest hits of rays ``origins + t directions``, t in [t_near, t_far] (scalars or per ray).
+
+        ``mount``: optional (n,) body index each ray is rigidly mounted on (-1: none).  Such a ray
+        is never tested against its mount body (a moving body): the caller decides those hits
+        once, in the body frame, with :meth:`cast_local`, and keeps the nearer of the two.  It
+        also lets the broad phase skip, in one test per body, the rays of bodies whose rays cannot
+        reach any other moving body (the rays of 100 robots' sensors, instead of one grid lookup
+        per ray).
+
+        ``distance_only``: the caller reads only ``distance`` (a lidar); FAST then skips the normals
+        and shape ids (returned as None) and the work that only serves them, with the same
+        distances.  Origins may be a broadcast array (one origin for all rays), never written."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
@@ -288,6 +302,10 @@ class RayEngine(TierTracer):
         t_near = _param(t_near, n, np.float64, float)
         t_far = _param(t_far, n, np.float64, float)
         excl = _param(exclude_owner, n, np.int64, int)
+        if mount is not None:
+            mount = np.asarray(mount, dtype=np.int64).reshape(n)
+            if n and (int(mount.max()) >= len(self._bodies) or int(mount.min()) < -1):
+                raise ValueError(f"mount must hold body indices in [-1, {len(self._bodies) - 1}]")
         self.counters["rays_cast"] += n
         variant = self._variant(kind, skip_transparent)
         # builds happen on the first cast after a change, even with no rays
@@ -297,38 +315,89 @@ class RayEngine(TierTracer):
         if n == 0:
             return RayHits(np.zeros(0), np.zeros((0, 3)), np.zeros(0, dtype=np.int64))
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
-        big = max(map(abs, O.ravel().tolist())) if n <= _SMALL else max(float(O.max()), -float(O.min()))
+        Ou = O[:1] if O.strides[0] == 0 else O   # one origin for all rays (a broadcast array)
+        big = max(map(abs, Ou.ravel().tolist())) if len(Ou) <= _SMALL else max(float(Ou.max()), -float(Ou.min()))
+        distance_only = distance_only and self._precision is Precision.FAST
         # one errstate for the whole cast: inf/NaN are handled explicitly (entering the context
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big)
+            if n <= _CHUNK:
+                return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only)
+            # large batches in chunks: the temporaries (~150 bytes per ray) stay a few MB whatever
+            # the batch, and so in cache; every ray's answer is the same (big is the batch's)
+            dist = np.empty(n)
+            normal = None if distance_only else np.empty((n, 3))
+            shape = None if distance_only else np.empty(n, dtype=np.int64)
+            for a in range(0, n, _CHUNK):
+                sl = slice(a, min(n, a + _CHUNK))
+                m = sl.stop - a
+                h = self._cast(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
+                               _param(_take(t_far, sl), m, np.float64, float), _param(_take(excl, sl), m, np.int64, int),
+                               planes, static, movers, big, None if mount is None else mount[sl], distance_only)
+                dist[sl] = h.distance
+                if not distance_only:
+                    normal[sl], shape[sl] = h.normal, h.shape
+            return RayHits(dist, normal, shape)
 
-    def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float) -> RayHits:
+    def cast_local(self, body: int, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
+                   skip_transparent=False) -> RayHits:
+        """Hits of rays given in ``body``'s own frame on that (moving) body's shapes only (planes
+        excepted: they take part in every :meth:`cast`); normals in the body frame.  Rigidly
+        mounted rays (a sensor on its robot) give the same answer at every pose, so this is called
+        once and combined with casts that pass ``mount`` (see :meth:`cast`).  The same tier and
+        trace as :meth:`cast` uses for this body; the float64 self-hit epsilon comes from the local
+        origins instead of the batch's world coordinates (it is 1e-9 m + 1e-14 max|O|)."""
+        b = self._bodies[body]
+        if not b.mover:
+            raise ValueError(f"body {body} is static: only moving bodies are cast in their own frame")
+        O = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+        D = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+        n = len(O)
+        tier = self._mover_tier(b, self._variant(kind, skip_transparent))
+        t = np.full(n, _INF)
+        shape = np.full(n, -1, dtype=np.int64)
+        normal = np.zeros((n, 3))
+        if tier is None or n == 0:
+            return RayHits(t, normal, shape)
+        t_near = _param(t_near, n, np.float64, float)
+        t_far = _param(t_far, n, np.float64, float)
+        big = max(float(O.max()), -float(O.min()))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            res = self._trace(tier, O, D, t_near, np.array(_full(t_far, n), dtype=np.float64), -1,
+                              1e-9 + 1e-14 * big, self._precision is Precision.EXACT)
+        if res is not None:
+            t, s, normal = res
+            shape = np.where(s >= 0, s + b.first, -1)
+        return RayHits(t, normal, shape)
+
+    def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
+              distance_only: bool = False) -> RayHits:
         n = len(O)
         exact = self._precision is Precision.EXACT
         eps64 = 1e-9 + 1e-14 * big  # float64 self-hit epsilon: 1e-9 m + ~50 ulps of the largest coordinate
-        hits = self._cast_planes(planes, O, D, t_near, t_far, excl, eps64) if planes is not None else None
+        hits = (cast_planes(planes, self._epoch, O, D, t_near, t_far, excl, eps64, distance_only)
+                if planes is not None else None)
         if static is not None:
             lim = t_far if hits is None else np.minimum(t_far, hits[0])
-            res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big)
+            res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big,
+                              distance_only)
             if res is not None and hits is None:
                 hits = res
+            elif res is not None and distance_only:   # the nearer of plane and mesh (ties: the plane)
+                np.minimum(hits[0], res[0], out=hits[0])
             elif res is not None:
                 t, s, nrm = res
                 better = (t < hits[0]).nonzero()[0]
                 hits[0][better], hits[1][better], hits[2][better] = t[better], s[better], nrm[better]
         if hits is None:
-            hits = (np.full(n, _INF), np.full(n, -1, dtype=np.int64), np.zeros((n, 3)))
+            hits = ((np.full(n, _INF), None, None) if distance_only else
+                    (np.full(n, _INF), np.full(n, -1, dtype=np.int64), np.zeros((n, 3))))
         if movers is not None:
-            self._cast_movers(movers, O, D, t_near, t_far, excl, eps64, exact, *hits)
+            self._cast_movers(movers, O, D, t_near, t_far, excl, eps64, exact, *hits, mount=mount)
         return RayHits(hits[0], hits[2], hits[1])
 
-    def _cast_planes(self, pl: _Planes, O, D, t_near, t_far, excl, eps64):
-        """(dist, shape, normal) of the nearest plane hits, or None if no ray hits a plane."""
-        return cast_planes(pl, self._epoch, O, D, t_near, t_far, excl, eps64)
-
-
-    def _cast_movers(self, mt: _Movers, O, D, t_near, t_far, excl, eps64, exact, dist, shape, normal) -> None:
+    def _cast_movers(self, mt: _Movers, O, D, t_near, t_far, excl, eps64, exact, dist, shape, normal,
+                     mount=None) -> None:
         """Broad phase over all movers, then one trace per shared tier over its (ray, mover) pairs
         moved into their body frames; improves dist/shape/normal in place."""
         n = len(O)
@@ -340,11 +409,35 @@ class RayEngine(TierTracer):
             mt.epoch = self._epoch
         R, T, C = mt.R, mt.T, mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
-        grid = len(C) > _FEW_MOVERS and n * len(C) > _DENSE_PAIRS
-        if grid:
-            pr, pm = _grid_pairs(C, mt.radius, mt.r2, owner, O, D, t_near, lim, excl)
+        mounted = mrow = None
+        if mount is not None:
+            if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
+                mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
+                mt.row_of[mt.index] = np.arange(len(mt.index))
+            mrow = mt.row_of[mount]
+            mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+        if mounted is not None and len(mounted[2]) == 0:   # every ray mounted
+            pr, pm = mounted[0], mounted[1]
         else:
-            pr, pm = _sphere_pairs(C, mt.r2, owner, O, D, t_near, lim, excl)
+            sub = None if mounted is None else mounted[2]
+            if sub is None:
+                Os, Ds, tn, ls, ex = O, D, t_near, lim, excl
+            else:   # the unmounted rays only
+                Os, Ds, ls = np.take(O, sub, axis=0), np.take(D, sub, axis=0), lim[sub]
+                tn, ex = _take(t_near, sub), _take(excl, sub)
+            if len(C) > _FEW_MOVERS and len(Os) * len(C) > _DENSE_PAIRS:
+                pr, pm = _grid_pairs(C, mt.radius, mt.r2, owner, Os, Ds, tn, ls, ex)
+            else:
+                pr, pm = _sphere_pairs(C, mt.r2, owner, Os, Ds, tn, ls, ex)
+            if sub is not None:   # merge with the mounted rays' pairs, in ray order
+                pr = sub[pr]
+                if len(pr):       # an unbounded mounted ray never meets its own body here either
+                    keep = (pm != mrow[pr]).nonzero()[0]
+                    pr, pm = pr[keep], pm[keep]
+                pr = np.concatenate([pr, mounted[0]])
+                pm = np.concatenate([pm, mounted[1]])
+                order = np.argsort(pr, kind="stable")
+                pr, pm = pr[order], pm[order]
         if len(pr) == 0:
             return
         if len(pr) <= _TINY:  # few pairs: is it one mover? (plain Python beats two numpy calls)
@@ -387,7 +480,7 @@ class RayEngine(TierTracer):
                     if len(keep) == 0:
                         continue
                     rr, mm, Ob, Db, lim_r = rr[keep], mm[keep], Ob[keep], Db[keep], lim_r[keep]
-            res = self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact)
+            res = self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact, None, shape is None)
             if res is None:
                 continue
             t, s, nb = res
@@ -398,8 +491,9 @@ class RayEngine(TierTracer):
             if not _strictly_increasing(rows):  # a ray near several movers of this tier: nearest wins
                 keep = _best_per_row(rows, t[win])
                 win, rows = win[keep], rows[keep]
-            nb = nb[win]
             mw = mm[win]
             dist[rows] = t[win]
-            shape[rows] = mt.first[mw] + s[win]
-            normal[rows] = _mat(nb, Rb.T) if one else np.einsum("nij,nj->ni", R[mw], nb)
+            if shape is not None:
+                shape[rows] = mt.first[mw] + s[win]
+                nb = nb[win]
+                normal[rows] = _mat(nb, Rb.T) if one else np.einsum("nij,nj->ni", R[mw], nb)

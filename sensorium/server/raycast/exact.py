@@ -30,6 +30,7 @@ _FEW_MOVERS = 4          # up to this many movers, or ...
 _DENSE_PAIRS = 16384     # ... (rays x movers) up to this size: one dense broad-phase test, else a grid
 _PRUNE = 64              # from this many (ray, mover) pairs of one tier, a bound test prunes them
 _MATMUL_ROWS = 32768     # row block of (n,3) @ (3,3) products (see _mat)
+_CHUNK = 1 << 16         # rays per pass of a large cast (RayEngine.cast): bounds its temporaries
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _take
+from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _take
 from sensorium.server.world.geometry import Pose
 
 
@@ -208,3 +208,70 @@ class _Movers:
     R: np.ndarray | None = None   # (M,3,3) body rotations
     T: np.ndarray | None = None   # (M,3) body translations
     C: np.ndarray | None = None   # (M,3) bounding-sphere centres, world
+    row_of: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # body -> row, -1: none
+
+
+def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndarray, excl, mrow: np.ndarray):
+    """Broad phase of rays rigidly mounted on movers (``mrow``: each ray's mount row, -1 for none):
+    (ray, mover) pairs of the mounted rays, never with their own mount, and the indices of the
+    other rays (unmounted, or unbounded: for the general broad phase); None when no ray is mounted.  Every point of a
+    mounted ray's segment lies within |o - c| + max(lim, -t_near) of its mount's centre c (unit
+    directions); a body's reach is the largest over its rays.  Bodies are paired with the movers
+    their reach can touch (a sweep over sorted centres), each ray inherits its body's neighbours,
+    and the segment/sphere test runs on those candidates: no per-ray grid, and the rays of a body
+    with no neighbour cost nothing."""
+    mounted = mrow >= 0
+    mi = mounted.nonzero()[0]
+    if len(mi) == 0:
+        return None
+    rows = mrow[mi]
+    rel = np.take(O, mi, axis=0) - np.take(C, rows, axis=0)
+    reach = np.sqrt(_dot(rel, rel)) + np.maximum(lim[mi], -_take(t_near, mi))
+    bounded = reach < _INF
+    if not bounded.all():                   # unbounded rays: the general broad phase
+        mounted[mi[~bounded]] = False
+        mi, rows, reach = mi[bounded], rows[bounded], reach[bounded]
+    M = len(C)
+    R = np.full(M, -1.0)                    # -1: no mounted ray on this mover
+    np.maximum.at(R, rows, reach)
+    used = (R >= 0.0).nonzero()[0]
+    pb, pm = _near_centres(np.take(C, used, axis=0), R[used], C, mt.radius)
+    nb = (pm != used[pb]).nonzero()[0]      # CSR of each mover's neighbours (pb is sorted)
+    src, dst = used[pb[nb]], pm[nb]
+    cnt = np.bincount(src, minlength=M)
+    ptr = np.cumsum(cnt) - cnt
+    c = cnt[rows]
+    pr = np.repeat(mi, c)
+    pm = dst[np.repeat(ptr[rows] - (np.cumsum(c) - c), c) + np.arange(len(pr))]
+    if len(pr):
+        Cp = np.take(C, pm, axis=0)
+        Op = np.take(O, pr, axis=0)
+        Dp = np.take(D, pr, axis=0)
+        sel = _segment_near_sphere(Cp[:, 0] - Op[:, 0], Cp[:, 1] - Op[:, 1], Cp[:, 2] - Op[:, 2],
+                                   Dp[:, 0], Dp[:, 1], Dp[:, 2], _take(t_near, pr), lim[pr], mt.r2[pm])
+        if owner is not None:
+            sel &= owner[pm] != _take(excl, pr)
+        keep = sel.nonzero()[0]
+        pr, pm = pr[keep], pm[keep]
+    rest = (~mounted).nonzero()[0]
+    return pr, pm, rest
+
+
+def _near_centres(Cu: np.ndarray, Ru: np.ndarray, C: np.ndarray, radius: np.ndarray):
+    """(i, j) pairs with |Cu[i] - C[j]| <= Ru[i] + radius[j] (with a relative slack of 1e-9): a
+    sweep along the axis of largest spread (sorted centres, two binary searches), then the exact
+    test on the candidates; linear in the number of bodies when they are spread out.  Pairs
+    ordered by i."""
+    k = int(np.argmax(C.max(0) - C.min(0)))
+    order = np.argsort(C[:, k], kind="stable")
+    xs = C[order, k]
+    w = (Ru + float(radius.max())) * (1.0 + 1e-9) + 1e-12 * float(np.abs(xs).max())   # rounding slack
+    lo = np.searchsorted(xs, Cu[:, k] - w, "left")
+    hi = np.searchsorted(xs, Cu[:, k] + w, "right")
+    cnt = hi - lo
+    pb = np.repeat(np.arange(len(Cu)), cnt)
+    pm = order[np.repeat(lo - (np.cumsum(cnt) - cnt), cnt) + np.arange(len(pb))]
+    d = np.take(C, pm, axis=0) - np.take(Cu, pb, axis=0)
+    gap = Ru[pb] + radius[pm]
+    ok = (_dot(d, d) <= gap * gap * (1.0 + 1e-9) + 1e-18).nonzero()[0]
+    return pb[ok], pm[ok]

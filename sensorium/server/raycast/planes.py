@@ -46,8 +46,10 @@ class _Planes:
 
 
 
-def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64):
-    """(dist, shape, normal) of the nearest plane hits, or None if no ray hits a plane."""
+def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, distance_only: bool = False):
+    """(dist, shape, normal) of the nearest plane hits, or None if no ray hits a plane (shape and
+    normal None with ``distance_only``).  Rays sharing one origin (a broadcast array: a lidar)
+    compute the origin's offsets once."""
     pl.refresh(epoch)
     n, P = len(O), len(pl.sid)
     den = _mat(D, pl.nz_t)                               # (n, P)
@@ -57,9 +59,10 @@ def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64):
     lo = np.maximum(t_near, eps64)[:, None] if isinstance(t_near, np.ndarray) else max(t_near, eps64)
     hi = t_far[:, None] if isinstance(t_far, np.ndarray) else t_far
     # rel = P - O column by column, then rel . nz: exact far from the origin (no cancellation)
-    r0 = pl.pt[:, 0] - O[:, 0:1]
-    r1 = pl.pt[:, 1] - O[:, 1:2]
-    r2 = pl.pt[:, 2] - O[:, 2:3]
+    Oo = O[:1] if O.strides[0] == 0 else O   # one origin: (1, P) offsets, the same values
+    r0 = pl.pt[:, 0] - Oo[:, 0:1]
+    r1 = pl.pt[:, 1] - Oo[:, 1:2]
+    r2 = pl.pt[:, 2] - Oo[:, 2:3]
     nz = pl.nz
     t = (r0 * nz[:, 0] + r1 * nz[:, 1] + r2 * nz[:, 2]) / den
     ok &= (t >= lo) & (t <= hi)
@@ -73,6 +76,8 @@ def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64):
     if not np.count_nonzero(ok):
         return None
     np.copyto(t, _INF, where=~ok)
+    if distance_only:   # the nearest plane's distance (argmin's pick, without the argmin)
+        return (t.reshape(n) if P == 1 else t.min(axis=1)), None, None
     if P == 1:
         dist = t.reshape(n)
         col = np.zeros(n, dtype=np.int64)

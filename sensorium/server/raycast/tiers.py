@@ -79,39 +79,32 @@ class _Tier:
             c_bound.append(float(np.linalg.norm(verts[k] - pose.translation, axis=1).max()))
         V = np.vstack(verts) - self.anchor
         F = np.vstack(faces)
+        F = np.ascontiguousarray(F, dtype=np.int32)   # one index array: Embree's, and ours
         self.V, self.F = V, F
         self.radius = float(np.linalg.norm(V, axis=1).max()) + 4.0 * self.res
         self.tri_shape = np.append(np.concatenate(tri_shape), -1)  # sentinel row for primID = -1
-        self.v0 = V[F[:, 0]]
-        self.e1 = V[F[:, 1]] - self.v0
-        self.e2 = V[F[:, 2]] - self.v0
-        nrm = np.cross(self.e1, self.e2)
+        v0 = V[F[:, 0]]
+        e1 = V[F[:, 1]] - v0
+        e2 = V[F[:, 2]] - v0
+        nrm = np.cross(e1, e2)
+        self.ng_max = float(np.linalg.norm(nrm, axis=1).max())
         with np.errstate(invalid="ignore", divide="ignore"):
             nrm /= np.linalg.norm(nrm, axis=1)[:, None]
         self.normal = np.vstack([np.nan_to_num(nrm), np.zeros((1, 3))])
-        # [normal; -normal]: row prim + (M+1)*back is the normal oriented toward the ray origin
-        self.normal2 = np.vstack([self.normal, -self.normal])
-        self.n_rows = len(self.normal)
-        self.ng_max = float(np.linalg.norm(np.cross(self.e1, self.e2), axis=1).max())
-        # dual basis of (e1, e2) in each triangle's plane: barycentrics u = (P - v0).g1, v = (P - v0).g2
-        g11, g12, g22 = _dot(self.e1, self.e1), _dot(self.e1, self.e2), _dot(self.e2, self.e2)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            inv = 1.0 / (g11 * g22 - g12 * g12)
-        inv = np.where(np.isfinite(inv), inv, 0.0)[:, None]
-        self.g1 = np.vstack([(g22[:, None] * self.e1 - g12[:, None] * self.e2) * inv, np.zeros((1, 3))])
-        self.g2 = np.vstack([(g11[:, None] * self.e2 - g12[:, None] * self.e1) * inv, np.zeros((1, 3))])
-        tv = V[F]
-        self.t_lo, self.t_hi = tv.min(1), tv.max(1)   # per-triangle boxes (float64)
+        del v0, e1, e2, nrm
+        # float64 refinement data (v0, e1, e2, g1, g2, t_lo, t_hi, ring) is made on first use: FAST
+        # needs none of it, so a static scene costs ~1/3 of the memory (see _exact_data)
+        self._exact: dict[str, np.ndarray] | None = None
         owners = owner_of[self.tri_shape[:-1]]
         self.owned = bool((owners >= 0).any())
         # -2 marks "no owner" so it never equals an exclude_owner value (>= -1)
-        self.tri_owner = np.append(np.where(owners >= 0, owners, -2), -2)
+        self.tri_owner = np.append(np.where(owners >= 0, owners, -2), -2).astype(np.int32)   # robot indices
         # curved shapes, indexed by "slot"
         self.has_curved = bool(curved)
         self.c_shape = np.array(c_shape, dtype=np.int64)
         slot_of_shape = np.full(int(self.tri_shape.max()) + 2, -1, dtype=np.int64)
         slot_of_shape[self.c_shape] = np.arange(len(c_shape))
-        self.tri_slot = slot_of_shape[self.tri_shape]  # sentinel row maps to -1 as well
+        self.tri_slot = slot_of_shape[self.tri_shape].astype(np.int32)  # sentinel row maps to -1 as well
         self.tri_curved = self.tri_slot >= 0
         self.c_code = np.array(c_code, dtype=np.int64)
         self.c_r = np.array(c_r, dtype=np.float64)
@@ -142,9 +135,41 @@ class _Tier:
         self._ring: tuple[np.ndarray, np.ndarray] | None = None
         # Embree keeps pointers into these buffers: hold references for the scenes' lifetime
         self._v32 = np.ascontiguousarray(V, dtype=_F32)
-        self._f32 = np.ascontiguousarray(F, dtype=np.int32)
+        self._f32 = F
         self._device = device
         self._scenes: dict[bool, object] = {}
+
+    def _exact_data(self) -> dict[str, np.ndarray]:
+        """Per-triangle float64 data of the refinement, computed once on first use (EXACT, or a
+        FAST ray redone by the general loop): v0, e1, e2; the dual basis g1, g2 of (e1, e2) in each
+        triangle's plane (barycentrics u = (P - v0).g1, v = (P - v0).g2, zero sentinel row); the
+        per-triangle boxes t_lo, t_hi."""
+        if self._exact is None:
+            V, F = self.V, self.F
+            v0 = V[F[:, 0]]
+            e1 = V[F[:, 1]] - v0
+            e2 = V[F[:, 2]] - v0
+            g11, g12, g22 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                inv = 1.0 / (g11 * g22 - g12 * g12)
+            inv = np.where(np.isfinite(inv), inv, 0.0)[:, None]
+            g1 = np.vstack([(g22[:, None] * e1 - g12[:, None] * e2) * inv, np.zeros((1, 3))])
+            g2 = np.vstack([(g11[:, None] * e2 - g12[:, None] * e1) * inv, np.zeros((1, 3))])
+            tv = V[F]
+            self._exact = {"v0": v0, "e1": e1, "e2": e2, "g1": g1, "g2": g2, "t_lo": tv.min(1), "t_hi": tv.max(1)}
+        return self._exact
+
+    v0 = property(lambda self: self._exact_data()["v0"])
+    e1 = property(lambda self: self._exact_data()["e1"])
+    e2 = property(lambda self: self._exact_data()["e2"])
+    g1 = property(lambda self: self._exact_data()["g1"])
+    g2 = property(lambda self: self._exact_data()["g2"])
+    t_lo = property(lambda self: self._exact_data()["t_lo"])
+    t_hi = property(lambda self: self._exact_data()["t_hi"])
+
+    def first_vertex(self, tri: np.ndarray) -> np.ndarray:
+        """v0 of the given triangles, without the full refinement data (FAST's self-hit test)."""
+        return self.V[self.F[tri, 0]]
 
     def may_hit(self, O, D, lo, hi) -> np.ndarray:
         """Mask of the rays (parent frame) whose segment [lo, hi] may meet ``bound`` (conservative:

@@ -35,17 +35,20 @@ class TierTracer(Refiner):
         self.counters["embree_calls"] += 1
         return scene.run(o32, d32, far, output=1)
 
-    def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None):
+    def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
+               distance_only: bool = False):
         """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
-        for an unanchored tier)."""
+        for an unanchored tier).  ``distance_only``: FAST may return None for shape and normal
+        (the same t; a lidar needs nothing else)."""
         if exact:
             res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True)
             return res if np.count_nonzero(res[0] < _INF) else None
-        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big)
+        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only)
 
-    def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None):
+    def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
+                    distance_only: bool = False):
         """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
         self-hits, shells left from inside, excluded owners) are redone by the general loop.
         Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
@@ -103,19 +106,23 @@ class TierTracer(Refiner):
             return None   # no hit at all (the common case for short sensor rays)
         if 2 * n_hit >= m:  # mostly hits: whole arrays, misses masked (primID -1 picks the
             # sentinel rows: shape -1, zero normal)
-            (t, normal), redo = self._judge_fast(tier, Ot, D, d32, res, prim, slice(None), start, lim, excl)
-            shape = np.take(tier.tri_shape, prim)
+            (t, normal), redo = self._judge_fast(tier, Ot, D, d32, res, prim, slice(None), start, lim, excl,
+                                                 distance_only)
+            shape = None if distance_only else np.take(tier.tri_shape, prim)
             if n_hit < m:
                 t[~hit] = _INF
         else:
             h = hit.nonzero()[0]
             t = np.full(m, _INF)
-            shape = np.full(m, -1, dtype=np.int64)
-            normal = np.zeros((m, 3))
+            shape = None if distance_only else np.full(m, -1, dtype=np.int64)
+            normal = None if distance_only else np.zeros((m, 3))
             redo = None
             if len(h):
-                (th, nrm), special = self._judge_fast(tier, Ot, D, d32, res, prim[h], h, start, lim, excl)
-                t[h], shape[h], normal[h] = th, np.take(tier.tri_shape, prim[h]), nrm
+                (th, nrm), special = self._judge_fast(tier, Ot, D, d32, res, prim[h], h, start, lim, excl,
+                                                      distance_only)
+                t[h] = th
+                if not distance_only:
+                    shape[h], normal[h] = np.take(tier.tri_shape, prim[h]), nrm
                 if special is not None:
                     redo = np.zeros(m, dtype=bool)
                     redo[h[special]] = True
@@ -125,23 +132,30 @@ class TierTracer(Refiner):
             rows = redo.nonzero()[0]
             t2, s2, n2 = self._trace_loop(tier, O[rows], D[rows], _take(t_near, rows), _take(lim_in, rows),
                                           _take(excl, rows), eps64, exact=False)
-            t[rows], shape[rows], normal[rows] = t2, s2, n2
+            t[rows] = t2
+            if not distance_only:
+                shape[rows], normal[rows] = s2, n2
         if pre is not None:  # analytic hits of the pre-pass, unless a nearer hit was found
             rows, tp, sp, np_ = pre
             if len(rows) <= _SMALL:  # a few: plain Python (ten numpy calls otherwise)
                 for k, (i, ti) in enumerate(zip(rows.tolist(), tp.tolist())):
                     if ti <= t[i]:
-                        t[i], shape[i], normal[i] = ti, sp[k], np_[k]
+                        t[i] = ti
+                        if not distance_only:
+                            shape[i], normal[i] = sp[k], np_[k]
             else:
                 take = (tp <= t[rows]).nonzero()[0]
                 r = rows[take]
-                t[r], shape[r], normal[r] = tp[take], sp[take], np_[take]
+                t[r] = tp[take]
+                if not distance_only:
+                    shape[r], normal[r] = sp[take], np_[take]
         return t, shape, normal
 
-    def _judge_fast(self, tier: _Tier, Ot, D, d32, res, ph, rows, start, lim, excl):
+    def _judge_fast(self, tier: _Tier, Ot, D, d32, res, ph, rows, start, lim, excl, distance_only=False):
         """FAST hit data of the Embree results at ``rows`` (a slice of all rays, or an index array
         of hit rays; ``ph`` = their primIDs): ((t, normal toward the origin), special mask or None),
-        special = rays the general loop must redo."""
+        special = rays the general loop must redo.  ``distance_only``: normal None, and the side
+        hit is only worked out when curved shells need it (the same t and special)."""
         every = isinstance(rows, slice)
         tf = res["tfar"][rows]
         t = tf.astype(np.float64)
@@ -150,6 +164,15 @@ class TierTracer(Refiner):
             np.minimum(t, lim[rows], out=t)
         elif lim != _INF:
             np.minimum(t, lim, out=t)
+        if distance_only:   # the side hit matters only on curved shells: judge those rows alone
+            back = None
+            if tier.has_curved:
+                back = np.zeros(len(tf), dtype=bool)
+                cv = np.take(tier.tri_curved, ph).nonzero()[0]
+                if len(cv):
+                    back[cv] = self._back(tier, D, d32, res, ph[cv], rows if every else rows[cv],
+                                          cv if every else None)
+            return (t, None), self._special(tier, Ot, tf, ph, rows, every, back, excl)
         dh = d32[rows]
         ng = res["Ng"][rows]                 # Embree's Ng has our winding: sign = side hit
         if len(ng) > _SMALL:                 # one pass over the rows
@@ -157,7 +180,10 @@ class TierTracer(Refiner):
         else:
             dots = ng[:, 0] * dh[:, 0] + ng[:, 1] * dh[:, 1] + ng[:, 2] * dh[:, 2]
         back = dots > 0.0
-        nrm = np.take(tier.normal2, ph + back * tier.n_rows, axis=0)   # misses: zero sentinel rows
+        nrm = np.take(tier.normal, ph, axis=0)   # misses (-1): the zero sentinel row
+        # toward the origin (exact negation); misses keep the sign bits they always had (-0.0
+        # unless "back"), so the arrays stay bit-identical to the former [normal; -normal] table
+        nrm[(back ^ (ph < 0)) if every else back] *= -1.0
         grazing = np.abs(dots) < 1e-5 * tier.ng_max
         if every:
             grazing &= ph >= 0
@@ -168,19 +194,42 @@ class TierTracer(Refiner):
             g_nrm[flip] *= -1.0
             nrm[grazing] = g_nrm
             back[grazing] = flip
+        return (t, nrm), self._special(tier, Ot, tf, ph, rows, every, back, excl)
+
+    @staticmethod
+    def _back(tier: _Tier, D, d32, res, ph, rows, sub):
+        """Side hit (True: the back) of the hits of ``ph`` at ray ``rows`` (``sub``: their indices
+        when ``rows`` is a slice of all rays), as :meth:`_judge_fast` decides it."""
+        idx = rows if sub is None else sub
+        dh = d32[idx]
+        ng = res["Ng"][idx]
+        if len(ng) > _SMALL:
+            dots = np.einsum("ij,ij->i", ng, dh)
+        else:
+            dots = ng[:, 0] * dh[:, 0] + ng[:, 1] * dh[:, 1] + ng[:, 2] * dh[:, 2]
+        back = dots > 0.0
+        grazing = (np.abs(dots) < 1e-5 * tier.ng_max).nonzero()[0]
+        if len(grazing):  # float32 sign unreliable: orient in float64
+            back[grazing] = _dot(tier.normal[ph[grazing]], D[idx[grazing]]) > 0.0
+        return back
+
+    @staticmethod
+    def _special(tier: _Tier, Ot, tf, ph, rows, every: bool, back, excl):
+        """Mask of the rays FAST must redo in the general loop, or None: possible self-hits, shells
+        left from inside (``back``: side hit, needed when the tier has curved shells), excluded owners."""
         special = tf < tier.eps              # possible self-hit (origin on the surface)
         if every:
             special &= ph >= 0
         if np.count_nonzero(special):
             sp = special.nonzero()[0]
             tri = ph[sp]
-            gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.v0[tri], tier.normal[tri]))
+            gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.first_vertex(tri), tier.normal[tri]))
             special[sp] = gap <= 2.0 * tier.eps
         if tier.has_curved:                  # leaving a curved shell: the true surface decides
             special |= back & np.take(tier.tri_curved, ph)
         if tier.owned and not (not isinstance(excl, np.ndarray) and excl < 0):
             special |= np.take(tier.tri_owner, ph) == (excl[rows] if isinstance(excl, np.ndarray) else excl)
-        return (t, nrm), (special if np.count_nonzero(special) else None)
+        return special if np.count_nonzero(special) else None
 
     def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool):
         """General path: cast, judge each hit, continue rejected rays past their hit (bounded).

@@ -20,6 +20,7 @@ from __future__ import annotations
 import array
 import struct
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -243,6 +244,13 @@ class ExportReport:
     topics: dict[str, str] = field(default_factory=dict)  # topic -> exported type
     skipped: dict[str, int] = field(default_factory=dict)  # topic -> messages not exported
     reasons: dict[str, str] = field(default_factory=dict)
+    truncated: bool = False                                # the source was not finished (writer killed?)
+    readable_bytes: int | None = None                      # ... and only this much of it could be read
+    size_bytes: int = 0
+    last_stamp_ns: int | None = None                       # the last message exported
+    progress: Any = None                                   # callback (done, total), or None
+    total: int = 0
+    read: int = 0
 
 
 @dataclass
@@ -285,6 +293,9 @@ def _iter_recorded(rec: Recording, typestore, topics, pointcloud2: bool, report:
                    start_ns: int | None, end_ns: int | None):
     bad: set[str] = set()
     for m in rec.messages(topics, start_ns, end_ns):
+        if report.progress is not None:
+            report.read += 1
+            report.progress(report.read, report.total)
         if m.topic in bad:
             report.skipped[m.topic] = report.skipped.get(m.topic, 0) + 1
             continue
@@ -300,15 +311,18 @@ def _iter_recorded(rec: Recording, typestore, topics, pointcloud2: bool, report:
             report.reasons.setdefault(m.topic, f"{type(exc).__name__}: {exc}")
             continue
         report.topics.setdefault(m.topic, typename)
+        report.last_stamp_ns = m.stamp_ns if report.last_stamp_ns is None else max(report.last_stamp_ns, m.stamp_ns)
         yield m, typename, msg
 
 
 def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt: str | None = None,
                 pointcloud2: bool = False, topics: list[str] | None = None,
-                start_ns: int | None = None, end_ns: int | None = None, views: bool = True) -> ExportReport:
+                start_ns: int | None = None, end_ns: int | None = None, views: bool = True,
+                progress: Callable[[int, int], None] | None = None) -> ExportReport:
     """Export ``src`` to ``out``. ``fmt`` is ``"bag"`` (rosbag2 directory, via rosbags) or
     ``"mcap"`` (single file, via mcap-ros2-support); by default ``.mcap`` outputs are single files.
-    ``views``: add ``/tf_static``, ``/tf`` and ``/scene`` from the recorded world (:mod:`.ros_views`)."""
+    ``views``: add ``/tf_static``, ``/tf`` and ``/scene`` from the recorded world (:mod:`.ros_views`).
+    ``progress(done, total)`` is called as messages are read (total: the recording's message count)."""
     out = Path(out)
     if distro not in DISTROS:
         raise ExportError(f"unknown distro {distro!r} (choose from {', '.join(DISTROS)})")
@@ -318,6 +332,8 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
     typestore = typestore_for(distro)
     report = ExportReport(out=out, distro=distro, fmt=fmt)
     with Recording(src) as rec:
+        report.progress = progress
+        report.total = sum(t.count for t in rec.topics()) if progress else 0
         meta = rec.metadata().get("sensorium", {})
         world = rec.world()
         if fmt == "bag":
@@ -327,6 +343,10 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
                           views)
         else:
             raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
+        report.size_bytes = rec.path.stat().st_size
+        if rec.truncated:
+            report.truncated = True
+            report.readable_bytes = rec._scan().get("stopped_at")
     return report
 
 
@@ -387,6 +407,17 @@ def _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world,
                                       if name.endswith((".yaml", ".yml")) else "application/octet-stream", data=data)
         finally:
             writer.finish()
+
+
+def truncation_warning(report: ExportReport) -> str | None:
+    """One line saying how much of a truncated recording was exported, or None."""
+    if not report.truncated:
+        return None
+    upto = "no message" if report.last_stamp_ns is None else f"up to t={report.last_stamp_ns / 1e9:.3f} s"
+    part = (f", read from the first {report.readable_bytes} of its {report.size_bytes} bytes"
+            if report.readable_bytes is not None else "")
+    return (f"warning: the recording is truncated (not finished: the writer was killed?): exported "
+            f"{report.messages} messages, {upto}{part}; the rest is lost")
 
 
 def print_report(report: ExportReport, file=sys.stdout) -> None:

@@ -184,6 +184,7 @@ class Recording:
         with open(self.path, "rb") as f:
             reader = StreamReader(f, emit_chunks=True, validate_crcs=False)
             it = reader.records
+            last_good = f.tell()                # bytes read completely (header, whole chunks)
             while True:
                 try:
                     record = next(it)
@@ -193,14 +194,17 @@ class Recording:
                             stats["chunks"] = stats.get("chunks", 0) + 1
                             stats.setdefault("compression", set()).add(record.compression or "none")
                         yield from inner
+                        last_good = f.tell()
                         continue
                 except StopIteration:
                     return
-                except Exception as exc:
+                except Exception as exc:  # noqa: BLE001 - a damaged or missing record ends the readable part
                     if stats is not None:
                         stats["stopped"] = type(exc).__name__ + (f": {exc}" if str(exc) else "")
+                        stats["stopped_at"] = last_good
                     self.truncated = True
                     return
+                last_good = f.tell()
                 yield record
 
     def _scan(self) -> dict:
@@ -242,7 +246,8 @@ class Recording:
         self._scan_cache = {"header": header, "topics": _sources(topics.values()), "metadata": metadata,
                             "attachments": attachments, "chunks": stats.get("chunks", 0),
                             "compression": sorted(stats.get("compression", set())),
-                            "stopped": stats.get("stopped"), "complete": complete}
+                            "stopped": stats.get("stopped"), "stopped_at": stats.get("stopped_at"),
+                            "complete": complete}
         return self._scan_cache
 
     # ----- public reading API

@@ -15,7 +15,7 @@ import numpy as np
 
 from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import light as light_math
-from sensorium.server.devices.lookup import add_noise, quantize_sensor
+from sensorium.server.devices.lookup import RESOLUTION_OFF, add_noise, quantize_sensor
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.sensors import DistanceSensor, LightSensor, RayRequest
 from sensorium.server.world.geometry import Pose
@@ -90,38 +90,131 @@ class LightBatch:
         _output(self.devices, e, now_ms)
 
 
-class DistanceBatch:
-    """All distance sensors due this step; sensors with the same ray count share array shapes."""
+class DistancePlan:
+    """The constants of a set of distance sensors, stacked once (the same sensors are due step after
+    step, so the simulation keeps this while they are): per-group local ray directions, exclusion,
+    ranges, weights and types; lookup-table groups; resolutions; each ray's mount body; and each
+    ray's hit on its own robot's body, decided once in the body frame (a sensor is rigidly mounted:
+    where its rays meet their own body never changes)."""
 
-    def __init__(self, devices: list[DistanceSensor], robot_poses: list[Pose], scene_red: np.ndarray,
-                 scene_roughness: np.ndarray):
-        self.red, self.roughness = scene_red, scene_roughness
+    def __init__(self, devices: list[DistanceSensor], robot_bodies: list[int | None] | None = None):
+        self.all = devices
         self.empty = [d for d in devices if not d.config.lookup_table]     # value 0, no ray matters (§3.1)
-        self.devices = [d for d in devices if d.config.lookup_table]
-        self.groups: list[tuple[list[int], np.ndarray, int, bool]] = []   # (indices, world dirs, kind, skip)
-        if not self.devices:
+        self.devices = devs = [d for d in devices if d.config.lookup_table]
+        self.groups: list[_Group] = []
+        if not devs:
             return
-        rot, self.positions = world_frames(self.devices, robot_poses)
+        self.robot = np.array([d.robot_index for d in devs], dtype=np.int64)
+        self.local_rot = np.stack([d.local_pose.rotation for d in devs])
+        self.local_pos = np.stack([d.local_pose.translation for d in devs])
         by_shape: dict = defaultdict(list)
-        for i, d in enumerate(self.devices):
+        for i, d in enumerate(devs):
             infra_red = d.type_code == _INFRA_RED
             by_shape[(len(d.weights), RayKind.VISUAL if infra_red else RayKind.BOUNDING, d.type_code == _LASER)].append(i)
-        for (_n, kind, skip), idx in by_shape.items():
-            local = np.stack([self.devices[i].directions_local for i in idx])           # (S, N, 3)
-            dirs = np.einsum("sij,snj->sni", rot[idx], local)
-            self.groups.append((idx, dirs, kind, skip))
+        for (n, kind, skip), idx in by_shape.items():
+            self.groups.append(_Group(np.array(idx, dtype=np.int64), [devs[i] for i in idx], n, kind, skip, robot_bodies))
+        by_table: dict = defaultdict(list)
+        for i, d in enumerate(devs):
+            by_table[d.table].append(i)
+        self.tables = [(table, np.array(idx, dtype=np.int64)) for table, idx in by_table.items()]
+        self.resolution = np.array([float(d.config.resolution) for d in devs])
+        self.rounded = self.resolution != RESOLUTION_OFF
+
+    def output(self, measured: np.ndarray, now_ms: int) -> None:
+        """Lookup (by table), per-sensor noise from each sensor's own stream, resolution; store."""
+        values = np.empty(len(self.devices))
+        for table, idx in self.tables:
+            y, n = table.interpolate(measured[idx])
+            noisy = (n != 0.0).nonzero()[0]
+            for k in noisy.tolist():   # noise drawn only when non-zero, from the device's own stream
+                y[k] = add_noise(y[k:k + 1], n[k:k + 1], self.devices[int(idx[k])].rng)[0]
+            values[idx] = y
+        if np.count_nonzero(self.rounded):   # quantize_sensor, element by element the same arithmetic
+            res = self.resolution
+            q = np.trunc(values / res + 0.5) * res + 0.0
+            values = np.where(self.rounded, q, values)
+        for d, v in zip(self.devices, values.tolist()):
+            d.value = v
+            d.measurements += 1
+            d.measured_at_ms = now_ms
+
+
+class _Group:
+    """Sensors of one plan with the same ray count, ray kind and transparency rule."""
+
+    def __init__(self, idx: np.ndarray, devs: list[DistanceSensor], n: int, kind: RayKind, skip: bool,
+                 robot_bodies: list[int | None] | None):
+        self.idx, self.n, self.kind, self.skip = idx, n, kind, skip
+        self.local_dirs = np.stack([d.directions_local for d in devs])           # (S, N, 3)
+        # infra-red sees the robot's own visual shapes (Webots); ODE-style rays skip them
+        exclude = np.array([-1 if kind == RayKind.VISUAL else d.exclude_self() for d in devs], dtype=np.int64)
+        self.exclude = np.repeat(exclude, n)
+        self.lut_max_range = np.array([d.lut_max_range for d in devs])
+        self.t_far = np.repeat(self.lut_max_range, n)
+        self.types = np.array([d.type_code for d in devs])
+        self.weights = np.stack([d.weights for d in devs])
+        self.sensitivity = np.array([d.config.red_color_sensitivity for d in devs])
+        self.mount: np.ndarray | None = None
+        self.own_visible: np.ndarray | None = None
+        if robot_bodies is not None:
+            body = np.array([-1 if robot_bodies[d.robot_index] is None else robot_bodies[d.robot_index]
+                             for d in devs], dtype=np.int64)
+            if np.count_nonzero(body >= 0):
+                self.mount = np.repeat(body, n)
+                robot = np.repeat(np.array([d.robot_index for d in devs], dtype=np.int64), n)
+                self.own_visible = (self.mount >= 0) & (self.exclude != robot)
+        self.own: tuple | None = None        # (precision, RayHits in body frames), made on first use
+
+    def own_hits(self, engine, local_rot: np.ndarray, local_pos: np.ndarray) -> RayHits | None:
+        """Each ray's hit on its own robot's body (body frame), cast once per engine precision."""
+        if self.own_visible is None or not np.count_nonzero(self.own_visible):
+            return None
+        if self.own is None or self.own[0] != engine.precision:
+            S, n = len(self.idx), self.n
+            O = np.repeat(local_pos[self.idx], n, axis=0)
+            D = np.einsum("sij,snj->sni", local_rot[self.idx], self.local_dirs).reshape(-1, 3)
+            t = np.full(S * n, np.inf)
+            shape = np.full(S * n, -1, dtype=np.int64)
+            normal = np.zeros((S * n, 3))
+            for body in np.unique(self.mount[self.own_visible]).tolist():
+                rows = (self.own_visible & (self.mount == body)).nonzero()[0]
+                h = engine.cast_local(body, O[rows], D[rows], 0.0, self.t_far[rows], kind=self.kind,
+                                      skip_transparent=self.skip)
+                t[rows], shape[rows], normal[rows] = h.distance, h.shape, h.normal
+            self.own = (engine.precision, RayHits(t, normal, shape))
+        return self.own[1]
+
+
+class DistanceBatch:
+    """All distance sensors due this step; sensors with the same ray count share array shapes.
+    ``plan``: the constants of these sensors when already stacked (see :class:`DistancePlan`);
+    ``engine``: the ray engine, to decide the rays' hits on their own bodies once."""
+
+    def __init__(self, devices: list[DistanceSensor], robot_poses: list[Pose], scene_red: np.ndarray,
+                 scene_roughness: np.ndarray, plan: DistancePlan | None = None, engine=None):
+        self.red, self.roughness = scene_red, scene_roughness
+        self.plan_data = plan = plan if plan is not None else DistancePlan(devices)
+        self.engine = engine if plan.groups and plan.groups[0].mount is not None else None
+        self.empty, self.devices = plan.empty, plan.devices
+        self.dirs: list[np.ndarray] = []
+        if not self.devices:
+            return
+        # robot pose ∘ device pose, as world_frames computes it (same arithmetic, stacked once per robot)
+        robot_rot = np.stack([p.rotation for p in robot_poses])
+        robot_pos = np.stack([p.translation for p in robot_poses])
+        self.robot_rot = rr = robot_rot[plan.robot]
+        rot = np.einsum("sij,sjk->sik", rr, plan.local_rot)
+        self.positions = np.einsum("sij,sj->si", rr, plan.local_pos) + robot_pos[plan.robot]
+        for g in plan.groups:
+            self.dirs.append(np.einsum("sij,snj->sni", rot[g.idx], g.local_dirs))
 
     def plan(self) -> list[RayRequest]:
         requests = []
-        for idx, dirs, kind, skip in self.groups:
-            devs = [self.devices[i] for i in idx]
-            n = dirs.shape[1]
-            # infra-red sees the robot's own visual shapes (Webots); ODE-style rays skip them
-            exclude = np.array([-1 if kind == RayKind.VISUAL else d.exclude_self() for d in devs], dtype=np.int64)
+        for g, dirs in zip(self.plan_data.groups, self.dirs):
             requests.append(RayRequest(
-                np.repeat(self.positions[idx], n, axis=0), dirs.reshape(-1, 3), 0.0,
-                np.repeat(np.array([d.lut_max_range for d in devs]), n), kind, np.repeat(exclude, n),
-                skip_transparent=skip, tag="distance"))
+                np.repeat(self.positions[g.idx], g.n, axis=0), dirs.reshape(-1, 3), 0.0, g.t_far, g.kind,
+                g.exclude, skip_transparent=g.skip, tag="distance",
+                mount=g.mount if self.engine is not None else None))
         return requests
 
     def finish(self, hits: list[RayHits], now_ms: int) -> None:
@@ -130,19 +223,25 @@ class DistanceBatch:
             d._mark(now_ms)
         if not self.devices:
             return
+        plan = self.plan_data
         measured = np.empty(len(self.devices))
-        for (idx, dirs, kind, _skip), h in zip(self.groups, hits):
-            devs = [self.devices[i] for i in idx]
+        for g, dirs, h in zip(plan.groups, self.dirs, hits):
             S, n = dirs.shape[:2]
-            dist = h.distance.reshape(S, n)
-            types = np.array([d.type_code for d in devs])
+            dist, shape, normal = h.distance, h.shape, h.normal
+            own = g.own_hits(self.engine, plan.local_rot, plan.local_pos) if self.engine is not None else None
+            if own is not None:   # the nearer of the cast and the ray's own-body hit
+                win = (own.distance < dist).nonzero()[0]
+                if len(win):
+                    dist, shape, normal = dist.copy(), shape.copy(), normal.copy()
+                    dist[win], shape[win] = own.distance[win], own.shape[win]
+                    rr = np.repeat(g.idx, n)[win]
+                    normal[win] = np.einsum("sij,sj->si", self.robot_rot[rr], own.normal[win])
+            dist = dist.reshape(S, n)
             reflection = None
-            if kind == RayKind.VISUAL:
+            if g.kind == RayKind.VISUAL:
                 # colour lookups only for infra-red; shape -1 picks the trailing "no hit" entry
-                shape = h.shape.reshape(S, n)
-                reflection = np.where(shape >= 0, dmath.reflection_factor(self.red[shape], self.roughness[shape]), 1.0)
-            measured[idx] = dmath.combine_distance_batch(
-                types, dist, dirs, h.normal.reshape(S, n, 3), np.stack([d.weights for d in devs]),
-                np.array([d.lut_max_range for d in devs]), reflection,
-                np.array([d.config.red_color_sensitivity for d in devs]))
-        _output(self.devices, measured, now_ms)
+                sh = shape.reshape(S, n)
+                reflection = np.where(sh >= 0, dmath.reflection_factor(self.red[sh], self.roughness[sh]), 1.0)
+            measured[g.idx] = dmath.combine_distance_batch(
+                g.types, dist, dirs, normal.reshape(S, n, 3), g.weights, g.lut_max_range, reflection, g.sensitivity)
+        plan.output(measured, now_ms)

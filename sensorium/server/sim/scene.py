@@ -163,6 +163,10 @@ class Scene:
                 out.append(place_light(model, frame.compose(local)))
         return out
 
+    def robot_body(self, index: int) -> int | None:
+        """The engine body of robot ``index`` (None for a robot without a body)."""
+        return self._robot_body.get(index)
+
     def set_robot_pose(self, index: int, pose: Pose) -> None:
         self.robot_poses[index] = pose
         if index in self._attached:

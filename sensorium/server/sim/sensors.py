@@ -36,6 +36,8 @@ class RayRequest:
     exclude_owner: int | np.ndarray   # per request or per ray
     skip_transparent: bool = False
     tag: str = ""              # counter bucket: "light", "distance", "lidar"
+    mount: np.ndarray | None = None   # per ray: body the ray is rigidly mounted on, -1 none (see RayEngine.cast)
+    distance_only: bool = False       # the device reads only distances (see RayEngine.cast)
 
     def __len__(self) -> int:
         return len(self.origins)
@@ -173,6 +175,9 @@ class Lidar(Device):
         self.range_image = np.zeros((L, W), dtype=np.float32)
         self.point_cloud = np.zeros(L * W, dtype=lmath.POINT_DTYPE)
         self._all_dirs = lmath.ray_directions(self.params)               # (L, W, 3) lidar frame
+        # the same beams as three contiguous columns, for planning (see _rotate_columns)
+        self._dir_columns = tuple(np.ascontiguousarray(self._all_dirs[:, :, k]).reshape(-1) for k in range(3))
+        self._cloud_dirs: np.ndarray | None = None     # point-cloud directions (L, W, 3), made on first use
         # planar lidars store depth: a ray must reach max_range in depth, not in length
         factor = lmath.value_factors(self.params, self._all_dirs)
         with np.errstate(divide="ignore"):
@@ -217,13 +222,15 @@ class Lidar(Device):
                 return []
             dirs_local = self._all_dirs[:, cols, :]
             t_far = self._t_far[:, cols]
+            pose = self.world_pose(robot_pose)
+            dirs = _rotate(pose.rotation, dirs_local.reshape(-1, 3))
         else:
-            dirs_local = self._all_dirs
             t_far = self._t_far
-        pose = self.world_pose(robot_pose)
-        dirs = _rotate(pose.rotation, dirs_local.reshape(-1, 3))
+            pose = self.world_pose(robot_pose)
+            dirs = _rotate_columns(pose.rotation, self._dir_columns)
         origins = np.broadcast_to(pose.translation, dirs.shape)
-        return [RayRequest(origins, dirs, self.params.near, t_far.reshape(-1), RayKind.VISUAL, -1, tag="lidar")]
+        return [RayRequest(origins, dirs, self.params.near, t_far.reshape(-1), RayKind.VISUAL, -1, tag="lidar",
+                           distance_only=True)]
 
     def finish(self, hits: list[RayHits], now_ms: int, counters: dict[str, int]) -> None:
         L = self.config.number_of_layers
@@ -238,7 +245,8 @@ class Lidar(Device):
             self.range_image[:, cols] = ranges
             if self.point_cloud_enabled:
                 # point times follow the sweep: when the head passed each column
-                pts = lmath.point_cloud(self.params, ranges, 0.0, 0.0, columns=cols, times=sweep.times)
+                pts = lmath.point_cloud(self.params, ranges, 0.0, 0.0, columns=cols, times=sweep.times,
+                                        directions=self._point_dirs()[:, cols, :])
                 index = (np.arange(L)[:, None] * self.config.horizontal_resolution + cols[None, :]).reshape(-1)
                 self.point_cloud[index] = pts
                 counters["points_built"] += pts.size
@@ -247,9 +255,16 @@ class Lidar(Device):
             self.range_image = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
             if self.point_cloud_enabled:
                 period_s = self.schedule.period_ms / 1000.0
-                self.point_cloud = lmath.point_cloud(self.params, self.range_image, now_ms / 1000.0, period_s)
+                self.point_cloud = lmath.point_cloud(self.params, self.range_image, now_ms / 1000.0, period_s,
+                                                     directions=self._point_dirs())
                 counters["points_built"] += self.point_cloud.size
         self._mark(now_ms)
+
+    def _point_dirs(self) -> np.ndarray:
+        """Point-cloud directions of every beam (lmath.point_cloud_directions), computed once."""
+        if self._cloud_dirs is None:
+            self._cloud_dirs = lmath.point_cloud_directions(self.params)
+        return self._cloud_dirs
 
     def _noise_rng(self) -> np.random.Generator | None:
         return self.rng if self.params.noise > 0 else None
@@ -268,6 +283,24 @@ def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     out += vectors[:, 1:2] * rotation[:, 1]
     out += vectors[:, 2:3] * rotation[:, 2]
     return out
+
+
+def _rotate_columns(rotation: np.ndarray, columns: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+    """``_rotate`` for vectors given as three contiguous columns (x, y, z): the same products and
+    sums in the same order (bit-identical), on contiguous arrays instead of (N, 3) broadcasts."""
+    x, y, z = columns
+    out = np.empty((len(x), 3))
+    tmp = np.empty(len(x))
+    acc = np.empty(len(x))
+    for k in range(3):
+        np.multiply(x, rotation[k, 0], out=acc)
+        np.multiply(y, rotation[k, 1], out=tmp)
+        acc += tmp
+        np.multiply(z, rotation[k, 2], out=tmp)
+        acc += tmp
+        out[:, k] = acc
+    return out
+
 
 
 class PositionSensor(Device):

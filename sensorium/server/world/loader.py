@@ -53,8 +53,9 @@ def default_world_path() -> Path:
 
 @dataclass(frozen=True, slots=True)
 class Problem:
-    path: str
+    path: str                        # robots[1].devices[0].x (stable, for programs)
     message: str
+    label: str = ""                  # robots[1] (scout).devices[0] (lidar).x (what the user reads)
 
 
 class WorldError(Exception):
@@ -63,7 +64,7 @@ class WorldError(Exception):
     def __init__(self, source: str, problems: list[Problem]):
         self.source = source
         self.problems = problems
-        lines = [f"{source}: {p.path}: {p.message}" if p.path else f"{source}: {p.message}" for p in problems]
+        lines = [f"{source}: {p.label or p.path}: {p.message}" if p.path else f"{source}: {p.message}" for p in problems]
         super().__init__("\n".join(lines))
 
 
@@ -86,6 +87,10 @@ def read_world_text(path: str | Path, limits: WorldLimits | None = None) -> byte
             text = f.read(limits.file_bytes + 1)
     except (OSError, ValueError) as exc:       # ValueError: a NUL byte in the path
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        if isinstance(exc, FileNotFoundError) and path.parent == Path("."):
+            from sensorium import worlds
+
+            reason += f" (nor a bundled world: {', '.join(worlds.names())})"
         raise WorldError(source, [Problem("", f"cannot read world file: {reason}")]) from None
     if len(text) > limits.file_bytes:
         raise WorldError(source, [Problem("", f"file larger than the limit of {limits.file_bytes:,} bytes "
@@ -107,6 +112,8 @@ def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: W
     except RecursionError:
         raise WorldError(source, [Problem("", f"nested deeper than {limits.nesting_depth} levels "
                                               "(raise the limits with --allow-large)")]) from None
+    except (yaml.YAMLError, json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise WorldError(source, [Problem("", syntax_problem(exc))]) from None
     except Exception as exc:  # noqa: BLE001 - yaml/json raise many types (and constructors ValueError) for bad text
         detail = str(exc)
         if len(detail) > 300:
@@ -114,11 +121,26 @@ def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: W
         raise WorldError(source, [Problem("", f"not valid YAML/JSON: {detail}")]) from None
 
 
+def bundled_or_path(path: str | Path) -> Path:
+    """``path``, or the bundled world of that bare name (``arena``, ``warehouse.yaml``) when no such
+    file exists here: examples then work from any directory."""
+    path = Path(path)
+    if not path.exists() and path.parent == Path("."):
+        from sensorium import worlds
+
+        try:
+            return worlds.world_path(path.name)
+        except FileNotFoundError:
+            pass
+    return path
+
+
 def load_world(path: str | Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
     """Read, parse, validate and sanitise a world file (``WorldError`` listing every problem).
     ``limits``: the work it may ask for (default ``WorldLimits()``; ``--allow-large`` is
-    ``WorldLimits.large()``); ``allow_outside_meshes``: mesh urls may leave the world's folder."""
-    path = Path(path)
+    ``WorldLimits.large()``); ``allow_outside_meshes``: mesh urls may leave the world's folder.
+    A bare name of a bundled world (``arena``) works from any directory."""
+    path = bundled_or_path(path)
     source = str(path)
     if path.suffix.lower() == ".wbt":
         return load_wbt(path, limits=limits, allow_outside_meshes=allow_outside_meshes)
@@ -126,6 +148,55 @@ def load_world(path: str | Path, *, limits: WorldLimits | None = None, allow_out
     data = parse_text(text, source, json_format=path.suffix.lower() == ".json", limits=limits)
     return parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
                        allow_outside_meshes=allow_outside_meshes)
+
+
+def syntax_problem(exc: Exception) -> str:
+    """One line for a file that does not parse: where (line, column) and what, without the parser's
+    internal names (PyYAML says "<byte string>" for the file)."""
+    if isinstance(exc, json.JSONDecodeError):
+        return f"line {exc.lineno}, column {exc.colno}: not valid JSON: {exc.msg}"
+    if isinstance(exc, UnicodeDecodeError):
+        return f"byte {exc.start}: not UTF-8 text ({exc.reason})"
+    mark = getattr(exc, "problem_mark", None)
+    problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+    context = getattr(exc, "context", None)
+    context_mark = getattr(exc, "context_mark", None)
+    where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark is not None else ""
+    also = ""
+    if context:
+        also = f" ({context}" + (f" at line {context_mark.line + 1}, column {context_mark.column + 1}"
+                                 if context_mark is not None else "") + ")"
+    return f"{where}not valid YAML: {problem}{also}"
+
+
+_PATH_PART = re.compile(r"\.?([A-Za-z_][A-Za-z0-9_]*)|\[(\d+)\]")
+
+
+def with_names(path: str, data: Any) -> str:
+    """``robots[1].devices[0].x`` → ``robots[1] (scout).devices[0] (lidar).x``: each list item that
+    has a ``name`` in the file is named after its index (what users recognise)."""
+    out, pos, node = "", 0, data
+    while pos < len(path):
+        m = _PATH_PART.match(path, pos)
+        if m is None:
+            return out + path[pos:]
+        key, index = m.group(1), m.group(2)
+        if key is not None:
+            out += ("." if out else "") + key
+            node = node.get(key) if isinstance(node, dict) else None
+        else:
+            i = int(index)
+            out += f"[{i}]"
+            node = node[i] if isinstance(node, list) and i < len(node) else None
+            name = node.get("name") if isinstance(node, dict) else None
+            if isinstance(name, str) and name:
+                out += f" ({name})"
+        pos = m.end()
+    return out
+
+
+def _named(data: Any, problems: list[Problem]) -> list[Problem]:
+    return [Problem(p.path, p.message, with_names(p.path, data)) if p.path else p for p in problems]
 
 
 def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
@@ -187,11 +258,11 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
     try:
         world = wm.World.model_validate(data)
     except ValidationError as exc:
-        raise WorldError(source, [_problem_from_pydantic(e) for e in exc.errors()]) from None
+        raise WorldError(source, _named(data, [_problem_from_pydantic(e) for e in exc.errors()])) from None
     base = base_dir or Path.cwd()
     problems = check_world(world, base, limits=limits, allow_outside_meshes=allow_outside_meshes)
     if problems:
-        raise WorldError(source, problems)
+        raise WorldError(source, _named(data, problems))
     world, warnings = sanitize(world)
     return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings)
 

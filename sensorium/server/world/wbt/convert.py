@@ -405,6 +405,8 @@ class Converter:
                                 "synchronization": f.flag("synchronization", True), "devices": []}
         self.def_name(node, data)
         controller = f.string("controller", "<extern>")
+        if controller in ("", "void"):                      # Webots' other ways of saying "no controller"
+            controller = "<none>"
         if controller not in ("<extern>", "<none>"):
             self.warn(node, f"Robot {unique!r}: controller {controller!r} is not started here; run it with "
                             f"`sensorium controller` (the robot is an <extern> robot)")

@@ -1,0 +1,237 @@
+"""The processes of the transport section (``python -m sensorium.benchmarks.transport_roles ROLE
+ARGS…``): raw pyzmq floors, minimal servers, and clients that time round trips on request."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+
+# ============================================================================ subprocess roles
+def _bind(s, endpoint: str) -> str:
+    """Bind ``tcp://host`` to an ephemeral port, or an ``ipc://path`` as given; the bound endpoint."""
+    if endpoint.startswith("ipc://"):
+        s.bind(endpoint)
+        return endpoint
+    return f"{endpoint}:{s.bind_to_random_port(endpoint)}"
+
+
+def _role_rep_echo(endpoint: str) -> None:
+    """Raw pyzmq REP: echo every message (the floor of any request/reply round trip)."""
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.REP)
+    print(f"ready {_bind(s, endpoint)}", flush=True)
+    poller = zmq.Poller()
+    poller.register(s, zmq.POLLIN)
+    while True:
+        if not poller.poll(10_000):
+            break                                    # idle for 10 s: the parent is gone
+        msg = s.recv()
+        if msg == b"quit":
+            s.send(b"bye")
+            break
+        s.send(msg)
+    s.close(0)
+    ctx.term()
+
+
+def _role_router_echo(endpoint: str) -> None:
+    """A minimal Python msgpack server on a ROUTER: answer every request with a step-like ok reply.
+    With the client library on the other end, it is the floor of a Python request/reply round trip."""
+    import msgpack
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.ROUTER)
+    print(f"ready {_bind(s, endpoint)}", flush=True)
+    poller = zmq.Poller()
+    poller.register(s, zmq.POLLIN)
+    while poller.poll(10_000):
+        frames = s.recv_multipart()
+        req = msgpack.unpackb(frames[-1], raw=False)
+        if req.get("service") == "quit":
+            break
+        body = msgpack.packb({"id": req["id"], "ok": True, "result": {"status": 0, "time_ms": 0, "values": {}}},
+                             use_bin_type=True)
+        s.send_multipart(frames[:-1] + [body])
+    s.close(0)
+    ctx.term()
+
+
+def _chunks(call, close) -> None:
+    """Serve timing requests from stdin: 'run K' → K timed calls, printed as a JSON list of
+    seconds; anything else → ``close()`` and stop. (Lets the parent interleave several clients.)"""
+    for _ in range(200):
+        call()
+    print("ready", flush=True)
+    for line in sys.stdin:
+        parts = line.split()
+        if not parts or parts[0] != "run":
+            break
+        out = np.empty(int(parts[1]))
+        for i in range(len(out)):
+            t0 = time.perf_counter()
+            call()
+            out[i] = time.perf_counter() - t0
+        print(json.dumps(out.tolist()), flush=True)
+    close()
+
+
+def _role_conn_client(endpoint: str) -> None:
+    """The client library's Connection calling a step-like service."""
+    from sensorium.client.connection import Connection
+
+    conn = Connection(endpoint, timeout=30)
+    args = {"duration": 8}
+
+    def close():
+        conn.send("quit", {})
+        conn.close()
+
+    _chunks(lambda: conn.call("/c0/robot/step", args), close)
+
+
+def _role_dealer_client(endpoint: str) -> None:
+    """A bare DEALER: pack, send, blocking recv, unpack."""
+    import msgpack
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.DEALER)
+    s.connect(endpoint)
+    body = msgpack.packb({"id": 7, "service": "/c0/robot/step", "args": {"duration": 8}}, use_bin_type=True)
+
+    def call():
+        s.send(body)
+        msgpack.unpackb(s.recv(), raw=False)
+
+    def close():
+        s.send(msgpack.packb({"id": 0, "service": "quit", "args": {}}))
+        s.close(0)
+        ctx.term()
+
+    _chunks(call, close)
+
+
+def _role_req(endpoint: str) -> None:
+    """Raw pyzmq REQ ping-pong of a step request's size."""
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.REQ)
+    s.connect(endpoint)
+    msg = b"\x83\xa2id\x01\xa7service\xaa/c0/robot/step\xa4args\x81\xa8duration\x08"
+
+    def call():
+        s.send(msg)
+        s.recv()
+
+    def close():
+        s.send(b"quit")
+        s.recv()
+        s.close(0)
+        ctx.term()
+
+    _chunks(call, close)
+
+
+def _role_stepper(rpc: str, robot: str, duration: str) -> None:
+    """A Sensorium controller (client library ``Connection``) stepping its robot in lockstep."""
+    from sensorium.client.connection import Connection
+
+    conn = Connection(rpc, timeout=30)
+    session = conn.call("attach", {"robot": robot})["session"]
+    service, args = f"/{robot}/robot/step", {"duration": int(duration)}
+
+    def close():
+        conn.call("detach", {"session": session})
+        conn.close()
+
+    _chunks(lambda: conn.call(service, args), close)
+
+
+def _role_pub(endpoint: str, size: str, count: str) -> None:
+    """Raw pyzmq PUB: wait for a subscriber, then publish ``count`` messages of ``size`` bytes."""
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.XPUB)
+    s.setsockopt(zmq.SNDHWM, 100)
+    port = s.bind_to_random_port(endpoint)
+    print(f"ready {endpoint}:{port}", flush=True)
+    if not s.poll(20_000):
+        return
+    s.recv()                                         # the subscription
+    body = os.urandom(int(size))
+    for i in range(int(count)):
+        s.send_multipart([b"/pc\0", i.to_bytes(8, "little"), body])
+    s.send_multipart([b"/pc\0", b"end", b""])
+    time.sleep(1.0)
+    s.close(0)
+    ctx.term()
+
+
+def _role_controller(rpc: str, robot: str, steps: str, duration: str) -> None:
+    """A controller: attach, say 'ready', wait for 'go' on stdin, step ``steps`` times as fast as
+    the lockstep allows, print the send/reply times (time.monotonic, comparable across processes)."""
+    from sensorium.client.connection import Connection
+
+    conn = Connection(rpc, timeout=60)
+    conn.call("attach", {"robot": robot})
+    print("ready", flush=True)
+    sys.stdin.readline()
+    n, d = int(steps), int(duration)
+    t0 = np.empty(n)
+    t1 = np.empty(n)
+    service = f"/{robot}/robot/step"
+    args = {"duration": d}
+    for i in range(n):
+        t0[i] = time.monotonic()
+        conn.call(service, args)
+        t1[i] = time.monotonic()
+    print(json.dumps({"t0": t0.tolist(), "t1": t1.tolist()}), flush=True)
+    conn.close()
+
+
+def _role_raw_controller(endpoint: str, steps: str) -> None:
+    """The raw floor of ``controller``: a REQ socket doing step-sized ping-pongs with a do-nothing REP
+    server, timed the same way (say 'ready', wait for 'go', print send/reply times)."""
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.REQ)
+    s.connect(endpoint)
+    msg = b"\x83\xa2id\x01\xa7service\xaa/c0/robot/step\xa4args\x81\xa8duration\x08"
+    for _ in range(50):
+        s.send(msg)
+        s.recv()
+    print("ready", flush=True)
+    sys.stdin.readline()
+    n = int(steps)
+    t0 = np.empty(n)
+    t1 = np.empty(n)
+    for i in range(n):
+        t0[i] = time.monotonic()
+        s.send(msg)
+        s.recv()
+        t1[i] = time.monotonic()
+    print(json.dumps({"t0": t0.tolist(), "t1": t1.tolist()}), flush=True)
+    s.close(0)
+    ctx.term()
+
+
+def main(argv: list[str]) -> None:
+    roles = {"rep-echo": _role_rep_echo, "req": _role_req, "router-echo": _role_router_echo,
+             "conn-client": _role_conn_client, "dealer-client": _role_dealer_client, "stepper": _role_stepper,
+             "pub": _role_pub, "controller": _role_controller, "raw-controller": _role_raw_controller}
+    roles[argv[0]](*argv[1:])
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,93 @@
+"""``sensorium services`` and ``sensorium call``: list and call a running server's services from the
+shell, like ``ros2 service list -t`` / ``ros2 service call`` (pyzmq + msgpack only; PyYAML, when
+installed, lets arguments be written in YAML flow style as well as JSON)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+from sensorium.cli.format import dumps, to_yaml
+from sensorium.client.connection import DEFAULT_RPC_ENDPOINT, Connection, SensoriumError, parse_controller_url
+
+
+def _endpoint(url: str | None) -> str:
+    return parse_controller_url(url or DEFAULT_RPC_ENDPOINT).endpoint
+
+
+def services(args: argparse.Namespace) -> int:
+    try:
+        with Connection(_endpoint(args.url), timeout=args.timeout) as conn:
+            try:
+                listed = conn.call("get_services")["services"]
+            except SensoriumError as exc:
+                if exc.name not in ("UNKNOWN_SERVICE", "WRONG_STATE"):
+                    raise
+                # a replay (sensorium replay) lists its service names in get_info
+                listed = [{"name": n, "scope": "server", "robot": None, "device": None, "device_type": None,
+                           "attached": False, "args": {}} for n in conn.call("get_info").get("services", [])]
+    except SensoriumError as exc:
+        print(f"sensorium services: {exc}", file=sys.stderr)
+        return 1
+    if args.robot:                        # one robot's services, or 'server' for the server's own
+        listed = [s for s in listed if s.get("robot") == (None if args.robot == "server" else args.robot)]
+    if args.json:
+        print(dumps({"services": listed}))
+        return 0
+    group = None
+    for s in listed:
+        here = ("server" if s.get("robot") is None else
+                f"{s['robot']}" if s.get("device") is None else f"{s['robot']}/{s['device']} ({s['device_type']})")
+        if here != group:
+            group = here
+            print(f"{here}:")
+        arg_text = ", ".join(f"{k}: {v}" for k, v in s.get("args", {}).items())
+        mark = "  [attached controller only]" if s.get("attached") else ""
+        print(f"  {s['name']}  {{{arg_text}}}{mark}")
+    return 0
+
+
+def parse_args_text(text: str | None) -> dict[str, Any]:
+    """ARGS of ``sensorium call``: a JSON object, or YAML flow style (``{mode: fast}``) when PyYAML is there."""
+    if text is None or not text.strip():
+        return {}
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as exc:
+        try:
+            import yaml
+        except ImportError:
+            raise ValueError(f"ARGS is not JSON: {exc}") from None
+        try:
+            value = yaml.safe_load(text)
+        except yaml.YAMLError as yexc:
+            raise ValueError(f"ARGS is neither JSON nor YAML: {str(yexc).splitlines()[0]}") from None
+    if not isinstance(value, dict):
+        raise ValueError(f"ARGS must be a mapping such as '{{\"mode\": \"fast\"}}', got {text!r}")
+    return value
+
+
+def call(args: argparse.Namespace) -> int:
+    try:
+        request = parse_args_text(args.args)
+    except ValueError as exc:
+        print(f"sensorium call: {exc}", file=sys.stderr)
+        return 2
+    try:
+        with Connection(_endpoint(args.url), timeout=args.timeout) as conn:
+            result = conn.call(args.service, request)
+    except SensoriumError as exc:
+        hint = ""
+        if exc.name == "NOT_ATTACHED":
+            hint = " (only the robot's controller may call it: see `sensorium services`)"
+        elif exc.name in ("UNKNOWN_SERVICE", "UNKNOWN_ROBOT", "UNKNOWN_DEVICE"):
+            hint = " (`sensorium services` lists them)"
+        print(f"sensorium call {args.service}: {exc}{hint}", file=sys.stderr)
+        return 1
+    if args.json:
+        print(dumps(result))
+    else:
+        print("\n".join(to_yaml(result, args.full)) if result else "{}")
+    return 0
