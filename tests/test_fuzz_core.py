@@ -96,32 +96,46 @@ values = st.recursive(scalars, lambda c: st.lists(c, max_size=5) | st.dictionari
 arg_maps = st.dictionaries(st.sampled_from(ARG_NAMES) | st.text(max_size=8), values, max_size=4)
 
 
-def services_of(core: Core) -> st.SearchStrategy[str]:
+@st.composite
+def services_of(draw, core: Core) -> str:
+    """Mostly real service names; sometimes near misses and noise."""
     names = sorted(core.routes)
-    return (st.sampled_from(names) | st.sampled_from(names).map(lambda s: s[:-1]) | st.text(max_size=24)
-            | st.sampled_from(["/", "//", "/bot/", "/bot/robot/", "/pioneer/robot/x", "/nobody/ls/get_value"]))
+    pick = draw(st.sampled_from(range(10)))
+    if pick < 7:
+        return draw(st.sampled_from(names))
+    if pick == 7:
+        return draw(st.sampled_from(names))[:-1]
+    if pick == 8:
+        return draw(st.sampled_from(["/", "//", "/bot/", "/bot/robot/", "/pioneer/robot/x", "/nobody/ls/get_value"]))
+    return draw(st.text(max_size=24))
 
 
 @st.composite
 def messages(draw, core: Core):
+    """Mostly well-shaped requests to real services with their own argument names (so handlers run),
+    some with foreign or missing arguments, some malformed envelopes and bodies."""
     peer = draw(st.sampled_from(PEERS))
-    envelope = [peer] + draw(st.lists(st.binary(max_size=8), max_size=2))
-    kind = draw(st.integers(0, 9))
-    rid: object = draw(st.integers(0, (1 << 64) - 1) | st.integers(-5, -1) | st.none() | st.text(max_size=3))
+    envelope = [peer] + (draw(st.lists(st.binary(max_size=8), max_size=2)) if draw(st.sampled_from(range(5))) == 0 else [])
+    kind = draw(st.sampled_from(range(20)))
+    rid: object = draw(st.integers(0, 1 << 20)) if kind > 2 else draw(
+        st.integers(0, (1 << 64) - 1) | st.integers(-5, -1) | st.none() | st.text(max_size=3))
     if kind == 0:
-        body = draw(st.binary(max_size=64))                       # not msgpack, or the wrong shape
-        rid = None
-    elif kind == 1:
-        body = msgpack.packb(draw(values))
-        rid = None
+        return envelope, draw(st.binary(max_size=64)), None           # not msgpack, or the wrong shape
+    if kind == 1:
+        return envelope, msgpack.packb(draw(values)), None
+    service = draw(services_of(core))
+    route = core.routes.get(service)
+    if route is not None and kind > 4:                                 # the service's own arguments
+        fields = sorted(route.spec.args.model_fields)
+        args: object = draw(st.dictionaries(st.sampled_from(fields), values, max_size=len(fields))) if fields else {}
     else:
-        req = {"id": rid, "service": draw(services_of(core)), "args": draw(arg_maps | values)}
-        for key in draw(st.sets(st.sampled_from(["id", "service", "args"]), max_size=1)):
-            del req[key]                                          # a missing key now and then
-            if key == "id":
-                rid = None
-        body = msgpack.packb(req)
-    return envelope, body, rid
+        args = draw(arg_maps | values)
+    req = {"id": rid, "service": service, "args": args}
+    if kind == 2:
+        del req[draw(st.sampled_from(["id", "service", "args"]))]     # a missing key
+        if "id" not in req:
+            rid = None
+    return envelope, msgpack.packb(req), rid
 
 
 @pytest.mark.parametrize("world", ["server.yaml", "webots_api.yaml"])
