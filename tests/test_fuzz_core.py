@@ -27,7 +27,7 @@ WORLDS = Path(__file__).resolve().parent / "worlds"
 PEERS = [b"A", b"B", b"C"]
 CODES = {int(c) for c in ErrorCode}
 TOKENS = [f"s{i}" for i in range(6)]          # the cores below hand out these session tokens
-SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
+SETTINGS = settings(max_examples=400, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 
 
