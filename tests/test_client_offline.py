@@ -325,7 +325,7 @@ def test_dropped_session_ends_the_step(server, capsys):
         _until(lambda: "r1" in server.pending)
         server.attached.clear()           # the server forgets the session: pings now fail
         assert r1.step_end() == -1
-        assert "dropped session" in capsys.readouterr().err
+        assert "released the robot" in capsys.readouterr().err
     finally:
         r1.close()
 

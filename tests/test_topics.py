@@ -78,10 +78,23 @@ def test_subscription_events_and_device_state():
     ls = sim.robots["bot"].devices["ls"]
     assert t.subscription(SUB + b"/bot/ls/value\0") is True
     assert ls.sampling_period == 32                  # a subscriber alone enables at the basic step
-    assert t.subscription(SUB + b"/bot/ls/value\0") is False   # duplicate: no change
+    assert t.subscription(SUB + b"/bot/ls/value\0") is False   # a second subscriber: no change
     assert t.subscription(b"\x02junk") is False and t.subscription(b"") is False
+    assert t.subscription(UNSUB + b"/bot/ls/value\0") is False  # one of the two left: still demanded
+    assert ls.sampling_period == 32
     assert t.subscription(UNSUB + b"/bot/ls/value\0") is True
     assert ls.sampling_period == 0 and t.demanded == set()
+    assert t.subscription(UNSUB + b"/bot/ls/value\0") is False  # nobody subscribed: ignored
+
+
+def test_subscriptions_that_match_no_topic_are_not_kept():
+    sim, t = make()
+    assert t.subscription(SUB + b"/nothing/here") is False
+    assert t.subscription(SUB + b"/bot/ls/value\0" + b"x" * 100) is False
+    assert t.subscription(SUB + b"/" * 70_000) is False
+    assert t.prefixes == {}
+    assert t.subscription(SUB + b"/bo") is True                  # a prefix of topics: kept
+    assert t.prefixes == {b"/bo": 1}
 
 
 def test_nothing_computed_without_demand():

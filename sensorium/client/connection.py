@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import secrets
 import stat
 import threading
 import time
@@ -37,6 +38,8 @@ WEBOTS_ENV_URL = "WEBOTS_CONTROLLER_URL"
 ENV_CURVE_SERVERKEY = "SENSORIUM_CURVE_SERVERKEY"   # the server's CURVE public key: encrypt, authenticate it
 ENV_CURVE_PUBLICKEY = "SENSORIUM_CURVE_PUBLICKEY"   # this client's key pair (default: a fresh one per socket)
 ENV_CURVE_SECRETKEY = "SENSORIUM_CURVE_SECRETKEY"
+RETRY_S = 1.0                   # a step request unanswered this long is sent again (same id)
+RETRIED_SERVICES = ("/robot/step", "/robot/time_step")
 DEFAULT_TIMEOUT = 10.0          # seconds for a non-step request (the server may still be starting)
 
 _NO_TIMEOUT = object()
@@ -279,6 +282,10 @@ class Connection:
         self._context = context or zmq.Context.instance()
         self._socket = self._context.socket(zmq.DEALER)
         self._socket.setsockopt(zmq.LINGER, 0)
+        # a random routing id of our own: if the TCP connection drops and libzmq reconnects, the
+        # server sees the same peer (ROUTER_HANDOVER), so the session and a pending step follow
+        # (a first byte of 0 is reserved by libzmq)
+        self._socket.setsockopt(zmq.ROUTING_ID, b"S" + secrets.token_bytes(15))
         curve_client(self._socket, self._serverkey)
         self._socket.connect(self.endpoint)
         self._poller = zmq.Poller()                  # kept for callers that poll the socket themselves
@@ -288,7 +295,9 @@ class Connection:
         self._ids = itertools.count(1)
         self._outstanding: dict[int, str] = {}      # id -> service, for messages
         self._replies: dict[int, dict] = {}
+        self._retry: dict[int, tuple[bytes, float]] = {}   # step requests: id -> (bytes, last sent)
         self.heartbeat: Heartbeat | None = None
+        self.retries = 0                            # step requests sent again (see _resend_due)
         self.closed = False
 
     # -- requests
@@ -297,8 +306,11 @@ class Connection:
         if self.closed:
             raise SensoriumError(ErrorCode.WRONG_STATE, f"connection to {self.endpoint} is closed")
         rid = next(self._ids)
-        self._socket.send(pack({"id": rid, "service": service, "args": args or {}}))
+        data = pack({"id": rid, "service": service, "args": args or {}})
+        self._socket.send(data)
         self._outstanding[rid] = service
+        if service.endswith(RETRIED_SERVICES):
+            self._retry[rid] = (data, time.monotonic())
         return rid
 
     def wait(self, rid: int, timeout: Any = _NO_TIMEOUT) -> dict:
@@ -330,6 +342,7 @@ class Connection:
             try:
                 frames = sock.recv_multipart()
             except zmq.Again:
+                self._resend_due(rid)
                 if self.heartbeat is not None:
                     problem = self.heartbeat.problem()
                     if problem is not None:
@@ -338,6 +351,7 @@ class Connection:
                 continue
             self._accept(frames)
         del self._outstanding[rid]
+        self._retry.pop(rid, None)
         reply = self._replies.pop(rid)
         if reply.get("ok") is True:
             result = reply.get("result")
@@ -348,8 +362,18 @@ class Connection:
         """``send`` then ``wait``."""
         return self.wait(self.send(service, args), timeout)
 
+    def _resend_due(self, rid: int) -> None:
+        """Re-send a step request not answered for :data:`RETRY_S`: its reply may have been lost
+        with a dropped connection. The server answers a repeated id once (PROTOCOL.md)."""
+        entry = self._retry.get(rid)
+        if entry is not None and time.monotonic() - entry[1] >= RETRY_S:
+            self._socket.send(entry[0])
+            self._retry[rid] = (entry[0], time.monotonic())
+            self.retries += 1
+
     def discard(self, rid: int) -> None:
         """Forget an outstanding request: its reply, if it comes, is dropped."""
+        self._retry.pop(rid, None)
         self._outstanding.pop(rid, None)
         self._replies.pop(rid, None)
 
@@ -429,13 +453,14 @@ class Heartbeat(threading.Thread):
         self.last_reply = time.monotonic()
         self.pings = 0
         self.replies = 0
+        self.paused_s = 0.0        # longest time this thread did not run (SIGSTOP, a stalled VM)
 
     def problem(self) -> str | None:
         if self._problem is not None:
             return self._problem
         silent = time.monotonic() - self.last_reply
         if silent > self.lost_after:
-            return f"no answer from {self.endpoint} for {silent:.1f} s (server gone?)"
+            return f"no answer from {self.endpoint} for {silent:.1f} s (server gone, or the network down)"
         return None
 
     def stop(self) -> None:
@@ -451,8 +476,16 @@ class Heartbeat(threading.Thread):
             sock.connect(self.endpoint)
             ids = itertools.count(1)
             next_ping = time.monotonic()
+            last_turn = next_ping
             while not self._stop_event.is_set():
                 now = time.monotonic()
+                if now - last_turn > max(1.0, 2 * self.interval):
+                    # this process did not run (stopped, suspended): the server's silence is ours,
+                    # not a sign that it is gone; ask again before judging
+                    self.paused_s = max(self.paused_s, now - last_turn)
+                    self.last_reply = now
+                    next_ping = now
+                last_turn = now
                 if now >= next_ping:
                     sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
                     self.pings += 1
@@ -470,7 +503,10 @@ class Heartbeat(threading.Thread):
                         self.replies += 1
                         if isinstance(reply, dict) and reply.get("ok") is False:
                             err = _error_from(reply)
-                            self._problem = f"the server dropped session {self.session!r} ({err})"
+                            why = (f"after this process did not run for {self.paused_s:.1f} s"
+                                   if self.paused_s else "after it heard nothing from this controller for "
+                                   "3 heartbeats (a network stall?)")
+                            self._problem = f"the server released the robot {why} ({err.name})"
         except zmq.ContextTerminated:
             pass
         finally:

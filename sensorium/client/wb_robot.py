@@ -235,6 +235,15 @@ class RobotClient:
             if exc.code == ErrorCode.SHUTTING_DOWN:
                 self.terminated = True
                 return -1
+            if exc.code == ErrorCode.NOT_ATTACHED:
+                # the session was dropped (3 heartbeats of silence: a network stall, or this
+                # process was stopped); like a Webots extern controller whose simulation went
+                # away, the controller's step loop ends instead of crashing
+                problem = self.conn.heartbeat.problem() if self.conn.heartbeat is not None else None
+                print(f"sensorium: {problem or 'the server released this robot (no heartbeat for 3 periods)'}; "
+                      f"ending the controller's steps (start it again to re-attach)", file=sys.stderr)
+                self.terminated = True
+                return -1
             raise
         status = int(result.get("status", 0))
         self.time_ms = int(result.get("time_ms", self.time_ms))

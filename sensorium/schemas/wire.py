@@ -134,8 +134,39 @@ def ok_reply(rid: int | None, result: dict) -> bytes:
     return pack({"id": rid, "ok": True, "result": result})
 
 
+MAX_ERROR_MESSAGE = 512      # characters: an error never echoes a large input back
+
+
 def error_reply(rid: int | None, code: ErrorCode | int, message: str) -> bytes:
+    if len(message) > MAX_ERROR_MESSAGE:
+        message = message[:MAX_ERROR_MESSAGE - 1] + "…"
     return pack({"id": rid, "ok": False, "error": {"code": int(code), "message": message}})
+
+
+MAX_ARGS_DEPTH = 16          # nesting of a request's args (maps and arrays)
+MAX_ARGS_ITEMS = 100_000     # values in a request's args, all levels
+
+
+def check_args_shape(args: Any) -> str | None:
+    """Why a request's args are too deep or too large to validate, or ``None``. Iterative (no
+    recursion), stops at the first excess: the cost is bounded by the limits, not the input."""
+    stack = [(args, 1)]
+    items = 0
+    while stack:
+        value, depth = stack.pop()
+        if isinstance(value, dict):
+            children: Any = value.values()
+        elif isinstance(value, (list, tuple)):
+            children = value
+        else:
+            continue
+        if depth > MAX_ARGS_DEPTH:
+            return f"args nested deeper than {MAX_ARGS_DEPTH} levels"
+        items += len(value)
+        if items > MAX_ARGS_ITEMS:
+            return f"args hold more than {MAX_ARGS_ITEMS} values"
+        stack.extend((v, depth + 1) for v in children if isinstance(v, (dict, list, tuple)))
+    return None
 
 
 # ---------------------------------------------------------------------- typed arrays

@@ -63,6 +63,7 @@ class Session:
     pending: PendingStep | None = None
     last_reply_ms: int | None = None     # simulated time of the previous step reply (async dt)
     alive: bool = True
+    last_step: tuple[Any, bytes] | None = None   # (request id, reply body) of the last answered step
 
 
 @dataclass(frozen=True, slots=True)

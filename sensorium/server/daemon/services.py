@@ -31,6 +31,7 @@ from sensorium.schemas.wire import (
     SOFT_LIMIT,
     ErrorCode,
     RequestError,
+    check_args_shape,
     error_reply,
     ok_reply,
     parse_request,
@@ -109,7 +110,8 @@ class Core:
         self.pub_endpoint = pub_endpoint
         self.max_request = max_request
         self.open_controls = open_controls       # world-wide controls for any caller (roles.py)
-        self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
+        self._log_line = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
+        self._log_counts: dict[str, int] = {}             # first line of a message -> times seen
         self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
                                  sim.basic_time_step, heartbeat_ms=heartbeat_ms, mode=mode,
                                  time_ms=sim.time_ms, new_token=new_token,
@@ -123,6 +125,20 @@ class Core:
             self._controls_by_robot[ctl.robot].append(ctl)
         self.routes = self._routes()
         self.errors = 0
+
+    def log(self, line: str) -> None:
+        """Log a line. The same first line again is printed only the 10th, 100th, 1000th… time,
+        with its count, so a client repeating a failing request cannot flood the log (counting,
+        not timing: the core has no clock)."""
+        key = line.split("\n", 1)[0][:200]
+        if len(self._log_counts) > 1000 and key not in self._log_counts:
+            self._log_counts.clear()
+        n = self._log_counts.get(key, 0) + 1
+        self._log_counts[key] = n
+        if n == 1:
+            self._log_line(line)
+        elif n >= 10 and str(n).strip("0") == "1":
+            self._log_line(f"{key} (seen {n} times)")
 
     # ------------------------------------------------------------------ routing table
     def _routes(self) -> dict[str, Route]:
@@ -188,6 +204,9 @@ class Core:
             route = self.routes.get(req.service)
             if route is None:
                 raise self._unknown(req.service)
+            too_big = check_args_shape(req.args)
+            if too_big is not None:
+                raise ServiceError(ErrorCode.TOO_LARGE, f"{req.service}: {too_big}")
             try:
                 args = route.spec.args.model_validate(req.args)
             except ValidationError as exc:
@@ -293,11 +312,14 @@ class Core:
     def _step_reply(self, d: StepDone) -> Frames:
         envelope, rid = d.step.reply_to
         if d.step.kind == "time_step":
-            return envelope + [ok_reply(rid, {"success": d.status != -1})]
-        values: dict[str, dict] = {}
-        if d.status != -1 and d.session.alive:
-            values = self._new_values(d.session)
-        return envelope + [ok_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})]
+            body = ok_reply(rid, {"success": d.status != -1})
+        else:
+            values: dict[str, dict] = {}
+            if d.status != -1 and d.session.alive:
+                values = self._new_values(d.session)
+            body = ok_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})
+        d.session.last_step = (rid, body)         # kept for a retry of a reply lost in transit
+        return envelope + [body]
 
     def _new_values(self, session: Session) -> dict[str, dict]:
         """The readings of the session's enabled devices that it has not received yet."""
@@ -398,7 +420,22 @@ class Core:
         assert s is not None and s.peer == c.peer          # checked by handle()
         return s
 
+    def _retried_step(self, c: Call) -> bool:
+        """A step request repeated with the same id (the client re-sends it when its reply may
+        have been lost with a dropped connection, PROTOCOL.md): a pending one is answered on the
+        caller's current route; an answered one gets its reply again. Never steps twice."""
+        s = self._session(c)
+        if s.pending is not None and s.pending.reply_to[1] == c.id:
+            s.pending.reply_to = (c.envelope, c.id)
+            return True
+        if s.pending is None and s.last_step is not None and s.last_step[0] == c.id:
+            c.extra.append(c.envelope + [s.last_step[1]])
+            return True
+        return False
+
     def _robot_step(self, c: Call) -> dict | None:
+        if self._retried_step(c):
+            return _DEFERRED
         commands = self._motor_commands(c.robot, c.args.motors) if c.args.motors else []
         if c.args.duration == 0:
             # Webots' step(0): deliver the commands and the values not yet read, time stands still
@@ -438,6 +475,8 @@ class Core:
         return out
 
     def _robot_time_step(self, c: Call) -> dict | None:
+        if self._retried_step(c):
+            return _DEFERRED
         done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.value, c.now, kind="time_step")
         if done is not None:
             return {"success": False}

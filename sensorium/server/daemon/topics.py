@@ -33,6 +33,8 @@ from sensorium.schemas.wire import pack, stamp, topic_frame
 __all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "laser_scan_angles",
            "pose_quaternion", "pose_msg"]
 
+MAX_PREFIX = 1024     # bytes: longer subscriptions are refused (topic names are short)
+
 POINT_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer_id", "<i4"), ("time", "<f4")])
 """A WbLidarPoint on the wire (20 bytes, little-endian)."""
 
@@ -212,7 +214,7 @@ class Topics:
             self.pose_topics[robot_name] = pose_topic
         self.by_name = {t.name: t for t in self.topics}
         self.seq: dict[str, int] = {t.name: 0 for t in self.topics}
-        self.prefixes: set[bytes] = set()
+        self.prefixes: dict[bytes, int] = {}       # accepted subscription prefix -> subscriptions
         self.subscribed: set[str] = set()
         self.recorded: set[str] = set()
         self._recorder: Recorder | None = None
@@ -239,10 +241,23 @@ class Topics:
             return False
         prefix = bytes(event[1:])
         if event[0] == 1:
-            self.prefixes.add(prefix)
+            if not self.accepts(prefix):
+                return False
+            self.prefixes[prefix] = self.prefixes.get(prefix, 0) + 1
         else:
-            self.prefixes.discard(prefix)
+            n = self.prefixes.get(prefix, 0) - 1
+            if n < 0:
+                return False
+            if n:
+                self.prefixes[prefix] = n
+            else:
+                del self.prefixes[prefix]
         return self._recompute()
+
+    def accepts(self, prefix: bytes) -> bool:
+        """Whether a subscription prefix matches at least one topic (the only ones kept: a prefix
+        that can never match costs memory and nothing else, PROTOCOL.md)."""
+        return len(prefix) <= MAX_PREFIX and any(t.frame.startswith(prefix) for t in self.topics)
 
     def set_recorder(self, recorder: Recorder | Any | None, topics: Iterable[str] | None = None) -> None:
         """Attach (``None``: detach) the recorder: a callable ``(topic, type, envelope, body,

@@ -28,7 +28,7 @@ import zmq
 import zmq.auth
 import zmq.utils.z85
 
-from sensorium.schemas.wire import HARD_LIMIT
+from sensorium.schemas.wire import ErrorCode, error_reply
 from sensorium.server.daemon.services import Core
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
@@ -41,6 +41,12 @@ MAX_IDLE_WAIT_S = 1.0
 MAX_IDLE_WAIT_MS = int(MAX_IDLE_WAIT_S * 1000)
 EXPIRE_EVERY_S = 0.01           # session expiry scan at most this often while messages flow
 ZERO_COPY_MIN = 64 * 1024       # replies at least this large are sent zero-copy
+REQUESTS_PER_TURN = 64          # requests served before the world may step again (fairness)
+MAX_FRAMES = 16                 # frames in one request message (identity, REQ envelope, body)
+FRAME_LIMIT = 2 * 1024 * 1024   # bytes per frame, libzmq-enforced (the core's soft limit is 1 MiB)
+DISCARD_PER_TURN = 4096         # frames of an oversized message dropped per loop turn
+SUB_LIMIT = 1024                # bytes of one subscription message (topic names are short)
+ROUTER_SNDHWM = 256             # replies queued for one peer that does not read them
 
 
 def _bindable(url: str) -> str:
@@ -118,7 +124,7 @@ class Transport:
     handler or another thread."""
 
     def __init__(self, core: Core, rpc: str = DEFAULT_RPC, pub: str = DEFAULT_PUB, *,
-                 hard_limit: int = HARD_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
+                 hard_limit: int = FRAME_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
                  context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic,
                  stop_at_ms: int | None = None, curve_secret: bytes | None = None):
         self.core = core
@@ -135,10 +141,18 @@ class Transport:
             s.setsockopt(zmq.HEARTBEAT_IVL, hb)
             s.setsockopt(zmq.HEARTBEAT_TIMEOUT, 3 * hb)
         self.router.setsockopt(zmq.MAXMSGSIZE, hard_limit)
-        self.router.setsockopt(zmq.SNDHWM, 10_000)
+        self.router.setsockopt(zmq.SNDHWM, ROUTER_SNDHWM)
         self.router.setsockopt(zmq.RCVHWM, 10_000)
+        # a controller whose TCP connection was reset reconnects with the same routing id (the
+        # client sets a random one): the new connection takes the identity over, so the session
+        # and its pending step follow it (PROTOCOL.md, "Connections that drop")
+        self.router.setsockopt(zmq.ROUTER_HANDOVER, 1)
         self.xpub.setsockopt(zmq.SNDHWM, pub_hwm)
-        self.xpub.setsockopt(zmq.MAXMSGSIZE, 64 * 1024)       # subscription messages only
+        self.xpub.setsockopt(zmq.MAXMSGSIZE, SUB_LIMIT)       # subscription messages only
+        # subscriptions are applied by us, only for prefixes that match a topic: a peer cannot
+        # make libzmq hold arbitrary prefixes (memory), and each is released when its peer goes
+        self.xpub.setsockopt(zmq.XPUB_MANUAL, 1)
+        self._discarding = False          # in the middle of an over-long message: drop its frames
         self.curve = curve_secret is not None
         for s in (self.router, self.xpub):
             curve_server(s, curve_secret)
@@ -240,17 +254,46 @@ class Transport:
             return MAX_IDLE_WAIT_MS
         return max(0, min(MAX_IDLE_WAIT_MS, int((deadline - now) * 1000 + 0.999)))
 
-    def _drain_router(self, limit: int = 1000) -> None:
+    def _drain_router(self, limit: int = REQUESTS_PER_TURN) -> None:
+        """Serve up to ``limit`` queued requests (libzmq fair-queues peers, so a flooding peer
+        gets its share, not the loop: the world steps between turns)."""
         core, router, clock = self.core, self.router, self.clock
-        recv, EVENTS, POLLIN, NOBLOCK = router.recv_multipart, zmq.EVENTS, zmq.POLLIN, zmq.NOBLOCK
+        recv, EVENTS, POLLIN, NOBLOCK = router.recv, zmq.EVENTS, zmq.POLLIN, zmq.NOBLOCK
         for _ in range(limit):
             if not router.getsockopt(EVENTS) & POLLIN:   # cheaper than a recv raising zmq.Again
                 return
+            if self._discarding and not self._discard_rest():
+                return
+            frames: list[bytes] = []
             try:
-                frames = recv(NOBLOCK, copy=True)
+                while True:
+                    frames.append(recv(NOBLOCK, copy=True))
+                    if not router.getsockopt(zmq.RCVMORE):
+                        break
+                    if len(frames) >= MAX_FRAMES:
+                        # too many frames: answer the sender, drop the rest over the next turns
+                        self._send_replies([[frames[0], error_reply(
+                            None, ErrorCode.TOO_LARGE, f"a request has at most {MAX_FRAMES} frames")]])
+                        self._discarding = True
+                        break
             except zmq.Again:
                 return
+            if self._discarding:
+                continue
             self._send_replies(core.handle(frames, clock()))
+
+    def _discard_rest(self) -> bool:
+        """Drop frames of an over-long message, a bounded number per turn; True when done."""
+        router = self.router
+        for _ in range(DISCARD_PER_TURN):
+            try:
+                router.recv(zmq.NOBLOCK, copy=False)
+            except zmq.Again:
+                return False
+            if not router.getsockopt(zmq.RCVMORE):
+                self._discarding = False
+                return True
+        return False
 
     def _drain_xpub(self, limit: int = 1000) -> None:
         xpub = self.xpub
@@ -261,6 +304,15 @@ class Transport:
                 event = xpub.recv(zmq.NOBLOCK)
             except zmq.Again:
                 return
+            if not event or event[0] not in (0, 1):
+                continue
+            prefix = event[1:]
+            if event[0] == 1:
+                if not self.core.topics.accepts(prefix):
+                    continue                              # matches no topic: not kept
+                xpub.setsockopt(zmq.SUBSCRIBE, prefix)    # applies to the pipe it came from
+            else:
+                xpub.setsockopt(zmq.UNSUBSCRIBE, prefix)
             self.core.subscription(event)
 
     def _drain_wake(self) -> None:

@@ -288,7 +288,15 @@ struct sn_conn {
   pthread_mutex_t hb_lock;
   int hb_interval_ms;
   int64_t hb_lost_after_ms;
+  /* the step request in flight, re-sent (same id) while unanswered: its reply may have been lost
+     with a dropped connection (PROTOCOL.md, "Connections that drop") */
+  char *retry_data;
+  size_t retry_size;
+  uint64_t retry_id;
+  int64_t retry_sent_ms;
 };
+
+#define RETRY_MS 1000
 
 sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen) {
   sn_conn *c = calloc(1, sizeof *c);
@@ -308,6 +316,21 @@ sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen) {
   int64_t maxmsg = MAX_REPLY;
   zmq_setsockopt(c->sock, ZMQ_LINGER, &zero, sizeof zero);
   zmq_setsockopt(c->sock, ZMQ_MAXMSGSIZE, &maxmsg, sizeof maxmsg);
+  /* a random routing id of our own, so that after a reconnection the server sees the same peer
+     (a first byte of 0 is reserved by libzmq) */
+  unsigned char rid[16];
+  rid[0] = 'S';
+  FILE *urandom = fopen("/dev/urandom", "rb");
+  if (urandom == NULL || fread(rid + 1, 1, sizeof rid - 1, urandom) != sizeof rid - 1) {
+    uint64_t x = (uint64_t)now_ms() ^ ((uint64_t)(uintptr_t)c << 16);
+    for (size_t i = 1; i < sizeof rid; i++) {
+      x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+      rid[i] = (unsigned char)(x >> 56);
+    }
+  }
+  if (urandom != NULL)
+    fclose(urandom);
+  zmq_setsockopt(c->sock, ZMQ_ROUTING_ID, rid, sizeof rid);
   if (zmq_connect(c->sock, endpoint) != 0) {
     snprintf(err, errlen, "cannot connect to %s: %s", endpoint, zmq_strerror(zmq_errno()));
     sn_conn_close(c);
@@ -326,6 +349,7 @@ void sn_conn_close(sn_conn *c) {
     zmq_close(c->sock);
   if (c->ctx != NULL)
     zmq_ctx_term(c->ctx);
+  free(c->retry_data);
   for (size_t i = 0; i < c->n_stash; i++)
     free(c->stash[i].data);
   free(c->stash);
@@ -349,6 +373,11 @@ static bool is_outstanding(const sn_conn *c, uint64_t id, size_t *where) {
 
 static void forget(sn_conn *c, uint64_t id) {
   size_t i;
+  if (c->retry_id == id && id != 0) {
+    free(c->retry_data);
+    c->retry_data = NULL;
+    c->retry_id = 0;
+  }
   if (is_outstanding(c, id, &i))
     c->outstanding[i] = c->outstanding[--c->n_out];
   for (size_t k = 0; k < c->n_stash; k++)
@@ -371,6 +400,20 @@ int sn_conn_send(sn_conn *c, sn_req *r, uint64_t id) {
   if (zmq_send(c->sock, r->buf.data, r->buf.size, 0) < 0)
     return -1;
   c->outstanding[c->n_out++] = id;
+  return 0;
+}
+
+int sn_conn_send_retried(sn_conn *c, sn_req *r, uint64_t id) {
+  if (sn_conn_send(c, r, id) != 0)
+    return -1;
+  free(c->retry_data);
+  c->retry_data = malloc(r->buf.size ? r->buf.size : 1);
+  c->retry_id = c->retry_data != NULL ? id : 0;
+  if (c->retry_data != NULL) {
+    memcpy(c->retry_data, r->buf.data, r->buf.size);
+    c->retry_size = r->buf.size;
+    c->retry_sent_ms = now_ms();
+  }
   return 0;
 }
 
@@ -433,6 +476,10 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
       return -1;
     }
     if (n == 0) {
+      if (c->retry_id == id && now_ms() - c->retry_sent_ms >= RETRY_MS) {
+        zmq_send(c->sock, c->retry_data, c->retry_size, ZMQ_DONTWAIT);
+        c->retry_sent_ms = now_ms();
+      }
       char why[300];
       if (heartbeat_problem(c, why, sizeof why) != NULL) {
         forget(c, id);

@@ -86,6 +86,9 @@ void sn_conn_close(sn_conn *c);
 /* Send a built request (consumes nothing: the caller frees r). Returns its id, 0 on failure. */
 uint64_t sn_conn_next_id(sn_conn *c);
 int sn_conn_send(sn_conn *c, sn_req *r, uint64_t id);
+/* Like sn_conn_send, for a step request: re-sent with the same id every second while
+   sn_conn_wait waits for it (a reply lost with a dropped connection is answered again). */
+int sn_conn_send_retried(sn_conn *c, sn_req *r, uint64_t id);
 /* Wait for the reply of id: timeout_ms < 0 waits forever (but gives up with SN_CONNECTION_LOST when
  * the heartbeat finds the server gone). Returns 0 and fills out (ok or error reply), or -1 with a
  * client-side error in out->code/out->message. */

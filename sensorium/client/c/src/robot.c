@@ -403,7 +403,7 @@ int wb_robot_step_begin(int duration) {
       d->cmd_position = d->cmd_velocity = false;
     }
   }
-  int rc = sn_conn_send(rb->conn, &r, id);
+  int rc = sn_conn_send_retried(rb->conn, &r, id);
   sn_req_free(&r);
   if (rc != 0) {
     fprintf(stderr, "sensorium: cannot send the step request to %s; ending the controller's steps\n",

@@ -1,0 +1,223 @@
+"""A controller's TCP connection that drops (a NAT timeout, a Wi-Fi roam) must not freeze the world.
+
+A small TCP proxy sits between one controller and the server and resets every connection it
+carries, several times mid-run; a second controller talks to the server directly. Before the fix
+the step reply in flight went to the dead connection's identity and the world waited forever; now
+the client reconnects with the same routing id, re-sends its step, and both controllers go on.
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from pathlib import Path
+
+import msgpack
+import pytest
+import zmq
+
+from sensorium.client.connection import Connection
+from sensorium.server.daemon.services import Core
+from sensorium.server.daemon.transport import Transport
+from sensorium.server.sim.simulation import Simulation
+
+WORLD = Path(__file__).parent / "worlds" / "server.yaml"
+
+
+class ResettingProxy:
+    """Accepts on 127.0.0.1:<port>, forwards to the server; :meth:`reset` closes every connection
+    with RST (SO_LINGER 0), like a middlebox dropping state."""
+
+    def __init__(self, target: tuple[str, int]):
+        self.target = target
+        self.listener = socket.create_server(("127.0.0.1", 0))
+        self.port = self.listener.getsockname()[1]
+        self.pairs: list[tuple[socket.socket, socket.socket]] = []
+        self.lock = threading.Lock()
+        self.resets = 0
+        self.closed = False
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        while not self.closed:
+            try:
+                client, _ = self.listener.accept()
+            except OSError:
+                return
+            upstream = socket.create_connection(self.target)
+            with self.lock:
+                self.pairs.append((client, upstream))
+            for a, b in ((client, upstream), (upstream, client)):
+                threading.Thread(target=self._pump, args=(a, b), daemon=True).start()
+
+    @staticmethod
+    def _pump(src: socket.socket, dst: socket.socket) -> None:
+        try:
+            while data := src.recv(65536):
+                dst.sendall(data)
+        except OSError:
+            pass
+
+    def reset(self) -> None:
+        with self.lock:
+            pairs, self.pairs = self.pairs, []
+        for pair in pairs:
+            for s in pair:
+                try:
+                    s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, b"\x01\x00\x00\x00\x00\x00\x00\x00")
+                    s.close()
+                except OSError:
+                    pass
+        self.resets += 1
+
+    def close(self) -> None:
+        self.closed = True
+        self.listener.close()
+        self.reset()
+
+
+@pytest.fixture
+def server():
+    core = Core(Simulation.from_file(WORLD, precision="fast"), heartbeat_ms=500)
+    transport = Transport(core, "tcp://127.0.0.1:0", "tcp://127.0.0.1:0")
+    thread = threading.Thread(target=transport.run, daemon=True)
+    thread.start()
+    yield core, transport
+    transport.stop()
+    thread.join(timeout=30)
+
+
+def _port(endpoint: str) -> int:
+    return int(endpoint.rsplit(":", 1)[1])
+
+
+def test_connection_reset_mid_run_does_not_freeze_the_world(server) -> None:
+    core, transport = server
+    proxy = ResettingProxy(("127.0.0.1", _port(transport.rpc_endpoint)))
+    flaky = Connection(f"tcp://127.0.0.1:{proxy.port}", timeout=60)
+    steady = Connection(transport.rpc_endpoint, timeout=60)
+    try:
+        s1 = flaky.call("attach", {"robot": "bot"})["session"]
+        s2 = steady.call("attach", {"robot": "bot2"})["session"]
+        flaky.start_heartbeat(s1, 500)
+        steady.start_heartbeat(s2, 500)
+        times: list[int] = []
+        errors: list[BaseException] = []
+
+        def run_steady() -> None:
+            try:
+                for _ in range(60):
+                    times.append(steady.call("/bot2/robot/step", {})["time_ms"])
+            except BaseException as exc:  # noqa: BLE001 - reported below
+                errors.append(exc)
+
+        t = threading.Thread(target=run_steady)
+        t.start()
+        flaky_times = []
+        for i in range(60):
+            rid = flaky.send("/bot/robot/step", {})
+            if i in (10, 25, 40):
+                proxy.reset()                       # the reply to this step is likely in flight
+            flaky_times.append(flaky.wait(rid)["time_ms"])
+        t.join(timeout=120)
+        assert not errors, errors
+        assert not t.is_alive()
+        # every step answered once, in order, one basic step apart: nothing skipped or doubled
+        assert flaky_times == [16 * (k + 1) for k in range(60)]
+        assert times == flaky_times
+        assert proxy.resets == 3
+        assert core.lockstep.session_for("bot") is not None       # the session survived
+    finally:
+        flaky.close()
+        steady.close()
+        proxy.close()
+
+
+def test_a_repeated_step_id_is_answered_once(server) -> None:
+    """The server side of the retry: the same request id again while pending just re-routes the
+    reply; after the answer it returns the same reply again; it never steps twice."""
+    core, transport = server
+    ctx = zmq.Context.instance()
+    dealer = ctx.socket(zmq.DEALER)
+    dealer.setsockopt(zmq.LINGER, 0)
+    dealer.setsockopt(zmq.ROUTING_ID, b"Stest-repeat")
+    dealer.connect(transport.rpc_endpoint)
+    try:
+        def rpc(rid: int, service: str, args: dict | None = None) -> dict:
+            dealer.send(msgpack.packb({"id": rid, "service": service, "args": args or {}}))
+            assert dealer.poll(30_000)
+            return msgpack.unpackb(dealer.recv())
+
+        rpc(1, "attach", {"robot": "bot2"})
+        step = msgpack.packb({"id": 2, "service": "/bot2/robot/step", "args": {}})
+        dealer.send(step)
+        dealer.send(step)                                   # a retry before the answer
+        assert dealer.poll(30_000)
+        first = msgpack.unpackb(dealer.recv())
+        assert first["ok"] and first["result"]["time_ms"] == 16
+        assert not dealer.poll(500)                         # answered once, not twice
+        again = rpc(2, "/bot2/robot/step")                  # a retry after the answer
+        assert again == first and core.sim.time_ms == 16
+        assert rpc(3, "/bot2/robot/step")["result"]["time_ms"] == 32
+    finally:
+        dealer.close()
+
+
+def test_reconnect_timing_is_bounded_by_polling(server) -> None:
+    """The other robots never wait longer than the heartbeat timeout for a controller whose
+    connection vanished for good: its session is dropped and the world goes on."""
+    core, transport = server
+    proxy = ResettingProxy(("127.0.0.1", _port(transport.rpc_endpoint)))
+    gone = Connection(f"tcp://127.0.0.1:{proxy.port}", timeout=30)
+    steady = Connection(transport.rpc_endpoint, timeout=30)
+    try:
+        gone.call("attach", {"robot": "bot"})
+        steady.call("attach", {"robot": "bot2"})
+        proxy.close()                                       # gone for good, no heartbeat either
+        gone.close()
+        start = time.monotonic()
+        assert steady.call("/bot2/robot/step", {})["time_ms"] == 16
+        assert time.monotonic() - start < 3 * 0.5 + 10       # liveness (3 heartbeats) + load slack
+        assert core.lockstep.session_for("bot") is None
+    finally:
+        steady.close()
+
+
+def test_a_stopped_controller_is_told_what_happened(server, tmp_path) -> None:
+    """SIGSTOP for longer than the liveness period, then SIGCONT: the server released the robot
+    meanwhile; the controller says so (not "server gone?") and its step loop ends cleanly."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    core, transport = server
+    script = tmp_path / "ctrl.py"
+    script.write_text(
+        "import sys\n"
+        "from controller import Robot\n"
+        "r = Robot()\n"
+        "n = 0\n"
+        "while r.step(16) != -1:\n"
+        "    n += 1\n"
+        "    if n == 5:\n"
+        "        print('ready', flush=True)\n"
+        "print('ended after', n, flush=True)\n")
+    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "controller", str(script), "--robot", "bot2",
+                             "--url", transport.rpc_endpoint], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        os.kill(proc.pid, signal.SIGSTOP)
+        deadline = time.monotonic() + 60
+        while core.lockstep.session_for("bot2") is not None and time.monotonic() < deadline:
+            time.sleep(0.05)                               # poll: released after 3 heartbeats (1.5 s)
+        assert core.lockstep.session_for("bot2") is None
+        os.kill(proc.pid, signal.SIGCONT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, err
+    assert "ended after" in out
+    assert "released the robot" in err and "Traceback" not in err and "server gone" not in err, err
