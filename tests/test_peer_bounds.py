@@ -127,3 +127,14 @@ def test_subscriptions_that_match_no_topic_are_not_held(server) -> None:
     finally:
         if not sub.closed:
             sub.close()
+
+
+def test_a_repeated_error_is_logged_at_powers_of_ten() -> None:
+    lines: list[str] = []
+    core = Core(Simulation.from_file(WORLD, precision="fast"), log=lines.append)
+    for _ in range(1000):
+        core.log_error("internal error: boom\ntraceback lines")
+    core.log_error("internal error: another")
+    assert lines == ["internal error: boom\ntraceback lines", "internal error: boom (seen 10 times)",
+                     "internal error: boom (seen 100 times)", "internal error: boom (seen 1000 times)",
+                     "internal error: another"]

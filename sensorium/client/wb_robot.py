@@ -239,9 +239,15 @@ class RobotClient:
                 # the session was dropped (3 heartbeats of silence: a network stall, or this
                 # process was stopped); like a Webots extern controller whose simulation went
                 # away, the controller's step loop ends instead of crashing
-                problem = self.conn.heartbeat.problem() if self.conn.heartbeat is not None else None
-                print(f"sensorium: {problem or 'the server released this robot (no heartbeat for 3 periods)'}; "
-                      f"ending the controller's steps (start it again to re-attach)", file=sys.stderr)
+                hb = self.conn.heartbeat
+                problem = hb.problem() if hb is not None else None
+                if problem is None:
+                    paused = hb.paused_s if hb is not None else 0.0
+                    problem = ("the server released the robot after 3 heartbeats without hearing from this "
+                               "controller (" + (f"this process did not run for {paused:.1f} s)" if paused
+                                                 else "a network stall, or this process was stopped)"))
+                print(f"sensorium: {problem}; ending the controller's steps (start it again to re-attach)",
+                      file=sys.stderr)
                 self.terminated = True
                 return -1
             raise

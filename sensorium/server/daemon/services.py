@@ -37,21 +37,13 @@ from sensorium.schemas.wire import (
     parse_request,
 )
 from sensorium.server.daemon import roles, supervisor
+from sensorium.server.daemon.device_services import MOTOR, DeviceServices, ServiceError
 from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
-from sensorium.server.daemon.topics import Control, Topics, header, image_msg, point_cloud_msg, pose_quaternion
+from sensorium.server.daemon.topics import Control, Topics, pose_quaternion
 
 __all__ = ["Core", "ServiceError"]
 
 Frames = list[bytes]
-
-
-class ServiceError(Exception):
-    """Raised by a handler: answered with ``code`` and ``message``."""
-
-    def __init__(self, code: ErrorCode, message: str):
-        super().__init__(f"{code.name}: {message}")
-        self.code = code
-        self.message = message
 
 
 @dataclass(slots=True)
@@ -79,7 +71,6 @@ class Route:
 
 
 _DEFERRED = None              # a handler returning None answers later (step)
-MOTOR = "RotationalMotor"
 
 
 def _arg_errors(exc: ValidationError) -> str:
@@ -95,7 +86,7 @@ def _arg_errors(exc: ValidationError) -> str:
     return "; ".join(parts)
 
 
-class Core:
+class Core(DeviceServices):
     """One world served: requests in, replies and publications out."""
 
     def __init__(self, sim: Any, *, world_name: str | None = None, heartbeat_ms: int = 1000, mode: str = "fast",
@@ -110,7 +101,7 @@ class Core:
         self.pub_endpoint = pub_endpoint
         self.max_request = max_request
         self.open_controls = open_controls       # world-wide controls for any caller (roles.py)
-        self._log_line = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
+        self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
         self._log_counts: dict[str, int] = {}             # first line of a message -> times seen
         self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
                                  sim.basic_time_step, heartbeat_ms=heartbeat_ms, mode=mode,
@@ -126,19 +117,19 @@ class Core:
         self.routes = self._routes()
         self.errors = 0
 
-    def log(self, line: str) -> None:
-        """Log a line. The same first line again is printed only the 10th, 100th, 1000th… time,
-        with its count, so a client repeating a failing request cannot flood the log (counting,
-        not timing: the core has no clock)."""
+    def log_error(self, line: str) -> None:
+        """Log an error a client may trigger again and again: the same first line is printed the
+        1st, 10th, 100th… time only, with its count, so a client repeating a failing request
+        cannot flood the log (counting, not timing: the core has no clock)."""
         key = line.split("\n", 1)[0][:200]
         if len(self._log_counts) > 1000 and key not in self._log_counts:
             self._log_counts.clear()
         n = self._log_counts.get(key, 0) + 1
         self._log_counts[key] = n
         if n == 1:
-            self._log_line(line)
+            self.log(line)
         elif n >= 10 and str(n).strip("0") == "1":
-            self._log_line(f"{key} (seen {n} times)")
+            self.log(f"{key} (seen {n} times)")
 
     # ------------------------------------------------------------------ routing table
     def _routes(self) -> dict[str, Route]:
@@ -237,7 +228,7 @@ class Core:
             return [envelope + [error_reply(rid, exc.code, exc.message)]]
         except Exception as exc:  # noqa: BLE001 - a bug must not stop the server
             self.errors += 1
-            self.log(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
+            self.log_error(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
             return [envelope + [error_reply(rid, ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}")]]
 
     def subscription(self, event: bytes) -> None:
@@ -526,145 +517,3 @@ class Core:
             return supervisor.HANDLERS[item](self.sim, self.lockstep, c.robot, c.args)
         except ValueError as exc:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{item}: {exc}") from None
-
-    # ------------------------------------------------------------------ device services
-    def _describe(self, ctl: Control) -> dict:
-        dev = ctl.device
-        out: dict[str, Any] = {"name": dev.name, "type": ctl.kind, "sampling_period": ctl.controller_period}
-        if ctl.kind in ("LightSensor", "DistanceSensor"):
-            out["lookup_table"] = self._lookup_table(dev)
-        if ctl.kind == "DistanceSensor":
-            out.update(min_value=float(dev.table.min_value), max_value=float(dev.table.max_value),
-                       aperture=float(dev.config.aperture), sensor_type=int(dev.type_code))
-        if ctl.kind == "Lidar":
-            out.update(self._lidar_info(dev))
-            out.update(self._frequency_info(dev))
-            out["point_cloud_enabled"] = ctl.controller_point_cloud
-        if ctl.kind == "PositionSensor":
-            out.update(motor=dev.config.motor, noise=float(dev.config.noise), resolution=float(dev.config.resolution))
-        if ctl.kind == "LED":
-            del out["sampling_period"]
-            out.update(value=int(dev.value), color=[float(v) for rgb in dev.config.color for v in rgb],
-                       gradual=bool(dev.config.gradual))
-        return out
-
-    @staticmethod
-    def _describe_motor(m: Any) -> dict:
-        return {"name": m.name, "type": MOTOR, "maxVelocity": float(m.max_velocity), "minPosition": 0.0,
-                "maxPosition": 0.0, "targetPosition": float(m.target_position), "velocity": float(m.velocity)}
-
-    @staticmethod
-    def _lookup_table(dev: Any) -> list[float]:
-        flat = getattr(dev.table, "flattened", None)
-        if flat is None:
-            flat = [v for row in dev.config.lookup_table for v in row]
-        return [float(v) for v in flat]
-
-    @staticmethod
-    def _lidar_info(dev: Any) -> dict:
-        cfg = dev.config
-        return {"horizontalResolution": int(cfg.horizontal_resolution), "numberOfLayers": int(cfg.number_of_layers),
-                "fov": float(cfg.field_of_view), "verticalFov": float(cfg.vertical_field_of_view),
-                "minRange": float(cfg.min_range), "maxRange": float(cfg.max_range)}
-
-    @staticmethod
-    def _frequency_info(dev: Any) -> dict:
-        cfg = dev.config
-        return {"frequency": float(dev.frequency), "minFrequency": float(cfg.min_frequency),
-                "maxFrequency": float(cfg.max_frequency)}
-
-    def _dev_get_value(self, c: Call) -> dict:
-        return {"value": float(c.ctl.device.value)}
-
-    def _dev_set(self, c: Call) -> dict:
-        try:
-            c.ctl.device.set(c.args.value, self.sim.time_ms)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set: {exc}") from None
-        return {"success": True}
-
-    def _dev_get(self, c: Call) -> dict:
-        return {"value": int(c.ctl.device.value)}
-
-    def _dev_enable(self, c: Call) -> dict:
-        self.topics.controller_enable(c.ctl.path, c.args.value)
-        return {"success": True}
-
-    def _dev_get_sampling_period(self, c: Call) -> dict:
-        return {"value": c.ctl.controller_period}
-
-    def _dev_get_lookup_table(self, c: Call) -> dict:
-        return {"value": self._lookup_table(c.ctl.device)}
-
-    def _dev_get_min_value(self, c: Call) -> dict:
-        return {"value": float(c.ctl.device.table.min_value)}
-
-    def _dev_get_max_value(self, c: Call) -> dict:
-        return {"value": float(c.ctl.device.table.max_value)}
-
-    def _dev_get_aperture(self, c: Call) -> dict:
-        return {"value": float(c.ctl.device.config.aperture)}
-
-    def _dev_get_type(self, c: Call) -> dict:
-        return {"value": int(c.ctl.device.type_code)}
-
-    def _dev_get_info(self, c: Call) -> dict:
-        return self._lidar_info(c.ctl.device)
-
-    def _dev_enable_point_cloud(self, c: Call) -> dict:
-        self.topics.controller_point_cloud(c.ctl.path, c.args.value)
-        return {"success": True}
-
-    def _dev_is_point_cloud_enabled(self, c: Call) -> dict:
-        return {"status": int(c.ctl.controller_point_cloud)}
-
-    def _dev_get_frequency_info(self, c: Call) -> dict:
-        return self._frequency_info(c.ctl.device)
-
-    def _dev_set_frequency(self, c: Call) -> dict:
-        try:
-            c.ctl.device.set_frequency(c.args.value)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_frequency: {exc}") from None
-        return {"success": True}
-
-    def _layer(self, c: Call) -> int:
-        n = c.ctl.device.config.number_of_layers
-        if c.args.layer >= n:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"argument 'layer': {c.args.layer} outside [0, {n - 1}]")
-        return c.args.layer
-
-    def _dev_get_layer_range_image(self, c: Call) -> dict:
-        layer = self._layer(c)
-        dev = c.ctl.device
-        row = dev.layer_range_image(layer)
-        w = int(dev.config.horizontal_resolution)
-        import numpy as np
-
-        data = np.ascontiguousarray(row, dtype="<f4").tobytes()
-        return {"image": image_msg(header(c.ctl.frame_id, dev.measured_at_ms), 1, w, data)}
-
-    def _dev_get_layer_point_cloud(self, c: Call) -> dict:
-        if not c.ctl.controller_point_cloud:
-            raise ServiceError(ErrorCode.WRONG_STATE, f"the point cloud of {c.ctl.path} is not enabled (enable_point_cloud)")
-        layer = self._layer(c)
-        dev = c.ctl.device
-        return {"pointCloud": point_cloud_msg(header(c.ctl.frame_id, dev.measured_at_ms), dev.layer_point_cloud(layer))}
-
-    # ------------------------------------------------------------------ motor services
-    def _motor_set_position(self, c: Call) -> dict:
-        c.motor.set_position(c.args.value)
-        return {"success": True}
-
-    def _motor_set_velocity(self, c: Call) -> dict:
-        c.motor.set_velocity(c.args.value)
-        return {"success": True}
-
-    def _motor_get_velocity(self, c: Call) -> dict:
-        return {"value": float(c.motor.velocity)}
-
-    def _motor_get_max_velocity(self, c: Call) -> dict:
-        return {"value": float(c.motor.max_velocity)}
-
-    def _motor_get_target_position(self, c: Call) -> dict:
-        return {"value": float(c.motor.target_position)}
