@@ -71,3 +71,13 @@ def test_compose_services_run_as_processes(tmp_path: Path) -> None:
 
     summary = summarize(tmp_path / "recordings" / "run.mcap")
     assert summary["messages"] > 0 and not summary["truncated"]
+
+
+def test_compose_publishes_ports_on_loopback_only() -> None:
+    """The server has no authentication without --curve-keys: compose must not expose it on every
+    host interface ("5560:5560" would publish on 0.0.0.0)."""
+    ports = COMPOSE["services"]["server"]["ports"]
+    assert ports, "the server publishes its ports"
+    for spec in ports:
+        host_ip = str(spec).split(":")[0]
+        assert host_ip == "127.0.0.1", f"port {spec!r} is published beyond loopback"

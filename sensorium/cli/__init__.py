@@ -190,10 +190,25 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="export only these topics")
     p.add_argument("--start", type=_seconds, metavar="S", help="from S seconds of simulation time")
     p.add_argument("--end", type=_seconds, metavar="E", help="up to E seconds of simulation time")
+
+
+@command("recover", "rewrite a truncated recording (writer killed, disk full) as a complete, indexed MCAP file",
+         "sensorium.cli.recording:recover_cmd")
+def _recover_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="recording (.mcap), e.g. one whose writer was killed")
+    p.add_argument("out", nargs="?", help="output file (default: FILE with -recovered before the suffix)")
+    p.add_argument("--force", action="store_true", help="overwrite OUT if it exists")
 # --- end recording ---
 
 
 # --- server: serve (server/serve.py) and schemas (schemas/export.py) ---
+@command("keys", "create a CURVE key pair for serve --curve-keys DIR (encrypted, authenticated tcp)",
+         "sensorium.cli.serve:keys")
+def _keys_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("dir", help="directory for server.key (public) and server.key_secret (created if missing)")
+    p.add_argument("--force", action="store_true", help="replace an existing key pair")
+
+
 @command("serve", "serve a world to controllers (services) and subscribers (topics) over ZeroMQ",
          "sensorium.cli.serve:main")
 def _serve_args(p: argparse.ArgumentParser) -> None:

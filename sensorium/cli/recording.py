@@ -1,5 +1,5 @@
-"""``sensorium record``, ``replay``, ``export`` and ``info FILE.mcap``: argparse shells over
-:mod:`sensorium.server.recording` (live.py, replay.py, export.py, reader.py).
+"""``sensorium record``, ``replay``, ``export``, ``recover`` and ``info FILE.mcap``: argparse shells over
+:mod:`sensorium.server.recording` (live.py, replay.py, export.py, recover.py, reader.py).
 """
 
 from __future__ import annotations
@@ -65,8 +65,10 @@ def record(args: argparse.Namespace) -> int:
     else:
         lost = "" if not s["lost"] else ", " + ", ".join(f"{t}: {n}" for t, n in s["lost_by_topic"].items())
         print(f"sensorium: recorded {s['received']} messages on {s['topics']} topics to {s['file']}; "
-              f"{s['gaps']} gaps, {s['lost']} messages lost{lost}", flush=True)
-    return 0
+              f"{s['gaps']} gaps, {s['lost']} messages lost{lost}"
+              + (f"; the server restarted {s['restarts']} time(s): files {', '.join(s['files'])}" if s["restarts"] else ""),
+              flush=True)
+    return 1 if rec.recorder is not None and rec.recorder.failed else 0
 
 
 # ------------------------------------------------------------------------------------ replay
@@ -160,6 +162,22 @@ def export_cmd(args: argparse.Namespace) -> int:
 # ------------------------------------------------------------------------------------ info
 
 
+def recover_cmd(args: argparse.Namespace) -> int:
+    """``sensorium recover FILE [OUT]``: exit 0 with a one-line summary, or 1 with one error line."""
+    from sensorium.server.recording.recover import recover
+
+    try:
+        r = recover(args.file, args.out, overwrite=args.force)
+    except (OSError, ValueError, McapError) as exc:
+        print(f"sensorium recover: {exc}", file=sys.stderr)
+        return 1
+    state = f"truncated, read up to its last complete record ({r.stopped})" if r.stopped else (
+        "truncated (no summary or footer)" if r.truncated else "complete")
+    print(f"sensorium: recovered {r.messages} messages on {r.channels} channels, {r.metadata} metadata records, "
+          f"{r.attachments} attachments from {args.file} ({state}) into {r.out}", flush=True)
+    return 0
+
+
 def _human_size(n: float) -> str:
     for unit in ("B", "KiB", "MiB", "GiB"):
         if n < 1024 or unit == "GiB":
@@ -203,6 +221,12 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
                       if meta.get("format") == "2" else "no (msgpack only: export with sensorium export --ros2)"))
     if session.get("started_at"):
         lines.append(("Recorded", session["started_at"]))
+    if session.get("previous_file"):
+        lines.append(("Continues from", f"{session['previous_file']} (the server restarted; record --connect)"))
+    restart = s["metadata"].get("server_restart", {})
+    if restart.get("next_file"):
+        lines.append(("Continues in", f"{restart['next_file']} (the server restarted: {restart.get('topic', '?')} "
+                                      f"went back to {_secs(int(restart.get('stamp_ns', 0) or 0))})"))
     for a in s["attachments"]:
         lines.append(("Attachment", f"{a['name']} ({a['media_type']}, {_human_size(a['size_bytes'])})"))
     for key, value in lines:

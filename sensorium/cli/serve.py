@@ -54,10 +54,39 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--foxglove", metavar="[HOST:]PORT",
                    help="also serve the topics, transforms and the world to Foxglove (WebSocket) on PORT, "
                    "host 127.0.0.1 unless given; port 0 picks a free port")
+    p.add_argument("--controls", choices=["auto", "open", "supervisor"], default="auto",
+                   help="who may use world-wide controls (set_mode): open = any caller; supervisor = only the "
+                   "controller of a robot with 'supervisor: true'; auto (default) = open when --rpc is loopback/ipc, "
+                   "else supervisor")
+    p.add_argument("--curve-keys", metavar="DIR",
+                   help="encrypt both sockets with CURVE using DIR/server.key_secret (create it with "
+                   "'sensorium keys DIR'); clients need the public key: SENSORIUM_CURVE_SERVERKEY or URL?serverkey=")
     add_world_options(p)
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
                    "without subscribers (default: every topic)")
+
+
+def z85_hex(key: bytes) -> str:
+    """A Z85 key as 64 hex digits: safe to paste into a shell (Z85 has $, &, quotes...)."""
+    import zmq.utils.z85
+
+    return zmq.utils.z85.decode(key).hex()
+
+
+def keys(args: argparse.Namespace) -> int:
+    """``sensorium keys DIR``: a CURVE key pair for ``serve --curve-keys DIR``."""
+    from sensorium.server.daemon.transport import generate_curve_keys
+
+    try:
+        public = generate_curve_keys(args.dir, overwrite=args.force)
+    except (OSError, ValueError) as exc:
+        print(f"sensorium keys: {exc}", file=sys.stderr)
+        return 1
+    print(f"sensorium: wrote {args.dir}/server.key and {args.dir}/server.key_secret (keep it private); "
+          f"serve with --curve-keys {args.dir}; clients need:", flush=True)
+    print(f"SENSORIUM_CURVE_SERVERKEY={z85_hex(public)}", flush=True)
+    return 0
 
 
 def options(args: argparse.Namespace):
@@ -68,7 +97,8 @@ def options(args: argparse.Namespace):
                         heartbeat_ms=args.heartbeat_ms, until=getattr(args, "until", None),
                         allow_large=getattr(args, "allow_large", False),
                         allow_outside_meshes=getattr(args, "allow_outside_meshes", False),
-                        contact=False if getattr(args, "no_contact", False) else None)
+                        contact=False if getattr(args, "no_contact", False) else None,
+                        controls=getattr(args, "controls", "auto"), curve_keys=getattr(args, "curve_keys", None))
 
 
 def bind_problem(exc: BaseException) -> str:
@@ -106,6 +136,11 @@ def main(args: argparse.Namespace) -> int:
     except (OSError, zmq.ZMQError) as exc:          # address in use, bad endpoint
         print(f"sensorium serve: {bind_problem(exc)}", file=sys.stderr)
         return 1
+    if server.transport.curve:
+        from sensorium.server.daemon.transport import load_curve_keys
+
+        public = load_curve_keys(args.curve_keys)[0]
+        print(f"sensorium serve: CURVE on; clients need SENSORIUM_CURVE_SERVERKEY={z85_hex(public)}", file=sys.stderr)
     if getattr(args, "record", None):
         from sensorium.server.recording.writer import recorder_for_server
         try:
@@ -139,7 +174,8 @@ def main(args: argparse.Namespace) -> int:
             viewer.close()
             print(f"sensorium: {viewer.report()}", file=sys.stderr, flush=True)
         if server.recorder is not None:
-            print(f"sensorium: recorded {server.recorder.message_count} messages to {args.record}",
+            print(f"sensorium: recorded {server.recorder.message_count} messages to {args.record}"
+                  + (f" (stopped early: {server.recorder.failed})" if server.recorder.failed else ""),
                   file=sys.stderr, flush=True)
     core = server.core
     print(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps", file=sys.stderr, flush=True)

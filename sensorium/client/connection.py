@@ -28,12 +28,16 @@ from urllib.parse import quote, unquote
 
 import msgpack
 import zmq
+import zmq.utils.z85
 
 DEFAULT_RPC_ENDPOINT = "tcp://127.0.0.1:5560"
 DEFAULT_PUB_ENDPOINT = "tcp://127.0.0.1:5561"
 DEFAULT_PORT = 5560
 ENV_URL = "SENSORIUM_CONTROLLER_URL"
 WEBOTS_ENV_URL = "WEBOTS_CONTROLLER_URL"
+ENV_CURVE_SERVERKEY = "SENSORIUM_CURVE_SERVERKEY"   # the server's CURVE public key: encrypt, authenticate it
+ENV_CURVE_PUBLICKEY = "SENSORIUM_CURVE_PUBLICKEY"   # this client's key pair (default: a fresh one per socket)
+ENV_CURVE_SECRETKEY = "SENSORIUM_CURVE_SECRETKEY"
 RETRY_S = 1.0                   # a step request unanswered this long is sent again (same id)
 RETRIED_SERVICES = ("/robot/step", "/robot/time_step")
 DEFAULT_TIMEOUT = 10.0          # seconds for a non-step request (the server may still be starting)
@@ -105,7 +109,8 @@ class ControllerURL:
     def __str__(self) -> str:
         if self.robot is None:
             return self.endpoint
-        return f"{self.endpoint}/{quote(self.robot, safe='')}"
+        base, sep, query = self.endpoint.partition("?")
+        return f"{base}/{quote(self.robot, safe='')}{sep}{query}"
 
     def with_robot(self, robot: str | None) -> ControllerURL:
         return ControllerURL(self.endpoint, robot)
@@ -147,7 +152,11 @@ def parse_controller_url(url: str | None, default_endpoint: str = DEFAULT_RPC_EN
     """
     if url is None or not url.strip():
         return ControllerURL(default_endpoint, None)
-    url = url.strip()
+    url, sep, query = url.strip().partition("?")
+    if sep:                                          # ?serverkey=KEY (CURVE): carried by the endpoint
+        split_curve("tcp://x?" + query, {})          # checked now: a bad key is a bad URL
+        parsed = parse_controller_url(url, default_endpoint)
+        return ControllerURL(f"{parsed.endpoint}?{query}", parsed.robot)
     scheme, sep, rest = url.partition("://")
     if not sep:
         return ControllerURL(default_endpoint, _robot_part(url, url))
@@ -191,6 +200,56 @@ def controller_url_from_env(environ: dict[str, str] | None = None) -> Controller
     return parse_controller_url(env.get(ENV_URL) or env.get(WEBOTS_ENV_URL) or None)
 
 
+# ---------------------------------------------------------------------- CURVE (encryption)
+
+def _curve_key(text: str, where: str) -> bytes:
+    """A CURVE key as Z85 (40 characters) or hex (64) → Z85 bytes; SensoriumError(BAD_URL) otherwise."""
+    text = text.strip()
+    if len(text) == 64:
+        try:
+            return zmq.utils.z85.encode(bytes.fromhex(text))
+        except ValueError:
+            pass
+    if len(text) == 40:
+        try:
+            zmq.utils.z85.decode(text.encode("ascii"))
+            return text.encode("ascii")
+        except (ValueError, UnicodeEncodeError, KeyError):
+            pass
+    raise SensoriumError(ErrorCode.BAD_URL, f"{where}: a CURVE key is 40 Z85 or 64 hex characters "
+                                            f"(got {len(text)} characters)")
+
+
+def split_curve(endpoint: str, environ: dict[str, str] | None = None) -> tuple[str, bytes | None]:
+    """``tcp://HOST:PORT?serverkey=KEY`` → (``tcp://HOST:PORT``, KEY); without a query the key is
+    ``SENSORIUM_CURVE_SERVERKEY`` (or None: a plain connection). KEY runs to the end of the URL."""
+    env = os.environ if environ is None else environ
+    base, sep, query = endpoint.partition("?")
+    if sep:
+        name, eq, value = query.partition("=")
+        if name != "serverkey" or not eq:
+            raise SensoriumError(ErrorCode.BAD_URL, f"endpoint {base!r}: the only query is ?serverkey=KEY")
+        return base, _curve_key(value, f"endpoint {base!r}: serverkey")
+    key = env.get(ENV_CURVE_SERVERKEY)
+    return base, (_curve_key(key, ENV_CURVE_SERVERKEY) if key else None)
+
+
+def curve_client(sock: zmq.Socket, serverkey: bytes | None, environ: dict[str, str] | None = None) -> None:
+    """Make ``sock`` a CURVE client of the server with public key ``serverkey`` (before connect).
+    Its own key pair is ``SENSORIUM_CURVE_PUBLICKEY``/``SECRETKEY``, else a fresh one."""
+    if serverkey is None:
+        return
+    env = os.environ if environ is None else environ
+    pub, sec = env.get(ENV_CURVE_PUBLICKEY), env.get(ENV_CURVE_SECRETKEY)
+    if pub and sec:
+        public, secret = _curve_key(pub, ENV_CURVE_PUBLICKEY), _curve_key(sec, ENV_CURVE_SECRETKEY)
+    else:
+        public, secret = zmq.curve_keypair()
+    sock.setsockopt(zmq.CURVE_SERVERKEY, serverkey)
+    sock.setsockopt(zmq.CURVE_PUBLICKEY, public)
+    sock.setsockopt(zmq.CURVE_SECRETKEY, secret)
+
+
 # ---------------------------------------------------------------------- encoding
 
 def pack(obj: Any) -> bytes:
@@ -218,7 +277,7 @@ class Connection:
 
     def __init__(self, endpoint: str, *, timeout: float | None = DEFAULT_TIMEOUT,
                  context: zmq.Context | None = None):
-        self.endpoint = endpoint
+        self.endpoint, self._serverkey = split_curve(endpoint)
         self.timeout = timeout
         self._context = context or zmq.Context.instance()
         self._socket = self._context.socket(zmq.DEALER)
@@ -227,7 +286,8 @@ class Connection:
         # server sees the same peer (ROUTER_HANDOVER), so the session and a pending step follow
         # (a first byte of 0 is reserved by libzmq)
         self._socket.setsockopt(zmq.ROUTING_ID, b"S" + secrets.token_bytes(15))
-        self._socket.connect(endpoint)
+        curve_client(self._socket, self._serverkey)
+        self._socket.connect(self.endpoint)
         self._poller = zmq.Poller()                  # kept for callers that poll the socket themselves
         self._poller.register(self._socket, zmq.POLLIN)
         self._rcvtimeo: zmq.Socket | None = None     # the socket whose RCVTIMEO is _rcvtimeo_ms
@@ -349,7 +409,8 @@ class Connection:
     # -- lifecycle
     def start_heartbeat(self, session: str, interval_ms: int, lost_after_s: float | None = None) -> Heartbeat:
         self.stop_heartbeat()
-        self.heartbeat = Heartbeat(self.endpoint, session, interval_ms, self._context, lost_after_s)
+        self.heartbeat = Heartbeat(self.endpoint, session, interval_ms, self._context, lost_after_s,
+                                   serverkey=self._serverkey)
         self.heartbeat.start()
         return self.heartbeat
 
@@ -379,9 +440,10 @@ class Heartbeat(threading.Thread):
     (default: 5 heartbeats, at least 2 s), or the server answered that the session is gone."""
 
     def __init__(self, endpoint: str, session: str, interval_ms: int, context: zmq.Context,
-                 lost_after_s: float | None = None):
+                 lost_after_s: float | None = None, serverkey: bytes | None = None):
         super().__init__(name="sensorium-heartbeat", daemon=True)
         self.endpoint = endpoint
+        self.serverkey = serverkey                      # CURVE: the server's public key (Z85)
         self.session = session
         self.interval = max(1, int(interval_ms)) / 1000.0
         self.lost_after = lost_after_s if lost_after_s is not None else max(2.0, 5 * self.interval)
@@ -410,6 +472,7 @@ class Heartbeat(threading.Thread):
         sock = self._context.socket(zmq.DEALER)
         sock.setsockopt(zmq.LINGER, 0)
         try:
+            curve_client(sock, self.serverkey)
             sock.connect(self.endpoint)
             ids = itertools.count(1)
             next_ping = time.monotonic()
@@ -454,11 +517,12 @@ class SubSocket:
     """A SUB socket on a topic endpoint, for :mod:`sensorium.client.topics` (which stays zmq-free)."""
 
     def __init__(self, endpoint: str, *, context: zmq.Context | None = None, rcvhwm: int = 1000):
-        self.endpoint = endpoint
+        self.endpoint, serverkey = split_curve(endpoint)
         self._socket = (context or zmq.Context.instance()).socket(zmq.SUB)
         self._socket.setsockopt(zmq.LINGER, 0)
         self._socket.setsockopt(zmq.RCVHWM, rcvhwm)
-        self._socket.connect(endpoint)
+        curve_client(self._socket, serverkey)
+        self._socket.connect(self.endpoint)
 
     def subscribe(self, prefix: bytes) -> None:
         self._socket.setsockopt(zmq.SUBSCRIBE, prefix)

@@ -12,8 +12,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sensorium.server.daemon.roles import CONTROLS, open_controls
 from sensorium.server.daemon.services import Core
-from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport
+from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport, load_curve_keys
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import default_world_path
@@ -34,11 +35,17 @@ class ServeOptions:
     contact: bool | None = None       # kinematic contact; None: the world's world_info.contact
     allow_large: bool = False         # raise the world limits (WorldLimits.large())
     allow_outside_meshes: bool = False  # mesh urls may leave the world's folder
+    controls: str = "auto"            # world-wide controls: auto | open | supervisor (daemon/roles.py)
+    curve_keys: str | None = None     # DIR with server.key_secret: CURVE on both sockets
 
     def check(self) -> None:
         """Raise ValueError naming the first bad option."""
         if self.heartbeat_ms <= 0:
             raise ValueError("--heartbeat-ms must be > 0")
+        if self.controls not in CONTROLS:
+            raise ValueError(f"--controls must be one of {', '.join(CONTROLS)}, got {self.controls!r}")
+        if self.curve_keys:
+            load_curve_keys(self.curve_keys)
 
 
 def build(world: str | Path | None, options: ServeOptions | None = None) -> tuple[Core, Transport]:
@@ -47,12 +54,14 @@ def build(world: str | Path | None, options: ServeOptions | None = None) -> tupl
     embedded arena world."""
     opts = options or ServeOptions()
     opts.check()
+    secret = load_curve_keys(opts.curve_keys)[1] if opts.curve_keys else None
     path = Path(world) if world else default_world_path()
     sim = Simulation.from_file(path, precision=opts.precision,
                                limits=WorldLimits.large() if opts.allow_large else WorldLimits(),
                                allow_outside_meshes=opts.allow_outside_meshes, contact=opts.contact)
-    core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode)
-    return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until)
+    core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode,
+                open_controls=open_controls(opts.controls, opts.rpc))
+    return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until, curve_secret=secret)
 
 
 class Server:

@@ -36,7 +36,7 @@ from sensorium.schemas.wire import (
     ok_reply,
     parse_request,
 )
-from sensorium.server.daemon import supervisor
+from sensorium.server.daemon import roles, supervisor
 from sensorium.server.daemon.device_services import MOTOR, DeviceServices, ServiceError
 from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
 from sensorium.server.daemon.topics import Control, Topics, pose_quaternion
@@ -91,7 +91,8 @@ class Core(DeviceServices):
 
     def __init__(self, sim: Any, *, world_name: str | None = None, heartbeat_ms: int = 1000, mode: str = "fast",
                  pub_endpoint: str = "", version: str | None = None, new_token: Callable[[], str] | None = None,
-                 log: Callable[[str], None] | None = None, max_request: int = SOFT_LIMIT):
+                 log: Callable[[str], None] | None = None, max_request: int = SOFT_LIMIT,
+                 open_controls: bool = True):
         from sensorium import __version__
 
         self.sim = sim
@@ -99,6 +100,7 @@ class Core(DeviceServices):
         self.version = version or __version__
         self.pub_endpoint = pub_endpoint
         self.max_request = max_request
+        self.open_controls = open_controls       # world-wide controls for any caller (roles.py)
         self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
         self._log_counts: dict[str, int] = {}             # first line of a message -> times seen
         self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
@@ -210,6 +212,9 @@ class Core(DeviceServices):
                 raise ServiceError(ErrorCode.NOT_SUPERVISOR,
                                    f"{req.service}: robot {route.robot!r} is not a supervisor "
                                    f"(set 'supervisor: true' on it in the world file)")
+            if route.robot is None and route.spec.item in roles.WORLD_CONTROLS and not self.open_controls \
+                    and not roles.has_supervisor_role(self.sim, self.lockstep, peer):
+                raise ServiceError(ErrorCode.NOT_SUPERVISOR, roles.denied(req.service))
             ctl = self.topics.controls[route.device] if route.device else None
             motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
             call = Call(envelope, peer, rid, args, route.robot or "", cast(Control, ctl), motor, now, [])
@@ -485,6 +490,7 @@ class Core(DeviceServices):
         if a.rotation is not None and a.quaternion is not None:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, "give either 'rotation' (axis-angle) or 'quaternion', not both")
         try:
+            roles.check_pose(a.translation, a.rotation, a.quaternion)
             self.sim.robots[c.robot].set_pose(a.translation, a.rotation, a.quaternion)
         except (ValueError, ArithmeticError) as exc:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_pose: {exc}") from None

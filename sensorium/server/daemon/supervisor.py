@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.server.daemon.roles import check_pose
 from sensorium.server.world.poses import matrix_quaternion
 
 MODES = ("pause", "realtime", "fast")     # Webots WB_SUPERVISOR_SIMULATION_MODE_PAUSE = 0, REAL_TIME, FAST
@@ -88,6 +89,8 @@ def set_field(sim: Any, node: Node, field: str, value: list[float]) -> None:
         raise ValueError(f"field {field!r} takes {want} numbers, got {len(value)}")
     if not all(math.isfinite(v) for v in value):
         raise ValueError(f"field {field!r}: values must be finite")
+    if field == "translation":
+        check_pose(translation=value)
     if field == "rotation" and math.hypot(*value[:3]) == 0.0:
         raise ValueError("rotation axis must not be zero")
     kwargs = {"translation": value} if field == "translation" else {"translation": None, "rotation": value}

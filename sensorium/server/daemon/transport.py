@@ -17,17 +17,22 @@ A thin adapter around :class:`sensorium.server.daemon.services.Core` (sans-IO): 
 
 from __future__ import annotations
 
+import os
 import signal
 import socket
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import zmq
+import zmq.auth
+import zmq.utils.z85
 
 from sensorium.schemas.wire import ErrorCode, error_reply
 from sensorium.server.daemon.services import Core
 
-__all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB"]
+__all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
+           "curve_client_from_env"]
 
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
@@ -51,6 +56,69 @@ def _bindable(url: str) -> str:
     return url
 
 
+# ---------------------------------------------------------------------- CURVE (serve --curve-keys DIR)
+CURVE_NAME = "server"          # DIR/server.key (public) and DIR/server.key_secret (ZeroMQ certificate files)
+
+
+def generate_curve_keys(directory: str | Path, *, overwrite: bool = False) -> bytes:
+    """Write a fresh server key pair (``zmq.curve_keypair``) to DIR/server.key and
+    DIR/server.key_secret (owner-only); return the public key (Z85) clients need."""
+    d = Path(directory)
+    paths = [d / f"{CURVE_NAME}.key", d / f"{CURVE_NAME}.key_secret"]
+    if not overwrite and any(p.exists() for p in paths):
+        raise FileExistsError(f"{d}: a key pair exists already (--force to replace it)")
+    d.mkdir(parents=True, exist_ok=True)
+    old = os.umask(0o077)
+    try:
+        zmq.auth.create_certificates(d, CURVE_NAME)
+    finally:
+        os.umask(old)
+    os.chmod(paths[1], 0o600)
+    return load_curve_keys(d)[0]
+
+
+def load_curve_keys(directory: str | Path) -> tuple[bytes, bytes]:
+    """(public, secret) Z85 keys from DIR/server.key_secret; ValueError naming the problem."""
+    path = Path(directory) / f"{CURVE_NAME}.key_secret"
+    if not path.is_file():
+        raise ValueError(f"--curve-keys: {path} not found (create a key pair with: sensorium keys {directory})")
+    try:
+        public, secret = zmq.auth.load_certificate(path)
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"--curve-keys: {path}: {exc}") from None
+    if secret is None:
+        raise ValueError(f"--curve-keys: {path} has no secret key")
+    return public, secret
+
+
+def curve_server(sock: zmq.Socket, secret: bytes | None) -> None:
+    """Make ``sock`` a CURVE server (before bind): every connection is encrypted, and only clients
+    that know the server's public key complete the handshake."""
+    if secret is None:
+        return
+    sock.setsockopt(zmq.CURVE_SERVER, 1)
+    sock.setsockopt(zmq.CURVE_SECRETKEY, secret)
+
+
+def curve_client_from_env(sock: zmq.Socket, environ: dict[str, str] | None = None) -> None:
+    """For the server package's own client sockets (``record --connect``): CURVE with the server
+    key ``SENSORIUM_CURVE_SERVERKEY`` (Z85 or hex) and a fresh key pair, like the client library."""
+    key = (os.environ if environ is None else environ).get("SENSORIUM_CURVE_SERVERKEY", "").strip()
+    if not key:
+        return
+    try:
+        z85 = zmq.utils.z85.encode(bytes.fromhex(key)) if len(key) == 64 else key.encode("ascii")
+        zmq.utils.z85.decode(z85)
+    except (ValueError, UnicodeEncodeError, KeyError):
+        raise ValueError("SENSORIUM_CURVE_SERVERKEY: a CURVE key is 40 Z85 or 64 hex characters") from None
+    if len(z85) != 40:
+        raise ValueError("SENSORIUM_CURVE_SERVERKEY: a CURVE key is 40 Z85 or 64 hex characters")
+    public, secret = zmq.curve_keypair()
+    sock.setsockopt(zmq.CURVE_SERVERKEY, z85)
+    sock.setsockopt(zmq.CURVE_PUBLICKEY, public)
+    sock.setsockopt(zmq.CURVE_SECRETKEY, secret)
+
+
 class Transport:
     """Bind, serve until stopped, close. ``run()`` blocks; ``stop()`` may be called from a signal
     handler or another thread."""
@@ -58,7 +126,7 @@ class Transport:
     def __init__(self, core: Core, rpc: str = DEFAULT_RPC, pub: str = DEFAULT_PUB, *,
                  hard_limit: int = FRAME_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
                  context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic,
-                 stop_at_ms: int | None = None):
+                 stop_at_ms: int | None = None, curve_secret: bytes | None = None):
         self.core = core
         self.stop_at_ms = stop_at_ms          # quit (steps answer -1) once simulated time reaches it
         self.clock = clock
@@ -85,6 +153,9 @@ class Transport:
         # make libzmq hold arbitrary prefixes (memory), and each is released when its peer goes
         self.xpub.setsockopt(zmq.XPUB_MANUAL, 1)
         self._discarding = False          # in the middle of an over-long message: drop its frames
+        self.curve = curve_secret is not None
+        for s in (self.router, self.xpub):
+            curve_server(s, curve_secret)
         try:
             self.router.bind(_bindable(rpc))
             self.xpub.bind(_bindable(pub))

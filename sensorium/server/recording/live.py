@@ -23,6 +23,7 @@ from urllib.parse import urlsplit
 import msgpack
 import zmq
 
+from sensorium.server.daemon.transport import curve_client_from_env
 from sensorium.server.recording.envelope import DEFAULT_CHUNK_SIZE, topic_matcher
 from sensorium.server.recording.writer import McapRecorder
 
@@ -84,6 +85,7 @@ def rpc_call(ctx: zmq.Context, url: str, service: str, args: dict | None = None,
     sock = ctx.socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)
     try:
+        curve_client_from_env(sock)
         sock.connect(url)
         sock.send(msgpack.packb({"id": 1, "service": service, "args": args or {}}))
         if not sock.poll(int(timeout * 1000)):
@@ -115,7 +117,12 @@ def reachable_pub(pub: str, rpc: str) -> str:
 
 class LiveRecorder:
     """Subscribe to a server's topics and record them. ``on_message(topic, seq)`` is called after
-    each message is stored (tests use it to play a slow reader)."""
+    each message is stored (tests use it to play a slow reader).
+
+    A server restart (a topic's ``seq`` or stamp goes back: a new server on the same endpoint)
+    starts a new file, ``NAME-2.mcap`` (then ``-3``...; never an existing file), so that each file
+    holds one run with one clock. The closed file gets a ``server_restart`` metadata record naming
+    the next file; the new one a ``session.previous_file``; ``sensorium info`` shows both."""
 
     def __init__(self, path: str | Path, *, connect: str | None = "tcp://127.0.0.1:5560",
                  pub: str | None = None, topics: list[str] | None = None, world: str | None = None,
@@ -139,6 +146,9 @@ class LiveRecorder:
         self.recorder: McapRecorder | None = None
         self.pub_endpoint = ""
         self._gap_lines = 0
+        self.files: list[Path] = [self.path]      # one per server run
+        self._last_stamp: dict[str, int] = {}
+        self._rec_args: tuple = ()
 
     def stop(self) -> None:
         self._stop = True
@@ -166,6 +176,17 @@ class LiveRecorder:
                 world_model, base_dir = load_world(self.world).world, Path(self.world).resolve().parent
             except (WorldError, OSError, ValueError):
                 pass
+        self._rec_args = (world_text, world_name or "world.yaml", world_model, base_dir)
+        self.sub = self.ctx.socket(zmq.SUB)
+        self.sub.setsockopt(zmq.RCVHWM, self.rcvhwm)
+        self.sub.setsockopt(zmq.LINGER, 0)
+        for prefix in subscription_prefixes(self.topics):
+            self.sub.setsockopt(zmq.SUBSCRIBE, prefix)
+        curve_client_from_env(self.sub)
+        self.sub.connect(self.pub_endpoint)
+        self.recorder = self._new_recorder(self.path)
+
+    def _metadata(self) -> dict[str, str]:
         meta = {}
         rec_meta = self.info.get("recording", {}).get("metadata", {}) if isinstance(self.info.get("recording"), dict) else {}
         meta.update({k: str(v) for k, v in rec_meta.items() if k in ("seed", "world", "basic_time_step_ms")})
@@ -178,16 +199,47 @@ class LiveRecorder:
                 meta["seed"] = str(self.info[key])
         if self.info.get("version"):
             meta["server_version"] = str(self.info["version"])
-        self.sub = self.ctx.socket(zmq.SUB)
-        self.sub.setsockopt(zmq.RCVHWM, self.rcvhwm)
-        self.sub.setsockopt(zmq.LINGER, 0)
-        for prefix in subscription_prefixes(self.topics):
-            self.sub.setsockopt(zmq.SUBSCRIBE, prefix)
-        self.sub.connect(self.pub_endpoint)
-        self.recorder = McapRecorder(self.path, world_text, world_name or "world.yaml", meta, self.topics,
-                                     self.chunk_size, world=world_model, base_dir=base_dir,
-                                     session={"mode": "subscriber", "pub_endpoint": self.pub_endpoint,
-                                              "connect": self.connect or ""})
+        return meta
+
+    def _new_recorder(self, path: Path, previous: str | None = None) -> McapRecorder:
+        world_text, world_name, world_model, base_dir = self._rec_args
+        session = {"mode": "subscriber", "pub_endpoint": self.pub_endpoint, "connect": self.connect or ""}
+        if previous:
+            session["previous_file"] = previous
+        return McapRecorder(path, world_text, world_name, self._metadata(), self.topics, self.chunk_size,
+                            world=world_model, base_dir=base_dir, session=session)
+
+    def _next_path(self) -> Path:
+        n = len(self.files) + 1
+        while True:
+            p = self.path.with_name(f"{self.path.stem}-{n}{self.path.suffix}")
+            if not p.exists():
+                return p
+            n += 1
+
+    def _restarted(self, topic: str, seq: int, stamp_ns: int) -> bool:
+        last_stamp, last_seq = self._last_stamp.get(topic), self.gaps.last.get(topic)
+        return (last_stamp is not None and stamp_ns < last_stamp) or (last_seq is not None and seq < last_seq)
+
+    def _rotate(self, topic: str, stamp_ns: int) -> None:
+        """A new server run: finish this file, continue in the next one."""
+        assert self.recorder is not None
+        last = self._last_stamp.get(topic, 0)
+        nxt = self._next_path()
+        self.recorder.add_metadata("server_restart", {
+            "next_file": nxt.name, "topic": topic, "last_stamp_ns": str(last), "stamp_ns": str(stamp_ns)})
+        self.recorder.close()
+        self.gaps.last.clear()
+        self._last_stamp.clear()
+        if self.connect:
+            try:
+                self.info = rpc_call(self.ctx, rpc_endpoint(self.connect), "get_info", timeout=2.0)
+            except Exception:  # noqa: BLE001 - the new run's metadata is a nicety; keep recording
+                pass
+        self.recorder = self._new_recorder(nxt, previous=self.files[-1].name)
+        self.files.append(nxt)
+        self.log(f"sensorium: the server restarted ({topic} went back from {last / 1e9:.3f} s to "
+                 f"{stamp_ns / 1e9:.3f} s): continuing in {nxt}")
 
     def run(self, duration: float | None = None, max_messages: int | None = None) -> None:
         assert self.sub is not None and self.recorder is not None
@@ -215,7 +267,12 @@ class LiveRecorder:
                     ros_type, seq, stamp_ns = str(env["type"]), int(env["seq"]), int(env["stamp_ns"])
                 except Exception:
                     continue
+                if self._restarted(topic, seq, stamp_ns):
+                    self._rotate(topic, stamp_ns)
+                self._last_stamp[topic] = stamp_ns
                 self.recorder.record(topic, ros_type, frames[1], frames[2], stamp_ns, seq)
+                if self.recorder.failed:                 # disk full: said once by the recorder; stop
+                    return
                 lost = self.gaps.see(topic, seq)
                 if lost:
                     self._gap_lines += 1
@@ -247,4 +304,4 @@ class LiveRecorder:
         g = self.gaps
         return {"file": str(self.path), "received": g.total_received, "topics": len(g.received),
                 "gaps": g.gaps, "lost": g.total_lost, "lost_by_topic": dict(sorted(g.lost.items())),
-                "resets": g.resets}
+                "resets": g.resets, "files": [str(p) for p in self.files], "restarts": len(self.files) - 1}

@@ -401,7 +401,8 @@ class Recording:
         }
         if self.truncated:
             out["note"] = ("the file was not finished (writer killed?); read up to its last complete chunk"
-                           + (f" ({stopped or self.error})" if (stopped or self.error) else ""))
+                           + (f" ({stopped or self.error})" if (stopped or self.error) else "")
+                           + f"; `sensorium recover {self.path.name}` rewrites it as a complete, indexed file")
         return out
 
 

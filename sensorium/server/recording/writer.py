@@ -27,8 +27,10 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
+import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any, cast
 
@@ -110,8 +112,12 @@ class McapRecorder:
                  compression: str = "zstd", flush_interval: float | None = 1.0,
                  session: dict[str, str] | None = None, demand: bool = True,
                  background_flush: bool = True, foxglove: bool = True, world: Any = None,
-                 base_dir: str | os.PathLike = "."):
+                 base_dir: str | os.PathLike = ".", on_error: Callable[[str], None] | None = None):
         self.path = Path(path)
+        # a write error (disk full, file size limit) stops the recording, never the caller: one line
+        # through on_error, ``failed`` says why, record() and close() return quietly from then on
+        self.failed: str | None = None
+        self._on_error = on_error or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
         # Foxglove views (format 2) when asked for and the extra is installed
         self.foxglove_unavailable = fxv.available() if foxglove else "not requested"
         self._views = fxv.FoxgloveViews(world, Path(base_dir)) if self.foxglove_unavailable is None else None
@@ -201,29 +207,51 @@ class McapRecorder:
         with self._lock:
             if self._closed:
                 return
-            cid = self._channels.get(topic)
-            if cid is None:
-                cid = self._register(topic, ros_type, envelope, body)
-            stamp = int(stamp_ns)
-            if stamp < 0:
-                raise ValueError(f"{topic}: negative stamp_ns {stamp}")
-            if self._views is None:
-                self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
-                                         data=bytes(body), sequence=int(seq) % SEQ_MODULUS)
-            else:
-                self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
-                                         data=fxv.wire_wrap(bytes(body)), sequence=int(seq) % SEQ_MODULUS)
-                for view in self._views.views(topic, ros_type, bytes(body), stamp):
-                    self._add_view(view, stamp, int(seq) if view[0] == topic else None)
-            self.counts[topic] = self.counts.get(topic, 0) + 1
-            self.message_count += 1
-            self._dirty = True
-            if self._flush_interval is not None:
-                now = time.monotonic()
-                if now - self._last_flush >= self._flush_interval:
-                    self._flush_locked(now)
+            try:
+                self._record_locked(topic, ros_type, envelope, body, stamp_ns, seq)
+            except OSError as exc:
+                self._fail(exc)
 
     __call__ = record
+
+    def _fail(self, exc: OSError) -> None:
+        """Stop recording after a write error (caller holds the lock): say so once, keep the file
+        as it is (readable up to its last complete chunk)."""
+        if self.failed is not None:
+            return
+        self.failed = exc.strerror or str(exc)
+        self._closed = True
+        try:
+            self._stream.close()
+        except OSError:
+            pass
+        self._on_error(f"recording to {self.path} stopped after {self.message_count} messages: {self.failed}; "
+                       f"live topics are still published; the file is readable up to its last complete chunk "
+                       f"(`sensorium recover {self.path}` rewrites it as a complete file)")
+
+    def _record_locked(self, topic: str, ros_type: str, envelope: bytes, body: bytes, stamp_ns: int,
+                       seq: int) -> None:
+        cid = self._channels.get(topic)
+        if cid is None:
+            cid = self._register(topic, ros_type, envelope, body)
+        stamp = int(stamp_ns)
+        if stamp < 0:
+            raise ValueError(f"{topic}: negative stamp_ns {stamp}")
+        if self._views is None:
+            self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
+                                     data=bytes(body), sequence=int(seq) % SEQ_MODULUS)
+        else:
+            self._writer.add_message(channel_id=cid, log_time=stamp, publish_time=stamp,
+                                     data=fxv.wire_wrap(bytes(body)), sequence=int(seq) % SEQ_MODULUS)
+            for view in self._views.views(topic, ros_type, bytes(body), stamp):
+                self._add_view(view, stamp, int(seq) if view[0] == topic else None)
+        self.counts[topic] = self.counts.get(topic, 0) + 1
+        self.message_count += 1
+        self._dirty = True
+        if self._flush_interval is not None:
+            now = time.monotonic()
+            if now - self._last_flush >= self._flush_interval:
+                self._flush_locked(now)
 
     def _add_view(self, view: tuple[str, str, str, bytes, str, bytes], stamp: int, seq: int | None = None) -> None:
         """One Foxglove view record (caller holds the lock or is the constructor)."""
@@ -279,7 +307,10 @@ class McapRecorder:
 
     # -- life cycle ---------------------------------------------------------------------------
     def _flush_locked(self, now: float) -> None:
-        self._writer.flush()
+        try:
+            self._writer.flush()
+        except OSError as exc:
+            self._fail(exc)
         self._last_flush = now
         self._dirty = False
 
@@ -302,7 +333,10 @@ class McapRecorder:
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
         with self._lock:
             if not self._closed:
-                self._writer.add_metadata(name, {str(k): str(v) for k, v in data.items()})
+                try:
+                    self._writer.add_metadata(name, {str(k): str(v) for k, v in data.items()})
+                except OSError as exc:
+                    self._fail(exc)
 
     def close(self) -> None:
         """Finish the file (summary, indexes, footer). Idempotent."""
@@ -321,6 +355,8 @@ class McapRecorder:
                     self._writer.add_metadata("foxglove_view_errors", dict(self._views.errors))
                 self._writer.finish()
                 self._stream.fsync()
+            except OSError as exc:
+                self._fail(exc)
             finally:
                 self._stream.close()
 

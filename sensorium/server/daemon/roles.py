@@ -1,0 +1,76 @@
+"""Who may do what (sans-IO): world-wide controls and the poses a request may set.
+
+* **Controllers** control their own robot: the robot and device services check that the caller is
+  the robot's attached controller (:meth:`sensorium.server.daemon.services.Core.handle`).
+* **World-wide controls** (:data:`WORLD_CONTROLS`: ``set_mode``, which pauses or speeds up the world
+  for everyone) need the *supervisor role*: the caller is the attached controller of a robot with
+  ``supervisor: true``, or the server runs with open controls. ``serve --controls`` chooses:
+  ``open`` (any caller), ``supervisor`` (supervisor role only) or ``auto`` (the default): open
+  when the RPC endpoint is only reachable from this machine (loopback tcp, ipc, inproc),
+  supervisor otherwise — so ``sensorium call set_mode`` keeps working on a workstation and a
+  server bound to a network interface is not paused by any client that can connect.
+* **Poses**: every pose a request sets (``set_pose``, Supervisor ``set_field``) is checked by
+  :func:`check_pose` — finite numbers, every coordinate within ``±MAX_COORDINATE_M``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from ipaddress import ip_address
+from typing import Any
+
+__all__ = ["WORLD_CONTROLS", "MAX_COORDINATE_M", "CONTROLS", "open_controls", "is_local_endpoint", "check_pose",
+           "has_supervisor_role", "denied"]
+
+WORLD_CONTROLS = frozenset({"set_mode"})      # server services that change the world for everyone
+MAX_COORDINATE_M = 1e5                        # |x|, |y|, |z| of a pose set by a request (100 km)
+CONTROLS = ("auto", "open", "supervisor")
+
+
+def is_local_endpoint(url: str) -> bool:
+    """True for endpoints only this machine can reach: ``ipc://``, ``inproc://``, tcp on a loopback
+    address (``127.0.0.0/8``, ``::1``, ``localhost``)."""
+    if url.startswith(("ipc://", "inproc://")):
+        return True
+    if not url.startswith("tcp://"):
+        return False
+    host = url[len("tcp://"):].rsplit(":", 1)[0].strip("[]")
+    if host == "localhost":
+        return True
+    try:
+        return ip_address(host).is_loopback
+    except ValueError:
+        return False                                # '*', an interface or host name: reachable from outside
+
+
+def open_controls(controls: str, rpc_endpoint: str) -> bool:
+    """``serve --controls`` → may any caller use the world-wide controls?"""
+    if controls not in CONTROLS:
+        raise ValueError(f"--controls must be one of {', '.join(CONTROLS)}, got {controls!r}")
+    if controls == "auto":
+        return is_local_endpoint(rpc_endpoint)
+    return controls == "open"
+
+
+def has_supervisor_role(sim: Any, lockstep: Any, peer: bytes) -> bool:
+    """Is ``peer`` the attached controller of a robot with ``supervisor: true``?"""
+    return any(s.peer == peer and getattr(sim.robots[s.robot], "supervisor", False) for s in lockstep.sessions)
+
+
+def denied(service: str) -> str:
+    return (f"{service} changes the world for everyone: attach a robot with 'supervisor: true' first, "
+            f"or run the server with --controls open")
+
+
+def check_pose(translation: Iterable[float] | None = None, rotation: Iterable[float] | None = None,
+               quaternion: Iterable[float] | None = None) -> None:
+    """Raise ValueError unless every value is finite and the translation lies within the world bounds."""
+    for name, values in (("translation", translation), ("rotation", rotation), ("quaternion", quaternion)):
+        if values is None:
+            continue
+        vals = [float(v) for v in values]
+        if not all(math.isfinite(v) for v in vals):
+            raise ValueError(f"{name} values must be finite, got {vals}")
+        if name == "translation" and any(abs(v) > MAX_COORDINATE_M for v in vals):
+            raise ValueError(f"translation {vals} is outside the world bounds (|coordinate| <= {MAX_COORDINATE_M:g} m)")

@@ -1,0 +1,96 @@
+"""Who may do what: world-wide controls need the supervisor role unless the server opens them,
+and every pose a request sets is finite and within the world bounds (issue 16)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from test_supervisor import Live
+
+from sensorium.schemas.wire import ErrorCode
+from sensorium.server.daemon.roles import MAX_COORDINATE_M, is_local_endpoint, open_controls
+from sensorium.server.daemon.serve import ServeOptions, build
+from sensorium.server.daemon.services import Core
+
+A, B, C = b"A", b"B", b"C"
+
+
+def closed() -> Live:
+    lv = Live()
+    lv.core = Core(lv.sim, log=lambda line: None, open_controls=False)
+    lv.ok(A, "attach", {"robot": "pioneer"})        # supervisor: true in the world
+    lv.ok(B, "attach", {"robot": "rover"})          # a plain robot
+    return lv
+
+
+def test_set_mode_needs_the_supervisor_role_when_controls_are_closed():
+    lv = closed()
+    for peer in (B, C):                             # a plain robot's controller, an unattached caller
+        msg = lv.err(peer, "set_mode", {"mode": "pause"}, ErrorCode.NOT_SUPERVISOR)
+        assert "supervisor: true" in msg and "--controls open" in msg
+    assert lv.ok(C, "get_info")["mode"] == "fast"   # nothing changed
+    assert lv.ok(A, "set_mode", {"mode": "pause"}) == {"mode": "pause"}
+    assert lv.ok(C, "get_info")["mode"] == "pause"
+    lv.ok(A, "detach", {"session": lv.core.lockstep.session_for("pioneer").token})
+    lv.err(A, "set_mode", {"mode": "fast"}, ErrorCode.NOT_SUPERVISOR)   # the role goes with the session
+
+
+def test_open_controls_let_any_caller_set_the_mode():
+    lv = Live()                                     # Core's default: open
+    assert lv.ok(C, "set_mode", {"mode": "pause"}) == {"mode": "pause"}
+
+
+@pytest.mark.parametrize("url,local", [
+    ("tcp://127.0.0.1:5560", True), ("tcp://127.0.0.2:0", True), ("tcp://[::1]:5560", True),
+    ("tcp://localhost:5560", True), ("ipc:///tmp/s.sock", True), ("inproc://x", True),
+    ("tcp://0.0.0.0:5560", False), ("tcp://*:5560", False), ("tcp://192.168.1.5:5560", False),
+    ("tcp://eth0:5560", False), ("tcp://[::]:5560", False),
+])
+def test_auto_controls_are_open_only_on_local_endpoints(url, local):
+    assert is_local_endpoint(url) is local
+    assert open_controls("auto", url) is local
+    assert open_controls("open", url) is True
+    assert open_controls("supervisor", url) is False
+
+
+def test_serve_options_choose_the_controls():
+    with pytest.raises(ValueError, match="--controls"):
+        ServeOptions(controls="everyone").check()
+    for controls, want in (("auto", True), ("supervisor", False), ("open", True)):
+        core, transport = build(None, ServeOptions(rpc="tcp://127.0.0.1:0", pub="tcp://127.0.0.1:0", controls=controls))
+        try:
+            assert core.open_controls is want
+        finally:
+            transport.close()
+
+
+@pytest.mark.parametrize("args", [
+    {"translation": [1e300, 0.0, 0.0]},
+    {"translation": [0.0, -(MAX_COORDINATE_M * 1.01), 0.0]},
+    {"translation": [math.nan, 0.0, 0.0]},
+    {"translation": [0.0, 0.0, math.inf]},
+    {"rotation": [0.0, 0.0, 1.0, math.nan]},
+    {"quaternion": [0.0, 0.0, math.inf, 1.0]},
+])
+def test_set_pose_rejects_non_finite_and_far_poses(args):
+    lv = closed()
+    before = lv.ok(B, "/rover/robot/get_pose")
+    msg = lv.err(B, "/rover/robot/set_pose", args, ErrorCode.INVALID_ARGUMENT)
+    assert "set_pose" in msg
+    assert lv.ok(B, "/rover/robot/get_pose") == before
+
+
+def test_set_pose_accepts_the_bounds():
+    lv = closed()
+    lv.ok(B, "/rover/robot/set_pose", {"translation": [MAX_COORDINATE_M, -MAX_COORDINATE_M, 0.1]})
+    assert lv.ok(B, "/rover/robot/get_pose")["translation"] == [MAX_COORDINATE_M, -MAX_COORDINATE_M, 0.1]
+
+
+@pytest.mark.parametrize("value", [[1e300, 0.0, 0.0], [0.0, 2e5, 0.0], [math.nan, 0.0, 0.0]])
+def test_supervisor_set_field_rejects_far_or_non_finite_translations(value):
+    lv = closed()
+    before = lv.ok(A, "/pioneer/robot/get_field", {"node": 2, "field": "translation"})
+    lv.err(A, "/pioneer/robot/set_field", {"node": 2, "field": "translation", "value": value},
+           ErrorCode.INVALID_ARGUMENT)
+    assert lv.ok(A, "/pioneer/robot/get_field", {"node": 2, "field": "translation"}) == before
