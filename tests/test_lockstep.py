@@ -243,3 +243,34 @@ def test_deterministic_answer_order():
     for s in (c, b, a):
         ls.request_step(s, s.robot, None, 0.0)
     assert run(ls) == [(32, "a", 0), (32, "b", 0), (32, "c", 0)]
+
+
+def test_a_robot_whose_controllers_vanish_before_stepping_rests():
+    """A client that attaches a free robot and disconnects, again and again, held the world for
+    3 heartbeats each time. From the second such vanishing the robot rests 1, 2, 4 … s (at most
+    60) before it can be attached again, so the world mostly steps; a controller that steps clears it."""
+    from sensorium.server.daemon.lockstep import Lockstep, LockstepError
+
+    ls = Lockstep({"a": True, "b": True}, basic_time_step=32, heartbeat_ms=1000)
+    stepper = ls.attach("b", peer=b"B", now=0.0)
+    blocked = 0.0
+    t = 0.0
+    while t < 120.0:                            # the attacker tries every 0.5 s; b steps and pings
+        ls.ping(stepper.token, t)
+        try:
+            ls.attach("a", peer=b"X%d" % int(t * 2), now=t)
+        except LockstepError as exc:
+            assert exc.code in (ErrorCode.ROBOT_TAKEN,)
+        ls.expire(t)
+        if ls.session_for("a") is not None:
+            blocked += 0.5                      # a attached and silent: the world waits for it
+        t += 0.5
+    assert blocked / 120.0 < 0.3, blocked       # without the rest: ~0.86 (waiting 3 s of every 3.5)
+    vanished, until = ls._rest["a"]
+    assert vanished >= 5 and until - 120.0 <= 60.0
+    with pytest.raises(LockstepError) as e:
+        ls.attach("a", peer=b"late", now=until - 0.1)
+    assert "went silent before their first step" in e.value.message
+    s = ls.attach("a", peer=b"good", now=until)          # after the rest: a real controller
+    ls.request_step(s, "r", None, now=until)
+    assert "a" not in ls._rest                            # it stepped: the rest is forgotten

@@ -32,6 +32,7 @@ __all__ = ["Lockstep", "LockstepError", "Session", "PendingStep", "StepDone", "M
 
 MODES = ("fast", "realtime", "pause")
 STATUS_QUIT = -1
+REST_MAX_S = 60.0      # longest rest of a robot whose controllers keep vanishing before their first step
 RTF_WINDOW_S = 1.0
 
 
@@ -64,6 +65,7 @@ class Session:
     last_reply_ms: int | None = None     # simulated time of the previous step reply (async dt)
     alive: bool = True
     last_step: tuple[Any, bytes] | None = None   # (request id, reply body) of the last answered step
+    stepped: bool = False                # asked for a step at least once
 
 
 @dataclass(frozen=True, slots=True)
@@ -105,6 +107,8 @@ class Lockstep:
         self._new_token = new_token or (lambda: secrets.token_hex(8))
         self._by_robot: dict[str, Session] = {}
         self._by_token: dict[str, Session] = {}
+        # robot -> (controllers that attached and vanished before stepping, no attach before this time)
+        self._rest: dict[str, tuple[int, float]] = {}
         self._rt_next: float | None = None          # realtime: earliest wall time of the next step
         self._rtf: deque[tuple[float, int]] = deque()
 
@@ -137,10 +141,16 @@ class Lockstep:
             raise LockstepError(ErrorCode.WRONG_STATE, f"robot {robot!r} has controller \"<none>\" in the world file: "
                                                        "it takes no controller (set controller: \"<extern>\")")
         current = self._by_robot.get(robot)
-        if current is not None:
-            if now - current.last_heard <= self.liveness_s:
-                raise LockstepError(ErrorCode.ROBOT_TAKEN, f"robot {robot!r} already has a live controller attached")
-            self._remove(current)                 # dead but not yet collected: replace it
+        if current is not None and now - current.last_heard > self.liveness_s:
+            self._drop(current, now)              # dead but not yet collected
+        vanished, until = self._rest.get(robot, (0, 0.0))
+        if now < until:
+            raise LockstepError(ErrorCode.ROBOT_TAKEN,
+                                f"robot {robot!r} takes no controller for another {until - now:.1f} s: the last "
+                                f"{vanished} controller(s) that attached to it went silent before their first step "
+                                f"(PROTOCOL.md, 'Sessions and liveness')")
+        if self._by_robot.get(robot) is not None:
+            raise LockstepError(ErrorCode.ROBOT_TAKEN, f"robot {robot!r} already has a live controller attached")
         token = self._new_token()
         while token in self._by_token:
             token = self._new_token()
@@ -173,8 +183,20 @@ class Lockstep:
         """Drop sessions not heard from for :attr:`liveness_s`; their pending steps are discarded."""
         dead = [s for s in self._by_robot.values() if now - s.last_heard > self.liveness_s]
         for s in dead:
-            self._remove(s)
+            self._drop(s, now)
         return dead
+
+    def _drop(self, s: Session, now: float) -> None:
+        """Remove a session that went silent."""
+        self._remove(s)
+        if not s.stepped:
+            # attached, then gone before stepping: the world waited liveness_s for nothing. A
+            # client doing this in a loop would hold every other robot; from the second time
+            # the robot rests 1, 2, 4 … 60 s before it may be attached again (a session that
+            # steps clears it)
+            vanished = self._rest.get(s.robot, (0, 0.0))[0] + 1
+            rest = 0.0 if vanished == 1 else min(REST_MAX_S, 2.0 ** (vanished - 2))
+            self._rest[s.robot] = (vanished, now + rest)
 
     def _remove(self, s: Session) -> None:
         s.alive = False
@@ -205,6 +227,9 @@ class Lockstep:
             raise LockstepError(ErrorCode.WRONG_STATE, f"robot {session.robot!r} already has a step pending "
                                                        f"(wake at {session.pending.wake_ms} ms)")
         session.last_heard = now
+        if not session.stepped:
+            session.stepped = True
+            self._rest.pop(session.robot, None)
         step = PendingStep(reply_to, kind, d, self.time_ms, self.time_ms + d)
         if self.shutting_down:
             return StepDone(session, step, STATUS_QUIT, self.time_ms)
