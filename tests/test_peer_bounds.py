@@ -130,3 +130,16 @@ def test_a_repeated_error_is_logged_at_powers_of_ten() -> None:
     assert lines == ["internal error: boom\ntraceback lines", "internal error: boom (seen 10 times)",
                      "internal error: boom (seen 100 times)", "internal error: boom (seen 1000 times)",
                      "internal error: another"]
+
+
+def test_a_step_with_thousands_of_motor_commands_is_refused_cheaply(server) -> None:
+    core, transport = server
+    client = Dealer(transport.rpc_endpoint)
+    try:
+        assert client.call("attach", {"robot": "rover"})["ok"]
+        motors = {f"m{i}": {"velocity": 1.0} for i in range(20_000)}
+        r = client.call("/rover/robot/step", {"motors": motors})
+        assert r["error"]["code"] == ErrorCode.INVALID_ARGUMENT and "at most 256" in r["error"]["message"]
+        assert core.sim.time_ms == 0                       # refused before any step
+    finally:
+        client.close()

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from types import UnionType
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from sensorium.schemas.messages import Image, PointCloud
 from sensorium.schemas.wire import PROTOCOL_VERSION, ErrorCode
@@ -23,6 +23,7 @@ from sensorium.schemas.wire import PROTOCOL_VERSION, ErrorCode
 __all__ = ["ErrorCode", "PROTOCOL_VERSION", "SERVICES", "ServiceSpec", "service_names"]
 
 MAX_PERIOD_MS = (1 << 31) - 1
+MAX_MOTOR_COMMANDS = 256        # per step request (a robot has a handful of motors)
 Mode = Literal["fast", "realtime", "pause"]
 DeviceType = Literal["LightSensor", "DistanceSensor", "Lidar", "RotationalMotor", "PositionSensor", "LED"]
 FieldName = Literal["translation", "rotation"]
@@ -123,7 +124,17 @@ class StepArgs(Args):
                                              "up to one (Webots). 0: apply the motor commands and answer at once with "
                                              "the values not yet delivered, without advancing time (Webots' step(0))")
     motors: dict[str, MotorCommand] | None = Field(
-        default=None, description="motor name -> commands, applied when the request arrives (before the world advances)")
+        default=None, description="motor name -> commands, applied when the request arrives (before the world advances); "
+                                  f"at most {MAX_MOTOR_COMMANDS}")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _few_motor_commands(cls, data: Any) -> Any:
+        # counted before each command is validated: a step carrying thousands costs nothing
+        motors = data.get("motors") if isinstance(data, dict) else None
+        if isinstance(motors, dict) and len(motors) > MAX_MOTOR_COMMANDS:
+            raise ValueError(f"motors: {len(motors)} commands, at most {MAX_MOTOR_COMMANDS} per step")
+        return data
 
 
 class TimeStepArgs(Args):
