@@ -605,3 +605,23 @@ def test_unknown_robot_and_launcher_errors(cbin, servers, tmp_path):
     done = subprocess.run([sys.executable, "-m", "sensorium", "controller", "--url", "ftp://x", cbin["script"]],
                           capture_output=True, text=True, env=ENV, cwd=str(REPO), timeout=60)
     assert done.returncode == 2 and "unsupported scheme" in done.stderr
+
+
+def test_a_curve_server_serves_a_c_controller_that_has_its_key(cbin, servers, tmp_path):
+    """CURVE from the C library: SENSORIUM_CURVE_SERVERKEY (hex or Z85) as for the Python client;
+    without it the server does not answer; a malformed key is one clear line."""
+    keys = tmp_path / "keys"
+    made = subprocess.run([sys.executable, "-m", "sensorium", "keys", str(keys)], capture_output=True, text=True,
+                          env=ENV, cwd=str(REPO), timeout=60)
+    assert made.returncode == 0, made.stderr
+    key = (made.stdout + made.stderr).split("SENSORIUM_CURVE_SERVERKEY=")[1].split()[0]
+    server = servers(ARENA, "--curve-keys", str(keys))
+    code, lines, err = finish(start([cbin["script"], "step", "32", "2"], server.url("epuck"),
+                                    SENSORIUM_CURVE_SERVERKEY=key))
+    assert code == 0 and [fields(x)["t"] for x in lines] == ["32", "64"], err
+    code, lines, err = finish(start([cbin["script"], "step", "32", "1"], server.url("epuck"),
+                                    SENSORIUM_CONTROLLER_TIMEOUT="2"))
+    assert code == 1 and lines == [] and "TIMEOUT" in err, err
+    code, lines, err = finish(start([cbin["script"], "step", "32", "1"], server.url("epuck"),
+                                    SENSORIUM_CURVE_SERVERKEY="not-a-key"))
+    assert code == 1 and len(err.strip().splitlines()) == 1 and "CURVE key" in err, err

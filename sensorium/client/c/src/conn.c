@@ -298,6 +298,50 @@ struct sn_conn {
 
 #define RETRY_MS 1000
 
+/* CURVE (PROTOCOL.md, README "Security and limits"): with SENSORIUM_CURVE_SERVERKEY set (the
+   server's public key, 64 hex or 40 Z85 characters) the socket encrypts and authenticates the
+   server, with a fresh key pair of its own. Returns 0, or -1 with a message for a malformed key. */
+static int curve_client(void *sock, char *err, size_t errlen) {
+  const char *text = getenv("SENSORIUM_CURVE_SERVERKEY");
+  if (text == NULL || *text == '\0')
+    return 0;
+  char z85[41];
+  size_t n = strlen(text);
+  if (n == 64) {
+    uint8_t raw[32];
+    for (size_t i = 0; i < 32; i++) {
+      unsigned v;
+      if (!isxdigit((unsigned char)text[2 * i]) || !isxdigit((unsigned char)text[2 * i + 1]) ||
+          sscanf(text + 2 * i, "%2x", &v) != 1)
+        goto bad;
+      raw[i] = (uint8_t)v;
+    }
+    if (zmq_z85_encode(z85, raw, sizeof raw) == NULL)
+      goto bad;
+  } else if (n == 40) {
+    uint8_t raw[32];
+    memcpy(z85, text, 41);
+    if (zmq_z85_decode(raw, z85) == NULL)
+      goto bad;
+  } else {
+    goto bad;
+  }
+  char pub[41], sec[41];
+  if (zmq_curve_keypair(pub, sec) != 0) {
+    snprintf(err, errlen, "SENSORIUM_CURVE_SERVERKEY is set but this libzmq has no CURVE: %s", zmq_strerror(zmq_errno()));
+    return -1;
+  }
+  if (zmq_setsockopt(sock, ZMQ_CURVE_SERVERKEY, z85, 40) != 0 || zmq_setsockopt(sock, ZMQ_CURVE_PUBLICKEY, pub, 40) != 0 ||
+      zmq_setsockopt(sock, ZMQ_CURVE_SECRETKEY, sec, 40) != 0) {
+    snprintf(err, errlen, "cannot set the CURVE keys: %s", zmq_strerror(zmq_errno()));
+    return -1;
+  }
+  return 0;
+bad:
+  snprintf(err, errlen, "SENSORIUM_CURVE_SERVERKEY: a CURVE key is 40 Z85 or 64 hex characters (got %zu characters)", n);
+  return -1;
+}
+
 sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen) {
   sn_conn *c = calloc(1, sizeof *c);
   if (c == NULL)
@@ -331,6 +375,10 @@ sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen) {
   if (urandom != NULL)
     fclose(urandom);
   zmq_setsockopt(c->sock, ZMQ_ROUTING_ID, rid, sizeof rid);
+  if (curve_client(c->sock, err, errlen) != 0) {
+    sn_conn_close(c);
+    return NULL;
+  }
   if (zmq_connect(c->sock, endpoint) != 0) {
     snprintf(err, errlen, "cannot connect to %s: %s", endpoint, zmq_strerror(zmq_errno()));
     sn_conn_close(c);
@@ -577,7 +625,8 @@ static void *heartbeat_main(void *arg) {
     return NULL;
   int zero = 0;
   zmq_setsockopt(sock, ZMQ_LINGER, &zero, sizeof zero);
-  if (zmq_connect(sock, c->endpoint) != 0) {
+  char curve_err[160];
+  if (curve_client(sock, curve_err, sizeof curve_err) != 0 || zmq_connect(sock, c->endpoint) != 0) {
     zmq_close(sock);
     return NULL;
   }
