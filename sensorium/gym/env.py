@@ -28,7 +28,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from sensorium.gym.render import TopDown
+from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
 from sensorium.schemas import world as wm
 from sensorium.server.sim.sensors import Lidar
@@ -174,7 +174,7 @@ def rebuild(loaded: LoadedWorld, world_seed: int, precision: str) -> Simulation:
                       precision=precision)
 
 
-class SensoriumEnv(gym.Env):
+class SensoriumEnv(TopDownRendering, gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
     def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None, task: Task | None = None,
@@ -219,16 +219,3 @@ class SensoriumEnv(gym.Env):
         obs = self.agent.observe(self.sim)
         reward, terminated, truncated = self.agent.outcome(self.sim, obs, self.steps)
         return obs, reward, terminated, truncated, self.agent.info(self.sim, self.steps)
-
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
-        if self.sim is None:
-            raise RuntimeError("call reset() before render()")
-        if self._renderer is None:
-            self._renderer = TopDown(self.sim, self.render_size)
-        return self._renderer.render()
-
-    def close(self) -> None:
-        self.sim = None
-        self._renderer = None

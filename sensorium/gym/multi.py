@@ -21,7 +21,7 @@ from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
 from sensorium.gym.env import Agent, load, rebuild
-from sensorium.gym.render import TopDown
+from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
 from sensorium.schemas import world as wm
 from sensorium.server.world.loader import LoadedWorld
@@ -29,7 +29,7 @@ from sensorium.server.world.loader import LoadedWorld
 __all__ = ["SensoriumParallelEnv"]
 
 
-class SensoriumParallelEnv(ParallelEnv):
+class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
     metadata = {"render_modes": ["rgb_array"], "name": "sensorium_parallel_v0", "render_fps": 30}
 
     def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None,
@@ -104,16 +104,3 @@ class SensoriumParallelEnv(ParallelEnv):
                 self._agents[a].act(self.sim, np.zeros(2))      # a finished robot stops where it is
                 self.agents.remove(a)
         return obs, rewards, terms, truncs, infos
-
-    def render(self):
-        if self.render_mode != "rgb_array":
-            return None
-        if self.sim is None:
-            raise RuntimeError("call reset() before render()")
-        if self._renderer is None:
-            self._renderer = TopDown(self.sim, self.render_size)
-        return self._renderer.render()
-
-    def close(self) -> None:
-        self.sim = None
-        self._renderer = None

@@ -9,6 +9,7 @@ dots. The view covers the bounding box of everything drawn plus a margin; image 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -154,3 +155,27 @@ class TopDown:
             norm = math.hypot(*fwd) or 1.0
             self._line(img, pose.translation[:2], pose.translation[:2] + fwd / norm * reach * 1.4, (255, 255, 255))
         return img
+
+
+class TopDownRendering:
+    """``render()`` (``render_mode="rgb_array"``: a top-down RGB image) and ``close()`` for the
+    single- and multi-robot environments, which both hold ``sim``, ``render_mode``,
+    ``render_size`` and ``_renderer``."""
+
+    sim: Any
+    render_mode: str | None
+    render_size: int
+    _renderer: TopDown | None
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        if self.sim is None:
+            raise RuntimeError("call reset() before render()")
+        if self._renderer is None:
+            self._renderer = TopDown(self.sim, self.render_size)
+        return self._renderer.render()
+
+    def close(self) -> None:
+        self.sim = None
+        self._renderer = None
