@@ -248,7 +248,7 @@ def test_bad_requests_get_typed_errors_while_a_client_steps(client, ctx, server)
     # a REQ client gets its envelope back
     req = client(zmq.REQ)
     assert req.ok("get_info")["world"] == "server-test"
-    # above the hard cap (16 MiB) libzmq drops that connection; the server goes on
+    # above the hard cap (2 MiB per frame) libzmq drops that connection; the server goes on
     huge = ctx.socket(zmq.DEALER)
     huge.setsockopt(zmq.LINGER, 0)
     huge.connect(server.rpc)

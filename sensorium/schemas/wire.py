@@ -30,8 +30,9 @@ PROTOCOL_VERSION = 1
 SOFT_LIMIT = 1 << 20
 """Requests larger than this (bytes, all frames) are answered with ``TOO_LARGE`` (PROTOCOL §3.1)."""
 
-HARD_LIMIT = 16 << 20
-"""ZMQ_MAXMSGSIZE on the server's ROUTER: libzmq drops the connection of a peer sending more."""
+HARD_LIMIT = 2 << 20
+"""ZMQ_MAXMSGSIZE on the server's ROUTER, per frame: libzmq drops the connection of a peer sending
+a larger frame (the number of frames is bounded by the transport, PROTOCOL §3.1)."""
 
 
 class ErrorCode(IntEnum):

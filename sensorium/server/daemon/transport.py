@@ -28,7 +28,7 @@ import zmq
 import zmq.auth
 import zmq.utils.z85
 
-from sensorium.schemas.wire import ErrorCode, error_reply
+from sensorium.schemas.wire import HARD_LIMIT, ErrorCode, error_reply
 from sensorium.server.daemon.services import Core
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
@@ -43,7 +43,6 @@ EXPIRE_EVERY_S = 0.01           # session expiry scan at most this often while m
 ZERO_COPY_MIN = 64 * 1024       # replies at least this large are sent zero-copy
 REQUESTS_PER_TURN = 64          # requests served before the world may step again (fairness)
 MAX_FRAMES = 16                 # frames in one request message (identity, REQ envelope, body)
-FRAME_LIMIT = 2 * 1024 * 1024   # bytes per frame, libzmq-enforced (the core's soft limit is 1 MiB)
 DISCARD_PER_TURN = 4096         # frames of an oversized message dropped per loop turn
 SUB_LIMIT = 1024                # bytes of one subscription message (topic names are short)
 ROUTER_SNDHWM = 256             # replies queued for one peer that does not read them
@@ -124,7 +123,7 @@ class Transport:
     handler or another thread."""
 
     def __init__(self, core: Core, rpc: str = DEFAULT_RPC, pub: str = DEFAULT_PUB, *,
-                 hard_limit: int = FRAME_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
+                 hard_limit: int = HARD_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
                  context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic,
                  stop_at_ms: int | None = None, curve_secret: bytes | None = None):
         self.core = core
