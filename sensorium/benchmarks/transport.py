@@ -257,9 +257,11 @@ def server_cpu_per_step(k: int, steps: int) -> dict:
     ids = [f"peer{i}".encode() for i in range(k)]
     for i, ident in enumerate(ids):
         core.handle([ident, pack({"id": 1, "service": "attach", "args": {"robot": f"c{i}"}})], time.monotonic())
-    bodies = [pack({"id": 2, "service": f"/c{i}/robot/step", "args": {"duration": 8}}) for i in range(k)]
+    # A fresh request id per step: a repeated id is a resend, answered from the reply cache.
+    bodies_by_step = [[pack({"id": 2 + s, "service": f"/c{i}/robot/step", "args": {"duration": 8}})
+                       for i in range(k)] for s in range(steps)]
     t_handle = t_step = 0.0
-    for _ in range(steps):
+    for bodies in bodies_by_step:
         now = time.monotonic()
         t0 = time.perf_counter()
         for ident, body in zip(ids, bodies):
