@@ -293,6 +293,7 @@ class Connection:
         self._rcvtimeo: zmq.Socket | None = None     # the socket whose RCVTIMEO is _rcvtimeo_ms
         self._rcvtimeo_ms = -1
         self._ids = itertools.count(1)
+        self._packer = msgpack.Packer(use_bin_type=True)   # reused: one per connection (one thread)
         self._outstanding: dict[int, str] = {}      # id -> service, for messages
         self._replies: dict[int, dict] = {}
         self._retry: dict[int, tuple[bytes, float]] = {}   # step requests: id -> (bytes, last sent)
@@ -306,7 +307,7 @@ class Connection:
         if self.closed:
             raise SensoriumError(ErrorCode.WRONG_STATE, f"connection to {self.endpoint} is closed")
         rid = next(self._ids)
-        data = pack({"id": rid, "service": service, "args": args or {}})
+        data = self._packer.pack({"id": rid, "service": service, "args": args or {}})
         self._socket.send(data)
         self._outstanding[rid] = service
         if service.endswith(RETRIED_SERVICES):
@@ -317,23 +318,34 @@ class Connection:
         """The ``result`` of request ``rid``; raise :class:`SensoriumError` for an error reply,
         :class:`ServiceTimeout` after ``timeout`` seconds, :class:`ConnectionLost` if the
         heartbeat found the server gone or the session dropped."""
-        if timeout is _NO_TIMEOUT:
-            timeout = self.timeout
-        service = self._outstanding.get(rid, "?")
+        reply = self._replies.pop(rid, None)
+        if reply is None:
+            reply = self._receive(rid, self.timeout if timeout is _NO_TIMEOUT else timeout)
+        del self._outstanding[rid]
+        if self._retry:
+            self._retry.pop(rid, None)
+        if reply.get("ok") is True:
+            result = reply.get("result")
+            return result if isinstance(result, dict) else {}
+        raise _error_from(reply)
+
+    def _receive(self, rid: int, timeout: float | None) -> dict:
+        """Receive until the reply to ``rid`` arrives (others are kept for their :meth:`wait`)."""
+        if rid not in self._outstanding:
+            raise SensoriumError(ErrorCode.WRONG_STATE, f"request {rid} is not outstanding")
         deadline = None if timeout is None else time.monotonic() + timeout
-        replies = self._replies
-        while rid not in replies:
-            if rid not in self._outstanding:
-                raise SensoriumError(ErrorCode.WRONG_STATE, f"request {rid} is not outstanding")
+        while True:
             slice_ms = 250
             if deadline is not None:
                 left = deadline - time.monotonic()
                 if left <= 0:
-                    del self._outstanding[rid]
+                    service = self._outstanding.pop(rid, "?")
+                    self._retry.pop(rid, None)
                     raise ServiceTimeout(
                         f"no reply to {service!r} from {self.endpoint} within {timeout:g} s "
                         f"(is `sensorium serve` running there?)")
-                slice_ms = max(1, min(slice_ms, int(left * 1000) + 1))
+                if left < 0.25:
+                    slice_ms = max(1, int(left * 1000) + 1)
             # one blocking receive (RCVTIMEO = the slice) instead of poll + non-blocking drain
             sock = self._socket
             if self._rcvtimeo is not sock or self._rcvtimeo_ms != slice_ms:
@@ -346,17 +358,17 @@ class Connection:
                 if self.heartbeat is not None:
                     problem = self.heartbeat.problem()
                     if problem is not None:
-                        self._outstanding.pop(rid, None)
+                        service = self._outstanding.pop(rid, "?")
+                        self._retry.pop(rid, None)
                         raise ConnectionLost(f"while waiting for {service!r}: {problem}") from None
                 continue
-            self._accept(frames)
-        del self._outstanding[rid]
-        self._retry.pop(rid, None)
-        reply = self._replies.pop(rid)
-        if reply.get("ok") is True:
-            result = reply.get("result")
-            return result if isinstance(result, dict) else {}
-        raise _error_from(reply)
+            reply = self._decode(frames)
+            got = reply.get("id")
+            if got == rid:
+                return reply
+            if got in self._outstanding:
+                self._replies[got] = reply
+            # else: the reply to a request we gave up on (timeout, discard): drop it
 
     def call(self, service: str, args: dict | None = None, timeout: Any = _NO_TIMEOUT) -> dict:
         """``send`` then ``wait``."""
@@ -389,18 +401,24 @@ class Connection:
 
     def _accept(self, frames: list[bytes]) -> None:
         """One received reply: keep it if its request is outstanding, else drop it."""
+        reply = self._decode(frames)
+        rid = reply.get("id")
+        if rid in self._outstanding:
+            self._replies[rid] = reply
+        # else: the reply to a request we gave up on (timeout, discard): drop it
+
+    def _decode(self, frames: list[bytes]) -> dict:
+        """A reply's map; SensoriumError for an undecodable one, or for the server's id-less error
+        reply (it could not read one of our requests)."""
         try:
             reply = unpack(frames[-1])
         except Exception as exc:  # noqa: BLE001 - any decoding failure is a bad reply
             raise SensoriumError(ErrorCode.BAD_REPLY, f"undecodable reply from {self.endpoint}: {exc}") from None
-        if not isinstance(reply, dict):
+        if type(reply) is not dict:
             raise SensoriumError(ErrorCode.BAD_REPLY, f"reply is not a map: {reply!r}")
-        rid = reply.get("id")
-        if rid is None and reply.get("ok") is False:
-            raise _error_from(reply)          # the server could not read one of our requests
-        if rid in self._outstanding:
-            self._replies[rid] = reply
-        # else: the reply to a request we gave up on (timeout, discard): drop it
+        if reply.get("id") is None and reply.get("ok") is False:
+            raise _error_from(reply)
+        return reply
 
     @property
     def outstanding(self) -> int:

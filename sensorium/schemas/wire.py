@@ -13,6 +13,7 @@ be strings (or bytes), extension types are refused, and every failure is a :clas
 from __future__ import annotations
 
 import math
+import threading
 from enum import IntEnum
 from typing import Any, NamedTuple
 
@@ -69,9 +70,19 @@ class RequestError(Exception):
 
 # ---------------------------------------------------------------------- msgpack
 
+_PACKERS = threading.local()    # one reused msgpack.Packer per thread (packb makes a new one per call)
+PACKER_KEEP = 64 * 1024         # a packer that made a larger document is dropped, not its buffer kept
+
+
 def pack(obj: Any) -> bytes:
     """One msgpack document; ``str`` as str, ``bytes``/``memoryview`` as bin, floats as float64."""
-    return msgpack.packb(obj, use_bin_type=True)
+    packer = getattr(_PACKERS, "packer", None)
+    if packer is None:
+        packer = _PACKERS.packer = msgpack.Packer(use_bin_type=True)
+    data = packer.pack(obj)            # resets its buffer, also when packing fails
+    if len(data) > PACKER_KEEP:
+        _PACKERS.packer = None
+    return data
 
 
 def unpack(data: bytes | bytearray | memoryview, max_size: int | None = SOFT_LIMIT) -> Any:

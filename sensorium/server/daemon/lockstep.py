@@ -68,7 +68,7 @@ class Session:
     stepped: bool = False                # asked for a step at least once
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class StepDone:
     """A pending step to answer now: ``status`` 0, -1 (quit) or the asynchronous lateness."""
 
@@ -106,6 +106,7 @@ class Lockstep:
         self.shutting_down = False
         self._new_token = new_token or (lambda: secrets.token_hex(8))
         self._by_robot: dict[str, Session] = {}
+        self.synchronous_attached = 0                # attached sessions with synchronization true
         self._by_token: dict[str, Session] = {}
         # robot -> (controllers that attached and vanished before stepping, no attach before this time)
         self._rest: dict[str, tuple[int, float]] = {}
@@ -156,6 +157,7 @@ class Lockstep:
             token = self._new_token()
         s = Session(token, robot, peer, self.robots[robot], now)
         self._by_robot[robot] = s
+        self.synchronous_attached += s.synchronous
         self._by_token[token] = s
         return s
 
@@ -201,6 +203,8 @@ class Lockstep:
     def _remove(self, s: Session) -> None:
         s.alive = False
         s.pending = None
+        if self._by_robot.get(s.robot) is s:
+            self.synchronous_attached -= s.synchronous
         self._by_robot.pop(s.robot, None)
         self._by_token.pop(s.token, None)
 

@@ -71,6 +71,8 @@ class Route:
 
 
 _DEFERRED = None              # a handler returning None answers later (step)
+ARG_CACHE_KEYS = 4            # argument maps of at most this many int/str values are cached once validated
+ARG_CACHE_SIZE = 1024         # validated argument maps kept
 
 
 def _arg_errors(exc: ValidationError) -> str:
@@ -115,6 +117,7 @@ class Core(DeviceServices):
         for ctl in self.topics.controls.values():
             self._controls_by_robot[ctl.robot].append(ctl)
         self.routes = self._routes()
+        self._arg_cache: dict[tuple, Any] = {}            # (model, args items) -> validated model
         self.errors = 0
 
     def log_error(self, line: str) -> None:
@@ -195,13 +198,7 @@ class Core(DeviceServices):
             route = self.routes.get(req.service)
             if route is None:
                 raise self._unknown(req.service)
-            too_big = check_args_shape(req.args)
-            if too_big is not None:
-                raise ServiceError(ErrorCode.TOO_LARGE, f"{req.service}: {too_big}")
-            try:
-                args = route.spec.args.model_validate(req.args)
-            except ValidationError as exc:
-                raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{req.service}: {_arg_errors(exc)}") from None
+            args = self._validated(route.spec.args, req.service, req.args)
             if route.spec.attached:
                 s = self.lockstep.session_for(route.robot) if route.robot else None
                 if s is None or s.peer != peer:
@@ -231,6 +228,36 @@ class Core(DeviceServices):
             self.log_error(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
             return [envelope + [error_reply(rid, ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}")]]
 
+    def _validated(self, model: type, service: str, raw: dict) -> Any:
+        """``raw`` validated by the service's pydantic ``model`` (frozen): TOO_LARGE / INVALID_ARGUMENT
+        otherwise. Flat maps of exact ``int``/``str`` values (a step's ``{"duration": 32}``, a ping's
+        session) validate to the same model every time, so the model is kept and reused: equal keys
+        mean equal values of the same types, so no check is skipped (bool, float and nested values
+        are validated every time)."""
+        key = None
+        if len(raw) <= ARG_CACHE_KEYS:
+            items = tuple(raw.items())
+            for _, v in items:
+                if type(v) is not int and type(v) is not str:
+                    break
+            else:
+                key = (model, items)
+                hit = self._arg_cache.get(key)
+                if hit is not None:
+                    return hit
+        too_big = check_args_shape(raw)
+        if too_big is not None:
+            raise ServiceError(ErrorCode.TOO_LARGE, f"{service}: {too_big}")
+        try:
+            args = model.model_validate(raw)  # type: ignore[attr-defined]
+        except ValidationError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{service}: {_arg_errors(exc)}") from None
+        if key is not None:
+            if len(self._arg_cache) >= ARG_CACHE_SIZE:
+                self._arg_cache.clear()               # bounded: a client varying its values only evicts
+            self._arg_cache[key] = args
+        return args
+
     def subscription(self, event: bytes) -> None:
         """An XPUB subscription event."""
         self.topics.subscription(event)
@@ -238,7 +265,8 @@ class Core(DeviceServices):
     # ------------------------------------------------------------------ stepping
     def next_advance(self, now: float) -> float | None:
         t = self.lockstep.next_advance(now)
-        if not self._announced:
+        # (both announcements need no synchronous controller attached: skip the scan while one is)
+        if not self._announced and not self.lockstep.synchronous_attached:
             self._announce()
         return t
 

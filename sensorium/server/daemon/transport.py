@@ -39,7 +39,9 @@ DEFAULT_PUB = "tcp://127.0.0.1:5561"
 STEP_BUDGET_S = 0.005          # at most this long stepping before looking at the sockets again
 MAX_IDLE_WAIT_S = 1.0
 MAX_IDLE_WAIT_MS = int(MAX_IDLE_WAIT_S * 1000)
-EXPIRE_EVERY_S = 0.01           # session expiry scan at most this often while messages flow
+EXPIRE_EVERY_S = 0.01           # session expiry scan (and, while busy, a look at XPUB + wake) this often
+HOT_S = 0.01                    # busy: a request arrived this recently; wait in the ROUTER's recv alone
+HOT_WAIT_MS = 10                # longest such wait (then XPUB, wake and deadlines are looked at)
 ZERO_COPY_MIN = 64 * 1024       # replies at least this large are sent zero-copy
 REQUESTS_PER_TURN = 64          # requests served before the world may step again (fairness)
 MAX_FRAMES = 16                 # frames in one request message (identity, REQ envelope, body)
@@ -201,49 +203,82 @@ class Transport:
 
     # ------------------------------------------------------------------ loop
     def run(self) -> None:
+        """Serve until stopped. Two ways to wait:
+
+        * *busy* (a request arrived within the last :data:`HOT_S`): block in the ROUTER's own
+          ``recv`` (``RCVTIMEO`` ≤ :data:`HOT_WAIT_MS`), one request per pass. That is the lockstep's
+          hot path: libzmq wakes this thread through the socket's mailbox alone, without the
+          readiness checks of ``zmq_poll`` over three sockets (each ``ZMQ_EVENTS`` query is a
+          ``poll`` and a ``getpid``). The XPUB and the wake socket are looked at every
+          :data:`EXPIRE_EVERY_S` (a zero-timeout poll), and a wait that times out drops to idle.
+        * *idle*: ``zmq_poll`` on ROUTER, XPUB and the wake socket until the next deadline.
+        """
         core = self.core
         clock = self.clock
-        router, xpub = self.router, self.xpub
+        router = self.router
         poll = self.poller.poll
-        POLLIN, EVENTS = zmq.POLLIN, zmq.EVENTS
         quit_at: float | None = None
         next_expire = 0.0
+        busy_until = 0.0
+        rcvtimeo = -1
         try:
             while True:
                 if self._stop_requested and quit_at is None:
                     self._send_replies(core.shutdown())
                     quit_at = clock() + self.grace_s
-                # fast path: a request already queued (e.g. the next step) is served without polling
-                if router.getsockopt(EVENTS) & POLLIN:
-                    self._drain_router()
-                    if xpub.getsockopt(EVENTS) & POLLIN:
-                        self._drain_xpub()
-                    timed_out = False
-                else:
+                now = clock()
+                if quit_at is not None and now >= quit_at:
+                    break
+                timed_out = False
+                if now < busy_until and quit_at is None:
+                    t = core.next_advance(now)           # the world may step by itself: wait no longer
+                    wait_ms = HOT_WAIT_MS if t is None else max(0, min(HOT_WAIT_MS, int((t - now) * 1000 + 0.999)))
+                    if wait_ms != rcvtimeo:
+                        router.setsockopt(zmq.RCVTIMEO, wait_ms)
+                        rcvtimeo = wait_ms
+                    frames = self._recv_request(0 if wait_ms else zmq.NOBLOCK)
                     now = clock()
-                    if quit_at is not None and now >= quit_at:
-                        break
+                    if frames:
+                        self._send_replies(core.handle(frames, now))
+                    if frames is not None:
+                        busy_until = now + HOT_S
+                    elif wait_ms:
+                        busy_until = 0.0                 # nothing for a while: wait on every socket
+                        timed_out = True
+                else:
                     events = poll(self._timeout(now, quit_at))
                     timed_out = not events
                     for sock, _ in events:
                         if sock is router:
                             self._drain_router()
-                        elif sock is xpub:
+                            busy_until = clock() + HOT_S
+                        elif sock is self.xpub:
                             self._drain_xpub()
                         else:
                             self._drain_wake()
-                now = clock()
+                    now = clock()
                 if quit_at is not None and now >= quit_at:
                     break
-                # session expiry: when a deadline woke us, else at most every EXPIRE_EVERY_S
+                # session expiry (and, while busy, the other sockets): when a deadline woke us,
+                # else at most every EXPIRE_EVERY_S
                 if timed_out or now >= next_expire:
                     core.expire(now)
                     next_expire = now + EXPIRE_EVERY_S
+                    if busy_until:
+                        self._look_around()
                 for hook in self.hooks:
                     hook()
                 self._run_steps(now)
         finally:
             self.close()
+
+    def _look_around(self) -> None:
+        """While busy: serve the XPUB and the wake socket if they have something (no waiting)."""
+        for sock, _ in self.poller.poll(0):
+            if sock is self.xpub:
+                self._drain_xpub()
+            elif sock is not self.router:
+                self._drain_wake()
 
     def _timeout(self, now: float, quit_at: float | None) -> int:
         deadline = self.core.next_deadline(now)
@@ -253,33 +288,42 @@ class Transport:
             return MAX_IDLE_WAIT_MS
         return max(0, min(MAX_IDLE_WAIT_MS, int((deadline - now) * 1000 + 0.999)))
 
+    def _recv_request(self, flags: int) -> list[bytes] | None:
+        """The frames of one request message; ``None``: nothing arrived (``flags`` NOBLOCK, or
+        ``RCVTIMEO`` passed); ``[]``: frames of an over-long message were dropped (it was answered
+        when its frame count passed :data:`MAX_FRAMES`; the rest goes over the next calls)."""
+        router = self.router
+        if self._discarding and not self._discard_rest():
+            return []
+        recv = router.recv
+        try:
+            frames = [recv(flags)]
+            # the other frames of a message are there already (libzmq delivers messages whole)
+            while router.getsockopt(zmq.RCVMORE):
+                if len(frames) >= MAX_FRAMES:
+                    # too many frames: answer the sender, drop the rest over the next turns
+                    self._send_replies([[frames[0], error_reply(
+                        None, ErrorCode.TOO_LARGE, f"a request has at most {MAX_FRAMES} frames")]])
+                    self._discarding = True
+                    return []
+                frames.append(recv(zmq.NOBLOCK))
+        except zmq.Again:
+            return None
+        return frames
+
     def _drain_router(self, limit: int = REQUESTS_PER_TURN) -> None:
         """Serve up to ``limit`` queued requests (libzmq fair-queues peers, so a flooding peer
-        gets its share, not the loop: the world steps between turns)."""
-        core, router, clock = self.core, self.router, self.clock
-        recv, EVENTS, POLLIN, NOBLOCK = router.recv, zmq.EVENTS, zmq.POLLIN, zmq.NOBLOCK
+        gets its share, not the loop: the world steps between turns). A non-blocking ``recv``
+        that finds nothing costs what a ``ZMQ_EVENTS`` query costs; one that finds a message, nothing."""
+        core, clock, NOBLOCK = self.core, self.clock, zmq.NOBLOCK
         for _ in range(limit):
-            if not router.getsockopt(EVENTS) & POLLIN:   # cheaper than a recv raising zmq.Again
-                return
             if self._discarding and not self._discard_rest():
+                return                        # the over-long message's rest: the next turns
+            frames = self._recv_request(NOBLOCK)
+            if frames is None:
                 return
-            frames: list[bytes] = []
-            try:
-                while True:
-                    frames.append(recv(NOBLOCK, copy=True))
-                    if not router.getsockopt(zmq.RCVMORE):
-                        break
-                    if len(frames) >= MAX_FRAMES:
-                        # too many frames: answer the sender, drop the rest over the next turns
-                        self._send_replies([[frames[0], error_reply(
-                            None, ErrorCode.TOO_LARGE, f"a request has at most {MAX_FRAMES} frames")]])
-                        self._discarding = True
-                        break
-            except zmq.Again:
-                return
-            if self._discarding:
-                continue
-            self._send_replies(core.handle(frames, clock()))
+            if frames:
+                self._send_replies(core.handle(frames, clock()))
 
     def _discard_rest(self) -> bool:
         """Drop frames of an over-long message, a bounded number per turn; True when done."""
