@@ -223,6 +223,7 @@ class Transport:
         quit_at: float | None = None
         next_expire = 0.0
         busy_until = 0.0
+        next_step: float | None = None               # when the world may step next (None: not by itself)
         rcvtimeo = -1
         try:
             while True:
@@ -234,7 +235,7 @@ class Transport:
                     break
                 timed_out = False
                 if now < busy_until and quit_at is None:
-                    t = core.next_advance(now)           # the world may step by itself: wait no longer
+                    t = next_step                        # the world may step by itself: wait no longer
                     wait_ms = HOT_WAIT_MS if t is None else max(0, min(HOT_WAIT_MS, int((t - now) * 1000 + 0.999)))
                     if wait_ms != rcvtimeo:
                         router.setsockopt(zmq.RCVTIMEO, wait_ms)
@@ -271,7 +272,7 @@ class Transport:
                         self._look_around()
                 for hook in self.hooks:
                     hook()
-                self._run_steps(now)
+                next_step = self._run_steps(now)
         finally:
             self.close()
 
@@ -368,23 +369,25 @@ class Transport:
         except (BlockingIOError, OSError):
             pass
 
-    def _run_steps(self, now: float | None = None) -> None:
+    def _run_steps(self, now: float | None = None) -> float | None:
+        """Step while the lockstep allows it (at most :data:`STEP_BUDGET_S`); return when the world
+        may step next (wall time; ``None``: when a request or deadline allows it)."""
         core, clock = self.core, self.clock
         start = now = clock() if now is None else now
         while True:
             t = core.next_advance(now)
             if t is None or t > now:
-                return
+                return t
             replies, pubs = core.step_once(now)
             for frames in pubs:
                 self.xpub.send_multipart(frames, copy=False)
             self._send_replies(replies)
             if self.stop_at_ms is not None and core.sim.time_ms >= self.stop_at_ms:
                 self.stop()
-                return
+                return None
             now = clock()
             if now - start > STEP_BUDGET_S:
-                return                                  # let the sockets be served
+                return now                              # let the sockets be served, then step on
 
     def _send_replies(self, replies: list[list[bytes]]) -> None:
         # frame by frame (what send_multipart does, without its per-call type checks and enum flags)
