@@ -63,18 +63,22 @@ class Proc:
         self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                   env=child_env(env), cwd=None if cwd is None else str(cwd), **popen)
         self.lines: queue.Queue[str | None] = queue.Queue()     # None: stdout closed
-        self.out: list[str] = []
-        self.err: list[str] = []
-        self._pumps = [threading.Thread(target=self._pump, args=(self.p.stdout, self.out, self.lines), daemon=True),
-                       threading.Thread(target=self._pump, args=(self.p.stderr, self.err, None), daemon=True)]
+        self.out: list[str] = []        # stdout lines, without their newlines
+        self.err: list[str] = []        # stderr lines, without their newlines
+        self._text: tuple[list[str], list[str]] = ([], [])     # stdout, stderr exactly as written
+        self._pumps = [threading.Thread(target=self._pump, args=(self.p.stdout, self.out, self._text[0], self.lines),
+                                        daemon=True),
+                       threading.Thread(target=self._pump, args=(self.p.stderr, self.err, self._text[1], None),
+                                        daemon=True)]
         for t in self._pumps:
             t.start()
 
     @staticmethod
-    def _pump(stream: IO[str], into: list[str], lines: queue.Queue[str | None] | None) -> None:
+    def _pump(stream: IO[str], into: list[str], text: list[str], lines: queue.Queue[str | None] | None) -> None:
         try:
-            for line in stream:
-                line = line.rstrip("\n")
+            for raw in stream:
+                text.append(raw)
+                line = raw.rstrip("\n")
                 into.append(line)
                 if lines is not None:
                     lines.put(line)
@@ -138,13 +142,13 @@ class Proc:
         """What the process wrote to stderr so far (all of it once it has exited)."""
         if self.p.poll() is not None:
             self._pumps[1].join(STOP_S)
-        return "\n".join(self.err)
+        return "".join(self._text[1])
 
     def stdout(self) -> str:
         """What the process wrote to stdout so far (all of it once it has exited)."""
         if self.p.poll() is not None:
             self._pumps[0].join(STOP_S)
-        return "\n".join(self.out)
+        return "".join(self._text[0])
 
     def stop(self, sig: int = signal.SIGINT, timeout: float = STOP_S) -> int:
         """Stop the process: ``sig``, then SIGTERM, then SIGKILL, each given ``timeout`` s; its exit code."""
