@@ -15,11 +15,13 @@
   by side, then ``wait_ready`` each).
 
 The child imports this tree (the repository is put first on its PYTHONPATH) and runs unbuffered.
-``env`` adds variables to the test's environment; a value of ``None`` removes one.
+``env`` adds variables to the test's environment; a value of ``None`` removes one. Whatever a
+failed test left running is killed when the test run ends.
 """
 
 from __future__ import annotations
 
+import atexit
 import os
 import queue
 import signal
@@ -54,6 +56,18 @@ def child_env(env: Mapping[str, str | None] | None = None) -> dict[str, str]:
     return full
 
 
+_STARTED: set[subprocess.Popen[str]] = set()
+
+
+@atexit.register
+def _kill_leftovers() -> None:
+    """The safety net: a process a failed test did not stop does not outlive the test run."""
+    for p in list(_STARTED):
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+
+
 class Proc:
     """A subprocess whose stdout lines and stderr are collected by two threads."""
 
@@ -62,6 +76,7 @@ class Proc:
         self.args = argv
         self.p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                   env=child_env(env), cwd=None if cwd is None else str(cwd), **popen)
+        _STARTED.add(self.p)
         self.lines: queue.Queue[str | None] = queue.Queue()     # None: stdout closed
         self.out: list[str] = []        # stdout lines, without their newlines
         self.err: list[str] = []        # stderr lines, without their newlines
@@ -97,7 +112,8 @@ class Proc:
         return self.p.poll()
 
     def _what(self) -> str:
-        return " ".join(Path(a).name if os.sep in a else a for a in self.args[1:6])
+        args = ["sensorium", *self.args[3:]] if self.args[1:3] == ["-m", "sensorium"] else self.args
+        return " ".join(Path(a).name if os.path.isabs(a) else a for a in args[:5])
 
     def _failure(self, why: str) -> AssertionError:
         return AssertionError(f"{self._what()}: {why}; exit code {self.p.poll()}; stderr:\n{self.stderr()}")
@@ -107,7 +123,7 @@ class Proc:
         try:
             got = self.lines.get(timeout=max(0.0, timeout))
         except queue.Empty:
-            raise self._failure(f"no output in {timeout:g} s") from None
+            raise self._failure(f"no further line on stdout in {timeout:.1f} s") from None
         if got is None:
             self.lines.put(None)            # stays closed for the next reader
             try:
@@ -121,7 +137,10 @@ class Proc:
         """The next stdout line that starts with ``prefix`` (earlier lines are skipped, kept in ``out``)."""
         deadline = time.monotonic() + timeout
         while True:
-            line = self.line(deadline - time.monotonic())
+            try:
+                line = self.line(deadline - time.monotonic())
+            except AssertionError as exc:
+                raise AssertionError(f"waiting {timeout:g} s for a line starting {prefix!r}: {exc}") from None
             if line.startswith(prefix):
                 return line
 
@@ -131,6 +150,7 @@ class Proc:
             code = self.p.wait(timeout)
         except subprocess.TimeoutExpired:
             raise self._failure(f"still running after {timeout:g} s") from None
+        _STARTED.discard(self.p)
         self._join()
         return code
 
@@ -164,9 +184,10 @@ class Proc:
             except subprocess.TimeoutExpired:
                 continue
         self.p.wait()
+        _STARTED.discard(self.p)
         self._join()
-        for f in (self.p.stdout, self.p.stderr):
-            if f is not None:
+        for f, pump in zip((self.p.stdout, self.p.stderr), self._pumps):
+            if f is not None and not pump.is_alive():   # (a grandchild may hold a pipe open: leave it be)
                 f.close()
         return self.p.returncode
 
