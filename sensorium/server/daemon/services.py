@@ -59,6 +59,7 @@ class Call:
     motor: Any                # the WheelMotor of a motor service, else None
     now: float
     extra: list[Frames]       # more replies to send (e.g. a step answered by detach)
+    session: Session | None = None   # the caller's session, for services that need it attached
 
 
 @dataclass(frozen=True, slots=True)
@@ -199,6 +200,7 @@ class Core(DeviceServices):
             if route is None:
                 raise self._unknown(req.service)
             args = self._validated(route.spec.args, req.service, req.args)
+            s = None
             if route.spec.attached:
                 s = self.lockstep.session_for(route.robot) if route.robot else None
                 if s is None or s.peer != peer:
@@ -214,7 +216,7 @@ class Core(DeviceServices):
                 raise ServiceError(ErrorCode.NOT_SUPERVISOR, roles.denied(req.service))
             ctl = self.topics.controls[route.device] if route.device else None
             motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
-            call = Call(envelope, peer, rid, args, route.robot or "", cast(Control, ctl), motor, now, [])
+            call = Call(envelope, peer, rid, args, route.robot or "", cast(Control, ctl), motor, now, [], s)
             result = route.handler(call)
             if result is _DEFERRED:
                 return call.extra
@@ -435,6 +437,8 @@ class Core(DeviceServices):
 
     # ------------------------------------------------------------------ robot services
     def _session(self, c: Call) -> Session:
+        if c.session is not None:
+            return c.session                                 # found by handle()
         s = self.lockstep.session_for(c.robot)
         assert s is not None and s.peer == c.peer          # checked by handle()
         return s
@@ -444,10 +448,11 @@ class Core(DeviceServices):
         have been lost with a dropped connection, PROTOCOL.md): a pending one is answered on the
         caller's current route; an answered one gets its reply again. Never steps twice."""
         s = self._session(c)
-        if s.pending is not None and s.pending.reply_to[1] == c.id:
-            s.pending.reply_to = (c.envelope, c.id)
+        p = s.pending
+        if p is not None and p.reply_to[1] == c.id:
+            p.reply_to = (c.envelope, c.id)
             return True
-        if s.pending is None and s.last_step is not None and s.last_step[0] == c.id:
+        if p is None and s.last_step is not None and s.last_step[0] == c.id:
             c.extra.append(c.envelope + [s.last_step[1]])
             return True
         return False
