@@ -302,6 +302,9 @@ class Simulation:
                 enc.measure(now)
                 enc.schedule.last_update_ms = now
                 encoders += 1
+        if not (lights or distances or lidars):         # no ray this step (e.g. between sensor periods)
+            self._counters["measurements"] += encoders
+            return StepReport(now, [])
         work: list[tuple[Any, list[RayRequest]]] = []
         if lights:
             if self._lights_version != self.scene.lights_version:  # a light moved with its owner
