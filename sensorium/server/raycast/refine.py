@@ -10,7 +10,9 @@ from sensorium.server.raycast.exact import (
     _CAPSULE,
     _CYLINDER,
     _DENSE_PAIRS,
+    _F32,
     _INF,
+    _MAX_LOOPS,
     _SCALAR,
     _SPHERE,
     _TINY,
@@ -22,9 +24,11 @@ from sensorium.server.raycast.exact import (
     _mat,
     _minus,
     _moller_trumbore,
+    _rows,
     _strictly_increasing,
     _take,
 )
+from sensorium.server.raycast.guards import PRISM_TRIANGLES
 from sensorium.server.raycast.tiers import _Tier
 
 
@@ -61,6 +65,60 @@ class Refiner:
             tri[bad[got]] = btri[got]
             ok[bad[got]] = True
         return ok, t, tri
+
+    def _guard_hits(self, tier: _Tier, Ot, D, rows, gprim, lo, hi, excl):
+        """Float64 hits of rays ``rows`` (all arrays indexed by ray) on the flat triangles of the risky
+        edges whose guards (prism triangles ``gprim``) they met: (rows, t, triangle) of the rays that
+        hit one with lo <= t <= hi, the nearest per ray."""
+        _, ptr, idx = tier.guard[:3]
+        edge = gprim.astype(np.int64) // PRISM_TRIANGLES
+        starts = ptr[edge]
+        counts = ptr[edge + 1] - starts
+        ray = rows[np.repeat(np.arange(len(rows)), counts)]
+        cand = idx[np.repeat(starts - (np.cumsum(counts) - counts), counts) + np.arange(int(counts.sum()))]
+        if excl is not None:
+            keep = tier.tri_owner[cand] != excl[ray]
+            ray, cand = ray[keep], cand[keep]
+        ok, t = _moller_trumbore(Ot[ray], D[ray], tier.v0[cand], tier.e1[cand], tier.e2[cand])
+        ok &= (t >= lo[ray]) & (t <= hi[ray])
+        ray, t, cand = ray[ok], t[ok], cand[ok]
+        if len(ray) > 1 and not _strictly_increasing(ray):
+            keep = _best_per_row(ray, t)
+            ray, t, cand = ray[keep], t[keep], cand[keep]
+        return ray, t, cand
+
+    def _guard_pass(self, tier: _Tier, Ot, D, lo, act, seg, lim, excl, best_t, best_s, best_n):
+        """The second look of EXACT (see :mod:`.guards`): rays ``act`` (tier frame, from ``seg`` up to
+        their limit ``lim``) cast against the prisms of the tier's risky edges, up to a little past
+        their hit ``best_t``; each prism met is followed by a float64 test of its edge's triangles,
+        and a nearer hit replaces ``best_*`` in place.  Rays are followed past each prism (steps of
+        w/2 cannot jump over a prism that a ray within w/2 of its edge crosses) until none is left."""
+        w = 4.0 * tier.eps
+        scene = tier.guard_scene()
+        for _ in range(_MAX_LOOPS):
+            far = np.minimum(best_t[act] + 4.0 * w, lim) - seg
+            keep = (far >= 0.0).nonzero()[0]
+            if len(keep) < len(act):
+                act, seg, lim, far = act[keep], seg[keep], lim[keep], far[keep]
+            if not len(act):
+                return
+            o32 = (_rows(Ot, act) + seg[:, None] * _rows(D, act)).astype(_F32)
+            self.counters["embree_calls"] += 1
+            res = scene.run(o32, _rows(D, act).astype(_F32), (far * (1.0 + 2.0 ** -20)).astype(_F32), output=1)
+            met = (res["primID"] >= 0).nonzero()[0]
+            if not len(met):
+                return
+            act, seg, lim = act[met], seg[met] + res["tfar"][met], lim[met]
+            rr, tt, tri = self._guard_hits(tier, Ot, D, act, res["primID"][met], lo, best_t, excl)
+            better = (tt < best_t[rr]).nonzero()[0]
+            if len(better):
+                r, tri = rr[better], tri[better]
+                nrm = tier.normal[tri]
+                nrm[_dot(nrm, D[r]) > 0.0] *= -1.0
+                best_t[r], best_s[r], best_n[r] = tt[better], tier.tri_shape[tri], nrm
+                self.counters["leak_repairs"] += len(r)
+            seg = seg + 0.5 * w
+        self.counters["unresolved_rays"] += int(len(act))
 
     def _nearby_triangles(self, tier: _Tier, Ot, D, t_e, lo, hi, excl):
         """Float64 hit of the ORIGINAL rays on the flat triangles whose box, grown by float32

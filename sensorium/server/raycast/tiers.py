@@ -11,6 +11,7 @@ from embreex import rtcore_scene as _rts
 from embreex.mesh_construction import TriangleMesh as _TriangleMesh
 
 from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
+from sensorium.server.raycast.guards import MAX_EDGES_PER_FLAT_TRIANGLE, MAX_GUARDED_EDGES, prisms, risky_edges
 from sensorium.server.world.geometry import Capsule, Cylinder, Mesh, Pose, Primitive, Sphere, tessellate
 
 
@@ -133,11 +134,12 @@ class _Tier:
         else:
             self.bound = ("box", V.min(0) - slack, V.max(0) + slack)
         self._ring: tuple[np.ndarray, np.ndarray] | None = None
+        self._guard: tuple | None = None
         # Embree keeps pointers into these buffers: hold references for the scenes' lifetime
         self._v32 = np.ascontiguousarray(V, dtype=_F32)
         self._f32 = F
         self._device = device
-        self._scenes: dict[bool, object] = {}
+        self._scenes: dict[bool | str, object] = {}
 
     def _exact_data(self) -> dict[str, np.ndarray]:
         """Per-triangle float64 data of the refinement, computed once on first use (EXACT, or a
@@ -207,7 +209,40 @@ class _Tier:
         _TriangleMesh(sc, self._v32, self._f32)
         sc.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))  # commit now: this is the build
         self._scenes[robust] = sc
+        if robust and self.guard is not None:   # EXACT's second look (one build with the scene)
+            gs = _rts.EmbreeScene(self._device, robust=True)
+            _TriangleMesh(gs, self.guard[3], self.guard[4])
+            gs.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))
+            self._scenes["guard"] = gs
         return sc, True
+
+    @property
+    def guard(self) -> tuple | None:
+        """Edge guards of the EXACT scene, or None (no risky edge, or too many: then EXACT repairs
+        leaks with an offset copy of each cast instead).  (edges, ptr, idx, prism vertices float32,
+        prism faces): the flat triangles of risky edge i are ``idx[ptr[i]:ptr[i + 1]]``; prism
+        triangle k guards edge ``k // PRISM_TRIANGLES``.  Built on first use."""
+        if self._guard is None:
+            flat = ~self.tri_curved[:-1]
+            edges, ptr, idx = risky_edges(self.F, flat, self.normal[:-1])
+            n_flat = int(np.count_nonzero(flat))
+            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat:
+                self._guard = (None, len(edges) == 0)
+            else:
+                pv, pf = prisms(self.V, edges, 4.0 * self.eps)
+                self._guard = (edges, ptr, idx, np.ascontiguousarray(pv, dtype=_F32), pf)
+        return None if self._guard[0] is None else self._guard
+
+    def guard_scene(self):
+        """Robust Embree scene of the edge guards' prisms (built with the EXACT scene)."""
+        if "guard" not in self._scenes:
+            self.scene(True)
+        return self._scenes["guard"]
+
+    @property
+    def guarded(self) -> bool:
+        """True if the EXACT scene carries edge guards (False: EXACT uses the offset copy)."""
+        return self.guard is not None or self._guard[1]
 
     def _isolation(self, verts, tri_shape, c_shape) -> np.ndarray:
         """Per curved slot: True if no other shape of the tier overlaps its shell's bounding box.

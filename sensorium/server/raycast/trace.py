@@ -270,6 +270,8 @@ class TierTracer(Refiner):
                 np.minimum(lim, best_t, out=lim)
 
         act = alive.nonzero()[0]
+        if exact and tier.guard is not None:   # for the edge guards' pass after the loop
+            guard_from = (act, seg[act], lim[act].copy())
         delta = None   # per-ray continuation step, allocated on the first continuation
         for _ in range(_MAX_LOOPS):
             if len(act) == 0:
@@ -280,10 +282,11 @@ class TierTracer(Refiner):
             d32 = da.astype(_F32)
             far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)
             far32 = np.where(far >= 0.0, far, -1.0).astype(_F32)
-            res = self._run(tier, o_seg.astype(_F32), d32, far32.copy() if exact else far32, robust=exact)
+            copy = exact and not tier.guarded
+            res = self._run(tier, o_seg.astype(_F32), d32, far32.copy() if copy else far32, robust=exact)
             prim, tf = res["primID"].astype(np.int64), res["tfar"]
             repaired = fixed = None
-            if exact:
+            if copy:
                 # leak repair: a copy offset by a few ulps perpendicular to the ray
                 o2 = (o_seg + _perpendicular(da) * (_LEAK_OFFSET_ULPS * tier.res)).astype(_F32)
                 prim2 = self._run(tier, o2, d32, far32, robust=True)["primID"]
@@ -412,4 +415,6 @@ class TierTracer(Refiner):
             self.counters["continued_rays"] += int(len(rows))
         else:
             self.counters["unresolved_rays"] += int(len(act))
+        if exact and tier.guard is not None and len(guard_from[0]):
+            self._guard_pass(tier, Ot, D, lo, *guard_from, excl_arr, best_t, best_s, best_n)
         return best_t, best_s, best_n
