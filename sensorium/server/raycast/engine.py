@@ -135,7 +135,7 @@ class RayEngine(TierTracer):
         self._epoch = 0                                 # bumped by every set_body_pose
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
-            "continued_rays": 0, "unresolved_rays": 0,
+            "continued_rays": 0, "unresolved_rays": 0, "edge_guard_hits": 0,
         }
 
     # ---- configuration ----------------------------------------------------------------------

@@ -24,7 +24,6 @@ from sensorium.server.raycast.exact import (
     _mat,
     _minus,
     _moller_trumbore,
-    _rows,
     _strictly_increasing,
     _take,
 )
@@ -66,10 +65,47 @@ class Refiner:
             ok[bad[got]] = True
         return ok, t, tri
 
-    def _guard_hits(self, tier: _Tier, Ot, D, rows, gprim, lo, hi, excl):
-        """Float64 hits of rays ``rows`` (all arrays indexed by ray) on the flat triangles of the risky
-        edges whose guards (prism triangles ``gprim``) they met: (rows, t, triangle) of the rays that
-        hit one with lo <= t <= hi, the nearest per ray."""
+    def _guard_rays(self, tier: _Tier, res, g, act, Ot, D, o_seg, d32, sa, far, lo, lim, excl, best_t, best_s, best_n):
+        """The second look of EXACT (see :mod:`.guards`) for the rays ``g`` (rows of this pass's Embree
+        results ``res``; ray ``act[g]``, segment from ``sa``, float64 ``far``) whose first hit was a
+        guard: (1) float64 test of that risky edge's triangles; (2) the same past every further guard
+        met before any scene surface (a step of w/2 cannot jump over a prism that a ray within w/2 of
+        its edge crosses); (3) their Embree results replaced by those of the scene without guards,
+        so that the pass goes on as if the guards were not there."""
+        rows = act[g]
+        self._guard_hits(tier, Ot, D, rows, res["primID"][g], lo, lim, excl, best_t, best_s, best_n)
+        scene = tier.scene(True)[0]
+        half_w = 2.0 * tier.eps
+        sub = np.arange(len(g))
+        s = res["tfar"][g].astype(np.float64)
+        for _ in range(_MAX_LOOPS):
+            s = s + half_w
+            f = far[g[sub]] - s
+            keep = (f >= 0.0).nonzero()[0]
+            sub, s, f = sub[keep], s[keep], f[keep]
+            if not len(sub):
+                break
+            r = rows[sub]
+            o = (Ot[r] + (sa[g[sub]] + s)[:, None] * D[r]).astype(_F32)
+            self.counters["embree_calls"] += 1
+            r1 = scene.run(o, d32[g[sub]], f.astype(_F32), output=1)
+            more = (r1["geomID"] == 1).nonzero()[0]
+            if not len(more):
+                break
+            sub, s = sub[more], s[more] + r1["tfar"][more]
+            self._guard_hits(tier, Ot, D, rows[sub], r1["primID"][more], lo, lim, excl, best_t, best_s, best_n)
+        self.counters["embree_calls"] += 1
+        fg = far[g]
+        r0 = tier.bare_scene().run(o_seg[g].astype(_F32), d32[g], np.where(fg >= 0.0, fg, -1.0).astype(_F32),
+                                   output=1)
+        for k in ("primID", "tfar", "u", "v", "Ng", "geomID"):
+            res[k][g] = r0[k]
+
+    def _guard_hits(self, tier: _Tier, Ot, D, rows, gprim, lo, hi, excl, best_t, best_s, best_n):
+        """The second look of EXACT (see :mod:`.guards`): rays ``rows`` met the guards (prism triangles
+        ``gprim``) of risky edges; test them in float64 on the flat triangles of those edges, and
+        where one is hit with lo <= t <= hi nearer than ``best_t``, take it (``best_*``, ``hi`` are
+        updated in place; arrays indexed by ray)."""
         _, ptr, idx = tier.guard[:3]
         edge = gprim.astype(np.int64) // PRISM_TRIANGLES
         starts = ptr[edge]
@@ -80,45 +116,18 @@ class Refiner:
             keep = tier.tri_owner[cand] != excl[ray]
             ray, cand = ray[keep], cand[keep]
         ok, t = _moller_trumbore(Ot[ray], D[ray], tier.v0[cand], tier.e1[cand], tier.e2[cand])
-        ok &= (t >= lo[ray]) & (t <= hi[ray])
+        ok &= (t >= lo[ray]) & (t <= hi[ray]) & (t < best_t[ray])
         ray, t, cand = ray[ok], t[ok], cand[ok]
+        if not len(ray):
+            return
         if len(ray) > 1 and not _strictly_increasing(ray):
             keep = _best_per_row(ray, t)
             ray, t, cand = ray[keep], t[keep], cand[keep]
-        return ray, t, cand
-
-    def _guard_pass(self, tier: _Tier, Ot, D, lo, act, seg, lim, excl, best_t, best_s, best_n):
-        """The second look of EXACT (see :mod:`.guards`): rays ``act`` (tier frame, from ``seg`` up to
-        their limit ``lim``) cast against the prisms of the tier's risky edges, up to a little past
-        their hit ``best_t``; each prism met is followed by a float64 test of its edge's triangles,
-        and a nearer hit replaces ``best_*`` in place.  Rays are followed past each prism (steps of
-        w/2 cannot jump over a prism that a ray within w/2 of its edge crosses) until none is left."""
-        w = 4.0 * tier.eps
-        scene = tier.guard_scene()
-        for _ in range(_MAX_LOOPS):
-            far = np.minimum(best_t[act] + 4.0 * w, lim) - seg
-            keep = (far >= 0.0).nonzero()[0]
-            if len(keep) < len(act):
-                act, seg, lim, far = act[keep], seg[keep], lim[keep], far[keep]
-            if not len(act):
-                return
-            o32 = (_rows(Ot, act) + seg[:, None] * _rows(D, act)).astype(_F32)
-            self.counters["embree_calls"] += 1
-            res = scene.run(o32, _rows(D, act).astype(_F32), (far * (1.0 + 2.0 ** -20)).astype(_F32), output=1)
-            met = (res["primID"] >= 0).nonzero()[0]
-            if not len(met):
-                return
-            act, seg, lim = act[met], seg[met] + res["tfar"][met], lim[met]
-            rr, tt, tri = self._guard_hits(tier, Ot, D, act, res["primID"][met], lo, best_t, excl)
-            better = (tt < best_t[rr]).nonzero()[0]
-            if len(better):
-                r, tri = rr[better], tri[better]
-                nrm = tier.normal[tri]
-                nrm[_dot(nrm, D[r]) > 0.0] *= -1.0
-                best_t[r], best_s[r], best_n[r] = tt[better], tier.tri_shape[tri], nrm
-                self.counters["leak_repairs"] += len(r)
-            seg = seg + 0.5 * w
-        self.counters["unresolved_rays"] += int(len(act))
+        nrm = tier.normal[cand]
+        nrm[_dot(nrm, D[ray]) > 0.0] *= -1.0
+        best_t[ray], best_s[ray], best_n[ray] = t, tier.tri_shape[cand], nrm
+        hi[ray] = t
+        self.counters["edge_guard_hits"] += len(ray)
 
     def _nearby_triangles(self, tier: _Tier, Ot, D, t_e, lo, hi, excl):
         """Float64 hit of the ORIGINAL rays on the flat triangles whose box, grown by float32

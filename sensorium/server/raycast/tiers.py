@@ -207,21 +207,24 @@ class _Tier:
             return sc, False
         sc = _rts.EmbreeScene(self._device, robust=robust)
         _TriangleMesh(sc, self._v32, self._f32)
+        if robust and self.guard is not None:   # geometry 1 of the EXACT scene: the edge guards
+            _TriangleMesh(sc, self.guard[3], self.guard[4])
         sc.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))  # commit now: this is the build
         self._scenes[robust] = sc
-        if robust and self.guard is not None:   # EXACT's second look (one build with the scene)
-            gs = _rts.EmbreeScene(self._device, robust=True)
-            _TriangleMesh(gs, self.guard[3], self.guard[4])
-            gs.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))
-            self._scenes["guard"] = gs
+        if robust and self.guard is not None:   # and the same without guards (for the rays that meet one)
+            bare = _rts.EmbreeScene(self._device, robust=True)
+            _TriangleMesh(bare, self._v32, self._f32)
+            bare.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))
+            self._scenes["bare"] = bare
         return sc, True
 
     @property
     def guard(self) -> tuple | None:
         """Edge guards of the EXACT scene, or None (no risky edge, or too many: then EXACT repairs
         leaks with an offset copy of each cast instead).  (edges, ptr, idx, prism vertices float32,
-        prism faces): the flat triangles of risky edge i are ``idx[ptr[i]:ptr[i + 1]]``; prism
-        triangle k guards edge ``k // PRISM_TRIANGLES``.  Built on first use."""
+        prism faces): the triangles to test for a ray near risky edge i are ``idx[ptr[i]:ptr[i + 1]]``
+        (the vertex rings of its flat triangles); prism triangle k guards edge ``k // PRISM_TRIANGLES``.
+        Built on first use."""
         if self._guard is None:
             flat = ~self.tri_curved[:-1]
             edges, ptr, idx = risky_edges(self.F, flat, self.normal[:-1])
@@ -230,14 +233,23 @@ class _Tier:
                 self._guard = (None, len(edges) == 0)
             else:
                 pv, pf = prisms(self.V, edges, 4.0 * self.eps)
-                self._guard = (edges, ptr, idx, np.ascontiguousarray(pv, dtype=_F32), pf)
+                # candidates of edge i: the vertex rings of its triangles (the float64 hit can lie
+                # across a coplanar neighbour, e.g. the other triangle of a box face)
+                rptr, ridx = self.ring
+                e_of = np.repeat(np.arange(len(edges)), np.diff(ptr))
+                cnt = rptr[idx + 1] - rptr[idx]
+                cand = ridx[np.repeat(rptr[idx] - (np.cumsum(cnt) - cnt), cnt) + np.arange(int(cnt.sum()))]
+                key = np.unique(np.repeat(e_of, cnt) * (len(self.F) + 1) + cand)
+                e_of, cand = key // (len(self.F) + 1), key % (len(self.F) + 1)
+                cand_ptr = np.r_[0, np.cumsum(np.bincount(e_of, minlength=len(edges)))]
+                self._guard = (edges, cand_ptr, cand, np.ascontiguousarray(pv, dtype=_F32), pf)
         return None if self._guard[0] is None else self._guard
 
-    def guard_scene(self):
-        """Robust Embree scene of the edge guards' prisms (built with the EXACT scene)."""
-        if "guard" not in self._scenes:
+    def bare_scene(self):
+        """The EXACT scene without its edge guards (built with it)."""
+        if "bare" not in self._scenes:
             self.scene(True)
-        return self._scenes["guard"]
+        return self._scenes["bare"]
 
     @property
     def guarded(self) -> bool:

@@ -270,8 +270,6 @@ class TierTracer(Refiner):
                 np.minimum(lim, best_t, out=lim)
 
         act = alive.nonzero()[0]
-        if exact and tier.guard is not None:   # for the edge guards' pass after the loop
-            guard_from = (act, seg[act], lim[act].copy())
         delta = None   # per-ray continuation step, allocated on the first continuation
         for _ in range(_MAX_LOOPS):
             if len(act) == 0:
@@ -286,7 +284,14 @@ class TierTracer(Refiner):
             res = self._run(tier, o_seg.astype(_F32), d32, far32.copy() if copy else far32, robust=exact)
             prim, tf = res["primID"].astype(np.int64), res["tfar"]
             repaired = fixed = None
-            if copy:
+            if exact and not copy:
+                if tier.guard is not None:   # rays that met an edge guard first: the second look
+                    g = (res["geomID"] == 1).nonzero()[0]
+                    if len(g):
+                        self._guard_rays(tier, res, g, act, Ot, D, o_seg, d32, sa, far, lo, lim, excl_arr,
+                                         best_t, best_s, best_n)
+                        prim = res["primID"].astype(np.int64)
+            elif exact:
                 # leak repair: a copy offset by a few ulps perpendicular to the ray
                 o2 = (o_seg + _perpendicular(da) * (_LEAK_OFFSET_ULPS * tier.res)).astype(_F32)
                 prim2 = self._run(tier, o2, d32, far32, robust=True)["primID"]
@@ -415,6 +420,4 @@ class TierTracer(Refiner):
             self.counters["continued_rays"] += int(len(rows))
         else:
             self.counters["unresolved_rays"] += int(len(act))
-        if exact and tier.guard is not None and len(guard_from[0]):
-            self._guard_pass(tier, Ot, D, lo, *guard_from, excl_arr, best_t, best_s, best_n)
         return best_t, best_s, best_n
