@@ -91,3 +91,46 @@ def prisms(V: np.ndarray, edges: np.ndarray, w: float) -> tuple[np.ndarray, np.n
                 corners[:, 4 * e + 2 * i + j] = ends[e] + (2 * i - 1) * w * s1 + (2 * j - 1) * w * s2
     faces = (_PRISM_FACES[None] + 8 * np.arange(len(edges), dtype=np.int32)[:, None, None]).reshape(-1, 3)
     return corners.reshape(-1, 3), faces
+
+
+def _expand(ptr: np.ndarray, idx: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For CSR (ptr, idx): (position in ``rows``, entry) of every entry of every row listed."""
+    cnt = ptr[rows + 1] - ptr[rows]
+    pos = np.repeat(np.arange(len(rows)), cnt)
+    return pos, idx[np.repeat(ptr[rows] - (np.cumsum(cnt) - cnt), cnt) + np.arange(int(cnt.sum()))]
+
+
+def _overlapping(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All (i, j) with boxes i and j overlapping (i == j included), by a sweep along x."""
+    n = len(lo)
+    order = np.argsort(lo[:, 0], kind="stable")
+    slo, shi = lo[order], hi[order]
+    end = np.searchsorted(slo[:, 0], shi[:, 0], side="right")
+    cnt = np.maximum(end - np.arange(n), 1)
+    i = np.repeat(np.arange(n), cnt)
+    j = i + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    ok = np.all((slo[j] <= shi[i]) & (shi[j] >= slo[i]), axis=1)
+    i, j = order[i[ok]], order[j[ok]]
+    return np.r_[i, j], np.r_[j, i]
+
+
+def candidates(V, edges, ptr, idx, ring, flat, w: float) -> tuple[np.ndarray, np.ndarray]:
+    """CSR (ptr, idx) of the flat triangles to test in float64 when a ray meets the guard of risky
+    edge i: the vertex rings of the edge's triangles (the float64 hit can lie across a coplanar
+    neighbour: the other triangle of a box face), for edge i and for every risky edge whose prism
+    comes within w/2 of i's (coincident or crossing prisms, e.g. the common edge of two touching
+    boxes: stepping past one prism's face must not step past the other's unexamined)."""
+    e_of, tri = np.repeat(np.arange(len(edges)), np.diff(ptr)), idx
+    pos, cand = _expand(ring[0], ring[1], tri)
+    own = np.unique(e_of[pos] * (len(flat) + 1) + cand)     # (edge, triangle) keys, sorted
+    own_e, own_t = own // (len(flat) + 1), own % (len(flat) + 1)
+    own_ptr = np.r_[0, np.cumsum(np.bincount(own_e, minlength=len(edges)))]
+    p, q = V[edges[:, 0]], V[edges[:, 1]]
+    grow = 1.5 * w
+    i, j = _overlapping(np.minimum(p, q) - grow, np.maximum(p, q) + grow)
+    pos, cand = _expand(own_ptr, own_t, j)
+    key = np.unique(i[pos] * (len(flat) + 1) + cand)
+    e_of, cand = key // (len(flat) + 1), key % (len(flat) + 1)
+    keep = flat[cand]
+    e_of, cand = e_of[keep], cand[keep]
+    return np.r_[0, np.cumsum(np.bincount(e_of, minlength=len(edges)))], cand

@@ -68,38 +68,43 @@ class Refiner:
     def _guard_rays(self, tier: _Tier, res, g, act, Ot, D, o_seg, d32, sa, far, lo, lim, excl, best_t, best_s, best_n):
         """The second look of EXACT (see :mod:`.guards`) for the rays ``g`` (rows of this pass's Embree
         results ``res``; ray ``act[g]``, segment from ``sa``, float64 ``far``) whose first hit was a
-        guard: (1) float64 test of that risky edge's triangles; (2) the same past every further guard
-        met before any scene surface (a step of w/2 cannot jump over a prism that a ray within w/2 of
-        its edge crosses); (3) their Embree results replaced by those of the scene without guards,
-        so that the pass goes on as if the guards were not there."""
+        guard: (1) their hit in the scene without guards (it replaces theirs in ``res``, so that the
+        pass goes on as if the guards were not there); (2) a float64 test of the guarded edge's
+        triangles, and the same for every further guard met up to a little past that hit (steps of
+        w/2 past each surface or guard: they cannot jump over a prism that a ray within w/2 of its
+        edge crosses, and prisms closer together than that share their candidates)."""
         rows = act[g]
+        fg = far[g]
+        s = res["tfar"][g].astype(np.float64)   # the first guard, from the segment start
+        o32 = o_seg[g].astype(_F32)
+        d32g = d32[g]
+        self.counters["embree_calls"] += 1
+        r0 = tier.bare_scene().run(o32, d32g, np.where(fg >= 0.0, fg, -1.0).astype(_F32), output=1)
+        w = 4.0 * tier.eps
+        stop = np.minimum(fg, np.where(r0["primID"] >= 0, r0["tfar"].astype(np.float64) + 4.0 * w, _INF))
         self._guard_hits(tier, Ot, D, rows, res["primID"][g], lo, lim, excl, best_t, best_s, best_n)
+        for k in ("primID", "tfar", "u", "v", "Ng", "geomID"):
+            res[k][g] = r0[k]
         scene = tier.scene(True)[0]
-        half_w = 2.0 * tier.eps
         sub = np.arange(len(g))
-        s = res["tfar"][g].astype(np.float64)
         for _ in range(_MAX_LOOPS):
-            s = s + half_w
-            f = far[g[sub]] - s
+            s = s + 0.5 * w
+            f = stop[sub] - s
             keep = (f >= 0.0).nonzero()[0]
             sub, s, f = sub[keep], s[keep], f[keep]
             if not len(sub):
-                break
+                return
             r = rows[sub]
             o = (Ot[r] + (sa[g[sub]] + s)[:, None] * D[r]).astype(_F32)
             self.counters["embree_calls"] += 1
-            r1 = scene.run(o, d32[g[sub]], f.astype(_F32), output=1)
-            more = (r1["geomID"] == 1).nonzero()[0]
-            if not len(more):
-                break
-            sub, s = sub[more], s[more] + r1["tfar"][more]
-            self._guard_hits(tier, Ot, D, rows[sub], r1["primID"][more], lo, lim, excl, best_t, best_s, best_n)
-        self.counters["embree_calls"] += 1
-        fg = far[g]
-        r0 = tier.bare_scene().run(o_seg[g].astype(_F32), d32[g], np.where(fg >= 0.0, fg, -1.0).astype(_F32),
-                                   output=1)
-        for k in ("primID", "tfar", "u", "v", "Ng", "geomID"):
-            res[k][g] = r0[k]
+            r1 = scene.run(o, d32g[sub], f.astype(_F32), output=1)
+            met = (r1["primID"] >= 0).nonzero()[0]
+            sub, s = sub[met], s[met] + r1["tfar"][met]
+            more = (r1["geomID"][met] == 1).nonzero()[0]
+            if len(more):
+                self._guard_hits(tier, Ot, D, rows[sub[more]], r1["primID"][met[more]], lo, lim, excl,
+                                 best_t, best_s, best_n)
+        self.counters["unresolved_rays"] += len(sub)
 
     def _guard_hits(self, tier: _Tier, Ot, D, rows, gprim, lo, hi, excl, best_t, best_s, best_n):
         """The second look of EXACT (see :mod:`.guards`): rays ``rows`` met the guards (prism triangles

@@ -11,7 +11,13 @@ from embreex import rtcore_scene as _rts
 from embreex.mesh_construction import TriangleMesh as _TriangleMesh
 
 from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
-from sensorium.server.raycast.guards import MAX_EDGES_PER_FLAT_TRIANGLE, MAX_GUARDED_EDGES, prisms, risky_edges
+from sensorium.server.raycast.guards import (
+    MAX_EDGES_PER_FLAT_TRIANGLE,
+    MAX_GUARDED_EDGES,
+    candidates,
+    prisms,
+    risky_edges,
+)
 from sensorium.server.world.geometry import Capsule, Cylinder, Mesh, Pose, Primitive, Sphere, tessellate
 
 
@@ -223,7 +229,7 @@ class _Tier:
         """Edge guards of the EXACT scene, or None (no risky edge, or too many: then EXACT repairs
         leaks with an offset copy of each cast instead).  (edges, ptr, idx, prism vertices float32,
         prism faces): the triangles to test for a ray near risky edge i are ``idx[ptr[i]:ptr[i + 1]]``
-        (the vertex rings of its flat triangles); prism triangle k guards edge ``k // PRISM_TRIANGLES``.
+        (see :func:`.guards.candidates`); prism triangle k guards edge ``k // PRISM_TRIANGLES``.
         Built on first use."""
         if self._guard is None:
             flat = ~self.tri_curved[:-1]
@@ -233,15 +239,7 @@ class _Tier:
                 self._guard = (None, len(edges) == 0)
             else:
                 pv, pf = prisms(self.V, edges, 4.0 * self.eps)
-                # candidates of edge i: the vertex rings of its triangles (the float64 hit can lie
-                # across a coplanar neighbour, e.g. the other triangle of a box face)
-                rptr, ridx = self.ring
-                e_of = np.repeat(np.arange(len(edges)), np.diff(ptr))
-                cnt = rptr[idx + 1] - rptr[idx]
-                cand = ridx[np.repeat(rptr[idx] - (np.cumsum(cnt) - cnt), cnt) + np.arange(int(cnt.sum()))]
-                key = np.unique(np.repeat(e_of, cnt) * (len(self.F) + 1) + cand)
-                e_of, cand = key // (len(self.F) + 1), key % (len(self.F) + 1)
-                cand_ptr = np.r_[0, np.cumsum(np.bincount(e_of, minlength=len(edges)))]
+                cand_ptr, cand = candidates(self.V, edges, ptr, idx, self.ring, flat, 4.0 * self.eps)
                 self._guard = (edges, cand_ptr, cand, np.ascontiguousarray(pv, dtype=_F32), pf)
         return None if self._guard[0] is None else self._guard
 
