@@ -222,3 +222,28 @@ def test_tiers_with_many_risky_edges_keep_the_offset_copy():
     e2.add_body([ShapeEntry(Box((1, 1, 1)), Pose.identity(), True, True)], Pose.identity())
     e2.cast(np.zeros((1, 3)) + [0, 0, 5], np.array([[0.0, 0.0, -1.0]]))
     assert e2._static_tier("bounding").guarded
+
+
+@pytest.mark.parametrize("offset", [0.0, 5e3])
+def test_exact_distance_only_gives_the_full_casts_distances(offset):
+    """A lidar's EXACT cast skips shapes and normals (distance_only): the distances are the full
+    cast's, bit for bit -- rays through edges, corners and seams, from a broadcast origin, with a
+    t_near, plus movers (a box robot) and an infinite floor plane."""
+    from sensorium.server.world.geometry import Plane
+    base = np.array([offset, -offset / 3, 0.0])
+    e = _engine(base)
+    e.add_body([ShapeEntry(Plane(), Pose.identity(), True, True)], Pose.from_axis_angle((0, 0, 1), 0.0, base))
+    robot = e.add_body([ShapeEntry(Box((0.4, 0.4, 0.3)), Pose.identity(), True, True)],
+                       Pose.from_axis_angle((0, 0, 1), 0.3, base + [1.0, 1.0, 0.15]), movable=True)
+    for eye in ([0.3, 0.2, 1.5], [-3.5, -3.0, 2.8]):
+        tgt = np.vstack([_targets(), [1.0, 1.0, 0.15] + np.random.default_rng(1).uniform(-0.3, 0.3, (200, 3))])
+        d = tgt - eye
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        o = np.broadcast_to(np.add(eye, base), d.shape)
+        for t_near in (0.0, 0.05):
+            full = e.cast(np.ascontiguousarray(o), d, t_near, 9.0)
+            lean = e.cast(o, d, t_near, 9.0, distance_only=True)
+            assert lean.normal is None and lean.shape is None
+            assert np.isfinite(full.distance).mean() > 0.5
+            assert robot in {e.shape_body(s) for s in full.shape[full.shape >= 0].tolist()}
+            np.testing.assert_array_equal(lean.distance, full.distance)

@@ -289,8 +289,8 @@ class RayEngine(TierTracer):
         reach any other moving body (the rays of 100 robots' sensors, instead of one grid lookup
         per ray).
 
-        ``distance_only``: the caller reads only ``distance`` (a lidar); FAST then skips the normals
-        and shape ids (returned as None) and the work that only serves them, with the same
+        ``distance_only``: the caller reads only ``distance`` (a lidar); the normals and shape ids
+        are then skipped (returned as None) with the work that only serves them, with the same
         distances.  Origins may be a broadcast array (one origin for all rays), never written."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
@@ -317,7 +317,6 @@ class RayEngine(TierTracer):
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
         Ou = O[:1] if O.strides[0] == 0 else O   # one origin for all rays (a broadcast array)
         big = max(map(abs, Ou.ravel().tolist())) if len(Ou) <= _SMALL else max(float(Ou.max()), -float(Ou.min()))
-        distance_only = distance_only and self._precision is Precision.FAST
         # one errstate for the whole cast: inf/NaN are handled explicitly (entering the context
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):

@@ -151,7 +151,7 @@ class _Tier:
         """Per-triangle float64 data of the refinement, computed once on first use (EXACT, or a
         FAST ray redone by the general loop): v0, e1, e2; the dual basis g1, g2 of (e1, e2) in each
         triangle's plane (barycentrics u = (P - v0).g1, v = (P - v0).g2, zero sentinel row); the
-        per-triangle boxes t_lo, t_hi."""
+        per-triangle boxes t_lo, t_hi; the smallest height h_min."""
         if self._exact is None:
             V, F = self.V, self.F
             v0 = V[F[:, 0]]
@@ -164,7 +164,13 @@ class _Tier:
             g1 = np.vstack([(g22[:, None] * e1 - g12[:, None] * e2) * inv, np.zeros((1, 3))])
             g2 = np.vstack([(g11[:, None] * e2 - g12[:, None] * e1) * inv, np.zeros((1, 3))])
             tv = V[F]
-            self._exact = {"v0": v0, "e1": e1, "e2": e2, "g1": g1, "g2": g2, "t_lo": tv.min(1), "t_hi": tv.max(1)}
+            # smallest height: every point at barycentric margin m is >= m * h_min from the edges
+            longest = np.sqrt(np.maximum(np.maximum(g11, g22), _dot(e2 - e1, e2 - e1)))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                h_min = np.linalg.norm(np.cross(e1, e2), axis=1) / longest
+            h_min = np.where(np.isfinite(h_min), h_min, 0.0)
+            self._exact = {"v0": v0, "e1": e1, "e2": e2, "g1": g1, "g2": g2, "t_lo": tv.min(1), "t_hi": tv.max(1),
+                           "h_min": h_min}
         return self._exact
 
     v0 = property(lambda self: self._exact_data()["v0"])
@@ -174,6 +180,7 @@ class _Tier:
     g2 = property(lambda self: self._exact_data()["g2"])
     t_lo = property(lambda self: self._exact_data()["t_lo"])
     t_hi = property(lambda self: self._exact_data()["t_hi"])
+    h_min = property(lambda self: self._exact_data()["h_min"])
 
     def first_vertex(self, tri: np.ndarray) -> np.ndarray:
         """v0 of the given triangles, without the full refinement data (FAST's self-hit test)."""

@@ -41,10 +41,12 @@ class TierTracer(Refiner):
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
         for an unanchored tier).  ``distance_only``: FAST may return None for shape and normal
-        (the same t; a lidar needs nothing else)."""
+        (the same t; a lidar needs nothing else), and so may EXACT."""
         if exact:
-            res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True)
-            return res if np.count_nonzero(res[0] < _INF) else None
+            res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True, distance_only=distance_only)
+            if not np.count_nonzero(res[0] < _INF):
+                return None
+            return (res[0], None, None) if distance_only else res
         return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only)
 
     def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
@@ -231,11 +233,13 @@ class TierTracer(Refiner):
             special |= np.take(tier.tri_owner, ph) == (excl[rows] if isinstance(excl, np.ndarray) else excl)
         return special if np.count_nonzero(special) else None
 
-    def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool):
+    def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool,
+                    distance_only: bool = False):
         """General path: cast, judge each hit, continue rejected rays past their hit (bounded).
         Judging: excluded owners are skipped; EXACT refines flat hits in float64 and curved hits
         on the true surface; FAST keeps Embree's answer except self-hits and shells left from
-        inside.  Returns (t, shape, normal oriented toward the origin)."""
+        inside.  Returns (t, shape, normal oriented toward the origin); ``distance_only``: the shape
+        and normal of flat hits are left unset (the same t)."""
         m = len(O)
         eps = tier.eps
         Ot = _minus(O, tier.anchor) if tier.anchored else O
@@ -331,23 +335,32 @@ class TierTracer(Refiner):
                     Dr = _rows(D, rows)
                     dn = _dot(Dr, nrm)
                     if exact:
-                        tx = _dot(np.take(tier.v0, tri, axis=0) - _rows(Ot, rows), nrm) / dn
+                        Or = _rows(Ot, rows)
+                        V0 = np.take(tier.v0, tri, axis=0)
+                        tx = _dot(V0 - Or, nrm) / dn
                         ok = np.isfinite(tx) & (tx >= lo[rows]) & (tx <= lim[rows])
                         # Embree barycentrics comfortably inside the triangle: float32 cannot have
                         # picked the wrong one and its float64 plane gives the exact distance; near
                         # an edge (or repaired), test in float64
                         hf = h[fl]
                         u, v = res["u"][hf], res["v"][hf]
-                        near_edge = ~(np.minimum(np.minimum(u, v), 1.0 - u - v) > 1e-4)
+                        margin = np.minimum(np.minimum(u, v), 1.0 - u - v)
+                        near_edge = ~(margin > 1e-4)
                         if repaired is not None:
                             near_edge |= repaired[hf]
-                        edge = near_edge.nonzero()[0]
-                        # float64 barycentrics of the plane hit: in a coarse float32 frame Embree
-                        # can report comfortable barycentrics on the adjacent face's triangle
-                        P = _rows(Ot, rows) + tx[:, None] * Dr - np.take(tier.v0, tri, axis=0)
-                        bu = _dot(P, np.take(tier.g1, tri, axis=0))
-                        bv = _dot(P, np.take(tier.g2, tri, axis=0))
-                        near_edge |= ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
+                        # float64 barycentrics of the plane hit (in a coarse float32 frame Embree
+                        # can report comfortable barycentrics on the adjacent face's triangle),
+                        # unless Embree's hit lies farther inside than the float32 rounding of the
+                        # ray and the triangle can move it (a few ulps, < 4 eps, across the plane:
+                        # / sin of the incidence): then they are inside for sure
+                        check = ~(margin * np.take(tier.h_min, tri) * np.abs(dn) > 4.0 * eps * np.sqrt(_dot(Dr, Dr)))
+                        check &= ~near_edge
+                        ci = check.nonzero()[0]
+                        if len(ci):
+                            P = Or[ci] + tx[ci, None] * Dr[ci] - V0[ci]
+                            bu = _dot(P, np.take(tier.g1, tri[ci], axis=0))
+                            bv = _dot(P, np.take(tier.g2, tri[ci], axis=0))
+                            near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
                         edge = near_edge.nonzero()[0]
                         if len(edge):
                             r = rows[edge]
@@ -367,12 +380,19 @@ class TierTracer(Refiner):
                         gap = np.abs(_dot(_rows(Ot, rows) - np.take(tier.v0, tri, axis=0), nrm))
                         ok = ~((t_e[h[fl]] < seg[rows] + eps) & (gap <= 2.0 * eps))  # self-hit
                     acc = ok & (tx < best_t[rows])
-                    nrm *= np.where(dn > 0.0, -1.0, 1.0)[:, None]   # toward the origin
                     if len(rows) == m and acc.all():
-                        best_t[:], best_s[:], best_n[:] = tx, tier.tri_shape[tri], nrm
+                        best_t[:] = tx
+                        if not distance_only:
+                            nrm *= np.where(dn > 0.0, -1.0, 1.0)[:, None]   # toward the origin
+                            best_s[:], best_n[:] = tier.tri_shape[tri], nrm
                     else:
-                        r = rows[acc]
-                        best_t[r], best_s[r], best_n[r] = tx[acc], tier.tri_shape[tri[acc]], nrm[acc]
+                        k = acc.nonzero()[0]
+                        r = rows[k]
+                        best_t[r] = tx[k]
+                        if not distance_only:
+                            nk = np.take(nrm, k, axis=0)
+                            nk *= np.where(dn[k] > 0.0, -1.0, 1.0)[:, None]   # toward the origin
+                            best_s[r], best_n[r] = tier.tri_shape[tri[k]], nk
                     rej[fl[~ok]] = True
                 # --- curved shells (sphere, cylinder, capsule)
                 cv = (curved & ~rej).nonzero()[0]
