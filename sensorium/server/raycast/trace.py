@@ -242,7 +242,10 @@ class TierTracer(Refiner):
         and normal of flat hits are left unset (the same t)."""
         m = len(O)
         eps = tier.eps
-        Ot = _minus(O, tier.anchor) if tier.anchored else O
+        if tier.anchored:   # one origin (a broadcast array) stays one
+            Ot = np.broadcast_to(O[:1] - tier.anchor, O.shape) if O.strides[0] == 0 and m else _minus(O, tier.anchor)
+        else:
+            Ot = O
         if isinstance(t_near, np.ndarray):       # accepted hits: lo <= t <= lim
             lo = np.maximum(t_near, eps64)
             seg = np.maximum(t_near - eps, eps)   # Embree start along the ray
@@ -257,7 +260,8 @@ class TierTracer(Refiner):
         best_s = np.full(m, -1, dtype=np.int64)
         best_n = np.zeros((m, 3))
         r2 = tier.radius ** 2
-        if m and max(-float(Ot.min()), float(Ot.max())) * 1.7321 > tier.radius:
+        Ou = Ot[:1] if m and Ot.strides[0] == 0 else Ot
+        if m and max(-float(Ou.min()), float(Ou.max())) * 1.7321 > tier.radius:
             # some origins outside the tier's sphere: clip to it
             b = _dot(Ot, D)
             q2 = _dot(Ot, Ot) - b * b
@@ -274,13 +278,17 @@ class TierTracer(Refiner):
                 np.minimum(lim, best_t, out=lim)
 
         act = alive.nonzero()[0]
+        one_origin = Ot.strides[0] == 0 and m > 0   # a broadcast array: one origin for all rays
+        if exact:   # bound of |d| (the float32 reach below scales with it): sqrt(3) max |component|
+            d_max = 1.7321 * max(float(D.max()), -float(D.min())) if m else 0.0
         delta = None   # per-ray continuation step, allocated on the first continuation
         for _ in range(_MAX_LOOPS):
             if len(act) == 0:
                 break
             view = slice(None) if len(act) == m else act   # all rays active: views, not copies
             oa, da, sa = Ot[view], D[view], seg[view]
-            o_seg = oa + sa[:, None] * da
+            o_seg = da * sa[:, None]
+            o_seg += oa
             d32 = da.astype(_F32)
             far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)
             far32 = np.where(far >= 0.0, far, -1.0).astype(_F32)
@@ -320,7 +328,7 @@ class TierTracer(Refiner):
             cont = np.zeros(len(act), dtype=bool)   # rays to continue past their hit
             if len(h):
                 ph = prim[h]
-                rows_h = act[h]
+                rows_h = h if len(act) == m else act[h]   # all active: act is 0..m-1
                 rej = np.zeros(len(h), dtype=bool)
                 if excl_arr is not None:
                     rej |= tier.tri_owner[ph] == excl_arr[rows_h]
@@ -335,9 +343,11 @@ class TierTracer(Refiner):
                     Dr = _rows(D, rows)
                     dn = _dot(Dr, nrm)
                     if exact:
-                        Or = _rows(Ot, rows)
                         V0 = np.take(tier.v0, tri, axis=0)
-                        tx = _dot(V0 - Or, nrm) / dn
+                        if one_origin:   # a lidar: v0 - o for its one origin (the same values)
+                            tx = _dot(_minus(V0, Ot[0]), nrm) / dn
+                        else:
+                            tx = _dot(V0 - _rows(Ot, rows), nrm) / dn
                         ok = np.isfinite(tx) & (tx >= lo[rows]) & (tx <= lim[rows])
                         # Embree barycentrics comfortably inside the triangle: float32 cannot have
                         # picked the wrong one and its float64 plane gives the exact distance; near
@@ -353,11 +363,11 @@ class TierTracer(Refiner):
                         # unless Embree's hit lies farther inside than the float32 rounding of the
                         # ray and the triangle can move it (a few ulps, < 4 eps, across the plane:
                         # / sin of the incidence): then they are inside for sure
-                        check = ~(margin * np.take(tier.h_min, tri) * np.abs(dn) > 4.0 * eps * np.sqrt(_dot(Dr, Dr)))
+                        check = ~(margin * np.take(tier.h_min, tri) * np.abs(dn) > 4.0 * eps * d_max)
                         check &= ~near_edge
                         ci = check.nonzero()[0]
                         if len(ci):
-                            P = Or[ci] + tx[ci, None] * Dr[ci] - V0[ci]
+                            P = Ot[rows[ci]] + tx[ci, None] * Dr[ci] - V0[ci]
                             bu = _dot(P, np.take(tier.g1, tri[ci], axis=0))
                             bv = _dot(P, np.take(tier.g2, tri[ci], axis=0))
                             near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
@@ -399,7 +409,7 @@ class TierTracer(Refiner):
                 if len(cv):
                     rows = rows_h[cv]
                     nrm = tier.normal[ph[cv]]
-                    leaving = _dot(nrm, D[rows]) > 0.0
+                    leaving = None if exact else _dot(nrm, D[rows]) > 0.0
                     todo = np.ones(len(cv), dtype=bool) if exact else leaving
                     if not exact:  # FAST trusts the shell it enters
                         keep = (~todo).nonzero()[0]
