@@ -33,7 +33,9 @@ Architecture
 * FAST uses plain scenes, EXACT robust ones (``EmbreeScene(robust=True)``), each built when the
   mode first needs it.  Measured in a 600-triangle room with 131k lidar rays, all hitting: robust
   traversal costs ~40% more.  On rays aimed exactly at the vertices and edge midpoints of closed
-  meshes, the plain scenes leak ~4% of rays; robust ones plus the repair below leak none.
+  meshes, the plain scenes leak ~4% of rays; robust ones plus the repair below leak none.  The
+  EXACT scene of a tier with few risky edges also holds their guards (:mod:`.guards`) as a second
+  geometry, beside a copy without them (built together, one build).
 * Small batches (a distance sensor's few rays) are dominated by the fixed cost of each numpy
   call (~1-3 us), so the per-cast path avoids work that does not apply: per-ray parameters that
   are uniform collapse to scalars, a tier that no ray hits returns at once, judging runs on the
@@ -53,11 +55,20 @@ Precision
 * EXACT: every hit is re-intersected in float64: boxes/meshes on the plane of the hit triangle,
   with a float64 Moller-Trumbore test on the triangle and its vertex neighbours when Embree's
   barycentrics are within 1e-4 of an edge; spheres/cylinders/capsules on the true surface.  Rays
-  whose refinement misses are continued past the hit (bounded loop).  Each Embree cast is paired
-  with a copy offset 4 float32 ulps perpendicular to the ray.  When the copy hits a nearer
-  triangle, and the float64 ray hits that triangle or one of its neighbours (barycentric
-  tolerance 1e-9), the nearer hit is taken.  This repairs leaks through shared edges and
-  vertices (``counters["leak_repairs"]``).
+  whose refinement misses are continued past the hit (bounded loop).  Embree's barycentrics are
+  trusted to pick the triangle only where they lie farther inside it than float32 rounding can
+  move the hit (``h_min`` margin); elsewhere the plane hit's float64 barycentrics decide.
+* EXACT repair rule (one cast; :mod:`.guards` proves it): after one watertight float32 cast a
+  float64 hit can be missed only where the float64 ray passes within float32 reach (< eps) of a
+  *risky* edge -- a boundary edge, or one between faces at an angle (box edges); curved shells
+  are inflated beyond that reach instead.  Thin prisms around the risky edges sit in the EXACT
+  scene: a ray that meets one is tested in float64 against that edge's triangles and their vertex
+  rings (and those of edges whose prisms come close), the same past every further prism up to its
+  hit, and then gets the hit of the scene without prisms (``counters["edge_guard_hits"]`` counts
+  the float64 hits they found).  A tier with many risky edges (a curved or terrain mesh: more
+  than 1.2 per flat triangle, or 20,000) keeps the former repair instead: each Embree cast paired
+  with a copy offset 4 float32 ulps perpendicular to the ray, whose nearer hits are taken when the
+  float64 ray hits that triangle or a neighbour (``counters["leak_repairs"]``).
 
 Epsilons (per tier; res = float32 spacing at the tier's radius in the anchored frame)
 * ``eps`` = max(1e-6 m, 8 res): self-hit distance and continuation step.  EXACT casts start
@@ -69,6 +80,9 @@ Epsilons (per tier; res = float32 spacing at the tier's radius in the anchored f
 Known limits (measure-zero in practice)
 * Two surfaces closer together along a ray than float32 resolution (~res) may come out in either order.
 * A surface within ``eps`` beyond a rejected or continued hit can be skipped.
+* EXACT guards: a float64 hit on a flat triangle seen at grazing incidence alpha can be missed
+  when another surface lies less than ~eps / sin(alpha) behind it (the float32 ray crosses the
+  guard past that surface), or across more than one coplanar sliver triangle from its risky edge.
 """
 
 from __future__ import annotations
