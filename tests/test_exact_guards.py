@@ -247,3 +247,21 @@ def test_exact_distance_only_gives_the_full_casts_distances(offset):
             assert np.isfinite(full.distance).mean() > 0.5
             assert robot in {e.shape_body(s) for s in full.shape[full.shape >= 0].tolist()}
             np.testing.assert_array_equal(lean.distance, full.distance)
+
+
+def test_dense_and_gathered_flat_judging_agree_bit_for_bit():
+    """A pass where most rays hit flat triangles judges them on whole arrays; mixed with twice as
+    many rays that hit nothing, the same rays go through the gathered path: identical answers
+    (distances, shapes, normals) on rays through edges, corners and seams."""
+    o, d = _rays(7)
+    o, d = o[::3], d[::3]
+    e = _engine(np.zeros(3))
+    dense = e.cast(o, d)
+    assert np.isfinite(dense.distance).mean() > 0.5
+    up = np.tile([0.0, 0.0, 1.0], (2 * len(o), 1))
+    sky = np.tile([0.0, 0.0, 10.0], (2 * len(o), 1))   # above everything, looking up
+    mixed = e.cast(np.vstack([o, sky]), np.vstack([d, up]))
+    assert not np.isfinite(mixed.distance[len(o):]).any()
+    np.testing.assert_array_equal(mixed.distance[:len(o)], dense.distance)
+    np.testing.assert_array_equal(mixed.shape[:len(o)], dense.shape)
+    np.testing.assert_array_equal(mixed.normal[:len(o)], dense.normal)

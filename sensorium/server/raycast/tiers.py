@@ -113,6 +113,8 @@ class _Tier:
         slot_of_shape[self.c_shape] = np.arange(len(c_shape))
         self.tri_slot = slot_of_shape[self.tri_shape].astype(np.int32)  # sentinel row maps to -1 as well
         self.tri_curved = self.tri_slot >= 0
+        self.tri_flat = ~self.tri_curved      # a flat triangle (sentinel row: False)
+        self.tri_flat[-1] = False
         self.c_code = np.array(c_code, dtype=np.int64)
         self.c_r = np.array(c_r, dtype=np.float64)
         self.c_h = np.array(c_h, dtype=np.float64)
