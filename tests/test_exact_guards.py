@@ -265,3 +265,14 @@ def test_dense_and_gathered_flat_judging_agree_bit_for_bit():
     np.testing.assert_array_equal(mixed.distance[:len(o)], dense.distance)
     np.testing.assert_array_equal(mixed.shape[:len(o)], dense.shape)
     np.testing.assert_array_equal(mixed.normal[:len(o)], dense.normal)
+
+
+def test_a_float32_frame_far_coarser_than_the_geometry_keeps_the_offset_copy():
+    """A room 1e6 m from a landmark box at the origin, one static tier: float32 resolution ~6 cm
+    there, prisms would be ~2 m wide (most rays would meet one): the offset copy instead.  At 1e4 m
+    (3 cm prisms beside 3-10 m edges) the guards stay."""
+    for far, guarded in ((1e6, False), (1e4, True)):
+        e = _engine(np.array([far, far / 2, 0.0]), landmark=True)
+        e.cast(np.array([[far + 0.3, far / 2 + 0.2, 1.5]]), np.array([[1.0, 0.0, 0.0]]))
+        tier = e._static_tier("bounding")
+        assert (tier.guard is not None) == guarded and tier.guarded == guarded

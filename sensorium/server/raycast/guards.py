@@ -32,6 +32,9 @@ import numpy as np
 # triangles per edge would make the scene several times larger: those tiers keep the offset copy)
 MAX_GUARDED_EDGES = 20000
 MAX_EDGES_PER_FLAT_TRIANGLE = 1.2
+# ... and while the prisms stay thin beside the edges: in a float32 frame far coarser than the
+# geometry (a room in a tier spanning 1e6 m: 2 m prisms) most rays would meet one
+MAX_WIDTH_PER_EDGE_LENGTH = 0.05
 _COPLANAR = 1.0 - 1e-12   # cosine between two unit normals treated as the same plane
 
 # the 6 faces of a prism whose corners are numbered (end, side1, side2) -> 4 * end + 2 * s1 + s2

@@ -14,6 +14,7 @@ from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _
 from sensorium.server.raycast.guards import (
     MAX_EDGES_PER_FLAT_TRIANGLE,
     MAX_GUARDED_EDGES,
+    MAX_WIDTH_PER_EDGE_LENGTH,
     candidates,
     prisms,
     risky_edges,
@@ -235,8 +236,9 @@ class _Tier:
 
     @property
     def guard(self) -> tuple | None:
-        """Edge guards of the EXACT scene, or None (no risky edge, or too many: then EXACT repairs
-        leaks with an offset copy of each cast instead).  (edges, ptr, idx, prism vertices float32,
+        """Edge guards of the EXACT scene, or None (no risky edge; or too many, or too wide for
+        the geometry (see :mod:`.guards`): then EXACT repairs leaks with an offset copy of each cast
+        instead).  (edges, ptr, idx, prism vertices float32,
         prism faces): the triangles to test for a ray near risky edge i are ``idx[ptr[i]:ptr[i + 1]]``
         (see :func:`.guards.candidates`); prism triangle k guards edge ``k // PRISM_TRIANGLES``.
         Built on first use."""
@@ -244,11 +246,14 @@ class _Tier:
             flat = ~self.tri_curved[:-1]
             edges, ptr, idx = risky_edges(self.F, flat, self.normal[:-1])
             n_flat = int(np.count_nonzero(flat))
-            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat:
+            w = 4.0 * self.eps
+            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat \
+                    or w > MAX_WIDTH_PER_EDGE_LENGTH * float(np.median(np.linalg.norm(
+                        self.V[edges[:, 0]] - self.V[edges[:, 1]], axis=1))):
                 self._guard = (None, len(edges) == 0)
             else:
-                pv, pf = prisms(self.V, edges, 4.0 * self.eps)
-                cand_ptr, cand = candidates(self.V, edges, ptr, idx, self.ring, flat, 4.0 * self.eps)
+                pv, pf = prisms(self.V, edges, w)
+                cand_ptr, cand = candidates(self.V, edges, ptr, idx, self.ring, flat, w)
                 self._guard = (edges, cand_ptr, cand, np.ascontiguousarray(pv, dtype=_F32), pf)
         return None if self._guard[0] is None else self._guard
 
