@@ -65,9 +65,9 @@ class Refiner:
             ok[bad[got]] = True
         return ok, t, tri
 
-    def _guard_rays(self, tier: _Tier, res, g, act, Ot, D, o_seg, d32, sa, far, lo, lim, excl, best_t, best_s, best_n):
+    def _guard_rays(self, tier: _Tier, res, g, act, Ot, D, o32, d32, sa, far, lo, lim, excl, best_t, best_s, best_n):
         """The second look of EXACT (see :mod:`.guards`) for the rays ``g`` (rows of this pass's Embree
-        results ``res``; ray ``act[g]``, segment from ``sa``, float64 ``far``) whose first hit was a
+        results ``res``; ray ``act[g]``, segment from ``sa`` (float32 start ``o32``), float64 ``far``) whose first hit was a
         guard: (1) their hit in the scene without guards (it replaces theirs in ``res``, so that the
         pass goes on as if the guards were not there); (2) a float64 test of the guarded edge's
         triangles, and the same for every further guard met up to a little past that hit (steps of
@@ -76,10 +76,9 @@ class Refiner:
         rows = act[g]
         fg = far[g]
         s = res["tfar"][g].astype(np.float64)   # the first guard, from the segment start
-        o32 = o_seg[g].astype(_F32)
         d32g = d32[g]
         self.counters["embree_calls"] += 1
-        r0 = tier.bare_scene().run(o32, d32g, np.where(fg >= 0.0, fg, -1.0).astype(_F32), output=1)
+        r0 = tier.bare_scene().run(o32[g], d32g, np.where(fg >= 0.0, fg, -1.0).astype(_F32), output=1)
         w = 4.0 * tier.eps
         stop = np.minimum(fg, np.where(r0["primID"] >= 0, r0["tfar"].astype(np.float64) + 4.0 * w, _INF))
         self._guard_hits(tier, Ot, D, rows, res["primID"][g], lo, lim, excl, best_t, best_s, best_n)

@@ -116,6 +116,7 @@ class _Tier:
         self.tri_curved = self.tri_slot >= 0
         self.tri_flat = ~self.tri_curved      # a flat triangle (sentinel row: False)
         self.tri_flat[-1] = False
+        self.flat_index = self.tri_flat.nonzero()[0]
         self.c_code = np.array(c_code, dtype=np.int64)
         self.c_r = np.array(c_r, dtype=np.float64)
         self.c_h = np.array(c_h, dtype=np.float64)

@@ -243,8 +243,14 @@ class TierTracer(Refiner):
         flat = np.take(tier.tri_flat, prim)            # primID -1 picks the sentinel row: False
         nrm = np.take(tier.normal, prim, axis=0)       # ... and a zero normal
         dn = _dot(D, nrm)
-        V0 = np.take(tier.v0, prim, axis=0, mode="clip")
-        tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, nrm) / dn
+        fi = tier.flat_index
+        if one_origin and len(fi) < len(prim):   # n.(v0 - o) per flat triangle, then per ray (same values)
+            c = np.zeros(len(tier.normal))
+            c[fi] = _dot(_minus(tier.v0[fi], Ot[0]), tier.normal[fi])
+            tx = np.take(c, prim) / dn
+        else:
+            V0 = np.take(tier.v0, prim, axis=0, mode="clip")
+            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, nrm) / dn
         ok = np.isfinite(tx) & (tx >= lo) & (tx <= lim) & flat
         u, v = res["u"], res["v"]
         margin = np.minimum(np.minimum(u, v), 1.0 - u - v)
@@ -253,7 +259,7 @@ class TierTracer(Refiner):
         check &= flat & ~near_edge
         ci = check.nonzero()[0]
         if len(ci):
-            P = Ot[ci] + tx[ci, None] * D[ci] - V0[ci]
+            P = Ot[ci] + tx[ci, None] * D[ci] - np.take(tier.v0, prim[ci], axis=0)
             bu = _dot(P, np.take(tier.g1, prim[ci], axis=0))
             bv = _dot(P, np.take(tier.g2, prim[ci], axis=0))
             near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
@@ -332,25 +338,25 @@ class TierTracer(Refiner):
                 break
             view = slice(None) if len(act) == m else act   # all rays active: views, not copies
             oa, da, sa = Ot[view], D[view], seg[view]
-            o_seg = da * sa[:, None]
-            o_seg += oa
+            o32 = np.empty(da.shape, dtype=_F32)   # oa + sa da in float64, rounded once
+            np.add(oa, da * sa[:, None], out=o32, casting="same_kind")
             d32 = da.astype(_F32)
             far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)
             far32 = np.where(far >= 0.0, far, -1.0).astype(_F32)
             copy = exact and not tier.guarded
-            res = self._run(tier, o_seg.astype(_F32), d32, far32.copy() if copy else far32, robust=exact)
+            res = self._run(tier, o32, d32, far32.copy() if copy else far32, robust=exact)
             prim, tf = res["primID"].astype(np.int64), res["tfar"]
             repaired = fixed = None
             if exact and not copy:
                 if tier.guard is not None:   # rays that met an edge guard first: the second look
                     g = (res["geomID"] == 1).nonzero()[0]
                     if len(g):
-                        self._guard_rays(tier, res, g, act, Ot, D, o_seg, d32, sa, far, lo, lim, excl_arr,
+                        self._guard_rays(tier, res, g, act, Ot, D, o32, d32, sa, far, lo, lim, excl_arr,
                                          best_t, best_s, best_n)
                         prim = res["primID"].astype(np.int64)
             elif exact:
                 # leak repair: a copy offset by a few ulps perpendicular to the ray
-                o2 = (o_seg + _perpendicular(da) * (_LEAK_OFFSET_ULPS * tier.res)).astype(_F32)
+                o2 = (oa + sa[:, None] * da + _perpendicular(da) * (_LEAK_OFFSET_ULPS * tier.res)).astype(_F32)
                 prim2 = self._run(tier, o2, d32, far32, robust=True)["primID"]
                 sus = ((prim2 >= 0) & (prim2 != prim)).nonzero()[0]
                 if len(sus):
