@@ -233,57 +233,6 @@ class TierTracer(Refiner):
             special |= np.take(tier.tri_owner, ph) == (excl[rows] if isinstance(excl, np.ndarray) else excl)
         return special if np.count_nonzero(special) else None
 
-    def _flat_dense(self, tier: _Tier, res, prim, Ot, D, one_origin: bool, lo, lim, t_e, d_max: float,
-                    best_t, best_s, best_n, distance_only: bool):
-        """EXACT's judging of flat hits (see :meth:`_trace_loop`) in a pass where every ray is active
-        and most hit a flat triangle (a lidar in a room): on whole arrays, misses and curved hits
-        masked, instead of gathering the hit rows; the same values.  Updates ``best_*``; returns
-        the mask of rays to continue (refinement missed)."""
-        eps = tier.eps
-        flat = np.take(tier.tri_flat, prim)            # primID -1 picks the sentinel row: False
-        nrm = np.take(tier.normal, prim, axis=0)       # ... and a zero normal
-        dn = _dot(D, nrm)
-        fi = tier.flat_index
-        if one_origin and len(fi) < len(prim):   # n.(v0 - o) per flat triangle, then per ray (same values)
-            c = np.zeros(len(tier.normal))
-            c[fi] = _dot(_minus(tier.v0[fi], Ot[0]), tier.normal[fi])
-            tx = np.take(c, prim) / dn
-        else:
-            V0 = np.take(tier.v0, prim, axis=0, mode="clip")
-            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, nrm) / dn
-        ok = np.isfinite(tx) & (tx >= lo) & (tx <= lim) & flat
-        u, v = res["u"], res["v"]
-        margin = np.minimum(np.minimum(u, v), 1.0 - u - v)
-        near_edge = ~(margin > 1e-4) & flat
-        check = ~(margin * np.take(tier.h_min, prim, mode="clip") * np.abs(dn) > 4.0 * eps * d_max)
-        check &= flat & ~near_edge
-        ci = check.nonzero()[0]
-        if len(ci):
-            P = Ot[ci] + tx[ci, None] * D[ci] - np.take(tier.v0, prim[ci], axis=0)
-            bu = _dot(P, np.take(tier.g1, prim[ci], axis=0))
-            bv = _dot(P, np.take(tier.g2, prim[ci], axis=0))
-            near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
-        r = near_edge.nonzero()[0]
-        tri = prim
-        if len(r):
-            tri = prim.copy()
-            ok_e, t_x, tri_e = self._refine_triangles(tier, Ot[r], D[r], tri[r], lo[r], lim[r])
-            miss = (~ok_e).nonzero()[0]
-            if len(miss):   # not the hit triangle nor a vertex neighbour: nearby triangles
-                rm = r[miss]
-                ok_n, t_n, tri_n = self._nearby_triangles(tier, Ot[rm], D[rm], t_e[rm], lo[rm], lim[rm], None)
-                ok_e[miss], t_x[miss], tri_e[miss] = ok_n, t_n, tri_n
-            ok[r], tx[r], tri[r] = ok_e, t_x, tri_e
-            nrm[r] = tier.normal[tri_e]
-            dn[r] = _dot(D[r], nrm[r])
-        k = (ok & (tx < best_t)).nonzero()[0]
-        best_t[k] = tx[k]
-        if not distance_only:
-            nk = np.take(nrm, k, axis=0)
-            nk *= np.where(dn[k] > 0.0, -1.0, 1.0)[:, None]   # toward the origin
-            best_s[k], best_n[k] = tier.tri_shape[tri[k]], nk
-        return flat & ~ok
-
     def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool,
                     distance_only: bool = False):
         """General path: cast, judge each hit, continue rejected rays past their hit (bounded).
