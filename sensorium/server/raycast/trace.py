@@ -268,8 +268,10 @@ class TierTracer(Refiner):
             half = np.sqrt(np.maximum(r2 - q2, 0.0))
             np.maximum(seg, -b - half, out=seg)
             alive = (q2 <= r2) & (-b + half >= lo) & (seg <= lim + eps)
+            s_one = None
         else:
             alive = seg <= lim + eps
+            s_one = None if isinstance(t_near, np.ndarray) else float(seg[0]) if m else None   # every start alike
         if tier.has_curved:
             pre = self._contained_prepass(tier, Ot, D, lo, lim, excl)
             if pre is not None:
@@ -288,7 +290,8 @@ class TierTracer(Refiner):
             view = slice(None) if len(act) == m else act   # all rays active: views, not copies
             oa, da, sa = Ot[view], D[view], seg[view]
             o32 = np.empty(da.shape, dtype=_F32)   # oa + sa da in float64, rounded once
-            np.add(oa, da * sa[:, None], out=o32, casting="same_kind")
+            np.add(oa, da * (sa[:, None] if s_one is None else s_one), out=o32, casting="same_kind")
+            s_one = None   # continued rays start apart
             d32 = da.astype(_F32)
             far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)
             far32 = np.where(far >= 0.0, far, -1.0).astype(_F32)
@@ -322,7 +325,7 @@ class TierTracer(Refiner):
             h = (prim >= 0).nonzero()[0]
             if len(h) == 0:  # nothing hit: every active ray is done
                 break
-            t_e = np.where(prim >= 0, sa + tf, _INF)   # Embree distance along the whole ray
+            t_e = sa + tf   # Embree distance along the whole ray (read at hit rows only)
             if fixed is not None:
                 t_e[fixed[0]] = fixed[1]
             cont = np.zeros(len(act), dtype=bool)   # rays to continue past their hit
