@@ -142,8 +142,9 @@ class Refiner:
         the mask of rays to continue (refinement missed)."""
         eps = tier.eps
         flat = np.take(tier.tri_flat, prim)            # primID -1 picks the sentinel row: False
-        nrm = np.take(tier.normal, prim, axis=0)       # ... and a zero normal
-        dn = _dot(D, nrm)
+        nx, ny, nz = (np.take(c, prim) for c in tier.normal_cols)   # ... and a zero normal
+        dn = D[:, 0] * nx + D[:, 1] * ny              # = _dot(D, normal[prim]), column by column
+        dn += D[:, 2] * nz
         fi = tier.flat_index
         if one_origin and len(fi) < len(prim):   # n.(v0 - o) per flat triangle, then per ray (same values)
             c = np.zeros(len(tier.normal))
@@ -151,7 +152,7 @@ class Refiner:
             tx = np.take(c, prim) / dn
         else:
             V0 = np.take(tier.v0, prim, axis=0, mode="clip")
-            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, nrm) / dn
+            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, np.take(tier.normal, prim, axis=0)) / dn
         ok = np.isfinite(tx) & (tx >= lo) & (tx <= lim) & flat
         u, v = res["u"], res["v"]
         margin = np.minimum(np.minimum(u, v), 1.0 - u - v)
@@ -175,12 +176,11 @@ class Refiner:
                 ok_n, t_n, tri_n = self._nearby_triangles(tier, Ot[rm], D[rm], t_e[rm], lo[rm], lim[rm], None)
                 ok_e[miss], t_x[miss], tri_e[miss] = ok_n, t_n, tri_n
             ok[r], tx[r], tri[r] = ok_e, t_x, tri_e
-            nrm[r] = tier.normal[tri_e]
-            dn[r] = _dot(D[r], nrm[r])
+            dn[r] = _dot(D[r], tier.normal[tri_e])
         k = (ok & (tx < best_t)).nonzero()[0]
         best_t[k] = tx[k]
         if not distance_only:
-            nk = np.take(nrm, k, axis=0)
+            nk = np.take(tier.normal, tri[k], axis=0)
             nk *= np.where(dn[k] > 0.0, -1.0, 1.0)[:, None]   # toward the origin
             best_s[k], best_n[k] = tier.tri_shape[tri[k]], nk
         return flat & ~ok
@@ -220,8 +220,9 @@ class Refiner:
         tri[~ok] = -1
         return ok, t, tri
 
-    def _analytic(self, tier: _Tier, slots, Ot, D, lo, hi):
-        """True-surface hit of curved shapes (tier-frame rays): (t, tier-frame unit normal)."""
+    def _analytic(self, tier: _Tier, slots, Ot, D, lo, hi, normals=True):
+        """True-surface hit of curved shapes (tier-frame rays): (t, tier-frame unit normal); the
+        normal None without ``normals`` (the same t)."""
         n = len(slots)
         lo, hi = _full(lo, n), _full(hi, n)
         if n and not np.count_nonzero(slots != slots[0]):   # one shape: one matrix
@@ -229,20 +230,22 @@ class Refiner:
             R = tier.c_rot[s0]
             p = _mat(_minus(Ot, tier.c_pos[s0]), R)   # R^T (o - c)
             d = _mat(D, R)
-            t, n_loc = _analytic_local(int(tier.c_code[s0]), p, d, tier.c_r[s0], tier.c_h[s0], lo, hi)
-            return t, _mat(n_loc, R.T)
+            t, n_loc = _analytic_local(int(tier.c_code[s0]), p, d, tier.c_r[s0], tier.c_h[s0], lo, hi, normals)
+            return t, (None if n_loc is None else _mat(n_loc, R.T))
         R = tier.c_rot[slots]
         p = np.einsum("nij,ni->nj", R, Ot - tier.c_pos[slots])  # R^T (o - c)
         d = np.einsum("nij,ni->nj", R, D)
         t = np.full(n, _INF)
-        n_loc = np.zeros((n, 3))
+        n_loc = np.zeros((n, 3)) if normals else None
         codes = tier.c_code[slots]
         for code in (_SPHERE, _CYLINDER, _CAPSULE):
             g = (codes == code).nonzero()[0]
             if len(g):
                 s = slots[g]
-                t[g], n_loc[g] = _analytic_local(code, p[g], d[g], tier.c_r[s], tier.c_h[s], lo[g], hi[g])
-        return t, np.einsum("nij,nj->ni", R, n_loc)
+                t[g], ng = _analytic_local(code, p[g], d[g], tier.c_r[s], tier.c_h[s], lo[g], hi[g], normals)
+                if normals:
+                    n_loc[g] = ng
+        return t, (np.einsum("nij,nj->ni", R, n_loc) if normals else None)
 
     def _contained_prepass(self, tier: _Tier, Ot, D, lo, lim, excl):
         """Rays starting inside a curved shell may reach the true surface before any crossing of

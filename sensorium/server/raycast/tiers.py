@@ -155,7 +155,7 @@ class _Tier:
         """Per-triangle float64 data of the refinement, computed once on first use (EXACT, or a
         FAST ray redone by the general loop): v0, e1, e2; the dual basis g1, g2 of (e1, e2) in each
         triangle's plane (barycentrics u = (P - v0).g1, v = (P - v0).g2, zero sentinel row); the
-        per-triangle boxes t_lo, t_hi; the smallest height h_min."""
+        per-triangle boxes t_lo, t_hi; the smallest height h_min; the normals' columns."""
         if self._exact is None:
             V, F = self.V, self.F
             v0 = V[F[:, 0]]
@@ -174,7 +174,7 @@ class _Tier:
                 h_min = np.linalg.norm(np.cross(e1, e2), axis=1) / longest
             h_min = np.where(np.isfinite(h_min), h_min, 0.0)
             self._exact = {"v0": v0, "e1": e1, "e2": e2, "g1": g1, "g2": g2, "t_lo": tv.min(1), "t_hi": tv.max(1),
-                           "h_min": h_min}
+                           "h_min": h_min, "normal_cols": tuple(np.ascontiguousarray(self.normal[:, k]) for k in range(3))}
         return self._exact
 
     v0 = property(lambda self: self._exact_data()["v0"])
@@ -185,6 +185,7 @@ class _Tier:
     t_lo = property(lambda self: self._exact_data()["t_lo"])
     t_hi = property(lambda self: self._exact_data()["t_hi"])
     h_min = property(lambda self: self._exact_data()["h_min"])
+    normal_cols = property(lambda self: self._exact_data()["normal_cols"])
 
     def first_vertex(self, tri: np.ndarray) -> np.ndarray:
         """v0 of the given triangles, without the full refinement data (FAST's self-hit test)."""

@@ -428,13 +428,15 @@ class TierTracer(Refiner):
                     if len(tdo):
                         rr = rows[tdo]
                         sl = slot[cv[tdo]]
-                        ta, na = self._analytic(tier, sl, Ot[rr], D[rr], lo[rr], lim[rr])
+                        ta, na = self._analytic(tier, sl, Ot[rr], D[rr], lo[rr], lim[rr], not distance_only)
                         found = np.isfinite(ta)
                         better = found & (ta < best_t[rr])
                         r = rr[better]
-                        na = na[better]
-                        na[_dot(na, D[r]) > 0.0] *= -1.0
-                        best_t[r], best_s[r], best_n[r] = ta[better], tier.c_shape[sl[better]], na
+                        best_t[r] = ta[better]
+                        if na is not None:
+                            na = na[better]
+                            na[_dot(na, D[r]) > 0.0] *= -1.0
+                            best_s[r], best_n[r] = tier.c_shape[sl[better]], na
                         lim[rr] = np.minimum(lim[rr], np.where(found, ta, _INF))
                         # continue if missed, or if something else could sit between the shell
                         # crossing and the true surface (shell overlaps another shape)
