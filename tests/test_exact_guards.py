@@ -11,6 +11,8 @@ float32's resolution at these coordinates.  Each answer is compared with the flo
 the closed form than the former offset-copy repair (forced on the same rays).
 """
 
+import zlib
+
 import numpy as np
 import pytest
 import trimesh
@@ -276,3 +278,50 @@ def test_a_float32_frame_far_coarser_than_the_geometry_keeps_the_offset_copy():
         e.cast(np.array([[far + 0.3, far / 2 + 0.2, 1.5]]), np.array([[1.0, 0.0, 0.0]]))
         tier = e._static_tier("bounding")
         assert (tier.guard is not None) == guarded and tier.guarded == guarded
+
+
+def _case_rays(case, rng, n=3000):
+    """Rays of one named case (see test_each_case_against_its_closed_form), nudged sideways by up to
+    1e-6 m (below float32 resolution here), with their aim points."""
+    if case == "shared edge (face diagonal)":     # the crate's top face diagonal, from above
+        a, b = np.array([-1.15, -0.75, 0.7]), np.array([-0.45, -0.05, 0.7])
+        eye = np.array([-0.3, -1.6, 2.9])
+    elif case == "vertex (box corner)":           # the crate's top corners, from above and the side
+        corners = np.array([[-1.15, -0.75, 0.7], [-0.45, -0.75, 0.7], [-0.45, -0.05, 0.7], [-1.15, -0.05, 0.7]])
+        a = b = None
+        eye = np.array([0.9, -2.2, 2.4])
+    elif case == "silhouette over a wall":        # a vertical silhouette edge of the near box, wall behind
+        a, b = np.array([2.5, -0.9, 0.0]), np.array([2.5, -0.9, 1.0])
+        eye = np.array([0.3, -1.4, 0.8])
+    else:                                         # "seam of two touching boxes": their common top edge
+        a, b = np.array([-2.25, 1.5, 0.9]), np.array([-1.75, 1.5, 0.9])
+        eye = np.array([-2.6, -0.4, 2.2])
+    if a is None:
+        tgt = corners[rng.integers(0, 4, n)]
+    else:
+        tgt = a + rng.uniform(0, 1, (n, 1)) * (b - a)
+    tgt = tgt + rng.normal(size=tgt.shape) * rng.choice([0.0, 1e-9, 1e-8, 1e-7, 1e-6], (n, 1))
+    d = tgt - eye
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    return np.broadcast_to(eye, d.shape).copy(), d
+
+
+@pytest.mark.parametrize("case", ["shared edge (face diagonal)", "vertex (box corner)", "silhouette over a wall",
+                                  "seam of two touching boxes"])
+def test_each_case_against_its_closed_form(case, monkeypatch):
+    """Each kind of ray the repair rule must catch, on its own, vs the slab closed form: a shared
+    edge of two coplanar triangles (the watertight cast alone suffices), a vertex, a silhouette with
+    a wall behind it, the seam between two separate boxes that touch.  All must be consistent with
+    the geometry; flat-face distances exact to 1e-12 m where clear of edges."""
+    o, d = _case_rays(case, np.random.default_rng(zlib.crc32(case.encode())))
+    t, c = _cast(o, d, np.zeros(3), False)
+    wrong, err = _judge(o, d, t, 1e-12)
+    assert not wrong.any(), np.flatnonzero(wrong)[:5]
+    assert err.max() <= 1e-12
+    assert np.isfinite(t).all()     # every case has a surface at or behind its aim point
+    t_none, _ = _cast(o, d, np.zeros(3), False, monkeypatch, "none")
+    leaks = int(_judge(o, d, t_none, 1e-12)[0].sum())
+    print(f"\n{case}: one cast without repair: {leaks} of {len(o)} wrong; with guards 0 "
+          f"({c['edge_guard_hits']} guard finds)")
+    if case.startswith("shared edge"):   # the premise: Embree's robust cast is watertight there
+        assert leaks == 0
