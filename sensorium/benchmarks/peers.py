@@ -253,7 +253,7 @@ PEERS = [Open3D, Open3D1, MuJoCo, PyBullet, TrimeshEmbree, TrimeshTriangle]
 
 def run(cfg: Config) -> Section:
     from sensorium.schemas.wire import pack
-    from sensorium.server.daemon.topics import header, image_msg, point_cloud_msg
+    from sensorium.server.daemon.topics import header, image_msg, lidar_cloud_msg
     from sensorium.server.raycast.engine import RayKind
 
     W, L = cfg.pick((1024, 128), (512, 64))
@@ -301,7 +301,7 @@ def run(cfg: Config) -> Section:
             t1 = time.perf_counter()
             hdr = header("r/lidar", s.time_ms)
             pack(image_msg(hdr, L, W, np.ascontiguousarray(d.range_image, dtype="<f4").tobytes()))
-            pack(point_cloud_msg(hdr, d.point_cloud))
+            pack(lidar_cloud_msg(hdr, d))
             t2 = time.perf_counter()
             for k, v in (("step", t1 - t0), ("cast", sw.total), ("plan", sp.total), ("finish", sf.total),
                          ("messages", t2 - t1)):
