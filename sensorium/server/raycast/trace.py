@@ -220,8 +220,8 @@ class TierTracer(Refiner):
         """Side hit (True: the back) of the hits of ``ph`` at ray ``rows`` (``sub``: their indices
         when ``rows`` is a slice of all rays), as :meth:`_judge_fast` decides it."""
         idx = rows if sub is None else sub
-        dh = d32[idx]
-        ng = res["Ng"][idx]
+        dh = np.take(d32, idx, axis=0)       # (np.take: several times faster than fancy indexing here)
+        ng = np.take(res["Ng"], idx, axis=0)
         if len(ng) > _SMALL:
             dots = np.einsum("ij,ij->i", ng, dh)
         else:
