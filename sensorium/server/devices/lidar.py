@@ -258,8 +258,8 @@ def ranges_from_hits(params: LidarParams, distances: np.ndarray, directions: np.
         # nothing moves a value: round to float32 first, then blank the invalid ones. The same
         # result as the general path below: ``v >= lo`` fails for NaN, and float32 rounding is
         # monotone, so ``float32(v) >= float32(hi)`` holds for every v >= hi (and for inf)
-        out = v.astype(np.float32)
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):   # beyond float32: inf, then blanked
+            out = v.astype(np.float32)
             bad = np.greater_equal(v, lo)
             np.logical_not(bad, out=bad)
             bad |= out >= np.float32(hi)

@@ -36,19 +36,20 @@ class TierTracer(Refiner):
         return scene.run(o32, d32, far, output=1)
 
     def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
-               distance_only: bool = False):
+               distance_only: bool = False, d32=None):
         """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
         for an unanchored tier).  ``distance_only``: FAST may return None for shape and normal
-        (the same t; a lidar needs nothing else)."""
+        (the same t; a lidar needs nothing else).  ``d32``: FAST only, ``D`` rounded to float32 when
+        the caller has it."""
         if exact:
             res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True)
             return res if np.count_nonzero(res[0] < _INF) else None
-        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only)
+        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32)
 
     def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
-                    distance_only: bool = False):
+                    distance_only: bool = False, d32=None):
         """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
         self-hits, shells left from inside, excluded owners) are redone by the general loop.
         Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
@@ -72,7 +73,7 @@ class TierTracer(Refiner):
         o1 = Ot[:1].astype(_F32) if one else None
         o32 = np.broadcast_to(o1, Ot.shape) if one else Ot.astype(_F32)
         shared = one
-        d32 = D.astype(_F32)
+        d32 = D.astype(_F32) if d32 is None else d32   # never written
         start = t_near
         dead = None
         if big is None:

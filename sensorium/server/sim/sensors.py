@@ -38,6 +38,7 @@ class RayRequest:
     tag: str = ""              # counter bucket: "light", "distance", "lidar"
     mount: np.ndarray | None = None   # per ray: body the ray is rigidly mounted on, -1 none (see RayEngine.cast)
     distance_only: bool = False       # the device reads only distances (see RayEngine.cast)
+    directions32: np.ndarray | None = None   # the directions rounded to float32, when kept (see RayEngine.cast)
 
     def __len__(self) -> int:
         return len(self.origins)
@@ -196,7 +197,8 @@ class Lidar(Device):
         # one value for every beam (cylindrical): the engine then needs no per-ray limits
         self._t_far: np.ndarray | float = float(t_far.flat[0]) if not np.count_nonzero(t_far != t_far.flat[0]) else t_far
         self._sweep: lmath.RotatingSweep | None = None
-        self._planned: tuple[bytes, np.ndarray] | None = None   # (rotation bytes, world beams) of a fixed lidar
+        # (rotation bytes, world beams float64, the same as float32) of a fixed lidar's latest plan
+        self._planned: tuple[bytes, np.ndarray, np.ndarray] | None = None
 
     # -- controller API
     def set_frequency(self, f: float) -> None:
@@ -271,9 +273,13 @@ class Lidar(Device):
             key = pose.rotation.tobytes()
             if self._planned is None or self._planned[0] != key:   # the lidar turned: rotate the beams
                 dirs = _rotate_columns(pose.rotation, self._dir_columns)
-                dirs.flags.writeable = False     # handed to every cast until the lidar turns
-                self._planned = (key, dirs)
-            dirs = self._planned[1]
+                d32 = dirs.astype(np.float32)
+                dirs.flags.writeable = d32.flags.writeable = False   # handed to every cast until it turns
+                self._planned = (key, dirs, d32)
+            _, dirs, d32 = self._planned
+            origins = np.broadcast_to(pose.translation, dirs.shape)
+            return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
+                               distance_only=True, directions32=d32)]
         origins = np.broadcast_to(pose.translation, dirs.shape)
         return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
                            distance_only=True)]
