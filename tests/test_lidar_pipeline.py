@@ -225,3 +225,21 @@ def test_counters_and_layers_channel():
     dev.finish([sim.scene.engine.cast(*_beams((0, 0, 0.45), n_az=180, layers=np.linspace(0.4, -0.4, 9)),
                                       kind=RayKind.VISUAL, distance_only=True)], 16, counters)
     assert counters["points_built"] == 9 * 180
+
+
+@pytest.mark.parametrize("n", [1, 5000, 16384, 40001])
+def test_beams_rotated_in_blocks_with_their_float32_copy(n):
+    from sensorium.server.sim.sensors import _rotate
+
+    rng = np.random.default_rng(n)
+    v = rng.normal(size=(n, 3))
+    v /= np.linalg.norm(v, axis=1)[:, None]
+    q = rng.normal(size=4)
+    w, x, y, z = q / np.linalg.norm(q)
+    R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                  [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                  [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    out32 = np.empty((n, 3), dtype=np.float32)
+    got = _rotate_columns(R, tuple(np.ascontiguousarray(v[:, k]) for k in range(3)), out32=out32)
+    assert got.tobytes() == _rotate(R, v).tobytes()
+    assert out32.tobytes() == got.astype(np.float32).tobytes()

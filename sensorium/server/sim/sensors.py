@@ -272,8 +272,8 @@ class Lidar(Device):
             t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far.reshape(-1)
             key = pose.rotation.tobytes()
             if self._planned is None or self._planned[0] != key:   # the lidar turned: rotate the beams
-                dirs = _rotate_columns(pose.rotation, self._dir_columns)
-                d32 = dirs.astype(np.float32)
+                d32 = np.empty((len(self._dir_columns[0]), 3), dtype=np.float32)
+                dirs = _rotate_columns(pose.rotation, self._dir_columns, out32=d32)
                 dirs.flags.writeable = d32.flags.writeable = False   # handed to every cast until it turns
                 self._planned = (key, dirs, d32)
             _, dirs, d32 = self._planned
@@ -335,6 +335,9 @@ class Lidar(Device):
         return out
 
 
+_ROTATE_BLOCK = 16384   # rows per block of _rotate_columns (its float64 temporaries: ~640 KB)
+
+
 def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     """``vectors @ rotation.T`` by columns: a BLAS matmul here lets OpenBLAS threads stall for tens
     of milliseconds when the other core is busy (measured), for no gain on (N, 3) arrays."""
@@ -344,20 +347,33 @@ def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     return out
 
 
-def _rotate_columns(rotation: np.ndarray, columns: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+def _rotate_columns(rotation: np.ndarray, columns: tuple[np.ndarray, np.ndarray, np.ndarray],
+                    out32: np.ndarray | None = None) -> np.ndarray:
     """``_rotate`` for vectors given as three contiguous columns (x, y, z): the same products and
-    sums in the same order (bit-identical), on contiguous arrays instead of (N, 3) broadcasts."""
+    sums in the same order (bit-identical), on contiguous arrays instead of (N, 3) broadcasts, in
+    blocks of rows whose temporaries stay in cache. ``out32``: an (N, 3) float32 array that also
+    receives the result rounded to float32 (what ``astype`` would give), from the same blocks."""
     x, y, z = columns
-    out = np.empty((len(x), 3))
-    tmp = np.empty(len(x))
-    acc = np.empty(len(x))
-    for k in range(3):
-        np.multiply(x, rotation[k, 0], out=acc)
-        np.multiply(y, rotation[k, 1], out=tmp)
-        acc += tmp
-        np.multiply(z, rotation[k, 2], out=tmp)
-        acc += tmp
-        out[:, k] = acc
+    n = len(x)
+    out = np.empty((n, 3))
+    block = max(1, min(n, _ROTATE_BLOCK))
+    buf = np.empty((block, 3))
+    tmp = np.empty(block)
+    acc = np.empty(block)
+    for a in range(0, n, block):
+        b = min(n, a + block)
+        m = b - a
+        t, c, part = tmp[:m], acc[:m], buf[:m]
+        for k in range(3):
+            np.multiply(x[a:b], rotation[k, 0], out=c)
+            np.multiply(y[a:b], rotation[k, 1], out=t)
+            c += t
+            np.multiply(z[a:b], rotation[k, 2], out=t)
+            c += t
+            part[:, k] = c
+        out[a:b] = part
+        if out32 is not None:
+            out32[a:b] = part
     return out
 
 
