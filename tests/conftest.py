@@ -2,14 +2,16 @@
 a fast local loop (CI runs everything).
 
 A test is slow when its module runs servers and controllers as processes (``SLOW_MODULES``), when
-it starts a subprocess itself or through a helper of its module (found in the module's source:
-a function that mentions ``subprocess``/``Popen``, or calls one that does), or when it is listed
-in ``SLOW_TESTS`` (long single-process runs, worker pools).
+it starts a subprocess itself or through a helper or fixture of its module (found in the module's
+source: a function or class that mentions ``subprocess``/``Popen`` or starts one with tests/_serve.py
+— ``Proc(``, ``Served(``, ``serve(`` — or calls one that does), or when it is listed in
+``SLOW_TESTS`` (long single-process runs, worker pools).
 """
 
 from __future__ import annotations
 
 import ast
+import re
 from functools import cache
 from pathlib import Path
 
@@ -23,13 +25,16 @@ SLOW_TESTS = {
 }
 
 
+SPAWNS = re.compile(r"subprocess|Popen|\b(?:Proc|Served|serve)\(")     # tests/_serve.py starts processes
+
+
 @cache
 def _spawning_functions(path: Path) -> frozenset[str]:
-    """Names of the module's functions that start a process, directly or through another of them."""
+    """Names of the module's functions (and classes) that start a process, directly or through another of them."""
     source = path.read_text()
     funcs = {node.name: ast.get_source_segment(source, node) or ""
-             for node in ast.walk(ast.parse(source)) if isinstance(node, ast.FunctionDef)}
-    spawning = {name for name, text in funcs.items() if "subprocess" in text or "Popen" in text}
+             for node in ast.walk(ast.parse(source)) if isinstance(node, (ast.FunctionDef, ast.ClassDef))}
+    spawning = {name for name, text in funcs.items() if SPAWNS.search(text)}
     grown = True
     while grown:
         grown = False
@@ -43,8 +48,9 @@ def _spawning_functions(path: Path) -> frozenset[str]:
 def is_slow(item: pytest.Item) -> bool:
     path = Path(str(item.path))
     name = getattr(item, "originalname", None) or item.name
+    spawning = _spawning_functions(path)
     return (path.stem in SLOW_MODULES or f"{path.name}::{name}" in SLOW_TESTS
-            or name in _spawning_functions(path))
+            or name in spawning or any(f in spawning for f in getattr(item, "fixturenames", ())))
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:

@@ -9,19 +9,16 @@ from __future__ import annotations
 import json
 import math
 import os
-import queue
 import shutil
 import signal
 import struct
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
 import pytest
-
-from sensorium.client.connection import Connection
+from _serve import Served, serve
 
 REPO = Path(__file__).resolve().parents[1]
 CLIB = REPO / "sensorium" / "client" / "c"
@@ -73,55 +70,12 @@ def cbin(tmp_path_factory) -> dict[str, str]:
     return out
 
 
-class Server:
-    """``sensorium serve`` on 127.0.0.1, free ports; ``url(robot)`` is a controller URL."""
-
-    def __init__(self, world: Path, *extra: str, rpc: str = "tcp://127.0.0.1:0", pub: str = "tcp://127.0.0.1:0"):
-        self.p = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", rpc,
-                                   "--pub", pub, *extra], stdout=subprocess.PIPE,
-                                  stderr=subprocess.PIPE, text=True, env=ENV, cwd=str(REPO))
-        lines: queue.Queue[str] = queue.Queue()
-        threading.Thread(target=lambda: [lines.put(x) for x in self.p.stdout], daemon=True).start()
-        self.err: list[str] = []
-        threading.Thread(target=lambda: [self.err.append(x) for x in self.p.stderr], daemon=True).start()
-        try:
-            ready = lines.get(timeout=60)
-        except queue.Empty:
-            self.p.kill()
-            raise AssertionError("server not ready in 60 s: " + "".join(self.err)) from None
-        assert ready.startswith("sensorium: serving world"), ready
-        self.rpc = ready.split("rpc=")[1].split()[0]
-        self.conn = Connection(self.rpc, timeout=10.0)
-
-    def url(self, robot: str) -> str:
-        return f"{self.rpc}/{robot}"
-
-    def attached(self) -> set[str]:
-        return {r["name"] for r in self.conn.call("get_info")["robots"] if r["attached"]}
-
-    def wait_attached(self, robots: set[str], timeout: float = 60.0) -> None:
-        deadline = time.monotonic() + timeout
-        while not robots <= self.attached():
-            assert time.monotonic() < deadline, f"attached {self.attached()}, waiting for {robots}"
-            time.sleep(0.02)
-
-    def stop(self) -> int:
-        self.conn.close()
-        if self.p.poll() is None:
-            self.p.send_signal(signal.SIGINT)
-        try:
-            return self.p.wait(20)
-        finally:
-            if self.p.poll() is None:
-                self.p.kill()
-
-
 @pytest.fixture
 def servers():
-    started: list[Server] = []
+    started: list[Served] = []
 
-    def start(world: Path = ARENA, *extra: str, **endpoints: str) -> Server:
-        started.append(Server(world, *extra, **endpoints))
+    def start(world: Path = ARENA, *extra: str, **endpoints: str) -> Served:
+        started.append(serve(world, *extra, env=SAN_ENV, **endpoints))
         return started[-1]
 
     yield start
@@ -453,7 +407,7 @@ PLANS = {  # robot -> (language, step ms, steps, device ops); 12*16 = 6*32 = 4*4
 }
 
 
-def _run_plans(server: Server, cbin: dict[str, str], languages: dict[str, str]) -> dict[str, list[str]]:
+def _run_plans(server: Served, cbin: dict[str, str], languages: dict[str, str]) -> dict[str, list[str]]:
     procs = {}
     for robot, (_, duration, steps, ops) in PLANS.items():
         args = [*ops, "step", str(duration), str(steps)]
@@ -524,8 +478,7 @@ def test_c_controller_ends_its_loop_when_the_server_dies(cbin, servers):
     while server.conn.call("get_info")["time_ms"] < 320:
         assert time.monotonic() < deadline
         time.sleep(0.01)
-    server.p.kill()
-    server.p.wait(10)
+    server.kill()
     code, lines, err = finish(p, 60)
     assert code == 0, err
     assert fields(lines[-1])["status"] == "-1" and all(fields(x)["status"] == "0" for x in lines[:-1])

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import signal
 import socket
 import subprocess
 import sys
@@ -13,6 +14,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from _serve import serve
 
 FREE_WORLD = """\
 world_info: {name: free, basic_time_step: 32}
@@ -34,42 +36,18 @@ def cli(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "sensorium", *args], capture_output=True, text=True, timeout=timeout)
 
 
-class Served:
-    """``sensorium serve`` on free ports; its endpoints from the ready line."""
-
-    def __init__(self, *args: str):
-        self.proc = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", *args, "--rpc", "tcp://127.0.0.1:0",
-                                      "--pub", "tcp://127.0.0.1:0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     text=True)
-        line = self.proc.stdout.readline()
-        assert "rpc=" in line, self.proc.stderr.read()
-        self.rpc = line.split("rpc=")[1].split()[0]
-        self.pub = line.split("pub=")[1].split()[0]
-
-    def stop(self) -> str:
-        self.proc.terminate()
-        try:
-            _, err = self.proc.communicate(timeout=30)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            _, err = self.proc.communicate()
-        return err
-
-
 @pytest.fixture(scope="module")
 def arena():
-    s = Served("--mode", "pause")
-    yield s
-    s.stop()
+    with serve(None, "--mode", "pause", stop_signal=signal.SIGTERM) as s:
+        yield s
 
 
 @pytest.fixture(scope="module")
 def free(tmp_path_factory):
     world = tmp_path_factory.mktemp("free") / "free.yaml"
     world.write_text(FREE_WORLD)
-    s = Served(str(world), "--mode", "realtime")
-    yield s
-    s.stop()
+    with serve(world, "--mode", "realtime", stop_signal=signal.SIGTERM) as s:
+        yield s
 
 
 def _free_port() -> int:
@@ -200,7 +178,7 @@ def test_none_controller_robot_cannot_be_attached(free):
 
 
 def test_server_says_once_that_it_waits(tmp_path: Path):
-    s = Served("--mode", "fast")
+    s = serve(None, "--mode", "fast", stop_signal=signal.SIGTERM)
     try:
         deadline = time.monotonic() + 30
         info = None
@@ -213,5 +191,6 @@ def test_server_says_once_that_it_waits(tmp_path: Path):
         time.sleep(0.5)
         assert json.loads(cli("call", "get_info", "--url", s.rpc, "--json").stdout)["time_ms"] == 0
     finally:
-        err = s.stop()
+        s.stop()
+        err = s.stderr()
     assert err.count("waiting for a controller to attach to robot 'epuck' or 'scout'") == 1

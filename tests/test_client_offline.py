@@ -17,6 +17,7 @@ from pathlib import Path
 import msgpack
 import pytest
 import zmq
+from _serve import Proc, sensorium
 from fake_router import BASIC, COLUMNS, LAYERS, FakeServer, distance_value, light_value, range_image
 
 from sensorium.client import arrays, wb
@@ -780,19 +781,17 @@ def test_cli_echo():
     pub = zmq.Context.instance().socket(zmq.XPUB)
     pub.bind("tcp://127.0.0.1:*")
     url = pub.getsockopt_string(zmq.LAST_ENDPOINT)
-    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "echo", "/r1/lid/laser_scan", "--url", url,
-                             "--count", "2", "--timeout", "60"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, cwd=str(REPO))
-    try:
-        assert pub.poll(60000) and pub.recv() == b"\x01/r1/lid/laser_scan\0"
-        for seq in (0, 3):
-            pub.send_multipart(_frames("/r1/lid/laser_scan", "sensor_msgs/msg/LaserScan", seq, {
-                "header": HEADER, "range_min": 0.05, "ranges": struct.pack("<3f", 1.0, float("inf"), 2.5)}))
-        out, err = proc.communicate(timeout=90)
-    finally:
-        proc.kill()
-        pub.close(0)
-    assert proc.returncode == 0, err
+    with Proc(sensorium("echo", "/r1/lid/laser_scan", "--url", url, "--count", "2", "--timeout", "60")) as proc:
+        try:
+            assert pub.poll(60000) and pub.recv() == b"\x01/r1/lid/laser_scan\0"
+            for seq in (0, 3):
+                pub.send_multipart(_frames("/r1/lid/laser_scan", "sensor_msgs/msg/LaserScan", seq, {
+                    "header": HEADER, "range_min": 0.05, "ranges": struct.pack("<3f", 1.0, float("inf"), 2.5)}))
+            code = proc.wait(90)
+        finally:
+            pub.close(0)
+    out, err = proc.stdout(), proc.stderr()
+    assert code == 0, err
     docs = out.split("---\n")
     assert len(docs) == 3 and docs[2] == ""                   # two YAML documents, each ended by ---
     assert docs[0].startswith("# /r1/lid/laser_scan [sensor_msgs/msg/LaserScan] seq=0 t=0.032 s\n")

@@ -10,16 +10,15 @@ from __future__ import annotations
 import json
 import math
 import os
-import signal
 import subprocess
 import sys
-import threading
 from pathlib import Path
 from typing import Any
 
 import msgpack
 import pytest
 import zmq
+from _serve import serve
 
 from sensorium.client.connection import Connection, SensoriumError
 from sensorium.server.sim import conformance
@@ -33,33 +32,10 @@ def load(name: str) -> dict:
     return json.loads((VECTORS / name).read_text())
 
 
-class Server:
-    def __init__(self, world: Path):
-        self.p = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", "tcp://127.0.0.1:0",
-                                   "--pub", "tcp://127.0.0.1:0"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                                  text=True, cwd=str(REPO))
-        box: list[str] = []
-        reader = threading.Thread(target=lambda: box.append(self.p.stdout.readline()), daemon=True)
-        reader.start()
-        reader.join(60)
-        assert box and box[0].startswith("sensorium: serving world"), box
-        self.rpc = box[0].split("rpc=")[1].split()[0]
-
-    def stop(self) -> None:
-        if self.p.poll() is None:
-            self.p.send_signal(signal.SIGINT)
-        try:
-            self.p.wait(20)
-        finally:
-            if self.p.poll() is None:
-                self.p.kill()
-
-
 @pytest.fixture
 def server():
-    s = Server(VECTORS / "world.yaml")
-    yield s
-    s.stop()
+    with serve(VECTORS / "world.yaml") as s:
+        yield s
 
 
 def _path(result: Any, dotted: str) -> bool:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -13,6 +14,7 @@ import time
 import pytest
 import zmq
 import zmq.utils.z85
+from _serve import Proc, sensorium, serve
 
 from sensorium.client.connection import (
     ENV_CURVE_SERVERKEY,
@@ -33,22 +35,9 @@ def curve_server(tmp_path_factory):
     assert out.returncode == 0, out.stderr
     hexkey = re.search(r"SENSORIUM_CURVE_SERVERKEY=([0-9a-f]{64})", out.stdout).group(1)
     assert oct((keys / "server.key_secret").stat().st_mode & 0o777) == "0o600"
-    env = {k: v for k, v in os.environ.items() if not k.startswith("SENSORIUM_CURVE")}
-    proc = subprocess.Popen([PY, "-m", "sensorium", "serve", "--curve-keys", str(keys), "--rpc", "tcp://127.0.0.1:0",
-                             "--pub", "tcp://127.0.0.1:0", "--mode", "realtime"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-    try:
-        line = proc.stdout.readline()
-        m = re.search(r"rpc=(\S+) pub=(\S+)", line)
-        assert m, (line, proc.stderr.read() if proc.poll() is not None else "")
-        yield m.group(1), m.group(2), hexkey
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(30)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+    no_key = {k: None for k in os.environ if k.startswith("SENSORIUM_CURVE")}
+    with serve(None, "--curve-keys", str(keys), "--mode", "realtime", env=no_key, stop_signal=signal.SIGTERM) as s:
+        yield s.rpc, s.pub, hexkey
 
 
 def _no_curve_env(monkeypatch):
@@ -167,9 +156,8 @@ def test_record_connect_uses_the_key_from_the_environment(curve_server, monkeypa
     r = subprocess.run([PY, "-m", "sensorium", "record", str(out), "--connect", rpc, "--duration", "1"],
                        capture_output=True, text=True, timeout=60, env=env)
     assert r.returncode == 1 and "no answer" in r.stderr and not out.exists()       # no key: no service
-    rec = subprocess.Popen([PY, "-m", "sensorium", "record", str(out), "--connect", rpc, "--topics", "/clock",
-                            "--max-messages", "5", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                           text=True, env=dict(env, SENSORIUM_CURVE_SERVERKEY=key))
+    rec = Proc(sensorium("record", str(out), "--connect", rpc, "--topics", "/clock", "--max-messages", "5", "--json"),
+               env={**{k: None for k in os.environ if k.startswith("SENSORIUM_CURVE")}, ENV_CURVE_SERVERKEY: key})
     ctx = zmq.Context()
     try:
         with Connection(f"{rpc}?serverkey={key}", timeout=30, context=ctx) as c:
@@ -177,15 +165,12 @@ def test_record_connect_uses_the_key_from_the_environment(curve_server, monkeypa
             robot = next(r["name"] for r in info["robots"] if not r.get("attached"))
             session = c.call("attach", {"robot": robot})["session"]
             deadline = time.monotonic() + 60
-            while rec.poll() is None:
+            while rec.returncode is None:
                 assert time.monotonic() < deadline, "the recorder got nothing"
                 c.call(f"/{robot}/robot/step", {"duration": info["basic_time_step"]})
             c.call("detach", {"session": session})
-        out_text, err = rec.communicate(timeout=30)
-        assert rec.returncode == 0, err
-        assert '"received": 5' in out_text
+        assert rec.wait() == 0, rec.stderr()
+        assert '"received": 5' in rec.stdout()
     finally:
-        if rec.poll() is None:
-            rec.kill()
-            rec.wait()
+        rec.stop()
         ctx.destroy(linger=0)

@@ -3,16 +3,14 @@ variables as plain processes on loopback (hosts and ports rewritten, nothing els
 
 from __future__ import annotations
 
-import os
 import re
 import signal
 import socket
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import yaml
+from _serve import Proc, Served, sensorium
 
 ROOT = Path(__file__).resolve().parents[1]
 COMPOSE = yaml.safe_load((ROOT / "docker" / "compose.yaml").read_text())
@@ -30,6 +28,21 @@ def _localise(arg: str, ports: dict[str, int]) -> str:
     return arg.replace("/app/", f"{ROOT}/")
 
 
+def _wait_recorded(path: Path, recorder: Proc, within_s: float = 60.0) -> None:
+    """Poll until the recorder has flushed a message into ``path`` (it flushes at least once a second)."""
+    from sensorium.server.recording.reader import Recording
+
+    deadline = time.monotonic() + within_s
+    while recorder.returncode is None and time.monotonic() < deadline:
+        try:
+            with Recording(path) as rec:
+                if next(iter(rec.messages()), None) is not None:
+                    return
+        except Exception:       # not there yet, or its first chunk half-written
+            pass
+        time.sleep(0.1)
+
+
 def test_dockerfile_copies_what_exists() -> None:
     text = (ROOT / "docker" / "Dockerfile").read_text()
     for src in re.findall(r"^COPY (.+) \S+$", text, flags=re.M):
@@ -43,30 +56,23 @@ def test_compose_services_run_as_processes(tmp_path: Path) -> None:
     services = COMPOSE["services"]
     assert set(services) == {"server", "braitenberg", "wanderer", "recorder"}
     ports = {"5560": _free_port(), "5561": _free_port()}
-    cli = [sys.executable, "-m", "sensorium"]
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
     server_cmd = [_localise(a, ports) for a in services["server"]["command"]] + ["--until", "1500"]
-    server = subprocess.Popen(cli + server_cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-    procs = []
-    try:
-        assert "serving world" in server.stdout.readline()
-        for name in ("braitenberg", "wanderer", "recorder"):
-            svc = services[name]
-            penv = dict(env, **{k: _localise(v, ports) for k, v in svc.get("environment", {}).items()})
-            procs.append((name, subprocess.Popen(cli + [_localise(a, ports) for a in svc["command"]], cwd=tmp_path,
-                                                 env=penv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)))
-        assert server.wait(timeout=60) == 0, server.stderr.read()
-        for name, p in procs:
-            if name == "recorder":
-                time.sleep(0.5)
-                p.send_signal(signal.SIGINT)
-            out = p.communicate(timeout=60)[0]
-            assert p.returncode == 0, f"{name}: {out}"
-    finally:
-        for p in [server, *(p for _, p in procs)]:
-            if p.poll() is None:
-                p.kill()
-                p.wait()
+    procs: list[tuple[str, Proc]] = []
+    with Served(sensorium(*server_cmd), "sensorium: serving world").wait_ready() as server:
+        try:
+            for name in ("braitenberg", "wanderer", "recorder"):
+                svc = services[name]
+                procs.append((name, Proc(sensorium(*(_localise(a, ports) for a in svc["command"])), cwd=tmp_path,
+                                         env={k: _localise(v, ports) for k, v in svc.get("environment", {}).items()})))
+            assert server.wait() == 0, server.stderr()
+            for name, p in procs:
+                if name == "recorder":
+                    _wait_recorded(tmp_path / "recordings" / "run.mcap", p)
+                    p.stop(signal.SIGINT)
+                assert p.wait() == 0, f"{name}: {p.stdout()}\n{p.stderr()}"
+        finally:
+            for _, p in procs:
+                p.stop()
     from sensorium.server.recording.reader import summarize
 
     summary = summarize(tmp_path / "recordings" / "run.mcap")

@@ -9,7 +9,6 @@ import base64
 import itertools
 import math
 import os
-import select
 import signal
 import subprocess
 import sys
@@ -21,43 +20,12 @@ import numpy as np
 import pytest
 import zmq
 from _node import NodeProcess, require_node
+from _serve import Served, sensorium, serve
 
 pytest.importorskip("foxglove")
 
 WORLD = Path(__file__).parent / "worlds" / "server.yaml"
 ROOT = Path(__file__).resolve().parents[1]
-
-
-class Serve:
-    def __init__(self, tmp: Path, *extra: str):
-        self.err_path = tmp / "serve.err"
-        self.err = open(self.err_path, "w")
-        env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "sensorium", "serve", str(WORLD), "--rpc", "tcp://127.0.0.1:0", "--pub",
-             "tcp://127.0.0.1:0", "--precision", "fast", "--heartbeat-ms", "2000", *extra],
-            stdout=subprocess.PIPE, stderr=self.err, text=True, env=env)
-        deadline = time.monotonic() + 60
-        self.fields: dict[str, str] = {}
-        while time.monotonic() < deadline and self.proc.poll() is None:
-            if select.select([self.proc.stdout], [], [], 0.2)[0]:
-                line = self.proc.stdout.readline()
-                if line.startswith("sensorium: serving world"):
-                    self.fields = dict(f.split("=", 1) for f in line.split() if "=" in f)
-                    return
-        raise AssertionError(f"server did not start: {self.err_path.read_text()}")
-
-    def stop(self) -> int:
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-            try:
-                self.proc.wait(20)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        self.proc.stdout.close()
-        self.err.close()
-        return self.proc.returncode
 
 
 class Rpc:
@@ -96,9 +64,9 @@ SENSORS = ["/bot/ls/value", "/bot/ds/value", "/bot/lidar/laser_scan", "/bot/lida
 
 
 @pytest.fixture()
-def live(tmp_path):
+def live():
     require_node()
-    srv = Serve(tmp_path, "--foxglove", "127.0.0.1:0")
+    srv = serve(WORLD, "--precision", "fast", "--heartbeat-ms", "2000", "--foxglove", "127.0.0.1:0")
     ctx = zmq.Context()
     node = None
     try:
@@ -108,9 +76,9 @@ def live(tmp_path):
     finally:
         if node is not None:
             node.close()
-        code = srv.stop()
+        code = srv.stop(signal.SIGTERM)
         ctx.destroy(0)
-        err = srv.err_path.read_text()
+        err = srv.stderr()
         assert code == 0, err
         assert "sensorium: Foxglove viewer: " in err and "not converted" not in err, err
 
@@ -271,19 +239,12 @@ def test_replay_serves_foxglove(tmp_path):
     make_recording(path, steps=20)
     with Recording(path) as rec:
         values = {msgpack.unpackb(m.data, raw=False)["illuminance"] for m in rec.messages(["/epuck/ls0/value"])}
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "replay", str(path), "--loop", "--rate", "1",
-                             "--pub", "tcp://127.0.0.1:0", "--rpc", "tcp://127.0.0.1:0", "--foxglove", "127.0.0.1:0",
-                             "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+    replay = Served(sensorium("replay", str(path), "--loop", "--rate", "1", "--pub", "tcp://127.0.0.1:0", "--rpc",
+                              "tcp://127.0.0.1:0", "--foxglove", "127.0.0.1:0", "--no-progress"),
+                    "sensorium: Foxglove viewer at ")
     node = None
     try:
-        url = None
-        deadline = time.monotonic() + 60
-        while url is None and time.monotonic() < deadline and proc.poll() is None:
-            if select.select([proc.stdout], [], [], 0.2)[0]:
-                line = proc.stdout.readline()
-                if "Foxglove viewer at " in line:
-                    url = line.split("Foxglove viewer at ", 1)[1].strip()
+        url = replay.wait_ready().ready_line.split("Foxglove viewer at ", 1)[1].strip()
         assert url and url.startswith("ws://127.0.0.1:")
         node = NodeProcess("live_client.js", url)
         node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
@@ -293,6 +254,4 @@ def test_replay_serves_foxglove(tmp_path):
     finally:
         if node is not None:
             node.close()
-        proc.send_signal(signal.SIGTERM)
-        proc.wait(20)
-        proc.stdout.close()
+        replay.stop(signal.SIGTERM)

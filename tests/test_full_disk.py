@@ -6,15 +6,13 @@ EFBIG, exactly like ENOSPC for the recorder; SIGXFSZ ignored so the write return
 
 from __future__ import annotations
 
-import re
 import resource
 import signal
-import subprocess
 import sys
-import threading
 import time
 
 import zmq
+from _serve import serve
 
 from sensorium.client.connection import Connection, SubSocket
 from sensorium.server.recording.reader import Recording
@@ -38,27 +36,20 @@ def _wait(cond, within_s: float, what: str) -> None:
 
 def test_full_disk_stops_the_recording_not_the_server(tmp_path):
     out = tmp_path / "run.mcap"
-    proc = subprocess.Popen([PY, "-m", "sensorium", "serve", "--record", str(out), "--rpc", "tcp://127.0.0.1:0",
-                             "--pub", "tcp://127.0.0.1:0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=_limit_file_size)
-    errors: list[str] = []
-    reader = threading.Thread(target=lambda: errors.extend(iter(proc.stderr.readline, "")), daemon=True)
+    server = serve(None, "--record", str(out), preexec_fn=_limit_file_size)
+    errors = server.err                                            # stderr lines, collected while it runs
     ctx = zmq.Context()
     try:
-        line = proc.stdout.readline()
-        m = re.search(r"rpc=(\S+) pub=(\S+)", line)
-        assert m, line
-        reader.start()
-        sub = SubSocket(m.group(2), context=ctx)
+        sub = SubSocket(server.pub, context=ctx)
         sub.subscribe(b"/clock")
-        with Connection(m.group(1), timeout=30, context=ctx) as c:
+        with Connection(server.rpc, timeout=30, context=ctx) as c:
             info = c.call("get_info")
             robot, dt = info["robots"][0]["name"], info["basic_time_step"]
             c.call("attach", {"robot": robot})
             stopped = lambda: any("recording to" in e and "stopped" in e for e in errors)  # noqa: E731
             deadline = time.monotonic() + 120
             while not stopped():                                   # fill the "disk"
-                assert time.monotonic() < deadline, "".join(errors)
+                assert time.monotonic() < deadline, server.stderr()
                 for _ in range(20):
                     c.call(f"/{robot}/robot/step", {"duration": dt})
             # after the failure: the world steps and live topics are still published
@@ -75,15 +66,12 @@ def test_full_disk_stops_the_recording_not_the_server(tmp_path):
             assert all(f[0] == b"/clock\0" for f in got)
             assert c.call("get_info")["time_ms"] > t0
         sub.close()
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(60) == 0
-        reader.join(10)
+        server.p.send_signal(signal.SIGTERM)
+        assert server.wait() == 0
     finally:
         ctx.destroy(linger=0)
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    text = "".join(errors)
+        server.stop()
+    text = server.stderr()
     assert "Traceback" not in text and "internal error" not in text, text
     failures = [e for e in errors if "recording to" in e and "stopped" in e]
     assert len(failures) == 1, text                                # one clear error, not one per message

@@ -13,16 +13,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import queue
-import signal
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
 import pytest
+from _serve import Proc, Served, sensorium, serve
 
 from sensorium.client.connection import Connection
 
@@ -31,95 +28,21 @@ TRIO = REPO / "tests" / "worlds" / "trio.yaml"
 ARENA = REPO / "sensorium" / "worlds" / "arena.yaml"
 CONTROLLERS = REPO / "tests" / "controllers"
 EXAMPLES = REPO / "sensorium" / "client" / "examples"
-ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints and signals")
 
 
-class Proc:
-    """A subprocess whose stdout lines are collected by a thread (stderr kept for messages)."""
-
-    def __init__(self, args: list[str], env: dict | None = None):
-        self.args = args
-        self.p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                  env={**ENV, **(env or {})}, cwd=str(REPO))
-        self.lines: queue.Queue[str] = queue.Queue()
-        self.out: list[str] = []
-        self.err: list[str] = []
-        threading.Thread(target=self._pump, args=(self.p.stdout, self.lines), daemon=True).start()
-        threading.Thread(target=self._pump, args=(self.p.stderr, None), daemon=True).start()
-
-    def _pump(self, stream, q) -> None:
-        for line in stream:
-            line = line.rstrip("\n")
-            if q is not None:
-                self.out.append(line)
-                q.put(line)
-            else:
-                self.err.append(line)
-
-    def line(self, timeout: float = 60.0) -> str:
-        try:
-            return self.lines.get(timeout=timeout)
-        except queue.Empty:
-            raise AssertionError(f"no output from {self.args[-4:]} in {timeout} s; stderr:\n" + "\n".join(self.err)) from None
-
-    def wait(self, timeout: float = 60.0) -> int:
-        try:
-            return self.p.wait(timeout)
-        except subprocess.TimeoutExpired:
-            raise AssertionError(f"{self.args} still running; stderr:\n" + "\n".join(self.err)) from None
-
-    def stderr(self) -> str:
-        return "\n".join(self.err)
-
-    def kill(self) -> None:
-        if self.p.poll() is None:
-            self.p.kill()
-            self.p.wait(30)
-
-
-def sensorium(*args: str) -> list[str]:
-    return [sys.executable, "-m", "sensorium", *args]
-
-
-class Server:
-    def __init__(self, world: Path, tmp: Path, *extra: str):
-        self.rpc, self.pub = f"ipc://{tmp}/rpc", f"ipc://{tmp}/pub"
-        self.proc = Proc(sensorium("serve", str(world), "--rpc", self.rpc, "--pub", self.pub, *extra))
-        ready = self.proc.line(timeout=60)
-        assert ready.startswith("sensorium: serving world"), ready
-        assert f"rpc={self.rpc}" in ready and f"pub={self.pub}" in ready, ready
-        self.conn = Connection(self.rpc, timeout=30.0)
-
-    def url(self, robot: str) -> str:
-        return f"{self.rpc}/{robot}"
-
-    def info(self) -> dict:
-        return self.conn.call("get_info")
-
-    def wait_attached(self, robots: set[str], timeout: float = 60.0) -> None:
-        deadline = time.monotonic() + timeout
-        while True:
-            attached = {r["name"] for r in self.info()["robots"] if r["attached"]}
-            if robots <= attached:
-                return
-            assert time.monotonic() < deadline, f"attached {attached}, waiting for {robots}"
-            time.sleep(0.02)
-
-    def stop(self) -> int:
-        self.conn.close()
-        if self.proc.p.poll() is None:
-            self.proc.p.send_signal(signal.SIGINT)
-        try:
-            return self.proc.wait(60)
-        finally:
-            self.proc.kill()
+def start_server(world: Path, tmp: Path, *extra: str) -> Served:
+    """``sensorium serve WORLD`` on ipc endpoints in ``tmp``, ready."""
+    rpc, pub = f"ipc://{tmp}/rpc", f"ipc://{tmp}/pub"
+    server = serve(world, *extra, rpc=rpc, pub=pub)
+    assert server.rpc == rpc and server.pub == pub, server.ready_line
+    return server
 
 
 @pytest.fixture
 def servers():
-    started: list[Server] = []
+    started: list[Served] = []
     procs: list[Proc] = []
     yield started, procs
     for p in procs:
@@ -173,7 +96,7 @@ def reference_run() -> dict[str, list[dict]]:
 
 def test_three_controllers_in_lockstep_match_the_in_process_simulation(servers, tmp_path):
     started, procs = servers
-    server = Server(TRIO, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
+    server = start_server(TRIO, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
     started.append(server)
     for robot, (duration, steps, specs) in PLANS.items():
         procs.append(Proc(sensorium("controller", str(CONTROLLERS / "record.py"), "--url", server.url(robot),
@@ -197,7 +120,7 @@ def test_three_controllers_in_lockstep_match_the_in_process_simulation(servers, 
 
 # ====================================================================== crash and re-attach
 
-def _stepper(server: Server, robot: str, duration: int, steps: int, device: str) -> Proc:
+def _stepper(server: Served, robot: str, duration: int, steps: int, device: str) -> Proc:
     return Proc([sys.executable, str(CONTROLLERS / "stepper.py"), str(duration), str(steps), device],
                 env={"SENSORIUM_CONTROLLER_URL": server.url(robot)})
 
@@ -215,7 +138,7 @@ def _times_until(proc: Proc, predicate, timeout: float = 60.0) -> list[tuple[int
 
 def test_killed_controller_blocks_nobody_and_its_robot_can_be_attached_again(servers, tmp_path):
     started, procs = servers
-    server = Server(TRIO, tmp_path, "--mode", "pause", "--heartbeat-ms", "200")
+    server = start_server(TRIO, tmp_path, "--mode", "pause", "--heartbeat-ms", "200")
     started.append(server)
     ant = _stepper(server, "ant", 16, 0, "ir")
     bee = _stepper(server, "bee", 32, 0, "sonar")
@@ -225,9 +148,8 @@ def test_killed_controller_blocks_nobody_and_its_robot_can_be_attached_again(ser
         assert p.line() == "attached"
     server.conn.call("set_mode", {"mode": "fast"})
     _times_until(bee, lambda row: row[0] >= 320)
-    ant.p.send_signal(signal.SIGKILL)
-    ant.p.wait(30)
-    killed_at = server.info()["time_ms"]
+    ant.kill()
+    killed_at = server.conn.call("get_info")["time_ms"]
     # the others keep stepping once the server has dropped the dead session (3 x 200 ms)
     rows = _times_until(bee, lambda row: row[0] >= killed_at + 50 * 32, timeout=60)
     assert all(status == 0 for _, status, _ in rows)
@@ -260,19 +182,19 @@ def test_heartbeat_keeps_a_slow_controller_attached(servers, tmp_path):
     from sensorium.client.wb import RobotClient
 
     started, _ = servers
-    server = Server(TRIO, tmp_path, "--heartbeat-ms", "100")
+    server = start_server(TRIO, tmp_path, "--heartbeat-ms", "100")
     started.append(server)
     with RobotClient(server.url("ant")) as ant:
         ant.enable(ant.by_name["ir"], 16, "test")
         assert ant.step() == 0
         time.sleep(1.0)                                   # 10 heartbeats, 3 would drop a silent peer
-        assert {r["name"]: r["attached"] for r in server.info()["robots"]}["ant"]
+        assert {r["name"]: r["attached"] for r in server.conn.call("get_info")["robots"]}["ant"]
         assert ant.step(32) == 0 and ant.time_ms == 48
         silent = Connection(server.rpc, timeout=5.0)      # attaches, then never pings
         silent.call("attach", {"robot": "bee"})
         time.sleep(0.6)
         assert ant.step() == 0                            # not blocked by the silent peer...
-        assert not {r["name"]: r["attached"] for r in server.info()["robots"]}["bee"]   # ...it was dropped
+        assert not {r["name"]: r["attached"] for r in server.conn.call("get_info")["robots"]}["bee"]   # ...it was dropped
         silent.close()
 
 
@@ -280,7 +202,7 @@ def test_heartbeat_keeps_a_slow_controller_attached(servers, tmp_path):
 
 def test_examples_through_the_launcher_with_topics_and_echo(servers, tmp_path):
     started, procs = servers
-    server = Server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "200")
+    server = start_server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "200")
     started.append(server)
     topics = subprocess.run(sensorium("topics", "--url", server.rpc), capture_output=True, text=True,
                             timeout=30, cwd=str(REPO))
@@ -331,7 +253,7 @@ def test_driven_epuck_matches_the_in_process_simulation(servers, tmp_path):
 
     steps, switch_at, speeds, later = 60, 40, (5.0, 5.0), (2.0, 6.0)     # straight, then a left arc
     started, procs = servers
-    server = Server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
+    server = start_server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
     started.append(server)
     start_pose = server.conn.call("/epuck/robot/get_pose")
     with Subscriber(server.pub, "/epuck/pose") as sub:
@@ -374,7 +296,7 @@ def test_driven_epuck_matches_the_in_process_simulation(servers, tmp_path):
 
 def test_examples_drive_their_robots(servers, tmp_path):
     started, procs = servers
-    server = Server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
+    server = start_server(ARENA, tmp_path, "--mode", "pause", "--heartbeat-ms", "500")
     started.append(server)
     before = {r: server.conn.call(f"/{r}/robot/get_pose") for r in ("epuck", "scout")}
     braitenberg = Proc(sensorium("controller", str(EXAMPLES / "braitenberg.py"), "--url", server.url("epuck"), "300"))

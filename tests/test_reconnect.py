@@ -16,6 +16,7 @@ import msgpack
 import pytest
 import zmq
 from _inproc import inproc_server
+from _serve import Proc, sensorium
 
 from sensorium.client.connection import Connection
 
@@ -181,8 +182,6 @@ def test_a_stopped_controller_is_told_what_happened(server, tmp_path) -> None:
     meanwhile; the controller says so (not "server gone?") and its step loop ends cleanly."""
     import os
     import signal
-    import subprocess
-    import sys
 
     core, transport = server
     script = tmp_path / "ctrl.py"
@@ -196,20 +195,19 @@ def test_a_stopped_controller_is_told_what_happened(server, tmp_path) -> None:
         "    if n == 5:\n"
         "        print('ready', flush=True)\n"
         "print('ended after', n, flush=True)\n")
-    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "controller", str(script), "--robot", "bot2",
-                             "--url", transport.rpc_endpoint], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = Proc(sensorium("controller", str(script), "--robot", "bot2", "--url", transport.rpc_endpoint))
     try:
-        assert proc.stdout.readline().strip() == "ready"
+        assert proc.line() == "ready"
         os.kill(proc.pid, signal.SIGSTOP)
         deadline = time.monotonic() + 60
         while core.lockstep.session_for("bot2") is not None and time.monotonic() < deadline:
             time.sleep(0.05)                               # poll: released after 3 heartbeats (1.5 s)
         assert core.lockstep.session_for("bot2") is None
         os.kill(proc.pid, signal.SIGCONT)
-        out, err = proc.communicate(timeout=60)
+        code = proc.wait()
     finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == 0, err
+        proc.kill()                                        # stopped, it would act on SIGKILL only
+    out, err = proc.stdout(), proc.stderr()
+    assert code == 0, err
     assert "ended after" in out
     assert "released the robot" in err and "Traceback" not in err and "server gone" not in err, err

@@ -14,6 +14,7 @@ from pathlib import Path
 import msgpack
 import pytest
 import zmq
+from _serve import serve
 
 from sensorium.server.recording.live import LiveRecorder
 from sensorium.server.recording.reader import Recording
@@ -26,17 +27,13 @@ class Server:
     def __init__(self, tmp: Path, *extra: str, name: str = "s"):
         self.rpc_url = f"ipc://{tmp}/{name}-rpc"
         self.pub_url = f"ipc://{tmp}/{name}-pub"
-        self.proc = subprocess.Popen([PY, "-m", "sensorium", "serve", "--rpc", self.rpc_url, "--pub", self.pub_url,
-                                      *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.proc = serve(None, *extra, rpc=self.rpc_url, pub=self.pub_url, wait=False, stop_signal=signal.SIGTERM)
         self.dealer = None
 
     def ready(self) -> Server:
         if self.dealer is not None:
             return self
-        line = self.proc.stdout.readline()
-        if not line.startswith("sensorium: serving"):
-            self.proc.kill()
-            raise AssertionError(line + self.proc.stderr.read())
+        self.proc.wait_ready()
         self.ctx = zmq.Context()
         self.dealer = self.ctx.socket(zmq.DEALER)
         self.dealer.setsockopt(zmq.LINGER, 0)
@@ -68,16 +65,13 @@ class Server:
         if self.dealer is not None:
             self.dealer.close()
             self.ctx.term()
-        if self.proc.poll() is None:
-            self.proc.send_signal(sig)
-        _out, err = self.proc.communicate(timeout=60)
-        assert self.proc.returncode == 0, err
+        code = self.proc.stop(sig)
+        err = self.proc.stderr()
+        assert code == 0, err
         return err
 
     def kill(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait(10)
+        self.proc.kill()
 
 
 @pytest.fixture
@@ -174,8 +168,7 @@ def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):
         except Exception:
             pass
         time.sleep(0.1)
-    server.proc.send_signal(signal.SIGKILL)
-    server.proc.wait(10)
+    server.proc.kill()
     with Recording(path) as rec:
         assert rec.truncated
         recorded = [(m.topic, m.seq, m.data) for m in rec.messages()]

@@ -12,6 +12,7 @@ from pathlib import Path
 import msgpack
 import pytest
 from _recdata import TOPICS, WORLD, make_recording, published
+from _serve import Proc
 from mcap.reader import make_reader
 
 from sensorium.cli.recording import print_info
@@ -146,30 +147,22 @@ WRITER = textwrap.dedent("""
 """)
 
 
-def _start_writer(path: Path) -> subprocess.Popen:
-    code = WRITER.format(tests=str(TESTS), path=str(path))
-    return subprocess.Popen([PY, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def _start_writer(path: Path) -> Proc:
+    return Proc([PY, "-c", WRITER.format(tests=str(TESTS), path=str(path))])
 
 
-def _wait_count(proc: subprocess.Popen, at_least: int) -> int:
+def _wait_count(proc: Proc, at_least: int) -> int:
     while True:
-        line = proc.stdout.readline()
-        assert line, proc.stderr.read()
-        n = int(line)
+        n = int(proc.line())
         if n >= at_least:
             return n
 
 
 def test_sigkill_leaves_a_readable_truncated_file(tmp_path, capsys):
     path = tmp_path / "killed.mcap"
-    proc = _start_writer(path)
-    try:
+    with _start_writer(path) as proc:
         flushed = _wait_count(proc, 600)
-        proc.send_signal(signal.SIGKILL)
-        proc.wait(10)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+        proc.kill()
     with Recording(path) as rec:
         assert rec.truncated
         got = list(rec.messages())
@@ -192,16 +185,11 @@ def test_sigkill_leaves_a_readable_truncated_file(tmp_path, capsys):
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
 def test_signal_finishes_the_file(tmp_path, sig):
     path = tmp_path / "signalled.mcap"
-    proc = _start_writer(path)
-    try:
+    with _start_writer(path) as proc:
         _wait_count(proc, 300)
-        proc.send_signal(sig)
-        out, err = proc.communicate(timeout=20)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == 0, err
-    total = int(out.strip().splitlines()[-1].split()[1])
+        code = proc.stop(sig)
+    assert code == 0, proc.stderr()
+    total = int(proc.stdout().strip().splitlines()[-1].split()[1])
     with open(path, "rb") as f:
         data = f.read()
     assert data.endswith(b"\x89MCAP0\r\n")

@@ -3,7 +3,6 @@ a complete, indexed file with every message our reader could read, byte for byte
 
 from __future__ import annotations
 
-import signal
 import subprocess
 import sys
 
@@ -21,14 +20,9 @@ PY = sys.executable
 
 def _killed_recording(tmp_path):
     path = tmp_path / "killed.mcap"
-    proc = _start_writer(path)
-    try:
+    with _start_writer(path) as proc:
         _wait_count(proc, 600)
-        proc.send_signal(signal.SIGKILL)
-        proc.wait(10)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+        proc.kill()
     return path
 
 

@@ -4,8 +4,6 @@
 from __future__ import annotations
 
 import signal
-import subprocess
-import sys
 import threading
 import time
 from contextlib import contextmanager
@@ -14,6 +12,7 @@ import msgpack
 import pytest
 import zmq
 from _recdata import STEP_NS, TOPICS, make_recording, published
+from _serve import Proc, Served, sensorium
 
 from sensorium.server.recording.envelope import pack_envelope
 from sensorium.server.recording.live import LiveRecorder, subscription_prefixes
@@ -21,7 +20,6 @@ from sensorium.server.recording.reader import Recording
 from sensorium.server.recording.replay import Replayer
 from sensorium.server.recording.writer import McapRecorder
 
-PY = sys.executable
 ANY = "tcp://127.0.0.1:*"
 
 
@@ -238,24 +236,16 @@ def test_lockstep(rec_path, ctx):
 
 def test_cli_replay_announces_and_finishes(rec_path, ctx):
     path, items = rec_path
-    proc = subprocess.Popen([PY, "-m", "sensorium", "replay", str(path), "--pub", ANY, "--rpc", ANY,
-                             "--rate", "0", "--wait", "--topics", "/epuck/ps1", "--progress"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        line = proc.stdout.readline()
-        assert line.startswith(f"sensorium: replaying {path} pub=tcp://127.0.0.1:"), line
-        pub = line.split("pub=")[1].split()[0]
-        rpc = line.split("rpc=")[1].split()[0]
-        assert call(ctx, rpc, "get_info")["result"]["pub_endpoint"] == pub
-        sub = subscriber(ctx, pub)
+    with Served(sensorium("replay", str(path), "--pub", ANY, "--rpc", ANY, "--rate", "0", "--wait", "--topics",
+                          "/epuck/ps1", "--progress"), "sensorium: replaying").wait_ready() as proc:
+        assert proc.out[0] == proc.ready_line                       # its first line
+        assert proc.ready_line.startswith(f"sensorium: replaying {path} pub=tcp://127.0.0.1:"), proc.ready_line
+        assert call(ctx, proc.rpc, "get_info")["result"]["pub_endpoint"] == proc.pub
+        sub = subscriber(ctx, proc.pub)
         got = [f for _t, f in drain(sub, limit=16)]
-        proc.wait(10)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == 0
+        assert proc.wait() == 0
     assert got == frames_of([i for i in items if i[0] == "/epuck/ps1/value"])
-    err = proc.stderr.read()
+    err = proc.stderr()
     assert "replay" in err and "100.0%" in err and "replay finished: 16 messages" in err
 
 
@@ -335,12 +325,10 @@ def test_cli_record_sigint_finishes_and_reports(rec_path, ctx, tmp_path):
     out = tmp_path / "cli.mcap"
     with running(path, ctx, rate=0, wait_subscriber=True) as (r, th):
         th.start()
-        proc = subprocess.Popen([PY, "-m", "sensorium", "record", str(out), "--connect", r.rpc_endpoint,
-                                 "--topics", "/epuck", "/scout/lidar/laser_scan"],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        try:
-            line = proc.stdout.readline()
-            assert line.startswith(f"sensorium: recording {out} from pub={r.pub_endpoint}"), (line, proc.stderr.read())
+        with Proc(sensorium("record", str(out), "--connect", r.rpc_endpoint, "--topics", "/epuck",
+                            "/scout/lidar/laser_scan")) as proc:
+            line = proc.line()
+            assert line.startswith(f"sensorium: recording {out} from pub={r.pub_endpoint}"), (line, proc.stderr())
             th.join(10)
             want = [i for i in items if i[0].startswith("/epuck/") or i[0] == "/scout/lidar/laser_scan"]
             deadline = time.monotonic() + 10
@@ -352,12 +340,9 @@ def test_cli_record_sigint_finishes_and_reports(rec_path, ctx, tmp_path):
                             break
                 except Exception:
                     pass
-            proc.send_signal(signal.SIGINT)
-            stdout, stderr = proc.communicate(timeout=10)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-    assert proc.returncode == 0, stderr
+            code = proc.stop(signal.SIGINT)
+    stdout, stderr = proc.stdout(), proc.stderr()
+    assert code == 0, stderr
     assert f"recorded {len(want)} messages on 4 topics" in stdout and "0 gaps, 0 messages lost" in stdout
     with Recording(out) as rec:
         assert not rec.truncated

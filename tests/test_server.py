@@ -5,11 +5,7 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
-import select
 import signal
-import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -17,6 +13,7 @@ import msgpack
 import numpy as np
 import pytest
 import zmq
+from _serve import Served, serve
 
 from sensorium.schemas import messages as M
 
@@ -27,46 +24,15 @@ BASIC = 16
 
 # ---------------------------------------------------------------------- a server process
 
-class Server:
-    def __init__(self, tmp: Path, *extra: str, heartbeat_ms: int = HEARTBEAT_MS):
-        self.err_path = tmp / f"serve-{os.getpid()}-{id(self)}.err"
-        self.err = open(self.err_path, "w")
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "sensorium", "serve", str(WORLD), "--rpc", "tcp://127.0.0.1:0",
-             "--pub", "tcp://127.0.0.1:*", "--heartbeat-ms", str(heartbeat_ms), "--precision", "fast", *extra],
-            stdout=subprocess.PIPE, stderr=self.err, text=True)
-        self.rpc = self.pub = None
+def server_process(*extra: str, heartbeat_ms: int = HEARTBEAT_MS, wait: bool = True) -> Served:
+    return serve(WORLD, "--heartbeat-ms", str(heartbeat_ms), "--precision", "fast", *extra, pub="tcp://127.0.0.1:*",
+                 wait=wait, stop_signal=signal.SIGTERM)
 
-    def wait_ready(self, timeout: float = 60.0) -> Server:
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            ready, _, _ = select.select([self.proc.stdout], [], [], 0.1)
-            if ready:
-                line = self.proc.stdout.readline()
-                if line.startswith("sensorium: serving world"):
-                    fields = dict(f.split("=", 1) for f in line.split() if "=" in f)
-                    self.rpc, self.pub = fields["rpc"], fields["pub"]
-                    assert "'server-test'" in line
-                    return self
-            if self.proc.poll() is not None:
-                break
-        raise AssertionError(f"server did not start: {self.stderr()}")
 
-    def stderr(self) -> str:
-        self.err.flush()
-        return self.err_path.read_text()
-
-    def stop(self) -> int:
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        self.proc.stdout.close()
-        self.err.close()
-        return self.proc.returncode
+def ready(s: Served) -> Served:
+    s.wait_ready()
+    assert "'server-test'" in s.ready_line
+    return s
 
 
 class Raw:
@@ -148,10 +114,10 @@ def ctx():
 
 
 @pytest.fixture(scope="module")
-def server(tmp_path_factory):
-    s = Server(tmp_path_factory.mktemp("serve")).wait_ready()
+def server():
+    s = ready(server_process())
     yield s
-    rc = s.stop()
+    rc = s.stop(signal.SIGTERM)
     assert rc == 0, s.stderr()
 
 
@@ -440,7 +406,7 @@ def test_unsubscribed_topics_are_not_computed(client, ctx, server):
 
 # ---------------------------------------------------------------------- determinism and shutdown
 
-def run_script(ctx, srv: Server) -> list[list[bytes]]:
+def run_script(ctx, srv: Served) -> list[list[bytes]]:
     c = Raw(ctx, srv.rpc)
     sub = ctx.socket(zmq.SUB)
     sub.setsockopt(zmq.LINGER, 0)
@@ -462,11 +428,11 @@ def run_script(ctx, srv: Server) -> list[list[bytes]]:
     return replies, frames
 
 
-def test_deterministic_and_sigterm(ctx, tmp_path):
-    a, b = Server(tmp_path), Server(tmp_path)
+def test_deterministic_and_sigterm(ctx):
+    a, b = server_process(wait=False), server_process(wait=False)
     try:
-        a.wait_ready()
-        b.wait_ready()
+        ready(a)
+        ready(b)
         ra, fa = run_script(ctx, a)
         rb, fb = run_script(ctx, b)
         assert ra == rb
@@ -478,12 +444,12 @@ def test_deterministic_and_sigterm(ctx, tmp_path):
         c.ok("set_mode", {"mode": "pause"})
         rid = c.send("/bot2/robot/step")
         time.sleep(0.05)
-        a.proc.send_signal(signal.SIGTERM)
+        a.p.send_signal(signal.SIGTERM)
         r = c.wait(rid, keepalive=False)
         assert r["ok"] and r["result"]["status"] == -1
-        assert a.proc.wait(10) == 0
+        assert a.wait() == 0
         assert "stopped" in a.stderr()
         c.sock.close(0)
     finally:
-        assert a.stop() == 0
-        assert b.stop() == 0
+        assert a.stop(signal.SIGTERM) == 0
+        assert b.stop(signal.SIGTERM) == 0

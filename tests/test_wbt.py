@@ -5,14 +5,14 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import select
+import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _serve import serve
 
 from sensorium.cli import main as cli
 from sensorium.schemas import world as wm
@@ -293,24 +293,8 @@ def test_builtin_protos(tmp_path: Path) -> None:
 @contextlib.contextmanager
 def serving(world: Path, *extra: str):
     """``sensorium serve WORLD`` in a subprocess on free loopback ports; yields its RPC endpoint."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    proc = subprocess.Popen([sys.executable, "-m", "sensorium", "serve", str(world), "--rpc", "tcp://127.0.0.1:0",
-                             "--pub", "tcp://127.0.0.1:*", "--precision", "fast", *extra],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
-    try:
-        rpc = None
-        deadline = time.monotonic() + 60
-        while rpc is None and time.monotonic() < deadline and proc.poll() is None:
-            if select.select([proc.stdout], [], [], 0.2)[0]:
-                line = proc.stdout.readline()
-                if line.startswith("sensorium: serving world"):
-                    rpc = dict(f.split("=", 1) for f in line.split() if "=" in f)["rpc"]
-        assert rpc is not None, "server did not start"
-        yield rpc
-    finally:
-        proc.terminate()
-        proc.wait(30)
-        proc.stdout.close()
+    with serve(world, "--precision", "fast", *extra, pub="tcp://127.0.0.1:*", stop_signal=signal.SIGTERM) as s:
+        yield s.rpc
 
 
 def test_serve_a_wbt_world(tmp_path: Path) -> None:

@@ -11,7 +11,8 @@ import sys
 import time
 
 import pytest
-from test_multiprocess import CONTROLLERS, REPO, Proc, Server, sensorium
+from _serve import Proc, sensorium
+from test_multiprocess import CONTROLLERS, REPO, start_server
 
 from sensorium.client.topics import Subscriber
 
@@ -24,7 +25,7 @@ pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
 
 @pytest.fixture
 def server(tmp_path):
-    s = Server(WORLD, tmp_path, "--mode", "pause")
+    s = start_server(WORLD, tmp_path, "--mode", "pause")
     yield s
     s.stop()
 
