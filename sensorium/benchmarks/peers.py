@@ -532,7 +532,7 @@ def run(cfg: Config) -> Section:
     if o3d1 in rate:
         r1 = versus("Sensorium lidar pipeline FAST", o3d1)
         why = (f"pipeline FAST {fmt_rate(fast)} vs Open3D {fmt_rate(rate[o3d1])} on 1 thread (distances only); "
-               + (f"Open3D on {Open3D.threads} cores {fmt_rate(rate[o3d])}; the pipeline reaches {fast / rate[o3d]:.2f}× of that."
+               + (f"Open3D on {Open3D.threads} cores {fmt_rate(rate[o3d])}; the pipeline reaches {versus('Sensorium lidar pipeline FAST', o3d):.2f}× of that."
                   if o3d in rate else ""))
         if r1 <= 1:
             why += (f" MISS by {1 / r1:.2f}×: Open3D's C++ loop hands Embree ray packets and returns distances "
