@@ -224,8 +224,9 @@ class Lidar(Device):
         return self._records
 
     def cloud_points(self) -> np.ndarray:
-        """Point coordinates (L·W, 3) float32 of the latest measurement (a fresh array per scan,
-        never written afterwards: messages may keep it)."""
+        """Point coordinates (L·W, 3) float32 of the latest measurement: a fixed lidar's scan gives a
+        fresh array that is never written afterwards (messages may keep it); otherwise (a rotating
+        head, or before the first scan) a view of the records, which later steps overwrite."""
         if self._records is None:
             return self._xyz
         return self._records.view(np.float32).reshape(-1, 5)[:, 0:3]
