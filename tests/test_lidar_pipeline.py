@@ -243,3 +243,21 @@ def test_beams_rotated_in_blocks_with_their_float32_copy(n):
     got = _rotate_columns(R, tuple(np.ascontiguousarray(v[:, k]) for k in range(3)), out32=out32)
     assert got.tobytes() == _rotate(R, v).tobytes()
     assert out32.tobytes() == got.astype(np.float32).tobytes()
+
+
+@pytest.mark.parametrize("kind", ["fixed", "rotating"])
+def test_a_cloud_message_keeps_its_scan_after_the_next_one(kind):
+    """The message's buffers are never overwritten by later scans (fixed: fresh coordinates per
+    scan; rotating: the records are copied), so a message packed late carries its own scan."""
+    sim = Simulation(parse_world(_lidar_world(type=kind)), precision="fast")
+    dev = sim.device("r/l")
+    dev.enable(sim.basic_time_step)
+    dev.enable_point_cloud()
+    sim.step()
+    msg = lidar_cloud_msg(header("r/l", 0), dev)
+    now = pack(msg)
+    for step in range(3):
+        sim.robots["r"].set_pose([0.2 * (step + 1), 0.1, 0.05], [0, 0, 1, 0.4 * (step + 1)])
+        sim.step()
+    assert pack(lidar_cloud_msg(header("r/l", 0), dev)) != now      # the scene changed ...
+    assert pack(msg) == now                                           # ... the old message did not
