@@ -309,7 +309,7 @@ class RayEngine(TierTracer):
         distances.  Origins may be a broadcast array (one origin for all rays), never written.
 
         ``directions32``: optional ``directions.astype(float32)`` the caller keeps (a lidar whose
-        beams did not turn since the last scan); FAST hands it to Embree instead of rounding again."""
+        beams did not turn since the last scan); it is handed to Embree instead of rounding again."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
@@ -402,7 +402,7 @@ class RayEngine(TierTracer):
         if static is not None:
             lim = t_far if hits is None else np.minimum(t_far, hits[0])
             res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big,
-                              distance_only, None if exact else d32)
+                              distance_only, d32)
             if res is not None and hits is None:
                 hits = res
             elif res is not None and distance_only:   # the nearer of plane and mesh (ties: the plane)

@@ -41,10 +41,11 @@ class TierTracer(Refiner):
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
         for an unanchored tier).  ``distance_only``: FAST may return None for shape and normal
-        (the same t; a lidar needs nothing else), and so may EXACT.  ``d32``: FAST only, ``D``
-        rounded to float32 when the caller has it."""
+        (the same t; a lidar needs nothing else), and so may EXACT.  ``d32``: ``D`` rounded to
+        float32 when the caller has it."""
         if exact:
-            res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True, distance_only=distance_only)
+            res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True, distance_only=distance_only,
+                                   d32_all=d32)
             if not np.count_nonzero(res[0] < _INF):
                 return None
             return (res[0], None, None) if distance_only else res
@@ -262,12 +263,13 @@ class TierTracer(Refiner):
         return special if found and np.count_nonzero(special) else None
 
     def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool,
-                    distance_only: bool = False):
+                    distance_only: bool = False, d32_all=None):
         """General path: cast, judge each hit, continue rejected rays past their hit (bounded).
         Judging: excluded owners are skipped; EXACT refines flat hits in float64 and curved hits
         on the true surface; FAST keeps Embree's answer except self-hits and shells left from
         inside.  Returns (t, shape, normal oriented toward the origin); ``distance_only``: the shape
-        and normal of flat hits are left unset (the same t)."""
+        and normal of flat hits are left unset (the same t); ``d32_all``: ``D`` as float32, if the
+        caller has it."""
         m = len(O)
         eps = tier.eps
         if tier.anchored:   # one origin (a broadcast array) stays one
@@ -320,7 +322,7 @@ class TierTracer(Refiner):
             o32 = np.empty(da.shape, dtype=_F32)   # oa + sa da in float64, rounded once
             np.add(oa, da * (sa[:, None] if s_one is None else s_one), out=o32, casting="same_kind")
             s_one = None   # continued rays start apart
-            d32 = da.astype(_F32)
+            d32 = d32_all if d32_all is not None and len(act) == m else da.astype(_F32)
             far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)
             far32 = np.where(far >= 0.0, far, -1.0).astype(_F32)
             copy = exact and not tier.guarded
