@@ -94,13 +94,23 @@ from sensorium.server.raycast.exact import (
     _take,
 )
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind, ShapeEntry
-from sensorium.server.raycast.movers import _Body, _grid_pairs, _mounted_pairs, _Movers, _sphere_pairs
+from sensorium.server.raycast.movers import (
+    Mount,
+    _Body,
+    _grid_pairs,
+    _mounted_pairs,
+    _Movers,
+    _near_pairs,
+    _sphere_pairs,
+    mount_candidates,
+    mount_state,
+)
 from sensorium.server.raycast.planes import _Planes, cast_planes
 from sensorium.server.raycast.tiers import _Tier, new_device
 from sensorium.server.raycast.trace import TierTracer
 from sensorium.server.world.geometry import Plane, Pose
 
-__all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine"]
+__all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine", "Mount"]
 
 
 # variants: which shapes a scene holds
@@ -287,7 +297,9 @@ class RayEngine(TierTracer):
         once, in the body frame, with :meth:`cast_local`, and keeps the nearer of the two.  It
         also lets the broad phase skip, in one test per body, the rays of bodies whose rays cannot
         reach any other moving body (the rays of 100 robots' sensors, instead of one grid lookup
-        per ray).
+        per ray).  A :class:`Mount` (the same rays cast again, step after step) keeps that body
+        test between casts: a neighbour list redone only when some mover has moved by more than
+        a margin; the answers are the same as with the plain array.
 
         ``distance_only``: the caller reads only ``distance`` (a lidar); FAST then skips the normals
         and shape ids (returned as None) and the work that only serves them, with the same
@@ -302,7 +314,12 @@ class RayEngine(TierTracer):
         t_near = _param(t_near, n, np.float64, float)
         t_far = _param(t_far, n, np.float64, float)
         excl = _param(exclude_owner, n, np.int64, int)
-        if mount is not None:
+        if isinstance(mount, Mount):   # the same rays cast again: what rigid mounting fixes is kept
+            if len(mount) != n:
+                raise ValueError(f"mount must hold one body per ray: {len(mount)} for {n} rays")
+            if n and (mount.hi >= len(self._bodies) or mount.lo < -1):
+                raise ValueError(f"mount must hold body indices in [-1, {len(self._bodies) - 1}]")
+        elif mount is not None:
             mount = np.asarray(mount, dtype=np.int64).reshape(n)
             if n and (int(mount.max()) >= len(self._bodies) or int(mount.min()) < -1):
                 raise ValueError(f"mount must hold body indices in [-1, {len(self._bodies) - 1}]")
@@ -333,7 +350,8 @@ class RayEngine(TierTracer):
                 m = sl.stop - a
                 h = self._cast(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
                                _param(_take(t_far, sl), m, np.float64, float), _param(_take(excl, sl), m, np.int64, int),
-                               planes, static, movers, big, None if mount is None else mount[sl], distance_only)
+                               planes, static, movers, big, None if mount is None else np.asarray(mount)[sl],
+                               distance_only)
                 dist[sl] = h.distance
                 if not distance_only:
                     normal[sl], shape[sl] = h.normal, h.shape
@@ -414,8 +432,14 @@ class RayEngine(TierTracer):
             if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
                 mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
                 mt.row_of[mt.index] = np.arange(len(mt.index))
-            mrow = mt.row_of[mount]
-            mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+            st = mount_state(mount, mt, C, O, t_near, t_far) if isinstance(mount, Mount) else None
+            if st is None:
+                mrow = mt.row_of[np.asarray(mount)]
+                mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+            elif len(st.mi):   # candidates kept between casts; the segment test as _mounted_pairs does it
+                mrow = st.mrow
+                cr, cm = mount_candidates(st, mt, C, self._epoch)
+                mounted = (*_near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, cr, cm), st.rest)
         if mounted is not None and len(mounted[2]) == 0:   # every ray mounted
             pr, pm = mounted[0], mounted[1]
         else:

@@ -243,18 +243,26 @@ def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndar
     c = cnt[rows]
     pr = np.repeat(mi, c)
     pm = dst[np.repeat(ptr[rows] - (np.cumsum(c) - c), c) + np.arange(len(pr))]
-    if len(pr):
-        Cp = np.take(C, pm, axis=0)
-        Op = np.take(O, pr, axis=0)
-        Dp = np.take(D, pr, axis=0)
-        sel = _segment_near_sphere(Cp[:, 0] - Op[:, 0], Cp[:, 1] - Op[:, 1], Cp[:, 2] - Op[:, 2],
-                                   Dp[:, 0], Dp[:, 1], Dp[:, 2], _take(t_near, pr), lim[pr], mt.r2[pm])
-        if owner is not None:
-            sel &= owner[pm] != _take(excl, pr)
-        keep = sel.nonzero()[0]
-        pr, pm = pr[keep], pm[keep]
+    pr, pm = _near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, pr, pm)
     rest = (~mounted).nonzero()[0]
     return pr, pm, rest
+
+
+def _near_pairs(C, O, D, t_near, lim, excl, owner, r2, pr, pm):
+    """Those of the candidate (ray, mover) pairs ``pr``, ``pm`` whose segment passes within the
+    mover's bounding sphere (centres C, squared radii r2) and whose owner is not excluded (``owner``
+    None: no check)."""
+    if len(pr) == 0:
+        return pr, pm
+    Cp = np.take(C, pm, axis=0)
+    Op = np.take(O, pr, axis=0)
+    Dp = np.take(D, pr, axis=0)
+    sel = _segment_near_sphere(Cp[:, 0] - Op[:, 0], Cp[:, 1] - Op[:, 1], Cp[:, 2] - Op[:, 2],
+                               Dp[:, 0], Dp[:, 1], Dp[:, 2], _take(t_near, pr), lim[pr], r2[pm])
+    if owner is not None:
+        sel &= owner[pm] != _take(excl, pr)
+    keep = sel.nonzero()[0]
+    return pr[keep], pm[keep]
 
 
 def _near_centres(Cu: np.ndarray, Ru: np.ndarray, C: np.ndarray, radius: np.ndarray):
@@ -275,3 +283,118 @@ def _near_centres(Cu: np.ndarray, Ru: np.ndarray, C: np.ndarray, radius: np.ndar
     gap = Ru[pb] + radius[pm]
     ok = (_dot(d, d) <= gap * gap * (1.0 + 1e-9) + 1e-18).nonzero()[0]
     return pb[ok], pm[ok]
+
+
+class Mount:
+    """Rays rigidly mounted on bodies, cast again and again (a robot's distance sensors, step after
+    step): ``bodies[i]`` is the body ray i rides (-1: none).  Array-like (``np.asarray(mount)`` is
+    ``bodies``, so it concatenates like a plain mount array).  Passing the same Mount to every cast
+    of the same rays lets the engine keep what rigid mounting leaves unchanged: which mover each ray
+    rides, how far each body's rays reach from its centre (the same at every pose), and which movers
+    are near enough to matter, a neighbour list kept until some mover has moved by more than a
+    margin.  Per cast only the segment test of the listed (ray, mover) candidates remains; rays of
+    bodies with no neighbour cost nothing.  The caller promises that the rays are those of the
+    first cast (same mounts, local origins and directions), moved with their bodies."""
+
+    __slots__ = ("bodies", "lo", "hi", "_state")
+
+    def __init__(self, bodies) -> None:
+        self.bodies = np.array(bodies, dtype=np.int64).reshape(-1)
+        self.bodies.setflags(write=False)
+        self.lo, self.hi = (int(self.bodies.min()), int(self.bodies.max())) if len(self.bodies) else (-1, -1)
+        self._state: _MountState | None = None
+
+    def __len__(self) -> int:
+        return len(self.bodies)
+
+    def __array__(self, dtype=None, copy=None):
+        return self.bodies if dtype is None else self.bodies.astype(dtype)
+
+
+_SKIN = 0.25          # neighbour-list margin, as a fraction of the median reach of the bodies' rays
+
+
+@dataclass(slots=True)
+class _MountState:
+    """What a :class:`Mount` keeps for one mover table (see there)."""
+    mt: _Movers
+    t_near: object        # the (t_near, t_far) the reaches were made for: floats, or array copies
+    t_far: object
+    mrow: np.ndarray      # per ray: its mover row, -1 none
+    mi: np.ndarray        # the mounted rays
+    rows: np.ndarray      # their mover rows
+    rest: np.ndarray      # the other rays
+    used: np.ndarray      # mover rows carrying mounted rays
+    reach: np.ndarray     # per used row: no point of its rays' segments is farther from its centre
+    skin: float
+    shift: float          # neighbour list valid while no centre moved more than this per axis
+    C_ref: np.ndarray | None = None   # centres when the list was made
+    epoch: int = -1       # engine pose epoch of the last check
+    pr: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # candidates: rays
+    pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # and movers
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and np.array_equal(a, b)
+    return a == b
+
+
+def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near, t_far) -> _MountState | None:
+    """The Mount's state for this mover table and these ray limits (made on first use, with the
+    rays' current world origins), or None when a mounted ray is unbounded (the caller then takes
+    the per-cast path)."""
+    st = mount._state
+    if st is not None and st.mt is mt and _same(st.t_near, t_near) and _same(st.t_far, t_far):
+        return st
+    mrow = mt.row_of[mount.bodies]
+    mounted = mrow >= 0
+    mi = mounted.nonzero()[0]
+    rows = mrow[mi]
+    span = np.maximum(_take(t_far, mi), -_take(t_near, mi))
+    if not np.all(span < _INF):
+        return None
+    rel = np.take(O, mi, axis=0) - np.take(C, rows, axis=0)
+    reach = np.full(len(C), -1.0)
+    np.maximum.at(reach, rows, np.sqrt(_dot(rel, rel)) + span)
+    used = (reach >= 0.0).nonzero()[0]
+    reach = reach[used]
+    # |o - c| is the same at every pose up to rounding (a few ulps of the coordinates): the slack
+    # covers it (and the rebuild adds 1e-12 of the coordinates then)
+    reach = reach * (1.0 + 1e-9) + 1e-12 * (float(np.abs(O).max()) + float(np.abs(C).max()) if len(mi) else 0.0)
+    skin = _SKIN * float(np.median(reach)) if len(used) else 0.0
+    st = _MountState(mt, t_near.copy() if isinstance(t_near, np.ndarray) else t_near,
+                     t_far.copy() if isinstance(t_far, np.ndarray) else t_far, mrow, mi, rows,
+                     (~mounted).nonzero()[0], used, reach, skin, 0.5 * skin / 1.7320508075688772 * (1.0 - 1e-6))
+    mount._state = st
+    return st
+
+
+def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, epoch: int) -> tuple[np.ndarray, np.ndarray]:
+    """(ray, mover) candidates of the mounted rays at the movers' current centres C: every pair
+    whose segment can come within the mover's bounding sphere, never the ray's own mount, in ray
+    order (then mover row).  The neighbour list is made with the reaches grown by the skin and kept
+    while no centre has moved by more than half of it (|shift| per axis, so <= skin / 2 in length):
+    a pair then still cannot meet unless it was listed."""
+    if st.epoch == epoch:
+        return st.pr, st.pm
+    st.epoch = epoch
+    if st.C_ref is not None and len(C) == len(st.C_ref) and float(np.abs(C - st.C_ref).max()) <= st.shift:
+        return st.pr, st.pm
+    st.C_ref = C.copy()
+    if len(st.used) == 0:
+        return st.pr, st.pm
+    # grown by the skin, and by a slack that keeps the list a superset of what the per-cast body
+    # test (_mounted_pairs) would pair, whatever the rounding
+    Ru = st.reach * (1.0 + 1e-8) + (st.skin + 1e-8 * float(mt.radius.max()) + 1e-9 + 1e-12 * float(np.abs(C).max()))
+    pb, pm = _near_centres(np.take(C, st.used, axis=0), Ru, C, mt.radius)
+    nb = (pm != st.used[pb]).nonzero()[0]
+    src, dst = st.used[pb[nb]], pm[nb]
+    order = np.lexsort((dst, src))
+    src, dst = src[order], dst[order]
+    cnt = np.bincount(src, minlength=len(C))
+    ptr = np.cumsum(cnt) - cnt
+    c = cnt[st.rows]
+    st.pr = pr = np.repeat(st.mi, c)
+    st.pm = dst[np.repeat(ptr[st.rows] - (np.cumsum(c) - c), c) + np.arange(len(pr))]
+    return st.pr, st.pm

@@ -16,7 +16,7 @@ import numpy as np
 from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import light as light_math
 from sensorium.server.devices.lookup import RESOLUTION_OFF, add_noise, quantize_sensor
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.sim.sensors import DistanceSensor, LightSensor, RayRequest
 from sensorium.server.world.geometry import Pose
 
@@ -155,12 +155,14 @@ class _Group:
         self.weights = np.stack([d.weights for d in devs])
         self.sensitivity = np.array([d.config.red_color_sensitivity for d in devs])
         self.mount: np.ndarray | None = None
+        self.mounted: Mount | None = None     # the same, kept by the engine between casts
         self.own_visible: np.ndarray | None = None
         if robot_bodies is not None:
             body = np.array([-1 if robot_bodies[d.robot_index] is None else robot_bodies[d.robot_index]
                              for d in devs], dtype=np.int64)
             if np.count_nonzero(body >= 0):
                 self.mount = np.repeat(body, n)
+                self.mounted = Mount(self.mount)
                 robot = np.repeat(np.array([d.robot_index for d in devs], dtype=np.int64), n)
                 self.own_visible = (self.mount >= 0) & (self.exclude != robot)
         self.own: tuple | None = None        # (precision, RayHits in body frames), made on first use
@@ -214,7 +216,7 @@ class DistanceBatch:
             requests.append(RayRequest(
                 np.repeat(self.positions[g.idx], g.n, axis=0), dirs.reshape(-1, 3), 0.0, g.t_far, g.kind,
                 g.exclude, skip_transparent=g.skip, tag="distance",
-                mount=g.mount if self.engine is not None else None))
+                mount=g.mounted if self.engine is not None else None))
         return requests
 
     def finish(self, hits: list[RayHits], now_ms: int) -> None:
