@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from sensorium.server.raycast.engine import Precision, RayEngine, RayKind, ShapeEntry
+from sensorium.server.raycast.engine import Mount, Precision, RayEngine, RayKind, ShapeEntry
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.geometry import Box, Cylinder, Plane, Pose, Sphere
 from sensorium.server.world.loader import parse_world
@@ -117,6 +117,62 @@ def test_mount_and_cast_local_reject_bad_bodies():
         eng.cast(np.zeros((2, 3)), np.array([[1.0, 0, 0]] * 2), mount=np.array([0, 99]))
     with pytest.raises(ValueError, match="static"):
         eng.cast_local(1, np.zeros((1, 3)), np.array([[1.0, 0, 0]]))
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_mount_kept_between_casts_gives_the_plain_answers_bit_for_bit_as_bodies_move(precision):
+    """The same rays cast step after step with one Mount: the engine keeps a neighbour list of
+    the bodies (redone only when some body moved by more than a margin) and gives exactly the
+    answers of the plain mount array and of the general broad phase, through small moves (list
+    kept), turns in place, and jumps (list redone)."""
+    eng, bodies, poses = _crowd(precision, n=25, spacing=0.08)
+    O_loc, D_loc, _, _, mount, owner, _ = _mounted_rays(poses, bodies, radius_at=0.0357)
+    m = Mount(mount)
+    assert np.asarray(m).tolist() == mount.tolist() and len(m) == len(mount)
+    rng = np.random.default_rng(11)
+    xy = np.array([p.translation[:2] for p in poses])
+    yaw = rng.uniform(0, 2 * math.pi, len(bodies))
+    lists, robot_hits = [], 0
+    for step in range(14):
+        if step == 9:                       # jumps: bodies swap neighbours
+            xy[::3] += rng.uniform(-0.15, 0.15, xy[::3].shape)
+        elif step:                          # small moves (1 mm) and turns
+            xy += 0.001 * np.stack([np.cos(yaw), np.sin(yaw)], 1)
+            yaw += rng.uniform(-0.3, 0.3, len(bodies))
+        poses = [Pose(_rz(a), np.array([x, y, 0.025])) for (x, y), a in zip(xy, yaw)]
+        for b, p in zip(bodies, poses):
+            eng.set_body_pose(b, p)
+        R = np.stack([poses[i].rotation for i in owner])
+        T = np.stack([poses[i].translation for i in owner])
+        O, D = np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+        for excl in (-1, owner):
+            ref = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, exclude_owner=excl)
+            plain = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, exclude_owner=excl, mount=mount)
+            got = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, exclude_owner=excl, mount=m)
+            for a, b in ((got, plain), (got, ref)):
+                assert a.distance.tobytes() == b.distance.tobytes()
+                assert a.shape.tobytes() == b.shape.tobytes()
+                assert a.normal.tobytes() == b.normal.tobytes()
+            robot_hits += np.count_nonzero(np.isin(ref.shape, np.arange(3, 3 + len(bodies))))
+        lists.append(eng.counters["neighbour_lists"])
+    assert robot_hits > 100                 # rays do meet the neighbours
+    made = np.diff([0] + lists)
+    assert made[0] == 1 and made[9] == 1    # first cast, and after the jumps
+    assert made[1:9].sum() <= 2             # 1 mm per step: the list is kept for several steps
+    # other limits for the same rays: the Mount's state is remade for them (same answers again)
+    far = np.where(np.arange(len(O)) % 2 == 0, 0.05, 0.1)
+    for t_far in (0.1, far):
+        got = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, mount=m)
+        ref = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL)
+        assert got.distance.tobytes() == ref.distance.tobytes() and got.shape.tobytes() == ref.shape.tobytes()
+
+
+def test_a_mount_must_match_the_rays_and_the_bodies():
+    eng, bodies, _ = _crowd(Precision.FAST, n=4)
+    with pytest.raises(ValueError, match="one body per ray"):
+        eng.cast(np.zeros((2, 3)), np.array([[1.0, 0, 0]] * 2), mount=Mount([bodies[0]] * 3))
+    with pytest.raises(ValueError, match="mount must hold body indices"):
+        eng.cast(np.zeros((2, 3)), np.array([[1.0, 0, 0]] * 2), mount=Mount([0, 99]))
 
 
 def _ir_world(yaw: float, x: float) -> dict:

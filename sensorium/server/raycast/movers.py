@@ -370,18 +370,21 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
     return st
 
 
-def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, epoch: int) -> tuple[np.ndarray, np.ndarray]:
+def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, epoch: int,
+                     counters: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
     """(ray, mover) candidates of the mounted rays at the movers' current centres C: every pair
     whose segment can come within the mover's bounding sphere, never the ray's own mount, in ray
     order (then mover row).  The neighbour list is made with the reaches grown by the skin and kept
     while no centre has moved by more than half of it (|shift| per axis, so <= skin / 2 in length):
-    a pair then still cannot meet unless it was listed."""
+    a pair then still cannot meet unless it was listed.  Each new list counts in
+    ``counters["neighbour_lists"]``."""
     if st.epoch == epoch:
         return st.pr, st.pm
     st.epoch = epoch
     if st.C_ref is not None and len(C) == len(st.C_ref) and float(np.abs(C - st.C_ref).max()) <= st.shift:
         return st.pr, st.pm
     st.C_ref = C.copy()
+    counters["neighbour_lists"] += 1
     if len(st.used) == 0:
         return st.pr, st.pm
     # grown by the skin, and by a slack that keeps the list a superset of what the per-cast body
