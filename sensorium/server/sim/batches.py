@@ -26,11 +26,22 @@ _LASER = dmath.SENSOR_TYPES["laser"]
 
 def world_frames(devices: list, robot_poses: list[Pose]) -> tuple[np.ndarray, np.ndarray]:
     """World rotations (S,3,3) and positions (S,3) of devices: robot pose ∘ device pose."""
-    rr = np.stack([robot_poses[d.robot_index].rotation for d in devices])
-    rt = np.stack([robot_poses[d.robot_index].translation for d in devices])
-    lr = np.stack([d.local_pose.rotation for d in devices])
-    lt = np.stack([d.local_pose.translation for d in devices])
-    return np.einsum("sij,sjk->sik", rr, lr), np.einsum("sij,sj->si", rr, lt) + rt
+    rr = np.array([robot_poses[d.robot_index].rotation for d in devices])
+    rt = np.array([robot_poses[d.robot_index].translation for d in devices])
+    lr = np.array([d.local_pose.rotation for d in devices])
+    lt = np.array([d.local_pose.translation for d in devices])
+    return compose_rotations(rr, lr), np.einsum("sij,sj->si", rr, lt) + rt
+
+
+def compose_rotations(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a @ b for stacks of 3x3 matrices, bit for bit what ``np.einsum("sij,sjk->sik", a, b)`` gives
+    (it sums the three products in order starting from +0.0; the final + 0.0 does the same to a
+    -0.0) in about half its time: einsum is slow on length-3 axes."""
+    out = a[:, :, 0:1] * b[:, 0:1, :]
+    out += a[:, :, 1:2] * b[:, 1:2, :]
+    out += a[:, :, 2:3] * b[:, 2:3, :]
+    out += 0.0
+    return out
 
 
 def _output(devices: list, measured: np.ndarray, now_ms: int) -> None:
@@ -105,8 +116,8 @@ class DistancePlan:
         if not devs:
             return
         self.robot = np.array([d.robot_index for d in devs], dtype=np.int64)
-        self.local_rot = np.stack([d.local_pose.rotation for d in devs])
-        self.local_pos = np.stack([d.local_pose.translation for d in devs])
+        self.local_rot = np.array([d.local_pose.rotation for d in devs])
+        self.local_pos = np.array([d.local_pose.translation for d in devs])
         by_shape: dict = defaultdict(list)
         for i, d in enumerate(devs):
             infra_red = d.type_code == _INFRA_RED
@@ -202,10 +213,10 @@ class DistanceBatch:
         if not self.devices:
             return
         # robot pose ∘ device pose, as world_frames computes it (same arithmetic, stacked once per robot)
-        robot_rot = np.stack([p.rotation for p in robot_poses])
-        robot_pos = np.stack([p.translation for p in robot_poses])
+        robot_rot = np.array([p.rotation for p in robot_poses])
+        robot_pos = np.array([p.translation for p in robot_poses])
         self.robot_rot = rr = robot_rot[plan.robot]
-        rot = np.einsum("sij,sjk->sik", rr, plan.local_rot)
+        rot = compose_rotations(rr, plan.local_rot)
         self.positions = np.einsum("sij,sj->si", rr, plan.local_pos) + robot_pos[plan.robot]
         for g in plan.groups:
             self.dirs.append(np.einsum("sij,snj->sni", rot[g.idx], g.local_dirs))
