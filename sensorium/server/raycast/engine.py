@@ -420,12 +420,12 @@ class RayEngine(TierTracer):
         moved into their body frames; improves dist/shape/normal in place."""
         n = len(O)
         lim = np.minimum(t_far, dist)
-        if mt.epoch != self._epoch:  # poses changed since the last cast
-            mt.R = self._rot[mt.index]
+        if mt.epoch != self._epoch:  # poses changed since the last cast (rotations gathered when needed)
             mt.T = self._pos[mt.index]
+            mt.R = self._rot[mt.index] if mt.anchored else None
             mt.C = mt.T + np.einsum("mij,mj->mi", mt.R, mt.anchor) if mt.anchored else mt.T
             mt.epoch = self._epoch
-        R, T, C = mt.R, mt.T, mt.C
+        T, C = mt.T, mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = None
         if mount is not None:
@@ -464,6 +464,9 @@ class RayEngine(TierTracer):
                 pr, pm = pr[order], pm[order]
         if len(pr) == 0:
             return
+        if mt.R is None:
+            mt.R = self._rot[mt.index]
+        R = mt.R
         if len(pr) <= _TINY:  # few pairs: is it one mover? (plain Python beats two numpy calls)
             pml = pm.tolist()
             single = pml.count(pml[0]) == len(pml)

@@ -177,6 +177,9 @@ class _Group:
                 robot = np.repeat(np.array([d.robot_index for d in devs], dtype=np.int64), n)
                 self.own_visible = (self.mount >= 0) & (self.exclude != robot)
         self.own: tuple | None = None        # (precision, RayHits in body frames), made on first use
+        # the request's limit and exclusion: one scalar when uniform (what the engine would make of them)
+        self.far_arg = float(self.t_far[0]) if not np.count_nonzero(self.t_far != self.t_far[0]) else self.t_far
+        self.exclude_arg = int(self.exclude[0]) if not np.count_nonzero(self.exclude != self.exclude[0]) else self.exclude
 
     def own_hits(self, engine, local_rot: np.ndarray, local_pos: np.ndarray) -> RayHits | None:
         """Each ray's hit on its own robot's body (body frame), cast once per engine precision."""
@@ -225,8 +228,8 @@ class DistanceBatch:
         requests = []
         for g, dirs in zip(self.plan_data.groups, self.dirs):
             requests.append(RayRequest(
-                np.repeat(self.positions[g.idx], g.n, axis=0), dirs.reshape(-1, 3), 0.0, g.t_far, g.kind,
-                g.exclude, skip_transparent=g.skip, tag="distance",
+                np.repeat(self.positions[g.idx], g.n, axis=0), dirs.reshape(-1, 3), 0.0, g.far_arg, g.kind,
+                g.exclude_arg, skip_transparent=g.skip, tag="distance",
                 mount=g.mounted if self.engine is not None else None))
         return requests
 
