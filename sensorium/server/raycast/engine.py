@@ -19,7 +19,10 @@ Architecture
   for few movers or small batches, else a uniform grid keyed by the segment midpoints.  The pairs
   of each shared scene are moved into their body frames in float64; when there are many, those
   whose segment misses a tight bound of the scene (the shell's own cylinder for a round body, else
-  its box) are dropped; the rest go to ONE Embree call per shared scene.
+  its box) are dropped; the rest go to ONE Embree call per shared scene.  Rays rigidly mounted on
+  movers (``cast(mount=...)``: sensors on robots) never meet their own mount here, and bodies are
+  paired before rays; with a :class:`Mount` passed again and again, the pairing is a neighbour list
+  kept between casts (see :mod:`.movers`).
 * Planes are analytic (float64), never triangles, all planes of a ray kind in one (rays x planes)
   computation.
 * Curved primitives are tessellated CIRCUMSCRIBED (true surface inside the shell) and inflated

@@ -3,6 +3,10 @@
 A mover is cast against a body-frame tier shared by all movers with the same shapes; per cast,
 the broad phase finds the (ray, mover) pairs whose segment passes within the mover's bounding
 sphere (dense test for few movers or rays, else a uniform grid keyed by segment midpoints).
+Rays rigidly mounted on movers (sensors on robots) pair bodies before rays (``_mounted_pairs``);
+a :class:`Mount` keeps that body pairing between casts as a neighbour list with a margin (the
+reach of a body's rays from its centre is fixed by the mounting), so per cast only the rays of
+bodies with a listed neighbour are tested.
 """
 
 from __future__ import annotations
