@@ -230,3 +230,26 @@ def test_composed_sensor_rotations_are_einsum_bit_for_bit():
         got = compose_rotations(a, b)
         assert got.tobytes() == want.tobytes()
         assert np.all(np.abs(got - a @ b) <= 1e-15 * (np.abs(a) @ np.abs(b)))   # and it is the product
+
+
+def test_component_major_sensor_frames_are_einsum_bit_for_bit():
+    """DistanceBatch computes sensor positions and ray directions component-major (long inner axes):
+    the bits of the einsum products it replaced, on the machine that runs the tests."""
+    from sensorium.server.sim.batches import _frames_t, _rotate_t
+
+    rng = np.random.default_rng(5)
+    special = np.array([0.0, -0.0, 1.0, -1.0, 0.5, -2.0, 1e-300, 3.7])
+    for trial, (S, N) in enumerate([(1, 1), (7, 3), (800, 3), (500, 5), (3000, 1)] * 2):
+        if trial % 2:
+            rr, lr = rng.choice(special, (S, 3, 3)), rng.choice(special, (S, 3, 3))
+            lp, L = rng.choice(special, (S, 3)), rng.choice(special, (S, N, 3))
+        else:
+            rr = rng.normal(size=(S, 3, 3)) * 10.0 ** rng.integers(-6, 6, (S, 3, 3))
+            lr, lp, L = rng.normal(size=(S, 3, 3)), rng.normal(size=(S, 3)), rng.normal(size=(S, N, 3))
+        rot_t, pos_t = _frames_t(np.ascontiguousarray(rr.transpose(1, 2, 0)), np.ascontiguousarray(lr.transpose(1, 2, 0)),
+                                 np.ascontiguousarray(lp.T))
+        rot = np.einsum("sij,sjk->sik", rr, lr)
+        assert np.ascontiguousarray(rot_t.transpose(2, 0, 1)).tobytes() == rot.tobytes()
+        assert np.ascontiguousarray(pos_t.T).tobytes() == np.einsum("sij,sj->si", rr, lp).tobytes()
+        dirs = _rotate_t(rot_t, np.ascontiguousarray(L.transpose(2, 1, 0)))
+        assert dirs.shape == (S, N, 3) and dirs.tobytes() == np.einsum("sij,snj->sni", rot, L).tobytes()

@@ -63,6 +63,33 @@ def _output(devices: list, measured: np.ndarray, now_ms: int) -> None:
             d._mark(now_ms)
 
 
+def _frames_t(rr_t: np.ndarray, lr_t: np.ndarray, lp_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Component-major robot ∘ sensor frames: rotations [i, k, s] = sum_j rr[i, j, s] lr[j, k, s] and
+    rotated local positions [i, s] = sum_j rr[i, j, s] lp[j, s], summed in the orders numpy's einsum
+    uses for ``"sij,sjk->sik"`` ((j0 + j1) + j2, as compose_rotations) and ``"sij,sj->si"`` ((j0 + j2)
+    + j1: its two-lane inner loop), each from +0.0, so the bits are einsum's
+    (tests/test_distance_math.py checks it on the machine that runs the tests)."""
+    rot = rr_t[:, 0, None, :] * lr_t[0]
+    rot += rr_t[:, 1, None, :] * lr_t[1]
+    rot += rr_t[:, 2, None, :] * lr_t[2]
+    rot += 0.0
+    pos = rr_t[:, 0] * lp_t[0]
+    pos += rr_t[:, 2] * lp_t[2]
+    pos += rr_t[:, 1] * lp_t[1]
+    pos += 0.0
+    return rot, pos
+
+
+def _rotate_t(rot_t: np.ndarray, d_t: np.ndarray) -> np.ndarray:
+    """(S, N, 3) world directions from component-major rotations [i, j, s] and local directions
+    [j, n, s]: einsum("sij,snj->sni", rot, dirs) bit for bit ((j0 + j2) + j1 from +0.0, as _frames_t)."""
+    out = rot_t[:, 0, None, :] * d_t[0]
+    out += rot_t[:, 2, None, :] * d_t[2]
+    out += rot_t[:, 1, None, :] * d_t[1]
+    out += 0.0
+    return np.ascontiguousarray(out.transpose(2, 1, 0))
+
+
 class LightBatch:
     """All light sensors due this step."""
 
@@ -118,12 +145,16 @@ class DistancePlan:
         self.robot = np.array([d.robot_index for d in devs], dtype=np.int64)
         self.local_rot = np.array([d.local_pose.rotation for d in devs])
         self.local_pos = np.array([d.local_pose.translation for d in devs])
+        # the same, component-major ([j, k, sensor], [j, sensor]): long inner axes for the per-step products
+        self.local_rot_t = np.ascontiguousarray(self.local_rot.transpose(1, 2, 0))
+        self.local_pos_t = np.ascontiguousarray(self.local_pos.T)
         by_shape: dict = defaultdict(list)
         for i, d in enumerate(devs):
             infra_red = d.type_code == _INFRA_RED
             by_shape[(len(d.weights), RayKind.VISUAL if infra_red else RayKind.BOUNDING, d.type_code == _LASER)].append(i)
         for (n, kind, skip), idx in by_shape.items():
             self.groups.append(_Group(np.array(idx, dtype=np.int64), [devs[i] for i in idx], n, kind, skip, robot_bodies))
+            self.groups[-1].every = len(idx) == len(devs)
         by_table: dict = defaultdict(list)
         for i, d in enumerate(devs):
             by_table[d.table].append(i)
@@ -157,6 +188,8 @@ class _Group:
                  robot_bodies: list[int | None] | None):
         self.idx, self.n, self.kind, self.skip = idx, n, kind, skip
         self.local_dirs = np.stack([d.directions_local for d in devs])           # (S, N, 3)
+        self.local_dirs_t = np.ascontiguousarray(self.local_dirs.transpose(2, 1, 0))   # [j, ray, sensor]
+        self.every = False                   # all the plan's sensors, in order (set by DistancePlan)
         # infra-red sees the robot's own visual shapes (Webots); ODE-style rays skip them
         exclude = np.array([-1 if kind == RayKind.VISUAL else d.exclude_self() for d in devs], dtype=np.int64)
         self.exclude = np.repeat(exclude, n)
@@ -215,14 +248,15 @@ class DistanceBatch:
         self.dirs: list[np.ndarray] = []
         if not self.devices:
             return
-        # robot pose ∘ device pose, as world_frames computes it (same arithmetic, stacked once per robot)
-        robot_rot = np.array([p.rotation for p in robot_poses])
+        # robot pose ∘ device pose, bit for bit what world_frames and einsum("sij,snj->sni", rot, dirs)
+        # give, computed component-major (einsum is slow on length-3 axes): see _frames_t
+        self.robot_rot = robot_rot = np.array([p.rotation for p in robot_poses])
         robot_pos = np.array([p.translation for p in robot_poses])
-        self.robot_rot = rr = robot_rot[plan.robot]
-        rot = compose_rotations(rr, plan.local_rot)
-        self.positions = np.einsum("sij,sj->si", rr, plan.local_pos) + robot_pos[plan.robot]
+        rr_t = robot_rot.transpose(1, 2, 0)[:, :, plan.robot]                  # [i, j, sensor]
+        rot_t, pos_t = _frames_t(rr_t, plan.local_rot_t, plan.local_pos_t)
+        self.positions = pos_t.T + robot_pos[plan.robot]
         for g in plan.groups:
-            self.dirs.append(np.einsum("sij,snj->sni", rot[g.idx], g.local_dirs))
+            self.dirs.append(_rotate_t(rot_t if g.every else rot_t[:, :, g.idx], g.local_dirs_t))
 
     def plan(self) -> list[RayRequest]:
         requests = []
@@ -250,7 +284,7 @@ class DistanceBatch:
                 if len(win):
                     dist, shape, normal = dist.copy(), shape.copy(), normal.copy()
                     dist[win], shape[win] = own.distance[win], own.shape[win]
-                    rr = np.repeat(g.idx, n)[win]
+                    rr = plan.robot[np.repeat(g.idx, n)[win]]
                     normal[win] = np.einsum("sij,sj->si", self.robot_rot[rr], own.normal[win])
             dist = dist.reshape(S, n)
             reflection = None
