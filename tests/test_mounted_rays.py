@@ -209,3 +209,32 @@ def test_sensor_inside_its_body_sees_the_body_at_every_pose(precision):
         # the wall's near face is at x = 0.475; turned to +y the generic ray misses it (max range 1 m)
         expect = 1000.0 * (0.475 - (x + 0.01)) if yaw == 0.0 else 1000.0
         assert sim.device("r/generic").value == pytest.approx(expect, abs=1e-6 if precision == "exact" else 1e-3)
+
+
+def test_the_simulation_keeps_one_joined_mount_for_sensor_groups_cast_together():
+    """Infra-red sensors with 3 and with 5 rays form two groups cast in one engine call: the
+    simulation joins their Mounts once and passes the same joined Mount every step, so the engine's
+    neighbour list is made once while the robots stand still, and redone when they move away."""
+    table = [[0.0, 0.0, 0.0], [0.07, 70.0, 0.0]]
+    robots = []
+    for i in range(9):
+        robots.append({"name": f"r{i}", "pose": {"translation": [0.09 * (i % 3), 0.09 * (i // 3), 0.025],
+                                                 "rotation": [0, 0, 1, 0.4 * i]},
+                       "body": {"geometry": {"type": "cylinder", "radius": 0.035, "height": 0.05}},
+                       "devices": [{"device": "DistanceSensor", "name": f"ps{k}", "type": "infra-red",
+                                    "lookup_table": table, "number_of_rays": 3 if k % 2 else 5, "aperture": 0.3,
+                                    "pose": {"translation": [0.036 * math.cos(k), 0.036 * math.sin(k), 0.0],
+                                             "rotation": [0, 0, 1, float(k)]}} for k in range(6)]})
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 8}, "robots": robots}), precision="fast")
+    for d in sim.all_devices():
+        d.enable(8)
+    eng = sim.scene.engine
+    for _ in range(5):
+        sim.step()
+    assert eng.counters["neighbour_lists"] == 1
+    seen = [d.value for d in sim.all_devices()]
+    assert min(seen) < 70.0                      # neighbours are seen (and the robot's own body is not)
+    sim.robot("r0").set_pose([-1.0, -1.0, 0.025], [0, 0, 1, 0.0])
+    sim.step()
+    assert eng.counters["neighbour_lists"] == 2
+    assert all(sim.device(f"r0/ps{k}").value == 70.0 for k in range(6))   # nothing in reach any more

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _take
+from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _take
 from sensorium.server.world.geometry import Pose
 
 
@@ -322,8 +322,8 @@ _SKIN = 0.25          # neighbour-list margin, as a fraction of the median reach
 class _MountState:
     """What a :class:`Mount` keeps for one mover table (see there)."""
     mt: _Movers
-    t_near: object        # the (t_near, t_far) the reaches were made for: floats, or array copies
-    t_far: object
+    limits: tuple | None  # (t_near, t_far) when both were scalars
+    span: np.ndarray      # per mounted ray: how far its segment reaches from its origin (then)
     mrow: np.ndarray      # per ray: its mover row, -1 none
     mi: np.ndarray        # the mounted rays
     rows: np.ndarray      # their mover rows
@@ -338,24 +338,25 @@ class _MountState:
     pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # and movers
 
 
-def _same(a, b) -> bool:
-    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        return isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and np.array_equal(a, b)
-    return a == b
-
-
 def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near, t_far) -> _MountState | None:
-    """The Mount's state for this mover table and these ray limits (made on first use, with the
-    rays' current world origins), or None when a mounted ray is unbounded (the caller then takes
-    the per-cast path)."""
+    """The Mount's state for this mover table (made on first use, with the rays' current world
+    origins), or None when a mounted ray is unbounded (the caller then takes the per-cast path).
+    The state is kept while every mounted ray's segment is no longer than when it was made (its
+    reaches still bound every segment; other limits, e.g. light rays cast in the same batch, do not
+    matter)."""
     st = mount._state
-    if st is not None and st.mt is mt and _same(st.t_near, t_near) and _same(st.t_far, t_far):
-        return st
+    if st is not None and st.mt is mt:
+        if (st.limits is not None and not isinstance(t_near, np.ndarray) and not isinstance(t_far, np.ndarray)
+                and st.limits == (t_near, t_far)):   # scalars, as when made
+            return st
+        if np.all(np.maximum(_take(t_far, st.mi), -_take(t_near, st.mi)) <= st.span):
+            return st
     mrow = mt.row_of[mount.bodies]
     mounted = mrow >= 0
     mi = mounted.nonzero()[0]
     rows = mrow[mi]
-    span = np.maximum(_take(t_far, mi), -_take(t_near, mi))
+    span = np.maximum(_full(t_far, len(mi)) if not isinstance(t_far, np.ndarray) else t_far[mi],
+                      -_take(t_near, mi))
     if not np.all(span < _INF):
         return None
     rel = np.take(O, mi, axis=0) - np.take(C, rows, axis=0)
@@ -367,9 +368,9 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
     # covers it (and the rebuild adds 1e-12 of the coordinates then)
     reach = reach * (1.0 + 1e-9) + 1e-12 * (float(np.abs(O).max()) + float(np.abs(C).max()) if len(mi) else 0.0)
     skin = _SKIN * float(np.median(reach)) if len(used) else 0.0
-    st = _MountState(mt, t_near.copy() if isinstance(t_near, np.ndarray) else t_near,
-                     t_far.copy() if isinstance(t_far, np.ndarray) else t_far, mrow, mi, rows,
-                     (~mounted).nonzero()[0], used, reach, skin, 0.5 * skin / 1.7320508075688772 * (1.0 - 1e-6))
+    scalar = not isinstance(t_near, np.ndarray) and not isinstance(t_far, np.ndarray)
+    st = _MountState(mt, (t_near, t_far) if scalar else None, span, mrow, mi, rows, (~mounted).nonzero()[0], used,
+                     reach, skin, 0.5 * skin / 1.7320508075688772 * (1.0 - 1e-6))
     mount._state = st
     return st
 
