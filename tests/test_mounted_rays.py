@@ -159,6 +159,20 @@ def test_a_mount_kept_between_casts_gives_the_plain_answers_bit_for_bit_as_bodie
     made = np.diff([0] + lists)
     assert made[0] == 1 and made[9] == 1    # first cast, and after the jumps
     assert made[1:9].sum() <= 2             # 1 mm per step: the list is kept for several steps
+    # turning in place: the body list holds (the centres stay), the list of rays near a neighbour
+    # is kept for a tiny turn and redone for a large one; the answers stay exact
+    for turn, redone in ((1e-4, 0), (0.5, 1)):
+        before = (eng.counters["neighbour_lists"], eng.counters["ray_lists"])
+        yaw += turn
+        poses = [Pose(_rz(a), p.translation) for p, a in zip(poses, yaw)]
+        for b, p in zip(bodies, poses):
+            eng.set_body_pose(b, p)
+        R = np.stack([poses[i].rotation for i in owner])
+        O, D = np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+        got = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, mount=m)
+        ref = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL)
+        assert got.distance.tobytes() == ref.distance.tobytes() and got.normal.tobytes() == ref.normal.tobytes()
+        assert (eng.counters["neighbour_lists"], eng.counters["ray_lists"]) == (before[0], before[1] + redone)
     # other limits for the same rays: the Mount's state is remade for them (same answers again)
     far = np.where(np.arange(len(O)) % 2 == 0, 0.05, 0.1)
     for t_far in (0.1, far):

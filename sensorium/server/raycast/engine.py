@@ -148,7 +148,7 @@ class RayEngine(TierTracer):
         self._epoch = 0                                 # bumped by every set_body_pose
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
-            "continued_rays": 0, "unresolved_rays": 0, "neighbour_lists": 0,
+            "continued_rays": 0, "unresolved_rays": 0, "neighbour_lists": 0, "ray_lists": 0,
         }
 
     # ---- configuration ----------------------------------------------------------------------
@@ -441,7 +441,7 @@ class RayEngine(TierTracer):
                 mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
             elif len(st.mi):   # candidates kept between casts; the segment test as _mounted_pairs does it
                 mrow = st.mrow
-                cr, cm = mount_candidates(st, mt, C, self._epoch, self.counters)
+                cr, cm = mount_candidates(st, mt, C, self._rot, O, D, self._epoch, self.counters)
                 mounted = (*_near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, cr, cm), st.rest)
         if mounted is not None and len(mounted[2]) == 0:   # every ray mounted
             pr, pm = mounted[0], mounted[1]

@@ -332,8 +332,19 @@ class _MountState:
     reach: np.ndarray     # per used row: no point of its rays' segments is farther from its centre
     skin: float
     shift: float          # neighbour list valid while no centre moved more than this per axis
-    C_ref: np.ndarray | None = None   # centres when the list was made
+    reach_row: np.ndarray = field(default_factory=lambda: np.zeros(0))   # reach by mover row (0: none)
+    C_ref: np.ndarray | None = None   # centres when the body list was made
     epoch: int = -1       # engine pose epoch of the last check
+    src: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # body list: (b, j) rows
+    dst: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    skin_r: float = 0.0   # margin of the ray list (length), checked per axis against skin_r / sqrt(3)
+    shift_r: float = 0.0
+    c_ref: np.ndarray | None = None   # j's centre in b's frame, per listed pair, when the ray list was made
+    o_loc: np.ndarray | None = None   # mounted rays in their bodies' frames (origin about the centre)
+    d_loc: np.ndarray | None = None
+    by_body: np.ndarray | None = None  # mounted rays (indices into mi) by body row, and CSR of it
+    body_cnt: np.ndarray | None = None
+    body_ptr: np.ndarray | None = None
     pr: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # candidates: rays
     pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # and movers
 
@@ -371,27 +382,50 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
     scalar = not isinstance(t_near, np.ndarray) and not isinstance(t_far, np.ndarray)
     st = _MountState(mt, (t_near, t_far) if scalar else None, span, mrow, mi, rows, (~mounted).nonzero()[0], used,
                      reach, skin, 0.5 * skin / 1.7320508075688772 * (1.0 - 1e-6))
+    st.reach_row = np.zeros(len(C))
+    st.reach_row[used] = reach
+    st.skin_r = 2.0 * skin
+    st.shift_r = st.skin_r / 1.7320508075688772 * (1.0 - 1e-6)
     mount._state = st
     return st
 
 
-def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, epoch: int,
-                     counters: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
-    """(ray, mover) candidates of the mounted rays at the movers' current centres C: every pair
-    whose segment can come within the mover's bounding sphere, never the ray's own mount, in ray
-    order (then mover row).  The neighbour list is made with the reaches grown by the skin and kept
-    while no centre has moved by more than half of it (|shift| per axis, so <= skin / 2 in length):
-    a pair then still cannot meet unless it was listed.  Each new list counts in
-    ``counters["neighbour_lists"]``."""
+def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, rot: np.ndarray, O: np.ndarray, D: np.ndarray,
+                     epoch: int, counters: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
+    """(ray, mover) candidates of the mounted rays at the movers' current centres C (``rot``: the
+    engine's body rotations; O, D: this cast's rays): every pair whose segment can come within the
+    mover's bounding sphere, never the ray's own mount, in ray order (then mover row).
+
+    Two lists, both kept between casts.  Bodies: the pairs (b, j) whose centres are within b's reach
+    plus j's radius, grown by the skin; kept while no centre has moved by more than half the skin
+    (|shift| per axis, so <= skin / 2 in length): an unlisted pair then still cannot meet.  Rays:
+    per listed pair, the rays of b whose segment (in b's frame, where it never moves) passes within
+    j's radius grown by ``skin_r`` of j's centre in b's frame; kept while no such centre has moved by
+    more than ``skin_r`` in its b's frame (turning b moves it too).  Each new list counts in
+    ``counters["neighbour_lists"]`` (bodies) or ``counters["ray_lists"]`` (rays)."""
     if st.epoch == epoch:
         return st.pr, st.pm
     st.epoch = epoch
-    if st.C_ref is not None and len(C) == len(st.C_ref) and float(np.abs(C - st.C_ref).max()) <= st.shift:
+    if st.C_ref is None or len(C) != len(st.C_ref) or float(np.abs(C - st.C_ref).max()) > st.shift:
+        _body_list(st, mt, C, counters)
+    if len(st.src) == 0:
         return st.pr, st.pm
+    # neighbour centres in the frames of the bodies whose rays may reach them
+    Rb = np.take(rot, mt.index[st.src], axis=0)
+    rel = np.take(C, st.dst, axis=0) - np.take(C, st.src, axis=0)
+    cb = np.einsum("pji,pj->pi", Rb, rel)
+    if st.c_ref is None or float(np.abs(cb - st.c_ref).max()) > st.shift_r:
+        _ray_list(st, mt, C, cb, rot, O, D, counters)
+    return st.pr, st.pm
+
+
+def _body_list(st: _MountState, mt: _Movers, C: np.ndarray, counters: dict[str, int]) -> None:
     st.C_ref = C.copy()
+    st.c_ref = None
     counters["neighbour_lists"] += 1
+    st.src = st.dst = st.pr = st.pm = np.zeros(0, dtype=np.int64)
     if len(st.used) == 0:
-        return st.pr, st.pm
+        return
     # grown by the skin, and by a slack that keeps the list a superset of what the per-cast body
     # test (_mounted_pairs) would pair, whatever the rounding
     Ru = st.reach * (1.0 + 1e-8) + (st.skin + 1e-8 * float(mt.radius.max()) + 1e-9 + 1e-12 * float(np.abs(C).max()))
@@ -399,10 +433,32 @@ def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, epoch: int,
     nb = (pm != st.used[pb]).nonzero()[0]
     src, dst = st.used[pb[nb]], pm[nb]
     order = np.lexsort((dst, src))
-    src, dst = src[order], dst[order]
-    cnt = np.bincount(src, minlength=len(C))
-    ptr = np.cumsum(cnt) - cnt
-    c = cnt[st.rows]
-    st.pr = pr = np.repeat(st.mi, c)
-    st.pm = dst[np.repeat(ptr[st.rows] - (np.cumsum(c) - c), c) + np.arange(len(pr))]
-    return st.pr, st.pm
+    st.src, st.dst = src[order], dst[order]
+
+
+def _ray_list(st: _MountState, mt: _Movers, C: np.ndarray, cb: np.ndarray, rot: np.ndarray, O: np.ndarray,
+              D: np.ndarray, counters: dict[str, int]) -> None:
+    counters["ray_lists"] += 1
+    st.c_ref = cb
+    if st.o_loc is None:   # the mounted rays in their bodies' frames, about the centres (rigid: fixed)
+        Rr = np.take(rot, mt.index[st.rows], axis=0)
+        st.o_loc = np.einsum("nji,nj->ni", Rr, np.take(O, st.mi, axis=0) - np.take(C, st.rows, axis=0))
+        st.d_loc = np.einsum("nji,nj->ni", Rr, np.take(D, st.mi, axis=0))
+        by_body = np.argsort(st.rows, kind="stable")
+        cnt = np.bincount(st.rows, minlength=len(C))
+        st.by_body, st.body_cnt, st.body_ptr = by_body, cnt, np.cumsum(cnt) - cnt
+    c = st.body_cnt[st.src]
+    pp = np.repeat(np.arange(len(st.src)), c)
+    kk = st.by_body[np.repeat(st.body_ptr[st.src] - (np.cumsum(c) - c), c) + np.arange(len(pp))]
+    # the segment test in the body frame, for t in [-span, span] (covers [t_near, lim] while the
+    # state holds), radius grown by the skin and by slacks for rounding and for the per-cast test's
+    # own slack (1e-12 of |o - c|^2)
+    j = st.dst[pp]
+    rad = mt.radius[j] + (st.skin_r + 1e-9 + 1e-12 * float(np.abs(C).max())) + 1e-6 * (st.reach_row[st.src[pp]] + mt.radius[j])
+    o, d, sp = st.o_loc[kk], st.d_loc[kk], st.span[kk]
+    near = _segment_near_sphere(cb[pp, 0] - o[:, 0], cb[pp, 1] - o[:, 1], cb[pp, 2] - o[:, 2],
+                                d[:, 0], d[:, 1], d[:, 2], -sp, sp, rad * rad)
+    keep = near.nonzero()[0]
+    pr, pm = st.mi[kk[keep]], j[keep]
+    order = np.lexsort((pm, pr))
+    st.pr, st.pm = pr[order], pm[order]
