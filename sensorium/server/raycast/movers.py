@@ -4,9 +4,10 @@ A mover is cast against a body-frame tier shared by all movers with the same sha
 the broad phase finds the (ray, mover) pairs whose segment passes within the mover's bounding
 sphere (dense test for few movers or rays, else a uniform grid keyed by segment midpoints).
 Rays rigidly mounted on movers (sensors on robots) pair bodies before rays (``_mounted_pairs``);
-a :class:`Mount` keeps that body pairing between casts as a neighbour list with a margin (the
-reach of a body's rays from its centre is fixed by the mounting), so per cast only the rays of
-bodies with a listed neighbour are tested.
+a :class:`Mount` keeps that pairing between casts as two lists with margins: the neighbouring
+bodies (the reach of a body's rays from its centre is fixed by the mounting), and per neighbour
+the rays that can reach it (decided in the body frame, where a mounted ray never moves), so per
+cast only those rays are tested.
 """
 
 from __future__ import annotations
@@ -294,10 +295,11 @@ class Mount:
     step): ``bodies[i]`` is the body ray i rides (-1: none).  Array-like (``np.asarray(mount)`` is
     ``bodies``, so it concatenates like a plain mount array).  Passing the same Mount to every cast
     of the same rays lets the engine keep what rigid mounting leaves unchanged: which mover each ray
-    rides, how far each body's rays reach from its centre (the same at every pose), and which movers
-    are near enough to matter, a neighbour list kept until some mover has moved by more than a
-    margin.  Per cast only the segment test of the listed (ray, mover) candidates remains; rays of
-    bodies with no neighbour cost nothing.  The caller promises that the rays are those of the
+    rides, how far each body's rays reach from its centre (the same at every pose), which movers
+    are near enough to matter (a neighbour list kept until some mover has moved by more than a
+    margin) and which of a body's rays can reach each neighbour (kept until the neighbour has moved
+    by more than a margin in the body's frame).  Per cast only the segment test of the listed
+    (ray, mover) candidates remains; rays of bodies with no neighbour cost nothing.  The caller promises that the rays are those of the
     first cast (same mounts, local origins and directions), moved with their bodies."""
 
     __slots__ = ("bodies", "lo", "hi", "_state")
