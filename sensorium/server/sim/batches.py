@@ -252,7 +252,7 @@ class DistanceBatch:
         # give, computed component-major (einsum is slow on length-3 axes): see _frames_t
         self.robot_rot = robot_rot = np.array([p.rotation for p in robot_poses])
         robot_pos = np.array([p.translation for p in robot_poses])
-        rr_t = robot_rot.transpose(1, 2, 0)[:, :, plan.robot]                  # [i, j, sensor]
+        rr_t = np.take(robot_rot.transpose(1, 2, 0), plan.robot, axis=2)      # [i, j, sensor]
         rot_t, pos_t = _frames_t(rr_t, plan.local_rot_t, plan.local_pos_t)
         self.positions = pos_t.T + robot_pos[plan.robot]
         for g in plan.groups:
