@@ -21,8 +21,8 @@ Architecture
   whose segment misses a tight bound of the scene (the shell's own cylinder for a round body, else
   its box) are dropped; the rest go to ONE Embree call per shared scene.  Rays rigidly mounted on
   movers (``cast(mount=...)``: sensors on robots) never meet their own mount here, and bodies are
-  paired before rays; with a :class:`Mount` passed again and again, the pairing is a neighbour list
-  kept between casts (see :mod:`.movers`).
+  paired before rays; with a :class:`Mount` passed again and again, the pairing is kept between
+  casts as lists with margins (see :mod:`.movers`).
 * Planes are analytic (float64), never triangles, all planes of a ray kind in one (rays x planes)
   computation.
 * Curved primitives are tessellated CIRCUMSCRIBED (true surface inside the shell) and inflated
@@ -300,9 +300,10 @@ class RayEngine(TierTracer):
         once, in the body frame, with :meth:`cast_local`, and keeps the nearer of the two.  It
         also lets the broad phase skip, in one test per body, the rays of bodies whose rays cannot
         reach any other moving body (the rays of 100 robots' sensors, instead of one grid lookup
-        per ray).  A :class:`Mount` (the same rays cast again, step after step) keeps that body
-        test between casts: a neighbour list redone only when some mover has moved by more than
-        a margin; the answers are the same as with the plain array.
+        per ray).  A :class:`Mount` (the same rays cast again, step after step) keeps that pairing
+        between casts: a neighbour list of the bodies and, per neighbour, the rays that can reach
+        it, each redone only when something moved by more than a margin; the answers are the same
+        as with the plain array.
 
         ``distance_only``: the caller reads only ``distance`` (a lidar); FAST then skips the normals
         and shape ids (returned as None) and the work that only serves them, with the same
