@@ -299,8 +299,9 @@ class Mount:
     are near enough to matter (a neighbour list kept until some mover has moved by more than a
     margin) and which of a body's rays can reach each neighbour (kept until the neighbour has moved
     by more than a margin in the body's frame).  Per cast only the segment test of the listed
-    (ray, mover) candidates remains; rays of bodies with no neighbour cost nothing.  The caller promises that the rays are those of the
-    first cast (same mounts, local origins and directions), moved with their bodies."""
+    (ray, mover) candidates remains; rays of bodies with no neighbour cost nothing.  The caller
+    promises that the rays are those of the first cast (same mounts, local origins and unit
+    directions), moved with their bodies."""
 
     __slots__ = ("bodies", "lo", "hi", "_state")
 
@@ -422,6 +423,7 @@ def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, rot: np.ndarra
 
 
 def _body_list(st: _MountState, mt: _Movers, C: np.ndarray, counters: dict[str, int]) -> None:
+    """A new body list (see mount_candidates); the ray list is then redone too."""
     st.C_ref = C.copy()
     st.c_ref = None
     counters["neighbour_lists"] += 1
@@ -440,6 +442,7 @@ def _body_list(st: _MountState, mt: _Movers, C: np.ndarray, counters: dict[str, 
 
 def _ray_list(st: _MountState, mt: _Movers, C: np.ndarray, cb: np.ndarray, rot: np.ndarray, O: np.ndarray,
               D: np.ndarray, counters: dict[str, int]) -> None:
+    """A new ray list for the listed body pairs (``cb``: each neighbour's centre in its body's frame)."""
     counters["ray_lists"] += 1
     st.c_ref = cb
     if st.o_loc is None:   # the mounted rays in their bodies' frames, about the centres (rigid: fixed)
