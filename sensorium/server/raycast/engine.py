@@ -292,7 +292,8 @@ class RayEngine(TierTracer):
     # ---- casting ----------------------------------------------------------------------------
 
     def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
-             exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False) -> RayHits:
+             exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False,
+             directions32=None) -> RayHits:
         """Nearest hits of rays ``origins + t directions``, t in [t_near, t_far] (scalars or per ray).
 
         ``mount``: optional (n,) body index each ray is rigidly mounted on (-1: none).  Such a ray
@@ -307,13 +308,19 @@ class RayEngine(TierTracer):
 
         ``distance_only``: the caller reads only ``distance`` (a lidar); FAST then skips the normals
         and shape ids (returned as None) and the work that only serves them, with the same
-        distances.  Origins may be a broadcast array (one origin for all rays), never written."""
+        distances.  Origins may be a broadcast array (one origin for all rays), never written.
+
+        ``directions32``: optional ``directions.astype(float32)`` the caller keeps (a lidar whose
+        beams did not turn since the last scan); FAST hands it to Embree instead of rounding again."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
             O, D = O.reshape(1, 3), D.reshape(1, 3)
         if O.shape != D.shape or O.ndim != 2 or O.shape[1] != 3:
             raise ValueError(f"origins/directions must both be (n,3), got {O.shape} and {D.shape}")
+        if directions32 is not None and (getattr(directions32, "dtype", None) != np.float32
+                                         or np.shape(directions32) != D.shape):
+            raise ValueError(f"directions32 must be the directions as a float32 {D.shape} array")
         n = len(O)
         t_near = _param(t_near, n, np.float64, float)
         t_far = _param(t_far, n, np.float64, float)
@@ -343,7 +350,8 @@ class RayEngine(TierTracer):
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             if n <= _CHUNK:
-                return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only)
+                return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
+                                  directions32)
             # large batches in chunks: the temporaries (~150 bytes per ray) stay a few MB whatever
             # the batch, and so in cache; every ray's answer is the same (big is the batch's)
             dist = np.empty(n)
@@ -355,7 +363,7 @@ class RayEngine(TierTracer):
                 h = self._cast(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
                                _param(_take(t_far, sl), m, np.float64, float), _param(_take(excl, sl), m, np.int64, int),
                                planes, static, movers, big, None if mount is None else np.asarray(mount)[sl],
-                               distance_only)
+                               distance_only, None if directions32 is None else directions32[sl])
                 dist[sl] = h.distance
                 if not distance_only:
                     normal[sl], shape[sl] = h.normal, h.shape
@@ -393,7 +401,7 @@ class RayEngine(TierTracer):
         return RayHits(t, normal, shape)
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
-              distance_only: bool = False) -> RayHits:
+              distance_only: bool = False, d32=None) -> RayHits:
         n = len(O)
         exact = self._precision is Precision.EXACT
         eps64 = 1e-9 + 1e-14 * big  # float64 self-hit epsilon: 1e-9 m + ~50 ulps of the largest coordinate
@@ -402,7 +410,7 @@ class RayEngine(TierTracer):
         if static is not None:
             lim = t_far if hits is None else np.minimum(t_far, hits[0])
             res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big,
-                              distance_only)
+                              distance_only, None if exact else d32)
             if res is not None and hits is None:
                 hits = res
             elif res is not None and distance_only:   # the nearer of plane and mesh (ties: the plane)

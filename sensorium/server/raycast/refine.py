@@ -146,8 +146,9 @@ class Refiner:
         if m * len(cp) > _DENSE_PAIRS:  # many rays: screen their bounding box first (a lidar: a point)
             # per column: numpy reduces a short inner axis ~10x slower than a contiguous column
             reach = float(lo.max()) if isinstance(lo, np.ndarray) else lo
-            box_lo = np.array([Ot[:, k].min() for k in range(3)]) - reach
-            box_hi = np.array([Ot[:, k].max() for k in range(3)]) + reach
+            Ou = Ot[:1] if Ot.strides[0] == 0 else Ot   # one origin for all rays (a broadcast array)
+            box_lo = np.array([Ou[:, k].min() for k in range(3)]) - reach
+            box_hi = np.array([Ou[:, k].max() for k in range(3)]) + reach
             gap = cp - np.minimum(np.maximum(cp, box_lo), box_hi)
             near = (_dot(gap, gap) <= tier.c_bound2).nonzero()[0].tolist()
             if not near:

@@ -36,25 +36,30 @@ class TierTracer(Refiner):
         return scene.run(o32, d32, far, output=1)
 
     def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
-               distance_only: bool = False):
+               distance_only: bool = False, d32=None):
         """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
         for an unanchored tier).  ``distance_only``: FAST may return None for shape and normal
-        (the same t; a lidar needs nothing else)."""
+        (the same t; a lidar needs nothing else).  ``d32``: FAST only, ``D`` rounded to float32 when
+        the caller has it."""
         if exact:
             res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True)
             return res if np.count_nonzero(res[0] < _INF) else None
-        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only)
+        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32)
 
     def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
-                    distance_only: bool = False):
+                    distance_only: bool = False, d32=None):
         """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
         self-hits, shells left from inside, excluded owners) are redone by the general loop.
         Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
         (a lidar in a room) on whole arrays without gathers."""
         m = len(O)
-        Ot = _minus(O, tier.anchor) if tier.anchored else O
+        one = m > 1 and O.strides[0] == 0   # one origin for every ray (a broadcast array: a lidar)
+        if tier.anchored:   # (the same subtraction for one origin as for each row)
+            Ot = np.broadcast_to(_minus(O[:1], tier.anchor), O.shape) if one else _minus(O, tier.anchor)
+        else:
+            Ot = O
         pre = None
         lim_in = lim   # the redo below gets the caller's limit: it runs its own pre-pass, whose
         # float64 path (scalar or vectorised) may differ from this one's in the last bit
@@ -64,15 +69,21 @@ class TierTracer(Refiner):
             if pre is not None:  # the cast only needs to look before the analytic hits
                 lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, lim)
                 lim[pre[0]] = np.minimum(lim[pre[0]], pre[1])
-        o32 = Ot.astype(_F32)
-        d32 = D.astype(_F32)
+        # one origin: a read-only broadcast of its float32 row until something must be written
+        o1 = Ot[:1].astype(_F32) if one else None
+        o32 = np.broadcast_to(o1, Ot.shape) if one else Ot.astype(_F32)
+        shared = one
+        d32 = D.astype(_F32) if d32 is None else d32   # never written
         start = t_near
         dead = None
         if big is None:
-            big = max(map(abs, o32.ravel().tolist())) if m <= _SMALL else max(-float(o32.min()), float(o32.max()))
+            ob = o1 if one else o32
+            big = max(map(abs, ob.ravel().tolist())) if len(ob) <= _SMALL else max(-float(ob.min()), float(ob.max()))
         if big * 1.7321 > tier.radius:
             far_rows = (_dot(o32, o32) > _F32(tier.radius * tier.radius)).nonzero()[0]
             if len(far_rows):  # origin outside the tier's sphere: start at its entry (precision)
+                if shared:
+                    o32, shared = o32.copy(), False
                 start = np.array(_full(start, m), dtype=np.float64)
                 Of = Ot[far_rows]
                 Df = D[far_rows]
@@ -84,20 +95,32 @@ class TierTracer(Refiner):
                 o32 += start[:, None] * d32
                 o32[far_rows] = Of + start[far_rows][:, None] * Df
         if not isinstance(start, np.ndarray):
-            if start > 0.0:
+            if start > 0.0 and shared:   # o + s d in float32 (the same sum, operands swapped)
+                o32 = _F32(start) * d32
+                o32 += o1
+                shared = False
+            elif start > 0.0:
                 o32 += _F32(start) * d32
         elif dead is None:
+            if shared:
+                o32, shared = o32.copy(), False
             o32 += start[:, None] * d32
-        far = (lim - start) * (1.0 + 2.0 ** -20)  # float32 slack so a hit exactly at t_far counts
-        if dead is not None and len(dead):
-            far = np.array(_full(far, m))
-            far[dead] = -1.0
-        if isinstance(far, np.ndarray):
-            far = far.astype(_F32)
-        elif far == _INF:
-            far = None
+        slack = 1.0 + 2.0 ** -20  # float32 slack so a hit exactly at t_far counts
+        if (dead is None or not len(dead)) and (isinstance(lim, np.ndarray) or isinstance(start, np.ndarray)):
+            # per-ray limits straight into float32 (the float64 product, rounded once); x - 0.0 == x
+            base = lim if not isinstance(start, np.ndarray) and start == 0.0 else lim - start
+            far = np.multiply(base, slack, out=np.empty(m, dtype=_F32), casting="same_kind")
         else:
-            far = float(far)
+            far = (lim - start) * slack
+            if dead is not None and len(dead):
+                far = np.array(_full(far, m))
+                far[dead] = -1.0
+            if isinstance(far, np.ndarray):
+                far = far.astype(_F32)
+            elif far == _INF:
+                far = None
+            else:
+                far = float(far)
         res = self._run(tier, o32, d32, far, robust=False)
         prim = res["primID"]
         hit = prim >= 0
@@ -158,21 +181,18 @@ class TierTracer(Refiner):
         hit is only worked out when curved shells need it (the same t and special)."""
         every = isinstance(rows, slice)
         tf = res["tfar"][rows]
-        t = tf.astype(np.float64)
-        t += start if not isinstance(start, np.ndarray) else start[rows]
+        t = np.add(tf, start if not isinstance(start, np.ndarray) else start[rows], dtype=np.float64)
         if isinstance(lim, np.ndarray):
             np.minimum(t, lim[rows], out=t)
         elif lim != _INF:
             np.minimum(t, lim, out=t)
         if distance_only:   # the side hit matters only on curved shells: judge those rows alone
-            back = None
+            leaving = None
             if tier.has_curved:
-                back = np.zeros(len(tf), dtype=bool)
                 cv = np.take(tier.tri_curved, ph).nonzero()[0]
-                if len(cv):
-                    back[cv] = self._back(tier, D, d32, res, ph[cv], rows if every else rows[cv],
-                                          cv if every else None)
-            return (t, None), self._special(tier, Ot, tf, ph, rows, every, back, excl)
+                back = self._back(tier, D, d32, res, ph[cv], rows if every else rows[cv], cv if every else None)
+                leaving = cv[back]
+            return (t, None), self._special(tier, Ot, tf, ph, rows, every, None, excl, leaving)
         dh = d32[rows]
         ng = res["Ng"][rows]                 # Embree's Ng has our winding: sign = side hit
         if len(ng) > _SMALL:                 # one pass over the rows
@@ -201,8 +221,8 @@ class TierTracer(Refiner):
         """Side hit (True: the back) of the hits of ``ph`` at ray ``rows`` (``sub``: their indices
         when ``rows`` is a slice of all rays), as :meth:`_judge_fast` decides it."""
         idx = rows if sub is None else sub
-        dh = d32[idx]
-        ng = res["Ng"][idx]
+        dh = np.take(d32, idx, axis=0)       # (np.take: several times faster than fancy indexing here)
+        ng = np.take(res["Ng"], idx, axis=0)
         if len(ng) > _SMALL:
             dots = np.einsum("ij,ij->i", ng, dh)
         else:
@@ -214,22 +234,30 @@ class TierTracer(Refiner):
         return back
 
     @staticmethod
-    def _special(tier: _Tier, Ot, tf, ph, rows, every: bool, back, excl):
+    def _special(tier: _Tier, Ot, tf, ph, rows, every: bool, back, excl, leaving=None):
         """Mask of the rays FAST must redo in the general loop, or None: possible self-hits, shells
-        left from inside (``back``: side hit, needed when the tier has curved shells), excluded owners."""
+        left from inside (``back``: side hit, needed when the tier has curved shells; or ``leaving``:
+        the positions of the curved hits on a back face), excluded owners."""
         special = tf < tier.eps              # possible self-hit (origin on the surface)
-        if every:
-            special &= ph >= 0
-        if np.count_nonzero(special):
+        found = bool(np.count_nonzero(special))
+        if found:
+            if every:
+                special &= ph >= 0
             sp = special.nonzero()[0]
-            tri = ph[sp]
-            gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.first_vertex(tri), tier.normal[tri]))
-            special[sp] = gap <= 2.0 * tier.eps
-        if tier.has_curved:                  # leaving a curved shell: the true surface decides
+            if len(sp):
+                tri = ph[sp]
+                gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.first_vertex(tri), tier.normal[tri]))
+                special[sp] = gap <= 2.0 * tier.eps
+        if leaving is not None:              # leaving a curved shell: the true surface decides
+            if len(leaving):
+                special[leaving] = found = True
+        elif tier.has_curved:
             special |= back & np.take(tier.tri_curved, ph)
+            found = True
         if tier.owned and not (not isinstance(excl, np.ndarray) and excl < 0):
             special |= np.take(tier.tri_owner, ph) == (excl[rows] if isinstance(excl, np.ndarray) else excl)
-        return special if np.count_nonzero(special) else None
+            found = True
+        return special if found and np.count_nonzero(special) else None
 
     def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool):
         """General path: cast, judge each hit, continue rejected rays past their hit (bounded).

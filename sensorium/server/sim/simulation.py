@@ -383,7 +383,7 @@ class Simulation:
                 r = reqs[0]
                 results[idx[0]] = engine.cast(r.origins, r.directions, r.t_near, r.t_far, kind=kind,
                                               exclude_owner=r.exclude_owner, skip_transparent=skip, mount=r.mount,
-                                              distance_only=distance_only)
+                                              distance_only=distance_only, directions32=r.directions32)
                 continue
             origins = np.concatenate([r.origins for r in reqs])
             dirs = np.concatenate([r.directions for r in reqs])
