@@ -68,7 +68,7 @@ def _frames_t(rr_t: np.ndarray, lr_t: np.ndarray, lp_t: np.ndarray) -> tuple[np.
     rotated local positions [i, s] = sum_j rr[i, j, s] lp[j, s], summed in the orders numpy's einsum
     uses for ``"sij,sjk->sik"`` ((j0 + j1) + j2, as compose_rotations) and ``"sij,sj->si"`` ((j0 + j2)
     + j1: its two-lane inner loop), each from +0.0, so the bits are einsum's
-    (tests/test_distance_math.py checks it on the machine that runs the tests)."""
+    (tests/test_distance_math.py pins these orders; numpy may pick others for einsum elsewhere)."""
     rot = rr_t[:, 0, None, :] * lr_t[0]
     rot += rr_t[:, 1, None, :] * lr_t[1]
     rot += rr_t[:, 2, None, :] * lr_t[2]
