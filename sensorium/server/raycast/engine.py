@@ -19,7 +19,10 @@ Architecture
   for few movers or small batches, else a uniform grid keyed by the segment midpoints.  The pairs
   of each shared scene are moved into their body frames in float64; when there are many, those
   whose segment misses a tight bound of the scene (the shell's own cylinder for a round body, else
-  its box) are dropped; the rest go to ONE Embree call per shared scene.
+  its box) are dropped; the rest go to ONE Embree call per shared scene.  Rays rigidly mounted on
+  movers (``cast(mount=...)``: sensors on robots) never meet their own mount here, and bodies are
+  paired before rays; with a :class:`Mount` passed again and again, the pairing is kept between
+  casts as lists with margins (see :mod:`.movers`).
 * Planes are analytic (float64), never triangles, all planes of a ray kind in one (rays x planes)
   computation.
 * Curved primitives are tessellated CIRCUMSCRIBED (true surface inside the shell) and inflated
@@ -108,13 +111,23 @@ from sensorium.server.raycast.exact import (
     _take,
 )
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind, ShapeEntry
-from sensorium.server.raycast.movers import _Body, _grid_pairs, _mounted_pairs, _Movers, _sphere_pairs
+from sensorium.server.raycast.movers import (
+    Mount,
+    _Body,
+    _grid_pairs,
+    _mounted_pairs,
+    _Movers,
+    _near_pairs,
+    _sphere_pairs,
+    mount_candidates,
+    mount_state,
+)
 from sensorium.server.raycast.planes import _Planes, cast_planes
 from sensorium.server.raycast.tiers import _Tier, new_device
 from sensorium.server.raycast.trace import TierTracer
 from sensorium.server.world.geometry import Plane, Pose
 
-__all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine"]
+__all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine", "Mount"]
 
 
 # variants: which shapes a scene holds
@@ -149,7 +162,7 @@ class RayEngine(TierTracer):
         self._epoch = 0                                 # bumped by every set_body_pose
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
-            "continued_rays": 0, "unresolved_rays": 0, "edge_guard_hits": 0,
+            "continued_rays": 0, "unresolved_rays": 0, "edge_guard_hits": 0, "neighbour_lists": 0, "ray_lists": 0,
         }
 
     # ---- configuration ----------------------------------------------------------------------
@@ -302,7 +315,10 @@ class RayEngine(TierTracer):
         once, in the body frame, with :meth:`cast_local`, and keeps the nearer of the two.  It
         also lets the broad phase skip, in one test per body, the rays of bodies whose rays cannot
         reach any other moving body (the rays of 100 robots' sensors, instead of one grid lookup
-        per ray).
+        per ray).  A :class:`Mount` (the same rays cast again, step after step) keeps that pairing
+        between casts: a neighbour list of the bodies and, per neighbour, the rays that can reach
+        it, each redone only when something moved by more than a margin; the answers are the same
+        as with the plain array.
 
         ``distance_only``: the caller reads only ``distance`` (a lidar); the normals and shape ids
         are then skipped (returned as None) with the work that only serves them, with the same
@@ -323,7 +339,12 @@ class RayEngine(TierTracer):
         t_near = _param(t_near, n, np.float64, float)
         t_far = _param(t_far, n, np.float64, float)
         excl = _param(exclude_owner, n, np.int64, int)
-        if mount is not None:
+        if isinstance(mount, Mount):   # the same rays cast again: what rigid mounting fixes is kept
+            if len(mount) != n:
+                raise ValueError(f"mount must hold one body per ray: {len(mount)} for {n} rays")
+            if n and (mount.hi >= len(self._bodies) or mount.lo < -1):
+                raise ValueError(f"mount must hold body indices in [-1, {len(self._bodies) - 1}]")
+        elif mount is not None:
             mount = np.asarray(mount, dtype=np.int64).reshape(n)
             if n and (int(mount.max()) >= len(self._bodies) or int(mount.min()) < -1):
                 raise ValueError(f"mount must hold body indices in [-1, {len(self._bodies) - 1}]")
@@ -354,8 +375,8 @@ class RayEngine(TierTracer):
                 m = sl.stop - a
                 h = self._cast(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
                                _param(_take(t_far, sl), m, np.float64, float), _param(_take(excl, sl), m, np.int64, int),
-                               planes, static, movers, big, None if mount is None else mount[sl], distance_only,
-                               None if directions32 is None else directions32[sl])
+                               planes, static, movers, big, None if mount is None else np.asarray(mount)[sl],
+                               distance_only, None if directions32 is None else directions32[sl])
                 dist[sl] = h.distance
                 if not distance_only:
                     normal[sl], shape[sl] = h.normal, h.shape
@@ -424,20 +445,26 @@ class RayEngine(TierTracer):
         moved into their body frames; improves dist/shape/normal in place."""
         n = len(O)
         lim = np.minimum(t_far, dist)
-        if mt.epoch != self._epoch:  # poses changed since the last cast
-            mt.R = self._rot[mt.index]
+        if mt.epoch != self._epoch:  # poses changed since the last cast (rotations gathered when needed)
             mt.T = self._pos[mt.index]
+            mt.R = self._rot[mt.index] if mt.anchored else None
             mt.C = mt.T + np.einsum("mij,mj->mi", mt.R, mt.anchor) if mt.anchored else mt.T
             mt.epoch = self._epoch
-        R, T, C = mt.R, mt.T, mt.C
+        T, C = mt.T, mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = None
         if mount is not None:
             if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
                 mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
                 mt.row_of[mt.index] = np.arange(len(mt.index))
-            mrow = mt.row_of[mount]
-            mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+            st = mount_state(mount, mt, C, O, t_near, t_far) if isinstance(mount, Mount) else None
+            if st is None:
+                mrow = mt.row_of[np.asarray(mount)]
+                mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+            elif len(st.mi):   # candidates kept between casts; the segment test as _mounted_pairs does it
+                mrow = st.mrow
+                cr, cm = mount_candidates(st, mt, C, self._rot, O, D, self._epoch, self.counters)
+                mounted = (*_near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, cr, cm), st.rest)
         if mounted is not None and len(mounted[2]) == 0:   # every ray mounted
             pr, pm = mounted[0], mounted[1]
         else:
@@ -462,6 +489,9 @@ class RayEngine(TierTracer):
                 pr, pm = pr[order], pm[order]
         if len(pr) == 0:
             return
+        if mt.R is None:
+            mt.R = self._rot[mt.index]
+        R = mt.R
         if len(pr) <= _TINY:  # few pairs: is it one mover? (plain Python beats two numpy calls)
             pml = pm.tolist()
             single = pml.count(pml[0]) == len(pml)

@@ -19,7 +19,7 @@ from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import lidar as lmath
 from sensorium.server.devices.lookup import LookupTable
 from sensorium.server.devices.noise import device_rng
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
@@ -36,7 +36,7 @@ class RayRequest:
     exclude_owner: int | np.ndarray   # per request or per ray
     skip_transparent: bool = False
     tag: str = ""              # counter bucket: "light", "distance", "lidar"
-    mount: np.ndarray | None = None   # per ray: body the ray is rigidly mounted on, -1 none (see RayEngine.cast)
+    mount: np.ndarray | Mount | None = None   # per ray: body the ray is rigidly mounted on, -1 none (see RayEngine.cast)
     distance_only: bool = False       # the device reads only distances (see RayEngine.cast)
     directions32: np.ndarray | None = None   # the directions rounded to float32, when kept (see RayEngine.cast)
 
