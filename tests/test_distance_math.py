@@ -210,3 +210,56 @@ def test_distance_value():
     assert value(0.05, -1) == pytest.approx(500.0)
     assert value(0.0512345, 1) == 512.0
     assert value(0.5, -1) == 1000.0
+
+
+def test_composed_sensor_rotations_sum_in_the_documented_order():
+    """sim/batches.py composes robot and sensor rotations by columns (faster than einsum), summing in
+    a fixed order from +0.0 (signed zeros included: yaw-only rotations are full of exact zeros)."""
+    from sensorium.server.sim.batches import compose_rotations
+
+    rng = np.random.default_rng(4)
+    special = np.array([0.0, -0.0, 1.0, -1.0, 0.5, -2.0, 1e-300, 3.7])
+    for trial in range(6):
+        if trial % 2:
+            a, b = rng.choice(special, (3000, 3, 3)), rng.choice(special, (3000, 3, 3))
+        else:
+            a = rng.normal(size=(3000, 3, 3)) * 10.0 ** rng.integers(-6, 6, (3000, 3, 3))
+            b = rng.normal(size=(3000, 3, 3))
+            a[rng.random(a.shape) < 0.2] = -0.0
+        # the documented order ((j0 + j1) + j2) from +0.0, written in the plain (S, 3, 3) layout; it is
+        # the order einsum used when the golden outputs were captured, but einsum's own order is
+        # numpy's choice per CPU and version, so the test pins ours, not einsum's
+        want = ((0.0 + a[:, :, 0, None] * b[:, None, 0, :]) + a[:, :, 1, None] * b[:, None, 1, :]) \
+            + a[:, :, 2, None] * b[:, None, 2, :]
+        got = compose_rotations(a, b)
+        assert got.tobytes() == want.tobytes()
+        assert np.all(np.abs(got - a @ b) <= 1e-15 * (np.abs(a) @ np.abs(b)))   # and it is the product
+
+
+def test_component_major_sensor_frames_sum_in_the_documented_order():
+    """DistanceBatch computes sensor positions and ray directions component-major (long inner axes),
+    in the fixed summation orders it documents (those of the einsum products it replaced)."""
+    from sensorium.server.sim.batches import _frames_t, _rotate_t
+
+    rng = np.random.default_rng(5)
+    special = np.array([0.0, -0.0, 1.0, -1.0, 0.5, -2.0, 1e-300, 3.7])
+    for trial, (S, N) in enumerate([(1, 1), (7, 3), (800, 3), (500, 5), (3000, 1)] * 2):
+        if trial % 2:
+            rr, lr = rng.choice(special, (S, 3, 3)), rng.choice(special, (S, 3, 3))
+            lp, L = rng.choice(special, (S, 3)), rng.choice(special, (S, N, 3))
+        else:
+            rr = rng.normal(size=(S, 3, 3)) * 10.0 ** rng.integers(-6, 6, (S, 3, 3))
+            lr, lp, L = rng.normal(size=(S, 3, 3)), rng.normal(size=(S, 3)), rng.normal(size=(S, N, 3))
+        rot_t, pos_t = _frames_t(np.ascontiguousarray(rr.transpose(1, 2, 0)), np.ascontiguousarray(lr.transpose(1, 2, 0)),
+                                 np.ascontiguousarray(lp.T))
+        # references in the plain layout, in the documented orders (see _frames_t, _rotate_t)
+        rot = ((0.0 + rr[:, :, 0, None] * lr[:, None, 0, :]) + rr[:, :, 1, None] * lr[:, None, 1, :]) \
+            + rr[:, :, 2, None] * lr[:, None, 2, :]
+        pos = ((0.0 + rr[:, :, 0] * lp[:, None, 0]) + rr[:, :, 2] * lp[:, None, 2]) + rr[:, :, 1] * lp[:, None, 1]
+        assert np.ascontiguousarray(rot_t.transpose(2, 0, 1)).tobytes() == rot.tobytes()
+        assert np.ascontiguousarray(pos_t.T).tobytes() == pos.tobytes()
+        dirs = _rotate_t(rot_t, np.ascontiguousarray(L.transpose(2, 1, 0)))
+        want = ((0.0 + L[:, :, None, 0] * rot[:, None, :, 0]) + L[:, :, None, 2] * rot[:, None, :, 2]) \
+            + L[:, :, None, 1] * rot[:, None, :, 1]
+        assert dirs.shape == (S, N, 3) and dirs.tobytes() == want.tobytes()
+        assert np.allclose(dirs, np.einsum("sij,snj->sni", rot, L), rtol=1e-15, atol=1e-300)

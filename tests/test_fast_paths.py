@@ -70,7 +70,7 @@ def test_distance_only_cast_gives_the_full_casts_distances(offset, origin):
             assert hit.all() and len(shapes) == 1
         np.testing.assert_array_equal(lean.distance, full.distance)
     exact = RayEngine(Precision.EXACT)
-    assert exact.cast(O[:3], D[:3], distance_only=True).normal is not None   # EXACT: full data always
+    assert exact.cast(O[:3], D[:3], distance_only=True).normal is None   # EXACT too (tests/test_exact_guards.py)
 
 
 def test_rotating_beams_by_columns_is_bit_identical():

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from sensorium.server.raycast.engine import Precision, RayEngine, RayKind, ShapeEntry
+from sensorium.server.raycast.engine import Mount, Precision, RayEngine, RayKind, ShapeEntry
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.geometry import Box, Cylinder, Plane, Pose, Sphere
 from sensorium.server.world.loader import parse_world
@@ -119,6 +119,117 @@ def test_mount_and_cast_local_reject_bad_bodies():
         eng.cast_local(1, np.zeros((1, 3)), np.array([[1.0, 0, 0]]))
 
 
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_mount_kept_between_casts_gives_the_plain_answers_bit_for_bit_as_bodies_move(precision):
+    """The same rays cast step after step with one Mount: the engine keeps a neighbour list of
+    the bodies (redone only when some body moved by more than a margin) and gives exactly the
+    answers of the plain mount array and of the general broad phase, through small moves (list
+    kept), turns in place, and jumps (list redone)."""
+    eng, bodies, poses = _crowd(precision, n=25, spacing=0.08)
+    O_loc, D_loc, _, _, mount, owner, _ = _mounted_rays(poses, bodies, radius_at=0.0357)
+    m = Mount(mount)
+    assert np.asarray(m).tolist() == mount.tolist() and len(m) == len(mount)
+    rng = np.random.default_rng(11)
+    xy = np.array([p.translation[:2] for p in poses])
+    yaw = rng.uniform(0, 2 * math.pi, len(bodies))
+    lists, robot_hits = [], 0
+    for step in range(14):
+        if step == 9:                       # jumps: bodies swap neighbours
+            xy[::3] += rng.uniform(-0.15, 0.15, xy[::3].shape)
+        elif step:                          # small moves (1 mm) and turns
+            xy += 0.001 * np.stack([np.cos(yaw), np.sin(yaw)], 1)
+            yaw += rng.uniform(-0.3, 0.3, len(bodies))
+        poses = [Pose(_rz(a), np.array([x, y, 0.025])) for (x, y), a in zip(xy, yaw)]
+        for b, p in zip(bodies, poses):
+            eng.set_body_pose(b, p)
+        R = np.stack([poses[i].rotation for i in owner])
+        T = np.stack([poses[i].translation for i in owner])
+        O, D = np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+        for excl in (-1, owner):
+            ref = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, exclude_owner=excl)
+            plain = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, exclude_owner=excl, mount=mount)
+            got = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, exclude_owner=excl, mount=m)
+            for a, b in ((got, plain), (got, ref)):
+                assert a.distance.tobytes() == b.distance.tobytes()
+                assert a.shape.tobytes() == b.shape.tobytes()
+                assert a.normal.tobytes() == b.normal.tobytes()
+            robot_hits += np.count_nonzero(np.isin(ref.shape, np.arange(3, 3 + len(bodies))))
+        lists.append(eng.counters["neighbour_lists"])
+    assert robot_hits > 100                 # rays do meet the neighbours
+    made = np.diff([0] + lists)
+    assert made[0] == 1 and made[9] == 1    # first cast, and after the jumps
+    assert made[1:9].sum() <= 2             # 1 mm per step: the list is kept for several steps
+    # turning in place: the body list holds (the centres stay), the list of rays near a neighbour
+    # is kept for a tiny turn and redone for a large one; the answers stay exact
+    for turn, redone in ((1e-4, 0), (0.5, 1)):
+        before = (eng.counters["neighbour_lists"], eng.counters["ray_lists"])
+        yaw += turn
+        poses = [Pose(_rz(a), p.translation) for p, a in zip(poses, yaw)]
+        for b, p in zip(bodies, poses):
+            eng.set_body_pose(b, p)
+        R = np.stack([poses[i].rotation for i in owner])
+        O, D = np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+        got = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, mount=m)
+        ref = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL)
+        assert got.distance.tobytes() == ref.distance.tobytes() and got.normal.tobytes() == ref.normal.tobytes()
+        assert (eng.counters["neighbour_lists"], eng.counters["ray_lists"]) == (before[0], before[1] + redone)
+    # other limits for the same rays: the Mount's state is remade for them (same answers again)
+    far = np.where(np.arange(len(O)) % 2 == 0, 0.05, 0.1)
+    for t_far in (0.1, far):
+        got = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, mount=m)
+        ref = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL)
+        assert got.distance.tobytes() == ref.distance.tobytes() and got.shape.tobytes() == ref.shape.tobytes()
+
+
+@pytest.mark.parametrize("precision,seed", [(Precision.FAST, 0), (Precision.FAST, 1), (Precision.FAST, 2),
+                                            (Precision.EXACT, 3)])
+def test_a_kept_mount_matches_the_plain_one_under_random_motion(precision, seed):
+    """Random crowds, rays (origins around each body, directions with a vertical part, per-ray
+    limits) and motions from sub-millimetre drifts to jumps and half turns: the kept lists never
+    lose a pair, the answers are the plain mount's bit for bit, every step."""
+    rng = np.random.default_rng(seed)
+    eng, bodies, poses = _crowd(precision, n=16, spacing=float(rng.uniform(0.075, 0.11)), seed=seed)
+    k = 6 * len(bodies)
+    owner = np.repeat(np.arange(len(bodies)), 6)
+    mount = np.array(bodies)[owner]
+    a = rng.uniform(0, 2 * math.pi, k)
+    O_loc = np.stack([rng.uniform(0.03, 0.04, k) * np.cos(a), rng.uniform(0.03, 0.04, k) * np.sin(a),
+                      rng.uniform(-0.02, 0.02, k)], 1)
+    D_loc = np.stack([np.cos(a + rng.uniform(-0.6, 0.6, k)), np.sin(a + rng.uniform(-0.6, 0.6, k)),
+                      rng.uniform(-0.3, 0.3, k)], 1)
+    D_loc /= np.linalg.norm(D_loc, axis=1)[:, None]
+    t_far = rng.uniform(0.02, 0.15, k)
+    m = Mount(mount)
+    xy = np.array([p.translation[:2] for p in poses])
+    yaw = rng.uniform(0, 2 * math.pi, len(bodies))
+    pairs = 0
+    for _ in range(25):
+        scale = rng.choice([0.0, 1e-4, 2e-3, 0.01, 0.1])
+        xy += rng.normal(0.0, scale, xy.shape)
+        yaw += rng.normal(0.0, rng.choice([0.0, 0.01, 0.2, 1.5]), len(bodies))
+        poses = [Pose(_rz(y), np.array([x0, x1, 0.025])) for (x0, x1), y in zip(xy, yaw)]
+        for b, p in zip(bodies, poses):
+            eng.set_body_pose(b, p)
+        R = np.stack([poses[i].rotation for i in owner])
+        T = np.stack([poses[i].translation for i in owner])
+        O, D = np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+        got = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, mount=m)
+        plain = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, mount=mount)
+        assert got.distance.tobytes() == plain.distance.tobytes()
+        assert got.shape.tobytes() == plain.shape.tobytes() and got.normal.tobytes() == plain.normal.tobytes()
+        pairs += np.count_nonzero(np.isin(got.shape, np.arange(3, 3 + len(bodies))))
+    assert pairs > 20                       # rays did meet other robots
+    assert 1 < eng.counters["neighbour_lists"] <= eng.counters["ray_lists"] < 25   # lists both kept and redone
+
+
+def test_a_mount_must_match_the_rays_and_the_bodies():
+    eng, bodies, _ = _crowd(Precision.FAST, n=4)
+    with pytest.raises(ValueError, match="one body per ray"):
+        eng.cast(np.zeros((2, 3)), np.array([[1.0, 0, 0]] * 2), mount=Mount([bodies[0]] * 3))
+    with pytest.raises(ValueError, match="mount must hold body indices"):
+        eng.cast(np.zeros((2, 3)), np.array([[1.0, 0, 0]] * 2), mount=Mount([0, 99]))
+
+
 def _ir_world(yaw: float, x: float) -> dict:
     table = [[0.0, 0.0, 0.0], [1.0, 1000.0, 0.0]]   # value = 1000 x distance (m)
     dev = {"device": "DistanceSensor", "type": "infra-red", "lookup_table": table, "number_of_rays": 1}
@@ -153,3 +264,32 @@ def test_sensor_inside_its_body_sees_the_body_at_every_pose(precision):
         # the wall's near face is at x = 0.475; turned to +y the generic ray misses it (max range 1 m)
         expect = 1000.0 * (0.475 - (x + 0.01)) if yaw == 0.0 else 1000.0
         assert sim.device("r/generic").value == pytest.approx(expect, abs=1e-6 if precision == "exact" else 1e-3)
+
+
+def test_the_simulation_keeps_one_joined_mount_for_sensor_groups_cast_together():
+    """Infra-red sensors with 3 and with 5 rays form two groups cast in one engine call: the
+    simulation joins their Mounts once and passes the same joined Mount every step, so the engine's
+    neighbour list is made once while the robots stand still, and redone when they move away."""
+    table = [[0.0, 0.0, 0.0], [0.07, 70.0, 0.0]]
+    robots = []
+    for i in range(9):
+        robots.append({"name": f"r{i}", "pose": {"translation": [0.09 * (i % 3), 0.09 * (i // 3), 0.025],
+                                                 "rotation": [0, 0, 1, 0.4 * i]},
+                       "body": {"geometry": {"type": "cylinder", "radius": 0.035, "height": 0.05}},
+                       "devices": [{"device": "DistanceSensor", "name": f"ps{k}", "type": "infra-red",
+                                    "lookup_table": table, "number_of_rays": 3 if k % 2 else 5, "aperture": 0.3,
+                                    "pose": {"translation": [0.036 * math.cos(k), 0.036 * math.sin(k), 0.0],
+                                             "rotation": [0, 0, 1, float(k)]}} for k in range(6)]})
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 8}, "robots": robots}), precision="fast")
+    for d in sim.all_devices():
+        d.enable(8)
+    eng = sim.scene.engine
+    for _ in range(5):
+        sim.step()
+    assert eng.counters["neighbour_lists"] == 1
+    seen = [d.value for d in sim.all_devices()]
+    assert min(seen) < 70.0                      # neighbours are seen (and the robot's own body is not)
+    sim.robot("r0").set_pose([-1.0, -1.0, 0.025], [0, 0, 1, 0.0])
+    sim.step()
+    assert eng.counters["neighbour_lists"] == 2
+    assert all(sim.device(f"r0/ps{k}").value == 70.0 for k in range(6))   # nothing in reach any more

@@ -30,7 +30,7 @@ import numpy as np
 from sensorium.schemas import messages as msgs
 from sensorium.schemas.wire import pack, stamp, topic_frame
 
-__all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "laser_scan_angles",
+__all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "lidar_cloud_msg", "laser_scan_angles",
            "pose_quaternion", "pose_msg"]
 
 MAX_PREFIX = 1024     # bytes: longer subscriptions are refused (topic names are short)
@@ -123,6 +123,18 @@ def point_cloud_msg(hdr: dict, pc: np.ndarray) -> dict:
     points = raw[:, :12].tobytes()
     layers = pc["layer_id"].astype("<f4").tobytes()
     return {"header": hdr, "points": points, "channels": [{"name": "layer", "values": layers}]}
+
+
+def lidar_cloud_msg(hdr: dict, lidar: Any) -> dict:
+    """:func:`point_cloud_msg` of a whole lidar scan, from the device's point coordinates and its
+    constant layer channel (no record copies: the buffers are handed to msgpack as they are).
+    A device with only records (``point_cloud``) goes through :func:`point_cloud_msg`."""
+    if not hasattr(lidar, "cloud_points"):
+        return point_cloud_msg(hdr, lidar.point_cloud)
+    xyz = np.ascontiguousarray(lidar.cloud_points(), dtype="<f4")
+    layers = np.ascontiguousarray(lidar.cloud_layers(), dtype="<f4")
+    return {"header": hdr, "points": memoryview(xyz).cast("B"),
+            "channels": [{"name": "layer", "values": memoryview(layers).cast("B")}]}
 
 
 def pose_quaternion(pose: Any) -> list[float]:
@@ -445,7 +457,7 @@ class Topics:
         if kind == "point_cloud":
             if not dev.point_cloud_enabled:
                 return None
-            return point_cloud_msg(hdr, dev.point_cloud)
+            return lidar_cloud_msg(hdr, dev)
         return None
 
     # ------------------------------------------------------------------ step-reply readings

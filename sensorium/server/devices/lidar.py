@@ -78,12 +78,16 @@ __all__ = [
     "value_factors",
     "ranges_from_hits",
     "point_cloud",
+    "point_xyz",
+    "point_records",
     "RotatingSweep",
     "rotating_sweep",
     "wrap_angle",
 ]
 
 _TWO_PI = 2.0 * math.pi
+
+_XYZ_BLOCK = 16384   # points per block of point_xyz (its float64 buffer: 384 KB)
 
 POINT_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer_id", "<i4"), ("time", "<f4")])
 """One WbLidarPoint (20 bytes)."""
@@ -248,15 +252,21 @@ def ranges_from_hits(params: LidarParams, distances: np.ndarray, directions: np.
         with np.errstate(invalid="ignore"):
             v = d * value_factors(params, directions)
     else:
-        v = d.copy()
+        v = d
     lo, hi = float(params.min_range), float(params.max_range)
+    if not (params.noise > 0.0 and rng is not None) and params.resolution == RESOLUTION_OFF:
+        # nothing moves a value: round to float32 first, then blank the invalid ones. The same
+        # result as the general path below: ``v >= lo`` fails for NaN, and float32 rounding is
+        # monotone, so ``float32(v) >= float32(hi)`` holds for every v >= hi (and for inf)
+        with np.errstate(invalid="ignore", over="ignore"):   # beyond float32: inf, then blanked
+            out = v.astype(np.float32)
+            bad = np.greater_equal(v, lo)
+            np.logical_not(bad, out=bad)
+            bad |= out >= np.float32(hi)
+        np.copyto(out, np.float32(np.inf), where=bad)
+        return out
     with np.errstate(invalid="ignore"):
         valid = np.isfinite(v) & (v >= lo) & (v < hi)
-    if not (params.noise > 0.0 and rng is not None) and params.resolution == RESOLUTION_OFF:
-        # nothing moves a value: the bounds below would keep exactly the valid ones (same result)
-        out = np.where(valid, v, np.inf).astype(np.float32)
-        out[out >= np.float32(hi)] = np.inf
-        return out
     v = np.where(valid, v, np.inf)
     if params.noise > 0.0 and rng is not None:
         count = int(np.count_nonzero(valid))
@@ -289,19 +299,46 @@ def point_cloud(params: LidarParams, range_image: np.ndarray, time_s: float, per
     the caller keeps them (they never change), else computed here."""
     j = _columns(params, columns)
     L, C = int(params.number_of_layers), len(j)
-    r = np.asarray(range_image, dtype=np.float64).reshape(L, C)
     dirs = point_cloud_directions(params, j) if directions is None else directions
     if times is None:
         t = float(time_s) - j * (float(period_s) / int(params.horizontal_resolution))
     else:
         t = np.asarray(times, dtype=np.float64).reshape(C)
-    xyz = np.empty((L, C, 3), dtype=np.float32)
-    with np.errstate(invalid="ignore"):   # float64 products rounded to float32 (inf x 0 = nan)
-        np.multiply(r[:, :, None], dirs, out=xyz, casting="same_kind")
+    cols = tuple(dirs[:, :, k] for k in range(3))
+    return point_records(point_xyz(range_image, cols), L, C, t)
+
+
+def point_xyz(range_image: np.ndarray, direction_columns) -> np.ndarray:
+    """Point coordinates (N, 3) float32 of ``range_image`` (N values in any shape, float32 or
+    float64) along unit directions given as three columns (x, y, z) of N values each: the float64
+    products ``r·d`` rounded to float32 (``inf·0`` gives NaN, as in Webots). Works in blocks: the
+    products of a block land in a small float64 (B, 3) buffer that is rounded into the output in
+    one contiguous copy (a third faster than three strided rounding writes)."""
+    r = np.asarray(range_image).reshape(-1)
+    cols = [np.asarray(c).reshape(-1) for c in direction_columns]
+    n = len(r)
+    xyz = np.empty((n, 3), dtype=np.float32)
+    block = max(1, min(n, _XYZ_BLOCK))
+    buf = np.empty((block, 3))
+    rb = np.empty(block)   # the block's ranges as float64 (exact), converted once for three products
+    with np.errstate(invalid="ignore"):
+        for a in range(0, n, block):
+            b = min(n, a + block)
+            part, rr = buf[:b - a], rb[:b - a]
+            rr[:] = r[a:b]
+            for k in range(3):
+                np.multiply(cols[k][a:b], rr, out=part[:, k])
+            xyz[a:b] = part
+    return xyz
+
+
+def point_records(xyz: np.ndarray, L: int, C: int, times: np.ndarray) -> np.ndarray:
+    """WbLidarPoint records (L·C,) from layer-major coordinates (L·C, 3) float32 and the float64
+    times (C,) of the columns (rounded to float32); ``layer_id`` = the layer of each point."""
     pts = np.empty((L, C), dtype=POINT_DTYPE)
     words = pts.view(np.float32).reshape(L, C, 5)    # the 5 fields of each 20-byte point
-    words[:, :, 0:3] = xyz
-    words[:, :, 4] = t[None, :]
+    words[:, :, 0:3] = xyz.reshape(L, C, 3)
+    words[:, :, 4] = np.asarray(times, dtype=np.float64)[None, :]
     pts.view(np.int32).reshape(L, C, 5)[:, :, 3] = np.arange(L, dtype=np.int32)[:, None]
     return pts.reshape(L * C)
 

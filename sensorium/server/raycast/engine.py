@@ -19,7 +19,10 @@ Architecture
   for few movers or small batches, else a uniform grid keyed by the segment midpoints.  The pairs
   of each shared scene are moved into their body frames in float64; when there are many, those
   whose segment misses a tight bound of the scene (the shell's own cylinder for a round body, else
-  its box) are dropped; the rest go to ONE Embree call per shared scene.
+  its box) are dropped; the rest go to ONE Embree call per shared scene.  Rays rigidly mounted on
+  movers (``cast(mount=...)``: sensors on robots) never meet their own mount here, and bodies are
+  paired before rays; with a :class:`Mount` passed again and again, the pairing is kept between
+  casts as lists with margins (see :mod:`.movers`).
 * Planes are analytic (float64), never triangles, all planes of a ray kind in one (rays x planes)
   computation.
 * Curved primitives are tessellated CIRCUMSCRIBED (true surface inside the shell) and inflated
@@ -33,7 +36,9 @@ Architecture
 * FAST uses plain scenes, EXACT robust ones (``EmbreeScene(robust=True)``), each built when the
   mode first needs it.  Measured in a 600-triangle room with 131k lidar rays, all hitting: robust
   traversal costs ~40% more.  On rays aimed exactly at the vertices and edge midpoints of closed
-  meshes, the plain scenes leak ~4% of rays; robust ones plus the repair below leak none.
+  meshes, the plain scenes leak ~4% of rays; robust ones plus the repair below leak none.  The
+  EXACT scene of a tier with few risky edges also holds their guards (:mod:`.guards`) as a second
+  geometry, beside a copy without them (built together, one build).
 * Small batches (a distance sensor's few rays) are dominated by the fixed cost of each numpy
   call (~1-3 us), so the per-cast path avoids work that does not apply: per-ray parameters that
   are uniform collapse to scalars, a tier that no ray hits returns at once, judging runs on the
@@ -53,11 +58,20 @@ Precision
 * EXACT: every hit is re-intersected in float64: boxes/meshes on the plane of the hit triangle,
   with a float64 Moller-Trumbore test on the triangle and its vertex neighbours when Embree's
   barycentrics are within 1e-4 of an edge; spheres/cylinders/capsules on the true surface.  Rays
-  whose refinement misses are continued past the hit (bounded loop).  Each Embree cast is paired
-  with a copy offset 4 float32 ulps perpendicular to the ray.  When the copy hits a nearer
-  triangle, and the float64 ray hits that triangle or one of its neighbours (barycentric
-  tolerance 1e-9), the nearer hit is taken.  This repairs leaks through shared edges and
-  vertices (``counters["leak_repairs"]``).
+  whose refinement misses are continued past the hit (bounded loop).  Embree's barycentrics are
+  trusted to pick the triangle only where they lie farther inside it than float32 rounding can
+  move the hit (``h_min`` margin); elsewhere the plane hit's float64 barycentrics decide.
+* EXACT repair rule (one cast; :mod:`.guards` proves it): after one watertight float32 cast a
+  float64 hit can be missed only where the float64 ray passes within float32 reach (< eps) of a
+  *risky* edge -- a boundary edge, or one between faces at an angle (box edges); curved shells
+  are inflated beyond that reach instead.  Thin prisms around the risky edges sit in the EXACT
+  scene: a ray that meets one is tested in float64 against that edge's triangles and their vertex
+  rings (and those of edges whose prisms come close), the same past every further prism up to its
+  hit, and then gets the hit of the scene without prisms (``counters["edge_guard_hits"]`` counts
+  the float64 hits they found).  A tier with many risky edges (a curved or terrain mesh: more
+  than 1.2 per flat triangle, or 20,000) keeps the former repair instead: each Embree cast paired
+  with a copy offset 4 float32 ulps perpendicular to the ray, whose nearer hits are taken when the
+  float64 ray hits that triangle or a neighbour (``counters["leak_repairs"]``).
 
 Epsilons (per tier; res = float32 spacing at the tier's radius in the anchored frame)
 * ``eps`` = max(1e-6 m, 8 res): self-hit distance and continuation step.  EXACT casts start
@@ -69,6 +83,9 @@ Epsilons (per tier; res = float32 spacing at the tier's radius in the anchored f
 Known limits (measure-zero in practice)
 * Two surfaces closer together along a ray than float32 resolution (~res) may come out in either order.
 * A surface within ``eps`` beyond a rejected or continued hit can be skipped.
+* EXACT guards: a float64 hit on a flat triangle seen at grazing incidence alpha can be missed
+  when another surface lies less than ~eps / sin(alpha) behind it (the float32 ray crosses the
+  guard past that surface), or across more than one coplanar sliver triangle from its risky edge.
 """
 
 from __future__ import annotations
@@ -94,13 +111,23 @@ from sensorium.server.raycast.exact import (
     _take,
 )
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind, ShapeEntry
-from sensorium.server.raycast.movers import _Body, _grid_pairs, _mounted_pairs, _Movers, _sphere_pairs
+from sensorium.server.raycast.movers import (
+    Mount,
+    _Body,
+    _grid_pairs,
+    _mounted_pairs,
+    _Movers,
+    _near_pairs,
+    _sphere_pairs,
+    mount_candidates,
+    mount_state,
+)
 from sensorium.server.raycast.planes import _Planes, cast_planes
 from sensorium.server.raycast.tiers import _Tier, new_device
 from sensorium.server.raycast.trace import TierTracer
 from sensorium.server.world.geometry import Plane, Pose
 
-__all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine"]
+__all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine", "Mount"]
 
 
 # variants: which shapes a scene holds
@@ -135,7 +162,7 @@ class RayEngine(TierTracer):
         self._epoch = 0                                 # bumped by every set_body_pose
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
-            "continued_rays": 0, "unresolved_rays": 0,
+            "continued_rays": 0, "unresolved_rays": 0, "edge_guard_hits": 0, "neighbour_lists": 0, "ray_lists": 0,
         }
 
     # ---- configuration ----------------------------------------------------------------------
@@ -279,7 +306,8 @@ class RayEngine(TierTracer):
     # ---- casting ----------------------------------------------------------------------------
 
     def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
-             exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False) -> RayHits:
+             exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False,
+             directions32=None) -> RayHits:
         """Nearest hits of rays ``origins + t directions``, t in [t_near, t_far] (scalars or per ray).
 
         ``mount``: optional (n,) body index each ray is rigidly mounted on (-1: none).  Such a ray
@@ -287,22 +315,36 @@ class RayEngine(TierTracer):
         once, in the body frame, with :meth:`cast_local`, and keeps the nearer of the two.  It
         also lets the broad phase skip, in one test per body, the rays of bodies whose rays cannot
         reach any other moving body (the rays of 100 robots' sensors, instead of one grid lookup
-        per ray).
+        per ray).  A :class:`Mount` (the same rays cast again, step after step) keeps that pairing
+        between casts: a neighbour list of the bodies and, per neighbour, the rays that can reach
+        it, each redone only when something moved by more than a margin; the answers are the same
+        as with the plain array.
 
-        ``distance_only``: the caller reads only ``distance`` (a lidar); FAST then skips the normals
-        and shape ids (returned as None) and the work that only serves them, with the same
-        distances.  Origins may be a broadcast array (one origin for all rays), never written."""
+        ``distance_only``: the caller reads only ``distance`` (a lidar); the normals and shape ids
+        are then skipped (returned as None) with the work that only serves them, with the same
+        distances.  Origins may be a broadcast array (one origin for all rays), never written.
+
+        ``directions32``: optional ``directions.astype(float32)`` the caller keeps (a lidar whose
+        beams did not turn since the last scan); it is handed to Embree instead of rounding again."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
             O, D = O.reshape(1, 3), D.reshape(1, 3)
         if O.shape != D.shape or O.ndim != 2 or O.shape[1] != 3:
             raise ValueError(f"origins/directions must both be (n,3), got {O.shape} and {D.shape}")
+        if directions32 is not None and (getattr(directions32, "dtype", None) != np.float32
+                                         or np.shape(directions32) != D.shape):
+            raise ValueError(f"directions32 must be the directions as a float32 {D.shape} array")
         n = len(O)
         t_near = _param(t_near, n, np.float64, float)
         t_far = _param(t_far, n, np.float64, float)
         excl = _param(exclude_owner, n, np.int64, int)
-        if mount is not None:
+        if isinstance(mount, Mount):   # the same rays cast again: what rigid mounting fixes is kept
+            if len(mount) != n:
+                raise ValueError(f"mount must hold one body per ray: {len(mount)} for {n} rays")
+            if n and (mount.hi >= len(self._bodies) or mount.lo < -1):
+                raise ValueError(f"mount must hold body indices in [-1, {len(self._bodies) - 1}]")
+        elif mount is not None:
             mount = np.asarray(mount, dtype=np.int64).reshape(n)
             if n and (int(mount.max()) >= len(self._bodies) or int(mount.min()) < -1):
                 raise ValueError(f"mount must hold body indices in [-1, {len(self._bodies) - 1}]")
@@ -317,12 +359,12 @@ class RayEngine(TierTracer):
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
         Ou = O[:1] if O.strides[0] == 0 else O   # one origin for all rays (a broadcast array)
         big = max(map(abs, Ou.ravel().tolist())) if len(Ou) <= _SMALL else max(float(Ou.max()), -float(Ou.min()))
-        distance_only = distance_only and self._precision is Precision.FAST
         # one errstate for the whole cast: inf/NaN are handled explicitly (entering the context
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             if n <= _CHUNK:
-                return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only)
+                return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
+                                  directions32)
             # large batches in chunks: the temporaries (~150 bytes per ray) stay a few MB whatever
             # the batch, and so in cache; every ray's answer is the same (big is the batch's)
             dist = np.empty(n)
@@ -333,7 +375,8 @@ class RayEngine(TierTracer):
                 m = sl.stop - a
                 h = self._cast(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
                                _param(_take(t_far, sl), m, np.float64, float), _param(_take(excl, sl), m, np.int64, int),
-                               planes, static, movers, big, None if mount is None else mount[sl], distance_only)
+                               planes, static, movers, big, None if mount is None else np.asarray(mount)[sl],
+                               distance_only, None if directions32 is None else directions32[sl])
                 dist[sl] = h.distance
                 if not distance_only:
                     normal[sl], shape[sl] = h.normal, h.shape
@@ -371,7 +414,7 @@ class RayEngine(TierTracer):
         return RayHits(t, normal, shape)
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
-              distance_only: bool = False) -> RayHits:
+              distance_only: bool = False, d32=None) -> RayHits:
         n = len(O)
         exact = self._precision is Precision.EXACT
         eps64 = 1e-9 + 1e-14 * big  # float64 self-hit epsilon: 1e-9 m + ~50 ulps of the largest coordinate
@@ -380,7 +423,7 @@ class RayEngine(TierTracer):
         if static is not None:
             lim = t_far if hits is None else np.minimum(t_far, hits[0])
             res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big,
-                              distance_only)
+                              distance_only, d32)
             if res is not None and hits is None:
                 hits = res
             elif res is not None and distance_only:   # the nearer of plane and mesh (ties: the plane)
@@ -402,20 +445,26 @@ class RayEngine(TierTracer):
         moved into their body frames; improves dist/shape/normal in place."""
         n = len(O)
         lim = np.minimum(t_far, dist)
-        if mt.epoch != self._epoch:  # poses changed since the last cast
-            mt.R = self._rot[mt.index]
+        if mt.epoch != self._epoch:  # poses changed since the last cast (rotations gathered when needed)
             mt.T = self._pos[mt.index]
+            mt.R = self._rot[mt.index] if mt.anchored else None
             mt.C = mt.T + np.einsum("mij,mj->mi", mt.R, mt.anchor) if mt.anchored else mt.T
             mt.epoch = self._epoch
-        R, T, C = mt.R, mt.T, mt.C
+        T, C = mt.T, mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = None
         if mount is not None:
             if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
                 mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
                 mt.row_of[mt.index] = np.arange(len(mt.index))
-            mrow = mt.row_of[mount]
-            mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+            st = mount_state(mount, mt, C, O, t_near, t_far) if isinstance(mount, Mount) else None
+            if st is None:
+                mrow = mt.row_of[np.asarray(mount)]
+                mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+            elif len(st.mi):   # candidates kept between casts; the segment test as _mounted_pairs does it
+                mrow = st.mrow
+                cr, cm = mount_candidates(st, mt, C, self._rot, O, D, self._epoch, self.counters)
+                mounted = (*_near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, cr, cm), st.rest)
         if mounted is not None and len(mounted[2]) == 0:   # every ray mounted
             pr, pm = mounted[0], mounted[1]
         else:
@@ -440,6 +489,9 @@ class RayEngine(TierTracer):
                 pr, pm = pr[order], pm[order]
         if len(pr) == 0:
             return
+        if mt.R is None:
+            mt.R = self._rot[mt.index]
+        R = mt.R
         if len(pr) <= _TINY:  # few pairs: is it one mover? (plain Python beats two numpy calls)
             pml = pm.tolist()
             single = pml.count(pml[0]) == len(pml)

@@ -125,10 +125,11 @@ def _sphere_roots_into(ts, k, p, d, r):
     _roots_into(ts, k, a, b, c, a * r * r - _dot(x, x))  # |p x d|^2 form: no cancellation far away
 
 
-def _analytic_local(code, p, d, r, h, lo, hi):
+def _analytic_local(code, p, d, r, h, lo, hi, normals=True):
     """Nearest true-surface hit with lo <= t <= hi, shape-local frame.  ``r`` radius, ``h`` half
     height (cylinder) or half length of the straight part (capsule), scalars or per-ray arrays;
-    ``lo``, ``hi`` per-ray arrays.  Returns (t, unit normal), +inf / zeros where no hit."""
+    ``lo``, ``hi`` per-ray arrays.  Returns (t, unit normal), +inf / zeros where no hit (normal
+    None without ``normals``: the same t)."""
     m = len(p)
     col = (lambda x: x[:, None]) if isinstance(h, np.ndarray) else (lambda x: x)  # noqa: E731
     tol = 1e-12 * (r + h)
@@ -158,6 +159,8 @@ def _analytic_local(code, p, d, r, h, lo, hi):
                 cap = ts[:, k:k + 2]
                 np.copyto(cap, _INF, where=~(sign * (pz + cap * dz) >= col(h - tol)))
     np.copyto(ts, _INF, where=~((ts >= lo[:, None]) & (ts <= hi[:, None])))
+    if not normals:
+        return ts.min(axis=1), None
     if m <= 256:
         k = ts.argmin(axis=1)   # first of equal candidates, in column order
         t = ts[np.arange(m), k]

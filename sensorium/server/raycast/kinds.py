@@ -34,4 +34,4 @@ class RayHits:
     distance: np.ndarray  # (n,) float64, +inf where no hit
     normal: np.ndarray | None   # (n,3) float64 unit, dot(normal, dir) <= 0; zeros where no hit
     shape: np.ndarray | None    # (n,) int64 global shape index, -1 where no hit
-    # (normal and shape are None when the cast was asked for distances only, in FAST)
+    # (normal and shape are None when the cast was asked for distances only)

@@ -3,6 +3,11 @@
 A mover is cast against a body-frame tier shared by all movers with the same shapes; per cast,
 the broad phase finds the (ray, mover) pairs whose segment passes within the mover's bounding
 sphere (dense test for few movers or rays, else a uniform grid keyed by segment midpoints).
+Rays rigidly mounted on movers (sensors on robots) pair bodies before rays (``_mounted_pairs``);
+a :class:`Mount` keeps that pairing between casts as two lists with margins: the neighbouring
+bodies (the reach of a body's rays from its centre is fixed by the mounting), and per neighbour
+the rays that can reach it (decided in the body frame, where a mounted ray never moves), so per
+cast only those rays are tested.
 """
 
 from __future__ import annotations
@@ -11,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _take
+from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _take
 from sensorium.server.world.geometry import Pose
 
 
@@ -243,18 +248,26 @@ def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndar
     c = cnt[rows]
     pr = np.repeat(mi, c)
     pm = dst[np.repeat(ptr[rows] - (np.cumsum(c) - c), c) + np.arange(len(pr))]
-    if len(pr):
-        Cp = np.take(C, pm, axis=0)
-        Op = np.take(O, pr, axis=0)
-        Dp = np.take(D, pr, axis=0)
-        sel = _segment_near_sphere(Cp[:, 0] - Op[:, 0], Cp[:, 1] - Op[:, 1], Cp[:, 2] - Op[:, 2],
-                                   Dp[:, 0], Dp[:, 1], Dp[:, 2], _take(t_near, pr), lim[pr], mt.r2[pm])
-        if owner is not None:
-            sel &= owner[pm] != _take(excl, pr)
-        keep = sel.nonzero()[0]
-        pr, pm = pr[keep], pm[keep]
+    pr, pm = _near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, pr, pm)
     rest = (~mounted).nonzero()[0]
     return pr, pm, rest
+
+
+def _near_pairs(C, O, D, t_near, lim, excl, owner, r2, pr, pm):
+    """Those of the candidate (ray, mover) pairs ``pr``, ``pm`` whose segment passes within the
+    mover's bounding sphere (centres C, squared radii r2) and whose owner is not excluded (``owner``
+    None: no check)."""
+    if len(pr) == 0:
+        return pr, pm
+    Cp = np.take(C, pm, axis=0)
+    Op = np.take(O, pr, axis=0)
+    Dp = np.take(D, pr, axis=0)
+    sel = _segment_near_sphere(Cp[:, 0] - Op[:, 0], Cp[:, 1] - Op[:, 1], Cp[:, 2] - Op[:, 2],
+                               Dp[:, 0], Dp[:, 1], Dp[:, 2], _take(t_near, pr), lim[pr], r2[pm])
+    if owner is not None:
+        sel &= owner[pm] != _take(excl, pr)
+    keep = sel.nonzero()[0]
+    return pr[keep], pm[keep]
 
 
 def _near_centres(Cu: np.ndarray, Ru: np.ndarray, C: np.ndarray, radius: np.ndarray):
@@ -275,3 +288,182 @@ def _near_centres(Cu: np.ndarray, Ru: np.ndarray, C: np.ndarray, radius: np.ndar
     gap = Ru[pb] + radius[pm]
     ok = (_dot(d, d) <= gap * gap * (1.0 + 1e-9) + 1e-18).nonzero()[0]
     return pb[ok], pm[ok]
+
+
+class Mount:
+    """Rays rigidly mounted on bodies, cast again and again (a robot's distance sensors, step after
+    step): ``bodies[i]`` is the body ray i rides (-1: none).  Array-like (``np.asarray(mount)`` is
+    ``bodies``, so it concatenates like a plain mount array).  Passing the same Mount to every cast
+    of the same rays lets the engine keep what rigid mounting leaves unchanged: which mover each ray
+    rides, how far each body's rays reach from its centre (the same at every pose), which movers
+    are near enough to matter (a neighbour list kept until some mover has moved by more than a
+    margin) and which of a body's rays can reach each neighbour (kept until the neighbour has moved
+    by more than a margin in the body's frame).  Per cast only the segment test of the listed
+    (ray, mover) candidates remains; rays of bodies with no neighbour cost nothing.  The caller
+    promises that the rays are those of the first cast (same mounts, local origins and unit
+    directions), moved with their bodies."""
+
+    __slots__ = ("bodies", "lo", "hi", "_state")
+
+    def __init__(self, bodies) -> None:
+        self.bodies = np.array(bodies, dtype=np.int64).reshape(-1)
+        self.bodies.setflags(write=False)
+        self.lo, self.hi = (int(self.bodies.min()), int(self.bodies.max())) if len(self.bodies) else (-1, -1)
+        self._state: _MountState | None = None
+
+    def __len__(self) -> int:
+        return len(self.bodies)
+
+    def __array__(self, dtype=None, copy=None):
+        return self.bodies if dtype is None else self.bodies.astype(dtype)
+
+
+_SKIN = 0.25          # neighbour-list margin, as a fraction of the median reach of the bodies' rays
+
+
+@dataclass(slots=True)
+class _MountState:
+    """What a :class:`Mount` keeps for one mover table (see there)."""
+    mt: _Movers
+    limits: tuple | None  # (t_near, t_far) when both were scalars
+    span: np.ndarray      # per mounted ray: how far its segment reaches from its origin (then)
+    mrow: np.ndarray      # per ray: its mover row, -1 none
+    mi: np.ndarray        # the mounted rays
+    rows: np.ndarray      # their mover rows
+    rest: np.ndarray      # the other rays
+    used: np.ndarray      # mover rows carrying mounted rays
+    reach: np.ndarray     # per used row: no point of its rays' segments is farther from its centre
+    skin: float
+    shift: float          # neighbour list valid while no centre moved more than this per axis
+    reach_row: np.ndarray = field(default_factory=lambda: np.zeros(0))   # reach by mover row (0: none)
+    C_ref: np.ndarray | None = None   # centres when the body list was made
+    epoch: int = -1       # engine pose epoch of the last check
+    src: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # body list: (b, j) rows
+    dst: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    skin_r: float = 0.0   # margin of the ray list (length), checked per axis against skin_r / sqrt(3)
+    shift_r: float = 0.0
+    c_ref: np.ndarray | None = None   # j's centre in b's frame, per listed pair, when the ray list was made
+    o_loc: np.ndarray | None = None   # mounted rays in their bodies' frames (origin about the centre)
+    d_loc: np.ndarray | None = None
+    by_body: np.ndarray | None = None  # mounted rays (indices into mi) by body row, and CSR of it
+    body_cnt: np.ndarray | None = None
+    body_ptr: np.ndarray | None = None
+    pr: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # candidates: rays
+    pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # and movers
+
+
+def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near, t_far) -> _MountState | None:
+    """The Mount's state for this mover table (made on first use, with the rays' current world
+    origins), or None when a mounted ray is unbounded (the caller then takes the per-cast path).
+    The state is kept while every mounted ray's segment is no longer than when it was made (its
+    reaches still bound every segment; other limits, e.g. light rays cast in the same batch, do not
+    matter)."""
+    st = mount._state
+    if st is not None and st.mt is mt:
+        if (st.limits is not None and not isinstance(t_near, np.ndarray) and not isinstance(t_far, np.ndarray)
+                and st.limits == (t_near, t_far)):   # scalars, as when made
+            return st
+        if np.all(np.maximum(_take(t_far, st.mi), -_take(t_near, st.mi)) <= st.span):
+            return st
+    mrow = mt.row_of[mount.bodies]
+    mounted = mrow >= 0
+    mi = mounted.nonzero()[0]
+    rows = mrow[mi]
+    span = np.maximum(_full(t_far, len(mi)) if not isinstance(t_far, np.ndarray) else t_far[mi],
+                      -_take(t_near, mi))
+    if not np.all(span < _INF):
+        return None
+    rel = np.take(O, mi, axis=0) - np.take(C, rows, axis=0)
+    reach = np.full(len(C), -1.0)
+    np.maximum.at(reach, rows, np.sqrt(_dot(rel, rel)) + span)
+    used = (reach >= 0.0).nonzero()[0]
+    reach = reach[used]
+    # |o - c| is the same at every pose up to rounding (a few ulps of the coordinates): the slack
+    # covers it (and the rebuild adds 1e-12 of the coordinates then)
+    reach = reach * (1.0 + 1e-9) + 1e-12 * (float(np.abs(O).max()) + float(np.abs(C).max()) if len(mi) else 0.0)
+    skin = _SKIN * float(np.median(reach)) if len(used) else 0.0
+    scalar = not isinstance(t_near, np.ndarray) and not isinstance(t_far, np.ndarray)
+    st = _MountState(mt, (t_near, t_far) if scalar else None, span, mrow, mi, rows, (~mounted).nonzero()[0], used,
+                     reach, skin, 0.5 * skin / 1.7320508075688772 * (1.0 - 1e-6))
+    st.reach_row = np.zeros(len(C))
+    st.reach_row[used] = reach
+    st.skin_r = 2.0 * skin
+    st.shift_r = st.skin_r / 1.7320508075688772 * (1.0 - 1e-6)
+    mount._state = st
+    return st
+
+
+def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, rot: np.ndarray, O: np.ndarray, D: np.ndarray,
+                     epoch: int, counters: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
+    """(ray, mover) candidates of the mounted rays at the movers' current centres C (``rot``: the
+    engine's body rotations; O, D: this cast's rays): every pair whose segment can come within the
+    mover's bounding sphere, never the ray's own mount, in ray order (then mover row).
+
+    Two lists, both kept between casts.  Bodies: the pairs (b, j) whose centres are within b's reach
+    plus j's radius, grown by the skin; kept while no centre has moved by more than half the skin
+    (|shift| per axis, so <= skin / 2 in length): an unlisted pair then still cannot meet.  Rays:
+    per listed pair, the rays of b whose segment (in b's frame, where it never moves) passes within
+    j's radius grown by ``skin_r`` of j's centre in b's frame; kept while no such centre has moved by
+    more than ``skin_r`` in its b's frame (turning b moves it too).  Each new list counts in
+    ``counters["neighbour_lists"]`` (bodies) or ``counters["ray_lists"]`` (rays)."""
+    if st.epoch == epoch:
+        return st.pr, st.pm
+    st.epoch = epoch
+    if st.C_ref is None or len(C) != len(st.C_ref) or float(np.abs(C - st.C_ref).max()) > st.shift:
+        _body_list(st, mt, C, counters)
+    if len(st.src) == 0:
+        return st.pr, st.pm
+    # neighbour centres in the frames of the bodies whose rays may reach them
+    Rb = np.take(rot, mt.index[st.src], axis=0)
+    rel = np.take(C, st.dst, axis=0) - np.take(C, st.src, axis=0)
+    cb = np.einsum("pji,pj->pi", Rb, rel)
+    if st.c_ref is None or float(np.abs(cb - st.c_ref).max()) > st.shift_r:
+        _ray_list(st, mt, C, cb, rot, O, D, counters)
+    return st.pr, st.pm
+
+
+def _body_list(st: _MountState, mt: _Movers, C: np.ndarray, counters: dict[str, int]) -> None:
+    """A new body list (see mount_candidates); the ray list is then redone too."""
+    st.C_ref = C.copy()
+    st.c_ref = None
+    counters["neighbour_lists"] += 1
+    st.src = st.dst = st.pr = st.pm = np.zeros(0, dtype=np.int64)
+    if len(st.used) == 0:
+        return
+    # grown by the skin, and by a slack that keeps the list a superset of what the per-cast body
+    # test (_mounted_pairs) would pair, whatever the rounding
+    Ru = st.reach * (1.0 + 1e-8) + (st.skin + 1e-8 * float(mt.radius.max()) + 1e-9 + 1e-12 * float(np.abs(C).max()))
+    pb, pm = _near_centres(np.take(C, st.used, axis=0), Ru, C, mt.radius)
+    nb = (pm != st.used[pb]).nonzero()[0]
+    src, dst = st.used[pb[nb]], pm[nb]
+    order = np.lexsort((dst, src))
+    st.src, st.dst = src[order], dst[order]
+
+
+def _ray_list(st: _MountState, mt: _Movers, C: np.ndarray, cb: np.ndarray, rot: np.ndarray, O: np.ndarray,
+              D: np.ndarray, counters: dict[str, int]) -> None:
+    """A new ray list for the listed body pairs (``cb``: each neighbour's centre in its body's frame)."""
+    counters["ray_lists"] += 1
+    st.c_ref = cb
+    if st.o_loc is None:   # the mounted rays in their bodies' frames, about the centres (rigid: fixed)
+        Rr = np.take(rot, mt.index[st.rows], axis=0)
+        st.o_loc = np.einsum("nji,nj->ni", Rr, np.take(O, st.mi, axis=0) - np.take(C, st.rows, axis=0))
+        st.d_loc = np.einsum("nji,nj->ni", Rr, np.take(D, st.mi, axis=0))
+        by_body = np.argsort(st.rows, kind="stable")
+        cnt = np.bincount(st.rows, minlength=len(C))
+        st.by_body, st.body_cnt, st.body_ptr = by_body, cnt, np.cumsum(cnt) - cnt
+    c = st.body_cnt[st.src]
+    pp = np.repeat(np.arange(len(st.src)), c)
+    kk = st.by_body[np.repeat(st.body_ptr[st.src] - (np.cumsum(c) - c), c) + np.arange(len(pp))]
+    # the segment test in the body frame, for t in [-span, span] (covers [t_near, lim] while the
+    # state holds), radius grown by the skin and by slacks for rounding and for the per-cast test's
+    # own slack (1e-12 of |o - c|^2)
+    j = st.dst[pp]
+    rad = mt.radius[j] + (st.skin_r + 1e-9 + 1e-12 * float(np.abs(C).max())) + 1e-6 * (st.reach_row[st.src[pp]] + mt.radius[j])
+    o, d, sp = st.o_loc[kk], st.d_loc[kk], st.span[kk]
+    near = _segment_near_sphere(cb[pp, 0] - o[:, 0], cb[pp, 1] - o[:, 1], cb[pp, 2] - o[:, 2],
+                                d[:, 0], d[:, 1], d[:, 2], -sp, sp, rad * rad)
+    keep = near.nonzero()[0]
+    pr, pm = st.mi[kk[keep]], j[keep]
+    order = np.lexsort((pm, pr))
+    st.pr, st.pm = pr[order], pm[order]

@@ -7,10 +7,13 @@ from __future__ import annotations
 import numpy as np
 
 from sensorium.server.raycast.exact import (
+    _BARY_TOL,
     _CAPSULE,
     _CYLINDER,
     _DENSE_PAIRS,
+    _F32,
     _INF,
+    _MAX_LOOPS,
     _SCALAR,
     _SPHERE,
     _TINY,
@@ -25,6 +28,7 @@ from sensorium.server.raycast.exact import (
     _strictly_increasing,
     _take,
 )
+from sensorium.server.raycast.guards import PRISM_TRIANGLES
 from sensorium.server.raycast.tiers import _Tier
 
 
@@ -62,6 +66,125 @@ class Refiner:
             ok[bad[got]] = True
         return ok, t, tri
 
+    def _guard_rays(self, tier: _Tier, res, g, act, Ot, D, o32, d32, sa, far, lo, lim, excl, best_t, best_s, best_n):
+        """The second look of EXACT (see :mod:`.guards`) for the rays ``g`` (rows of this pass's Embree
+        results ``res``; ray ``act[g]``, segment from ``sa`` (float32 start ``o32``), float64 ``far``) whose first hit was a
+        guard: (1) their hit in the scene without guards (it replaces theirs in ``res``, so that the
+        pass goes on as if the guards were not there); (2) a float64 test of the guarded edge's
+        triangles, and the same for every further guard met up to a little past that hit (steps of
+        w/2 past each surface or guard: they cannot jump over a prism that a ray within w/2 of its
+        edge crosses, and prisms closer together than that share their candidates)."""
+        rows = act[g]
+        fg = far[g]
+        s = res["tfar"][g].astype(np.float64)   # the first guard, from the segment start
+        d32g = d32[g]
+        self.counters["embree_calls"] += 1
+        r0 = tier.bare_scene().run(o32[g], d32g, np.where(fg >= 0.0, fg, -1.0).astype(_F32), output=1)
+        w = 4.0 * tier.eps
+        stop = np.minimum(fg, np.where(r0["primID"] >= 0, r0["tfar"].astype(np.float64) + 4.0 * w, _INF))
+        self._guard_hits(tier, Ot, D, rows, res["primID"][g], lo, lim, excl, best_t, best_s, best_n)
+        for k in ("primID", "tfar", "u", "v", "Ng", "geomID"):
+            res[k][g] = r0[k]
+        scene = tier.scene(True)[0]
+        sub = np.arange(len(g))
+        for _ in range(_MAX_LOOPS):
+            s = s + 0.5 * w
+            f = stop[sub] - s
+            keep = (f >= 0.0).nonzero()[0]
+            sub, s, f = sub[keep], s[keep], f[keep]
+            if not len(sub):
+                return
+            r = rows[sub]
+            o = (Ot[r] + (sa[g[sub]] + s)[:, None] * D[r]).astype(_F32)
+            self.counters["embree_calls"] += 1
+            r1 = scene.run(o, d32g[sub], f.astype(_F32), output=1)
+            met = (r1["primID"] >= 0).nonzero()[0]
+            sub, s = sub[met], s[met] + r1["tfar"][met]
+            more = (r1["geomID"][met] == 1).nonzero()[0]
+            if len(more):
+                self._guard_hits(tier, Ot, D, rows[sub[more]], r1["primID"][met[more]], lo, lim, excl,
+                                 best_t, best_s, best_n)
+        self.counters["unresolved_rays"] += len(sub)
+
+    def _guard_hits(self, tier: _Tier, Ot, D, rows, gprim, lo, hi, excl, best_t, best_s, best_n):
+        """The second look of EXACT (see :mod:`.guards`): rays ``rows`` met the guards (prism triangles
+        ``gprim``) of risky edges; test them in float64 on the flat triangles of those edges, and
+        where one is hit with lo <= t <= hi nearer than ``best_t``, take it (``best_*``, ``hi`` are
+        updated in place; arrays indexed by ray)."""
+        _, ptr, idx = tier.guard[:3]
+        edge = gprim.astype(np.int64) // PRISM_TRIANGLES
+        starts = ptr[edge]
+        counts = ptr[edge + 1] - starts
+        ray = rows[np.repeat(np.arange(len(rows)), counts)]
+        cand = idx[np.repeat(starts - (np.cumsum(counts) - counts), counts) + np.arange(int(counts.sum()))]
+        if excl is not None:
+            keep = tier.tri_owner[cand] != excl[ray]
+            ray, cand = ray[keep], cand[keep]
+        ok, t = _moller_trumbore(Ot[ray], D[ray], tier.v0[cand], tier.e1[cand], tier.e2[cand])
+        ok &= (t >= lo[ray]) & (t <= hi[ray]) & (t < best_t[ray])
+        ray, t, cand = ray[ok], t[ok], cand[ok]
+        if not len(ray):
+            return
+        if len(ray) > 1 and not _strictly_increasing(ray):
+            keep = _best_per_row(ray, t)
+            ray, t, cand = ray[keep], t[keep], cand[keep]
+        nrm = tier.normal[cand]
+        nrm[_dot(nrm, D[ray]) > 0.0] *= -1.0
+        best_t[ray], best_s[ray], best_n[ray] = t, tier.tri_shape[cand], nrm
+        hi[ray] = t
+        self.counters["edge_guard_hits"] += len(ray)
+
+    def _flat_dense(self, tier: _Tier, res, prim, Ot, D, one_origin: bool, lo, lim, t_e, d_max: float,
+                    best_t, best_s, best_n, distance_only: bool):
+        """EXACT's judging of flat hits (see :meth:`.trace.TierTracer._trace_loop`) in a pass where every ray is active
+        and most hit a flat triangle (a lidar in a room): on whole arrays, misses and curved hits
+        masked, instead of gathering the hit rows; the same values.  Updates ``best_*``; returns
+        the mask of rays to continue (refinement missed)."""
+        eps = tier.eps
+        flat = np.take(tier.tri_flat, prim)            # primID -1 picks the sentinel row: False
+        nx, ny, nz = (np.take(c, prim) for c in tier.normal_cols)   # ... and a zero normal
+        dn = D[:, 0] * nx + D[:, 1] * ny              # = _dot(D, normal[prim]), column by column
+        dn += D[:, 2] * nz
+        fi = tier.flat_index
+        if one_origin and len(fi) < len(prim):   # n.(v0 - o) per flat triangle, then per ray (same values)
+            c = np.zeros(len(tier.normal))
+            c[fi] = _dot(_minus(tier.v0[fi], Ot[0]), tier.normal[fi])
+            tx = np.take(c, prim) / dn
+        else:
+            V0 = np.take(tier.v0, prim, axis=0, mode="clip")
+            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, np.take(tier.normal, prim, axis=0)) / dn
+        ok = np.isfinite(tx) & (tx >= lo) & (tx <= lim) & flat
+        u, v = res["u"], res["v"]
+        margin = np.minimum(np.minimum(u, v), 1.0 - u - v)
+        near_edge = ~(margin > 1e-4) & flat
+        check = ~(margin * np.take(tier.h_min, prim, mode="clip") * np.abs(dn) > 4.0 * eps * d_max)
+        check &= flat & ~near_edge
+        ci = check.nonzero()[0]
+        if len(ci):
+            P = Ot[ci] + tx[ci, None] * D[ci] - np.take(tier.v0, prim[ci], axis=0)
+            bu = _dot(P, np.take(tier.g1, prim[ci], axis=0))
+            bv = _dot(P, np.take(tier.g2, prim[ci], axis=0))
+            near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
+        r = near_edge.nonzero()[0]
+        tri = prim
+        if len(r):
+            tri = prim.copy()
+            ok_e, t_x, tri_e = self._refine_triangles(tier, Ot[r], D[r], tri[r], lo[r], lim[r])
+            miss = (~ok_e).nonzero()[0]
+            if len(miss):   # not the hit triangle nor a vertex neighbour: nearby triangles
+                rm = r[miss]
+                ok_n, t_n, tri_n = self._nearby_triangles(tier, Ot[rm], D[rm], t_e[rm], lo[rm], lim[rm], None)
+                ok_e[miss], t_x[miss], tri_e[miss] = ok_n, t_n, tri_n
+            ok[r], tx[r], tri[r] = ok_e, t_x, tri_e
+            dn[r] = _dot(D[r], tier.normal[tri_e])
+        k = (ok & (tx < best_t)).nonzero()[0]
+        best_t[k] = tx[k]
+        if not distance_only:
+            nk = np.take(tier.normal, tri[k], axis=0)
+            nk *= np.where(dn[k] > 0.0, -1.0, 1.0)[:, None]   # toward the origin
+            best_s[k], best_n[k] = tier.tri_shape[tri[k]], nk
+        return flat & ~ok
+
     def _nearby_triangles(self, tier: _Tier, Ot, D, t_e, lo, hi, excl):
         """Float64 hit of the ORIGINAL rays on the flat triangles whose box, grown by float32
         uncertainty, contains the Embree hit point (a coarse float32 frame can report a triangle
@@ -97,8 +220,9 @@ class Refiner:
         tri[~ok] = -1
         return ok, t, tri
 
-    def _analytic(self, tier: _Tier, slots, Ot, D, lo, hi):
-        """True-surface hit of curved shapes (tier-frame rays): (t, tier-frame unit normal)."""
+    def _analytic(self, tier: _Tier, slots, Ot, D, lo, hi, normals=True):
+        """True-surface hit of curved shapes (tier-frame rays): (t, tier-frame unit normal); the
+        normal None without ``normals`` (the same t)."""
         n = len(slots)
         lo, hi = _full(lo, n), _full(hi, n)
         if n and not np.count_nonzero(slots != slots[0]):   # one shape: one matrix
@@ -106,20 +230,22 @@ class Refiner:
             R = tier.c_rot[s0]
             p = _mat(_minus(Ot, tier.c_pos[s0]), R)   # R^T (o - c)
             d = _mat(D, R)
-            t, n_loc = _analytic_local(int(tier.c_code[s0]), p, d, tier.c_r[s0], tier.c_h[s0], lo, hi)
-            return t, _mat(n_loc, R.T)
+            t, n_loc = _analytic_local(int(tier.c_code[s0]), p, d, tier.c_r[s0], tier.c_h[s0], lo, hi, normals)
+            return t, (None if n_loc is None else _mat(n_loc, R.T))
         R = tier.c_rot[slots]
         p = np.einsum("nij,ni->nj", R, Ot - tier.c_pos[slots])  # R^T (o - c)
         d = np.einsum("nij,ni->nj", R, D)
         t = np.full(n, _INF)
-        n_loc = np.zeros((n, 3))
+        n_loc = np.zeros((n, 3)) if normals else None
         codes = tier.c_code[slots]
         for code in (_SPHERE, _CYLINDER, _CAPSULE):
             g = (codes == code).nonzero()[0]
             if len(g):
                 s = slots[g]
-                t[g], n_loc[g] = _analytic_local(code, p[g], d[g], tier.c_r[s], tier.c_h[s], lo[g], hi[g])
-        return t, np.einsum("nij,nj->ni", R, n_loc)
+                t[g], ng = _analytic_local(code, p[g], d[g], tier.c_r[s], tier.c_h[s], lo[g], hi[g], normals)
+                if normals:
+                    n_loc[g] = ng
+        return t, (np.einsum("nij,nj->ni", R, n_loc) if normals else None)
 
     def _contained_prepass(self, tier: _Tier, Ot, D, lo, lim, excl):
         """Rays starting inside a curved shell may reach the true surface before any crossing of
@@ -146,8 +272,9 @@ class Refiner:
         if m * len(cp) > _DENSE_PAIRS:  # many rays: screen their bounding box first (a lidar: a point)
             # per column: numpy reduces a short inner axis ~10x slower than a contiguous column
             reach = float(lo.max()) if isinstance(lo, np.ndarray) else lo
-            box_lo = np.array([Ot[:, k].min() for k in range(3)]) - reach
-            box_hi = np.array([Ot[:, k].max() for k in range(3)]) + reach
+            Ou = Ot[:1] if Ot.strides[0] == 0 else Ot   # one origin for all rays (a broadcast array)
+            box_lo = np.array([Ou[:, k].min() for k in range(3)]) - reach
+            box_hi = np.array([Ou[:, k].max() for k in range(3)]) + reach
             gap = cp - np.minimum(np.maximum(cp, box_lo), box_hi)
             near = (_dot(gap, gap) <= tier.c_bound2).nonzero()[0].tolist()
             if not near:

@@ -11,6 +11,14 @@ from embreex import rtcore_scene as _rts
 from embreex.mesh_construction import TriangleMesh as _TriangleMesh
 
 from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
+from sensorium.server.raycast.guards import (
+    MAX_EDGES_PER_FLAT_TRIANGLE,
+    MAX_GUARDED_EDGES,
+    MAX_WIDTH_PER_EDGE_LENGTH,
+    candidates,
+    prisms,
+    risky_edges,
+)
 from sensorium.server.world.geometry import Capsule, Cylinder, Mesh, Pose, Primitive, Sphere, tessellate
 
 
@@ -106,6 +114,9 @@ class _Tier:
         slot_of_shape[self.c_shape] = np.arange(len(c_shape))
         self.tri_slot = slot_of_shape[self.tri_shape].astype(np.int32)  # sentinel row maps to -1 as well
         self.tri_curved = self.tri_slot >= 0
+        self.tri_flat = ~self.tri_curved      # a flat triangle (sentinel row: False)
+        self.tri_flat[-1] = False
+        self.flat_index = self.tri_flat.nonzero()[0]
         self.c_code = np.array(c_code, dtype=np.int64)
         self.c_r = np.array(c_r, dtype=np.float64)
         self.c_h = np.array(c_h, dtype=np.float64)
@@ -133,17 +144,18 @@ class _Tier:
         else:
             self.bound = ("box", V.min(0) - slack, V.max(0) + slack)
         self._ring: tuple[np.ndarray, np.ndarray] | None = None
+        self._guard: tuple | None = None
         # Embree keeps pointers into these buffers: hold references for the scenes' lifetime
         self._v32 = np.ascontiguousarray(V, dtype=_F32)
         self._f32 = F
         self._device = device
-        self._scenes: dict[bool, object] = {}
+        self._scenes: dict[bool | str, object] = {}
 
     def _exact_data(self) -> dict[str, np.ndarray]:
         """Per-triangle float64 data of the refinement, computed once on first use (EXACT, or a
         FAST ray redone by the general loop): v0, e1, e2; the dual basis g1, g2 of (e1, e2) in each
         triangle's plane (barycentrics u = (P - v0).g1, v = (P - v0).g2, zero sentinel row); the
-        per-triangle boxes t_lo, t_hi."""
+        per-triangle boxes t_lo, t_hi; the smallest height h_min; the normals' columns."""
         if self._exact is None:
             V, F = self.V, self.F
             v0 = V[F[:, 0]]
@@ -156,7 +168,13 @@ class _Tier:
             g1 = np.vstack([(g22[:, None] * e1 - g12[:, None] * e2) * inv, np.zeros((1, 3))])
             g2 = np.vstack([(g11[:, None] * e2 - g12[:, None] * e1) * inv, np.zeros((1, 3))])
             tv = V[F]
-            self._exact = {"v0": v0, "e1": e1, "e2": e2, "g1": g1, "g2": g2, "t_lo": tv.min(1), "t_hi": tv.max(1)}
+            # smallest height: every point at barycentric margin m is >= m * h_min from the edges
+            longest = np.sqrt(np.maximum(np.maximum(g11, g22), _dot(e2 - e1, e2 - e1)))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                h_min = np.linalg.norm(np.cross(e1, e2), axis=1) / longest
+            h_min = np.where(np.isfinite(h_min), h_min, 0.0)
+            self._exact = {"v0": v0, "e1": e1, "e2": e2, "g1": g1, "g2": g2, "t_lo": tv.min(1), "t_hi": tv.max(1),
+                           "h_min": h_min, "normal_cols": tuple(np.ascontiguousarray(self.normal[:, k]) for k in range(3))}
         return self._exact
 
     v0 = property(lambda self: self._exact_data()["v0"])
@@ -166,6 +184,8 @@ class _Tier:
     g2 = property(lambda self: self._exact_data()["g2"])
     t_lo = property(lambda self: self._exact_data()["t_lo"])
     t_hi = property(lambda self: self._exact_data()["t_hi"])
+    h_min = property(lambda self: self._exact_data()["h_min"])
+    normal_cols = property(lambda self: self._exact_data()["normal_cols"])
 
     def first_vertex(self, tri: np.ndarray) -> np.ndarray:
         """v0 of the given triangles, without the full refinement data (FAST's self-hit test)."""
@@ -205,9 +225,50 @@ class _Tier:
             return sc, False
         sc = _rts.EmbreeScene(self._device, robust=robust)
         _TriangleMesh(sc, self._v32, self._f32)
+        if robust and self.guard is not None:   # geometry 1 of the EXACT scene: the edge guards
+            _TriangleMesh(sc, self.guard[3], self.guard[4])
         sc.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))  # commit now: this is the build
         self._scenes[robust] = sc
+        if robust and self.guard is not None:   # and the same without guards (for the rays that meet one)
+            bare = _rts.EmbreeScene(self._device, robust=True)
+            _TriangleMesh(bare, self._v32, self._f32)
+            bare.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))
+            self._scenes["bare"] = bare
         return sc, True
+
+    @property
+    def guard(self) -> tuple | None:
+        """Edge guards of the EXACT scene, or None (no risky edge; or too many, or too wide for
+        the geometry (see :mod:`.guards`): then EXACT repairs leaks with an offset copy of each cast
+        instead).  (edges, ptr, idx, prism vertices float32,
+        prism faces): the triangles to test for a ray near risky edge i are ``idx[ptr[i]:ptr[i + 1]]``
+        (see :func:`.guards.candidates`); prism triangle k guards edge ``k // PRISM_TRIANGLES``.
+        Built on first use."""
+        if self._guard is None:
+            flat = ~self.tri_curved[:-1]
+            edges, ptr, idx = risky_edges(self.F, flat, self.normal[:-1])
+            n_flat = int(np.count_nonzero(flat))
+            w = 4.0 * self.eps
+            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat \
+                    or w > MAX_WIDTH_PER_EDGE_LENGTH * float(np.median(np.linalg.norm(
+                        self.V[edges[:, 0]] - self.V[edges[:, 1]], axis=1))):
+                self._guard = (None, len(edges) == 0)
+            else:
+                pv, pf = prisms(self.V, edges, w)
+                cand_ptr, cand = candidates(self.V, edges, ptr, idx, self.ring, flat, w)
+                self._guard = (edges, cand_ptr, cand, np.ascontiguousarray(pv, dtype=_F32), pf)
+        return None if self._guard[0] is None else self._guard
+
+    def bare_scene(self):
+        """The EXACT scene without its edge guards (built with it)."""
+        if "bare" not in self._scenes:
+            self.scene(True)
+        return self._scenes["bare"]
+
+    @property
+    def guarded(self) -> bool:
+        """True if the EXACT scene carries edge guards (False: EXACT uses the offset copy)."""
+        return self.guard is not None or self._guard[1]
 
     def _isolation(self, verts, tri_shape, c_shape) -> np.ndarray:
         """Per curved slot: True if no other shape of the tier overlaps its shell's bounding box.

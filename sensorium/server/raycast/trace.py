@@ -36,25 +36,33 @@ class TierTracer(Refiner):
         return scene.run(o32, d32, far, output=1)
 
     def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
-               distance_only: bool = False):
+               distance_only: bool = False, d32=None):
         """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
         for an unanchored tier).  ``distance_only``: FAST may return None for shape and normal
-        (the same t; a lidar needs nothing else)."""
+        (the same t; a lidar needs nothing else), and so may EXACT.  ``d32``: ``D`` rounded to
+        float32 when the caller has it."""
         if exact:
-            res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True)
-            return res if np.count_nonzero(res[0] < _INF) else None
-        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only)
+            res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True, distance_only=distance_only,
+                                   d32_all=d32)
+            if not np.count_nonzero(res[0] < _INF):
+                return None
+            return (res[0], None, None) if distance_only else res
+        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32)
 
     def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
-                    distance_only: bool = False):
+                    distance_only: bool = False, d32=None):
         """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
         self-hits, shells left from inside, excluded owners) are redone by the general loop.
         Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
         (a lidar in a room) on whole arrays without gathers."""
         m = len(O)
-        Ot = _minus(O, tier.anchor) if tier.anchored else O
+        one = m > 1 and O.strides[0] == 0   # one origin for every ray (a broadcast array: a lidar)
+        if tier.anchored:   # (the same subtraction for one origin as for each row)
+            Ot = np.broadcast_to(_minus(O[:1], tier.anchor), O.shape) if one else _minus(O, tier.anchor)
+        else:
+            Ot = O
         pre = None
         lim_in = lim   # the redo below gets the caller's limit: it runs its own pre-pass, whose
         # float64 path (scalar or vectorised) may differ from this one's in the last bit
@@ -64,15 +72,21 @@ class TierTracer(Refiner):
             if pre is not None:  # the cast only needs to look before the analytic hits
                 lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, lim)
                 lim[pre[0]] = np.minimum(lim[pre[0]], pre[1])
-        o32 = Ot.astype(_F32)
-        d32 = D.astype(_F32)
+        # one origin: a read-only broadcast of its float32 row until something must be written
+        o1 = Ot[:1].astype(_F32) if one else None
+        o32 = np.broadcast_to(o1, Ot.shape) if one else Ot.astype(_F32)
+        shared = one
+        d32 = D.astype(_F32) if d32 is None else d32   # never written
         start = t_near
         dead = None
         if big is None:
-            big = max(map(abs, o32.ravel().tolist())) if m <= _SMALL else max(-float(o32.min()), float(o32.max()))
+            ob = o1 if one else o32
+            big = max(map(abs, ob.ravel().tolist())) if len(ob) <= _SMALL else max(-float(ob.min()), float(ob.max()))
         if big * 1.7321 > tier.radius:
             far_rows = (_dot(o32, o32) > _F32(tier.radius * tier.radius)).nonzero()[0]
             if len(far_rows):  # origin outside the tier's sphere: start at its entry (precision)
+                if shared:
+                    o32, shared = o32.copy(), False
                 start = np.array(_full(start, m), dtype=np.float64)
                 Of = Ot[far_rows]
                 Df = D[far_rows]
@@ -84,20 +98,32 @@ class TierTracer(Refiner):
                 o32 += start[:, None] * d32
                 o32[far_rows] = Of + start[far_rows][:, None] * Df
         if not isinstance(start, np.ndarray):
-            if start > 0.0:
+            if start > 0.0 and shared:   # o + s d in float32 (the same sum, operands swapped)
+                o32 = _F32(start) * d32
+                o32 += o1
+                shared = False
+            elif start > 0.0:
                 o32 += _F32(start) * d32
         elif dead is None:
+            if shared:
+                o32, shared = o32.copy(), False
             o32 += start[:, None] * d32
-        far = (lim - start) * (1.0 + 2.0 ** -20)  # float32 slack so a hit exactly at t_far counts
-        if dead is not None and len(dead):
-            far = np.array(_full(far, m))
-            far[dead] = -1.0
-        if isinstance(far, np.ndarray):
-            far = far.astype(_F32)
-        elif far == _INF:
-            far = None
+        slack = 1.0 + 2.0 ** -20  # float32 slack so a hit exactly at t_far counts
+        if (dead is None or not len(dead)) and (isinstance(lim, np.ndarray) or isinstance(start, np.ndarray)):
+            # per-ray limits straight into float32 (the float64 product, rounded once); x - 0.0 == x
+            base = lim if not isinstance(start, np.ndarray) and start == 0.0 else lim - start
+            far = np.multiply(base, slack, out=np.empty(m, dtype=_F32), casting="same_kind")
         else:
-            far = float(far)
+            far = (lim - start) * slack
+            if dead is not None and len(dead):
+                far = np.array(_full(far, m))
+                far[dead] = -1.0
+            if isinstance(far, np.ndarray):
+                far = far.astype(_F32)
+            elif far == _INF:
+                far = None
+            else:
+                far = float(far)
         res = self._run(tier, o32, d32, far, robust=False)
         prim = res["primID"]
         hit = prim >= 0
@@ -158,21 +184,18 @@ class TierTracer(Refiner):
         hit is only worked out when curved shells need it (the same t and special)."""
         every = isinstance(rows, slice)
         tf = res["tfar"][rows]
-        t = tf.astype(np.float64)
-        t += start if not isinstance(start, np.ndarray) else start[rows]
+        t = np.add(tf, start if not isinstance(start, np.ndarray) else start[rows], dtype=np.float64)
         if isinstance(lim, np.ndarray):
             np.minimum(t, lim[rows], out=t)
         elif lim != _INF:
             np.minimum(t, lim, out=t)
         if distance_only:   # the side hit matters only on curved shells: judge those rows alone
-            back = None
+            leaving = None
             if tier.has_curved:
-                back = np.zeros(len(tf), dtype=bool)
                 cv = np.take(tier.tri_curved, ph).nonzero()[0]
-                if len(cv):
-                    back[cv] = self._back(tier, D, d32, res, ph[cv], rows if every else rows[cv],
-                                          cv if every else None)
-            return (t, None), self._special(tier, Ot, tf, ph, rows, every, back, excl)
+                back = self._back(tier, D, d32, res, ph[cv], rows if every else rows[cv], cv if every else None)
+                leaving = cv[back]
+            return (t, None), self._special(tier, Ot, tf, ph, rows, every, None, excl, leaving)
         dh = d32[rows]
         ng = res["Ng"][rows]                 # Embree's Ng has our winding: sign = side hit
         if len(ng) > _SMALL:                 # one pass over the rows
@@ -201,8 +224,8 @@ class TierTracer(Refiner):
         """Side hit (True: the back) of the hits of ``ph`` at ray ``rows`` (``sub``: their indices
         when ``rows`` is a slice of all rays), as :meth:`_judge_fast` decides it."""
         idx = rows if sub is None else sub
-        dh = d32[idx]
-        ng = res["Ng"][idx]
+        dh = np.take(d32, idx, axis=0)       # (np.take: several times faster than fancy indexing here)
+        ng = np.take(res["Ng"], idx, axis=0)
         if len(ng) > _SMALL:
             dots = np.einsum("ij,ij->i", ng, dh)
         else:
@@ -214,31 +237,45 @@ class TierTracer(Refiner):
         return back
 
     @staticmethod
-    def _special(tier: _Tier, Ot, tf, ph, rows, every: bool, back, excl):
+    def _special(tier: _Tier, Ot, tf, ph, rows, every: bool, back, excl, leaving=None):
         """Mask of the rays FAST must redo in the general loop, or None: possible self-hits, shells
-        left from inside (``back``: side hit, needed when the tier has curved shells), excluded owners."""
+        left from inside (``back``: side hit, needed when the tier has curved shells; or ``leaving``:
+        the positions of the curved hits on a back face), excluded owners."""
         special = tf < tier.eps              # possible self-hit (origin on the surface)
-        if every:
-            special &= ph >= 0
-        if np.count_nonzero(special):
+        found = bool(np.count_nonzero(special))
+        if found:
+            if every:
+                special &= ph >= 0
             sp = special.nonzero()[0]
-            tri = ph[sp]
-            gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.first_vertex(tri), tier.normal[tri]))
-            special[sp] = gap <= 2.0 * tier.eps
-        if tier.has_curved:                  # leaving a curved shell: the true surface decides
+            if len(sp):
+                tri = ph[sp]
+                gap = np.abs(_dot(Ot[sp if every else rows[sp]] - tier.first_vertex(tri), tier.normal[tri]))
+                special[sp] = gap <= 2.0 * tier.eps
+        if leaving is not None:              # leaving a curved shell: the true surface decides
+            if len(leaving):
+                special[leaving] = found = True
+        elif tier.has_curved:
             special |= back & np.take(tier.tri_curved, ph)
+            found = True
         if tier.owned and not (not isinstance(excl, np.ndarray) and excl < 0):
             special |= np.take(tier.tri_owner, ph) == (excl[rows] if isinstance(excl, np.ndarray) else excl)
-        return special if np.count_nonzero(special) else None
+            found = True
+        return special if found and np.count_nonzero(special) else None
 
-    def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool):
+    def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool,
+                    distance_only: bool = False, d32_all=None):
         """General path: cast, judge each hit, continue rejected rays past their hit (bounded).
         Judging: excluded owners are skipped; EXACT refines flat hits in float64 and curved hits
         on the true surface; FAST keeps Embree's answer except self-hits and shells left from
-        inside.  Returns (t, shape, normal oriented toward the origin)."""
+        inside.  Returns (t, shape, normal oriented toward the origin); ``distance_only``: the shape
+        and normal of flat hits are left unset (the same t); ``d32_all``: ``D`` as float32, if the
+        caller has it."""
         m = len(O)
         eps = tier.eps
-        Ot = _minus(O, tier.anchor) if tier.anchored else O
+        if tier.anchored:   # one origin (a broadcast array) stays one
+            Ot = np.broadcast_to(O[:1] - tier.anchor, O.shape) if O.strides[0] == 0 and m else _minus(O, tier.anchor)
+        else:
+            Ot = O
         if isinstance(t_near, np.ndarray):       # accepted hits: lo <= t <= lim
             lo = np.maximum(t_near, eps64)
             seg = np.maximum(t_near - eps, eps)   # Embree start along the ray
@@ -253,15 +290,18 @@ class TierTracer(Refiner):
         best_s = np.full(m, -1, dtype=np.int64)
         best_n = np.zeros((m, 3))
         r2 = tier.radius ** 2
-        if m and max(-float(Ot.min()), float(Ot.max())) * 1.7321 > tier.radius:
+        Ou = Ot[:1] if m and Ot.strides[0] == 0 else Ot
+        if m and max(-float(Ou.min()), float(Ou.max())) * 1.7321 > tier.radius:
             # some origins outside the tier's sphere: clip to it
             b = _dot(Ot, D)
             q2 = _dot(Ot, Ot) - b * b
             half = np.sqrt(np.maximum(r2 - q2, 0.0))
             np.maximum(seg, -b - half, out=seg)
             alive = (q2 <= r2) & (-b + half >= lo) & (seg <= lim + eps)
+            s_one = None
         else:
             alive = seg <= lim + eps
+            s_one = None if isinstance(t_near, np.ndarray) else float(seg[0]) if m else None   # every start alike
         if tier.has_curved:
             pre = self._contained_prepass(tier, Ot, D, lo, lim, excl)
             if pre is not None:
@@ -270,22 +310,35 @@ class TierTracer(Refiner):
                 np.minimum(lim, best_t, out=lim)
 
         act = alive.nonzero()[0]
+        one_origin = Ot.strides[0] == 0 and m > 0   # a broadcast array: one origin for all rays
+        if exact:   # bound of |d| (the float32 reach below scales with it): sqrt(3) max |component|
+            d_max = 1.7321 * max(float(D.max()), -float(D.min())) if m else 0.0
         delta = None   # per-ray continuation step, allocated on the first continuation
         for _ in range(_MAX_LOOPS):
             if len(act) == 0:
                 break
             view = slice(None) if len(act) == m else act   # all rays active: views, not copies
             oa, da, sa = Ot[view], D[view], seg[view]
-            o_seg = oa + sa[:, None] * da
-            d32 = da.astype(_F32)
+            o32 = np.empty(da.shape, dtype=_F32)   # oa + sa da in float64, rounded once
+            np.add(oa, da * (sa[:, None] if s_one is None else s_one), out=o32, casting="same_kind")
+            s_one = None   # continued rays start apart
+            d32 = d32_all if d32_all is not None and len(act) == m else da.astype(_F32)
             far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)
             far32 = np.where(far >= 0.0, far, -1.0).astype(_F32)
-            res = self._run(tier, o_seg.astype(_F32), d32, far32.copy() if exact else far32, robust=exact)
+            copy = exact and not tier.guarded
+            res = self._run(tier, o32, d32, far32.copy() if copy else far32, robust=exact)
             prim, tf = res["primID"].astype(np.int64), res["tfar"]
             repaired = fixed = None
-            if exact:
+            if exact and not copy:
+                if tier.guard is not None:   # rays that met an edge guard first: the second look
+                    g = (res["geomID"] == 1).nonzero()[0]
+                    if len(g):
+                        self._guard_rays(tier, res, g, act, Ot, D, o32, d32, sa, far, lo, lim, excl_arr,
+                                         best_t, best_s, best_n)
+                        prim = res["primID"].astype(np.int64)
+            elif exact:
                 # leak repair: a copy offset by a few ulps perpendicular to the ray
-                o2 = (o_seg + _perpendicular(da) * (_LEAK_OFFSET_ULPS * tier.res)).astype(_F32)
+                o2 = (oa + sa[:, None] * da + _perpendicular(da) * (_LEAK_OFFSET_ULPS * tier.res)).astype(_F32)
                 prim2 = self._run(tier, o2, d32, far32, robust=True)["primID"]
                 sus = ((prim2 >= 0) & (prim2 != prim)).nonzero()[0]
                 if len(sus):
@@ -302,13 +355,13 @@ class TierTracer(Refiner):
             h = (prim >= 0).nonzero()[0]
             if len(h) == 0:  # nothing hit: every active ray is done
                 break
-            t_e = np.where(prim >= 0, sa + tf, _INF)   # Embree distance along the whole ray
+            t_e = sa + tf   # Embree distance along the whole ray (read at hit rows only)
             if fixed is not None:
                 t_e[fixed[0]] = fixed[1]
             cont = np.zeros(len(act), dtype=bool)   # rays to continue past their hit
             if len(h):
                 ph = prim[h]
-                rows_h = act[h]
+                rows_h = h if len(act) == m else act[h]   # all active: act is 0..m-1
                 rej = np.zeros(len(h), dtype=bool)
                 if excl_arr is not None:
                     rej |= tier.tri_owner[ph] == excl_arr[rows_h]
@@ -316,30 +369,44 @@ class TierTracer(Refiner):
                 curved = slot >= 0
                 # --- flat triangles (boxes, meshes)
                 fl = (~curved & ~rej).nonzero()[0]
-                if len(fl):
+                if exact and len(act) == m and excl_arr is None and repaired is None and 2 * len(fl) > m:
+                    cont |= self._flat_dense(tier, res, prim, Ot, D, one_origin, lo, lim, t_e, d_max,
+                                             best_t, best_s, best_n, distance_only)
+                elif len(fl):
                     rows = rows_h[fl]
                     tri = ph[fl]
                     nrm = np.take(tier.normal, tri, axis=0)
                     Dr = _rows(D, rows)
                     dn = _dot(Dr, nrm)
                     if exact:
-                        tx = _dot(np.take(tier.v0, tri, axis=0) - _rows(Ot, rows), nrm) / dn
+                        V0 = np.take(tier.v0, tri, axis=0)
+                        if one_origin:   # a lidar: v0 - o for its one origin (the same values)
+                            tx = _dot(_minus(V0, Ot[0]), nrm) / dn
+                        else:
+                            tx = _dot(V0 - _rows(Ot, rows), nrm) / dn
                         ok = np.isfinite(tx) & (tx >= lo[rows]) & (tx <= lim[rows])
                         # Embree barycentrics comfortably inside the triangle: float32 cannot have
                         # picked the wrong one and its float64 plane gives the exact distance; near
                         # an edge (or repaired), test in float64
                         hf = h[fl]
                         u, v = res["u"][hf], res["v"][hf]
-                        near_edge = ~(np.minimum(np.minimum(u, v), 1.0 - u - v) > 1e-4)
+                        margin = np.minimum(np.minimum(u, v), 1.0 - u - v)
+                        near_edge = ~(margin > 1e-4)
                         if repaired is not None:
                             near_edge |= repaired[hf]
-                        edge = near_edge.nonzero()[0]
-                        # float64 barycentrics of the plane hit: in a coarse float32 frame Embree
-                        # can report comfortable barycentrics on the adjacent face's triangle
-                        P = _rows(Ot, rows) + tx[:, None] * Dr - np.take(tier.v0, tri, axis=0)
-                        bu = _dot(P, np.take(tier.g1, tri, axis=0))
-                        bv = _dot(P, np.take(tier.g2, tri, axis=0))
-                        near_edge |= ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
+                        # float64 barycentrics of the plane hit (in a coarse float32 frame Embree
+                        # can report comfortable barycentrics on the adjacent face's triangle),
+                        # unless Embree's hit lies farther inside than the float32 rounding of the
+                        # ray and the triangle can move it (a few ulps, < 4 eps, across the plane:
+                        # / sin of the incidence): then they are inside for sure
+                        check = ~(margin * np.take(tier.h_min, tri) * np.abs(dn) > 4.0 * eps * d_max)
+                        check &= ~near_edge
+                        ci = check.nonzero()[0]
+                        if len(ci):
+                            P = Ot[rows[ci]] + tx[ci, None] * Dr[ci] - V0[ci]
+                            bu = _dot(P, np.take(tier.g1, tri[ci], axis=0))
+                            bv = _dot(P, np.take(tier.g2, tri[ci], axis=0))
+                            near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
                         edge = near_edge.nonzero()[0]
                         if len(edge):
                             r = rows[edge]
@@ -359,19 +426,26 @@ class TierTracer(Refiner):
                         gap = np.abs(_dot(_rows(Ot, rows) - np.take(tier.v0, tri, axis=0), nrm))
                         ok = ~((t_e[h[fl]] < seg[rows] + eps) & (gap <= 2.0 * eps))  # self-hit
                     acc = ok & (tx < best_t[rows])
-                    nrm *= np.where(dn > 0.0, -1.0, 1.0)[:, None]   # toward the origin
                     if len(rows) == m and acc.all():
-                        best_t[:], best_s[:], best_n[:] = tx, tier.tri_shape[tri], nrm
+                        best_t[:] = tx
+                        if not distance_only:
+                            nrm *= np.where(dn > 0.0, -1.0, 1.0)[:, None]   # toward the origin
+                            best_s[:], best_n[:] = tier.tri_shape[tri], nrm
                     else:
-                        r = rows[acc]
-                        best_t[r], best_s[r], best_n[r] = tx[acc], tier.tri_shape[tri[acc]], nrm[acc]
+                        k = acc.nonzero()[0]
+                        r = rows[k]
+                        best_t[r] = tx[k]
+                        if not distance_only:
+                            nk = np.take(nrm, k, axis=0)
+                            nk *= np.where(dn[k] > 0.0, -1.0, 1.0)[:, None]   # toward the origin
+                            best_s[r], best_n[r] = tier.tri_shape[tri[k]], nk
                     rej[fl[~ok]] = True
                 # --- curved shells (sphere, cylinder, capsule)
                 cv = (curved & ~rej).nonzero()[0]
                 if len(cv):
                     rows = rows_h[cv]
                     nrm = tier.normal[ph[cv]]
-                    leaving = _dot(nrm, D[rows]) > 0.0
+                    leaving = None if exact else _dot(nrm, D[rows]) > 0.0
                     todo = np.ones(len(cv), dtype=bool) if exact else leaving
                     if not exact:  # FAST trusts the shell it enters
                         keep = (~todo).nonzero()[0]
@@ -384,13 +458,15 @@ class TierTracer(Refiner):
                     if len(tdo):
                         rr = rows[tdo]
                         sl = slot[cv[tdo]]
-                        ta, na = self._analytic(tier, sl, Ot[rr], D[rr], lo[rr], lim[rr])
+                        ta, na = self._analytic(tier, sl, Ot[rr], D[rr], lo[rr], lim[rr], not distance_only)
                         found = np.isfinite(ta)
                         better = found & (ta < best_t[rr])
                         r = rr[better]
-                        na = na[better]
-                        na[_dot(na, D[r]) > 0.0] *= -1.0
-                        best_t[r], best_s[r], best_n[r] = ta[better], tier.c_shape[sl[better]], na
+                        best_t[r] = ta[better]
+                        if na is not None:
+                            na = na[better]
+                            na[_dot(na, D[r]) > 0.0] *= -1.0
+                            best_s[r], best_n[r] = tier.c_shape[sl[better]], na
                         lim[rr] = np.minimum(lim[rr], np.where(found, ta, _INF))
                         # continue if missed, or if something else could sit between the shell
                         # crossing and the true surface (shell overlaps another shape)

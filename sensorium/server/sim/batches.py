@@ -16,7 +16,7 @@ import numpy as np
 from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import light as light_math
 from sensorium.server.devices.lookup import RESOLUTION_OFF, add_noise, quantize_sensor
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.sim.sensors import DistanceSensor, LightSensor, RayRequest
 from sensorium.server.world.geometry import Pose
 
@@ -26,11 +26,22 @@ _LASER = dmath.SENSOR_TYPES["laser"]
 
 def world_frames(devices: list, robot_poses: list[Pose]) -> tuple[np.ndarray, np.ndarray]:
     """World rotations (S,3,3) and positions (S,3) of devices: robot pose ∘ device pose."""
-    rr = np.stack([robot_poses[d.robot_index].rotation for d in devices])
-    rt = np.stack([robot_poses[d.robot_index].translation for d in devices])
-    lr = np.stack([d.local_pose.rotation for d in devices])
-    lt = np.stack([d.local_pose.translation for d in devices])
-    return np.einsum("sij,sjk->sik", rr, lr), np.einsum("sij,sj->si", rr, lt) + rt
+    rr = np.array([robot_poses[d.robot_index].rotation for d in devices])
+    rt = np.array([robot_poses[d.robot_index].translation for d in devices])
+    lr = np.array([d.local_pose.rotation for d in devices])
+    lt = np.array([d.local_pose.translation for d in devices])
+    return compose_rotations(rr, lr), np.einsum("sij,sj->si", rr, lt) + rt
+
+
+def compose_rotations(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a @ b for stacks of 3x3 matrices, bit for bit what ``np.einsum("sij,sjk->sik", a, b)`` gives
+    (it sums the three products in order starting from +0.0; the final + 0.0 does the same to a
+    -0.0) in about half its time: einsum is slow on length-3 axes."""
+    out = a[:, :, 0:1] * b[:, 0:1, :]
+    out += a[:, :, 1:2] * b[:, 1:2, :]
+    out += a[:, :, 2:3] * b[:, 2:3, :]
+    out += 0.0
+    return out
 
 
 def _output(devices: list, measured: np.ndarray, now_ms: int) -> None:
@@ -50,6 +61,33 @@ def _output(devices: list, measured: np.ndarray, now_ms: int) -> None:
                 v = add_noise(v, n[k:k + 1], d.rng)
             d.value = float(quantize_sensor(float(v[0]), d.config.resolution))
             d._mark(now_ms)
+
+
+def _frames_t(rr_t: np.ndarray, lr_t: np.ndarray, lp_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Component-major robot ∘ sensor frames: rotations [i, k, s] = sum_j rr[i, j, s] lr[j, k, s] and
+    rotated local positions [i, s] = sum_j rr[i, j, s] lp[j, s], summed in the orders numpy's einsum
+    uses for ``"sij,sjk->sik"`` ((j0 + j1) + j2, as compose_rotations) and ``"sij,sj->si"`` ((j0 + j2)
+    + j1: its two-lane inner loop), each from +0.0, so the bits are einsum's
+    (tests/test_distance_math.py pins these orders; numpy may pick others for einsum elsewhere)."""
+    rot = rr_t[:, 0, None, :] * lr_t[0]
+    rot += rr_t[:, 1, None, :] * lr_t[1]
+    rot += rr_t[:, 2, None, :] * lr_t[2]
+    rot += 0.0
+    pos = rr_t[:, 0] * lp_t[0]
+    pos += rr_t[:, 2] * lp_t[2]
+    pos += rr_t[:, 1] * lp_t[1]
+    pos += 0.0
+    return rot, pos
+
+
+def _rotate_t(rot_t: np.ndarray, d_t: np.ndarray) -> np.ndarray:
+    """(S, N, 3) world directions from component-major rotations [i, j, s] and local directions
+    [j, n, s]: einsum("sij,snj->sni", rot, dirs) bit for bit ((j0 + j2) + j1 from +0.0, as _frames_t)."""
+    out = rot_t[:, 0, None, :] * d_t[0]
+    out += rot_t[:, 2, None, :] * d_t[2]
+    out += rot_t[:, 1, None, :] * d_t[1]
+    out += 0.0
+    return np.ascontiguousarray(out.transpose(2, 1, 0))
 
 
 class LightBatch:
@@ -105,14 +143,18 @@ class DistancePlan:
         if not devs:
             return
         self.robot = np.array([d.robot_index for d in devs], dtype=np.int64)
-        self.local_rot = np.stack([d.local_pose.rotation for d in devs])
-        self.local_pos = np.stack([d.local_pose.translation for d in devs])
+        self.local_rot = np.array([d.local_pose.rotation for d in devs])
+        self.local_pos = np.array([d.local_pose.translation for d in devs])
+        # the same, component-major ([j, k, sensor], [j, sensor]): long inner axes for the per-step products
+        self.local_rot_t = np.ascontiguousarray(self.local_rot.transpose(1, 2, 0))
+        self.local_pos_t = np.ascontiguousarray(self.local_pos.T)
         by_shape: dict = defaultdict(list)
         for i, d in enumerate(devs):
             infra_red = d.type_code == _INFRA_RED
             by_shape[(len(d.weights), RayKind.VISUAL if infra_red else RayKind.BOUNDING, d.type_code == _LASER)].append(i)
         for (n, kind, skip), idx in by_shape.items():
             self.groups.append(_Group(np.array(idx, dtype=np.int64), [devs[i] for i in idx], n, kind, skip, robot_bodies))
+            self.groups[-1].every = len(idx) == len(devs)
         by_table: dict = defaultdict(list)
         for i, d in enumerate(devs):
             by_table[d.table].append(i)
@@ -146,6 +188,8 @@ class _Group:
                  robot_bodies: list[int | None] | None):
         self.idx, self.n, self.kind, self.skip = idx, n, kind, skip
         self.local_dirs = np.stack([d.directions_local for d in devs])           # (S, N, 3)
+        self.local_dirs_t = np.ascontiguousarray(self.local_dirs.transpose(2, 1, 0))   # [j, ray, sensor]
+        self.every = False                   # all the plan's sensors, in order (set by DistancePlan)
         # infra-red sees the robot's own visual shapes (Webots); ODE-style rays skip them
         exclude = np.array([-1 if kind == RayKind.VISUAL else d.exclude_self() for d in devs], dtype=np.int64)
         self.exclude = np.repeat(exclude, n)
@@ -155,15 +199,20 @@ class _Group:
         self.weights = np.stack([d.weights for d in devs])
         self.sensitivity = np.array([d.config.red_color_sensitivity for d in devs])
         self.mount: np.ndarray | None = None
+        self.mounted: Mount | None = None     # the same, kept by the engine between casts
         self.own_visible: np.ndarray | None = None
         if robot_bodies is not None:
             body = np.array([-1 if robot_bodies[d.robot_index] is None else robot_bodies[d.robot_index]
                              for d in devs], dtype=np.int64)
             if np.count_nonzero(body >= 0):
                 self.mount = np.repeat(body, n)
+                self.mounted = Mount(self.mount)
                 robot = np.repeat(np.array([d.robot_index for d in devs], dtype=np.int64), n)
                 self.own_visible = (self.mount >= 0) & (self.exclude != robot)
         self.own: tuple | None = None        # (precision, RayHits in body frames), made on first use
+        # the request's limit and exclusion: one scalar when uniform (what the engine would make of them)
+        self.far_arg = float(self.t_far[0]) if not np.count_nonzero(self.t_far != self.t_far[0]) else self.t_far
+        self.exclude_arg = int(self.exclude[0]) if not np.count_nonzero(self.exclude != self.exclude[0]) else self.exclude
 
     def own_hits(self, engine, local_rot: np.ndarray, local_pos: np.ndarray) -> RayHits | None:
         """Each ray's hit on its own robot's body (body frame), cast once per engine precision."""
@@ -199,22 +248,23 @@ class DistanceBatch:
         self.dirs: list[np.ndarray] = []
         if not self.devices:
             return
-        # robot pose ∘ device pose, as world_frames computes it (same arithmetic, stacked once per robot)
-        robot_rot = np.stack([p.rotation for p in robot_poses])
-        robot_pos = np.stack([p.translation for p in robot_poses])
-        self.robot_rot = rr = robot_rot[plan.robot]
-        rot = np.einsum("sij,sjk->sik", rr, plan.local_rot)
-        self.positions = np.einsum("sij,sj->si", rr, plan.local_pos) + robot_pos[plan.robot]
+        # robot pose ∘ device pose, bit for bit what world_frames and einsum("sij,snj->sni", rot, dirs)
+        # give, computed component-major (einsum is slow on length-3 axes): see _frames_t
+        self.robot_rot = robot_rot = np.array([p.rotation for p in robot_poses])
+        robot_pos = np.array([p.translation for p in robot_poses])
+        rr_t = np.take(robot_rot.transpose(1, 2, 0), plan.robot, axis=2)      # [i, j, sensor]
+        rot_t, pos_t = _frames_t(rr_t, plan.local_rot_t, plan.local_pos_t)
+        self.positions = pos_t.T + robot_pos[plan.robot]
         for g in plan.groups:
-            self.dirs.append(np.einsum("sij,snj->sni", rot[g.idx], g.local_dirs))
+            self.dirs.append(_rotate_t(rot_t if g.every else rot_t[:, :, g.idx], g.local_dirs_t))
 
     def plan(self) -> list[RayRequest]:
         requests = []
         for g, dirs in zip(self.plan_data.groups, self.dirs):
             requests.append(RayRequest(
-                np.repeat(self.positions[g.idx], g.n, axis=0), dirs.reshape(-1, 3), 0.0, g.t_far, g.kind,
-                g.exclude, skip_transparent=g.skip, tag="distance",
-                mount=g.mount if self.engine is not None else None))
+                np.repeat(self.positions[g.idx], g.n, axis=0), dirs.reshape(-1, 3), 0.0, g.far_arg, g.kind,
+                g.exclude_arg, skip_transparent=g.skip, tag="distance",
+                mount=g.mounted if self.engine is not None else None))
         return requests
 
     def finish(self, hits: list[RayHits], now_ms: int) -> None:
@@ -234,7 +284,7 @@ class DistanceBatch:
                 if len(win):
                     dist, shape, normal = dist.copy(), shape.copy(), normal.copy()
                     dist[win], shape[win] = own.distance[win], own.shape[win]
-                    rr = np.repeat(g.idx, n)[win]
+                    rr = plan.robot[np.repeat(g.idx, n)[win]]
                     normal[win] = np.einsum("sij,sj->si", self.robot_rot[rr], own.normal[win])
             dist = dist.reshape(S, n)
             reflection = None

@@ -19,7 +19,7 @@ from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import lidar as lmath
 from sensorium.server.devices.lookup import LookupTable
 from sensorium.server.devices.noise import device_rng
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
@@ -36,8 +36,9 @@ class RayRequest:
     exclude_owner: int | np.ndarray   # per request or per ray
     skip_transparent: bool = False
     tag: str = ""              # counter bucket: "light", "distance", "lidar"
-    mount: np.ndarray | None = None   # per ray: body the ray is rigidly mounted on, -1 none (see RayEngine.cast)
+    mount: np.ndarray | Mount | None = None   # per ray: body the ray is rigidly mounted on, -1 none (see RayEngine.cast)
     distance_only: bool = False       # the device reads only distances (see RayEngine.cast)
+    directions32: np.ndarray | None = None   # the directions rounded to float32, when kept (see RayEngine.cast)
 
     def __len__(self) -> int:
         return len(self.origins)
@@ -156,6 +157,12 @@ class DistanceSensor(Device):
 
 
 class Lidar(Device):
+    """A Webots Lidar. Per-device constants are made once: the beams in the lidar frame (as three
+    contiguous columns; ``_all_dirs`` is an (L, W, 3) view of them), the point-cloud directions, the
+    far limits. A fixed lidar also keeps its beams in world coordinates for the rotation they were
+    planned at: a lidar that does not turn between scans (it may move) plans no rays. The point
+    cloud of a fixed lidar is kept as coordinates; its WbLidarPoint records are made when read."""
+
     def __post_init__(self) -> None:
         super().__post_init__()
         c = self.config
@@ -173,16 +180,25 @@ class Lidar(Device):
         L, W = c.number_of_layers, c.horizontal_resolution
         # before the first measurement the image and cloud are all zeros (Webots)
         self.range_image = np.zeros((L, W), dtype=np.float32)
-        self.point_cloud = np.zeros(L * W, dtype=lmath.POINT_DTYPE)
-        self._all_dirs = lmath.ray_directions(self.params)               # (L, W, 3) lidar frame
-        # the same beams as three contiguous columns, for planning (see _rotate_columns)
-        self._dir_columns = tuple(np.ascontiguousarray(self._all_dirs[:, :, k]).reshape(-1) for k in range(3))
-        self._cloud_dirs: np.ndarray | None = None     # point-cloud directions (L, W, 3), made on first use
+        self._records: np.ndarray | None = np.zeros(L * W, dtype=lmath.POINT_DTYPE)
+        self._xyz: np.ndarray | None = None           # (L·W, 3) float32 of the latest fixed scan
+        self._cloud_time = (0.0, 0.0)                 # (time_s, period_s) of that scan
+        self._layers_f4: np.ndarray | None = None     # layer of every point as float32 (messages)
+        # the beams (L, W, 3) in the lidar frame, stored as three contiguous columns (planning and
+        # the point cloud read columns); _all_dirs is a view in (L, W, 3) order
+        cols = np.ascontiguousarray(np.moveaxis(lmath.ray_directions(self.params), -1, 0))   # (3, L, W)
+        self._all_dirs = np.moveaxis(cols, 0, -1)
+        self._dir_columns = tuple(cols[k].reshape(-1) for k in range(3))
+        self._cloud_columns: tuple[np.ndarray, ...] | None = None   # point-cloud directions, made on first use
         # planar lidars store depth: a ray must reach max_range in depth, not in length
         factor = lmath.value_factors(self.params, self._all_dirs)
         with np.errstate(divide="ignore"):
-            self._t_far = np.where(factor > 0, self.params.max_range / np.where(factor > 0, factor, 1.0), 0.0)
+            t_far = np.where(factor > 0, self.params.max_range / np.where(factor > 0, factor, 1.0), 0.0)
+        # one value for every beam (cylindrical): the engine then needs no per-ray limits
+        self._t_far: np.ndarray | float = float(t_far.flat[0]) if not np.count_nonzero(t_far != t_far.flat[0]) else t_far
         self._sweep: lmath.RotatingSweep | None = None
+        # (rotation bytes, world beams float64, the same as float32) of a fixed lidar's latest plan
+        self._planned: tuple[bytes, np.ndarray, np.ndarray] | None = None
 
     # -- controller API
     def set_frequency(self, f: float) -> None:
@@ -196,6 +212,35 @@ class Lidar(Device):
 
     def disable_point_cloud(self) -> None:
         self.point_cloud_enabled = False
+
+    @property
+    def point_cloud(self) -> np.ndarray:
+        """WbLidarPoint records (L·W,) of the latest measurement (zeros before the first)."""
+        if self._records is None:   # a fixed scan's coordinates: records on first read
+            L, W = self.config.number_of_layers, self.config.horizontal_resolution
+            time_s, period_s = self._cloud_time
+            t = time_s - np.arange(W) * (period_s / W)
+            self._records = lmath.point_records(self._xyz, L, W, t)
+        return self._records
+
+    def cloud_points(self) -> np.ndarray:
+        """Point coordinates (L·W, 3) float32 of the latest measurement: a fixed lidar's scan gives a
+        fresh array that is never written afterwards (messages may keep it); otherwise (a rotating
+        head, or before the first scan) a view of the records, which later steps overwrite."""
+        if self._records is None:
+            return self._xyz
+        return self._records.view(np.float32).reshape(-1, 5)[:, 0:3]
+
+    def cloud_layers(self) -> np.ndarray:
+        """The layer of every point as float32: for a fixed scan a constant of the device (made on
+        first use); else the records' (zeros where a rotating head has not swept yet)."""
+        if self._records is not None:
+            return self._records["layer_id"].astype(np.float32)
+        if self._layers_f4 is None:
+            L, W = self.config.number_of_layers, self.config.horizontal_resolution
+            self._layers_f4 = np.repeat(np.arange(L, dtype=np.float32), W)
+            self._layers_f4.flags.writeable = False
+        return self._layers_f4
 
     def layer_range_image(self, layer: int) -> np.ndarray:
         if not 0 <= layer < self.config.number_of_layers:
@@ -214,6 +259,7 @@ class Lidar(Device):
         return self.enabled if self.rotating else self.schedule.due(now_ms)
 
     def plan(self, robot_pose: Pose, now_ms: int, dt_ms: int) -> list[RayRequest]:
+        pose = self.world_pose(robot_pose)
         if self.rotating:
             # only the sector the head sweeps during this step (devices.md §4.9)
             self._sweep = lmath.rotating_sweep(self.params, self.head_angle, self.frequency, dt_ms, now_ms / 1000.0)
@@ -221,15 +267,22 @@ class Lidar(Device):
             if cols.size == 0:
                 return []
             dirs_local = self._all_dirs[:, cols, :]
-            t_far = self._t_far[:, cols]
-            pose = self.world_pose(robot_pose)
+            t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far[:, cols].reshape(-1)
             dirs = _rotate(pose.rotation, dirs_local.reshape(-1, 3))
         else:
-            t_far = self._t_far
-            pose = self.world_pose(robot_pose)
-            dirs = _rotate_columns(pose.rotation, self._dir_columns)
+            t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far.reshape(-1)
+            key = pose.rotation.tobytes()
+            if self._planned is None or self._planned[0] != key:   # the lidar turned: rotate the beams
+                d32 = np.empty((len(self._dir_columns[0]), 3), dtype=np.float32)
+                dirs = _rotate_columns(pose.rotation, self._dir_columns, out32=d32)
+                dirs.flags.writeable = d32.flags.writeable = False   # handed to every cast until it turns
+                self._planned = (key, dirs, d32)
+            _, dirs, d32 = self._planned
+            origins = np.broadcast_to(pose.translation, dirs.shape)
+            return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
+                               distance_only=True, directions32=d32)]
         origins = np.broadcast_to(pose.translation, dirs.shape)
-        return [RayRequest(origins, dirs, self.params.near, t_far.reshape(-1), RayKind.VISUAL, -1, tag="lidar",
+        return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
                            distance_only=True)]
 
     def finish(self, hits: list[RayHits], now_ms: int, counters: dict[str, int]) -> None:
@@ -245,26 +298,33 @@ class Lidar(Device):
             self.range_image[:, cols] = ranges
             if self.point_cloud_enabled:
                 # point times follow the sweep: when the head passed each column
-                pts = lmath.point_cloud(self.params, ranges, 0.0, 0.0, columns=cols, times=sweep.times,
-                                        directions=self._point_dirs()[:, cols, :])
-                index = (np.arange(L)[:, None] * self.config.horizontal_resolution + cols[None, :]).reshape(-1)
+                W = self.config.horizontal_resolution
+                xyz = lmath.point_xyz(ranges, tuple(c.reshape(L, W)[:, cols] for c in self._point_columns()))
+                pts = lmath.point_records(xyz, L, cols.size, sweep.times)
+                index = (np.arange(L)[:, None] * W + cols[None, :]).reshape(-1)
                 self.point_cloud[index] = pts
                 counters["points_built"] += pts.size
         else:
             dist = hits[0].distance.reshape(L, self.config.horizontal_resolution)
             self.range_image = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
             if self.point_cloud_enabled:
-                period_s = self.schedule.period_ms / 1000.0
-                self.point_cloud = lmath.point_cloud(self.params, self.range_image, now_ms / 1000.0, period_s,
-                                                     directions=self._point_dirs())
-                counters["points_built"] += self.point_cloud.size
+                self._xyz = lmath.point_xyz(self.range_image, self._point_columns())
+                self._xyz.flags.writeable = False   # messages may hold it
+                self._cloud_time = (now_ms / 1000.0, self.schedule.period_ms / 1000.0)
+                self._records = None
+                counters["points_built"] += len(self._xyz)
         self._mark(now_ms)
 
-    def _point_dirs(self) -> np.ndarray:
-        """Point-cloud directions of every beam (lmath.point_cloud_directions), computed once."""
-        if self._cloud_dirs is None:
-            self._cloud_dirs = lmath.point_cloud_directions(self.params)
-        return self._cloud_dirs
+    def _point_columns(self) -> tuple[np.ndarray, ...]:
+        """Point-cloud directions (lmath.point_cloud_directions) as three columns, made once: the
+        beams themselves unless the projection is planar."""
+        if self._cloud_columns is None:
+            if self.params.planar:
+                d = lmath.point_cloud_directions(self.params)
+                self._cloud_columns = tuple(np.ascontiguousarray(d[:, :, k]).reshape(-1) for k in range(3))
+            else:
+                self._cloud_columns = self._dir_columns
+        return self._cloud_columns
 
     def _noise_rng(self) -> np.random.Generator | None:
         return self.rng if self.params.noise > 0 else None
@@ -276,6 +336,9 @@ class Lidar(Device):
         return out
 
 
+_ROTATE_BLOCK = 16384   # rows per block of _rotate_columns (its float64 temporaries: ~640 KB)
+
+
 def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     """``vectors @ rotation.T`` by columns: a BLAS matmul here lets OpenBLAS threads stall for tens
     of milliseconds when the other core is busy (measured), for no gain on (N, 3) arrays."""
@@ -285,20 +348,33 @@ def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     return out
 
 
-def _rotate_columns(rotation: np.ndarray, columns: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
+def _rotate_columns(rotation: np.ndarray, columns: tuple[np.ndarray, np.ndarray, np.ndarray],
+                    out32: np.ndarray | None = None) -> np.ndarray:
     """``_rotate`` for vectors given as three contiguous columns (x, y, z): the same products and
-    sums in the same order (bit-identical), on contiguous arrays instead of (N, 3) broadcasts."""
+    sums in the same order (bit-identical), on contiguous arrays instead of (N, 3) broadcasts, in
+    blocks of rows whose temporaries stay in cache. ``out32``: an (N, 3) float32 array that also
+    receives the result rounded to float32 (what ``astype`` would give), from the same blocks."""
     x, y, z = columns
-    out = np.empty((len(x), 3))
-    tmp = np.empty(len(x))
-    acc = np.empty(len(x))
-    for k in range(3):
-        np.multiply(x, rotation[k, 0], out=acc)
-        np.multiply(y, rotation[k, 1], out=tmp)
-        acc += tmp
-        np.multiply(z, rotation[k, 2], out=tmp)
-        acc += tmp
-        out[:, k] = acc
+    n = len(x)
+    out = np.empty((n, 3))
+    block = max(1, min(n, _ROTATE_BLOCK))
+    buf = np.empty((block, 3))
+    tmp = np.empty(block)
+    acc = np.empty(block)
+    for a in range(0, n, block):
+        b = min(n, a + block)
+        m = b - a
+        t, c, part = tmp[:m], acc[:m], buf[:m]
+        for k in range(3):
+            np.multiply(x[a:b], rotation[k, 0], out=c)
+            np.multiply(y[a:b], rotation[k, 1], out=t)
+            c += t
+            np.multiply(z[a:b], rotation[k, 2], out=t)
+            c += t
+            part[:, k] = c
+        out[a:b] = part
+        if out32 is not None:
+            out32[a:b] = part
     return out
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
-from sensorium.server.raycast.engine import Precision, RayHits
+from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
@@ -155,6 +155,7 @@ class Simulation:
         self._counters: Counter[str] = Counter()
         self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[PositionSensor]] | None = None
         self._distance_plans: dict[tuple[int, ...], DistancePlan] = {}   # by the due sensors (see _distance_plan)
+        self._joined_mounts: dict[tuple, tuple[list, Mount]] = {}        # see _joined_mount
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = self._build_contact() if use_contact and self._driven else None
         self._initial: dict[str, Any] = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
@@ -349,6 +350,23 @@ class Simulation:
             plan = self._distance_plans[key] = DistancePlan(distances, bodies)
         return plan
 
+    def _joined_mount(self, reqs: list[RayRequest], sizes: list[int]):
+        """The mounts of requests cast together, as one array; when every part is a kept Mount
+        (or no mount), one joined Mount kept for the same parts step after step, so the engine can
+        keep its neighbour list (see RayEngine.cast)."""
+        parts = [r.mount for r in reqs]
+        if any(m is not None and not isinstance(m, Mount) for m in parts):
+            return np.concatenate([m if m is not None else np.full(n, -1, dtype=np.int64) for m, n in zip(parts, sizes)])
+        key = tuple(id(m) if m is not None else -n for m, n in zip(parts, sizes))
+        kept = self._joined_mounts.get(key)
+        if kept is None or any(a is not b for a, b in zip(kept[0], parts)):
+            if len(self._joined_mounts) >= 8:
+                self._joined_mounts.clear()
+            joined = Mount(np.concatenate([m if m is not None else np.full(n, -1, dtype=np.int64)
+                                           for m, n in zip(parts, sizes)]))
+            kept = self._joined_mounts[key] = (parts, joined)
+        return kept[1]
+
     def _cast_batched(self, requests: list[RayRequest]) -> list[RayHits]:
         """All rays of a step: one engine call per (ray kind, transparency rule, outputs needed)."""
         results: list[RayHits | None] = [None] * len(requests)
@@ -368,7 +386,7 @@ class Simulation:
                 r = reqs[0]
                 results[idx[0]] = engine.cast(r.origins, r.directions, r.t_near, r.t_far, kind=kind,
                                               exclude_owner=r.exclude_owner, skip_transparent=skip, mount=r.mount,
-                                              distance_only=distance_only)
+                                              distance_only=distance_only, directions32=r.directions32)
                 continue
             origins = np.concatenate([r.origins for r in reqs])
             dirs = np.concatenate([r.directions for r in reqs])
@@ -377,8 +395,7 @@ class Simulation:
             owners = np.concatenate([np.broadcast_to(np.asarray(r.exclude_owner, dtype=np.int64), (n,)) for r, n in zip(reqs, sizes)])
             mount = None
             if any(r.mount is not None for r in reqs):
-                mount = np.concatenate([r.mount if r.mount is not None else np.full(n, -1, dtype=np.int64)
-                                        for r, n in zip(reqs, sizes)])
+                mount = self._joined_mount(reqs, sizes)
             hits = engine.cast(origins, dirs, t_near, t_far, kind=kind, exclude_owner=owners, skip_transparent=skip,
                                mount=mount, distance_only=distance_only)
             start = 0
