@@ -279,3 +279,14 @@ def serve(world: Path | str | None = None, *extra: str, rpc: str = ANY_PORT, pub
     argv = sensorium("serve", *([] if world is None else [str(world)]), "--rpc", rpc, "--pub", pub, *extra)
     served = Served(argv, "sensorium: serving world", stop_signal=stop_signal, **kw)
     return served.wait_ready() if wait else served
+
+
+def wait_until(pred, timeout: float = 30.0, what: str = "condition", every: float = 0.01):
+    """Poll ``pred`` until it returns something truthy (returned) or ``timeout`` seconds pass."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        v = pred()
+        if v:
+            return v
+        time.sleep(every)
+    raise AssertionError(f"timed out waiting for {what}")

@@ -6,12 +6,12 @@ wait still matches out-of-order replies."""
 from __future__ import annotations
 
 import threading
-import time
 
 import msgpack
 import pytest
 import zmq
 from _inproc import WORLD, inproc_server
+from _serve import wait_until
 
 from sensorium.client.connection import Connection
 from sensorium.schemas import services as S
@@ -22,15 +22,6 @@ from sensorium.server.sim.simulation import Simulation
 
 BASIC = 16      # tests/worlds/server.yaml
 
-
-def wait_until(pred, timeout: float = 30.0, what: str = "condition"):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        v = pred()
-        if v:
-            return v
-        time.sleep(0.005)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 class Stepper(threading.Thread):

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 import zmq
 from _node import NodeProcess, require_node
-from _serve import Served, sensorium, serve
+from _serve import Served, sensorium, serve, wait_until
 
 pytest.importorskip("foxglove")
 
@@ -49,15 +49,6 @@ class Rpc:
                     return r["result"]
         raise TimeoutError(service)
 
-
-def wait_until(pred, timeout: float = 30.0, what: str = "condition"):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        v = pred()
-        if v:
-            return v
-        time.sleep(0.02)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 SENSORS = ["/bot/ls/value", "/bot/ds/value", "/bot/lidar/laser_scan", "/bot/lidar/point_cloud", "/bot/lidar/range_image"]

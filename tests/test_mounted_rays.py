@@ -22,6 +22,16 @@ def _rz(yaw: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def _move_bodies(eng, bodies, xy, yaw, owner, O_loc, D_loc):
+    """Place each body at (x, y, 0.025) turned by yaw; return its sensors' rays in the world."""
+    poses = [Pose(_rz(a), np.array([x, y, 0.025])) for (x, y), a in zip(xy, yaw)]
+    for b, p in zip(bodies, poses):
+        eng.set_body_pose(b, p)
+    R = np.stack([poses[i].rotation for i in owner])
+    T = np.stack([poses[i].translation for i in owner])
+    return np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+
+
 def _crowd(precision, n=36, spacing=0.08, seed=3):
     """n cylinder robots (r 0.035) packed closely (neighbours within sensor reach), walls, a floor."""
     rng = np.random.default_rng(seed)
@@ -139,12 +149,7 @@ def test_a_mount_kept_between_casts_gives_the_plain_answers_bit_for_bit_as_bodie
         elif step:                          # small moves (1 mm) and turns
             xy += 0.001 * np.stack([np.cos(yaw), np.sin(yaw)], 1)
             yaw += rng.uniform(-0.3, 0.3, len(bodies))
-        poses = [Pose(_rz(a), np.array([x, y, 0.025])) for (x, y), a in zip(xy, yaw)]
-        for b, p in zip(bodies, poses):
-            eng.set_body_pose(b, p)
-        R = np.stack([poses[i].rotation for i in owner])
-        T = np.stack([poses[i].translation for i in owner])
-        O, D = np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+        O, D = _move_bodies(eng, bodies, xy, yaw, owner, O_loc, D_loc)
         for excl in (-1, owner):
             ref = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, exclude_owner=excl)
             plain = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, exclude_owner=excl, mount=mount)
@@ -164,11 +169,7 @@ def test_a_mount_kept_between_casts_gives_the_plain_answers_bit_for_bit_as_bodie
     for turn, redone in ((1e-4, 0), (0.5, 1)):
         before = (eng.counters["neighbour_lists"], eng.counters["ray_lists"])
         yaw += turn
-        poses = [Pose(_rz(a), p.translation) for p, a in zip(poses, yaw)]
-        for b, p in zip(bodies, poses):
-            eng.set_body_pose(b, p)
-        R = np.stack([poses[i].rotation for i in owner])
-        O, D = np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+        O, D = _move_bodies(eng, bodies, xy, yaw, owner, O_loc, D_loc)   # same centres, turned
         got = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL, mount=m)
         ref = eng.cast(O, D, 0.0, 0.07, kind=RayKind.VISUAL)
         assert got.distance.tobytes() == ref.distance.tobytes() and got.normal.tobytes() == ref.normal.tobytes()
@@ -207,12 +208,7 @@ def test_a_kept_mount_matches_the_plain_one_under_random_motion(precision, seed)
         scale = rng.choice([0.0, 1e-4, 2e-3, 0.01, 0.1])
         xy += rng.normal(0.0, scale, xy.shape)
         yaw += rng.normal(0.0, rng.choice([0.0, 0.01, 0.2, 1.5]), len(bodies))
-        poses = [Pose(_rz(y), np.array([x0, x1, 0.025])) for (x0, x1), y in zip(xy, yaw)]
-        for b, p in zip(bodies, poses):
-            eng.set_body_pose(b, p)
-        R = np.stack([poses[i].rotation for i in owner])
-        T = np.stack([poses[i].translation for i in owner])
-        O, D = np.einsum("nij,nj->ni", R, O_loc) + T, np.einsum("nij,nj->ni", R, D_loc)
+        O, D = _move_bodies(eng, bodies, xy, yaw, owner, O_loc, D_loc)
         got = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, mount=m)
         plain = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, mount=mount)
         assert got.distance.tobytes() == plain.distance.tobytes()

@@ -13,7 +13,7 @@ import msgpack
 import numpy as np
 import pytest
 import zmq
-from _serve import Served, serve
+from _serve import Served, serve, wait_until
 
 from sensorium.schemas import messages as M
 
@@ -95,15 +95,6 @@ def error_code(reply: dict) -> int:
     assert isinstance(reply["error"]["message"], str)
     return reply["error"]["code"]
 
-
-def wait_until(pred, timeout: float = 30.0, what: str = "condition"):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        v = pred()
-        if v:
-            return v
-        time.sleep(0.01)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 @pytest.fixture(scope="module")
