@@ -43,7 +43,6 @@ RETRIED_SERVICES = ("/robot/step", "/robot/time_step")
 DEFAULT_TIMEOUT = 10.0          # seconds for a non-step request (the server may still be starting)
 
 _NO_TIMEOUT = object()
-_RCVMORE = int(zmq.RCVMORE)     # a plain int: pyzmq's enum constants cost a conversion per call
 
 
 class ErrorCode(IntEnum):
@@ -353,9 +352,13 @@ class Connection:
                 sock.setsockopt(zmq.RCVTIMEO, slice_ms)
                 self._rcvtimeo, self._rcvtimeo_ms = sock, slice_ms
             try:
-                frames = [sock.recv()]
-                while sock.getsockopt(_RCVMORE):         # (a reply to a DEALER is one frame)
-                    frames.append(sock.recv())
+                # a zero-copy frame's ``more`` flag is cheaper than a ZMQ_RCVMORE query
+                # (a reply to a DEALER is one frame)
+                frame = sock.recv(copy=False)
+                frames = [frame.bytes]
+                while frame.more:
+                    frame = sock.recv(copy=False)
+                    frames.append(frame.bytes)
             except zmq.Again:
                 self._resend_due(rid)
                 if self.heartbeat is not None:
