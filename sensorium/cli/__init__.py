@@ -123,7 +123,7 @@ def _call_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
-# --- recording: record / replay / export (server/cli_recording.py) ---
+# --- recording: record / replay / export / recover (cli/recording.py) ---
 @command("record", "record a running server's topics to MCAP as a subscriber (reports gaps)",
          "sensorium.cli.recording:record")
 def _record_args(p: argparse.ArgumentParser) -> None:
@@ -201,7 +201,7 @@ def _recover_args(p: argparse.ArgumentParser) -> None:
 # --- end recording ---
 
 
-# --- server: serve (server/serve.py) and schemas (schemas/export.py) ---
+# --- server: keys, serve, layout, schemas, demo ---
 @command("keys", "create a CURVE key pair for serve --curve-keys DIR (encrypted, authenticated tcp)",
          "sensorium.cli.serve:keys")
 def _keys_args(p: argparse.ArgumentParser) -> None:

@@ -355,16 +355,18 @@ class Simulation:
         (or no mount), one joined Mount kept for the same parts step after step, so the engine can
         keep its neighbour list (see RayEngine.cast)."""
         parts = [r.mount for r in reqs]
-        if any(m is not None and not isinstance(m, Mount) for m in parts):
+
+        def joined() -> np.ndarray:
             return np.concatenate([m if m is not None else np.full(n, -1, dtype=np.int64) for m, n in zip(parts, sizes)])
+
+        if any(m is not None and not isinstance(m, Mount) for m in parts):
+            return joined()
         key = tuple(id(m) if m is not None else -n for m, n in zip(parts, sizes))
         kept = self._joined_mounts.get(key)
         if kept is None or any(a is not b for a, b in zip(kept[0], parts)):
             if len(self._joined_mounts) >= 8:
                 self._joined_mounts.clear()
-            joined = Mount(np.concatenate([m if m is not None else np.full(n, -1, dtype=np.int64)
-                                           for m, n in zip(parts, sizes)]))
-            kept = self._joined_mounts[key] = (parts, joined)
+            kept = self._joined_mounts[key] = (parts, Mount(joined()))
         return kept[1]
 
     def _cast_batched(self, requests: list[RayRequest]) -> list[RayHits]:
