@@ -246,3 +246,55 @@ def test_replay_serves_foxglove(tmp_path):
         if node is not None:
             node.close()
         replay.stop(signal.SIGTERM)
+
+
+def test_the_default_client_and_the_sdk_name_are_both_accepted(live):
+    """@foxglove/ws-protocol at its defaults offers foxglove.websocket.v1 (the SDK's server alone
+    answers it with HTTP 400); the front names it back, and foxglove.sdk.v1 still works."""
+    srv, _ctx, node = live
+    opened = node.wait_for(lambda e: e["event"] == "open", what="open")
+    assert opened["protocol"] == "foxglove.websocket.v1"
+    node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+    other = NodeProcess("live_client.js", srv.fields["foxglove"], "sdk")
+    try:
+        assert other.wait_for(lambda e: e["event"] == "open", what="open (sdk)")["protocol"] == "foxglove.sdk.v1"
+        other.wait_for(lambda e: e["event"] == "advertise", what="advertise (sdk)")
+    finally:
+        other.close()
+
+
+def test_a_viewer_alone_is_told_why_nothing_moves(live):
+    srv, ctx, node = live
+    status = node.wait_for(lambda e: e["event"] == "status", what="waiting status")
+    assert status["level"] == 1 and status["id"] == "sensorium-waiting"
+    for robot in ("'bot'", "'bot2'", "'rover'"):
+        assert robot in status["message"], status
+    assert "'free'" not in status["message"]                       # asynchronous: never waited for
+    assert "sensorium controller" in status["message"] and "--watch" in status["message"]
+    rpc = Rpc(ctx, srv.fields["rpc"])
+    rpc.session = rpc.ok("attach", {"robot": "bot"})["session"]
+    rpc.ok("/bot/robot/step")
+    gone = node.wait_for(lambda e: e["event"] == "removeStatus", what="status removed once the world steps")
+    assert gone["ids"] == ["sensorium-waiting"]
+
+
+def test_watch_shows_the_warehouse_lidar_without_a_controller():
+    """`serve warehouse --watch`: its <extern> forklift runs as <none>, the world steps by itself
+    and a viewer gets the lidar's scans (no controller, no edit of the world)."""
+    require_node()
+    srv = serve("warehouse", "--precision", "fast", "--watch", "--foxglove", "127.0.0.1:0")
+    node = None
+    try:
+        node = NodeProcess("live_client.js", srv.fields["foxglove"])
+        adv = node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+        scans = [c["topic"] for c in adv["channels"] if c["schemaName"] == "sensor_msgs/msg/PointCloud2"]
+        assert scans, adv
+        node.send(cmd="subscribe", topic=scans[0], brief=True)
+        m = node.wait_for(lambda e: e["event"] == "message" and e["topic"] == scans[0], what="a point cloud")
+        assert m["msg"]["width"] > 0
+        assert not [e for e in node.seen if e["event"] == "status"]
+    finally:
+        if node is not None:
+            node.close()
+        srv.stop(signal.SIGTERM)
+        assert "waiting for a controller" not in srv.stderr()
