@@ -33,7 +33,7 @@ SDK_SUBPROTOCOL = "foxglove.sdk.v1"
 LEGACY_SUBPROTOCOL = "foxglove.websocket.v1"
 MAX_HEADER_BYTES = 16 * 1024          # an HTTP upgrade request is a few hundred bytes
 HEADER_TIMEOUT_S = 10.0               # a client that sends no complete request in this time is dropped
-MAX_CONNECTIONS = 512                 # viewers at once; more are refused (closed) at accept
+MAX_CONNECTIONS = 64                  # viewers at once; more are refused (closed) at accept
 CHUNK = 64 * 1024
 
 
@@ -83,9 +83,10 @@ class SubprotocolFront:
     at ``127.0.0.1:upstream_port`` with the subprotocol negotiated as above."""
 
     def __init__(self, host: str, port: int, upstream_port: int, *, on_connect: Callable[[], None] | None = None,
-                 max_connections: int = MAX_CONNECTIONS):
+                 on_disconnect: Callable[[], None] | None = None, max_connections: int = MAX_CONNECTIONS):
         self.upstream_port = int(upstream_port)
         self.on_connect = on_connect or (lambda: None)
+        self.on_disconnect = on_disconnect or (lambda: None)
         self.max_connections = max_connections
         self.connections = 0               # open now
         self.accepted = 0                  # handshakes completed
@@ -164,7 +165,13 @@ class SubprotocolFront:
                 self.on_connect()
             except Exception:  # noqa: BLE001 - a callback never breaks a connection
                 pass
-            await self._pipe_both(reader, writer, up_reader, up_writer)
+            try:
+                await self._pipe_both(reader, writer, up_reader, up_writer)
+            finally:
+                try:
+                    self.on_disconnect()
+                except Exception:  # noqa: BLE001
+                    pass
         except (ConnectionError, OSError):
             pass
         finally:
