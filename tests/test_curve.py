@@ -66,10 +66,19 @@ def test_a_client_with_the_key_is_served_one_without_is_not(curve_server, monkey
         with Connection(rpc, timeout=1.5, context=ctx) as c, pytest.raises(SensoriumError) as exc:
             c.call("get_info")
         assert exc.value.code == ErrorCode.TIMEOUT
+        # ... and the timeout says why (issue 26: it asked "is `sensorium serve` running there?")
+        assert "server key" in str(exc.value) and "is wrong" in str(exc.value), exc.value
+        assert "running there" not in str(exc.value)
         monkeypatch.delenv(ENV_CURVE_SERVERKEY)
         with Connection(rpc, timeout=1.5, context=ctx) as c, pytest.raises(SensoriumError) as exc:
             c.call("get_info")
         assert exc.value.code == ErrorCode.TIMEOUT
+        assert "uses CURVE encryption and this client has no key" in str(exc.value), exc.value
+        assert ENV_CURVE_SERVERKEY in str(exc.value) and "running there" not in str(exc.value)
+        # a server that is not there is still "is `sensorium serve` running there?"
+        with Connection("tcp://127.0.0.1:1", timeout=0.5, context=ctx) as c, pytest.raises(SensoriumError) as exc:
+            c.call("get_info")
+        assert "running there" in str(exc.value)
     finally:
         ctx.destroy(linger=0)
 
