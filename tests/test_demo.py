@@ -137,3 +137,14 @@ def test_stuck_spans_find_every_10_s_without_progress() -> None:
     # reaches 1.52 m): at 30 - (0.3 - 0.02) / 0.05 = 24.4 s
     assert span[0] == pytest.approx(24.4, abs=0.05) and span[1] == pytest.approx(s[-1], abs=0.05)
     assert longest_stuck_s(t, rocking) == pytest.approx(s[-1] - 24.4, abs=0.05)
+
+
+def test_the_demo_logs_stay_readable(tmp_path: Path) -> None:
+    """The example controllers printed a line per control step (~350 lines/s in fast mode); by
+    default they print one per simulated second plus every change of state (all with -v)."""
+    out = tmp_path / "demo"
+    res = _sensorium("demo", "--duration", "20", "--out", str(out), "--json")
+    assert res.returncode == 0, res.stderr
+    for robot, steps in (("scout", 20_000 // 64), ("epuck", 20_000 // 32)):
+        lines = (out / f"{robot}.log").read_text().splitlines()
+        assert 20 <= len(lines) < steps / 4, (robot, len(lines))

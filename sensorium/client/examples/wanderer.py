@@ -24,6 +24,7 @@ cannot see (transparent objects). The random draws come from a fixed seed: two r
 """
 
 import math
+import os
 import random
 import sys
 
@@ -46,7 +47,12 @@ FREE_RUN = 1.5                   # s: driving forward this long without a turn c
 NO_FREE_RUN = 7.0                # s: ... and this long without one is no progress (turning on the spot)
 
 robot = Robot()
-max_steps = int(sys.argv[1]) if len(sys.argv) > 1 else None
+args = [a for a in sys.argv[1:] if a not in ("-v", "--verbose")]
+max_steps = int(args[0]) if args else None
+# a line per control step is ~350 lines/s in fast mode: by default one per simulated second (and
+# every change of state); -v (or SENSORIUM_VERBOSE=1) prints every step
+VERBOSE = len(args) < len(sys.argv) - 1 or os.environ.get("SENSORIUM_VERBOSE") == "1"
+next_report = 0.0
 rng = random.Random(7)
 
 lidar = robot.getDevice("lidar")
@@ -203,6 +209,7 @@ class Wanderer:
 
 wanderer = Wanderer()
 last_sonar = None
+last_action = None
 step = 0
 while robot.step(CONTROL_STEP) != -1:
     ranges = lidar.getRangeImage()
@@ -213,8 +220,11 @@ while robot.step(CONTROL_STEP) != -1:
     last_sonar = sonar
     ahead, left, right = perceive(ranges, sonar["front"])
     action, (wl, wr) = wanderer.decide(robot.getTime(), ahead, left, right, sonar, ranges)
-    print(f"t={robot.getTime():7.3f}  ahead={ahead:5.2f} left={left:5.2f} right={right:5.2f}  "
-          f"sonar {' '.join(f'{k}={v:4.2f}' for k, v in sonar.items())}  -> {action}", flush=True)
+    if VERBOSE or robot.getTime() >= next_report or action != last_action:
+        next_report = robot.getTime() + 1.0
+        print(f"t={robot.getTime():7.3f}  ahead={ahead:5.2f} left={left:5.2f} right={right:5.2f}  "
+              f"sonar {' '.join(f'{k}={v:4.2f}' for k, v in sonar.items())}  -> {action}", flush=True)
+    last_action = action
     if left_motor is not None and right_motor is not None:
         left_motor.setVelocity(wl)
         right_motor.setVelocity(wr)
