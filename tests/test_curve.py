@@ -162,10 +162,10 @@ def test_record_connect_uses_the_key_from_the_environment(curve_server, monkeypa
     _no_curve_env(monkeypatch)
     env = {k: v for k, v in os.environ.items() if not k.startswith("SENSORIUM_CURVE")}
     out = tmp_path / "curve.mcap"
-    r = subprocess.run([PY, "-m", "sensorium", "record", str(out), "--connect", rpc, "--duration", "1"],
+    r = subprocess.run([PY, "-m", "sensorium", "record", str(out), "--url", rpc, "--duration", "1"],
                        capture_output=True, text=True, timeout=60, env=env)
     assert r.returncode == 1 and "no answer" in r.stderr and not out.exists()       # no key: no service
-    rec = Proc(sensorium("record", str(out), "--connect", rpc, "--topics", "/clock", "--max-messages", "5", "--json"),
+    rec = Proc(sensorium("record", str(out), "--url", rpc, "--topics", "/clock", "--max-messages", "5", "--json"),
                env={**{k: None for k in os.environ if k.startswith("SENSORIUM_CURVE")}, ENV_CURVE_SERVERKEY: key})
     ctx = zmq.Context()
     try:
