@@ -37,3 +37,43 @@ def test_pytest_says_at_the_end_which_node_tests_it_skipped_and_how_to_run_them(
     lines = [line for line in r.stdout.splitlines() if line.startswith("sensorium: ")]
     assert len(lines) == 1, r.stdout[-3000:]
     assert "1 Foxglove/Node test(s) skipped (node is not installed)" in lines[0] and "npm ci" in lines[0]
+
+
+def test_a_bad_yaml_argument_to_call_names_its_position():
+    import pytest
+
+    from sensorium.cli.services import parse_args_text
+
+    with pytest.raises(ValueError) as exc:
+        parse_args_text("{mode: [fast}")
+    assert str(exc.value) == ("ARGS '{mode: [fast}' is neither JSON nor YAML at line 1, column 13: "
+                              "expected ',' or ']', but got '}'")
+    r = run("call", "set_mode", "{mode: fast", "--url", "tcp://127.0.0.1:1")
+    assert r.returncode == 2 and r.stderr.strip().splitlines() == [
+        "sensorium call: ARGS '{mode: fast' is neither JSON nor YAML at line 1, column 12: "
+        "expected ',' or '}', but got '<stream end>'"]
+
+
+def test_services_marks_supervisor_only_services_and_replay_shows_arguments(tmp_path):
+    import signal
+
+    from _recdata import make_recording
+    from _serve import Served, sensorium, serve
+
+    with serve(ROOT / "tests" / "worlds" / "webots_api.yaml", stop_signal=signal.SIGTERM) as s:
+        r = run("services", "--url", s.rpc)
+        assert r.returncode == 0, r.stderr
+        lines = r.stdout.splitlines()
+        set_field = [line for line in lines if "/robot/set_field " in line]
+        assert set_field and all("[supervisor controller only" in line for line in set_field), set_field
+        step = [line for line in lines if "/robot/step " in line]
+        assert step and all(line.endswith("[attached controller only]") for line in step), step
+    rec = tmp_path / "rec.mcap"
+    make_recording(rec, steps=5)
+    replay = Served(sensorium("replay", str(rec), "--loop", "--pub", "tcp://127.0.0.1:0", "--rpc", "tcp://127.0.0.1:0",
+                              "--no-progress"), "sensorium: replaying")
+    with replay.wait_ready() as rp:
+        rpc = rp.fields.get("rpc")
+        r = run("services", "--url", rpc)
+    assert r.returncode == 0, r.stderr
+    assert "  /replay/set_rate  {value: float}" in r.stdout.splitlines(), r.stdout
