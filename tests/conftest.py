@@ -57,3 +57,19 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if is_slow(item):
             item.add_marker(pytest.mark.slow)
+
+
+NODE_SKIP_MARKERS = ("npm ci", "node is not installed")
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:  # noqa: ARG001
+    """One line at the end when the Foxglove/Node tests (tests/js) were skipped, saying how to run them."""
+    skipped = terminalreporter.stats.get("skipped", [])
+    node = [r for r in skipped if any(m in str(getattr(r, "longrepr", "")) for m in NODE_SKIP_MARKERS)]
+    if node:
+        why = "node is not installed" if any("node is not installed" in str(r.longrepr) for r in node) \
+            else "the npm packages are not installed"
+        terminalreporter.write_line(
+            f"sensorium: {len(node)} Foxglove/Node test(s) skipped ({why}): install Node.js, run `npm ci` in "
+            f"{Path(__file__).parent / 'js'}, then run pytest again (CI sets SENSORIUM_REQUIRE_NODE=1 to fail instead)",
+            yellow=True)

@@ -59,34 +59,56 @@ def _free_port() -> int:
 # ---------------------------------------------------------------------- echo
 
 def test_echo_unknown_topic_fails_at_once_with_the_closest_names(arena):
-    res = cli("echo", "/epuck/ls9/value", "--rpc", arena.rpc)
+    res = cli("echo", "/epuck/ls9/value", "--url", arena.rpc)
     assert res.returncode == 1
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and "no topic '/epuck/ls9/value'" in lines[0]
     assert "/epuck/ls0/value" in lines[0] and "/epuck/ls1/value" in lines[0]
-    prefix = cli("echo", "/epux/", "--rpc", arena.rpc)
+    prefix = cli("echo", "/epux/", "--url", arena.rpc)
     assert prefix.returncode == 1 and "no topic '/epux/'" in prefix.stderr
 
 
 def test_echo_without_a_server_times_out_with_a_message():
     rpc, pub = f"tcp://127.0.0.1:{_free_port()}", f"tcp://127.0.0.1:{_free_port()}"
     t0 = time.monotonic()
-    res = cli("echo", "/clock", "--rpc", rpc, "--url", pub, "--timeout", "1")
+    res = cli("echo", "/clock", "--url", rpc, "--pub", pub, "--timeout", "1")
     assert res.returncode == 1 and time.monotonic() - t0 < 30
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and "no server answers" in lines[0] and rpc in lines[0]
-    only_pub = cli("echo", "/clock", "--url", pub, "--timeout", "1")        # no --rpc: nobody asked
-    assert only_pub.returncode == 1 and "--rpc" in only_pub.stderr and len(only_pub.stderr.strip().splitlines()) == 1
+    only_pub = cli("echo", "/clock", "--pub", pub, "--timeout", "1")        # no --url: nobody asked
+    assert only_pub.returncode == 1 and "--url" in only_pub.stderr and len(only_pub.stderr.strip().splitlines()) == 1
+    # the default wait when no server answers is the 5 s of every client command (was 10 s)
+    default = cli("echo", "/clock", "--url", rpc, "--pub", pub)
+    assert default.returncode == 1 and "for 5 s" in default.stderr, default.stderr
+
+
+def test_one_flag_one_meaning_and_the_old_spellings_still_work(free, tmp_path):
+    """--url is the RPC endpoint for every client command, --pub a topic endpoint; echo/hz's --rpc,
+    echo/hz's --url given a topic endpoint, and record's --connect keep working with one line."""
+    old_rpc = cli("echo", "/clock", "--rpc", free.rpc, "--count", "1")
+    assert old_rpc.returncode == 0, old_rpc.stderr
+    assert old_rpc.stderr.strip().splitlines()[0] == ("sensorium echo: --rpc is deprecated: use --url (the server's "
+                                                      "RPC endpoint, as for topics, services and call)")
+    old_url = cli("hz", "/clock", "--url", free.pub, "--duration", "2", "--json")
+    assert old_url.returncode == 0, old_url.stderr
+    assert f"deprecated: use --pub {free.pub}" in old_url.stderr and old_url.stdout.strip()
+    new = cli("echo", "/clock", "--url", free.rpc, "--pub", free.pub, "--count", "1")
+    assert new.returncode == 0 and "deprecated" not in new.stderr, new.stderr
+    rec = cli("record", str(tmp_path / "r.mcap"), "--connect", free.rpc, "--max-messages", "3")
+    assert rec.returncode == 0, rec.stderr
+    assert rec.stderr.startswith("sensorium record: --connect is deprecated: use --url")
+    rec2 = cli("record", str(tmp_path / "r2.mcap"), "--url", free.rpc, "--max-messages", "3")
+    assert rec2.returncode == 0 and "deprecated" not in rec2.stderr, rec2.stderr
 
 
 def test_echo_says_why_a_waiting_world_is_silent(arena):
-    res = cli("echo", "/clock", "--rpc", arena.rpc, "--timeout", "4")
+    res = cli("echo", "/clock", "--url", arena.rpc, "--timeout", "4")
     assert res.returncode == 1
     assert "paused" in res.stderr                        # the arena server runs in pause mode
 
 
 def test_a_world_of_uncontrolled_robots_steps_by_itself_and_echo_prints_yaml(free):
-    res = cli("echo", "/clock", "--rpc", free.rpc, "--count", "3")
+    res = cli("echo", "/clock", "--url", free.rpc, "--count", "3")
     assert res.returncode == 0, res.stderr
     docs = [d for d in yaml.safe_load_all(res.stdout) if d is not None]
     assert len(docs) == 3
@@ -96,10 +118,10 @@ def test_a_world_of_uncontrolled_robots_steps_by_itself_and_echo_prints_yaml(fre
 
 
 def test_echo_summarises_arrays_unless_full_and_json_is_complete(free):
-    short = cli("echo", "/bot/lidar/laser_scan", "--rpc", free.rpc, "--count", "1")
+    short = cli("echo", "/bot/lidar/laser_scan", "--url", free.rpc, "--count", "1")
     assert short.returncode == 0, short.stderr
     assert "ranges: <float32[12]" in short.stdout
-    full = cli("echo", "/bot/lidar/laser_scan", "--rpc", free.rpc, "--count", "1", "--full")
+    full = cli("echo", "/bot/lidar/laser_scan", "--url", free.rpc, "--count", "1", "--full")
     doc = yaml.safe_load(full.stdout.split("\n---")[0])
     # Webots order: column 0 on the left, so the increment is negative (PROTOCOL.md, README ROS section)
     assert len(doc["ranges"]) == 12 and doc["angle_increment"] == pytest.approx(-1 / 12)
@@ -108,7 +130,7 @@ def test_echo_summarises_arrays_unless_full_and_json_is_complete(free):
     for i, r in enumerate(doc["ranges"]):
         angle = doc["angle_min"] + i * doc["angle_increment"]
         assert r == pytest.approx(0.95 / math.cos(angle), abs=1e-4)
-    js = cli("echo", "/bot/lidar/laser_scan", "--rpc", free.rpc, "--count", "1", "--json")
+    js = cli("echo", "/bot/lidar/laser_scan", "--url", free.rpc, "--count", "1", "--json")
     msg = json.loads(js.stdout)
     assert msg["topic"] == "/bot/lidar/laser_scan" and msg["type"] == "sensor_msgs/msg/LaserScan"
     assert len(msg["body"]["ranges"]) == 12 and msg["stamp_ns"] % 32_000_000 == 0
@@ -117,7 +139,7 @@ def test_echo_summarises_arrays_unless_full_and_json_is_complete(free):
 # ---------------------------------------------------------------------- hz, topics
 
 def test_hz_measures_the_simulated_rate_exactly(free):
-    res = cli("hz", "/clock", "/bot/ls/value", "--rpc", free.rpc, "--duration", "3", "--json")
+    res = cli("hz", "/clock", "/bot/ls/value", "--url", free.rpc, "--duration", "3", "--json")
     assert res.returncode == 0, res.stderr
     last = {}
     for line in res.stdout.splitlines():
@@ -127,7 +149,7 @@ def test_hz_measures_the_simulated_rate_exactly(free):
     for row in last.values():
         assert row["sim_rate_hz"] == pytest.approx(1000 / 32)         # one message per 32 ms basic step
         assert row["rate_hz"] > 0 and row["min_s"] <= row["max_s"] and row["window"] >= 2
-    text = cli("hz", "/clock", "--rpc", free.rpc, "--duration", "2")
+    text = cli("hz", "/clock", "--url", free.rpc, "--duration", "2")
     assert "/clock: average rate" in text.stdout and "std dev" in text.stdout
 
 

@@ -66,10 +66,19 @@ def test_a_client_with_the_key_is_served_one_without_is_not(curve_server, monkey
         with Connection(rpc, timeout=1.5, context=ctx) as c, pytest.raises(SensoriumError) as exc:
             c.call("get_info")
         assert exc.value.code == ErrorCode.TIMEOUT
+        # ... and the timeout says why (issue 26: it asked "is `sensorium serve` running there?")
+        assert "server key" in str(exc.value) and "is wrong" in str(exc.value), exc.value
+        assert "running there" not in str(exc.value)
         monkeypatch.delenv(ENV_CURVE_SERVERKEY)
         with Connection(rpc, timeout=1.5, context=ctx) as c, pytest.raises(SensoriumError) as exc:
             c.call("get_info")
         assert exc.value.code == ErrorCode.TIMEOUT
+        assert "uses CURVE encryption and this client has no key" in str(exc.value), exc.value
+        assert ENV_CURVE_SERVERKEY in str(exc.value) and "running there" not in str(exc.value)
+        # a server that is not there is still "is `sensorium serve` running there?"
+        with Connection("tcp://127.0.0.1:1", timeout=0.5, context=ctx) as c, pytest.raises(SensoriumError) as exc:
+            c.call("get_info")
+        assert "running there" in str(exc.value)
     finally:
         ctx.destroy(linger=0)
 
@@ -153,10 +162,10 @@ def test_record_connect_uses_the_key_from_the_environment(curve_server, monkeypa
     _no_curve_env(monkeypatch)
     env = {k: v for k, v in os.environ.items() if not k.startswith("SENSORIUM_CURVE")}
     out = tmp_path / "curve.mcap"
-    r = subprocess.run([PY, "-m", "sensorium", "record", str(out), "--connect", rpc, "--duration", "1"],
+    r = subprocess.run([PY, "-m", "sensorium", "record", str(out), "--url", rpc, "--duration", "1"],
                        capture_output=True, text=True, timeout=60, env=env)
     assert r.returncode == 1 and "no answer" in r.stderr and not out.exists()       # no key: no service
-    rec = Proc(sensorium("record", str(out), "--connect", rpc, "--topics", "/clock", "--max-messages", "5", "--json"),
+    rec = Proc(sensorium("record", str(out), "--url", rpc, "--topics", "/clock", "--max-messages", "5", "--json"),
                env={**{k: None for k in os.environ if k.startswith("SENSORIUM_CURVE")}, ENV_CURVE_SERVERKEY: key})
     ctx = zmq.Context()
     try:

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sensorium.demo.summary import cells_visited, path_length, smoothness
+from sensorium.demo.summary import cells_visited, longest_stuck_s, path_length, smoothness, stuck_spans
 
 WORLDS = Path(__file__).parent / "worlds"
 
@@ -23,12 +23,12 @@ def _sensorium(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
 
 def test_demo_robots_behave_as_described_and_recording_replays(tmp_path: Path) -> None:
     out = tmp_path / "demo"
-    res = _sensorium("demo", "--duration", "40", "--out", str(out), "--json")
+    res = _sensorium("demo", "--duration", "60", "--out", str(out), "--json")
     assert res.returncode == 0, res.stderr + "".join((out / n).read_text() for n in ("server.log", "epuck.log", "scout.log")
                                                       if (out / n).exists())
     summary = json.loads(res.stdout)
     assert summary["exit_codes"] == {"server": 0, "epuck": 0, "scout": 0}
-    steps = 40_000 // 32                              # --until is rounded down to whole basic steps
+    steps = 60_000 // 32                              # --until is rounded down to whole basic steps
     assert summary["simulated_s"] == steps * 32 / 1000
     assert summary["messages"]["/clock"] == steps and summary["messages"]["/epuck/pose"] == steps
     assert summary["messages"]["/scout/lidar/laser_scan"] > 0
@@ -42,6 +42,9 @@ def test_demo_robots_behave_as_described_and_recording_replays(tmp_path: Path) -
     assert summary["cells_visited"]["scout"] >= 10                                        # of 64
     assert summary["smoothness"]["scout"] > 0.8 and summary["smoothness"]["epuck"] > 0.8
     assert summary["distance_m"]["scout"] > 6.0
+    # ... and is never stuck: every 10 s window of the 60 s takes it more than 0.3 m from where the
+    # window began (it used to spend the last 21 s wedged between the west wall and the glass pane)
+    assert summary["longest_stuck_s"]["scout"] == 0, summary["longest_stuck_s"]
     # the picture: a real PNG of matplotlib's size
     png = (out / "arena.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
@@ -119,3 +122,29 @@ def test_demo_runs_are_reproducible(tmp_path: Path) -> None:
             h.update(m.topic.encode() + m.stamp_ns.to_bytes(8, "little") + m.data)
         digests.append(h.hexdigest())
     assert digests[0] == digests[1]
+
+
+def test_stuck_spans_find_every_10_s_without_progress() -> None:
+    t = np.arange(0, 60_000_000_000, 32_000_000, dtype=np.int64)          # 60 s of 32 ms steps
+    s = t / 1e9
+    moving = np.stack([0.05 * s, np.zeros(len(t))], axis=1)             # 5 cm/s: 0.5 m per 10 s
+    assert stuck_spans(t, moving) == [] and longest_stuck_s(t, moving) == 0.0
+    # drives for 30 s, then rocks on the spot (2 cm back and forth, turning) for the last 30 s
+    x = np.where(s < 30, 0.05 * s, 1.5 + 0.02 * (np.arange(len(t)) % 2))
+    rocking = np.stack([x, np.zeros(len(t))], axis=1)
+    (span,) = stuck_spans(t, rocking)
+    # the first stuck window starts once the 10 s from its start stay within 0.3 m of it (the rocking
+    # reaches 1.52 m): at 30 - (0.3 - 0.02) / 0.05 = 24.4 s
+    assert span[0] == pytest.approx(24.4, abs=0.05) and span[1] == pytest.approx(s[-1], abs=0.05)
+    assert longest_stuck_s(t, rocking) == pytest.approx(s[-1] - 24.4, abs=0.05)
+
+
+def test_the_demo_logs_stay_readable(tmp_path: Path) -> None:
+    """The example controllers printed a line per control step (~350 lines/s in fast mode); by
+    default they print one per simulated second plus every change of state (all with -v)."""
+    out = tmp_path / "demo"
+    res = _sensorium("demo", "--duration", "20", "--out", str(out), "--json")
+    assert res.returncode == 0, res.stderr
+    for robot, steps in (("scout", 20_000 // 64), ("epuck", 20_000 // 32)):
+        lines = (out / f"{robot}.log").read_text().splitlines()
+        assert 20 <= len(lines) < steps / 4, (robot, len(lines))

@@ -87,3 +87,31 @@ def test_compose_publishes_ports_on_loopback_only() -> None:
     for spec in ports:
         host_ip = str(spec).split(":")[0]
         assert host_ip == "127.0.0.1", f"port {spec!r} is published beyond loopback"
+
+
+def test_the_recorders_volume_is_writable_by_the_images_user() -> None:
+    """A host folder bind-mounted by docker is created root-owned, and the image runs as the user
+    'sensorium': the recorder could not write its file. The recorder now writes to a named volume
+    whose mount point the image creates as its own user (a new named volume copies that ownership)."""
+    text = (ROOT / "docker" / "Dockerfile").read_text()
+    user = re.findall(r"^USER (\S+)$", text, flags=re.M)
+    assert user == ["sensorium"]
+    recorder = COMPOSE["services"]["recorder"]
+    (volume,) = recorder["volumes"]
+    source, target = str(volume).split(":")[:2]
+    assert not source.startswith((".", "/", "~")), f"{volume}: a host path, created root-owned by docker"
+    assert source in (COMPOSE.get("volumes") or {}), f"named volume {source!r} is not declared"
+    # the mount point is made after USER sensorium (so owned by it), and the recorder writes inside it
+    after_user = text.split("USER sensorium", 1)[1]
+    assert re.search(rf"^RUN mkdir -p {re.escape(target)}$", after_user, flags=re.M), target
+    out = recorder["command"][1]
+    assert ("/home/sensorium/" + out).startswith(target + "/"), (out, target)
+
+
+def test_the_dockerfile_advice_publishes_on_loopback_or_with_keys() -> None:
+    text = (ROOT / "docker" / "Dockerfile").read_text()
+    runs = [line for line in text.splitlines() if "docker run" in line]
+    assert runs
+    for line in runs:
+        for spec in re.findall(r"-p (\S+)", line):
+            assert spec.startswith("127.0.0.1:"), f"{line.strip()}: publishes {spec} on every interface"

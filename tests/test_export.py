@@ -187,3 +187,185 @@ def test_cli_export(recording, tmp_path):
         assert topics == {t for t in TOPICS if t.startswith("/epuck/")}
         assert reader.message_count == sum(1 for i in items if i[0].startswith("/epuck/"))
     assert Path(out, "metadata.yaml").exists()
+
+
+# --------------------------------------------------------------------------------------------
+# QoS profiles in metadata.yaml: checked against rosbag2's own format (rules read in rosbag2's
+# rosbag2_storage/include/rosbag2_storage/yaml.hpp and src/rosbag2_storage/qos.cpp, written here
+# independently), then read back with rosbags' reader and, for the MCAP channels, the mcap package.
+
+RMW_NAMES = {   # rmw's *_policy_to_str names, what version >= 9 writes
+    "history": {"system_default", "keep_last", "keep_all", "unknown"},
+    "reliability": {"system_default", "reliable", "best_effort", "unknown", "best_available"},
+    "durability": {"system_default", "transient_local", "volatile", "unknown", "best_available"},
+    "liveliness": {"system_default", "automatic", "manual_by_topic", "unknown", "best_available"},
+}
+RMW_INTS = {"reliability": {"reliable": 1, "best_effort": 2}, "durability": {"transient_local": 1, "volatile": 2},
+            "history": {"keep_last": 1}, "liveliness": {"automatic": 1}}
+
+
+def rosbag2_qos_list(value, version: int) -> list[dict]:
+    """Decode ``offered_qos_profiles`` as rosbag2 of metadata ``version`` does; every policy as a name."""
+    import yaml
+
+    if version <= 8:
+        assert isinstance(value, str), f"version {version}: offered_qos_profiles must be a YAML string, got {value!r}"
+        items = yaml.safe_load(value) if value else []
+    else:
+        assert isinstance(value, list), f"version {version}: offered_qos_profiles must be a YAML list, got {value!r}"
+        items = value
+    out = []
+    for q in items:
+        assert set(q) == {"history", "depth", "reliability", "durability", "deadline", "lifespan", "liveliness",
+                          "liveliness_lease_duration", "avoid_ros_namespace_conventions"}, q
+        named = {}
+        for policy in ("history", "reliability", "durability", "liveliness"):
+            v = q[policy]
+            if version <= 8 and policy != "history":
+                assert isinstance(v, int) and not isinstance(v, bool), (policy, v)     # node.as<int>()
+                named[policy] = {i: n for n, i in RMW_INTS[policy].items()}.get(v, f"int {v}")
+            elif isinstance(v, int):
+                assert policy == "history", (policy, v)
+                named[policy] = {i: n for n, i in RMW_INTS[policy].items()}.get(v, f"int {v}")
+            else:
+                assert v in RMW_NAMES[policy], (policy, v)                               # rmw_*_from_str
+                named[policy] = v
+        assert isinstance(q["depth"], int) and q["depth"] >= 0
+        for d in ("deadline", "lifespan", "liveliness_lease_duration"):
+            assert set(q[d]) == {"sec", "nsec"} and all(isinstance(x, int) and x >= 0 for x in q[d].values()), q[d]
+        assert isinstance(q["avoid_ros_namespace_conventions"], bool)
+        named["depth"] = q["depth"]
+        out.append(named)
+    return out
+
+
+def check_rosbag2_metadata(text: str) -> dict[str, list[dict]]:
+    """metadata.yaml as rosbag2's decoder reads it, field by field per version; topic → QoS list."""
+    import yaml
+
+    doc = yaml.safe_load(text)
+    info = doc["rosbag2_bagfile_information"]
+    version = info["version"]
+    assert isinstance(version, int)
+    uint = lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0
+    assert isinstance(info["storage_identifier"], str) and info["storage_identifier"] == "mcap"
+    assert uint(info["duration"]["nanoseconds"]) and uint(info["starting_time"]["nanoseconds_since_epoch"])
+    assert uint(info["message_count"])
+    assert all(isinstance(p, str) for p in info["relative_file_paths"])
+    if version >= 3:
+        assert isinstance(info["compression_format"], str) and isinstance(info["compression_mode"], str)
+    if version >= 5:
+        for f in info["files"]:
+            assert isinstance(f["path"], str) and uint(f["message_count"])
+            assert uint(f["starting_time"]["nanoseconds_since_epoch"]) and uint(f["duration"]["nanoseconds"])
+    if version >= 6:
+        assert all(isinstance(k, str) and isinstance(v, str) for k, v in (info["custom_data"] or {}).items())
+    if version >= 8:
+        assert isinstance(info["ros_distro"], str)
+    qos = {}
+    for t in info["topics_with_message_count"]:
+        meta = t["topic_metadata"]
+        assert uint(t["message_count"])
+        assert all(isinstance(meta[k], str) for k in ("name", "type", "serialization_format"))
+        if version >= 7:
+            assert isinstance(meta["type_description_hash"], str) and meta["type_description_hash"].startswith("RIHS01_")
+        qos[meta["name"]] = rosbag2_qos_list(meta["offered_qos_profiles"], version)
+    return qos
+
+
+EXPECTED_QOS = {   # what a live driver offers (tf2's broadcasters, rclcpp's SensorDataQoS / ClockQoS / default)
+    "/tf_static": ("reliable", "transient_local", 1), "/scene": ("reliable", "transient_local", 1),
+    "/tf": ("reliable", "volatile", 100), "/clock": ("best_effort", "volatile", 1),
+}
+
+
+def expected_qos(topic: str, typename: str) -> tuple[str, str, int]:
+    if topic in EXPECTED_QOS:
+        return EXPECTED_QOS[topic]
+    if typename.startswith("sensor_msgs/msg/"):
+        return ("best_effort", "volatile", 5)
+    return ("reliable", "volatile", 10)
+
+
+VIEWS_WORLD = b"""world_info: {name: views, basic_time_step: 32, random_seed: 7}
+solids: [{name: box, pose: {translation: [1, 0, 0.1]}, geometry: {type: box, size: [0.2, 0.2, 0.2]}}]
+robots:
+  - name: epuck
+    shapes: [{geometry: {type: cylinder, radius: 0.035, height: 0.05}}]
+    devices: [{device: LightSensor, name: ls0, pose: {translation: [0.03, 0, 0.02]}}]
+"""
+
+
+@pytest.fixture(scope="module")
+def views_recording(tmp_path_factory):
+    """A recording whose attached world gives /tf_static, /scene and (from /epuck/pose) /tf."""
+    from _recdata import TOPICS as BASE
+    from _recdata import header, published
+
+    from sensorium.server.recording.writer import McapRecorder
+
+    def pose(t_ns: int, i: int) -> dict:
+        return {"header": header(t_ns, "world"), "pose": {"position": {"x": 0.001 * i, "y": 0.0, "z": 0.0},
+                                                         "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}}
+
+    topics = dict(BASE, **{"/epuck/pose": ("geometry_msgs/msg/PoseStamped", pose, 1)})
+    path = tmp_path_factory.mktemp("views") / "views.mcap"
+    with McapRecorder(path, VIEWS_WORLD, "views.yaml", {"seed": "7", "world": "views"}, None, 4096) as rec:
+        for item in published(8, topics):
+            rec.record(*item)
+    return path
+
+
+@pytest.mark.parametrize("distro,version", [("humble", 8), ("jazzy", 9)])
+def test_rosbag2_metadata_has_the_qos_a_live_driver_offers(views_recording, tmp_path, distro, version):
+    src = views_recording
+    out = tmp_path / f"qos_{distro}"
+    report = export_ros2(src, out, distro=distro)
+    assert "/tf_static" in report.topics and "/scene" in report.topics      # the recorded world's views
+    qos = check_rosbag2_metadata((out / "metadata.yaml").read_text())
+    assert set(qos) == set(report.topics)
+    for topic, typename in report.topics.items():
+        (profile,) = qos[topic]
+        rel, dur, depth = expected_qos(topic, typename)
+        assert (profile["reliability"], profile["durability"], profile["depth"], profile["history"]) == \
+               (rel, dur, depth, "keep_last"), topic
+    # rosbags' reader sees the same profiles
+    from rosbags.interfaces import QosDurability, QosReliability
+    from rosbags.rosbag2 import Reader
+
+    with Reader(out) as reader:
+        for conn in reader.connections:
+            (q,) = conn.ext.offered_qos_profiles
+            rel, dur, depth = expected_qos(conn.topic, conn.msgtype)
+            assert (q.reliability, q.durability, q.depth) == (QosReliability[rel.upper()], QosDurability[dur.upper()],
+                                                              depth), conn.topic
+    # the MCAP channels carry them too (rosbag2's MCAP plugin plays from these), in the same version's encoding
+    with open(next(out.glob("*.mcap")), "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        meta = {m.name: m.metadata for m in reader.iter_metadata()}
+        import yaml
+
+        mcap_version = yaml.safe_load(meta["rosbag2"]["serialized_metadata"])["version"] if "rosbag2" in meta else 8
+        assert mcap_version == version
+        for channel in summary.channels.values():
+            raw = channel.metadata["offered_qos_profiles"]
+            listed = raw if mcap_version <= 8 else yaml.safe_load(raw)
+            (profile,) = rosbag2_qos_list(listed, mcap_version)
+            schema = summary.schemas[channel.schema_id].name
+            assert (profile["reliability"], profile["durability"]) == expected_qos(channel.topic, schema)[:2]
+
+
+def test_single_file_channels_carry_the_qos(views_recording, tmp_path):
+    src = views_recording
+    out = tmp_path / "qos.mcap"
+    export_ros2(src, out, distro="jazzy")
+    with open(out, "rb") as f:
+        summary = make_reader(f).get_summary()
+    topics = {c.topic: c for c in summary.channels.values()}
+    assert "/tf_static" in topics
+    for topic, channel in topics.items():
+        # no rosbag2 metadata record: rosbag2's MCAP plugin reads the channels as version 8
+        (profile,) = rosbag2_qos_list(channel.metadata["offered_qos_profiles"], 8)
+        assert (profile["reliability"], profile["durability"], profile["depth"]) == \
+               expected_qos(topic, summary.schemas[channel.schema_id].name), topic

@@ -12,6 +12,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -246,3 +247,128 @@ def test_replay_serves_foxglove(tmp_path):
         if node is not None:
             node.close()
         replay.stop(signal.SIGTERM)
+
+
+def test_the_default_client_and_the_sdk_name_are_both_accepted(live):
+    """@foxglove/ws-protocol at its defaults offers foxglove.websocket.v1 (the SDK's server alone
+    answers it with HTTP 400); the front names it back, and foxglove.sdk.v1 still works."""
+    srv, _ctx, node = live
+    opened = node.wait_for(lambda e: e["event"] == "open", what="open")
+    assert opened["protocol"] == "foxglove.websocket.v1"
+    node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+    other = NodeProcess("live_client.js", srv.fields["foxglove"], "sdk")
+    try:
+        assert other.wait_for(lambda e: e["event"] == "open", what="open (sdk)")["protocol"] == "foxglove.sdk.v1"
+        other.wait_for(lambda e: e["event"] == "advertise", what="advertise (sdk)")
+    finally:
+        other.close()
+
+
+def test_a_viewer_alone_is_told_why_nothing_moves(live):
+    srv, ctx, node = live
+    status = node.wait_for(lambda e: e["event"] == "status", what="waiting status")
+    assert status["level"] == 1 and status["id"] == "sensorium-waiting"
+    for robot in ("'bot'", "'bot2'", "'rover'"):
+        assert robot in status["message"], status
+    assert "'free'" not in status["message"]                       # asynchronous: never waited for
+    assert "sensorium controller" in status["message"] and "--watch" in status["message"]
+    rpc = Rpc(ctx, srv.fields["rpc"])
+    rpc.session = rpc.ok("attach", {"robot": "bot"})["session"]
+    rpc.ok("/bot/robot/step")
+    gone = node.wait_for(lambda e: e["event"] == "removeStatus", what="status removed once the world steps")
+    assert gone["ids"] == ["sensorium-waiting"]
+
+
+def test_watch_shows_the_warehouse_lidar_without_a_controller():
+    """`serve warehouse --watch`: its <extern> forklift runs as <none>, the world steps by itself
+    and a viewer gets the lidar's scans (no controller, no edit of the world)."""
+    require_node()
+    srv = serve("warehouse", "--precision", "fast", "--watch", "--foxglove", "127.0.0.1:0")
+    node = None
+    try:
+        node = NodeProcess("live_client.js", srv.fields["foxglove"])
+        adv = node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+        scans = [c["topic"] for c in adv["channels"] if c["schemaName"] == "sensor_msgs/msg/PointCloud2"]
+        assert scans, adv
+        node.send(cmd="subscribe", topic=scans[0], brief=True)
+        m = node.wait_for(lambda e: e["event"] == "message" and e["topic"] == scans[0], what="a point cloud")
+        assert m["msg"]["width"] > 0
+        assert not [e for e in node.seen if e["event"] == "status"]
+    finally:
+        if node is not None:
+            node.close()
+        srv.stop(signal.SIGTERM)
+        assert "waiting for a controller" not in srv.stderr()
+
+
+def _rss_kib(pid: int, key: str = "VmRSS") -> int:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith(key + ":"):
+            return int(line.split()[1])
+    raise AssertionError(f"no {key} for {pid}")
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs /proc")
+def test_200_vanishing_viewers_leave_memory_bounded_and_the_log_quiet():
+    """Issue 28: after 200 viewers (20 at a time) subscribed to everything (the warehouse's 16-layer
+    lidar cloud is ~260 KB) and vanished without unsubscribing, the server kept 2.1–2.4 GB and
+    logged ~48,000 "Broken pipe" lines. Now each viewer's queue is bounded in bytes, freed memory
+    is returned, and the SDK's lines are one per viewer connection."""
+    require_node()
+    srv = serve("warehouse", "--precision", "fast", "--watch", "--foxglove", "127.0.0.1:0")
+    try:
+        before = _rss_kib(srv.pid)
+        from _node import run_script
+
+        for _ in range(2):
+            result = run_script("viewer_churn.js", srv.fields["foxglove"], "200", "20", "--parallel", "20", timeout=300)
+            assert result[-1]["viewers"] == 200 and result[-1]["messages"] > 200, result
+        wait_until(lambda: _rss_kib(srv.pid) < before + 300 * 1024,
+                           timeout=30, what=f"RSS back under {before // 1024 + 300} MB (now {_rss_kib(srv.pid) // 1024} MB)")
+        peak = _rss_kib(srv.pid, "VmHWM")
+        assert peak < before + 700 * 1024, f"peak {peak // 1024} MB (started at {before // 1024} MB)"
+    finally:
+        srv.stop(signal.SIGTERM)
+    err = srv.stderr()
+    sdk_lines = [line for line in err.splitlines() if line.startswith("sensorium: Foxglove: ")]
+    assert len(sdk_lines) <= 400 + 10, f"{len(sdk_lines)} SDK lines for 400 viewers"
+    assert "Broken pipe" not in "\n".join(err.splitlines()[-3:])
+    assert "400 connections" in err, err[-2000:]
+
+
+def test_subscribe_churn_does_not_stall_stepping():
+    """Issue 28: 10,000 subscribe/unsubscribe pairs (every channel, /scene included) stalled
+    stepping for 1.46 s, and each /scene subscription queued one more full scene. Now each
+    subscription event is O(1), wakes the loop at most once per pass, and a viewer's scene is
+    queued once: the controller's steps go on, and the churning viewer still gets its data."""
+    require_node()
+    srv = serve(None, "--precision", "fast", "--foxglove", "127.0.0.1:0")
+    ctx = zmq.Context()
+    try:
+        rpc = Rpc(ctx, srv.fields["rpc"])
+        rpc.session = rpc.ok("attach", {"robot": "epuck"})["session"]
+        durations: list[float] = []
+        done = threading.Event()
+
+        def stepper() -> None:
+            while not done.is_set():
+                t = time.perf_counter()
+                rpc.ok("/epuck/robot/step")
+                durations.append(time.perf_counter() - t)
+
+        thread = threading.Thread(target=stepper, daemon=True)
+        thread.start()
+        wait_until(lambda: len(durations) > 50, what="the controller stepping")
+        from _node import run_script
+
+        rounds = -(-10_000 // 22)                                           # arena: 22 channels
+        result = run_script("viewer_churn.js", srv.fields["foxglove"], "1", "1", "--churn", str(rounds), timeout=120)[-1]
+        n = len(durations)
+        wait_until(lambda: len(durations) > n + 50, what="stepping after the churn")
+        done.set()
+        thread.join(30)
+        assert result["churned"] >= 10_000 and result["failed"] == 0, result      # it got a message within 5 s
+        assert max(durations) < 0.5, f"a step took {max(durations) * 1000:.0f} ms during the churn"
+    finally:
+        ctx.destroy(0)
+        srv.stop(signal.SIGTERM)

@@ -164,7 +164,12 @@ def test_layout_command(tmp_path):
     again = run(str(WORLD), "-o", str(out))                     # never overwrite without being asked
     assert again.returncode == 1 and again.stderr.strip().endswith("not overwriting (--force to replace it)")
     missing = run(str(tmp_path / "nope.mcap"))
-    assert missing.returncode == 1 and missing.stderr.strip() == f"sensorium layout: {tmp_path / 'nope.mcap'}: no such file"
+    assert missing.returncode == 1 and missing.stderr.strip().startswith(
+        f"sensorium layout: {tmp_path / 'nope.mcap'}: no such file (nor a bundled world: arena")
+    bundled = run("arena", "-o", str(tmp_path / "arena.json"))             # a bundled name, from any directory
+    assert bundled.returncode == 0, bundled.stderr
+    assert "/scout/lidar/laser_scan" in json.loads((tmp_path / "arena.json").read_text())["content"]["items"][0][
+        "content"]["config"]["topics"]
 
 
 def test_grown_world_format_is_drawn_where_rays_see_it():

@@ -218,7 +218,7 @@ def test_examples_through_the_launcher_with_topics_and_echo(servers, tmp_path):
         time.sleep(0.05)
     braitenberg = Proc(sensorium("controller", str(EXAMPLES / "braitenberg.py"), "--robot", "epuck",
                                  "--url", server.rpc, "5"))
-    wanderer = Proc(sensorium("controller", str(EXAMPLES / "wanderer.py"), "--url", server.url("scout"), "3"))
+    wanderer = Proc(sensorium("controller", str(EXAMPLES / "wanderer.py"), "--url", server.url("scout"), "3", "-v"))
     procs += [braitenberg, wanderer]
     server.wait_attached({"epuck", "scout"})
     server.conn.call("set_mode", {"mode": "fast"})
@@ -300,7 +300,7 @@ def test_examples_drive_their_robots(servers, tmp_path):
     started.append(server)
     before = {r: server.conn.call(f"/{r}/robot/get_pose") for r in ("epuck", "scout")}
     braitenberg = Proc(sensorium("controller", str(EXAMPLES / "braitenberg.py"), "--url", server.url("epuck"), "300"))
-    wanderer = Proc(sensorium("controller", str(EXAMPLES / "wanderer.py"), "--url", server.url("scout"), "100"))
+    wanderer = Proc(sensorium("controller", str(EXAMPLES / "wanderer.py"), "--url", server.url("scout"), "100", "-v"))
     procs += [braitenberg, wanderer]
     server.wait_attached({"epuck", "scout"})
     server.conn.call("set_mode", {"mode": "fast"})

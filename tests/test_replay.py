@@ -325,7 +325,7 @@ def test_cli_record_sigint_finishes_and_reports(rec_path, ctx, tmp_path):
     out = tmp_path / "cli.mcap"
     with running(path, ctx, rate=0, wait_subscriber=True) as (r, th):
         th.start()
-        with Proc(sensorium("record", str(out), "--connect", r.rpc_endpoint, "--topics", "/epuck",
+        with Proc(sensorium("record", str(out), "--url", r.rpc_endpoint, "--topics", "/epuck",
                             "/scout/lidar/laser_scan")) as proc:
             line = proc.line()
             assert line.startswith(f"sensorium: recording {out} from pub={r.pub_endpoint}"), (line, proc.stderr())

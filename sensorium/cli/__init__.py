@@ -128,8 +128,9 @@ def _call_args(p: argparse.ArgumentParser) -> None:
          "sensorium.cli.recording:record")
 def _record_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", help="output .mcap file")
-    p.add_argument("--connect", default="tcp://127.0.0.1:5560", metavar="URL",
+    p.add_argument("--url", metavar="URL",
                    help="the server's RPC endpoint (its topic endpoint comes from get_info; default tcp://127.0.0.1:5560)")
+    p.add_argument("--connect", metavar="URL", help=argparse.SUPPRESS)      # deprecated spelling of --url
     p.add_argument("--pub", metavar="URL", help="subscribe to this topic endpoint instead of asking the server")
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="record only these topics: exact names, path prefixes (/epuck) or globs (/epuck/ps*)")

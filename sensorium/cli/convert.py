@@ -8,12 +8,12 @@ import os
 import sys
 from pathlib import Path
 
-from sensorium.server.world.loader import WorldError, load_world
+from sensorium.server.world.loader import WorldError, bundled_or_path, load_world
 from sensorium.server.world.wbt.emit import converted_world, dump_yaml
 
 
 def convert(args: argparse.Namespace) -> int:
-    src = Path(args.world)
+    src = bundled_or_path(args.world)          # a bundled name (epuck.wbt) works from any directory
     out = None if args.out == "-" else Path(args.out)
     if src.suffix.lower() != ".wbt":
         print(f"{src}: expected a Webots world (.wbt)", file=sys.stderr)
@@ -25,6 +25,11 @@ def convert(args: argparse.Namespace) -> int:
         if out.exists() and not args.force:
             print(f"{out}: exists; not overwriting it (use --force)", file=sys.stderr)
             return 1
+    if not src.is_file():
+        from sensorium import worlds
+
+        print(f"{args.world}: no such file (nor a bundled world: {', '.join(worlds.names())})", file=sys.stderr)
+        return 1
     try:
         loaded = load_world(src)   # every check a load makes, with problems at .wbt lines
     except WorldError as exc:

@@ -43,8 +43,12 @@ def record(args: argparse.Namespace) -> int:
     if Path(args.file).exists() and not args.force:
         print(f"sensorium record: {args.file} exists already; not overwriting (--force to replace it)", file=sys.stderr)
         return 1
+    if args.connect:
+        print("sensorium record: --connect is deprecated: use --url (the server's RPC endpoint, as for every "
+              "client command)", file=sys.stderr)
+    connect = args.url or args.connect or "tcp://127.0.0.1:5560"
     ctx: zmq.Context = zmq.Context.instance()
-    rec = LiveRecorder(args.file, connect=args.connect, pub=args.pub, topics=args.topics or None, world=args.world,
+    rec = LiveRecorder(args.file, connect=connect, pub=args.pub, topics=args.topics or None, world=args.world,
                        chunk_size=args.chunk_size, rcvhwm=args.rcvhwm, context=ctx)
     try:
         rec.open()

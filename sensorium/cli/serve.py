@@ -61,6 +61,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--curve-keys", metavar="DIR",
                    help="encrypt both sockets with CURVE using DIR/server.key_secret (create it with "
                    "'sensorium keys DIR'); clients need the public key: SENSORIUM_CURVE_SERVERKEY or URL?serverkey=")
+    p.add_argument("--watch", nargs="*", metavar="ROBOT",
+                   help="run these robots (default: every one) whose controller is \"<extern>\" as \"<none>\": "
+                   "nobody controls them and the world steps by itself, so a viewer (--foxglove) or a subscriber "
+                   "sees their sensors without starting controllers")
     add_world_options(p)
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
@@ -98,7 +102,8 @@ def options(args: argparse.Namespace):
                         allow_large=getattr(args, "allow_large", False),
                         allow_outside_meshes=getattr(args, "allow_outside_meshes", False),
                         contact=False if getattr(args, "no_contact", False) else None,
-                        controls=getattr(args, "controls", "auto"), curve_keys=getattr(args, "curve_keys", None))
+                        controls=getattr(args, "controls", "auto"), curve_keys=getattr(args, "curve_keys", None),
+                        watch=getattr(args, "watch", None))
 
 
 def bind_problem(exc: BaseException) -> str:

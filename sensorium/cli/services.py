@@ -44,7 +44,8 @@ def services(args: argparse.Namespace) -> int:
             group = here
             print(f"{here}:")
         arg_text = ", ".join(f"{k}: {v}" for k, v in s.get("args", {}).items())
-        mark = "  [attached controller only]" if s.get("attached") else ""
+        mark = ("  [supervisor controller only: robot with supervisor: true]" if s.get("supervisor") else
+                "  [attached controller only]" if s.get("attached") else "")
         print(f"  {s['name']}  {{{arg_text}}}{mark}")
     return 0
 
@@ -63,7 +64,10 @@ def parse_args_text(text: str | None) -> dict[str, Any]:
         try:
             value = yaml.safe_load(text)
         except yaml.YAMLError as yexc:
-            raise ValueError(f"ARGS is neither JSON nor YAML: {str(yexc).splitlines()[0]}") from None
+            mark = getattr(yexc, "problem_mark", None)
+            problem = getattr(yexc, "problem", None) or str(yexc).splitlines()[0]
+            where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+            raise ValueError(f"ARGS {text!r} is neither JSON nor YAML{where}: {problem}") from None
     if not isinstance(value, dict):
         raise ValueError(f"ARGS must be a mapping such as '{{\"mode\": \"fast\"}}', got {text!r}")
     return value

@@ -1,8 +1,12 @@
 """``sensorium topics``, ``echo`` and ``hz``: look at a running server's topics (pyzmq + msgpack only).
 
-``echo`` and ``hz`` first ask the server (its RPC endpoint, ``get_info``) which topics exist: a
-name that is not one of them fails at once with the closest names; a server that does not answer
-makes them give up after ``--timeout`` (default 10 s) with a message instead of waiting forever.
+``echo`` and ``hz`` first ask the server (its RPC endpoint ``--url``, ``get_info``) which topics
+exist: a name that is not one of them fails at once with the closest names; a server that does not
+answer makes them give up after ``--timeout`` (default 5 s, as every client command) with a message
+instead of waiting forever. One flag, one meaning across commands: ``--url`` is the server's RPC
+endpoint (topics, services, call, controller, echo, hz, record), ``--pub`` a topic endpoint. The
+old spellings still work with a deprecation line: ``--rpc`` of echo/hz, and ``--url`` of echo/hz
+given a topic endpoint (no server answers there: it is taken as ``--pub``).
 """
 
 from __future__ import annotations
@@ -25,13 +29,15 @@ from sensorium.client.connection import (
     parse_controller_url,
 )
 
-DEFAULT_WAIT_S = 10.0          # no server answered: give up after this long without a message
+DEFAULT_WAIT_S = 5.0           # no server answered: give up after this long without a message (as topics/call)
 NOTE_AFTER_S = 3.0             # the server answered but nothing came: say why after this long
 
 
 def add_endpoint_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--url", help=f"topic endpoint (default: the server's, else {DEFAULT_PUB_ENDPOINT})")
-    p.add_argument("--rpc", help=f"the server's RPC endpoint, asked for its topics (default {DEFAULT_RPC_ENDPOINT})")
+    p.add_argument("--url", help=f"the server's RPC endpoint, asked for its topics (default {DEFAULT_RPC_ENDPOINT})")
+    p.add_argument("--pub", metavar="URL",
+                   help=f"topic endpoint to subscribe to (default: the server's, else {DEFAULT_PUB_ENDPOINT})")
+    p.add_argument("--rpc", help=argparse.SUPPRESS)            # deprecated spelling of --url
     p.add_argument("--timeout", type=float, metavar="S",
                    help=f"exit 1 if no message arrives for S seconds (default: {DEFAULT_WAIT_S:g} s when no server "
                         "answers, else wait)")
@@ -103,23 +109,34 @@ def why_silent(view: ServerView) -> str:
 
 def no_message(cmd: str, what: str, url: str, waited: float, view: ServerView) -> str:
     if view.info is None and not view.rpc:
-        return (f"sensorium {cmd}: nothing on {what} from {url} for {waited:g} s (give --rpc to ask the server "
+        return (f"sensorium {cmd}: nothing on {what} from {url} for {waited:g} s (give --url to ask the server "
                 "why, or check that a server or replay publishes there)")
     if view.info is None:
         return (f"sensorium {cmd}: nothing on {what} from {url} for {waited:g} s, and no server answers at "
-                f"{view.rpc}: is `sensorium serve` running? (--url and --rpc point elsewhere)")
+                f"{view.rpc}: is `sensorium serve` running? (--url and --pub point elsewhere)")
     return f"sensorium {cmd}: nothing on {what} from {url} for {waited:g} s: {why_silent(view)}"
 
 
 def _setup(cmd: str, names: list[str], args: argparse.Namespace) -> tuple[ServerView, str] | int:
     """Ask the server, check the names; returns (view, topic endpoint) or an exit code."""
-    view = ask_server(args.rpc) if (args.rpc or not args.url) else ServerView(args.rpc or "")
+    rpc = args.url
+    if args.rpc:
+        print(f"sensorium {cmd}: --rpc is deprecated: use --url (the server's RPC endpoint, as for topics, "
+              "services and call)", file=sys.stderr)
+        rpc = rpc or args.rpc
+    pub = args.pub
+    view = ask_server(rpc) if (rpc or not pub) else ServerView("")
+    if view.info is None and args.url and not pub and not args.rpc:
+        # the old meaning of echo/hz --url: a topic endpoint (nothing answers RPCs there)
+        print(f"sensorium {cmd}: no server answers at --url {args.url}; taking it as the topic endpoint, which "
+              f"--url named for echo and hz before (deprecated: use --pub {args.url})", file=sys.stderr)
+        pub, view = args.url, ServerView("")
     for name in names:
         complaint = unknown_topic(name, view)
         if complaint:
             print(f"sensorium {cmd}: {complaint}", file=sys.stderr)
             return 1
-    return view, args.url or view.pub or DEFAULT_PUB_ENDPOINT
+    return view, pub or view.pub or DEFAULT_PUB_ENDPOINT
 
 
 # ---------------------------------------------------------------------- topics

@@ -11,11 +11,14 @@ __all__ = ["layout_cmd"]
 
 
 def layout_cmd(args: argparse.Namespace) -> int:
-    from sensorium.server.world.loader import WorldError, default_world_path
+    from sensorium.server.world.loader import WorldError, bundled_or_path, default_world_path
 
-    source = Path(args.source) if args.source else default_world_path()
+    source = bundled_or_path(args.source) if args.source else default_world_path()
     if not source.is_file():
-        print(f"sensorium layout: {source}: no such file", file=sys.stderr)
+        from sensorium import worlds
+
+        print(f"sensorium layout: {source}: no such file (nor a bundled world: {', '.join(worlds.names())})",
+              file=sys.stderr)
         return 1
     out = Path(args.out) if args.out else None
     if out is not None and out.exists() and not args.force:

@@ -287,6 +287,15 @@ class Connection:
         # (a first byte of 0 is reserved by libzmq)
         self._socket.setsockopt(zmq.ROUTING_ID, b"S" + secrets.token_bytes(15))
         curve_client(self._socket, self._serverkey)
+        # handshake events only (tcp): a timeout can then say "the key is missing or wrong" instead
+        # of "is the server running?"; dropped after the first successful handshake
+        self._monitor: zmq.Socket | None = None
+        if self.endpoint.startswith("tcp://"):
+            self._monitor = self._socket.get_monitor_socket(
+                zmq.EVENT_HANDSHAKE_SUCCEEDED | zmq.EVENT_HANDSHAKE_FAILED_PROTOCOL
+                | zmq.EVENT_HANDSHAKE_FAILED_NO_DETAIL | zmq.EVENT_HANDSHAKE_FAILED_AUTH,
+                addr=f"inproc://sensorium-handshake-{secrets.token_hex(8)}")
+        self._handshake_failed = 0                   # the last failed handshake's event (0: none)
         self._socket.connect(self.endpoint)
         self._poller = zmq.Poller()                  # kept for callers that poll the socket themselves
         self._poller.register(self._socket, zmq.POLLIN)
@@ -341,9 +350,10 @@ class Connection:
                 if left <= 0:
                     service = self._outstanding.pop(rid, "?")
                     self._retry.pop(rid, None)
+                    problem = self.handshake_problem()
                     raise ServiceTimeout(
                         f"no reply to {service!r} from {self.endpoint} within {timeout:g} s "
-                        f"(is `sensorium serve` running there?)")
+                        + (f"({problem})" if problem else "(is `sensorium serve` running there?)"))
                 if left < 0.25:
                     slice_ms = max(1, int(left * 1000) + 1)
             # one blocking receive (RCVTIMEO = the slice) instead of poll + non-blocking drain
@@ -361,6 +371,8 @@ class Connection:
                     frames.append(frame.bytes)
             except zmq.Again:
                 self._resend_due(rid)
+                if self._monitor is not None:
+                    self._watch_handshakes()
                 if self.heartbeat is not None:
                     problem = self.heartbeat.problem()
                     if problem is not None:
@@ -375,6 +387,43 @@ class Connection:
             if got in self._outstanding:
                 self._replies[got] = reply
             # else: the reply to a request we gave up on (timeout, discard): drop it
+
+    def _watch_handshakes(self) -> None:
+        """Read the monitor's events (non-blocking); stop monitoring once a handshake succeeded."""
+        mon = self._monitor
+        while mon is not None and mon.poll(0):
+            frames = mon.recv_multipart()
+            event = int.from_bytes(frames[0][:2], "little")
+            if event == zmq.EVENT_HANDSHAKE_SUCCEEDED:
+                self._handshake_failed = 0
+                self._stop_monitor()
+                return
+            self._handshake_failed = event
+
+    def _stop_monitor(self) -> None:
+        if self._monitor is not None:
+            try:
+                self._socket.disable_monitor()
+            except zmq.ZMQError:
+                pass
+            self._monitor.close(linger=0)
+            self._monitor = None
+
+    def handshake_problem(self) -> str | None:
+        """Why the server would not talk to this client, if its security handshake failed."""
+        self._watch_handshakes()
+        failed = self._handshake_failed
+        if not failed:
+            return None
+        if self._serverkey is None:
+            return ("the server refused the connection's handshake: it uses CURVE encryption and this client has "
+                    f"no key; set {ENV_CURVE_SERVERKEY} to the key `sensorium serve --curve-keys` prints, or add "
+                    "?serverkey=KEY to the URL")
+        if failed == zmq.EVENT_HANDSHAKE_FAILED_PROTOCOL:
+            return (f"the handshake failed: this client uses CURVE ({ENV_CURVE_SERVERKEY} or ?serverkey=) but the "
+                    "server does not (started without --curve-keys?)")
+        return (f"the server did not accept the CURVE handshake: the server key ({ENV_CURVE_SERVERKEY} or "
+                "?serverkey=) is wrong for this server")
 
     def call(self, service: str, args: dict | None = None, timeout: Any = _NO_TIMEOUT) -> dict:
         """``send`` then ``wait``."""
@@ -448,6 +497,7 @@ class Connection:
             return
         self.stop_heartbeat()
         self.closed = True
+        self._stop_monitor()
         self._socket.close(linger=0)
 
     def __enter__(self) -> Connection:

@@ -51,6 +51,7 @@ class DemoResult:
     distance_m: dict[str, float] = field(default_factory=dict)
     cells_visited: dict[str, int] = field(default_factory=dict)       # distinct 0.5 m grid cells
     smoothness: dict[str, float] = field(default_factory=dict)        # 1 s-resampled length / driven length
+    longest_stuck_s: dict[str, float] = field(default_factory=dict)   # longest stretch without progress (summary.py)
     light_start: float = math.nan          # e-puck ls0 + ls1 at the first and last reading
     light_end: float = math.nan
     lamp_distance_start: float = math.nan  # e-puck distance to the point light (m)
@@ -73,6 +74,7 @@ class DemoResult:
             "real_time_factor": round(self.real_time_factor, 2), "recording": str(self.recording),
             "picture": str(self.picture) if self.picture else None, "messages": self.messages,
             "distance_m": self.distance_m, "cells_visited": self.cells_visited, "smoothness": self.smoothness,
+            "longest_stuck_s": self.longest_stuck_s,
             "light_start": clean(self.light_start), "light_end": clean(self.light_end),
             "lamp_distance_start": clean(self.lamp_distance_start), "lamp_distance_end": clean(self.lamp_distance_end),
             "lamp_distance_min": clean(self.lamp_distance_min), "lamp_reached_s": clean(self.lamp_reached_s),

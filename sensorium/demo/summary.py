@@ -4,6 +4,9 @@
 * ``cells_visited``: distinct 0.5 m x 0.5 m floor cells the robot's centre entered (exploration);
 * ``smoothness``: the length of the path sampled once per simulated second divided by the driven
   length: 1 for a robot that drives where it goes, near 0 for one that jitters on the spot;
+* ``longest_stuck_s``: the longest stretch in which every 10 s window (:data:`STUCK_WINDOW_S`) kept
+  the robot within :data:`STUCK_RADIUS_M` of where the window began (turning on the spot or
+  bumping back and forth in a corner counts as stuck); 0 when every 10 s window made progress;
 * the follower's distance to the lamp: at start, at the end, its minimum, when it first came
   within :data:`LAMP_NEAR_M`, and the farthest it went after that.
 """
@@ -19,6 +22,8 @@ from sensorium.demo.runner import DemoResult
 CELL_M = 0.5
 LAMP_NEAR_M = 0.6               # the follower's light sensors saturate ~0.45 m from the arena's lamp
 FOLLOWER = "epuck"
+STUCK_WINDOW_S = 10.0
+STUCK_RADIUS_M = 0.3
 
 
 def path_length(xy: np.ndarray) -> float:
@@ -36,6 +41,32 @@ def smoothness(t_ns: np.ndarray, xy: np.ndarray, every_ns: int = 1_000_000_000) 
     picks = np.searchsorted(t_ns, np.arange(t_ns[0], t_ns[-1] + 1, every_ns))
     picks = np.unique(np.append(picks[picks < len(t_ns)], len(t_ns) - 1))
     return min(1.0, path_length(xy[picks]) / driven)
+
+
+def stuck_spans(t_ns: np.ndarray, xy: np.ndarray, window_s: float = STUCK_WINDOW_S,
+                radius_m: float = STUCK_RADIUS_M) -> list[tuple[float, float]]:
+    """The (start s, end s) spans, merged, of every ``window_s`` window in which the robot never got
+    farther than ``radius_m`` from its position at the window's start."""
+    if len(t_ns) < 2:
+        return []
+    window = int(window_s * 1e9)
+    ends = np.searchsorted(t_ns, t_ns + window, side="right")          # first sample after each window
+    spans: list[tuple[float, float]] = []
+    for i in range(len(t_ns)):
+        j = int(ends[i])
+        if j >= len(t_ns) + 1 or t_ns[-1] < t_ns[i] + window:
+            break                                                       # the last windows are not whole
+        if float(np.max(np.linalg.norm(xy[i:j] - xy[i], axis=1))) <= radius_m:
+            start, end = t_ns[i] / 1e9, t_ns[j - 1] / 1e9
+            if spans and start <= spans[-1][1]:
+                spans[-1] = (spans[-1][0], end)
+            else:
+                spans.append((start, end))
+    return spans
+
+
+def longest_stuck_s(t_ns: np.ndarray, xy: np.ndarray) -> float:
+    return max((b - a for a, b in stuck_spans(t_ns, xy)), default=0.0)
 
 
 def summarise(result: DemoResult, world) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -63,6 +94,7 @@ def summarise(result: DemoResult, world) -> dict[str, tuple[np.ndarray, np.ndarr
         result.distance_m[robot] = round(path_length(xy), 3)
         result.cells_visited[robot] = cells_visited(xy)
         result.smoothness[robot] = round(smoothness(t, xy), 3)
+        result.longest_stuck_s[robot] = round(longest_stuck_s(t, xy), 3)
     if light:
         result.light_start, result.light_end = light[0], light[-1]
     lamp = next((lt for lt in world.lights if lt.type == "PointLight" and lt.on), None)
@@ -85,7 +117,9 @@ def describe(result: DemoResult) -> list[str]:
            f"(real-time factor {result.real_time_factor:.1f})"]
     for robot, d in result.distance_m.items():
         out.append(f"  {robot:<6} drove {d:.2f} m through {result.cells_visited.get(robot, 0)} of the floor's "
-                   f"{CELL_M:g} m cells (smoothness {result.smoothness.get(robot, math.nan):.2f})")
+                   f"{CELL_M:g} m cells (smoothness {result.smoothness.get(robot, math.nan):.2f}"
+                   + (f"; no progress for {stuck:.1f} s" if (stuck := result.longest_stuck_s.get(robot, 0.0)) > 0
+                      else "") + ")")
     if not math.isnan(result.lamp_distance_start):
         reached = (f"within {LAMP_NEAR_M:g} m of it at t={result.lamp_reached_s:.1f} s and stayed within "
                    f"{result.lamp_distance_max_after_reached:.2f} m"

@@ -439,6 +439,7 @@ class ServiceRef(Result):
     device: str | None = None
     device_type: str | None = None
     attached: bool = Field(description="only the robot's attached controller may call it")
+    supervisor: bool = Field(default=False, description="... and only if the robot has supervisor: true (Supervisor API)")
     args: dict[str, str] = Field(description="argument name -> type; a trailing '?' marks an optional one")
 
 

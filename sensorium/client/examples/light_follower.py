@@ -16,6 +16,7 @@ printed with the readings and each change of state.
 """
 
 import math
+import os
 import sys
 
 from controller import Robot
@@ -37,7 +38,12 @@ WHEEL_RADIUS, AXLE = 0.0205, 0.052
 
 robot = Robot()
 timestep = int(robot.getBasicTimeStep())
-max_steps = int(sys.argv[1]) if len(sys.argv) > 1 else None
+args = [a for a in sys.argv[1:] if a not in ("-v", "--verbose")]
+max_steps = int(args[0]) if args else None
+# a line per control step is ~350 lines/s in fast mode: by default one per simulated second (and
+# every change of state); -v (or SENSORIUM_VERBOSE=1) prints every step
+VERBOSE = len(args) < len(sys.argv) - 1 or os.environ.get("SENSORIUM_VERBOSE") == "1"
+next_report = 0.0
 
 eyes = [robot.getDevice(name) for name in ("ls0", "ls1")]
 proximity = [robot.getDevice(f"ps{i}") for i in range(8)]
@@ -150,8 +156,10 @@ while robot.step(timestep) != -1:
     if follower.state != state:
         state = follower.state
         print(f"t={robot.getTime():7.3f}  -> {state}", flush=True)
-    print(f"t={robot.getTime():7.3f}  ls0={light[0]:8.2f} ls1={light[1]:8.2f}  "
-          f"ps=[{' '.join(f'{v:6.1f}' for v in ir)}]  wheels {left:+5.2f} {right:+5.2f} rad/s", flush=True)
+    if VERBOSE or robot.getTime() >= next_report:
+        next_report = robot.getTime() + 1.0
+        print(f"t={robot.getTime():7.3f}  ls0={light[0]:8.2f} ls1={light[1]:8.2f}  "
+              f"ps=[{' '.join(f'{v:6.1f}' for v in ir)}]  wheels {left:+5.2f} {right:+5.2f} rad/s", flush=True)
     if left_motor is not None and right_motor is not None:
         left_motor.setVelocity(left)
         right_motor.setVelocity(right)

@@ -8,6 +8,7 @@ builds one): the daemon never imports the recording package.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -17,7 +18,7 @@ from sensorium.server.daemon.services import Core
 from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport, load_curve_keys
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.limits import WorldLimits
-from sensorium.server.world.loader import default_world_path
+from sensorium.server.world.loader import LoadedWorld, Problem, WorldError, default_world_path, load_world
 
 __all__ = ["ServeOptions", "Server", "build"]
 
@@ -37,6 +38,7 @@ class ServeOptions:
     allow_outside_meshes: bool = False  # mesh urls may leave the world's folder
     controls: str = "auto"            # world-wide controls: auto | open | supervisor (daemon/roles.py)
     curve_keys: str | None = None     # DIR with server.key_secret: CURVE on both sockets
+    watch: list[str] | None = None    # run these "<extern>" robots ([] = every one) as "<none>" (serve --watch)
 
     def check(self) -> None:
         """Raise ValueError naming the first bad option."""
@@ -56,12 +58,28 @@ def build(world: str | Path | None, options: ServeOptions | None = None) -> tupl
     opts.check()
     secret = load_curve_keys(opts.curve_keys)[1] if opts.curve_keys else None
     path = Path(world) if world else default_world_path()
-    sim = Simulation.from_file(path, precision=opts.precision,
-                               limits=WorldLimits.large() if opts.allow_large else WorldLimits(),
-                               allow_outside_meshes=opts.allow_outside_meshes, contact=opts.contact)
+    loaded = load_world(path, limits=WorldLimits.large() if opts.allow_large else WorldLimits(),
+                        allow_outside_meshes=opts.allow_outside_meshes)
+    if opts.watch is not None:
+        loaded = watched(loaded, opts.watch)
+    sim = Simulation(loaded, opts.precision, contact=opts.contact)
     core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode,
                 open_controls=open_controls(opts.controls, opts.rpc))
     return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until, curve_secret=secret)
+
+
+def watched(loaded: LoadedWorld, robots: list[str]) -> LoadedWorld:
+    """``serve --watch``: the named ``"<extern>"`` robots (every one when ``robots`` is empty) as
+    ``"<none>"``, so the world steps by itself and a viewer sees their sensors with no controller.
+    Raises ``WorldError`` naming a robot the world does not have."""
+    names = [r.name for r in loaded.world.robots]
+    unknown = [r for r in robots if r not in names]
+    if unknown:
+        raise WorldError(loaded.source, [Problem("", f"--watch: no robot {unknown[0]!r} (robots: {', '.join(names)})")])
+    pick = set(robots) or set(names)
+    new = [r.model_copy(update={"controller": "<none>"}) if r.name in pick and r.controller == "<extern>" else r
+           for r in loaded.world.robots]
+    return dataclasses.replace(loaded, world=loaded.world.model_copy(update={"robots": new}))
 
 
 class Server:

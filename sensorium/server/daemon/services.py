@@ -432,7 +432,8 @@ class Core(DeviceServices):
             device = route.device.split("/", 1)[1] if route.device else route.motor
             out.append({"name": name, "scope": route.spec.scope, "robot": route.robot, "device": device,
                         "device_type": kinds[route.robot][device] if device else None,
-                        "attached": route.spec.attached, "args": S.arg_types(route.spec.args)})
+                        "attached": route.spec.attached, "supervisor": route.spec.supervisor,
+                        "args": S.arg_types(route.spec.args)})
         return {"services": out}
 
     # ------------------------------------------------------------------ robot services

@@ -3,9 +3,21 @@
 Two outputs, both MCAP storage with ``profile = "ros2"`` and ``ros2msg`` schemas:
 
 * a **rosbag2 directory** (``metadata.yaml`` + ``<name>.mcap``), written with ``rosbags``
-  (QoS-less connections, RIHS01 type hashes; metadata version 9 for Jazzy, 8 for Humble);
+  (RIHS01 type hashes; metadata version 9 for Jazzy, 8 for Humble);
 * a **single ``.mcap`` file**, written with ``mcap-ros2-support`` (what Foxglove opens by drag and
   drop; ``ros2 bag play`` accepts it too).
+
+Every topic carries the QoS profile a live driver would offer (:func:`offered_qos`), so that
+``ros2 bag play`` offers it again: ``/tf_static`` and the latched ``/scene`` reliable and
+transient-local (tf2's and RViz's late-joining subscriptions get them), sensors the sensor-data
+profile (best effort, keep last 5), ``/clock`` rclcpp's clock profile, ``/tf`` tf2's broadcaster
+profile, anything else rclcpp's default. How rosbag2 writes them differs per metadata version
+(read in rosbag2's ``rosbag2_storage/yaml.hpp`` and ``qos.cpp``): up to version 8 (Humble's reader,
+and a single ``.mcap`` file without rosbag2's metadata record) ``offered_qos_profiles`` is one YAML
+*string* whose policies are integers (``reliability: 1``); from version 9 (Jazzy) it is a YAML
+*list* whose policies are names (``reliability: reliable``); the MCAP channel metadata carries the
+same profiles as a string in the version's encoding. Durations are rmw's "infinite"
+(``{sec: 9223372036, nsec: 854775807}``), as rosbag2 records them from a live publisher.
 
 Bodies are msgpack maps with ROS field names; typed arrays are little-endian ``bin``
 (``float32[]`` → ``<f4``, ``uint8[]`` → bytes) and a PointCloud's ``points`` is one ``<f4``
@@ -48,6 +60,55 @@ _INTS = {"byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", 
 
 class ExportError(Exception):
     pass
+
+
+# --------------------------------------------------------------------------------------------
+# QoS: what a live driver offers on each topic
+
+SENSOR_TYPES = frozenset({"sensor_msgs/msg/Illuminance", "sensor_msgs/msg/Range", "sensor_msgs/msg/LaserScan",
+                          "sensor_msgs/msg/PointCloud", POINT_CLOUD2, "sensor_msgs/msg/Image"})
+LATCHED_TOPICS = frozenset({"/tf_static", "/scene"})
+INFINITE = (9223372036, 854775807)       # RMW_DURATION_INFINITE as rmw reports it (sec, nsec)
+
+
+@dataclass(frozen=True)
+class QosProfile:
+    """One offered profile, in rosbag2's terms (``history``/``reliability``/``durability`` names)."""
+
+    reliability: str                     # reliable | best_effort
+    durability: str                      # transient_local | volatile
+    depth: int
+    history: str = "keep_last"
+
+
+def offered_qos(topic: str, typename: str) -> QosProfile:
+    """The profile a ROS 2 driver offers on ``topic`` (of ``typename``)."""
+    if topic in LATCHED_TOPICS:                       # tf2 StaticTransformBroadcaster, latched markers
+        return QosProfile("reliable", "transient_local", 1)
+    if topic == "/tf":                                # tf2 TransformBroadcaster
+        return QosProfile("reliable", "volatile", 100)
+    if typename == "rosgraph_msgs/msg/Clock":         # rclcpp::ClockQoS
+        return QosProfile("best_effort", "volatile", 1)
+    if typename in SENSOR_TYPES:                      # rclcpp::SensorDataQoS
+        return QosProfile("best_effort", "volatile", 5)
+    return QosProfile("reliable", "volatile", 10)     # rclcpp::QoS(10), the default
+
+
+def rosbags_qos(profile: QosProfile) -> Any:
+    """The profile as a ``rosbags.interfaces.Qos`` (for rosbags' writer)."""
+    from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
+
+    forever = QosTime(*INFINITE)
+    return Qos(QosHistory[profile.history.upper()], profile.depth, QosReliability[profile.reliability.upper()],
+               QosDurability[profile.durability.upper()], forever, forever, QosLiveliness.AUTOMATIC, forever, False)
+
+
+def qos_yaml_v8(profile: QosProfile) -> str:
+    """The profile as rosbag2 up to metadata version 8 serialises it: a YAML list, policies as
+    rmw's integers, in one string (the ``offered_qos_profiles`` value and MCAP channel metadata)."""
+    from rosbags.rosbag2.metadata import dump_qos_v8
+
+    return dump_qos_v8([rosbags_qos(profile)])
 
 
 def typestore_for(distro: str):
@@ -366,7 +427,9 @@ def _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, met
                                                        views):
             conn = conns.get(m.topic)
             if conn is None:
-                conn = conns[m.topic] = writer.add_connection(m.topic, typename, typestore=typestore)
+                conn = conns[m.topic] = writer.add_connection(
+                    m.topic, typename, typestore=typestore,
+                    offered_qos_profiles=[rosbags_qos(offered_qos(m.topic, typename))])
             data = typestore.serialize_cdr(to_rosbags(typestore, typename, msg), typename)
             writer.write(conn, m.stamp_ns, data)
             if added:
@@ -387,12 +450,19 @@ def _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world,
         writer = Ros2Writer(f)
         try:
             schemas: dict[str, Any] = {}
+            channels: dict[str, int] = {}
             for m, typename, msg, added in _iter_converted(rec, typestore, topics, pointcloud2, report, start_ns,
                                                            end_ns, views):
                 schema = schemas.get(typename)
                 if schema is None:
                     text = typestore.generate_msgdef(typename, ros_version=2)[0]
                     schema = schemas[typename] = writer.register_msgdef(typename, text)
+                if m.topic not in channels:
+                    # registered here (not by write_message) to carry the QoS rosbag2's MCAP plugin reads;
+                    # without rosbag2's metadata record it reads them as metadata version 8
+                    channels[m.topic] = writer._channel_ids[m.topic] = writer._writer.register_channel(
+                        topic=m.topic, message_encoding="cdr", schema_id=schema.id,
+                        metadata={"offered_qos_profiles": qos_yaml_v8(offered_qos(m.topic, typename))})
                 writer.write_message(topic=m.topic, schema=schema, message=_to_mcap_ros2(typestore, typename, msg),
                                      log_time=m.stamp_ns, publish_time=m.stamp_ns, sequence=m.seq % (1 << 32))
                 if added:

@@ -243,7 +243,7 @@ class Replayer:
 
     def info(self) -> dict:
         world = self.meta.get("world") or self.meta.get("world_file") or ""
-        services = ["get_info", "ping", "/replay/get_state", "/replay/quit"]
+        services = ["get_info", "get_services", "ping", "/replay/get_state", "/replay/quit"]
         services += (["/replay/step", "/replay/seek"] if self.lockstep
                      else ["/replay/pause", "/replay/resume", "/replay/set_rate"])
         topics = [{"name": k, "type": v} for k, v in sorted(self.topic_types.items())]
@@ -262,9 +262,20 @@ class Replayer:
 
         return __version__
 
+    # arguments of each service, as ``get_services`` lists them (``sensorium services`` prints them)
+    SERVICE_ARGS = {"/replay/set_rate": {"value": "float"}, "/replay/step": {"duration?": "int"},
+                    "/replay/seek": {"time_ms": "int"}}
+
+    def services(self) -> dict:
+        return {"services": [{"name": n, "scope": "server", "robot": None, "device": None, "device_type": None,
+                              "attached": False, "args": self.SERVICE_ARGS.get(n, {})}
+                             for n in self.info()["services"]]}
+
     def _dispatch(self, service: str, args: dict) -> dict:
         if service == "get_info":
             return self.info()
+        if service == "get_services":
+            return self.services()
         if service == "ping":
             return {"time_ms": self.time_ns // 1_000_000}
         if service == "/replay/get_state":

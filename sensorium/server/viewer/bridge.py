@@ -16,6 +16,16 @@ subscriber (``Topics.set_viewer_demand``); ``/tf`` demands every ``/<robot>/pose
 unsubscription (or a disconnect) stops the work. The SDK calls the listener from its own thread;
 the events are applied by the step-loop thread in :meth:`FoxgloveBridge.pump` (a transport hook).
 
+Listening: the SDK's server listens on an ephemeral 127.0.0.1 port behind
+:class:`~sensorium.server.viewer.front.SubprotocolFront`, which owns the viewer-facing address and
+accepts both subprotocol names clients offer (``foxglove.sdk.v1`` and ``foxglove.websocket.v1``).
+
+Telling a viewer why it sees nothing: while the world waits for a controller (no synchronous
+controller attached), every viewer gets a Foxglove status message (warning) naming the robots and
+how to start a controller (or ``serve --watch``); it is removed once the world steps. The SDK's
+own log lines (a viewer that vanished makes it log one per message it could not send) are kept
+to one line per viewer connection plus a count (:class:`_SdkLog`).
+
 Never slowing the step loop: :meth:`record` (called by ``Topics`` in the step thread) only appends
 the msgpack bytes to a bounded queue (the oldest is dropped when full, ``dropped`` counts it); a
 worker thread encodes CDR/protobuf and hands the bytes to the SDK, whose per-client backlog drops
@@ -25,7 +35,11 @@ supervisor moves a solid, the scene is sent again to every ``/scene`` subscriber
 
 from __future__ import annotations
 
+import logging
+import re
+import sys
 import threading
+import time
 from collections import Counter, deque
 from collections.abc import Callable, Iterable
 from pathlib import Path
@@ -86,6 +100,110 @@ def exposure_warning(host: str) -> str | None:
             "(an SSH tunnel to 127.0.0.1 is the safe way: see README, See it in Foxglove)")
 
 
+WAITING_STATUS_ID = "sensorium-waiting"
+STATUS_REPEAT_S = 2.0          # a waiting status is sent again this often (viewers that connected since)
+STATUS_CHECK_S = 0.25          # the step loop looks at what the world waits for at most this often
+
+
+QUEUE_BUDGET_BYTES = 32 << 20     # the bridge's own queue (msgpack bodies waiting for the worker)
+VIEWER_BUDGET_BYTES = 8 << 20     # each viewer's queue in the SDK (its backlog, counted in messages)
+TRIM_EVERY_S = 1.0            # after viewers left, freed memory is returned at most this often
+
+
+def _fit(budget: int, largest: int, low: int, high: int) -> int:
+    """How many messages of ``largest`` bytes fit ``budget`` (within [low, high])."""
+    return high if largest <= 0 else max(low, min(high, budget // largest))
+
+
+def largest_message(world: wm.World | None) -> int:
+    """An upper estimate of the largest message a world publishes: a lidar's PointCloud2 (16 bytes
+    per point, x y z layer) or range image (4 per pixel)."""
+    best = 0
+    for robot in (world.robots if world is not None else []):
+        for dev in robot.devices:
+            cols, layers = getattr(dev, "horizontal_resolution", None), getattr(dev, "number_of_layers", None)
+            if isinstance(cols, int) and isinstance(layers, int):
+                best = max(best, 16 * cols * layers + 512)
+    return best
+
+
+def _malloc_trim() -> Callable[[int], int] | None:
+    """glibc's ``malloc_trim`` (None elsewhere)."""
+    try:
+        import ctypes
+
+        return cast(Callable[[int], int], ctypes.CDLL("libc.so.6").malloc_trim)
+    except (OSError, AttributeError):
+        return None
+
+
+class _SdkLog(logging.Handler):
+    """foxglove-sdk's log records (Python logger ``foxglove``): at most one line per viewer address
+    (``client HOST:PORT`` in the message), other lines identical to an earlier one at the 1st, 10th,
+    100th … time. A viewer that vanished made the SDK log one line per message it could not send
+    (~48,000 lines for 200 viewers); now it is one. ``suppressed`` counts the rest."""
+
+    ADDRESS = re.compile(r"client (\[?[0-9A-Fa-f:.]+\]?:\d+)")
+    MAX_KEYS = 4096
+
+    def __init__(self, stream: Any = None):
+        super().__init__(logging.WARNING)
+        self.stream = stream
+        self.suppressed = 0
+        self._seen: dict[str, int] = {}
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            text = record.getMessage()
+        except Exception:  # noqa: BLE001
+            return
+        m = self.ADDRESS.search(text)
+        key = m.group(1) if m else text
+        n = self._seen.get(key, 0) + 1
+        if len(self._seen) >= self.MAX_KEYS and key not in self._seen:
+            self._seen.clear()                       # bounded: old viewers are forgotten
+        self._seen[key] = n
+        if (m and n > 1) or (not m and n not in (1, 10, 100, 1000, 10000, 100000)):
+            self.suppressed += 1
+            return
+        extra = f" (seen {n} times)" if n > 1 else ""
+        stream = self.stream or sys.stderr
+        try:
+            print(f"sensorium: Foxglove: {text}{extra}", file=stream, flush=True)
+        except (OSError, ValueError):
+            pass
+
+
+_SDK_LOG: _SdkLog | None = None
+
+
+def sdk_log() -> _SdkLog:
+    """The one handler on the ``foxglove`` logger (installed once per process; not propagated)."""
+    global _SDK_LOG
+    if _SDK_LOG is None:
+        _SDK_LOG = _SdkLog()
+        logger = logging.getLogger("foxglove")
+        logger.addHandler(_SDK_LOG)
+        logger.propagate = False
+    return _SDK_LOG
+
+
+def waiting_message(core: Any) -> str | None:
+    """What a viewer of ``core``'s world should be told while the world waits for a controller."""
+    ls = core.lockstep
+    if ls.synchronous_attached:
+        return None
+    robots = ls.waiting_for()
+    if not robots:
+        return None
+    names = " or ".join(repr(r) for r in robots)
+    return (f"The world is not stepping: it waits for a controller to attach to robot {names} (controller "
+            f"\"<extern>\"). Start one, e.g. `sensorium controller my_controller.py --robot {robots[0]}` "
+            f"(bundled: example:light_follower, example:wanderer, example:braitenberg), or restart with "
+            f"`sensorium serve WORLD --watch --foxglove PORT` to run these robots as \"<none>\" and watch "
+            f"their sensors without controllers.")
+
+
 class _Listener:
     """The SDK's ``ServerListener``: counts subscriptions per topic (SDK thread)."""
 
@@ -108,12 +226,13 @@ class FoxgloveBridge:
     def __init__(self, topic_types: dict[str, str], world: wm.World | None = None, base_dir: str | Path = ".", *,
                  host: str = "127.0.0.1", port: int = DEFAULT_PORT, name: str = "sensorium",
                  on_demand: Callable[[set[str]], None] | None = None, wake: Callable[[], None] | None = None,
-                 solid_poses: Callable[[], dict[str, Any]] | None = None, queue_size: int = 512,
-                 backlog: int = 256, distro: str = "jazzy"):
+                 solid_poses: Callable[[], dict[str, Any]] | None = None, queue_size: int | None = None,
+                 backlog: int | None = None, distro: str = "jazzy", status: Callable[[], str | None] | None = None,
+                 largest_message: int = 0):
         try:
             import foxglove
             from foxglove.messages import FrameTransforms, SceneUpdate
-            from foxglove.websocket import Capability
+            from foxglove.websocket import Capability, StatusLevel
         except ImportError as exc:  # pragma: no cover - depends on the environment
             raise ViewerError("the Foxglove viewer needs the 'foxglove' extra: pip install 'sensorium[foxglove]'") from exc
         from sensorium.server.recording import scene3d as fxscene
@@ -159,7 +278,11 @@ class FoxgloveBridge:
         self._seen_poses: list[Any] = []
         # data path
         self._queue: deque[tuple[str, str, bytes, int]] = deque()
-        self.queue_size = max(1, int(queue_size))
+        # bounded in bytes, not only in messages: a 16-layer lidar's cloud is ~260 KB, and 256 of
+        # them queued for each of 20 viewers held 1.2 GB
+        self.queue_size = max(1, int(queue_size)) if queue_size else _fit(QUEUE_BUDGET_BYTES, largest_message, 16, 512)
+        backlog = backlog or _fit(VIEWER_BUDGET_BYTES, largest_message, 8, 256)
+        self.backlog = backlog
         self.dropped = 0
         self.sent = 0
         self.errors: dict[str, str] = {}
@@ -167,13 +290,31 @@ class FoxgloveBridge:
         self._sent_time_ns = -1
         self._event = threading.Event()
         self._stop = False
+        # what viewers are told (status): computed by the step thread, sent by the worker
+        self.status_fn = status
+        self._status_level = StatusLevel.Warning
+        self._status: str | None = None
+        self._status_sent: str | None = None
+        self._status_sent_at = 0.0
+        self._status_checked_at = 0.0
+        self.sdk_log = sdk_log()
+        self._trim_due = False
+        self._trimmed_at = 0.0
+        from sensorium.server.viewer.front import SubprotocolFront
+
         try:
-            self.server = foxglove.start_server(name=name, host=host, port=port, capabilities=[Capability.Time],
+            self.server = foxglove.start_server(name=name, host="127.0.0.1", port=0, capabilities=[Capability.Time],
                                                 server_listener=cast(Any, _Listener(self)), context=self.ctx,
                                                 message_backlog_size=backlog)
         except Exception as exc:  # the SDK raises RuntimeError on a busy/bad address
-            raise ViewerError(f"cannot start the Foxglove server on {host}:{port}: {exc}") from None
-        self.host, self.port = host, int(self.server.port)
+            raise ViewerError(f"cannot start the Foxglove server: {exc}") from None
+        try:
+            self.front = SubprotocolFront(host, port, int(self.server.port), on_connect=self._connected,
+                                          on_disconnect=self._disconnected)
+        except OSError as exc:
+            self.server.stop()
+            raise ViewerError(f"cannot start the Foxglove server on {host}:{port}: {exc.strerror or exc}") from None
+        self.host, self.port = host, self.front.port
         self._worker = threading.Thread(target=self._run, name="foxglove-bridge", daemon=True)
         self._worker.start()
 
@@ -187,7 +328,8 @@ class FoxgloveBridge:
         bridge = cls({t.name: t.type for t in topics.topics}, sim.world, getattr(loaded, "base_dir", "."),
                      host=host, port=port, name=f"sensorium {core.world_name}",
                      on_demand=topics.set_viewer_demand, wake=transport.wake,
-                     solid_poses=lambda: dict(sim.scene.solid_poses), **kw)
+                     solid_poses=lambda: dict(sim.scene.solid_poses), status=lambda: waiting_message(core),
+                     largest_message=largest_message(sim.world), **kw)
         topics.set_viewer(bridge.record)
         transport.hooks.append(lambda: bridge.pump(sim.time_ms * 1_000_000))
         return bridge
@@ -201,16 +343,23 @@ class FoxgloveBridge:
 
         world, base = recorded_world(replayer.recording)
         bridge = cls(dict(replayer.topic_types), world, base, host=host, port=port,
-                     name=f"sensorium replay {Path(replayer.path).name}", **kw)
+                     name=f"sensorium replay {Path(replayer.path).name}", largest_message=largest_message(world), **kw)
         replayer.viewer = bridge.record
         return bridge
 
     def app_url(self) -> str | None:
         """A Foxglove web-app link that opens this server as the data source (the SDK's), if any."""
         try:
-            return self.server.app_url()
+            url = self.server.app_url()
         except Exception:  # noqa: BLE001 - only a convenience
             return None
+        if not url:
+            return None
+        # the SDK names its own (internal) port; viewers connect to the front's
+        from urllib.parse import quote
+
+        inner = f"ws://127.0.0.1:{self.server.port}"
+        return url.replace(quote(inner, safe=""), quote(self.url, safe="")).replace(inner, self.url)
 
     @property
     def url(self) -> str:
@@ -218,7 +367,19 @@ class FoxgloveBridge:
         return f"ws://{host}:{self.port}"
 
     # ------------------------------------------------------------------ SDK thread
+    def _connected(self) -> None:
+        """A viewer completed its handshake (front thread): send it the status soon."""
+        self._status_sent_at = 0.0
+        self._event.set()
+
+    def _disconnected(self) -> None:
+        """A viewer went away (front thread): give the memory of its queues back soon."""
+        self._trim_due = True
+        self._event.set()
+
     def _subscribed(self, client: int, topic: str, delta: int) -> None:
+        """O(1) per event: counts change, and the step loop is woken only when it has nothing
+        pending yet (10,000 subscribe/unsubscribe pairs cost one demand update per loop pass)."""
         with self._lock:
             key = (client, topic)
             if delta > 0:
@@ -227,13 +388,18 @@ class FoxgloveBridge:
             elif self._clients[key] > 0:
                 self._clients[key] -= 1
                 self._subs[topic] -= 1
-            self._subs += Counter()            # drop zero counts
-            self._clients += Counter()
-            self._dirty = True
-            if delta > 0 and topic == SCENE_TOPIC:
+                if not self._clients[key]:
+                    del self._clients[key]
+                if not self._subs[topic]:
+                    del self._subs[topic]
+            else:
+                return
+            was_dirty, self._dirty = self._dirty, True
+            if delta > 0 and topic == SCENE_TOPIC and client not in self._scene_for:
                 self._scene_for.append(client)
         self._event.set()
-        self.wake()
+        if not was_dirty:
+            self.wake()
 
     def subscriptions(self) -> dict[str, int]:
         """Channel topic → number of client subscriptions now."""
@@ -256,6 +422,14 @@ class FoxgloveBridge:
         if time_ns is not None and time_ns != self._time_ns:
             self._time_ns = int(time_ns)
             self._event.set()
+        if self.status_fn is not None:
+            now = time.monotonic()
+            if now - self._status_checked_at >= STATUS_CHECK_S:
+                self._status_checked_at = now
+                status = self.status_fn()
+                if status != self._status:
+                    self._status = status
+                    self._event.set()
         if self.solid_poses is not None and self._subs.get(SCENE_TOPIC, 0) > 0:
             poses = list(self.solid_poses().values())
             if len(poses) != len(self._seen_poses) or any(a is not b for a, b in zip(poses, self._seen_poses)):
@@ -293,7 +467,29 @@ class FoxgloveBridge:
             except Exception as exc:  # noqa: BLE001 - the viewer must never take the server down
                 self.errors.setdefault("worker", f"{type(exc).__name__}: {exc}")
 
+    def _send_status(self) -> None:
+        status, now = self._status, time.monotonic()
+        if status is not None and (status != self._status_sent or now - self._status_sent_at >= STATUS_REPEAT_S):
+            self.server.publish_status(status, self._status_level, WAITING_STATUS_ID)
+            self._status_sent, self._status_sent_at = status, now
+        elif status is None and self._status_sent is not None:
+            self.server.remove_status([WAITING_STATUS_ID])
+            self._status_sent = None
+
+    def _trim(self) -> None:
+        """After viewers left: return the freed memory of their message queues to the system
+        (glibc keeps it in per-thread arenas otherwise: RSS stayed at ~850 MB after 200 viewers)."""
+        now = time.monotonic()
+        if not self._trim_due or now - self._trimmed_at < TRIM_EVERY_S:
+            return
+        self._trim_due, self._trimmed_at = False, now
+        trim = _malloc_trim()
+        if trim is not None:
+            trim(0)
+
     def _work(self) -> None:
+        self._send_status()
+        self._trim()
         while self._scene_for and self.scene_channel is not None:
             client = self._scene_for.popleft()
             if client is None:
@@ -348,7 +544,11 @@ class FoxgloveBridge:
 
     def report(self) -> str:
         """One line for the log: what was sent, dropped, and the first error per topic."""
-        line = f"Foxglove viewer: {self.sent} messages sent, {self.dropped} dropped (queue full)"
+        front = self.front
+        line = (f"Foxglove viewer: {front.accepted} connections ({front.renamed} as foxglove.websocket.v1), "
+                f"{self.sent} messages sent, {self.dropped} dropped (queue full)")
+        if self.sdk_log.suppressed:
+            line += f", {self.sdk_log.suppressed} repeated SDK log lines not shown"
         if self.errors:
             line += "; not converted: " + "; ".join(f"{t}: {e}" for t, e in sorted(self.errors.items()))
         return line
@@ -358,6 +558,7 @@ class FoxgloveBridge:
         self._stop = True
         self._event.set()
         self._worker.join(timeout=5.0)
+        self.front.close()
         try:
             self.server.stop()
         except Exception:  # noqa: BLE001 - already stopped

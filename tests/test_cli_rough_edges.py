@@ -1,0 +1,79 @@
+"""First-hour rough edges of the command line (issue 26): each one clear line or fixed."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(*args: str, cwd: Path | None = None, timeout: float = 120) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.run([sys.executable, "-m", "sensorium", *args], capture_output=True, text=True, env=env,
+                          cwd=cwd, timeout=timeout)
+
+
+def test_convert_takes_a_bundled_world_name(tmp_path):
+    out = tmp_path / "out.yaml"
+    r = run("convert", "epuck.wbt", str(out), cwd=tmp_path)               # no epuck.wbt here: the bundled one
+    assert r.returncode == 0, r.stderr
+    assert "Traceback" not in r.stderr and "robots:" in out.read_text()
+    missing = run("convert", "nope.wbt", str(tmp_path / "x.yaml"), cwd=tmp_path)
+    assert missing.returncode == 1 and "Traceback" not in missing.stderr
+    assert missing.stderr.strip().splitlines() == [
+        f"nope.wbt: no such file (nor a bundled world: {missing.stderr.split('bundled world: ')[1].strip()}"]
+    assert "epuck.wbt" in missing.stderr
+
+
+def test_pytest_says_at_the_end_which_node_tests_it_skipped_and_how_to_run_them(tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(ROOT), PATH=str(Path(sys.executable).parent))   # no node on PATH
+    env.pop("SENSORIUM_REQUIRE_NODE", None)
+    r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-W", "ignore",
+                        str(ROOT / "tests" / "test_foxglove_live.py"), "-k", "replay_serves"],
+                       capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
+    lines = [line for line in r.stdout.splitlines() if line.startswith("sensorium: ")]
+    assert len(lines) == 1, r.stdout[-3000:]
+    assert "1 Foxglove/Node test(s) skipped (node is not installed)" in lines[0] and "npm ci" in lines[0]
+
+
+def test_a_bad_yaml_argument_to_call_names_its_position():
+    import pytest
+
+    from sensorium.cli.services import parse_args_text
+
+    with pytest.raises(ValueError) as exc:
+        parse_args_text("{mode: [fast}")
+    assert str(exc.value) == ("ARGS '{mode: [fast}' is neither JSON nor YAML at line 1, column 13: "
+                              "expected ',' or ']', but got '}'")
+    r = run("call", "set_mode", "{mode: fast", "--url", "tcp://127.0.0.1:1")
+    assert r.returncode == 2 and r.stderr.strip().splitlines() == [
+        "sensorium call: ARGS '{mode: fast' is neither JSON nor YAML at line 1, column 12: "
+        "expected ',' or '}', but got '<stream end>'"]
+
+
+def test_services_marks_supervisor_only_services_and_replay_shows_arguments(tmp_path):
+    import signal
+
+    from _recdata import make_recording
+    from _serve import Served, sensorium, serve
+
+    with serve(ROOT / "tests" / "worlds" / "webots_api.yaml", stop_signal=signal.SIGTERM) as s:
+        r = run("services", "--url", s.rpc)
+        assert r.returncode == 0, r.stderr
+        lines = r.stdout.splitlines()
+        set_field = [line for line in lines if "/robot/set_field " in line]
+        assert set_field and all("[supervisor controller only" in line for line in set_field), set_field
+        step = [line for line in lines if "/robot/step " in line]
+        assert step and all(line.endswith("[attached controller only]") for line in step), step
+    rec = tmp_path / "rec.mcap"
+    make_recording(rec, steps=5)
+    replay = Served(sensorium("replay", str(rec), "--loop", "--pub", "tcp://127.0.0.1:0", "--rpc", "tcp://127.0.0.1:0",
+                              "--no-progress"), "sensorium: replaying")
+    with replay.wait_ready() as rp:
+        rpc = rp.fields.get("rpc")
+        r = run("services", "--url", rpc)
+    assert r.returncode == 0, r.stderr
+    assert "  /replay/set_rate  {value: float}" in r.stdout.splitlines(), r.stdout
