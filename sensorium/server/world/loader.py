@@ -222,7 +222,10 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
         data, warnings, origin = wbt_to_dict(path, webots_home=webots_home, proto_path=proto_path,
                                              limits=ProtoLimits.matching(limits))
     except WbtSyntaxError as exc:
-        where = f"line {exc.line}, column {exc.col}" if exc.line else ""
+        if exc.source != source:    # in a PROTO file the world uses
+            where = f"{exc.source}:{exc.line}:{exc.col}" if exc.line else exc.source
+        else:
+            where = f"line {exc.line}, column {exc.col}" if exc.line else ""
         raise WorldError(source, [Problem(where, exc.message)]) from None
     try:
         loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,

@@ -113,6 +113,7 @@ class _Expander:
         self.uses: dict[str, ProtoUse] = {}
         self.warnings: list[str] = []
         self.noted: set[str] = set()
+        self.stand_ins: dict[str, tuple[str, int, int]] = {}
         self.memo: dict[int, tuple[Node, Node]] = {}       # id(node) → (node, its expansion)
         self.outer: dict[int, tuple[str, ...]] = {}        # nodes an instance passed in → the chain they were written in
         self.bodies: dict[tuple[str, str], Node] = {}      # (PROTO file, generated text) → parsed root
@@ -128,6 +129,7 @@ class _Expander:
         nodes = [self.node(n, (), 0) for n in self.wbt.nodes]
         self.check_size(nodes)
         self.unused_declarations()
+        self.stand_in_note()
         return Expansion(nodes, list(self.uses.values()), self.warnings, self.search, self.wbt)
 
     def check_size(self, nodes: list[Node]) -> None:
@@ -173,7 +175,7 @@ class _Expander:
     def unused_declarations(self) -> None:
         scope = self.scopes[self.world]
         for name, decl in scope.declared.items():
-            if name in scope.found or decl.importable:
+            if name in scope.found or decl.importable or name in self.stand_ins:
                 continue
             try:
                 resolve_url(decl.url, self.world, self.search)
@@ -234,14 +236,22 @@ class _Expander:
             self.uses[key] = ProtoUse(proto.name, path, url or path, proto.license, proto.license_url)
 
     def note_builtin(self, scope: _Scope, decl: ExternProto, why: str) -> None:
-        if decl.name not in self.noted:
-            self.noted.add(decl.name)
-            instead = (f"using Sensorium's built-in {decl.name} instead" if decl.name in BUILTIN_PROTOS
-                       else f"{decl.name} does not matter to these sensors: skipped")
-            self.warnings.append(f"{scope.source}:{decl.line}:{decl.col}: EXTERNPROTO {decl.name}: file not found "
-                                 f"({_short_why(why)}); {instead}")
-            self.uses[f"\0{decl.name}"] = ProtoUse(decl.name, "", decl.url, "Sensorium built-in (no Webots file used)", None,
-                                            builtin=True)
+        if decl.name not in self.stand_ins:
+            self.stand_ins[decl.name] = (scope.source, decl.line, decl.col)
+            self.uses[f"\0{decl.name}"] = ProtoUse(decl.name, "", decl.url, "Sensorium built-in (no Webots file used)",
+                                                    None, builtin=True)
+
+    def stand_in_note(self) -> None:
+        """One line for every PROTO file not found that Sensorium stands in for."""
+        if not self.stand_ins:
+            return
+        source, line, col = min(self.stand_ins.values(), key=lambda at: (at[0] != self.world, at))
+        built = sorted(n for n in self.stand_ins if n in BUILTIN_PROTOS)
+        skipped = sorted(n for n in self.stand_ins if n not in BUILTIN_PROTOS)
+        parts = ([f"Sensorium's built-in stand-ins used for {', '.join(built)}"] if built else []) + \
+                ([f"{', '.join(skipped)} skipped (no effect on these sensors)"] if skipped else [])
+        self.warnings.append(f"{source}:{line}:{col}: PROTO files not found: {'; '.join(parts)} (give --webots-home "
+                             "or WEBOTS_HOME to use Webots' own)")
 
     def version_note(self, path: Path, decl: ExternProto) -> None:
         home = self.search.home
@@ -386,8 +396,7 @@ class _Expander:
                 self.rendered[key] = rendered
             for level, message in rendered.messages:
                 if level in ("error", "warn") and len(self.warnings) < 1000:
-                    line, col = proto.lines.at(proto.body_offset)
-                    self.warnings.append(f"{proto.source}:{line}:{col}: PROTO {proto.name} (instance at "
+                    self.warnings.append(f"{proto.source}:{proto.line}:{proto.col}: PROTO {proto.name} (instance at "
                                          f"{node.source or self.world}:{node.line}): template says: {message}")
         bkey = (proto.source, rendered.text)
         if bkey not in self.bodies:
@@ -411,7 +420,6 @@ class _Expander:
         return root
 
     def context(self, proto: ProtoDef) -> str:
-        self.context_id = getattr(self, "context_id", 0) + 1
         world = os.path.abspath(self.world)
         home = self.search.home
         system = platform.system()
@@ -419,7 +427,7 @@ class _Expander:
         ctx = {"world": world, "proto": logical_location(proto.source) if not proto.inline else world,
                "project_path": str(Path(world).parent.parent) + os.sep,
                "webots_home": str(home) if home is not None else "", "temporary_files_path": "",
-               "os": {"Windows": "windows", "Darwin": "mac"}.get(system, "linux"), "id": str(self.context_id),
+               "os": {"Windows": "windows", "Darwin": "mac"}.get(system, "linux"), "id": str(self.instances),
                "coordinate_system": self.coordinate_system,
                "webots_version": {"major": version, "revision": "0"}}
         return json.dumps(ctx)

@@ -133,7 +133,7 @@ def read_proto_file(path: Path, source: str, limits: ProtoLimits) -> ProtoDef:
     """A PROTO file: header comments, EXTERNPROTO declarations, interface, body text."""
     text = read_text(path, "PROTO", limits.proto_file_bytes)
     year, letter = parse_header(text, source, "PROTO file")
-    parser = Parser(Tokens(text, source), source, limits=limits)
+    parser = Parser(Tokens(text, source, chunk=1), source, limits=limits)
     decls: list[ExternProto] = []
     while True:
         tok = parser.peek()

@@ -144,11 +144,12 @@ class WbtFile:
 
 
 class Tokens:
-    """The token list, read lazily from the text (a PROTO file's header is read without reading the
-    template code of its body)."""
+    """The token list, read lazily from the text, ``chunk`` tokens at a time (1 for a PROTO file's
+    header: its body, template code, is never tokenized as VRML)."""
 
-    def __init__(self, text: str, source: str, lines: Lines | None = None, start: int = 0, end: int | None = None):
-        self.text, self.source = text, source
+    def __init__(self, text: str, source: str, lines: Lines | None = None, start: int = 0, end: int | None = None,
+                 chunk: int = 64):
+        self.text, self.source, self.chunk = text, source, chunk
         self.lines = lines or Lines(text)
         self.items: list[Token] = []
         self._it: Iterator[re.Match[str]] | None = _TOKEN.finditer(text, start, len(text) if end is None else end)
@@ -157,7 +158,7 @@ class Tokens:
     def get(self, j: int) -> Token:
         items = self.items
         while j >= len(items) and self._it is not None:
-            self._more(max(64, j + 1 - len(items)))
+            self._more(max(self.chunk, j + 1 - len(items)))
         return items[j] if j < len(items) else items[-1]
 
     def _more(self, n: int) -> None:
