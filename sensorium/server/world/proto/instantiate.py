@@ -97,7 +97,12 @@ def expand(wbt: WbtFile, search: ProtoSearch, limits: ProtoLimits | None = None)
     Raises ``ProtoError`` (one line) for a PROTO that cannot be found or instantiated."""
     if search.version is None:
         search = replace(search, version=wbt.version)
-    return _Expander(wbt, search, limits or ProtoLimits()).run()
+    try:
+        return _Expander(wbt, search, limits or ProtoLimits()).run()
+    except ProtoError:
+        raise
+    except WbtSyntaxError as exc:      # in a PROTO file's text
+        raise ProtoError(exc.source, exc.line, exc.col, exc.message) from None
 
 
 class _Expander:

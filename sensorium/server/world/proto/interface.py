@@ -321,11 +321,15 @@ def check_value(ftype: str, v: Any) -> Any:
                 _int(x)
         return flat
     single = "SF" + ftype[2:]
+    what = {"node": "nodes", "string": "strings", "bool": "TRUE or FALSE values"}[kind]
     out = []
     for x in items:
         if kind == "node" and x is None:
-            raise ValueError(f"{ftype} items must be nodes, got NULL")
-        out.append(_single(single, kind, width, x))
+            raise ValueError(f"{ftype} expects nodes, got NULL")
+        try:
+            out.append(_single(single, kind, width, x))
+        except ValueError:
+            raise ValueError(f"{ftype} expects {what}, got {show(x)}") from None
     return out
 
 
