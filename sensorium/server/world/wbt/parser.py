@@ -29,7 +29,7 @@ from sensorium.server.world.limits import ProtoLimits, quote
 MAX_FILE_BYTES = 64 * 1024 * 1024
 MAX_DEPTH = 100
 MAX_NODES = 1_000_000      # nodes as written (the expanded count is ProtoLimits.nodes)
-MAX_MESSAGE_CHARS = 600    # an error line longer than this is cut (it never echoes a huge input)
+MAX_MESSAGE_CHARS = 2000   # an error line longer than this is cut (it never echoes a huge input)
 
 _HEADER = re.compile(r"#VRML_SIM\s+R(\d{4})([a-z])\b")
 _TOKEN = re.compile(r"""
