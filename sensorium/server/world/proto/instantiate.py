@@ -185,8 +185,8 @@ class _Expander:
             try:
                 resolve_url(decl.url, self.world, self.search)
             except ProtoError as exc:
-                self.warnings.append(f"{self.world}:{decl.line}:{decl.col}: EXTERNPROTO {name} (not used by the "
-                                     f"world): {exc.message}")
+                self.warnings.append(f"{self.world}:{decl.line}:{decl.col}: EXTERNPROTO {short(name)} (not used by "
+                                     f"the world): {exc.message}")
 
     # ------------------------------------------------------------------ resolution
     def scope_of(self, node: Node) -> _Scope | None:

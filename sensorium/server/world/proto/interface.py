@@ -411,7 +411,7 @@ def _describe(tok: Token) -> str:
     return "end of file" if tok.kind == "eof" else repr(short(tok.text, 60))
 
 
-_COMMENTS = re.compile(r'"(?:[^"\\]|\\.)*"|%<.*?>%|#[^\n]*', re.DOTALL)
+_COMMENTS = re.compile(r'"[^"\\]*(?:\\.[^"\\]*)*"|%<.*?>%|#[^\n]*', re.DOTALL)
 
 
 def blank_comments(text: str) -> str:

@@ -10,7 +10,7 @@ SFColor ``{r, g, b}``, SFVec2f ``{x, y}``, SFNode ``{node_name, fields}`` or ``u
 arrays) and ``context`` (world, proto, project_path, webots_home, temporary_files_path, os, id,
 coordinate_system, webots_version ``{major, revision}``).
 
-The modules are our own implementations (``modules/*.js``) of the documented ``wbgeometry``,
+Programs run in :mod:`.engine` (QuickJS in a worker process). The modules are our own implementations (``modules/*.js``) of the documented ``wbgeometry``,
 ``wbrandom``, ``wbrotation``, ``wbvector2``, ``wbvector3`` and ``wbutility``; ``wbfile`` answers every
 call with an error. Runs are reproducible: ``wbrandom``'s seed starts at 0 (Webots' default),
 ``Math.random`` is a fixed-seed generator and ``Date.now()`` is 0.
@@ -24,7 +24,6 @@ from __future__ import annotations
 import bisect
 import json
 import re
-import time
 from dataclasses import dataclass
 from importlib.resources import files
 from typing import Any
@@ -159,7 +158,7 @@ class Budget:
 def render(body: str, *, source: str, proto: str, file_lines: Lines, body_offset: int, fields_js: str, context_js: str,
            limits: ProtoLimits, budget: Budget) -> Rendered:
     """Run one template; the generated text and where each of its characters came from."""
-    import quickjs
+    from sensorium.server.world.proto import engine
 
     modules = "".join(_module_js(mod) for mod in _needed_modules(body))
     template, line_map = _program(body, fields_js, context_js, limits.template_output_chars, source, file_lines,
@@ -168,23 +167,24 @@ def render(body: str, *, source: str, proto: str, file_lines: Lines, body_offset
     shift = before.count("\n")
     line_map = [(line + shift, off) for line, off in line_map]
     if budget.left <= 0:
-        raise ProtoError(source, *file_lines.at(body_offset), f"PROTO {proto}: the templates of this world used more "
-                         f"than {limits.template_total_seconds:g} s of CPU time (raise the limits with --allow-large)")
+        raise _over_budget(source, proto, file_lines, body_offset, limits)
     seconds = min(limits.template_seconds, budget.left)
-    ctx = quickjs.Context()
-    ctx.set_memory_limit(limits.template_memory)
-    ctx.set_max_stack_size(1 << 20)
-    ctx.set_time_limit(seconds)
-    t0 = time.process_time()
-    try:
-        out = ctx.eval(before + template)
-        messages = [(str(level), str(msg)) for level, msg in json.loads(ctx.eval("JSON.stringify(__messages)"))]
-    except Exception as exc:              # quickjs.JSException, StackOverflow
-        raise _template_error(exc, source, proto, file_lines, body_offset, line_map, limits, seconds) from None
-    finally:
-        budget.left -= time.process_time() - t0
-    result = json.loads(out)
-    parts, srcs = result["parts"], result["map"]
+    result = engine.run(before + template, memory=limits.template_memory, seconds=seconds)
+    budget.left -= result.cpu
+    if not result.ok:
+        if result.kind in ("crash", "timeout"):
+            what = (f"the template's JavaScript engine crashed (most likely it ran out of its "
+                    f"{limits.template_memory >> 20} MiB of memory)" if result.kind == "crash"
+                    else f"the template did not finish within {seconds * 4 + 5:g} s")
+            raise ProtoError(source, *file_lines.at(body_offset), f"PROTO {proto}: {what}")
+        if "interrupted" in result.error.split("\n", 1)[0] and seconds < limits.template_seconds:
+            raise _over_budget(source, proto, file_lines, body_offset, limits)
+        raise _template_error(result.error, result.kind, source, proto, file_lines, body_offset, line_map, limits,
+                              seconds)
+    out = result.out
+    messages = [(str(level), str(msg)) for level, msg in json.loads(result.messages)]
+    data = json.loads(out)
+    parts, srcs = data["parts"], data["map"]
     triples = []
     n = 0
     for i, part in enumerate(parts):
@@ -253,9 +253,13 @@ def _program(body: str, fields_js: str, context_js: str, max_chars: int, source:
     return program, [(line + shift, off) for line, off in line_map]
 
 
-def _template_error(exc: Exception, source: str, proto: str, file_lines: Lines, body_offset: int,
+def _over_budget(source: str, proto: str, file_lines: Lines, body_offset: int, limits: ProtoLimits) -> ProtoError:
+    return ProtoError(source, *file_lines.at(body_offset), f"PROTO {proto}: the templates of this world used more than "
+                      f"{limits.template_total_seconds:g} s of CPU time (raise the limits with --allow-large)")
+
+
+def _template_error(text: str, kind: str, source: str, proto: str, file_lines: Lines, body_offset: int,
                     line_map: list[tuple[int, int]], limits: ProtoLimits, seconds: float) -> ProtoError:
-    text = str(exc)
     first = text.split("\n", 1)[0].strip()
     where = file_lines.at(body_offset)
     frames = [int(x) for x in _STACK_LINE.findall(text)]
@@ -273,7 +277,7 @@ def _template_error(exc: Exception, source: str, proto: str, file_lines: Lines, 
         what = f"the template ran longer than {seconds:g} s of CPU time"
     elif "out of memory" in first:
         what = f"the template needs more than {limits.template_memory >> 20} MiB of memory"
-    elif "stack overflow" in first or type(exc).__name__ == "StackOverflow":
+    elif "stack overflow" in first or kind == "StackOverflow":
         what = "the template's recursion is too deep (stack overflow)"
     else:
         return ProtoError(source, *where, f"PROTO {proto}: template error: {short(first, 300)}")

@@ -29,6 +29,7 @@ from sensorium.server.world.limits import ProtoLimits, quote
 MAX_FILE_BYTES = 64 * 1024 * 1024
 MAX_DEPTH = 100
 MAX_NODES = 1_000_000      # nodes as written (the expanded count is ProtoLimits.nodes)
+MAX_NAME_CHARS = 1024     # node types, field and DEF names
 MAX_MESSAGE_CHARS = 2000   # an error line longer than this is cut (it never echoes a huge input)
 
 _HEADER = re.compile(r"#VRML_SIM\s+R(\d{4})([a-z])\b")
@@ -36,7 +37,7 @@ _TOKEN = re.compile(r"""
     (?P<ws>[\s,]+)
   | (?P<comment>\#[^\n]*)
   | (?P<num>[+-]?(?:0[xX][0-9a-fA-F]+|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(?![A-Za-z_]))
-  | (?P<str>"(?:[^"\\]|\\.)*")
+  | (?P<str>"[^"\\]*(?:\\.[^"\\]*)*")
   | (?P<tmpl>%<.*?>%)
   | (?P<punct>[{}\[\]])
   | (?P<name>[^\s,"#'.\[\]{}\\+\-0-9][^\s,"#'\[\]{}\\]*)
@@ -229,6 +230,9 @@ class Parser:
         tok = self.take()
         if tok.kind != kind:
             raise self.error(tok, f"expected {what}, found {_describe(tok)}")
+        if kind == "name" and len(tok.text) > MAX_NAME_CHARS:
+            raise self.error(tok, f"a name of {len(tok.text):,} characters (at most {MAX_NAME_CHARS}): "
+                                  f"{short(tok.text, 40)}")
         return tok
 
     def _grew(self, tok: Token) -> None:
@@ -299,6 +303,9 @@ class Parser:
             if ftok.kind != "name":
                 raise self.error(ftok, f"expected a field name or '}}' in {short(tok.text, 40)} (line {tok.line}), "
                                        f"found {_describe(ftok)}")
+            if len(ftok.text) > MAX_NAME_CHARS:
+                raise self.error(ftok, f"a field name of {len(ftok.text):,} characters (at most {MAX_NAME_CHARS}): "
+                                       f"{short(ftok.text, 40)}")
             if ftok.text == "hidden":  # saved simulation state: "hidden NAME VALUE"
                 self.expect("name", "a field name after 'hidden'")
                 self.value(depth + 1)
