@@ -117,14 +117,16 @@ def test_instances_multiplying_through_nesting_are_stopped(tmp_path: Path) -> No
 
 
 def test_distinct_instances_multiplying_through_nesting_are_stopped(tmp_path: Path) -> None:
-    """Each level passes a different value to each of its ten children: every instance is new work."""
+    """Each level passes its value on to each of its ten children through IS: every instance is a
+    copy of its own, so the instances themselves multiply (10**6) and their count stops them."""
     for level in range(7):
         inner = f"M{level + 1}" if level < 6 else None
-        kids = " ".join(f"{inner} {{ i {j} }}" for j in range(10)) if inner else "Shape { geometry Box { } }"
+        kids = " ".join(f"{inner} {{ t IS t }}" for _ in range(10)) if inner else "Shape { geometry Box { } }"
         decl = f'EXTERNPROTO "M{level + 1}.proto"\n' if inner else ""
-        proto_file(tmp_path, f"M{level}", f"[ field SFInt32 i 0 ] {{ Group {{ children [ {kids} ] }} }}", header=decl)
+        proto_file(tmp_path, f"M{level}", f"[ field SFVec3f t 0 0 0 ] {{ Pose {{ translation IS t children [ {kids} ] }} }}",
+                   header=decl)
     w = world_file(tmp_path, "Solid { children [ M0 { } ] }\n", ["M0.proto"])
-    refused(w, "nodes once PROTO instances are expanded")
+    refused(w, f"more than {ProtoLimits().instances:,} PROTO instances")
 
 
 def test_shared_instances_multiplying_through_use_are_stopped(tmp_path: Path) -> None:

@@ -260,7 +260,7 @@ class ProtoLimits:
 
     nodes: int = 1_000_000                  # nodes after DEF/USE reuse and PROTO expansion
     values: int = 4_000_000                 # numbers, strings and booleans after reuse and expansion
-    instances: int = 20_000                 # PROTO instances expanded (deterministic template output is reused)
+    instances: int = 5_000                  # PROTO instances expanded (identical ones share one expansion)
     depth: int = 24                         # PROTO instances nested inside one another
     proto_files: int = 2_000                # distinct PROTO files read
     proto_file_bytes: int = 8 * MiB         # each PROTO file

@@ -122,6 +122,7 @@ class _Expander:
         self.memo: dict[int, tuple[Node, Node]] = {}       # id(node) → (node, its expansion)
         self.outer: dict[int, tuple[str, ...]] = {}        # nodes an instance passed in → the chain they were written in
         self.bodies: dict[tuple[str, str], Node] = {}      # (PROTO file, generated text) → parsed root
+        self.is_holders: dict[int, tuple[Node, bool]] = {}  # id(body node) → (node, whether an IS is under it)
         self.rendered: dict[tuple[str, str], tpl.Rendered] = {}
         self.budget = tpl.Budget(limits.template_total_seconds)
         self.instances = 0
@@ -298,7 +299,7 @@ class _Expander:
                 changed[name] = new
         if changed is None:
             return node
-        return replace(node, fields=changed)
+        return _copy(node, fields=changed)
 
     def value(self, value: Any, chain: tuple[str, ...], depth: int) -> Any:
         if isinstance(value, Node):
@@ -333,7 +334,7 @@ class _Expander:
         root = self.substitute(body, proto, values, given, chain)
         out = self.node(root, inner, depth)
         self.uses[f"{proto.source}\0{proto.name}"].instances += 1
-        return replace(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col))
+        return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col))
 
     def values(self, node: Node, proto: ProtoDef, chain: tuple[str, ...]) -> tuple[dict[str, Any], set[str]]:
         """The instance's value of every field of ``proto``, checked."""
@@ -506,6 +507,9 @@ class _Expander:
             key = id(node)
             if key in done:
                 return done[key]
+            if not self.holds_is(node):
+                done[key] = node
+                return node
             changed: dict[str, Any] | None = None
             for fname, value in node.fields.items():
                 new = value
@@ -525,16 +529,43 @@ class _Expander:
                     if changed is None:
                         changed = dict(node.fields)
                     changed[fname] = new
-            result = node if changed is None else replace(node, fields=changed)
+            result = node if changed is None else _copy(node, fields=changed)
             done[key] = result
             return result
 
         return walk(body)
 
+    def holds_is(self, node: Node) -> bool:
+        """Whether an IS is written anywhere under ``node`` (body nodes, asked once each)."""
+        key = id(node)
+        known = self.is_holders.get(key)
+        if known is not None:
+            return known[1]
+        found = False
+        for value in node.fields.values():
+            if isinstance(value, IsRef):
+                found = True
+            elif isinstance(value, Node):
+                found = self.holds_is(value) or found
+            elif isinstance(value, list):
+                for x in value:
+                    if isinstance(x, Node) and self.holds_is(x):
+                        found = True
+        self.is_holders[key] = (node, found)
+        return found
+
     def memo_keep(self, node: Node) -> None:
         """Nodes marked by id must stay alive while the expansion runs (ids are reused)."""
         self._kept = getattr(self, "_kept", [])
         self._kept.append(node)
+
+
+def _copy(node: Node, **changes: Any) -> Node:
+    """A shallow copy of ``node`` with some attributes changed (dataclasses.replace, without its cost)."""
+    new = object.__new__(Node)
+    new.__dict__.update(node.__dict__)
+    new.__dict__.update(changes)
+    return new
 
 
 def _short_why(message: str) -> str:
