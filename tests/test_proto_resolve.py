@@ -156,7 +156,7 @@ def test_builtin_stand_ins_when_the_file_is_missing_and_the_real_one_when_found(
                      "TexturedBackground skipped (no effect on these sensors) (give --webots-home or WEBOTS_HOME to "
                      "use Webots' own)"]
     uses = {u.name: u for u in expanded(w).protos}
-    assert uses["RectangleArena"].builtin and uses["RectangleArena"].license.startswith("Sensorium built-in")
+    assert uses["RectangleArena"].builtin and uses["RectangleArena"].license.startswith("Sensorium's built-in stand-in")
     # with an installation holding a (our own) RectangleArena, that file is used
     home = tmp_path / "webots"
     proto_file(home / "projects" / "objects" / "floors" / "protos", "RectangleArena",

@@ -244,8 +244,9 @@ class _Expander:
     def note_builtin(self, scope: _Scope, decl: ExternProto, why: str) -> None:
         if decl.name not in self.stand_ins:
             self.stand_ins[decl.name] = (scope.source, decl.line, decl.col)
-            self.uses[f"\0{decl.name}"] = ProtoUse(decl.name, "", decl.url, "Sensorium built-in (no Webots file used)",
-                                                    None, builtin=True)
+            what = ("Sensorium's built-in stand-in (no Webots file used)" if decl.name in BUILTIN_PROTOS
+                    else "not read (skipped: no effect on these sensors)")
+            self.uses[f"\0{decl.name}"] = ProtoUse(decl.name, "", decl.url, what, None, builtin=True)
 
     def stand_in_note(self) -> None:
         """One line for every PROTO file not found that Sensorium stands in for."""
