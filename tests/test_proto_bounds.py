@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
-from _protos import HEADER, expanded, proto_file, world_file
+from _protos import HEADER, proto_file, world_file
 
 from sensorium.server.world.limits import ProtoLimits
 from sensorium.server.world.loader import WorldError, load_world

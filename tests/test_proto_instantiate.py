@@ -11,10 +11,10 @@ import pytest
 from _protos import expanded, nodes_of, proto_file, world_file
 
 from sensorium.schemas import world as wm
+from sensorium.server.world.limits import ProtoLimits
 from sensorium.server.world.loader import WorldError, load_world
 from sensorium.server.world.proto import ProtoError
 from sensorium.server.world.proto.interface import FIELD_TYPES, read_proto_file
-from sensorium.server.world.limits import ProtoLimits
 
 
 def test_every_field_type_and_declaration_kind(tmp_path: Path) -> None:

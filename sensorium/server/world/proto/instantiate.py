@@ -39,8 +39,8 @@ from sensorium.server.world.proto.interface import (
     show,
 )
 from sensorium.server.world.proto.resolve import ProtoSearch, logical_location, resolve_url
-from sensorium.server.world.wbt.parser import ExternProto, IsRef, Node, Parser, Tokens, WbtFile, WbtSyntaxError, short
 from sensorium.server.world.wbt.convert import SKIPPED
+from sensorium.server.world.wbt.parser import ExternProto, IsRef, Node, Parser, Tokens, WbtFile, WbtSyntaxError, short
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
 # PROTOs Sensorium stands in for when their file is not found: built-in expansions, and the
