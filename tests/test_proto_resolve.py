@@ -189,3 +189,22 @@ def test_resolve_url_for_assets(tmp_path: Path) -> None:
     with pytest.raises(ProtoError, match='"webots://projects/meshes/none.obj" not found'):
         resolve_url("webots://projects/meshes/none.obj", world, s)
     assert asset_roots(s) == [home.resolve()]
+
+
+def test_cli_flags_and_info_list_the_protos_with_their_licences(tmp_path: Path, monkeypatch, capsys) -> None:
+    from sensorium.cli import main as cli
+
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)          # restored after the test (the flags set it)
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots")
+    extra = tmp_path / "mine"
+    proto_file(extra, "Gadget", "[ ] { Solid { name \"gadget\" } }", header="# license: MIT\n")
+    w = world_file(tmp_path / "w", "AcmeBot { }\nGadget { }\n",
+                   [f"{RAW}/R2023b/projects/robots/acme/bot/protos/AcmeBot.proto", "https://example.org/x/Gadget.proto"])
+    assert cli(["validate", str(w)]) == 1
+    assert "not found" in capsys.readouterr().err
+    assert cli(["info", str(w), "--webots-home", str(home), "--proto-path", str(extra)]) == 0
+    out = capsys.readouterr().out
+    assert "proto     AcmeBot x1: no license line" in out and "proto     AcmeEye x1: no license line" in out
+    assert f"proto     Gadget x1: MIT ({extra / 'Gadget.proto'})" in out
+    assert cli(["validate", str(w)]) == 0                     # the flags now hold for this process

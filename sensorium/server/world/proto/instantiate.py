@@ -599,4 +599,13 @@ def _body_type(proto: ProtoDef) -> str | None:
     return m.group(1) if m else None
 
 
-__all__ = ["expand", "Expansion", "ProtoUse", "FIELD_TYPES", "WbtSyntaxError"]
+def protos_used(path: str | Path, webots_home: str | Path | None = None,
+                proto_path: tuple[str | Path, ...] = ()) -> list[ProtoUse]:
+    """The PROTOs a .wbt world uses (name, file, licence line, instances), for ``sensorium info``."""
+    from sensorium.server.world.wbt.parser import read_wbt
+
+    path = Path(path)
+    return expand(read_wbt(path), ProtoSearch.create(path.resolve().parent, webots_home, proto_path)).protos
+
+
+__all__ = ["expand", "protos_used", "Expansion", "ProtoUse", "FIELD_TYPES", "WbtSyntaxError"]
