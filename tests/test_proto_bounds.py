@@ -176,7 +176,7 @@ def test_deep_nesting_is_bounded(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("code, what", [
     ("while (true) {}", "the template ran longer than 0.25 s of CPU time"),
-    ("const a = []; while (true) a.push('x'.repeat(1000) + a.length);", "64 MiB of memory"),
+    ("const a = []; while (true) a.push('x'.repeat(100000) + a.length);", "64 MiB of memory"),
     ("function f(n) { return f(n + 1) + 1; } f(0);", "recursion is too deep"),
 ])
 def test_runaway_templates_are_stopped(tmp_path: Path, code: str, what: str) -> None:
@@ -194,11 +194,11 @@ def test_giant_template_output_is_stopped(tmp_path: Path) -> None:
 
 def test_total_template_time_is_bounded(tmp_path: Path) -> None:
     """Many instances of a slow (but each within its bound) nonDeterministic template."""
-    proto_file(tmp_path, "Slow", "[ ] {\n  %< let t = 0; for (let i = 0; i < 3e6; ++i) t += i; >%\n  Group { }\n}",
+    proto_file(tmp_path, "Slow", "[ ] {\n  %< let t = 0; for (let i = 0; i < 3e5; ++i) t += i; >%\n  Group { }\n}",
                header=JS + "# tags: nonDeterministic\n")
     w = world_file(tmp_path, "Slow { }\n" * 200, ["Slow.proto"])
-    limits = ProtoLimits(template_total_seconds=0.3)
-    with pytest.raises(ProtoError, match="the templates of this world used more than 0.3 s of CPU time"):
+    limits = ProtoLimits(template_total_seconds=0.1)
+    with pytest.raises(ProtoError, match="the templates of this world used more than 0.1 s of CPU time"):
         expanded_with(w, limits)
 
 
