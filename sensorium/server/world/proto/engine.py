@@ -5,8 +5,8 @@ network, ``std`` or ``os`` access (QuickJS's bare context has none of them).
 Why a process: QuickJS 2021-03-27 (what the package bundles) can crash on some out-of-memory
 paths, and a template is untrusted input. In the worker a crash ends only the worker: the caller
 gets one line saying so, and the next template starts a new worker. The parent also stops a
-worker that does not answer within a wall-clock bound. One worker per process, started on first
-use (~30 ms), ended with the process.
+worker that does not answer within a wall-clock bound. One worker, started on a world's first
+template (~50 ms) and ended when that world's expansion is done.
 """
 
 from __future__ import annotations
@@ -114,3 +114,9 @@ atexit.register(_ENGINE.stop)
 def run(code: str, *, memory: int, seconds: float, stack: int = 1 << 20) -> Result:
     """Run one template program in the shared worker."""
     return _ENGINE.run(code, memory=memory, seconds=seconds, stack=stack)
+
+
+def release() -> None:
+    """End the worker (the next run starts another): called when a world's expansion is done."""
+    with _ENGINE.lock:
+        _ENGINE.stop()

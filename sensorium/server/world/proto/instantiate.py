@@ -97,12 +97,16 @@ def expand(wbt: WbtFile, search: ProtoSearch, limits: ProtoLimits | None = None)
     Raises ``ProtoError`` (one line) for a PROTO that cannot be found or instantiated."""
     if search.version is None:
         search = replace(search, version=wbt.version)
+    from sensorium.server.world.proto import engine
+
     try:
         return _Expander(wbt, search, limits or ProtoLimits()).run()
     except ProtoError:
         raise
     except WbtSyntaxError as exc:      # in a PROTO file's text
         raise ProtoError(exc.source, exc.line, exc.col, exc.message) from None
+    finally:
+        engine.release()               # no worker process outlives the load
 
 
 class _Expander:
