@@ -279,6 +279,31 @@ def _bench_args(p: argparse.ArgumentParser) -> None:
 # --- end benchmarks ---
 
 
+# commands that load a world: where a .wbt world's PROTO files are found (the one place these are declared)
+WORLD_COMMANDS = {"validate", "convert", "info", "probe", "serve", "layout", "demo", "sweep", "record", "replay", "export"}
+
+
+def _add_proto_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--webots-home", metavar="DIR",
+                   help="Webots installation whose PROTOs and assets a .wbt world uses (default: $WEBOTS_HOME); "
+                   "nothing is ever downloaded")
+    p.add_argument("--proto-path", action="append", default=[], metavar="DIR",
+                   help="more folders to find PROTO files in (repeatable): a project's protos/, a copy of Webots' "
+                   "tree, an unpacked assets-RELEASE.zip (also $SENSORIUM_PROTO_PATH)")
+
+
+def _export_proto_args(args: argparse.Namespace) -> None:
+    """--webots-home/--proto-path become WEBOTS_HOME/SENSORIUM_PROTO_PATH, so every load of a world
+    in this command (and the processes it starts) finds the same PROTOs."""
+    import os
+
+    if getattr(args, "webots_home", None):
+        os.environ["WEBOTS_HOME"] = args.webots_home
+    if getattr(args, "proto_path", None):
+        before = [p for p in os.environ.get("SENSORIUM_PROTO_PATH", "").split(os.pathsep) if p]
+        os.environ["SENSORIUM_PROTO_PATH"] = os.pathsep.join([*args.proto_path, *before])
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sensorium", description="Headless sensor simulator with Webots device semantics.")
     from sensorium import __version__
@@ -288,6 +313,8 @@ def build_parser() -> argparse.ArgumentParser:
     for name, (help_text, add_args, target) in _COMMANDS.items():
         p = sub.add_parser(name, help=help_text, description=help_text)
         add_args(p)
+        if name in WORLD_COMMANDS:
+            _add_proto_args(p)
         p.set_defaults(_target=target)
     return parser
 
@@ -299,6 +326,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 2
     module_name, func_name = args._target.split(":")
+    _export_proto_args(args)
     import importlib
 
     func: Handler = getattr(importlib.import_module(module_name), func_name)

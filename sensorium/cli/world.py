@@ -54,6 +54,12 @@ def info(args: argparse.Namespace) -> int:
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1
+    if path.lower().endswith(".wbt"):       # each PROTO used, with its licence line
+        from dataclasses import asdict
+
+        from sensorium.server.world.proto import protos_used
+
+        s["protos"] = [asdict(u) for u in protos_used(path)]
     if args.json:
         print(json.dumps(s, indent=2))
         return 0
@@ -67,6 +73,8 @@ def info(args: argparse.Namespace) -> int:
         print(f"  {r['name']}{'' if r['synchronization'] else ' (asynchronous)'}: {len(r['devices'])} devices")
         for d in r["devices"]:
             print(f"    {d['name']:<14} {d['summary']}")
+    for u in s.get("protos", []):
+        print(f"proto     {u['name']} x{u['instances']}: {u['license'] or 'no license line'} ({u['path'] or u['url']})")
     for w in s["warnings"]:
         print(f"warning: {w}")
     return 0

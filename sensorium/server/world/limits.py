@@ -247,3 +247,36 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
     if per_step > limits.rays_per_step:
         over("", "rays in one step (every device due at once):", per_step, limits.rays_per_step)
     return problems
+
+
+# ------------------------------------------------------------------------------------ Webots .wbt and PROTO expansion
+
+
+@dataclass(frozen=True)
+class ProtoLimits:
+    """The work reading a ``.wbt`` world and expanding its PROTOs may do. A world file and the PROTO
+    files it names are untrusted input: DEF/USE and nested PROTO instances multiply, templates are
+    programs. Every bound is checked while the work is done, so a bomb stops at the bound, fast."""
+
+    nodes: int = 1_000_000                  # nodes after DEF/USE reuse and PROTO expansion
+    values: int = 4_000_000                 # numbers, strings and booleans after reuse and expansion
+    instances: int = 5_000                  # PROTO instances expanded (identical ones share one expansion)
+    depth: int = 24                         # PROTO instances nested inside one another
+    proto_files: int = 2_000                # distinct PROTO files read
+    proto_file_bytes: int = 8 * MiB         # each PROTO file
+    template_seconds: float = 0.25          # CPU time of one template run
+    template_total_seconds: float = 2.0     # CPU time of every template run of one world
+    template_memory: int = 64 * MiB         # JavaScript heap of one template run
+    template_output_chars: int = 8 * MiB    # text one template run may generate
+
+    @classmethod
+    def large(cls) -> ProtoLimits:
+        """``--allow-large``: every bound raised (still finite)."""
+        return cls(nodes=100_000_000, values=400_000_000, instances=2_000_000, depth=64, proto_files=100_000,
+                   proto_file_bytes=256 * MiB, template_seconds=30.0, template_total_seconds=600.0,
+                   template_memory=1024 * MiB, template_output_chars=256 * MiB)
+
+    @classmethod
+    def matching(cls, limits: WorldLimits | None) -> ProtoLimits:
+        """The PROTO bounds that go with a world's limits (raised with ``--allow-large``)."""
+        return cls.large() if limits is not None and limits.values > WorldLimits().values else cls()

@@ -24,7 +24,15 @@ import yaml
 from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
-from sensorium.server.world.limits import LimitError, WorldLimits, check_data, check_work, check_yaml_events, quote
+from sensorium.server.world.limits import (
+    LimitError,
+    ProtoLimits,
+    WorldLimits,
+    check_data,
+    check_work,
+    check_yaml_events,
+    quote,
+)
 
 
 class _Yaml12Loader(yaml.SafeLoader):
@@ -135,15 +143,18 @@ def bundled_or_path(path: str | Path) -> Path:
     return path
 
 
-def load_world(path: str | Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
+def load_world(path: str | Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False,
+               webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = ()) -> LoadedWorld:
     """Read, parse, validate and sanitise a world file (``WorldError`` listing every problem).
     ``limits``: the work it may ask for (default ``WorldLimits()``; ``--allow-large`` is
     ``WorldLimits.large()``); ``allow_outside_meshes``: mesh urls may leave the world's folder.
-    A bare name of a bundled world (``arena``) works from any directory."""
+    A bare name of a bundled world (``arena``) works from any directory. For a ``.wbt`` world,
+    PROTO files are found through ``webots_home`` (default ``$WEBOTS_HOME``) and ``proto_path``."""
     path = bundled_or_path(path)
     source = str(path)
     if path.suffix.lower() == ".wbt":
-        return load_wbt(path, limits=limits, allow_outside_meshes=allow_outside_meshes)
+        return load_wbt(path, limits=limits, allow_outside_meshes=allow_outside_meshes, webots_home=webots_home,
+                        proto_path=proto_path)
     text = read_world_text(path, limits)
     data = parse_text(text, source, json_format=path.suffix.lower() == ".json", limits=limits)
     return parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
@@ -199,7 +210,8 @@ def _named(data: Any, problems: list[Problem]) -> list[Problem]:
     return [Problem(p.path, p.message, with_names(p.path, data)) if p.path else p for p in problems]
 
 
-def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
+def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_meshes: bool = False,
+             webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = ()) -> LoadedWorld:
     """A Webots world, converted (``sensorium.server.world.wbt``); problems point at its lines.
     ``LoadedWorld.text`` is the .wbt file as read (recordings attach it under its own name)."""
     from sensorium.server.world.wbt import WbtSyntaxError, wbt_to_dict
@@ -207,9 +219,13 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
     source = str(path)
     text = read_world_text(path, limits)           # the size limit (and a readable file)
     try:
-        data, warnings, origin = wbt_to_dict(path)
+        data, warnings, origin = wbt_to_dict(path, webots_home=webots_home, proto_path=proto_path,
+                                             limits=ProtoLimits.matching(limits))
     except WbtSyntaxError as exc:
-        where = f"line {exc.line}, column {exc.col}" if exc.line else ""
+        if exc.source != source:    # in a PROTO file the world uses
+            where = f"{exc.source}:{exc.line}:{exc.col}" if exc.line else exc.source
+        else:
+            where = f"line {exc.line}, column {exc.col}" if exc.line else ""
         raise WorldError(source, [Problem(where, exc.message)]) from None
     try:
         loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,

@@ -1,23 +1,52 @@
-"""Webots worlds (``.wbt``): tokenizer and parser (``parser``), node-to-world conversion
-(``convert``, ``fields``, ``drive``, ``protos``). ``load_wbt`` is what ``load_world`` calls for a
+"""Webots worlds (``.wbt``): tokenizer and parser (``parser``), PROTO expansion
+(:mod:`sensorium.server.world.proto`), node-to-world conversion (``convert``, ``fields``, ``drive``,
+``protos``: built-in stand-ins for common PROTOs). ``load_wbt`` is what ``load_world`` calls for a
 ``.wbt`` file; ``wbt_to_dict`` gives the equivalent world file (``sensorium convert``)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sensorium.server.world.limits import ProtoLimits
 from sensorium.server.world.wbt.parser import WbtSyntaxError, read_wbt
 
-__all__ = ["WbtSyntaxError", "wbt_to_dict", "read_wbt"]
+__all__ = ["WbtSyntaxError", "WbtConversion", "wbt_convert", "wbt_to_dict", "read_wbt"]
 
 
-def wbt_to_dict(path: str | Path) -> tuple[dict[str, Any], list[str], dict[str, tuple[int, int, str]]]:
-    """(world-file dict, warnings, converted path → (line, column, node type) it came from)."""
+@dataclass
+class WbtConversion:
+    """A converted world: the world-file dict, warnings, converted path → (line, column, node type)
+    it came from, and the PROTOs used (``ProtoUse``: name, file, licence line, instances)."""
+
+    data: dict[str, Any]
+    warnings: list[str]
+    origin: dict[str, tuple[int, int, str]]
+    protos: list[Any]
+
+
+def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),
+                limits: ProtoLimits | None = None) -> WbtConversion:
+    """Read, expand (PROTOs found through ``webots_home``/``$WEBOTS_HOME`` and ``proto_path``) and
+    convert a .wbt world."""
+    from sensorium.server.world.proto import ProtoSearch, expand
     from sensorium.server.world.wbt.convert import Converter, strip_origins
 
     source = str(path)
-    conv = Converter(read_wbt(path), source)
+    limits = limits or ProtoLimits()
+    search = ProtoSearch.create(Path(path).resolve().parent, webots_home, tuple(proto_path))
+    expansion = expand(read_wbt(path, limits), search, limits)
+    conv = Converter(expansion.as_wbt(), source, expansion.search)
     raw = conv.run()
     origin: dict[str, tuple[int, int, str]] = {}
-    return strip_origins(raw, "", origin), conv.warnings, origin
+    data = strip_origins(raw, "", origin)
+    return WbtConversion(data, [*expansion.warnings, *conv.warnings], origin, expansion.protos)
+
+
+def wbt_to_dict(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),
+                limits: ProtoLimits | None = None) -> tuple[dict[str, Any], list[str], dict[str, tuple[int, int, str]]]:
+    """(world-file dict, warnings, converted path → (line, column, node type) it came from)."""
+    c = wbt_convert(path, webots_home=webots_home, proto_path=proto_path, limits=limits)
+    return c.data, c.warnings, c.origin

@@ -97,9 +97,10 @@ class Owner:
 
 
 class Converter:
-    def __init__(self, wbt: WbtFile, source: str):
+    def __init__(self, wbt: WbtFile, source: str, search: Any = None):
         self.wbt = wbt
         self.source = source
+        self.search = search               # proto.ProtoSearch: where asset urls resolve (resolve_url)
         self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
         self.warnings: list[str] = []
         self.skipped: Counter[str] = Counter()

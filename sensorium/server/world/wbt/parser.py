@@ -1,33 +1,44 @@
 """Webots world files (``.wbt``, R2022a+ syntax) → a tree of ``Node`` objects.
 
 The syntax is VRML97's as Webots writes it: a ``#VRML_SIM R2023b utf8`` header line, ``#`` comments,
-commas as white space, ``EXTERNPROTO "url"`` declarations, and nodes ``[DEF name] Type { field value
-... }`` or ``USE name``. Field values are parsed without knowing field types: a run of numbers, a
-string, ``TRUE``/``FALSE``, ``NULL``, a node, or a ``[ ... ]`` list of any of these. ``hidden``
-lines (Webots' saved joint and velocity state) are read and dropped.
+commas as white space, ``[IMPORTABLE] EXTERNPROTO "url"`` declarations, ``PROTO`` definitions (read
+by :mod:`sensorium.server.world.proto.interface`), and nodes ``[DEF name] Type { field value ... }``
+or ``USE name``. Field values are parsed without knowing field types: a run of numbers, a string,
+``TRUE``/``FALSE``, ``NULL``, a node, or a ``[ ... ]`` list of any of these; inside a PROTO body a
+value may also be ``IS name`` (an ``IsRef``). ``hidden`` lines (Webots' saved joint and velocity
+state) are read and dropped.
 
-Work is bounded: the file size, the nesting depth and the number of nodes are limited, and every
-error names the file, line and column (``WbtSyntaxError``).
+Work is bounded while parsing: the file size, the nesting depth, and the nodes and values the tree
+holds once every ``USE`` is counted as the copy it stands for (``ProtoLimits``), so a small file
+that USEs a big subtree many times is refused as soon as the count passes the bound. Every error
+names the file, line and column (``WbtSyntaxError``) and quotes at most a short prefix of the input.
 """
 
 from __future__ import annotations
 
 import bisect
+import math
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sensorium.server.world.limits import ProtoLimits, quote
+
 MAX_FILE_BYTES = 64 * 1024 * 1024
 MAX_DEPTH = 100
-MAX_NODES = 1_000_000
+MAX_NODES = 1_000_000      # nodes as written (the expanded count is ProtoLimits.nodes)
+MAX_NAME_CHARS = 1024     # node types, field and DEF names
+MAX_MESSAGE_CHARS = 2000   # an error line longer than this is cut (it never echoes a huge input)
 
 _HEADER = re.compile(r"#VRML_SIM\s+R(\d{4})([a-z])\b")
 _TOKEN = re.compile(r"""
     (?P<ws>[\s,]+)
   | (?P<comment>\#[^\n]*)
   | (?P<num>[+-]?(?:0[xX][0-9a-fA-F]+|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(?![A-Za-z_]))
-  | (?P<str>"(?:[^"\\]|\\.)*")
+  | (?P<str>"[^"\\]*(?:\\.[^"\\]*)*")
+  | (?P<tmpl>%<.*?>%)
   | (?P<punct>[{}\[\]])
   | (?P<name>[^\s,"#'.\[\]{}\\+\-0-9][^\s,"#'\[\]{}\\]*)
   | (?P<bad>.)
@@ -35,14 +46,17 @@ _TOKEN = re.compile(r"""
 
 
 class WbtSyntaxError(Exception):
-    """A .wbt file that cannot be read; the message is ``FILE:LINE:COL: what``."""
+    """A .wbt file that cannot be read; the message is ``FILE:LINE:COL: what`` (one line, short)."""
 
     def __init__(self, source: str, line: int, col: int, message: str):
+        if len(message) > MAX_MESSAGE_CHARS or "\n" in message:
+            flat = message.replace("\n", " ")
+            message = flat[:MAX_MESSAGE_CHARS] + (f"… ({len(flat)} characters)" if len(flat) > MAX_MESSAGE_CHARS else "")
         self.source, self.line, self.col, self.message = source, line, col, message
         super().__init__(f"{source}:{line}:{col}: {message}" if line else f"{source}: {message}")
 
 
-class _Lines:
+class Lines:
     """Offset → (line, column), both 1-based, by bisection over the newline offsets."""
 
     def __init__(self, text: str):
@@ -53,13 +67,16 @@ class _Lines:
         return i + 1, pos - self.starts[i] + 1
 
 
+_Lines = Lines
+
+
 class Token:
-    """One token: kind ("num", "str", "name", "{", "}", "[", "]", "eof"), text, offset; its line
-    and column are computed when asked (errors and node positions only)."""
+    """One token: kind ("num", "str", "name", "tmpl", "{", "}", "[", "]", "eof"), text, offset; its
+    line and column are computed when asked (errors and node positions only)."""
 
     __slots__ = ("kind", "text", "pos", "lines")
 
-    def __init__(self, kind: str, text: str, pos: int, lines: _Lines):
+    def __init__(self, kind: str, text: str, pos: int, lines: Lines):
         self.kind, self.text, self.pos, self.lines = kind, text, pos, lines
 
     @property
@@ -73,7 +90,12 @@ class Token:
 
 @dataclass(eq=False)
 class Node:
-    """One node as written: type name, fields in file order, position, DEF name."""
+    """One node as written: type name, fields in file order, position, DEF name.
+
+    ``source`` is the file whose text the node was read from (a world or a PROTO file; a node a
+    PROTO instance received through a field keeps the file it was written in). On the root node of
+    an expanded PROTO instance, ``proto`` is the PROTO's name and ``instance_at`` the (file, line,
+    column) of the instance as written."""
 
     type: str
     fields: dict[str, Any]
@@ -81,6 +103,34 @@ class Node:
     col: int
     def_name: str | None = None
     field_pos: dict[str, tuple[int, int]] = field(default_factory=dict)
+    source: str = ""
+    proto: str | None = None
+    instance_at: tuple[str, int, int] | None = None
+
+
+@dataclass(frozen=True)
+class IsRef:
+    """``field IS name`` inside a PROTO body: the value of the PROTO's field ``name``."""
+
+    name: str
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class ExternProto:
+    """One ``[IMPORTABLE] EXTERNPROTO "url"`` declaration and where it is written."""
+
+    url: str
+    line: int
+    col: int
+    importable: bool = False
+
+    @property
+    def name(self) -> str:
+        """The PROTO it declares: the url's file name without ``.proto`` (as Webots matches them)."""
+        base = self.url.replace("\\", "/").rstrip("/").rsplit("/", 1)[-1]
+        return base[:-6] if base.lower().endswith(".proto") else base
 
 
 @dataclass
@@ -88,51 +138,90 @@ class WbtFile:
     version: str                 # e.g. "R2023b"
     nodes: list[Node]            # top-level nodes in file order
     externprotos: list[str]      # declared EXTERNPROTO urls
+    source: str = ""
+    declarations: list[ExternProto] = field(default_factory=list)
+    protos: list[Any] = field(default_factory=list)   # PROTO definitions written in the file (proto.interface.ProtoDef)
+    header: list[str] = field(default_factory=list)   # the '#' comment lines after the first line
 
 
-def tokenize(text: str, source: str) -> list[Token]:
-    lines = _Lines(text)
-    tokens: list[Token] = []
-    append = tokens.append
-    for m in _TOKEN.finditer(text):
-        kind = m.lastgroup
-        if kind == "ws" or kind == "comment":
-            continue
-        value = m.group()
-        if kind == "punct":
-            append(Token(value, value, m.start(), lines))
-        elif kind == "bad":
-            line, col = lines.at(m.start())
-            what = "unterminated string" if value == '"' else f"unexpected character {value!r}"
-            raise WbtSyntaxError(source, line, col, what)
-        else:
-            append(Token(kind, value, m.start(), lines))  # type: ignore[arg-type]
-    append(Token("eof", "", len(text), lines))
-    return tokens
+class Tokens:
+    """The token list, read lazily from the text, ``chunk`` tokens at a time (1 for a PROTO file's
+    header: its body, template code, is never tokenized as VRML)."""
+
+    def __init__(self, text: str, source: str, lines: Lines | None = None, start: int = 0, end: int | None = None,
+                 chunk: int = 64):
+        self.text, self.source, self.chunk = text, source, chunk
+        self.lines = lines or Lines(text)
+        self.items: list[Token] = []
+        self._it: Iterator[re.Match[str]] | None = _TOKEN.finditer(text, start, len(text) if end is None else end)
+        self.end = len(text) if end is None else end
+
+    def get(self, j: int) -> Token:
+        items = self.items
+        while j >= len(items) and self._it is not None:
+            self._more(max(self.chunk, j + 1 - len(items)))
+        return items[j] if j < len(items) else items[-1]
+
+    def _more(self, n: int) -> None:
+        it, items, lines = self._it, self.items, self.lines
+        assert it is not None
+        for m in it:
+            kind = m.lastgroup
+            if kind == "ws" or kind == "comment":
+                continue
+            value = m.group()
+            if kind == "punct":
+                items.append(Token(value, value, m.start(), lines))
+            elif kind == "bad":
+                line, col = lines.at(m.start())
+                what = "unterminated string" if value == '"' else f"unexpected character {value!r}"
+                raise WbtSyntaxError(self.source, line, col, what)
+            else:
+                items.append(Token(kind, value, m.start(), lines))  # type: ignore[arg-type]
+            n -= 1
+            if n <= 0:
+                return
+        self._it = None
+        items.append(Token("eof", "", self.end, lines))
 
 
-def _unquote(text: str) -> str:
+def tokenize(text: str, source: str, lines: Lines | None = None) -> list[Token]:
+    toks = Tokens(text, source, lines)
+    toks.get(len(text) + 1)
+    return toks.items
+
+
+def unquote(text: str) -> str:
     return re.sub(r"\\(.)", r"\1", text[1:-1])
 
 
-class _Parser:
-    def __init__(self, tokens: list[Token], source: str):
-        self.t = tokens
-        self.n = len(tokens)
+_unquote = unquote
+
+
+class Parser:
+    """Nodes and values from a token stream. ``proto_body``: ``IS name`` is a value (a PROTO body).
+    ``nodes``/``values`` count what the tree holds once every USE stands for its copy."""
+
+    def __init__(self, tokens: Tokens, source: str, *, limits: ProtoLimits | None = None, proto_body: bool = False):
+        self.toks = tokens
         self.i = 0
         self.source = source
+        self.limits = limits or ProtoLimits()
+        self.proto_body = proto_body
         self.defs: dict[str, Node] = {}
-        self.count = 0
+        self.def_weight: dict[str, tuple[int, int]] = {}
+        self.count = 0          # nodes as written
+        self.nodes = 0          # nodes, USE counted as its copy
+        self.values = 0         # scalar values, USE counted as its copy
 
     def error(self, tok: Token, message: str) -> WbtSyntaxError:
         return WbtSyntaxError(self.source, tok.line, tok.col, message)
 
     def peek(self, k: int = 0) -> Token:
-        j = self.i + k
-        return self.t[j] if j < self.n else self.t[-1]
+        return self.toks.get(self.i + k)
 
     def take(self) -> Token:
-        tok = self.t[self.i]
+        tok = self.toks.get(self.i)
         if tok.kind != "eof":
             self.i += 1
         return tok
@@ -141,24 +230,44 @@ class _Parser:
         tok = self.take()
         if tok.kind != kind:
             raise self.error(tok, f"expected {what}, found {_describe(tok)}")
+        if kind == "name" and len(tok.text) > MAX_NAME_CHARS:
+            raise self.error(tok, f"a name of {len(tok.text):,} characters (at most {MAX_NAME_CHARS}): "
+                                  f"{short(tok.text, 40)}")
         return tok
 
-    def file(self, version: str) -> WbtFile:
+    def _grew(self, tok: Token) -> None:
+        lim = self.limits
+        if self.nodes > lim.nodes:
+            raise self.error(tok, f"more than {lim.nodes:,} nodes once DEF/USE copies are counted "
+                                  "(raise the limits with --allow-large)")
+        if self.values > lim.values:
+            raise self.error(tok, f"more than {lim.values:,} values once DEF/USE copies are counted "
+                                  "(raise the limits with --allow-large)")
+
+    def file(self, version: str, text: str) -> WbtFile:
         nodes: list[Node] = []
         protos: list[str] = []
+        decls: list[ExternProto] = []
+        defined: list[Any] = []
         while self.peek().kind != "eof":
             tok = self.peek()
+            importable = False
             if tok.kind == "name" and tok.text == "IMPORTABLE" and self.peek(1).text == "EXTERNPROTO":
                 self.take()
+                importable = True
                 tok = self.peek()
             if tok.kind == "name" and tok.text == "EXTERNPROTO":
                 self.take()
-                protos.append(_unquote(self.expect("str", "a quoted url after EXTERNPROTO").text))
+                url = unquote(self.expect("str", "a quoted url after EXTERNPROTO").text)
+                protos.append(url)
+                decls.append(ExternProto(url, tok.line, tok.col, importable))
             elif tok.kind == "name" and tok.text == "PROTO":
-                raise self.error(tok, "PROTO definitions inside a world file are not supported")
+                from sensorium.server.world.proto.interface import read_proto_definition
+
+                defined.append(read_proto_definition(self, text, inline=True))
             else:
                 nodes.append(self.node(0))
-        return WbtFile(version, nodes, protos)
+        return WbtFile(version, nodes, protos, self.source, decls, defined)
 
     def node(self, depth: int) -> Node:
         if depth > MAX_DEPTH:
@@ -167,33 +276,53 @@ class _Parser:
         if tok.text == "USE":
             ref = self.expect("name", "a DEF name after USE")
             if ref.text not in self.defs:
-                raise self.error(ref, f"USE {ref.text}: no DEF {ref.text} before this point")
+                raise self.error(ref, f"USE {short(ref.text, 40)}: no DEF {short(ref.text, 40)} before this point")
+            n, v = self.def_weight[ref.text]
+            self.nodes += n
+            self.values += v
+            self._grew(ref)
             return self.defs[ref.text]
         def_name = None
         if tok.text == "DEF":
             def_name = self.expect("name", "a name after DEF").text
-            tok = self.expect("name", f"a node type after DEF {def_name}")
-        if tok.text in ("TRUE", "FALSE", "NULL", "DEF", "USE"):
+            tok = self.expect("name", f"a node type after DEF {short(def_name, 40)}")
+        if tok.text in ("TRUE", "FALSE", "NULL", "DEF", "USE", "IS"):
             raise self.error(tok, f"expected a node type, found {tok.text}")
         self.count += 1
         if self.count > MAX_NODES:
             raise self.error(tok, f"more than {MAX_NODES} nodes")
-        self.expect("{", f"'{{' after node type {tok.text}")
-        node = Node(tok.text, {}, *tok.lines.at(tok.pos), def_name)
+        nodes0, values0 = self.nodes, self.values
+        self.nodes += 1
+        self._grew(tok)
+        self.expect("{", f"'{{' after node type {short(tok.text, 40)}")
+        node = Node(tok.text, {}, *tok.lines.at(tok.pos), def_name, source=self.source)
         while True:
             ftok = self.take()
             if ftok.kind == "}":
                 break
             if ftok.kind != "name":
-                raise self.error(ftok, f"expected a field name or '}}' in {tok.text} (line {tok.line}), found {_describe(ftok)}")
+                raise self.error(ftok, f"expected a field name or '}}' in {short(tok.text, 40)} (line {tok.line}), "
+                                       f"found {_describe(ftok)}")
+            if len(ftok.text) > MAX_NAME_CHARS:
+                raise self.error(ftok, f"a field name of {len(ftok.text):,} characters (at most {MAX_NAME_CHARS}): "
+                                       f"{short(ftok.text, 40)}")
             if ftok.text == "hidden":  # saved simulation state: "hidden NAME VALUE"
                 self.expect("name", "a field name after 'hidden'")
                 self.value(depth + 1)
                 continue
             node.field_pos[ftok.text] = ftok.lines.at(ftok.pos)
+            nxt = self.peek()
+            if nxt.kind == "name" and nxt.text == "IS":
+                self.take()
+                ref = self.expect("name", "a PROTO field name after IS")
+                if not self.proto_body:
+                    raise self.error(nxt, "IS is only allowed inside a PROTO body")
+                node.fields[ftok.text] = IsRef(ref.text, *ref.lines.at(ref.pos))
+                continue
             node.fields[ftok.text] = self.value(depth + 1)
         if def_name is not None:
             self.defs[def_name] = node
+            self.def_weight[def_name] = (self.nodes - nodes0, self.values - values0)
         return node
 
     def value(self, depth: int) -> Any:
@@ -210,66 +339,113 @@ class _Parser:
         if tok.kind == "num":
             nums = []
             while self.peek().kind == "num":
-                nums.append(_number(self.take()))
+                nums.append(self.number(self.take()))
+            self.values += len(nums)
+            self._grew(tok)
             return nums[0] if len(nums) == 1 else tuple(nums)
         return self.item(depth)
 
     def item(self, depth: int) -> Any:
         tok = self.peek()
         if tok.kind == "num":
-            return _number(self.take())
+            self.values += 1
+            self._grew(tok)
+            return self.number(self.take())
         if tok.kind == "str":
-            return _unquote(self.take().text)
+            self.values += 1
+            self._grew(tok)
+            return unquote(self.take().text)
         if tok.kind == "name":
             if tok.text in ("TRUE", "FALSE"):
                 self.take()
+                self.values += 1
                 return tok.text == "TRUE"
             if tok.text == "NULL":
                 self.take()
                 return None
             return self.node(depth)
+        if tok.kind == "tmpl":
+            raise self.error(tok, "template statement (%< ... >%) outside a PROTO body")
         raise self.error(tok, f"expected a value, found {_describe(tok)}")
 
+    def number(self, tok: Token) -> float:
+        text = tok.text
+        try:
+            if text.lstrip("+-").lower().startswith("0x"):
+                v = float(int(text, 16))
+            else:
+                v = float(text)
+        except OverflowError:
+            v = math.inf
+        if not math.isfinite(v):
+            raise self.error(tok, f"number {quote(text, 40)} is out of range (beyond ±1.8e308)")
+        return v
 
-def _number(tok: Token) -> float:
-    text = tok.text
-    if text.lstrip("+-").lower().startswith("0x"):
-        return float(int(text, 16))
-    return float(text)
+
+_Parser = Parser
+
+
+def short(text: str, limit: int = 40) -> str:
+    """``text`` cut to a short prefix (names echoed in errors)."""
+    return text if len(text) <= limit else text[:limit] + f"… ({len(text)} characters)"
 
 
 def _describe(tok: Token) -> str:
     if tok.kind == "eof":
         return "end of file"
-    return f"{tok.text!r}"
+    return quote(tok.text, 60)
 
 
-def parse_wbt(text: str, source: str = "<memory>") -> WbtFile:
+def parse_header(text: str, source: str, what: str = "world") -> tuple[int, str]:
+    """The version of ``#VRML_SIM R20xxy utf8`` on the first line: (year, letter)."""
     first = text.split("\n", 1)[0]
     m = _HEADER.match(first)
     if m is None:
-        raise WbtSyntaxError(source, 1, 1, "not a Webots world: the first line must be '#VRML_SIM R20xxy utf8'")
-    year, letter = int(m.group(1)), m.group(2)
+        raise WbtSyntaxError(source, 1, 1, f"not a Webots {what}: the first line must be '#VRML_SIM R20xxy utf8'")
+    return int(m.group(1)), m.group(2)
+
+
+def header_comments(text: str) -> list[str]:
+    """The ``#`` comment lines right after the first line (a file's licence, tags, template language)."""
+    out = []
+    for line in text.split("\n", 200)[1:200]:
+        s = line.strip()
+        if not s.startswith("#"):
+            if s:
+                break
+            continue
+        out.append(s[1:].strip())
+    return out
+
+
+def parse_wbt(text: str, source: str = "<memory>", limits: ProtoLimits | None = None) -> WbtFile:
+    year, letter = parse_header(text, source)
     if (year, letter) < (2022, "a"):
         raise WbtSyntaxError(source, 1, 1, f"Webots R{year}{letter} world: only R2022a and later are supported "
                              "(open and save it in Webots R2022a+ to convert it to the z-up, FLU conventions)")
-    return _Parser(tokenize(text, source), source).file(f"R{year}{letter}")
+    wbt = Parser(Tokens(text, source), source, limits=limits).file(f"R{year}{letter}", text)
+    wbt.header = header_comments(text)
+    return wbt
 
 
-def read_wbt(path: str | Path) -> WbtFile:
+def read_text(path: str | Path, what: str, max_bytes: int) -> str:
+    """A file's UTF-8 text, its size bounded; errors as ``WbtSyntaxError``."""
     path = Path(path)
     source = str(path)
     try:
         size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise WbtSyntaxError(source, 0, 0, f"file of {size} bytes exceeds the {MAX_FILE_BYTES}-byte limit for worlds")
+        if size > max_bytes:
+            raise WbtSyntaxError(source, 0, 0, f"file of {size} bytes exceeds the {max_bytes}-byte limit for {what}s")
         data = path.read_bytes()
     except OSError as exc:
-        raise WbtSyntaxError(source, 0, 0, f"cannot read world file: {exc.strerror or exc}") from None
+        raise WbtSyntaxError(source, 0, 0, f"cannot read {what} file: {exc.strerror or exc}") from None
     try:
-        text = data.decode("utf-8")
+        return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[:exc.start].count(b"\n") + 1
         raise WbtSyntaxError(source, line, exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1,
                              "not valid UTF-8") from None
-    return parse_wbt(text, source)
+
+
+def read_wbt(path: str | Path, limits: ProtoLimits | None = None) -> WbtFile:
+    return parse_wbt(read_text(path, "world", MAX_FILE_BYTES), str(path), limits)

@@ -15,7 +15,7 @@ from sensorium.server.world.wbt.parser import Node
 
 
 def _node(type_: str, at: Node, **fields) -> Node:
-    return Node(type_, dict(fields), at.line, at.col)
+    return Node(type_, dict(fields), at.line, at.col, source=at.source)
 
 
 def _solid(at: Node, f: Fields, name: str, items: list, translation=(0.0, 0.0, 0.0)) -> Node:

@@ -1,0 +1,615 @@
+"""Instantiate: every PROTO instance of a world replaced by the base nodes it stands for.
+
+For an instance of PROTO P (declared by an EXTERNPROTO of the file the instance is written in, or
+defined in that file): its field values are checked against P's interface (types, accepted values,
+unknown fields are errors at file:line:col), the fields it does not give take P's defaults; P's
+body is generated (a template, :mod:`.template`) or taken as written, parsed in a DEF/USE scope of
+its own, and every ``field IS name`` in it, at any depth, is replaced by the value of P's field
+``name``. The result is expanded in turn: PROTO instances inside P's body resolve through P's own
+EXTERNPROTOs, nodes the instance passed in (slots such as ``extensionSlot``) through the file they
+were written in. A PROTO that instantiates itself, directly or through others, is an error naming
+the chain.
+
+Nodes are never changed in place: a node whose subtree holds an instance is copied, the rest is
+shared (as DEF/USE shares it), so a parsed body serves every instance. Work is bounded by
+:class:`~sensorium.server.world.limits.ProtoLimits`: instances, nesting, the nodes and values of the
+expanded tree (DEF/USE reuse counted), template time, memory and output.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from sensorium.server.world.limits import ProtoLimits
+from sensorium.server.world.proto import template as tpl
+from sensorium.server.world.proto.errors import ProtoError
+from sensorium.server.world.proto.interface import (
+    FIELD_TYPES,
+    FieldDecl,
+    ProtoDef,
+    accepted_list,
+    check_value,
+    read_proto_file,
+    refused,
+    show,
+)
+from sensorium.server.world.proto.resolve import ProtoSearch, logical_location, resolve_url
+from sensorium.server.world.wbt.convert import SKIPPED
+from sensorium.server.world.wbt.parser import ExternProto, IsRef, Node, Parser, Tokens, WbtFile, WbtSyntaxError, short
+from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
+
+# PROTOs Sensorium stands in for when their file is not found: built-in expansions, and the
+# visual-only nodes the converter skips anyway (backgrounds)
+STAND_INS = frozenset(BUILTIN_PROTOS) | SKIPPED
+
+TREE_DEPTH = 150            # nodes nested inside one another in the expanded tree (the converter recurses)
+
+
+@dataclass
+class ProtoUse:
+    """One PROTO the world used: its file, licence line and how many instances."""
+
+    name: str
+    path: str                          # the file it was read from ('' for a built-in stand-in)
+    url: str                           # as declared (or the world file for a definition written in it)
+    license: str | None
+    license_url: str | None
+    instances: int = 0
+    builtin: bool = False              # Sensorium's built-in stand-in (the file was not found)
+
+
+@dataclass
+class Expansion:
+    """A world with every PROTO instance expanded. ``nodes``: the world's top-level nodes, base
+    nodes only (built-in stand-ins excepted); ``protos``: each PROTO used; ``warnings``: one
+    "file:line:col: message" each; ``search``: where files were looked for (with the world's
+    version tag), for resolving asset urls the same way."""
+
+    nodes: list[Node]
+    protos: list[ProtoUse]
+    warnings: list[str]
+    search: ProtoSearch
+    wbt: WbtFile | None = None
+
+    def as_wbt(self) -> WbtFile:
+        """The world file with its nodes replaced by the expansion."""
+        assert self.wbt is not None
+        return replace(self.wbt, nodes=self.nodes)
+
+
+@dataclass
+class _Scope:
+    """What a file's node types resolve to: its EXTERNPROTOs and the PROTOs written in it."""
+
+    source: str
+    declared: dict[str, ExternProto]
+    defined: dict[str, ProtoDef] = field(default_factory=dict)
+    found: dict[str, ProtoDef | None] = field(default_factory=dict)
+
+
+def expand(wbt: WbtFile, search: ProtoSearch, limits: ProtoLimits | None = None) -> Expansion:
+    """Expand every PROTO instance of ``wbt`` (read by :func:`~sensorium.server.world.wbt.parser.read_wbt`).
+    Raises ``ProtoError`` (one line) for a PROTO that cannot be found or instantiated."""
+    if search.version is None:
+        search = replace(search, version=wbt.version)
+    from sensorium.server.world.proto import engine
+
+    try:
+        return _Expander(wbt, search, limits or ProtoLimits()).run()
+    except ProtoError:
+        raise
+    except WbtSyntaxError as exc:      # in a PROTO file's text
+        raise ProtoError(exc.source, exc.line, exc.col, exc.message) from None
+    finally:
+        engine.release()               # no worker process outlives the load
+
+
+class _Expander:
+    def __init__(self, wbt: WbtFile, search: ProtoSearch, limits: ProtoLimits):
+        self.wbt = wbt
+        self.search = search
+        self.limits = limits
+        self.world = wbt.source
+        self.scopes: dict[str, _Scope] = {}
+        world_scope = _Scope(self.world, _declared(wbt.declarations), {p.name: p for p in wbt.protos})
+        self.scopes[self.world] = world_scope
+        self.files: dict[str, ProtoDef] = {}               # resolved path → PROTO read
+        self.uses: dict[str, ProtoUse] = {}
+        self.warnings: list[str] = []
+        self.noted: set[str] = set()
+        self.stand_ins: dict[str, tuple[str, int, int]] = {}
+        self.memo: dict[int, tuple[Node, Node]] = {}       # id(node) → (node, its expansion)
+        self.outer: dict[int, tuple[str, ...]] = {}        # nodes an instance passed in → the chain they were written in
+        self.bodies: dict[tuple[str, str], Node] = {}      # (PROTO file, generated text) → parsed root
+        self.is_holders: dict[int, tuple[Node, bool]] = {}  # id(body node) → (node, whether an IS is under it)
+        self.rendered: dict[tuple[str, str], tpl.Rendered] = {}
+        self.budget = tpl.Budget(limits.template_total_seconds)
+        self.instances = 0
+        self.coordinate_system = _coordinate_system(wbt.nodes)
+        for p in wbt.protos:
+            self.warnings += p.warnings
+
+    # ------------------------------------------------------------------ top level
+    def run(self) -> Expansion:
+        nodes = [self.node(n, (), 0) for n in self.wbt.nodes]
+        self.check_size(nodes)
+        self.unused_declarations()
+        self.stand_in_note()
+        return Expansion(nodes, list(self.uses.values()), self.warnings, self.search, self.wbt)
+
+    def check_size(self, nodes: list[Node]) -> None:
+        """Nodes and values of the expanded tree, each DEF/USE or shared copy counted (what the
+        converter walks), stopped at the bound."""
+        weight: dict[int, tuple[int, int]] = {}
+        lim = self.limits
+        total_n = total_v = 0
+
+        def of(node: Node) -> tuple[int, int]:
+            key = id(node)
+            if key in weight:
+                return weight[key]
+            n, v = 1, 0
+            for value in node.fields.values():
+                dn, dv = of_value(value)
+                n, v = n + dn, v + dv
+            weight[key] = (n, v)
+            return n, v
+
+        def of_value(value: Any) -> tuple[int, int]:
+            if isinstance(value, Node):
+                return of(value)
+            if isinstance(value, list):
+                n = v = 0
+                for x in value:
+                    dn, dv = of_value(x)
+                    n, v = n + dn, v + dv
+                return n, v
+            if isinstance(value, tuple):
+                return 0, len(value)
+            return 0, 0 if value is None else 1
+
+        for top in nodes:
+            n, v = of(top)
+            total_n, total_v = total_n + n, total_v + v
+            if total_n > lim.nodes or total_v > lim.values:
+                what = f"{lim.nodes:,} nodes" if total_n > lim.nodes else f"{lim.values:,} values"
+                raise ProtoError(top.source or self.world, top.line, top.col,
+                                 f"the world holds more than {what} once PROTO instances are expanded and DEF/USE "
+                                 "copies counted (raise the limits with --allow-large)")
+
+    def unused_declarations(self) -> None:
+        scope = self.scopes[self.world]
+        for name, decl in scope.declared.items():
+            if name in scope.found or decl.importable or name in self.stand_ins:
+                continue
+            try:
+                resolve_url(decl.url, self.world, self.search)
+            except ProtoError as exc:
+                self.warnings.append(f"{self.world}:{decl.line}:{decl.col}: EXTERNPROTO {short(name)} (not used by "
+                                     f"the world): {exc.message}")
+
+    # ------------------------------------------------------------------ resolution
+    def scope_of(self, node: Node) -> _Scope | None:
+        return self.scopes.get(node.source or self.world)
+
+    def lookup(self, node: Node) -> ProtoDef | None:
+        """The PROTO ``node``'s type names in the file it was written in (None: a base node, an
+        undeclared type, or a built-in stand-in)."""
+        scope = self.scope_of(node)
+        if scope is None:
+            return None
+        name = node.type
+        if name in scope.found:
+            return scope.found[name]
+        found: ProtoDef | None = None
+        if name in scope.defined:
+            found = scope.defined[name]
+            self.use(found, "", found.source)
+        elif name in scope.declared:
+            found = self.load(scope, scope.declared[name])
+        scope.found[name] = found
+        return found
+
+    def load(self, scope: _Scope, decl: ExternProto) -> ProtoDef | None:
+        try:
+            path = resolve_url(decl.url, scope.source, self.search)
+        except ProtoError as exc:
+            if decl.name in STAND_INS:
+                self.note_builtin(scope, decl, exc.message)
+                return None
+            raise ProtoError(scope.source, decl.line, decl.col, f"EXTERNPROTO {short(decl.name)}: {exc.message}") from None
+        key = str(path)
+        if key not in self.files:
+            if len(self.files) >= self.limits.proto_files:
+                raise ProtoError(scope.source, decl.line, decl.col, f"more than {self.limits.proto_files:,} PROTO files "
+                                 "(raise the limits with --allow-large)")
+            proto = read_proto_file(path, key, self.limits)
+            if proto.name != decl.name:
+                raise ProtoError(key, proto.line, proto.col, f"PROTO {short(proto.name)}: the name does not match the "
+                                 f"file name {short(decl.name)}.proto (Webots requires them to match)")
+            self.files[key] = proto
+            self.scopes[key] = _Scope(key, _declared(proto.externprotos))
+            self.warnings += proto.warnings
+            self.version_note(path, decl)
+        proto = self.files[key]
+        self.use(proto, decl.url, key)
+        return proto
+
+    def use(self, proto: ProtoDef, url: str, path: str) -> None:
+        key = f"{proto.source}\0{proto.name}"
+        if key not in self.uses:
+            self.uses[key] = ProtoUse(proto.name, path, url or path, proto.license, proto.license_url)
+
+    def note_builtin(self, scope: _Scope, decl: ExternProto, why: str) -> None:
+        if decl.name not in self.stand_ins:
+            self.stand_ins[decl.name] = (scope.source, decl.line, decl.col)
+            what = ("Sensorium's built-in stand-in (no Webots file used)" if decl.name in BUILTIN_PROTOS
+                    else "not read (skipped: no effect on these sensors)")
+            self.uses[f"\0{decl.name}"] = ProtoUse(decl.name, "", decl.url, what, None, builtin=True)
+
+    def stand_in_note(self) -> None:
+        """One line for every PROTO file not found that Sensorium stands in for."""
+        if not self.stand_ins:
+            return
+        source, line, col = min(self.stand_ins.values(), key=lambda at: (at[0] != self.world, at))
+        built = sorted(n for n in self.stand_ins if n in BUILTIN_PROTOS)
+        skipped = sorted(n for n in self.stand_ins if n not in BUILTIN_PROTOS)
+        parts = ([f"Sensorium's built-in stand-ins used for {', '.join(built)}"] if built else []) + \
+                ([f"{', '.join(skipped)} skipped (no effect on these sensors)"] if skipped else [])
+        self.warnings.append(f"{source}:{line}:{col}: PROTO files not found: {'; '.join(parts)} (give --webots-home "
+                             "or WEBOTS_HOME to use Webots' own)")
+
+    def version_note(self, path: Path, decl: ExternProto) -> None:
+        home = self.search.home
+        if home is None or "installation" in self.noted:
+            return
+        try:
+            inside = path.resolve().is_relative_to(home.resolve())
+        except OSError:
+            inside = False
+        installed = self.search.installed_version()
+        wanted = self.search.version
+        if inside and installed and wanted and installed != wanted:
+            self.noted.add("installation")
+            self.warnings.append(f"{self.world}: PROTOs of Webots {wanted} are read from the Webots {installed} "
+                                 f"installation at {home} (its PROTOs may differ from {wanted}'s)")
+
+    # ------------------------------------------------------------------ the walk
+    def node(self, node: Node, chain: tuple[str, ...], depth: int) -> Node:
+        key = id(node)
+        hit = self.memo.get(key)
+        if hit is not None:
+            return hit[1]
+        if depth > TREE_DEPTH:
+            raise ProtoError(node.source or self.world, node.line, node.col,
+                             f"nodes nested deeper than {TREE_DEPTH} levels once PROTOs are expanded")
+        chain = self.outer.get(key, chain)
+        proto = self.lookup(node)
+        result = self.instance(node, proto, chain, depth) if proto is not None else self.fields(node, chain, depth)
+        self.memo[key] = (node, result)
+        return result
+
+    def fields(self, node: Node, chain: tuple[str, ...], depth: int) -> Node:
+        changed: dict[str, Any] | None = None
+        for name, value in node.fields.items():
+            new = self.value(value, chain, depth)
+            if new is not value:
+                if changed is None:
+                    changed = dict(node.fields)
+                changed[name] = new
+        if changed is None:
+            return node
+        return _copy(node, fields=changed)
+
+    def value(self, value: Any, chain: tuple[str, ...], depth: int) -> Any:
+        if isinstance(value, Node):
+            return self.node(value, chain, depth + 1)
+        if isinstance(value, list) and any(isinstance(x, Node) for x in value):
+            out = [self.node(x, chain, depth + 1) if isinstance(x, Node) else x for x in value]
+            return value if all(a is b for a, b in zip(out, value)) else out
+        if isinstance(value, IsRef):
+            raise ProtoError(self.world, value.line, value.col, f"IS {value.name}: outside a PROTO body")
+        return value
+
+    # ------------------------------------------------------------------ one instance
+    def instance(self, node: Node, proto: ProtoDef, chain: tuple[str, ...], depth: int) -> Node:
+        where = node.source or self.world
+        if proto.name in chain:
+            loop = " → ".join([*chain[chain.index(proto.name):], proto.name])
+            raise ProtoError(where, node.line, node.col, f"PROTO {proto.name} instantiates itself: {loop}")
+        if len(chain) >= self.limits.depth:
+            raise ProtoError(where, node.line, node.col, f"PROTO instances nested deeper than {self.limits.depth} "
+                             f"levels: {' → '.join(chain[:6])} … {proto.name} (raise the limits with --allow-large)")
+        self.instances += 1
+        if self.instances > self.limits.instances:
+            raise ProtoError(where, node.line, node.col, f"more than {self.limits.instances:,} PROTO instances "
+                             "(raise the limits with --allow-large)")
+        if proto.is_lua:
+            raise ProtoError(proto.source, proto.line, proto.col, f"PROTO {proto.name}: Lua templates (Webots before "
+                             "R2022b) are not supported: open and save the PROTO in Webots R2022b or later, or port its "
+                             "template to JavaScript")
+        values, given = self.values(node, proto, chain)
+        body = self.body(node, proto, values)
+        inner = (*chain, proto.name)
+        root = self.substitute(body, proto, values, given, chain)
+        out = self.node(root, inner, depth)
+        self.uses[f"{proto.source}\0{proto.name}"].instances += 1
+        return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col))
+
+    def values(self, node: Node, proto: ProtoDef, chain: tuple[str, ...]) -> tuple[dict[str, Any], set[str]]:
+        """The instance's value of every field of ``proto``, checked."""
+        where = node.source or self.world
+        values: dict[str, Any] = {}
+        for name, raw in node.fields.items():
+            line, col = node.field_pos.get(name, (node.line, node.col))
+            decl = proto.fields.get(name)
+            if decl is None:
+                raise ProtoError(where, line, col, f"{proto.name}.{short(name)}: not a field of PROTO {proto.name} "
+                                 f"(its fields: {proto.field_list()})")
+            if isinstance(raw, IsRef):
+                raise ProtoError(where, raw.line, raw.col, f"IS {raw.name}: outside a PROTO body")
+            try:
+                value = check_value(decl.type, raw)
+            except ValueError as exc:
+                raise ProtoError(where, line, col, f"{proto.name}.{name}: {exc}") from None
+            bad = refused(decl, value, self.type_names)
+            if bad is not None:
+                raise ProtoError(where, line, col, f"{proto.name}.{name}: {show(bad)} is not an accepted value "
+                                 f"(one of: {accepted_list(decl)})")
+            values[name] = value
+        given = set(values)
+        for name, decl in proto.fields.items():
+            values.setdefault(name, decl.default)
+        return values, given
+
+    def type_names(self, node: Node) -> set[str]:
+        """A node's type and, for a PROTO instance, the base node type it expands to."""
+        names = {node.type}
+        proto = self.lookup(node)
+        while proto is not None and len(names) < 16:
+            base = _body_type(proto)
+            if base is None or base in names:
+                break
+            names.add(base)
+            probe = Node(base, {}, node.line, node.col, source=proto.source)
+            proto = self.lookup(probe)
+        return names
+
+    # ------------------------------------------------------------------ the body
+    def body(self, node: Node, proto: ProtoDef, values: dict[str, Any]) -> Node:
+        """The PROTO's body as nodes (with IsRefs): generated by its template when it has one."""
+        if not proto.is_template:
+            key = (proto.source, "")
+            if key not in self.bodies:
+                tokens = Tokens(proto.text, proto.source, proto.lines, proto.body_offset, proto.body_end)
+                self.bodies[key] = self.parse_body(tokens, proto)
+            return self.bodies[key]
+        names = tpl.referenced_fields(proto.body, list(proto.fields))
+        if "indirectFieldAccess" in proto.tags:
+            names = list(proto.fields)
+        fields_js = "{" + ", ".join(
+            f"{n}: {{value: {self.js(proto.fields[n], values[n])}, defaultValue: {self.js(proto.fields[n], proto.fields[n].default)}}}"
+            for n in names) + "}"
+        deterministic = "nonDeterministic" not in proto.tags
+        key = (proto.source, fields_js + "\0" + self.coordinate_system)
+        rendered = self.rendered.get(key) if deterministic else None
+        if rendered is None:
+            context = self.context(proto)
+            rendered = tpl.render(proto.body, source=proto.source, proto=proto.name, file_lines=proto.lines,
+                                  body_offset=proto.body_offset, fields_js=fields_js, context_js=context,
+                                  limits=self.limits, budget=self.budget)
+            if deterministic:
+                self.rendered[key] = rendered
+            for level, message in rendered.messages:
+                if level in ("error", "warn") and len(self.warnings) < 1000:
+                    self.warnings.append(f"{proto.source}:{proto.line}:{proto.col}: PROTO {proto.name} (instance at "
+                                         f"{node.source or self.world}:{node.line}): template says: {message}")
+        bkey = (proto.source, rendered.text)
+        if bkey not in self.bodies:
+            try:
+                self.bodies[bkey] = self.parse_body(Tokens(rendered.text, proto.source, rendered.lines), proto)
+            except WbtSyntaxError as exc:
+                raise ProtoError(exc.source, exc.line, exc.col, f"{exc.message} (in the text PROTO {proto.name}'s "
+                                 "template generated)") from None
+        return self.bodies[bkey]
+
+    def parse_body(self, tokens: Tokens, proto: ProtoDef) -> Node:
+        parser = Parser(tokens, proto.source, limits=self.limits, proto_body=True)
+        first = parser.peek()
+        if first.kind == "eof":
+            raise ProtoError(proto.source, proto.line, proto.col, f"PROTO {proto.name}: the body holds no node")
+        root = parser.node(0)
+        extra = parser.peek()
+        if extra.kind != "eof":
+            raise parser.error(extra, f"PROTO {proto.name}: the body holds more than one node (found {extra.text!r} "
+                                      "after its first node)")
+        return root
+
+    def context(self, proto: ProtoDef) -> str:
+        world = os.path.abspath(self.world)
+        home = self.search.home
+        system = platform.system()
+        version = self.search.version or ""
+        ctx = {"world": world, "proto": logical_location(proto.source) if not proto.inline else world,
+               "project_path": str(Path(world).parent.parent) + os.sep,
+               "webots_home": str(home) if home is not None else "", "temporary_files_path": "",
+               "os": {"Windows": "windows", "Darwin": "mac"}.get(system, "linux"), "id": str(self.instances),
+               "coordinate_system": self.coordinate_system,
+               "webots_version": {"major": version, "revision": "0"}}
+        return json.dumps(ctx)
+
+    def js(self, decl: FieldDecl, value: Any) -> str:
+        budget = [2000]                       # nodes written out per field (a huge slot stays a small object)
+        return tpl.js_value(decl.type, value, lambda n: self.node_js(n, budget, 0))
+
+    def node_js(self, node: Node | None, budget: list[int], depth: int) -> str:
+        if node is None:
+            return "undefined"
+        budget[0] -= 1
+        if budget[0] < 0 or depth > 12:
+            return json.dumps({"node_name": node.type, "fields": {}})
+        proto = self.lookup(node)
+        parts = []
+        if proto is not None:
+            for name, decl in proto.fields.items():
+                try:
+                    value = check_value(decl.type, node.fields[name]) if name in node.fields else decl.default
+                except ValueError:
+                    value = decl.default
+                if isinstance(value, IsRef):
+                    value = decl.default
+                write = lambda n, b=budget, d=depth: self.node_js(n, b, d + 1)
+                parts.append(f"{name}: {{value: {tpl.js_value(decl.type, value, write)}, "
+                             f"defaultValue: {tpl.js_value(decl.type, decl.default, write)}}}")
+        else:
+            for name, value in node.fields.items():
+                js = self.guess_js(name, value, budget, depth)
+                parts.append(f"{name}: {{value: {js}, defaultValue: {js}}}")
+        return "{node_name: " + json.dumps(node.type) + ", fields: {" + ", ".join(parts) + "}}"
+
+    def guess_js(self, name: str, value: Any, budget: list[int], depth: int) -> str:
+        """A base node's field in JavaScript without its declared type: numbers by their count
+        (three numbers named like a colour are {r, g, b})."""
+        write = lambda n: self.node_js(n, budget, depth + 1)
+        if isinstance(value, Node) or value is None:
+            return write(value)
+        if isinstance(value, bool):
+            return "true" if value else "false"
+        if isinstance(value, float | int):
+            return tpl.js_number(value)
+        if isinstance(value, str):
+            return json.dumps(value)
+        if isinstance(value, tuple):
+            kind = {2: "SFVec2f", 3: "SFColor" if "color" in name.lower() else "SFVec3f", 4: "SFRotation"}.get(len(value))
+            if kind is None:
+                return "[" + ", ".join(tpl.js_number(x) for x in value) + "]"
+            return tpl.js_value(kind, value, write)
+        if isinstance(value, list):
+            return "[" + ", ".join(self.guess_js(name, x, budget, depth) for x in value) + "]"
+        return "undefined"
+
+    # ------------------------------------------------------------------ IS
+    def substitute(self, body: Node, proto: ProtoDef, values: dict[str, Any], given: set[str],
+                   chain: tuple[str, ...]) -> Node:
+        """``body`` with every ``IS name`` replaced by the value of the PROTO's field ``name``;
+        nodes the instance passed in keep the chain they were written in."""
+        done: dict[int, Node] = {}
+
+        def put(value: Any, name: str) -> Any:
+            if name in given:
+                for n in (value if isinstance(value, list) else [value]):
+                    if isinstance(n, Node):
+                        self.outer.setdefault(id(n), chain)
+                        self.memo_keep(n)
+            return value
+
+        def walk(node: Node) -> Node:
+            key = id(node)
+            if key in done:
+                return done[key]
+            if not self.holds_is(node):
+                done[key] = node
+                return node
+            changed: dict[str, Any] | None = None
+            for fname, value in node.fields.items():
+                new = value
+                if isinstance(value, IsRef):
+                    if value.name not in proto.fields:
+                        raise ProtoError(proto.source, value.line, value.col, f"IS {short(value.name)}: PROTO "
+                                         f"{proto.name} has no field {short(value.name)} (its fields: {proto.field_list()})")
+                    new = put(values[value.name], value.name)
+                    if isinstance(new, list):
+                        new = list(new)
+                elif isinstance(value, Node):
+                    new = walk(value)
+                elif isinstance(value, list) and any(isinstance(x, Node) for x in value):
+                    out = [walk(x) if isinstance(x, Node) else x for x in value]
+                    new = value if all(a is b for a, b in zip(out, value)) else out
+                if new is not value:
+                    if changed is None:
+                        changed = dict(node.fields)
+                    changed[fname] = new
+            result = node if changed is None else _copy(node, fields=changed)
+            done[key] = result
+            return result
+
+        return walk(body)
+
+    def holds_is(self, node: Node) -> bool:
+        """Whether an IS is written anywhere under ``node`` (body nodes, asked once each)."""
+        key = id(node)
+        known = self.is_holders.get(key)
+        if known is not None:
+            return known[1]
+        found = False
+        for value in node.fields.values():
+            if isinstance(value, IsRef):
+                found = True
+            elif isinstance(value, Node):
+                found = self.holds_is(value) or found
+            elif isinstance(value, list):
+                for x in value:
+                    if isinstance(x, Node) and self.holds_is(x):
+                        found = True
+        self.is_holders[key] = (node, found)
+        return found
+
+    def memo_keep(self, node: Node) -> None:
+        """Nodes marked by id must stay alive while the expansion runs (ids are reused)."""
+        self._kept = getattr(self, "_kept", [])
+        self._kept.append(node)
+
+
+def _copy(node: Node, **changes: Any) -> Node:
+    """A shallow copy of ``node`` with some attributes changed (dataclasses.replace, without its cost)."""
+    new = object.__new__(Node)
+    new.__dict__.update(node.__dict__)
+    new.__dict__.update(changes)
+    return new
+
+
+def _short_why(message: str) -> str:
+    """The places tried, from a not-found message (the note stays one short line)."""
+    looked = message.split("; looked in: ", 1)
+    return "looked in: " + looked[1].split("; nothing is downloaded", 1)[0] if len(looked) == 2 else message
+
+
+def _declared(decls: list[ExternProto]) -> dict[str, ExternProto]:
+    out: dict[str, ExternProto] = {}
+    for d in decls:
+        out.setdefault(d.name, d)
+    return out
+
+
+def _coordinate_system(nodes: list[Node]) -> str:
+    for n in nodes:
+        if n.type == "WorldInfo":
+            v = n.fields.get("coordinateSystem", "ENU")
+            return v if isinstance(v, str) else "ENU"
+    return "ENU"
+
+
+def _body_type(proto: ProtoDef) -> str | None:
+    """The type of a PROTO body's root node as written (templates: the first word outside a statement)."""
+    import re
+
+    text = re.sub(r"%<.*?>%", " ", proto.body, flags=re.DOTALL)
+    m = re.search(r"(?:DEF\s+\S+\s+)?([A-Za-z_][^\s{}\[\]\"#,]*)\s*\{", text)
+    return m.group(1) if m else None
+
+
+def protos_used(path: str | Path, webots_home: str | Path | None = None,
+                proto_path: tuple[str | Path, ...] = ()) -> list[ProtoUse]:
+    """The PROTOs a .wbt world uses (name, file, licence line, instances), for ``sensorium info``."""
+    from sensorium.server.world.wbt.parser import read_wbt
+
+    path = Path(path)
+    return expand(read_wbt(path), ProtoSearch.create(path.resolve().parent, webots_home, proto_path)).protos
+
+
+__all__ = ["expand", "protos_used", "Expansion", "ProtoUse", "FIELD_TYPES", "WbtSyntaxError"]

@@ -1,0 +1,210 @@
+"""Where PROTO files (and assets) are found, never downloading: relative to the declaring file,
+siblings by bare file name, ``webots://`` and raw.githubusercontent.com urls against a fake Webots
+installation (WEBOTS_HOME) and proto_path folders (a tree, Webots' asset-cache layout, a project's
+protos/), built-in stand-ins, and the one-line message when a file is nowhere."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import pytest
+from _protos import HEADER, expanded, proto_file, world_file
+
+from sensorium.server.world.loader import WorldError, load_world
+from sensorium.server.world.proto import ProtoError, ProtoSearch, asset_roots, resolve_url
+from sensorium.server.world.proto.resolve import logical_location
+
+RAW = "https://raw.githubusercontent.com/cyberbotics/webots"
+
+
+def fake_webots(root: Path, version: str = "R2023b") -> Path:
+    """A Webots installation tree: a robot PROTO using a sibling by bare name and a webots:// device."""
+    protos = root / "projects" / "robots" / "acme" / "bot" / "protos"
+    proto_file(protos, "AcmeBot", """[ field SFString name "acme" field MFNode extensionSlot [ ] ]
+{ Robot { name IS name children [ AcmeEye { } Group { children IS extensionSlot } ] } }""",
+               header='EXTERNPROTO "AcmeEye.proto"\n')
+    proto_file(protos, "AcmeEye", "[ ] { LightSensor { name \"eye\" } }")
+    devices = root / "projects" / "devices" / "acme" / "protos"
+    proto_file(devices, "AcmeRanger", "[ ] { DistanceSensor { name \"ranger\" } }")
+    (root / "resources").mkdir(parents=True, exist_ok=True)
+    (root / "resources" / "version.txt").write_text(version + "\n")
+    return root
+
+
+def test_webots_and_raw_github_urls_map_to_the_installation(tmp_path: Path, monkeypatch) -> None:
+    home = fake_webots(tmp_path / "webots")
+    monkeypatch.setenv("WEBOTS_HOME", str(home))
+    w = world_file(tmp_path / "project" / "worlds", 'AcmeBot { extensionSlot [ AcmeRanger { } ] }\n', [
+        f"{RAW}/R2023b/projects/robots/acme/bot/protos/AcmeBot.proto",
+        "webots://projects/devices/acme/protos/AcmeRanger.proto"])
+    (robot,) = load_world(w).world.robots
+    assert [d.name for d in robot.devices] == ["eye", "ranger"]
+    uses = {u.name: u.path for u in expanded(w).protos}
+    assert uses == {"AcmeBot": str(home / "projects/robots/acme/bot/protos/AcmeBot.proto"),
+                    "AcmeEye": str(home / "projects/robots/acme/bot/protos/AcmeEye.proto"),
+                    "AcmeRanger": str(home / "projects/devices/acme/protos/AcmeRanger.proto")}
+
+
+def test_explicit_webots_home_and_macos_bundle(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
+    app = tmp_path / "Webots.app"
+    fake_webots(app / "Contents")
+    w = world_file(tmp_path, "AcmeRanger { }\n", ["webots://projects/devices/acme/protos/AcmeRanger.proto"])
+    with pytest.raises(WorldError, match="not found"):
+        load_world(w)
+    robot_less = expanded(w, webots_home=app).nodes
+    assert robot_less[0].type == "DistanceSensor"
+    assert asset_roots(ProtoSearch.create(tmp_path, app)) == [(app / "Contents").resolve()]
+
+
+def test_a_different_installed_version_is_noted(tmp_path: Path) -> None:
+    home = fake_webots(tmp_path / "webots", version="R2025a")
+    w = world_file(tmp_path, "AcmeRanger { }\n", ["webots://projects/devices/acme/protos/AcmeRanger.proto"])
+    notes = [x for x in expanded(w, webots_home=home).warnings if "installation" in x]
+    assert notes == [f"{w}: PROTOs of Webots R2023b are read from the Webots R2025a installation at {home} "
+                     "(its PROTOs may differ from R2023b's)"]
+
+
+def test_relative_and_sibling_urls(tmp_path: Path) -> None:
+    lib = tmp_path / "lib" / "protos"
+    proto_file(lib, "Wheel", "[ ] { Solid { name \"wheel\" } }")
+    proto_file(lib, "Cart", "[ ] { Group { children [ Wheel { } Wheel { } ] } }", header='EXTERNPROTO "Wheel.proto"\n')
+    w = world_file(tmp_path / "worlds", "Cart { }\n", ["../lib/protos/Cart.proto"])
+    assert [s.name for s in load_world(w).world.solids] == ["wheel", "wheel(1)"]
+
+
+def test_proto_path_tree_cache_layout_and_project_protos(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
+    # 1. a folder holding a copy of Webots' tree
+    tree = fake_webots(tmp_path / "copy")
+    # 2. Webots' asset-cache layout (an unpacked assets-R2023b.zip): files named by the SHA-1 of their raw url;
+    #    the PROTO's relative EXTERNPROTO and mesh urls resolve against that url
+    cache = tmp_path / "assets-R2023b"
+    cache.mkdir()
+    url = f"{RAW}/R2023b/projects/objects/acme/protos/Crate.proto"
+    sibling = f"{RAW}/R2023b/projects/objects/acme/protos/Lid.proto"
+    mesh = f"{RAW}/R2023b/projects/objects/acme/protos/meshes/crate.obj"
+    (cache / hashlib.sha1(url.encode()).hexdigest()).write_text(
+        HEADER + 'EXTERNPROTO "Lid.proto"\nPROTO Crate [ ] { Group { children [ Lid { } ] } }\n')
+    (cache / hashlib.sha1(sibling.encode()).hexdigest()).write_text(HEADER + 'PROTO Lid [ ] { Solid { name "lid" } }\n')
+    (cache / hashlib.sha1(mesh.encode()).hexdigest()).write_text("v 0 0 0\n")
+    # 3. a project's protos/ folder: found by file name, however deep
+    proto_file(tmp_path / "project" / "protos" / "deep" / "er", "Shelf", "[ ] { Solid { name \"shelf\" } }")
+    w = world_file(tmp_path / "w", "AcmeRanger { }\nCrate { }\nShelf { }\n", [
+        "webots://projects/devices/acme/protos/AcmeRanger.proto",
+        "webots://projects/objects/acme/protos/Crate.proto",
+        "https://example.org/users/someone/Shelf.proto"])
+    search = dict(proto_path=[tree, cache, tmp_path / "project" / "protos"])
+    nodes = expanded(w, **search).nodes
+    assert [n.type for n in nodes] == ["DistanceSensor", "Group", "Solid"]
+    assert nodes[1].fields["children"][0].fields["name"] == "lid" and nodes[2].fields["name"] == "shelf"
+    # an asset named relative to the cached PROTO resolves to its cached file too
+    crate = cache / hashlib.sha1(url.encode()).hexdigest()
+    assert logical_location(crate) == url
+    s = ProtoSearch.create(w.parent, proto_path=search["proto_path"], version="R2023b")
+    assert resolve_url("meshes/crate.obj", crate, s) == cache / hashlib.sha1(mesh.encode()).hexdigest()
+    # the same through the environment variable the CLI flags set
+    monkeypatch.setenv("SENSORIUM_PROTO_PATH", f"{tree}:{cache}:{tmp_path / 'project' / 'protos'}")
+    assert [n.type for n in expanded(w).nodes] == ["DistanceSensor", "Group", "Solid"]
+
+
+def test_cache_log_names_the_urls(tmp_path: Path) -> None:
+    """A cache folder's log.txt ('HASH URL' lines, as Webots writes it) tells what a file stands for."""
+    cache = tmp_path / "assets"
+    cache.mkdir()
+    url = f"{RAW}/R2023b/projects/x/protos/Y.proto"
+    h = hashlib.sha1(url.encode()).hexdigest()
+    (cache / h).write_text("x")
+    (cache / "log.txt").write_text(f"Cache generated with tag R2023b\n\n{h} {url}\n")
+    assert logical_location(cache / h) == url
+
+
+def test_missing_file_is_one_line_naming_url_places_tag_and_remedy(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots")
+    w = world_file(tmp_path, "Nope { }\n", [f"{RAW}/R2023a/projects/robots/nope/protos/Nope.proto"])
+    with pytest.raises(ProtoError) as exc:
+        expanded(w, webots_home=home, proto_path=[tmp_path / "extra"])
+    msg = str(exc.value)
+    assert "\n" not in msg and msg.startswith(f"{w}:2:1: EXTERNPROTO Nope: ")
+    assert f'"{RAW}/R2023a/projects/robots/nope/protos/Nope.proto" not found (Webots R2023a)' in msg
+    assert f"looked in: {home}/projects/robots/nope/protos/Nope.proto, {tmp_path}/extra/projects/robots/nope/protos/Nope.proto" in msg
+    assert "nothing is downloaded" in msg and "--webots-home" in msg and "WEBOTS_HOME" in msg and "--proto-path" in msg
+    # without any installation, the message says so
+    with pytest.raises(ProtoError, match="looked in: nothing .no Webots installation, no --proto-path folder.*WEBOTS_HOME is not set"):
+        expanded(w)
+
+
+def test_missing_relative_file_names_the_place(tmp_path: Path) -> None:
+    w = world_file(tmp_path, "Gone { }\n", ["protos/Gone.proto"])
+    with pytest.raises(ProtoError, match=rf'"protos/Gone.proto" not found \(Webots R2023b\); looked in: {tmp_path}/protos/Gone.proto'):
+        expanded(w)
+
+
+def test_builtin_stand_ins_when_the_file_is_missing_and_the_real_one_when_found(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
+    body = "RectangleArena { floorSize 2 2 }\nTexturedBackground { }\n"
+    decls = [f"{RAW}/R2023b/projects/objects/floors/protos/RectangleArena.proto",
+             f"{RAW}/R2023b/projects/objects/backgrounds/protos/TexturedBackground.proto"]
+    w = world_file(tmp_path, body, decls)
+    loaded = load_world(w)
+    assert loaded.world.solids[0].name == "rectangle arena"
+    notes = [x for x in loaded.warnings if "PROTO files not found" in x]
+    assert notes == [f"{w}:2:1: PROTO files not found: Sensorium's built-in stand-ins used for RectangleArena; "
+                     "TexturedBackground skipped (no effect on these sensors) (give --webots-home or WEBOTS_HOME to "
+                     "use Webots' own)"]
+    uses = {u.name: u for u in expanded(w).protos}
+    assert uses["RectangleArena"].builtin and uses["RectangleArena"].license.startswith("Sensorium's built-in stand-in")
+    # with an installation holding a (our own) RectangleArena, that file is used
+    home = tmp_path / "webots"
+    proto_file(home / "projects" / "objects" / "floors" / "protos", "RectangleArena",
+               "[ field SFVec2f floorSize 1 1 ] { Solid { name \"real arena\" } }")
+    loaded = load_world(w, webots_home=home)
+    assert loaded.world.solids[0].name == "real arena"
+    assert not [x for x in loaded.warnings if "RectangleArena" in x]
+
+
+def test_unused_declarations_that_are_missing_are_a_warning(tmp_path: Path) -> None:
+    w = world_file(tmp_path, "Solid { }\n", ["protos/Unused.proto"])
+    (tmp_path / "w2").mkdir()
+    warnings = expanded(w).warnings
+    assert len(warnings) == 1 and warnings[0].startswith(f"{w}:2:1: EXTERNPROTO Unused (not used by the world): ")
+    w.write_text(HEADER + 'IMPORTABLE EXTERNPROTO "protos/Unused.proto"\nSolid { }\n')
+    assert expanded(w).warnings == []
+
+
+def test_resolve_url_for_assets(tmp_path: Path) -> None:
+    home = tmp_path / "webots"
+    (home / "projects" / "meshes").mkdir(parents=True)
+    (home / "projects" / "meshes" / "m.obj").write_text("v 0 0 0\n")
+    (tmp_path / "local.obj").write_text("v 0 0 0\n")
+    s = ProtoSearch.create(tmp_path, home, version="R2023b")
+    world = tmp_path / "w.wbt"
+    assert resolve_url("local.obj", world, s) == tmp_path / "local.obj"
+    assert resolve_url(str(tmp_path / "local.obj"), world, s) == tmp_path / "local.obj"
+    assert resolve_url("webots://projects/meshes/m.obj", world, s) == home / "projects/meshes/m.obj"
+    assert resolve_url(f"{RAW}/R2023b/projects/meshes/m.obj", world, s) == home / "projects/meshes/m.obj"
+    with pytest.raises(ProtoError, match='"webots://projects/meshes/none.obj" not found'):
+        resolve_url("webots://projects/meshes/none.obj", world, s)
+    assert asset_roots(s) == [home.resolve()]
+
+
+def test_cli_flags_and_info_list_the_protos_with_their_licences(tmp_path: Path, monkeypatch, capsys) -> None:
+    from sensorium.cli import main as cli
+
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)          # restored after the test (the flags set it)
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots")
+    extra = tmp_path / "mine"
+    proto_file(extra, "Gadget", "[ ] { Solid { name \"gadget\" } }", header="# license: MIT\n")
+    w = world_file(tmp_path / "w", "AcmeBot { }\nGadget { }\n",
+                   [f"{RAW}/R2023b/projects/robots/acme/bot/protos/AcmeBot.proto", "https://example.org/x/Gadget.proto"])
+    assert cli(["validate", str(w)]) == 1
+    assert "not found" in capsys.readouterr().err
+    assert cli(["info", str(w), "--webots-home", str(home), "--proto-path", str(extra)]) == 0
+    out = capsys.readouterr().out
+    assert "proto     AcmeBot x1: no license line" in out and "proto     AcmeEye x1: no license line" in out
+    assert f"proto     Gadget x1: MIT ({extra / 'Gadget.proto'})" in out
+    assert cli(["validate", str(w)]) == 0                     # the flags now hold for this process
