@@ -147,6 +147,7 @@ class Scene:
         # textures: one sampler for the world's images (None without any), read by infra-red only
         sampler = TextureSampler([(shape.geometry, shape.appearance) for _, _, shape in self._parts], base_dir)
         self.textures: TextureSampler | None = sampler if sampler else None
+        self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         self.lights_version = 0        # changes whenever a light moves with its owner
         # infra-red reads these per hit shape; -1 (no hit) indexes the trailing "no hit" entry
         self.red = np.array([s.red for s in self.shapes] + [1.0])
@@ -198,6 +199,15 @@ class Scene:
         owner = self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
         return owner.compose(local)
 
+    def _world_to_shape(self, shape: int) -> Pose:
+        """The inverse of a shape's world pose, kept while its owner's pose object is the same."""
+        key, local, _ = self._parts[shape]
+        owner = self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
+        kept = self._inverse.get(shape)
+        if kept is None or kept[0] is not owner:
+            kept = self._inverse[shape] = (owner, owner.compose(local).inverse())
+        return kept[1]
+
     def infra_red_terms(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                         distance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(red, roughness, occlusion) an infra-red ray reads at its hit (WbShape::pickColor):
@@ -212,14 +222,15 @@ class Scene:
         if sampler is None:
             return red, rough, occl
         hit = sampler.textured[shape].nonzero()[0]
-        for s in np.unique(shape[hit]).tolist():
-            rows = hit[shape[hit] == s]
-            inv = self.shape_pose(s).inverse()
+        on = shape[hit]
+        for s in sorted(set(on.tolist())):
+            rows = hit[on == s] if len(hit) > 1 else hit
+            inv = self._world_to_shape(s)
             o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
-            texel, rmap, omap, ok = sampler.infra_red(s, o, d, distance[rows])
+            texel, rmap, omap, picked = sampler.infra_red(s, o, d, distance[rows])
             red[rows] = red[rows] * texel
             if rmap is not None:
-                rough[rows] = np.where(ok, rmap, rough[rows])
+                rough[rows] = rmap if picked is None else np.where(picked, rmap, rough[rows])
             if omap is not None:
-                occl[rows] = np.where(ok, omap, 0.0)
+                occl[rows] = omap if picked is None else np.where(picked, omap, 0.0)
         return red, rough, occl

@@ -236,23 +236,31 @@ class TextureImage:
         """(row, column) of the nearest texel (WbImageTexture::pickColor's wrap and index)."""
         h, w = self.rgb.shape[:2]
         u, v = uv[:, 0], uv[:, 1]
-        u = _wrap(u) if self.repeat_s else np.clip(u, 0.0, 1.0)
-        v = _wrap(v) if self.repeat_t else np.clip(v, 0.0, 1.0)
-        col = np.minimum(np.nan_to_num(u * w).astype(np.int64), w - 1)
-        row = np.minimum(np.nan_to_num(v * h).astype(np.int64), h - 1)
-        return np.maximum(row, 0), np.maximum(col, 0)
+        u = _wrap(u) if self.repeat_s else np.minimum(np.maximum(u, 0.0), 1.0)
+        v = _wrap(v) if self.repeat_t else np.minimum(np.maximum(v, 0.0), 1.0)
+        # u, v in [0, 1] here (NaN, from a failed pick, is not: the callers replace it first)
+        col = np.minimum((u * w).astype(np.int64), w - 1)
+        row = np.minimum((v * h).astype(np.int64), h - 1)
+        return row, col
+
+    def red(self, uv: np.ndarray) -> np.ndarray:
+        """The red channel in [0, 1] at finite ``(n, 2)`` coordinates (the infra-red path)."""
+        row, col = self.texel_index(uv)
+        return self.rgb[row, col, 0] / 255.0
 
     def texels(self, uv: np.ndarray, channel: int | None = None) -> np.ndarray:
         """Texel colours ``(n, 3)`` in [0, 1] (``byte / 255``), or one channel ``(n,)``."""
-        row, col = self.texel_index(np.asarray(uv, dtype=np.float64).reshape(-1, 2))
+        uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+        uv = np.where(np.isnan(uv), 0.0, uv)
+        row, col = self.texel_index(uv)
         px = self.rgb[row, col] if channel is None else self.rgb[row, col, channel]
         return px / 255.0
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
-    """C ``fmod(x, 1)`` then ``+1`` when negative (repeat)."""
-    r = np.fmod(x, 1.0)
-    return np.where(r < 0.0, r + 1.0, r)
+    """Webots' repeat: C ``fmod(x, 1)``, plus 1 when negative. ``x − ⌊x⌋`` is the same number (both
+    are the one rounding of the same exact sum; fmod itself is exact), up to the sign of a zero."""
+    return x - np.floor(x)
 
 
 def transform_uv(uv: np.ndarray, t: wm.TextureTransform | None) -> np.ndarray:
@@ -373,19 +381,22 @@ class TriangleLocator:
 class ShapeTexture:
     """One textured shape: how its geometry maps points to (u, v), its images, its transform."""
 
-    uv_of: Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+    uv_of: UvOf                 # (origins, directions, t) -> (uv, picked) ; picked None: all
     base: TextureImage
     roughness: TextureImage | None
     occlusion: TextureImage | None
     transform: wm.TextureTransform | None
 
 
-def _primitive_uv(geometry: Any) -> Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+UvOf = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray | None]]
+
+
+def _primitive_uv(geometry: Any) -> UvOf:
     def points(o: np.ndarray, d: np.ndarray, t: np.ndarray) -> np.ndarray:
         return o + t[:, None] * d
 
-    def ok(uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return uv, np.ones(len(uv), dtype=bool)
+    def ok(uv: np.ndarray) -> tuple[np.ndarray, None]:
+        return uv, None                     # picking a primitive never fails
 
     g = geometry
     if isinstance(g, wm.Box):
@@ -495,8 +506,9 @@ class TextureSampler:
            ) -> tuple[np.ndarray, np.ndarray]:
         """Webots' ``(u, v)`` of hits ``origins + t·directions`` on ``shape`` (before the
         TextureTransform), and where picking succeeded (a mesh hit whose triangle is not found
-        again fails, as Webots' picking can)."""
-        return self.shapes[shape].uv_of(origins, directions, t)
+        again fails, as Webots' picking can; its (u, v) is then NaN)."""
+        uv, picked = self.shapes[shape].uv_of(origins, directions, t)
+        return uv, np.ones(len(uv), dtype=bool) if picked is None else picked
 
     def texels(self, shape: int, uv: np.ndarray, which: str = "base", channel: int | None = None) -> np.ndarray:
         """Colours of ``shape``'s ``which`` map ("base", "roughness", "occlusion") at ``uv``
@@ -508,16 +520,20 @@ class TextureSampler:
         return img.texels(transform_uv(np.asarray(uv, dtype=np.float64).reshape(-1, 2), st.transform), channel)
 
     def infra_red(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray
-                  ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray]:
+                  ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None]:
         """For hits on ``shape`` (WbShape::pickColor): the base map's red (1 where picking failed:
         Webots then reads the untextured colour), the roughness and occlusion maps' red (None when
-        the appearance has no such map) and where picking succeeded (elsewhere the roughness field
-        and no occlusion apply)."""
-        uv, ok = self.uv(shape, origins, directions, t)
+        the appearance has no such map) and where picking succeeded (None: everywhere; elsewhere
+        the roughness field and no occlusion apply)."""
         st = self.shapes[shape]
+        uv, picked = st.uv_of(origins, directions, t)
         self.lookups += len(t)
-        uvt = transform_uv(np.where(ok[:, None], uv, 0.0), st.transform)
-        red = np.where(ok, st.base.texels(uvt, 0), 1.0)
-        rough = None if st.roughness is None else st.roughness.texels(uvt, 0)
-        occl = None if st.occlusion is None else st.occlusion.texels(uvt, 0)
-        return red, rough, occl, ok
+        if picked is not None:
+            uv = np.where(picked[:, None], uv, 0.0)
+        uvt = transform_uv(uv, st.transform)
+        red = st.base.red(uvt)
+        if picked is not None:
+            red = np.where(picked, red, 1.0)
+        rough = None if st.roughness is None else st.roughness.red(uvt)
+        occl = None if st.occlusion is None else st.occlusion.red(uvt)
+        return red, rough, occl, picked
