@@ -164,10 +164,10 @@ def test_negative_attenuation_rejected() -> None:
 
 
 def test_unknown_device_and_sensor_type_rejected() -> None:
-    probs = _problems({"robots": [_robot([{"device": "Camera", "name": "c"},
+    probs = _problems({"robots": [_robot([{"device": "Kamera", "name": "c"},
                                           {"device": "DistanceSensor", "name": "d", "type": "radar"}])]})
     assert probs[0][0] == "robots[0].devices[0]"
-    assert "'Camera'" in probs[0][1] and "LightSensor" in probs[0][1]
+    assert "'Kamera'" in probs[0][1] and "LightSensor" in probs[0][1] and "Camera" in probs[0][1]
     assert probs[1][0] == "robots[0].devices[1].type"
     assert "'radar'" in probs[1][1] and "sonar" in probs[1][1]
 
@@ -268,3 +268,14 @@ def test_names_that_would_break_topic_paths_rejected() -> None:
         ("robots[1].devices[0].name", "name 'robot' is reserved (robot-level services live under /<robot>/robot/)"),
         ("robots[1].devices[1].name", "name 'x\\x00y' must not contain '/' or NUL (names are used in topic paths)"),
     ]
+
+
+def test_unsimulated_devices_are_accepted_with_their_model_and_nothing_else() -> None:
+    devices = [{"device": "Camera", "name": "camera", "model": "Logitech", "pose": {"translation": [0.1, 0, 0]}},
+               {"device": "RotationalMotor", "name": "left wheel motor"},
+               {"device": "GPS", "name": "gps"}]
+    loaded = parse_world({"robots": [_robot(devices, differential_drive={})]}, source="w.yaml", base_dir=Path.cwd())
+    assert [(d.device, d.name, d.model) for d in loaded.world.robots[0].devices] == [
+        ("Camera", "camera", "Logitech"), ("RotationalMotor", "left wheel motor", ""), ("GPS", "gps", "")]
+    probs = _problems({"robots": [_robot([{"device": "Camera", "name": "camera", "width": 64}])]})
+    assert probs and probs[0][0].startswith("robots[0].devices[0]") and "width" in probs[0][0] + probs[0][1]

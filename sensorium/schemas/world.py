@@ -292,6 +292,7 @@ LookupRow = tuple[float, float, float]  # input, output, relative noise
 
 class _Device(Strict):
     name: str = Field(min_length=1)
+    model: str = Field(default="", max_length=4096, description="Webots model (Device.getModel)")
     pose: Pose = Pose()
 
 
@@ -349,7 +350,9 @@ class PositionSensor(_Device):
     the differential-drive wheel turned by ``motor``. ``pose`` is unused (kept for symmetry)."""
 
     device: Literal["PositionSensor"]
-    motor: str = Field(min_length=1, description="name of the drive's wheel motor whose joint it measures")
+    motor: str | None = Field(default=None, min_length=1,
+                              description="name of the drive's wheel motor whose joint it measures; left out: a "
+                                          "sensor on a joint nothing turns here (present, not simulated)")
     noise: float = Field(default=0.0, ge=0.0, description="standard deviation of Gaussian noise (rad)")
     resolution: float = -1.0
 
@@ -371,7 +374,38 @@ class LED(_Device):
         return v
 
 
-Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED, Field(discriminator="device")]
+class RotationalMotor(_Device):
+    """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
+    motors *is* that motor, at this index of the device list (a drive motor without an entry comes
+    after the listed devices). Any other RotationalMotor is present but not simulated (no joint moves
+    here). ``pose`` is unused."""
+
+    device: Literal["RotationalMotor"]
+
+
+UNSIMULATED_DEVICE_TYPES = (
+    "Accelerometer", "Altimeter", "Brake", "Camera", "Compass", "Connector", "Display", "Emitter", "GPS", "Gyro",
+    "InertialUnit", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
+    "Speaker", "TouchSensor", "VacuumGripper",
+)
+"""Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
+
+
+class UnsimulatedDevice(_Device):
+    """A Webots device that Sensorium does not simulate: present in the robot's device list (its
+    index, type, name and model are Webots'), its functions answer Webots' "no value" (NaN, NULL, 0)
+    with one warning per device. Only ``device``, ``name``, ``model`` and ``pose`` are accepted: the
+    device's other Webots fields come with its model (the .wbt converter leaves them out)."""
+
+    device: Literal[UNSIMULATED_DEVICE_TYPES]  # type: ignore[valid-type]
+
+
+Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | RotationalMotor | UnsimulatedDevice,
+                   Field(discriminator="device")]
+
+DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "RotationalMotor",
+                *UNSIMULATED_DEVICE_TYPES)
+"""Every Webots device node type a robot's ``devices`` list accepts."""
 
 
 # ---------------------------------------------------------------- motion
@@ -414,7 +448,8 @@ class Robot(Strict):
     lights: list[Light] = Field(
         default=[], description="lights carried by the robot (location and a SpotLight's direction in its frame)")
     differential_drive: DifferentialDrive | None = None
-    devices: list[Device] = []
+    devices: list[Device] = Field(default=[], description="in Webots' tree order (the order of the device "
+                                  "indices); every Webots device type is accepted, those not simulated as present")
 
 
 class WorldInfo(Strict):

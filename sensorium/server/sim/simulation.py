@@ -74,7 +74,9 @@ class RobotState:
         self.controller = model.controller
         self.devices: dict[str, Device] = {}
         for d in model.devices:
-            cls = DEVICE_CLASSES[d.device]
+            cls = DEVICE_CLASSES.get(d.device)
+            if cls is None:       # listed, not simulated (schemas.world.UnsimulatedDevice)
+                continue
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
                                        clock=lambda: sim.time_ms)

@@ -341,8 +341,11 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
         rp = f"robots[{r_i}]"
         names = [(f"{rp}.devices[{d_i}].name", d.name) for d_i, d in enumerate(robot.devices)]
         if robot.differential_drive is not None:
-            names += [(f"{rp}.differential_drive.left_motor", robot.differential_drive.left_motor),
-                      (f"{rp}.differential_drive.right_motor", robot.differential_drive.right_motor)]
+            # a RotationalMotor entry named like a drive motor is that motor (its place in the device list)
+            listed = {d.name for d in robot.devices if d.device == "RotationalMotor"}
+            names += [(f"{rp}.differential_drive.{side}", m) for side, m in
+                      (("left_motor", robot.differential_drive.left_motor),
+                       ("right_motor", robot.differential_drive.right_motor)) if m not in listed]
         unique(names, "device")
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"
@@ -354,7 +357,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                             f"{dp}.lookup_table[{k}]",
                             f"lookup table inputs must be strictly increasing: input {table[k][0]} "
                             f"follows {table[k - 1][0]}"))
-            if isinstance(dev, wm.PositionSensor):
+            if isinstance(dev, wm.PositionSensor) and dev.motor is not None:
                 drive = robot.differential_drive
                 motors = (drive.left_motor, drive.right_motor) if drive is not None else ()
                 if dev.motor not in motors:
