@@ -510,3 +510,75 @@ def test_no_texture_work_without_textures_or_without_infra_red(tmp_path: Path) -
     for _ in range(3):
         read_all(sim)
     assert sim.counters["texture_lookups"] == 0
+
+
+# ------------------------------------------------------------------ ink (the Pen's paint texture)
+
+def _stroke(sim: Simulation, origin, direction, lead: float, color, density: float) -> int:
+    """One pen stroke as the Pen device makes it: the nearest visual shape along the pen's ray."""
+    from sensorium.server.raycast.engine import RayKind
+
+    o, d = np.array([origin], dtype=float), np.array([direction], dtype=float)
+    h = sim.scene.engine.cast(o, d, 0.0, math.inf, kind=RayKind.VISUAL)
+    assert h.shape[0] >= 0
+    return sim.scene.paint(int(h.shape[0]), o[0], d[0], float(h.distance[0]), lead, color, density)
+
+
+def test_ink_blends_as_webots_infra_red_test_expects(tmp_path: Path) -> None:
+    """Webots' distance_sensor_infra-red test paints green (0.3), violet 0xCC33FF (0.3) and red
+    (0.7) under its two sensors; its expectations follow from WbPaintTexture's blending: colour
+    old/(old + new) of the old ink, density added and capped at 1, read as (1 - c)·colour·texel + c·ink."""
+    sim = Simulation.from_file(_webots_ir_test_world(tmp_path))
+    # NUE: y is up, the pens look down; 5 mm aside, on the texel each sensor reads (the sensors'
+    # rotation of 1.5708, not pi/2, puts them a hair to the -x side of u = 0.5)
+    pens = {"ds0": (-0.005, 0.07, 0.08), "ds1": (-0.005, 0.07, -0.08)}
+    down = (0.0, -1.0, 0.0)
+    for d in sim.all_devices():
+        d.enable(32)
+    sim.step()
+    assert sim.counters["texture_lookups"] == 1                    # only the textured board so far
+    steps = [((0, 1, 0), 0.3, 1283.6893, 1450.385), ((0xCC / 255, 0x33 / 255, 1.0), 0.3, 1252.266, 1217.675),
+             ((1, 0, 0), 0.7, 1025.485, 834.98)]
+    for color, density, want0, want1 in steps:
+        c32 = tuple(float(np.float32(np.float32(round(c * 255)) / np.float32(255))) for c in color)   # r/255.0f
+        for p in pens.values():
+            assert _stroke(sim, p, down, 0.01, c32, density) >= 1
+        sim.step()
+        v = {d.config.name: d.value for d in sim.all_devices()}
+        assert v["ds0"] == pytest.approx(want0, abs=1e-3) and v["ds1"] == pytest.approx(want1, abs=1e-3)
+    # the same from the formula, with the float32 the ink is kept in
+    ink_r = np.float32(0.0) * np.float32(0.5) + np.float32(0.8) * np.float32(0.5)      # after violet: 0.4
+    assert float(ink_r) == pytest.approx(0.4, abs=1e-7)
+    sim.scene.clear_ink()
+    sim.step()
+    v = {d.config.name: d.value for d in sim.all_devices()}
+    assert v["ds0"] == pytest.approx(1019.3725, abs=1e-3) and v["ds1"] == pytest.approx(1172.2065, abs=1e-3)
+
+
+def test_ink_layer_sizes_discs_and_atlas(tmp_path: Path) -> None:
+    from sensorium.server.world.textures import InkLayer, TextureSampler, bounding_radius
+
+    board(tmp_path)
+    models = [(wm.Plane(type="plane", size=(0.15, 0.15)), None),
+              (wm.Box(type="box", size=(1.0, 1.0, 1.0)), wm.Appearance(texture=wm.Texture(url="board.png"))),
+              (wm.Cylinder(type="cylinder", radius=0.1, height=0.2), None)]
+    sampler = TextureSampler(models, tmp_path)
+    # an untextured plane of radius 0.106 m: 32 + 992 * 0.0106 = 42.5 texels -> the nearer power of two, 32
+    assert sampler.ink_layer(0).density.shape == (32, 32)
+    # a textured box: its image (4x4) times the atlas factor 4 x 2
+    assert sampler.ink_layer(1).density.shape == (8, 16)
+    # a cylinder of radius |(0.1, 0.1)|: 32 + 992 * 0.01414 = 46.0 -> 32 (|64 - 46| > |32 - 46|), times 2 x 2
+    assert sampler.ink_layer(2).density.shape == (64, 64)
+    assert bounding_radius(models[2][0]) == pytest.approx(math.hypot(0.1, 0.1))
+    assert sampler.textured[[0, 1, 2, 3]].tolist() == [True, True, True, False]
+    # a lead of 5 texels across: a disc of radius 2 (13 texels) around (u w, v h)
+    layer = InkLayer(32, 32, 100.0)
+    assert layer.paint(0.5, 0.5, 0.05, (1, 0, 0), 0.5) == 13
+    assert layer.density[16, 14:19].tolist() == [0.5] * 5 and layer.density[14, 15:18].tolist() == [0, 0.5, 0]
+    assert layer.paint(1.2, 0.5, 0.05, (1, 0, 0), 0.5) == 0                  # outside [0, 1]: nothing
+    assert layer.paint(0.5, 0.5, 0.05, (0, 0, 1), 0.75)
+    assert layer.density[16, 16] == 1.0 and layer.rgb[16, 16].tolist() == pytest.approx([0.4, 0, 0.6], abs=1e-6)
+    # the box paints on set 1 (the atlas) but is read on set 0, as in Webots
+    top = np.array([[0.0, 0.0, 0.5]])
+    uv1, _ = sampler.uv(1, top + [0, 0, 1], np.array([[0, 0, -1.0]]), np.array([1.0]), atlas=True)
+    assert uv1.tolist() == [[0.625, 0.25]]

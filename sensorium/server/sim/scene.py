@@ -145,8 +145,9 @@ class Scene:
                 self._robot_body[i] = self._add_body(parts, base_dir, pose, owner=i, movable=True, key=i)
         self._attached = {owner for _, owner, _ in self._lights if owner is not None}
         # textures: one sampler for the world's images (None without any), read by infra-red only
+        self._base_dir = base_dir
         sampler = TextureSampler([(shape.geometry, shape.appearance) for _, _, shape in self._parts], base_dir)
-        self.textures: TextureSampler | None = sampler if sampler else None
+        self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         self.lights_version = 0        # changes whenever a light moves with its owner
         # infra-red reads these per hit shape; -1 (no hit) indexes the trailing "no hit" entry
@@ -208,6 +209,23 @@ class Scene:
             kept = self._inverse[shape] = (owner, owner.compose(local).inverse())
         return kept[1]
 
+    def paint(self, shape: int, origin: np.ndarray, direction: np.ndarray, distance: float, lead_size: float,
+              color, density: float) -> int:
+        """A pen's stroke where its ray (world frame) hit ``shape`` at ``distance``: ink laid in the
+        shape's ink layer (textures.InkLayer), made on the first stroke; returns the texels inked."""
+        if self.textures is None:
+            self.textures = TextureSampler([(shape_.geometry, shape_.appearance) for _, _, shape_ in self._parts],
+                                           self._base_dir)
+        inv = self._world_to_shape(shape)
+        return self.textures.paint(shape, inv.apply(np.asarray(origin, dtype=np.float64)),
+                                   inv.apply_dirs(np.asarray(direction, dtype=np.float64)), float(distance),
+                                   lead_size, color, density)
+
+    def clear_ink(self) -> None:
+        """All ink gone (a simulation reset, as Webots' Pen reset clears every paint texture)."""
+        if self.textures is not None:
+            self.textures.clear_ink()
+
     def infra_red_terms(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                         distance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(red, roughness, occlusion) an infra-red ray reads at its hit (WbShape::pickColor):
@@ -227,8 +245,8 @@ class Scene:
             rows = hit[on == s] if len(hit) > 1 else hit
             inv = self._world_to_shape(s)
             o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
-            texel, rmap, omap, picked = sampler.infra_red(s, o, d, distance[rows])
-            red[rows] = red[rows] * texel
+            read, rmap, omap, picked = sampler.infra_red(s, o, d, distance[rows], red[rows])
+            red[rows] = read
             if rmap is not None:
                 rough[rows] = rmap if picked is None else np.where(picked, rmap, rough[rows])
             if omap is not None:

@@ -34,23 +34,39 @@ def _on_surface(points: np.ndarray, centre_dist: np.ndarray, radius: float) -> n
     return scale
 
 
-def box_uv(points: np.ndarray, size) -> np.ndarray:
-    """WbBox::computeTextureCoordinate (texture set 0: the whole image on each face).
+# where each box face sits in Webots' "non-recursive" atlas (texture set 1, the pen's paint
+# texture): u scaled by 1/4 and v by 1/2, then offset (WbBox::computeTextureCoordinate)
+_ATLAS_OFFSETS = np.array([(0.75, 0.5), (0.25, 0.5), (0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.5, 0.5)])
+
+
+def box_uv(points: np.ndarray, size, atlas: bool = False) -> np.ndarray:
+    """WbBox::computeTextureCoordinate (texture set 0: the whole image on each face; ``atlas``:
+    set 1, the faces side by side in one image, as the pen paints them).
 
     The face is the first of front (+x), back (−x), bottom (−z), top (+z), left (+y), right (−y)
     within 1e-9 m of the point, as in WbBox::findIntersectedFace (so an edge or corner belongs to
     the first face of that order); a point on none (a FAST hit) takes the nearest face."""
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     s = np.asarray(size, dtype=np.float64)
-    h = s / 2.0
-    vx, vy, vz = (p + h).T                      # vertex = point - minBound
+    return _face_uv(_box_face(p, s / 2.0), p + s / 2.0, s, atlas)
+
+
+def _box_face(p: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """Index (Webots' order, see box_uv) of the face of a box of half sizes ``h`` a point is on."""
     gap = np.stack([np.abs(p[:, 0] - h[0]), np.abs(p[:, 0] + h[0]), np.abs(p[:, 2] + h[2]),
                     np.abs(p[:, 2] - h[2]), np.abs(p[:, 1] - h[1]), np.abs(p[:, 1] + h[1])], axis=1)
     near = gap < TOLERANCE
-    face = np.where(near.any(axis=1), np.argmax(near, axis=1), np.argmin(gap, axis=1))
-    a, b, c = vx / s[0], vy / s[1], vz / s[2]
+    return np.where(near.any(axis=1), np.argmax(near, axis=1), np.argmin(gap, axis=1))
+
+
+def _face_uv(face: np.ndarray, vertex: np.ndarray, s: np.ndarray, atlas: bool) -> np.ndarray:
+    """(u, v) on box ``face`` of points ``vertex`` given relative to the min corner, size ``s``."""
+    a, b, c = vertex[:, 0] / s[0], vertex[:, 1] / s[1], vertex[:, 2] / s[2]
     u = np.select([face == 0, face == 1, face == 2, face == 3, face == 4], [b, 1 - b, a, a, 1 - a], a)
     v = np.select([face == 2, face == 3], [b, 1 - b], 1 - c)
+    if atlas:
+        off = _ATLAS_OFFSETS[face]
+        u, v = 0.25 * u + off[:, 0], 0.5 * v + off[:, 1]
     return np.stack([u, v], axis=1)
 
 
@@ -113,8 +129,9 @@ def _capsule_points(p: np.ndarray, radius: float, half: float) -> tuple[np.ndarr
     return q, side
 
 
-def cylinder_uv(points: np.ndarray, radius: float, height: float) -> np.ndarray:
-    """WbCylinder::pickUVCoordinate (texture set 0).
+def cylinder_uv(points: np.ndarray, radius: float, height: float, atlas: bool = False) -> np.ndarray:
+    """WbCylinder::pickUVCoordinate (texture set 0; ``atlas``: set 1, the pen's: every part scaled
+    by 1/2, the top cap moved right by 1/2, the bottom cap down by 1/2).
 
     Side: ``θ = asin(−x/r)``, ``π − θ`` where ``y < 0``, wrapped to [0, 2π); ``u = θ/(2π)``,
     ``v = 1 − (z + h/2)/h``. Caps: ``u = (x + r)/(2r)``, ``v = (r − y)/(2r)``, flipped (``1 − v``)
@@ -129,7 +146,12 @@ def cylinder_uv(points: np.ndarray, radius: float, height: float) -> np.ndarray:
     u_cap = (q[:, 0] + radius) / (2 * radius)
     v_cap = (-q[:, 1] + radius) / (2 * radius)
     v_cap = np.where(q[:, 2] < 0, 1 - v_cap, v_cap)
-    return np.stack([np.where(side, u_side, u_cap), np.where(side, v_side, v_cap)], axis=1)
+    u, v = np.where(side, u_side, u_cap), np.where(side, v_side, v_cap)
+    if atlas:
+        top = ~side & (q[:, 2] > 0)
+        bottom = ~side & ~top
+        u, v = 0.5 * u + np.where(top, 0.5, 0.0), 0.5 * v + np.where(bottom, 0.5, 0.0)
+    return np.stack([u, v], axis=1)
 
 
 def capsule_uv(points: np.ndarray, radius: float, height: float, subdivision: int) -> np.ndarray:
@@ -189,3 +211,22 @@ def default_triangle_uv(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     u = (corner[..., longest] - lo[longest]) / extent
     w = 1.0 - (corner[..., second] - lo[second]) / extent
     return np.stack([u, w], axis=-1)
+
+
+def default_triangle_atlas_uv(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Corner coordinates ``(F, 3, 2)`` of texture set 1 (the pen's) of an IndexedFaceSet without
+    ``texCoord`` (WbTriangleMesh::setDefaultTextureCoordinates): each triangle is mapped on the
+    box atlas of the points' bounding box, on the face its normal from its centroid leaves by."""
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    size = hi - lo
+    safe = np.where(size > 0, size, 1.0)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    corner = v[f]
+    n = np.cross(corner[:, 1] - corner[:, 0], corner[:, 2] - corner[:, 0])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    centroid = corner.mean(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):      # where the normal leaves the box
+        t = np.where(n > 0, (hi - centroid) / n, np.where(n < 0, (lo - centroid) / n, np.inf)).min(axis=1)
+    face = _box_face(centroid + t[:, None] * n - (lo + hi) / 2, size / 2)
+    return np.stack([_face_uv(face, corner[:, k] - lo, safe, atlas=True) for k in range(3)], axis=1)

@@ -377,21 +377,20 @@ class TriangleLocator:
         return tri_out, b1_out, b2_out
 
 
+UvOf = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray | None]]
+
+
 @dataclass
 class ShapeTexture:
-    """One textured shape: how its geometry maps points to (u, v), its images, its transform."""
+    """One textured shape: its images and its transform."""
 
-    uv_of: UvOf                 # (origins, directions, t) -> (uv, picked) ; picked None: all
     base: TextureImage
     roughness: TextureImage | None
     occlusion: TextureImage | None
     transform: wm.TextureTransform | None
 
 
-UvOf = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray | None]]
-
-
-def _primitive_uv(geometry: Any) -> UvOf:
+def _primitive_uv(geometry: Any, atlas: bool) -> UvOf:
     def points(o: np.ndarray, d: np.ndarray, t: np.ndarray) -> np.ndarray:
         return o + t[:, None] * d
 
@@ -400,25 +399,21 @@ def _primitive_uv(geometry: Any) -> UvOf:
 
     g = geometry
     if isinstance(g, wm.Box):
-        return lambda o, d, t: ok(tc.box_uv(points(o, d, t), g.size))
+        return lambda o, d, t: ok(tc.box_uv(points(o, d, t), g.size, atlas))
     if isinstance(g, wm.Plane):
         return lambda o, d, t: ok(tc.plane_uv(points(o, d, t), g.size))
     if isinstance(g, wm.Sphere):
         return lambda o, d, t: ok(tc.sphere_uv(points(o, d, t), g.radius))
     if isinstance(g, wm.Cylinder):
-        return lambda o, d, t: ok(tc.cylinder_uv(points(o, d, t), g.radius, g.height))
+        return lambda o, d, t: ok(tc.cylinder_uv(points(o, d, t), g.radius, g.height, atlas))
     if isinstance(g, wm.Capsule):
         return lambda o, d, t: ok(tc.capsule_uv(points(o, d, t), g.radius, g.height, g.subdivision))
     raise TypeError(f"not a primitive: {g!r}")
 
 
-def _mesh_uv(vertices: np.ndarray, faces: np.ndarray, corners: np.ndarray):
-    locator: list[TriangleLocator] = []      # built on the first lookup
-
+def _mesh_uv(locator: Callable[[], TriangleLocator], corners: np.ndarray) -> UvOf:
     def uv_of(o: np.ndarray, d: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        if not locator:
-            locator.append(TriangleLocator(vertices, faces))
-        tri, b1, b2 = locator[0].locate(o, d, t)
+        tri, b1, b2 = locator().locate(o, d, t)
         found = tri >= 0
         uv = np.full((len(t), 2), np.nan)
         if found.any():
@@ -460,54 +455,192 @@ def _mesh_file_uv(path: str, _mtime: int) -> tuple[np.ndarray, np.ndarray, np.nd
     return vertices, faces, per_vertex[faces]
 
 
-class TextureSampler:
-    """The textures of a scene's shapes (indexed like ``Scene.shapes``).
+# ------------------------------------------------------------------------------------ ink (Pen)
 
-    ``textured[s]`` tells whether shape ``s`` has an image (index −1, no hit, is False). All
-    arrays given to the methods are in the shape's local frame (float64); ``lookups`` counts the
-    points sampled (one per infra-red hit on a textured shape)."""
+INK_MIN_SIZE, INK_MAX_SIZE = 32, 1024      # WbPaintTexture: the paint texture of an untextured shape
+
+
+def _next_power_of_2(n: int) -> int:
+    p = 1
+    while p < n:
+        p *= 2
+    return p
+
+
+def bounding_radius(geometry: Any, vertices: np.ndarray | None = None, faces: np.ndarray | None = None) -> float:
+    """Webots' bounding-sphere radius of a geometry (each node's ``recomputeBoundingSphere``): half
+    the diagonal of a Box or Plane, a Sphere's radius, ``|(r, h/2)|`` for a Cylinder, ``h/2 + r``
+    for a Capsule, Ritter's sphere of a triangle mesh's corners (WbTriangleMeshGeometry)."""
+    g = geometry
+    if isinstance(g, wm.Box):
+        return math.hypot(*g.size) / 2.0
+    if isinstance(g, wm.Plane):
+        return math.inf if g.size is None else math.hypot(*g.size) / 2.0
+    if isinstance(g, wm.Sphere):
+        return g.radius
+    if isinstance(g, wm.Cylinder):
+        return math.hypot(g.radius, g.height / 2.0)
+    if isinstance(g, wm.Capsule):
+        return g.height / 2.0 + g.radius
+    assert vertices is not None and faces is not None
+    pts = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)].reshape(-1, 3)
+    p2 = pts[0]
+    for _ in range(2):            # the farthest corner from the farthest corner of the first one
+        p1 = p2
+        d = ((pts - p1) ** 2).sum(axis=1)
+        k = int(np.argmax(d)) if d.max() > 0 else 0
+        p2, far = pts[k], float(d[k])
+    centre, radius = (p1 + p2) / 2.0, math.sqrt(far) / 2.0
+    for q in pts:                 # WbBoundingSphere::enclose, corner by corner
+        delta = centre - q
+        dist = float(np.linalg.norm(delta))
+        if dist > radius:
+            radius = (dist + radius) / 2.0
+            centre = q + delta / dist * radius
+    return radius
+
+
+class InkLayer:
+    """The ink a Pen laid on one shape (Webots' WbPaintTexture): RGB and density per texel
+    (float32, as Webots keeps them), white and 0 at first.
+
+    Its size is the shape's image size (an untextured shape: from its bounding sphere radius r,
+    ``32 + 992·r/10`` texels, 1024 beyond 10 m, to the nearest power of two) times the geometry's
+    factor for texture set 1 (Box 4 x 2, Cylinder 2 x 2, triangles without texture coordinates 4 x 2,
+    else 1 x 1). ``lead_texels_per_m`` is the image width over the bounding radius: a pen's lead
+    of size L covers a disc of ``⌊L·that⌋`` texels across."""
+
+    def __init__(self, width: int, height: int, lead_texels_per_m: float):
+        self.rgb = np.ones((height, width, 3), dtype=np.float32)
+        self.density = np.zeros((height, width), dtype=np.float32)
+        self.lead_texels_per_m = lead_texels_per_m
+        self.strokes = 0
+
+    def paint(self, u: float, v: float, lead_size: float, color, density: float) -> int:
+        """One stroke at texture-set-1 coordinates (WbPaintTexture::paint): nothing outside
+        [0, 1]; else a disc of texels around ``(⌊u·w⌋, ⌊v·h⌋)`` takes the ink: colour blended by
+        the densities (``old/(old + new)`` of the old colour), density added and capped at 1.
+        Returns the texels inked."""
+        if not (0.0 <= u <= 1.0 and 0.0 <= v <= 1.0):
+            return 0
+        h, w = self.density.shape
+        x, y = int(u * w), int(v * h)
+        size = max(1, int(float(np.float32(lead_size)) * self.lead_texels_per_m))
+        half = size // 2
+        ox, oy, sx, sy = max(x - half, 0), max(y - half, 0), min(x + half, w - 1), min(y + half, h - 1)
+        if ox > sx or oy > sy:
+            return 0
+        ty, tx = np.mgrid[oy:sy + 1, ox:sx + 1]
+        inside = (tx - x) ** 2 <= half * half - (ty - y) ** 2
+        rows, cols = ty[inside], tx[inside]
+        d = np.float32(density)
+        prev = self.density[rows, cols]
+        total = d + prev
+        with np.errstate(divide="ignore", invalid="ignore"):
+            old = np.where(total < np.float32(1e-15), np.float32(0.0), prev / total).astype(np.float32)
+        ink = np.asarray(color, dtype=np.float64)
+        keep = (old[:, None] * self.rgb[rows, cols]).astype(np.float64)       # float * float
+        new = (np.float32(1.0) - old).astype(np.float64)[:, None] * ink         # (1 - ratio) * colour (double)
+        self.rgb[rows, cols] = (keep + new).astype(np.float32)
+        self.density[rows, cols] = np.minimum(total, np.float32(1.0))
+        self.strokes += 1
+        return int(len(rows))
+
+    def pick(self, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(ink RGB as float64, density as float32) at texture-set-0 coordinates
+        (WbPaintTexture::pickColor: truncated toward zero, then wrapped into the texture)."""
+        h, w = self.density.shape
+        uv = np.where(np.isnan(uv), 0.0, uv)
+        x = np.trunc(uv[:, 0] * w).astype(np.int64) % w
+        y = np.trunc(uv[:, 1] * h).astype(np.int64) % h
+        return self.rgb[y, x].astype(np.float64), self.density[y, x]
+
+    def clear(self) -> None:
+        self.rgb[:] = 1.0
+        self.density[:] = 0.0
+
+
+class TextureSampler:
+    """The surface colours of a scene's shapes (indexed like ``Scene.shapes``): their images and
+    the ink pens laid on them.
+
+    ``textured[s]`` tells whether shape ``s`` has an image or ink (index −1, no hit, is False); it
+    is updated in place when a shape first takes ink. All arrays given to the methods are in the
+    shape's local frame (float64); ``lookups`` counts the points sampled (one per infra-red hit on
+    such a shape)."""
 
     def __init__(self, shapes: list[tuple[Any, wm.Appearance | None]], base_dir: Path):
+        self.models = shapes
+        self.base_dir = Path(base_dir)
         self.shapes: dict[int, ShapeTexture] = {}
+        self.ink: dict[int, InkLayer] = {}
+        self._uv: dict[tuple[int, bool], UvOf] = {}
+        self._locators: dict[int, TriangleLocator] = {}
+        self._meshes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         images: dict[Path, np.ndarray] = {}
-        for i, (geometry, app) in enumerate(shapes):
-            if app is None or app.texture is None:
-                continue
 
-            def image(t: wm.Texture | None) -> TextureImage | None:
-                if t is None:
-                    return None
-                path = resolve_texture_url(t.url, base_dir, allow_outside=True)
-                if path not in images:
-                    images[path] = load_image(path, t.url)
-                return TextureImage(images[path], t.repeat_s, t.repeat_t)
+        def image(t: wm.Texture | None) -> TextureImage | None:
+            if t is None:
+                return None
+            path = resolve_texture_url(t.url, base_dir, allow_outside=True)
+            if path not in images:
+                images[path] = load_image(path, t.url)
+            return TextureImage(images[path], t.repeat_s, t.repeat_t)
 
-            base = image(app.texture)
-            assert base is not None
-            if isinstance(geometry, wm.Triangles):
-                uv_of = _mesh_uv(np.asarray(geometry.vertices, dtype=np.float64).reshape(-1, 3),
-                                 np.asarray(geometry.faces, dtype=np.int64), triangles_corner_uv(geometry))
-            elif isinstance(geometry, wm.Mesh):
-                file = (Path(base_dir) / geometry.url).resolve()
-                v, f, corners = _mesh_file_uv(str(file), file.stat().st_mtime_ns)
-                uv_of = _mesh_uv(v * np.asarray(geometry.scale, dtype=np.float64), f, corners)
-            else:
-                uv_of = _primitive_uv(geometry)
-            self.shapes[i] = ShapeTexture(uv_of, base, image(app.roughness_map), image(app.occlusion_map),
-                                          app.texture_transform)
+        for i, (_, app) in enumerate(shapes):
+            if app is not None and app.texture is not None:
+                base = image(app.texture)
+                assert base is not None
+                self.shapes[i] = ShapeTexture(base, image(app.roughness_map), image(app.occlusion_map),
+                                              app.texture_transform)
         self.textured = np.zeros(len(shapes) + 1, dtype=bool)
         self.textured[list(self.shapes)] = True
         self.lookups = 0
 
     def __bool__(self) -> bool:
-        return bool(self.shapes)
+        return bool(self.shapes) or bool(self.ink)
 
-    def uv(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray
+    # ---- texture coordinates
+
+    def _mesh(self, shape: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(vertices, faces, set-0 corner coordinates) of a triangle shape."""
+        if shape not in self._meshes:
+            g = self.models[shape][0]
+            if isinstance(g, wm.Triangles):
+                self._meshes[shape] = (np.asarray(g.vertices, dtype=np.float64).reshape(-1, 3),
+                                       np.asarray(g.faces, dtype=np.int64), triangles_corner_uv(g))
+            else:
+                file = (self.base_dir / g.url).resolve()
+                v, f, corners = _mesh_file_uv(str(file), file.stat().st_mtime_ns)
+                self._meshes[shape] = (v * np.asarray(g.scale, dtype=np.float64), f, corners)
+        return self._meshes[shape]
+
+    def _uv_of(self, shape: int, atlas: bool) -> UvOf:
+        key = (shape, atlas)
+        if key not in self._uv:
+            g = self.models[shape][0]
+            if isinstance(g, wm.Triangles | wm.Mesh):
+                v, f, corners = self._mesh(shape)
+                if atlas and isinstance(g, wm.Triangles) and g.tex_coords is None:
+                    corners = tc.default_triangle_atlas_uv(v, f)
+
+                def locator(s: int = shape, v: np.ndarray = v, f: np.ndarray = f) -> TriangleLocator:
+                    if s not in self._locators:          # built on the first lookup
+                        self._locators[s] = TriangleLocator(v, f)
+                    return self._locators[s]
+
+                self._uv[key] = _mesh_uv(locator, corners)
+            else:
+                self._uv[key] = _primitive_uv(g, atlas)
+        return self._uv[key]
+
+    def uv(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray, atlas: bool = False
            ) -> tuple[np.ndarray, np.ndarray]:
         """Webots' ``(u, v)`` of hits ``origins + t·directions`` on ``shape`` (before the
-        TextureTransform), and where picking succeeded (a mesh hit whose triangle is not found
-        again fails, as Webots' picking can; its (u, v) is then NaN)."""
-        uv, picked = self.shapes[shape].uv_of(origins, directions, t)
+        TextureTransform; ``atlas``: texture set 1, where pens paint), and where picking succeeded
+        (a mesh hit whose triangle is not found again fails, as Webots' picking can; its (u, v) is
+        then NaN)."""
+        uv, picked = self._uv_of(shape, atlas)(origins, directions, t)
         return uv, np.ones(len(uv), dtype=bool) if picked is None else picked
 
     def texels(self, shape: int, uv: np.ndarray, which: str = "base", channel: int | None = None) -> np.ndarray:
@@ -519,21 +652,74 @@ class TextureSampler:
             raise KeyError(f"shape {shape} has no {which} map")
         return img.texels(transform_uv(np.asarray(uv, dtype=np.float64).reshape(-1, 2), st.transform), channel)
 
-    def infra_red(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray
+    # ---- ink
+
+    def ink_layer(self, shape: int) -> InkLayer:
+        """The shape's ink layer, made on its first stroke (WbPaintTexture::paintTexture)."""
+        layer = self.ink.get(shape)
+        if layer is None:
+            g = self.models[shape][0]
+            st = self.shapes.get(shape)
+            tri = isinstance(g, wm.Triangles | wm.Mesh)
+            v, f, _ = self._mesh(shape) if tri else (None, None, None)
+            radius = bounding_radius(g, v, f)
+            if st is not None:
+                h, w = st.base.rgb.shape[:2]
+            else:
+                size = INK_MAX_SIZE if radius > 10.0 else INK_MIN_SIZE + (INK_MAX_SIZE - INK_MIN_SIZE) * radius / 10.0
+                nxt = _next_power_of_2(int(size))
+                w = h = int(nxt / 2 if abs(nxt - size) > abs(nxt / 2 - size) else nxt)
+            fx, fy = ((4, 2) if isinstance(g, wm.Box) or (isinstance(g, wm.Triangles) and g.tex_coords is None)
+                      else (2, 2) if isinstance(g, wm.Cylinder) else (1, 1))
+            layer = self.ink[shape] = InkLayer(w * fx, h * fy, w / radius if math.isfinite(radius) else 0.0)
+            self.textured[shape] = True
+        return layer
+
+    def paint(self, shape: int, origin: np.ndarray, direction: np.ndarray, t: float, lead_size: float,
+              color, density: float) -> int:
+        """A pen's stroke where its ray hit ``shape`` (local frame): texels inked."""
+        uv, ok = self.uv(shape, origin.reshape(1, 3), direction.reshape(1, 3), np.array([t]), atlas=True)
+        if not ok[0]:
+            return 0
+        return self.ink_layer(shape).paint(float(uv[0, 0]), float(uv[0, 1]), lead_size, color, density)
+
+    def clear_ink(self) -> None:
+        """Every ink layer white again (Webots' Pen reset clears all paint textures)."""
+        for layer in self.ink.values():
+            layer.clear()
+
+    # ---- what infra-red sensors read
+
+    def infra_red(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray, red: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None]:
-        """For hits on ``shape`` (WbShape::pickColor): the base map's red (1 where picking failed:
-        Webots then reads the untextured colour), the roughness and occlusion maps' red (None when
-        the appearance has no such map) and where picking succeeded (None: everywhere; elsewhere
-        the roughness field and no occlusion apply)."""
-        st = self.shapes[shape]
-        uv, picked = st.uv_of(origins, directions, t)
+        """For hits on ``shape`` whose untextured red is ``red`` (WbShape::pickColor): the red read
+        (``(1 − c)·red·texel + c·ink`` with ``c`` the ink's density; the texel where picking failed
+        is 1 and the ink ignored), the roughness and occlusion maps' red (None when there is no
+        such map) and where picking succeeded (None: everywhere; elsewhere the roughness field and
+        no occlusion apply)."""
+        uv, picked = self._uv_of(shape, False)(origins, directions, t)
         self.lookups += len(t)
         if picked is not None:
             uv = np.where(picked[:, None], uv, 0.0)
-        uvt = transform_uv(uv, st.transform)
-        red = st.base.red(uvt)
-        if picked is not None:
-            red = np.where(picked, red, 1.0)
-        rough = None if st.roughness is None else st.roughness.red(uvt)
-        occl = None if st.occlusion is None else st.occlusion.red(uvt)
-        return red, rough, occl, picked
+        st = self.shapes.get(shape)
+        rough = occl = None
+        if st is not None:
+            uvt = transform_uv(uv, st.transform)
+            texel = st.base.red(uvt)
+            if picked is not None:
+                texel = np.where(picked, texel, 1.0)
+            out = red * texel
+            rough = None if st.roughness is None else st.roughness.red(uvt)
+            occl = None if st.occlusion is None else st.occlusion.red(uvt)
+        else:
+            out = red
+        layer = self.ink.get(shape)
+        if layer is not None:
+            ink, c = layer.pick(uv)
+            if picked is not None:
+                c = np.where(picked, c, np.float32(0.0))
+            blended = (np.float32(1.0) - c).astype(np.float64) * red      # (1.0f - c) in float32
+            if st is not None:
+                blended = blended * texel
+            out = blended + c.astype(np.float64) * ink[:, 0]
+        return out, rough, occl, picked
