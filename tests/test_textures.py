@@ -582,3 +582,18 @@ def test_ink_layer_sizes_discs_and_atlas(tmp_path: Path) -> None:
     top = np.array([[0.0, 0.0, 0.5]])
     uv1, _ = sampler.uv(1, top + [0, 0, 1], np.array([[0, 0, -1.0]]), np.array([1.0]), atlas=True)
     assert uv1.tolist() == [[0.625, 0.25]]
+
+
+def test_few_point_paths_are_the_vector_paths() -> None:
+    """Up to 8 points take plain-Python paths (plane coordinates, texel lookup): the same numbers."""
+    rng = np.random.default_rng(11)
+    img = rng.integers(0, 256, (5, 7, 3)).astype(np.uint8)
+    special = np.array([[0, 0], [1, 1], [-1e-20, 0.5], [-1, -2], [0.5, 1.0], [3.25, -0.75], [1 - 1e-17, 0.2], [2, 0]])
+    for uv in [special, rng.uniform(-3, 3, (8, 2)), rng.uniform(0, 1, (5, 2))]:
+        for rs in (True, False):
+            for rt in (True, False):
+                t = TextureImage(img, rs, rt)
+                big = np.vstack([uv] * 3)                   # > 8 points: the numpy path
+                assert np.array_equal(t.red(uv), t.red(big)[:len(uv)]), (rs, rt)
+    p = rng.uniform(-2, 2, (8, 3))
+    assert np.array_equal(tc.plane_uv(p, (1.3, 0.7)), tc.plane_uv(np.vstack([p, p]), (1.3, 0.7))[:8])

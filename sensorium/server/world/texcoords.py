@@ -76,6 +76,9 @@ def plane_uv(points: np.ndarray, size) -> np.ndarray:
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if size is None:
         return np.full((len(p), 2), 0.5)
+    if len(p) <= 8:       # a few points: the same arithmetic in Python floats (cheaper than numpy calls)
+        sx, sy = size
+        return np.array([(x / sx + 0.5, -y / sy + 0.5) for x, y, _ in p.tolist()]).reshape(-1, 2)
     return np.stack([p[:, 0] / size[0] + 0.5, -p[:, 1] / size[1] + 0.5], axis=1)
 
 

@@ -47,6 +47,7 @@ __all__ = ["TextureFileError", "resolve_texture_url", "image_header", "load_imag
            "TextureImage", "transform_uv", "TextureSampler", "TriangleLocator", "texture_urls"]
 
 FORMATS = {"PNG": "PNG", "JPEG": "JPEG", "MPO": "JPEG"}     # Pillow's format → what Webots calls it
+_FEW = 8                     # up to this many points, plain Python beats numpy's per-call cost
 
 
 class TextureFileError(Exception):
@@ -244,7 +245,17 @@ class TextureImage:
         return row, col
 
     def red(self, uv: np.ndarray) -> np.ndarray:
-        """The red channel in [0, 1] at finite ``(n, 2)`` coordinates (the infra-red path)."""
+        """The red channel in [0, 1] at finite ``(n, 2)`` coordinates (the infra-red path). A few
+        points (a line follower's sensors) are looked up in plain Python floats, the same
+        arithmetic as ``texel_index`` (a numpy call costs more than a texel)."""
+        if len(uv) <= _FEW:
+            h, w = self.rgb.shape[:2]
+            out = np.empty(len(uv))
+            for k, (u, v) in enumerate(uv.tolist()):
+                u = u - math.floor(u) if self.repeat_s else min(max(u, 0.0), 1.0)
+                v = v - math.floor(v) if self.repeat_t else min(max(v, 0.0), 1.0)
+                out[k] = int(self.rgb[min(int(v * h), h - 1), min(int(u * w), w - 1), 0]) / 255.0
+            return out
         row, col = self.texel_index(uv)
         return self.rgb[row, col, 0] / 255.0
 
