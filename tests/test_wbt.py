@@ -476,9 +476,10 @@ def test_textures_summarised_once(tmp_path: Path) -> None:
     p = write(tmp_path, f"Solid {{ name \"a\" children [ {shape} ] }}\nSolid {{ name \"b\" children [ {shape} ] }}\n")
     w = load_world(p)
     assert w.world.solids[0].shapes[0].appearance.base_color == (0.5, 0.2, 0.2)
-    notes = [x for x in w.warnings if "textures are not sampled" in x]
-    assert notes == [f"{p}:2:48: textures are not sampled (2 appearances): a PBRAppearance reads as its baseColor, "
-                     "a textured Appearance as white"]
+    notes = [x for x in w.warnings if "not loaded" in x]
+    assert notes == [f"{p}:2:99: 2 textures not loaded (first: texture file 'a.png' not found (urls are relative to "
+                     "the world file)); read as Webots reads a texture it cannot load: an Appearance as its material's "
+                     "diffuseColor, a PBRAppearance as its baseColor"]
 
 
 def test_mangled_worlds_fail_cleanly(tmp_path: Path) -> None:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
 
 Vec3 = tuple[float, float, float]
 
@@ -110,6 +110,13 @@ class Triangles(Strict):
     type: Literal["triangles"]
     vertices: list[Vec3] = Field(max_length=1_000_000)
     faces: list[tuple[int, int, int]] = Field(min_length=1, max_length=2_000_000)
+    tex_coords: list[tuple[float, float]] | None = Field(
+        default=None, max_length=1_000_000,
+        description="texture coordinates (s, t), t up as in Webots' TextureCoordinate; none: Webots' default "
+                    "mapping from the bounding box")
+    tex_coord_faces: list[tuple[int, int, int]] | None = Field(
+        default=None, max_length=2_000_000,
+        description="per face, the tex_coords index of each corner (Webots' texCoordIndex); none: the faces' indices")
 
 
 class Mesh(Strict):
@@ -123,12 +130,48 @@ class Mesh(Strict):
 Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Triangles | Mesh, Field(discriminator="type")]
 
 
+class Texture(Strict):
+    """An image on a surface (Webots' ImageTexture): a PNG or JPEG file, path relative to the world
+    file (confined to its folder like meshes). Infra-red sensors read the texel under each hit,
+    nearest texel, alpha ignored (Webots' pickColor). A bare string is taken as the url."""
+
+    url: str = Field(min_length=1)
+    repeat_s: bool = True
+    repeat_t: bool = True
+    filtering: int = Field(default=4, ge=0, le=5, description="Webots' rendering filter; sensors read the nearest texel")
+
+
+class TextureTransform(Strict):
+    """Webots' TextureTransform (X3D order: translation, then rotation and scale about center)."""
+
+    center: tuple[float, float] = (0.0, 0.0)
+    rotation: float = 0.0
+    scale: tuple[float, float] = (1.0, 1.0)
+    translation: tuple[float, float] = (0.0, 0.0)
+
+
+def _texture_from_url(v: object) -> object:
+    return {"url": v} if isinstance(v, str) else v
+
+
+TextureField = Annotated[Texture | None, BeforeValidator(_texture_from_url)]
+
+
 class Appearance(Strict):
-    """What infra-red sensors see (PBRAppearance fields). No appearance means white (red = 1)."""
+    """What infra-red sensors see (PBRAppearance fields). No appearance means white (red = 1).
+
+    With a ``texture`` the colour is ``base_color × (1 − transparency) × texel`` (Webots multiplies
+    a PBRAppearance's baseColor by its baseColorMap; a textured Appearance's diffuse colour is
+    replaced by white). ``roughness_map``/``occlusion_map`` (red channel) are read only where
+    ``texture`` is set, as in Webots."""
 
     base_color: Vec3 = (1.0, 1.0, 1.0)
     transparency: float = Field(default=0.0, ge=0.0, le=1.0)
     roughness: float = Field(default=0.0, ge=0.0, le=1.0)
+    texture: TextureField = None
+    roughness_map: TextureField = None
+    occlusion_map: TextureField = None
+    texture_transform: TextureTransform | None = None
 
     @field_validator("base_color")
     @classmethod

@@ -1,4 +1,5 @@
-"""The bundled example worlds: ``arena`` (the default), ``warehouse``, ``lighting`` (YAML) and
+"""The bundled example worlds: ``arena`` (the default), ``warehouse``, ``lighting``,
+``line_following`` (YAML; its floor texture in ``textures/``, made by :mod:`.line_loop`) and
 ``epuck.wbt`` (a Webots world).
 
 Every command and :func:`sensorium.server.world.loader.load_world` also take a bundled world's bare

@@ -237,11 +237,15 @@ class _Group:
 class DistanceBatch:
     """All distance sensors due this step; sensors with the same ray count share array shapes.
     ``plan``: the constants of these sensors when already stacked (see :class:`DistancePlan`);
-    ``engine``: the ray engine, to decide the rays' hits on their own bodies once."""
+    ``engine``: the ray engine, to decide the rays' hits on their own bodies once; ``scene``: the
+    scene, whose textures infra-red rays read (nothing is sampled in a world without textures)."""
 
     def __init__(self, devices: list[DistanceSensor], robot_poses: list[Pose], scene_red: np.ndarray,
-                 scene_roughness: np.ndarray, plan: DistancePlan | None = None, engine=None):
+                 scene_roughness: np.ndarray, plan: DistancePlan | None = None, engine=None, scene=None):
         self.red, self.roughness = scene_red, scene_roughness
+        # the scene, when it has textures: infra-red hits on textured shapes read their texels
+        self.textured = scene.textures.textured if scene is not None and scene.textures is not None else None
+        self.scene = scene
         self.plan_data = plan = plan if plan is not None else DistancePlan(devices)
         self.engine = engine if plan.groups and plan.groups[0].mount is not None else None
         self.empty, self.devices = plan.empty, plan.devices
@@ -291,7 +295,13 @@ class DistanceBatch:
             if g.kind == RayKind.VISUAL:
                 # colour lookups only for infra-red; shape -1 picks the trailing "no hit" entry
                 sh = shape.reshape(S, n)
-                reflection = np.where(sh >= 0, dmath.reflection_factor(self.red[sh], self.roughness[sh]), 1.0)
+                if self.textured is not None and np.count_nonzero(self.textured[shape]):
+                    red, rough, occl = self.scene.infra_red_terms(
+                        shape, np.repeat(self.positions[g.idx], n, axis=0), dirs.reshape(-1, 3), dist.reshape(-1))
+                    shade = dmath.reflection_factor(red, rough, occl).reshape(S, n)
+                else:
+                    shade = dmath.reflection_factor(self.red[sh], self.roughness[sh])
+                reflection = np.where(sh >= 0, shade, 1.0)
             measured[g.idx] = dmath.combine_distance_batch(
                 g.types, dist, dirs, normal.reshape(S, n, 3), g.weights, g.lut_max_range, reflection, g.sensitivity)
         plan.output(measured, now_ms)

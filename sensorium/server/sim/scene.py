@@ -5,7 +5,8 @@ its nested children, poses composed at load time; every robot is one movable bod
 shapes). Lights attached to a solid or robot are kept with their local frame and placed in the
 world on demand (``world_lights``). The global shape index returned by the ray engine indexes ``Scene.shapes``, which
 carries what the devices need: owner robot, and the red channel and roughness infra-red sensors
-read.
+read. Textured shapes also have a sampler (``Scene.textures``, world/textures.py; None in a world
+without textures): ``infra_red_terms`` turns hits into the colour terms of Webots' pickColor.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.meshes import load_mesh, triangles_mesh
 from sensorium.server.world.poses import pose_from_model
+from sensorium.server.world.textures import TextureSampler
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,6 +123,7 @@ class Scene:
         self._solid_body: dict[str, int] = {}
         self.solid_poses: dict[str, Pose] = {}
         self.triangle_count = 0
+        self._parts: list[tuple[str | int | None, Pose, wm.Shape | wm.Solid]] = []   # per shape: owner, frame, model
         # lights: (model, owner, pose in the owner's frame); owner None = world, str = solid, int = robot
         self._lights: list[tuple[object, str | int | None, Pose]] = [(lt, None, Pose.identity()) for lt in world.lights]
         for s in world.solids:
@@ -129,7 +132,7 @@ class Scene:
             self._lights += [(lt, s.name, f) for lt, f in solid_lights(s, Pose.identity())]
             parts = list(solid_parts(s, Pose.identity()))
             if parts:
-                self._solid_body[s.name] = self._add_body(parts, base_dir, pose, owner=-1, movable=False)
+                self._solid_body[s.name] = self._add_body(parts, base_dir, pose, owner=-1, movable=False, key=s.name)
         self.robot_names = [r.name for r in world.robots]
         self.robot_poses: list[Pose] = []
         self._robot_body: dict[int, int] = {}
@@ -139,15 +142,22 @@ class Scene:
             self._lights += [(lt, i, Pose.identity()) for lt in r.lights]
             parts = list(robot_parts(r))
             if parts:
-                self._robot_body[i] = self._add_body(parts, base_dir, pose, owner=i, movable=True)
+                self._robot_body[i] = self._add_body(parts, base_dir, pose, owner=i, movable=True, key=i)
         self._attached = {owner for _, owner, _ in self._lights if owner is not None}
+        # textures: one sampler for the world's images (None without any), read by infra-red only
+        self._base_dir = base_dir
+        sampler = TextureSampler([(shape.geometry, shape.appearance) for _, _, shape in self._parts], base_dir)
+        self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
+        self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         self.lights_version = 0        # changes whenever a light moves with its owner
         # infra-red reads these per hit shape; -1 (no hit) indexes the trailing "no hit" entry
         self.red = np.array([s.red for s in self.shapes] + [1.0])
         self.roughness = np.array([s.roughness for s in self.shapes] + [0.0])
 
-    def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool) -> int:
+    def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool,
+                  key: str | int | None = None) -> int:
         entries = [_entry(shape, base_dir, local) for _, local, shape in parts]
+        self._parts += [(key, local, shape) for _, local, shape in parts]
         self.triangle_count += sum(geo.triangle_count(e.primitive) for e in entries)
         self.shapes += [_shape_info(name, owner, shape) for name, _, shape in parts]
         return self.engine.add_body(entries, pose, owner=owner, movable=movable)
@@ -183,3 +193,62 @@ class Scene:
             self.lights_version += 1
         if name in self._solid_body:
             self.engine.set_body_pose(self._solid_body[name], pose)
+
+    def shape_pose(self, shape: int) -> Pose:
+        """The world pose of a shape now (its owner's pose ∘ its frame in the owner)."""
+        key, local, _ = self._parts[shape]
+        owner = self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
+        return owner.compose(local)
+
+    def _world_to_shape(self, shape: int) -> Pose:
+        """The inverse of a shape's world pose, kept while its owner's pose object is the same."""
+        key, local, _ = self._parts[shape]
+        owner = self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
+        kept = self._inverse.get(shape)
+        if kept is None or kept[0] is not owner:
+            kept = self._inverse[shape] = (owner, owner.compose(local).inverse())
+        return kept[1]
+
+    def paint(self, shape: int, origin: np.ndarray, direction: np.ndarray, distance: float, lead_size: float,
+              color, density: float) -> int:
+        """A pen's stroke where its ray (world frame) hit ``shape`` at ``distance``: ink laid in the
+        shape's ink layer (textures.InkLayer), made on the first stroke; returns the texels inked."""
+        if self.textures is None:
+            self.textures = TextureSampler([(shape_.geometry, shape_.appearance) for _, _, shape_ in self._parts],
+                                           self._base_dir)
+        inv = self._world_to_shape(shape)
+        return self.textures.paint(shape, inv.apply(np.asarray(origin, dtype=np.float64)),
+                                   inv.apply_dirs(np.asarray(direction, dtype=np.float64)), float(distance),
+                                   lead_size, color, density)
+
+    def clear_ink(self) -> None:
+        """All ink gone (a simulation reset, as Webots' Pen reset clears every paint texture)."""
+        if self.textures is not None:
+            self.textures.clear_ink()
+
+    def infra_red_terms(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
+                        distance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(red, roughness, occlusion) an infra-red ray reads at its hit (WbShape::pickColor):
+        ``red = base_color.r·(1 − transparency)·texel.r`` on textured shapes (the texel at Webots'
+        texture coordinates of the hit, in the shape's frame, float64), the shape's red elsewhere;
+        roughness from a roughness map where there is one; occlusion from an occlusion map (else 0).
+        ``shape`` −1 (no hit) reads the trailing "no hit" entries."""
+        red = self.red[shape]
+        rough = self.roughness[shape]
+        occl = np.zeros(len(shape))
+        sampler = self.textures
+        if sampler is None:
+            return red, rough, occl
+        hit = sampler.textured[shape].nonzero()[0]
+        on = shape[hit]
+        for s in sorted(set(on.tolist())):
+            rows = hit[on == s] if len(hit) > 1 else hit
+            inv = self._world_to_shape(s)
+            o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
+            read, rmap, omap, picked = sampler.infra_red(s, o, d, distance[rows], red[rows])
+            red[rows] = read
+            if rmap is not None:
+                rough[rows] = rmap if picked is None else np.where(picked, rmap, rough[rows])
+            if omap is not None:
+                occl[rows] = omap if picked is None else np.where(picked, omap, 0.0)
+        return red, rough, occl

@@ -256,6 +256,7 @@ class Simulation:
         out["engine_rays"] = eng["rays_cast"]
         for key in ("rays_light", "rays_distance", "rays_lidar", "cast_calls", "points_built", "measurements"):
             out.setdefault(key, 0)
+        out["texture_lookups"] = self.scene.textures.lookups if self.scene.textures is not None else 0
         out["contacts"] = self.contact.contacts if self.contact is not None else 0
         out["contact_checks"] = self.contact.checks if self.contact is not None else 0
         return out
@@ -317,7 +318,7 @@ class Simulation:
             work.append((batch, batch.plan()))
         if distances:
             dbatch = DistanceBatch(distances, poses, self.scene.red, self.scene.roughness,
-                                   self._distance_plan(distances), self.scene.engine)
+                                   self._distance_plan(distances), self.scene.engine, self.scene)
             work.append((dbatch, dbatch.plan()))
         for lidar in lidars:
             work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt)))

@@ -45,6 +45,10 @@ class WorldLimits:
     beams_per_lidar: int = 1 << 20           # horizontal_resolution × number_of_layers
     rays_per_step: int = 1 << 22             # every device due at once: distance rays + lidar beams + light occlusion rays
     triangles: int = 4_000_000               # tessellated primitives + meshes (planes are analytic)
+    # textures (world/textures.py): each image file, each image's pixels, all images' pixels (3 bytes each)
+    texture_file_bytes: int = 64 * MiB
+    texture_pixels: int = 1 << 24            # 4096 x 4096
+    texture_pixels_total: int = 1 << 25      # ~100 MB decoded
 
     @classmethod
     def large(cls) -> WorldLimits:
@@ -52,7 +56,8 @@ class WorldLimits:
         return cls(file_bytes=1024 * MiB, mesh_file_bytes=4096 * MiB, nesting_depth=256, values=100_000_000,
                    name_chars=4096, string_chars=1 * MiB, number_magnitude=1e15, robots=100_000,
                    devices_per_robot=65_536, lights=65_536, solids=10_000_000, rays_per_sensor=1 << 20,
-                   beams_per_lidar=1 << 28, rays_per_step=1 << 30, triangles=1 << 30)
+                   beams_per_lidar=1 << 28, rays_per_step=1 << 30, triangles=1 << 30,
+                   texture_file_bytes=4096 * MiB, texture_pixels=1 << 30, texture_pixels_total=1 << 32)
 
     def describe(self) -> list[tuple[str, Any]]:
         return [(f.name, getattr(self, f.name)) for f in fields(self)]

@@ -383,6 +383,10 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
     problems += _check_meshes_and_work(world, base_dir, limits or WorldLimits(), allow_outside_meshes)
+    if not problems:    # textures: confined like meshes, within the limits, decoded once (world/textures.py)
+        from sensorium.server.world.textures import check_textures
+
+        problems += [Problem(*p) for p in check_textures(world, base_dir, limits or WorldLimits(), allow_outside_meshes)]
     return problems
 
 

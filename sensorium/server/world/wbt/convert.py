@@ -110,7 +110,7 @@ class Converter:
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.defs: set[str] = set()        # DEF names kept (def_name)
-        self.textured: dict[int, tuple[int, int]] = {}   # appearances with a texture → (line, column)
+        self.textured: dict[int, tuple[int, int, str]] = {}   # textures not loaded → (line, column, why)
         self.robot_fields = set(wm.Robot.model_fields)
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
 
@@ -143,11 +143,11 @@ class Converter:
             self.visit(node, Frame.identity(), world, top=True)
         if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
             self.world["solids"].append(self.solid_dict(world, {"name": self.unique_name("shapes")}))
-        if self.textured:
-            line, col = min(self.textured.values())
-            n = len(self.textured)
-            self.warnings.append(f"{self.source}:{line}:{col}: textures are not sampled ({n} appearance{'s' if n > 1 else ''}"
-                                 "): a PBRAppearance reads as its baseColor, a textured Appearance as white")
+        if self.textured:   # textures not loaded: one line (world/textures.py says why each is refused)
+            (line, col, why), n = min(self.textured.values()), len(self.textured)
+            self.warnings.append(f"{self.source}:{line}:{col}: {n} texture{'s' if n > 1 else ''} not loaded (first: {why}); "
+                                 "read as Webots reads a texture it cannot load: an Appearance as its material's "
+                                 "diffuseColor, a PBRAppearance as its baseColor")
         if self.skipped:
             listed = ", ".join(f"{k} x{v}" if v > 1 else k for k, v in sorted(self.skipped.items()))
             self.warnings.append(f"{self.source}: skipped nodes that do not matter to these sensors: {listed}")
@@ -231,9 +231,9 @@ class Converter:
                             f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
 
     def appearance_note(self, node: Node, message: str) -> None:
-        if message == "texture":   # one summary line for all textures
+        if message.startswith("texture: "):   # one summary line for all textures not loaded
             if id(node) not in self.textured:
-                self.textured[id(node)] = (node.line, node.col)
+                self.textured[id(node)] = (node.line, node.col, message[len("texture: "):])
         else:
             self.warn(node, message)
 
@@ -333,21 +333,30 @@ class Converter:
             if "://" in urls[0]:
                 raise f.error("url", f"only local mesh files are supported, got {urls[0]!r}")
             return {"type": "mesh", "url": urls[0], "scale": [s, s, s]}
-        # IndexedFaceSet: polygons separated by -1, fan-triangulated
+        # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
         coord = f.node_("coord")
         points = self.fields(coord).rows("point", 3, []) if coord is not None else []
         index = [int(i) for i in f.numbers("coordIndex")]
+        tex, tex_index = fx.tex_coords(node, f, len(index), self.warn)
         faces: list[list[int]] = []
+        tex_faces: list[list[int]] = []
         poly: list[int] = []
-        for i in [*index, -1]:
+        for n_i, i in enumerate([*index, -1]):
             if i >= 0:
-                poly.append(i)
+                poly.append(n_i)
                 continue
-            faces += [[poly[0], poly[k], poly[k + 1]] for k in range(1, len(poly) - 1)]
+            for k in range(1, len(poly) - 1):
+                corners = (poly[0], poly[k], poly[k + 1])
+                faces.append([index[c] for c in corners])
+                if tex_index is not None:
+                    tex_faces.append([tex_index[c] for c in corners])
             poly = []
         if not faces:
             raise f.error("coordIndex", "an IndexedFaceSet needs at least one polygon")
-        return {"type": "triangles", "vertices": [[v * s for v in p] for p in points], "faces": faces}
+        out = {"type": "triangles", "vertices": [[v * s for v in p] for p in points], "faces": faces}
+        if tex is not None:
+            out["tex_coords"], out["tex_coord_faces"] = tex, tex_faces
+        return out
 
     # ------------------------------------------------------------ lights
     def light(self, node: Node, frame: Frame, owner: Owner) -> None:

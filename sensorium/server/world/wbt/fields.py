@@ -176,29 +176,104 @@ DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light senso
 
 def appearance(node: Node | None, source: str, warn) -> dict | None:
     """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read).
-    ``warn(node, "texture")`` notes a texture that is not sampled: a PBRAppearance keeps its
-    baseColor, an Appearance reads white (Webots replaces the material's diffuse colour by the
-    texture's)."""
+
+    As Webots' pickColor: a PBRAppearance is ``baseColor × (1 − transparency)`` times its
+    ``baseColorMap`` texel (roughness and occlusion maps read where the base map is); an Appearance
+    with a loaded ``texture`` reads white × ``(1 − transparency)`` × texel (WbAppearance::diffuseColor
+    replaces the material's colour by white), without one its material's diffuseColor. A texture
+    that cannot be loaded here (missing file, not PNG/JPEG, webots:// or remote url) is noted with
+    ``warn(node, "texture: <why>")`` and read as Webots reads a texture it could not load."""
     if node is None:
         return None
     f = Fields(node, source)
     if node.type == "PBRAppearance":
-        if f.node_("baseColorMap") is not None:
-            warn(node, "texture")
-        return {"base_color": list(f.vec("baseColor", (1.0, 1.0, 1.0))),
-                "transparency": f.num("transparency", 0.0), "roughness": f.num("roughness", 0.0)}
+        out: dict[str, Any] = {"base_color": list(f.vec("baseColor", (1.0, 1.0, 1.0))),
+                               "transparency": f.num("transparency", 0.0), "roughness": f.num("roughness", 0.0)}
+        base = image_texture(f.node_("baseColorMap"), source, warn)
+        if base is not None:
+            out["texture"] = base
+            for field, key in (("roughnessMap", "roughness_map"), ("occlusionMap", "occlusion_map")):
+                extra = image_texture(f.node_(field), source, warn)
+                if extra is not None:
+                    out[key] = extra
+            _texture_transform(f, source, out)
+        return out
     if node.type == "Appearance":
         material = f.node_("material")
-        textured = f.node_("texture") is not None
-        if textured:
-            warn(node, "texture")
-        if material is None:
-            return {"base_color": [1.0, 1.0, 1.0]}
-        m = Fields(material, source)
-        colour = [1.0, 1.0, 1.0] if textured else list(m.vec("diffuseColor", (0.8, 0.8, 0.8)))
-        return {"base_color": colour, "transparency": m.num("transparency", 0.0)}
+        texture = image_texture(f.node_("texture"), source, warn)
+        out = {"base_color": [1.0, 1.0, 1.0]}
+        if material is not None:
+            m = Fields(material, source)
+            if texture is None:
+                out["base_color"] = list(m.vec("diffuseColor", (0.8, 0.8, 0.8)))
+            out["transparency"] = m.num("transparency", 0.0)
+        if texture is not None:
+            out["texture"] = texture
+            _texture_transform(f, source, out)
+        return out
     warn(node, f"appearance {node.type}: not built in (a PROTO?); taken as white")
     return None
+
+
+def image_texture(node: Node | None, source: str, warn) -> dict | None:
+    """An ImageTexture → the world format's texture, if its first url is a PNG/JPEG file found
+    relative to the world file (else ``warn(node, "texture: …")`` and None: Webots would not load it).
+    The url is kept as written (backslashes made slashes, as Webots does)."""
+    from pathlib import Path
+
+    from sensorium.server.world.textures import TextureFileError, image_header, resolve_texture_url
+
+    if node is None:
+        return None
+    if node.type != "ImageTexture":
+        warn(node, f"texture: {node.type} is not an ImageTexture")
+        return None
+    f = Fields(node, source)
+    urls = f.strings("url")
+    if not urls:
+        warn(node, "texture: ImageTexture without url")
+        return None
+    url = urls[0].replace("\\", "/")
+    try:
+        path = resolve_texture_url(url, Path(source).resolve().parent, allow_outside=True)
+        image_header(path, url)
+    except TextureFileError as exc:
+        warn(node, f"texture: {exc}")
+        return None
+    filtering = f.integer("filtering", 4)
+    return {"url": url, "repeat_s": f.flag("repeatS", True), "repeat_t": f.flag("repeatT", True),
+            "filtering": filtering if 0 <= filtering <= 5 else 4}
+
+
+def tex_coords(node: Node, f: Fields, n_index: int, warn) -> tuple[list[list[float]] | None, list[int] | None]:
+    """An IndexedFaceSet's texture coordinates and one texCoord index per coordIndex entry
+    (WbTriangleMesh): ``texCoordIndex`` if given (it must be as long as ``coordIndex``, else Webots
+    warns and uses its default mapping), else ``coordIndex``; an index outside ``texCoord`` reads
+    (0.5, 0.5), kept here as one extra coordinate. (None, None): the default mapping."""
+    tnode = f.node_("texCoord")
+    points = [list(p) for p in Fields(tnode, f.source).rows("point", 2, [])] if tnode is not None else []
+    if not points:
+        return None, None
+    index = [int(i) for i in f.numbers("texCoordIndex")] or [int(i) for i in f.numbers("coordIndex")]
+    if len(index) != n_index:
+        warn(node, f"IndexedFaceSet: texCoordIndex has {len(index)} entries for {n_index} in coordIndex: "
+                   "Webots' default texture mapping applies")
+        return None, None
+    n = len(points)
+    if any(i >= n or i < 0 for i in index):      # (separators are -1 too; they never become corners)
+        points.append([0.5, 0.5])
+        index = [i if 0 <= i < n else n for i in index]
+    return points, index
+
+
+def _texture_transform(f: Fields, source: str, out: dict) -> None:
+    node = f.node_("textureTransform")
+    if node is None:
+        return
+    t = Fields(node, source)
+    out["texture_transform"] = {"center": list(t.vec("center", (0.0, 0.0))), "rotation": t.num("rotation", 0.0),
+                                "scale": list(t.vec("scale", (1.0, 1.0))),
+                                "translation": list(t.vec("translation", (0.0, 0.0)))}
 
 
 # ---------------------------------------------------------------- typo check
@@ -244,6 +319,9 @@ WEBOTS_FIELDS: dict[str, set[str]] = {
                              "dampingConstant", "staticFriction", "suspensionSpringConstant",
                              "suspensionDampingConstant", "suspensionAxis", "stopERP", "stopCFM"},
     "Coordinate": {"point"},
+    "ImageTexture": {"url", "repeatS", "repeatT", "filtering"},
+    "TextureTransform": {"center", "rotation", "scale", "translation"},
+    "TextureCoordinate": {"point"},
 }
 
 

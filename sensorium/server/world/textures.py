@@ -1,0 +1,736 @@
+"""Textures: image files → texel arrays (Pillow), the limits on them, and the sampler the scene owns.
+
+What Webots does, and so what this does (sources: ``WbImageTexture.cpp``, ``WbAppearance.cpp``,
+``WbPbrAppearance.cpp``, ``WbAbstractAppearance.cpp``, ``WbTextureTransform.cpp``,
+``wren/TextureTransform.{hpp,cpp}``, ``WbShape.cpp`` ``pickColor``; docs/textures.md restates them):
+
+* an image is read once (PNG or JPEG), converted to 8-bit RGB; alpha is never read by sensors;
+* a lookup takes the geometry's ``(u, v)`` (:mod:`.texcoords`), applies the appearance's
+  TextureTransform (X3D order: translation, then rotation and scale about ``center``; Webots'
+  wren matrix ``−C·S·R·C·T`` with its flipped ``v``), wraps each coordinate (``repeatS``/``repeatT``:
+  ``fmod`` into [0, 1); otherwise clamped to [0, 1]) and reads the **nearest texel**: column
+  ``min(⌊u·w⌋, w − 1)``, row ``min(⌊v·h⌋, h − 1)`` counted from the image's top row, each channel
+  ``byte / 255``. The ``filtering`` field only changes Webots' rendering.
+
+Differences kept on purpose (docs/textures.md): the transform is applied in float64 (Webots:
+float32), and an image whose sides are not powers of two is sampled as stored (Webots rescales it
+to the next powers of two first, keeping its aspect ratio, with Qt's nearest-pixel scaling): such
+an image reads the same texels except within about one texel of a texel boundary.
+
+Images are decoded once (when the world is checked; cached by file, modification time and size)
+and bounded by the world limits (``texture_file_bytes``, ``texture_pixels`` per image,
+``texture_pixels_total`` per world): a larger image is rejected with the limit it exceeds, never
+silently reduced (reduced texels would change readings).
+
+The sampler (:class:`TextureSampler`) is per scene: for each shape, the mapping of its geometry and
+its images. Its API works on one shape's local-frame points at a time — ``uv`` (Webots'
+coordinates and whether picking succeeded), ``texels`` (colours of a map at those coordinates) and
+``infra_red`` (the terms an infra-red sensor reads) — so the Camera can sample the same textures.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.world import texcoords as tc
+
+__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "load_image", "check_textures",
+           "TextureImage", "transform_uv", "TextureSampler", "TriangleLocator", "texture_urls"]
+
+FORMATS = {"PNG": "PNG", "JPEG": "JPEG", "MPO": "JPEG"}     # Pillow's format → what Webots calls it
+_FEW = 8                     # up to this many points, plain Python beats numpy's per-call cost
+
+
+class TextureFileError(Exception):
+    """A texture file that is missing, unreadable, not a PNG/JPEG, or over a limit."""
+
+
+def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False,
+                        max_bytes: int | None = None) -> Path:
+    """A texture ``url`` → the file it names, relative to ``base_dir`` (the world's folder), which
+    it may not leave unless ``allow_outside`` (as mesh urls). Errors quote the url as written."""
+    if "\0" in url:
+        raise TextureFileError("texture url contains a NUL byte")
+    if not url.strip():
+        raise TextureFileError("texture url is empty")
+    if url.startswith("webots://"):
+        raise TextureFileError(f"texture url {url!r}: webots:// urls (files of a Webots installation) are not "
+                               "resolved yet")
+    if "://" in url:
+        raise TextureFileError(f"texture url {url!r}: only local files are read (no downloads)")
+    base = Path(base_dir).resolve()
+    try:
+        path = (base / url).resolve()
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise TextureFileError(f"texture url {url!r} cannot be resolved: {exc}") from None
+    if not allow_outside and not path.is_relative_to(base):
+        raise TextureFileError(f"texture url {url!r} leaves the world's folder (absolute paths and '..' are "
+                               "refused; use --allow-outside-meshes to allow them)")
+    try:
+        if not path.is_file():
+            raise TextureFileError(f"texture file {url!r} not found (urls are relative to the world file)")
+        size = path.stat().st_size
+    except OSError as exc:
+        raise TextureFileError(f"texture file {url!r} cannot be read: {exc.strerror or exc}") from None
+    if max_bytes is not None and size > max_bytes:
+        raise TextureFileError(f"texture file {url!r} is larger than the limit of {max_bytes:,} bytes "
+                               "(raise the limits with --allow-large)")
+    return path
+
+
+def image_header(path: Path, display: str) -> tuple[str, int, int]:
+    """(format, width, height) from the file's header only (nothing decoded)."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(path) as im:
+                fmt, (w, h) = im.format, im.size
+    except UnidentifiedImageError:
+        raise TextureFileError(f"texture file {display!r} is not a PNG or JPEG image") from None
+    except (OSError, ValueError, Image.DecompressionBombError) as exc:
+        raise TextureFileError(f"texture file {display!r} cannot be read: {exc}") from None
+    if fmt not in FORMATS:
+        raise TextureFileError(f"texture file {display!r} is a {fmt} image; Webots reads PNG and JPEG only")
+    if w < 1 or h < 1:
+        raise TextureFileError(f"texture file {display!r} has no pixels ({w}x{h})")
+    return FORMATS[fmt], w, h
+
+
+def load_image(path: Path, display: str | None = None) -> np.ndarray:
+    """The image as a read-only ``(h, w, 3)`` uint8 RGB array, top row first (cached)."""
+    path = Path(path).resolve()
+    st = path.stat()
+    try:
+        return _decode(str(path), st.st_mtime_ns, st.st_size)
+    except TextureFileError as exc:
+        raise TextureFileError(str(exc).replace(str(path), display or str(path))) from None
+
+
+@lru_cache(maxsize=16)
+def _decode(path: str, _mtime: int, _size: int) -> np.ndarray:
+    from PIL import Image
+
+    old = Image.MAX_IMAGE_PIXELS       # the world limits were checked on the header; Pillow's own
+    Image.MAX_IMAGE_PIXELS = None      # bomb guard would refuse what --allow-large allows
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(path) as im:
+                im.load()
+                if im.mode in ("I;16", "I;16B", "I;16L", "I"):    # 16-bit grey: rounded to 8 bits
+                    a = np.clip(np.asarray(im, dtype=np.int64), 0, 65535)
+                    grey = ((a * 255 + 32767) // 65535).astype(np.uint8)
+                    rgb = np.repeat(grey[..., None], 3, axis=2)
+                else:
+                    rgb = np.asarray(im.convert("RGB"), dtype=np.uint8)
+    except (OSError, ValueError, SyntaxError) as exc:
+        raise TextureFileError(f"texture file {path} cannot be decoded: {exc}") from None
+    finally:
+        Image.MAX_IMAGE_PIXELS = old
+    rgb = np.ascontiguousarray(rgb)
+    rgb.flags.writeable = False
+    return rgb
+
+
+# ------------------------------------------------------------------------------------ the world
+
+
+def texture_urls(appearance: wm.Appearance | None) -> Iterator[tuple[str, wm.Texture]]:
+    """(field name, texture) of every image an appearance names."""
+    if appearance is None:
+        return
+    for name in ("texture", "roughness_map", "occlusion_map"):
+        t = getattr(appearance, name)
+        if t is not None:
+            yield name, t
+
+
+def _appearances(world: wm.World) -> Iterator[tuple[str, Any]]:
+    """(path, shape-like) of every shape of a world: solids (nested), parts, robot bodies."""
+    def solid(path: str, s: wm.Solid) -> Iterator[tuple[str, Any]]:
+        if s.geometry is not None:
+            yield path, s
+        for i, part in enumerate(s.shapes):
+            yield f"{path}.shapes[{i}]", part
+        for i, child in enumerate(s.children):
+            yield from solid(f"{path}.children[{i}]", child)
+
+    for i, s in enumerate(world.solids):
+        yield from solid(f"solids[{i}]", s)
+    for r_i, robot in enumerate(world.robots):
+        if robot.body is not None:
+            yield f"robots[{r_i}].body", robot.body
+        for i, part in enumerate(robot.shapes):
+            yield f"robots[{r_i}].shapes[{i}]", part
+
+
+def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False) -> list[tuple[str, str]]:
+    """Every texture of a world: url confined and readable, a PNG or JPEG within the limits, decoded
+    (so a broken file is found when the world is checked, and decoded once); the texture
+    coordinates of inline triangles consistent. ``(path, message)`` per problem."""
+    problems: list[tuple[str, str]] = []
+    seen: dict[Path, int] = {}
+    total = 0
+    for path, shape in _appearances(world):
+        g = shape.geometry
+        if isinstance(g, wm.Triangles) and g.tex_coords is not None:
+            problems += _check_tex_coords(g, f"{path}.geometry")
+        for field, tex in texture_urls(shape.appearance):
+            where = f"{path}.appearance.{field}.url"
+            try:
+                file = resolve_texture_url(tex.url, base_dir, allow_outside=allow_outside,
+                                           max_bytes=limits.texture_file_bytes)
+                if file in seen:
+                    continue
+                _, w, h = image_header(file, tex.url)
+                if w * h > limits.texture_pixels:
+                    raise TextureFileError(f"texture {tex.url!r} has {w}x{h} = {w * h:,} pixels, more than the "
+                                           f"limit of {limits.texture_pixels:,} (raise the limits with --allow-large)")
+                total += w * h
+                if total > limits.texture_pixels_total:
+                    raise TextureFileError(f"the world's textures have more than {limits.texture_pixels_total:,} "
+                                           "pixels together (raise the limits with --allow-large)")
+                load_image(file, tex.url)
+                seen[file] = w * h
+            except TextureFileError as exc:
+                problems.append((where, str(exc)))
+    return problems
+
+
+def _check_tex_coords(g: wm.Triangles, path: str) -> list[tuple[str, str]]:
+    assert g.tex_coords is not None
+    n = len(g.tex_coords)
+    corners = g.tex_coord_faces if g.tex_coord_faces is not None else g.faces
+    if g.tex_coord_faces is not None and len(g.tex_coord_faces) != len(g.faces):
+        return [(f"{path}.tex_coord_faces", f"{len(g.tex_coord_faces)} entries for {len(g.faces)} faces "
+                                            "(one per face is needed)")]
+    for i, face in enumerate(corners):
+        if min(face) < 0 or max(face) >= n:
+            key = "tex_coord_faces" if g.tex_coord_faces is not None else "faces"
+            return [(f"{path}.{key}[{i}]", f"texture coordinate index outside 0..{n - 1}: {list(face)}")]
+    return []
+
+
+# ------------------------------------------------------------------------------------ sampling
+
+
+@dataclass(frozen=True, eq=False)
+class TextureImage:
+    """One decoded image and how it wraps (Webots' ImageTexture)."""
+
+    rgb: np.ndarray            # (h, w, 3) uint8, top row first
+    repeat_s: bool = True
+    repeat_t: bool = True
+
+    def texel_index(self, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(row, column) of the nearest texel (WbImageTexture::pickColor's wrap and index)."""
+        h, w = self.rgb.shape[:2]
+        u, v = uv[:, 0], uv[:, 1]
+        u = _wrap(u) if self.repeat_s else np.minimum(np.maximum(u, 0.0), 1.0)
+        v = _wrap(v) if self.repeat_t else np.minimum(np.maximum(v, 0.0), 1.0)
+        # u, v in [0, 1] here (NaN, from a failed pick, is not: the callers replace it first)
+        col = np.minimum((u * w).astype(np.int64), w - 1)
+        row = np.minimum((v * h).astype(np.int64), h - 1)
+        return row, col
+
+    def red(self, uv: np.ndarray) -> np.ndarray:
+        """The red channel in [0, 1] at finite ``(n, 2)`` coordinates (the infra-red path). A few
+        points (a line follower's sensors) are looked up in plain Python floats, the same
+        arithmetic as ``texel_index`` (a numpy call costs more than a texel)."""
+        if len(uv) <= _FEW:
+            h, w = self.rgb.shape[:2]
+            out = np.empty(len(uv))
+            for k, (u, v) in enumerate(uv.tolist()):
+                u = u - math.floor(u) if self.repeat_s else min(max(u, 0.0), 1.0)
+                v = v - math.floor(v) if self.repeat_t else min(max(v, 0.0), 1.0)
+                out[k] = int(self.rgb[min(int(v * h), h - 1), min(int(u * w), w - 1), 0]) / 255.0
+            return out
+        row, col = self.texel_index(uv)
+        return self.rgb[row, col, 0] / 255.0
+
+    def texels(self, uv: np.ndarray, channel: int | None = None) -> np.ndarray:
+        """Texel colours ``(n, 3)`` in [0, 1] (``byte / 255``), or one channel ``(n,)``."""
+        uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+        uv = np.where(np.isnan(uv), 0.0, uv)
+        row, col = self.texel_index(uv)
+        px = self.rgb[row, col] if channel is None else self.rgb[row, col, channel]
+        return px / 255.0
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    """Webots' repeat: C ``fmod(x, 1)``, plus 1 when negative. ``x − ⌊x⌋`` is the same number (both
+    are the one rounding of the same exact sum; fmod itself is exact), up to the sign of a zero."""
+    return x - np.floor(x)
+
+
+def transform_uv(uv: np.ndarray, t: wm.TextureTransform | None) -> np.ndarray:
+    """Webots' TextureTransform on ``(u, v)`` (v from the top): wren's ``−C·S·R·C·T`` with its
+    translation and center given in X3D's upward ``t`` (hence the ``−y`` and the offsets of 1)."""
+    if t is None:
+        return uv
+    (cx, cy), (sx, sy), (px, py) = t.center, t.scale, t.translation
+    c, s = math.cos(t.rotation), math.sin(t.rotation)
+    x = uv[:, 0] + px + cx
+    y = uv[:, 1] - py - cy - 1.0
+    xr, yr = c * x + s * y, -s * x + c * y
+    return np.stack([sx * xr - cx, sy * yr + cy + 1.0], axis=1)
+
+
+class TriangleLocator:
+    """The triangle of a mesh a ray hit, and the hit's barycentrics, found again in float64: the
+    candidate triangles are those whose (slightly enlarged) bounding box holds the hit point, in a
+    uniform grid built once; among those the ray meets (Möller–Trumbore), the one whose distance is
+    closest to the engine's wins. Used until the ray engine reports triangles itself."""
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray):
+        v = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]      # (F, 3, 3)
+        self.v0, self.e1, self.e2 = v[:, 0], v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]
+        lo_t, hi_t = v.min(axis=1), v.max(axis=1)
+        self.lo = lo_t.min(axis=0)
+        extent = hi_t.max(axis=0) - self.lo
+        self.scale = float(max(extent.max(), 1e-12))
+        self.pad = 1e-7 * self.scale + 1e-9
+        lo_t, hi_t = lo_t - self.pad, hi_t + self.pad
+        n_tri = len(v)
+        # cells about the size of a typical triangle, at most ~4 per triangle (and per axis 1..1024)
+        typical = float(np.median((hi_t - lo_t).max(axis=1))) if n_tri else 1.0
+        cell = max(typical, self.scale / 1024.0, 1e-12)
+        while True:
+            dims = np.clip(np.ceil((extent + 2 * self.pad) / cell).astype(np.int64), 1, 1024)
+            if int(np.prod(dims)) <= 4 * n_tri + 64:
+                break
+            cell *= 1.5
+        self.cell, self.dims = cell, dims
+        a = self._cells(lo_t)
+        b = self._cells(hi_t)
+        span = b - a + 1
+        count = np.prod(span, axis=1)
+        while int(count.sum()) > 32 * n_tri + 100_000:        # huge overlapping triangles: coarser
+            self.cell *= 2.0
+            self.dims = np.maximum(self.dims // 2, 1)
+            a, b = self._cells(lo_t), self._cells(hi_t)
+            span = b - a + 1
+            count = np.prod(span, axis=1)
+        tri = np.repeat(np.arange(n_tri), count)
+        k = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+        sy, sz = span[tri, 1], span[tri, 2]
+        ix = a[tri, 0] + k // (sy * sz)
+        iy = a[tri, 1] + (k // sz) % sy
+        iz = a[tri, 2] + k % sz
+        key = (ix * self.dims[1] + iy) * self.dims[2] + iz
+        order = np.argsort(key, kind="stable")
+        self.tris = tri[order]
+        self.start = np.searchsorted(key[order], np.arange(int(np.prod(self.dims)) + 1))
+
+    def _cells(self, p: np.ndarray) -> np.ndarray:
+        idx = np.floor((p - (self.lo - self.pad)) / self.cell).astype(np.int64)
+        return np.clip(idx, 0, self.dims - 1)
+
+    def locate(self, origins: np.ndarray, directions: np.ndarray, t: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(triangle or −1, b1, b2) for rays ``origins + t·directions`` (local frame)."""
+        n = len(t)
+        tri_out = np.full(n, -1, dtype=np.int64)
+        b1_out, b2_out = np.zeros(n), np.zeros(n)
+        if n == 0:
+            return tri_out, b1_out, b2_out
+        p = origins + t[:, None] * directions
+        c = self._cells(p)
+        key = (c[:, 0] * self.dims[1] + c[:, 1]) * self.dims[2] + c[:, 2]
+        first, last = self.start[key], self.start[key + 1]
+        count = last - first
+        q = np.repeat(np.arange(n), count)
+        if len(q) == 0:
+            return tri_out, b1_out, b2_out
+        k = np.arange(len(q)) - np.repeat(np.cumsum(count) - count, count)
+        tri = self.tris[np.repeat(first, count) + k]
+        d, o = directions[q], origins[q]
+        e1, e2 = self.e1[tri], self.e2[tri]
+        pvec = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, pvec)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = 1.0 / det
+            tvec = o - self.v0[tri]
+            b1 = np.einsum("ij,ij->i", tvec, pvec) * inv
+            qvec = np.cross(tvec, e1)
+            b2 = np.einsum("ij,ij->i", d, qvec) * inv
+            tt = np.einsum("ij,ij->i", e2, qvec) * inv
+        eps = 1e-7
+        tol = 1e-6 * (1.0 + np.abs(t[q]) + self.scale)
+        good = (np.isfinite(tt) & (np.abs(det) > 0) & (b1 >= -eps) & (b2 >= -eps) & (b1 + b2 <= 1 + eps)
+                & (np.abs(tt - t[q]) <= tol))
+        if not good.any():
+            return tri_out, b1_out, b2_out
+        gi = good.nonzero()[0]
+        err = np.abs(tt[gi] - t[q[gi]])
+        order = np.lexsort((err, q[gi]))
+        gi = gi[order]
+        first_of = np.ones(len(gi), dtype=bool)
+        first_of[1:] = q[gi][1:] != q[gi][:-1]
+        gi = gi[first_of]
+        rows = q[gi]
+        tri_out[rows] = tri[gi]
+        bb1, bb2 = np.clip(b1[gi], 0.0, 1.0), np.clip(b2[gi], 0.0, 1.0)
+        over = bb1 + bb2 > 1.0
+        s = np.where(over, bb1 + bb2, 1.0)
+        b1_out[rows], b2_out[rows] = bb1 / s, bb2 / s
+        return tri_out, b1_out, b2_out
+
+
+UvOf = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray | None]]
+
+
+@dataclass
+class ShapeTexture:
+    """One textured shape: its images and its transform."""
+
+    base: TextureImage
+    roughness: TextureImage | None
+    occlusion: TextureImage | None
+    transform: wm.TextureTransform | None
+
+
+def _primitive_uv(geometry: Any, atlas: bool) -> UvOf:
+    def points(o: np.ndarray, d: np.ndarray, t: np.ndarray) -> np.ndarray:
+        return o + t[:, None] * d
+
+    def ok(uv: np.ndarray) -> tuple[np.ndarray, None]:
+        return uv, None                     # picking a primitive never fails
+
+    g = geometry
+    if isinstance(g, wm.Box):
+        return lambda o, d, t: ok(tc.box_uv(points(o, d, t), g.size, atlas))
+    if isinstance(g, wm.Plane):
+        return lambda o, d, t: ok(tc.plane_uv(points(o, d, t), g.size))
+    if isinstance(g, wm.Sphere):
+        return lambda o, d, t: ok(tc.sphere_uv(points(o, d, t), g.radius))
+    if isinstance(g, wm.Cylinder):
+        return lambda o, d, t: ok(tc.cylinder_uv(points(o, d, t), g.radius, g.height, atlas))
+    if isinstance(g, wm.Capsule):
+        return lambda o, d, t: ok(tc.capsule_uv(points(o, d, t), g.radius, g.height, g.subdivision))
+    raise TypeError(f"not a primitive: {g!r}")
+
+
+def _mesh_uv(locator: Callable[[], TriangleLocator], corners: np.ndarray) -> UvOf:
+    def uv_of(o: np.ndarray, d: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        tri, b1, b2 = locator().locate(o, d, t)
+        found = tri >= 0
+        uv = np.full((len(t), 2), np.nan)
+        if found.any():
+            uv[found] = tc.triangle_uv(corners[tri[found]], b1[found], b2[found])
+        return uv, found
+
+    return uv_of
+
+
+def triangles_corner_uv(g: wm.Triangles) -> np.ndarray:
+    """Corner coordinates ``(F, 3, 2)`` of inline triangles: ``(s, 1 − t)`` of their tex_coords
+    (WbTriangleMesh's finalPass), else Webots' default bounding-box mapping."""
+    faces = np.asarray(g.faces, dtype=np.int64)
+    if g.tex_coords is None:
+        return tc.default_triangle_uv(np.asarray(g.vertices, dtype=np.float64), faces)
+    st = np.asarray(g.tex_coords, dtype=np.float64).reshape(-1, 2)
+    idx = np.asarray(g.tex_coord_faces if g.tex_coord_faces is not None else g.faces, dtype=np.int64)
+    corners = st[idx]
+    corners[..., 1] = 1.0 - corners[..., 1]
+    return corners
+
+
+@lru_cache(maxsize=16)
+def _mesh_file_uv(path: str, _mtime: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertices, faces, corner uv) of a mesh file as loaded for the scene (trimesh, unprocessed):
+    the file's first UV set with ``v`` flipped (Webots' assimp ``FlipUVs``), ``(0.5, 0.5)`` for a
+    file without UVs (WbMesh)."""
+    import trimesh
+
+    m = trimesh.load(path, force="mesh", process=False)
+    vertices = np.asarray(m.vertices, dtype=np.float64)
+    faces = np.asarray(m.faces, dtype=np.int64)
+    uv = getattr(getattr(m, "visual", None), "uv", None)
+    if uv is None or len(uv) != len(vertices):
+        per_vertex = np.full((len(vertices), 2), 0.5)
+    else:
+        per_vertex = np.asarray(uv, dtype=np.float64).reshape(-1, 2).copy()
+        per_vertex[:, 1] = 1.0 - per_vertex[:, 1]
+    return vertices, faces, per_vertex[faces]
+
+
+# ------------------------------------------------------------------------------------ ink (Pen)
+
+INK_MIN_SIZE, INK_MAX_SIZE = 32, 1024      # WbPaintTexture: the paint texture of an untextured shape
+
+
+def _next_power_of_2(n: int) -> int:
+    p = 1
+    while p < n:
+        p *= 2
+    return p
+
+
+def bounding_radius(geometry: Any, vertices: np.ndarray | None = None, faces: np.ndarray | None = None) -> float:
+    """Webots' bounding-sphere radius of a geometry (each node's ``recomputeBoundingSphere``): half
+    the diagonal of a Box or Plane, a Sphere's radius, ``|(r, h/2)|`` for a Cylinder, ``h/2 + r``
+    for a Capsule, Ritter's sphere of a triangle mesh's corners (WbTriangleMeshGeometry)."""
+    g = geometry
+    if isinstance(g, wm.Box):
+        return math.hypot(*g.size) / 2.0
+    if isinstance(g, wm.Plane):
+        return math.inf if g.size is None else math.hypot(*g.size) / 2.0
+    if isinstance(g, wm.Sphere):
+        return g.radius
+    if isinstance(g, wm.Cylinder):
+        return math.hypot(g.radius, g.height / 2.0)
+    if isinstance(g, wm.Capsule):
+        return g.height / 2.0 + g.radius
+    assert vertices is not None and faces is not None
+    pts = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)].reshape(-1, 3)
+    p2 = pts[0]
+    for _ in range(2):            # the farthest corner from the farthest corner of the first one
+        p1 = p2
+        d = ((pts - p1) ** 2).sum(axis=1)
+        k = int(np.argmax(d)) if d.max() > 0 else 0
+        p2, far = pts[k], float(d[k])
+    centre, radius = (p1 + p2) / 2.0, math.sqrt(far) / 2.0
+    for q in pts:                 # WbBoundingSphere::enclose, corner by corner
+        delta = centre - q
+        dist = float(np.linalg.norm(delta))
+        if dist > radius:
+            radius = (dist + radius) / 2.0
+            centre = q + delta / dist * radius
+    return radius
+
+
+class InkLayer:
+    """The ink a Pen laid on one shape (Webots' WbPaintTexture): RGB and density per texel
+    (float32, as Webots keeps them), white and 0 at first.
+
+    Its size is the shape's image size (an untextured shape: from its bounding sphere radius r,
+    ``32 + 992·r/10`` texels, 1024 beyond 10 m, to the nearest power of two) times the geometry's
+    factor for texture set 1 (Box 4 x 2, Cylinder 2 x 2, triangles without texture coordinates 4 x 2,
+    else 1 x 1). ``lead_texels_per_m`` is the image width over the bounding radius: a pen's lead
+    of size L covers a disc of ``⌊L·that⌋`` texels across."""
+
+    def __init__(self, width: int, height: int, lead_texels_per_m: float):
+        self.rgb = np.ones((height, width, 3), dtype=np.float32)
+        self.density = np.zeros((height, width), dtype=np.float32)
+        self.lead_texels_per_m = lead_texels_per_m
+        self.strokes = 0
+
+    def paint(self, u: float, v: float, lead_size: float, color, density: float) -> int:
+        """One stroke at texture-set-1 coordinates (WbPaintTexture::paint): nothing outside
+        [0, 1]; else a disc of texels around ``(⌊u·w⌋, ⌊v·h⌋)`` takes the ink: colour blended by
+        the densities (``old/(old + new)`` of the old colour), density added and capped at 1.
+        Returns the texels inked."""
+        if not (0.0 <= u <= 1.0 and 0.0 <= v <= 1.0):
+            return 0
+        h, w = self.density.shape
+        x, y = int(u * w), int(v * h)
+        size = max(1, int(float(np.float32(lead_size)) * self.lead_texels_per_m))
+        half = size // 2
+        ox, oy, sx, sy = max(x - half, 0), max(y - half, 0), min(x + half, w - 1), min(y + half, h - 1)
+        if ox > sx or oy > sy:
+            return 0
+        ty, tx = np.mgrid[oy:sy + 1, ox:sx + 1]
+        inside = (tx - x) ** 2 <= half * half - (ty - y) ** 2
+        rows, cols = ty[inside], tx[inside]
+        d = np.float32(density)
+        prev = self.density[rows, cols]
+        total = d + prev
+        with np.errstate(divide="ignore", invalid="ignore"):
+            old = np.where(total < np.float32(1e-15), np.float32(0.0), prev / total).astype(np.float32)
+        ink = np.asarray(color, dtype=np.float64)
+        keep = (old[:, None] * self.rgb[rows, cols]).astype(np.float64)       # float * float
+        new = (np.float32(1.0) - old).astype(np.float64)[:, None] * ink         # (1 - ratio) * colour (double)
+        self.rgb[rows, cols] = (keep + new).astype(np.float32)
+        self.density[rows, cols] = np.minimum(total, np.float32(1.0))
+        self.strokes += 1
+        return int(len(rows))
+
+    def pick(self, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(ink RGB as float64, density as float32) at texture-set-0 coordinates
+        (WbPaintTexture::pickColor: truncated toward zero, then wrapped into the texture)."""
+        h, w = self.density.shape
+        uv = np.where(np.isnan(uv), 0.0, uv)
+        x = np.trunc(uv[:, 0] * w).astype(np.int64) % w
+        y = np.trunc(uv[:, 1] * h).astype(np.int64) % h
+        return self.rgb[y, x].astype(np.float64), self.density[y, x]
+
+    def clear(self) -> None:
+        self.rgb[:] = 1.0
+        self.density[:] = 0.0
+
+
+class TextureSampler:
+    """The surface colours of a scene's shapes (indexed like ``Scene.shapes``): their images and
+    the ink pens laid on them.
+
+    ``textured[s]`` tells whether shape ``s`` has an image or ink (index −1, no hit, is False); it
+    is updated in place when a shape first takes ink. All arrays given to the methods are in the
+    shape's local frame (float64); ``lookups`` counts the points sampled (one per infra-red hit on
+    such a shape)."""
+
+    def __init__(self, shapes: list[tuple[Any, wm.Appearance | None]], base_dir: Path):
+        self.models = shapes
+        self.base_dir = Path(base_dir)
+        self.shapes: dict[int, ShapeTexture] = {}
+        self.ink: dict[int, InkLayer] = {}
+        self._uv: dict[tuple[int, bool], UvOf] = {}
+        self._locators: dict[int, TriangleLocator] = {}
+        self._meshes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        images: dict[Path, np.ndarray] = {}
+
+        def image(t: wm.Texture | None) -> TextureImage | None:
+            if t is None:
+                return None
+            path = resolve_texture_url(t.url, base_dir, allow_outside=True)
+            if path not in images:
+                images[path] = load_image(path, t.url)
+            return TextureImage(images[path], t.repeat_s, t.repeat_t)
+
+        for i, (_, app) in enumerate(shapes):
+            if app is not None and app.texture is not None:
+                base = image(app.texture)
+                assert base is not None
+                self.shapes[i] = ShapeTexture(base, image(app.roughness_map), image(app.occlusion_map),
+                                              app.texture_transform)
+        self.textured = np.zeros(len(shapes) + 1, dtype=bool)
+        self.textured[list(self.shapes)] = True
+        self.lookups = 0
+
+    def __bool__(self) -> bool:
+        return bool(self.shapes) or bool(self.ink)
+
+    # ---- texture coordinates
+
+    def _mesh(self, shape: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(vertices, faces, set-0 corner coordinates) of a triangle shape."""
+        if shape not in self._meshes:
+            g = self.models[shape][0]
+            if isinstance(g, wm.Triangles):
+                self._meshes[shape] = (np.asarray(g.vertices, dtype=np.float64).reshape(-1, 3),
+                                       np.asarray(g.faces, dtype=np.int64), triangles_corner_uv(g))
+            else:
+                file = (self.base_dir / g.url).resolve()
+                v, f, corners = _mesh_file_uv(str(file), file.stat().st_mtime_ns)
+                self._meshes[shape] = (v * np.asarray(g.scale, dtype=np.float64), f, corners)
+        return self._meshes[shape]
+
+    def _uv_of(self, shape: int, atlas: bool) -> UvOf:
+        key = (shape, atlas)
+        if key not in self._uv:
+            g = self.models[shape][0]
+            if isinstance(g, wm.Triangles | wm.Mesh):
+                v, f, corners = self._mesh(shape)
+                if atlas and isinstance(g, wm.Triangles) and g.tex_coords is None:
+                    corners = tc.default_triangle_atlas_uv(v, f)
+
+                def locator(s: int = shape, v: np.ndarray = v, f: np.ndarray = f) -> TriangleLocator:
+                    if s not in self._locators:          # built on the first lookup
+                        self._locators[s] = TriangleLocator(v, f)
+                    return self._locators[s]
+
+                self._uv[key] = _mesh_uv(locator, corners)
+            else:
+                self._uv[key] = _primitive_uv(g, atlas)
+        return self._uv[key]
+
+    def uv(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray, atlas: bool = False
+           ) -> tuple[np.ndarray, np.ndarray]:
+        """Webots' ``(u, v)`` of hits ``origins + t·directions`` on ``shape`` (before the
+        TextureTransform; ``atlas``: texture set 1, where pens paint), and where picking succeeded
+        (a mesh hit whose triangle is not found again fails, as Webots' picking can; its (u, v) is
+        then NaN)."""
+        uv, picked = self._uv_of(shape, atlas)(origins, directions, t)
+        return uv, np.ones(len(uv), dtype=bool) if picked is None else picked
+
+    def texels(self, shape: int, uv: np.ndarray, which: str = "base", channel: int | None = None) -> np.ndarray:
+        """Colours of ``shape``'s ``which`` map ("base", "roughness", "occlusion") at ``uv``
+        (the TextureTransform applied, then the map's wrap, nearest texel)."""
+        st = self.shapes[shape]
+        img = st.base if which == "base" else st.roughness if which == "roughness" else st.occlusion
+        if img is None:
+            raise KeyError(f"shape {shape} has no {which} map")
+        return img.texels(transform_uv(np.asarray(uv, dtype=np.float64).reshape(-1, 2), st.transform), channel)
+
+    # ---- ink
+
+    def ink_layer(self, shape: int) -> InkLayer:
+        """The shape's ink layer, made on its first stroke (WbPaintTexture::paintTexture)."""
+        layer = self.ink.get(shape)
+        if layer is None:
+            g = self.models[shape][0]
+            st = self.shapes.get(shape)
+            tri = isinstance(g, wm.Triangles | wm.Mesh)
+            v, f, _ = self._mesh(shape) if tri else (None, None, None)
+            radius = bounding_radius(g, v, f)
+            if st is not None:
+                h, w = st.base.rgb.shape[:2]
+            else:
+                size = INK_MAX_SIZE if radius > 10.0 else INK_MIN_SIZE + (INK_MAX_SIZE - INK_MIN_SIZE) * radius / 10.0
+                nxt = _next_power_of_2(int(size))
+                w = h = int(nxt / 2 if abs(nxt - size) > abs(nxt / 2 - size) else nxt)
+            fx, fy = ((4, 2) if isinstance(g, wm.Box) or (isinstance(g, wm.Triangles) and g.tex_coords is None)
+                      else (2, 2) if isinstance(g, wm.Cylinder) else (1, 1))
+            layer = self.ink[shape] = InkLayer(w * fx, h * fy, w / radius if math.isfinite(radius) else 0.0)
+            self.textured[shape] = True
+        return layer
+
+    def paint(self, shape: int, origin: np.ndarray, direction: np.ndarray, t: float, lead_size: float,
+              color, density: float) -> int:
+        """A pen's stroke where its ray hit ``shape`` (local frame): texels inked."""
+        uv, ok = self.uv(shape, origin.reshape(1, 3), direction.reshape(1, 3), np.array([t]), atlas=True)
+        if not ok[0]:
+            return 0
+        return self.ink_layer(shape).paint(float(uv[0, 0]), float(uv[0, 1]), lead_size, color, density)
+
+    def clear_ink(self) -> None:
+        """Every ink layer white again (Webots' Pen reset clears all paint textures)."""
+        for layer in self.ink.values():
+            layer.clear()
+
+    # ---- what infra-red sensors read
+
+    def infra_red(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray, red: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None]:
+        """For hits on ``shape`` whose untextured red is ``red`` (WbShape::pickColor): the red read
+        (``(1 − c)·red·texel + c·ink`` with ``c`` the ink's density; the texel where picking failed
+        is 1 and the ink ignored), the roughness and occlusion maps' red (None when there is no
+        such map) and where picking succeeded (None: everywhere; elsewhere the roughness field and
+        no occlusion apply)."""
+        uv, picked = self._uv_of(shape, False)(origins, directions, t)
+        self.lookups += len(t)
+        if picked is not None:
+            uv = np.where(picked[:, None], uv, 0.0)
+        st = self.shapes.get(shape)
+        rough = occl = None
+        if st is not None:
+            uvt = transform_uv(uv, st.transform)
+            texel = st.base.red(uvt)
+            if picked is not None:
+                texel = np.where(picked, texel, 1.0)
+            out = red * texel
+            rough = None if st.roughness is None else st.roughness.red(uvt)
+            occl = None if st.occlusion is None else st.occlusion.red(uvt)
+        else:
+            out = red
+        layer = self.ink.get(shape)
+        if layer is not None:
+            ink, c = layer.pick(uv)
+            if picked is not None:
+                c = np.where(picked, c, np.float32(0.0))
+            blended = (np.float32(1.0) - c).astype(np.float64) * red      # (1.0f - c) in float32
+            if st is not None:
+                blended = blended * texel
+            out = blended + c.astype(np.float64) * ink[:, 0]
+        return out, rough, occl, picked
