@@ -157,6 +157,7 @@ class _SdkLog(logging.Handler):
             text = record.getMessage()
         except Exception:  # noqa: BLE001
             return
+        text = " ".join(text.split())               # the SDK's messages may span lines: one line each
         m = self.ADDRESS.search(text)
         key = m.group(1) if m else text
         n = self._seen.get(key, 0) + 1
