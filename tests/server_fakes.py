@@ -14,6 +14,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.sim import sensors
 from sensorium.server.sim.motion import DifferentialDrive
 
 POINT_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer_id", "<i4"), ("time", "<f4")])
@@ -47,6 +48,10 @@ class FakeDevice:
     def kind(self):
         return self.config.device
 
+    # the real classes' descriptions (they read only the attributes the fakes have too)
+    flat_lookup_table = sensors.Device.flat_lookup_table
+    describe = sensors.Device.describe
+
     def enable(self, period):
         if isinstance(period, bool) or not isinstance(period, int) or period < 0:
             raise ValueError(f"bad period {period!r}")
@@ -73,6 +78,7 @@ class FakeDevice:
 
 class FakeLight(FakeDevice):
     tag, rays = "light", 1
+    describe = sensors.LightSensor.describe
 
     def __init__(self, *a):
         super().__init__(*a)
@@ -87,6 +93,7 @@ class FakeLight(FakeDevice):
 class FakeDistance(FakeDevice):
     tag, rays = "distance", 1
     TYPES = {"generic": 0, "infra-red": 1, "infrared": 1, "sonar": 2, "laser": 3}
+    describe = sensors.DistanceSensor.describe
 
     def __init__(self, *a):
         super().__init__(*a)
@@ -101,6 +108,7 @@ class FakeDistance(FakeDevice):
 
 class FakeLidar(FakeDevice):
     tag = "lidar"
+    info, frequency_info, describe = sensors.Lidar.info, sensors.Lidar.frequency_info, sensors.Lidar.describe
 
     def __init__(self, *a):
         super().__init__(*a)

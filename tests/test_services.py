@@ -303,7 +303,7 @@ def test_motors_are_devices_after_the_sensors(hm):
     assert [d.name for d in res.devices] == ["ls", "ds", "lidar", "lidar2", LEFT, RIGHT]
     assert res.devices[4].model_dump() == {"name": LEFT, "type": "RotationalMotor", "maxVelocity": 10.0,
                                            "minPosition": 0.0, "maxPosition": 0.0, "targetPosition": 0.0,
-                                           "velocity": 10.0}
+                                           "velocity": 10.0, "model": "", "index": 4, "simulated": True}
     assert ok(hm.call(B, "/bot/robot/get_device_list")) == {"list": ["ls", "ds", "lidar", "lidar2", LEFT, RIGHT]}
     assert ok(hm.call(B, "/bot/robot/get_number_of_devices")) == {"value": 6}
     assert ok(hm.call(B, "/free/robot/get_number_of_devices")) == {"value": 1}      # no drive, no motors

@@ -44,7 +44,8 @@ def services(args: argparse.Namespace) -> int:
             group = here
             print(f"{here}:")
         arg_text = ", ".join(f"{k}: {v}" for k, v in s.get("args", {}).items())
-        mark = ("  [supervisor controller only: robot with supervisor: true]" if s.get("supervisor") else
+        mark = ("  [not simulated: its functions answer Webots' no value (NaN, NULL, 0)]" if s.get("simulated") is False else
+                "  [supervisor controller only: robot with supervisor: true]" if s.get("supervisor") else
                 "  [attached controller only]" if s.get("attached") else "")
         print(f"  {s['name']}  {{{arg_text}}}{mark}")
     return 0

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from types import UnionType
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator, model_validator
 
 from sensorium.schemas.messages import Image, PointCloud
 from sensorium.schemas.wire import PROTOCOL_VERSION, ErrorCode
@@ -25,7 +25,6 @@ __all__ = ["ErrorCode", "PROTOCOL_VERSION", "SERVICES", "ServiceSpec", "service_
 MAX_PERIOD_MS = (1 << 31) - 1
 MAX_MOTOR_COMMANDS = 256        # per step request (a robot has a handful of motors)
 Mode = Literal["fast", "realtime", "pause"]
-DeviceType = Literal["LightSensor", "DistanceSensor", "Lidar", "RotationalMotor", "PositionSensor", "LED"]
 FieldName = Literal["translation", "rotation"]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
@@ -220,8 +219,13 @@ class Empty(Result):
 
 
 class DeviceRef(Result):
+    """A robot's device as ``get_info`` lists it (every device, in Webots' tree order)."""
+
     name: str
-    type: DeviceType
+    type: str = Field(description="the Webots node type (a kind of schemas.devices)")
+    model: str = ""
+    index: int = Field(ge=0, description="Webots' device index (wb_robot_get_device_by_index)")
+    simulated: bool = True
 
 
 class RobotInfo(Result):
@@ -250,15 +254,29 @@ class InfoResult(Result):
     topics: list[TopicRef]
 
 
-class LightSensorDescription(Result):
+class _Entry(Result):
+    """What every device entry says: Webots' identity of the device (``wb_device_get_*``)."""
+
     name: str
+    model: str = Field(default="", description="the device's Webots 'model' field (wb_device_get_model)")
+    index: int = Field(ge=0, description="position in the robot's device list: Webots' tree order, unsimulated devices included")
+    simulated: bool = Field(default=True, description="false: listed, its functions answer Webots' 'no value'")
+
+
+class UnsimulatedDescription(_Entry):
+    """A device Sensorium lists but does not simulate (a controller gets Webots' "no value")."""
+
+    type: str
+    simulated: bool = False
+
+
+class LightSensorDescription(_Entry):
     type: Literal["LightSensor"]
     sampling_period: int
     lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
 
 
-class DistanceSensorDescription(Result):
-    name: str
+class DistanceSensorDescription(_Entry):
     type: Literal["DistanceSensor"]
     sampling_period: int
     lookup_table: list[float]
@@ -268,8 +286,7 @@ class DistanceSensorDescription(Result):
     sensor_type: int = Field(description="get_type: 0 generic, 1 infra-red, 2 sonar, 3 laser")
 
 
-class LidarDescription(Result):
-    name: str
+class LidarDescription(_Entry):
     type: Literal["Lidar"]
     sampling_period: int
     horizontalResolution: int
@@ -284,8 +301,7 @@ class LidarDescription(Result):
     point_cloud_enabled: bool
 
 
-class MotorDescription(Result):
-    name: str
+class MotorDescription(_Entry):
     type: Literal["RotationalMotor"]
     maxVelocity: float = Field(description="rad/s")
     minPosition: float = Field(description="rad; minPosition = maxPosition = 0: no limits (Webots)")
@@ -294,8 +310,7 @@ class MotorDescription(Result):
     velocity: float = Field(description="rad/s (the motor's current command)")
 
 
-class PositionSensorDescription(Result):
-    name: str
+class PositionSensorDescription(_Entry):
     type: Literal["PositionSensor"]
     sampling_period: int
     motor: str = Field(description="the wheel motor on the same joint (Motor.getPositionSensor / getMotor)")
@@ -303,16 +318,26 @@ class PositionSensorDescription(Result):
     resolution: float
 
 
-class LEDDescription(Result):
-    name: str
+class LEDDescription(_Entry):
     type: Literal["LED"]
     value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
     color: list[float] = Field(description="flat [r0, g0, b0, r1, ...]")
     gradual: bool
 
 
-DeviceDescription = Annotated[LightSensorDescription | DistanceSensorDescription | LidarDescription | MotorDescription
-                              | PositionSensorDescription | LEDDescription, Field(discriminator="type")]
+def _description_tag(v: Any) -> str:
+    get = v.get if isinstance(v, dict) else (lambda k, d=None: getattr(v, k, d))
+    return str(get("type", "")) if get("simulated", True) else "unsimulated"
+
+
+DeviceDescription = Annotated[
+    Annotated[LightSensorDescription, Tag("LightSensor")] | Annotated[DistanceSensorDescription, Tag("DistanceSensor")]
+    | Annotated[LidarDescription, Tag("Lidar")] | Annotated[MotorDescription, Tag("RotationalMotor")]
+    | Annotated[PositionSensorDescription, Tag("PositionSensor")] | Annotated[LEDDescription, Tag("LED")]
+    | Annotated[UnsimulatedDescription, Tag("unsimulated")],
+    Discriminator(_description_tag)]
+"""An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
+:class:`UnsimulatedDescription` for a device that is listed only."""
 
 
 class AttachResult(Result):
@@ -440,6 +465,7 @@ class ServiceRef(Result):
     device_type: str | None = None
     attached: bool = Field(description="only the robot's attached controller may call it")
     supervisor: bool = Field(default=False, description="... and only if the robot has supervisor: true (Supervisor API)")
+    simulated: bool = Field(default=True, description="false: a listed device's functions, answered by the client with Webots' 'no value'")
     args: dict[str, str] = Field(description="argument name -> type; a trailing '?' marks an optional one")
 
 
@@ -484,18 +510,17 @@ class ServiceSpec:
     args: type[Args]
     result: type[Result]
     attached: bool = False
-    devices: frozenset[str] = frozenset()
     supervisor: bool = False       # the robot's world entry must have ``supervisor: true``
 
+    @property
+    def devices(self) -> frozenset[str]:
+        """The device kinds that offer a device-scope service (their declarations in
+        :mod:`sensorium.schemas.devices` list its item)."""
+        if self.scope != "device":
+            return frozenset()
+        from sensorium.schemas.devices import KINDS  # devices.py imports world and messages only
+        return frozenset(k.type for k in KINDS.values() if self.item in k.services)
 
-_ALL = frozenset({"LightSensor", "DistanceSensor", "Lidar"})          # sensors
-_M = frozenset({"RotationalMotor"})
-_LD = frozenset({"LightSensor", "DistanceSensor"})
-_D = frozenset({"DistanceSensor"})
-_L = frozenset({"Lidar"})
-_P = frozenset({"PositionSensor"})
-_LED = frozenset({"LED"})
-_SENSORS = frozenset({"LightSensor", "DistanceSensor", "Lidar", "PositionSensor"})
 
 SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_info", "server", NoArgs, InfoResult),
@@ -524,28 +549,28 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),
-    ServiceSpec("enable", "device", EnableArgs, SuccessResult, attached=True, devices=_SENSORS),
-    ServiceSpec("get_sampling_period", "device", NoArgs, IntValue, devices=_SENSORS),
-    ServiceSpec("get_lookup_table", "device", NoArgs, FloatArrayValue, devices=_LD),
-    ServiceSpec("get_min_value", "device", NoArgs, FloatValue, devices=_D),
-    ServiceSpec("get_max_value", "device", NoArgs, FloatValue, devices=_D),
-    ServiceSpec("get_aperture", "device", NoArgs, FloatValue, devices=_D),
-    ServiceSpec("get_type", "device", NoArgs, IntValue, devices=_D),
-    ServiceSpec("get_info", "device", NoArgs, LidarInfoResult, devices=_L),
-    ServiceSpec("enable_point_cloud", "device", BoolArgs, SuccessResult, attached=True, devices=_L),
-    ServiceSpec("is_point_cloud_enabled", "device", NoArgs, StatusResult, devices=_L),
-    ServiceSpec("get_frequency_info", "device", NoArgs, FrequencyInfoResult, devices=_L),
-    ServiceSpec("set_frequency", "device", FrequencyArgs, SuccessResult, attached=True, devices=_L),
-    ServiceSpec("get_layer_range_image", "device", LayerArgs, LayerRangeImageResult, devices=_L),
-    ServiceSpec("get_layer_point_cloud", "device", LayerArgs, LayerPointCloudResult, devices=_L),
-    ServiceSpec("set_position", "device", MotorPositionArgs, SuccessResult, attached=True, devices=_M),
-    ServiceSpec("set_velocity", "device", MotorVelocityArgs, SuccessResult, attached=True, devices=_M),
-    ServiceSpec("get_velocity", "device", NoArgs, FloatValue, devices=_M),
-    ServiceSpec("get_max_velocity", "device", NoArgs, FloatValue, devices=_M),
-    ServiceSpec("get_target_position", "device", NoArgs, FloatValue, devices=_M),
-    ServiceSpec("get_value", "device", NoArgs, FloatValue, devices=_P),
-    ServiceSpec("set", "device", IntArgs, SuccessResult, attached=True, devices=_LED),
-    ServiceSpec("get", "device", NoArgs, IntValue, devices=_LED),
+    ServiceSpec("enable", "device", EnableArgs, SuccessResult, attached=True),
+    ServiceSpec("get_sampling_period", "device", NoArgs, IntValue),
+    ServiceSpec("get_lookup_table", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_min_value", "device", NoArgs, FloatValue),
+    ServiceSpec("get_max_value", "device", NoArgs, FloatValue),
+    ServiceSpec("get_aperture", "device", NoArgs, FloatValue),
+    ServiceSpec("get_type", "device", NoArgs, IntValue),
+    ServiceSpec("get_info", "device", NoArgs, LidarInfoResult),
+    ServiceSpec("enable_point_cloud", "device", BoolArgs, SuccessResult, attached=True),
+    ServiceSpec("is_point_cloud_enabled", "device", NoArgs, StatusResult),
+    ServiceSpec("get_frequency_info", "device", NoArgs, FrequencyInfoResult),
+    ServiceSpec("set_frequency", "device", FrequencyArgs, SuccessResult, attached=True),
+    ServiceSpec("get_layer_range_image", "device", LayerArgs, LayerRangeImageResult),
+    ServiceSpec("get_layer_point_cloud", "device", LayerArgs, LayerPointCloudResult),
+    ServiceSpec("set_position", "device", MotorPositionArgs, SuccessResult, attached=True),
+    ServiceSpec("set_velocity", "device", MotorVelocityArgs, SuccessResult, attached=True),
+    ServiceSpec("get_velocity", "device", NoArgs, FloatValue),
+    ServiceSpec("get_max_velocity", "device", NoArgs, FloatValue),
+    ServiceSpec("get_target_position", "device", NoArgs, FloatValue),
+    ServiceSpec("get_value", "device", NoArgs, FloatValue),
+    ServiceSpec("set", "device", IntArgs, SuccessResult, attached=True),
+    ServiceSpec("get", "device", NoArgs, IntValue),
 )
 
 

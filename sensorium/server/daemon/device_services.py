@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from sensorium.schemas.devices import KINDS
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.daemon.topics import Control, header, image_msg, point_cloud_msg
 
@@ -32,24 +33,30 @@ class DeviceServices:
     topics: Any
 
     # ------------------------------------------------------------------ device services
+    def _describe_robot(self, robot: str) -> list[dict]:
+        """``attach``'s device list: every device in Webots' tree order, each described by its kind
+        (an unsimulated one by its identity only)."""
+        r = self.sim.robots[robot]
+        out = []
+        for e in self._device_entries(robot):            # type: ignore[attr-defined]
+            if not e.simulated:
+                d: dict[str, Any] = {"name": e.name, "type": e.type, "simulated": False}
+            elif e.type == MOTOR:
+                d = self._describe_motor(r.motors[e.name])
+            else:
+                d = self._describe(self.topics.controls[f"{robot}/{e.name}"])
+            d.update(model=e.model, index=e.index, simulated=e.simulated)
+            out.append(d)
+        return out
+
     def _describe(self, ctl: Control) -> dict:
         dev = ctl.device
         out: dict[str, Any] = {"name": dev.name, "type": ctl.kind, "sampling_period": ctl.controller_period}
-        if ctl.kind in ("LightSensor", "DistanceSensor"):
-            out["lookup_table"] = self._lookup_table(dev)
-        if ctl.kind == "DistanceSensor":
-            out.update(min_value=float(dev.table.min_value), max_value=float(dev.table.max_value),
-                       aperture=float(dev.config.aperture), sensor_type=int(dev.type_code))
-        if ctl.kind == "Lidar":
-            out.update(self._lidar_info(dev))
-            out.update(self._frequency_info(dev))
-            out["point_cloud_enabled"] = ctl.controller_point_cloud
-        if ctl.kind == "PositionSensor":
-            out.update(motor=dev.config.motor, noise=float(dev.config.noise), resolution=float(dev.config.resolution))
-        if ctl.kind == "LED":
+        if "enable" not in KINDS[ctl.kind].services:          # nothing to enable (an LED)
             del out["sampling_period"]
-            out.update(value=int(dev.value), color=[float(v) for rgb in dev.config.color for v in rgb],
-                       gradual=bool(dev.config.gradual))
+        out.update(dev.describe())                               # the kind's own fields
+        if "point_cloud_enabled" in out:                         # what this controller asked for
+            out["point_cloud_enabled"] = ctl.controller_point_cloud
         return out
 
     @staticmethod
@@ -59,23 +66,15 @@ class DeviceServices:
 
     @staticmethod
     def _lookup_table(dev: Any) -> list[float]:
-        flat = getattr(dev.table, "flattened", None)
-        if flat is None:
-            flat = [v for row in dev.config.lookup_table for v in row]
-        return [float(v) for v in flat]
+        return dev.flat_lookup_table()
 
     @staticmethod
     def _lidar_info(dev: Any) -> dict:
-        cfg = dev.config
-        return {"horizontalResolution": int(cfg.horizontal_resolution), "numberOfLayers": int(cfg.number_of_layers),
-                "fov": float(cfg.field_of_view), "verticalFov": float(cfg.vertical_field_of_view),
-                "minRange": float(cfg.min_range), "maxRange": float(cfg.max_range)}
+        return dev.info()
 
     @staticmethod
     def _frequency_info(dev: Any) -> dict:
-        cfg = dev.config
-        return {"frequency": float(dev.frequency), "minFrequency": float(cfg.min_frequency),
-                "maxFrequency": float(cfg.max_frequency)}
+        return dev.frequency_info()
 
     def _dev_get_value(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.value)}

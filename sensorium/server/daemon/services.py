@@ -27,6 +27,7 @@ from typing import Any, cast
 from pydantic import ValidationError
 
 from sensorium.schemas import services as S
+from sensorium.schemas.devices import KINDS
 from sensorium.schemas.wire import (
     SOFT_LIMIT,
     ErrorCode,
@@ -40,6 +41,7 @@ from sensorium.server.daemon import roles, supervisor
 from sensorium.server.daemon.device_services import MOTOR, DeviceServices, ServiceError
 from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
 from sensorium.server.daemon.topics import Control, Topics, pose_quaternion
+from sensorium.server.sim.simulation import DeviceEntry
 
 __all__ = ["Core", "ServiceError"]
 
@@ -139,18 +141,16 @@ class Core(DeviceServices):
     def _routes(self) -> dict[str, Route]:
         routes: dict[str, Route] = {}
         for robot_name, robot in self.sim.robots.items():
+            # a device's services are its kind's (schemas/devices.py); the handler is named after the item
             for dev_name, dev in robot.devices.items():
-                kind = dev.config.device
                 path = f"{robot_name}/{dev_name}"
-                for spec in S.SERVICES:
-                    if spec.scope == "device" and kind in spec.devices:
-                        routes[f"/{robot_name}/{dev_name}/{spec.item}"] = Route(
-                            spec, getattr(self, f"_dev_{spec.item}"), robot_name, path)
+                for item in KINDS[dev.kind].services:
+                    routes[f"/{robot_name}/{dev_name}/{item}"] = Route(
+                        S.spec("device", item), getattr(self, f"_dev_{item}"), robot_name, path)
             for motor_name in robot.motors:
-                for spec in S.SERVICES:
-                    if spec.scope == "device" and MOTOR in spec.devices:
-                        routes[f"/{robot_name}/{motor_name}/{spec.item}"] = Route(
-                            spec, getattr(self, f"_motor_{spec.item}"), robot_name, None, motor_name)
+                for item in KINDS[MOTOR].services:
+                    routes[f"/{robot_name}/{motor_name}/{item}"] = Route(
+                        S.spec("device", item), getattr(self, f"_motor_{item}"), robot_name, None, motor_name)
             for spec in S.SERVICES:
                 if spec.scope == "robot":
                     handler = (partial(self._supervisor, spec.item) if spec.supervisor
@@ -362,11 +362,16 @@ class Core(DeviceServices):
         return self._controls_by_robot[robot]
 
     def _device_kinds(self, robot: str) -> dict[str, str]:
-        """Every device of a robot → its type: sensors first (world order), then motors."""
+        """Every device of a robot → its type, in Webots' tree order (unsimulated devices too)."""
+        return {e.name: e.type for e in self._device_entries(robot)}
+
+    def _device_entries(self, robot: str) -> list:
         r = self.sim.robots[robot]
-        out = {name: dev.config.device for name, dev in r.devices.items()}
-        out.update((name, MOTOR) for name in r.motors)
-        return out
+        entries = getattr(r, "device_list", None)
+        if entries is None:           # a stand-in simulation (tests): its devices, then its motors
+            names = [(n, d.kind) for n, d in r.devices.items()] + [(n, MOTOR) for n in r.motors]
+            entries = [DeviceEntry(i, k, n, "", True) for i, (n, k) in enumerate(names)]
+        return entries
 
     # ------------------------------------------------------------------ server services
     def _srv_get_info(self, c: Call) -> dict:
@@ -382,7 +387,8 @@ class Core(DeviceServices):
             "robots": [{"name": name, "controller": getattr(r, "controller", "<extern>"),
                         "synchronization": bool(r.synchronization),
                         "attached": self.lockstep.session_for(name) is not None,
-                        "devices": [{"name": d, "type": kind} for d, kind in self._device_kinds(name).items()]}
+                        "devices": [{"name": e.name, "type": e.type, "model": e.model, "index": e.index,
+                                     "simulated": e.simulated} for e in self._device_entries(name)]}
                        for name, r in self.sim.robots.items()],
             "topics": [{"name": t.name, "type": t.type} for t in self.topics.topics],
         }
@@ -398,8 +404,7 @@ class Core(DeviceServices):
                 "heartbeat_ms": self.lockstep.heartbeat_ms, "supervisor": bool(getattr(robot, "supervisor", False)),
                 "model": str(getattr(getattr(robot, "model", None), "model", "")),
                 "custom_data": str(getattr(robot, "custom_data", "")),
-                "devices": [self._describe(ctl) for ctl in self._robot_controls(s.robot)]
-                + [self._describe_motor(m) for m in robot.motors.values()]}
+                "devices": self._describe_robot(s.robot)}
 
     def _srv_detach(self, c: Call) -> dict:
         s, done = self.lockstep.detach(c.args.session)
@@ -433,7 +438,13 @@ class Core(DeviceServices):
             out.append({"name": name, "scope": route.spec.scope, "robot": route.robot, "device": device,
                         "device_type": kinds[route.robot][device] if device else None,
                         "attached": route.spec.attached, "supervisor": route.spec.supervisor,
-                        "args": S.arg_types(route.spec.args)})
+                        "simulated": True, "args": S.arg_types(route.spec.args)})
+        for robot in self.sim.robots:           # listed devices: the client answers Webots' "no value"
+            for e in self._device_entries(robot):
+                if not e.simulated:
+                    out.append({"name": f"/{robot}/{e.name}/*", "scope": "device", "robot": robot, "device": e.name,
+                                "device_type": e.type, "attached": False, "supervisor": False,
+                                "simulated": False, "args": {}})
         return {"services": out}
 
     # ------------------------------------------------------------------ robot services

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import messages as msgs
+from sensorium.schemas.devices import KINDS
 from sensorium.schemas.wire import pack, stamp, topic_frame
 
 __all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "lidar_cloud_msg", "laser_scan_angles",
@@ -62,7 +63,7 @@ class Control:
 
     robot: str
     device: Any
-    kind: str                                  # LightSensor | DistanceSensor | Lidar
+    kind: str                                  # its device kind (schemas/devices.py)
     topics: list[Topic]
     frame_id: str
     controller_period: int = 0                 # what the controller asked (get_sampling_period)
@@ -72,6 +73,9 @@ class Control:
     _cache_m: int = -1
     _range: bytes = b""
     _cloud: bytes | None = None
+
+    def __post_init__(self) -> None:
+        self.topic_types: dict[str, str] = {t.kind: t.type for t in self.topics}   # item -> message type
 
     @property
     def path(self) -> str:
@@ -183,23 +187,11 @@ def laser_scan_angles(cfg: Any) -> tuple[float, float, float] | None:
 
 
 def _device_topics(robot: str, name: str, kind: str, cfg: Any) -> list[Topic]:
+    """The device's topics: its kind's declaration (schemas/devices.py)."""
     base = f"/{robot}/{name}/"
     path = f"{robot}/{name}"
-    out: list[tuple[str, str, str]] = []
-    if kind == "LightSensor":
-        out.append(("value", msgs.ILLUMINANCE, "value"))
-    elif kind == "DistanceSensor":
-        out.append(("value", msgs.RANGE, "value"))
-    elif kind == "Lidar":
-        out.append(("range_image", msgs.IMAGE, "range_image"))
-        if laser_scan_angles(cfg) is not None:
-            out.append(("laser_scan", msgs.LASER_SCAN, "laser_scan"))
-        out.append(("point_cloud", msgs.POINT_CLOUD, "point_cloud"))
-    elif kind == "PositionSensor":
-        out.append(("value", msgs.JOINT_STATE, "value"))
-    elif kind == "LED":
-        out.append(("value", msgs.COLOR_RGBA, "value"))
-    return [Topic(base + item, t, k, path, topic_frame(base + item)) for item, t, k in out]
+    return [Topic(base + t.item, t.message, t.item, path, topic_frame(base + t.item))
+            for t in KINDS[kind].topics if t.exists is None or t.exists(cfg)]
 
 
 # ---------------------------------------------------------------------- the topic table
@@ -368,7 +360,7 @@ class Topics:
                     dev.enable(self.basic_time_step)
             elif dev.sampling_period != 0:
                 dev.disable()
-        if ctl.kind == "Lidar":
+        if "point_cloud" in ctl.topic_types:
             want = ctl.controller_point_cloud or "point_cloud" in ctl.demanded
             if want != dev.point_cloud_enabled:
                 if want:
@@ -416,56 +408,82 @@ class Topics:
             self._viewer(t.name, t.type, env, data, ns, seq)
 
     def build(self, ctl: Control, kind: str, at_ms: int) -> dict | None:
-        """The body of one of ``ctl``'s topics from the device's current state."""
+        """The body of ``ctl``'s topic ``kind`` (its item) from the device's current state: built
+        by the builder of the topic's message type (one per type in :data:`MESSAGE_BUILDERS`)."""
+        t = ctl.topic_types.get(kind)
+        if t is None:
+            return None
+        return MESSAGE_BUILDERS[t](self, ctl, header(ctl.frame_id, at_ms))
+
+    def _illuminance(self, ctl: Control, hdr: dict) -> dict:
+        return {"header": hdr, "illuminance": float(ctl.device.value), "variance": 0.0}
+
+    def _joint_state(self, ctl: Control, hdr: dict) -> dict:
         dev = ctl.device
-        hdr = header(ctl.frame_id, at_ms)
-        if ctl.kind == "LightSensor":
-            return {"header": hdr, "illuminance": float(dev.value), "variance": 0.0}
-        if ctl.kind == "PositionSensor":
-            return {"header": hdr, "name": [dev.name], "position": np.array([dev.value], dtype="<f8").tobytes(),
-                    "velocity": b"", "effort": b""}
-        if ctl.kind == "LED":
-            r, g, b = dev.rgb()
-            return {"r": r, "g": g, "b": b, "a": 1.0 if dev.value else 0.0}
-        if ctl.kind == "DistanceSensor":
-            code = int(dev.type_code)
-            return {"header": hdr,
-                    "radiation_type": 1 if code == _INFRA_RED else 0,
-                    "field_of_view": float(dev.config.aperture),
-                    "min_range": float(dev.table.min_value),
-                    "max_range": float(dev.table.max_value),
-                    "range": float(dev.value),
-                    "variance": 0.0}
+        return {"header": hdr, "name": [dev.name], "position": np.array([dev.value], dtype="<f8").tobytes(),
+                "velocity": b"", "effort": b""}
+
+    def _color(self, ctl: Control, hdr: dict) -> dict:
+        dev = ctl.device
+        r, g, b = dev.rgb()
+        return {"r": r, "g": g, "b": b, "a": 1.0 if dev.value else 0.0}
+
+    def _range(self, ctl: Control, hdr: dict) -> dict:
+        dev = ctl.device
+        code = int(dev.type_code)
+        return {"header": hdr,
+                "radiation_type": 1 if code == _INFRA_RED else 0,
+                "field_of_view": float(dev.config.aperture),
+                "min_range": float(dev.table.min_value),
+                "max_range": float(dev.table.max_value),
+                "range": float(dev.value),
+                "variance": 0.0}
+
+    def _range_image(self, ctl: Control, hdr: dict) -> dict:
+        cfg = ctl.device.config
+        return image_msg(hdr, cfg.number_of_layers, cfg.horizontal_resolution, ctl.range_bytes())
+
+    def _laser_scan(self, ctl: Control, hdr: dict) -> dict | None:
+        dev = ctl.device
         cfg = dev.config
-        if kind == "range_image":
-            return image_msg(hdr, cfg.number_of_layers, cfg.horizontal_resolution, ctl.range_bytes())
-        if kind == "laser_scan":
-            angles = laser_scan_angles(cfg)
-            if angles is None:
-                return None
-            if cfg.type == "rotating":
-                scan = 1.0 / float(dev.frequency)
-                t_inc = scan / cfg.horizontal_resolution
-            else:
-                p = dev.sampling_period
-                scan = math.ceil(p / self.basic_time_step) * self.basic_time_step / 1000.0
-                t_inc = 0.0          # every ray of a fixed lidar is cast at the same instant
-            return {"header": hdr, "angle_min": angles[0], "angle_max": angles[1], "angle_increment": angles[2],
-                    "time_increment": t_inc, "scan_time": scan,
-                    "range_min": float(cfg.min_range), "range_max": float(cfg.max_range),
-                    "ranges": ctl.range_bytes()[: 4 * cfg.horizontal_resolution], "intensities": b""}
-        if kind == "point_cloud":
-            if not dev.point_cloud_enabled:
-                return None
-            return lidar_cloud_msg(hdr, dev)
-        return None
+        angles = laser_scan_angles(cfg)
+        if angles is None:
+            return None
+        if cfg.type == "rotating":
+            scan = 1.0 / float(dev.frequency)
+            t_inc = scan / cfg.horizontal_resolution
+        else:
+            p = dev.sampling_period
+            scan = math.ceil(p / self.basic_time_step) * self.basic_time_step / 1000.0
+            t_inc = 0.0          # every ray of a fixed lidar is cast at the same instant
+        return {"header": hdr, "angle_min": angles[0], "angle_max": angles[1], "angle_increment": angles[2],
+                "time_increment": t_inc, "scan_time": scan,
+                "range_min": float(cfg.min_range), "range_max": float(cfg.max_range),
+                "ranges": ctl.range_bytes()[: 4 * cfg.horizontal_resolution], "intensities": b""}
+
+    def _point_cloud(self, ctl: Control, hdr: dict) -> dict | None:
+        if not ctl.device.point_cloud_enabled:
+            return None
+        return lidar_cloud_msg(hdr, ctl.device)
 
     # ------------------------------------------------------------------ step-reply readings
     def reading(self, ctl: Control) -> dict:
         """The device's latest reading for a step reply (PROTOCOL §3.6)."""
-        if ctl.kind == "Lidar":
+        if "range_image" in ctl.topic_types:
             out = {"range_image": ctl.range_bytes()}
             if ctl.controller_point_cloud:
                 out["point_cloud"] = ctl.cloud_bytes()
             return out
         return {"value": float(ctl.device.value)}
+
+
+MESSAGE_BUILDERS: dict[str, Callable[[Topics, Control, dict], dict | None]] = {
+    msgs.ILLUMINANCE: Topics._illuminance,
+    msgs.RANGE: Topics._range,
+    msgs.JOINT_STATE: Topics._joint_state,
+    msgs.COLOR_RGBA: Topics._color,
+    msgs.IMAGE: Topics._range_image,
+    msgs.LASER_SCAN: Topics._laser_scan,
+    msgs.POINT_CLOUD: Topics._point_cloud,
+}
+"""Message type -> the builder of a device topic's body (a device kind's topics name their types)."""

@@ -40,6 +40,7 @@ from typing import Any
 import msgpack
 import numpy as np
 
+from sensorium.schemas.devices import KINDS
 from sensorium.server.recording import cdr
 from sensorium.server.recording.reader import Recording
 
@@ -65,8 +66,8 @@ class ExportError(Exception):
 # --------------------------------------------------------------------------------------------
 # QoS: what a live driver offers on each topic
 
-SENSOR_TYPES = frozenset({"sensor_msgs/msg/Illuminance", "sensor_msgs/msg/Range", "sensor_msgs/msg/LaserScan",
-                          "sensor_msgs/msg/PointCloud", POINT_CLOUD2, "sensor_msgs/msg/Image"})
+# the message types of device topics declared with SensorDataQoS (schemas/devices.py), and PointCloud2
+SENSOR_TYPES = frozenset({t.message for k in KINDS.values() for t in k.topics if t.sensor_qos} | {POINT_CLOUD2})
 LATCHED_TOPICS = frozenset({"/tf_static", "/scene"})
 INFINITE = (9223372036, 854775807)       # RMW_DURATION_INFINITE as rmw reports it (sec, nsec)
 

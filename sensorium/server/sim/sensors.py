@@ -8,13 +8,15 @@ the simulation passes times in and decides who is due (``Schedule``).
 
 from __future__ import annotations
 
+import importlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any, ClassVar
 
 import numpy as np
 
-from sensorium.schemas import world as wm
+from sensorium.schemas.devices import kind
 from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import lidar as lmath
 from sensorium.server.devices.lookup import LookupTable
@@ -71,7 +73,7 @@ def _check_period(period_ms: object) -> int:
 class Device:
     """Common state: name, owner robot, local pose, schedule, random stream (created on first use)."""
 
-    config: wm.LightSensor | wm.DistanceSensor | wm.Lidar | wm.PositionSensor | wm.LED
+    config: Any          # the kind's world-file model (schemas/world.py)
     robot_index: int
     robot_name: str
     self_collision: bool
@@ -81,6 +83,10 @@ class Device:
     measurements: int = 0           # how many values were produced (publishers watch it)
     measured_at_ms: int = -1        # simulated time of the latest value
     _rng: np.random.Generator | None = None
+
+    kinematic: ClassVar[bool] = False
+    """A device measured without rays from the kinematic world: the step calls ``measure(now_ms)``
+    when it is due (after ``bind`` handed it what it reads)."""
 
     def __post_init__(self) -> None:
         self.local_pose: Pose = pose_from_model(self.config.pose)
@@ -130,6 +136,21 @@ class Device:
         self.measurements += 1
         self.measured_at_ms = now_ms
 
+    def bind(self, robot: Any) -> None:
+        """Called once with the device's ``RobotState`` (motors, drive, pose) when the robot is made."""
+
+    def describe(self) -> dict:
+        """The kind's own fields of its ``attach`` description (schemas/services.py ``*Description``)."""
+        return {}
+
+    def flat_lookup_table(self) -> list[float]:
+        """Webots' ``get_lookup_table``: the rows flattened (x0, y0, n0, x1, ...)."""
+        table = getattr(self, "table", None)
+        flat = getattr(table, "flattened", None)
+        if flat is None:
+            flat = [v for row in self.config.lookup_table for v in row]
+        return [float(v) for v in flat]
+
 
 class LightSensor(Device):
     def __post_init__(self) -> None:
@@ -139,6 +160,9 @@ class LightSensor(Device):
 
     def readings(self) -> dict:
         return {"value": self.value}
+
+    def describe(self) -> dict:
+        return {"lookup_table": self.flat_lookup_table()}
 
 
 class DistanceSensor(Device):
@@ -154,6 +178,11 @@ class DistanceSensor(Device):
 
     def readings(self) -> dict:
         return {"value": self.value}
+
+    def describe(self) -> dict:
+        return {"lookup_table": self.flat_lookup_table(), "min_value": float(self.table.min_value),
+                "max_value": float(self.table.max_value), "aperture": float(self.config.aperture),
+                "sensor_type": int(self.type_code)}
 
 
 class Lidar(Device):
@@ -201,6 +230,21 @@ class Lidar(Device):
         self._planned: tuple[bytes, np.ndarray, np.ndarray] | None = None
 
     # -- controller API
+    def info(self) -> dict:
+        """Webots' lidar constants (``get_info``)."""
+        cfg = self.config
+        return {"horizontalResolution": int(cfg.horizontal_resolution), "numberOfLayers": int(cfg.number_of_layers),
+                "fov": float(cfg.field_of_view), "verticalFov": float(cfg.vertical_field_of_view),
+                "minRange": float(cfg.min_range), "maxRange": float(cfg.max_range)}
+
+    def frequency_info(self) -> dict:
+        cfg = self.config
+        return {"frequency": float(self.frequency), "minFrequency": float(cfg.min_frequency),
+                "maxFrequency": float(cfg.max_frequency)}
+
+    def describe(self) -> dict:
+        return {**self.info(), **self.frequency_info(), "point_cloud_enabled": self.point_cloud_enabled}
+
     def set_frequency(self, f: float) -> None:
         c = self.config
         if not (isinstance(f, (int, float)) and math.isfinite(f) and c.min_frequency <= f <= c.max_frequency):
@@ -387,10 +431,15 @@ class PositionSensor(Device):
     :attr:`wheel` to the drive's :class:`~sensorium.server.sim.motion.WheelMotor`.
     """
 
+    kinematic = True
+
     def __post_init__(self) -> None:
         super().__post_init__()
         self.value = math.nan
         self.wheel: object | None = None          # the WheelMotor whose ``position`` is read
+
+    def bind(self, robot: Any) -> None:
+        self.wheel = robot.motors.get(self.config.motor) if self.config.motor is not None else None
 
     def measure(self, now_ms: int) -> None:
         v = float(self.wheel.position) if self.wheel is not None else 0.0  # type: ignore[attr-defined]
@@ -405,6 +454,10 @@ class PositionSensor(Device):
 
     def readings(self) -> dict:
         return {"value": self.value}
+
+    def describe(self) -> dict:
+        c = self.config
+        return {"motor": c.motor, "noise": float(c.noise), "resolution": float(c.resolution)}
 
 
 class LED(Device):
@@ -438,7 +491,23 @@ class LED(Device):
     def readings(self) -> dict:
         return {"value": self.value}
 
+    def describe(self) -> dict:
+        c = self.config
+        return {"value": int(self.value), "color": [float(v) for rgb in c.color for v in rgb], "gradual": bool(c.gradual)}
 
-DEVICE_CLASSES = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar,
-                  "PositionSensor": PositionSensor, "LED": LED}
+
+def device_class(type_name: str) -> type | None:
+    """The simulation's class of a device kind (its ``implementation`` in schemas/devices.py),
+    ``None`` for a kind that is listed, not simulated."""
+    impl = kind(type_name).implementation
+    if impl is None:
+        return None
+    cls = _CLASSES.get(impl)
+    if cls is None:
+        module, _, name = impl.partition(":")
+        cls = _CLASSES[impl] = getattr(importlib.import_module(module), name)
+    return cls
+
+
+_CLASSES: dict[str, type] = {}
 RAY_DEVICES = (LightSensor, DistanceSensor, Lidar)

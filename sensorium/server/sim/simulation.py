@@ -28,14 +28,13 @@ from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
 from sensorium.server.sim.scene import Scene, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
-    DEVICE_CLASSES,
     LED,
     Device,
     DistanceSensor,
     Lidar,
     LightSensor,
-    PositionSensor,
     RayRequest,
+    device_class,
 )
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits
@@ -62,6 +61,31 @@ def lights_from_models(models: list) -> light_math.LightArrays:
     return light_math.LightArrays.from_lights(out)
 
 
+@dataclass(frozen=True, slots=True)
+class DeviceEntry:
+    """One device of a robot as Webots lists it (``wb_robot_get_device_by_index``): its index in
+    the robot's tree order (the world file's ``devices`` order, then the drive's motors that the
+    list leaves out), Webots node type, name, ``model`` field, and whether Sensorium simulates it."""
+
+    index: int
+    type: str
+    name: str
+    model: str
+    simulated: bool
+
+
+def device_entries(model: wm.Robot, devices: dict[str, Device], motors: dict[str, WheelMotor]) -> list[DeviceEntry]:
+    out: list[DeviceEntry] = []
+    for d in model.devices:
+        simulated = d.name in (motors if d.device == "RotationalMotor" else devices)
+        out.append(DeviceEntry(len(out), d.device, d.name, getattr(d, "model", "") or "", simulated))
+    listed = {e.name for e in out}
+    for name in motors:
+        if name not in listed:
+            out.append(DeviceEntry(len(out), "RotationalMotor", name, "", True))
+    return out
+
+
 class RobotState:
     """A robot: its devices by name and its pose."""
 
@@ -74,8 +98,8 @@ class RobotState:
         self.controller = model.controller
         self.devices: dict[str, Device] = {}
         for d in model.devices:
-            cls = DEVICE_CLASSES.get(d.device)
-            if cls is None:       # listed, not simulated (schemas.world.UnsimulatedDevice)
+            cls = device_class(d.device)
+            if cls is None or not issubclass(cls, Device):   # listed only, or a motor (the drive owns wheels)
                 continue
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
@@ -84,12 +108,9 @@ class RobotState:
                                         up=sim.world.world_info.coordinate_system)
                       if model.differential_drive is not None else None)
         self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
-        self.encoders: list[PositionSensor] = []
         for dev in self.devices.values():
-            if isinstance(dev, PositionSensor):
-                assert isinstance(dev.config, wm.PositionSensor)
-                dev.wheel = self.motors.get(dev.config.motor)
-                self.encoders.append(dev)
+            dev.bind(self)
+        self.device_list = device_entries(model, self.devices, self.motors)
         self.custom_data = model.custom_data
         self.supervisor = model.supervisor
 
@@ -155,7 +176,7 @@ class Simulation:
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._counters: Counter[str] = Counter()
-        self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[PositionSensor]] | None = None
+        self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[Device]] | None = None
         self._distance_plans: dict[tuple[int, ...], DistancePlan] = {}   # by the due sensors (see _distance_plan)
         self._joined_mounts: dict[tuple, tuple[list, Mount]] = {}        # see _joined_mount
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
@@ -292,18 +313,18 @@ class Simulation:
             self._by_kind = ([d for d in every if isinstance(d, LightSensor)],
                              [d for d in every if isinstance(d, DistanceSensor)],
                              [d for d in every if isinstance(d, Lidar)],
-                             [d for d in every if isinstance(d, PositionSensor)])
-        all_lights, all_distances, all_lidars, all_encoders = self._by_kind
+                             [d for d in every if d.kinematic])
+        all_lights, all_distances, all_lidars, all_kinematic = self._by_kind
         # Schedule.due inlined (a step of 1,000 robots asks 8,000 sensors)
         lights: list[LightSensor] = [d for d in all_lights if (s := d.schedule).period_ms > 0
                                      and now - s.last_update_ms >= s.period_ms]
         distances: list[DistanceSensor] = [d for d in all_distances if (s := d.schedule).period_ms > 0
                                            and now - s.last_update_ms >= s.period_ms]
         lidars: list[Lidar] = [d for d in all_lidars if d.due(now)]
-        encoders = 0
-        for enc in all_encoders:
+        encoders = 0                  # devices measured from the kinematic world (no rays)
+        for enc in all_kinematic:
             if enc.schedule.due(now):
-                enc.measure(now)
+                enc.measure(now)      # type: ignore[attr-defined]
                 enc.schedule.last_update_ms = now
                 encoders += 1
         if not (lights or distances or lidars):         # no ray this step (e.g. between sensor periods)

@@ -23,6 +23,8 @@ from typing import Any
 import yaml
 from pydantic import BaseModel
 
+from sensorium.schemas.devices import KINDS
+
 __all__ = ["WorldLimits", "LimitError", "check_yaml_events", "check_data", "check_work", "quote", "triangle_count"]
 
 MiB = 1 << 20
@@ -236,19 +238,13 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
             over(f"{rp}.devices", "devices:", len(robot.devices), limits.devices_per_robot)
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"
-            kind = getattr(dev, "device", "")
-            if kind == "DistanceSensor":
-                n = max(1, int(dev.number_of_rays))       # an upper bound of the rays Webots casts
-                if n > limits.rays_per_sensor:
-                    over(f"{dp}.number_of_rays", "rays:", n, limits.rays_per_sensor)
-                per_step += n
-            elif kind == "Lidar":
-                n = int(dev.horizontal_resolution) * int(dev.number_of_layers)
-                if n > limits.beams_per_lidar:
-                    over(dp, "beams (horizontal_resolution × number_of_layers):", n, limits.beams_per_lidar)
-                per_step += n
-            elif kind == "LightSensor" and getattr(dev, "occlusion", False):
-                per_step += lights
+            kind = KINDS.get(getattr(dev, "device", ""))
+            n = kind.rays(dev, lights) if kind is not None and kind.rays is not None else 0
+            if kind is not None and kind.ray_bound is not None:     # one device's own bound
+                field_name, label, attr = kind.ray_bound
+                if n > getattr(limits, attr):
+                    over(f"{dp}{field_name}", label, n, getattr(limits, attr))
+            per_step += n
     if per_step > limits.rays_per_step:
         over("", "rays in one step (every device due at once):", per_step, limits.rays_per_step)
     return problems

@@ -1,0 +1,184 @@
+"""Device kinds: one declaration per Webots device type, which the rest of Sensorium follows.
+
+A :class:`DeviceKind` names everything about a device type that is not its formulas:
+
+* ``type`` — the Webots node type (``device:`` in a world file) and ``node`` — Webots'
+  ``WB_NODE_*`` value (``wb_device_get_node_type``), the client-visible table;
+* ``model`` — its world-file model in :mod:`sensorium.schemas.world` (``None``: listed, not simulated);
+* ``implementation`` — ``"module:Class"`` of the simulation's device class (it holds the state and
+  calls the pure model of ``server/devices/``), resolved by the simulation when a world has one;
+* ``services`` — the device-scope service items it offers (``/<robot>/<device>/<item>``; the
+  arguments and results are the :data:`sensorium.schemas.services.SERVICES` entry of that item,
+  the handler is the daemon's ``_dev_<item>``, or ``_motor_<item>`` for a motor);
+* ``topics`` — its topics (``/<robot>/<device>/<item>``), each with its ROS-shaped message type,
+  which is also the ROS 2 type a bag export writes, and the QoS a ROS 2 driver offers;
+* ``rays`` — an upper bound of the rays one measurement casts (world limits add them up), and
+  ``ray_bound`` the per-device limit it must stay under;
+* ``description`` — what ``attach`` tells a controller about it (a model in ``services.py``).
+
+The daemon's routing (``services.Core._routes``), the topic table (``daemon/topics.py``), the ROS 2
+export's QoS table, the world limits and the client's node-type table (``tests/test_device_kinds.py``
+keeps the client copies equal) all read :data:`KINDS`. No I/O, no server imports.
+"""
+
+from __future__ import annotations
+
+import builtins
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from sensorium.schemas import messages as msgs
+from sensorium.schemas import world as wm
+
+__all__ = ["DeviceKind", "KINDS", "TopicDecl", "WEBOTS_NODE_TYPES", "kind", "node_type", "register"]
+
+
+# Webots' WbNodeType, in Webots' order (include/controller/c/webots/nodes.h, R2023b on): the value of
+# WB_NODE_<NAME> is the position in this list. Facts only: the names and their order.
+_WEBOTS_NODE_ORDER = (
+    "NO_NODE",
+    "APPEARANCE", "BACKGROUND", "BILLBOARD", "BOX", "CAD_SHAPE", "CAPSULE", "COLOR", "CONE", "COORDINATE",
+    "CYLINDER", "DIRECTIONAL_LIGHT", "ELEVATION_GRID", "FOG", "GROUP", "IMAGE_TEXTURE", "INDEXED_FACE_SET",
+    "INDEXED_LINE_SET", "MATERIAL", "MESH", "MUSCLE", "NORMAL", "PBR_APPEARANCE", "PLANE", "POINT_LIGHT",
+    "POINT_SET", "POSE", "SHAPE", "SPHERE", "SPOT_LIGHT", "TEXTURE_COORDINATE", "TEXTURE_TRANSFORM", "TRANSFORM",
+    "VIEWPOINT",
+    "ROBOT",
+    "ACCELEROMETER", "ALTIMETER", "BRAKE", "CAMERA", "COMPASS", "CONNECTOR", "DISPLAY", "DISTANCE_SENSOR",
+    "EMITTER", "GPS", "GYRO", "INERTIAL_UNIT", "LED", "LIDAR", "LIGHT_SENSOR", "LINEAR_MOTOR", "PEN",
+    "POSITION_SENSOR", "PROPELLER", "RADAR", "RANGE_FINDER", "RECEIVER", "ROTATIONAL_MOTOR", "SKIN", "SPEAKER",
+    "TOUCH_SENSOR", "VACUUM_GRIPPER",
+    "BALL_JOINT", "BALL_JOINT_PARAMETERS", "CHARGER", "CONTACT_PROPERTIES", "DAMPING", "FLUID", "FOCUS",
+    "HINGE_JOINT", "HINGE_JOINT_PARAMETERS", "HINGE_2_JOINT", "IMMERSION_PROPERTIES", "JOINT_PARAMETERS", "LENS",
+    "LENS_FLARE", "PHYSICS", "RECOGNITION", "SLIDER_JOINT", "SLOT", "SOLID", "SOLID_REFERENCE", "TRACK",
+    "TRACK_WHEEL", "WORLD_INFO", "ZOOM",
+    "MICROPHONE", "RADIO",
+)
+WEBOTS_NODE_TYPES: dict[str, int] = {f"WB_NODE_{name}": i for i, name in enumerate(_WEBOTS_NODE_ORDER)}
+"""``WB_NODE_*`` name → Webots' value."""
+
+
+def node_type(type_name: str) -> int:
+    """Webots' ``WB_NODE_*`` value of a node type named as in a world file (``"DistanceSensor"``)."""
+    snake = "".join("_" + ch if ch.isupper() and i and not type_name[i - 1].isupper() else ch
+                    for i, ch in enumerate(type_name)).upper()
+    return WEBOTS_NODE_TYPES[f"WB_NODE_{snake}"]
+
+
+@dataclass(frozen=True, slots=True)
+class TopicDecl:
+    """One topic of a device: ``/<robot>/<device>/<item>`` carrying ``message`` (a type of
+    :data:`sensorium.schemas.messages.MESSAGE_TYPES`, a ROS 2 type name, exported as is).
+    ``reading``: the readings key it publishes; ``exists``: whether a device of this
+    configuration has the topic (default: always); ``sensor_qos``: a ROS 2 driver offers it with
+    SensorDataQoS (best effort, depth 5), else the default QoS(10)."""
+
+    item: str
+    message: str
+    reading: str = "value"
+    exists: Callable[[Any], bool] | None = None
+    sensor_qos: bool = True
+
+
+@dataclass(frozen=True, slots=True)
+class DeviceKind:
+    """One Webots device type (see the module docstring for what each field drives)."""
+
+    type: str
+    model: builtins.type | None                         # the world-file model (schemas/world.py)
+    implementation: str | None = None
+    services: tuple[str, ...] = ()
+    topics: tuple[TopicDecl, ...] = ()
+    rays: Callable[[Any, int], int] | None = None       # (config, number of lights) -> rays per measurement
+    ray_bound: tuple[str, str, str] | None = None       # (field in the message, what is counted, WorldLimits bound)
+    description: str | None = None                      # services.py model name of its attach description
+    motor: bool = False                                 # a motor: services go to ``_motor_<item>``
+
+    @property
+    def simulated(self) -> bool:
+        return self.implementation is not None
+
+    @property
+    def node(self) -> int:
+        return node_type(self.type)
+
+    @property
+    def node_name(self) -> str:
+        return f"WB_NODE_{_WEBOTS_NODE_ORDER[self.node]}"
+
+
+KINDS: dict[str, DeviceKind] = {}
+"""Every device kind by type name, in registration order."""
+
+
+def register(k: DeviceKind) -> DeviceKind:
+    """Add a kind (a test may add a toy one; a name is registered once)."""
+    if k.type in KINDS and KINDS[k.type] is not k:
+        raise ValueError(f"device kind {k.type!r} is already registered")
+    node_type(k.type)                        # a Webots node type, or KeyError
+    KINDS[k.type] = k
+    return k
+
+
+def kind(type_name: str) -> DeviceKind:
+    try:
+        return KINDS[type_name]
+    except KeyError:
+        raise KeyError(f"no device kind {type_name!r} (kinds: {', '.join(KINDS)})") from None
+
+
+# ---------------------------------------------------------------------- the simulated kinds
+
+_SENSOR = ("enable", "get_sampling_period")
+_SIM = "sensorium.server.sim.sensors:"
+
+
+def _laser_scan(cfg: Any) -> bool:
+    # one layer, cylindrical: the beams are at equal angles (a LaserScan can say them)
+    return cfg.number_of_layers == 1 and cfg.projection == "cylindrical"
+
+
+register(DeviceKind(
+    "LightSensor", wm.LightSensor, _SIM + "LightSensor",
+    services=(*_SENSOR, "get_lookup_table", "get_value"),
+    topics=(TopicDecl("value", msgs.ILLUMINANCE),),
+    rays=lambda cfg, lights: lights if cfg.occlusion else 0,
+    description="LightSensorDescription"))
+register(DeviceKind(
+    "DistanceSensor", wm.DistanceSensor, _SIM + "DistanceSensor",
+    services=(*_SENSOR, "get_lookup_table", "get_min_value", "get_max_value", "get_aperture", "get_type", "get_value"),
+    topics=(TopicDecl("value", msgs.RANGE),),
+    rays=lambda cfg, lights: max(1, int(cfg.number_of_rays)),    # an upper bound of the rays Webots casts
+    ray_bound=(".number_of_rays", "rays:", "rays_per_sensor"),
+    description="DistanceSensorDescription"))
+register(DeviceKind(
+    "Lidar", wm.Lidar, _SIM + "Lidar",
+    services=(*_SENSOR, "get_info", "enable_point_cloud", "is_point_cloud_enabled", "get_frequency_info",
+              "set_frequency", "get_layer_range_image", "get_layer_point_cloud"),
+    topics=(TopicDecl("range_image", msgs.IMAGE, "range_image"),
+            TopicDecl("laser_scan", msgs.LASER_SCAN, "range_image", exists=_laser_scan),
+            TopicDecl("point_cloud", msgs.POINT_CLOUD, "point_cloud")),
+    rays=lambda cfg, lights: int(cfg.horizontal_resolution) * int(cfg.number_of_layers),
+    ray_bound=("", "beams (horizontal_resolution × number_of_layers):", "beams_per_lidar"),
+    description="LidarDescription"))
+register(DeviceKind(
+    "PositionSensor", wm.PositionSensor, _SIM + "PositionSensor",
+    services=(*_SENSOR, "get_value"),
+    topics=(TopicDecl("value", msgs.JOINT_STATE, sensor_qos=False),),
+    description="PositionSensorDescription"))
+register(DeviceKind(
+    "LED", wm.LED, _SIM + "LED",
+    services=("set", "get"),
+    topics=(TopicDecl("value", msgs.COLOR_RGBA, sensor_qos=False),),
+    description="LEDDescription"))
+# A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
+# any other is listed, not simulated (schemas.world.RotationalMotor).
+register(DeviceKind(
+    "RotationalMotor", wm.RotationalMotor, "sensorium.server.sim.motion:WheelMotor",
+    services=("set_position", "set_velocity", "get_velocity", "get_max_velocity", "get_target_position"),
+    description="MotorDescription", motor=True))
+
+# ---------------------------------------------------------------------- listed, not simulated (yet)
+
+for _t in wm.UNSIMULATED_DEVICE_TYPES:
+    register(DeviceKind(_t, None))
