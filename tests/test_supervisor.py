@@ -132,10 +132,13 @@ def test_attach_robot_extras_and_custom_data(live):
     res = live.ok(A, "attach", {"robot": "pioneer"})
     assert (res["supervisor"], res["model"], res["custom_data"]) == (True, "Pioneer 3-DX (kinematic)", "gain=2")
     kinds = {d["name"]: d for d in res["devices"]}
-    assert kinds["left wheel sensor"] == {"name": "left wheel sensor", "type": "PositionSensor", "sampling_period": 0,
-                                          "motor": "left wheel motor", "noise": 0.0, "resolution": -1.0}
-    assert kinds["led0"] == {"name": "led0", "type": "LED", "value": 0, "color": [1.0, 0, 0, 0, 1.0, 0],
-                             "gradual": False}
+    assert [d["index"] for d in res["devices"]] == list(range(len(res["devices"])))
+    assert {k: v for k, v in kinds["left wheel sensor"].items() if k != "index"} == {
+        "name": "left wheel sensor", "type": "PositionSensor", "sampling_period": 0, "motor": "left wheel motor",
+        "noise": 0.0, "resolution": -1.0, "model": "", "simulated": True}
+    assert {k: v for k, v in kinds["led0"].items() if k != "index"} == {
+        "name": "led0", "type": "LED", "value": 0, "color": [1.0, 0, 0, 0, 1.0, 0], "gradual": False,
+        "model": "", "simulated": True}
     live.err(B, "/pioneer/robot/set_custom_data", {"value": "x"}, ErrorCode.NOT_ATTACHED)
     live.ok(A, "/pioneer/robot/set_custom_data", {"value": "x"})
     assert live.ok(B, "/pioneer/robot/get_custom_data") == {"value": "x"}
