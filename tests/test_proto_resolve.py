@@ -208,3 +208,47 @@ def test_cli_flags_and_info_list_the_protos_with_their_licences(tmp_path: Path, 
     assert "proto     AcmeBot x1: no license line" in out and "proto     AcmeEye x1: no license line" in out
     assert f"proto     Gadget x1: MIT ({extra / 'Gadget.proto'})" in out
     assert cli(["validate", str(w)]) == 0                     # the flags now hold for this process
+
+
+TETRA = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+
+
+def test_mesh_urls_of_protos_and_webots_assets_load_read_only(tmp_path: Path, monkeypatch) -> None:
+    """A PROTO's mesh url is relative to the PROTO file, webots:// comes from the installation; both
+    are read where they are (the world's folder does not hold them); a missing one is a warning."""
+    home = tmp_path / "webots"
+    (home / "projects" / "meshes").mkdir(parents=True)
+    (home / "projects" / "meshes" / "cone.obj").write_text(TETRA)
+    (home / "resources").mkdir()
+    (home / "resources" / "version.txt").write_text("R2023b\n")
+    monkeypatch.setenv("WEBOTS_HOME", str(home))
+    protos = tmp_path / "project" / "protos"
+    (protos / "meshes").mkdir(parents=True)
+    (protos / "meshes" / "shell.obj").write_text(TETRA)
+    proto_file(protos, "Shell", """[ field SFString name "shell" ]
+{ Solid { name IS name children [
+    Shape { geometry Mesh { url "meshes/shell.obj" } }
+    Shape { geometry Mesh { url "webots://projects/meshes/cone.obj" } }
+    Shape { geometry Mesh { url "meshes/missing.obj" } } ] } }""")
+    w = world_file(tmp_path / "project" / "worlds", 'Shell { }\n', ["../protos/Shell.proto"])
+    loaded = load_world(w)
+    (solid,) = loaded.world.solids
+    urls = [s.geometry.url for s in solid.shapes]
+    assert urls == [str((protos / "meshes" / "shell.obj").resolve()), str((home / "projects/meshes/cone.obj").resolve())]
+    (warning,) = [m for m in loaded.warnings if "missing.obj" in m]
+    assert f"Shell.proto:6:22 (in PROTO Shell at {w}:3:1): mesh file " in warning
+    assert '"meshes/missing.obj" not found' in warning and "this shape is left out" in warning
+    from sensorium.server.sim.summary import world_summary
+
+    assert world_summary(w)["triangles"] == 8       # both meshes read from where they are: 4 + 4 faces
+    # a world file naming a file outside its folder is still refused (the PROTO assets are the exception)
+    bad = world_file(tmp_path / "project" / "worlds", f'Solid {{ children [ Shape {{ geometry Mesh {{ url "{home}/projects/meshes/cone.obj" }} }} ] }}\n', name="bad.wbt")
+    with pytest.raises(WorldError, match="leaves the world's folder"):
+        load_world(bad)
+
+
+def test_messages_about_proto_nodes_name_the_proto_file_and_the_instance(tmp_path: Path) -> None:
+    proto_file(tmp_path, "Odd", '[ ] { Robot { name "odd" children [ Wobbler { } ] } }')
+    w = world_file(tmp_path, 'Pose { children [ Odd { } ] }\n', ["Odd.proto"])
+    (line,) = [m for m in load_world(w).warnings if "Wobbler" in m]
+    assert line.startswith(f"{tmp_path / 'Odd.proto'}:2:47 (in PROTO Odd at {w}:3:19): Wobbler: not a built-in node")

@@ -382,15 +382,30 @@ def test_contact_with_multi_shape_bodies() -> None:
 def test_robot_inside_groups_gets_the_composed_pose(tmp_path: Path) -> None:
     p = write(tmp_path, 'Pose { translation 1 0 0 rotation 0 0 1 1.5707963267948966 children [\n'
                         '  Group { children [ Robot { translation 0 2 0 rotation 0 0 1 1.5707963267948966 name "r" } ] } ] }\n'
-                        'Solid { children [ Robot { name "inner" } ] }\n')
+                        'Solid { translation 0 0 1 rotation 0 0 1 1.5707963267948966 children [\n'
+                        '  Solid { translation 1 0 0 children [ Pose { translation 0 0.5 0 children [\n'
+                        '    Robot { name "inner" rotation 0 0 1 1.5707963267948966 } ] } ] } ] }\n')
     w = load_world(p)
-    (r,) = w.world.robots
+    r, inner = w.world.robots
     from sensorium.server.world.poses import pose_from_model
 
     pose = pose_from_model(r.pose)
     assert pose.translation == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)      # (0, 2) turned a quarter, plus (1, 0)
     assert pose.rotation[:, 0] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)   # two quarter turns: facing -x
-    assert f"{p}:4:20: a Robot inside a Solid or another Robot is not supported: skipped" in w.warnings
+    # a Robot nested in Solids is a robot of the world; its pose is the solids' poses composed with its own
+    pose = pose_from_model(inner.pose)
+    assert inner.name == "inner"
+    assert pose.translation == pytest.approx([-0.5, 1.0, 1.0], abs=1e-12)       # (1, 0.5) turned a quarter, up 1
+    assert pose.rotation[:, 0] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)
+    assert w.warnings == []
+
+
+def test_a_robot_on_a_robot_is_dropped_with_a_reason(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "base" children [ Robot { name "rider" } ] }\n')
+    w = load_world(p)
+    assert [r.name for r in w.world.robots] == ["base"]
+    assert (f"{p}:2:32: Robot 'rider' inside robot 'base': a robot riding on another robot is not supported here; "
+            "dropped with everything inside it") in w.warnings
 
 
 def test_unsimulated_devices_keep_their_shapes(tmp_path: Path) -> None:
@@ -400,7 +415,29 @@ def test_unsimulated_devices_keep_their_shapes(tmp_path: Path) -> None:
     (part,) = w.world.robots[0].shapes
     assert part.geometry == wm.Box(type="box", size=(0.01, 0.02, 0.03)) and part.pose.translation == (0.1, 0.0, 0.0)
     assert part.seen_by == "visual"
-    assert f"{p}: skipped nodes that do not matter to these sensors: Camera, GPS" in w.warnings
+    # listed in Webots' device order (indices and getModel match Webots), not simulated
+    assert [(d.device, d.name, d.model) for d in w.world.robots[0].devices] == [("Camera", "camera", ""),
+                                                                                ("GPS", "gps", "")]
+    assert w.world.robots[0].devices[0].pose.translation == (0.1, 0.0, 0.0)
+    assert w.warnings == []
+
+
+def test_devices_are_listed_in_webots_tree_order(tmp_path: Path) -> None:
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+                        '  DistanceSensor { name "ds" model "GP2D120" children [ Compass { } ] }\n'
+                        '  HingeJoint { jointParameters HingeJointParameters { axis 1 0 0 } device [\n'
+                        '      Brake { } RotationalMotor { name "arm" } PositionSensor { name "arm sensor" } ]\n'
+                        '    endPoint Solid { children [ TouchSensor { name "bumper" model "tactile" } ] } }\n'
+                        '  SliderJoint { device [ LinearMotor { } ] }\n'
+                        '  Emitter { } ] }\n')
+    w = load_world(p)
+    devs = w.world.robots[0].devices
+    assert [(d.device, d.name) for d in devs] == [
+        ("DistanceSensor", "ds"), ("Compass", "compass"), ("Brake", "brake"), ("RotationalMotor", "arm"),
+        ("PositionSensor", "arm sensor"), ("TouchSensor", "bumper"), ("LinearMotor", "linear motor"),
+        ("Emitter", "emitter")]
+    assert devs[0].model == "GP2D120" and devs[5].model == "tactile"
+    assert devs[4].motor is None      # on a joint nothing turns here: present, reads no value
 
 
 def test_named_controllers_become_extern(tmp_path: Path) -> None:

@@ -83,6 +83,8 @@ class LoadedWorld:
     base_dir: Path                   # mesh urls are relative to it
     text: bytes = b""                # the file as read (recordings attach it)
     warnings: list[str] = field(default_factory=list)
+    dropped: list[str] = field(default_factory=list)    # the warnings that are losses sensors notice
+    asset_files: frozenset[Path] = frozenset()          # files outside base_dir it may read (PROTO assets)
 
 
 def read_world_text(path: str | Path, limits: WorldLimits | None = None) -> bytes:
@@ -214,13 +216,13 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
              webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = ()) -> LoadedWorld:
     """A Webots world, converted (``sensorium.server.world.wbt``); problems point at its lines.
     ``LoadedWorld.text`` is the .wbt file as read (recordings attach it under its own name)."""
-    from sensorium.server.world.wbt import WbtSyntaxError, wbt_to_dict
+    from sensorium.server.world.wbt import WbtSyntaxError, wbt_convert
 
     source = str(path)
     text = read_world_text(path, limits)           # the size limit (and a readable file)
     try:
-        data, warnings, origin = wbt_to_dict(path, webots_home=webots_home, proto_path=proto_path,
-                                             limits=ProtoLimits.matching(limits))
+        conv = wbt_convert(path, webots_home=webots_home, proto_path=proto_path, limits=ProtoLimits.matching(limits))
+        data, warnings, origin = conv.data, conv.warnings, conv.origin
     except WbtSyntaxError as exc:
         if exc.source != source:    # in a PROTO file the world uses
             where = f"{exc.source}:{exc.line}:{exc.col}" if exc.line else exc.source
@@ -229,7 +231,7 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
         raise WorldError(source, [Problem(where, exc.message)]) from None
     try:
         loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
-                             allow_outside_meshes=allow_outside_meshes)
+                             allow_outside_meshes=allow_outside_meshes, asset_files=conv.asset_files)
     except WorldError as exc:
         raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
     placed = []
@@ -238,7 +240,7 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
         at = _origin_of(where, origin)
         placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w)
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
-                       warnings=[*warnings, *placed])
+                       warnings=[*warnings, *placed], dropped=list(conv.dropped), asset_files=conv.asset_files)
 
 
 def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:
@@ -261,7 +263,8 @@ def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem
 
 
 def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = None, text: bytes = b"", *,
-                limits: WorldLimits | None = None, allow_outside_meshes: bool = False) -> LoadedWorld:
+                limits: WorldLimits | None = None, allow_outside_meshes: bool = False,
+                asset_files: frozenset[Path] = frozenset()) -> LoadedWorld:
     limits = limits or WorldLimits()
     if data is None:
         data = {}
@@ -276,7 +279,8 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
     except ValidationError as exc:
         raise WorldError(source, _named(data, [_problem_from_pydantic(e) for e in exc.errors()])) from None
     base = base_dir or Path.cwd()
-    problems = check_world(world, base, limits=limits, allow_outside_meshes=allow_outside_meshes)
+    problems = check_world(world, base, limits=limits, allow_outside_meshes=allow_outside_meshes,
+                           asset_files=asset_files)
     if problems:
         raise WorldError(source, _named(data, problems))
     world, warnings = sanitize(world)
@@ -319,7 +323,7 @@ def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
 
 
 def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None = None,
-                allow_outside_meshes: bool = False) -> list[Problem]:
+                allow_outside_meshes: bool = False, asset_files: frozenset[Path] = frozenset()) -> list[Problem]:
     """Checks that relate several fields or the file system, and the world's limits; one problem
     per finding."""
     problems: list[Problem] = []
@@ -382,7 +386,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                                        f"(motors: {', '.join(repr(m) for m in motors) or 'none: no differential_drive'})"))
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
-    problems += _check_meshes_and_work(world, base_dir, limits or WorldLimits(), allow_outside_meshes)
+    problems += _check_meshes_and_work(world, base_dir, limits or WorldLimits(), allow_outside_meshes, asset_files)
     if not problems:    # textures: confined like meshes, within the limits, decoded once (world/textures.py)
         from sensorium.server.world.textures import check_textures
 
@@ -391,7 +395,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
 
 
 def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
-                           allow_outside_meshes: bool) -> list[Problem]:
+                           allow_outside_meshes: bool, asset_files: frozenset[Path] = frozenset()) -> list[Problem]:
     """Every mesh url (confined, readable, bounded) and the work the world asks for."""
     from sensorium.server.world.limits import _walk
     from sensorium.server.world.meshes import MeshFileError, load_mesh, resolve_mesh_url
@@ -407,7 +411,7 @@ def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
         faces[key] = 0
         try:
             file = resolve_mesh_url(geom.url, base_dir, allow_outside=allow_outside_meshes,
-                                    max_bytes=limits.mesh_file_bytes)
+                                    max_bytes=limits.mesh_file_bytes, allowed=asset_files)
             faces[key] = len(load_mesh(file, geom.scale, display=geom.url).faces)
         except MeshFileError as exc:
             problems.append(Problem(f"{path}.url", str(exc)))

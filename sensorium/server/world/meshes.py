@@ -18,11 +18,13 @@ class MeshFileError(Exception):
     """A mesh file that is missing, unreadable or not a triangle mesh."""
 
 
-def resolve_mesh_url(url: str, base_dir: Path, *, allow_outside: bool = False, max_bytes: int | None = None) -> Path:
+def resolve_mesh_url(url: str, base_dir: Path, *, allow_outside: bool = False, max_bytes: int | None = None,
+                     allowed: frozenset[Path] = frozenset()) -> Path:
     """A world file's mesh ``url`` → the file it names, relative to the world's folder.
 
     Unless ``allow_outside``, the file (symbolic links followed) must be inside ``base_dir``: an
-    absolute url or one that climbs out with ``..`` is refused. Errors quote the url as written,
+    absolute url or one that climbs out with ``..`` is refused, except the files in ``allowed`` (a
+    .wbt world's PROTO meshes and ``webots://`` assets, read only). Errors quote the url as written,
     never a resolved path elsewhere on the machine."""
     if "\0" in url:
         raise MeshFileError("mesh url contains a NUL byte")
@@ -33,7 +35,7 @@ def resolve_mesh_url(url: str, base_dir: Path, *, allow_outside: bool = False, m
         path = (base / url).resolve()
     except (OSError, RuntimeError, ValueError) as exc:       # symlink loops, bad names
         raise MeshFileError(f"mesh url {url!r} cannot be resolved: {exc}") from None
-    if not allow_outside and not path.is_relative_to(base):
+    if not allow_outside and not path.is_relative_to(base) and path not in allowed:
         raise MeshFileError(f"mesh url {url!r} leaves the world's folder (absolute paths and '..' are refused; "
                             "use --allow-outside-meshes to allow them)")
     try:

@@ -19,12 +19,16 @@ __all__ = ["WbtSyntaxError", "WbtConversion", "wbt_convert", "wbt_to_dict", "rea
 @dataclass
 class WbtConversion:
     """A converted world: the world-file dict, warnings, converted path → (line, column, node type)
-    it came from, and the PROTOs used (``ProtoUse``: name, file, licence line, instances)."""
+    it came from, the PROTOs used (``ProtoUse``: name, file, licence line, instances), the asset
+    files outside the world's folder it may read (meshes of PROTOs, ``webots://`` assets) and the
+    warnings that are losses sensors would notice (``dropped``: a robot, a sensor device)."""
 
     data: dict[str, Any]
     warnings: list[str]
     origin: dict[str, tuple[int, int, str]]
     protos: list[Any]
+    asset_files: frozenset[Path] = frozenset()
+    dropped: tuple[str, ...] = ()
 
 
 def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),
@@ -42,7 +46,8 @@ def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, prot
     raw = conv.run()
     origin: dict[str, tuple[int, int, str]] = {}
     data = strip_origins(raw, "", origin)
-    return WbtConversion(data, [*expansion.warnings, *conv.warnings], origin, expansion.protos)
+    return WbtConversion(data, [*expansion.warnings, *conv.warnings], origin, expansion.protos,
+                         frozenset(conv.asset_files), tuple(conv.dropped))
 
 
 def wbt_to_dict(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),

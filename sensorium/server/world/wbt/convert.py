@@ -32,11 +32,15 @@ MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
 SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "ImmersionProperties",
-           "ContactProperties", "Damping", "Brake", "Muscle", "Propeller", "Skin", "CadShape"}
-# devices not simulated here; they are Solids, so their shapes stay part of the robot's body
+           "ContactProperties", "Damping", "Muscle", "Propeller", "CadShape"}
+# devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
+# the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
 OTHER_DEVICES = {"Camera", "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
                  "Compass", "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger",
-                 "Connector", "Radar", "Altimeter", "VacuumGripper", "Radio", "Track"}
+                 "Connector", "Radar", "Altimeter", "VacuumGripper", "Radio", "Track", "Skin"}
+# Webots' default device names (the ``name`` field's default of each node)
+OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "TouchSensor": "touch sensor",
+               "VacuumGripper": "vacuum gripper", "LinearMotor": "linear motor", "GPS": "gps"}
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh"}
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED"}
@@ -70,6 +74,18 @@ class Frame:
             aa = None
         return Frame(self.rotation @ r2, t, self.scale * scale, aa)  # type: ignore[arg-type]
 
+    def compose(self, inner: Frame) -> Frame:
+        """``inner`` (a frame given relative to this one) in this frame's parent."""
+        aa: tuple[float, float, float, float] | None
+        if self.aa is not None and self.aa[3] == 0.0:
+            aa = inner.aa
+        elif inner.aa is not None and inner.aa[3] == 0.0:
+            aa = self.aa
+        else:
+            aa = None
+        t = self.rotation @ (self.scale * inner.translation) + self.translation
+        return Frame(self.rotation @ inner.rotation, t, self.scale * inner.scale, aa)
+
     def apply(self, p) -> list[float]:
         return [float(v) for v in self.rotation @ (self.scale * np.asarray(p, dtype=np.float64)) + self.translation]
 
@@ -94,6 +110,7 @@ class Owner:
     parts: list[dict] = field(default_factory=list)
     keys: dict[tuple, dict] = field(default_factory=dict)      # visual parts by (geometry, frame)
     wheels: list[dict] = field(default_factory=list)           # motorised hinges (robots)
+    placed: Frame = field(default_factory=Frame.identity)      # the owner's frame in the world
 
 
 class Converter:
@@ -110,19 +127,56 @@ class Converter:
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.defs: set[str] = set()        # DEF names kept (def_name)
-        self.textured: dict[int, tuple[int, int, str]] = {}   # textures not loaded → (line, column, why)
+        self.textured: dict[int, tuple[int, int, str, str]] = {}   # textures not loaded → (line, column, why)
         self.robot_fields = set(wm.Robot.model_fields)
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
+        self.instances: list[tuple[str, tuple[str, int, int]]] = []   # PROTO instances being walked (name, at)
+        self.asset_files: set[Path] = set()   # asset files outside the world's folder this world may read
+        self.dropped: list[str] = []      # robots, sensor devices and sensor-visible shapes lost (messages)
 
     # ------------------------------------------------------------ messages
+    def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
+        """``file:line:col`` of a node (or of ``pos`` in its file); a node read from a PROTO file also
+        names the PROTO instance written in the world that brought it."""
+        line, col = pos or (node.line, node.col)
+        src = node.source or self.source
+        out = f"{src}:{line}:{col}"
+        if src != self.source and self.instances:
+            name, (file, i_line, i_col) = self.world_instance()
+            out += f" (in PROTO {name} at {file}:{i_line}:{i_col})"
+        return out
+
+    def world_instance(self) -> tuple[str, tuple[str, int, int]]:
+        """The outermost PROTO instance being walked that the world file itself writes."""
+        for name, at in self.instances:
+            if at[0] == self.source:
+                return name, at
+        return self.instances[0]
+
+    def at(self, node: Node) -> tuple[int, int, str]:
+        """(line, column, what) in the world file for converted-path bookkeeping: a node of a PROTO file
+        is placed at the instance the world writes."""
+        src = node.source or self.source
+        if src == self.source or not self.instances:
+            return node.line, node.col, node.type
+        name, (_, line, col) = self.world_instance()
+        return line, col, f"{node.type} of PROTO {name}"
+
     def warn(self, node: Node, message: str) -> None:
-        self.warnings.append(f"{self.source}:{node.line}:{node.col}: {message}")
+        self.warnings.append(f"{self.where(node)}: {message}")
+
+    def drop(self, node: Node, message: str) -> None:
+        """A loss that changes what sensors read (a robot, a sensor device, a shape sensors see): a
+        warning that ``validate`` counts as an error unless ``--allow-skipped``."""
+        text = f"{self.where(node)}: {message}"
+        self.warnings.append(text)
+        self.dropped.append(text)
 
     def fields(self, node: Node) -> Fields:
-        return Fields(node, self.source)
+        return Fields(node, node.source or self.source)
 
     def error(self, node: Node, message: str) -> WbtSyntaxError:
-        return WbtSyntaxError(self.source, node.line, node.col, message)
+        return WbtSyntaxError(node.source or self.source, node.line, node.col, message)
 
     def walk(self, node: Node) -> None:
         """Count a node walked (DEF/USE can make a small file a huge tree)."""
@@ -144,8 +198,8 @@ class Converter:
         if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
             self.world["solids"].append(self.solid_dict(world, {"name": self.unique_name("shapes")}))
         if self.textured:   # textures not loaded: one line (world/textures.py says why each is refused)
-            (line, col, why), n = min(self.textured.values()), len(self.textured)
-            self.warnings.append(f"{self.source}:{line}:{col}: {n} texture{'s' if n > 1 else ''} not loaded (first: {why}); "
+            (_, _, where, why), n = min(self.textured.values()), len(self.textured)
+            self.warnings.append(f"{where}: {n} texture{'s' if n > 1 else ''} not loaded (first: {why}); "
                                  "read as Webots reads a texture it cannot load: an Appearance as its material's "
                                  "diffuseColor, a PBRAppearance as its baseColor")
         if self.skipped:
@@ -181,6 +235,16 @@ class Converter:
 
     # ------------------------------------------------------------ the walk
     def visit(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
+        if node.proto is not None and node.instance_at is not None:
+            self.instances.append((node.proto, node.instance_at))
+            try:
+                self.visit_node(node, frame, owner, top)
+            finally:
+                self.instances.pop()
+        else:
+            self.visit_node(node, frame, owner, top)
+
+    def visit_node(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
         self.walk(node)
         t = node.type
         f = self.fields(node)
@@ -192,9 +256,14 @@ class Converter:
         elif t in SKIPPED:
             self.skipped[t] += 1
         elif t in OTHER_DEVICES:
-            self.skipped[t] += 1
             if owner.kind == "robot":
-                self.solid_contents(node, self.child_frame(node, frame), owner)
+                inner = self.child_frame(node, frame)
+                if t in wm.UNSIMULATED_DEVICE_TYPES:
+                    self.tick(node)
+                    self.unsimulated(node, inner, owner)
+                self.solid_contents(node, inner, owner)
+            else:
+                self.skipped[t] += 1
         elif t == "Group":
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
@@ -207,12 +276,15 @@ class Converter:
         elif t in LIGHTS:
             self.light(node, frame, owner)
         elif t == "Robot":
-            if owner.kind != "world":
-                self.warn(node, "a Robot inside a Solid or another Robot is not supported: skipped")
-            elif frame.scale != 1.0:
-                self.warn(node, "a Robot inside a scaled Transform is not supported: skipped")
-            else:
-                self.robot(node, frame)
+            name = self.fields(node).string("name", "robot")
+            if owner.kind == "robot":
+                self.drop(node, f"Robot {name!r} inside robot {owner.data['name']!r}: a robot riding on another "
+                                "robot is not supported here; dropped with everything inside it")
+            elif frame.scale != 1.0 or owner.placed.scale != 1.0:
+                self.drop(node, f"Robot {name!r} inside a scaled Transform: Webots does not allow a Solid "
+                                "(so a Robot) under a Transform that scales; dropped")
+            else:     # at the top or nested in solids and groups: a robot placed where they put it
+                self.robot(node, owner.placed.compose(frame))
         elif t == "Solid":
             self.solid(node, frame, owner)
         elif t in SENSORS or t in MOTORS:
@@ -227,13 +299,13 @@ class Converter:
         elif t in GEOMETRIES:
             self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
         else:
-            self.warn(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
+            self.drop(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
                             f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
 
     def appearance_note(self, node: Node, message: str) -> None:
         if message.startswith("texture: "):   # one summary line for all textures not loaded
             if id(node) not in self.textured:
-                self.textured[id(node)] = (node.line, node.col, message[len("texture: "):])
+                self.textured[id(node)] = (node.line, node.col, self.where(node), message[len("texture: "):])
         else:
             self.warn(node, message)
 
@@ -249,7 +321,7 @@ class Converter:
         self.checked.add(id(node))
         for name, meant in fx.field_typos(node):
             line, col = node.field_pos.get(name, (node.line, node.col))
-            self.warnings.append(f"{self.source}:{line}:{col}: {node.type}.{name}: not a {node.type} field, "
+            self.warnings.append(f"{self.where(node, (line, col))}: {node.type}.{name}: not a {node.type} field, "
                                  f"ignored (did you mean {meant}?)")
 
     def child_frame(self, node: Node, frame: Frame) -> Frame:
@@ -283,6 +355,8 @@ class Converter:
                 if isinstance(material, Node):
                     self.typos(material)
         geometry = self.geometry(gnode, frame.scale)
+        if geometry is None:
+            return
         key = (id(gnode), frame.key())
         if seen_by == "bounding" and key in owner.keys:   # the same geometry seen by both kinds of ray
             owner.keys[key]["seen_by"] = "both"
@@ -293,7 +367,7 @@ class Converter:
             if app is not None:
                 part["appearance"] = app
             owner.keys[key] = part
-        part["_at"] = (gnode.line, gnode.col, gnode.type)
+        part["_at"] = self.at(gnode)
         owner.parts.append(part)
 
     def bounding(self, node: Node | None, frame: Frame, owner: Owner) -> None:
@@ -313,7 +387,45 @@ class Converter:
         else:
             self.warn(node, f"{node.type} in a boundingObject: ignored")
 
-    def geometry(self, node: Node, s: float) -> dict:
+    def asset(self, node: Node, url: str) -> str | None:
+        """The url a converted world names for an asset ``url`` written in ``node``'s file: as written
+        when the world file names a local file (the loader confines it to the world's folder); else
+        (a PROTO's url, relative to the PROTO file; ``webots://`` or Webots' GitHub urls, from the
+        installation) the local file it names, which must lie in the Webots installation, a
+        --proto-path folder or the project of the PROTO file that names it (read only). None: the
+        file is missing (a warning naming it: the shape is left out)."""
+        from sensorium.server.world.proto import ProtoError, asset_roots, resolve_url
+
+        src = node.source or self.source
+        if src == self.source and "://" not in url:
+            if not (Path(self.source).resolve().parent / url).is_file() and "\0" not in url:
+                self.warn(node, f"mesh file {url!r} not found (relative to the world file): this shape is left out, "
+                                "rays do not see it")
+                return None
+            return url
+        if self.search is None:
+            self.warn(node, f"mesh url {url!r}: no PROTO search places to resolve it; this shape is left out")
+            return None
+        try:
+            path = resolve_url(url, src, self.search).resolve()
+        except ProtoError as exc:
+            self.warn(node, f"mesh file {exc.message}; this shape is left out, rays do not see it")
+            return None
+        except (OSError, ValueError) as exc:
+            self.warn(node, f"mesh url {url!r} cannot be resolved ({exc}); this shape is left out")
+            return None
+        roots = [*asset_roots(self.search), Path(src).resolve().parent.parent, Path(self.source).resolve().parent]
+        if not any(path.is_relative_to(r) for r in roots):
+            self.warn(node, f"mesh url {url!r} names a file outside the Webots installation, the --proto-path "
+                            "folders and the PROTO's project: refused, this shape is left out")
+            return None
+        if not path.is_file():
+            self.warn(node, f"mesh file {url!r} not found: this shape is left out, rays do not see it")
+            return None
+        self.asset_files.add(path)
+        return str(path)
+
+    def geometry(self, node: Node, s: float) -> dict | None:
         f = self.fields(node)
         t = node.type
         if t == "Box":
@@ -330,9 +442,10 @@ class Converter:
             urls = f.strings("url")
             if not urls:
                 raise f.error("url", "a Mesh needs a url")
-            if "://" in urls[0]:
-                raise f.error("url", f"only local mesh files are supported, got {urls[0]!r}")
-            return {"type": "mesh", "url": urls[0], "scale": [s, s, s]}
+            url = self.asset(node, urls[0].replace("\\", "/"))
+            if url is None:
+                return None
+            return {"type": "mesh", "url": url, "scale": [s, s, s]}
         # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
         coord = f.node_("coord")
         points = self.fields(coord).rows("point", 3, []) if coord is not None else []
@@ -366,7 +479,7 @@ class Converter:
             data["location"] = frame.apply(data["location"])
         if node.type == "SpotLight":
             data["direction"] = [float(v) for v in frame.rotation @ np.asarray(data["direction"])]
-        data["_at"] = (node.line, node.col, node.type)
+        data["_at"] = self.at(node)
         owner.data.setdefault("lights", []).append(data) if owner.kind != "world" else self.world["lights"].append(data)
 
     # ------------------------------------------------------------ solids and robots
@@ -384,10 +497,10 @@ class Converter:
             self.def_name(node, data)
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
-        mine = Owner("solid", data)
+        mine = Owner("solid", data, placed=owner.placed.compose(inner))
         self.solid_contents(node, Frame.identity(), mine)
         out = self.solid_dict(mine, data)
-        out["_at"] = (node.line, node.col, node.type)
+        out["_at"] = self.at(node)
         if owner.kind == "world":
             self.world["solids"].append(out)
         else:
@@ -430,7 +543,7 @@ class Converter:
                     data[key] = value
             elif value != defaults[key]:
                 self.warn(node, f"Robot field {key}: not supported by this version; ignored")
-        data["_at"] = (node.line, node.col, node.type)
+        data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.solid_contents(node, Frame.identity(), mine)
         self.drive(node, mine)
@@ -445,7 +558,8 @@ class Converter:
         """Device names address topics and services, so a repeated one gets a suffix (Webots warns
         and its getDevice returns the first); the wheel motors' names count too."""
         drive = robot.get("differential_drive") or {}
-        seen: Counter[str] = Counter(v for k, v in drive.items() if k in ("left_motor", "right_motor"))
+        listed = {d["name"] for d in robot["devices"] if d["device"] == "RotationalMotor"}
+        seen: Counter[str] = Counter(v for k, v in drive.items() if k in ("left_motor", "right_motor") and v not in listed)
         for dev in robot["devices"]:
             name = dev["name"]
             seen[name] += 1
@@ -470,20 +584,64 @@ class Converter:
             self.warn(node, f"{node.type} outside a joint: skipped")
             return
         if node.type not in self.device_kinds:
-            self.warn(node, f"{node.type}: device kind not supported by this version; skipped")
+            self.drop(node, f"{node.type}: device kind not supported by this version; skipped")
         else:
             data = {"name": f.string("name", fx.DEVICE_NAMES[node.type]), "pose": inner.pose(), **fx.device(node, f)}
-            data["_at"] = (node.line, node.col, node.type)
+            model = f.string("model", "")
+            if model:
+                data["model"] = model
+            data["_at"] = self.at(node)
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
             owner.data["devices"].append(data)
         self.solid_contents(node, inner, owner)
 
+    def unsimulated(self, node: Node, frame: Frame, owner: Owner) -> dict:
+        """A device listed (its index, type, name and model are Webots') but not simulated here."""
+        f = self.fields(node)
+        t = node.type
+        data: dict[str, Any] = {"name": f.string("name", OTHER_NAMES.get(t, t.lower())), "device": t}
+        if "model" in node.fields:
+            model = f.string("model", "")
+            if model:
+                data["model"] = model
+        if frame.pose() != {"translation": [0.0, 0.0, 0.0]}:
+            data["pose"] = frame.pose()
+        data["_at"] = self.at(node)
+        owner.data["devices"].append(data)
+        return data
+
+    def joint_devices(self, node: Node, owner: Owner) -> tuple[list[dict], list[dict]]:
+        """A joint's devices in its ``device`` order (Webots lists them before the end point's):
+        (motor entries, position sensor entries)."""
+        motors, sensors = [], []
+        for d in self.fields(node).nodes("device"):
+            self.walk(d)
+            self.tick(d)
+            if d.type == "RotationalMotor":
+                entry = {"name": self.fields(d).string("name", "rotational motor"), "device": "RotationalMotor",
+                         "_at": self.at(d)}
+                owner.data["devices"].append(entry)
+                motors.append(entry)
+            elif d.type == "PositionSensor":
+                sf = self.fields(d)
+                entry = {"name": sf.string("name", "position sensor"), "device": "PositionSensor",
+                         "noise": sf.num("noise", 0.0), "resolution": sf.num("resolution", -1.0), "_at": self.at(d)}
+                owner.data["devices"].append(entry)
+                sensors.append(entry)
+            elif d.type in ("LinearMotor", "Brake"):
+                self.unsimulated(d, Frame.identity(), owner)
+            else:
+                self.warn(d, f"{d.type} in a joint's device list: ignored")
+        return motors, sensors
+
     def joint(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
         end = f.node_("endPoint")
         motors = [d for d in f.nodes("device") if d.type in MOTORS]
-        sensors = [d for d in f.nodes("device") if d.type == "PositionSensor"]
+        sensors: list[dict] = []
+        if owner.kind == "robot":
+            _, sensors = self.joint_devices(node, owner)
         if owner.kind == "robot" and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
             if params is not None:
@@ -501,9 +659,9 @@ class Converter:
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
         elif motors:
-            self.warn(node, f"{node.type} motor(s) not part of a wheel: skipped (joints do not move here)")
+            self.warn(node, f"{node.type} motor(s) not part of a wheel: listed, not simulated (joints do not move here)")
         if sensors and not (owner.kind == "robot" and node.type == "HingeJoint" and motors):
-            self.warn(node, "PositionSensor on a joint without a drive wheel motor: skipped")
+            self.warn(node, "PositionSensor on a joint without a drive wheel motor: listed, reads no value")
         if end is not None:
             if end.type == "SolidReference":
                 return
@@ -520,16 +678,9 @@ class Converter:
             self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
             return
         robot.data["differential_drive"] = drive
-        if "PositionSensor" in self.device_kinds:
-            for w in wheels:
-                for s in w["sensors"]:
-                    sf = self.fields(s)
-                    robot.data["devices"].append({"name": sf.string("name", "position sensor"), "device": "PositionSensor",
-                                                  "motor": w["motor"], "noise": sf.num("noise", 0.0),
-                                                  "resolution": sf.num("resolution", -1.0),
-                                                  "_at": (s.line, s.col, s.type)})
-        elif any(w["sensors"] for w in wheels):
-            self.warn(node, "PositionSensor: device kind not supported by this version; skipped")
+        for w in wheels:    # the wheels' encoders measure the drive's wheels
+            for entry in w["sensors"]:
+                entry["motor"] = w["motor"]
 
 
 def _clean_part(p: dict) -> dict:
