@@ -69,14 +69,14 @@ def node_type(type_name: str) -> int:
 class TopicDecl:
     """One topic of a device: ``/<robot>/<device>/<item>`` carrying ``message`` (a type of
     :data:`sensorium.schemas.messages.MESSAGE_TYPES`, a ROS 2 type name, exported as is).
-    ``reading``: the readings key it publishes; ``exists``: whether a device of this
-    configuration has the topic (default: always); ``sensor_qos``: a ROS 2 driver offers it with
+    ``reading``: the device attribute it publishes; ``exists(config, world_info)``: whether a
+    device of this configuration in this world has the topic (default: always); ``sensor_qos``: a ROS 2 driver offers it with
     SensorDataQoS (best effort, depth 5), else the default QoS(10)."""
 
     item: str
     message: str
     reading: str = "value"
-    exists: Callable[[Any], bool] | None = None
+    exists: Callable[[Any, Any], bool] | None = None
     sensor_qos: bool = True
 
 
@@ -133,7 +133,7 @@ _SENSOR = ("enable", "get_sampling_period")
 _SIM = "sensorium.server.sim.sensors:"
 
 
-def _laser_scan(cfg: Any) -> bool:
+def _laser_scan(cfg: Any, world_info: Any) -> bool:
     # one layer, cylindrical: the beams are at equal angles (a LaserScan can say them)
     return cfg.number_of_layers == 1 and cfg.projection == "cylindrical"
 
@@ -171,6 +171,14 @@ register(DeviceKind(
     services=("set", "get"),
     topics=(TopicDecl("value", msgs.COLOR_RGBA, sensor_qos=False),),
     description="LEDDescription"))
+register(DeviceKind(
+    "GPS", wm.GPS, _SIM + "GPS",
+    services=(*_SENSOR, "get_values", "get_speed", "get_speed_vector", "get_coordinate_system"),
+    topics=(TopicDecl("values", msgs.NAV_SAT_FIX, "values", exists=lambda cfg, wi: wi.gps_coordinate_system == "WGS84"),
+            TopicDecl("values", msgs.POINT_STAMPED, "values", exists=lambda cfg, wi: wi.gps_coordinate_system == "local"),
+            TopicDecl("speed", msgs.FLOAT64, "speed"),
+            TopicDecl("speed_vector", msgs.VECTOR3_STAMPED, "speed_vector")),
+    description="GPSDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

@@ -318,6 +318,17 @@ class PositionSensorDescription(_Entry):
     resolution: float
 
 
+class GPSDescription(_Entry):
+    type: Literal["GPS"]
+    sampling_period: int
+    coordinate_system: int = Field(description="wb_gps_get_coordinate_system: 0 local, 1 WGS84")
+    accuracy: float
+    noise_correlation: float
+    resolution: float
+    speed_noise: float
+    speed_resolution: float
+
+
 class LEDDescription(_Entry):
     type: Literal["LED"]
     value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
@@ -334,6 +345,7 @@ DeviceDescription = Annotated[
     Annotated[LightSensorDescription, Tag("LightSensor")] | Annotated[DistanceSensorDescription, Tag("DistanceSensor")]
     | Annotated[LidarDescription, Tag("Lidar")] | Annotated[MotorDescription, Tag("RotationalMotor")]
     | Annotated[PositionSensorDescription, Tag("PositionSensor")] | Annotated[LEDDescription, Tag("LED")]
+    | Annotated[GPSDescription, Tag("GPS")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -571,6 +583,10 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_value", "device", NoArgs, FloatValue),
     ServiceSpec("set", "device", IntArgs, SuccessResult, attached=True),
     ServiceSpec("get", "device", NoArgs, IntValue),
+    ServiceSpec("get_values", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_speed", "device", NoArgs, FloatValue),
+    ServiceSpec("get_speed_vector", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_coordinate_system", "device", NoArgs, IntValue),
 )
 
 

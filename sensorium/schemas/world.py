@@ -374,6 +374,20 @@ class LED(_Device):
         return v
 
 
+class GPS(_Device):
+    """Webots GPS: the device's position (local coordinates, or WGS84 latitude / longitude /
+    altitude, per ``world_info.gps_coordinate_system``), its speed and speed vector."""
+
+    device: Literal["GPS"]
+    type: Literal["satellite", "laser"] = Field(default="satellite", description="ignored, as in Webots")
+    accuracy: float = Field(default=0.0, ge=0.0, description="standard deviation (m) of the position noise")
+    noise_correlation: float = Field(default=0.0, ge=0.0, le=1.0,
+                                     description="how much the noise of one second ago remains (Gauss-Markov)")
+    resolution: float = Field(default=-1.0, description="m; -1 = infinite")
+    speed_noise: float = Field(default=0.0, ge=0.0, description="relative standard deviation of the speed")
+    speed_resolution: float = Field(default=-1.0, description="m/s; -1 = infinite")
+
+
 class RotationalMotor(_Device):
     """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
     motors *is* that motor, at this index of the device list (a drive motor without an entry comes
@@ -384,7 +398,7 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Accelerometer", "Altimeter", "Brake", "Camera", "Compass", "Connector", "Display", "Emitter", "GPS", "Gyro",
+    "Accelerometer", "Altimeter", "Brake", "Camera", "Compass", "Connector", "Display", "Emitter", "Gyro",
     "InertialUnit", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
     "Speaker", "TouchSensor", "VacuumGripper",
 )
@@ -400,10 +414,11 @@ class UnsimulatedDevice(_Device):
     device: Literal[UNSIMULATED_DEVICE_TYPES]  # type: ignore[valid-type]
 
 
-Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | RotationalMotor | UnsimulatedDevice,
+Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | RotationalMotor
+                   | UnsimulatedDevice,
                    Field(discriminator="device")]
 
-DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "RotationalMotor",
+DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "RotationalMotor",
                 *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
@@ -461,6 +476,11 @@ class WorldInfo(Strict):
     coordinate_system: Literal["ENU", "NUE"] = Field(
         default="ENU", description="world axes: ENU = x east, y north, z up; NUE = x north, y up, z east. "
         "Only the up axis matters here: differential drives move in the plane normal to it")
+    gps_coordinate_system: Literal["local", "WGS84"] = Field(
+        default="local", description="what a GPS reads: local coordinates (m) or WGS84 latitude, longitude (degrees), "
+        "altitude (m)")
+    gps_reference: Vec3 = Field(default=(0.0, 0.0, 0.0), description="local: added to the position; WGS84: the "
+                                "latitude, longitude (degrees) and altitude (m) of the world's origin")
 
 
 class World(Strict):

@@ -79,6 +79,18 @@ class DeviceServices:
     def _dev_get_value(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.value)}
 
+    def _dev_get_values(self, c: Call) -> dict:
+        return {"value": [float(v) for v in c.ctl.device.values]}
+
+    def _dev_get_speed(self, c: Call) -> dict:
+        return {"value": float(c.ctl.device.speed)}
+
+    def _dev_get_speed_vector(self, c: Call) -> dict:
+        return {"value": [float(v) for v in c.ctl.device.speed_vector]}
+
+    def _dev_get_coordinate_system(self, c: Call) -> dict:
+        return {"value": int(c.ctl.device.coordinate_system)}
+
     def _dev_set(self, c: Call) -> dict:
         try:
             c.ctl.device.set(c.args.value, self.sim.time_ms)

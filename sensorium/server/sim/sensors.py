@@ -16,8 +16,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from sensorium.schemas import world as wm
 from sensorium.schemas.devices import kind
 from sensorium.server.devices import distance as dmath
+from sensorium.server.devices import gps as gps_math
 from sensorium.server.devices import lidar as lmath
 from sensorium.server.devices.lookup import LookupTable
 from sensorium.server.devices.noise import device_rng
@@ -135,6 +137,10 @@ class Device:
     def _mark(self, now_ms: int) -> None:
         self.measurements += 1
         self.measured_at_ms = now_ms
+
+    def step_reading(self) -> dict:
+        """What a step reply carries for the device (PROTOCOL §3.6)."""
+        return {"value": float(self.value)}  # type: ignore[attr-defined]
 
     def bind(self, robot: Any) -> None:
         """Called once with the device's ``RobotState`` (motors, drive, pose) when the robot is made."""
@@ -511,3 +517,56 @@ def device_class(type_name: str) -> type | None:
 
 _CLASSES: dict[str, type] = {}
 RAY_DEVICES = (LightSensor, DistanceSensor, Lidar)
+
+
+class GPS(Device):
+    """Webots GPS (``server/devices/gps.py``): position, speed, speed vector of the device, from
+    the kinematic world; NaN before the first value, the speed also at the first one (Webots: no
+    previous position)."""
+
+    kinematic = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.values = np.full(3, math.nan)
+        self.speed = math.nan
+        self.speed_vector = np.full(3, math.nan)
+        self._noise = np.zeros(3)                         # the Gauss-Markov state of the position noise
+        self._previous: np.ndarray | None = None          # the translation at the previous measurement
+        self._robot: Any = None
+        self._world_info: Any = wm.WorldInfo()
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._world_info = robot.world_info
+
+    @property
+    def coordinate_system(self) -> int:
+        return 1 if self._world_info.gps_coordinate_system == "WGS84" else 0
+
+    def measure(self, now_ms: int) -> None:
+        c, wi = self.config, self._world_info
+        elapsed = now_ms - self.schedule.last_update_ms
+        t = self.world_pose(self._robot.pose).translation
+        rng = self.rng if (c.accuracy > 0.0 or c.speed_noise > 0.0) else None
+        self.values = gps_math.position(
+            t, coordinate_system=wi.gps_coordinate_system, reference=wi.gps_reference, axes=wi.coordinate_system,
+            accuracy=c.accuracy, correlation=c.noise_correlation, elapsed_ms=elapsed, noise=self._noise, rng=rng,
+            resolution=c.resolution)
+        self.speed_vector = gps_math.speed_vector(t, self._previous, elapsed)
+        self._previous = np.array(t, dtype=np.float64)
+        self.speed = gps_math.speed(self.speed_vector, noise=c.speed_noise, rng=rng, resolution=c.speed_resolution)
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"values": self.values, "speed": self.speed, "speed_vector": self.speed_vector}
+
+    def step_reading(self) -> dict:
+        return {"values": [float(v) for v in self.values], "speed": float(self.speed),
+                "speed_vector": [float(v) for v in self.speed_vector]}
+
+    def describe(self) -> dict:
+        c = self.config
+        return {"coordinate_system": self.coordinate_system, "accuracy": float(c.accuracy),
+                "noise_correlation": float(c.noise_correlation), "resolution": float(c.resolution),
+                "speed_noise": float(c.speed_noise), "speed_resolution": float(c.speed_resolution)}

@@ -118,6 +118,10 @@ class RobotState:
     def pose(self) -> Pose:
         return self._sim.scene.robot_poses[self.index]
 
+    @property
+    def world_info(self) -> wm.WorldInfo:
+        return self._sim.world.world_info
+
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
         setters); the next measurement sees it there. Translation and rotation are independent
