@@ -179,6 +179,16 @@ register(DeviceKind(
             TopicDecl("speed", msgs.FLOAT64, "speed"),
             TopicDecl("speed_vector", msgs.VECTOR3_STAMPED, "speed_vector")),
     description="GPSDescription"))
+register(DeviceKind(
+    "InertialUnit", wm.InertialUnit, _SIM + "InertialUnit",
+    services=(*_SENSOR, "get_roll_pitch_yaw", "get_quaternion", "get_noise"),
+    topics=(TopicDecl("quaternion", msgs.IMU, "quaternion"),),
+    description="InertialUnitDescription"))
+register(DeviceKind(
+    "Compass", wm.Compass, _SIM + "Compass",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.MAGNETIC_FIELD, "values"),),
+    description="CompassDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

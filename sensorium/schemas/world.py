@@ -388,6 +388,30 @@ class GPS(_Device):
     speed_resolution: float = Field(default=-1.0, description="m/s; -1 = infinite")
 
 
+class InertialUnit(_Device):
+    """Webots InertialUnit: the device's orientation (quaternion; roll, pitch, yaw in the world's
+    coordinate system's convention)."""
+
+    device: Literal["InertialUnit"]
+    noise: float = Field(default=0.0, ge=0.0, description="σ of each Gaussian angle, as a fraction of π")
+    resolution: float = -1.0
+    x_axis: bool = True
+    y_axis: bool = True
+    z_axis: bool = True
+
+
+class Compass(_Device):
+    """Webots Compass: the world's north (ENU: +y, NUE: +x) in the device frame, through the lookup
+    table per axis (empty table: the unit vector itself)."""
+
+    device: Literal["Compass"]
+    lookup_table: list[LookupRow] = Field(default=[], max_length=4096)
+    resolution: float = -1.0
+    x_axis: bool = True
+    y_axis: bool = True
+    z_axis: bool = True
+
+
 class RotationalMotor(_Device):
     """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
     motors *is* that motor, at this index of the device list (a drive motor without an entry comes
@@ -398,8 +422,8 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Accelerometer", "Altimeter", "Brake", "Camera", "Compass", "Connector", "Display", "Emitter", "Gyro",
-    "InertialUnit", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
+    "Accelerometer", "Altimeter", "Brake", "Camera", "Connector", "Display", "Emitter", "Gyro",
+    "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
     "Speaker", "TouchSensor", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -414,11 +438,12 @@ class UnsimulatedDevice(_Device):
     device: Literal[UNSIMULATED_DEVICE_TYPES]  # type: ignore[valid-type]
 
 
-Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | RotationalMotor
-                   | UnsimulatedDevice,
+Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
+                   | RotationalMotor | UnsimulatedDevice,
                    Field(discriminator="device")]
 
-DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "RotationalMotor",
+DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
+                "RotationalMotor",
                 *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 

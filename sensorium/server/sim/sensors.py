@@ -21,11 +21,12 @@ from sensorium.schemas.devices import kind
 from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import gps as gps_math
 from sensorium.server.devices import lidar as lmath
+from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import LookupTable
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.world.geometry import Pose
-from sensorium.server.world.poses import pose_from_model
+from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
 
 @dataclass(slots=True)
@@ -570,3 +571,75 @@ class GPS(Device):
         return {"coordinate_system": self.coordinate_system, "accuracy": float(c.accuracy),
                 "noise_correlation": float(c.noise_correlation), "resolution": float(c.resolution),
                 "speed_noise": float(c.speed_noise), "speed_resolution": float(c.speed_resolution)}
+
+
+class InertialUnit(Device):
+    """Webots InertialUnit (``server/devices/orientation.py``): the device's world orientation as a
+    quaternion and as roll, pitch, yaw in the world's convention (ENU or NUE); NaN before the first value."""
+
+    kinematic = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.quaternion = np.full(4, math.nan)
+        self.roll_pitch_yaw = np.full(3, math.nan)
+        self._robot: Any = None
+        self._axes = "ENU"
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._axes = robot.world_info.coordinate_system
+
+    def measure(self, now_ms: int) -> None:
+        c = self.config
+        q = matrix_quaternion(self.world_pose(self._robot.pose).rotation)
+        self.quaternion = orient.inertial_quaternion(
+            q, noise=c.noise, rng=self.rng if c.noise > 0.0 else None, x_axis=c.x_axis, y_axis=c.y_axis,
+            z_axis=c.z_axis, resolution=c.resolution)
+        self.roll_pitch_yaw = orient.roll_pitch_yaw(self.quaternion, self._axes)
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"quaternion": self.quaternion, "roll_pitch_yaw": self.roll_pitch_yaw}
+
+    def step_reading(self) -> dict:
+        return {"quaternion": [float(v) for v in self.quaternion],
+                "roll_pitch_yaw": [float(v) for v in self.roll_pitch_yaw]}
+
+    def describe(self) -> dict:
+        return {"noise": float(self.config.noise), "coordinate_system": self._axes}
+
+
+class Compass(Device):
+    """Webots Compass (``server/devices/orientation.py``): north in the device frame through the
+    lookup table; NaN before the first value and on a disabled axis."""
+
+    kinematic = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.table = LookupTable(self.config.lookup_table)
+        self.values = np.full(3, math.nan)
+        self._robot: Any = None
+        self._axes = "ENU"
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._axes = robot.world_info.coordinate_system
+
+    def measure(self, now_ms: int) -> None:
+        c = self.config
+        self.values = orient.compass_values(
+            self.world_pose(self._robot.pose).rotation, self._axes, self.table,
+            self.rng if self.table.has_noise else None, x_axis=c.x_axis, y_axis=c.y_axis, z_axis=c.z_axis,
+            resolution=c.resolution)
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"values": self.values}
+
+    def step_reading(self) -> dict:
+        return {"values": [float(v) for v in self.values]}
+
+    def describe(self) -> dict:
+        return {"lookup_table": self.flat_lookup_table()}
