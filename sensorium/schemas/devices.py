@@ -189,6 +189,21 @@ register(DeviceKind(
     services=(*_SENSOR, "get_values", "get_lookup_table"),
     topics=(TopicDecl("values", msgs.MAGNETIC_FIELD, "values"),),
     description="CompassDescription"))
+register(DeviceKind(
+    "Accelerometer", wm.Accelerometer, _SIM + "Accelerometer",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.VECTOR3_STAMPED, "values"),),
+    description="AccelerometerDescription"))
+register(DeviceKind(
+    "Gyro", wm.Gyro, _SIM + "Gyro",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.VECTOR3_STAMPED, "values"),),
+    description="GyroDescription"))
+register(DeviceKind(
+    "Altimeter", wm.Altimeter, _SIM + "Altimeter",
+    services=(*_SENSOR, "get_value"),
+    topics=(TopicDecl("value", msgs.FLOAT64, "value"),),
+    description="AltimeterDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

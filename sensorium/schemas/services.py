@@ -342,6 +342,25 @@ class CompassDescription(_Entry):
     lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
 
 
+class AccelerometerDescription(_Entry):
+    type: Literal["Accelerometer"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class GyroDescription(_Entry):
+    type: Literal["Gyro"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class AltimeterDescription(_Entry):
+    type: Literal["Altimeter"]
+    sampling_period: int
+    accuracy: float
+    resolution: float
+
+
 class LEDDescription(_Entry):
     type: Literal["LED"]
     value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
@@ -359,7 +378,8 @@ DeviceDescription = Annotated[
     | Annotated[LidarDescription, Tag("Lidar")] | Annotated[MotorDescription, Tag("RotationalMotor")]
     | Annotated[PositionSensorDescription, Tag("PositionSensor")] | Annotated[LEDDescription, Tag("LED")]
     | Annotated[GPSDescription, Tag("GPS")] | Annotated[InertialUnitDescription, Tag("InertialUnit")]
-    | Annotated[CompassDescription, Tag("Compass")]
+    | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]
+    | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or

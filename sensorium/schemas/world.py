@@ -412,6 +412,37 @@ class Compass(_Device):
     z_axis: bool = True
 
 
+class Accelerometer(_Device):
+    """Webots Accelerometer on a kinematic robot: the specific force (m/s²) in the device frame from
+    the motion's second difference and the world's gravity (README "What is simulated")."""
+
+    device: Literal["Accelerometer"]
+    lookup_table: list[LookupRow] = Field(default=[], max_length=4096)
+    resolution: float = -1.0
+    x_axis: bool = True
+    y_axis: bool = True
+    z_axis: bool = True
+
+
+class Gyro(_Device):
+    """Webots Gyro on a kinematic robot: the angular velocity (rad/s) in the device frame."""
+
+    device: Literal["Gyro"]
+    lookup_table: list[LookupRow] = Field(default=[], max_length=4096)
+    resolution: float = -1.0
+    x_axis: bool = True
+    y_axis: bool = True
+    z_axis: bool = True
+
+
+class Altimeter(_Device):
+    """Webots Altimeter: the device's height along the world's up axis (m)."""
+
+    device: Literal["Altimeter"]
+    accuracy: float = Field(default=0.0, ge=0.0, description="standard deviation (m) of Gaussian noise")
+    resolution: float = -1.0
+
+
 class RotationalMotor(_Device):
     """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
     motors *is* that motor, at this index of the device list (a drive motor without an entry comes
@@ -422,8 +453,7 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Accelerometer", "Altimeter", "Brake", "Camera", "Connector", "Display", "Emitter", "Gyro",
-    "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
+    "Brake", "Camera", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
     "Speaker", "TouchSensor", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -439,11 +469,11 @@ class UnsimulatedDevice(_Device):
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
-                   | RotationalMotor | UnsimulatedDevice,
+                   | Accelerometer | Gyro | Altimeter | RotationalMotor | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
-                "RotationalMotor",
+                "Accelerometer", "Gyro", "Altimeter", "RotationalMotor",
                 *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
@@ -501,6 +531,7 @@ class WorldInfo(Strict):
     coordinate_system: Literal["ENU", "NUE"] = Field(
         default="ENU", description="world axes: ENU = x east, y north, z up; NUE = x north, y up, z east. "
         "Only the up axis matters here: differential drives move in the plane normal to it")
+    gravity: float = Field(default=9.81, ge=0.0, le=1000.0, description="m/s², what an accelerometer at rest reads")
     gps_coordinate_system: Literal["local", "WGS84"] = Field(
         default="local", description="what a GPS reads: local coordinates (m) or WGS84 latitude, longitude (degrees), "
         "altitude (m)")

@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from sensorium.server.devices.lookup import LookupTable, quantize_sensor
+from sensorium.server.devices.motion_sensors import axes_through_table
 
 __all__ = ["compass_values", "inertial_quaternion", "north_vector", "quaternion_multiply", "roll_pitch_yaw"]
 
@@ -106,9 +107,4 @@ def compass_values(rotation: np.ndarray, axes: str, table: LookupTable, rng: np.
     """``wb_compass_get_values``: north in the device frame, through the lookup table per axis."""
     local = np.asarray(rotation, dtype=np.float64).T @ north_vector(axes)
     local /= math.sqrt(float(local @ local))
-    out = np.full(3, math.nan)
-    for i, on in enumerate((x_axis, y_axis, z_axis)):
-        if on:
-            v = float(table.lookup(np.array([local[i]]), rng)[0])
-            out[i] = v if resolution == -1.0 else float(quantize_sensor(v, resolution))
-    return out
+    return axes_through_table(local, table, rng, (x_axis, y_axis, z_axis), resolution)

@@ -122,6 +122,10 @@ class RobotState:
     def world_info(self) -> wm.WorldInfo:
         return self._sim.world.world_info
 
+    @property
+    def basic_time_step(self) -> int:
+        return self._sim.basic_time_step
+
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
         setters); the next measurement sees it there. Translation and rotation are independent
@@ -181,6 +185,7 @@ class Simulation:
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._counters: Counter[str] = Counter()
         self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[Device]] | None = None
+        self._tracking: list[Device] = []
         self._distance_plans: dict[tuple[int, ...], DistancePlan] = {}   # by the due sensors (see _distance_plan)
         self._joined_mounts: dict[tuple, tuple[list, Mount]] = {}        # see _joined_mount
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
@@ -318,7 +323,11 @@ class Simulation:
                              [d for d in every if isinstance(d, DistanceSensor)],
                              [d for d in every if isinstance(d, Lidar)],
                              [d for d in every if d.kinematic])
+            self._tracking = [d for d in every if d.tracks_motion]
         all_lights, all_distances, all_lidars, all_kinematic = self._by_kind
+        for dev in self._tracking:    # devices that read the motion keep its last poses while enabled
+            if dev.enabled:
+                dev.track()           # type: ignore[attr-defined]
         # Schedule.due inlined (a step of 1,000 robots asks 8,000 sensors)
         lights: list[LightSensor] = [d for d in all_lights if (s := d.schedule).period_ms > 0
                                      and now - s.last_update_ms >= s.period_ms]
