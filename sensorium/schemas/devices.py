@@ -204,6 +204,12 @@ register(DeviceKind(
     services=(*_SENSOR, "get_value"),
     topics=(TopicDecl("value", msgs.FLOAT64, "value"),),
     description="AltimeterDescription"))
+register(DeviceKind(
+    "TouchSensor", wm.TouchSensor, _SIM + "TouchSensor",
+    services=(*_SENSOR, "get_value", "get_values", "get_type", "get_lookup_table"),
+    topics=(TopicDecl("value", msgs.FLOAT64, "value", exists=lambda cfg, wi: cfg.type != "force-3d"),
+            TopicDecl("values", msgs.VECTOR3_STAMPED, "values", exists=lambda cfg, wi: cfg.type == "force-3d")),
+    description="TouchSensorDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

@@ -361,6 +361,13 @@ class AltimeterDescription(_Entry):
     resolution: float
 
 
+class TouchSensorDescription(_Entry):
+    type: Literal["TouchSensor"]
+    sampling_period: int
+    sensor_type: int = Field(description="get_type: 0 bumper, 1 force, 2 force-3d")
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
 class LEDDescription(_Entry):
     type: Literal["LED"]
     value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
@@ -380,6 +387,7 @@ DeviceDescription = Annotated[
     | Annotated[GPSDescription, Tag("GPS")] | Annotated[InertialUnitDescription, Tag("InertialUnit")]
     | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]
     | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
+    | Annotated[TouchSensorDescription, Tag("TouchSensor")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or

@@ -443,6 +443,17 @@ class Altimeter(_Device):
     resolution: float = -1.0
 
 
+class TouchSensor(_Device):
+    """Webots TouchSensor. ``bumper``: 1 while the robot's body pushes against a solid or another
+    robot (kinematic contact clipped its motion in the last basic step), else 0. ``force`` and
+    ``force-3d`` need physics: they read NaN (Webots' "no value"), said once when the world loads."""
+
+    device: Literal["TouchSensor"]
+    type: Literal["bumper", "force", "force-3d"] = "bumper"
+    lookup_table: list[LookupRow] = Field(default=[(0.0, 0.0, 0.0), (5000.0, 50000.0, 0.0)], max_length=4096)
+    resolution: float = -1.0
+
+
 class RotationalMotor(_Device):
     """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
     motors *is* that motor, at this index of the device list (a drive motor without an entry comes
@@ -454,7 +465,7 @@ class RotationalMotor(_Device):
 
 UNSIMULATED_DEVICE_TYPES = (
     "Brake", "Camera", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
-    "Speaker", "TouchSensor", "VacuumGripper",
+    "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
 
@@ -469,11 +480,11 @@ class UnsimulatedDevice(_Device):
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
-                   | Accelerometer | Gyro | Altimeter | RotationalMotor | UnsimulatedDevice,
+                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
-                "Accelerometer", "Gyro", "Altimeter", "RotationalMotor",
+                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor",
                 *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 

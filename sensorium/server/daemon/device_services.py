@@ -129,7 +129,7 @@ class DeviceServices:
     def _dev_get_aperture(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.config.aperture)}
 
-    def _dev_get_type(self, c: Call) -> dict:
+    def _dev_get_type(self, c: Call) -> dict:  # DistanceSensor and TouchSensor: their type code
         return {"value": int(c.ctl.device.type_code)}
 
     def _dev_get_info(self, c: Call) -> dict:

@@ -758,3 +758,38 @@ class Altimeter(Device):
 
     def describe(self) -> dict:
         return {"accuracy": float(self.config.accuracy), "resolution": float(self.config.resolution)}
+
+
+class TouchSensor(Device):
+    """Webots TouchSensor: a bumper reads 1 while its robot pushes against something (kinematic
+    contact), else 0; ``force`` and ``force-3d`` read NaN (they need physics)."""
+
+    kinematic = True
+    TYPE_CODES: ClassVar[dict[str, int]] = {"bumper": 0, "force": 1, "force-3d": 2}
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.table = LookupTable(self.config.lookup_table)
+        self.type_code = self.TYPE_CODES[self.config.type]
+        self.value = math.nan
+        self.values = np.full(3, math.nan)
+        self._robot: Any = None
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+
+    def measure(self, now_ms: int) -> None:
+        if self.type_code == 0:
+            self.value = 1.0 if self._robot.pressing else 0.0
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"value": self.value, "values": self.values}
+
+    def step_reading(self) -> dict:
+        if self.type_code == 2:
+            return {"values": [float(v) for v in self.values]}
+        return {"value": float(self.value)}
+
+    def describe(self) -> dict:
+        return {"sensor_type": self.type_code, "lookup_table": self.flat_lookup_table()}

@@ -111,6 +111,7 @@ class RobotState:
         for dev in self.devices.values():
             dev.bind(self)
         self.device_list = device_entries(model, self.devices, self.motors)
+        self.pressing = False         # kinematic contact clipped the drive's motion in the last step
         self.custom_data = model.custom_data
         self.supervisor = model.supervisor
 
@@ -302,6 +303,7 @@ class Simulation:
         for robot in self._driven:
             drive = robot.drive
             assert drive is not None
+            robot.pressing = False
             start = (drive.x, drive.y)
             pose = drive.step(dt)
             if pose is not None:
@@ -312,6 +314,7 @@ class Simulation:
             for k, (end, clipped) in enumerate(ends):
                 if clipped:
                     robot, drive, start, _ = moved[k]
+                    robot.pressing = True
                     drive.x, drive.y = float(end[0]), float(end[1])
                     moved[k] = (robot, drive, start, drive.pose())
         for robot, _, _, pose in moved:
