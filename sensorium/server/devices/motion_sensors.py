@@ -54,9 +54,16 @@ def specific_force(rotation: np.ndarray, p0, p1, p2, dt_s: float, gravity: float
 
 def axes_through_table(values: np.ndarray, table: LookupTable, rng: np.random.Generator | None,
                        enabled: tuple[bool, bool, bool], resolution: float) -> np.ndarray:
+    """Each enabled axis through the lookup table (one call: its noise drawn in axis order; an
+    empty table is the identity), then ``resolution``; a disabled axis is NaN."""
     out = np.full(3, math.nan)
-    for i, on in enumerate(enabled):
-        if on:
-            v = float(table.lookup(np.array([values[i]]), rng)[0])
-            out[i] = v if resolution == -1.0 else float(quantize_sensor(v, resolution))
+    on = [i for i in range(3) if enabled[i]]
+    if not on:
+        return out
+    v = np.asarray(values, dtype=np.float64)[on]
+    if len(table):
+        v = np.asarray(table.lookup(v, rng), dtype=np.float64)
+    if resolution != -1.0:
+        v = np.asarray(quantize_sensor(v, resolution), dtype=np.float64)
+    out[on] = v
     return out
