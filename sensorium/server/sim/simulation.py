@@ -37,7 +37,7 @@ from sensorium.server.sim.sensors import (
     device_class,
 )
 from sensorium.server.world.geometry import Pose
-from sensorium.server.world.limits import WorldLimits
+from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
 
@@ -130,7 +130,9 @@ class RobotState:
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
         setters); the next measurement sees it there. Translation and rotation are independent
-        (Webots): leave one out (``None``) and it keeps its current value."""
+        (Webots): leave one out (``None``) and it keeps its current value. Non-finite values or a
+        translation beyond ``limits.MAX_COORDINATE_M`` raise ValueError and the robot stays."""
+        check_pose(translation, rotation, quaternion)
         current = self.pose
         if translation is None:
             translation = current.translation
