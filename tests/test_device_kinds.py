@@ -80,7 +80,7 @@ def test_client_node_types_are_webots_names():
 # ---------------------------------------------------------------------- a kind registered here
 
 class ToyAltimeter(Device):
-    """A toy: reads the robot's height (z) from the kinematic world, no rays."""
+    """A toy kind on a listed-only node type: reads the robot's height (z), no rays."""
 
     kinematic = True
 
@@ -97,7 +97,7 @@ class ToyAltimeter(Device):
         self._mark(now_ms)
 
 
-TOY = D.DeviceKind("Altimeter", wm.UnsimulatedDevice, f"{__name__}:ToyAltimeter",
+TOY = D.DeviceKind("Speaker", wm.UnsimulatedDevice, f"{__name__}:ToyAltimeter",
                    services=("enable", "get_sampling_period", "get_value"),
                    topics=(D.TopicDecl("value", msgs.ILLUMINANCE),))
 
@@ -105,7 +105,7 @@ WORLD = {
     "world_info": {"basic_time_step": 16},
     "robots": [{"name": "bot", "pose": {"translation": [0.0, 0.0, 0.25]},
                 "devices": [{"device": "Radar", "name": "radar", "model": "u-blox"},
-                            {"device": "Altimeter", "name": "alt", "model": "toy 1"},
+                            {"device": "Speaker", "name": "alt", "model": "toy 1"},
                             {"device": "LightSensor", "name": "ls"}]}],
 }
 
@@ -119,7 +119,7 @@ def call(core, service, args=None):
 
 
 def test_a_registered_kind_gets_routing_topics_and_its_place(monkeypatch):
-    monkeypatch.setitem(D.KINDS, "Altimeter", TOY)
+    monkeypatch.setitem(D.KINDS, "Speaker", TOY)
     sim = Simulation(wm.World.model_validate(WORLD))
     core = Core(sim)
     assert {"/bot/alt/enable", "/bot/alt/get_sampling_period", "/bot/alt/get_value"} <= set(core.routes)
@@ -128,7 +128,7 @@ def test_a_registered_kind_gets_routing_topics_and_its_place(monkeypatch):
     info = call(core, "get_info")["result"]
     assert info["robots"][0]["devices"] == [
         {"name": "radar", "type": "Radar", "model": "u-blox", "index": 0, "simulated": False},
-        {"name": "alt", "type": "Altimeter", "model": "toy 1", "index": 1, "simulated": True},
+        {"name": "alt", "type": "Speaker", "model": "toy 1", "index": 1, "simulated": True},
         {"name": "ls", "type": "LightSensor", "model": "", "index": 2, "simulated": True}]
     attached = call(core, "attach", {"robot": "bot"})["result"]
     assert [(d["name"], d["index"], d["simulated"]) for d in attached["devices"]] == [

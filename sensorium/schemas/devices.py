@@ -179,6 +179,37 @@ register(DeviceKind(
             TopicDecl("speed", msgs.FLOAT64, "speed"),
             TopicDecl("speed_vector", msgs.VECTOR3_STAMPED, "speed_vector")),
     description="GPSDescription"))
+register(DeviceKind(
+    "InertialUnit", wm.InertialUnit, _SIM + "InertialUnit",
+    services=(*_SENSOR, "get_roll_pitch_yaw", "get_quaternion", "get_noise"),
+    topics=(TopicDecl("quaternion", msgs.IMU, "quaternion"),),
+    description="InertialUnitDescription"))
+register(DeviceKind(
+    "Compass", wm.Compass, _SIM + "Compass",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.MAGNETIC_FIELD, "values"),),
+    description="CompassDescription"))
+register(DeviceKind(
+    "Accelerometer", wm.Accelerometer, _SIM + "Accelerometer",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.VECTOR3_STAMPED, "values"),),
+    description="AccelerometerDescription"))
+register(DeviceKind(
+    "Gyro", wm.Gyro, _SIM + "Gyro",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.VECTOR3_STAMPED, "values"),),
+    description="GyroDescription"))
+register(DeviceKind(
+    "Altimeter", wm.Altimeter, _SIM + "Altimeter",
+    services=(*_SENSOR, "get_value"),
+    topics=(TopicDecl("value", msgs.FLOAT64, "value"),),
+    description="AltimeterDescription"))
+register(DeviceKind(
+    "TouchSensor", wm.TouchSensor, _SIM + "TouchSensor",
+    services=(*_SENSOR, "get_value", "get_values", "get_type", "get_lookup_table"),
+    topics=(TopicDecl("value", msgs.FLOAT64, "value", exists=lambda cfg, wi: cfg.type != "force-3d"),
+            TopicDecl("values", msgs.VECTOR3_STAMPED, "values", exists=lambda cfg, wi: cfg.type == "force-3d")),
+    description="TouchSensorDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

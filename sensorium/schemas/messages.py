@@ -200,6 +200,28 @@ class NavSatFix(Msg):
     position_covariance_type: int = Field(ge=0, le=3)
 
 
+class Imu(Msg):
+    """``sensor_msgs/msg/Imu`` for an InertialUnit: the orientation only; the angular velocity and
+    linear acceleration covariances start with -1 (REP 145: not provided)."""
+
+    header: Header
+    orientation: Quaternion
+    orientation_covariance: bytes = Field(description="<f8[9], row-major, rad²")
+    angular_velocity: Vector3
+    angular_velocity_covariance: bytes = Field(description="<f8[9]")
+    linear_acceleration: Vector3
+    linear_acceleration_covariance: bytes = Field(description="<f8[9]")
+
+
+class MagneticField(Msg):
+    """``sensor_msgs/msg/MagneticField`` for a Compass: its values (the lookup-table output of
+    north in the device frame, not Tesla), covariance 0."""
+
+    header: Header
+    magnetic_field: Vector3
+    magnetic_field_covariance: bytes = Field(description="<f8[9]")
+
+
 class Float64(Msg):
     """``std_msgs/msg/Float64``: a GPS speed (m/s); its time is the envelope's ``stamp_ns``."""
 
@@ -227,6 +249,8 @@ POINT_STAMPED = "geometry_msgs/msg/PointStamped"
 VECTOR3_STAMPED = "geometry_msgs/msg/Vector3Stamped"
 NAV_SAT_FIX = "sensor_msgs/msg/NavSatFix"
 FLOAT64 = "std_msgs/msg/Float64"
+IMU = "sensor_msgs/msg/Imu"
+MAGNETIC_FIELD = "sensor_msgs/msg/MagneticField"
 
 MESSAGE_TYPES: dict[str, type[Msg]] = {
     ILLUMINANCE: Illuminance,
@@ -242,6 +266,8 @@ MESSAGE_TYPES: dict[str, type[Msg]] = {
     VECTOR3_STAMPED: Vector3Stamped,
     NAV_SAT_FIX: NavSatFix,
     FLOAT64: Float64,
+    IMU: Imu,
+    MAGNETIC_FIELD: MagneticField,
 }
 """ROS type name → model, for every topic the server publishes."""
 

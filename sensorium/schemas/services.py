@@ -329,6 +329,45 @@ class GPSDescription(_Entry):
     speed_resolution: float
 
 
+class InertialUnitDescription(_Entry):
+    type: Literal["InertialUnit"]
+    sampling_period: int
+    noise: float = Field(description="wb_inertial_unit_get_noise")
+    coordinate_system: str = Field(description="ENU or NUE: the roll/pitch/yaw convention")
+
+
+class CompassDescription(_Entry):
+    type: Literal["Compass"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class AccelerometerDescription(_Entry):
+    type: Literal["Accelerometer"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class GyroDescription(_Entry):
+    type: Literal["Gyro"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class AltimeterDescription(_Entry):
+    type: Literal["Altimeter"]
+    sampling_period: int
+    accuracy: float
+    resolution: float
+
+
+class TouchSensorDescription(_Entry):
+    type: Literal["TouchSensor"]
+    sampling_period: int
+    sensor_type: int = Field(description="get_type: 0 bumper, 1 force, 2 force-3d")
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
 class LEDDescription(_Entry):
     type: Literal["LED"]
     value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
@@ -345,7 +384,10 @@ DeviceDescription = Annotated[
     Annotated[LightSensorDescription, Tag("LightSensor")] | Annotated[DistanceSensorDescription, Tag("DistanceSensor")]
     | Annotated[LidarDescription, Tag("Lidar")] | Annotated[MotorDescription, Tag("RotationalMotor")]
     | Annotated[PositionSensorDescription, Tag("PositionSensor")] | Annotated[LEDDescription, Tag("LED")]
-    | Annotated[GPSDescription, Tag("GPS")]
+    | Annotated[GPSDescription, Tag("GPS")] | Annotated[InertialUnitDescription, Tag("InertialUnit")]
+    | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]
+    | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
+    | Annotated[TouchSensorDescription, Tag("TouchSensor")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -587,6 +629,9 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_speed", "device", NoArgs, FloatValue),
     ServiceSpec("get_speed_vector", "device", NoArgs, FloatArrayValue),
     ServiceSpec("get_coordinate_system", "device", NoArgs, IntValue),
+    ServiceSpec("get_roll_pitch_yaw", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_quaternion", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_noise", "device", NoArgs, FloatValue),
 )
 
 

@@ -489,6 +489,23 @@ class Topics:
                 "altitude": alt, "position_covariance": cov.astype("<f8").tobytes(),
                 "position_covariance_type": 2 if sigma > 0 else 0}
 
+    def _imu(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        x, y, z, w = (float(v) for v in getattr(ctl.device, reading))
+        sigma = float(ctl.device.config.noise) * math.pi
+        unknown = np.zeros(9)
+        unknown[0] = -1.0                                     # REP 145: not provided
+        return {"header": hdr, "orientation": {"x": x, "y": y, "z": z, "w": w},
+                "orientation_covariance": (np.eye(3) * sigma * sigma).astype("<f8").tobytes(),
+                "angular_velocity": {"x": 0.0, "y": 0.0, "z": 0.0},
+                "angular_velocity_covariance": unknown.astype("<f8").tobytes(),
+                "linear_acceleration": {"x": 0.0, "y": 0.0, "z": 0.0},
+                "linear_acceleration_covariance": unknown.astype("<f8").tobytes()}
+
+    def _magnetic_field(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        x, y, z = (float(v) for v in getattr(ctl.device, reading))
+        return {"header": hdr, "magnetic_field": {"x": x, "y": y, "z": z},
+                "magnetic_field_covariance": bytes(72)}
+
     # ------------------------------------------------------------------ step-reply readings
     def reading(self, ctl: Control) -> dict:
         """The device's latest reading for a step reply (PROTOCOL §3.6)."""
@@ -512,5 +529,7 @@ MESSAGE_BUILDERS: dict[str, Callable[[Topics, Control, dict, str], dict | None]]
     msgs.VECTOR3_STAMPED: Topics._vector3_stamped,
     msgs.FLOAT64: Topics._float64,
     msgs.NAV_SAT_FIX: Topics._nav_sat_fix,
+    msgs.IMU: Topics._imu,
+    msgs.MAGNETIC_FIELD: Topics._magnetic_field,
 }
 """Message type -> the builder of a device topic's body (a device kind's topics name their types)."""

@@ -498,6 +498,8 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
             if res <= 0 and res != -1:
                 upd[name] = -1.0
                 warnings.append(f"{p}.{name}: {res} <= 0, reset to -1 (off)")
+        if isinstance(dev, wm.TouchSensor) and dev.type != "bumper":
+            warnings.append(f"{p}.type: a {dev.type} TouchSensor needs physics; it reads NaN (Webots' no value)")
         if isinstance(dev, wm.DistanceSensor):
             if dev.type == "infrared":
                 upd["type"] = "infra-red"
