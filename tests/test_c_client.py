@@ -601,3 +601,11 @@ def test_every_device_kind_is_present_and_unsimulated_ones_answer_no_value(cbin,
     assert got["joystick"] == ["0 mouse 1"]
     assert got["wait"] == ["0 112"]      # WB_EVENT_NO_EVENT after 100 ms rounded up to whole 16 ms steps
     assert got["infinity"] == ["1"]
+
+
+def test_every_device_is_present_in_the_python_controller_classes(servers):
+    server = servers(REPO / "tests" / "worlds" / "every_device.yaml", "--mode", "fast")
+    out = run([sys.executable, "-m", "sensorium", "controller", "--url", server.url("bot"),
+               str(REPO / "tests" / "controllers" / "every_device.py")])
+    assert out == ["device 0 radar u-blox", "device 1 gps -", "device 2 camera -", "device 3 speaker -",
+                   "found radar gps camera speaker", "wait 0 96"]
