@@ -571,12 +571,14 @@ bool sn_unsimulated(WbDeviceTag tag, int node_type, const char *func) {
     fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
     return false;
   }
-  if (d->simulated)
-    return true;
   if (!d->warned_unsimulated) {
     d->warned_unsimulated = true;
-    fprintf(stderr, "Warning: %s(): Sensorium does not simulate %s '%s': its functions answer Webots' \"no value\" "
-            "(NaN, NULL, 0).\n", func, d->type_name, d->name);
+    if (d->simulated) /* the server measures it; this library does not read those readings yet */
+      fprintf(stderr, "Warning: %s(): the C client does not read %s '%s' yet (its services and topics do): its functions "
+              "answer Webots' \"no value\" (NaN, NULL, 0).\n", func, d->type_name, d->name);
+    else
+      fprintf(stderr, "Warning: %s(): Sensorium does not simulate %s '%s': its functions answer Webots' \"no value\" "
+              "(NaN, NULL, 0).\n", func, d->type_name, d->name);
   }
   return false;
 }
