@@ -51,6 +51,7 @@ class FakeDevice:
     # the real classes' descriptions (they read only the attributes the fakes have too)
     flat_lookup_table = sensors.Device.flat_lookup_table
     describe = sensors.Device.describe
+    step_reading = sensors.Device.step_reading
 
     def enable(self, period):
         if isinstance(period, bool) or not isinstance(period, int) or period < 0:

@@ -32,7 +32,7 @@ ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
 CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
-               "wire_vectors"]
+               "wire_vectors", "every_device"]
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -578,3 +578,34 @@ def test_a_curve_server_serves_a_c_controller_that_has_its_key(cbin, servers, tm
     code, lines, err = finish(start([cbin["script"], "step", "32", "1"], server.url("epuck"),
                                     SENSORIUM_CURVE_SERVERKEY="not-a-key"))
     assert code == 1 and len(err.strip().splitlines()) == 1 and "CURVE key" in err, err
+
+
+def test_every_device_kind_is_present_and_unsimulated_ones_answer_no_value(cbin, servers):
+    from sensorium.schemas.devices import WEBOTS_NODE_TYPES as N
+    server = servers(REPO / "tests" / "worlds" / "every_device.yaml", "--mode", "fast")
+    code, out, err = finish(start([cbin["every_device"]], server.url("bot")))
+    assert code == 0, err
+    got = {}
+    for line in out:
+        key, rest = line.split(" ", 1)
+        got.setdefault(key, []).append(rest)
+    # Webots' tree order, Webots' node type values, the world's model
+    assert got["device"] == [f"0 radar {N['WB_NODE_RADAR']} u-blox", f"1 gps {N['WB_NODE_GPS']} ",
+                             f"2 camera {N['WB_NODE_CAMERA']} ", f"3 speaker {N['WB_NODE_SPEAKER']} "]
+    assert got["radar"] == ["0 1 1"] and got["camera"] == ["1 0"]
+    # one warning line per unsimulated device, however many calls
+    warnings = [line for line in err.splitlines() if "does not simulate" in line]
+    assert len(warnings) == 2 and any("Radar 'radar'" in w for w in warnings) and any("Camera 'camera'" in w for w in warnings)
+    x, y, z, cs = got["gps"][0].split()
+    assert (float(x), float(y), float(z), cs) == (0.5, -0.25, 0.0, "0")      # the robot's pose, local coordinates
+    assert got["joystick"] == ["0 mouse 1"]
+    assert got["wait"] == ["0 112"]      # WB_EVENT_NO_EVENT after 100 ms rounded up to whole 16 ms steps
+    assert got["infinity"] == ["1"]
+
+
+def test_every_device_is_present_in_the_python_controller_classes(servers):
+    server = servers(REPO / "tests" / "worlds" / "every_device.yaml", "--mode", "fast")
+    out = run([sys.executable, "-m", "sensorium", "controller", "--url", server.url("bot"),
+               str(REPO / "tests" / "controllers" / "every_device.py")])
+    assert out == ["device 0 radar u-blox", "device 1 gps -", "device 2 camera -", "device 3 speaker -",
+                   "found radar gps camera speaker", "wait 0 96"]

@@ -168,7 +168,7 @@ def test_services_lists_every_service_with_arguments(arena):
     by_name = {s["name"]: s for s in json.loads(res.stdout)["services"]}
     assert by_name["/epuck/ps0/enable"] == {"name": "/epuck/ps0/enable", "scope": "device", "robot": "epuck",
                                             "device": "ps0", "device_type": "DistanceSensor", "attached": True,
-                                            "supervisor": False, "args": {"value": "int"}}
+                                            "supervisor": False, "simulated": True, "args": {"value": "int"}}
     assert by_name["set_mode"]["args"] == {"mode": "fast|realtime|pause"}
     assert by_name["/scout/left wheel motor/set_velocity"]["device_type"] == "RotationalMotor"
     assert by_name["/epuck/robot/step"]["args"]["duration"] == "int?"

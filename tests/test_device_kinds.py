@@ -68,18 +68,19 @@ def test_webots_node_types():
         D.register(D.DeviceKind("GPS", None))
 
 
-def test_client_node_types_name_every_kind():
-    # the C header names a WB_NODE_* constant for every kind the server simulates
+def test_client_node_types_are_webots_names():
+    # every WB_NODE_* the C header names is one of Webots' (no typo); the first kinds are all there
     header = (Path(__file__).parents[1] / "sensorium/client/c/include/webots/nodes.h").read_text()
     names = set(re.findall(r"\b(WB_NODE_[A-Z0-9_]+)\b", header))
-    for k in SIMULATED:
-        assert k.node_name in names, k.node_name
+    assert names <= set(D.WEBOTS_NODE_TYPES) | {"WB_NODE_KEYBOARD"}, names - set(D.WEBOTS_NODE_TYPES)
+    for t in ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "RotationalMotor"):
+        assert D.KINDS[t].node_name in names
 
 
 # ---------------------------------------------------------------------- a kind registered here
 
 class ToyAltimeter(Device):
-    """A toy: reads the robot's height (z) from the kinematic world, no rays."""
+    """A toy kind on a listed-only node type: reads the robot's height (z), no rays."""
 
     kinematic = True
 
@@ -96,15 +97,15 @@ class ToyAltimeter(Device):
         self._mark(now_ms)
 
 
-TOY = D.DeviceKind("Altimeter", wm.UnsimulatedDevice, f"{__name__}:ToyAltimeter",
+TOY = D.DeviceKind("Speaker", wm.UnsimulatedDevice, f"{__name__}:ToyAltimeter",
                    services=("enable", "get_sampling_period", "get_value"),
                    topics=(D.TopicDecl("value", msgs.ILLUMINANCE),))
 
 WORLD = {
     "world_info": {"basic_time_step": 16},
     "robots": [{"name": "bot", "pose": {"translation": [0.0, 0.0, 0.25]},
-                "devices": [{"device": "GPS", "name": "gps", "model": "u-blox"},
-                            {"device": "Altimeter", "name": "alt", "model": "toy 1"},
+                "devices": [{"device": "Radar", "name": "radar", "model": "u-blox"},
+                            {"device": "Speaker", "name": "alt", "model": "toy 1"},
                             {"device": "LightSensor", "name": "ls"}]}],
 }
 
@@ -118,20 +119,20 @@ def call(core, service, args=None):
 
 
 def test_a_registered_kind_gets_routing_topics_and_its_place(monkeypatch):
-    monkeypatch.setitem(D.KINDS, "Altimeter", TOY)
+    monkeypatch.setitem(D.KINDS, "Speaker", TOY)
     sim = Simulation(wm.World.model_validate(WORLD))
     core = Core(sim)
     assert {"/bot/alt/enable", "/bot/alt/get_sampling_period", "/bot/alt/get_value"} <= set(core.routes)
     assert "/bot/alt/value" in core.topics.by_name
-    assert not any(r.startswith("/bot/gps/") for r in core.routes)          # listed, not simulated
+    assert not any(r.startswith("/bot/radar/") for r in core.routes)        # listed, not simulated
     info = call(core, "get_info")["result"]
     assert info["robots"][0]["devices"] == [
-        {"name": "gps", "type": "GPS", "model": "u-blox", "index": 0, "simulated": False},
-        {"name": "alt", "type": "Altimeter", "model": "toy 1", "index": 1, "simulated": True},
+        {"name": "radar", "type": "Radar", "model": "u-blox", "index": 0, "simulated": False},
+        {"name": "alt", "type": "Speaker", "model": "toy 1", "index": 1, "simulated": True},
         {"name": "ls", "type": "LightSensor", "model": "", "index": 2, "simulated": True}]
     attached = call(core, "attach", {"robot": "bot"})["result"]
     assert [(d["name"], d["index"], d["simulated"]) for d in attached["devices"]] == [
-        ("gps", 0, False), ("alt", 1, True), ("ls", 2, True)]
+        ("radar", 0, False), ("alt", 1, True), ("ls", 2, True)]
     # (the toy has no description model: a real kind adds one)
     described = TypeAdapter(S.DeviceDescription)
     assert isinstance(described.validate_python(attached["devices"][0]), S.UnsimulatedDescription)
@@ -142,7 +143,7 @@ def test_a_registered_kind_gets_routing_topics_and_its_place(monkeypatch):
         sim.step()
     assert call(core, "/bot/alt/get_value")["result"]["value"] == 0.25
     listed = {s["name"]: s for s in call(core, "get_services")["result"]["services"]}
-    assert listed["/bot/gps/*"]["simulated"] is False and listed["/bot/alt/get_value"]["simulated"] is True
+    assert listed["/bot/radar/*"]["simulated"] is False and listed["/bot/alt/get_value"]["simulated"] is True
 
 
 def test_limits_follow_the_declared_rays():

@@ -36,6 +36,33 @@ def test_set_mode_needs_the_supervisor_role_when_controls_are_closed():
     lv.err(A, "set_mode", {"mode": "fast"}, ErrorCode.NOT_SUPERVISOR)   # the role goes with the session
 
 
+def test_set_pose_and_counters_need_the_supervisor_role_when_controls_are_closed():
+    """issue 28: under --controls supervisor any client moved robots and read get_counters."""
+    lv = closed()
+    before = lv.ok(C, "/rover/robot/get_pose")
+    for peer in (B, C):              # the rover's own controller, an unattached caller
+        msg = lv.err(peer, "/rover/robot/set_pose", {"translation": [1.0, 2.0, 0.0]}, ErrorCode.NOT_SUPERVISOR)
+        assert "supervisor: true" in msg
+        lv.err(peer, "get_counters", {}, ErrorCode.NOT_SUPERVISOR)
+    assert lv.ok(C, "/rover/robot/get_pose") == before             # nobody moved it
+    assert lv.ok(A, "/rover/robot/set_pose", {"translation": [1.0, 2.0, 0.0]}) == {"success": True}
+    assert lv.ok(C, "/rover/robot/get_pose")["translation"] == [1.0, 2.0, 0.0]
+    assert "counters" in lv.ok(A, "get_counters")
+    lv.ok(C, "get_info")                                           # reading the world stays open
+
+
+@pytest.mark.parametrize("translation", [[1e300, 0.0, 0.0], [0.0, math.nan, 0.0], [0.0, 0.0, -2 * MAX_COORDINATE_M]])
+def test_in_process_set_pose_rejects_absurd_poses(translation):
+    lv = Live()
+    robot = lv.sim.robots["rover"]
+    before = robot.pose.translation.copy()
+    with pytest.raises(ValueError, match="translation"):
+        robot.set_pose(translation)
+    assert (robot.pose.translation == before).all()
+    with pytest.raises(ValueError, match="rotation"):
+        robot.set_pose(None, rotation=[0.0, 0.0, 1.0, math.inf])
+
+
 def test_open_controls_let_any_caller_set_the_mode():
     lv = Live()                                     # Core's default: open
     assert lv.ok(C, "set_mode", {"mode": "pause"}) == {"mode": "pause"}
@@ -76,14 +103,14 @@ def test_serve_options_choose_the_controls():
 def test_set_pose_rejects_non_finite_and_far_poses(args):
     lv = closed()
     before = lv.ok(B, "/rover/robot/get_pose")
-    msg = lv.err(B, "/rover/robot/set_pose", args, ErrorCode.INVALID_ARGUMENT)
+    msg = lv.err(A, "/rover/robot/set_pose", args, ErrorCode.INVALID_ARGUMENT)   # the supervisor moves it
     assert "set_pose" in msg
     assert lv.ok(B, "/rover/robot/get_pose") == before
 
 
 def test_set_pose_accepts_the_bounds():
     lv = closed()
-    lv.ok(B, "/rover/robot/set_pose", {"translation": [MAX_COORDINATE_M, -MAX_COORDINATE_M, 0.1]})
+    lv.ok(A, "/rover/robot/set_pose", {"translation": [MAX_COORDINATE_M, -MAX_COORDINATE_M, 0.1]})
     assert lv.ok(B, "/rover/robot/get_pose")["translation"] == [MAX_COORDINATE_M, -MAX_COORDINATE_M, 0.1]
 
 

@@ -38,7 +38,10 @@ def test_documents_cover_every_type():
     msgs = docs["messages.schema.json"]
     assert set(msgs["x-ros-types"]) == {"sensor_msgs/msg/Illuminance", "sensor_msgs/msg/Range", "sensor_msgs/msg/Image",
                                         "sensor_msgs/msg/LaserScan", "sensor_msgs/msg/PointCloud", "rosgraph_msgs/msg/Clock",
-                                        "geometry_msgs/msg/PoseStamped", "sensor_msgs/msg/JointState", "std_msgs/msg/ColorRGBA"}
+                                        "geometry_msgs/msg/PoseStamped", "sensor_msgs/msg/JointState", "std_msgs/msg/ColorRGBA",
+                                        "geometry_msgs/msg/PointStamped", "geometry_msgs/msg/Vector3Stamped",
+                                        "sensor_msgs/msg/NavSatFix", "std_msgs/msg/Float64", "sensor_msgs/msg/Imu",
+                                        "sensor_msgs/msg/MagneticField"}
     for ref in msgs["x-ros-types"].values():
         assert ref.split("/")[-1] in msgs["$defs"]
     svc = docs["services.schema.json"]

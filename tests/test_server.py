@@ -265,7 +265,8 @@ def test_motors_over_the_wire_match_the_in_process_simulation(client):
     res = c.attach("rover")
     assert res["devices"] == [
         {"name": n, "type": "RotationalMotor", "maxVelocity": 8.0, "minPosition": 0.0, "maxPosition": 0.0,
-         "targetPosition": 0.0, "velocity": 8.0} for n in ("left wheel motor", "right wheel motor")]
+         "targetPosition": 0.0, "velocity": 8.0, "model": "", "index": i, "simulated": True}
+        for i, n in enumerate(("left wheel motor", "right wheel motor"))]
     t0 = res["time_ms"]
     assert error_code(c.call("/rover/robot/step", {"motors": {"left wheel motor": {"position": math.nan}}})) == 5
     assert error_code(c.call("/rover/robot/step", {"motors": {"left wheel motor": {"velocity": math.inf}}})) == 5
@@ -357,7 +358,8 @@ def test_subscriber_gets_every_topic_type(client, ctx, server):
     pc = got["/bot/lidar2/point_cloud"][-1][1]
     assert len(pc["points"]) == 16 * 12 and pc["channels"][0]["name"] == "layer"
     assert np.frombuffer(pc["channels"][0]["values"], "<f4").tolist() == [0.0] * 8 + [1.0] * 8
-    assert got["/clock"][-1][1]["clock"]["nanosec"] % (BASIC * 10**6) == 0
+    clock = got["/clock"][-1][1]["clock"]              # the whole time, not its sub-second part (1 s % 16 ms != 0)
+    assert (clock["sec"] * 10**9 + clock["nanosec"]) % (BASIC * 10**6) == 0
     assert not math.isnan(got["/bot/ls/value"][-1][1]["illuminance"])
     pose = got["/bot2/pose"][-1][1]["pose"]
     assert pose == {"position": {"x": -1.0, "y": 1.0, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}

@@ -69,14 +69,14 @@ def node_type(type_name: str) -> int:
 class TopicDecl:
     """One topic of a device: ``/<robot>/<device>/<item>`` carrying ``message`` (a type of
     :data:`sensorium.schemas.messages.MESSAGE_TYPES`, a ROS 2 type name, exported as is).
-    ``reading``: the readings key it publishes; ``exists``: whether a device of this
-    configuration has the topic (default: always); ``sensor_qos``: a ROS 2 driver offers it with
+    ``reading``: the device attribute it publishes; ``exists(config, world_info)``: whether a
+    device of this configuration in this world has the topic (default: always); ``sensor_qos``: a ROS 2 driver offers it with
     SensorDataQoS (best effort, depth 5), else the default QoS(10)."""
 
     item: str
     message: str
     reading: str = "value"
-    exists: Callable[[Any], bool] | None = None
+    exists: Callable[[Any, Any], bool] | None = None
     sensor_qos: bool = True
 
 
@@ -133,7 +133,7 @@ _SENSOR = ("enable", "get_sampling_period")
 _SIM = "sensorium.server.sim.sensors:"
 
 
-def _laser_scan(cfg: Any) -> bool:
+def _laser_scan(cfg: Any, world_info: Any) -> bool:
     # one layer, cylindrical: the beams are at equal angles (a LaserScan can say them)
     return cfg.number_of_layers == 1 and cfg.projection == "cylindrical"
 
@@ -171,6 +171,45 @@ register(DeviceKind(
     services=("set", "get"),
     topics=(TopicDecl("value", msgs.COLOR_RGBA, sensor_qos=False),),
     description="LEDDescription"))
+register(DeviceKind(
+    "GPS", wm.GPS, _SIM + "GPS",
+    services=(*_SENSOR, "get_values", "get_speed", "get_speed_vector", "get_coordinate_system"),
+    topics=(TopicDecl("values", msgs.NAV_SAT_FIX, "values", exists=lambda cfg, wi: wi.gps_coordinate_system == "WGS84"),
+            TopicDecl("values", msgs.POINT_STAMPED, "values", exists=lambda cfg, wi: wi.gps_coordinate_system == "local"),
+            TopicDecl("speed", msgs.FLOAT64, "speed"),
+            TopicDecl("speed_vector", msgs.VECTOR3_STAMPED, "speed_vector")),
+    description="GPSDescription"))
+register(DeviceKind(
+    "InertialUnit", wm.InertialUnit, _SIM + "InertialUnit",
+    services=(*_SENSOR, "get_roll_pitch_yaw", "get_quaternion", "get_noise"),
+    topics=(TopicDecl("quaternion", msgs.IMU, "quaternion"),),
+    description="InertialUnitDescription"))
+register(DeviceKind(
+    "Compass", wm.Compass, _SIM + "Compass",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.MAGNETIC_FIELD, "values"),),
+    description="CompassDescription"))
+register(DeviceKind(
+    "Accelerometer", wm.Accelerometer, _SIM + "Accelerometer",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.VECTOR3_STAMPED, "values"),),
+    description="AccelerometerDescription"))
+register(DeviceKind(
+    "Gyro", wm.Gyro, _SIM + "Gyro",
+    services=(*_SENSOR, "get_values", "get_lookup_table"),
+    topics=(TopicDecl("values", msgs.VECTOR3_STAMPED, "values"),),
+    description="GyroDescription"))
+register(DeviceKind(
+    "Altimeter", wm.Altimeter, _SIM + "Altimeter",
+    services=(*_SENSOR, "get_value"),
+    topics=(TopicDecl("value", msgs.FLOAT64, "value"),),
+    description="AltimeterDescription"))
+register(DeviceKind(
+    "TouchSensor", wm.TouchSensor, _SIM + "TouchSensor",
+    services=(*_SENSOR, "get_value", "get_values", "get_type", "get_lookup_table"),
+    topics=(TopicDecl("value", msgs.FLOAT64, "value", exists=lambda cfg, wi: cfg.type != "force-3d"),
+            TopicDecl("values", msgs.VECTOR3_STAMPED, "values", exists=lambda cfg, wi: cfg.type == "force-3d")),
+    description="TouchSensorDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

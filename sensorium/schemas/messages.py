@@ -158,6 +158,76 @@ class ColorRGBA(Msg):
     a: float
 
 
+class Vector3(Msg):
+    """``geometry_msgs/msg/Vector3`` (float64)."""
+
+    x: float
+    y: float
+    z: float
+
+
+class PointStamped(Msg):
+    """``geometry_msgs/msg/PointStamped``: a GPS position in local coordinates (m)."""
+
+    header: Header
+    point: Point
+
+
+class Vector3Stamped(Msg):
+    """``geometry_msgs/msg/Vector3Stamped``: a GPS speed vector (m/s, world axes)."""
+
+    header: Header
+    vector: Vector3
+
+
+class NavSatStatus(Msg):
+    """``sensor_msgs/msg/NavSatStatus``: status 0 = fix (STATUS_FIX), service 1 = GPS."""
+
+    status: int = Field(ge=-128, le=127)
+    service: int = Field(ge=0, le=65535)
+
+
+class NavSatFix(Msg):
+    """``sensor_msgs/msg/NavSatFix``: a GPS in a WGS84 world (degrees, m); the covariance is the
+    diagonal of ``accuracy²`` (type 2, diagonal known), or unknown (type 0) without noise."""
+
+    header: Header
+    status: NavSatStatus
+    latitude: float
+    longitude: float
+    altitude: float
+    position_covariance: bytes = Field(description="<f8[9]: row-major, m²")
+    position_covariance_type: int = Field(ge=0, le=3)
+
+
+class Imu(Msg):
+    """``sensor_msgs/msg/Imu`` for an InertialUnit: the orientation only; the angular velocity and
+    linear acceleration covariances start with -1 (REP 145: not provided)."""
+
+    header: Header
+    orientation: Quaternion
+    orientation_covariance: bytes = Field(description="<f8[9], row-major, rad²")
+    angular_velocity: Vector3
+    angular_velocity_covariance: bytes = Field(description="<f8[9]")
+    linear_acceleration: Vector3
+    linear_acceleration_covariance: bytes = Field(description="<f8[9]")
+
+
+class MagneticField(Msg):
+    """``sensor_msgs/msg/MagneticField`` for a Compass: its values (the lookup-table output of
+    north in the device frame, not Tesla), covariance 0."""
+
+    header: Header
+    magnetic_field: Vector3
+    magnetic_field_covariance: bytes = Field(description="<f8[9]")
+
+
+class Float64(Msg):
+    """``std_msgs/msg/Float64``: a GPS speed (m/s); its time is the envelope's ``stamp_ns``."""
+
+    data: float
+
+
 class Envelope(Msg):
     """The second frame of every topic message."""
 
@@ -175,6 +245,12 @@ POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 CLOCK = "rosgraph_msgs/msg/Clock"
 JOINT_STATE = "sensor_msgs/msg/JointState"
 COLOR_RGBA = "std_msgs/msg/ColorRGBA"
+POINT_STAMPED = "geometry_msgs/msg/PointStamped"
+VECTOR3_STAMPED = "geometry_msgs/msg/Vector3Stamped"
+NAV_SAT_FIX = "sensor_msgs/msg/NavSatFix"
+FLOAT64 = "std_msgs/msg/Float64"
+IMU = "sensor_msgs/msg/Imu"
+MAGNETIC_FIELD = "sensor_msgs/msg/MagneticField"
 
 MESSAGE_TYPES: dict[str, type[Msg]] = {
     ILLUMINANCE: Illuminance,
@@ -186,6 +262,12 @@ MESSAGE_TYPES: dict[str, type[Msg]] = {
     CLOCK: Clock,
     JOINT_STATE: JointState,
     COLOR_RGBA: ColorRGBA,
+    POINT_STAMPED: PointStamped,
+    VECTOR3_STAMPED: Vector3Stamped,
+    NAV_SAT_FIX: NavSatFix,
+    FLOAT64: Float64,
+    IMU: Imu,
+    MAGNETIC_FIELD: MagneticField,
 }
 """ROS type name → model, for every topic the server publishes."""
 

@@ -318,6 +318,56 @@ class PositionSensorDescription(_Entry):
     resolution: float
 
 
+class GPSDescription(_Entry):
+    type: Literal["GPS"]
+    sampling_period: int
+    coordinate_system: int = Field(description="wb_gps_get_coordinate_system: 0 local, 1 WGS84")
+    accuracy: float
+    noise_correlation: float
+    resolution: float
+    speed_noise: float
+    speed_resolution: float
+
+
+class InertialUnitDescription(_Entry):
+    type: Literal["InertialUnit"]
+    sampling_period: int
+    noise: float = Field(description="wb_inertial_unit_get_noise")
+    coordinate_system: str = Field(description="ENU or NUE: the roll/pitch/yaw convention")
+
+
+class CompassDescription(_Entry):
+    type: Literal["Compass"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class AccelerometerDescription(_Entry):
+    type: Literal["Accelerometer"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class GyroDescription(_Entry):
+    type: Literal["Gyro"]
+    sampling_period: int
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
+class AltimeterDescription(_Entry):
+    type: Literal["Altimeter"]
+    sampling_period: int
+    accuracy: float
+    resolution: float
+
+
+class TouchSensorDescription(_Entry):
+    type: Literal["TouchSensor"]
+    sampling_period: int
+    sensor_type: int = Field(description="get_type: 0 bumper, 1 force, 2 force-3d")
+    lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
+
+
 class LEDDescription(_Entry):
     type: Literal["LED"]
     value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
@@ -334,6 +384,10 @@ DeviceDescription = Annotated[
     Annotated[LightSensorDescription, Tag("LightSensor")] | Annotated[DistanceSensorDescription, Tag("DistanceSensor")]
     | Annotated[LidarDescription, Tag("Lidar")] | Annotated[MotorDescription, Tag("RotationalMotor")]
     | Annotated[PositionSensorDescription, Tag("PositionSensor")] | Annotated[LEDDescription, Tag("LED")]
+    | Annotated[GPSDescription, Tag("GPS")] | Annotated[InertialUnitDescription, Tag("InertialUnit")]
+    | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]
+    | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
+    | Annotated[TouchSensorDescription, Tag("TouchSensor")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -571,6 +625,13 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_value", "device", NoArgs, FloatValue),
     ServiceSpec("set", "device", IntArgs, SuccessResult, attached=True),
     ServiceSpec("get", "device", NoArgs, IntValue),
+    ServiceSpec("get_values", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_speed", "device", NoArgs, FloatValue),
+    ServiceSpec("get_speed_vector", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_coordinate_system", "device", NoArgs, IntValue),
+    ServiceSpec("get_roll_pitch_yaw", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_quaternion", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("get_noise", "device", NoArgs, FloatValue),
 )
 
 

@@ -374,6 +374,86 @@ class LED(_Device):
         return v
 
 
+class GPS(_Device):
+    """Webots GPS: the device's position (local coordinates, or WGS84 latitude / longitude /
+    altitude, per ``world_info.gps_coordinate_system``), its speed and speed vector."""
+
+    device: Literal["GPS"]
+    type: Literal["satellite", "laser"] = Field(default="satellite", description="ignored, as in Webots")
+    accuracy: float = Field(default=0.0, ge=0.0, description="standard deviation (m) of the position noise")
+    noise_correlation: float = Field(default=0.0, ge=0.0, le=1.0,
+                                     description="how much the noise of one second ago remains (Gauss-Markov)")
+    resolution: float = Field(default=-1.0, description="m; -1 = infinite")
+    speed_noise: float = Field(default=0.0, ge=0.0, description="relative standard deviation of the speed")
+    speed_resolution: float = Field(default=-1.0, description="m/s; -1 = infinite")
+
+
+class InertialUnit(_Device):
+    """Webots InertialUnit: the device's orientation (quaternion; roll, pitch, yaw in the world's
+    coordinate system's convention)."""
+
+    device: Literal["InertialUnit"]
+    noise: float = Field(default=0.0, ge=0.0, description="σ of each Gaussian angle, as a fraction of π")
+    resolution: float = -1.0
+    x_axis: bool = True
+    y_axis: bool = True
+    z_axis: bool = True
+
+
+class Compass(_Device):
+    """Webots Compass: the world's north (ENU: +y, NUE: +x) in the device frame, through the lookup
+    table per axis (empty table: the unit vector itself)."""
+
+    device: Literal["Compass"]
+    lookup_table: list[LookupRow] = Field(default=[], max_length=4096)
+    resolution: float = -1.0
+    x_axis: bool = True
+    y_axis: bool = True
+    z_axis: bool = True
+
+
+class Accelerometer(_Device):
+    """Webots Accelerometer on a kinematic robot: the specific force (m/s²) in the device frame from
+    the motion's second difference and the world's gravity (README "What is simulated")."""
+
+    device: Literal["Accelerometer"]
+    lookup_table: list[LookupRow] = Field(default=[], max_length=4096)
+    resolution: float = -1.0
+    x_axis: bool = True
+    y_axis: bool = True
+    z_axis: bool = True
+
+
+class Gyro(_Device):
+    """Webots Gyro on a kinematic robot: the angular velocity (rad/s) in the device frame."""
+
+    device: Literal["Gyro"]
+    lookup_table: list[LookupRow] = Field(default=[], max_length=4096)
+    resolution: float = -1.0
+    x_axis: bool = True
+    y_axis: bool = True
+    z_axis: bool = True
+
+
+class Altimeter(_Device):
+    """Webots Altimeter: the device's height along the world's up axis (m)."""
+
+    device: Literal["Altimeter"]
+    accuracy: float = Field(default=0.0, ge=0.0, description="standard deviation (m) of Gaussian noise")
+    resolution: float = -1.0
+
+
+class TouchSensor(_Device):
+    """Webots TouchSensor. ``bumper``: 1 while the robot's body pushes against a solid or another
+    robot (kinematic contact clipped its motion in the last basic step), else 0. ``force`` and
+    ``force-3d`` need physics: they read NaN (Webots' "no value"), said once when the world loads."""
+
+    device: Literal["TouchSensor"]
+    type: Literal["bumper", "force", "force-3d"] = "bumper"
+    lookup_table: list[LookupRow] = Field(default=[(0.0, 0.0, 0.0), (5000.0, 50000.0, 0.0)], max_length=4096)
+    resolution: float = -1.0
+
+
 class RotationalMotor(_Device):
     """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
     motors *is* that motor, at this index of the device list (a drive motor without an entry comes
@@ -384,9 +464,8 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Accelerometer", "Altimeter", "Brake", "Camera", "Compass", "Connector", "Display", "Emitter", "GPS", "Gyro",
-    "InertialUnit", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
-    "Speaker", "TouchSensor", "VacuumGripper",
+    "Brake", "Camera", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
+    "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
 
@@ -400,10 +479,12 @@ class UnsimulatedDevice(_Device):
     device: Literal[UNSIMULATED_DEVICE_TYPES]  # type: ignore[valid-type]
 
 
-Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | RotationalMotor | UnsimulatedDevice,
+Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
+                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | UnsimulatedDevice,
                    Field(discriminator="device")]
 
-DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "RotationalMotor",
+DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
+                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor",
                 *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
@@ -461,6 +542,12 @@ class WorldInfo(Strict):
     coordinate_system: Literal["ENU", "NUE"] = Field(
         default="ENU", description="world axes: ENU = x east, y north, z up; NUE = x north, y up, z east. "
         "Only the up axis matters here: differential drives move in the plane normal to it")
+    gravity: float = Field(default=9.81, ge=0.0, le=1000.0, description="m/s², what an accelerometer at rest reads")
+    gps_coordinate_system: Literal["local", "WGS84"] = Field(
+        default="local", description="what a GPS reads: local coordinates (m) or WGS84 latitude, longitude (degrees), "
+        "altitude (m)")
+    gps_reference: Vec3 = Field(default=(0.0, 0.0, 0.0), description="local: added to the position; WGS84: the "
+                                "latitude, longitude (degrees) and altitude (m) of the world's origin")
 
 
 class World(Strict):

@@ -79,6 +79,27 @@ class DeviceServices:
     def _dev_get_value(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.value)}
 
+    def _dev_get_values(self, c: Call) -> dict:
+        return {"value": [float(v) for v in c.ctl.device.values]}
+
+    def _dev_get_speed(self, c: Call) -> dict:
+        return {"value": float(c.ctl.device.speed)}
+
+    def _dev_get_speed_vector(self, c: Call) -> dict:
+        return {"value": [float(v) for v in c.ctl.device.speed_vector]}
+
+    def _dev_get_coordinate_system(self, c: Call) -> dict:
+        return {"value": int(c.ctl.device.coordinate_system)}
+
+    def _dev_get_roll_pitch_yaw(self, c: Call) -> dict:
+        return {"value": [float(v) for v in c.ctl.device.roll_pitch_yaw]}
+
+    def _dev_get_quaternion(self, c: Call) -> dict:
+        return {"value": [float(v) for v in c.ctl.device.quaternion]}
+
+    def _dev_get_noise(self, c: Call) -> dict:
+        return {"value": float(c.ctl.device.config.noise)}
+
     def _dev_set(self, c: Call) -> dict:
         try:
             c.ctl.device.set(c.args.value, self.sim.time_ms)
@@ -108,7 +129,7 @@ class DeviceServices:
     def _dev_get_aperture(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.config.aperture)}
 
-    def _dev_get_type(self, c: Call) -> dict:
+    def _dev_get_type(self, c: Call) -> dict:  # DistanceSensor and TouchSensor: their type code
         return {"value": int(c.ctl.device.type_code)}
 
     def _dev_get_info(self, c: Call) -> dict:

@@ -3,28 +3,31 @@
 * **Controllers** control their own robot: the robot and device services check that the caller is
   the robot's attached controller (:meth:`sensorium.server.daemon.services.Core.handle`).
 * **World-wide controls** (:data:`WORLD_CONTROLS`: ``set_mode``, which pauses or speeds up the world
-  for everyone) need the *supervisor role*: the caller is the attached controller of a robot with
+  for everyone, ``/<robot>/robot/set_pose``, which moves any robot, and the debug ``get_counters``) need the *supervisor role*: the caller is the attached controller of a robot with
   ``supervisor: true``, or the server runs with open controls. ``serve --controls`` chooses:
   ``open`` (any caller), ``supervisor`` (supervisor role only) or ``auto`` (the default): open
   when the RPC endpoint is only reachable from this machine (loopback tcp, ipc, inproc),
   supervisor otherwise — so ``sensorium call set_mode`` keeps working on a workstation and a
   server bound to a network interface is not paused by any client that can connect.
 * **Poses**: every pose a request sets (``set_pose``, Supervisor ``set_field``) is checked by
-  :func:`check_pose` — finite numbers, every coordinate within ``±MAX_COORDINATE_M``.
+  :func:`check_pose` (world/limits.py, also used by the in-process ``Robot.set_pose``) — finite
+  numbers, every coordinate within ``±MAX_COORDINATE_M``.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Iterable
 from ipaddress import ip_address
 from typing import Any
+
+from sensorium.server.world.limits import MAX_COORDINATE_M, check_pose
 
 __all__ = ["WORLD_CONTROLS", "MAX_COORDINATE_M", "CONTROLS", "open_controls", "is_local_endpoint", "check_pose",
            "has_supervisor_role", "denied"]
 
-WORLD_CONTROLS = frozenset({"set_mode"})      # server services that change the world for everyone
-MAX_COORDINATE_M = 1e5                        # |x|, |y|, |z| of a pose set by a request (100 km)
+# services any caller could otherwise use to change (or watch) the world for everyone: pausing it,
+# moving robots (``/<robot>/robot/set_pose`` is not limited to the robot's own controller), the
+# debug counters (which topics others demand)
+WORLD_CONTROLS = frozenset({"set_mode", "set_pose", "get_counters"})
 CONTROLS = ("auto", "open", "supervisor")
 
 
@@ -61,16 +64,3 @@ def has_supervisor_role(sim: Any, lockstep: Any, peer: bytes) -> bool:
 def denied(service: str) -> str:
     return (f"{service} changes the world for everyone: attach a robot with 'supervisor: true' first, "
             f"or run the server with --controls open")
-
-
-def check_pose(translation: Iterable[float] | None = None, rotation: Iterable[float] | None = None,
-               quaternion: Iterable[float] | None = None) -> None:
-    """Raise ValueError unless every value is finite and the translation lies within the world bounds."""
-    for name, values in (("translation", translation), ("rotation", rotation), ("quaternion", quaternion)):
-        if values is None:
-            continue
-        vals = [float(v) for v in values]
-        if not all(math.isfinite(v) for v in vals):
-            raise ValueError(f"{name} values must be finite, got {vals}")
-        if name == "translation" and any(abs(v) > MAX_COORDINATE_M for v in vals):
-            raise ValueError(f"translation {vals} is outside the world bounds (|coordinate| <= {MAX_COORDINATE_M:g} m)")

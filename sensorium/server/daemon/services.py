@@ -211,7 +211,7 @@ class Core(DeviceServices):
                 raise ServiceError(ErrorCode.NOT_SUPERVISOR,
                                    f"{req.service}: robot {route.robot!r} is not a supervisor "
                                    f"(set 'supervisor: true' on it in the world file)")
-            if route.robot is None and route.spec.item in roles.WORLD_CONTROLS and not self.open_controls \
+            if route.spec.item in roles.WORLD_CONTROLS and route.spec.scope != "device" and not self.open_controls \
                     and not roles.has_supervisor_role(self.sim, self.lockstep, peer):
                 raise ServiceError(ErrorCode.NOT_SUPERVISOR, roles.denied(req.service))
             ctl = self.topics.controls[route.device] if route.device else None

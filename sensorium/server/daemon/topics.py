@@ -76,6 +76,8 @@ class Control:
 
     def __post_init__(self) -> None:
         self.topic_types: dict[str, str] = {t.kind: t.type for t in self.topics}   # item -> message type
+        # item -> the device attribute it publishes (schemas/devices.py TopicDecl.reading)
+        self.topic_readings: dict[str, str] = {t.item: t.reading for t in KINDS[self.kind].topics}
 
     @property
     def path(self) -> str:
@@ -186,12 +188,12 @@ def laser_scan_angles(cfg: Any) -> tuple[float, float, float] | None:
     return first, first + (w - 1) * inc, inc
 
 
-def _device_topics(robot: str, name: str, kind: str, cfg: Any) -> list[Topic]:
+def _device_topics(robot: str, name: str, kind: str, cfg: Any, world_info: Any) -> list[Topic]:
     """The device's topics: its kind's declaration (schemas/devices.py)."""
     base = f"/{robot}/{name}/"
     path = f"{robot}/{name}"
     return [Topic(base + t.item, t.message, t.item, path, topic_frame(base + t.item))
-            for t in KINDS[kind].topics if t.exists is None or t.exists(cfg)]
+            for t in KINDS[kind].topics if t.exists is None or t.exists(cfg, world_info)]
 
 
 # ---------------------------------------------------------------------- the topic table
@@ -205,10 +207,11 @@ class Topics:
         self.controls: dict[str, Control] = {}
         self.topics: list[Topic] = [Topic(CLOCK, msgs.CLOCK, "clock", None, topic_frame(CLOCK))]
         self.pose_topics: dict[str, Topic] = {}      # robot -> its /<robot>/pose topic
+        world_info = getattr(getattr(sim, "world", None), "world_info", None)
         for robot_name, robot in sim.robots.items():
             for dev_name, dev in robot.devices.items():
                 kind = dev.config.device
-                ts = _device_topics(robot_name, dev_name, kind, dev.config)
+                ts = _device_topics(robot_name, dev_name, kind, dev.config, world_info)
                 self.topics.extend(ts)
                 self.controls[f"{robot_name}/{dev_name}"] = Control(robot_name, dev, kind, ts,
                                                                     f"{robot_name}/{dev_name}", seen=dev.measurements)
@@ -413,22 +416,22 @@ class Topics:
         t = ctl.topic_types.get(kind)
         if t is None:
             return None
-        return MESSAGE_BUILDERS[t](self, ctl, header(ctl.frame_id, at_ms))
+        return MESSAGE_BUILDERS[t](self, ctl, header(ctl.frame_id, at_ms), ctl.topic_readings[kind])
 
-    def _illuminance(self, ctl: Control, hdr: dict) -> dict:
+    def _illuminance(self, ctl: Control, hdr: dict, reading: str) -> dict:
         return {"header": hdr, "illuminance": float(ctl.device.value), "variance": 0.0}
 
-    def _joint_state(self, ctl: Control, hdr: dict) -> dict:
+    def _joint_state(self, ctl: Control, hdr: dict, reading: str) -> dict:
         dev = ctl.device
         return {"header": hdr, "name": [dev.name], "position": np.array([dev.value], dtype="<f8").tobytes(),
                 "velocity": b"", "effort": b""}
 
-    def _color(self, ctl: Control, hdr: dict) -> dict:
+    def _color(self, ctl: Control, hdr: dict, reading: str) -> dict:
         dev = ctl.device
         r, g, b = dev.rgb()
         return {"r": r, "g": g, "b": b, "a": 1.0 if dev.value else 0.0}
 
-    def _range(self, ctl: Control, hdr: dict) -> dict:
+    def _range(self, ctl: Control, hdr: dict, reading: str) -> dict:
         dev = ctl.device
         code = int(dev.type_code)
         return {"header": hdr,
@@ -439,11 +442,11 @@ class Topics:
                 "range": float(dev.value),
                 "variance": 0.0}
 
-    def _range_image(self, ctl: Control, hdr: dict) -> dict:
+    def _range_image(self, ctl: Control, hdr: dict, reading: str) -> dict:
         cfg = ctl.device.config
         return image_msg(hdr, cfg.number_of_layers, cfg.horizontal_resolution, ctl.range_bytes())
 
-    def _laser_scan(self, ctl: Control, hdr: dict) -> dict | None:
+    def _laser_scan(self, ctl: Control, hdr: dict, reading: str) -> dict | None:
         dev = ctl.device
         cfg = dev.config
         angles = laser_scan_angles(cfg)
@@ -461,23 +464,60 @@ class Topics:
                 "range_min": float(cfg.min_range), "range_max": float(cfg.max_range),
                 "ranges": ctl.range_bytes()[: 4 * cfg.horizontal_resolution], "intensities": b""}
 
-    def _point_cloud(self, ctl: Control, hdr: dict) -> dict | None:
+    def _point_cloud(self, ctl: Control, hdr: dict, reading: str) -> dict | None:
         if not ctl.device.point_cloud_enabled:
             return None
         return lidar_cloud_msg(hdr, ctl.device)
 
+    def _point_stamped(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        x, y, z = (float(v) for v in getattr(ctl.device, reading))
+        return {"header": hdr, "point": {"x": x, "y": y, "z": z}}
+
+    def _vector3_stamped(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        x, y, z = (float(v) for v in getattr(ctl.device, reading))
+        return {"header": hdr, "vector": {"x": x, "y": y, "z": z}}
+
+    def _float64(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        return {"data": float(getattr(ctl.device, reading))}
+
+    def _nav_sat_fix(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        lat, lon, alt = (float(v) for v in getattr(ctl.device, reading))
+        sigma = float(getattr(ctl.device.config, "accuracy", 0.0))
+        cov = np.zeros(9)
+        cov[[0, 4, 8]] = sigma * sigma
+        return {"header": hdr, "status": {"status": 0, "service": 1}, "latitude": lat, "longitude": lon,
+                "altitude": alt, "position_covariance": cov.astype("<f8").tobytes(),
+                "position_covariance_type": 2 if sigma > 0 else 0}
+
+    def _imu(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        x, y, z, w = (float(v) for v in getattr(ctl.device, reading))
+        sigma = float(ctl.device.config.noise) * math.pi
+        unknown = np.zeros(9)
+        unknown[0] = -1.0                                     # REP 145: not provided
+        return {"header": hdr, "orientation": {"x": x, "y": y, "z": z, "w": w},
+                "orientation_covariance": (np.eye(3) * sigma * sigma).astype("<f8").tobytes(),
+                "angular_velocity": {"x": 0.0, "y": 0.0, "z": 0.0},
+                "angular_velocity_covariance": unknown.astype("<f8").tobytes(),
+                "linear_acceleration": {"x": 0.0, "y": 0.0, "z": 0.0},
+                "linear_acceleration_covariance": unknown.astype("<f8").tobytes()}
+
+    def _magnetic_field(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        x, y, z = (float(v) for v in getattr(ctl.device, reading))
+        return {"header": hdr, "magnetic_field": {"x": x, "y": y, "z": z},
+                "magnetic_field_covariance": bytes(72)}
+
     # ------------------------------------------------------------------ step-reply readings
     def reading(self, ctl: Control) -> dict:
         """The device's latest reading for a step reply (PROTOCOL §3.6)."""
-        if "range_image" in ctl.topic_types:
-            out = {"range_image": ctl.range_bytes()}
-            if ctl.controller_point_cloud:
-                out["point_cloud"] = ctl.cloud_bytes()
-            return out
-        return {"value": float(ctl.device.value)}
+        if "range_image" not in ctl.topic_types:
+            return ctl.device.step_reading()
+        out = {"range_image": ctl.range_bytes()}          # a lidar's bytes, shared with its topics
+        if ctl.controller_point_cloud:
+            out["point_cloud"] = ctl.cloud_bytes()
+        return out
 
 
-MESSAGE_BUILDERS: dict[str, Callable[[Topics, Control, dict], dict | None]] = {
+MESSAGE_BUILDERS: dict[str, Callable[[Topics, Control, dict, str], dict | None]] = {
     msgs.ILLUMINANCE: Topics._illuminance,
     msgs.RANGE: Topics._range,
     msgs.JOINT_STATE: Topics._joint_state,
@@ -485,5 +525,11 @@ MESSAGE_BUILDERS: dict[str, Callable[[Topics, Control, dict], dict | None]] = {
     msgs.IMAGE: Topics._range_image,
     msgs.LASER_SCAN: Topics._laser_scan,
     msgs.POINT_CLOUD: Topics._point_cloud,
+    msgs.POINT_STAMPED: Topics._point_stamped,
+    msgs.VECTOR3_STAMPED: Topics._vector3_stamped,
+    msgs.FLOAT64: Topics._float64,
+    msgs.NAV_SAT_FIX: Topics._nav_sat_fix,
+    msgs.IMU: Topics._imu,
+    msgs.MAGNETIC_FIELD: Topics._magnetic_field,
 }
 """Message type -> the builder of a device topic's body (a device kind's topics name their types)."""

@@ -16,14 +16,18 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from sensorium.schemas import world as wm
 from sensorium.schemas.devices import kind
 from sensorium.server.devices import distance as dmath
+from sensorium.server.devices import gps as gps_math
 from sensorium.server.devices import lidar as lmath
-from sensorium.server.devices.lookup import LookupTable
+from sensorium.server.devices import motion_sensors as motion_math
+from sensorium.server.devices import orientation as orient
+from sensorium.server.devices.lookup import LookupTable, quantize_sensor
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.world.geometry import Pose
-from sensorium.server.world.poses import pose_from_model
+from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
 
 @dataclass(slots=True)
@@ -84,6 +88,8 @@ class Device:
     measured_at_ms: int = -1        # simulated time of the latest value
     _rng: np.random.Generator | None = None
 
+    tracks_motion: ClassVar[bool] = False
+    """The step calls ``track()`` after every basic step while the device is enabled."""
     kinematic: ClassVar[bool] = False
     """A device measured without rays from the kinematic world: the step calls ``measure(now_ms)``
     when it is due (after ``bind`` handed it what it reads)."""
@@ -135,6 +141,10 @@ class Device:
     def _mark(self, now_ms: int) -> None:
         self.measurements += 1
         self.measured_at_ms = now_ms
+
+    def step_reading(self) -> dict:
+        """What a step reply carries for the device (PROTOCOL §3.6)."""
+        return {"value": float(self.value)}  # type: ignore[attr-defined]
 
     def bind(self, robot: Any) -> None:
         """Called once with the device's ``RobotState`` (motors, drive, pose) when the robot is made."""
@@ -511,3 +521,275 @@ def device_class(type_name: str) -> type | None:
 
 _CLASSES: dict[str, type] = {}
 RAY_DEVICES = (LightSensor, DistanceSensor, Lidar)
+
+
+class GPS(Device):
+    """Webots GPS (``server/devices/gps.py``): position, speed, speed vector of the device, from
+    the kinematic world; NaN before the first value, the speed also at the first one (Webots: no
+    previous position)."""
+
+    kinematic = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.values = np.full(3, math.nan)
+        self.speed = math.nan
+        self.speed_vector = np.full(3, math.nan)
+        self._noise = np.zeros(3)                         # the Gauss-Markov state of the position noise
+        self._previous: np.ndarray | None = None          # the translation at the previous measurement
+        self._robot: Any = None
+        self._world_info: Any = wm.WorldInfo()
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._world_info = robot.world_info
+
+    @property
+    def coordinate_system(self) -> int:
+        return 1 if self._world_info.gps_coordinate_system == "WGS84" else 0
+
+    def measure(self, now_ms: int) -> None:
+        c, wi = self.config, self._world_info
+        elapsed = now_ms - self.schedule.last_update_ms
+        t = self.world_pose(self._robot.pose).translation
+        rng = self.rng if (c.accuracy > 0.0 or c.speed_noise > 0.0) else None
+        self.values = gps_math.position(
+            t, coordinate_system=wi.gps_coordinate_system, reference=wi.gps_reference, axes=wi.coordinate_system,
+            accuracy=c.accuracy, correlation=c.noise_correlation, elapsed_ms=elapsed, noise=self._noise, rng=rng,
+            resolution=c.resolution)
+        self.speed_vector = gps_math.speed_vector(t, self._previous, elapsed)
+        self._previous = np.array(t, dtype=np.float64)
+        self.speed = gps_math.speed(self.speed_vector, noise=c.speed_noise, rng=rng, resolution=c.speed_resolution)
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"values": self.values, "speed": self.speed, "speed_vector": self.speed_vector}
+
+    def step_reading(self) -> dict:
+        return {"values": [float(v) for v in self.values], "speed": float(self.speed),
+                "speed_vector": [float(v) for v in self.speed_vector]}
+
+    def describe(self) -> dict:
+        c = self.config
+        return {"coordinate_system": self.coordinate_system, "accuracy": float(c.accuracy),
+                "noise_correlation": float(c.noise_correlation), "resolution": float(c.resolution),
+                "speed_noise": float(c.speed_noise), "speed_resolution": float(c.speed_resolution)}
+
+
+class InertialUnit(Device):
+    """Webots InertialUnit (``server/devices/orientation.py``): the device's world orientation as a
+    quaternion and as roll, pitch, yaw in the world's convention (ENU or NUE); NaN before the first value."""
+
+    kinematic = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.quaternion = np.full(4, math.nan)
+        self.roll_pitch_yaw = np.full(3, math.nan)
+        self._robot: Any = None
+        self._axes = "ENU"
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._axes = robot.world_info.coordinate_system
+
+    def measure(self, now_ms: int) -> None:
+        c = self.config
+        q = matrix_quaternion(self.world_pose(self._robot.pose).rotation)
+        self.quaternion = orient.inertial_quaternion(
+            q, noise=c.noise, rng=self.rng if c.noise > 0.0 else None, x_axis=c.x_axis, y_axis=c.y_axis,
+            z_axis=c.z_axis, resolution=c.resolution)
+        self.roll_pitch_yaw = orient.roll_pitch_yaw(self.quaternion, self._axes)
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"quaternion": self.quaternion, "roll_pitch_yaw": self.roll_pitch_yaw}
+
+    def step_reading(self) -> dict:
+        return {"quaternion": [float(v) for v in self.quaternion],
+                "roll_pitch_yaw": [float(v) for v in self.roll_pitch_yaw]}
+
+    def describe(self) -> dict:
+        return {"noise": float(self.config.noise), "coordinate_system": self._axes}
+
+
+class Compass(Device):
+    """Webots Compass (``server/devices/orientation.py``): north in the device frame through the
+    lookup table; NaN before the first value and on a disabled axis."""
+
+    kinematic = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.table = LookupTable(self.config.lookup_table)
+        self.values = np.full(3, math.nan)
+        self._robot: Any = None
+        self._axes = "ENU"
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._axes = robot.world_info.coordinate_system
+
+    def measure(self, now_ms: int) -> None:
+        c = self.config
+        self.values = orient.compass_values(
+            self.world_pose(self._robot.pose).rotation, self._axes, self.table,
+            self.rng if self.table.has_noise else None, x_axis=c.x_axis, y_axis=c.y_axis, z_axis=c.z_axis,
+            resolution=c.resolution)
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"values": self.values}
+
+    def step_reading(self) -> dict:
+        return {"values": [float(v) for v in self.values]}
+
+    def describe(self) -> dict:
+        return {"lookup_table": self.flat_lookup_table()}
+
+
+class _MotionSensor(Device):
+    """A device that reads the kinematic motion: the device's world poses after the last basic
+    steps (since it was enabled), kept by ``track``."""
+
+    kinematic = True
+    tracks_motion = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.values = np.full(3, math.nan)
+        self._poses: list[Pose] = []
+        self._robot: Any = None
+        self._axes = "ENU"
+        self._gravity = 9.81
+        self._dt_s = 0.032
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._axes = robot.world_info.coordinate_system
+        self._gravity = float(robot.world_info.gravity)
+        self._dt_s = robot.basic_time_step / 1000.0
+
+    def enable(self, period_ms: int) -> None:
+        super().enable(period_ms)
+        self._poses = [self.world_pose(self._robot.pose)] if self._robot is not None else []
+
+    def track(self) -> None:
+        self._poses = [*self._poses[-2:], self.world_pose(self._robot.pose)]
+
+    def _through_table(self, raw: np.ndarray) -> np.ndarray:
+        c = self.config
+        table = self.table
+        return motion_math.axes_through_table(raw, table, self.rng if table.has_noise else None,
+                                              (c.x_axis, c.y_axis, c.z_axis), c.resolution)
+
+    def readings(self) -> dict:
+        return {"values": self.values}
+
+    def step_reading(self) -> dict:
+        return {"values": [float(v) for v in self.values]}
+
+    def describe(self) -> dict:
+        return {"lookup_table": self.flat_lookup_table()}
+
+
+class Accelerometer(_MotionSensor):
+    """Webots Accelerometer (``server/devices/motion_sensors.py``): gravity and the kinematic
+    acceleration in the device frame; rest is assumed until three poses are known."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.table = LookupTable(self.config.lookup_table)
+
+    def measure(self, now_ms: int) -> None:
+        poses = self._poses or [self.world_pose(self._robot.pose)]
+        last = poses[-1]
+        p = [q.translation for q in poses]
+        p0, p1 = (p[-3], p[-2]) if len(p) >= 3 else (last.translation, last.translation)
+        raw = motion_math.specific_force(last.rotation, p0, p1, last.translation, self._dt_s, self._gravity, self._axes)
+        self.values = self._through_table(raw)
+        self._mark(now_ms)
+
+
+class Gyro(_MotionSensor):
+    """Webots Gyro (``server/devices/motion_sensors.py``): the angular velocity in the device frame
+    over the last basic step; rest until two poses are known."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.table = LookupTable(self.config.lookup_table)
+
+    def measure(self, now_ms: int) -> None:
+        poses = self._poses or [self.world_pose(self._robot.pose)]
+        r0 = poses[-2].rotation if len(poses) >= 2 else poses[-1].rotation
+        raw = motion_math.angular_velocity(r0, poses[-1].rotation, self._dt_s)
+        self.values = self._through_table(raw)
+        self._mark(now_ms)
+
+
+class Altimeter(Device):
+    """Webots Altimeter: the device's height along the up axis (+ the WGS84 reference altitude),
+    Gaussian ``accuracy`` noise, ``resolution``; NaN before the first value."""
+
+    kinematic = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.value = math.nan
+        self._robot: Any = None
+        self._up = 2
+        self._offset = 0.0
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        wi = robot.world_info
+        self._up = wi.coordinate_system.index("U")
+        self._offset = float(wi.gps_reference[2]) if wi.gps_coordinate_system == "WGS84" else 0.0
+
+    def measure(self, now_ms: int) -> None:
+        c = self.config
+        v = float(self.world_pose(self._robot.pose).translation[self._up]) + self._offset
+        if c.accuracy > 0.0:
+            v += c.accuracy * float(self.rng.standard_normal())
+        if c.resolution != -1.0:
+            v = float(quantize_sensor(v, c.resolution))
+        self.value = v
+        self._mark(now_ms)
+
+    def describe(self) -> dict:
+        return {"accuracy": float(self.config.accuracy), "resolution": float(self.config.resolution)}
+
+
+class TouchSensor(Device):
+    """Webots TouchSensor: a bumper reads 1 while its robot pushes against something (kinematic
+    contact), else 0; ``force`` and ``force-3d`` read NaN (they need physics)."""
+
+    kinematic = True
+    TYPE_CODES: ClassVar[dict[str, int]] = {"bumper": 0, "force": 1, "force-3d": 2}
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.table = LookupTable(self.config.lookup_table)
+        self.type_code = self.TYPE_CODES[self.config.type]
+        self.value = math.nan
+        self.values = np.full(3, math.nan)
+        self._robot: Any = None
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+
+    def measure(self, now_ms: int) -> None:
+        if self.type_code == 0:
+            self.value = 1.0 if self._robot.pressing else 0.0
+        self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"value": self.value, "values": self.values}
+
+    def step_reading(self) -> dict:
+        if self.type_code == 2:
+            return {"values": [float(v) for v in self.values]}
+        return {"value": float(self.value)}
+
+    def describe(self) -> dict:
+        return {"sensor_type": self.type_code, "lookup_table": self.flat_lookup_table()}

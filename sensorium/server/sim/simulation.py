@@ -37,7 +37,7 @@ from sensorium.server.sim.sensors import (
     device_class,
 )
 from sensorium.server.world.geometry import Pose
-from sensorium.server.world.limits import WorldLimits
+from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
 
@@ -111,6 +111,7 @@ class RobotState:
         for dev in self.devices.values():
             dev.bind(self)
         self.device_list = device_entries(model, self.devices, self.motors)
+        self.pressing = False         # kinematic contact clipped the drive's motion in the last step
         self.custom_data = model.custom_data
         self.supervisor = model.supervisor
 
@@ -118,10 +119,20 @@ class RobotState:
     def pose(self) -> Pose:
         return self._sim.scene.robot_poses[self.index]
 
+    @property
+    def world_info(self) -> wm.WorldInfo:
+        return self._sim.world.world_info
+
+    @property
+    def basic_time_step(self) -> int:
+        return self._sim.basic_time_step
+
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
         setters); the next measurement sees it there. Translation and rotation are independent
-        (Webots): leave one out (``None``) and it keeps its current value."""
+        (Webots): leave one out (``None``) and it keeps its current value. Non-finite values or a
+        translation beyond ``limits.MAX_COORDINATE_M`` raise ValueError and the robot stays."""
+        check_pose(translation, rotation, quaternion)
         current = self.pose
         if translation is None:
             translation = current.translation
@@ -177,6 +188,7 @@ class Simulation:
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._counters: Counter[str] = Counter()
         self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[Device]] | None = None
+        self._tracking: list[Device] = []
         self._distance_plans: dict[tuple[int, ...], DistancePlan] = {}   # by the due sensors (see _distance_plan)
         self._joined_mounts: dict[tuple, tuple[list, Mount]] = {}        # see _joined_mount
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
@@ -293,6 +305,7 @@ class Simulation:
         for robot in self._driven:
             drive = robot.drive
             assert drive is not None
+            robot.pressing = False
             start = (drive.x, drive.y)
             pose = drive.step(dt)
             if pose is not None:
@@ -303,6 +316,7 @@ class Simulation:
             for k, (end, clipped) in enumerate(ends):
                 if clipped:
                     robot, drive, start, _ = moved[k]
+                    robot.pressing = True
                     drive.x, drive.y = float(end[0]), float(end[1])
                     moved[k] = (robot, drive, start, drive.pose())
         for robot, _, _, pose in moved:
@@ -314,7 +328,11 @@ class Simulation:
                              [d for d in every if isinstance(d, DistanceSensor)],
                              [d for d in every if isinstance(d, Lidar)],
                              [d for d in every if d.kinematic])
+            self._tracking = [d for d in every if d.tracks_motion]
         all_lights, all_distances, all_lidars, all_kinematic = self._by_kind
+        for dev in self._tracking:    # devices that read the motion keep its last poses while enabled
+            if dev.enabled:
+                dev.track()           # type: ignore[attr-defined]
         # Schedule.due inlined (a step of 1,000 robots asks 8,000 sensors)
         lights: list[LightSensor] = [d for d in all_lights if (s := d.schedule).period_ms > 0
                                      and now - s.last_update_ms >= s.period_ms]

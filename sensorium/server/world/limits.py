@@ -16,7 +16,7 @@ worlds that deliberately ask for more. The table is in README "Security and limi
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -25,9 +25,24 @@ from pydantic import BaseModel
 
 from sensorium.schemas.devices import KINDS
 
-__all__ = ["WorldLimits", "LimitError", "check_yaml_events", "check_data", "check_work", "quote", "triangle_count"]
+__all__ = ["MAX_COORDINATE_M", "check_pose", "WorldLimits", "LimitError", "check_yaml_events", "check_data", "check_work", "quote", "triangle_count"]
 
 MiB = 1 << 20
+MAX_COORDINATE_M = 1e5          # |x|, |y|, |z| of a pose set at run time (set_pose, set_field): 100 km
+
+
+def check_pose(translation: Iterable[float] | None = None, rotation: Iterable[float] | None = None,
+               quaternion: Iterable[float] | None = None) -> None:
+    """Raise ValueError unless every value is finite and the translation lies within the world
+    bounds (every pose set at run time: requests and the in-process ``Robot.set_pose``)."""
+    for name, values in (("translation", translation), ("rotation", rotation), ("quaternion", quaternion)):
+        if values is None:
+            continue
+        vals = [float(v) for v in values]
+        if not all(math.isfinite(v) for v in vals):
+            raise ValueError(f"{name} values must be finite, got {vals}")
+        if name == "translation" and any(abs(v) > MAX_COORDINATE_M for v in vals):
+            raise ValueError(f"translation {vals} is outside the world bounds (|coordinate| <= {MAX_COORDINATE_M:g} m)")
 
 
 @dataclass(frozen=True)

@@ -288,7 +288,7 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
 
 
 _TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "triangles", "mesh", "PointLight", "SpotLight",
-         "DirectionalLight", "LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED"}
+         "DirectionalLight", *wm.DEVICE_TYPES}
 
 
 def format_path(loc: tuple[Any, ...]) -> str:
@@ -497,10 +497,13 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
 
     def fix_device(p: str, dev: Any) -> Any:
         upd: dict[str, Any] = {}
-        res = getattr(dev, "resolution", -1.0)
-        if res <= 0 and res != -1:
-            upd["resolution"] = -1.0
-            warnings.append(f"{p}.resolution: {res} <= 0, reset to -1 (off)")
+        for name in ("resolution", "speed_resolution"):
+            res = getattr(dev, name, -1.0)
+            if res <= 0 and res != -1:
+                upd[name] = -1.0
+                warnings.append(f"{p}.{name}: {res} <= 0, reset to -1 (off)")
+        if isinstance(dev, wm.TouchSensor) and dev.type != "bumper":
+            warnings.append(f"{p}.type: a {dev.type} TouchSensor needs physics; it reads NaN (Webots' no value)")
         if isinstance(dev, wm.DistanceSensor):
             if dev.type == "infrared":
                 upd["type"] = "infra-red"

@@ -1,6 +1,7 @@
 /* Sensorium C controller library: generic device functions, LightSensor and DistanceSensor. */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <webots/device.h>
 #include <webots/distance_sensor.h>
@@ -17,7 +18,7 @@ const char *wb_device_get_name(WbDeviceTag tag) {
 
 const char *wb_device_get_model(WbDeviceTag tag) {
   sn_device *d = sn_device_get(tag, SN_OTHER, "wb_device_get_model");
-  return d ? "" : NULL;
+  return d ? d->model : NULL;
 }
 
 const char *sensorium_device_get_type_name(WbDeviceTag tag) {
@@ -29,6 +30,8 @@ WbNodeType wb_device_get_node_type(WbDeviceTag tag) {
   sn_device *d = sn_device_get(tag, SN_OTHER, "wb_device_get_node_type");
   if (d == NULL)
     return WB_NODE_NO_NODE;
+  if (d->node_type != WB_NODE_NO_NODE)
+    return (WbNodeType)d->node_type;
   switch (d->kind) {
     case SN_LIGHT: return WB_NODE_LIGHT_SENSOR;
     case SN_DISTANCE: return WB_NODE_DISTANCE_SENSOR;
@@ -38,6 +41,49 @@ WbNodeType wb_device_get_node_type(WbDeviceTag tag) {
     case SN_LED: return WB_NODE_LED;
     default: return WB_NODE_NO_NODE;
   }
+}
+
+/* Webots' device type names and their node types */
+static const struct {
+  const char *name;
+  WbNodeType node;
+} NODE_TYPES[] = {
+    {"Accelerometer", WB_NODE_ACCELEROMETER},
+    {"Altimeter", WB_NODE_ALTIMETER},
+    {"Brake", WB_NODE_BRAKE},
+    {"Camera", WB_NODE_CAMERA},
+    {"Compass", WB_NODE_COMPASS},
+    {"Connector", WB_NODE_CONNECTOR},
+    {"Display", WB_NODE_DISPLAY},
+    {"DistanceSensor", WB_NODE_DISTANCE_SENSOR},
+    {"Emitter", WB_NODE_EMITTER},
+    {"GPS", WB_NODE_GPS},
+    {"Gyro", WB_NODE_GYRO},
+    {"InertialUnit", WB_NODE_INERTIAL_UNIT},
+    {"LED", WB_NODE_LED},
+    {"Lidar", WB_NODE_LIDAR},
+    {"LightSensor", WB_NODE_LIGHT_SENSOR},
+    {"LinearMotor", WB_NODE_LINEAR_MOTOR},
+    {"Pen", WB_NODE_PEN},
+    {"PositionSensor", WB_NODE_POSITION_SENSOR},
+    {"Radar", WB_NODE_RADAR},
+    {"RangeFinder", WB_NODE_RANGE_FINDER},
+    {"Receiver", WB_NODE_RECEIVER},
+    {"RotationalMotor", WB_NODE_ROTATIONAL_MOTOR},
+    {"Skin", WB_NODE_SKIN},
+    {"Speaker", WB_NODE_SPEAKER},
+    {"TouchSensor", WB_NODE_TOUCH_SENSOR},
+    {"VacuumGripper", WB_NODE_VACUUM_GRIPPER},
+    {"Microphone", WB_NODE_MICROPHONE},
+    {"Radio", WB_NODE_RADIO},
+    {"Robot", WB_NODE_ROBOT},
+};
+
+int sn_node_type_of(const char *type_name) {
+  for (size_t i = 0; type_name && i < sizeof NODE_TYPES / sizeof NODE_TYPES[0]; i++)
+    if (strcmp(NODE_TYPES[i].name, type_name) == 0)
+      return NODE_TYPES[i].node;
+  return WB_NODE_NO_NODE;
 }
 
 /* ------------------------------------------------------------------ scalar sensors */

@@ -101,12 +101,16 @@ void sn_conn_stop_heartbeat(sn_conn *c);
 const char *sn_conn_endpoint(const sn_conn *c);
 
 /* ------------------------------------------------------------------ robot.c */
-typedef enum { SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_OTHER } sn_kind;
+typedef enum { SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_OTHER } sn_kind;
 
 typedef struct {
   WbDeviceTag tag;
   char *name;
   char *type_name;
+  char *model;      /* the world's "model" field, "" when absent */
+  int node_type;    /* Webots' WB_NODE_* value of type_name (WB_NODE_NO_NODE if unknown) */
+  bool simulated;   /* false: listed only, every function answers "no value" (sn_unsimulated) */
+  bool warned_unsimulated;
   sn_kind kind;
   int sampling_period;
   bool warned; /* "disabled device" message printed since the last enable */
@@ -126,6 +130,9 @@ typedef struct {
   char *motor_name;
   int led_value, led_colors;
   bool led_gradual;
+  /* GPS: position, speed, speed vector; WbGpsCoordinateSystem */
+  double gps_values[3], gps_speed, gps_speed_vector[3];
+  int coordinate_system;
   /* motor */
   double max_velocity, min_position, max_position, target_position, velocity;
   bool cmd_position, cmd_velocity; /* to send with the next step */
@@ -170,6 +177,13 @@ void sn_arg_bool(sn_req *r, const void *arg);
 void sn_arg_double(sn_req *r, const void *arg);
 /* enable/disable a sensor (period 0 disables): RPC, then the local state. */
 void sn_device_enable(sn_device *dev, int period, const char *func);
+/* A device Sensorium lists but does not simulate: checks that tag is a device of node_type (else
+ * Webots' error), prints one warning line per device, returns false. true if tag is simulated. */
+bool sn_unsimulated(WbDeviceTag tag, int node_type, const char *func);
+/* Webots' "no value" for a vector getter: NaN values (16 of them), never NULL. */
+const double *sn_no_values(void);
+/* Webots' node type of a device type name ("DistanceSensor"), WB_NODE_NO_NODE if unknown. */
+int sn_node_type_of(const char *type_name);
 void sn_warn_disabled(sn_device *dev, const char *func, const char *enabler, const char *what);
 
 #endif /* SENSORIUM_INTERNAL_H */

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <webots/nodes.h>
 #include <webots/robot.h>
 
 #include "internal.h"
@@ -56,6 +57,8 @@ static sn_kind kind_of(const char *type) {
     return SN_POSITION;
   if (strcmp(type, "LED") == 0)
     return SN_LED;
+  if (strcmp(type, "GPS") == 0)
+    return SN_GPS;
   return SN_OTHER;
 }
 
@@ -90,7 +93,16 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
   d->type_name = sn_strdup_obj(sn_get(desc, "type"));
   if (d->name == NULL || d->type_name == NULL)
     return -1;
-  d->kind = kind_of(d->type_name);
+  d->model = sn_strdup_obj(sn_get(desc, "model"));
+  if (d->model == NULL && (d->model = strdup("")) == NULL)
+    return -1;
+  d->node_type = sn_node_type_of(d->type_name);
+  d->simulated = sn_bool_or(desc, "simulated", true); /* servers before the device list said nothing */
+  d->kind = d->simulated ? kind_of(d->type_name) : SN_OTHER;
+  for (int i = 0; i < 3; i++)
+    d->gps_values[i] = d->gps_speed_vector[i] = NAN;
+  d->gps_speed = NAN;
+  d->coordinate_system = (int)sn_int_or(desc, "coordinate_system", 0);
   d->sampling_period = (int)sn_int_or(desc, "sampling_period", 0);
   d->value = NAN;
   const msgpack_object *table = sn_get(desc, "lookup_table");
@@ -143,6 +155,7 @@ static void free_robot(sn_robot *rb) {
     sn_device *d = &rb->devices[i];
     free(d->name);
     free(d->type_name);
+    free(d->model);
     free(d->lookup_table);
     free(d->range_image);
     free(d->point_cloud);
@@ -325,6 +338,17 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
       dev->value = x;
       if (dev->kind == SN_LED && isfinite(x))
         dev->led_value = (int)x;
+    }
+    if (dev->kind == SN_GPS) {
+      const msgpack_object *pos = sn_get(v, "values"), *vel = sn_get(v, "speed_vector");
+      for (uint32_t j = 0; j < 3; j++) {
+        if (pos && pos->type == MSGPACK_OBJECT_ARRAY && pos->via.array.size == 3 && !sn_as_double(&pos->via.array.ptr[j], &dev->gps_values[j]))
+          dev->gps_values[j] = NAN;
+        if (vel && vel->type == MSGPACK_OBJECT_ARRAY && vel->via.array.size == 3 && !sn_as_double(&vel->via.array.ptr[j], &dev->gps_speed_vector[j]))
+          dev->gps_speed_vector[j] = NAN;
+      }
+      if (!sn_as_double(sn_get(v, "speed"), &dev->gps_speed))
+        dev->gps_speed = NAN;
     }
     if (dev->kind != SN_LIDAR)
       continue;
@@ -522,12 +546,60 @@ WbDeviceTag wb_robot_get_device_by_index(int index) {
 
 /* ------------------------------------------------------------------ device helpers */
 
+/* the node types whose devices a kind's functions take (wb_motor_* takes both motors) */
+static bool kind_accepts(sn_kind kind, int node) {
+  switch (kind) {
+    case SN_LIGHT: return node == WB_NODE_LIGHT_SENSOR;
+    case SN_DISTANCE: return node == WB_NODE_DISTANCE_SENSOR;
+    case SN_LIDAR: return node == WB_NODE_LIDAR;
+    case SN_MOTOR: return node == WB_NODE_ROTATIONAL_MOTOR || node == WB_NODE_LINEAR_MOTOR;
+    case SN_POSITION: return node == WB_NODE_POSITION_SENSOR;
+    case SN_LED: return node == WB_NODE_LED;
+    case SN_GPS: return node == WB_NODE_GPS;
+    default: return false;
+  }
+}
+
+bool sn_unsimulated(WbDeviceTag tag, int node_type, const char *func) {
+  sn_robot *rb = sn_robot_get(func);
+  if (tag < 1 || tag > rb->n_devices) {
+    fprintf(stderr, "Error: %s(): invalid device tag %u\n", func, (unsigned)tag);
+    return false;
+  }
+  sn_device *d = &rb->devices[tag - 1];
+  if (d->node_type != node_type && !(node_type == WB_NODE_ROTATIONAL_MOTOR && d->node_type == WB_NODE_LINEAR_MOTOR)) {
+    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
+    return false;
+  }
+  if (!d->warned_unsimulated) {
+    d->warned_unsimulated = true;
+    if (d->simulated) /* the server measures it; this library does not read those readings yet */
+      fprintf(stderr, "Warning: %s(): the C client does not read %s '%s' yet (its services and topics do): its functions "
+              "answer Webots' \"no value\" (NaN, NULL, 0).\n", func, d->type_name, d->name);
+    else
+      fprintf(stderr, "Warning: %s(): Sensorium does not simulate %s '%s': its functions answer Webots' \"no value\" "
+              "(NaN, NULL, 0).\n", func, d->type_name, d->name);
+  }
+  return false;
+}
+
+const double *sn_no_values(void) {
+  static double nan_values[16];
+  for (int i = 0; i < 16; i++)
+    nan_values[i] = NAN;
+  return nan_values;
+}
+
 sn_device *sn_device_get(WbDeviceTag tag, sn_kind kind, const char *func) {
   sn_robot *rb = sn_robot_get(func);
   if (tag >= 1 && tag <= rb->n_devices) {
     sn_device *d = &rb->devices[tag - 1];
     if (kind == SN_OTHER || d->kind == kind)
       return d;
+    if (!d->simulated && kind_accepts(kind, d->node_type)) {
+      sn_unsimulated(tag, d->node_type, func);
+      return NULL;
+    }
     fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
     return NULL;
   }

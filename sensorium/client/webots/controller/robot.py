@@ -59,8 +59,9 @@ class Robot:
             kind = wb.wb_device_get_type_name(tag)
             cls = _CLASSES.get(kind)
             if cls is None:
-                print(f"Unsupported device type {kind!r} for device {wb.wb_device_get_name(tag)!r}", file=sys.stderr)
-                continue
+                # a device this client has no class for yet (listed, not simulated): present with its
+                # name and model, so getDevice/getDeviceByIndex find it as in Webots
+                cls = Device
             self.devices[wb.wb_device_get_name(tag)] = cls(tag)
 
     # -- stepping

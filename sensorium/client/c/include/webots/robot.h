@@ -44,6 +44,18 @@ int wb_robot_get_number_of_devices(void);
 WbDeviceTag wb_robot_get_device(const char *name);       /* 0 if the robot has no such device */
 WbDeviceTag wb_robot_get_device_by_index(int index);     /* 0 if index is out of range */
 
+/* Webots' semantics: the simulation runs (steps of the basic time step) until an event of
+ * event_type (WB_EVENT_* flags) happens or timeout ms pass. Headless, no keyboard, mouse or
+ * joystick event ever happens: it steps timeout ms and returns WB_EVENT_NO_EVENT (WB_EVENT_QUIT
+ * when the simulation ends). */
+WbUserInputEvent wb_robot_wait_for_user_input_event(WbUserInputEvent event_type, int timeout);
+
+/* The robot's battery (Robot.battery): Sensorium does not simulate batteries; the value is NaN. */
+void wb_robot_battery_sensor_enable(int sampling_period);
+void wb_robot_battery_sensor_disable(void);
+int wb_robot_battery_sensor_get_sampling_period(void);
+double wb_robot_battery_sensor_get_value(void);
+
 #ifdef __cplusplus
 }
 #endif

@@ -3,8 +3,15 @@
 #ifndef WB_TYPES_H
 #define WB_TYPES_H
 
+#include <math.h> /* INFINITY, NAN: Webots controllers write wb_motor_set_position(m, INFINITY) */
 #ifndef __cplusplus
 #include <stdbool.h>
+#endif
+#ifndef INFINITY
+#define INFINITY (__builtin_inf())
+#endif
+#ifndef NAN
+#define NAN (__builtin_nan(""))
 #endif
 
 #ifdef __cplusplus
@@ -17,6 +24,10 @@ typedef unsigned short WbDeviceTag;
 /* Supervisor handles (opaque). */
 typedef struct WbNodeStructPrivate *WbNodeRef;
 typedef struct WbFieldStructPrivate *WbFieldRef;
+/* Display images, motion files and proto handles (opaque; Sensorium hands out none). */
+typedef struct WbImageStructPrivate *WbImageRef;
+typedef struct WbMotionStructPrivate *WbMotionRef;
+typedef struct WbProtoInfoStructPrivate *WbProtoRef;
 
 /* One lidar point: the device-frame position of a hit, its layer and its time offset (s). */
 typedef struct {
@@ -28,6 +39,18 @@ typedef struct {
 } WbLidarPoint;
 
 typedef enum { WB_ROTATIONAL = 0, WB_LINEAR } WbJointType;
+
+/* The user input events wb_robot_wait_for_user_input_event() waits for (flags, or-ed). */
+typedef enum {
+  WB_EVENT_QUIT = -1,
+  WB_EVENT_NO_EVENT = 0,
+  WB_EVENT_MOUSE_CLICK = 1,
+  WB_EVENT_MOUSE_MOVE = 2,
+  WB_EVENT_KEYBOARD = 4,
+  WB_EVENT_JOYSTICK_BUTTON = 8,
+  WB_EVENT_JOYSTICK_AXIS = 16,
+  WB_EVENT_JOYSTICK_POV = 32
+} WbUserInputEvent;
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,16 @@
+// Sensorium C++ controller layer: RotationalMotor (a Motor; see Motor.hpp).
+#ifndef WEBOTS_ROTATIONALMOTOR_HPP
+#define WEBOTS_ROTATIONALMOTOR_HPP
+
+#include <webots/Motor.hpp>
+
+namespace webots {
+
+class RotationalMotor : public Motor {
+public:
+  explicit RotationalMotor(WbDeviceTag tag) : Motor(tag) {}
+};
+
+}  // namespace webots
+
+#endif

@@ -1,0 +1,62 @@
+/* Sensorium C controller library: GPS. Position, speed and speed vector arrive with the step reply
+ * (NaN before the first measurement); the coordinate system comes from the attach description. */
+#include <math.h>
+#include <stdio.h>
+
+#include <webots/gps.h>
+
+#include "internal.h"
+
+void wb_gps_enable(WbDeviceTag tag, int sampling_period) {
+  sn_device *d = sn_device_get(tag, SN_GPS, "wb_gps_enable");
+  if (d != NULL)
+    sn_device_enable(d, sampling_period, "wb_gps_enable");
+}
+
+void wb_gps_disable(WbDeviceTag tag) {
+  sn_device *d = sn_device_get(tag, SN_GPS, "wb_gps_disable");
+  if (d != NULL)
+    sn_device_enable(d, 0, "wb_gps_disable");
+}
+
+int wb_gps_get_sampling_period(WbDeviceTag tag) {
+  sn_device *d = sn_device_get(tag, SN_GPS, "wb_gps_get_sampling_period");
+  return d ? d->sampling_period : 0;
+}
+
+static sn_device *reading(WbDeviceTag tag, const char *func) {
+  sn_device *d = sn_device_get(tag, SN_GPS, func);
+  if (d != NULL && d->sampling_period <= 0)
+    sn_warn_disabled(d, func, "wb_gps_enable", NULL);
+  return d;
+}
+
+const double *wb_gps_get_values(WbDeviceTag tag) {
+  sn_device *d = reading(tag, "wb_gps_get_values");
+  return d ? d->gps_values : sn_no_values();
+}
+
+double wb_gps_get_speed(WbDeviceTag tag) {
+  sn_device *d = reading(tag, "wb_gps_get_speed");
+  return d ? d->gps_speed : NAN;
+}
+
+const double *wb_gps_get_speed_vector(WbDeviceTag tag) {
+  sn_device *d = reading(tag, "wb_gps_get_speed_vector");
+  return d ? d->gps_speed_vector : sn_no_values();
+}
+
+WbGpsCoordinateSystem wb_gps_get_coordinate_system(WbDeviceTag tag) {
+  sn_device *d = sn_device_get(tag, SN_GPS, "wb_gps_get_coordinate_system");
+  return d && d->coordinate_system == 1 ? WB_GPS_WGS84_COORDINATE : WB_GPS_LOCAL_COORDINATE;
+}
+
+const char *wb_gps_convert_to_degrees_minutes_seconds(double decimal_degrees) {
+  /* whole degrees, whole minutes and seconds, each carrying the sign of the angle */
+  static char text[64];
+  double degrees = trunc(decimal_degrees);
+  double minutes = trunc((decimal_degrees - degrees) * 60.0);
+  double seconds = (decimal_degrees - degrees - minutes / 60.0) * 3600.0;
+  snprintf(text, sizeof text, "%.0f\xc2\xb0 %.0f\xe2\x80\xb2 %.2f\xe2\x80\xb3", degrees, minutes, seconds);
+  return text;
+}

@@ -1,0 +1,893 @@
+/* Sensorium C controller library: the devices Sensorium lists but does not simulate. Each function
+ * checks the tag names a device of its type, prints one warning line per device (sn_unsimulated) and
+ * answers Webots' "no value". Written from Webots' documented signatures. */
+#include <math.h>
+#include <stddef.h>
+
+#include <webots/accelerometer.h>
+#include <webots/altimeter.h>
+#include <webots/brake.h>
+#include <webots/camera.h>
+#include <webots/compass.h>
+#include <webots/connector.h>
+#include <webots/display.h>
+#include <webots/emitter.h>
+#include <webots/gyro.h>
+#include <webots/inertial_unit.h>
+#include <webots/pen.h>
+#include <webots/radar.h>
+#include <webots/range_finder.h>
+#include <webots/receiver.h>
+#include <webots/skin.h>
+#include <webots/speaker.h>
+#include <webots/touch_sensor.h>
+#include <webots/vacuum_gripper.h>
+#include <webots/nodes.h>
+
+#include "internal.h"
+
+/* ------------------------------------------------------------------ Accelerometer */
+void wb_accelerometer_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_enable");
+}
+
+void wb_accelerometer_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_disable");
+}
+
+int wb_accelerometer_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_get_sampling_period");
+  return 0;
+}
+
+const double *wb_accelerometer_get_values(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_get_values");
+  return sn_no_values();
+}
+
+int wb_accelerometer_get_lookup_table_size(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_get_lookup_table_size");
+  return 0;
+}
+
+const double *wb_accelerometer_get_lookup_table(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_get_lookup_table");
+  return sn_no_values();
+}
+
+/* ------------------------------------------------------------------ Altimeter */
+void wb_altimeter_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_ALTIMETER, "wb_altimeter_enable");
+}
+
+void wb_altimeter_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_ALTIMETER, "wb_altimeter_disable");
+}
+
+int wb_altimeter_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_ALTIMETER, "wb_altimeter_get_sampling_period");
+  return 0;
+}
+
+double wb_altimeter_get_value(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_ALTIMETER, "wb_altimeter_get_value");
+  return NAN;
+}
+
+/* ------------------------------------------------------------------ Brake */
+void wb_brake_set_damping_constant(WbDeviceTag tag, double damping_constant) {
+  (void)damping_constant;
+  sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_set_damping_constant");
+}
+
+WbJointType wb_brake_get_type(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_get_type");
+  return (WbJointType)0;
+}
+
+WbDeviceTag wb_brake_get_motor(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_get_motor");
+  return 0;
+}
+
+WbDeviceTag wb_brake_get_position_sensor(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_get_position_sensor");
+  return 0;
+}
+
+/* ------------------------------------------------------------------ Camera */
+void wb_camera_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_enable");
+}
+
+void wb_camera_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_disable");
+}
+
+int wb_camera_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_sampling_period");
+  return 0;
+}
+
+const unsigned char *wb_camera_get_image(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_image");
+  return NULL;
+}
+
+int wb_camera_get_width(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_width");
+  return 0;
+}
+
+int wb_camera_get_height(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_height");
+  return 0;
+}
+
+double wb_camera_get_fov(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_fov");
+  return NAN;
+}
+
+double wb_camera_get_max_fov(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_max_fov");
+  return NAN;
+}
+
+double wb_camera_get_min_fov(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_min_fov");
+  return NAN;
+}
+
+void wb_camera_set_fov(WbDeviceTag tag, double fov) {
+  (void)fov;
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_set_fov");
+}
+
+double wb_camera_get_exposure(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_exposure");
+  return NAN;
+}
+
+void wb_camera_set_exposure(WbDeviceTag tag, double exposure) {
+  (void)exposure;
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_set_exposure");
+}
+
+double wb_camera_get_focal_length(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_focal_length");
+  return NAN;
+}
+
+double wb_camera_get_focal_distance(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_focal_distance");
+  return NAN;
+}
+
+double wb_camera_get_max_focal_distance(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_max_focal_distance");
+  return NAN;
+}
+
+double wb_camera_get_min_focal_distance(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_min_focal_distance");
+  return NAN;
+}
+
+void wb_camera_set_focal_distance(WbDeviceTag tag, double focal_distance) {
+  (void)focal_distance;
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_set_focal_distance");
+}
+
+double wb_camera_get_near(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_near");
+  return NAN;
+}
+
+int wb_camera_save_image(WbDeviceTag tag, const char *filename, int quality) {
+  (void)filename;
+  (void)quality;
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_save_image");
+  return 0;
+}
+
+bool wb_camera_has_recognition(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_has_recognition");
+  return false;
+}
+
+void wb_camera_recognition_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_enable");
+}
+
+void wb_camera_recognition_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_disable");
+}
+
+int wb_camera_recognition_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_sampling_period");
+  return 0;
+}
+
+int wb_camera_recognition_get_number_of_objects(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_number_of_objects");
+  return 0;
+}
+
+const WbCameraRecognitionObject *wb_camera_recognition_get_objects(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_objects");
+  return NULL;
+}
+
+bool wb_camera_recognition_has_segmentation(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_has_segmentation");
+  return false;
+}
+
+void wb_camera_recognition_enable_segmentation(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_enable_segmentation");
+}
+
+void wb_camera_recognition_disable_segmentation(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_disable_segmentation");
+}
+
+bool wb_camera_recognition_is_segmentation_enabled(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_is_segmentation_enabled");
+  return false;
+}
+
+const unsigned char *wb_camera_recognition_get_segmentation_image(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_segmentation_image");
+  return NULL;
+}
+
+int wb_camera_recognition_save_segmentation_image(WbDeviceTag tag, const char *filename, int quality) {
+  (void)filename;
+  (void)quality;
+  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_save_segmentation_image");
+  return 0;
+}
+
+/* ------------------------------------------------------------------ Compass */
+void wb_compass_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_enable");
+}
+
+void wb_compass_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_disable");
+}
+
+int wb_compass_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_get_sampling_period");
+  return 0;
+}
+
+const double *wb_compass_get_values(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_get_values");
+  return sn_no_values();
+}
+
+int wb_compass_get_lookup_table_size(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_get_lookup_table_size");
+  return 0;
+}
+
+const double *wb_compass_get_lookup_table(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_get_lookup_table");
+  return sn_no_values();
+}
+
+/* ------------------------------------------------------------------ Connector */
+void wb_connector_enable_presence(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_enable_presence");
+}
+
+void wb_connector_disable_presence(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_disable_presence");
+}
+
+int wb_connector_get_presence_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_get_presence_sampling_period");
+  return 0;
+}
+
+int wb_connector_get_presence(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_get_presence");
+  return 0;
+}
+
+void wb_connector_lock(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_lock");
+}
+
+void wb_connector_unlock(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_unlock");
+}
+
+bool wb_connector_is_locked(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_is_locked");
+  return false;
+}
+
+/* ------------------------------------------------------------------ Display */
+int wb_display_get_width(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_get_width");
+  return 0;
+}
+
+int wb_display_get_height(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_get_height");
+  return 0;
+}
+
+void wb_display_set_color(WbDeviceTag tag, int color) {
+  (void)color;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_set_color");
+}
+
+void wb_display_set_alpha(WbDeviceTag tag, double alpha) {
+  (void)alpha;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_set_alpha");
+}
+
+void wb_display_set_opacity(WbDeviceTag tag, double opacity) {
+  (void)opacity;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_set_opacity");
+}
+
+void wb_display_set_font(WbDeviceTag tag, const char *font, int size, bool anti_aliasing) {
+  (void)font;
+  (void)size;
+  (void)anti_aliasing;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_set_font");
+}
+
+void wb_display_attach_camera(WbDeviceTag tag, WbDeviceTag camera_tag) {
+  (void)camera_tag;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_attach_camera");
+}
+
+void wb_display_detach_camera(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_detach_camera");
+}
+
+void wb_display_draw_pixel(WbDeviceTag tag, int x, int y) {
+  (void)x;
+  (void)y;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_pixel");
+}
+
+void wb_display_draw_line(WbDeviceTag tag, int x1, int y1, int x2, int y2) {
+  (void)x1;
+  (void)y1;
+  (void)x2;
+  (void)y2;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_line");
+}
+
+void wb_display_draw_rectangle(WbDeviceTag tag, int x, int y, int width, int height) {
+  (void)x;
+  (void)y;
+  (void)width;
+  (void)height;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_rectangle");
+}
+
+void wb_display_draw_oval(WbDeviceTag tag, int cx, int cy, int a, int b) {
+  (void)cx;
+  (void)cy;
+  (void)a;
+  (void)b;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_oval");
+}
+
+void wb_display_draw_polygon(WbDeviceTag tag, const int *x, const int *y, int size) {
+  (void)x;
+  (void)y;
+  (void)size;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_polygon");
+}
+
+void wb_display_draw_text(WbDeviceTag tag, const char *text, int x, int y) {
+  (void)text;
+  (void)x;
+  (void)y;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_text");
+}
+
+void wb_display_fill_rectangle(WbDeviceTag tag, int x, int y, int width, int height) {
+  (void)x;
+  (void)y;
+  (void)width;
+  (void)height;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_fill_rectangle");
+}
+
+void wb_display_fill_oval(WbDeviceTag tag, int cx, int cy, int a, int b) {
+  (void)cx;
+  (void)cy;
+  (void)a;
+  (void)b;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_fill_oval");
+}
+
+void wb_display_fill_polygon(WbDeviceTag tag, const int *x, const int *y, int size) {
+  (void)x;
+  (void)y;
+  (void)size;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_fill_polygon");
+}
+
+WbImageRef wb_display_image_new(WbDeviceTag tag, int width, int height, const void *data, int format) {
+  (void)width;
+  (void)height;
+  (void)data;
+  (void)format;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_new");
+  return NULL;
+}
+
+WbImageRef wb_display_image_load(WbDeviceTag tag, const char *filename) {
+  (void)filename;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_load");
+  return NULL;
+}
+
+WbImageRef wb_display_image_copy(WbDeviceTag tag, int x, int y, int width, int height) {
+  (void)x;
+  (void)y;
+  (void)width;
+  (void)height;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_copy");
+  return NULL;
+}
+
+void wb_display_image_paste(WbDeviceTag tag, WbImageRef ir, int x, int y, bool blend) {
+  (void)ir;
+  (void)x;
+  (void)y;
+  (void)blend;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_paste");
+}
+
+void wb_display_image_save(WbDeviceTag tag, WbImageRef ir, const char *filename) {
+  (void)ir;
+  (void)filename;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_save");
+}
+
+void wb_display_image_delete(WbDeviceTag tag, WbImageRef ir) {
+  (void)ir;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_delete");
+}
+
+/* ------------------------------------------------------------------ Emitter */
+int wb_emitter_send(WbDeviceTag tag, const void *data, int size) {
+  (void)data;
+  (void)size;
+  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_send");
+  return 0;
+}
+
+int wb_emitter_get_buffer_size(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_get_buffer_size");
+  return 0;
+}
+
+void wb_emitter_set_channel(WbDeviceTag tag, int channel) {
+  (void)channel;
+  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_set_channel");
+}
+
+int wb_emitter_get_channel(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_get_channel");
+  return 0;
+}
+
+double wb_emitter_get_range(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_get_range");
+  return NAN;
+}
+
+void wb_emitter_set_range(WbDeviceTag tag, double range) {
+  (void)range;
+  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_set_range");
+}
+
+/* ------------------------------------------------------------------ Gyro */
+void wb_gyro_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_enable");
+}
+
+void wb_gyro_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_disable");
+}
+
+int wb_gyro_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_get_sampling_period");
+  return 0;
+}
+
+const double *wb_gyro_get_values(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_get_values");
+  return sn_no_values();
+}
+
+int wb_gyro_get_lookup_table_size(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_get_lookup_table_size");
+  return 0;
+}
+
+const double *wb_gyro_get_lookup_table(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_get_lookup_table");
+  return sn_no_values();
+}
+
+/* ------------------------------------------------------------------ InertialUnit */
+void wb_inertial_unit_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_enable");
+}
+
+void wb_inertial_unit_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_disable");
+}
+
+int wb_inertial_unit_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_sampling_period");
+  return 0;
+}
+
+double wb_inertial_unit_get_noise(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_noise");
+  return NAN;
+}
+
+const double *wb_inertial_unit_get_roll_pitch_yaw(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_roll_pitch_yaw");
+  return sn_no_values();
+}
+
+const double *wb_inertial_unit_get_quaternion(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_quaternion");
+  return sn_no_values();
+}
+
+/* ------------------------------------------------------------------ Pen */
+void wb_pen_write(WbDeviceTag tag, bool write) {
+  (void)write;
+  sn_unsimulated(tag, WB_NODE_PEN, "wb_pen_write");
+}
+
+void wb_pen_set_ink_color(WbDeviceTag tag, int color, double density) {
+  (void)color;
+  (void)density;
+  sn_unsimulated(tag, WB_NODE_PEN, "wb_pen_set_ink_color");
+}
+
+/* ------------------------------------------------------------------ Radar */
+void wb_radar_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_enable");
+}
+
+void wb_radar_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_disable");
+}
+
+int wb_radar_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_sampling_period");
+  return 0;
+}
+
+int wb_radar_get_number_of_targets(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_number_of_targets");
+  return 0;
+}
+
+const WbRadarTarget *wb_radar_get_targets(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_targets");
+  return NULL;
+}
+
+double wb_radar_get_min_range(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_min_range");
+  return NAN;
+}
+
+double wb_radar_get_max_range(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_max_range");
+  return NAN;
+}
+
+double wb_radar_get_horizontal_fov(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_horizontal_fov");
+  return NAN;
+}
+
+double wb_radar_get_vertical_fov(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_vertical_fov");
+  return NAN;
+}
+
+/* ------------------------------------------------------------------ RangeFinder */
+void wb_range_finder_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_enable");
+}
+
+void wb_range_finder_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_disable");
+}
+
+int wb_range_finder_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_sampling_period");
+  return 0;
+}
+
+const float *wb_range_finder_get_range_image(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_range_image");
+  return NULL;
+}
+
+int wb_range_finder_get_width(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_width");
+  return 0;
+}
+
+int wb_range_finder_get_height(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_height");
+  return 0;
+}
+
+double wb_range_finder_get_fov(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_fov");
+  return NAN;
+}
+
+double wb_range_finder_get_min_range(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_min_range");
+  return NAN;
+}
+
+double wb_range_finder_get_max_range(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_max_range");
+  return NAN;
+}
+
+int wb_range_finder_save_image(WbDeviceTag tag, const char *filename, int quality) {
+  (void)filename;
+  (void)quality;
+  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_save_image");
+  return 0;
+}
+
+/* ------------------------------------------------------------------ Receiver */
+void wb_receiver_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_enable");
+}
+
+void wb_receiver_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_disable");
+}
+
+int wb_receiver_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_sampling_period");
+  return 0;
+}
+
+void wb_receiver_set_channel(WbDeviceTag tag, int channel) {
+  (void)channel;
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_set_channel");
+}
+
+int wb_receiver_get_channel(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_channel");
+  return 0;
+}
+
+int wb_receiver_get_queue_length(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_queue_length");
+  return 0;
+}
+
+void wb_receiver_next_packet(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_next_packet");
+}
+
+int wb_receiver_get_data_size(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_data_size");
+  return 0;
+}
+
+const void *wb_receiver_get_data(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_data");
+  return NULL;
+}
+
+double wb_receiver_get_signal_strength(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_signal_strength");
+  return NAN;
+}
+
+const double *wb_receiver_get_emitter_direction(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_emitter_direction");
+  return sn_no_values();
+}
+
+/* ------------------------------------------------------------------ Skin */
+void wb_skin_set_bone_orientation(WbDeviceTag tag, int index, const double orientation[4], bool absolute) {
+  (void)index;
+  (void)orientation;
+  (void)absolute;
+  sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_set_bone_orientation");
+}
+
+void wb_skin_set_bone_position(WbDeviceTag tag, int index, const double position[3], bool absolute) {
+  (void)index;
+  (void)position;
+  (void)absolute;
+  sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_set_bone_position");
+}
+
+int wb_skin_get_bone_count(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_get_bone_count");
+  return 0;
+}
+
+const char *wb_skin_get_bone_name(WbDeviceTag tag, int index) {
+  (void)index;
+  sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_get_bone_name");
+  return "";
+}
+
+const double *wb_skin_get_bone_orientation(WbDeviceTag tag, int index, bool absolute) {
+  (void)index;
+  (void)absolute;
+  sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_get_bone_orientation");
+  return sn_no_values();
+}
+
+const double *wb_skin_get_bone_position(WbDeviceTag tag, int index, bool absolute) {
+  (void)index;
+  (void)absolute;
+  sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_get_bone_position");
+  return sn_no_values();
+}
+
+/* ------------------------------------------------------------------ Speaker */
+void wb_speaker_play_sound(WbDeviceTag left, WbDeviceTag right, const char *sound, double volume, double pitch, double balance, bool loop) {
+  (void)right;
+  (void)sound;
+  (void)volume;
+  (void)pitch;
+  (void)balance;
+  (void)loop;
+  sn_unsimulated(left, WB_NODE_SPEAKER, "wb_speaker_play_sound");
+}
+
+void wb_speaker_stop(WbDeviceTag tag, const char *sound) {
+  (void)sound;
+  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_stop");
+}
+
+bool wb_speaker_is_sound_playing(WbDeviceTag tag, const char *sound) {
+  (void)sound;
+  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_is_sound_playing");
+  return false;
+}
+
+bool wb_speaker_set_engine(WbDeviceTag tag, const char *engine) {
+  (void)engine;
+  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_set_engine");
+  return false;
+}
+
+bool wb_speaker_set_language(WbDeviceTag tag, const char *language) {
+  (void)language;
+  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_set_language");
+  return false;
+}
+
+const char *wb_speaker_get_engine(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_get_engine");
+  return "";
+}
+
+const char *wb_speaker_get_language(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_get_language");
+  return "";
+}
+
+void wb_speaker_speak(WbDeviceTag tag, const char *text, double volume) {
+  (void)text;
+  (void)volume;
+  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_speak");
+}
+
+bool wb_speaker_is_speaking(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_is_speaking");
+  return false;
+}
+
+/* ------------------------------------------------------------------ TouchSensor */
+void wb_touch_sensor_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_enable");
+}
+
+void wb_touch_sensor_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_disable");
+}
+
+int wb_touch_sensor_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_sampling_period");
+  return 0;
+}
+
+double wb_touch_sensor_get_value(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_value");
+  return NAN;
+}
+
+const double *wb_touch_sensor_get_values(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_values");
+  return sn_no_values();
+}
+
+WbTouchSensorType wb_touch_sensor_get_type(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_type");
+  return (WbTouchSensorType)0;
+}
+
+int wb_touch_sensor_get_lookup_table_size(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_lookup_table_size");
+  return 0;
+}
+
+const double *wb_touch_sensor_get_lookup_table(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_lookup_table");
+  return sn_no_values();
+}
+
+/* ------------------------------------------------------------------ VacuumGripper */
+void wb_vacuum_gripper_enable_presence(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_enable_presence");
+}
+
+void wb_vacuum_gripper_disable_presence(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_disable_presence");
+}
+
+int wb_vacuum_gripper_get_presence_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_get_presence_sampling_period");
+  return 0;
+}
+
+bool wb_vacuum_gripper_get_presence(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_get_presence");
+  return false;
+}
+
+void wb_vacuum_gripper_turn_on(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_turn_on");
+}
+
+void wb_vacuum_gripper_turn_off(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_turn_off");
+}
+
+bool wb_vacuum_gripper_is_on(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_is_on");
+  return false;
+}
