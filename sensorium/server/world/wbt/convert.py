@@ -258,7 +258,7 @@ class Converter:
         elif t in OTHER_DEVICES:
             if owner.kind == "robot":
                 inner = self.child_frame(node, frame)
-                if t in wm.UNSIMULATED_DEVICE_TYPES:
+                if t in wm.DEVICE_TYPES:     # listed (simulated kinds take their schema defaults)
                     self.tick(node)
                     self.unsimulated(node, inner, owner)
                 self.solid_contents(node, inner, owner)
