@@ -365,12 +365,14 @@ def test_subscribe_churn_does_not_stall_stepping():
         from _node import run_script
 
         rounds = -(-10_000 // 22)                                           # arena: 22 channels
-        result = run_script("viewer_churn.js", srv.fields["foxglove"], "1", "1", "--churn", str(rounds), timeout=120)[-1]
+        result = run_script("viewer_churn.js", srv.fields["foxglove"], "1", "1", "--churn", str(rounds),
+                            "--wait", "60", timeout=180)[-1]
         n = len(durations)
         wait_until(lambda: len(durations) > n + 50, what="stepping after the churn")
         done.set()
         thread.join(30)
-        assert result["churned"] >= 10_000 and result["failed"] == 0, result      # it got a message within 5 s
+        # the churning viewer got its data (within 60 s of its last subscribe: generous for a busy machine)
+        assert result["churned"] >= 10_000 and result["failed"] == 0, result
         assert max(durations) < 0.5, f"a step took {max(durations) * 1000:.0f} ms during the churn"
     finally:
         ctx.destroy(0)
