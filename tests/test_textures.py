@@ -571,8 +571,9 @@ def test_ink_layer_sizes_discs_and_atlas(tmp_path: Path) -> None:
     assert sampler.ink_layer(2).density.shape == (64, 64)
     assert bounding_radius(models[2][0]) == pytest.approx(math.hypot(0.1, 0.1))
     assert sampler.textured[[0, 1, 2, 3]].tolist() == [True, True, True, False]
-    # a lead of 5 texels across: a disc of radius 2 (13 texels) around (u w, v h)
-    layer = InkLayer(32, 32, 100.0)
+    # a lead of 5 texels across (0.05 x 32 / 0.32): a disc of radius 2 (13 texels) around (u w, v h)
+    layer = InkLayer(32, 32, 32, 0.32)
+    assert layer.lead_texels(0.05) == 5
     assert layer.paint(0.5, 0.5, 0.05, (1, 0, 0), 0.5) == 13
     assert layer.density[16, 14:19].tolist() == [0.5] * 5 and layer.density[14, 15:18].tolist() == [0, 0.5, 0]
     assert layer.paint(1.2, 0.5, 0.05, (1, 0, 0), 0.5) == 0                  # outside [0, 1]: nothing

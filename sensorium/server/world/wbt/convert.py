@@ -231,6 +231,9 @@ class Converter:
             raise f.error("coordinateSystem", f"{system!r} is not supported (ENU or NUE)")
         info = {"name": f.string("title", "") or Path(self.source).stem, "basic_time_step": int(step),
                 "random_seed": seed, "coordinate_system": system}
+        evaporation = f.num("inkEvaporation", 0.0)
+        if evaporation > 0.0:          # Webots' pen ink fading (a value <= 0 never evaporates)
+            info["ink_evaporation"] = evaporation
         self.world["world_info"] = info
 
     # ------------------------------------------------------------ the walk
@@ -260,7 +263,9 @@ class Converter:
                 inner = self.child_frame(node, frame)
                 if t in wm.DEVICE_TYPES:     # listed (simulated kinds take their schema defaults)
                     self.tick(node)
-                    self.unsimulated(node, inner, owner)
+                    entry = self.unsimulated(node, inner, owner)
+                    if t == "Pen":             # a Pen keeps its fields (simulated: it inks)
+                        entry.update(fx.pen(f))
                 self.solid_contents(node, inner, owner)
             else:
                 self.skipped[t] += 1

@@ -168,6 +168,14 @@ def device(node: Node, f: Fields) -> dict:
     raise AssertionError(t)
 
 
+def pen(f: Fields) -> dict:
+    """A Pen's fields in the world format's names (Webots' defaults; its colour clamped to [0, 1]
+    as an SFColor is, its density left to the loader's Webots clamping)."""
+    colour = [min(max(c, 0.0), 1.0) for c in f.vec("inkColor", (0.0, 0.0, 0.0))]
+    return {"ink_color": colour, "ink_density": f.num("inkDensity", 0.5), "lead_size": max(f.num("leadSize", 0.002), 0.0),
+            "max_distance": f.num("maxDistance", 0.0), "write": f.flag("write", True)}
+
+
 DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light sensor", "Lidar": "lidar",
                 "PositionSensor": "position sensor", "LED": "led", "RotationalMotor": "rotational motor"}
 
