@@ -377,3 +377,45 @@ Robot {
     # the marker's tip is the bottom of its own cylinder; its ray goes down to the floor
     assert sim.counters["ink_strokes"] == 1
     assert sim.device("r/marker").stroke.tolist() == pytest.approx([0.1, 0.2, 0.0], abs=1e-12)
+
+
+def test_a_recording_holds_every_stroke_and_exports_to_ros2(tmp_path: Path) -> None:
+    """``serve --record`` records the pen's topics like any other: one stroke (where) and one ink
+    (which) per basic step that inked; the ROS 2 export carries them as PointStamped and ColorRGBA."""
+    from rosbags.highlevel import AnyReader
+
+    from sensorium.server.recording.export import export_ros2
+    from sensorium.server.recording.reader import Recording
+    from sensorium.server.recording.writer import McapRecorder
+
+    sim = make([pen(ink_color=[1.0, 0.5, 0.0], ink_density=0.25)], at=(-0.2, 0.1), drive=True)
+    for m in sim.robot("r").motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(5.0)
+    core = Core(sim)
+    path = tmp_path / "pen.mcap"
+    points = []
+    with McapRecorder(path, b"", "pen.yaml", {}, ["/r/pen/"], foxglove=False) as rec:
+        core.topics.set_recorder(rec)
+        for k in range(5):
+            if k == 3:
+                sim.device("r/pen").set_write(False)      # no stroke, no message
+            sim.step()
+            core.topics.publish(sim.time_ms)
+            if k < 3:
+                points.append(sim.device("r/pen").stroke.tolist())
+    got = [(m.topic, m.stamp_ns, m.decode()) for m in Recording(path).messages()]
+    assert [t for t, _, _ in got] == ["/r/pen/stroke", "/r/pen/ink"] * 3
+    assert [ns for _, ns, _ in got] == [16_000_000, 16_000_000, 32_000_000, 32_000_000, 48_000_000, 48_000_000]
+    strokes = [body["point"] for t, _, body in got if t == "/r/pen/stroke"]
+    assert [[p["x"], p["y"], p["z"]] for p in strokes] == points
+    assert points[1][0] - points[0][0] == pytest.approx(0.0016, abs=1e-12)        # 0.1 m/s x 16 ms
+    assert got[1][2] == {"r": 1.0, "g": 0.5, "b": 0.0, "a": 0.25}
+    out = tmp_path / "pen_ros2.mcap"
+    report = export_ros2(path, out, distro="jazzy")
+    assert report.messages == 6 and not report.skipped
+    with AnyReader([out]) as reader:
+        msgs_ = [(c.topic, c.msgtype, reader.deserialize(raw, c.msgtype)) for c, _, raw in reader.messages()]
+    assert msgs_[0][1] == "geometry_msgs/msg/PointStamped" and msgs_[0][2].header.frame_id == "world"
+    assert msgs_[0][2].point.x == points[0][0] and msgs_[1][1] == "std_msgs/msg/ColorRGBA"
+    assert msgs_[1][2].a == pytest.approx(0.25)

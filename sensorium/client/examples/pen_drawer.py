@@ -19,7 +19,7 @@ import sys
 try:                                   # as a bundled module, and as a script run by `sensorium controller`
     from sensorium.client.examples.line_follower import LineFollower
 except ImportError:                    # pragma: no cover - a copy of this file next to line_follower.py
-    from line_follower import LineFollower
+    from line_follower import LineFollower  # type: ignore[no-redef]
 
 RADIUS = 0.5             # m, the circle the robot's centre drives
 SPEED = 0.08             # m/s along it

@@ -512,6 +512,14 @@ def bounding_radius(geometry: Any, vertices: np.ndarray | None = None, faces: np
     return radius
 
 
+@lru_cache(maxsize=64)
+def _disc(half: int) -> tuple[np.ndarray, np.ndarray]:
+    """(row, column) offsets of a lead's texels: ``dx² ≤ half² − dy²`` (WbPaintTexture::paint)."""
+    dy, dx = np.mgrid[-half:half + 1, -half:half + 1]
+    inside = dx * dx <= half * half - dy * dy
+    return dy[inside], dx[inside]
+
+
 class InkLayer:
     """The ink pens laid on one shape (Webots' WbPaintTexture): RGB and density per texel
     (float32, as Webots keeps them), white and 0 at first.
@@ -552,12 +560,13 @@ class InkLayer:
         h, w = self.density.shape
         x, y = int(u * w), int(v * h)
         half = self.lead_texels(lead_size) // 2
-        ox, oy, sx, sy = max(x - half, 0), max(y - half, 0), min(x + half, w - 1), min(y + half, h - 1)
-        if ox > sx or oy > sy:
-            return 0
-        ty, tx = np.mgrid[oy:sy + 1, ox:sx + 1]
-        inside = (tx - x) ** 2 <= half * half - (ty - y) ** 2
-        rows, cols = ty[inside], tx[inside]
+        dy, dx = _disc(half)
+        rows, cols = dy + y, dx + x
+        if x - half < 0 or y - half < 0 or x + half >= w or y + half >= h:     # clipped at the edges
+            keep = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+            rows, cols = rows[keep], cols[keep]
+            if not len(rows):
+                return 0
         d = np.float32(density)
         prev = self.density[rows, cols]
         total = d + prev
@@ -570,7 +579,7 @@ class InkLayer:
         self.density[rows, cols] = np.minimum(total, np.float32(1.0))
         if self.evaporation is not None:
             self.evaporation[rows, cols] = np.minimum(self.evaporation[rows, cols] + float(d), 1.0)
-            box = [oy, sy + 1, ox, sx + 1]
+            box = [max(y - half, 0), min(y + half + 1, h), max(x - half, 0), min(x + half + 1, w)]
             live = self._live
             self._live = box if live is None else [min(live[0], box[0]), max(live[1], box[1]),
                                                    min(live[2], box[2]), max(live[3], box[3])]
