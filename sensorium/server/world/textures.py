@@ -55,16 +55,18 @@ class TextureFileError(Exception):
 
 
 def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False,
-                        max_bytes: int | None = None) -> Path:
+                        max_bytes: int | None = None, allowed: frozenset[Path] = frozenset()) -> Path:
     """A texture ``url`` → the file it names, relative to ``base_dir`` (the world's folder), which
-    it may not leave unless ``allow_outside`` (as mesh urls). Errors quote the url as written."""
+    it may not leave unless ``allow_outside`` (as mesh urls), except the files in ``allowed`` (a
+    converted .wbt's PROTO and Webots assets, read where they are). Errors quote the url as written."""
     if "\0" in url:
         raise TextureFileError("texture url contains a NUL byte")
     if not url.strip():
         raise TextureFileError("texture url is empty")
     if url.startswith("webots://"):
-        raise TextureFileError(f"texture url {url!r}: webots:// urls (files of a Webots installation) are not "
-                               "resolved yet")
+        raise TextureFileError(f"texture url {url!r}: webots:// urls (files of a Webots installation) are "
+                               "resolved in .wbt worlds only (with --webots-home or WEBOTS_HOME); a YAML world "
+                               "names files relative to itself")
     if "://" in url:
         raise TextureFileError(f"texture url {url!r}: only local files are read (no downloads)")
     base = Path(base_dir).resolve()
@@ -72,7 +74,7 @@ def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False
         path = (base / url).resolve()
     except (OSError, RuntimeError, ValueError) as exc:
         raise TextureFileError(f"texture url {url!r} cannot be resolved: {exc}") from None
-    if not allow_outside and not path.is_relative_to(base):
+    if not allow_outside and not path.is_relative_to(base) and path not in allowed:
         raise TextureFileError(f"texture url {url!r} leaves the world's folder (absolute paths and '..' are "
                                "refused; use --allow-outside-meshes to allow them)")
     try:
@@ -175,10 +177,12 @@ def _appearances(world: wm.World) -> Iterator[tuple[str, Any]]:
             yield f"robots[{r_i}].shapes[{i}]", part
 
 
-def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False) -> list[tuple[str, str]]:
-    """Every texture of a world: url confined and readable, a PNG or JPEG within the limits, decoded
-    (so a broken file is found when the world is checked, and decoded once); the texture
-    coordinates of inline triangles consistent. ``(path, message)`` per problem."""
+def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False,
+                   allowed: frozenset[Path] = frozenset()) -> list[tuple[str, str]]:
+    """Every texture of a world: url confined (``allowed``: files outside the world's folder it may
+    read, a .wbt's PROTO assets) and readable, a PNG or JPEG within the limits, decoded (so a broken
+    file is found when the world is checked, and decoded once); the texture coordinates of inline
+    triangles consistent. ``(path, message)`` per problem."""
     problems: list[tuple[str, str]] = []
     seen: dict[Path, int] = {}
     total = 0
@@ -190,7 +194,7 @@ def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: 
             where = f"{path}.appearance.{field}.url"
             try:
                 file = resolve_texture_url(tex.url, base_dir, allow_outside=allow_outside,
-                                           max_bytes=limits.texture_file_bytes)
+                                           max_bytes=limits.texture_file_bytes, allowed=allowed)
                 if file in seen:
                     continue
                 _, w, h = image_header(file, tex.url)
