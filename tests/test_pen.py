@@ -76,6 +76,11 @@ def texel_centre(col: int, row: int, n: int = 128, side: float = 1.0) -> tuple[f
     return ((col + 0.5) / n - 0.5) * side, (0.5 - (row + 0.5) / n) * side
 
 
+# an appearance (white): ink blends with it by density; a shape without any appearance reads the
+# ink's colour alone (test_a_shape_without_appearance_reads_the_ink_colour_alone)
+WHITE_FLOOR = {"name": "floor", "geometry": {"type": "plane", "size": [1.0, 1.0]}, "appearance": {"base_color": [1, 1, 1]}}
+
+
 # ------------------------------------------------------------------ a stroke, then a reading
 
 @pytest.mark.parametrize("precision", PRECISIONS)
@@ -142,7 +147,7 @@ def test_density_blends_colours_and_caps_at_one() -> None:
     """WbPaintTexture::paint: the colour keeps old/(old + new) of itself, the density adds up to 1.
     Colours set with set_ink_color are Webots' float32 byte/255."""
     x, y = texel_centre(70, 60)
-    sim = make([pen(write=False), ir("over", 0.0, 0.0)], at=(x, y))
+    sim = make([pen(write=False), ir("over", 0.0, 0.0)], at=(x, y), floor=WHITE_FLOOR)
     p = sim.device("r/pen")
     c1 = (ink_channel(0x33), ink_channel(0x66), ink_channel(0x99))
     assert c1[0] == float(np.float32(51) / np.float32(255)) and c1[0] != 0.2      # Webots' r / 255.0f
@@ -168,6 +173,27 @@ def test_density_blends_colours_and_caps_at_one() -> None:
     assert p.ink_density == 0.0
     with pytest.raises(ValueError, match="finite"):
         p.set_ink_color(0, math.nan)
+
+
+@pytest.mark.parametrize("precision", PRECISIONS)
+def test_a_shape_without_appearance_reads_the_ink_colour_alone(precision: str) -> None:
+    """WbShape::pickColor: a shape with neither Appearance nor PBRAppearance reads its paint
+    texture's colour, whatever the density (white where never inked); with an appearance the ink
+    blends by density. Ink 0x336699 at density 0.25 on both."""
+    bare = {"name": "bare", "geometry": {"type": "plane", "size": [1.0, 1.0]}}
+    white = {**WHITE_FLOOR, "name": "white", "pose": {"translation": [2.0, 0.0, 0.0]}}
+    x, y = texel_centre(70, 60)
+    sim = make([pen("p0", x, y, write=False), pen("p1", 2.0 + x, y, write=False), ir("bare", x, y),
+                ir("white", 2.0 + x, y), ir("beside", x + 2 / 128, y)], floor=bare, solids=[white], precision=precision)
+    for name in ("p0", "p1"):
+        sim.device(f"r/{name}").set_ink_color(0x336699, 0.25)
+        sim.device(f"r/{name}").set_write(True)
+    sim.step()
+    c = ink_channel(0x33)
+    v = values(sim)
+    assert v["bare"] == pytest.approx(reading(c), rel=tol(precision))
+    assert v["white"] == pytest.approx(reading(0.75 + 0.25 * c), rel=tol(precision))
+    assert v["beside"] == pytest.approx(reading(1.0), rel=tol(precision))       # never inked: white
 
 
 # ------------------------------------------------------------------ lead size
@@ -251,7 +277,7 @@ def test_ink_evaporates_as_webots_inkEvaporation_and_reset_clears_it() -> None: 
     (1 − D)·1 + D·0 under black ink."""
     x, y = texel_centre(70, 60)
     e, dt = 2.0, 16
-    sim = make([pen(ink_density=0.5), ir("over", 0.0, 0.0)], at=(x, y), evaporation=e, step=dt)
+    sim = make([pen(ink_density=0.5), ir("over", 0.0, 0.0)], at=(x, y), evaporation=e, step=dt, floor=WHITE_FLOOR)
     p = sim.device("r/pen")
     sim.step()
     p.set_write(False)
@@ -296,7 +322,8 @@ def call(core: Core, service: str, args: dict | None = None) -> dict:
 
 def test_services_attach_description_and_topics() -> None:
     x, y = texel_centre(70, 60)
-    sim = make([pen(write=False, lead_size=0.004, max_distance=0.1), ir("over", 0.0, 0.0)], at=(x, y))
+    sim = make([pen(write=False, lead_size=0.004, max_distance=0.1), ir("over", 0.0, 0.0)], at=(x, y),
+               floor=WHITE_FLOOR)
     core = Core(sim)
     assert {"/r/pen/write", "/r/pen/set_ink_color"} <= set(core.routes)
     types = {t.name: t.type for t in core.topics.topics}

@@ -791,10 +791,10 @@ class TextureSampler:
     def infra_red(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray, red: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None]:
         """For hits on ``shape`` whose untextured red is ``red`` (WbShape::pickColor): the red read
-        (``(1 − c)·red·texel + c·ink`` with ``c`` the ink's density; the texel where picking failed
-        is 1 and the ink ignored), the roughness and occlusion maps' red (None when there is no
-        such map) and where picking succeeded (None: everywhere; elsewhere the roughness field and
-        no occlusion apply)."""
+        (``(1 − c)·red·texel + c·ink`` with ``c`` the ink's density; a shape without appearance
+        reads the ink's colour alone; the texel where picking failed is 1 and the ink ignored), the
+        roughness and occlusion maps' red (None when there is no such map) and where picking
+        succeeded (None: everywhere; elsewhere the roughness field and no occlusion apply)."""
         uv, picked = self._uv_of(shape, False)(origins, directions, t)
         self.lookups += len(t)
         if picked is not None:
@@ -814,6 +814,11 @@ class TextureSampler:
         layer = self.ink.get(shape)
         if layer is not None:
             ink, c = layer.pick(uv)
+            if self.models[shape][1] is None:
+                # a shape without any appearance reads the paint texture's colour alone, whatever its
+                # density (WbShape::pickColor: neither Appearance nor PBRAppearance -> paintColor)
+                out = ink[:, 0] if picked is None else np.where(picked, ink[:, 0], red)
+                return out, rough, occl, picked
             if picked is not None:
                 c = np.where(picked, c, np.float32(0.0))
             blended = (np.float32(1.0) - c).astype(np.float64) * red      # (1.0f - c) in float32
