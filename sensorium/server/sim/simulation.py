@@ -216,7 +216,8 @@ class Simulation:
 
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, wheel
-        motors to their initial commands and angles, LEDs off, custom data as in the world file.
+        motors to their initial commands and angles, LEDs off, pen ink cleared (the pens keep their
+        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file.
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
         for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):

@@ -108,6 +108,9 @@ class Robot:
     def getMotor(self, name: str) -> Device | None:
         return self._deprecated("getMotor", name)
 
+    def getPen(self, name: str) -> Device | None:
+        return self._deprecated("getPen", name)
+
     @classmethod
     def device_by_tag(cls, tag: int) -> Device | None:
         robot = cls.created
