@@ -146,9 +146,10 @@ def test_webots_infra_red_test_situation(tmp_path: Path, precision: str) -> None
     assert v["ds0"] == pytest.approx(1019.3725, abs=1e-3)
 
 
-def test_a_texture_webots_could_not_load_reads_the_untextured_colour(tmp_path: Path) -> None:
-    """Missing file (or webots:// url, not resolved yet): a warning, and Webots' reading of a
-    texture it could not load: an Appearance's material diffuseColor (not white)."""
+def test_a_texture_webots_could_not_load_reads_the_untextured_colour(tmp_path: Path, monkeypatch) -> None:
+    """Missing file (or a webots:// url without a Webots installation): a warning, and Webots'
+    reading of a texture it could not load: an Appearance's material diffuseColor (not white)."""
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
     path = _webots_ir_test_world(tmp_path)
     (tmp_path / "textures" / "greenish.png").unlink()
     sim = Simulation.from_file(path)
@@ -157,7 +158,48 @@ def test_a_texture_webots_could_not_load_reads_the_untextured_colour(tmp_path: P
     assert read_all(sim)["ds1"] == pytest.approx(10 * expected(0.065, 0.75), rel=1e-9)
     path.write_text(path.read_text().replace("textures/greenish.png", "webots://projects/x.png"))
     notes = [w for w in load_world(path).warnings if "texture" in w]
-    assert len(notes) == 1 and "webots:// urls" in notes[0] and "not resolved yet" in notes[0]
+    assert len(notes) == 1 and '"webots://projects/x.png" not found' in notes[0] and "WEBOTS_HOME" in notes[0]
+
+
+def test_proto_relative_and_webots_texture_urls_are_read_where_they_are(tmp_path: Path, monkeypatch) -> None:
+    """A PROTO's ImageTexture url is relative to the PROTO file, a webots:// url names the Webots
+    installation's file (as mesh urls): both read in place, and infra-red sensors read their texels."""
+    from _protos import proto_file, world_file
+
+    home = tmp_path / "webots"
+    (home / "projects" / "textures").mkdir(parents=True)
+    Image.new("RGB", (4, 4), (51, 0, 0)).save(home / "projects" / "textures" / "dark.png")
+    (home / "resources").mkdir()
+    (home / "resources" / "version.txt").write_text("R2023b\n")
+    monkeypatch.setenv("WEBOTS_HOME", str(home))
+    protos = tmp_path / "project" / "protos"
+    (protos / "textures").mkdir(parents=True)
+    Image.new("RGB", (4, 4), (153, 0, 0)).save(protos / "textures" / "mid.png")
+    proto_file(protos, "Tiles", """[ field SFVec3f translation 0 0 0 field SFString name "tiles" ]
+{ Solid { translation IS translation name IS name children [
+    Shape { appearance Appearance { texture ImageTexture { url [ "textures/mid.png" ] } } geometry Plane { size 0.2 0.2 } }
+    Pose { translation 0.5 0 0 children [ Shape { appearance PBRAppearance {
+      baseColorMap ImageTexture { url [ "webots://projects/textures/dark.png" ] } } geometry Plane { size 0.2 0.2 } } ] } ] } }""")
+    w = world_file(tmp_path / "project" / "worlds", """Tiles { }
+Robot { name "r" children [
+  DistanceSensor { translation 0 0 0.01 rotation 0 1 0 1.5707963267948966 name "a" type "infra-red" lookupTable [ 0 0 0, 1 1000 0 ] }
+  DistanceSensor { translation 0.5 0 0.01 rotation 0 1 0 1.5707963267948966 name "b" type "infra-red" lookupTable [ 0 0 0, 1 1000 0 ] } ] }
+""", ["../protos/Tiles.proto"])
+    loaded = load_world(w)
+    assert not [m for m in loaded.warnings if "texture" in m]
+    urls = [p.appearance.texture.url for p in loaded.world.solids[0].shapes]
+    assert urls == [str((protos / "textures" / "mid.png").resolve()), str((home / "projects/textures/dark.png").resolve())]
+    sim = Simulation(loaded)
+    v = read_all(sim)
+    assert v["a"] == pytest.approx(expected(0.01, 153 / 255), rel=1e-9)
+    assert v["b"] == pytest.approx(expected(0.01, 51 / 255), rel=1e-9)
+    # a world file naming a file outside its folder is still refused
+    bad = world_file(tmp_path / "project" / "worlds", f"""Solid {{ children [ Shape {{
+  appearance Appearance {{ texture ImageTexture {{ url [ "{home}/projects/textures/dark.png" ] }} }}
+  geometry Plane {{ }} }} ] }}
+""", name="bad.wbt")
+    with pytest.raises(WorldError, match="leaves the world's folder"):
+        load_world(bad)
 
 
 # ------------------------------------------------------------------ texture coordinates at known points
@@ -571,8 +613,9 @@ def test_ink_layer_sizes_discs_and_atlas(tmp_path: Path) -> None:
     assert sampler.ink_layer(2).density.shape == (64, 64)
     assert bounding_radius(models[2][0]) == pytest.approx(math.hypot(0.1, 0.1))
     assert sampler.textured[[0, 1, 2, 3]].tolist() == [True, True, True, False]
-    # a lead of 5 texels across: a disc of radius 2 (13 texels) around (u w, v h)
-    layer = InkLayer(32, 32, 100.0)
+    # a lead of 5 texels across (0.05 x 32 / 0.32): a disc of radius 2 (13 texels) around (u w, v h)
+    layer = InkLayer(32, 32, 32, 0.32)
+    assert layer.lead_texels(0.05) == 5
     assert layer.paint(0.5, 0.5, 0.05, (1, 0, 0), 0.5) == 13
     assert layer.density[16, 14:19].tolist() == [0.5] * 5 and layer.density[14, 15:18].tolist() == [0, 0.5, 0]
     assert layer.paint(1.2, 0.5, 0.05, (1, 0, 0), 0.5) == 0                  # outside [0, 1]: nothing

@@ -22,16 +22,17 @@ out-of-range LED value are printed and ignored, as Webots does); reads of a disa
 device print Webots' message to stderr once per disable. A velocity above ``maxVelocity`` is
 clamped here with Webots' warning (Webots clamps in the simulator).
 The functions live in ``wb_robot`` (session, robot, keyboard), ``wb_sensors``, ``wb_motor`` (motors,
-LEDs) and ``wb_supervisor``; this module re-exports them all. One process drives one robot through
+LEDs), ``wb_pen`` and ``wb_supervisor``; this module re-exports them all. One process drives one robot through
 these functions; :class:`RobotClient` is the same thing as
 an object, for programs (and tests) that want several.
 """
 
 from __future__ import annotations
 
-from sensorium.client import wb_motor, wb_robot, wb_sensors, wb_supervisor
+from sensorium.client import wb_motor, wb_pen, wb_robot, wb_sensors, wb_supervisor
 from sensorium.client.connection import SensoriumError  # noqa: F401
 from sensorium.client.wb_motor import *  # noqa: F403
+from sensorium.client.wb_pen import *  # noqa: F403
 from sensorium.client.wb_robot import *  # noqa: F403
 from sensorium.client.wb_robot import (  # noqa: F401 - used by the controller classes and tests
     DISTANCE_SENSOR,
@@ -48,5 +49,5 @@ from sensorium.client.wb_sensors import *  # noqa: F403
 from sensorium.client.wb_sensors import lidar_cloud_bytes, lidar_range_bytes  # noqa: F401
 from sensorium.client.wb_supervisor import *  # noqa: F403
 
-__all__ = sorted({n for m in (wb_robot, wb_sensors, wb_motor, wb_supervisor) for n in vars(m)
+__all__ = sorted({n for m in (wb_robot, wb_sensors, wb_motor, wb_pen, wb_supervisor) for n in vars(m)
                   if n.startswith(("wb_", "WB_"))} | {"SensoriumError", "RobotClient"})

@@ -210,6 +210,13 @@ register(DeviceKind(
     topics=(TopicDecl("value", msgs.FLOAT64, "value", exists=lambda cfg, wi: cfg.type != "force-3d"),
             TopicDecl("values", msgs.VECTOR3_STAMPED, "values", exists=lambda cfg, wi: cfg.type == "force-3d")),
     description="TouchSensorDescription"))
+register(DeviceKind(
+    "Pen", wm.Pen, "sensorium.server.sim.pen:Pen",
+    services=("write", "set_ink_color"),
+    topics=(TopicDecl("stroke", msgs.POINT_STAMPED, "stroke"),
+            TopicDecl("ink", msgs.COLOR_RGBA, "ink", sensor_qos=False)),
+    rays=lambda cfg, lights: 1,                  # one ray per basic step while it writes
+    description="PenDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

@@ -184,6 +184,13 @@ class IntArgs(Args):
     value: int = Field(ge=-(1 << 31), lt=1 << 31)
 
 
+class InkColorArgs(Args):
+    """``wb_pen_set_ink_color``: Webots' 0xRRGGBB colour and the ink density (clamped to [0, 1])."""
+
+    color: int = Field(ge=0, le=0xFFFFFF, description="0xRRGGBB (each channel byte / 255)")
+    density: float = Field(description="0 transparent ... 1 opaque; clamped to [0, 1] (Webots)")
+
+
 class StringArgs(Args):
     value: str = Field(max_length=1 << 20)
 
@@ -375,6 +382,15 @@ class LEDDescription(_Entry):
     gradual: bool
 
 
+class PenDescription(_Entry):
+    type: Literal["Pen"]
+    write: bool = Field(description="whether it writes now (wb_pen_write)")
+    ink_color: list[float] = Field(description="[r, g, b] in [0, 1], the ink now (wb_pen_set_ink_color)")
+    ink_density: float
+    lead_size: float = Field(description="m")
+    max_distance: float = Field(description="m; <= 0: unlimited")
+
+
 def _description_tag(v: Any) -> str:
     get = v.get if isinstance(v, dict) else (lambda k, d=None: getattr(v, k, d))
     return str(get("type", "")) if get("simulated", True) else "unsimulated"
@@ -387,7 +403,7 @@ DeviceDescription = Annotated[
     | Annotated[GPSDescription, Tag("GPS")] | Annotated[InertialUnitDescription, Tag("InertialUnit")]
     | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]
     | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
-    | Annotated[TouchSensorDescription, Tag("TouchSensor")]
+    | Annotated[TouchSensorDescription, Tag("TouchSensor")] | Annotated[PenDescription, Tag("Pen")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -632,6 +648,8 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_roll_pitch_yaw", "device", NoArgs, FloatArrayValue),
     ServiceSpec("get_quaternion", "device", NoArgs, FloatArrayValue),
     ServiceSpec("get_noise", "device", NoArgs, FloatValue),
+    ServiceSpec("write", "device", BoolArgs, SuccessResult, attached=True),
+    ServiceSpec("set_ink_color", "device", InkColorArgs, SuccessResult, attached=True),
 )
 
 

@@ -374,6 +374,27 @@ class LED(_Device):
         return v
 
 
+class Pen(_Device):
+    """Webots Pen: at each basic step while ``write`` is on, ink on the first visual shape its
+    ray meets (from the pen's origin along its -z axis, nearer than ``max_distance``; 0 or less:
+    unlimited), in that shape's paint texture, which infra-red sensors read (README "Textures and
+    line following"). ``ink_density`` outside [0, 1] is clamped with a warning, as Webots does."""
+
+    device: Literal["Pen"]
+    ink_color: Color = (0.0, 0.0, 0.0)
+    ink_density: float = 0.5
+    lead_size: float = Field(default=0.002, ge=0.0, description="m, the width of the pen's tip")
+    max_distance: float = Field(default=0.0, description="m; <= 0: unlimited range")
+    write: bool = Field(default=True, description="writing from the first step (wb_pen_write switches it)")
+
+    @field_validator("ink_color")
+    @classmethod
+    def _unit(cls, v: Color) -> Color:
+        if min(v) < 0 or max(v) > 1:
+            raise ValueError("colour components must be within [0, 1]")
+        return v
+
+
 class GPS(_Device):
     """Webots GPS: the device's position (local coordinates, or WGS84 latitude / longitude /
     altitude, per ``world_info.gps_coordinate_system``), its speed and speed vector."""
@@ -464,7 +485,7 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Camera", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
+    "Brake", "Camera", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
     "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -480,11 +501,11 @@ class UnsimulatedDevice(_Device):
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
-                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | UnsimulatedDevice,
+                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | Pen | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
-                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor",
+                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor", "Pen",
                 *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
@@ -548,6 +569,8 @@ class WorldInfo(Strict):
         "altitude (m)")
     gps_reference: Vec3 = Field(default=(0.0, 0.0, 0.0), description="local: added to the position; WGS84: the "
                                 "latitude, longitude (degrees) and altitude (m) of the world's origin")
+    ink_evaporation: float = Field(default=0.0, ge=0.0, description="1/s: pen ink fades as exp(-ink_evaporation·t) "
+                                   "(Webots' inkEvaporation); 0 = never")
 
 
 class World(Strict):

@@ -110,6 +110,17 @@ class DeviceServices:
     def _dev_get(self, c: Call) -> dict:
         return {"value": int(c.ctl.device.value)}
 
+    def _dev_write(self, c: Call) -> dict:          # a Pen: from the next basic step
+        c.ctl.device.set_write(c.args.value)
+        return {"success": True}
+
+    def _dev_set_ink_color(self, c: Call) -> dict:  # a Pen: 0xRRGGBB, density clamped to [0, 1]
+        try:
+            c.ctl.device.set_ink_color(c.args.color, c.args.density)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_ink_color: {exc}") from None
+        return {"success": True}
+
     def _dev_enable(self, c: Call) -> dict:
         self.topics.controller_enable(c.ctl.path, c.args.value)
         return {"success": True}

@@ -416,7 +416,8 @@ class Topics:
         t = ctl.topic_types.get(kind)
         if t is None:
             return None
-        return MESSAGE_BUILDERS[t](self, ctl, header(ctl.frame_id, at_ms), ctl.topic_readings[kind])
+        frame = getattr(ctl.device, "topic_frames", {}).get(kind, ctl.frame_id)   # a pen's stroke: "world"
+        return MESSAGE_BUILDERS[t](self, ctl, header(frame, at_ms), ctl.topic_readings[kind])
 
     def _illuminance(self, ctl: Control, hdr: dict, reading: str) -> dict:
         return {"header": hdr, "illuminance": float(ctl.device.value), "variance": 0.0}
@@ -428,6 +429,9 @@ class Topics:
 
     def _color(self, ctl: Control, hdr: dict, reading: str) -> dict:
         dev = ctl.device
+        if reading != "value":       # a colour kept as (r, g, b, a): a pen's ink and its density
+            r, g, b, a = (float(v) for v in getattr(dev, reading))
+            return {"r": r, "g": g, "b": b, "a": a}
         r, g, b = dev.rgb()
         return {"r": r, "g": g, "b": b, "a": 1.0 if dev.value else 0.0}
 

@@ -146,7 +146,9 @@ class Scene:
         self._attached = {owner for _, owner, _ in self._lights if owner is not None}
         # textures: one sampler for the world's images (None without any), read by infra-red only
         self._base_dir = base_dir
-        sampler = TextureSampler([(shape.geometry, shape.appearance) for _, _, shape in self._parts], base_dir)
+        self._ink_evaporation = world.world_info.ink_evaporation
+        sampler = TextureSampler([(shape.geometry, shape.appearance) for _, _, shape in self._parts], base_dir,
+                                 ink_evaporation=self._ink_evaporation)
         self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         self.lights_version = 0        # changes whenever a light moves with its owner
@@ -215,11 +217,16 @@ class Scene:
         shape's ink layer (textures.InkLayer), made on the first stroke; returns the texels inked."""
         if self.textures is None:
             self.textures = TextureSampler([(shape_.geometry, shape_.appearance) for _, _, shape_ in self._parts],
-                                           self._base_dir)
+                                           self._base_dir, ink_evaporation=self._ink_evaporation)
         inv = self._world_to_shape(shape)
         return self.textures.paint(shape, inv.apply(np.asarray(origin, dtype=np.float64)),
                                    inv.apply_dirs(np.asarray(direction, dtype=np.float64)), float(distance),
                                    lead_size, color, density)
+
+    def evaporate_ink(self, step_ms: float) -> None:
+        """One basic step of the world's ink evaporation (``world_info.ink_evaporation``)."""
+        if self.textures is not None and self._ink_evaporation > 0.0:
+            self.textures.evaporate_ink(step_ms)
 
     def clear_ink(self) -> None:
         """All ink gone (a simulation reset, as Webots' Pen reset clears every paint texture)."""

@@ -26,6 +26,7 @@ from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
+from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.scene import Scene, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
     LED,
@@ -186,6 +187,7 @@ class Simulation:
         self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
+        self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
         self._counters: Counter[str] = Counter()
         self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[Device]] | None = None
         self._tracking: list[Device] = []
@@ -214,7 +216,8 @@ class Simulation:
 
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, wheel
-        motors to their initial commands and angles, LEDs off, custom data as in the world file.
+        motors to their initial commands and angles, LEDs off, pen ink cleared (the pens keep their
+        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file.
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
         for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):
@@ -232,6 +235,7 @@ class Simulation:
             self.scene.set_solid_pose(name, pose)
             if self.contact is not None:
                 self.contact.update_solid(name, pose)
+        self.scene.clear_ink()          # WbPen::reset clears every paint texture
         self._counters["resets"] += 1
 
     @classmethod
@@ -287,7 +291,8 @@ class Simulation:
         out["bvh_builds"] = eng["bvh_builds"]
         out["embree_calls"] = eng["embree_calls"]
         out["engine_rays"] = eng["rays_cast"]
-        for key in ("rays_light", "rays_distance", "rays_lidar", "cast_calls", "points_built", "measurements"):
+        for key in ("rays_light", "rays_distance", "rays_lidar", "rays_pen", "ink_strokes", "cast_calls",
+                    "points_built", "measurements"):
             out.setdefault(key, 0)
         out["texture_lookups"] = self.scene.textures.lookups if self.scene.textures is not None else 0
         out["contacts"] = self.contact.contacts if self.contact is not None else 0
@@ -301,6 +306,9 @@ class Simulation:
         self.step_count += 1
         now = self.time_ms
         dt = self.basic_time_step
+        if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
+            lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
+        self.scene.evaporate_ink(dt)
         moved: list[tuple[RobotState, DifferentialDrive, tuple[float, float], Pose]] = []
         for robot in self._driven:
             drive = robot.drive

@@ -390,7 +390,8 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
     if not problems:    # textures: confined like meshes, within the limits, decoded once (world/textures.py)
         from sensorium.server.world.textures import check_textures
 
-        problems += [Problem(*p) for p in check_textures(world, base_dir, limits or WorldLimits(), allow_outside_meshes)]
+        problems += [Problem(*p) for p in check_textures(world, base_dir, limits or WorldLimits(), allow_outside_meshes,
+                                                         asset_files)]
     return problems
 
 
@@ -502,6 +503,9 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
             if res <= 0 and res != -1:
                 upd[name] = -1.0
                 warnings.append(f"{p}.{name}: {res} <= 0, reset to -1 (off)")
+        if isinstance(dev, wm.Pen) and not 0.0 <= dev.ink_density <= 1.0:     # WbPen::preFinalize
+            upd["ink_density"] = min(max(dev.ink_density, 0.0), 1.0)
+            warnings.append(f"{p}.ink_density: {dev.ink_density} outside [0, 1], clamped to {upd['ink_density']}")
         if isinstance(dev, wm.TouchSensor) and dev.type != "bumper":
             warnings.append(f"{p}.type: a {dev.type} TouchSensor needs physics; it reads NaN (Webots' no value)")
         if isinstance(dev, wm.DistanceSensor):

@@ -55,16 +55,18 @@ class TextureFileError(Exception):
 
 
 def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False,
-                        max_bytes: int | None = None) -> Path:
+                        max_bytes: int | None = None, allowed: frozenset[Path] = frozenset()) -> Path:
     """A texture ``url`` → the file it names, relative to ``base_dir`` (the world's folder), which
-    it may not leave unless ``allow_outside`` (as mesh urls). Errors quote the url as written."""
+    it may not leave unless ``allow_outside`` (as mesh urls), except the files in ``allowed`` (a
+    converted .wbt's PROTO and Webots assets, read where they are). Errors quote the url as written."""
     if "\0" in url:
         raise TextureFileError("texture url contains a NUL byte")
     if not url.strip():
         raise TextureFileError("texture url is empty")
     if url.startswith("webots://"):
-        raise TextureFileError(f"texture url {url!r}: webots:// urls (files of a Webots installation) are not "
-                               "resolved yet")
+        raise TextureFileError(f"texture url {url!r}: webots:// urls (files of a Webots installation) are "
+                               "resolved in .wbt worlds only (with --webots-home or WEBOTS_HOME); a YAML world "
+                               "names files relative to itself")
     if "://" in url:
         raise TextureFileError(f"texture url {url!r}: only local files are read (no downloads)")
     base = Path(base_dir).resolve()
@@ -72,7 +74,7 @@ def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False
         path = (base / url).resolve()
     except (OSError, RuntimeError, ValueError) as exc:
         raise TextureFileError(f"texture url {url!r} cannot be resolved: {exc}") from None
-    if not allow_outside and not path.is_relative_to(base):
+    if not allow_outside and not path.is_relative_to(base) and path not in allowed:
         raise TextureFileError(f"texture url {url!r} leaves the world's folder (absolute paths and '..' are "
                                "refused; use --allow-outside-meshes to allow them)")
     try:
@@ -175,10 +177,12 @@ def _appearances(world: wm.World) -> Iterator[tuple[str, Any]]:
             yield f"robots[{r_i}].shapes[{i}]", part
 
 
-def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False) -> list[tuple[str, str]]:
-    """Every texture of a world: url confined and readable, a PNG or JPEG within the limits, decoded
-    (so a broken file is found when the world is checked, and decoded once); the texture
-    coordinates of inline triangles consistent. ``(path, message)`` per problem."""
+def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False,
+                   allowed: frozenset[Path] = frozenset()) -> list[tuple[str, str]]:
+    """Every texture of a world: url confined (``allowed``: files outside the world's folder it may
+    read, a .wbt's PROTO assets) and readable, a PNG or JPEG within the limits, decoded (so a broken
+    file is found when the world is checked, and decoded once); the texture coordinates of inline
+    triangles consistent. ``(path, message)`` per problem."""
     problems: list[tuple[str, str]] = []
     seen: dict[Path, int] = {}
     total = 0
@@ -190,7 +194,7 @@ def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: 
             where = f"{path}.appearance.{field}.url"
             try:
                 file = resolve_texture_url(tex.url, base_dir, allow_outside=allow_outside,
-                                           max_bytes=limits.texture_file_bytes)
+                                           max_bytes=limits.texture_file_bytes, allowed=allowed)
                 if file in seen:
                     continue
                 _, w, h = image_header(file, tex.url)
@@ -469,6 +473,7 @@ def _mesh_file_uv(path: str, _mtime: int) -> tuple[np.ndarray, np.ndarray, np.nd
 # ------------------------------------------------------------------------------------ ink (Pen)
 
 INK_MIN_SIZE, INK_MAX_SIZE = 32, 1024      # WbPaintTexture: the paint texture of an untextured shape
+INK_TEXELS_MAX = 1 << 24    # all ink layers of a world together (16 bytes each: 256 MiB); see TextureSampler
 
 
 def _next_power_of_2(n: int) -> int:
@@ -511,21 +516,43 @@ def bounding_radius(geometry: Any, vertices: np.ndarray | None = None, faces: np
     return radius
 
 
+@lru_cache(maxsize=64)
+def _disc(half: int) -> tuple[np.ndarray, np.ndarray]:
+    """(row, column) offsets of a lead's texels: ``dx² ≤ half² − dy²`` (WbPaintTexture::paint)."""
+    dy, dx = np.mgrid[-half:half + 1, -half:half + 1]
+    inside = dx * dx <= half * half - dy * dy
+    return dy[inside], dx[inside]
+
+
 class InkLayer:
-    """The ink a Pen laid on one shape (Webots' WbPaintTexture): RGB and density per texel
+    """The ink pens laid on one shape (Webots' WbPaintTexture): RGB and density per texel
     (float32, as Webots keeps them), white and 0 at first.
 
     Its size is the shape's image size (an untextured shape: from its bounding sphere radius r,
     ``32 + 992·r/10`` texels, 1024 beyond 10 m, to the nearest power of two) times the geometry's
     factor for texture set 1 (Box 4 x 2, Cylinder 2 x 2, triangles without texture coordinates 4 x 2,
-    else 1 x 1). ``lead_texels_per_m`` is the image width over the bounding radius: a pen's lead
-    of size L covers a disc of ``⌊L·that⌋`` texels across."""
+    else 1 x 1). A pen's lead of size L covers a disc ``⌊L·w₀/r⌋`` texels across, ``w₀`` being
+    that size before the factor (``original_width``) and ``r`` the bounding radius.
 
-    def __init__(self, width: int, height: int, lead_texels_per_m: float):
+    ``evaporating`` (the world's ``ink_evaporation`` > 0): each texel also keeps its ink as a double
+    that :meth:`evaporate` multiplies down and writes back as the density (WbPaintTexture's
+    evaporation array)."""
+
+    def __init__(self, width: int, height: int, original_width: int, radius: float, evaporating: bool = False):
         self.rgb = np.ones((height, width, 3), dtype=np.float32)
         self.density = np.zeros((height, width), dtype=np.float32)
-        self.lead_texels_per_m = lead_texels_per_m
+        self.original_width = int(original_width)
+        self.radius = float(radius)
+        self.evaporation: np.ndarray | None = np.zeros((height, width)) if evaporating else None
+        self._live: list[int] | None = None      # [y0, y1, x0, x1): every texel that may still evaporate
         self.strokes = 0
+
+    def lead_texels(self, lead_size: float) -> int:
+        """The disc's width in texels (WbPaintTexture::paint: ``int(leadSize·w₀/r)``, at least 1;
+        ``leadSize`` is a float there, the rest doubles)."""
+        if not math.isfinite(self.radius) or self.radius <= 0.0:
+            return 1
+        return max(1, int(float(np.float32(lead_size)) * self.original_width / self.radius))
 
     def paint(self, u: float, v: float, lead_size: float, color, density: float) -> int:
         """One stroke at texture-set-1 coordinates (WbPaintTexture::paint): nothing outside
@@ -536,14 +563,14 @@ class InkLayer:
             return 0
         h, w = self.density.shape
         x, y = int(u * w), int(v * h)
-        size = max(1, int(float(np.float32(lead_size)) * self.lead_texels_per_m))
-        half = size // 2
-        ox, oy, sx, sy = max(x - half, 0), max(y - half, 0), min(x + half, w - 1), min(y + half, h - 1)
-        if ox > sx or oy > sy:
-            return 0
-        ty, tx = np.mgrid[oy:sy + 1, ox:sx + 1]
-        inside = (tx - x) ** 2 <= half * half - (ty - y) ** 2
-        rows, cols = ty[inside], tx[inside]
+        half = self.lead_texels(lead_size) // 2
+        dy, dx = _disc(half)
+        rows, cols = dy + y, dx + x
+        if x - half < 0 or y - half < 0 or x + half >= w or y + half >= h:     # clipped at the edges
+            keep = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+            rows, cols = rows[keep], cols[keep]
+            if not len(rows):
+                return 0
         d = np.float32(density)
         prev = self.density[rows, cols]
         total = d + prev
@@ -554,8 +581,30 @@ class InkLayer:
         new = (np.float32(1.0) - old).astype(np.float64)[:, None] * ink         # (1 - ratio) * colour (double)
         self.rgb[rows, cols] = (keep + new).astype(np.float32)
         self.density[rows, cols] = np.minimum(total, np.float32(1.0))
+        if self.evaporation is not None:
+            self.evaporation[rows, cols] = np.minimum(self.evaporation[rows, cols] + float(d), 1.0)
+            box = [max(y - half, 0), min(y + half + 1, h), max(x - half, 0), min(x + half + 1, w)]
+            live = self._live
+            self._live = box if live is None else [min(live[0], box[0]), max(live[1], box[1]),
+                                                   min(live[2], box[2]), max(live[3], box[3])]
         self.strokes += 1
         return int(len(rows))
+
+    def evaporate(self, factor: float) -> bool:
+        """One basic step of evaporation (WbPaintTexture::evaporateInk): every texel whose ink is
+        above 0.001 is multiplied by ``factor`` and its density set to it. Returns whether any
+        texel was (False: the layer is dry, and costs nothing until it is painted again)."""
+        if self.evaporation is None or self._live is None:
+            return False
+        y0, y1, x0, x1 = self._live
+        ink = self.evaporation[y0:y1, x0:x1]
+        wet = ink > 0.001
+        if not wet.any():
+            self._live = None
+            return False
+        ink[wet] *= factor
+        self.density[y0:y1, x0:x1][wet] = ink[wet].astype(np.float32)
+        return True
 
     def pick(self, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(ink RGB as float64, density as float32) at texture-set-0 coordinates
@@ -569,6 +618,13 @@ class InkLayer:
     def clear(self) -> None:
         self.rgb[:] = 1.0
         self.density[:] = 0.0
+        if self.evaporation is not None:
+            self.evaporation[:] = 0.0
+        self._live = None
+
+    @property
+    def texels(self) -> int:
+        return int(self.density.size)
 
 
 class TextureSampler:
@@ -580,11 +636,16 @@ class TextureSampler:
     shape's local frame (float64); ``lookups`` counts the points sampled (one per infra-red hit on
     such a shape)."""
 
-    def __init__(self, shapes: list[tuple[Any, wm.Appearance | None]], base_dir: Path):
+    def __init__(self, shapes: list[tuple[Any, wm.Appearance | None]], base_dir: Path, *,
+                 ink_evaporation: float = 0.0, ink_texels_max: int = INK_TEXELS_MAX):
         self.models = shapes
         self.base_dir = Path(base_dir)
         self.shapes: dict[int, ShapeTexture] = {}
         self.ink: dict[int, InkLayer] = {}
+        self.ink_evaporation = float(ink_evaporation)
+        self.ink_texels_max = int(ink_texels_max)
+        self.ink_refused: set[int] = set()         # shapes whose ink layer would exceed ink_texels_max
+        self._evaporating: list[InkLayer] = []     # layers with ink that still evaporates
         self._uv: dict[tuple[int, bool], UvOf] = {}
         self._locators: dict[int, TriangleLocator] = {}
         self._meshes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -665,10 +726,14 @@ class TextureSampler:
 
     # ---- ink
 
-    def ink_layer(self, shape: int) -> InkLayer:
-        """The shape's ink layer, made on its first stroke (WbPaintTexture::paintTexture)."""
+    def ink_layer(self, shape: int) -> InkLayer | None:
+        """The shape's ink layer, made on its first stroke (WbPaintTexture::paintTexture); None
+        (with one warning per shape) when it would take the world's ink layers over
+        ``ink_texels_max`` texels: that shape takes no ink (a bound Webots does not have)."""
         layer = self.ink.get(shape)
         if layer is None:
+            if shape in self.ink_refused:
+                return None
             g = self.models[shape][0]
             st = self.shapes.get(shape)
             tri = isinstance(g, wm.Triangles | wm.Mesh)
@@ -682,7 +747,14 @@ class TextureSampler:
                 w = h = int(nxt / 2 if abs(nxt - size) > abs(nxt / 2 - size) else nxt)
             fx, fy = ((4, 2) if isinstance(g, wm.Box) or (isinstance(g, wm.Triangles) and g.tex_coords is None)
                       else (2, 2) if isinstance(g, wm.Cylinder) else (1, 1))
-            layer = self.ink[shape] = InkLayer(w * fx, h * fy, w / radius if math.isfinite(radius) else 0.0)
+            used = sum(layer.texels for layer in self.ink.values())
+            if used + w * fx * h * fy > self.ink_texels_max:
+                self.ink_refused.add(shape)
+                warnings.warn(f"pen ink on shape {shape} ({type(g).__name__}) refused: its paint texture of "
+                              f"{w * fx}x{h * fy} texels would take the world's ink over {self.ink_texels_max:,} "
+                              "texels (textures.INK_TEXELS_MAX)", RuntimeWarning, stacklevel=2)
+                return None
+            layer = self.ink[shape] = InkLayer(w * fx, h * fy, w, radius, evaporating=self.ink_evaporation > 0.0)
             self.textured[shape] = True
         return layer
 
@@ -692,22 +764,37 @@ class TextureSampler:
         uv, ok = self.uv(shape, origin.reshape(1, 3), direction.reshape(1, 3), np.array([t]), atlas=True)
         if not ok[0]:
             return 0
-        return self.ink_layer(shape).paint(float(uv[0, 0]), float(uv[0, 1]), lead_size, color, density)
+        layer = self.ink_layer(shape)
+        if layer is None:
+            return 0
+        n = layer.paint(float(uv[0, 0]), float(uv[0, 1]), lead_size, color, density)
+        if n and layer.evaporation is not None and layer not in self._evaporating:
+            self._evaporating.append(layer)
+        return n
+
+    def evaporate_ink(self, step_ms: float) -> None:
+        """One basic step of ``step_ms`` of evaporation (WbPaintTexture::prePhysicsStep): every wet
+        layer's ink times ``exp(−ink_evaporation·step_ms/1000)``; dry layers leave the list."""
+        if not self._evaporating:
+            return
+        factor = math.exp(-self.ink_evaporation * step_ms / 1000.0)
+        self._evaporating = [layer for layer in self._evaporating if layer.evaporate(factor)]
 
     def clear_ink(self) -> None:
         """Every ink layer white again (Webots' Pen reset clears all paint textures)."""
         for layer in self.ink.values():
             layer.clear()
+        self._evaporating = []
 
     # ---- what infra-red sensors read
 
     def infra_red(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray, red: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None]:
         """For hits on ``shape`` whose untextured red is ``red`` (WbShape::pickColor): the red read
-        (``(1 − c)·red·texel + c·ink`` with ``c`` the ink's density; the texel where picking failed
-        is 1 and the ink ignored), the roughness and occlusion maps' red (None when there is no
-        such map) and where picking succeeded (None: everywhere; elsewhere the roughness field and
-        no occlusion apply)."""
+        (``(1 − c)·red·texel + c·ink`` with ``c`` the ink's density; a shape without appearance
+        reads the ink's colour alone; the texel where picking failed is 1 and the ink ignored), the
+        roughness and occlusion maps' red (None when there is no such map) and where picking
+        succeeded (None: everywhere; elsewhere the roughness field and no occlusion apply)."""
         uv, picked = self._uv_of(shape, False)(origins, directions, t)
         self.lookups += len(t)
         if picked is not None:
@@ -727,6 +814,11 @@ class TextureSampler:
         layer = self.ink.get(shape)
         if layer is not None:
             ink, c = layer.pick(uv)
+            if self.models[shape][1] is None:
+                # a shape without any appearance reads the paint texture's colour alone, whatever its
+                # density (WbShape::pickColor: neither Appearance nor PBRAppearance -> paintColor)
+                out = ink[:, 0] if picked is None else np.where(picked, ink[:, 0], red)
+                return out, rough, occl, picked
             if picked is not None:
                 c = np.where(picked, c, np.float32(0.0))
             blended = (np.float32(1.0) - c).astype(np.float64) * red      # (1.0f - c) in float32

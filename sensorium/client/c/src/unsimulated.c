@@ -14,7 +14,6 @@
 #include <webots/emitter.h>
 #include <webots/gyro.h>
 #include <webots/inertial_unit.h>
-#include <webots/pen.h>
 #include <webots/radar.h>
 #include <webots/range_finder.h>
 #include <webots/receiver.h>
@@ -559,18 +558,6 @@ const double *wb_inertial_unit_get_roll_pitch_yaw(WbDeviceTag tag) {
 const double *wb_inertial_unit_get_quaternion(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_quaternion");
   return sn_no_values();
-}
-
-/* ------------------------------------------------------------------ Pen */
-void wb_pen_write(WbDeviceTag tag, bool write) {
-  (void)write;
-  sn_unsimulated(tag, WB_NODE_PEN, "wb_pen_write");
-}
-
-void wb_pen_set_ink_color(WbDeviceTag tag, int color, double density) {
-  (void)color;
-  (void)density;
-  sn_unsimulated(tag, WB_NODE_PEN, "wb_pen_set_ink_color");
 }
 
 /* ------------------------------------------------------------------ Radar */

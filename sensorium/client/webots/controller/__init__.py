@@ -12,9 +12,10 @@ from .led import LED
 from .lidar import Lidar, LidarPoint
 from .light_sensor import LightSensor
 from .motor import Motor, RotationalMotor
+from .pen import Pen
 from .position_sensor import PositionSensor
 from .robot import Robot
 from .supervisor import Field, Node, Supervisor
 
 __all__ = ["LED", "Device", "DistanceSensor", "Field", "Keyboard", "Lidar", "LidarPoint", "LightSensor", "Motor",
-           "Node", "PositionSensor", "Robot", "RotationalMotor", "Sensor", "SensoriumError", "Supervisor"]
+           "Node", "Pen", "PositionSensor", "Robot", "RotationalMotor", "Sensor", "SensoriumError", "Supervisor"]

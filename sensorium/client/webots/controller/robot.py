@@ -13,6 +13,7 @@ from .led import LED
 from .lidar import Lidar
 from .light_sensor import LightSensor
 from .motor import RotationalMotor
+from .pen import Pen
 from .position_sensor import PositionSensor
 
 _CLASSES: dict[str, type[Device]] = {
@@ -22,6 +23,7 @@ _CLASSES: dict[str, type[Device]] = {
     wb.ROTATIONAL_MOTOR: RotationalMotor,
     wb.POSITION_SENSOR: PositionSensor,
     wb.LED: LED,
+    "Pen": Pen,
 }
 
 
@@ -105,6 +107,9 @@ class Robot:
 
     def getMotor(self, name: str) -> Device | None:
         return self._deprecated("getMotor", name)
+
+    def getPen(self, name: str) -> Device | None:
+        return self._deprecated("getPen", name)
 
     @classmethod
     def device_by_tag(cls, tag: int) -> Device | None:

@@ -231,6 +231,9 @@ class Converter:
             raise f.error("coordinateSystem", f"{system!r} is not supported (ENU or NUE)")
         info = {"name": f.string("title", "") or Path(self.source).stem, "basic_time_step": int(step),
                 "random_seed": seed, "coordinate_system": system}
+        evaporation = f.num("inkEvaporation", 0.0)
+        if evaporation > 0.0:          # Webots' pen ink fading (a value <= 0 never evaporates)
+            info["ink_evaporation"] = evaporation
         self.world["world_info"] = info
 
     # ------------------------------------------------------------ the walk
@@ -260,7 +263,9 @@ class Converter:
                 inner = self.child_frame(node, frame)
                 if t in wm.DEVICE_TYPES:     # listed (simulated kinds take their schema defaults)
                     self.tick(node)
-                    self.unsimulated(node, inner, owner)
+                    entry = self.unsimulated(node, inner, owner)
+                    if t == "Pen":             # a Pen keeps its fields (simulated: it inks)
+                        entry.update(fx.pen(f))
                 self.solid_contents(node, inner, owner)
             else:
                 self.skipped[t] += 1
@@ -363,7 +368,7 @@ class Converter:
             return
         part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
         if seen_by == "visual":
-            app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note)
+            app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note, self.texture_file)
             if app is not None:
                 part["appearance"] = app
             owner.keys[key] = part
@@ -424,6 +429,35 @@ class Converter:
             return None
         self.asset_files.add(path)
         return str(path)
+
+    def texture_file(self, node: Node, url: str) -> tuple[str, Path]:
+        """(the url the converted world names, the file) of a texture ``url`` written in ``node``'s
+        file: as written when the world file names a local file (relative to it); else — a PROTO's
+        url, relative to the PROTO file; ``webots://`` or Webots' GitHub urls, from the installation —
+        the file it names, which must lie where mesh assets may (see :meth:`asset`). Raises
+        ``TextureFileError`` (the texture is then read as one Webots could not load)."""
+        from sensorium.server.world.proto import ProtoError, asset_roots, resolve_url
+        from sensorium.server.world.textures import TextureFileError, resolve_texture_url
+
+        src = node.source or self.source
+        if src == self.source and "://" not in url:
+            return url, resolve_texture_url(url, Path(self.source).resolve().parent, allow_outside=True)
+        if self.search is None:
+            raise TextureFileError(f"texture url {url!r}: no PROTO search places to resolve it")
+        try:
+            path = resolve_url(url, src, self.search).resolve()
+        except ProtoError as exc:
+            raise TextureFileError(f"texture file {exc.message}") from None
+        except (OSError, ValueError) as exc:
+            raise TextureFileError(f"texture url {url!r} cannot be resolved ({exc})") from None
+        roots = [*asset_roots(self.search), Path(src).resolve().parent.parent, Path(self.source).resolve().parent]
+        if not any(path.is_relative_to(r) for r in roots):
+            raise TextureFileError(f"texture url {url!r} names a file outside the Webots installation, the "
+                                   "--proto-path folders and the PROTO's project: refused")
+        if not path.is_file():
+            raise TextureFileError(f"texture file {url!r} not found")
+        self.asset_files.add(path)
+        return str(path), path
 
     def geometry(self, node: Node, s: float) -> dict | None:
         f = self.fields(node)

@@ -168,39 +168,48 @@ def device(node: Node, f: Fields) -> dict:
     raise AssertionError(t)
 
 
+def pen(f: Fields) -> dict:
+    """A Pen's fields in the world format's names (Webots' defaults; its colour clamped to [0, 1]
+    as an SFColor is, its density left to the loader's Webots clamping)."""
+    colour = [min(max(c, 0.0), 1.0) for c in f.vec("inkColor", (0.0, 0.0, 0.0))]
+    return {"ink_color": colour, "ink_density": f.num("inkDensity", 0.5), "lead_size": max(f.num("leadSize", 0.002), 0.0),
+            "max_distance": f.num("maxDistance", 0.0), "write": f.flag("write", True)}
+
+
 DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light sensor", "Lidar": "lidar",
                 "PositionSensor": "position sensor", "LED": "led", "RotationalMotor": "rotational motor"}
 
 
 # ---------------------------------------------------------------- appearance
 
-def appearance(node: Node | None, source: str, warn) -> dict | None:
+def appearance(node: Node | None, source: str, warn, resolve=None) -> dict | None:
     """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read).
 
     As Webots' pickColor: a PBRAppearance is ``baseColor × (1 − transparency)`` times its
     ``baseColorMap`` texel (roughness and occlusion maps read where the base map is); an Appearance
     with a loaded ``texture`` reads white × ``(1 − transparency)`` × texel (WbAppearance::diffuseColor
     replaces the material's colour by white), without one its material's diffuseColor. A texture
-    that cannot be loaded here (missing file, not PNG/JPEG, webots:// or remote url) is noted with
-    ``warn(node, "texture: <why>")`` and read as Webots reads a texture it could not load."""
+    that cannot be loaded here (missing file, not PNG/JPEG, a webots:// url without the installation,
+    a remote url) is noted with ``warn(node, "texture: <why>")`` and read as Webots reads a texture
+    it could not load. ``resolve(node, url)``: see :func:`image_texture`."""
     if node is None:
         return None
     f = Fields(node, source)
     if node.type == "PBRAppearance":
         out: dict[str, Any] = {"base_color": list(f.vec("baseColor", (1.0, 1.0, 1.0))),
                                "transparency": f.num("transparency", 0.0), "roughness": f.num("roughness", 0.0)}
-        base = image_texture(f.node_("baseColorMap"), source, warn)
+        base = image_texture(f.node_("baseColorMap"), source, warn, resolve)
         if base is not None:
             out["texture"] = base
             for field, key in (("roughnessMap", "roughness_map"), ("occlusionMap", "occlusion_map")):
-                extra = image_texture(f.node_(field), source, warn)
+                extra = image_texture(f.node_(field), source, warn, resolve)
                 if extra is not None:
                     out[key] = extra
             _texture_transform(f, source, out)
         return out
     if node.type == "Appearance":
         material = f.node_("material")
-        texture = image_texture(f.node_("texture"), source, warn)
+        texture = image_texture(f.node_("texture"), source, warn, resolve)
         out = {"base_color": [1.0, 1.0, 1.0]}
         if material is not None:
             m = Fields(material, source)
@@ -215,10 +224,13 @@ def appearance(node: Node | None, source: str, warn) -> dict | None:
     return None
 
 
-def image_texture(node: Node | None, source: str, warn) -> dict | None:
+def image_texture(node: Node | None, source: str, warn, resolve=None) -> dict | None:
     """An ImageTexture → the world format's texture, if its first url is a PNG/JPEG file found
-    relative to the world file (else ``warn(node, "texture: …")`` and None: Webots would not load it).
-    The url is kept as written (backslashes made slashes, as Webots does)."""
+    (else ``warn(node, "texture: …")`` and None: Webots would not load it). ``resolve(node, url)``
+    → (the url the converted world names, the file) or ``TextureFileError``: where the url leads
+    (a PROTO's url is relative to the PROTO file, webots:// names the installation's file; the
+    converter's); without it the url is relative to the world file and kept as written
+    (backslashes made slashes, as Webots does)."""
     from pathlib import Path
 
     from sensorium.server.world.textures import TextureFileError, image_header, resolve_texture_url
@@ -235,7 +247,10 @@ def image_texture(node: Node | None, source: str, warn) -> dict | None:
         return None
     url = urls[0].replace("\\", "/")
     try:
-        path = resolve_texture_url(url, Path(source).resolve().parent, allow_outside=True)
+        if resolve is None:
+            path = resolve_texture_url(url, Path(source).resolve().parent, allow_outside=True)
+        else:
+            url, path = resolve(node, url)
         image_header(path, url)
     except TextureFileError as exc:
         warn(node, f"texture: {exc}")

@@ -1,7 +1,6 @@
 /* Sensorium C controller library: Pen (Webots' wb_pen_* functions).
- * Sensorium lists this device (name, model, type, index) but does not simulate it: every function
- * answers Webots' "no value" (NaN, a NaN vector, NULL, 0, "") and the first call per device prints one
- * warning line. */
+ * The server simulates the pen: every basic step while it writes, it inks the first visual shape its
+ * -z axis meets (nearer than maxDistance), and infra-red distance sensors read that ink. */
 #ifndef WB_PEN_H
 #define WB_PEN_H
 
