@@ -60,10 +60,14 @@ def test_compose_services_run_as_processes(tmp_path: Path) -> None:
     procs: list[tuple[str, Proc]] = []
     with Served(sensorium(*server_cmd), "sensorium: serving world").wait_ready() as server:
         try:
-            for name in ("braitenberg", "wanderer", "recorder"):
+            # the recorder first, and only once it records do the controllers start the world's clock:
+            # a recorder that joins late (a loaded machine) would find a world that already ran out
+            for name in ("recorder", "braitenberg", "wanderer"):
                 svc = services[name]
                 procs.append((name, Proc(sensorium(*(_localise(a, ports) for a in svc["command"])), cwd=tmp_path,
                                          env={k: _localise(v, ports) for k, v in svc.get("environment", {}).items()})))
+                if name == "recorder":
+                    procs[-1][1].wait_line("sensorium: recording")
             assert server.wait() == 0, server.stderr()
             for name, p in procs:
                 if name == "recorder":
