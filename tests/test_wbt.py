@@ -450,17 +450,17 @@ def test_named_controllers_become_extern(tmp_path: Path) -> None:
         assert w.world.robots[0].controller == "<extern>"
 
 
-def test_mesh_and_scale_problems_point_at_lines(tmp_path: Path) -> None:
-    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.dae" ] } }\n  ]\n}\n')
+def test_mesh_losses_load_and_name_their_lines(tmp_path: Path) -> None:
+    """A mesh Sensorium cannot read (a format it does not read, a missing file) is a loss naming the
+    file and line; the world still loads (the rest of the solid too)."""
+    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.dae" ] } }\n'
+                        '    Shape { geometry Mesh { url [ "gone.stl" ] } }\n    Shape { geometry Box { } }\n  ]\n}\n')
     (tmp_path / "robot.dae").write_text("<COLLADA/>")
-    with pytest.raises(WorldError) as exc:
-        load_world(p)
-    assert str(exc.value).startswith(f"{p}: line 4, column 22 (Mesh, converted as solids[0].shapes[0].geometry.url): "
-                                     "unsupported mesh format '.dae'")
-    p = write(tmp_path, 'Transform {\n  scale 1 2 1\n  children [ Shape { geometry Box { } } ]\n}\n')
-    with pytest.raises(WorldError) as exc:
-        load_world(p)
-    assert str(exc.value) == f"{p}: line 3, column 3: Transform.scale: only a uniform positive scale is supported, got 1.0 2.0 1.0"
+    w = load_world(p)
+    assert [s.geometry.type for s in w.world.solids[0].shapes] == ["box"]
+    assert [(loss.kind, loss.where) for loss in w.losses] == [("shape", f"{p}:4:22"), ("shape", f"{p}:5:22")]
+    assert "the .dae format is not read here" in w.losses[0].why
+    assert "mesh file 'gone.stl' not found (relative to the world file)" in w.losses[1].why
 
 
 def test_scaled_transform_scales_geometry(tmp_path: Path) -> None:

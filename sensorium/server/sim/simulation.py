@@ -39,6 +39,7 @@ from sensorium.server.sim.sensors import (
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
+from sensorium.server.world.report import warn_losses
 from sensorium.server.world.poses import pose_from_values
 
 
@@ -239,9 +240,12 @@ class Simulation:
                   limits: WorldLimits | None = None, allow_outside_meshes: bool = False,
                   contact: bool | None = None) -> Simulation:
         """``limits``/``allow_outside_meshes``: see :func:`sensorium.server.world.loader.load_world`;
-        ``contact``: kinematic contact on/off (default: the world's ``world_info.contact``)."""
-        return cls(load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes), precision,
-                   contact=contact)
+        ``contact``: kinematic contact on/off (default: the world's ``world_info.contact``). What the
+        load left out is ``sim.loaded.report`` (``sim.loaded.warnings``: every message); a loss
+        sensors would notice (a robot, a device, a shape) is also one ``WorldLossWarning``."""
+        loaded = load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes)
+        warn_losses(loaded.report)
+        return cls(loaded, precision, contact=contact)
 
     # ------------------------------------------------------------------ access
     @property

@@ -33,6 +33,7 @@ from sensorium.server.world.limits import (
     check_yaml_events,
     quote,
 )
+from sensorium.server.world.report import LoadReport, Loss
 
 
 class _Yaml12Loader(yaml.SafeLoader):
@@ -82,9 +83,19 @@ class LoadedWorld:
     source: str                      # file path or "<memory>"
     base_dir: Path                   # mesh urls are relative to it
     text: bytes = b""                # the file as read (recordings attach it)
-    warnings: list[str] = field(default_factory=list)
-    dropped: list[str] = field(default_factory=list)    # the warnings that are losses sensors notice
+    warnings: list[str] = field(default_factory=list)   # every message of the load, losses included
+    losses: tuple[Loss, ...] = ()                        # what sensors would notice was left out (report.py)
     asset_files: frozenset[Path] = frozenset()          # files outside base_dir it may read (PROTO assets)
+
+    @property
+    def report(self) -> LoadReport:
+        """What the load left out, for printing (``report.text()``) or programs (``report.losses``)."""
+        return LoadReport(self.source, self.losses, tuple(self.warnings))
+
+    @property
+    def dropped(self) -> list[str]:
+        """The losses' messages (``file:line:col: why``)."""
+        return [loss.text for loss in self.losses]
 
 
 def read_world_text(path: str | Path, limits: WorldLimits | None = None) -> bytes:
@@ -240,7 +251,7 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
         at = _origin_of(where, origin)
         placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w)
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
-                       warnings=[*warnings, *placed], dropped=list(conv.dropped), asset_files=conv.asset_files)
+                       warnings=[*warnings, *placed], losses=conv.losses, asset_files=conv.asset_files)
 
 
 def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:

@@ -21,14 +21,15 @@ class WbtConversion:
     """A converted world: the world-file dict, warnings, converted path → (line, column, node type)
     it came from, the PROTOs used (``ProtoUse``: name, file, licence line, instances), the asset
     files outside the world's folder it may read (meshes of PROTOs, ``webots://`` assets) and the
-    warnings that are losses sensors would notice (``dropped``: a robot, a sensor device)."""
+    warnings that are losses sensors would notice (``losses``: robots, sensor devices, shapes;
+    :mod:`sensorium.server.world.report`)."""
 
     data: dict[str, Any]
     warnings: list[str]
     origin: dict[str, tuple[int, int, str]]
     protos: list[Any]
     asset_files: frozenset[Path] = frozenset()
-    dropped: tuple[str, ...] = ()
+    losses: tuple[Any, ...] = ()
 
 
 def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),
@@ -47,7 +48,7 @@ def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, prot
     origin: dict[str, tuple[int, int, str]] = {}
     data = strip_origins(raw, "", origin)
     return WbtConversion(data, [*expansion.warnings, *conv.warnings], origin, expansion.protos,
-                         frozenset(conv.asset_files), tuple(conv.dropped))
+                         frozenset(conv.asset_files), tuple(conv.losses))
 
 
 def wbt_to_dict(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),
