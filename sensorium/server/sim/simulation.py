@@ -39,8 +39,8 @@ from sensorium.server.sim.sensors import (
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
-from sensorium.server.world.report import warn_losses
 from sensorium.server.world.poses import pose_from_values
+from sensorium.server.world.report import warn_losses
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:

@@ -80,6 +80,7 @@ class Converter:
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
+        self.constrained: set[int] = set()     # Transforms in boundingObjects whose scale Webots constrains
         self.defs: set[str] = set()        # DEF names kept (def_name)
         self.textured: dict[int, tuple[int, int, str, str]] = {}   # textures not loaded → (line, column, why)
         self.robot_fields = set(wm.Robot.model_fields)
@@ -377,8 +378,8 @@ class Converter:
             scale = None
             if node.type == "Transform":     # Webots' physics constraint on the scale over its geometry
                 scale, why = bounding_constraint(self.first_geometry(node), self.transform_scale(node))
-                if why and ("bounding", id(node)) not in self.checked_scale:
-                    self.checked_scale.add(("bounding", id(node)))   # type: ignore[arg-type]
+                if why and id(node) not in self.constrained:
+                    self.constrained.add(id(node))
                     self.warn(node, why)
             inner = self.child_frame(node, frame, scale)
             for child in f.nodes("children"):
@@ -404,9 +405,8 @@ class Converter:
         installation) the local file it names, which must lie in the Webots installation, a
         --proto-path folder or the project of the PROTO file that names it (read only). (None, why):
         the file is missing or refused (the caller reports the shape as lost, naming it)."""
-        from sensorium.server.world.proto import ProtoError, asset_roots, resolve_url
-
         from sensorium.server.world.meshes import SUPPORTED
+        from sensorium.server.world.proto import ProtoError, asset_roots, resolve_url
 
         src = node.source or self.source
         suffix = Path(url.split("?")[0]).suffix.lower()
