@@ -33,7 +33,7 @@ MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
 SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "ImmersionProperties",
-           "ContactProperties", "Damping", "Muscle", "Propeller", "CadShape"}
+           "ContactProperties", "Damping", "Muscle", "Propeller"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
 # the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
 OTHER_DEVICES = {"Camera", "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
@@ -237,6 +237,12 @@ class Converter:
                 self.visit(child, inner, owner)
         elif t == "Shape":
             self.shape(node, frame, owner, seen_by="visual")
+        elif t == "CadShape":     # a visual mesh file (its own materials are not read: seen white)
+            urls = f.strings("url")
+            if urls:
+                mesh = Node("Mesh", {"url": urls[:1]}, node.line, node.col, source=node.source)
+                self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
+                           seen_by="visual")
         elif t in LIGHTS:
             self.light(node, frame, owner)
         elif t == "Robot":
