@@ -140,5 +140,5 @@ def test_cad_shapes_are_visual_meshes_or_said_lost(tmp_path: Path) -> None:
     (shape,) = w.world.solids[0].shapes
     assert (shape.geometry.type, shape.geometry.url, shape.seen_by) == ("mesh", "part.obj", "visual")
     (loss,) = w.losses
-    assert (loss.kind, loss.name, loss.where) == ("shape", "s", f"{p}:2:52")
+    assert (loss.kind, loss.name, loss.where) == ("shape", "s", f"{p}:2:61")   # the second CadShape
     assert "mesh 'part.dae': the .dae format is not read here" in loss.why
