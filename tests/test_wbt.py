@@ -213,7 +213,9 @@ def test_hinge_wheels_become_a_differential_drive(tmp_path: Path) -> None:
     (dict(axis_left="0 -1 0"), "wheel axis of motor 'left wheel motor' is [0.0, -1.0, 0.0], not the robot's +y"),
     (dict(anchor_x=0.02), "the axle midpoint is at x=0.02, y=0 in the robot frame, not under the robot's origin"),
     (dict(extra='HingeJoint { device [ RotationalMotor { name "third" } ] }\n'),
-     "3 motorised hinge joints; a differential drive needs exactly two wheels"),
+     "wheel axis of motor 'third' is [1.0, 0.0, 0.0], not the robot's +y"),
+    (dict(extra='HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } device [ RotationalMotor { name "third" } ] }\n'),
+     "3 motorised wheels, not all on either side of the robot's x axis"),
 ])
 def test_no_drive_says_why(tmp_path: Path, kwargs: dict, why: str) -> None:
     p = write(tmp_path, _two_wheels(**kwargs))

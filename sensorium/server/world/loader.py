@@ -374,9 +374,11 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
         if robot.differential_drive is not None:
             # a RotationalMotor entry named like a drive motor is that motor (its place in the device list)
             listed = {d.name for d in robot.devices if d.device == "RotationalMotor"}
-            names += [(f"{rp}.differential_drive.{side}", m) for side, m in
-                      (("left_motor", robot.differential_drive.left_motor),
-                       ("right_motor", robot.differential_drive.right_motor)) if m not in listed]
+            left, right = robot.differential_drive.motor_names
+            sides = [("left_motor", left[0]), ("right_motor", right[0])]
+            sides += [(f"skid_steer.left[{i}]", m) for i, m in enumerate(left[1:])]
+            sides += [(f"skid_steer.right[{i}]", m) for i, m in enumerate(right[1:])]
+            names += [(f"{rp}.differential_drive.{side}", m) for side, m in sides if m not in listed]
         unique(names, "device")
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"
@@ -390,7 +392,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                             f"follows {table[k - 1][0]}"))
             if isinstance(dev, wm.PositionSensor) and dev.motor is not None:
                 drive = robot.differential_drive
-                motors = (drive.left_motor, drive.right_motor) if drive is not None else ()
+                motors = tuple(m for side in drive.motor_names for m in side) if drive is not None else ()
                 if dev.motor not in motors:
                     problems.append(Problem(
                         f"{dp}.motor", f"{dev.motor!r} is not a wheel motor of this robot's differential_drive "

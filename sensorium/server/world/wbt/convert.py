@@ -587,7 +587,10 @@ class Converter:
         and its getDevice returns the first); the wheel motors' names count too."""
         drive = robot.get("differential_drive") or {}
         listed = {d["name"] for d in robot["devices"] if d["device"] == "RotationalMotor"}
-        seen: Counter[str] = Counter(v for k, v in drive.items() if k in ("left_motor", "right_motor") and v not in listed)
+        skid = drive.get("skid_steer") or {}
+        motors = [v for k, v in drive.items() if k in ("left_motor", "right_motor")] + [
+            *skid.get("left", ()), *skid.get("right", ())]
+        seen: Counter[str] = Counter(v for v in motors if v not in listed)
         for dev in robot["devices"]:
             name = dev["name"]
             seen[name] += 1
@@ -673,6 +676,9 @@ class Converter:
         sensors: list[dict] = []
         if owner.kind == "robot":
             _, sensors = self.joint_devices(node, owner)
+        if owner.kind == "robot" and node.type == "Hinge2Joint" and motors:    # a steered wheel (a car)
+            owner.wheels.append({"node": node, "motor": self.fields(motors[0]).string("name", "rotational motor"),
+                                 "steers": True})
         if owner.kind == "robot" and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
             if params is not None:
@@ -684,12 +690,14 @@ class Converter:
             centre = anchor
             if end is not None and end.type == "Solid":
                 centre = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
+            turn = frame.rotation @ np.asarray(axis)
             owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"),
+                                 "steers": abs(turn[2]) > 0.9 * float(np.linalg.norm(turn)),   # a vertical axis
                                  "max_velocity": m.num("maxVelocity", 10.0),
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
-        elif motors:
+        elif motors and node.type != "Hinge2Joint":
             self.warn(node, f"{node.type} motor(s) not part of a wheel: listed, not simulated (joints do not move here)")
         if sensors and not (owner.kind == "robot" and node.type == "HingeJoint" and motors):
             self.warn(node, "PositionSensor on a joint without a drive wheel motor: listed, reads no value")
@@ -710,7 +718,7 @@ class Converter:
             return
         robot.data["differential_drive"] = drive
         for w in wheels:    # the wheels' encoders measure the drive's wheels
-            for entry in w["sensors"]:
+            for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]
 
 
