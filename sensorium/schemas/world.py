@@ -198,6 +198,10 @@ class Part(Shape):
 
     name: str | None = None
     pose: Pose = Pose()
+    of_device: str | None = Field(
+        default=None, min_length=1,
+        description="on a robot: the device whose own Solid this shape belongs to (a sensor's housing); that "
+                    "device's infra-red rays and lidar beams do not see it, as in Webots")
 
 
 # ---------------------------------------------------------------- lights

@@ -104,7 +104,7 @@ class RobotState:
                 continue
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
-                                       clock=lambda: sim.time_ms)
+                                       clock=lambda: sim.time_ms, own_shapes=sim.scene.device_shapes(index, d.name))
         self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index],
                                         up=sim.world.world_info.coordinate_system)
                       if model.differential_drive is not None else None)
@@ -123,6 +123,10 @@ class RobotState:
     @property
     def world_info(self) -> wm.WorldInfo:
         return self._sim.world.world_info
+
+    @property
+    def scene(self) -> Scene:
+        return self._sim.scene
 
     @property
     def basic_time_step(self) -> int:

@@ -366,6 +366,11 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
     unique([(f"robots[{i}].def_name", r.def_name) for i, r in enumerate(world.robots)]
            + [(f"solids[{i}].def_name", s.def_name) for i, s in enumerate(world.solids)], "DEF")
 
+    for path, solid in all_solids(world):
+        for s_i, part in enumerate(solid.shapes):
+            if part.of_device is not None:
+                problems.append(Problem(f"{path}.shapes[{s_i}].of_device",
+                                        "only a robot's shapes belong to one of its devices"))
     for p, geom in all_geometries(world):
         problems += _check_geometry(geom, p, base_dir)
     for r_i, robot in enumerate(world.robots):
@@ -380,6 +385,12 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
             sides += [(f"skid_steer.right[{i}]", m) for i, m in enumerate(right[1:])]
             names += [(f"{rp}.differential_drive.{side}", m) for side, m in sides if m not in listed]
         unique(names, "device")
+        device_names = {d.name for d in robot.devices}
+        for s_i, part in enumerate(robot.shapes):
+            if part.of_device is not None and part.of_device not in device_names:
+                problems.append(Problem(f"{rp}.shapes[{s_i}].of_device",
+                                        f"{part.of_device!r} is not a device of this robot "
+                                        f"(devices: {', '.join(repr(n) for n in device_names) or 'none'})"))
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"
             table = getattr(dev, "lookup_table", None)

@@ -220,10 +220,11 @@ class Converter:
         elif t in OTHER_DEVICES:
             if owner.kind == "robot":
                 inner = self.child_frame(node, frame)
+                data = None
                 if t in wm.DEVICE_TYPES:     # listed (simulated kinds take their schema defaults)
                     self.tick(node)
-                    self.unsimulated(node, inner, owner)
-                self.solid_contents(node, inner, owner)
+                    data = self.unsimulated(node, inner, owner)
+                self.device_contents(node, inner, owner, data)
             else:     # a device outside a robot is still a Solid whose shapes rays see
                 self.warn(node, f"{t} outside a Robot: not a device here (devices belong to robots); its shapes "
                                 "are kept as a solid")
@@ -578,6 +579,9 @@ class Converter:
         if mine.parts:
             data["shapes"] = [_clean_part(p) for p in mine.parts]
         self.unique_devices(data)
+        for part in data.get("shapes", ()):      # the device's final name (after unique_devices)
+            if "_device" in part:
+                part["of_device"] = part.pop("_device")["name"]
         if not data["devices"]:
             del data["devices"]
         self.world["robots"].append(data)
@@ -628,7 +632,18 @@ class Converter:
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
             owner.data["devices"].append(data)
+            self.device_contents(node, inner, owner, data)
+            return
         self.solid_contents(node, inner, owner)
+
+    def device_contents(self, node: Node, frame: Frame, owner: Owner, device: dict | None) -> None:
+        """A device's own Solid contents: robot body shapes marked as the device's own (its visual
+        rays do not see them, sim/own_shapes.py), the innermost device's for nested ones."""
+        start = len(owner.parts)
+        self.solid_contents(node, frame, owner)
+        if device is not None:
+            for part in owner.parts[start:]:
+                part.setdefault("_device", device)
 
     def unsimulated(self, node: Node, frame: Frame, owner: Owner) -> dict:
         """A device listed (its index, type, name and model are Webots') but not simulated here."""
