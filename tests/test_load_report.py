@@ -142,3 +142,10 @@ def test_cad_shapes_are_visual_meshes_or_said_lost(tmp_path: Path) -> None:
     (loss,) = w.losses
     assert (loss.kind, loss.name, loss.where) == ("shape", "s", f"{p}:2:61")   # the second CadShape
     assert "mesh 'part.dae': the .dae format is not read here" in loss.why
+
+
+def test_a_wbt_load_times_each_stage() -> None:
+    """What ``sensorium bench --only loading`` reads: wall seconds per stage of a .wbt load."""
+    w = load_world(Path(__file__).parent / "worlds" / "proto" / "minipuck.wbt", proto_path=[])
+    assert set(w.timings) == {"parse", "proto files", "instantiate", "template", "convert", "validate"}
+    assert all(v >= 0.0 for v in w.timings.values()) and w.timings["template"] > 0.0

@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import time
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -86,6 +87,7 @@ class LoadedWorld:
     warnings: list[str] = field(default_factory=list)   # every message of the load, losses included
     losses: tuple[Loss, ...] = ()                        # what sensors would notice was left out (report.py)
     asset_files: frozenset[Path] = frozenset()          # files outside base_dir it may read (PROTO assets)
+    timings: dict[str, float] = field(default_factory=dict)   # wall seconds per loading stage (sensorium bench)
 
     @property
     def report(self) -> LoadReport:
@@ -240,6 +242,7 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
         else:
             where = f"line {exc.line}, column {exc.col}" if exc.line else ""
         raise WorldError(source, [Problem(where, exc.message)]) from None
+    t0 = time.perf_counter()
     try:
         loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
                              allow_outside_meshes=allow_outside_meshes, asset_files=conv.asset_files)
@@ -251,7 +254,8 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
         at = _origin_of(where, origin)
         placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w)
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
-                       warnings=[*warnings, *placed], losses=conv.losses, asset_files=conv.asset_files)
+                       warnings=[*warnings, *placed], losses=conv.losses, asset_files=conv.asset_files,
+                       timings={**conv.timings, "validate": time.perf_counter() - t0})
 
 
 def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:

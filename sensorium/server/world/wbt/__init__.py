@@ -6,7 +6,8 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +31,7 @@ class WbtConversion:
     protos: list[Any]
     asset_files: frozenset[Path] = frozenset()
     losses: tuple[Any, ...] = ()
+    timings: dict[str, float] = field(default_factory=dict)   # wall seconds per stage (sensorium bench)
 
 
 def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),
@@ -41,14 +43,22 @@ def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, prot
 
     source = str(path)
     limits = limits or ProtoLimits()
+    t0 = time.perf_counter()
     search = ProtoSearch.create(Path(path).resolve().parent, webots_home, tuple(proto_path))
-    expansion = expand(read_wbt(path, limits), search, limits)
+    wbt = read_wbt(path, limits)
+    t1 = time.perf_counter()
+    expansion = expand(wbt, search, limits)
+    t2 = time.perf_counter()
     conv = Converter(expansion.as_wbt(), source, expansion.search)
     raw = conv.run()
     origin: dict[str, tuple[int, int, str]] = {}
     data = strip_origins(raw, "", origin)
+    t3 = time.perf_counter()
+    files, template = expansion.timings.get("proto files", 0.0), expansion.timings.get("template", 0.0)
+    timings = {"parse": t1 - t0, "proto files": files, "instantiate": t2 - t1 - files - template,
+               "template": template, "convert": t3 - t2}
     return WbtConversion(data, [*expansion.warnings, *conv.warnings], origin, expansion.protos,
-                         frozenset(conv.asset_files), tuple(conv.losses))
+                         frozenset(conv.asset_files), tuple(conv.losses), timings)
 
 
 def wbt_to_dict(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),
