@@ -147,8 +147,8 @@ def test_webots_infra_red_test_situation(tmp_path: Path, precision: str) -> None
 
 
 def test_a_texture_webots_could_not_load_reads_the_untextured_colour(tmp_path: Path) -> None:
-    """Missing file (or webots:// url, not resolved yet): a warning, and Webots' reading of a
-    texture it could not load: an Appearance's material diffuseColor (not white)."""
+    """Missing file (or a webots:// url with no Webots installation given): a warning, and Webots'
+    reading of a texture it could not load: an Appearance's material diffuseColor (not white)."""
     path = _webots_ir_test_world(tmp_path)
     (tmp_path / "textures" / "greenish.png").unlink()
     sim = Simulation.from_file(path)
@@ -157,7 +157,7 @@ def test_a_texture_webots_could_not_load_reads_the_untextured_colour(tmp_path: P
     assert read_all(sim)["ds1"] == pytest.approx(10 * expected(0.065, 0.75), rel=1e-9)
     path.write_text(path.read_text().replace("textures/greenish.png", "webots://projects/x.png"))
     notes = [w for w in load_world(path).warnings if "texture" in w]
-    assert len(notes) == 1 and "webots:// urls" in notes[0] and "not resolved yet" in notes[0]
+    assert len(notes) == 1 and '"webots://projects/x.png" not found' in notes[0] and "--webots-home" in notes[0]
 
 
 # ------------------------------------------------------------------ texture coordinates at known points

@@ -418,7 +418,8 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
     if not problems:    # textures: confined like meshes, within the limits, decoded once (world/textures.py)
         from sensorium.server.world.textures import check_textures
 
-        problems += [Problem(*p) for p in check_textures(world, base_dir, limits or WorldLimits(), allow_outside_meshes)]
+        problems += [Problem(*p) for p in check_textures(world, base_dir, limits or WorldLimits(), allow_outside_meshes,
+                                                         asset_files)]
     return problems
 
 

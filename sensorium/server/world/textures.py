@@ -55,9 +55,10 @@ class TextureFileError(Exception):
 
 
 def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False,
-                        max_bytes: int | None = None) -> Path:
+                        max_bytes: int | None = None, allowed: frozenset[Path] = frozenset()) -> Path:
     """A texture ``url`` → the file it names, relative to ``base_dir`` (the world's folder), which
-    it may not leave unless ``allow_outside`` (as mesh urls). Errors quote the url as written."""
+    it may not leave unless ``allow_outside`` (as mesh urls) or the file is in ``allowed`` (a .wbt
+    world's PROTO textures and ``webots://`` assets, read only). Errors quote the url as written."""
     if "\0" in url:
         raise TextureFileError("texture url contains a NUL byte")
     if not url.strip():
@@ -72,7 +73,7 @@ def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False
         path = (base / url).resolve()
     except (OSError, RuntimeError, ValueError) as exc:
         raise TextureFileError(f"texture url {url!r} cannot be resolved: {exc}") from None
-    if not allow_outside and not path.is_relative_to(base):
+    if not allow_outside and not path.is_relative_to(base) and path not in allowed:
         raise TextureFileError(f"texture url {url!r} leaves the world's folder (absolute paths and '..' are "
                                "refused; use --allow-outside-meshes to allow them)")
     try:
@@ -175,7 +176,8 @@ def _appearances(world: wm.World) -> Iterator[tuple[str, Any]]:
             yield f"robots[{r_i}].shapes[{i}]", part
 
 
-def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False) -> list[tuple[str, str]]:
+def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False,
+                   allowed: frozenset[Path] = frozenset()) -> list[tuple[str, str]]:
     """Every texture of a world: url confined and readable, a PNG or JPEG within the limits, decoded
     (so a broken file is found when the world is checked, and decoded once); the texture
     coordinates of inline triangles consistent. ``(path, message)`` per problem."""
@@ -190,7 +192,7 @@ def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: 
             where = f"{path}.appearance.{field}.url"
             try:
                 file = resolve_texture_url(tex.url, base_dir, allow_outside=allow_outside,
-                                           max_bytes=limits.texture_file_bytes)
+                                           max_bytes=limits.texture_file_bytes, allowed=allowed)
                 if file in seen:
                     continue
                 _, w, h = image_header(file, tex.url)

@@ -364,7 +364,8 @@ class Converter:
             return
         part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
         if seen_by == "visual":
-            app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note)
+            app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note,
+                                lambda n, u: self.asset(n, u, "texture"))
             if app is not None:
                 part["appearance"] = app
             owner.keys[key] = part
@@ -405,39 +406,42 @@ class Converter:
             return g.type if g is not None else ""
         return first.type
 
-    def asset(self, node: Node, url: str) -> tuple[str | None, str]:
-        """The url a converted world names for an asset ``url`` written in ``node``'s file: as written
-        when the world file names a local file (the loader confines it to the world's folder); else
-        (a PROTO's url, relative to the PROTO file; ``webots://`` or Webots' GitHub urls, from the
-        installation) the local file it names, which must lie in the Webots installation, a
-        --proto-path folder or the project of the PROTO file that names it (read only). (None, why):
-        the file is missing or refused (the caller reports the shape as lost, naming it)."""
+    def asset(self, node: Node, url: str, kind: str = "mesh") -> tuple[str | None, str]:
+        """The url a converted world names for an asset (``kind``: mesh or texture) ``url`` written in
+        ``node``'s file: as written when the world file names a local file (the loader confines it to
+        the world's folder); else (a PROTO's url, relative to the PROTO file; ``webots://`` or Webots'
+        GitHub urls, from the installation) the local file it names, which must lie in the Webots
+        installation, a --proto-path folder or the project of the PROTO file that names it (read
+        only). (None, why): the file is missing or refused (the caller says so, naming it)."""
         from sensorium.server.world.meshes import SUPPORTED
         from sensorium.server.world.proto import ProtoError, asset_roots, resolve_url
 
         src = node.source or self.source
         suffix = Path(url.split("?")[0]).suffix.lower()
-        if suffix not in SUPPORTED:
+        if kind == "mesh" and suffix not in SUPPORTED:
             return None, (f"mesh {url!r}: the {suffix or 'unnamed'} format is not read here "
                           f"({', '.join(sorted(SUPPORTED))}); this shape is left out, rays do not see it")
         if src == self.source and "://" not in url:
+            if kind == "texture":
+                return url, ""            # checked (and said when missing) where textures are read
             if not (Path(self.source).resolve().parent / url).is_file() and "\0" not in url:
                 return None, f"mesh file {url!r} not found (relative to the world file): this shape is left out"
             return url, ""
+        lost = "this shape is left out" if kind == "mesh" else "not loaded"
         if self.search is None:
-            return None, f"mesh url {url!r}: no PROTO search places to resolve it; this shape is left out"
+            return None, f"{kind} url {url!r}: no PROTO search places to resolve it; {lost}"
         try:
             path = resolve_url(url, src, self.search).resolve()
         except ProtoError as exc:
-            return None, f"mesh file {exc.message}; this shape is left out"
+            return None, f"{kind} file {exc.message}; {lost}"
         except (OSError, ValueError) as exc:
-            return None, f"mesh url {url!r} cannot be resolved ({exc}); this shape is left out"
+            return None, f"{kind} url {url!r} cannot be resolved ({exc}); {lost}"
         roots = [*asset_roots(self.search), Path(src).resolve().parent.parent, Path(self.source).resolve().parent]
         if not any(path.is_relative_to(r) for r in roots):
-            return None, (f"mesh url {url!r} names a file outside the Webots installation, the --proto-path "
-                          "folders and the PROTO's project: refused, this shape is left out")
+            return None, (f"{kind} url {url!r} names a file outside the Webots installation, the --proto-path "
+                          f"folders and the PROTO's project: refused, {lost}")
         if not path.is_file():
-            return None, f"mesh file {url!r} not found: this shape is left out"
+            return None, f"{kind} file {url!r} not found: {lost}"
         self.asset_files.add(path)
         return str(path), ""
 

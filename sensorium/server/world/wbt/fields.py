@@ -174,7 +174,7 @@ DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light senso
 
 # ---------------------------------------------------------------- appearance
 
-def appearance(node: Node | None, source: str, warn) -> dict | None:
+def appearance(node: Node | None, source: str, warn, resolve=None) -> dict | None:
     """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read).
 
     As Webots' pickColor: a PBRAppearance is ``baseColor × (1 − transparency)`` times its
@@ -182,25 +182,27 @@ def appearance(node: Node | None, source: str, warn) -> dict | None:
     with a loaded ``texture`` reads white × ``(1 − transparency)`` × texel (WbAppearance::diffuseColor
     replaces the material's colour by white), without one its material's diffuseColor. A texture
     that cannot be loaded here (missing file, not PNG/JPEG, webots:// or remote url) is noted with
-    ``warn(node, "texture: <why>")`` and read as Webots reads a texture it could not load."""
+    ``warn(node, "texture: <why>")`` and read as Webots reads a texture it could not load.
+    ``resolve(node, url) -> (url or None, why)``: where a url of a PROTO file or ``webots://`` is
+    (the converter's asset resolution); without it urls are relative to ``source``."""
     if node is None:
         return None
     f = Fields(node, source)
     if node.type == "PBRAppearance":
         out: dict[str, Any] = {"base_color": list(f.vec("baseColor", (1.0, 1.0, 1.0))),
                                "transparency": f.num("transparency", 0.0), "roughness": f.num("roughness", 0.0)}
-        base = image_texture(f.node_("baseColorMap"), source, warn)
+        base = image_texture(f.node_("baseColorMap"), source, warn, resolve)
         if base is not None:
             out["texture"] = base
             for field, key in (("roughnessMap", "roughness_map"), ("occlusionMap", "occlusion_map")):
-                extra = image_texture(f.node_(field), source, warn)
+                extra = image_texture(f.node_(field), source, warn, resolve)
                 if extra is not None:
                     out[key] = extra
             _texture_transform(f, source, out)
         return out
     if node.type == "Appearance":
         material = f.node_("material")
-        texture = image_texture(f.node_("texture"), source, warn)
+        texture = image_texture(f.node_("texture"), source, warn, resolve)
         out = {"base_color": [1.0, 1.0, 1.0]}
         if material is not None:
             m = Fields(material, source)
@@ -215,7 +217,7 @@ def appearance(node: Node | None, source: str, warn) -> dict | None:
     return None
 
 
-def image_texture(node: Node | None, source: str, warn) -> dict | None:
+def image_texture(node: Node | None, source: str, warn, resolve=None) -> dict | None:
     """An ImageTexture → the world format's texture, if its first url is a PNG/JPEG file found
     relative to the world file (else ``warn(node, "texture: …")`` and None: Webots would not load it).
     The url is kept as written (backslashes made slashes, as Webots does)."""
@@ -234,6 +236,12 @@ def image_texture(node: Node | None, source: str, warn) -> dict | None:
         warn(node, "texture: ImageTexture without url")
         return None
     url = urls[0].replace("\\", "/")
+    if resolve is not None:
+        found, why = resolve(node, url)
+        if found is None:
+            warn(node, f"texture: {why}")
+            return None
+        url = found
     try:
         path = resolve_texture_url(url, Path(source).resolve().parent, allow_outside=True)
         image_header(path, url)
