@@ -567,3 +567,16 @@ def test_def_use_walk_is_bounded_without_shapes(tmp_path: Path, monkeypatch) -> 
     bomb = "Solid { boundingObject Group { children [\n" + "\n".join(levels) + "\n] } }\n"
     with pytest.raises(WorldError, match="more than 5000 nodes to walk"):
         load_world(write(tmp_path, bomb))
+
+
+def test_simulated_device_kinds_read_their_own_fields(tmp_path: Path) -> None:
+    """GPS, Compass, InertialUnit, ... take their .wbt fields (once left at their defaults in
+    silence); a field the model does not have is said."""
+    p = write(tmp_path, 'Robot { children [ GPS { accuracy 0.5 noiseCorrelation 0.9 speedNoise 0.1 }\n'
+                        '  Compass { lookupTable [ -1 -1 0, 1 1 0 ] yAxis FALSE } Altimeter { accuracy 0.2 wobble 3 } ] }\n')
+    w = load_world(p)
+    gps, compass, alt = w.world.robots[0].devices
+    assert (gps.accuracy, gps.noise_correlation, gps.speed_noise) == (0.5, 0.9, 0.1)
+    assert compass.lookup_table == [(-1.0, -1.0, 0.0), (1.0, 1.0, 0.0)] and compass.y_axis is False
+    assert alt.accuracy == 0.2
+    assert any("Altimeter.wobble: not read here" in x for x in w.warnings)

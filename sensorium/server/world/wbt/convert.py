@@ -48,6 +48,10 @@ LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED"}
 JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
 MOTORS = {"RotationalMotor", "LinearMotor"}
+# the fields every Solid has (a device's own fields are the others)
+SOLID_FIELDS = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
+                "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection",
+                "recognitionColors", "linearVelocity", "angularVelocity", "translationStep", "rotationStep"}
 # fields only robots have: an unknown node (a PROTO not found) that sets one was a robot
 ROBOT_ONLY_FIELDS = {"controller", "controllerArgs", "supervisor", "synchronization", "customData", "window",
                      "remoteControl", "battery", "selfCollision"}
@@ -660,9 +664,28 @@ class Converter:
                 data["model"] = model
         if frame.pose() != {"translation": [0.0, 0.0, 0.0]}:
             data["pose"] = frame.pose()
+        if t not in wm.UNSIMULATED_DEVICE_TYPES:       # a kind simulated here: its own fields, by their names
+            data.update(self.device_fields(node))
         data["_at"] = self.at(node)
         owner.data["devices"].append(data)
         return data
+
+    def device_fields(self, node: Node) -> dict[str, Any]:
+        """The fields of a device node that its world-file model has (Webots' camelCase names in
+        snake_case: ``noiseCorrelation`` → ``noise_correlation``; ``lookupTable`` as rows); a field
+        written that the model does not have is said (it is not read)."""
+        f = self.fields(node)
+        model = getattr(wm, node.type, None)
+        known = set(getattr(model, "model_fields", {})) - {"name", "model", "pose", "device"}
+        out: dict[str, Any] = {}
+        for field, value in node.fields.items():
+            key = "".join(f"_{c.lower()}" if c.isupper() else c for c in field)
+            if key in known:
+                out[key] = ([list(r) for r in f.rows(field, 3, [])] if key == "lookup_table"
+                            else list(value) if isinstance(value, tuple) else value)
+            elif field not in SOLID_FIELDS:
+                self.warn(node, f"{node.type}.{field}: not read here (the device takes its default)")
+        return out
 
     def joint_devices(self, node: Node, owner: Owner) -> tuple[list[dict], list[dict]]:
         """A joint's devices in its ``device`` order (Webots lists them before the end point's):
