@@ -678,13 +678,13 @@ class Converter:
         model = getattr(wm, node.type, None)
         known = set(getattr(model, "model_fields", {})) - {"name", "model", "pose", "device"}
         out: dict[str, Any] = {}
-        for field, value in node.fields.items():
-            key = "".join(f"_{c.lower()}" if c.isupper() else c for c in field)
+        for written, value in node.fields.items():
+            key = "".join(f"_{c.lower()}" if c.isupper() else c for c in written)
             if key in known:
-                out[key] = ([list(r) for r in f.rows(field, 3, [])] if key == "lookup_table"
+                out[key] = ([list(r) for r in f.rows(written, 3, [])] if key == "lookup_table"
                             else list(value) if isinstance(value, tuple) else value)
-            elif field not in SOLID_FIELDS:
-                self.warn(node, f"{node.type}.{field}: not read here (the device takes its default)")
+            elif written not in SOLID_FIELDS:
+                self.warn(node, f"{node.type}.{written}: not read here (the device takes its default)")
         return out
 
     def joint_devices(self, node: Node, owner: Owner) -> tuple[list[dict], list[dict]]:
