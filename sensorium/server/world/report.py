@@ -105,20 +105,20 @@ class LoadReport:
             out += [f"lost {loss.label()}: {loss.text}" for loss in self.losses]
             out += [f"warning: {w}" for w in self.notes]
             return out
-        groups: dict[tuple[str, str], list[str]] = {}
+        groups: dict[tuple[str, str], list[tuple[str, str]]] = {}     # (head, message) -> (where, label)
         for loss in self.losses:
             where, msg = _split(loss.text)
-            groups.setdefault(("lost " + (_KIND_WORDS[loss.kind][0] if loss.kind in _KIND_WORDS else loss.kind), msg),
-                              []).append(where if not loss.name else f"{where} ({loss.label()})")
+            word = _KIND_WORDS[loss.kind][0] if loss.kind in _KIND_WORDS else loss.kind
+            groups.setdefault(("lost " + word, msg), []).append((where, "lost " + loss.label()))
         for w in self.notes:
             where, msg = _split(w)
-            groups.setdefault(("warning", msg), []).append(where)
+            groups.setdefault(("warning", msg), []).append((where, "warning"))
         for (head, msg), places in groups.items():
-            first = places[0]
+            where, label = places[0]
             if len(places) == 1:
-                out.append(f"{head}: {first}: {msg}" if first else f"{head}: {msg}")
+                out.append(f"{label}: {where}: {msg}" if where else f"{label}: {msg}")
             else:
-                out.append(f"{head} (x{len(places)}, first at {first}): {msg}")
+                out.append(f"{head} (x{len(places)}, first at {where}): {msg}")
         return out
 
     def text(self, *, every: bool = False) -> str:
