@@ -247,6 +247,48 @@ def test_mesh_urls_of_protos_and_webots_assets_load_read_only(tmp_path: Path, mo
         load_world(bad)
 
 
+def test_texture_urls_of_protos_and_webots_assets_load_read_only(tmp_path: Path, monkeypatch) -> None:
+    """Textures as meshes: a PROTO's url relative to the PROTO file, webots:// from the installation,
+    read where they are; infra-red reads their texels (a red and a blue image: red channel 1 and 0)."""
+    from PIL import Image
+
+    home = tmp_path / "webots"
+    (home / "projects" / "textures").mkdir(parents=True)
+    Image.new("RGB", (2, 2), (0, 0, 255)).save(home / "projects" / "textures" / "blue.png")
+    (home / "resources").mkdir()
+    (home / "resources" / "version.txt").write_text("R2023b\n")
+    monkeypatch.setenv("WEBOTS_HOME", str(home))
+    protos = tmp_path / "project" / "protos"
+    (protos / "textures").mkdir(parents=True)
+    Image.new("RGB", (2, 2), (255, 0, 0)).save(protos / "textures" / "red.png")
+    proto_file(protos, "Tiles", """[ ]
+{ Solid { children [
+    Shape { appearance PBRAppearance { baseColorMap ImageTexture { url "textures/red.png" } } geometry Box { } }
+    Pose { translation 0 0 5 children [ Shape { appearance PBRAppearance { baseColorMap ImageTexture {
+      url "webots://projects/textures/blue.png" } } geometry Sphere { } } ] } ] } }""")
+    w = world_file(tmp_path / "project" / "worlds", 'Tiles { }\n', ["../protos/Tiles.proto"])
+    loaded = load_world(w)
+    urls = [s.appearance.texture.url for s in loaded.world.solids[0].shapes]
+    assert urls == [str((protos / "textures" / "red.png").resolve()), str((home / "projects/textures/blue.png").resolve())]
+    assert not [m for m in loaded.warnings if "texture" in m]
+    from sensorium.server.sim.scene import Scene
+
+    scene = Scene(loaded.world, loaded.base_dir)
+    import numpy as np
+
+    o, d = np.array([[5.0, 0, 0], [5.0, 0, 5.0]]), np.array([[-1.0, 0, 0], [-1.0, 0, 0]])
+    hits = scene.engine.cast(o, d, kind=1)
+    assert hits.shape.tolist() == [0, 1]
+    red, _, _ = scene.infra_red_terms(hits.shape, o, d, hits.distance)
+    assert red.tolist() == [1.0, 0.0]
+    # the world file itself naming a file outside its folder is still refused
+    bad = world_file(tmp_path / "project" / "worlds", 'Solid { children [ Shape { appearance PBRAppearance { '
+                     f'baseColorMap ImageTexture {{ url "{protos}/textures/red.png" }} }} geometry Box {{ }} }} ] }}\n',
+                     name="bad.wbt")
+    with pytest.raises(WorldError, match="leaves the world's folder"):
+        load_world(bad)
+
+
 def test_messages_about_proto_nodes_name_the_proto_file_and_the_instance(tmp_path: Path) -> None:
     proto_file(tmp_path, "Odd", '[ ] { Robot { name "odd" children [ Wobbler { } ] } }')
     w = world_file(tmp_path, 'Pose { children [ Odd { } ] }\n', ["Odd.proto"])

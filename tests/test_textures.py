@@ -158,7 +158,7 @@ def test_a_texture_webots_could_not_load_reads_the_untextured_colour(tmp_path: P
     assert read_all(sim)["ds1"] == pytest.approx(10 * expected(0.065, 0.75), rel=1e-9)
     path.write_text(path.read_text().replace("textures/greenish.png", "webots://projects/x.png"))
     notes = [w for w in load_world(path).warnings if "texture" in w]
-    assert len(notes) == 1 and '"webots://projects/x.png" not found' in notes[0] and "WEBOTS_HOME" in notes[0]
+    assert len(notes) == 1 and '"webots://projects/x.png" not found' in notes[0] and "--webots-home" in notes[0]
 
 
 def test_proto_relative_and_webots_texture_urls_are_read_where_they_are(tmp_path: Path, monkeypatch) -> None:

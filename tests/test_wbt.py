@@ -213,7 +213,9 @@ def test_hinge_wheels_become_a_differential_drive(tmp_path: Path) -> None:
     (dict(axis_left="0 -1 0"), "wheel axis of motor 'left wheel motor' is [0.0, -1.0, 0.0], not the robot's +y"),
     (dict(anchor_x=0.02), "the axle midpoint is at x=0.02, y=0 in the robot frame, not under the robot's origin"),
     (dict(extra='HingeJoint { device [ RotationalMotor { name "third" } ] }\n'),
-     "3 motorised hinge joints; a differential drive needs exactly two wheels"),
+     "wheel axis of motor 'third' is [1.0, 0.0, 0.0], not the robot's +y"),
+    (dict(extra='HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } device [ RotationalMotor { name "third" } ] }\n'),
+     "3 motorised wheels, not all on either side of the robot's x axis"),
 ])
 def test_no_drive_says_why(tmp_path: Path, kwargs: dict, why: str) -> None:
     p = write(tmp_path, _two_wheels(**kwargs))
@@ -450,17 +452,17 @@ def test_named_controllers_become_extern(tmp_path: Path) -> None:
         assert w.world.robots[0].controller == "<extern>"
 
 
-def test_mesh_and_scale_problems_point_at_lines(tmp_path: Path) -> None:
-    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.dae" ] } }\n  ]\n}\n')
+def test_mesh_losses_load_and_name_their_lines(tmp_path: Path) -> None:
+    """A mesh Sensorium cannot read (a format it does not read, a missing file) is a loss naming the
+    file and line; the world still loads (the rest of the solid too)."""
+    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.dae" ] } }\n'
+                        '    Shape { geometry Mesh { url [ "gone.stl" ] } }\n    Shape { geometry Box { } }\n  ]\n}\n')
     (tmp_path / "robot.dae").write_text("<COLLADA/>")
-    with pytest.raises(WorldError) as exc:
-        load_world(p)
-    assert str(exc.value).startswith(f"{p}: line 4, column 22 (Mesh, converted as solids[0].shapes[0].geometry.url): "
-                                     "unsupported mesh format '.dae'")
-    p = write(tmp_path, 'Transform {\n  scale 1 2 1\n  children [ Shape { geometry Box { } } ]\n}\n')
-    with pytest.raises(WorldError) as exc:
-        load_world(p)
-    assert str(exc.value) == f"{p}: line 3, column 3: Transform.scale: only a uniform positive scale is supported, got 1.0 2.0 1.0"
+    w = load_world(p)
+    assert [s.geometry.type for s in w.world.solids[0].shapes] == ["box"]
+    assert [(loss.kind, loss.where) for loss in w.losses] == [("shape", f"{p}:4:22"), ("shape", f"{p}:5:22")]
+    assert "the .dae format is not read here" in w.losses[0].why
+    assert "mesh file 'gone.stl' not found (relative to the world file)" in w.losses[1].why
 
 
 def test_scaled_transform_scales_geometry(tmp_path: Path) -> None:
@@ -565,3 +567,16 @@ def test_def_use_walk_is_bounded_without_shapes(tmp_path: Path, monkeypatch) -> 
     bomb = "Solid { boundingObject Group { children [\n" + "\n".join(levels) + "\n] } }\n"
     with pytest.raises(WorldError, match="more than 5000 nodes to walk"):
         load_world(write(tmp_path, bomb))
+
+
+def test_simulated_device_kinds_read_their_own_fields(tmp_path: Path) -> None:
+    """GPS, Compass, InertialUnit, ... take their .wbt fields (once left at their defaults in
+    silence); a field the model does not have is said."""
+    p = write(tmp_path, 'Robot { children [ GPS { accuracy 0.5 noiseCorrelation 0.9 speedNoise 0.1 }\n'
+                        '  Compass { lookupTable [ -1 -1 0, 1 1 0 ] yAxis FALSE } Altimeter { accuracy 0.2 wobble 3 } ] }\n')
+    w = load_world(p)
+    gps, compass, alt = w.world.robots[0].devices
+    assert (gps.accuracy, gps.noise_correlation, gps.speed_noise) == (0.5, 0.9, 0.1)
+    assert compass.lookup_table == [(-1.0, -1.0, 0.0), (1.0, 1.0, 0.0)] and compass.y_axis is False
+    assert alt.accuracy == 0.2
+    assert any("Altimeter.wobble: not read here" in x for x in w.warnings)

@@ -27,6 +27,8 @@ def _validate_args(p: argparse.ArgumentParser) -> None:
 
     p.add_argument("world", nargs="+", help="world file(s): YAML, JSON or Webots .wbt")
     add_world_options(p)
+    p.add_argument("--allow-skipped", action="store_true",
+                   help="exit 0 although the world lost a robot, a sensor device or a shape sensors see (listed)")
 
 
 @command("convert", "write a Webots world (.wbt) as an equivalent Sensorium world file",

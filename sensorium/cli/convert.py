@@ -36,8 +36,8 @@ def convert(args: argparse.Namespace) -> int:
         print(str(exc), file=sys.stderr)
         return 1
     data = converted_world(src, out.resolve().parent if out is not None else Path.cwd())
-    for w in loaded.warnings:
-        print(f"warning: {w}", file=sys.stderr)
+    if loaded.report:
+        print(loaded.report.text(), file=sys.stderr)
     if out is not None and out.suffix.lower() == ".json":
         text = json.dumps(data, indent=2) + "\n"
     else:

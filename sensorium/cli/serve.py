@@ -66,6 +66,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "nobody controls them and the world steps by itself, so a viewer (--foxglove) or a subscriber "
                    "sees their sensors without starting controllers")
     add_world_options(p)
+    p.add_argument("--allow-skipped", action="store_true",
+                   help="serve a world even when every robot it writes was lost when it loaded (each is listed)")
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
                    "without subscribers (default: every topic)")
@@ -103,7 +105,7 @@ def options(args: argparse.Namespace):
                         allow_outside_meshes=getattr(args, "allow_outside_meshes", False),
                         contact=False if getattr(args, "no_contact", False) else None,
                         controls=getattr(args, "controls", "auto"), curve_keys=getattr(args, "curve_keys", None),
-                        watch=getattr(args, "watch", None))
+                        watch=getattr(args, "watch", None), allow_skipped=getattr(args, "allow_skipped", False))
 
 
 def bind_problem(exc: BaseException) -> str:
@@ -141,6 +143,9 @@ def main(args: argparse.Namespace) -> int:
     except (OSError, zmq.ZMQError) as exc:          # address in use, bad endpoint
         print(f"sensorium serve: {bind_problem(exc)}", file=sys.stderr)
         return 1
+    report = server.core.sim.loaded.report
+    if report:          # what the load left out, once, before the ready line
+        print(report.text(), file=sys.stderr, flush=True)
     if server.transport.curve:
         from sensorium.server.daemon.transport import load_curve_keys
 

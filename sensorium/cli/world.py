@@ -23,7 +23,18 @@ def world_options(args: argparse.Namespace) -> dict[str, Any]:
             "allow_outside_meshes": getattr(args, "allow_outside_meshes", False)}
 
 
+def print_report(loaded, *, every: bool = False) -> None:
+    """What a load left out, once, on standard error: a header with the counts, then each loss and
+    warning (``every``) or the same grouped with their counts (:mod:`sensorium.server.world.report`)."""
+    report = loaded.report
+    if report:
+        print(report.text(every=every), file=sys.stderr, flush=True)
+
+
 def validate(args: argparse.Namespace) -> int:
+    """Exit 1 when a world cannot load, or loads without a robot, a sensor device or a shape sensors
+    see (each named with its line and why); ``--allow-skipped`` accepts those. Visual- or
+    physics-only differences are warnings (exit 0)."""
     status = 0
     for path in args.world:
         try:
@@ -33,8 +44,13 @@ def validate(args: argparse.Namespace) -> int:
             print(f"{path}: INVALID ({len(exc.problems)} problem{'s' if len(exc.problems) != 1 else ''})", file=sys.stderr)
             status = 1
             continue
-        for w in loaded.warnings:
-            print(f"{path}: warning: {w}", file=sys.stderr)
+        print_report(loaded, every=True)
+        losses = loaded.report.losses
+        if losses and not getattr(args, "allow_skipped", False):
+            print(f"{path}: INVALID ({loaded.report.counts()}; --allow-skipped accepts what was left out)",
+                  file=sys.stderr)
+            status = 1
+            continue
         print(f"{path}: OK")
     return status
 
@@ -75,8 +91,8 @@ def info(args: argparse.Namespace) -> int:
             print(f"    {d['name']:<14} {d['summary']}")
     for u in s.get("protos", []):
         print(f"proto     {u['name']} x{u['instances']}: {u['license'] or 'no license line'} ({u['path'] or u['url']})")
-    for w in s["warnings"]:
-        print(f"warning: {w}")
+    for line in s["report"]:
+        print(line)
     return 0
 
 
@@ -110,10 +126,12 @@ def probe(args: argparse.Namespace) -> int:
 
     path = args.world or str(default_world_path())
     try:
-        sim = Simulation.from_file(path, precision=args.precision, **world_options(args))
+        loaded = load_world(path, **world_options(args))
+        sim = Simulation(loaded, precision=args.precision)
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1
+    print_report(loaded)
     enabled: list[Any] = []        # sensors.LightSensor | DistanceSensor | Lidar: each has readings()
     try:
         for spec in args.enable:

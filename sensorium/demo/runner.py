@@ -162,6 +162,8 @@ def run_demo(world: str | None, duration_s: float, out_dir: Path, precision: str
         loaded = load_world(world_path)
     except WorldError as exc:
         raise DemoError(str(exc).splitlines()[0] if str(exc) else f"invalid world {world_path}") from None
+    if loaded.report:           # what the load left out, once (the server's copy goes to server.log)
+        log(loaded.report.text())
     problems = check_demo_world(loaded.world)
     if problems:
         raise DemoError(f"{world_path}: cannot run the demo's controllers on this world: {'; '.join(problems)}")

@@ -34,6 +34,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.sensors import Lidar
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
+from sensorium.server.world.report import warn_losses
 
 __all__ = ["SensoriumEnv", "Agent", "load", "rebuild"]
 
@@ -46,7 +47,9 @@ def load(world: str | Path | LoadedWorld | wm.World | None) -> LoadedWorld:
         return world
     if isinstance(world, wm.World):
         return LoadedWorld(world=world, source="<memory>", base_dir=Path.cwd())
-    return load_world(world)
+    loaded = load_world(world)
+    warn_losses(loaded.report)        # a robot, device or shape the world lost: said once
+    return loaded
 
 
 class Agent:

@@ -198,6 +198,10 @@ class Part(Shape):
 
     name: str | None = None
     pose: Pose = Pose()
+    of_device: str | None = Field(
+        default=None, min_length=1,
+        description="on a robot: the device whose own Solid this shape belongs to (a sensor's housing); that "
+                    "device's infra-red rays and lidar beams do not see it, as in Webots")
 
 
 # ---------------------------------------------------------------- lights
@@ -512,20 +516,40 @@ DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED
 
 # ---------------------------------------------------------------- motion
 
+class SkidSteer(Strict):
+    """The other motorised wheels of a skid-steer robot (a Pioneer 3-AT's back wheels), by side:
+    each side rolls at the mean of its wheels' speeds (``left_motor`` and these on the left)."""
+
+    left: list[str] = Field(default_factory=list, max_length=16)
+    right: list[str] = Field(default_factory=list, max_length=16)
+
+
 class DifferentialDrive(Strict):
-    """Kinematic two-wheel drive (no physics, no collision response): the robot moves in the world
-    xy-plane from its two wheel motors, controlled with Webots' motor API."""
+    """Kinematic wheeled drive (no physics, no collision response): the robot moves in the world
+    xy-plane from its wheel motors, controlled with Webots' motor API. Two wheels, or several per
+    side (``skid_steer``: a side rolls at the mean of its wheels' speeds, no slip)."""
 
     wheel_radius: float = Field(default=0.0205, gt=0)
-    axle_length: float = Field(default=0.052, gt=0, description="distance between the wheels")
+    axle_length: float = Field(default=0.052, gt=0, description="distance between the wheels (the wheel lines)")
     max_wheel_speed: float = Field(default=6.28, gt=0, description="rad/s, Webots maxVelocity")
     left_motor: str = Field(default="left wheel motor", min_length=1)
     right_motor: str = Field(default="right wheel motor", min_length=1)
+    skid_steer: SkidSteer | None = Field(default=None, description="more wheels per side (skid steer)")
+
+    @property
+    def motor_names(self) -> tuple[list[str], list[str]]:
+        """(left side's motors, right side's motors), first the ``left_motor``/``right_motor``."""
+        extra = self.skid_steer or SkidSteer()
+        return [self.left_motor, *extra.left], [self.right_motor, *extra.right]
 
     @model_validator(mode="after")
     def _distinct(self) -> DifferentialDrive:
         if self.left_motor == self.right_motor:
             raise ValueError("left_motor and right_motor must have different names")
+        left, right = self.motor_names
+        names = [*left, *right]
+        if len(set(names)) != len(names):
+            raise ValueError(f"every wheel motor needs its own name, got {names}")
         return self
 
 

@@ -39,6 +39,7 @@ class ServeOptions:
     controls: str = "auto"            # world-wide controls: auto | open | supervisor (daemon/roles.py)
     curve_keys: str | None = None     # DIR with server.key_secret: CURVE on both sockets
     watch: list[str] | None = None    # run these "<extern>" robots ([] = every one) as "<none>" (serve --watch)
+    allow_skipped: bool = False       # serve a world whose robots were all dropped when it loaded
 
     def check(self) -> None:
         """Raise ValueError naming the first bad option."""
@@ -60,12 +61,30 @@ def build(world: str | Path | None, options: ServeOptions | None = None) -> tupl
     path = Path(world) if world else default_world_path()
     loaded = load_world(path, limits=WorldLimits.large() if opts.allow_large else WorldLimits(),
                         allow_outside_meshes=opts.allow_outside_meshes)
+    if not opts.allow_skipped:
+        refuse_robotless(loaded)
     if opts.watch is not None:
         loaded = watched(loaded, opts.watch)
     sim = Simulation(loaded, opts.precision, contact=opts.contact)
     core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode,
                 open_controls=open_controls(opts.controls, opts.rpc))
     return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until, curve_secret=secret)
+
+
+def refuse_robotless(loaded: LoadedWorld) -> None:
+    """A world that wrote robots but lost every one when it loaded is not served (it would run by
+    itself with nothing to control): ``WorldError`` naming each, unless ``--allow-skipped``."""
+    dropped = loaded.report.dropped_robots()
+    if loaded.world.robots or not dropped:
+        return
+    robots = sum(loss.kind == "robot" for loss in dropped)
+    what = ", ".join(part for part in (f"{robots} robot{'s' if robots != 1 else ''}" if robots else "",
+                                       f"{len(dropped) - robots} unknown node{'s' if len(dropped) - robots != 1 else ''} "
+                                       "that may have been one" if len(dropped) > robots else "") if part)
+    lines = [f"every robot of this world was lost when it loaded ({what}); nothing to control "
+             "(--allow-skipped serves it anyway):", *(f"  lost {loss.label()}: {loss.text}" for loss in dropped)]
+    problems = [Problem("", "\n".join(lines))]
+    raise WorldError(loaded.source, problems)
 
 
 def watched(loaded: LoadedWorld, robots: list[str]) -> LoadedWorld:

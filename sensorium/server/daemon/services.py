@@ -169,7 +169,8 @@ class Core(DeviceServices):
         if not robots:
             name = service[1:].split("/", 1)[0]
             return ServiceError(ErrorCode.UNKNOWN_ROBOT,
-                                f"no robot {name!r} (robots: {', '.join(self.sim.robots) or 'none'})")
+                                f"no robot {name!r} (robots: {', '.join(self.sim.robots) or 'none'})"
+                                f"{self._dropped_note(name)}")
         robot = robots[0]
         rest = service[len(robot) + 2:]
         devices = self._device_kinds(robot)
@@ -393,7 +394,17 @@ class Core(DeviceServices):
             "topics": [{"name": t.name, "type": t.type} for t in self.topics.topics],
         }
 
+    def _dropped_note(self, robot: str) -> str:
+        """Why ``robot`` is missing when the world lost it (or nodes that may have been it) at load."""
+        from sensorium.server.world.report import dropped_robot_note
+
+        loaded = getattr(self.sim, "loaded", None)
+        return dropped_robot_note(getattr(loaded, "report", None), robot)
+
     def _srv_attach(self, c: Call) -> dict:
+        if c.args.robot not in self.lockstep.robots:     # told why when the world lost it at load
+            raise LockstepError(ErrorCode.UNKNOWN_ROBOT, f"no robot {c.args.robot!r} (robots: "
+                                f"{', '.join(self.lockstep.robots) or 'none'}){self._dropped_note(c.args.robot)}")
         s = self.lockstep.attach(c.args.robot, c.peer, c.now)
         self._announced = False                     # say it again once the world waits again
         self.topics.release_robot(s.robot)          # a new controller starts from scratch

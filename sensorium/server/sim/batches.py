@@ -17,6 +17,7 @@ from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import light as light_math
 from sensorium.server.devices.lookup import RESOLUTION_OFF, add_noise, quantize_sensor
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
+from sensorium.server.sim.own_shapes import cast_local_skipping
 from sensorium.server.sim.sensors import DistanceSensor, LightSensor, RayRequest
 from sensorium.server.world.geometry import Pose
 
@@ -210,6 +211,9 @@ class _Group:
                 robot = np.repeat(np.array([d.robot_index for d in devs], dtype=np.int64), n)
                 self.own_visible = (self.mount >= 0) & (self.exclude != robot)
         self.own: tuple | None = None        # (precision, RayHits in body frames), made on first use
+        # infra-red rays do not see their device's own shapes (own_shapes.py): per ray, those shapes
+        owned = kind == RayKind.VISUAL and any(d.own_shapes for d in devs)
+        self.blind: list[frozenset[int]] | None = [d.own_shapes for d in devs for _ in range(n)] if owned else None
         # the request's limit and exclusion: one scalar when uniform (what the engine would make of them)
         self.far_arg = float(self.t_far[0]) if not np.count_nonzero(self.t_far != self.t_far[0]) else self.t_far
         self.exclude_arg = int(self.exclude[0]) if not np.count_nonzero(self.exclude != self.exclude[0]) else self.exclude
@@ -227,8 +231,12 @@ class _Group:
             normal = np.zeros((S * n, 3))
             for body in np.unique(self.mount[self.own_visible]).tolist():
                 rows = (self.own_visible & (self.mount == body)).nonzero()[0]
-                h = engine.cast_local(body, O[rows], D[rows], 0.0, self.t_far[rows], kind=self.kind,
-                                      skip_transparent=self.skip)
+                if self.blind is not None:
+                    h = cast_local_skipping(engine, body, O[rows], D[rows], 0.0, self.t_far[rows], self.kind,
+                                            self.skip, [self.blind[r] for r in rows.tolist()])
+                else:
+                    h = engine.cast_local(body, O[rows], D[rows], 0.0, self.t_far[rows], kind=self.kind,
+                                          skip_transparent=self.skip)
                 t[rows], shape[rows], normal[rows] = h.distance, h.shape, h.normal
             self.own = (engine.precision, RayHits(t, normal, shape))
         return self.own[1]

@@ -1,4 +1,5 @@
-"""Kinematic differential drive: Webots-style wheel motors and exact pose integration.
+"""Kinematic wheeled drive (two wheels, or skid steer): Webots-style wheel motors and exact pose
+integration.
 
 No physics: wheels never slip and nothing collides. Over a basic step the wheel speeds are
 constant, so the robot follows an exact circular arc (or a straight segment); integrating the arc
@@ -93,7 +94,11 @@ _TO_ENU = {
 
 
 class DifferentialDrive:
-    """The drive of one robot: two wheel motors and the robot's planar state (x, y, yaw).
+    """The drive of one robot: its wheel motors and the robot's planar state (x, y, yaw).
+
+    Two wheels, or several per side (skid steer, ``config.skid_steer``): each side rolls at the
+    mean of its wheels' speeds, without slip, so a skid-steer robot turns as a two-wheel robot whose
+    track is the distance between its wheel lines (a real one skids and turns slower).
 
     The robot's rotation is kept as ``Rz(yaw) @ base`` where ``base`` is the part of its initial
     rotation that is not a turn about the up axis, so a tilted robot keeps its tilt while driving.
@@ -105,8 +110,12 @@ class DifferentialDrive:
         self._to_enu = _TO_ENU[up]
         self.wheel_radius = float(config.wheel_radius)
         self.axle_length = float(config.axle_length)
-        self.left = WheelMotor(config.left_motor, float(config.max_wheel_speed))
-        self.right = WheelMotor(config.right_motor, float(config.max_wheel_speed))
+        speed = float(config.max_wheel_speed)
+        skid = getattr(config, "skid_steer", None)
+        self.left = WheelMotor(config.left_motor, speed)
+        self.right = WheelMotor(config.right_motor, speed)
+        self.lefts = [self.left, *(WheelMotor(name, speed) for name in (skid.left if skid else ()))]
+        self.rights = [self.right, *(WheelMotor(name, speed) for name in (skid.right if skid else ()))]
         self.reset(pose)
 
     def reset(self, pose: Pose) -> None:
@@ -120,16 +129,20 @@ class DifferentialDrive:
 
     @property
     def motors(self) -> dict[str, WheelMotor]:
-        return {self.left.name: self.left, self.right.name: self.right}
+        return {m.name: m for m in (*self.lefts, *self.rights)}
 
     @property
     def moving(self) -> bool:
-        return any(m.velocity != 0.0 for m in (self.left, self.right))
+        return any(m.velocity != 0.0 for m in (*self.lefts, *self.rights))
 
     def step(self, dt_ms: int) -> Pose | None:
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
         dt = dt_ms / 1000.0
-        wl, wr = self.left.advance(dt), self.right.advance(dt)
+        if len(self.lefts) == 1 and len(self.rights) == 1:
+            wl, wr = self.left.advance(dt), self.right.advance(dt)
+        else:       # skid steer: each side at the mean of its wheels
+            wl = sum(m.advance(dt) for m in self.lefts) / len(self.lefts)
+            wr = sum(m.advance(dt) for m in self.rights) / len(self.rights)
         if wl == 0.0 and wr == 0.0:
             return None
         v = self.wheel_radius * (wl + wr) / 2.0

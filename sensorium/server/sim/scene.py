@@ -136,13 +136,21 @@ class Scene:
         self.robot_names = [r.name for r in world.robots]
         self.robot_poses: list[Pose] = []
         self._robot_body: dict[int, int] = {}
+        self._device_shapes: dict[tuple[int, str], frozenset[int]] = {}   # (robot, device) -> its own shapes
         for i, r in enumerate(world.robots):
             pose = pose_from_model(r.pose)
             self.robot_poses.append(pose)
             self._lights += [(lt, i, Pose.identity()) for lt in r.lights]
             parts = list(robot_parts(r))
             if parts:
+                first = len(self.shapes)
                 self._robot_body[i] = self._add_body(parts, base_dir, pose, owner=i, movable=True, key=i)
+                owned: dict[str, set[int]] = {}
+                for k, (_, _, shape) in enumerate(parts):
+                    device = getattr(shape, "of_device", None)
+                    if device is not None:
+                        owned.setdefault(device, set()).add(first + k)
+                self._device_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
         self._attached = {owner for _, owner, _ in self._lights if owner is not None}
         # textures: one sampler for the world's images (None without any), read by infra-red only
         self._base_dir = base_dir
@@ -174,6 +182,11 @@ class Scene:
                 frame = self.robot_poses[owner] if isinstance(owner, int) else self.solid_poses[owner]
                 out.append(place_light(model, frame.compose(local)))
         return out
+
+    def device_shapes(self, robot: int, device: str) -> frozenset[int]:
+        """The shapes (``Scene.shapes`` indices) of a device's own Solid (``of_device``), which its
+        visual rays do not see (sim/own_shapes.py)."""
+        return self._device_shapes.get((robot, device), frozenset())
 
     def robot_body(self, index: int) -> int | None:
         """The engine body of robot ``index`` (None for a robot without a body)."""

@@ -26,6 +26,7 @@ from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import LookupTable, quantize_sensor
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
+from sensorium.server.sim.own_shapes import cast_local_skipping
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
@@ -87,6 +88,7 @@ class Device:
     measurements: int = 0           # how many values were produced (publishers watch it)
     measured_at_ms: int = -1        # simulated time of the latest value
     _rng: np.random.Generator | None = None
+    own_shapes: frozenset[int] = frozenset()   # its own Solid's shapes: its visual rays do not see them (own_shapes.py)
 
     tracks_motion: ClassVar[bool] = False
     """The step calls ``track()`` after every basic step while the device is enabled."""
@@ -238,6 +240,33 @@ class Lidar(Device):
         self._sweep: lmath.RotatingSweep | None = None
         # (rotation bytes, world beams float64, the same as float32) of a fixed lidar's latest plan
         self._planned: tuple[bytes, np.ndarray, np.ndarray] | None = None
+        # a lidar with shapes of its own (a housing): its beams are mounted on the robot's body and
+        # meet that body once, in its frame, blind to the lidar's own shapes (own_shapes.py)
+        self._own_body: tuple[Any, int, Mount] | None = None     # (scene, body, mount of every beam)
+        self._own_hits: tuple[Any, np.ndarray] | None = None       # (precision, (L, W) distances)
+
+    def bind(self, robot: Any) -> None:
+        if self.own_shapes:
+            scene = robot.scene
+            body = scene.robot_body(self.robot_index)
+            if body is not None:
+                n = self.config.number_of_layers * self.config.horizontal_resolution
+                self._own_body = (scene, body, Mount(np.full(n, body, dtype=np.int64)))
+
+    def _own_distances(self) -> np.ndarray:
+        """Each beam's distance to its robot's body other than the lidar's own shapes (L, W)."""
+        assert self._own_body is not None
+        scene, body, _ = self._own_body
+        engine = scene.engine
+        if self._own_hits is None or self._own_hits[0] != engine.precision:
+            L, W = self.config.number_of_layers, self.config.horizontal_resolution
+            D = self._all_dirs.reshape(-1, 3) @ self.local_pose.rotation.T
+            O = np.broadcast_to(self.local_pose.translation, D.shape)
+            far = self._t_far.reshape(-1) if isinstance(self._t_far, np.ndarray) else self._t_far
+            h = cast_local_skipping(engine, body, np.ascontiguousarray(O), D, self.params.near, far, RayKind.VISUAL,
+                                    False, [self.own_shapes] * (L * W))
+            self._own_hits = (engine.precision, h.distance.reshape(L, W))
+        return self._own_hits[1]
 
     # -- controller API
     def info(self) -> dict:
@@ -323,6 +352,10 @@ class Lidar(Device):
             dirs_local = self._all_dirs[:, cols, :]
             t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far[:, cols].reshape(-1)
             dirs = _rotate(pose.rotation, dirs_local.reshape(-1, 3))
+            if self._own_body is not None:
+                return [RayRequest(np.broadcast_to(pose.translation, dirs.shape), dirs, self.params.near, t_far,
+                                   RayKind.VISUAL, -1, tag="lidar", distance_only=True,
+                                   mount=np.full(len(dirs), self._own_body[1], dtype=np.int64))]
         else:
             t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far.reshape(-1)
             key = pose.rotation.tobytes()
@@ -334,7 +367,8 @@ class Lidar(Device):
             _, dirs, d32 = self._planned
             origins = np.broadcast_to(pose.translation, dirs.shape)
             return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
-                               distance_only=True, directions32=d32)]
+                               distance_only=True, directions32=d32,
+                               mount=self._own_body[2] if self._own_body is not None else None)]
         origins = np.broadcast_to(pose.translation, dirs.shape)
         return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
                            distance_only=True)]
@@ -348,6 +382,8 @@ class Lidar(Device):
             if cols.size == 0:
                 return
             dist = hits[0].distance.reshape(L, cols.size)
+            if self._own_body is not None:
+                dist = np.minimum(dist, self._own_distances()[:, cols])
             ranges = lmath.ranges_from_hits(self.params, dist, self._all_dirs[:, cols, :], self._noise_rng())
             self.range_image[:, cols] = ranges
             if self.point_cloud_enabled:
@@ -360,6 +396,8 @@ class Lidar(Device):
                 counters["points_built"] += pts.size
         else:
             dist = hits[0].distance.reshape(L, self.config.horizontal_resolution)
+            if self._own_body is not None:
+                dist = np.minimum(dist, self._own_distances())
             self.range_image = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
             if self.point_cloud_enabled:
                 self._xyz = lmath.point_xyz(self.range_image, self._point_columns())

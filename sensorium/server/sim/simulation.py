@@ -41,6 +41,7 @@ from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
 from sensorium.server.world.poses import pose_from_values
+from sensorium.server.world.report import warn_losses
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:
@@ -104,7 +105,7 @@ class RobotState:
                 continue
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
-                                       clock=lambda: sim.time_ms)
+                                       clock=lambda: sim.time_ms, own_shapes=sim.scene.device_shapes(index, d.name))
         self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index],
                                         up=sim.world.world_info.coordinate_system)
                       if model.differential_drive is not None else None)
@@ -123,6 +124,10 @@ class RobotState:
     @property
     def world_info(self) -> wm.WorldInfo:
         return self._sim.world.world_info
+
+    @property
+    def scene(self) -> Scene:
+        return self._sim.scene
 
     @property
     def basic_time_step(self) -> int:
@@ -243,9 +248,12 @@ class Simulation:
                   limits: WorldLimits | None = None, allow_outside_meshes: bool = False,
                   contact: bool | None = None) -> Simulation:
         """``limits``/``allow_outside_meshes``: see :func:`sensorium.server.world.loader.load_world`;
-        ``contact``: kinematic contact on/off (default: the world's ``world_info.contact``)."""
-        return cls(load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes), precision,
-                   contact=contact)
+        ``contact``: kinematic contact on/off (default: the world's ``world_info.contact``). What the
+        load left out is ``sim.loaded.report`` (``sim.loaded.warnings``: every message); a loss
+        sensors would notice (a robot, a device, a shape) is also one ``WorldLossWarning``."""
+        loaded = load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes)
+        warn_losses(loaded.report)
+        return cls(loaded, precision, contact=contact)
 
     # ------------------------------------------------------------------ access
     @property

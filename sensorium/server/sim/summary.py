@@ -56,4 +56,7 @@ def world_summary(path: str | Path) -> dict:
             for r in w.robots
         ],
         "warnings": loaded.warnings,
+        "losses": [{"kind": x.kind, "name": x.name, "robot": x.robot, "where": x.where, "why": x.why}
+                   for x in loaded.losses],
+        "report": loaded.report.lines(),
     }

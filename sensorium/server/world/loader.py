@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import time
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +34,7 @@ from sensorium.server.world.limits import (
     check_yaml_events,
     quote,
 )
+from sensorium.server.world.report import LoadReport, Loss
 
 
 class _Yaml12Loader(yaml.SafeLoader):
@@ -82,9 +84,20 @@ class LoadedWorld:
     source: str                      # file path or "<memory>"
     base_dir: Path                   # mesh urls are relative to it
     text: bytes = b""                # the file as read (recordings attach it)
-    warnings: list[str] = field(default_factory=list)
-    dropped: list[str] = field(default_factory=list)    # the warnings that are losses sensors notice
+    warnings: list[str] = field(default_factory=list)   # every message of the load, losses included
+    losses: tuple[Loss, ...] = ()                        # what sensors would notice was left out (report.py)
     asset_files: frozenset[Path] = frozenset()          # files outside base_dir it may read (PROTO assets)
+    timings: dict[str, float] = field(default_factory=dict)   # wall seconds per loading stage (sensorium bench)
+
+    @property
+    def report(self) -> LoadReport:
+        """What the load left out, for printing (``report.text()``) or programs (``report.losses``)."""
+        return LoadReport(self.source, self.losses, tuple(self.warnings))
+
+    @property
+    def dropped(self) -> list[str]:
+        """The losses' messages (``file:line:col: why``)."""
+        return [loss.text for loss in self.losses]
 
 
 def read_world_text(path: str | Path, limits: WorldLimits | None = None) -> bytes:
@@ -229,6 +242,7 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
         else:
             where = f"line {exc.line}, column {exc.col}" if exc.line else ""
         raise WorldError(source, [Problem(where, exc.message)]) from None
+    t0 = time.perf_counter()
     try:
         loaded = parse_world(data, source=source, base_dir=path.resolve().parent, text=text, limits=limits,
                              allow_outside_meshes=allow_outside_meshes, asset_files=conv.asset_files)
@@ -240,7 +254,8 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
         at = _origin_of(where, origin)
         placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w)
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
-                       warnings=[*warnings, *placed], dropped=list(conv.dropped), asset_files=conv.asset_files)
+                       warnings=[*warnings, *placed], losses=conv.losses, asset_files=conv.asset_files,
+                       timings={**conv.timings, "validate": time.perf_counter() - t0})
 
 
 def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:
@@ -355,6 +370,11 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
     unique([(f"robots[{i}].def_name", r.def_name) for i, r in enumerate(world.robots)]
            + [(f"solids[{i}].def_name", s.def_name) for i, s in enumerate(world.solids)], "DEF")
 
+    for path, solid in all_solids(world):
+        for s_i, part in enumerate(solid.shapes):
+            if part.of_device is not None:
+                problems.append(Problem(f"{path}.shapes[{s_i}].of_device",
+                                        "only a robot's shapes belong to one of its devices"))
     for p, geom in all_geometries(world):
         problems += _check_geometry(geom, p, base_dir)
     for r_i, robot in enumerate(world.robots):
@@ -363,10 +383,18 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
         if robot.differential_drive is not None:
             # a RotationalMotor entry named like a drive motor is that motor (its place in the device list)
             listed = {d.name for d in robot.devices if d.device == "RotationalMotor"}
-            names += [(f"{rp}.differential_drive.{side}", m) for side, m in
-                      (("left_motor", robot.differential_drive.left_motor),
-                       ("right_motor", robot.differential_drive.right_motor)) if m not in listed]
+            left, right = robot.differential_drive.motor_names
+            sides = [("left_motor", left[0]), ("right_motor", right[0])]
+            sides += [(f"skid_steer.left[{i}]", m) for i, m in enumerate(left[1:])]
+            sides += [(f"skid_steer.right[{i}]", m) for i, m in enumerate(right[1:])]
+            names += [(f"{rp}.differential_drive.{side}", m) for side, m in sides if m not in listed]
         unique(names, "device")
+        device_names = {d.name for d in robot.devices}
+        for s_i, part in enumerate(robot.shapes):
+            if part.of_device is not None and part.of_device not in device_names:
+                problems.append(Problem(f"{rp}.shapes[{s_i}].of_device",
+                                        f"{part.of_device!r} is not a device of this robot "
+                                        f"(devices: {', '.join(repr(n) for n in device_names) or 'none'})"))
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"
             table = getattr(dev, "lookup_table", None)
@@ -379,7 +407,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                             f"follows {table[k - 1][0]}"))
             if isinstance(dev, wm.PositionSensor) and dev.motor is not None:
                 drive = robot.differential_drive
-                motors = (drive.left_motor, drive.right_motor) if drive is not None else ()
+                motors = tuple(m for side in drive.motor_names for m in side) if drive is not None else ()
                 if dev.motor not in motors:
                     problems.append(Problem(
                         f"{dp}.motor", f"{dev.motor!r} is not a wheel motor of this robot's differential_drive "

@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import os
 import platform
+import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -75,6 +76,7 @@ class Expansion:
     warnings: list[str]
     search: ProtoSearch
     wbt: WbtFile | None = None
+    timings: dict[str, float] = field(default_factory=dict)   # wall seconds: "proto files", "template"
 
     def as_wbt(self) -> WbtFile:
         """The world file with its nodes replaced by the expansion."""
@@ -130,6 +132,7 @@ class _Expander:
         self.rendered: dict[tuple[str, str], tpl.Rendered] = {}
         self.budget = tpl.Budget(limits.template_total_seconds)
         self.instances = 0
+        self.timings = {"proto files": 0.0, "template": 0.0}   # wall seconds (``sensorium bench --only loading``)
         self.coordinate_system = _coordinate_system(wbt.nodes)
         for p in wbt.protos:
             self.warnings += p.warnings
@@ -140,7 +143,7 @@ class _Expander:
         self.check_size(nodes)
         self.unused_declarations()
         self.stand_in_note()
-        return Expansion(nodes, list(self.uses.values()), self.warnings, self.search, self.wbt)
+        return Expansion(nodes, list(self.uses.values()), self.warnings, self.search, self.wbt, self.timings)
 
     def check_size(self, nodes: list[Node]) -> None:
         """Nodes and values of the expanded tree, each DEF/USE or shared copy counted (what the
@@ -228,7 +231,9 @@ class _Expander:
             if len(self.files) >= self.limits.proto_files:
                 raise ProtoError(scope.source, decl.line, decl.col, f"more than {self.limits.proto_files:,} PROTO files "
                                  "(raise the limits with --allow-large)")
+            t0 = time.perf_counter()
             proto = read_proto_file(path, key, self.limits)
+            self.timings["proto files"] += time.perf_counter() - t0
             if proto.name != decl.name:
                 raise ProtoError(key, proto.line, proto.col, f"PROTO {short(proto.name)}: the name does not match the "
                                  f"file name {short(decl.name)}.proto (Webots requires them to match)")
@@ -400,9 +405,11 @@ class _Expander:
         rendered = self.rendered.get(key) if deterministic else None
         if rendered is None:
             context = self.context(proto)
+            t0 = time.perf_counter()
             rendered = tpl.render(proto.body, source=proto.source, proto=proto.name, file_lines=proto.lines,
                                   body_offset=proto.body_offset, fields_js=fields_js, context_js=context,
                                   limits=self.limits, budget=self.budget)
+            self.timings["template"] += time.perf_counter() - t0
             if deterministic:
                 self.rendered[key] = rendered
             for level, message in rendered.messages:

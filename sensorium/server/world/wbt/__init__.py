@@ -5,8 +5,9 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -21,14 +22,16 @@ class WbtConversion:
     """A converted world: the world-file dict, warnings, converted path → (line, column, node type)
     it came from, the PROTOs used (``ProtoUse``: name, file, licence line, instances), the asset
     files outside the world's folder it may read (meshes of PROTOs, ``webots://`` assets) and the
-    warnings that are losses sensors would notice (``dropped``: a robot, a sensor device)."""
+    warnings that are losses sensors would notice (``losses``: robots, sensor devices, shapes;
+    :mod:`sensorium.server.world.report`)."""
 
     data: dict[str, Any]
     warnings: list[str]
     origin: dict[str, tuple[int, int, str]]
     protos: list[Any]
     asset_files: frozenset[Path] = frozenset()
-    dropped: tuple[str, ...] = ()
+    losses: tuple[Any, ...] = ()
+    timings: dict[str, float] = field(default_factory=dict)   # wall seconds per stage (sensorium bench)
 
 
 def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),
@@ -40,14 +43,22 @@ def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, prot
 
     source = str(path)
     limits = limits or ProtoLimits()
+    t0 = time.perf_counter()
     search = ProtoSearch.create(Path(path).resolve().parent, webots_home, tuple(proto_path))
-    expansion = expand(read_wbt(path, limits), search, limits)
+    wbt = read_wbt(path, limits)
+    t1 = time.perf_counter()
+    expansion = expand(wbt, search, limits)
+    t2 = time.perf_counter()
     conv = Converter(expansion.as_wbt(), source, expansion.search)
     raw = conv.run()
     origin: dict[str, tuple[int, int, str]] = {}
     data = strip_origins(raw, "", origin)
+    t3 = time.perf_counter()
+    files, template = expansion.timings.get("proto files", 0.0), expansion.timings.get("template", 0.0)
+    timings = {"parse": t1 - t0, "proto files": files, "instantiate": t2 - t1 - files - template,
+               "template": template, "convert": t3 - t2}
     return WbtConversion(data, [*expansion.warnings, *conv.warnings], origin, expansion.protos,
-                         frozenset(conv.asset_files), tuple(conv.dropped))
+                         frozenset(conv.asset_files), tuple(conv.losses), timings)
 
 
 def wbt_to_dict(path: str | Path, *, webots_home: str | Path | None = None, proto_path: Sequence[str | Path] = (),

@@ -22,9 +22,10 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import world as wm
-from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
+from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
 from sensorium.server.world.wbt.fields import Fields
+from sensorium.server.world.wbt.frames import Frame, bounding_constraint, bounding_geometry, visual_geometry
 from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
@@ -32,7 +33,7 @@ MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
 SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "ImmersionProperties",
-           "ContactProperties", "Damping", "Muscle", "Propeller", "CadShape"}
+           "ContactProperties", "Damping", "Muscle", "Propeller"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
 # the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
 OTHER_DEVICES = {"Camera", "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
@@ -42,63 +43,19 @@ OTHER_DEVICES = {"Camera", "RangeFinder", "Display", "Speaker", "Microphone", "E
 OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "TouchSensor": "touch sensor",
                "VacuumGripper": "vacuum gripper", "LinearMotor": "linear motor", "GPS": "gps"}
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh"}
+UNSEEN_GEOMETRIES = {"IndexedLineSet", "PointSet"}      # lines and points: no surface a ray could hit
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED"}
 JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
 MOTORS = {"RotationalMotor", "LinearMotor"}
-
-
-@dataclass(frozen=True)
-class Frame:
-    """Rigid transform with a uniform scale: x_parent = R (s x) + t; ``aa`` = the exact axis-angle
-    of R when known (None once two rotations were composed)."""
-
-    rotation: np.ndarray
-    translation: np.ndarray
-    scale: float = 1.0
-    aa: tuple[float, float, float, float] | None = (0.0, 0.0, 1.0, 0.0)
-
-    @staticmethod
-    def identity() -> Frame:
-        return Frame(np.eye(3), np.zeros(3))
-
-    def then(self, translation, rotation, scale: float = 1.0) -> Frame:
-        r2 = axis_angle_matrix(rotation[:3], rotation[3]) if rotation[3] != 0.0 else np.eye(3)
-        t = self.rotation @ (self.scale * np.asarray(translation, dtype=np.float64)) + self.translation
-        aa: tuple[float, ...] | None
-        if self.aa is not None and self.aa[3] == 0.0:
-            aa = tuple(rotation)
-        elif rotation[3] == 0.0:
-            aa = self.aa
-        else:
-            aa = None
-        return Frame(self.rotation @ r2, t, self.scale * scale, aa)  # type: ignore[arg-type]
-
-    def compose(self, inner: Frame) -> Frame:
-        """``inner`` (a frame given relative to this one) in this frame's parent."""
-        aa: tuple[float, float, float, float] | None
-        if self.aa is not None and self.aa[3] == 0.0:
-            aa = inner.aa
-        elif inner.aa is not None and inner.aa[3] == 0.0:
-            aa = self.aa
-        else:
-            aa = None
-        t = self.rotation @ (self.scale * inner.translation) + self.translation
-        return Frame(self.rotation @ inner.rotation, t, self.scale * inner.scale, aa)
-
-    def apply(self, p) -> list[float]:
-        return [float(v) for v in self.rotation @ (self.scale * np.asarray(p, dtype=np.float64)) + self.translation]
-
-    def pose(self) -> dict:
-        out: dict[str, Any] = {"translation": [float(v) for v in self.translation]}
-        if self.aa is None:
-            out["quaternion"] = list(matrix_quaternion(self.rotation))
-        elif self.aa[3] != 0.0:
-            out["rotation"] = list(self.aa)
-        return out
-
-    def key(self) -> bytes:
-        return self.rotation.tobytes() + self.translation.tobytes() + np.float64(self.scale).tobytes()
+# the fields every Solid has (a device's own fields are the others)
+SOLID_FIELDS = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
+                "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection",
+                "recognitionColors", "linearVelocity", "angularVelocity", "translationStep", "rotationStep"}
+# fields only robots have: an unknown node (a PROTO not found) that sets one was a robot
+ROBOT_ONLY_FIELDS = {"controller", "controllerArgs", "supervisor", "synchronization", "customData", "window",
+                     "remoteControl", "battery", "selfCollision"}
+SOLIDS = {"Robot", "Solid"} | SENSORS | JOINTS     # Solid nodes (a joint: its end point) Webots never scales
 
 
 @dataclass
@@ -126,13 +83,15 @@ class Converter:
         self.solid_names: Counter[str] = Counter()
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
+        self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
+        self.constrained: set[int] = set()     # Transforms in boundingObjects whose scale Webots constrains
         self.defs: set[str] = set()        # DEF names kept (def_name)
         self.textured: dict[int, tuple[int, int, str, str]] = {}   # textures not loaded → (line, column, why)
         self.robot_fields = set(wm.Robot.model_fields)
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
         self.instances: list[tuple[str, tuple[str, int, int]]] = []   # PROTO instances being walked (name, at)
         self.asset_files: set[Path] = set()   # asset files outside the world's folder this world may read
-        self.dropped: list[str] = []      # robots, sensor devices and sensor-visible shapes lost (messages)
+        self.losses: list[Loss] = []      # robots, sensor devices and sensor-visible shapes lost (report.py)
 
     # ------------------------------------------------------------ messages
     def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
@@ -165,12 +124,17 @@ class Converter:
     def warn(self, node: Node, message: str) -> None:
         self.warnings.append(f"{self.where(node)}: {message}")
 
-    def drop(self, node: Node, message: str) -> None:
-        """A loss that changes what sensors read (a robot, a sensor device, a shape sensors see): a
-        warning that ``validate`` counts as an error unless ``--allow-skipped``."""
-        text = f"{self.where(node)}: {message}"
-        self.warnings.append(text)
-        self.dropped.append(text)
+    def drop(self, node: Node, message: str, kind: str, name: str = "", robot: str = "") -> None:
+        """A loss that changes what sensors read (``kind``: a robot, a sensor device, a solid or
+        shape sensors see, an unknown node): a warning that ``validate`` counts as an error unless
+        ``--allow-skipped``, and what a controller asking for a dropped robot is told."""
+        loss = Loss(kind, name, self.where(node), message, robot)
+        self.warnings.append(loss.text)
+        self.losses.append(loss)
+
+    def lose_shape(self, node: Node, message: str, owner: Owner) -> None:
+        """A shape sensors would see, left out (a mesh file missing, a geometry not read here)."""
+        self.drop(node, message, "shape", owner.data.get("name", "") if owner.kind != "world" else "")
 
     def fields(self, node: Node) -> Fields:
         return Fields(node, node.source or self.source)
@@ -258,17 +222,22 @@ class Converter:
             self.world_info(node)
         elif t in SKIPPED:
             self.skipped[t] += 1
+        elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
+            self.scaled_solid(node, owner)
         elif t in OTHER_DEVICES:
             if owner.kind == "robot":
                 inner = self.child_frame(node, frame)
+                data = None
                 if t in wm.DEVICE_TYPES:     # listed (simulated kinds take their schema defaults)
                     self.tick(node)
-                    entry = self.unsimulated(node, inner, owner)
+                    data = self.unsimulated(node, inner, owner)
                     if t == "Pen":             # a Pen keeps its fields (simulated: it inks)
-                        entry.update(fx.pen(f))
-                self.solid_contents(node, inner, owner)
-            else:
-                self.skipped[t] += 1
+                        data.update(fx.pen(f))
+                self.device_contents(node, inner, owner, data)
+            else:     # a device outside a robot is still a Solid whose shapes rays see
+                self.warn(node, f"{t} outside a Robot: not a device here (devices belong to robots); its shapes "
+                                "are kept as a solid")
+                self.solid(node, frame, owner, OTHER_NAMES.get(t, t.lower()))
         elif t == "Group":
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
@@ -278,16 +247,19 @@ class Converter:
                 self.visit(child, inner, owner)
         elif t == "Shape":
             self.shape(node, frame, owner, seen_by="visual")
+        elif t == "CadShape":     # a visual mesh file (its own materials are not read: seen white)
+            urls = f.strings("url")
+            if urls:
+                mesh = Node("Mesh", {"url": urls[:1]}, node.line, node.col, source=node.source)
+                self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
+                           seen_by="visual")
         elif t in LIGHTS:
             self.light(node, frame, owner)
         elif t == "Robot":
             name = self.fields(node).string("name", "robot")
             if owner.kind == "robot":
                 self.drop(node, f"Robot {name!r} inside robot {owner.data['name']!r}: a robot riding on another "
-                                "robot is not supported here; dropped with everything inside it")
-            elif frame.scale != 1.0 or owner.placed.scale != 1.0:
-                self.drop(node, f"Robot {name!r} inside a scaled Transform: Webots does not allow a Solid "
-                                "(so a Robot) under a Transform that scales; dropped")
+                                "robot is not supported here; dropped with everything inside it", "robot", name)
             else:     # at the top or nested in solids and groups: a robot placed where they put it
                 self.robot(node, owner.placed.compose(frame))
         elif t == "Solid":
@@ -304,8 +276,26 @@ class Converter:
         elif t in GEOMETRIES:
             self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
         else:
+            named = node.fields.get("name")
+            robot_like = any(k in node.fields for k in ROBOT_ONLY_FIELDS)   # a robot PROTO instance, surely
             self.drop(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
-                            f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
+                            f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}", "robot" if robot_like else "node",
+                      named if isinstance(named, str) else t)
+
+    def scaled_solid(self, node: Node, owner: Owner) -> None:
+        """A Solid (a robot, a device, a joint's end point) under a Transform that scales: Webots
+        (R2022a+) allows only Transform, Pose, Group and Shape in a Transform, and never scales a
+        Solid; dropped as a loss, saying so."""
+        t = node.type
+        named = node.fields.get("name")
+        name = named if isinstance(named, str) else ""
+        kind = ("robot" if t == "Robot" else "device" if t in SENSORS or t in OTHER_DEVICES
+                else "solid")
+        robot = owner.data.get("name", "") if owner.kind == "robot" else ""
+        what = f"{t} {name!r}" if name else t
+        self.drop(node, f"{what} under a Transform that scales: Webots allows only Transform, Pose, Group and "
+                        "Shape in a Transform's children (a Solid, robot or device is never scaled); dropped with "
+                        "everything inside it", kind, name, robot)
 
     def appearance_note(self, node: Node, message: str) -> None:
         if message.startswith("texture: "):   # one summary line for all textures not loaded
@@ -329,18 +319,28 @@ class Converter:
             self.warnings.append(f"{self.where(node, (line, col))}: {node.type}.{name}: not a {node.type} field, "
                                  f"ignored (did you mean {meant}?)")
 
-    def child_frame(self, node: Node, frame: Frame) -> Frame:
+    def child_frame(self, node: Node, frame: Frame, scale: tuple[float, float, float] | None = None) -> Frame:
+        """The frame of a Pose, Transform or Solid under ``frame``; ``scale``: a Transform's scale
+        as already sanitised (else read here: Webots resets a zero component to 1, with a warning)."""
         f = self.fields(node)
         rotation = f.vec("rotation", (0.0, 0.0, 1.0, 0.0))
         if rotation[3] != 0.0 and math.hypot(*rotation[:3]) == 0.0:
             raise f.error("rotation", "the rotation axis must not be zero")
-        scale = 1.0
-        if node.type == "Transform":
-            sx, sy, sz = f.vec("scale", (1.0, 1.0, 1.0))
-            if not (sx == sy == sz) or sx <= 0:
-                raise f.error("scale", f"only a uniform positive scale is supported, got {sx} {sy} {sz}")
-            scale = sx
+        if scale is None:
+            scale = self.transform_scale(node) if node.type == "Transform" else (1.0, 1.0, 1.0)
         return frame.then(f.vec("translation", (0.0, 0.0, 0.0)), rotation, scale)
+
+    def transform_scale(self, node: Node) -> tuple[float, float, float]:
+        """A Transform's scale; a zero component is reset to 1 as Webots does (its warning)."""
+        f = self.fields(node)
+        scale = list(f.vec("scale", (1.0, 1.0, 1.0)))
+        for k, axis in enumerate("xyz"):
+            if scale[k] == 0.0 and id(node) not in self.checked_scale:
+                self.warn(node, f"All 'scale' coordinates must be non-zero: {axis} is set to 1.0.")
+            if scale[k] == 0.0:
+                scale[k] = 1.0
+        self.checked_scale.add(id(node))
+        return scale[0], scale[1], scale[2]
 
     # ------------------------------------------------------------ shapes
     def shape(self, node: Node, frame: Frame, owner: Owner, seen_by: str) -> None:
@@ -348,9 +348,12 @@ class Converter:
         gnode = f.node_("geometry") if node.type == "Shape" else node
         if gnode is None:
             return
+        if gnode.type in UNSEEN_GEOMETRIES:
+            self.skipped[gnode.type] += 1
+            return
         if gnode.type not in GEOMETRIES:
-            self.warn(gnode, f"geometry {gnode.type} is not supported (Box, Sphere, Cylinder, Capsule, Plane, "
-                             "IndexedFaceSet, Mesh): ignored")
+            self.lose_shape(gnode, f"geometry {gnode.type} is not read here (Box, Sphere, Cylinder, Capsule, Plane, "
+                                   "IndexedFaceSet, Mesh): this shape is left out, rays do not see it", owner)
             return
         self.tick(gnode)
         for checked in (node, gnode, f.node_("appearance") if node.type == "Shape" else None):
@@ -359,16 +362,19 @@ class Converter:
                 material = checked.fields.get("material") if checked.type == "Appearance" else None
                 if isinstance(material, Node):
                     self.typos(material)
-        geometry = self.geometry(gnode, frame.scale)
+        geometry, why = self.geometry(gnode, frame, seen_by)
         if geometry is None:
+            if why:
+                self.lose_shape(gnode, why, owner)
             return
         key = (id(gnode), frame.key())
-        if seen_by == "bounding" and key in owner.keys:   # the same geometry seen by both kinds of ray
-            owner.keys[key]["seen_by"] = "both"
+        if seen_by == "bounding" and key in owner.keys and owner.keys[key]["geometry"] == geometry:
+            owner.keys[key]["seen_by"] = "both"     # the same geometry seen by both kinds of ray
             return
         part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
         if seen_by == "visual":
-            app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note, self.texture_file)
+            app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note,
+                                lambda n, u: self.asset(n, u, "texture"))
             if app is not None:
                 part["appearance"] = app
             owner.keys[key] = part
@@ -386,100 +392,103 @@ class Converter:
             for child in f.nodes("children"):
                 self.bounding(child, frame, owner)
         elif node.type in ("Pose", "Transform"):
-            inner = self.child_frame(node, frame)
+            scale = None
+            if node.type == "Transform":     # Webots' physics constraint on the scale over its geometry
+                scale, why = bounding_constraint(self.first_geometry(node), self.transform_scale(node))
+                if why and id(node) not in self.constrained:
+                    self.constrained.add(id(node))
+                    self.warn(node, why)
+            inner = self.child_frame(node, frame, scale)
             for child in f.nodes("children"):
                 self.bounding(child, inner, owner)
         else:
             self.warn(node, f"{node.type} in a boundingObject: ignored")
 
-    def asset(self, node: Node, url: str) -> str | None:
-        """The url a converted world names for an asset ``url`` written in ``node``'s file: as written
-        when the world file names a local file (the loader confines it to the world's folder); else
-        (a PROTO's url, relative to the PROTO file; ``webots://`` or Webots' GitHub urls, from the
-        installation) the local file it names, which must lie in the Webots installation, a
-        --proto-path folder or the project of the PROTO file that names it (read only). None: the
-        file is missing (a warning naming it: the shape is left out)."""
+    def first_geometry(self, node: Node) -> str:
+        """The type of a Transform's first child geometry (directly or in a Shape), as Webots looks it up."""
+        children = self.fields(node).nodes("children")
+        if not children:
+            return ""
+        first = children[0]
+        if first.type == "Shape":
+            g = self.fields(first).node_("geometry")
+            return g.type if g is not None else ""
+        return first.type
+
+    def asset(self, node: Node, url: str, kind: str = "mesh") -> tuple[str | None, str]:
+        """The url a converted world names for an asset (``kind``: mesh or texture) ``url`` written in
+        ``node``'s file: as written when the world file names a local file (the loader confines it to
+        the world's folder); else (a PROTO's url, relative to the PROTO file; ``webots://`` or Webots'
+        GitHub urls, from the installation) the local file it names, which must lie in the Webots
+        installation, a --proto-path folder or the project of the PROTO file that names it (read
+        only). (None, why): the file is missing or refused (the caller says so, naming it)."""
+        from sensorium.server.world.meshes import SUPPORTED
         from sensorium.server.world.proto import ProtoError, asset_roots, resolve_url
 
         src = node.source or self.source
+        suffix = Path(url.split("?")[0]).suffix.lower()
+        if kind == "mesh" and suffix not in SUPPORTED:
+            return None, (f"mesh {url!r}: the {suffix or 'unnamed'} format is not read here "
+                          f"({', '.join(sorted(SUPPORTED))}); this shape is left out, rays do not see it")
         if src == self.source and "://" not in url:
+            if kind == "texture":
+                return url, ""            # checked (and said when missing) where textures are read
             if not (Path(self.source).resolve().parent / url).is_file() and "\0" not in url:
-                self.warn(node, f"mesh file {url!r} not found (relative to the world file): this shape is left out, "
-                                "rays do not see it")
-                return None
-            return url
+                return None, f"mesh file {url!r} not found (relative to the world file): this shape is left out"
+            return url, ""
+        lost = "this shape is left out" if kind == "mesh" else "not loaded"
         if self.search is None:
-            self.warn(node, f"mesh url {url!r}: no PROTO search places to resolve it; this shape is left out")
-            return None
+            return None, f"{kind} url {url!r}: no PROTO search places to resolve it; {lost}"
         try:
             path = resolve_url(url, src, self.search).resolve()
         except ProtoError as exc:
-            self.warn(node, f"mesh file {exc.message}; this shape is left out, rays do not see it")
-            return None
+            return None, f"{kind} file {exc.message}; {lost}"
         except (OSError, ValueError) as exc:
-            self.warn(node, f"mesh url {url!r} cannot be resolved ({exc}); this shape is left out")
-            return None
+            return None, f"{kind} url {url!r} cannot be resolved ({exc}); {lost}"
         roots = [*asset_roots(self.search), Path(src).resolve().parent.parent, Path(self.source).resolve().parent]
         if not any(path.is_relative_to(r) for r in roots):
-            self.warn(node, f"mesh url {url!r} names a file outside the Webots installation, the --proto-path "
-                            "folders and the PROTO's project: refused, this shape is left out")
-            return None
+            return None, (f"{kind} url {url!r} names a file outside the Webots installation, the --proto-path "
+                          f"folders and the PROTO's project: refused, {lost}")
         if not path.is_file():
-            self.warn(node, f"mesh file {url!r} not found: this shape is left out, rays do not see it")
-            return None
+            return None, f"{kind} file {url!r} not found: {lost}"
         self.asset_files.add(path)
-        return str(path)
+        return str(path), ""
 
-    def texture_file(self, node: Node, url: str) -> tuple[str, Path]:
-        """(the url the converted world names, the file) of a texture ``url`` written in ``node``'s
-        file: as written when the world file names a local file (relative to it); else — a PROTO's
-        url, relative to the PROTO file; ``webots://`` or Webots' GitHub urls, from the installation —
-        the file it names, which must lie where mesh assets may (see :meth:`asset`). Raises
-        ``TextureFileError`` (the texture is then read as one Webots could not load)."""
-        from sensorium.server.world.proto import ProtoError, asset_roots, resolve_url
-        from sensorium.server.world.textures import TextureFileError, resolve_texture_url
+    def geometry(self, node: Node, frame: Frame, seen_by: str) -> tuple[dict | None, str]:
+        """The geometry dict of a geometry node under ``frame``'s scale (``frames.py``: a visual shape
+        is the exact affine image, a bounding one what Webots gives ODE); (None, why) when it is
+        left out (why: "" when another message was given already)."""
+        w = frame.webots_scale
+        if frame.stretch is None and frame.scale > 0 and w[0] == w[1] == w[2] > 0:
+            return self.base_geometry(node, frame.scale)
+        g, why = self.base_geometry(node, 1.0)
+        if g is None:
+            return None, why
+        if seen_by == "bounding":
+            return bounding_geometry(g["type"], g, frame.webots_scale), ""
+        return visual_geometry(g["type"], g, frame)
 
-        src = node.source or self.source
-        if src == self.source and "://" not in url:
-            return url, resolve_texture_url(url, Path(self.source).resolve().parent, allow_outside=True)
-        if self.search is None:
-            raise TextureFileError(f"texture url {url!r}: no PROTO search places to resolve it")
-        try:
-            path = resolve_url(url, src, self.search).resolve()
-        except ProtoError as exc:
-            raise TextureFileError(f"texture file {exc.message}") from None
-        except (OSError, ValueError) as exc:
-            raise TextureFileError(f"texture url {url!r} cannot be resolved ({exc})") from None
-        roots = [*asset_roots(self.search), Path(src).resolve().parent.parent, Path(self.source).resolve().parent]
-        if not any(path.is_relative_to(r) for r in roots):
-            raise TextureFileError(f"texture url {url!r} names a file outside the Webots installation, the "
-                                   "--proto-path folders and the PROTO's project: refused")
-        if not path.is_file():
-            raise TextureFileError(f"texture file {url!r} not found")
-        self.asset_files.add(path)
-        return str(path), path
-
-    def geometry(self, node: Node, s: float) -> dict | None:
+    def base_geometry(self, node: Node, s: float) -> tuple[dict | None, str]:
         f = self.fields(node)
         t = node.type
         if t == "Box":
-            return {"type": "box", "size": [v * s for v in f.vec("size", (2.0, 2.0, 2.0))]}
+            return {"type": "box", "size": [v * s for v in f.vec("size", (2.0, 2.0, 2.0))]}, ""
         if t == "Sphere":
-            return {"type": "sphere", "radius": f.num("radius", 1.0) * s}
+            return {"type": "sphere", "radius": f.num("radius", 1.0) * s}, ""
         if t in ("Cylinder", "Capsule"):
             if not all(f.flag(k, True) for k in ("bottom", "side", "top")):
                 self.warn(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
-            return {"type": t.lower(), "radius": f.num("radius", 1.0) * s, "height": f.num("height", 2.0) * s}
+            return {"type": t.lower(), "radius": f.num("radius", 1.0) * s, "height": f.num("height", 2.0) * s}, ""
         if t == "Plane":
-            return {"type": "plane", "size": [v * s for v in f.vec("size", (1.0, 1.0))]}
+            return {"type": "plane", "size": [v * s for v in f.vec("size", (1.0, 1.0))]}, ""
         if t == "Mesh":
             urls = f.strings("url")
             if not urls:
                 raise f.error("url", "a Mesh needs a url")
-            url = self.asset(node, urls[0].replace("\\", "/"))
+            url, why = self.asset(node, urls[0].replace("\\", "/"))
             if url is None:
-                return None
-            return {"type": "mesh", "url": url, "scale": [s, s, s]}
+                return None, why
+            return {"type": "mesh", "url": url, "scale": [s, s, s]}, ""
         # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
         coord = f.node_("coord")
         points = self.fields(coord).rows("point", 3, []) if coord is not None else []
@@ -503,7 +512,7 @@ class Converter:
         out = {"type": "triangles", "vertices": [[v * s for v in p] for p in points], "faces": faces}
         if tex is not None:
             out["tex_coords"], out["tex_coord_faces"] = tex, tex_faces
-        return out
+        return out, ""
 
     # ------------------------------------------------------------ lights
     def light(self, node: Node, frame: Frame, owner: Owner) -> None:
@@ -517,15 +526,14 @@ class Converter:
         owner.data.setdefault("lights", []).append(data) if owner.kind != "world" else self.world["lights"].append(data)
 
     # ------------------------------------------------------------ solids and robots
-    def solid(self, node: Node, frame: Frame, owner: Owner) -> None:
+    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> None:
+        """A Solid (``default``: its name when it has none: a device's default name)."""
         f = self.fields(node)
         inner = self.child_frame(node, frame)
         if owner.kind == "robot":   # part of the robot's body
             self.solid_contents(node, inner, owner)
             return
-        if frame.scale != 1.0:
-            raise self.error(node, "a Solid inside a scaled Transform is not supported")
-        name = f.string("name", "solid")
+        name = f.string("name", default)
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
             self.def_name(node, data)
@@ -584,6 +592,9 @@ class Converter:
         if mine.parts:
             data["shapes"] = [_clean_part(p) for p in mine.parts]
         self.unique_devices(data)
+        for part in data.get("shapes", ()):      # the device's final name (after unique_devices)
+            if "_device" in part:
+                part["of_device"] = part.pop("_device")["name"]
         if not data["devices"]:
             del data["devices"]
         self.world["robots"].append(data)
@@ -593,7 +604,10 @@ class Converter:
         and its getDevice returns the first); the wheel motors' names count too."""
         drive = robot.get("differential_drive") or {}
         listed = {d["name"] for d in robot["devices"] if d["device"] == "RotationalMotor"}
-        seen: Counter[str] = Counter(v for k, v in drive.items() if k in ("left_motor", "right_motor") and v not in listed)
+        skid = drive.get("skid_steer") or {}
+        motors = [v for k, v in drive.items() if k in ("left_motor", "right_motor")] + [
+            *skid.get("left", ()), *skid.get("right", ())]
+        seen: Counter[str] = Counter(v for v in motors if v not in listed)
         for dev in robot["devices"]:
             name = dev["name"]
             seen[name] += 1
@@ -610,7 +624,9 @@ class Converter:
     def device(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
         if owner.kind != "robot":
-            self.warn(node, f"{node.type} outside a Robot: skipped (devices belong to robots)")
+            self.warn(node, f"{node.type} outside a Robot: not a device here (devices belong to robots); its "
+                            "shapes are kept as a solid")
+            self.solid(node, frame, owner, fx.DEVICE_NAMES.get(node.type, node.type.lower()))
             return
         self.tick(node)
         inner = self.child_frame(node, frame)
@@ -618,7 +634,8 @@ class Converter:
             self.warn(node, f"{node.type} outside a joint: skipped")
             return
         if node.type not in self.device_kinds:
-            self.drop(node, f"{node.type}: device kind not supported by this version; skipped")
+            self.drop(node, f"{node.type}: device kind not supported by this version; skipped", "device",
+                      f.string("name", node.type), owner.data["name"])
         else:
             data = {"name": f.string("name", fx.DEVICE_NAMES[node.type]), "pose": inner.pose(), **fx.device(node, f)}
             model = f.string("model", "")
@@ -628,7 +645,18 @@ class Converter:
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
             owner.data["devices"].append(data)
+            self.device_contents(node, inner, owner, data)
+            return
         self.solid_contents(node, inner, owner)
+
+    def device_contents(self, node: Node, frame: Frame, owner: Owner, device: dict | None) -> None:
+        """A device's own Solid contents: robot body shapes marked as the device's own (its visual
+        rays do not see them, sim/own_shapes.py), the innermost device's for nested ones."""
+        start = len(owner.parts)
+        self.solid_contents(node, frame, owner)
+        if device is not None:
+            for part in owner.parts[start:]:
+                part.setdefault("_device", device)
 
     def unsimulated(self, node: Node, frame: Frame, owner: Owner) -> dict:
         """A device listed (its index, type, name and model are Webots') but not simulated here."""
@@ -641,9 +669,28 @@ class Converter:
                 data["model"] = model
         if frame.pose() != {"translation": [0.0, 0.0, 0.0]}:
             data["pose"] = frame.pose()
+        if t not in wm.UNSIMULATED_DEVICE_TYPES:       # a kind simulated here: its own fields, by their names
+            data.update(self.device_fields(node))
         data["_at"] = self.at(node)
         owner.data["devices"].append(data)
         return data
+
+    def device_fields(self, node: Node) -> dict[str, Any]:
+        """The fields of a device node that its world-file model has (Webots' camelCase names in
+        snake_case: ``noiseCorrelation`` → ``noise_correlation``; ``lookupTable`` as rows); a field
+        written that the model does not have is said (it is not read)."""
+        f = self.fields(node)
+        model = getattr(wm, node.type, None)
+        known = set(getattr(model, "model_fields", {})) - {"name", "model", "pose", "device"}
+        out: dict[str, Any] = {}
+        for written, value in node.fields.items():
+            key = "".join(f"_{c.lower()}" if c.isupper() else c for c in written)
+            if key in known:
+                out[key] = ([list(r) for r in f.rows(written, 3, [])] if key == "lookup_table"
+                            else list(value) if isinstance(value, tuple) else value)
+            elif written not in SOLID_FIELDS:
+                self.warn(node, f"{node.type}.{written}: not read here (the device takes its default)")
+        return out
 
     def joint_devices(self, node: Node, owner: Owner) -> tuple[list[dict], list[dict]]:
         """A joint's devices in its ``device`` order (Webots lists them before the end point's):
@@ -676,6 +723,9 @@ class Converter:
         sensors: list[dict] = []
         if owner.kind == "robot":
             _, sensors = self.joint_devices(node, owner)
+        if owner.kind == "robot" and node.type == "Hinge2Joint" and motors:    # a steered wheel (a car)
+            owner.wheels.append({"node": node, "motor": self.fields(motors[0]).string("name", "rotational motor"),
+                                 "steers": True})
         if owner.kind == "robot" and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
             if params is not None:
@@ -687,12 +737,14 @@ class Converter:
             centre = anchor
             if end is not None and end.type == "Solid":
                 centre = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
+            turn = frame.rotation @ np.asarray(axis)
             owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"),
+                                 "steers": abs(turn[2]) > 0.9 * float(np.linalg.norm(turn)),   # a vertical axis
                                  "max_velocity": m.num("maxVelocity", 10.0),
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
-        elif motors:
+        elif motors and node.type != "Hinge2Joint":
             self.warn(node, f"{node.type} motor(s) not part of a wheel: listed, not simulated (joints do not move here)")
         if sensors and not (owner.kind == "robot" and node.type == "HingeJoint" and motors):
             self.warn(node, "PositionSensor on a joint without a drive wheel motor: listed, reads no value")
@@ -713,7 +765,7 @@ class Converter:
             return
         robot.data["differential_drive"] = drive
         for w in wheels:    # the wheels' encoders measure the drive's wheels
-            for entry in w["sensors"]:
+            for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]
 
 

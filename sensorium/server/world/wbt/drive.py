@@ -1,11 +1,16 @@
-"""Two motorised HingeJoint wheels → the world format's kinematic ``differential_drive``.
+"""Motorised HingeJoint wheels → the world format's kinematic ``differential_drive``.
 
 The kinematic drive turns the robot about its origin, x forward, wheels on the robot's y axis, and
 a positive wheel speed drives forward. A Webots robot maps onto it when it clearly is such a robot:
-exactly two motorised hinges, both axes along the robot's +y, both anchors on one line parallel to
-y, the two wheels (their end points' origins) on either side of the robot's origin (their midpoint
-under it), and wheels of one radius. Anything else gets one
-sentence saying which of these failed.
+every motorised hinge's axis along the robot's +y and wheels of one radius, and either
+
+* two wheels: both anchors on one line parallel to y, the wheels (their end points' origins) on
+  either side of the robot's origin (their midpoint under it); or
+* several wheels per side (skid steer, a Pioneer 3-AT): each side's wheels on one line parallel to
+  x, the two lines at the same distance either side of the origin, the wheels' centre under it.
+
+A robot with steered wheels (a motorised hinge with a vertical axis, a Hinge2Joint: a car) is not
+driven. Anything else gets one sentence saying which of these failed.
 """
 
 from __future__ import annotations
@@ -45,14 +50,47 @@ def wheel_radius(end: Node | None, conv) -> float | None:
 
 
 def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
-    if len(wheels) != 2:
-        return None, f"{len(wheels)} motorised hinge joints; a differential drive needs exactly two wheels"
+    """The kinematic drive of a robot's motorised hinges (two wheels, or several per side: skid
+    steer), or (None, the sentence saying why not)."""
+    steering = [w for w in wheels if w.get("steers")]
+    if steering:
+        names = ", ".join(repr(w["motor"]) for w in steering)
+        return None, (f"a car-like robot: motor(s) {names} steer (a vertical hinge axis or a Hinge2Joint); Sensorium's "
+                      "kinematic drives are two-wheel and skid-steer, a steered robot is not driven here")
+    if len(wheels) < 2:
+        return None, f"{len(wheels)} motorised hinge joint; a drive needs two wheels or more, on both sides"
     y = np.array([0.0, 1.0, 0.0])
     for w in wheels:
         a = w["axis"] / np.linalg.norm(w["axis"])
         if np.linalg.norm(a - y) > TOL:
             return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not the robot's +y "
-                          "(the kinematic drive needs both axes along +y so that positive speeds drive forward)")
+                          "(the kinematic drive needs every axis along +y so that positive speeds drive forward)")
+    if len(wheels) == 2:
+        return _two_wheels(wheels, conv)
+    return _skid_steer(wheels, conv)
+
+
+def _radius(wheels: list[dict], conv) -> tuple[float | None, str]:
+    radii = [wheel_radius(w["end"], conv) for w in wheels]
+    if any(r is None for r in radii):
+        return None, "a wheel end point has no cylinder or sphere to take the wheel radius from"
+    r0 = radii[0]
+    assert r0 is not None
+    for r in radii[1:]:
+        assert r is not None
+        if abs(r - r0) > TOL * max(r, r0):
+            return None, f"the wheels have different radii ({', '.join(f'{x:g}' for x in radii if x is not None)})"
+    return r0, ""
+
+
+def _max_speed(wheels: list[dict], conv) -> float:
+    speeds = {w["max_velocity"] for w in wheels}
+    if len(speeds) > 1:
+        conv.warn(wheels[0]["node"], f"wheel motors have different maxVelocity {sorted(speeds)}: using the smaller")
+    return min(speeds)
+
+
+def _two_wheels(wheels: list[dict], conv) -> tuple[dict | None, str]:
     a0, a1 = wheels[0]["anchor"], wheels[1]["anchor"]
     if abs(a0[0] - a1[0]) > TOL or abs(a0[2] - a1[2]) > TOL:
         return None, "the two wheel anchors are not on one axle parallel to the robot's y axis"
@@ -64,14 +102,37 @@ def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     if abs(mid[0]) > TOL or abs(mid[1]) > TOL:
         return None, (f"the axle midpoint is at x={mid[0]:g}, y={mid[1]:g} in the robot frame, not under the robot's "
                       "origin (the kinematic drive turns about the origin)")
-    r0, r1 = (wheel_radius(w["end"], conv) for w in wheels)
-    if r0 is None or r1 is None:
-        return None, "a wheel end point has no cylinder or sphere to take the wheel radius from"
-    if abs(r0 - r1) > TOL * max(r0, r1):
-        return None, f"the wheels have different radii ({r0:g} and {r1:g})"
+    r0, why = _radius(wheels, conv)
+    if r0 is None:
+        return None, why
     left, right = (wheels[0], wheels[1]) if a0[1] > a1[1] else (wheels[1], wheels[0])
-    speeds = {w["max_velocity"] for w in wheels}
-    if len(speeds) > 1:
-        conv.warn(wheels[0]["node"], f"wheel motors have different maxVelocity {sorted(speeds)}: using the smaller")
-    return {"wheel_radius": r0, "axle_length": float(abs(a0[1] - a1[1])), "max_wheel_speed": min(speeds),
+    return {"wheel_radius": r0, "axle_length": float(abs(a0[1] - a1[1])), "max_wheel_speed": _max_speed(wheels, conv),
             "left_motor": left["motor"], "right_motor": right["motor"]}, ""
+
+
+def _skid_steer(wheels: list[dict], conv) -> tuple[dict | None, str]:
+    """Several wheels per side on parallel axes (a Pioneer 3-AT): each side's wheels on one line
+    parallel to x, the two lines either side of the origin at the same distance, the wheels'
+    centroid under the origin (the kinematic drive turns about it)."""
+    centres = np.array([w["centre"] for w in wheels])
+    left = [w for w, c in zip(wheels, centres) if c[1] > TOL]
+    right = [w for w, c in zip(wheels, centres) if c[1] < -TOL]
+    if len(left) + len(right) != len(wheels) or not left or not right:
+        return None, (f"{len(wheels)} motorised wheels, not all on either side of the robot's x axis (a skid-steer "
+                      "drive needs wheels on both sides and none on the axis)")
+    yl, yr = (np.array([w["centre"][1] for w in side]) for side in (left, right))
+    if np.ptp(yl) > TOL or np.ptp(yr) > TOL:
+        return None, "the wheels of one side are not on one line parallel to the robot's x axis"
+    if abs(yl[0] + yr[0]) > TOL:
+        return None, (f"the wheel lines are at y={yl[0]:g} and y={yr[0]:g}, not symmetric about the robot's origin "
+                      "(the kinematic drive turns about the origin)")
+    mid_x = float(centres[:, 0].mean())
+    if abs(mid_x) > TOL:
+        return None, (f"the wheels' centre is at x={mid_x:g} in the robot frame, not under the robot's origin "
+                      "(the kinematic drive turns about the origin)")
+    r0, why = _radius(wheels, conv)
+    if r0 is None:
+        return None, why
+    return {"wheel_radius": r0, "axle_length": float(yl[0] - yr[0]), "max_wheel_speed": _max_speed(wheels, conv),
+            "left_motor": left[0]["motor"], "right_motor": right[0]["motor"],
+            "skid_steer": {"left": [w["motor"] for w in left[1:]], "right": [w["motor"] for w in right[1:]]}}, ""

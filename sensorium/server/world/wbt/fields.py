@@ -189,9 +189,10 @@ def appearance(node: Node | None, source: str, warn, resolve=None) -> dict | Non
     ``baseColorMap`` texel (roughness and occlusion maps read where the base map is); an Appearance
     with a loaded ``texture`` reads white × ``(1 − transparency)`` × texel (WbAppearance::diffuseColor
     replaces the material's colour by white), without one its material's diffuseColor. A texture
-    that cannot be loaded here (missing file, not PNG/JPEG, a webots:// url without the installation,
-    a remote url) is noted with ``warn(node, "texture: <why>")`` and read as Webots reads a texture
-    it could not load. ``resolve(node, url)``: see :func:`image_texture`."""
+    that cannot be loaded here (missing file, not PNG/JPEG, webots:// or remote url) is noted with
+    ``warn(node, "texture: <why>")`` and read as Webots reads a texture it could not load.
+    ``resolve(node, url) -> (url or None, why)``: where a url of a PROTO file or ``webots://`` is
+    (the converter's asset resolution); without it urls are relative to ``source``."""
     if node is None:
         return None
     f = Fields(node, source)
@@ -227,10 +228,10 @@ def appearance(node: Node | None, source: str, warn, resolve=None) -> dict | Non
 def image_texture(node: Node | None, source: str, warn, resolve=None) -> dict | None:
     """An ImageTexture → the world format's texture, if its first url is a PNG/JPEG file found
     (else ``warn(node, "texture: …")`` and None: Webots would not load it). ``resolve(node, url)``
-    → (the url the converted world names, the file) or ``TextureFileError``: where the url leads
-    (a PROTO's url is relative to the PROTO file, webots:// names the installation's file; the
-    converter's); without it the url is relative to the world file and kept as written
-    (backslashes made slashes, as Webots does)."""
+    → (the url the converted world names, or None, why): where the url leads (a PROTO's url is
+    relative to the PROTO file, webots:// names the installation's file; the converter's); without
+    it the url is relative to the world file and kept as written (backslashes made slashes, as
+    Webots does)."""
     from pathlib import Path
 
     from sensorium.server.world.textures import TextureFileError, image_header, resolve_texture_url
@@ -246,11 +247,14 @@ def image_texture(node: Node | None, source: str, warn, resolve=None) -> dict | 
         warn(node, "texture: ImageTexture without url")
         return None
     url = urls[0].replace("\\", "/")
+    if resolve is not None:
+        found, why = resolve(node, url)
+        if found is None:
+            warn(node, f"texture: {why}")
+            return None
+        url = found
     try:
-        if resolve is None:
-            path = resolve_texture_url(url, Path(source).resolve().parent, allow_outside=True)
-        else:
-            url, path = resolve(node, url)
+        path = resolve_texture_url(url, Path(source).resolve().parent, allow_outside=True)
         image_header(path, url)
     except TextureFileError as exc:
         warn(node, f"texture: {exc}")

@@ -1,0 +1,151 @@
+"""Loading is honest (issue 27): what a world loses is said once, grouped and counted, by every
+command; ``validate`` fails on losses sensors notice (robots, devices, shapes) and passes on visual-
+or physics-only warnings; ``serve`` refuses a world whose robots were all lost; a controller asking
+for a lost robot is told why."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import msgpack
+import pytest
+
+from sensorium.cli import main
+from sensorium.schemas.wire import ErrorCode
+from sensorium.server.daemon.serve import refuse_robotless
+from sensorium.server.daemon.services import Core
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import WorldError, load_world
+from sensorium.server.world.report import WorldLossWarning
+
+HEADER = "#VRML_SIM R2023b utf8\n"
+
+
+def write(tmp_path: Path, body: str, name: str = "w.wbt") -> Path:
+    p = tmp_path / name
+    p.write_text(HEADER + body)
+    return p
+
+
+LOSSY = ('WorldInfo { }\n'                                                          # line 2
+         'Solid { name "floor" children [ Shape { geometry DEF F Plane { size 2 2 } } ] boundingObject USE F }\n'
+         'E-puck { name "e-puck" controller "braitenberg" }\n'                      # line 4: a robot PROTO not found
+         'CircleArena { }\n'                                                        # line 5: unknown, maybe anything
+         'Solid { name "pillar" children [ Shape { geometry Mesh { url [ "gone.stl" ] } } ] }\n')   # line 6
+
+
+def test_validate_fails_naming_each_loss_and_allow_skipped_accepts(tmp_path: Path, capsys) -> None:
+    p = write(tmp_path, LOSSY)
+    assert main(["validate", str(p)]) == 1
+    err = capsys.readouterr().err
+    assert f"{p}: 3 losses sensors notice (1 robot, 1 shape, 1 unknown node)" in err
+    assert f"lost robot 'e-puck': {p}:4:1: E-puck: not a built-in node or PROTO here" in err
+    assert f"lost unknown node 'CircleArena': {p}:5:1: CircleArena: not a built-in node or PROTO here" in err
+    assert f"lost shape of 'pillar': {p}:6:51: mesh file 'gone.stl' not found" in err
+    assert f"{p}: INVALID" in err
+    assert main(["validate", str(p), "--allow-skipped"]) == 0
+    assert capsys.readouterr().out.strip() == f"{p}: OK"
+
+
+def test_visual_and_physics_only_differences_are_warnings(tmp_path: Path, capsys) -> None:
+    """A Viewpoint, a Physics node, a texture that cannot be read, a joint that does not move: the
+    sensors read the same; validate says so and exits 0."""
+    p = write(tmp_path, 'Viewpoint { }\nBackground { }\n'
+                        'Solid { children [ Shape { appearance Appearance { texture ImageTexture { url [ "no.png" ] } } '
+                        'geometry Box { } } ] physics Physics { } }\n'
+                        'Robot { name "arm" children [ HingeJoint { device [ RotationalMotor { name "m" } ] '
+                        'endPoint Solid { } } ] }\n')
+    assert main(["validate", str(p)]) == 0
+    out = capsys.readouterr()
+    assert out.out.strip() == f"{p}: OK"
+    assert "losses" not in out.err and "warnings" in out.err
+    assert load_world(p).losses == ()
+
+
+def test_repeated_messages_are_grouped_with_their_count(tmp_path: Path) -> None:
+    body = "".join(f'Solid {{ name "s{i}" children [ Shape {{ geometry Mesh {{ url [ "gone.stl" ] }} }} ] }}\n'
+                   for i in range(5))
+    report = load_world(write(tmp_path, "WorldInfo { }\n" + body)).report
+    assert report.counts() == "5 losses sensors notice (5 shapes)"
+    (line,) = report.lines()
+    assert line.startswith(f"lost shape (x5, first at {tmp_path / 'w.wbt'}:3:")   # shapes of s0 ... s4
+    assert line.endswith("mesh file 'gone.stl' not found (relative to the world file): this shape is left out")
+    assert len(report.lines(every=True)) == 5
+
+
+def test_serve_refuses_a_world_whose_robots_were_all_lost(tmp_path: Path, capsys) -> None:
+    p = write(tmp_path, LOSSY)
+    assert main(["serve", str(p), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"]) == 1
+    err = capsys.readouterr().err
+    assert "every robot of this world was lost when it loaded (1 robot, 1 unknown node that may have been one)" in err
+    assert f"lost robot 'e-puck': {p}:4:1" in err and "--allow-skipped" in err
+    # a world that writes no robot at all is served as before (it runs by itself)
+    refuse_robotless(load_world(write(tmp_path, 'WorldInfo { }\nSolid { }\n', "empty.wbt")))
+    with pytest.raises(WorldError):
+        refuse_robotless(load_world(p))
+
+
+def _attach(core: Core, robot: str) -> dict:
+    body = msgpack.packb({"id": 1, "service": "attach", "args": {"robot": robot}})
+    (frames,) = core.handle([b"peer", body], 0.0)
+    return msgpack.unpackb(frames[-1])
+
+
+def test_a_controller_asking_for_a_lost_robot_is_told_why(tmp_path: Path) -> None:
+    p = write(tmp_path, LOSSY + 'Robot { name "kept" }\n')
+    core = Core(Simulation(load_world(p), "fast"), log=lambda line: None)
+    reply = _attach(core, "e-puck")
+    assert reply["ok"] is False and reply["error"]["code"] == ErrorCode.UNKNOWN_ROBOT
+    assert reply["error"]["message"] == (
+        f"no robot 'e-puck' (robots: kept); it was dropped when the world loaded: {p}:4:1: E-puck: not a built-in "
+        "node or PROTO here; skipped (with everything inside it). Built-in PROTOs: Floor, RectangleArena, SolidBox, "
+        "TexturedBackgroundLight, WoodenBox")
+    other = _attach(core, "scout")["error"]["message"]     # a name the world never wrote: the candidates
+    assert other.startswith("no robot 'scout' (robots: kept); the world lost 2 nodes that may have been it")
+    assert _attach(core, "kept")["ok"] is True
+
+
+def test_in_process_loads_warn_once_and_keep_the_list(tmp_path: Path) -> None:
+    p = write(tmp_path, LOSSY + 'Robot { name "kept" }\n')
+    with pytest.warns(WorldLossWarning, match="3 losses sensors notice"):
+        sim = Simulation.from_file(p, precision="fast")
+    assert [(x.kind, x.name) for x in sim.loaded.losses] == [("robot", "e-puck"), ("node", "CircleArena"),
+                                                             ("shape", "pillar")]
+    assert sim.loaded.dropped == [x.text for x in sim.loaded.losses]
+    clean = write(tmp_path, 'WorldInfo { }\nRobot { name "r" }\n', "clean.wbt")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        Simulation.from_file(clean, precision="fast")       # nothing lost: no warning
+
+
+def test_a_device_outside_a_robot_keeps_its_shapes(tmp_path: Path) -> None:
+    """Webots' devices are Solids: outside a robot they do nothing, but rays still see them."""
+    p = write(tmp_path, 'DistanceSensor { translation 1 0 0 name "ds" children [ Shape { geometry Box { size 0.1 0.1 0.1 } } ] }\n'
+                        'Camera { translation 2 0 0 children [ Shape { geometry Sphere { radius 0.05 } } ] }\n')
+    w = load_world(p)
+    assert [(s.name, s.pose.translation, s.shapes[0].geometry.type) for s in w.world.solids] == [
+        ("ds", (1.0, 0.0, 0.0), "box"), ("camera", (2.0, 0.0, 0.0), "sphere")]
+    assert w.losses == ()
+    assert sum("outside a Robot: not a device here" in x for x in w.warnings) == 2
+
+
+def test_cad_shapes_are_visual_meshes_or_said_lost(tmp_path: Path) -> None:
+    """A CadShape (Webots' visual mesh) is seen by lidars and infra-red: read as a visual mesh when
+    its format is read here, else a loss naming it (it was once skipped as if it did not matter)."""
+    (tmp_path / "part.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    (tmp_path / "part.dae").write_text("<COLLADA/>")
+    p = write(tmp_path, 'Solid { name "s" children [ CadShape { url [ "part.obj" ] } CadShape { url [ "part.dae" ] } ] }\n')
+    w = load_world(p)
+    (shape,) = w.world.solids[0].shapes
+    assert (shape.geometry.type, shape.geometry.url, shape.seen_by) == ("mesh", "part.obj", "visual")
+    (loss,) = w.losses
+    assert (loss.kind, loss.name, loss.where) == ("shape", "s", f"{p}:2:61")   # the second CadShape
+    assert "mesh 'part.dae': the .dae format is not read here" in loss.why
+
+
+def test_a_wbt_load_times_each_stage() -> None:
+    """What ``sensorium bench --only loading`` reads: wall seconds per stage of a .wbt load."""
+    w = load_world(Path(__file__).parent / "worlds" / "proto" / "minipuck.wbt", proto_path=[])
+    assert set(w.timings) == {"parse", "proto files", "instantiate", "template", "convert", "validate"}
+    assert all(v >= 0.0 for v in w.timings.values()) and w.timings["template"] > 0.0

@@ -1,0 +1,116 @@
+"""A device never sees its own shapes (issue 27): an infra-red sensor inside its own small box and a
+lidar inside its housing read what they read without them, while the rest of their robot stays in
+view (Webots: a ray never sees a shape from inside it). Distances against closed forms."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world, parse_world
+
+BOTH = ["fast", "exact"]
+WALL_X = 0.3          # the wall's face at x = 0.3 (a box 0.02 thick centred at 0.31)
+
+
+def world(ir_box: bool = True, housing: bool = True, mark: bool = True, mast: bool = False, rotating: bool = False) -> dict:
+    shapes = [{"pose": {"translation": [0, 0, 0.03]}, "geometry": {"type": "cylinder", "radius": 0.035, "height": 0.05}}]
+    if ir_box:        # the sensor's own small box, around its origin (an e-puck's infra-red sensor)
+        shapes.append({"pose": {"translation": [0.04, 0, 0.02]}, "geometry": {"type": "box", "size": [0.004, 0.008, 0.004]},
+                       **({"of_device": "ir"} if mark else {})})
+    if housing:       # the lidar's housing, around its origin (a SICK lidar)
+        shapes.append({"pose": {"translation": [0, 0, 0.1]}, "geometry": {"type": "cylinder", "radius": 0.02, "height": 0.03},
+                       **({"of_device": "lidar"} if mark else {})})
+    if mast:          # part of the robot that is not the lidar's: it stays in view (Webots)
+        shapes.append({"pose": {"translation": [0, 0.05, 0.1]}, "geometry": {"type": "box", "size": [0.01, 0.01, 0.1]}})
+    lidar = {"device": "Lidar", "name": "lidar", "pose": {"translation": [0, 0, 0.1]}, "horizontal_resolution": 64,
+             "field_of_view": 6.283185307179586, "number_of_layers": 1, "min_range": 0.01, "max_range": 2.0, "near": 0.01}
+    if rotating:
+        lidar |= {"type": "rotating", "default_frequency": 10, "min_frequency": 1, "max_frequency": 20}
+    return {
+        "world_info": {"basic_time_step": 16},
+        "solids": [{"name": "wall", "pose": {"translation": [WALL_X + 0.01, 0, 0.1]},
+                    "geometry": {"type": "box", "size": [0.02, 2, 0.2]}}],
+        "robots": [{"name": "r", "shapes": shapes, "devices": [
+            {"device": "DistanceSensor", "name": "ir", "type": "infra-red", "pose": {"translation": [0.04, 0, 0.02]},
+             "lookup_table": [[0, 0, 0], [1, 1000, 0]]},
+            lidar]}],
+    }
+
+
+def beam(data: dict, direction) -> tuple[int, np.ndarray]:
+    """The beam (column of layer 0) nearest a direction in the lidar frame, and its direction."""
+    sim = Simulation(parse_world(copy.deepcopy(data)), "fast")
+    dirs = sim.device("r/lidar")._all_dirs[0]
+    j = int(np.argmax(dirs @ np.asarray(direction, dtype=np.float64)))
+    return j, dirs[j]
+
+
+def readings(data: dict, precision: str, steps: int = 4) -> tuple[float, np.ndarray]:
+    sim = Simulation(parse_world(copy.deepcopy(data)), precision)
+    sim.device("r/ir").enable(16)
+    lidar = sim.device("r/lidar")
+    lidar.enable(16)
+    sim.run(steps)
+    return sim.device("r/ir").value, lidar.range_image.copy()
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_own_shapes_are_invisible_to_their_device(precision: str) -> None:
+    ir, image = readings(world(), precision)
+    ir_bare, image_bare = readings(world(ir_box=False, housing=False), precision)
+    assert ir == ir_bare and np.array_equal(image, image_bare)       # bit for bit as without them
+    assert ir == pytest.approx(1000 * (WALL_X - 0.04), rel=1e-6)      # the wall, white: D/F = D (fast: float32)
+    j, d = beam(world(), (1, 0, 0))                                    # the wall along this beam: WALL_X / cos
+    assert image[0, j] == pytest.approx(WALL_X / d[0], rel=1e-6)       # (float32 image)
+    # the same shapes not marked as the devices' own: each sees its own shape from inside
+    ir_seen, image_seen = readings(world(mark=False), precision)
+    assert ir_seen < 1000 * 0.003 and np.all(image_seen <= 0.021)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+@pytest.mark.parametrize("rotating", [False, True])
+def test_the_rest_of_the_robot_stays_in_view(precision: str, rotating: bool) -> None:
+    """The mast (the robot's, not the lidar's) is seen through the housing at its closed-form range."""
+    _, image = readings(world(mast=True, rotating=rotating), precision, steps=8)
+    if not rotating:    # (a rotating head's columns follow its sweep: compared with the bare robot below)
+        j, d = beam(world(mast=True), (0, 1, 0))
+        # the mast's face y = 0.045 (|x| <= 0.005 along the beams near +y): the range is 0.045 / d_y
+        assert abs(d[0]) * 0.045 / d[1] < 0.005
+        assert image[0, j] == pytest.approx(0.045 / d[1], rel=1e-6)
+    assert np.count_nonzero(image < 0.06) >= 1     # the mast is in view
+    _, bare = readings(world(housing=False, mast=True, rotating=rotating), precision, steps=8)
+    if precision == "exact":
+        assert np.array_equal(image, bare)
+    else:     # FAST: the mast met in the body frame (mounted beams) vs in the world: float32 rounding
+        np.testing.assert_allclose(image, bare, rtol=1e-6)
+
+
+def test_wbt_device_children_are_marked_as_its_own(tmp_path: Path) -> None:
+    p = tmp_path / "w.wbt"
+    p.write_text('#VRML_SIM R2023b utf8\nRobot { name "r" children [\n'
+                 '  DistanceSensor { translation 0.04 0 0.02 name "ps0" type "infra-red" children [\n'
+                 '    Shape { geometry Box { size 0.004 0.008 0.004 } } ] }\n'
+                 '  DistanceSensor { name "ps0" children [ Shape { geometry Sphere { radius 0.002 } } ] }\n'
+                 '  Camera { children [ Shape { geometry Box { size 0.01 0.01 0.01 } } ] }\n'
+                 '  Shape { geometry Cylinder { radius 0.035 height 0.05 } } ] }\n')
+    (robot,) = load_world(p).world.robots
+    assert [(s.geometry.type, s.of_device) for s in robot.shapes] == [
+        ("box", "ps0"), ("sphere", "ps0(1)"), ("box", "camera"), ("cylinder", None)]
+
+
+def test_of_device_must_name_a_device_of_the_robot() -> None:
+    from sensorium.server.world.loader import WorldError
+
+    data = world()
+    data["robots"][0]["shapes"][1]["of_device"] = "nope"
+    with pytest.raises(WorldError, match=r"robots\[0\] \(r\)\.shapes\[1\]\.of_device: 'nope' is not a device of this robot"):
+        parse_world(data)
+    data = world()
+    data["solids"][0]["shapes"] = [{"geometry": {"type": "sphere"}, "of_device": "ir"}]
+    with pytest.raises(WorldError, match="only a robot's shapes belong to one of its devices"):
+        parse_world(data)

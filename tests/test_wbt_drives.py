@@ -1,0 +1,134 @@
+"""Wheeled robots beyond two wheels (issue 27): a skid-steer robot (several motorised wheels per
+side, a Pioneer 3-AT written by us) drives kinematically with the same contact as a two-wheel one;
+a car-like robot (steered wheels) gets one line saying why it is not driven. Closed-form checks."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import WorldError, load_world, parse_world
+
+HEADER = "#VRML_SIM R2023b utf8\n"
+R, X, Y = 0.11, 0.133, 0.197          # Pioneer 3-AT-like: wheel radius, half wheelbase, half track
+
+
+def write(tmp_path: Path, body: str) -> Path:
+    p = tmp_path / "w.wbt"
+    p.write_text(HEADER + "WorldInfo { basicTimeStep 16 }\n" + body)
+    return p
+
+
+def wheel(name: str, x: float, y: float, axis: str = "0 1 0", joint: str = "HingeJoint") -> str:
+    params = "Hinge2JointParameters" if joint == "Hinge2Joint" else "HingeJointParameters"
+    return (f'{joint} {{ jointParameters {params} {{ axis {axis} anchor {x} {y} {R} }} '
+            f'device [ RotationalMotor {{ name "{name}" maxVelocity 12.3 }} PositionSensor {{ name "{name} sensor" }} ] '
+            f'endPoint Solid {{ translation {x} {y} {R} rotation 1 0 0 1.5708 children [ DEF W Shape {{ geometry '
+            f'Cylinder {{ radius {R} height 0.095 }} }} ] boundingObject USE W }} }}\n')
+
+
+def pioneer(name: str = "p3at", at: str = "0 0 0") -> str:
+    return (f'Robot {{ name "{name}" translation {at} children [\n'
+            f'  Pose {{ translation 0 0 0.2 children [ Shape {{ geometry Box {{ size 0.5 0.4 0.2 }} }} ] }}\n'
+            + wheel("front left wheel", X, Y) + wheel("front right wheel", X, -Y)
+            + wheel("back left wheel", -X, Y) + wheel("back right wheel", -X, -Y)
+            + '] boundingObject Pose { translation 0 0 0.2 children [ Box { size 0.5 0.4 0.2 } ] } }\n')
+
+
+def drive(sim: Simulation, robot: str, left: float, right: float) -> None:
+    r = sim.robot(robot)
+    for side, speed in (("left", left), ("right", right)):
+        for end in ("front", "back"):
+            m = r.motor(f"{end} {side} wheel")
+            m.set_position(math.inf)
+            m.set_velocity(speed)
+
+
+def test_four_wheels_become_a_skid_steer_drive(tmp_path: Path) -> None:
+    w = load_world(write(tmp_path, pioneer()))
+    (robot,) = w.world.robots
+    assert robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="front left wheel",
+        right_motor="front right wheel", skid_steer=wm.SkidSteer(left=["back left wheel"], right=["back right wheel"]))
+    names = [(d.name, d.device) for d in robot.devices]       # Webots' tree order: each joint's motor, then sensor
+    assert names[:4] == [("front left wheel", "RotationalMotor"), ("front left wheel sensor", "PositionSensor"),
+                         ("front right wheel", "RotationalMotor"), ("front right wheel sensor", "PositionSensor")]
+    assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == [
+        "front left wheel", "front right wheel", "back left wheel", "back right wheel"]
+    assert w.warnings == []
+
+
+def test_skid_steer_straight_line_and_turn_radius_closed_form(tmp_path: Path) -> None:
+    sim = Simulation(load_world(write(tmp_path, pioneer())), "fast")
+    drive(sim, "p3at", 2.0, 2.0)
+    sim.run(125)                                  # 2 s at 2 rad/s on 0.11 m wheels: 0.44 m
+    pose = sim.robot("p3at").pose
+    assert pose.translation == pytest.approx([0.44, 0.0, 0.0], abs=1e-12)
+    # wheels 1 and 3 rad/s: v = r·2, ω = r·2/(2Y), on a circle of radius v/ω = 2Y about (0.44, 2Y)
+    drive(sim, "p3at", 1.0, 3.0)
+    sim.run(500)                                  # 8 s
+    v, w = R * 2.0, R * 2.0 / (2 * Y)
+    t = 8.0
+    cx, cy = 0.44, v / w
+    expect = (cx + (v / w) * math.sin(w * t), cy - (v / w) * math.cos(w * t))
+    assert tuple(sim.robot("p3at").pose.translation[:2]) == pytest.approx(expect, abs=1e-9)
+    enc = sim.device("p3at/back right wheel sensor")
+    enc.enable(16)
+    sim.step()
+    assert enc.value == pytest.approx(2.0 * 2.0 + 3.0 * (8.0 + 0.016), abs=1e-9)   # its own wheel's angle
+
+
+def test_skid_steer_side_speed_is_the_mean_of_its_wheels(tmp_path: Path) -> None:
+    """Wheels of one side commanded differently (Webots' physics would skid): the side rolls at their mean."""
+    sim = Simulation(load_world(write(tmp_path, pioneer())), "fast")
+    r = sim.robot("p3at")
+    for name, speed in (("front left wheel", 1.0), ("back left wheel", 3.0),
+                        ("front right wheel", 2.0), ("back right wheel", 2.0)):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(speed)
+    sim.run(125)
+    assert r.pose.translation == pytest.approx([0.44, 0.0, 0.0], abs=1e-12)
+
+
+def test_skid_steer_stops_at_a_wall_like_a_two_wheel_robot(tmp_path: Path) -> None:
+    p = write(tmp_path, pioneer() + 'Solid { translation 1 0 0.2 children [ DEF WALL Shape { geometry Box { size 0.1 2 0.4 } } ] '
+                                    'boundingObject USE WALL }\n')
+    sim = Simulation(load_world(p), "fast")
+    drive(sim, "p3at", 5.0, 5.0)
+    sim.run(250)
+    x = sim.robot("p3at").pose.translation[0]
+    # the body's enclosing disc (contact.py): a turned wheel bounded by its sphere, off centre
+    footprint = max(math.hypot(0.25, 0.2), math.hypot(X, Y) + math.hypot(R, 0.095 / 2))
+    assert x == pytest.approx(0.95 - footprint, abs=1e-9)
+    assert sim.counters["contacts"] > 0
+
+
+def test_a_car_like_robot_gets_one_line_saying_why(tmp_path: Path) -> None:
+    car = ('Robot { name "car" children [\n' + wheel("left rear", 0, Y) + wheel("right rear", 0, -Y)
+           + wheel("left steer", 0.3, Y, axis="0 0 1") + wheel("right steer", 0.3, -Y, axis="0 0 1") + '] }\n')
+    p = write(tmp_path, car)
+    w = load_world(p)
+    assert w.world.robots[0].differential_drive is None
+    (line,) = [x for x in w.warnings if "no differential drive" in x]
+    assert line == (f"{p}:3:1: robot 'car': no differential drive (a car-like robot: motor(s) 'left steer', "
+                    "'right steer' steer (a vertical hinge axis or a Hinge2Joint); Sensorium's kinematic drives are "
+                    "two-wheel and skid-steer, a steered robot is not driven here); the robot will not move")
+    hinge2 = ('Robot { name "car" children [\n' + wheel("left rear", 0, Y) + wheel("right rear", 0, -Y)
+              + wheel("left front", 0.3, Y, joint="Hinge2Joint") + '] }\n')
+    w = load_world(write(tmp_path, hinge2))
+    assert any("a car-like robot: motor(s) 'left front' steer" in x for x in w.warnings)
+
+
+def test_skid_steer_in_a_world_file_and_its_checks() -> None:
+    data = {"robots": [{"name": "r", "differential_drive": {
+        "left_motor": "fl", "right_motor": "fr", "skid_steer": {"left": ["bl"], "right": ["br"]}},
+        "devices": [{"device": "PositionSensor", "name": "e", "motor": "bl"}]}]}
+    w = parse_world(data)
+    assert set(Simulation(w, "fast").robot("r").motors) == {"fl", "fr", "bl", "br"}
+    data["robots"][0]["differential_drive"]["skid_steer"]["right"] = ["fl"]
+    with pytest.raises(WorldError, match="every wheel motor needs its own name"):
+        parse_world(data)
