@@ -210,6 +210,14 @@ register(DeviceKind(
     topics=(TopicDecl("value", msgs.FLOAT64, "value", exists=lambda cfg, wi: cfg.type != "force-3d"),
             TopicDecl("values", msgs.VECTOR3_STAMPED, "values", exists=lambda cfg, wi: cfg.type == "force-3d")),
     description="TouchSensorDescription"))
+register(DeviceKind(
+    "RangeFinder", wm.RangeFinder, "sensorium.server.sim.cameras:RangeFinder",
+    services=_SENSOR,
+    topics=(TopicDecl("range_image", msgs.IMAGE, "range_image"),
+            TopicDecl("camera_info", msgs.CAMERA_INFO, "range_image", exists=lambda cfg, wi: cfg.projection == "planar")),
+    rays=lambda cfg, lights: int(cfg.width) * int(cfg.height),
+    ray_bound=("", "pixels (width × height):", "rays_per_image"),
+    description="RangeFinderDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

@@ -301,6 +301,18 @@ class LidarDescription(_Entry):
     point_cloud_enabled: bool
 
 
+class RangeFinderDescription(_Entry):
+    type: Literal["RangeFinder"]
+    sampling_period: int
+    width: int
+    height: int
+    fov: float = Field(description="rad, horizontal")
+    near: float
+    minRange: float
+    maxRange: float
+    projection: str = Field(description="planar, cylindrical or spherical")
+
+
 class MotorDescription(_Entry):
     type: Literal["RotationalMotor"]
     maxVelocity: float = Field(description="rad/s")
@@ -388,6 +400,7 @@ DeviceDescription = Annotated[
     | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]
     | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
     | Annotated[TouchSensorDescription, Tag("TouchSensor")]
+    | Annotated[RangeFinderDescription, Tag("RangeFinder")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or

@@ -454,6 +454,30 @@ class TouchSensor(_Device):
     resolution: float = -1.0
 
 
+class RangeFinder(_Device):
+    """Webots RangeFinder (a depth camera): ``width`` × ``height`` ranges, by exact rays through the
+    pixel centres. ``planar``: the depth along the device's +x axis (Webots' z-buffer distance to
+    the image plane); ``cylindrical``/``spherical``: the distance along each pixel's ray. Values
+    outside [min_range, max_range) and no hit read +inf (README "Cameras and range finders")."""
+
+    device: Literal["RangeFinder"]
+    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
+    width: int = Field(default=64, ge=1, le=1 << 16)
+    height: int = Field(default=64, ge=1, le=1 << 16)
+    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
+    near: float = Field(default=0.01, ge=0.0)
+    min_range: float = Field(default=0.01, ge=0.0)
+    max_range: float = Field(default=1.0, gt=0.0)
+    noise: float = Field(default=0.0, ge=0.0, description="σ of the Gaussian noise as a fraction of max_range")
+    resolution: float = -1.0
+
+    @model_validator(mode="after")
+    def _planar_fov(self) -> RangeFinder:
+        if self.projection == "planar" and self.field_of_view >= math.pi:
+            raise ValueError("a planar range finder's field_of_view must be < pi")
+        return self
+
+
 class RotationalMotor(_Device):
     """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
     motors *is* that motor, at this index of the device list (a drive motor without an entry comes
@@ -464,7 +488,7 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Camera", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
+    "Brake", "Camera", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Pen", "Radar", "Radio", "Receiver", "Skin",
     "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -480,11 +504,11 @@ class UnsimulatedDevice(_Device):
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
-                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | UnsimulatedDevice,
+                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | RangeFinder | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
-                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor",
+                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor", "RangeFinder",
                 *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 

@@ -16,7 +16,6 @@
 #include <webots/inertial_unit.h>
 #include <webots/pen.h>
 #include <webots/radar.h>
-#include <webots/range_finder.h>
 #include <webots/receiver.h>
 #include <webots/skin.h>
 #include <webots/speaker.h>
@@ -616,58 +615,6 @@ double wb_radar_get_horizontal_fov(WbDeviceTag tag) {
 double wb_radar_get_vertical_fov(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_vertical_fov");
   return NAN;
-}
-
-/* ------------------------------------------------------------------ RangeFinder */
-void wb_range_finder_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_enable");
-}
-
-void wb_range_finder_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_disable");
-}
-
-int wb_range_finder_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_sampling_period");
-  return 0;
-}
-
-const float *wb_range_finder_get_range_image(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_range_image");
-  return NULL;
-}
-
-int wb_range_finder_get_width(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_width");
-  return 0;
-}
-
-int wb_range_finder_get_height(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_height");
-  return 0;
-}
-
-double wb_range_finder_get_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_fov");
-  return NAN;
-}
-
-double wb_range_finder_get_min_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_min_range");
-  return NAN;
-}
-
-double wb_range_finder_get_max_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_max_range");
-  return NAN;
-}
-
-int wb_range_finder_save_image(WbDeviceTag tag, const char *filename, int quality) {
-  (void)filename;
-  (void)quality;
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_save_image");
-  return 0;
 }
 
 /* ------------------------------------------------------------------ Receiver */

@@ -13,8 +13,9 @@ from .lidar import Lidar, LidarPoint
 from .light_sensor import LightSensor
 from .motor import Motor, RotationalMotor
 from .position_sensor import PositionSensor
+from .range_finder import RangeFinder
 from .robot import Robot
 from .supervisor import Field, Node, Supervisor
 
 __all__ = ["LED", "Device", "DistanceSensor", "Field", "Keyboard", "Lidar", "LidarPoint", "LightSensor", "Motor",
-           "Node", "PositionSensor", "Robot", "RotationalMotor", "Sensor", "SensoriumError", "Supervisor"]
+           "Node", "PositionSensor", "RangeFinder", "Robot", "RotationalMotor", "Sensor", "SensoriumError", "Supervisor"]

@@ -14,6 +14,7 @@ from .lidar import Lidar
 from .light_sensor import LightSensor
 from .motor import RotationalMotor
 from .position_sensor import PositionSensor
+from .range_finder import RangeFinder
 
 _CLASSES: dict[str, type[Device]] = {
     wb.LIGHT_SENSOR: LightSensor,
@@ -22,6 +23,7 @@ _CLASSES: dict[str, type[Device]] = {
     wb.ROTATIONAL_MOTOR: RotationalMotor,
     wb.POSITION_SENSOR: PositionSensor,
     wb.LED: LED,
+    wb.RANGE_FINDER: RangeFinder,
 }
 
 

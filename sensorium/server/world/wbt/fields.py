@@ -160,6 +160,14 @@ def device(node: Node, f: Fields) -> dict:
                 "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0),
                 "default_frequency": f.num("defaultFrequency", 10.0), "min_frequency": f.num("minFrequency", 1.0),
                 "max_frequency": f.num("maxFrequency", 25.0)}
+    if t == "RangeFinder":
+        projection = f.string("projection", "planar")
+        if f.flag("spherical", False) and projection == "planar":    # deprecated in R2023 (WbRangeFinder::init)
+            projection = "cylindrical"
+        return {"device": t, "field_of_view": f.num("fieldOfView", 0.785398), "width": f.integer("width", 64),
+                "height": f.integer("height", 64), "projection": projection, "near": f.num("near", 0.01),
+                "min_range": f.num("minRange", 0.01), "max_range": f.num("maxRange", 1.0),
+                "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
     if t == "PositionSensor":
         return {"device": t, "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
     if t == "LED":
@@ -169,6 +177,7 @@ def device(node: Node, f: Fields) -> dict:
 
 
 DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light sensor", "Lidar": "lidar",
+                "RangeFinder": "range-finder",
                 "PositionSensor": "position sensor", "LED": "led", "RotationalMotor": "rotational motor"}
 
 

@@ -1,0 +1,257 @@
+/* Sensorium C controller library: the image devices, RangeFinder and Camera. Their images live in
+ * per-device buffers filled at each step from the step reply (PROTOCOL.md 3.6; zeros before the
+ * first image, Webots' black for a camera), so the pointers handed out stay valid until
+ * wb_robot_cleanup(). Written from Webots' documented signatures and behaviour. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <webots/camera.h>
+#include <webots/nodes.h>
+#include <webots/range_finder.h>
+
+#include "internal.h"
+
+struct sn_imaging {
+  int width, height;
+  double fov, near, min_range, max_range;
+  float *range;          /* range finder: height rows of width floats */
+};
+
+#define MAX_PIXELS (1 << 28) /* the server's --allow-large bound on an image's rays */
+
+int sn_imaging_describe(sn_device *d, const msgpack_object *desc) {
+  if (d->kind != SN_RANGE_FINDER)
+    return 0;
+  struct sn_imaging *im = calloc(1, sizeof *im);
+  if (im == NULL)
+    return -1;
+  d->imaging = im;
+  im->width = (int)sn_int_or(desc, "width", 0);
+  im->height = (int)sn_int_or(desc, "height", 0);
+  if (im->width <= 0 || im->height <= 0 || (int64_t)im->width * im->height > MAX_PIXELS)
+    return -1;
+  im->fov = sn_double_or(desc, "fov", NAN);
+  im->near = sn_double_or(desc, "near", NAN);
+  im->min_range = sn_double_or(desc, "minRange", NAN);
+  im->max_range = sn_double_or(desc, "maxRange", NAN);
+  im->range = calloc((size_t)im->width * (size_t)im->height, sizeof(float));
+  return im->range == NULL ? -1 : 0;
+}
+
+void sn_imaging_free(sn_device *d) {
+  if (d->imaging == NULL)
+    return;
+  free(d->imaging->range);
+  free(d->imaging);
+  d->imaging = NULL;
+}
+
+static float le_float(const unsigned char *p) {
+  uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+  float f;
+  memcpy(&f, &u, sizeof f);
+  return f;
+}
+
+void sn_imaging_apply(sn_device *d, const msgpack_object *reading) {
+  struct sn_imaging *im = d->imaging;
+  if (im == NULL)
+    return;
+  size_t n = (size_t)im->width * (size_t)im->height;
+  const msgpack_object *img = sn_get(reading, "range_image");
+  if (img != NULL && img->type == MSGPACK_OBJECT_BIN && img->via.bin.size == 4 * n) {
+    const unsigned char *p = (const unsigned char *)img->via.bin.ptr;
+    for (size_t j = 0; j < n; j++)
+      im->range[j] = le_float(p + 4 * j);
+  } else if (img != NULL)
+    fprintf(stderr, "Warning: range finder '%s': range image of %u bytes, expected %zu: ignored\n", d->name,
+            img->type == MSGPACK_OBJECT_BIN ? img->via.bin.size : 0u, 4 * n);
+}
+
+/* ------------------------------------------------------------------ PNG (stored deflate: no zlib needed) */
+
+static uint32_t crc_table[256];
+
+static uint32_t crc32_of(uint32_t crc, const unsigned char *p, size_t n) {
+  if (crc_table[1] == 0)
+    for (uint32_t i = 0; i < 256; i++) {
+      uint32_t c = i;
+      for (int k = 0; k < 8; k++)
+        c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      crc_table[i] = c;
+    }
+  crc = ~crc;
+  for (size_t i = 0; i < n; i++)
+    crc = crc_table[(crc ^ p[i]) & 0xFF] ^ (crc >> 8);
+  return ~crc;
+}
+
+static void put32(unsigned char *p, uint32_t v) {
+  p[0] = (unsigned char)(v >> 24);
+  p[1] = (unsigned char)(v >> 16);
+  p[2] = (unsigned char)(v >> 8);
+  p[3] = (unsigned char)v;
+}
+
+static int chunk(FILE *f, const char *kind, const unsigned char *data, size_t n) {
+  unsigned char head[8];
+  put32(head, (uint32_t)n);
+  memcpy(head + 4, kind, 4);
+  uint32_t crc = crc32_of(crc32_of(0, (const unsigned char *)kind, 4), data, n);
+  unsigned char tail[4];
+  put32(tail, crc);
+  return fwrite(head, 1, 8, f) == 8 && (n == 0 || fwrite(data, 1, n, f) == n) && fwrite(tail, 1, 4, f) == 4 ? 0 : -1;
+}
+
+/* An 8-bit RGB PNG of rgb (height rows of 3*width bytes). 0 or -1. */
+static int write_png(const char *filename, const unsigned char *rgb, int width, int height) {
+  size_t row = 3 * (size_t)width + 1, raw_n = row * (size_t)height;
+  size_t blocks = (raw_n + 65534) / 65535;
+  size_t z_n = 2 + raw_n + 5 * (blocks ? blocks : 1) + 4;
+  unsigned char *z = malloc(z_n);
+  if (z == NULL)
+    return -1;
+  size_t k = 0;
+  z[k++] = 0x78;
+  z[k++] = 0x01;
+  uint32_t a = 1, b = 0;
+  size_t pos = 0, left = raw_n;
+  do {
+    size_t len = left > 65535 ? 65535 : left;
+    left -= len;
+    z[k++] = left == 0 ? 1 : 0;
+    z[k++] = (unsigned char)(len & 0xFF);
+    z[k++] = (unsigned char)(len >> 8);
+    z[k++] = (unsigned char)(~len & 0xFF);
+    z[k++] = (unsigned char)((~len >> 8) & 0xFF);
+    for (size_t i = 0; i < len; i++, pos++) {
+      size_t y = pos / row, x = pos % row;
+      unsigned char v = x == 0 ? 0 : rgb[y * (row - 1) + x - 1];
+      z[k++] = v;
+      a = (a + v) % 65521;
+      b = (b + a) % 65521;
+    }
+  } while (left > 0);
+  put32(z + k, (b << 16) | a);
+  k += 4;
+  FILE *f = fopen(filename, "wb");
+  if (f == NULL) {
+    free(z);
+    return -1;
+  }
+  unsigned char ihdr[13];
+  put32(ihdr, (uint32_t)width);
+  put32(ihdr + 4, (uint32_t)height);
+  ihdr[8] = 8;
+  ihdr[9] = 2;
+  ihdr[10] = ihdr[11] = ihdr[12] = 0;
+  int ret = fwrite("\x89PNG\r\n\x1a\n", 1, 8, f) == 8 && chunk(f, "IHDR", ihdr, 13) == 0 &&
+                    chunk(f, "IDAT", z, k) == 0 && chunk(f, "IEND", NULL, 0) == 0
+              ? 0
+              : -1;
+  free(z);
+  if (fclose(f) != 0)
+    ret = -1;
+  return ret;
+}
+
+/* Webots' argument checks; PNG only here (JPEG needs a codec this library does not carry). */
+static int save_rgb(const char *func, const char *filename, int quality, const unsigned char *rgb, int w, int h) {
+  if (filename == NULL || filename[0] == '\0') {
+    fprintf(stderr, "Error: %s() called with NULL or empty 'filename' argument.\n", func);
+    return -1;
+  }
+  if (quality < 1 || quality > 100) {
+    fprintf(stderr, "Error: %s() called with invalid 'quality' argument.\n", func);
+    return -1;
+  }
+  size_t n = strlen(filename);
+  if (n < 4 || (strcmp(filename + n - 4, ".png") != 0 && strcmp(filename + n - 4, ".PNG") != 0)) {
+    fprintf(stderr, "Error: %s(): only .png images can be saved by this library ('%s').\n", func, filename);
+    return -1;
+  }
+  if (write_png(filename, rgb, w, h) != 0) {
+    fprintf(stderr, "Error: %s(): cannot write '%s'.\n", func, filename);
+    return -1;
+  }
+  return 0;
+}
+
+/* ------------------------------------------------------------------ RangeFinder */
+
+#define RANGE_FINDER(func) sn_device *d = sn_device_get(tag, SN_RANGE_FINDER, func)
+
+void wb_range_finder_enable(WbDeviceTag tag, int sampling_period) {
+  RANGE_FINDER("wb_range_finder_enable");
+  if (d != NULL)
+    sn_device_enable(d, sampling_period, "wb_range_finder_enable");
+}
+
+void wb_range_finder_disable(WbDeviceTag tag) {
+  RANGE_FINDER("wb_range_finder_disable");
+  if (d != NULL)
+    sn_device_enable(d, 0, "wb_range_finder_disable");
+}
+
+int wb_range_finder_get_sampling_period(WbDeviceTag tag) {
+  RANGE_FINDER("wb_range_finder_get_sampling_period");
+  return d ? d->sampling_period : 0;
+}
+
+/* Webots' rule: a disabled range finder prints an error and still hands out its (last) image. */
+const float *wb_range_finder_get_range_image(WbDeviceTag tag) {
+  RANGE_FINDER("wb_range_finder_get_range_image");
+  if (d == NULL)
+    return NULL;
+  if (d->sampling_period <= 0)
+    sn_warn_disabled(d, "wb_range_finder_get_range_image", "wb_range_finder_enable", NULL);
+  return d->imaging->range;
+}
+
+int wb_range_finder_get_width(WbDeviceTag tag) {
+  RANGE_FINDER("wb_range_finder_get_width");
+  return d ? d->imaging->width : 0;
+}
+
+int wb_range_finder_get_height(WbDeviceTag tag) {
+  RANGE_FINDER("wb_range_finder_get_height");
+  return d ? d->imaging->height : 0;
+}
+
+double wb_range_finder_get_fov(WbDeviceTag tag) {
+  RANGE_FINDER("wb_range_finder_get_fov");
+  return d ? d->imaging->fov : NAN;
+}
+
+double wb_range_finder_get_min_range(WbDeviceTag tag) {
+  RANGE_FINDER("wb_range_finder_get_min_range");
+  return d ? d->imaging->min_range : NAN;
+}
+
+double wb_range_finder_get_max_range(WbDeviceTag tag) {
+  RANGE_FINDER("wb_range_finder_get_max_range");
+  return d ? d->imaging->max_range : NAN;
+}
+
+/* Webots' grey scale: (unsigned char)(255 clamp((v - minRange)/maxRange, 0, 1)), inf white. */
+int wb_range_finder_save_image(WbDeviceTag tag, const char *filename, int quality) {
+  const char *func = "wb_range_finder_save_image";
+  RANGE_FINDER(func);
+  if (d == NULL)
+    return -1;
+  struct sn_imaging *im = d->imaging;
+  size_t n = (size_t)im->width * (size_t)im->height;
+  unsigned char *rgb = malloc(3 * n);
+  if (rgb == NULL)
+    return -1;
+  for (size_t j = 0; j < n; j++) {
+    double v = (im->range[j] - im->min_range) / im->max_range;
+    v = !(v <= 1.0) ? 1.0 : v < 0.0 ? 0.0 : v;
+    rgb[3 * j] = rgb[3 * j + 1] = rgb[3 * j + 2] = (unsigned char)(v * 255.0);
+  }
+  int ret = save_rgb(func, filename, quality, rgb, im->width, im->height);
+  free(rgb);
+  return ret;
+}
