@@ -52,3 +52,16 @@ def test_range_finder_bytes_match_python(reader):
     first = bytes.fromhex(c_out[0].split("=")[1])
     assert len(first) == 4 * 12 * 8 and first != bytes(len(first))    # an image arrived with the first step
     assert "cannot write" in c_err
+
+
+def test_camera_bytes_match_python(reader):
+    with serve(WORLD, env=SAN_ENV) as s:
+        c_out, c_err = _run([reader, "camera", "3"], s.url("bot"))
+    with serve(WORLD, env=SAN_ENV) as s:
+        py_out, _ = _run([sys.executable, "-m", "sensorium", "controller", "--url", s.url("bot"),
+                          str(REPO / "tests" / "controllers" / "image_reader.py"), "camera", "3"], s.url("bot"))
+    assert c_out == py_out
+    assert c_out[0] == "# null_before 1" and c_out[-2] == "# exposure 2" and c_out[-1] == "# save -1"
+    first = bytes.fromhex(c_out[1].split("=")[1])
+    assert len(first) == 4 * 16 * 12 and len(set(first[2::4])) > 5      # a picture, not a flat colour
+    assert "wb_camera_get_image() called for a disabled device" in c_err

@@ -1,4 +1,4 @@
-"""Webots' image devices: ``wb_range_finder_*`` (and ``wb_camera_*``), readings cached per step.
+"""Webots' image devices: ``wb_range_finder_*`` and ``wb_camera_*``, readings cached per step.
 
 The images arrive with the step reply (PROTOCOL.md §3.6) as raw bytes; constants (size, field of
 view, ranges) come from the ``attach`` description. As in Webots' library, reading the image of a
@@ -8,6 +8,7 @@ disabled device prints Webots' error and still returns the last image (zeros bef
 from __future__ import annotations
 
 import math
+import sys
 from typing import Any
 
 from sensorium.client import arrays, images
@@ -16,7 +17,14 @@ from sensorium.client.wb_robot import DeviceState, current
 
 RANGE_FINDER = "RangeFinder"
 
-__all__ = ["RANGE_FINDER", "wb_range_finder_enable", "wb_range_finder_disable", "wb_range_finder_get_sampling_period",
+__all__ = ["CAMERA", "camera_bytes", "wb_camera_enable", "wb_camera_disable", "wb_camera_get_sampling_period",
+           "wb_camera_get_image", "wb_camera_image_get_red", "wb_camera_image_get_green", "wb_camera_image_get_blue",
+           "wb_camera_image_get_gray", "wb_camera_image_get_grey", "wb_camera_get_width", "wb_camera_get_height",
+           "wb_camera_get_fov", "wb_camera_get_min_fov", "wb_camera_get_max_fov", "wb_camera_set_fov",
+           "wb_camera_get_exposure", "wb_camera_set_exposure", "wb_camera_get_focal_length",
+           "wb_camera_get_focal_distance", "wb_camera_get_min_focal_distance", "wb_camera_get_max_focal_distance",
+           "wb_camera_set_focal_distance", "wb_camera_get_near", "wb_camera_save_image",
+           "RANGE_FINDER", "wb_range_finder_enable", "wb_range_finder_disable", "wb_range_finder_get_sampling_period",
            "wb_range_finder_get_range_image", "wb_range_finder_image_get_depth", "wb_range_finder_get_width",
            "wb_range_finder_get_height", "wb_range_finder_get_fov", "wb_range_finder_get_min_range",
            "wb_range_finder_get_max_range", "wb_range_finder_save_image", "range_finder_bytes"]
@@ -116,3 +124,188 @@ def wb_range_finder_save_image(tag: int, filename: str, quality: int) -> int:
     w, h = int(dev.desc.get("width", 0)), int(dev.desc.get("height", 0))
     max_range = float(dev.desc.get("maxRange", math.inf))
     return images.save_rgb(func, filename, quality, depth_gray(buf, float(dev.desc.get("minRange", 0.0)), max_range), w, h)
+
+
+# ---------------------------------------------------------------------- camera
+
+CAMERA = "Camera"
+
+
+def _cam(tag: int, func: str) -> DeviceState:
+    return current().device(tag, CAMERA, func)
+
+
+def wb_camera_enable(tag: int, sampling_period: int) -> None:
+    r = current()
+    r.enable(_cam(tag, "wb_camera_enable"), sampling_period, "wb_camera_enable")
+
+
+def wb_camera_disable(tag: int) -> None:
+    r = current()
+    r.enable(_cam(tag, "wb_camera_disable"), 0, "wb_camera_disable")
+
+
+def wb_camera_get_sampling_period(tag: int) -> int:
+    return _cam(tag, "wb_camera_get_sampling_period").sampling_period
+
+
+def _black(dev: DeviceState) -> bytes:
+    """Webots' image before the first one: every pixel 0xFF000000 (BGRA 0, 0, 0, 255)."""
+    return b"\0\0\0\xff" * (int(dev.desc.get("width", 0)) * int(dev.desc.get("height", 0)))
+
+
+def camera_bytes(tag: int, func: str = "wb_camera_get_image") -> bytes | None:
+    """The latest image, BGRA bytes row by row (top row first); ``None`` with Webots' error while the
+    camera is disabled (Webots returns NULL)."""
+    r = current()
+    dev = _cam(tag, func)
+    if dev.sampling_period <= 0:
+        r.warn_disabled(dev, func, "wb_camera_enable")
+        return None
+    img = dev.camera.get("image")
+    return _black(dev) if img is None else bytes(img)
+
+
+def wb_camera_get_image(tag: int) -> bytes | None:
+    """Webots' BGRA image (4 bytes a pixel, ``width × height``, top row first) as ``bytes``;
+    ``None`` while the camera is disabled."""
+    return camera_bytes(tag)
+
+
+def _channel(image: Any, width: int, x: int, y: int, c: int) -> int:
+    return int(image[4 * (y * width + x) + c])
+
+
+def wb_camera_image_get_red(image: Any, width: int, x: int, y: int) -> int:
+    return _channel(image, width, x, y, 2)
+
+
+def wb_camera_image_get_green(image: Any, width: int, x: int, y: int) -> int:
+    return _channel(image, width, x, y, 1)
+
+
+def wb_camera_image_get_blue(image: Any, width: int, x: int, y: int) -> int:
+    return _channel(image, width, x, y, 0)
+
+
+def wb_camera_image_get_gray(image: Any, width: int, x: int, y: int) -> int:
+    """The integer mean of red, green and blue (Webots' C macro)."""
+    i = 4 * (y * width + x)
+    return (int(image[i]) + int(image[i + 1]) + int(image[i + 2])) // 3
+
+
+wb_camera_image_get_grey = wb_camera_image_get_gray
+
+
+def _cam_const(tag: int, key: str, func: str) -> Any:
+    return _desc(_cam(tag, func), key, func)
+
+
+def wb_camera_get_width(tag: int) -> int:
+    return int(_cam_const(tag, "width", "wb_camera_get_width"))
+
+
+def wb_camera_get_height(tag: int) -> int:
+    return int(_cam_const(tag, "height", "wb_camera_get_height"))
+
+
+def wb_camera_get_fov(tag: int) -> float:
+    return float(_cam_const(tag, "fov", "wb_camera_get_fov"))
+
+
+def wb_camera_get_min_fov(tag: int) -> float:
+    """The field of view (a camera without a Zoom node: Webots' min = max = fov)."""
+    return float(_cam_const(tag, "fov", "wb_camera_get_min_fov"))
+
+
+def wb_camera_get_max_fov(tag: int) -> float:
+    return float(_cam_const(tag, "fov", "wb_camera_get_max_fov"))
+
+
+def wb_camera_set_fov(tag: int, fov: float) -> None:
+    """Webots' rule without a Zoom node: only the current field of view is in the zoom range."""
+    func = "wb_camera_set_fov"
+    dev = _cam(tag, func)
+    cur = float(_desc(dev, "fov", func))
+    planar = dev.desc.get("projection", "planar") == "planar"
+    hi = math.pi if planar else 2.0 * math.pi
+    if not isinstance(fov, (int, float)) or not 0.0 <= fov <= hi:
+        print(f"Error: {func}() called with 'fov' argument outside of the [0, {'pi' if planar else '2.0*pi'}] range.",
+              file=sys.stderr)
+    elif fov != cur:
+        print(f"Error: {func}() out of zoom range [{cur:f}, {cur:f}].", file=sys.stderr)
+
+
+def wb_camera_get_exposure(tag: int) -> float:
+    return float(_cam_const(tag, "exposure", "wb_camera_get_exposure"))
+
+
+def wb_camera_set_exposure(tag: int, exposure: float) -> None:
+    func = "wb_camera_set_exposure"
+    r = current()
+    dev = _cam(tag, func)
+    if isinstance(exposure, bool) or not isinstance(exposure, (int, float)) or not math.isfinite(exposure):
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'exposure' must be a finite number, got {exposure!r}")
+    if exposure < 0:
+        print(f"Error: 'exposure' argument of {func}() can't be negative.", file=sys.stderr)
+        return
+    if not r.terminated:
+        r._expect_success(r.rpc(dev, "set_exposure", {"value": float(exposure)}), func)
+    dev.desc["exposure"] = float(exposure)
+
+
+def wb_camera_get_focal_length(tag: int) -> float:
+    """0: a camera without a Focus node (Webots)."""
+    _cam(tag, "wb_camera_get_focal_length")
+    return 0.0
+
+
+def wb_camera_get_focal_distance(tag: int) -> float:
+    _cam(tag, "wb_camera_get_focal_distance")
+    return 0.0
+
+
+def wb_camera_get_min_focal_distance(tag: int) -> float:
+    _cam(tag, "wb_camera_get_min_focal_distance")
+    return 0.0
+
+
+def wb_camera_get_max_focal_distance(tag: int) -> float:
+    _cam(tag, "wb_camera_get_max_focal_distance")
+    return 0.0
+
+
+def wb_camera_set_focal_distance(tag: int, focal_distance: float) -> None:
+    func = "wb_camera_set_focal_distance"
+    dev = _cam(tag, func)
+    if dev.desc.get("projection", "planar") != "planar":
+        print(f"Error: {func}() can only be called on a planar camera.", file=sys.stderr)
+    elif focal_distance != 0.0:
+        print(f"Error: {func}() out of focus range [0.000000, 0.000000].", file=sys.stderr)
+
+
+def wb_camera_get_near(tag: int) -> float:
+    return float(_cam_const(tag, "near", "wb_camera_get_near"))
+
+
+def save_bgra(func: str, filename: str, quality: int, bgra: bytes | None, width: int, height: int) -> int:
+    if not filename:
+        print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
+        return -1
+    lower = str(filename).lower()
+    if not lower.endswith((".png", ".jpg", ".jpeg")):
+        print(f"Error: {func}() called with unsupported image format (should be PNG or JPEG).", file=sys.stderr)
+        return -1
+    if bgra is None:
+        return -1
+    return images.save_rgb(func, filename, quality if lower.endswith((".jpg", ".jpeg")) else 100,
+                           images.bgra_to_rgb(bgra), width, height)
+
+
+def wb_camera_save_image(tag: int, filename: str, quality: int) -> int:
+    """The latest image as PNG (or JPEG with Pillow); 0, or -1 (Webots)."""
+    func = "wb_camera_save_image"
+    dev = _cam(tag, func)
+    img = dev.camera.get("image")
+    return save_bgra(func, filename, quality, _black(dev) if img is None else bytes(img),
+                     int(dev.desc.get("width", 0)), int(dev.desc.get("height", 0)))

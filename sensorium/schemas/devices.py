@@ -218,6 +218,14 @@ register(DeviceKind(
     rays=lambda cfg, lights: int(cfg.width) * int(cfg.height),
     ray_bound=("", "pixels (width × height):", "rays_per_image"),
     description="RangeFinderDescription"))
+register(DeviceKind(
+    "Camera", wm.Camera, "sensorium.server.sim.cameras:Camera",
+    services=(*_SENSOR, "set_exposure"),
+    topics=(TopicDecl("image", msgs.IMAGE, "image"),
+            TopicDecl("camera_info", msgs.CAMERA_INFO, "image", exists=lambda cfg, wi: cfg.projection == "planar")),
+    rays=lambda cfg, lights: int(cfg.width) * int(cfg.height) * (4 if cfg.anti_aliasing else 1),
+    ray_bound=("", "rays (width × height, × 4 anti-aliased):", "rays_per_image"),
+    description="CameraDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

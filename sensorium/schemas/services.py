@@ -159,6 +159,10 @@ class FrequencyArgs(Args):
     value: float = Field(description="Hz, within [minFrequency, maxFrequency]")
 
 
+class ExposureArgs(Args):
+    value: float = Field(ge=0.0, description="the camera's photometric exposure (Webots' exposure, >= 0)")
+
+
 class LayerArgs(Args):
     layer: int = Field(ge=0, lt=1 << 31)
 
@@ -313,6 +317,20 @@ class RangeFinderDescription(_Entry):
     projection: str = Field(description="planar, cylindrical or spherical")
 
 
+class CameraDescription(_Entry):
+    type: Literal["Camera"]
+    sampling_period: int
+    width: int
+    height: int
+    fov: float = Field(description="rad, horizontal")
+    near: float
+    far: float = Field(description="0: no far plane")
+    exposure: float
+    projection: str = Field(description="planar, cylindrical or spherical")
+    anti_aliasing: bool
+    noise: float
+
+
 class MotorDescription(_Entry):
     type: Literal["RotationalMotor"]
     maxVelocity: float = Field(description="rad/s")
@@ -400,7 +418,7 @@ DeviceDescription = Annotated[
     | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]
     | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
     | Annotated[TouchSensorDescription, Tag("TouchSensor")]
-    | Annotated[RangeFinderDescription, Tag("RangeFinder")]
+    | Annotated[RangeFinderDescription, Tag("RangeFinder")] | Annotated[CameraDescription, Tag("Camera")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -645,6 +663,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_roll_pitch_yaw", "device", NoArgs, FloatArrayValue),
     ServiceSpec("get_quaternion", "device", NoArgs, FloatArrayValue),
     ServiceSpec("get_noise", "device", NoArgs, FloatValue),
+    ServiceSpec("set_exposure", "device", ExposureArgs, SuccessResult, attached=True),
 )
 
 

@@ -8,14 +8,31 @@ wb.wb_robot_init()
 name, steps = sys.argv[1], int(sys.argv[2])
 tag = wb.wb_robot_get_device(name)
 step = int(wb.wb_robot_get_basic_time_step())
-wb.wb_range_finder_enable(tag, step)
-w, h = wb.wb_range_finder_get_width(tag), wb.wb_range_finder_get_height(tag)
+camera = wb.wb_device_get_type_name(tag) == "Camera"
+if camera:
+    print(f"# null_before {int(wb.wb_camera_get_image(tag) is None)}")
+    wb.wb_camera_enable(tag, step)
+    w, h = wb.wb_camera_get_width(tag), wb.wb_camera_get_height(tag)
+else:
+    wb.wb_range_finder_enable(tag, step)
+    w, h = wb.wb_range_finder_get_width(tag), wb.wb_range_finder_get_height(tag)
 for _ in range(steps):
     status = wb.wb_robot_step(step)
-    print(f"{round(wb.wb_robot_get_time() * 1000)} {status} {name}={wb.range_finder_bytes(tag).hex()}")
+    data = wb.camera_bytes(tag) if camera else wb.range_finder_bytes(tag)
+    print(f"{round(wb.wb_robot_get_time() * 1000)} {status} {name}={data.hex()}")
     if status == -1:
         break
-print(f"# info {w} {h} {wb.wb_range_finder_get_fov(tag):.17g} {wb.wb_range_finder_get_min_range(tag):.17g} "
-      f"{wb.wb_range_finder_get_max_range(tag):.17g}")
-print(f"# save {wb.wb_range_finder_save_image(tag, '/nonexistent-dir/x.png', 100)}")
+if camera:
+    img = wb.wb_camera_get_image(tag)
+    px = [f(img, w, w - 1, h - 1) for f in (wb.wb_camera_image_get_red, wb.wb_camera_image_get_green,
+                                             wb.wb_camera_image_get_blue, wb.wb_camera_image_get_gray)]
+    print(f"# info {w} {h} {wb.wb_camera_get_fov(tag):.17g} {wb.wb_camera_get_near(tag):.17g} "
+          f"{wb.wb_camera_get_exposure(tag):.17g} {' '.join(map(str, px))}")
+    wb.wb_camera_set_exposure(tag, 2.0)
+    print(f"# exposure {wb.wb_camera_get_exposure(tag):.17g}")
+    print(f"# save {wb.wb_camera_save_image(tag, '/nonexistent-dir/x.png', 100)}")
+else:
+    print(f"# info {w} {h} {wb.wb_range_finder_get_fov(tag):.17g} {wb.wb_range_finder_get_min_range(tag):.17g} "
+          f"{wb.wb_range_finder_get_max_range(tag):.17g}")
+    print(f"# save {wb.wb_range_finder_save_image(tag, '/nonexistent-dir/x.png', 100)}")
 wb.wb_robot_cleanup()

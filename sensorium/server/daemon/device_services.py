@@ -100,6 +100,13 @@ class DeviceServices:
     def _dev_get_noise(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.config.noise)}
 
+    def _dev_set_exposure(self, c: Call) -> dict:
+        try:
+            c.ctl.device.set_exposure(c.args.value)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_exposure: {exc}") from None
+        return {"success": True}
+
     def _dev_set(self, c: Call) -> dict:
         try:
             c.ctl.device.set(c.args.value, self.sim.time_ms)

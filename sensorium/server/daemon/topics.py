@@ -443,9 +443,13 @@ class Topics:
                 "range": float(dev.value),
                 "variance": 0.0}
 
-    def _range_image(self, ctl: Control, hdr: dict, reading: str) -> dict:
+    def _range_image(self, ctl: Control, hdr: dict, reading: str) -> dict | None:
         if reading != "range_image":         # a camera's own images (bgra8), sim/cameras.py
-            return ctl.device.image_msg(hdr, reading)
+            data = ctl.device.image_data(reading)
+            if data is None:
+                return None
+            height, width, encoding, raw = data
+            return image_msg(hdr, height, width, raw, encoding)
         rows, cols = ctl.device.range_image.shape      # a lidar's layers × columns, a range finder's pixels
         return image_msg(hdr, rows, cols, ctl.range_bytes())
 

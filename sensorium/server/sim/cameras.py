@@ -10,16 +10,18 @@ its shading needs). Nothing is computed while a device is disabled; the simulati
 
 from __future__ import annotations
 
+import math
 from typing import Any, ClassVar
 
 import numpy as np
 
-from sensorium.server.devices import imaging
+from sensorium.server.devices import imaging, shading
+from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.sensors import Device
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["RangeFinder", "MountedRays"]
+__all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info"]
 
 
 class MountedRays:
@@ -125,3 +127,226 @@ class RangeFinder(Device):
             c.resolution, self.rng if c.noise > 0 else None)
         self.schedule.last_update_ms = now_ms
         self._mark(now_ms)
+
+
+# ---------------------------------------------------------------------------------- Camera
+
+MAX_LAYERS = 8
+"""Semi-transparent surfaces composited along one ray; the next surface is taken as opaque."""
+
+_LIGHT_KINDS = {"PointLight": light_math.LightKind.POINT, "SpotLight": light_math.LightKind.SPOT,
+                "DirectionalLight": light_math.LightKind.DIRECTIONAL}
+
+
+def camera_lights(models: list) -> tuple[light_math.LightArrays, np.ndarray]:
+    """The lights that are on (world frame) and which of them cast shadows (Webots' castShadows)."""
+    out, shadows = [], []
+    for m in models:
+        if not m.on:
+            continue
+        fields = dict(kind=_LIGHT_KINDS[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity,
+                      color=m.color)
+        if m.type != "DirectionalLight":
+            fields.update(position=m.location, attenuation=m.attenuation)
+        if m.type != "PointLight":
+            fields.update(direction=m.direction)
+        if m.type == "SpotLight":
+            fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
+        out.append(light_math.Light(**fields))
+        shadows.append(bool(m.cast_shadows))
+    return light_math.LightArrays.from_lights(out), np.array(shadows, dtype=bool)
+
+
+class Camera(Device):
+    """Webots' Camera: a BGRA image (H, W, 4) uint8, black (alpha 255) before the first one (Webots).
+    The shading model is ``server/devices/shading.py``."""
+
+    captures: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        c = self.config
+        self.geometry = imaging.ImageGeometry(c.width, c.height, c.field_of_view, c.projection)
+        self.image = np.zeros((c.height, c.width, 4), dtype=np.uint8)
+        self.image[:, :, 3] = 255
+        self.exposure = float(c.exposure)
+        self._samples = imaging.SAMPLES_2X2 if c.anti_aliasing else imaging.SAMPLES_CENTRE
+        self._rays: MountedRays | None = None
+        self._limits: tuple[Any, Any] = (0.0, 0.0)
+        self._robot: Any = None
+        self._scene: Any = None
+        self._background = np.zeros(3)
+        self._lights: tuple[int, light_math.LightArrays, np.ndarray] | None = None
+        self._bytes: tuple[int, bytes] = (-1, b"")
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._scene = robot.scene
+        self._background = self._scene.background
+
+    # -- controller API
+    def describe(self) -> dict:
+        c = self.config
+        return {"width": int(c.width), "height": int(c.height), "fov": float(c.field_of_view), "near": float(c.near),
+                "far": float(c.far), "exposure": float(self.exposure), "projection": c.projection,
+                "anti_aliasing": bool(c.anti_aliasing), "noise": float(c.noise)}
+
+    def set_exposure(self, exposure: float) -> None:
+        if not (isinstance(exposure, (int, float)) and math.isfinite(exposure) and exposure >= 0.0):
+            raise ValueError(f"exposure must be a finite number >= 0, got {exposure!r}")
+        self.exposure = float(exposure)
+
+    def readings(self) -> dict:
+        return {"image": self.image}
+
+    def image_bytes(self) -> bytes:
+        """The BGRA bytes of the latest image, made once per image (topics and step replies share them)."""
+        if self._bytes[0] != self.measurements:
+            self._bytes = (self.measurements, self.image.tobytes())
+        return self._bytes[1]
+
+    def step_reading(self) -> dict:
+        return {"image": self.image_bytes()}
+
+    def image_data(self, reading: str) -> tuple[int, int, str, bytes] | None:
+        """(height, width, encoding, bytes) of the image a topic publishes (``sensor_msgs/Image``)."""
+        c = self.config
+        return int(c.height), int(c.width), "bgra8", self.image_bytes()
+
+    def camera_info(self) -> dict:
+        return camera_info(self.geometry)
+
+    # -- measurement
+    def due(self, now_ms: int) -> bool:
+        return self.schedule.due(now_ms)
+
+    def _prepare(self) -> MountedRays:
+        if self._rays is None:
+            c = self.config
+            dirs = imaging.pixel_directions(self.geometry, self._samples)
+            factors = imaging.depth_factors(self.geometry, dirs)
+            self._limits = imaging.clip_limits(self.geometry, factors, c.near, c.far if c.far > 0 else math.inf)
+            self._rays = MountedRays(dirs)
+        return self._rays
+
+    def _light_arrays(self) -> tuple[light_math.LightArrays, np.ndarray]:
+        scene = self._scene
+        if self._lights is None or self._lights[0] != scene.lights_version:
+            arrays, shadows = camera_lights(scene.world_lights())
+            self._lights = (scene.lights_version, arrays, shadows)
+        return self._lights[1], self._lights[2]
+
+    def capture(self, now_ms: int, counters: Any) -> None:
+        rays = self._prepare()
+        pose: Pose = self.world_pose(self._robot.pose)
+        dirs, dirs32 = rays.at(pose.rotation)
+        L = self._render(pose.translation, dirs, dirs32, counters)
+        c = self.config
+        S = len(self._samples)
+        if S > 1:      # supersampling: the mean radiance of the pixel's rays
+            L = L.reshape(S, -1, 3).mean(axis=0)
+        v = shading.tone_map(L, self.exposure).reshape(c.height, c.width, 3)
+        rgb = shading.to_bytes(v, c.noise, self.rng if c.noise > 0 else None)
+        image = np.empty((c.height, c.width, 4), dtype=np.uint8)
+        image[:, :, 0], image[:, :, 1], image[:, :, 2], image[:, :, 3] = rgb[:, :, 2], rgb[:, :, 1], rgb[:, :, 0], 255
+        self.image = image
+        self.schedule.last_update_ms = now_ms
+        self._mark(now_ms)
+
+    def _render(self, origin: np.ndarray, dirs: np.ndarray, dirs32: np.ndarray, counters: Any) -> np.ndarray:
+        """The radiance (N, 3) along every ray: the surfaces it crosses composited front to back
+        (semi-transparent ones let ``transparency`` of what is behind through; a closed shape's
+        faces are crossed twice and only its entering face is seen, as with back-face culling),
+        the background where nothing is hit."""
+        scene = self._scene
+        engine = scene.engine
+        n = len(dirs)
+        t_near, t_far = self._limits
+        tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
+        out = np.zeros((n, 3))            # when a ray first goes through a semi-transparent surface
+        weight = np.ones(n)
+        rows = np.arange(n)
+        lights, shadows = self._light_arrays()
+        for layer in range(MAX_LAYERS + 1):
+            if layer == 0:
+                D = dirs
+                hits = engine.cast(np.broadcast_to(origin, D.shape), D, t_near, t_far, kind=RayKind.VISUAL,
+                                   exclude_owner=-1, directions32=dirs32)
+            else:
+                assert tn is not None and tf is not None
+                D = dirs[rows]
+                hits = engine.cast(np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows], kind=RayKind.VISUAL,
+                                   exclude_owner=-1)
+            counters["rays_camera"] += len(rows)
+            counters["cast_calls"] += 1
+            t, shape, normal = hits.distance, hits.shape, hits.normal
+            hit = np.isfinite(t)
+            miss = (~hit).nonzero()[0]
+            if len(miss):
+                out[rows[miss]] += weight[rows[miss], None] * self._background
+            k = hit.nonzero()[0]
+            if len(k) == 0:
+                break
+            r, s = rows[k], shape[k]
+            tau = scene.transparency[s]
+            clear = tau > 0.0
+            leaving = np.zeros(len(k), dtype=bool)
+            any_clear = bool(clear.any())
+            if any_clear and inside is None:
+                inside = np.full((n, MAX_LAYERS), -1, dtype=np.int64)
+                tn = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,)).copy()
+                tf = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))
+            if any_clear:              # a transparent shape the ray is already in: its far face
+                assert inside is not None
+                leaving = clear & (inside[r] == s[:, None]).any(axis=1)
+            seen = (~leaving).nonzero()[0]
+            if len(seen):
+                kk, rr = k[seen], r[seen]
+                Dk = D[kk] if len(kk) < len(D) else D
+                P = origin + t[kk, None] * Dk
+                N = normal[kk] if len(kk) < len(D) else normal
+                back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+                if back.any():         # facing the camera
+                    N = np.where(back[:, None], -N, N)
+                albedo = scene.surface_colors(s[seen], np.broadcast_to(origin, (len(kk), 3)), Dk, t[kk])
+                lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
+                L = shading.radiance(P, N, albedo, lights, lit)
+                last = layer == MAX_LAYERS
+                a = np.where(last, 0.0, tau[seen])[:, None]
+                out[rr] += weight[rr, None] * (1.0 - a) * L
+                weight[rr] *= a[:, 0]
+            # the rays that go on: through a transparent surface (entering or leaving it)
+            go = clear & (layer < MAX_LAYERS)
+            if not go.any():
+                break
+            assert inside is not None and tn is not None
+            g = go.nonzero()[0]
+            rg, sg = r[g], s[g]
+            ent = ~leaving[g]
+            if ent.any():            # entering: remember the shape (in its first free slot)
+                free = np.argmax(inside[rg[ent]] < 0, axis=1)
+                inside[rg[ent], free] = sg[ent]
+            if (~ent).any():         # leaving: forget it
+                lv = rg[~ent]
+                inside[lv] = np.where(inside[lv] == sg[~ent][:, None], -1, inside[lv])
+            tn[rg] = t[k[g]] * (1.0 + 1e-12) + 1e-7      # just past this surface
+            rows = rg
+        return out
+
+    def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
+                 counters: Any) -> np.ndarray:
+        """(S, n) False where a shadow-casting light is hidden from the point by a visible shape
+        (its segment to the light, 1000 m towards a directional one); only lit, facing pairs cast."""
+        att, direct = light_math.light_terms(P, N, lights)
+        lit = np.ones(direct.shape, dtype=bool)
+        unit, length = light_math.occlusion_segments_many(P, lights)
+        for j in shadows.nonzero()[0].tolist():
+            i = (direct[:, j] > 0.0).nonzero()[0]
+            if len(i) == 0:
+                continue
+            hits = self._scene.engine.cast(P[i], unit[i, j], 0.0, length[i, j], kind=RayKind.VISUAL, exclude_owner=-1,
+                                           distance_only=True)
+            counters["rays_camera"] += len(i)
+            counters["cast_calls"] += 1
+            lit[i, j] = ~(hits.distance <= length[i, j])
+        return lit

@@ -17,12 +17,16 @@ struct sn_imaging {
   int width, height;
   double fov, near, min_range, max_range;
   float *range;          /* range finder: height rows of width floats */
+  unsigned char *image;  /* camera: BGRA, height rows of 4 * width bytes */
+  double exposure;
+  bool planar;
 };
 
+#define PI 3.14159265358979323846
 #define MAX_PIXELS (1 << 28) /* the server's --allow-large bound on an image's rays */
 
 int sn_imaging_describe(sn_device *d, const msgpack_object *desc) {
-  if (d->kind != SN_RANGE_FINDER)
+  if (d->kind != SN_RANGE_FINDER && d->kind != SN_CAMERA)
     return 0;
   struct sn_imaging *im = calloc(1, sizeof *im);
   if (im == NULL)
@@ -36,14 +40,27 @@ int sn_imaging_describe(sn_device *d, const msgpack_object *desc) {
   im->near = sn_double_or(desc, "near", NAN);
   im->min_range = sn_double_or(desc, "minRange", NAN);
   im->max_range = sn_double_or(desc, "maxRange", NAN);
-  im->range = calloc((size_t)im->width * (size_t)im->height, sizeof(float));
-  return im->range == NULL ? -1 : 0;
+  im->exposure = sn_double_or(desc, "exposure", NAN);
+  char *projection = sn_strdup_obj(sn_get(desc, "projection"));
+  im->planar = projection == NULL || strcmp(projection, "planar") == 0;
+  free(projection);
+  size_t n = (size_t)im->width * (size_t)im->height;
+  if (d->kind == SN_RANGE_FINDER)
+    return (im->range = calloc(n, sizeof(float))) == NULL ? -1 : 0;
+  if ((im->image = malloc(4 * n)) == NULL)
+    return -1;
+  for (size_t j = 0; j < n; j++) { /* Webots' black before the first image: 0xFF000000 */
+    im->image[4 * j] = im->image[4 * j + 1] = im->image[4 * j + 2] = 0;
+    im->image[4 * j + 3] = 255;
+  }
+  return 0;
 }
 
 void sn_imaging_free(sn_device *d) {
   if (d->imaging == NULL)
     return;
   free(d->imaging->range);
+  free(d->imaging->image);
   free(d->imaging);
   d->imaging = NULL;
 }
@@ -60,6 +77,15 @@ void sn_imaging_apply(sn_device *d, const msgpack_object *reading) {
   if (im == NULL)
     return;
   size_t n = (size_t)im->width * (size_t)im->height;
+  if (d->kind == SN_CAMERA) {
+    const msgpack_object *bgra = sn_get(reading, "image");
+    if (bgra != NULL && bgra->type == MSGPACK_OBJECT_BIN && bgra->via.bin.size == 4 * n)
+      memcpy(im->image, bgra->via.bin.ptr, 4 * n);
+    else if (bgra != NULL)
+      fprintf(stderr, "Warning: camera '%s': image of %u bytes, expected %zu: ignored\n", d->name,
+              bgra->type == MSGPACK_OBJECT_BIN ? bgra->via.bin.size : 0u, 4 * n);
+    return;
+  }
   const msgpack_object *img = sn_get(reading, "range_image");
   if (img != NULL && img->type == MSGPACK_OBJECT_BIN && img->via.bin.size == 4 * n) {
     const unsigned char *p = (const unsigned char *)img->via.bin.ptr;
@@ -163,7 +189,7 @@ static int save_rgb(const char *func, const char *filename, int quality, const u
     fprintf(stderr, "Error: %s() called with NULL or empty 'filename' argument.\n", func);
     return -1;
   }
-  if (quality < 1 || quality > 100) {
+  if (quality != 0 && (quality < 1 || quality > 100)) { /* 0: a camera's PNG, whose quality Webots ignores */
     fprintf(stderr, "Error: %s() called with invalid 'quality' argument.\n", func);
     return -1;
   }
@@ -254,4 +280,161 @@ int wb_range_finder_save_image(WbDeviceTag tag, const char *filename, int qualit
   int ret = save_rgb(func, filename, quality, rgb, im->width, im->height);
   free(rgb);
   return ret;
+}
+
+/* ------------------------------------------------------------------ Camera */
+
+#define CAMERA(func) sn_device *d = sn_device_get(tag, SN_CAMERA, func)
+
+void wb_camera_enable(WbDeviceTag tag, int sampling_period) {
+  CAMERA("wb_camera_enable");
+  if (d != NULL)
+    sn_device_enable(d, sampling_period, "wb_camera_enable");
+}
+
+void wb_camera_disable(WbDeviceTag tag) {
+  CAMERA("wb_camera_disable");
+  if (d != NULL)
+    sn_device_enable(d, 0, "wb_camera_disable");
+}
+
+int wb_camera_get_sampling_period(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_sampling_period");
+  return d ? d->sampling_period : 0;
+}
+
+/* Webots' rule: NULL (and an error) while the camera is disabled. */
+const unsigned char *wb_camera_get_image(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_image");
+  if (d == NULL)
+    return NULL;
+  if (d->sampling_period <= 0) {
+    sn_warn_disabled(d, "wb_camera_get_image", "wb_camera_enable", NULL);
+    return NULL;
+  }
+  return d->imaging->image;
+}
+
+int wb_camera_get_width(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_width");
+  return d ? d->imaging->width : 0;
+}
+
+int wb_camera_get_height(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_height");
+  return d ? d->imaging->height : 0;
+}
+
+double wb_camera_get_fov(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_fov");
+  return d ? d->imaging->fov : NAN;
+}
+
+/* without a Zoom node, Webots' zoom range is the field of view itself */
+double wb_camera_get_min_fov(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_min_fov");
+  return d ? d->imaging->fov : NAN;
+}
+
+double wb_camera_get_max_fov(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_max_fov");
+  return d ? d->imaging->fov : NAN;
+}
+
+void wb_camera_set_fov(WbDeviceTag tag, double fov) {
+  const char *func = "wb_camera_set_fov";
+  CAMERA(func);
+  if (d == NULL)
+    return;
+  double hi = d->imaging->planar ? PI : 2.0 * PI;
+  if (!(fov >= 0.0 && fov <= hi))
+    fprintf(stderr, "Error: %s() called with 'fov' argument outside of the [0, %s] range.\n", func,
+            d->imaging->planar ? "pi" : "2.0*pi");
+  else if (fov != d->imaging->fov)
+    fprintf(stderr, "Error: %s() out of zoom range [%f, %f].\n", func, d->imaging->fov, d->imaging->fov);
+}
+
+double wb_camera_get_exposure(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_exposure");
+  return d ? d->imaging->exposure : NAN;
+}
+
+void wb_camera_set_exposure(WbDeviceTag tag, double exposure) {
+  const char *func = "wb_camera_set_exposure";
+  CAMERA(func);
+  if (d == NULL)
+    return;
+  if (!(exposure >= 0.0) || isinf(exposure)) {
+    fprintf(stderr, "Error: 'exposure' argument of %s() can't be negative.\n", func);
+    return;
+  }
+  sn_robot *rb = sn_robot_get(func);
+  if (!rb->terminated) {
+    sn_reply rep;
+    if (sn_device_call(rb, d, "set_exposure", sn_arg_double, &exposure, func, &rep) != 0)
+      return;
+    sn_reply_free(&rep);
+  }
+  d->imaging->exposure = exposure;
+}
+
+/* a camera without a Focus node: Webots' zeros */
+double wb_camera_get_focal_length(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_focal_length");
+  return d ? 0.0 : NAN;
+}
+
+double wb_camera_get_focal_distance(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_focal_distance");
+  return d ? 0.0 : NAN;
+}
+
+double wb_camera_get_max_focal_distance(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_max_focal_distance");
+  return d ? 0.0 : NAN;
+}
+
+double wb_camera_get_min_focal_distance(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_min_focal_distance");
+  return d ? 0.0 : NAN;
+}
+
+void wb_camera_set_focal_distance(WbDeviceTag tag, double focal_distance) {
+  const char *func = "wb_camera_set_focal_distance";
+  CAMERA(func);
+  if (d == NULL)
+    return;
+  if (!d->imaging->planar)
+    fprintf(stderr, "Error: %s() can only be called on a planar camera.\n", func);
+  else if (focal_distance != 0.0)
+    fprintf(stderr, "Error: %s() out of focus range [0.000000, 0.000000].\n", func);
+}
+
+double wb_camera_get_near(WbDeviceTag tag) {
+  CAMERA("wb_camera_get_near");
+  return d ? d->imaging->near : NAN;
+}
+
+static int save_bgra(const char *func, const char *filename, int quality, const unsigned char *bgra, int w, int h) {
+  size_t n = (size_t)w * (size_t)h;
+  unsigned char *rgb = malloc(3 * n + 1);
+  if (rgb == NULL)
+    return -1;
+  for (size_t j = 0; j < n; j++) {
+    rgb[3 * j] = bgra[4 * j + 2];
+    rgb[3 * j + 1] = bgra[4 * j + 1];
+    rgb[3 * j + 2] = bgra[4 * j];
+  }
+  int ret = save_rgb(func, filename, quality, rgb, w, h);
+  free(rgb);
+  return ret;
+}
+
+int wb_camera_save_image(WbDeviceTag tag, const char *filename, int quality) {
+  const char *func = "wb_camera_save_image";
+  CAMERA(func);
+  (void)quality; /* Webots checks it for JPEG only; this library writes PNG */
+  if (d == NULL)
+    return -1;
+  return save_bgra(func, filename, 0, d->imaging->image, d->imaging->width, d->imaging->height);
 }

@@ -6,6 +6,7 @@ import sys
 
 from sensorium.client import wb
 
+from .camera import Camera
 from .device import Device
 from .distance_sensor import DistanceSensor
 from .keyboard import Keyboard
@@ -24,6 +25,7 @@ _CLASSES: dict[str, type[Device]] = {
     wb.POSITION_SENSOR: PositionSensor,
     wb.LED: LED,
     wb.RANGE_FINDER: RangeFinder,
+    wb.CAMERA: Camera,
 }
 
 

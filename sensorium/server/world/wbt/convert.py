@@ -35,7 +35,7 @@ SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "I
            "ContactProperties", "Damping", "Muscle", "Propeller", "CadShape"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
 # the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
-OTHER_DEVICES = {"Camera", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
+OTHER_DEVICES = {"Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
                  "Compass", "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger",
                  "Connector", "Radar", "Altimeter", "VacuumGripper", "Radio", "Track", "Skin"}
 # Webots' default device names (the ``name`` field's default of each node)
@@ -43,7 +43,7 @@ OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "
                "VacuumGripper": "vacuum gripper", "LinearMotor": "linear motor", "GPS": "gps"}
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh"}
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
-SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder"}
+SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder", "Camera"}
 JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
 MOTORS = {"RotationalMotor", "LinearMotor"}
 
@@ -253,6 +253,10 @@ class Converter:
             if not top:
                 raise self.error(node, "WorldInfo must be a top-level node")
             self.world_info(node)
+        elif t == "Background" and top and f.has("skyColor"):     # what cameras see past everything
+            sky = f.rows("skyColor", 3, [(0.0, 0.0, 0.0)])
+            self.world["background"] = {"sky_color": list(sky[0]) if sky else [0.0, 0.0, 0.0]}
+            self.skipped[t] += 1     # its other fields (textures, luminosity) are not read
         elif t in SKIPPED:
             self.skipped[t] += 1
         elif t in OTHER_DEVICES:
