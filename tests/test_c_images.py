@@ -62,6 +62,7 @@ def test_camera_bytes_match_python(reader):
                           str(REPO / "tests" / "controllers" / "image_reader.py"), "camera", "3"], s.url("bot"))
     assert c_out == py_out
     assert c_out[0] == "# null_before 1" and c_out[-2] == "# exposure 2" and c_out[-1] == "# save -1"
-    first = bytes.fromhex(c_out[1].split("=")[1])
+    first = bytes.fromhex(c_out[1].split(" ")[2].split("=")[1])
     assert len(first) == 4 * 16 * 12 and len(set(first[2::4])) > 5      # a picture, not a flat colour
+    assert " objects=1 [4 ball " in c_out[1]                             # the ball: robots 1, solids 2.. in order
     assert "wb_camera_get_image() called for a disabled device" in c_err

@@ -32,7 +32,14 @@ from __future__ import annotations
 from sensorium.client import wb_camera, wb_motor, wb_robot, wb_sensors, wb_supervisor
 from sensorium.client.connection import SensoriumError  # noqa: F401
 from sensorium.client.wb_camera import *  # noqa: F403
-from sensorium.client.wb_camera import CAMERA, RANGE_FINDER, camera_bytes, range_finder_bytes  # noqa: F401
+from sensorium.client.wb_camera import (  # noqa: F401
+    CAMERA,
+    RANGE_FINDER,
+    camera_bytes,
+    range_finder_bytes,
+    recognition_objects,
+    segmentation_bytes,
+)
 from sensorium.client.wb_motor import *  # noqa: F403
 from sensorium.client.wb_robot import *  # noqa: F403
 from sensorium.client.wb_robot import (  # noqa: F401 - used by the controller classes and tests

@@ -23,7 +23,13 @@ __all__ = ["CAMERA", "camera_bytes", "wb_camera_enable", "wb_camera_disable", "w
            "wb_camera_get_fov", "wb_camera_get_min_fov", "wb_camera_get_max_fov", "wb_camera_set_fov",
            "wb_camera_get_exposure", "wb_camera_set_exposure", "wb_camera_get_focal_length",
            "wb_camera_get_focal_distance", "wb_camera_get_min_focal_distance", "wb_camera_get_max_focal_distance",
-           "wb_camera_set_focal_distance", "wb_camera_get_near", "wb_camera_save_image",
+           "wb_camera_set_focal_distance", "wb_camera_get_near", "wb_camera_save_image", "wb_camera_has_recognition",
+           "wb_camera_recognition_enable", "wb_camera_recognition_disable", "wb_camera_recognition_get_sampling_period",
+           "wb_camera_recognition_get_number_of_objects", "wb_camera_recognition_get_objects",
+           "wb_camera_recognition_has_segmentation", "wb_camera_recognition_enable_segmentation",
+           "wb_camera_recognition_disable_segmentation", "wb_camera_recognition_is_segmentation_enabled",
+           "wb_camera_recognition_get_segmentation_image", "wb_camera_recognition_save_segmentation_image",
+           "recognition_objects", "segmentation_bytes",
            "RANGE_FINDER", "wb_range_finder_enable", "wb_range_finder_disable", "wb_range_finder_get_sampling_period",
            "wb_range_finder_get_range_image", "wb_range_finder_image_get_depth", "wb_range_finder_get_width",
            "wb_range_finder_get_height", "wb_range_finder_get_fov", "wb_range_finder_get_min_range",
@@ -309,3 +315,122 @@ def wb_camera_save_image(tag: int, filename: str, quality: int) -> int:
     img = dev.camera.get("image")
     return save_bgra(func, filename, quality, _black(dev) if img is None else bytes(img),
                      int(dev.desc.get("width", 0)), int(dev.desc.get("height", 0)))
+
+
+# ---------------------------------------------------------------------- camera recognition
+
+def _rec(tag: int, func: str, need_enabled: bool = False) -> DeviceState | None:
+    """The camera, or None with Webots' error when it has no Recognition node (or, with
+    ``need_enabled``, when the recognition is disabled)."""
+    dev = _cam(tag, func)
+    if not dev.desc.get("has_recognition", False):
+        print(f"Error: {func}() called on a Camera without Recognition node.", file=sys.stderr)
+        return None
+    if need_enabled and int(dev.camera.get("recognition_period", dev.desc.get("recognition_sampling_period", 0))) <= 0:
+        print(f"Error: {func}() called for a disabled device! Please use: wb_camera_recognition_enable().", file=sys.stderr)
+        return None
+    return dev
+
+
+def wb_camera_has_recognition(tag: int) -> bool:
+    return bool(_cam(tag, "wb_camera_has_recognition").desc.get("has_recognition", False))
+
+
+def wb_camera_recognition_enable(tag: int, sampling_period: int) -> None:
+    func = "wb_camera_recognition_enable"
+    r = current()
+    dev = _rec(tag, func)
+    if dev is None:
+        return
+    if isinstance(sampling_period, bool) or not isinstance(sampling_period, int) or sampling_period < 0:
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer >= 0, got {sampling_period!r}")
+    if not r.terminated:
+        r._expect_success(r.rpc(dev, "recognition_enable", {"value": sampling_period}), func)
+    dev.camera["recognition_period"] = sampling_period
+    if sampling_period == 0:
+        dev.camera["segmentation_enabled"] = False
+
+
+def wb_camera_recognition_disable(tag: int) -> None:
+    if _rec(tag, "wb_camera_recognition_disable") is not None:
+        wb_camera_recognition_enable(tag, 0)
+
+
+def wb_camera_recognition_get_sampling_period(tag: int) -> int:
+    dev = _rec(tag, "wb_camera_recognition_get_sampling_period")
+    return 0 if dev is None else int(dev.camera.get("recognition_period", dev.desc.get("recognition_sampling_period", 0)))
+
+
+def recognition_objects(tag: int, func: str = "wb_camera_recognition_get_objects") -> list[dict] | None:
+    """The latest recognised objects as maps (PROTOCOL.md §3.6); None with Webots' error while the
+    recognition is disabled or the camera has none."""
+    dev = _rec(tag, func, need_enabled=True)
+    if dev is None:
+        return None
+    return list(dev.camera.get("recognition") or [])
+
+
+def wb_camera_recognition_get_number_of_objects(tag: int) -> int:
+    objs = recognition_objects(tag, "wb_camera_recognition_get_number_of_objects")
+    return 0 if objs is None else len(objs)
+
+
+def wb_camera_recognition_get_objects(tag: int) -> list[dict] | None:
+    return recognition_objects(tag)
+
+
+def wb_camera_recognition_has_segmentation(tag: int) -> bool:
+    return bool(_cam(tag, "wb_camera_recognition_has_segmentation").desc.get("has_segmentation", False))
+
+
+def _segmentation(tag: int, on: bool, func: str) -> None:
+    r = current()
+    dev = _rec(tag, func)
+    if dev is None:
+        return
+    if not dev.desc.get("has_segmentation", False):
+        print(f"Error: {func}() called on a Camera whose Recognition node has no segmentation.", file=sys.stderr)
+        return
+    if on and int(dev.camera.get("recognition_period", 0)) <= 0:
+        print(f"Error: {func}() called while the recognition is disabled! Please use: wb_camera_recognition_enable().",
+              file=sys.stderr)
+        return
+    if not r.terminated:
+        r._expect_success(r.rpc(dev, "enable_segmentation", {"value": bool(on)}), func)
+    dev.camera["segmentation_enabled"] = bool(on)
+
+
+def wb_camera_recognition_enable_segmentation(tag: int) -> None:
+    _segmentation(tag, True, "wb_camera_recognition_enable_segmentation")
+
+
+def wb_camera_recognition_disable_segmentation(tag: int) -> None:
+    _segmentation(tag, False, "wb_camera_recognition_disable_segmentation")
+
+
+def wb_camera_recognition_is_segmentation_enabled(tag: int) -> bool:
+    dev = _cam(tag, "wb_camera_recognition_is_segmentation_enabled")
+    return bool(dev.camera.get("segmentation_enabled", False))
+
+
+def segmentation_bytes(tag: int, func: str = "wb_camera_recognition_get_segmentation_image") -> bytes | None:
+    """The latest segmentation image (BGRA like the camera's); None with Webots' error unless the
+    segmentation is enabled."""
+    dev = _cam(tag, func)
+    if not dev.camera.get("segmentation_enabled", False):
+        print(f"Error: {func}() called while the segmentation is disabled! Please use: "
+              "wb_camera_recognition_enable_segmentation().", file=sys.stderr)
+        return None
+    img = dev.camera.get("segmentation_image")
+    return _black(dev) if img is None else bytes(img)
+
+
+def wb_camera_recognition_get_segmentation_image(tag: int) -> bytes | None:
+    return segmentation_bytes(tag)
+
+
+def wb_camera_recognition_save_segmentation_image(tag: int, filename: str, quality: int) -> int:
+    func = "wb_camera_recognition_save_segmentation_image"
+    dev = _cam(tag, func)
+    return save_bgra(func, filename, quality, segmentation_bytes(tag, func), int(dev.desc.get("width", 0)),
+                     int(dev.desc.get("height", 0)))

@@ -220,9 +220,12 @@ register(DeviceKind(
     description="RangeFinderDescription"))
 register(DeviceKind(
     "Camera", wm.Camera, "sensorium.server.sim.cameras:Camera",
-    services=(*_SENSOR, "set_exposure"),
+    services=(*_SENSOR, "set_exposure", "recognition_enable", "get_recognition_sampling_period",
+              "enable_segmentation", "is_segmentation_enabled", "get_recognition_objects"),
     topics=(TopicDecl("image", msgs.IMAGE, "image"),
-            TopicDecl("camera_info", msgs.CAMERA_INFO, "image", exists=lambda cfg, wi: cfg.projection == "planar")),
+            TopicDecl("camera_info", msgs.CAMERA_INFO, "image", exists=lambda cfg, wi: cfg.projection == "planar"),
+            TopicDecl("segmentation_image", msgs.IMAGE, "segmentation_image",
+                      exists=lambda cfg, wi: cfg.recognition is not None and cfg.recognition.segmentation)),
     rays=lambda cfg, lights: int(cfg.width) * int(cfg.height) * (4 if cfg.anti_aliasing else 1),
     ray_bound=("", "rays (width × height, × 4 anti-aliased):", "rays_per_image"),
     description="CameraDescription"))

@@ -329,6 +329,10 @@ class CameraDescription(_Entry):
     projection: str = Field(description="planar, cylindrical or spherical")
     anti_aliasing: bool
     noise: float
+    has_recognition: bool = Field(description="wb_camera_has_recognition: a Recognition node")
+    has_segmentation: bool = Field(description="wb_camera_recognition_has_segmentation")
+    recognition_sampling_period: int = Field(description="0 at attach")
+    segmentation_enabled: bool
 
 
 class MotorDescription(_Entry):
@@ -506,6 +510,23 @@ class StatusResult(Result):
     status: int
 
 
+class RecognitionObject(Result):
+    """One object a camera recognised (Webots' ``WbCameraRecognitionObject``)."""
+
+    id: int = Field(description="the object's node id (Supervisor ids: robots 1..R, then top-level solids)")
+    position: list[float] = Field(description="m: its box's centre in the camera frame (FLU)")
+    orientation: list[float] = Field(description="axis-angle of its rotation in the camera frame")
+    size: list[float] = Field(description="m: its box's extents along the camera's y and z")
+    position_on_image: list[int] = Field(description="pixel: its box's centre on the image")
+    size_on_image: list[int] = Field(description="pixels: width, height of its box on the image")
+    colors: list[float] = Field(description="its recognition colours, flat [r0, g0, b0, r1, ...]")
+    model: str
+
+
+class RecognitionObjectsResult(Result):
+    value: list[RecognitionObject]
+
+
 class LayerRangeImageResult(Result):
     image: Image
 
@@ -664,6 +685,11 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_quaternion", "device", NoArgs, FloatArrayValue),
     ServiceSpec("get_noise", "device", NoArgs, FloatValue),
     ServiceSpec("set_exposure", "device", ExposureArgs, SuccessResult, attached=True),
+    ServiceSpec("recognition_enable", "device", EnableArgs, SuccessResult, attached=True),
+    ServiceSpec("get_recognition_sampling_period", "device", NoArgs, IntValue),
+    ServiceSpec("enable_segmentation", "device", BoolArgs, SuccessResult, attached=True),
+    ServiceSpec("is_segmentation_enabled", "device", NoArgs, StatusResult),
+    ServiceSpec("get_recognition_objects", "device", NoArgs, RecognitionObjectsResult),
 )
 
 

@@ -283,6 +283,26 @@ class Solid(Strict):
     shapes: list[Part] = []
     children: list[Solid] = []
     lights: list[Light] = []
+    model: str = Field(default="", max_length=4096, description="Webots model (a recognised object's model)")
+    recognition_colors: list[Color] = Field(
+        default=[], max_length=1024, description="Webots recognitionColors: cameras with a Recognition node report "
+        "this solid (with its children); top-level solids only")
+
+    @field_validator("recognition_colors")
+    @classmethod
+    def _unit_colors(cls, v: list[Color]) -> list[Color]:
+        for c in v:
+            if min(c) < 0 or max(c) > 1:
+                raise ValueError("colour components must be within [0, 1]")
+        return v
+
+    @model_validator(mode="after")
+    def _recognised_at_the_top(self) -> Solid:
+        for i, child in enumerate(self.children):
+            if child.recognition_colors:
+                raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "
+                                 "and robots only (give them to the top-level solid)")
+        return self
 
 
 # ---------------------------------------------------------------- devices
@@ -591,6 +611,17 @@ class Robot(Strict):
     differential_drive: DifferentialDrive | None = None
     devices: list[Device] = Field(default=[], description="in Webots' tree order (the order of the device "
                                   "indices); every Webots device type is accepted, those not simulated as present")
+    recognition_colors: list[Color] = Field(
+        default=[], max_length=1024, description="Webots recognitionColors: other robots' cameras with a Recognition "
+        "node report this robot")
+
+    @field_validator("recognition_colors")
+    @classmethod
+    def _unit_colors(cls, v: list[Color]) -> list[Color]:
+        for c in v:
+            if min(c) < 0 or max(c) > 1:
+                raise ValueError("colour components must be within [0, 1]")
+        return v
 
 
 class WorldInfo(Strict):

@@ -23,6 +23,10 @@ int main(int argc, char **argv) {
   if (camera) {
     printf("# null_before %d\n", wb_camera_get_image(tag) == NULL); /* disabled: NULL + message */
     wb_camera_enable(tag, step);
+    if (wb_camera_has_recognition(tag)) {
+      wb_camera_recognition_enable(tag, step);
+      wb_camera_recognition_enable_segmentation(tag);
+    }
   } else
     wb_range_finder_enable(tag, step);
   int w = camera ? wb_camera_get_width(tag) : wb_range_finder_get_width(tag);
@@ -30,9 +34,30 @@ int main(int argc, char **argv) {
   for (int s = 0; s < steps; s++) {
     int status = wb_robot_step(step);
     printf("%.0f %d %s=", wb_robot_get_time() * 1000.0, status, argv[1]);
-    if (camera)
+    if (camera) {
       print_hex(wb_camera_get_image(tag), 4 * (size_t)w * (size_t)h);
-    else
+      if (wb_camera_has_recognition(tag)) {
+        printf(" seg=");
+        print_hex(wb_camera_recognition_get_segmentation_image(tag), 4 * (size_t)w * (size_t)h);
+        int n = wb_camera_recognition_get_number_of_objects(tag);
+        const WbCameraRecognitionObject *o = wb_camera_recognition_get_objects(tag);
+        printf(" objects=%d", n);
+        for (int i = 0; i < n; i++) {
+          printf(" [%d %s", o[i].id, o[i].model);
+          print_bits("p0", o[i].position[0]);
+          print_bits("p1", o[i].position[1]);
+          print_bits("p2", o[i].position[2]);
+          print_bits("a", o[i].orientation[3]);
+          print_bits("s0", o[i].size[0]);
+          print_bits("s1", o[i].size[1]);
+          printf(" %d %d %d %d %d", o[i].position_on_image[0], o[i].position_on_image[1], o[i].size_on_image[0],
+                 o[i].size_on_image[1], o[i].number_of_colors);
+          for (int k = 0; k < 3 * o[i].number_of_colors; k++)
+            print_bits("c", o[i].colors[k]);
+          printf("]");
+        }
+      }
+    } else
       print_hex(wb_range_finder_get_range_image(tag), 4 * (size_t)w * (size_t)h);
     printf("\n");
     if (status == -1)

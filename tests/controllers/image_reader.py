@@ -1,8 +1,14 @@
 """The twin of tests/c/image_reader.c: the same lines from the Python client."""
 
+import struct
 import sys
 
 from sensorium.client import wb
+
+
+def bits(v: float) -> str:
+    return f"{struct.unpack('<Q', struct.pack('<d', v))[0]:016x}"
+
 
 wb.wb_robot_init()
 name, steps = sys.argv[1], int(sys.argv[2])
@@ -12,6 +18,9 @@ camera = wb.wb_device_get_type_name(tag) == "Camera"
 if camera:
     print(f"# null_before {int(wb.wb_camera_get_image(tag) is None)}")
     wb.wb_camera_enable(tag, step)
+    if wb.wb_camera_has_recognition(tag):
+        wb.wb_camera_recognition_enable(tag, step)
+        wb.wb_camera_recognition_enable_segmentation(tag)
     w, h = wb.wb_camera_get_width(tag), wb.wb_camera_get_height(tag)
 else:
     wb.wb_range_finder_enable(tag, step)
@@ -19,7 +28,18 @@ else:
 for _ in range(steps):
     status = wb.wb_robot_step(step)
     data = wb.camera_bytes(tag) if camera else wb.range_finder_bytes(tag)
-    print(f"{round(wb.wb_robot_get_time() * 1000)} {status} {name}={data.hex()}")
+    line = f"{round(wb.wb_robot_get_time() * 1000)} {status} {name}={data.hex()}"
+    if camera and wb.wb_camera_has_recognition(tag):
+        objs = wb.wb_camera_recognition_get_objects(tag)
+        line += f" seg={wb.wb_camera_recognition_get_segmentation_image(tag).hex()} objects={len(objs)}"
+        for o in objs:
+            line += f" [{o['id']} {o['model']}"
+            for key, v in (("p0", o["position"][0]), ("p1", o["position"][1]), ("p2", o["position"][2]),
+                           ("a", o["orientation"][3]), ("s0", o["size"][0]), ("s1", o["size"][1])):
+                line += f" {key}={bits(v)}"
+            line += " " + " ".join(map(str, [*o["position_on_image"], *o["size_on_image"], len(o["colors"]) // 3]))
+            line += "".join(f" c={bits(c)}" for c in o["colors"]) + "]"
+    print(line)
     if status == -1:
         break
 if camera:

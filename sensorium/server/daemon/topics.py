@@ -350,6 +350,9 @@ class Topics:
     def release_robot(self, robot: str) -> None:
         """The robot's controller left (detached or dropped): forget its requests."""
         for ctl in self.controls.values():
+            released = getattr(ctl.device, "controller_released", None)   # a camera's recognition
+            if ctl.robot == robot and released is not None:
+                released()
             if ctl.robot == robot and (ctl.controller_period or ctl.controller_point_cloud):
                 had = ctl.controller_period
                 ctl.controller_period = 0

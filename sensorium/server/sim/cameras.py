@@ -18,7 +18,8 @@ import numpy as np
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import RayKind
-from sensorium.server.sim.sensors import Device
+from sensorium.server.sim.sensors import Device, Schedule
+from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info"]
@@ -178,6 +179,16 @@ class Camera(Device):
         self._background = np.zeros(3)
         self._lights: tuple[int, light_math.LightArrays, np.ndarray] | None = None
         self._bytes: tuple[int, bytes] = (-1, b"")
+        # recognition (Webots' Recognition node): its own period, objects, segmentation image
+        self.recognition_schedule = Schedule()
+        self.segmentation_enabled = False
+        self.objects: list[Any] = []
+        self.segmentation_image = np.zeros((c.height, c.width, 4), dtype=np.uint8)
+        self.segmentation_image[:, :, 3] = 255
+        self._recognizer: Any = None
+        self._centre_rays: MountedRays | None = None
+        self._image_at = self._segmentation_at = -1      # the measurement that made the latest of each
+        self._seg_bytes: tuple[int, bytes] = (-1, b"")
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
@@ -187,9 +198,35 @@ class Camera(Device):
     # -- controller API
     def describe(self) -> dict:
         c = self.config
+        rc = c.recognition
         return {"width": int(c.width), "height": int(c.height), "fov": float(c.field_of_view), "near": float(c.near),
                 "far": float(c.far), "exposure": float(self.exposure), "projection": c.projection,
-                "anti_aliasing": bool(c.anti_aliasing), "noise": float(c.noise)}
+                "anti_aliasing": bool(c.anti_aliasing), "noise": float(c.noise),
+                "has_recognition": rc is not None, "has_segmentation": bool(rc is not None and rc.segmentation),
+                "recognition_sampling_period": int(self.recognition_schedule.period_ms),
+                "segmentation_enabled": bool(self.segmentation_enabled)}
+
+    # -- recognition (controller API)
+    def recognition_enable(self, period_ms: int) -> None:
+        """Webots' ``wb_camera_recognition_enable`` (0 disables it, and the segmentation with it)."""
+        if self.config.recognition is None:
+            raise ValueError("this camera has no Recognition node")
+        self.recognition_schedule.enable(_period(period_ms), self.clock())
+        if period_ms == 0:
+            self.segmentation_enabled = False
+
+    def controller_released(self) -> None:
+        """The robot's controller left: its recognition requests end with it."""
+        self.recognition_schedule.enable(0, self.clock())
+        self.segmentation_enabled = False
+
+    def enable_segmentation(self, on: bool) -> None:
+        rc = self.config.recognition
+        if on and (rc is None or not rc.segmentation):
+            raise ValueError("this camera's Recognition node has no segmentation (segmentation: true)")
+        if on and self.recognition_schedule.period_ms <= 0:
+            raise ValueError("the segmentation needs the recognition enabled first (recognition_enable)")
+        self.segmentation_enabled = bool(on)
 
     def set_exposure(self, exposure: float) -> None:
         if not (isinstance(exposure, (int, float)) and math.isfinite(exposure) and exposure >= 0.0):
@@ -201,16 +238,35 @@ class Camera(Device):
 
     def image_bytes(self) -> bytes:
         """The BGRA bytes of the latest image, made once per image (topics and step replies share them)."""
-        if self._bytes[0] != self.measurements:
-            self._bytes = (self.measurements, self.image.tobytes())
+        if self._bytes[0] != self._image_at:
+            self._bytes = (self._image_at, self.image.tobytes())
         return self._bytes[1]
 
+    def segmentation_bytes(self) -> bytes:
+        if self._seg_bytes[0] != self._segmentation_at:
+            self._seg_bytes = (self._segmentation_at, self.segmentation_image.tobytes())
+        return self._seg_bytes[1]
+
     def step_reading(self) -> dict:
-        return {"image": self.image_bytes()}
+        out: dict[str, Any] = {}
+        if self.schedule.period_ms > 0:
+            out["image"] = self.image_bytes()
+        if self.recognition_schedule.period_ms > 0:
+            out["recognition"] = [o.as_dict() for o in self.objects]
+            if self.segmentation_enabled:
+                out["segmentation_image"] = self.segmentation_bytes()
+        return out
 
     def image_data(self, reading: str) -> tuple[int, int, str, bytes] | None:
-        """(height, width, encoding, bytes) of the image a topic publishes (``sensor_msgs/Image``)."""
+        """(height, width, encoding, bytes) of an image a topic publishes (``sensor_msgs/Image``), or
+        None when the latest measurement did not make it (a recognition-only one, say)."""
         c = self.config
+        if reading == "segmentation_image":
+            if self._segmentation_at != self.measurements:
+                return None
+            return int(c.height), int(c.width), "bgra8", self.segmentation_bytes()
+        if self._image_at != self.measurements:
+            return None
         return int(c.height), int(c.width), "bgra8", self.image_bytes()
 
     def camera_info(self) -> dict:
@@ -218,7 +274,7 @@ class Camera(Device):
 
     # -- measurement
     def due(self, now_ms: int) -> bool:
-        return self.schedule.due(now_ms)
+        return self.schedule.due(now_ms) or self.recognition_schedule.due(now_ms)
 
     def _prepare(self) -> MountedRays:
         if self._rays is None:
@@ -237,8 +293,52 @@ class Camera(Device):
         return self._lights[1], self._lights[2]
 
     def capture(self, now_ms: int, counters: Any) -> None:
-        rays = self._prepare()
         pose: Pose = self.world_pose(self._robot.pose)
+        if self.schedule.due(now_ms):
+            self._capture_image(pose, counters)
+            self.schedule.last_update_ms = now_ms
+            self._image_at = self.measurements + 1
+        if self.recognition_schedule.due(now_ms):
+            self._recognise(pose, counters)
+            self.recognition_schedule.last_update_ms = now_ms
+        self._mark(now_ms)
+
+    def _recognise(self, pose: Pose, counters: Any) -> None:
+        from sensorium.server.sim.recognition import Recognizer
+
+        rc = self.config.recognition
+        assert rc is not None
+        if self._recognizer is None:
+            self._recognizer = Recognizer(self._scene, self.robot_index, rc, self.geometry)
+        rec = self._recognizer
+        pixels = None
+        if rc.occlusion == 2 or self.segmentation_enabled:
+            pixels = self._pixel_objects(pose, rec, counters)
+        self.objects = rec.recognise(pose, pixels, counters)
+        if self.segmentation_enabled and pixels is not None:
+            c = self.config
+            self.segmentation_image = rec.segmentation(pixels, c.height, c.width)
+            self._segmentation_at = self.measurements + 1
+
+    def _pixel_objects(self, pose: Pose, rec: Any, counters: Any) -> np.ndarray:
+        """The recognisable object (index, -1 none) each pixel centre's ray sees within max_range."""
+        c = self.config
+        if self._centre_rays is None:
+            dirs = imaging.pixel_directions(self.geometry)[0]
+            self._centre_factors = imaging.depth_factors(self.geometry, dirs)
+            rng = float(c.recognition.max_range) if c.recognition is not None else math.inf
+            self._centre_limits = imaging.clip_limits(self.geometry, self._centre_factors, c.near, rng)
+            self._centre_rays = MountedRays(dirs)
+        dirs, dirs32 = self._centre_rays.at(pose.rotation)
+        t_near, t_far = self._centre_limits
+        hits = self._scene.engine.cast(np.broadcast_to(pose.translation, dirs.shape), dirs, t_near, t_far,
+                                       kind=RayKind.VISUAL, exclude_owner=-1, directions32=dirs32)
+        counters["rays_camera"] += len(dirs)
+        counters["cast_calls"] += 1
+        return np.where(np.isfinite(hits.distance), rec.key_of[hits.shape], -1)
+
+    def _capture_image(self, pose: Pose, counters: Any) -> None:
+        rays = self._prepare()
         dirs, dirs32 = rays.at(pose.rotation)
         L = self._render(pose.translation, dirs, dirs32, counters)
         c = self.config
@@ -250,8 +350,6 @@ class Camera(Device):
         image = np.empty((c.height, c.width, 4), dtype=np.uint8)
         image[:, :, 0], image[:, :, 1], image[:, :, 2], image[:, :, 3] = rgb[:, :, 2], rgb[:, :, 1], rgb[:, :, 0], 255
         self.image = image
-        self.schedule.last_update_ms = now_ms
-        self._mark(now_ms)
 
     def _render(self, origin: np.ndarray, dirs: np.ndarray, dirs32: np.ndarray, counters: Any) -> np.ndarray:
         """The radiance (N, 3) along every ray: the surfaces it crosses composited front to back

@@ -163,6 +163,17 @@ class Scene:
         self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
         self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
         self.background = np.asarray(world.background.sky_color, dtype=np.float64)   # what cameras see past everything
+        self.base_dir = Path(base_dir)
+        # what cameras with a Recognition node report: owner (robot index, solid name) -> (the Supervisor's
+        # node id: robots 1..R in world order, then the top-level solids; recognition colours; model)
+        self.recognisable: dict[str | int, tuple[int, list, str]] = {}
+        for i, r in enumerate(world.robots):
+            if r.recognition_colors:
+                self.recognisable[i] = (i + 1, [tuple(c) for c in r.recognition_colors], r.model)
+        for j, sd in enumerate(world.solids):
+            if sd.recognition_colors:
+                self.recognisable[sd.name] = (len(world.robots) + 1 + j, [tuple(c) for c in sd.recognition_colors],
+                                              sd.model)
 
     def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool,
                   key: str | int | None = None) -> int:
@@ -239,6 +250,10 @@ class Scene:
     def part(self, shape: int) -> tuple[str | int | None, Pose, wm.Shape | wm.Solid]:
         """A shape's owner (solid name, robot index), its frame in the owner and its model."""
         return self._parts[shape]
+
+    def owner_pose(self, key: str | int) -> Pose:
+        """The pose of a shape owner: a robot (index) or a top-level solid (name)."""
+        return self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
 
     def surface_colors(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                        distance: np.ndarray) -> np.ndarray:

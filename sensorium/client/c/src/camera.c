@@ -2,6 +2,7 @@
  * per-device buffers filled at each step from the step reply (PROTOCOL.md 3.6; zeros before the
  * first image, Webots' black for a camera), so the pointers handed out stay valid until
  * wb_robot_cleanup(). Written from Webots' documented signatures and behaviour. */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,6 +21,12 @@ struct sn_imaging {
   unsigned char *image;  /* camera: BGRA, height rows of 4 * width bytes */
   double exposure;
   bool planar;
+  /* camera recognition */
+  bool has_recognition, has_segmentation, segmentation_enabled;
+  int recognition_period;
+  WbCameraRecognitionObject *objects;
+  int n_objects;
+  unsigned char *segmentation; /* BGRA like the image */
 };
 
 #define PI 3.14159265358979323846
@@ -47,13 +54,85 @@ int sn_imaging_describe(sn_device *d, const msgpack_object *desc) {
   size_t n = (size_t)im->width * (size_t)im->height;
   if (d->kind == SN_RANGE_FINDER)
     return (im->range = calloc(n, sizeof(float))) == NULL ? -1 : 0;
-  if ((im->image = malloc(4 * n)) == NULL)
+  im->has_recognition = sn_bool_or(desc, "has_recognition", false);
+  im->has_segmentation = sn_bool_or(desc, "has_segmentation", false);
+  if ((im->image = malloc(4 * n)) == NULL || (im->segmentation = malloc(4 * n)) == NULL)
     return -1;
   for (size_t j = 0; j < n; j++) { /* Webots' black before the first image: 0xFF000000 */
     im->image[4 * j] = im->image[4 * j + 1] = im->image[4 * j + 2] = 0;
     im->image[4 * j + 3] = 255;
   }
+  memcpy(im->segmentation, im->image, 4 * n);
   return 0;
+}
+
+static void free_objects(struct sn_imaging *im) {
+  for (int i = 0; i < im->n_objects; i++) {
+    free(im->objects[i].colors);
+    free(im->objects[i].model);
+  }
+  free(im->objects);
+  im->objects = NULL;
+  im->n_objects = 0;
+}
+
+static void read_doubles(const msgpack_object *arr, double *out, int n) {
+  for (int i = 0; i < n; i++)
+    out[i] = NAN;
+  if (arr == NULL || arr->type != MSGPACK_OBJECT_ARRAY)
+    return;
+  for (uint32_t i = 0; i < arr->via.array.size && (int)i < n; i++)
+    if (!sn_as_double(&arr->via.array.ptr[i], &out[i]))
+      out[i] = NAN;
+}
+
+static void read_ints(const msgpack_object *arr, int *out, int n) {
+  for (int i = 0; i < n; i++)
+    out[i] = 0;
+  if (arr == NULL || arr->type != MSGPACK_OBJECT_ARRAY)
+    return;
+  for (uint32_t i = 0; i < arr->via.array.size && (int)i < n; i++) {
+    int64_t v;
+    if (sn_as_int64(&arr->via.array.ptr[i], &v))
+      out[i] = (int)v;
+  }
+}
+
+/* the step reply's "recognition": a list of object maps (PROTOCOL.md 3.6) */
+static void read_objects(sn_device *d, const msgpack_object *list) {
+  struct sn_imaging *im = d->imaging;
+  if (list->type != MSGPACK_OBJECT_ARRAY || list->via.array.size > (1u << 20)) {
+    fprintf(stderr, "Warning: camera '%s': recognition objects that are not a list: ignored\n", d->name);
+    return;
+  }
+  free_objects(im);
+  uint32_t n = list->via.array.size;
+  if (n == 0)
+    return;
+  if ((im->objects = calloc(n, sizeof *im->objects)) == NULL)
+    return;
+  for (uint32_t i = 0; i < n; i++) {
+    const msgpack_object *o = &list->via.array.ptr[i];
+    WbCameraRecognitionObject *r = &im->objects[im->n_objects];
+    if (o->type != MSGPACK_OBJECT_MAP)
+      continue;
+    r->id = (int)sn_int_or(o, "id", 0);
+    read_doubles(sn_get(o, "position"), r->position, 3);
+    read_doubles(sn_get(o, "orientation"), r->orientation, 4);
+    read_doubles(sn_get(o, "size"), r->size, 2);
+    read_ints(sn_get(o, "position_on_image"), r->position_on_image, 2);
+    read_ints(sn_get(o, "size_on_image"), r->size_on_image, 2);
+    const msgpack_object *colors = sn_get(o, "colors");
+    int nc = colors && colors->type == MSGPACK_OBJECT_ARRAY ? (int)(colors->via.array.size / 3) : 0;
+    r->number_of_colors = nc;
+    r->colors = calloc(nc > 0 ? 3 * (size_t)nc : 1, sizeof(double));
+    if (r->colors != NULL && nc > 0)
+      read_doubles(colors, r->colors, 3 * nc);
+    r->model = sn_strdup_obj(sn_get(o, "model"));
+    if (r->model == NULL)
+      r->model = strdup("");
+    im->n_objects++;
+  }
 }
 
 void sn_imaging_free(sn_device *d) {
@@ -61,6 +140,8 @@ void sn_imaging_free(sn_device *d) {
     return;
   free(d->imaging->range);
   free(d->imaging->image);
+  free(d->imaging->segmentation);
+  free_objects(d->imaging);
   free(d->imaging);
   d->imaging = NULL;
 }
@@ -84,6 +165,12 @@ void sn_imaging_apply(sn_device *d, const msgpack_object *reading) {
     else if (bgra != NULL)
       fprintf(stderr, "Warning: camera '%s': image of %u bytes, expected %zu: ignored\n", d->name,
               bgra->type == MSGPACK_OBJECT_BIN ? bgra->via.bin.size : 0u, 4 * n);
+    const msgpack_object *seg = sn_get(reading, "segmentation_image");
+    if (seg != NULL && seg->type == MSGPACK_OBJECT_BIN && seg->via.bin.size == 4 * n)
+      memcpy(im->segmentation, seg->via.bin.ptr, 4 * n);
+    const msgpack_object *objs = sn_get(reading, "recognition");
+    if (objs != NULL)
+      read_objects(d, objs);
     return;
   }
   const msgpack_object *img = sn_get(reading, "range_image");
@@ -437,4 +524,135 @@ int wb_camera_save_image(WbDeviceTag tag, const char *filename, int quality) {
   if (d == NULL)
     return -1;
   return save_bgra(func, filename, 0, d->imaging->image, d->imaging->width, d->imaging->height);
+}
+
+/* ------------------------------------------------------------------ Camera recognition */
+
+/* the camera, or NULL with Webots' error if it has no Recognition node */
+static sn_device *recognition(WbDeviceTag tag, const char *func) {
+  sn_device *d = sn_device_get(tag, SN_CAMERA, func);
+  if (d != NULL && !d->imaging->has_recognition) {
+    fprintf(stderr, "Error: %s() called on a Camera without Recognition node.\n", func);
+    return NULL;
+  }
+  return d;
+}
+
+bool wb_camera_has_recognition(WbDeviceTag tag) {
+  CAMERA("wb_camera_has_recognition");
+  return d ? d->imaging->has_recognition : false;
+}
+
+void wb_camera_recognition_enable(WbDeviceTag tag, int sampling_period) {
+  const char *func = "wb_camera_recognition_enable";
+  if (sampling_period < 0) {
+    fprintf(stderr, "Error: %s() called with negative sampling period.\n", func);
+    return;
+  }
+  sn_device *d = recognition(tag, func);
+  if (d == NULL)
+    return;
+  sn_robot *rb = sn_robot_get(func);
+  if (!rb->terminated) {
+    sn_reply rep;
+    if (sn_device_call(rb, d, "recognition_enable", sn_arg_int, &sampling_period, func, &rep) != 0)
+      return;
+    sn_reply_free(&rep);
+  }
+  d->imaging->recognition_period = sampling_period;
+  if (sampling_period == 0)
+    d->imaging->segmentation_enabled = false;
+}
+
+void wb_camera_recognition_disable(WbDeviceTag tag) {
+  if (recognition(tag, "wb_camera_recognition_disable") != NULL)
+    wb_camera_recognition_enable(tag, 0);
+}
+
+int wb_camera_recognition_get_sampling_period(WbDeviceTag tag) {
+  sn_device *d = recognition(tag, "wb_camera_recognition_get_sampling_period");
+  return d ? d->imaging->recognition_period : 0;
+}
+
+static sn_device *recognition_enabled(WbDeviceTag tag, const char *func) {
+  sn_device *d = recognition(tag, func);
+  if (d != NULL && d->imaging->recognition_period <= 0) {
+    fprintf(stderr, "Error: %s() called for a disabled device! Please use: wb_camera_recognition_enable().\n", func);
+    return NULL;
+  }
+  return d;
+}
+
+int wb_camera_recognition_get_number_of_objects(WbDeviceTag tag) {
+  sn_device *d = recognition_enabled(tag, "wb_camera_recognition_get_number_of_objects");
+  return d ? d->imaging->n_objects : 0;
+}
+
+const WbCameraRecognitionObject *wb_camera_recognition_get_objects(WbDeviceTag tag) {
+  sn_device *d = recognition_enabled(tag, "wb_camera_recognition_get_objects");
+  return d ? d->imaging->objects : NULL;
+}
+
+bool wb_camera_recognition_has_segmentation(WbDeviceTag tag) {
+  CAMERA("wb_camera_recognition_has_segmentation");
+  return d ? d->imaging->has_segmentation : false;
+}
+
+static void segmentation(WbDeviceTag tag, bool on, const char *func) {
+  sn_device *d = recognition(tag, func);
+  if (d == NULL)
+    return;
+  if (!d->imaging->has_segmentation) {
+    fprintf(stderr, "Error: %s() called on a Camera whose Recognition node has no segmentation.\n", func);
+    return;
+  }
+  if (on && d->imaging->recognition_period <= 0) {
+    fprintf(stderr, "Error: %s() called while the recognition is disabled! Please use: wb_camera_recognition_enable().\n",
+            func);
+    return;
+  }
+  sn_robot *rb = sn_robot_get(func);
+  if (!rb->terminated) {
+    sn_reply rep;
+    if (sn_device_call(rb, d, "enable_segmentation", sn_arg_bool, &on, func, &rep) != 0)
+      return;
+    sn_reply_free(&rep);
+  }
+  d->imaging->segmentation_enabled = on;
+}
+
+void wb_camera_recognition_enable_segmentation(WbDeviceTag tag) {
+  segmentation(tag, true, "wb_camera_recognition_enable_segmentation");
+}
+
+void wb_camera_recognition_disable_segmentation(WbDeviceTag tag) {
+  segmentation(tag, false, "wb_camera_recognition_disable_segmentation");
+}
+
+bool wb_camera_recognition_is_segmentation_enabled(WbDeviceTag tag) {
+  CAMERA("wb_camera_recognition_is_segmentation_enabled");
+  return d ? d->imaging->segmentation_enabled : false;
+}
+
+const unsigned char *wb_camera_recognition_get_segmentation_image(WbDeviceTag tag) {
+  const char *func = "wb_camera_recognition_get_segmentation_image";
+  CAMERA(func);
+  if (d == NULL)
+    return NULL;
+  if (!d->imaging->segmentation_enabled) {
+    fprintf(stderr, "Error: %s() called while the segmentation is disabled! Please use: "
+                    "wb_camera_recognition_enable_segmentation().\n", func);
+    return NULL;
+  }
+  return d->imaging->segmentation;
+}
+
+int wb_camera_recognition_save_segmentation_image(WbDeviceTag tag, const char *filename, int quality) {
+  const char *func = "wb_camera_recognition_save_segmentation_image";
+  (void)quality;
+  const unsigned char *img = wb_camera_recognition_get_segmentation_image(tag);
+  if (img == NULL)
+    return -1;
+  sn_device *d = sn_device_get(tag, SN_CAMERA, func);
+  return save_bgra(func, filename, 0, img, d->imaging->width, d->imaging->height);
 }

@@ -7,7 +7,6 @@
 #include <webots/accelerometer.h>
 #include <webots/altimeter.h>
 #include <webots/brake.h>
-#include <webots/camera.h>
 #include <webots/compass.h>
 #include <webots/connector.h>
 #include <webots/display.h>
@@ -93,66 +92,6 @@ WbDeviceTag wb_brake_get_motor(WbDeviceTag tag) {
 
 WbDeviceTag wb_brake_get_position_sensor(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_get_position_sensor");
-  return 0;
-}
-
-/* ------------------------------------------------------------------ Camera */
-bool wb_camera_has_recognition(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_has_recognition");
-  return false;
-}
-
-void wb_camera_recognition_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_enable");
-}
-
-void wb_camera_recognition_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_disable");
-}
-
-int wb_camera_recognition_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_sampling_period");
-  return 0;
-}
-
-int wb_camera_recognition_get_number_of_objects(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_number_of_objects");
-  return 0;
-}
-
-const WbCameraRecognitionObject *wb_camera_recognition_get_objects(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_objects");
-  return NULL;
-}
-
-bool wb_camera_recognition_has_segmentation(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_has_segmentation");
-  return false;
-}
-
-void wb_camera_recognition_enable_segmentation(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_enable_segmentation");
-}
-
-void wb_camera_recognition_disable_segmentation(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_disable_segmentation");
-}
-
-bool wb_camera_recognition_is_segmentation_enabled(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_is_segmentation_enabled");
-  return false;
-}
-
-const unsigned char *wb_camera_recognition_get_segmentation_image(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_segmentation_image");
-  return NULL;
-}
-
-int wb_camera_recognition_save_segmentation_image(WbDeviceTag tag, const char *filename, int quality) {
-  (void)filename;
-  (void)quality;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_save_segmentation_image");
   return 0;
 }
 

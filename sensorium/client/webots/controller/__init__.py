@@ -5,7 +5,7 @@ the path. State lives in :mod:`sensorium.client.wb`, so importing this package u
 
 from sensorium.client.connection import SensoriumError
 
-from .camera import Camera
+from .camera import Camera, CameraRecognitionObject
 from .device import Device, Sensor
 from .distance_sensor import DistanceSensor
 from .keyboard import Keyboard
@@ -18,5 +18,5 @@ from .range_finder import RangeFinder
 from .robot import Robot
 from .supervisor import Field, Node, Supervisor
 
-__all__ = ["LED", "Camera", "Device", "DistanceSensor", "Field", "Keyboard", "Lidar", "LidarPoint", "LightSensor", "Motor",
+__all__ = ["LED", "Camera", "CameraRecognitionObject", "Device", "DistanceSensor", "Field", "Keyboard", "Lidar", "LidarPoint", "LightSensor", "Motor",
            "Node", "PositionSensor", "RangeFinder", "Robot", "RotationalMotor", "Sensor", "SensoriumError", "Supervisor"]

@@ -9,6 +9,55 @@ from sensorium.client import wb
 from .device import Sensor
 
 
+class CameraRecognitionObject:
+    """One object a camera recognised (Webots' class; fields as ``WbCameraRecognitionObject``)."""
+
+    __slots__ = ("id", "position", "orientation", "size", "position_on_image", "size_on_image",
+                 "number_of_colors", "colors", "model")
+
+    def __init__(self, data: dict):
+        self.id = int(data.get("id", 0))
+        self.position = [float(v) for v in data.get("position", ())]
+        self.orientation = [float(v) for v in data.get("orientation", ())]
+        self.size = [float(v) for v in data.get("size", ())]
+        self.position_on_image = [int(v) for v in data.get("position_on_image", ())]
+        self.size_on_image = [int(v) for v in data.get("size_on_image", ())]
+        self.colors = [float(v) for v in data.get("colors", ())]
+        self.number_of_colors = len(self.colors) // 3
+        self.model = str(data.get("model", ""))
+
+    def getId(self) -> int:
+        return self.id
+
+    def getPosition(self) -> list[float]:
+        return self.position
+
+    def getOrientation(self) -> list[float]:
+        return self.orientation
+
+    def getSize(self) -> list[float]:
+        return self.size
+
+    def getPositionOnImage(self) -> list[int]:
+        return self.position_on_image
+
+    def getSizeOnImage(self) -> list[int]:
+        return self.size_on_image
+
+    def getNumberOfColors(self) -> int:
+        return self.number_of_colors
+
+    def getColors(self) -> list[float]:
+        return self.colors
+
+    def getModel(self) -> str:
+        return self.model
+
+    def __repr__(self) -> str:
+        return (f"CameraRecognitionObject(id={self.id}, model={self.model!r}, position={self.position}, "
+                f"position_on_image={self.position_on_image}, size_on_image={self.size_on_image})")
+
+
 class Camera(Sensor):
     _enable = staticmethod(wb.wb_camera_enable)
     _get_sampling_period = staticmethod(wb.wb_camera_get_sampling_period)
@@ -93,8 +142,55 @@ class Camera(Sensor):
     def getNear(self) -> float:
         return wb.wb_camera_get_near(self._tag)
 
+    # -- recognition
+    def hasRecognition(self) -> bool:
+        return wb.wb_camera_has_recognition(self._tag)
+
+    def recognitionEnable(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
+        wb.wb_camera_recognition_enable(self._tag, samplingPeriod)
+
+    def recognitionDisable(self) -> None:
+        wb.wb_camera_recognition_disable(self._tag)
+
+    def getRecognitionSamplingPeriod(self) -> int:
+        return wb.wb_camera_recognition_get_sampling_period(self._tag)
+
+    def getRecognitionNumberOfObjects(self) -> int:
+        return wb.wb_camera_recognition_get_number_of_objects(self._tag)
+
+    def getRecognitionObjects(self) -> list[CameraRecognitionObject]:
+        objs = wb.recognition_objects(self._tag, "getRecognitionObjects")
+        return [] if objs is None else [CameraRecognitionObject(o) for o in objs]
+
+    def hasRecognitionSegmentation(self) -> bool:
+        return wb.wb_camera_recognition_has_segmentation(self._tag)
+
+    def enableRecognitionSegmentation(self) -> None:
+        wb.wb_camera_recognition_enable_segmentation(self._tag)
+
+    def disableRecognitionSegmentation(self) -> None:
+        wb.wb_camera_recognition_disable_segmentation(self._tag)
+
+    def isRecognitionSegmentationEnabled(self) -> bool:
+        return wb.wb_camera_recognition_is_segmentation_enabled(self._tag)
+
+    def getRecognitionSegmentationImage(self) -> bytes | None:
+        return wb.segmentation_bytes(self._tag, "getRecognitionSegmentationImage")
+
+    def getRecognitionSegmentationImageArray(self) -> list[list[list[int]]] | None:
+        img = self.getRecognitionSegmentationImage()
+        if img is None:
+            return None
+        w, h = self.getWidth(), self.getHeight()
+        return [[[img[4 * (y * w + x) + 2], img[4 * (y * w + x) + 1], img[4 * (y * w + x)]] for y in range(h)]
+                for x in range(w)]
+
+    def saveRecognitionSegmentationImage(self, filename: str, quality: int) -> int:
+        return wb.wb_camera_recognition_save_segmentation_image(self._tag, filename, quality)
+
     # Webots' properties
     image = property(getImage)
+    segmentation_image = property(getRecognitionSegmentationImage)
     width = property(getWidth)
     height = property(getHeight)
     fov = property(getFov, setFov)

@@ -499,6 +499,14 @@ class Converter:
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
             self.def_name(node, data)
+            colors = f.rows("recognitionColors", 3, [])        # what cameras with a Recognition node report
+            if colors:
+                data["recognition_colors"] = [list(c) for c in colors]
+            if f.string("model", ""):
+                data["model"] = f.string("model", "")
+        elif f.has("recognitionColors") and f.rows("recognitionColors", 3, []):
+            self.warn(node, f"Solid {name!r}: recognitionColors of a nested solid are not read (give them to the "
+                            "top-level solid); ignored")
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
@@ -547,6 +555,9 @@ class Converter:
                     data[key] = value
             elif value != defaults[key]:
                 self.warn(node, f"Robot field {key}: not supported by this version; ignored")
+        colors = f.rows("recognitionColors", 3, [])
+        if colors:
+            data["recognition_colors"] = [list(c) for c in colors]
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.solid_contents(node, Frame.identity(), mine)
