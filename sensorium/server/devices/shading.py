@@ -22,6 +22,8 @@ Webots' ``hdr_resolve``: ``v = (1 − exp(−L·exposure))^(1/2.2)``; then ``noi
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .light import LightArrays, LightKind
@@ -59,32 +61,54 @@ def radiance(points: np.ndarray, normals: np.ndarray, albedo: np.ndarray, lights
     with np.errstate(divide="ignore", invalid="ignore"):
         for j in range(len(lights)):
             kind = int(lights.kind[j])
-            if kind == LightKind.DIRECTIONAL:
-                vx, vy, vz = (np.full(S, -float(c)) for c in lights.direction[j])
-                length = np.ones(S)
-                att: np.ndarray | float = 1.0
+            intensity, ambient = float(lights.intensity[j]), float(lights.ambient_intensity[j])
+            if kind == LightKind.DIRECTIONAL:          # L = -direction (unit), att = 1
+                dx, dy, dz = (-float(c) for c in lights.direction[j])
+                c = nx * dx
+                c += ny * dy
+                c += nz * dz
+                direct = np.maximum(c, 0.0)
+                direct *= intensity
+                att: np.ndarray | None = None
+                length = None
             else:
                 qx, qy, qz = (float(c) for c in lights.position[j])
                 vx, vy, vz = qx - px, qy - py, qz - pz
                 length = np.sqrt(vx * vx + vy * vy + vz * vz)
                 a1, a2, a3 = (float(c) for c in lights.attenuation[j])
-                att = 1.0 / (a1 + a2 * length + a3 * length * length)
-            safe = np.where(length > 0.0, length, 1.0)
-            c = (nx * vx + ny * vy + nz * vz) / safe
-            direct = np.where(c > 0.0, float(lights.intensity[j]) * c, 0.0)
-            if kind == LightKind.SPOT:
-                rx, ry, rz = (-float(v) for v in lights.direction[j])
-                ux, uy, uz = vx / safe, vy / safe, vz / safe
-                cx, cy, cz = uy * rz - uz * ry, uz * rx - ux * rz, ux * ry - uy * rx
-                alpha = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * rx + uy * ry + uz * rz)
-                bw, co = float(lights.beam_width[j]), float(lights.cut_off_angle[j])
-                factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, (alpha - co) / (bw - co)))
-                direct = direct * factor
+                att = 1.0 / (a1 + length * (a2 + a3 * length)) if (a2 or a3) else None
+                if att is None and a1 != 1.0:
+                    att = np.full(S, 1.0 / a1)
+                safe = np.where(length > 0.0, length, 1.0)
+                c = nx * vx
+                c += ny * vy
+                c += nz * vz
+                c /= safe
+                direct = np.maximum(c, 0.0)
+                direct *= intensity
+                if kind == LightKind.SPOT:
+                    # alpha = atan2(|L x R|, L.R) as the LightSensor; outside [bw, co] only its side matters
+                    rx, ry, rz = (-float(v) for v in lights.direction[j])
+                    cosa = (vx * rx + vy * ry + vz * rz) / safe
+                    bw, co = float(lights.beam_width[j]), float(lights.cut_off_angle[j])
+                    factor = np.where(cosa >= math.cos(bw), 1.0, 0.0)
+                    band = ((cosa < math.cos(bw)) & (cosa >= math.cos(co))).nonzero()[0]
+                    if len(band):
+                        ux, uy, uz = vx[band] / safe[band], vy[band] / safe[band], vz[band] / safe[band]
+                        cx, cy, cz = uy * rz - uz * ry, uz * rx - ux * rz, ux * ry - uy * rx
+                        alpha = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * rx + uy * ry + uz * rz)
+                        factor[band] = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, (alpha - co) / (bw - co)))
+                    direct *= factor
             if lit is not None:
                 direct = np.where(lit[:, j], direct, 0.0)
-            weight = float(lights.ambient_intensity[j]) + direct
-            term = np.where(weight == 0.0, 0.0, att * weight)          # a zero term stays zero (att may be inf)
-            acc += term[:, None] * lights.color[j]
+            weight = direct
+            weight += ambient
+            if att is not None:
+                if length is not None and not np.all(length > 0.0):     # a point at the light: att may be inf
+                    weight = np.where(weight == 0.0, 0.0, att * weight)    # a zero term stays zero
+                else:
+                    weight *= att
+            acc += weight[:, None] * lights.color[j]
     return A * acc
 
 
