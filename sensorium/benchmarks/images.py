@@ -25,7 +25,6 @@ from sensorium.benchmarks.common import (
     Section,
     Table,
     fmt_time,
-    interleaved,
     make_sim,
     median,
     merge_triangles,
@@ -76,6 +75,31 @@ class _Raw:
         return lambda: self.scene.run(o32, d32, dists=dist.copy(), query="DISTANCE")
 
 
+def _interleaved_cpu(fns: dict, rounds: int) -> tuple[dict[str, list[float]], dict[str, list[float]]]:
+    """Like ``common.interleaved`` (A B C A B C …, one warm-up each, gc off), with each call's
+    wall-clock and CPU time (``time.process_time``)."""
+    import gc
+    import time
+
+    for fn in fns.values():
+        fn()
+    wall: dict[str, list[float]] = {k: [] for k in fns}
+    cpu: dict[str, list[float]] = {k: [] for k in fns}
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        for _ in range(rounds):
+            for k, fn in fns.items():
+                t0, c0 = time.perf_counter(), time.process_time()
+                fn()
+                cpu[k].append(time.process_time() - c0)
+                wall[k].append(time.perf_counter() - t0)
+    finally:
+        if was:
+            gc.enable()
+    return wall, cpu
+
+
 def run(cfg: Config) -> Section:
     data, base = _world()
     rounds = cfg.pick(7, 3)
@@ -121,15 +145,16 @@ def run(cfg: Config) -> Section:
             fns[label] = one
             casts[label] = dev
         fns.update({f"raw embreex, {k} rays": v for k, v in raws.items()})
-        times = interleaved(fns, rounds=rounds)
-        base_t = median(times["step, no device enabled"])
+        times, cpu = _interleaved_cpu(fns, rounds)
+        base_t, base_c = median(times["step, no device enabled"]), median(cpu["step, no device enabled"])
         for label, d in DEVICES.items():
-            t = median(times[label])
-            tr = median(times[f"raw embreex, {label} rays"])
+            t, c = median(times[label]), median(cpu[label])
+            tr, cr = median(times[f"raw embreex, {label} rays"]), median(cpu[f"raw embreex, {label} rays"])
             n = d["width"] * d["height"]
-            rows.append([precision, label, f"{n:,}", fmt_time(t), fmt_time(t - base_t), fmt_time(tr),
-                         f"{(t - base_t) / tr:.1f}×", f"{n / max(t - base_t, 1e-12) / 1e6:.2f} M"])
-            out.setdefault(precision, {})[label] = {"step_s": t, "image_s": t - base_t, "raw_embreex_s": tr, "pixels": n}
+            rows.append([precision, label, f"{n:,}", fmt_time(t - base_t), fmt_time(c - base_c), fmt_time(tr),
+                         fmt_time(cr), f"{(c - base_c) / max(cr, 1e-9):.1f}×", f"{n / max(c - base_c, 1e-12) / 1e6:.2f} M"])
+            out.setdefault(precision, {})[label] = {"step_s": t, "image_s": t - base_t, "image_cpu_s": c - base_c,
+                                                    "raw_embreex_s": tr, "raw_embreex_cpu_s": cr, "pixels": n}
         # a camera's image split into its casts and the shading (engine.cast wrapped)
         for label, d in DEVICES.items():
             if d["device"] != "Camera":
@@ -141,11 +166,11 @@ def run(cfg: Config) -> Section:
 
             def timed_cast(*a, _inner=inner, **k):
                 import time as _t
-                t0 = _t.perf_counter()
+                t0 = _t.process_time()
                 try:
                     return _inner(*a, **k)
                 finally:
-                    spent[0] += _t.perf_counter() - t0
+                    spent[0] += _t.process_time() - t0
 
             eng.cast = timed_cast
             totals = []
@@ -153,31 +178,34 @@ def run(cfg: Config) -> Section:
             for _ in range(rounds):
                 spent[0] = 0.0
                 import time as _t
-                t0 = _t.perf_counter()
+                t0 = _t.process_time()
                 dev._capture_image(dev.world_pose(robot.pose), sim._counters)
-                totals.append(_t.perf_counter() - t0)
+                totals.append(_t.process_time() - t0)
                 cast_totals.append(spent[0])
             del eng.cast
             tt, tc = median(totals), median(cast_totals)
             split_rows.append([precision, label, fmt_time(tt), fmt_time(tc), fmt_time(tt - tc), f"{tc / tt:.0%}"])
     table = Table("images_time", "Time per image, and raw embreex on the same rays (one interleaved run)",
-                  ["precision", "device", "rays", "step with one image", "image (step − empty step)",
-                   "raw embreex, same rays", "image ÷ raw embreex", "pixels/s"], rows,
-                  ["the arena world; each device alone on the e-puck, enabled at the basic step; medians of "
-                   f"{rounds} interleaved rounds; raw embreex: distances only, float32, one call",
+                  ["precision", "device", "rays", "image (wall)", "image (CPU)", "raw embreex (wall)",
+                   "raw embreex (CPU)", "image ÷ raw embreex (CPU)", "pixels per CPU second"], rows,
+                  ["the arena world; each device alone on the e-puck, enabled at the basic step; an image = a step "
+                   "that makes it − a step with nothing enabled; medians of "
+                   f"{rounds} interleaved rounds, wall-clock and this process's CPU time (time.process_time: on a "
+                   "shared machine the wall clock also counts other jobs); raw embreex: distances only, float32, one call",
                    "a camera's image is one visual cast of its pixel rays plus shadow rays for lights with "
                    "cast_shadows, then the lighting of every pixel (numpy); a range finder's is one distance-only cast"])
     split = Table("images_split", "A camera image: its casts and its shading",
                   ["precision", "device", "image", "engine.cast", "shading, tone mapping, bytes", "cast share"], split_rows,
-                  ["engine.cast timed inside one capture of the image (medians)"])
+                  ["CPU time (time.process_time) of one capture of the image and of the engine.cast calls in it (medians)"])
     counters = Table("images_counters", "Only enabled devices cost anything (sim.counters)",
                      ["precision", "what", "rays_camera", "rays_range_finder", "engine_rays"], counter_rows,
                      ["no device of the arena is enabled but the one named: every ray counted is the image's"])
     epuck = out["exact"]["e-puck camera 52×39"]
-    findings.append(f"an e-puck camera image (52×39) costs {fmt_time(epuck['image_s'])} in EXACT "
-                    f"({fmt_time(out['fast']['e-puck camera 52×39']['image_s'])} FAST); a 640×480 image "
-                    f"{fmt_time(out['exact']['camera 640×480']['image_s'])} EXACT, "
-                    f"{fmt_time(out['fast']['camera 640×480']['image_s'])} FAST")
+    findings.append(f"an e-puck camera image (52×39) costs {fmt_time(epuck['image_cpu_s'])} of CPU in EXACT "
+                    f"({fmt_time(out['fast']['e-puck camera 52×39']['image_cpu_s'])} FAST); a 640×480 image "
+                    f"{fmt_time(out['exact']['camera 640×480']['image_cpu_s'])} EXACT, "
+                    f"{fmt_time(out['fast']['camera 640×480']['image_cpu_s'])} FAST; a 320×240 range image "
+                    f"{fmt_time(out['exact']['range finder 320×240']['image_cpu_s'])} EXACT")
     if not math.isfinite(epuck["image_s"]):
         findings.append("the e-puck camera could not be timed")
     return Section("images", "Images: cameras and range finders on the ray engine",
