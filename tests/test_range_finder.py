@@ -260,3 +260,28 @@ def test_image_and_camera_info_export_to_ros2_and_foxglove_cdr():
         body = pack(core.topics.build(ctl, item, 16))
         name, cdr = enc.encode(typ, body)
         assert name == typ and cdr == enc.encode_generic(typ, body)
+
+
+def test_a_cylindrical_range_finder_and_lidar_see_the_same_ranges():
+    """Webots' lidar_vs_range_finder idea: a cylindrical lidar of H layers spanning fov·(H−1)/W
+    casts the rays of a W × H cylindrical range finder (same azimuths, same elevations), so both
+    images agree in every pixel."""
+    W, H, fov = 24, 9, 1.6
+    solids = [TILTED_WALL, {"name": "ball", "pose": {"translation": [1.2, -0.3, 0.1]},
+                            "geometry": {"type": "sphere", "radius": 0.3}}]
+    w = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16},
+        "solids": solids,
+        "robots": [{"name": "r", "devices": [
+            {"device": "RangeFinder", "name": "rf", "width": W, "height": H, "field_of_view": fov,
+             "projection": "cylindrical", "max_range": 8.0, "min_range": 0.01},
+            {"device": "Lidar", "name": "lidar", "horizontal_resolution": W, "number_of_layers": H,
+             "field_of_view": fov, "vertical_field_of_view": fov * (H - 1) / W, "max_range": 8.0, "min_range": 0.01}]}]})
+    sim = Simulation(w)
+    sim.device("r/rf").enable(16)
+    sim.device("r/lidar").enable(16)
+    sim.step()
+    a, b = sim.device("r/rf").range_image, sim.device("r/lidar").range_image
+    assert a.shape == b.shape == (H, W)
+    np.testing.assert_allclose(a, b, rtol=1e-6)
+    assert np.isfinite(a).sum() > W * H // 2
