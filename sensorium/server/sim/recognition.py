@@ -93,10 +93,15 @@ class Recognizer:
         self.geometry = geometry
         self.key_of = np.full(len(scene.shapes) + 1, -1, dtype=np.int64)   # shape -> object index (-1: none)
         objects: list[_Object] = []
+        by_owner: dict[Any, list[int]] = {}            # one pass over the shapes
+        for i in range(len(scene.shapes)):
+            key = scene.part(i)[0]
+            if key in scene.recognisable:
+                by_owner.setdefault(key, []).append(i)
         for key, (node_id, colors, model) in sorted(scene.recognisable.items(), key=lambda kv: kv[1][0]):
             if key == own:                      # Webots skips the camera's own robot and what it carries
                 continue
-            shapes = [i for i in range(len(scene.shapes)) if scene.part(i)[0] == key]
+            shapes = by_owner.get(key, [])
             bounding = [i for i in shapes if scene.part(i)[2].seen_by in ("both", "bounding")]
             parts = tuple((scene.part(i)[1], *_kind(scene.part(i)[2].geometry, scene.base_dir))
                           for i in (bounding or shapes))
