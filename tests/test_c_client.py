@@ -591,11 +591,11 @@ def test_every_device_kind_is_present_and_unsimulated_ones_answer_no_value(cbin,
         got.setdefault(key, []).append(rest)
     # Webots' tree order, Webots' node type values, the world's model
     assert got["device"] == [f"0 radar {N['WB_NODE_RADAR']} u-blox", f"1 gps {N['WB_NODE_GPS']} ",
-                             f"2 camera {N['WB_NODE_CAMERA']} ", f"3 speaker {N['WB_NODE_SPEAKER']} "]
-    assert got["radar"] == ["0 1 1"] and got["camera"] == ["1 0"]
+                             f"2 display {N['WB_NODE_DISPLAY']} ", f"3 speaker {N['WB_NODE_SPEAKER']} "]
+    assert got["radar"] == ["0 1 1"] and got["display"] == ["0 0"]
     # one warning line per unsimulated device, however many calls
     warnings = [line for line in err.splitlines() if "does not simulate" in line]
-    assert len(warnings) == 2 and any("Radar 'radar'" in w for w in warnings) and any("Camera 'camera'" in w for w in warnings)
+    assert len(warnings) == 2 and any("Radar 'radar'" in w for w in warnings) and any("Display 'display'" in w for w in warnings)
     x, y, z, cs = got["gps"][0].split()
     assert (float(x), float(y), float(z), cs) == (0.5, -0.25, 0.0, "0")      # the robot's pose, local coordinates
     assert got["joystick"] == ["0 mouse 1"]
@@ -607,5 +607,5 @@ def test_every_device_is_present_in_the_python_controller_classes(servers):
     server = servers(REPO / "tests" / "worlds" / "every_device.yaml", "--mode", "fast")
     out = run([sys.executable, "-m", "sensorium", "controller", "--url", server.url("bot"),
                str(REPO / "tests" / "controllers" / "every_device.py")])
-    assert out == ["device 0 radar u-blox", "device 1 gps -", "device 2 camera -", "device 3 speaker -",
-                   "found radar gps camera speaker", "wait 0 96"]
+    assert out == ["device 0 radar u-blox", "device 1 gps -", "device 2 display -", "device 3 speaker -",
+                   "found radar gps display speaker", "wait 0 96"]

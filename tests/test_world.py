@@ -271,11 +271,11 @@ def test_names_that_would_break_topic_paths_rejected() -> None:
 
 
 def test_unsimulated_devices_are_accepted_with_their_model_and_nothing_else() -> None:
-    devices = [{"device": "Camera", "name": "camera", "model": "Logitech", "pose": {"translation": [0.1, 0, 0]}},
+    devices = [{"device": "Display", "name": "display", "model": "Logitech", "pose": {"translation": [0.1, 0, 0]}},
                {"device": "RotationalMotor", "name": "left wheel motor"},
                {"device": "GPS", "name": "gps"}]
     loaded = parse_world({"robots": [_robot(devices, differential_drive={})]}, source="w.yaml", base_dir=Path.cwd())
     assert [(d.device, d.name, d.model) for d in loaded.world.robots[0].devices] == [
-        ("Camera", "camera", "Logitech"), ("RotationalMotor", "left wheel motor", ""), ("GPS", "gps", "")]
-    probs = _problems({"robots": [_robot([{"device": "Camera", "name": "camera", "width": 64}])]})
+        ("Display", "display", "Logitech"), ("RotationalMotor", "left wheel motor", ""), ("GPS", "gps", "")]
+    probs = _problems({"robots": [_robot([{"device": "Display", "name": "display", "width": 64}])]})
     assert probs and probs[0][0].startswith("robots[0].devices[0]") and "width" in probs[0][0] + probs[0][1]

@@ -29,8 +29,17 @@ an object, for programs (and tests) that want several.
 
 from __future__ import annotations
 
-from sensorium.client import wb_motor, wb_pen, wb_robot, wb_sensors, wb_supervisor
+from sensorium.client import wb_camera, wb_motor, wb_pen, wb_robot, wb_sensors, wb_supervisor
 from sensorium.client.connection import SensoriumError  # noqa: F401
+from sensorium.client.wb_camera import *  # noqa: F403
+from sensorium.client.wb_camera import (  # noqa: F401
+    CAMERA,
+    RANGE_FINDER,
+    camera_bytes,
+    range_finder_bytes,
+    recognition_objects,
+    segmentation_bytes,
+)
 from sensorium.client.wb_motor import *  # noqa: F403
 from sensorium.client.wb_pen import *  # noqa: F403
 from sensorium.client.wb_robot import *  # noqa: F403
@@ -49,5 +58,5 @@ from sensorium.client.wb_sensors import *  # noqa: F403
 from sensorium.client.wb_sensors import lidar_cloud_bytes, lidar_range_bytes  # noqa: F401
 from sensorium.client.wb_supervisor import *  # noqa: F403
 
-__all__ = sorted({n for m in (wb_robot, wb_sensors, wb_motor, wb_pen, wb_supervisor) for n in vars(m)
+__all__ = sorted({n for m in (wb_robot, wb_sensors, wb_motor, wb_pen, wb_supervisor, wb_camera) for n in vars(m)
                   if n.startswith(("wb_", "WB_"))} | {"SensoriumError", "RobotClient"})

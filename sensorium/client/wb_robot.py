@@ -112,7 +112,7 @@ class DeviceState:
 
     __slots__ = ("tag", "index", "name", "kind", "desc", "sampling_period", "value", "range_bytes",
                  "cloud_bytes", "point_cloud_enabled", "max_velocity", "target_position", "velocity",
-                 "_consts", "_range", "_cloud", "_warned")
+                 "_consts", "_range", "_cloud", "_warned", "camera")
 
     def __init__(self, index: int, desc: dict):
         self.index = index
@@ -133,6 +133,7 @@ class DeviceState:
         self._range: Any = None                  # decoded forms, rebuilt when new bytes arrive
         self._cloud: Any = None
         self._warned = False
+        self.camera: dict[str, Any] = {}         # a camera's latest readings (wb_camera.py): image, recognition
 
     def __repr__(self) -> str:
         return f"<{self.kind} {self.name!r} tag={self.tag} period={self.sampling_period}>"
@@ -279,6 +280,9 @@ class RobotClient:
             if "point_cloud" in reading:
                 dev.cloud_bytes = bytes(reading["point_cloud"])
                 dev._cloud = None
+            for key in ("image", "recognition", "segmentation_image"):    # a camera's (wb_camera.py)
+                if key in reading:
+                    dev.camera[key] = reading[key]
 
     # ------------------------------------------------------------------ devices
     def device(self, tag: int, kind: str | None, func: str) -> DeviceState:

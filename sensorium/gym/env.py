@@ -8,7 +8,10 @@ Observation: a ``Dict`` with one ``Box`` per observed sensor (LEDs are not obser
 or distance sensor is a float32 ``(1,)`` box bounded by its lookup table's output column (values are clipped into it:
 relative lookup noise is Gaussian and could leave it); a lidar is its float32 ``(layers,
 width)`` range image bounded by ``[0, max_range]``, with "no hit" (``inf`` in Webots) given as
-``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians. Action: float32 ``(2,)`` = left, right wheel velocity (rad/s), bounded by the
+``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians; a camera
+(only when named in ``Task.observations``: images are not observed by default) is a uint8
+``(height, width, 3)`` RGB box, a range finder (likewise) its float32 ``(height, width)`` range image
+in ``[0, max_range]`` with "no hit" as ``max_range``. Action: float32 ``(2,)`` = left, right wheel velocity (rad/s), bounded by the
 drive's max wheel speed. One action lasts ``control_period_ms``.
 
 ``reset(seed=s)`` rebuilds the simulation from the world model with world seed drawn from the
@@ -80,8 +83,8 @@ class Agent:
         devices = {d.name: d for d in model.devices if d.device in OBSERVABLE}
         actuators = {d.name for d in model.devices if d.device not in OBSERVABLE}
         obs = task.observations
-        if obs is None:
-            periods = {n: self.control_period_ms for n in devices}
+        if obs is None:              # images cost a ray per pixel: observed only when named
+            periods = {n: self.control_period_ms for n, d in devices.items() if d.device not in IMAGES}
         elif isinstance(obs, dict):
             periods = {str(k): int(v) for k, v in obs.items()}
         else:
@@ -133,7 +136,9 @@ class Agent:
         out = {}
         for n, box in self.observation_space.spaces.items():
             dev = robot.device(n)
-            if isinstance(dev, Lidar):
+            if dev.kind == "Camera":                       # BGRA -> RGB
+                out[n] = np.ascontiguousarray(dev.image[:, :, 2::-1])
+            elif isinstance(dev, Lidar) or dev.kind == "RangeFinder":
                 img = np.nan_to_num(dev.range_image, nan=box.high.flat[0], posinf=box.high.flat[0])
                 out[n] = np.clip(img, box.low, box.high).astype(np.float32)
             else:
@@ -155,12 +160,17 @@ class Agent:
                 "pose": np.array([pose.translation[0], pose.translation[1], math.atan2(fwd[1], fwd[0])])}
 
 
-OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
+OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "Camera", "RangeFinder")
+IMAGES = ("Camera", "RangeFinder")
 
 
 def _space(cfg) -> spaces.Box:
     if cfg.device == "PositionSensor":          # a wheel angle (rad): unbounded
         return spaces.Box(-np.inf, np.inf, shape=(1,), dtype=np.float32)
+    if cfg.device == "Camera":
+        return spaces.Box(0, 255, shape=(cfg.height, cfg.width, 3), dtype=np.uint8)
+    if cfg.device == "RangeFinder":
+        return spaces.Box(0.0, np.float32(cfg.max_range), shape=(cfg.height, cfg.width), dtype=np.float32)
     if cfg.device == "Lidar":
         return spaces.Box(0.0, np.float32(cfg.max_range), shape=(cfg.number_of_layers, cfg.horizontal_resolution),
                           dtype=np.float32)

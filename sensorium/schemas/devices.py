@@ -217,6 +217,25 @@ register(DeviceKind(
             TopicDecl("ink", msgs.COLOR_RGBA, "ink", sensor_qos=False)),
     rays=lambda cfg, lights: 1,                  # one ray per basic step while it writes
     description="PenDescription"))
+register(DeviceKind(
+    "RangeFinder", wm.RangeFinder, "sensorium.server.sim.cameras:RangeFinder",
+    services=_SENSOR,
+    topics=(TopicDecl("range_image", msgs.IMAGE, "range_image"),
+            TopicDecl("camera_info", msgs.CAMERA_INFO, "range_image", exists=lambda cfg, wi: cfg.projection == "planar")),
+    rays=lambda cfg, lights: int(cfg.width) * int(cfg.height),
+    ray_bound=("", "pixels (width × height):", "rays_per_image"),
+    description="RangeFinderDescription"))
+register(DeviceKind(
+    "Camera", wm.Camera, "sensorium.server.sim.cameras:Camera",
+    services=(*_SENSOR, "set_exposure", "recognition_enable", "get_recognition_sampling_period",
+              "enable_segmentation", "is_segmentation_enabled", "get_recognition_objects"),
+    topics=(TopicDecl("image", msgs.IMAGE, "image"),
+            TopicDecl("camera_info", msgs.CAMERA_INFO, "image", exists=lambda cfg, wi: cfg.projection == "planar"),
+            TopicDecl("segmentation_image", msgs.IMAGE, "segmentation_image",
+                      exists=lambda cfg, wi: cfg.recognition is not None and cfg.recognition.segmentation)),
+    rays=lambda cfg, lights: int(cfg.width) * int(cfg.height) * (4 if cfg.anti_aliasing else 1),
+    ray_bound=("", "rays (width × height, × 4 anti-aliased):", "rays_per_image"),
+    description="CameraDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

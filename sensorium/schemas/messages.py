@@ -58,7 +58,8 @@ class Range(Msg):
 
 
 class Image(Msg):
-    """``sensor_msgs/msg/Image``; a lidar range image is ``32FC1``, one row per layer."""
+    """``sensor_msgs/msg/Image``: a lidar or range-finder range image is ``32FC1`` (a lidar: one row
+    per layer), a camera image ``bgra8`` (Webots' byte order), its segmentation image too."""
 
     header: Header
     height: int = Field(ge=0, lt=1 << 32)
@@ -67,6 +68,34 @@ class Image(Msg):
     is_bigendian: int = Field(ge=0, le=1)
     step: int = Field(ge=0, lt=1 << 32, description="bytes per row")
     data: bytes = Field(description="height x step bytes; 32FC1 = little-endian float32")
+
+
+class RegionOfInterest(Msg):
+    """``sensor_msgs/msg/RegionOfInterest``."""
+
+    x_offset: int = Field(default=0, ge=0, lt=1 << 32)
+    y_offset: int = Field(default=0, ge=0, lt=1 << 32)
+    height: int = Field(default=0, ge=0, lt=1 << 32)
+    width: int = Field(default=0, ge=0, lt=1 << 32)
+    do_rectify: bool = False
+
+
+class CameraInfo(Msg):
+    """``sensor_msgs/msg/CameraInfo`` of a planar camera or range finder: the pinhole of its exact
+    pixel rays (square pixels, pixel centres at integer coordinates), no distortion. ``header`` is
+    the image's (frame ``robot/device``: FLU, x along the optical axis, as Webots)."""
+
+    header: Header
+    height: int = Field(ge=0, lt=1 << 32)
+    width: int = Field(ge=0, lt=1 << 32)
+    distortion_model: str = "plumb_bob"
+    d: bytes = Field(description="little-endian float64[5]: zeros")
+    k: bytes = Field(description="little-endian float64[9]: fx 0 cx / 0 fy cy / 0 0 1 (row-major)")
+    r: bytes = Field(description="little-endian float64[9]: identity")
+    p: bytes = Field(description="little-endian float64[12]: fx 0 cx 0 / 0 fy cy 0 / 0 0 1 0")
+    binning_x: int = Field(default=0, ge=0, lt=1 << 32)
+    binning_y: int = Field(default=0, ge=0, lt=1 << 32)
+    roi: RegionOfInterest = RegionOfInterest()
 
 
 class LaserScan(Msg):
@@ -251,6 +280,7 @@ NAV_SAT_FIX = "sensor_msgs/msg/NavSatFix"
 FLOAT64 = "std_msgs/msg/Float64"
 IMU = "sensor_msgs/msg/Imu"
 MAGNETIC_FIELD = "sensor_msgs/msg/MagneticField"
+CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
 
 MESSAGE_TYPES: dict[str, type[Msg]] = {
     ILLUMINANCE: Illuminance,
@@ -268,6 +298,7 @@ MESSAGE_TYPES: dict[str, type[Msg]] = {
     FLOAT64: Float64,
     IMU: Imu,
     MAGNETIC_FIELD: MagneticField,
+    CAMERA_INFO: CameraInfo,
 }
 """ROS type name → model, for every topic the server publishes."""
 

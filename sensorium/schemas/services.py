@@ -159,6 +159,10 @@ class FrequencyArgs(Args):
     value: float = Field(description="Hz, within [minFrequency, maxFrequency]")
 
 
+class ExposureArgs(Args):
+    value: float = Field(ge=0.0, description="the camera's photometric exposure (Webots' exposure, >= 0)")
+
+
 class LayerArgs(Args):
     layer: int = Field(ge=0, lt=1 << 31)
 
@@ -308,6 +312,36 @@ class LidarDescription(_Entry):
     point_cloud_enabled: bool
 
 
+class RangeFinderDescription(_Entry):
+    type: Literal["RangeFinder"]
+    sampling_period: int
+    width: int
+    height: int
+    fov: float = Field(description="rad, horizontal")
+    near: float
+    minRange: float
+    maxRange: float
+    projection: str = Field(description="planar, cylindrical or spherical")
+
+
+class CameraDescription(_Entry):
+    type: Literal["Camera"]
+    sampling_period: int
+    width: int
+    height: int
+    fov: float = Field(description="rad, horizontal")
+    near: float
+    far: float = Field(description="0: no far plane")
+    exposure: float
+    projection: str = Field(description="planar, cylindrical or spherical")
+    anti_aliasing: bool
+    noise: float
+    has_recognition: bool = Field(description="wb_camera_has_recognition: a Recognition node")
+    has_segmentation: bool = Field(description="wb_camera_recognition_has_segmentation")
+    recognition_sampling_period: int = Field(description="0 at attach")
+    segmentation_enabled: bool
+
+
 class MotorDescription(_Entry):
     type: Literal["RotationalMotor"]
     maxVelocity: float = Field(description="rad/s")
@@ -404,6 +438,7 @@ DeviceDescription = Annotated[
     | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]
     | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
     | Annotated[TouchSensorDescription, Tag("TouchSensor")] | Annotated[PenDescription, Tag("Pen")]
+    | Annotated[RangeFinderDescription, Tag("RangeFinder")] | Annotated[CameraDescription, Tag("Camera")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -489,6 +524,23 @@ class FrequencyInfoResult(Result):
 
 class StatusResult(Result):
     status: int
+
+
+class RecognitionObject(Result):
+    """One object a camera recognised (Webots' ``WbCameraRecognitionObject``)."""
+
+    id: int = Field(description="the object's node id (Supervisor ids: robots 1..R, then top-level solids)")
+    position: list[float] = Field(description="m: its box's centre in the camera frame (FLU)")
+    orientation: list[float] = Field(description="axis-angle of its rotation in the camera frame")
+    size: list[float] = Field(description="m: its box's extents along the camera's y and z")
+    position_on_image: list[int] = Field(description="pixel: its box's centre on the image")
+    size_on_image: list[int] = Field(description="pixels: width, height of its box on the image")
+    colors: list[float] = Field(description="its recognition colours, flat [r0, g0, b0, r1, ...]")
+    model: str
+
+
+class RecognitionObjectsResult(Result):
+    value: list[RecognitionObject]
 
 
 class LayerRangeImageResult(Result):
@@ -650,6 +702,12 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_noise", "device", NoArgs, FloatValue),
     ServiceSpec("write", "device", BoolArgs, SuccessResult, attached=True),
     ServiceSpec("set_ink_color", "device", InkColorArgs, SuccessResult, attached=True),
+    ServiceSpec("set_exposure", "device", ExposureArgs, SuccessResult, attached=True),
+    ServiceSpec("recognition_enable", "device", EnableArgs, SuccessResult, attached=True),
+    ServiceSpec("get_recognition_sampling_period", "device", NoArgs, IntValue),
+    ServiceSpec("enable_segmentation", "device", BoolArgs, SuccessResult, attached=True),
+    ServiceSpec("is_segmentation_enabled", "device", NoArgs, StatusResult),
+    ServiceSpec("get_recognition_objects", "device", NoArgs, RecognitionObjectsResult),
 )
 
 

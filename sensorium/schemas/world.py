@@ -287,6 +287,26 @@ class Solid(Strict):
     shapes: list[Part] = []
     children: list[Solid] = []
     lights: list[Light] = []
+    model: str = Field(default="", max_length=4096, description="Webots model (a recognised object's model)")
+    recognition_colors: list[Color] = Field(
+        default=[], max_length=1024, description="Webots recognitionColors: cameras with a Recognition node report "
+        "this solid (with its children); top-level solids only")
+
+    @field_validator("recognition_colors")
+    @classmethod
+    def _unit_colors(cls, v: list[Color]) -> list[Color]:
+        for c in v:
+            if min(c) < 0 or max(c) > 1:
+                raise ValueError("colour components must be within [0, 1]")
+        return v
+
+    @model_validator(mode="after")
+    def _recognised_at_the_top(self) -> Solid:
+        for i, child in enumerate(self.children):
+            if child.recognition_colors:
+                raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "
+                                 "and robots only (give them to the top-level solid)")
+        return self
 
 
 # ---------------------------------------------------------------- devices
@@ -479,6 +499,66 @@ class TouchSensor(_Device):
     resolution: float = -1.0
 
 
+class RangeFinder(_Device):
+    """Webots RangeFinder (a depth camera): ``width`` × ``height`` ranges, by exact rays through the
+    pixel centres. ``planar``: the depth along the device's +x axis (Webots' z-buffer distance to
+    the image plane); ``cylindrical``/``spherical``: the distance along each pixel's ray. Values
+    outside [min_range, max_range) and no hit read +inf (README "Cameras and range finders")."""
+
+    device: Literal["RangeFinder"]
+    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
+    width: int = Field(default=64, ge=1, le=1 << 16)
+    height: int = Field(default=64, ge=1, le=1 << 16)
+    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
+    near: float = Field(default=0.01, ge=0.0)
+    min_range: float = Field(default=0.01, ge=0.0)
+    max_range: float = Field(default=1.0, gt=0.0)
+    noise: float = Field(default=0.0, ge=0.0, description="σ of the Gaussian noise as a fraction of max_range")
+    resolution: float = -1.0
+
+    @model_validator(mode="after")
+    def _planar_fov(self) -> RangeFinder:
+        if self.projection == "planar" and self.field_of_view >= math.pi:
+            raise ValueError("a planar range finder's field_of_view must be < pi")
+        return self
+
+
+class Recognition(Strict):
+    """Webots' Recognition node in a Camera's ``recognition`` field: the camera reports the solids
+    (and robots) that have ``recognition_colors`` and that it sees (README "Recognition")."""
+
+    max_range: float = Field(default=100.0, ge=0.0, description="m: objects farther are not recognised")
+    max_objects: int = Field(default=-1, ge=-1, description="-1: no limit; else the biggest on the image")
+    occlusion: int = Field(default=1, ge=0, le=2, description="0 none, 1 the centre's ray, 2 any pixel of the image")
+    frame_color: Color = (1.0, 0.0, 0.0)
+    frame_thickness: int = Field(default=1, ge=0)
+    segmentation: bool = False
+
+
+class Camera(_Device):
+    """Webots Camera: a ``width`` × ``height`` BGRA image by exact rays through the pixels (four per
+    pixel with ``anti_aliasing``), shaded with the LightSensor's lighting, textures, transparency,
+    shadows of the lights that cast them, the background colour (README "Cameras and range finders")."""
+
+    device: Literal["Camera"]
+    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
+    width: int = Field(default=64, ge=1, le=1 << 16)
+    height: int = Field(default=64, ge=1, le=1 << 16)
+    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
+    near: float = Field(default=0.01, ge=0.0)
+    far: float = Field(default=0.0, ge=0.0, description="0: no far clipping plane")
+    exposure: float = Field(default=1.0, ge=0.0)
+    anti_aliasing: bool = False
+    noise: float = Field(default=0.0, ge=0.0, le=1.0, description="σ of the per-channel Gaussian noise, in [0, 1] units")
+    recognition: Recognition | None = None
+
+    @model_validator(mode="after")
+    def _planar_fov(self) -> Camera:
+        if self.projection == "planar" and self.field_of_view >= math.pi:
+            raise ValueError("a planar camera's field_of_view must be < pi")
+        return self
+
+
 class RotationalMotor(_Device):
     """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
     motors *is* that motor, at this index of the device list (a drive motor without an entry comes
@@ -489,7 +569,7 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Camera", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Radar", "Radio", "RangeFinder", "Receiver", "Skin",
+    "Brake", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Radar", "Radio", "Receiver", "Skin",
     "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -505,12 +585,13 @@ class UnsimulatedDevice(_Device):
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
-                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | Pen | UnsimulatedDevice,
+                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | Pen | RangeFinder | Camera
+                   | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
-                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor", "Pen",
-                *UNSIMULATED_DEVICE_TYPES)
+                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor", "Pen", "RangeFinder",
+                "Camera", *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
 
@@ -576,6 +657,17 @@ class Robot(Strict):
     differential_drive: DifferentialDrive | None = None
     devices: list[Device] = Field(default=[], description="in Webots' tree order (the order of the device "
                                   "indices); every Webots device type is accepted, those not simulated as present")
+    recognition_colors: list[Color] = Field(
+        default=[], max_length=1024, description="Webots recognitionColors: other robots' cameras with a Recognition "
+        "node report this robot")
+
+    @field_validator("recognition_colors")
+    @classmethod
+    def _unit_colors(cls, v: list[Color]) -> list[Color]:
+        for c in v:
+            if min(c) < 0 or max(c) > 1:
+                raise ValueError("colour components must be within [0, 1]")
+        return v
 
 
 class WorldInfo(Strict):
@@ -597,6 +689,20 @@ class WorldInfo(Strict):
                                    "(Webots' inkEvaporation); 0 = never")
 
 
+class Background(Strict):
+    """Webots' Background node: what a camera sees where no shape is (``skyColor``'s first colour,
+    through the camera's tone mapping as Webots clears its image with it)."""
+
+    sky_color: Color = (0.0, 0.0, 0.0)
+
+    @field_validator("sky_color")
+    @classmethod
+    def _unit(cls, v: Color) -> Color:
+        if min(v) < 0 or max(v) > 1:
+            raise ValueError("colour components must be within [0, 1]")
+        return v
+
+
 class World(Strict):
     """A whole world file.
 
@@ -608,6 +714,7 @@ class World(Strict):
     solids: list[Solid] = []
     lights: list[Light] = []
     robots: list[Robot] = []
+    background: Background = Background()
 
 
 def json_schema() -> dict:

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 
-#include <webots/camera.h>
+#include <webots/display.h>
 #include <webots/gps.h>
 #include <webots/joystick.h>
 #include <webots/motor.h>
@@ -22,13 +22,13 @@ int main(void) {
     printf("device %d %s %d %s\n", i, wb_device_get_name(t), (int)wb_device_get_node_type(t), wb_device_get_model(t));
   }
   WbDeviceTag radar = wb_robot_get_device("radar"), gps = wb_robot_get_device("gps");
-  WbDeviceTag camera = wb_robot_get_device("camera");
+  WbDeviceTag display = wb_robot_get_device("display");
   wb_radar_enable(radar, 16);
   wb_gps_enable(gps, 16);
   wb_robot_step(16);
   printf("radar %d %d %d\n", wb_radar_get_number_of_targets(radar), wb_radar_get_targets(radar) == NULL,
          isnan(wb_radar_get_max_range(radar)));
-  printf("camera %d %d\n", wb_camera_get_image(camera) == NULL, wb_camera_get_width(camera));
+  printf("display %d %d\n", wb_display_get_width(display), wb_display_get_height(display));
   const double *p = wb_gps_get_values(gps);
   printf("gps %.17g %.17g %.17g %d\n", p[0], p[1], p[2], (int)wb_gps_get_coordinate_system(gps));
   printf("joystick %d mouse %d\n", wb_joystick_is_connected(), isnan(wb_mouse_get_state().u));

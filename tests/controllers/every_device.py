@@ -7,7 +7,7 @@ robot = Robot()
 for i in range(robot.getNumberOfDevices()):
     dev = robot.getDeviceByIndex(i)
     print("device", i, dev.getName(), dev.getModel() or "-")
-print("found", " ".join(n for n in ("radar", "gps", "camera", "speaker") if robot.getDevice(n) is not None))
+print("found", " ".join(n for n in ("radar", "gps", "display", "speaker") if robot.getDevice(n) is not None))
 t0 = robot.getTime()
 event = robot.waitForUserInputEvent(Robot.EVENT_KEYBOARD, 96)
 print("wait", event, round((robot.getTime() - t0) * 1000))

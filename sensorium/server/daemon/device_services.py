@@ -100,6 +100,36 @@ class DeviceServices:
     def _dev_get_noise(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.config.noise)}
 
+    def _dev_set_exposure(self, c: Call) -> dict:
+        try:
+            c.ctl.device.set_exposure(c.args.value)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_exposure: {exc}") from None
+        return {"success": True}
+
+    def _dev_recognition_enable(self, c: Call) -> dict:
+        try:
+            c.ctl.device.recognition_enable(c.args.value)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.WRONG_STATE, f"recognition_enable: {exc}") from None
+        return {"success": True}
+
+    def _dev_get_recognition_sampling_period(self, c: Call) -> dict:
+        return {"value": int(c.ctl.device.recognition_schedule.period_ms)}
+
+    def _dev_enable_segmentation(self, c: Call) -> dict:
+        try:
+            c.ctl.device.enable_segmentation(c.args.value)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.WRONG_STATE, f"enable_segmentation: {exc}") from None
+        return {"success": True}
+
+    def _dev_is_segmentation_enabled(self, c: Call) -> dict:
+        return {"status": int(c.ctl.device.segmentation_enabled)}
+
+    def _dev_get_recognition_objects(self, c: Call) -> dict:
+        return {"value": [o.as_dict() for o in c.ctl.device.objects]}
+
     def _dev_set(self, c: Call) -> dict:
         try:
             c.ctl.device.set(c.args.value, self.sim.time_ms)

@@ -348,7 +348,9 @@ class Core(DeviceServices):
         values: dict[str, dict] = {}
         seen = self._seen.setdefault(session.token, {})
         for ctl in self._robot_controls(session.robot):
-            if ctl.controller_period > 0:
+            # a camera's recognition has its own period (the controller enabled it with its own service)
+            rec = getattr(ctl.device, "recognition_schedule", None)
+            if ctl.controller_period > 0 or (rec is not None and rec.period_ms > 0):
                 m = ctl.device.measurements
                 if seen.get(ctl.path, 0) != m:
                     seen[ctl.path] = m

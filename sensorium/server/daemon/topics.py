@@ -114,9 +114,10 @@ def header(frame_id: str, ms: int) -> dict:
     return {"stamp": stamp(max(ms, 0) * 1_000_000), "frame_id": frame_id}
 
 
-def image_msg(hdr: dict, height: int, width: int, data: bytes) -> dict:
-    """``sensor_msgs/Image`` 32FC1 (lidar range image)."""
-    return {"header": hdr, "height": height, "width": width, "encoding": "32FC1", "is_bigendian": 0,
+def image_msg(hdr: dict, height: int, width: int, data: bytes, encoding: str = "32FC1") -> dict:
+    """``sensor_msgs/Image``: 32FC1 (a lidar's or range finder's range image) or bgra8 (a camera's);
+    4 bytes a pixel either way."""
+    return {"header": hdr, "height": height, "width": width, "encoding": encoding, "is_bigendian": 0,
             "step": 4 * width, "data": data}
 
 
@@ -349,6 +350,9 @@ class Topics:
     def release_robot(self, robot: str) -> None:
         """The robot's controller left (detached or dropped): forget its requests."""
         for ctl in self.controls.values():
+            released = getattr(ctl.device, "controller_released", None)   # a camera's recognition
+            if ctl.robot == robot and released is not None:
+                released()
             if ctl.robot == robot and (ctl.controller_period or ctl.controller_point_cloud):
                 had = ctl.controller_period
                 ctl.controller_period = 0
@@ -446,9 +450,18 @@ class Topics:
                 "range": float(dev.value),
                 "variance": 0.0}
 
-    def _range_image(self, ctl: Control, hdr: dict, reading: str) -> dict:
-        cfg = ctl.device.config
-        return image_msg(hdr, cfg.number_of_layers, cfg.horizontal_resolution, ctl.range_bytes())
+    def _range_image(self, ctl: Control, hdr: dict, reading: str) -> dict | None:
+        if reading != "range_image":         # a camera's own images (bgra8), sim/cameras.py
+            data = ctl.device.image_data(reading)
+            if data is None:
+                return None
+            height, width, encoding, raw = data
+            return image_msg(hdr, height, width, raw, encoding)
+        rows, cols = ctl.device.range_image.shape      # a lidar's layers × columns, a range finder's pixels
+        return image_msg(hdr, rows, cols, ctl.range_bytes())
+
+    def _camera_info(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        return {"header": hdr, **ctl.device.camera_info()}
 
     def _laser_scan(self, ctl: Control, hdr: dict, reading: str) -> dict | None:
         dev = ctl.device
@@ -535,5 +548,6 @@ MESSAGE_BUILDERS: dict[str, Callable[[Topics, Control, dict, str], dict | None]]
     msgs.NAV_SAT_FIX: Topics._nav_sat_fix,
     msgs.IMU: Topics._imu,
     msgs.MAGNETIC_FIELD: Topics._magnetic_field,
+    msgs.CAMERA_INFO: Topics._camera_info,
 }
 """Message type -> the builder of a device topic's body (a device kind's topics name their types)."""

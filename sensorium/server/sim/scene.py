@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.devices.shading import srgb_to_linear
 from sensorium.server.raycast.engine import Precision, RayEngine, ShapeEntry
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
@@ -61,6 +62,11 @@ def _shape_info(name: str, owner: int, shape: wm.Shape | wm.Solid) -> ShapeInfo:
         return ShapeInfo(name, owner, red=1.0, roughness=0.0, transparency=0.0)
     return ShapeInfo(name, owner, red=a.base_color[0] * (1.0 - a.transparency), roughness=a.roughness,
                      transparency=a.transparency)
+
+
+def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
+    a = shape.appearance
+    return (1.0, 1.0, 1.0) if a is None else tuple(float(v) for v in a.base_color)  # type: ignore[return-value]
 
 
 def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None) -> ShapeEntry:
@@ -163,6 +169,21 @@ class Scene:
         # infra-red reads these per hit shape; -1 (no hit) indexes the trailing "no hit" entry
         self.red = np.array([s.red for s in self.shapes] + [1.0])
         self.roughness = np.array([s.roughness for s in self.shapes] + [0.0])
+        # cameras read these (sim/cameras.py): base colour (white without appearance) and transparency
+        self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
+        self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
+        self.background = np.asarray(world.background.sky_color, dtype=np.float64)   # what cameras see past everything
+        self.base_dir = Path(base_dir)
+        # what cameras with a Recognition node report: owner (robot index, solid name) -> (the Supervisor's
+        # node id: robots 1..R in world order, then the top-level solids; recognition colours; model)
+        self.recognisable: dict[str | int, tuple[int, list, str]] = {}
+        for i, r in enumerate(world.robots):
+            if r.recognition_colors:
+                self.recognisable[i] = (i + 1, [tuple(c) for c in r.recognition_colors], r.model)
+        for j, sd in enumerate(world.solids):
+            if sd.recognition_colors:
+                self.recognisable[sd.name] = (len(world.robots) + 1 + j, [tuple(c) for c in sd.recognition_colors],
+                                              sd.model)
 
     def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool,
                   key: str | int | None = None) -> int:
@@ -245,6 +266,45 @@ class Scene:
         """All ink gone (a simulation reset, as Webots' Pen reset clears every paint texture)."""
         if self.textures is not None:
             self.textures.clear_ink()
+
+    def part(self, shape: int) -> tuple[str | int | None, Pose, wm.Shape | wm.Solid]:
+        """A shape's owner (solid name, robot index), its frame in the owner and its model."""
+        return self._parts[shape]
+
+    def owner_pose(self, key: str | int) -> Pose:
+        """The pose of a shape owner: a robot (index) or a top-level solid (name)."""
+        return self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
+
+    def surface_colors(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
+                       distance: np.ndarray) -> np.ndarray:
+        """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): the base colour,
+        times the texel of a textured shape converted from sRGB to linear (Webots' shaders;
+        where picking fails, 1), blended with a pen's ink as infra-red reads it
+        (``(1 − c)·colour + c·ink``)."""
+        col = self.colors[shape]
+        sampler = self.textures
+        if sampler is None:
+            return col
+        hit = sampler.textured[shape].nonzero()[0]
+        on = shape[hit]
+        for s in sorted(set(on.tolist())):
+            rows = hit[on == s]
+            inv = self._world_to_shape(s)
+            o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
+            uv, picked = sampler.uv(s, o, d, distance[rows])
+            sampler.lookups += len(rows)
+            uv = np.where(picked[:, None], uv, 0.0)
+            base = col[rows]
+            if s in sampler.shapes:
+                texel = srgb_to_linear(sampler.texels(s, uv, "base"))
+                base = base * np.where(picked[:, None], texel, 1.0)
+            layer = sampler.ink.get(s)
+            if layer is not None:
+                ink, c = layer.pick(uv)
+                c = np.where(picked, c.astype(np.float64), 0.0)[:, None]
+                base = (1.0 - c) * base + c * ink
+            col[rows] = base
+        return col
 
     def infra_red_terms(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                         distance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -127,6 +127,7 @@ class RobotState:
 
     @property
     def scene(self) -> Scene:
+        """The world's scene (devices that cast their own rays, e.g. cameras, bind to it)."""
         return self._sim.scene
 
     @property
@@ -195,6 +196,7 @@ class Simulation:
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
         self._counters: Counter[str] = Counter()
         self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[Device]] | None = None
+        self._capturing: list[Any] = []     # devices that cast their own rays (cameras, range finders)
         self._tracking: list[Device] = []
         self._distance_plans: dict[tuple[int, ...], DistancePlan] = {}   # by the due sensors (see _distance_plan)
         self._joined_mounts: dict[tuple, tuple[list, Mount]] = {}        # see _joined_mount
@@ -299,8 +301,8 @@ class Simulation:
         out["bvh_builds"] = eng["bvh_builds"]
         out["embree_calls"] = eng["embree_calls"]
         out["engine_rays"] = eng["rays_cast"]
-        for key in ("rays_light", "rays_distance", "rays_lidar", "rays_pen", "ink_strokes", "cast_calls",
-                    "points_built", "measurements"):
+        for key in ("rays_light", "rays_distance", "rays_lidar", "rays_pen", "ink_strokes", "rays_range_finder",
+                    "rays_camera", "cast_calls", "points_built", "measurements"):
             out.setdefault(key, 0)
         out["texture_lookups"] = self.scene.textures.lookups if self.scene.textures is not None else 0
         out["contacts"] = self.contact.contacts if self.contact is not None else 0
@@ -345,6 +347,7 @@ class Simulation:
                              [d for d in every if isinstance(d, Lidar)],
                              [d for d in every if d.kinematic])
             self._tracking = [d for d in every if d.tracks_motion]
+            self._capturing = [d for d in every if getattr(d, "captures", False)]
         all_lights, all_distances, all_lidars, all_kinematic = self._by_kind
         for dev in self._tracking:    # devices that read the motion keep its last poses while enabled
             if dev.enabled:
@@ -360,6 +363,10 @@ class Simulation:
             if enc.schedule.due(now):
                 enc.measure(now)      # type: ignore[attr-defined]
                 enc.schedule.last_update_ms = now
+                encoders += 1
+        for cam in self._capturing:   # cameras and range finders: their own casts (sim/cameras.py)
+            if cam.due(now):
+                cam.capture(now, self._counters)
                 encoders += 1
         if not (lights or distances or lidars):         # no ray this step (e.g. between sensor periods)
             self._counters["measurements"] += encoders

@@ -4,7 +4,7 @@ Foxglove *Layouts → Import from file*.
 Built with the SDK's layout types (``foxglove.layouts``), from the topics of a recording or a world
 file: a 3D panel (fixed frame ``world``; the scene, every laser scan and point cloud visible), a
 plot of every light sensor's illuminance and every distance sensor's range, an image panel on the
-first lidar range image, and a raw-messages panel on ``/clock``.
+first camera image (else the first lidar or range-finder range image), and a raw-messages panel on ``/clock``.
 """
 
 from __future__ import annotations
@@ -32,12 +32,15 @@ def layout_json(topics: Mapping[str, str]) -> str:
         field = {"sensor_msgs/msg/Illuminance": "illuminance", "sensor_msgs/msg/Range": "range"}.get(typ)
         if field:
             series.append(fl.PlotSeries(value=f"{name}.{field}"))
-    images = sorted(n for n, t in topics.items() if t == "sensor_msgs/msg/Image")
+    # a camera's image first (…/image), then range images
+    images = sorted((n for n, t in topics.items() if t == "sensor_msgs/msg/Image"),
+                    key=lambda n: (not n.endswith("/image"), n))
     side = [fl.SplitItem(content=fl.PlotPanel(title="Sensor values",
                                               config=fl.PlotConfig(paths=series[:MAX_PLOTTED], show_legend=True)))]
     if images:
         side.append(fl.SplitItem(content=fl.ImagePanel(
-            title="Range image", config=fl.ImageConfig(image_mode=fl.ImageModeConfig(image_topic=images[0])))))
+            title="Camera image" if images[0].endswith("/image") else "Range image",
+            config=fl.ImageConfig(image_mode=fl.ImageModeConfig(image_topic=images[0])))))
     side.append(fl.SplitItem(content=fl.RawMessagesPanel(title="Raw messages",
                                                          config=fl.RawMessagesConfig(topic_path="/clock"))))
     layout = fl.Layout(content=fl.SplitContainer(direction="row", items=[

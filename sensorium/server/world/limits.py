@@ -60,6 +60,7 @@ class WorldLimits:
     solids: int = 10_000
     rays_per_sensor: int = 1024              # DistanceSensor rays (after Webots' sanitising)
     beams_per_lidar: int = 1 << 20           # horizontal_resolution × number_of_layers
+    rays_per_image: int = 1 << 22            # a camera's or range finder's rays: width × height (× 4 anti-aliased)
     rays_per_step: int = 1 << 22             # every device due at once: distance rays + lidar beams + light occlusion rays
     triangles: int = 4_000_000               # tessellated primitives + meshes (planes are analytic)
     # textures (world/textures.py): each image file, each image's pixels, all images' pixels (3 bytes each)
@@ -73,7 +74,7 @@ class WorldLimits:
         return cls(file_bytes=1024 * MiB, mesh_file_bytes=4096 * MiB, nesting_depth=256, values=100_000_000,
                    name_chars=4096, string_chars=1 * MiB, number_magnitude=1e15, robots=100_000,
                    devices_per_robot=65_536, lights=65_536, solids=10_000_000, rays_per_sensor=1 << 20,
-                   beams_per_lidar=1 << 28, rays_per_step=1 << 30, triangles=1 << 30,
+                   beams_per_lidar=1 << 28, rays_per_image=1 << 28, rays_per_step=1 << 30, triangles=1 << 30,
                    texture_file_bytes=4096 * MiB, texture_pixels=1 << 30, texture_pixels_total=1 << 32)
 
     def describe(self) -> list[tuple[str, Any]]:

@@ -554,6 +554,13 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
             if dev.type == "laser" and upd.get("number_of_rays", dev.number_of_rays) > 1:
                 upd["number_of_rays"] = 1
                 warnings.append(f"{p}.number_of_rays: a laser sensor has a single ray, reset to 1")
+        if isinstance(dev, wm.RangeFinder):         # WbRangeFinder::updateNear/updateMinRange/updateMaxRange
+            if dev.near > dev.min_range:
+                upd["near"] = dev.min_range
+                warnings.append(f"{p}.near: greater than min_range, set to min_range {dev.min_range}")
+            if dev.max_range <= dev.min_range:
+                upd["max_range"] = dev.min_range + 1.0
+                warnings.append(f"{p}.max_range: not greater than min_range, set to min_range + 1")
         if isinstance(dev, wm.Lidar):
             if dev.near > dev.min_range:
                 upd["near"] = dev.min_range

@@ -4,7 +4,8 @@
  *             the heartbeat thread;
  * wire.c    - msgpack helpers (building requests, reading reply maps);
  * robot.c   - the session: attach, step (motor commands out, readings in), cleanup;
- * devices.c - light and distance sensors, generic device functions; lidar.c; motor.c.
+ * devices.c - light and distance sensors, generic device functions; lidar.c; motor.c;
+ * camera.c  - range finders and cameras.
  */
 #ifndef SENSORIUM_INTERNAL_H
 #define SENSORIUM_INTERNAL_H
@@ -101,7 +102,10 @@ void sn_conn_stop_heartbeat(sn_conn *c);
 const char *sn_conn_endpoint(const sn_conn *c);
 
 /* ------------------------------------------------------------------ robot.c */
-typedef enum { SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_OTHER } sn_kind;
+typedef enum { SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_RANGE_FINDER, SN_CAMERA,
+               SN_OTHER } sn_kind;
+
+struct sn_imaging; /* camera.c: a range finder's or camera's images and constants */
 
 typedef struct {
   WbDeviceTag tag;
@@ -133,6 +137,8 @@ typedef struct {
   /* GPS: position, speed, speed vector; WbGpsCoordinateSystem */
   double gps_values[3], gps_speed, gps_speed_vector[3];
   int coordinate_system;
+  /* range finder, camera (camera.c) */
+  struct sn_imaging *imaging;
   /* motor */
   double max_velocity, min_position, max_position, target_position, velocity;
   bool cmd_position, cmd_velocity; /* to send with the next step */
@@ -185,5 +191,12 @@ const double *sn_no_values(void);
 /* Webots' node type of a device type name ("DistanceSensor"), WB_NODE_NO_NODE if unknown. */
 int sn_node_type_of(const char *type_name);
 void sn_warn_disabled(sn_device *dev, const char *func, const char *enabler, const char *what);
+
+/* ------------------------------------------------------------------ camera.c */
+/* A range finder's or camera's state from its attach description (0, or -1 on a bad one); its
+ * readings from a step reply; freed at cleanup. No-ops for other devices. */
+int sn_imaging_describe(sn_device *d, const msgpack_object *desc);
+void sn_imaging_apply(sn_device *d, const msgpack_object *reading);
+void sn_imaging_free(sn_device *d);
 
 #endif /* SENSORIUM_INTERNAL_H */

@@ -59,6 +59,10 @@ static sn_kind kind_of(const char *type) {
     return SN_LED;
   if (strcmp(type, "GPS") == 0)
     return SN_GPS;
+  if (strcmp(type, "RangeFinder") == 0)
+    return SN_RANGE_FINDER;
+  if (strcmp(type, "Camera") == 0)
+    return SN_CAMERA;
   return SN_OTHER;
 }
 
@@ -136,6 +140,8 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
     if (d->range_image == NULL || d->point_cloud == NULL)
       return -1;
   }
+  if (sn_imaging_describe(d, desc) != 0)
+    return -1;
   d->motor_name = sn_strdup_obj(sn_get(desc, "motor"));
   d->led_value = (int)sn_int_or(desc, "value", 0);
   d->led_colors = count_leaves(sn_get(desc, "color")) / 3;
@@ -160,6 +166,7 @@ static void free_robot(sn_robot *rb) {
     free(d->range_image);
     free(d->point_cloud);
     free(d->motor_name);
+    sn_imaging_free(d);
   }
   sn_supervisor_free(rb);
   free(rb->devices);
@@ -350,6 +357,7 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
       if (!sn_as_double(sn_get(v, "speed"), &dev->gps_speed))
         dev->gps_speed = NAN;
     }
+    sn_imaging_apply(dev, v);
     if (dev->kind != SN_LIDAR)
       continue;
     size_t n = (size_t)dev->width * (size_t)dev->layers;
@@ -556,6 +564,8 @@ static bool kind_accepts(sn_kind kind, int node) {
     case SN_POSITION: return node == WB_NODE_POSITION_SENSOR;
     case SN_LED: return node == WB_NODE_LED;
     case SN_GPS: return node == WB_NODE_GPS;
+    case SN_RANGE_FINDER: return node == WB_NODE_RANGE_FINDER;
+    case SN_CAMERA: return node == WB_NODE_CAMERA;
     default: return false;
   }
 }

@@ -7,7 +7,6 @@
 #include <webots/accelerometer.h>
 #include <webots/altimeter.h>
 #include <webots/brake.h>
-#include <webots/camera.h>
 #include <webots/compass.h>
 #include <webots/connector.h>
 #include <webots/display.h>
@@ -15,7 +14,6 @@
 #include <webots/gyro.h>
 #include <webots/inertial_unit.h>
 #include <webots/radar.h>
-#include <webots/range_finder.h>
 #include <webots/receiver.h>
 #include <webots/skin.h>
 #include <webots/speaker.h>
@@ -93,162 +91,6 @@ WbDeviceTag wb_brake_get_motor(WbDeviceTag tag) {
 
 WbDeviceTag wb_brake_get_position_sensor(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_get_position_sensor");
-  return 0;
-}
-
-/* ------------------------------------------------------------------ Camera */
-void wb_camera_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_enable");
-}
-
-void wb_camera_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_disable");
-}
-
-int wb_camera_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_sampling_period");
-  return 0;
-}
-
-const unsigned char *wb_camera_get_image(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_image");
-  return NULL;
-}
-
-int wb_camera_get_width(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_width");
-  return 0;
-}
-
-int wb_camera_get_height(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_height");
-  return 0;
-}
-
-double wb_camera_get_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_fov");
-  return NAN;
-}
-
-double wb_camera_get_max_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_max_fov");
-  return NAN;
-}
-
-double wb_camera_get_min_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_min_fov");
-  return NAN;
-}
-
-void wb_camera_set_fov(WbDeviceTag tag, double fov) {
-  (void)fov;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_set_fov");
-}
-
-double wb_camera_get_exposure(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_exposure");
-  return NAN;
-}
-
-void wb_camera_set_exposure(WbDeviceTag tag, double exposure) {
-  (void)exposure;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_set_exposure");
-}
-
-double wb_camera_get_focal_length(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_focal_length");
-  return NAN;
-}
-
-double wb_camera_get_focal_distance(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_focal_distance");
-  return NAN;
-}
-
-double wb_camera_get_max_focal_distance(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_max_focal_distance");
-  return NAN;
-}
-
-double wb_camera_get_min_focal_distance(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_min_focal_distance");
-  return NAN;
-}
-
-void wb_camera_set_focal_distance(WbDeviceTag tag, double focal_distance) {
-  (void)focal_distance;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_set_focal_distance");
-}
-
-double wb_camera_get_near(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_get_near");
-  return NAN;
-}
-
-int wb_camera_save_image(WbDeviceTag tag, const char *filename, int quality) {
-  (void)filename;
-  (void)quality;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_save_image");
-  return 0;
-}
-
-bool wb_camera_has_recognition(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_has_recognition");
-  return false;
-}
-
-void wb_camera_recognition_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_enable");
-}
-
-void wb_camera_recognition_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_disable");
-}
-
-int wb_camera_recognition_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_sampling_period");
-  return 0;
-}
-
-int wb_camera_recognition_get_number_of_objects(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_number_of_objects");
-  return 0;
-}
-
-const WbCameraRecognitionObject *wb_camera_recognition_get_objects(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_objects");
-  return NULL;
-}
-
-bool wb_camera_recognition_has_segmentation(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_has_segmentation");
-  return false;
-}
-
-void wb_camera_recognition_enable_segmentation(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_enable_segmentation");
-}
-
-void wb_camera_recognition_disable_segmentation(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_disable_segmentation");
-}
-
-bool wb_camera_recognition_is_segmentation_enabled(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_is_segmentation_enabled");
-  return false;
-}
-
-const unsigned char *wb_camera_recognition_get_segmentation_image(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_get_segmentation_image");
-  return NULL;
-}
-
-int wb_camera_recognition_save_segmentation_image(WbDeviceTag tag, const char *filename, int quality) {
-  (void)filename;
-  (void)quality;
-  sn_unsimulated(tag, WB_NODE_CAMERA, "wb_camera_recognition_save_segmentation_image");
   return 0;
 }
 
@@ -603,58 +445,6 @@ double wb_radar_get_horizontal_fov(WbDeviceTag tag) {
 double wb_radar_get_vertical_fov(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_vertical_fov");
   return NAN;
-}
-
-/* ------------------------------------------------------------------ RangeFinder */
-void wb_range_finder_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_enable");
-}
-
-void wb_range_finder_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_disable");
-}
-
-int wb_range_finder_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_sampling_period");
-  return 0;
-}
-
-const float *wb_range_finder_get_range_image(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_range_image");
-  return NULL;
-}
-
-int wb_range_finder_get_width(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_width");
-  return 0;
-}
-
-int wb_range_finder_get_height(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_height");
-  return 0;
-}
-
-double wb_range_finder_get_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_fov");
-  return NAN;
-}
-
-double wb_range_finder_get_min_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_min_range");
-  return NAN;
-}
-
-double wb_range_finder_get_max_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_get_max_range");
-  return NAN;
-}
-
-int wb_range_finder_save_image(WbDeviceTag tag, const char *filename, int quality) {
-  (void)filename;
-  (void)quality;
-  sn_unsimulated(tag, WB_NODE_RANGE_FINDER, "wb_range_finder_save_image");
-  return 0;
 }
 
 /* ------------------------------------------------------------------ Receiver */

@@ -5,6 +5,7 @@ the path. State lives in :mod:`sensorium.client.wb`, so importing this package u
 
 from sensorium.client.connection import SensoriumError
 
+from .camera import Camera, CameraRecognitionObject
 from .device import Device, Sensor
 from .distance_sensor import DistanceSensor
 from .keyboard import Keyboard
@@ -14,8 +15,10 @@ from .light_sensor import LightSensor
 from .motor import Motor, RotationalMotor
 from .pen import Pen
 from .position_sensor import PositionSensor
+from .range_finder import RangeFinder
 from .robot import Robot
 from .supervisor import Field, Node, Supervisor
 
-__all__ = ["LED", "Device", "DistanceSensor", "Field", "Keyboard", "Lidar", "LidarPoint", "LightSensor", "Motor",
-           "Node", "Pen", "PositionSensor", "Robot", "RotationalMotor", "Sensor", "SensoriumError", "Supervisor"]
+__all__ = ["LED", "Camera", "CameraRecognitionObject", "Device", "DistanceSensor", "Field", "Keyboard", "Lidar",
+           "LidarPoint", "LightSensor", "Motor", "Node", "Pen", "PositionSensor", "RangeFinder", "Robot", "RotationalMotor",
+           "Sensor", "SensoriumError", "Supervisor"]

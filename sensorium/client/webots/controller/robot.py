@@ -6,6 +6,7 @@ import sys
 
 from sensorium.client import wb
 
+from .camera import Camera
 from .device import Device
 from .distance_sensor import DistanceSensor
 from .keyboard import Keyboard
@@ -15,6 +16,7 @@ from .light_sensor import LightSensor
 from .motor import RotationalMotor
 from .pen import Pen
 from .position_sensor import PositionSensor
+from .range_finder import RangeFinder
 
 _CLASSES: dict[str, type[Device]] = {
     wb.LIGHT_SENSOR: LightSensor,
@@ -24,6 +26,8 @@ _CLASSES: dict[str, type[Device]] = {
     wb.POSITION_SENSOR: PositionSensor,
     wb.LED: LED,
     "Pen": Pen,
+    wb.RANGE_FINDER: RangeFinder,
+    wb.CAMERA: Camera,
 }
 
 

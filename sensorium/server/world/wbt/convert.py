@@ -36,7 +36,7 @@ SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "I
            "ContactProperties", "Damping", "Muscle", "Propeller"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
 # the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
-OTHER_DEVICES = {"Camera", "RangeFinder", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
+OTHER_DEVICES = {"Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
                  "Compass", "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Charger",
                  "Connector", "Radar", "Altimeter", "VacuumGripper", "Radio", "Track", "Skin"}
 # Webots' default device names (the ``name`` field's default of each node)
@@ -45,7 +45,7 @@ OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh"}
 UNSEEN_GEOMETRIES = {"IndexedLineSet", "PointSet"}      # lines and points: no surface a ray could hit
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
-SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED"}
+SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder", "Camera"}
 JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
 MOTORS = {"RotationalMotor", "LinearMotor"}
 # the fields every Solid has (a device's own fields are the others)
@@ -220,6 +220,10 @@ class Converter:
             if not top:
                 raise self.error(node, "WorldInfo must be a top-level node")
             self.world_info(node)
+        elif t == "Background" and top and f.has("skyColor"):     # what cameras see past everything
+            sky = f.rows("skyColor", 3, [(0.0, 0.0, 0.0)])
+            self.world["background"] = {"sky_color": list(sky[0]) if sky else [0.0, 0.0, 0.0]}
+            self.skipped[t] += 1     # its other fields (textures, luminosity) are not read
         elif t in SKIPPED:
             self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
@@ -537,6 +541,14 @@ class Converter:
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
             self.def_name(node, data)
+            colors = f.rows("recognitionColors", 3, [])        # what cameras with a Recognition node report
+            if colors:
+                data["recognition_colors"] = [list(c) for c in colors]
+            if f.string("model", ""):
+                data["model"] = f.string("model", "")
+        elif f.has("recognitionColors") and f.rows("recognitionColors", 3, []):
+            self.warn(node, f"Solid {name!r}: recognitionColors of a nested solid are not read (give them to the "
+                            "top-level solid); ignored")
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
@@ -585,6 +597,9 @@ class Converter:
                     data[key] = value
             elif value != defaults[key]:
                 self.warn(node, f"Robot field {key}: not supported by this version; ignored")
+        colors = f.rows("recognitionColors", 3, [])
+        if colors:
+            data["recognition_colors"] = [list(c) for c in colors]
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.solid_contents(node, Frame.identity(), mine)

@@ -160,6 +160,30 @@ def device(node: Node, f: Fields) -> dict:
                 "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0),
                 "default_frequency": f.num("defaultFrequency", 10.0), "min_frequency": f.num("minFrequency", 1.0),
                 "max_frequency": f.num("maxFrequency", 25.0)}
+    if t == "RangeFinder":
+        projection = f.string("projection", "planar")
+        if f.flag("spherical", False) and projection == "planar":    # deprecated in R2023 (WbRangeFinder::init)
+            projection = "cylindrical"
+        return {"device": t, "field_of_view": f.num("fieldOfView", 0.785398), "width": f.integer("width", 64),
+                "height": f.integer("height", 64), "projection": projection, "near": f.num("near", 0.01),
+                "min_range": f.num("minRange", 0.01), "max_range": f.num("maxRange", 1.0),
+                "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
+    if t == "Camera":
+        projection = f.string("projection", "planar")
+        if f.flag("spherical", False) and projection == "planar":    # deprecated in R2023
+            projection = "spherical"
+        out = {"device": t, "field_of_view": f.num("fieldOfView", 0.785398), "width": f.integer("width", 64),
+               "height": f.integer("height", 64), "projection": projection, "near": f.num("near", 0.01),
+               "far": f.num("far", 0.0), "exposure": f.num("exposure", 1.0),
+               "anti_aliasing": f.flag("antiAliasing", False), "noise": f.num("noise", 0.0)}
+        rec = f.node_("recognition")
+        if rec is not None:
+            rf = Fields(rec, f.source)
+            out["recognition"] = {"max_range": rf.num("maxRange", 100.0), "max_objects": rf.integer("maxObjects", -1),
+                                  "occlusion": rf.integer("occlusion", 1), "frame_color": list(rf.vec("frameColor", (1.0, 0.0, 0.0))),
+                                  "frame_thickness": rf.integer("frameThickness", 1),
+                                  "segmentation": rf.flag("segmentation", False)}
+        return out
     if t == "PositionSensor":
         return {"device": t, "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
     if t == "LED":
@@ -177,6 +201,7 @@ def pen(f: Fields) -> dict:
 
 
 DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light sensor", "Lidar": "lidar",
+                "RangeFinder": "range-finder", "Camera": "camera",
                 "PositionSensor": "position sensor", "LED": "led", "RotationalMotor": "rotational motor"}
 
 

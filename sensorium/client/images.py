@@ -1,0 +1,64 @@
+"""Saving images as Webots' ``save_image`` functions do: PNG written here (zlib only, the client
+stays light), JPEG through Pillow when it is installed. Returns Webots' 0 / -1."""
+
+from __future__ import annotations
+
+import struct
+import sys
+import zlib
+
+
+def _chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+
+def png_bytes(rgb: bytes, width: int, height: int) -> bytes:
+    """An 8-bit RGB PNG of ``rgb`` (``height`` rows of ``width`` × 3 bytes, top row first)."""
+    row = 3 * width
+    raw = b"".join(b"\0" + rgb[y * row:(y + 1) * row] for y in range(height))
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + _chunk(b"IHDR", header) + _chunk(b"IDAT", zlib.compress(raw, 6)) + _chunk(b"IEND", b"")
+
+
+def bgra_to_rgb(bgra: bytes) -> bytes:
+    out = bytearray(len(bgra) // 4 * 3)
+    out[0::3] = bgra[2::4]
+    out[1::3] = bgra[1::4]
+    out[2::3] = bgra[0::4]
+    return bytes(out)
+
+
+def save_rgb(func: str, filename: str, quality: int, rgb: bytes, width: int, height: int) -> int:
+    """Webots' checks and formats: ``.png``, ``.jpg``/``.jpeg`` (quality 1..100); -1 with Webots'
+    message on a bad argument, an unknown extension or a file that cannot be written."""
+    if not filename:
+        print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
+        return -1
+    if isinstance(quality, bool) or not isinstance(quality, int) or not 1 <= quality <= 100:
+        print(f"Error: {func}() called with invalid 'quality' argument.", file=sys.stderr)
+        return -1
+    lower = str(filename).lower()
+    try:
+        if lower.endswith(".png"):
+            data = png_bytes(rgb, width, height)
+        elif lower.endswith((".jpg", ".jpeg")):
+            try:
+                from PIL import Image
+            except ImportError:
+                print(f"Error: {func}(): JPEG needs Pillow here (pip install pillow); save a .png instead.",
+                      file=sys.stderr)
+                return -1
+            import io
+            buf = io.BytesIO()
+            Image.frombytes("RGB", (width, height), rgb).save(buf, format="JPEG", quality=quality)
+            data = buf.getvalue()
+        else:
+            print(f"Error: {func}(): unsupported image format of {filename!r} (use .png, .jpg or .jpeg).",
+                  file=sys.stderr)
+            return -1
+        with open(filename, "wb") as f:
+            f.write(data)
+    except OSError as exc:
+        print(f"Error: {func}(): cannot write {filename!r}: {exc.strerror or exc}", file=sys.stderr)
+        return -1
+    return 0

@@ -1,0 +1,171 @@
+"""Image geometry of Webots' cameras and range finders — pure math, device frame FLU, float64.
+
+An image is ``width`` × ``height`` pixels, row 0 at the top, column 0 at the left (Webots' scan
+lines). Pixel ``(r, j)`` is sampled at image coordinates ``u = (j + ox)/W``, ``v = (r + oy)/H``
+with ``(ox, oy) = (½, ½)`` (its centre) or, with anti-aliasing, the four points of a 2×2 grid
+(``¼``, ``¾``). Φ = ``fieldOfView`` (horizontal).
+
+Projections (Webots' ``WbWrenCamera`` and its ``merge_spherical.frag``)
+    * ``planar`` — a pinhole camera with square pixels: the ray through ``(u, v)`` is
+      ``(1, (1 − 2u)·tan(Φ/2), (1 − 2v)·tan(Φ/2)·H/W)``, so the vertical field of view is
+      ``2·atan(tan(Φ/2)·H/W)`` (``computeFieldOfViewY``; Webots' reference formula).
+    * ``cylindrical`` — equal angles: azimuth ``(½ − u)·Φ``, elevation ``(½ − v)·Φ·H/W``,
+      direction ``(cos e cos a, cos e sin a, sin e)``.
+    * ``spherical`` — Webots' fisheye: with ``(dx, dy) = (u − ½, v − ½)`` (each in its own axis'
+      unit, as the shader has them) the ray makes the angle ``ψ = |(dx, dy)|·Φ`` with +x, in the
+      direction ``(−dx, −dy)`` of the image plane: ``(cos ψ, −sin ψ·dx/ρ, −sin ψ·dy/ρ)``. A
+      non-square spherical image therefore spans Φ vertically as well (the shader's choice).
+
+Range values (``range_image``)
+    ``planar``: the depth along +x (the distance to the plane x = 0 of the device, Webots' reference
+    page), i.e. ``t·cos`` of the ray with +x; the other projections: the distance ``t`` along the
+    ray (the merge shader's depth/cosine). Then Webots' steps, as for the lidar: no hit,
+    ``v < minRange`` or ``v >= maxRange`` → ``+inf``; Gaussian noise σ = ``noise·maxRange``
+    (reference manual) on each finite value; ``resolution`` rounding ``floor(v/res + ½)·res``; the
+    bounds again (noise or rounding can push a value out, never in); float32.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .lookup import RESOLUTION_OFF, quantize_lidar
+from .noise import gaussian
+
+__all__ = ["PROJECTIONS", "ImageGeometry", "SAMPLES_CENTRE", "SAMPLES_2X2", "pixel_directions", "depth_factors",
+           "clip_limits", "range_values", "pinhole_intrinsics"]
+
+PROJECTIONS = ("planar", "cylindrical", "spherical")
+SAMPLES_CENTRE = ((0.5, 0.5),)
+"""One sample per pixel: its centre."""
+SAMPLES_2X2 = ((0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75))
+"""Anti-aliasing: a 2×2 grid of samples per pixel (supersampling)."""
+
+
+@dataclass(frozen=True, slots=True)
+class ImageGeometry:
+    """What decides the pixels' rays (Webots' fields)."""
+
+    width: int
+    height: int
+    field_of_view: float
+    projection: str = "planar"
+
+    def __post_init__(self) -> None:
+        if int(self.width) < 1 or int(self.height) < 1:
+            raise ValueError(f"image size must be at least 1 x 1, got {self.width} x {self.height}")
+        if self.projection not in PROJECTIONS:
+            raise ValueError(f"projection must be one of {', '.join(PROJECTIONS)}, got {self.projection!r}")
+        if not 0.0 < float(self.field_of_view) <= 2.0 * math.pi:
+            raise ValueError(f"field_of_view must be in (0, 2 pi], got {self.field_of_view}")
+        if self.projection == "planar" and float(self.field_of_view) >= math.pi:
+            raise ValueError(f"a planar projection needs field_of_view < pi, got {self.field_of_view}")
+
+    @property
+    def planar(self) -> bool:
+        return self.projection == "planar"
+
+    @property
+    def vertical_field_of_view(self) -> float:
+        """The image's vertical extent (rad): planar ``2·atan(tan(Φ/2)·H/W)``, cylindrical ``Φ·H/W``,
+        spherical ``Φ`` (see the module docstring)."""
+        fov, w, h = float(self.field_of_view), int(self.width), int(self.height)
+        if self.projection == "planar":
+            return 2.0 * math.atan(math.tan(fov / 2.0) * h / w)
+        if self.projection == "cylindrical":
+            return fov * h / w
+        return fov
+
+
+def _grid(g: ImageGeometry, samples) -> tuple[np.ndarray, np.ndarray]:
+    """Image coordinates ``u`` (S, 1, W) and ``v`` (S, H, 1) of every sample."""
+    W, H = int(g.width), int(g.height)
+    off = np.asarray(samples, dtype=np.float64).reshape(-1, 2)
+    u = (np.arange(W)[None, None, :] + off[:, 0][:, None, None]) / W
+    v = (np.arange(H)[None, :, None] + off[:, 1][:, None, None]) / H
+    return u, v
+
+
+def pixel_directions(g: ImageGeometry, samples=SAMPLES_CENTRE) -> np.ndarray:
+    """Unit ray directions (S, H, W, 3) in the device frame (FLU) for each sample of each pixel."""
+    u, v = _grid(g, samples)
+    fov = float(g.field_of_view)
+    S, H, W = len(u), int(g.height), int(g.width)
+    if g.projection == "planar":
+        t = math.tan(fov / 2.0)
+        y = np.broadcast_to((1.0 - 2.0 * u) * t, (S, H, W))
+        z = np.broadcast_to((1.0 - 2.0 * v) * (t * H / W), (S, H, W))
+        d = np.stack([np.ones((S, H, W)), y, z], axis=-1)
+        return d / np.linalg.norm(d, axis=-1, keepdims=True)
+    if g.projection == "cylindrical":
+        a = np.broadcast_to((0.5 - u) * fov, (S, H, W))
+        e = np.broadcast_to((0.5 - v) * (fov * H / W), (S, H, W))
+        ce = np.cos(e)
+        return np.stack([ce * np.cos(a), ce * np.sin(a), np.sin(e)], axis=-1)
+    dx = np.broadcast_to(u - 0.5, (S, H, W))
+    dy = np.broadcast_to(v - 0.5, (S, H, W))
+    rho = np.hypot(dx, dy)
+    psi = rho * fov
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.where(rho > 0.0, np.sin(psi) / rho, 0.0)
+    return np.stack([np.cos(psi), -k * dx, -k * dy], axis=-1)
+
+
+def depth_factors(g: ImageGeometry, directions: np.ndarray) -> np.ndarray | None:
+    """The factor turning a ray's hit distance into the stored range: the ray's cosine with +x
+    for a planar image (depth), ``None`` (1) otherwise."""
+    if not g.planar:
+        return None
+    return np.ascontiguousarray(directions[..., 0])
+
+
+def clip_limits(g: ImageGeometry, factors: np.ndarray | None, near: float, far: float
+                ) -> tuple[np.ndarray | float, np.ndarray | float]:
+    """Per-ray ``(t_near, t_far)`` of the clipping planes ``near`` and ``far`` (``far`` = inf: none):
+    planes at those depths for a planar image (the OpenGL frustum), spheres of those radii for the
+    others (Webots: the near and far planes of a spherical camera are sphere parts)."""
+    if factors is None:
+        return float(near), float(far)
+    f = factors.reshape(-1)
+    with np.errstate(divide="ignore"):
+        return float(near) / f, (float(far) / f if math.isfinite(far) else float(far))
+
+
+def range_values(distances: np.ndarray, factors: np.ndarray | None, min_range: float, max_range: float,
+                 noise: float, resolution: float, rng: np.random.Generator | None) -> np.ndarray:
+    """The range image (float32, shape of ``distances``) from the hit distances (``+inf`` = no hit)
+    and :func:`depth_factors` (module docstring: validity, noise σ = ``noise·max_range``, resolution,
+    bounds). ``rng`` None: no noise."""
+    d = np.asarray(distances, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        v = d if factors is None else d * np.asarray(factors).reshape(d.shape)
+    lo, hi = float(min_range), float(max_range)
+    noisy = noise > 0.0 and rng is not None
+    with np.errstate(invalid="ignore", over="ignore"):
+        valid = np.isfinite(v) & (v >= lo) & (v < hi)
+        if not noisy and resolution == RESOLUTION_OFF:
+            out = v.astype(np.float32)
+            out[~valid | (out >= np.float32(hi))] = np.inf     # a value just below maxRange may round up to it
+            return out
+        v = np.where(valid, v, np.inf)
+        if noisy:
+            count = int(np.count_nonzero(valid))
+            if count:
+                v[valid] += float(noise) * hi * gaussian(rng, count)   # type: ignore[arg-type]
+        v = quantize_lidar(v, resolution)
+        out = np.where((v >= lo) & (v < hi), v, np.inf).astype(np.float32)
+    out[out >= np.float32(hi)] = np.inf
+    return out
+
+
+def pinhole_intrinsics(g: ImageGeometry) -> tuple[float, float, float, float]:
+    """``(fx, fy, cx, cy)`` of a planar image in pixels, pixel centres at integer coordinates (ROS'
+    CameraInfo convention): ``fx = fy = (W/2)/tan(Φ/2)``, ``cx = (W − 1)/2``, ``cy = (H − 1)/2`` —
+    exactly the rays of :func:`pixel_directions` (square pixels)."""
+    if not g.planar:
+        raise ValueError("only a planar image has pinhole intrinsics")
+    f = (int(g.width) / 2.0) / math.tan(float(g.field_of_view) / 2.0)
+    return f, f, (int(g.width) - 1) / 2.0, (int(g.height) - 1) / 2.0

@@ -1,0 +1,127 @@
+"""A camera pixel's colour — pure math, world frame, float64.
+
+The light a surface point sends to the camera is the LightSensor's sum (``light.py``, spec §2.2)
+with the surface's normal in place of the sensor's axis and its albedo in place of the colour
+filter, per RGB channel ``c``::
+
+    L_c = albedo_c · Σ_lights att · (Ia + I · max(N·L, 0) · spot · lit) · C_c
+
+``att`` the light's attenuation ``1/(a1 + a2 d + a3 d²)`` (1 for a directional light), ``Ia`` its
+ambient intensity, ``I`` its intensity, ``spot`` Webots' spot cut-off factor, ``lit`` 0 where a
+shadow-casting light is occluded, ``C`` its colour; ``N`` faces the camera (both faces of a surface
+are lit as seen). The albedo is the shape's ``base_color`` times its texture's texel, the texel
+converted from sRGB to linear as Webots' shaders do (``SRGBtoLINEAR``).
+
+Semi-transparent surfaces are composited front to back (Webots' alpha blending: a surface of
+``transparency`` τ adds ``(1 − τ)·L`` and lets ``τ`` of what is behind through); what no surface
+covers is the background colour. The sum is a radiance in Webots' HDR buffer; the pixel is
+Webots' ``hdr_resolve``: ``v = (1 − exp(−L·exposure))^(1/2.2)``; then ``noise`` (Gaussian, σ =
+``noise`` in [0, 1] units, per channel, clamped: ``color_noise.frag``) and the byte
+``⌊255·v + ½⌋``. Anti-aliasing averages the radiance of a 2×2 grid of rays per pixel.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .light import LightArrays, LightKind
+from .noise import gaussian
+
+__all__ = ["GAMMA", "srgb_to_linear", "radiance", "tone_map", "to_bytes"]
+
+GAMMA = 2.2
+"""Webots' ``hdr_resolve.frag`` gamma."""
+
+
+def srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    """Webots' ``SRGBtoLINEAR`` of colours in [0, 1]."""
+    c = np.asarray(c, dtype=np.float64)
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def radiance(points: np.ndarray, normals: np.ndarray, albedo: np.ndarray, lights: LightArrays,
+             lit: np.ndarray | None = None) -> np.ndarray:
+    """``L`` (S, 3) at S surface points (S, 3) with unit normals facing the camera (S, 3) and
+    albedos (S, 3); ``lit`` (S, n) False where a light's direct term is shadowed (None: all lit).
+
+    The LightSensor's terms (``light.py``: ``att``, ``c = N·(q − p)/d``, the spot factor from
+    ``alpha = atan2(|L × R|, L·R)``) evaluated light by light on columns: an image has many points
+    and few lights, so this keeps every temporary one column long."""
+    P = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    A = np.asarray(albedo, dtype=np.float64).reshape(-1, 3)
+    S = len(P)
+    acc = np.zeros((S, 3))
+    if len(lights) == 0 or S == 0:
+        return acc
+    px, py, pz = P[:, 0], P[:, 1], P[:, 2]
+    nx, ny, nz = N[:, 0], N[:, 1], N[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for j in range(len(lights)):
+            kind = int(lights.kind[j])
+            intensity, ambient = float(lights.intensity[j]), float(lights.ambient_intensity[j])
+            if kind == LightKind.DIRECTIONAL:          # L = -direction (unit), att = 1
+                dx, dy, dz = (-float(c) for c in lights.direction[j])
+                c = nx * dx
+                c += ny * dy
+                c += nz * dz
+                direct = np.maximum(c, 0.0)
+                direct *= intensity
+                att: np.ndarray | None = None
+                length = None
+            else:
+                qx, qy, qz = (float(c) for c in lights.position[j])
+                vx, vy, vz = qx - px, qy - py, qz - pz
+                length = np.sqrt(vx * vx + vy * vy + vz * vz)
+                a1, a2, a3 = (float(c) for c in lights.attenuation[j])
+                att = 1.0 / (a1 + length * (a2 + a3 * length)) if (a2 or a3) else None
+                if att is None and a1 != 1.0:
+                    att = np.full(S, 1.0 / a1)
+                safe = np.where(length > 0.0, length, 1.0)
+                c = nx * vx
+                c += ny * vy
+                c += nz * vz
+                c /= safe
+                direct = np.maximum(c, 0.0)
+                direct *= intensity
+                if kind == LightKind.SPOT:
+                    # alpha = atan2(|L x R|, L.R) as the LightSensor; outside [bw, co] only its side matters
+                    rx, ry, rz = (-float(v) for v in lights.direction[j])
+                    cosa = (vx * rx + vy * ry + vz * rz) / safe
+                    bw, co = float(lights.beam_width[j]), float(lights.cut_off_angle[j])
+                    factor = np.where(cosa >= math.cos(bw), 1.0, 0.0)
+                    band = ((cosa < math.cos(bw)) & (cosa >= math.cos(co))).nonzero()[0]
+                    if len(band):
+                        ux, uy, uz = vx[band] / safe[band], vy[band] / safe[band], vz[band] / safe[band]
+                        cx, cy, cz = uy * rz - uz * ry, uz * rx - ux * rz, ux * ry - uy * rx
+                        alpha = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * rx + uy * ry + uz * rz)
+                        factor[band] = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, (alpha - co) / (bw - co)))
+                    direct *= factor
+            if lit is not None:
+                direct = np.where(lit[:, j], direct, 0.0)
+            weight = direct
+            weight += ambient
+            if att is not None:
+                if length is not None and not np.all(length > 0.0):     # a point at the light: att may be inf
+                    weight = np.where(weight == 0.0, 0.0, att * weight)    # a zero term stays zero
+                else:
+                    weight *= att
+            acc += weight[:, None] * lights.color[j]
+    return A * acc
+
+
+def tone_map(radiance: np.ndarray, exposure: float) -> np.ndarray:
+    """Webots' HDR resolve: ``(1 − exp(−L·exposure))^(1/2.2)`` (values in [0, 1))."""
+    with np.errstate(over="ignore"):
+        return (1.0 - np.exp(-np.maximum(radiance, 0.0) * float(exposure))) ** (1.0 / GAMMA)
+
+
+def to_bytes(values: np.ndarray, noise: float = 0.0, rng: np.random.Generator | None = None) -> np.ndarray:
+    """Display values in [0, 1] → uint8, with Webots' colour noise first (σ = ``noise``, one
+    standard normal per value in C order from ``rng``, clamped to [0, 1])."""
+    v = np.asarray(values, dtype=np.float64)
+    if noise > 0.0 and rng is not None:
+        v = np.clip(v + float(noise) * gaussian(rng, v.size).reshape(v.shape), 0.0, 1.0)
+    return np.floor(np.clip(v, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)

@@ -1,0 +1,450 @@
+"""Devices that see images: Webots' RangeFinder (and Camera, its recognition) on the ray engine.
+
+An image is a batch of rays, one per pixel (four with anti-aliasing), rigidly mounted on the
+device: their directions in the device frame are made once (on the first capture), rotated into
+the world only when the device turns, and cast in one engine call (plus, for a camera, the calls
+its shading needs). Nothing is computed while a device is disabled; the simulation calls
+``capture`` when ``due``. The pure models are ``server/devices/imaging.py`` (rays, ranges),
+``shading.py`` (colours) and ``recognition.py`` (objects).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, ClassVar
+
+import numpy as np
+
+from sensorium.server.devices import imaging, shading
+from sensorium.server.devices import light as light_math
+from sensorium.server.raycast.engine import RayKind
+from sensorium.server.sim.sensors import Device, Schedule
+from sensorium.server.sim.sensors import _check_period as _period
+from sensorium.server.world.geometry import Pose
+
+__all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info"]
+
+
+class MountedRays:
+    """A device's pixel rays: local directions (made once), world directions kept until the
+    device's rotation changes (a parked or translating robot rotates nothing), and their float32
+    copy for Embree."""
+
+    def __init__(self, local: np.ndarray):
+        self.local = np.ascontiguousarray(local.reshape(-1, 3))
+        self._cols = tuple(np.ascontiguousarray(self.local[:, k]) for k in range(3))
+        self._key: bytes | None = None
+        self.world = np.empty((0, 3))
+        self.world32 = np.empty((0, 3), dtype=np.float32)
+
+    def __len__(self) -> int:
+        return len(self.local)
+
+    def at(self, rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        key = rotation.tobytes()
+        if key != self._key:
+            x, y, z = self._cols
+            out = np.empty((len(x), 3))
+            for k in range(3):     # by columns: no BLAS call (threads stall on a busy machine)
+                out[:, k] = x * rotation[k, 0] + y * rotation[k, 1] + z * rotation[k, 2]
+            out.flags.writeable = False
+            w32 = out.astype(np.float32)
+            w32.flags.writeable = False
+            self._key, self.world, self.world32 = key, out, w32
+        return self.world, self.world32
+
+
+def camera_info(geometry: imaging.ImageGeometry) -> dict:
+    """The fields of a ``sensor_msgs/CameraInfo`` after its header (a planar image's exact pinhole)."""
+    fx, fy, cx, cy = imaging.pinhole_intrinsics(geometry)
+    k = np.array([fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0], dtype="<f8")
+    p = np.array([fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0], dtype="<f8")
+    return {"height": int(geometry.height), "width": int(geometry.width), "distortion_model": "plumb_bob",
+            "d": bytes(40), "k": k.tobytes(), "r": np.eye(3, dtype="<f8").tobytes(), "p": p.tobytes(),
+            "binning_x": 0, "binning_y": 0,
+            "roi": {"x_offset": 0, "y_offset": 0, "height": 0, "width": 0, "do_rectify": False}}
+
+
+class RangeFinder(Device):
+    """Webots' RangeFinder: a float32 range image (H, W), zeros before the first one (Webots)."""
+
+    captures: ClassVar[bool] = True
+    """The simulation calls ``capture(now_ms, counters)`` when ``due(now_ms)``."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        c = self.config
+        self.geometry = imaging.ImageGeometry(c.width, c.height, c.field_of_view, c.projection)
+        self.range_image = np.zeros((c.height, c.width), dtype=np.float32)
+        self._rays: MountedRays | None = None
+        self._factors: np.ndarray | None = None
+        self._limits: tuple[Any, Any] = (0.0, 0.0)
+        self._robot: Any = None
+        self._scene: Any = None
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._scene = robot.scene
+
+    # -- controller API
+    def describe(self) -> dict:
+        c = self.config
+        return {"width": int(c.width), "height": int(c.height), "fov": float(c.field_of_view),
+                "near": float(c.near), "minRange": float(c.min_range), "maxRange": float(c.max_range),
+                "projection": c.projection}
+
+    def readings(self) -> dict:
+        return {"range_image": self.range_image}
+
+    def camera_info(self) -> dict:
+        return camera_info(self.geometry)
+
+    # -- measurement
+    def due(self, now_ms: int) -> bool:
+        return self.schedule.due(now_ms)
+
+    def _prepare(self) -> MountedRays:
+        if self._rays is None:
+            dirs = imaging.pixel_directions(self.geometry)[0]
+            self._factors = imaging.depth_factors(self.geometry, dirs)
+            # rays need not reach beyond max_range (in depth for a planar image): nothing there counts
+            self._limits = imaging.clip_limits(self.geometry, self._factors, self.config.near, self.config.max_range)
+            self._rays = MountedRays(dirs)
+        return self._rays
+
+    def capture(self, now_ms: int, counters: Any) -> None:
+        rays = self._prepare()
+        pose: Pose = self.world_pose(self._robot.pose)
+        dirs, dirs32 = rays.at(pose.rotation)
+        origins = np.broadcast_to(pose.translation, dirs.shape)
+        t_near, t_far = self._limits
+        hits = self._scene.engine.cast(origins, dirs, t_near, t_far, kind=RayKind.VISUAL, exclude_owner=-1,
+                                       distance_only=True, directions32=dirs32)
+        counters["rays_range_finder"] += len(rays)
+        counters["cast_calls"] += 1
+        c = self.config
+        self.range_image = imaging.range_values(
+            hits.distance.reshape(c.height, c.width), self._factors, c.min_range, c.max_range, c.noise,
+            c.resolution, self.rng if c.noise > 0 else None)
+        self.schedule.last_update_ms = now_ms
+        self._mark(now_ms)
+
+
+# ---------------------------------------------------------------------------------- Camera
+
+MAX_LAYERS = 8
+"""Semi-transparent surfaces composited along one ray; the next surface is taken as opaque."""
+
+_LIGHT_KINDS = {"PointLight": light_math.LightKind.POINT, "SpotLight": light_math.LightKind.SPOT,
+                "DirectionalLight": light_math.LightKind.DIRECTIONAL}
+
+
+def camera_lights(models: list) -> tuple[light_math.LightArrays, np.ndarray]:
+    """The lights that are on (world frame) and which of them cast shadows (Webots' castShadows)."""
+    out, shadows = [], []
+    for m in models:
+        if not m.on:
+            continue
+        fields = dict(kind=_LIGHT_KINDS[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity,
+                      color=m.color)
+        if m.type != "DirectionalLight":
+            fields.update(position=m.location, attenuation=m.attenuation)
+        if m.type != "PointLight":
+            fields.update(direction=m.direction)
+        if m.type == "SpotLight":
+            fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
+        out.append(light_math.Light(**fields))
+        shadows.append(bool(m.cast_shadows))
+    return light_math.LightArrays.from_lights(out), np.array(shadows, dtype=bool)
+
+
+class Camera(Device):
+    """Webots' Camera: a BGRA image (H, W, 4) uint8, black (alpha 255) before the first one (Webots).
+    The shading model is ``server/devices/shading.py``."""
+
+    captures: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        c = self.config
+        self.geometry = imaging.ImageGeometry(c.width, c.height, c.field_of_view, c.projection)
+        self.image = np.zeros((c.height, c.width, 4), dtype=np.uint8)
+        self.image[:, :, 3] = 255
+        self.exposure = float(c.exposure)
+        self._samples = imaging.SAMPLES_2X2 if c.anti_aliasing else imaging.SAMPLES_CENTRE
+        self._rays: MountedRays | None = None
+        self._limits: tuple[Any, Any] = (0.0, 0.0)
+        self._robot: Any = None
+        self._scene: Any = None
+        self._background = np.zeros(3)
+        self._lights: tuple[int, light_math.LightArrays, np.ndarray] | None = None
+        self._bytes: tuple[int, bytes] = (-1, b"")
+        # recognition (Webots' Recognition node): its own period, objects, segmentation image
+        self.recognition_schedule = Schedule()
+        self.segmentation_enabled = False
+        self.objects: list[Any] = []
+        self.segmentation_image = np.zeros((c.height, c.width, 4), dtype=np.uint8)
+        self.segmentation_image[:, :, 3] = 255
+        self._recognizer: Any = None
+        self._centre_rays: MountedRays | None = None
+        self._image_at = self._segmentation_at = -1      # the measurement that made the latest of each
+        self._seg_bytes: tuple[int, bytes] = (-1, b"")
+
+    def bind(self, robot: Any) -> None:
+        self._robot = robot
+        self._scene = robot.scene
+        self._background = self._scene.background
+
+    # -- controller API
+    def describe(self) -> dict:
+        c = self.config
+        rc = c.recognition
+        return {"width": int(c.width), "height": int(c.height), "fov": float(c.field_of_view), "near": float(c.near),
+                "far": float(c.far), "exposure": float(self.exposure), "projection": c.projection,
+                "anti_aliasing": bool(c.anti_aliasing), "noise": float(c.noise),
+                "has_recognition": rc is not None, "has_segmentation": bool(rc is not None and rc.segmentation),
+                "recognition_sampling_period": int(self.recognition_schedule.period_ms),
+                "segmentation_enabled": bool(self.segmentation_enabled)}
+
+    # -- recognition (controller API)
+    def recognition_enable(self, period_ms: int) -> None:
+        """Webots' ``wb_camera_recognition_enable`` (0 disables it, and the segmentation with it)."""
+        if self.config.recognition is None:
+            raise ValueError("this camera has no Recognition node")
+        self.recognition_schedule.enable(_period(period_ms), self.clock())
+        if period_ms == 0:
+            self.segmentation_enabled = False
+
+    def controller_released(self) -> None:
+        """The robot's controller left: its recognition requests end with it."""
+        self.recognition_schedule.enable(0, self.clock())
+        self.segmentation_enabled = False
+
+    def enable_segmentation(self, on: bool) -> None:
+        rc = self.config.recognition
+        if on and (rc is None or not rc.segmentation):
+            raise ValueError("this camera's Recognition node has no segmentation (segmentation: true)")
+        if on and self.recognition_schedule.period_ms <= 0:
+            raise ValueError("the segmentation needs the recognition enabled first (recognition_enable)")
+        self.segmentation_enabled = bool(on)
+
+    def set_exposure(self, exposure: float) -> None:
+        if not (isinstance(exposure, (int, float)) and math.isfinite(exposure) and exposure >= 0.0):
+            raise ValueError(f"exposure must be a finite number >= 0, got {exposure!r}")
+        self.exposure = float(exposure)
+
+    def readings(self) -> dict:
+        return {"image": self.image}
+
+    def image_bytes(self) -> bytes:
+        """The BGRA bytes of the latest image, made once per image (topics and step replies share them)."""
+        if self._bytes[0] != self._image_at:
+            self._bytes = (self._image_at, self.image.tobytes())
+        return self._bytes[1]
+
+    def segmentation_bytes(self) -> bytes:
+        if self._seg_bytes[0] != self._segmentation_at:
+            self._seg_bytes = (self._segmentation_at, self.segmentation_image.tobytes())
+        return self._seg_bytes[1]
+
+    def step_reading(self) -> dict:
+        out: dict[str, Any] = {}
+        if self.schedule.period_ms > 0:
+            out["image"] = self.image_bytes()
+        if self.recognition_schedule.period_ms > 0:
+            out["recognition"] = [o.as_dict() for o in self.objects]
+            if self.segmentation_enabled:
+                out["segmentation_image"] = self.segmentation_bytes()
+        return out
+
+    def image_data(self, reading: str) -> tuple[int, int, str, bytes] | None:
+        """(height, width, encoding, bytes) of an image a topic publishes (``sensor_msgs/Image``), or
+        None when the latest measurement did not make it (a recognition-only one, say)."""
+        c = self.config
+        if reading == "segmentation_image":
+            if self._segmentation_at != self.measurements:
+                return None
+            return int(c.height), int(c.width), "bgra8", self.segmentation_bytes()
+        if self._image_at != self.measurements:
+            return None
+        return int(c.height), int(c.width), "bgra8", self.image_bytes()
+
+    def camera_info(self) -> dict:
+        return camera_info(self.geometry)
+
+    # -- measurement
+    def due(self, now_ms: int) -> bool:
+        return self.schedule.due(now_ms) or self.recognition_schedule.due(now_ms)
+
+    def _prepare(self) -> MountedRays:
+        if self._rays is None:
+            c = self.config
+            dirs = imaging.pixel_directions(self.geometry, self._samples)
+            factors = imaging.depth_factors(self.geometry, dirs)
+            self._limits = imaging.clip_limits(self.geometry, factors, c.near, c.far if c.far > 0 else math.inf)
+            self._rays = MountedRays(dirs)
+        return self._rays
+
+    def _light_arrays(self) -> tuple[light_math.LightArrays, np.ndarray]:
+        scene = self._scene
+        if self._lights is None or self._lights[0] != scene.lights_version:
+            arrays, shadows = camera_lights(scene.world_lights())
+            self._lights = (scene.lights_version, arrays, shadows)
+        return self._lights[1], self._lights[2]
+
+    def capture(self, now_ms: int, counters: Any) -> None:
+        pose: Pose = self.world_pose(self._robot.pose)
+        if self.schedule.due(now_ms):
+            self._capture_image(pose, counters)
+            self.schedule.last_update_ms = now_ms
+            self._image_at = self.measurements + 1
+        if self.recognition_schedule.due(now_ms):
+            self._recognise(pose, counters)
+            self.recognition_schedule.last_update_ms = now_ms
+        self._mark(now_ms)
+
+    def _recognise(self, pose: Pose, counters: Any) -> None:
+        from sensorium.server.sim.recognition import Recognizer
+
+        rc = self.config.recognition
+        assert rc is not None
+        if self._recognizer is None:
+            self._recognizer = Recognizer(self._scene, self.robot_index, rc, self.geometry)
+        rec = self._recognizer
+        pixels = None
+        if rc.occlusion == 2 or self.segmentation_enabled:
+            pixels = self._pixel_objects(pose, rec, counters)
+        self.objects = rec.recognise(pose, pixels, counters)
+        if self.segmentation_enabled and pixels is not None:
+            c = self.config
+            self.segmentation_image = rec.segmentation(pixels, c.height, c.width)
+            self._segmentation_at = self.measurements + 1
+
+    def _pixel_objects(self, pose: Pose, rec: Any, counters: Any) -> np.ndarray:
+        """The recognisable object (index, -1 none) each pixel centre's ray sees within max_range."""
+        c = self.config
+        if self._centre_rays is None:
+            dirs = imaging.pixel_directions(self.geometry)[0]
+            self._centre_factors = imaging.depth_factors(self.geometry, dirs)
+            rng = float(c.recognition.max_range) if c.recognition is not None else math.inf
+            self._centre_limits = imaging.clip_limits(self.geometry, self._centre_factors, c.near, rng)
+            self._centre_rays = MountedRays(dirs)
+        dirs, dirs32 = self._centre_rays.at(pose.rotation)
+        t_near, t_far = self._centre_limits
+        hits = self._scene.engine.cast(np.broadcast_to(pose.translation, dirs.shape), dirs, t_near, t_far,
+                                       kind=RayKind.VISUAL, exclude_owner=-1, directions32=dirs32)
+        counters["rays_camera"] += len(dirs)
+        counters["cast_calls"] += 1
+        return np.where(np.isfinite(hits.distance), rec.key_of[hits.shape], -1)
+
+    def _capture_image(self, pose: Pose, counters: Any) -> None:
+        rays = self._prepare()
+        dirs, dirs32 = rays.at(pose.rotation)
+        L = self._render(pose.translation, dirs, dirs32, counters)
+        c = self.config
+        S = len(self._samples)
+        if S > 1:      # supersampling: the mean radiance of the pixel's rays
+            L = L.reshape(S, -1, 3).mean(axis=0)
+        v = shading.tone_map(L, self.exposure).reshape(c.height, c.width, 3)
+        rgb = shading.to_bytes(v, c.noise, self.rng if c.noise > 0 else None)
+        image = np.empty((c.height, c.width, 4), dtype=np.uint8)
+        image[:, :, 0], image[:, :, 1], image[:, :, 2], image[:, :, 3] = rgb[:, :, 2], rgb[:, :, 1], rgb[:, :, 0], 255
+        self.image = image
+
+    def _render(self, origin: np.ndarray, dirs: np.ndarray, dirs32: np.ndarray, counters: Any) -> np.ndarray:
+        """The radiance (N, 3) along every ray: the surfaces it crosses composited front to back
+        (semi-transparent ones let ``transparency`` of what is behind through; a closed shape's
+        faces are crossed twice and only its entering face is seen, as with back-face culling),
+        the background where nothing is hit."""
+        scene = self._scene
+        engine = scene.engine
+        n = len(dirs)
+        t_near, t_far = self._limits
+        tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
+        out = np.zeros((n, 3))            # when a ray first goes through a semi-transparent surface
+        weight = np.ones(n)
+        rows = np.arange(n)
+        lights, shadows = self._light_arrays()
+        for layer in range(MAX_LAYERS + 1):
+            if layer == 0:
+                D = dirs
+                hits = engine.cast(np.broadcast_to(origin, D.shape), D, t_near, t_far, kind=RayKind.VISUAL,
+                                   exclude_owner=-1, directions32=dirs32)
+            else:
+                assert tn is not None and tf is not None
+                D = dirs[rows]
+                hits = engine.cast(np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows], kind=RayKind.VISUAL,
+                                   exclude_owner=-1)
+            counters["rays_camera"] += len(rows)
+            counters["cast_calls"] += 1
+            t, shape, normal = hits.distance, hits.shape, hits.normal
+            hit = np.isfinite(t)
+            miss = (~hit).nonzero()[0]
+            if len(miss):
+                out[rows[miss]] += weight[rows[miss], None] * self._background
+            k = hit.nonzero()[0]
+            if len(k) == 0:
+                break
+            r, s = rows[k], shape[k]
+            tau = scene.transparency[s]
+            clear = tau > 0.0
+            leaving = np.zeros(len(k), dtype=bool)
+            any_clear = bool(clear.any())
+            if any_clear and inside is None:
+                inside = np.full((n, MAX_LAYERS), -1, dtype=np.int64)
+                tn = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,)).copy()
+                tf = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))
+            if any_clear:              # a transparent shape the ray is already in: its far face
+                assert inside is not None
+                leaving = clear & (inside[r] == s[:, None]).any(axis=1)
+            seen = (~leaving).nonzero()[0]
+            if len(seen):
+                kk, rr = k[seen], r[seen]
+                Dk = D[kk] if len(kk) < len(D) else D
+                P = origin + t[kk, None] * Dk
+                N = normal[kk] if len(kk) < len(D) else normal
+                back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+                if back.any():         # facing the camera
+                    N = np.where(back[:, None], -N, N)
+                albedo = scene.surface_colors(s[seen], np.broadcast_to(origin, (len(kk), 3)), Dk, t[kk])
+                lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
+                L = shading.radiance(P, N, albedo, lights, lit)
+                last = layer == MAX_LAYERS
+                a = np.where(last, 0.0, tau[seen])[:, None]
+                out[rr] += weight[rr, None] * (1.0 - a) * L
+                weight[rr] *= a[:, 0]
+            # the rays that go on: through a transparent surface (entering or leaving it)
+            go = clear & (layer < MAX_LAYERS)
+            if not go.any():
+                break
+            assert inside is not None and tn is not None
+            g = go.nonzero()[0]
+            rg, sg = r[g], s[g]
+            ent = ~leaving[g]
+            if ent.any():            # entering: remember the shape (in its first free slot)
+                free = np.argmax(inside[rg[ent]] < 0, axis=1)
+                inside[rg[ent], free] = sg[ent]
+            if (~ent).any():         # leaving: forget it
+                lv = rg[~ent]
+                inside[lv] = np.where(inside[lv] == sg[~ent][:, None], -1, inside[lv])
+            tn[rg] = t[k[g]] * (1.0 + 1e-12) + 1e-7      # just past this surface
+            rows = rg
+        return out
+
+    def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
+                 counters: Any) -> np.ndarray:
+        """(S, n) False where a shadow-casting light is hidden from the point by a visible shape
+        (its segment to the light, 1000 m towards a directional one); only lit, facing pairs cast."""
+        att, direct = light_math.light_terms(P, N, lights)
+        lit = np.ones(direct.shape, dtype=bool)
+        unit, length = light_math.occlusion_segments_many(P, lights)
+        for j in shadows.nonzero()[0].tolist():
+            i = (direct[:, j] > 0.0).nonzero()[0]
+            if len(i) == 0:
+                continue
+            hits = self._scene.engine.cast(P[i], unit[i, j], 0.0, length[i, j], kind=RayKind.VISUAL, exclude_owner=-1,
+                                           distance_only=True)
+            counters["rays_camera"] += len(i)
+            counters["cast_calls"] += 1
+            lit[i, j] = ~(hits.distance <= length[i, j])
+        return lit

@@ -1,0 +1,173 @@
+"""A camera's Recognition (Webots' node): which recognisable objects it sees and where, and its
+segmentation image. The geometry is ``server/devices/recognition.py``; this module gathers the
+objects' shapes from the scene once, places them at each recognition, and casts the rays the
+occlusion test needs (Webots' ``occlusion`` field):
+
+* 0 — no test: every object in range and on the image is recognised;
+* 1 — one ray from the camera to the object's centre: recognised if it reaches the centre or first
+  meets one of the object's own shapes (Webots casts the same ray against bounding objects);
+* 2 — the image's pixel rays: recognised if at least one pixel sees it (exact at the image's
+  resolution; Webots tests the object's outline).
+
+An object is in range when its box reaches in front of the camera and starts before ``max_range``
+(in depth). ``max_objects`` keeps the biggest on the image (``size_on_image`` area; ties in id
+order). The segmentation image: each pixel whose ray's first visible surface belongs to a
+recognisable object within ``max_range`` (depth for a planar camera) has the object's first
+recognition colour, the rest black; alpha 255.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import imaging
+from sensorium.server.devices import recognition as rmath
+from sensorium.server.raycast.engine import RayKind
+from sensorium.server.sim.scene import primitive_from_model
+from sensorium.server.world.geometry import Pose
+
+__all__ = ["RecognisedObject", "Recognizer"]
+
+
+@dataclass(frozen=True, slots=True)
+class RecognisedObject:
+    """One object a camera recognised (Webots' ``WbCameraRecognitionObject``)."""
+
+    id: int
+    position: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+    size: tuple[float, float]
+    position_on_image: tuple[int, int]
+    size_on_image: tuple[int, int]
+    colors: tuple[tuple[float, float, float], ...]
+    model: str
+
+    def as_dict(self) -> dict:
+        return {"id": self.id, "position": list(self.position), "orientation": list(self.orientation),
+                "size": list(self.size), "position_on_image": list(self.position_on_image),
+                "size_on_image": list(self.size_on_image), "colors": [v for c in self.colors for v in c],
+                "model": self.model}
+
+
+@dataclass(frozen=True, slots=True)
+class _Object:
+    key: str | int
+    id: int
+    colors: tuple[tuple[float, float, float], ...]
+    model: str
+    shapes: tuple[int, ...]                                # every shape (occlusion, segmentation)
+    parts: tuple[tuple[Pose, str, tuple, np.ndarray | None], ...]   # the shapes its size is read from
+
+
+def _kind(g: Any, base_dir: Any) -> tuple[str, tuple, np.ndarray | None]:
+    if isinstance(g, wm.Box):
+        return "box", (tuple(g.size),), None
+    if isinstance(g, wm.Sphere):
+        return "sphere", (g.radius,), None
+    if isinstance(g, wm.Cylinder):
+        return "cylinder", (g.radius, g.height), None
+    if isinstance(g, wm.Capsule):
+        return "capsule", (g.radius, g.height), None
+    if isinstance(g, wm.Plane):
+        if g.size is None:
+            return "unbounded", (), None
+        sx, sy = g.size[0] / 2.0, g.size[1] / 2.0
+        return "points", (), np.array([[sx, sy, 0.0], [sx, -sy, 0.0], [-sx, sy, 0.0], [-sx, -sy, 0.0]])
+    if isinstance(g, wm.Triangles):
+        return "points", (), np.asarray(g.vertices, dtype=np.float64).reshape(-1, 3)
+    return "points", (), np.asarray(primitive_from_model(g, base_dir).vertices, dtype=np.float64)
+
+
+class Recognizer:
+    """The recognisable objects of a scene as one camera (on robot ``own``) sees them."""
+
+    def __init__(self, scene: Any, own: int, config: wm.Recognition, geometry: imaging.ImageGeometry):
+        self.scene = scene
+        self.own = own
+        self.config = config
+        self.geometry = geometry
+        self.key_of = np.full(len(scene.shapes) + 1, -1, dtype=np.int64)   # shape -> object index (-1: none)
+        objects: list[_Object] = []
+        by_owner: dict[Any, list[int]] = {}            # one pass over the shapes
+        for i in range(len(scene.shapes)):
+            key = scene.part(i)[0]
+            if key in scene.recognisable:
+                by_owner.setdefault(key, []).append(i)
+        for key, (node_id, colors, model) in sorted(scene.recognisable.items(), key=lambda kv: kv[1][0]):
+            if key == own:                      # Webots skips the camera's own robot and what it carries
+                continue
+            shapes = by_owner.get(key, [])
+            bounding = [i for i in shapes if scene.part(i)[2].seen_by in ("both", "bounding")]
+            parts = tuple((scene.part(i)[1], *_kind(scene.part(i)[2].geometry, scene.base_dir))
+                          for i in (bounding or shapes))
+            self.key_of[shapes] = len(objects)
+            objects.append(_Object(key, node_id, tuple(colors), model, tuple(shapes), parts))  # type: ignore[arg-type]
+        self.objects = objects
+        self.first_color = np.array([o.colors[0] for o in objects] + [(0.0, 0.0, 0.0)]).reshape(-1, 3)
+
+    def _box(self, obj: _Object, cam: Pose) -> tuple[np.ndarray, np.ndarray] | None:
+        """The object's box (lo, hi) in the camera frame, None if unbounded."""
+        owner = self.scene.owner_pose(obj.key)
+        inv = cam.rotation.T
+        lo = np.full(3, np.inf)
+        hi = np.full(3, -np.inf)
+        for local, kind, params, points in obj.parts:
+            pose = owner.compose(local)
+            b = rmath.shape_bounds(kind, params, inv @ pose.rotation, inv @ (pose.translation - cam.translation), points)
+            if b is None:
+                return None
+            lo, hi = np.minimum(lo, b[0]), np.maximum(hi, b[1])
+        return (lo, hi) if np.isfinite(lo).all() else None
+
+    def recognise(self, cam: Pose, pixel_objects: np.ndarray | None, counters: Any) -> list[RecognisedObject]:
+        """The objects seen from the camera pose ``cam``; ``pixel_objects`` (H·W,) the object index
+        each pixel sees (-1 none), needed for occlusion 2."""
+        c = self.config
+        out: list[RecognisedObject] = []
+        seen_by_pixels = set(np.unique(pixel_objects).tolist()) if pixel_objects is not None else set()
+        for k, obj in enumerate(self.objects):
+            box = self._box(obj, cam)
+            if box is None:
+                continue
+            lo, hi = box
+            if not (hi[0] > 0.0 and lo[0] < c.max_range):
+                continue
+            centre, size = (lo + hi) / 2.0, hi - lo
+            on_image = rmath.box_on_image(centre, size, self.geometry)
+            if on_image is None:
+                continue
+            if c.occlusion == 1 and not self._centre_visible(k, cam, centre, counters):
+                continue
+            if c.occlusion == 2 and k not in seen_by_pixels:
+                continue
+            orientation = rmath.axis_angle(cam.rotation.T @ self.scene.owner_pose(obj.key).rotation)
+            out.append(RecognisedObject(obj.id, tuple(float(v) for v in centre), tuple(float(v) for v in orientation),  # type: ignore[arg-type]
+                                        (float(size[1]), float(size[2])), on_image[0], on_image[1], obj.colors,
+                                        obj.model))
+        if c.max_objects >= 0 and len(out) > c.max_objects:
+            keep = sorted(range(len(out)), key=lambda i: -out[i].size_on_image[0] * out[i].size_on_image[1])
+            out = [out[i] for i in sorted(keep[:c.max_objects])]
+        return out
+
+    def _centre_visible(self, k: int, cam: Pose, centre: np.ndarray, counters: Any) -> bool:
+        d = cam.rotation @ centre
+        dist = float(np.linalg.norm(d))
+        if dist == 0.0:
+            return True
+        hits = self.scene.engine.cast(cam.translation.reshape(1, 3), (d / dist).reshape(1, 3), 0.0, dist,
+                                      kind=RayKind.VISUAL, exclude_owner=self.own)
+        counters["rays_camera"] += 1
+        counters["cast_calls"] += 1
+        return not math.isfinite(float(hits.distance[0])) or int(self.key_of[int(hits.shape[0])]) == k
+
+    def segmentation(self, pixel_objects: np.ndarray, height: int, width: int) -> np.ndarray:
+        """BGRA (H, W, 4): each pixel the first recognition colour of the object it sees, else black."""
+        rgb = np.floor(self.first_color[pixel_objects] * 255.0 + 0.5).astype(np.uint8).reshape(height, width, 3)
+        out = np.empty((height, width, 4), dtype=np.uint8)
+        out[:, :, 0], out[:, :, 1], out[:, :, 2], out[:, :, 3] = rgb[:, :, 2], rgb[:, :, 1], rgb[:, :, 0], 255
+        return out

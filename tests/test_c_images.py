@@ -1,0 +1,68 @@
+"""The C library's image devices (issue 23) against a live server, built with AddressSanitizer and
+UBSan: a C controller reads exactly the bytes the Python client reads on the same world (range
+images, camera images), and the save functions answer Webots' codes."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+
+import pytest
+from _serve import serve
+from test_c_client import CLIB, ENV, REPO, SAN_ENV, TESTS_C, _make, finish
+
+WORLD = REPO / "tests" / "worlds" / "images.yaml"
+
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
+                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")]
+
+
+@pytest.fixture(scope="module")
+def reader(tmp_path_factory) -> str:
+    build = tmp_path_factory.mktemp("cimages")
+    _make(f"BUILD={build}", "SANITIZE=1")
+    libs = _make("libs").split()
+    exe = build / "image_reader"
+    cmd = ["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+           "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", f"-I{TESTS_C}", str(TESTS_C / "image_reader.c"),
+           "-o", str(exe), str(build / "libController.a"), *libs, "-lm"]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return str(exe)
+
+
+def _run(cmd: list[str], url: str) -> tuple[list[str], str]:
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env={**ENV, "SENSORIUM_CONTROLLER_URL": url}, cwd=str(REPO))
+    code, out, err = finish(p)
+    assert code == 0, err
+    return out, err
+
+
+def test_range_finder_bytes_match_python(reader):
+    with serve(WORLD, env=SAN_ENV) as s:
+        c_out, c_err = _run([reader, "depth", "3"], s.url("bot"))
+    with serve(WORLD, env=SAN_ENV) as s:
+        py_out, _ = _run([sys.executable, "-m", "sensorium", "controller", "--url", s.url("bot"),
+                          str(REPO / "tests" / "controllers" / "image_reader.py"), "depth", "3"], s.url("bot"))
+    assert c_out == py_out
+    assert c_out[-2] == "# info 12 8 1 0.050000000000000003 3" and c_out[-1] == "# save -1"
+    first = bytes.fromhex(c_out[0].split("=")[1])
+    assert len(first) == 4 * 12 * 8 and first != bytes(len(first))    # an image arrived with the first step
+    assert "cannot write" in c_err
+
+
+def test_camera_bytes_match_python(reader):
+    with serve(WORLD, env=SAN_ENV) as s:
+        c_out, c_err = _run([reader, "camera", "3"], s.url("bot"))
+    with serve(WORLD, env=SAN_ENV) as s:
+        py_out, _ = _run([sys.executable, "-m", "sensorium", "controller", "--url", s.url("bot"),
+                          str(REPO / "tests" / "controllers" / "image_reader.py"), "camera", "3"], s.url("bot"))
+    assert c_out == py_out
+    assert c_out[0] == "# null_before 1" and c_out[-2] == "# exposure 2" and c_out[-1] == "# save -1"
+    first = bytes.fromhex(c_out[1].split(" ")[2].split("=")[1])
+    assert len(first) == 4 * 16 * 12 and len(set(first[2::4])) > 5      # a picture, not a flat colour
+    assert " objects=1 [4 ball " in c_out[1]                             # the ball: robots 1, solids 2.. in order
+    assert "wb_camera_get_image() called for a disabled device" in c_err

@@ -1,0 +1,215 @@
+"""Camera recognition (Webots' Recognition node, issue 23) against the projected geometry: positions,
+sizes and orientations of boxes, rotated boxes and cylinders in the camera frame; their boxes on the
+image by Webots' projection; occlusion 0/1/2, range, maxObjects, the camera's own robot; the
+segmentation image; the services and the Python API."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.schemas.wire import pack, unpack
+from sensorium.server.daemon.services import Core
+from sensorium.server.devices import imaging
+from sensorium.server.sim.simulation import Simulation
+
+W, H, FOV = 64, 48, 1.0
+
+
+def world(solids=(), recognition=None, robots=(), cam=None) -> wm.World:
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16},
+        "solids": list(solids),
+        "robots": [{"name": "r", "recognition_colors": [[0, 1, 1]],
+                    "shapes": [{"pose": {"translation": [-0.3, 0, 0]}, "geometry": {"type": "sphere", "radius": 0.05}}],
+                    "devices": [{"device": "Camera", "name": "cam", "width": W, "height": H, "field_of_view": FOV,
+                                 "recognition": recognition or {}, **(cam or {})}]}, *robots]})
+
+
+def recognise(w: wm.World, segmentation=False) -> tuple[Simulation, list]:
+    sim = Simulation(w)
+    cam = sim.device("r/cam")
+    cam.recognition_enable(16)
+    if segmentation:
+        cam.enable_segmentation(True)
+    sim.step()
+    return sim, cam.objects
+
+
+def webots_box(corners: np.ndarray) -> tuple[tuple[int, int], tuple[int, int]]:
+    """Webots' projectOnImage of camera-frame corners (planar), then round/ceil of the extent."""
+    t = math.tan(FOV / 2)
+    u = np.clip(0.5 - 0.5 * (corners[:, 1] / np.abs(corners[:, 0])) / t, 0, 1)
+    v = np.clip(0.5 - 0.5 * (corners[:, 2] / np.abs(corners[:, 0])) / (t * H / W), 0, 1)
+    pu, pv = ((W - 1) * u).astype(int), ((H - 1) * v).astype(int)
+    return (round((pu.max() + pu.min()) / 2), round((pv.max() + pv.min()) / 2)), \
+        (math.ceil(pu.max() - pu.min()), math.ceil(pv.max() - pv.min()))
+
+
+def aabb_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+
+def solid(name, pose, geometry, colors=((1, 0, 0),), **extra):
+    return {"name": name, "pose": pose, "geometry": geometry, "recognition_colors": [list(c) for c in colors], **extra}
+
+
+def test_box_position_size_and_box_on_image():
+    box = solid("crate", {"translation": [2.0, 0.3, -0.1]}, {"type": "box", "size": [0.2, 0.4, 0.6]},
+                colors=[(1, 0, 0), (0.5, 0.5, 0)], model="crate")
+    _, [obj] = recognise(world([box]))
+    assert obj.id == 2 and obj.model == "crate" and obj.colors == ((1.0, 0.0, 0.0), (0.5, 0.5, 0.0))
+    np.testing.assert_allclose(obj.position, [2.0, 0.3, -0.1], atol=1e-15)
+    np.testing.assert_allclose(obj.size, [0.4, 0.6], atol=1e-15)
+    assert obj.orientation == (0.0, 0.0, 1.0, 0.0)
+    lo, hi = np.array([1.9, 0.1, -0.4]), np.array([2.1, 0.5, 0.2])
+    assert (obj.position_on_image, obj.size_on_image) == webots_box(aabb_corners(lo, hi))
+
+
+def test_rotated_box_and_cylinder_bounds_are_exact():
+    yaw = 0.5
+    box = solid("box", {"translation": [2.0, -0.4, 0.0], "rotation": [0, 0, 1, yaw]}, {"type": "box", "size": [0.2, 0.4, 0.6]})
+    cyl = solid("cyl", {"translation": [3.0, 0.8, 0.2], "rotation": [1, 0, 0, math.pi / 2]},
+                {"type": "cylinder", "radius": 0.1, "height": 0.5})
+    _, objs = recognise(world([box, cyl]))
+    b, c = objs
+    c_, s_ = math.cos(yaw), math.sin(yaw)
+    ext_x, ext_y = 0.2 * abs(c_) + 0.4 * abs(s_), 0.2 * abs(s_) + 0.4 * abs(c_)     # the rotated rectangle's extents
+    np.testing.assert_allclose(b.position, [2.0, -0.4, 0.0], atol=1e-15)
+    np.testing.assert_allclose(b.size, [ext_y, 0.6], rtol=1e-15)
+    np.testing.assert_allclose(b.orientation, [0, 0, 1, yaw], atol=1e-15)
+    lo = np.array([2.0 - ext_x / 2, -0.4 - ext_y / 2, -0.3])
+    assert (b.position_on_image, b.size_on_image) == webots_box(aabb_corners(lo, lo + [ext_x, ext_y, 0.6]))
+    # a cylinder lying along y: 2r x h x 2r
+    np.testing.assert_allclose(c.position, [3.0, 0.8, 0.2], atol=1e-15)
+    np.testing.assert_allclose(c.size, [0.5, 0.2], atol=1e-12)
+    np.testing.assert_allclose(c.orientation, [1, 0, 0, math.pi / 2], atol=1e-12)
+
+
+def test_the_camera_frame_is_the_devices():
+    # the robot turned by 90 degrees, the camera looking along world +y: positions are in its frame
+    box = solid("crate", {"translation": [0.3, 2.0, 0.1]}, {"type": "box", "size": [0.2, 0.2, 0.2]})
+    w = world([box])
+    w = w.model_copy(update={"robots": [w.robots[0].model_copy(update={"pose": wm.Pose(rotation=(0, 0, 1, math.pi / 2))})]})
+    _, [obj] = recognise(w)
+    np.testing.assert_allclose(obj.position, [2.0, -0.3, 0.1], atol=1e-12)
+    np.testing.assert_allclose(obj.orientation, [0, 0, -1, math.pi / 2], atol=1e-12)  # R_cam^T R_object: -90° yaw
+
+
+def test_occlusion_range_image_bounds_and_max_objects():
+    target = solid("target", {"translation": [3.0, 0.0, 0.0]}, {"type": "box", "size": [0.2, 0.2, 0.2]})
+    pane = {"name": "pane", "pose": {"translation": [1.5, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.6, 0.6]}}
+    for occlusion, seen in ((0, True), (1, False), (2, False)):
+        _, objs = recognise(world([target, pane], {"occlusion": occlusion}))
+        assert (len(objs) == 1) is seen, occlusion
+    # half hidden: the centre's ray is blocked, some pixels see it
+    wide = solid("target", {"translation": [3.0, 0.0, 0.0]}, {"type": "box", "size": [0.2, 0.6, 0.2]})
+    half = {**pane, "pose": {"translation": [1.5, 0.28, 0.0]}}          # hides y > -0.02 at x = 1.5
+    assert [len(recognise(world([wide, half], {"occlusion": k}))[1]) for k in (1, 2)] == [0, 1]
+    assert recognise(world([target], {"max_range": 2.5}))[1] == []                 # beyond max_range
+    behind = solid("behind", {"translation": [-2.0, 0.0, 0.0]}, {"type": "box", "size": [0.2, 0.2, 0.2]})
+    aside = solid("aside", {"translation": [0.5, 3.0, 0.0]}, {"type": "box", "size": [0.2, 0.2, 0.2]})
+    assert recognise(world([behind, aside]))[1] == []                               # not on the image
+    big = solid("big", {"translation": [2.0, 0.4, 0.0]}, {"type": "box", "size": [0.3, 0.3, 0.3]})
+    small = solid("small", {"translation": [2.0, -0.4, 0.0]}, {"type": "box", "size": [0.1, 0.1, 0.1]})
+    _, objs = recognise(world([small, big, target], {"max_objects": 2}))
+    # on the image: big (id 3) 0.3 m at 1.85 m > target (id 4) 0.2 m at 2.9 m > small (id 2) 0.1 m at 1.95 m
+    assert [o.id for o in objs] == [3, 4]                                           # the two biggest, id order
+
+
+def test_own_robot_is_not_recognised_another_is():
+    other = {"name": "other", "pose": {"translation": [2.0, 0.0, 0.0]}, "recognition_colors": [[1, 1, 0]],
+             "model": "rover", "body": {"geometry": {"type": "cylinder", "radius": 0.2, "height": 0.3}}}
+    _, objs = recognise(world([], robots=[other]))
+    assert [(o.id, o.model, o.colors) for o in objs] == [(2, "rover", ((1.0, 1.0, 0.0),))]
+    np.testing.assert_allclose(objs[0].size, [0.4, 0.3], atol=1e-15)
+
+
+def test_segmentation_image_colours_the_pixels_that_see_an_object():
+    ball = solid("ball", {"translation": [2.0, 0.3, 0.1]}, {"type": "sphere", "radius": 0.4, "subdivision": 5},
+                 colors=[(1, 0.5, 0), (0, 0, 1)])
+    plain = {"name": "plain", "pose": {"translation": [2.5, -0.5, 0]}, "geometry": {"type": "box", "size": [0.2, 0.4, 0.4]}}
+    sim, _ = recognise(world([ball, plain], {"segmentation": True}), segmentation=True)
+    seg = sim.device("r/cam").segmentation_image
+    d = imaging.pixel_directions(imaging.ImageGeometry(W, H, FOV))[0]
+    c = np.array([2.0, 0.3, 0.1])
+    b = d @ c
+    disc = b * b - (c @ c - 0.16)
+    sees = disc > 1e-4
+    clear = np.abs(disc) > 1e-4
+    orange = (seg[..., 2] == 255) & (seg[..., 1] == 128) & (seg[..., 0] == 0)
+    black = (seg[..., :3] == 0).all(axis=-1)
+    np.testing.assert_array_equal(orange[clear], sees[clear])
+    np.testing.assert_array_equal(black[clear], ~sees[clear])                    # the plain box is black
+    assert np.all(seg[..., 3] == 255) and sees.sum() > 100
+
+
+def test_services_and_step_reading():
+    box = solid("crate", {"translation": [2.0, 0.0, 0.0]}, {"type": "box", "size": [0.2, 0.2, 0.2]})
+    sim = Simulation(world([box], {"segmentation": True}))
+    core = Core(sim)
+    ids = iter(range(1, 100))
+
+    def call(service, args=None):
+        [reply] = core.handle([b"peer", pack({"id": next(ids), "service": service, "args": args or {}})], 0.0)
+        return unpack(reply[-1])
+
+    att = call("attach", {"robot": "r"})["result"]
+    [desc] = [d for d in att["devices"] if d["name"] == "cam"]
+    assert desc["has_recognition"] and desc["has_segmentation"] and desc["recognition_sampling_period"] == 0
+    assert call("/r/cam/enable_segmentation", {"value": True})["error"]["code"] == 10        # WRONG_STATE
+    assert call("/r/cam/recognition_enable", {"value": 16})["ok"]
+    assert call("/r/cam/enable_segmentation", {"value": True})["ok"]
+    assert call("/r/cam/get_recognition_sampling_period")["result"]["value"] == 16
+    sim.step()
+    [obj] = call("/r/cam/get_recognition_objects")["result"]["value"]
+    assert obj["id"] == 2 and obj["position"] == [2.0, 0.0, 0.0] and obj["colors"] == [1.0, 0.0, 0.0]
+    reading = core.topics.reading(core.topics.controls["r/cam"])
+    assert "image" not in reading and reading["recognition"] == [obj]                 # the camera itself is off
+    assert len(reading["segmentation_image"]) == 4 * W * H
+    no_rec = Core(Simulation(world([box], cam={"recognition": None})))
+    assert [d for d in no_rec.sim.robot("r").model.devices][0].recognition is None
+
+
+def test_python_api_through_a_server(tmp_path):
+    import yaml
+    from _inproc import inproc_server
+
+    from sensorium.client import wb
+    from sensorium.client.webots.controller import CameraRecognitionObject, Robot
+    box = solid("crate", {"translation": [2.0, 0.2, 0.0]}, {"type": "box", "size": [0.2, 0.2, 0.2]}, model="crate")
+    path = tmp_path / "rec.yaml"
+    path.write_text(yaml.safe_dump(world([box], {"segmentation": True}).model_dump(mode="json", exclude_defaults=True)))
+    with inproc_server(heartbeat_ms=5000, world=path) as (core, transport):
+        wb.wb_robot_init(f"{transport.rpc_endpoint}/r")
+        try:
+            robot = Robot()
+            cam = robot.getDevice("cam")
+            assert cam.hasRecognition() and cam.hasRecognitionSegmentation()
+            assert cam.getRecognitionObjects() == [] and cam.getRecognitionNumberOfObjects() == 0   # disabled
+            cam.recognitionEnable(16)
+            cam.enableRecognitionSegmentation()
+            robot.step(16)
+            [obj] = cam.getRecognitionObjects()
+            assert isinstance(obj, CameraRecognitionObject)
+            want = core.sim.device("r/cam").objects[0]
+            assert (obj.getId(), obj.getModel(), obj.getPosition(), obj.getPositionOnImage(), obj.getSizeOnImage(),
+                    obj.getNumberOfColors(), obj.getColors()) == (
+                want.id, "crate", list(want.position), list(want.position_on_image), list(want.size_on_image), 1,
+                [1.0, 0.0, 0.0])
+            seg = cam.getRecognitionSegmentationImage()
+            assert seg == core.sim.device("r/cam").segmentation_image.tobytes()
+            assert cam.getImage() is None                        # recognition works with the camera disabled
+            cam.recognitionDisable()
+            assert not cam.isRecognitionSegmentationEnabled() and cam.getRecognitionSamplingPeriod() == 0
+        finally:
+            wb.wb_robot_cleanup()
+            Robot.created = None
+
+
+def test_nested_solids_cannot_carry_recognition_colours():
+    with pytest.raises(ValueError, match="recognition_colors are read on top-level solids"):
+        wm.Solid.model_validate({"name": "a", "children": [{"name": "b", "recognition_colors": [[1, 0, 0]]}]})
