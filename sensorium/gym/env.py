@@ -8,8 +8,15 @@ Observation: a ``Dict`` with one ``Box`` per observed sensor (LEDs are not obser
 or distance sensor is a float32 ``(1,)`` box bounded by its lookup table's output column (values are clipped into it:
 relative lookup noise is Gaussian and could leave it); a lidar is its float32 ``(layers,
 width)`` range image bounded by ``[0, max_range]``, with "no hit" (``inf`` in Webots) given as
-``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians. Action: float32 ``(2,)`` = left, right wheel velocity (rad/s), bounded by the
-drive's max wheel speed. One action lasts ``control_period_ms``.
+``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians.
+``flatten=True``: one float32 ``Box`` instead, the Dict's boxes flattened and concatenated in its
+(sorted) key order, as ``gymnasium.wrappers.FlattenObservation`` gives.
+
+Action: float32 ``(2,)`` = left, right wheel. ``actions="normalized"`` (the default): in
+``[-1, 1]``, times the drive's max wheel speed (rad/s) -- the symmetric, normalised box training
+libraries and Gymnasium's checker recommend; ``actions="wheel"``: the wheel velocities themselves
+(rad/s), bounded by the max wheel speed. Either way a velocity beyond the maximum is clamped, as
+Webots does. One action lasts ``control_period_ms``.
 
 ``reset(seed=s)`` rebuilds the simulation from the world model with world seed drawn from the
 environment's generator seeded with ``s``: every device noise stream, the start pose drawn by
@@ -52,8 +59,12 @@ def load(world: str | Path | LoadedWorld | wm.World | None) -> LoadedWorld:
 class Agent:
     """One acting robot: its task, observed devices and periods, observation and action spaces."""
 
-    def __init__(self, loaded: LoadedWorld, task: Task, default_robot: str | None = None):
+    def __init__(self, loaded: LoadedWorld, task: Task, default_robot: str | None = None,
+                 actions: str = "normalized", flatten: bool = False):
+        if actions not in ACTION_MODES:
+            raise ValueError(f"actions must be one of {', '.join(ACTION_MODES)}, got {actions!r}")
         self.task = task
+        self.actions = actions
         w = loaded.world
         basic = w.world_info.basic_time_step
         robots = {r.name: r for r in w.robots}
@@ -93,9 +104,13 @@ class Agent:
                 raise ValueError(f"task observation {n!r}: sampling period must be > 0 ms, got {p}")
         self.periods = periods
         self.warmup_steps = max((math.ceil(p / basic) for p in periods.values()), default=0)
-        self.observation_space = spaces.Dict({n: _space(devices[n]) for n in periods})
-        vmax = float(model.differential_drive.max_wheel_speed)
-        self.action_space = spaces.Box(-vmax, vmax, shape=(2,), dtype=np.float32)
+        self.dict_space = spaces.Dict({n: _space(devices[n]) for n in periods})
+        self.flatten = bool(flatten)
+        self.observation_space: spaces.Space = (spaces.flatten_space(self.dict_space) if self.flatten
+                                                else self.dict_space)
+        self.vmax = vmax = float(model.differential_drive.max_wheel_speed)
+        self.action_space = (spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32) if actions == "normalized"
+                             else spaces.Box(-vmax, vmax, shape=(2,), dtype=np.float32))
 
     def start(self, sim: Simulation, rng: np.random.Generator) -> None:
         """After a rebuild: start pose, wheels at rest in velocity control, devices enabled."""
@@ -117,18 +132,24 @@ class Agent:
                 owners.append(owner)
                 owner.reset(sim, robot)
 
-    def act(self, sim: Simulation, action) -> None:
+    def wheel_velocities(self, action) -> np.ndarray:
+        """An action -> (left, right) wheel velocities (rad/s, float64; clamped later by the motors)."""
         a = np.asarray(action, dtype=np.float64).reshape(-1)
         if a.shape != (2,) or not np.all(np.isfinite(a)):
-            raise ValueError(f"{self.robot}: action must be 2 finite wheel velocities (left, right), got {action!r}")
-        drive = sim.robot(self.robot).drive
-        drive.left.set_velocity(float(a[0]))
-        drive.right.set_velocity(float(a[1]))
+            what = "values in [-1, 1]" if self.actions == "normalized" else "wheel velocities"
+            raise ValueError(f"{self.robot}: action must be 2 finite {what} (left, right), got {action!r}")
+        return a * self.vmax if self.actions == "normalized" else a
 
-    def observe(self, sim: Simulation) -> dict[str, np.ndarray]:
+    def act(self, sim: Simulation, action) -> None:
+        v = self.wheel_velocities(action)
+        drive = sim.robot(self.robot).drive
+        drive.left.set_velocity(float(v[0]))
+        drive.right.set_velocity(float(v[1]))
+
+    def observe(self, sim: Simulation):
         robot = sim.robot(self.robot)
         out = {}
-        for n, box in self.observation_space.spaces.items():
+        for n, box in self.dict_space.spaces.items():
             dev = robot.device(n)
             if isinstance(dev, Lidar):
                 img = np.nan_to_num(dev.range_image, nan=box.high.flat[0], posinf=box.high.flat[0])
@@ -136,7 +157,7 @@ class Agent:
             else:
                 v = dev.value if math.isfinite(dev.value) else (box.low[0] if np.isfinite(box.low[0]) else 0.0)
                 out[n] = np.clip(np.array([v], dtype=np.float32), box.low, box.high)
-        return out
+        return spaces.flatten(self.dict_space, out) if self.flatten else out
 
     def outcome(self, sim: Simulation, obs: dict, steps: int) -> tuple[float, bool, bool]:
         robot = sim.robot(self.robot)
@@ -153,6 +174,7 @@ class Agent:
 
 
 OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
+ACTION_MODES = ("normalized", "wheel")
 
 
 def _space(cfg) -> spaces.Box:
@@ -178,7 +200,8 @@ class SensoriumEnv(TopDownRendering, gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
     def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None, task: Task | None = None,
-                 render_mode: str | None = None, precision: str = "exact", render_size: int = 256):
+                 render_mode: str | None = None, precision: str = "exact", render_size: int = 256,
+                 actions: str = "normalized", flatten: bool = False):
         self.loaded = load(world)
         self.task = task or Task()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -187,7 +210,7 @@ class SensoriumEnv(TopDownRendering, gym.Env):
         self.precision = precision
         self.render_size = render_size
         self.basic_time_step = self.loaded.world.world_info.basic_time_step
-        self.agent = Agent(self.loaded, self.task)
+        self.agent = Agent(self.loaded, self.task, actions=actions, flatten=flatten)
         self.robot_name = self.agent.robot
         self.control_period_ms = self.agent.control_period_ms
         self.steps_per_action = self.control_period_ms // self.basic_time_step

@@ -504,13 +504,12 @@ class BatchedSimulation:
         box_hi = starts + (reach + Rr)[:, None]
         band_lo = self.heights[copies, slots] + self.foot_low[slots]
         band_hi = self.heights[copies, slots] + self.foot_high[slots]
-        near_solids: list[list[int]] = [[] for _ in range(k)]
+        solid_hit = robot_hit = None
+        near = np.zeros(k, dtype=bool)
         if len(ct._obs):
-            hit = (np.all((ct._lo[None] <= box_hi[:, None]) & (ct._hi[None] >= box_lo[:, None]), axis=2)
-                   & (ct._zhi[None] > band_lo[:, None] + EPS) & (ct._zlo[None] < band_hi[:, None] - EPS))
-            for m, j in zip(*(x.tolist() for x in np.nonzero(hit))):
-                near_solids[m].append(j)
-        near_robots: list[list[int]] = [[] for _ in range(k)]
+            solid_hit = (np.all((ct._lo[None] <= box_hi[:, None]) & (ct._hi[None] >= box_lo[:, None]), axis=2)
+                         & (ct._zhi[None] > band_lo[:, None] + EPS) & (ct._zlo[None] < band_hi[:, None] - EPS))
+            near |= solid_hit.any(axis=1)
         if self.R > 1:
             grow = np.zeros((self.copies, self.R))
             grow[copies, slots] = reach
@@ -518,38 +517,59 @@ class BatchedSimulation:
             r_all = self.foot_radius[None, :] + grow[copies]                     # (k, R)
             a_lo = self.heights[copies] + self.foot_low[None, :]
             a_hi = self.heights[copies] + self.foot_high[None, :]
-            hit = ((c[:, :, 0] + r_all >= box_lo[:, None, 0]) & (c[:, :, 0] - r_all <= box_hi[:, None, 0])
-                   & (c[:, :, 1] + r_all >= box_lo[:, None, 1]) & (c[:, :, 1] - r_all <= box_hi[:, None, 1])
-                   & (a_hi > band_lo[:, None] + EPS) & (a_lo < band_hi[:, None] - EPS))
-            hit[np.arange(k), slots] = False
-            for m, j in zip(*(x.tolist() for x in np.nonzero(hit))):
-                near_robots[m].append(j)
-        # slot by slot (each slot's robots see the earlier slots of their copy where they ended)
-        for r in sorted(set(slots.tolist())):
-            rows = (slots == r).nonzero()[0]
-            if self.feet[r] is None:
-                self.centres[copies[rows], r] = ends[rows]
-                continue
-            quiet = [m for m in rows.tolist() if not near_solids[m] and not near_robots[m]]
-            if quiet:
-                q = np.array(quiet)
-                self.centres[copies[q], r] = starts[q] + (ends[q] - starts[q])
-            for m in rows.tolist():
-                if not near_solids[m] and not near_robots[m]:
-                    continue
-                cands = [ct._in_band(ct._obs[j], float(band_lo[m]), float(band_hi[m])) for j in near_solids[m]]
+            with np.errstate(invalid="ignore"):
+                robot_hit = ((c[:, :, 0] + r_all >= box_lo[:, None, 0]) & (c[:, :, 0] - r_all <= box_hi[:, None, 0])
+                             & (c[:, :, 1] + r_all >= box_lo[:, None, 1]) & (c[:, :, 1] - r_all <= box_hi[:, None, 1])
+                             & (a_hi > band_lo[:, None] + EPS) & (a_lo < band_hi[:, None] - EPS))
+            robot_hit[np.arange(k), slots] = False
+            near |= robot_hit.any(axis=1)
+        footless = np.isnan(Rr)
+        # slot by slot, as Contact.resolve_all takes robots in world order (each sees the earlier
+        # slots of its copy where they ended, the later ones where they started)
+        for r in np.unique(slots).tolist():
+            mine = slots == r
+            bare = (mine & footless).nonzero()[0]
+            self.centres[copies[bare], r] = ends[bare]
+            # nothing near: Contact._clip without candidates moves to start + (end - start)
+            free = (mine & ~near & ~footless).nonzero()[0]
+            self.centres[copies[free], r] = starts[free] + (ends[free] - starts[free])
+            for m in (mine & near & ~footless).nonzero()[0].tolist():
+                # candidates as resolve_all lists them: solids, then robots, in index order
+                cands = ([ct._in_band(ct._obs[j], float(band_lo[m]), float(band_hi[m]))
+                          for j in solid_hit[m].nonzero()[0].tolist()] if solid_hit is not None else [])
                 cm = int(copies[m])
-                for j in near_robots[m]:
-                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
-                                          float(self.foot_radius[j]),
-                                          (float(self.heights[cm, j] + self.foot_low[j]),
-                                           float(self.heights[cm, j] + self.foot_high[j]))))
+                if robot_hit is not None:
+                    for j in robot_hit[m].nonzero()[0].tolist():
+                        cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
+                                              float(self.foot_radius[j]),
+                                              (float(self.heights[cm, j] + self.foot_low[j]),
+                                               float(self.heights[cm, j] + self.foot_high[j]))))
                 p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
                 self.centres[cm, r] = p
                 if clipped:
                     self.pressing[cm, r] = True
                     self.counters["contacts"] += 1
                     out[m] = p
+        return out[:, 0], out[:, 1]
+        # the others slot by slot (each sees the earlier slots of its copy where they ended), in
+        # Contact.resolve_all's narrow phase: candidates solids first, then robots, in index order
+        order = rows[np.lexsort((copies[rows], slots[rows]))]
+        for m in order.tolist():
+            cands = ([ct._in_band(ct._obs[j], float(band_lo[m]), float(band_hi[m]))
+                      for j in solid_hit[m].nonzero()[0].tolist()] if solid_hit is not None else [])
+            cm, r = int(copies[m]), int(slots[m])
+            if robot_hit is not None:
+                for j in robot_hit[m].nonzero()[0].tolist():
+                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
+                                          float(self.foot_radius[j]),
+                                          (float(self.heights[cm, j] + self.foot_low[j]),
+                                           float(self.heights[cm, j] + self.foot_high[j]))))
+            p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
+            self.centres[cm, r] = p
+            if clipped:
+                self.pressing[cm, r] = True
+                self.counters["contacts"] += 1
+                out[m] = p
         return out[:, 0], out[:, 1]
 
     # -- devices
