@@ -34,7 +34,7 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
 
     def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None,
                  tasks: Mapping[str, Task] | None = None, render_mode: str | None = None,
-                 precision: str = "exact", render_size: int = 256):
+                 precision: str = "exact", render_size: int = 256, actions: str = "normalized"):
         self.loaded = load(world)
         if tasks is None:
             tasks = {r.name: Task(robot=r.name) for r in self.loaded.world.robots if r.differential_drive is not None}
@@ -45,7 +45,7 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
         self.render_mode = render_mode
         self.precision = precision
         self.render_size = render_size
-        self._agents = {name: Agent(self.loaded, task, default_robot=name) for name, task in tasks.items()}
+        self._agents = {name: Agent(self.loaded, task, default_robot=name, actions=actions) for name, task in tasks.items()}
         for name, ag in self._agents.items():
             if ag.robot != name:
                 raise ValueError(f"agent {name!r}: its task names robot {ag.robot!r}; agents are named after their robot")

@@ -359,6 +359,8 @@ class SubEnv(gym.Env):
         self.action_space = venv.single_action_space
         self.render_mode = venv.render_mode
         self.metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+        # the registered single environment's spec (what a sub-env is), for tools that remake it
+        self.spec = gym.spec(venv.spec.id) if venv.spec is not None else None
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)

@@ -83,14 +83,38 @@ class CopyRays:
             got = self._spheres[variant] = (tiers, anchor, r2, r2 >= 0.0)
         return got
 
+    def may_reach(self, slot: int, kind: RayKind, origins, directions, t_near, t_far,
+                  skip_transparent: bool = False, margin: float = 1e-6) -> np.ndarray:
+        """Which rays, given in slot ``slot``'s body frame, may meet its body: the box of the
+        body's tier (its shells included) grown by ``margin`` -- conservative for the same rays
+        moved into the frame from any pose (their rounding is ~1e-15 m). A rigidly mounted ray
+        that fails it never meets that body, at any pose: pass the slot as its ``mount_slot``."""
+        tiers = self._slot_tiers(self.movers._variant(kind, skip_transparent))[0]
+        O = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+        D = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+        tier = tiers[slot]
+        if tier is None:
+            return np.zeros(len(D), dtype=bool)
+        lo = tier.V.min(axis=0) + tier.anchor - margin
+        hi = tier.V.max(axis=0) + tier.anchor + margin
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Dn = np.where(D == 0.0, 1e-300, D)
+            ta, tb = (lo - O) / Dn, (hi - O) / Dn
+        near = np.minimum(ta, tb).max(axis=1)
+        far = np.maximum(ta, tb).min(axis=1)
+        t0 = np.maximum(near, np.broadcast_to(np.asarray(t_near, dtype=np.float64), (len(D),)) - margin)
+        t1 = np.minimum(far, np.broadcast_to(np.asarray(t_far, dtype=np.float64), (len(D),)) + margin)
+        return t0 <= t1
+
     def cast(self, origins, directions, t_near, t_far, kind: RayKind, copy: np.ndarray, rot: np.ndarray,
              pos: np.ndarray, exclude_slot=-1, mount_slot=-1, skip_transparent: bool = False,
              distance_only: bool = False, directions32=None) -> RayHits:
         """Nearest hits of rays of several copies. ``copy``: (n,) the copy of each ray; ``rot``
         (C, R, 3, 3) and ``pos`` (C, R, 3): every copy's robot poses now; ``exclude_slot``: the
         robot (slot) whose body a ray ignores (scalar or (n,); -1 none), as ``exclude_owner``;
-        ``mount_slot``: the robot a ray is rigidly mounted on (-1 none), never paired with it (the
-        caller decides those hits once in the body frame, as with ``RayEngine.cast(mount=...)``).
+        ``mount_slot``: a robot whose body the ray is never paired with (-1 none): the robot a
+        sensor is rigidly mounted on, whose hits the caller decides once in the body frame (as
+        with ``RayEngine.cast(mount=...)``), or whose body it cannot reach (:meth:`may_reach`).
         Other arguments as :meth:`RayEngine.cast`."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
@@ -114,20 +138,34 @@ class CopyRays:
         R = self.slots
         centre = pos + np.einsum("crij,rj->cri", rot, anchor)          # (C, R, 3): a conservative test only
         pr_list, pm_list = [], []
-        excl = np.broadcast_to(np.asarray(exclude_slot, dtype=np.int64), (n,))
-        mnt = np.broadcast_to(np.asarray(mount_slot, dtype=np.int64), (n,))
+        excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else np.asarray(exclude_slot).reshape(n)
+        mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else np.asarray(mount_slot).reshape(n)
+        valid = lim >= lo
         for r in range(R):
             if not present[r]:
                 continue
-            rel = centre[copy, r] - O
-            b = np.einsum("ij,ij->i", rel, D)
+            cand = valid
+            for skip in (excl, mnt):      # rays that ignore this body (excluded owner, mount)
+                if isinstance(skip, np.ndarray):
+                    cand = cand & (skip != r)
+                elif skip == r:
+                    cand = None
+                    break
+            if cand is None:
+                continue
+            rows = cand.nonzero()[0]
+            if not len(rows):
+                continue
+            rc = copy[rows]
+            rel = centre[rc, r] - O[rows]
+            Dr = D[rows]
+            b = np.einsum("ij,ij->i", rel, Dr)
             e2 = np.einsum("ij,ij->i", rel, rel)
-            tc = np.minimum(np.maximum(b, lo), lim)
-            near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)) & (excl != r) & (mnt != r) & (lim >= lo)
-            rows = near.nonzero()[0]
-            if len(rows):
-                pr_list.append(rows)
-                pm_list.append(copy[rows] * R + r)
+            tc = np.minimum(np.maximum(b, lo[rows]), lim[rows])
+            near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)).nonzero()[0]
+            if len(near):
+                pr_list.append(rows[near])
+                pm_list.append(rc[near] * R + r)
         if not pr_list:
             return hits
         pr = np.concatenate(pr_list)

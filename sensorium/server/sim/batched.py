@@ -82,7 +82,7 @@ class NoiseStreams:
     same numbers whether drawn one by one or ``block`` at a time, so a value drawn here is the
     value the single simulation draws. :meth:`next` takes one number from many streams at once."""
 
-    def __init__(self, copies: int, paths: Sequence[str], block: int = 32):
+    def __init__(self, copies: int, paths: Sequence[str], block: int = 64):
         self.paths = list(paths)
         self.block = int(block)
         n = len(self.paths)
@@ -259,13 +259,19 @@ class BatchedSimulation:
                                         world_seed=0, clock=lambda: 0)
                 self.refs[(slot, d.name)] = DeviceRef(d.device, len(lists[d.device]), slot, d.name)
                 lists[d.device].append(dev)   # type: ignore[attr-defined]
-        # noise streams: one per (copy, device) of every kind that can draw, in one bank
+        # noise streams: one per (copy, device) of every device that can draw (a noisy lookup
+        # table or a noise field), in one bank; columns of a kind are consecutive
         self._noise_col: dict[tuple[str, int], int] = {}
+        self._noise_of: dict[str, np.ndarray] = {}
         paths = []
         for kind_name, devs in lists.items():
+            cols = np.full(len(devs), -1, dtype=np.int64)
             for k, d in enumerate(devs):
-                self._noise_col[(kind_name, k)] = len(paths)
-                paths.append(d.path)
+                table = getattr(d, "table", None)
+                if (table is not None and table.has_noise) or float(getattr(d.config, "noise", 0.0) or 0.0) > 0.0:
+                    cols[k] = self._noise_col[(kind_name, k)] = len(paths)
+                    paths.append(d.path)
+            self._noise_of[kind_name] = cols
         self.noise = NoiseStreams(C, paths)
         # per kind: schedules (period, last update) per copy and the latest values
         self.period = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
@@ -274,6 +280,7 @@ class BatchedSimulation:
         for lid in self.lidar:
             if lid.rotating:
                 continue
+        self._lidar_skips: dict[int, np.ndarray] = {}
         self.range_images = [np.zeros((C, d.config.number_of_layers, d.config.horizontal_resolution), dtype=np.float32)
                              for d in self.lidar]
         # light sensors: constants stacked once
@@ -706,8 +713,7 @@ class BatchedSimulation:
         noisy = (n != 0.0).nonzero()[0]
         if not len(noisy):
             return y
-        dev = np.array([self._noise_col[(kind, c)] for c in cols[noisy].tolist()], dtype=np.int64)
-        g = self.noise.next(copies[noisy], dev)
+        g = self.noise.next(copies[noisy], self._noise_of[kind][cols[noisy]])
         y = np.array(y, dtype=np.float64)
         y[noisy] = y[noisy] * (1.0 + n[noisy] * g)
         return y
@@ -833,9 +839,25 @@ class BatchedSimulation:
             d = dirs.reshape(-1, 3)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
             reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, np.repeat(c, W),
-                              -1, -1, distance_only=True, d32=d.astype(np.float32)))
+                              -1, np.tile(self._lidar_skip(col), len(c)), distance_only=True, d32=d.astype(np.float32)))
             state["items"].append((col, c))
         return state, reqs
+
+    def _lidar_skip(self, col: int) -> np.ndarray:
+        """Per beam: the lidar's own robot slot where the beam can never meet that robot's body
+        (a Webots lidar sees its own robot, so the others are paired with it every scan; a fixed
+        lidar's beams never move in the body frame), else -1. Decided once."""
+        got = self._lidar_skips.get(col)
+        if got is None:
+            lid = self.lidar[col]
+            slot = lid.robot_index
+            x, y, z = lid._dir_columns
+            local = lid.local_pose
+            dirs = np.stack([x, y, z], axis=1) @ local.rotation.T
+            reach = self.rays.may_reach(slot, RayKind.VISUAL, np.broadcast_to(local.translation, dirs.shape), dirs,
+                                        lid.params.near, lid._t_far)
+            got = self._lidar_skips[col] = np.where(reach, -1, slot).astype(np.int64)
+        return got
 
     def _finish_lidar(self, state: dict, hits: list[RayHits]) -> None:
         for (col, c), h in zip(state["items"], hits):
@@ -848,9 +870,8 @@ class BatchedSimulation:
                 for k, cc in enumerate(c.tolist()):
                     stream = _Stream(self.noise, cc, nc)
                     img[cc] = lmath.ranges_from_hits(lid.params, dist[k], lid._all_dirs, stream)  # type: ignore[arg-type]
-            else:
-                for k, cc in enumerate(c.tolist()):
-                    img[cc] = lmath.ranges_from_hits(lid.params, dist[k], lid._all_dirs, None)
+            else:   # element by element: every copy's scans in one call
+                img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
             self.last["Lidar"][c, col] = self.time_ms[c]
             self.counters["measurements"] += len(c)
 
