@@ -20,7 +20,7 @@ import numpy as np
 from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
-from sensorium.gym.env import Agent, load, rebuild
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, load, rebuild
 from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
 from sensorium.schemas import world as wm
@@ -34,7 +34,7 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
 
     def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None,
                  tasks: Mapping[str, Task] | None = None, render_mode: str | None = None,
-                 precision: str = "exact", render_size: int = 256, actions: str = "normalized"):
+                 precision: str = DEFAULT_PRECISION, render_size: int = 256, actions: str = "normalized"):
         self.loaded = load(world)
         if tasks is None:
             tasks = {r.name: Task(robot=r.name) for r in self.loaded.world.robots if r.differential_drive is not None}

@@ -43,7 +43,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from sensorium.gym.env import Agent, load
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, load
 from sensorium.gym.render import TopDown
 from sensorium.gym.task import Task, VectorGoal, never, zero
 from sensorium.gym.views import CopySim
@@ -51,12 +51,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.world.loader import LoadedWorld
 
-__all__ = ["SensoriumVectorEnv", "SubEnv", "DEFAULT_PRECISION"]
-
-DEFAULT_PRECISION = "fast"
-"""The vector environment's default precision: EXACT's float64 refinement costs a training run
-more time than it changes its outcome (README "Training and sweeps": the measured cost); pass
-``precision="exact"`` for Webots-exact rays (the single environment's default)."""
+__all__ = ["SensoriumVectorEnv", "SubEnv"]
 
 
 class _PerCopy(VectorGoal):
