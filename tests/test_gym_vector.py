@@ -198,3 +198,36 @@ def test_bad_actions_and_stepping_before_reset_say_what_is_wrong():
         venv.step(np.zeros((3, 2), dtype=np.float32))
     with pytest.raises(ValueError, match="sub-env 1"):
         venv.step(np.array([[0.0, 0.0], [np.nan, 0.0]], dtype=np.float32))
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_pettingzoo_env_on_the_batched_engine_equals_the_rebuilt_simulation(precision):
+    pytest.importorskip("pettingzoo")
+    from pettingzoo.test import parallel_api_test
+
+    from sensorium.gym import SensoriumParallelEnv
+    from sensorium.gym.tasks import lidar_avoid_task, reach_light_task
+
+    def make(engine):
+        return SensoriumParallelEnv(None, {"epuck": reach_light_task(max_steps=25), "scout": lidar_avoid_task(max_steps=40)},
+                                    precision=precision, engine=engine)
+
+    batched, rebuilt = make("batched"), make("simulation")
+    parallel_api_test(make("batched"), num_cycles=30)
+    rng = np.random.default_rng(4)
+    for episode in range(2):
+        ob, _ = batched.reset(seed=10 + episode)
+        orr, _ = rebuilt.reset(seed=10 + episode)
+        builds = batched._batched.scene.engine.counters["bvh_builds"]
+        while batched.agents:
+            assert batched.agents == rebuilt.agents
+            for a in batched.agents:
+                assert _same_obs(ob[a], orr[a])
+            acts = {a: rng.uniform(-1, 1, 2).astype(np.float32) for a in batched.agents}
+            ob, rb, tb, trb, ib = batched.step(acts)
+            orr, rr, tr_, trr, ir = rebuilt.step(acts)
+            assert (rb, tb, trb) == (rr, tr_, trr)
+            assert all(ib[a]["pose"].tobytes() == ir[a]["pose"].tobytes() for a in ib)
+        assert not rebuilt.agents
+        if episode:
+            assert batched._batched.scene.engine.counters["bvh_builds"] == builds     # the reset rebuilt nothing

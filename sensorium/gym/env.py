@@ -38,7 +38,6 @@ from gymnasium import spaces
 from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
 from sensorium.schemas import world as wm
-from sensorium.server.sim.sensors import Lidar
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
 
@@ -151,7 +150,7 @@ class Agent:
         out = {}
         for n, box in self.dict_space.spaces.items():
             dev = robot.device(n)
-            if isinstance(dev, Lidar):
+            if dev.kind == "Lidar":
                 img = np.nan_to_num(dev.range_image, nan=box.high.flat[0], posinf=box.high.flat[0])
                 out[n] = np.clip(img, box.low, box.high).astype(np.float32)
             else:

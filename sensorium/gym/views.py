@@ -71,6 +71,7 @@ class _Device:
         self._s, self._c = sim, copy
         self.ref = sim.device(sim.robot_names[slot], name)
         self.name = name
+        self.kind = self.ref.kind
 
     def enable(self, period_ms: int) -> None:
         self._s.enable(self.ref, period_ms, copies=[self._c])
