@@ -120,9 +120,9 @@ def train_es(task: str = "reach_light", workers: int = 2, copies: int = 32, iter
     started = False
     ray = None
     if use_ray:
-        from sensorium.sweep.engines import init_ray
-
         import ray as _ray
+
+        from sensorium.sweep.engines import init_ray
 
         started = not _ray.is_initialized()
         ray = init_ray(address, workers)

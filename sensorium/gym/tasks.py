@@ -51,7 +51,7 @@ def lidar_avoid(world=None, render_mode=None, max_steps: int = 1000, **kw) -> Se
 
 
 def _vector(task: Task, world, num_envs: int, render_mode, **kw):
-    from sensorium.gym.vector import SensoriumVectorEnv   # imported on use: the single envs do not need it
+    from sensorium.gym.vector import SensoriumVectorEnv  # imported on use: the single envs do not need it
 
     kw.pop("max_episode_steps", None)        # make_vec passes the spec's (None here: tasks truncate themselves)
     return SensoriumVectorEnv(world, task, num_envs, render_mode=render_mode, **kw)

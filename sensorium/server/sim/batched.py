@@ -36,15 +36,15 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import distance as dmath
-from sensorium.server.devices import light as light_math
 from sensorium.server.devices import lidar as lmath
+from sensorium.server.devices import light as light_math
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
-from sensorium.server.sim.motion import DifferentialDrive, _rz
+from sensorium.server.sim.motion import DifferentialDrive
 from sensorium.server.sim.scene import Scene, _entry, _shape_info, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import DistanceSensor, Lidar, LightSensor, PositionSensor
 from sensorium.server.sim.simulation import lights_from_models
@@ -558,26 +558,6 @@ class BatchedSimulation:
                     self.counters["contacts"] += 1
                     out[m] = p
         return out[:, 0], out[:, 1]
-        # the others slot by slot (each sees the earlier slots of its copy where they ended), in
-        # Contact.resolve_all's narrow phase: candidates solids first, then robots, in index order
-        order = rows[np.lexsort((copies[rows], slots[rows]))]
-        for m in order.tolist():
-            cands = ([ct._in_band(ct._obs[j], float(band_lo[m]), float(band_hi[m]))
-                      for j in solid_hit[m].nonzero()[0].tolist()] if solid_hit is not None else [])
-            cm, r = int(copies[m]), int(slots[m])
-            if robot_hit is not None:
-                for j in robot_hit[m].nonzero()[0].tolist():
-                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
-                                          float(self.foot_radius[j]),
-                                          (float(self.heights[cm, j] + self.foot_low[j]),
-                                           float(self.heights[cm, j] + self.foot_high[j]))))
-            p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
-            self.centres[cm, r] = p
-            if clipped:
-                self.pressing[cm, r] = True
-                self.counters["contacts"] += 1
-                out[m] = p
-        return out[:, 0], out[:, 1]
 
     # -- devices
     def _due(self, kind: str, live: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -646,7 +626,7 @@ class BatchedSimulation:
                 continue
             sizes = [len(r.origins) for r in reqs]
 
-            def cat(name: str, dtype) -> np.ndarray:
+            def cat(name: str, dtype, reqs=reqs, sizes=sizes) -> np.ndarray:
                 return np.concatenate([np.broadcast_to(np.asarray(getattr(r, name), dtype=dtype), (n,))
                                        for r, n in zip(reqs, sizes)])
 
@@ -947,5 +927,3 @@ def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: 
         yo[t] = y[t] - r * (c1 - c0)
     return xo, yo, np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi
 
-
-__all__ += ["_rz"]   # (re-exported for tests comparing the drive's rotation arithmetic)
