@@ -150,3 +150,38 @@ def test_what_the_batched_simulation_does_not_simulate_is_refused_with_a_reason(
         bs.enable(bs.device("scout", "lidar"), 32)
     with pytest.raises(KeyError, match="no device 'nope'"):
         bs.device("epuck", "nope")
+
+
+def test_wheel_encoders_with_noise_and_resolution_match_the_single_simulation():
+    world = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "random_seed": 0},
+        "solids": [{"name": "floor", "geometry": {"type": "plane"}}],
+        "robots": [{"name": "bot", "pose": {"translation": [0, 0, 0.05]},
+                    "body": {"geometry": {"type": "cylinder", "radius": 0.035, "height": 0.05}},
+                    "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 6.0},
+                    "devices": [{"device": "PositionSensor", "name": "left", "motor": "left wheel motor"},
+                                {"device": "PositionSensor", "name": "right", "motor": "right wheel motor",
+                                 "noise": 0.01, "resolution": 0.001}]}]})
+    seeds = [3, 4]
+    bs = BatchedSimulation(world, 2)
+    bs.reset(np.arange(2), seeds)
+    sims = [Simulation(world.model_copy(update={"world_info": world.world_info.model_copy(
+        update={"random_seed": s})})) for s in seeds]
+    for name, period in (("left", 16), ("right", 48)):
+        bs.enable(bs.device("bot", name), period)
+        for s in sims:
+            s.robot("bot").device(name).enable(period)
+    bs.set_wheels(0, np.array([2.0, -3.0]), np.array([1.5, 6.5]))       # 6.5 is clamped to 6
+    for c, s in enumerate(sims):
+        for m in s.robot("bot").motors.values():
+            m.set_position(math.inf)
+        s.robot("bot").drive.left.set_velocity([2.0, -3.0][c])
+        s.robot("bot").drive.right.set_velocity([1.5, 6.5][c])
+    for _ in range(30):
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for name in ("left", "right"):
+                assert _same_value(s.robot("bot").device(name).value, float(bs.value(bs.device("bot", name))[c]))
+            assert s.robot("bot").pose.translation.tobytes() == bs.pos[c, 0].tobytes()
+    assert bs.value(bs.device("bot", "left"))[0] == pytest.approx(2.0 * 0.016 * 30, abs=1e-12)   # rad turned

@@ -316,6 +316,8 @@ class BatchedSimulation:
                 wheel.append(names.index(m) if m is not None and m in names and self.has_drive[d.robot_index] else -1)
             self._p_wheel = np.array(wheel, dtype=np.int64)
             self._p_slot = np.array([d.robot_index for d in self.position], dtype=np.int64)
+            self._p_plain = np.array([float(d.config.noise) <= 0.0 and float(d.config.resolution) <= 0.0
+                                      for d in self.position], dtype=bool)
 
     # ------------------------------------------------------------------ access
     @property
@@ -575,7 +577,9 @@ class BatchedSimulation:
         wheel = self._p_wheel[cols]
         slot = self._p_slot[cols]
         v = np.where(wheel >= 0, self.wheel_angle[copies, slot, np.maximum(wheel, 0)], 0.0)
-        for k, col in enumerate(cols.tolist()):
+        plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself
+        for k in (~plain).nonzero()[0].tolist():
+            col = int(cols[k])
             cfg = self.position[col].config
             noise, res = float(cfg.noise), float(cfg.resolution)
             if noise > 0.0:
