@@ -158,9 +158,16 @@ class SensoriumVectorEnv(VectorEnv):
                 self._rngs[c], _ = seeding.np_random(int(s))
             world_seeds.append(int(self._rngs[c].integers(0, 2**62)))
         self.sim.reset(copies, world_seeds)
-        for c in copies.tolist():
-            view = self._view(c)
-            self.agent.start(view, self._rngs[c])        # the single environment's own start, on a view
+        # Agent.start for all these copies: the task's start per copy (on a view: the single
+        # environment's own draws), then wheels at rest in velocity control and the observed
+        # devices enabled, for all of them at once
+        if self.task.start is not None:
+            for c in copies.tolist():
+                view = self._view(c)
+                self.task.start(view, view.robot(self.agent.robot), self._rngs[c])
+        self.sim.set_wheels(self.slot, np.zeros(len(copies)), np.zeros(len(copies)), copies)
+        for name, period in self.agent.periods.items():
+            self.sim.enable(self.refs[name], period, copies)
         self.steps[copies] = 0
         self._needs_reset[copies] = False
 
