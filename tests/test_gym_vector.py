@@ -34,7 +34,7 @@ def _lockstep(env_id: str, precision: str, n: int, steps: int, max_steps: int, s
     on one side, reset() after an ended episode on the other. Returns the number of resets seen."""
     venv = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", precision=precision,
                         max_steps=max_steps)
-    singles = [gym.make(env_id, precision=precision, max_steps=max_steps) for _ in range(n)]
+    singles = [gym.make(env_id, precision=precision, max_steps=max_steps, engine="simulation") for _ in range(n)]
     obs, info = venv.reset(seed=seed)
     for i, env in enumerate(singles):
         o, inf = env.reset(seed=seed + i)
@@ -90,7 +90,7 @@ def test_same_step_autoreset_returns_the_new_episode_and_keeps_the_last_observat
     venv = SensoriumVectorEnv(None, sensorium.gym.tasks.reach_light_task(max_steps=3), n,
                               autoreset_mode=AutoresetMode.SAME_STEP)
     assert venv.metadata["autoreset_mode"] is AutoresetMode.SAME_STEP
-    single = [sensorium.gym.reach_light(max_steps=3, precision="fast") for _ in range(n)]
+    single = [sensorium.gym.reach_light(max_steps=3, precision="fast", engine="simulation") for _ in range(n)]
     venv.reset(seed=[7, 9])
     for env, s in zip(single, [7, 9]):
         env.reset(seed=s)
@@ -129,7 +129,8 @@ def test_disabled_autoreset_resets_through_the_mask_only():
 def test_checker_passes_without_warnings_on_single_envs_and_sub_envs(env_id):
     with warnings.catch_warnings():
         warnings.simplefilter("error")                    # any checker warning fails the test
-        check_env(gym.make(env_id).unwrapped)
+        check_env(gym.make(env_id).unwrapped)                          # a rebuilt Simulation
+        check_env(gym.make(env_id, engine="batched").unwrapped)        # the batched engine (one copy)
         venv = gym.make_vec(env_id, num_envs=3, vectorization_mode="vector_entry_point", render_mode="rgb_array")
         check_env(venv.unwrapped.sub_env(2), skip_render_check=False)
         check_env(gym.make_vec(env_id, num_envs=2, vectorization_mode="vector_entry_point",
@@ -161,7 +162,7 @@ def test_flattened_observations_are_the_dict_boxes_in_key_order():
     keys = list(boxed.single_observation_space.spaces)
     assert keys == sorted(keys)
     np.testing.assert_array_equal(f, np.concatenate([d[k].reshape(n, -1) for k in keys], axis=1))
-    single = gym.make("sensorium/LidarAvoid-v0", flatten=True, precision="fast")
+    single = gym.make("sensorium/LidarAvoid-v0", flatten=True, precision="fast", engine="simulation")
     s, _ = single.reset(seed=4)
     assert s.tobytes() == f[1].tobytes()                 # sub-env 1 had seed 3 + 1
 
@@ -177,7 +178,7 @@ def test_a_reward_without_a_vectorised_form_is_called_per_copy_with_the_same_val
     task = Task(robot="epuck", observations={"ls0": 64}, control_period_ms=64, max_steps=20, reward=closer_to_origin,
                 terminated=ReachLight("lamp").terminated)
     venv = SensoriumVectorEnv(None, task, 2)
-    single = SensoriumEnv(None, task, precision="fast")
+    single = SensoriumEnv(None, task, precision="fast", engine="simulation")
     venv.reset(seed=[3, 4])
     single.reset(seed=4)
     rng = np.random.default_rng(2)
@@ -187,6 +188,7 @@ def test_a_reward_without_a_vectorised_form_is_called_per_copy_with_the_same_val
         _, r1, *_ = single.step(a[1])
         assert r[1] == r1
     assert len(calls) == 5 * 2 + 5
+    assert single.engine == "simulation" and SensoriumEnv(None, task, engine="auto").engine == "batched"
 
 
 def test_bad_actions_and_stepping_before_reset_say_what_is_wrong():
@@ -231,3 +233,45 @@ def test_pettingzoo_env_on_the_batched_engine_equals_the_rebuilt_simulation(prec
         assert not rebuilt.agents
         if episode:
             assert batched._batched.scene.engine.counters["bvh_builds"] == builds     # the reset rebuilt nothing
+
+
+def test_auto_engine_falls_back_to_the_simulation_for_what_the_batched_one_does_not_simulate():
+    from sensorium.server.sim.batched import BatchedError
+    from sensorium.server.world.loader import default_world_path, load_world
+
+    lw = load_world(default_world_path())
+    robots = [r.model_dump(mode="json", exclude_none=True) for r in lw.world.robots]
+    robots[1]["devices"][0]["type"] = "rotating"                  # the scout's lidar
+    w = lw.world.model_validate({**lw.world.model_dump(mode="json", exclude_none=True), "robots": robots})
+    from sensorium.server.world.loader import LoadedWorld
+
+    world = LoadedWorld(world=w, source="rotating", base_dir=lw.base_dir)
+    task = Task(robot="scout", observations={"lidar": 64}, control_period_ms=64)
+    env = SensoriumEnv(world, task, engine="auto")
+    assert env.engine == "simulation"
+    obs, _ = env.reset(seed=0)
+    assert obs["lidar"].shape == (1, 360)
+    with pytest.raises(BatchedError, match="rotating lidars"):
+        SensoriumEnv(world, task, engine="batched")
+    with pytest.raises(BatchedError, match="rotating lidars"):
+        SensoriumVectorEnv(world, task, 2).reset(seed=0)
+    assert SensoriumEnv(world, Task(robot="epuck", observations=["ps0"]), engine="auto").engine == "batched"
+
+
+@pytest.mark.parametrize("env_id", ["sensorium/AvoidObstacles-v0", "sensorium/LidarAvoid-v0"])
+def test_single_env_on_the_batched_engine_equals_the_rebuilt_simulation(env_id):
+    batched = gym.make(env_id, engine="batched", max_steps=10)
+    rebuilt = gym.make(env_id, engine="simulation", max_steps=10)
+    assert batched.unwrapped.engine == "batched" and rebuilt.unwrapped.engine == "simulation"
+    rng = np.random.default_rng(6)
+    for seed in (1, None, 2):
+        ob, ib = batched.reset(seed=seed)
+        orr, ir = rebuilt.reset(seed=seed)
+        assert _same_obs(ob, orr) and ib["pose"].tobytes() == ir["pose"].tobytes()
+        done = False
+        while not done:
+            a = rng.uniform(-1, 1, 2).astype(np.float32)
+            ob, rb, tb, trb, ib = batched.step(a)
+            orr, rr, tr_, trr, ir = rebuilt.step(a)
+            assert _same_obs(ob, orr) and (rb, tb, trb) == (rr, tr_, trr) and ib["time_ms"] == ir["time_ms"]
+            done = tb or trb

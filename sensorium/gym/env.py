@@ -18,10 +18,17 @@ libraries and Gymnasium's checker recommend; ``actions="wheel"``: the wheel velo
 (rad/s), bounded by the max wheel speed. Either way a velocity beyond the maximum is clamped, as
 Webots does. One action lasts ``control_period_ms``.
 
-``reset(seed=s)`` rebuilds the simulation from the world model with world seed drawn from the
-environment's generator seeded with ``s``: every device noise stream, the start pose drawn by
-``Task.start`` and the clock restart exactly, so the same seed and actions give a bit-identical
-episode. Before the first observation the simulation runs until every observed device has a value
+``reset(seed=s)`` restarts the world with a world seed drawn from the environment's generator
+seeded with ``s``: every device noise stream, the start pose drawn by ``Task.start`` and the clock
+restart exactly, so the same seed and actions give a bit-identical episode. ``engine``: where the
+world runs -- ``"batched"``: the batched simulation of the vector environment with one copy (a reset
+reuses the built scene; ``sim`` is a view of the copy, :mod:`sensorium.gym.views`);
+``"simulation"`` (the default): a :class:`Simulation` rebuilt at every reset (every device kind;
+``sim`` is it); ``"auto"``: batched when it simulates every observed device and the world, else
+simulation. Both engines give the same episodes bit for bit (tested). Measured here: a batched
+reset takes 2.6 ms of CPU against 22 ms for a rebuild, but one copy steps at ~60 % of the rate of a
+Simulation (383 vs 625 ReachLight steps per CPU second): the batched engine pays off with many
+copies (the vector environment), or with many short episodes. Before the first observation the simulation runs until every observed device has a value
 (its longest sampling period), as a Webots controller would wait.
 """
 
@@ -37,6 +44,7 @@ from gymnasium import spaces
 
 from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
+from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
@@ -195,6 +203,30 @@ def _space(cfg) -> spaces.Box:
     return spaces.Box(np.float32(min(out)), np.float32(max(out)), shape=(1,), dtype=np.float32)
 
 
+ENGINES = ("auto", "batched", "simulation")
+
+
+def batched_engine(loaded: LoadedWorld, agents: list[Agent], precision: str, engine: str):
+    """The one-copy batched simulation the environments run on (``engine`` "batched", or "auto"
+    when it simulates the world and every observed device), None for a rebuilt Simulation."""
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    if engine == "simulation":
+        return None
+    try:
+        sim = BatchedSimulation(loaded, 1, precision=precision)
+        for ag in agents:
+            for name in ag.periods:
+                sim.check_observable(ag.robot, name)
+    except BatchedError:
+        if engine == "batched":
+            raise
+        return None
+    return sim
+
+
 def rebuild(loaded: LoadedWorld, world_seed: int, precision: str) -> Simulation:
     """A fresh simulation of ``loaded`` with ``world_seed``: clock, poses, motors, device state and
     noise streams all as at the start."""
@@ -209,7 +241,7 @@ class SensoriumEnv(TopDownRendering, gym.Env):
 
     def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None, task: Task | None = None,
                  render_mode: str | None = None, precision: str = DEFAULT_PRECISION, render_size: int = 256,
-                 actions: str = "normalized", flatten: bool = False):
+                 actions: str = "normalized", flatten: bool = False, engine: str = "simulation"):
         self.loaded = load(world)
         self.task = task or Task()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -225,14 +257,21 @@ class SensoriumEnv(TopDownRendering, gym.Env):
         self.periods = self.agent.periods
         self.observation_space = self.agent.observation_space
         self.action_space = self.agent.action_space
-        self.sim: Simulation | None = None
+        self.sim: Any = None
+        self._batched = batched_engine(self.loaded, [self.agent], precision, engine)
+        self.engine = "batched" if self._batched is not None else "simulation"
         self.steps = 0
         self._renderer: TopDown | None = None
 
     # ---------------------------------------------------------------- gymnasium API
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        self.sim = sim = rebuild(self.loaded, int(self.np_random.integers(0, 2**62)), self.precision)
+        world_seed = int(self.np_random.integers(0, 2**62))
+        if self._batched is not None:           # the built scene, the copy as new: nothing rebuilt
+            self._batched.reset([0], [world_seed])
+            self.sim = sim = CopySim(self._batched, 0)
+        else:
+            self.sim = sim = rebuild(self.loaded, world_seed, self.precision)
         self.agent.start(sim, self.np_random)
         # run until every observed device has measured once (Webots: first value one period later)
         sim.run(self.agent.warmup_steps)

@@ -10,11 +10,12 @@ Every agent is a robot with a differential drive and its own :class:`~sensorium.
 be the same for all. An agent that terminates or truncates leaves ``agents`` and its robot stops;
 the world keeps running for the others. Resets are exact as in the single-agent environment.
 
-``engine="batched"`` (the default) runs the world on the batched simulation of the vector
-environment (one copy): a reset reuses the built scene instead of rebuilding it, and ``sim`` is a
-view of that copy (:mod:`sensorium.gym.views`: poses, devices, motors, casts). ``engine=
-"simulation"`` rebuilds a :class:`~sensorium.server.sim.simulation.Simulation` per reset (every
-device kind; ``sim`` is that simulation). Both give the same episodes bit for bit (tested).
+``engine`` as :class:`~sensorium.gym.env.SensoriumEnv`: ``"batched"`` runs the world on the
+batched simulation of the vector environment (one copy: a reset reuses the built scene; ``sim`` is
+a view of that copy, :mod:`sensorium.gym.views`), ``"simulation"`` rebuilds a
+:class:`~sensorium.server.sim.simulation.Simulation` per reset (every device kind; ``sim`` is it),
+``"auto"`` (the default) the first when it simulates everything observed. Both give the same
+episodes bit for bit (tested).
 """
 
 from __future__ import annotations
@@ -27,12 +28,11 @@ import numpy as np
 from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
-from sensorium.gym.env import DEFAULT_PRECISION, Agent, load, rebuild
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, batched_engine, load, rebuild
 from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
-from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.world.loader import LoadedWorld
 
 __all__ = ["SensoriumParallelEnv"]
@@ -44,10 +44,7 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
     def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None,
                  tasks: Mapping[str, Task] | None = None, render_mode: str | None = None,
                  precision: str = DEFAULT_PRECISION, render_size: int = 256, actions: str = "normalized",
-                 engine: str = "batched"):
-        if engine not in ("batched", "simulation"):
-            raise ValueError(f"engine must be 'batched' or 'simulation', got {engine!r}")
-        self.engine = engine
+                 engine: str = "auto"):
         self.loaded = load(world)
         if tasks is None:
             tasks = {r.name: Task(robot=r.name) for r in self.loaded.world.robots if r.differential_drive is not None}
@@ -72,20 +69,11 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
         self.observation_spaces = {a: ag.observation_space for a, ag in self._agents.items()}
         self.action_spaces = {a: ag.action_space for a, ag in self._agents.items()}
         self.sim: Any = None
-        self._batched = BatchedSimulation(self.loaded, 1, precision=precision) if engine == "batched" else None
-        if self._batched is not None:
-            for ag in self._agents.values():        # every observed device must be one the batched engine measures
-                for name in ag.periods:
-                    self._batched.device(ag.robot, name)
+        self._batched = batched_engine(self.loaded, list(self._agents.values()), precision, engine)
+        self.engine = "batched" if self._batched is not None else "simulation"
         self.steps = 0
         self._rng, _ = seeding.np_random()
         self._renderer: TopDown | None = None
-
-    def _run(self, steps: int) -> None:
-        if self._batched is not None:
-            self._batched.run(steps)
-        else:
-            self.sim.run(steps)
 
     def observation_space(self, agent: str):
         return self.observation_spaces[agent]
@@ -104,7 +92,7 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
             self.sim = sim = rebuild(self.loaded, world_seed, self.precision)
         for ag in self._agents.values():
             ag.start(sim, self._rng)
-        self._run(max(ag.warmup_steps for ag in self._agents.values()))
+        sim.run(max(ag.warmup_steps for ag in self._agents.values()))
         for ag in self._agents.values():
             ag.reset_callables(sim)
         self.steps = 0
@@ -120,7 +108,7 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
             if a not in actions:
                 raise ValueError(f"no action for agent {a!r} (agents: {', '.join(self.agents)})")
             self._agents[a].act(self.sim, actions[a])
-        self._run(self.steps_per_action)
+        self.sim.run(self.steps_per_action)
         self.steps += 1
         obs, rewards, terms, truncs, infos = {}, {}, {}, {}, {}
         for a in self.agents:

@@ -109,7 +109,7 @@ class SensoriumVectorEnv(VectorEnv):
         self.agent = Agent(self.loaded, self.task, actions=actions, flatten=flatten)
         self.sim = BatchedSimulation(self.loaded, n, precision=precision)
         self.slot = self.sim.slot(self.agent.robot)
-        self.refs = {name: self.sim.device(self.agent.robot, name) for name in self.agent.periods}
+        self.refs = {name: self.sim.check_observable(self.agent.robot, name) for name in self.agent.periods}
         self.basic_time_step = self.sim.basic_time_step
         self.steps_per_action = self.agent.control_period_ms // self.basic_time_step
         self.single_observation_space = self.agent.observation_space

@@ -6,6 +6,7 @@ without a vectorised form) is written against :class:`~sensorium.server.sim.simu
 and its ``RobotState``. The vector environment hands them these views of one copy instead:
 
 * ``CopySim``: ``time_ms``, ``basic_time_step``, ``world``, ``loaded``, ``robots`` / ``robot(name)``,
+  ``run(steps)`` / ``step()`` (this copy alone),
   ``scene`` (``world_lights()``, ``solid_poses``, and ``engine.cast(...)`` casting in this copy only:
   ``exclude_owner`` is a robot index, as in the single simulation);
 * ``CopyRobot``: ``name``, ``index``, ``model``, ``pose``, ``set_pose(...)``, ``motors`` /
@@ -83,6 +84,10 @@ class _Device:
     @property
     def range_image(self) -> np.ndarray:
         return self._s.range_image(self.ref)[self._c]
+
+    def __getattr__(self, name: str) -> Any:
+        # the device's constants (config, params, table, ...) from its template in the batched simulation
+        return getattr(self._s.template(self.ref), name)
 
 
 class CopyRobot:
@@ -169,6 +174,15 @@ class CopySim:
             return self.robots[name]
         except KeyError:
             raise KeyError(f"no robot {name!r} (robots: {', '.join(self.robots)})") from None
+
+    def run(self, steps: int) -> None:
+        """Advance this copy alone by ``steps`` basic steps."""
+        active = np.zeros(self._s.copies, dtype=bool)
+        active[self.copy] = True
+        self._s.run(steps, active if self._s.copies > 1 else None)
+
+    def step(self) -> None:
+        self.run(1)
 
     def __getattr__(self, name: str) -> Any:
         raise AttributeError(f"CopySim (one copy of a batched simulation) has no {name!r}")

@@ -345,6 +345,19 @@ class BatchedSimulation:
             raise KeyError(f"robot {robot!r} has no device {name!r} (devices: {', '.join(kinds)})")
         return ref
 
+    def check_observable(self, robot: str, name: str) -> DeviceRef:
+        """The device, if the batched simulation measures it (else BatchedError saying why)."""
+        ref = self.device(robot, name)
+        if ref.kind == "Lidar" and self.lidar[ref.column].rotating:
+            raise BatchedError(f"{robot}/{name}: rotating lidars are not simulated by the batched simulation "
+                               "(use Simulation)")
+        return ref
+
+    def template(self, ref: DeviceRef):
+        """The device object holding a device's constants (config, lookup table, lidar params)."""
+        return {"LightSensor": self.light, "DistanceSensor": self.distance, "Lidar": self.lidar,
+                "PositionSensor": self.position}[ref.kind][ref.column]
+
     def pose(self, copy: int, slot: int) -> Pose:
         return Pose(self.rot[copy, slot], self.pos[copy, slot])
 
