@@ -290,3 +290,11 @@ def test_flattened_observations_for_libraries_that_need_one_box():
     obs, _ = env.reset(seed=2)
     raw, _ = env.unwrapped.reset(seed=2)
     np.testing.assert_array_equal(obs, np.concatenate([raw[k] for k in sorted(raw)]))
+
+
+def test_example_loop_runs_the_batched_vector_env_with_the_same_episodes():
+    from sensorium.gym.examples.random_policy import run
+
+    sync = run("sensorium/ReachLight-v0", 2, 6, "sync", policy="scripted")
+    batched = run("sensorium/ReachLight-v0", 2, 6, "batched", policy="scripted")
+    assert batched["env_steps"] == 12 and batched["mean_reward"] == sync["mean_reward"]
