@@ -184,8 +184,8 @@ OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
 
 DEFAULT_PRECISION = "fast"
 """The Gymnasium environments' default ray precision (single, vector and PettingZoo alike, so the
-same seed gives the same episode in all of them). EXACT's float64 refinement costs 40 % of
-ReachLight's and 44 % of LidarAvoid's batched env steps/s (``sensorium bench --only training``),
+same seed gives the same episode in all of them). EXACT's float64 refinement cost 27-40 % of
+ReachLight's and 44-51 % of LidarAvoid's batched env steps/s (``sensorium bench --only training``),
 while what FAST changes is small: over 16 x 150 random-action steps the ReachLight observations
 were identical, and 0.4 % of LidarAvoid's lidar ranges differed by more than 1 mm (beams grazing
 edges, where float32 traversal can slip between triangles; 45 % differed by float32 rounding,
