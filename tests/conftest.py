@@ -22,6 +22,8 @@ SLOW_TESTS = {
     "test_simulation.py::test_million_steps_no_clock_drift",
     "test_simulation.py::test_circle_stays_on_circle_for_a_million_steps",
     "test_sweep.py::test_same_sweep_on_ray_and_on_the_process_pool_gives_identical_results",   # a Ray cluster
+    "test_train.py::test_ppo_on_the_batched_env_reaches_the_lamp",                             # ~1.5 min of PPO
+    "test_train.py::test_evolution_strategy_on_ray_actors_equals_the_same_workers_in_process",  # a Ray cluster
 }
 
 

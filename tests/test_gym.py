@@ -71,7 +71,7 @@ def _same(a, b) -> bool:
 def test_same_seed_gives_a_bit_identical_episode_and_reset_restores_the_world(precision):
     env = avoid_obstacles(precision=precision)
     rng = np.random.default_rng(0)
-    actions = [rng.uniform(-6.28, 6.28, 2).astype(np.float32) for _ in range(40)]
+    actions = [rng.uniform(-1, 1, 2).astype(np.float32) for _ in range(40)]
     first = _episode(env, 11, actions)
     other = _episode(env, 12, actions)      # another seed in between: noise and start pose change ...
     again = _episode(env, 11, actions)      # ... and seed 11 comes back exactly
@@ -90,7 +90,9 @@ def test_observation_and_action_bounds_come_from_the_world():
     assert box.shape == (1,) and box.dtype == np.float32
     assert box.low[0] == np.float32(67.19) and box.high[0] == np.float32(4095)
     assert env.observation_space["ls0"].low[0] == 0 and env.observation_space["ls0"].high[0] == 4096
-    assert env.action_space.low.tolist() == [np.float32(-6.28)] * 2 and env.action_space.high.tolist() == [np.float32(6.28)] * 2
+    assert env.action_space.low.tolist() == [-1.0] * 2 and env.action_space.high.tolist() == [1.0] * 2   # normalised
+    wheel = reach_light(actions="wheel").action_space
+    assert wheel.low.tolist() == [np.float32(-6.28)] * 2 and wheel.high.tolist() == [np.float32(6.28)] * 2
     lid = lidar_avoid().observation_space["lidar"]
     assert lid.shape == (1, 360) and lid.dtype == np.float32 and lid.high.max() == 6.0
     with pytest.raises(ValueError, match="no such device"):
@@ -119,7 +121,8 @@ def test_driving_straight_moves_the_exact_distance_and_ends_on_contact_with_the_
     # robot at the centre facing +x; the wall's inner face is at x = 1: contact when the body
     # (radius 0.035) is within 0.005 m of it, i.e. once x >= 1 - 0.035 - 0.005
     goal = AvoidObstacles(near=0.1, contact_distance=0.005, contact_penalty=10.0)
-    env = SensoriumEnv(room(), Task(observations=[], reward=goal, terminated=goal.terminated, max_steps=None))
+    env = SensoriumEnv(room(), Task(observations=[], reward=goal, terminated=goal.terminated, max_steps=None),
+                       actions="wheel")
     _, info = env.reset(seed=0)
     v = 6.28 * 0.0205                                            # m/s at full wheel speed
     step_m = v * 0.032
@@ -137,7 +140,8 @@ def test_driving_straight_moves_the_exact_distance_and_ends_on_contact_with_the_
 
 def test_reach_light_rewards_telescope_to_the_distance_gained():
     goal = ReachLight("lamp", radius=0.2, progress_weight=10.0, bonus=5.0, step_cost=0.01)
-    env = SensoriumEnv(room(), Task(observations=[], reward=goal, terminated=goal.terminated, max_steps=200))
+    env = SensoriumEnv(room(), Task(observations=[], reward=goal, terminated=goal.terminated, max_steps=200),
+                       actions="wheel")
     _, info = env.reset(seed=0)
     d0 = math.hypot(0.5, 0.5)
     total, n, terminated = 0.0, 0, False
@@ -184,7 +188,7 @@ def test_vector_envs_step_in_lockstep_with_single_envs(vector_cls):
         obs, _ = venv.reset(seed=[5, 6, 7])
         assert obs["ps0"].shape == (n, 1) and obs["ls0"].dtype == np.float32
         rng = np.random.default_rng(1)
-        actions = [rng.uniform(-6.28, 6.28, (n, 2)).astype(np.float32) for _ in range(10)]
+        actions = [rng.uniform(-1, 1, (n, 2)).astype(np.float32) for _ in range(10)]
         batched = [venv.step(a) for a in actions]
     finally:
         venv.close()
@@ -213,7 +217,7 @@ def test_pettingzoo_parallel_env_passes_the_api_test_and_moves_each_robot_exactl
     from sensorium.gym import SensoriumParallelEnv
 
     tasks = {"bot": Task(observations=[], max_steps=30), "bot2": Task(observations=[], max_steps=20)}
-    env = SensoriumParallelEnv(two_robot_room(), tasks)
+    env = SensoriumParallelEnv(two_robot_room(), tasks, actions="wheel")
     parallel_api_test(env, num_cycles=40)
     obs, infos = env.reset(seed=4)
     assert env.agents == ["bot", "bot2"]
@@ -244,7 +248,7 @@ def test_example_loop_reports_steps_per_second_and_is_deterministic():
 def test_wheel_encoders_are_observed_and_leds_are_not():
     devices = [{"device": "PositionSensor", "name": "enc", "motor": "left wheel motor"},
                {"device": "LED", "name": "led"}]
-    env = SensoriumEnv(room(devices=devices), Task(control_period_ms=32))
+    env = SensoriumEnv(room(devices=devices), Task(control_period_ms=32), actions="wheel")
     assert list(env.observation_space.spaces) == ["enc"]
     env.reset(seed=0)
     obs, *_ = env.step(np.array([2.0, 2.0], dtype=np.float32))
@@ -286,3 +290,11 @@ def test_flattened_observations_for_libraries_that_need_one_box():
     obs, _ = env.reset(seed=2)
     raw, _ = env.unwrapped.reset(seed=2)
     np.testing.assert_array_equal(obs, np.concatenate([raw[k] for k in sorted(raw)]))
+
+
+def test_example_loop_runs_the_batched_vector_env_with_the_same_episodes():
+    from sensorium.gym.examples.random_policy import run
+
+    sync = run("sensorium/ReachLight-v0", 2, 6, "sync", policy="scripted")
+    batched = run("sensorium/ReachLight-v0", 2, 6, "batched", policy="scripted")
+    assert batched["env_steps"] == 12 and batched["mean_reward"] == sync["mean_reward"]

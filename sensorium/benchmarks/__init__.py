@@ -10,8 +10,9 @@ One module per section, each ``run(cfg) -> Section``:
 * :mod:`.scaleout`  — vectorised Gymnasium env steps/s, sweep throughput on the process pool vs Ray;
 * :mod:`.loading`   — loading a PROTO-heavy Webots world, per stage (expansion, templates, conversion, scene);
 * :mod:`.images`    — a camera's and a range finder's picture vs raw embreex on the same rays;
+* :mod:`.training`  — the batched vector env (many worlds in one simulation) vs MuJoCo Hopper, scaling, resets;
 
 and :mod:`.report` writes ``benchmarks.md``, ``benchmarks.json`` and the PNG plots.
 """
 
-SECTIONS = ("transport", "memory", "accuracy", "scaling", "scaleout", "loading", "images", "peers")   # run order: peers last (its libraries start thread pools)
+SECTIONS = ("transport", "memory", "accuracy", "scaling", "scaleout", "loading", "images", "training", "peers")   # run order: peers last (its libraries start thread pools)

@@ -9,6 +9,10 @@ Registered ids (all on the embedded arena world): ``sensorium/ReachLight-v0`` (e
 infra-red sensors, drive to the lamp), ``sensorium/AvoidObstacles-v0`` (e-puck, infra-red sensors,
 explore without contact), ``sensorium/LidarAvoid-v0`` (scout, 360-ray lidar + sonars).
 ``SensoriumParallelEnv`` (PettingZoo) runs several robots of one world as agents.
+
+Batched: ``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` gives a
+:class:`~sensorium.gym.vector.SensoriumVectorEnv`: N copies of the world in one simulation (one
+cast per ray kind for all of them), each sub-environment bit-identical to the single one.
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ from sensorium.gym.env import SensoriumEnv
 from sensorium.gym.task import AvoidObstacles, ReachLight, Task, clearance, never, random_start
 from sensorium.gym.tasks import avoid_obstacles, lidar_avoid, reach_light
 
-__all__ = ["SensoriumEnv", "SensoriumParallelEnv", "Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start",
+__all__ = ["SensoriumEnv", "SensoriumParallelEnv", "SensoriumVectorEnv", "Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start",
            "reach_light", "avoid_obstacles", "lidar_avoid"]
 
 
@@ -29,11 +33,15 @@ def __getattr__(name: str):
         from sensorium.gym.multi import SensoriumParallelEnv
 
         return SensoriumParallelEnv
+    if name == "SensoriumVectorEnv":
+        from sensorium.gym.vector import SensoriumVectorEnv
+
+        return SensoriumVectorEnv
     raise AttributeError(f"module 'sensorium.gym' has no attribute {name!r}")
 
 
 for _id, _fn in (("sensorium/ReachLight-v0", "reach_light"),
-                         ("sensorium/AvoidObstacles-v0", "avoid_obstacles"),
-                         ("sensorium/LidarAvoid-v0", "lidar_avoid")):
+                 ("sensorium/AvoidObstacles-v0", "avoid_obstacles"),
+                 ("sensorium/LidarAvoid-v0", "lidar_avoid")):
     if _id not in registry:
-        register(id=_id, entry_point=f"sensorium.gym.tasks:{_fn}")
+        register(id=_id, entry_point=f"sensorium.gym.tasks:{_fn}", vector_entry_point=f"sensorium.gym.tasks:{_fn}_vector")

@@ -9,20 +9,29 @@ Every agent is a robot with a differential drive and its own :class:`~sensorium.
 (spaces as in :class:`~sensorium.gym.env.SensoriumEnv`); all act every control period, which must
 be the same for all. An agent that terminates or truncates leaves ``agents`` and its robot stops;
 the world keeps running for the others. Resets are exact as in the single-agent environment.
+
+``engine`` as :class:`~sensorium.gym.env.SensoriumEnv`: ``"batched"`` runs the world on the
+batched simulation of the vector environment (one copy: a reset reuses the built scene; ``sim`` is
+a view of that copy, :mod:`sensorium.gym.views`), ``"simulation"`` rebuilds a
+:class:`~sensorium.server.sim.simulation.Simulation` per reset (every device kind; ``sim`` is it),
+``"auto"`` (the default) the first when it simulates everything observed. Both give the same
+episodes bit for bit (tested).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
-from sensorium.gym.env import Agent, load, rebuild
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, batched_engine, load, rebuild
 from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
+from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.world.loader import LoadedWorld
 
@@ -34,7 +43,8 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
 
     def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None,
                  tasks: Mapping[str, Task] | None = None, render_mode: str | None = None,
-                 precision: str = "exact", render_size: int = 256):
+                 precision: str = DEFAULT_PRECISION, render_size: int = 256, actions: str = "normalized",
+                 engine: str = "auto"):
         self.loaded = load(world)
         if tasks is None:
             tasks = {r.name: Task(robot=r.name) for r in self.loaded.world.robots if r.differential_drive is not None}
@@ -45,7 +55,7 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
         self.render_mode = render_mode
         self.precision = precision
         self.render_size = render_size
-        self._agents = {name: Agent(self.loaded, task, default_robot=name) for name, task in tasks.items()}
+        self._agents = {name: Agent(self.loaded, task, default_robot=name, actions=actions) for name, task in tasks.items()}
         for name, ag in self._agents.items():
             if ag.robot != name:
                 raise ValueError(f"agent {name!r}: its task names robot {ag.robot!r}; agents are named after their robot")
@@ -58,7 +68,9 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
         self.agents: list[str] = []
         self.observation_spaces = {a: ag.observation_space for a, ag in self._agents.items()}
         self.action_spaces = {a: ag.action_space for a, ag in self._agents.items()}
-        self.sim = None
+        self.sim: Any = None
+        self._batched = batched_engine(self.loaded, list(self._agents.values()), precision, engine)
+        self.engine = "batched" if self._batched is not None else "simulation"
         self.steps = 0
         self._rng, _ = seeding.np_random()
         self._renderer: TopDown | None = None
@@ -72,7 +84,12 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
     def reset(self, seed: int | None = None, options: dict | None = None):
         if seed is not None:
             self._rng, _ = seeding.np_random(seed)
-        self.sim = sim = rebuild(self.loaded, int(self._rng.integers(0, 2**62)), self.precision)
+        world_seed = int(self._rng.integers(0, 2**62))
+        if self._batched is not None:           # the built scene, that copy as new (nothing rebuilt)
+            self._batched.reset([0], [world_seed])
+            self.sim = sim = CopySim(self._batched, 0)
+        else:
+            self.sim = sim = rebuild(self.loaded, world_seed, self.precision)
         for ag in self._agents.values():
             ag.start(sim, self._rng)
         sim.run(max(ag.warmup_steps for ag in self._agents.values()))

@@ -16,6 +16,12 @@ Examples (all small, all deterministic given the world):
 * :class:`AvoidObstacles` - forward, straight and far from obstacles (Floreano & Mondada's fitness);
   terminates on contact (:func:`clearance` below ``contact_distance``);
 * :func:`clearance`     - the free horizontal distance around a robot's centre, by ray casting.
+
+The batched vector environment (:mod:`sensorium.gym.vector`) asks a reward or termination for its
+*vectorised form*: an object with ``vectorized(sim, slot)`` (``ReachLight`` and ``AvoidObstacles``
+have one) returns a :class:`VectorGoal` computing every copy's values in a few array operations,
+bit for bit what the callables give one copy at a time. A callable without one is called once per
+copy with views of that copy (slower, same values).
 """
 
 from __future__ import annotations
@@ -23,13 +29,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 
 from sensorium.server.raycast.engine import RayKind
 
-__all__ = ["Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start"]
+__all__ = ["Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start", "VectorGoal"]
 
 StepFn = Callable[[Any, Any, dict], Any]
 
@@ -160,6 +167,49 @@ class ReachLight:
     def terminated(self, sim, robot, obs) -> bool:
         return self.distance(sim, robot) < self.radius
 
+    def vectorized(self, sim, slot: int) -> VectorGoal:
+        return _ReachLightCopies(self, sim, slot)
+
+
+class VectorGoal:
+    """A reward/termination for every copy of a batched simulation (see the module docstring):
+    ``reset(copies)`` after those copies' reset (as ``reset(sim, robot)``), then per action
+    ``reward(copies)`` and ``terminated(copies)`` (both read the state after the action; reward
+    first, as the single environment calls them), each an array over ``copies``."""
+
+    def reset(self, copies: np.ndarray) -> None:
+        """After a reset of these copies (and their warm-up), before their first action."""
+
+    def reward(self, copies: np.ndarray) -> np.ndarray:
+        return np.zeros(len(copies))
+
+    def terminated(self, copies: np.ndarray) -> np.ndarray:
+        return np.zeros(len(copies), dtype=bool)
+
+
+class _ReachLightCopies(VectorGoal):
+    def __init__(self, goal: ReachLight, sim, slot: int):
+        self.goal, self.sim, self.slot = goal, sim, slot
+        self.target = goal.target(sim)
+        self.previous = np.full(sim.copies, math.inf)
+
+    def distance(self, copies: np.ndarray) -> np.ndarray:
+        p = self.sim.pos[copies, self.slot]
+        return np.hypot(p[:, 0] - self.target[0], p[:, 1] - self.target[1])
+
+    def reset(self, copies: np.ndarray) -> None:
+        self.previous[copies] = self.distance(copies)
+
+    def reward(self, copies: np.ndarray) -> np.ndarray:
+        g = self.goal
+        d = self.distance(copies)
+        r = g.progress_weight * (self.previous[copies] - d) - g.step_cost
+        self.previous[copies] = d
+        return np.where(d < g.radius, r + g.bonus, r)
+
+    def terminated(self, copies: np.ndarray) -> np.ndarray:
+        return self.distance(copies) < self.goal.radius
+
 
 class AvoidObstacles:
     """Explore without touching anything: per action, ``v (1 - sqrt(|dv|)) (1 - p)`` with ``v`` the
@@ -202,3 +252,53 @@ class AvoidObstacles:
 
     def terminated(self, sim, robot, obs) -> bool:
         return self._gap(sim, robot) < self.contact_distance
+
+    def vectorized(self, sim, slot: int) -> VectorGoal:
+        return _AvoidObstaclesCopies(self, sim, slot)
+
+
+class _AvoidObstaclesCopies(VectorGoal):
+    """AvoidObstacles for every copy: one clearance cast of every copy's rays per action (the gap
+    is computed once and read by both reward and termination; the single environment casts it
+    twice with the same answer)."""
+
+    RAYS = 32
+
+    def __init__(self, goal: AvoidObstacles, sim, slot: int):
+        self.goal, self.sim, self.slot = goal, sim, slot
+        self.radius = body_radius(SimpleNamespace(model=sim.world.robots[slot]), sim.loaded.base_dir)
+        angles = np.arange(self.RAYS) * (2.0 * math.pi / self.RAYS)     # clearance()'s directions, bit for bit
+        self.dirs = np.stack([np.cos(angles), np.sin(angles), np.zeros(self.RAYS)], axis=1)
+        self.vmax = float(sim.max_wheel[slot, 0])
+        self._gap: tuple[int, np.ndarray, np.ndarray] | None = None     # (step key, copies, gaps)
+
+    def gaps(self, copies: np.ndarray) -> np.ndarray:
+        key = int(self.sim.counters["copy_steps"])
+        if self._gap is not None and self._gap[0] == key and np.array_equal(self._gap[1], copies):
+            return self._gap[2]
+        g, r = self.goal, self.radius
+        far = r + max(g.near, g.contact_distance) + 1e-6
+        n = len(copies)
+        origins = np.repeat(self.sim.pos[copies, self.slot], self.RAYS, axis=0)
+        hits = self.sim.cast(np.repeat(copies, self.RAYS), origins, np.tile(self.dirs, (n, 1)), 0.0, far,
+                             kind=RayKind.BOUNDING, exclude_slot=self.slot)
+        d = hits.distance.reshape(n, self.RAYS)
+        clear = np.where(np.isfinite(d), d, np.inf).min(axis=1)
+        clear = np.where(np.isfinite(clear), clear, far)
+        gap = clear - r
+        self._gap = (key, copies.copy(), gap)
+        return gap
+
+    def reward(self, copies: np.ndarray) -> np.ndarray:
+        g = self.goal
+        vel = self.sim.velocity[copies, self.slot]
+        wl, wr = vel[:, 0] / self.vmax, vel[:, 1] / self.vmax
+        v = 0.5 * (wl + wr)
+        dv = np.abs(wl - wr) / 2.0
+        gap = self.gaps(copies)
+        p = np.minimum(np.maximum(1.0 - gap / g.near, 0.0), 1.0)
+        r = v * (1.0 - np.sqrt(dv)) * (1.0 - p)
+        return np.where(gap < g.contact_distance, r - g.contact_penalty, r)
+
+    def terminated(self, copies: np.ndarray) -> np.ndarray:
+        return self.gaps(copies) < self.goal.contact_distance

@@ -1,4 +1,10 @@
-"""Ready-made environments on the embedded arena world (the registered Gymnasium ids)."""
+"""Ready-made environments on the embedded arena world (the registered Gymnasium ids).
+
+Each id has a single environment (``entry_point``: :class:`~sensorium.gym.env.SensoriumEnv`) and a
+batched vector environment (``vector_entry_point``: :class:`~sensorium.gym.vector.SensoriumVectorEnv`,
+what ``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` returns);
+sub-environment *i* of the vector environment equals the single environment with the same seed.
+"""
 
 from __future__ import annotations
 
@@ -8,28 +14,61 @@ from sensorium.gym.task import AvoidObstacles, ReachLight, Task, random_start
 IR = [f"ps{i}" for i in range(8)]
 
 
-def reach_light(world=None, render_mode=None, max_steps: int = 400, **kw) -> SensoriumEnv:
+def reach_light_task(max_steps: int = 400) -> Task:
     """e-puck: drive to the lamp (1.4, 1.4) from its world pose, seeing two light sensors and eight
     infra-red sensors every 64 ms (two basic steps)."""
     goal = ReachLight("lamp", radius=0.2)
-    task = Task(robot="epuck", observations={n: 64 for n in ["ls0", "ls1", *IR]}, control_period_ms=64,
+    return Task(robot="epuck", observations={n: 64 for n in ["ls0", "ls1", *IR]}, control_period_ms=64,
                 max_steps=max_steps, reward=goal, terminated=goal.terminated)
-    return SensoriumEnv(world, task, render_mode=render_mode, **kw)
 
 
-def avoid_obstacles(world=None, render_mode=None, max_steps: int = 1000, **kw) -> SensoriumEnv:
+def avoid_obstacles_task(max_steps: int = 1000) -> Task:
     """e-puck: explore from a random start in the free middle of the arena without touching anything."""
     goal = AvoidObstacles()
-    task = Task(robot="epuck", observations={n: 32 for n in IR}, control_period_ms=32, max_steps=max_steps,
+    return Task(robot="epuck", observations={n: 32 for n in IR}, control_period_ms=32, max_steps=max_steps,
                 reward=goal, terminated=goal.terminated, start=random_start((-0.5, 0.5), (-0.3, 0.3)))
-    return SensoriumEnv(world, task, render_mode=render_mode, **kw)
 
 
-def lidar_avoid(world=None, render_mode=None, max_steps: int = 1000, **kw) -> SensoriumEnv:
+def lidar_avoid_task(max_steps: int = 1000) -> Task:
     """scout: the same exploration task seen through its 360-ray lidar and four sonars."""
     goal = AvoidObstacles(near=0.3)
-    task = Task(robot="scout", observations={"lidar": 64, "sonar_front": 64, "sonar_left": 64,
+    return Task(robot="scout", observations={"lidar": 64, "sonar_front": 64, "sonar_left": 64,
                                              "sonar_right": 64, "sonar_back": 64},
                 control_period_ms=64, max_steps=max_steps, reward=goal, terminated=goal.terminated,
                 start=random_start((-0.3, 0.3), (-0.2, 0.6)))
-    return SensoriumEnv(world, task, render_mode=render_mode, **kw)
+
+
+def reach_light(world=None, render_mode=None, max_steps: int = 400, **kw) -> SensoriumEnv:
+    return SensoriumEnv(world, reach_light_task(max_steps), render_mode=render_mode, **kw)
+
+
+def avoid_obstacles(world=None, render_mode=None, max_steps: int = 1000, **kw) -> SensoriumEnv:
+    return SensoriumEnv(world, avoid_obstacles_task(max_steps), render_mode=render_mode, **kw)
+
+
+def lidar_avoid(world=None, render_mode=None, max_steps: int = 1000, **kw) -> SensoriumEnv:
+    return SensoriumEnv(world, lidar_avoid_task(max_steps), render_mode=render_mode, **kw)
+
+
+def _vector(task: Task, world, num_envs: int, render_mode, **kw):
+    from sensorium.gym.vector import SensoriumVectorEnv  # imported on use: the single envs do not need it
+
+    kw.pop("max_episode_steps", None)        # make_vec passes the spec's (None here: tasks truncate themselves)
+    return SensoriumVectorEnv(world, task, num_envs, render_mode=render_mode, **kw)
+
+
+def reach_light_vector(num_envs: int = 1, world=None, render_mode=None, max_steps: int = 400, **kw):
+    return _vector(reach_light_task(max_steps), world, num_envs, render_mode, **kw)
+
+
+def avoid_obstacles_vector(num_envs: int = 1, world=None, render_mode=None, max_steps: int = 1000, **kw):
+    return _vector(avoid_obstacles_task(max_steps), world, num_envs, render_mode, **kw)
+
+
+def lidar_avoid_vector(num_envs: int = 1, world=None, render_mode=None, max_steps: int = 1000, **kw):
+    return _vector(lidar_avoid_task(max_steps), world, num_envs, render_mode, **kw)
+
+
+reach_light.__doc__ = reach_light_task.__doc__
+avoid_obstacles.__doc__ = avoid_obstacles_task.__doc__
+lidar_avoid.__doc__ = lidar_avoid_task.__doc__

@@ -4,6 +4,9 @@ environment steps per second for one environment and for Gymnasium's vector envi
     python -m sensorium.gym.examples.random_policy                  # ReachLight, 300 steps, 1/2/4 envs
     python -m sensorium.gym.examples.random_policy --env sensorium/LidarAvoid-v0 --envs 1 8 --steps 200
 
+Each vector size runs three ways: ``sync`` and ``async`` (Gymnasium's vector envs of single envs)
+and ``batched`` (the copies in one batched simulation, ``gymnasium.make_vec(..., "vector_entry_point")``).
+
 Nothing is trained: the point is the loop any Gymnasium-compatible library runs, and its speed.
 The scripted policy is a Braitenberg vehicle (turn toward the brighter light sensor) where the
 observation has ``ls0``/``ls1``, else it drives straight and turns away from the nearest obstacle.
@@ -51,8 +54,11 @@ def run(env_id: str, n_envs: int, steps: int, mode: str = "sync", policy: str = 
         env.close()
         return {"env": env_id, "envs": 1, "mode": "single", "policy": policy, "env_steps": steps, "seconds": dt,
                 "env_steps_per_s": steps / dt, "episodes": episodes, "mean_reward": total_reward / steps}
-    cls = gym.vector.AsyncVectorEnv if mode == "async" else gym.vector.SyncVectorEnv
-    venv = cls([lambda: gym.make(env_id) for _ in range(n_envs)])
+    if mode == "batched":      # n copies in one batched simulation (the ids' vector_entry_point)
+        venv = gym.make_vec(env_id, num_envs=n_envs, vectorization_mode="vector_entry_point")
+    else:
+        cls = gym.vector.AsyncVectorEnv if mode == "async" else gym.vector.SyncVectorEnv
+        venv = cls([lambda: gym.make(env_id) for _ in range(n_envs)])
     try:
         obs, _ = venv.reset(seed=seed)
         venv.action_space.seed(seed)
@@ -81,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     rows = [run(args.env, 0, args.steps, policy=args.policy)]
     for n in args.envs:
-        for mode in ("sync", "async"):
+        for mode in ("sync", "async", "batched"):
             rows.append(run(args.env, n, args.steps, mode, args.policy))
     print(f"{args.env}, {args.policy} policy, {args.steps} steps per measurement")
     print(f"{'mode':>7} {'envs':>5} {'env steps/s':>12} {'episodes':>9} {'mean reward':>12}")

@@ -1,0 +1,377 @@
+"""``SensoriumVectorEnv``: N copies of a world in ONE batched simulation, as a Gymnasium ``VectorEnv``.
+
+    import gymnasium as gym, sensorium.gym
+    envs = gym.make_vec("sensorium/ReachLight-v0", num_envs=256, vectorization_mode="vector_entry_point")
+    obs, info = envs.reset(seed=0)                     # sub-env i: seed 0 + i
+    obs, rewards, terminations, truncations, info = envs.step(envs.action_space.sample())
+
+Unlike ``SyncVectorEnv``/``AsyncVectorEnv`` (N environments, N simulations), the copies share one
+:class:`~sensorium.server.sim.batched.BatchedSimulation`: the static world is built once, every
+copy's rays go out in one cast per ray kind and every device model runs once per step over all
+copies. Sub-environment *i* reset with seed *s* and given the same actions is bit-identical to
+``SensoriumEnv`` (the single environment) reset with seed *s*, at the same precision: the same
+world seed drawn from the same generator, the same start pose, clock, noise streams, observations,
+rewards and flags (tests compare them step by step, resets included).
+
+* Autoreset: Gymnasium 1.x's ``AutoresetMode.NEXT_STEP`` by default (declared in ``metadata``):
+  the step after a sub-env's episode ended resets it and returns its first observation with reward
+  0 and both flags False (its action is ignored). ``autoreset_mode=SAME_STEP`` resets within the
+  ending step (the ended episode's last observation and info in ``info["final_obs"]`` /
+  ``info["final_info"]``, masks ``info["_final_obs"]``); ``DISABLED`` leaves it to
+  ``reset(options={"reset_mask": mask})``.
+* A reset reuses the built scene (nothing is rebuilt): the world seed, the copy's state and its
+  start pose, then the warm-up steps (until every observed device has a value) run batched with
+  whatever else steps at that time.
+* ``sub_env(i)``: sub-environment *i* as a plain ``gymnasium.Env`` (reset and step it alone; for
+  checkers and tests).
+* Options as ``SensoriumEnv``: ``actions`` (``"normalized"``: [-1, 1], the default; ``"wheel"``:
+  rad/s), ``flatten`` (one Box), ``precision``; a task's reward and termination use their
+  vectorised form when they have one (``ReachLight``, ``AvoidObstacles``, :mod:`.task`), else
+  they are called per copy with views of that copy.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, load
+from sensorium.gym.render import TopDown
+from sensorium.gym.task import Task, VectorGoal, never, zero
+from sensorium.gym.views import CopySim
+from sensorium.schemas import world as wm
+from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.world.loader import LoadedWorld
+
+__all__ = ["SensoriumVectorEnv", "SubEnv"]
+
+
+class _PerCopy(VectorGoal):
+    """A reward/termination callable without a vectorised form: called once per copy with views."""
+
+    def __init__(self, fn, venv: SensoriumVectorEnv, owner):
+        self.fn, self.venv, self.owner = fn, venv, owner
+
+    def reset(self, copies: np.ndarray) -> None:
+        if self.owner is not None:
+            for c in copies.tolist():
+                self.owner.reset(self.venv._view(c), self.venv._view(c).robot(self.venv.agent.robot))
+
+    def _call(self, copies: np.ndarray, dtype) -> np.ndarray:
+        out = np.empty(len(copies), dtype=dtype)
+        for k, c in enumerate(copies.tolist()):
+            view = self.venv._view(c)
+            out[k] = self.fn(view, view.robot(self.venv.agent.robot), self.venv._last_obs_of(c))
+        return out
+
+    def reward(self, copies: np.ndarray) -> np.ndarray:
+        return self._call(copies, np.float64)
+
+    def terminated(self, copies: np.ndarray) -> np.ndarray:
+        return self._call(copies, bool)
+
+
+def _owner(fn):
+    """The object a reward/termination callable belongs to (itself, or the instance of a bound method)."""
+    if hasattr(fn, "vectorized") or hasattr(fn, "reset"):
+        return fn
+    return getattr(fn, "__self__", None)
+
+
+class SensoriumVectorEnv(VectorEnv):
+    """N copies of a world stepped in one batched simulation (see the module docstring)."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30, "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(self, world: str | Path | LoadedWorld | wm.World | None = None, task: Task | None = None,
+                 num_envs: int = 1, *, precision: str = DEFAULT_PRECISION, actions: str = "normalized",
+                 flatten: bool = False, autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+                 render_mode: str | None = None, render_size: int = 256, **_spec_kwargs):
+        if int(num_envs) < 1:
+            raise ValueError(f"num_envs must be >= 1, got {num_envs}")
+        self.loaded = load(world)
+        self.task = task or Task()
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
+        self.autoreset_mode = AutoresetMode(autoreset_mode)
+        self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode}
+        self.render_mode = render_mode
+        self.render_size = render_size
+        self.num_envs = n = int(num_envs)
+        self.precision = precision
+        self.agent = Agent(self.loaded, self.task, actions=actions, flatten=flatten)
+        self.sim = BatchedSimulation(self.loaded, n, precision=precision)
+        self.slot = self.sim.slot(self.agent.robot)
+        self.refs = {name: self.sim.check_observable(self.agent.robot, name) for name in self.agent.periods}
+        self.basic_time_step = self.sim.basic_time_step
+        self.steps_per_action = self.agent.control_period_ms // self.basic_time_step
+        self.single_observation_space = self.agent.observation_space
+        self.single_action_space = self.agent.action_space
+        self.observation_space = batch_space(self.single_observation_space, n)
+        self.action_space = batch_space(self.single_action_space, n)
+        self._goals = self._vector_goals()
+        self._rngs = [seeding.np_random()[0] for _ in range(n)]
+        self.steps = np.zeros(n, dtype=np.int64)
+        self._autoreset = np.zeros(n, dtype=bool)
+        self._needs_reset = np.ones(n, dtype=bool)       # before the first reset: stepping is an error
+        self._obs_cache: Any = None
+        self._renderers: dict[int, TopDown] = {}
+
+    # ------------------------------------------------------------------ building
+    def _vector_goals(self) -> tuple[VectorGoal, VectorGoal, list]:
+        """(reward goal, termination goal, the objects whose reset(copies) runs after a reset)."""
+        t = self.task
+        made: dict[int, VectorGoal] = {}
+
+        def goal(fn, trivial) -> VectorGoal:
+            if fn is trivial:
+                return VectorGoal()
+            owner = _owner(fn)
+            if owner is not None and hasattr(owner, "vectorized"):
+                if id(owner) not in made:
+                    made[id(owner)] = owner.vectorized(self.sim, self.slot)
+                return made[id(owner)]
+            vg = _PerCopy(fn, self, owner if owner is not None and hasattr(owner, "reset") else None)
+            made.setdefault(id(owner) if owner is not None else id(vg), vg)
+            return vg
+
+        reward = goal(t.reward, zero)
+        term = goal(t.terminated, never)
+        return reward, term, list(made.values())
+
+    def _view(self, copy: int) -> CopySim:
+        return CopySim(self.sim, copy)
+
+    # ------------------------------------------------------------------ the batched core
+    def _begin_reset(self, copies: np.ndarray, seeds: list[int | None]) -> None:
+        """Reset these copies as SensoriumEnv.reset does (warm-up left to the next run)."""
+        world_seeds = []
+        for c, s in zip(copies.tolist(), seeds):
+            if s is not None:
+                self._rngs[c], _ = seeding.np_random(int(s))
+            world_seeds.append(int(self._rngs[c].integers(0, 2**62)))
+        self.sim.reset(copies, world_seeds)
+        # Agent.start for all these copies: the task's start per copy (on a view: the single
+        # environment's own draws), then wheels at rest in velocity control and the observed
+        # devices enabled, for all of them at once
+        if self.task.start is not None:
+            for c in copies.tolist():
+                view = self._view(c)
+                self.task.start(view, view.robot(self.agent.robot), self._rngs[c])
+        self.sim.set_wheels(self.slot, np.zeros(len(copies)), np.zeros(len(copies)), copies)
+        for name, period in self.agent.periods.items():
+            self.sim.enable(self.refs[name], period, copies)
+        self.steps[copies] = 0
+        self._needs_reset[copies] = False
+
+    def _run(self, stepping: np.ndarray, resetting: np.ndarray) -> None:
+        """The basic steps of one vector step: ``steps_per_action`` for the stepping copies, the
+        warm-up for the resetting ones, interleaved in one loop (copies are independent)."""
+        spa = self.steps_per_action if stepping.any() else 0
+        warm = self.agent.warmup_steps if resetting.any() else 0
+        for k in range(max(spa, warm)):
+            active = (stepping & (k < spa)) | (resetting & (k < warm))
+            self.sim.step(active)
+
+    def _act(self, copies: np.ndarray, actions: np.ndarray) -> None:
+        a = np.asarray(actions, dtype=np.float64).reshape(len(copies), 2)
+        if not np.isfinite(a).all():
+            bad = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
+            raise ValueError(f"sub-env {int(copies[bad])}: action must be 2 finite values, got {actions[bad]!r}")
+        v = a * self.agent.vmax if self.agent.actions == "normalized" else a
+        self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], copies)
+
+    def _observe(self, copies: np.ndarray | slice = slice(None)):
+        out = {}
+        for name, box in self.agent.dict_space.spaces.items():
+            ref = self.refs[name]
+            if ref.kind == "Lidar":
+                img = self.sim.range_image(ref)[copies]
+                hi = box.high.flat[0]
+                out[name] = np.clip(np.nan_to_num(img, nan=hi, posinf=hi), box.low, box.high).astype(np.float32)
+            else:
+                v = self.sim.value(ref)[copies]
+                fill = box.low[0] if np.isfinite(box.low[0]) else 0.0
+                v = np.where(np.isfinite(v), v, fill)
+                out[name] = np.clip(v.astype(np.float32)[:, None], box.low, box.high)
+        if self.agent.flatten:
+            m = len(next(iter(out.values()))) if out else 0
+            return np.concatenate([out[k].reshape(m, -1) for k in self.agent.dict_space.spaces], axis=1).astype(np.float32)
+        return out
+
+    def _last_obs_of(self, copy: int):
+        obs = self._observe(np.array([copy]))
+        return obs[0] if self.agent.flatten else {k: v[0] for k, v in obs.items()}
+
+    def _outcome(self, copies: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        reward_goal, term_goal, _ = self._goals
+        reward = np.asarray(reward_goal.reward(copies), dtype=np.float64)
+        term = np.asarray(term_goal.terminated(copies), dtype=bool)
+        ms = self.task.max_steps
+        trunc = (self.steps[copies] >= ms) & ~term if ms is not None else np.zeros(len(copies), dtype=bool)
+        return reward, term, trunc
+
+    def _info(self, copies: np.ndarray) -> dict[str, np.ndarray]:
+        rot = self.sim.rot[copies, self.slot]
+        pos = self.sim.pos[copies, self.slot]
+        yaw = np.array(list(map(math.atan2, rot[:, 1, 0].tolist(), rot[:, 0, 0].tolist())))
+        return {"time_ms": self.sim.time_ms[copies].copy(), "steps": self.steps[copies].copy(),
+                "pose": np.stack([pos[:, 0], pos[:, 1], yaw], axis=1)}
+
+    def _full_info(self, mask: np.ndarray) -> dict[str, np.ndarray]:
+        """Info of every sub-env (Gymnasium's vector layout: one array per key and a ``_key`` mask)."""
+        info = self._info(np.arange(self.num_envs))
+        out: dict[str, np.ndarray] = {}
+        for k, v in info.items():
+            out[k] = v
+            out["_" + k] = mask.copy()
+        return out
+
+    # ------------------------------------------------------------------ gymnasium API
+    def reset(self, *, seed: int | list[int | None] | None = None, options: dict | None = None):
+        n = self.num_envs
+        if seed is None:
+            seeds: list[int | None] = [None] * n
+        elif isinstance(seed, (int, np.integer)):
+            seeds = [int(seed) + i for i in range(n)]
+        else:
+            seeds = list(seed)
+            if len(seeds) != n:
+                raise ValueError(f"reset: {len(seeds)} seeds for num_envs={n}")
+        mask = np.ones(n, dtype=bool)
+        if options is not None and "reset_mask" in options:
+            mask = np.asarray(options["reset_mask"])
+            if mask.shape != (n,) or mask.dtype != np.bool_ or not mask.any():
+                raise ValueError(f"options['reset_mask'] must be a bool array of shape ({n},) with a True value")
+        copies = mask.nonzero()[0]
+        self._begin_reset(copies, [seeds[c] for c in copies.tolist()])
+        self._run(np.zeros(n, dtype=bool), mask)
+        for g in self._goals[2]:
+            g.reset(copies)
+        self._autoreset[copies] = False
+        return self._observe(), self._full_info(mask)
+
+    def step(self, actions):
+        n = self.num_envs
+        if self._needs_reset.any():
+            raise RuntimeError("call reset() before step()")
+        actions = np.asarray(actions)
+        if actions.shape != (n, 2):
+            raise ValueError(f"actions must have shape ({n}, 2), got {actions.shape}")
+        resetting = self._autoreset.copy() if self.autoreset_mode == AutoresetMode.NEXT_STEP else np.zeros(n, bool)
+        if self.autoreset_mode == AutoresetMode.DISABLED and self._autoreset.any():
+            raise RuntimeError(f"sub-envs {self._autoreset.nonzero()[0].tolist()} ended: reset them "
+                               "(options={'reset_mask': ...}) before stepping (autoreset is disabled)")
+        stepping = ~resetting
+        moving = stepping.nonzero()[0]
+        self._act(moving, actions[moving])
+        if resetting.any():
+            self._begin_reset(resetting.nonzero()[0], [None] * int(resetting.sum()))
+        self._run(stepping, resetting)
+        rewards = np.zeros(n)
+        terms = np.zeros(n, dtype=bool)
+        truncs = np.zeros(n, dtype=bool)
+        if resetting.any():
+            for g in self._goals[2]:
+                g.reset(resetting.nonzero()[0])
+        self.steps[moving] += 1
+        if len(moving):
+            r, te, tr = self._outcome(moving)
+            rewards[moving], terms[moving], truncs[moving] = r, te, tr
+        done = terms | truncs
+        info = self._full_info(np.ones(n, dtype=bool))
+        if self.autoreset_mode == AutoresetMode.SAME_STEP and done.any():
+            ended = done.nonzero()[0]
+            final_obs = self._observe()
+            info["final_obs"], info["_final_obs"] = final_obs, done.copy()
+            info["final_info"], info["_final_info"] = {k: v.copy() for k, v in info.items()}, done.copy()
+            self._begin_reset(ended, [None] * len(ended))
+            self._run(np.zeros(n, dtype=bool), done)
+            for g in self._goals[2]:
+                g.reset(ended)
+            fresh = self._info(np.arange(n))
+            for k in ("time_ms", "steps", "pose"):
+                info[k] = fresh[k]
+            done = np.zeros(n, dtype=bool)
+        self._autoreset = done
+        return self._observe(), rewards, terms, truncs, info
+
+    def render(self):
+        """Top-down images of every sub-env (``render_mode="rgb_array"``), a tuple of (H, W, 3) uint8."""
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(self.render_copy(i) for i in range(self.num_envs))
+
+    def render_copy(self, i: int) -> np.ndarray:
+        r = self._renderers.get(i)
+        if r is None:
+            r = self._renderers[i] = TopDown(self._view(i), self.render_size)
+        return r.render()
+
+    def close_extras(self, **kwargs) -> None:
+        self._renderers.clear()
+
+    def sub_env(self, i: int) -> SubEnv:
+        """Sub-environment ``i`` as a plain ``gymnasium.Env`` (see :class:`SubEnv`)."""
+        if not 0 <= i < self.num_envs:
+            raise IndexError(f"sub-env {i} outside [0, {self.num_envs - 1}]")
+        return SubEnv(self, i)
+
+    # the one-copy paths the SubEnv view uses
+    def _reset_one(self, i: int, seed: int | None):
+        mask = np.zeros(self.num_envs, dtype=bool)
+        mask[i] = True
+        self._begin_reset(np.array([i]), [seed])
+        self._run(np.zeros(self.num_envs, dtype=bool), mask)
+        for g in self._goals[2]:
+            g.reset(np.array([i]))
+        self._autoreset[i] = False
+        return self._last_obs_of(i), {k: v[0] for k, v in self._info(np.array([i])).items()}
+
+    def _step_one(self, i: int, action):
+        if self._needs_reset[i]:
+            raise RuntimeError("call reset() before step()")
+        mask = np.zeros(self.num_envs, dtype=bool)
+        mask[i] = True
+        copies = np.array([i])
+        self._act(copies, np.asarray(action)[None])
+        self._run(mask, np.zeros(self.num_envs, dtype=bool))
+        self.steps[i] += 1
+        r, te, tr = self._outcome(copies)
+        info = {k: v[0] for k, v in self._info(copies).items()}
+        return self._last_obs_of(i), float(r[0]), bool(te[0]), bool(tr[0]), info
+
+
+class SubEnv(gym.Env):
+    """Sub-environment ``i`` of a :class:`SensoriumVectorEnv` as a ``gymnasium.Env``: ``reset`` and
+    ``step`` act on that copy alone (the others stay where they are), with the single
+    environment's semantics (no autoreset)."""
+
+    def __init__(self, venv: SensoriumVectorEnv, i: int):
+        self.venv, self.index = venv, i
+        self.observation_space = venv.single_observation_space
+        self.action_space = venv.single_action_space
+        self.render_mode = venv.render_mode
+        self.metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+        # the registered single environment's spec (what a sub-env is), for tools that remake it
+        self.spec = gym.spec(venv.spec.id) if venv.spec is not None else None
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        return self.venv._reset_one(self.index, seed)
+
+    def step(self, action):
+        return self.venv._step_one(self.index, action)
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        return self.venv.render_copy(self.index)
+

@@ -1,0 +1,188 @@
+"""One copy of a batched simulation seen as a single simulation: what task callables and the
+renderer read of ``sim`` and ``robot``.
+
+A :class:`~sensorium.gym.task.Task`'s ``start(sim, robot, rng)`` (and a reward or termination
+without a vectorised form) is written against :class:`~sensorium.server.sim.simulation.Simulation`
+and its ``RobotState``. The vector environment hands them these views of one copy instead:
+
+* ``CopySim``: ``time_ms``, ``basic_time_step``, ``world``, ``loaded``, ``robots`` / ``robot(name)``,
+  ``run(steps)`` / ``step()`` (this copy alone),
+  ``scene`` (``world_lights()``, ``solid_poses``, and ``engine.cast(...)`` casting in this copy only:
+  ``exclude_owner`` is a robot index, as in the single simulation);
+* ``CopyRobot``: ``name``, ``index``, ``model``, ``pose``, ``set_pose(...)``, ``motors`` /
+  ``motor(name)`` and ``drive.left`` / ``drive.right`` (``set_position``, ``set_velocity``,
+  ``velocity``, ``position``, ``max_velocity``), ``device(name).enable(period)`` / ``.value``.
+
+Anything else a callable reaches for raises AttributeError naming the view.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.sim.batched import BatchedSimulation
+
+__all__ = ["CopySim", "CopyRobot"]
+
+
+class _Motor:
+    def __init__(self, sim: BatchedSimulation, copy: int, slot: int, wheel: int):
+        self._s, self._c, self._r, self._w = sim, copy, slot, wheel
+        self.name = sim.motor_names[slot][wheel]
+        self.max_velocity = float(sim.max_wheel[slot, wheel])
+
+    @property
+    def velocity(self) -> float:
+        return float(self._s.velocity[self._c, self._r, self._w])
+
+    @property
+    def position(self) -> float:
+        return float(self._s.wheel_angle[self._c, self._r, self._w])
+
+    @property
+    def target_position(self) -> float:
+        return float(self._s.target[self._c, self._r, self._w])
+
+    def set_position(self, value: float) -> None:
+        if not isinstance(value, (int, float)) or math.isnan(value):
+            raise ValueError(f"motor {self.name!r}: position must be a number or inf, got {value!r}")
+        self._s.target[self._c, self._r, self._w] = float(value)
+
+    def set_velocity(self, value: float) -> None:
+        if not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ValueError(f"motor {self.name!r}: velocity must be a finite number, got {value!r}")
+        self._s.velocity[self._c, self._r, self._w] = float(min(max(value, -self.max_velocity), self.max_velocity))
+
+
+class _Drive:
+    def __init__(self, left: _Motor, right: _Motor):
+        self.left, self.right = left, right
+
+    @property
+    def motors(self) -> dict[str, _Motor]:
+        return {self.left.name: self.left, self.right.name: self.right}
+
+
+class _Device:
+    def __init__(self, sim: BatchedSimulation, copy: int, slot: int, name: str):
+        self._s, self._c = sim, copy
+        self.ref = sim.device(sim.robot_names[slot], name)
+        self.name = name
+        self.kind = self.ref.kind
+
+    def enable(self, period_ms: int) -> None:
+        self._s.enable(self.ref, period_ms, copies=[self._c])
+
+    @property
+    def value(self) -> float:
+        return float(self._s.value(self.ref)[self._c])
+
+    @property
+    def range_image(self) -> np.ndarray:
+        return self._s.range_image(self.ref)[self._c]
+
+    def __getattr__(self, name: str) -> Any:
+        # the device's constants (config, params, table, ...) from its template in the batched simulation
+        return getattr(self._s.template(self.ref), name)
+
+
+class CopyRobot:
+    """Robot ``slot`` of copy ``copy`` (see the module docstring)."""
+
+    def __init__(self, sim: BatchedSimulation, copy: int, slot: int):
+        self._s, self._c = sim, copy
+        self.index = slot
+        self.name = sim.robot_names[slot]
+        self.model = sim.world.robots[slot]
+        if sim.has_drive[slot]:
+            self.drive: _Drive | None = _Drive(_Motor(sim, copy, slot, 0), _Motor(sim, copy, slot, 1))
+            self.motors = self.drive.motors
+        else:
+            self.drive = None
+            self.motors = {}
+
+    @property
+    def pose(self):
+        return self._s.pose(self._c, self.index)
+
+    def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
+        self._s.set_pose(self._c, self.index, translation, rotation, quaternion)
+
+    def motor(self, name: str) -> _Motor:
+        try:
+            return self.motors[name]
+        except KeyError:
+            raise KeyError(f"robot {self.name!r} has no motor {name!r}") from None
+
+    def device(self, name: str) -> _Device:
+        return _Device(self._s, self._c, self.index, name)
+
+    def __getattr__(self, name: str) -> Any:
+        raise AttributeError(f"CopyRobot (a robot of one copy of a batched simulation) has no {name!r}")
+
+
+class _Engine:
+    def __init__(self, sim: BatchedSimulation, copy: int):
+        self._s, self._c = sim, copy
+
+    @property
+    def precision(self):
+        return self._s.precision
+
+    def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING, exclude_owner=-1,
+             skip_transparent=False, **_ignored) -> RayHits:
+        O = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+        return self._s.cast(np.full(len(O), self._c, dtype=np.int64), O, directions, t_near, t_far, kind,
+                            exclude_owner, skip_transparent)
+
+
+class _Scene:
+    def __init__(self, sim: BatchedSimulation, copy: int):
+        self._s = sim
+        self.engine = _Engine(sim, copy)
+        self.solid_poses = sim.scene.solid_poses
+
+    def world_lights(self) -> list:
+        return self._s.scene.world_lights()
+
+
+class CopySim:
+    """Copy ``copy`` of a batched simulation (see the module docstring)."""
+
+    def __init__(self, sim: BatchedSimulation, copy: int):
+        self._s, self.copy = sim, copy
+        self.world = sim.world
+        self.loaded = sim.loaded
+        self.basic_time_step = sim.basic_time_step
+        self.scene = _Scene(sim, copy)
+        self.robots = {name: CopyRobot(sim, copy, i) for i, name in enumerate(sim.robot_names)}
+
+    @property
+    def time_ms(self) -> int:
+        return int(self._s.time_ms[self.copy])
+
+    @property
+    def precision(self):
+        return self._s.precision
+
+    def robot(self, name: str) -> CopyRobot:
+        try:
+            return self.robots[name]
+        except KeyError:
+            raise KeyError(f"no robot {name!r} (robots: {', '.join(self.robots)})") from None
+
+    def run(self, steps: int) -> None:
+        """Advance this copy alone by ``steps`` basic steps."""
+        active = np.zeros(self._s.copies, dtype=bool)
+        active[self.copy] = True
+        self._s.run(steps, active if self._s.copies > 1 else None)
+
+    def step(self) -> None:
+        self.run(1)
+
+    def __getattr__(self, name: str) -> Any:
+        raise AttributeError(f"CopySim (one copy of a batched simulation) has no {name!r}")

@@ -1,0 +1,247 @@
+"""Rays of many copies of one world: the static geometry held once, each copy's moving bodies its own.
+
+N independent copies of a world (a batched training environment) share everything that never
+moves, so that is built once: ``static`` is a :class:`~.engine.RayEngine` holding the world's
+solids (its static tier and planes). What moves -- the robots -- differs per copy, but every copy
+has the same *slots* (robot 0, robot 1, ...), each with the same shapes, so ``movers`` holds one
+template body per slot; a copy's robot is that template at the copy's pose. Copies overlap in
+space (they all use the world's own coordinates, so a copy's rays see the static geometry exactly
+as the single world's rays do) and never see each other: a ray carries its copy, and it is paired
+only with the bodies of its own copy.
+
+One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
+
+* the static pass is one :meth:`RayEngine.cast` of all the rays on ``static`` (which has no movers);
+* the mover pass pairs each ray with the bodies of its copy (a dense (rays x slots) bounding-sphere
+  test: the copy gives the candidates, no grid), drops its excluded owner and its mount, moves each
+  pair into the body's frame with the same float64 products the single world's engine uses for
+  one mover (``(O - T) @ R``, one product per body, so the bits are the engine's), and traces all
+  pairs of one template tier in ONE call -- a hundred robots' pairs cost one Embree call, not a
+  hundred.
+
+Per ray, the answer is the single world's: the same static tier, the same body-frame rays, the
+same tiers. What depends on the batch is only what the engine itself takes from a whole cast: the
+float64 self-hit threshold ``1e-9 m + 1e-14 max|O|`` (max over the cast's origins, so a hit closer
+than ~1 nm to a ray's origin could be judged differently) -- the same dependence a single world
+has between casts of different sizes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from sensorium.server.raycast.engine import RayEngine
+from sensorium.server.raycast.exact import _INF, _PRUNE, _mat, _minus, _param, _take
+from sensorium.server.raycast.kinds import Precision, RayHits, RayKind
+
+__all__ = ["CopyRays"]
+
+
+class CopyRays:
+    """Casts for ``copies`` copies of a world (see the module docstring).
+
+    ``static``: an engine with the world's solids and no movable body. ``movers``: an engine with
+    one movable template body per robot slot that has a body (``slot_body[r]`` its body index, None
+    for a robot without one; the body's owner is the slot). ``shape_offset``: the number of shapes
+    of ``static``; a hit on a robot is reported as ``shape_offset`` + its shape index in ``movers``
+    (with solids added before robots, as a world's scene does, these are the single world's shape
+    indices)."""
+
+    def __init__(self, static: RayEngine, movers: RayEngine, slot_body: Sequence[int | None], shape_offset: int):
+        self.static = static
+        self.movers = movers
+        self.slot_body = list(slot_body)
+        self.shape_offset = int(shape_offset)
+        self.slots = len(self.slot_body)
+        self._spheres: dict[str, tuple] = {}     # per variant: (tier per slot, anchor (R,3), r2 (R,), has body (R,))
+        self.counters = {"casts": 0, "rays": 0, "mover_pairs": 0, "mover_traces": 0}
+
+    @property
+    def precision(self) -> Precision:
+        return self.static.precision
+
+    @precision.setter
+    def precision(self, value: Precision | str) -> None:
+        self.static.precision = value
+        self.movers.precision = value
+
+    def _slot_tiers(self, variant: str) -> tuple:
+        got = self._spheres.get(variant)
+        if got is None:
+            eng = self.movers
+            tiers: list = []
+            anchor = np.zeros((self.slots, 3))
+            r2 = np.full(self.slots, -1.0)           # no body (or nothing this ray kind sees): never paired
+            for r, body in enumerate(self.slot_body):
+                tier = None if body is None else eng._mover_tier(eng._bodies[body], variant)
+                tiers.append(tier)
+                if tier is not None:
+                    anchor[r] = tier.anchor
+                    r2[r] = tier.radius * tier.radius
+            got = self._spheres[variant] = (tiers, anchor, r2, r2 >= 0.0)
+        return got
+
+    def may_reach(self, slot: int, kind: RayKind, origins, directions, t_near, t_far,
+                  skip_transparent: bool = False, margin: float = 1e-6) -> np.ndarray:
+        """Which rays, given in slot ``slot``'s body frame, may meet its body: the box of the
+        body's tier (its shells included) grown by ``margin`` -- conservative for the same rays
+        moved into the frame from any pose (their rounding is ~1e-15 m). A rigidly mounted ray
+        that fails it never meets that body, at any pose: pass the slot as its ``mount_slot``."""
+        tiers = self._slot_tiers(self.movers._variant(kind, skip_transparent))[0]
+        O = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+        D = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+        tier = tiers[slot]
+        if tier is None:
+            return np.zeros(len(D), dtype=bool)
+        lo = tier.V.min(axis=0) + tier.anchor - margin
+        hi = tier.V.max(axis=0) + tier.anchor + margin
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Dn = np.where(D == 0.0, 1e-300, D)
+            ta, tb = (lo - O) / Dn, (hi - O) / Dn
+        near = np.minimum(ta, tb).max(axis=1)
+        far = np.maximum(ta, tb).min(axis=1)
+        t0 = np.maximum(near, np.broadcast_to(np.asarray(t_near, dtype=np.float64), (len(D),)) - margin)
+        t1 = np.minimum(far, np.broadcast_to(np.asarray(t_far, dtype=np.float64), (len(D),)) + margin)
+        return t0 <= t1
+
+    def cast(self, origins, directions, t_near, t_far, kind: RayKind, copy: np.ndarray, rot: np.ndarray,
+             pos: np.ndarray, exclude_slot=-1, mount_slot=-1, skip_transparent: bool = False,
+             distance_only: bool = False, directions32=None) -> RayHits:
+        """Nearest hits of rays of several copies. ``copy``: (n,) the copy of each ray; ``rot``
+        (C, R, 3, 3) and ``pos`` (C, R, 3): every copy's robot poses now; ``exclude_slot``: the
+        robot (slot) whose body a ray ignores (scalar or (n,); -1 none), as ``exclude_owner``;
+        ``mount_slot``: a robot whose body the ray is never paired with (-1 none): the robot a
+        sensor is rigidly mounted on, whose hits the caller decides once in the body frame (as
+        with ``RayEngine.cast(mount=...)``), or whose body it cannot reach (:meth:`may_reach`).
+        Other arguments as :meth:`RayEngine.cast`."""
+        O = np.asarray(origins, dtype=np.float64)
+        D = np.asarray(directions, dtype=np.float64)
+        n = len(O)
+        t_near = _param(t_near, n, np.float64, float)     # uniform -> scalar, as the engine normalises it
+        self.counters["casts"] += 1
+        self.counters["rays"] += n
+        hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
+                                distance_only=distance_only, directions32=directions32)
+        if n == 0 or not self.slots:
+            return hits
+        variant = self.movers._variant(kind, skip_transparent)
+        tiers, anchor, r2, present = self._slot_tiers(variant)
+        if not present.any():
+            return hits
+        dist = hits.distance
+        lim = np.minimum(np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,)), dist)
+        lo = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,))
+        copy = np.asarray(copy, dtype=np.int64).reshape(n)
+        # broad phase: each ray against the bounding spheres of its own copy's bodies
+        R = self.slots
+        centre = pos + np.einsum("crij,rj->cri", rot, anchor)          # (C, R, 3): a conservative test only
+        pr_list, pm_list = [], []
+        excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else np.asarray(exclude_slot).reshape(n)
+        mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else np.asarray(mount_slot).reshape(n)
+        valid = lim >= lo
+        for r in range(R):
+            if not present[r]:
+                continue
+            cand = valid
+            for skip in (excl, mnt):      # rays that ignore this body (excluded owner, mount)
+                if isinstance(skip, np.ndarray):
+                    cand = cand & (skip != r)
+                elif skip == r:
+                    cand = None
+                    break
+            if cand is None:
+                continue
+            rows = cand.nonzero()[0]
+            if not len(rows):
+                continue
+            rc = copy[rows]
+            rel = centre[rc, r] - O[rows]
+            Dr = D[rows]
+            b = np.einsum("ij,ij->i", rel, Dr)
+            e2 = np.einsum("ij,ij->i", rel, rel)
+            tc = np.minimum(np.maximum(b, lo[rows]), lim[rows])
+            near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)).nonzero()[0]
+            if len(near):
+                pr_list.append(rows[near])
+                pm_list.append(rc[near] * R + r)
+        if not pr_list:
+            return hits
+        pr = np.concatenate(pr_list)
+        pm = np.concatenate(pm_list)
+        self.counters["mover_pairs"] += len(pr)
+        # pairs grouped by body, each body's rays in ray order (as the engine's one-mover path sees them)
+        order = np.lexsort((pr, pm))
+        pr, pm = pr[order], pm[order]
+        cuts = np.flatnonzero(pm[1:] != pm[:-1]) + 1
+        starts = np.concatenate([[0], cuts]).tolist()
+        ends = np.concatenate([cuts, [len(pm)]]).tolist()
+        movers = pm[starts].tolist()
+        Ob = np.empty((len(pr), 3))
+        Db = np.empty((len(pr), 3))
+        rotf = rot.reshape(-1, 3, 3)
+        posf = pos.reshape(-1, 3)
+        for a, z, m in zip(starts, ends, movers):
+            rows = pr[a:z]
+            Rb, Tb = rotf[m], posf[m]
+            Ob[a:z] = _mat(_minus(np.take(O, rows, axis=0), Tb), Rb)
+            Db[a:z] = _mat(np.take(D, rows, axis=0), Rb)
+        slot = pm % R
+        t_all = np.full(len(pr), _INF)
+        s_all = None if distance_only else np.full(len(pr), -1, dtype=np.int64)
+        n_all = None if distance_only else np.zeros((len(pr), 3))
+        exact = self.movers.precision is Precision.EXACT
+        big = max(float(np.abs(O).max()), 0.0)
+        eps64 = 1e-9 + 1e-14 * big          # the engine's float64 self-hit threshold for this cast
+        done: set[int] = set()
+        for r in range(R):
+            tier = tiers[r]
+            if tier is None or id(tier) in done:
+                continue
+            done.add(id(tier))
+            sel = np.flatnonzero(np.isin(slot, [q for q in range(R) if tiers[q] is tier]))
+            if not len(sel):
+                continue
+            ob, db, rr = Ob[sel], Db[sel], pr[sel]
+            tn, lm = _take(t_near, rr) if isinstance(t_near, np.ndarray) else t_near, lim[rr]
+            if len(sel) >= _PRUNE:     # many pairs: drop those missing the tier's tight bound (conservative)
+                keep = tier.may_hit(ob, db, tn, lm).nonzero()[0]
+                if len(keep) < len(sel):
+                    if not len(keep):
+                        continue
+                    sel, ob, db, lm = sel[keep], ob[keep], db[keep], lm[keep]
+                    tn = tn[keep] if isinstance(tn, np.ndarray) else tn
+            self.counters["mover_traces"] += 1
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
+                res = self.movers._trace(tier, ob, db, tn, lm, -1, eps64, exact, None, distance_only)
+            if res is None:
+                continue
+            t_all[sel] = res[0]
+            if not distance_only:
+                body = np.array([self.movers._bodies[self.slot_body[q]].first if self.slot_body[q] is not None else 0
+                                 for q in range(R)], dtype=np.int64)
+                s_all[sel] = np.where(res[1] >= 0, res[1] + body[slot[sel]], -1)
+                n_all[sel] = res[2]
+        win = (t_all < dist[pr]).nonzero()[0]
+        if not len(win):
+            return hits
+        # the nearest body per ray; equal distances: the lower slot (the engine takes bodies in order)
+        keep = np.lexsort((slot[win], t_all[win], pr[win]))
+        w = win[keep]
+        first = np.ones(len(w), dtype=bool)
+        first[1:] = pr[w][1:] != pr[w][:-1]
+        w = np.sort(w[first])                  # by body, then ray (the pairs' order)
+        rows = pr[w]
+        dist = dist.copy()
+        dist[rows] = t_all[w]
+        if distance_only:
+            return RayHits(dist, hits.normal, hits.shape)
+        shape = hits.shape.copy()
+        normal = hits.normal.copy()
+        shape[rows] = self.shape_offset + s_all[w]
+        wm = pm[w]
+        cut = np.flatnonzero(wm[1:] != wm[:-1]) + 1
+        for a, z in zip(np.concatenate([[0], cut]).tolist(), np.concatenate([cut, [len(w)]]).tolist()):
+            normal[rows[a:z]] = _mat(n_all[w[a:z]], rotf[wm[a]].T)   # body frame -> world, as the engine
+        return RayHits(dist, normal, shape)

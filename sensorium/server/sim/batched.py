@@ -1,0 +1,946 @@
+"""Many independent copies of one world stepped together: the batched simulation behind training.
+
+    sim = BatchedSimulation(load_world("arena.yaml"), copies=256, precision="fast")
+    sim.reset(np.arange(256), world_seeds)          # every copy as a freshly built world with its seed
+    k = sim.device("epuck", "ps0"); sim.enable(k, 64)
+    sim.set_wheels(sim.slot("epuck"), left, right)   # (copies,) rad/s
+    sim.run(2)
+    sim.value(k)                                     # (copies,) the readings
+
+A copy is the whole world: every robot of the world file (its *slots*), its own clock, poses,
+wheel motors, device schedules, values and noise streams; only what never moves (solids, planes,
+lights) is shared and built once. A step advances the copies named in ``active`` by one basic
+time step and measures their due devices; the rays of all copies go out in one cast per ray kind
+(:class:`~sensorium.server.raycast.copies.CopyRays`: copies never see each other's robots), and
+every device model runs once over all copies' devices of a kind.
+
+Copy ``c`` reproduces :class:`~sensorium.server.sim.simulation.Simulation` built from the world
+with copy c's seed, bit for bit, for what it simulates: the drive (the same float64 arc, the same
+3x3 products), kinematic contact (the same broad phase per copy, the same narrow phase), light
+sensors, distance sensors, fixed lidars and wheel encoders, each device's noise drawn from its own
+stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in the same
+order). Tests compare it with the single simulation step by step.
+
+Not simulated here (use :class:`Simulation`): rotating lidars, the kinds without an observation
+(LEDs, GPS, IMU, pens, ...), lights carried by robots, textured robot bodies, NUE worlds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import distance as dmath
+from sensorium.server.devices import lidar as lmath
+from sensorium.server.devices import light as light_math
+from sensorium.server.devices.lookup import RESOLUTION_OFF
+from sensorium.server.devices.noise import device_rng
+from sensorium.server.raycast.copies import CopyRays
+from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
+from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations
+from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
+from sensorium.server.sim.motion import DifferentialDrive
+from sensorium.server.sim.scene import Scene, _entry, _shape_info, primitive_from_model, robot_parts, solid_parts
+from sensorium.server.sim.sensors import DistanceSensor, Lidar, LightSensor, PositionSensor
+from sensorium.server.sim.simulation import lights_from_models
+from sensorium.server.world.geometry import Pose
+from sensorium.server.world.limits import check_pose
+from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, sanitize
+from sensorium.server.world.poses import pose_from_model, pose_from_values
+
+__all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS"]
+
+SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
+_TWO_PI = 2.0 * math.pi
+
+
+class BatchedError(ValueError):
+    """The world uses something the batched simulation does not simulate (the message says what)."""
+
+
+@dataclass(frozen=True, slots=True)
+class DeviceRef:
+    """A device of a slot, as the batched simulation indexes it: its kind and its column in that
+    kind's state arrays (``(copies, devices of the kind)``)."""
+
+    kind: str
+    column: int
+    slot: int
+    name: str
+
+
+class NoiseStreams:
+    """Every (copy, device) noise stream, drawn ahead in blocks of ``block`` standard normals.
+
+    A stream is ``device_rng(world seed of the copy, device path)`` (devices/noise.py), created on
+    its first draw after a reseed, as a single simulation creates it; numpy's generator gives the
+    same numbers whether drawn one by one or ``block`` at a time, so a value drawn here is the
+    value the single simulation draws. :meth:`next` takes one number from many streams at once."""
+
+    def __init__(self, copies: int, paths: Sequence[str], block: int = 64):
+        self.paths = list(paths)
+        self.block = int(block)
+        n = len(self.paths)
+        self.buffer = np.zeros((copies, n, self.block))
+        self.cursor = np.full((copies, n), self.block, dtype=np.int64)    # block: empty, refill first
+        self.rngs: list[list[np.random.Generator | None]] = [[None] * n for _ in range(copies)]
+        self.seeds: list[int] = [0] * copies
+
+    def reseed(self, copies: Iterable[int], seeds: Iterable[int]) -> None:
+        for c, s in zip(copies, seeds):
+            self.seeds[c] = int(s)
+            self.rngs[c] = [None] * len(self.paths)
+            self.cursor[c] = self.block
+
+    def _refill(self, c: int, d: int) -> None:
+        rng = self.rngs[c][d]
+        if rng is None:
+            rng = self.rngs[c][d] = device_rng(self.seeds[c], self.paths[d])
+        self.buffer[c, d] = rng.standard_normal(self.block)
+        self.cursor[c, d] = 0
+
+    def next(self, copies: np.ndarray, devices: np.ndarray) -> np.ndarray:
+        """One standard normal from each (copy, device) stream named (pairs distinct)."""
+        cur = self.cursor[copies, devices]
+        empty = (cur >= self.block).nonzero()[0]
+        for k in empty.tolist():
+            self._refill(int(copies[k]), int(devices[k]))
+        if len(empty):
+            cur = self.cursor[copies, devices]
+        self.cursor[copies, devices] = cur + 1
+        return self.buffer[copies, devices, cur]
+
+    def take(self, c: int, d: int, count: int) -> np.ndarray:
+        """``count`` standard normals from one stream, in order."""
+        out = np.empty(count)
+        k = 0
+        while k < count:
+            if self.cursor[c, d] >= self.block:
+                self._refill(c, d)
+            a = int(self.cursor[c, d])
+            m = min(self.block - a, count - k)
+            out[k:k + m] = self.buffer[c, d, a:a + m]
+            self.cursor[c, d] = a + m
+            k += m
+        return out
+
+
+class BatchedSimulation:
+    """``copies`` independent copies of a world stepped together (see the module docstring)."""
+
+    def __init__(self, world: LoadedWorld | wm.World, copies: int, precision: Precision | str = Precision.EXACT,
+                 base_dir: Path | None = None, contact: bool | None = None):
+        if isinstance(world, wm.World):
+            problems = check_world(world, base_dir or Path.cwd())
+            if problems:
+                raise WorldError("<memory>", problems)
+            world, _ = sanitize(world)
+            world = LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
+        if int(copies) < 1:
+            raise BatchedError(f"copies must be >= 1, got {copies}")
+        self.loaded = world
+        self.world = w = world.world
+        self.copies = C = int(copies)
+        self.basic_time_step = w.world_info.basic_time_step
+        self._check_supported()
+        base = world.base_dir
+        # -- what never moves, once: the solids' scene (static tier, planes), the lights
+        self.scene = Scene(w.model_copy(update={"robots": []}), base, precision)
+        self.lights = lights_from_models(self.scene.world_lights())
+        n_static = len(self.scene.shapes)
+        # -- one template body per robot slot (movable), the copies' robots are its poses
+        self.robot_names = [r.name for r in w.robots]
+        self.R = R = len(w.robots)
+        movers = RayEngine(Precision(precision))
+        slot_body: list[int | None] = []
+        red, rough = list(self.scene.red[:-1]), list(self.scene.roughness[:-1])
+        for i, r in enumerate(w.robots):
+            parts = list(robot_parts(r))
+            if parts:
+                slot_body.append(movers.add_body([_entry(s, base, local) for _, local, s in parts],
+                                                 pose_from_model(r.pose), owner=i, movable=True))
+                for name, _, shape in parts:
+                    info = _shape_info(name, i, shape)
+                    red.append(info.red)
+                    rough.append(info.roughness)
+            else:
+                slot_body.append(None)
+        self.rays = CopyRays(self.scene.engine, movers, slot_body, n_static)
+        self.red = np.array(red + [1.0])              # per hit shape; -1 (no hit) reads the last entry
+        self.roughness = np.array(rough + [0.0])
+        self.n_static_shapes = n_static
+        # -- robots: initial poses and drives (the template state every reset starts from)
+        self.initial = [pose_from_model(r.pose) for r in w.robots]
+        self.has_drive = np.array([r.differential_drive is not None for r in w.robots], dtype=bool)
+        self.wheel_radius = np.array([r.differential_drive.wheel_radius if r.differential_drive else 0.0
+                                      for r in w.robots], dtype=np.float64)
+        self.axle = np.array([r.differential_drive.axle_length if r.differential_drive else 1.0
+                              for r in w.robots], dtype=np.float64)
+        self.max_wheel = np.array([[r.differential_drive.max_wheel_speed] * 2 if r.differential_drive else [0.0, 0.0]
+                                   for r in w.robots], dtype=np.float64)
+        self.motor_names = [(r.differential_drive.left_motor, r.differential_drive.right_motor)
+                            if r.differential_drive else ("", "") for r in w.robots]
+        self._templates = [DifferentialDrive(r.differential_drive, self.initial[i]) if r.differential_drive else None
+                           for i, r in enumerate(w.robots)]
+        # -- per copy state
+        self.time_ms = np.zeros(C, dtype=np.int64)
+        self.rot = np.zeros((C, R, 3, 3))
+        self.pos = np.zeros((C, R, 3))
+        self.yaw = np.zeros((C, R))
+        self.x = np.zeros((C, R))
+        self.y = np.zeros((C, R))
+        self.z = np.zeros((C, R))
+        self.base = np.zeros((C, R, 3, 3))
+        self.target = np.zeros((C, R, 2))        # wheel motors: target position (inf: velocity control)
+        self.velocity = np.zeros((C, R, 2))
+        self.wheel_angle = np.zeros((C, R, 2))
+        self.pressing = np.zeros((C, R), dtype=bool)
+        # -- kinematic contact: the solids' obstacles once, the robots' discs per copy
+        use_contact = w.world_info.contact if contact is None else bool(contact)
+        self.contact: Contact | None = None
+        if use_contact and self.has_drive.any():
+            solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
+                       shape.seen_by in ("both", "bounding"))
+                      for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
+            self.contact = Contact(solids, [])
+            feet = [robot_footprint([(primitive_from_model(shape.geometry, base), local)
+                                     for _, local, shape in robot_parts(r) if shape.seen_by in ("both", "bounding")])
+                    for r in w.robots]
+            self.feet = feet
+            nan = math.nan
+            self.foot_radius = np.array([f.radius if f else nan for f in feet])
+            self.foot_low = np.array([f.z_low if f else nan for f in feet])
+            self.foot_high = np.array([f.z_high if f else nan for f in feet])
+            self.centres = np.zeros((C, R, 2))
+            self.heights = np.zeros((C, R))
+        # -- devices: one template object per device (its constants); values per copy
+        self._build_devices()
+        self.counters = {"steps": 0, "copy_steps": 0, "measurements": 0, "resets": 0, "contacts": 0}
+        self.reset(np.arange(C), [w.world_info.random_seed] * C)
+
+    # ------------------------------------------------------------------ building
+    def _check_supported(self) -> None:
+        w = self.world
+        if w.world_info.coordinate_system != "ENU":
+            raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU worlds only "
+                               f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
+        for r in w.robots:
+            if r.lights:
+                raise BatchedError(f"{self.loaded.source}: robot {r.name!r} carries lights; the batched simulation "
+                                   "shares the lights of all copies (use Simulation)")
+            for _, _, shape in robot_parts(r):
+                a = shape.appearance
+                if a is not None and (getattr(a, "texture", None) or getattr(a, "roughness_map", None)
+                                      or getattr(a, "occlusion_map", None)):
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r} has a textured body; the batched "
+                                       "simulation reads textures of solids only (use Simulation)")
+
+    def _build_devices(self) -> None:
+        C = self.copies
+        self.refs: dict[tuple[int, str], DeviceRef] = {}
+        self.light: list[LightSensor] = []
+        self.distance: list[DistanceSensor] = []
+        self.lidar: list[Lidar] = []
+        self.position: list[PositionSensor] = []
+        lists = {"LightSensor": self.light, "DistanceSensor": self.distance, "Lidar": self.lidar,
+                 "PositionSensor": self.position}
+        classes = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar,
+                   "PositionSensor": PositionSensor}
+        for slot, r in enumerate(self.world.robots):
+            for d in r.devices:
+                if d.device not in lists:
+                    continue
+                dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
+                                        world_seed=0, clock=lambda: 0)
+                self.refs[(slot, d.name)] = DeviceRef(d.device, len(lists[d.device]), slot, d.name)
+                lists[d.device].append(dev)   # type: ignore[attr-defined]
+        # noise streams: one per (copy, device) of every device that can draw (a noisy lookup
+        # table or a noise field), in one bank; columns of a kind are consecutive
+        self._noise_col: dict[tuple[str, int], int] = {}
+        self._noise_of: dict[str, np.ndarray] = {}
+        paths = []
+        for kind_name, devs in lists.items():
+            cols = np.full(len(devs), -1, dtype=np.int64)
+            for k, d in enumerate(devs):
+                table = getattr(d, "table", None)
+                if (table is not None and table.has_noise) or float(getattr(d.config, "noise", 0.0) or 0.0) > 0.0:
+                    cols[k] = self._noise_col[(kind_name, k)] = len(paths)
+                    paths.append(d.path)
+            self._noise_of[kind_name] = cols
+        self.noise = NoiseStreams(C, paths)
+        # per kind: schedules (period, last update) per copy and the latest values
+        self.period = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
+        self.last = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
+        self.values = {k: np.full((C, len(v)), math.nan) for k, v in lists.items() if k != "Lidar"}
+        for lid in self.lidar:
+            if lid.rotating:
+                continue
+        self._lidar_skips: dict[int, np.ndarray] = {}
+        self.range_images = [np.zeros((C, d.config.number_of_layers, d.config.horizontal_resolution), dtype=np.float32)
+                             for d in self.lidar]
+        # light sensors: constants stacked once
+        if self.light:
+            self._l_slot = np.array([d.robot_index for d in self.light], dtype=np.int64)
+            self._l_rot = np.array([d.local_pose.rotation for d in self.light])
+            self._l_pos = np.array([d.local_pose.translation for d in self.light])
+            self._l_filter = np.array([d.config.color_filter for d in self.light], dtype=np.float64)
+            self._l_occl = np.array([d.config.occlusion for d in self.light], dtype=bool)
+            self._l_excl = np.array([d.exclude_self() for d in self.light], dtype=np.int64)
+            self._l_res = np.array([float(d.config.resolution) for d in self.light])
+            self._l_tables = _by_table(self.light)
+        # distance sensors: the single simulation's plan over one copy's sensors (groups, own-body hits)
+        if self.distance:
+            bodies = [self.rays.slot_body[s] for s in range(self.R)]
+            self._d_plan = DistancePlan(self.distance, bodies)
+            self._d_col = {id(d): k for k, d in enumerate(self.distance)}
+            self._d_empty = np.array([not d.config.lookup_table for d in self.distance], dtype=bool)
+            self._d_slot = np.array([d.robot_index for d in self.distance], dtype=np.int64)
+            self._d_res = np.array([float(d.config.resolution) for d in self.distance])
+            self._d_groups = []          # per plan group: where each distance column sits in it (-1: not)
+            for g in self._d_plan.groups:
+                where = np.full(len(self.distance), -1, dtype=np.int64)
+                where[[self._d_col[id(self._d_plan.devices[i])] for i in g.idx.tolist()]] = np.arange(len(g.idx))
+                self._d_groups.append((g, where))
+            self._d_tables = [(table, np.array([self._d_col[id(self._d_plan.devices[i])] for i in idx.tolist()],
+                                               dtype=np.int64)) for table, idx in self._d_plan.tables]
+        if self.position:
+            wheel = []
+            for d in self.position:
+                names = self.motor_names[d.robot_index]
+                m = d.config.motor
+                wheel.append(names.index(m) if m is not None and m in names and self.has_drive[d.robot_index] else -1)
+            self._p_wheel = np.array(wheel, dtype=np.int64)
+            self._p_slot = np.array([d.robot_index for d in self.position], dtype=np.int64)
+            self._p_plain = np.array([float(d.config.noise) <= 0.0 and float(d.config.resolution) <= 0.0
+                                      for d in self.position], dtype=bool)
+
+    # ------------------------------------------------------------------ access
+    @property
+    def precision(self) -> Precision:
+        return self.rays.precision
+
+    @precision.setter
+    def precision(self, value: Precision | str) -> None:
+        self.rays.precision = Precision(value)
+
+    def slot(self, robot: str) -> int:
+        try:
+            return self.robot_names.index(robot)
+        except ValueError:
+            raise KeyError(f"no robot {robot!r} (robots: {', '.join(self.robot_names)})") from None
+
+    def device(self, robot: str, name: str) -> DeviceRef:
+        slot = self.slot(robot)
+        ref = self.refs.get((slot, name))
+        if ref is None:
+            kinds = {d.name: d.device for d in self.world.robots[slot].devices}
+            if name in kinds:
+                raise BatchedError(f"robot {robot!r}: device {name!r} is a {kinds[name]}; the batched simulation "
+                                   f"measures {', '.join(SUPPORTED_KINDS)} (use Simulation)")
+            raise KeyError(f"robot {robot!r} has no device {name!r} (devices: {', '.join(kinds)})")
+        return ref
+
+    def check_observable(self, robot: str, name: str) -> DeviceRef:
+        """The device, if the batched simulation measures it (else BatchedError saying why)."""
+        ref = self.device(robot, name)
+        if ref.kind == "Lidar" and self.lidar[ref.column].rotating:
+            raise BatchedError(f"{robot}/{name}: rotating lidars are not simulated by the batched simulation "
+                               "(use Simulation)")
+        return ref
+
+    def template(self, ref: DeviceRef):
+        """The device object holding a device's constants (config, lookup table, lidar params)."""
+        return {"LightSensor": self.light, "DistanceSensor": self.distance, "Lidar": self.lidar,
+                "PositionSensor": self.position}[ref.kind][ref.column]
+
+    def pose(self, copy: int, slot: int) -> Pose:
+        return Pose(self.rot[copy, slot], self.pos[copy, slot])
+
+    def value(self, ref: DeviceRef) -> np.ndarray:
+        """The latest values of a light, distance or position sensor in every copy: (copies,)."""
+        return self.values[ref.kind][:, ref.column]
+
+    def range_image(self, ref: DeviceRef) -> np.ndarray:
+        """A lidar's latest range images in every copy: (copies, layers, width) float32."""
+        return self.range_images[ref.column]
+
+    # ------------------------------------------------------------------ control
+    def reset(self, copies: np.ndarray | Sequence[int], world_seeds: Sequence[int]) -> None:
+        """The named copies as a world freshly built with these world seeds: clock 0, robots at
+        their world-file poses, wheel motors in position control at 0 (Webots' default), devices
+        disabled with no value, every noise stream restarted from its seed. The built scene is
+        kept: nothing is rebuilt."""
+        idx = np.asarray(copies, dtype=np.int64).reshape(-1)
+        if len(idx) != len(world_seeds):
+            raise ValueError(f"reset: {len(idx)} copies but {len(world_seeds)} world seeds")
+        self.time_ms[idx] = 0
+        for r, pose in enumerate(self.initial):
+            self.rot[idx, r] = pose.rotation
+            self.pos[idx, r] = pose.translation
+            tpl = self._templates[r]
+            if tpl is not None:
+                self.x[idx, r], self.y[idx, r], self.z[idx, r], self.yaw[idx, r] = tpl.x, tpl.y, tpl.z, tpl.yaw
+                self.base[idx, r] = tpl.base
+            if self.contact is not None:
+                self.centres[idx, r] = pose.translation[:2]
+                self.heights[idx, r] = pose.translation[2]
+        self.target[idx] = 0.0
+        self.velocity[idx] = self.max_wheel
+        self.wheel_angle[idx] = 0.0
+        self.pressing[idx] = False
+        for k in self.period:
+            self.period[k][idx] = 0
+            self.last[k][idx] = 0
+        for v in self.values.values():
+            v[idx] = math.nan
+        for img in self.range_images:
+            img[idx] = 0.0
+        self.noise.reseed(idx.tolist(), world_seeds)
+        self.counters["resets"] += len(idx)
+
+    def set_pose(self, copy: int, slot: int, translation=None, rotation=None, quaternion=None) -> None:
+        """Move a robot of one copy (supervisor-style, no contact check), as ``RobotState.set_pose``."""
+        check_pose(translation, rotation, quaternion)
+        current = self.pose(copy, slot)
+        if translation is None:
+            translation = current.translation
+        if rotation is None and quaternion is None:
+            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
+        else:
+            pose = pose_from_values(translation, rotation, quaternion)
+        self.rot[copy, slot] = pose.rotation
+        self.pos[copy, slot] = pose.translation
+        if self.contact is not None:
+            self.centres[copy, slot] = pose.translation[:2]
+            self.heights[copy, slot] = pose.translation[2]
+        tpl = self._templates[slot]
+        if tpl is not None:
+            tpl.reset(pose)       # the single simulation's own arithmetic (yaw, base)
+            self.x[copy, slot], self.y[copy, slot], self.z[copy, slot], self.yaw[copy, slot] = tpl.x, tpl.y, tpl.z, tpl.yaw
+            self.base[copy, slot] = tpl.base
+            tpl.reset(self.initial[slot])
+
+    def set_wheels(self, slot: int, left, right, copies=None) -> None:
+        """Velocity control of a slot's two wheels (rad/s, clamped to the maximum as Webots does) in
+        the named copies (default: all): ``setPosition(inf)`` and ``setVelocity`` of both motors."""
+        idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
+        vmax = self.max_wheel[slot]
+        left = np.asarray(left, dtype=np.float64)
+        right = np.asarray(right, dtype=np.float64)
+        if not (np.isfinite(left).all() and np.isfinite(right).all()):
+            raise ValueError(f"{self.robot_names[slot]}: wheel velocities must be finite")
+        self.target[idx, slot] = math.inf
+        self.velocity[idx, slot, 0] = np.minimum(np.maximum(left, -vmax[0]), vmax[0])
+        self.velocity[idx, slot, 1] = np.minimum(np.maximum(right, -vmax[1]), vmax[1])
+
+    def enable(self, ref: DeviceRef, period_ms: int, copies=None) -> None:
+        """``enable(period)`` of a device in the named copies (default: all), counted from each
+        copy's clock (0 disables)."""
+        if isinstance(period_ms, bool) or not isinstance(period_ms, (int, np.integer)) or period_ms < 0:
+            raise ValueError(f"sampling period must be an integer >= 0 ms, got {period_ms!r}")
+        if ref.kind == "Lidar" and self.lidar[ref.column].rotating:
+            raise BatchedError(f"{self.robot_names[ref.slot]}/{ref.name}: rotating lidars are not simulated by "
+                               "the batched simulation (use Simulation)")
+        idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
+        self.period[ref.kind][idx, ref.column] = int(period_ms)
+        self.last[ref.kind][idx, ref.column] = self.time_ms[idx]
+
+    # ------------------------------------------------------------------ stepping
+    def run(self, steps: int, active: np.ndarray | None = None) -> None:
+        for _ in range(int(steps)):
+            self.step(active)
+
+    def step(self, active: np.ndarray | None = None) -> None:
+        """One basic time step of the copies in ``active`` ((copies,) bool; default all): clocks,
+        wheels and drives, contact, then every due device measured at the end-of-step poses."""
+        C = self.copies
+        act = np.ones(C, dtype=bool) if active is None else np.asarray(active, dtype=bool).reshape(C)
+        live = act.nonzero()[0]
+        if not len(live):
+            return
+        dt = self.basic_time_step
+        self.time_ms[live] += dt
+        self.counters["steps"] += 1
+        self.counters["copy_steps"] += len(live)
+        self._drive(live, dt)
+        self._measure_positions(live)
+        self._measure_rays(live, dt)
+
+    # -- motion
+    def _drive(self, live: np.ndarray, dt_ms: int) -> None:
+        driven = self.has_drive.nonzero()[0]
+        if not len(driven):
+            return
+        dt = dt_ms / 1000.0
+        self.pressing[live] = False
+        # WheelMotor.advance, element by element the same arithmetic
+        tgt = self.target[live][:, driven]
+        vel = self.velocity[live][:, driven]
+        ang = self.wheel_angle[live][:, driven]
+        free = np.isinf(tgt)
+        remaining = tgt - ang
+        with np.errstate(invalid="ignore"):
+            speed = np.minimum(np.abs(vel), np.abs(remaining) / dt) if dt > 0 else np.zeros_like(vel)
+            held = np.where(remaining != 0.0, np.copysign(speed, remaining), 0.0)
+        omega = np.where(free, vel, held)
+        self.wheel_angle[np.ix_(live, driven)] = ang + omega * dt
+        wl, wr = omega[..., 0], omega[..., 1]
+        moving = (wl != 0.0) | (wr != 0.0)                      # (live, driven)
+        ci, ri = moving.nonzero()
+        if not len(ci):
+            return
+        copies, slots = live[ci], driven[ri]
+        wl, wr = wl[ci, ri], wr[ci, ri]
+        rad, axle = self.wheel_radius[slots], self.axle[slots]
+        v = rad * (wl + wr) / 2.0
+        w = rad * (wr - wl) / axle
+        x0, y0 = self.x[copies, slots], self.y[copies, slots]
+        x, y, yaw = _arc_steps(x0, y0, self.yaw[copies, slots], v, w, dt)
+        self.yaw[copies, slots] = yaw
+        if self.contact is not None:
+            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
+        self.x[copies, slots], self.y[copies, slots] = x, y
+        # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
+        cos, sin = _cos_sin(yaw)
+        rz = np.zeros((len(yaw), 3, 3))
+        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
+        self.rot[copies, slots] = np.matmul(rz, self.base[copies, slots])
+        self.pos[copies, slots] = np.stack([x, y, self.z[copies, slots]], axis=1)
+
+    def _contact(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray):
+        """Contact.resolve_all per copy: robots in slot order, each against the solids and its own
+        copy's other robots (where they are when its turn comes); the same broad phase, the same
+        narrow phase (Contact._clip). Returns the final xy."""
+        ct = self.contact
+        assert ct is not None
+        k = len(copies)
+        out = ends.copy()
+        reach = np.hypot(*(ends - starts).T) + EPS
+        Rr = self.foot_radius[slots]
+        box_lo = starts - (reach + Rr)[:, None]
+        box_hi = starts + (reach + Rr)[:, None]
+        band_lo = self.heights[copies, slots] + self.foot_low[slots]
+        band_hi = self.heights[copies, slots] + self.foot_high[slots]
+        solid_hit = robot_hit = None
+        near = np.zeros(k, dtype=bool)
+        if len(ct._obs):
+            solid_hit = (np.all((ct._lo[None] <= box_hi[:, None]) & (ct._hi[None] >= box_lo[:, None]), axis=2)
+                         & (ct._zhi[None] > band_lo[:, None] + EPS) & (ct._zlo[None] < band_hi[:, None] - EPS))
+            near |= solid_hit.any(axis=1)
+        if self.R > 1:
+            grow = np.zeros((self.copies, self.R))
+            grow[copies, slots] = reach
+            c = self.centres[copies]                                            # (k, R, 2): before this step
+            r_all = self.foot_radius[None, :] + grow[copies]                     # (k, R)
+            a_lo = self.heights[copies] + self.foot_low[None, :]
+            a_hi = self.heights[copies] + self.foot_high[None, :]
+            with np.errstate(invalid="ignore"):
+                robot_hit = ((c[:, :, 0] + r_all >= box_lo[:, None, 0]) & (c[:, :, 0] - r_all <= box_hi[:, None, 0])
+                             & (c[:, :, 1] + r_all >= box_lo[:, None, 1]) & (c[:, :, 1] - r_all <= box_hi[:, None, 1])
+                             & (a_hi > band_lo[:, None] + EPS) & (a_lo < band_hi[:, None] - EPS))
+            robot_hit[np.arange(k), slots] = False
+            near |= robot_hit.any(axis=1)
+        footless = np.isnan(Rr)
+        # slot by slot, as Contact.resolve_all takes robots in world order (each sees the earlier
+        # slots of its copy where they ended, the later ones where they started)
+        for r in np.unique(slots).tolist():
+            mine = slots == r
+            bare = (mine & footless).nonzero()[0]
+            self.centres[copies[bare], r] = ends[bare]
+            # nothing near: Contact._clip without candidates moves to start + (end - start)
+            free = (mine & ~near & ~footless).nonzero()[0]
+            self.centres[copies[free], r] = starts[free] + (ends[free] - starts[free])
+            for m in (mine & near & ~footless).nonzero()[0].tolist():
+                # candidates as resolve_all lists them: solids, then robots, in index order
+                cands = ([ct._in_band(ct._obs[j], float(band_lo[m]), float(band_hi[m]))
+                          for j in solid_hit[m].nonzero()[0].tolist()] if solid_hit is not None else [])
+                cm = int(copies[m])
+                if robot_hit is not None:
+                    for j in robot_hit[m].nonzero()[0].tolist():
+                        cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
+                                              float(self.foot_radius[j]),
+                                              (float(self.heights[cm, j] + self.foot_low[j]),
+                                               float(self.heights[cm, j] + self.foot_high[j]))))
+                p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
+                self.centres[cm, r] = p
+                if clipped:
+                    self.pressing[cm, r] = True
+                    self.counters["contacts"] += 1
+                    out[m] = p
+        return out[:, 0], out[:, 1]
+
+    # -- devices
+    def _due(self, kind: str, live: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        per = self.period[kind][live]
+        due = (per > 0) & (self.time_ms[live][:, None] - self.last[kind][live] >= per)
+        ci, di = due.nonzero()
+        return live[ci], di
+
+    def _measure_positions(self, live: np.ndarray) -> None:
+        if not self.position:
+            return
+        copies, cols = self._due("PositionSensor", live)
+        if not len(copies):
+            return
+        wheel = self._p_wheel[cols]
+        slot = self._p_slot[cols]
+        v = np.where(wheel >= 0, self.wheel_angle[copies, slot, np.maximum(wheel, 0)], 0.0)
+        plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself
+        for k in (~plain).nonzero()[0].tolist():
+            col = int(cols[k])
+            cfg = self.position[col].config
+            noise, res = float(cfg.noise), float(cfg.resolution)
+            if noise > 0.0:
+                g = self.noise.take(int(copies[k]), self._noise_col[("PositionSensor", col)], 1)[0]
+                v[k] = v[k] + float(0.0 + noise * g)
+            if res > 0.0:
+                v[k] = round(float(v[k]) / res) * res
+        self.values["PositionSensor"][copies, cols] = v
+        self.last["PositionSensor"][copies, cols] = self.time_ms[copies]
+        self.counters["measurements"] += len(copies)
+
+    def _measure_rays(self, live: np.ndarray, dt: int) -> None:
+        work: list = []
+        if self.light:
+            lc, lcol = self._due("LightSensor", live)
+            if len(lc):
+                work.append(("light", self._plan_lights(lc, lcol)))
+        if self.distance:
+            dc, dcol = self._due("DistanceSensor", live)
+            if len(dc):
+                work.append(("distance", self._plan_distances(dc, dcol)))
+        if self.lidar:
+            ic, icol = self._due("Lidar", live)
+            if len(ic):
+                work.append(("lidar", self._plan_lidars(ic, icol)))
+        if not work:
+            return
+        # one cast per (ray kind, transparency rule, distance only), every copy's rays together
+        requests = [req for _, (_, reqs) in work for req in reqs]
+        hits = self._cast_requests(requests)
+        k = 0
+        for what, (state, reqs) in work:
+            mine = hits[k:k + len(reqs)]
+            k += len(reqs)
+            getattr(self, f"_finish_{what}")(state, mine)
+
+    def _cast_requests(self, requests: list[_Rays]) -> list[RayHits]:
+        groups: dict[tuple, list[int]] = {}
+        for i, r in enumerate(requests):
+            groups.setdefault((int(r.kind), r.skip, r.distance_only), []).append(i)
+        out: list[RayHits | None] = [None] * len(requests)
+        for (kind, skip, distance_only), idx in groups.items():
+            reqs = [requests[i] for i in idx]
+            if len(reqs) == 1:
+                r = reqs[0]
+                out[idx[0]] = self.rays.cast(r.origins, r.directions, r.t_near, r.t_far, RayKind(kind), r.copy,
+                                             self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32)
+                continue
+            sizes = [len(r.origins) for r in reqs]
+
+            def cat(name: str, dtype, reqs=reqs, sizes=sizes) -> np.ndarray:
+                return np.concatenate([np.broadcast_to(np.asarray(getattr(r, name), dtype=dtype), (n,))
+                                       for r, n in zip(reqs, sizes)])
+
+            h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
+                               cat("t_near", np.float64), cat("t_far", np.float64), RayKind(kind), cat("copy", np.int64),
+                               self.rot, self.pos, cat("exclude", np.int64), cat("mount", np.int64), skip,
+                               distance_only)
+            a = 0
+            for i, n in zip(idx, sizes):
+                sl = slice(a, a + n)
+                out[i] = RayHits(h.distance[sl], None if h.normal is None else h.normal[sl],
+                                 None if h.shape is None else h.shape[sl])
+                a += n
+        return out   # type: ignore[return-value]
+
+    # light sensors (LightBatch over every copy's due sensors)
+    def _plan_lights(self, copies: np.ndarray, cols: np.ndarray):
+        slot = self._l_slot[cols]
+        rr = self.rot[copies, slot]
+        rt = self.pos[copies, slot]
+        rot = compose_rotations(rr, self._l_rot[cols])
+        positions = np.einsum("sij,sj->si", rr, self._l_pos[cols]) + rt
+        normals = rot[:, :, 0]
+        att, direct = light_math.light_terms(positions, normals, self.lights)
+        state = {"copies": copies, "cols": cols, "att": att, "direct": direct, "pairs": None}
+        if self.lights.count == 0 or not self._l_occl[cols].any():
+            return state, []
+        mask = (direct > 0.0) & self._l_occl[cols][:, None]
+        s, light = np.nonzero(mask)
+        if s.size == 0:
+            return state, []
+        state["pairs"] = (s, light)
+        unit, length = light_math.occlusion_segments_many(positions[s], self.lights)
+        rows = np.arange(s.size)
+        return state, [_Rays(positions[s], unit[rows, light], 0.0, length[rows, light], RayKind.BOUNDING,
+                             copies[s], self._l_excl[cols][s], -1)]
+
+    def _finish_light(self, state: dict, hits: list[RayHits]) -> None:
+        copies, cols = state["copies"], state["cols"]
+        occluded = np.zeros(state["att"].shape, dtype=bool)
+        if state["pairs"] is not None:
+            s, light = state["pairs"]
+            occluded[s, light] = np.isfinite(hits[0].distance)
+        e = light_math.irradiance_from_terms(state["att"], state["direct"], self.lights, occluded, self._l_filter[cols])
+        values = np.empty(len(cols))
+        for table, members in self._l_tables:
+            sel = np.isin(cols, members).nonzero()[0]
+            if not len(sel):
+                continue
+            if len(table) == 0:        # an empty table is the identity, without noise (devices.md §1.2)
+                values[sel] = e[sel]
+                continue
+            y, n = table.interpolate(e[sel])
+            y = self._noisy(y, n, "LightSensor", copies[sel], cols[sel])
+            values[sel] = y
+        res = self._l_res[cols]
+        rounded = res != RESOLUTION_OFF
+        if rounded.any():
+            values = np.where(rounded, np.trunc(values / np.where(rounded, res, 1.0) + 0.5) * res + 0.0, values)
+        self._store("LightSensor", copies, cols, values)
+
+    def _noisy(self, y: np.ndarray, n: np.ndarray, kind: str, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """``y (1 + n G)`` where ``n != 0``, G from each (copy, device) stream (add_noise)."""
+        noisy = (n != 0.0).nonzero()[0]
+        if not len(noisy):
+            return y
+        g = self.noise.next(copies[noisy], self._noise_of[kind][cols[noisy]])
+        y = np.array(y, dtype=np.float64)
+        y[noisy] = y[noisy] * (1.0 + n[noisy] * g)
+        return y
+
+    def _store(self, kind: str, copies: np.ndarray, cols: np.ndarray, values: np.ndarray) -> None:
+        self.values[kind][copies, cols] = values
+        self.last[kind][copies, cols] = self.time_ms[copies]
+        self.counters["measurements"] += len(copies)
+
+    # distance sensors (DistanceBatch over every copy's due sensors)
+    def _plan_distances(self, copies: np.ndarray, cols: np.ndarray):
+        plan = self._d_plan
+        state = {"copies": copies, "cols": cols, "groups": []}
+        reqs: list[_Rays] = []
+        for g, where in self._d_groups:
+            # the group's sensors among the due ones: (row in the due list, index in the group)
+            k = where[cols]
+            rows = (k >= 0).nonzero()[0]
+            if not len(rows):
+                continue
+            k = k[rows]
+            pi = g.idx[k]                                  # index in the plan's stacked constants
+            c = copies[rows]
+            slot = plan.robot[pi]
+            rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
+            rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
+                                     np.ascontiguousarray(plan.local_pos_t[:, pi]))
+            positions = pos_t.T + self.pos[c, slot]
+            dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
+            n = g.n
+            mount = -1
+            if g.mount is not None:
+                mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
+            exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
+            reqs.append(_Rays(np.repeat(positions, n, axis=0), dirs.reshape(-1, 3), 0.0,
+                              g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1),
+                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip))
+            state["groups"].append((g, rows, k, c, slot, positions, dirs))
+        return state, reqs
+
+    def _finish_distance(self, state: dict, hits: list[RayHits]) -> None:
+        plan = self._d_plan
+        copies, cols = state["copies"], state["cols"]
+        measured = np.full(len(cols), math.nan)
+        for (g, rows, k, c, slot, positions, dirs), h in zip(state["groups"], hits):
+            S, n = dirs.shape[:2]
+            dist, shape, normal = h.distance, h.shape, h.normal
+            own = g.own_hits(self.rays.movers, plan.local_rot, plan.local_pos) if g.mount is not None else None
+            if own is not None:   # the nearer of the cast and the ray's own-body hit (decided once)
+                ray = (k[:, None] * n + np.arange(n)).reshape(-1)
+                od, osh, onr = own.distance[ray], own.shape[ray], own.normal[ray]
+                win = (od < dist).nonzero()[0]
+                if len(win):
+                    dist, shape, normal = dist.copy(), shape.copy(), normal.copy()
+                    dist[win] = od[win]
+                    shape[win] = np.where(osh[win] >= 0, osh[win] + self.n_static_shapes, -1)
+                    rr = np.repeat(np.arange(S), n)[win]
+                    normal[win] = np.einsum("sij,sj->si", self.rot[c[rr], slot[rr]], onr[win])
+            dist = dist.reshape(S, n)
+            reflection = None
+            if g.kind == RayKind.VISUAL:
+                sh = shape.reshape(S, n)
+                textures = self.scene.textures
+                if textures is not None and np.count_nonzero(textures.textured[np.where(shape < self.n_static_shapes,
+                                                                                        shape, -1)]):
+                    red, rough, occl = self._infra_red_terms(shape, np.repeat(positions, n, axis=0),
+                                                             dirs.reshape(-1, 3), dist.reshape(-1))
+                    shade = dmath.reflection_factor(red, rough, occl).reshape(S, n)
+                else:
+                    shade = dmath.reflection_factor(self.red[sh], self.roughness[sh])
+                reflection = np.where(sh >= 0, shade, 1.0)
+            measured[rows] = dmath.combine_distance_batch(
+                g.types[k], dist, dirs, normal.reshape(S, n, 3), g.weights[k], g.lut_max_range[k], reflection,
+                g.sensitivity[k])
+        # DistancePlan.output: lookup (by table), each sensor's noise, resolution
+        values = np.zeros(len(cols))
+        full = ~self._d_empty[cols]
+        for table, members in self._d_tables:
+            sel = (np.isin(cols, members) & full).nonzero()[0]
+            if not len(sel):
+                continue
+            y, nz = table.interpolate(measured[sel])
+            values[sel] = self._noisy(y, nz, "DistanceSensor", copies[sel], cols[sel])
+        res = self._d_res[cols]
+        rounded = full & (res != RESOLUTION_OFF)
+        if np.count_nonzero(rounded):
+            q = np.trunc(values / np.where(rounded, res, 1.0) + 0.5) * res + 0.0
+            values = np.where(rounded, q, values)
+        self._store("DistanceSensor", copies, cols, values)
+
+    def _infra_red_terms(self, shape, origins, directions, distance):
+        """Scene.infra_red_terms for hits on solids (textures live there); robot shapes read their
+        colour (robot bodies are never textured here)."""
+        red, rough = self.red[shape], self.roughness[shape]
+        occl = np.zeros(len(shape))
+        on_static = (shape >= 0) & (shape < self.n_static_shapes)
+        rows = on_static.nonzero()[0]
+        if len(rows):
+            r2, g2, o2 = self.scene.infra_red_terms(shape[rows], origins[rows], directions[rows], distance[rows])
+            red, rough = red.copy(), rough.copy()
+            red[rows], rough[rows], occl[rows] = r2, g2, o2
+        return red, rough, occl
+
+    # fixed lidars (Lidar.plan/finish over every copy's due lidars)
+    def _plan_lidars(self, copies: np.ndarray, cols: np.ndarray):
+        reqs: list[_Rays] = []
+        state = {"items": []}
+        for col in sorted(set(cols.tolist())):
+            lid = self.lidar[col]
+            c = copies[cols == col]
+            slot = lid.robot_index
+            rr = self.rot[c, slot]
+            rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
+            org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
+            x, y, z = lid._dir_columns
+            W = len(x)
+            dirs = np.empty((len(c), W, 3))
+            for j in range(3):                                                  # _rotate_columns, stacked
+                acc = x[None, :] * rot[:, j, 0, None]
+                acc += y[None, :] * rot[:, j, 1, None]
+                acc += z[None, :] * rot[:, j, 2, None]
+                dirs[:, :, j] = acc
+            d = dirs.reshape(-1, 3)
+            t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
+            reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, np.repeat(c, W),
+                              -1, np.tile(self._lidar_skip(col), len(c)), distance_only=True, d32=d.astype(np.float32)))
+            state["items"].append((col, c))
+        return state, reqs
+
+    def _lidar_skip(self, col: int) -> np.ndarray:
+        """Per beam: the lidar's own robot slot where the beam can never meet that robot's body
+        (a Webots lidar sees its own robot, so the others are paired with it every scan; a fixed
+        lidar's beams never move in the body frame), else -1. Decided once."""
+        got = self._lidar_skips.get(col)
+        if got is None:
+            lid = self.lidar[col]
+            slot = lid.robot_index
+            x, y, z = lid._dir_columns
+            local = lid.local_pose
+            dirs = np.stack([x, y, z], axis=1) @ local.rotation.T
+            reach = self.rays.may_reach(slot, RayKind.VISUAL, np.broadcast_to(local.translation, dirs.shape), dirs,
+                                        lid.params.near, lid._t_far)
+            got = self._lidar_skips[col] = np.where(reach, -1, slot).astype(np.int64)
+        return got
+
+    def _finish_lidar(self, state: dict, hits: list[RayHits]) -> None:
+        for (col, c), h in zip(state["items"], hits):
+            lid = self.lidar[col]
+            L, W = lid.config.number_of_layers, lid.config.horizontal_resolution
+            dist = h.distance.reshape(len(c), L, W)
+            img = self.range_images[col]
+            if lid.params.noise > 0:
+                nc = self._noise_col[("Lidar", col)]
+                for k, cc in enumerate(c.tolist()):
+                    stream = _Stream(self.noise, cc, nc)
+                    img[cc] = lmath.ranges_from_hits(lid.params, dist[k], lid._all_dirs, stream)  # type: ignore[arg-type]
+            else:   # element by element: every copy's scans in one call
+                img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
+            self.last["Lidar"][c, col] = self.time_ms[c]
+            self.counters["measurements"] += len(c)
+
+    # ------------------------------------------------------------------ tasks
+    def cast(self, copies: np.ndarray, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
+             exclude_slot=-1, skip_transparent: bool = False) -> RayHits:
+        """Rays of the named copies (one entry per ray) against each copy's world, as
+        ``scene.engine.cast`` of a single simulation (``exclude_slot``: a robot slot whose body
+        the rays ignore, as ``exclude_owner``)."""
+        return self.rays.cast(origins, directions, t_near, t_far, RayKind(kind), np.asarray(copies, dtype=np.int64),
+                              self.rot, self.pos, exclude_slot, -1, skip_transparent)
+
+
+@dataclass(slots=True)
+class _Rays:
+    """One request of a batched step: rays of several copies."""
+
+    origins: np.ndarray
+    directions: np.ndarray
+    t_near: np.ndarray | float
+    t_far: np.ndarray | float
+    kind: RayKind
+    copy: np.ndarray
+    exclude: np.ndarray | int
+    mount: np.ndarray | int
+    skip: bool = False
+    distance_only: bool = False
+    d32: np.ndarray | None = None
+
+
+class _Stream:
+    """One (copy, device) noise stream with the interface lidar.ranges_from_hits draws through."""
+
+    def __init__(self, bank: NoiseStreams, copy: int, column: int):
+        self.bank, self.copy, self.column = bank, copy, column
+
+    def standard_normal(self, count: int) -> np.ndarray:
+        return self.bank.take(self.copy, self.column, int(count))
+
+
+def _by_table(devices: list) -> list[tuple]:
+    """(table, device columns) for devices sharing a lookup table (tables compare by rows)."""
+    out: dict = {}
+    for k, d in enumerate(devices):
+        out.setdefault(d.table, []).append(k)
+    return [(t, np.array(v, dtype=np.int64)) for t, v in out.items()]
+
+
+def _cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """math.cos and math.sin of each element (the single simulation's libm calls, whatever SIMD
+    routines numpy would pick for np.cos on this machine)."""
+    vals = a.tolist()
+    return np.array(list(map(math.cos, vals))), np.array(list(map(math.sin, vals)))
+
+
+def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):
+    """motion.arc_step for many robots, element by element the same float64 operations."""
+    dyaw = w * dt
+    straight = np.abs(dyaw) < 1e-9
+    xo, yo = x.copy(), y.copy()
+    s = straight.nonzero()[0]
+    if len(s):
+        mid = yaw[s] + 0.5 * dyaw[s]
+        cm, sm = _cos_sin(mid)
+        xo[s] = x[s] + v[s] * dt * cm
+        yo[s] = y[s] + v[s] * dt * sm
+    t = (~straight).nonzero()[0]
+    if len(t):
+        r = v[t] / w[t]
+        c1, s1 = _cos_sin(yaw[t] + dyaw[t])
+        c0, s0 = _cos_sin(yaw[t])
+        xo[t] = x[t] + r * (s1 - s0)
+        yo[t] = y[t] - r * (c1 - c0)
+    return xo, yo, np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi
+

@@ -1,0 +1,187 @@
+"""sensorium.server.sim.batched: N copies of a world in one simulation, each bit-identical to the
+single Simulation with its seed, never seeing the others."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
+
+EPUCK = ["ls0", "ls1", *[f"ps{i}" for i in range(8)]]
+SCOUT = ["lidar", "sonar_front", "sonar_left", "sonar_right", "sonar_back"]
+
+
+def arena(seed: int) -> LoadedWorld:
+    lw = load_world(default_world_path())
+    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
+    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+
+
+def _same_value(a: float, b: float) -> bool:
+    return a == b or (math.isnan(a) and math.isnan(b))
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_every_copy_is_the_single_simulation_with_its_seed(precision):
+    """Both robots drive (into walls, at each other); every observable device of both is enabled
+    (different periods); after every basic step each copy's poses, clock, values and range images
+    equal those of a Simulation built with that copy's seed, bit for bit."""
+    seeds = [11, 12, 13]
+    bs = BatchedSimulation(arena(0), len(seeds), precision=precision)
+    bs.reset(np.arange(3), seeds)
+    sims = [Simulation(arena(s), precision=precision) for s in seeds]
+    periods = {"ls0": 64, "ls1": 32, "lidar": 64, "ps3": 96}
+    for robot, names in (("epuck", EPUCK), ("scout", SCOUT)):
+        for n in names:
+            bs.enable(bs.device(robot, n), periods.get(n, 32))
+            for s in sims:
+                s.robot(robot).device(n).enable(periods.get(n, 32))
+    rng = np.random.default_rng(0)
+    for step in range(48):
+        if step % 4 == 0:
+            for robot in ("epuck", "scout"):
+                slot = bs.slot(robot)
+                vmax = float(bs.max_wheel[slot, 0])
+                lr = rng.uniform(-vmax, vmax, (3, 2)) if step % 16 else np.full((3, 2), 0.9 * vmax)
+                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
+                for c, s in enumerate(sims):
+                    for m in s.robot(robot).motors.values():
+                        m.set_position(math.inf)
+                    s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
+                    s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            assert bs.time_ms[c] == s.time_ms
+            for robot, names in (("epuck", EPUCK), ("scout", SCOUT)):
+                slot = bs.slot(robot)
+                pose = s.robot(robot).pose
+                assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
+                assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
+                for n in names:
+                    ref, dev = bs.device(robot, n), s.robot(robot).device(n)
+                    if ref.kind == "Lidar":
+                        assert dev.range_image.tobytes() == bs.range_image(ref)[c].tobytes(), (step, c, n)
+                    else:
+                        assert _same_value(dev.value, float(bs.value(ref)[c])), (step, c, n, dev.value)
+    # the copies differ from one another (own noise streams), and the IR noise was drawn
+    ps = bs.value(bs.device("epuck", "ps0"))
+    assert len(set(ps.tolist())) == 3
+
+
+def test_a_robot_in_one_copy_is_invisible_to_the_others_sensors_and_contact():
+    """Copy 3's scout stands right in front of the e-puck; in every other copy it stays where the
+    world file puts it. Copy 3's e-puck sees it (infra-red) and is stopped by it (contact); copy
+    4's e-puck, on the same spot with the same commands, reads exactly what a single simulation
+    without the scout there reads, and drives through where copy 3's scout is."""
+    n = 6
+    bs = BatchedSimulation(arena(5), n, precision="exact")
+    bs.reset(np.arange(n), [5] * n)
+    epuck, scout = bs.slot("epuck"), bs.slot("scout")
+    for c in range(n):
+        bs.set_pose(c, epuck, [0.0, -1.0, 0.01], rotation=[0, 0, 1, 0.0])
+    bs.set_pose(3, scout, [0.21, -1.0, 0.06], rotation=[0, 0, 1, 0.0])     # back face at x = 0.06
+    single = Simulation(arena(5), precision="exact")
+    single.robot("epuck").set_pose([0.0, -1.0, 0.01], rotation=[0, 0, 1, 0.0])
+    refs = [bs.device("epuck", f"ps{i}") for i in (0, 7)]
+    for ref in refs:
+        bs.enable(ref, 32)
+        single.robot("epuck").device(ref.name).enable(32)
+    bs.step()
+    single.step()
+    for ref in refs:
+        seen, unseen = float(bs.value(ref)[3]), float(bs.value(ref)[4])
+        assert seen > 200.0                    # the box 2.6 cm ahead: far above the no-hit level
+        assert unseen == single.robot("epuck").device(ref.name).value   # exactly the world without it
+        assert unseen < 130.0
+    # drive straight ahead at full speed for 2 s (0.26 m): copy 3 stops at the scout's disc (the
+    # kinematic contact's footprint of a box: its circumscribed circle, radius hypot(0.3, 0.2) / 2)
+    bs.set_pose(3, scout, [0.35, -1.0, 0.06], rotation=[0, 0, 1, 0.0])
+    bs.set_wheels(epuck, np.full(n, 6.28), np.full(n, 6.28))
+    bs.run(62)
+    assert bs.pos[3, epuck, 0] == pytest.approx(0.35 - math.hypot(0.3, 0.2) / 2 - 0.035, abs=1e-9)
+    assert bs.pressing[3, epuck] or bs.counters["contacts"] > 0
+    step_m = 6.28 * 0.0205 * 0.032
+    for c in (0, 1, 2, 4, 5):
+        assert bs.pos[c, epuck, 0] == pytest.approx(62 * step_m, abs=1e-9)     # through copy 3's scout
+
+
+def test_reset_restarts_a_copy_without_rebuilding_anything():
+    bs = BatchedSimulation(arena(1), 4, precision="fast")
+    ref = bs.device("epuck", "ps0")
+    bs.reset(np.arange(4), [1, 2, 3, 4])
+    bs.enable(ref, 32)
+    bs.set_wheels(bs.slot("epuck"), np.full(4, 3.0), np.full(4, 2.0))
+    bs.run(10)
+    first = bs.value(ref).copy()
+    builds = bs.scene.engine.counters["bvh_builds"] + bs.rays.movers.counters["bvh_builds"]
+    bs.reset(np.array([1, 2]), [2, 3])            # the same seeds again: those copies start over
+    assert bs.time_ms.tolist() == [320, 0, 0, 320]
+    assert math.isnan(bs.value(ref)[1]) and bs.pos[1, 0].tolist() == bs.initial[0].translation.tolist()
+    bs.enable(ref, 32, copies=[1, 2])
+    bs.set_wheels(bs.slot("epuck"), np.full(2, 3.0), np.full(2, 2.0), copies=[1, 2])
+    active = np.array([False, True, True, False])
+    bs.run(10, active)
+    assert bs.time_ms.tolist() == [320, 320, 320, 320]
+    assert bs.value(ref).tobytes() == first.tobytes()           # bit for bit the same ten steps
+    assert bs.scene.engine.counters["bvh_builds"] + bs.rays.movers.counters["bvh_builds"] == builds
+
+
+def test_what_the_batched_simulation_does_not_simulate_is_refused_with_a_reason():
+    lw = load_world(default_world_path())
+    w = lw.world
+    nue = w.model_copy(update={"world_info": w.world_info.model_copy(update={"coordinate_system": "NUE"})})
+    with pytest.raises(BatchedError, match="ENU worlds only"):
+        BatchedSimulation(nue, 2, base_dir=lw.base_dir)
+    robots = [r.model_dump(mode="json", exclude_none=True) for r in w.robots]
+    robots[0]["devices"].append({"device": "LED", "name": "led0"})
+    robots[1]["devices"][0].update(type="rotating", name="lidar")
+    lit = wm.World.model_validate({**w.model_dump(mode="json", exclude_none=True), "robots": robots})
+    bs = BatchedSimulation(lit, 2, base_dir=lw.base_dir)
+    with pytest.raises(BatchedError, match="is a LED"):
+        bs.device("epuck", "led0")
+    with pytest.raises(BatchedError, match="rotating lidars"):
+        bs.enable(bs.device("scout", "lidar"), 32)
+    with pytest.raises(KeyError, match="no device 'nope'"):
+        bs.device("epuck", "nope")
+
+
+def test_wheel_encoders_with_noise_and_resolution_match_the_single_simulation():
+    world = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "random_seed": 0},
+        "solids": [{"name": "floor", "geometry": {"type": "plane"}}],
+        "robots": [{"name": "bot", "pose": {"translation": [0, 0, 0.05]},
+                    "body": {"geometry": {"type": "cylinder", "radius": 0.035, "height": 0.05}},
+                    "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 6.0},
+                    "devices": [{"device": "PositionSensor", "name": "left", "motor": "left wheel motor"},
+                                {"device": "PositionSensor", "name": "right", "motor": "right wheel motor",
+                                 "noise": 0.01, "resolution": 0.001}]}]})
+    seeds = [3, 4]
+    bs = BatchedSimulation(world, 2)
+    bs.reset(np.arange(2), seeds)
+    sims = [Simulation(world.model_copy(update={"world_info": world.world_info.model_copy(
+        update={"random_seed": s})})) for s in seeds]
+    for name, period in (("left", 16), ("right", 48)):
+        bs.enable(bs.device("bot", name), period)
+        for s in sims:
+            s.robot("bot").device(name).enable(period)
+    bs.set_wheels(0, np.array([2.0, -3.0]), np.array([1.5, 6.5]))       # 6.5 is clamped to 6
+    for c, s in enumerate(sims):
+        for m in s.robot("bot").motors.values():
+            m.set_position(math.inf)
+        s.robot("bot").drive.left.set_velocity([2.0, -3.0][c])
+        s.robot("bot").drive.right.set_velocity([1.5, 6.5][c])
+    for _ in range(30):
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for name in ("left", "right"):
+                assert _same_value(s.robot("bot").device(name).value, float(bs.value(bs.device("bot", name))[c]))
+            assert s.robot("bot").pose.translation.tobytes() == bs.pos[c, 0].tobytes()
+    assert bs.value(bs.device("bot", "left"))[0] == pytest.approx(2.0 * 0.016 * 30, abs=1e-12)   # rad turned

@@ -1,0 +1,276 @@
+"""sensorium.gym.vector: the batched VectorEnv -- make_vec, Gymnasium's autoreset modes, sub-envs
+bit-identical to the single environment, the checker, resets without rebuilding."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+gym = pytest.importorskip("gymnasium")
+
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+from gymnasium.vector import AutoresetMode  # noqa: E402
+
+import sensorium.gym  # noqa: E402,F401  (registers the ids)
+from sensorium.gym import ReachLight, SensoriumEnv, Task  # noqa: E402
+from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
+
+IDS = ["sensorium/ReachLight-v0", "sensorium/AvoidObstacles-v0", "sensorium/LidarAvoid-v0"]
+
+
+def _same_obs(a: dict, b: dict) -> bool:
+    return set(a) == set(b) and all(np.asarray(a[k]).tobytes() == np.asarray(b[k]).tobytes() for k in a)
+
+
+def _row(obs: dict, i: int) -> dict:
+    return {k: v[i] for k, v in obs.items()}
+
+
+def _lockstep(env_id: str, precision: str, n: int, steps: int, max_steps: int, seed: int = 5):
+    """The vector env and n single envs (seeds seed + i) fed the same actions; NEXT_STEP autoreset
+    on one side, reset() after an ended episode on the other. Returns the number of resets seen."""
+    venv = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", precision=precision,
+                        max_steps=max_steps)
+    singles = [gym.make(env_id, precision=precision, max_steps=max_steps, engine="simulation") for _ in range(n)]
+    obs, info = venv.reset(seed=seed)
+    for i, env in enumerate(singles):
+        o, inf = env.reset(seed=seed + i)
+        assert _same_obs(_row(obs, i), o) and inf["pose"].tobytes() == info["pose"][i].tobytes()
+    rng = np.random.default_rng(1)
+    done = np.zeros(n, dtype=bool)
+    resets = 0
+    for t in range(steps):
+        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        if t % 20 < 10:
+            a[:, 1] = a[:, 0] = 1.0                       # full speed ahead: walls, contact, terminations
+        vobs, vr, vte, vtr, vinfo = venv.step(a)
+        for i, env in enumerate(singles):
+            if done[i]:
+                o, inf = env.reset()
+                r, te, tr = 0.0, False, False
+                resets += 1
+            else:
+                o, r, te, tr, inf = env.step(a[i])
+            assert _same_obs(_row(vobs, i), o), (t, i)
+            assert (r, te, tr) == (vr[i], vte[i], vtr[i]), (t, i)
+            assert inf["time_ms"] == vinfo["time_ms"][i] and inf["steps"] == vinfo["steps"][i]
+            assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes()
+            done[i] = te or tr
+    venv.close()
+    return resets
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+@pytest.mark.parametrize("env_id", IDS)
+def test_sub_env_i_is_the_single_env_with_seed_i_across_autoresets(env_id, precision):
+    resets = _lockstep(env_id, precision, n=3, steps=45, max_steps=12)
+    assert resets >= 3                                   # every sub-env ended and restarted at least once
+
+
+def test_make_vec_gives_the_batched_env_with_next_step_autoreset():
+    venv = gym.make_vec("sensorium/ReachLight-v0", num_envs=4, vectorization_mode="vector_entry_point")
+    assert isinstance(venv.unwrapped, SensoriumVectorEnv)
+    assert venv.metadata["autoreset_mode"] is AutoresetMode.NEXT_STEP
+    assert venv.num_envs == 4 and venv.observation_space["ps0"].shape == (4, 1)
+    assert venv.single_action_space.low.tolist() == [-1.0, -1.0] and venv.action_space.shape == (4, 2)
+    obs, info = venv.reset(seed=0)
+    assert venv.observation_space.contains(obs)
+    assert info["_time_ms"].all() and info["time_ms"].tolist() == [64] * 4     # warm-up: one 64 ms period
+    # a vector step is steps_per_action basic steps of every copy
+    _, _, _, _, info = venv.step(np.zeros((4, 2), dtype=np.float32))
+    assert info["time_ms"].tolist() == [128] * 4
+    venv.close()
+
+
+def test_same_step_autoreset_returns_the_new_episode_and_keeps_the_last_observation():
+    n = 2
+    venv = SensoriumVectorEnv(None, sensorium.gym.tasks.reach_light_task(max_steps=3), n,
+                              autoreset_mode=AutoresetMode.SAME_STEP)
+    assert venv.metadata["autoreset_mode"] is AutoresetMode.SAME_STEP
+    single = [sensorium.gym.reach_light(max_steps=3, precision="fast", engine="simulation") for _ in range(n)]
+    venv.reset(seed=[7, 9])
+    for env, s in zip(single, [7, 9]):
+        env.reset(seed=s)
+    a = np.full((n, 2), 0.5, dtype=np.float32)
+    for _ in range(2):
+        venv.step(a)
+        for env in single:
+            env.step(a[0])
+    obs, rew, term, trunc, info = venv.step(a)          # the third action truncates both
+    assert trunc.all() and not term.any()
+    for i, env in enumerate(single):
+        last, r, _, tr, _ = env.step(a[i])
+        assert tr and r == rew[i]
+        assert info["_final_obs"][i] and _same_obs(_row(info["final_obs"], i), last)
+        first, first_info = env.reset()
+        assert _same_obs(_row(obs, i), first)            # already the next episode's first observation
+        assert info["steps"][i] == 0 and info["time_ms"][i] == first_info["time_ms"]
+
+
+def test_disabled_autoreset_resets_through_the_mask_only():
+    venv = SensoriumVectorEnv(None, sensorium.gym.tasks.reach_light_task(max_steps=1), 3,
+                              autoreset_mode="Disabled")
+    venv.reset(seed=0)
+    _, _, _, trunc, _ = venv.step(np.zeros((3, 2), dtype=np.float32))
+    assert trunc.all()
+    with pytest.raises(RuntimeError, match="autoreset is disabled"):
+        venv.step(np.zeros((3, 2), dtype=np.float32))
+    mask = np.array([True, False, True])
+    _, info = venv.reset(options={"reset_mask": mask})
+    assert info["_steps"].tolist() == [True, False, True]
+    with pytest.raises(RuntimeError, match=r"sub-envs \[1\]"):
+        venv.step(np.zeros((3, 2), dtype=np.float32))
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_checker_passes_without_warnings_on_single_envs_and_sub_envs(env_id):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                    # any checker warning fails the test
+        check_env(gym.make(env_id).unwrapped)                          # a rebuilt Simulation
+        check_env(gym.make(env_id, engine="batched").unwrapped)        # the batched engine (one copy)
+        venv = gym.make_vec(env_id, num_envs=3, vectorization_mode="vector_entry_point", render_mode="rgb_array")
+        check_env(venv.unwrapped.sub_env(2), skip_render_check=False)
+        check_env(gym.make_vec(env_id, num_envs=2, vectorization_mode="vector_entry_point",
+                               flatten=True).unwrapped.sub_env(0))
+
+
+def test_resets_reuse_the_built_scene():
+    venv = gym.make_vec("sensorium/AvoidObstacles-v0", num_envs=8, vectorization_mode="vector_entry_point",
+                        max_steps=2)
+    sim = venv.unwrapped.sim
+    venv.reset(seed=1)
+    venv.step(venv.action_space.sample())                 # every ray kind cast once: every scene built
+    builds = sim.scene.engine.counters["bvh_builds"] + sim.rays.movers.counters["bvh_builds"]
+    resets = sim.counters["resets"]
+    for _ in range(9):                                    # every sub-env ends after 2 actions: 3 rounds of resets
+        venv.step(venv.action_space.sample())
+    venv.reset()
+    assert sim.counters["resets"] - resets >= 3 * 8
+    assert sim.scene.engine.counters["bvh_builds"] + sim.rays.movers.counters["bvh_builds"] == builds
+
+
+def test_flattened_observations_are_the_dict_boxes_in_key_order():
+    n = 3
+    flat = gym.make_vec("sensorium/LidarAvoid-v0", num_envs=n, vectorization_mode="vector_entry_point", flatten=True)
+    boxed = gym.make_vec("sensorium/LidarAvoid-v0", num_envs=n, vectorization_mode="vector_entry_point")
+    f, _ = flat.reset(seed=3)
+    d, _ = boxed.reset(seed=3)
+    assert f.shape == (n, 364) and f.dtype == np.float32 and flat.single_observation_space.shape == (364,)
+    keys = list(boxed.single_observation_space.spaces)
+    assert keys == sorted(keys)
+    np.testing.assert_array_equal(f, np.concatenate([d[k].reshape(n, -1) for k in keys], axis=1))
+    single = gym.make("sensorium/LidarAvoid-v0", flatten=True, precision="fast", engine="simulation")
+    s, _ = single.reset(seed=4)
+    assert s.tobytes() == f[1].tobytes()                 # sub-env 1 had seed 3 + 1
+
+
+def test_a_reward_without_a_vectorised_form_is_called_per_copy_with_the_same_values():
+    calls = []
+
+    def closer_to_origin(sim, robot, obs) -> float:     # reads the pose through the copy's view
+        calls.append(sim.time_ms)
+        x, y = robot.pose.translation[:2]
+        return -math.hypot(x, y) + 0.001 * float(obs["ls0"][0])
+
+    task = Task(robot="epuck", observations={"ls0": 64}, control_period_ms=64, max_steps=20, reward=closer_to_origin,
+                terminated=ReachLight("lamp").terminated)
+    venv = SensoriumVectorEnv(None, task, 2)
+    single = SensoriumEnv(None, task, precision="fast", engine="simulation")
+    venv.reset(seed=[3, 4])
+    single.reset(seed=4)
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        a = rng.uniform(-1, 1, (2, 2)).astype(np.float32)
+        _, r, *_ = venv.step(a)
+        _, r1, *_ = single.step(a[1])
+        assert r[1] == r1
+    assert len(calls) == 5 * 2 + 5
+    assert single.engine == "simulation" and SensoriumEnv(None, task, engine="auto").engine == "batched"
+
+
+def test_bad_actions_and_stepping_before_reset_say_what_is_wrong():
+    venv = SensoriumVectorEnv(None, sensorium.gym.tasks.reach_light_task(), 2)
+    with pytest.raises(RuntimeError, match="reset"):
+        venv.step(np.zeros((2, 2), dtype=np.float32))
+    venv.reset(seed=0)
+    with pytest.raises(ValueError, match=r"shape \(2, 2\)"):
+        venv.step(np.zeros((3, 2), dtype=np.float32))
+    with pytest.raises(ValueError, match="sub-env 1"):
+        venv.step(np.array([[0.0, 0.0], [np.nan, 0.0]], dtype=np.float32))
+
+
+def test_pettingzoo_env_on_the_batched_engine_equals_the_rebuilt_simulation(precision="fast"):
+    pytest.importorskip("pettingzoo")
+    from pettingzoo.test import parallel_api_test
+
+    from sensorium.gym import SensoriumParallelEnv
+    from sensorium.gym.tasks import lidar_avoid_task, reach_light_task
+
+    def make(engine):
+        return SensoriumParallelEnv(None, {"epuck": reach_light_task(max_steps=25), "scout": lidar_avoid_task(max_steps=40)},
+                                    precision=precision, engine=engine)
+
+    batched, rebuilt = make("batched"), make("simulation")
+    parallel_api_test(make("batched"), num_cycles=30)
+    rng = np.random.default_rng(4)
+    for episode in range(2):
+        ob, _ = batched.reset(seed=10 + episode)
+        orr, _ = rebuilt.reset(seed=10 + episode)
+        builds = batched._batched.scene.engine.counters["bvh_builds"]
+        while batched.agents:
+            assert batched.agents == rebuilt.agents
+            for a in batched.agents:
+                assert _same_obs(ob[a], orr[a])
+            acts = {a: rng.uniform(-1, 1, 2).astype(np.float32) for a in batched.agents}
+            ob, rb, tb, trb, ib = batched.step(acts)
+            orr, rr, tr_, trr, ir = rebuilt.step(acts)
+            assert (rb, tb, trb) == (rr, tr_, trr)
+            assert all(ib[a]["pose"].tobytes() == ir[a]["pose"].tobytes() for a in ib)
+        assert not rebuilt.agents
+        if episode:
+            assert batched._batched.scene.engine.counters["bvh_builds"] == builds     # the reset rebuilt nothing
+
+
+def test_auto_engine_falls_back_to_the_simulation_for_what_the_batched_one_does_not_simulate():
+    from sensorium.server.sim.batched import BatchedError
+    from sensorium.server.world.loader import default_world_path, load_world
+
+    lw = load_world(default_world_path())
+    robots = [r.model_dump(mode="json", exclude_none=True) for r in lw.world.robots]
+    robots[1]["devices"][0]["type"] = "rotating"                  # the scout's lidar
+    w = lw.world.model_validate({**lw.world.model_dump(mode="json", exclude_none=True), "robots": robots})
+    from sensorium.server.world.loader import LoadedWorld
+
+    world = LoadedWorld(world=w, source="rotating", base_dir=lw.base_dir)
+    task = Task(robot="scout", observations={"lidar": 64}, control_period_ms=64)
+    env = SensoriumEnv(world, task, engine="auto")
+    assert env.engine == "simulation"
+    obs, _ = env.reset(seed=0)
+    assert obs["lidar"].shape == (1, 360)
+    with pytest.raises(BatchedError, match="rotating lidars"):
+        SensoriumEnv(world, task, engine="batched")
+    with pytest.raises(BatchedError, match="rotating lidars"):
+        SensoriumVectorEnv(world, task, 2).reset(seed=0)
+    assert SensoriumEnv(world, Task(robot="epuck", observations=["ps0"]), engine="auto").engine == "batched"
+
+
+@pytest.mark.parametrize("env_id", ["sensorium/AvoidObstacles-v0", "sensorium/LidarAvoid-v0"])
+def test_single_env_on_the_batched_engine_equals_the_rebuilt_simulation(env_id):
+    batched = gym.make(env_id, engine="batched", max_steps=10)
+    rebuilt = gym.make(env_id, engine="simulation", max_steps=10)
+    assert batched.unwrapped.engine == "batched" and rebuilt.unwrapped.engine == "simulation"
+    rng = np.random.default_rng(6)
+    for seed in (1, None, 2):
+        ob, ib = batched.reset(seed=seed)
+        orr, ir = rebuilt.reset(seed=seed)
+        assert _same_obs(ob, orr) and ib["pose"].tobytes() == ir["pose"].tobytes()
+        done = False
+        while not done:
+            a = rng.uniform(-1, 1, 2).astype(np.float32)
+            ob, rb, tb, trb, ib = batched.step(a)
+            orr, rr, tr_, trr, ir = rebuilt.step(a)
+            assert _same_obs(ob, orr) and (rb, tb, trb) == (rr, tr_, trr) and ib["time_ms"] == ir["time_ms"]
+            done = tb or trb

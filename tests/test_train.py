@@ -1,0 +1,58 @@
+"""Training on the batched environment: Stable-Baselines3 PPO learns ReachLight (slow), and the
+evolution strategy on Ray actors computes exactly what the same workers compute in-process."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("gymnasium")
+
+
+def test_ppo_on_the_batched_env_reaches_the_lamp():
+    """README "Training and sweeps": PPO, 16 copies, 150k env steps (about a minute and a half
+    here); the last rollouts' episodes end at the lamp (ReachLight terminates only on arrival)."""
+    pytest.importorskip("stable_baselines3")
+    pytest.importorskip("torch")
+    from sensorium.gym.examples.train_ppo import train
+
+    curve = train(steps=150_000, envs=16, seed=0, log=lambda _line: None)
+    assert curve["reached"][0] == 0.0                          # it starts knowing nothing
+    assert np.mean(curve["reached"][-3:]) >= 0.8, curve["reached"]
+    assert curve["return"][-1] > curve["return"][0] + 30
+
+
+def test_sb3_adapter_passes_sb3s_checker_and_hands_over_terminal_observations():
+    pytest.importorskip("stable_baselines3")
+    from stable_baselines3.common.env_checker import check_env
+
+    from sensorium.gym.sb3 import SB3VecEnv
+    from sensorium.gym.tasks import reach_light_task
+
+    check_env(SB3VecEnv(reach_light_task(), 2, seed=0).venv.sub_env(0), warn=True)
+    venv = SB3VecEnv(reach_light_task(max_steps=3), 2, seed=1)
+    obs = venv.reset()
+    assert obs.shape == (2, 10) and obs.dtype == np.float32
+    for _ in range(3):
+        venv.step_async(np.zeros((2, 2), dtype=np.float32))
+        obs, rewards, dones, infos = venv.step_wait()
+    assert dones.all()
+    for info in infos:
+        assert info["TimeLimit.truncated"] and info["terminal_observation"].shape == (10,)
+        assert info["episode"]["l"] == 3 and not info["episode"]["reached"]
+
+
+def test_evolution_strategy_on_ray_actors_equals_the_same_workers_in_process():
+    """Two Ray actors (Ray bound to 127.0.0.1), each holding a batched env of 4 copies, feed the
+    learner; the parameters and every return equal those of the same workers run in this process."""
+    pytest.importorskip("ray")
+    from sensorium.gym.ray_train import train_es
+
+    kw = dict(task="reach_light", workers=2, copies=4, iterations=2, max_steps=15, seed=3)
+    remote = train_es(**kw, use_ray=True)
+    local = train_es(**kw, use_ray=False)
+    assert remote["theta"].tobytes() == local["theta"].tobytes()
+    for a, b in zip(remote["curve"], local["curve"]):
+        assert (a["mean_return"], a["best_return"], a["env_steps"]) == (b["mean_return"], b["best_return"], b["env_steps"])
+    assert np.count_nonzero(remote["theta"]) > 0               # the learner moved
+    assert remote["curve"][0]["env_steps"] == 2 * 4 * 15       # every copy ran one 15-step episode
