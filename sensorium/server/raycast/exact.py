@@ -213,7 +213,8 @@ def _analytic_one(code: int, p, d, r: float, h: float, lo: float, hi: float):
         a = dx * dx + dy * dy
         x = px * dy - py * dx
         for t in _roots_one(a, px * dx + py * dy, px * px + py * py - r * r, a * r * r - x * x):
-            cands.append(t if abs(pz + t * dz) <= h + tol else _INF)
+            # no root (inf): no candidate, decided before inf * dz (0 for a ray parallel to the caps)
+            cands.append(t if t < _INF and abs(pz + t * dz) <= h + tol else _INF)
         if code == _CYLINDER:
             for zc in (h * 1.0, h * -1.0):
                 t = (zc - pz) / dz if dz != 0.0 else _INF
@@ -229,7 +230,7 @@ def _analytic_one(code: int, p, d, r: float, h: float, lo: float, hi: float):
                 a3 = dx * dx + dy * dy + dz * dz
                 for t in _roots_one(a3, px * dx + py * dy + qz * dz, px * px + py * py + qz * qz - r * r,
                                     a3 * r * r - (cx * cx + cy * cy + cz * cz)):
-                    cands.append(t if sign * (pz + t * dz) >= h - tol else _INF)
+                    cands.append(t if t < _INF and sign * (pz + t * dz) >= h - tol else _INF)
     best, k = _INF, -1
     for j, t in enumerate(cands):   # first of equal candidates, like argmin
         if lo <= t <= hi and t < best:
