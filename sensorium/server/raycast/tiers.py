@@ -12,6 +12,8 @@ from embreex.mesh_construction import TriangleMesh as _TriangleMesh
 
 from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
 from sensorium.server.raycast.guards import (
+    MAX_CANDIDATES_BASE,
+    MAX_CANDIDATES_PER_FLAT_TRIANGLE,
     MAX_EDGES_PER_FLAT_TRIANGLE,
     MAX_GUARDED_EDGES,
     MAX_WIDTH_PER_EDGE_LENGTH,
@@ -34,7 +36,15 @@ class _Tier:
     def __init__(self, device, items: list[tuple[int, Primitive, Pose]], owner_of: np.ndarray):
         verts, faces, tri_shape, curved = [], [], [], []
         nv = 0
+        seen = set()
         for sid, prim, pose in items:
+            # the same shape of the same owner again at the same pose adds nothing a ray could hit
+            # first (k pasted copies of a world's solids: the tier, its guards and its refinement
+            # would grow k-fold or worse); the first copy is the one hit
+            key = (prim, pose.rotation.tobytes(), pose.translation.tobytes(), int(owner_of[sid]))
+            if key in seen:
+                continue
+            seen.add(key)
             v, f = tessellate(prim)
             if len(f) == 0:
                 continue
@@ -254,9 +264,13 @@ class _Tier:
                         self.V[edges[:, 0]] - self.V[edges[:, 1]], axis=1))):
                 self._guard = (None, len(edges) == 0)
             else:
-                pv, pf = prisms(self.V, edges, w)
-                cand_ptr, cand = candidates(self.V, edges, ptr, idx, self.ring, flat, w)
-                self._guard = (edges, cand_ptr, cand, np.ascontiguousarray(pv, dtype=_F32), pf)
+                found = candidates(self.V, edges, ptr, idx, self.ring, flat, w,
+                                   MAX_CANDIDATES_PER_FLAT_TRIANGLE * n_flat + MAX_CANDIDATES_BASE)
+                if found is None:   # coincident copies of the same edges: the offset copy instead
+                    self._guard = (None, False)
+                else:
+                    pv, pf = prisms(self.V, edges, w)
+                    self._guard = (edges, *found, np.ascontiguousarray(pv, dtype=_F32), pf)
         return None if self._guard[0] is None else self._guard
 
     def bare_scene(self):
