@@ -90,10 +90,12 @@ Known limits (measure-zero in practice)
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 
 import numpy as np
 
+from sensorium.server.raycast.blocks import available, run, split
 from sensorium.server.raycast.exact import (
     _CHUNK,
     _DENSE_PAIRS,
@@ -103,12 +105,13 @@ from sensorium.server.raycast.exact import (
     _SMALL,
     _TINY,
     _best_per_row,
+    _from_frame,
     _full,
-    _mat,
     _minus,
     _param,
     _strictly_increasing,
     _take,
+    _to_frame,
 )
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind, ShapeEntry
 from sensorium.server.raycast.movers import (
@@ -160,6 +163,8 @@ class RayEngine(TierTracer):
         self._mover_tables: dict[str, _Movers | None] = {}
         self._shared: dict[tuple, _Tier | None] = {}   # body-frame tiers by (variant, shapes)
         self._epoch = 0                                 # bumped by every set_body_pose
+        self.threads = available()   # threads a large cast may use (see .blocks; 1: the calling thread only)
+        self._counting = threading.Lock()
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
             "continued_rays": 0, "unresolved_rays": 0, "edge_guard_hits": 0, "neighbour_lists": 0, "ray_lists": 0,
@@ -362,24 +367,46 @@ class RayEngine(TierTracer):
         # one errstate for the whole cast: inf/NaN are handled explicitly (entering the context
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            if n <= _CHUNK:
+            threads = self.threads
+            parts = split(n, threads, _CHUNK)
+            if len(parts) == 1:
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
                                   directions32)
-            # large batches in chunks: the temporaries (~150 bytes per ray) stay a few MB whatever
-            # the batch, and so in cache; every ray's answer is the same (big is the batch's)
+            # large batches in blocks: the temporaries (~150 bytes per ray) stay a few MB whatever the
+            # batch, and the blocks of the planes and the static tier run side by side on the
+            # threads; then the movers, on the whole batch (a Mount keeps its lists for it) or in
+            # blocks; every ray's answer is the same (big is the batch's)
+            exact = self._precision is Precision.EXACT
+            if planes is not None:
+                planes.refresh(self._epoch)
+            if static is not None:
+                static.prepare(exact)
             dist = np.empty(n)
             normal = None if distance_only else np.empty((n, 3))
             shape = None if distance_only else np.empty(n, dtype=np.int64)
-            for a in range(0, n, _CHUNK):
-                sl = slice(a, min(n, a + _CHUNK))
-                m = sl.stop - a
-                h = self._cast(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
-                               _param(_take(t_far, sl), m, np.float64, float), _param(_take(excl, sl), m, np.int64, int),
-                               planes, static, movers, big, None if mount is None else np.asarray(mount)[sl],
-                               distance_only, None if directions32 is None else directions32[sl])
-                dist[sl] = h.distance
+
+            def block(sl: slice) -> None:
+                m = sl.stop - sl.start
+                with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # per thread
+                    h = self._cast_static(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
+                                          _param(_take(t_far, sl), m, np.float64, float),
+                                          _param(_take(excl, sl), m, np.int64, int), planes, static, big,
+                                          distance_only, None if directions32 is None else directions32[sl])
+                dist[sl] = h[0]
                 if not distance_only:
-                    normal[sl], shape[sl] = h.normal, h.shape
+                    shape[sl], normal[sl] = h[1], h[2]
+
+            run(block, parts, threads)
+            if movers is not None:
+                hits = (dist, shape, normal)
+                if isinstance(mount, Mount):
+                    self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits,
+                                      mount=mount)
+                else:
+                    for sl in split(n, 1, _CHUNK):
+                        self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
+                                          1e-9 + 1e-14 * big, exact, *(None if x is None else x[sl] for x in hits),
+                                          mount=None if mount is None else np.asarray(mount)[sl])
             return RayHits(dist, normal, shape)
 
     def cast_local(self, body: int, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
@@ -415,6 +442,16 @@ class RayEngine(TierTracer):
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
               distance_only: bool = False, d32=None) -> RayHits:
+        exact = self._precision is Precision.EXACT
+        hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32)
+        if movers is not None:
+            self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits, mount=mount)
+        return RayHits(hits[0], hits[2], hits[1])
+
+    def _cast_static(self, O, D, t_near, t_far, excl, planes, static, big: float, distance_only: bool = False,
+                     d32=None) -> tuple:
+        """(dist, shape, normal) of the planes and the static tier (shape, normal None when
+        ``distance_only``): the part of a cast that blocks of rays run side by side."""
         n = len(O)
         exact = self._precision is Precision.EXACT
         eps64 = 1e-9 + 1e-14 * big  # float64 self-hit epsilon: 1e-9 m + ~50 ulps of the largest coordinate
@@ -435,9 +472,7 @@ class RayEngine(TierTracer):
         if hits is None:
             hits = ((np.full(n, _INF), None, None) if distance_only else
                     (np.full(n, _INF), np.full(n, -1, dtype=np.int64), np.zeros((n, 3))))
-        if movers is not None:
-            self._cast_movers(movers, O, D, t_near, t_far, excl, eps64, exact, *hits, mount=mount)
-        return RayHits(hits[0], hits[2], hits[1])
+        return hits
 
     def _cast_movers(self, mt: _Movers, O, D, t_near, t_far, excl, eps64, exact, dist, shape, normal,
                      mount=None) -> None:
@@ -520,7 +555,7 @@ class RayEngine(TierTracer):
                 Or, Dr = np.take(O, rr, axis=0), np.take(D, rr, axis=0)
             if one:
                 Rb, Tb = R[mm[0]], T[mm[0]]
-                Ob, Db = _mat(_minus(Or, Tb), Rb), _mat(Dr, Rb)
+                Ob, Db = _to_frame(_minus(Or, Tb), Rb), _to_frame(Dr, Rb)
             else:
                 Rg = np.take(R, mm, axis=0)
                 Ob = np.einsum("nij,ni->nj", Rg, Or - np.take(T, mm, axis=0))
@@ -548,4 +583,4 @@ class RayEngine(TierTracer):
             if shape is not None:
                 shape[rows] = mt.first[mw] + s[win]
                 nb = nb[win]
-                normal[rows] = _mat(nb, Rb.T) if one else np.einsum("nij,nj->ni", R[mw], nb)
+                normal[rows] = _from_frame(nb, Rb) if one else np.einsum("nij,nj->ni", R[mw], nb)

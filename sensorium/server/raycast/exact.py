@@ -81,6 +81,36 @@ def _mat(x: np.ndarray, M: np.ndarray) -> np.ndarray:
     return out
 
 
+def _to_frame(x: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """``x @ R`` for (n,3) rows and one rotation (world to a shape's or body's frame), each row
+    summed as (x0 R[0] + x1 R[1]) + x2 R[2]: the bits of ``einsum("nij,ni->nj")`` (rows with
+    several rotations) and of the scalar twins, whatever n. A BLAS product rounds differently
+    (fused multiply-adds), so a ray's answer would depend on whether the other rays of its batch
+    met the same shape; in blocks of rows for large n (contiguous columns, no BLAS threads)."""
+    n = len(x)
+    if n <= _SMALL:
+        return (x[:, 0:1] * R[0] + x[:, 1:2] * R[1]) + x[:, 2:3] * R[2]
+    out = np.empty((n, 3))
+    tmp = np.empty(min(n, _MATMUL_ROWS))
+    for a in range(0, n, _MATMUL_ROWS):
+        b = min(n, a + _MATMUL_ROWS)
+        t, x0, x1, x2 = tmp[:b - a], x[a:b, 0], x[a:b, 1], x[a:b, 2]
+        for j in range(3):
+            col = out[a:b, j]
+            np.multiply(x0, R[0, j], out=col)
+            np.multiply(x1, R[1, j], out=t)
+            col += t
+            np.multiply(x2, R[2, j], out=t)
+            col += t
+    return out
+
+
+def _from_frame(x: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """``x @ R.T`` (a shape's or body's frame back to the world), each row summed as
+    (x0 R[:,0] + x2 R[:,2]) + x1 R[:,1]: the bits of ``einsum("nij,nj->ni")``, whatever n."""
+    return (x[:, 0:1] * R[:, 0] + x[:, 2:3] * R[:, 2]) + x[:, 1:2] * R[:, 1]
+
+
 def _ulp32(x: float) -> float:
     return float(np.spacing(_F32(max(abs(x), 1e-30))))
 

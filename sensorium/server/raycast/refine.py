@@ -4,6 +4,8 @@ starting inside a curved shell.  A mixin of :class:`RayEngine` (via :class:`.tra
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from sensorium.server.raycast.exact import (
@@ -21,12 +23,13 @@ from sensorium.server.raycast.exact import (
     _analytic_one,
     _best_per_row,
     _dot,
+    _from_frame,
     _full,
-    _mat,
     _minus,
     _moller_trumbore,
     _strictly_increasing,
     _take,
+    _to_frame,
 )
 from sensorium.server.raycast.guards import PRISM_TRIANGLES
 from sensorium.server.raycast.tiers import _Tier
@@ -36,6 +39,12 @@ class Refiner:
     """Refinement methods of :class:`~sensorium.server.raycast.engine.RayEngine`."""
 
     counters: dict[str, int]
+    _counting: threading.Lock
+
+    def _count(self, key: str, n: int) -> None:
+        """counters[key] += n (blocks of a cast may run on several threads)."""
+        with self._counting:
+            self.counters[key] += n
 
     def _refine_triangles(self, tier: _Tier, Ot, D, tri, lo, hi):
         """Float64 hit of the ORIGINAL rays on triangle ``tri`` or, failing that, on the triangles
@@ -78,7 +87,7 @@ class Refiner:
         fg = far[g]
         s = res["tfar"][g].astype(np.float64)   # the first guard, from the segment start
         d32g = d32[g]
-        self.counters["embree_calls"] += 1
+        self._count("embree_calls", 1)
         r0 = tier.bare_scene().run(o32[g], d32g, np.where(fg >= 0.0, fg, -1.0).astype(_F32), output=1)
         w = 4.0 * tier.eps
         stop = np.minimum(fg, np.where(r0["primID"] >= 0, r0["tfar"].astype(np.float64) + 4.0 * w, _INF))
@@ -96,7 +105,7 @@ class Refiner:
                 return
             r = rows[sub]
             o = (Ot[r] + (sa[g[sub]] + s)[:, None] * D[r]).astype(_F32)
-            self.counters["embree_calls"] += 1
+            self._count("embree_calls", 1)
             r1 = scene.run(o, d32g[sub], f.astype(_F32), output=1)
             met = (r1["primID"] >= 0).nonzero()[0]
             sub, s = sub[met], s[met] + r1["tfar"][met]
@@ -104,7 +113,7 @@ class Refiner:
             if len(more):
                 self._guard_hits(tier, Ot, D, rows[sub[more]], r1["primID"][met[more]], lo, lim, excl,
                                  best_t, best_s, best_n)
-        self.counters["unresolved_rays"] += len(sub)
+        self._count("unresolved_rays", len(sub))
 
     def _guard_hits(self, tier: _Tier, Ot, D, rows, gprim, lo, hi, excl, best_t, best_s, best_n):
         """The second look of EXACT (see :mod:`.guards`): rays ``rows`` met the guards (prism triangles
@@ -132,7 +141,7 @@ class Refiner:
         nrm[_dot(nrm, D[ray]) > 0.0] *= -1.0
         best_t[ray], best_s[ray], best_n[ray] = t, tier.tri_shape[cand], nrm
         hi[ray] = t
-        self.counters["edge_guard_hits"] += len(ray)
+        self._count("edge_guard_hits", len(ray))
 
     def _flat_dense(self, tier: _Tier, res, prim, Ot, D, one_origin: bool, lo, lim, t_e, d_max: float,
                     best_t, best_s, best_n, distance_only: bool):
@@ -228,10 +237,10 @@ class Refiner:
         if n and not np.count_nonzero(slots != slots[0]):   # one shape: one matrix
             s0 = int(slots[0])
             R = tier.c_rot[s0]
-            p = _mat(_minus(Ot, tier.c_pos[s0]), R)   # R^T (o - c)
-            d = _mat(D, R)
+            p = _to_frame(_minus(Ot, tier.c_pos[s0]), R)   # R^T (o - c)
+            d = _to_frame(D, R)
             t, n_loc = _analytic_local(int(tier.c_code[s0]), p, d, tier.c_r[s0], tier.c_h[s0], lo, hi, normals)
-            return t, (None if n_loc is None else _mat(n_loc, R.T))
+            return t, (None if n_loc is None else _from_frame(n_loc, R))
         R = tier.c_rot[slots]
         p = np.einsum("nij,ni->nj", R, Ot - tier.c_pos[slots])  # R^T (o - c)
         d = np.einsum("nij,ni->nj", R, D)
@@ -335,7 +344,7 @@ class Refiner:
         p = _minus(S, tier.c_pos[k])
         if tier.c_code[k] == _SPHERE:
             return _dot(p, p) <= tier.c_bound2[k]
-        p = _mat(p, tier.c_rot[k])
+        p = _to_frame(p, tier.c_rot[k])
         return (p[:, 0] * p[:, 0] + p[:, 1] * p[:, 1] <= tier.c_rad2[k]) & (np.abs(p[:, 2]) <= tier.c_ax[k])
 
     def _prepass_scalar(self, tier: _Tier, pairs, S, Ot, D, lo, lim, excl):
@@ -364,7 +373,8 @@ class Refiner:
                 (dx * r0 + dy * r3 + dz * r6, dx * r1 + dy * r4 + dz * r7, dx * r2 + dy * r5 + dz * r8),
                 r, h, lo if lo_l is None else float(lo_l[i]), lim if lim_l is None else float(lim_l[i]))
             if t < _INF and (i not in found or t < found[i][0]):
-                n = (r0 * nx + r1 * ny + r2 * nz, r3 * nx + r4 * ny + r5 * nz, r6 * nx + r7 * ny + r8 * nz)
+                # R n, summed (0 + 2) + 1 as einsum("nij,nj->ni") does for the vectorised pre-pass
+                n = (r0 * nx + r2 * nz + r1 * ny, r3 * nx + r5 * nz + r4 * ny, r6 * nx + r8 * nz + r7 * ny)
                 if n[0] * dx + n[1] * dy + n[2] * dz > 0.0:   # toward the origin
                     n = (-n[0], -n[1], -n[2])
                 found[i] = (t, sid, n)

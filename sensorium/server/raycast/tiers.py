@@ -1,6 +1,8 @@
 """Tiers: one Embree scene of a set of shapes and the float64 data that refines its hits.
 
-The only module of the engine that imports embreex.
+The engine's Embree scenes are made here: through the packet path (:mod:`.packets`) when it is
+available, else through embreex (the only other embreex importer is :mod:`.packets`, to find the
+library embreex loaded).
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ from embreex import rtcore as _rtc
 from embreex import rtcore_scene as _rts
 from embreex.mesh_construction import TriangleMesh as _TriangleMesh
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
 from sensorium.server.raycast.guards import (
     MAX_CANDIDATES_BASE,
@@ -25,7 +28,9 @@ from sensorium.server.world.geometry import Capsule, Cylinder, Mesh, Pose, Primi
 
 
 def new_device():
-    """A fresh Embree device (one per engine)."""
+    """A fresh Embree device (one per engine): the packet path's when it is available."""
+    if packets.library() is not None:
+        return packets.Device()
     return _rtc.EmbreeDevice()
 
 
@@ -227,19 +232,37 @@ class _Tier:
         leave = np.minimum(np.minimum(np.minimum(far[:, 0], far[:, 1]), far[:, 2]), hi)
         return enter <= leave
 
+    def prepare(self, exact: bool) -> None:
+        """Make now what casts make on first use (the scene of the mode and, for EXACT, the float64
+        data, guards and vertex rings), so that blocks of rays on several threads only read."""
+        self.scene(exact)
+        if exact:
+            self._exact_data()
+            _ = self.ring
+            if self.guard is not None:
+                self.bare_scene()
+
     def scene(self, robust: bool):
         """(Embree scene, built now?).  FAST uses a plain scene, EXACT a robust one (watertight
         traversal, ~40% slower in a room where every ray hits); each is built on first use."""
         sc = self._scenes.get(robust)
         if sc is not None:
             return sc, False
+        guard = self.guard if robust else None   # geometry 1 of the EXACT scene: the edge guards
+        if isinstance(self._device, packets.Device):
+            sc = packets.Scene(self._device, robust, self._v32, self._f32,
+                               *((guard[3], guard[4]) if guard is not None else ()))
+            if guard is not None:   # and the same without guards (for the rays that meet one)
+                self._scenes["bare"] = packets.Scene(self._device, True, self._v32, self._f32)
+            self._scenes[robust] = sc
+            return sc, True
         sc = _rts.EmbreeScene(self._device, robust=robust)
         _TriangleMesh(sc, self._v32, self._f32)
-        if robust and self.guard is not None:   # geometry 1 of the EXACT scene: the edge guards
-            _TriangleMesh(sc, self.guard[3], self.guard[4])
+        if guard is not None:
+            _TriangleMesh(sc, guard[3], guard[4])
         sc.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))  # commit now: this is the build
         self._scenes[robust] = sc
-        if robust and self.guard is not None:   # and the same without guards (for the rays that meet one)
+        if guard is not None:
             bare = _rts.EmbreeScene(self._device, robust=True)
             _TriangleMesh(bare, self._v32, self._f32)
             bare.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import (
     _BARY_TOL,
     _F32,
@@ -29,10 +30,14 @@ class TierTracer(Refiner):
 
     counters: dict[str, int]
 
-    def _run(self, tier: _Tier, o32, d32, far, robust: bool):
+    def _run(self, tier: _Tier, o32, d32, far, robust: bool, coherent: bool = False):
+        """One Embree call; ``coherent``: rays from one origin (a lidar), traced as coherent packets
+        where the packet path is on."""
         scene, built = tier.scene(robust)
-        self.counters["bvh_builds"] += built
-        self.counters["embree_calls"] += 1
+        self._count("bvh_builds", built)
+        self._count("embree_calls", 1)
+        if coherent and isinstance(scene, packets.Scene):
+            return scene.run(o32, d32, far, output=1, coherent=True)
         return scene.run(o32, d32, far, output=1)
 
     def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
@@ -124,7 +129,7 @@ class TierTracer(Refiner):
                 far = None
             else:
                 far = float(far)
-        res = self._run(tier, o32, d32, far, robust=False)
+        res = self._run(tier, o32, d32, far, robust=False, coherent=one)
         prim = res["primID"]
         hit = prim >= 0
         n_hit = np.count_nonzero(hit)
@@ -326,7 +331,7 @@ class TierTracer(Refiner):
             far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)
             far32 = np.where(far >= 0.0, far, -1.0).astype(_F32)
             copy = exact and not tier.guarded
-            res = self._run(tier, o32, d32, far32.copy() if copy else far32, robust=exact)
+            res = self._run(tier, o32, d32, far32.copy() if copy else far32, robust=exact, coherent=one_origin)
             prim, tf = res["primID"].astype(np.int64), res["tfar"]
             repaired = fixed = None
             if exact and not copy:
@@ -351,7 +356,7 @@ class TierTracer(Refiner):
                         prim[fixed[0]] = tri2[fix]
                         repaired = np.zeros(len(prim), dtype=bool)   # Embree's barycentrics no longer apply
                         repaired[fixed[0]] = True
-                        self.counters["leak_repairs"] += len(fixed[0])
+                        self._count("leak_repairs", len(fixed[0]))
             h = (prim >= 0).nonzero()[0]
             if len(h) == 0:  # nothing hit: every active ray is done
                 break
@@ -485,7 +490,7 @@ class TierTracer(Refiner):
             delta[rows] = np.where(stuck, delta[rows] * 4.0, eps)
             seg[rows] = np.maximum(te, seg[rows]) + delta[rows]
             act = rows[seg[rows] <= lim[rows] + eps]
-            self.counters["continued_rays"] += int(len(rows))
+            self._count("continued_rays", int(len(rows)))
         else:
-            self.counters["unresolved_rays"] += int(len(act))
+            self._count("unresolved_rays", int(len(act)))
         return best_t, best_s, best_n
