@@ -124,6 +124,8 @@ from sensorium.server.raycast.movers import (
     _sphere_pairs,
     mount_candidates,
     mount_state,
+    one_origin_pairs,
+    with_own_pairs,
 )
 from sensorium.server.raycast.planes import _Planes, cast_planes
 from sensorium.server.raycast.tiers import _Tier, new_device
@@ -488,17 +490,26 @@ class RayEngine(TierTracer):
         T, C = mt.T, mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = None
+        tight = -1   # a mover row whose pairs are only a Mount's own pairs (already tested against its bound)
         if mount is not None:
             if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
                 mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
                 mt.row_of[mt.index] = np.arange(len(mt.index))
-            st = mount_state(mount, mt, C, O, t_near, t_far) if isinstance(mount, Mount) else None
-            if st is None:
+            kept = isinstance(mount, Mount)
+            st = mount_state(mount, mt, C, O, t_near, t_far, D, self._rot) if kept else None
+            if st is None and kept and mount.own is not None:
+                pass   # unbounded rays that see their own mount: the general broad phase for all
+            elif st is None:
                 mrow = mt.row_of[np.asarray(mount)]
                 mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+            elif len(st.mi) and O.strides[0] == 0 and len(st.used) == 1 and not len(st.rest):   # a lidar
+                mrow = st.mrow
+                tight = int(st.used[0])
+                mounted = (*one_origin_pairs(st, mt, C, O, D, t_near, lim, excl, owner, self._epoch, self.counters),
+                           st.rest)
             elif len(st.mi):   # candidates kept between casts; the segment test as _mounted_pairs does it
                 mrow = st.mrow
-                cr, cm = mount_candidates(st, mt, C, self._rot, O, D, self._epoch, self.counters)
+                cr, cm = with_own_pairs(st, *mount_candidates(st, mt, C, self._rot, O, D, self._epoch, self.counters))
                 mounted = (*_near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, cr, cm), st.rest)
         if mounted is not None and len(mounted[2]) == 0:   # every ray mounted
             pr, pm = mounted[0], mounted[1]
@@ -547,26 +558,33 @@ class RayEngine(TierTracer):
                 gp = mt.group[pm]
                 todo = [(tier, pr[sel], pm[sel], False)
                         for g, tier in enumerate(mt.tiers) if len(sel := (gp == g).nonzero()[0])]
+        one_origin = O.strides[0] == 0   # one origin for all rays (a lidar): it stays one, in every frame
         for tier, rr, mm, one in todo:
             # rays into the body frames (float64): one matrix when all pairs share a mover
             if one and len(rr) == n:   # one mover, every ray (its pairs are then 0..n-1 in order)
                 Or, Dr = O, D
             else:
-                Or, Dr = np.take(O, rr, axis=0), np.take(D, rr, axis=0)
+                Or = np.broadcast_to(O[:1], (len(rr), 3)) if one_origin else np.take(O, rr, axis=0)
+                Dr = np.take(D, rr, axis=0)
             if one:
                 Rb, Tb = R[mm[0]], T[mm[0]]
-                Ob, Db = _to_frame(_minus(Or, Tb), Rb), _to_frame(Dr, Rb)
+                Ob = (np.broadcast_to(_to_frame(_minus(O[:1], Tb), Rb), Or.shape) if one_origin
+                      else _to_frame(_minus(Or, Tb), Rb))
+                Db = _to_frame(Dr, Rb)
             else:
                 Rg = np.take(R, mm, axis=0)
                 Ob = np.einsum("nij,ni->nj", Rg, Or - np.take(T, mm, axis=0))
                 Db = np.einsum("nij,ni->nj", Rg, Dr)
             lim_r = lim[rr]
-            if len(rr) >= _PRUNE:  # many pairs (many movers): drop those missing the tier's tight bound
+            # many pairs (many movers): drop those missing the tier's tight bound (a Mount's own
+            # pairs passed that test when they were listed)
+            if len(rr) >= _PRUNE and not (one and int(mm[0]) == tight):
                 keep = tier.may_hit(Ob, Db, _take(t_near, rr), lim_r).nonzero()[0]
                 if len(keep) < len(rr):
                     if len(keep) == 0:
                         continue
-                    rr, mm, Ob, Db, lim_r = rr[keep], mm[keep], Ob[keep], Db[keep], lim_r[keep]
+                    Ob = np.broadcast_to(Ob[:1], (len(keep), 3)) if Ob.strides[0] == 0 else Ob[keep]
+                    rr, mm, Db, lim_r = rr[keep], mm[keep], Db[keep], lim_r[keep]
             res = self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact, None, shape is None)
             if res is None:
                 continue

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _take
+from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _minus, _take, _to_frame
 from sensorium.server.world.geometry import Pose
 
 
@@ -70,7 +70,7 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
         if owner is not None:
             sel &= owner != (excl[:, None] if isinstance(excl, np.ndarray) else excl)
         return sel.nonzero()
-    shared = not np.count_nonzero(O != O[0])   # one origin (a lidar): rel = C - o is per mover
+    shared = O.strides[0] == 0 or not np.count_nonzero(O != O[0])   # one origin (a lidar): rel = C - o is per mover
     if not shared:
         ox, oy, oz, dx, dy, dz = (np.ascontiguousarray(a[:, k]) for a in (O, D) for k in range(3))
     prs, pms = [], []
@@ -301,14 +301,22 @@ class Mount:
     by more than a margin in the body's frame).  Per cast only the segment test of the listed
     (ray, mover) candidates remains; rays of bodies with no neighbour cost nothing.  The caller
     promises that the rays are those of the first cast (same mounts, local origins and unit
-    directions), moved with their bodies."""
+    directions), moved with their bodies.
 
-    __slots__ = ("bodies", "lo", "hi", "_state")
+    ``own``: rays (True for all, or a per-ray mask) that also see their own mount body (a lidar sees
+    its robot; a distance sensor's own-body hits are decided by the caller instead, see
+    :meth:`RayEngine.cast`): which of them can reach it is decided once, in the body frame, and
+    only those are tested against it per cast, with the same arithmetic as rays that are not
+    mounted (the same bits)."""
 
-    def __init__(self, bodies) -> None:
+    __slots__ = ("bodies", "lo", "hi", "own", "_state")
+
+    def __init__(self, bodies, own=False) -> None:
         self.bodies = np.array(bodies, dtype=np.int64).reshape(-1)
         self.bodies.setflags(write=False)
         self.lo, self.hi = (int(self.bodies.min()), int(self.bodies.max())) if len(self.bodies) else (-1, -1)
+        mask = np.broadcast_to(np.asarray(own, dtype=bool), self.bodies.shape)
+        self.own: np.ndarray | None = np.array(mask) if mask.any() else None
         self._state: _MountState | None = None
 
     def __len__(self) -> int:
@@ -350,11 +358,17 @@ class _MountState:
     body_ptr: np.ndarray | None = None
     pr: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # candidates: rays
     pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # and movers
+    own_pr: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # rays that can reach
+    own_pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # their own mount
+    merged: tuple = ()    # (pr, pm, candidates with the own pairs) of the last merge
+    own_ahead: bool | None = None   # own pairs tested for t >= 0 only (kept while t_near >= 0)
 
 
-def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near, t_far) -> _MountState | None:
+def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near, t_far, D: np.ndarray | None = None,
+                rot: np.ndarray | None = None) -> _MountState | None:
     """The Mount's state for this mover table (made on first use, with the rays' current world
-    origins), or None when a mounted ray is unbounded (the caller then takes the per-cast path).
+    origins; ``D`` and the engine's body rotations ``rot`` are needed when some rays see their own
+    mount), or None when a mounted ray is unbounded (the caller then takes the per-cast path).
     The state is kept while every mounted ray's segment is no longer than when it was made (its
     reaches still bound every segment; other limits, e.g. light rays cast in the same batch, do not
     matter)."""
@@ -363,7 +377,8 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
         if (st.limits is not None and not isinstance(t_near, np.ndarray) and not isinstance(t_far, np.ndarray)
                 and st.limits == (t_near, t_far)):   # scalars, as when made
             return st
-        if np.all(np.maximum(_take(t_far, st.mi), -_take(t_near, st.mi)) <= st.span):
+        if np.all(np.maximum(_take(t_far, st.mi), -_take(t_near, st.mi)) <= st.span) and \
+                (not st.own_ahead or np.all(_take(t_near, st.mi) >= 0.0)):
             return st
     mrow = mt.row_of[mount.bodies]
     mounted = mrow >= 0
@@ -389,8 +404,77 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
     st.reach_row[used] = reach
     st.skin_r = 2.0 * skin
     st.shift_r = st.skin_r / 1.7320508075688772 * (1.0 - 1e-6)
+    if mount.own is not None and D is not None and rot is not None:
+        # segments that start at or beyond their origin (t_near >= 0: a lidar) are tested ahead of
+        # it only, and the list is kept only while they do
+        st.own_ahead = bool(np.all(_take(t_near, mi) >= 0.0)) if len(mi) else False
+        _own_pairs(st, mount.own, mt, O, D, rot, span, st.own_ahead)
     mount._state = st
     return st
+
+
+def _own_pairs(st: _MountState, own: np.ndarray, mt: _Movers, O: np.ndarray, D: np.ndarray, rot: np.ndarray,
+               span: np.ndarray, ahead: bool) -> None:
+    """The (ray, own mount) pairs of the mounted rays that see their own body and whose segment can
+    reach its tier's tight bound: tested in the body frame, where a rigidly mounted ray never moves
+    (its coordinates change only by rounding there, far below the bound's slack, which is grown
+    further by the rounding of the world coordinates), for t in [0, span] (``ahead``), else
+    [-span, span]."""
+    sel = own[st.mi].nonzero()[0]
+    if len(sel) == 0:
+        return
+    rays, rows = st.mi[sel], st.rows[sel]
+    grow = 1e-9 + 1e-12 * (float(np.abs(O[:1] if O.strides[0] == 0 else O).max()) + float(np.abs(mt.T).max()))
+    prs, pms = [], []
+    for row in np.unique(rows).tolist():
+        k = (rows == row).nonzero()[0]
+        r = rays[k]
+        Rb, Tb = rot[mt.index[row]], mt.T[row]
+        Ob = _to_frame(_minus(np.take(O, r, axis=0), Tb), Rb)
+        Db = _to_frame(np.take(D, r, axis=0), Rb)
+        sp = span[sel[k]]
+        reach = mt.tiers[mt.group[row]].may_hit(Ob, Db, 0.0 if ahead else -sp, sp, grow).nonzero()[0]
+        prs.append(r[reach])
+        pms.append(np.full(len(reach), row, dtype=np.int64))
+    pr, pm = np.concatenate(prs), np.concatenate(pms)
+    order = np.argsort(pr, kind="stable")
+    st.own_pr, st.own_pm = pr[order], pm[order]
+
+
+def one_origin_pairs(st: _MountState, mt: _Movers, C: np.ndarray, O: np.ndarray, D: np.ndarray, t_near, lim,
+                     excl, owner, epoch: int, counters: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
+    """(ray, mover) candidates of a batch from one origin mounted on one body (a lidar): its
+    own-mount pairs (decided once) and, per neighbouring mover of the body list (kept as for any
+    Mount), the rays whose segment passes within that mover's bounding sphere, tested for all rays
+    with one matrix-vector product per neighbour. No ray lists: a lidar's beams fan out in every
+    direction, so a list would hold most of them and cost more to keep than this test."""
+    if st.epoch != epoch:
+        st.epoch = epoch
+        if st.C_ref is None or len(C) != len(st.C_ref) or float(np.abs(C - st.C_ref).max()) > st.shift:
+            _body_list(st, mt, C, counters)
+    nb = st.dst
+    if len(nb):
+        pr, pm = _sphere_pairs(np.take(C, nb, axis=0), mt.r2[nb], None if owner is None else owner[nb], O, D,
+                               t_near, lim, excl)
+        pm = nb[pm]
+    else:
+        pr = pm = np.zeros(0, dtype=np.int64)
+    if len(st.own_pr):   # pairs of one mover stay in ray order; groups of movers in any order
+        pr, pm = np.concatenate([st.own_pr, pr]), np.concatenate([st.own_pm, pm])
+    return pr, pm
+
+
+def with_own_pairs(st: _MountState, pr: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The candidates ``pr``, ``pm`` (ray order) with the own-mount pairs merged in, in ray order
+    (then mover row); kept while the candidates are the same arrays."""
+    if not len(st.own_pr):
+        return pr, pm
+    if st.merged and st.merged[0] is pr and st.merged[1] is pm:
+        return st.merged[2], st.merged[3]
+    r, m = np.concatenate([pr, st.own_pr]), np.concatenate([pm, st.own_pm])
+    order = np.lexsort((m, r))
+    st.merged = (pr, pm, r[order], m[order])
+    return st.merged[2], st.merged[3]
 
 
 def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, rot: np.ndarray, O: np.ndarray, D: np.ndarray,

@@ -206,15 +206,17 @@ class _Tier:
         """v0 of the given triangles, without the full refinement data (FAST's self-hit test)."""
         return self.V[self.F[tri, 0]]
 
-    def may_hit(self, O, D, lo, hi) -> np.ndarray:
+    def may_hit(self, O, D, lo, hi, grow: float = 0.0) -> np.ndarray:
         """Mask of the rays (parent frame) whose segment [lo, hi] may meet ``bound`` (conservative:
-        every triangle of the tier, and every start point inside a shell, lies inside the bound)."""
+        every triangle of the tier, and every start point inside a shell, lies inside the bound),
+        the bound grown by ``grow``."""
         Ot = _minus(O, self.anchor) if self.anchored else O
         hi = np.minimum(hi, 1e300)          # t * d stays finite (and 0 for d = 0)
         if self.bound[0] == "cylinder":
             # two cheap necessary conditions, tested separately: the segment comes within the
             # radius of the axis, and it overlaps the slab |z| <= half-height
             _, R, c, rad, ax = self.bound
+            rad, ax = rad + grow, ax + grow
             p = _mat(_minus(Ot, c), R)
             d = _mat(D, R)
             px, py, pz, dx, dy, dz = p[:, 0], p[:, 1], p[:, 2], d[:, 0], d[:, 1], d[:, 2]
@@ -224,6 +226,8 @@ class _Tier:
             z0, z1 = pz + lo * dz, pz + hi * dz
             return (qx * qx + qy * qy <= rad * rad) & (np.maximum(z0, z1) >= -ax) & (np.minimum(z0, z1) <= ax)
         _, blo, bhi = self.bound
+        if grow:
+            blo, bhi = blo - grow, bhi + grow
         Dn = np.where(D == 0.0, 1e-300, D)   # parallel to a slab: +-huge (or 0 on its plane), no NaN
         t_a = (blo - Ot) / Dn
         t_b = (bhi - Ot) / Dn

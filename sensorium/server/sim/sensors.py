@@ -238,6 +238,9 @@ class Lidar(Device):
         self._sweep: lmath.RotatingSweep | None = None
         # (rotation bytes, world beams float64, the same as float32) of a fixed lidar's latest plan
         self._planned: tuple[bytes, np.ndarray, np.ndarray] | None = None
+        # a fixed lidar on a robot with a body: its beams are rigidly mounted on that body, which
+        # they also see (Mount(own=True): which beams can reach it is decided once)
+        self._mount: tuple[int, Mount] | None = None
 
     # -- controller API
     def info(self) -> dict:
@@ -312,7 +315,9 @@ class Lidar(Device):
         # a rotating head turns (and sweeps its sector) every basic step while enabled
         return self.enabled if self.rotating else self.schedule.due(now_ms)
 
-    def plan(self, robot_pose: Pose, now_ms: int, dt_ms: int) -> list[RayRequest]:
+    def plan(self, robot_pose: Pose, now_ms: int, dt_ms: int, body: int | None = None) -> list[RayRequest]:
+        """The rays of this step's measurement; ``body``: the engine body of the robot carrying the
+        lidar (None: it has none), which a fixed lidar's rays are mounted on."""
         pose = self.world_pose(robot_pose)
         if self.rotating:
             # only the sector the head sweeps during this step (devices.md §4.9)
@@ -333,8 +338,13 @@ class Lidar(Device):
                 self._planned = (key, dirs, d32)
             _, dirs, d32 = self._planned
             origins = np.broadcast_to(pose.translation, dirs.shape)
+            mount = None
+            if body is not None:
+                if self._mount is None or self._mount[0] != body:
+                    self._mount = (body, Mount(np.full(len(dirs), body, dtype=np.int64), own=True))
+                mount = self._mount[1]
             return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
-                               distance_only=True, directions32=d32)]
+                               mount=mount, distance_only=True, directions32=d32)]
         origins = np.broadcast_to(pose.translation, dirs.shape)
         return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
                            distance_only=True)]
