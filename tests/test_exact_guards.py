@@ -277,6 +277,35 @@ def test_near_coincident_copies_keep_the_offset_copy_before_any_list_is_made(mon
     assert np.count_nonzero(right) >= 0.98 * len(t), np.count_nonzero(~right)
 
 
+def test_a_room_with_an_stl_rock_and_curved_shapes_keeps_its_guards():
+    """The arena's kind of scene: boxes, curved shapes and a rock mesh read from STL (every vertex
+    repeated per triangle). The rock's vertices are welded (its triangles share edges, so only its
+    creases are risky: 1.5 per triangle, not 3), and the tier keeps its guards (prisms adding ~3
+    triangles per triangle) instead of the offset copy; rays at the boxes' edges stay exact."""
+    from sensorium.server.world.geometry import Cylinder, Sphere
+
+    rock = trimesh.creation.icosphere(subdivisions=2, radius=0.3)
+    soup = rock.vertices[rock.faces].reshape(-1, 3)            # an STL: three vertices per triangle
+    e = _engine(np.zeros(3))
+    e.add_body([ShapeEntry(Mesh(soup + [0.5, 2.0, -2.0], np.arange(len(soup)).reshape(-1, 3), closed=True),
+                           Pose.identity(), True, True)], Pose.identity())
+    for k in range(4):
+        e.add_body([ShapeEntry(Sphere(0.2, subdivision=3) if k % 2 else Cylinder(0.1, 0.5, subdivision=64),
+                               Pose.from_axis_angle((0, 0, 1), 0.0, [-3.0 + 0.6 * k, -3.0, -2.0]), True, True)],
+                   Pose.identity())
+    o, d = _rays(6)
+    o, d = o[::8], d[::8]
+    t = e.cast(o, d).distance
+    tier = e._static_tier("bounding")
+    rock_tri = (tier.tri_shape[:-1] == len(BOXES) + 1).nonzero()[0]
+    assert len(np.unique(tier.F[rock_tri])) == len(rock.vertices)   # welded: 162 vertices, not 960
+    flat = ~tier.tri_curved[:-1]
+    assert len(risky_edges(tier.F, flat, tier.normal[:-1])[0]) > 1.2 * flat.sum()   # more than 1.2 per flat triangle
+    assert tier.guarded and tier.guard is not None
+    wrong, err = _judge(o, d, t, 1e-12)        # (the rock and the shells lie under the floor slab)
+    assert not wrong.any() and err.max() <= 1e-12
+
+
 @pytest.mark.parametrize("offset", [0.0, 5e3])
 def test_exact_distance_only_gives_the_full_casts_distances(offset):
     """A lidar's EXACT cast skips shapes and normals (distance_only): the distances are the full

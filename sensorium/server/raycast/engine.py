@@ -68,8 +68,10 @@ Precision
   scene: a ray that meets one is tested in float64 against that edge's triangles and their vertex
   rings (and those of edges whose prisms come close), the same past every further prism up to its
   hit, and then gets the hit of the scene without prisms (``counters["edge_guard_hits"]`` counts
-  the float64 hits they found).  A tier with many risky edges (a curved or terrain mesh: more
-  than 1.2 per flat triangle, or 20,000) keeps the former repair instead: each Embree cast paired
+  the float64 hits they found).  A tier with many risky edges (a curved or terrain mesh alone:
+  more than 1.2 per flat triangle and prisms adding more than 4 triangles per triangle of the
+  tier, or 20,000 edges; candidate lists past their budget, see :mod:`.guards`) keeps the former
+  repair instead: each Embree cast paired
   with a copy offset 4 float32 ulps perpendicular to the ray, whose nearer hits are taken when the
   float64 ray hits that triangle or a neighbour (``counters["leak_repairs"]``).
 

@@ -19,7 +19,9 @@ from sensorium.server.raycast.guards import (
     MAX_CANDIDATES_PER_FLAT_TRIANGLE,
     MAX_EDGES_PER_FLAT_TRIANGLE,
     MAX_GUARDED_EDGES,
+    MAX_PRISM_TRIANGLES_PER_TRIANGLE,
     MAX_WIDTH_PER_EDGE_LENGTH,
+    PRISM_TRIANGLES,
     candidates,
     prisms,
     risky_edges,
@@ -32,6 +34,21 @@ def new_device():
     if packets.library() is not None:
         return packets.Device()
     return _rtc.EmbreeDevice()
+
+
+def _welded(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The referenced vertices of a mesh, one per distinct position (in order of first use), and
+    its faces on them."""
+    used, f = np.unique(f, return_inverse=True)
+    v = np.ascontiguousarray(v[used], dtype=np.float64)
+    _, first, inverse = np.unique(v.view(np.dtype((np.void, 24))).ravel(), return_index=True, return_inverse=True)
+    if len(first) == len(v):
+        return v, f.reshape(-1, 3)
+    keep = np.sort(first)                        # distinct positions, in their order in v
+    rank = np.empty(len(v), dtype=np.int64)
+    rank[keep] = np.arange(len(keep))
+    to = rank[first[inverse.ravel()]]            # every vertex -> its position's first occurrence
+    return v[keep], to[f.reshape(-1, 3)]
 
 
 class _Tier:
@@ -53,9 +70,11 @@ class _Tier:
             v, f = tessellate(prim)
             if len(f) == 0:
                 continue
-            if isinstance(prim, Mesh):  # keep only referenced vertices (they set the tier bounds)
-                used, f = np.unique(f, return_inverse=True)
-                v, f = v[used], f.reshape(-1, 3)
+            if isinstance(prim, Mesh):
+                # keep only referenced vertices (they set the tier bounds), each position once: an STL
+                # file repeats a vertex in every triangle that has it, and the triangles that meet
+                # there must share it (vertex rings, edges shared by two faces; the same surface)
+                v, f = _welded(v, f)
             verts.append(pose.apply(v))
             faces.append(f + nv)
             tri_shape.append(np.full(len(f), sid, dtype=np.int64))
@@ -286,7 +305,9 @@ class _Tier:
             edges, ptr, idx = risky_edges(self.F, flat, self.normal[:-1])
             n_flat = int(np.count_nonzero(flat))
             w = 4.0 * self.eps
-            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat \
+            dense = (len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat
+                     and PRISM_TRIANGLES * len(edges) > MAX_PRISM_TRIANGLES_PER_TRIANGLE * len(self.F))
+            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or dense \
                     or w > MAX_WIDTH_PER_EDGE_LENGTH * float(np.median(np.linalg.norm(
                         self.V[edges[:, 0]] - self.V[edges[:, 1]], axis=1))):
                 self._guard = (None, len(edges) == 0)
