@@ -29,6 +29,7 @@ _SCALAR = 8              # (ray, curved shape) pairs intersected analytically in
 _FEW_MOVERS = 4          # up to this many movers, or ...
 _DENSE_PAIRS = 16384     # ... (rays x movers) up to this size: one dense broad-phase test, else a grid
 _PRUNE = 64              # from this many (ray, mover) pairs of one tier, a bound test prunes them
+_MIXED = 1024            # up to this many (ray, curved shape) pairs of several kinds: one pass for all kinds
 _MATMUL_ROWS = 32768     # row block of (n,3) @ (3,3) products (see _mat)
 _CHUNK = 1 << 16         # rays per pass of a large cast (RayEngine.cast): bounds its temporaries
 
@@ -40,7 +41,7 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out = np.empty(a.shape if a.shape == b.shape else np.broadcast_shapes(a.shape, b.shape))   # (broadcast_shapes: ~5 us)
     out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
     out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
     out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
@@ -210,6 +211,54 @@ def _analytic_local(code, p, d, r, h, lo, hi, normals=True):
         n[:, 2] = (k == 2).astype(np.float64) - (k == 3)
     elif code == _CAPSULE:             # side: radial; hemispheres: from their centre
         n[:, 2] -= np.where(k < 2, n[:, 2], np.where(k < 4, h, -h))
+    n /= np.sqrt(_dot(n, n))[:, None]
+    np.copyto(n, 0.0, where=~hit[:, None])
+    return t, n
+
+
+def _analytic_mixed(codes, p, d, r, h, lo, hi, normals=True):
+    """``_analytic_local`` for rows of different shape kinds (``codes``, ``r``, ``h`` per row) in one
+    pass: every row gets the eight candidate columns -- the side (0, 1), a cylinder's caps (2, 3),
+    a capsule's hemispheres (4, 5 at z = +h; 6, 7 at z = -h), a sphere being the capsule with
+    h = 0 -- and the columns its kind does not have are masked out. Each row's candidates, their
+    order and the arithmetic of its normal are those of its kind in ``_analytic_local``, so the
+    same hits (for a few rows, one pass of ~50 numpy calls instead of ~35 per kind present)."""
+    m = len(p)
+    sphere, cyl = codes == _SPHERE, codes == _CYLINDER
+    tol = 1e-12 * (r + h)
+    hc, tc, rc = h[:, None], tol[:, None], r[:, None]
+    pz, dz = p[:, 2:3], d[:, 2:3]
+    ts = np.empty((m, 8))
+    px, py, dx, dy = p[:, 0], p[:, 1], d[:, 0], d[:, 1]
+    a = dx * dx + dy * dy
+    x = px * dy - py * dx
+    _roots_into(ts, 0, a, px * dx + py * dy, px * px + py * py - r * r, a * r * r - x * x)
+    side = ts[:, 0:2]
+    np.copyto(side, _INF, where=~(np.abs(pz + side * dz) <= hc + tc) | sphere[:, None])
+    caps = ts[:, 2:4]
+    np.divide(hc * np.array([1.0, -1.0]) - pz, dz, out=caps)
+    cx, cy = p[:, 0:1] + caps * d[:, 0:1], p[:, 1:2] + caps * d[:, 1:2]
+    np.copyto(caps, _INF, where=~(np.isfinite(caps) & (cx * cx + cy * cy <= rc * rc + tc * rc)) | ~cyl[:, None])
+    for k, sign in ((4, 1.0), (6, -1.0)):
+        pc = p.copy()
+        pc[:, 2] -= sign * h
+        _sphere_roots_into(ts, k, pc, d, r)
+        cap = ts[:, k:k + 2]
+        np.copyto(cap, _INF, where=~(sign * (pz + cap * dz) >= hc - tc) | cyl[:, None])
+    np.copyto(ts, _INF, where=~((ts >= lo[:, None]) & (ts <= hi[:, None])))
+    if not normals:
+        return ts.min(axis=1), None
+    k = ts.argmin(axis=1)   # first of equal candidates, in column order (each kind's own order)
+    t = ts[np.arange(m), k]
+    hit = t < _INF
+    t0 = t.copy()
+    np.copyto(t0, 0.0, where=~hit)
+    n = p + t0[:, None] * d            # hit point
+    # cylinder: side radial, caps +-z; capsule (and sphere, h = 0): hemispheres from their centre
+    n[:, 0:2] *= np.where(cyl, k < 2, 1.0)[:, None]
+    nz = n[:, 2]
+    n[:, 2] = np.where(cyl, (k == 2).astype(np.float64) - (k == 3),
+                       np.where(sphere, nz, nz - np.where(k < 2, nz, np.where(k < 6, h, -h))))
     n /= np.sqrt(_dot(n, n))[:, None]
     np.copyto(n, 0.0, where=~hit[:, None])
     return t, n

@@ -16,10 +16,12 @@ from sensorium.server.raycast.exact import (
     _F32,
     _INF,
     _MAX_LOOPS,
+    _MIXED,
     _SCALAR,
     _SPHERE,
     _TINY,
     _analytic_local,
+    _analytic_mixed,
     _analytic_one,
     _best_per_row,
     _dot,
@@ -244,9 +246,12 @@ class Refiner:
         R = tier.c_rot[slots]
         p = np.einsum("nij,ni->nj", R, Ot - tier.c_pos[slots])  # R^T (o - c)
         d = np.einsum("nij,ni->nj", R, D)
+        codes = tier.c_code[slots]
+        if n <= _MIXED and np.count_nonzero(codes != codes[0]):   # a few rays, several kinds: one pass
+            t, n_loc = _analytic_mixed(codes, p, d, tier.c_r[slots], tier.c_h[slots], lo, hi, normals)
+            return t, (np.einsum("nij,nj->ni", R, n_loc) if normals else None)
         t = np.full(n, _INF)
         n_loc = np.zeros((n, 3)) if normals else None
-        codes = tier.c_code[slots]
         for code in (_SPHERE, _CYLINDER, _CAPSULE):
             g = (codes == code).nonzero()[0]
             if len(g):
