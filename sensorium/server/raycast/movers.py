@@ -12,12 +12,15 @@ cast only those rays are tested.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _minus, _take, _to_frame
 from sensorium.server.world.geometry import Pose
+
+_FEW = 8   # one-origin batches against up to this many movers: one matrix-vector test per mover
 
 
 def _segment_near_sphere(rel_x, rel_y, rel_z, dx, dy, dz, t_lo, t_hi, r2):
@@ -38,7 +41,8 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
     (a lidar): one mover at a time on contiguous columns, pairs ordered by mover (so the pairs of
     any one mover are always in ray order)."""
     n, M = len(O), len(C)
-    if n * M <= _TINY:  # a few rays and movers: plain floats (same test)
+    one = O.strides[0] == 0 and n > 1   # one origin for all rays (a lidar): the per-mover path below
+    if n * M <= _TINY and not one:  # a few rays and movers: plain floats (same test)
         Cl, Ol, Dl, r2l, hil = C.tolist(), O.tolist(), D.tolist(), r2.tolist(), lim.tolist()
         lol = t_near.tolist() if isinstance(t_near, np.ndarray) else [t_near] * n
         exl = excl.tolist() if isinstance(excl, np.ndarray) else [excl] * n
@@ -56,7 +60,7 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
                     pr.append(i)
                     pm.append(j)
         return np.array(pr, dtype=np.int64), np.array(pm, dtype=np.int64)
-    if n * M <= _DENSE_PAIRS:
+    if n * M <= _DENSE_PAIRS and not (one and M <= _FEW):
         tn = t_near[:, None] if isinstance(t_near, np.ndarray) else t_near
         if n * M <= 256:   # one (rays, movers, 3) table: fewest calls
             rel = C[None, :, :] - O[:, None, :]
@@ -70,7 +74,7 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
         if owner is not None:
             sel &= owner != (excl[:, None] if isinstance(excl, np.ndarray) else excl)
         return sel.nonzero()
-    shared = O.strides[0] == 0 or not np.count_nonzero(O != O[0])   # one origin (a lidar): rel = C - o is per mover
+    shared = one or not np.count_nonzero(O != O[0])   # one origin (a lidar): rel = C - o is per mover
     if not shared:
         ox, oy, oz, dx, dy, dz = (np.ascontiguousarray(a[:, k]) for a in (O, D) for k in range(3))
     prs, pms = [], []
@@ -81,8 +85,15 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
             rel = C[j] - O[0]
             b = D @ rel                              # matrix-vector: fast at any size
             e2 = float(rel @ rel)
-            tc = np.minimum(np.maximum(b, t_near), lim)
-            sel = e2 - tc * (b + b - tc) <= r2[j] + 1e-12 * e2
+            if one and e2 > 2.0 * r2[j]:
+                # one origin well outside the sphere: its rays that pass within it are those
+                # within the sphere's cone, b >= sqrt(e2 - r2) (unit directions), whatever their
+                # limits (a superset: a pair whose segment stops short traces to no hit); the
+                # slack covers the rounding of b
+                sel = b >= math.sqrt(e2 - r2[j]) * (1.0 - 1e-9) - 1e-12 * math.sqrt(e2)
+            else:
+                tc = np.minimum(np.maximum(b, t_near), lim)
+                sel = e2 - tc * (b + b - tc) <= r2[j] + 1e-12 * e2
         else:
             sel = _segment_near_sphere(C[j, 0] - ox, C[j, 1] - oy, C[j, 2] - oz, dx, dy, dz, t_near, lim, r2[j])
         if owner is not None and isinstance(excl, np.ndarray):

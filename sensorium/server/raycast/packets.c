@@ -107,11 +107,18 @@ void* sp_new_scene(void* device, int robust, size_t nv0, const float* v0, size_t
 void sp_release_scene(void* scene) { release_scene(scene); }
 
 /* Nearest hits of n rays: origins (n,3) float32 with row stride `o_stride` floats (0: one origin
- * for all rays), directions (n,3), far limits tfar[i] (overwritten with the hit distance, as
- * embreex does; untouched on a miss), tnear 0. prim[i] = primID (-1: miss). geom, u, v, ng (n,3)
- * may be NULL (distance-only casts); a miss gets geom -1 and zeros. */
+ * for all rays), directions (n,3), tnear 0. `out` holds n far limits on entry (float32) and
+ * receives, in blocks of n 32-bit words: the hit distance (the far limit on a miss, as embreex),
+ * primID (-1: miss), and with `full`: geomID (-1: miss), u, v, then Ng as (n,3) (zeros on a miss).
+ * `coherent`: the rays are traced as coherent packets (one origin: a lidar). */
 void sp_intersect(void* scene, size_t n, const float* origins, size_t o_stride, const float* directions,
-                  float* tfar, int32_t* prim, int32_t* geom, float* u, float* v, float* ng, int coherent) {
+                  float* out, int full, int coherent) {
+  float* tfar = out;
+  int32_t* prim = (int32_t*)(out + n);
+  int32_t* geom = full ? (int32_t*)(out + 2 * n) : NULL;
+  float* u = out + 3 * n;
+  float* v = out + 4 * n;
+  float* ng = out + 5 * n;
   struct ray_hit16 r;
   struct intersect_args args;
   memset(&args, 0, sizeof args);

@@ -4,6 +4,7 @@ starting inside a curved shell.  A mixin of :class:`RayEngine` (via :class:`.tra
 
 from __future__ import annotations
 
+import math
 import threading
 
 import numpy as np
@@ -283,7 +284,14 @@ class Refiner:
             if not pairs:
                 return None
             return self._prepass_scalar(tier, pairs, S, Ot.tolist(), D.tolist(), lo, lim, excl)
-        if m * len(cp) > _DENSE_PAIRS:  # many rays: screen their bounding box first (a lidar: a point)
+        if Ot.strides[0] == 0 and not isinstance(lo, np.ndarray):   # one origin (a lidar), plain floats:
+            # its start points lie within lo of it (unit directions)
+            ox, oy, oz = Ot[0].tolist()
+            near = [k for k, (cx, cy, cz, b2) in enumerate(tier.c_sphere)
+                    if math.sqrt((ox - cx) ** 2 + (oy - cy) ** 2 + (oz - cz) ** 2) <= (math.sqrt(b2) + lo) * (1.0 + 1e-9)]
+            if not near:
+                return None
+        elif m * len(cp) > _DENSE_PAIRS:  # many rays: screen their bounding box first (a lidar: a point)
             # per column: numpy reduces a short inner axis ~10x slower than a contiguous column
             reach = float(lo.max()) if isinstance(lo, np.ndarray) else lo
             Ou = Ot[:1] if Ot.strides[0] == 0 else Ot   # one origin for all rays (a broadcast array)

@@ -307,8 +307,9 @@ class TierTracer(Refiner):
         else:
             alive = seg <= lim + eps
             s_one = None if isinstance(t_near, np.ndarray) else float(seg[0]) if m else None   # every start alike
-        if tier.has_curved:
-            pre = self._contained_prepass(tier, Ot, D, lo, lim, excl)
+        if tier.has_curved:   # (a uniform start as a scalar: the pre-pass's one-origin screen)
+            pre = self._contained_prepass(tier, Ot, D, lo if isinstance(t_near, np.ndarray) else float(lo[0]) if m else lo,
+                                          lim, excl)
             if pre is not None:
                 rows, tp, sp, np_ = pre
                 best_t[rows], best_s[rows], best_n[rows] = tp, sp, np_
