@@ -531,6 +531,19 @@ def world_triangles(sim, plane_half: float = 100.0) -> list[tuple[str, np.ndarra
     return out
 
 
+def world_shapes(sim) -> list[tuple[str, Any, Any]]:
+    """The visible shapes of a simulation as (name, geometry model, world pose), one per solid or
+    robot body, for engines with their own primitives (MuJoCo's planes, boxes, spheres, cylinders,
+    capsules; a mesh stays a mesh)."""
+    items = [(s.name, s, None) for s in sim.world.solids]
+    items += [(f"{r.name}/body", r.body, sim.scene.robot_poses[i]) for i, r in enumerate(sim.world.robots)
+              if r.body is not None]
+    from sensorium.server.world.poses import pose_from_model
+
+    return [(name, shape.geometry, pose if pose is not None else pose_from_model(shape.pose))
+            for name, shape, pose in items if shape.seen_by != "bounding"]
+
+
 def merge_triangles(parts) -> tuple[np.ndarray, np.ndarray]:
     vs, fs, k = [], [], 0
     for _, v, f, _ in parts:

@@ -2,10 +2,20 @@
 
 A small C file (``packets.c``) is compiled once per machine with the system C compiler into a cache
 folder and loaded with ctypes; it opens the Embree library embreex itself loaded (embreex's wheel
-carries Embree 4) and traces a batch in packets of 16, coherent for a lidar's beams. Same library,
-same scenes, same float32 rays: the same answers as embreex (tests/test_packets.py compares them
-bit for bit, plain and robust scenes, rays through vertices and edges). Measured on the warehouse
-lidar (131,072 rays, 110k triangles, one thread): about 3.4x embreex's rays/s.
+carries Embree 4, whose ``rtcIntersect16`` embreex does not expose) and traces a batch in packets
+of 16. Same library, same scenes, same float32 rays:
+
+* incoherent packets (EXACT, scattered sensor rays) give embreex's answers bit for bit
+  (tests/test_packets.py: plain and robust scenes, rays aimed at vertices and edges); measured on
+  the warehouse lidar (131,072 rays, 110k triangles, one thread) ~1.2-1.3x embreex's rays/s;
+* coherent packets (a FAST lidar scan: rays from one origin) traverse each node once per packet,
+  ~3.4x embreex's rays/s, and differ from it only for rays within float32 rounding of an edge or a
+  vertex: the neighbouring triangle of the same surface (within 32 float32 ulps of the distance)
+  or, in FAST's plain (not watertight) scene, the other side of the edge (0 of the 131,072
+  warehouse beams; ~1 % of rays aimed exactly at vertices and edges).
+
+Debian bookworm packages Embree 3.13 (libembree3-3): not needed, as embreex's Embree 4 offers the
+same packet entry points.
 
 Where there is no C compiler, no embreex-loaded Embree 4 library, or ``SENSORIUM_PACKETS=0``, the
 engine casts through embreex as before (only slower); :func:`status` says which and why.
