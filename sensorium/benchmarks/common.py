@@ -288,13 +288,17 @@ def machine() -> dict:
 
 
 # ----------------------------------------------------------------------------- simulations
-def make_sim(world: dict, precision: str = "exact", base_dir=None):
+def make_sim(world: dict, precision: str = "exact", base_dir=None, threads: int | None = None):
+    """A simulation of ``world`` (limits raised: benchmark worlds are deliberately large);
+    ``threads``: the threads its ray engine may use (default: the engine's, both cores here)."""
     from sensorium.server.sim.simulation import Simulation
     from sensorium.server.world.limits import WorldLimits
     from sensorium.server.world.loader import parse_world
 
-    # benchmark worlds are deliberately large (--allow-large)
-    return Simulation(parse_world(world, base_dir=base_dir, limits=WorldLimits.large()), precision=precision)
+    sim = Simulation(parse_world(world, base_dir=base_dir, limits=WorldLimits.large()), precision=precision)
+    if threads is not None:
+        sim.scene.engine.threads = threads
+    return sim
 
 
 def identity_table(max_range: float, noise: float = 0.0) -> list[list[float]]:
