@@ -478,6 +478,33 @@ class RayEngine(TierTracer):
                     (np.full(n, _INF), np.full(n, -1, dtype=np.int64), np.zeros((n, 3))))
         return hits
 
+    def _trace_split(self, tier: _Tier, O, D, t_near, lim, eps64: float, exact: bool, distance_only: bool):
+        """``_trace`` of a mover tier's (ray, mover) pairs, in blocks on the threads when they are
+        many (a lidar's beams that can reach its own robot): the same answers."""
+        m = len(O)
+        parts = split(m, self.threads, _CHUNK)
+        if len(parts) == 1:
+            return self._trace(tier, O, D, t_near, lim, -1, eps64, exact, None, distance_only)
+        tier.prepare(exact)
+
+        def block(sl: slice):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # per thread
+                return self._trace(tier, O[sl], D[sl], _take(t_near, sl), lim[sl], -1, eps64, exact, None,
+                                   distance_only)
+
+        outs = run(block, parts, self.threads)
+        if all(o is None for o in outs):
+            return None
+        t = np.full(m, _INF)
+        s = None if distance_only else np.full(m, -1, dtype=np.int64)
+        nrm = None if distance_only else np.zeros((m, 3))
+        for sl, o in zip(parts, outs):
+            if o is not None:
+                t[sl] = o[0]
+                if not distance_only:
+                    s[sl], nrm[sl] = o[1], o[2]
+        return t, s, nrm
+
     def _cast_movers(self, mt: _Movers, O, D, t_near, t_far, excl, eps64, exact, dist, shape, normal,
                      mount=None) -> None:
         """Broad phase over all movers, then one trace per shared tier over its (ray, mover) pairs
@@ -587,7 +614,7 @@ class RayEngine(TierTracer):
                         continue
                     Ob = np.broadcast_to(Ob[:1], (len(keep), 3)) if Ob.strides[0] == 0 else Ob[keep]
                     rr, mm, Db, lim_r = rr[keep], mm[keep], Db[keep], lim_r[keep]
-            res = self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact, None, shape is None)
+            res = self._trace_split(tier, Ob, Db, _take(t_near, rr), lim_r, eps64, exact, shape is None)
             if res is None:
                 continue
             t, s, nb = res

@@ -70,6 +70,25 @@ def _minus(x: np.ndarray, v: np.ndarray) -> np.ndarray:
     return out
 
 
+def _start32(o: np.ndarray, d: np.ndarray, s) -> np.ndarray:
+    """float32(o + s d) for (m,3) origins (possibly one broadcast row) and directions and a scalar
+    or per-row s: the float64 sum rounded once, by columns for large m (broadcasting over a
+    length-3 axis into a float32 output is ~4x slower; the same values)."""
+    m = len(d)
+    if m <= _SMALL:
+        out = np.empty(d.shape, dtype=_F32)
+        np.add(o, d * (s[:, None] if isinstance(s, np.ndarray) else s), out=out, casting="same_kind")
+        return out
+    out = np.empty((m, 3), dtype=_F32)
+    t = np.empty(m)
+    one = o.strides[0] == 0
+    for k in range(3):
+        np.multiply(d[:, k], s, out=t)
+        t += o[0, k] if one else o[:, k]
+        out[:, k] = t
+    return out
+
+
 def _mat(x: np.ndarray, M: np.ndarray) -> np.ndarray:
     """x @ M for (n, k) x and a small (k, j) M, in blocks of rows: OpenBLAS multi-threads larger
     products, which made a (131072, 3) @ (3, 3) product ~100x slower on a busy 2-core machine."""

@@ -19,6 +19,7 @@ from sensorium.server.raycast.exact import (
     _minus,
     _perpendicular,
     _rows,
+    _start32,
     _take,
 )
 from sensorium.server.raycast.refine import Refiner
@@ -326,9 +327,9 @@ class TierTracer(Refiner):
             if len(act) == 0:
                 break
             view = slice(None) if len(act) == m else act   # all rays active: views, not copies
-            oa, da, sa = Ot[view], D[view], seg[view]
-            o32 = np.empty(da.shape, dtype=_F32)   # oa + sa da in float64, rounded once
-            np.add(oa, da * (sa[:, None] if s_one is None else s_one), out=o32, casting="same_kind")
+            oa = np.broadcast_to(Ot[:1], (len(act), 3)) if one_origin else Ot[view]   # one origin stays one
+            da, sa = D[view], seg[view]
+            o32 = _start32(oa, da, sa if s_one is None else s_one)   # oa + sa da in float64, rounded once
             s_one = None   # continued rays start apart
             d32 = d32_all if d32_all is not None and len(act) == m else da.astype(_F32)
             far = ((lim[view] - sa) + (eps if exact else 0.0)) * (1.0 + 2.0 ** -20)

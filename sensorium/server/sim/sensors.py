@@ -25,6 +25,7 @@ from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import LookupTable, quantize_sensor
 from sensorium.server.devices.noise import device_rng
+from sensorium.server.raycast import blocks
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
@@ -349,7 +350,9 @@ class Lidar(Device):
         return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
                            distance_only=True)]
 
-    def finish(self, hits: list[RayHits], now_ms: int, counters: dict[str, int]) -> None:
+    def finish(self, hits: list[RayHits], now_ms: int, counters: dict[str, int], threads: int = 1) -> None:
+        """Range image and point cloud from this step's hits; ``threads``: the point coordinates of a
+        large scan are made in blocks on that many threads (the same values)."""
         L = self.config.number_of_layers
         if self.rotating:
             sweep = self._sweep
@@ -372,7 +375,7 @@ class Lidar(Device):
             dist = hits[0].distance.reshape(L, self.config.horizontal_resolution)
             self.range_image = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
             if self.point_cloud_enabled:
-                self._xyz = lmath.point_xyz(self.range_image, self._point_columns())
+                self._xyz = _point_xyz(self.range_image, self._point_columns(), threads)
                 self._xyz.flags.writeable = False   # messages may hold it
                 self._cloud_time = (now_ms / 1000.0, self.schedule.period_ms / 1000.0)
                 self._records = None
@@ -401,6 +404,22 @@ class Lidar(Device):
 
 
 _ROTATE_BLOCK = 16384   # rows per block of _rotate_columns (its float64 temporaries: ~640 KB)
+
+
+def _point_xyz(ranges: np.ndarray, columns: tuple[np.ndarray, ...], threads: int) -> np.ndarray:
+    """lmath.point_xyz, in blocks on ``threads`` threads for a large scan (each point's value is
+    its own product: the same array)."""
+    r = ranges.reshape(-1)
+    parts = blocks.split(len(r), threads, 1 << 16)
+    if len(parts) == 1:
+        return lmath.point_xyz(r, columns)
+    out = np.empty((len(r), 3), dtype=np.float32)
+
+    def block(sl: slice) -> None:
+        out[sl] = lmath.point_xyz(r[sl], tuple(c[sl] for c in columns))
+
+    blocks.run(block, parts, threads)
+    return out
 
 
 def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:

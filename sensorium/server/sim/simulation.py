@@ -367,7 +367,7 @@ class Simulation:
             mine = hits[k:k + len(reqs)]
             k += len(reqs)
             if isinstance(item, Lidar):
-                item.finish(mine, now, self._counters)
+                item.finish(mine, now, self._counters, self.scene.engine.threads)
             else:
                 item.finish(mine, now)
         for dev in (*lights, *distances, *(x for x in lidars if not x.rotating)):
