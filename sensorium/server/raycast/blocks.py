@@ -50,7 +50,8 @@ def split(n: int, threads: int, chunk: int) -> list[slice]:
     thread when the batch is large enough to share (``MIN_RAYS``, blocks of ``MIN_BLOCK``)."""
     k = max(1, -(-n // chunk))
     if threads > 1 and n >= MIN_RAYS:
-        k = max(k, min(threads, n // MIN_BLOCK))
+        # two blocks per thread: a thread that starts late (its core busy) leaves less undone
+        k = max(k, min(2 * threads, n // MIN_BLOCK))
         k = -(-k // threads) * threads          # whole rounds: every thread gets as many blocks
     size = -(-n // k)
     return [slice(a, min(n, a + size)) for a in range(0, n, size)]
@@ -71,27 +72,42 @@ def _executor(workers: int) -> ThreadPoolExecutor:
 
 def run(fn: Callable[[B], T], blocks: Sequence[B], threads: int) -> list[T]:
     """``[fn(b) for b in blocks]`` on up to ``threads`` threads: the calling thread and pool workers
-    take the next block until none is left. A worker's exception is raised here. Called from a
-    pool worker (a nested split), the blocks run on that thread."""
+    take the next block until none is left, and the call returns once every block taken is done.
+    A worker that has not started by then (its core busy with another process) finds nothing to do
+    and is not waited for, so on a busy machine this costs at most what one thread would. A block's
+    exception is raised here. Called from a pool worker (a nested split), the blocks run on that
+    thread."""
     if threads <= 1 or len(blocks) <= 1 or threading.current_thread().name.startswith(_PREFIX):
         return [fn(b) for b in blocks]
     results: list = [None] * len(blocks)
-    order = iter(range(len(blocks)))
-    take = threading.Lock()
+    errors: list[BaseException] = []
+    state = {"next": 0, "busy": 0}
+    cond = threading.Condition()
 
     def work() -> None:
         while True:
-            with take:
-                i = next(order, None)
-            if i is None:
-                return
-            results[i] = fn(blocks[i])
+            with cond:
+                i = state["next"]
+                if i >= len(blocks) or errors:
+                    return
+                state["next"] = i + 1
+                state["busy"] += 1
+            try:
+                results[i] = fn(blocks[i])
+            except BaseException as exc:  # noqa: BLE001 - handed to the calling thread
+                with cond:
+                    errors.append(exc)
+            finally:
+                with cond:
+                    state["busy"] -= 1
+                    cond.notify_all()
 
     pool = _executor(threads - 1)
-    helpers = [pool.submit(work) for _ in range(min(threads, len(blocks)) - 1)]
-    try:
-        work()
-    finally:
-        for h in helpers:
-            h.result()
+    for _ in range(min(threads, len(blocks)) - 1):
+        pool.submit(work)
+    work()
+    with cond:
+        cond.wait_for(lambda: state["busy"] == 0)
+    if errors:
+        raise errors[0]
     return results
