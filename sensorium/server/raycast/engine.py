@@ -1,9 +1,23 @@
 """Ray-query engine: Embree (float32 BVH traversal) + float64 refinement.
 
 The public cast API (:class:`RayEngine`).  The package is split by job: :mod:`.kinds` (value
-types), :mod:`.exact` (float64 kernels), :mod:`.tiers` (Embree scenes; the only embreex import),
-:mod:`.movers` (moving bodies, broad phase), :mod:`.planes` (analytic planes), :mod:`.trace`
-(tracing one tier) and :mod:`.refine` (float64 refinement, curved-shell pre-pass).
+types), :mod:`.exact` (float64 kernels), :mod:`.tiers` (Embree scenes), :mod:`.packets` (Embree's
+packet traversal through a small C helper, when a compiler is there; else embreex), :mod:`.blocks`
+(large casts in ray blocks on both cores), :mod:`.movers` (moving bodies, broad phase, Mount),
+:mod:`.planes` (analytic planes), :mod:`.trace` (tracing one tier) and :mod:`.refine` (float64
+refinement, curved-shell pre-pass).
+
+Speed (measured in ``sensorium bench``, peers section)
+------------------------------------------------------
+* Traversal: packets of 16 rays through the Embree library embreex loaded; a FAST scan from one
+  origin as coherent packets (~3.4x embreex's one ray per call on one thread), everything else as
+  incoherent ones (embreex's answers bit for bit; see :mod:`.packets` for the bounded difference
+  of coherent packets).  Without a C compiler: embreex, the same answers.
+* Threads: a cast of >= ``blocks.MIN_RAYS`` rays runs its planes and static tier in blocks on
+  ``RayEngine.threads`` threads (default: the cores this process may use; ``SENSORIUM_THREADS``),
+  and so do a lidar's own-body pairs; no ray's answer depends on its block or on the other rays of
+  its batch (world-to-frame rotations are summed in one fixed order, never by BLAS), so the bits
+  are the same on any number of threads.
 
 Architecture
 ------------

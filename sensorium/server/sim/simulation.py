@@ -410,7 +410,7 @@ class Simulation:
         if kept is None or any(a is not b for a, b in zip(kept[0], parts)):
             if len(self._joined_mounts) >= 8:
                 self._joined_mounts.clear()
-            own = np.concatenate([m.own if m is not None and m.own is not None else np.zeros(n, dtype=bool)
+            own = np.concatenate([m.own if isinstance(m, Mount) and m.own is not None else np.zeros(n, dtype=bool)
                                   for m, n in zip(parts, sizes)])
             kept = self._joined_mounts[key] = (parts, Mount(joined(), own=own))
         return kept[1]
