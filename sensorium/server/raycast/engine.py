@@ -111,7 +111,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from sensorium.server.raycast.blocks import available, run, split
+from sensorium.server.raycast.blocks import MIN_RAYS, available, run, split
 from sensorium.server.raycast.exact import (
     _CHUNK,
     _DENSE_PAIRS,
@@ -356,7 +356,7 @@ class RayEngine(TierTracer):
         if O.shape != D.shape or O.ndim != 2 or O.shape[1] != 3:
             raise ValueError(f"origins/directions must both be (n,3), got {O.shape} and {D.shape}")
         if directions32 is not None and (getattr(directions32, "dtype", None) != np.float32
-                                         or np.shape(directions32) != D.shape):
+                                         or directions32.shape != D.shape):
             raise ValueError(f"directions32 must be the directions as a float32 {D.shape} array")
         n = len(O)
         t_near = _param(t_near, n, np.float64, float)
@@ -380,12 +380,17 @@ class RayEngine(TierTracer):
         if n == 0:
             return RayHits(np.zeros(0), np.zeros((0, 3)), np.zeros(0, dtype=np.int64))
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
-        Ou = O[:1] if O.strides[0] == 0 else O   # one origin for all rays (a broadcast array)
-        big = max(map(abs, Ou.ravel().tolist())) if len(Ou) <= _SMALL else max(float(Ou.max()), -float(Ou.min()))
+        if O.strides[0] == 0:   # one origin for all rays (a broadcast array)
+            big = max(map(abs, O[0].tolist()))
+        else:
+            big = max(map(abs, O.ravel().tolist())) if n <= _SMALL else max(float(O.max()), -float(O.min()))
         # one errstate for the whole cast: inf/NaN are handled explicitly (entering the context
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             threads = self.threads
+            if n <= _CHUNK and (threads <= 1 or n < MIN_RAYS):   # (split's answer: one part)
+                return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
+                                  directions32)
             parts = split(n, threads, _CHUNK)
             if len(parts) == 1:
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
@@ -561,7 +566,7 @@ class RayEngine(TierTracer):
             if sub is None:
                 Os, Ds, tn, ls, ex = O, D, t_near, lim, excl
             else:   # the unmounted rays only
-                Os, Ds, ls = np.take(O, sub, axis=0), np.take(D, sub, axis=0), lim[sub]
+                Os, Ds, ls = O.take(sub, axis=0), D.take(sub, axis=0), lim[sub]
                 tn, ex = _take(t_near, sub), _take(excl, sub)
             if len(C) > _FEW_MOVERS and len(Os) * len(C) > _DENSE_PAIRS:
                 pr, pm = _grid_pairs(C, mt.radius, mt.r2, owner, Os, Ds, tn, ls, ex)
@@ -607,16 +612,16 @@ class RayEngine(TierTracer):
             if one and len(rr) == n:   # one mover, every ray (its pairs are then 0..n-1 in order)
                 Or, Dr = O, D
             else:
-                Or = np.broadcast_to(O[:1], (len(rr), 3)) if one_origin else np.take(O, rr, axis=0)
-                Dr = np.take(D, rr, axis=0)
+                Or = np.broadcast_to(O[:1], (len(rr), 3)) if one_origin else O.take(rr, axis=0)
+                Dr = D.take(rr, axis=0)
             if one:
                 Rb, Tb = R[mm[0]], T[mm[0]]
                 Ob = (np.broadcast_to(_to_frame(_minus(O[:1], Tb), Rb), Or.shape) if one_origin
                       else _to_frame(_minus(Or, Tb), Rb))
                 Db = _to_frame(Dr, Rb)
             else:
-                Rg = np.take(R, mm, axis=0)
-                Ob = np.einsum("nij,ni->nj", Rg, Or - np.take(T, mm, axis=0))
+                Rg = R.take(mm, axis=0)
+                Ob = np.einsum("nij,ni->nj", Rg, Or - T.take(mm, axis=0))
                 Db = np.einsum("nij,ni->nj", Rg, Dr)
             lim_r = lim[rr]
             # many pairs (many movers): drop those missing the tier's tight bound (a Mount's own

@@ -56,7 +56,7 @@ def _take(x, idx):
 def _rows(x: np.ndarray, idx: np.ndarray) -> np.ndarray:
     """x[idx] for a sorted subset idx of range(len(x)): the array itself when idx is everything
     (np.take is also markedly faster than fancy indexing for (n,3) arrays)."""
-    return x if len(idx) == len(x) else np.take(x, idx, axis=0)
+    return x if len(idx) == len(x) else x.take(idx, axis=0)
 
 
 def _minus(x: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -155,7 +155,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     short_m = fin & (L <= L_cap)
     every = bool(short_m.all())
     short = None if every else short_m.nonzero()[0]
-    Os, Ds, Ls = (O, D, L) if every else (np.take(O, short, axis=0), np.take(D, short, axis=0), L[short])
+    Os, Ds, Ls = (O, D, L) if every else (O.take(short, axis=0), D.take(short, axis=0), L[short])
     mid = Os + ((t_near if short is None else _take(t_near, short)) + 0.5 * Ls)[:, None] * Ds
     q = np.floor((mid - g0) * inv) + 1.0
     np.clip(q, 0.0, G - 1.0, out=q)
@@ -170,8 +170,8 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     pr = np.repeat(np.arange(len(key)) if every else short, c2)
     pm = smov[np.repeat(start - (np.cumsum(c2) - c2), c2) + np.arange(len(pr))]
     # exact sphere test on the candidates
-    rel = np.take(C, pm, axis=0) - np.take(O, pr, axis=0)
-    Dp = np.take(D, pr, axis=0)
+    rel = C.take(pm, axis=0) - O.take(pr, axis=0)
+    Dp = D.take(pr, axis=0)
     b = np.einsum("ij,ij->i", rel, Dp)
     e2 = np.einsum("ij,ij->i", rel, rel)
     tc = np.minimum(np.maximum(b, _take(t_near, pr)), lim[pr])
@@ -182,7 +182,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     if not every:
         longs = (valid & ~short_m).nonzero()[0]
         if len(longs):
-            lp, lm = _sphere_pairs(C, r2, owner, np.take(O, longs, axis=0), np.take(D, longs, axis=0),
+            lp, lm = _sphere_pairs(C, r2, owner, O.take(longs, axis=0), D.take(longs, axis=0),
                                    _take(t_near, longs), lim[longs], _take(excl, longs))
             pr = np.concatenate([pr, longs[lp]])
             pm = np.concatenate([pm, lm])
@@ -241,7 +241,7 @@ def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndar
     if len(mi) == 0:
         return None
     rows = mrow[mi]
-    rel = np.take(O, mi, axis=0) - np.take(C, rows, axis=0)
+    rel = O.take(mi, axis=0) - C.take(rows, axis=0)
     reach = np.sqrt(_dot(rel, rel)) + np.maximum(lim[mi], -_take(t_near, mi))
     bounded = reach < _INF
     if not bounded.all():                   # unbounded rays: the general broad phase
@@ -251,7 +251,7 @@ def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndar
     R = np.full(M, -1.0)                    # -1: no mounted ray on this mover
     np.maximum.at(R, rows, reach)
     used = (R >= 0.0).nonzero()[0]
-    pb, pm = _near_centres(np.take(C, used, axis=0), R[used], C, mt.radius)
+    pb, pm = _near_centres(C.take(used, axis=0), R[used], C, mt.radius)
     nb = (pm != used[pb]).nonzero()[0]      # CSR of each mover's neighbours (pb is sorted)
     src, dst = used[pb[nb]], pm[nb]
     cnt = np.bincount(src, minlength=M)
@@ -270,9 +270,9 @@ def _near_pairs(C, O, D, t_near, lim, excl, owner, r2, pr, pm):
     None: no check)."""
     if len(pr) == 0:
         return pr, pm
-    Cp = np.take(C, pm, axis=0)
-    Op = np.take(O, pr, axis=0)
-    Dp = np.take(D, pr, axis=0)
+    Cp = C.take(pm, axis=0)
+    Op = O.take(pr, axis=0)
+    Dp = D.take(pr, axis=0)
     sel = _segment_near_sphere(Cp[:, 0] - Op[:, 0], Cp[:, 1] - Op[:, 1], Cp[:, 2] - Op[:, 2],
                                Dp[:, 0], Dp[:, 1], Dp[:, 2], _take(t_near, pr), lim[pr], r2[pm])
     if owner is not None:
@@ -295,7 +295,7 @@ def _near_centres(Cu: np.ndarray, Ru: np.ndarray, C: np.ndarray, radius: np.ndar
     cnt = hi - lo
     pb = np.repeat(np.arange(len(Cu)), cnt)
     pm = order[np.repeat(lo - (np.cumsum(cnt) - cnt), cnt) + np.arange(len(pb))]
-    d = np.take(C, pm, axis=0) - np.take(Cu, pb, axis=0)
+    d = C.take(pm, axis=0) - Cu.take(pb, axis=0)
     gap = Ru[pb] + radius[pm]
     ok = (_dot(d, d) <= gap * gap * (1.0 + 1e-9) + 1e-18).nonzero()[0]
     return pb[ok], pm[ok]
@@ -399,7 +399,7 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
                       -_take(t_near, mi))
     if not np.all(span < _INF):
         return None
-    rel = np.take(O, mi, axis=0) - np.take(C, rows, axis=0)
+    rel = O.take(mi, axis=0) - C.take(rows, axis=0)
     reach = np.full(len(C), -1.0)
     np.maximum.at(reach, rows, np.sqrt(_dot(rel, rel)) + span)
     used = (reach >= 0.0).nonzero()[0]
@@ -441,8 +441,8 @@ def _own_pairs(st: _MountState, own: np.ndarray, mt: _Movers, O: np.ndarray, D: 
         k = (rows == row).nonzero()[0]
         r = rays[k]
         Rb, Tb = rot[mt.index[row]], mt.T[row]
-        Ob = _to_frame(_minus(np.take(O, r, axis=0), Tb), Rb)
-        Db = _to_frame(np.take(D, r, axis=0), Rb)
+        Ob = _to_frame(_minus(O.take(r, axis=0), Tb), Rb)
+        Db = _to_frame(D.take(r, axis=0), Rb)
         sp = span[sel[k]]
         reach = mt.tiers[mt.group[row]].may_hit(Ob, Db, 0.0 if ahead else -sp, sp, grow).nonzero()[0]
         prs.append(r[reach])
@@ -465,7 +465,7 @@ def one_origin_pairs(st: _MountState, mt: _Movers, C: np.ndarray, O: np.ndarray,
             _body_list(st, mt, C, counters)
     nb = st.dst
     if len(nb):
-        pr, pm = _sphere_pairs(np.take(C, nb, axis=0), mt.r2[nb], None if owner is None else owner[nb], O, D,
+        pr, pm = _sphere_pairs(C.take(nb, axis=0), mt.r2[nb], None if owner is None else owner[nb], O, D,
                                t_near, lim, excl)
         pm = nb[pm]
     else:
@@ -509,8 +509,8 @@ def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, rot: np.ndarra
     if len(st.src) == 0:
         return st.pr, st.pm
     # neighbour centres in the frames of the bodies whose rays may reach them
-    Rb = np.take(rot, mt.index[st.src], axis=0)
-    rel = np.take(C, st.dst, axis=0) - np.take(C, st.src, axis=0)
+    Rb = rot.take(mt.index[st.src], axis=0)
+    rel = C.take(st.dst, axis=0) - C.take(st.src, axis=0)
     cb = np.einsum("pji,pj->pi", Rb, rel)
     if st.c_ref is None or float(np.abs(cb - st.c_ref).max()) > st.shift_r:
         _ray_list(st, mt, C, cb, rot, O, D, counters)
@@ -528,7 +528,7 @@ def _body_list(st: _MountState, mt: _Movers, C: np.ndarray, counters: dict[str, 
     # grown by the skin, and by a slack that keeps the list a superset of what the per-cast body
     # test (_mounted_pairs) would pair, whatever the rounding
     Ru = st.reach * (1.0 + 1e-8) + (st.skin + 1e-8 * float(mt.radius.max()) + 1e-9 + 1e-12 * float(np.abs(C).max()))
-    pb, pm = _near_centres(np.take(C, st.used, axis=0), Ru, C, mt.radius)
+    pb, pm = _near_centres(C.take(st.used, axis=0), Ru, C, mt.radius)
     nb = (pm != st.used[pb]).nonzero()[0]
     src, dst = st.used[pb[nb]], pm[nb]
     order = np.lexsort((dst, src))
@@ -541,9 +541,9 @@ def _ray_list(st: _MountState, mt: _Movers, C: np.ndarray, cb: np.ndarray, rot: 
     counters["ray_lists"] += 1
     st.c_ref = cb
     if st.o_loc is None:   # the mounted rays in their bodies' frames, about the centres (rigid: fixed)
-        Rr = np.take(rot, mt.index[st.rows], axis=0)
-        st.o_loc = np.einsum("nji,nj->ni", Rr, np.take(O, st.mi, axis=0) - np.take(C, st.rows, axis=0))
-        st.d_loc = np.einsum("nji,nj->ni", Rr, np.take(D, st.mi, axis=0))
+        Rr = rot.take(mt.index[st.rows], axis=0)
+        st.o_loc = np.einsum("nji,nj->ni", Rr, O.take(st.mi, axis=0) - C.take(st.rows, axis=0))
+        st.d_loc = np.einsum("nji,nj->ni", Rr, D.take(st.mi, axis=0))
         by_body = np.argsort(st.rows, kind="stable")
         cnt = np.bincount(st.rows, minlength=len(C))
         st.by_body, st.body_cnt, st.body_ptr = by_body, cnt, np.cumsum(cnt) - cnt

@@ -40,6 +40,7 @@ import numpy as np
 _SOURCE = Path(__file__).with_name("packets.c")
 _lock = threading.Lock()
 _state: dict = {}          # "lib": the loaded helper, or "why": the reason there is none; "embree": its path
+_SCRATCH = 2048           # casts of up to this many rays write into a per-thread scratch buffer
 
 
 def _cache_dir() -> Path:
@@ -203,6 +204,7 @@ class Scene:
                                             _ptr(f1))
         if not self.handle:
             raise RuntimeError("Embree could not build the scene")
+        self._local = threading.local()   # per thread: scratch buffer, last directions array
 
     def __del__(self) -> None:
         if getattr(self, "handle", None):
@@ -213,20 +215,44 @@ class Scene:
         """Nearest hits (see embreex): ``origins`` (n,3) float32, possibly one broadcast row;
         ``directions`` (n,3) float32; ``dists`` the far limits: None (1e37), a number or an (n,)
         array (not written: the distances come back in a new array). ``output`` 0: only "tfar" and
-        "primID". One output buffer and three pointers per call: a small cast's fixed cost."""
+        "primID". A small cast's fixed cost is mostly the ctypes pointers: a few rays use a
+        per-thread scratch buffer whose address is known, and the directions array of the last call
+        (a lidar's kept beams) keeps its address too."""
         n = len(directions)
         d = directions if directions.flags.c_contiguous and directions.dtype == np.float32 else \
             np.ascontiguousarray(directions, dtype=np.float32)
-        if origins.strides[0] == 0 and origins.strides[1] == 4 and origins.dtype == np.float32:
-            o, stride = origins, 0
+        one = origins.strides[0] == 0 and origins.dtype == np.float32
+        words = 8 * n if output else 2 * n
+        local = self._local
+        if d is getattr(local, "d", None):
+            d_ptr = local.d_ptr
         else:
-            o, stride = np.ascontiguousarray(origins, dtype=np.float32), 3
-        out = np.empty(8 * n if output else 2 * n, dtype=np.float32)
+            local.d, local.d_ptr = d, d_ptr = d, d.ctypes.data
+        small = n <= _SCRATCH
+        if small:   # outputs and the one origin in the thread's scratch buffer, copied out after
+            buf = getattr(local, "buf", None)
+            if buf is None:
+                arr = np.empty(8 * _SCRATCH + 4, dtype=np.float32)
+                local.buf = buf = (arr, arr.ctypes.data)
+            out, out_ptr = buf[0][:words], buf[1]
+        else:
+            out = np.empty(words, dtype=np.float32)
+            out_ptr = out.ctypes.data
+        if one and small:
+            buf[0][words:words + 3] = origins[0]
+            o_ptr, stride = out_ptr + 4 * words, 0
+        elif one:
+            o_ptr, stride = origins.ctypes.data, 0
+        else:
+            o = np.ascontiguousarray(origins, dtype=np.float32)
+            o_ptr, stride = o.ctypes.data, 3
         tfar = out[:n]
         tfar[:] = 1e37 if dists is None else dists
         if n:
-            self.lib.sp_intersect(self.handle, n, o.ctypes.data, stride, d.ctypes.data, out.ctypes.data,
-                                  1 if output else 0, 1 if coherent else 0)
+            self.lib.sp_intersect(self.handle, n, o_ptr, stride, d_ptr, out_ptr, 1 if output else 0, 1 if coherent else 0)
+        if small:
+            out = out.copy()
+            tfar = out[:n]
         res = {"tfar": tfar, "primID": out[n:2 * n].view(np.int32)}
         if output:
             res.update(geomID=out[2 * n:3 * n].view(np.int32), u=out[3 * n:4 * n], v=out[4 * n:5 * n],

@@ -120,9 +120,9 @@ def _floor_distances(pl: _Planes, O, D, t_near, t_far, eps64):
     front side, ``t > 0`` exactly when the ray goes down, so the range test alone picks the hits;
     from behind or on the plane no ray hits it."""
     Oo = O[:1]
+    (px, py, pz), (ox, oy, oz), (nx, ny, nz_) = pl.pt[0].tolist(), Oo[0].tolist(), pl.nz[0].tolist()
+    num = (px - ox) * nx + (py - oy) * ny + (pz - oz) * nz_   # the general pass's sum, in plain floats
     nz = pl.nz
-    num = float(((pl.pt[:, 0] - Oo[:, 0:1]) * nz[:, 0] + (pl.pt[:, 1] - Oo[:, 1:2]) * nz[:, 1]
-                 + (pl.pt[:, 2] - Oo[:, 2:3]) * nz[:, 2])[0, 0])
     if not num < 0.0:
         return None
     k = pl.axis

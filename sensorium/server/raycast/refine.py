@@ -153,29 +153,29 @@ class Refiner:
         masked, instead of gathering the hit rows; the same values.  Updates ``best_*``; returns
         the mask of rays to continue (refinement missed)."""
         eps = tier.eps
-        flat = np.take(tier.tri_flat, prim)            # primID -1 picks the sentinel row: False
-        nx, ny, nz = (np.take(c, prim) for c in tier.normal_cols)   # ... and a zero normal
+        flat = tier.tri_flat.take(prim)            # primID -1 picks the sentinel row: False
+        nx, ny, nz = (c.take(prim) for c in tier.normal_cols)   # ... and a zero normal
         dn = D[:, 0] * nx + D[:, 1] * ny              # = _dot(D, normal[prim]), column by column
         dn += D[:, 2] * nz
         fi = tier.flat_index
         if one_origin and len(fi) < len(prim):   # n.(v0 - o) per flat triangle, then per ray (same values)
             c = np.zeros(len(tier.normal))
             c[fi] = _dot(_minus(tier.v0[fi], Ot[0]), tier.normal[fi])
-            tx = np.take(c, prim) / dn
+            tx = c.take(prim) / dn
         else:
-            V0 = np.take(tier.v0, prim, axis=0, mode="clip")
-            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, np.take(tier.normal, prim, axis=0)) / dn
+            V0 = tier.v0.take(prim, axis=0, mode="clip")
+            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, tier.normal.take(prim, axis=0)) / dn
         ok = np.isfinite(tx) & (tx >= lo) & (tx <= lim) & flat
         u, v = res["u"], res["v"]
         margin = np.minimum(np.minimum(u, v), 1.0 - u - v)
         near_edge = ~(margin > 1e-4) & flat
-        check = ~(margin * np.take(tier.h_min, prim, mode="clip") * np.abs(dn) > 4.0 * eps * d_max)
+        check = ~(margin * tier.h_min.take(prim, mode="clip") * np.abs(dn) > 4.0 * eps * d_max)
         check &= flat & ~near_edge
         ci = check.nonzero()[0]
         if len(ci):
-            P = Ot[ci] + tx[ci, None] * D[ci] - np.take(tier.v0, prim[ci], axis=0)
-            bu = _dot(P, np.take(tier.g1, prim[ci], axis=0))
-            bv = _dot(P, np.take(tier.g2, prim[ci], axis=0))
+            P = Ot[ci] + tx[ci, None] * D[ci] - tier.v0.take(prim[ci], axis=0)
+            bu = _dot(P, tier.g1.take(prim[ci], axis=0))
+            bv = _dot(P, tier.g2.take(prim[ci], axis=0))
             near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
         r = near_edge.nonzero()[0]
         tri = prim
@@ -192,7 +192,7 @@ class Refiner:
         k = (ok & (tx < best_t)).nonzero()[0]
         best_t[k] = tx[k]
         if not distance_only:
-            nk = np.take(tier.normal, tri[k], axis=0)
+            nk = tier.normal.take(tri[k], axis=0)
             nk *= np.where(dn[k] > 0.0, -1.0, 1.0)[:, None]   # toward the origin
             best_s[k], best_n[k] = tier.tri_shape[tri[k]], nk
         return flat & ~ok

@@ -142,7 +142,7 @@ class TierTracer(Refiner):
             # sentinel rows: shape -1, zero normal)
             (t, normal), redo = self._judge_fast(tier, Ot, D, d32, res, prim, slice(None), start, lim, excl,
                                                  distance_only)
-            shape = None if distance_only else np.take(tier.tri_shape, prim)
+            shape = None if distance_only else tier.tri_shape.take(prim)
             if n_hit < m:
                 t[~hit] = _INF
         else:
@@ -156,7 +156,7 @@ class TierTracer(Refiner):
                                                       distance_only)
                 t[h] = th
                 if not distance_only:
-                    shape[h], normal[h] = np.take(tier.tri_shape, prim[h]), nrm
+                    shape[h], normal[h] = tier.tri_shape.take(prim[h]), nrm
                 if special is not None:
                     redo = np.zeros(m, dtype=bool)
                     redo[h[special]] = True
@@ -200,7 +200,7 @@ class TierTracer(Refiner):
         if distance_only:   # the side hit matters only on curved shells: judge those rows alone
             leaving = None
             if tier.has_curved:
-                cv = np.take(tier.tri_curved, ph).nonzero()[0]
+                cv = tier.tri_curved.take(ph).nonzero()[0]
                 back = self._back(tier, D, d32, res, ph[cv], rows if every else rows[cv], cv if every else None)
                 leaving = cv[back]
             return (t, None), self._special(tier, Ot, tf, ph, rows, every, None, excl, leaving)
@@ -211,7 +211,7 @@ class TierTracer(Refiner):
         else:
             dots = ng[:, 0] * dh[:, 0] + ng[:, 1] * dh[:, 1] + ng[:, 2] * dh[:, 2]
         back = dots > 0.0
-        nrm = np.take(tier.normal, ph, axis=0)   # misses (-1): the zero sentinel row
+        nrm = tier.normal.take(ph, axis=0)   # misses (-1): the zero sentinel row
         # toward the origin (exact negation); misses keep the sign bits they always had (-0.0
         # unless "back"), so the arrays stay bit-identical to the former [normal; -normal] table
         nrm[(back ^ (ph < 0)) if every else back] *= -1.0
@@ -232,8 +232,8 @@ class TierTracer(Refiner):
         """Side hit (True: the back) of the hits of ``ph`` at ray ``rows`` (``sub``: their indices
         when ``rows`` is a slice of all rays), as :meth:`_judge_fast` decides it."""
         idx = rows if sub is None else sub
-        dh = np.take(d32, idx, axis=0)       # (np.take: several times faster than fancy indexing here)
-        ng = np.take(res["Ng"], idx, axis=0)
+        dh = d32.take(idx, axis=0)       # (np.take: several times faster than fancy indexing here)
+        ng = res["Ng"].take(idx, axis=0)
         if len(ng) > _SMALL:
             dots = np.einsum("ij,ij->i", ng, dh)
         else:
@@ -263,10 +263,10 @@ class TierTracer(Refiner):
             if len(leaving):
                 special[leaving] = found = True
         elif tier.has_curved:
-            special |= back & np.take(tier.tri_curved, ph)
+            special |= back & tier.tri_curved.take(ph)
             found = True
         if tier.owned and not (not isinstance(excl, np.ndarray) and excl < 0):
-            special |= np.take(tier.tri_owner, ph) == (excl[rows] if isinstance(excl, np.ndarray) else excl)
+            special |= tier.tri_owner.take(ph) == (excl[rows] if isinstance(excl, np.ndarray) else excl)
             found = True
         return special if found and np.count_nonzero(special) else None
 
@@ -384,11 +384,11 @@ class TierTracer(Refiner):
                 elif len(fl):
                     rows = rows_h[fl]
                     tri = ph[fl]
-                    nrm = np.take(tier.normal, tri, axis=0)
+                    nrm = tier.normal.take(tri, axis=0)
                     Dr = _rows(D, rows)
                     dn = _dot(Dr, nrm)
                     if exact:
-                        V0 = np.take(tier.v0, tri, axis=0)
+                        V0 = tier.v0.take(tri, axis=0)
                         if one_origin:   # a lidar: v0 - o for its one origin (the same values)
                             tx = _dot(_minus(V0, Ot[0]), nrm) / dn
                         else:
@@ -408,13 +408,13 @@ class TierTracer(Refiner):
                         # unless Embree's hit lies farther inside than the float32 rounding of the
                         # ray and the triangle can move it (a few ulps, < 4 eps, across the plane:
                         # / sin of the incidence): then they are inside for sure
-                        check = ~(margin * np.take(tier.h_min, tri) * np.abs(dn) > 4.0 * eps * d_max)
+                        check = ~(margin * tier.h_min.take(tri) * np.abs(dn) > 4.0 * eps * d_max)
                         check &= ~near_edge
                         ci = check.nonzero()[0]
                         if len(ci):
                             P = Ot[rows[ci]] + tx[ci, None] * Dr[ci] - V0[ci]
-                            bu = _dot(P, np.take(tier.g1, tri[ci], axis=0))
-                            bv = _dot(P, np.take(tier.g2, tri[ci], axis=0))
+                            bu = _dot(P, tier.g1.take(tri[ci], axis=0))
+                            bv = _dot(P, tier.g2.take(tri[ci], axis=0))
                             near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
                         edge = near_edge.nonzero()[0]
                         if len(edge):
@@ -432,7 +432,7 @@ class TierTracer(Refiner):
                             dn[edge] = _dot(D[r], nrm[edge])
                     else:
                         tx = np.minimum(t_e[h[fl]], lim[rows])
-                        gap = np.abs(_dot(_rows(Ot, rows) - np.take(tier.v0, tri, axis=0), nrm))
+                        gap = np.abs(_dot(_rows(Ot, rows) - tier.v0.take(tri, axis=0), nrm))
                         ok = ~((t_e[h[fl]] < seg[rows] + eps) & (gap <= 2.0 * eps))  # self-hit
                     acc = ok & (tx < best_t[rows])
                     if len(rows) == m and acc.all():
@@ -445,7 +445,7 @@ class TierTracer(Refiner):
                         r = rows[k]
                         best_t[r] = tx[k]
                         if not distance_only:
-                            nk = np.take(nrm, k, axis=0)
+                            nk = nrm.take(k, axis=0)
                             nk *= np.where(dn[k] > 0.0, -1.0, 1.0)[:, None]   # toward the origin
                             best_s[r], best_n[r] = tier.tri_shape[tri[k]], nk
                     rej[fl[~ok]] = True
