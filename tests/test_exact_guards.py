@@ -47,13 +47,18 @@ def _grid_square(n=4):
     return v, np.array(f)
 
 
-def _engine(base, landmark=False):
+def _engine(base, landmark=False, copies=1, shift=0.0):
+    """The scene at ``base``; ``copies`` > 1: pasted again at the same poses, each copy moved by
+    ``shift`` m along (1, 1, 1) from the last (0: the same shapes at the same poses)."""
     e = RayEngine(Precision.EXACT)
-    for size, c in BOXES:
-        e.add_body([ShapeEntry(Box(size), Pose.from_axis_angle((0, 0, 1), 0.0, np.add(base, c)), True, True)],
-                   Pose.identity())
     v, f = _grid_square()
-    e.add_body([ShapeEntry(Mesh(v + base, f, closed=False), Pose.identity(), True, True)], Pose.identity())
+    square = Mesh(v + base, f, closed=False)
+    for k in range(copies):
+        at = np.add(base, k * shift)
+        for size, c in BOXES:
+            e.add_body([ShapeEntry(Box(size), Pose.from_axis_angle((0, 0, 1), 0.0, np.add(at, c)), True, True)],
+                       Pose.identity())
+        e.add_body([ShapeEntry(square, Pose.from_axis_angle((0, 0, 1), 0.0, at - base), True, True)], Pose.identity())
     if landmark:   # one static tier from the origin to base: a coarse float32 frame (res ~1 mm at 1e4 m)
         e.add_body([ShapeEntry(Box((1, 1, 1)), Pose.identity(), True, True)], Pose.identity())
     return e
@@ -226,6 +231,81 @@ def test_tiers_with_many_risky_edges_keep_the_offset_copy():
     assert e2._static_tier("bounding").guarded
 
 
+
+def test_pasted_copies_of_the_solids_cost_one_copy():
+    """k copies of the same solids at the same poses (a world whose solids were pasted k times:
+    it validates) are one copy to the engine: the `lighting` world x333 took 39 s and 3.4 GB in
+    EXACT (every risky edge had k coincident neighbours: the guards' lists grew as k^2)."""
+    one, many = _engine(np.zeros(3)), _engine(np.zeros(3), copies=300)
+    o, d = _rays(5)
+    o, d = o[::8], d[::8]
+    t1, t = one.cast(o, d), many.cast(o, d)
+    assert len(many._static_tier("bounding").F) == len(one._static_tier("bounding").F)
+    assert many._static_tier("bounding").guarded
+    assert np.array_equal(t.distance, t1.distance) and np.array_equal(t.shape, t1.shape)   # the first copy
+    wrong, err = _judge(o, d, t.distance, 1e-12)
+    assert not wrong.any() and err.max() <= 1e-12
+
+
+def test_near_coincident_copies_keep_the_offset_copy_before_any_list_is_made(monkeypatch):
+    """Copies a few nm apart are different surfaces (no two are the same shape), so they stay; their
+    guards' candidate lists would grow as k^2 and are counted first: past the budget (linear in
+    the triangles) the tier keeps the offset-copy repair, linear work, without making them."""
+    made = []
+    real = tiers.candidates
+
+    def counted(*a, **k):
+        out = real(*a, **k)
+        made.append(None if out is None else len(out[1]))
+        return out
+
+    monkeypatch.setattr(tiers, "candidates", counted)
+    few = _engine(np.zeros(3), copies=2, shift=1e-9)
+    many = _engine(np.zeros(3), copies=60, shift=1e-9)
+    o, d = _rays(5)
+    o, d = o[::8], d[::8]
+    few.cast(o, d)
+    assert few._static_tier("bounding").guarded and made[-1] <= 256 * len(few._static_tier("bounding").F)
+    t = many.cast(o, d).distance
+    assert made[-1] is None and not many._static_tier("bounding").guarded
+    # the closed form of the 60 copies (the nearest over them; surfaces closer than float32's
+    # resolution may come out in either order: 1e-6 m); the offset copy is the former repair,
+    # which leaves some rays wrong that graze an edge (all of these do: tests/test_raycast_precision.py)
+    ref = np.min([_closed_form(o - k * 1e-9, d) for k in range(60)], axis=0)
+    with np.errstate(invalid="ignore"):
+        right = (np.abs(t - ref) <= 1e-6) | (np.isinf(t) & np.isinf(ref))
+    assert np.count_nonzero(right) >= 0.98 * len(t), np.count_nonzero(~right)
+
+
+def test_a_room_with_an_stl_rock_and_curved_shapes_keeps_its_guards():
+    """The arena's kind of scene: boxes, curved shapes and a rock mesh read from STL (every vertex
+    repeated per triangle). The rock's vertices are welded (its triangles share edges, so only its
+    creases are risky: 1.5 per triangle, not 3), and the tier keeps its guards (prisms adding ~3
+    triangles per triangle) instead of the offset copy; rays at the boxes' edges stay exact."""
+    from sensorium.server.world.geometry import Cylinder, Sphere
+
+    rock = trimesh.creation.icosphere(subdivisions=2, radius=0.3)
+    soup = rock.vertices[rock.faces].reshape(-1, 3)            # an STL: three vertices per triangle
+    e = _engine(np.zeros(3))
+    e.add_body([ShapeEntry(Mesh(soup + [0.5, 2.0, -2.0], np.arange(len(soup)).reshape(-1, 3), closed=True),
+                           Pose.identity(), True, True)], Pose.identity())
+    for k in range(4):
+        e.add_body([ShapeEntry(Sphere(0.2, subdivision=3) if k % 2 else Cylinder(0.1, 0.5, subdivision=64),
+                               Pose.from_axis_angle((0, 0, 1), 0.0, [-3.0 + 0.6 * k, -3.0, -2.0]), True, True)],
+                   Pose.identity())
+    o, d = _rays(6)
+    o, d = o[::8], d[::8]
+    t = e.cast(o, d).distance
+    tier = e._static_tier("bounding")
+    rock_tri = (tier.tri_shape[:-1] == len(BOXES) + 1).nonzero()[0]
+    assert len(np.unique(tier.F[rock_tri])) == len(rock.vertices)   # welded: 162 vertices, not 960
+    flat = ~tier.tri_curved[:-1]
+    assert len(risky_edges(tier.F, flat, tier.normal[:-1])[0]) > 1.2 * flat.sum()   # more than 1.2 per flat triangle
+    assert tier.guarded and tier.guard is not None
+    wrong, err = _judge(o, d, t, 1e-12)        # (the rock and the shells lie under the floor slab)
+    assert not wrong.any() and err.max() <= 1e-12
+
+
 @pytest.mark.parametrize("offset", [0.0, 5e3])
 def test_exact_distance_only_gives_the_full_casts_distances(offset):
     """A lidar's EXACT cast skips shapes and normals (distance_only): the distances are the full
@@ -325,3 +405,35 @@ def test_each_case_against_its_closed_form(case, monkeypatch):
           f"({c['edge_guard_hits']} guard finds)")
     if case.startswith("shared edge"):   # the premise: Embree's robust cast is watertight there
         assert leaks == 0
+
+
+def test_the_lighting_world_pasted_333_times_runs_like_the_lighting_world(tmp_path):
+    """Issue 28's case, as a world file: the `lighting` example's solids pasted 333 times at the
+    same poses (127 KB, within every limit) validates; its first EXACT steps took 39 s and 3.4 GB.
+    Now its static scenes are the original's (the copies add no triangle) and every device reads
+    what it reads in the original world."""
+    from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.loader import default_world_path
+
+    src = default_world_path().with_name("lighting.yaml").read_text()
+    head, rest = src.split("solids:\n", 1)
+    solids, tail = rest.split("\nlights:", 1)
+    pasted = "".join(solids.replace("name: floor", f"name: floor_{k}").replace("name: screen", f"name: screen_{k}")
+                     .replace("name: lamp_shade", f"name: lamp_shade_{k}") for k in range(333))
+    (tmp_path / "one.yaml").write_text(src)
+    (tmp_path / "pasted.yaml").write_text(head + "solids:\n" + pasted + "\nlights:" + tail)
+    assert (tmp_path / "pasted.yaml").stat().st_size > 100_000
+    sims = []
+    for name in ("one.yaml", "pasted.yaml"):
+        sim = Simulation.from_file(tmp_path / name, precision="exact")
+        for dev in sim.all_devices():
+            dev.enable(sim.basic_time_step)
+        sim.step()
+        sim.step()
+        sims.append(sim)
+    assert len(sims[1].world.solids) == 333 * len(sims[0].world.solids)
+    for variant in ("bounding", "visual"):
+        one, pasted_tier = (s.scene.engine._static_tier(variant) for s in sims)
+        assert len(one.F) == len(pasted_tier.F)
+    for a, b in zip(sims[0].all_devices(), sims[1].all_devices()):
+        assert a.path == b.path and a.value == b.value, a.path

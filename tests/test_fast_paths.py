@@ -104,11 +104,16 @@ def test_point_cloud_with_cached_directions_is_bit_identical(kw):
         a = lmath.point_cloud(p, rng_img, 1.5, 0.1, columns=columns)
         b = lmath.point_cloud(p, rng_img, 1.5, 0.1, columns=columns, directions=dirs)
         assert a.tobytes() == b.tobytes()
-        # the record fields hold the float32-rounded float64 products, in layer-major order
+        # the record fields hold the float32-rounded float64 products, in layer-major order; a ray
+        # without a hit (range inf) gives inf along its direction's non-zero components and NaN
+        # where the component is zero (inf * 0, as in Webots), decided here without computing it
         d = lmath.point_cloud_directions(p, columns)
-        xyz = (rng_img.astype(np.float64)[:, :, None] * d).astype(np.float32).reshape(-1, 3)
-        finite = np.isfinite(xyz[:, 0])
-        np.testing.assert_array_equal(np.stack([a["x"], a["y"], a["z"]], 1)[finite], xyz[finite])
+        r64 = rng_img.astype(np.float64)[:, :, None]
+        hit = np.isfinite(r64)
+        xyz = np.where(hit, np.where(hit, r64, 0.0) * d,
+                       np.where(d == 0.0, np.nan, np.copysign(np.inf, d))).astype(np.float32).reshape(-1, 3)
+        assert np.isinf(xyz).any() and np.isnan(xyz).any() == bool(np.any(d == 0.0))
+        np.testing.assert_array_equal(np.stack([a["x"], a["y"], a["z"]], 1), xyz)
         assert a["layer_id"].tolist() == np.repeat(np.arange(8), rng_img.shape[1]).tolist()
 
 

@@ -81,6 +81,35 @@ def test_floor_under_a_lidar_gives_the_general_plane_answer(origin, floor):
     assert seen_plane == {"up": origin[2] > 0.0, "down": origin[2] < 2.0, "shifted": origin[2] > 0.25}[floor]
 
 
+@pytest.mark.parametrize("yaw", [0.0, 0.3])
+def test_sized_floor_under_a_lidar_gives_the_general_plane_answer(yaw):
+    """A sized floor (the arena's 4 m x 4 m, its sides along world axes): the lean path tests the
+    size on the two horizontal coordinates alone, with the general pass's values bit for bit
+    (beams that leave the floor miss it); turned by 0.3 rad it is not along world axes and takes
+    the general pass."""
+    eng = RayEngine(Precision.FAST)
+    eng.add_body([ShapeEntry(Plane((4.0, 3.0)), Pose.identity(), True, True)],
+                 Pose.from_axis_angle((0, 0, 1), yaw, [0.3, -0.2, 0.0]))
+    O, D = _beams((0.6, 0.4, 0.15), n_az=720, layers=(-0.3, -0.1, -0.05, -0.02, 0.0))
+    eng.cast(O[:1], D[:1], kind=RayKind.VISUAL)
+    pl = eng._plane_set("visual")
+    assert (pl.size_axes is not None) == (yaw != 0.3)
+    for t_far in (6.0, 40.0):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lean = planes_module.cast_planes(pl, eng._epoch, O, D, 0.02, t_far, -1, 1e-9, True)
+            axis, pl.axis = pl.axis, -1
+            try:
+                general = planes_module.cast_planes(pl, eng._epoch, O, D, 0.02, t_far, -1, 1e-9, True)
+            finally:
+                pl.axis = axis
+        assert lean[0].tobytes() == general[0].tobytes()
+        hit = np.isfinite(general[0])
+        assert 0 < hit.sum() < len(D) * 0.8          # some beams leave the floor before reaching it
+        full = eng.cast(np.ascontiguousarray(O), D, 0.02, t_far, kind=RayKind.VISUAL)
+        assert eng.cast(O, D, 0.02, t_far, kind=RayKind.VISUAL, distance_only=True).distance.tobytes() == \
+            full.distance.tobytes()
+
+
 def test_float32_directions_kept_by_the_caller():
     eng = _floor_scene(Pose.identity())
     O, D = _beams((0.1, 0.2, 0.9))

@@ -289,3 +289,70 @@ def test_the_simulation_keeps_one_joined_mount_for_sensor_groups_cast_together()
     sim.step()
     assert eng.counters["neighbour_lists"] == 2
     assert all(sim.device(f"r0/ps{k}").value == 70.0 for k in range(6))   # nothing in reach any more
+
+
+def _lidar_beams(W=720, L=24, vfov=0.6):
+    az = np.linspace(-math.pi, math.pi, W, endpoint=False)
+    el = np.linspace(-vfov / 2, vfov / 2, L)
+    A, E = np.meshgrid(az, el)
+    return np.stack([np.cos(E) * np.cos(A), np.cos(E) * np.sin(A), np.sin(E)], -1).reshape(-1, 3)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_lidar_mount_that_sees_its_own_body_gives_the_plain_answers_bit_for_bit(precision):
+    """A lidar rides a robot whose body its lower beams hit, beside other robots that move and turn:
+    Mount(own=True) decides once which beams can reach the own body (in the body frame) and traces
+    only those against it, and pairs the other robots per cast; every distance is the one the cast
+    without a mount gives (which pairs every beam with the own body), bit for bit."""
+    eng = RayEngine(precision)
+    eng.add_body([ShapeEntry(Plane(), Pose.identity(), True, True)], Pose.identity())
+    eng.add_body([ShapeEntry(Box((4.0, 0.1, 0.3)), Pose.identity(), True, True)], Pose(np.eye(3), np.array([0.0, 1.5, 0.15])))
+    scout = eng.add_body([ShapeEntry(Box((0.3, 0.2, 0.12)), Pose.identity(), True, True)],
+                         Pose(_rz(0.4), np.array([0.1, 0.2, 0.06])), owner=0, movable=True)
+    others = [eng.add_body([ShapeEntry(Cylinder(0.035, 0.05), Pose.identity(), True, True)],
+                           Pose(_rz(0.0), np.array([x, y, 0.025])), owner=k + 1, movable=True)
+              for k, (x, y) in enumerate([(0.6, 0.2), (-0.5, -0.4), (0.2, 0.9)])]
+    D_loc = _lidar_beams()
+    lidar_at = np.array([0.0, 0.0, 0.09])
+    mount = Mount(np.full(len(D_loc), scout), own=True)
+    rng = np.random.default_rng(4)
+    own_rays = []
+    for step in range(6):
+        pose = Pose(_rz(0.4 + 0.3 * step), np.array([0.1 + 0.05 * step, 0.2 - 0.03 * step, 0.06]))
+        eng.set_body_pose(scout, pose)
+        for b in others:
+            eng.set_body_pose(b, Pose(_rz(rng.uniform(0, 6)), np.array([*rng.uniform(-0.8, 0.8, 2), 0.025])))
+        O = np.broadcast_to(pose.apply(lidar_at[None])[0], D_loc.shape)
+        D = D_loc @ pose.rotation.T
+        plain = eng.cast(O, D, 0.02, 6.0, kind=RayKind.VISUAL, distance_only=True)
+        kept = eng.cast(O, D, 0.02, 6.0, kind=RayKind.VISUAL, distance_only=True, mount=mount)
+        assert plain.distance.tobytes() == kept.distance.tobytes()
+        own_rays.append(len(mount._state.own_pr))
+    st = mount._state
+    assert 0 < own_rays[0] < 0.3 * len(D_loc) and len(set(own_rays)) == 1   # decided once, a few beams
+    assert (D_loc[st.own_pr, 2] < 0.0).all()          # the beams that go down towards the body
+    assert np.isfinite(kept.distance[st.own_pr]).mean() > 0.9
+
+
+def test_the_simulation_mounts_a_fixed_lidar_on_its_robots_body():
+    world = {"world_info": {"basic_time_step": 32},
+             "solids": [{"name": "floor", "geometry": {"type": "plane"}},
+                        {"name": "wall", "pose": {"translation": [1.0, 0, 0.2]}, "geometry": {"type": "box", "size": [0.1, 2, 0.4]}}],
+             "robots": [{"name": "scout", "pose": {"translation": [0, 0, 0.06]},
+                         "body": {"geometry": {"type": "box", "size": [0.3, 0.2, 0.12]}},
+                         "devices": [{"device": "Lidar", "name": "lidar", "pose": {"translation": [0, 0, 0.09]},
+                                      "horizontal_resolution": 360, "number_of_layers": 16,
+                                      "vertical_field_of_view": 0.6, "field_of_view": 6.283185307179586,
+                                      "near": 0.0, "min_range": 0.0, "max_range": 6.0}]}]}
+    sims = [Simulation(parse_world(world), precision="fast") for _ in range(2)]
+    for sim in sims:
+        sim.device("scout/lidar").enable(32)
+    sims[1].device("scout/lidar")._mount = (-7, None)   # a body index no cast accepts: replaced at once
+    for sim in sims:
+        sim.step()
+    a, b = (s.device("scout/lidar") for s in sims)
+    assert a._mount is not None and a._mount[1].own is not None and a._mount[1]._state is not None
+    assert b._mount[0] == a._mount[0]
+    assert a.range_image.tobytes() == b.range_image.tobytes()
+    plan = a.plan(sims[0].robots["scout"].pose, 64, 32)[0]
+    assert plan.mount is None                          # without the body index: no mount

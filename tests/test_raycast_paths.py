@@ -63,6 +63,34 @@ def test_scalar_analytic_is_bit_identical(code, m):
     assert np.isfinite(t).sum() > m // 5               # the test exercises hits, not just misses
 
 
+def test_one_pass_over_mixed_kinds_is_bit_identical_to_each_kind_alone():
+    """EXACT refines a few curved hits of several kinds (a sphere, a cylinder, a capsule) in one pass:
+    every row's t and normal are those of its own kind's intersector, bit for bit (origins inside,
+    rays parallel to the caps, along the axis, hits near the rims)."""
+    rng = np.random.default_rng(9)
+    m = 600
+    codes = rng.choice([exact._SPHERE, exact._CYLINDER, exact._CAPSULE], m)
+    r = rng.uniform(0.2, 0.9, m)
+    h = np.where(codes == exact._SPHERE, 0.0, rng.uniform(0.1, 0.8, m))
+    p = rng.uniform(-1.5, 1.5, (m, 3))
+    p[:60] *= 0.2                                   # some origins inside
+    d = _unit(rng.uniform(-0.6, 0.6, (m, 3)) - p)
+    d[60:90, 2] = 0.0                               # parallel to the caps
+    d[90:100] = [0.0, 0.0, -1.0]                    # along the axis
+    d = _unit(d)
+    lo = rng.uniform(0.0, 0.3, m)
+    hi = lo + rng.uniform(0.0, 3.0, m)
+    with np.errstate(all="ignore"):
+        t, n = exact._analytic_mixed(codes, p, d, r, h, lo, hi)
+        t_only, _ = exact._analytic_mixed(codes, p, d, r, h, lo, hi, normals=False)
+        for code in (exact._SPHERE, exact._CYLINDER, exact._CAPSULE):
+            g = codes == code
+            tk, nk = exact._analytic_local(code, p[g], d[g], r[g], h[g], lo[g], hi[g])
+            assert t[g].tobytes() == tk.tobytes() and n[g].tobytes() == nk.tobytes()
+            assert np.isfinite(tk).sum() > g.sum() // 5
+    assert t_only.tobytes() == t.tobytes()
+
+
 # ---------------------------------------------------------------------------------------------
 # broad phase
 

@@ -139,9 +139,12 @@ def timed(fn: Callable[[], Any], repeat: int, warmup: int = 1, min_total_s: floa
 
 
 def interleaved(fns: dict[str, Callable[[], Any]], rounds: int, per_round: int = 1,
-                warmup: int = 1) -> dict[str, list[float]]:
+                warmup: int = 1, clock: Callable[[], float] = time.perf_counter) -> dict[str, list[float]]:
     """Time several competitors in alternation (A B C A B C …) so that load from other processes
-    on this shared machine hits all of them alike; returns per-call seconds for each."""
+    on this shared machine hits all of them alike; returns per-call seconds for each. ``clock``:
+    ``time.thread_time`` measures the calling thread's CPU time instead of the wall clock (for
+    one-thread calls on a busy machine: a call preempted by another process is not charged for
+    the wait, which otherwise falls more often on the longer calls)."""
     for fn in fns.values():
         for _ in range(warmup):
             fn()
@@ -152,9 +155,9 @@ def interleaved(fns: dict[str, Callable[[], Any]], rounds: int, per_round: int =
         for _ in range(rounds):
             for k, fn in fns.items():
                 for _ in range(per_round):
-                    t0 = time.perf_counter()
+                    t0 = clock()
                     fn()
-                    out[k].append(time.perf_counter() - t0)
+                    out[k].append(clock() - t0)
     finally:
         if gc_was:
             gc.enable()
@@ -288,13 +291,17 @@ def machine() -> dict:
 
 
 # ----------------------------------------------------------------------------- simulations
-def make_sim(world: dict, precision: str = "exact", base_dir=None):
+def make_sim(world: dict, precision: str = "exact", base_dir=None, threads: int | None = None):
+    """A simulation of ``world`` (limits raised: benchmark worlds are deliberately large);
+    ``threads``: the threads its ray engine may use (default: the engine's, both cores here)."""
     from sensorium.server.sim.simulation import Simulation
     from sensorium.server.world.limits import WorldLimits
     from sensorium.server.world.loader import parse_world
 
-    # benchmark worlds are deliberately large (--allow-large)
-    return Simulation(parse_world(world, base_dir=base_dir, limits=WorldLimits.large()), precision=precision)
+    sim = Simulation(parse_world(world, base_dir=base_dir, limits=WorldLimits.large()), precision=precision)
+    if threads is not None:
+        sim.scene.engine.threads = threads
+    return sim
 
 
 def identity_table(max_range: float, noise: float = 0.0) -> list[list[float]]:
@@ -529,6 +536,19 @@ def world_triangles(sim, plane_half: float = 100.0) -> list[tuple[str, np.ndarra
         v, f = tessellate(primitive_from_model(g, sim.loaded.base_dir))
         out.append((name, pose.apply(v), np.asarray(f), False))
     return out
+
+
+def world_shapes(sim) -> list[tuple[str, Any, Any]]:
+    """The visible shapes of a simulation as (name, geometry model, world pose), one per solid or
+    robot body, for engines with their own primitives (MuJoCo's planes, boxes, spheres, cylinders,
+    capsules; a mesh stays a mesh)."""
+    items = [(s.name, s, None) for s in sim.world.solids]
+    items += [(f"{r.name}/body", r.body, sim.scene.robot_poses[i]) for i, r in enumerate(sim.world.robots)
+              if r.body is not None]
+    from sensorium.server.world.poses import pose_from_model
+
+    return [(name, shape.geometry, pose if pose is not None else pose_from_model(shape.pose))
+            for name, shape, pose in items if shape.seen_by != "bounding"]
 
 
 def merge_triangles(parts) -> tuple[np.ndarray, np.ndarray]:

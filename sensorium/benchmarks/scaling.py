@@ -56,7 +56,8 @@ def run(cfg: Config) -> Section:
         "planning rays and reducing hits in Python. Growth is the least-squares slope of log(time) vs "
         "log(size) over the upper half of each sweep (1 = linear, 0 = constant), where per-step fixed "
         "costs no longer hide it. The points of a sweep are measured one after another on a shared machine, so "
-        "read slopes to about ±0.2. Controllers in lockstep are in the transport section."))
+        "read slopes to about ±0.2. One thread throughout (`RayEngine.threads = 1`: what both cores add is "
+        "in the peers section). Controllers in lockstep are in the transport section."))
     for sweep in (rays_sweep, triangles_sweep, lights_sweep, devices_sweep, robots_sweep):
         t0 = time.perf_counter()
         sweep(cfg, sec)
@@ -113,7 +114,7 @@ def rays_sweep(cfg: Config, sec: Section) -> None:
         n = W * L
         res = {}
         for prec in ("fast", "exact"):
-            sim = make_sim(room_world([lidar_device("lidar", W, L)]), prec)
+            sim = make_sim(room_world([lidar_device("lidar", W, L)]), prec, threads=1)
             sim.device("r/lidar").enable(32)
             res[prec] = _step_times(sim, cfg, cfg.pick(0.5, 0.1) if n <= 100_000 else 0.0)
         xs.append(n)
@@ -164,7 +165,7 @@ def triangles_sweep(cfg: Config, sec: Section) -> None:
                      "solids": [{"name": "terrain", "geometry": {"type": "mesh", "url": str(path)}}],
                      "robots": [{"name": "r", "pose": {"translation": [0.0, 0.0, 1.5]},
                                  "devices": [{**lidar_device("lidar", W, L, max_range=30.0), "tilt_angle": -0.35}]}]}
-            sim = make_sim(world, "exact", base_dir=Path(tmp))
+            sim = make_sim(world, "exact", base_dir=Path(tmp), threads=1)
             sim.device("r/lidar").enable(32)
             t0 = time.perf_counter()
             sim.step()                                    # first step builds the BVH
@@ -204,7 +205,7 @@ def lights_sweep(cfg: Config, sec: Section) -> None:
         world = room_world(devs)
         world["lights"] = lights
         world["world_info"]["basic_time_step"] = 8
-        sim = make_sim(world, "exact")
+        sim = make_sim(world, "exact", threads=1)
         for d in sim.all_devices():
             d.enable(8)
         t, r = _step_times(sim, cfg, cfg.pick(0.4, 0.1))
@@ -227,7 +228,7 @@ def devices_sweep(cfg: Config, sec: Section) -> None:
                  "pose": {"rotation": [0, 0, 1, 2 * math.pi * i / n]}, "lookup_table": identity_table(2.0)} for i in range(n)]
         world = room_world(devs)
         world["world_info"]["basic_time_step"] = 8
-        sim = make_sim(world, "exact")
+        sim = make_sim(world, "exact", threads=1)
         for d in sim.all_devices():
             d.enable(8)
         t, r = _step_times(sim, cfg, cfg.pick(0.4, 0.1))
@@ -252,13 +253,13 @@ def robots_sweep(cfg: Config, sec: Section) -> None:
         robots = [epuck(f"e{i}", -3.0 + 6.0 * (i % side) / max(side - 1, 1), -2.2 + 4.4 * (i // side) / max(side - 1, 1),
                         yaw=0.37 * i) for i in range(n)]
         world = {"world_info": {"basic_time_step": 8}, "solids": [s.solid() for s in shapes], "robots": robots}
-        sim = make_sim(world, "exact")
+        sim = make_sim(world, "exact", threads=1)
         for d in sim.all_devices():
             d.enable(8)
         t, r = _step_times(sim, cfg, cfg.pick(0.5, 0.15))
         # the same rays cast one sensor at a time (what batching saves)
         unb = _unbatched_ray_time(sim, cfg) if n <= cfg.pick(100, 10) else float("nan")
-        fast = make_sim(world, "fast")
+        fast = make_sim(world, "fast", threads=1)
         for d in fast.all_devices():
             d.enable(8)
         cpu: list[float] = []
@@ -271,7 +272,7 @@ def robots_sweep(cfg: Config, sec: Section) -> None:
                                        prof, "800 infra-red sensors (2,400 rays) measured every step.")
             sec.data["robots_profile"] = prof
             bodiless = {**world, "robots": [{k: v for k, v in rb.items() if k != "body"} for rb in world["robots"]]}
-            nb = make_sim(bodiless, "fast")
+            nb = make_sim(bodiless, "fast", threads=1)
             for dd in nb.all_devices():
                 dd.enable(8)
             _, r_nobody = _step_times(nb, cfg, cfg.pick(0.3, 0.1))

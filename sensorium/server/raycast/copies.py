@@ -15,7 +15,7 @@ One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
 * the mover pass pairs each ray with the bodies of its copy (a dense (rays x slots) bounding-sphere
   test: the copy gives the candidates, no grid), drops its excluded owner and its mount, moves each
   pair into the body's frame with the same float64 products the single world's engine uses for
-  one mover (``(O - T) @ R``, one product per body, so the bits are the engine's), and traces all
+  one mover (``(O - T) @ R`` in the engine's summation order, ``exact._to_frame``, so the bits are the engine's), and traces all
   pairs of one template tier in ONE call -- a hundred robots' pairs cost one Embree call, not a
   hundred.
 
@@ -33,7 +33,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from sensorium.server.raycast.engine import RayEngine
-from sensorium.server.raycast.exact import _INF, _PRUNE, _mat, _minus, _param, _take
+from sensorium.server.raycast.exact import _INF, _PRUNE, _from_frame, _minus, _param, _take, _to_frame
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind
 
 __all__ = ["CopyRays"]
@@ -185,8 +185,8 @@ class CopyRays:
         for a, z, m in zip(starts, ends, movers):
             rows = pr[a:z]
             Rb, Tb = rotf[m], posf[m]
-            Ob[a:z] = _mat(_minus(np.take(O, rows, axis=0), Tb), Rb)
-            Db[a:z] = _mat(np.take(D, rows, axis=0), Rb)
+            Ob[a:z] = _to_frame(_minus(np.take(O, rows, axis=0), Tb), Rb)    # the engine's summation order
+            Db[a:z] = _to_frame(np.take(D, rows, axis=0), Rb)
         slot = pm % R
         t_all = np.full(len(pr), _INF)
         s_all = None if distance_only else np.full(len(pr), -1, dtype=np.int64)
@@ -243,5 +243,5 @@ class CopyRays:
         wm = pm[w]
         cut = np.flatnonzero(wm[1:] != wm[:-1]) + 1
         for a, z in zip(np.concatenate([[0], cut]).tolist(), np.concatenate([cut, [len(w)]]).tolist()):
-            normal[rows[a:z]] = _mat(n_all[w[a:z]], rotf[wm[a]].T)   # body frame -> world, as the engine
+            normal[rows[a:z]] = _from_frame(n_all[w[a:z]], rotf[wm[a]])   # body frame -> world, as the engine
         return RayHits(dist, normal, shape)

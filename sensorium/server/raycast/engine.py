@@ -1,9 +1,23 @@
 """Ray-query engine: Embree (float32 BVH traversal) + float64 refinement.
 
 The public cast API (:class:`RayEngine`).  The package is split by job: :mod:`.kinds` (value
-types), :mod:`.exact` (float64 kernels), :mod:`.tiers` (Embree scenes; the only embreex import),
-:mod:`.movers` (moving bodies, broad phase), :mod:`.planes` (analytic planes), :mod:`.trace`
-(tracing one tier) and :mod:`.refine` (float64 refinement, curved-shell pre-pass).
+types), :mod:`.exact` (float64 kernels), :mod:`.tiers` (Embree scenes), :mod:`.packets` (Embree's
+packet traversal through a small C helper, when a compiler is there; else embreex), :mod:`.blocks`
+(large casts in ray blocks on both cores), :mod:`.movers` (moving bodies, broad phase, Mount),
+:mod:`.planes` (analytic planes), :mod:`.trace` (tracing one tier) and :mod:`.refine` (float64
+refinement, curved-shell pre-pass).
+
+Speed (measured in ``sensorium bench``, peers section)
+------------------------------------------------------
+* Traversal: packets of 16 rays through the Embree library embreex loaded; a FAST scan from one
+  origin as coherent packets (~3.4x embreex's one ray per call on one thread), everything else as
+  incoherent ones (embreex's answers bit for bit; see :mod:`.packets` for the bounded difference
+  of coherent packets).  Without a C compiler: embreex, the same answers.
+* Threads: a cast of >= ``blocks.MIN_RAYS`` rays runs its planes and static tier in blocks on
+  ``RayEngine.threads`` threads (default: the cores this process may use; ``SENSORIUM_THREADS``),
+  and so do a lidar's own-body pairs; no ray's answer depends on its block or on the other rays of
+  its batch (world-to-frame rotations are summed in one fixed order, never by BLAS), so the bits
+  are the same on any number of threads.
 
 Architecture
 ------------
@@ -68,8 +82,10 @@ Precision
   scene: a ray that meets one is tested in float64 against that edge's triangles and their vertex
   rings (and those of edges whose prisms come close), the same past every further prism up to its
   hit, and then gets the hit of the scene without prisms (``counters["edge_guard_hits"]`` counts
-  the float64 hits they found).  A tier with many risky edges (a curved or terrain mesh: more
-  than 1.2 per flat triangle, or 20,000) keeps the former repair instead: each Embree cast paired
+  the float64 hits they found).  A tier with many risky edges (a curved or terrain mesh alone:
+  more than 1.2 per flat triangle and prisms adding more than 4 triangles per triangle of the
+  tier, or 20,000 edges; candidate lists past their budget, see :mod:`.guards`) keeps the former
+  repair instead: each Embree cast paired
   with a copy offset 4 float32 ulps perpendicular to the ray, whose nearer hits are taken when the
   float64 ray hits that triangle or a neighbour (``counters["leak_repairs"]``).
 
@@ -90,10 +106,12 @@ Known limits (measure-zero in practice)
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 
 import numpy as np
 
+from sensorium.server.raycast.blocks import MIN_RAYS, available, run, split
 from sensorium.server.raycast.exact import (
     _CHUNK,
     _DENSE_PAIRS,
@@ -103,12 +121,13 @@ from sensorium.server.raycast.exact import (
     _SMALL,
     _TINY,
     _best_per_row,
+    _from_frame,
     _full,
-    _mat,
     _minus,
     _param,
     _strictly_increasing,
     _take,
+    _to_frame,
 )
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind, ShapeEntry
 from sensorium.server.raycast.movers import (
@@ -121,6 +140,8 @@ from sensorium.server.raycast.movers import (
     _sphere_pairs,
     mount_candidates,
     mount_state,
+    one_origin_pairs,
+    with_own_pairs,
 )
 from sensorium.server.raycast.planes import _Planes, cast_planes
 from sensorium.server.raycast.tiers import _Tier, new_device
@@ -160,6 +181,8 @@ class RayEngine(TierTracer):
         self._mover_tables: dict[str, _Movers | None] = {}
         self._shared: dict[tuple, _Tier | None] = {}   # body-frame tiers by (variant, shapes)
         self._epoch = 0                                 # bumped by every set_body_pose
+        self.threads = available()   # threads a large cast may use (see .blocks; 1: the calling thread only)
+        self._counting = threading.Lock()
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
             "continued_rays": 0, "unresolved_rays": 0, "edge_guard_hits": 0, "neighbour_lists": 0, "ray_lists": 0,
@@ -333,7 +356,7 @@ class RayEngine(TierTracer):
         if O.shape != D.shape or O.ndim != 2 or O.shape[1] != 3:
             raise ValueError(f"origins/directions must both be (n,3), got {O.shape} and {D.shape}")
         if directions32 is not None and (getattr(directions32, "dtype", None) != np.float32
-                                         or np.shape(directions32) != D.shape):
+                                         or directions32.shape != D.shape):
             raise ValueError(f"directions32 must be the directions as a float32 {D.shape} array")
         n = len(O)
         t_near = _param(t_near, n, np.float64, float)
@@ -357,29 +380,56 @@ class RayEngine(TierTracer):
         if n == 0:
             return RayHits(np.zeros(0), np.zeros((0, 3)), np.zeros(0, dtype=np.int64))
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
-        Ou = O[:1] if O.strides[0] == 0 else O   # one origin for all rays (a broadcast array)
-        big = max(map(abs, Ou.ravel().tolist())) if len(Ou) <= _SMALL else max(float(Ou.max()), -float(Ou.min()))
+        if O.strides[0] == 0:   # one origin for all rays (a broadcast array)
+            big = max(map(abs, O[0].tolist()))
+        else:
+            big = max(map(abs, O.ravel().tolist())) if n <= _SMALL else max(float(O.max()), -float(O.min()))
         # one errstate for the whole cast: inf/NaN are handled explicitly (entering the context
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            if n <= _CHUNK:
+            threads = self.threads
+            if n <= _CHUNK and (threads <= 1 or n < MIN_RAYS):   # (split's answer: one part)
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
                                   directions32)
-            # large batches in chunks: the temporaries (~150 bytes per ray) stay a few MB whatever
-            # the batch, and so in cache; every ray's answer is the same (big is the batch's)
+            parts = split(n, threads, _CHUNK)
+            if len(parts) == 1:
+                return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
+                                  directions32)
+            # large batches in blocks: the temporaries (~150 bytes per ray) stay a few MB whatever the
+            # batch, and the blocks of the planes and the static tier run side by side on the
+            # threads; then the movers, on the whole batch (a Mount keeps its lists for it) or in
+            # blocks; every ray's answer is the same (big is the batch's)
+            exact = self._precision is Precision.EXACT
+            if planes is not None:
+                planes.refresh(self._epoch)
+            if static is not None:
+                static.prepare(exact)
             dist = np.empty(n)
             normal = None if distance_only else np.empty((n, 3))
             shape = None if distance_only else np.empty(n, dtype=np.int64)
-            for a in range(0, n, _CHUNK):
-                sl = slice(a, min(n, a + _CHUNK))
-                m = sl.stop - a
-                h = self._cast(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
-                               _param(_take(t_far, sl), m, np.float64, float), _param(_take(excl, sl), m, np.int64, int),
-                               planes, static, movers, big, None if mount is None else np.asarray(mount)[sl],
-                               distance_only, None if directions32 is None else directions32[sl])
-                dist[sl] = h.distance
+
+            def block(sl: slice) -> None:
+                m = sl.stop - sl.start
+                with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # per thread
+                    h = self._cast_static(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
+                                          _param(_take(t_far, sl), m, np.float64, float),
+                                          _param(_take(excl, sl), m, np.int64, int), planes, static, big,
+                                          distance_only, None if directions32 is None else directions32[sl])
+                dist[sl] = h[0]
                 if not distance_only:
-                    normal[sl], shape[sl] = h.normal, h.shape
+                    shape[sl], normal[sl] = h[1], h[2]
+
+            run(block, parts, threads)
+            if movers is not None:
+                hits = (dist, shape, normal)
+                if isinstance(mount, Mount):
+                    self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits,
+                                      mount=mount)
+                else:
+                    for sl in split(n, 1, _CHUNK):
+                        self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
+                                          1e-9 + 1e-14 * big, exact, *(None if x is None else x[sl] for x in hits),
+                                          mount=None if mount is None else np.asarray(mount)[sl])
             return RayHits(dist, normal, shape)
 
     def cast_local(self, body: int, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
@@ -415,6 +465,16 @@ class RayEngine(TierTracer):
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
               distance_only: bool = False, d32=None) -> RayHits:
+        exact = self._precision is Precision.EXACT
+        hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32)
+        if movers is not None:
+            self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits, mount=mount)
+        return RayHits(hits[0], hits[2], hits[1])
+
+    def _cast_static(self, O, D, t_near, t_far, excl, planes, static, big: float, distance_only: bool = False,
+                     d32=None) -> tuple:
+        """(dist, shape, normal) of the planes and the static tier (shape, normal None when
+        ``distance_only``): the part of a cast that blocks of rays run side by side."""
         n = len(O)
         exact = self._precision is Precision.EXACT
         eps64 = 1e-9 + 1e-14 * big  # float64 self-hit epsilon: 1e-9 m + ~50 ulps of the largest coordinate
@@ -435,9 +495,34 @@ class RayEngine(TierTracer):
         if hits is None:
             hits = ((np.full(n, _INF), None, None) if distance_only else
                     (np.full(n, _INF), np.full(n, -1, dtype=np.int64), np.zeros((n, 3))))
-        if movers is not None:
-            self._cast_movers(movers, O, D, t_near, t_far, excl, eps64, exact, *hits, mount=mount)
-        return RayHits(hits[0], hits[2], hits[1])
+        return hits
+
+    def _trace_split(self, tier: _Tier, O, D, t_near, lim, eps64: float, exact: bool, distance_only: bool):
+        """``_trace`` of a mover tier's (ray, mover) pairs, in blocks on the threads when they are
+        many (a lidar's beams that can reach its own robot): the same answers."""
+        m = len(O)
+        parts = split(m, self.threads, _CHUNK)
+        if len(parts) == 1:
+            return self._trace(tier, O, D, t_near, lim, -1, eps64, exact, None, distance_only)
+        tier.prepare(exact)
+
+        def block(sl: slice):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # per thread
+                return self._trace(tier, O[sl], D[sl], _take(t_near, sl), lim[sl], -1, eps64, exact, None,
+                                   distance_only)
+
+        outs = run(block, parts, self.threads)
+        if all(o is None for o in outs):
+            return None
+        t = np.full(m, _INF)
+        s = None if distance_only else np.full(m, -1, dtype=np.int64)
+        nrm = None if distance_only else np.zeros((m, 3))
+        for sl, o in zip(parts, outs):
+            if o is not None:
+                t[sl] = o[0]
+                if not distance_only:
+                    s[sl], nrm[sl] = o[1], o[2]
+        return t, s, nrm
 
     def _cast_movers(self, mt: _Movers, O, D, t_near, t_far, excl, eps64, exact, dist, shape, normal,
                      mount=None) -> None:
@@ -453,17 +538,26 @@ class RayEngine(TierTracer):
         T, C = mt.T, mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = None
+        tight = -1   # a mover row whose pairs are only a Mount's own pairs (already tested against its bound)
         if mount is not None:
             if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
                 mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
                 mt.row_of[mt.index] = np.arange(len(mt.index))
-            st = mount_state(mount, mt, C, O, t_near, t_far) if isinstance(mount, Mount) else None
-            if st is None:
+            kept = isinstance(mount, Mount)
+            st = mount_state(mount, mt, C, O, t_near, t_far, D, self._rot) if kept else None
+            if st is None and kept and mount.own is not None:
+                pass   # unbounded rays that see their own mount: the general broad phase for all
+            elif st is None:
                 mrow = mt.row_of[np.asarray(mount)]
                 mounted = _mounted_pairs(mt, C, owner, O, D, t_near, lim, excl, mrow)
+            elif len(st.mi) and O.strides[0] == 0 and len(st.used) == 1 and not len(st.rest):   # a lidar
+                mrow = st.mrow
+                tight = int(st.used[0])
+                mounted = (*one_origin_pairs(st, mt, C, O, D, t_near, lim, excl, owner, self._epoch, self.counters),
+                           st.rest)
             elif len(st.mi):   # candidates kept between casts; the segment test as _mounted_pairs does it
                 mrow = st.mrow
-                cr, cm = mount_candidates(st, mt, C, self._rot, O, D, self._epoch, self.counters)
+                cr, cm = with_own_pairs(st, *mount_candidates(st, mt, C, self._rot, O, D, self._epoch, self.counters))
                 mounted = (*_near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, cr, cm), st.rest)
         if mounted is not None and len(mounted[2]) == 0:   # every ray mounted
             pr, pm = mounted[0], mounted[1]
@@ -472,7 +566,7 @@ class RayEngine(TierTracer):
             if sub is None:
                 Os, Ds, tn, ls, ex = O, D, t_near, lim, excl
             else:   # the unmounted rays only
-                Os, Ds, ls = np.take(O, sub, axis=0), np.take(D, sub, axis=0), lim[sub]
+                Os, Ds, ls = O.take(sub, axis=0), D.take(sub, axis=0), lim[sub]
                 tn, ex = _take(t_near, sub), _take(excl, sub)
             if len(C) > _FEW_MOVERS and len(Os) * len(C) > _DENSE_PAIRS:
                 pr, pm = _grid_pairs(C, mt.radius, mt.r2, owner, Os, Ds, tn, ls, ex)
@@ -512,27 +606,34 @@ class RayEngine(TierTracer):
                 gp = mt.group[pm]
                 todo = [(tier, pr[sel], pm[sel], False)
                         for g, tier in enumerate(mt.tiers) if len(sel := (gp == g).nonzero()[0])]
+        one_origin = O.strides[0] == 0   # one origin for all rays (a lidar): it stays one, in every frame
         for tier, rr, mm, one in todo:
             # rays into the body frames (float64): one matrix when all pairs share a mover
             if one and len(rr) == n:   # one mover, every ray (its pairs are then 0..n-1 in order)
                 Or, Dr = O, D
             else:
-                Or, Dr = np.take(O, rr, axis=0), np.take(D, rr, axis=0)
+                Or = np.broadcast_to(O[:1], (len(rr), 3)) if one_origin else O.take(rr, axis=0)
+                Dr = D.take(rr, axis=0)
             if one:
                 Rb, Tb = R[mm[0]], T[mm[0]]
-                Ob, Db = _mat(_minus(Or, Tb), Rb), _mat(Dr, Rb)
+                Ob = (np.broadcast_to(_to_frame(_minus(O[:1], Tb), Rb), Or.shape) if one_origin
+                      else _to_frame(_minus(Or, Tb), Rb))
+                Db = _to_frame(Dr, Rb)
             else:
-                Rg = np.take(R, mm, axis=0)
-                Ob = np.einsum("nij,ni->nj", Rg, Or - np.take(T, mm, axis=0))
+                Rg = R.take(mm, axis=0)
+                Ob = np.einsum("nij,ni->nj", Rg, Or - T.take(mm, axis=0))
                 Db = np.einsum("nij,ni->nj", Rg, Dr)
             lim_r = lim[rr]
-            if len(rr) >= _PRUNE:  # many pairs (many movers): drop those missing the tier's tight bound
+            # many pairs (many movers): drop those missing the tier's tight bound (a Mount's own
+            # pairs passed that test when they were listed)
+            if len(rr) >= _PRUNE and not (one and int(mm[0]) == tight):
                 keep = tier.may_hit(Ob, Db, _take(t_near, rr), lim_r).nonzero()[0]
                 if len(keep) < len(rr):
                     if len(keep) == 0:
                         continue
-                    rr, mm, Ob, Db, lim_r = rr[keep], mm[keep], Ob[keep], Db[keep], lim_r[keep]
-            res = self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact, None, shape is None)
+                    Ob = np.broadcast_to(Ob[:1], (len(keep), 3)) if Ob.strides[0] == 0 else Ob[keep]
+                    rr, mm, Db, lim_r = rr[keep], mm[keep], Db[keep], lim_r[keep]
+            res = self._trace_split(tier, Ob, Db, _take(t_near, rr), lim_r, eps64, exact, shape is None)
             if res is None:
                 continue
             t, s, nb = res
@@ -548,4 +649,4 @@ class RayEngine(TierTracer):
             if shape is not None:
                 shape[rows] = mt.first[mw] + s[win]
                 nb = nb[win]
-                normal[rows] = _mat(nb, Rb.T) if one else np.einsum("nij,nj->ni", R[mw], nb)
+                normal[rows] = _from_frame(nb, Rb) if one else np.einsum("nij,nj->ni", R[mw], nb)

@@ -27,14 +27,26 @@ from __future__ import annotations
 
 import numpy as np
 
-# a tier uses guards while they stay few: at most this many risky edges, and at most this many
-# per flat triangle (a world of boxes has 1; a curved mesh or a terrain ~1.5, where 12 prism
-# triangles per edge would make the scene several times larger: those tiers keep the offset copy)
+# a tier uses guards while they stay few: at most this many risky edges, and either at most this
+# many per flat triangle (a world of boxes has 1) or prisms (12 triangles each) adding at most this
+# many triangles per triangle of the tier (a room of boxes, a rock mesh and curved shells, like the
+# arena: 1.4 edges per flat triangle, 2.7 prism triangles per triangle; measured there: guards
+# 1.4x faster than the copy on a 360-ray EXACT scan). A curved mesh or a terrain alone (~1.5 edges
+# per flat triangle, ~18 prism triangles per triangle) keeps the offset copy
 MAX_GUARDED_EDGES = 20000
 MAX_EDGES_PER_FLAT_TRIANGLE = 1.2
+MAX_PRISM_TRIANGLES_PER_TRIANGLE = 4.0
 # ... and while the prisms stay thin beside the edges: in a float32 frame far coarser than the
 # geometry (a room in a tier spanning 1e6 m: 2 m prisms) most rays would meet one
 MAX_WIDTH_PER_EDGE_LENGTH = 0.05
+# ... and while the float64 look of each guard stays short. A guard's candidate triangles are the
+# vertex rings around its edge and around every risky edge whose prism comes close: a few dozen in
+# a world of boxes, but k copies of the same box at one pose (coincident edges) give every edge k
+# neighbours, and the lists grow as k^2 (333 copies of a world's solids: 3.4 GB). Beyond this many
+# entries per flat triangle (plus a fixed allowance), counted before any list is made, the tier
+# keeps the offset copy (a second cast, linear in the scene) instead
+MAX_CANDIDATES_PER_FLAT_TRIANGLE = 256
+MAX_CANDIDATES_BASE = 1 << 20
 _COPLANAR = 1.0 - 1e-12   # cosine between two unit normals treated as the same plane
 
 # the 6 faces of a prism whose corners are numbered (end, side1, side2) -> 4 * end + 2 * s1 + s2
@@ -103,13 +115,16 @@ def _expand(ptr: np.ndarray, idx: np.ndarray, rows: np.ndarray) -> tuple[np.ndar
     return pos, idx[np.repeat(ptr[rows] - (np.cumsum(cnt) - cnt), cnt) + np.arange(int(cnt.sum()))]
 
 
-def _overlapping(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All (i, j) with boxes i and j overlapping (i == j included), by a sweep along x."""
+def _overlapping(lo: np.ndarray, hi: np.ndarray, limit: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """All (i, j) with boxes i and j overlapping (i == j included), by a sweep along x; None when
+    the sweep would test more than ``limit`` pairs."""
     n = len(lo)
     order = np.argsort(lo[:, 0], kind="stable")
     slo, shi = lo[order], hi[order]
     end = np.searchsorted(slo[:, 0], shi[:, 0], side="right")
     cnt = np.maximum(end - np.arange(n), 1)
+    if int(cnt.sum()) > limit:
+        return None
     i = np.repeat(np.arange(n), cnt)
     j = i + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
     ok = np.all((slo[j] <= shi[i]) & (shi[j] >= slo[i]), axis=1)
@@ -117,20 +132,29 @@ def _overlapping(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return np.r_[i, j], np.r_[j, i]
 
 
-def candidates(V, edges, ptr, idx, ring, flat, w: float) -> tuple[np.ndarray, np.ndarray]:
+def candidates(V, edges, ptr, idx, ring, flat, w: float, budget: int) -> tuple[np.ndarray, np.ndarray] | None:
     """CSR (ptr, idx) of the flat triangles to test in float64 when a ray meets the guard of risky
     edge i: the vertex rings of the edge's triangles (the float64 hit can lie across a coplanar
     neighbour: the other triangle of a box face), for edge i and for every risky edge whose prism
     comes within w/2 of i's (coincident or crossing prisms, e.g. the common edge of two touching
-    boxes: stepping past one prism's face must not step past the other's unexamined)."""
+    boxes: stepping past one prism's face must not step past the other's unexamined).  None when
+    the lists would hold more than ``budget`` entries (counted before they are made: see
+    MAX_CANDIDATES_PER_FLAT_TRIANGLE)."""
     e_of, tri = np.repeat(np.arange(len(edges)), np.diff(ptr)), idx
+    if int((ring[0][tri + 1] - ring[0][tri]).sum()) > budget:
+        return None
     pos, cand = _expand(ring[0], ring[1], tri)
     own = np.unique(e_of[pos] * (len(flat) + 1) + cand)     # (edge, triangle) keys, sorted
     own_e, own_t = own // (len(flat) + 1), own % (len(flat) + 1)
     own_ptr = np.r_[0, np.cumsum(np.bincount(own_e, minlength=len(edges)))]
     p, q = V[edges[:, 0]], V[edges[:, 1]]
     grow = 1.5 * w
-    i, j = _overlapping(np.minimum(p, q) - grow, np.maximum(p, q) + grow)
+    pairs = _overlapping(np.minimum(p, q) - grow, np.maximum(p, q) + grow, budget)
+    if pairs is None:
+        return None
+    i, j = pairs
+    if int((own_ptr[j + 1] - own_ptr[j]).sum()) > budget:
+        return None
     pos, cand = _expand(own_ptr, own_t, j)
     key = np.unique(i[pos] * (len(flat) + 1) + cand)
     e_of, cand = key // (len(flat) + 1), key % (len(flat) + 1)

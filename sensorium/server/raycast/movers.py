@@ -12,12 +12,15 @@ cast only those rays are tested.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _take
+from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _minus, _take, _to_frame
 from sensorium.server.world.geometry import Pose
+
+_FEW = 8   # one-origin batches against up to this many movers: one matrix-vector test per mover
 
 
 def _segment_near_sphere(rel_x, rel_y, rel_z, dx, dy, dz, t_lo, t_hi, r2):
@@ -38,7 +41,8 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
     (a lidar): one mover at a time on contiguous columns, pairs ordered by mover (so the pairs of
     any one mover are always in ray order)."""
     n, M = len(O), len(C)
-    if n * M <= _TINY:  # a few rays and movers: plain floats (same test)
+    one = O.strides[0] == 0 and n > 1   # one origin for all rays (a lidar): the per-mover path below
+    if n * M <= _TINY and not one:  # a few rays and movers: plain floats (same test)
         Cl, Ol, Dl, r2l, hil = C.tolist(), O.tolist(), D.tolist(), r2.tolist(), lim.tolist()
         lol = t_near.tolist() if isinstance(t_near, np.ndarray) else [t_near] * n
         exl = excl.tolist() if isinstance(excl, np.ndarray) else [excl] * n
@@ -56,7 +60,7 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
                     pr.append(i)
                     pm.append(j)
         return np.array(pr, dtype=np.int64), np.array(pm, dtype=np.int64)
-    if n * M <= _DENSE_PAIRS:
+    if n * M <= _DENSE_PAIRS and not (one and M <= _FEW):
         tn = t_near[:, None] if isinstance(t_near, np.ndarray) else t_near
         if n * M <= 256:   # one (rays, movers, 3) table: fewest calls
             rel = C[None, :, :] - O[:, None, :]
@@ -70,7 +74,7 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
         if owner is not None:
             sel &= owner != (excl[:, None] if isinstance(excl, np.ndarray) else excl)
         return sel.nonzero()
-    shared = not np.count_nonzero(O != O[0])   # one origin (a lidar): rel = C - o is per mover
+    shared = one or not np.count_nonzero(O != O[0])   # one origin (a lidar): rel = C - o is per mover
     if not shared:
         ox, oy, oz, dx, dy, dz = (np.ascontiguousarray(a[:, k]) for a in (O, D) for k in range(3))
     prs, pms = [], []
@@ -81,8 +85,15 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
             rel = C[j] - O[0]
             b = D @ rel                              # matrix-vector: fast at any size
             e2 = float(rel @ rel)
-            tc = np.minimum(np.maximum(b, t_near), lim)
-            sel = e2 - tc * (b + b - tc) <= r2[j] + 1e-12 * e2
+            if one and e2 > 2.0 * r2[j]:
+                # one origin well outside the sphere: its rays that pass within it are those
+                # within the sphere's cone, b >= sqrt(e2 - r2) (unit directions), whatever their
+                # limits (a superset: a pair whose segment stops short traces to no hit); the
+                # slack covers the rounding of b
+                sel = b >= math.sqrt(e2 - r2[j]) * (1.0 - 1e-9) - 1e-12 * math.sqrt(e2)
+            else:
+                tc = np.minimum(np.maximum(b, t_near), lim)
+                sel = e2 - tc * (b + b - tc) <= r2[j] + 1e-12 * e2
         else:
             sel = _segment_near_sphere(C[j, 0] - ox, C[j, 1] - oy, C[j, 2] - oz, dx, dy, dz, t_near, lim, r2[j])
         if owner is not None and isinstance(excl, np.ndarray):
@@ -144,7 +155,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     short_m = fin & (L <= L_cap)
     every = bool(short_m.all())
     short = None if every else short_m.nonzero()[0]
-    Os, Ds, Ls = (O, D, L) if every else (np.take(O, short, axis=0), np.take(D, short, axis=0), L[short])
+    Os, Ds, Ls = (O, D, L) if every else (O.take(short, axis=0), D.take(short, axis=0), L[short])
     mid = Os + ((t_near if short is None else _take(t_near, short)) + 0.5 * Ls)[:, None] * Ds
     q = np.floor((mid - g0) * inv) + 1.0
     np.clip(q, 0.0, G - 1.0, out=q)
@@ -159,8 +170,8 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     pr = np.repeat(np.arange(len(key)) if every else short, c2)
     pm = smov[np.repeat(start - (np.cumsum(c2) - c2), c2) + np.arange(len(pr))]
     # exact sphere test on the candidates
-    rel = np.take(C, pm, axis=0) - np.take(O, pr, axis=0)
-    Dp = np.take(D, pr, axis=0)
+    rel = C.take(pm, axis=0) - O.take(pr, axis=0)
+    Dp = D.take(pr, axis=0)
     b = np.einsum("ij,ij->i", rel, Dp)
     e2 = np.einsum("ij,ij->i", rel, rel)
     tc = np.minimum(np.maximum(b, _take(t_near, pr)), lim[pr])
@@ -171,7 +182,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     if not every:
         longs = (valid & ~short_m).nonzero()[0]
         if len(longs):
-            lp, lm = _sphere_pairs(C, r2, owner, np.take(O, longs, axis=0), np.take(D, longs, axis=0),
+            lp, lm = _sphere_pairs(C, r2, owner, O.take(longs, axis=0), D.take(longs, axis=0),
                                    _take(t_near, longs), lim[longs], _take(excl, longs))
             pr = np.concatenate([pr, longs[lp]])
             pm = np.concatenate([pm, lm])
@@ -230,7 +241,7 @@ def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndar
     if len(mi) == 0:
         return None
     rows = mrow[mi]
-    rel = np.take(O, mi, axis=0) - np.take(C, rows, axis=0)
+    rel = O.take(mi, axis=0) - C.take(rows, axis=0)
     reach = np.sqrt(_dot(rel, rel)) + np.maximum(lim[mi], -_take(t_near, mi))
     bounded = reach < _INF
     if not bounded.all():                   # unbounded rays: the general broad phase
@@ -240,7 +251,7 @@ def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndar
     R = np.full(M, -1.0)                    # -1: no mounted ray on this mover
     np.maximum.at(R, rows, reach)
     used = (R >= 0.0).nonzero()[0]
-    pb, pm = _near_centres(np.take(C, used, axis=0), R[used], C, mt.radius)
+    pb, pm = _near_centres(C.take(used, axis=0), R[used], C, mt.radius)
     nb = (pm != used[pb]).nonzero()[0]      # CSR of each mover's neighbours (pb is sorted)
     src, dst = used[pb[nb]], pm[nb]
     cnt = np.bincount(src, minlength=M)
@@ -259,9 +270,9 @@ def _near_pairs(C, O, D, t_near, lim, excl, owner, r2, pr, pm):
     None: no check)."""
     if len(pr) == 0:
         return pr, pm
-    Cp = np.take(C, pm, axis=0)
-    Op = np.take(O, pr, axis=0)
-    Dp = np.take(D, pr, axis=0)
+    Cp = C.take(pm, axis=0)
+    Op = O.take(pr, axis=0)
+    Dp = D.take(pr, axis=0)
     sel = _segment_near_sphere(Cp[:, 0] - Op[:, 0], Cp[:, 1] - Op[:, 1], Cp[:, 2] - Op[:, 2],
                                Dp[:, 0], Dp[:, 1], Dp[:, 2], _take(t_near, pr), lim[pr], r2[pm])
     if owner is not None:
@@ -284,7 +295,7 @@ def _near_centres(Cu: np.ndarray, Ru: np.ndarray, C: np.ndarray, radius: np.ndar
     cnt = hi - lo
     pb = np.repeat(np.arange(len(Cu)), cnt)
     pm = order[np.repeat(lo - (np.cumsum(cnt) - cnt), cnt) + np.arange(len(pb))]
-    d = np.take(C, pm, axis=0) - np.take(Cu, pb, axis=0)
+    d = C.take(pm, axis=0) - Cu.take(pb, axis=0)
     gap = Ru[pb] + radius[pm]
     ok = (_dot(d, d) <= gap * gap * (1.0 + 1e-9) + 1e-18).nonzero()[0]
     return pb[ok], pm[ok]
@@ -301,14 +312,22 @@ class Mount:
     by more than a margin in the body's frame).  Per cast only the segment test of the listed
     (ray, mover) candidates remains; rays of bodies with no neighbour cost nothing.  The caller
     promises that the rays are those of the first cast (same mounts, local origins and unit
-    directions), moved with their bodies."""
+    directions), moved with their bodies.
 
-    __slots__ = ("bodies", "lo", "hi", "_state")
+    ``own``: rays (True for all, or a per-ray mask) that also see their own mount body (a lidar sees
+    its robot; a distance sensor's own-body hits are decided by the caller instead, see
+    :meth:`RayEngine.cast`): which of them can reach it is decided once, in the body frame, and
+    only those are tested against it per cast, with the same arithmetic as rays that are not
+    mounted (the same bits)."""
 
-    def __init__(self, bodies) -> None:
+    __slots__ = ("bodies", "lo", "hi", "own", "_state")
+
+    def __init__(self, bodies, own=False) -> None:
         self.bodies = np.array(bodies, dtype=np.int64).reshape(-1)
         self.bodies.setflags(write=False)
         self.lo, self.hi = (int(self.bodies.min()), int(self.bodies.max())) if len(self.bodies) else (-1, -1)
+        mask = np.broadcast_to(np.asarray(own, dtype=bool), self.bodies.shape)
+        self.own: np.ndarray | None = np.array(mask) if mask.any() else None
         self._state: _MountState | None = None
 
     def __len__(self) -> int:
@@ -350,11 +369,17 @@ class _MountState:
     body_ptr: np.ndarray | None = None
     pr: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # candidates: rays
     pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # and movers
+    own_pr: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # rays that can reach
+    own_pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # their own mount
+    merged: tuple = ()    # (pr, pm, candidates with the own pairs) of the last merge
+    own_ahead: bool | None = None   # own pairs tested for t >= 0 only (kept while t_near >= 0)
 
 
-def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near, t_far) -> _MountState | None:
+def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near, t_far, D: np.ndarray | None = None,
+                rot: np.ndarray | None = None) -> _MountState | None:
     """The Mount's state for this mover table (made on first use, with the rays' current world
-    origins), or None when a mounted ray is unbounded (the caller then takes the per-cast path).
+    origins; ``D`` and the engine's body rotations ``rot`` are needed when some rays see their own
+    mount), or None when a mounted ray is unbounded (the caller then takes the per-cast path).
     The state is kept while every mounted ray's segment is no longer than when it was made (its
     reaches still bound every segment; other limits, e.g. light rays cast in the same batch, do not
     matter)."""
@@ -363,7 +388,8 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
         if (st.limits is not None and not isinstance(t_near, np.ndarray) and not isinstance(t_far, np.ndarray)
                 and st.limits == (t_near, t_far)):   # scalars, as when made
             return st
-        if np.all(np.maximum(_take(t_far, st.mi), -_take(t_near, st.mi)) <= st.span):
+        if np.all(np.maximum(_take(t_far, st.mi), -_take(t_near, st.mi)) <= st.span) and \
+                (not st.own_ahead or np.all(_take(t_near, st.mi) >= 0.0)):
             return st
     mrow = mt.row_of[mount.bodies]
     mounted = mrow >= 0
@@ -373,7 +399,7 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
                       -_take(t_near, mi))
     if not np.all(span < _INF):
         return None
-    rel = np.take(O, mi, axis=0) - np.take(C, rows, axis=0)
+    rel = O.take(mi, axis=0) - C.take(rows, axis=0)
     reach = np.full(len(C), -1.0)
     np.maximum.at(reach, rows, np.sqrt(_dot(rel, rel)) + span)
     used = (reach >= 0.0).nonzero()[0]
@@ -389,8 +415,77 @@ def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near,
     st.reach_row[used] = reach
     st.skin_r = 2.0 * skin
     st.shift_r = st.skin_r / 1.7320508075688772 * (1.0 - 1e-6)
+    if mount.own is not None and D is not None and rot is not None:
+        # segments that start at or beyond their origin (t_near >= 0: a lidar) are tested ahead of
+        # it only, and the list is kept only while they do
+        st.own_ahead = bool(np.all(_take(t_near, mi) >= 0.0)) if len(mi) else False
+        _own_pairs(st, mount.own, mt, O, D, rot, span, st.own_ahead)
     mount._state = st
     return st
+
+
+def _own_pairs(st: _MountState, own: np.ndarray, mt: _Movers, O: np.ndarray, D: np.ndarray, rot: np.ndarray,
+               span: np.ndarray, ahead: bool) -> None:
+    """The (ray, own mount) pairs of the mounted rays that see their own body and whose segment can
+    reach its tier's tight bound: tested in the body frame, where a rigidly mounted ray never moves
+    (its coordinates change only by rounding there, far below the bound's slack, which is grown
+    further by the rounding of the world coordinates), for t in [0, span] (``ahead``), else
+    [-span, span]."""
+    sel = own[st.mi].nonzero()[0]
+    if len(sel) == 0:
+        return
+    rays, rows = st.mi[sel], st.rows[sel]
+    grow = 1e-9 + 1e-12 * (float(np.abs(O[:1] if O.strides[0] == 0 else O).max()) + float(np.abs(mt.T).max()))
+    prs, pms = [], []
+    for row in np.unique(rows).tolist():
+        k = (rows == row).nonzero()[0]
+        r = rays[k]
+        Rb, Tb = rot[mt.index[row]], mt.T[row]
+        Ob = _to_frame(_minus(O.take(r, axis=0), Tb), Rb)
+        Db = _to_frame(D.take(r, axis=0), Rb)
+        sp = span[sel[k]]
+        reach = mt.tiers[mt.group[row]].may_hit(Ob, Db, 0.0 if ahead else -sp, sp, grow).nonzero()[0]
+        prs.append(r[reach])
+        pms.append(np.full(len(reach), row, dtype=np.int64))
+    pr, pm = np.concatenate(prs), np.concatenate(pms)
+    order = np.argsort(pr, kind="stable")
+    st.own_pr, st.own_pm = pr[order], pm[order]
+
+
+def one_origin_pairs(st: _MountState, mt: _Movers, C: np.ndarray, O: np.ndarray, D: np.ndarray, t_near, lim,
+                     excl, owner, epoch: int, counters: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
+    """(ray, mover) candidates of a batch from one origin mounted on one body (a lidar): its
+    own-mount pairs (decided once) and, per neighbouring mover of the body list (kept as for any
+    Mount), the rays whose segment passes within that mover's bounding sphere, tested for all rays
+    with one matrix-vector product per neighbour. No ray lists: a lidar's beams fan out in every
+    direction, so a list would hold most of them and cost more to keep than this test."""
+    if st.epoch != epoch:
+        st.epoch = epoch
+        if st.C_ref is None or len(C) != len(st.C_ref) or float(np.abs(C - st.C_ref).max()) > st.shift:
+            _body_list(st, mt, C, counters)
+    nb = st.dst
+    if len(nb):
+        pr, pm = _sphere_pairs(C.take(nb, axis=0), mt.r2[nb], None if owner is None else owner[nb], O, D,
+                               t_near, lim, excl)
+        pm = nb[pm]
+    else:
+        pr = pm = np.zeros(0, dtype=np.int64)
+    if len(st.own_pr):   # pairs of one mover stay in ray order; groups of movers in any order
+        pr, pm = np.concatenate([st.own_pr, pr]), np.concatenate([st.own_pm, pm])
+    return pr, pm
+
+
+def with_own_pairs(st: _MountState, pr: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The candidates ``pr``, ``pm`` (ray order) with the own-mount pairs merged in, in ray order
+    (then mover row); kept while the candidates are the same arrays."""
+    if not len(st.own_pr):
+        return pr, pm
+    if st.merged and st.merged[0] is pr and st.merged[1] is pm:
+        return st.merged[2], st.merged[3]
+    r, m = np.concatenate([pr, st.own_pr]), np.concatenate([pm, st.own_pm])
+    order = np.lexsort((m, r))
+    st.merged = (pr, pm, r[order], m[order])
+    return st.merged[2], st.merged[3]
 
 
 def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, rot: np.ndarray, O: np.ndarray, D: np.ndarray,
@@ -414,8 +509,8 @@ def mount_candidates(st: _MountState, mt: _Movers, C: np.ndarray, rot: np.ndarra
     if len(st.src) == 0:
         return st.pr, st.pm
     # neighbour centres in the frames of the bodies whose rays may reach them
-    Rb = np.take(rot, mt.index[st.src], axis=0)
-    rel = np.take(C, st.dst, axis=0) - np.take(C, st.src, axis=0)
+    Rb = rot.take(mt.index[st.src], axis=0)
+    rel = C.take(st.dst, axis=0) - C.take(st.src, axis=0)
     cb = np.einsum("pji,pj->pi", Rb, rel)
     if st.c_ref is None or float(np.abs(cb - st.c_ref).max()) > st.shift_r:
         _ray_list(st, mt, C, cb, rot, O, D, counters)
@@ -433,7 +528,7 @@ def _body_list(st: _MountState, mt: _Movers, C: np.ndarray, counters: dict[str, 
     # grown by the skin, and by a slack that keeps the list a superset of what the per-cast body
     # test (_mounted_pairs) would pair, whatever the rounding
     Ru = st.reach * (1.0 + 1e-8) + (st.skin + 1e-8 * float(mt.radius.max()) + 1e-9 + 1e-12 * float(np.abs(C).max()))
-    pb, pm = _near_centres(np.take(C, st.used, axis=0), Ru, C, mt.radius)
+    pb, pm = _near_centres(C.take(st.used, axis=0), Ru, C, mt.radius)
     nb = (pm != st.used[pb]).nonzero()[0]
     src, dst = st.used[pb[nb]], pm[nb]
     order = np.lexsort((dst, src))
@@ -446,9 +541,9 @@ def _ray_list(st: _MountState, mt: _Movers, C: np.ndarray, cb: np.ndarray, rot: 
     counters["ray_lists"] += 1
     st.c_ref = cb
     if st.o_loc is None:   # the mounted rays in their bodies' frames, about the centres (rigid: fixed)
-        Rr = np.take(rot, mt.index[st.rows], axis=0)
-        st.o_loc = np.einsum("nji,nj->ni", Rr, np.take(O, st.mi, axis=0) - np.take(C, st.rows, axis=0))
-        st.d_loc = np.einsum("nji,nj->ni", Rr, np.take(D, st.mi, axis=0))
+        Rr = rot.take(mt.index[st.rows], axis=0)
+        st.o_loc = np.einsum("nji,nj->ni", Rr, O.take(st.mi, axis=0) - C.take(st.rows, axis=0))
+        st.d_loc = np.einsum("nji,nj->ni", Rr, D.take(st.mi, axis=0))
         by_body = np.argsort(st.rows, kind="stable")
         cnt = np.bincount(st.rows, minlength=len(C))
         st.by_body, st.body_cnt, st.body_ptr = by_body, cnt, np.cumsum(cnt) - cnt

@@ -42,9 +42,16 @@ class _Planes:
         self.ay = np.array([w.rotation[:, 1] for w in world])
         self.pt = np.array([w.translation for w in world])
         self.nz_t = np.ascontiguousarray(self.nz.T)
-        # one axis-aligned plane (a floor): its normal's only non-zero component, else -1
+        # one axis-aligned plane (a floor): its normal's only non-zero component, else -1; when sized,
+        # also the world axes of its x and y (each a unit axis), else None
         zero = self.nz == 0.0
         self.axis = int(np.argmin(zero[0])) if len(self.nz) == 1 and np.count_nonzero(zero[0]) == 2 else -1
+        self.size_axes = None
+        if self.axis >= 0 and self.sized:
+            a, b = np.abs(self.ax[0]), np.abs(self.ay[0])
+            if np.count_nonzero(a == 1.0) == 1 and np.count_nonzero(a) == 1 and np.count_nonzero(b == 1.0) == 1 \
+                    and np.count_nonzero(b) == 1:
+                self.size_axes = (int(np.argmax(a)), int(np.argmax(b)))
         self._poses = poses
 
 
@@ -55,7 +62,8 @@ def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, dista
     compute the origin's offsets once."""
     pl.refresh(epoch)
     n, P = len(O), len(pl.sid)
-    if distance_only and pl.axis >= 0 and pl.visual and not pl.sized and n > 1 and O.strides[0] == 0 and \
+    if distance_only and pl.axis >= 0 and pl.visual and n > 1 and O.strides[0] == 0 and \
+            (not pl.sized or (pl.size_axes is not None and not isinstance(t_far, np.ndarray) and t_far < _INF)) and \
             not (pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0)):
         return _floor_distances(pl, O, D, t_near, t_far, eps64)
     den = _mat(D, pl.nz_t)                               # (n, P)
@@ -103,17 +111,18 @@ def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, dista
 
 
 def _floor_distances(pl: _Planes, O, D, t_near, t_far, eps64):
-    """:func:`cast_planes` (distances only) for one unbounded axis-aligned visual plane and rays
-    sharing one origin (a lidar over a floor): the same numbers with a third of the work. The
+    """:func:`cast_planes` (distances only) for one axis-aligned visual plane (unbounded, or sized
+    along world axes with a finite t_far) and rays sharing one origin (a lidar over a floor): the
+    same numbers with a third of the work. The
     denominator ``D . n`` is one column times the normal's non-zero component (the matrix product
     adds exact zeros to that one rounded product, so it is the same value up to the sign of a zero,
     which only decides rays that miss either way). The numerator is one number: from above the
     front side, ``t > 0`` exactly when the ray goes down, so the range test alone picks the hits;
     from behind or on the plane no ray hits it."""
     Oo = O[:1]
+    (px, py, pz), (ox, oy, oz), (nx, ny, nz_) = pl.pt[0].tolist(), Oo[0].tolist(), pl.nz[0].tolist()
+    num = (px - ox) * nx + (py - oy) * ny + (pz - oz) * nz_   # the general pass's sum, in plain floats
     nz = pl.nz
-    num = float(((pl.pt[:, 0] - Oo[:, 0:1]) * nz[:, 0] + (pl.pt[:, 1] - Oo[:, 1:2]) * nz[:, 1]
-                 + (pl.pt[:, 2] - Oo[:, 2:3]) * nz[:, 2])[0, 0])
     if not num < 0.0:
         return None
     k = pl.axis
@@ -125,5 +134,11 @@ def _floor_distances(pl: _Planes, O, D, t_near, t_far, eps64):
         return None
     if isinstance(t_far, np.ndarray) or t_far < _INF:
         bad |= t > t_far
+    if pl.sized:   # the hit within the size along the plane's x and y (unit world axes i, j): the
+        # general test's x.ax sums exact zeros to the one product (finite: t <= t_far < inf)
+        for j, h in zip(pl.size_axes, pl.half[0].tolist()):
+            x = t * D[:, j]
+            x -= float(pl.pt[0, j] - Oo[0, j])
+            bad |= ~(np.abs(x) <= h)
     np.copyto(t, _INF, where=bad)
     return t, None, None

@@ -4,6 +4,9 @@ starting inside a curved shell.  A mixin of :class:`RayEngine` (via :class:`.tra
 
 from __future__ import annotations
 
+import math
+import threading
+
 import numpy as np
 
 from sensorium.server.raycast.exact import (
@@ -14,19 +17,22 @@ from sensorium.server.raycast.exact import (
     _F32,
     _INF,
     _MAX_LOOPS,
+    _MIXED,
     _SCALAR,
     _SPHERE,
     _TINY,
     _analytic_local,
+    _analytic_mixed,
     _analytic_one,
     _best_per_row,
     _dot,
+    _from_frame,
     _full,
-    _mat,
     _minus,
     _moller_trumbore,
     _strictly_increasing,
     _take,
+    _to_frame,
 )
 from sensorium.server.raycast.guards import PRISM_TRIANGLES
 from sensorium.server.raycast.tiers import _Tier
@@ -36,6 +42,12 @@ class Refiner:
     """Refinement methods of :class:`~sensorium.server.raycast.engine.RayEngine`."""
 
     counters: dict[str, int]
+    _counting: threading.Lock
+
+    def _count(self, key: str, n: int) -> None:
+        """counters[key] += n (blocks of a cast may run on several threads)."""
+        with self._counting:
+            self.counters[key] += n
 
     def _refine_triangles(self, tier: _Tier, Ot, D, tri, lo, hi):
         """Float64 hit of the ORIGINAL rays on triangle ``tri`` or, failing that, on the triangles
@@ -78,7 +90,7 @@ class Refiner:
         fg = far[g]
         s = res["tfar"][g].astype(np.float64)   # the first guard, from the segment start
         d32g = d32[g]
-        self.counters["embree_calls"] += 1
+        self._count("embree_calls", 1)
         r0 = tier.bare_scene().run(o32[g], d32g, np.where(fg >= 0.0, fg, -1.0).astype(_F32), output=1)
         w = 4.0 * tier.eps
         stop = np.minimum(fg, np.where(r0["primID"] >= 0, r0["tfar"].astype(np.float64) + 4.0 * w, _INF))
@@ -96,7 +108,7 @@ class Refiner:
                 return
             r = rows[sub]
             o = (Ot[r] + (sa[g[sub]] + s)[:, None] * D[r]).astype(_F32)
-            self.counters["embree_calls"] += 1
+            self._count("embree_calls", 1)
             r1 = scene.run(o, d32g[sub], f.astype(_F32), output=1)
             met = (r1["primID"] >= 0).nonzero()[0]
             sub, s = sub[met], s[met] + r1["tfar"][met]
@@ -104,7 +116,7 @@ class Refiner:
             if len(more):
                 self._guard_hits(tier, Ot, D, rows[sub[more]], r1["primID"][met[more]], lo, lim, excl,
                                  best_t, best_s, best_n)
-        self.counters["unresolved_rays"] += len(sub)
+        self._count("unresolved_rays", len(sub))
 
     def _guard_hits(self, tier: _Tier, Ot, D, rows, gprim, lo, hi, excl, best_t, best_s, best_n):
         """The second look of EXACT (see :mod:`.guards`): rays ``rows`` met the guards (prism triangles
@@ -132,7 +144,7 @@ class Refiner:
         nrm[_dot(nrm, D[ray]) > 0.0] *= -1.0
         best_t[ray], best_s[ray], best_n[ray] = t, tier.tri_shape[cand], nrm
         hi[ray] = t
-        self.counters["edge_guard_hits"] += len(ray)
+        self._count("edge_guard_hits", len(ray))
 
     def _flat_dense(self, tier: _Tier, res, prim, Ot, D, one_origin: bool, lo, lim, t_e, d_max: float,
                     best_t, best_s, best_n, distance_only: bool):
@@ -141,29 +153,29 @@ class Refiner:
         masked, instead of gathering the hit rows; the same values.  Updates ``best_*``; returns
         the mask of rays to continue (refinement missed)."""
         eps = tier.eps
-        flat = np.take(tier.tri_flat, prim)            # primID -1 picks the sentinel row: False
-        nx, ny, nz = (np.take(c, prim) for c in tier.normal_cols)   # ... and a zero normal
+        flat = tier.tri_flat.take(prim)            # primID -1 picks the sentinel row: False
+        nx, ny, nz = (c.take(prim) for c in tier.normal_cols)   # ... and a zero normal
         dn = D[:, 0] * nx + D[:, 1] * ny              # = _dot(D, normal[prim]), column by column
         dn += D[:, 2] * nz
         fi = tier.flat_index
         if one_origin and len(fi) < len(prim):   # n.(v0 - o) per flat triangle, then per ray (same values)
             c = np.zeros(len(tier.normal))
             c[fi] = _dot(_minus(tier.v0[fi], Ot[0]), tier.normal[fi])
-            tx = np.take(c, prim) / dn
+            tx = c.take(prim) / dn
         else:
-            V0 = np.take(tier.v0, prim, axis=0, mode="clip")
-            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, np.take(tier.normal, prim, axis=0)) / dn
+            V0 = tier.v0.take(prim, axis=0, mode="clip")
+            tx = _dot(_minus(V0, Ot[0]) if one_origin else V0 - Ot, tier.normal.take(prim, axis=0)) / dn
         ok = np.isfinite(tx) & (tx >= lo) & (tx <= lim) & flat
         u, v = res["u"], res["v"]
         margin = np.minimum(np.minimum(u, v), 1.0 - u - v)
         near_edge = ~(margin > 1e-4) & flat
-        check = ~(margin * np.take(tier.h_min, prim, mode="clip") * np.abs(dn) > 4.0 * eps * d_max)
+        check = ~(margin * tier.h_min.take(prim, mode="clip") * np.abs(dn) > 4.0 * eps * d_max)
         check &= flat & ~near_edge
         ci = check.nonzero()[0]
         if len(ci):
-            P = Ot[ci] + tx[ci, None] * D[ci] - np.take(tier.v0, prim[ci], axis=0)
-            bu = _dot(P, np.take(tier.g1, prim[ci], axis=0))
-            bv = _dot(P, np.take(tier.g2, prim[ci], axis=0))
+            P = Ot[ci] + tx[ci, None] * D[ci] - tier.v0.take(prim[ci], axis=0)
+            bu = _dot(P, tier.g1.take(prim[ci], axis=0))
+            bv = _dot(P, tier.g2.take(prim[ci], axis=0))
             near_edge[ci] = ~((bu >= -_BARY_TOL) & (bv >= -_BARY_TOL) & (bu + bv <= 1.0 + _BARY_TOL))
         r = near_edge.nonzero()[0]
         tri = prim
@@ -180,7 +192,7 @@ class Refiner:
         k = (ok & (tx < best_t)).nonzero()[0]
         best_t[k] = tx[k]
         if not distance_only:
-            nk = np.take(tier.normal, tri[k], axis=0)
+            nk = tier.normal.take(tri[k], axis=0)
             nk *= np.where(dn[k] > 0.0, -1.0, 1.0)[:, None]   # toward the origin
             best_s[k], best_n[k] = tier.tri_shape[tri[k]], nk
         return flat & ~ok
@@ -228,16 +240,19 @@ class Refiner:
         if n and not np.count_nonzero(slots != slots[0]):   # one shape: one matrix
             s0 = int(slots[0])
             R = tier.c_rot[s0]
-            p = _mat(_minus(Ot, tier.c_pos[s0]), R)   # R^T (o - c)
-            d = _mat(D, R)
+            p = _to_frame(_minus(Ot, tier.c_pos[s0]), R)   # R^T (o - c)
+            d = _to_frame(D, R)
             t, n_loc = _analytic_local(int(tier.c_code[s0]), p, d, tier.c_r[s0], tier.c_h[s0], lo, hi, normals)
-            return t, (None if n_loc is None else _mat(n_loc, R.T))
+            return t, (None if n_loc is None else _from_frame(n_loc, R))
         R = tier.c_rot[slots]
         p = np.einsum("nij,ni->nj", R, Ot - tier.c_pos[slots])  # R^T (o - c)
         d = np.einsum("nij,ni->nj", R, D)
+        codes = tier.c_code[slots]
+        if n <= _MIXED and np.count_nonzero(codes != codes[0]):   # a few rays, several kinds: one pass
+            t, n_loc = _analytic_mixed(codes, p, d, tier.c_r[slots], tier.c_h[slots], lo, hi, normals)
+            return t, (np.einsum("nij,nj->ni", R, n_loc) if normals else None)
         t = np.full(n, _INF)
         n_loc = np.zeros((n, 3)) if normals else None
-        codes = tier.c_code[slots]
         for code in (_SPHERE, _CYLINDER, _CAPSULE):
             g = (codes == code).nonzero()[0]
             if len(g):
@@ -269,7 +284,14 @@ class Refiner:
             if not pairs:
                 return None
             return self._prepass_scalar(tier, pairs, S, Ot.tolist(), D.tolist(), lo, lim, excl)
-        if m * len(cp) > _DENSE_PAIRS:  # many rays: screen their bounding box first (a lidar: a point)
+        if Ot.strides[0] == 0 and not isinstance(lo, np.ndarray):   # one origin (a lidar), plain floats:
+            # its start points lie within lo of it (unit directions)
+            ox, oy, oz = Ot[0].tolist()
+            near = [k for k, (cx, cy, cz, b2) in enumerate(tier.c_sphere)
+                    if math.sqrt((ox - cx) ** 2 + (oy - cy) ** 2 + (oz - cz) ** 2) <= (math.sqrt(b2) + lo) * (1.0 + 1e-9)]
+            if not near:
+                return None
+        elif m * len(cp) > _DENSE_PAIRS:  # many rays: screen their bounding box first (a lidar: a point)
             # per column: numpy reduces a short inner axis ~10x slower than a contiguous column
             reach = float(lo.max()) if isinstance(lo, np.ndarray) else lo
             Ou = Ot[:1] if Ot.strides[0] == 0 else Ot   # one origin for all rays (a broadcast array)
@@ -335,7 +357,7 @@ class Refiner:
         p = _minus(S, tier.c_pos[k])
         if tier.c_code[k] == _SPHERE:
             return _dot(p, p) <= tier.c_bound2[k]
-        p = _mat(p, tier.c_rot[k])
+        p = _to_frame(p, tier.c_rot[k])
         return (p[:, 0] * p[:, 0] + p[:, 1] * p[:, 1] <= tier.c_rad2[k]) & (np.abs(p[:, 2]) <= tier.c_ax[k])
 
     def _prepass_scalar(self, tier: _Tier, pairs, S, Ot, D, lo, lim, excl):
@@ -364,7 +386,8 @@ class Refiner:
                 (dx * r0 + dy * r3 + dz * r6, dx * r1 + dy * r4 + dz * r7, dx * r2 + dy * r5 + dz * r8),
                 r, h, lo if lo_l is None else float(lo_l[i]), lim if lim_l is None else float(lim_l[i]))
             if t < _INF and (i not in found or t < found[i][0]):
-                n = (r0 * nx + r1 * ny + r2 * nz, r3 * nx + r4 * ny + r5 * nz, r6 * nx + r7 * ny + r8 * nz)
+                # R n, summed (0 + 2) + 1 as einsum("nij,nj->ni") does for the vectorised pre-pass
+                n = (r0 * nx + r2 * nz + r1 * ny, r3 * nx + r5 * nz + r4 * ny, r6 * nx + r8 * nz + r7 * ny)
                 if n[0] * dx + n[1] * dy + n[2] * dz > 0.0:   # toward the origin
                     n = (-n[0], -n[1], -n[2])
                 found[i] = (t, sid, n)

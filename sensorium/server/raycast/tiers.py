@@ -1,6 +1,8 @@
 """Tiers: one Embree scene of a set of shapes and the float64 data that refines its hits.
 
-The only module of the engine that imports embreex.
+The engine's Embree scenes are made here: through the packet path (:mod:`.packets`) when it is
+available, else through embreex (the only other embreex importer is :mod:`.packets`, to find the
+library embreex loaded).
 """
 
 from __future__ import annotations
@@ -10,11 +12,16 @@ from embreex import rtcore as _rtc
 from embreex import rtcore_scene as _rts
 from embreex.mesh_construction import TriangleMesh as _TriangleMesh
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
 from sensorium.server.raycast.guards import (
+    MAX_CANDIDATES_BASE,
+    MAX_CANDIDATES_PER_FLAT_TRIANGLE,
     MAX_EDGES_PER_FLAT_TRIANGLE,
     MAX_GUARDED_EDGES,
+    MAX_PRISM_TRIANGLES_PER_TRIANGLE,
     MAX_WIDTH_PER_EDGE_LENGTH,
+    PRISM_TRIANGLES,
     candidates,
     prisms,
     risky_edges,
@@ -23,8 +30,25 @@ from sensorium.server.world.geometry import Capsule, Cylinder, Mesh, Pose, Primi
 
 
 def new_device():
-    """A fresh Embree device (one per engine)."""
+    """A fresh Embree device (one per engine): the packet path's when it is available."""
+    if packets.library() is not None:
+        return packets.Device()
     return _rtc.EmbreeDevice()
+
+
+def _welded(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The referenced vertices of a mesh, one per distinct position (in order of first use), and
+    its faces on them."""
+    used, f = np.unique(f, return_inverse=True)
+    v = np.ascontiguousarray(v[used], dtype=np.float64)
+    _, first, inverse = np.unique(v.view(np.dtype((np.void, 24))).ravel(), return_index=True, return_inverse=True)
+    if len(first) == len(v):
+        return v, f.reshape(-1, 3)
+    keep = np.sort(first)                        # distinct positions, in their order in v
+    rank = np.empty(len(v), dtype=np.int64)
+    rank[keep] = np.arange(len(keep))
+    to = rank[first[inverse.ravel()]]            # every vertex -> its position's first occurrence
+    return v[keep], to[f.reshape(-1, 3)]
 
 
 class _Tier:
@@ -34,13 +58,23 @@ class _Tier:
     def __init__(self, device, items: list[tuple[int, Primitive, Pose]], owner_of: np.ndarray):
         verts, faces, tri_shape, curved = [], [], [], []
         nv = 0
+        seen = set()
         for sid, prim, pose in items:
+            # the same shape of the same owner again at the same pose adds nothing a ray could hit
+            # first (k pasted copies of a world's solids: the tier, its guards and its refinement
+            # would grow k-fold or worse); the first copy is the one hit
+            key = (prim, pose.rotation.tobytes(), pose.translation.tobytes(), int(owner_of[sid]))
+            if key in seen:
+                continue
+            seen.add(key)
             v, f = tessellate(prim)
             if len(f) == 0:
                 continue
-            if isinstance(prim, Mesh):  # keep only referenced vertices (they set the tier bounds)
-                used, f = np.unique(f, return_inverse=True)
-                v, f = v[used], f.reshape(-1, 3)
+            if isinstance(prim, Mesh):
+                # keep only referenced vertices (they set the tier bounds), each position once: an STL
+                # file repeats a vertex in every triangle that has it, and the triangles that meet
+                # there must share it (vertex rings, edges shared by two faces; the same surface)
+                v, f = _welded(v, f)
             verts.append(pose.apply(v))
             faces.append(f + nv)
             tri_shape.append(np.full(len(f), sid, dtype=np.int64))
@@ -191,15 +225,17 @@ class _Tier:
         """v0 of the given triangles, without the full refinement data (FAST's self-hit test)."""
         return self.V[self.F[tri, 0]]
 
-    def may_hit(self, O, D, lo, hi) -> np.ndarray:
+    def may_hit(self, O, D, lo, hi, grow: float = 0.0) -> np.ndarray:
         """Mask of the rays (parent frame) whose segment [lo, hi] may meet ``bound`` (conservative:
-        every triangle of the tier, and every start point inside a shell, lies inside the bound)."""
+        every triangle of the tier, and every start point inside a shell, lies inside the bound),
+        the bound grown by ``grow``."""
         Ot = _minus(O, self.anchor) if self.anchored else O
         hi = np.minimum(hi, 1e300)          # t * d stays finite (and 0 for d = 0)
         if self.bound[0] == "cylinder":
             # two cheap necessary conditions, tested separately: the segment comes within the
             # radius of the axis, and it overlaps the slab |z| <= half-height
             _, R, c, rad, ax = self.bound
+            rad, ax = rad + grow, ax + grow
             p = _mat(_minus(Ot, c), R)
             d = _mat(D, R)
             px, py, pz, dx, dy, dz = p[:, 0], p[:, 1], p[:, 2], d[:, 0], d[:, 1], d[:, 2]
@@ -209,6 +245,8 @@ class _Tier:
             z0, z1 = pz + lo * dz, pz + hi * dz
             return (qx * qx + qy * qy <= rad * rad) & (np.maximum(z0, z1) >= -ax) & (np.minimum(z0, z1) <= ax)
         _, blo, bhi = self.bound
+        if grow:
+            blo, bhi = blo - grow, bhi + grow
         Dn = np.where(D == 0.0, 1e-300, D)   # parallel to a slab: +-huge (or 0 on its plane), no NaN
         t_a = (blo - Ot) / Dn
         t_b = (bhi - Ot) / Dn
@@ -217,19 +255,37 @@ class _Tier:
         leave = np.minimum(np.minimum(np.minimum(far[:, 0], far[:, 1]), far[:, 2]), hi)
         return enter <= leave
 
+    def prepare(self, exact: bool) -> None:
+        """Make now what casts make on first use (the scene of the mode and, for EXACT, the float64
+        data, guards and vertex rings), so that blocks of rays on several threads only read."""
+        self.scene(exact)
+        if exact:
+            self._exact_data()
+            _ = self.ring
+            if self.guard is not None:
+                self.bare_scene()
+
     def scene(self, robust: bool):
         """(Embree scene, built now?).  FAST uses a plain scene, EXACT a robust one (watertight
         traversal, ~40% slower in a room where every ray hits); each is built on first use."""
         sc = self._scenes.get(robust)
         if sc is not None:
             return sc, False
+        guard = self.guard if robust else None   # geometry 1 of the EXACT scene: the edge guards
+        if isinstance(self._device, packets.Device):
+            sc = packets.Scene(self._device, robust, self._v32, self._f32,
+                               *((guard[3], guard[4]) if guard is not None else ()))
+            if guard is not None:   # and the same without guards (for the rays that meet one)
+                self._scenes["bare"] = packets.Scene(self._device, True, self._v32, self._f32)
+            self._scenes[robust] = sc
+            return sc, True
         sc = _rts.EmbreeScene(self._device, robust=robust)
         _TriangleMesh(sc, self._v32, self._f32)
-        if robust and self.guard is not None:   # geometry 1 of the EXACT scene: the edge guards
-            _TriangleMesh(sc, self.guard[3], self.guard[4])
+        if guard is not None:
+            _TriangleMesh(sc, guard[3], guard[4])
         sc.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))  # commit now: this is the build
         self._scenes[robust] = sc
-        if robust and self.guard is not None:   # and the same without guards (for the rays that meet one)
+        if guard is not None:
             bare = _rts.EmbreeScene(self._device, robust=True)
             _TriangleMesh(bare, self._v32, self._f32)
             bare.run(np.zeros((0, 3), _F32), np.zeros((0, 3), _F32))
@@ -249,14 +305,20 @@ class _Tier:
             edges, ptr, idx = risky_edges(self.F, flat, self.normal[:-1])
             n_flat = int(np.count_nonzero(flat))
             w = 4.0 * self.eps
-            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat \
+            dense = (len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat
+                     and PRISM_TRIANGLES * len(edges) > MAX_PRISM_TRIANGLES_PER_TRIANGLE * len(self.F))
+            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or dense \
                     or w > MAX_WIDTH_PER_EDGE_LENGTH * float(np.median(np.linalg.norm(
                         self.V[edges[:, 0]] - self.V[edges[:, 1]], axis=1))):
                 self._guard = (None, len(edges) == 0)
             else:
-                pv, pf = prisms(self.V, edges, w)
-                cand_ptr, cand = candidates(self.V, edges, ptr, idx, self.ring, flat, w)
-                self._guard = (edges, cand_ptr, cand, np.ascontiguousarray(pv, dtype=_F32), pf)
+                found = candidates(self.V, edges, ptr, idx, self.ring, flat, w,
+                                   MAX_CANDIDATES_PER_FLAT_TRIANGLE * n_flat + MAX_CANDIDATES_BASE)
+                if found is None:   # coincident copies of the same edges: the offset copy instead
+                    self._guard = (None, False)
+                else:
+                    pv, pf = prisms(self.V, edges, w)
+                    self._guard = (edges, *found, np.ascontiguousarray(pv, dtype=_F32), pf)
         return None if self._guard[0] is None else self._guard
 
     def bare_scene(self):

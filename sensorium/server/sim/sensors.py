@@ -25,6 +25,7 @@ from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import LookupTable, quantize_sensor
 from sensorium.server.devices.noise import device_rng
+from sensorium.server.raycast import blocks
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.sim.own_shapes import cast_local_skipping
 from sensorium.server.world.geometry import Pose
@@ -244,6 +245,10 @@ class Lidar(Device):
         # meet that body once, in its frame, blind to the lidar's own shapes (own_shapes.py)
         self._own_body: tuple[Any, int, Mount] | None = None     # (scene, body, mount of every beam)
         self._own_hits: tuple[Any, np.ndarray] | None = None       # (precision, (L, W) distances)
+        # a fixed lidar on a robot with a body (and no shapes of its own): its beams are rigidly
+        # mounted on that body, which they also see (Mount(own=True): which beams can reach it is
+        # decided once)
+        self._mount: tuple[int, Mount] | None = None
 
     def bind(self, robot: Any) -> None:
         if self.own_shapes:
@@ -341,7 +346,9 @@ class Lidar(Device):
         # a rotating head turns (and sweeps its sector) every basic step while enabled
         return self.enabled if self.rotating else self.schedule.due(now_ms)
 
-    def plan(self, robot_pose: Pose, now_ms: int, dt_ms: int) -> list[RayRequest]:
+    def plan(self, robot_pose: Pose, now_ms: int, dt_ms: int, body: int | None = None) -> list[RayRequest]:
+        """The rays of this step's measurement; ``body``: the engine body of the robot carrying the
+        lidar (None: it has none), which a fixed lidar's rays are mounted on."""
         pose = self.world_pose(robot_pose)
         if self.rotating:
             # only the sector the head sweeps during this step (devices.md §4.9)
@@ -366,14 +373,22 @@ class Lidar(Device):
                 self._planned = (key, dirs, d32)
             _, dirs, d32 = self._planned
             origins = np.broadcast_to(pose.translation, dirs.shape)
+            mount = None
+            if self._own_body is not None:        # blind to its own shapes: the body met apart (finish)
+                mount = self._own_body[2]
+            elif body is not None:
+                if self._mount is None or self._mount[0] != body:
+                    self._mount = (body, Mount(np.full(len(dirs), body, dtype=np.int64), own=True))
+                mount = self._mount[1]
             return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
-                               distance_only=True, directions32=d32,
-                               mount=self._own_body[2] if self._own_body is not None else None)]
+                               mount=mount, distance_only=True, directions32=d32)]
         origins = np.broadcast_to(pose.translation, dirs.shape)
         return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
                            distance_only=True)]
 
-    def finish(self, hits: list[RayHits], now_ms: int, counters: dict[str, int]) -> None:
+    def finish(self, hits: list[RayHits], now_ms: int, counters: dict[str, int], threads: int = 1) -> None:
+        """Range image and point cloud from this step's hits; ``threads``: the point coordinates of a
+        large scan are made in blocks on that many threads (the same values)."""
         L = self.config.number_of_layers
         if self.rotating:
             sweep = self._sweep
@@ -400,7 +415,7 @@ class Lidar(Device):
                 dist = np.minimum(dist, self._own_distances())
             self.range_image = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
             if self.point_cloud_enabled:
-                self._xyz = lmath.point_xyz(self.range_image, self._point_columns())
+                self._xyz = _point_xyz(self.range_image, self._point_columns(), threads)
                 self._xyz.flags.writeable = False   # messages may hold it
                 self._cloud_time = (now_ms / 1000.0, self.schedule.period_ms / 1000.0)
                 self._records = None
@@ -429,6 +444,22 @@ class Lidar(Device):
 
 
 _ROTATE_BLOCK = 16384   # rows per block of _rotate_columns (its float64 temporaries: ~640 KB)
+
+
+def _point_xyz(ranges: np.ndarray, columns: tuple[np.ndarray, ...], threads: int) -> np.ndarray:
+    """lmath.point_xyz, in blocks on ``threads`` threads for a large scan (each point's value is
+    its own product: the same array)."""
+    r = ranges.reshape(-1)
+    parts = blocks.split(len(r), threads, 1 << 16)
+    if len(parts) == 1:
+        return lmath.point_xyz(r, columns)
+    out = np.empty((len(r), 3), dtype=np.float32)
+
+    def block(sl: slice) -> None:
+        out[sl] = lmath.point_xyz(r[sl], tuple(c[sl] for c in columns))
+
+    blocks.run(block, parts, threads)
+    return out
 
 
 def _rotate(rotation: np.ndarray, vectors: np.ndarray) -> np.ndarray:

@@ -383,14 +383,14 @@ class Simulation:
                                    self._distance_plan(distances), self.scene.engine, self.scene)
             work.append((dbatch, dbatch.plan()))
         for lidar in lidars:
-            work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt)))
+            work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt, self.scene.robot_body(lidar.robot_index))))
         hits = self._cast_batched([req for _, reqs in work for req in reqs])
         k = 0
         for item, reqs in work:
             mine = hits[k:k + len(reqs)]
             k += len(reqs)
             if isinstance(item, Lidar):
-                item.finish(mine, now, self._counters)
+                item.finish(mine, now, self._counters, self.scene.engine.threads)
             else:
                 item.finish(mine, now)
         for dev in (*lights, *distances, *(x for x in lidars if not x.rotating)):
@@ -425,13 +425,17 @@ class Simulation:
             return np.concatenate([m if m is not None else np.full(n, -1, dtype=np.int64) for m, n in zip(parts, sizes)])
 
         if any(m is not None and not isinstance(m, Mount) for m in parts):
+            if any(isinstance(m, Mount) and m.own is not None for m in parts):
+                return None   # rays that see their own body, beside plain mounts: the general broad phase
             return joined()
         key = tuple(id(m) if m is not None else -n for m, n in zip(parts, sizes))
         kept = self._joined_mounts.get(key)
         if kept is None or any(a is not b for a, b in zip(kept[0], parts)):
             if len(self._joined_mounts) >= 8:
                 self._joined_mounts.clear()
-            kept = self._joined_mounts[key] = (parts, Mount(joined()))
+            own = np.concatenate([m.own if isinstance(m, Mount) and m.own is not None else np.zeros(n, dtype=bool)
+                                  for m, n in zip(parts, sizes)])
+            kept = self._joined_mounts[key] = (parts, Mount(joined(), own=own))
         return kept[1]
 
     def _cast_batched(self, requests: list[RayRequest]) -> list[RayHits]:

@@ -1,0 +1,207 @@
+"""Packet traversal (sensorium/server/raycast/packets.py) and ray blocks on several threads
+(blocks.py): the same answers as embreex's one-ray-per-call loop and as one thread, bit for bit;
+without a compiler or with the path switched off, the engine falls back to embreex and says why."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import trimesh
+
+from sensorium.server.raycast import blocks, packets
+from sensorium.server.raycast.engine import Mount, Precision, RayEngine, RayKind, ShapeEntry
+from sensorium.server.world.geometry import Box, Capsule, Cylinder, Mesh, Plane, Pose, Sphere, tessellate
+
+needs_packets = pytest.mark.skipif(packets.library() is None, reason=f"no packet path here: {packets.status()}")
+
+
+def _rz(yaw: float) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _soup():
+    """Boxes, a tessellated sphere and an open square: (vertices, faces) and the points rays aim at
+    (vertices, edge midpoints, triangle centres: where traversal ties and watertightness matter)."""
+    vs, fs, k = [], [], 0
+    for prim, at in ((Box((1.0, 0.6, 0.8)), (1.5, 0.2, 0.4)), (Box((0.3, 2.0, 1.5)), (-1.2, -0.4, 0.75)),
+                     (Sphere(0.4, subdivision=2), (0.2, -1.4, 0.6))):
+        v, f = tessellate(prim)
+        vs.append(v + at)
+        fs.append(np.asarray(f) + k)
+        k += len(v)
+    V, F = np.vstack(vs), np.vstack(fs)
+    e = trimesh.Trimesh(V, F, process=False).edges_unique
+    aims = np.vstack([V, (V[e[:, 0]] + V[e[:, 1]]) / 2, V[F].mean(axis=1)])
+    return V, F, aims
+
+
+def _rays(aims, eye, jitter, rng):
+    d = aims + rng.normal(size=aims.shape) * jitter - eye
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    return np.broadcast_to(np.asarray(eye, dtype=np.float64), d.shape), d
+
+
+@needs_packets
+@pytest.mark.parametrize("robust", [False, True])
+def test_packets_give_embreex_answers_bit_for_bit(robust):
+    """rtcIntersect16 (incoherent packets: what EXACT and scattered sensor rays use) and embreex's
+    rtcIntersect1 loop on the same library, scene and float32 rays: the same distance, triangle,
+    geometry, barycentrics and normal for every ray, including rays aimed exactly at vertices and
+    edges; misses come back as misses. Coherent packets (a FAST lidar scan) differ only for rays
+    aimed within float32 rounding of an edge or a vertex: the neighbouring triangle of the same
+    surface (within 32 float32 ulps) or, in a plain scene, the other side of the edge."""
+    from embreex import rtcore as rtc
+    from embreex import rtcore_scene as rts
+    from embreex.mesh_construction import TriangleMesh
+
+    V, F, aims = _soup()
+    at_edge = np.arange(len(aims)) < len(aims) - len(F)      # vertices and edge midpoints (not centres)
+    V32, F32 = V.astype(np.float32), F.astype(np.int32)
+    gv, gf = tessellate(Box((0.1, 0.1, 3.0)))              # a second geometry (as EXACT's guards are)
+    gv = (gv + [0.0, 1.0, 1.5]).astype(np.float32)
+    ref = rts.EmbreeScene(rtc.EmbreeDevice(), robust=robust)
+    TriangleMesh(ref, V32, F32)
+    TriangleMesh(ref, gv, np.asarray(gf, dtype=np.int32))
+    dev = packets.Device()
+    scene = packets.Scene(dev, robust, V32, F32, gv, gf)
+    rng = np.random.default_rng(1)
+    second, differ, total = False, 0, 0
+    for eye in ([0.3, 0.1, 2.5], [-3.0, 2.5, 0.4], [0.0, 0.0, 0.5]):
+        for jitter in (0.0, 1e-7, 1e-3):
+            O, D = _rays(aims, eye, jitter, rng)
+            o32, d32 = np.ascontiguousarray(O, dtype=np.float32), D.astype(np.float32)
+            far = np.full(len(D), 20.0, dtype=np.float32)
+            far[::7] = 1.0                                     # some rays stop short
+            want = ref.run(o32, d32, far.copy(), output=1)
+            hit = want["primID"] >= 0
+            assert hit.sum() > len(D) // 3 and (~hit).sum() > 0
+            got = scene.run(np.broadcast_to(o32[:1], o32.shape), d32, far, output=1)
+            for key in ("tfar", "primID", "geomID"):
+                assert got[key].tobytes() == want[key].tobytes(), key
+            for key in ("u", "v", "Ng"):
+                assert got[key][hit].tobytes() == want[key][hit].tobytes(), key
+            second |= bool((got["geomID"] == 1).any())
+            assert np.array_equal(far[::7], np.ones(len(far[::7]), np.float32))   # the limits are not written
+            coh = scene.run(np.broadcast_to(o32[:1], o32.shape), d32, far, output=1, coherent=True)
+            bad = (coh["tfar"] != want["tfar"]) | (coh["primID"] != want["primID"])
+            differ += int(bad.sum())
+            total += len(D)
+            assert not bad[~at_edge].any()                      # only rays aimed at an edge or a vertex
+            if robust:   # watertight: the same surface, within 32 float32 ulps
+                both = bad & hit & (coh["primID"] >= 0)
+                ulp = np.spacing(want["tfar"][both])
+                assert np.all(np.abs(coh["tfar"][both] - want["tfar"][both]) <= 32 * ulp)
+            if jitter == 1e-3:
+                assert not bad.any()                            # clear of edges: the same answers
+    assert second                                               # the second geometry was hit too
+    assert differ <= 0.02 * total
+
+
+def _scene(precision):
+    """Flat and curved solids, a floor, a mesh, a moving robot with a body and two others."""
+    eng = RayEngine(precision)
+    eng.add_body([ShapeEntry(Plane(), Pose.identity(), True, True)], Pose.identity())
+    for prim, at in ((Box((0.5, 0.4, 1.0)), (1.5, 0.3, 0.5)), (Sphere(0.4), (-1.2, 0.8, 0.4)),
+                     (Cylinder(0.2, 1.5), (0.4, -1.4, 0.75)), (Capsule(0.15, 0.8), (-0.6, -0.9, 0.6)),
+                     (Box((6.0, 0.1, 2.0)), (0.0, 3.0, 1.0))):
+        eng.add_body([ShapeEntry(prim, Pose.identity(), True, True)], Pose(_rz(0.3), np.array(at)))
+    rock = trimesh.creation.icosphere(subdivisions=1, radius=0.3)
+    eng.add_body([ShapeEntry(Mesh(rock.vertices, rock.faces, closed=True), Pose.identity(), True, True)],
+                 Pose(np.eye(3), np.array([2.0, -2.0, 0.3])))
+    robot = eng.add_body([ShapeEntry(Box((0.3, 0.2, 0.12)), Pose.identity(), True, True)],
+                         Pose(_rz(0.5), np.array([0.1, 0.2, 0.06])), owner=0, movable=True)
+    for k, at in enumerate([(0.8, -0.2), (-0.7, 0.1)]):
+        eng.add_body([ShapeEntry(Cylinder(0.05, 0.1), Pose.identity(), True, True)],
+                     Pose(np.eye(3), np.array([*at, 0.05])), owner=k + 1, movable=True)
+    return eng, robot
+
+
+def _lidar(W=512, L=48):
+    az = np.linspace(-math.pi, math.pi, W, endpoint=False)
+    el = np.linspace(-0.4, 0.3, L)
+    A, E = np.meshgrid(az, el)
+    return np.stack([np.cos(E) * np.cos(A), np.cos(E) * np.sin(A), np.sin(E)], -1).reshape(-1, 3)
+
+
+@pytest.mark.parametrize("precision", [Precision.FAST, Precision.EXACT])
+def test_paths_and_threads_give_the_same_answers(precision, monkeypatch):
+    """One engine on embreex's path, one on the packet path with 1 thread, one with 2 threads (a
+    24,576-ray batch: split in blocks), one with 4 threads and tiny blocks: every distance, normal
+    and shape id is the same bit for bit -- a lidar mounted on a robot with a body (Mount(own=True)),
+    and scattered rays with per-ray limits and exclusions."""
+    from sensorium.server.raycast import engine as engine_module
+
+    engines = {}
+    with monkeypatch.context() as m:
+        m.setattr(packets, "library", lambda: None)
+        engines["embreex"] = _scene(precision)
+    for name, threads in (("packets", 1), ("2 threads", 2), ("4 threads", 4)):
+        engines[name] = _scene(precision)
+        engines[name][0].threads = threads
+    rng = np.random.default_rng(3)
+    D_loc = _lidar()
+    assert len(D_loc) >= blocks.MIN_RAYS
+    O_many = rng.uniform(-2.5, 2.5, (len(D_loc), 3)) * [1, 1, 0.3] + [0, 0, 0.5]
+    D_many = rng.normal(size=O_many.shape)
+    D_many /= np.linalg.norm(D_many, axis=1)[:, None]
+    far = rng.uniform(0.5, 6.0, len(D_many))
+    excl = rng.choice([-1, 0, 1], len(D_many))
+    results = {}
+    for name, (eng, robot) in engines.items():
+        if name == "4 threads":
+            monkeypatch.setattr(engine_module, "_CHUNK", 1000)
+        mount = Mount(np.full(len(D_loc), robot), own=True)
+        out = []
+        for step in range(3):
+            pose = Pose(_rz(0.5 + 0.4 * step), np.array([0.1 + 0.1 * step, 0.2, 0.06]))
+            eng.set_body_pose(robot, pose)
+            O = np.broadcast_to(pose.apply(np.array([[0.0, 0.0, 0.09]]))[0], D_loc.shape)
+            D = D_loc @ pose.rotation.T
+            out.append(eng.cast(O, D, 0.02, 6.0, kind=RayKind.VISUAL, mount=mount, distance_only=True).distance)
+            h = eng.cast(O_many, D_many, 0.0, far, kind=RayKind.BOUNDING, exclude_owner=excl)
+            out += [h.distance, h.normal, h.shape]
+        results[name] = out
+        monkeypatch.setattr(engine_module, "_CHUNK", 1 << 16)
+    base = results["embreex"]
+    assert np.isfinite(base[0]).mean() > 0.5 and np.isfinite(base[1]).mean() > 0.3
+    for name, out in results.items():
+        for a, b in zip(base, out):
+            assert a.tobytes() == b.tobytes(), name
+
+
+def test_blocks_split_cover_the_batch_and_run_keeps_order():
+    for n, threads, chunk in ((10, 2, 65536), (20000, 2, 65536), (131072, 2, 65536), (1_000_003, 3, 65536),
+                              (5000, 1, 1000)):
+        parts = blocks.split(n, threads, chunk)
+        assert parts[0].start == 0 and parts[-1].stop == n
+        assert all(a.stop == b.start for a, b in zip(parts, parts[1:]))
+        assert all(p.stop - p.start <= chunk for p in parts)
+        if threads > 1 and n >= blocks.MIN_RAYS:
+            assert len(parts) >= threads and len(parts) % threads == 0
+        if n < blocks.MIN_RAYS and n <= chunk:
+            assert len(parts) == 1                    # small batches stay whole, on one thread
+    out = blocks.run(lambda k: k * k, list(range(50)), 3)
+    assert out == [k * k for k in range(50)]
+    with pytest.raises(ZeroDivisionError):
+        blocks.run(lambda k: 1 // (k - 7), list(range(20)), 2)
+    # a block that splits again runs its parts on its own thread (no waiting on the pool)
+    assert blocks.run(lambda k: sum(blocks.run(lambda j: j, list(range(k)), 2)), [3, 4, 5], 2) == [3, 6, 10]
+
+
+def test_without_a_compiler_or_switched_off_the_engine_uses_embreex_and_says_why(monkeypatch, tmp_path):
+    monkeypatch.setattr(packets, "_state", {})
+    monkeypatch.setenv("SENSORIUM_PACKETS", "0")
+    assert packets.library() is None and "SENSORIUM_PACKETS=0" in packets.status()
+    monkeypatch.setattr(packets, "_state", {})
+    monkeypatch.delenv("SENSORIUM_PACKETS")
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    monkeypatch.setenv("SENSORIUM_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(packets.tempfile, "gettempdir", lambda: str(tmp_path / "tmp"))
+    assert packets.library() is None
+    assert packets.status().startswith("embreex, one ray per call (compiling packets.c failed")
+    eng = RayEngine(Precision.FAST)                      # still casts, through embreex
+    eng.add_body([ShapeEntry(Box((1.0, 1.0, 1.0)), Pose.identity(), True, True)], Pose.identity())
+    assert eng.cast(np.array([[0.0, 0.0, 3.0]]), np.array([[0.0, 0.0, -1.0]])).distance[0] == pytest.approx(2.5)
