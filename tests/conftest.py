@@ -1,5 +1,6 @@
-"""The ``slow`` marker: multi-process and subprocess-heavy tests, so that ``pytest -m "not slow"`` is
-a fast local loop (CI runs everything).
+"""The ``slow`` marker: multi-process and subprocess-heavy tests. A plain ``pytest`` runs the rest (the
+fast suite, a few minutes on 2 cores) and says how many slow tests it left out; ``pytest -m slow``
+runs those, ``pytest -m "slow or not slow"`` (or ``SENSORIUM_SLOW=1``) everything. CI runs both.
 
 A test is slow when its module runs servers and controllers as processes (``SLOW_MODULES``), when
 it starts a subprocess itself or through a helper or fixture of its module (found in the module's
@@ -11,6 +12,7 @@ source: a function or class that mentions ``subprocess``/``Popen`` or starts one
 from __future__ import annotations
 
 import ast
+import os
 import re
 from functools import cache
 from pathlib import Path
@@ -59,13 +61,32 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if is_slow(item):
             item.add_marker(pytest.mark.slow)
+    # without a marker expression (and unless SENSORIUM_SLOW=1) the slow tests are left out; a test
+    # named on the command line (file::name) always runs
+    named = any("::" in arg for arg in config.args)
+    if config.getoption("markexpr") or os.environ.get("SENSORIUM_SLOW") == "1" or named:
+        return
+    slow = [item for item in items if item.get_closest_marker("slow")]
+    if slow:
+        config.hook.pytest_deselected(items=slow)
+        items[:] = [item for item in items if not item.get_closest_marker("slow")]
+        config.stash[_SLOW_LEFT_OUT] = len(slow)
+
+
+_SLOW_LEFT_OUT = pytest.StashKey[int]()
 
 
 NODE_SKIP_MARKERS = ("npm ci", "node is not installed")
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:  # noqa: ARG001
-    """One line at the end when the Foxglove/Node tests (tests/js) were skipped, saying how to run them."""
+    """One line at the end when slow tests were left out, and one when the Foxglove/Node tests
+    (tests/js) were skipped, each saying how to run them."""
+    left_out = config.stash.get(_SLOW_LEFT_OUT, 0)
+    if left_out:
+        terminalreporter.write_line(
+            f"sensorium: {left_out} slow test(s) (servers, controllers and tools as processes) left out: "
+            "run `pytest -m slow` for them, or SENSORIUM_SLOW=1 pytest for everything (CI runs both)", yellow=True)
     skipped = terminalreporter.stats.get("skipped", [])
     node = [r for r in skipped if any(m in str(getattr(r, "longrepr", "")) for m in NODE_SKIP_MARKERS)]
     if node:
