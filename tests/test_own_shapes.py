@@ -114,3 +114,99 @@ def test_of_device_must_name_a_device_of_the_robot() -> None:
     data["solids"][0]["shapes"] = [{"geometry": {"type": "sphere"}, "of_device": "ir"}]
     with pytest.raises(WorldError, match="only a robot's shapes belong to one of its devices"):
         parse_world(data)
+
+
+# -- cameras and range finders follow the same rule (a camera housed in its own small box sees out)
+
+DEV = np.array([0.05, 0.0, 0.05])     # the image device's origin, at the centre of its own 2 cm box
+POST_X = 0.14                         # the face of a post of the robot's own (not the device's)
+
+
+def image_world(kind: str, housing: bool = True, mark: bool = True, post: bool = False, ball: bool = False) -> dict:
+    shapes = [{"pose": {"translation": [0, 0, 0.03]}, "geometry": {"type": "cylinder", "radius": 0.035, "height": 0.05}}]
+    if housing:
+        shapes.append({"pose": {"translation": DEV.tolist()}, "geometry": {"type": "box", "size": [0.02, 0.02, 0.02]},
+                       "appearance": {"base_color": [0, 0, 1]}, **({"of_device": "eye"} if mark else {})})
+    if post:
+        shapes.append({"pose": {"translation": [POST_X + 0.01, 0, 0.05]}, "geometry": {"type": "box", "size": [0.02, 0.01, 0.2]},
+                       "appearance": {"base_color": [0, 1, 0]}})
+    device = {"device": kind, "name": "eye", "pose": {"translation": DEV.tolist()}, "width": 8, "height": 6,
+              "field_of_view": 0.5, "near": 0.005}
+    if kind == "RangeFinder":
+        device |= {"min_range": 0.005, "max_range": 2.0}
+    if ball:
+        device["recognition"] = {"occlusion": 2, "segmentation": True}
+    solids = ([{"name": "ball", "pose": {"translation": [0.25, 0, 0.05]}, "geometry": {"type": "sphere", "radius": 0.03},
+                "recognition_colors": [[1, 0, 0]]}] if ball else
+              [{"name": "wall", "pose": {"translation": [WALL_X + 0.01, 0, 0.05]}, "geometry": {"type": "box", "size": [0.02, 2, 1]},
+                "appearance": {"base_color": [1, 0, 0]}}])
+    return {"world_info": {"basic_time_step": 16}, "solids": solids,
+            "lights": [{"type": "PointLight", "location": [-0.2, 0, 0.3], "intensity": 1}],
+            "robots": [{"name": "r", "shapes": shapes, "devices": [device]}]}
+
+
+def capture(data: dict, precision: str) -> np.ndarray:
+    sim = Simulation(parse_world(copy.deepcopy(data)), precision)
+    dev = sim.device("r/eye")
+    dev.enable(16)
+    sim.step()
+    return dev.range_image.copy() if dev.kind == "RangeFinder" else dev.image.copy()
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_range_finder_sees_out_of_its_own_box(precision: str) -> None:
+    depth = capture(image_world("RangeFinder"), precision)
+    # planar: every pixel holds the wall's depth, WALL_X - x of the device (the box is not there)
+    np.testing.assert_allclose(depth, WALL_X - DEV[0], rtol=2e-7 if precision == "exact" else 1e-6)
+    bare = capture(image_world("RangeFinder", housing=False), precision)
+    if precision == "exact":
+        assert np.array_equal(depth, bare)
+    # the same box not marked as the device's: it sees the box's inside (1 cm in depth) everywhere
+    np.testing.assert_allclose(capture(image_world("RangeFinder", mark=False), precision), 0.01, rtol=1e-5)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_range_finder_still_sees_the_rest_of_its_robot(precision: str) -> None:
+    """A post of the robot stands in front of the housed device: the pixels whose rays meet its face
+    (x = POST_X, |y| <= 5 mm, closed form from the pixel rays) read its depth, the others the wall's."""
+    from sensorium.server.devices import imaging
+
+    depth = capture(image_world("RangeFinder", post=True), precision)
+    d = imaging.pixel_directions(imaging.ImageGeometry(8, 6, 0.5, "planar"))[0]
+    t = (POST_X - DEV[0]) / d[..., 0]
+    on_post = np.abs(t * d[..., 1]) <= 0.005
+    assert 0 < on_post.sum() < on_post.size
+    want = np.where(on_post, POST_X - DEV[0], WALL_X - DEV[0])
+    np.testing.assert_allclose(depth, want, rtol=2e-7 if precision == "exact" else 1e-6)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_camera_sees_out_of_its_own_box(precision: str) -> None:
+    image = capture(image_world("Camera"), precision)
+    bare = capture(image_world("Camera", housing=False), precision)
+    if precision == "exact":
+        assert np.array_equal(image, bare)
+    else:   # the wall met again from just past the box: float32 distances, the same colours to a unit
+        assert np.abs(image.astype(int) - bare.astype(int)).max() <= 1
+    bgr = image[:, :, :3].astype(int)
+    assert (bgr[:, :, 2] > 50).all() and (bgr[:, :, 0] == 0).all()          # the red wall in every pixel
+    seen = capture(image_world("Camera", mark=False), precision)[:, :, :3].astype(int)
+    assert (seen[:, :, 0] > 50).all() and (seen[:, :, 2] == 0).all()        # unmarked: the blue box's inside
+
+
+def test_recognition_pixel_rays_see_out_of_the_cameras_own_box() -> None:
+    """Occlusion 2 and the segmentation image use the pixel rays: the ball in front is recognised
+    and coloured from inside the camera's own box, as from a bare camera."""
+    def run(data: dict):
+        sim = Simulation(parse_world(copy.deepcopy(data)), "exact")
+        cam = sim.device("r/eye")
+        cam.recognition_enable(16)
+        cam.enable_segmentation(True)
+        sim.step()
+        return [o.id for o in cam.objects], cam.segmentation_image.copy()
+
+    objects, seg = run(image_world("Camera", ball=True))
+    bare_objects, bare_seg = run(image_world("Camera", housing=False, ball=True))
+    assert objects == bare_objects == [2] and np.array_equal(seg, bare_seg)
+    assert (seg[:, :, 2] == 255).sum() > 0                                   # the ball's red pixels
+    assert run(image_world("Camera", mark=False, ball=True))[0] == []       # unmarked: the box hides it

@@ -5,7 +5,9 @@ device: their directions in the device frame are made once (on the first capture
 the world only when the device turns, and cast in one engine call (plus, for a camera, the calls
 its shading needs). Nothing is computed while a device is disabled; the simulation calls
 ``capture`` when ``due``. The pure models are ``server/devices/imaging.py`` (rays, ranges),
-``shading.py`` (colours) and ``recognition.py`` (objects).
+``shading.py`` (colours) and ``recognition.py`` (objects). A device never sees the shapes of its
+own Solid (``of_device``, a camera's small housing): its pixel rays pass through them
+(``own_shapes.py``, the lidar's rule).
 """
 
 from __future__ import annotations
@@ -17,7 +19,8 @@ import numpy as np
 
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
-from sensorium.server.raycast.engine import RayKind
+from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.sim.own_shapes import cast_skipping
 from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
@@ -52,6 +55,16 @@ class MountedRays:
             w32.flags.writeable = False
             self._key, self.world, self.world32 = key, out, w32
         return self.world, self.world32
+
+
+def _see(device: Device, engine: Any, origins: np.ndarray, dirs: np.ndarray, t_near: Any, t_far: Any,
+        directions32: np.ndarray | None = None, distance_only: bool = False) -> RayHits:
+    """A device's pixel rays cast in the world: nothing excluded, but blind to the device's own
+    shapes (``own_shapes.py``; their casts then carry shape ids)."""
+    if device.own_shapes:
+        return cast_skipping(engine, origins, dirs, t_near, t_far, device.own_shapes, directions32=directions32)
+    return engine.cast(origins, dirs, t_near, t_far, kind=RayKind.VISUAL, exclude_owner=-1,
+                       distance_only=distance_only, directions32=directions32)
 
 
 def camera_info(geometry: imaging.ImageGeometry) -> dict:
@@ -118,8 +131,7 @@ class RangeFinder(Device):
         dirs, dirs32 = rays.at(pose.rotation)
         origins = np.broadcast_to(pose.translation, dirs.shape)
         t_near, t_far = self._limits
-        hits = self._scene.engine.cast(origins, dirs, t_near, t_far, kind=RayKind.VISUAL, exclude_owner=-1,
-                                       distance_only=True, directions32=dirs32)
+        hits = _see(self, self._scene.engine, origins, dirs, t_near, t_far, directions32=dirs32, distance_only=True)
         counters["rays_range_finder"] += len(rays)
         counters["cast_calls"] += 1
         c = self.config
@@ -331,8 +343,8 @@ class Camera(Device):
             self._centre_rays = MountedRays(dirs)
         dirs, dirs32 = self._centre_rays.at(pose.rotation)
         t_near, t_far = self._centre_limits
-        hits = self._scene.engine.cast(np.broadcast_to(pose.translation, dirs.shape), dirs, t_near, t_far,
-                                       kind=RayKind.VISUAL, exclude_owner=-1, directions32=dirs32)
+        hits = _see(self, self._scene.engine, np.broadcast_to(pose.translation, dirs.shape), dirs, t_near, t_far,
+                   directions32=dirs32)
         counters["rays_camera"] += len(dirs)
         counters["cast_calls"] += 1
         return np.where(np.isfinite(hits.distance), rec.key_of[hits.shape], -1)
@@ -368,13 +380,11 @@ class Camera(Device):
         for layer in range(MAX_LAYERS + 1):
             if layer == 0:
                 D = dirs
-                hits = engine.cast(np.broadcast_to(origin, D.shape), D, t_near, t_far, kind=RayKind.VISUAL,
-                                   exclude_owner=-1, directions32=dirs32)
+                hits = _see(self, engine, np.broadcast_to(origin, D.shape), D, t_near, t_far, directions32=dirs32)
             else:
                 assert tn is not None and tf is not None
                 D = dirs[rows]
-                hits = engine.cast(np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows], kind=RayKind.VISUAL,
-                                   exclude_owner=-1)
+                hits = _see(self, engine, np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows])
             counters["rays_camera"] += len(rows)
             counters["cast_calls"] += 1
             t, shape, normal = hits.distance, hits.shape, hits.normal
