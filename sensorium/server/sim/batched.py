@@ -21,8 +21,9 @@ sensors, distance sensors, fixed lidars and wheel encoders, each device's noise 
 stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in the same
 order). Tests compare it with the single simulation step by step.
 
-Not simulated here (use :class:`Simulation`): rotating lidars, the kinds without an observation
-(LEDs, GPS, IMU, pens, ...), lights carried by robots, textured robot bodies, NUE worlds.
+Not simulated here (use :class:`Simulation`): rotating lidars, cameras and range finders, the kinds
+without an observation (LEDs, GPS, IMU, pens, ...), lights carried by robots, textured robot bodies,
+NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
 
 from __future__ import annotations
@@ -185,6 +186,13 @@ class BatchedSimulation:
                                    for r in w.robots], dtype=np.float64)
         self.motor_names = [(r.differential_drive.left_motor, r.differential_drive.right_motor)
                             if r.differential_drive else ("", "") for r in w.robots]
+        # every wheel motor's side (0 left, 1 right): a skid-steer robot's wheels of one side are
+        # always commanded together here (set_wheels), so one state per side is each of its wheels
+        self.wheel_side: list[dict[str, int]] = [
+            {name: side for side, names in enumerate(r.differential_drive.motor_names) for name in names}
+            if r.differential_drive else {} for r in w.robots]
+        self.side_wheels = np.array([[len(n) for n in r.differential_drive.motor_names] if r.differential_drive
+                                     else [1, 1] for r in w.robots], dtype=np.int64)
         self._templates = [DifferentialDrive(r.differential_drive, self.initial[i]) if r.differential_drive else None
                            for i, r in enumerate(w.robots)]
         # -- per copy state
@@ -311,9 +319,8 @@ class BatchedSimulation:
         if self.position:
             wheel = []
             for d in self.position:
-                names = self.motor_names[d.robot_index]
                 m = d.config.motor
-                wheel.append(names.index(m) if m is not None and m in names and self.has_drive[d.robot_index] else -1)
+                wheel.append(self.wheel_side[d.robot_index].get(m, -1) if m is not None else -1)
             self._p_wheel = np.array(wheel, dtype=np.int64)
             self._p_slot = np.array([d.robot_index for d in self.position], dtype=np.int64)
             self._p_plain = np.array([float(d.config.noise) <= 0.0 and float(d.config.resolution) <= 0.0
@@ -426,8 +433,9 @@ class BatchedSimulation:
             tpl.reset(self.initial[slot])
 
     def set_wheels(self, slot: int, left, right, copies=None) -> None:
-        """Velocity control of a slot's two wheels (rad/s, clamped to the maximum as Webots does) in
-        the named copies (default: all): ``setPosition(inf)`` and ``setVelocity`` of both motors."""
+        """Velocity control of a slot's wheels (rad/s, clamped to the maximum as Webots does) in the
+        named copies (default: all): ``setPosition(inf)`` and ``setVelocity`` of every wheel motor of
+        each side (a skid-steer robot's too)."""
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         vmax = self.max_wheel[slot]
         left = np.asarray(left, dtype=np.float64)
@@ -490,6 +498,13 @@ class BatchedSimulation:
         omega = np.where(free, vel, held)
         self.wheel_angle[np.ix_(live, driven)] = ang + omega * dt
         wl, wr = omega[..., 0], omega[..., 1]
+        counts = self.side_wheels[driven]
+        skid = ((counts[:, 0] > 1) | (counts[:, 1] > 1)).nonzero()[0]
+        if len(skid):     # DifferentialDrive.step: each side the mean of its (equal) wheels, summed in order
+            wl, wr = wl.copy(), wr.copy()
+            for j in skid.tolist():
+                wl[:, j] = _side_mean(wl[:, j], int(counts[j, 0]))
+                wr[:, j] = _side_mean(wr[:, j], int(counts[j, 1]))
         moving = (wl != 0.0) | (wr != 0.0)                      # (live, driven)
         ci, ri = moving.nonzero()
         if not len(ci):
@@ -915,6 +930,14 @@ def _by_table(devices: list) -> list[tuple]:
     for k, d in enumerate(devices):
         out.setdefault(d.table, []).append(k)
     return [(t, np.array(v, dtype=np.int64)) for t, v in out.items()]
+
+
+def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
+    """``sum(w for each of n wheels) / n`` as Python's ``sum`` and one division give it (0 + w + w ...)."""
+    acc = 0.0 + w
+    for _ in range(n - 1):
+        acc = acc + w
+    return acc / n
 
 
 def _cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
