@@ -210,3 +210,29 @@ def test_recognition_pixel_rays_see_out_of_the_cameras_own_box() -> None:
     assert objects == bare_objects == [2] and np.array_equal(seg, bare_seg)
     assert (seg[:, :, 2] == 255).sum() > 0                                   # the ball's red pixels
     assert run(image_world("Camera", mark=False, ball=True))[0] == []       # unmarked: the box hides it
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_the_batched_simulation_follows_the_same_rule(precision: str) -> None:
+    """Infra-red and lidar with their own shapes (and a mast of the robot in view), two copies at
+    different poses: each copy reads what the single simulation reads, bit for bit (the gym's
+    engine="auto" runs such worlds batched)."""
+    from sensorium.server.sim.batched import BatchedSimulation
+
+    data = world(mast=True)
+    bs = BatchedSimulation(parse_world(copy.deepcopy(data)), 2, precision=precision)
+    sims = [Simulation(parse_world(copy.deepcopy(data)), precision) for _ in range(2)]
+    bs.set_pose(1, 0, [0.05, 0.02, 0.0], rotation=[0, 0, 1, 0.3])
+    sims[1].robot("r").set_pose([0.05, 0.02, 0.0], rotation=[0, 0, 1, 0.3])
+    for n in ("ir", "lidar"):
+        bs.enable(bs.device("r", n), 16)
+        for s in sims:
+            s.device(f"r/{n}").enable(16)
+    bs.run(2)
+    for c, s in enumerate(sims):
+        s.run(2)
+        assert s.device("r/ir").value == float(bs.value(bs.device("r", "ir"))[c])
+        assert s.device("r/lidar").range_image.tobytes() == bs.range_image(bs.device("r", "lidar"))[c].tobytes()
+    ir_bare, _ = readings(world(ir_box=False, housing=False), precision)
+    assert float(bs.value(bs.device("r", "ir"))[0]) == ir_bare        # copy 0: the wall, not the sensor's box
+    assert np.count_nonzero(bs.range_image(bs.device("r", "lidar"))[0] < 0.06) >= 1    # the mast

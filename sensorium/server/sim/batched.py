@@ -160,11 +160,21 @@ class BatchedSimulation:
         movers = RayEngine(Precision(precision))
         slot_body: list[int | None] = []
         red, rough = list(self.scene.red[:-1]), list(self.scene.roughness[:-1])
+        # the shapes of each device's own Solid (of_device), numbered as the movers' engine numbers
+        # them: its visual rays do not see them (own_shapes.py), as in the single simulation
+        self._own_shapes: dict[tuple[int, str], frozenset[int]] = {}
+        first = 0
         for i, r in enumerate(w.robots):
             parts = list(robot_parts(r))
             if parts:
                 slot_body.append(movers.add_body([_entry(s, base, local) for _, local, s in parts],
                                                  pose_from_model(r.pose), owner=i, movable=True))
+                owned: dict[str, set[int]] = {}
+                for k, (_, _, shape) in enumerate(parts):
+                    if getattr(shape, "of_device", None) is not None:
+                        owned.setdefault(shape.of_device, set()).add(first + k)
+                self._own_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
+                first += len(parts)
                 for name, _, shape in parts:
                     info = _shape_info(name, i, shape)
                     red.append(info.red)
@@ -264,7 +274,12 @@ class BatchedSimulation:
                 if d.device not in lists:
                     continue
                 dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
-                                        world_seed=0, clock=lambda: 0)
+                                        world_seed=0, clock=lambda: 0,
+                                        own_shapes=self._own_shapes.get((slot, d.name), frozenset()))
+                if d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
+                    # its beams meet its own robot's body once, in the body frame, blind to its own
+                    # shapes (Lidar._own_distances, on the movers' engine)
+                    dev._own_body = (_OnEngine(self.rays.movers), self.rays.slot_body[slot], None)
                 self.refs[(slot, d.name)] = DeviceRef(d.device, len(lists[d.device]), slot, d.name)
                 lists[d.device].append(dev)   # type: ignore[attr-defined]
         # noise streams: one per (copy, device) of every device that can draw (a noisy lookup
@@ -850,8 +865,10 @@ class BatchedSimulation:
                 dirs[:, :, j] = acc
             d = dirs.reshape(-1, 3)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
+            # a lidar with own shapes never meets its own body in the cast (finish adds those hits)
+            mount = slot if lid._own_body is not None else np.tile(self._lidar_skip(col), len(c))
             reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, np.repeat(c, W),
-                              -1, np.tile(self._lidar_skip(col), len(c)), distance_only=True, d32=d.astype(np.float32)))
+                              -1, mount, distance_only=True, d32=d.astype(np.float32)))
             state["items"].append((col, c))
         return state, reqs
 
@@ -876,6 +893,8 @@ class BatchedSimulation:
             lid = self.lidar[col]
             L, W = lid.config.number_of_layers, lid.config.horizontal_resolution
             dist = h.distance.reshape(len(c), L, W)
+            if lid._own_body is not None:
+                dist = np.minimum(dist, lid._own_distances())
             img = self.range_images[col]
             if lid.params.noise > 0:
                 nc = self._noise_col[("Lidar", col)]
@@ -912,6 +931,13 @@ class _Rays:
     skip: bool = False
     distance_only: bool = False
     d32: np.ndarray | None = None
+
+
+class _OnEngine:
+    """What a device template's own-body cast reads of its scene: the engine holding the robots."""
+
+    def __init__(self, engine: RayEngine):
+        self.engine = engine
 
 
 class _Stream:
