@@ -225,13 +225,15 @@ ENGINES = ("auto", "batched", "simulation")
 def batched_engine(loaded: LoadedWorld, agents: list[Agent], precision: str, engine: str):
     """The one-copy batched simulation the environments run on (``engine`` "batched", or "auto"
     when it simulates the world and every observed device), None for a rebuilt Simulation."""
-    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_observable
 
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     if engine == "simulation":
         return None
     try:
+        for ag in agents:              # an observed camera, range finder, rotating lidar: nothing built
+            check_observable(loaded.world, ag.robot, ag.periods)
         sim = BatchedSimulation(loaded, 1, precision=precision)
         for ag in agents:
             for name in ag.periods:

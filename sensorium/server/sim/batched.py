@@ -54,7 +54,7 @@ from sensorium.server.world.limits import check_pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, sanitize
 from sensorium.server.world.poses import pose_from_model, pose_from_values
 
-__all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS"]
+__all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS", "check_observable"]
 
 SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
 _TWO_PI = 2.0 * math.pi
@@ -62,6 +62,27 @@ _TWO_PI = 2.0 * math.pi
 
 class BatchedError(ValueError):
     """The world uses something the batched simulation does not simulate (the message says what)."""
+
+
+def _refusal(robot: str, config) -> str | None:
+    """Why the batched simulation does not measure a device (its world-file model), or None."""
+    if config.device not in SUPPORTED_KINDS:
+        return (f"robot {robot!r}: device {config.name!r} is a {config.device}; the batched simulation measures "
+                f"{', '.join(SUPPORTED_KINDS)} (use Simulation)")
+    if config.device == "Lidar" and config.type == "rotating":
+        return f"{robot}/{config.name}: rotating lidars are not simulated by the batched simulation (use Simulation)"
+    return None
+
+
+def check_observable(world: wm.World, robot: str, names: Iterable[str]) -> None:
+    """BatchedError (one line saying why) unless the batched simulation measures each named device
+    of the world's robot: the check of :meth:`BatchedSimulation.check_observable`, before anything
+    is built (names it does not know are left to the caller)."""
+    devices = {d.name: d for r in world.robots if r.name == robot for d in r.devices}
+    for name in names:
+        why = _refusal(robot, devices[name]) if name in devices else None
+        if why:
+            raise BatchedError(why)
 
 
 @dataclass(frozen=True, slots=True)
@@ -360,19 +381,18 @@ class BatchedSimulation:
         slot = self.slot(robot)
         ref = self.refs.get((slot, name))
         if ref is None:
-            kinds = {d.name: d.device for d in self.world.robots[slot].devices}
+            kinds = {d.name: d for d in self.world.robots[slot].devices}
             if name in kinds:
-                raise BatchedError(f"robot {robot!r}: device {name!r} is a {kinds[name]}; the batched simulation "
-                                   f"measures {', '.join(SUPPORTED_KINDS)} (use Simulation)")
+                raise BatchedError(_refusal(robot, kinds[name]) or f"{robot}/{name}: not measured")
             raise KeyError(f"robot {robot!r} has no device {name!r} (devices: {', '.join(kinds)})")
         return ref
 
     def check_observable(self, robot: str, name: str) -> DeviceRef:
         """The device, if the batched simulation measures it (else BatchedError saying why)."""
         ref = self.device(robot, name)
-        if ref.kind == "Lidar" and self.lidar[ref.column].rotating:
-            raise BatchedError(f"{robot}/{name}: rotating lidars are not simulated by the batched simulation "
-                               "(use Simulation)")
+        why = _refusal(robot, self.template(ref).config)
+        if why:
+            raise BatchedError(why)
         return ref
 
     def template(self, ref: DeviceRef):
