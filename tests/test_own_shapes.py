@@ -236,3 +236,20 @@ def test_the_batched_simulation_follows_the_same_rule(precision: str) -> None:
     ir_bare, _ = readings(world(ir_box=False, housing=False), precision)
     assert float(bs.value(bs.device("r", "ir"))[0]) == ir_bare        # copy 0: the wall, not the sensor's box
     assert np.count_nonzero(bs.range_image(bs.device("r", "lidar"))[0] < 0.06) >= 1    # the mast
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_housed_camera_sees_and_shades_the_rest_of_its_robot_as_a_bare_one(precision: str) -> None:
+    """The robot turned and lit from the side: the post (the robot's, met in the body frame when the
+    camera has shapes of its own) has the colours a bare camera gives it, so its normals are turned
+    into the world with the robot."""
+    def image(housing: bool) -> np.ndarray:
+        data = image_world("Camera", housing=housing, post=True)
+        data["robots"][0]["pose"] = {"rotation": [0, 0, 1, 0.7]}
+        data["lights"] = [{"type": "PointLight", "location": [0, -0.5, 0.3], "intensity": 1}]
+        return capture(data, precision)[:, :, :3].astype(int)
+
+    housed, bare = image(True), image(False)
+    assert np.abs(housed - bare).max() <= 1
+    post = (housed[:, :, 1] > 50) & (housed[:, :, 2] == 0)          # green, not the red wall
+    assert 0 < post.sum() < post.size

@@ -13,16 +13,13 @@ rays -- generic, sonar, laser, light occlusion -- skip the whole robot unless ``
 Webots does, and are not changed; a camera's shadow rays are the scene's lighting: its housing
 still casts shadows, as in Webots.)
 
-Two ways to cast blind to them, the same loop: a ray whose nearest hit is one of its device's own
-shapes is cast again from just past it, until it meets another shape or nothing.
-
-* :func:`cast_local_skipping`, rigidly mounted rays (infra-red, lidar): the robot's own body is
-  cast once per sensor, in the body frame, and kept.
-* :func:`cast_skipping`, an image's rays in the world (cameras, range finders: their casts carry
-  shape ids anyway): every capture, only the rays that met an own shape are cast again (a camera
-  inside a closed box: each ray twice).
-
-Only devices that have own shapes pay for this.
+The loop: a ray whose nearest hit is one of its device's own shapes is cast again from just past
+it, until it meets another shape or nothing. Rays rigidly mounted on the robot (infra-red, lidar
+beams, an image's pixel rays) are cast in the world without their robot's body (``mount``), and
+that body is met once, in its own frame, with :func:`cast_local_skipping` (the same answer at every
+pose: kept); :class:`OwnBodyRays` does both for an image device. :func:`cast_skipping` runs the
+loop in the world, for the rays a camera casts on past a semi-transparent surface. Only devices
+that have own shapes pay for this.
 """
 
 from __future__ import annotations
@@ -31,7 +28,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import Mount, RayHits, RayKind
+from sensorium.server.world.geometry import Pose
 
 MAX_PASSES = 64     # crossings of a device's own shapes one ray may pass (two per closed shape)
 
@@ -60,16 +58,23 @@ def _skipping(cast: Callable[[bool, np.ndarray, np.ndarray, np.ndarray], RayHits
 
 
 def cast_local_skipping(engine, body: int, origins: np.ndarray, directions: np.ndarray, t_near, t_far,
-                        kind: RayKind, skip_transparent: bool, own: Sequence[frozenset[int]]) -> RayHits:
+                        kind: RayKind, skip_transparent: bool,
+                        own: Sequence[frozenset[int]] | frozenset[int]) -> RayHits:
     """``engine.cast_local`` on ``body``, each ray ``i`` blind to the shapes ``own[i]`` (global shape
-    indices): the nearest hit on any other shape of the body, or no hit."""
+    indices; one set for every ray: ``own``): the nearest hit on any other shape of the body, or no hit."""
 
     def cast(first: bool, rows: np.ndarray, near: np.ndarray, far: np.ndarray) -> RayHits:
         return engine.cast_local(body, origins[rows], directions[rows], near, far, kind=kind,
                                  skip_transparent=skip_transparent)
 
-    def mine(rows: np.ndarray, shapes: np.ndarray) -> np.ndarray:
-        return np.array([s >= 0 and int(s) in own[r] for r, s in zip(rows.tolist(), shapes.tolist())], dtype=bool)
+    if isinstance(own, frozenset):
+        ids = np.fromiter(own, dtype=np.int64, count=len(own))
+
+        def mine(rows: np.ndarray, shapes: np.ndarray) -> np.ndarray:
+            return np.isin(shapes, ids)
+    else:
+        def mine(rows: np.ndarray, shapes: np.ndarray) -> np.ndarray:
+            return np.array([s >= 0 and int(s) in own[r] for r, s in zip(rows.tolist(), shapes.tolist())], dtype=bool)
 
     return _skipping(cast, len(origins), t_near, t_far, mine)
 
@@ -93,3 +98,46 @@ def cast_skipping(engine, origins: np.ndarray, directions: np.ndarray, t_near, t
         return np.isin(shapes, own_ids)
 
     return _skipping(cast, len(origins), t_near, t_far, mine)
+
+
+class OwnBodyRays:
+    """An image device's pixel rays (directions in its frame) when it has shapes of its own: cast
+    mounted on its robot's body, which the world cast then skips, and nearer hits on that body
+    (blind to the device's own shapes) taken from one cast in the body frame, kept per precision --
+    the lidar's way. Distances come out as a plain cast's; a hit on the robot's body is the body-frame
+    answer (the same surface; the last bit may differ from a world cast's)."""
+
+    def __init__(self, body: int, local: Pose, directions: np.ndarray, t_near, t_far, own: frozenset[int]):
+        self.body = body
+        self.mount = Mount(np.full(len(directions), body, dtype=np.int64))
+        self.limits = (t_near, t_far)
+        self._local = (np.ascontiguousarray(np.broadcast_to(local.translation, directions.shape)),
+                       np.ascontiguousarray(directions @ local.rotation.T))
+        self._own = own
+        self._hits: tuple[object, RayHits] | None = None
+
+    def body_hits(self, engine) -> RayHits:
+        if self._hits is None or self._hits[0] != engine.precision:
+            O, D = self._local
+            self._hits = (engine.precision, cast_local_skipping(engine, self.body, O, D, *self.limits,
+                                                                RayKind.VISUAL, False, self._own))
+        return self._hits[1]
+
+    def cast(self, engine, origins: np.ndarray, directions: np.ndarray, robot_rotation: np.ndarray,
+             directions32: np.ndarray | None = None, distance_only: bool = False) -> RayHits:
+        """The rays from the device's world pose (``directions``: these rays turned into the world)."""
+        h = engine.cast(origins, directions, *self.limits, kind=RayKind.VISUAL, exclude_owner=-1, mount=self.mount,
+                        distance_only=distance_only, directions32=directions32)
+        b = self.body_hits(engine)
+        win = (b.distance < h.distance).nonzero()[0]
+        if not len(win):
+            return h
+        dist = h.distance.copy()
+        dist[win] = b.distance[win]
+        if distance_only:
+            return RayHits(dist, None, None)
+        assert h.shape is not None and h.normal is not None and b.shape is not None
+        shape, normal = h.shape.copy(), h.normal.copy()
+        shape[win] = b.shape[win]
+        normal[win] = b.normal[win] @ robot_rotation.T          # body frame -> world
+        return RayHits(dist, normal, shape)
