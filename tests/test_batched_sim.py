@@ -185,3 +185,41 @@ def test_wheel_encoders_with_noise_and_resolution_match_the_single_simulation():
                 assert _same_value(s.robot("bot").device(name).value, float(bs.value(bs.device("bot", name))[c]))
             assert s.robot("bot").pose.translation.tobytes() == bs.pos[c, 0].tobytes()
     assert bs.value(bs.device("bot", "left"))[0] == pytest.approx(2.0 * 0.016 * 30, abs=1e-12)   # rad turned
+
+
+def test_skid_steer_robots_match_the_single_simulation_with_every_wheel_of_a_side_driven():
+    """Three wheels per side (the side's speed is the mean of its wheels, summed as the single
+    simulation sums them) and an encoder on every wheel: poses and encoder values bit for bit."""
+    left, right = ["l0", "l1", "l2"], ["r0", "r1", "r2"]
+    world = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "random_seed": 0},
+        "robots": [{"name": "rover", "pose": {"translation": [0, 0, 0.1]},
+                    "differential_drive": {"wheel_radius": 0.1, "axle_length": 0.37, "max_wheel_speed": 7.0,
+                                           "left_motor": "l0", "right_motor": "r0",
+                                           "skid_steer": {"left": left[1:], "right": right[1:]}},
+                    "devices": [{"device": "PositionSensor", "name": f"{m} sensor", "motor": m, "noise": 0.0}
+                                for m in left + right]}]})
+    bs = BatchedSimulation(world, 2)
+    sims = [Simulation(world), Simulation(world)]
+    for m in left + right:
+        bs.enable(bs.device("rover", f"{m} sensor"), 16)
+        for s in sims:
+            s.robot("rover").device(f"{m} sensor").enable(16)
+    rng = np.random.default_rng(2)
+    for step in range(40):
+        if step % 8 == 0:
+            lr = rng.uniform(-7.0, 7.0, (2, 2))
+            bs.set_wheels(0, lr[:, 0], lr[:, 1])
+            for c, s in enumerate(sims):
+                for names, v in ((left, lr[c, 0]), (right, lr[c, 1])):
+                    for m in names:
+                        s.robot("rover").motor(m).set_position(math.inf)
+                        s.robot("rover").motor(m).set_velocity(float(v))
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            assert s.robot("rover").pose.translation.tobytes() == bs.pos[c, 0].tobytes(), (step, c)
+            assert s.robot("rover").pose.rotation.tobytes() == bs.rot[c, 0].tobytes(), (step, c)
+            for m in left + right:
+                assert s.robot("rover").device(f"{m} sensor").value == float(bs.value(bs.device("rover", f"{m} sensor"))[c])
+    assert bs.value(bs.device("rover", "l2 sensor")).tolist() == bs.value(bs.device("rover", "l0 sensor")).tolist()

@@ -298,3 +298,41 @@ def test_example_loop_runs_the_batched_vector_env_with_the_same_episodes():
     sync = run("sensorium/ReachLight-v0", 2, 6, "sync", policy="scripted")
     batched = run("sensorium/ReachLight-v0", 2, 6, "batched", policy="scripted")
     assert batched["env_steps"] == 12 and batched["mean_reward"] == sync["mean_reward"]
+
+
+# -- a skid-steer robot (several wheels per side): an action drives every wheel of its side
+
+R_WHEEL, TRACK, VMAX = 0.11, 0.4, 5.0
+
+
+def skid_world(per_side: int) -> wm.World:
+    left, right = [f"left {i}" for i in range(per_side)], [f"right {i}" for i in range(per_side)]
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "random_seed": 0},
+        "robots": [{"name": "rover", "pose": {"translation": [0, 0, R_WHEEL]},
+                    "differential_drive": {"wheel_radius": R_WHEEL, "axle_length": TRACK, "max_wheel_speed": VMAX,
+                                           "left_motor": left[0], "right_motor": right[0],
+                                           "skid_steer": {"left": left[1:], "right": right[1:]}},
+                    "devices": [{"device": "PositionSensor", "name": "back left", "motor": left[-1]},
+                                {"device": "PositionSensor", "name": "back right", "motor": right[-1]}]}]})
+
+
+@pytest.mark.parametrize("per_side", [2, 3])
+@pytest.mark.parametrize("engine", ["simulation", "batched"])
+def test_a_skid_steer_robot_drives_straight_and_turns_at_the_closed_form_rates(engine, per_side):
+    env = SensoriumEnv(skid_world(per_side), Task(robot="rover", control_period_ms=64, max_steps=None), engine=engine)
+    assert env.engine == engine
+    t = 10 * 0.064
+    env.reset(seed=0)
+    for _ in range(10):
+        obs, *_, info = env.step(np.array([1.0, 1.0], dtype=np.float32))
+    # every wheel at VMAX: v = R VMAX, the back wheels' encoders read VMAX t
+    assert info["pose"] == pytest.approx([R_WHEEL * VMAX * t, 0.0, 0.0], abs=1e-12)
+    assert obs["back left"][0] == pytest.approx(VMAX * t, rel=1e-7) and obs["back right"][0] == obs["back left"][0]
+    env.reset(seed=0)
+    for _ in range(10):
+        obs, *_, info = env.step(np.array([-1.0, 1.0], dtype=np.float32))
+    # turning on the spot: w = R (VMAX - -VMAX) / TRACK
+    assert info["pose"] == pytest.approx([0.0, 0.0, R_WHEEL * 2 * VMAX / TRACK * t], abs=1e-12)
+    assert obs["back left"][0] == pytest.approx(-VMAX * t, rel=1e-7)
+    env.close()

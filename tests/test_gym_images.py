@@ -55,3 +55,40 @@ def test_images_are_not_observed_unless_named():
     env.reset(seed=0)
     assert env.sim.counters["rays_camera"] == 0 and env.sim.counters["rays_range_finder"] == 0
     env.close()
+
+
+def test_the_auto_engine_runs_image_tasks_on_the_simulation_with_the_same_episodes():
+    """The batched engine does not simulate cameras and range finders: engine="auto" (the PettingZoo
+    env's default) runs such a task on the rebuilt Simulation, giving engine="simulation"'s episode
+    bit for bit; engine="batched" and the batched vector env refuse it in one line saying what to use."""
+    from sensorium.gym import SensoriumParallelEnv
+    from sensorium.gym.vector import SensoriumVectorEnv
+    from sensorium.server.sim.batched import BatchedError
+
+    task = Task(robot="bot", observations=["cam", "depth", "ds"], max_steps=5)
+    auto, ref = SensoriumEnv(world(), task, engine="auto"), SensoriumEnv(world(), task, engine="simulation")
+    assert auto.engine == "simulation"
+    rng = np.random.default_rng(0)
+    for seed in (4, None):
+        a, _ = auto.reset(seed=seed)
+        b, _ = ref.reset(seed=seed)
+        for _ in range(3):
+            assert all(a[k].tobytes() == b[k].tobytes() for k in ("cam", "depth", "ds"))
+            act = rng.uniform(-1, 1, 2).astype(np.float32)
+            a, ra, *_ = auto.step(act)
+            b, rb, *_ = ref.step(act)
+            assert ra == rb
+    assert SensoriumParallelEnv(world(), {"bot": task}).engine == "simulation"
+    for name, kind in (("cam", "Camera"), ("depth", "RangeFinder")):
+        one = Task(robot="bot", observations=[name])
+        with pytest.raises(BatchedError, match=rf"^robot 'bot': device '{name}' is a {kind}; the batched simulation "
+                                               r"measures .* \(use Simulation\)$"):
+            SensoriumEnv(world(), one, engine="batched")
+        with pytest.raises(BatchedError) as e:
+            SensoriumVectorEnv(world(), one, 2)
+        assert str(e.value) == (f"robot 'bot': device '{name}' is a {kind}; the batched simulation measures "
+                                "LightSensor, DistanceSensor, Lidar, PositionSensor: the batched vector environment "
+                                "cannot run this task (SensoriumEnv can: gymnasium.vector.SyncVectorEnv or "
+                                "AsyncVectorEnv of it)")
+    # the same robot observed without its images runs batched (its camera is never computed)
+    assert SensoriumEnv(world(), Task(robot="bot", observations=["ds"]), engine="auto").engine == "batched"

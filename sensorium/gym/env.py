@@ -15,11 +15,12 @@ in ``[0, max_range]`` with "no hit" as ``max_range``.
 ``flatten=True``: one float32 ``Box`` instead, the Dict's boxes flattened and concatenated in its
 (sorted) key order, as ``gymnasium.wrappers.FlattenObservation`` gives.
 
-Action: float32 ``(2,)`` = left, right wheel. ``actions="normalized"`` (the default): in
-``[-1, 1]``, times the drive's max wheel speed (rad/s) -- the symmetric, normalised box training
-libraries and Gymnasium's checker recommend; ``actions="wheel"``: the wheel velocities themselves
-(rad/s), bounded by the max wheel speed. Either way a velocity beyond the maximum is clamped, as
-Webots does. One action lasts ``control_period_ms``.
+Action: float32 ``(2,)`` = left, right wheel (every wheel of its side, for a skid-steer robot).
+``actions="normalized"`` (the default): in ``[-1, 1]``, times the drive's max wheel speed (rad/s) --
+the symmetric, normalised box training libraries and Gymnasium's checker recommend;
+``actions="wheel"``: the wheel velocities themselves (rad/s), bounded by the max wheel speed.
+Either way a velocity beyond the maximum is clamped, as Webots does. One action lasts
+``control_period_ms``.
 
 ``reset(seed=s)`` restarts the world with a world seed drawn from the environment's generator
 seeded with ``s``: every device noise stream, the start pose drawn by ``Task.start`` and the clock
@@ -156,8 +157,10 @@ class Agent:
     def act(self, sim: Simulation, action) -> None:
         v = self.wheel_velocities(action)
         drive = sim.robot(self.robot).drive
-        drive.left.set_velocity(float(v[0]))
-        drive.right.set_velocity(float(v[1]))
+        for m in drive.lefts:        # every wheel of a side (a skid-steer robot has several)
+            m.set_velocity(float(v[0]))
+        for m in drive.rights:
+            m.set_velocity(float(v[1]))
 
     def observe(self, sim: Simulation):
         robot = sim.robot(self.robot)
@@ -222,13 +225,15 @@ ENGINES = ("auto", "batched", "simulation")
 def batched_engine(loaded: LoadedWorld, agents: list[Agent], precision: str, engine: str):
     """The one-copy batched simulation the environments run on (``engine`` "batched", or "auto"
     when it simulates the world and every observed device), None for a rebuilt Simulation."""
-    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_observable
 
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     if engine == "simulation":
         return None
     try:
+        for ag in agents:              # an observed camera, range finder, rotating lidar: nothing built
+            check_observable(loaded.world, ag.robot, ag.periods)
         sim = BatchedSimulation(loaded, 1, precision=precision)
         for ag in agents:
             for name in ag.periods:

@@ -47,7 +47,7 @@ from sensorium.gym.render import TopDown
 from sensorium.gym.task import Task, VectorGoal, never, zero
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
-from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_observable
 from sensorium.server.world.loader import LoadedWorld
 
 __all__ = ["SensoriumVectorEnv", "SubEnv"]
@@ -107,7 +107,13 @@ class SensoriumVectorEnv(VectorEnv):
         self.num_envs = n = int(num_envs)
         self.precision = precision
         self.agent = Agent(self.loaded, self.task, actions=actions, flatten=flatten)
-        self.sim = BatchedSimulation(self.loaded, n, precision=precision)
+        try:      # what the batched simulation does not simulate: one line, before anything is built
+            check_observable(self.loaded.world, self.agent.robot, self.agent.periods)
+            self.sim = BatchedSimulation(self.loaded, n, precision=precision)
+        except BatchedError as e:
+            raise BatchedError(f"{str(e).removesuffix(' (use Simulation)')}: the batched vector environment cannot "
+                               "run this task (SensoriumEnv can: gymnasium.vector.SyncVectorEnv or "
+                               "AsyncVectorEnv of it)") from None
         self.slot = self.sim.slot(self.agent.robot)
         self.refs = {name: self.sim.check_observable(self.agent.robot, name) for name in self.agent.periods}
         self.basic_time_step = self.sim.basic_time_step

@@ -10,8 +10,11 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   ``scene`` (``world_lights()``, ``solid_poses``, and ``engine.cast(...)`` casting in this copy only:
   ``exclude_owner`` is a robot index, as in the single simulation);
 * ``CopyRobot``: ``name``, ``index``, ``model``, ``pose``, ``set_pose(...)``, ``motors`` /
-  ``motor(name)`` and ``drive.left`` / ``drive.right`` (``set_position``, ``set_velocity``,
-  ``velocity``, ``position``, ``max_velocity``), ``device(name).enable(period)`` / ``.value``.
+  ``motor(name)``, ``drive.left`` / ``drive.right`` and ``drive.lefts`` / ``drive.rights`` (every
+  wheel of a side: ``set_position``, ``set_velocity``, ``velocity``, ``position``,
+  ``max_velocity``), ``device(name).enable(period)`` / ``.value``. The batched simulation drives a
+  skid-steer robot's wheels of one side together: its wheels of a side share one state, so
+  commanding one of them commands its side.
 
 Anything else a callable reaches for raises AttributeError naming the view.
 """
@@ -30,10 +33,10 @@ __all__ = ["CopySim", "CopyRobot"]
 
 
 class _Motor:
-    def __init__(self, sim: BatchedSimulation, copy: int, slot: int, wheel: int):
-        self._s, self._c, self._r, self._w = sim, copy, slot, wheel
-        self.name = sim.motor_names[slot][wheel]
-        self.max_velocity = float(sim.max_wheel[slot, wheel])
+    def __init__(self, sim: BatchedSimulation, copy: int, slot: int, name: str):
+        self._s, self._c, self._r, self._w = sim, copy, slot, sim.wheel_side[slot][name]
+        self.name = name
+        self.max_velocity = float(sim.max_wheel[slot, self._w])
 
     @property
     def velocity(self) -> float:
@@ -59,12 +62,15 @@ class _Motor:
 
 
 class _Drive:
-    def __init__(self, left: _Motor, right: _Motor):
-        self.left, self.right = left, right
+    def __init__(self, sim: BatchedSimulation, copy: int, slot: int):
+        left, right = sim.world.robots[slot].differential_drive.motor_names
+        self.lefts = [_Motor(sim, copy, slot, name) for name in left]
+        self.rights = [_Motor(sim, copy, slot, name) for name in right]
+        self.left, self.right = self.lefts[0], self.rights[0]
 
     @property
     def motors(self) -> dict[str, _Motor]:
-        return {self.left.name: self.left, self.right.name: self.right}
+        return {m.name: m for m in (*self.lefts, *self.rights)}
 
 
 class _Device:
@@ -99,7 +105,7 @@ class CopyRobot:
         self.name = sim.robot_names[slot]
         self.model = sim.world.robots[slot]
         if sim.has_drive[slot]:
-            self.drive: _Drive | None = _Drive(_Motor(sim, copy, slot, 0), _Motor(sim, copy, slot, 1))
+            self.drive: _Drive | None = _Drive(sim, copy, slot)
             self.motors = self.drive.motors
         else:
             self.drive = None

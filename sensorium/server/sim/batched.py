@@ -21,8 +21,9 @@ sensors, distance sensors, fixed lidars and wheel encoders, each device's noise 
 stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in the same
 order). Tests compare it with the single simulation step by step.
 
-Not simulated here (use :class:`Simulation`): rotating lidars, the kinds without an observation
-(LEDs, GPS, IMU, pens, ...), lights carried by robots, textured robot bodies, NUE worlds.
+Not simulated here (use :class:`Simulation`): rotating lidars, cameras and range finders, the kinds
+without an observation (LEDs, GPS, IMU, pens, ...), lights carried by robots, textured robot bodies,
+NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ from sensorium.server.world.limits import check_pose
 from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, sanitize
 from sensorium.server.world.poses import pose_from_model, pose_from_values
 
-__all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS"]
+__all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS", "check_observable"]
 
 SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
 _TWO_PI = 2.0 * math.pi
@@ -61,6 +62,27 @@ _TWO_PI = 2.0 * math.pi
 
 class BatchedError(ValueError):
     """The world uses something the batched simulation does not simulate (the message says what)."""
+
+
+def _refusal(robot: str, config) -> str | None:
+    """Why the batched simulation does not measure a device (its world-file model), or None."""
+    if config.device not in SUPPORTED_KINDS:
+        return (f"robot {robot!r}: device {config.name!r} is a {config.device}; the batched simulation measures "
+                f"{', '.join(SUPPORTED_KINDS)} (use Simulation)")
+    if config.device == "Lidar" and config.type == "rotating":
+        return f"{robot}/{config.name}: rotating lidars are not simulated by the batched simulation (use Simulation)"
+    return None
+
+
+def check_observable(world: wm.World, robot: str, names: Iterable[str]) -> None:
+    """BatchedError (one line saying why) unless the batched simulation measures each named device
+    of the world's robot: the check of :meth:`BatchedSimulation.check_observable`, before anything
+    is built (names it does not know are left to the caller)."""
+    devices = {d.name: d for r in world.robots if r.name == robot for d in r.devices}
+    for name in names:
+        why = _refusal(robot, devices[name]) if name in devices else None
+        if why:
+            raise BatchedError(why)
 
 
 @dataclass(frozen=True, slots=True)
@@ -159,11 +181,21 @@ class BatchedSimulation:
         movers = RayEngine(Precision(precision))
         slot_body: list[int | None] = []
         red, rough = list(self.scene.red[:-1]), list(self.scene.roughness[:-1])
+        # the shapes of each device's own Solid (of_device), numbered as the movers' engine numbers
+        # them: its visual rays do not see them (own_shapes.py), as in the single simulation
+        self._own_shapes: dict[tuple[int, str], frozenset[int]] = {}
+        first = 0
         for i, r in enumerate(w.robots):
             parts = list(robot_parts(r))
             if parts:
                 slot_body.append(movers.add_body([_entry(s, base, local) for _, local, s in parts],
                                                  pose_from_model(r.pose), owner=i, movable=True))
+                owned: dict[str, set[int]] = {}
+                for k, (_, _, shape) in enumerate(parts):
+                    if getattr(shape, "of_device", None) is not None:
+                        owned.setdefault(shape.of_device, set()).add(first + k)
+                self._own_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
+                first += len(parts)
                 for name, _, shape in parts:
                     info = _shape_info(name, i, shape)
                     red.append(info.red)
@@ -185,6 +217,13 @@ class BatchedSimulation:
                                    for r in w.robots], dtype=np.float64)
         self.motor_names = [(r.differential_drive.left_motor, r.differential_drive.right_motor)
                             if r.differential_drive else ("", "") for r in w.robots]
+        # every wheel motor's side (0 left, 1 right): a skid-steer robot's wheels of one side are
+        # always commanded together here (set_wheels), so one state per side is each of its wheels
+        self.wheel_side: list[dict[str, int]] = [
+            {name: side for side, names in enumerate(r.differential_drive.motor_names) for name in names}
+            if r.differential_drive else {} for r in w.robots]
+        self.side_wheels = np.array([[len(n) for n in r.differential_drive.motor_names] if r.differential_drive
+                                     else [1, 1] for r in w.robots], dtype=np.int64)
         self._templates = [DifferentialDrive(r.differential_drive, self.initial[i]) if r.differential_drive else None
                            for i, r in enumerate(w.robots)]
         # -- per copy state
@@ -256,7 +295,12 @@ class BatchedSimulation:
                 if d.device not in lists:
                     continue
                 dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
-                                        world_seed=0, clock=lambda: 0)
+                                        world_seed=0, clock=lambda: 0,
+                                        own_shapes=self._own_shapes.get((slot, d.name), frozenset()))
+                if d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
+                    # its beams meet its own robot's body once, in the body frame, blind to its own
+                    # shapes (Lidar._own_distances, on the movers' engine)
+                    dev._own_body = (_OnEngine(self.rays.movers), self.rays.slot_body[slot], None)
                 self.refs[(slot, d.name)] = DeviceRef(d.device, len(lists[d.device]), slot, d.name)
                 lists[d.device].append(dev)   # type: ignore[attr-defined]
         # noise streams: one per (copy, device) of every device that can draw (a noisy lookup
@@ -311,9 +355,8 @@ class BatchedSimulation:
         if self.position:
             wheel = []
             for d in self.position:
-                names = self.motor_names[d.robot_index]
                 m = d.config.motor
-                wheel.append(names.index(m) if m is not None and m in names and self.has_drive[d.robot_index] else -1)
+                wheel.append(self.wheel_side[d.robot_index].get(m, -1) if m is not None else -1)
             self._p_wheel = np.array(wheel, dtype=np.int64)
             self._p_slot = np.array([d.robot_index for d in self.position], dtype=np.int64)
             self._p_plain = np.array([float(d.config.noise) <= 0.0 and float(d.config.resolution) <= 0.0
@@ -338,19 +381,18 @@ class BatchedSimulation:
         slot = self.slot(robot)
         ref = self.refs.get((slot, name))
         if ref is None:
-            kinds = {d.name: d.device for d in self.world.robots[slot].devices}
+            kinds = {d.name: d for d in self.world.robots[slot].devices}
             if name in kinds:
-                raise BatchedError(f"robot {robot!r}: device {name!r} is a {kinds[name]}; the batched simulation "
-                                   f"measures {', '.join(SUPPORTED_KINDS)} (use Simulation)")
+                raise BatchedError(_refusal(robot, kinds[name]) or f"{robot}/{name}: not measured")
             raise KeyError(f"robot {robot!r} has no device {name!r} (devices: {', '.join(kinds)})")
         return ref
 
     def check_observable(self, robot: str, name: str) -> DeviceRef:
         """The device, if the batched simulation measures it (else BatchedError saying why)."""
         ref = self.device(robot, name)
-        if ref.kind == "Lidar" and self.lidar[ref.column].rotating:
-            raise BatchedError(f"{robot}/{name}: rotating lidars are not simulated by the batched simulation "
-                               "(use Simulation)")
+        why = _refusal(robot, self.template(ref).config)
+        if why:
+            raise BatchedError(why)
         return ref
 
     def template(self, ref: DeviceRef):
@@ -426,8 +468,9 @@ class BatchedSimulation:
             tpl.reset(self.initial[slot])
 
     def set_wheels(self, slot: int, left, right, copies=None) -> None:
-        """Velocity control of a slot's two wheels (rad/s, clamped to the maximum as Webots does) in
-        the named copies (default: all): ``setPosition(inf)`` and ``setVelocity`` of both motors."""
+        """Velocity control of a slot's wheels (rad/s, clamped to the maximum as Webots does) in the
+        named copies (default: all): ``setPosition(inf)`` and ``setVelocity`` of every wheel motor of
+        each side (a skid-steer robot's too)."""
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         vmax = self.max_wheel[slot]
         left = np.asarray(left, dtype=np.float64)
@@ -490,6 +533,13 @@ class BatchedSimulation:
         omega = np.where(free, vel, held)
         self.wheel_angle[np.ix_(live, driven)] = ang + omega * dt
         wl, wr = omega[..., 0], omega[..., 1]
+        counts = self.side_wheels[driven]
+        skid = ((counts[:, 0] > 1) | (counts[:, 1] > 1)).nonzero()[0]
+        if len(skid):     # DifferentialDrive.step: each side the mean of its (equal) wheels, summed in order
+            wl, wr = wl.copy(), wr.copy()
+            for j in skid.tolist():
+                wl[:, j] = _side_mean(wl[:, j], int(counts[j, 0]))
+                wr[:, j] = _side_mean(wr[:, j], int(counts[j, 1]))
         moving = (wl != 0.0) | (wr != 0.0)                      # (live, driven)
         ci, ri = moving.nonzero()
         if not len(ci):
@@ -835,8 +885,10 @@ class BatchedSimulation:
                 dirs[:, :, j] = acc
             d = dirs.reshape(-1, 3)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
+            # a lidar with own shapes never meets its own body in the cast (finish adds those hits)
+            mount = slot if lid._own_body is not None else np.tile(self._lidar_skip(col), len(c))
             reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, np.repeat(c, W),
-                              -1, np.tile(self._lidar_skip(col), len(c)), distance_only=True, d32=d.astype(np.float32)))
+                              -1, mount, distance_only=True, d32=d.astype(np.float32)))
             state["items"].append((col, c))
         return state, reqs
 
@@ -861,6 +913,8 @@ class BatchedSimulation:
             lid = self.lidar[col]
             L, W = lid.config.number_of_layers, lid.config.horizontal_resolution
             dist = h.distance.reshape(len(c), L, W)
+            if lid._own_body is not None:
+                dist = np.minimum(dist, lid._own_distances())
             img = self.range_images[col]
             if lid.params.noise > 0:
                 nc = self._noise_col[("Lidar", col)]
@@ -899,6 +953,13 @@ class _Rays:
     d32: np.ndarray | None = None
 
 
+class _OnEngine:
+    """What a device template's own-body cast reads of its scene: the engine holding the robots."""
+
+    def __init__(self, engine: RayEngine):
+        self.engine = engine
+
+
 class _Stream:
     """One (copy, device) noise stream with the interface lidar.ranges_from_hits draws through."""
 
@@ -915,6 +976,14 @@ def _by_table(devices: list) -> list[tuple]:
     for k, d in enumerate(devices):
         out.setdefault(d.table, []).append(k)
     return [(t, np.array(v, dtype=np.int64)) for t, v in out.items()]
+
+
+def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
+    """``sum(w for each of n wheels) / n`` as Python's ``sum`` and one division give it (0 + w + w ...)."""
+    acc = 0.0 + w
+    for _ in range(n - 1):
+        acc = acc + w
+    return acc / n
 
 
 def _cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

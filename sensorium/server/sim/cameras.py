@@ -5,7 +5,9 @@ device: their directions in the device frame are made once (on the first capture
 the world only when the device turns, and cast in one engine call (plus, for a camera, the calls
 its shading needs). Nothing is computed while a device is disabled; the simulation calls
 ``capture`` when ``due``. The pure models are ``server/devices/imaging.py`` (rays, ranges),
-``shading.py`` (colours) and ``recognition.py`` (objects).
+``shading.py`` (colours) and ``recognition.py`` (objects). A device never sees the shapes of its
+own Solid (``of_device``, a camera's small housing): its pixel rays pass through them
+(``own_shapes.py``, the lidar's rule).
 """
 
 from __future__ import annotations
@@ -17,7 +19,8 @@ import numpy as np
 
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
-from sensorium.server.raycast.engine import RayKind
+from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
@@ -28,10 +31,11 @@ __all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info
 class MountedRays:
     """A device's pixel rays: local directions (made once), world directions kept until the
     device's rotation changes (a parked or translating robot rotates nothing), and their float32
-    copy for Embree."""
+    copy for Embree. ``own``: how they are cast when the device has shapes of its own."""
 
-    def __init__(self, local: np.ndarray):
+    def __init__(self, local: np.ndarray, own: OwnBodyRays | None = None):
         self.local = np.ascontiguousarray(local.reshape(-1, 3))
+        self.own = own
         self._cols = tuple(np.ascontiguousarray(self.local[:, k]) for k in range(3))
         self._key: bytes | None = None
         self.world = np.empty((0, 3))
@@ -52,6 +56,27 @@ class MountedRays:
             w32.flags.writeable = False
             self._key, self.world, self.world32 = key, out, w32
         return self.world, self.world32
+
+
+def _mounted(device: Any, dirs: np.ndarray, limits: tuple[Any, Any]) -> MountedRays:
+    """A device's pixel rays (directions in its frame) and, when it has shapes of its own, their
+    cast mounted on its robot's body, blind to those shapes (``own_shapes.py``, the lidar's way)."""
+    body = device._scene.robot_body(device.robot_index) if device.own_shapes else None
+    own = None if body is None else OwnBodyRays(body, device.local_pose, dirs.reshape(-1, 3), *limits, device.own_shapes)
+    return MountedRays(dirs, own)
+
+
+def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, Any],
+                 distance_only: bool = False) -> RayHits:
+    """The nearest surface along each of a device's pixel rays from its world pose ``pose``: nothing
+    excluded (its robot is in view), but blind to the device's own shapes."""
+    dirs, dirs32 = rays.at(pose.rotation)
+    origins = np.broadcast_to(pose.translation, dirs.shape)
+    engine = device._scene.engine
+    if rays.own is not None:
+        return rays.own.cast(engine, origins, dirs, device._robot.pose.rotation, dirs32, distance_only)
+    return engine.cast(origins, dirs, *limits, kind=RayKind.VISUAL, exclude_owner=-1, distance_only=distance_only,
+                       directions32=dirs32)
 
 
 def camera_info(geometry: imaging.ImageGeometry) -> dict:
@@ -109,17 +134,12 @@ class RangeFinder(Device):
             self._factors = imaging.depth_factors(self.geometry, dirs)
             # rays need not reach beyond max_range (in depth for a planar image): nothing there counts
             self._limits = imaging.clip_limits(self.geometry, self._factors, self.config.near, self.config.max_range)
-            self._rays = MountedRays(dirs)
+            self._rays = _mounted(self, dirs, self._limits)
         return self._rays
 
     def capture(self, now_ms: int, counters: Any) -> None:
         rays = self._prepare()
-        pose: Pose = self.world_pose(self._robot.pose)
-        dirs, dirs32 = rays.at(pose.rotation)
-        origins = np.broadcast_to(pose.translation, dirs.shape)
-        t_near, t_far = self._limits
-        hits = self._scene.engine.cast(origins, dirs, t_near, t_far, kind=RayKind.VISUAL, exclude_owner=-1,
-                                       distance_only=True, directions32=dirs32)
+        hits = _cast_pixels(self, rays, self.world_pose(self._robot.pose), self._limits, distance_only=True)
         counters["rays_range_finder"] += len(rays)
         counters["cast_calls"] += 1
         c = self.config
@@ -282,7 +302,7 @@ class Camera(Device):
             dirs = imaging.pixel_directions(self.geometry, self._samples)
             factors = imaging.depth_factors(self.geometry, dirs)
             self._limits = imaging.clip_limits(self.geometry, factors, c.near, c.far if c.far > 0 else math.inf)
-            self._rays = MountedRays(dirs)
+            self._rays = _mounted(self, dirs, self._limits)
         return self._rays
 
     def _light_arrays(self) -> tuple[light_math.LightArrays, np.ndarray]:
@@ -328,19 +348,15 @@ class Camera(Device):
             self._centre_factors = imaging.depth_factors(self.geometry, dirs)
             rng = float(c.recognition.max_range) if c.recognition is not None else math.inf
             self._centre_limits = imaging.clip_limits(self.geometry, self._centre_factors, c.near, rng)
-            self._centre_rays = MountedRays(dirs)
-        dirs, dirs32 = self._centre_rays.at(pose.rotation)
-        t_near, t_far = self._centre_limits
-        hits = self._scene.engine.cast(np.broadcast_to(pose.translation, dirs.shape), dirs, t_near, t_far,
-                                       kind=RayKind.VISUAL, exclude_owner=-1, directions32=dirs32)
-        counters["rays_camera"] += len(dirs)
+            self._centre_rays = _mounted(self, dirs, self._centre_limits)
+        hits = _cast_pixels(self, self._centre_rays, pose, self._centre_limits)
+        counters["rays_camera"] += len(self._centre_rays)
         counters["cast_calls"] += 1
         return np.where(np.isfinite(hits.distance), rec.key_of[hits.shape], -1)
 
     def _capture_image(self, pose: Pose, counters: Any) -> None:
         rays = self._prepare()
-        dirs, dirs32 = rays.at(pose.rotation)
-        L = self._render(pose.translation, dirs, dirs32, counters)
+        L = self._render(pose, rays, counters)
         c = self.config
         S = len(self._samples)
         if S > 1:      # supersampling: the mean radiance of the pixel's rays
@@ -351,13 +367,15 @@ class Camera(Device):
         image[:, :, 0], image[:, :, 1], image[:, :, 2], image[:, :, 3] = rgb[:, :, 2], rgb[:, :, 1], rgb[:, :, 0], 255
         self.image = image
 
-    def _render(self, origin: np.ndarray, dirs: np.ndarray, dirs32: np.ndarray, counters: Any) -> np.ndarray:
+    def _render(self, pose: Pose, rays: MountedRays, counters: Any) -> np.ndarray:
         """The radiance (N, 3) along every ray: the surfaces it crosses composited front to back
         (semi-transparent ones let ``transparency`` of what is behind through; a closed shape's
         faces are crossed twice and only its entering face is seen, as with back-face culling),
-        the background where nothing is hit."""
+        the background where nothing is hit. The device's own shapes are never met."""
         scene = self._scene
         engine = scene.engine
+        origin = pose.translation
+        dirs = rays.at(pose.rotation)[0]
         n = len(dirs)
         t_near, t_far = self._limits
         tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
@@ -368,13 +386,15 @@ class Camera(Device):
         for layer in range(MAX_LAYERS + 1):
             if layer == 0:
                 D = dirs
-                hits = engine.cast(np.broadcast_to(origin, D.shape), D, t_near, t_far, kind=RayKind.VISUAL,
-                                   exclude_owner=-1, directions32=dirs32)
-            else:
+                hits = _cast_pixels(self, rays, pose, self._limits)
+            else:                       # on past semi-transparent surfaces
                 assert tn is not None and tf is not None
                 D = dirs[rows]
-                hits = engine.cast(np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows], kind=RayKind.VISUAL,
-                                   exclude_owner=-1)
+                if self.own_shapes:
+                    hits = cast_skipping(engine, np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows], self.own_shapes)
+                else:
+                    hits = engine.cast(np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows], kind=RayKind.VISUAL,
+                                       exclude_owner=-1)
             counters["rays_camera"] += len(rows)
             counters["cast_calls"] += 1
             t, shape, normal = hits.distance, hits.shape, hits.normal
