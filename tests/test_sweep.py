@@ -118,6 +118,23 @@ def test_circle_run_ends_where_the_arc_says_and_records_every_step(tmp_path):
         assert rec.metadata()["sensorium"]["seed"] == "3"
 
 
+def test_builtin_controllers_drive_every_wheel_of_a_skid_steer_robot(tmp_path):
+    """A skid-steer robot (two wheels per side) runs the circle at the same arc as a two-wheel one:
+    the built-in controllers set every wheel of a side (before, the second wheels held still and
+    the robot went at half speed)."""
+    plain = room_world(tmp_path / "plain.yaml")
+    data = yaml.safe_load(plain.read_text())
+    data["robots"][0]["differential_drive"].update(
+        {"left_motor": "left front", "right_motor": "right front",
+         "skid_steer": {"left": ["left back"], "right": ["right back"]}})
+    skid = tmp_path / "skid.yaml"
+    skid.write_text(yaml.safe_dump(data))
+    rows = [run_one(RunSpec(0, str(w), 3, (), "circle", 640, None)) for w in (plain, skid)]
+    assert all(r["status"] == "ok" for r in rows), [r["error"] for r in rows]
+    assert (rows[1]["bot.x"], rows[1]["bot.y"]) == (rows[0]["bot.x"], rows[0]["bot.y"])
+    assert rows[1]["bot.path_m"] == rows[0]["bot.path_m"] > 0
+
+
 def test_a_python_file_controller_and_parameters(tmp_path):
     world = room_world(tmp_path / "room.yaml")
     ctrl = tmp_path / "fwd.py"

@@ -32,9 +32,11 @@ __all__ = ["BUILTIN", "resolve", "idle", "circle", "spin", "braitenberg"]
 
 
 def _velocity(robot, left: float, right: float) -> None:
-    for motor, v in ((robot.drive.left, left), (robot.drive.right, right)):
-        motor.set_position(math.inf)
-        motor.set_velocity(v)
+    # every wheel of a side (a skid-steer robot has several; sim/motion.py rolls a side at their mean)
+    for motors, v in ((robot.drive.lefts, left), (robot.drive.rights, right)):
+        for motor in motors:
+            motor.set_position(math.inf)
+            motor.set_velocity(v)
 
 
 def idle(sim) -> None:
