@@ -180,14 +180,31 @@ def test_a_truncated_file_whose_first_chunk_is_damaged_says_what_it_cannot_name(
 # ------------------------------------------------------------------------------------ cut files
 
 
-def test_a_zero_filled_tail_ends_the_readable_part_at_once(tmp_path, finished):
+def record_ends(path: Path) -> list[int]:
+    """Where each record of the data section ends."""
+    data = path.read_bytes()
+    out, pos = [], 8
+    while pos + 9 <= len(data) and data[pos] not in (0x0F, 0x02):
+        (length,) = struct.unpack_from("<Q", data, pos + 1)
+        pos += 9 + length
+        out.append(pos)
+    return out
+
+
+@pytest.mark.parametrize("where", ["after a record", "inside a chunk"])
+def test_a_zero_filled_tail_ends_the_readable_part_at_once(tmp_path, finished, where):
+    """A power loss leaves the file's length but not its last writes: zeros from the end of the
+    last write that reached the disk (the old reader took 66 s over 64 MiB of them, 9 bytes at a time)."""
     data = finished.read_bytes()
+    size = len(data) * 6 // 10
+    if where == "after a record":
+        size = max(end for end in record_ends(finished) if end <= size)
     cut = tmp_path / "cut.mcap"
-    cut.write_bytes(data[: len(data) * 6 // 10])
+    cut.write_bytes(data[:size])
     zeros = tmp_path / "zeros.mcap"
     with open(zeros, "wb") as f:
         f.write(cut.read_bytes())
-        f.truncate(cut.stat().st_size + (64 << 20))             # 64 MiB of zeros, as a power loss leaves
+        f.truncate(cut.stat().st_size + (64 << 20))             # 64 MiB of zeros
     t0 = time.perf_counter()
     s = summarize(zeros)
     res = recover(zeros)

@@ -75,6 +75,21 @@ def test_rays_per_sensor_robots_devices_lights_and_rays_per_step() -> None:
     assert "6 exceeds the limit of 5" in problems(world, limits=few)[0][1]
 
 
+def test_triangles_and_rays_each_within_their_limit_are_bounded_together() -> None:
+    """47 spheres of 81,920 triangles and 16 robots of 256 distance sensors × 1024 rays: each
+    within its limit, together (with two 4096² textures) they took 3.0 GB to build (issue 28)."""
+    spheres = [{"name": f"s{i}", "pose": {"translation": [i % 7 * 3, i // 7 * 3, 0]},
+                "geometry": {"type": "sphere", "radius": 1, "subdivision": 6}} for i in range(47)]
+    ds = [{"device": "DistanceSensor", "name": f"d{i}", "number_of_rays": 1024, "aperture": 0.5} for i in range(256)]
+    robots = [{"name": f"r{j}", "devices": ds} for j in range(16)]
+    probs = problems({"solids": spheres, "robots": robots})
+    assert probs == [("", "building this world would take about 2.9 GiB of memory (3,850,240 triangles ≈ 2.0 GiB, "
+                          "4,194,304 rays per step ≈ 0.9 GiB), more than the limit of 2 GiB (raise the limits with "
+                          "--allow-large)")]
+    parse_world({"solids": spheres[:20], "robots": robots})                     # 1.6M triangles: fine
+    parse_world({"solids": spheres, "robots": robots}, limits=WorldLimits(build_bytes=4 << 30))
+
+
 def test_triangles_are_counted_in_closed_form_and_from_mesh_files(tmp_path: Path) -> None:
     (tmp_path / "rock.stl").write_bytes(MESH.read_bytes())
     import trimesh

@@ -7,9 +7,10 @@ One module per section, each ``run(cfg) -> Section``:
 * :mod:`.peers`     — the same scene and rays through raw embreex, Open3D, MuJoCo, PyBullet, trimesh;
 * :mod:`.transport` — lockstep round trips and steps/s over loopback against a raw pyzmq floor;
 * :mod:`.memory`    — bytes per static triangle, transient memory and time per ray of large scans;
+* :mod:`.limits`    — peak memory of worlds at the world-file limits, time to refuse oversize or damaged input;
 * :mod:`.scaleout`  — vectorised Gymnasium env steps/s, sweep throughput on the process pool vs Ray;
 
 and :mod:`.report` writes ``benchmarks.md``, ``benchmarks.json`` and the PNG plots.
 """
 
-SECTIONS = ("transport", "memory", "accuracy", "scaling", "scaleout", "peers")   # run order: peers last (its libraries start thread pools)
+SECTIONS = ("transport", "memory", "limits", "accuracy", "scaling", "scaleout", "peers")   # run order: peers last (its libraries start thread pools)

@@ -401,6 +401,8 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
     report = ExportReport(out=out, distro=distro, fmt=fmt)
     with Recording(src, on_damage=on_damage) as rec:
         report.progress = progress
+        if progress:
+            rec.check()                     # damaged chunks found first: the total counts what will be read
         report.total = sum(t.count for t in rec.topics()) if progress else 0
         meta = rec.metadata().get("sensorium", {})
         world = rec.world()

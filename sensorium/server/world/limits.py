@@ -7,8 +7,9 @@ Two kinds of limits:
   lengths, and the number of robots, devices per robot, lights and solids: checked while the
   text is read (:mod:`.yamlload`) and on the parsed data *before* the model is validated, so a
   hostile file costs little time and memory and its error quotes only a short prefix;
-* **work** — rays per distance sensor, beams per lidar, rays per step, triangles, the magnitude
-  of every number: checked on the validated model.
+* **work** — rays per distance sensor, beams per lidar, rays per step, triangles, the memory
+  building them takes together (``build_bytes``, at measured costs per triangle and per ray), the
+  magnitude of every number: checked on the validated model.
 
 ``WorldLimits()`` are the defaults; ``WorldLimits.large()`` (``--allow-large``) raises every limit for
 worlds that deliberately ask for more. The table is in README "Security and limits".
@@ -25,10 +26,17 @@ from pydantic import BaseModel
 
 from sensorium.schemas.devices import KINDS
 
-__all__ = ["MAX_COORDINATE_M", "check_pose", "WorldLimits", "LimitError", "check_counts", "check_data", "check_work", "quote", "triangle_count"]
+__all__ = ["BYTES_PER_RAY", "BYTES_PER_TRIANGLE", "MAX_COORDINATE_M", "check_pose", "WorldLimits", "LimitError", "check_counts", "check_data", "check_work", "quote", "triangle_count"]
 
 MiB = 1 << 20
+GiB = 1 << 30
 MAX_COORDINATE_M = 1e5          # |x|, |y|, |z| of a pose set at run time (set_pose, set_field): 100 km
+# What building a world costs in the server process, per unit (peak resident memory of `sensorium
+# probe WORLD --steps 1 --enable all:32`, EXACT, worst cases measured: `sensorium bench --only limits`):
+# a triangle of the ray engine's scene with its EXACT edge guards ~515 B (~235 B without them), a
+# ray cast per step ~200 B (distance sensor rays, lidar beams, light occlusion rays). With margin:
+BYTES_PER_TRIANGLE = 560
+BYTES_PER_RAY = 220
 
 
 def check_pose(translation: Iterable[float] | None = None, rotation: Iterable[float] | None = None,
@@ -63,6 +71,7 @@ class WorldLimits:
     beams_per_lidar: int = 1 << 20           # horizontal_resolution × number_of_layers
     rays_per_step: int = 1 << 22             # every device due at once: distance rays + lidar beams + light occlusion rays
     triangles: int = 4_000_000               # tessellated primitives + meshes (planes are analytic)
+    build_bytes: int = 2 * GiB               # triangles and rays per step at the costs above, together
     # textures (world/textures.py): each image file, each image's pixels, all images' pixels (3 bytes each)
     texture_file_bytes: int = 64 * MiB
     texture_pixels: int = 1 << 24            # 4096 x 4096
@@ -74,7 +83,7 @@ class WorldLimits:
         return cls(file_bytes=1024 * MiB, mesh_file_bytes=4096 * MiB, mesh_load_bytes=65536 * MiB, nesting_depth=256, values=100_000_000,
                    name_chars=4096, string_chars=1 * MiB, number_magnitude=1e15, robots=100_000,
                    devices_per_robot=65_536, lights=65_536, solids=10_000_000, rays_per_sensor=1 << 20,
-                   beams_per_lidar=1 << 28, rays_per_step=1 << 30, triangles=1 << 30,
+                   beams_per_lidar=1 << 28, rays_per_step=1 << 30, triangles=1 << 30, build_bytes=1024 * GiB,
                    texture_file_bytes=4096 * MiB, texture_pixels=1 << 30, texture_pixels_total=1 << 32)
 
     def describe(self) -> list[tuple[str, Any]]:
@@ -250,6 +259,13 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
             per_step += n
     if per_step > limits.rays_per_step:
         over("", "rays in one step (every device due at once):", per_step, limits.rays_per_step)
+    need = BYTES_PER_TRIANGLE * triangles + BYTES_PER_RAY * per_step
+    if not problems and need > limits.build_bytes:      # each within its limit, too much together
+        problems.append(("", f"building this world would take about {need / GiB:.1f} GiB of memory "
+                             f"({triangles:,} triangles ≈ {BYTES_PER_TRIANGLE * triangles / GiB:.1f} GiB, "
+                             f"{per_step:,} ray{'s' if per_step != 1 else ''} per step ≈ "
+                             f"{BYTES_PER_RAY * per_step / GiB:.1f} GiB), more than "
+                             f"the limit of {limits.build_bytes / GiB:g} GiB {RAISE}"))
     return problems
 
 
