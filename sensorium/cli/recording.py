@@ -21,10 +21,11 @@ from sensorium.server.recording.scan import Damage
 
 
 def file_error(path: str | os.PathLike, exc: BaseException) -> str:
-    """One line for a recording that cannot be opened, naming the file once."""
-    name = os.fspath(path)
+    """One line for a file that cannot be read or written, naming it once (an ``OSError`` names
+    its own file when it has one: the output, for a write that failed)."""
     if isinstance(exc, OSError) and exc.strerror:
-        return f"{name}: {exc.strerror}"
+        return f"{os.fspath(exc.filename)}: {exc.strerror}" if exc.filename is not None else exc.strerror
+    name = os.fspath(path)
     text = str(exc)
     return text if text.startswith(name) else f"{name}: {text}"
 
@@ -178,8 +179,7 @@ def export_cmd(args: argparse.Namespace) -> int:
                              progress=advance, on_damage=damage_printer("export", args.file))
     except (OSError, McapError) as exc:
         progress.close()
-        where = args.file if not isinstance(exc, OSError) or exc.filename in (None, args.file) else exc.filename
-        print(f"sensorium export: {file_error(where, exc)}", file=sys.stderr)
+        print(f"sensorium export: {file_error(args.file, exc)}", file=sys.stderr)
         return 1
     except ExportError as exc:
         progress.close()
@@ -210,8 +210,7 @@ def recover_cmd(args: argparse.Namespace) -> int:
         print(f"sensorium recover: {exc}", file=sys.stderr)
         return 1
     except (OSError, McapError) as exc:
-        where = args.file if not isinstance(exc, OSError) or exc.filename in (None, args.file) else exc.filename
-        print(f"sensorium recover: {file_error(where, exc)}", file=sys.stderr)
+        print(f"sensorium recover: {file_error(args.file, exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("sensorium recover: interrupted; nothing written", file=sys.stderr)

@@ -404,6 +404,9 @@ class McapScan:
                 pos = nxt
                 continue
             end = frame[1]
+            if op == Opcode.MESSAGE_INDEX and pending is None:      # the file's own index: not needed here
+                pos = end
+                continue
             body = view[pos + 9:end]
             if op == Opcode.MESSAGE_INDEX and pending is not None:
                 try:
