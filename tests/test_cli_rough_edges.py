@@ -77,3 +77,36 @@ def test_services_marks_supervisor_only_services_and_replay_shows_arguments(tmp_
         r = run("services", "--url", rpc)
     assert r.returncode == 0, r.stderr
     assert "  /replay/set_rate  {value: float}" in r.stdout.splitlines(), r.stdout
+
+
+def test_info_names_a_bad_file_once_and_claims_only_the_views_a_recording_has(tmp_path):
+    from _recdata import make_recording
+
+    bad = tmp_path / "cut5.mcap"
+    bad.write_bytes(b"hello")
+    r = run("info", str(bad))
+    assert r.returncode == 1 and r.stderr == f"sensorium info: {bad}: not an MCAP file\n"
+    missing = run("info", str(tmp_path / "none.mcap"))
+    assert missing.returncode == 1 and missing.stderr.count("none.mcap") == 1, missing.stderr
+    rec = tmp_path / "rec.mcap"                          # Foxglove-ready (format 2), recorded without a world
+    make_recording(rec, steps=5)
+    r = run("info", str(rec))
+    line = next(line for line in r.stdout.splitlines() if line.startswith("Foxglove:"))
+    assert line.split(None, 1)[1] == "ready (ROS 2 CDR views; bodies kept byte for byte)"     # no /tf, no /scene
+
+
+def test_replay_says_interrupted_after_ctrl_c_not_finished(tmp_path):
+    import signal
+
+    from _recdata import make_recording
+    from _serve import Served, sensorium
+
+    rec = tmp_path / "rec.mcap"
+    make_recording(rec, steps=5)
+    replay = Served(sensorium("replay", str(rec), "--loop", "--pub", "tcp://127.0.0.1:0", "--rpc", "tcp://127.0.0.1:0",
+                              "--no-progress"), "sensorium: replaying")
+    with replay.wait_ready() as rp:
+        assert rp.stop(signal.SIGINT) == 0
+    lines = rp.stderr().splitlines()
+    assert any(line.startswith("sensorium: replay interrupted after ") for line in lines), lines
+    assert not any("replay finished" in line for line in lines), lines

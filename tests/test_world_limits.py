@@ -10,9 +10,11 @@ from __future__ import annotations
 import itertools
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import msgpack
@@ -56,9 +58,9 @@ def test_rays_per_sensor_robots_devices_lights_and_rays_per_step() -> None:
     assert problems({"robots": [robot(ds("a", 9))]}, limits=limits) == [
         ("robots[0].devices[0].number_of_rays", "rays: 9 exceeds the limit of 8 (raise the limits with --allow-large)")]
     probs = problems({"robots": [robot(name=f"r{i}") for i in range(3)]}, limits=limits)
-    assert probs == [("robots", "robots: 3 exceeds the limit of 2 (raise the limits with --allow-large)")]
+    assert probs == [("robots", "3 robots, more than the limit of 2 (raise the limits with --allow-large)")]
     probs = problems({"robots": [robot(*(ds(f"d{i}") for i in range(4)))]}, limits=limits)
-    assert probs == [("robots[0].devices", "devices: 4 exceeds the limit of 3 (raise the limits with --allow-large)")]
+    assert probs == [("robots[0].devices", "4 devices, more than the limit of 3 (raise the limits with --allow-large)")]
     lights = [{"type": "PointLight", "location": [0, 0, i]} for i in range(2)]
     assert problems({"lights": lights}, limits=limits)[0][0] == "lights"
     # 3 sensors × 8 rays = 24 rays when all are due in the same step
@@ -71,6 +73,21 @@ def test_rays_per_sensor_robots_devices_lights_and_rays_per_step() -> None:
     world = {"lights": [{"type": "PointLight", "location": [0, 0, 1]}, {"type": "PointLight", "location": [0, 0, 2]}],
              "robots": [robot(*light_sensors)]}
     assert "6 exceeds the limit of 5" in problems(world, limits=few)[0][1]
+
+
+def test_triangles_and_rays_each_within_their_limit_are_bounded_together() -> None:
+    """47 spheres of 81,920 triangles and 16 robots of 256 distance sensors × 1024 rays: each
+    within its limit, together (with two 4096² textures) they took 3.0 GB to build (issue 28)."""
+    spheres = [{"name": f"s{i}", "pose": {"translation": [i % 7 * 3, i // 7 * 3, 0]},
+                "geometry": {"type": "sphere", "radius": 1, "subdivision": 6}} for i in range(47)]
+    ds = [{"device": "DistanceSensor", "name": f"d{i}", "number_of_rays": 1024, "aperture": 0.5} for i in range(256)]
+    robots = [{"name": f"r{j}", "devices": ds} for j in range(16)]
+    probs = problems({"solids": spheres, "robots": robots})
+    assert probs == [("", "building this world would take about 2.9 GiB of memory (3,850,240 triangles ≈ 2.0 GiB, "
+                          "4,194,304 rays per step ≈ 0.9 GiB), more than the limit of 2 GiB (raise the limits with "
+                          "--allow-large)")]
+    parse_world({"solids": spheres[:20], "robots": robots})                     # 1.6M triangles: fine
+    parse_world({"solids": spheres, "robots": robots}, limits=WorldLimits(build_bytes=4 << 30))
 
 
 def test_triangles_are_counted_in_closed_form_and_from_mesh_files(tmp_path: Path) -> None:
@@ -148,6 +165,124 @@ def test_file_size_nesting_and_alias_expansion(tmp_path: Path) -> None:
     bomb.write_text("\n".join(lines) + "\n")
     with pytest.raises(WorldError, match="values once aliases are expanded"):
         load_world(bomb)
+
+
+GUARD_S = 20.0      # a hang guard for a busy machine (the 4 MB case took 34-42 s before), not a speed claim
+
+
+def _flow(value) -> str:
+    return json.dumps(value, separators=(", ", ": "))       # JSON is YAML flow style
+
+
+def _robot_line(i: int, devices: int = 40) -> str:
+    """One robot on one line (~4 KB with 40 infra-red sensors), so that robot i is on line ``first + i``."""
+    table = [[0.0, 4095, 0.002], [0.01, 1465.73, 0.0073], [0.03, 234.93, 0.0302], [0.07, 67.19, 0.0778]]
+    devs = [{"device": "DistanceSensor", "name": f"ps{k}", "type": "infra-red", "lookup_table": table,
+             "pose": {"translation": [0.03, 0.001 * k, 0.01], "rotation": [0, 0, 1, 0.1 * k]}} for k in range(devices)]
+    return "  - " + _flow({"name": f"r{i}", "pose": {"translation": [i % 40 * 0.1, i // 40 * 0.1, 0.01]},
+                           "devices": devs})
+
+
+def test_a_4_mb_world_of_1000_robots_is_refused_at_the_257th_in_one_line(tmp_path: Path) -> None:
+    path = tmp_path / "crowd.yaml"
+    head = ["world_info: {name: crowd, basic_time_step: 32}", "robots:"]
+    path.write_text("\n".join(head + [_robot_line(i) for i in range(1000)]) + "\n")
+    assert path.stat().st_size > 4_000_000
+    t0 = time.perf_counter()
+    with pytest.raises(WorldError) as err:
+        load_world(path)
+    assert time.perf_counter() - t0 < GUARD_S
+    assert [(p.path, p.message) for p in err.value.problems] == [
+        ("robots", f"more than 256 robots: the next starts at line {len(head) + 257} "
+                   "(raise the limits with --allow-large)")]
+    assert "robots: robots:" not in str(err.value) and "\n" not in str(err.value)
+    # a JSON world (parsed whole by the C decoder) is counted before any model is built
+    js = tmp_path / "crowd.json"
+    js.write_text(json.dumps({"robots": [{"name": f"r{i}"} for i in range(1000)]}))
+    with pytest.raises(WorldError) as err:
+        load_world(js)
+    assert [(p.path, p.message) for p in err.value.problems] == [
+        ("robots", "1,000 robots, more than the limit of 256 (raise the limits with --allow-large)")]
+
+
+@pytest.mark.parametrize("text, path, what", [
+    ("robots:\n  - {name: r, devices: [" + ", ".join(f"{{device: LED, name: d{k}}}" for k in range(300)) + "]}\n",
+     "robots[0].devices", "more than 256 devices in this robot: the next starts at line 2"),
+    ("solids:\n  - {name: a, children: [" + ", ".join(f"{{name: c{k}}}" for k in range(10_000)) + "]}\n",
+     "solids[0].children", "more than 10,000 solids (nested children included): the next starts at line 2"),
+    ("lights:\n" + "".join(f"  - {{type: PointLight, location: [0, 0, {k}]}}\n" for k in range(200))
+     + "robots:\n  - {name: r, lights: [" + ", ".join("{type: PointLight}" for _ in range(60)) + "]}\n",
+     "robots[0].lights", "more than 256 lights: the next starts at line 203"),
+    ("r: &r {name: r}\nrobots: [" + ", ".join(["*r"] * 300) + "]\n",         # aliases count as robots too
+     "robots", "more than 256 robots: the next starts at line 2"),
+])
+def test_robots_devices_solids_and_lights_are_counted_while_the_file_is_read(tmp_path: Path, text: str, path: str,
+                                                                              what: str) -> None:
+    p = tmp_path / "w.yaml"
+    p.write_text(text)
+    with pytest.raises(WorldError) as err:
+        load_world(p)
+    assert [(q.path, q.message) for q in err.value.problems] == [(path, f"{what} (raise the limits with --allow-large)")]
+
+
+class _Yaml12(yaml.SafeLoader):
+    """The reference: PyYAML's own loader with YAML 1.2 booleans (what the loader used before)."""
+
+
+_Yaml12.yaml_implicit_resolvers = {k: [(t, rx) for t, rx in v if t != "tag:yaml.org,2002:bool"]
+                                   for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+_Yaml12.add_implicit_resolver("tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"),
+                              list("tTfF"))
+
+
+def _same_as_pyyaml(text: str) -> None:
+    from sensorium.server.world.yamlload import load_yaml
+
+    try:
+        want: object = ("ok", yaml.load(text, Loader=_Yaml12))  # noqa: S506 (a safe loader)
+    except Exception as exc:  # noqa: BLE001
+        want = ("error", type(exc).__name__)
+    try:
+        got: object = ("ok", load_yaml(text, WorldLimits.large()))
+    except Exception as exc:  # noqa: BLE001
+        got = ("error", type(exc).__name__)
+    if want[0] == "ok" and got[0] == "ok":
+        assert repr(got[1]) == repr(want[1]), text        # repr: nan == nan, 1 vs 1.0 vs True
+    else:
+        assert want[0] == got[0] == "error", (text, want, got)
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "sensorium" / "worlds").glob("*.yaml"))
+                         + sorted((ROOT / "tests" / "worlds").glob("*.yaml")), ids=lambda p: p.name)
+def test_the_one_pass_reader_builds_what_pyyaml_builds_for_every_bundled_world(path: Path) -> None:
+    _same_as_pyyaml(path.read_text())
+
+
+YAML_BITS = ["a", "b", ":", " ", "\n", "  ", "- ", "[", "]", "{", "}", ",", "&x ", "*x", "&y ", "*y", "<<: ", "'q'",
+             '"d\\n"', "1", "-2", "0x1F", "017", "1_000", "1:30", "3.5", "-.5", "1e5", "1.0e+5", ".inf", "-.Inf",
+             ".NaN", "~", "null", "true", "False", "on", "yes", "2001-12-14", "!!str ", "!!int ", "!!float ", "? ",
+             "|\n  x\n", "#c\n", "---\n", "...\n", "=", "!!binary ", "aGk="]
+
+
+@settings(max_examples=400, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@given(bits=st.lists(st.sampled_from(YAML_BITS), max_size=30))
+def test_the_one_pass_reader_builds_what_pyyaml_builds(bits: list[str]) -> None:
+    text = "".join(bits)
+    if "<<" in text or "*" in text:          # departures: recursive aliases; which merged key wins
+        return
+    _same_as_pyyaml(text)
+
+
+def test_merge_keys_and_yaml_12_booleans() -> None:
+    from sensorium.server.world.yamlload import load_yaml
+
+    text = "base: &b {x: 1, y: 2}\nmore: &m {y: 3, z: 4}\nr: {<<: [*b, *m], x: 9}\non: yes\nt: true\n"
+    assert load_yaml(text) == {"base": {"x": 1, "y": 2}, "more": {"y": 3, "z": 4},
+                               "r": {"x": 9, "y": 2, "z": 4}, "on": "yes", "t": True}
+    with pytest.raises(yaml.YAMLError, match="refers to a node that contains it"):
+        load_yaml("a: &a [1, *a]\n")
+    with pytest.raises(yaml.YAMLError, match="not supported in world files"):
+        load_yaml("a: !!set {x, y}\n")
 
 
 def test_bad_text_is_a_world_error(tmp_path: Path) -> None:
@@ -331,3 +466,9 @@ def test_validate_prints_one_line_per_problem_and_no_traceback(tmp_path: Path) -
     assert out.returncode == 1 and "Traceback" not in out.stderr
     assert out.stderr.splitlines() == [f"{path}: line 1: nested deeper than 64 levels (raise the limits with --allow-large)",
                                        f"{path}: INVALID (1 problem)"]
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@given(data=values, flow=st.booleans())
+def test_dumped_data_reads_back_the_same(data, flow: bool) -> None:
+    _same_as_pyyaml(yaml.safe_dump(data, default_flow_style=flow, allow_unicode=True))

@@ -7,6 +7,7 @@ One module per section, each ``run(cfg) -> Section``:
 * :mod:`.peers`     — the same scene and rays through raw embreex, Open3D, MuJoCo, PyBullet, trimesh;
 * :mod:`.transport` — lockstep round trips and steps/s over loopback against a raw pyzmq floor;
 * :mod:`.memory`    — bytes per static triangle, transient memory and time per ray of large scans;
+* :mod:`.limits`    — peak memory of worlds at the world-file limits, time to refuse oversize or damaged input;
 * :mod:`.scaleout`  — vectorised Gymnasium env steps/s, sweep throughput on the process pool vs Ray;
 * :mod:`.loading`   — loading a PROTO-heavy Webots world, per stage (expansion, templates, conversion, scene);
 * :mod:`.images`    — a camera's and a range finder's picture vs raw embreex on the same rays;
@@ -15,4 +16,4 @@ One module per section, each ``run(cfg) -> Section``:
 and :mod:`.report` writes ``benchmarks.md``, ``benchmarks.json`` and the PNG plots.
 """
 
-SECTIONS = ("transport", "memory", "accuracy", "scaling", "scaleout", "loading", "images", "training", "peers")   # run order: peers last (its libraries start thread pools)
+SECTIONS = ("transport", "memory", "limits", "accuracy", "scaling", "scaleout", "loading", "images", "training", "peers")   # run order: peers last (its libraries start thread pools)

@@ -9,6 +9,7 @@ import json
 import os
 import signal
 import sys
+from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -16,6 +17,24 @@ import zmq
 
 from sensorium.server.recording.live import LiveRecorder
 from sensorium.server.recording.reader import McapError, summarize
+from sensorium.server.recording.scan import Damage
+
+
+def file_error(path: str | os.PathLike, exc: BaseException) -> str:
+    """One line for a file that cannot be read or written, naming it once (an ``OSError`` names
+    its own file when it has one: the output, for a write that failed)."""
+    if isinstance(exc, OSError) and exc.strerror:
+        return f"{os.fspath(exc.filename)}: {exc.strerror}" if exc.filename is not None else exc.strerror
+    name = os.fspath(path)
+    text = str(exc)
+    return text if text.startswith(name) else f"{name}: {text}"
+
+
+def damage_printer(command: str, path: str | os.PathLike) -> Callable[[Damage], None]:
+    """``on_damage`` for a reader: one warning line on stderr per damaged part skipped."""
+    def say(damage: Damage) -> None:
+        print(f"sensorium {command}: warning: {os.fspath(path)}: {damage.line()}", file=sys.stderr, flush=True)
+    return say
 
 
 @contextmanager
@@ -85,10 +104,13 @@ def replay_cmd(args: argparse.Namespace) -> int:
         r = Replayer(args.file, pub=args.pub, rpc=args.rpc, rate=args.rate, loop=args.loop,
                      topics=args.topics or None, start_s=args.start, end_s=args.end, clock_hz=args.clock,
                      lockstep=args.lockstep, progress=args.progress, wait_subscriber=args.wait,
-                     delay_s=args.delay, sndhwm=args.sndhwm, nodrop=args.nodrop)
-    except (OSError, ValueError, McapError) as exc:
-        print(f"sensorium replay: {exc.strerror + ': ' + str(exc.filename) if isinstance(exc, OSError) and exc.strerror else exc}",
-              file=sys.stderr)
+                     delay_s=args.delay, sndhwm=args.sndhwm, nodrop=args.nodrop,
+                     on_damage=damage_printer("replay", args.file))
+    except (OSError, McapError) as exc:
+        print(f"sensorium replay: {file_error(args.file, exc)}", file=sys.stderr)
+        return 1
+    except ValueError as exc:
+        print(f"sensorium replay: {exc}", file=sys.stderr)
         return 1
     viewer = None
     try:
@@ -108,16 +130,20 @@ def replay_cmd(args: argparse.Namespace) -> int:
             print(f"sensorium: Foxglove viewer at {viewer.url}", flush=True)
             if viewer.app_url():
                 print(f"sensorium: Foxglove web app: {viewer.app_url()}", file=sys.stderr, flush=True)
-        print(r.announce(), flush=True)
-        if r.recording.truncated:
-            print("sensorium: warning: the recording is truncated; replaying up to its last complete chunk",
-                  file=sys.stderr)
-        with sigterm_as_interrupt():
-            try:
+        interrupted = False
+        try:                    # Ctrl-C from the announcement on (scripts send it once they read it)
+            with sigterm_as_interrupt():
+                print(r.announce(), flush=True)
+                if r.recording.truncated:
+                    print("sensorium: warning: the recording is truncated; replaying up to its last complete "
+                          "record", file=sys.stderr)
                 r.run()
-            except KeyboardInterrupt:
-                pass
-        print(f"sensorium: replay finished: {r.emitted} messages", file=sys.stderr, flush=True)
+        except KeyboardInterrupt:
+            interrupted = True
+        if interrupted or r.interrupted:
+            print(f"sensorium: replay interrupted after {r.emitted} messages", file=sys.stderr, flush=True)
+        else:
+            print(f"sensorium: replay finished: {r.emitted} messages", file=sys.stderr, flush=True)
         return 0
     finally:
         if viewer is not None:
@@ -150,11 +176,19 @@ def export_cmd(args: argparse.Namespace) -> int:
                              views=not getattr(args, "no_views", False),
                              start_ns=None if args.start is None else int(round(args.start * 1e9)),
                              end_ns=None if args.end is None else int(round(args.end * 1e9)),
-                             progress=advance)
-    except (ExportError, OSError, McapError) as exc:
+                             progress=advance, on_damage=damage_printer("export", args.file))
+    except (OSError, McapError) as exc:
+        progress.close()
+        print(f"sensorium export: {file_error(args.file, exc)}", file=sys.stderr)
+        return 1
+    except ExportError as exc:
         progress.close()
         print(f"sensorium export: {exc}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        progress.close()
+        print(f"sensorium export: interrupted; {args.out} removed (nothing partial is kept)", file=sys.stderr)
+        return 130
     progress.close()
     warning = truncation_warning(report)
     if warning:
@@ -171,14 +205,25 @@ def recover_cmd(args: argparse.Namespace) -> int:
     from sensorium.server.recording.recover import recover
 
     try:
-        r = recover(args.file, args.out, overwrite=args.force)
-    except (OSError, ValueError, McapError) as exc:
+        r = recover(args.file, args.out, overwrite=args.force, on_damage=damage_printer("recover", args.file))
+    except (FileExistsError, ValueError) as exc:
         print(f"sensorium recover: {exc}", file=sys.stderr)
         return 1
+    except (OSError, McapError) as exc:
+        print(f"sensorium recover: {file_error(args.file, exc)}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("sensorium recover: interrupted; nothing written", file=sys.stderr)
+        return 130
     state = f"truncated, read up to its last complete record ({r.stopped})" if r.stopped else (
         "truncated (no summary or footer)" if r.truncated else "complete")
-    print(f"sensorium: recovered {r.messages} messages on {r.channels} channels, {r.metadata} metadata records, "
-          f"{r.attachments} attachments from {args.file} ({state}) into {r.out}", flush=True)
+    if r.damaged:
+        state += f"; {len(r.damaged)} damaged part{'s' if len(r.damaged) != 1 else ''} skipped"
+    extra = f" (and {r.views} Foxglove view messages)" if r.views else ""
+    lost = (f"; {r.unnamed} message records dropped: their channel was defined only in a damaged chunk"
+            if r.unnamed else "")
+    print(f"sensorium: recovered {r.messages} messages{extra} on {r.channels} channels, {r.metadata} metadata "
+          f"records, {r.attachments} attachments from {args.file} ({state}) into {r.out}{lost}", flush=True)
     return 0
 
 
@@ -199,7 +244,7 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
     try:
         s = summarize(path)
     except (OSError, McapError) as exc:
-        print(f"sensorium info: {path}: {exc}", file=sys.stderr)
+        print(f"sensorium info: {file_error(path, exc)}", file=sys.stderr)
         return 1
     if as_json:
         print(json.dumps(s, indent=2))
@@ -221,8 +266,10 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
         world = meta.get("world") or meta.get("world_file") or "-"
         lines.append(("World", f"{world}   seed {meta.get('seed', '-')}   time step "
                                f"{meta.get('basic_time_step_ms', '-')} ms   sensorium {meta.get('version', '-')}"))
-        lines.append(("Foxglove", "ready (ROS 2 CDR views, /tf, /scene; bodies kept byte for byte)"
-                      if meta.get("format") == "2" else "no (msgpack only: export with sensorium export --ros2)"))
+        scene = [t for t in ("/tf", "/scene") if t in s["channels"]]
+        lines.append(("Foxglove", f"ready (ROS 2 CDR views{''.join(', ' + t for t in scene)}; bodies kept byte "
+                                  "for byte)" if meta.get("format") == "2" else
+                      "no (msgpack only: export with sensorium export --ros2)"))
     if session.get("started_at"):
         lines.append(("Recorded", session["started_at"]))
     if session.get("previous_file"):
@@ -233,8 +280,17 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
                                       f"went back to {_secs(int(restart.get('stamp_ns', 0) or 0))})"))
     for a in s["attachments"]:
         lines.append(("Attachment", f"{a['name']} ({a['media_type']}, {_human_size(a['size_bytes'])})"))
+    damaged = s["damaged"]
+    if damaged:
+        lines.insert(4, ("Damaged", f"{len(damaged)} part{'s' if len(damaged) != 1 else ''} skipped by every "
+                                    "reader (not counted below):"))
+        for k, line in enumerate(damaged):
+            lines.insert(5 + k, ("", line))
+    if s.get("unnamed_messages"):
+        lines.append(("Unnamed", f"{s['unnamed_messages']} message records on channels defined only in a "
+                                 "damaged chunk (bodies or Foxglove views: not counted)"))
     for key, value in lines:
-        print(f"{key + ':':<19}{value}")
+        print(f"{key + ':' if key else '':<19}{value}")
     topics = s["topics"]
     width = max((len(t["topic"]) for t in topics), default=0)
     twidth = max((len(t["type"]) for t in topics), default=0)

@@ -313,6 +313,7 @@ class ExportReport:
     progress: Any = None                                   # callback (done, total), or None
     total: int = 0
     read: int = 0
+    damaged: list[Any] = field(default_factory=list)       # parts of the source skipped (scan.Damage)
 
 
 @dataclass
@@ -380,36 +381,59 @@ def _iter_recorded(rec: Recording, typestore, topics, pointcloud2: bool, report:
 def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt: str | None = None,
                 pointcloud2: bool = False, topics: list[str] | None = None,
                 start_ns: int | None = None, end_ns: int | None = None, views: bool = True,
-                progress: Callable[[int, int], None] | None = None) -> ExportReport:
+                progress: Callable[[int, int], None] | None = None,
+                on_damage: Callable[[Any], None] | None = None) -> ExportReport:
     """Export ``src`` to ``out``. ``fmt`` is ``"bag"`` (rosbag2 directory, via rosbags) or
     ``"mcap"`` (single file, via mcap-ros2-support); by default ``.mcap`` outputs are single files.
     ``views``: add ``/tf_static``, ``/tf`` and ``/scene`` from the recorded world (:mod:`.ros_views`).
-    ``progress(done, total)`` is called as messages are read (total: the recording's message count)."""
+    ``progress(done, total)`` is called as messages are read (total: the recording's message count).
+    A damaged part of ``src`` is skipped and passed to ``on_damage`` (a :class:`~.scan.Damage`).
+    Never leaves a partial output: if the export fails or is interrupted, what it wrote is removed."""
     out = Path(out)
     if distro not in DISTROS:
         raise ExportError(f"unknown distro {distro!r} (choose from {', '.join(DISTROS)})")
     fmt = fmt or ("mcap" if out.suffix == ".mcap" else "bag")
-    if out.exists():
+    if fmt not in ("bag", "mcap"):
+        raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
+    if out.exists() or out.is_symlink():
         raise ExportError(f"{out} exists already; not overwriting")
     typestore = typestore_for(distro)
     report = ExportReport(out=out, distro=distro, fmt=fmt)
-    with Recording(src) as rec:
+    with Recording(src, on_damage=on_damage) as rec:
         report.progress = progress
+        if progress:
+            rec.check()                     # damaged chunks found first: the total counts what will be read
         report.total = sum(t.count for t in rec.topics()) if progress else 0
         meta = rec.metadata().get("sensorium", {})
         world = rec.world()
-        if fmt == "bag":
-            _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns, views)
-        elif fmt == "mcap":
-            _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns,
-                          views)
-        else:
-            raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
+        try:
+            if fmt == "bag":
+                _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns, views)
+            else:
+                _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns,
+                              views)
+        except BaseException:
+            _remove_output(out)
+            raise
         report.size_bytes = rec.path.stat().st_size
+        report.damaged = list(rec.damaged)
         if rec.truncated:
             report.truncated = True
             report.readable_bytes = rec._scan().get("stopped_at")
     return report
+
+
+def _remove_output(out: Path) -> None:
+    """Remove what a failed export wrote at ``out`` (it did not exist before: export_ros2 checks)."""
+    import shutil
+
+    try:
+        if out.is_dir() and not out.is_symlink():
+            shutil.rmtree(out)
+        else:
+            out.unlink(missing_ok=True)
+    except OSError:
+        pass
 
 
 def _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns, views) -> None:

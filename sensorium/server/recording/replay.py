@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import IO, Any
 
 import zmq
@@ -37,6 +37,7 @@ from sensorium.schemas.wire import (
 )
 from sensorium.server.recording.envelope import pack_envelope, topic_matcher
 from sensorium.server.recording.reader import RecordedMessage, Recording
+from sensorium.server.recording.scan import Damage
 
 CLOCK_TOPIC = "/clock"
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
@@ -58,11 +59,12 @@ class Replayer:
                  start_s: float | None = None, end_s: float | None = None,
                  clock_hz: float | None = None, lockstep: bool = False, progress: bool | None = None,
                  wait_subscriber: bool = False, delay_s: float = 0.0, sndhwm: int = 1000,
-                 nodrop: bool = False, out: IO[str] | None = None, context: zmq.Context | None = None):
+                 nodrop: bool = False, out: IO[str] | None = None, context: zmq.Context | None = None,
+                 on_damage: Callable[[Damage], None] | None = None):
         if rate < 0 or not math.isfinite(rate):
             raise ValueError("rate must be >= 0 (0: as fast as possible)")
         self.path = str(path)
-        self.recording = Recording(path)
+        self.recording = Recording(path, on_damage=on_damage)     # a damaged chunk is skipped and said
         self.pub_url, self.rpc_url = pub, rpc
         self.rate = float(rate)
         self.loop = loop
@@ -83,6 +85,7 @@ class Replayer:
         self._stop = False
         self._paused = False
         self.emitted = 0
+        self.interrupted = False               # run() ended by Ctrl-C / SIGTERM (not by its end or /replay/quit)
         self.loops = 0
         self.subscriptions: set[bytes] = set()
         self.viewer: Any = None                # a recorder-like sink also fed every published message
@@ -409,7 +412,7 @@ class Replayer:
             else:
                 self._run_free()
         except KeyboardInterrupt:
-            pass
+            self.interrupted = True
         finally:
             if self._progress_shown or self._progress_enabled():
                 self._show_progress(final=True)

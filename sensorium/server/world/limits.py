@@ -4,10 +4,12 @@ accepts exactly the worlds ``serve`` can run).
 Two kinds of limits:
 
 * **parsing** — file size, YAML/JSON nesting depth, alias expansion, number of values, string
-  lengths: checked on the raw text and the parsed data *before* the model is validated, so a
+  lengths, and the number of robots, devices per robot, lights and solids: checked while the
+  text is read (:mod:`.yamlload`) and on the parsed data *before* the model is validated, so a
   hostile file costs little time and memory and its error quotes only a short prefix;
-* **work** — robots, devices, rays per distance sensor, beams per lidar, rays per step, triangles,
-  lights, the magnitude of every number: checked on the validated model.
+* **work** — rays per distance sensor, beams per lidar, rays per step, triangles, the memory
+  building them takes together (``build_bytes``, at measured costs per triangle and per ray), the
+  magnitude of every number: checked on the validated model.
 
 ``WorldLimits()`` are the defaults; ``WorldLimits.large()`` (``--allow-large``) raises every limit for
 worlds that deliberately ask for more. The table is in README "Security and limits".
@@ -20,15 +22,21 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, fields
 from typing import Any
 
-import yaml
 from pydantic import BaseModel
 
 from sensorium.schemas.devices import KINDS
 
-__all__ = ["MAX_COORDINATE_M", "check_pose", "WorldLimits", "LimitError", "check_yaml_events", "check_data", "check_work", "quote", "triangle_count"]
+__all__ = ["BYTES_PER_RAY", "BYTES_PER_TRIANGLE", "MAX_COORDINATE_M", "check_pose", "WorldLimits", "LimitError", "check_counts", "check_data", "check_work", "quote", "triangle_count"]
 
 MiB = 1 << 20
+GiB = 1 << 30
 MAX_COORDINATE_M = 1e5          # |x|, |y|, |z| of a pose set at run time (set_pose, set_field): 100 km
+# What building a world costs in the server process, per unit (peak resident memory of `sensorium
+# probe WORLD --steps 1 --enable all:32`, EXACT, worst cases measured: `sensorium bench --only limits`):
+# a triangle of the ray engine's scene with its EXACT edge guards ~515 B (~235 B without them), a
+# ray cast per step ~200 B (distance sensor rays, lidar beams, light occlusion rays). With margin:
+BYTES_PER_TRIANGLE = 560
+BYTES_PER_RAY = 220
 
 
 def check_pose(translation: Iterable[float] | None = None, rotation: Iterable[float] | None = None,
@@ -49,6 +57,7 @@ def check_pose(translation: Iterable[float] | None = None, rotation: Iterable[fl
 class WorldLimits:
     file_bytes: int = 16 * MiB               # the world file
     mesh_file_bytes: int = 256 * MiB         # each mesh file
+    mesh_load_bytes: int = 2048 * MiB        # memory reading one mesh file larger than 1 MiB may take (a worker)
     nesting_depth: int = 64                  # nested mappings/sequences in the file
     values: int = 2_000_000                  # scalars + containers after YAML aliases are expanded
     name_chars: int = 256                    # names become topic paths (/<robot>/<device>/value)
@@ -63,6 +72,7 @@ class WorldLimits:
     rays_per_image: int = 1 << 22            # a camera's or range finder's rays: width × height (× 4 anti-aliased)
     rays_per_step: int = 1 << 22             # every device due at once: distance rays + lidar beams + light occlusion rays
     triangles: int = 4_000_000               # tessellated primitives + meshes (planes are analytic)
+    build_bytes: int = 2 * GiB               # triangles and rays per step at the costs above, together
     # textures (world/textures.py): each image file, each image's pixels, all images' pixels (3 bytes each)
     texture_file_bytes: int = 64 * MiB
     texture_pixels: int = 1 << 24            # 4096 x 4096
@@ -71,10 +81,11 @@ class WorldLimits:
     @classmethod
     def large(cls) -> WorldLimits:
         """``--allow-large``: every limit raised (parsing limits stay finite)."""
-        return cls(file_bytes=1024 * MiB, mesh_file_bytes=4096 * MiB, nesting_depth=256, values=100_000_000,
+        return cls(file_bytes=1024 * MiB, mesh_file_bytes=4096 * MiB, mesh_load_bytes=65536 * MiB, nesting_depth=256, values=100_000_000,
                    name_chars=4096, string_chars=1 * MiB, number_magnitude=1e15, robots=100_000,
                    devices_per_robot=65_536, lights=65_536, solids=10_000_000, rays_per_sensor=1 << 20,
                    beams_per_lidar=1 << 28, rays_per_image=1 << 28, rays_per_step=1 << 30, triangles=1 << 30,
+                   build_bytes=1024 * GiB,
                    texture_file_bytes=4096 * MiB, texture_pixels=1 << 30, texture_pixels_total=1 << 32)
 
     def describe(self) -> list[tuple[str, Any]]:
@@ -100,40 +111,6 @@ def quote(value: Any, limit: int = 60) -> str:
 
 
 # ------------------------------------------------------------------------------------ parsing
-
-
-def check_yaml_events(text: bytes | str, limits: WorldLimits) -> None:
-    """Scan YAML without building it: nesting depth and the number of values once aliases are
-    expanded (``&a [*b, *b, …]`` chains grow exponentially). Raises ``LimitError``; YAML syntax
-    errors propagate as ``yaml.YAMLError``."""
-    depth = 0
-    # per open container: the number of values inside it so far, and its anchor
-    stack: list[list[Any]] = [[0, None]]
-    sizes: dict[str, int] = {}
-    for event in yaml.parse(text, Loader=yaml.SafeLoader):
-        if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
-            depth += 1
-            if depth > limits.nesting_depth:
-                raise LimitError(f"line {event.start_mark.line + 1}",
-                                 f"nested deeper than {limits.nesting_depth} levels {RAISE}")
-            stack.append([1, event.anchor])
-        elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
-            depth -= 1
-            count, anchor = stack.pop()
-            if anchor is not None:
-                sizes[anchor] = count
-            stack[-1][0] += count
-        elif isinstance(event, (yaml.ScalarEvent, yaml.AliasEvent)):
-            n = 1 if isinstance(event, yaml.ScalarEvent) else sizes.get(event.anchor, 1)
-            if isinstance(event, yaml.ScalarEvent) and event.anchor is not None:
-                sizes[event.anchor] = 1
-            stack[-1][0] += n
-        else:
-            continue
-        if sum(c for c, _ in stack) > limits.values:
-            mark = event.start_mark
-            raise LimitError(f"line {mark.line + 1}",
-                             f"more than {limits.values} values once aliases are expanded {RAISE}")
 
 
 def _string_limit(key: str, limits: WorldLimits) -> int:
@@ -169,6 +146,37 @@ def check_data(data: Any, limits: WorldLimits) -> None:
             if len(value) > cap:
                 raise LimitError(path, f"string of {len(value)} characters, longer than {cap} "
                                        f"(starts {quote(value[:40])}) {RAISE}")
+
+
+def check_counts(data: Any, limits: WorldLimits) -> None:
+    """Robots, devices per robot, lights and solids (nested children included) of the parsed, not
+    yet validated data: one ``LimitError`` naming the list, before any model is built."""
+    if not isinstance(data, dict):
+        return
+
+    def items(value: Any) -> list:
+        return value if isinstance(value, list) else []
+
+    def over(path: str, n: int, cap: int, what: str) -> None:
+        if n > cap:
+            raise LimitError(path, f"{n:,} {what}, more than the limit of {cap:,} {RAISE}")
+
+    robots = items(data.get("robots"))
+    over("robots", len(robots), limits.robots, "robots")
+    for i, robot in enumerate(robots):
+        if isinstance(robot, dict):
+            over(f"robots[{i}].devices", len(items(robot.get("devices"))), limits.devices_per_robot, "devices")
+    lights = len(items(data.get("lights"))) + sum(len(items(r.get("lights"))) for r in robots if isinstance(r, dict))
+    solids = 0
+    todo = list(items(data.get("solids")))
+    while todo and solids <= limits.solids:
+        solid = todo.pop()
+        solids += 1
+        if isinstance(solid, dict):
+            todo.extend(items(solid.get("children")))
+            lights += len(items(solid.get("lights")))
+    over("solids", solids, limits.solids, "solids (nested children included)")
+    over("lights", lights, limits.lights, "lights")
 
 
 # ------------------------------------------------------------------------------------ work
@@ -220,8 +228,7 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
         problems.append((path, f"{what} {num(n)} exceeds the limit of {num(cap)} {RAISE}"))
 
     triangles = 0
-    lights = 0
-    solids = 0
+    lights = 0                              # occluding light sensors cast a ray per light
     for path, v in _walk(world):
         if isinstance(v, float):
             mag = abs(v)
@@ -237,21 +244,12 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
                 triangles += triangle_count(v, mesh_triangles)
             elif isinstance(kind, str) and kind.endswith("Light"):
                 lights += 1
-            if path.endswith("]") and path.rpartition("[")[0].rpartition(".")[2] in ("solids", "children"):
-                solids += 1
-    if len(world.robots) > limits.robots:
-        over("robots", "robots:", len(world.robots), limits.robots)
-    if lights > limits.lights:
-        over("lights", "lights:", lights, limits.lights)
-    if solids > limits.solids:
-        over("solids", "solids:", solids, limits.solids)
+    # robots, devices, lights and solids: check_counts, on the data before validation
     if triangles > limits.triangles:
         over("", "the world's triangles:", triangles, limits.triangles)
     per_step = 0
     for r_i, robot in enumerate(world.robots):
         rp = f"robots[{r_i}]"
-        if len(robot.devices) > limits.devices_per_robot:
-            over(f"{rp}.devices", "devices:", len(robot.devices), limits.devices_per_robot)
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"
             kind = KINDS.get(getattr(dev, "device", ""))
@@ -263,6 +261,13 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
             per_step += n
     if per_step > limits.rays_per_step:
         over("", "rays in one step (every device due at once):", per_step, limits.rays_per_step)
+    need = BYTES_PER_TRIANGLE * triangles + BYTES_PER_RAY * per_step
+    if not problems and need > limits.build_bytes:      # each within its limit, too much together
+        problems.append(("", f"building this world would take about {need / GiB:.1f} GiB of memory "
+                             f"({triangles:,} triangles ≈ {BYTES_PER_TRIANGLE * triangles / GiB:.1f} GiB, "
+                             f"{per_step:,} ray{'s' if per_step != 1 else ''} per step ≈ "
+                             f"{BYTES_PER_RAY * per_step / GiB:.1f} GiB), more than "
+                             f"the limit of {limits.build_bytes / GiB:g} GiB {RAISE}"))
     return problems
 
 

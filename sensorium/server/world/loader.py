@@ -29,25 +29,13 @@ from sensorium.server.world.limits import (
     LimitError,
     ProtoLimits,
     WorldLimits,
+    check_counts,
     check_data,
     check_work,
-    check_yaml_events,
     quote,
 )
 from sensorium.server.world.report import LoadReport, Loss
-
-
-class _Yaml12Loader(yaml.SafeLoader):
-    """YAML 1.2 booleans: only true/false. YAML 1.1 would turn Webots' field name ``on`` (and
-    yes/no/off) into booleans."""
-
-
-_Yaml12Loader.yaml_implicit_resolvers = {
-    k: [(tag, rx) for tag, rx in v if tag != "tag:yaml.org,2002:bool"]
-    for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()
-}
-_Yaml12Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
+from sensorium.server.world.yamlload import load_yaml
 
 DEFAULT_WORLD = Path(__file__).resolve().parents[2] / "worlds" / "arena.yaml"
 
@@ -128,8 +116,7 @@ def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: W
     try:
         if json_format:
             return json.loads(text)
-        check_yaml_events(text, limits)
-        return yaml.load(text, Loader=_Yaml12Loader)  # noqa: S506 (a safe loader)
+        return load_yaml(text, limits)        # bounded while it is read (nesting, aliases, robots, ...)
     except LimitError as exc:
         raise WorldError(source, [Problem(exc.path, exc.message)]) from None
     except RecursionError:
@@ -286,6 +273,7 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
     if not isinstance(data, dict):
         raise WorldError(source, [Problem("", f"a world must be a mapping, got {type(data).__name__}")])
     try:
+        check_counts(data, limits)          # robots, devices, lights, solids: before anything is built
         check_data(data, limits)
     except LimitError as exc:
         raise WorldError(source, [Problem(exc.path, exc.message)]) from None
@@ -441,7 +429,8 @@ def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
         try:
             file = resolve_mesh_url(geom.url, base_dir, allow_outside=allow_outside_meshes,
                                     max_bytes=limits.mesh_file_bytes, allowed=asset_files)
-            faces[key] = len(load_mesh(file, geom.scale, display=geom.url).faces)
+            faces[key] = len(load_mesh(file, geom.scale, display=geom.url, memory=limits.mesh_load_bytes,
+                                       max_triangles=limits.triangles).faces)
         except MeshFileError as exc:
             problems.append(Problem(f"{path}.url", str(exc)))
     if problems:

@@ -1,17 +1,23 @@
 """Mesh files (STL, OBJ, PLY, GLB) → float64 triangle arrays, via trimesh.
 
 Loaded meshes are cached by (resolved path, modification time, scale): validating a world and then
-building its scene reads each file once.
+building its scene reads each file once. A file larger than ``IN_PROCESS_BYTES`` is read in a
+worker process with a memory limit (:mod:`.mesh_worker`): mesh readers need up to hundreds of
+times a file's size (3.4 GB for a 16 MB OBJ), and a world file names its meshes.
 """
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 SUPPORTED = {".stl", ".obj", ".ply", ".glb", ".gltf", ".off"}
+IN_PROCESS_BYTES = 1 << 20            # smaller files are read in process (a 1 MiB OBJ costs ~0.2 GB at worst)
+DEFAULT_LOAD_MEMORY = 2 << 30         # the worker's address space (WorldLimits.mesh_load_bytes)
 
 
 class MeshFileError(Exception):
@@ -50,8 +56,11 @@ def resolve_mesh_url(url: str, base_dir: Path, *, allow_outside: bool = False, m
     return path
 
 
-def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *, display: str | None = None):
-    """Load and scale a mesh file (cached). ``display``: how errors name the file (default: its path)."""
+def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *, display: str | None = None,
+              memory: int | None = None, max_triangles: int | None = None):
+    """Load and scale a mesh file (cached). ``display``: how errors name the file (default: its path);
+    ``memory``: what reading a large file may take (default ``DEFAULT_LOAD_MEMORY``);
+    ``max_triangles``: refuse a larger mesh before its arrays are copied out of the worker."""
     path = Path(path).resolve()
     name = display if display is not None else str(path)
     if not path.is_file():
@@ -59,16 +68,34 @@ def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1
     if path.suffix.lower() not in SUPPORTED:
         raise MeshFileError(f"unsupported mesh format {path.suffix!r} (expected one of {sorted(SUPPORTED)})")
     try:
-        return _load(str(path), path.stat().st_mtime_ns, tuple(float(s) for s in scale))
+        stat = path.stat()
+        key = (str(path), stat.st_mtime_ns, tuple(float(s) for s in scale))
+        mesh = _CACHE.get(key)
+        if mesh is None:
+            mesh = _load(*key, memory if memory is not None else DEFAULT_LOAD_MEMORY, stat.st_size, max_triangles)
+            _CACHE[key] = mesh
+            while len(_CACHE) > 64:
+                _CACHE.popitem(last=False)
+        else:
+            _CACHE.move_to_end(key)
+        return mesh
     except MeshFileError as exc:
         raise MeshFileError(str(exc).replace(str(path), name)) from None
 
 
-@lru_cache(maxsize=64)
-def _load(path: str, _mtime: int, scale: tuple[float, float, float]):
-    import trimesh
+# meshes read, by (resolved path, modification time, scale), the 64 most recently used (whatever
+# memory bound they were read under: validating and building read each file once)
+_CACHE: OrderedDict[tuple[str, int, tuple[float, ...]], Any] = OrderedDict()
 
+
+def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: int, max_triangles: int | None):
     from sensorium.server.world.geometry import Mesh
+
+    if size > IN_PROCESS_BYTES:
+        vertices, faces, closed = _read_in_worker(path, scale, memory, max_triangles)
+        vertices *= np.asarray(scale, dtype=np.float64)
+        return Mesh(vertices=vertices, faces=faces, closed=closed)
+    import trimesh
 
     try:
         loaded = trimesh.load(path, force="mesh", process=False)
@@ -87,6 +114,62 @@ def _load(path: str, _mtime: int, scale: tuple[float, float, float]):
     merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
     closed = bool(merged.is_watertight)
     return Mesh(vertices=np.ascontiguousarray(vertices), faces=np.ascontiguousarray(faces), closed=closed)
+
+
+def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
+                    max_triangles: int | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(vertices, faces, closed) of a mesh file read by :mod:`.mesh_worker` within ``memory`` bytes."""
+    import json
+    import os
+    import struct
+    import subprocess
+    import sys
+
+    worker = Path(__file__).with_name("mesh_worker.py")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+    env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
+    proc = subprocess.Popen([sys.executable, "-I", str(worker), path, *map(repr, scale), str(memory)],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=env,
+                            close_fds=True)
+    assert proc.stdout is not None
+    try:
+        head = proc.stdout.read(4)
+        header = json.loads(proc.stdout.read(struct.unpack(">I", head)[0])) if len(head) == 4 else None
+        if header is not None and header.get("ok") and max_triangles is not None and header["faces"] > max_triangles:
+            proc.kill()
+            raise MeshFileError(f"mesh {path} has {header['faces']:,} triangles, more than the world's limit of "
+                                f"{max_triangles:,} (raise the limits with --allow-large)")
+        if header is not None and header.get("ok"):
+            vertices = np.empty((header["vertices"], 3), dtype=np.float64)
+            faces = np.empty((header["faces"], 3), dtype=np.int64)
+            for a in (vertices, faces):
+                view = memoryview(a).cast("B")
+                got = 0
+                while got < len(view):
+                    n = proc.stdout.readinto(view[got:])
+                    if not n:
+                        header = None
+                        break
+                    got += n
+    finally:
+        proc.stdout.close()
+        code = proc.wait()
+    limit = f"{memory / (1 << 30):g} GiB"
+    if header is None:
+        raise MeshFileError(f"cannot read mesh {path}: its reader stopped (exit status {code}), most likely at the "
+                            f"limits for reading a mesh ({limit} of memory, 300 s) (raise the limits with --allow-large)")
+    if not header.get("ok"):
+        if header.get("kind") == "memory":
+            raise MeshFileError(f"cannot read mesh {path}: reading it needs more than {limit} of memory "
+                                "(raise the limits with --allow-large)")
+        if header.get("kind") == "no triangles":
+            raise MeshFileError(f"mesh {path} has no triangles")
+        raise MeshFileError(f"cannot read mesh {path}: {header.get('error', '?')}")
+    if not np.isfinite(vertices).all():
+        raise MeshFileError(f"mesh {path} has non-finite vertex coordinates")
+    if faces.min() < 0 or faces.max() >= len(vertices):
+        raise MeshFileError(f"mesh {path} has face indices outside its vertex list")
+    return vertices, faces, bool(header["closed"])
 
 
 def triangles_mesh(vertices, faces):

@@ -1,0 +1,61 @@
+"""Reads one mesh file in a process of its own, with a memory limit, for :mod:`.meshes`.
+
+Mesh readers cost far more memory than the mesh they return: trimesh's OBJ reader took 3.4 GB
+for a 16 MB file of 2 million ``f 1 2 3`` lines, its STL path ~1 KB per triangle (merging vertices
+to judge watertightness included). A world file names its meshes, so a hostile one could make
+``validate`` exhaust the machine. Here the reading runs under ``RLIMIT_AS``: past the limit the
+reader fails (``MemoryError``) or the process dies, and the parent reports one line.
+
+Run as ``python -I mesh_worker.py PATH SX SY SZ MEMORY_BYTES``. It imports numpy and trimesh,
+never sensorium. Reply on stdout: a 4-byte big-endian length and a JSON header — ``{"ok": true,
+"vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3 float64 and NF×3 int64 (native
+order), or ``{"ok": false, "kind": "memory" | "error", "error": "..."}``.
+"""
+
+import json
+import resource
+import struct
+import sys
+
+
+def _reply(header, *arrays):
+    out = sys.stdout.buffer
+    data = json.dumps(header).encode("utf-8")
+    out.write(struct.pack(">I", len(data)) + data)
+    for a in arrays:
+        out.write(memoryview(a).cast("B"))
+    out.flush()
+
+
+def main():
+    path, sx, sy, sz, memory = sys.argv[1], *map(float, sys.argv[2:5]), int(sys.argv[5])
+    resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+    resource.setrlimit(resource.RLIMIT_CPU, (300, 300))       # a reader that never ends is stopped too
+    try:
+        import numpy as np
+        import trimesh
+
+        loaded = trimesh.load(path, force="mesh", process=False)
+        vertices = np.ascontiguousarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
+        faces = np.ascontiguousarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
+        del loaded
+        if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0 or vertices.ndim != 2 or vertices.shape[1] != 3:
+            _reply({"ok": False, "kind": "no triangles", "error": "no triangles"})
+            return
+        closed = False
+        if np.isfinite(vertices).all() and faces.min() >= 0 and faces.max() < len(vertices):
+            scaled = vertices * np.asarray((sx, sy, sz), dtype=np.float64)
+            # merge coincident vertices so that watertightness is judged on the topology (as meshes.py)
+            closed = bool(trimesh.Trimesh(vertices=scaled, faces=faces, process=True, validate=False).is_watertight)
+            del scaled
+    except MemoryError:
+        _reply({"ok": False, "kind": "memory", "error": "out of memory"})
+        return
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many types for bad files
+        _reply({"ok": False, "kind": "error", "error": f"{type(exc).__name__}: {exc}"[:2000]})
+        return
+    _reply({"ok": True, "vertices": len(vertices), "faces": len(faces), "closed": closed}, vertices, faces)
+
+
+if __name__ == "__main__":
+    main()
