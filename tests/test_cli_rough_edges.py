@@ -32,7 +32,7 @@ def test_pytest_says_at_the_end_which_node_tests_it_skipped_and_how_to_run_them(
     env = dict(os.environ, PYTHONPATH=str(ROOT), PATH=str(Path(sys.executable).parent))   # no node on PATH
     env.pop("SENSORIUM_REQUIRE_NODE", None)
     r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-W", "ignore",
-                        str(ROOT / "tests" / "test_foxglove_live.py"), "-k", "replay_serves"],
+                        str(ROOT / "tests" / "test_foxglove_live.py"), "-k", "replay_serves", "-m", "slow or not slow"],
                        capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
     lines = [line for line in r.stdout.splitlines() if line.startswith("sensorium: ")]
     assert len(lines) == 1, r.stdout[-3000:]
