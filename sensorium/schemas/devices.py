@@ -210,6 +210,16 @@ register(DeviceKind(
     topics=(TopicDecl("value", msgs.FLOAT64, "value", exists=lambda cfg, wi: cfg.type != "force-3d"),
             TopicDecl("values", msgs.VECTOR3_STAMPED, "values", exists=lambda cfg, wi: cfg.type == "force-3d")),
     description="TouchSensorDescription"))
+# Emitter and Receiver (server/sim/radio.py): packets travel with step requests and replies, no topics
+# (a packet is the receiving controller's, taken from the receiver when it reads it).
+register(DeviceKind(
+    "Emitter", wm.Emitter, "sensorium.server.sim.radio:Emitter",
+    services=("get_channel", "set_channel", "get_range", "set_range", "get_buffer_size"),
+    description="EmitterDescription"))
+register(DeviceKind(
+    "Receiver", wm.Receiver, "sensorium.server.sim.radio:Receiver",
+    services=(*_SENSOR, "get_channel", "set_channel", "get_buffer_size"),
+    description="ReceiverDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(
