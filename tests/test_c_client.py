@@ -350,6 +350,20 @@ def test_c_client_replays_the_conformance_session(cbin, servers):
     assert lines == session["lines"]
 
 
+def test_c_and_mixed_controllers_replay_the_radio_session(cbin, servers):
+    """sensorium/schemas/conformance/radio.json: two C controllers, then a C rover and a Python buddy,
+    talk by radio and print exactly the lines computed from the simulation (packets, signal
+    strengths and directions bit for bit, the emitters' buffers and baud rates)."""
+    from test_conformance import python_runner, replay_radio
+
+    session = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "radio.json").read_text())
+    world = REPO / "sensorium" / "schemas" / "conformance" / session["world"]
+    assert replay_radio(servers(world, "--mode", "pause"), {"rover": [cbin["script"]], "buddy": [cbin["script"]]}) \
+        == session["lines"]
+    assert replay_radio(servers(world, "--mode", "pause"), {"rover": [cbin["script"]], "buddy": python_runner()}) \
+        == session["lines"]
+
+
 def test_c_codec_replays_the_request_vectors(cbin, servers):
     """sensorium/schemas/conformance/requests.json through the library's own transport and msgpack
     decoding (tests/c/wire_vectors.c): ids, ok, error codes, result keys and scalar results."""
