@@ -33,6 +33,8 @@ CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device"]
+API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
+C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -51,7 +53,9 @@ def cbin(tmp_path_factory) -> dict[str, str]:
     _make(f"BUILD={build}", "SANITIZE=1")
     libs = _make("libs").split()
     out = {}
-    for name, src in [(n, TESTS_C / f"{n}.c") for n in CONTROLLERS] + [("api_check", CLIB / "tests" / "api_check.c")]:
+    sources = ([(n, TESTS_C / f"{n}.c") for n in CONTROLLERS] + [(n, TESTS_C / "api" / f"{n}.c") for n in API_TESTS]
+               + [("api_check", CLIB / "tests" / "api_check.c")])
+    for name, src in sources:
         exe = build / name
         cmd = ["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
                "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", f"-I{TESTS_C}", str(src), "-o", str(exe),
@@ -645,3 +649,24 @@ def test_every_device_in_c_and_python_reads_the_same_and_what_kinematics_answers
                  "Speaker 'speaker'", "VacuumGripper 'gripper'", "LinearMotor 'linear motor'",
                  "RotationalMotor 'arm motor'"):
         assert sum(name in w for w in warned) == 1, (name, warned)
+
+
+# ====================================================================== Webots-style API tests
+
+def _succeeded(p: subprocess.Popen, what: str) -> None:
+    code, out, err = finish(p)
+    assert code == 0 and out and out[-1] == "success", f"{what}: exit {code}\n{chr(10).join(out)}\n{err}"
+
+
+def test_webots_style_api_tests(cbin, servers):
+    """tests/c/api: our own API tests in the manner of Webots' (a controller asserting what the API
+    answers, ending with "success"), built with the sanitizers: the motion sensors' closed forms, two
+    controllers talking by radio, the robot and device API with listed-only devices."""
+    _succeeded(start([cbin["motion_sensors"]], servers(C_API_WORLD, "--mode", "fast").url("walker")), "motion_sensors")
+    _succeeded(start([cbin["robot_devices"]], servers(C_API_WORLD, "--mode", "fast").url("gadget")), "robot_devices")
+    server = servers(C_API_WORLD, "--mode", "pause")           # both attached before the world runs
+    pair = {robot: start([cbin["emitter_receiver"]], server.url(robot)) for robot in ("alice", "bob")}
+    server.wait_attached(set(pair))
+    assert server.conn.call("set_mode", {"mode": "fast"})["mode"] == "fast"
+    for robot, p in pair.items():
+        _succeeded(p, f"emitter_receiver as {robot}")
