@@ -1,6 +1,10 @@
 /* The robot and device API on a robot with listed-only devices (tests/worlds/c_api.yaml, "gadget"):
  * Webots' device order, node types and models; listed-only devices answer "no value"; step(0) delivers
- * without advancing time; waiting for user input runs the simulation for the timeout. */
+ * without advancing time; waiting for user input runs the simulation for the timeout; tasks and
+ * mutexes. */
+#define _POSIX_C_SOURCE 200809L
+#include <time.h>
+
 #include <webots/camera.h>
 #include <webots/device.h>
 #include <webots/display.h>
@@ -10,6 +14,15 @@
 #include <webots/radar.h>
 
 #include "ts.h"
+
+static WbMutexRef g_mutex;
+static int g_result = 0;
+
+static void task(void *param) { /* Webots' wb_robot_task_new: runs in its own thread */
+  wb_robot_mutex_lock(g_mutex);
+  g_result = *(const int *)param;
+  wb_robot_mutex_unlock(g_mutex);
+}
 
 int main(void) {
   ts_setup();
@@ -53,6 +66,22 @@ int main(void) {
   ts_assert_int_equal(e, WB_EVENT_NO_EVENT, "no user input event");
   ts_assert_double_in_delta(wb_robot_get_time(), 0.016 + 0.048, 1e-12, "waited 48 ms");
   ts_assert_boolean_equal(isinf(INFINITY), true, "INFINITY");
+  /* no Webots project here; tasks and mutexes are threads */
+  ts_assert_string_equal(wb_robot_get_project_path(), "", "no project path");
+  ts_assert_string_equal(wb_robot_get_urdf(""), "", "no URDF");
+  g_mutex = wb_robot_mutex_new();
+  static const int answer = 42;
+  wb_robot_task_new(task, (void *)&answer);
+  int seen = 0;
+  for (int k = 0; k < 10000 && seen != 42; k++) {
+    wb_robot_mutex_lock(g_mutex);
+    seen = g_result;
+    wb_robot_mutex_unlock(g_mutex);
+    struct timespec ms = {0, 1000000L};
+    nanosleep(&ms, NULL);
+  }
+  wb_robot_mutex_delete(g_mutex);
+  ts_assert_int_equal(seen, 42, "the task ran");
   ts_send_success();
   return 0;
 }
