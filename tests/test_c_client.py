@@ -598,57 +598,18 @@ def test_a_curve_server_serves_a_c_controller_that_has_its_key(cbin, servers, tm
     assert code == 1 and len(err.strip().splitlines()) == 1 and "CURVE key" in err, err
 
 
-def _bits(hexes: str) -> list[float]:
-    return [struct.unpack("<d", struct.pack("<Q", int(x, 16)))[0] for x in hexes.split(",")]
+def test_every_device_in_c_reads_what_python_reads(cbin, servers):
+    """tests/c/every_device.c prints exactly the lines of tests/controllers/every_device.py (Webots'
+    Python classes; its closed forms are checked in tests/test_every_device.py): every Webots device
+    kind, simulated or listed-only, through the C API, bit for bit, no crash, one warning per
+    listed-only device."""
+    from test_every_device import WORLD, check_lines, python_lines
 
-
-def test_every_device_in_c_and_python_reads_the_same_and_what_kinematics_answers(cbin, servers):
-    """tests/c/every_device.c and tests/controllers/every_device.py (Webots' Python classes) touch
-    every Webots device kind of tests/worlds/every_device.yaml: the same lines bit for bit, Webots'
-    order and node types, closed-form readings of the robot at rest, Webots' "no value" with one
-    warning per listed-only device, and no crash anywhere."""
-    from sensorium.schemas.devices import WEBOTS_NODE_TYPES as N
-    world = REPO / "tests" / "worlds" / "every_device.yaml"
-    code, c_out, c_err = finish(start([cbin["every_device"]], servers(world, "--mode", "fast").url("bot")))
+    code, c_out, c_err = finish(start([cbin["every_device"]], servers(WORLD, "--mode", "fast").url("bot")))
     assert code == 0, c_err
-    py_out = run([sys.executable, "-m", "sensorium", "controller", "--url", servers(world, "--mode", "fast").url("bot"),
-                  str(REPO / "tests" / "controllers" / "every_device.py")])
     assert c_out[-1] == "infinity 1"                        # INFINITY from webots/types.h
-    assert c_out[:-1] == py_out
-    got = {line.split(" ", 1)[0]: line.split(" ")[1:] for line in py_out if not line.startswith("device ")}
-    devices = [line.split(" ") for line in py_out if line.startswith("device ")]
-    # Webots' tree order (the drive's wheel motors last), Webots' node types, the world's model
-    names = [" ".join(d[2:-2]) for d in devices]
-    assert names[:4] == ["radar", "gps", "camera", "speaker"] and names[-2:] == ["left wheel motor", "right wheel motor"]
-    assert len(devices) == 28 and [int(d[1]) for d in devices] == list(range(28))
-    assert devices[0][-2:] == [str(N["WB_NODE_RADAR"]), "u-blox"]
-    assert {int(d[-2]) for d in devices} >= {N[k] for k in N if N[k] >= N["WB_NODE_ACCELEROMETER"] and
-                                             N[k] <= N["WB_NODE_VACUUM_GRIPPER"] and k != "WB_NODE_PROPELLER"}
-    # NaN before the first value; the robot at rest at (0.5, -0.25, 0) heading +x (ENU, g = 9.81)
-    assert all(math.isnan(v) for part in got["before"] for v in _bits(part))
-    assert _bits(got["gps"][0]) == [0.5, -0.25, 0.0] and math.isnan(_bits(got["gps"][1])[0])   # no speed yet
-    assert got["gps"][3] == "0"
-    assert _bits(got["accelerometer"][0]) == [0.0, 0.0, 9.81]
-    assert _bits(got["altimeter"][0]) == [0.04]
-    assert _bits(got["compass"][0]) == [0.0, 1.0, 0.0]           # north (+y) in the device frame
-    assert _bits(got["gyro"][0]) == [0.0, 0.0, 0.0]
-    assert _bits(got["imu"][0]) == [0.0, 0.0, 0.0] and _bits(got["imu"][1]) == [0.0, 0.0, 0.0, 1.0]
-    assert _bits(got["ds"][0]) == [1000.0]                        # nothing ahead: the table's far value
-    assert _bits(got["lidar"][0]) == [math.inf] * 4 and _bits(got["light"][0]) == [0.0]
-    assert _bits(got["bumper"][0]) == [0.0] and got["bumper"][1:] == ["0", "none"]
-    assert got["send"][:3] == ["1", "1", "2"] and got["led"] == ["2"] and got["receiver"][:2] == ["0", "1"]
-    assert got["wheel"][1] == "0" and math.isnan(_bits(got["wheel"][2])[0])
-    assert got["radar"] == ["0", "0", "1"] and got["brake"] == ["0", "1"] and got["connector"] == ["-1", "0"]
-    assert got["display"] == ["0", "0"] and got["skin"] == ["0", "1"] and got["speaker"] == ["0", "1"]
-    assert got["gripper"] == ["0", "0"] and got["linear"][0] == "1" and got["arm"][0] == "0"
-    assert got["joystick"] == ["0", "-1"] and got["mouse"] == ["1", "0"] and got["battery"] == ["1"]
-    assert got["wait"] == ["0", "112"]       # WB_EVENT_NO_EVENT after 100 ms rounded up to whole 16 ms steps
-    # one warning line per listed-only device, however many calls
-    warned = [line for line in c_err.splitlines() if "does not simulate" in line]
-    for name in ("Radar 'radar'", "Brake 'brake'", "Connector 'connector'", "Display 'display'", "Skin 'skin'",
-                 "Speaker 'speaker'", "VacuumGripper 'gripper'", "LinearMotor 'linear motor'",
-                 "RotationalMotor 'arm motor'"):
-        assert sum(name in w for w in warned) == 1, (name, warned)
+    assert c_out[:-1] == python_lines(servers(WORLD, "--mode", "fast").url("bot"))
+    check_lines(c_out[:-1], c_err)
 
 
 # ====================================================================== Webots-style API tests
