@@ -70,6 +70,14 @@ def test_webots_node_types():
         D.register(D.DeviceKind("GPS", None))
 
 
+def test_the_python_clients_node_types_are_the_declarations():
+    from sensorium.client import nodes, wb
+
+    assert nodes.WEBOTS_NODE_TYPES == D.WEBOTS_NODE_TYPES
+    for k in D.KINDS.values():
+        assert nodes.node_type(k.type) == k.node and getattr(wb, k.node_name) == k.node
+
+
 def test_client_node_types_are_webots_names():
     # every WB_NODE_* the C header names is one of Webots' (no typo); the first kinds are all there
     header = (Path(__file__).parents[1] / "sensorium/client/c/include/webots/nodes.h").read_text()

@@ -19,6 +19,7 @@ from typing import Any
 from sensorium.client.connection import ErrorCode, SensoriumError
 from sensorium.client.wb_robot import EMITTER, RECEIVER, DeviceState, current
 
+
 def _emitter(tag: int, func: str) -> DeviceState:
     return current().device(tag, EMITTER, func)
 

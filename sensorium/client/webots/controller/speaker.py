@@ -15,4 +15,4 @@ class Speaker(UnsimulatedDevice):
     @staticmethod
     def playSound(left: Speaker, right: Speaker, sound: str, volume: float, pitch: float, balance: float,
                   loop: bool) -> None:
-        getattr(wb, "wb_speaker_play_sound")(left._tag, right._tag, sound, volume, pitch, balance, loop)
+        wb.wb_speaker_play_sound(left._tag, right._tag, sound, volume, pitch, balance, loop)
