@@ -8,8 +8,9 @@ One module per section, each ``run(cfg) -> Section``:
 * :mod:`.transport` — lockstep round trips and steps/s over loopback against a raw pyzmq floor;
 * :mod:`.memory`    — bytes per static triangle, transient memory and time per ray of large scans;
 * :mod:`.scaleout`  — vectorised Gymnasium env steps/s, sweep throughput on the process pool vs Ray;
+* :mod:`.radio`     — Emitter/Receiver traffic: time per delivered packet, radio and infra-red;
 
 and :mod:`.report` writes ``benchmarks.md``, ``benchmarks.json`` and the PNG plots.
 """
 
-SECTIONS = ("transport", "memory", "accuracy", "scaling", "scaleout", "peers")   # run order: peers last (its libraries start thread pools)
+SECTIONS = ("transport", "memory", "accuracy", "scaling", "scaleout", "radio", "peers")   # run order: peers last (its libraries start thread pools)

@@ -9,7 +9,7 @@ import math
 from pathlib import Path
 
 SCHEMA = 1
-ORDER = ("peers", "accuracy", "scaling", "memory", "transport", "scaleout")
+ORDER = ("peers", "accuracy", "scaling", "memory", "transport", "scaleout", "radio")
 
 
 def load(out: Path) -> dict:

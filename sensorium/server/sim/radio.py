@@ -249,44 +249,49 @@ class Radio:
         if not self._in_flight:
             return
         flight, self._in_flight = self._in_flight, []
-        world: dict[int, Any] = {}
+        # each device's world pose once per step, as plain floats (a few packets cost no numpy calls)
+        world: dict[int, tuple[list[float], list[list[float]]]] = {}
 
-        def pose(d: Device) -> Any:
+        def pose(d: Device) -> tuple[list[float], list[list[float]]]:
             p = world.get(id(d))
             if p is None:
-                p = world[id(d)] = d.world_pose(poses[d.robot_index])
+                w = d.world_pose(poses[d.robot_index])
+                p = world[id(d)] = (w.translation.tolist(), w.rotation.tolist())
             return p
+
+        def x_axis(rotation: list[list[float]]) -> list[float]:
+            return [rotation[0][0], rotation[1][0], rotation[2][0]]
 
         passed: list[tuple[Packet, Emitter, Receiver]] = []
         infra_red: list[tuple[Packet, Emitter, Receiver]] = []
         for t in flight:
             _, e, r = t
-            pe, pr = pose(e).translation, pose(r).translation
+            (pe, re), (pr, rr) = pose(e), pose(r)
             if not rmath.within_range(pe, pr, e.range):
                 continue
             if e.config.type != "infra-red":
                 passed.append(t)
-            elif (rmath.within_cone(pe, pose(e).rotation[:, 0], pr, e.config.aperture)
-                  and rmath.within_cone(pr, pose(r).rotation[:, 0], pe, r.config.aperture)):
+            elif (rmath.within_cone(pe, x_axis(re), pr, e.config.aperture)
+                  and rmath.within_cone(pr, x_axis(rr), pe, r.config.aperture)):
                 infra_red.append(t)
         if infra_red:
-            clear = self._line_of_sight([(pose(e).translation, pose(r).translation, e.robot_index, r.robot_index)
+            clear = self._line_of_sight([(pose(e)[0], pose(r)[0], e.robot_index, r.robot_index)
                                          for _, e, r in infra_red])
             passed += [t for t, ok in zip(infra_red, clear) if ok]
-        # in the order the packets were sent (Webots keeps it per receiver)
-        order = {id(t): i for i, t in enumerate(flight)}
-        passed.sort(key=lambda t: order[id(t)])
+            # in the order the packets were sent (Webots keeps it per receiver)
+            order = {id(t): i for i, t in enumerate(flight)}
+            passed.sort(key=lambda t: order[id(t)])
         for p, e, r in passed:
-            pr = pose(r)
+            pr, rr = pose(r)
             c = r.config
             noisy = c.direction_noise != 0.0 or c.signal_strength_noise != 0.0
             direction, strength = rmath.reception(
-                pr.rotation, pr.translation, pose(e).translation, direction_noise=c.direction_noise,
+                rr, pr, pose(e)[0], direction_noise=c.direction_noise,
                 signal_strength_noise=c.signal_strength_noise, rng=r.rng if noisy else None)
-            r.arrive(Received(p.data, float(strength), (float(direction[0]), float(direction[1]), float(direction[2]))))
+            r.arrive(Received(p.data, strength, direction))
         self.counters["radio_packets"] += len(passed)
 
-    def _line_of_sight(self, segments: list[tuple[np.ndarray, np.ndarray, int, int]]) -> list[bool]:
+    def _line_of_sight(self, segments: list[tuple[list[float], list[float], int, int]]) -> list[bool]:
         """Whether each emitter→receiver segment is free of bounding objects other than the two
         robots' own (Webots: the emitting and receiving robots never block). One batched cast per
         round; a ray stopped by the receiving robot's shapes is cast again from just past them."""
