@@ -33,6 +33,8 @@ CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device"]
+API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
+C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -51,7 +53,9 @@ def cbin(tmp_path_factory) -> dict[str, str]:
     _make(f"BUILD={build}", "SANITIZE=1")
     libs = _make("libs").split()
     out = {}
-    for name, src in [(n, TESTS_C / f"{n}.c") for n in CONTROLLERS] + [("api_check", CLIB / "tests" / "api_check.c")]:
+    sources = ([(n, TESTS_C / f"{n}.c") for n in CONTROLLERS] + [(n, TESTS_C / "api" / f"{n}.c") for n in API_TESTS]
+               + [("api_check", CLIB / "tests" / "api_check.c")])
+    for name, src in sources:
         exe = build / name
         cmd = ["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
                "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", f"-I{TESTS_C}", str(src), "-o", str(exe),
@@ -350,6 +354,20 @@ def test_c_client_replays_the_conformance_session(cbin, servers):
     assert lines == session["lines"]
 
 
+def test_c_and_mixed_controllers_replay_the_radio_session(cbin, servers):
+    """sensorium/schemas/conformance/radio.json: two C controllers, then a C rover and a Python buddy,
+    talk by radio and print exactly the lines computed from the simulation (packets, signal
+    strengths and directions bit for bit, the emitters' buffers and baud rates)."""
+    from test_conformance import python_runner, replay_radio
+
+    session = json.loads((REPO / "sensorium" / "schemas" / "conformance" / "radio.json").read_text())
+    world = REPO / "sensorium" / "schemas" / "conformance" / session["world"]
+    assert replay_radio(servers(world, "--mode", "pause"), {"rover": [cbin["script"]], "buddy": [cbin["script"]]}) \
+        == session["lines"]
+    assert replay_radio(servers(world, "--mode", "pause"), {"rover": [cbin["script"]], "buddy": python_runner()}) \
+        == session["lines"]
+
+
 def test_c_codec_replays_the_request_vectors(cbin, servers):
     """sensorium/schemas/conformance/requests.json through the library's own transport and msgpack
     decoding (tests/c/wire_vectors.c): ids, ok, error codes, result keys and scalar results."""
@@ -580,32 +598,36 @@ def test_a_curve_server_serves_a_c_controller_that_has_its_key(cbin, servers, tm
     assert code == 1 and len(err.strip().splitlines()) == 1 and "CURVE key" in err, err
 
 
-def test_every_device_kind_is_present_and_unsimulated_ones_answer_no_value(cbin, servers):
-    from sensorium.schemas.devices import WEBOTS_NODE_TYPES as N
-    server = servers(REPO / "tests" / "worlds" / "every_device.yaml", "--mode", "fast")
-    code, out, err = finish(start([cbin["every_device"]], server.url("bot")))
-    assert code == 0, err
-    got = {}
-    for line in out:
-        key, rest = line.split(" ", 1)
-        got.setdefault(key, []).append(rest)
-    # Webots' tree order, Webots' node type values, the world's model
-    assert got["device"] == [f"0 radar {N['WB_NODE_RADAR']} u-blox", f"1 gps {N['WB_NODE_GPS']} ",
-                             f"2 display {N['WB_NODE_DISPLAY']} ", f"3 speaker {N['WB_NODE_SPEAKER']} "]
-    assert got["radar"] == ["0 1 1"] and got["display"] == ["0 0"]
-    # one warning line per unsimulated device, however many calls
-    warnings = [line for line in err.splitlines() if "does not simulate" in line]
-    assert len(warnings) == 2 and any("Radar 'radar'" in w for w in warnings) and any("Display 'display'" in w for w in warnings)
-    x, y, z, cs = got["gps"][0].split()
-    assert (float(x), float(y), float(z), cs) == (0.5, -0.25, 0.0, "0")      # the robot's pose, local coordinates
-    assert got["joystick"] == ["0 mouse 1"]
-    assert got["wait"] == ["0 112"]      # WB_EVENT_NO_EVENT after 100 ms rounded up to whole 16 ms steps
-    assert got["infinity"] == ["1"]
+def test_every_device_in_c_reads_what_python_reads(cbin, servers):
+    """tests/c/every_device.c prints exactly the lines of tests/controllers/every_device.py (Webots'
+    Python classes; its closed forms are checked in tests/test_every_device.py): every Webots device
+    kind, simulated or listed-only, through the C API, bit for bit, no crash, one warning per
+    listed-only device."""
+    from test_every_device import WORLD, check_lines, python_lines
+
+    code, c_out, c_err = finish(start([cbin["every_device"]], servers(WORLD, "--mode", "fast").url("bot")))
+    assert code == 0, c_err
+    assert c_out[-1] == "infinity 1"                        # INFINITY from webots/types.h
+    assert c_out[:-1] == python_lines(servers(WORLD, "--mode", "fast").url("bot"))
+    check_lines(c_out[:-1], c_err)
 
 
-def test_every_device_is_present_in_the_python_controller_classes(servers):
-    server = servers(REPO / "tests" / "worlds" / "every_device.yaml", "--mode", "fast")
-    out = run([sys.executable, "-m", "sensorium", "controller", "--url", server.url("bot"),
-               str(REPO / "tests" / "controllers" / "every_device.py")])
-    assert out == ["device 0 radar u-blox", "device 1 gps -", "device 2 display -", "device 3 speaker -",
-                   "found radar gps display speaker", "wait 0 96"]
+# ====================================================================== Webots-style API tests
+
+def _succeeded(p: subprocess.Popen, what: str) -> None:
+    code, out, err = finish(p)
+    assert code == 0 and out and out[-1] == "success", f"{what}: exit {code}\n{chr(10).join(out)}\n{err}"
+
+
+def test_webots_style_api_tests(cbin, servers):
+    """tests/c/api: our own API tests in the manner of Webots' (a controller asserting what the API
+    answers, ending with "success"), built with the sanitizers: the motion sensors' closed forms, two
+    controllers talking by radio, the robot and device API with listed-only devices."""
+    _succeeded(start([cbin["motion_sensors"]], servers(C_API_WORLD, "--mode", "fast").url("walker")), "motion_sensors")
+    _succeeded(start([cbin["robot_devices"]], servers(C_API_WORLD, "--mode", "fast").url("gadget")), "robot_devices")
+    server = servers(C_API_WORLD, "--mode", "pause")           # both attached before the world runs
+    pair = {robot: start([cbin["emitter_receiver"]], server.url(robot)) for robot in ("alice", "bob")}
+    server.wait_attached(set(pair))
+    assert server.conn.call("set_mode", {"mode": "fast"})["mode"] == "fast"
+    for robot, p in pair.items():
+        _succeeded(p, f"emitter_receiver as {robot}")

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import struct
 import subprocess
 import sys
 from pathlib import Path
@@ -135,3 +136,60 @@ def test_session_vector_replayed_by_the_python_client(server):
     assert any("7ff8000000000000" in r for line in session["lines"] for r in line.split())
     assert len({r[2] for r in rows}) == len(rows)                       # ir: a new noisy value every step
     assert sum("lidar.cloud=" in line for line in session["lines"]) < len(rows)
+
+
+def replay_radio(server, runners: dict[str, list[str]]) -> dict[str, list[str]]:
+    """radio.json's scripts, one controller process per robot (``runners[robot]``: the argv before
+    the script's ops) stepping together on one server started in pause mode: the world runs once
+    every controller is attached (else the first would step alone); each robot's printed lines."""
+    session = load("radio.json")
+    rpc = server.rpc
+    procs = {robot: subprocess.Popen([*runners[robot], *session["scripts"][robot]], stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True, cwd=str(REPO),
+                                     env={**os.environ, "PYTHONUNBUFFERED": "1", "SENSORIUM_CONTROLLER_URL": f"{rpc}/{robot}",
+                                          "ASAN_OPTIONS": "detect_leaks=1:exitcode=86",
+                                          "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"})
+             for robot in session["scripts"]}
+    server.wait_attached(set(procs))
+    assert server.conn.call("set_mode", {"mode": "fast"})["mode"] == "fast"
+    out = {}
+    for robot, p in procs.items():
+        try:
+            stdout, stderr = p.communicate(timeout=180)
+        finally:
+            for q in procs.values():
+                if q.poll() is None and q is not p and p.returncode is None:
+                    q.kill()
+        assert p.returncode == 0, f"{robot}: {stderr}"
+        assert "Sanitizer" not in stderr and "runtime error" not in stderr, stderr
+        out[robot] = stdout.splitlines()
+    return out
+
+
+def python_runner() -> list[str]:
+    return [sys.executable, "-m", "sensorium", "controller", str(SCRIPT_PY)]
+
+
+@pytest.fixture
+def paused_server():
+    with serve(VECTORS / "world.yaml", "--mode", "pause") as s:
+        yield s
+
+
+def test_radio_session_two_python_controllers(paused_server):
+    """Two controllers of one world talking by radio (sensorium/schemas/conformance/radio.json): the
+    exact packets, signal strengths and directions each receives, what each emitter's buffer and
+    baud rate let through, channels, ranges, broadcast; computed from the simulation alone."""
+    session = load("radio.json")
+    got = replay_radio(paused_server, {"rover": python_runner(), "buddy": python_runner()})
+    assert got == session["lines"]
+    rover, buddy = session["lines"]["rover"], session["lines"]["buddy"]
+    # not vacuous: packets arrive both ways, the rover's buffer refuses one, the buddy's noisy receiver
+    # reads a direction of unit length, a packet sent out of range never arrives
+    assert rover[0].endswith("radio out.sent=1110") and "radio in=1:6275646479/" in rover[0]
+    assert "radio in=1:68656c6c6f/" in buddy[1]
+    assert not any(":0d/" in line for line in buddy) and any(":0e/" in line for line in buddy)
+    assert not any(":" + "ff" * 30 in line for line in buddy)          # larger than the buddy's buffer
+    head = buddy[1].split("radio in=1:")[1].split(" ")[0]
+    x, y, z = (struct.unpack("<d", struct.pack("<Q", int(h, 16)))[0] for h in head.split("/")[2].split(","))
+    assert abs(math.hypot(x, y, z) - 1.0) < 1e-12

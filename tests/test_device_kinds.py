@@ -52,7 +52,9 @@ def test_every_simulated_kind_is_complete(k):
         assert t.message in store.fielddefs, f"the ROS 2 export has no type {t.message}"
         assert (t.message in SENSOR_TYPES) == t.sensor_qos
     if not k.motor:
-        assert k.topics, f"{k.type} publishes nothing"
+        # communication devices carry packets between controllers (step requests and replies): a
+        # packet belongs to the receiving controller, which takes it from the receiver's queue
+        assert k.topics or k.type in ("Emitter", "Receiver"), f"{k.type} publishes nothing"
         assert issubclass(cls, Device)
 
 
@@ -66,6 +68,14 @@ def test_webots_node_types():
     assert len({k.node for k in D.KINDS.values()}) == len(D.KINDS)
     with pytest.raises(ValueError, match="already registered"):
         D.register(D.DeviceKind("GPS", None))
+
+
+def test_the_python_clients_node_types_are_the_declarations():
+    from sensorium.client import nodes, wb
+
+    assert nodes.WEBOTS_NODE_TYPES == D.WEBOTS_NODE_TYPES
+    for k in D.KINDS.values():
+        assert nodes.node_type(k.type) == k.node and getattr(wb, k.node_name) == k.node
 
 
 def test_client_node_types_are_webots_names():

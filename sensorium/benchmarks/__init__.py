@@ -12,8 +12,9 @@ One module per section, each ``run(cfg) -> Section``:
 * :mod:`.loading`   — loading a PROTO-heavy Webots world, per stage (expansion, templates, conversion, scene);
 * :mod:`.images`    — a camera's and a range finder's picture vs raw embreex on the same rays;
 * :mod:`.training`  — the batched vector env (many worlds in one simulation) vs MuJoCo Hopper, scaling, resets;
+* :mod:`.radio`     — Emitter/Receiver traffic: time per delivered packet, radio and infra-red;
 
 and :mod:`.report` writes ``benchmarks.md``, ``benchmarks.json`` and the PNG plots.
 """
 
-SECTIONS = ("transport", "memory", "limits", "accuracy", "scaling", "scaleout", "loading", "images", "training", "peers")   # run order: peers last (its libraries start thread pools)
+SECTIONS = ("transport", "memory", "limits", "accuracy", "scaling", "scaleout", "loading", "images", "training", "radio", "peers")   # run order: peers last (its libraries start thread pools)

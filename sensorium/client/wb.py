@@ -21,15 +21,30 @@ carrying on (a NaN position or velocity, a negative velocity in position control
 out-of-range LED value are printed and ignored, as Webots does); reads of a disabled
 device print Webots' message to stderr once per disable. A velocity above ``maxVelocity`` is
 clamped here with Webots' warning (Webots clamps in the simulator).
-The functions live in ``wb_robot`` (session, robot, keyboard), ``wb_sensors``, ``wb_motor`` (motors,
-LEDs), ``wb_pen`` and ``wb_supervisor``; this module re-exports them all. One process drives one robot through
+The functions live in ``wb_robot`` (session, robot, keyboard), ``wb_sensors`` (light, distance,
+lidar, encoders), ``wb_kinematic`` (GPS, InertialUnit, Compass, Accelerometer, Gyro, Altimeter,
+TouchSensor), ``wb_radio`` (Emitter, Receiver), ``wb_camera`` (RangeFinder, Camera, Recognition), ``wb_pen``, ``wb_motor`` (motors, LEDs), ``wb_input``
+(joystick, mouse, waiting for user input, battery), ``wb_unsimulated`` (the devices Sensorium
+lists without simulating: Webots' "no value" with one warning per device) and ``wb_supervisor``;
+this module re-exports them all. One process drives one robot through
 these functions; :class:`RobotClient` is the same thing as
 an object, for programs (and tests) that want several.
 """
 
 from __future__ import annotations
 
-from sensorium.client import wb_camera, wb_motor, wb_pen, wb_robot, wb_sensors, wb_supervisor
+from sensorium.client import (
+    wb_camera,
+    wb_input,
+    wb_kinematic,
+    wb_motor,
+    wb_pen,
+    wb_radio,
+    wb_robot,
+    wb_sensors,
+    wb_supervisor,
+    wb_unsimulated,
+)
 from sensorium.client.connection import SensoriumError  # noqa: F401
 from sensorium.client.wb_camera import *  # noqa: F403
 from sensorium.client.wb_camera import (  # noqa: F401
@@ -40,8 +55,11 @@ from sensorium.client.wb_camera import (  # noqa: F401
     recognition_objects,
     segmentation_bytes,
 )
+from sensorium.client.wb_input import *  # noqa: F403
+from sensorium.client.wb_kinematic import *  # noqa: F403
 from sensorium.client.wb_motor import *  # noqa: F403
 from sensorium.client.wb_pen import *  # noqa: F403
+from sensorium.client.wb_radio import *  # noqa: F403
 from sensorium.client.wb_robot import *  # noqa: F403
 from sensorium.client.wb_robot import (  # noqa: F401 - used by the controller classes and tests
     DISTANCE_SENSOR,
@@ -57,6 +75,10 @@ from sensorium.client.wb_robot import (  # noqa: F401 - used by the controller c
 from sensorium.client.wb_sensors import *  # noqa: F403
 from sensorium.client.wb_sensors import lidar_cloud_bytes, lidar_range_bytes  # noqa: F401
 from sensorium.client.wb_supervisor import *  # noqa: F403
+from sensorium.client.wb_unsimulated import *  # noqa: F403
 
-__all__ = sorted({n for m in (wb_robot, wb_sensors, wb_motor, wb_pen, wb_supervisor, wb_camera) for n in vars(m)
-                  if n.startswith(("wb_", "WB_"))} | {"SensoriumError", "RobotClient"})
+_MODULES = (wb_robot, wb_sensors, wb_kinematic, wb_radio, wb_camera, wb_pen, wb_motor, wb_input, wb_unsimulated,
+            wb_supervisor)
+globals().update({n: v for m in _MODULES for n, v in vars(m).items() if n.startswith(("wb_", "WB_"))})
+__all__ = sorted({n for m in _MODULES for n in vars(m) if n.startswith(("wb_", "WB_"))}
+                 | {"SensoriumError", "RobotClient", "WbMouseState"})

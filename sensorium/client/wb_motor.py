@@ -3,18 +3,24 @@ and ``wb_led_*``."""
 
 from __future__ import annotations
 
+import math
 import sys
 
 from sensorium.client.connection import ErrorCode, SensoriumError
 from sensorium.client.wb_robot import (
     LED,
+    LINEAR_MOTOR,
     POSITION_SENSOR,
     ROTATIONAL_MOTOR,
+    WB_LINEAR,
     WB_ROTATIONAL,
     DeviceState,
     _float,
+    answers,
     current,
 )
+
+_NAN = math.nan
 
 # ---------------------------------------------------------------------- motor
 
@@ -22,43 +28,54 @@ def _motor(tag: int, func: str) -> DeviceState:
     return current().device(tag, ROTATIONAL_MOTOR, func)
 
 
+@answers(None)
 def wb_motor_set_position(tag: int, position: float) -> None:
     """Target position (rad) sent with the next step; ``float('inf')`` selects velocity control."""
     current().set_motor_position(_motor(tag, "wb_motor_set_position"), position, "wb_motor_set_position")
 
 
+@answers(None)
 def wb_motor_set_velocity(tag: int, velocity: float) -> None:
     """Velocity (rad/s) sent with the next step: the wheel speed in velocity control, the speed
     limit in position control. Above ``maxVelocity`` it is clamped (with Webots' warning)."""
     current().set_motor_velocity(_motor(tag, "wb_motor_set_velocity"), velocity, "wb_motor_set_velocity")
 
 
+@answers(_NAN)
 def wb_motor_get_velocity(tag: int) -> float:
     return _motor(tag, "wb_motor_get_velocity").velocity
 
 
+@answers(_NAN)
 def wb_motor_get_max_velocity(tag: int) -> float:
     return _motor(tag, "wb_motor_get_max_velocity").max_velocity
 
 
+@answers(_NAN)
 def wb_motor_get_target_position(tag: int) -> float:
     return _motor(tag, "wb_motor_get_target_position").target_position
 
 
+@answers(_NAN)
 def wb_motor_get_min_position(tag: int) -> float:
     """0 with :func:`wb_motor_get_max_position` 0: no position limits (a wheel)."""
     return _float(_motor(tag, "wb_motor_get_min_position").desc.get("minPosition"), 0.0)
 
 
+@answers(_NAN)
 def wb_motor_get_max_position(tag: int) -> float:
     return _float(_motor(tag, "wb_motor_get_max_position").desc.get("maxPosition"), 0.0)
 
 
 def wb_motor_get_type(tag: int) -> int:
-    _motor(tag, "wb_motor_get_type")
-    return WB_ROTATIONAL
+    """``WB_ROTATIONAL`` or ``WB_LINEAR`` (a linear motor is listed, not simulated)."""
+    dev = current().device(tag, None, "wb_motor_get_type")
+    if dev.kind not in (ROTATIONAL_MOTOR, LINEAR_MOTOR):
+        raise SensoriumError(ErrorCode.UNKNOWN_DEVICE, f"wb_motor_get_type(): device tag {tag} is {dev.name!r}, a {dev.kind}, not a motor")
+    return WB_LINEAR if dev.kind == LINEAR_MOTOR else WB_ROTATIONAL
 
 
+@answers(0)
 def wb_motor_get_position_sensor(tag: int) -> int:
     """The tag of the PositionSensor on the wheel's joint, 0 if it has none."""
     r = current()
@@ -69,9 +86,137 @@ def wb_motor_get_position_sensor(tag: int) -> int:
     return 0
 
 
+@answers(0)
 def wb_motor_get_brake(tag: int) -> int:
     _motor(tag, "wb_motor_get_brake")
     return 0
+
+
+# -- what needs physics: a kinematic wheel turns at its commanded speed at once. The setters are
+#    accepted and ignored, the getters answer Webots' default or NaN; one warning line per motor.
+
+def _physics(tag: int, func: str) -> DeviceState:
+    dev = _motor(tag, func)
+    if not dev._consts.get("physics_warned"):
+        dev._consts["physics_warned"] = True
+        print(f"Warning: {func}(): {dev.kind} '{dev.name}' is a kinematic wheel: accelerations, forces, torques and "
+              "PID gains are ignored, force and torque feedback read NaN.", file=sys.stderr)
+    return dev
+
+
+@answers(None)
+def wb_motor_set_acceleration(tag: int, acceleration: float) -> None:
+    _physics(tag, "wb_motor_set_acceleration")._consts["acceleration"] = float(acceleration)
+
+
+@answers(_NAN)
+def wb_motor_get_acceleration(tag: int) -> float:
+    """-1 (unlimited, Webots' default) unless set."""
+    return float(_motor(tag, "wb_motor_get_acceleration")._consts.get("acceleration", -1.0))
+
+
+@answers(None)
+def wb_motor_set_available_force(tag: int, force: float) -> None:
+    _physics(tag, "wb_motor_set_available_force")
+
+
+@answers(None)
+def wb_motor_set_available_torque(tag: int, torque: float) -> None:
+    _physics(tag, "wb_motor_set_available_torque")
+
+
+@answers(_NAN)
+def wb_motor_get_available_force(tag: int) -> float:
+    _physics(tag, "wb_motor_get_available_force")
+    return _NAN
+
+
+@answers(_NAN)
+def wb_motor_get_available_torque(tag: int) -> float:
+    _physics(tag, "wb_motor_get_available_torque")
+    return _NAN
+
+
+@answers(_NAN)
+def wb_motor_get_max_force(tag: int) -> float:
+    _physics(tag, "wb_motor_get_max_force")
+    return _NAN
+
+
+@answers(_NAN)
+def wb_motor_get_max_torque(tag: int) -> float:
+    _physics(tag, "wb_motor_get_max_torque")
+    return _NAN
+
+
+@answers(None)
+def wb_motor_set_control_pid(tag: int, p: float, i: float, d: float) -> None:
+    _physics(tag, "wb_motor_set_control_pid")
+
+
+@answers(_NAN)
+def wb_motor_get_multiplier(tag: int) -> float:
+    _motor(tag, "wb_motor_get_multiplier")
+    return 1.0
+
+
+@answers(None)
+def wb_motor_set_force(tag: int, force: float) -> None:
+    _physics(tag, "wb_motor_set_force")
+
+
+@answers(None)
+def wb_motor_set_torque(tag: int, torque: float) -> None:
+    _physics(tag, "wb_motor_set_torque")
+
+
+def _feedback_period(tag: int, key: str, period: int, func: str) -> None:
+    dev = _physics(tag, func)
+    if isinstance(period, bool) or not isinstance(period, int) or period < 0:
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer >= 0 (ms), got {period!r}")
+    dev._consts[key] = period
+
+
+@answers(None)
+def wb_motor_enable_force_feedback(tag: int, sampling_period: int) -> None:
+    _feedback_period(tag, "force_feedback", sampling_period, "wb_motor_enable_force_feedback")
+
+
+@answers(None)
+def wb_motor_disable_force_feedback(tag: int) -> None:
+    _feedback_period(tag, "force_feedback", 0, "wb_motor_disable_force_feedback")
+
+
+@answers(0)
+def wb_motor_get_force_feedback_sampling_period(tag: int) -> int:
+    return int(_motor(tag, "wb_motor_get_force_feedback_sampling_period")._consts.get("force_feedback", 0))
+
+
+@answers(_NAN)
+def wb_motor_get_force_feedback(tag: int) -> float:
+    _physics(tag, "wb_motor_get_force_feedback")
+    return _NAN
+
+
+@answers(None)
+def wb_motor_enable_torque_feedback(tag: int, sampling_period: int) -> None:
+    _feedback_period(tag, "torque_feedback", sampling_period, "wb_motor_enable_torque_feedback")
+
+
+@answers(None)
+def wb_motor_disable_torque_feedback(tag: int) -> None:
+    _feedback_period(tag, "torque_feedback", 0, "wb_motor_disable_torque_feedback")
+
+
+@answers(0)
+def wb_motor_get_torque_feedback_sampling_period(tag: int) -> int:
+    return int(_motor(tag, "wb_motor_get_torque_feedback_sampling_period")._consts.get("torque_feedback", 0))
+
+
+@answers(_NAN)
+def wb_motor_get_torque_feedback(tag: int) -> float:
+    _physics(tag, "wb_motor_get_torque_feedback")
+    return _NAN
 
 
 # ---------------------------------------------------------------------- LED

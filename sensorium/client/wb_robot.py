@@ -7,11 +7,14 @@ process-wide robot of the flat ``wb_robot_*`` functions, and ``wb_device_*``.
 from __future__ import annotations
 
 import atexit
+import functools
 import math
 import sys
-from typing import Any
+from collections import deque
+from collections.abc import Callable
+from typing import Any, TypeVar
 
-from sensorium.client import arrays
+from sensorium.client import arrays, nodes
 from sensorium.client.connection import (
     DEFAULT_TIMEOUT,
     Connection,
@@ -36,8 +39,15 @@ LIGHT_SENSOR = "LightSensor"
 DISTANCE_SENSOR = "DistanceSensor"
 LIDAR = "Lidar"
 ROTATIONAL_MOTOR = "RotationalMotor"
+LINEAR_MOTOR = "LinearMotor"
 POSITION_SENSOR = "PositionSensor"
 LED = "LED"
+EMITTER = "Emitter"
+RECEIVER = "Receiver"
+
+WB_CHANNEL_BROADCAST = -1
+
+globals().update(nodes.WEBOTS_NODE_TYPES)      # WB_NODE_GPS, ... (Webots' values)
 
 # wb_robot_get_mode()
 WB_MODE_SIMULATION = 0
@@ -107,12 +117,41 @@ def _float(v: Any, default: float) -> float:
     return default if v is None else float(v)
 
 
-class DeviceState:
-    """What the client knows about one device: its description, enable state and latest reading."""
+class NoValue(Exception):
+    """Raised by :meth:`RobotClient.device` for a device Sensorium lists but does not simulate; the
+    public function catches it and answers Webots' "no value" (:func:`answers`)."""
 
-    __slots__ = ("tag", "index", "name", "kind", "desc", "sampling_period", "value", "range_bytes",
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def answers(no_value: Any) -> Callable[[F], F]:
+    """Decorate a device function: for a listed-only device it returns ``no_value`` (a fresh copy
+    of a list) after the device's one warning line."""
+    def wrap(fn: F) -> F:
+        @functools.wraps(fn)
+        def call(*args: Any, **kwargs: Any) -> Any:
+            try:
+                return fn(*args, **kwargs)
+            except NoValue:
+                return list(no_value) if isinstance(no_value, list) else no_value
+        return call  # type: ignore[return-value]
+    return wrap
+
+
+def _nans(n: int) -> list[float]:
+    return [math.nan] * n
+
+
+class DeviceState:
+    """What the client knows about one device: its description, enable state and latest reading
+    (an emitter's and a receiver's packet queues too)."""
+
+    __slots__ = ("tag", "index", "name", "kind", "desc", "simulated", "node_type", "model", "sampling_period",
+                 "value", "values", "speed", "speed_vector", "quaternion", "roll_pitch_yaw", "range_bytes",
                  "cloud_bytes", "point_cloud_enabled", "max_velocity", "target_position", "velocity",
-                 "_consts", "_range", "_cloud", "_warned", "camera")
+                 "channel", "range", "queue", "queue_bytes", "bytes_to_send",
+                 "_consts", "_range", "_cloud", "_warned", "_warned_unsimulated", "camera")
 
     def __init__(self, index: int, desc: dict):
         self.index = index
@@ -120,8 +159,16 @@ class DeviceState:
         self.name = str(desc.get("name", f"device{index}"))
         self.kind = str(desc.get("type", ""))
         self.desc = desc
+        self.simulated = bool(desc.get("simulated", True))
+        self.node_type = nodes.node_type(self.kind)
+        self.model = str(desc.get("model", "") or "")
         self.sampling_period = int(desc.get("sampling_period", desc.get("samplingPeriod", 0)) or 0)
         self.value = math.nan
+        self.values = _nans(3)                   # GPS, Compass, Accelerometer, Gyro, force-3d TouchSensor
+        self.speed = math.nan                    # GPS
+        self.speed_vector = _nans(3)
+        self.quaternion = _nans(4)               # InertialUnit
+        self.roll_pitch_yaw = _nans(3)
         self.range_bytes: bytes | None = None
         self.cloud_bytes: bytes | None = None
         self.point_cloud_enabled = bool(desc.get("point_cloud_enabled", desc.get("pointCloudEnabled", False)))
@@ -129,11 +176,19 @@ class DeviceState:
         self.max_velocity = _float(desc.get("maxVelocity", desc.get("max_velocity")), 10.0)   # Webots' default
         self.target_position = _float(desc.get("targetPosition", desc.get("target_position")), 0.0)
         self.velocity = _float(desc.get("velocity"), self.max_velocity)       # libController starts at maxVelocity
+        # emitter / receiver: the channel and range as this controller set them, the packet queue
+        # (an emitter's: (data, channel, range) waiting for the baud rate; a receiver's: what arrived)
+        self.channel = int(desc.get("channel", 0) or 0)
+        self.range = _float(desc.get("range"), -1.0)
+        self.queue: deque[Any] = deque()
+        self.queue_bytes = 0
+        self.bytes_to_send = 0.0
         self._consts: dict[str, Any] = {}
         self._range: Any = None                  # decoded forms, rebuilt when new bytes arrive
         self._cloud: Any = None
         self._warned = False
         self.camera: dict[str, Any] = {}         # a camera's latest readings (wb_camera.py): image, recognition
+        self._warned_unsimulated = False
 
     def __repr__(self) -> str:
         return f"<{self.kind} {self.name!r} tag={self.tag} period={self.sampling_period}>"
@@ -182,6 +237,7 @@ class RobotClient:
         self._warned_duration = False
         self.devices = [DeviceState(i, d) for i, d in enumerate(reply.get("devices", []))]
         self.by_name = {d.name: d for d in self.devices}
+        self._emitters = [d for d in self.devices if d.kind == EMITTER and d.simulated]
         self.motor_commands: dict[str, dict[str, float]] = {}   # sent with the next step request
         self._prefix = f"/{self.name}/"
         self.conn.start_heartbeat(self.session, self.heartbeat_ms, lost_after_s)
@@ -217,8 +273,32 @@ class RobotClient:
         args: dict[str, Any] = {"duration": duration}
         if self.motor_commands:
             args["motors"], self.motor_commands = self.motor_commands, {}
+        packets = self._emitted(duration)
+        if packets:
+            args["emitters"] = packets
         self.pending = self.conn.send(self._prefix + "robot/step", args)
         return 0
+
+    def _emitted(self, duration: int) -> dict[str, list[dict]]:
+        """The packets each emitter's baud rate lets leave with this step (libController's rule:
+        ``byte_rate × duration`` more bytes may go while packets wait; a packet leaves whole)."""
+        out: dict[str, list[dict]] = {}
+        for dev in self._emitters:
+            q = dev.queue
+            if not q:
+                continue
+            rate = float(dev.desc.get("byte_rate", -1.0))
+            if rate != -1.0:
+                dev.bytes_to_send += rate * duration
+            sent = []
+            while q and (rate == -1.0 or len(q[0][0]) <= dev.bytes_to_send):
+                data, channel, range_m = q.popleft()
+                dev.queue_bytes -= len(data)
+                dev.bytes_to_send -= len(data)
+                sent.append({"data": data, "channel": channel, "range": range_m})
+            if sent:
+                out[dev.name] = sent
+        return out
 
     def step_end(self) -> int:
         if self.pending is None:
@@ -274,6 +354,13 @@ class RobotClient:
             if "value" in reading:
                 v = reading["value"]
                 dev.value = math.nan if v is None else float(v)
+            for key in ("values", "speed_vector", "quaternion", "roll_pitch_yaw"):
+                if key in reading:
+                    setattr(dev, key, [math.nan if x is None else float(x) for x in reading[key]])
+            if "speed" in reading:
+                dev.speed = math.nan if reading["speed"] is None else float(reading["speed"])
+            if "packets" in reading:
+                self._received(dev, reading["packets"])
             if "range_image" in reading:
                 dev.range_bytes = bytes(reading["range_image"])
                 dev._range = None
@@ -284,14 +371,40 @@ class RobotClient:
                 if key in reading:
                     dev.camera[key] = reading[key]
 
+    @staticmethod
+    def _received(dev: DeviceState, packets: Any) -> None:
+        """A receiver's new packets join its queue while they fit its buffer (libController drops
+        a packet larger than the room left)."""
+        size = int(dev.desc.get("buffer_size", -1))
+        for p in packets or ():
+            data = bytes(p.get("data", b""))
+            if size == -1 or len(data) <= size - dev.queue_bytes:
+                direction = [math.nan if x is None else float(x) for x in p.get("direction", (None,) * 3)]
+                dev.queue.append((data, float(p.get("signal_strength", math.nan)), direction))
+                dev.queue_bytes += len(data)
+
     # ------------------------------------------------------------------ devices
     def device(self, tag: int, kind: str | None, func: str) -> DeviceState:
+        """The device of ``tag`` if it is a ``kind`` (``None``: any). A listed-only device of that
+        kind prints its one warning and raises :class:`NoValue` (see :func:`answers`)."""
         if isinstance(tag, int) and not isinstance(tag, bool) and 1 <= tag <= len(self.devices):
             dev = self.devices[tag - 1]
-            if kind is None or dev.kind == kind:
+            if kind is None:
+                return dev
+            if dev.kind == kind or (kind == ROTATIONAL_MOTOR and dev.kind == LINEAR_MOTOR):
+                if not dev.simulated:
+                    self.warn_unsimulated(dev, func)
+                    raise NoValue(func)
                 return dev
             raise SensoriumError(ErrorCode.UNKNOWN_DEVICE, f"{func}(): device tag {tag} is {dev.name!r}, a {dev.kind}, not a {kind}")
         raise SensoriumError(ErrorCode.UNKNOWN_DEVICE, f"{func}(): invalid device tag {tag!r}")
+
+    @staticmethod
+    def warn_unsimulated(dev: DeviceState, func: str) -> None:
+        if not dev._warned_unsimulated:
+            dev._warned_unsimulated = True
+            print(f"Warning: {func}(): Sensorium does not simulate {dev.kind} '{dev.name}': its functions answer "
+                  f"Webots' \"no value\" (NaN, None, 0).", file=sys.stderr)
 
     def tag_of(self, name: str) -> int:
         dev = self.by_name.get(name)
@@ -515,6 +628,16 @@ def wb_robot_get_device_by_index(index: int) -> int:
 
 def wb_device_get_name(tag: int) -> str:
     return current().device(tag, None, "wb_device_get_name").name
+
+
+def wb_device_get_model(tag: int) -> str:
+    """The device's Webots ``model`` field ("" when the world gives none)."""
+    return current().device(tag, None, "wb_device_get_model").model
+
+
+def wb_device_get_node_type(tag: int) -> int:
+    """Webots' ``WB_NODE_*`` value of the device's type (``WB_NODE_GPS``, ...)."""
+    return current().device(tag, None, "wb_device_get_node_type").node_type
 
 
 def wb_robot_get_model() -> str:

@@ -236,6 +236,16 @@ register(DeviceKind(
     rays=lambda cfg, lights: int(cfg.width) * int(cfg.height) * (4 if cfg.anti_aliasing else 1),
     ray_bound=("", "rays (width × height, × 4 anti-aliased):", "rays_per_image"),
     description="CameraDescription"))
+# Emitter and Receiver (server/sim/radio.py): packets travel with step requests and replies, no topics
+# (a packet is the receiving controller's, taken from the receiver when it reads it).
+register(DeviceKind(
+    "Emitter", wm.Emitter, "sensorium.server.sim.radio:Emitter",
+    services=("get_channel", "set_channel", "get_range", "set_range", "get_buffer_size"),
+    description="EmitterDescription"))
+register(DeviceKind(
+    "Receiver", wm.Receiver, "sensorium.server.sim.radio:Receiver",
+    services=(*_SENSOR, "get_channel", "set_channel", "get_buffer_size"),
+    description="ReceiverDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(

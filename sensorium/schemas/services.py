@@ -24,6 +24,7 @@ __all__ = ["ErrorCode", "PROTOCOL_VERSION", "SERVICES", "ServiceSpec", "service_
 
 MAX_PERIOD_MS = (1 << 31) - 1
 MAX_MOTOR_COMMANDS = 256        # per step request (a robot has a handful of motors)
+MAX_EMITTERS = 256              # emitters named in one step request
 Mode = Literal["fast", "realtime", "pause"]
 FieldName = Literal["translation", "rotation"]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
@@ -117,6 +118,22 @@ class MotorCommand(Args):
         return v
 
 
+class PacketOut(Args):
+    """One packet a controller's emitter sends with a step request (Webots' C_EMITTER_SEND): its
+    bytes and the emitter's channel and range when the controller sent it."""
+
+    data: bytes = Field(min_length=1, description="the packet (at least 1 byte)")
+    channel: int = Field(ge=-1, le=(1 << 31) - 1, description="-1: every channel")
+    range: float = Field(description="m; -1: unlimited")
+
+    @field_validator("range")
+    @classmethod
+    def _range(cls, v: float) -> float:
+        if v != -1.0 and not v >= 0.0:
+            raise ValueError("range must be -1 or >= 0")
+        return v
+
+
 class StepArgs(Args):
     duration: int | None = Field(default=None, ge=0, le=MAX_PERIOD_MS,
                                  description="ms; default: one basic step. Not a multiple of the basic step: rounded "
@@ -125,6 +142,9 @@ class StepArgs(Args):
     motors: dict[str, MotorCommand] | None = Field(
         default=None, description="motor name -> commands, applied when the request arrives (before the world advances); "
                                   f"at most {MAX_MOTOR_COMMANDS}")
+    emitters: dict[str, list[PacketOut]] | None = Field(
+        default=None, description="emitter name -> the packets its controller sent since the previous step (as its "
+                                  "baud rate let them leave), in order; they travel at the next basic step")
 
     @model_validator(mode="before")
     @classmethod
@@ -133,7 +153,18 @@ class StepArgs(Args):
         motors = data.get("motors") if isinstance(data, dict) else None
         if isinstance(motors, dict) and len(motors) > MAX_MOTOR_COMMANDS:
             raise ValueError(f"motors: {len(motors)} commands, at most {MAX_MOTOR_COMMANDS} per step")
+        emitters = data.get("emitters") if isinstance(data, dict) else None
+        if isinstance(emitters, dict) and len(emitters) > MAX_EMITTERS:
+            raise ValueError(f"emitters: {len(emitters)} emitters, at most {MAX_EMITTERS} per step")
         return data
+
+
+class ChannelArgs(Args):
+    value: int = Field(ge=-1, le=(1 << 31) - 1, description="-1: every channel")
+
+
+class RangeArgs(Args):
+    value: float = Field(description="m; -1: the maximum range")
 
 
 class TimeStepArgs(Args):
@@ -409,6 +440,30 @@ class TouchSensorDescription(_Entry):
     lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
 
 
+class EmitterDescription(_Entry):
+    type: Literal["Emitter"]
+    medium: Literal["radio", "serial", "infra-red"]
+    channel: int = Field(description="the current channel (-1: broadcast)")
+    range: float = Field(description="m, the current range; -1: unlimited")
+    max_range: float = Field(description="m; -1: unlimited")
+    aperture: float = Field(description="rad, infra-red cone; -1: every direction")
+    buffer_size: int = Field(description="bytes the controller's queue holds; -1: unlimited")
+    byte_rate: float = Field(description="bytes per ms the controller may send (baudRate / byteSize / 1000); -1: unlimited")
+    allowed_channels: list[int] = Field(description="empty: any channel")
+
+
+class ReceiverDescription(_Entry):
+    type: Literal["Receiver"]
+    sampling_period: int
+    medium: Literal["radio", "serial", "infra-red"]
+    channel: int = Field(description="the current channel (-1: every channel)")
+    aperture: float
+    buffer_size: int = Field(description="bytes the controller's queue holds; -1: unlimited")
+    allowed_channels: list[int]
+    signal_strength_noise: float
+    direction_noise: float
+
+
 class LEDDescription(_Entry):
     type: Literal["LED"]
     value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
@@ -439,6 +494,7 @@ DeviceDescription = Annotated[
     | Annotated[GyroDescription, Tag("Gyro")] | Annotated[AltimeterDescription, Tag("Altimeter")]
     | Annotated[TouchSensorDescription, Tag("TouchSensor")] | Annotated[PenDescription, Tag("Pen")]
     | Annotated[RangeFinderDescription, Tag("RangeFinder")] | Annotated[CameraDescription, Tag("Camera")]
+    | Annotated[EmitterDescription, Tag("Emitter")] | Annotated[ReceiverDescription, Tag("Receiver")]
     | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -476,10 +532,31 @@ class LidarReading(Result):
                                                                 "present while the point cloud is enabled")
 
 
+class VectorReading(Result):
+    """A GPS, InertialUnit, Compass, Accelerometer, Gyro or force-3d TouchSensor reading: the keys
+    its getters read (NaN before the first measurement)."""
+
+    values: list[float] | None = Field(default=None, description="GPS, Compass, Accelerometer, Gyro, force-3d TouchSensor")
+    speed: float | None = Field(default=None, description="GPS (m/s)")
+    speed_vector: list[float] | None = Field(default=None, description="GPS (m/s)")
+    quaternion: list[float] | None = Field(default=None, description="InertialUnit: x, y, z, w")
+    roll_pitch_yaw: list[float] | None = Field(default=None, description="InertialUnit (rad)")
+
+
+class PacketIn(Result):
+    data: bytes
+    signal_strength: float = Field(description="1/r² (r: emitter-receiver distance), with the receiver's noise")
+    direction: list[float] = Field(description="unit vector to the emitter in the receiver frame")
+
+
+class ReceiverReading(Result):
+    packets: list[PacketIn] = Field(description="the packets that became readable since the previous reply, oldest first")
+
+
 class StepResult(Result):
     status: int = Field(description="0; -1 when the server quits; the lateness dt (ms) for asynchronous robots")
     time_ms: int
-    values: dict[str, ScalarReading | LidarReading]
+    values: dict[str, ScalarReading | LidarReading | VectorReading | ReceiverReading]
 
 
 class SuccessResult(Result):
@@ -708,6 +785,11 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("enable_segmentation", "device", BoolArgs, SuccessResult, attached=True),
     ServiceSpec("is_segmentation_enabled", "device", NoArgs, StatusResult),
     ServiceSpec("get_recognition_objects", "device", NoArgs, RecognitionObjectsResult),
+    ServiceSpec("get_channel", "device", NoArgs, IntValue),
+    ServiceSpec("set_channel", "device", ChannelArgs, SuccessResult, attached=True),
+    ServiceSpec("get_range", "device", NoArgs, FloatValue),
+    ServiceSpec("set_range", "device", RangeArgs, SuccessResult, attached=True),
+    ServiceSpec("get_buffer_size", "device", NoArgs, IntValue),
 )
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 Vec3 = tuple[float, float, float]
 
@@ -559,6 +559,88 @@ class Camera(_Device):
         return self
 
 
+def _minus_one_or_positive(name: str, v: float) -> float:
+    if v != -1 and not v > 0:
+        raise ValueError(f"{name} must be -1 (unlimited) or > 0, got {v}")
+    return v
+
+
+def _medium(v: object) -> object:
+    if isinstance(v, str):
+        v = v.lower()
+        return "infra-red" if v == "infrared" else v
+    return v
+
+
+Medium = Annotated[Literal["radio", "serial", "infra-red"], BeforeValidator(_medium)]
+
+
+class _Radio(_Device):
+    """What Webots' Emitter and Receiver share: the medium (``radio`` and ``serial`` ignore
+    obstacles; ``infra-red`` is blocked by bounding objects and has a cone), the channel (-1:
+    every channel), ``allowed_channels`` (empty: any), the transmission buffer in bytes (-1:
+    unlimited), Webots' baud rate and byte size."""
+
+    type: Medium = "radio"
+    aperture: float = Field(default=-1.0, description="infra-red cone opening (rad) around the device's x axis; -1: "
+                                                      "every direction")
+    channel: int = Field(default=0, ge=-1, le=(1 << 31) - 1)
+    baud_rate: int = Field(default=-1, ge=-1, le=(1 << 31) - 1, description="bits per second; -1: unlimited")
+    byte_size: int = Field(default=8, ge=8, le=(1 << 31) - 1, description="bits per byte on the wire")
+    buffer_size: int = Field(default=-1, ge=-1, le=(1 << 31) - 1, description="bytes; -1: unlimited")
+    allowed_channels: list[int] = Field(default=[], max_length=4096)
+
+    @field_validator("aperture")
+    @classmethod
+    def _aperture(cls, v: float) -> float:
+        if v != -1 and not 0.0 <= v <= 2 * math.pi:
+            raise ValueError(f"aperture must be -1 or within [0, 2*pi], got {v}")
+        return v
+
+    @field_validator("baud_rate", "buffer_size")
+    @classmethod
+    def _unlimited_or_positive(cls, v: int, info: ValidationInfo) -> int:
+        return int(_minus_one_or_positive(str(info.field_name), v))
+
+    @model_validator(mode="after")
+    def _allowed(self) -> _Radio:
+        if self.allowed_channels and self.channel not in self.allowed_channels:
+            raise ValueError(f"channel {self.channel} is not one of allowed_channels {self.allowed_channels}")
+        return self
+
+
+class Emitter(_Radio):
+    """Webots Emitter: packets a controller sends reach the enabled receivers of other robots on the
+    same medium and channel within ``range`` (m, -1: unlimited; ``set_range`` is capped at
+    ``max_range``), at the next basic step; infra-red ones only inside its cone and with no bounding
+    object in between (README "Emitter and Receiver")."""
+
+    device: Literal["Emitter"]
+    range: float = Field(default=-1.0, description="m; -1: unlimited")
+    max_range: float = Field(default=-1.0, description="m, the largest range set_range may set; -1: unlimited")
+
+    @field_validator("range", "max_range")
+    @classmethod
+    def _range(cls, v: float, info: ValidationInfo) -> float:
+        return _minus_one_or_positive(str(info.field_name), v)
+
+    @model_validator(mode="after")
+    def _within_max(self) -> Emitter:
+        if self.max_range != -1 and (self.range == -1 or self.range > self.max_range):
+            raise ValueError(f"range {self.range} exceeds max_range {self.max_range}")
+        return self
+
+
+class Receiver(_Radio):
+    """Webots Receiver: queues the packets of emitters on its medium and channel while enabled; the
+    controller reads them at the receiver's sampling period, each with the signal strength 1/r²
+    and the emitter's direction in the receiver frame (Gaussian noise per Webots' fields)."""
+
+    device: Literal["Receiver"]
+    signal_strength_noise: float = Field(default=0.0, ge=0.0, description="relative σ of the signal strength")
+    direction_noise: float = Field(default=0.0, ge=0.0, description="σ of each direction component, times the distance")
+
+
 class RotationalMotor(_Device):
     """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
     motors *is* that motor, at this index of the device list (a drive motor without an entry comes
@@ -569,7 +651,7 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Connector", "Display", "Emitter", "LinearMotor", "Microphone", "Radar", "Radio", "Receiver", "Skin",
+    "Brake", "Connector", "Display", "LinearMotor", "Microphone", "Radar", "Radio", "Skin",
     "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -585,13 +667,13 @@ class UnsimulatedDevice(_Device):
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
-                   | Accelerometer | Gyro | Altimeter | TouchSensor | RotationalMotor | Pen | RangeFinder | Camera
-                   | UnsimulatedDevice,
+                   | Accelerometer | Gyro | Altimeter | TouchSensor | Emitter | Receiver | RotationalMotor | Pen
+                   | RangeFinder | Camera | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
-                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "RotationalMotor", "Pen", "RangeFinder",
-                "Camera", *UNSIMULATED_DEVICE_TYPES)
+                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "Emitter", "Receiver", "RotationalMotor", "Pen",
+                "RangeFinder", "Camera", *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
 

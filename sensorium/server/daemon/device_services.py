@@ -130,6 +130,29 @@ class DeviceServices:
     def _dev_get_recognition_objects(self, c: Call) -> dict:
         return {"value": [o.as_dict() for o in c.ctl.device.objects]}
 
+    def _dev_get_channel(self, c: Call) -> dict:
+        return {"value": int(c.ctl.device.channel)}
+
+    def _dev_set_channel(self, c: Call) -> dict:
+        try:
+            c.ctl.device.set_channel(c.args.value)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_channel: {exc}") from None
+        return {"success": True}
+
+    def _dev_get_range(self, c: Call) -> dict:
+        return {"value": float(c.ctl.device.range)}
+
+    def _dev_set_range(self, c: Call) -> dict:
+        try:
+            c.ctl.device.set_range(c.args.value)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_range: {exc}") from None
+        return {"success": True}
+
+    def _dev_get_buffer_size(self, c: Call) -> dict:
+        return {"value": int(c.ctl.device.config.buffer_size)}
+
     def _dev_set(self, c: Call) -> dict:
         try:
             c.ctl.device.set(c.args.value, self.sim.time_ms)

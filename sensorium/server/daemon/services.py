@@ -486,19 +486,47 @@ class Core(DeviceServices):
         if self._retried_step(c):
             return _DEFERRED
         commands = self._motor_commands(c.robot, c.args.motors) if c.args.motors else []
+        packets = self._emitter_packets(c.robot, c.args.emitters) if c.args.emitters else []
         if c.args.duration == 0:
             # Webots' step(0): deliver the commands and the values not yet read, time stands still
             s = self._session(c)
             if s.pending is not None:
                 raise ServiceError(ErrorCode.WRONG_STATE, f"robot {c.robot!r} already has a step pending")
             self._apply_motor_commands(commands)
+            self._queue_packets(packets)
             return {"status": 0, "time_ms": self.sim.time_ms, "values": self._new_values(s)}
         done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.duration, c.now)
         if done is not None:                                 # quitting: -1 at once
             return {"status": done.status, "time_ms": done.time_ms, "values": {}}
         # the world has not advanced since the request arrived: Webots' "at the start of the step"
         self._apply_motor_commands(commands)
+        self._queue_packets(packets)
         return _DEFERRED
+
+    def _emitter_packets(self, robot: str, emitters: dict[str, Any]) -> list[tuple[Any, Any]]:
+        """(emitter device, packets) of a step request; every name resolved first, so that a bad
+        one queues none of them."""
+        r = self.sim.robots[robot]
+        out = []
+        for name, packets in emitters.items():
+            dev = r.devices.get(name)
+            if dev is None or dev.kind != "Emitter":
+                what = f"is a {dev.kind}, not an emitter" if dev is not None else "is no device of the robot"
+                raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: emitters: {robot}/{name} {what}")
+            allowed = dev.config.allowed_channels
+            for p in packets:
+                if allowed and p.channel not in allowed:
+                    raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"step: emitters: {robot}/{name}: channel "
+                                                                   f"{p.channel} is not one of allowed_channels {list(allowed)}")
+            out.append((dev, packets))
+        return out
+
+    @staticmethod
+    def _queue_packets(packets: list[tuple[Any, Any]]) -> None:
+        # the emitter takes each packet's channel and range, as Webots' emitter node does
+        for dev, items in packets:
+            for p in items:
+                dev.send(p.data, channel=p.channel, range_m=p.range)
 
     @staticmethod
     def _apply_motor_commands(commands: list[tuple[Any, Any]]) -> None:

@@ -27,6 +27,7 @@ from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
+from sensorium.server.sim.radio import Emitter, Radio, Receiver
 from sensorium.server.sim.scene import Scene, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
     LED,
@@ -202,6 +203,9 @@ class Simulation:
         self._joined_mounts: dict[tuple, tuple[list, Mount]] = {}        # see _joined_mount
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = self._build_contact() if use_contact and self._driven else None
+        every = list(self.all_devices())
+        self.radio = Radio([d for d in every if isinstance(d, Emitter)], [d for d in every if isinstance(d, Receiver)],
+                           self.scene, self._counters)
         self._initial: dict[str, Any] = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
                          "solids": dict(self.scene.solid_poses)}
 
@@ -238,6 +242,7 @@ class Simulation:
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
                     dev.set(0, self.time_ms)
+        self.radio.reset()
         for name, pose in self._initial["solids"].items():
             self.scene.set_solid_pose(name, pose)
             if self.contact is not None:
@@ -316,6 +321,9 @@ class Simulation:
         self.step_count += 1
         now = self.time_ms
         dt = self.basic_time_step
+        radio = self.radio if self.radio else None
+        if radio is not None:
+            radio.forward()           # packets sent with the step requests leave before anything moves
         if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
@@ -340,6 +348,8 @@ class Simulation:
         for robot, _, _, pose in moved:
             self.scene.set_robot_pose(robot.index, pose)
         poses = self.scene.robot_poses
+        if radio is not None:
+            radio.deliver(poses)      # range, cones, line of sight and readings at the end-of-step poses
         if self._by_kind is None:   # devices never change after loading: sort them by kind once
             every = list(self.all_devices())
             self._by_kind = ([d for d in every if isinstance(d, LightSensor)],

@@ -4,8 +4,11 @@
  *             the heartbeat thread;
  * wire.c    - msgpack helpers (building requests, reading reply maps);
  * robot.c   - the session: attach, step (motor commands out, readings in), cleanup;
- * devices.c - light and distance sensors, generic device functions; lidar.c; motor.c;
- * camera.c  - range finders and cameras.
+ * devices.c - light and distance sensors, generic device functions; lidar.c; motor.c; gps.c;
+ * kinematic.c - InertialUnit, Compass, Accelerometer, Gyro, Altimeter, TouchSensor;
+ * radio.c   - Emitter and Receiver (packet queues, baud-rate pacing);
+ * camera.c  - range finders and cameras;
+ * unsimulated.c - the devices Sensorium lists without simulating ("no value").
  */
 #ifndef SENSORIUM_INTERNAL_H
 #define SENSORIUM_INTERNAL_H
@@ -102,10 +105,24 @@ void sn_conn_stop_heartbeat(sn_conn *c);
 const char *sn_conn_endpoint(const sn_conn *c);
 
 /* ------------------------------------------------------------------ robot.c */
-typedef enum { SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_RANGE_FINDER, SN_CAMERA,
-               SN_OTHER } sn_kind;
+typedef enum {
+  SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_IMU, SN_COMPASS, SN_ACCELEROMETER,
+  SN_GYRO, SN_ALTIMETER, SN_TOUCH, SN_EMITTER, SN_RECEIVER, SN_RANGE_FINDER, SN_CAMERA, SN_OTHER
+} sn_kind;
 
 struct sn_imaging; /* camera.c: a range finder's or camera's images and constants */
+
+/* A packet in an emitter's queue (channel and range when sent) or a receiver's (signal strength,
+ * emitter direction); data follows the struct. */
+typedef struct sn_packet {
+  struct sn_packet *next;
+  int size;
+  int channel;
+  double range;
+  double signal;
+  double direction[3];
+  unsigned char data[];
+} sn_packet;
 
 typedef struct {
   WbDeviceTag tag;
@@ -139,9 +156,22 @@ typedef struct {
   int coordinate_system;
   /* range finder, camera (camera.c) */
   struct sn_imaging *imaging;
+  /* Compass, Accelerometer, Gyro, force-3d TouchSensor: values; InertialUnit: quaternion (x, y, z, w),
+     roll/pitch/yaw, noise */
+  double values[3], quaternion[4], roll_pitch_yaw[3], noise;
+  /* Emitter / Receiver: channel and range as this controller set them, the world's constants, the
+     packet queue (bytes used; an emitter's byte budget of libController's baud-rate rule) */
+  int channel, buffer_size, n_allowed, sending;
+  int *allowed;
+  double range, emitter_max_range, byte_rate, bytes_to_send;
+  sn_packet *queue, *queue_tail;
+  int queue_length;
+  long queue_bytes;
   /* motor */
-  double max_velocity, min_position, max_position, target_position, velocity;
+  double max_velocity, min_position, max_position, target_position, velocity, acceleration;
   bool cmd_position, cmd_velocity; /* to send with the next step */
+  bool warned_physics;             /* a physics-only motor function was called (one warning) */
+  int force_feedback_period, torque_feedback_period;
 } sn_device;
 
 typedef struct {
@@ -191,6 +221,13 @@ const double *sn_no_values(void);
 /* Webots' node type of a device type name ("DistanceSensor"), WB_NODE_NO_NODE if unknown. */
 int sn_node_type_of(const char *type_name);
 void sn_warn_disabled(sn_device *dev, const char *func, const char *enabler, const char *what);
+/* radio.c: the packets of a step reply into a receiver's queue; an emitter's packets into a step request
+   (sn_radio_pace counts those its baud rate lets leave with a step of duration ms, sn_radio_pack writes
+   them as "name": [{"data", "channel", "range"}, ...] and drops them from the queue) */
+void sn_radio_receive(sn_device *dev, const msgpack_object *packets);
+int sn_radio_pace(sn_device *dev, int duration);
+void sn_radio_pack(sn_device *dev, sn_req *r);
+void sn_radio_free(sn_device *dev);
 
 /* ------------------------------------------------------------------ camera.c */
 /* A range finder's or camera's state from its attach description (0, or -1 on a bad one); its

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include <webots/motor.h>
+#include <webots/nodes.h>
 
 #include "internal.h"
 
@@ -71,9 +72,15 @@ double wb_motor_get_max_velocity(WbDeviceTag tag) {
 }
 
 WbJointType wb_motor_get_type(WbDeviceTag tag) {
-  MOTOR("wb_motor_get_type");
-  (void)d;
-  return WB_ROTATIONAL;
+  /* the joint type is the node's, whether Sensorium simulates the motor or not */
+  sn_device *d = sn_device_get(tag, SN_OTHER, "wb_motor_get_type");
+  if (d == NULL)
+    return WB_ROTATIONAL;
+  if (d->node_type != WB_NODE_ROTATIONAL_MOTOR && d->node_type != WB_NODE_LINEAR_MOTOR) {
+    fprintf(stderr, "Error: wb_motor_get_type(): device tag %u is '%s', a %s\n", (unsigned)tag, d->name, d->type_name);
+    return WB_ROTATIONAL;
+  }
+  return d->node_type == WB_NODE_LINEAR_MOTOR ? WB_LINEAR : WB_ROTATIONAL;
 }
 
 WbDeviceTag wb_motor_get_position_sensor(WbDeviceTag tag) {
@@ -93,4 +100,106 @@ WbDeviceTag wb_motor_get_brake(WbDeviceTag tag) {
   MOTOR("wb_motor_get_brake");
   (void)d;
   return 0;
+}
+
+/* ------------------------------------------------------------------ what needs physics */
+
+static sn_device *physics(WbDeviceTag tag, const char *func) {
+  sn_device *d = sn_device_get(tag, SN_MOTOR, func);
+  if (d != NULL && !d->warned_physics) {
+    d->warned_physics = true;
+    fprintf(stderr, "Warning: %s(): %s '%s' is a kinematic wheel: accelerations, forces, torques and PID gains are "
+            "ignored, force and torque feedback read NaN.\n", func, d->type_name, d->name);
+  }
+  return d;
+}
+
+void wb_motor_set_acceleration(WbDeviceTag tag, double acceleration) {
+  sn_device *d = physics(tag, "wb_motor_set_acceleration");
+  if (d != NULL)
+    d->acceleration = acceleration;
+}
+double wb_motor_get_acceleration(WbDeviceTag tag) {
+  MOTOR("wb_motor_get_acceleration");
+  return d ? d->acceleration : NAN;
+}
+void wb_motor_set_available_force(WbDeviceTag tag, double force) {
+  (void)force;
+  physics(tag, "wb_motor_set_available_force");
+}
+double wb_motor_get_available_force(WbDeviceTag tag) {
+  physics(tag, "wb_motor_get_available_force");
+  return NAN;
+}
+double wb_motor_get_max_force(WbDeviceTag tag) {
+  physics(tag, "wb_motor_get_max_force");
+  return NAN;
+}
+void wb_motor_set_available_torque(WbDeviceTag tag, double torque) {
+  (void)torque;
+  physics(tag, "wb_motor_set_available_torque");
+}
+double wb_motor_get_available_torque(WbDeviceTag tag) {
+  physics(tag, "wb_motor_get_available_torque");
+  return NAN;
+}
+double wb_motor_get_max_torque(WbDeviceTag tag) {
+  physics(tag, "wb_motor_get_max_torque");
+  return NAN;
+}
+void wb_motor_set_control_pid(WbDeviceTag tag, double p, double i, double d) {
+  (void)p;
+  (void)i;
+  (void)d;
+  physics(tag, "wb_motor_set_control_pid");
+}
+double wb_motor_get_multiplier(WbDeviceTag tag) {
+  MOTOR("wb_motor_get_multiplier");
+  return d ? 1.0 : NAN;
+}
+void wb_motor_set_force(WbDeviceTag tag, double force) {
+  (void)force;
+  physics(tag, "wb_motor_set_force");
+}
+void wb_motor_set_torque(WbDeviceTag tag, double torque) {
+  (void)torque;
+  physics(tag, "wb_motor_set_torque");
+}
+
+static void feedback_period(WbDeviceTag tag, bool torque, int period, const char *func) {
+  sn_device *d = physics(tag, func);
+  if (d == NULL)
+    return;
+  if (period < 0) {
+    fprintf(stderr, "Error: %s(): negative sampling period %d\n", func, period);
+    return;
+  }
+  if (torque)
+    d->torque_feedback_period = period;
+  else
+    d->force_feedback_period = period;
+}
+void wb_motor_enable_force_feedback(WbDeviceTag tag, int sampling_period) {
+  feedback_period(tag, false, sampling_period, "wb_motor_enable_force_feedback");
+}
+void wb_motor_disable_force_feedback(WbDeviceTag tag) { feedback_period(tag, false, 0, "wb_motor_disable_force_feedback"); }
+int wb_motor_get_force_feedback_sampling_period(WbDeviceTag tag) {
+  MOTOR("wb_motor_get_force_feedback_sampling_period");
+  return d ? d->force_feedback_period : 0;
+}
+double wb_motor_get_force_feedback(WbDeviceTag tag) {
+  physics(tag, "wb_motor_get_force_feedback");
+  return NAN;
+}
+void wb_motor_enable_torque_feedback(WbDeviceTag tag, int sampling_period) {
+  feedback_period(tag, true, sampling_period, "wb_motor_enable_torque_feedback");
+}
+void wb_motor_disable_torque_feedback(WbDeviceTag tag) { feedback_period(tag, true, 0, "wb_motor_disable_torque_feedback"); }
+int wb_motor_get_torque_feedback_sampling_period(WbDeviceTag tag) {
+  MOTOR("wb_motor_get_torque_feedback_sampling_period");
+  return d ? d->torque_feedback_period : 0;
+}
+double wb_motor_get_torque_feedback(WbDeviceTag tag) {
+  physics(tag, "wb_motor_get_torque_feedback");
+  return NAN;
 }

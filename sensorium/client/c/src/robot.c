@@ -63,6 +63,22 @@ static sn_kind kind_of(const char *type) {
     return SN_RANGE_FINDER;
   if (strcmp(type, "Camera") == 0)
     return SN_CAMERA;
+  if (strcmp(type, "InertialUnit") == 0)
+    return SN_IMU;
+  if (strcmp(type, "Compass") == 0)
+    return SN_COMPASS;
+  if (strcmp(type, "Accelerometer") == 0)
+    return SN_ACCELEROMETER;
+  if (strcmp(type, "Gyro") == 0)
+    return SN_GYRO;
+  if (strcmp(type, "Altimeter") == 0)
+    return SN_ALTIMETER;
+  if (strcmp(type, "TouchSensor") == 0)
+    return SN_TOUCH;
+  if (strcmp(type, "Emitter") == 0)
+    return SN_EMITTER;
+  if (strcmp(type, "Receiver") == 0)
+    return SN_RECEIVER;
   return SN_OTHER;
 }
 
@@ -104,8 +120,27 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
   d->simulated = sn_bool_or(desc, "simulated", true); /* servers before the device list said nothing */
   d->kind = d->simulated ? kind_of(d->type_name) : SN_OTHER;
   for (int i = 0; i < 3; i++)
-    d->gps_values[i] = d->gps_speed_vector[i] = NAN;
+    d->gps_values[i] = d->gps_speed_vector[i] = d->values[i] = d->roll_pitch_yaw[i] = NAN;
+  for (int i = 0; i < 4; i++)
+    d->quaternion[i] = NAN;
   d->gps_speed = NAN;
+  d->noise = sn_double_or(desc, "noise", 0.0);
+  d->channel = (int)sn_int_or(desc, "channel", 0);
+  d->range = sn_double_or(desc, "range", -1.0);
+  d->emitter_max_range = sn_double_or(desc, "max_range", -1.0);
+  d->byte_rate = sn_double_or(desc, "byte_rate", -1.0);
+  d->buffer_size = (int)sn_int_or(desc, "buffer_size", -1);
+  const msgpack_object *allowed = sn_get(desc, "allowed_channels");
+  if (allowed != NULL && allowed->type == MSGPACK_OBJECT_ARRAY && allowed->via.array.size > 0) {
+    d->allowed = calloc(allowed->via.array.size, sizeof(int));
+    if (d->allowed == NULL)
+      return -1;
+    for (uint32_t i = 0; i < allowed->via.array.size; i++) {
+      int64_t c;
+      if (sn_as_int64(&allowed->via.array.ptr[i], &c))
+        d->allowed[d->n_allowed++] = (int)c;
+    }
+  }
   d->coordinate_system = (int)sn_int_or(desc, "coordinate_system", 0);
   d->sampling_period = (int)sn_int_or(desc, "sampling_period", 0);
   d->value = NAN;
@@ -151,6 +186,7 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
   d->max_position = sn_double_or(desc, "maxPosition", 0.0);
   d->target_position = sn_double_or(desc, "targetPosition", 0.0);
   d->velocity = sn_double_or(desc, "velocity", d->max_velocity);
+  d->acceleration = -1.0; /* Webots' default: unlimited */
   return 0;
 }
 
@@ -167,6 +203,7 @@ static void free_robot(sn_robot *rb) {
     free(d->point_cloud);
     free(d->motor_name);
     sn_imaging_free(d);
+    sn_radio_free(d);
   }
   sn_supervisor_free(rb);
   free(rb->devices);
@@ -327,6 +364,16 @@ static float le_float(const unsigned char *p) {
   return f;
 }
 
+/* the n doubles of reading[key] into out (NaN for a non-number), when present with n elements */
+static void read_vector(const msgpack_object *reading, const char *key, double *out, uint32_t n) {
+  const msgpack_object *v = sn_get(reading, key);
+  if (v == NULL || v->type != MSGPACK_OBJECT_ARRAY || v->via.array.size != n)
+    return;
+  for (uint32_t j = 0; j < n; j++)
+    if (!sn_as_double(&v->via.array.ptr[j], &out[j]))
+      out[j] = NAN;
+}
+
 static void apply_values(sn_robot *rb, const msgpack_object *values) {
   if (values == NULL || values->type != MSGPACK_OBJECT_MAP)
     return;
@@ -347,17 +394,18 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
         dev->led_value = (int)x;
     }
     if (dev->kind == SN_GPS) {
-      const msgpack_object *pos = sn_get(v, "values"), *vel = sn_get(v, "speed_vector");
-      for (uint32_t j = 0; j < 3; j++) {
-        if (pos && pos->type == MSGPACK_OBJECT_ARRAY && pos->via.array.size == 3 && !sn_as_double(&pos->via.array.ptr[j], &dev->gps_values[j]))
-          dev->gps_values[j] = NAN;
-        if (vel && vel->type == MSGPACK_OBJECT_ARRAY && vel->via.array.size == 3 && !sn_as_double(&vel->via.array.ptr[j], &dev->gps_speed_vector[j]))
-          dev->gps_speed_vector[j] = NAN;
-      }
+      read_vector(v, "values", dev->gps_values, 3);
+      read_vector(v, "speed_vector", dev->gps_speed_vector, 3);
       if (!sn_as_double(sn_get(v, "speed"), &dev->gps_speed))
         dev->gps_speed = NAN;
+    } else {
+      read_vector(v, "values", dev->values, 3);
+      read_vector(v, "quaternion", dev->quaternion, 4);
+      read_vector(v, "roll_pitch_yaw", dev->roll_pitch_yaw, 3);
     }
     sn_imaging_apply(dev, v);
+    if (dev->kind == SN_RECEIVER)
+      sn_radio_receive(dev, sn_get(v, "packets"));
     if (dev->kind != SN_LIDAR)
       continue;
     size_t n = (size_t)dev->width * (size_t)dev->layers;
@@ -405,16 +453,26 @@ int wb_robot_step_begin(int duration) {
     fprintf(stderr, "Warning: the step duration %d ms of robot '%s' is not a multiple of the basic time step (%d ms); "
             "the server rounds it up.\n", duration, rb->name, rb->basic_time_step);
   }
-  int motors = 0;
-  for (int i = 0; i < rb->n_devices; i++)
+  int motors = 0, emitters = 0;
+  for (int i = 0; i < rb->n_devices; i++) {
     motors += rb->devices[i].kind == SN_MOTOR && (rb->devices[i].cmd_position || rb->devices[i].cmd_velocity);
+    if (rb->devices[i].kind == SN_EMITTER)
+      emitters += sn_radio_pace(&rb->devices[i], duration) > 0; /* what the baud rate lets leave now */
+  }
   char service[512];
   snprintf(service, sizeof service, "%srobot/step", rb->prefix);
   sn_req r;
   uint64_t id = sn_conn_next_id(rb->conn);
-  sn_req_begin(&r, id, service, motors ? 2 : 1);
+  sn_req_begin(&r, id, service, 1 + (motors > 0) + (emitters > 0));
   sn_req_key(&r, "duration");
   msgpack_pack_int(&r.pk, duration);
+  if (emitters) {
+    sn_req_key(&r, "emitters");
+    msgpack_pack_map(&r.pk, (size_t)emitters);
+    for (int i = 0; i < rb->n_devices; i++)
+      if (rb->devices[i].kind == SN_EMITTER && rb->devices[i].sending > 0)
+        sn_radio_pack(&rb->devices[i], &r);
+  }
   if (motors) {
     sn_req_key(&r, "motors");
     msgpack_pack_map(&r.pk, (size_t)motors);
@@ -566,6 +624,14 @@ static bool kind_accepts(sn_kind kind, int node) {
     case SN_GPS: return node == WB_NODE_GPS;
     case SN_RANGE_FINDER: return node == WB_NODE_RANGE_FINDER;
     case SN_CAMERA: return node == WB_NODE_CAMERA;
+    case SN_IMU: return node == WB_NODE_INERTIAL_UNIT;
+    case SN_COMPASS: return node == WB_NODE_COMPASS;
+    case SN_ACCELEROMETER: return node == WB_NODE_ACCELEROMETER;
+    case SN_GYRO: return node == WB_NODE_GYRO;
+    case SN_ALTIMETER: return node == WB_NODE_ALTIMETER;
+    case SN_TOUCH: return node == WB_NODE_TOUCH_SENSOR;
+    case SN_EMITTER: return node == WB_NODE_EMITTER;
+    case SN_RECEIVER: return node == WB_NODE_RECEIVER;
     default: return false;
   }
 }

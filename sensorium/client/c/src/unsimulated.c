@@ -4,74 +4,16 @@
 #include <math.h>
 #include <stddef.h>
 
-#include <webots/accelerometer.h>
-#include <webots/altimeter.h>
 #include <webots/brake.h>
-#include <webots/compass.h>
 #include <webots/connector.h>
 #include <webots/display.h>
-#include <webots/emitter.h>
-#include <webots/gyro.h>
-#include <webots/inertial_unit.h>
 #include <webots/radar.h>
-#include <webots/receiver.h>
 #include <webots/skin.h>
 #include <webots/speaker.h>
-#include <webots/touch_sensor.h>
 #include <webots/vacuum_gripper.h>
 #include <webots/nodes.h>
 
 #include "internal.h"
-
-/* ------------------------------------------------------------------ Accelerometer */
-void wb_accelerometer_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_enable");
-}
-
-void wb_accelerometer_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_disable");
-}
-
-int wb_accelerometer_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_get_sampling_period");
-  return 0;
-}
-
-const double *wb_accelerometer_get_values(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_get_values");
-  return sn_no_values();
-}
-
-int wb_accelerometer_get_lookup_table_size(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_get_lookup_table_size");
-  return 0;
-}
-
-const double *wb_accelerometer_get_lookup_table(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_ACCELEROMETER, "wb_accelerometer_get_lookup_table");
-  return sn_no_values();
-}
-
-/* ------------------------------------------------------------------ Altimeter */
-void wb_altimeter_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_ALTIMETER, "wb_altimeter_enable");
-}
-
-void wb_altimeter_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_ALTIMETER, "wb_altimeter_disable");
-}
-
-int wb_altimeter_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_ALTIMETER, "wb_altimeter_get_sampling_period");
-  return 0;
-}
-
-double wb_altimeter_get_value(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_ALTIMETER, "wb_altimeter_get_value");
-  return NAN;
-}
 
 /* ------------------------------------------------------------------ Brake */
 void wb_brake_set_damping_constant(WbDeviceTag tag, double damping_constant) {
@@ -94,36 +36,6 @@ WbDeviceTag wb_brake_get_position_sensor(WbDeviceTag tag) {
   return 0;
 }
 
-/* ------------------------------------------------------------------ Compass */
-void wb_compass_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_enable");
-}
-
-void wb_compass_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_disable");
-}
-
-int wb_compass_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_get_sampling_period");
-  return 0;
-}
-
-const double *wb_compass_get_values(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_get_values");
-  return sn_no_values();
-}
-
-int wb_compass_get_lookup_table_size(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_get_lookup_table_size");
-  return 0;
-}
-
-const double *wb_compass_get_lookup_table(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_COMPASS, "wb_compass_get_lookup_table");
-  return sn_no_values();
-}
-
 /* ------------------------------------------------------------------ Connector */
 void wb_connector_enable_presence(WbDeviceTag tag, int sampling_period) {
   (void)sampling_period;
@@ -141,7 +53,7 @@ int wb_connector_get_presence_sampling_period(WbDeviceTag tag) {
 
 int wb_connector_get_presence(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_get_presence");
-  return 0;
+  return -1; /* Webots: -1 when no presence was measured */
 }
 
 void wb_connector_lock(WbDeviceTag tag) {
@@ -309,99 +221,6 @@ void wb_display_image_delete(WbDeviceTag tag, WbImageRef ir) {
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_delete");
 }
 
-/* ------------------------------------------------------------------ Emitter */
-int wb_emitter_send(WbDeviceTag tag, const void *data, int size) {
-  (void)data;
-  (void)size;
-  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_send");
-  return 0;
-}
-
-int wb_emitter_get_buffer_size(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_get_buffer_size");
-  return 0;
-}
-
-void wb_emitter_set_channel(WbDeviceTag tag, int channel) {
-  (void)channel;
-  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_set_channel");
-}
-
-int wb_emitter_get_channel(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_get_channel");
-  return 0;
-}
-
-double wb_emitter_get_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_get_range");
-  return NAN;
-}
-
-void wb_emitter_set_range(WbDeviceTag tag, double range) {
-  (void)range;
-  sn_unsimulated(tag, WB_NODE_EMITTER, "wb_emitter_set_range");
-}
-
-/* ------------------------------------------------------------------ Gyro */
-void wb_gyro_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_enable");
-}
-
-void wb_gyro_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_disable");
-}
-
-int wb_gyro_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_get_sampling_period");
-  return 0;
-}
-
-const double *wb_gyro_get_values(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_get_values");
-  return sn_no_values();
-}
-
-int wb_gyro_get_lookup_table_size(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_get_lookup_table_size");
-  return 0;
-}
-
-const double *wb_gyro_get_lookup_table(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_GYRO, "wb_gyro_get_lookup_table");
-  return sn_no_values();
-}
-
-/* ------------------------------------------------------------------ InertialUnit */
-void wb_inertial_unit_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_enable");
-}
-
-void wb_inertial_unit_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_disable");
-}
-
-int wb_inertial_unit_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_sampling_period");
-  return 0;
-}
-
-double wb_inertial_unit_get_noise(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_noise");
-  return NAN;
-}
-
-const double *wb_inertial_unit_get_roll_pitch_yaw(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_roll_pitch_yaw");
-  return sn_no_values();
-}
-
-const double *wb_inertial_unit_get_quaternion(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_INERTIAL_UNIT, "wb_inertial_unit_get_quaternion");
-  return sn_no_values();
-}
-
 /* ------------------------------------------------------------------ Radar */
 void wb_radar_enable(WbDeviceTag tag, int sampling_period) {
   (void)sampling_period;
@@ -445,60 +264,6 @@ double wb_radar_get_horizontal_fov(WbDeviceTag tag) {
 double wb_radar_get_vertical_fov(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_vertical_fov");
   return NAN;
-}
-
-/* ------------------------------------------------------------------ Receiver */
-void wb_receiver_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_enable");
-}
-
-void wb_receiver_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_disable");
-}
-
-int wb_receiver_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_sampling_period");
-  return 0;
-}
-
-void wb_receiver_set_channel(WbDeviceTag tag, int channel) {
-  (void)channel;
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_set_channel");
-}
-
-int wb_receiver_get_channel(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_channel");
-  return 0;
-}
-
-int wb_receiver_get_queue_length(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_queue_length");
-  return 0;
-}
-
-void wb_receiver_next_packet(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_next_packet");
-}
-
-int wb_receiver_get_data_size(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_data_size");
-  return 0;
-}
-
-const void *wb_receiver_get_data(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_data");
-  return NULL;
-}
-
-double wb_receiver_get_signal_strength(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_signal_strength");
-  return NAN;
-}
-
-const double *wb_receiver_get_emitter_direction(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RECEIVER, "wb_receiver_get_emitter_direction");
-  return sn_no_values();
 }
 
 /* ------------------------------------------------------------------ Skin */
@@ -594,46 +359,6 @@ void wb_speaker_speak(WbDeviceTag tag, const char *text, double volume) {
 bool wb_speaker_is_speaking(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_is_speaking");
   return false;
-}
-
-/* ------------------------------------------------------------------ TouchSensor */
-void wb_touch_sensor_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
-  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_enable");
-}
-
-void wb_touch_sensor_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_disable");
-}
-
-int wb_touch_sensor_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_sampling_period");
-  return 0;
-}
-
-double wb_touch_sensor_get_value(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_value");
-  return NAN;
-}
-
-const double *wb_touch_sensor_get_values(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_values");
-  return sn_no_values();
-}
-
-WbTouchSensorType wb_touch_sensor_get_type(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_type");
-  return (WbTouchSensorType)0;
-}
-
-int wb_touch_sensor_get_lookup_table_size(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_lookup_table_size");
-  return 0;
-}
-
-const double *wb_touch_sensor_get_lookup_table(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_TOUCH_SENSOR, "wb_touch_sensor_get_lookup_table");
-  return sn_no_values();
 }
 
 /* ------------------------------------------------------------------ VacuumGripper */

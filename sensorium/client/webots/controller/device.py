@@ -24,7 +24,11 @@ class Device:
         return self._state.name
 
     def getModel(self) -> str:
-        return str(self._state.desc.get("model", ""))
+        return self._state.model
+
+    def getNodeType(self) -> int:
+        """Webots' node type (``Node.GPS``, ...)."""
+        return self._state.node_type
 
     def getTag(self) -> int:
         return self._tag
@@ -40,6 +44,10 @@ class Device:
     @property
     def tag(self) -> int:
         return self._tag
+
+    @property
+    def node_type(self) -> int:
+        return self._state.node_type
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self._state.name!r})"

@@ -50,6 +50,67 @@ class Motor(Device):
     def getBrake(self) -> None:
         return None
 
+    # -- what needs physics (kinematic wheels: ignored, NaN; see sensorium.client.wb_motor)
+    def setAcceleration(self, acceleration: float) -> None:
+        wb.wb_motor_set_acceleration(self._tag, acceleration)
+
+    def getAcceleration(self) -> float:
+        return wb.wb_motor_get_acceleration(self._tag)
+
+    def setAvailableForce(self, force: float) -> None:
+        wb.wb_motor_set_available_force(self._tag, force)
+
+    def getAvailableForce(self) -> float:
+        return wb.wb_motor_get_available_force(self._tag)
+
+    def getMaxForce(self) -> float:
+        return wb.wb_motor_get_max_force(self._tag)
+
+    def setAvailableTorque(self, torque: float) -> None:
+        wb.wb_motor_set_available_torque(self._tag, torque)
+
+    def getAvailableTorque(self) -> float:
+        return wb.wb_motor_get_available_torque(self._tag)
+
+    def getMaxTorque(self) -> float:
+        return wb.wb_motor_get_max_torque(self._tag)
+
+    def setControlPID(self, p: float, i: float, d: float) -> None:
+        wb.wb_motor_set_control_pid(self._tag, p, i, d)
+
+    def getMultiplier(self) -> float:
+        return wb.wb_motor_get_multiplier(self._tag)
+
+    def setForce(self, force: float) -> None:
+        wb.wb_motor_set_force(self._tag, force)
+
+    def setTorque(self, torque: float) -> None:
+        wb.wb_motor_set_torque(self._tag, torque)
+
+    def enableForceFeedback(self, sampling_period: int) -> None:
+        wb.wb_motor_enable_force_feedback(self._tag, sampling_period)
+
+    def disableForceFeedback(self) -> None:
+        wb.wb_motor_disable_force_feedback(self._tag)
+
+    def getForceFeedbackSamplingPeriod(self) -> int:
+        return wb.wb_motor_get_force_feedback_sampling_period(self._tag)
+
+    def getForceFeedback(self) -> float:
+        return wb.wb_motor_get_force_feedback(self._tag)
+
+    def enableTorqueFeedback(self, sampling_period: int) -> None:
+        wb.wb_motor_enable_torque_feedback(self._tag, sampling_period)
+
+    def disableTorqueFeedback(self) -> None:
+        wb.wb_motor_disable_torque_feedback(self._tag)
+
+    def getTorqueFeedbackSamplingPeriod(self) -> int:
+        return wb.wb_motor_get_torque_feedback_sampling_period(self._tag)
+
+    def getTorqueFeedback(self) -> float:
+        return wb.wb_motor_get_torque_feedback(self._tag)
+
     # -- Webots' property spellings
     target_position = property(getTargetPosition, setPosition)
     target_velocity = property(getVelocity, setVelocity)
@@ -59,7 +120,23 @@ class Motor(Device):
     type = property(getType)
     position_sensor = property(getPositionSensor)
     brake = property(getBrake)
+    target_acceleration = property(getAcceleration, setAcceleration)
+    available_force = property(getAvailableForce, setAvailableForce)
+    available_torque = property(getAvailableTorque, setAvailableTorque)
+    max_force = property(getMaxForce)
+    max_torque = property(getMaxTorque)
+    multiplier = property(getMultiplier)
+    force_feedback = property(getForceFeedback)
+    torque_feedback = property(getTorqueFeedback)
+    force = property(fset=setForce)
+    torque = property(fset=setTorque)
 
 
 class RotationalMotor(Motor):
-    """What ``Robot.getDevice`` returns for a wheel motor."""
+    """What ``Robot.getDevice`` returns for a rotational motor (a differential drive's wheel is
+    simulated; any other is listed and answers Webots' "no value")."""
+
+
+class LinearMotor(Motor):
+    """What ``Robot.getDevice`` returns for a linear motor (listed, not simulated: no slider joint
+    moves here; its functions answer Webots' "no value")."""

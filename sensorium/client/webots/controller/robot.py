@@ -3,32 +3,45 @@
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 from sensorium.client import wb
 
+from .accelerometer import Accelerometer
+from .altimeter import Altimeter
+from .brake import Brake
 from .camera import Camera
+from .compass import Compass
+from .connector import Connector
 from .device import Device
+from .display import Display
 from .distance_sensor import DistanceSensor
+from .emitter import Emitter
+from .gps import GPS
+from .gyro import Gyro
+from .inertial_unit import InertialUnit
+from .joystick import Joystick
 from .keyboard import Keyboard
 from .led import LED
 from .lidar import Lidar
 from .light_sensor import LightSensor
-from .motor import RotationalMotor
+from .motor import LinearMotor, RotationalMotor
+from .mouse import Mouse
 from .pen import Pen
 from .position_sensor import PositionSensor
+from .radar import Radar
 from .range_finder import RangeFinder
+from .receiver import Receiver
+from .skin import Skin
+from .speaker import Speaker
+from .touch_sensor import TouchSensor
+from .vacuum_gripper import VacuumGripper
 
-_CLASSES: dict[str, type[Device]] = {
-    wb.LIGHT_SENSOR: LightSensor,
-    wb.DISTANCE_SENSOR: DistanceSensor,
-    wb.LIDAR: Lidar,
-    wb.ROTATIONAL_MOTOR: RotationalMotor,
-    wb.POSITION_SENSOR: PositionSensor,
-    wb.LED: LED,
-    "Pen": Pen,
-    wb.RANGE_FINDER: RangeFinder,
-    wb.CAMERA: Camera,
-}
+# Webots' device classes by node type name (every device type a robot may have)
+_CLASSES: dict[str, type[Device]] = {cls.__name__: cls for cls in (
+    Accelerometer, Altimeter, Brake, Camera, Compass, Connector, Display, DistanceSensor, Emitter, GPS, Gyro,
+    InertialUnit, LED, Lidar, LightSensor, LinearMotor, Pen, PositionSensor, Radar, RangeFinder, Receiver,
+    RotationalMotor, Skin, Speaker, TouchSensor, VacuumGripper)}
 
 
 class Robot:
@@ -59,15 +72,13 @@ class Robot:
         wb.wb_robot_init()
         Robot.created = self
         self.keyboard = Keyboard()
+        self.mouse = Mouse()
+        self.joystick = Joystick()
         self.devices: dict[str, Device] = {}
         for i in range(wb.wb_robot_get_number_of_devices()):
             tag = wb.wb_robot_get_device_by_index(i)
-            kind = wb.wb_device_get_type_name(tag)
-            cls = _CLASSES.get(kind)
-            if cls is None:
-                # a device this client has no class for yet (listed, not simulated): present with its
-                # name and model, so getDevice/getDeviceByIndex find it as in Webots
-                cls = Device
+            # a type this client has no class for (a newer server's) is still present as a Device
+            cls = _CLASSES.get(wb.wb_device_get_type_name(tag), Device)
             self.devices[wb.wb_device_get_name(tag)] = cls(tag)
 
     # -- stepping
@@ -100,17 +111,6 @@ class Robot:
         print(f"DEPRECATION: Robot.{method} is deprecated, please use Robot.getDevice instead.", file=sys.stderr)
         return self.getDevice(name)
 
-    def getLightSensor(self, name: str) -> Device | None:
-        return self._deprecated("getLightSensor", name)
-
-    def getDistanceSensor(self, name: str) -> Device | None:
-        return self._deprecated("getDistanceSensor", name)
-
-    def getLidar(self, name: str) -> Device | None:
-        return self._deprecated("getLidar", name)
-
-    def getMotor(self, name: str) -> Device | None:
-        return self._deprecated("getMotor", name)
 
     def getPen(self, name: str) -> Device | None:
         return self._deprecated("getPen", name)
@@ -124,6 +124,45 @@ class Robot:
 
     def getKeyboard(self) -> Keyboard:
         return self.keyboard
+
+    def getMouse(self) -> Mouse:
+        return self.mouse
+
+    def getJoystick(self) -> Joystick:
+        return self.joystick
+
+    # -- what a headless server does not have
+    def batterySensorEnable(self, sampling_period: int) -> None:
+        wb.wb_robot_battery_sensor_enable(sampling_period)
+
+    def batterySensorDisable(self) -> None:
+        wb.wb_robot_battery_sensor_disable()
+
+    def batterySensorGetSamplingPeriod(self) -> int:
+        return wb.wb_robot_battery_sensor_get_sampling_period()
+
+    def batterySensorGetValue(self) -> float:
+        """NaN: Sensorium robots have no battery."""
+        return wb.wb_robot_battery_sensor_get_value()
+
+    def getProjectPath(self) -> str:
+        return wb.wb_robot_get_project_path()
+
+    def getWorldPath(self) -> str:
+        return wb.wb_robot_get_world_path()
+
+    def getUrdf(self, prefix: str = "") -> str:
+        return wb.wb_robot_get_urdf(prefix)
+
+    def wwiSendText(self, text: str) -> None:
+        wb.wb_robot_wwi_send_text(text)
+
+    def wwiReceiveText(self) -> str | None:
+        return wb.wb_robot_wwi_receive_text()
+
+    def setMode(self, mode: int, arg: str = "") -> None:
+        if mode != self.MODE_SIMULATION:
+            print(f"Error: Robot.setMode(): Sensorium robots are simulated only (mode {mode} refused)", file=sys.stderr)
 
     # -- robot information
     def getCustomData(self) -> str:
@@ -145,9 +184,9 @@ class Robot:
         return wb.wb_robot_get_type()
 
     def waitForUserInputEvent(self, event_type: int, timeout: int) -> int:
-        """No user input ever arrives headless: steps ``timeout`` ms and answers EVENT_NO_EVENT
-        (EVENT_QUIT when the simulation ends)."""
-        return self.EVENT_QUIT if self.step(max(int(timeout), 0)) == -1 else self.EVENT_NO_EVENT
+        """No user input ever arrives headless: runs whole basic steps covering ``timeout`` ms and
+        answers EVENT_NO_EVENT (EVENT_QUIT when the simulation ends)."""
+        return wb.wb_robot_wait_for_user_input_event(event_type, timeout)
 
     def getTime(self) -> float:
         return wb.wb_robot_get_time()
@@ -170,3 +209,19 @@ class Robot:
     model = property(getModel)
     supervisor = property(getSupervisor)
     mode = property(getMode)
+    project_path = property(getProjectPath)
+    world_path = property(getWorldPath)
+
+
+def _deprecated_getter(method: str) -> Any:
+    def get(self: Robot, name: str) -> Device | None:
+        return self._deprecated(method, name)
+    get.__name__ = get.__qualname__ = method
+    return get
+
+
+# Webots' deprecated getters, one per device class: getGPS(name) is getDevice(name) with a warning
+for _cls in ("Accelerometer", "Altimeter", "Brake", "Camera", "Compass", "Connector", "Display", "DistanceSensor",
+             "Emitter", "GPS", "Gyro", "InertialUnit", "LED", "Lidar", "LightSensor", "Motor", "Pen", "PositionSensor",
+             "Radar", "RangeFinder", "Receiver", "Skin", "Speaker", "TouchSensor"):
+    setattr(Robot, f"get{_cls}", _deprecated_getter(f"get{_cls}"))

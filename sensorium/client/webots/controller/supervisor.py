@@ -4,7 +4,9 @@ reset the simulation and change its mode. The robot's world entry needs ``superv
 
 from __future__ import annotations
 
-from sensorium.client import wb
+from dataclasses import dataclass, field
+
+from sensorium.client import nodes, wb
 
 from .robot import Robot
 
@@ -91,6 +93,26 @@ def _node(ref: dict | None) -> Node | None:
     if not ref or not ref.get("node"):
         return None
     return Node(int(ref["node"]), str(ref.get("type", "")), str(ref.get("name", "")))
+
+
+# Webots' node types as Node class constants (Node.ROBOT, Node.GPS, ...)
+for _name, _value in nodes.WEBOTS_NODE_TYPES.items():
+    setattr(Node, _name[len("WB_NODE_"):], _value)
+
+
+@dataclass
+class ContactPoint:
+    """Webots' contact point (``Node.getContactPoints``): Sensorium has no physics contacts, so no
+    function returns one; the class exists for ``from controller import ContactPoint``."""
+
+    point: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    node_id: int = -1
+
+    def getPoint(self) -> list[float]:
+        return self.point
+
+    def getNodeId(self) -> int:
+        return self.node_id
 
 
 class Supervisor(Robot):

@@ -11,6 +11,7 @@ namespace webots {
 
 class Emitter : public Device {
 public:
+  enum { CHANNEL_BROADCAST = WB_CHANNEL_BROADCAST };
   explicit Emitter(WbDeviceTag tag) : Device(tag) {}
   int send(const void *data, int size) { return wb_emitter_send(tag_, data, size); }
   int getBufferSize() const { return wb_emitter_get_buffer_size(tag_); }

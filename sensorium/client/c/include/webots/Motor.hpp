@@ -29,6 +29,27 @@ public:
   Type getType() const { return static_cast<Type>(wb_motor_get_type(tag_)); }
   inline PositionSensor *getPositionSensor() const;
   Device *getBrake() const { return 0; }
+  // what needs physics: ignored, NaN (kinematic wheels; see webots/motor.h)
+  void setAcceleration(double acceleration) { wb_motor_set_acceleration(tag_, acceleration); }
+  double getAcceleration() const { return wb_motor_get_acceleration(tag_); }
+  void setAvailableForce(double force) { wb_motor_set_available_force(tag_, force); }
+  double getAvailableForce() const { return wb_motor_get_available_force(tag_); }
+  double getMaxForce() const { return wb_motor_get_max_force(tag_); }
+  void setAvailableTorque(double torque) { wb_motor_set_available_torque(tag_, torque); }
+  double getAvailableTorque() const { return wb_motor_get_available_torque(tag_); }
+  double getMaxTorque() const { return wb_motor_get_max_torque(tag_); }
+  void setControlPID(double p, double i, double d) { wb_motor_set_control_pid(tag_, p, i, d); }
+  double getMultiplier() const { return wb_motor_get_multiplier(tag_); }
+  void setForce(double force) { wb_motor_set_force(tag_, force); }
+  void setTorque(double torque) { wb_motor_set_torque(tag_, torque); }
+  void enableForceFeedback(int samplingPeriod) { wb_motor_enable_force_feedback(tag_, samplingPeriod); }
+  void disableForceFeedback() { wb_motor_disable_force_feedback(tag_); }
+  int getForceFeedbackSamplingPeriod() const { return wb_motor_get_force_feedback_sampling_period(tag_); }
+  double getForceFeedback() const { return wb_motor_get_force_feedback(tag_); }
+  void enableTorqueFeedback(int samplingPeriod) { wb_motor_enable_torque_feedback(tag_, samplingPeriod); }
+  void disableTorqueFeedback() { wb_motor_disable_torque_feedback(tag_); }
+  int getTorqueFeedbackSamplingPeriod() const { return wb_motor_get_torque_feedback_sampling_period(tag_); }
+  double getTorqueFeedback() const { return wb_motor_get_torque_feedback(tag_); }
 };
 
 class PositionSensor : public Device {

@@ -11,6 +11,7 @@ namespace webots {
 
 class Receiver : public Device {
 public:
+  enum { CHANNEL_BROADCAST = WB_CHANNEL_BROADCAST };
   explicit Receiver(WbDeviceTag tag) : Device(tag) {}
   void enable(int samplingPeriod) { wb_receiver_enable(tag_, samplingPeriod); }
   void disable() { wb_receiver_disable(tag_); }

@@ -11,7 +11,7 @@ namespace webots {
 
 class TouchSensor : public Device {
 public:
-  enum Type { BUMPER = WB_BUMPER, FORCE = WB_FORCE, FORCE3D = WB_FORCE3D };
+  enum Type { BUMPER = WB_TOUCH_SENSOR_BUMPER, FORCE = WB_TOUCH_SENSOR_FORCE, FORCE3D = WB_TOUCH_SENSOR_FORCE3D };
   explicit TouchSensor(WbDeviceTag tag) : Device(tag) {}
   void enable(int samplingPeriod) { wb_touch_sensor_enable(tag_, samplingPeriod); }
   void disable() { wb_touch_sensor_disable(tag_); }

@@ -56,6 +56,27 @@ void wb_robot_battery_sensor_disable(void);
 int wb_robot_battery_sensor_get_sampling_period(void);
 double wb_robot_battery_sensor_get_value(void);
 
+/* What a controller of a Sensorium server does not have: a Webots project ("" paths), a URDF
+ * export (""), a robot window to pin. */
+const char *wb_robot_get_project_path(void);
+const char *wb_robot_get_world_path(void);
+const char *wb_robot_get_urdf(const char *prefix);
+void wb_robot_pin_to_static_environment(bool pin);
+
+/* Webots' multi-thread helpers: a task runs in its own (detached) thread; mutexes are pthread ones. */
+typedef void *WbMutexRef;
+void wb_robot_task_new(void (*task)(void *), void *param);
+WbMutexRef wb_robot_mutex_new(void);
+void wb_robot_mutex_lock(WbMutexRef mutex);
+void wb_robot_mutex_unlock(WbMutexRef mutex);
+void wb_robot_mutex_delete(WbMutexRef mutex);
+
+/* Deprecated in Webots: the controller's name ("<extern>": Sensorium starts no controller) and the
+ * robot's custom data under its old names. */
+const char *wb_robot_get_controller_name(void);
+const char *wb_robot_get_data(void);
+void wb_robot_set_data(const char *data);
+
 #ifdef __cplusplus
 }
 #endif

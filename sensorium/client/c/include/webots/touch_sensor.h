@@ -11,7 +11,7 @@
 extern "C" {
 #endif
 
-typedef enum { WB_BUMPER = 0, WB_FORCE, WB_FORCE3D } WbTouchSensorType;
+typedef enum { WB_TOUCH_SENSOR_BUMPER = 0, WB_TOUCH_SENSOR_FORCE, WB_TOUCH_SENSOR_FORCE3D } WbTouchSensorType;
 
 void wb_touch_sensor_enable(WbDeviceTag tag, int sampling_period);
 void wb_touch_sensor_disable(WbDeviceTag tag);

@@ -1,0 +1,141 @@
+/* Sensorium C controller library: what Webots' robot API offers beyond the simulation (paths, URDF,
+ * threads and mutexes, deprecated names) and the motion-file player, which has no joints to move. */
+#define _POSIX_C_SOURCE 200809L
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <webots/device.h>
+#include <webots/robot.h>
+#include <webots/utils/motion.h>
+
+#include "internal.h"
+
+const char *wb_robot_get_project_path(void) {
+  sn_robot_get("wb_robot_get_project_path");
+  return ""; /* no Webots project: the controller runs beside a Sensorium server */
+}
+
+const char *wb_robot_get_world_path(void) {
+  sn_robot_get("wb_robot_get_world_path");
+  return "";
+}
+
+const char *wb_robot_get_urdf(const char *prefix) {
+  (void)prefix;
+  sn_robot_get("wb_robot_get_urdf");
+  return "";
+}
+
+void wb_robot_pin_to_static_environment(bool pin) {
+  (void)pin;
+  sn_robot_get("wb_robot_pin_to_static_environment");
+}
+
+const char *wb_robot_get_controller_name(void) {
+  sn_robot_get("wb_robot_get_controller_name");
+  return "<extern>";
+}
+
+const char *wb_robot_get_data(void) { return wb_robot_get_custom_data(); }
+
+void wb_robot_set_data(const char *data) { wb_robot_set_custom_data(data); }
+
+WbNodeType wb_device_get_type(WbDeviceTag tag) { return wb_device_get_node_type(tag); }
+
+/* ------------------------------------------------------------------ tasks and mutexes */
+
+typedef struct {
+  void (*task)(void *);
+  void *param;
+} task_start;
+
+static void *run_task(void *arg) {
+  task_start start = *(task_start *)arg;
+  free(arg);
+  start.task(start.param);
+  return NULL;
+}
+
+void wb_robot_task_new(void (*task)(void *), void *param) {
+  task_start *start = malloc(sizeof *start);
+  pthread_t thread;
+  if (start == NULL || task == NULL) {
+    free(start);
+    fprintf(stderr, "Error: wb_robot_task_new(): %s\n", task == NULL ? "NULL task" : "out of memory");
+    return;
+  }
+  start->task = task;
+  start->param = param;
+  if (pthread_create(&thread, NULL, run_task, start) != 0) {
+    free(start);
+    fprintf(stderr, "Error: wb_robot_task_new(): cannot start a thread\n");
+    return;
+  }
+  pthread_detach(thread);
+}
+
+WbMutexRef wb_robot_mutex_new(void) {
+  pthread_mutex_t *m = malloc(sizeof *m);
+  if (m != NULL && pthread_mutex_init(m, NULL) != 0) {
+    free(m);
+    m = NULL;
+  }
+  return m;
+}
+
+void wb_robot_mutex_lock(WbMutexRef mutex) {
+  if (mutex != NULL)
+    pthread_mutex_lock((pthread_mutex_t *)mutex);
+}
+
+void wb_robot_mutex_unlock(WbMutexRef mutex) {
+  if (mutex != NULL)
+    pthread_mutex_unlock((pthread_mutex_t *)mutex);
+}
+
+void wb_robot_mutex_delete(WbMutexRef mutex) {
+  if (mutex != NULL) {
+    pthread_mutex_destroy((pthread_mutex_t *)mutex);
+    free(mutex);
+  }
+}
+
+/* ------------------------------------------------------------------ motion files */
+
+WbMotionRef wbu_motion_new(const char *filename) {
+  static bool warned = false;
+  if (!warned) {
+    warned = true;
+    fprintf(stderr, "Warning: wbu_motion_new(\"%s\"): Sensorium does not play motion files (no joints to animate).\n",
+            filename ? filename : "");
+  }
+  return NULL;
+}
+void wbu_motion_delete(WbMotionRef motion) { (void)motion; }
+void wbu_motion_play(WbMotionRef motion) { (void)motion; }
+void wbu_motion_stop(WbMotionRef motion) { (void)motion; }
+void wbu_motion_set_loop(WbMotionRef motion, bool loop) {
+  (void)motion;
+  (void)loop;
+}
+void wbu_motion_set_reverse(WbMotionRef motion, bool reverse) {
+  (void)motion;
+  (void)reverse;
+}
+bool wbu_motion_is_over(WbMotionRef motion) {
+  (void)motion;
+  return true;
+}
+int wbu_motion_get_duration(WbMotionRef motion) {
+  (void)motion;
+  return -1;
+}
+int wbu_motion_get_time(WbMotionRef motion) {
+  (void)motion;
+  return -1;
+}
+void wbu_motion_set_time(WbMotionRef motion, int time) {
+  (void)motion;
+  (void)time;
+}

@@ -1,0 +1,199 @@
+"""Webots' user-input and robot extras on a headless server: ``wb_joystick_*`` (never connected),
+``wb_mouse_*`` (no state: NaN), ``wb_robot_wait_for_user_input_event`` (no event ever comes: the
+simulation runs for the whole timeout), the battery (none: NaN), project/world paths and URDF
+(""), robot-window messages (none). The keyboard is in :mod:`sensorium.client.wb_robot`."""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+
+from sensorium.client.connection import ErrorCode, SensoriumError
+from sensorium.client.wb_robot import WB_EVENT_NO_EVENT, WB_EVENT_QUIT, current
+
+
+@dataclass
+class _Input:
+    joystick_period: int = 0
+    mouse_period: int = 0
+    mouse_3d: bool = False
+    battery_period: int = 0
+
+
+_state = _Input()
+
+
+def _period(value: int, func: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer >= 0 (ms), got {value!r}")
+    current()
+    return value
+
+
+def wb_robot_wait_for_user_input_event(event_type: int, timeout: int) -> int:
+    """Steps whole basic time steps covering ``timeout`` ms and answers ``WB_EVENT_NO_EVENT``
+    (``WB_EVENT_QUIT`` when the simulation ends): headless, no key, click or joystick event comes."""
+    r = current()
+    if isinstance(timeout, bool) or not isinstance(timeout, int) or timeout < 0:
+        print(f"Error: wb_robot_wait_for_user_input_event(): negative timeout {timeout} ms", file=sys.stderr)
+        return WB_EVENT_NO_EVENT
+    step = r.basic_time_step
+    steps = -(-timeout // step)
+    if steps == 0:
+        return WB_EVENT_NO_EVENT
+    return WB_EVENT_QUIT if r.step(steps * step) == -1 else WB_EVENT_NO_EVENT
+
+
+# ---------------------------------------------------------------------- battery, paths, windows
+
+def wb_robot_battery_sensor_enable(sampling_period: int) -> None:
+    _state.battery_period = _period(sampling_period, "wb_robot_battery_sensor_enable")
+
+
+def wb_robot_battery_sensor_disable() -> None:
+    _state.battery_period = 0
+
+
+def wb_robot_battery_sensor_get_sampling_period() -> int:
+    return _state.battery_period
+
+
+def wb_robot_battery_sensor_get_value() -> float:
+    """NaN: Sensorium robots have no battery."""
+    current()
+    return math.nan
+
+
+def wb_robot_get_project_path() -> str:
+    """"": a controller of a Sensorium server has no Webots project."""
+    current()
+    return ""
+
+
+def wb_robot_get_world_path() -> str:
+    current()
+    return ""
+
+
+def wb_robot_get_urdf(prefix: str = "") -> str:
+    current()
+    return ""
+
+
+def wb_robot_wwi_send_text(text: str) -> None:
+    """No robot window: the text goes nowhere."""
+    current()
+
+
+def wb_robot_wwi_receive_text() -> str | None:
+    current()
+    return None
+
+
+# ---------------------------------------------------------------------- joystick (never connected)
+
+def wb_joystick_enable(sampling_period: int) -> None:
+    _state.joystick_period = _period(sampling_period, "wb_joystick_enable")
+
+
+def wb_joystick_disable() -> None:
+    _state.joystick_period = 0
+
+
+def wb_joystick_get_sampling_period() -> int:
+    return _state.joystick_period
+
+
+def wb_joystick_is_connected() -> bool:
+    return False
+
+
+def wb_joystick_get_model() -> str | None:
+    return None
+
+
+def wb_joystick_get_number_of_axes() -> int:
+    return 0
+
+
+def wb_joystick_get_axis_value(axis: int) -> int:
+    return 0
+
+
+def wb_joystick_get_number_of_povs() -> int:
+    return 0
+
+
+def wb_joystick_get_pov_value(pov: int) -> int:
+    return 0
+
+
+def wb_joystick_get_pressed_button() -> int:
+    return -1
+
+
+def wb_joystick_set_constant_force(level: int) -> None:
+    pass
+
+
+def wb_joystick_set_constant_force_duration(duration: float) -> None:
+    pass
+
+
+def wb_joystick_set_auto_centering_gain(gain: float) -> None:
+    pass
+
+
+def wb_joystick_set_resistance_gain(gain: float) -> None:
+    pass
+
+
+def wb_joystick_set_force_axis(axis: int) -> None:
+    pass
+
+
+# ---------------------------------------------------------------------- mouse (no pointer)
+
+@dataclass(frozen=True)
+class WbMouseState:
+    """Webots' mouse state: no button pressed, no position (NaN)."""
+
+    left: bool = False
+    middle: bool = False
+    right: bool = False
+    u: float = math.nan
+    v: float = math.nan
+    x: float = math.nan
+    y: float = math.nan
+    z: float = math.nan
+
+
+def wb_mouse_enable(sampling_period: int) -> None:
+    _state.mouse_period = _period(sampling_period, "wb_mouse_enable")
+
+
+def wb_mouse_disable() -> None:
+    _state.mouse_period = 0
+
+
+def wb_mouse_get_sampling_period() -> int:
+    return _state.mouse_period
+
+
+def wb_mouse_enable_3d_position() -> None:
+    _state.mouse_3d = True
+
+
+def wb_mouse_disable_3d_position() -> None:
+    _state.mouse_3d = False
+
+
+def wb_mouse_is_3d_position_enabled() -> bool:
+    return _state.mouse_3d
+
+
+def wb_mouse_get_state() -> WbMouseState:
+    if _state.mouse_period <= 0:
+        print("Error: wb_mouse_get_state() called for a disabled device! Please use: wb_mouse_enable().", file=sys.stderr)
+    return WbMouseState()

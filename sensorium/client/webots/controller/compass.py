@@ -1,0 +1,21 @@
+"""Webots' ``Compass`` class: the north direction in the device frame, through its lookup table."""
+
+from __future__ import annotations
+
+from sensorium.client import wb
+
+from .device import Sensor
+
+
+class Compass(Sensor):
+    _enable = staticmethod(wb.wb_compass_enable)
+    _get_sampling_period = staticmethod(wb.wb_compass_get_sampling_period)
+
+    def getValues(self) -> list[float]:
+        return wb.wb_compass_get_values(self._tag)
+
+    def getLookupTable(self) -> list[float]:
+        return wb.wb_compass_get_lookup_table(self._tag)
+
+    value = property(getValues)
+    lookup_table = property(getLookupTable)
