@@ -59,7 +59,11 @@ class NodeProcess:
         assert self.proc.stdout is not None
         for line in self.proc.stdout:
             if line.strip():
-                self.events.put(json.loads(line))
+                try:
+                    self.events.put(json.loads(line))
+                except json.JSONDecodeError:      # a line cut short when the script is stopped mid-write
+                    if self.proc.poll() is None and line.endswith("\n"):
+                        raise
 
     def send(self, **cmd) -> None:
         assert self.proc.stdin is not None

@@ -125,16 +125,24 @@ def test_live_foxglove_client_sees_the_camera_image():
         sub.connect(srv.fields["pub"])
         sub.setsockopt(zmq.SUBSCRIBE, b"/bot/camera/image\0")
         node.send(cmd="subscribe", topic="/bot/camera/image")
-        ours = {}
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and len(ours) < 3:
-            if sub.poll(100):
+        # both streams are read together until an image seen by both turns up (a loaded machine may
+        # make the viewer's bounded queue skip some images, so any common one will do)
+        ours: dict[int, bytes] = {}
+        theirs: dict[int, dict] = {}
+        ev = None
+        deadline = time.monotonic() + 120
+        while ev is None and time.monotonic() < deadline:
+            if sub.poll(50):
                 _topic, env, body = sub.recv_multipart()
                 ours[msgpack.unpackb(env)["stamp_ns"]] = body
+            for e in node.drain():
+                if e["event"] == "message" and e["topic"] == "/bot/camera/image":
+                    theirs[e["log_time"]] = e
+            common = sorted(set(ours) & set(theirs))
+            ev = theirs[common[0]] if common else None
+            assert node.proc.poll() is None, f"the Node client exited: {node.proc.poll()}"
         sub.close(0)
-        assert len(ours) >= 3
-        ev = node.wait_for(lambda e: e["event"] == "message" and e["topic"] == "/bot/camera/image"
-                           and e["log_time"] in ours, timeout=60, what="a camera image seen by both")
+        assert ev is not None, f"no camera image seen by both in 120 s ({len(ours)} over ZeroMQ, {len(theirs)} in Foxglove)"
         m = ev["msg"]
         body = msgpack.unpackb(ours[ev["log_time"]], raw=False)
         assert (m["encoding"], m["width"], m["height"]) == ("bgra8", 16, 12) and bytes(m["data"]) == body["data"]
