@@ -19,6 +19,23 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationIn
 Vec3 = tuple[float, float, float]
 
 
+Color = Vec3
+
+
+def _unit_colors(v: Color | list[Color]) -> Color | list[Color]:
+    """A colour, or each of a list of colours, with every component within [0, 1]."""
+    for c in v if isinstance(v, list) else [v]:
+        if min(c) < 0 or max(c) > 1:
+            raise ValueError("colour components must be within [0, 1]")
+    return v
+
+
+def _nonzero_direction(v: Vec3) -> Vec3:
+    if math.hypot(*v) == 0:
+        raise ValueError("direction must not be the zero vector")
+    return v
+
+
 class Strict(BaseModel):
     """Base: unknown keys are errors, NaN/inf rejected everywhere, models immutable."""
 
@@ -173,12 +190,7 @@ class Appearance(Strict):
     occlusion_map: TextureField = None
     texture_transform: TextureTransform | None = None
 
-    @field_validator("base_color")
-    @classmethod
-    def _unit(cls, v: Vec3) -> Vec3:
-        if min(v) < 0 or max(v) > 1:
-            raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("base_color")(_unit_colors)
 
 
 SeenBy = Literal["both", "bounding", "visual"]
@@ -205,8 +217,6 @@ class Part(Shape):
 
 
 # ---------------------------------------------------------------- lights
-
-Color = Vec3
 
 
 class _Light(Strict):
@@ -243,24 +253,14 @@ class SpotLight(_Attenuated):
     beam_width: float = 1.570796
     cut_off_angle: float = 0.785398
 
-    @field_validator("direction")
-    @classmethod
-    def _nonzero(cls, v: Vec3) -> Vec3:
-        if math.hypot(*v) == 0:
-            raise ValueError("direction must not be the zero vector")
-        return v
+    _nonzero = field_validator("direction")(_nonzero_direction)
 
 
 class DirectionalLight(_Light):
     type: Literal["DirectionalLight"]
     direction: Vec3 = (0.0, 0.0, -1.0)
 
-    @field_validator("direction")
-    @classmethod
-    def _nonzero(cls, v: Vec3) -> Vec3:
-        if math.hypot(*v) == 0:
-            raise ValueError("direction must not be the zero vector")
-        return v
+    _nonzero = field_validator("direction")(_nonzero_direction)
 
 
 Light = Annotated[PointLight | SpotLight | DirectionalLight, Field(discriminator="type")]
@@ -292,13 +292,7 @@ class Solid(Strict):
         default=[], max_length=1024, description="Webots recognitionColors: cameras with a Recognition node report "
         "this solid (with its children); top-level solids only")
 
-    @field_validator("recognition_colors")
-    @classmethod
-    def _unit_colors(cls, v: list[Color]) -> list[Color]:
-        for c in v:
-            if min(c) < 0 or max(c) > 1:
-                raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
     def _recognised_at_the_top(self) -> Solid:
@@ -389,13 +383,7 @@ class LED(_Device):
     color: list[Color] = Field(default=[(1.0, 0.0, 0.0)], max_length=1024)
     gradual: bool = False
 
-    @field_validator("color")
-    @classmethod
-    def _unit(cls, v: list[Color]) -> list[Color]:
-        for c in v:
-            if min(c) < 0 or max(c) > 1:
-                raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("color")(_unit_colors)
 
 
 class Pen(_Device):
@@ -411,12 +399,7 @@ class Pen(_Device):
     max_distance: float = Field(default=0.0, description="m; <= 0: unlimited range")
     write: bool = Field(default=True, description="writing from the first step (wb_pen_write switches it)")
 
-    @field_validator("ink_color")
-    @classmethod
-    def _unit(cls, v: Color) -> Color:
-        if min(v) < 0 or max(v) > 1:
-            raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("ink_color")(_unit_colors)
 
 
 class GPS(_Device):
@@ -743,13 +726,7 @@ class Robot(Strict):
         default=[], max_length=1024, description="Webots recognitionColors: other robots' cameras with a Recognition "
         "node report this robot")
 
-    @field_validator("recognition_colors")
-    @classmethod
-    def _unit_colors(cls, v: list[Color]) -> list[Color]:
-        for c in v:
-            if min(c) < 0 or max(c) > 1:
-                raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("recognition_colors")(_unit_colors)
 
 
 class WorldInfo(Strict):
@@ -777,12 +754,7 @@ class Background(Strict):
 
     sky_color: Color = (0.0, 0.0, 0.0)
 
-    @field_validator("sky_color")
-    @classmethod
-    def _unit(cls, v: Color) -> Color:
-        if min(v) < 0 or max(v) > 1:
-            raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("sky_color")(_unit_colors)
 
 
 class World(Strict):
