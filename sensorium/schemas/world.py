@@ -12,7 +12,7 @@ radians, time in integer milliseconds.
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
@@ -482,28 +482,36 @@ class TouchSensor(_Device):
     resolution: float = -1.0
 
 
-class RangeFinder(_Device):
+class _Imager(_Device):
+    """What Webots' RangeFinder and Camera share: the image's size and projection, the near plane."""
+
+    device: str
+    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
+    width: int = Field(default=64, ge=1, le=1 << 16)
+    height: int = Field(default=64, ge=1, le=1 << 16)
+    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
+    near: float = Field(default=0.01, ge=0.0)
+    _what: ClassVar[str]
+
+    @model_validator(mode="after")
+    def _planar_fov(self) -> _Imager:
+        if self.projection == "planar" and self.field_of_view >= math.pi:
+            raise ValueError(f"a planar {self._what}'s field_of_view must be < pi")
+        return self
+
+
+class RangeFinder(_Imager):
     """Webots RangeFinder (a depth camera): ``width`` × ``height`` ranges, by exact rays through the
     pixel centres. ``planar``: the depth along the device's +x axis (Webots' z-buffer distance to
     the image plane); ``cylindrical``/``spherical``: the distance along each pixel's ray. Values
     outside [min_range, max_range) and no hit read +inf (README "Cameras and range finders")."""
 
     device: Literal["RangeFinder"]
-    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
-    width: int = Field(default=64, ge=1, le=1 << 16)
-    height: int = Field(default=64, ge=1, le=1 << 16)
-    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
-    near: float = Field(default=0.01, ge=0.0)
     min_range: float = Field(default=0.01, ge=0.0)
     max_range: float = Field(default=1.0, gt=0.0)
     noise: float = Field(default=0.0, ge=0.0, description="σ of the Gaussian noise as a fraction of max_range")
     resolution: float = -1.0
-
-    @model_validator(mode="after")
-    def _planar_fov(self) -> RangeFinder:
-        if self.projection == "planar" and self.field_of_view >= math.pi:
-            raise ValueError("a planar range finder's field_of_view must be < pi")
-        return self
+    _what: ClassVar[str] = "range finder"
 
 
 class Recognition(Strict):
@@ -518,28 +526,18 @@ class Recognition(Strict):
     segmentation: bool = False
 
 
-class Camera(_Device):
+class Camera(_Imager):
     """Webots Camera: a ``width`` × ``height`` BGRA image by exact rays through the pixels (four per
     pixel with ``anti_aliasing``), shaded with the LightSensor's lighting, textures, transparency,
     shadows of the lights that cast them, the background colour (README "Cameras and range finders")."""
 
     device: Literal["Camera"]
-    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
-    width: int = Field(default=64, ge=1, le=1 << 16)
-    height: int = Field(default=64, ge=1, le=1 << 16)
-    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
-    near: float = Field(default=0.01, ge=0.0)
     far: float = Field(default=0.0, ge=0.0, description="0: no far clipping plane")
     exposure: float = Field(default=1.0, ge=0.0)
     anti_aliasing: bool = False
     noise: float = Field(default=0.0, ge=0.0, le=1.0, description="σ of the per-channel Gaussian noise, in [0, 1] units")
     recognition: Recognition | None = None
-
-    @model_validator(mode="after")
-    def _planar_fov(self) -> Camera:
-        if self.projection == "planar" and self.field_of_view >= math.pi:
-            raise ValueError("a planar camera's field_of_view must be < pi")
-        return self
+    _what: ClassVar[str] = "camera"
 
 
 def _minus_one_or_positive(name: str, v: float) -> float:
