@@ -28,7 +28,7 @@ from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
-from sensorium.server.sim.scene import Scene, primitive_from_model, robot_parts, solid_parts
+from sensorium.server.sim.scene import Scene, light_from_model, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
     LED,
     Device,
@@ -47,21 +47,7 @@ from sensorium.server.world.report import warn_losses
 
 def lights_from_models(models: list) -> light_math.LightArrays:
     """The lights that are on, as arrays in world coordinates (lights that are off contribute nothing)."""
-    kinds = {"PointLight": light_math.LightKind.POINT, "SpotLight": light_math.LightKind.SPOT,
-             "DirectionalLight": light_math.LightKind.DIRECTIONAL}
-    out = []
-    for m in models:
-        if not m.on:
-            continue
-        fields = dict(kind=kinds[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity, color=m.color)
-        if m.type != "DirectionalLight":
-            fields.update(position=m.location, attenuation=m.attenuation)
-        if m.type != "PointLight":
-            fields.update(direction=m.direction)
-        if m.type == "SpotLight":
-            fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
-        out.append(light_math.Light(**fields))
-    return light_math.LightArrays.from_lights(out)
+    return light_math.LightArrays.from_lights([light_from_model(m) for m in models if m.on])
 
 
 @dataclass(frozen=True, slots=True)
