@@ -51,7 +51,7 @@ from sensorium.server.sim.sensors import DistanceSensor, Lidar, LightSensor, Pos
 from sensorium.server.sim.simulation import lights_from_models
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import check_pose
-from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, sanitize
+from sensorium.server.world.loader import LoadedWorld, from_model
 from sensorium.server.world.poses import pose_from_model, pose_from_values
 
 __all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS", "check_observable"]
@@ -158,11 +158,7 @@ class BatchedSimulation:
     def __init__(self, world: LoadedWorld | wm.World, copies: int, precision: Precision | str = Precision.EXACT,
                  base_dir: Path | None = None, contact: bool | None = None):
         if isinstance(world, wm.World):
-            problems = check_world(world, base_dir or Path.cwd())
-            if problems:
-                raise WorldError("<memory>", problems)
-            world, _ = sanitize(world)
-            world = LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
+            world = from_model(world, base_dir)
         if int(copies) < 1:
             raise BatchedError(f"copies must be >= 1, got {copies}")
         self.loaded = world

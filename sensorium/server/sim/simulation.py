@@ -40,7 +40,7 @@ from sensorium.server.sim.sensors import (
 )
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
-from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
+from sensorium.server.world.loader import LoadedWorld, from_model, load_world
 from sensorium.server.world.poses import pose_from_values
 from sensorium.server.world.report import warn_losses
 
@@ -161,14 +161,7 @@ class Simulation:
     def __init__(self, world: LoadedWorld | wm.World, precision: Precision | str = Precision.EXACT,
                  base_dir: Path | None = None, contact: bool | None = None):
         """``contact``: kinematic contact on/off (default: the world's ``world_info.contact``)."""
-        if isinstance(world, wm.World):
-            problems = check_world(world, base_dir or Path.cwd())
-            if problems:
-                raise WorldError("<memory>", problems)
-            world, _ = sanitize(world)
-            loaded = LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
-        else:
-            loaded = world
+        loaded = from_model(world, base_dir) if isinstance(world, wm.World) else world
         self.loaded = loaded
         self.world = loaded.world
         self.basic_time_step = self.world.world_info.basic_time_step

@@ -290,6 +290,16 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
     return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings)
 
 
+def from_model(world: wm.World, base_dir: Path | None = None) -> LoadedWorld:
+    """A world model built in memory (``<memory>``), checked against its files under ``base_dir``
+    (default: the working directory) and sanitised as a world file is; ``WorldError`` if unusable."""
+    problems = check_world(world, base_dir or Path.cwd())
+    if problems:
+        raise WorldError("<memory>", problems)
+    world, _ = sanitize(world)
+    return LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
+
+
 _TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "triangles", "mesh", "PointLight", "SpotLight",
          "DirectionalLight", *wm.DEVICE_TYPES}
 
