@@ -43,7 +43,7 @@ from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
-from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations
+from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
 from sensorium.server.sim.motion import DifferentialDrive
 from sensorium.server.sim.scene import Scene, _entry, _shape_info, primitive_from_model, robot_parts, solid_parts
@@ -688,21 +688,13 @@ class BatchedSimulation:
                                              self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32)
                 continue
             sizes = [len(r.origins) for r in reqs]
-
-            def cat(name: str, dtype, reqs=reqs, sizes=sizes) -> np.ndarray:
-                return np.concatenate([np.broadcast_to(np.asarray(getattr(r, name), dtype=dtype), (n,))
-                                       for r, n in zip(reqs, sizes)])
-
             h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
-                               cat("t_near", np.float64), cat("t_far", np.float64), RayKind(kind), cat("copy", np.int64),
-                               self.rot, self.pos, cat("exclude", np.int64), cat("mount", np.int64), skip,
+                               joined(reqs, sizes, "t_near", np.float64), joined(reqs, sizes, "t_far", np.float64),
+                               RayKind(kind), joined(reqs, sizes, "copy", np.int64), self.rot, self.pos,
+                               joined(reqs, sizes, "exclude", np.int64), joined(reqs, sizes, "mount", np.int64), skip,
                                distance_only)
-            a = 0
-            for i, n in zip(idx, sizes):
-                sl = slice(a, a + n)
-                out[i] = RayHits(h.distance[sl], None if h.normal is None else h.normal[sl],
-                                 None if h.shape is None else h.shape[sl])
-                a += n
+            for i, hit in zip(idx, split_hits(h, sizes)):
+                out[i] = hit
         return out   # type: ignore[return-value]
 
     # light sensors (LightBatch over every copy's due sensors)

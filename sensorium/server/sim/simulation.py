@@ -23,7 +23,7 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
-from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch
+from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
@@ -450,18 +450,14 @@ class Simulation:
                 continue
             origins = np.concatenate([r.origins for r in reqs])
             dirs = np.concatenate([r.directions for r in reqs])
-            t_near = np.concatenate([np.broadcast_to(np.asarray(r.t_near, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
-            t_far = np.concatenate([np.broadcast_to(np.asarray(r.t_far, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
-            owners = np.concatenate([np.broadcast_to(np.asarray(r.exclude_owner, dtype=np.int64), (n,)) for r, n in zip(reqs, sizes)])
+            t_near = joined(reqs, sizes, "t_near", np.float64)
+            t_far = joined(reqs, sizes, "t_far", np.float64)
+            owners = joined(reqs, sizes, "exclude_owner", np.int64)
             mount = None
             if any(r.mount is not None for r in reqs):
                 mount = self._joined_mount(reqs, sizes)
             hits = engine.cast(origins, dirs, t_near, t_far, kind=kind, exclude_owner=owners, skip_transparent=skip,
                                mount=mount, distance_only=distance_only)
-            start = 0
-            for i, n in zip(idx, sizes):
-                sl = slice(start, start + n)
-                results[i] = RayHits(hits.distance[sl], None if hits.normal is None else hits.normal[sl],
-                                     None if hits.shape is None else hits.shape[sl])
-                start += n
+            for i, h in zip(idx, split_hits(hits, sizes)):
+                results[i] = h
         return results  # type: ignore[return-value]
