@@ -52,7 +52,7 @@ from sensorium.server.sim.simulation import lights_from_models
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import check_pose
 from sensorium.server.world.loader import LoadedWorld, from_model
-from sensorium.server.world.poses import pose_from_model, pose_from_values
+from sensorium.server.world.poses import moved_pose, pose_from_model
 
 __all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS", "check_observable"]
 
@@ -444,13 +444,7 @@ class BatchedSimulation:
     def set_pose(self, copy: int, slot: int, translation=None, rotation=None, quaternion=None) -> None:
         """Move a robot of one copy (supervisor-style, no contact check), as ``RobotState.set_pose``."""
         check_pose(translation, rotation, quaternion)
-        current = self.pose(copy, slot)
-        if translation is None:
-            translation = current.translation
-        if rotation is None and quaternion is None:
-            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
-        else:
-            pose = pose_from_values(translation, rotation, quaternion)
+        pose = moved_pose(self.pose(copy, slot), translation, rotation, quaternion)
         self.rot[copy, slot] = pose.rotation
         self.pos[copy, slot] = pose.translation
         if self.contact is not None:

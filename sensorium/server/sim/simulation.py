@@ -41,7 +41,7 @@ from sensorium.server.sim.sensors import (
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, from_model, load_world
-from sensorium.server.world.poses import pose_from_values
+from sensorium.server.world.poses import moved_pose
 from sensorium.server.world.report import warn_losses
 
 
@@ -127,13 +127,7 @@ class RobotState:
         (Webots): leave one out (``None``) and it keeps its current value. Non-finite values or a
         translation beyond ``limits.MAX_COORDINATE_M`` raise ValueError and the robot stays."""
         check_pose(translation, rotation, quaternion)
-        current = self.pose
-        if translation is None:
-            translation = current.translation
-        if rotation is None and quaternion is None:
-            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
-        else:
-            pose = pose_from_values(translation, rotation, quaternion)
+        pose = moved_pose(self.pose, translation, rotation, quaternion)
         self._sim.place_robot(self.index, pose)
         if self.drive is not None:
             self.drive.reset(pose)
@@ -266,13 +260,7 @@ class Simulation:
     def set_solid_pose(self, name: str, translation, rotation=None, quaternion=None) -> None:
         if name not in self.scene.solid_poses:
             raise KeyError(f"no solid {name!r}")
-        current = self.scene.solid_poses[name]
-        if translation is None:
-            translation = current.translation
-        if rotation is None and quaternion is None:
-            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
-        else:
-            pose = pose_from_values(translation, rotation, quaternion)
+        pose = moved_pose(self.scene.solid_poses[name], translation, rotation, quaternion)
         self.scene.set_solid_pose(name, pose)
         if self.contact is not None:
             self.contact.update_solid(name, pose)

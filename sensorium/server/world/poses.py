@@ -86,3 +86,13 @@ def pose_from_values(translation, rotation=None, quaternion=None) -> Pose:
     else:
         r = np.eye(3)
     return Pose(rotation=r, translation=t)
+
+
+def moved_pose(current: Pose, translation=None, rotation=None, quaternion=None) -> Pose:
+    """``current`` with what is given replaced (a supervisor's move): no ``translation`` keeps its
+    translation, neither ``rotation`` nor ``quaternion`` keeps its rotation."""
+    if translation is None:
+        translation = current.translation
+    if rotation is None and quaternion is None:
+        return Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
+    return pose_from_values(translation, rotation, quaternion)
