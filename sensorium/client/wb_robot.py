@@ -566,6 +566,28 @@ def current() -> RobotClient:
     return _robot
 
 
+def sensor_enable(tag: int, kind: str, period: int, func: str) -> None:
+    """Every sensor's ``wb_<kind>_enable``/``_disable`` (period 0): the device of ``tag``, if it is a
+    ``kind``, enabled on the server and here."""
+    r = current()
+    r.enable(r.device(tag, kind, func), period, func)
+
+
+def sensor_period(tag: int, kind: str, func: str) -> int:
+    """Every sensor's ``wb_<kind>_get_sampling_period``."""
+    return current().device(tag, kind, func).sampling_period
+
+
+def sensor_reading(tag: int, kind: str, func: str, enabler: str) -> DeviceState:
+    """The device for a getter of its readings, with Webots' message (once per disable) when it is
+    read while disabled."""
+    r = current()
+    dev = r.device(tag, kind, func)
+    if dev.sampling_period <= 0:
+        r.warn_disabled(dev, func, enabler)
+    return dev
+
+
 def wb_robot_init(url: str | None = None, **options: Any) -> None:
     """Attach this process to its robot (URL from the environment unless given). Idempotent."""
     global _robot, _atexit_registered
