@@ -248,8 +248,7 @@ def wb_camera_set_exposure(tag: int, exposure: float) -> None:
     if exposure < 0:
         print(f"Error: 'exposure' argument of {func}() can't be negative.", file=sys.stderr)
         return
-    if not r.terminated:
-        r._expect_success(r.rpc(dev, "set_exposure", {"value": float(exposure)}), func)
+    r.device_set(dev, "set_exposure", float(exposure), func)
     dev.desc["exposure"] = float(exposure)
 
 
@@ -337,8 +336,7 @@ def wb_camera_recognition_enable(tag: int, sampling_period: int) -> None:
         return
     if isinstance(sampling_period, bool) or not isinstance(sampling_period, int) or sampling_period < 0:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer >= 0, got {sampling_period!r}")
-    if not r.terminated:
-        r._expect_success(r.rpc(dev, "recognition_enable", {"value": sampling_period}), func)
+    r.device_set(dev, "recognition_enable", sampling_period, func)
     dev.camera["recognition_period"] = sampling_period
     if sampling_period == 0:
         dev.camera["segmentation_enabled"] = False
@@ -388,8 +386,7 @@ def _segmentation(tag: int, on: bool, func: str) -> None:
         print(f"Error: {func}() called while the recognition is disabled! Please use: wb_camera_recognition_enable().",
               file=sys.stderr)
         return
-    if not r.terminated:
-        r._expect_success(r.rpc(dev, "enable_segmentation", {"value": bool(on)}), func)
+    r.device_set(dev, "enable_segmentation", bool(on), func)
     dev.camera["segmentation_enabled"] = bool(on)
 
 

@@ -118,8 +118,7 @@ def wb_receiver_set_channel(tag: int, channel: int) -> None:
     dev = _receiver(tag, "wb_receiver_set_channel")
     if channel == dev.channel or not _allowed(dev, channel, "wb_receiver_set_channel"):
         return
-    if not r.terminated:
-        r.rpc(dev, "set_channel", {"value": channel})
+    r.device_set(dev, "set_channel", channel, "wb_receiver_set_channel")
     dev.channel = channel
 
 
