@@ -143,7 +143,9 @@ void wb_distance_sensor_enable(WbDeviceTag tag, int sampling_period) {
   sn_sensor_enable(tag, SN_DISTANCE, sampling_period, "wb_distance_sensor_enable");
 }
 
-void wb_distance_sensor_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_DISTANCE, 0, "wb_distance_sensor_disable"); }
+void wb_distance_sensor_disable(WbDeviceTag tag) {
+  sn_sensor_enable(tag, SN_DISTANCE, 0, "wb_distance_sensor_disable");
+}
 
 int wb_distance_sensor_get_sampling_period(WbDeviceTag tag) {
   return sn_sensor_period(tag, SN_DISTANCE, "wb_distance_sensor_get_sampling_period");

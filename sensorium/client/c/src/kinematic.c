@@ -46,9 +46,13 @@ const double *wb_inertial_unit_get_quaternion(WbDeviceTag tag) {
 }
 
 /* ------------------------------------------------------------------ Compass */
-void wb_compass_enable(WbDeviceTag tag, int sampling_period) { sn_sensor_enable(tag, SN_COMPASS, sampling_period, "wb_compass_enable"); }
+void wb_compass_enable(WbDeviceTag tag, int sampling_period) {
+  sn_sensor_enable(tag, SN_COMPASS, sampling_period, "wb_compass_enable");
+}
 void wb_compass_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_COMPASS, 0, "wb_compass_disable"); }
-int wb_compass_get_sampling_period(WbDeviceTag tag) { return sn_sensor_period(tag, SN_COMPASS, "wb_compass_get_sampling_period"); }
+int wb_compass_get_sampling_period(WbDeviceTag tag) {
+  return sn_sensor_period(tag, SN_COMPASS, "wb_compass_get_sampling_period");
+}
 const double *wb_compass_get_values(WbDeviceTag tag) {
   sn_device *d = sn_sensor_reading(tag, SN_COMPASS, "wb_compass_get_values", "wb_compass_enable");
   return d ? d->values : sn_no_values();
@@ -64,7 +68,9 @@ const double *wb_compass_get_lookup_table(WbDeviceTag tag) {
 void wb_accelerometer_enable(WbDeviceTag tag, int sampling_period) {
   sn_sensor_enable(tag, SN_ACCELEROMETER, sampling_period, "wb_accelerometer_enable");
 }
-void wb_accelerometer_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_ACCELEROMETER, 0, "wb_accelerometer_disable"); }
+void wb_accelerometer_disable(WbDeviceTag tag) {
+  sn_sensor_enable(tag, SN_ACCELEROMETER, 0, "wb_accelerometer_disable");
+}
 int wb_accelerometer_get_sampling_period(WbDeviceTag tag) {
   return sn_sensor_period(tag, SN_ACCELEROMETER, "wb_accelerometer_get_sampling_period");
 }
@@ -80,9 +86,13 @@ const double *wb_accelerometer_get_lookup_table(WbDeviceTag tag) {
 }
 
 /* ------------------------------------------------------------------ Gyro */
-void wb_gyro_enable(WbDeviceTag tag, int sampling_period) { sn_sensor_enable(tag, SN_GYRO, sampling_period, "wb_gyro_enable"); }
+void wb_gyro_enable(WbDeviceTag tag, int sampling_period) {
+  sn_sensor_enable(tag, SN_GYRO, sampling_period, "wb_gyro_enable");
+}
 void wb_gyro_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_GYRO, 0, "wb_gyro_disable"); }
-int wb_gyro_get_sampling_period(WbDeviceTag tag) { return sn_sensor_period(tag, SN_GYRO, "wb_gyro_get_sampling_period"); }
+int wb_gyro_get_sampling_period(WbDeviceTag tag) {
+  return sn_sensor_period(tag, SN_GYRO, "wb_gyro_get_sampling_period");
+}
 const double *wb_gyro_get_values(WbDeviceTag tag) {
   sn_device *d = sn_sensor_reading(tag, SN_GYRO, "wb_gyro_get_values", "wb_gyro_enable");
   return d ? d->values : sn_no_values();
