@@ -4,7 +4,8 @@
  *             the heartbeat thread;
  * wire.c    - msgpack helpers (building requests, reading reply maps);
  * robot.c   - the session: attach, step (motor commands out, readings in), cleanup;
- * devices.c - light and distance sensors, generic device functions; lidar.c; motor.c; gps.c;
+ * devices.c - light and distance sensors, generic device functions (and every sensor's enable,
+ *             sampling period and reading: sn_sensor_*); lidar.c; motor.c; gps.c;
  * kinematic.c - InertialUnit, Compass, Accelerometer, Gyro, Altimeter, TouchSensor;
  * radio.c   - Emitter and Receiver (packet queues, baud-rate pacing);
  * camera.c  - range finders and cameras;
