@@ -19,6 +19,16 @@ def proto_file(folder: Path, name: str, body: str, header: str = "") -> Path:
     return p
 
 
+def webots_home(root: Path, monkeypatch=None, version: str = "R2023b") -> Path:
+    """``root`` made a Webots installation (its ``resources/version.txt``) and, with ``monkeypatch``,
+    the test's ``WEBOTS_HOME``."""
+    (root / "resources").mkdir(parents=True, exist_ok=True)
+    (root / "resources" / "version.txt").write_text(version + "\n")
+    if monkeypatch is not None:
+        monkeypatch.setenv("WEBOTS_HOME", str(root))
+    return root
+
+
 def world_file(folder: Path, body: str, protos: list[str] = (), name: str = "w.wbt") -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     p = folder / name

@@ -13,6 +13,8 @@
 * ``serve(WORLD, *extra)``: ``sensorium serve`` on 127.0.0.1 free ports (``--rpc``/``--pub``
   ``tcp://127.0.0.1:0``), ready. ``serve(..., wait=False)`` starts it only (to start several side
   by side, then ``wait_ready`` each).
+* ``run_example(WORLD, EXAMPLE, ROBOT, STEPS)``: a bundled example controller run to its end against
+  ``sensorium serve WORLD``; the robot's final pose and the finished controller process.
 
 The child imports this tree (the repository is put first on its PYTHONPATH) and runs unbuffered.
 ``env`` adds variables to the test's environment; a value of ``None`` removes one. Whatever a
@@ -279,6 +281,21 @@ def serve(world: Path | str | None = None, *extra: str, rpc: str = ANY_PORT, pub
     argv = sensorium("serve", *([] if world is None else [str(world)]), "--rpc", rpc, "--pub", pub, *extra)
     served = Served(argv, "sensorium: serving world", stop_signal=stop_signal, **kw)
     return served.wait_ready() if wait else served
+
+
+def run_example(world: str, example: str, robot: str, steps: int) -> tuple[dict, Proc]:
+    """``sensorium controller example:EXAMPLE --url … STEPS`` against ``sensorium serve WORLD``: the
+    world waits (pause) until the controller has attached, then runs fast until the controller exits
+    by itself (code 0 asserted). Returns ``ROBOT``'s pose then and the finished controller process."""
+    with serve(world, "--mode", "pause", "--heartbeat-ms", "500") as server:
+        proc = Proc(sensorium("controller", f"example:{example}", "--url", server.url(robot), str(steps)))
+        try:
+            server.wait_attached({robot})
+            server.conn.call("set_mode", {"mode": "fast"})
+            assert proc.wait(300) == 0, proc.stderr()
+        finally:
+            proc.stop()
+        return server.conn.call(f"/{robot}/robot/get_pose"), proc
 
 
 def wait_until(pred, timeout: float = 30.0, what: str = "condition", every: float = 0.01):

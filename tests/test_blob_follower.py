@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from _serve import Proc, sensorium, serve
+from _serve import run_example
 
 from sensorium.client.examples.blob_follower import BlobFollower, red_pixels
 from sensorium.server.sim.simulation import Simulation
@@ -68,15 +68,7 @@ def test_red_pixels_of_a_bgra_image():
 def test_the_controller_process_drives_like_the_in_process_run():
     steps = 250
     expected = chase("exact", steps)
-    with serve("blob_chase", "--mode", "pause", "--heartbeat-ms", "500") as server:
-        proc = Proc(sensorium("controller", "example:blob_follower", "--url", server.url("epuck"), str(steps)))
-        try:
-            server.wait_attached({"epuck"})
-            server.conn.call("set_mode", {"mode": "fast"})
-            assert proc.wait(300) == 0, proc.stderr()
-        finally:
-            proc.stop()
-        got = server.conn.call("/epuck/robot/get_pose")
+    got, proc = run_example("blob_chase", "blob_follower", "epuck", steps)
     assert got["translation"][:2] == expected["xy"].tolist()
     lines = [x for x in proc.out if x.startswith("t=")]
     assert len(lines) == steps // 31 and all("red_pixels=0 " not in x for x in lines[1:])

@@ -41,12 +41,19 @@ def _run(cmd: list[str], url: str) -> tuple[list[str], str]:
     return out, err
 
 
-def test_range_finder_bytes_match_python(reader):
+def _read_in_c_and_python(reader: str, *args: str) -> tuple[list[str], str, list[str]]:
+    """The C image reader's stdout and stderr, and the Python reader's stdout, each run with ``args``
+    against a fresh server of the images world."""
     with serve(WORLD, env=SAN_ENV) as s:
-        c_out, c_err = _run([reader, "depth", "3"], s.url("bot"))
+        c_out, c_err = _run([reader, *args], s.url("bot"))
     with serve(WORLD, env=SAN_ENV) as s:
         py_out, _ = _run([sys.executable, "-m", "sensorium", "controller", "--url", s.url("bot"),
-                          str(REPO / "tests" / "controllers" / "image_reader.py"), "depth", "3"], s.url("bot"))
+                          str(REPO / "tests" / "controllers" / "image_reader.py"), *args], s.url("bot"))
+    return c_out, c_err, py_out
+
+
+def test_range_finder_bytes_match_python(reader):
+    c_out, c_err, py_out = _read_in_c_and_python(reader, "depth", "3")
     assert c_out == py_out
     assert c_out[-2] == "# info 12 8 1 0.050000000000000003 3" and c_out[-1] == "# save -1"
     first = bytes.fromhex(c_out[0].split("=")[1])
@@ -55,11 +62,7 @@ def test_range_finder_bytes_match_python(reader):
 
 
 def test_camera_bytes_match_python(reader):
-    with serve(WORLD, env=SAN_ENV) as s:
-        c_out, c_err = _run([reader, "camera", "3"], s.url("bot"))
-    with serve(WORLD, env=SAN_ENV) as s:
-        py_out, _ = _run([sys.executable, "-m", "sensorium", "controller", "--url", s.url("bot"),
-                          str(REPO / "tests" / "controllers" / "image_reader.py"), "camera", "3"], s.url("bot"))
+    c_out, c_err, py_out = _read_in_c_and_python(reader, "camera", "3")
     assert c_out == py_out
     assert c_out[0] == "# null_before 1" and c_out[-2] == "# exposure 2" and c_out[-1] == "# save -1"
     first = bytes.fromhex(c_out[1].split(" ")[2].split("=")[1])

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from _serve import Proc, sensorium, serve
+from _serve import run_example
 from PIL import Image
 
 from sensorium import worlds
@@ -71,15 +71,7 @@ def test_the_controller_process_follows_the_line_like_the_in_process_run(tmp_pat
     on the line."""
     steps = line_loop.lap()["steps"]
     expected = line_loop.lap(steps=steps)
-    with serve("line_following", "--mode", "pause", "--heartbeat-ms", "500") as server:
-        proc = Proc(sensorium("controller", "example:line_follower", "--url", server.url("epuck"), str(steps)))
-        try:
-            server.wait_attached({"epuck"})
-            server.conn.call("set_mode", {"mode": "fast"})
-            assert proc.wait(300) == 0, proc.stderr()
-        finally:
-            proc.stop()
-        got = server.conn.call("/epuck/robot/get_pose")
+    got, proc = run_example("line_following", "line_follower", "epuck", steps)
     assert got["translation"][:2] == expected["path"][-1].tolist()
     assert line_loop.distance_to_line(np.array([got["translation"][:2]]))[0][0] < 0.03
     lines = [x for x in proc.out if x.startswith("t=")]

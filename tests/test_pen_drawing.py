@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from _serve import Proc, sensorium, serve
+from _serve import run_example
 from PIL import Image
 
 from sensorium import worlds
@@ -54,15 +54,7 @@ def test_the_robot_draws_a_circle_then_follows_its_ink_once_round(precision: str
 def test_the_controller_process_draws_and_follows_like_the_in_process_run() -> None:
     steps = 1228 + 300
     expected = pen_drawing.run(follow_steps=300)
-    with serve("pen_drawing", "--mode", "pause", "--heartbeat-ms", "500") as server:
-        proc = Proc(sensorium("controller", "example:pen_drawer", "--url", server.url("epuck"), str(steps)))
-        try:
-            server.wait_attached({"epuck"})
-            server.conn.call("set_mode", {"mode": "fast"})
-            assert proc.wait(300) == 0, proc.stderr()
-        finally:
-            proc.stop()
-        got = server.conn.call("/epuck/robot/get_pose")
+    got, proc = run_example("pen_drawing", "pen_drawer", "epuck", steps)
     assert got["translation"][:2] == expected["path"][-1].tolist()
     out = proc.stdout()
     assert "the circle is drawn: pen off, following the ink" in out

@@ -9,7 +9,7 @@ import hashlib
 from pathlib import Path
 
 import pytest
-from _protos import HEADER, expanded, proto_file, world_file
+from _protos import HEADER, expanded, proto_file, webots_home, world_file
 
 from sensorium.server.world.loader import WorldError, load_world
 from sensorium.server.world.proto import ProtoError, ProtoSearch, asset_roots, resolve_url
@@ -27,9 +27,7 @@ def fake_webots(root: Path, version: str = "R2023b") -> Path:
     proto_file(protos, "AcmeEye", "[ ] { LightSensor { name \"eye\" } }")
     devices = root / "projects" / "devices" / "acme" / "protos"
     proto_file(devices, "AcmeRanger", "[ ] { DistanceSensor { name \"ranger\" } }")
-    (root / "resources").mkdir(parents=True, exist_ok=True)
-    (root / "resources" / "version.txt").write_text(version + "\n")
-    return root
+    return webots_home(root, version=version)
 
 
 def test_webots_and_raw_github_urls_map_to_the_installation(tmp_path: Path, monkeypatch) -> None:
@@ -216,12 +214,9 @@ TETRA = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 
 def test_mesh_urls_of_protos_and_webots_assets_load_read_only(tmp_path: Path, monkeypatch) -> None:
     """A PROTO's mesh url is relative to the PROTO file, webots:// comes from the installation; both
     are read where they are (the world's folder does not hold them); a missing one is a warning."""
-    home = tmp_path / "webots"
+    home = webots_home(tmp_path / "webots", monkeypatch)
     (home / "projects" / "meshes").mkdir(parents=True)
     (home / "projects" / "meshes" / "cone.obj").write_text(TETRA)
-    (home / "resources").mkdir()
-    (home / "resources" / "version.txt").write_text("R2023b\n")
-    monkeypatch.setenv("WEBOTS_HOME", str(home))
     protos = tmp_path / "project" / "protos"
     (protos / "meshes").mkdir(parents=True)
     (protos / "meshes" / "shell.obj").write_text(TETRA)
@@ -252,12 +247,9 @@ def test_texture_urls_of_protos_and_webots_assets_load_read_only(tmp_path: Path,
     read where they are; infra-red reads their texels (a red and a blue image: red channel 1 and 0)."""
     from PIL import Image
 
-    home = tmp_path / "webots"
+    home = webots_home(tmp_path / "webots", monkeypatch)
     (home / "projects" / "textures").mkdir(parents=True)
     Image.new("RGB", (2, 2), (0, 0, 255)).save(home / "projects" / "textures" / "blue.png")
-    (home / "resources").mkdir()
-    (home / "resources" / "version.txt").write_text("R2023b\n")
-    monkeypatch.setenv("WEBOTS_HOME", str(home))
     protos = tmp_path / "project" / "protos"
     (protos / "textures").mkdir(parents=True)
     Image.new("RGB", (2, 2), (255, 0, 0)).save(protos / "textures" / "red.png")

@@ -164,14 +164,11 @@ def test_a_texture_webots_could_not_load_reads_the_untextured_colour(tmp_path: P
 def test_proto_relative_and_webots_texture_urls_are_read_where_they_are(tmp_path: Path, monkeypatch) -> None:
     """A PROTO's ImageTexture url is relative to the PROTO file, a webots:// url names the Webots
     installation's file (as mesh urls): both read in place, and infra-red sensors read their texels."""
-    from _protos import proto_file, world_file
+    from _protos import proto_file, webots_home, world_file
 
-    home = tmp_path / "webots"
+    home = webots_home(tmp_path / "webots", monkeypatch)
     (home / "projects" / "textures").mkdir(parents=True)
     Image.new("RGB", (4, 4), (51, 0, 0)).save(home / "projects" / "textures" / "dark.png")
-    (home / "resources").mkdir()
-    (home / "resources" / "version.txt").write_text("R2023b\n")
-    monkeypatch.setenv("WEBOTS_HOME", str(home))
     protos = tmp_path / "project" / "protos"
     (protos / "textures").mkdir(parents=True)
     Image.new("RGB", (4, 4), (153, 0, 0)).save(protos / "textures" / "mid.png")

@@ -13,7 +13,7 @@ from typing import Any
 
 from sensorium.client import arrays, images
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import DeviceState, current
+from sensorium.client.wb_robot import DeviceState, current, sensor_enable, sensor_period, sensor_reading
 
 RANGE_FINDER = "RangeFinder"
 
@@ -50,17 +50,15 @@ def _rf(tag: int, func: str) -> DeviceState:
 
 
 def wb_range_finder_enable(tag: int, sampling_period: int) -> None:
-    r = current()
-    r.enable(_rf(tag, "wb_range_finder_enable"), sampling_period, "wb_range_finder_enable")
+    sensor_enable(tag, RANGE_FINDER, sampling_period, "wb_range_finder_enable")
 
 
 def wb_range_finder_disable(tag: int) -> None:
-    r = current()
-    r.enable(_rf(tag, "wb_range_finder_disable"), 0, "wb_range_finder_disable")
+    sensor_enable(tag, RANGE_FINDER, 0, "wb_range_finder_disable")
 
 
 def wb_range_finder_get_sampling_period(tag: int) -> int:
-    return _rf(tag, "wb_range_finder_get_sampling_period").sampling_period
+    return sensor_period(tag, RANGE_FINDER, "wb_range_finder_get_sampling_period")
 
 
 def wb_range_finder_get_width(tag: int) -> int:
@@ -86,10 +84,7 @@ def wb_range_finder_get_max_range(tag: int) -> float:
 def range_finder_bytes(tag: int, func: str = "wb_range_finder_get_range_image") -> bytes:
     """The raw little-endian float32 image (``height`` rows of ``width``), zeros before the first
     image; a disabled device prints Webots' error once and still returns it (Webots)."""
-    r = current()
-    dev = _rf(tag, func)
-    if dev.sampling_period <= 0:
-        r.warn_disabled(dev, func, "wb_range_finder_enable")
+    dev = sensor_reading(tag, RANGE_FINDER, func, "wb_range_finder_enable")
     if dev.range_bytes is None:
         return bytes(4 * int(dev.desc.get("width", 0)) * int(dev.desc.get("height", 0)))
     return dev.range_bytes
@@ -142,17 +137,15 @@ def _cam(tag: int, func: str) -> DeviceState:
 
 
 def wb_camera_enable(tag: int, sampling_period: int) -> None:
-    r = current()
-    r.enable(_cam(tag, "wb_camera_enable"), sampling_period, "wb_camera_enable")
+    sensor_enable(tag, CAMERA, sampling_period, "wb_camera_enable")
 
 
 def wb_camera_disable(tag: int) -> None:
-    r = current()
-    r.enable(_cam(tag, "wb_camera_disable"), 0, "wb_camera_disable")
+    sensor_enable(tag, CAMERA, 0, "wb_camera_disable")
 
 
 def wb_camera_get_sampling_period(tag: int) -> int:
-    return _cam(tag, "wb_camera_get_sampling_period").sampling_period
+    return sensor_period(tag, CAMERA, "wb_camera_get_sampling_period")
 
 
 def _black(dev: DeviceState) -> bytes:
@@ -255,8 +248,7 @@ def wb_camera_set_exposure(tag: int, exposure: float) -> None:
     if exposure < 0:
         print(f"Error: 'exposure' argument of {func}() can't be negative.", file=sys.stderr)
         return
-    if not r.terminated:
-        r._expect_success(r.rpc(dev, "set_exposure", {"value": float(exposure)}), func)
+    r.device_set(dev, "set_exposure", float(exposure), func)
     dev.desc["exposure"] = float(exposure)
 
 
@@ -344,8 +336,7 @@ def wb_camera_recognition_enable(tag: int, sampling_period: int) -> None:
         return
     if isinstance(sampling_period, bool) or not isinstance(sampling_period, int) or sampling_period < 0:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer >= 0, got {sampling_period!r}")
-    if not r.terminated:
-        r._expect_success(r.rpc(dev, "recognition_enable", {"value": sampling_period}), func)
+    r.device_set(dev, "recognition_enable", sampling_period, func)
     dev.camera["recognition_period"] = sampling_period
     if sampling_period == 0:
         dev.camera["segmentation_enabled"] = False
@@ -395,8 +386,7 @@ def _segmentation(tag: int, on: bool, func: str) -> None:
         print(f"Error: {func}() called while the recognition is disabled! Please use: wb_camera_recognition_enable().",
               file=sys.stderr)
         return
-    if not r.terminated:
-        r._expect_success(r.rpc(dev, "enable_segmentation", {"value": bool(on)}), func)
+    r.device_set(dev, "enable_segmentation", bool(on), func)
     dev.camera["segmentation_enabled"] = bool(on)
 
 

@@ -9,7 +9,7 @@ import math
 import sys
 from typing import Any
 
-from sensorium.client.wb_robot import DeviceState, current
+from sensorium.client.wb_robot import DeviceState, current, sensor_enable, sensor_period, sensor_reading
 
 WB_GPS_LOCAL_COORDINATE = 0
 WB_GPS_WGS84_COORDINATE = 1
@@ -31,20 +31,6 @@ def _dev(tag: int, kind: str, func: str) -> DeviceState:
     return current().device(tag, kind, func)
 
 
-def _enable(tag: int, kind: str, period: int, func: str) -> None:
-    r = current()
-    r.enable(r.device(tag, kind, func), period, func)
-
-
-def _read(tag: int, kind: str, func: str, enabler: str) -> DeviceState:
-    """The device, with Webots' message once per disable when it is read while disabled."""
-    r = current()
-    dev = r.device(tag, kind, func)
-    if dev.sampling_period <= 0:
-        r.warn_disabled(dev, func, enabler)
-    return dev
-
-
 def _table(tag: int, kind: str, func: str) -> list[float]:
     r = current()
     return list(r.constant(r.device(tag, kind, func), "lookup_table"))
@@ -53,28 +39,28 @@ def _table(tag: int, kind: str, func: str) -> list[float]:
 # ---------------------------------------------------------------------- GPS
 
 def wb_gps_enable(tag: int, sampling_period: int) -> None:
-    _enable(tag, GPS, sampling_period, "wb_gps_enable")
+    sensor_enable(tag, GPS, sampling_period, "wb_gps_enable")
 
 
 def wb_gps_disable(tag: int) -> None:
-    _enable(tag, GPS, 0, "wb_gps_disable")
+    sensor_enable(tag, GPS, 0, "wb_gps_disable")
 
 
 def wb_gps_get_sampling_period(tag: int) -> int:
-    return _dev(tag, GPS, "wb_gps_get_sampling_period").sampling_period
+    return sensor_period(tag, GPS, "wb_gps_get_sampling_period")
 
 
 def wb_gps_get_values(tag: int) -> list[float]:
     """x, y, z (local, m) or latitude, longitude (degrees), altitude (m) with WGS84."""
-    return list(_read(tag, GPS, "wb_gps_get_values", "wb_gps_enable").values)
+    return list(sensor_reading(tag, GPS, "wb_gps_get_values", "wb_gps_enable").values)
 
 
 def wb_gps_get_speed(tag: int) -> float:
-    return _read(tag, GPS, "wb_gps_get_speed", "wb_gps_enable").speed
+    return sensor_reading(tag, GPS, "wb_gps_get_speed", "wb_gps_enable").speed
 
 
 def wb_gps_get_speed_vector(tag: int) -> list[float]:
-    return list(_read(tag, GPS, "wb_gps_get_speed_vector", "wb_gps_enable").speed_vector)
+    return list(sensor_reading(tag, GPS, "wb_gps_get_speed_vector", "wb_gps_enable").speed_vector)
 
 
 def wb_gps_get_coordinate_system(tag: int) -> int:
@@ -94,25 +80,25 @@ def wb_gps_convert_to_degrees_minutes_seconds(decimal_degrees: float) -> str:
 # ---------------------------------------------------------------------- InertialUnit
 
 def wb_inertial_unit_enable(tag: int, sampling_period: int) -> None:
-    _enable(tag, INERTIAL_UNIT, sampling_period, "wb_inertial_unit_enable")
+    sensor_enable(tag, INERTIAL_UNIT, sampling_period, "wb_inertial_unit_enable")
 
 
 def wb_inertial_unit_disable(tag: int) -> None:
-    _enable(tag, INERTIAL_UNIT, 0, "wb_inertial_unit_disable")
+    sensor_enable(tag, INERTIAL_UNIT, 0, "wb_inertial_unit_disable")
 
 
 def wb_inertial_unit_get_sampling_period(tag: int) -> int:
-    return _dev(tag, INERTIAL_UNIT, "wb_inertial_unit_get_sampling_period").sampling_period
+    return sensor_period(tag, INERTIAL_UNIT, "wb_inertial_unit_get_sampling_period")
 
 
 def wb_inertial_unit_get_roll_pitch_yaw(tag: int) -> list[float]:
     """Roll, pitch, yaw (rad) in the world's convention (ENU or NUE)."""
-    return list(_read(tag, INERTIAL_UNIT, "wb_inertial_unit_get_roll_pitch_yaw", "wb_inertial_unit_enable").roll_pitch_yaw)
+    return list(sensor_reading(tag, INERTIAL_UNIT, "wb_inertial_unit_get_roll_pitch_yaw", "wb_inertial_unit_enable").roll_pitch_yaw)
 
 
 def wb_inertial_unit_get_quaternion(tag: int) -> list[float]:
     """x, y, z, w."""
-    return list(_read(tag, INERTIAL_UNIT, "wb_inertial_unit_get_quaternion", "wb_inertial_unit_enable").quaternion)
+    return list(sensor_reading(tag, INERTIAL_UNIT, "wb_inertial_unit_get_quaternion", "wb_inertial_unit_enable").quaternion)
 
 
 def wb_inertial_unit_get_noise(tag: int) -> float:
@@ -122,20 +108,20 @@ def wb_inertial_unit_get_noise(tag: int) -> float:
 # ---------------------------------------------------------------------- Compass, Accelerometer, Gyro
 
 def wb_compass_enable(tag: int, sampling_period: int) -> None:
-    _enable(tag, COMPASS, sampling_period, "wb_compass_enable")
+    sensor_enable(tag, COMPASS, sampling_period, "wb_compass_enable")
 
 
 def wb_compass_disable(tag: int) -> None:
-    _enable(tag, COMPASS, 0, "wb_compass_disable")
+    sensor_enable(tag, COMPASS, 0, "wb_compass_disable")
 
 
 def wb_compass_get_sampling_period(tag: int) -> int:
-    return _dev(tag, COMPASS, "wb_compass_get_sampling_period").sampling_period
+    return sensor_period(tag, COMPASS, "wb_compass_get_sampling_period")
 
 
 def wb_compass_get_values(tag: int) -> list[float]:
     """The north direction in the device frame (through the lookup table)."""
-    return list(_read(tag, COMPASS, "wb_compass_get_values", "wb_compass_enable").values)
+    return list(sensor_reading(tag, COMPASS, "wb_compass_get_values", "wb_compass_enable").values)
 
 
 def wb_compass_get_lookup_table_size(tag: int) -> int:
@@ -147,20 +133,20 @@ def wb_compass_get_lookup_table(tag: int) -> list[float]:
 
 
 def wb_accelerometer_enable(tag: int, sampling_period: int) -> None:
-    _enable(tag, ACCELEROMETER, sampling_period, "wb_accelerometer_enable")
+    sensor_enable(tag, ACCELEROMETER, sampling_period, "wb_accelerometer_enable")
 
 
 def wb_accelerometer_disable(tag: int) -> None:
-    _enable(tag, ACCELEROMETER, 0, "wb_accelerometer_disable")
+    sensor_enable(tag, ACCELEROMETER, 0, "wb_accelerometer_disable")
 
 
 def wb_accelerometer_get_sampling_period(tag: int) -> int:
-    return _dev(tag, ACCELEROMETER, "wb_accelerometer_get_sampling_period").sampling_period
+    return sensor_period(tag, ACCELEROMETER, "wb_accelerometer_get_sampling_period")
 
 
 def wb_accelerometer_get_values(tag: int) -> list[float]:
     """The specific force (m/s²) in the device frame: (0, 0, g) at rest in ENU."""
-    return list(_read(tag, ACCELEROMETER, "wb_accelerometer_get_values", "wb_accelerometer_enable").values)
+    return list(sensor_reading(tag, ACCELEROMETER, "wb_accelerometer_get_values", "wb_accelerometer_enable").values)
 
 
 def wb_accelerometer_get_lookup_table_size(tag: int) -> int:
@@ -172,20 +158,20 @@ def wb_accelerometer_get_lookup_table(tag: int) -> list[float]:
 
 
 def wb_gyro_enable(tag: int, sampling_period: int) -> None:
-    _enable(tag, GYRO, sampling_period, "wb_gyro_enable")
+    sensor_enable(tag, GYRO, sampling_period, "wb_gyro_enable")
 
 
 def wb_gyro_disable(tag: int) -> None:
-    _enable(tag, GYRO, 0, "wb_gyro_disable")
+    sensor_enable(tag, GYRO, 0, "wb_gyro_disable")
 
 
 def wb_gyro_get_sampling_period(tag: int) -> int:
-    return _dev(tag, GYRO, "wb_gyro_get_sampling_period").sampling_period
+    return sensor_period(tag, GYRO, "wb_gyro_get_sampling_period")
 
 
 def wb_gyro_get_values(tag: int) -> list[float]:
     """The angular velocity (rad/s) in the device frame."""
-    return list(_read(tag, GYRO, "wb_gyro_get_values", "wb_gyro_enable").values)
+    return list(sensor_reading(tag, GYRO, "wb_gyro_get_values", "wb_gyro_enable").values)
 
 
 def wb_gyro_get_lookup_table_size(tag: int) -> int:
@@ -199,34 +185,34 @@ def wb_gyro_get_lookup_table(tag: int) -> list[float]:
 # ---------------------------------------------------------------------- Altimeter
 
 def wb_altimeter_enable(tag: int, sampling_period: int) -> None:
-    _enable(tag, ALTIMETER, sampling_period, "wb_altimeter_enable")
+    sensor_enable(tag, ALTIMETER, sampling_period, "wb_altimeter_enable")
 
 
 def wb_altimeter_disable(tag: int) -> None:
-    _enable(tag, ALTIMETER, 0, "wb_altimeter_disable")
+    sensor_enable(tag, ALTIMETER, 0, "wb_altimeter_disable")
 
 
 def wb_altimeter_get_sampling_period(tag: int) -> int:
-    return _dev(tag, ALTIMETER, "wb_altimeter_get_sampling_period").sampling_period
+    return sensor_period(tag, ALTIMETER, "wb_altimeter_get_sampling_period")
 
 
 def wb_altimeter_get_value(tag: int) -> float:
     """The device's height (m) along the world's up axis."""
-    return _read(tag, ALTIMETER, "wb_altimeter_get_value", "wb_altimeter_enable").value
+    return sensor_reading(tag, ALTIMETER, "wb_altimeter_get_value", "wb_altimeter_enable").value
 
 
 # ---------------------------------------------------------------------- TouchSensor
 
 def wb_touch_sensor_enable(tag: int, sampling_period: int) -> None:
-    _enable(tag, TOUCH_SENSOR, sampling_period, "wb_touch_sensor_enable")
+    sensor_enable(tag, TOUCH_SENSOR, sampling_period, "wb_touch_sensor_enable")
 
 
 def wb_touch_sensor_disable(tag: int) -> None:
-    _enable(tag, TOUCH_SENSOR, 0, "wb_touch_sensor_disable")
+    sensor_enable(tag, TOUCH_SENSOR, 0, "wb_touch_sensor_disable")
 
 
 def wb_touch_sensor_get_sampling_period(tag: int) -> int:
-    return _dev(tag, TOUCH_SENSOR, "wb_touch_sensor_get_sampling_period").sampling_period
+    return sensor_period(tag, TOUCH_SENSOR, "wb_touch_sensor_get_sampling_period")
 
 
 def wb_touch_sensor_get_type(tag: int) -> int:
@@ -240,7 +226,7 @@ def wb_touch_sensor_get_value(tag: int) -> float:
         print(f'Error: {func}() must be used with a TouchSensor of type "bumper" or "force"\n'
               "Error: you should use wb_touch_sensor_get_values() instead.", file=sys.stderr)
         return math.nan
-    return _read(tag, TOUCH_SENSOR, func, "wb_touch_sensor_enable").value
+    return sensor_reading(tag, TOUCH_SENSOR, func, "wb_touch_sensor_enable").value
 
 
 def wb_touch_sensor_get_values(tag: int) -> Any:
@@ -250,7 +236,7 @@ def wb_touch_sensor_get_values(tag: int) -> Any:
         print(f'Error: {func}() must be used with a TouchSensor of type "force-3d"\n'
               "Error: you should use wb_touch_sensor_get_value() instead.", file=sys.stderr)
         return None
-    return list(_read(tag, TOUCH_SENSOR, func, "wb_touch_sensor_enable").values)
+    return list(sensor_reading(tag, TOUCH_SENSOR, func, "wb_touch_sensor_enable").values)
 
 
 def wb_touch_sensor_get_lookup_table_size(tag: int) -> int:

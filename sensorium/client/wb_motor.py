@@ -238,8 +238,7 @@ def wb_led_set(tag: int, value: int) -> None:
     if not 0 <= value <= hi:
         print(f"Error: wb_led_set(): value {value} out of range [0, {hi}] for LED {dev.name!r}.", file=sys.stderr)
         return
-    if not r.terminated:
-        r.rpc(dev, "set", {"value": value})
+    r.device_set(dev, "set", value, "wb_led_set")
     dev.value = value
 
 

@@ -17,7 +17,7 @@ import sys
 from typing import Any
 
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import EMITTER, RECEIVER, DeviceState, current
+from sensorium.client.wb_robot import EMITTER, RECEIVER, DeviceState, current, sensor_enable, sensor_period
 
 
 def _emitter(tag: int, func: str) -> DeviceState:
@@ -102,17 +102,15 @@ def wb_emitter_get_range(tag: int) -> float:
 # ---------------------------------------------------------------------- receiver
 
 def wb_receiver_enable(tag: int, sampling_period: int) -> None:
-    r = current()
-    r.enable(_receiver(tag, "wb_receiver_enable"), sampling_period, "wb_receiver_enable")
+    sensor_enable(tag, RECEIVER, sampling_period, "wb_receiver_enable")
 
 
 def wb_receiver_disable(tag: int) -> None:
-    r = current()
-    r.enable(_receiver(tag, "wb_receiver_disable"), 0, "wb_receiver_disable")
+    sensor_enable(tag, RECEIVER, 0, "wb_receiver_disable")
 
 
 def wb_receiver_get_sampling_period(tag: int) -> int:
-    return _receiver(tag, "wb_receiver_get_sampling_period").sampling_period
+    return sensor_period(tag, RECEIVER, "wb_receiver_get_sampling_period")
 
 
 def wb_receiver_set_channel(tag: int, channel: int) -> None:
@@ -120,8 +118,7 @@ def wb_receiver_set_channel(tag: int, channel: int) -> None:
     dev = _receiver(tag, "wb_receiver_set_channel")
     if channel == dev.channel or not _allowed(dev, channel, "wb_receiver_set_channel"):
         return
-    if not r.terminated:
-        r.rpc(dev, "set_channel", {"value": channel})
+    r.device_set(dev, "set_channel", channel, "wb_receiver_set_channel")
     dev.channel = channel
 
 

@@ -434,6 +434,12 @@ class RobotClient:
         dev._consts[key] = value
         return value
 
+    def device_set(self, dev: DeviceState, item: str, value: Any, func: str) -> None:
+        """A setting the server keeps: ``/<robot>/<device>/<item>`` with ``{"value": value}``, unless the
+        controller's steps have ended (the caller's local copy is all there is then)."""
+        if not self.terminated:
+            self._expect_success(self.rpc(dev, item, {"value": value}), func)
+
     def enable(self, dev: DeviceState, period: int, func: str) -> None:
         if isinstance(period, bool) or not isinstance(period, int):
             if isinstance(period, float) and float(period).is_integer():
@@ -442,14 +448,12 @@ class RobotClient:
                 raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer (ms), got {period!r}")
         if period < 0:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): negative sampling period {period}")
-        if not self.terminated:
-            self._expect_success(self.rpc(dev, "enable", {"value": period}), func)
+        self.device_set(dev, "enable", period, func)
         dev.sampling_period = period
         dev._warned = False
 
     def enable_point_cloud(self, dev: DeviceState, on: bool, func: str) -> None:
-        if not self.terminated:
-            self._expect_success(self.rpc(dev, "enable_point_cloud", {"value": bool(on)}), func)
+        self.device_set(dev, "enable_point_cloud", bool(on), func)
         dev.point_cloud_enabled = bool(on)
         dev._warned = False
 
@@ -457,8 +461,7 @@ class RobotClient:
         lo, hi = self.constant(dev, "min_frequency"), self.constant(dev, "max_frequency")
         if not (isinstance(frequency, (int, float)) and lo <= frequency <= hi):
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): frequency {frequency!r} outside [{lo:g}, {hi:g}] Hz")
-        if not self.terminated:
-            self._expect_success(self.rpc(dev, "set_frequency", {"value": float(frequency)}), func)
+        self.device_set(dev, "set_frequency", float(frequency), func)
         dev._consts["frequency"] = float(frequency)
 
     # -- motors: buffered, sent with the next step request
@@ -564,6 +567,28 @@ def current() -> RobotClient:
     if _robot is None:
         raise SensoriumError(ErrorCode.WRONG_STATE, "no robot: call wb_robot_init() first")
     return _robot
+
+
+def sensor_enable(tag: int, kind: str, period: int, func: str) -> None:
+    """Every sensor's ``wb_<kind>_enable``/``_disable`` (period 0): the device of ``tag``, if it is a
+    ``kind``, enabled on the server and here."""
+    r = current()
+    r.enable(r.device(tag, kind, func), period, func)
+
+
+def sensor_period(tag: int, kind: str, func: str) -> int:
+    """Every sensor's ``wb_<kind>_get_sampling_period``."""
+    return current().device(tag, kind, func).sampling_period
+
+
+def sensor_reading(tag: int, kind: str, func: str, enabler: str) -> DeviceState:
+    """The device for a getter of its readings, with Webots' message (once per disable) when it is
+    read while disabled."""
+    r = current()
+    dev = r.device(tag, kind, func)
+    if dev.sampling_period <= 0:
+        r.warn_disabled(dev, func, enabler)
+    return dev
 
 
 def wb_robot_init(url: str | None = None, **options: Any) -> None:

@@ -16,30 +16,27 @@ from sensorium.client.wb_robot import (
     DeviceState,
     RobotClient,
     current,
+    sensor_enable,
+    sensor_period,
+    sensor_reading,
 )
 
 # ---------------------------------------------------------------------- light sensor
 
 def _scalar_value(tag: int, kind: str, func: str, enabler: str) -> float:
-    robot = current()
-    dev = robot.device(tag, kind, func)
-    if dev.sampling_period <= 0:
-        robot.warn_disabled(dev, func, enabler)
-    return dev.value
+    return sensor_reading(tag, kind, func, enabler).value
 
 
 def wb_light_sensor_enable(tag: int, sampling_period: int) -> None:
-    r = current()
-    r.enable(r.device(tag, LIGHT_SENSOR, "wb_light_sensor_enable"), sampling_period, "wb_light_sensor_enable")
+    sensor_enable(tag, LIGHT_SENSOR, sampling_period, "wb_light_sensor_enable")
 
 
 def wb_light_sensor_disable(tag: int) -> None:
-    r = current()
-    r.enable(r.device(tag, LIGHT_SENSOR, "wb_light_sensor_disable"), 0, "wb_light_sensor_disable")
+    sensor_enable(tag, LIGHT_SENSOR, 0, "wb_light_sensor_disable")
 
 
 def wb_light_sensor_get_sampling_period(tag: int) -> int:
-    return current().device(tag, LIGHT_SENSOR, "wb_light_sensor_get_sampling_period").sampling_period
+    return sensor_period(tag, LIGHT_SENSOR, "wb_light_sensor_get_sampling_period")
 
 
 def wb_light_sensor_get_value(tag: int) -> float:
@@ -59,17 +56,15 @@ def wb_light_sensor_get_lookup_table(tag: int) -> list[float]:
 # ---------------------------------------------------------------------- distance sensor
 
 def wb_distance_sensor_enable(tag: int, sampling_period: int) -> None:
-    r = current()
-    r.enable(r.device(tag, DISTANCE_SENSOR, "wb_distance_sensor_enable"), sampling_period, "wb_distance_sensor_enable")
+    sensor_enable(tag, DISTANCE_SENSOR, sampling_period, "wb_distance_sensor_enable")
 
 
 def wb_distance_sensor_disable(tag: int) -> None:
-    r = current()
-    r.enable(r.device(tag, DISTANCE_SENSOR, "wb_distance_sensor_disable"), 0, "wb_distance_sensor_disable")
+    sensor_enable(tag, DISTANCE_SENSOR, 0, "wb_distance_sensor_disable")
 
 
 def wb_distance_sensor_get_sampling_period(tag: int) -> int:
-    return current().device(tag, DISTANCE_SENSOR, "wb_distance_sensor_get_sampling_period").sampling_period
+    return sensor_period(tag, DISTANCE_SENSOR, "wb_distance_sensor_get_sampling_period")
 
 
 def wb_distance_sensor_get_value(tag: int) -> float:
@@ -124,17 +119,15 @@ def _check_layer(r: RobotClient, dev: DeviceState, layer: int, func: str) -> int
 
 
 def wb_lidar_enable(tag: int, sampling_period: int) -> None:
-    r = current()
-    r.enable(_lidar(tag, "wb_lidar_enable"), sampling_period, "wb_lidar_enable")
+    sensor_enable(tag, LIDAR, sampling_period, "wb_lidar_enable")
 
 
 def wb_lidar_disable(tag: int) -> None:
-    r = current()
-    r.enable(_lidar(tag, "wb_lidar_disable"), 0, "wb_lidar_disable")
+    sensor_enable(tag, LIDAR, 0, "wb_lidar_disable")
 
 
 def wb_lidar_get_sampling_period(tag: int) -> int:
-    return _lidar(tag, "wb_lidar_get_sampling_period").sampling_period
+    return sensor_period(tag, LIDAR, "wb_lidar_get_sampling_period")
 
 
 def wb_lidar_enable_point_cloud(tag: int) -> None:
@@ -286,17 +279,15 @@ def _position_sensor(tag: int, func: str) -> DeviceState:
 
 
 def wb_position_sensor_enable(tag: int, sampling_period: int) -> None:
-    r = current()
-    r.enable(_position_sensor(tag, "wb_position_sensor_enable"), sampling_period, "wb_position_sensor_enable")
+    sensor_enable(tag, POSITION_SENSOR, sampling_period, "wb_position_sensor_enable")
 
 
 def wb_position_sensor_disable(tag: int) -> None:
-    r = current()
-    r.enable(_position_sensor(tag, "wb_position_sensor_disable"), 0, "wb_position_sensor_disable")
+    sensor_enable(tag, POSITION_SENSOR, 0, "wb_position_sensor_disable")
 
 
 def wb_position_sensor_get_sampling_period(tag: int) -> int:
-    return _position_sensor(tag, "wb_position_sensor_get_sampling_period").sampling_period
+    return sensor_period(tag, POSITION_SENSOR, "wb_position_sensor_get_sampling_period")
 
 
 def wb_position_sensor_get_value(tag: int) -> float:

@@ -12,11 +12,28 @@ radians, time in integer milliseconds.
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 Vec3 = tuple[float, float, float]
+
+
+Color = Vec3
+
+
+def _unit_colors(v: Color | list[Color]) -> Color | list[Color]:
+    """A colour, or each of a list of colours, with every component within [0, 1]."""
+    for c in v if isinstance(v, list) else [v]:
+        if min(c) < 0 or max(c) > 1:
+            raise ValueError("colour components must be within [0, 1]")
+    return v
+
+
+def _nonzero_direction(v: Vec3) -> Vec3:
+    if math.hypot(*v) == 0:
+        raise ValueError("direction must not be the zero vector")
+    return v
 
 
 class Strict(BaseModel):
@@ -173,12 +190,7 @@ class Appearance(Strict):
     occlusion_map: TextureField = None
     texture_transform: TextureTransform | None = None
 
-    @field_validator("base_color")
-    @classmethod
-    def _unit(cls, v: Vec3) -> Vec3:
-        if min(v) < 0 or max(v) > 1:
-            raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("base_color")(_unit_colors)
 
 
 SeenBy = Literal["both", "bounding", "visual"]
@@ -205,8 +217,6 @@ class Part(Shape):
 
 
 # ---------------------------------------------------------------- lights
-
-Color = Vec3
 
 
 class _Light(Strict):
@@ -243,24 +253,14 @@ class SpotLight(_Attenuated):
     beam_width: float = 1.570796
     cut_off_angle: float = 0.785398
 
-    @field_validator("direction")
-    @classmethod
-    def _nonzero(cls, v: Vec3) -> Vec3:
-        if math.hypot(*v) == 0:
-            raise ValueError("direction must not be the zero vector")
-        return v
+    _nonzero = field_validator("direction")(_nonzero_direction)
 
 
 class DirectionalLight(_Light):
     type: Literal["DirectionalLight"]
     direction: Vec3 = (0.0, 0.0, -1.0)
 
-    @field_validator("direction")
-    @classmethod
-    def _nonzero(cls, v: Vec3) -> Vec3:
-        if math.hypot(*v) == 0:
-            raise ValueError("direction must not be the zero vector")
-        return v
+    _nonzero = field_validator("direction")(_nonzero_direction)
 
 
 Light = Annotated[PointLight | SpotLight | DirectionalLight, Field(discriminator="type")]
@@ -292,13 +292,7 @@ class Solid(Strict):
         default=[], max_length=1024, description="Webots recognitionColors: cameras with a Recognition node report "
         "this solid (with its children); top-level solids only")
 
-    @field_validator("recognition_colors")
-    @classmethod
-    def _unit_colors(cls, v: list[Color]) -> list[Color]:
-        for c in v:
-            if min(c) < 0 or max(c) > 1:
-                raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
     def _recognised_at_the_top(self) -> Solid:
@@ -389,13 +383,7 @@ class LED(_Device):
     color: list[Color] = Field(default=[(1.0, 0.0, 0.0)], max_length=1024)
     gradual: bool = False
 
-    @field_validator("color")
-    @classmethod
-    def _unit(cls, v: list[Color]) -> list[Color]:
-        for c in v:
-            if min(c) < 0 or max(c) > 1:
-                raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("color")(_unit_colors)
 
 
 class Pen(_Device):
@@ -411,12 +399,7 @@ class Pen(_Device):
     max_distance: float = Field(default=0.0, description="m; <= 0: unlimited range")
     write: bool = Field(default=True, description="writing from the first step (wb_pen_write switches it)")
 
-    @field_validator("ink_color")
-    @classmethod
-    def _unit(cls, v: Color) -> Color:
-        if min(v) < 0 or max(v) > 1:
-            raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("ink_color")(_unit_colors)
 
 
 class GPS(_Device):
@@ -499,28 +482,36 @@ class TouchSensor(_Device):
     resolution: float = -1.0
 
 
-class RangeFinder(_Device):
+class _Imager(_Device):
+    """What Webots' RangeFinder and Camera share: the image's size and projection, the near plane."""
+
+    device: str
+    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
+    width: int = Field(default=64, ge=1, le=1 << 16)
+    height: int = Field(default=64, ge=1, le=1 << 16)
+    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
+    near: float = Field(default=0.01, ge=0.0)
+    _what: ClassVar[str]
+
+    @model_validator(mode="after")
+    def _planar_fov(self) -> _Imager:
+        if self.projection == "planar" and self.field_of_view >= math.pi:
+            raise ValueError(f"a planar {self._what}'s field_of_view must be < pi")
+        return self
+
+
+class RangeFinder(_Imager):
     """Webots RangeFinder (a depth camera): ``width`` × ``height`` ranges, by exact rays through the
     pixel centres. ``planar``: the depth along the device's +x axis (Webots' z-buffer distance to
     the image plane); ``cylindrical``/``spherical``: the distance along each pixel's ray. Values
     outside [min_range, max_range) and no hit read +inf (README "Cameras and range finders")."""
 
     device: Literal["RangeFinder"]
-    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
-    width: int = Field(default=64, ge=1, le=1 << 16)
-    height: int = Field(default=64, ge=1, le=1 << 16)
-    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
-    near: float = Field(default=0.01, ge=0.0)
     min_range: float = Field(default=0.01, ge=0.0)
     max_range: float = Field(default=1.0, gt=0.0)
     noise: float = Field(default=0.0, ge=0.0, description="σ of the Gaussian noise as a fraction of max_range")
     resolution: float = -1.0
-
-    @model_validator(mode="after")
-    def _planar_fov(self) -> RangeFinder:
-        if self.projection == "planar" and self.field_of_view >= math.pi:
-            raise ValueError("a planar range finder's field_of_view must be < pi")
-        return self
+    _what: ClassVar[str] = "range finder"
 
 
 class Recognition(Strict):
@@ -535,28 +526,18 @@ class Recognition(Strict):
     segmentation: bool = False
 
 
-class Camera(_Device):
+class Camera(_Imager):
     """Webots Camera: a ``width`` × ``height`` BGRA image by exact rays through the pixels (four per
     pixel with ``anti_aliasing``), shaded with the LightSensor's lighting, textures, transparency,
     shadows of the lights that cast them, the background colour (README "Cameras and range finders")."""
 
     device: Literal["Camera"]
-    field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
-    width: int = Field(default=64, ge=1, le=1 << 16)
-    height: int = Field(default=64, ge=1, le=1 << 16)
-    projection: Literal["planar", "cylindrical", "spherical"] = "planar"
-    near: float = Field(default=0.01, ge=0.0)
     far: float = Field(default=0.0, ge=0.0, description="0: no far clipping plane")
     exposure: float = Field(default=1.0, ge=0.0)
     anti_aliasing: bool = False
     noise: float = Field(default=0.0, ge=0.0, le=1.0, description="σ of the per-channel Gaussian noise, in [0, 1] units")
     recognition: Recognition | None = None
-
-    @model_validator(mode="after")
-    def _planar_fov(self) -> Camera:
-        if self.projection == "planar" and self.field_of_view >= math.pi:
-            raise ValueError("a planar camera's field_of_view must be < pi")
-        return self
+    _what: ClassVar[str] = "camera"
 
 
 def _minus_one_or_positive(name: str, v: float) -> float:
@@ -743,13 +724,7 @@ class Robot(Strict):
         default=[], max_length=1024, description="Webots recognitionColors: other robots' cameras with a Recognition "
         "node report this robot")
 
-    @field_validator("recognition_colors")
-    @classmethod
-    def _unit_colors(cls, v: list[Color]) -> list[Color]:
-        for c in v:
-            if min(c) < 0 or max(c) > 1:
-                raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("recognition_colors")(_unit_colors)
 
 
 class WorldInfo(Strict):
@@ -777,12 +752,7 @@ class Background(Strict):
 
     sky_color: Color = (0.0, 0.0, 0.0)
 
-    @field_validator("sky_color")
-    @classmethod
-    def _unit(cls, v: Color) -> Color:
-        if min(v) < 0 or max(v) > 1:
-            raise ValueError("colour components must be within [0, 1]")
-        return v
+    _unit = field_validator("sky_color")(_unit_colors)
 
 
 class World(Strict):

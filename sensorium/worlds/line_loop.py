@@ -23,6 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+from sensorium.worlds import floor_runs
+
 HERE = Path(__file__).resolve().parent
 IMAGE = HERE / "textures" / "line_loop.png"
 WORLD = HERE / "line_following.yaml"
@@ -89,17 +91,8 @@ def lap(steps: int | None = None, precision: str = "exact") -> dict:
     process until it completes one lap (or for ``steps`` steps): its positions, the largest
     distance of its centre from the line, whether it lapped, and the steps taken."""
     from sensorium.client.examples.line_follower import LineFollower
-    from sensorium.server.sim.simulation import Simulation
 
-    sim = Simulation.from_file(WORLD, precision=precision)
-    robot = sim.robot("epuck")
-    sensors = [sim.device(f"epuck/gs{i}") for i in range(3)]
-    for s in sensors:
-        s.enable(sim.basic_time_step)
-    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
-    for motor in (left, right):          # as the controller does: velocity control, standing still
-        motor.set_position(math.inf)
-        motor.set_velocity(0.0)
+    sim, robot, sensors, (left, right) = floor_runs.epuck(WORLD, precision)
     law = LineFollower()
     line = centreline()
     seg_len = np.linalg.norm(np.roll(line, -1, axis=0) - line, axis=1)
@@ -131,46 +124,23 @@ def lap(steps: int | None = None, precision: str = "exact") -> dict:
 
 def picture(out: Path) -> dict:
     """One lap drawn over the floor image (matplotlib), saved to ``out``; returns :func:`lap`'s result."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from PIL import Image
 
     run = lap()
-    img = np.asarray(Image.open(IMAGE))
-    fig, ax = plt.subplots(figsize=(5, 5), dpi=120)
-    half = FLOOR / 2
-    ax.imshow(img, extent=(-half, half, -half, half), interpolation="nearest")
     path = run["path"]
-    ax.plot(path[:, 0], path[:, 1], color="tab:red", lw=1.2, label="robot centre")
-    ax.plot(*path[0], "o", color="tab:green", label="start")
-    ax.set_xlim(-0.85, 0.85)
-    ax.set_ylim(-0.85, 0.85)
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title(f"one lap in {run['time_ms'] / 1000:.1f} s, at most {run['worst'] * 100:.1f} cm off the line")
-    ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out)
-    plt.close(fig)
+    floor_runs.save_picture(
+        out, np.asarray(Image.open(IMAGE)), FLOOR / 2, path, label="robot centre", lw=1.2, start=path[0], lim=0.85,
+        title=f"one lap in {run['time_ms'] / 1000:.1f} s, at most {run['worst'] * 100:.1f} cm off the line")
     return run
 
 
-def main(argv: list[str]) -> int:
-    from PIL import Image
+def _picture_line(out: Path) -> str:
+    run = picture(out)
+    return f"lapped={run['lapped']} in {run['time_ms']} ms, worst {run['worst'] * 100:.2f} cm off the line"
 
-    if argv[:1] == ["picture"] and len(argv) == 2:
-        run = picture(Path(argv[1]))
-        print(f"{argv[1]}: lapped={run['lapped']} in {run['time_ms']} ms, worst {run['worst'] * 100:.2f} cm off the line")
-        return 0
-    if argv:
-        print("usage: python -m sensorium.worlds.line_loop [picture OUT.png]", file=sys.stderr)
-        return 2
-    IMAGE.parent.mkdir(exist_ok=True)
-    Image.fromarray(render()).save(IMAGE, optimize=True)
-    print(f"wrote {IMAGE}")
-    return 0
+
+def main(argv: list[str]) -> int:
+    return floor_runs.main(argv, "line_loop", IMAGE, render, _picture_line)
 
 
 if __name__ == "__main__":

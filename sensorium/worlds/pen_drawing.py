@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from sensorium.worlds import floor_runs
+
 HERE = Path(__file__).resolve().parent
 IMAGE = HERE / "textures" / "paper.png"
 WORLD = HERE / "pen_drawing.yaml"
@@ -34,17 +36,9 @@ def run(follow_steps: int | None = None, precision: str = "exact") -> dict:
     strokes' points, the robot's path while following, the largest distance of its centre from the
     drawn circle, whether it lapped, the steps and the simulation."""
     from sensorium.client.examples.pen_drawer import RADIUS, PenDrawer
-    from sensorium.server.sim.simulation import Simulation
 
-    sim = Simulation.from_file(WORLD, precision=precision)
-    robot = sim.robot("epuck")
+    sim, robot, sensors, (left, right) = floor_runs.epuck(WORLD, precision)
     pen = sim.device("epuck/pen")
-    sensors = [sim.device(f"epuck/gs{i}") for i in range(3)]
-    for s in sensors:
-        s.enable(sim.basic_time_step)
-    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
-    for motor in (left, right):
-        motor.set_position(math.inf)
     law = PenDrawer(sim.basic_time_step)
     values = [math.nan] * 3
     strokes, path, readings = [], [], []
@@ -83,47 +77,24 @@ def run(follow_steps: int | None = None, precision: str = "exact") -> dict:
 def picture(out: Path) -> dict:
     """The paint texture after a run (the ink as the floor shows it) with the robot's path while it
     followed the ink; returns :func:`run`'s result."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     result = run()
-    sim = result["sim"]
-    layer = sim.scene.textures.ink[0]
+    layer = result["sim"].scene.textures.ink[0]
     shade = 1.0 - layer.density[..., None] * (1.0 - layer.rgb)       # the ink over white paper
-    fig, ax = plt.subplots(figsize=(5, 5), dpi=120)
-    ax.imshow(np.clip(shade, 0, 1), extent=(-1, 1, -1, 1), interpolation="nearest")
-    path = result["path"]
-    ax.plot(path[:, 0], path[:, 1], color="tab:red", lw=1.0, label="robot centre, following the ink")
-    ax.plot(*result["strokes"][0], "o", color="tab:green", label="start")
-    ax.set_xlim(-0.7, 0.7)
-    ax.set_ylim(-0.7, 0.7)
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title(f"{len(result['strokes'])} strokes drawn, then a lap {result['worst'] * 1000:.1f} mm at most off them")
-    ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out)
-    plt.close(fig)
+    floor_runs.save_picture(
+        out, np.clip(shade, 0, 1), 1, result["path"], label="robot centre, following the ink", lw=1.0,
+        start=result["strokes"][0], lim=0.7,
+        title=f"{len(result['strokes'])} strokes drawn, then a lap {result['worst'] * 1000:.1f} mm at most off them")
     return result
 
 
-def main(argv: list[str]) -> int:
-    from PIL import Image
+def _picture_line(out: Path) -> str:
+    result = picture(out)
+    return (f"{len(result['strokes'])} strokes, lapped={result['lapped']} in {result['follow_steps']} steps, "
+            f"worst {result['worst'] * 1000:.2f} mm off the drawn circle")
 
-    if argv[:1] == ["picture"] and len(argv) == 2:
-        result = picture(Path(argv[1]))
-        print(f"{argv[1]}: {len(result['strokes'])} strokes, lapped={result['lapped']} in "
-              f"{result['follow_steps']} steps, worst {result['worst'] * 1000:.2f} mm off the drawn circle")
-        return 0
-    if argv:
-        print("usage: python -m sensorium.worlds.pen_drawing [picture OUT.png]", file=sys.stderr)
-        return 2
-    IMAGE.parent.mkdir(exist_ok=True)
-    Image.fromarray(render()).save(IMAGE, optimize=True)
-    print(f"wrote {IMAGE}")
-    return 0
+
+def main(argv: list[str]) -> int:
+    return floor_runs.main(argv, "pen_drawing", IMAGE, render, _picture_line)
 
 
 if __name__ == "__main__":

@@ -26,6 +26,17 @@ class ServiceError(Exception):
         self.message = message
 
 
+def _configured(c: Call, item: str, *args: Any, code: ErrorCode = ErrorCode.INVALID_ARGUMENT) -> dict:
+    """The device service ``item``: the device's method of that name called with ``args``; a
+    ValueError it raises (a value the device refuses, or a state it cannot take it in) answers the
+    request with ``code``."""
+    try:
+        getattr(c.ctl.device, item)(*args)
+    except ValueError as exc:
+        raise ServiceError(code, f"{item}: {exc}") from None
+    return {"success": True}
+
+
 class DeviceServices:
     """Handlers ``_dev_*`` and ``_motor_*``; needs ``self.sim`` and ``self.topics`` (the core's)."""
 
@@ -101,28 +112,16 @@ class DeviceServices:
         return {"value": float(c.ctl.device.config.noise)}
 
     def _dev_set_exposure(self, c: Call) -> dict:
-        try:
-            c.ctl.device.set_exposure(c.args.value)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_exposure: {exc}") from None
-        return {"success": True}
+        return _configured(c, "set_exposure", c.args.value)
 
     def _dev_recognition_enable(self, c: Call) -> dict:
-        try:
-            c.ctl.device.recognition_enable(c.args.value)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.WRONG_STATE, f"recognition_enable: {exc}") from None
-        return {"success": True}
+        return _configured(c, "recognition_enable", c.args.value, code=ErrorCode.WRONG_STATE)
 
     def _dev_get_recognition_sampling_period(self, c: Call) -> dict:
         return {"value": int(c.ctl.device.recognition_schedule.period_ms)}
 
     def _dev_enable_segmentation(self, c: Call) -> dict:
-        try:
-            c.ctl.device.enable_segmentation(c.args.value)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.WRONG_STATE, f"enable_segmentation: {exc}") from None
-        return {"success": True}
+        return _configured(c, "enable_segmentation", c.args.value, code=ErrorCode.WRONG_STATE)
 
     def _dev_is_segmentation_enabled(self, c: Call) -> dict:
         return {"status": int(c.ctl.device.segmentation_enabled)}
@@ -134,31 +133,19 @@ class DeviceServices:
         return {"value": int(c.ctl.device.channel)}
 
     def _dev_set_channel(self, c: Call) -> dict:
-        try:
-            c.ctl.device.set_channel(c.args.value)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_channel: {exc}") from None
-        return {"success": True}
+        return _configured(c, "set_channel", c.args.value)
 
     def _dev_get_range(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.range)}
 
     def _dev_set_range(self, c: Call) -> dict:
-        try:
-            c.ctl.device.set_range(c.args.value)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_range: {exc}") from None
-        return {"success": True}
+        return _configured(c, "set_range", c.args.value)
 
     def _dev_get_buffer_size(self, c: Call) -> dict:
         return {"value": int(c.ctl.device.config.buffer_size)}
 
     def _dev_set(self, c: Call) -> dict:
-        try:
-            c.ctl.device.set(c.args.value, self.sim.time_ms)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set: {exc}") from None
-        return {"success": True}
+        return _configured(c, "set", c.args.value, self.sim.time_ms)
 
     def _dev_get(self, c: Call) -> dict:
         return {"value": int(c.ctl.device.value)}
@@ -168,11 +155,7 @@ class DeviceServices:
         return {"success": True}
 
     def _dev_set_ink_color(self, c: Call) -> dict:  # a Pen: 0xRRGGBB, density clamped to [0, 1]
-        try:
-            c.ctl.device.set_ink_color(c.args.color, c.args.density)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_ink_color: {exc}") from None
-        return {"success": True}
+        return _configured(c, "set_ink_color", c.args.color, c.args.density)
 
     def _dev_enable(self, c: Call) -> dict:
         self.topics.controller_enable(c.ctl.path, c.args.value)
@@ -210,11 +193,7 @@ class DeviceServices:
         return self._frequency_info(c.ctl.device)
 
     def _dev_set_frequency(self, c: Call) -> dict:
-        try:
-            c.ctl.device.set_frequency(c.args.value)
-        except ValueError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"set_frequency: {exc}") from None
-        return {"success": True}
+        return _configured(c, "set_frequency", c.args.value)
 
     def _layer(self, c: Call) -> int:
         n = c.ctl.device.config.number_of_layers

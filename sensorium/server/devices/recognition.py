@@ -8,7 +8,7 @@ bounding shapes if it has any, else all of them — Webots: the boundingObject, 
   capsule's ``|a_k|·h/2 + r`` per camera axis k (``a`` its axis in the camera frame); an infinite
   plane has none (never recognised);
 * ``position`` its centre, ``size`` its extents along the camera's y and z (Webots: "the Y and Z
-  sizes ... relatively to the camera"), ``orientation`` the axis-angle of ``R_cam^T·R_object``;
+  sizes ... relatively to the camera"), ``orientation`` the axis-angle of ``R_cam^T·R_object`` (``world.poses.axis_angle``);
 * on the image (``box_on_image``, Webots' ``WbCamera::setRecognizedObjectProperties``): its 8
   corners (and, for a non-planar camera, its centre) projected by ``project_on_image``, whose image
   coordinates are the inverse of the camera's pixel rays (``imaging.py``), clamped to the image and
@@ -25,7 +25,7 @@ import numpy as np
 
 from .imaging import ImageGeometry
 
-__all__ = ["image_coordinates", "project_on_image", "box_on_image", "shape_bounds", "axis_angle"]
+__all__ = ["image_coordinates", "project_on_image", "box_on_image", "shape_bounds"]
 
 
 def image_coordinates(p: np.ndarray, g: ImageGeometry) -> np.ndarray:
@@ -105,28 +105,3 @@ def shape_bounds(kind: str, params: tuple, rotation: np.ndarray, centre: np.ndar
         pts = np.asarray(points, dtype=np.float64) @ R.T + c
         return pts.min(axis=0), pts.max(axis=0)
     return None
-
-
-def axis_angle(r: np.ndarray) -> list[float]:
-    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, π]); identity → 0 0 1 0. Through
-    the unit quaternion (Shepperd's method: the largest of w, x, y, z first), accurate at half turns."""
-    m = np.asarray(r, dtype=np.float64)
-    tr = m[0, 0] + m[1, 1] + m[2, 2]
-    if tr > 0.0:
-        s = math.sqrt(tr + 1.0) * 2.0
-        w, x, y, z = 0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2.0
-        w, x, y, z = (m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
-    elif m[1, 1] > m[2, 2]:
-        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2.0
-        w, x, y, z = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s
-    else:
-        s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2.0
-        w, x, y, z = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s
-    if w < 0.0:
-        w, x, y, z = -w, -x, -y, -z
-    n = math.sqrt(x * x + y * y + z * z)
-    if n < 1e-300:
-        return [0.0, 0.0, 1.0, 0.0]
-    return [x / n, y / n, z / n, 2.0 * math.atan2(n, w)]

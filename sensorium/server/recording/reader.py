@@ -284,14 +284,20 @@ class Recording:
             return self._file.header()
         return self._scan()["header"]
 
+    def _indexed_records(self, indexes: list, record: type, what: str) -> list:
+        """The records an index points at (metadata or attachments), read at their offsets; a
+        damaged one is reported and left out."""
+        out = []
+        for ix in indexes:
+            try:
+                out.append(self._file.record_at(ix.offset, record))
+            except DamagedRecord as exc:
+                self._report(Damage(ix.offset, ix.length, what, str(exc)))
+        return out
+
     def metadata(self) -> dict[str, dict[str, str]]:
         if self._indexed:
-            records = []
-            for mi in self._index().metadata_indexes:
-                try:
-                    records.append(self._file.record_at(mi.offset, Metadata))
-                except DamagedRecord as exc:
-                    self._report(Damage(mi.offset, mi.length, "metadata", str(exc)))
+            records = self._indexed_records(self._index().metadata_indexes, Metadata, "metadata")
         else:
             records = self._scan()["metadata"]
         out: dict[str, dict[str, str]] = {}
@@ -301,13 +307,7 @@ class Recording:
 
     def attachments(self) -> list[Attachment]:
         if self._indexed:
-            out = []
-            for ai in self._index().attachment_indexes:
-                try:
-                    out.append(self._file.record_at(ai.offset, Attachment))
-                except DamagedRecord as exc:
-                    self._report(Damage(ai.offset, ai.length, "attachment", str(exc)))
-            return out
+            return self._indexed_records(self._index().attachment_indexes, Attachment, "attachment")
         return list(self._scan()["attachments"])
 
     def world(self) -> tuple[str, bytes] | None:

@@ -43,7 +43,7 @@ from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
-from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations
+from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
 from sensorium.server.sim.motion import DifferentialDrive
 from sensorium.server.sim.scene import Scene, _entry, _shape_info, primitive_from_model, robot_parts, solid_parts
@@ -51,8 +51,8 @@ from sensorium.server.sim.sensors import DistanceSensor, Lidar, LightSensor, Pos
 from sensorium.server.sim.simulation import lights_from_models
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import check_pose
-from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, sanitize
-from sensorium.server.world.poses import pose_from_model, pose_from_values
+from sensorium.server.world.loader import LoadedWorld, from_model
+from sensorium.server.world.poses import moved_pose, pose_from_model
 
 __all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS", "check_observable"]
 
@@ -158,11 +158,7 @@ class BatchedSimulation:
     def __init__(self, world: LoadedWorld | wm.World, copies: int, precision: Precision | str = Precision.EXACT,
                  base_dir: Path | None = None, contact: bool | None = None):
         if isinstance(world, wm.World):
-            problems = check_world(world, base_dir or Path.cwd())
-            if problems:
-                raise WorldError("<memory>", problems)
-            world, _ = sanitize(world)
-            world = LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
+            world = from_model(world, base_dir)
         if int(copies) < 1:
             raise BatchedError(f"copies must be >= 1, got {copies}")
         self.loaded = world
@@ -448,13 +444,7 @@ class BatchedSimulation:
     def set_pose(self, copy: int, slot: int, translation=None, rotation=None, quaternion=None) -> None:
         """Move a robot of one copy (supervisor-style, no contact check), as ``RobotState.set_pose``."""
         check_pose(translation, rotation, quaternion)
-        current = self.pose(copy, slot)
-        if translation is None:
-            translation = current.translation
-        if rotation is None and quaternion is None:
-            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
-        else:
-            pose = pose_from_values(translation, rotation, quaternion)
+        pose = moved_pose(self.pose(copy, slot), translation, rotation, quaternion)
         self.rot[copy, slot] = pose.rotation
         self.pos[copy, slot] = pose.translation
         if self.contact is not None:
@@ -692,21 +682,13 @@ class BatchedSimulation:
                                              self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32)
                 continue
             sizes = [len(r.origins) for r in reqs]
-
-            def cat(name: str, dtype, reqs=reqs, sizes=sizes) -> np.ndarray:
-                return np.concatenate([np.broadcast_to(np.asarray(getattr(r, name), dtype=dtype), (n,))
-                                       for r, n in zip(reqs, sizes)])
-
             h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
-                               cat("t_near", np.float64), cat("t_far", np.float64), RayKind(kind), cat("copy", np.int64),
-                               self.rot, self.pos, cat("exclude", np.int64), cat("mount", np.int64), skip,
+                               joined(reqs, sizes, "t_near", np.float64), joined(reqs, sizes, "t_far", np.float64),
+                               RayKind(kind), joined(reqs, sizes, "copy", np.int64), self.rot, self.pos,
+                               joined(reqs, sizes, "exclude", np.int64), joined(reqs, sizes, "mount", np.int64), skip,
                                distance_only)
-            a = 0
-            for i, n in zip(idx, sizes):
-                sl = slice(a, a + n)
-                out[i] = RayHits(h.distance[sl], None if h.normal is None else h.normal[sl],
-                                 None if h.shape is None else h.shape[sl])
-                a += n
+            for i, hit in zip(idx, split_hits(h, sizes)):
+                out[i] = hit
         return out   # type: ignore[return-value]
 
     # light sensors (LightBatch over every copy's due sensors)

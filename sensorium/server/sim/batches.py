@@ -45,6 +45,24 @@ def compose_rotations(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
+def joined(requests: list, sizes: list[int], field: str, dtype) -> np.ndarray:
+    """Every request's ``field`` (one value per ray, or one value for all ``sizes[i]`` rays of
+    request ``i``) in one array, in request order: an input of one cast for all of them."""
+    return np.concatenate([np.broadcast_to(np.asarray(getattr(r, field), dtype=dtype), (n,))
+                           for r, n in zip(requests, sizes)])
+
+
+def split_hits(hits: RayHits, sizes: list[int]) -> list[RayHits]:
+    """The hits of one cast over requests of ``sizes`` rays each (in order), as one RayHits each."""
+    out, start = [], 0
+    for n in sizes:
+        sl = slice(start, start + n)
+        out.append(RayHits(hits.distance[sl], None if hits.normal is None else hits.normal[sl],
+                           None if hits.shape is None else hits.shape[sl]))
+        start += n
+    return out
+
+
 def _output(devices: list, measured: np.ndarray, now_ms: int) -> None:
     """Lookup (grouped by table), per-sensor noise, resolution; store the values."""
     by_table: dict = defaultdict(list)

@@ -21,6 +21,7 @@ from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
+from sensorium.server.sim.scene import light_from_model
 from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
@@ -155,27 +156,11 @@ class RangeFinder(Device):
 MAX_LAYERS = 8
 """Semi-transparent surfaces composited along one ray; the next surface is taken as opaque."""
 
-_LIGHT_KINDS = {"PointLight": light_math.LightKind.POINT, "SpotLight": light_math.LightKind.SPOT,
-                "DirectionalLight": light_math.LightKind.DIRECTIONAL}
-
-
 def camera_lights(models: list) -> tuple[light_math.LightArrays, np.ndarray]:
     """The lights that are on (world frame) and which of them cast shadows (Webots' castShadows)."""
-    out, shadows = [], []
-    for m in models:
-        if not m.on:
-            continue
-        fields = dict(kind=_LIGHT_KINDS[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity,
-                      color=m.color)
-        if m.type != "DirectionalLight":
-            fields.update(position=m.location, attenuation=m.attenuation)
-        if m.type != "PointLight":
-            fields.update(direction=m.direction)
-        if m.type == "SpotLight":
-            fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
-        out.append(light_math.Light(**fields))
-        shadows.append(bool(m.cast_shadows))
-    return light_math.LightArrays.from_lights(out), np.array(shadows, dtype=bool)
+    on = [m for m in models if m.on]
+    return (light_math.LightArrays.from_lights([light_from_model(m) for m in on]),
+            np.array([bool(m.cast_shadows) for m in on], dtype=bool))
 
 
 class Camera(Device):

@@ -77,6 +77,16 @@ class _Queue:
         return len(self.items)
 
 
+def _allowed_channel(config: Any, channel: int) -> int:
+    """``channel`` if an emitter or receiver of ``config`` may use it: an integer >= -1 and, when the
+    device lists ``allowed_channels``, one of them (else ValueError)."""
+    if isinstance(channel, bool) or not isinstance(channel, (int, np.integer)) or channel < -1:
+        raise ValueError(f"channel must be an integer >= -1, got {channel!r}")
+    if config.allowed_channels and channel not in config.allowed_channels:
+        raise ValueError(f"channel {channel} is not one of allowed_channels {list(config.allowed_channels)}")
+    return int(channel)
+
+
 class Emitter(Device):
     """Webots Emitter: ``send`` queues a packet for the next basic step (channel and range as they
     are now); ``channel`` and ``range`` are the emitter's current ones (a controller's packets carry
@@ -91,12 +101,7 @@ class Emitter(Device):
         self.dropped = 0
 
     def set_channel(self, channel: int) -> None:
-        c = self.config
-        if isinstance(channel, bool) or not isinstance(channel, (int, np.integer)) or channel < -1:
-            raise ValueError(f"channel must be an integer >= -1, got {channel!r}")
-        if c.allowed_channels and channel not in c.allowed_channels:
-            raise ValueError(f"channel {channel} is not one of allowed_channels {list(c.allowed_channels)}")
-        self.channel = int(channel)
+        self.channel = _allowed_channel(self.config, channel)
 
     def set_range(self, range_m: float) -> None:
         """Webots' ``wb_emitter_set_range``: -1 asks for the maximum, larger values are capped at it."""
@@ -150,12 +155,7 @@ class Receiver(Device):
         self.dropped = 0
 
     def set_channel(self, channel: int) -> None:
-        c = self.config
-        if isinstance(channel, bool) or not isinstance(channel, (int, np.integer)) or channel < -1:
-            raise ValueError(f"channel must be an integer >= -1, got {channel!r}")
-        if c.allowed_channels and channel not in c.allowed_channels:
-            raise ValueError(f"channel {channel} is not one of allowed_channels {list(c.allowed_channels)}")
-        self.channel = int(channel)
+        self.channel = _allowed_channel(self.config, channel)
 
     def disable(self) -> None:
         super().disable()

@@ -30,6 +30,7 @@ from sensorium.server.devices import recognition as rmath
 from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.world.geometry import Pose
+from sensorium.server.world.poses import axis_angle
 
 __all__ = ["RecognisedObject", "Recognizer"]
 
@@ -145,7 +146,7 @@ class Recognizer:
                 continue
             if c.occlusion == 2 and k not in seen_by_pixels:
                 continue
-            orientation = rmath.axis_angle(cam.rotation.T @ self.scene.owner_pose(obj.key).rotation)
+            orientation = axis_angle(cam.rotation.T @ self.scene.owner_pose(obj.key).rotation)
             out.append(RecognisedObject(obj.id, tuple(float(v) for v in centre), tuple(float(v) for v in orientation),  # type: ignore[arg-type]
                                         (float(size[1]), float(size[2])), on_image[0], on_image[1], obj.colors,
                                         obj.model))

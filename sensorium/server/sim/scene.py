@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.devices import light as light_math
 from sensorium.server.devices.shading import srgb_to_linear
 from sensorium.server.raycast.engine import Precision, RayEngine, ShapeEntry
 from sensorium.server.world import geometry as geo
@@ -117,6 +118,23 @@ def place_light(model, pose: Pose):
     if model.type == "SpotLight":
         upd["direction"] = tuple(float(v) for v in pose.apply_dirs(np.asarray(model.direction)))
     return model.model_copy(update=upd)
+
+
+_LIGHT_KINDS = {"PointLight": light_math.LightKind.POINT, "SpotLight": light_math.LightKind.SPOT,
+                "DirectionalLight": light_math.LightKind.DIRECTIONAL}
+
+
+def light_from_model(m) -> light_math.Light:
+    """A light model (world coordinates, e.g. from :meth:`Scene.world_lights`) as the light model of
+    server/devices/light.py computes with it."""
+    fields = dict(kind=_LIGHT_KINDS[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity, color=m.color)
+    if m.type != "DirectionalLight":
+        fields.update(position=m.location, attenuation=m.attenuation)
+    if m.type != "PointLight":
+        fields.update(direction=m.direction)
+    if m.type == "SpotLight":
+        fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
+    return light_math.Light(**fields)
 
 
 class Scene:

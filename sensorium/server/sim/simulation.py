@@ -23,12 +23,12 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
-from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch
+from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
-from sensorium.server.sim.scene import Scene, primitive_from_model, robot_parts, solid_parts
+from sensorium.server.sim.scene import Scene, light_from_model, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
     LED,
     Device,
@@ -40,28 +40,14 @@ from sensorium.server.sim.sensors import (
 )
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
-from sensorium.server.world.loader import LoadedWorld, WorldError, check_world, load_world, sanitize
-from sensorium.server.world.poses import pose_from_values
+from sensorium.server.world.loader import LoadedWorld, from_model, load_world
+from sensorium.server.world.poses import moved_pose
 from sensorium.server.world.report import warn_losses
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:
     """The lights that are on, as arrays in world coordinates (lights that are off contribute nothing)."""
-    kinds = {"PointLight": light_math.LightKind.POINT, "SpotLight": light_math.LightKind.SPOT,
-             "DirectionalLight": light_math.LightKind.DIRECTIONAL}
-    out = []
-    for m in models:
-        if not m.on:
-            continue
-        fields = dict(kind=kinds[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity, color=m.color)
-        if m.type != "DirectionalLight":
-            fields.update(position=m.location, attenuation=m.attenuation)
-        if m.type != "PointLight":
-            fields.update(direction=m.direction)
-        if m.type == "SpotLight":
-            fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
-        out.append(light_math.Light(**fields))
-    return light_math.LightArrays.from_lights(out)
+    return light_math.LightArrays.from_lights([light_from_model(m) for m in models if m.on])
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,13 +127,7 @@ class RobotState:
         (Webots): leave one out (``None``) and it keeps its current value. Non-finite values or a
         translation beyond ``limits.MAX_COORDINATE_M`` raise ValueError and the robot stays."""
         check_pose(translation, rotation, quaternion)
-        current = self.pose
-        if translation is None:
-            translation = current.translation
-        if rotation is None and quaternion is None:
-            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
-        else:
-            pose = pose_from_values(translation, rotation, quaternion)
+        pose = moved_pose(self.pose, translation, rotation, quaternion)
         self._sim.place_robot(self.index, pose)
         if self.drive is not None:
             self.drive.reset(pose)
@@ -175,14 +155,7 @@ class Simulation:
     def __init__(self, world: LoadedWorld | wm.World, precision: Precision | str = Precision.EXACT,
                  base_dir: Path | None = None, contact: bool | None = None):
         """``contact``: kinematic contact on/off (default: the world's ``world_info.contact``)."""
-        if isinstance(world, wm.World):
-            problems = check_world(world, base_dir or Path.cwd())
-            if problems:
-                raise WorldError("<memory>", problems)
-            world, _ = sanitize(world)
-            loaded = LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
-        else:
-            loaded = world
+        loaded = from_model(world, base_dir) if isinstance(world, wm.World) else world
         self.loaded = loaded
         self.world = loaded.world
         self.basic_time_step = self.world.world_info.basic_time_step
@@ -287,13 +260,7 @@ class Simulation:
     def set_solid_pose(self, name: str, translation, rotation=None, quaternion=None) -> None:
         if name not in self.scene.solid_poses:
             raise KeyError(f"no solid {name!r}")
-        current = self.scene.solid_poses[name]
-        if translation is None:
-            translation = current.translation
-        if rotation is None and quaternion is None:
-            pose = Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
-        else:
-            pose = pose_from_values(translation, rotation, quaternion)
+        pose = moved_pose(self.scene.solid_poses[name], translation, rotation, quaternion)
         self.scene.set_solid_pose(name, pose)
         if self.contact is not None:
             self.contact.update_solid(name, pose)
@@ -471,18 +438,14 @@ class Simulation:
                 continue
             origins = np.concatenate([r.origins for r in reqs])
             dirs = np.concatenate([r.directions for r in reqs])
-            t_near = np.concatenate([np.broadcast_to(np.asarray(r.t_near, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
-            t_far = np.concatenate([np.broadcast_to(np.asarray(r.t_far, dtype=np.float64), (n,)) for r, n in zip(reqs, sizes)])
-            owners = np.concatenate([np.broadcast_to(np.asarray(r.exclude_owner, dtype=np.int64), (n,)) for r, n in zip(reqs, sizes)])
+            t_near = joined(reqs, sizes, "t_near", np.float64)
+            t_far = joined(reqs, sizes, "t_far", np.float64)
+            owners = joined(reqs, sizes, "exclude_owner", np.int64)
             mount = None
             if any(r.mount is not None for r in reqs):
                 mount = self._joined_mount(reqs, sizes)
             hits = engine.cast(origins, dirs, t_near, t_far, kind=kind, exclude_owner=owners, skip_transparent=skip,
                                mount=mount, distance_only=distance_only)
-            start = 0
-            for i, n in zip(idx, sizes):
-                sl = slice(start, start + n)
-                results[i] = RayHits(hits.distance[sl], None if hits.normal is None else hits.normal[sl],
-                                     None if hits.shape is None else hits.shape[sl])
-                start += n
+            for i, h in zip(idx, split_hits(hits, sizes)):
+                results[i] = h
         return results  # type: ignore[return-value]

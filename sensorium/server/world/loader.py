@@ -290,6 +290,16 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
     return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings)
 
 
+def from_model(world: wm.World, base_dir: Path | None = None) -> LoadedWorld:
+    """A world model built in memory (``<memory>``), checked against its files under ``base_dir``
+    (default: the working directory) and sanitised as a world file is; ``WorldError`` if unusable."""
+    problems = check_world(world, base_dir or Path.cwd())
+    if problems:
+        raise WorldError("<memory>", problems)
+    world, _ = sanitize(world)
+    return LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
+
+
 _TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "triangles", "mesh", "PointLight", "SpotLight",
          "DirectionalLight", *wm.DEVICE_TYPES}
 
@@ -543,7 +553,8 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
             if dev.type == "laser" and upd.get("number_of_rays", dev.number_of_rays) > 1:
                 upd["number_of_rays"] = 1
                 warnings.append(f"{p}.number_of_rays: a laser sensor has a single ray, reset to 1")
-        if isinstance(dev, wm.RangeFinder):         # WbRangeFinder::updateNear/updateMinRange/updateMaxRange
+        # WbRangeFinder's and WbLidar's updateNear, updateMinRange, updateMaxRange
+        if isinstance(dev, (wm.RangeFinder, wm.Lidar)):
             if dev.near > dev.min_range:
                 upd["near"] = dev.min_range
                 warnings.append(f"{p}.near: greater than min_range, set to min_range {dev.min_range}")
@@ -551,12 +562,6 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
                 upd["max_range"] = dev.min_range + 1.0
                 warnings.append(f"{p}.max_range: not greater than min_range, set to min_range + 1")
         if isinstance(dev, wm.Lidar):
-            if dev.near > dev.min_range:
-                upd["near"] = dev.min_range
-                warnings.append(f"{p}.near: greater than min_range, set to min_range {dev.min_range}")
-            if dev.max_range <= dev.min_range:
-                upd["max_range"] = dev.min_range + 1.0
-                warnings.append(f"{p}.max_range: not greater than min_range, set to min_range + 1")
             if not 0.0 < dev.vertical_field_of_view <= math.pi:
                 upd["vertical_field_of_view"] = min(max(dev.vertical_field_of_view, 1e-6), math.pi)
                 warnings.append(f"{p}.vertical_field_of_view: outside (0, pi], clamped")

@@ -34,27 +34,44 @@ def quaternion_matrix(q: tuple[float, float, float, float] | np.ndarray) -> np.n
     ])
 
 
-def matrix_quaternion(r: np.ndarray) -> tuple[float, float, float, float]:
-    """Rotation matrix → unit quaternion (x, y, z, w) with w >= 0."""
+def _shepperd(r: np.ndarray) -> tuple[float, float, float, float]:
+    """Rotation matrix → its quaternion (w, x, y, z), not normalised, by Shepperd's method: the
+    largest of w, x, y, z first, accurate at half turns."""
     m = np.asarray(r, dtype=np.float64)
     tr = m[0, 0] + m[1, 1] + m[2, 2]
-    if tr > 0:
-        s = math.sqrt(tr + 1.0) * 2
-        w, x, y, z = 0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
-        w, x, y, z = (m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
-    elif m[1, 1] > m[2, 2]:
-        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
-        w, x, y, z = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s
-    else:
-        s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
-        w, x, y, z = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s
+    if tr > 0.0:
+        s = math.sqrt(tr + 1.0) * 2.0
+        return 0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
+    if m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2.0
+        return (m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
+    if m[1, 1] > m[2, 2]:
+        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2.0
+        return (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s
+    s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2.0
+    return (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s
+
+
+def matrix_quaternion(r: np.ndarray) -> tuple[float, float, float, float]:
+    """Rotation matrix → unit quaternion (x, y, z, w) with w >= 0."""
+    w, x, y, z = _shepperd(r)
     q = np.array([x, y, z, w])
     q /= np.linalg.norm(q)
     if q[3] < 0:
         q = -q
     return tuple(float(v) for v in q)  # type: ignore[return-value]
+
+
+def axis_angle(r: np.ndarray) -> list[float]:
+    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, π]); identity → 0 0 1 0. Through
+    the quaternion of :func:`_shepperd`, accurate at half turns (a recognised object's orientation)."""
+    w, x, y, z = _shepperd(r)
+    if w < 0.0:
+        w, x, y, z = -w, -x, -y, -z
+    n = math.sqrt(x * x + y * y + z * z)
+    if n < 1e-300:
+        return [0.0, 0.0, 1.0, 0.0]
+    return [x / n, y / n, z / n, 2.0 * math.atan2(n, w)]
 
 
 def pose_from_model(p) -> Pose:
@@ -86,3 +103,13 @@ def pose_from_values(translation, rotation=None, quaternion=None) -> Pose:
     else:
         r = np.eye(3)
     return Pose(rotation=r, translation=t)
+
+
+def moved_pose(current: Pose, translation=None, rotation=None, quaternion=None) -> Pose:
+    """``current`` with what is given replaced (a supervisor's move): no ``translation`` keeps its
+    translation, neither ``rotation`` nor ``quaternion`` keeps its rotation."""
+    if translation is None:
+        translation = current.translation
+    if rotation is None and quaternion is None:
+        return Pose(rotation=current.rotation.copy(), translation=pose_from_values(translation).translation)
+    return pose_from_values(translation, rotation, quaternion)

@@ -297,30 +297,19 @@ static int save_rgb(const char *func, const char *filename, int quality, const u
 #define RANGE_FINDER(func) sn_device *d = sn_device_get(tag, SN_RANGE_FINDER, func)
 
 void wb_range_finder_enable(WbDeviceTag tag, int sampling_period) {
-  RANGE_FINDER("wb_range_finder_enable");
-  if (d != NULL)
-    sn_device_enable(d, sampling_period, "wb_range_finder_enable");
+  sn_sensor_enable(tag, SN_RANGE_FINDER, sampling_period, "wb_range_finder_enable");
 }
 
-void wb_range_finder_disable(WbDeviceTag tag) {
-  RANGE_FINDER("wb_range_finder_disable");
-  if (d != NULL)
-    sn_device_enable(d, 0, "wb_range_finder_disable");
-}
+void wb_range_finder_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_RANGE_FINDER, 0, "wb_range_finder_disable"); }
 
 int wb_range_finder_get_sampling_period(WbDeviceTag tag) {
-  RANGE_FINDER("wb_range_finder_get_sampling_period");
-  return d ? d->sampling_period : 0;
+  return sn_sensor_period(tag, SN_RANGE_FINDER, "wb_range_finder_get_sampling_period");
 }
 
 /* Webots' rule: a disabled range finder prints an error and still hands out its (last) image. */
 const float *wb_range_finder_get_range_image(WbDeviceTag tag) {
-  RANGE_FINDER("wb_range_finder_get_range_image");
-  if (d == NULL)
-    return NULL;
-  if (d->sampling_period <= 0)
-    sn_warn_disabled(d, "wb_range_finder_get_range_image", "wb_range_finder_enable", NULL);
-  return d->imaging->range;
+  sn_device *d = sn_sensor_reading(tag, SN_RANGE_FINDER, "wb_range_finder_get_range_image", "wb_range_finder_enable");
+  return d ? d->imaging->range : NULL;
 }
 
 int wb_range_finder_get_width(WbDeviceTag tag) {
@@ -374,20 +363,13 @@ int wb_range_finder_save_image(WbDeviceTag tag, const char *filename, int qualit
 #define CAMERA(func) sn_device *d = sn_device_get(tag, SN_CAMERA, func)
 
 void wb_camera_enable(WbDeviceTag tag, int sampling_period) {
-  CAMERA("wb_camera_enable");
-  if (d != NULL)
-    sn_device_enable(d, sampling_period, "wb_camera_enable");
+  sn_sensor_enable(tag, SN_CAMERA, sampling_period, "wb_camera_enable");
 }
 
-void wb_camera_disable(WbDeviceTag tag) {
-  CAMERA("wb_camera_disable");
-  if (d != NULL)
-    sn_device_enable(d, 0, "wb_camera_disable");
-}
+void wb_camera_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_CAMERA, 0, "wb_camera_disable"); }
 
 int wb_camera_get_sampling_period(WbDeviceTag tag) {
-  CAMERA("wb_camera_get_sampling_period");
-  return d ? d->sampling_period : 0;
+  return sn_sensor_period(tag, SN_CAMERA, "wb_camera_get_sampling_period");
 }
 
 /* Webots' rule: NULL (and an error) while the camera is disabled. */
@@ -455,13 +437,8 @@ void wb_camera_set_exposure(WbDeviceTag tag, double exposure) {
     fprintf(stderr, "Error: 'exposure' argument of %s() can't be negative.\n", func);
     return;
   }
-  sn_robot *rb = sn_robot_get(func);
-  if (!rb->terminated) {
-    sn_reply rep;
-    if (sn_device_call(rb, d, "set_exposure", sn_arg_double, &exposure, func, &rep) != 0)
-      return;
-    sn_reply_free(&rep);
-  }
+  if (!sn_device_set(d, "set_exposure", sn_arg_double, &exposure, func))
+    return;
   d->imaging->exposure = exposure;
 }
 
@@ -552,13 +529,8 @@ void wb_camera_recognition_enable(WbDeviceTag tag, int sampling_period) {
   sn_device *d = recognition(tag, func);
   if (d == NULL)
     return;
-  sn_robot *rb = sn_robot_get(func);
-  if (!rb->terminated) {
-    sn_reply rep;
-    if (sn_device_call(rb, d, "recognition_enable", sn_arg_int, &sampling_period, func, &rep) != 0)
-      return;
-    sn_reply_free(&rep);
-  }
+  if (!sn_device_set(d, "recognition_enable", sn_arg_int, &sampling_period, func))
+    return;
   d->imaging->recognition_period = sampling_period;
   if (sampling_period == 0)
     d->imaging->segmentation_enabled = false;
@@ -611,13 +583,8 @@ static void segmentation(WbDeviceTag tag, bool on, const char *func) {
             func);
     return;
   }
-  sn_robot *rb = sn_robot_get(func);
-  if (!rb->terminated) {
-    sn_reply rep;
-    if (sn_device_call(rb, d, "enable_segmentation", sn_arg_bool, &on, func, &rep) != 0)
-      return;
-    sn_reply_free(&rep);
-  }
+  if (!sn_device_set(d, "enable_segmentation", sn_arg_bool, &on, func))
+    return;
   d->imaging->segmentation_enabled = on;
 }
 

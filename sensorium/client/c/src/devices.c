@@ -86,37 +86,42 @@ int sn_node_type_of(const char *type_name) {
   return WB_NODE_NO_NODE;
 }
 
-/* ------------------------------------------------------------------ scalar sensors */
+/* ------------------------------------------------------------------ every sensor */
 
-static double scalar_value(WbDeviceTag tag, sn_kind kind, const char *func, const char *enabler) {
-  sn_device *d = sn_device_get(tag, kind, func);
-  if (d == NULL)
-    return NAN;
-  if (d->sampling_period <= 0)
-    sn_warn_disabled(d, func, enabler, NULL);
-  return d->value;
-}
-
-static void enable(WbDeviceTag tag, sn_kind kind, int period, const char *func) {
+void sn_sensor_enable(WbDeviceTag tag, sn_kind kind, int period, const char *func) {
   sn_device *d = sn_device_get(tag, kind, func);
   if (d != NULL)
     sn_device_enable(d, period, func);
 }
 
-static int period(WbDeviceTag tag, sn_kind kind, const char *func) {
+int sn_sensor_period(WbDeviceTag tag, sn_kind kind, const char *func) {
   sn_device *d = sn_device_get(tag, kind, func);
   return d ? d->sampling_period : 0;
 }
 
-/* light sensor */
-void wb_light_sensor_enable(WbDeviceTag tag, int sampling_period) {
-  enable(tag, SN_LIGHT, sampling_period, "wb_light_sensor_enable");
+sn_device *sn_sensor_reading(WbDeviceTag tag, sn_kind kind, const char *func, const char *enabler) {
+  sn_device *d = sn_device_get(tag, kind, func);
+  if (d != NULL && d->sampling_period <= 0)
+    sn_warn_disabled(d, func, enabler, NULL);
+  return d;
 }
 
-void wb_light_sensor_disable(WbDeviceTag tag) { enable(tag, SN_LIGHT, 0, "wb_light_sensor_disable"); }
+/* ------------------------------------------------------------------ scalar sensors */
+
+static double scalar_value(WbDeviceTag tag, sn_kind kind, const char *func, const char *enabler) {
+  sn_device *d = sn_sensor_reading(tag, kind, func, enabler);
+  return d ? d->value : NAN;
+}
+
+/* light sensor */
+void wb_light_sensor_enable(WbDeviceTag tag, int sampling_period) {
+  sn_sensor_enable(tag, SN_LIGHT, sampling_period, "wb_light_sensor_enable");
+}
+
+void wb_light_sensor_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_LIGHT, 0, "wb_light_sensor_disable"); }
 
 int wb_light_sensor_get_sampling_period(WbDeviceTag tag) {
-  return period(tag, SN_LIGHT, "wb_light_sensor_get_sampling_period");
+  return sn_sensor_period(tag, SN_LIGHT, "wb_light_sensor_get_sampling_period");
 }
 
 double wb_light_sensor_get_value(WbDeviceTag tag) {
@@ -135,13 +140,15 @@ const double *wb_light_sensor_get_lookup_table(WbDeviceTag tag) {
 
 /* distance sensor */
 void wb_distance_sensor_enable(WbDeviceTag tag, int sampling_period) {
-  enable(tag, SN_DISTANCE, sampling_period, "wb_distance_sensor_enable");
+  sn_sensor_enable(tag, SN_DISTANCE, sampling_period, "wb_distance_sensor_enable");
 }
 
-void wb_distance_sensor_disable(WbDeviceTag tag) { enable(tag, SN_DISTANCE, 0, "wb_distance_sensor_disable"); }
+void wb_distance_sensor_disable(WbDeviceTag tag) {
+  sn_sensor_enable(tag, SN_DISTANCE, 0, "wb_distance_sensor_disable");
+}
 
 int wb_distance_sensor_get_sampling_period(WbDeviceTag tag) {
-  return period(tag, SN_DISTANCE, "wb_distance_sensor_get_sampling_period");
+  return sn_sensor_period(tag, SN_DISTANCE, "wb_distance_sensor_get_sampling_period");
 }
 
 double wb_distance_sensor_get_value(WbDeviceTag tag) {

@@ -15,29 +15,20 @@
 #define POSITION(func) sn_device *d = sn_device_get(tag, SN_POSITION, func)
 
 void wb_position_sensor_enable(WbDeviceTag tag, int sampling_period) {
-  POSITION("wb_position_sensor_enable");
-  if (d != NULL)
-    sn_device_enable(d, sampling_period, "wb_position_sensor_enable");
+  sn_sensor_enable(tag, SN_POSITION, sampling_period, "wb_position_sensor_enable");
 }
 
 void wb_position_sensor_disable(WbDeviceTag tag) {
-  POSITION("wb_position_sensor_disable");
-  if (d != NULL)
-    sn_device_enable(d, 0, "wb_position_sensor_disable");
+  sn_sensor_enable(tag, SN_POSITION, 0, "wb_position_sensor_disable");
 }
 
 int wb_position_sensor_get_sampling_period(WbDeviceTag tag) {
-  POSITION("wb_position_sensor_get_sampling_period");
-  return d ? d->sampling_period : 0;
+  return sn_sensor_period(tag, SN_POSITION, "wb_position_sensor_get_sampling_period");
 }
 
 double wb_position_sensor_get_value(WbDeviceTag tag) {
-  POSITION("wb_position_sensor_get_value");
-  if (d == NULL)
-    return NAN;
-  if (d->sampling_period <= 0)
-    sn_warn_disabled(d, "wb_position_sensor_get_value", "wb_position_sensor_enable", NULL);
-  return d->value;
+  sn_device *d = sn_sensor_reading(tag, SN_POSITION, "wb_position_sensor_get_value", "wb_position_sensor_enable");
+  return d ? d->value : NAN;
 }
 
 WbJointType wb_position_sensor_get_type(WbDeviceTag tag) {
@@ -68,13 +59,8 @@ void wb_led_set(WbDeviceTag tag, int value) {
     fprintf(stderr, "Error: wb_led_set(): value %d out of range [0, %d] for LED '%s'.\n", value, hi, d->name);
     return;
   }
-  sn_robot *rb = sn_robot_get("wb_led_set");
-  if (!rb->terminated) {
-    sn_reply rep;
-    if (sn_device_call(rb, d, "set", sn_arg_int, &value, "wb_led_set", &rep) != 0)
-      return;
-    sn_reply_free(&rep);
-  }
+  if (!sn_device_set(d, "set", sn_arg_int, &value, "wb_led_set"))
+    return;
   d->led_value = value;
 }
 

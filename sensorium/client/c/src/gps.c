@@ -8,41 +8,25 @@
 #include "internal.h"
 
 void wb_gps_enable(WbDeviceTag tag, int sampling_period) {
-  sn_device *d = sn_device_get(tag, SN_GPS, "wb_gps_enable");
-  if (d != NULL)
-    sn_device_enable(d, sampling_period, "wb_gps_enable");
+  sn_sensor_enable(tag, SN_GPS, sampling_period, "wb_gps_enable");
 }
 
-void wb_gps_disable(WbDeviceTag tag) {
-  sn_device *d = sn_device_get(tag, SN_GPS, "wb_gps_disable");
-  if (d != NULL)
-    sn_device_enable(d, 0, "wb_gps_disable");
-}
+void wb_gps_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_GPS, 0, "wb_gps_disable"); }
 
-int wb_gps_get_sampling_period(WbDeviceTag tag) {
-  sn_device *d = sn_device_get(tag, SN_GPS, "wb_gps_get_sampling_period");
-  return d ? d->sampling_period : 0;
-}
-
-static sn_device *reading(WbDeviceTag tag, const char *func) {
-  sn_device *d = sn_device_get(tag, SN_GPS, func);
-  if (d != NULL && d->sampling_period <= 0)
-    sn_warn_disabled(d, func, "wb_gps_enable", NULL);
-  return d;
-}
+int wb_gps_get_sampling_period(WbDeviceTag tag) { return sn_sensor_period(tag, SN_GPS, "wb_gps_get_sampling_period"); }
 
 const double *wb_gps_get_values(WbDeviceTag tag) {
-  sn_device *d = reading(tag, "wb_gps_get_values");
+  sn_device *d = sn_sensor_reading(tag, SN_GPS, "wb_gps_get_values", "wb_gps_enable");
   return d ? d->gps_values : sn_no_values();
 }
 
 double wb_gps_get_speed(WbDeviceTag tag) {
-  sn_device *d = reading(tag, "wb_gps_get_speed");
+  sn_device *d = sn_sensor_reading(tag, SN_GPS, "wb_gps_get_speed", "wb_gps_enable");
   return d ? d->gps_speed : NAN;
 }
 
 const double *wb_gps_get_speed_vector(WbDeviceTag tag) {
-  sn_device *d = reading(tag, "wb_gps_get_speed_vector");
+  sn_device *d = sn_sensor_reading(tag, SN_GPS, "wb_gps_get_speed_vector", "wb_gps_enable");
   return d ? d->gps_speed_vector : sn_no_values();
 }
 

@@ -4,7 +4,8 @@
  *             the heartbeat thread;
  * wire.c    - msgpack helpers (building requests, reading reply maps);
  * robot.c   - the session: attach, step (motor commands out, readings in), cleanup;
- * devices.c - light and distance sensors, generic device functions; lidar.c; motor.c; gps.c;
+ * devices.c - light and distance sensors, generic device functions (and every sensor's enable,
+ *             sampling period and reading: sn_sensor_*); lidar.c; motor.c; gps.c;
  * kinematic.c - InertialUnit, Compass, Accelerometer, Gyro, Altimeter, TouchSensor;
  * radio.c   - Emitter and Receiver (packet queues, baud-rate pacing);
  * camera.c  - range finders and cameras;
@@ -211,8 +212,18 @@ void sn_supervisor_free(sn_robot *rb);
 void sn_arg_int(sn_req *r, const void *arg);
 void sn_arg_bool(sn_req *r, const void *arg);
 void sn_arg_double(sn_req *r, const void *arg);
+/* A setting the server keeps: "/<robot>/<device>/<item>" with one argument. true once the server
+ * took it, or at once when the controller's steps have ended (its local copy is all there is then);
+ * false after the error message of a refused call (the caller keeps its local copy unchanged). */
+bool sn_device_set(sn_device *dev, const char *item, sn_arg_fn add_value, const void *arg, const char *func);
 /* enable/disable a sensor (period 0 disables): RPC, then the local state. */
 void sn_device_enable(sn_device *dev, int period, const char *func);
+/* devices.c: what every sensor's wb_<kind>_enable/disable/get_sampling_period does on the device of tag
+ * (Webots' error and no effect when tag is not of kind); sn_sensor_reading: the device for a getter of
+ * its readings, with Webots' once-per-disable message when it is read while disabled. */
+void sn_sensor_enable(WbDeviceTag tag, sn_kind kind, int period, const char *func);
+int sn_sensor_period(WbDeviceTag tag, sn_kind kind, const char *func);
+sn_device *sn_sensor_reading(WbDeviceTag tag, sn_kind kind, const char *func, const char *enabler);
 /* A device Sensorium lists but does not simulate: checks that tag is a device of node_type (else
  * Webots' error), prints one warning line per device, returns false. true if tag is simulated. */
 bool sn_unsimulated(WbDeviceTag tag, int node_type, const char *func);

@@ -11,33 +11,21 @@
 #define LIDAR(func) sn_device *d = sn_device_get(tag, SN_LIDAR, func)
 
 void wb_lidar_enable(WbDeviceTag tag, int sampling_period) {
-  LIDAR("wb_lidar_enable");
-  if (d != NULL)
-    sn_device_enable(d, sampling_period, "wb_lidar_enable");
+  sn_sensor_enable(tag, SN_LIDAR, sampling_period, "wb_lidar_enable");
 }
 
-void wb_lidar_disable(WbDeviceTag tag) {
-  LIDAR("wb_lidar_disable");
-  if (d != NULL)
-    sn_device_enable(d, 0, "wb_lidar_disable");
-}
+void wb_lidar_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_LIDAR, 0, "wb_lidar_disable"); }
 
 int wb_lidar_get_sampling_period(WbDeviceTag tag) {
-  LIDAR("wb_lidar_get_sampling_period");
-  return d ? d->sampling_period : 0;
+  return sn_sensor_period(tag, SN_LIDAR, "wb_lidar_get_sampling_period");
 }
 
 static void point_cloud(WbDeviceTag tag, bool on, const char *func) {
   LIDAR(func);
   if (d == NULL)
     return;
-  sn_robot *rb = sn_robot_get(func);
-  if (!rb->terminated) {
-    sn_reply rep;
-    if (sn_device_call(rb, d, "enable_point_cloud", sn_arg_bool, &on, func, &rep) != 0)
-      return;
-    sn_reply_free(&rep);
-  }
+  if (!sn_device_set(d, "enable_point_cloud", sn_arg_bool, &on, func))
+    return;
   d->point_cloud_enabled = on;
   d->warned = false;
 }
@@ -61,12 +49,8 @@ static bool layer_ok(const sn_device *d, int layer, const char *func) {
 
 /* Webots' rule: a disabled lidar prints an error; the whole image is still the cached one. */
 const float *wb_lidar_get_range_image(WbDeviceTag tag) {
-  LIDAR("wb_lidar_get_range_image");
-  if (d == NULL)
-    return NULL;
-  if (d->sampling_period <= 0)
-    sn_warn_disabled(d, "wb_lidar_get_range_image", "wb_lidar_enable", NULL);
-  return d->range_image;
+  sn_device *d = sn_sensor_reading(tag, SN_LIDAR, "wb_lidar_get_range_image", "wb_lidar_enable");
+  return d ? d->range_image : NULL;
 }
 
 const float *wb_lidar_get_layer_range_image(WbDeviceTag tag, int layer) {
@@ -150,13 +134,8 @@ void wb_lidar_set_frequency(WbDeviceTag tag, double frequency) {
             d->max_frequency);
     return;
   }
-  sn_robot *rb = sn_robot_get(func);
-  if (!rb->terminated) {
-    sn_reply rep;
-    if (sn_device_call(rb, d, "set_frequency", sn_arg_double, &frequency, func, &rep) != 0)
-      return;
-    sn_reply_free(&rep);
-  }
+  if (!sn_device_set(d, "set_frequency", sn_arg_double, &frequency, func))
+    return;
   d->frequency = frequency;
 }
 

@@ -29,12 +29,8 @@ static sn_device *pen(WbDeviceTag tag, const char *func) {
 
 void wb_pen_write(WbDeviceTag tag, bool write) {
   sn_device *d = pen(tag, "wb_pen_write");
-  sn_robot *rb = sn_robot_get("wb_pen_write");
-  if (d == NULL || rb->terminated)
-    return;
-  sn_reply rep;
-  if (sn_device_call(rb, d, "write", sn_arg_bool, &write, "wb_pen_write", &rep) == 0)
-    sn_reply_free(&rep);
+  if (d != NULL)
+    sn_device_set(d, "write", sn_arg_bool, &write, "wb_pen_write");
 }
 
 typedef struct {

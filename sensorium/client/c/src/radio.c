@@ -197,33 +197,21 @@ void sn_radio_receive(sn_device *d, const msgpack_object *packets) {
 }
 
 void wb_receiver_enable(WbDeviceTag tag, int sampling_period) {
-  sn_device *d = sn_device_get(tag, SN_RECEIVER, "wb_receiver_enable");
-  if (d != NULL)
-    sn_device_enable(d, sampling_period, "wb_receiver_enable");
+  sn_sensor_enable(tag, SN_RECEIVER, sampling_period, "wb_receiver_enable");
 }
 
-void wb_receiver_disable(WbDeviceTag tag) {
-  sn_device *d = sn_device_get(tag, SN_RECEIVER, "wb_receiver_disable");
-  if (d != NULL)
-    sn_device_enable(d, 0, "wb_receiver_disable");
-}
+void wb_receiver_disable(WbDeviceTag tag) { sn_sensor_enable(tag, SN_RECEIVER, 0, "wb_receiver_disable"); }
 
 int wb_receiver_get_sampling_period(WbDeviceTag tag) {
-  sn_device *d = sn_device_get(tag, SN_RECEIVER, "wb_receiver_get_sampling_period");
-  return d ? d->sampling_period : 0;
+  return sn_sensor_period(tag, SN_RECEIVER, "wb_receiver_get_sampling_period");
 }
 
 void wb_receiver_set_channel(WbDeviceTag tag, int channel) {
   sn_device *d = sn_device_get(tag, SN_RECEIVER, "wb_receiver_set_channel");
   if (d == NULL || channel == d->channel || !allowed(d, channel, "wb_receiver_set_channel"))
     return;
-  sn_robot *rb = sn_robot_get("wb_receiver_set_channel");
-  if (!rb->terminated) {
-    sn_reply rep;
-    if (sn_device_call(rb, d, "set_channel", sn_arg_int, &channel, "wb_receiver_set_channel", &rep) != 0)
-      return;
-    sn_reply_free(&rep);
-  }
+  if (!sn_device_set(d, "set_channel", sn_arg_int, &channel, "wb_receiver_set_channel"))
+    return;
   d->channel = channel;
 }
 

@@ -736,18 +736,24 @@ int sn_device_call(sn_robot *rb, const sn_device *dev, const char *item, sn_arg_
   return sn_robot_call(rb, path, add_value ? 1 : 0, add_value ? add_value_arg : NULL, &v, func, out);
 }
 
-void sn_device_enable(sn_device *dev, int period, const char *func) {
+bool sn_device_set(sn_device *dev, const char *item, sn_arg_fn add_value, const void *arg, const char *func) {
   sn_robot *rb = sn_robot_get(func);
+  if (rb->terminated)
+    return true;
+  sn_reply rep;
+  if (sn_device_call(rb, dev, item, add_value, arg, func, &rep) != 0)
+    return false;
+  sn_reply_free(&rep);
+  return true;
+}
+
+void sn_device_enable(sn_device *dev, int period, const char *func) {
   if (period < 0) {
     fprintf(stderr, "Error: %s(): negative sampling period %d\n", func, period);
     return;
   }
-  if (!rb->terminated) {
-    sn_reply rep;
-    if (sn_device_call(rb, dev, "enable", sn_arg_int, &period, func, &rep) != 0)
-      return;
-    sn_reply_free(&rep);
-  }
+  if (!sn_device_set(dev, "enable", sn_arg_int, &period, func))
+    return;
   dev->sampling_period = period;
   dev->warned = false;
 }
