@@ -43,6 +43,7 @@ RETRIED_SERVICES = ("/robot/step", "/robot/time_step")
 DEFAULT_TIMEOUT = 10.0          # seconds for a non-step request (the server may still be starting)
 
 _NO_TIMEOUT = object()
+_NOBLOCK = int(zmq.NOBLOCK)     # a plain int: pyzmq's enum flags cost ~0.3 µs per call
 
 
 class ErrorCode(IntEnum):
@@ -317,7 +318,13 @@ class Connection:
             raise SensoriumError(ErrorCode.WRONG_STATE, f"connection to {self.endpoint} is closed")
         rid = next(self._ids)
         data = self._packer.pack({"id": rid, "service": service, "args": args or {}})
-        self._socket.send(data)
+        try:
+            # never blocks: a DEALER queues while (re)connecting and refuses only once ZeroMQ closed
+            # its connection for good (see _resend_due) or 1000 requests wait unsent
+            self._socket.send(data, _NOBLOCK)
+        except zmq.Again:
+            raise ConnectionLost(f"cannot send {service!r} to {self.endpoint}: ZeroMQ closed the connection for good "
+                                 "or 1000 requests wait unsent") from None
         self._outstanding[rid] = service
         if service.endswith(RETRIED_SERVICES):
             self._retry[rid] = (data, time.monotonic())
@@ -434,7 +441,15 @@ class Connection:
         with a dropped connection. The server answers a repeated id once (PROTOCOL.md)."""
         entry = self._retry.get(rid)
         if entry is not None and time.monotonic() - entry[1] >= RETRY_S:
-            self._socket.send(entry[0])
+            try:
+                self._socket.send(entry[0], _NOBLOCK)
+            except zmq.Again:
+                # no connection left to queue on: ZeroMQ closed it for good (it does so, without
+                # reconnecting, when a message breaks the protocol); a dropped network one would queue
+                service = self._outstanding.pop(rid, "?")
+                self._retry.pop(rid, None)
+                raise ConnectionLost(f"ZeroMQ closed the connection to {self.endpoint} for good while the reply to "
+                                     f"{service!r} was due (a message that is not ZeroMQ ends it)") from None
             self._retry[rid] = (entry[0], time.monotonic())
             self.retries += 1
 
