@@ -262,7 +262,7 @@ class Transport:
                     if lockstep.generation != peers_generation:
                         gate.set_peers(core.step_peers())
                         peers_generation = lockstep.generation
-                    if now - deaf_since > STALL_S:
+                    if now - deaf_since > STALL_S:      # a long stretch without reading: not their silence
                         core.unheard(now - deaf_since, now)
                     batch = gate.receive(wait_ms, lockstep.waiting_slots(), REQUESTS_PER_TURN)
                     now = deaf_since = clock()
@@ -291,6 +291,9 @@ class Transport:
                 # session expiry (and, while busy, the other sockets): when a deadline woke us,
                 # else at most every EXPIRE_EVERY_S
                 if timed_out or now >= next_expire:
+                    if now - deaf_since > STALL_S:          # not listening since (dropping frames): credit it first
+                        core.unheard(now - deaf_since, now)
+                        deaf_since = now
                     core.expire(now)
                     next_expire = now + EXPIRE_EVERY_S
                     if busy_until:
