@@ -220,6 +220,23 @@ def test_handle_step_answers_as_handle_does(body, rid, duration):
     assert a.lockstep.time_ms == b.lockstep.time_ms
 
 
+def test_a_step_reply_without_values_is_msgpacks_bytes():
+    """Core assembles the common step reply (no new value) from pieces: the same bytes as packing it."""
+    from sensorium.schemas.wire import ok_reply
+
+    c = core()
+    attach(c, IDENT, "bot2")
+    for i, rid in enumerate((0, 1, 127, 128, 255, 256, 65535, 65536, 2**32, 2**64 - 1)):
+        for duration in ((None, 16 * 4200)[i % 2],):     # time_ms past 127, 255, 65535 too
+            c.handle_step(2, IDENT, rid, duration, 0.0)
+            (reply,) = step_all(c)
+            t = c.lockstep.time_ms
+            assert reply == [IDENT, ok_reply(rid, {"status": 0, "time_ms": t, "values": {}})], (rid, t)
+    c.shutdown()
+    assert c.handle_step(2, IDENT, 5, None, 0.0) == [[IDENT, ok_reply(5, {"status": -1, "time_ms": c.lockstep.time_ms,
+                                                                          "values": {}})]]
+
+
 # ---------------------------------------------------------------------- the whole server, both gates
 
 def scripted_session(step_path: str) -> list[bytes]:

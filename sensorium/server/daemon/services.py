@@ -76,6 +76,12 @@ class Route:
 
 
 _DEFERRED = None              # a handler returning None answers later (step)
+# ok_reply(rid, {"status": s, "time_ms": t, "values": {}}) in pieces, around the packed rid, s and t
+# (tests/test_steppath.py checks the bytes against ok_reply)
+_STEP_HEAD = b"\x83\xa2id"
+_STEP_STATUS = b"\xa2ok\xc3\xa6result\x83\xa6status"
+_STEP_TIME = b"\xa7time_ms"
+_STEP_NO_VALUES = b"\xa6values\x80"
 ARG_CACHE_KEYS = 4            # argument maps of at most this many int/str values are cached once validated
 ARG_CACHE_SIZE = 1024         # validated argument maps kept
 
@@ -399,7 +405,11 @@ class Core(DeviceServices):
             values: dict[str, dict] = {}
             if d.status != -1 and d.session.alive:
                 values = self._new_values(d.session)
-            body = self._bounded_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})
+            if values:
+                body = self._bounded_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})
+            else:                                 # most replies: no new value; msgpack's bytes, assembled
+                body = b"".join((_STEP_HEAD, pack(rid), _STEP_STATUS, pack(d.status), _STEP_TIME, pack(d.time_ms),
+                                 _STEP_NO_VALUES))
         d.session.last_step = (rid, body)         # kept for a retry of a reply lost in transit
         return envelope + [body]
 
