@@ -156,6 +156,35 @@ def _role_stepper(rpc: str, robot: str, duration: str) -> None:
     _chunks(lambda: conn.call(service, args), close)
 
 
+def _role_bare_stepper(rpc: str, robot: str, duration: str) -> None:
+    """A bare DEALER stepping a robot in lockstep (pack, send, blocking recv, unpack): the client
+    library's share of a Sensorium round trip is the difference to ``stepper``."""
+    import msgpack
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.DEALER)
+    s.setsockopt(zmq.LINGER, 0)
+    s.connect(rpc)
+    s.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": robot}}))
+    session = msgpack.unpackb(s.recv())["result"]["session"]
+    packer = msgpack.Packer()
+    service, args = f"/{robot}/robot/step", {"duration": int(duration)}
+    ids = iter(range(2, 1 << 62))
+
+    def call():
+        s.send(packer.pack({"id": next(ids), "service": service, "args": args}))
+        msgpack.unpackb(s.recv(), raw=False)
+
+    def close():
+        s.send(msgpack.packb({"id": 0, "service": "detach", "args": {"session": session}}))
+        s.recv()
+        s.close(0)
+        ctx.term()
+
+    _chunks(call, close)
+
+
 def _role_pub(endpoint: str, size: str, count: str) -> None:
     """Raw pyzmq PUB: wait for a subscriber, then publish ``count`` messages of ``size`` bytes."""
     import zmq
@@ -229,6 +258,7 @@ def _role_raw_controller(endpoint: str, steps: str) -> None:
 def main(argv: list[str]) -> None:
     roles = {"rep-echo": _role_rep_echo, "req": _role_req, "router-echo": _role_router_echo,
              "conn-client": _role_conn_client, "dealer-client": _role_dealer_client, "stepper": _role_stepper,
+             "bare-stepper": _role_bare_stepper,
              "pub": _role_pub, "controller": _role_controller, "raw-controller": _role_raw_controller}
     roles[argv[0]](*argv[1:])
 

@@ -261,6 +261,9 @@ def unpack(data: bytes) -> Any:
     return msgpack.unpackb(data, raw=False, strict_map_key=False)
 
 
+_unpackb = msgpack.unpackb
+
+
 def _error_from(reply: dict) -> SensoriumError:
     err = reply.get("error")
     if not isinstance(err, dict):
@@ -334,7 +337,7 @@ class Connection:
         """The ``result`` of request ``rid``; raise :class:`SensoriumError` for an error reply,
         :class:`ServiceTimeout` after ``timeout`` seconds, :class:`ConnectionLost` if the
         heartbeat found the server gone or the session dropped."""
-        reply = self._replies.pop(rid, None)
+        reply = self._replies.pop(rid, None) if self._replies else None
         if reply is None:
             reply = self._receive(rid, self.timeout if timeout is _NO_TIMEOUT else timeout)
         del self._outstanding[rid]
@@ -384,10 +387,18 @@ class Connection:
                         self._retry.pop(rid, None)
                         raise ConnectionLost(f"while waiting for {service!r}: {problem}") from None
                 continue
-            reply = self._decode_body(data)
+            # _decode_body inlined (the step loop's hot path): the same checks
+            try:
+                reply = _unpackb(data, raw=False, strict_map_key=False)
+            except Exception as exc:  # noqa: BLE001 - any decoding failure is a bad reply
+                raise SensoriumError(ErrorCode.BAD_REPLY, f"undecodable reply from {self.endpoint}: {exc}") from None
+            if type(reply) is not dict:
+                raise SensoriumError(ErrorCode.BAD_REPLY, f"reply is not a map: {reply!r}")
             got = reply.get("id")
             if got == rid:
                 return reply
+            if got is None and reply.get("ok") is False:
+                raise _error_from(reply)
             if got in self._outstanding:
                 self._replies[got] = reply
             # else: the reply to a request we gave up on (timeout, discard): drop it
