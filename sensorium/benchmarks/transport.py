@@ -124,18 +124,20 @@ def round_trips(tmp: Path, n: int, rounds: int, ipc: bool = False) -> dict[str, 
         router = Proc(_role_args("router-echo", f"ipc://{tmp}/router" if ipc else "tcp://127.0.0.1"))
         servers.append(router)
         router_ep = router.line().split()[1]
+        # every server first, then the clients together: a controller that waits silent for longer
+        # than 3 heartbeats (while a server starts) would lose its session
+        sens = {path: Server(_robots_world(1), tmp, ipc=ipc, step_path=path) for path in step_paths()}
+        servers += list(sens.values())
+        bare = Server(_robots_world(1), tmp, ipc=ipc, step_path=step_paths()[0])
+        servers.append(bare)
         clients = {
             "floor": Proc(_role_args("req", rep_ep), stdin=True),
             "bare": Proc(_role_args("dealer-client", router_ep), stdin=True),
             "conn": Proc(_role_args("conn-client", router_ep), stdin=True),
+            **{f"sensorium-{path}": Proc(_role_args("stepper", srv.rpc, "c0", "8"), stdin=True)
+               for path, srv in sens.items()},
+            "sensorium-bare": Proc(_role_args("bare-stepper", bare.rpc, "c0", "8"), stdin=True),
         }
-        for path in step_paths():
-            sens = Server(_robots_world(1), tmp, ipc=ipc, step_path=path)
-            servers.append(sens)
-            clients[f"sensorium-{path}"] = Proc(_role_args("stepper", sens.rpc, "c0", "8"), stdin=True)
-        sens = Server(_robots_world(1), tmp, ipc=ipc, step_path=step_paths()[0])
-        servers.append(sens)
-        clients["sensorium-bare"] = Proc(_role_args("bare-stepper", sens.rpc, "c0", "8"), stdin=True)
         for c in clients.values():
             if c.line(60) != "ready":
                 raise RuntimeError("client not ready")
@@ -158,23 +160,46 @@ def round_trips(tmp: Path, n: int, rounds: int, ipc: bool = False) -> dict[str, 
             srv.stop()
 
 
-def multi_runs(tmp: Path, k: int, steps: int, runs: int) -> list[dict]:
-    """``runs`` rounds, each: ``k`` raw REQ processes ↔ a do-nothing REP, then ``k`` controller
-    processes ↔ ``sensorium serve`` with each step path, one right after the other (so each round's
-    ratios share the machine's load of the moment). Per round: world steps/s and round trips."""
+def multi_runs(tmp: Path, k: int, steps: int, runs: int, bursts: int) -> list[dict]:
+    """``runs`` runs with fresh processes, each: ``k`` raw REQ processes ↔ a do-nothing REP, and
+    ``k`` controller processes ↔ ``sensorium serve`` for every step path, all started, then run in
+    ``bursts`` alternating bursts of ``steps // bursts`` steps (so the load of the moment hits each
+    system alike). Per run and system: world steps/s (median over its bursts) and round trips."""
     out = []
     for _ in range(runs):
-        rep = Proc(_role_args("rep-echo", "tcp://127.0.0.1"))
+        groups: dict[str, list[Proc]] = {}
+        servers: list = []
         try:
-            res = {"raw": lockstep_multi(rep.line().split()[1], k, steps, raw=True), "load": load()}
+            rep = Proc(_role_args("rep-echo", "tcp://127.0.0.1"))
+            servers.append(rep)
+            rep_ep = rep.line().split()[1]
+            sens = {path: Server(_robots_world(k), tmp, step_path=path) for path in step_paths()}
+            servers += list(sens.values())
+            groups["raw"] = [Proc(_role_args("raw-controller", rep_ep, str(steps)), stdin=True) for _ in range(k)]
+            for path, srv in sens.items():
+                groups[path] = [Proc(_role_args("controller", srv.rpc, f"c{i}", str(steps), "8"), stdin=True)
+                                for i in range(k)]
+            for procs in groups.values():
+                for p in procs:
+                    if p.line(120) != "ready":
+                        raise RuntimeError("controller did not attach")
+            per: dict[str, list[dict]] = {g: [] for g in groups}
+            for _ in range(bursts):
+                for g, procs in groups.items():
+                    for p in procs:
+                        p.send(f"go {steps // bursts}")
+                    per[g].append(_window([json.loads(p.line(300)) for p in procs]))
+            res: dict = {"load": load()}
+            for g, ws in per.items():
+                res[g] = {"steps_per_s": float(np.median([w["steps_per_s"] for w in ws])),
+                          "rtt": np.concatenate([w["rtt"] for w in ws]),
+                          "bursts_steps_per_s": [w["steps_per_s"] for w in ws]}
         finally:
-            rep.stop()
-        for path in step_paths():
-            server = Server(_robots_world(k), tmp, step_path=path)
-            try:
-                res[path] = lockstep_multi(server.rpc, k, steps)
-            finally:
-                server.stop()
+            for procs in groups.values():
+                for p in procs:
+                    p.stop()
+            for srv in servers:
+                srv.stop()
         out.append(res)
     return out
 
@@ -196,8 +221,7 @@ def native_multi(exes: dict[str, str], rpc: str, k: int, steps: int, step: int =
 
 
 def _multi(procs: list[Proc]) -> dict:
-    """Start together ('go' to all), collect each process's send/reply times: round trips and world
-    steps/s in the window where all were stepping."""
+    """Start together ('go' to all), collect each process's send/reply times (:func:`_window`)."""
     try:
         for p in procs:
             if p.line(60) != "ready":
@@ -208,10 +232,15 @@ def _multi(procs: list[Proc]) -> dict:
     finally:
         for p in procs:
             p.stop()
+    return _window(res)
+
+
+def _window(res: list[dict]) -> dict:
+    """Round trips and world steps/s from the send/reply times of processes that stepped together:
+    steps/s in the window where all were stepping (each one's first 10 % skipped)."""
     t0 = [np.asarray(r["t0"]) for r in res]
     t1 = [np.asarray(r["t1"]) for r in res]
     rtt = np.concatenate([b - a for a, b in zip(t0, t1)])
-    # steady state: the window in which every controller was stepping; skip each one's first 10 %
     lo = max(a[len(a) // 10] for a in t0)
     hi = min(b[-1] for b in t1)
     counts = [np.sum((b >= lo) & (b <= hi)) for b in t1]
@@ -460,27 +489,28 @@ def run(cfg: Config) -> Section:
                          f"{median(xs) / median(fl):.2f}×", f"+{(median(xs) - median(fl)) * 1e6:.1f} µs"])
     steps_multi = cfg.pick(2000, 600)
     runs = cfg.pick(5, 2)
+    bursts = cfg.pick(8, 3)
     sps = {}
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        # 8 controllers vs 8 raw REQ processes: `runs` rounds, each raw then every step path
-        multi = multi_runs(tmp, 8, steps_multi, runs)
+        # 8 controllers vs 8 raw REQ processes: `runs` runs, each in bursts alternating raw and every step path
+        multi = multi_runs(tmp, 8, steps_multi, runs, bursts)
         loads.append(load())
         data["multi_8_runs"] = [{"load": m["load"], **{k: {"steps_per_s": m[k]["steps_per_s"], "p50_s": median(m[k]["rtt"]),
                                                          "p99_s": pct(m[k]["rtt"], 99)} for k in ["raw", *paths]}}
                                 for m in multi]
         for i, m in enumerate(multi):
             raw = m["raw"]
-            rows.append([f"round {i + 1} of {runs} (load {m['load']:.1f}): 8 raw REQ processes ↔ one do-nothing REP", 8,
+            rows.append([f"run {i + 1} of {runs} (load {m['load']:.1f}): 8 raw REQ processes ↔ one do-nothing REP", 8,
                          fmt_time(median(raw["rtt"])), fmt_time(pct(raw["rtt"], 99)), f"{raw['steps_per_s']:,.0f}",
                          f"{median(raw['rtt']) / median(floor):.2f}×", "–"])
             for path in paths:
                 x = m[path]
-                rows.append([f"round {i + 1}: 8 controller processes ↔ `sensorium serve`, {path} step path", 8,
+                rows.append([f"run {i + 1}: 8 controller processes ↔ `sensorium serve`, {path} step path", 8,
                              fmt_time(median(x["rtt"])), fmt_time(pct(x["rtt"], 99)),
                              f"{x['steps_per_s']:,.0f} ({x['steps_per_s'] / raw['steps_per_s']:.2f}× raw)",
                              f"{median(x['rtt']) / median(floor):.2f}×", "–"])
-            cfg.log(f"  transport: 8 controllers, round {i + 1}: raw {raw['steps_per_s']:.0f}/s, "
+            cfg.log(f"  transport: 8 controllers, run {i + 1}: raw {raw['steps_per_s']:.0f}/s, "
                     + ", ".join(f"{p} {m[p]['steps_per_s']:.0f}/s ({m[p]['steps_per_s'] / raw['steps_per_s']:.2f}×)"
                                 for p in paths) + f" (load {m['load']:.1f})")
         sps[8] = float(np.median([m[best]["steps_per_s"] for m in multi]))
@@ -508,10 +538,11 @@ def run(cfg: Config) -> Section:
             "p50 above the floor"], rows, [
             f"Every client and server is its own process. The 1-controller rows ({n:,} round trips each) were timed in "
             f"{rounds} alternating chunks, so their ratios share the same machine load. The 8-controller rows are "
-            f"{runs} rounds of {steps_multi:,} steps per process; in each round the raw floor and every step path ran "
-            "one right after the other, all processes of a row started together, and the ratio in the steps/s column "
-            "compares a row with its own round's floor. World steps/s: steps every controller completed inside the "
-            "window where all were stepping (each one's first 10 % skipped).",
+            f"{runs} runs with fresh processes; in each, the raw floor's 8 processes and 8 controllers per step path "
+            f"ran in {bursts} alternating bursts of {steps_multi // bursts:,} steps (all processes of a burst started "
+            "together), and the ratio in the steps/s column compares a row with its own run's floor. World steps/s: "
+            "the median over a row's bursts of the steps every process completed inside the window where all were "
+            "stepping (each one's first 10 % skipped).",
             f"Machine load (1-minute load average, 2 cores) during this section: {min(loads):.1f}–{max(loads):.1f}.",
             *([f"Time per world step vs controllers: {fmt_growth(g)}."] if g else []),
             "C rows: controllers on the C client library (sensorium/client/c) and a raw libzmq REQ ↔ REP floor, all "
@@ -565,7 +596,7 @@ def run(cfg: Config) -> Section:
         f"What this means for you: one Python controller steps in {fmt_time(data['single']['p50_s'])} (tcp) / "
         f"{fmt_time(data['single_ipc']['p50_s'])} (ipc) per round trip, so a 32 ms-step robot runs "
         f"~{0.032 / data['single']['p50_s']:,.0f}× faster than real time when the simulation itself is cheap; with 8 "
-        f"controllers the world advances {sps[8]:,.0f} steps/s on this 2-core machine (median of {runs} rounds).")
+        f"controllers the world advances {sps[8]:,.0f} steps/s on this 2-core machine (median of {runs} runs).")
     sec.findings.append(
         f"Point clouds: {pc['msgs_per_s']:,.0f} messages/s of {pc['bytes_per_msg'] / 1e6:.2f} MB "
         f"({pc['mb_per_s']:,.0f} MB/s) end to end vs {floor_ps['msgs_per_s']:,.0f}/s ({floor_ps['mb_per_s']:,.0f} MB/s) for raw "
@@ -611,8 +642,8 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
     r = ratios[best]
     ok8 = min(r) >= 0.7
     c8 = data["server_cpu"]["8"]
-    why8 = [f"{len(multi)} rounds, each: 8 raw REQ processes ↔ a do-nothing REP, then 8 controller processes ↔ "
-            "`sensorium serve` per step path, one right after the other. Ratios per round: "
+    why8 = [f"{len(multi)} runs, each: 8 raw REQ processes ↔ a do-nothing REP and 8 controller processes ↔ "
+            "`sensorium serve` per step path, in alternating bursts. Ratios per run: "
             + "; ".join(f"{p} step path " + ", ".join(f"{x:.2f}×" for x in v) for p, v in ratios.items())
             + " (load " + ", ".join(f"{m['load']:.1f}" for m in multi) + "). Server Python per world step without sockets: "
             + f"{us(c8['handle']['total_s'])} from bytes, {us(c8['handle_step']['total_s'])} parsed in C."]
@@ -629,6 +660,6 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
                     "the next step waits for the last request, while the raw floor's 8 processes overlap freely; each "
                     "message also costs a wake-up of libzmq's I/O threads on both sides (context switches, costly in "
                     "this VM), the same as for the floor.")
-    sec.targets.append(Target("World steps/s with 8 controllers vs the same 8 processes on raw REQ/REP, in each round",
-                              "≥ 0.7× in every round", f"{min(r):.2f}–{max(r):.2f}× over {len(r)} rounds [{best} step path]",
+    sec.targets.append(Target("World steps/s with 8 controllers vs the same 8 processes on raw REQ/REP, in each run",
+                              "≥ 0.7× in every run", f"{min(r):.2f}–{max(r):.2f}× over {len(r)} runs [{best} step path]",
                               ok8, " ".join(why8)))

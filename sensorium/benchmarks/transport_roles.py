@@ -146,7 +146,9 @@ def _role_stepper(rpc: str, robot: str, duration: str) -> None:
     from sensorium.client.connection import Connection
 
     conn = Connection(rpc, timeout=30)
-    session = conn.call("attach", {"robot": robot})["session"]
+    reply = conn.call("attach", {"robot": robot})
+    session = reply["session"]
+    conn.start_heartbeat(session, reply["heartbeat_ms"])        # silent while the other clients run
     service, args = f"/{robot}/robot/step", {"duration": int(duration)}
 
     def close():
@@ -206,31 +208,43 @@ def _role_pub(endpoint: str, size: str, count: str) -> None:
     ctx.term()
 
 
+def _bursts(step, steps: int) -> None:
+    """After 'ready': each stdin line 'go [N]' runs N steps (default ``steps``) as fast as the
+    lockstep allows and prints their send/reply times (time.monotonic, comparable across processes)
+    as JSON; 'quit' or the end of stdin stops. (One 'go' is a whole run; several interleave runs
+    of different systems in bursts, so the load of the moment hits each alike.)"""
+    print("ready", flush=True)
+    for line in sys.stdin:
+        parts = line.split()
+        if not parts or parts[0] != "go":
+            break
+        n = int(parts[1]) if len(parts) > 1 else steps
+        t0 = np.empty(n)
+        t1 = np.empty(n)
+        for i in range(n):
+            t0[i] = time.monotonic()
+            step()
+            t1[i] = time.monotonic()
+        print(json.dumps({"t0": t0.tolist(), "t1": t1.tolist()}), flush=True)
+
+
 def _role_controller(rpc: str, robot: str, steps: str, duration: str) -> None:
-    """A controller: attach, say 'ready', wait for 'go' on stdin, step ``steps`` times as fast as
-    the lockstep allows, print the send/reply times (time.monotonic, comparable across processes)."""
+    """A controller (the client library's ``Connection``, with its heartbeat as every controller
+    has): attach, then step in bursts (:func:`_bursts`)."""
     from sensorium.client.connection import Connection
 
     conn = Connection(rpc, timeout=60)
-    conn.call("attach", {"robot": robot})
-    print("ready", flush=True)
-    sys.stdin.readline()
-    n, d = int(steps), int(duration)
-    t0 = np.empty(n)
-    t1 = np.empty(n)
+    reply = conn.call("attach", {"robot": robot})
+    conn.start_heartbeat(reply["session"], reply["heartbeat_ms"])   # silent while other bursts run
     service = f"/{robot}/robot/step"
-    args = {"duration": d}
-    for i in range(n):
-        t0[i] = time.monotonic()
-        conn.call(service, args)
-        t1[i] = time.monotonic()
-    print(json.dumps({"t0": t0.tolist(), "t1": t1.tolist()}), flush=True)
+    args = {"duration": int(duration)}
+    _bursts(lambda: conn.call(service, args), int(steps))
     conn.close()
 
 
 def _role_raw_controller(endpoint: str, steps: str) -> None:
     """The raw floor of ``controller``: a REQ socket doing step-sized ping-pongs with a do-nothing REP
-    server, timed the same way (say 'ready', wait for 'go', print send/reply times)."""
+    server, in the same bursts."""
     import zmq
 
     ctx = zmq.Context()
@@ -240,17 +254,12 @@ def _role_raw_controller(endpoint: str, steps: str) -> None:
     for _ in range(50):
         s.send(msg)
         s.recv()
-    print("ready", flush=True)
-    sys.stdin.readline()
-    n = int(steps)
-    t0 = np.empty(n)
-    t1 = np.empty(n)
-    for i in range(n):
-        t0[i] = time.monotonic()
+
+    def step():
         s.send(msg)
         s.recv()
-        t1[i] = time.monotonic()
-    print(json.dumps({"t0": t0.tolist(), "t1": t1.tolist()}), flush=True)
+
+    _bursts(step, int(steps))
     s.close(0)
     ctx.term()
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 import itertools
 import os
 import secrets
+import socket
 import stat
 import threading
 import time
@@ -549,6 +550,10 @@ class Heartbeat(threading.Thread):
         self.lost_after = lost_after_s if lost_after_s is not None else max(2.0, 5 * self.interval)
         self._context = context
         self._stop_event = threading.Event()
+        # stop() wakes the thread through this pair: it sleeps until its next ping, not in short
+        # slices (each wake-up of a Python thread takes the GIL from the stepping one)
+        self._wake_r, self._wake_w = socket.socketpair()
+        self._wake_w.setblocking(False)
         self._problem: str | None = None
         self.last_reply = time.monotonic()
         self.pings = 0
@@ -565,12 +570,19 @@ class Heartbeat(threading.Thread):
 
     def stop(self) -> None:
         self._stop_event.set()
+        try:
+            self._wake_w.send(b"\0")
+        except OSError:
+            pass
         if self.is_alive() and threading.current_thread() is not self:
             self.join(timeout=2.0)
 
     def run(self) -> None:
         sock = self._context.socket(zmq.DEALER)
         sock.setsockopt(zmq.LINGER, 0)
+        poller = zmq.Poller()
+        poller.register(sock, zmq.POLLIN)
+        poller.register(self._wake_r.fileno(), zmq.POLLIN)
         try:
             curve_client(sock, self.serverkey)
             sock.connect(self.endpoint)
@@ -590,8 +602,8 @@ class Heartbeat(threading.Thread):
                     sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
                     self.pings += 1
                     next_ping = now + self.interval
-                wait_ms = int(min(next_ping - time.monotonic(), 0.05) * 1000)
-                if sock.poll(max(wait_ms, 1), zmq.POLLIN):
+                wait_ms = int((next_ping - time.monotonic()) * 1000) + 1
+                if dict(poller.poll(max(wait_ms, 1))).get(sock):
                     while True:
                         try:
                             reply = unpack(sock.recv_multipart(zmq.NOBLOCK)[-1])
@@ -611,6 +623,8 @@ class Heartbeat(threading.Thread):
             pass
         finally:
             sock.close(linger=0)
+            self._wake_r.close()
+            self._wake_w.close()
 
 
 class SubSocket:

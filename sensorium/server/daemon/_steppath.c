@@ -369,7 +369,16 @@ static int drop_rest(Gate *g) {
 }
 
 /* discard() -> True when the over-long message is gone (call while .discarding). */
+static int closed(Gate *g) {
+  if (g->sock != NULL)
+    return 0;
+  PyErr_SetString(PyExc_RuntimeError, "the step path's gate is closed (its socket was closed)");
+  return 1;
+}
+
 static PyObject *Gate_discard(Gate *g, PyObject *Py_UNUSED(arg)) {
+  if (closed(g))
+    return NULL;
   if (g->discarding)
     drop_rest(g);
   return PyBool_FromLong(!g->discarding);
@@ -388,7 +397,7 @@ static PyObject *Gate_discard(Gate *g, PyObject *Py_UNUSED(arg)) {
 static PyObject *Gate_receive(Gate *g, PyObject *args) {
   int wait_ms, limit;
   PyObject *waiting_arg;
-  if (!PyArg_ParseTuple(args, "iOi", &wait_ms, &waiting_arg, &limit))
+  if (!PyArg_ParseTuple(args, "iOi", &wait_ms, &waiting_arg, &limit) || closed(g))
     return NULL;
   if (g->discarding) {
     PyErr_SetString(PyExc_RuntimeError, "receive() while an over-long message is being dropped: discard() first");
@@ -527,6 +536,8 @@ static PyObject *Gate_receive(Gate *g, PyObject *args) {
 /* send([[frame, ..., body], ...]): each reply as one message (frames copied); a reply libzmq
  * refuses (peer gone) is dropped, as the ROUTER does. */
 static PyObject *Gate_send(Gate *g, PyObject *arg) {
+  if (closed(g))
+    return NULL;
   PyObject *replies = PySequence_Fast(arg, "send takes a sequence of frame lists");
   if (replies == NULL)
     return NULL;
@@ -562,6 +573,14 @@ static PyObject *Gate_send(Gate *g, PyObject *arg) {
   Py_RETURN_NONE;
 }
 
+/* close(): forget the socket (before it is closed: libzmq frees it, so no call may follow). */
+static PyObject *Gate_close(Gate *g, PyObject *Py_UNUSED(arg)) {
+  g->sock = NULL;
+  g->discarding = 0;
+  Py_CLEAR(g->owner);
+  Py_RETURN_NONE;
+}
+
 static PyObject *Gate_get_discarding(Gate *g, void *Py_UNUSED(c)) { return PyBool_FromLong(g->discarding); }
 
 static PyObject *Gate_get_counts(Gate *g, void *Py_UNUSED(c)) {
@@ -574,6 +593,7 @@ static PyMethodDef Gate_methods[] = {
     {"receive", (PyCFunction)Gate_receive, METH_VARARGS, "receive(wait_ms, waiting_slots, limit) -> list | None"},
     {"discard", (PyCFunction)Gate_discard, METH_NOARGS, "drop frames of an over-long message; True when done"},
     {"send", (PyCFunction)Gate_send, METH_O, "send(replies): each a list of frames"},
+    {"close", (PyCFunction)Gate_close, METH_NOARGS, "forget the socket (call before closing it)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -107,6 +107,9 @@ class PyGate:
     def set_peers(self, peers: list[tuple[bytes, bytes, int]]) -> None:
         """(Recognising steps is the C gate's: nothing to keep.)"""
 
+    def close(self) -> None:
+        """(The C gate forgets its socket here; pyzmq guards this one.)"""
+
     def _recv(self, wait_ms: int) -> list[bytes] | bytes | None:
         sock = self.sock
         if wait_ms:

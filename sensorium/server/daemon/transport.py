@@ -384,6 +384,9 @@ class Transport:
 
     # ------------------------------------------------------------------ close
     def _close_sockets(self) -> None:
+        gate = getattr(self, "gate", None)
+        if gate is not None:
+            gate.close()                      # before the socket goes: the C gate holds its raw handle
         for s in (self.router, self.xpub):
             if not s.closed:
                 s.close()
