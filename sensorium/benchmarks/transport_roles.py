@@ -242,6 +242,30 @@ def _role_controller(rpc: str, robot: str, steps: str, duration: str) -> None:
     conn.close()
 
 
+def _role_bare_controller(rpc: str, robot: str, steps: str, duration: str) -> None:
+    """``controller`` with a bare DEALER instead of the client library (no heartbeat, no retries):
+    what the library costs when 8 controllers share 2 cores."""
+    import msgpack
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.DEALER)
+    s.connect(rpc)
+    s.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": robot}}))
+    msgpack.unpackb(s.recv())
+    packer = msgpack.Packer()
+    service, args = f"/{robot}/robot/step", {"duration": int(duration)}
+    ids = iter(range(2, 1 << 62))
+
+    def step():
+        s.send(packer.pack({"id": next(ids), "service": service, "args": args}))
+        msgpack.unpackb(s.recv(), raw=False)
+
+    _bursts(step, int(steps))
+    s.close(0)
+    ctx.term()
+
+
 def _role_raw_controller(endpoint: str, steps: str) -> None:
     """The raw floor of ``controller``: a REQ socket doing step-sized ping-pongs with a do-nothing REP
     server, in the same bursts."""
@@ -267,7 +291,7 @@ def _role_raw_controller(endpoint: str, steps: str) -> None:
 def main(argv: list[str]) -> None:
     roles = {"rep-echo": _role_rep_echo, "req": _role_req, "router-echo": _role_router_echo,
              "conn-client": _role_conn_client, "dealer-client": _role_dealer_client, "stepper": _role_stepper,
-             "bare-stepper": _role_bare_stepper,
+             "bare-stepper": _role_bare_stepper, "bare-controller": _role_bare_controller,
              "pub": _role_pub, "controller": _role_controller, "raw-controller": _role_raw_controller}
     roles[argv[0]](*argv[1:])
 
