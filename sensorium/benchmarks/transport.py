@@ -31,12 +31,42 @@ def step_paths() -> list[str]:
     return (["c"] if native_gate_class()[0] is not None else []) + ["python"]
 
 
-def load() -> float:
-    """The machine's 1-minute load average (how busy the shared machine was)."""
-    try:
-        return os.getloadavg()[0]
-    except OSError:
-        return float("nan")
+class OthersCPU:
+    """How busy the shared machine was with *other* work during a measurement: CPU time of every
+    process (``/proc/stat``) minus that of this benchmark's processes, per wall second, in cores
+    (Linux; NaN elsewhere). Unlike the load average it leaves out the measured processes."""
+
+    def __init__(self) -> None:
+        self.t0 = time.perf_counter()
+        self.busy0 = self._busy()
+        self.ours0: dict[int, float] = {}
+
+    @staticmethod
+    def _busy() -> float:
+        try:
+            fields = Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]
+            user, nice, system, _idle, _iowait, irq, softirq, steal = (int(x) for x in fields[:8])
+            return (user + nice + system + irq + softirq + steal) / os.sysconf("SC_CLK_TCK")
+        except (OSError, ValueError):
+            return float("nan")
+
+    @staticmethod
+    def _cpu(pid: int) -> float:
+        try:
+            f = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+            return (int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK")
+        except (OSError, ValueError, IndexError):
+            return 0.0
+
+    def start(self, pids: list[int]) -> None:
+        self.t0, self.busy0 = time.perf_counter(), self._busy()
+        self.ours0 = {pid: self._cpu(pid) for pid in [os.getpid(), *pids]}
+
+    def cores(self) -> float:
+        """Cores busy with other work since :meth:`start` (call while the measured processes live)."""
+        wall = time.perf_counter() - self.t0
+        ours = sum(self._cpu(pid) - c for pid, c in self.ours0.items())
+        return max(0.0, (self._busy() - self.busy0 - ours) / wall) if wall > 0 else float("nan")
 
 
 # ============================================================================ process helpers
@@ -143,10 +173,14 @@ def round_trips(tmp: Path, n: int, rounds: int, ipc: bool = False) -> dict[str, 
                 raise RuntimeError("client not ready")
         out: dict[str, list] = {k: [] for k in clients}
         chunk = max(1, n // rounds)
+        others = OthersCPU()
+        others.start([c.p.pid for c in clients.values()]
+                     + [srv.proc.p.pid if isinstance(srv, Server) else srv.p.pid for srv in servers])
         for _ in range(rounds):
             for k, c in clients.items():
                 c.send(f"run {chunk}")
                 out[k] += json.loads(c.line(120))
+        out["others_cores"] = [others.cores()]
         for c in clients.values():
             c.send("quit")
         return {k: np.asarray(v) for k, v in out.items()}
@@ -189,14 +223,20 @@ def multi_runs(tmp: Path, k: int, steps: int, runs: int, bursts: int) -> list[di
                     if p.line(120) != "ready":
                         raise RuntimeError("controller did not attach")
             per: dict[str, list[dict]] = {g: [] for g in groups}
+            others = OthersCPU()
+            others.start([p.p.pid for procs in groups.values() for p in procs]
+                         + [srv.proc.p.pid if isinstance(srv, Server) else srv.p.pid for srv in servers])
             for _ in range(bursts):
                 for g, procs in groups.items():
                     for p in procs:
                         p.send(f"go {steps // bursts}")
                     per[g].append(_window([json.loads(p.line(300)) for p in procs]))
-            res: dict = {"load": load()}
+            res: dict = {"others_cores": others.cores()}
             for g, ws in per.items():
-                res[g] = {"steps_per_s": float(np.median([w["steps_per_s"] for w in ws])),
+                # a burst whose processes never all stepped at once (one done before another began,
+                # on a loaded machine) has no window: NaN, left out
+                rates = [w["steps_per_s"] for w in ws]
+                res[g] = {"steps_per_s": float(np.nanmedian(rates)) if np.isfinite(rates).any() else float("nan"),
                           "rtt": np.concatenate([w["rtt"] for w in ws]),
                           "bursts_steps_per_s": [w["steps_per_s"] for w in ws]}
         finally:
@@ -451,20 +491,18 @@ def run(cfg: Config) -> Section:
         "one (`SENSORIUM_STEP_PATH=python`); same replies, byte for byte (tests/test_steppath.py). The lockstep "
         "worlds have robots without devices, so a step costs the simulation almost nothing and the round trip is "
         "transport + request handling + lockstep bookkeeping. On 2 cores, 8 controller processes and the server "
-        "share the CPU with whatever else runs on the machine: its 1-minute load average is given with each "
-        "measurement."))
+        "share the CPU with whatever else runs on the machine: how many cores that other work kept busy is given "
+        "with each measurement (CPU time of every process but the benchmark's own, from /proc)."))
     n = cfg.pick(6000, 1200)
     rounds = n // 100             # many short alternating chunks: the load of the moment hits every row alike
     t_all = time.perf_counter()
     paths = step_paths()
     best = paths[0]                              # the step path a default install uses
-    loads = [load()]
     with tempfile.TemporaryDirectory() as tmp:
         rt = round_trips(Path(tmp), n, rounds)
-    loads.append(load())
     with tempfile.TemporaryDirectory() as tmp:
         rt_ipc = round_trips(Path(tmp), n, rounds, ipc=True)
-    loads.append(load())
+    others = {"tcp": float(rt.pop("others_cores")[0]), "ipc": float(rt_ipc.pop("others_cores")[0])}
     floor = rt["floor"]
     cfg.log(f"  transport: REQ/REP floor p50 {fmt_time(median(floor))}, Sensorium 1 controller "
             + ", ".join(f"{p} {fmt_time(median(rt[f'sensorium-{p}']))}" for p in paths))
@@ -492,7 +530,7 @@ def run(cfg: Config) -> Section:
             rows.append([f"{tr}: {label}", 1, fmt_time(median(xs)), fmt_time(pct(xs, 99)),
                          f"{1.0 / float(np.mean(xs)):,.0f}" if lockstep_row else "–",
                          f"{median(xs) / median(fl):.2f}×", f"+{(median(xs) - median(fl)) * 1e6:.1f} µs"])
-    steps_multi = cfg.pick(2000, 600)
+    steps_multi = cfg.pick(4000, 1200)
     runs = cfg.pick(5, 2)
     bursts = cfg.pick(8, 3)
     sps = {}
@@ -500,15 +538,15 @@ def run(cfg: Config) -> Section:
         tmp = Path(tmp)
         # 8 controllers vs 8 raw REQ processes: `runs` runs, each in bursts alternating raw and every step path
         multi = multi_runs(tmp, 8, steps_multi, runs, bursts)
-        loads.append(load())
-        data["multi_8_runs"] = [{"load": m["load"], **{k: {"steps_per_s": m[k]["steps_per_s"], "p50_s": median(m[k]["rtt"]),
+        data["multi_8_runs"] = [{"others_cores": m["others_cores"], **{k: {"steps_per_s": m[k]["steps_per_s"], "p50_s": median(m[k]["rtt"]),
                                                          "p99_s": pct(m[k]["rtt"], 99),
                                                          "bursts_steps_per_s": m[k]["bursts_steps_per_s"]}
                                                      for k in ["raw", *paths, "bare"]}}
                                 for m in multi]
         for i, m in enumerate(multi):
             raw = m["raw"]
-            rows.append([f"run {i + 1} of {runs} (load {m['load']:.1f}): 8 raw REQ processes ↔ one do-nothing REP", 8,
+            rows.append([f"run {i + 1} of {runs} (other work: {m['others_cores']:.1f} cores): 8 raw REQ processes ↔ "
+                         "one do-nothing REP", 8,
                          fmt_time(median(raw["rtt"])), fmt_time(pct(raw["rtt"], 99)), f"{raw['steps_per_s']:,.0f}",
                          f"{median(raw['rtt']) / median(floor):.2f}×", "–"])
             for path in [*paths, "bare"]:
@@ -521,7 +559,7 @@ def run(cfg: Config) -> Section:
                              f"{median(x['rtt']) / median(floor):.2f}×", "–"])
             cfg.log(f"  transport: 8 controllers, run {i + 1}: raw {raw['steps_per_s']:.0f}/s, "
                     + ", ".join(f"{p} {m[p]['steps_per_s']:.0f}/s ({m[p]['steps_per_s'] / raw['steps_per_s']:.2f}×)"
-                                for p in paths) + f" (load {m['load']:.1f})")
+                                for p in paths) + f" (other work: {m['others_cores']:.1f} cores)")
         sps[8] = float(np.median([m[best]["steps_per_s"] for m in multi]))
         # world steps/s vs controllers (the default step path)
         for k in cfg.pick([1, 2, 4], []):
@@ -539,8 +577,7 @@ def run(cfg: Config) -> Section:
         sps = dict(sorted(sps.items()))
         data["multi_8"] = {"steps_per_s": sps[8]}
         native_rows(tmp, cfg, data, rows, steps_multi, median(floor))
-        loads.append(load())
-        data["load"] = loads
+        data["others_cores"] = {**others, "multi_8": [m["others_cores"] for m in multi]}
         g = growth(list(sps), [1.0 / v for v in sps.values()]) if len(sps) > 2 else None
         sec.tables.append(Table("lockstep", "Lockstep step round trip and world steps/s", [
             "what", "controllers", "round trip p50", "round trip p99", "world steps/s", "p50 ÷ REQ/REP floor",
@@ -552,7 +589,9 @@ def run(cfg: Config) -> Section:
             "together), and the ratio in the steps/s column compares a row with its own run's floor. World steps/s: "
             "the median over a row's bursts of the steps every process completed inside the window where all were "
             "stepping (each one's first 10 % skipped).",
-            f"Machine load (1-minute load average, 2 cores) during this section: {min(loads):.1f}–{max(loads):.1f}.",
+            f"Other work on the machine (cores of 2 kept busy by processes other than the benchmark's): "
+            f"{others['tcp']:.1f} during the tcp rows, {others['ipc']:.1f} during the ipc rows, "
+            + ", ".join(f"{m['others_cores']:.1f}" for m in multi) + " during the 8-controller runs.",
             *([f"Time per world step vs controllers: {fmt_growth(g)}."] if g else []),
             "C rows: controllers on the C client library (sensorium/client/c) and a raw libzmq REQ ↔ REP floor, all "
             "compiled with -O2 by the benchmark (sensorium/benchmarks/c; skipped without a C compiler, libzmq or "
@@ -638,8 +677,8 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
                    f"reference, a bare DEALER against a do-nothing Python msgpack ROUTER: {us(bare - fl)} above the floor.")
     c1 = data["server_cpu"]["1"]
     why.append(f"The server's Python per step without sockets (1 controller): {us(c1['handle']['total_s'])} from bytes, "
-               f"{us(c1['handle_step']['total_s'])} with the step parsed in C. Machine load "
-               f"{min(data['load']):.1f}–{max(data['load']):.1f}.")
+               f"{us(c1['handle_step']['total_s'])} with the step parsed in C. Other work on the machine meanwhile: "
+               f"{data['others_cores']['tcp']:.1f} (tcp) and {data['others_cores']['ipc']:.1f} (ipc) cores of 2.")
     if not ok:
         why.append("MISS: what is left is per-message work on both sides that the raw floor does not do: the client "
                    "library's Python (request ids, msgpack, retries), and the server's Python step (the simulation "
@@ -655,7 +694,8 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
             "`sensorium serve` per step path, in alternating bursts. Ratios per run: "
             + "; ".join(("bare DEALERs instead of the client library " if p == "bare" else f"{p} step path ")
                         + ", ".join(f"{x:.2f}×" for x in v) for p, v in ratios.items())
-            + " (load " + ", ".join(f"{m['load']:.1f}" for m in multi) + "). Server Python per world step without sockets: "
+            + " (other work: " + ", ".join(f"{m['others_cores']:.1f}" for m in multi)
+            + " cores of 2). Server Python per world step without sockets: "
             + f"{us(c8['handle']['total_s'])} from bytes, {us(c8['handle_step']['total_s'])} parsed in C."]
     nat = data.get("native", {})
     for p in paths:
