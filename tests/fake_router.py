@@ -72,7 +72,7 @@ class _Dev:
 
 
 class FakeServer(threading.Thread):
-    def __init__(self, full_descriptions: bool = True, heartbeat_ms: int = 100):
+    def __init__(self, full_descriptions: bool = True, heartbeat_ms: int = 100, step_padding: int = 0):
         super().__init__(daemon=True)
         self.ctx = zmq.Context.instance()
         self.sock = self.ctx.socket(zmq.ROUTER)
@@ -90,6 +90,7 @@ class FakeServer(threading.Thread):
         self.hold = False          # don't advance the lockstep
         self.silent = False        # don't answer anything (a hung server)
         self.quitting = False      # answer steps with status -1
+        self.step_padding = step_padding   # bytes of junk added to every step reply (a reply over a client's limit)
         self._sessions = itertools.count(1)
         self._halt = threading.Event()
         self.lock = threading.Lock()
@@ -246,6 +247,8 @@ class FakeServer(threading.Thread):
                         if dev.changed and dev.reading is not None:
                             values[dev.name] = dev.reading
                             dev.changed = False
+                    if self.step_padding:
+                        values["padding"] = {"value": bytes(self.step_padding)}
                     self._send(identity, rid, {"status": 0, "time_ms": self.time_ms, "values": values})
 
 

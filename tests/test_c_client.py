@@ -503,6 +503,24 @@ def test_c_controller_ends_its_loop_when_the_server_dies(cbin, servers):
     assert "CONNECTION_LOST" in err and "server gone" in err, err
 
 
+def test_a_step_reply_over_the_clients_limit_ends_the_step_with_one_clear_line(cbin):
+    """issue 28: a step reply above the C client's 64 MiB (its ZMQ_MAXMSGSIZE) made ZeroMQ close the
+    connection for good, without reconnecting; wb_robot_step never returned. Now the step's retry
+    finds no connection to queue on and the step returns -1 with the reason. (Sensorium's server
+    never sends more than 64 MiB: tests/test_peer_bounds.py; this is a stand-in server that does.)"""
+    from fake_router import FakeServer
+
+    server = FakeServer(step_padding=(64 << 20) + 1)
+    server.start()
+    try:
+        code, lines, err = finish(start([cbin["script"], "step", "32", "3"], f"{server.endpoint}/r1"), 60)
+    finally:
+        server.stop()
+    assert code == 0, err
+    assert [fields(x)["status"] for x in data(lines)] == ["-1"]
+    assert "CONNECTION_LOST" in err and "64 MiB" in err and "for good" in err, err
+
+
 def test_heartbeat_keeps_a_computing_c_controller_attached(cbin, servers):
     server = servers(ARENA, "--heartbeat-ms", "100")
     lines = run([cbin["script"], "enable", "ps0", "32", "step", "32", "1", "sleep", "1500", "step", "32", "2"],

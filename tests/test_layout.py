@@ -38,7 +38,7 @@ SERVER_NEVER = {"sensorium.cli", "sensorium.client", "sensorium.benchmarks", "se
 # third-party modules that only these files may import (relative to sensorium/)
 OWNED = {
     "embreex": {"server/raycast/", "benchmarks/"},
-    "zmq": {"client/connection.py", "server/daemon/transport.py", "server/recording/live.py",
+    "zmq": {"client/connection.py", "server/daemon/transport.py", "server/daemon/steppath.py", "server/recording/live.py",
             "server/recording/replay.py", "cli/", "benchmarks/", "gym/", "sweep/", "demo/"},
 }
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from test_supervisor import Live
 
@@ -61,6 +62,28 @@ def test_in_process_set_pose_rejects_absurd_poses(translation):
     assert (robot.pose.translation == before).all()
     with pytest.raises(ValueError, match="rotation"):
         robot.set_pose(None, rotation=[0.0, 0.0, 1.0, math.inf])
+
+
+@pytest.mark.parametrize("translation", [[1e300, 0.0, 0.0], [0.0, math.inf, 0.0]])
+def test_in_process_set_solid_pose_rejects_absurd_poses(translation):
+    """issue 28, the rest of the in-process API: a solid's pose is checked like a robot's."""
+    lv = Live()
+    before = lv.sim.scene.solid_poses["wall"].translation.copy()
+    with pytest.raises(ValueError, match="translation"):
+        lv.sim.set_solid_pose("wall", translation)
+    assert (lv.sim.scene.solid_poses["wall"].translation == before).all()
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e-300, 1.0])
+def test_huge_or_tiny_quaternions_and_axes_give_the_rotation_they_denote(scale):
+    """A quaternion (1e300, 0, 0, 1e300·0) is a half turn about x; its norm overflowed to inf and
+    the robot ended up unrotated (an axis likewise). Values are scaled before normalising."""
+    lv = Live()
+    robot = lv.sim.robots["rover"]
+    robot.set_pose(None, quaternion=[scale, 0.0, 0.0, 0.0])
+    np.testing.assert_allclose(robot.pose.rotation, [[1, 0, 0], [0, -1, 0], [0, 0, -1]], atol=1e-12)
+    robot.set_pose(None, rotation=[0.0, 0.0, scale, math.pi / 2])
+    np.testing.assert_allclose(robot.pose.rotation, [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-12)
 
 
 def test_open_controls_let_any_caller_set_the_mode():

@@ -146,7 +146,9 @@ def _role_stepper(rpc: str, robot: str, duration: str) -> None:
     from sensorium.client.connection import Connection
 
     conn = Connection(rpc, timeout=30)
-    session = conn.call("attach", {"robot": robot})["session"]
+    reply = conn.call("attach", {"robot": robot})
+    session = reply["session"]
+    conn.start_heartbeat(session, reply["heartbeat_ms"])        # silent while the other clients run
     service, args = f"/{robot}/robot/step", {"duration": int(duration)}
 
     def close():
@@ -154,6 +156,35 @@ def _role_stepper(rpc: str, robot: str, duration: str) -> None:
         conn.close()
 
     _chunks(lambda: conn.call(service, args), close)
+
+
+def _role_bare_stepper(rpc: str, robot: str, duration: str) -> None:
+    """A bare DEALER stepping a robot in lockstep (pack, send, blocking recv, unpack): the client
+    library's share of a Sensorium round trip is the difference to ``stepper``."""
+    import msgpack
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.DEALER)
+    s.setsockopt(zmq.LINGER, 0)
+    s.connect(rpc)
+    s.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": robot}}))
+    session = msgpack.unpackb(s.recv())["result"]["session"]
+    packer = msgpack.Packer()
+    service, args = f"/{robot}/robot/step", {"duration": int(duration)}
+    ids = iter(range(2, 1 << 62))
+
+    def call():
+        s.send(packer.pack({"id": next(ids), "service": service, "args": args}))
+        msgpack.unpackb(s.recv(), raw=False)
+
+    def close():
+        s.send(msgpack.packb({"id": 0, "service": "detach", "args": {"session": session}}))
+        s.recv()
+        s.close(0)
+        ctx.term()
+
+    _chunks(call, close)
 
 
 def _role_pub(endpoint: str, size: str, count: str) -> None:
@@ -177,31 +208,67 @@ def _role_pub(endpoint: str, size: str, count: str) -> None:
     ctx.term()
 
 
+def _bursts(step, steps: int) -> None:
+    """After 'ready': each stdin line 'go [N]' runs N steps (default ``steps``) as fast as the
+    lockstep allows and prints their send/reply times (time.monotonic, comparable across processes)
+    as JSON; 'quit' or the end of stdin stops. (One 'go' is a whole run; several interleave runs
+    of different systems in bursts, so the load of the moment hits each alike.)"""
+    print("ready", flush=True)
+    for line in sys.stdin:
+        parts = line.split()
+        if not parts or parts[0] != "go":
+            break
+        n = int(parts[1]) if len(parts) > 1 else steps
+        t0 = np.empty(n)
+        t1 = np.empty(n)
+        for i in range(n):
+            t0[i] = time.monotonic()
+            step()
+            t1[i] = time.monotonic()
+        print(json.dumps({"t0": t0.tolist(), "t1": t1.tolist()}), flush=True)
+
+
 def _role_controller(rpc: str, robot: str, steps: str, duration: str) -> None:
-    """A controller: attach, say 'ready', wait for 'go' on stdin, step ``steps`` times as fast as
-    the lockstep allows, print the send/reply times (time.monotonic, comparable across processes)."""
+    """A controller (the client library's ``Connection``, with its heartbeat as every controller
+    has): attach, then step in bursts (:func:`_bursts`)."""
     from sensorium.client.connection import Connection
 
     conn = Connection(rpc, timeout=60)
-    conn.call("attach", {"robot": robot})
-    print("ready", flush=True)
-    sys.stdin.readline()
-    n, d = int(steps), int(duration)
-    t0 = np.empty(n)
-    t1 = np.empty(n)
+    reply = conn.call("attach", {"robot": robot})
+    conn.start_heartbeat(reply["session"], reply["heartbeat_ms"])   # silent while other bursts run
     service = f"/{robot}/robot/step"
-    args = {"duration": d}
-    for i in range(n):
-        t0[i] = time.monotonic()
-        conn.call(service, args)
-        t1[i] = time.monotonic()
-    print(json.dumps({"t0": t0.tolist(), "t1": t1.tolist()}), flush=True)
+    args = {"duration": int(duration)}
+    _bursts(lambda: conn.call(service, args), int(steps))
     conn.close()
+
+
+def _role_bare_controller(rpc: str, robot: str, steps: str, duration: str) -> None:
+    """``controller`` with a bare DEALER instead of the client library (no heartbeat, no retries):
+    what the library costs when 8 controllers share 2 cores."""
+    import msgpack
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.DEALER)
+    s.connect(rpc)
+    s.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": robot}}))
+    msgpack.unpackb(s.recv())
+    packer = msgpack.Packer()
+    service, args = f"/{robot}/robot/step", {"duration": int(duration)}
+    ids = iter(range(2, 1 << 62))
+
+    def step():
+        s.send(packer.pack({"id": next(ids), "service": service, "args": args}))
+        msgpack.unpackb(s.recv(), raw=False)
+
+    _bursts(step, int(steps))
+    s.close(0)
+    ctx.term()
 
 
 def _role_raw_controller(endpoint: str, steps: str) -> None:
     """The raw floor of ``controller``: a REQ socket doing step-sized ping-pongs with a do-nothing REP
-    server, timed the same way (say 'ready', wait for 'go', print send/reply times)."""
+    server, in the same bursts."""
     import zmq
 
     ctx = zmq.Context()
@@ -211,17 +278,12 @@ def _role_raw_controller(endpoint: str, steps: str) -> None:
     for _ in range(50):
         s.send(msg)
         s.recv()
-    print("ready", flush=True)
-    sys.stdin.readline()
-    n = int(steps)
-    t0 = np.empty(n)
-    t1 = np.empty(n)
-    for i in range(n):
-        t0[i] = time.monotonic()
+
+    def step():
         s.send(msg)
         s.recv()
-        t1[i] = time.monotonic()
-    print(json.dumps({"t0": t0.tolist(), "t1": t1.tolist()}), flush=True)
+
+    _bursts(step, int(steps))
     s.close(0)
     ctx.term()
 
@@ -229,6 +291,7 @@ def _role_raw_controller(endpoint: str, steps: str) -> None:
 def main(argv: list[str]) -> None:
     roles = {"rep-echo": _role_rep_echo, "req": _role_req, "router-echo": _role_router_echo,
              "conn-client": _role_conn_client, "dealer-client": _role_dealer_client, "stepper": _role_stepper,
+             "bare-stepper": _role_bare_stepper, "bare-controller": _role_bare_controller,
              "pub": _role_pub, "controller": _role_controller, "raw-controller": _role_raw_controller}
     roles[argv[0]](*argv[1:])
 

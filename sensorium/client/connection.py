@@ -18,6 +18,7 @@ from __future__ import annotations
 import itertools
 import os
 import secrets
+import socket
 import stat
 import threading
 import time
@@ -43,6 +44,7 @@ RETRIED_SERVICES = ("/robot/step", "/robot/time_step")
 DEFAULT_TIMEOUT = 10.0          # seconds for a non-step request (the server may still be starting)
 
 _NO_TIMEOUT = object()
+_NOBLOCK = int(zmq.NOBLOCK)     # a plain int: pyzmq's enum flags cost ~0.3 µs per call
 
 
 class ErrorCode(IntEnum):
@@ -260,6 +262,9 @@ def unpack(data: bytes) -> Any:
     return msgpack.unpackb(data, raw=False, strict_map_key=False)
 
 
+_unpackb = msgpack.unpackb
+
+
 def _error_from(reply: dict) -> SensoriumError:
     err = reply.get("error")
     if not isinstance(err, dict):
@@ -317,7 +322,13 @@ class Connection:
             raise SensoriumError(ErrorCode.WRONG_STATE, f"connection to {self.endpoint} is closed")
         rid = next(self._ids)
         data = self._packer.pack({"id": rid, "service": service, "args": args or {}})
-        self._socket.send(data)
+        try:
+            # never blocks: a DEALER queues while (re)connecting and refuses only once ZeroMQ closed
+            # its connection for good (see _resend_due) or 1000 requests wait unsent
+            self._socket.send(data, _NOBLOCK)
+        except zmq.Again:
+            raise ConnectionLost(f"cannot send {service!r} to {self.endpoint}: ZeroMQ closed the connection for good "
+                                 "or 1000 requests wait unsent") from None
         self._outstanding[rid] = service
         if service.endswith(RETRIED_SERVICES):
             self._retry[rid] = (data, time.monotonic())
@@ -327,7 +338,7 @@ class Connection:
         """The ``result`` of request ``rid``; raise :class:`SensoriumError` for an error reply,
         :class:`ServiceTimeout` after ``timeout`` seconds, :class:`ConnectionLost` if the
         heartbeat found the server gone or the session dropped."""
-        reply = self._replies.pop(rid, None)
+        reply = self._replies.pop(rid, None) if self._replies else None
         if reply is None:
             reply = self._receive(rid, self.timeout if timeout is _NO_TIMEOUT else timeout)
         del self._outstanding[rid]
@@ -362,13 +373,10 @@ class Connection:
                 sock.setsockopt(zmq.RCVTIMEO, slice_ms)
                 self._rcvtimeo, self._rcvtimeo_ms = sock, slice_ms
             try:
-                # a zero-copy frame's ``more`` flag is cheaper than a ZMQ_RCVMORE query
-                # (a reply to a DEALER is one frame)
-                frame = sock.recv(copy=False)
-                frames = [frame.bytes]
-                while frame.more:
-                    frame = sock.recv(copy=False)
-                    frames.append(frame.bytes)
+                # a reply to a DEALER is one frame (PROTOCOL.md §3.1), received as bytes: the
+                # cheapest form (a zero-copy frame, or a ZMQ_RCVMORE query, costs ~0.6 µs more); a
+                # longer message would come apart into frames that do not decode (BAD_REPLY)
+                data = sock.recv()
             except zmq.Again:
                 self._resend_due(rid)
                 if self._monitor is not None:
@@ -380,10 +388,18 @@ class Connection:
                         self._retry.pop(rid, None)
                         raise ConnectionLost(f"while waiting for {service!r}: {problem}") from None
                 continue
-            reply = self._decode(frames)
+            # _decode_body inlined (the step loop's hot path): the same checks
+            try:
+                reply = _unpackb(data, raw=False, strict_map_key=False)
+            except Exception as exc:  # noqa: BLE001 - any decoding failure is a bad reply
+                raise SensoriumError(ErrorCode.BAD_REPLY, f"undecodable reply from {self.endpoint}: {exc}") from None
+            if type(reply) is not dict:
+                raise SensoriumError(ErrorCode.BAD_REPLY, f"reply is not a map: {reply!r}")
             got = reply.get("id")
             if got == rid:
                 return reply
+            if got is None and reply.get("ok") is False:
+                raise _error_from(reply)
             if got in self._outstanding:
                 self._replies[got] = reply
             # else: the reply to a request we gave up on (timeout, discard): drop it
@@ -434,7 +450,15 @@ class Connection:
         with a dropped connection. The server answers a repeated id once (PROTOCOL.md)."""
         entry = self._retry.get(rid)
         if entry is not None and time.monotonic() - entry[1] >= RETRY_S:
-            self._socket.send(entry[0])
+            try:
+                self._socket.send(entry[0], _NOBLOCK)
+            except zmq.Again:
+                # no connection left to queue on: ZeroMQ closed it for good (it does so, without
+                # reconnecting, when a message breaks the protocol); a dropped network one would queue
+                service = self._outstanding.pop(rid, "?")
+                self._retry.pop(rid, None)
+                raise ConnectionLost(f"ZeroMQ closed the connection to {self.endpoint} for good while the reply to "
+                                     f"{service!r} was due (a message that is not ZeroMQ ends it)") from None
             self._retry[rid] = (entry[0], time.monotonic())
             self.retries += 1
 
@@ -463,10 +487,13 @@ class Connection:
         # else: the reply to a request we gave up on (timeout, discard): drop it
 
     def _decode(self, frames: list[bytes]) -> dict:
+        return self._decode_body(frames[-1])
+
+    def _decode_body(self, body: bytes) -> dict:
         """A reply's map; SensoriumError for an undecodable one, or for the server's id-less error
         reply (it could not read one of our requests)."""
         try:
-            reply = unpack(frames[-1])
+            reply = unpack(body)
         except Exception as exc:  # noqa: BLE001 - any decoding failure is a bad reply
             raise SensoriumError(ErrorCode.BAD_REPLY, f"undecodable reply from {self.endpoint}: {exc}") from None
         if type(reply) is not dict:
@@ -523,6 +550,10 @@ class Heartbeat(threading.Thread):
         self.lost_after = lost_after_s if lost_after_s is not None else max(2.0, 5 * self.interval)
         self._context = context
         self._stop_event = threading.Event()
+        # stop() wakes the thread through this pair: it sleeps until its next ping, not in short
+        # slices (each wake-up of a Python thread takes the GIL from the stepping one)
+        self._wake_r, self._wake_w = socket.socketpair()
+        self._wake_w.setblocking(False)
         self._problem: str | None = None
         self.last_reply = time.monotonic()
         self.pings = 0
@@ -539,12 +570,19 @@ class Heartbeat(threading.Thread):
 
     def stop(self) -> None:
         self._stop_event.set()
+        try:
+            self._wake_w.send(b"\0")
+        except OSError:
+            pass
         if self.is_alive() and threading.current_thread() is not self:
             self.join(timeout=2.0)
 
     def run(self) -> None:
         sock = self._context.socket(zmq.DEALER)
         sock.setsockopt(zmq.LINGER, 0)
+        poller = zmq.Poller()
+        poller.register(sock, zmq.POLLIN)
+        poller.register(self._wake_r.fileno(), zmq.POLLIN)
         try:
             curve_client(sock, self.serverkey)
             sock.connect(self.endpoint)
@@ -564,8 +602,8 @@ class Heartbeat(threading.Thread):
                     sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
                     self.pings += 1
                     next_ping = now + self.interval
-                wait_ms = int(min(next_ping - time.monotonic(), 0.05) * 1000)
-                if sock.poll(max(wait_ms, 1), zmq.POLLIN):
+                wait_ms = int((next_ping - time.monotonic()) * 1000) + 1
+                if dict(poller.poll(max(wait_ms, 1))).get(sock):
                     while True:
                         try:
                             reply = unpack(sock.recv_multipart(zmq.NOBLOCK)[-1])
@@ -585,6 +623,8 @@ class Heartbeat(threading.Thread):
             pass
         finally:
             sock.close(linger=0)
+            self._wake_r.close()
+            self._wake_w.close()
 
 
 class SubSocket:

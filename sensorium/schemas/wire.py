@@ -20,7 +20,7 @@ from typing import Any, NamedTuple
 import msgpack
 
 __all__ = [
-    "PROTOCOL_VERSION", "SOFT_LIMIT", "HARD_LIMIT", "ErrorCode", "WireError", "RequestError",
+    "PROTOCOL_VERSION", "SOFT_LIMIT", "HARD_LIMIT", "MAX_REPLY", "ErrorCode", "WireError", "RequestError",
     "pack", "unpack", "Request", "parse_request", "ok_reply", "error_reply",
     "to_bin", "from_bin", "F32", "I32", "topic_frame", "topic_frames", "decode_topic",
     "stamp", "stamp_ns", "ms_to_ns", "covers",
@@ -34,6 +34,10 @@ SOFT_LIMIT = 1 << 20
 HARD_LIMIT = 2 << 20
 """ZMQ_MAXMSGSIZE on the server's ROUTER, per frame: libzmq drops the connection of a peer sending
 a larger frame (the number of frames is bounded by the transport, PROTOCOL §3.1)."""
+
+MAX_REPLY = 64 << 20
+"""The largest reply the server sends (PROTOCOL §3.1): a longer one is answered with ``TOO_LARGE``
+instead. Clients may refuse longer messages (the C client sets ``ZMQ_MAXMSGSIZE`` to it)."""
 
 
 class ErrorCode(IntEnum):

@@ -3,7 +3,8 @@
 No sockets, no clock: the driver passes wall time (``now``, seconds, monotonic) into every call
 that needs it and does the I/O. The machine decides:
 
-* who is attached to which robot, and who is still alive (last heard + 3 heartbeats);
+* who is attached to which robot, and who is still alive (last heard + 3 heartbeats, not counting
+  the time the server itself did not read requests: :meth:`Lockstep.unheard`);
 * whether the world may advance one basic step now (every attached synchronous controller has a
   step pending, at least one step is pending, the mode allows it, real-time pacing allows it) - or
   runs by itself: when no synchronous controller is attached and no robot waits for one (every
@@ -32,7 +33,8 @@ __all__ = ["Lockstep", "LockstepError", "Session", "PendingStep", "StepDone", "M
 
 MODES = ("fast", "realtime", "pause")
 STATUS_QUIT = -1
-REST_MAX_S = 60.0      # longest rest of a robot whose controllers keep vanishing before their first step
+REST_MAX_S = 60.0      # longest rest of a robot whose controllers keep vanishing
+REST_CLEAR_S = 60.0    # a session heard from for this long after attaching is no vanishing one: the count restarts
 RTF_WINDOW_S = 1.0
 
 
@@ -66,6 +68,13 @@ class Session:
     alive: bool = True
     last_step: tuple[Any, bytes] | None = None   # (request id, reply body) of the last answered step
     stepped: bool = False                # asked for a step at least once
+    attached_at: float = 0.0             # wall time of the attach
+    slot: int = 0                        # the robot's index in the world (the transport's step path names it so)
+
+    @property
+    def lived_s(self) -> float:
+        """How long the controller was heard from after attaching (wall seconds)."""
+        return self.last_heard - self.attached_at
 
 
 @dataclass(slots=True)
@@ -94,6 +103,9 @@ class Lockstep:
         if heartbeat_ms <= 0:
             raise ValueError("heartbeat_ms must be > 0")
         self.robots = dict(robots)
+        self._slots = {name: i for i, name in enumerate(self.robots)}
+        self._by_slot: list[Session | None] = [None] * len(self.robots)
+        self.generation = 0                          # changes whenever a session comes or goes
         self.uncontrolled = frozenset(uncontrolled)
         # robots with an "<extern>" synchronous controller: while none of them is attached, the
         # world waits for one (Webots waits for a synchronous extern controller to connect)
@@ -108,7 +120,8 @@ class Lockstep:
         self._by_robot: dict[str, Session] = {}
         self.synchronous_attached = 0                # attached sessions with synchronization true
         self._by_token: dict[str, Session] = {}
-        # robot -> (controllers that attached and vanished before stepping, no attach before this time)
+        self._by_peer: dict[Hashable, list[Session]] = {}
+        # robot -> (controllers in a row that vanished within REST_CLEAR_S of attaching, no attach before this time)
         self._rest: dict[str, tuple[int, float]] = {}
         self._rt_next: float | None = None          # realtime: earliest wall time of the next step
         self._rtf: deque[tuple[float, int]] = deque()
@@ -125,6 +138,10 @@ class Lockstep:
 
     def session_for(self, robot: str) -> Session | None:
         return self._by_robot.get(robot)
+
+    def session_at(self, slot: int) -> Session | None:
+        """The session of the robot with index ``slot`` (:attr:`Session.slot`)."""
+        return self._by_slot[slot]
 
     def session(self, token: str) -> Session:
         s = self._by_token.get(token)
@@ -148,17 +165,20 @@ class Lockstep:
         if now < until:
             raise LockstepError(ErrorCode.ROBOT_TAKEN,
                                 f"robot {robot!r} takes no controller for another {until - now:.1f} s: the last "
-                                f"{vanished} controller(s) that attached to it went silent before their first step "
-                                f"(PROTOCOL.md, 'Sessions and liveness')")
+                                f"{vanished} controllers that attached to it went silent without detaching, each "
+                                f"within {REST_CLEAR_S:g} s (PROTOCOL.md, 'Sessions and liveness')")
         if self._by_robot.get(robot) is not None:
             raise LockstepError(ErrorCode.ROBOT_TAKEN, f"robot {robot!r} already has a live controller attached")
         token = self._new_token()
         while token in self._by_token:
             token = self._new_token()
-        s = Session(token, robot, peer, self.robots[robot], now)
+        s = Session(token, robot, peer, self.robots[robot], now, attached_at=now, slot=self._slots[robot])
+        self.generation += 1
         self._by_robot[robot] = s
+        self._by_slot[s.slot] = s
         self.synchronous_attached += s.synchronous
         self._by_token[token] = s
+        self._by_peer.setdefault(peer, []).append(s)
         return s
 
     def detach(self, token: str) -> tuple[Session, StepDone | None]:
@@ -168,13 +188,25 @@ class Lockstep:
         if s.pending is not None:
             done = StepDone(s, s.pending, STATUS_QUIT, self.time_ms)
         self._remove(s)
+        if s.lived_s >= REST_CLEAR_S:
+            self._rest.pop(s.robot, None)           # a controller that lived and said goodbye
         return s, done
 
     def heard(self, peer: Hashable, now: float) -> None:
         """Any request arrived from ``peer``: its sessions are alive."""
-        for s in self._by_robot.values():
-            if s.peer == peer:
+        sessions = self._by_peer.get(peer)
+        if sessions:
+            for s in sessions:
                 s.last_heard = now
+
+    def unheard(self, seconds: float, now: float) -> None:
+        """The server read no requests for ``seconds`` (a long step, a long request, an over-long
+        message dropped frame by frame): requests that came meanwhile waited in the socket, so that
+        time does not count toward any session's silence (never blame a peer for the server's stall)."""
+        if seconds <= 0:
+            return
+        for s in self._by_robot.values():
+            s.last_heard = min(s.last_heard + seconds, now)
 
     def ping(self, token: str, now: float) -> Session:
         s = self.session(token)
@@ -189,24 +221,34 @@ class Lockstep:
         return dead
 
     def _drop(self, s: Session, now: float) -> None:
-        """Remove a session that went silent."""
+        """Remove a session that went silent.
+
+        Its robot's wait cost the world up to :attr:`liveness_s`. A client that attaches (and
+        perhaps steps) and vanishes, in a loop, would hold every other robot most of the time; so
+        vanishings in a row of sessions that lived less than :data:`REST_CLEAR_S` are counted per
+        robot, and from the second one the robot rests 1, 2, 4 … 60 s before it may be attached
+        again: the world then waits at most ``liveness_s`` per ``liveness_s`` + 60 s for that
+        robot (~5 % with the default heartbeat). A session that lived longer restarts the count."""
         self._remove(s)
-        if not s.stepped:
-            # attached, then gone before stepping: the world waited liveness_s for nothing. A
-            # client doing this in a loop would hold every other robot; from the second time
-            # the robot rests 1, 2, 4 … 60 s before it may be attached again (a session that
-            # steps clears it)
-            vanished = self._rest.get(s.robot, (0, 0.0))[0] + 1
-            rest = 0.0 if vanished == 1 else min(REST_MAX_S, 2.0 ** (vanished - 2))
-            self._rest[s.robot] = (vanished, now + rest)
+        vanished = 1 if s.lived_s >= REST_CLEAR_S else self._rest.get(s.robot, (0, 0.0))[0] + 1
+        rest = 0.0 if vanished == 1 else min(REST_MAX_S, 2.0 ** (vanished - 2))
+        self._rest[s.robot] = (vanished, now + rest)
 
     def _remove(self, s: Session) -> None:
+        self.generation += 1
         s.alive = False
         s.pending = None
         if self._by_robot.get(s.robot) is s:
             self.synchronous_attached -= s.synchronous
-        self._by_robot.pop(s.robot, None)
+            self._by_robot.pop(s.robot, None)
+            self._by_slot[s.slot] = None
         self._by_token.pop(s.token, None)
+        peers = self._by_peer.get(s.peer)
+        if peers is not None:
+            if s in peers:
+                peers.remove(s)
+            if not peers:
+                del self._by_peer[s.peer]
 
     # ------------------------------------------------------------------ steps
     def check_duration(self, duration: int | None, kind: str = "step") -> int:
@@ -231,9 +273,7 @@ class Lockstep:
             raise LockstepError(ErrorCode.WRONG_STATE, f"robot {session.robot!r} already has a step pending "
                                                        f"(wake at {session.pending.wake_ms} ms)")
         session.last_heard = now
-        if not session.stepped:
-            session.stepped = True
-            self._rest.pop(session.robot, None)
+        session.stepped = True
         step = PendingStep(reply_to, kind, d, self.time_ms, self.time_ms + d)
         if self.shutting_down:
             return StepDone(session, step, STATUS_QUIT, self.time_ms)
@@ -243,6 +283,10 @@ class Lockstep:
     def blocking(self) -> list[str]:
         """Attached synchronous robots without a pending step (the world waits for them)."""
         return [s.robot for s in self._by_robot.values() if s.synchronous and s.pending is None]
+
+    def waiting_slots(self) -> list[int]:
+        """The :attr:`Session.slot` of every attached synchronous robot without a pending step."""
+        return [s.slot for s in self._by_robot.values() if s.synchronous and s.pending is None]
 
     def can_advance(self) -> bool:
         """Lockstep rule alone (no mode, no pacing): no attached synchronous controller without a

@@ -29,12 +29,14 @@ from pydantic import ValidationError
 from sensorium.schemas import services as S
 from sensorium.schemas.devices import KINDS
 from sensorium.schemas.wire import (
+    MAX_REPLY,
     SOFT_LIMIT,
     ErrorCode,
     RequestError,
     check_args_shape,
     error_reply,
     ok_reply,
+    pack,
     parse_request,
 )
 from sensorium.server.daemon import roles, supervisor
@@ -74,6 +76,12 @@ class Route:
 
 
 _DEFERRED = None              # a handler returning None answers later (step)
+# ok_reply(rid, {"status": s, "time_ms": t, "values": {}}) in pieces, around the packed rid, s and t
+# (tests/test_steppath.py checks the bytes against ok_reply)
+_STEP_HEAD = b"\x83\xa2id"
+_STEP_STATUS = b"\xa2ok\xc3\xa6result\x83\xa6status"
+_STEP_TIME = b"\xa7time_ms"
+_STEP_NO_VALUES = b"\xa6values\x80"
 ARG_CACHE_KEYS = 4            # argument maps of at most this many int/str values are cached once validated
 ARG_CACHE_SIZE = 1024         # validated argument maps kept
 
@@ -120,6 +128,9 @@ class Core(DeviceServices):
         for ctl in self.topics.controls.values():
             self._controls_by_robot[ctl.robot].append(ctl)
         self.routes = self._routes()
+        # the step service of each robot, by its lockstep slot (the transport's C step path names robots so)
+        self._step_service_names = [f"/{name}/robot/step" for name in sim.robots]
+        self._step_services = [name.encode() for name in self._step_service_names]
         self._arg_cache: dict[tuple, Any] = {}            # (model, args items) -> validated model
         self.errors = 0
 
@@ -187,41 +198,75 @@ class Core(DeviceServices):
     # ------------------------------------------------------------------ requests
     def handle(self, frames: Frames, now: float) -> list[Frames]:
         """One ROUTER message ``[identity, (envelope frames...), body]`` → replies to send now."""
-        envelope, body = frames[:-1], frames[-1]
-        peer = frames[0] if len(frames) > 1 else b""
+        return self._serve(frames[:-1], frames[0] if len(frames) > 1 else b"", frames[-1], None, now)
+
+    def handle_step(self, slot: int, identity: bytes, rid: int, duration: int | None, now: float) -> list[Frames]:
+        """What :meth:`handle` returns for ``[identity, body]`` when ``body`` is the plain step request
+        ``{"id": rid, "service": "/<robot>/robot/step", "args": {} or {"duration": duration}}`` of the
+        robot with index ``slot``, already parsed by the transport's C step path (steppath.py); the
+        same checks and handler run, only the decoding and validation of those bytes are skipped.
+
+        The common case (the caller is the robot's attached socket, no step pending, not a repeated
+        id, not quitting) is the handler's own outcome done directly: the step is queued, nothing is
+        answered yet. Anything else goes the general way (:meth:`_serve`)."""
+        ls = self.lockstep
+        s = ls.session_at(slot)
+        if s is None or s.peer != identity or s.pending is not None or ls.shutting_down \
+                or (s.last_step is not None and s.last_step[0] == rid):
+            return self._serve([identity], identity, None, (slot, rid, duration), now)
+        ls.heard(identity, now)
+        ls.request_step(s, ([identity], rid), duration, now)
+        return []
+
+    def step_peers(self) -> list[tuple[bytes, bytes, int]]:
+        """(identity, step service, slot) of every attached controller: the step requests the C step
+        path may recognise (the caller's socket must be the attached one, as :meth:`handle` checks)."""
+        return [(s.peer, self._step_services[s.slot], s.slot) for s in self.lockstep.sessions
+                if isinstance(s.peer, bytes)]
+
+    def _serve(self, envelope: Frames, peer: bytes, body: bytes | None, step: tuple[int, int, int | None] | None,
+               now: float) -> list[Frames]:
         self.lockstep.heard(peer, now)
         rid: int | None = None
         try:
-            size = len(body) if len(frames) == 2 else sum(len(f) for f in frames[1:])
-            if size > self.max_request:
-                raise RequestError(ErrorCode.TOO_LARGE, f"request of {size} bytes exceeds the limit of {self.max_request} bytes")
-            req = parse_request(body, self.max_request)
-            rid = req.id
-            route = self.routes.get(req.service)
-            if route is None:
-                raise self._unknown(req.service)
-            args = self._validated(route.spec.args, req.service, req.args)
+            if step is None:
+                assert body is not None
+                size = len(body) if len(envelope) == 1 else len(body) + sum(len(f) for f in envelope[1:])
+                if size > self.max_request:
+                    raise RequestError(ErrorCode.TOO_LARGE, f"request of {size} bytes exceeds the limit of {self.max_request} bytes")
+                req = parse_request(body, self.max_request)
+                rid = req.id
+                service = req.service
+                route = self.routes.get(service)
+                if route is None:
+                    raise self._unknown(service)
+                args = self._validated(route.spec.args, service, req.args)
+            else:
+                slot, rid, duration = step
+                service = self._step_service_names[slot]
+                route = self.routes[service]
+                args = self._validated(route.spec.args, service, {} if duration is None else {"duration": duration})
             s = None
             if route.spec.attached:
                 s = self.lockstep.session_for(route.robot) if route.robot else None
                 if s is None or s.peer != peer:
                     raise ServiceError(ErrorCode.NOT_ATTACHED,
-                                       f"{req.service} needs the caller to be {route.robot!r}'s attached controller"
+                                       f"{service} needs the caller to be {route.robot!r}'s attached controller"
                                        + ("" if s is None else " (another socket is)"))
             if route.spec.supervisor and not getattr(self.sim.robots[route.robot], "supervisor", False):
                 raise ServiceError(ErrorCode.NOT_SUPERVISOR,
-                                   f"{req.service}: robot {route.robot!r} is not a supervisor "
+                                   f"{service}: robot {route.robot!r} is not a supervisor "
                                    f"(set 'supervisor: true' on it in the world file)")
             if route.spec.item in roles.WORLD_CONTROLS and route.spec.scope != "device" and not self.open_controls \
                     and not roles.has_supervisor_role(self.sim, self.lockstep, peer):
-                raise ServiceError(ErrorCode.NOT_SUPERVISOR, roles.denied(req.service))
+                raise ServiceError(ErrorCode.NOT_SUPERVISOR, roles.denied(service))
             ctl = self.topics.controls[route.device] if route.device else None
             motor = self.sim.robots[route.robot].motors[route.motor] if route.motor else None
             call = Call(envelope, peer, rid, args, route.robot or "", cast(Control, ctl), motor, now, [], s)
             result = route.handler(call)
             if result is _DEFERRED:
                 return call.extra
-            return call.extra + [envelope + [ok_reply(rid, result)]]
+            return call.extra + [envelope + [self._bounded_reply(rid, result)]]
         except RequestError as exc:
             return [envelope + [error_reply(exc.id if exc.id is not None else rid, exc.code, exc.message)]]
         except (ServiceError, LockstepError) as exc:
@@ -230,6 +275,24 @@ class Core(DeviceServices):
             self.errors += 1
             self.log_error(f"internal error: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
             return [envelope + [error_reply(rid, ErrorCode.INTERNAL, f"{type(exc).__name__}: {exc}")]]
+
+    def _bounded_reply(self, rid: int | None, result: dict) -> bytes:
+        """``ok_reply``, or ``TOO_LARGE`` when it would exceed :data:`MAX_REPLY` (a client may refuse
+        longer messages: the C client's libzmq drops the connection, and a step would never return)."""
+        body = ok_reply(rid, result)
+        if len(body) > MAX_REPLY:
+            return error_reply(rid, ErrorCode.TOO_LARGE, f"the reply of {len(body):,} bytes exceeds the limit of "
+                                                         f"{MAX_REPLY:,} bytes{self._reply_hint(result)}")
+        return body
+
+    @staticmethod
+    def _reply_hint(result: dict) -> str:
+        values = result.get("values") if isinstance(result, dict) else None
+        if not isinstance(values, dict) or not values:
+            return ""
+        big = sorted(values, key=lambda name: -len(pack(values[name])))[:3]
+        return (f" (largest values: {', '.join(big)}; read them from their topics, or enable fewer or smaller "
+                f"devices or point clouds)")
 
     def _validated(self, model: type, service: str, raw: dict) -> Any:
         """``raw`` validated by the service's pydantic ``model`` (frozen): TOO_LARGE / INVALID_ARGUMENT
@@ -314,6 +377,10 @@ class Core(DeviceServices):
             pubs = []
         return [self._step_reply(d) for d in done], pubs
 
+    def unheard(self, seconds: float, now: float) -> None:
+        """The transport read no requests for ``seconds``: not the sessions' silence (Lockstep.unheard)."""
+        self.lockstep.unheard(seconds, now)
+
     def expire(self, now: float) -> None:
         for s in self.lockstep.expire(now):
             self._released(s)
@@ -339,7 +406,11 @@ class Core(DeviceServices):
             values: dict[str, dict] = {}
             if d.status != -1 and d.session.alive:
                 values = self._new_values(d.session)
-            body = ok_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})
+            if values:
+                body = self._bounded_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})
+            else:                                 # most replies: no new value; msgpack's bytes, assembled
+                body = b"".join((_STEP_HEAD, pack(rid), _STEP_STATUS, pack(d.status), _STEP_TIME, pack(d.time_ms),
+                                 _STEP_NO_VALUES))
         d.session.last_step = (rid, body)         # kept for a retry of a reply lost in transit
         return envelope + [body]
 

@@ -5,6 +5,8 @@ A thin adapter around :class:`sensorium.server.daemon.services.Core` (sans-IO): 
 * ``ROUTER`` (RPC) with ``ZMQ_MAXMSGSIZE`` as the hard cap (libzmq drops the connection of a peer
   that sends more); the 1 MiB soft limit is the core's and is answered with ``TOO_LARGE``. ZMTP
   heartbeats detect silently dead TCP peers; session liveness is the lockstep's (heartbeat × 3).
+  Requests are read and replies sent by the step path's gate (steppath.py: C when built, else
+  pyzmq), in batches that end wherever the world might step.
 * ``XPUB`` (topics): subscription events feed the demand; a small ``SNDHWM`` bounds the memory a
   slow subscriber costs (PUB semantics: excess messages are dropped, ``seq`` shows the gap).
 * Run modes ``fast``/``realtime``/``pause`` are decided by the lockstep; this loop only sleeps
@@ -28,8 +30,10 @@ import zmq
 import zmq.auth
 import zmq.utils.z85
 
+from sensorium.schemas.services import MAX_PERIOD_MS
 from sensorium.schemas.wire import HARD_LIMIT, ErrorCode, error_reply
 from sensorium.server.daemon.services import Core
+from sensorium.server.daemon.steppath import gate_for
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
            "curve_client_from_env"]
@@ -42,15 +46,13 @@ MAX_IDLE_WAIT_MS = int(MAX_IDLE_WAIT_S * 1000)
 EXPIRE_EVERY_S = 0.01           # session expiry scan (and, while busy, a look at XPUB + wake) this often
 HOT_S = 0.01                    # busy: a request arrived this recently; wait in the ROUTER's recv alone
 HOT_WAIT_MS = 10                # longest such wait (then XPUB, wake and deadlines are looked at)
-ZERO_COPY_MIN = 64 * 1024       # replies at least this large are sent zero-copy
-REQUESTS_PER_TURN = 64          # requests served before the world may step again (fairness)
+REQUESTS_PER_TURN = 64          # requests in one batch of the step path (the world may step after each but steps)
 MAX_FRAMES = 16                 # frames in one request message (identity, REQ envelope, body)
-DISCARD_PER_TURN = 4096         # frames of an oversized message dropped per loop turn
+DISCARD_PER_TURN = 1 << 16      # frames of an over-long message dropped per loop pass (C: ~3 ms, Python: ~45 ms)
+STALL_S = 0.05                  # a longer stretch without reading requests is not the sessions' silence
+TOO_MANY_FRAMES = error_reply(None, ErrorCode.TOO_LARGE, f"a request has at most {MAX_FRAMES} frames")
 SUB_LIMIT = 1024                # bytes of one subscription message (topic names are short)
 ROUTER_SNDHWM = 256             # replies queued for one peer that does not read them
-# pyzmq's constants are enums: ``zmq.SNDMORE | flags`` runs enum code and each enum argument is
-# converted per call (~0.3-1.5 µs); the loop passes plain ints
-_NOBLOCK, _SNDMORE = int(zmq.NOBLOCK), int(zmq.SNDMORE)
 
 
 def _bindable(url: str) -> str:
@@ -130,7 +132,7 @@ class Transport:
     def __init__(self, core: Core, rpc: str = DEFAULT_RPC, pub: str = DEFAULT_PUB, *,
                  hard_limit: int = HARD_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
                  context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic,
-                 stop_at_ms: int | None = None, curve_secret: bytes | None = None):
+                 stop_at_ms: int | None = None, curve_secret: bytes | None = None, step_path: str | None = None):
         self.core = core
         self.stop_at_ms = stop_at_ms          # quit (steps answer -1) once simulated time reaches it
         self.clock = clock
@@ -156,7 +158,6 @@ class Transport:
         # subscriptions are applied by us, only for prefixes that match a topic: a peer cannot
         # make libzmq hold arbitrary prefixes (memory), and each is released when its peer goes
         self.xpub.setsockopt(zmq.XPUB_MANUAL, 1)
-        self._discarding = False          # in the middle of an over-long message: drop its frames
         self.curve = curve_secret is not None
         for s in (self.router, self.xpub):
             curve_server(s, curve_secret)
@@ -164,6 +165,14 @@ class Transport:
             self.router.bind(_bindable(rpc))
             self.xpub.bind(_bindable(pub))
         except zmq.ZMQError:
+            self._close_sockets()
+            raise
+        try:
+            # requests in, replies out: C when built (steppath.py), else pyzmq; step_path or
+            # SENSORIUM_STEP_PATH chooses
+            self.gate = gate_for(self.router, max_frames=MAX_FRAMES, max_request=core.max_request,
+                                 max_duration=MAX_PERIOD_MS, discard_budget=DISCARD_PER_TURN, step_path=step_path)
+        except ValueError:
             self._close_sockets()
             raise
         self.rpc_endpoint = self.router.getsockopt_string(zmq.LAST_ENDPOINT)
@@ -209,53 +218,69 @@ class Transport:
         """Serve until stopped. Two ways to wait:
 
         * *busy* (a request arrived within the last :data:`HOT_S`): block in the ROUTER's own
-          ``recv`` (``RCVTIMEO`` ≤ :data:`HOT_WAIT_MS`), one request per pass. That is the lockstep's
-          hot path: libzmq wakes this thread through the socket's mailbox alone, without the
-          readiness checks of ``zmq_poll`` over three sockets (each ``ZMQ_EVENTS`` query is a
-          ``poll`` and a ``getpid``). The XPUB and the wake socket are looked at every
-          :data:`EXPIRE_EVERY_S` (a zero-timeout poll), and a wait that times out drops to idle.
-        * *idle*: ``zmq_poll`` on ROUTER, XPUB and the wake socket until the next deadline.
+          receive (the step path's gate, ``RCVTIMEO`` ≤ :data:`HOT_WAIT_MS`). That is the
+          lockstep's hot path: libzmq wakes this thread through the socket's mailbox alone,
+          without the readiness checks of ``zmq_poll`` over three sockets (each ``ZMQ_EVENTS``
+          query is a ``poll`` and a ``getpid``). The C gate reads on while the world waits for
+          more controllers' steps (steppath.py), so this loop runs once per world step. The XPUB
+          and the wake socket are looked at every :data:`EXPIRE_EVERY_S` (a zero-timeout poll),
+          and a wait that times out drops to idle.
+        * *idle*: ``zmq_poll`` on ROUTER, XPUB and the wake socket until the next deadline; a
+          request makes the loop busy.
+
+        A stretch of more than :data:`STALL_S` in which the loop read no request (a long world
+        step, a long request, an over-long message being dropped) is credited to every session
+        (``Core.unheard``): requests waited in the socket meanwhile, so that is not their silence.
         """
         core = self.core
         clock = self.clock
-        router = self.router
+        gate = self.gate
         poll = self.poller.poll
+        lockstep = core.lockstep
         quit_at: float | None = None
         next_expire = 0.0
         busy_until = 0.0
         next_step: float | None = None               # when the world may step next (None: not by itself)
-        rcvtimeo = -1
+        deaf_since = clock()                         # the loop last listened to the ROUTER then
+        peers_generation = -1
         try:
             while True:
                 if self._stop_requested and quit_at is None:
-                    self._send_replies(core.shutdown())
+                    gate.send(core.shutdown())
                     quit_at = clock() + self.grace_s
                 now = clock()
                 if quit_at is not None and now >= quit_at:
                     break
                 timed_out = False
-                if now < busy_until and quit_at is None:
+                if gate.discarding:
+                    # the rest of an over-long message: nobody else's request can be read meanwhile
+                    gate.discard()
+                    busy_until = now + HOT_S
+                elif now < busy_until:
                     t = next_step                        # the world may step by itself: wait no longer
                     wait_ms = HOT_WAIT_MS if t is None else max(0, min(HOT_WAIT_MS, int((t - now) * 1000 + 0.999)))
-                    if wait_ms != rcvtimeo:
-                        router.setsockopt(zmq.RCVTIMEO, wait_ms)
-                        rcvtimeo = wait_ms
-                    frames = self._recv_request(0 if wait_ms else _NOBLOCK)
-                    now = clock()
-                    if frames:
-                        self._send_replies(core.handle(frames, now))
-                    if frames is not None:
+                    if lockstep.generation != peers_generation:
+                        gate.set_peers(core.step_peers())
+                        peers_generation = lockstep.generation
+                    if now - deaf_since > STALL_S:      # a long stretch without reading: not their silence
+                        core.unheard(now - deaf_since, now)
+                    batch = gate.receive(wait_ms, lockstep.waiting_slots(), REQUESTS_PER_TURN)
+                    now = deaf_since = clock()
+                    if batch is not None:
+                        self._serve(batch, now)
                         busy_until = now + HOT_S
                     elif wait_ms:
                         busy_until = 0.0                 # nothing for a while: wait on every socket
                         timed_out = True
                 else:
+                    if now - deaf_since > STALL_S:
+                        core.unheard(now - deaf_since, now)
                     events = poll(self._timeout(now, quit_at))
+                    now = deaf_since = clock()
                     timed_out = not events
                     for sock, _ in events:
-                        if sock is router:
-                            self._drain_router()
-                            busy_until = clock() + HOT_S
+                        if sock is self.router:
+                            busy_until = now + HOT_S     # read by the busy branch, right away
                         elif sock is self.xpub:
                             self._drain_xpub()
                         else:
@@ -266,6 +291,9 @@ class Transport:
                 # session expiry (and, while busy, the other sockets): when a deadline woke us,
                 # else at most every EXPIRE_EVERY_S
                 if timed_out or now >= next_expire:
+                    if now - deaf_since > STALL_S:          # not listening since (dropping frames): credit it first
+                        core.unheard(now - deaf_since, now)
+                        deaf_since = now
                     core.expire(now)
                     next_expire = now + EXPIRE_EVERY_S
                     if busy_until:
@@ -275,6 +303,21 @@ class Transport:
                 next_step = self._run_steps(now)
         finally:
             self.close()
+
+    def _serve(self, batch: list, now: float) -> None:
+        """Answer one batch from the gate: recognised steps, other messages, over-long messages."""
+        core = self.core
+        replies: list[list[bytes]] = []
+        for item in batch:
+            kind = type(item)
+            if kind is tuple:
+                replies += core.handle_step(item[0], item[1], item[2], item[3], now)
+            elif kind is list:
+                replies += core.handle(item, now)
+            else:                                        # the identity of a message with too many frames
+                replies.append([item, TOO_MANY_FRAMES])
+        if replies:
+            self.gate.send(replies)
 
     def _look_around(self) -> None:
         """While busy: serve the XPUB and the wake socket if they have something (no waiting)."""
@@ -291,59 +334,6 @@ class Transport:
         if deadline is None:
             return MAX_IDLE_WAIT_MS
         return max(0, min(MAX_IDLE_WAIT_MS, int((deadline - now) * 1000 + 0.999)))
-
-    def _recv_request(self, flags: int) -> list[bytes] | None:
-        """The frames of one request message; ``None``: nothing arrived (``flags`` NOBLOCK, or
-        ``RCVTIMEO`` passed); ``[]``: frames of an over-long message were dropped (it was answered
-        when its frame count passed :data:`MAX_FRAMES`; the rest goes over the next calls)."""
-        router = self.router
-        if self._discarding and not self._discard_rest():
-            return []
-        recv = router.recv
-        try:
-            # zero-copy frames: their ``more`` flag is read from the message itself, cheaper than a
-            # ZMQ_RCVMORE query per frame (libzmq delivers messages whole, so the rest is there)
-            frame = recv(flags, copy=False)
-            frames = [frame.bytes]
-            while frame.more:
-                if len(frames) >= MAX_FRAMES:
-                    # too many frames: answer the sender, drop the rest over the next turns
-                    self._send_replies([[frames[0], error_reply(
-                        None, ErrorCode.TOO_LARGE, f"a request has at most {MAX_FRAMES} frames")]])
-                    self._discarding = True
-                    return []
-                frame = recv(_NOBLOCK, copy=False)
-                frames.append(frame.bytes)
-        except zmq.Again:
-            return None
-        return frames
-
-    def _drain_router(self, limit: int = REQUESTS_PER_TURN) -> None:
-        """Serve up to ``limit`` queued requests (libzmq fair-queues peers, so a flooding peer
-        gets its share, not the loop: the world steps between turns). A non-blocking ``recv``
-        that finds nothing costs what a ``ZMQ_EVENTS`` query costs; one that finds a message, nothing."""
-        core, clock, NOBLOCK = self.core, self.clock, _NOBLOCK
-        for _ in range(limit):
-            if self._discarding and not self._discard_rest():
-                return                        # the over-long message's rest: the next turns
-            frames = self._recv_request(NOBLOCK)
-            if frames is None:
-                return
-            if frames:
-                self._send_replies(core.handle(frames, clock()))
-
-    def _discard_rest(self) -> bool:
-        """Drop frames of an over-long message, a bounded number per turn; True when done."""
-        router = self.router
-        for _ in range(DISCARD_PER_TURN):
-            try:
-                router.recv(zmq.NOBLOCK, copy=False)
-            except zmq.Again:
-                return False
-            if not router.getsockopt(zmq.RCVMORE):
-                self._discarding = False
-                return True
-        return False
 
     def _drain_xpub(self, limit: int = 1000) -> None:
         xpub = self.xpub
@@ -384,7 +374,7 @@ class Transport:
             replies, pubs = core.step_once(now)
             for frames in pubs:
                 self.xpub.send_multipart(frames, copy=False)
-            self._send_replies(replies)
+            self.gate.send(replies)
             if self.stop_at_ms is not None and core.sim.time_ms >= self.stop_at_ms:
                 self.stop()
                 return None
@@ -392,21 +382,11 @@ class Transport:
             if now - start > STEP_BUDGET_S:
                 return now                              # let the sockets be served, then step on
 
-    def _send_replies(self, replies: list[list[bytes]]) -> None:
-        # frame by frame (what send_multipart does, without its per-call type checks and enum flags)
-        send = self.router.send
-        for frames in replies:
-            body = frames[-1]
-            try:
-                for frame in frames[:-1]:
-                    send(frame, _SNDMORE)
-                # small frames: copying is cheaper than zero-copy bookkeeping
-                send(body, 0, copy=len(body) < ZERO_COPY_MIN)
-            except zmq.ZMQError:
-                pass                                     # peer gone: ROUTER drops, never raises upward
-
     # ------------------------------------------------------------------ close
     def _close_sockets(self) -> None:
+        gate = getattr(self, "gate", None)
+        if gate is not None:
+            gate.close()                      # before the socket goes: the C gate holds its raw handle
         for s in (self.router, self.xpub):
             if not s.closed:
                 s.close()

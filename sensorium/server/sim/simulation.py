@@ -258,8 +258,11 @@ class Simulation:
             yield from robot.devices.values()
 
     def set_solid_pose(self, name: str, translation, rotation=None, quaternion=None) -> None:
+        """Move a solid (as ``RobotState.set_pose``: non-finite values or a translation beyond
+        ``limits.MAX_COORDINATE_M`` raise ValueError and it stays)."""
         if name not in self.scene.solid_poses:
             raise KeyError(f"no solid {name!r}")
+        check_pose(translation, rotation, quaternion)
         pose = moved_pose(self.scene.solid_poses[name], translation, rotation, quaternion)
         self.scene.set_solid_pose(name, pose)
         if self.contact is not None:

@@ -11,10 +11,11 @@ from sensorium.server.world.geometry import Pose
 
 def axis_angle_matrix(axis: tuple[float, float, float] | np.ndarray, angle: float) -> np.ndarray:
     a = np.asarray(axis, dtype=np.float64)
-    n = float(np.linalg.norm(a))
-    if n == 0.0:
+    big = float(np.max(np.abs(a)))
+    if big == 0.0:
         return np.eye(3)
-    x, y, z = a / n
+    a = a / big                        # first to [-1, 1]: a norm of 1e300-sized values would overflow
+    x, y, z = a / float(np.linalg.norm(a))
     c, s = math.cos(angle), math.sin(angle)
     t = 1.0 - c
     return np.array([
@@ -25,8 +26,11 @@ def axis_angle_matrix(axis: tuple[float, float, float] | np.ndarray, angle: floa
 
 
 def quaternion_matrix(q: tuple[float, float, float, float] | np.ndarray) -> np.ndarray:
-    """Quaternion in ROS order (x, y, z, w), normalised here."""
-    x, y, z, w = np.asarray(q, dtype=np.float64) / float(np.linalg.norm(q))
+    """Quaternion in ROS order (x, y, z, w), normalised here (scaled to [-1, 1] first, so that
+    1e300-sized or 1e-300-sized components neither overflow nor vanish)."""
+    q = np.asarray(q, dtype=np.float64)
+    q = q / float(np.max(np.abs(q)))
+    x, y, z, w = q / float(np.linalg.norm(q))
     return np.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
@@ -92,7 +96,7 @@ def pose_from_values(translation, rotation=None, quaternion=None) -> Pose:
         raise ValueError("translation must be finite")
     if quaternion is not None:
         q = np.asarray(quaternion, dtype=np.float64).reshape(4)
-        if not np.isfinite(q).all() or not np.linalg.norm(q) > 0:
+        if not np.isfinite(q).all() or not np.abs(q).max() > 0:
             raise ValueError("quaternion must be finite and non-zero")
         r = quaternion_matrix(q)
     elif rotation is not None:

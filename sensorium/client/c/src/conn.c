@@ -17,7 +17,7 @@
 
 #define DEFAULT_ENDPOINT "tcp://127.0.0.1:5560"
 #define DEFAULT_PORT 5560
-#define MAX_REPLY (64u << 20) /* a reply larger than this is refused (bounded memory) */
+#define MAX_REPLY (64u << 20) /* a reply larger than this is refused (bounded memory); the server's MAX_REPLY */
 
 static int64_t now_ms(void) {
   struct timespec ts;
@@ -445,7 +445,9 @@ int sn_conn_send(sn_conn *c, sn_req *r, uint64_t id) {
     c->outstanding = p;
     c->cap_out = cap;
   }
-  if (zmq_send(c->sock, r->buf.data, r->buf.size, 0) < 0)
+  /* never blocks: a DEALER queues while (re)connecting; it refuses (EAGAIN) only once ZeroMQ closed
+     its connection for good (see sn_conn_wait) or 1000 requests are queued */
+  if (zmq_send(c->sock, r->buf.data, r->buf.size, ZMQ_DONTWAIT) < 0)
     return -1;
   c->outstanding[c->n_out++] = id;
   return 0;
@@ -525,7 +527,19 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
     }
     if (n == 0) {
       if (c->retry_id == id && now_ms() - c->retry_sent_ms >= RETRY_MS) {
-        zmq_send(c->sock, c->retry_data, c->retry_size, ZMQ_DONTWAIT);
+        if (zmq_send(c->sock, c->retry_data, c->retry_size, ZMQ_DONTWAIT) < 0 && zmq_errno() == EAGAIN) {
+          /* the socket has no connection left to queue on: ZeroMQ closed it for good, which it does
+             (without reconnecting) when a message breaks the protocol, e.g. a reply larger than
+             MAX_REPLY (ZMQ_MAXMSGSIZE); a dropped network connection would still queue */
+          forget(c, id);
+          char limit[32];
+          snprintf(limit, sizeof limit, "%u MiB", MAX_REPLY >> 20);
+          client_error(out, SN_CONNECTION_LOST,
+                       "ZeroMQ closed the connection to %s for good while a reply was due: a reply larger than "
+                       "this client's limit of %s (or not ZeroMQ) ends it; the Sensorium server sends no larger one",
+                       c->endpoint, limit);
+          return -1;
+        }
         c->retry_sent_ms = now_ms();
       }
       char why[300];
