@@ -182,6 +182,7 @@ class RayEngine(TierTracer):
         self._shared: dict[tuple, _Tier | None] = {}   # body-frame tiers by (variant, shapes)
         self._epoch = 0                                 # bumped by every set_body_pose
         self.threads = available()   # threads a large cast may use (see .blocks; 1: the calling thread only)
+        self.native = True   # judge and refine hits in packets.c where the packet path is on (the same answers)
         self._counting = threading.Lock()
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,

@@ -87,7 +87,8 @@ def _compile(out: Path) -> str | None:
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=out.parent)
     os.close(fd)
-    cmd = [*cc.split(), "-O2", "-shared", "-fPIC", "-o", tmp, str(_SOURCE)]
+    # no fused multiply-adds and no fast-math: the judging in C rounds every operation as numpy does
+    cmd = [*cc.split(), "-O2", "-ffp-contract=off", "-fno-fast-math", "-shared", "-fPIC", "-o", tmp, str(_SOURCE), "-lm"]
     if sys.platform.startswith("linux"):
         cmd.append("-ldl")
     try:
@@ -147,6 +148,14 @@ def _load() -> None:
     lib.sp_release_scene.argtypes = [vp]
     lib.sp_intersect.restype = None
     lib.sp_intersect.argtypes = [vp, sz, vp, sz, vp, vp, i, i]
+    d = ctypes.c_double
+    lib.sp_exact_pass.restype = sz
+    lib.sp_exact_pass.argtypes = [vp, vp, sz, vp, sz, vp, vp, vp, vp, sz, vp, vp, sz, vp, d, vp, vp, vp, vp, vp]
+    lib.sp_fast_pass.restype = sz
+    lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, vp, sz, vp, sz, vp, vp, sz, vp, sz, i, vp, sz, i, vp, vp,
+                                 vp, vp]
+    lib.sp_analytic.restype = None
+    lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
     _state["lib"] = lib
     _state["embree"] = embree
 
@@ -258,3 +267,36 @@ class Scene:
             res.update(geomID=out[2 * n:3 * n].view(np.int32), u=out[3 * n:4 * n], v=out[4 * n:5 * n],
                        Ng=out[5 * n:].reshape(n, 3))
         return res
+
+
+class TierArrays(ctypes.Structure):
+    """``struct sp_tier`` of packets.c: pointers to a tier's arrays (see :func:`tier_arrays`)."""
+
+    _fields_ = [(name, ctypes.c_void_p) for name in (
+        "normal", "v0", "g1", "g2", "h_min", "V", "F", "tri_slot", "tri_shape", "tri_owner", "c_code", "c_r", "c_h",
+        "c_rot", "c_pos", "c_shape", "c_isolated")] + [("eps", ctypes.c_double), ("ng_max", ctypes.c_double),
+                                                       ("guarded", ctypes.c_int64)]
+
+
+def tier_arrays(tier, exact: bool):
+    """(struct, address, arrays kept alive) describing ``tier`` (a :class:`.tiers._Tier`) to the
+    judging passes of packets.c; ``exact``: with the float64 refinement data."""
+    keep = []
+
+    def ptr(a, dtype):
+        a = np.ascontiguousarray(a, dtype=dtype)
+        keep.append(a)
+        return a.ctypes.data
+
+    f64, i32, i64 = np.float64, np.int32, np.int64
+    st = TierArrays(
+        normal=ptr(tier.normal, f64), V=ptr(tier.V, f64), F=ptr(tier.F, i32), tri_slot=ptr(tier.tri_slot, i32),
+        tri_shape=ptr(tier.tri_shape, i64), tri_owner=ptr(tier.tri_owner, i32),
+        c_code=ptr(tier.c_code, i64), c_r=ptr(tier.c_r, f64), c_h=ptr(tier.c_h, f64),
+        c_rot=ptr(tier.c_rot, f64), c_pos=ptr(tier.c_pos, f64), c_shape=ptr(tier.c_shape, i64),
+        c_isolated=ptr(tier.c_isolated, np.uint8), eps=tier.eps, ng_max=tier.ng_max,
+        guarded=int(exact and tier.guard is not None))
+    if exact:
+        st.v0, st.g1, st.g2, st.h_min = (ptr(tier.v0, f64), ptr(tier.g1, f64), ptr(tier.g2, f64),
+                                          ptr(tier.h_min, f64))
+    return st, ctypes.addressof(st), keep

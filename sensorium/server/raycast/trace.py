@@ -26,10 +26,35 @@ from sensorium.server.raycast.refine import Refiner
 from sensorium.server.raycast.tiers import _Tier
 
 
+def _vec(x, dtype=np.float64) -> tuple:
+    """(array kept alive, address, stride in elements) of a per-ray parameter that may be a scalar
+    (stride 0: one value for every ray)."""
+    if isinstance(x, np.ndarray):
+        a = np.ascontiguousarray(x, dtype=dtype)
+        return a, a.ctypes.data, 1
+    a = np.array([x], dtype=dtype)
+    return a, a.ctypes.data, 0
+
+
+def _rows_of(O: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """O[rows], one origin (a broadcast array) kept one."""
+    return np.broadcast_to(O[:1], (len(rows), 3)) if O.strides[0] == 0 and len(O) else O[rows]
+
+
+def _rows_ptr(x: np.ndarray) -> tuple:
+    """(array kept alive, address, row stride in elements) of (m,3) float64 rows, possibly one
+    broadcast row (stride 0)."""
+    if x.strides[0] == 0 and x.strides[1] == 8 and x.dtype == np.float64:
+        return x, x.ctypes.data, 0
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    return a, a.ctypes.data, 3
+
+
 class TierTracer(Refiner):
     """Per-tier tracing methods of :class:`~sensorium.server.raycast.engine.RayEngine`."""
 
     counters: dict[str, int]
+    native: bool   # judge (and in EXACT refine) hits in packets.c where the packet path is on
 
     def _run(self, tier: _Tier, o32, d32, far, robust: bool, coherent: bool = False):
         """One Embree call; ``coherent``: rays from one origin (a FAST lidar scan), traced as coherent
@@ -132,13 +157,22 @@ class TierTracer(Refiner):
                 far = None
             else:
                 far = float(far)
-        res = self._run(tier, o32, d32, far, robust=False, coherent=one)
-        prim = res["primID"]
-        hit = prim >= 0
-        n_hit = np.count_nonzero(hit)
-        if n_hit == 0 and pre is None:
-            return None   # no hit at all (the common case for short sensor rays)
-        if 2 * n_hit >= m:  # mostly hits: whole arrays, misses masked (primID -1 picks the
+        judged = self._fast_native(tier, Ot, D, o32, d32, far, one, start, lim, excl, distance_only) \
+            if self.native and m else None
+        if judged is not None:   # traversal and judging in one C call (the same values)
+            n_hit, t, shape, normal, redo = judged
+            if n_hit == 0 and pre is None:
+                return None
+        else:
+            res = self._run(tier, o32, d32, far, robust=False, coherent=one)
+            prim = res["primID"]
+            hit = prim >= 0
+            n_hit = np.count_nonzero(hit)
+            if n_hit == 0 and pre is None:
+                return None   # no hit at all (the common case for short sensor rays)
+        if judged is not None:
+            pass
+        elif 2 * n_hit >= m:  # mostly hits: whole arrays, misses masked (primID -1 picks the
             # sentinel rows: shape -1, zero normal)
             (t, normal), redo = self._judge_fast(tier, Ot, D, d32, res, prim, slice(None), start, lim, excl,
                                                  distance_only)
@@ -164,7 +198,7 @@ class TierTracer(Refiner):
             redo[pre[0][pre[1] <= t[pre[0]]]] = False
         if redo is not None and np.count_nonzero(redo):
             rows = redo.nonzero()[0]
-            t2, s2, n2 = self._trace_loop(tier, O[rows], D[rows], _take(t_near, rows), _take(lim_in, rows),
+            t2, s2, n2 = self._trace_loop(tier, _rows_of(O, rows), D[rows], _take(t_near, rows), _take(lim_in, rows),
                                           _take(excl, rows), eps64, exact=False)
             t[rows] = t2
             if not distance_only:
@@ -184,6 +218,77 @@ class TierTracer(Refiner):
                 if not distance_only:
                     shape[r], normal[r] = sp[take], np_[take]
         return t, shape, normal
+
+    def _fast_native(self, tier: _Tier, Ot, D, o32, d32, far, one: bool, start, lim, excl, distance_only: bool):
+        """FAST's Embree call and judging (``_judge_fast``, ``_special``) in one call of packets.c:
+        (hits, t, shape, normal, redo mask or None), the values of the numpy path; None where the
+        tier has no packet scene."""
+        st = tier.native(False)
+        if st is None:
+            return None
+        scene, built = tier.scene(False)
+        self._count("bvh_builds", built)
+        self._count("embree_calls", 1)
+        m = len(d32)
+        d32 = np.ascontiguousarray(d32, dtype=_F32)
+        if o32.strides[0] == 0:
+            o_ptr, o_stride = o32.ctypes.data, 0
+        else:
+            o32 = np.ascontiguousarray(o32)
+            o_ptr, o_stride = o32.ctypes.data, 3
+        if far is None:
+            far_ptr, far_stride = None, 0
+        elif isinstance(far, np.ndarray):
+            far = np.ascontiguousarray(far, dtype=_F32)
+            far_ptr, far_stride = far.ctypes.data, 1
+        else:
+            far = np.array([far], dtype=_F32)
+            far_ptr, far_stride = far.ctypes.data, 0
+        ot = _rows_ptr(Ot)
+        dd = np.ascontiguousarray(D)
+        sv = _vec(start)
+        lim_min = isinstance(lim, np.ndarray) or lim != _INF
+        lv = _vec(lim)
+        ex = _vec(excl, np.int64) if tier.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
+        t = np.empty(m)
+        shape = None if distance_only else np.empty(m, dtype=np.int64)
+        normal = None if distance_only else np.empty((m, 3))
+        special = np.empty(m, dtype=np.uint8)
+        n_hit = packets.library().sp_fast_pass(
+            scene.handle, st, m, 1 if one else 0, o_ptr, o_stride, d32.ctypes.data, far_ptr, far_stride, ot[1], ot[2],
+            dd.ctypes.data, sv[1], sv[2], lv[1], lv[2], 1 if lim_min else 0, None if ex is None else ex[1],
+            0 if ex is None else ex[2], 1 if distance_only else 0, t.ctypes.data,
+            None if shape is None else shape.ctypes.data, None if normal is None else normal.ctypes.data,
+            special.ctypes.data)
+        redo = special.view(bool)
+        return n_hit, t, shape, normal, (redo if np.count_nonzero(redo) else None)
+
+    def _exact_native(self, tier: _Tier, st: int, Ot, D, d32, seg, lo, lim, excl, alive, thr: float, best_t, best_s,
+                      best_n, distance_only: bool) -> np.ndarray:
+        """EXACT's ``_trace_loop`` in packets.c (robust scene, incoherent packets, the float64
+        refinement of flat and curved hits, rays continued past rejected hits); updates ``best_*``
+        for the rays it settles and returns the others (guards met, hits near edges, excluded
+        owners), which the caller traces on the numpy path."""
+        scene, built = tier.scene(True)
+        self._count("bvh_builds", built)
+        self._count("embree_calls", 1)
+        m = len(D)
+        ot = _rows_ptr(Ot)
+        dd = np.ascontiguousarray(D, dtype=np.float64)
+        d32 = None if d32 is None or len(d32) != m else np.ascontiguousarray(d32, dtype=_F32)
+        ex = None if excl is None else _vec(excl, np.int64)
+        left = np.zeros(m, dtype=np.uint8)
+        counts = np.zeros(2, dtype=np.uintp)
+        n_left = packets.library().sp_exact_pass(
+            scene.handle, st, m, ot[1], ot[2], dd.ctypes.data, None if d32 is None else d32.ctypes.data,
+            seg.ctypes.data, lo.ctypes.data, 1, lim.ctypes.data, None if ex is None else ex[1],
+            0 if ex is None else ex[2], alive.ctypes.data, thr, best_t.ctypes.data, best_s.ctypes.data,
+            None if distance_only else best_n.ctypes.data, left.ctypes.data, counts.ctypes.data)
+        if counts[0]:
+            self._count("continued_rays", int(counts[0]))
+        if counts[1]:
+            self._count("unresolved_rays", int(counts[1]))
+        return left.view(bool).nonzero()[0] if n_left else np.zeros(0, dtype=np.int64)
 
     def _judge_fast(self, tier: _Tier, Ot, D, d32, res, ph, rows, start, lim, excl, distance_only=False):
         """FAST hit data of the Embree results at ``rows`` (a slice of all rays, or an index array
@@ -271,15 +376,16 @@ class TierTracer(Refiner):
         return special if found and np.count_nonzero(special) else None
 
     def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool,
-                    distance_only: bool = False, d32_all=None):
+                    distance_only: bool = False, d32_all=None, native: bool = True):
         """General path: cast, judge each hit, continue rejected rays past their hit (bounded).
         Judging: excluded owners are skipped; EXACT refines flat hits in float64 and curved hits
         on the true surface; FAST keeps Embree's answer except self-hits and shells left from
         inside.  Returns (t, shape, normal oriented toward the origin); ``distance_only``: the shape
         and normal of flat hits are left unset (the same t); ``d32_all``: ``D`` as float32, if the
-        caller has it."""
+        caller has it; ``native``: EXACT's first pass may run in packets.c)."""
         m = len(O)
         eps = tier.eps
+        lim_in = lim
         if tier.anchored:   # one origin (a broadcast array) stays one
             Ot = np.broadcast_to(O[:1] - tier.anchor, O.shape) if O.strides[0] == 0 and m else _minus(O, tier.anchor)
         else:
@@ -318,10 +424,21 @@ class TierTracer(Refiner):
                 best_t[rows], best_s[rows], best_n[rows] = tp, sp, np_
                 np.minimum(lim, best_t, out=lim)
 
-        act = alive.nonzero()[0]
         one_origin = Ot.strides[0] == 0 and m > 0   # a broadcast array: one origin for all rays
         if exact:   # bound of |d| (the float32 reach below scales with it): sqrt(3) max |component|
             d_max = 1.7321 * max(float(D.max()), -float(D.min())) if m else 0.0
+            if native and self.native and m and tier.guarded:
+                st = tier.native(True)
+                if st is not None:   # the first pass in C; the rays it leaves, on this path from the start
+                    left = self._exact_native(tier, st, Ot, D, d32_all, seg, lo, lim, excl_arr, alive,
+                                              4.0 * eps * d_max, best_t, best_s, best_n, distance_only)
+                    if len(left):
+                        t2, s2, n2 = self._trace_loop(tier, _rows_of(O, left), D[left], _take(t_near, left),
+                                                      _take(lim_in, left), _take(excl, left), eps64, True,
+                                                      distance_only, native=False)
+                        best_t[left], best_s[left], best_n[left] = t2, s2, n2
+                    return best_t, best_s, best_n
+        act = alive.nonzero()[0]
         delta = None   # per-ray continuation step, allocated on the first continuation
         for _ in range(_MAX_LOOPS):
             if len(act) == 0:
