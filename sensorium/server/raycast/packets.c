@@ -203,14 +203,15 @@ static inline double np_min(double a, double b) { return (a < b || a != a) ? a :
 static inline double np_max(double a, double b) { return (a > b || a != a) ? a : b; }
 static inline double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* exact._to_frame for one row: x @ R summed (x0 R0j + x1 R1j) + x2 R2j */
+/* A curved shape's frame in and out, as refine._analytic moves rays and normals (einsum's sums:
+ * x @ R summed (x0 R0j + x1 R1j) + x2 R2j, x @ R.T summed (x0 Ri0 + x2 Ri2) + x1 Ri1, each added to
+ * +0.0, so a sum of zeros is +0.0) */
 static inline void to_frame(const double* x, const double* R, double* out) {
-  for (int j = 0; j < 3; j++) out[j] = x[0] * R[j] + x[1] * R[3 + j] + x[2] * R[6 + j];
+  for (int j = 0; j < 3; j++) out[j] = (x[0] * R[j] + x[1] * R[3 + j] + x[2] * R[6 + j]) + 0.0;
 }
 
-/* exact._from_frame for one row: x @ R.T summed (x0 Ri0 + x2 Ri2) + x1 Ri1 */
 static inline void from_frame(const double* x, const double* R, double* out) {
-  for (int i = 0; i < 3; i++) out[i] = x[0] * R[3 * i] + x[2] * R[3 * i + 2] + x[1] * R[3 * i + 1];
+  for (int i = 0; i < 3; i++) out[i] = (x[0] * R[3 * i] + x[2] * R[3 * i + 2] + x[1] * R[3 * i + 1]) + 0.0;
 }
 
 /* exact._roots_into for one row */
