@@ -212,3 +212,37 @@ def test_numpy_minimum_semantics_the_c_code_follows():
     x = np.float32(1e-4)
     assert float(x) < 1e-4 and not (np.array([x]) < 1e-4)[0]          # compared as float32(1e-4)
     assert exact._BARY_TOL == 1e-9                                      # the tolerance written in packets.c
+
+
+@pytest.mark.parametrize("visual", [True, False])
+def test_axis_aligned_plane_without_blas_gives_the_blas_answers(visual, monkeypatch):
+    """A floor (or any axis-aligned plane) met by rays of many origins: D . n taken as one column
+    times the normal's component instead of the BLAS product -- the same hits, distances, normals
+    and shape ids bit for bit (rays along the plane, from below and above, on it, with -0.0)."""
+    from sensorium.server.raycast import planes
+
+    rng = np.random.default_rng(5)
+    n = 5000
+    O = rng.uniform(-3.0, 3.0, (n, 3))
+    O[:200, 2] = 0.25                                     # on the plane
+    D = _unit(rng.normal(size=(n, 3)))
+    D[200:400, 2] = 0.0                                   # along it
+    D[400:500, 2] = -0.0
+    D[500:600] = [0.0, 0.0, -1.0]
+    out = {}
+    for lean in (True, False):
+        if not lean:   # the general (n,3) @ (3,P) product for every plane
+            monkeypatch.setattr(planes._Planes, "refresh", lambda self, epoch, f=planes._Planes.refresh: (
+                f(self, epoch), setattr(self, "axis", -1)))
+        res = []
+        for c in (1.0, -1.0):
+            eng = RayEngine(Precision.EXACT)
+            rot = np.eye(3) if c == 1.0 else np.diag([1.0, -1.0, -1.0])   # a ceiling: normal -z
+            eng.add_body([ShapeEntry(Plane(), Pose.identity(), True, True)], Pose(rot, np.array([0.0, 0.0, 0.25])))
+            kind = RayKind.VISUAL if visual else RayKind.BOUNDING
+            h = eng.cast(O, D, 0.0, np.inf, kind=kind)
+            res += [h.distance, h.normal, h.shape, eng.cast(O, D, 0.0, 4.0, kind=kind, distance_only=True).distance]
+        out[lean] = res
+    for a, b in zip(out[True], out[False]):
+        assert a.tobytes() == b.tobytes()
+    assert 0.2 < np.isfinite(out[True][0]).mean() < 0.8

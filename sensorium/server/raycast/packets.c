@@ -535,3 +535,17 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
   }
   return n_hit;
 }
+
+/* The rows i of the (n,3) directions D with D[i] . v >= thr, into out (ascending); their number.
+ * movers.py's cone test of a lidar's beams against a neighbouring body (a conservative test with
+ * slack: the rounding of the dot product does not matter). */
+size_t sp_cone(size_t n, const double* D, const double* v, double thr, int64_t* out) {
+  size_t k = 0;
+  const double v0 = v[0], v1 = v[1], v2 = v[2];
+  for (size_t i = 0; i < n; i++) {
+    const double* d = D + 3 * i;
+    out[k] = (int64_t)i;
+    k += d[0] * v0 + d[1] * v1 + d[2] * v2 >= thr;
+  }
+  return k;
+}

@@ -154,6 +154,8 @@ def _load() -> None:
     lib.sp_fast_pass.restype = sz
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, vp, sz, vp, sz, vp, vp, sz, vp, sz, i, vp, sz, i, vp, vp,
                                  vp, vp]
+    lib.sp_cone.restype = sz
+    lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
     _state["lib"] = lib
@@ -300,3 +302,15 @@ def tier_arrays(tier, exact: bool):
         st.v0, st.g1, st.g2, st.h_min = (ptr(tier.v0, f64), ptr(tier.g1, f64), ptr(tier.g2, f64),
                                           ptr(tier.h_min, f64))
     return st, ctypes.addressof(st), keep
+
+
+def cone_rows(D: np.ndarray, v: np.ndarray, thr: float) -> np.ndarray | None:
+    """Indices of the rows of the (n,3) float64 directions D with D . v >= thr (one pass in C), or
+    None without the helper."""
+    lib = library()
+    if lib is None or D.dtype != np.float64 or not D.flags.c_contiguous:
+        return None
+    out = np.empty(len(D), dtype=np.int64)
+    vv = np.ascontiguousarray(v, dtype=np.float64)
+    k = lib.sp_cone(len(D), D.ctypes.data, vv.ctypes.data, float(thr), out.ctypes.data)
+    return out[:k]
