@@ -192,6 +192,19 @@ struct sp_tier {
   double eps;                /* the tier's self-hit distance and continuation step */
   double ng_max;             /* largest |Embree Ng| */
   int64_t guarded;           /* geometry 1 of the scene holds edge guards */
+  /* EXACT only: */
+  const double* e1;          /* (n, 3) edges v1 - v0, v2 - v0 */
+  const double* e2;
+  const double* t_lo;        /* (n, 3) triangle boxes */
+  const double* t_hi;
+  const int64_t* ring_ptr;   /* CSR: the triangles sharing a vertex with triangle i */
+  const int64_t* ring_idx;
+  const int64_t* guard_ptr;  /* CSR: the flat triangles to test for a ray near risky edge e */
+  const int64_t* guard_idx;
+  int64_t n_tri;
+  int64_t prism_triangles;   /* guard prism triangle k guards edge k / prism_triangles */
+  double grow;               /* eps + 8 res: float32 uncertainty of a hit point */
+  void* bare;                /* the EXACT scene without guards */
 };
 
 #define INF_D ((double)INFINITY)
@@ -313,22 +326,135 @@ void sp_analytic(const struct sp_tier* T, size_t m, const int64_t* slots, const 
     t[i] = analytic_slot(T, slots[i], O + 3 * i, D + 3 * i, lo[i], hi[i], n ? n + 3 * i : NULL);
 }
 
+static inline void cross3(const double* a, const double* b, double* out) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* exact._moller_trumbore for one (ray, triangle): inside within the barycentric tolerance, and t */
+static int moller_trumbore(const struct sp_tier* T, int64_t tri, const double* o, const double* d, double* t_out) {
+  const double *v0 = T->v0 + 3 * tri, *e1 = T->e1 + 3 * tri, *e2 = T->e2 + 3 * tri;
+  double p[3], q[3], sv[3] = {o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]};
+  cross3(d, e2, p);
+  double inv = 1.0 / dot3(e1, p);
+  double u = dot3(sv, p) * inv;
+  cross3(sv, e1, q);
+  double v = dot3(d, q) * inv;
+  double t = dot3(e2, q) * inv;
+  *t_out = t;
+  return isfinite(t) && u >= -1e-9 && v >= -1e-9 && u + v <= 1.0 + 1e-9;
+}
+
+/* refine._refine_triangles (the hit triangle, else its vertex ring; of equal distances the ring's
+ * last) and, failing both, refine._nearby_triangles (flat triangles whose grown box holds the
+ * Embree hit point at t_e, hits up to t_e + eps; of equal distances the first): 1 and t, tri when
+ * found (tri -1 when nothing near). */
+static int refine_flat(const struct sp_tier* T, int64_t* tri, const double* o, const double* d, double lo, double hi,
+                       double t_e, const int64_t* excl, double* t_out) {
+  double t;
+  if (moller_trumbore(T, *tri, o, d, &t) && t >= lo && t <= hi) { *t_out = t; return 1; }
+  double best = INF_D;
+  int64_t btri = -1;
+  for (int64_t k = T->ring_ptr[*tri]; k < T->ring_ptr[*tri + 1]; k++) {
+    int64_t c = T->ring_idx[k];
+    double tc;
+    int ok = moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= hi;
+    if (!ok) continue;
+    if (tc < best) best = tc;
+  }
+  if (isfinite(best)) {
+    for (int64_t k = T->ring_ptr[*tri]; k < T->ring_ptr[*tri + 1]; k++) {   /* the last candidate at best */
+      int64_t c = T->ring_idx[k];
+      double tc;
+      if (moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= hi && tc == best) btri = c;
+    }
+    *t_out = best;
+    *tri = btri;
+    return 1;
+  }
+  double te = t_e < 1e300 ? t_e : 1e300;
+  double P[3] = {o[0] + te * d[0], o[1] + te * d[1], o[2] + te * d[2]};
+  double top = np_min(hi, t_e + T->eps);
+  const double g = T->grow;
+  best = INF_D;
+  btri = -1;
+  for (int64_t c = 0; c < T->n_tri; c++) {
+    if (T->tri_slot[c] >= 0) continue;
+    const double *a = T->t_lo + 3 * c, *b = T->t_hi + 3 * c;
+    if (!(P[0] >= a[0] - g && P[1] >= a[1] - g && P[2] >= a[2] - g && P[0] <= b[0] + g && P[1] <= b[1] + g &&
+          P[2] <= b[2] + g)) continue;
+    if (excl && T->tri_owner[c] == *excl) continue;
+    double tc;
+    int ok = moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= top;
+    if (!ok) tc = INF_D;
+    if (btri < 0 || tc < best) { best = tc; btri = c; }
+  }
+  *t_out = best;
+  *tri = isfinite(best) ? btri : -1;
+  return isfinite(best);
+}
+
+/* refine._guard_hits for one ray that met the guard prism triangle `gprim`: the flat triangles of
+ * that edge tested in float64; the nearest hit with lo <= t <= hi and t < best_t is taken (of
+ * equal distances the first), and hi becomes it. Returns 1 when one was taken. */
+static int guard_hits(const struct sp_tier* T, int64_t gprim, const double* o, const double* d, double lo, double* hi,
+                      const int64_t* excl, double* best_t, int64_t* best_s, double* best_n) {
+  int64_t e = gprim / T->prism_triangles;
+  double best = INF_D;
+  int64_t btri = -1;
+  for (int64_t k = T->guard_ptr[e]; k < T->guard_ptr[e + 1]; k++) {
+    int64_t c = T->guard_idx[k];
+    if (excl && T->tri_owner[c] == *excl) continue;
+    double t;
+    if (!(moller_trumbore(T, c, o, d, &t) && t >= lo && t <= *hi && t < *best_t)) continue;
+    if (t < best) { best = t; btri = c; }
+  }
+  if (btri < 0) return 0;
+  *best_t = best;
+  *hi = best;
+  if (best_n) {
+    const double* nrm = T->normal + 3 * btri;
+    double f = dot3(nrm, d) > 0.0 ? -1.0 : 1.0;
+    *best_s = T->tri_shape[btri];
+    if (f < 0.0) { best_n[0] = nrm[0] * f; best_n[1] = nrm[1] * f; best_n[2] = nrm[2] * f; }
+    else { best_n[0] = nrm[0]; best_n[1] = nrm[1]; best_n[2] = nrm[2]; }
+  }
+  return 1;
+}
+
+/* One ray through Embree (a packet with one valid lane: the same answer as in any packet). */
+static void intersect1(void* scene, float ox, float oy, float oz, float dx, float dy, float dz, float far,
+                       struct ray_hit16* r, struct intersect_args* args) {
+  int valid[16];
+  for (int k = 0; k < 16; k++) {
+    valid[k] = k == 0 ? -1 : 0;
+    r->org_x[k] = ox; r->org_y[k] = oy; r->org_z[k] = oz;
+    r->dir_x[k] = dx; r->dir_y[k] = dy; r->dir_z[k] = dz;
+    r->tnear[k] = 0.0f; r->time[k] = 0.0f; r->mask[k] = INVALID; r->id[k] = 0; r->flags[k] = 0;
+    r->tfar[k] = far;
+    r->geom[k] = INVALID; r->prim[k] = INVALID; r->inst[k] = INVALID;
+  }
+  intersect16(valid, scene, r, args);
+}
+
 /* EXACT: trace.py's _trace_loop over the rays with alive[i] (a robust scene, incoherent packets),
- * for a tier with edge guards or no risky edge: each pass judges every hit (float64 refinement of
- * flat and curved hits), continues the rays it rejects past their hit, up to 32 passes per ray.
+ * for a tier with edge guards or no risky edge: each pass judges every hit -- a guard met first
+ * gets refine.py's second look (the guarded edge's triangles in float64, the hit of the scene
+ * without guards, every further guard up to it), flat hits their float64 plane with barycentrics
+ * checked near edges and the triangle's vertex ring or nearby triangles where needed, curved hits
+ * the true surface -- and continues the rays it rejects past their hit, up to 32 passes per ray.
  * Per ray: the Embree start seg (updated in place as rays continue), lo, lim (after the pre-pass;
- * updated in place by curved hits), the owner excluded (`excl` NULL: none in this tier).
- * `thr` = 4 eps d_max. Settled rays get best_t, best_s, best_n (NULL: distances only) as the
- * numpy loop sets them; a ray that meets an edge guard, hits a flat triangle near an edge or hits
- * an excluded owner gets left[i] = 1 (the engine traces it again on the numpy path). Packets are
- * refilled as rays finish (a ray's answer does not depend on the rays traced beside it).
- * counts[0] += rays continued, counts[1] += rays unresolved after 32 passes. Returns the number
- * of rays left. */
-size_t sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double* O, size_t o_stride,
-                     const double* D, const float* d32, double* seg, const double* lo, size_t lo_stride,
-                     double* lim, const int64_t* excl, size_t excl_stride, const uint8_t* alive, double thr,
-                     double* best_t, int64_t* best_s, double* best_n, uint8_t* left, size_t* counts) {
-  struct ray_hit16 r;
+ * updated in place), the owner excluded (`excl` NULL: none in this tier). `thr` = 4 eps d_max.
+ * best_t, best_s, best_n (NULL: distances only) as the numpy loop sets them. Packets are refilled
+ * as rays finish (a ray's answer does not depend on the rays traced beside it).
+ * counts[0] += rays continued, counts[1] += rays unresolved after 32 passes (or 32 guard steps),
+ * counts[2] += float64 hits found by the guards' second look. */
+void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double* O, size_t o_stride,
+                   const double* D, const float* d32, double* seg, const double* lo, size_t lo_stride, double* lim,
+                   const int64_t* excl, size_t excl_stride, const uint8_t* alive, double thr, double* best_t,
+                   int64_t* best_s, double* best_n, size_t* counts) {
+  struct ray_hit16 r, r1;
   struct intersect_args args;
   memset(&args, 0, sizeof args);
   args.feature_mask = INVALID;
@@ -341,9 +467,10 @@ size_t sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const doubl
   double lane_delta[16];
   int lane_pass[16];
   int lanes = 0;
-  size_t next = 0, n_left = 0;
+  size_t next = 0;
   const double eps = T->eps;
   const double slack = 1.0 + 0x1p-20;
+  const double w = 4.0 * eps;
   for (;;) {
     while (lanes < 16 && next < m) {   /* refill the packet with the next rays */
       if (alive[next]) {
@@ -353,6 +480,7 @@ size_t sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const doubl
       next++;
     }
     if (lanes == 0) break;
+    double far64[16];
     for (int k = 0; k < 16; k++) {
       size_t i = lane_row[k < lanes ? k : 0];
       const double* o = O + o_stride * i;
@@ -367,41 +495,72 @@ size_t sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const doubl
       } else {
         r.dir_x[k] = (float)d[0]; r.dir_y[k] = (float)d[1]; r.dir_z[k] = (float)d[2];
       }
-      double far = ((lim[i] - sa) + eps) * slack;
-      r.tfar[k] = (float)(far >= 0.0 ? far : -1.0);
+      far64[k] = ((lim[i] - sa) + eps) * slack;
+      r.tfar[k] = (float)(far64[k] >= 0.0 ? far64[k] : -1.0);
       r.geom[k] = INVALID; r.prim[k] = INVALID; r.inst[k] = INVALID;
     }
     intersect16(valid, scene, &r, &args);
     int kept = 0;
     for (int q = 0; q < lanes; q++) {
       size_t row = lane_row[q];
-      int cont = 0;
-      if (r.geom[q] == INVALID) goto done;                    /* no hit: done */
-      if (T->guarded && r.geom[q] == 1) goto leave;           /* a guard first */
-      int64_t tri = (int64_t)r.prim[q];
-      if (excl && T->tri_owner[tri] == excl[excl_stride * row]) goto leave;
       const double* o = O + o_stride * row;
       const double* d = D + 3 * row;
-      double lo_i = lo[lo_stride * row], lim_i = lim[row];
+      const int64_t* ex = excl ? excl + excl_stride * row : NULL;
+      double* bn = best_n ? best_n + 3 * row : NULL;
+      int64_t* bs = best_n ? best_s + row : NULL;
       double sa = seg[row];
-      double t_e = sa + (double)r.tfar[q];
+      double lo_i = lo[lo_stride * row];
+      unsigned geom = r.geom[q], prim = r.prim[q];
+      float tf = r.tfar[q], u = r.u[q], v = r.v[q];
+      int cont = 0;
+      if (geom == INVALID) goto done;                           /* no hit: done */
+      if (T->guarded && geom == 1) {   /* a guard first: the second look (refine._guard_rays) */
+        double s = (double)tf;
+        float ox = r.org_x[q], oy = r.org_y[q], oz = r.org_z[q], dx = r.dir_x[q], dy = r.dir_y[q], dz = r.dir_z[q];
+        intersect1(T->bare, ox, oy, oz, dx, dy, dz, (float)(far64[q] >= 0.0 ? far64[q] : -1.0), &r1, &args);
+        double stop = np_min(far64[q], r1.geom[0] != INVALID ? (double)r1.tfar[0] + 4.0 * w : INF_D);
+        counts[2] += guard_hits(T, prim, o, d, lo_i, lim + row, ex, best_t + row, bs, bn);
+        geom = r1.geom[0]; prim = r1.prim[0]; tf = r1.tfar[0]; u = r1.u[0]; v = r1.v[0];
+        int steps = 0;
+        for (; steps < 32; steps++) {
+          s = s + 0.5 * w;
+          double f = stop - s;
+          if (!(f >= 0.0)) break;
+          double at = sa + s;
+          intersect1(scene, (float)(o[0] + at * d[0]), (float)(o[1] + at * d[1]), (float)(o[2] + at * d[2]), dx, dy,
+                     dz, (float)f, &r1, &args);
+          if (r1.geom[0] == INVALID) break;
+          s = s + (double)r1.tfar[0];
+          if (r1.geom[0] == 1) counts[2] += guard_hits(T, r1.prim[0], o, d, lo_i, lim + row, ex, best_t + row, bs, bn);
+        }
+        if (steps == 32) counts[1]++;
+        if (geom == INVALID) goto done;
+      }
+      int64_t tri = (int64_t)prim;
+      double lim_i = lim[row];
+      double t_e = sa + (double)tf;
+      if (ex && T->tri_owner[tri] == *ex) { cont = 1; goto next_pass; }   /* an excluded owner */
       int32_t slot = T->tri_slot[tri];
       if (slot < 0) {   /* a flat triangle: its float64 plane, barycentrics checked near edges */
         const double* nrm = T->normal + 3 * tri;
         const double* v0 = T->v0 + 3 * tri;
         double dn = d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2];
-        double w[3] = {v0[0] - o[0], v0[1] - o[1], v0[2] - o[2]};
-        double tx = dot3(w, nrm) / dn;
+        double wv[3] = {v0[0] - o[0], v0[1] - o[1], v0[2] - o[2]};
+        double tx = dot3(wv, nrm) / dn;
         int ok = isfinite(tx) && tx >= lo_i && tx <= lim_i;
-        float u = r.u[q], v = r.v[q];
         float m1 = (u < v || u != u) ? u : v;                  /* np.minimum in float32 */
         float m2 = (1.0f - u) - v;
         float margin = (m1 < m2 || m1 != m1) ? m1 : m2;
-        if (!(margin > 1e-4f)) goto leave;                     /* near an edge */
-        if (!((double)margin * T->h_min[tri] * fabs(dn) > thr)) {
+        int near_edge = !(margin > 1e-4f);
+        if (!near_edge && !((double)margin * T->h_min[tri] * fabs(dn) > thr)) {
           double P[3] = {o[0] + tx * d[0] - v0[0], o[1] + tx * d[1] - v0[1], o[2] + tx * d[2] - v0[2]};
           double bu = dot3(P, T->g1 + 3 * tri), bv = dot3(P, T->g2 + 3 * tri);
-          if (!(bu >= -1e-9 && bv >= -1e-9 && bu + bv <= 1.0 + 1e-9)) goto leave;
+          near_edge = !(bu >= -1e-9 && bv >= -1e-9 && bu + bv <= 1.0 + 1e-9);
+        }
+        if (near_edge) {   /* float64 tests of the hit triangle, its vertex ring, nearby triangles */
+          ok = refine_flat(T, &tri, o, d, lo_i, lim_i, t_e, ex, &tx);
+          nrm = T->normal + 3 * (tri >= 0 ? tri : T->n_tri);
+          dn = dot3(d, nrm);
         }
         if (ok && tx < best_t[row]) {
           best_t[row] = tx;
@@ -428,6 +587,7 @@ size_t sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const doubl
         /* continued if missed, or if something else could lie between the shell and the surface */
         cont = !found || (ta > t_e + eps && !T->c_isolated[slot]);
       }
+    next_pass:
       if (cont) {   /* past the hit: a wider step each time no progress is made */
         double delta = t_e < sa + eps ? lane_delta[q] * 4.0 : eps;
         seg[row] = np_max(t_e, sa) + delta;
@@ -436,17 +596,11 @@ size_t sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const doubl
         if (++lane_pass[q] >= 32) { counts[1]++; goto done; }
         lane_row[kept] = row; lane_delta[kept] = delta; lane_pass[kept] = lane_pass[q];
         kept++;
-        continue;
       }
-      goto done;
-    leave:
-      left[row] = 1;
-      n_left++;
     done:;
     }
     lanes = kept;
   }
-  return n_left;
 }
 
 /* FAST: trace.py's _trace_fast from the Embree call to its judging (_judge_fast, _special): one

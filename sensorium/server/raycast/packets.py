@@ -149,8 +149,8 @@ def _load() -> None:
     lib.sp_intersect.restype = None
     lib.sp_intersect.argtypes = [vp, sz, vp, sz, vp, vp, i, i]
     d = ctypes.c_double
-    lib.sp_exact_pass.restype = sz
-    lib.sp_exact_pass.argtypes = [vp, vp, sz, vp, sz, vp, vp, vp, vp, sz, vp, vp, sz, vp, d, vp, vp, vp, vp, vp]
+    lib.sp_exact_pass.restype = None
+    lib.sp_exact_pass.argtypes = [vp, vp, sz, vp, sz, vp, vp, vp, vp, sz, vp, vp, sz, vp, d, vp, vp, vp, vp]
     lib.sp_fast_pass.restype = sz
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, vp, sz, vp, sz, vp, vp, sz, vp, sz, i, vp, sz, i, vp, vp,
                                  vp, vp]
@@ -277,7 +277,11 @@ class TierArrays(ctypes.Structure):
     _fields_ = [(name, ctypes.c_void_p) for name in (
         "normal", "v0", "g1", "g2", "h_min", "V", "F", "tri_slot", "tri_shape", "tri_owner", "c_code", "c_r", "c_h",
         "c_rot", "c_pos", "c_shape", "c_isolated")] + [("eps", ctypes.c_double), ("ng_max", ctypes.c_double),
-                                                       ("guarded", ctypes.c_int64)]
+                                                       ("guarded", ctypes.c_int64)] + [
+        (name, ctypes.c_void_p) for name in ("e1", "e2", "t_lo", "t_hi", "ring_ptr", "ring_idx", "guard_ptr",
+                                             "guard_idx")] + [
+        ("n_tri", ctypes.c_int64), ("prism_triangles", ctypes.c_int64), ("grow", ctypes.c_double),
+        ("bare", ctypes.c_void_p)]
 
 
 def tier_arrays(tier, exact: bool):
@@ -299,8 +303,20 @@ def tier_arrays(tier, exact: bool):
         c_isolated=ptr(tier.c_isolated, np.uint8), eps=tier.eps, ng_max=tier.ng_max,
         guarded=int(exact and tier.guard is not None))
     if exact:
+        from sensorium.server.raycast.guards import PRISM_TRIANGLES
+
         st.v0, st.g1, st.g2, st.h_min = (ptr(tier.v0, f64), ptr(tier.g1, f64), ptr(tier.g2, f64),
                                           ptr(tier.h_min, f64))
+        st.e1, st.e2, st.t_lo, st.t_hi = (ptr(tier.e1, f64), ptr(tier.e2, f64), ptr(tier.t_lo, f64),
+                                          ptr(tier.t_hi, f64))
+        st.ring_ptr, st.ring_idx = ptr(tier.ring[0], i64), ptr(tier.ring[1], i64)
+        st.n_tri, st.prism_triangles, st.grow = len(tier.F), PRISM_TRIANGLES, tier.eps + 8.0 * tier.res
+        guard = tier.guard
+        if guard is not None:
+            st.guard_ptr, st.guard_idx = ptr(guard[1], i64), ptr(guard[2], i64)
+            bare = tier.bare_scene()
+            keep.append(bare)
+            st.bare = bare.handle
     return st, ctypes.addressof(st), keep
 
 

@@ -264,11 +264,11 @@ class TierTracer(Refiner):
         return n_hit, t, shape, normal, (redo if np.count_nonzero(redo) else None)
 
     def _exact_native(self, tier: _Tier, st: int, Ot, D, d32, seg, lo, lim, excl, alive, thr: float, best_t, best_s,
-                      best_n, distance_only: bool) -> np.ndarray:
-        """EXACT's ``_trace_loop`` in packets.c (robust scene, incoherent packets, the float64
-        refinement of flat and curved hits, rays continued past rejected hits); updates ``best_*``
-        for the rays it settles and returns the others (guards met, hits near edges, excluded
-        owners), which the caller traces on the numpy path."""
+                      best_n, distance_only: bool) -> None:
+        """EXACT's ``_trace_loop`` in packets.c for a tier with edge guards or no risky edge: robust
+        scene, incoherent packets, the guards' second look, the float64 refinement of flat hits
+        (vertex rings and nearby triangles near edges) and curved hits, rays continued past rejected
+        hits; updates ``best_*`` (and ``seg``, ``lim``) as the numpy loop does."""
         scene, built = tier.scene(True)
         self._count("bvh_builds", built)
         self._count("embree_calls", 1)
@@ -277,18 +277,15 @@ class TierTracer(Refiner):
         dd = np.ascontiguousarray(D, dtype=np.float64)
         d32 = None if d32 is None or len(d32) != m else np.ascontiguousarray(d32, dtype=_F32)
         ex = None if excl is None else _vec(excl, np.int64)
-        left = np.zeros(m, dtype=np.uint8)
-        counts = np.zeros(2, dtype=np.uintp)
-        n_left = packets.library().sp_exact_pass(
+        counts = np.zeros(3, dtype=np.uintp)
+        packets.library().sp_exact_pass(
             scene.handle, st, m, ot[1], ot[2], dd.ctypes.data, None if d32 is None else d32.ctypes.data,
             seg.ctypes.data, lo.ctypes.data, 1, lim.ctypes.data, None if ex is None else ex[1],
             0 if ex is None else ex[2], alive.ctypes.data, thr, best_t.ctypes.data, best_s.ctypes.data,
-            None if distance_only else best_n.ctypes.data, left.ctypes.data, counts.ctypes.data)
-        if counts[0]:
-            self._count("continued_rays", int(counts[0]))
-        if counts[1]:
-            self._count("unresolved_rays", int(counts[1]))
-        return left.view(bool).nonzero()[0] if n_left else np.zeros(0, dtype=np.int64)
+            None if distance_only else best_n.ctypes.data, counts.ctypes.data)
+        for key, k in (("continued_rays", 0), ("unresolved_rays", 1), ("edge_guard_hits", 2)):
+            if counts[k]:
+                self._count(key, int(counts[k]))
 
     def _judge_fast(self, tier: _Tier, Ot, D, d32, res, ph, rows, start, lim, excl, distance_only=False):
         """FAST hit data of the Embree results at ``rows`` (a slice of all rays, or an index array
@@ -376,16 +373,15 @@ class TierTracer(Refiner):
         return special if found and np.count_nonzero(special) else None
 
     def _trace_loop(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool,
-                    distance_only: bool = False, d32_all=None, native: bool = True):
+                    distance_only: bool = False, d32_all=None):
         """General path: cast, judge each hit, continue rejected rays past their hit (bounded).
         Judging: excluded owners are skipped; EXACT refines flat hits in float64 and curved hits
         on the true surface; FAST keeps Embree's answer except self-hits and shells left from
         inside.  Returns (t, shape, normal oriented toward the origin); ``distance_only``: the shape
         and normal of flat hits are left unset (the same t); ``d32_all``: ``D`` as float32, if the
-        caller has it; ``native``: EXACT's first pass may run in packets.c)."""
+        caller has it).  EXACT runs in packets.c where the packet path is on (``_exact_native``)."""
         m = len(O)
         eps = tier.eps
-        lim_in = lim
         if tier.anchored:   # one origin (a broadcast array) stays one
             Ot = np.broadcast_to(O[:1] - tier.anchor, O.shape) if O.strides[0] == 0 and m else _minus(O, tier.anchor)
         else:
@@ -427,16 +423,11 @@ class TierTracer(Refiner):
         one_origin = Ot.strides[0] == 0 and m > 0   # a broadcast array: one origin for all rays
         if exact:   # bound of |d| (the float32 reach below scales with it): sqrt(3) max |component|
             d_max = 1.7321 * max(float(D.max()), -float(D.min())) if m else 0.0
-            if native and self.native and m and tier.guarded:
+            if self.native and m and tier.guarded:
                 st = tier.native(True)
-                if st is not None:   # the first pass in C; the rays it leaves, on this path from the start
-                    left = self._exact_native(tier, st, Ot, D, d32_all, seg, lo, lim, excl_arr, alive,
-                                              4.0 * eps * d_max, best_t, best_s, best_n, distance_only)
-                    if len(left):
-                        t2, s2, n2 = self._trace_loop(tier, _rows_of(O, left), D[left], _take(t_near, left),
-                                                      _take(lim_in, left), _take(excl, left), eps64, True,
-                                                      distance_only, native=False)
-                        best_t[left], best_s[left], best_n[left] = t2, s2, n2
+                if st is not None:   # the passes in C
+                    self._exact_native(tier, st, Ot, D, d32_all, seg, lo, lim, excl_arr, alive, 4.0 * eps * d_max,
+                                       best_t, best_s, best_n, distance_only)
                     return best_t, best_s, best_n
         act = alive.nonzero()[0]
         delta = None   # per-ray continuation step, allocated on the first continuation
