@@ -124,6 +124,7 @@ from sensorium.server.raycast.exact import (
     _from_frame,
     _full,
     _minus,
+    _one_row,
     _param,
     _strictly_increasing,
     _take,
@@ -613,11 +614,11 @@ class RayEngine(TierTracer):
             if one and len(rr) == n:   # one mover, every ray (its pairs are then 0..n-1 in order)
                 Or, Dr = O, D
             else:
-                Or = np.broadcast_to(O[:1], (len(rr), 3)) if one_origin else O.take(rr, axis=0)
+                Or = _one_row(O[:1], len(rr)) if one_origin else O.take(rr, axis=0)
                 Dr = D.take(rr, axis=0)
             if one:
                 Rb, Tb = R[mm[0]], T[mm[0]]
-                Ob = (np.broadcast_to(_to_frame(_minus(O[:1], Tb), Rb), Or.shape) if one_origin
+                Ob = (_one_row(_to_frame(_minus(O[:1], Tb), Rb), len(rr)) if one_origin
                       else _to_frame(_minus(Or, Tb), Rb))
                 Db = _to_frame(Dr, Rb)
             else:
@@ -632,7 +633,7 @@ class RayEngine(TierTracer):
                 if len(keep) < len(rr):
                     if len(keep) == 0:
                         continue
-                    Ob = np.broadcast_to(Ob[:1], (len(keep), 3)) if Ob.strides[0] == 0 else Ob[keep]
+                    Ob = _one_row(Ob[:1], len(keep)) if Ob.strides[0] == 0 else Ob[keep]
                     rr, mm, Db, lim_r = rr[keep], mm[keep], Db[keep], lim_r[keep]
             res = self._trace_split(tier, Ob, Db, _take(t_near, rr), lim_r, eps64, exact, shape is None)
             if res is None:

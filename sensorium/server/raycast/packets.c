@@ -608,13 +608,16 @@ void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double*
  * limited by lim when `lim_min`; shape and normal toward the origin unless `distance_only`; and
  * special[i] = 1 for the rays the general loop must redo (possible self-hits, a curved shell hit
  * from inside, an excluded owner). Misses: t = inf, shape -1, a zero normal (-0.0 when most rays
- * hit, as the numpy path's whole-array judging leaves it). o32 and far as sp_intersect takes them
- * (`far_stride` 0: one limit; `far` NULL: none); Ot (tier frame), D, start, lim: float64, strides
- * 0 for one value. Returns the number of hits. */
+ * hit, as the numpy path's whole-array judging leaves it). Returns the number of hits.
+ * Per-ray values come as a pointer, or NULL and one value for all rays: the float32 origins o32
+ * (row stride o_stride; NULL: o1, or start32 * d + o1 in float32 when `shifted`, as numpy computes
+ * a lidar's shifted origins), the far limits (NULL: far_value, or none when `far_none`), the tier
+ * frame origins Ot (NULL: `origin`), start, lim, the owner excluded (`has_excl`). */
 size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent, const float* o32, size_t o_stride,
-                    const float* d32, const float* far, size_t far_stride, const double* Ot, size_t ot_stride,
-                    const double* D, const double* start, size_t start_stride, const double* lim, size_t lim_stride,
-                    int lim_min, const int64_t* excl, size_t excl_stride, int distance_only, double* t_out,
+                    const float* o1, int shifted, float start32, const float* d32, const float* far, float far_value,
+                    int far_none, const double* Ot, size_t ot_stride, const double* origin, const double* D,
+                    const double* start, double start_value, const double* lim, double lim_value, int lim_min,
+                    const int64_t* excl, int64_t excl_value, int has_excl, int distance_only, double* t_out,
                     int64_t* s_out, double* n_out, uint8_t* special) {
   struct ray_hit16 r;
   struct intersect_args args;
@@ -629,16 +632,23 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
   size_t n_hit = 0;
   const float eps32 = (float)T->eps;
   const float graze = (float)(1e-5 * T->ng_max);
+  const float far1 = far_none ? 1e37f : far_value;
   for (size_t a = 0; a < m; a += 16) {
     int mk = m - a < 16 ? (int)(m - a) : 16;
     for (int k = 0; k < 16; k++) {
       size_t i = a + (k < mk ? (size_t)k : 0);
-      const float* o = o32 + o_stride * i;
       const float* d = d32 + 3 * i;
       valid[k] = k < mk ? -1 : 0;
-      r.org_x[k] = o[0]; r.org_y[k] = o[1]; r.org_z[k] = o[2];
+      if (o32) {
+        const float* o = o32 + o_stride * i;
+        r.org_x[k] = o[0]; r.org_y[k] = o[1]; r.org_z[k] = o[2];
+      } else if (shifted) {
+        r.org_x[k] = start32 * d[0] + o1[0]; r.org_y[k] = start32 * d[1] + o1[1]; r.org_z[k] = start32 * d[2] + o1[2];
+      } else {
+        r.org_x[k] = o1[0]; r.org_y[k] = o1[1]; r.org_z[k] = o1[2];
+      }
       r.dir_x[k] = d[0]; r.dir_y[k] = d[1]; r.dir_z[k] = d[2];
-      r.tfar[k] = far ? far[far_stride * i] : 1e37f;
+      r.tfar[k] = far ? far[i] : far1;
       r.geom[k] = INVALID; r.prim[k] = INVALID; r.inst[k] = INVALID;
     }
     intersect16(valid, scene, &r, &args);
@@ -653,8 +663,8 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
       n_hit++;
       int64_t tri = (int64_t)r.prim[k];
       float tf = r.tfar[k];
-      double t = (double)tf + start[start_stride * i];
-      if (lim_min) t = np_min(t, lim[lim_stride * i]);
+      double t = (double)tf + (start ? start[i] : start_value);
+      if (lim_min) t = np_min(t, lim ? lim[i] : lim_value);
       t_out[i] = t;
       int curved = T->tri_slot[tri] >= 0;
       int back = 0;
@@ -666,20 +676,19 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
       }
       if (!distance_only) {
         const double* nrm = T->normal + 3 * tri;
-        double f = back ? -1.0 : 1.0;
         s_out[i] = T->tri_shape[tri];
-        if (back) { n_out[3 * i] = nrm[0] * f; n_out[3 * i + 1] = nrm[1] * f; n_out[3 * i + 2] = nrm[2] * f; }
+        if (back) { n_out[3 * i] = nrm[0] * -1.0; n_out[3 * i + 1] = nrm[1] * -1.0; n_out[3 * i + 2] = nrm[2] * -1.0; }
         else { n_out[3 * i] = nrm[0]; n_out[3 * i + 1] = nrm[1]; n_out[3 * i + 2] = nrm[2]; }
       }
       int sp = 0;
       if (tf < eps32) {   /* possible self-hit: the origin on the triangle's plane */
         const double* v = T->V + 3 * (size_t)T->F[3 * tri];
-        const double* o = Ot + ot_stride * i;
+        const double* o = Ot ? Ot + ot_stride * i : origin;
         double w[3] = {o[0] - v[0], o[1] - v[1], o[2] - v[2]};
         sp = fabs(dot3(w, T->normal + 3 * tri)) <= 2.0 * T->eps;
       }
       if (back && curved) sp = 1;                              /* leaving a curved shell */
-      if (excl && T->tri_owner[tri] == excl[excl_stride * i]) sp = 1;
+      if (has_excl && T->tri_owner[tri] == (excl ? excl[i] : excl_value)) sp = 1;
       special[i] = (uint8_t)sp;
     }
   }

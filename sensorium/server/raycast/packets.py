@@ -152,8 +152,9 @@ def _load() -> None:
     lib.sp_exact_pass.restype = None
     lib.sp_exact_pass.argtypes = [vp, vp, sz, vp, sz, vp, vp, vp, vp, sz, vp, vp, sz, vp, d, vp, vp, vp, vp]
     lib.sp_fast_pass.restype = sz
-    lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, vp, sz, vp, sz, vp, vp, sz, vp, sz, i, vp, sz, i, vp, vp,
-                                 vp, vp]
+    f, i64 = ctypes.c_float, ctypes.c_int64
+    lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
+                                 i, i, vp, vp, vp, vp]
     lib.sp_cone.restype = sz
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
@@ -320,13 +321,63 @@ def tier_arrays(tier, exact: bool):
     return st, ctypes.addressof(st), keep
 
 
+_tls = threading.local()
+
+
+class Scratch:
+    """A thread's buffers for the judging passes of small casts (up to ``_SCRATCH`` rays): outputs
+    and one-origin rows at addresses known once, so a call converts no array to a pointer."""
+
+    def __init__(self) -> None:
+        n = _SCRATCH
+        self.t, self.s, self.n = np.empty(n), np.empty(n, dtype=np.int64), np.empty((n, 3))
+        self.sp, self.rows = np.empty(n, dtype=np.uint8), np.empty(n, dtype=np.int64)
+        self.o1, self.origin = np.empty(3, dtype=np.float32), np.empty(3)
+        self.p_t, self.p_s, self.p_n, self.p_sp, self.p_rows, self.p_o1, self.p_origin = (
+            a.ctypes.data for a in (self.t, self.s, self.n, self.sp, self.rows, self.o1, self.origin))
+
+
+def scratch() -> Scratch:
+    """This thread's :class:`Scratch`."""
+    sc = getattr(_tls, "scratch", None)
+    if sc is None:
+        sc = _tls.scratch = Scratch()
+    return sc
+
+
+SCRATCH = _SCRATCH
+
+
+def address(a: np.ndarray) -> int:
+    """``a.ctypes.data`` (~1 us), remembered for the last few small arrays this thread passed (a
+    lidar's beams, cast scan after scan); those arrays are kept alive meanwhile."""
+    if a.nbytes > 65536:   # large arrays: not kept (the conversion is small beside their cast)
+        return a.ctypes.data
+    cache = getattr(_tls, "addresses", None)
+    if cache is None:
+        cache = _tls.addresses = {}
+    got = cache.get(id(a))
+    if got is not None and got[0] is a:
+        return got[1]
+    p = a.ctypes.data
+    if len(cache) >= 8:
+        cache.clear()
+    cache[id(a)] = (a, p)
+    return p
+
+
 def cone_rows(D: np.ndarray, v: np.ndarray, thr: float) -> np.ndarray | None:
     """Indices of the rows of the (n,3) float64 directions D with D . v >= thr (one pass in C), or
     None without the helper."""
     lib = library()
     if lib is None or D.dtype != np.float64 or not D.flags.c_contiguous:
         return None
-    out = np.empty(len(D), dtype=np.int64)
-    vv = np.ascontiguousarray(v, dtype=np.float64)
-    k = lib.sp_cone(len(D), D.ctypes.data, vv.ctypes.data, float(thr), out.ctypes.data)
+    n = len(D)
+    sc = scratch()
+    sc.origin[:] = v
+    if n <= _SCRATCH:
+        k = lib.sp_cone(n, address(D), sc.p_origin, float(thr), sc.p_rows)
+        return sc.rows[:k].copy()
+    out = np.empty(n, dtype=np.int64)
+    k = lib.sp_cone(n, address(D), sc.p_origin, float(thr), out.ctypes.data)
     return out[:k]
