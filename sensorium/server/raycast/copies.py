@@ -156,12 +156,14 @@ class CopyRays:
             rows = cand.nonzero()[0]
             if not len(rows):
                 continue
-            rc = copy[rows]
-            rel = centre[rc, r] - O[rows]
-            Dr = D[rows]
+            every = len(rows) == n          # no ray skips this body: the arrays as they are
+            rc = copy if every else copy[rows]
+            rel = np.ascontiguousarray(centre[:, r]).take(rc, axis=0)
+            rel -= O if every else O.take(rows, axis=0)
+            Dr = D if every else D.take(rows, axis=0)
             b = np.einsum("ij,ij->i", rel, Dr)
             e2 = np.einsum("ij,ij->i", rel, rel)
-            tc = np.minimum(np.maximum(b, lo[rows]), lim[rows])
+            tc = np.minimum(np.maximum(b, lo if every else lo[rows]), lim if every else lim[rows])
             near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)).nonzero()[0]
             if len(near):
                 pr_list.append(rows[near])
