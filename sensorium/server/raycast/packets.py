@@ -14,6 +14,11 @@ of 16. Same library, same scenes, same float32 rays:
   or, in FAST's plain (not watertight) scene, the other side of the edge (0 of the 131,072
   warehouse beams; ~1 % of rays aimed exactly at vertices and edges).
 
+The same helper judges the hits of a pass where trace.py/refine.py would in numpy
+(``sp_fast_pass``, ``sp_exact_pass``; see the engine docstring): compiled with
+``-ffp-contract=off`` and without fast-math, each operation rounds as numpy's does, so the answers
+are the numpy path's bit for bit (tests/test_native_judging.py).
+
 Debian bookworm packages Embree 3.13 (libembree3-3): not needed, as embreex's Embree 4 offers the
 same packet entry points.
 
@@ -155,6 +160,8 @@ def _load() -> None:
     f, i64 = ctypes.c_float, ctypes.c_int64
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
                                  i, i, vp, vp, vp, vp]
+    lib.sp_floor.restype = sz
+    lib.sp_floor.argtypes = [sz, vp, i, d, d, vp, sz, vp, sz, i, i, i, d, d, i, d, d, vp]
     lib.sp_cone.restype = sz
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
