@@ -286,31 +286,3 @@ def test_c_refinement_in_a_coarse_float32_frame_gives_the_numpy_answers(monkeypa
         assert a.tobytes() == b.tobytes()
     assert used["nearby"] > 0
 
-
-@pytest.mark.parametrize("sized", [False, True])
-def test_floor_in_c_gives_the_numpy_distances(sized):
-    """A lidar over a floor along world axes (distances only): the floor's distances from packets.c
-    (sp_floor) and from planes.py's numpy lines are the same bits (rays down, up, along the floor,
-    limits per ray and one for all)."""
-    from sensorium.server.raycast import planes
-
-    eng = RayEngine(Precision.FAST)
-    eng.add_body([ShapeEntry(Plane(size=(4.0, 6.0) if sized else None), Pose.identity(), True, True)],
-                 Pose(np.eye(3), np.array([0.3, -0.2, 0.0])))
-    pl = eng._plane_set("visual")
-    pl.refresh(0)
-    rng = np.random.default_rng(8)
-    n = 3000
-    D = _unit(rng.normal(size=(n, 3)))
-    D[:100, 2] = 0.0
-    D[100:150] = [0.0, 0.0, -1.0]
-    D = np.ascontiguousarray(D)
-    O = np.broadcast_to(np.array([0.1, 0.2, 1.3]), D.shape)
-    for t_near, t_far in ((0.0, 8.0), (0.05, rng.uniform(0.5, 5.0, n)), (rng.uniform(0.0, 0.5, n), 3.0)):
-        c_path = planes._floor_distances(pl, O, D, t_near, t_far, 1e-9)
-        numpy_path = planes._floor_distances(pl, O, np.asfortranarray(D), t_near, t_far, 1e-9)   # not C-contiguous
-        assert c_path is not None and numpy_path is not None
-        assert c_path[0].tobytes() == numpy_path[0].tobytes()
-        assert 0.1 < np.isfinite(c_path[0]).mean() < 0.9
-    up = np.ascontiguousarray(np.abs(D) * [1, 1, 1])            # every ray upwards: no ray reaches it
-    assert planes._floor_distances(pl, O, up, 0.0, 8.0, 1e-9) is None

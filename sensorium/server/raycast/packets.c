@@ -713,28 +713,3 @@ size_t sp_cone(size_t n, const double* D, const double* v, double thr, int64_t* 
   }
   return k;
 }
-
-/* planes.py's _floor_distances for n rays from one origin (a lidar over a floor along world axes):
- * t = num / (D[:, k] c) (c == 1: D[:, k]); a ray misses (t = inf) where t < lo, t > far (with
- * `check_far`), or, for a sized floor (`sized`), the hit lies beyond a half size h_a along world
- * axis j_a (|t D[:, j_a] - off_a| > h_a). lo and far: per ray (stride 1) or one value (stride 0).
- * Returns the number of rays not below lo (0: none reaches the floor). */
-size_t sp_floor(size_t n, const double* D, int k, double c, double num, const double* lo, size_t lo_stride,
-                const double* far, size_t far_stride, int check_far, int sized, int j1, double h1, double off1,
-                int j2, double h2, double off2, double* t_out) {
-  size_t reach = 0;
-  for (size_t i = 0; i < n; i++) {
-    const double* d = D + 3 * i;
-    double t = num / (c == 1.0 ? d[k] : d[k] * c);
-    int bad = t < lo[lo_stride * i];
-    reach += !bad;
-    if (check_far) bad |= t > far[far_stride * i];
-    if (sized) {
-      double x1 = t * d[j1] - off1, x2 = t * d[j2] - off2;
-      bad |= !(fabs(x1) <= h1);
-      bad |= !(fabs(x2) <= h2);
-    }
-    t_out[i] = bad ? INF_D : t;
-  }
-  return reach;
-}

@@ -160,8 +160,6 @@ def _load() -> None:
     f, i64 = ctypes.c_float, ctypes.c_int64
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
                                  i, i, vp, vp, vp, vp]
-    lib.sp_floor.restype = sz
-    lib.sp_floor.argtypes = [sz, vp, i, d, d, vp, sz, vp, sz, i, i, i, d, d, i, d, d, vp]
     lib.sp_cone.restype = sz
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import _INF, _mat
 from sensorium.server.raycast.kinds import ShapeEntry
 from sensorium.server.raycast.movers import _Body
@@ -136,8 +135,6 @@ def _floor_distances(pl: _Planes, O, D, t_near, t_far, eps64):
     k = pl.axis
     c = float(nz[0, k])
     lo = np.maximum(t_near, eps64) if isinstance(t_near, np.ndarray) else max(t_near, eps64)
-    if packets.library() is not None and D.flags.c_contiguous and D.dtype == np.float64:
-        return _floor_in_c(pl, Oo, D, k, c, num, lo, t_far)
     t = num / (D[:, k] if c == 1.0 else D[:, k] * c)
     bad = t < lo
     if np.count_nonzero(bad) == len(t):   # no ray reaches it (e.g. the upper layers)
@@ -153,19 +150,3 @@ def _floor_distances(pl: _Planes, O, D, t_near, t_far, eps64):
     np.copyto(t, _INF, where=bad)
     return t, None, None
 
-
-def _floor_in_c(pl: _Planes, Oo, D, k: int, c: float, num: float, lo, t_far):
-    """:func:`_floor_distances`'s tests in one pass of packets.c (the same operations per ray)."""
-    n = len(D)
-    lo_a = np.ascontiguousarray(lo, dtype=np.float64) if isinstance(lo, np.ndarray) else np.array([lo])
-    check = isinstance(t_far, np.ndarray) or t_far < _INF
-    far_a = np.ascontiguousarray(t_far, dtype=np.float64) if isinstance(t_far, np.ndarray) else np.array([t_far])
-    axes = (0, 0.0, 0.0, 0, 0.0, 0.0)
-    if pl.sized:
-        (j1, j2), (h1, h2) = pl.size_axes, pl.half[0].tolist()
-        axes = (j1, h1, float(pl.pt[0, j1] - Oo[0, j1]), j2, h2, float(pl.pt[0, j2] - Oo[0, j2]))
-    t = np.empty(n)
-    reach = packets.library().sp_floor(n, packets.address(D), k, c, num, lo_a.ctypes.data, 1 if isinstance(lo, np.ndarray) else 0,
-                                       far_a.ctypes.data, 1 if isinstance(t_far, np.ndarray) else 0, 1 if check else 0,
-                                       1 if pl.sized else 0, *axes, t.ctypes.data)
-    return None if reach == 0 else (t, None, None)
