@@ -420,29 +420,45 @@ class RayEngine(TierTracer):
             dist = np.empty(n)
             normal = None if distance_only else np.empty((n, 3))
             shape = None if distance_only else np.empty(n, dtype=np.int64)
+            eps64 = 1e-9 + 1e-14 * big
+            pairs = None
+            if movers is not None and isinstance(mount, Mount):
+                # a Mount's pairs, listed for the whole batch up to t_far (a superset of those up to
+                # each ray's nearest static hit), then traced in the blocks beside the static tier
+                # with each ray's own limit: the same hits as tracing them after all blocks
+                pairs = self._mover_pairs(movers, O, D, t_near, t_far,
+                                          t_far if isinstance(t_far, np.ndarray) else np.full(n, t_far), excl, mount)
+                if movers.R is None:
+                    movers.R = self._rot[movers.index]
+                for tier in movers.tiers:
+                    tier.prepare(exact)
 
             def block(sl: slice) -> None:
                 m = sl.stop - sl.start
                 with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # per thread
-                    h = self._cast_static(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
-                                          _param(_take(t_far, sl), m, np.float64, float),
-                                          _param(_take(excl, sl), m, np.int64, int), planes, static, big,
-                                          distance_only, None if directions32 is None else directions32[sl])
-                dist[sl] = h[0]
-                if not distance_only:
-                    shape[sl], normal[sl] = h[1], h[2]
+                    tn, tf = _param(_take(t_near, sl), m, np.float64, float), _param(_take(t_far, sl), m, np.float64, float)
+                    h = self._cast_static(O[sl], D[sl], tn, tf, _param(_take(excl, sl), m, np.int64, int), planes,
+                                          static, big, distance_only, None if directions32 is None else directions32[sl])
+                    dist[sl] = h[0]
+                    if not distance_only:
+                        shape[sl], normal[sl] = h[1], h[2]
+                    if pairs is not None and len(pairs[0]):
+                        pr, pm, tight = pairs
+                        sel = ((pr >= sl.start) & (pr < sl.stop)).nonzero()[0]
+                        if len(sel):
+                            d = dist[sl]
+                            self._trace_pairs(movers, O[sl], D[sl], tn, np.minimum(tf, d), eps64, exact, d,
+                                              None if distance_only else shape[sl],
+                                              None if distance_only else normal[sl], pr[sel] - sl.start, pm[sel],
+                                              tight, split=False)
 
             run(block, parts, threads)
-            if movers is not None:
+            if movers is not None and pairs is None:   # no Mount: the movers after the blocks, in chunks
                 hits = (dist, shape, normal)
-                if isinstance(mount, Mount):
-                    self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits,
-                                      mount=mount)
-                else:
-                    for sl in split(n, 1, _CHUNK):
-                        self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
-                                          1e-9 + 1e-14 * big, exact, *(None if x is None else x[sl] for x in hits),
-                                          mount=None if mount is None else np.asarray(mount)[sl])
+                for sl in split(n, 1, _CHUNK):
+                    self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
+                                      eps64, exact, *(None if x is None else x[sl] for x in hits),
+                                      mount=None if mount is None else np.asarray(mount)[sl])
             return RayHits(dist, normal, shape)
 
     def cast_local(self, body: int, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
@@ -541,14 +557,22 @@ class RayEngine(TierTracer):
                      mount=None) -> None:
         """Broad phase over all movers, then one trace per shared tier over its (ray, mover) pairs
         moved into their body frames; improves dist/shape/normal in place."""
-        n = len(O)
         lim = np.minimum(t_far, dist)
+        pr, pm, tight = self._mover_pairs(mt, O, D, t_near, t_far, lim, excl, mount)
+        if len(pr):
+            self._trace_pairs(mt, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight)
+
+    def _mover_pairs(self, mt: _Movers, O, D, t_near, t_far, lim, excl, mount=None) -> tuple:
+        """(rays, mover rows, tight row) of the (ray, mover) pairs whose segment up to ``lim`` can meet
+        the mover (every test is conservative: a larger ``lim`` gives more pairs, never fewer);
+        ``tight``: a mover row whose pairs are only a Mount's own pairs (tested against its bound
+        when listed), else -1."""
         if mt.epoch != self._epoch:  # poses changed since the last cast (rotations gathered when needed)
             mt.T = self._pos[mt.index]
             mt.R = self._rot[mt.index] if mt.anchored else None
             mt.C = mt.T + np.einsum("mij,mj->mi", mt.R, mt.anchor) if mt.anchored else mt.T
             mt.epoch = self._epoch
-        T, C = mt.T, mt.C
+        C = mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = None
         tight = -1   # a mover row whose pairs are only a Mount's own pairs (already tested against its bound)
@@ -594,8 +618,15 @@ class RayEngine(TierTracer):
                 pm = np.concatenate([pm, mounted[1]])
                 order = np.argsort(pr, kind="stable")
                 pr, pm = pr[order], pm[order]
-        if len(pr) == 0:
-            return
+        return pr, pm, tight
+
+    def _trace_pairs(self, mt: _Movers, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight: int,
+                     split: bool = True) -> None:
+        """One trace per mover (few) or shared tier over the pairs (``pr``, ``pm``, as
+        :meth:`_mover_pairs` gives them), the rays moved into their body frames; improves
+        dist/shape/normal in place. ``split``: large traces in blocks on the engine's threads."""
+        n = len(O)
+        T, C = mt.T, mt.C
         if mt.R is None:
             mt.R = self._rot[mt.index]
         R = mt.R
@@ -646,7 +677,8 @@ class RayEngine(TierTracer):
                         continue
                     Ob = _one_row(Ob[:1], len(keep)) if Ob.strides[0] == 0 else Ob[keep]
                     rr, mm, Db, lim_r = rr[keep], mm[keep], Db[keep], lim_r[keep]
-            res = self._trace_split(tier, Ob, Db, _take(t_near, rr), lim_r, eps64, exact, shape is None)
+            res = (self._trace_split(tier, Ob, Db, _take(t_near, rr), lim_r, eps64, exact, shape is None) if split
+                   else self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact, None, shape is None))
             if res is None:
                 continue
             t, s, nb = res
