@@ -286,3 +286,14 @@ def test_c_refinement_in_a_coarse_float32_frame_gives_the_numpy_answers(monkeypa
         assert a.tobytes() == b.tobytes()
     assert used["nearby"] > 0
 
+
+
+def test_rows_into_a_body_frame_in_c_are_the_engine_sums():
+    """A lidar's beams gathered and turned into its body's frame in one C pass: the bits of
+    ``exact._to_frame`` (small and large batches, a rotation with exact zeros)."""
+    rng = np.random.default_rng(4)
+    D = np.ascontiguousarray(_unit(rng.normal(size=(5000, 3))))
+    for R in (_rot(rng, False), _rot(rng, True)):
+        for k in (65, 3000):
+            rows = np.sort(rng.choice(len(D), k, replace=False)).astype(np.int64)
+            assert packets.to_frame_rows(D, rows, R).tobytes() == exact._to_frame(D.take(rows, axis=0), R).tobytes()

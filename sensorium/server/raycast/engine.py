@@ -122,6 +122,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.blocks import MIN_RAYS, available, run, split
 from sensorium.server.raycast.exact import (
     _CHUNK,
@@ -653,8 +654,12 @@ class RayEngine(TierTracer):
         one_origin = O.strides[0] == 0   # one origin for all rays (a lidar): it stays one, in every frame
         for tier, rr, mm, one in todo:
             # rays into the body frames (float64): one matrix when all pairs share a mover
+            Db = None
             if one and len(rr) == n:   # one mover, every ray (its pairs are then 0..n-1 in order)
                 Or, Dr = O, D
+            elif one and one_origin and len(rr) > _SMALL:   # a lidar's beams: gathered and turned in one pass
+                Or, Dr = _one_row(O[:1], len(rr)), None
+                Db = packets.to_frame_rows(D, rr, R[mm[0]])
             else:
                 Or = _one_row(O[:1], len(rr)) if one_origin else O.take(rr, axis=0)
                 Dr = D.take(rr, axis=0)
@@ -662,7 +667,8 @@ class RayEngine(TierTracer):
                 Rb, Tb = R[mm[0]], T[mm[0]]
                 Ob = (_one_row(_to_frame(_minus(O[:1], Tb), Rb), len(rr)) if one_origin
                       else _to_frame(_minus(Or, Tb), Rb))
-                Db = _to_frame(Dr, Rb)
+                if Db is None:
+                    Db = _to_frame(D.take(rr, axis=0) if Dr is None else Dr, Rb)
             else:
                 Rg = R.take(mm, axis=0)
                 Ob = np.einsum("nij,ni->nj", Rg, Or - T.take(mm, axis=0))

@@ -713,3 +713,13 @@ size_t sp_cone(size_t n, const double* D, const double* v, double thr, int64_t* 
   }
   return k;
 }
+
+/* exact._to_frame of gathered rows: out[i] = x[rows[i]] @ R, each summed (x0 R0j + x1 R1j) + x2 R2j
+ * (no +0.0: the engine's rays into a body frame); rows NULL: every row in order. */
+void sp_to_frame(size_t n, const double* x, const int64_t* rows, const double* R, double* out) {
+  for (size_t i = 0; i < n; i++) {
+    const double* v = x + 3 * (rows ? (size_t)rows[i] : i);
+    double* o = out + 3 * i;
+    for (int j = 0; j < 3; j++) o[j] = v[0] * R[j] + v[1] * R[3 + j] + v[2] * R[6 + j];
+  }
+}

@@ -160,6 +160,8 @@ def _load() -> None:
     f, i64 = ctypes.c_float, ctypes.c_int64
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
                                  i, i, vp, vp, vp, vp]
+    lib.sp_to_frame.restype = None
+    lib.sp_to_frame.argtypes = [sz, vp, vp, vp, vp]
     lib.sp_cone.restype = sz
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
@@ -380,9 +382,21 @@ def cone_rows(D: np.ndarray, v: np.ndarray, thr: float) -> np.ndarray | None:
     n = len(D)
     sc = scratch()
     sc.origin[:] = v
-    if n <= _SCRATCH:
-        k = lib.sp_cone(n, address(D), sc.p_origin, float(thr), sc.p_rows)
-        return sc.rows[:k].copy()
-    out = np.empty(n, dtype=np.int64)
-    k = lib.sp_cone(n, address(D), sc.p_origin, float(thr), out.ctypes.data)
-    return out[:k]
+    if len(sc.rows) < n:   # grown to the largest batch seen (a lidar's): no new pages per scan
+        sc.rows = np.empty(n, dtype=np.int64)
+        sc.p_rows = sc.rows.ctypes.data
+    k = lib.sp_cone(n, address(D), sc.p_origin, float(thr), sc.p_rows)
+    return sc.rows[:k].copy()
+
+
+def to_frame_rows(x: np.ndarray, rows: np.ndarray, R: np.ndarray) -> np.ndarray | None:
+    """``exact._to_frame(x.take(rows, axis=0), R)`` in one C pass (the same sums, the same bits), or
+    None without the helper."""
+    lib = library()
+    if lib is None or x.dtype != np.float64 or not x.flags.c_contiguous or rows.dtype != np.int64:
+        return None
+    out = np.empty((len(rows), 3))
+    rr = np.ascontiguousarray(rows)
+    Rc = np.ascontiguousarray(R, dtype=np.float64)
+    lib.sp_to_frame(len(rows), address(x), rr.ctypes.data, Rc.ctypes.data, out.ctypes.data)
+    return out
