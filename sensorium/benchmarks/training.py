@@ -129,10 +129,15 @@ def _throughput(cfg: Config, sec: Section, gym) -> None:
         f"LidarAvoid x64 {lidar[1]:,.0f}; EXACT costs {100 * (1 - reach_x[1] / reach[1]):.0f} % (ReachLight) and "
         f"{100 * (1 - lidar_x[1] / lidar[1]):.0f} % (LidarAvoid) of FAST's throughput"
         + (f"; MuJoCo Hopper-v5 {hop[1]:,.0f} (a physics step, no sensors)." if hop else "."))
+    from sensorium.server.raycast import packets
+
     sec.findings.append(
-        "What bounds LidarAvoid: 360 beams per env step go through Embree one ray at a time (embreex); at this "
-        "machine's single-thread Embree rate the rays alone cap it well below 5x Hopper -- packets and both cores "
-        "(issue 25's engine work) raise that ceiling, the batched structure is ready for them.")
+        "What bounds LidarAvoid: every copy's rays go out in one cast per ray kind through the engine's packet "
+        f"traversal ({packets.status()}), the hits judged in its C helper: in a profile of 64 copies that is "
+        "about an eighth of a step; the rest is Python around it -- planning the rays, the broad phase over the "
+        "copies' robots, each device model's array operations, driving, contacts, the task's reward and "
+        "observations -- so the ray engine alone cannot reach 5x Hopper: that needs the batched step itself in "
+        "compiled code.")
 
 
 def _scaling(cfg: Config, sec: Section, gym) -> None:

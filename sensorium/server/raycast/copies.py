@@ -15,7 +15,7 @@ One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
 * the mover pass pairs each ray with the bodies of its copy (a dense (rays x slots) bounding-sphere
   test: the copy gives the candidates, no grid), drops its excluded owner and its mount, moves each
   pair into the body's frame with the same float64 products the single world's engine uses for
-  one mover (``(O - T) @ R`` in the engine's summation order, ``exact._to_frame``, so the bits are the engine's), and traces all
+  one mover (``(O - T) @ R`` in the engine's summation order, ``exact._to_frame``, for all pairs at once, so the bits are the engine's), and traces all
   pairs of one template tier in ONE call -- a hundred robots' pairs cost one Embree call, not a
   hundred.
 
@@ -33,7 +33,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from sensorium.server.raycast.engine import RayEngine
-from sensorium.server.raycast.exact import _INF, _PRUNE, _from_frame, _minus, _param, _take, _to_frame
+from sensorium.server.raycast.exact import _INF, _PRUNE, _param, _take
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind
 
 __all__ = ["CopyRays"]
@@ -156,12 +156,14 @@ class CopyRays:
             rows = cand.nonzero()[0]
             if not len(rows):
                 continue
-            rc = copy[rows]
-            rel = centre[rc, r] - O[rows]
-            Dr = D[rows]
+            every = len(rows) == n          # no ray skips this body: the arrays as they are
+            rc = copy if every else copy[rows]
+            rel = np.ascontiguousarray(centre[:, r]).take(rc, axis=0)
+            rel -= O if every else O.take(rows, axis=0)
+            Dr = D if every else D.take(rows, axis=0)
             b = np.einsum("ij,ij->i", rel, Dr)
             e2 = np.einsum("ij,ij->i", rel, rel)
-            tc = np.minimum(np.maximum(b, lo[rows]), lim[rows])
+            tc = np.minimum(np.maximum(b, lo if every else lo[rows]), lim if every else lim[rows])
             near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)).nonzero()[0]
             if len(near):
                 pr_list.append(rows[near])
@@ -174,19 +176,15 @@ class CopyRays:
         # pairs grouped by body, each body's rays in ray order (as the engine's one-mover path sees them)
         order = np.lexsort((pr, pm))
         pr, pm = pr[order], pm[order]
-        cuts = np.flatnonzero(pm[1:] != pm[:-1]) + 1
-        starts = np.concatenate([[0], cuts]).tolist()
-        ends = np.concatenate([cuts, [len(pm)]]).tolist()
-        movers = pm[starts].tolist()
-        Ob = np.empty((len(pr), 3))
-        Db = np.empty((len(pr), 3))
         rotf = rot.reshape(-1, 3, 3)
         posf = pos.reshape(-1, 3)
-        for a, z, m in zip(starts, ends, movers):
-            rows = pr[a:z]
-            Rb, Tb = rotf[m], posf[m]
-            Ob[a:z] = _to_frame(_minus(np.take(O, rows, axis=0), Tb), Rb)    # the engine's summation order
-            Db[a:z] = _to_frame(np.take(D, rows, axis=0), Rb)
+        # every pair into its body's frame at once, each row summed (x0 R0 + x1 R1) + x2 R2 as the
+        # engine's _to_frame sums it for one body (elementwise products and sums: the same bits)
+        Rg = rotf.take(pm, axis=0)
+        x = O.take(pr, axis=0) - posf.take(pm, axis=0)
+        Ob = (x[:, 0:1] * Rg[:, 0] + x[:, 1:2] * Rg[:, 1]) + x[:, 2:3] * Rg[:, 2]
+        x = D.take(pr, axis=0)
+        Db = (x[:, 0:1] * Rg[:, 0] + x[:, 1:2] * Rg[:, 1]) + x[:, 2:3] * Rg[:, 2]
         slot = pm % R
         t_all = np.full(len(pr), _INF)
         s_all = None if distance_only else np.full(len(pr), -1, dtype=np.int64)
@@ -240,8 +238,9 @@ class CopyRays:
         shape = hits.shape.copy()
         normal = hits.normal.copy()
         shape[rows] = self.shape_offset + s_all[w]
-        wm = pm[w]
-        cut = np.flatnonzero(wm[1:] != wm[:-1]) + 1
-        for a, z in zip(np.concatenate([[0], cut]).tolist(), np.concatenate([cut, [len(w)]]).tolist()):
-            normal[rows[a:z]] = _from_frame(n_all[w[a:z]], rotf[wm[a]])   # body frame -> world, as the engine
+        # body frame -> world, each row summed (x0 R[:,0] + x2 R[:,2]) + x1 R[:,1] as the engine's
+        # _from_frame sums it for one body
+        Rw = rotf.take(pm[w], axis=0)
+        x = n_all[w]
+        normal[rows] = (x[:, 0:1] * Rw[:, :, 0] + x[:, 2:3] * Rw[:, :, 2]) + x[:, 1:2] * Rw[:, :, 1]
         return RayHits(dist, normal, shape)

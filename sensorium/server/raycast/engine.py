@@ -13,11 +13,22 @@ Speed (measured in ``sensorium bench``, peers section)
   origin as coherent packets (~3.4x embreex's one ray per call on one thread), everything else as
   incoherent ones (embreex's answers bit for bit; see :mod:`.packets` for the bounded difference
   of coherent packets).  Without a C compiler: embreex, the same answers.
+* Judging in C: with the packet path, the same C helper also judges each tier's hits where the
+  numpy code of :mod:`.trace` and :mod:`.refine` would: FAST's side, self-hit and limit tests
+  (``sp_fast_pass``), and EXACT's whole loop for a tier with edge guards or no risky edge
+  (``sp_exact_pass``: the guards' second look, the float64 plane and barycentric check of flat hits
+  with vertex rings and nearby triangles near edges, the true surface of curved hits, rays continued
+  past rejected hits).  The same formulas in the same order, compiled without fused multiply-adds:
+  the same bits (tests/test_native_judging.py compares them with ``RayEngine.native = False``, the
+  numpy path on the same traversal).  A small cast's fixed cost is then mostly the Python around
+  the calls (a 360-ray FAST scan: ~0.6 M instructions, Embree ~0.25 M of them; callgrind).
 * Threads: a cast of >= ``blocks.MIN_RAYS`` rays runs its planes and static tier in blocks on
   ``RayEngine.threads`` threads (default: the cores this process may use; ``SENSORIUM_THREADS``),
   and so do a lidar's own-body pairs; no ray's answer depends on its block or on the other rays of
-  its batch (world-to-frame rotations are summed in one fixed order, never by BLAS), so the bits
-  are the same on any number of threads.
+  its batch (world-to-frame rotations are summed in one fixed order, never by BLAS; a curved
+  shape's frame as einsum sums it, a sum of zeros being +0.0, whether one shape or several are
+  refined together), so the bits are the same on any number of threads.  No BLAS call runs beside
+  the blocks either (OpenBLAS's own threads fight them: ~10x slower on a busy 2-core machine).
 
 Architecture
 ------------
@@ -111,6 +122,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.blocks import MIN_RAYS, available, run, split
 from sensorium.server.raycast.exact import (
     _CHUNK,
@@ -124,6 +136,7 @@ from sensorium.server.raycast.exact import (
     _from_frame,
     _full,
     _minus,
+    _one_row,
     _param,
     _strictly_increasing,
     _take,
@@ -182,6 +195,7 @@ class RayEngine(TierTracer):
         self._shared: dict[tuple, _Tier | None] = {}   # body-frame tiers by (variant, shapes)
         self._epoch = 0                                 # bumped by every set_body_pose
         self.threads = available()   # threads a large cast may use (see .blocks; 1: the calling thread only)
+        self.native = True   # judge and refine hits in packets.c where the packet path is on (the same answers)
         self._counting = threading.Lock()
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
@@ -407,29 +421,45 @@ class RayEngine(TierTracer):
             dist = np.empty(n)
             normal = None if distance_only else np.empty((n, 3))
             shape = None if distance_only else np.empty(n, dtype=np.int64)
+            eps64 = 1e-9 + 1e-14 * big
+            pairs = None
+            if movers is not None and isinstance(mount, Mount):
+                # a Mount's pairs, listed for the whole batch up to t_far (a superset of those up to
+                # each ray's nearest static hit), then traced in the blocks beside the static tier
+                # with each ray's own limit: the same hits as tracing them after all blocks
+                pairs = self._mover_pairs(movers, O, D, t_near, t_far,
+                                          t_far if isinstance(t_far, np.ndarray) else np.full(n, t_far), excl, mount)
+                if movers.R is None:
+                    movers.R = self._rot[movers.index]
+                for tier in movers.tiers:
+                    tier.prepare(exact)
 
             def block(sl: slice) -> None:
                 m = sl.stop - sl.start
                 with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # per thread
-                    h = self._cast_static(O[sl], D[sl], _param(_take(t_near, sl), m, np.float64, float),
-                                          _param(_take(t_far, sl), m, np.float64, float),
-                                          _param(_take(excl, sl), m, np.int64, int), planes, static, big,
-                                          distance_only, None if directions32 is None else directions32[sl])
-                dist[sl] = h[0]
-                if not distance_only:
-                    shape[sl], normal[sl] = h[1], h[2]
+                    tn, tf = _param(_take(t_near, sl), m, np.float64, float), _param(_take(t_far, sl), m, np.float64, float)
+                    h = self._cast_static(O[sl], D[sl], tn, tf, _param(_take(excl, sl), m, np.int64, int), planes,
+                                          static, big, distance_only, None if directions32 is None else directions32[sl])
+                    dist[sl] = h[0]
+                    if not distance_only:
+                        shape[sl], normal[sl] = h[1], h[2]
+                    if pairs is not None and len(pairs[0]):
+                        pr, pm, tight = pairs
+                        sel = ((pr >= sl.start) & (pr < sl.stop)).nonzero()[0]
+                        if len(sel):
+                            d = dist[sl]
+                            self._trace_pairs(movers, O[sl], D[sl], tn, np.minimum(tf, d), eps64, exact, d,
+                                              None if distance_only else shape[sl],
+                                              None if distance_only else normal[sl], pr[sel] - sl.start, pm[sel],
+                                              tight, split=False)
 
             run(block, parts, threads)
-            if movers is not None:
+            if movers is not None and pairs is None:   # no Mount: the movers after the blocks, in chunks
                 hits = (dist, shape, normal)
-                if isinstance(mount, Mount):
-                    self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits,
-                                      mount=mount)
-                else:
-                    for sl in split(n, 1, _CHUNK):
-                        self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
-                                          1e-9 + 1e-14 * big, exact, *(None if x is None else x[sl] for x in hits),
-                                          mount=None if mount is None else np.asarray(mount)[sl])
+                for sl in split(n, 1, _CHUNK):
+                    self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
+                                      eps64, exact, *(None if x is None else x[sl] for x in hits),
+                                      mount=None if mount is None else np.asarray(mount)[sl])
             return RayHits(dist, normal, shape)
 
     def cast_local(self, body: int, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
@@ -528,14 +558,22 @@ class RayEngine(TierTracer):
                      mount=None) -> None:
         """Broad phase over all movers, then one trace per shared tier over its (ray, mover) pairs
         moved into their body frames; improves dist/shape/normal in place."""
-        n = len(O)
         lim = np.minimum(t_far, dist)
+        pr, pm, tight = self._mover_pairs(mt, O, D, t_near, t_far, lim, excl, mount)
+        if len(pr):
+            self._trace_pairs(mt, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight)
+
+    def _mover_pairs(self, mt: _Movers, O, D, t_near, t_far, lim, excl, mount=None) -> tuple:
+        """(rays, mover rows, tight row) of the (ray, mover) pairs whose segment up to ``lim`` can meet
+        the mover (every test is conservative: a larger ``lim`` gives more pairs, never fewer);
+        ``tight``: a mover row whose pairs are only a Mount's own pairs (tested against its bound
+        when listed), else -1."""
         if mt.epoch != self._epoch:  # poses changed since the last cast (rotations gathered when needed)
             mt.T = self._pos[mt.index]
             mt.R = self._rot[mt.index] if mt.anchored else None
             mt.C = mt.T + np.einsum("mij,mj->mi", mt.R, mt.anchor) if mt.anchored else mt.T
             mt.epoch = self._epoch
-        T, C = mt.T, mt.C
+        C = mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = None
         tight = -1   # a mover row whose pairs are only a Mount's own pairs (already tested against its bound)
@@ -581,8 +619,15 @@ class RayEngine(TierTracer):
                 pm = np.concatenate([pm, mounted[1]])
                 order = np.argsort(pr, kind="stable")
                 pr, pm = pr[order], pm[order]
-        if len(pr) == 0:
-            return
+        return pr, pm, tight
+
+    def _trace_pairs(self, mt: _Movers, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight: int,
+                     split: bool = True) -> None:
+        """One trace per mover (few) or shared tier over the pairs (``pr``, ``pm``, as
+        :meth:`_mover_pairs` gives them), the rays moved into their body frames; improves
+        dist/shape/normal in place. ``split``: large traces in blocks on the engine's threads."""
+        n = len(O)
+        T, C = mt.T, mt.C
         if mt.R is None:
             mt.R = self._rot[mt.index]
         R = mt.R
@@ -609,16 +654,21 @@ class RayEngine(TierTracer):
         one_origin = O.strides[0] == 0   # one origin for all rays (a lidar): it stays one, in every frame
         for tier, rr, mm, one in todo:
             # rays into the body frames (float64): one matrix when all pairs share a mover
+            Db = None
             if one and len(rr) == n:   # one mover, every ray (its pairs are then 0..n-1 in order)
                 Or, Dr = O, D
+            elif one and one_origin and len(rr) > _SMALL:   # a lidar's beams: gathered and turned in one pass
+                Or, Dr = _one_row(O[:1], len(rr)), None
+                Db = packets.to_frame_rows(D, rr, R[mm[0]])
             else:
-                Or = np.broadcast_to(O[:1], (len(rr), 3)) if one_origin else O.take(rr, axis=0)
+                Or = _one_row(O[:1], len(rr)) if one_origin else O.take(rr, axis=0)
                 Dr = D.take(rr, axis=0)
             if one:
                 Rb, Tb = R[mm[0]], T[mm[0]]
-                Ob = (np.broadcast_to(_to_frame(_minus(O[:1], Tb), Rb), Or.shape) if one_origin
+                Ob = (_one_row(_to_frame(_minus(O[:1], Tb), Rb), len(rr)) if one_origin
                       else _to_frame(_minus(Or, Tb), Rb))
-                Db = _to_frame(Dr, Rb)
+                if Db is None:
+                    Db = _to_frame(D.take(rr, axis=0) if Dr is None else Dr, Rb)
             else:
                 Rg = R.take(mm, axis=0)
                 Ob = np.einsum("nij,ni->nj", Rg, Or - T.take(mm, axis=0))
@@ -631,9 +681,10 @@ class RayEngine(TierTracer):
                 if len(keep) < len(rr):
                     if len(keep) == 0:
                         continue
-                    Ob = np.broadcast_to(Ob[:1], (len(keep), 3)) if Ob.strides[0] == 0 else Ob[keep]
+                    Ob = _one_row(Ob[:1], len(keep)) if Ob.strides[0] == 0 else Ob[keep]
                     rr, mm, Db, lim_r = rr[keep], mm[keep], Db[keep], lim_r[keep]
-            res = self._trace_split(tier, Ob, Db, _take(t_near, rr), lim_r, eps64, exact, shape is None)
+            res = (self._trace_split(tier, Ob, Db, _take(t_near, rr), lim_r, eps64, exact, shape is None) if split
+                   else self._trace(tier, Ob, Db, _take(t_near, rr), lim_r, -1, eps64, exact, None, shape is None))
             if res is None:
                 continue
             t, s, nb = res

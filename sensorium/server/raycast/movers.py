@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _minus, _take, _to_frame
 from sensorium.server.world.geometry import Pose
 
@@ -81,24 +82,33 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
     for j in range(M):
         if owner is not None and not isinstance(excl, np.ndarray) and owner[j] == excl:
             continue
+        r = None
         if shared:
             rel = C[j] - O[0]
-            b = D @ rel                              # matrix-vector: fast at any size
             e2 = float(rel @ rel)
             if one and e2 > 2.0 * r2[j]:
                 # one origin well outside the sphere: its rays that pass within it are those
                 # within the sphere's cone, b >= sqrt(e2 - r2) (unit directions), whatever their
                 # limits (a superset: a pair whose segment stops short traces to no hit); the
-                # slack covers the rounding of b
-                sel = b >= math.sqrt(e2 - r2[j]) * (1.0 - 1e-9) - 1e-12 * math.sqrt(e2)
+                # slack covers the rounding of b (so the C pass, summing b its own way, selects
+                # the same rays that can hit)
+                thr = math.sqrt(e2 - r2[j]) * (1.0 - 1e-9) - 1e-12 * math.sqrt(e2)
+                r = packets.cone_rows(D, rel, thr)
+                if r is None:
+                    sel = D @ rel >= thr
             else:
+                b = D @ rel                          # matrix-vector: fast at any size
                 tc = np.minimum(np.maximum(b, t_near), lim)
                 sel = e2 - tc * (b + b - tc) <= r2[j] + 1e-12 * e2
         else:
             sel = _segment_near_sphere(C[j, 0] - ox, C[j, 1] - oy, C[j, 2] - oz, dx, dy, dz, t_near, lim, r2[j])
-        if owner is not None and isinstance(excl, np.ndarray):
-            sel &= excl != owner[j]
-        r = sel.nonzero()[0]
+        if r is not None:
+            if owner is not None and isinstance(excl, np.ndarray):
+                r = r[excl[r] != owner[j]]
+        else:
+            if owner is not None and isinstance(excl, np.ndarray):
+                sel &= excl != owner[j]
+            r = sel.nonzero()[0]
         prs.append(r)
         pms.append(np.full(len(r), j, dtype=np.int64))
     if not prs:

@@ -1,4 +1,5 @@
-/* Packet traversal for the ray engine: Embree's rtcIntersect16 over a batch of rays.
+/* Packet traversal for the ray engine: Embree's rtcIntersect16 over a batch of rays, and the
+ * judging of the hits (below: sp_fast_pass, sp_exact_pass).
  *
  * embreex casts one ray per rtcIntersect1 call. Here the same Embree library (found and opened by
  * packets.py, normally the one embreex itself loaded) traces the batch in packets of 16 with the
@@ -153,5 +154,572 @@ void sp_intersect(void* scene, size_t n, const float* origins, size_t o_stride, 
         ng[3 * i] = hit ? r.ng_x[k] : 0.0f; ng[3 * i + 1] = hit ? r.ng_y[k] : 0.0f; ng[3 * i + 2] = hit ? r.ng_z[k] : 0.0f;
       }
     }
+  }
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * One pass over a tier in C: the traversal above and the judging of its hits that the engine's
+ * numpy code does (trace.py: FAST's _trace_fast/_judge_fast, EXACT's first pass of _trace_loop
+ * with refine.py's float64 refinement), for the rays whose first hit is settled in that pass. A
+ * ray it cannot settle (a guard met first, a hit near a triangle's edge, a refinement that misses,
+ * an excluded owner, a self-hit, a shell left from inside) is flagged and the engine traces it
+ * again on the numpy path, which answers it as it always did (a ray's answer never depends on the
+ * other rays of its batch). So the answers are the numpy path's, bit for bit: the same formulas in
+ * the same order, each operation rounded as numpy rounds it (compiled with -ffp-contract=off, so
+ * no fused multiply-add; float32 where numpy computes in float32, e.g. comparisons of float32
+ * arrays with Python floats).
+ */
+#include <math.h>
+
+/* A tier's arrays (tiers.py, _Tier), read only; `n` triangles, sentinel rows where noted. */
+struct sp_tier {
+  const double* normal;      /* (n+1, 3) unit normals, zero sentinel row */
+  const double* v0;          /* (n, 3) first vertices (EXACT; NULL for FAST) */
+  const double* g1;          /* (n+1, 3) dual basis: barycentric u = (P - v0).g1 (EXACT) */
+  const double* g2;          /* (n+1, 3) ... v = (P - v0).g2 (EXACT) */
+  const double* h_min;       /* (n,) smallest height (EXACT) */
+  const double* V;           /* vertices (float64, tier frame) */
+  const int32_t* F;          /* (n, 3) faces */
+  const int32_t* tri_slot;   /* (n+1,) curved slot of a triangle, -1: flat (and the sentinel) */
+  const int64_t* tri_shape;  /* (n+1,) global shape, sentinel -1 */
+  const int32_t* tri_owner;  /* (n+1,) owner, -2: none */
+  const int64_t* c_code;     /* per curved slot: 1 sphere, 2 cylinder, 3 capsule */
+  const double* c_r;
+  const double* c_h;
+  const double* c_rot;       /* (slots, 3, 3) */
+  const double* c_pos;       /* (slots, 3) */
+  const int64_t* c_shape;
+  const uint8_t* c_isolated;
+  double eps;                /* the tier's self-hit distance and continuation step */
+  double ng_max;             /* largest |Embree Ng| */
+  int64_t guarded;           /* geometry 1 of the scene holds edge guards */
+  /* EXACT only: */
+  const double* e1;          /* (n, 3) edges v1 - v0, v2 - v0 */
+  const double* e2;
+  const double* t_lo;        /* (n, 3) triangle boxes */
+  const double* t_hi;
+  const int64_t* ring_ptr;   /* CSR: the triangles sharing a vertex with triangle i */
+  const int64_t* ring_idx;
+  const int64_t* guard_ptr;  /* CSR: the flat triangles to test for a ray near risky edge e */
+  const int64_t* guard_idx;
+  int64_t n_tri;
+  int64_t prism_triangles;   /* guard prism triangle k guards edge k / prism_triangles */
+  double grow;               /* eps + 8 res: float32 uncertainty of a hit point */
+  void* bare;                /* the EXACT scene without guards */
+};
+
+#define INF_D ((double)INFINITY)
+enum { SPHERE = 1, CYLINDER = 2, CAPSULE = 3 };
+
+/* numpy's minimum and maximum: a NaN in either operand wins (the first one); else b unless a is
+ * strictly smaller (greater) */
+static inline double np_min(double a, double b) { return (a < b || a != a) ? a : b; }
+static inline double np_max(double a, double b) { return (a > b || a != a) ? a : b; }
+static inline double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* A curved shape's frame in and out, as refine._analytic moves rays and normals (einsum's sums:
+ * x @ R summed (x0 R0j + x1 R1j) + x2 R2j, x @ R.T summed (x0 Ri0 + x2 Ri2) + x1 Ri1, each added to
+ * +0.0, so a sum of zeros is +0.0) */
+static inline void to_frame(const double* x, const double* R, double* out) {
+  for (int j = 0; j < 3; j++) out[j] = (x[0] * R[j] + x[1] * R[3 + j] + x[2] * R[6 + j]) + 0.0;
+}
+
+static inline void from_frame(const double* x, const double* R, double* out) {
+  for (int i = 0; i < 3; i++) out[i] = (x[0] * R[3 * i] + x[2] * R[3 * i + 2] + x[1] * R[3 * i + 1]) + 0.0;
+}
+
+/* exact._roots_into for one row */
+static void roots(double a, double b, double c, double disc, double* t) {
+  double s = sqrt(np_max(disc, 0.0));
+  double q = -(b + copysign(s, b));
+  double t1 = q / a, t2 = c / q;
+  if (q == 0.0) t2 = t1;
+  if (disc < 0.0 || !isfinite(t1)) t1 = t2 = INF_D;
+  t[0] = t1;
+  t[1] = t2;
+}
+
+/* exact._sphere_roots_into for one row */
+static void sphere_roots(const double* p, const double* d, double r, double* t) {
+  double a = dot3(d, d), b = dot3(p, d), c = dot3(p, p) - r * r;
+  double x[3] = {p[1] * d[2] - p[2] * d[1], p[2] * d[0] - p[0] * d[2], p[0] * d[1] - p[1] * d[0]};
+  roots(a, b, c, a * r * r - dot3(x, x), t);
+}
+
+/* exact._analytic_local for one row (the vectorised semantics, signed zeros included): the
+ * nearest true-surface hit with lo <= t <= hi in the shape frame; +inf and a zero normal if none
+ * (`n` NULL: the distance only). */
+static double analytic(int64_t code, const double* p, const double* d, double r, double h, double lo, double hi,
+                       double* n) {
+  double ts[6];
+  int k_n = 2;
+  double tol = 1e-12 * (r + h);
+  double pz = p[2], dz = d[2];
+  if (code == SPHERE) {
+    sphere_roots(p, d, r, ts);
+  } else {
+    double px = p[0], py = p[1], dx = d[0], dy = d[1];
+    double a = dx * dx + dy * dy;
+    double x = px * dy - py * dx;
+    roots(a, px * dx + py * dy, px * px + py * py - r * r, a * r * r - x * x, ts);
+    for (int j = 0; j < 2; j++)
+      if (!(fabs(pz + ts[j] * dz) <= h + tol)) ts[j] = INF_D;
+    if (code == CYLINDER) {
+      k_n = 4;
+      for (int j = 0; j < 2; j++) {
+        double c = (j == 0 ? h * 1.0 : h * -1.0);
+        double t = (c - pz) / dz;
+        double cx = px + t * dx, cy = py + t * dy;
+        ts[2 + j] = (isfinite(t) && cx * cx + cy * cy <= r * r + tol * r) ? t : INF_D;
+      }
+    } else {
+      k_n = 6;
+      for (int j = 0; j < 2; j++) {
+        double sign = j == 0 ? 1.0 : -1.0;
+        double pc[3] = {p[0], p[1], pz - sign * h};
+        sphere_roots(pc, d, r, ts + 2 + 2 * j);
+        for (int q = 2 + 2 * j; q < 4 + 2 * j; q++)
+          if (!(sign * (pz + ts[q] * dz) >= h - tol)) ts[q] = INF_D;
+      }
+    }
+  }
+  double t = INF_D;
+  int k = 0;
+  for (int j = 0; j < k_n; j++) {
+    double c = (ts[j] >= lo && ts[j] <= hi) ? ts[j] : INF_D;
+    if (j == 0 || c < t) { t = c; k = j; }     /* argmin: the first of equal candidates */
+  }
+  if (n == NULL) return t;
+  int hit = t < INF_D;
+  double t0 = hit ? t : 0.0;
+  double v[3] = {p[0] + t0 * d[0], p[1] + t0 * d[1], p[2] + t0 * d[2]};
+  if (code == CYLINDER) {
+    double side = k < 2 ? 1.0 : 0.0;
+    v[0] *= side;
+    v[1] *= side;
+    v[2] = (k == 2 ? 1.0 : 0.0) - (k == 3 ? 1.0 : 0.0);
+  } else if (code == CAPSULE) {
+    v[2] -= k < 2 ? v[2] : (k < 4 ? h : -h);
+  }
+  double norm = sqrt(dot3(v, v));
+  for (int j = 0; j < 3; j++) n[j] = hit ? v[j] / norm : 0.0;
+  return t;
+}
+
+/* refine._analytic for one (ray, slot): tier-frame origin o and direction d; the normal back in
+ * the tier frame (NULL: distance only). */
+static double analytic_slot(const struct sp_tier* T, int64_t s, const double* o, const double* d, double lo,
+                            double hi, double* n) {
+  const double* R = T->c_rot + 9 * s;
+  double x[3] = {o[0] - T->c_pos[3 * s], o[1] - T->c_pos[3 * s + 1], o[2] - T->c_pos[3 * s + 2]};
+  double p[3], dl[3], nl[3];
+  to_frame(x, R, p);
+  to_frame(d, R, dl);
+  double t = analytic(T->c_code[s], p, dl, T->c_r[s], T->c_h[s], lo, hi, n ? nl : NULL);
+  if (n) from_frame(nl, R, n);
+  return t;
+}
+
+/* For tests: the analytic hit of m rays on one curved slot each, as analytic_slot computes it. */
+void sp_analytic(const struct sp_tier* T, size_t m, const int64_t* slots, const double* O, const double* D,
+                 const double* lo, const double* hi, double* t, double* n) {
+  for (size_t i = 0; i < m; i++)
+    t[i] = analytic_slot(T, slots[i], O + 3 * i, D + 3 * i, lo[i], hi[i], n ? n + 3 * i : NULL);
+}
+
+static inline void cross3(const double* a, const double* b, double* out) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* exact._moller_trumbore for one (ray, triangle): inside within the barycentric tolerance, and t */
+static int moller_trumbore(const struct sp_tier* T, int64_t tri, const double* o, const double* d, double* t_out) {
+  const double *v0 = T->v0 + 3 * tri, *e1 = T->e1 + 3 * tri, *e2 = T->e2 + 3 * tri;
+  double p[3], q[3], sv[3] = {o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]};
+  cross3(d, e2, p);
+  double inv = 1.0 / dot3(e1, p);
+  double u = dot3(sv, p) * inv;
+  cross3(sv, e1, q);
+  double v = dot3(d, q) * inv;
+  double t = dot3(e2, q) * inv;
+  *t_out = t;
+  return isfinite(t) && u >= -1e-9 && v >= -1e-9 && u + v <= 1.0 + 1e-9;
+}
+
+/* refine._refine_triangles (the hit triangle, else its vertex ring; of equal distances the ring's
+ * last) and, failing both, refine._nearby_triangles (flat triangles whose grown box holds the
+ * Embree hit point at t_e, hits up to t_e + eps; of equal distances the first): 1 and t, tri when
+ * found (tri -1 when nothing near). */
+static int refine_flat(const struct sp_tier* T, int64_t* tri, const double* o, const double* d, double lo, double hi,
+                       double t_e, const int64_t* excl, double* t_out) {
+  double t;
+  if (moller_trumbore(T, *tri, o, d, &t) && t >= lo && t <= hi) { *t_out = t; return 1; }
+  double best = INF_D;
+  int64_t btri = -1;
+  for (int64_t k = T->ring_ptr[*tri]; k < T->ring_ptr[*tri + 1]; k++) {
+    int64_t c = T->ring_idx[k];
+    double tc;
+    int ok = moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= hi;
+    if (!ok) continue;
+    if (tc < best) best = tc;
+  }
+  if (isfinite(best)) {
+    for (int64_t k = T->ring_ptr[*tri]; k < T->ring_ptr[*tri + 1]; k++) {   /* the last candidate at best */
+      int64_t c = T->ring_idx[k];
+      double tc;
+      if (moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= hi && tc == best) btri = c;
+    }
+    *t_out = best;
+    *tri = btri;
+    return 1;
+  }
+  double te = t_e < 1e300 ? t_e : 1e300;
+  double P[3] = {o[0] + te * d[0], o[1] + te * d[1], o[2] + te * d[2]};
+  double top = np_min(hi, t_e + T->eps);
+  const double g = T->grow;
+  best = INF_D;
+  btri = -1;
+  for (int64_t c = 0; c < T->n_tri; c++) {
+    if (T->tri_slot[c] >= 0) continue;
+    const double *a = T->t_lo + 3 * c, *b = T->t_hi + 3 * c;
+    if (!(P[0] >= a[0] - g && P[1] >= a[1] - g && P[2] >= a[2] - g && P[0] <= b[0] + g && P[1] <= b[1] + g &&
+          P[2] <= b[2] + g)) continue;
+    if (excl && T->tri_owner[c] == *excl) continue;
+    double tc;
+    int ok = moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= top;
+    if (!ok) tc = INF_D;
+    if (btri < 0 || tc < best) { best = tc; btri = c; }
+  }
+  *t_out = best;
+  *tri = isfinite(best) ? btri : -1;
+  return isfinite(best);
+}
+
+/* refine._guard_hits for one ray that met the guard prism triangle `gprim`: the flat triangles of
+ * that edge tested in float64; the nearest hit with lo <= t <= hi and t < best_t is taken (of
+ * equal distances the first), and hi becomes it. Returns 1 when one was taken. */
+static int guard_hits(const struct sp_tier* T, int64_t gprim, const double* o, const double* d, double lo, double* hi,
+                      const int64_t* excl, double* best_t, int64_t* best_s, double* best_n) {
+  int64_t e = gprim / T->prism_triangles;
+  double best = INF_D;
+  int64_t btri = -1;
+  for (int64_t k = T->guard_ptr[e]; k < T->guard_ptr[e + 1]; k++) {
+    int64_t c = T->guard_idx[k];
+    if (excl && T->tri_owner[c] == *excl) continue;
+    double t;
+    if (!(moller_trumbore(T, c, o, d, &t) && t >= lo && t <= *hi && t < *best_t)) continue;
+    if (t < best) { best = t; btri = c; }
+  }
+  if (btri < 0) return 0;
+  *best_t = best;
+  *hi = best;
+  if (best_n) {
+    const double* nrm = T->normal + 3 * btri;
+    double f = dot3(nrm, d) > 0.0 ? -1.0 : 1.0;
+    *best_s = T->tri_shape[btri];
+    if (f < 0.0) { best_n[0] = nrm[0] * f; best_n[1] = nrm[1] * f; best_n[2] = nrm[2] * f; }
+    else { best_n[0] = nrm[0]; best_n[1] = nrm[1]; best_n[2] = nrm[2]; }
+  }
+  return 1;
+}
+
+/* One ray through Embree (a packet with one valid lane: the same answer as in any packet). */
+static void intersect1(void* scene, float ox, float oy, float oz, float dx, float dy, float dz, float far,
+                       struct ray_hit16* r, struct intersect_args* args) {
+  int valid[16];
+  for (int k = 0; k < 16; k++) {
+    valid[k] = k == 0 ? -1 : 0;
+    r->org_x[k] = ox; r->org_y[k] = oy; r->org_z[k] = oz;
+    r->dir_x[k] = dx; r->dir_y[k] = dy; r->dir_z[k] = dz;
+    r->tnear[k] = 0.0f; r->time[k] = 0.0f; r->mask[k] = INVALID; r->id[k] = 0; r->flags[k] = 0;
+    r->tfar[k] = far;
+    r->geom[k] = INVALID; r->prim[k] = INVALID; r->inst[k] = INVALID;
+  }
+  intersect16(valid, scene, r, args);
+}
+
+/* EXACT: trace.py's _trace_loop over the rays with alive[i] (a robust scene, incoherent packets),
+ * for a tier with edge guards or no risky edge: each pass judges every hit -- a guard met first
+ * gets refine.py's second look (the guarded edge's triangles in float64, the hit of the scene
+ * without guards, every further guard up to it), flat hits their float64 plane with barycentrics
+ * checked near edges and the triangle's vertex ring or nearby triangles where needed, curved hits
+ * the true surface -- and continues the rays it rejects past their hit, up to 32 passes per ray.
+ * Per ray: the Embree start seg (updated in place as rays continue), lo, lim (after the pre-pass;
+ * updated in place), the owner excluded (`excl` NULL: none in this tier). `thr` = 4 eps d_max.
+ * best_t, best_s, best_n (NULL: distances only) as the numpy loop sets them. Packets are refilled
+ * as rays finish (a ray's answer does not depend on the rays traced beside it).
+ * counts[0] += rays continued, counts[1] += rays unresolved after 32 passes (or 32 guard steps),
+ * counts[2] += float64 hits found by the guards' second look. */
+void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double* O, size_t o_stride,
+                   const double* D, const float* d32, double* seg, const double* lo, size_t lo_stride, double* lim,
+                   const int64_t* excl, size_t excl_stride, const uint8_t* alive, double thr, double* best_t,
+                   int64_t* best_s, double* best_n, size_t* counts) {
+  struct ray_hit16 r, r1;
+  struct intersect_args args;
+  memset(&args, 0, sizeof args);
+  args.feature_mask = INVALID;
+  args.min_width_distance_factor = 1.0f;
+  for (int k = 0; k < 16; k++) {
+    r.tnear[k] = 0.0f; r.time[k] = 0.0f; r.mask[k] = INVALID; r.id[k] = 0; r.flags[k] = 0;
+  }
+  int valid[16];
+  size_t lane_row[16];
+  double lane_delta[16];
+  int lane_pass[16];
+  int lanes = 0;
+  size_t next = 0;
+  const double eps = T->eps;
+  const double slack = 1.0 + 0x1p-20;
+  const double w = 4.0 * eps;
+  for (;;) {
+    while (lanes < 16 && next < m) {   /* refill the packet with the next rays */
+      if (alive[next]) {
+        lane_row[lanes] = next; lane_delta[lanes] = eps; lane_pass[lanes] = 0;
+        lanes++;
+      }
+      next++;
+    }
+    if (lanes == 0) break;
+    double far64[16];
+    for (int k = 0; k < 16; k++) {
+      size_t i = lane_row[k < lanes ? k : 0];
+      const double* o = O + o_stride * i;
+      const double* d = D + 3 * i;
+      double sa = seg[i];
+      valid[k] = k < lanes ? -1 : 0;
+      r.org_x[k] = (float)(o[0] + d[0] * sa);
+      r.org_y[k] = (float)(o[1] + d[1] * sa);
+      r.org_z[k] = (float)(o[2] + d[2] * sa);
+      if (d32) {
+        r.dir_x[k] = d32[3 * i]; r.dir_y[k] = d32[3 * i + 1]; r.dir_z[k] = d32[3 * i + 2];
+      } else {
+        r.dir_x[k] = (float)d[0]; r.dir_y[k] = (float)d[1]; r.dir_z[k] = (float)d[2];
+      }
+      far64[k] = ((lim[i] - sa) + eps) * slack;
+      r.tfar[k] = (float)(far64[k] >= 0.0 ? far64[k] : -1.0);
+      r.geom[k] = INVALID; r.prim[k] = INVALID; r.inst[k] = INVALID;
+    }
+    intersect16(valid, scene, &r, &args);
+    int kept = 0;
+    for (int q = 0; q < lanes; q++) {
+      size_t row = lane_row[q];
+      const double* o = O + o_stride * row;
+      const double* d = D + 3 * row;
+      const int64_t* ex = excl ? excl + excl_stride * row : NULL;
+      double* bn = best_n ? best_n + 3 * row : NULL;
+      int64_t* bs = best_n ? best_s + row : NULL;
+      double sa = seg[row];
+      double lo_i = lo[lo_stride * row];
+      unsigned geom = r.geom[q], prim = r.prim[q];
+      float tf = r.tfar[q], u = r.u[q], v = r.v[q];
+      int cont = 0;
+      if (geom == INVALID) goto done;                           /* no hit: done */
+      if (T->guarded && geom == 1) {   /* a guard first: the second look (refine._guard_rays) */
+        double s = (double)tf;
+        float ox = r.org_x[q], oy = r.org_y[q], oz = r.org_z[q], dx = r.dir_x[q], dy = r.dir_y[q], dz = r.dir_z[q];
+        intersect1(T->bare, ox, oy, oz, dx, dy, dz, (float)(far64[q] >= 0.0 ? far64[q] : -1.0), &r1, &args);
+        double stop = np_min(far64[q], r1.geom[0] != INVALID ? (double)r1.tfar[0] + 4.0 * w : INF_D);
+        counts[2] += guard_hits(T, prim, o, d, lo_i, lim + row, ex, best_t + row, bs, bn);
+        geom = r1.geom[0]; prim = r1.prim[0]; tf = r1.tfar[0]; u = r1.u[0]; v = r1.v[0];
+        int steps = 0;
+        for (; steps < 32; steps++) {
+          s = s + 0.5 * w;
+          double f = stop - s;
+          if (!(f >= 0.0)) break;
+          double at = sa + s;
+          intersect1(scene, (float)(o[0] + at * d[0]), (float)(o[1] + at * d[1]), (float)(o[2] + at * d[2]), dx, dy,
+                     dz, (float)f, &r1, &args);
+          if (r1.geom[0] == INVALID) break;
+          s = s + (double)r1.tfar[0];
+          if (r1.geom[0] == 1) counts[2] += guard_hits(T, r1.prim[0], o, d, lo_i, lim + row, ex, best_t + row, bs, bn);
+        }
+        if (steps == 32) counts[1]++;
+        if (geom == INVALID) goto done;
+      }
+      int64_t tri = (int64_t)prim;
+      double lim_i = lim[row];
+      double t_e = sa + (double)tf;
+      if (ex && T->tri_owner[tri] == *ex) { cont = 1; goto next_pass; }   /* an excluded owner */
+      int32_t slot = T->tri_slot[tri];
+      if (slot < 0) {   /* a flat triangle: its float64 plane, barycentrics checked near edges */
+        const double* nrm = T->normal + 3 * tri;
+        const double* v0 = T->v0 + 3 * tri;
+        double dn = d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2];
+        double wv[3] = {v0[0] - o[0], v0[1] - o[1], v0[2] - o[2]};
+        double tx = dot3(wv, nrm) / dn;
+        int ok = isfinite(tx) && tx >= lo_i && tx <= lim_i;
+        float m1 = (u < v || u != u) ? u : v;                  /* np.minimum in float32 */
+        float m2 = (1.0f - u) - v;
+        float margin = (m1 < m2 || m1 != m1) ? m1 : m2;
+        int near_edge = !(margin > 1e-4f);
+        if (!near_edge && !((double)margin * T->h_min[tri] * fabs(dn) > thr)) {
+          double P[3] = {o[0] + tx * d[0] - v0[0], o[1] + tx * d[1] - v0[1], o[2] + tx * d[2] - v0[2]};
+          double bu = dot3(P, T->g1 + 3 * tri), bv = dot3(P, T->g2 + 3 * tri);
+          near_edge = !(bu >= -1e-9 && bv >= -1e-9 && bu + bv <= 1.0 + 1e-9);
+        }
+        if (near_edge) {   /* float64 tests of the hit triangle, its vertex ring, nearby triangles */
+          ok = refine_flat(T, &tri, o, d, lo_i, lim_i, t_e, ex, &tx);
+          nrm = T->normal + 3 * (tri >= 0 ? tri : T->n_tri);
+          dn = dot3(d, nrm);
+        }
+        if (ok && tx < best_t[row]) {
+          best_t[row] = tx;
+          if (best_n) {
+            double f = dn > 0.0 ? -1.0 : 1.0;
+            best_s[row] = T->tri_shape[tri];
+            best_n[3 * row] = nrm[0] * f; best_n[3 * row + 1] = nrm[1] * f; best_n[3 * row + 2] = nrm[2] * f;
+          }
+        }
+        cont = !ok;                                            /* refinement missed: continued */
+      } else {          /* a curved shell: the true surface */
+        double nw[3];
+        double ta = analytic_slot(T, slot, o, d, lo_i, lim_i, best_n ? nw : NULL);
+        int found = isfinite(ta);
+        if (found && ta < best_t[row]) {
+          best_t[row] = ta;
+          if (best_n) {
+            if (dot3(nw, d) > 0.0) { nw[0] *= -1.0; nw[1] *= -1.0; nw[2] *= -1.0; }
+            best_s[row] = T->c_shape[slot];
+            best_n[3 * row] = nw[0]; best_n[3 * row + 1] = nw[1]; best_n[3 * row + 2] = nw[2];
+          }
+        }
+        lim[row] = np_min(lim_i, found ? ta : INF_D);
+        /* continued if missed, or if something else could lie between the shell and the surface */
+        cont = !found || (ta > t_e + eps && !T->c_isolated[slot]);
+      }
+    next_pass:
+      if (cont) {   /* past the hit: a wider step each time no progress is made */
+        double delta = t_e < sa + eps ? lane_delta[q] * 4.0 : eps;
+        seg[row] = np_max(t_e, sa) + delta;
+        counts[0]++;
+        if (!(seg[row] <= lim[row] + eps)) goto done;
+        if (++lane_pass[q] >= 32) { counts[1]++; goto done; }
+        lane_row[kept] = row; lane_delta[kept] = delta; lane_pass[kept] = lane_pass[q];
+        kept++;
+      }
+    done:;
+    }
+    lanes = kept;
+  }
+}
+
+/* FAST: trace.py's _trace_fast from the Embree call to its judging (_judge_fast, _special): one
+ * plain-scene call (`coherent`: one origin, a lidar), then per ray t = tfar + start (float64),
+ * limited by lim when `lim_min`; shape and normal toward the origin unless `distance_only`; and
+ * special[i] = 1 for the rays the general loop must redo (possible self-hits, a curved shell hit
+ * from inside, an excluded owner). Misses: t = inf, shape -1, a zero normal (-0.0 when most rays
+ * hit, as the numpy path's whole-array judging leaves it). Returns the number of hits.
+ * Per-ray values come as a pointer, or NULL and one value for all rays: the float32 origins o32
+ * (row stride o_stride; NULL: o1, or start32 * d + o1 in float32 when `shifted`, as numpy computes
+ * a lidar's shifted origins), the far limits (NULL: far_value, or none when `far_none`), the tier
+ * frame origins Ot (NULL: `origin`), start, lim, the owner excluded (`has_excl`). */
+size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent, const float* o32, size_t o_stride,
+                    const float* o1, int shifted, float start32, const float* d32, const float* far, float far_value,
+                    int far_none, const double* Ot, size_t ot_stride, const double* origin, const double* D,
+                    const double* start, double start_value, const double* lim, double lim_value, int lim_min,
+                    const int64_t* excl, int64_t excl_value, int has_excl, int distance_only, double* t_out,
+                    int64_t* s_out, double* n_out, uint8_t* special) {
+  struct ray_hit16 r;
+  struct intersect_args args;
+  memset(&args, 0, sizeof args);
+  args.flags = coherent ? QUERY_COHERENT : 0;
+  args.feature_mask = INVALID;
+  args.min_width_distance_factor = 1.0f;
+  int valid[16];
+  for (int k = 0; k < 16; k++) {
+    r.tnear[k] = 0.0f; r.time[k] = 0.0f; r.mask[k] = INVALID; r.id[k] = 0; r.flags[k] = 0;
+  }
+  size_t n_hit = 0;
+  const float eps32 = (float)T->eps;
+  const float graze = (float)(1e-5 * T->ng_max);
+  const float far1 = far_none ? 1e37f : far_value;
+  for (size_t a = 0; a < m; a += 16) {
+    int mk = m - a < 16 ? (int)(m - a) : 16;
+    for (int k = 0; k < 16; k++) {
+      size_t i = a + (k < mk ? (size_t)k : 0);
+      const float* d = d32 + 3 * i;
+      valid[k] = k < mk ? -1 : 0;
+      if (o32) {
+        const float* o = o32 + o_stride * i;
+        r.org_x[k] = o[0]; r.org_y[k] = o[1]; r.org_z[k] = o[2];
+      } else if (shifted) {
+        r.org_x[k] = start32 * d[0] + o1[0]; r.org_y[k] = start32 * d[1] + o1[1]; r.org_z[k] = start32 * d[2] + o1[2];
+      } else {
+        r.org_x[k] = o1[0]; r.org_y[k] = o1[1]; r.org_z[k] = o1[2];
+      }
+      r.dir_x[k] = d[0]; r.dir_y[k] = d[1]; r.dir_z[k] = d[2];
+      r.tfar[k] = far ? far[i] : far1;
+      r.geom[k] = INVALID; r.prim[k] = INVALID; r.inst[k] = INVALID;
+    }
+    intersect16(valid, scene, &r, &args);
+    for (int k = 0; k < mk; k++) {
+      size_t i = a + (size_t)k;
+      special[i] = 0;
+      if (r.geom[k] == INVALID) {
+        t_out[i] = INF_D;
+        if (!distance_only) { s_out[i] = -1; n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0; }
+        continue;
+      }
+      n_hit++;
+      int64_t tri = (int64_t)r.prim[k];
+      float tf = r.tfar[k];
+      double t = (double)tf + (start ? start[i] : start_value);
+      if (lim_min) t = np_min(t, lim ? lim[i] : lim_value);
+      t_out[i] = t;
+      int curved = T->tri_slot[tri] >= 0;
+      int back = 0;
+      if (!distance_only || curved) {   /* the side hit: Embree's Ng has our winding */
+        const float* d = d32 + 3 * i;
+        float dots = r.ng_x[k] * d[0] + r.ng_y[k] * d[1] + r.ng_z[k] * d[2];
+        back = dots > 0.0f;
+        if (fabsf(dots) < graze) back = dot3(T->normal + 3 * tri, D + 3 * i) > 0.0;   /* grazing: float64 */
+      }
+      if (!distance_only) {
+        const double* nrm = T->normal + 3 * tri;
+        s_out[i] = T->tri_shape[tri];
+        if (back) { n_out[3 * i] = nrm[0] * -1.0; n_out[3 * i + 1] = nrm[1] * -1.0; n_out[3 * i + 2] = nrm[2] * -1.0; }
+        else { n_out[3 * i] = nrm[0]; n_out[3 * i + 1] = nrm[1]; n_out[3 * i + 2] = nrm[2]; }
+      }
+      int sp = 0;
+      if (tf < eps32) {   /* possible self-hit: the origin on the triangle's plane */
+        const double* v = T->V + 3 * (size_t)T->F[3 * tri];
+        const double* o = Ot ? Ot + ot_stride * i : origin;
+        double w[3] = {o[0] - v[0], o[1] - v[1], o[2] - v[2]};
+        sp = fabs(dot3(w, T->normal + 3 * tri)) <= 2.0 * T->eps;
+      }
+      if (back && curved) sp = 1;                              /* leaving a curved shell */
+      if (has_excl && T->tri_owner[tri] == (excl ? excl[i] : excl_value)) sp = 1;
+      special[i] = (uint8_t)sp;
+    }
+  }
+  if (!distance_only && 2 * n_hit >= m) {   /* the whole-array judging's misses: -0.0 normals */
+    for (size_t i = 0; i < m; i++)
+      if (s_out[i] < 0) n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = -0.0;
+  }
+  return n_hit;
+}
+
+/* The rows i of the (n,3) directions D with D[i] . v >= thr, into out (ascending); their number.
+ * movers.py's cone test of a lidar's beams against a neighbouring body (a conservative test with
+ * slack: the rounding of the dot product does not matter). */
+size_t sp_cone(size_t n, const double* D, const double* v, double thr, int64_t* out) {
+  size_t k = 0;
+  const double v0 = v[0], v1 = v[1], v2 = v[2];
+  for (size_t i = 0; i < n; i++) {
+    const double* d = D + 3 * i;
+    out[k] = (int64_t)i;
+    k += d[0] * v0 + d[1] * v1 + d[2] * v2 >= thr;
+  }
+  return k;
+}
+
+/* exact._to_frame of gathered rows: out[i] = x[rows[i]] @ R, each summed (x0 R0j + x1 R1j) + x2 R2j
+ * (no +0.0: the engine's rays into a body frame); rows NULL: every row in order. */
+void sp_to_frame(size_t n, const double* x, const int64_t* rows, const double* R, double* out) {
+  for (size_t i = 0; i < n; i++) {
+    const double* v = x + 3 * (rows ? (size_t)rows[i] : i);
+    double* o = out + 3 * i;
+    for (int j = 0; j < 3; j++) o[j] = v[0] * R[j] + v[1] * R[3 + j] + v[2] * R[6 + j];
   }
 }

@@ -14,6 +14,11 @@ of 16. Same library, same scenes, same float32 rays:
   or, in FAST's plain (not watertight) scene, the other side of the edge (0 of the 131,072
   warehouse beams; ~1 % of rays aimed exactly at vertices and edges).
 
+The same helper judges the hits of a pass where trace.py/refine.py would in numpy
+(``sp_fast_pass``, ``sp_exact_pass``; see the engine docstring): compiled with
+``-ffp-contract=off`` and without fast-math, each operation rounds as numpy's does, so the answers
+are the numpy path's bit for bit (tests/test_native_judging.py).
+
 Debian bookworm packages Embree 3.13 (libembree3-3): not needed, as embreex's Embree 4 offers the
 same packet entry points.
 
@@ -87,7 +92,8 @@ def _compile(out: Path) -> str | None:
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=out.parent)
     os.close(fd)
-    cmd = [*cc.split(), "-O2", "-shared", "-fPIC", "-o", tmp, str(_SOURCE)]
+    # no fused multiply-adds and no fast-math: the judging in C rounds every operation as numpy does
+    cmd = [*cc.split(), "-O2", "-ffp-contract=off", "-fno-fast-math", "-shared", "-fPIC", "-o", tmp, str(_SOURCE), "-lm"]
     if sys.platform.startswith("linux"):
         cmd.append("-ldl")
     try:
@@ -147,6 +153,19 @@ def _load() -> None:
     lib.sp_release_scene.argtypes = [vp]
     lib.sp_intersect.restype = None
     lib.sp_intersect.argtypes = [vp, sz, vp, sz, vp, vp, i, i]
+    d = ctypes.c_double
+    lib.sp_exact_pass.restype = None
+    lib.sp_exact_pass.argtypes = [vp, vp, sz, vp, sz, vp, vp, vp, vp, sz, vp, vp, sz, vp, d, vp, vp, vp, vp]
+    lib.sp_fast_pass.restype = sz
+    f, i64 = ctypes.c_float, ctypes.c_int64
+    lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
+                                 i, i, vp, vp, vp, vp]
+    lib.sp_to_frame.restype = None
+    lib.sp_to_frame.argtypes = [sz, vp, vp, vp, vp]
+    lib.sp_cone.restype = sz
+    lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
+    lib.sp_analytic.restype = None
+    lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
     _state["lib"] = lib
     _state["embree"] = embree
 
@@ -258,3 +277,126 @@ class Scene:
             res.update(geomID=out[2 * n:3 * n].view(np.int32), u=out[3 * n:4 * n], v=out[4 * n:5 * n],
                        Ng=out[5 * n:].reshape(n, 3))
         return res
+
+
+class TierArrays(ctypes.Structure):
+    """``struct sp_tier`` of packets.c: pointers to a tier's arrays (see :func:`tier_arrays`)."""
+
+    _fields_ = [(name, ctypes.c_void_p) for name in (
+        "normal", "v0", "g1", "g2", "h_min", "V", "F", "tri_slot", "tri_shape", "tri_owner", "c_code", "c_r", "c_h",
+        "c_rot", "c_pos", "c_shape", "c_isolated")] + [("eps", ctypes.c_double), ("ng_max", ctypes.c_double),
+                                                       ("guarded", ctypes.c_int64)] + [
+        (name, ctypes.c_void_p) for name in ("e1", "e2", "t_lo", "t_hi", "ring_ptr", "ring_idx", "guard_ptr",
+                                             "guard_idx")] + [
+        ("n_tri", ctypes.c_int64), ("prism_triangles", ctypes.c_int64), ("grow", ctypes.c_double),
+        ("bare", ctypes.c_void_p)]
+
+
+def tier_arrays(tier, exact: bool):
+    """(struct, address, arrays kept alive) describing ``tier`` (a :class:`.tiers._Tier`) to the
+    judging passes of packets.c; ``exact``: with the float64 refinement data."""
+    keep = []
+
+    def ptr(a, dtype):
+        a = np.ascontiguousarray(a, dtype=dtype)
+        keep.append(a)
+        return a.ctypes.data
+
+    f64, i32, i64 = np.float64, np.int32, np.int64
+    st = TierArrays(
+        normal=ptr(tier.normal, f64), V=ptr(tier.V, f64), F=ptr(tier.F, i32), tri_slot=ptr(tier.tri_slot, i32),
+        tri_shape=ptr(tier.tri_shape, i64), tri_owner=ptr(tier.tri_owner, i32),
+        c_code=ptr(tier.c_code, i64), c_r=ptr(tier.c_r, f64), c_h=ptr(tier.c_h, f64),
+        c_rot=ptr(tier.c_rot, f64), c_pos=ptr(tier.c_pos, f64), c_shape=ptr(tier.c_shape, i64),
+        c_isolated=ptr(tier.c_isolated, np.uint8), eps=tier.eps, ng_max=tier.ng_max,
+        guarded=int(exact and tier.guard is not None))
+    if exact:
+        from sensorium.server.raycast.guards import PRISM_TRIANGLES
+
+        st.v0, st.g1, st.g2, st.h_min = (ptr(tier.v0, f64), ptr(tier.g1, f64), ptr(tier.g2, f64),
+                                          ptr(tier.h_min, f64))
+        st.e1, st.e2, st.t_lo, st.t_hi = (ptr(tier.e1, f64), ptr(tier.e2, f64), ptr(tier.t_lo, f64),
+                                          ptr(tier.t_hi, f64))
+        st.ring_ptr, st.ring_idx = ptr(tier.ring[0], i64), ptr(tier.ring[1], i64)
+        st.n_tri, st.prism_triangles, st.grow = len(tier.F), PRISM_TRIANGLES, tier.eps + 8.0 * tier.res
+        guard = tier.guard
+        if guard is not None:
+            st.guard_ptr, st.guard_idx = ptr(guard[1], i64), ptr(guard[2], i64)
+            bare = tier.bare_scene()
+            keep.append(bare)
+            st.bare = bare.handle
+    return st, ctypes.addressof(st), keep
+
+
+_tls = threading.local()
+
+
+class Scratch:
+    """A thread's buffers for the judging passes of small casts (up to ``_SCRATCH`` rays): outputs
+    and one-origin rows at addresses known once, so a call converts no array to a pointer."""
+
+    def __init__(self) -> None:
+        n = _SCRATCH
+        self.t, self.s, self.n = np.empty(n), np.empty(n, dtype=np.int64), np.empty((n, 3))
+        self.sp, self.rows = np.empty(n, dtype=np.uint8), np.empty(n, dtype=np.int64)
+        self.o1, self.origin = np.empty(3, dtype=np.float32), np.empty(3)
+        self.p_t, self.p_s, self.p_n, self.p_sp, self.p_rows, self.p_o1, self.p_origin = (
+            a.ctypes.data for a in (self.t, self.s, self.n, self.sp, self.rows, self.o1, self.origin))
+
+
+def scratch() -> Scratch:
+    """This thread's :class:`Scratch`."""
+    sc = getattr(_tls, "scratch", None)
+    if sc is None:
+        sc = _tls.scratch = Scratch()
+    return sc
+
+
+SCRATCH = _SCRATCH
+
+
+def address(a: np.ndarray) -> int:
+    """``a.ctypes.data`` (~1 us), remembered for the last few small arrays this thread passed (a
+    lidar's beams, cast scan after scan); those arrays are kept alive meanwhile."""
+    if a.nbytes > 65536:   # large arrays: not kept (the conversion is small beside their cast)
+        return a.ctypes.data
+    cache = getattr(_tls, "addresses", None)
+    if cache is None:
+        cache = _tls.addresses = {}
+    got = cache.get(id(a))
+    if got is not None and got[0] is a:
+        return got[1]
+    p = a.ctypes.data
+    if len(cache) >= 8:
+        cache.clear()
+    cache[id(a)] = (a, p)
+    return p
+
+
+def cone_rows(D: np.ndarray, v: np.ndarray, thr: float) -> np.ndarray | None:
+    """Indices of the rows of the (n,3) float64 directions D with D . v >= thr (one pass in C), or
+    None without the helper."""
+    lib = library()
+    if lib is None or D.dtype != np.float64 or not D.flags.c_contiguous:
+        return None
+    n = len(D)
+    sc = scratch()
+    sc.origin[:] = v
+    if len(sc.rows) < n:   # grown to the largest batch seen (a lidar's): no new pages per scan
+        sc.rows = np.empty(n, dtype=np.int64)
+        sc.p_rows = sc.rows.ctypes.data
+    k = lib.sp_cone(n, address(D), sc.p_origin, float(thr), sc.p_rows)
+    return sc.rows[:k].copy()
+
+
+def to_frame_rows(x: np.ndarray, rows: np.ndarray, R: np.ndarray) -> np.ndarray | None:
+    """``exact._to_frame(x.take(rows, axis=0), R)`` in one C pass (the same sums, the same bits), or
+    None without the helper."""
+    lib = library()
+    if lib is None or x.dtype != np.float64 or not x.flags.c_contiguous or rows.dtype != np.int64:
+        return None
+    out = np.empty((len(rows), 3))
+    rr = np.ascontiguousarray(rows)
+    Rc = np.ascontiguousarray(R, dtype=np.float64)
+    lib.sp_to_frame(len(rows), address(x), rr.ctypes.data, Rc.ctypes.data, out.ctypes.data)
+    return out

@@ -234,16 +234,25 @@ class Refiner:
 
     def _analytic(self, tier: _Tier, slots, Ot, D, lo, hi, normals=True):
         """True-surface hit of curved shapes (tier-frame rays): (t, tier-frame unit normal); the
-        normal None without ``normals`` (the same t)."""
+        normal None without ``normals`` (the same t). The frames in and out are einsum's sums, whose
+        sum of zeros is +0.0: the one-shape path adds +0.0 to its sums for the same bits (the sign of
+        a zero in the shape frame can decide which rounding of a root is taken), so a ray's answer
+        does not depend on the other rays refined with it (and packets.c computes the same)."""
         n = len(slots)
         lo, hi = _full(lo, n), _full(hi, n)
         if n and not np.count_nonzero(slots != slots[0]):   # one shape: one matrix
             s0 = int(slots[0])
             R = tier.c_rot[s0]
             p = _to_frame(_minus(Ot, tier.c_pos[s0]), R)   # R^T (o - c)
+            p += 0.0
             d = _to_frame(D, R)
+            d += 0.0
             t, n_loc = _analytic_local(int(tier.c_code[s0]), p, d, tier.c_r[s0], tier.c_h[s0], lo, hi, normals)
-            return t, (None if n_loc is None else _from_frame(n_loc, R))
+            if n_loc is None:
+                return t, None
+            nw = _from_frame(n_loc, R)
+            nw += 0.0
+            return t, nw
         R = tier.c_rot[slots]
         p = np.einsum("nij,ni->nj", R, Ot - tier.c_pos[slots])  # R^T (o - c)
         d = np.einsum("nij,ni->nj", R, D)
@@ -381,13 +390,17 @@ class Refiner:
             oi = Ot[i]
             ox, oy, oz = oi[0] - c0, oi[1] - c1, oi[2] - c2
             dx, dy, dz = D[i]
+            # into the shape frame and back as einsum sums (see _analytic): + 0.0 makes a sum of zeros +0.0
             t, (nx, ny, nz) = _analytic_one(
-                code, (ox * r0 + oy * r3 + oz * r6, ox * r1 + oy * r4 + oz * r7, ox * r2 + oy * r5 + oz * r8),
-                (dx * r0 + dy * r3 + dz * r6, dx * r1 + dy * r4 + dz * r7, dx * r2 + dy * r5 + dz * r8),
+                code, ((ox * r0 + oy * r3 + oz * r6) + 0.0, (ox * r1 + oy * r4 + oz * r7) + 0.0,
+                       (ox * r2 + oy * r5 + oz * r8) + 0.0),
+                ((dx * r0 + dy * r3 + dz * r6) + 0.0, (dx * r1 + dy * r4 + dz * r7) + 0.0,
+                 (dx * r2 + dy * r5 + dz * r8) + 0.0),
                 r, h, lo if lo_l is None else float(lo_l[i]), lim if lim_l is None else float(lim_l[i]))
             if t < _INF and (i not in found or t < found[i][0]):
                 # R n, summed (0 + 2) + 1 as einsum("nij,nj->ni") does for the vectorised pre-pass
-                n = (r0 * nx + r2 * nz + r1 * ny, r3 * nx + r5 * nz + r4 * ny, r6 * nx + r8 * nz + r7 * ny)
+                n = ((r0 * nx + r2 * nz + r1 * ny) + 0.0, (r3 * nx + r5 * nz + r4 * ny) + 0.0,
+                     (r6 * nx + r8 * nz + r7 * ny) + 0.0)
                 if n[0] * dx + n[1] * dy + n[2] * dz > 0.0:   # toward the origin
                     n = (-n[0], -n[1], -n[2])
                 found[i] = (t, sid, n)

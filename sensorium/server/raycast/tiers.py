@@ -184,6 +184,7 @@ class _Tier:
         self._f32 = F
         self._device = device
         self._scenes: dict[bool | str, object] = {}
+        self._native: dict[bool, tuple] = {}   # per mode: the tier described to packets.c's judging passes
 
     def _exact_data(self) -> dict[str, np.ndarray]:
         """Per-triangle float64 data of the refinement, computed once on first use (EXACT, or a
@@ -264,6 +265,17 @@ class _Tier:
             _ = self.ring
             if self.guard is not None:
                 self.bare_scene()
+        self.native(exact)
+
+    def native(self, exact: bool) -> int | None:
+        """Address of this tier's ``struct sp_tier`` for the judging passes of packets.c (made once
+        per mode), or None where its scenes are embreex's. EXACT's needs the refinement data."""
+        got = self._native.get(exact)
+        if got is None:
+            if not isinstance(self._device, packets.Device):
+                return None
+            got = self._native[exact] = packets.tier_arrays(self, exact)
+        return got[1]
 
     def scene(self, robust: bool):
         """(Embree scene, built now?).  FAST uses a plain scene, EXACT a robust one (watertight

@@ -17,6 +17,7 @@ from sensorium.server.raycast.exact import (
     _dot,
     _full,
     _minus,
+    _one_row,
     _perpendicular,
     _rows,
     _start32,
@@ -26,10 +27,35 @@ from sensorium.server.raycast.refine import Refiner
 from sensorium.server.raycast.tiers import _Tier
 
 
+def _vec(x, dtype=np.float64) -> tuple:
+    """(array kept alive, address, stride in elements) of a per-ray parameter that may be a scalar
+    (stride 0: one value for every ray)."""
+    if isinstance(x, np.ndarray):
+        a = np.ascontiguousarray(x, dtype=dtype)
+        return a, a.ctypes.data, 1
+    a = np.array([x], dtype=dtype)
+    return a, a.ctypes.data, 0
+
+
+def _rows_of(O: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """O[rows], one origin (a broadcast array) kept one."""
+    return _one_row(O[:1], len(rows)) if O.strides[0] == 0 and len(O) else O[rows]
+
+
+def _rows_ptr(x: np.ndarray) -> tuple:
+    """(array kept alive, address, row stride in elements) of (m,3) float64 rows, possibly one
+    broadcast row (stride 0)."""
+    if x.strides[0] == 0 and x.strides[1] == 8 and x.dtype == np.float64:
+        return x, x.ctypes.data, 0
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    return a, a.ctypes.data, 3
+
+
 class TierTracer(Refiner):
     """Per-tier tracing methods of :class:`~sensorium.server.raycast.engine.RayEngine`."""
 
     counters: dict[str, int]
+    native: bool   # judge (and in EXACT refine) hits in packets.c where the packet path is on
 
     def _run(self, tier: _Tier, o32, d32, far, robust: bool, coherent: bool = False):
         """One Embree call; ``coherent``: rays from one origin (a FAST lidar scan), traced as coherent
@@ -68,7 +94,7 @@ class TierTracer(Refiner):
         m = len(O)
         one = m > 1 and O.strides[0] == 0   # one origin for every ray (a broadcast array: a lidar)
         if tier.anchored:   # (the same subtraction for one origin as for each row)
-            Ot = np.broadcast_to(_minus(O[:1], tier.anchor), O.shape) if one else _minus(O, tier.anchor)
+            Ot = _one_row(_minus(O[:1], tier.anchor), m) if one else _minus(O, tier.anchor)
         else:
             Ot = O
         pre = None
@@ -80,9 +106,11 @@ class TierTracer(Refiner):
             if pre is not None:  # the cast only needs to look before the analytic hits
                 lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, lim)
                 lim[pre[0]] = np.minimum(lim[pre[0]], pre[1])
-        # one origin: a read-only broadcast of its float32 row until something must be written
+        # one origin: its float32 row o1, as a read-only broadcast o32 once needed (the C pass takes
+        # o1 and the start itself: see _fast_native)
+        native = self.native and m > 0 and tier.native(False) is not None
         o1 = Ot[:1].astype(_F32) if one else None
-        o32 = np.broadcast_to(o1, Ot.shape) if one else Ot.astype(_F32)
+        o32 = None if one else Ot.astype(_F32)
         shared = one
         d32 = D.astype(_F32) if d32 is None else d32   # never written
         start = t_near
@@ -91,6 +119,8 @@ class TierTracer(Refiner):
             ob = o1 if one else o32
             big = max(map(abs, ob.ravel().tolist())) if len(ob) <= _SMALL else max(-float(ob.min()), float(ob.max()))
         if big * 1.7321 > tier.radius:
+            if o32 is None:
+                o32 = _one_row(o1, m)
             far_rows = (_dot(o32, o32) > _F32(tier.radius * tier.radius)).nonzero()[0]
             if len(far_rows):  # origin outside the tier's sphere: start at its entry (precision)
                 if shared:
@@ -105,16 +135,20 @@ class TierTracer(Refiner):
                 dead = far_rows[q2 > tier.radius ** 2]
                 o32 += start[:, None] * d32
                 o32[far_rows] = Of + start[far_rows][:, None] * Df
+        shifted = False   # o32 = float32(start) d32 + o1, made in the C pass
         if not isinstance(start, np.ndarray):
             if start > 0.0 and shared:   # o + s d in float32 (the same sum, operands swapped)
-                o32 = _F32(start) * d32
-                o32 += o1
+                if native and o32 is None:
+                    shifted = True
+                else:
+                    o32 = _F32(start) * d32
+                    o32 += o1
                 shared = False
             elif start > 0.0:
                 o32 += _F32(start) * d32
         elif dead is None:
             if shared:
-                o32, shared = o32.copy(), False
+                o32, shared = (_one_row(o1, m) if o32 is None else o32).copy(), False
             o32 += start[:, None] * d32
         slack = 1.0 + 2.0 ** -20  # float32 slack so a hit exactly at t_far counts
         if (dead is None or not len(dead)) and (isinstance(lim, np.ndarray) or isinstance(start, np.ndarray)):
@@ -132,13 +166,23 @@ class TierTracer(Refiner):
                 far = None
             else:
                 far = float(far)
-        res = self._run(tier, o32, d32, far, robust=False, coherent=one)
-        prim = res["primID"]
-        hit = prim >= 0
-        n_hit = np.count_nonzero(hit)
-        if n_hit == 0 and pre is None:
-            return None   # no hit at all (the common case for short sensor rays)
-        if 2 * n_hit >= m:  # mostly hits: whole arrays, misses masked (primID -1 picks the
+        if native:   # traversal and judging in one C call (the same values)
+            n_hit, t, shape, normal, redo = self._fast_native(tier, Ot, D, o32, o1, shifted, d32, far, one, start, lim,
+                                                              excl, distance_only)
+            if n_hit == 0 and pre is None:
+                return None
+        else:
+            if o32 is None:
+                o32 = _one_row(o1, m)
+            res = self._run(tier, o32, d32, far, robust=False, coherent=one)
+            prim = res["primID"]
+            hit = prim >= 0
+            n_hit = np.count_nonzero(hit)
+            if n_hit == 0 and pre is None:
+                return None   # no hit at all (the common case for short sensor rays)
+        if native:
+            pass
+        elif 2 * n_hit >= m:  # mostly hits: whole arrays, misses masked (primID -1 picks the
             # sentinel rows: shape -1, zero normal)
             (t, normal), redo = self._judge_fast(tier, Ot, D, d32, res, prim, slice(None), start, lim, excl,
                                                  distance_only)
@@ -164,7 +208,7 @@ class TierTracer(Refiner):
             redo[pre[0][pre[1] <= t[pre[0]]]] = False
         if redo is not None and np.count_nonzero(redo):
             rows = redo.nonzero()[0]
-            t2, s2, n2 = self._trace_loop(tier, O[rows], D[rows], _take(t_near, rows), _take(lim_in, rows),
+            t2, s2, n2 = self._trace_loop(tier, _rows_of(O, rows), D[rows], _take(t_near, rows), _take(lim_in, rows),
                                           _take(excl, rows), eps64, exact=False)
             t[rows] = t2
             if not distance_only:
@@ -184,6 +228,96 @@ class TierTracer(Refiner):
                 if not distance_only:
                     shape[r], normal[r] = sp[take], np_[take]
         return t, shape, normal
+
+    def _fast_native(self, tier: _Tier, Ot, D, o32, o1, shifted: bool, d32, far, one: bool, start, lim, excl,
+                     distance_only: bool):
+        """FAST's Embree call and judging (``_judge_fast``, ``_special``) in one call of packets.c:
+        (hits, t, shape, normal, redo mask or None), the values of the numpy path. ``o32`` None: one
+        origin ``o1``, shifted by ``start`` along each ray when ``shifted``. A small cast writes into
+        the thread's scratch buffers and passes no array it did not pass before (a lidar's beams):
+        its fixed cost is the call."""
+        scene, built = tier.scene(False)
+        if built:
+            self._count("bvh_builds", built)
+        self._count("embree_calls", 1)
+        m = len(d32)
+        sc = packets.scratch()
+        small = m <= packets.SCRATCH
+        addr = packets.address if small else (lambda a: a.ctypes.data)
+        if not (d32.flags.c_contiguous and d32.dtype == _F32):
+            d32 = np.ascontiguousarray(d32, dtype=_F32)
+        if o32 is None:
+            sc.o1[:] = o1[0]
+            o_ptr, o_stride = None, 0
+        elif o32.strides[0] == 0:
+            sc.o1[:] = o32[0]
+            o_ptr, o_stride = None, 0
+        else:
+            o32 = np.ascontiguousarray(o32, dtype=_F32)
+            o_ptr, o_stride = o32.ctypes.data, 3
+        if isinstance(far, np.ndarray):
+            far = np.ascontiguousarray(far, dtype=_F32)
+            far_ptr, far_value = far.ctypes.data, 0.0
+        else:
+            far_ptr, far_value = None, 0.0 if far is None else far
+        if Ot.strides[0] == 0:
+            sc.origin[:] = Ot[0]
+            ot_ptr, ot_stride = None, 0
+        else:
+            ot = _rows_ptr(Ot)
+            ot_ptr, ot_stride = ot[1], ot[2]
+        dd = D if D.flags.c_contiguous else np.ascontiguousarray(D)
+        st_arr = np.ascontiguousarray(start, dtype=np.float64) if isinstance(start, np.ndarray) else None
+        lim_arr = np.ascontiguousarray(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else None
+        has_excl = tier.owned and not (not isinstance(excl, np.ndarray) and excl < 0)
+        ex_arr = np.ascontiguousarray(excl, dtype=np.int64) if has_excl and isinstance(excl, np.ndarray) else None
+        if small:
+            p_t, p_s, p_n, p_sp = sc.p_t, sc.p_s, sc.p_n, sc.p_sp
+        else:
+            t, special = np.empty(m), np.empty(m, dtype=np.uint8)
+            shape = None if distance_only else np.empty(m, dtype=np.int64)
+            normal = None if distance_only else np.empty((m, 3))
+            p_t, p_sp = t.ctypes.data, special.ctypes.data
+            p_s, p_n = (None, None) if distance_only else (shape.ctypes.data, normal.ctypes.data)
+        n_hit = packets.library().sp_fast_pass(
+            scene.handle, tier.native(False), m, 1 if one else 0, o_ptr, o_stride, sc.p_o1, 1 if shifted else 0,
+            _F32(start) if shifted else 0.0, addr(d32), far_ptr, far_value, 1 if far is None else 0, ot_ptr,
+            ot_stride, sc.p_origin, addr(dd), None if st_arr is None else st_arr.ctypes.data,
+            0.0 if st_arr is not None else start, None if lim_arr is None else lim_arr.ctypes.data,
+            0.0 if lim_arr is not None else lim, 1 if isinstance(lim, np.ndarray) or lim != _INF else 0,
+            None if ex_arr is None else ex_arr.ctypes.data, 0 if ex_arr is not None or not has_excl else excl,
+            1 if has_excl else 0, 1 if distance_only else 0, p_t, p_s, p_n, p_sp)
+        if small:
+            t = sc.t[:m].copy()
+            shape = None if distance_only else sc.s[:m].copy()
+            normal = None if distance_only else sc.n[:m].copy()
+            special = sc.sp[:m]
+        redo = special.view(bool)
+        return n_hit, t, shape, normal, (redo.copy() if np.count_nonzero(redo) else None)
+
+    def _exact_native(self, tier: _Tier, st: int, Ot, D, d32, seg, lo, lim, excl, alive, thr: float, best_t, best_s,
+                      best_n, distance_only: bool) -> None:
+        """EXACT's ``_trace_loop`` in packets.c for a tier with edge guards or no risky edge: robust
+        scene, incoherent packets, the guards' second look, the float64 refinement of flat hits
+        (vertex rings and nearby triangles near edges) and curved hits, rays continued past rejected
+        hits; updates ``best_*`` (and ``seg``, ``lim``) as the numpy loop does."""
+        scene, built = tier.scene(True)
+        self._count("bvh_builds", built)
+        self._count("embree_calls", 1)
+        m = len(D)
+        ot = _rows_ptr(Ot)
+        dd = np.ascontiguousarray(D, dtype=np.float64)
+        d32 = None if d32 is None or len(d32) != m else np.ascontiguousarray(d32, dtype=_F32)
+        ex = None if excl is None else _vec(excl, np.int64)
+        counts = np.zeros(3, dtype=np.uintp)
+        packets.library().sp_exact_pass(
+            scene.handle, st, m, ot[1], ot[2], dd.ctypes.data, None if d32 is None else d32.ctypes.data,
+            seg.ctypes.data, lo.ctypes.data, 1, lim.ctypes.data, None if ex is None else ex[1],
+            0 if ex is None else ex[2], alive.ctypes.data, thr, best_t.ctypes.data, best_s.ctypes.data,
+            None if distance_only else best_n.ctypes.data, counts.ctypes.data)
+        for key, k in (("continued_rays", 0), ("unresolved_rays", 1), ("edge_guard_hits", 2)):
+            if counts[k]:
+                self._count(key, int(counts[k]))
 
     def _judge_fast(self, tier: _Tier, Ot, D, d32, res, ph, rows, start, lim, excl, distance_only=False):
         """FAST hit data of the Embree results at ``rows`` (a slice of all rays, or an index array
@@ -277,11 +411,11 @@ class TierTracer(Refiner):
         on the true surface; FAST keeps Embree's answer except self-hits and shells left from
         inside.  Returns (t, shape, normal oriented toward the origin); ``distance_only``: the shape
         and normal of flat hits are left unset (the same t); ``d32_all``: ``D`` as float32, if the
-        caller has it."""
+        caller has it).  EXACT runs in packets.c where the packet path is on (``_exact_native``)."""
         m = len(O)
         eps = tier.eps
         if tier.anchored:   # one origin (a broadcast array) stays one
-            Ot = np.broadcast_to(O[:1] - tier.anchor, O.shape) if O.strides[0] == 0 and m else _minus(O, tier.anchor)
+            Ot = _one_row(O[:1] - tier.anchor, m) if O.strides[0] == 0 and m else _minus(O, tier.anchor)
         else:
             Ot = O
         if isinstance(t_near, np.ndarray):       # accepted hits: lo <= t <= lim
@@ -318,10 +452,16 @@ class TierTracer(Refiner):
                 best_t[rows], best_s[rows], best_n[rows] = tp, sp, np_
                 np.minimum(lim, best_t, out=lim)
 
-        act = alive.nonzero()[0]
         one_origin = Ot.strides[0] == 0 and m > 0   # a broadcast array: one origin for all rays
         if exact:   # bound of |d| (the float32 reach below scales with it): sqrt(3) max |component|
             d_max = 1.7321 * max(float(D.max()), -float(D.min())) if m else 0.0
+            if self.native and m and tier.guarded:
+                st = tier.native(True)
+                if st is not None:   # the passes in C
+                    self._exact_native(tier, st, Ot, D, d32_all, seg, lo, lim, excl_arr, alive, 4.0 * eps * d_max,
+                                       best_t, best_s, best_n, distance_only)
+                    return best_t, best_s, best_n
+        act = alive.nonzero()[0]
         delta = None   # per-ray continuation step, allocated on the first continuation
         for _ in range(_MAX_LOOPS):
             if len(act) == 0:
