@@ -77,6 +77,17 @@ void* sp_new_device(void) { return new_device(NULL); }
 
 void sp_release_device(void* device) { release_device(device); }
 
+/* A packet's query arguments and the lanes' constant fields (tnear 0, every mask bit, no time). */
+static void packet_init(struct ray_hit16* r, struct intersect_args* args, int coherent) {
+  memset(args, 0, sizeof *args);
+  args->flags = coherent ? QUERY_COHERENT : 0;
+  args->feature_mask = INVALID;
+  args->min_width_distance_factor = 1.0f;
+  for (int k = 0; k < 16; k++) {
+    r->tnear[k] = 0.0f; r->time[k] = 0.0f; r->mask[k] = INVALID; r->id[k] = 0; r->flags[k] = 0;
+  }
+}
+
 static int add_triangles(void* device, void* scene, size_t nv, const float* vertices, size_t nf, const int32_t* faces) {
   void* g = new_geometry(device, GEOMETRY_TRIANGLE);
   if (!g) return -1;
@@ -122,14 +133,8 @@ void sp_intersect(void* scene, size_t n, const float* origins, size_t o_stride, 
   float* ng = out + 5 * n;
   struct ray_hit16 r;
   struct intersect_args args;
-  memset(&args, 0, sizeof args);
-  args.flags = coherent ? QUERY_COHERENT : 0;
-  args.feature_mask = INVALID;
-  args.min_width_distance_factor = 1.0f;
+  packet_init(&r, &args, coherent);
   int valid[16];
-  for (int k = 0; k < 16; k++) {
-    r.tnear[k] = 0.0f; r.time[k] = 0.0f; r.mask[k] = INVALID; r.id[k] = 0; r.flags[k] = 0;
-  }
   for (size_t a = 0; a < n; a += 16) {
     int m = n - a < 16 ? (int)(n - a) : 16;
     for (int k = 0; k < 16; k++) {
@@ -457,12 +462,7 @@ void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double*
                    int64_t* best_s, double* best_n, size_t* counts) {
   struct ray_hit16 r, r1;
   struct intersect_args args;
-  memset(&args, 0, sizeof args);
-  args.feature_mask = INVALID;
-  args.min_width_distance_factor = 1.0f;
-  for (int k = 0; k < 16; k++) {
-    r.tnear[k] = 0.0f; r.time[k] = 0.0f; r.mask[k] = INVALID; r.id[k] = 0; r.flags[k] = 0;
-  }
+  packet_init(&r, &args, 0);
   int valid[16];
   size_t lane_row[16];
   double lane_delta[16];
@@ -622,14 +622,8 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
                     int64_t* s_out, double* n_out, uint8_t* special) {
   struct ray_hit16 r;
   struct intersect_args args;
-  memset(&args, 0, sizeof args);
-  args.flags = coherent ? QUERY_COHERENT : 0;
-  args.feature_mask = INVALID;
-  args.min_width_distance_factor = 1.0f;
+  packet_init(&r, &args, coherent);
   int valid[16];
-  for (int k = 0; k < 16; k++) {
-    r.tnear[k] = 0.0f; r.time[k] = 0.0f; r.mask[k] = INVALID; r.id[k] = 0; r.flags[k] = 0;
-  }
   size_t n_hit = 0;
   const float eps32 = (float)T->eps;
   const float graze = (float)(1e-5 * T->ng_max);
