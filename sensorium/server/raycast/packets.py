@@ -283,41 +283,42 @@ class TierArrays(ctypes.Structure):
     """``struct sp_tier`` of packets.c: pointers to a tier's arrays (see :func:`tier_arrays`)."""
 
     _fields_ = [(name, ctypes.c_void_p) for name in (
-        "normal", "v0", "g1", "g2", "h_min", "V", "F", "tri_slot", "tri_shape", "tri_owner", "c_code", "c_r", "c_h",
+        "normal", "g1", "g2", "h_min", "V", "F", "tri_slot", "tri_shape", "tri_owner", "c_code", "c_r", "c_h",
         "c_rot", "c_pos", "c_shape", "c_isolated")] + [("eps", ctypes.c_double), ("ng_max", ctypes.c_double),
                                                        ("guarded", ctypes.c_int64)] + [
-        (name, ctypes.c_void_p) for name in ("e1", "e2", "t_lo", "t_hi", "ring_ptr", "ring_idx", "guard_ptr",
-                                             "guard_idx")] + [
+        (name, ctypes.c_void_p) for name in ("ring_ptr", "ring_idx", "guard_ptr", "guard_idx")] + [
         ("n_tri", ctypes.c_int64), ("prism_triangles", ctypes.c_int64), ("grow", ctypes.c_double),
         ("bare", ctypes.c_void_p)]
 
 
 def tier_arrays(tier, exact: bool):
     """(struct, address, arrays kept alive) describing ``tier`` (a :class:`.tiers._Tier`) to the
-    judging passes of packets.c; ``exact``: with the float64 refinement data."""
+    judging passes of packets.c; ``exact``: with the float64 refinement data it reads (the dual
+    basis, the vertex rings, the guards' lists). The tier's own arrays, never copies: each already
+    has the dtype C reads (a mismatch is a bug, not a conversion that would double the memory)."""
     keep = []
 
     def ptr(a, dtype):
-        a = np.ascontiguousarray(a, dtype=dtype)
+        if a.dtype != dtype or not a.flags.c_contiguous:
+            raise TypeError(f"tier array of {a.dtype} {a.shape} where packets.c reads contiguous {np.dtype(dtype)}")
         keep.append(a)
         return a.ctypes.data
 
     f64, i32, i64 = np.float64, np.int32, np.int64
+    isolated = np.ascontiguousarray(tier.c_isolated, dtype=np.uint8)   # one byte per curved shape
+    keep.append(isolated)
     st = TierArrays(
         normal=ptr(tier.normal, f64), V=ptr(tier.V, f64), F=ptr(tier.F, i32), tri_slot=ptr(tier.tri_slot, i32),
         tri_shape=ptr(tier.tri_shape, i64), tri_owner=ptr(tier.tri_owner, i32),
         c_code=ptr(tier.c_code, i64), c_r=ptr(tier.c_r, f64), c_h=ptr(tier.c_h, f64),
         c_rot=ptr(tier.c_rot, f64), c_pos=ptr(tier.c_pos, f64), c_shape=ptr(tier.c_shape, i64),
-        c_isolated=ptr(tier.c_isolated, np.uint8), eps=tier.eps, ng_max=tier.ng_max,
+        c_isolated=isolated.ctypes.data, eps=tier.eps, ng_max=tier.ng_max,
         guarded=int(exact and tier.guard is not None))
     if exact:
         from sensorium.server.raycast.guards import PRISM_TRIANGLES
 
-        st.v0, st.g1, st.g2, st.h_min = (ptr(tier.v0, f64), ptr(tier.g1, f64), ptr(tier.g2, f64),
-                                          ptr(tier.h_min, f64))
-        st.e1, st.e2, st.t_lo, st.t_hi = (ptr(tier.e1, f64), ptr(tier.e2, f64), ptr(tier.t_lo, f64),
-                                          ptr(tier.t_hi, f64))
-        st.ring_ptr, st.ring_idx = ptr(tier.ring[0], i64), ptr(tier.ring[1], i64)
+        st.g1, st.g2, st.h_min = ptr(tier.g1, f64), ptr(tier.g2, f64), ptr(tier.h_min, f64)
+        st.ring_ptr, st.ring_idx = ptr(tier.ring[0], i64), ptr(tier.ring[1], i32)
         st.n_tri, st.prism_triangles, st.grow = len(tier.F), PRISM_TRIANGLES, tier.eps + 8.0 * tier.res
         guard = tier.guard
         if guard is not None:

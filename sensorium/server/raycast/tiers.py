@@ -7,6 +7,8 @@ library embreex loaded).
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from embreex import rtcore as _rtc
 from embreex import rtcore_scene as _rts
@@ -125,18 +127,22 @@ class _Tier:
         self.V, self.F = V, F
         self.radius = float(np.linalg.norm(V, axis=1).max()) + 4.0 * self.res
         self.tri_shape = np.append(np.concatenate(tri_shape), -1)  # sentinel row for primID = -1
-        v0 = V[F[:, 0]]
-        e1 = V[F[:, 1]] - v0
-        e2 = V[F[:, 2]] - v0
-        nrm = np.cross(e1, e2)
-        self.ng_max = float(np.linalg.norm(nrm, axis=1).max())
-        with np.errstate(invalid="ignore", divide="ignore"):
-            nrm /= np.linalg.norm(nrm, axis=1)[:, None]
-        self.normal = np.vstack([np.nan_to_num(nrm), np.zeros((1, 3))])
-        del v0, e1, e2, nrm
-        # float64 refinement data (v0, e1, e2, g1, g2, t_lo, t_hi, ring) is made on first use: FAST
-        # needs none of it, so a static scene costs ~1/3 of the memory (see _exact_data)
-        self._exact: dict[str, np.ndarray] | None = None
+        # unit normals (zero sentinel row), a block of triangles at a time: the temporaries stay a
+        # few MB whatever the tier (every value is computed row by row: the same bits)
+        self.normal = np.zeros((len(F) + 1, 3))
+        ng = [0.0]
+        for a, b, v0, e1, e2 in _edges(V, F):
+            nrm = np.cross(e1, e2)
+            norm = np.linalg.norm(nrm, axis=1)
+            ng.append(norm.max())
+            with np.errstate(invalid="ignore", divide="ignore"):
+                nrm /= norm[:, None]
+            self.normal[a:b] = np.nan_to_num(nrm)
+        self.ng_max = float(np.max(ng[1:])) if len(F) else 0.0
+        # float64 refinement data is made on first use, each array when it is needed: FAST needs
+        # none of it; EXACT in packets.c only the dual basis and the vertex rings (see _exact_data)
+        self._exact: dict[str, np.ndarray] = {}
+        self._making = threading.Lock()
         owners = owner_of[self.tri_shape[:-1]]
         self.owned = bool((owners >= 0).any())
         # -2 marks "no owner" so it never equals an exclude_owner value (>= -1)
@@ -186,41 +192,58 @@ class _Tier:
         self._scenes: dict[bool | str, object] = {}
         self._native: dict[bool, tuple] = {}   # per mode: the tier described to packets.c's judging passes
 
-    def _exact_data(self) -> dict[str, np.ndarray]:
-        """Per-triangle float64 data of the refinement, computed once on first use (EXACT, or a
-        FAST ray redone by the general loop): v0, e1, e2; the dual basis g1, g2 of (e1, e2) in each
-        triangle's plane (barycentrics u = (P - v0).g1, v = (P - v0).g2, zero sentinel row); the
-        per-triangle boxes t_lo, t_hi; the smallest height h_min; the normals' columns."""
-        if self._exact is None:
+    def _exact_data(self, *keys: str) -> dict[str, np.ndarray]:
+        """Per-triangle float64 data of the refinement, each array computed once on first use (EXACT,
+        or a FAST ray redone by the general loop), under a lock (blocks of a cast run on threads):
+        v0, e1, e2 ("edges"); the dual basis g1, g2 of (e1, e2) in each triangle's plane (barycentrics
+        u = (P - v0).g1, v = (P - v0).g2, zero sentinel row) and the smallest height h_min ("basis");
+        the per-triangle boxes t_lo, t_hi ("boxes"); the normals' columns ("normal_cols"). packets.c
+        reads only the basis (it takes v0, e1, e2 and the boxes from V and F, the same values): a
+        tier judged there holds ~56 B of it per triangle instead of ~250 B."""
+        got = self._exact
+        if all(k in got for k in keys):
+            return got
+        with self._making:
             V, F = self.V, self.F
-            v0 = V[F[:, 0]]
-            e1 = V[F[:, 1]] - v0
-            e2 = V[F[:, 2]] - v0
-            g11, g12, g22 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                inv = 1.0 / (g11 * g22 - g12 * g12)
-            inv = np.where(np.isfinite(inv), inv, 0.0)[:, None]
-            g1 = np.vstack([(g22[:, None] * e1 - g12[:, None] * e2) * inv, np.zeros((1, 3))])
-            g2 = np.vstack([(g11[:, None] * e2 - g12[:, None] * e1) * inv, np.zeros((1, 3))])
-            tv = V[F]
-            # smallest height: every point at barycentric margin m is >= m * h_min from the edges
-            longest = np.sqrt(np.maximum(np.maximum(g11, g22), _dot(e2 - e1, e2 - e1)))
-            with np.errstate(invalid="ignore", divide="ignore"):
-                h_min = np.linalg.norm(np.cross(e1, e2), axis=1) / longest
-            h_min = np.where(np.isfinite(h_min), h_min, 0.0)
-            self._exact = {"v0": v0, "e1": e1, "e2": e2, "g1": g1, "g2": g2, "t_lo": tv.min(1), "t_hi": tv.max(1),
-                           "h_min": h_min, "normal_cols": tuple(np.ascontiguousarray(self.normal[:, k]) for k in range(3))}
-        return self._exact
+            if "v0" in keys and "v0" not in got:
+                v0 = V[F[:, 0]]
+                got.update(v0=v0, e1=V[F[:, 1]] - v0, e2=V[F[:, 2]] - v0)
+            if "g1" in keys and "g1" not in got:
+                n = len(F)
+                g1, g2, h_min = np.zeros((n + 1, 3)), np.zeros((n + 1, 3)), np.empty(n)
+                for a, b, _, e1, e2 in _edges(V, F):   # row by row, a block at a time: the same bits
+                    g11, g12, g22 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
+                    with np.errstate(invalid="ignore", divide="ignore"):
+                        inv = 1.0 / (g11 * g22 - g12 * g12)
+                    inv = np.where(np.isfinite(inv), inv, 0.0)[:, None]
+                    g1[a:b] = (g22[:, None] * e1 - g12[:, None] * e2) * inv
+                    g2[a:b] = (g11[:, None] * e2 - g12[:, None] * e1) * inv
+                    # smallest height: every point at barycentric margin m is >= m * h_min from the edges
+                    longest = np.sqrt(np.maximum(np.maximum(g11, g22), _dot(e2 - e1, e2 - e1)))
+                    with np.errstate(invalid="ignore", divide="ignore"):
+                        h = np.linalg.norm(np.cross(e1, e2), axis=1) / longest
+                    h_min[a:b] = np.where(np.isfinite(h), h, 0.0)
+                got.update(g1=g1, g2=g2, h_min=h_min)
+            if "t_lo" in keys and "t_lo" not in got:
+                n = len(F)
+                t_lo, t_hi = np.empty((n, 3)), np.empty((n, 3))
+                for a in range(0, n, _BLOCK):
+                    tv = V[F[a:a + _BLOCK]]
+                    t_lo[a:a + _BLOCK], t_hi[a:a + _BLOCK] = tv.min(1), tv.max(1)
+                got.update(t_lo=t_lo, t_hi=t_hi)
+            if "normal_cols" in keys and "normal_cols" not in got:
+                got["normal_cols"] = tuple(np.ascontiguousarray(self.normal[:, k]) for k in range(3))
+        return got
 
-    v0 = property(lambda self: self._exact_data()["v0"])
-    e1 = property(lambda self: self._exact_data()["e1"])
-    e2 = property(lambda self: self._exact_data()["e2"])
-    g1 = property(lambda self: self._exact_data()["g1"])
-    g2 = property(lambda self: self._exact_data()["g2"])
-    t_lo = property(lambda self: self._exact_data()["t_lo"])
-    t_hi = property(lambda self: self._exact_data()["t_hi"])
-    h_min = property(lambda self: self._exact_data()["h_min"])
-    normal_cols = property(lambda self: self._exact_data()["normal_cols"])
+    v0 = property(lambda self: self._exact_data("v0")["v0"])
+    e1 = property(lambda self: self._exact_data("v0")["e1"])
+    e2 = property(lambda self: self._exact_data("v0")["e2"])
+    g1 = property(lambda self: self._exact_data("g1")["g1"])
+    g2 = property(lambda self: self._exact_data("g1")["g2"])
+    t_lo = property(lambda self: self._exact_data("t_lo")["t_lo"])
+    t_hi = property(lambda self: self._exact_data("t_lo")["t_hi"])
+    h_min = property(lambda self: self._exact_data("g1")["h_min"])
+    normal_cols = property(lambda self: self._exact_data("normal_cols")["normal_cols"])
 
     def first_vertex(self, tri: np.ndarray) -> np.ndarray:
         """v0 of the given triangles, without the full refinement data (FAST's self-hit test)."""
@@ -261,11 +284,13 @@ class _Tier:
         data, guards and vertex rings), so that blocks of rays on several threads only read."""
         self.scene(exact)
         if exact:
-            self._exact_data()
-            _ = self.ring
             if self.guard is not None:
                 self.bare_scene()
-        self.native(exact)
+            if self.native(exact) is None or not self.guarded:   # the numpy loop judges EXACT's hits
+                self._exact_data("v0", "g1", "t_lo", "normal_cols")
+                _ = self.ring
+        else:
+            self.native(exact)
 
     def native(self, exact: bool) -> int | None:
         """Address of this tier's ``struct sp_tier`` for the judging passes of packets.c (made once
@@ -362,17 +387,45 @@ class _Tier:
 
     @property
     def ring(self) -> tuple[np.ndarray, np.ndarray]:
-        """CSR (ptr, idx): for each triangle, the triangles sharing one of its vertices (itself
-        included).  Built on first use (EXACT only)."""
+        """CSR (ptr int64, idx int32): for each triangle, the triangles sharing one of its vertices
+        (itself included).  Built on first use (EXACT only)."""
         if self._ring is None:
-            flat = self.F.ravel()
-            tri_of = np.argsort(flat, kind="stable") // 3
-            deg = np.bincount(flat, minlength=len(self.V))
-            vptr = np.concatenate([[0], np.cumsum(deg)])
-            lens = deg[flat]
-            total = int(lens.sum())
-            first = np.repeat(vptr[flat] - (np.cumsum(lens) - lens), lens)
-            idx = tri_of[first + np.arange(total)]
-            ptr = np.concatenate([[0], np.cumsum(lens.reshape(-1, 3).sum(1))])
-            self._ring = (ptr, idx)
+            with self._making:
+                if self._ring is None:
+                    self._ring = vertex_rings(self.F, len(self.V))
         return self._ring
+
+
+_BLOCK = 1 << 16   # triangles per block of the per-triangle arrays' computations (a few MB of temporaries)
+
+
+def _edges(V: np.ndarray, F: np.ndarray):
+    """(a, b, v0, e1, e2) for the triangles F[a:b], a block at a time: v0 = V[F[:, 0]], e1 = V[F[:, 1]]
+    - v0, e2 = V[F[:, 2]] - v0 (the values of the whole arrays, row by row)."""
+    for a in range(0, len(F), _BLOCK):
+        f = F[a:a + _BLOCK]
+        v0 = V[f[:, 0]]
+        yield a, a + len(f), v0, V[f[:, 1]] - v0, V[f[:, 2]] - v0
+
+
+def vertex_rings(F: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
+    """CSR (ptr int64, idx int32) of the vertex rings of faces F: row i lists, for each corner of
+    triangle i in order, the triangles having that vertex (ascending). idx has ~18 entries per
+    triangle of a closed mesh (a vertex is in ~6): int32 (triangle indices are Embree's 32-bit
+    primIDs), and made a block of corners at a time, so that no int64 array of that length exists."""
+    flat = F.ravel()
+    tri_of = (np.argsort(flat, kind="stable") // 3).astype(np.int32)
+    deg = np.bincount(flat, minlength=n_vertices)
+    vptr = np.concatenate([[0], np.cumsum(deg)])
+    lens = deg[flat]
+    ptr = np.concatenate([[0], np.cumsum(lens.reshape(-1, 3).sum(1))])
+    idx = np.empty(int(ptr[-1]), dtype=np.int32)
+    step = 3 * _BLOCK
+    for a in range(0, len(flat), step):
+        ln = lens[a:a + step]
+        start = int(ptr[a // 3])
+        total = int(ln.sum())
+        first = np.repeat(vptr[flat[a:a + step]] - (np.cumsum(ln) - ln), ln)
+        first += np.arange(total)
+        idx[start:start + total] = tri_of[first]
+    return ptr, idx
