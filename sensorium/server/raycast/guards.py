@@ -65,25 +65,34 @@ def risky_edges(F: np.ndarray, flat: np.ndarray, normal: np.ndarray):
     tri = flat.nonzero()[0]
     if len(tri) == 0:
         return np.zeros((0, 2), dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    f = F[tri].astype(np.int64)
+    # the 3 edges of every flat triangle (edge 3i + c: corner c to the next), as keys lo * M + hi
+    # sorted (stably); the rest is read through that order where needed (~90 B per triangle at the
+    # peak, not ~300: a mesh of millions of triangles builds this)
+    f = F[tri]
     a = f.ravel()
     b = f[:, [1, 2, 0]].ravel()
-    t = np.repeat(tri, 3)
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
-    key = lo * (int(F.max()) + 1) + hi
+    del f
+    M = int(F.max()) + 1
+    fwd = a < b
+    key = np.minimum(a, b).astype(np.int64)
+    key *= M
+    key += np.maximum(a, b)
+    del a, b
     order = np.argsort(key, kind="stable")
-    key, lo, hi, t, fwd = key[order], lo[order], hi[order], t[order], (a < b)[order]
+    key = key[order]
     start = np.r_[True, key[1:] != key[:-1]].nonzero()[0]
     count = np.diff(np.r_[start, len(key)])
     safe = count == 2
     two = start[safe]
-    n1, n2 = normal[t[two]], normal[t[two + 1]]
-    safe[safe] = (fwd[two] != fwd[two + 1]) & (np.einsum("ij,ij->i", n1, n2) >= _COPLANAR)
+    o1, o2 = order[two], order[two + 1]
+    n1, n2 = normal[tri[o1 // 3]], normal[tri[o2 // 3]]
+    safe[safe] = (fwd[o1] != fwd[o2]) & (np.einsum("ij,ij->i", n1, n2) >= _COPLANAR)
     risky = (~safe).nonzero()[0]
-    edges = np.c_[lo[start[risky]], hi[start[risky]]]
+    k = key[start[risky]]
+    edges = np.c_[k // M, k % M]
     counts = count[risky]
     ptr = np.r_[0, np.cumsum(counts)]
-    idx = t[np.repeat(start[risky] - ptr[:-1], counts) + np.arange(int(ptr[-1]))]
+    idx = tri[order[np.repeat(start[risky] - ptr[:-1], counts) + np.arange(int(ptr[-1]))] // 3]
     return edges, ptr, idx
 
 
