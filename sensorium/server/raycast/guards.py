@@ -58,10 +58,11 @@ _PRISM_FACES = np.array([
 PRISM_TRIANGLES = len(_PRISM_FACES)
 
 
-def risky_edges(F: np.ndarray, flat: np.ndarray, normal: np.ndarray):
+def risky_edges(F: np.ndarray, flat: np.ndarray, normal: np.ndarray, too_many=None):
     """Risky edges of the flat triangles ``F[flat]`` (``normal``: unit normals per triangle, zero
     for degenerate ones).  Returns (edges (k, 2) vertex indices, ptr, idx): the triangles of edge
-    i are ``idx[ptr[i]:ptr[i + 1]]``."""
+    i are ``idx[ptr[i]:ptr[i + 1]]``; or None if ``too_many(k)`` (counted before they are listed:
+    a triangle soup's every edge is risky)."""
     tri = flat.nonzero()[0]
     if len(tri) == 0:
         return np.zeros((0, 2), dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)
@@ -88,6 +89,8 @@ def risky_edges(F: np.ndarray, flat: np.ndarray, normal: np.ndarray):
     n1, n2 = normal[tri[o1 // 3]], normal[tri[o2 // 3]]
     safe[safe] = (fwd[o1] != fwd[o2]) & (np.einsum("ij,ij->i", n1, n2) >= _COPLANAR)
     risky = (~safe).nonzero()[0]
+    if too_many is not None and too_many(len(risky)):
+        return None
     k = key[start[risky]]
     edges = np.c_[k // M, k % M]
     counts = count[risky]

@@ -52,6 +52,7 @@ static void (*commit_scene)(void*);
 static void (*release_scene)(void*);
 static void* (*new_geometry)(void*, int);
 static void* (*new_geometry_buffer)(void*, int, unsigned, int, size_t, size_t);
+static void (*shared_geometry_buffer)(void*, int, unsigned, int, const void*, size_t, size_t, size_t);
 static void (*commit_geometry)(void*);
 static unsigned (*attach_geometry)(void*, void*);
 static void (*release_geometry)(void*);
@@ -67,7 +68,8 @@ const char* sp_open(const char* path) {
   LOAD(device_error, "rtcGetDeviceError") LOAD(new_scene, "rtcNewScene")
   LOAD(set_scene_flags, "rtcSetSceneFlags") LOAD(commit_scene, "rtcCommitScene")
   LOAD(release_scene, "rtcReleaseScene") LOAD(new_geometry, "rtcNewGeometry")
-  LOAD(new_geometry_buffer, "rtcSetNewGeometryBuffer") LOAD(commit_geometry, "rtcCommitGeometry")
+  LOAD(new_geometry_buffer, "rtcSetNewGeometryBuffer")
+  LOAD(shared_geometry_buffer, "rtcSetSharedGeometryBuffer") LOAD(commit_geometry, "rtcCommitGeometry")
   LOAD(attach_geometry, "rtcAttachGeometry") LOAD(release_geometry, "rtcReleaseGeometry")
   LOAD(intersect16, "rtcIntersect16")
   return NULL;
@@ -88,29 +90,39 @@ static void packet_init(struct ray_hit16* r, struct intersect_args* args, int co
   }
 }
 
-static int add_triangles(void* device, void* scene, size_t nv, const float* vertices, size_t nf, const int32_t* faces) {
+/* A triangle geometry of nv vertices and nf faces: `shared`, Embree reads the caller's arrays (which
+ * must outlive the scene and have 16 bytes readable past their ends: Embree loads the last vertex
+ * with a 16-byte load); else it copies them into buffers of its own. */
+static int add_triangles(void* device, void* scene, size_t nv, const float* vertices, size_t nf, const int32_t* faces,
+                         int shared) {
   void* g = new_geometry(device, GEOMETRY_TRIANGLE);
   if (!g) return -1;
-  float* vb = new_geometry_buffer(g, BUFFER_VERTEX, 0, FORMAT_FLOAT3, 3 * sizeof(float), nv);
-  int32_t* ib = new_geometry_buffer(g, BUFFER_INDEX, 0, FORMAT_UINT3, 3 * sizeof(int32_t), nf);
-  if (!vb || !ib) { release_geometry(g); return -1; }
-  memcpy(vb, vertices, nv * 3 * sizeof(float));
-  memcpy(ib, faces, nf * 3 * sizeof(int32_t));
+  if (shared) {
+    shared_geometry_buffer(g, BUFFER_VERTEX, 0, FORMAT_FLOAT3, vertices, 0, 3 * sizeof(float), nv);
+    shared_geometry_buffer(g, BUFFER_INDEX, 0, FORMAT_UINT3, faces, 0, 3 * sizeof(int32_t), nf);
+  } else {
+    float* vb = new_geometry_buffer(g, BUFFER_VERTEX, 0, FORMAT_FLOAT3, 3 * sizeof(float), nv);
+    int32_t* ib = new_geometry_buffer(g, BUFFER_INDEX, 0, FORMAT_UINT3, 3 * sizeof(int32_t), nf);
+    if (!vb || !ib) { release_geometry(g); return -1; }
+    memcpy(vb, vertices, nv * 3 * sizeof(float));
+    memcpy(ib, faces, nf * 3 * sizeof(int32_t));
+  }
   commit_geometry(g);
   attach_geometry(scene, g);
   release_geometry(g);
   return 0;
 }
 
-/* A committed scene of one triangle geometry (id 0) and, when nv1 > 0, a second one (id 1), the
- * vertices copied into Embree's own buffers; NULL on any Embree error. */
+/* A committed scene of one triangle geometry (id 0) and, when nv1 > 0, a second one (id 1); bit k
+ * of `shared`: geometry k's arrays are shared with Embree (see add_triangles), else copied; NULL on
+ * any Embree error. */
 void* sp_new_scene(void* device, int robust, size_t nv0, const float* v0, size_t nf0, const int32_t* f0,
-                   size_t nv1, const float* v1, size_t nf1, const int32_t* f1) {
+                   size_t nv1, const float* v1, size_t nf1, const int32_t* f1, int shared) {
   void* scene = new_scene(device);
   if (!scene) return NULL;
   if (robust) set_scene_flags(scene, SCENE_ROBUST);
-  int bad = nf0 && add_triangles(device, scene, nv0, v0, nf0, f0);
-  if (!bad && nv1) bad = add_triangles(device, scene, nv1, v1, nf1, f1);
+  int bad = nf0 && add_triangles(device, scene, nv0, v0, nf0, f0, shared & 1);
+  if (!bad && nv1) bad = add_triangles(device, scene, nv1, v1, nf1, f1, shared & 2);
   if (!bad) commit_scene(scene);
   if (bad || device_error(device)) { release_scene(scene); return NULL; }
   return scene;

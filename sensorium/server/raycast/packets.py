@@ -149,7 +149,7 @@ def _load() -> None:
     lib.sp_new_device.restype = vp
     lib.sp_release_device.argtypes = [vp]
     lib.sp_new_scene.restype = vp
-    lib.sp_new_scene.argtypes = [vp, i, sz, vp, sz, vp, sz, vp, sz, vp]
+    lib.sp_new_scene.argtypes = [vp, i, sz, vp, sz, vp, sz, vp, sz, vp, i]
     lib.sp_release_scene.argtypes = [vp]
     lib.sp_intersect.restype = None
     lib.sp_intersect.argtypes = [vp, sz, vp, sz, vp, vp, i, i]
@@ -194,6 +194,22 @@ def _ptr(a: np.ndarray | None) -> int | None:
     return None if a is None else a.ctypes.data
 
 
+def padded(a: np.ndarray, dtype) -> np.ndarray:
+    """``a`` as a C-contiguous array of ``dtype`` that a :class:`Scene` shares with Embree instead of
+    copying it (Embree reads the last vertex with a 16-byte load: 16 bytes readable past the end)."""
+    a = np.asarray(a)
+    out = np.empty(a.size + 16 // np.dtype(dtype).itemsize, dtype=dtype)[:a.size].reshape(a.shape)
+    out[...] = a
+    return out
+
+
+def _shareable(a: np.ndarray) -> bool:
+    """True if ``a`` is a view with 16 bytes of its own buffer past its end (see :func:`padded`)."""
+    b = a.base
+    return (isinstance(b, np.ndarray) and a.flags.c_contiguous and b.flags.c_contiguous
+            and b.ctypes.data <= a.ctypes.data and a.ctypes.data + a.nbytes + 16 <= b.ctypes.data + b.nbytes)
+
+
 class Device:
     """An Embree device of the packet path."""
 
@@ -218,9 +234,13 @@ class Scene:
         v0, f0 = np.ascontiguousarray(V, dtype=np.float32), np.ascontiguousarray(F, dtype=np.int32)
         v1 = None if V1 is None else np.ascontiguousarray(V1, dtype=np.float32)
         f1 = None if F1 is None else np.ascontiguousarray(F1, dtype=np.int32)
+        # geometry 0's arrays shared with Embree where they allow it (the tier's, made with
+        # `padded`: no second copy of the vertices and faces per scene), else copied; kept alive here
+        shared = int(v0 is V and f0 is F and _shareable(v0) and _shareable(f0))
+        self._shared = (v0, f0) if shared else ()
         self.handle = self.lib.sp_new_scene(device.handle, int(robust), len(v0), _ptr(v0), len(f0), _ptr(f0),
                                             0 if v1 is None else len(v1), _ptr(v1), 0 if f1 is None else len(f1),
-                                            _ptr(f1))
+                                            _ptr(f1), shared)
         if not self.handle:
             raise RuntimeError("Embree could not build the scene")
         self._local = threading.local()   # per thread: scratch buffer, last directions array

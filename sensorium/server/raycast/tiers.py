@@ -145,7 +145,7 @@ class _Tier:
             c_bound.append(float(np.linalg.norm(verts[k] - pose.translation, axis=1).max()))
         V = np.vstack(verts) - self.anchor
         F = np.vstack(faces)
-        F = np.ascontiguousarray(F, dtype=np.int32)   # one index array: Embree's, and ours
+        F = packets.padded(F, np.int32)   # one index array: Embree's (shared with its scenes), and ours
         self.V, self.F = V, F
         self.radius = float(np.linalg.norm(V, axis=1).max()) + 4.0 * self.res
         self.tri_shape = np.append(np.concatenate(tri_shape), -1)  # sentinel row for primID = -1
@@ -208,7 +208,7 @@ class _Tier:
         self._ring: tuple[np.ndarray, np.ndarray] | None = None
         self._guard: tuple | None = None
         # Embree keeps pointers into these buffers: hold references for the scenes' lifetime
-        self._v32 = np.ascontiguousarray(V, dtype=_F32)
+        self._v32 = packets.padded(V, _F32)   # shared with the packet path's scenes (see packets.Scene)
         self._f32 = F
         self._device = device
         self._scenes: dict[bool | str, object] = {}
@@ -361,12 +361,19 @@ class _Tier:
         Built on first use."""
         if self._guard is None:
             flat = ~self.tri_curved[:-1]
-            edges, ptr, idx = risky_edges(self.F, flat, self.normal[:-1])
             n_flat = int(np.count_nonzero(flat))
+
+            def too_many(k: int) -> bool:   # too many to guard, or too dense
+                return k > MAX_GUARDED_EDGES or (k > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat
+                                                 and PRISM_TRIANGLES * k > MAX_PRISM_TRIANGLES_PER_TRIANGLE * len(self.F))
+
+            found_edges = risky_edges(self.F, flat, self.normal[:-1], too_many)
+            if found_edges is None:
+                self._guard = (None, False)
+                return None
+            edges, ptr, idx = found_edges
             w = 4.0 * self.eps
-            dense = (len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat
-                     and PRISM_TRIANGLES * len(edges) > MAX_PRISM_TRIANGLES_PER_TRIANGLE * len(self.F))
-            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or dense \
+            if len(edges) == 0 \
                     or w > MAX_WIDTH_PER_EDGE_LENGTH * float(np.median(np.linalg.norm(
                         self.V[edges[:, 0]] - self.V[edges[:, 1]], axis=1))):
                 self._guard = (None, len(edges) == 0)
