@@ -143,11 +143,17 @@ class _Tier:
             c_pos.append(pose.translation - self.anchor)
             c_shape.append(sid)
             c_bound.append(float(np.linalg.norm(verts[k] - pose.translation, axis=1).max()))
-        V = np.vstack(verts) - self.anchor
-        F = np.vstack(faces)
-        F = packets.padded(F, np.int32)   # one index array: Embree's (shared with its scenes), and ours
+        self.has_curved = bool(curved)
+        del curved   # the shapes' local vertices
+        V = np.vstack(verts)
+        V -= self.anchor
+        # from here on only the shapes' boxes are needed (see _isolation): not a second copy of V
+        verts = [np.array([v.min(0), v.max(0)]) for v in verts]
+        F = packets.padded(np.vstack(faces), np.int32)   # one index array: Embree's (shared with its scenes), and ours
+        del faces
         self.V, self.F = V, F
-        self.radius = float(np.linalg.norm(V, axis=1).max()) + 4.0 * self.res
+        self.radius = float(np.max([np.linalg.norm(V[a:a + _BLOCK], axis=1).max() for a in range(0, len(V), _BLOCK)])) \
+            + 4.0 * self.res
         self.tri_shape = np.append(np.concatenate(tri_shape), -1)  # sentinel row for primID = -1
         # unit normals (zero sentinel row), a block of triangles at a time: the temporaries stay a
         # few MB whatever the tier (every value is computed row by row: the same bits)
@@ -170,7 +176,6 @@ class _Tier:
         # -2 marks "no owner" so it never equals an exclude_owner value (>= -1)
         self.tri_owner = np.append(np.where(owners >= 0, owners, -2), -2).astype(np.int32)   # robot indices
         # curved shapes, indexed by "slot"
-        self.has_curved = bool(curved)
         self.c_shape = np.array(c_shape, dtype=np.int64)
         slot_of_shape = np.full(int(self.tri_shape.max()) + 2, -1, dtype=np.int64)
         slot_of_shape[self.c_shape] = np.arange(len(c_shape))
