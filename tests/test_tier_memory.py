@@ -26,16 +26,18 @@ def _fan_and_grid() -> tuple[np.ndarray, np.ndarray]:
     return np.vstack([fan_v, grid_v]), np.vstack([fan_f, grid_f])
 
 
-def test_vertex_rings_are_int32_and_list_each_corners_triangles_in_order(monkeypatch):
-    monkeypatch.setattr(tiers, "_BLOCK", 7)   # many blocks of corners
+def test_vertex_rings_list_each_corners_triangles_in_order_from_three_entries_per_triangle():
     V, F = _fan_and_grid()
-    ptr, idx = tiers.vertex_rings(F.astype(np.int32), len(V))
-    assert idx.dtype == np.int32 and ptr.dtype == np.int64
+    ring = tiers.VertexRings(F.astype(np.int32), len(V))
+    assert ring.tri_of.dtype == np.int32 and len(ring.tri_of) == 3 * len(F)   # not the fan's 300² ring entries
     having = [sorted(np.flatnonzero((F == v).any(axis=1)).tolist()) for v in range(len(V))]
-    for t, f in enumerate(F):
-        assert idx[ptr[t]:ptr[t + 1]].tolist() == having[f[0]] + having[f[1]] + having[f[2]]
-    hub = idx[ptr[0]:ptr[1]]
-    assert len(hub) == 300 + 2 + 2 and set(hub.tolist()) == set(range(300))   # the hub's whole fan
+    want = [having[f[0]] + having[f[1]] + having[f[2]] for f in F]
+    assert ring.sizes(np.arange(len(F))).tolist() == [len(w) for w in want]
+    rows = np.array([5, 0, 310, 299, 0], dtype=np.int64)   # any triangles, repeated, in any order
+    pos, members = ring.rows(rows)
+    assert pos.tolist() == [i for i, t in enumerate(rows) for _ in want[t]]
+    assert members.tolist() == [m for t in rows for m in want[t]]
+    assert set(want[0]) == set(range(300))   # the hub's whole fan
 
 
 def test_welding_groups_positions_by_their_bytes_in_order_of_first_use():
@@ -100,7 +102,7 @@ def test_the_packet_path_shares_the_tiers_arrays_instead_of_copying_them():
     scene, _ = tier.scene(True)
     assert scene._shared and scene._shared[0] is tier._v32 and scene._shared[1] is tier.F
     st, _, keep = packets.tier_arrays(tier, True)
-    assert any(a is tier.ring[1] for a in keep) and tier.ring[1].dtype == np.int32
+    assert any(a is tier.ring.tri_of for a in keep) and any(a is tier.g1 for a in keep)
     with pytest.raises(TypeError, match="packets.c reads"):   # a conversion would be a second copy
         tier._exact["h_min"] = tier._exact["h_min"].astype(np.float32)
         packets.tier_arrays(tier, True)

@@ -151,11 +151,11 @@ def candidates(V, edges, ptr, idx, ring, flat, w: float, budget: int) -> tuple[n
     comes within w/2 of i's (coincident or crossing prisms, e.g. the common edge of two touching
     boxes: stepping past one prism's face must not step past the other's unexamined).  None when
     the lists would hold more than ``budget`` entries (counted before they are made: see
-    MAX_CANDIDATES_PER_FLAT_TRIANGLE)."""
+    MAX_CANDIDATES_PER_FLAT_TRIANGLE). ``ring``: the tier's :class:`.tiers.VertexRings`."""
     e_of, tri = np.repeat(np.arange(len(edges)), np.diff(ptr)), idx
-    if int((ring[0][tri + 1] - ring[0][tri]).sum()) > budget:
+    if int(ring.sizes(tri).sum()) > budget:
         return None
-    pos, cand = _expand(ring[0], ring[1], tri)
+    pos, cand = ring.rows(tri)
     own = np.unique(e_of[pos] * (len(flat) + 1) + cand)     # (edge, triangle) keys, sorted
     own_e, own_t = own // (len(flat) + 1), own % (len(flat) + 1)
     own_ptr = np.r_[0, np.cumsum(np.bincount(own_e, minlength=len(edges)))]

@@ -213,8 +213,8 @@ struct sp_tier {
   double ng_max;             /* largest |Embree Ng| */
   int64_t guarded;           /* geometry 1 of the scene holds edge guards */
   /* EXACT only: */
-  const int64_t* ring_ptr;   /* CSR: the triangles sharing a vertex with triangle i */
-  const int32_t* ring_idx;
+  const int64_t* ring_vptr;  /* CSR: the triangles of vertex v (ascending); triangle i's vertex ring */
+  const int32_t* ring_tri;   /* is its three corners' lists in order */
   const int64_t* guard_ptr;  /* CSR: the flat triangles to test for a ray near risky edge e */
   const int64_t* guard_idx;
   int64_t n_tri;
@@ -378,16 +378,17 @@ static int refine_flat(const struct sp_tier* T, int64_t* tri, const double* o, c
   if (moller_trumbore(T, *tri, o, d, &t) && t >= lo && t <= hi) { *t_out = t; return 1; }
   double best = INF_D;
   int64_t btri = -1;
-  for (int64_t k = T->ring_ptr[*tri]; k < T->ring_ptr[*tri + 1]; k++) {
-    int64_t c = (int64_t)T->ring_idx[k];
+  const int32_t* corner = T->F + 3 * *tri;
+  for (int j = 0; j < 3; j++) for (int64_t k = T->ring_vptr[corner[j]]; k < T->ring_vptr[corner[j] + 1]; k++) {
+    int64_t c = (int64_t)T->ring_tri[k];
     double tc;
     int ok = moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= hi;
     if (!ok) continue;
     if (tc < best) best = tc;
   }
   if (isfinite(best)) {
-    for (int64_t k = T->ring_ptr[*tri]; k < T->ring_ptr[*tri + 1]; k++) {   /* the last candidate at best */
-      int64_t c = (int64_t)T->ring_idx[k];
+    for (int j = 0; j < 3; j++) for (int64_t k = T->ring_vptr[corner[j]]; k < T->ring_vptr[corner[j] + 1]; k++) {
+      int64_t c = (int64_t)T->ring_tri[k];   /* the last candidate at best */
       double tc;
       if (moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= hi && tc == best) btri = c;
     }

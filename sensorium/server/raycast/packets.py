@@ -306,7 +306,7 @@ class TierArrays(ctypes.Structure):
         "normal", "g1", "g2", "h_min", "V", "F", "tri_slot", "tri_shape", "tri_owner", "c_code", "c_r", "c_h",
         "c_rot", "c_pos", "c_shape", "c_isolated")] + [("eps", ctypes.c_double), ("ng_max", ctypes.c_double),
                                                        ("guarded", ctypes.c_int64)] + [
-        (name, ctypes.c_void_p) for name in ("ring_ptr", "ring_idx", "guard_ptr", "guard_idx")] + [
+        (name, ctypes.c_void_p) for name in ("ring_vptr", "ring_tri", "guard_ptr", "guard_idx")] + [
         ("n_tri", ctypes.c_int64), ("prism_triangles", ctypes.c_int64), ("grow", ctypes.c_double),
         ("bare", ctypes.c_void_p)]
 
@@ -338,7 +338,7 @@ def tier_arrays(tier, exact: bool):
         from sensorium.server.raycast.guards import PRISM_TRIANGLES
 
         st.g1, st.g2, st.h_min = ptr(tier.g1, f64), ptr(tier.g2, f64), ptr(tier.h_min, f64)
-        st.ring_ptr, st.ring_idx = ptr(tier.ring[0], i64), ptr(tier.ring[1], i32)
+        st.ring_vptr, st.ring_tri = ptr(tier.ring.vptr, i64), ptr(tier.ring.tri_of, i32)
         st.n_tri, st.prism_triangles, st.grow = len(tier.F), PRISM_TRIANGLES, tier.eps + 8.0 * tier.res
         guard = tier.guard
         if guard is not None:

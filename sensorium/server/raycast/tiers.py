@@ -168,7 +168,7 @@ class _Tier:
             self.normal[a:b] = np.nan_to_num(nrm)
         self.ng_max = float(np.max(ng[1:])) if len(F) else 0.0
         # float64 refinement data is made on first use, each array when it is needed: FAST needs
-        # none of it; EXACT in packets.c only the dual basis and the vertex rings (see _exact_data)
+        # none of it; EXACT in packets.c only the dual basis (see _exact_data) and the vertex rings
         self._exact: dict[str, np.ndarray] = {}
         self._making = threading.Lock()
         owners = owner_of[self.tri_shape[:-1]]
@@ -210,7 +210,7 @@ class _Tier:
             self.bound = ("cylinder", self.c_rot[0], self.c_pos[0], self.c_rad[0] + slack, self.c_ax[0] + slack)
         else:
             self.bound = ("box", V.min(0) - slack, V.max(0) + slack)
-        self._ring: tuple[np.ndarray, np.ndarray] | None = None
+        self._ring: VertexRings | None = None
         self._guard: tuple | None = None
         # Embree keeps pointers into these buffers: hold references for the scenes' lifetime
         self._v32 = packets.padded(V, _F32)   # shared with the packet path's scenes (see packets.Scene)
@@ -420,14 +420,43 @@ class _Tier:
         return out
 
     @property
-    def ring(self) -> tuple[np.ndarray, np.ndarray]:
-        """CSR (ptr int64, idx int32): for each triangle, the triangles sharing one of its vertices
-        (itself included).  Built on first use (EXACT only)."""
+    def ring(self) -> VertexRings:
+        """The vertex rings: for each triangle, the triangles sharing one of its vertices (itself
+        included), read from the triangles of each vertex.  Built on first use (EXACT only)."""
         if self._ring is None:
             with self._making:
                 if self._ring is None:
-                    self._ring = vertex_rings(self.F, len(self.V))
+                    self._ring = VertexRings(self.F, len(self.V))
         return self._ring
+
+
+class VertexRings:
+    """The vertex rings of faces F, kept as the triangles of each vertex: CSR (``vptr`` int64 per
+    vertex, ``tri_of`` int32, ascending) -- 3 entries per triangle. The ring of triangle i is, for
+    each corner of i in order, that corner's list: reading it from here costs nothing more, while
+    storing the rings would take ~18 entries per triangle of a closed mesh and grow with the square
+    of a vertex's valence (a fan of n triangles around one vertex: n² entries)."""
+
+    def __init__(self, F: np.ndarray, n_vertices: int) -> None:
+        self.F = F
+        flat = F.ravel()
+        self.tri_of = (np.argsort(flat, kind="stable") // 3).astype(np.int32)
+        self.deg = np.bincount(flat, minlength=n_vertices)
+        self.vptr = np.concatenate([[0], np.cumsum(self.deg)])
+
+    def sizes(self, tri: np.ndarray) -> np.ndarray:
+        """The ring length of each triangle listed."""
+        return self.deg[self.F[tri]].sum(1)
+
+    def rows(self, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(position in ``tri``, ring member) of every member of the rings of the triangles listed,
+        ring after ring, each in ring order."""
+        v = self.F[tri].ravel()
+        cnt = self.deg[v]
+        pos = np.repeat(np.repeat(np.arange(len(tri)), 3), cnt)
+        first = np.repeat(self.vptr[v] - (np.cumsum(cnt) - cnt), cnt)
+        first += np.arange(len(first))
+        return pos, self.tri_of[first]
 
 
 _BLOCK = 1 << 16   # triangles per block of the per-triangle arrays' computations (a few MB of temporaries)
@@ -440,26 +469,3 @@ def _edges(V: np.ndarray, F: np.ndarray):
         f = F[a:a + _BLOCK]
         v0 = V[f[:, 0]]
         yield a, a + len(f), v0, V[f[:, 1]] - v0, V[f[:, 2]] - v0
-
-
-def vertex_rings(F: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
-    """CSR (ptr int64, idx int32) of the vertex rings of faces F: row i lists, for each corner of
-    triangle i in order, the triangles having that vertex (ascending). idx has ~18 entries per
-    triangle of a closed mesh (a vertex is in ~6): int32 (triangle indices are Embree's 32-bit
-    primIDs), and made a block of corners at a time, so that no int64 array of that length exists."""
-    flat = F.ravel()
-    tri_of = (np.argsort(flat, kind="stable") // 3).astype(np.int32)
-    deg = np.bincount(flat, minlength=n_vertices)
-    vptr = np.concatenate([[0], np.cumsum(deg)])
-    lens = deg[flat]
-    ptr = np.concatenate([[0], np.cumsum(lens.reshape(-1, 3).sum(1))])
-    idx = np.empty(int(ptr[-1]), dtype=np.int32)
-    step = 3 * _BLOCK
-    for a in range(0, len(flat), step):
-        ln = lens[a:a + step]
-        start = int(ptr[a // 3])
-        total = int(ln.sum())
-        first = np.repeat(vptr[flat[a:a + step]] - (np.cumsum(ln) - ln), ln)
-        first += np.arange(total)
-        idx[start:start + total] = tri_of[first]
-    return ptr, idx
