@@ -33,13 +33,13 @@ GiB = 1 << 30
 MAX_COORDINATE_M = 1e5          # |x|, |y|, |z| of a pose set at run time (set_pose, set_field): 100 km
 # What building a world costs in the server process, per unit (peak resident memory of `sensorium
 # probe WORLD --steps 1 --enable all:32` above a trivial world's, FAST and EXACT, the packet path on
-# and off). A triangle, on worlds of ~1M (2026-12-03): worst a flat mesh file under EXACT with edge
-# guards, ~500 B (an STL grid: its vertex rings and its Embree scene twice, with and without the
-# guards); an STL triangle soup ~475 B; curved tessellations (spheres) ~365 B; FAST <= 480 B.
-# BYTES_PER_TRIANGLE is the worst + 12%. Not covered: a vertex's ring grows with the square of its
-# valence (EXACT; a fan of n triangles around one vertex). A ray cast per step ~200 B (distance
-# sensor rays, lidar beams, light occlusion rays: `sensorium bench --only limits`). With margin:
-BYTES_PER_TRIANGLE = 560
+# and off; worlds of ~1M triangles, 2026-12-03). A triangle: worst a binary STL triangle soup
+# (three vertices of its own per triangle) without the packet path (embreex copies the vertices),
+# ~476 B; with it ~430 B; a flat STL grid under EXACT with edge guards (its Embree scene twice, with
+# and without the guards) ~415 B; curved tessellations (spheres) ~256 B EXACT, ~230 B FAST.
+# BYTES_PER_TRIANGLE is the worst + 13%. A ray cast per step ~200 B (distance sensor rays, lidar
+# beams, light occlusion rays: `sensorium bench --only limits`). With margin:
+BYTES_PER_TRIANGLE = 540
 BYTES_PER_RAY = 220
 
 
