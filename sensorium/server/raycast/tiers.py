@@ -440,7 +440,10 @@ class VertexRings:
     def __init__(self, F: np.ndarray, n_vertices: int) -> None:
         self.F = F
         flat = F.ravel()
-        self.tri_of = (np.argsort(flat, kind="stable") // 3).astype(np.int32)
+        order = np.argsort(flat, kind="stable")
+        order //= 3
+        self.tri_of = order.astype(np.int32)
+        del order
         self.deg = np.bincount(flat, minlength=n_vertices)
         self.vptr = np.concatenate([[0], np.cumsum(self.deg)])
 
