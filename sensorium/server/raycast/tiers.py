@@ -159,7 +159,7 @@ class _Tier:
         # few MB whatever the tier (every value is computed row by row: the same bits)
         self.normal = np.zeros((len(F) + 1, 3))
         ng = [0.0]
-        for a, b, v0, e1, e2 in _edges(V, F):
+        for a, b, _, e1, e2 in _edges(V, F):
             nrm = np.cross(e1, e2)
             norm = np.linalg.norm(nrm, axis=1)
             ng.append(norm.max())
