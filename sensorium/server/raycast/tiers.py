@@ -220,13 +220,13 @@ class _Tier:
         self._native: dict[bool, tuple] = {}   # per mode: the tier described to packets.c's judging passes
 
     def _exact_data(self, *keys: str) -> dict[str, np.ndarray]:
-        """Per-triangle float64 data of the refinement, each array computed once on first use (EXACT,
-        or a FAST ray redone by the general loop), under a lock (blocks of a cast run on threads):
-        v0, e1, e2 ("edges"); the dual basis g1, g2 of (e1, e2) in each triangle's plane (barycentrics
-        u = (P - v0).g1, v = (P - v0).g2, zero sentinel row) and the smallest height h_min ("basis");
-        the per-triangle boxes t_lo, t_hi ("boxes"); the normals' columns ("normal_cols"). packets.c
-        reads only the basis (it takes v0, e1, e2 and the boxes from V and F, the same values): a
-        tier judged there holds ~56 B of it per triangle instead of ~250 B."""
+        """Per-triangle float64 data of EXACT's refinement, each group computed once on first use
+        (under a lock: blocks of a cast run on threads) and named in ``keys`` by its first array:
+        "v0" -- v0, e1, e2; "g1" -- the dual basis g1, g2 of (e1, e2) in each triangle's plane
+        (barycentrics u = (P - v0).g1, v = (P - v0).g2, zero sentinel row) and the smallest height
+        h_min; "t_lo" -- the per-triangle boxes t_lo, t_hi; "normal_cols" -- the normals' columns.
+        packets.c reads only the "g1" group (it takes v0, e1, e2 and the boxes from V and F, the
+        same values): a tier judged there holds ~56 B of it per triangle instead of ~250 B."""
         got = self._exact
         if all(k in got for k in keys):
             return got
