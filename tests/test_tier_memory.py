@@ -106,3 +106,31 @@ def test_the_packet_path_shares_the_tiers_arrays_instead_of_copying_them():
     with pytest.raises(TypeError, match="packets.c reads"):   # a conversion would be a second copy
         tier._exact["h_min"] = tier._exact["h_min"].astype(np.float32)
         packets.tier_arrays(tier, True)
+
+
+@pytest.mark.skipif(packets.library() is None, reason=f"packet path unavailable: {packets.status()}")
+def test_rays_at_a_high_valence_vertex_get_the_same_bits_in_c_and_numpy():
+    """A cone of 64 triangles around one apex (its ring holds the whole cone) and a grid: EXACT rays
+    aimed at vertices and edge midpoints are refined through the vertex rings read from each vertex's
+    triangles, in packets.c and in numpy alike."""
+    from sensorium.server.raycast.engine import Precision, RayEngine, ShapeEntry
+
+    V, F = _fan_and_grid()
+    V = V.copy()
+    V[0, 2] = 0.3                                    # the hub raised: a cone, creased edges
+    aims = np.tile(np.vstack([V, (V[F[:, 0]] + V[F[:, 1]]) / 2.0, (V[F[:, 1]] + V[F[:, 2]]) / 2.0]), (4, 1))
+    rng = np.random.default_rng(7)
+    eyes = rng.uniform(-1.0, 1.0, (len(aims), 3)) + [0.0, 0.0, 2.0]
+    D = aims + rng.normal(size=aims.shape) * rng.choice([0.0, 1e-9, 1e-7], (len(aims), 1)) - eyes
+    D /= np.linalg.norm(D, axis=1)[:, None]
+    out = {}
+    for native in (False, True):
+        eng = RayEngine(Precision.EXACT)
+        eng.threads = 1
+        eng.native = native
+        eng.add_body([ShapeEntry(Mesh(V, F, closed=False), Pose.identity(), True, True)], Pose.identity())
+        h = eng.cast(eyes, D, 0.0, 10.0)
+        out[native] = (h.distance.tobytes(), h.normal.tobytes(), h.shape.tobytes())
+        hit = np.isfinite(h.distance)
+    assert out[True] == out[False]
+    assert hit.mean() > 0.7
