@@ -5,7 +5,11 @@ limits"); each cause has a test here that failed before its fix:
 * occluding LightSensors: the occlusion segments were computed for every (sensor, light) pair
   toward every light — (S × n) × n — 4.3 GB for 16,384 sensors and 64 lights;
 * mesh files: trimesh's readers take up to hundreds of times a file's size (3.4 GB for a 16 MB OBJ
-  of 2 million faces); a file larger than 1 MiB is now read in a worker process under a memory limit.
+  of 2 million faces); a file larger than 1 MiB is now read in a worker process under a memory limit;
+* EXACT's refinement data in the packet path: every float64 array of the numpy path made up front,
+  and vertex rings stored per triangle as int64 (~18 entries each) -- ~400 B per triangle; now the
+  dual basis and each vertex's triangles, ~75 B (README "Security and limits": 2.67 GiB peak for a
+  world the limits accepted, now 1.4 GiB).
 
 Memory is compared as a ratio of allocations (tracemalloc, deterministic) or bounded by the
 operating system, never timed."""
@@ -115,3 +119,27 @@ def test_a_mesh_over_the_triangle_limit_is_refused_before_its_arrays_are_copied(
     stl = _binary_stl(tmp_path / "many.stl", 30_000)
     with pytest.raises(MeshFileError, match="has 30,000 triangles, more than the world's limit of 20,000"):
         load_mesh(stl, (1.0, 1.0, 1.0), max_triangles=20_000, memory=1 << 30)
+
+
+def test_exact_refinement_data_of_the_packet_path_costs_under_100_bytes_per_triangle(monkeypatch) -> None:
+    from sensorium.server.raycast import packets, tiers
+    from sensorium.server.world.geometry import Pose, Sphere
+
+    if packets.library() is None:
+        pytest.skip(f"packet path unavailable: {packets.status()}")
+    items = [(k, Sphere(radius=1.0, subdivision=5), Pose(np.eye(3), np.array([3.0 * k, 0.0, 0.0]))) for k in range(3)]
+    monkeypatch.setattr(tiers, "_BLOCK", 4096)   # 15 blocks
+    tracemalloc.start()
+    try:
+        tier = tiers._Tier(packets.Device(), items, np.full(3, -1))
+        tier.scene(True)
+        before = tracemalloc.get_traced_memory()[0]
+        tracemalloc.reset_peak()
+        tier.prepare(True)          # what EXACT's first cast makes: the judging passes' data in packets.c
+        held, peak = (m - before for m in tracemalloc.get_traced_memory())
+    finally:
+        tracemalloc.stop()
+    n = len(tier.F)                 # 61,440 triangles
+    assert tier.native(True) is not None
+    assert held < 100 * n           # g1, g2 (48 B), h_min (8 B), each vertex's triangles (~16 B)
+    assert peak < held + 40 * n     # made a block at a time (the vertices' sort: 36 B per triangle)

@@ -83,10 +83,11 @@ def test_triangles_and_rays_each_within_their_limit_are_bounded_together() -> No
     ds = [{"device": "DistanceSensor", "name": f"d{i}", "number_of_rays": 1024, "aperture": 0.5} for i in range(256)]
     robots = [{"name": f"r{j}", "devices": ds} for j in range(16)]
     probs = problems({"solids": spheres, "robots": robots})
-    assert probs == [("", "building this world would take about 2.9 GiB of memory (3,850,240 triangles ≈ 2.0 GiB, "
+    assert probs == [("", "building this world would take about 2.8 GiB of memory (3,850,240 triangles ≈ 1.9 GiB, "
                           "4,194,304 rays per step ≈ 0.9 GiB), more than the limit of 2 GiB (raise the limits with "
                           "--allow-large)")]
     parse_world({"solids": spheres[:20], "robots": robots})                     # 1.6M triangles: fine
+    parse_world({"solids": spheres, "robots": robots[:1]})   # 3.85M triangles alone: 1.9 GiB at 540 B each, fine
     parse_world({"solids": spheres, "robots": robots}, limits=WorldLimits(build_bytes=4 << 30))
 
 

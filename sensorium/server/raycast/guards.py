@@ -58,32 +58,44 @@ _PRISM_FACES = np.array([
 PRISM_TRIANGLES = len(_PRISM_FACES)
 
 
-def risky_edges(F: np.ndarray, flat: np.ndarray, normal: np.ndarray):
+def risky_edges(F: np.ndarray, flat: np.ndarray, normal: np.ndarray, too_many=None):
     """Risky edges of the flat triangles ``F[flat]`` (``normal``: unit normals per triangle, zero
     for degenerate ones).  Returns (edges (k, 2) vertex indices, ptr, idx): the triangles of edge
-    i are ``idx[ptr[i]:ptr[i + 1]]``."""
+    i are ``idx[ptr[i]:ptr[i + 1]]``; or None if ``too_many(k)`` (counted before they are listed:
+    a triangle soup's every edge is risky)."""
     tri = flat.nonzero()[0]
     if len(tri) == 0:
         return np.zeros((0, 2), dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    f = F[tri].astype(np.int64)
+    # the 3 edges of every flat triangle (edge 3i + c: corner c to the next), as keys lo * M + hi
+    # sorted (stably); the rest is read through that order where needed (~90 B per triangle at the
+    # peak, not ~300: a mesh of millions of triangles builds this)
+    f = F[tri]
     a = f.ravel()
     b = f[:, [1, 2, 0]].ravel()
-    t = np.repeat(tri, 3)
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
-    key = lo * (int(F.max()) + 1) + hi
+    del f
+    M = int(F.max()) + 1
+    fwd = a < b
+    key = np.minimum(a, b).astype(np.int64)
+    key *= M
+    key += np.maximum(a, b)
+    del a, b
     order = np.argsort(key, kind="stable")
-    key, lo, hi, t, fwd = key[order], lo[order], hi[order], t[order], (a < b)[order]
+    key = key[order]
     start = np.r_[True, key[1:] != key[:-1]].nonzero()[0]
     count = np.diff(np.r_[start, len(key)])
     safe = count == 2
     two = start[safe]
-    n1, n2 = normal[t[two]], normal[t[two + 1]]
-    safe[safe] = (fwd[two] != fwd[two + 1]) & (np.einsum("ij,ij->i", n1, n2) >= _COPLANAR)
+    o1, o2 = order[two], order[two + 1]
+    n1, n2 = normal[tri[o1 // 3]], normal[tri[o2 // 3]]
+    safe[safe] = (fwd[o1] != fwd[o2]) & (np.einsum("ij,ij->i", n1, n2) >= _COPLANAR)
     risky = (~safe).nonzero()[0]
-    edges = np.c_[lo[start[risky]], hi[start[risky]]]
+    if too_many is not None and too_many(len(risky)):
+        return None
+    k = key[start[risky]]
+    edges = np.c_[k // M, k % M]
     counts = count[risky]
     ptr = np.r_[0, np.cumsum(counts)]
-    idx = t[np.repeat(start[risky] - ptr[:-1], counts) + np.arange(int(ptr[-1]))]
+    idx = tri[order[np.repeat(start[risky] - ptr[:-1], counts) + np.arange(int(ptr[-1]))] // 3]
     return edges, ptr, idx
 
 
@@ -139,11 +151,11 @@ def candidates(V, edges, ptr, idx, ring, flat, w: float, budget: int) -> tuple[n
     comes within w/2 of i's (coincident or crossing prisms, e.g. the common edge of two touching
     boxes: stepping past one prism's face must not step past the other's unexamined).  None when
     the lists would hold more than ``budget`` entries (counted before they are made: see
-    MAX_CANDIDATES_PER_FLAT_TRIANGLE)."""
+    MAX_CANDIDATES_PER_FLAT_TRIANGLE). ``ring``: the tier's :class:`.tiers.VertexRings`."""
     e_of, tri = np.repeat(np.arange(len(edges)), np.diff(ptr)), idx
-    if int((ring[0][tri + 1] - ring[0][tri]).sum()) > budget:
+    if int(ring.sizes(tri).sum()) > budget:
         return None
-    pos, cand = _expand(ring[0], ring[1], tri)
+    pos, cand = ring.rows(tri)
     own = np.unique(e_of[pos] * (len(flat) + 1) + cand)     # (edge, triangle) keys, sorted
     own_e, own_t = own // (len(flat) + 1), own % (len(flat) + 1)
     own_ptr = np.r_[0, np.cumsum(np.bincount(own_e, minlength=len(edges)))]

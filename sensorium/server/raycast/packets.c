@@ -52,6 +52,7 @@ static void (*commit_scene)(void*);
 static void (*release_scene)(void*);
 static void* (*new_geometry)(void*, int);
 static void* (*new_geometry_buffer)(void*, int, unsigned, int, size_t, size_t);
+static void (*shared_geometry_buffer)(void*, int, unsigned, int, const void*, size_t, size_t, size_t);
 static void (*commit_geometry)(void*);
 static unsigned (*attach_geometry)(void*, void*);
 static void (*release_geometry)(void*);
@@ -67,7 +68,8 @@ const char* sp_open(const char* path) {
   LOAD(device_error, "rtcGetDeviceError") LOAD(new_scene, "rtcNewScene")
   LOAD(set_scene_flags, "rtcSetSceneFlags") LOAD(commit_scene, "rtcCommitScene")
   LOAD(release_scene, "rtcReleaseScene") LOAD(new_geometry, "rtcNewGeometry")
-  LOAD(new_geometry_buffer, "rtcSetNewGeometryBuffer") LOAD(commit_geometry, "rtcCommitGeometry")
+  LOAD(new_geometry_buffer, "rtcSetNewGeometryBuffer")
+  LOAD(shared_geometry_buffer, "rtcSetSharedGeometryBuffer") LOAD(commit_geometry, "rtcCommitGeometry")
   LOAD(attach_geometry, "rtcAttachGeometry") LOAD(release_geometry, "rtcReleaseGeometry")
   LOAD(intersect16, "rtcIntersect16")
   return NULL;
@@ -88,29 +90,39 @@ static void packet_init(struct ray_hit16* r, struct intersect_args* args, int co
   }
 }
 
-static int add_triangles(void* device, void* scene, size_t nv, const float* vertices, size_t nf, const int32_t* faces) {
+/* A triangle geometry of nv vertices and nf faces: `shared`, Embree reads the caller's arrays (which
+ * must outlive the scene and have 16 bytes readable past their ends: Embree loads the last vertex
+ * with a 16-byte load); else it copies them into buffers of its own. */
+static int add_triangles(void* device, void* scene, size_t nv, const float* vertices, size_t nf, const int32_t* faces,
+                         int shared) {
   void* g = new_geometry(device, GEOMETRY_TRIANGLE);
   if (!g) return -1;
-  float* vb = new_geometry_buffer(g, BUFFER_VERTEX, 0, FORMAT_FLOAT3, 3 * sizeof(float), nv);
-  int32_t* ib = new_geometry_buffer(g, BUFFER_INDEX, 0, FORMAT_UINT3, 3 * sizeof(int32_t), nf);
-  if (!vb || !ib) { release_geometry(g); return -1; }
-  memcpy(vb, vertices, nv * 3 * sizeof(float));
-  memcpy(ib, faces, nf * 3 * sizeof(int32_t));
+  if (shared) {
+    shared_geometry_buffer(g, BUFFER_VERTEX, 0, FORMAT_FLOAT3, vertices, 0, 3 * sizeof(float), nv);
+    shared_geometry_buffer(g, BUFFER_INDEX, 0, FORMAT_UINT3, faces, 0, 3 * sizeof(int32_t), nf);
+  } else {
+    float* vb = new_geometry_buffer(g, BUFFER_VERTEX, 0, FORMAT_FLOAT3, 3 * sizeof(float), nv);
+    int32_t* ib = new_geometry_buffer(g, BUFFER_INDEX, 0, FORMAT_UINT3, 3 * sizeof(int32_t), nf);
+    if (!vb || !ib) { release_geometry(g); return -1; }
+    memcpy(vb, vertices, nv * 3 * sizeof(float));
+    memcpy(ib, faces, nf * 3 * sizeof(int32_t));
+  }
   commit_geometry(g);
   attach_geometry(scene, g);
   release_geometry(g);
   return 0;
 }
 
-/* A committed scene of one triangle geometry (id 0) and, when nv1 > 0, a second one (id 1), the
- * vertices copied into Embree's own buffers; NULL on any Embree error. */
+/* A committed scene of one triangle geometry (id 0) and, when nv1 > 0, a second one (id 1); bit k
+ * of `shared`: geometry k's arrays are shared with Embree (see add_triangles), else copied; NULL on
+ * any Embree error. */
 void* sp_new_scene(void* device, int robust, size_t nv0, const float* v0, size_t nf0, const int32_t* f0,
-                   size_t nv1, const float* v1, size_t nf1, const int32_t* f1) {
+                   size_t nv1, const float* v1, size_t nf1, const int32_t* f1, int shared) {
   void* scene = new_scene(device);
   if (!scene) return NULL;
   if (robust) set_scene_flags(scene, SCENE_ROBUST);
-  int bad = nf0 && add_triangles(device, scene, nv0, v0, nf0, f0);
-  if (!bad && nv1) bad = add_triangles(device, scene, nv1, v1, nf1, f1);
+  int bad = nf0 && add_triangles(device, scene, nv0, v0, nf0, f0, shared & 1);
+  if (!bad && nv1) bad = add_triangles(device, scene, nv1, v1, nf1, f1, shared & 2);
   if (!bad) commit_scene(scene);
   if (bad || device_error(device)) { release_scene(scene); return NULL; }
   return scene;
@@ -176,10 +188,12 @@ void sp_intersect(void* scene, size_t n, const float* origins, size_t o_stride, 
  */
 #include <math.h>
 
-/* A tier's arrays (tiers.py, _Tier), read only; `n` triangles, sentinel rows where noted. */
+/* A tier's arrays (tiers.py, _Tier), read only; `n` triangles, sentinel rows where noted. A
+ * triangle's first vertex v0 = V[F[i][0]], its edges e1 = V[F[i][1]] - v0, e2 = V[F[i][2]] - v0 and
+ * its box (the componentwise min and max of its vertices) are taken from V and F where needed:
+ * the values of the numpy path's arrays, without holding 120 bytes per triangle of them. */
 struct sp_tier {
   const double* normal;      /* (n+1, 3) unit normals, zero sentinel row */
-  const double* v0;          /* (n, 3) first vertices (EXACT; NULL for FAST) */
   const double* g1;          /* (n+1, 3) dual basis: barycentric u = (P - v0).g1 (EXACT) */
   const double* g2;          /* (n+1, 3) ... v = (P - v0).g2 (EXACT) */
   const double* h_min;       /* (n,) smallest height (EXACT) */
@@ -199,12 +213,8 @@ struct sp_tier {
   double ng_max;             /* largest |Embree Ng| */
   int64_t guarded;           /* geometry 1 of the scene holds edge guards */
   /* EXACT only: */
-  const double* e1;          /* (n, 3) edges v1 - v0, v2 - v0 */
-  const double* e2;
-  const double* t_lo;        /* (n, 3) triangle boxes */
-  const double* t_hi;
-  const int64_t* ring_ptr;   /* CSR: the triangles sharing a vertex with triangle i */
-  const int64_t* ring_idx;
+  const int64_t* ring_vptr;  /* CSR: the triangles of vertex v (ascending); triangle i's vertex ring */
+  const int32_t* ring_tri;   /* is its three corners' lists in order */
   const int64_t* guard_ptr;  /* CSR: the flat triangles to test for a ray near risky edge e */
   const int64_t* guard_idx;
   int64_t n_tri;
@@ -338,9 +348,15 @@ static inline void cross3(const double* a, const double* b, double* out) {
   out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
+/* Triangle tri's first vertex (tiers.py's v0 row) */
+static inline const double* first_vertex(const struct sp_tier* T, int64_t tri) { return T->V + 3 * (size_t)T->F[3 * tri]; }
+
 /* exact._moller_trumbore for one (ray, triangle): inside within the barycentric tolerance, and t */
 static int moller_trumbore(const struct sp_tier* T, int64_t tri, const double* o, const double* d, double* t_out) {
-  const double *v0 = T->v0 + 3 * tri, *e1 = T->e1 + 3 * tri, *e2 = T->e2 + 3 * tri;
+  const int32_t* f = T->F + 3 * tri;
+  const double *v0 = T->V + 3 * (size_t)f[0], *v1 = T->V + 3 * (size_t)f[1], *v2 = T->V + 3 * (size_t)f[2];
+  const double e1[3] = {v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]};   /* tiers.py's e1, e2 rows */
+  const double e2[3] = {v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]};
   double p[3], q[3], sv[3] = {o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]};
   cross3(d, e2, p);
   double inv = 1.0 / dot3(e1, p);
@@ -362,16 +378,17 @@ static int refine_flat(const struct sp_tier* T, int64_t* tri, const double* o, c
   if (moller_trumbore(T, *tri, o, d, &t) && t >= lo && t <= hi) { *t_out = t; return 1; }
   double best = INF_D;
   int64_t btri = -1;
-  for (int64_t k = T->ring_ptr[*tri]; k < T->ring_ptr[*tri + 1]; k++) {
-    int64_t c = T->ring_idx[k];
+  const int32_t* corner = T->F + 3 * *tri;
+  for (int j = 0; j < 3; j++) for (int64_t k = T->ring_vptr[corner[j]]; k < T->ring_vptr[corner[j] + 1]; k++) {
+    int64_t c = (int64_t)T->ring_tri[k];
     double tc;
     int ok = moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= hi;
     if (!ok) continue;
     if (tc < best) best = tc;
   }
   if (isfinite(best)) {
-    for (int64_t k = T->ring_ptr[*tri]; k < T->ring_ptr[*tri + 1]; k++) {   /* the last candidate at best */
-      int64_t c = T->ring_idx[k];
+    for (int j = 0; j < 3; j++) for (int64_t k = T->ring_vptr[corner[j]]; k < T->ring_vptr[corner[j] + 1]; k++) {
+      int64_t c = (int64_t)T->ring_tri[k];   /* the last candidate at best */
       double tc;
       if (moller_trumbore(T, c, o, d, &tc) && tc >= lo && tc <= hi && tc == best) btri = c;
     }
@@ -387,7 +404,13 @@ static int refine_flat(const struct sp_tier* T, int64_t* tri, const double* o, c
   btri = -1;
   for (int64_t c = 0; c < T->n_tri; c++) {
     if (T->tri_slot[c] >= 0) continue;
-    const double *a = T->t_lo + 3 * c, *b = T->t_hi + 3 * c;
+    const int32_t* f = T->F + 3 * c;   /* its box: tiers.py's t_lo, t_hi rows (numpy's min/max) */
+    const double *p0 = T->V + 3 * (size_t)f[0], *p1 = T->V + 3 * (size_t)f[1], *p2 = T->V + 3 * (size_t)f[2];
+    double a[3], b[3];
+    for (int j = 0; j < 3; j++) {
+      a[j] = np_min(np_min(p0[j], p1[j]), p2[j]);
+      b[j] = np_max(np_max(p0[j], p1[j]), p2[j]);
+    }
     if (!(P[0] >= a[0] - g && P[1] >= a[1] - g && P[2] >= a[2] - g && P[0] <= b[0] + g && P[1] <= b[1] + g &&
           P[2] <= b[2] + g)) continue;
     if (excl && T->tri_owner[c] == *excl) continue;
@@ -544,7 +567,7 @@ void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double*
       int32_t slot = T->tri_slot[tri];
       if (slot < 0) {   /* a flat triangle: its float64 plane, barycentrics checked near edges */
         const double* nrm = T->normal + 3 * tri;
-        const double* v0 = T->v0 + 3 * tri;
+        const double* v0 = first_vertex(T, tri);
         double dn = d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2];
         double wv[3] = {v0[0] - o[0], v0[1] - o[1], v0[2] - o[2]};
         double tx = dot3(wv, nrm) / dn;

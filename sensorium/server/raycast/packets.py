@@ -149,7 +149,7 @@ def _load() -> None:
     lib.sp_new_device.restype = vp
     lib.sp_release_device.argtypes = [vp]
     lib.sp_new_scene.restype = vp
-    lib.sp_new_scene.argtypes = [vp, i, sz, vp, sz, vp, sz, vp, sz, vp]
+    lib.sp_new_scene.argtypes = [vp, i, sz, vp, sz, vp, sz, vp, sz, vp, i]
     lib.sp_release_scene.argtypes = [vp]
     lib.sp_intersect.restype = None
     lib.sp_intersect.argtypes = [vp, sz, vp, sz, vp, vp, i, i]
@@ -194,6 +194,22 @@ def _ptr(a: np.ndarray | None) -> int | None:
     return None if a is None else a.ctypes.data
 
 
+def padded(a: np.ndarray, dtype) -> np.ndarray:
+    """``a`` as a C-contiguous array of ``dtype`` that a :class:`Scene` shares with Embree instead of
+    copying it (Embree reads the last vertex with a 16-byte load: 16 bytes readable past the end)."""
+    a = np.asarray(a)
+    out = np.empty(a.size + 16 // np.dtype(dtype).itemsize, dtype=dtype)[:a.size].reshape(a.shape)
+    out[...] = a
+    return out
+
+
+def _shareable(a: np.ndarray) -> bool:
+    """True if ``a`` is a view with 16 bytes of its own buffer past its end (see :func:`padded`)."""
+    b = a.base
+    return (isinstance(b, np.ndarray) and a.flags.c_contiguous and b.flags.c_contiguous
+            and b.ctypes.data <= a.ctypes.data and a.ctypes.data + a.nbytes + 16 <= b.ctypes.data + b.nbytes)
+
+
 class Device:
     """An Embree device of the packet path."""
 
@@ -218,9 +234,13 @@ class Scene:
         v0, f0 = np.ascontiguousarray(V, dtype=np.float32), np.ascontiguousarray(F, dtype=np.int32)
         v1 = None if V1 is None else np.ascontiguousarray(V1, dtype=np.float32)
         f1 = None if F1 is None else np.ascontiguousarray(F1, dtype=np.int32)
+        # geometry 0's arrays shared with Embree where they allow it (the tier's, made with
+        # `padded`: no second copy of the vertices and faces per scene), else copied; kept alive here
+        shared = int(v0 is V and f0 is F and _shareable(v0) and _shareable(f0))
+        self._shared = (v0, f0) if shared else ()
         self.handle = self.lib.sp_new_scene(device.handle, int(robust), len(v0), _ptr(v0), len(f0), _ptr(f0),
                                             0 if v1 is None else len(v1), _ptr(v1), 0 if f1 is None else len(f1),
-                                            _ptr(f1))
+                                            _ptr(f1), shared)
         if not self.handle:
             raise RuntimeError("Embree could not build the scene")
         self._local = threading.local()   # per thread: scratch buffer, last directions array
@@ -283,41 +303,42 @@ class TierArrays(ctypes.Structure):
     """``struct sp_tier`` of packets.c: pointers to a tier's arrays (see :func:`tier_arrays`)."""
 
     _fields_ = [(name, ctypes.c_void_p) for name in (
-        "normal", "v0", "g1", "g2", "h_min", "V", "F", "tri_slot", "tri_shape", "tri_owner", "c_code", "c_r", "c_h",
+        "normal", "g1", "g2", "h_min", "V", "F", "tri_slot", "tri_shape", "tri_owner", "c_code", "c_r", "c_h",
         "c_rot", "c_pos", "c_shape", "c_isolated")] + [("eps", ctypes.c_double), ("ng_max", ctypes.c_double),
                                                        ("guarded", ctypes.c_int64)] + [
-        (name, ctypes.c_void_p) for name in ("e1", "e2", "t_lo", "t_hi", "ring_ptr", "ring_idx", "guard_ptr",
-                                             "guard_idx")] + [
+        (name, ctypes.c_void_p) for name in ("ring_vptr", "ring_tri", "guard_ptr", "guard_idx")] + [
         ("n_tri", ctypes.c_int64), ("prism_triangles", ctypes.c_int64), ("grow", ctypes.c_double),
         ("bare", ctypes.c_void_p)]
 
 
 def tier_arrays(tier, exact: bool):
     """(struct, address, arrays kept alive) describing ``tier`` (a :class:`.tiers._Tier`) to the
-    judging passes of packets.c; ``exact``: with the float64 refinement data."""
+    judging passes of packets.c; ``exact``: with the float64 refinement data it reads (the dual
+    basis, the vertex rings, the guards' lists). The tier's own arrays, never copies: each already
+    has the dtype C reads (a mismatch is a bug, not a conversion that would double the memory)."""
     keep = []
 
     def ptr(a, dtype):
-        a = np.ascontiguousarray(a, dtype=dtype)
+        if a.dtype != dtype or not a.flags.c_contiguous:
+            raise TypeError(f"tier array of {a.dtype} {a.shape} where packets.c reads contiguous {np.dtype(dtype)}")
         keep.append(a)
         return a.ctypes.data
 
     f64, i32, i64 = np.float64, np.int32, np.int64
+    isolated = np.ascontiguousarray(tier.c_isolated, dtype=np.uint8)   # one byte per curved shape
+    keep.append(isolated)
     st = TierArrays(
         normal=ptr(tier.normal, f64), V=ptr(tier.V, f64), F=ptr(tier.F, i32), tri_slot=ptr(tier.tri_slot, i32),
         tri_shape=ptr(tier.tri_shape, i64), tri_owner=ptr(tier.tri_owner, i32),
         c_code=ptr(tier.c_code, i64), c_r=ptr(tier.c_r, f64), c_h=ptr(tier.c_h, f64),
         c_rot=ptr(tier.c_rot, f64), c_pos=ptr(tier.c_pos, f64), c_shape=ptr(tier.c_shape, i64),
-        c_isolated=ptr(tier.c_isolated, np.uint8), eps=tier.eps, ng_max=tier.ng_max,
+        c_isolated=isolated.ctypes.data, eps=tier.eps, ng_max=tier.ng_max,
         guarded=int(exact and tier.guard is not None))
     if exact:
         from sensorium.server.raycast.guards import PRISM_TRIANGLES
 
-        st.v0, st.g1, st.g2, st.h_min = (ptr(tier.v0, f64), ptr(tier.g1, f64), ptr(tier.g2, f64),
-                                          ptr(tier.h_min, f64))
-        st.e1, st.e2, st.t_lo, st.t_hi = (ptr(tier.e1, f64), ptr(tier.e2, f64), ptr(tier.t_lo, f64),
-                                          ptr(tier.t_hi, f64))
-        st.ring_ptr, st.ring_idx = ptr(tier.ring[0], i64), ptr(tier.ring[1], i64)
+        st.g1, st.g2, st.h_min = ptr(tier.g1, f64), ptr(tier.g2, f64), ptr(tier.h_min, f64)
+        st.ring_vptr, st.ring_tri = ptr(tier.ring.vptr, i64), ptr(tier.ring.tri_of, i32)
         st.n_tri, st.prism_triangles, st.grow = len(tier.F), PRISM_TRIANGLES, tier.eps + 8.0 * tier.res
         guard = tier.guard
         if guard is not None:

@@ -59,11 +59,7 @@ class Refiner:
         tri = tri.copy()
         bad = (~ok).nonzero()[0]
         if len(bad):
-            ptr, idx = tier.ring
-            starts = ptr[tri[bad]]
-            counts = ptr[tri[bad] + 1] - starts
-            ray = np.repeat(np.arange(len(bad)), counts)
-            cand = idx[np.repeat(starts - (np.cumsum(counts) - counts), counts) + np.arange(int(counts.sum()))]
+            ray, cand = tier.ring.rows(tri[bad])
             okc, tc = _moller_trumbore(Ot[bad][ray], D[bad][ray], tier.v0[cand], tier.e1[cand], tier.e2[cand])
             okc &= (tc >= lo[bad][ray]) & (tc <= hi[bad][ray])
             tc = np.where(okc, tc, _INF)

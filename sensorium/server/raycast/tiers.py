@@ -7,6 +7,8 @@ library embreex loaded).
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from embreex import rtcore as _rtc
 from embreex import rtcore_scene as _rts
@@ -38,17 +40,39 @@ def new_device():
 
 def _welded(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The referenced vertices of a mesh, one per distinct position (in order of first use), and
-    its faces on them."""
-    used, f = np.unique(f, return_inverse=True)
+    its faces on them. (Positions are grouped by their bytes, as np.unique of 24-byte rows would,
+    through a stable sort of the three coordinates' int64 views: ~40 B per vertex at the peak
+    instead of ~100; a binary STL file gives three vertices per triangle.)"""
+    f = np.asarray(f).reshape(-1, 3)
+    present = np.zeros(len(v), dtype=bool)
+    present[f.ravel()] = True
+    used = present.nonzero()[0]                  # np.unique(f) and its inverse, without sorting f
+    if len(used) < len(v):
+        rank = np.cumsum(present) - 1
+        f = rank[f]
+        del rank
+    del present
     v = np.ascontiguousarray(v[used], dtype=np.float64)
-    _, first, inverse = np.unique(v.view(np.dtype((np.void, 24))).ravel(), return_index=True, return_inverse=True)
+    del used
+    bits = v.view(np.int64)
+    order = np.lexsort((bits[:, 2], bits[:, 1], bits[:, 0]))   # stable: each group's first is its first use
+    new = np.zeros(len(v), dtype=bool)
+    new[:1] = True
+    for k in range(3):
+        col = bits[order, k]
+        new[1:] |= col[1:] != col[:-1]
+        del col
+    first = order[new]                            # per distinct position (sorted by bytes): its first use
     if len(first) == len(v):
-        return v, f.reshape(-1, 3)
+        return v, np.asarray(f, dtype=np.int64).reshape(-1, 3)
+    group = np.empty(len(v), dtype=np.int64)
+    group[order] = np.cumsum(new) - 1
+    del order, new
     keep = np.sort(first)                        # distinct positions, in their order in v
     rank = np.empty(len(v), dtype=np.int64)
     rank[keep] = np.arange(len(keep))
-    to = rank[first[inverse.ravel()]]            # every vertex -> its position's first occurrence
-    return v[keep], to[f.reshape(-1, 3)]
+    to = rank[first[group]]                      # every vertex -> its position's first occurrence
+    return v[keep], to[f]
 
 
 class _Tier:
@@ -119,30 +143,39 @@ class _Tier:
             c_pos.append(pose.translation - self.anchor)
             c_shape.append(sid)
             c_bound.append(float(np.linalg.norm(verts[k] - pose.translation, axis=1).max()))
-        V = np.vstack(verts) - self.anchor
-        F = np.vstack(faces)
-        F = np.ascontiguousarray(F, dtype=np.int32)   # one index array: Embree's, and ours
+        self.has_curved = bool(curved)
+        del curved   # the shapes' local vertices
+        V = np.vstack(verts)
+        V -= self.anchor
+        # from here on only the shapes' boxes are needed (see _isolation): not a second copy of V
+        verts = [np.array([v.min(0), v.max(0)]) for v in verts]
+        F = packets.padded(np.vstack(faces), np.int32)   # one index array: Embree's (shared with its scenes), and ours
+        del faces
         self.V, self.F = V, F
-        self.radius = float(np.linalg.norm(V, axis=1).max()) + 4.0 * self.res
+        self.radius = float(np.max([np.linalg.norm(V[a:a + _BLOCK], axis=1).max() for a in range(0, len(V), _BLOCK)])) \
+            + 4.0 * self.res
         self.tri_shape = np.append(np.concatenate(tri_shape), -1)  # sentinel row for primID = -1
-        v0 = V[F[:, 0]]
-        e1 = V[F[:, 1]] - v0
-        e2 = V[F[:, 2]] - v0
-        nrm = np.cross(e1, e2)
-        self.ng_max = float(np.linalg.norm(nrm, axis=1).max())
-        with np.errstate(invalid="ignore", divide="ignore"):
-            nrm /= np.linalg.norm(nrm, axis=1)[:, None]
-        self.normal = np.vstack([np.nan_to_num(nrm), np.zeros((1, 3))])
-        del v0, e1, e2, nrm
-        # float64 refinement data (v0, e1, e2, g1, g2, t_lo, t_hi, ring) is made on first use: FAST
-        # needs none of it, so a static scene costs ~1/3 of the memory (see _exact_data)
-        self._exact: dict[str, np.ndarray] | None = None
+        # unit normals (zero sentinel row), a block of triangles at a time: the temporaries stay a
+        # few MB whatever the tier (every value is computed row by row: the same bits)
+        self.normal = np.zeros((len(F) + 1, 3))
+        ng = [0.0]
+        for a, b, _, e1, e2 in _edges(V, F):
+            nrm = np.cross(e1, e2)
+            norm = np.linalg.norm(nrm, axis=1)
+            ng.append(norm.max())
+            with np.errstate(invalid="ignore", divide="ignore"):
+                nrm /= norm[:, None]
+            self.normal[a:b] = np.nan_to_num(nrm)
+        self.ng_max = float(np.max(ng[1:])) if len(F) else 0.0
+        # float64 refinement data is made on first use, each array when it is needed: FAST needs
+        # none of it; EXACT in packets.c only the dual basis (see _exact_data) and the vertex rings
+        self._exact: dict[str, np.ndarray] = {}
+        self._making = threading.Lock()
         owners = owner_of[self.tri_shape[:-1]]
         self.owned = bool((owners >= 0).any())
         # -2 marks "no owner" so it never equals an exclude_owner value (>= -1)
         self.tri_owner = np.append(np.where(owners >= 0, owners, -2), -2).astype(np.int32)   # robot indices
         # curved shapes, indexed by "slot"
-        self.has_curved = bool(curved)
         self.c_shape = np.array(c_shape, dtype=np.int64)
         slot_of_shape = np.full(int(self.tri_shape.max()) + 2, -1, dtype=np.int64)
         slot_of_shape[self.c_shape] = np.arange(len(c_shape))
@@ -177,50 +210,67 @@ class _Tier:
             self.bound = ("cylinder", self.c_rot[0], self.c_pos[0], self.c_rad[0] + slack, self.c_ax[0] + slack)
         else:
             self.bound = ("box", V.min(0) - slack, V.max(0) + slack)
-        self._ring: tuple[np.ndarray, np.ndarray] | None = None
+        self._ring: VertexRings | None = None
         self._guard: tuple | None = None
         # Embree keeps pointers into these buffers: hold references for the scenes' lifetime
-        self._v32 = np.ascontiguousarray(V, dtype=_F32)
+        self._v32 = packets.padded(V, _F32)   # shared with the packet path's scenes (see packets.Scene)
         self._f32 = F
         self._device = device
         self._scenes: dict[bool | str, object] = {}
         self._native: dict[bool, tuple] = {}   # per mode: the tier described to packets.c's judging passes
 
-    def _exact_data(self) -> dict[str, np.ndarray]:
-        """Per-triangle float64 data of the refinement, computed once on first use (EXACT, or a
-        FAST ray redone by the general loop): v0, e1, e2; the dual basis g1, g2 of (e1, e2) in each
-        triangle's plane (barycentrics u = (P - v0).g1, v = (P - v0).g2, zero sentinel row); the
-        per-triangle boxes t_lo, t_hi; the smallest height h_min; the normals' columns."""
-        if self._exact is None:
+    def _exact_data(self, *keys: str) -> dict[str, np.ndarray]:
+        """Per-triangle float64 data of EXACT's refinement, each group computed once on first use
+        (under a lock: blocks of a cast run on threads) and named in ``keys`` by its first array:
+        "v0" -- v0, e1, e2; "g1" -- the dual basis g1, g2 of (e1, e2) in each triangle's plane
+        (barycentrics u = (P - v0).g1, v = (P - v0).g2, zero sentinel row) and the smallest height
+        h_min; "t_lo" -- the per-triangle boxes t_lo, t_hi; "normal_cols" -- the normals' columns.
+        packets.c reads only the "g1" group (it takes v0, e1, e2 and the boxes from V and F, the
+        same values): a tier judged there holds ~56 B of it per triangle instead of ~250 B."""
+        got = self._exact
+        if all(k in got for k in keys):
+            return got
+        with self._making:
             V, F = self.V, self.F
-            v0 = V[F[:, 0]]
-            e1 = V[F[:, 1]] - v0
-            e2 = V[F[:, 2]] - v0
-            g11, g12, g22 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                inv = 1.0 / (g11 * g22 - g12 * g12)
-            inv = np.where(np.isfinite(inv), inv, 0.0)[:, None]
-            g1 = np.vstack([(g22[:, None] * e1 - g12[:, None] * e2) * inv, np.zeros((1, 3))])
-            g2 = np.vstack([(g11[:, None] * e2 - g12[:, None] * e1) * inv, np.zeros((1, 3))])
-            tv = V[F]
-            # smallest height: every point at barycentric margin m is >= m * h_min from the edges
-            longest = np.sqrt(np.maximum(np.maximum(g11, g22), _dot(e2 - e1, e2 - e1)))
-            with np.errstate(invalid="ignore", divide="ignore"):
-                h_min = np.linalg.norm(np.cross(e1, e2), axis=1) / longest
-            h_min = np.where(np.isfinite(h_min), h_min, 0.0)
-            self._exact = {"v0": v0, "e1": e1, "e2": e2, "g1": g1, "g2": g2, "t_lo": tv.min(1), "t_hi": tv.max(1),
-                           "h_min": h_min, "normal_cols": tuple(np.ascontiguousarray(self.normal[:, k]) for k in range(3))}
-        return self._exact
+            if "v0" in keys and "v0" not in got:
+                v0 = V[F[:, 0]]
+                got.update(v0=v0, e1=V[F[:, 1]] - v0, e2=V[F[:, 2]] - v0)
+            if "g1" in keys and "g1" not in got:
+                n = len(F)
+                g1, g2, h_min = np.zeros((n + 1, 3)), np.zeros((n + 1, 3)), np.empty(n)
+                for a, b, _, e1, e2 in _edges(V, F):   # row by row, a block at a time: the same bits
+                    g11, g12, g22 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
+                    with np.errstate(invalid="ignore", divide="ignore"):
+                        inv = 1.0 / (g11 * g22 - g12 * g12)
+                    inv = np.where(np.isfinite(inv), inv, 0.0)[:, None]
+                    g1[a:b] = (g22[:, None] * e1 - g12[:, None] * e2) * inv
+                    g2[a:b] = (g11[:, None] * e2 - g12[:, None] * e1) * inv
+                    # smallest height: every point at barycentric margin m is >= m * h_min from the edges
+                    longest = np.sqrt(np.maximum(np.maximum(g11, g22), _dot(e2 - e1, e2 - e1)))
+                    with np.errstate(invalid="ignore", divide="ignore"):
+                        h = np.linalg.norm(np.cross(e1, e2), axis=1) / longest
+                    h_min[a:b] = np.where(np.isfinite(h), h, 0.0)
+                got.update(g1=g1, g2=g2, h_min=h_min)
+            if "t_lo" in keys and "t_lo" not in got:
+                n = len(F)
+                t_lo, t_hi = np.empty((n, 3)), np.empty((n, 3))
+                for a in range(0, n, _BLOCK):
+                    tv = V[F[a:a + _BLOCK]]
+                    t_lo[a:a + _BLOCK], t_hi[a:a + _BLOCK] = tv.min(1), tv.max(1)
+                got.update(t_lo=t_lo, t_hi=t_hi)
+            if "normal_cols" in keys and "normal_cols" not in got:
+                got["normal_cols"] = tuple(np.ascontiguousarray(self.normal[:, k]) for k in range(3))
+        return got
 
-    v0 = property(lambda self: self._exact_data()["v0"])
-    e1 = property(lambda self: self._exact_data()["e1"])
-    e2 = property(lambda self: self._exact_data()["e2"])
-    g1 = property(lambda self: self._exact_data()["g1"])
-    g2 = property(lambda self: self._exact_data()["g2"])
-    t_lo = property(lambda self: self._exact_data()["t_lo"])
-    t_hi = property(lambda self: self._exact_data()["t_hi"])
-    h_min = property(lambda self: self._exact_data()["h_min"])
-    normal_cols = property(lambda self: self._exact_data()["normal_cols"])
+    v0 = property(lambda self: self._exact_data("v0")["v0"])
+    e1 = property(lambda self: self._exact_data("v0")["e1"])
+    e2 = property(lambda self: self._exact_data("v0")["e2"])
+    g1 = property(lambda self: self._exact_data("g1")["g1"])
+    g2 = property(lambda self: self._exact_data("g1")["g2"])
+    t_lo = property(lambda self: self._exact_data("t_lo")["t_lo"])
+    t_hi = property(lambda self: self._exact_data("t_lo")["t_hi"])
+    h_min = property(lambda self: self._exact_data("g1")["h_min"])
+    normal_cols = property(lambda self: self._exact_data("normal_cols")["normal_cols"])
 
     def first_vertex(self, tri: np.ndarray) -> np.ndarray:
         """v0 of the given triangles, without the full refinement data (FAST's self-hit test)."""
@@ -261,11 +311,13 @@ class _Tier:
         data, guards and vertex rings), so that blocks of rays on several threads only read."""
         self.scene(exact)
         if exact:
-            self._exact_data()
-            _ = self.ring
             if self.guard is not None:
                 self.bare_scene()
-        self.native(exact)
+            if self.native(exact) is None or not self.guarded:   # the numpy loop judges EXACT's hits
+                self._exact_data("v0", "g1", "t_lo", "normal_cols")
+                _ = self.ring
+        else:
+            self.native(exact)
 
     def native(self, exact: bool) -> int | None:
         """Address of this tier's ``struct sp_tier`` for the judging passes of packets.c (made once
@@ -314,12 +366,19 @@ class _Tier:
         Built on first use."""
         if self._guard is None:
             flat = ~self.tri_curved[:-1]
-            edges, ptr, idx = risky_edges(self.F, flat, self.normal[:-1])
             n_flat = int(np.count_nonzero(flat))
+
+            def too_many(k: int) -> bool:   # too many to guard, or too dense
+                return k > MAX_GUARDED_EDGES or (k > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat
+                                                 and PRISM_TRIANGLES * k > MAX_PRISM_TRIANGLES_PER_TRIANGLE * len(self.F))
+
+            found_edges = risky_edges(self.F, flat, self.normal[:-1], too_many)
+            if found_edges is None:
+                self._guard = (None, False)
+                return None
+            edges, ptr, idx = found_edges
             w = 4.0 * self.eps
-            dense = (len(edges) > MAX_EDGES_PER_FLAT_TRIANGLE * n_flat
-                     and PRISM_TRIANGLES * len(edges) > MAX_PRISM_TRIANGLES_PER_TRIANGLE * len(self.F))
-            if len(edges) == 0 or len(edges) > MAX_GUARDED_EDGES or dense \
+            if len(edges) == 0 \
                     or w > MAX_WIDTH_PER_EDGE_LENGTH * float(np.median(np.linalg.norm(
                         self.V[edges[:, 0]] - self.V[edges[:, 1]], axis=1))):
                 self._guard = (None, len(edges) == 0)
@@ -361,18 +420,55 @@ class _Tier:
         return out
 
     @property
-    def ring(self) -> tuple[np.ndarray, np.ndarray]:
-        """CSR (ptr, idx): for each triangle, the triangles sharing one of its vertices (itself
-        included).  Built on first use (EXACT only)."""
+    def ring(self) -> VertexRings:
+        """The vertex rings: for each triangle, the triangles sharing one of its vertices (itself
+        included), read from the triangles of each vertex.  Built on first use (EXACT only)."""
         if self._ring is None:
-            flat = self.F.ravel()
-            tri_of = np.argsort(flat, kind="stable") // 3
-            deg = np.bincount(flat, minlength=len(self.V))
-            vptr = np.concatenate([[0], np.cumsum(deg)])
-            lens = deg[flat]
-            total = int(lens.sum())
-            first = np.repeat(vptr[flat] - (np.cumsum(lens) - lens), lens)
-            idx = tri_of[first + np.arange(total)]
-            ptr = np.concatenate([[0], np.cumsum(lens.reshape(-1, 3).sum(1))])
-            self._ring = (ptr, idx)
+            with self._making:
+                if self._ring is None:
+                    self._ring = VertexRings(self.F, len(self.V))
         return self._ring
+
+
+class VertexRings:
+    """The vertex rings of faces F, kept as the triangles of each vertex: CSR (``vptr`` int64 per
+    vertex, ``tri_of`` int32, ascending) -- 3 entries per triangle. The ring of triangle i is, for
+    each corner of i in order, that corner's list: reading it from here costs nothing more, while
+    storing the rings would take ~18 entries per triangle of a closed mesh and grow with the square
+    of a vertex's valence (a fan of n triangles around one vertex: n² entries)."""
+
+    def __init__(self, F: np.ndarray, n_vertices: int) -> None:
+        self.F = F
+        flat = F.ravel()
+        order = np.argsort(flat, kind="stable")
+        order //= 3
+        self.tri_of = order.astype(np.int32)
+        del order
+        self.deg = np.bincount(flat, minlength=n_vertices)
+        self.vptr = np.concatenate([[0], np.cumsum(self.deg)])
+
+    def sizes(self, tri: np.ndarray) -> np.ndarray:
+        """The ring length of each triangle listed."""
+        return self.deg[self.F[tri]].sum(1)
+
+    def rows(self, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(position in ``tri``, ring member) of every member of the rings of the triangles listed,
+        ring after ring, each in ring order."""
+        v = self.F[tri].ravel()
+        cnt = self.deg[v]
+        pos = np.repeat(np.repeat(np.arange(len(tri)), 3), cnt)
+        first = np.repeat(self.vptr[v] - (np.cumsum(cnt) - cnt), cnt)
+        first += np.arange(len(first))
+        return pos, self.tri_of[first]
+
+
+_BLOCK = 1 << 16   # triangles per block of the per-triangle arrays' computations (a few MB of temporaries)
+
+
+def _edges(V: np.ndarray, F: np.ndarray):
+    """(a, b, v0, e1, e2) for the triangles F[a:b], a block at a time: v0 = V[F[:, 0]], e1 = V[F[:, 1]]
+    - v0, e2 = V[F[:, 2]] - v0 (the values of the whole arrays, row by row)."""
+    for a in range(0, len(F), _BLOCK):
+        f = F[a:a + _BLOCK]
+        v0 = V[f[:, 0]]
+        yield a, a + len(f), v0, V[f[:, 1]] - v0, V[f[:, 2]] - v0

@@ -572,7 +572,7 @@ class TierTracer(Refiner):
                             dn[edge] = _dot(D[r], nrm[edge])
                     else:
                         tx = np.minimum(t_e[h[fl]], lim[rows])
-                        gap = np.abs(_dot(_rows(Ot, rows) - tier.v0.take(tri, axis=0), nrm))
+                        gap = np.abs(_dot(_rows(Ot, rows) - tier.first_vertex(tri), nrm))
                         ok = ~((t_e[h[fl]] < seg[rows] + eps) & (gap <= 2.0 * eps))  # self-hit
                     acc = ok & (tx < best_t[rows])
                     if len(rows) == m and acc.all():

@@ -210,13 +210,21 @@ def valid_faces(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
     if len(faces) == 0:
         return faces
-    distinct = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
-    v = np.asarray(vertices, dtype=np.float64)[faces]
-    e1, e2, e3 = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0], v[:, 2] - v[:, 1]
-    area2 = np.linalg.norm(np.cross(e1, e2), axis=1)
-    longest2 = np.max(np.stack([(e1 * e1).sum(1), (e2 * e2).sum(1), (e3 * e3).sum(1)]), axis=0)
-    # twice the area vs longest edge squared: below ~1e-14 the normal is numerical noise
-    return faces[distinct & (area2 > 1e-14 * longest2)]
+    vertices = np.asarray(vertices, dtype=np.float64)
+    keep = np.empty(len(faces), dtype=bool)
+    for a in range(0, len(faces), _BLOCK):   # a block at a time: the temporaries stay a few MB
+        f = faces[a:a + _BLOCK]
+        distinct = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+        v = vertices[f]
+        e1, e2, e3 = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0], v[:, 2] - v[:, 1]
+        area2 = np.linalg.norm(np.cross(e1, e2), axis=1)
+        longest2 = np.max(np.stack([(e1 * e1).sum(1), (e2 * e2).sum(1), (e3 * e3).sum(1)]), axis=0)
+        # twice the area vs longest edge squared: below ~1e-14 the normal is numerical noise
+        keep[a:a + len(f)] = distinct & (area2 > 1e-14 * longest2)
+    return faces[keep]
+
+
+_BLOCK = 1 << 16   # faces per block of valid_faces
 
 
 def _orient_outward(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

@@ -32,10 +32,14 @@ MiB = 1 << 20
 GiB = 1 << 30
 MAX_COORDINATE_M = 1e5          # |x|, |y|, |z| of a pose set at run time (set_pose, set_field): 100 km
 # What building a world costs in the server process, per unit (peak resident memory of `sensorium
-# probe WORLD --steps 1 --enable all:32`, EXACT, worst cases measured: `sensorium bench --only limits`):
-# a triangle of the ray engine's scene with its EXACT edge guards ~515 B (~235 B without them), a
-# ray cast per step ~200 B (distance sensor rays, lidar beams, light occlusion rays). With margin:
-BYTES_PER_TRIANGLE = 560
+# probe WORLD --steps 1 --enable all:32` above a trivial world's, FAST and EXACT, the packet path on
+# and off; worlds of ~1M triangles, 2026-12-03). A triangle: worst a binary STL triangle soup
+# (three vertices of its own per triangle) without the packet path (embreex copies the vertices),
+# ~477 B; with it ~430 B; a flat STL grid under EXACT with edge guards (its Embree scene twice, with
+# and without the guards) ~415 B; curved tessellations (spheres) ~256 B EXACT, ~230 B FAST.
+# BYTES_PER_TRIANGLE is the worst + 13%. A ray cast per step ~200 B (distance sensor rays, lidar
+# beams, light occlusion rays: `sensorium bench --only limits`). With margin:
+BYTES_PER_TRIANGLE = 540
 BYTES_PER_RAY = 220
 
 
