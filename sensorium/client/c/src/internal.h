@@ -19,6 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <webots/lidar_point.h>
 #include <webots/types.h>
 
 /* ------------------------------------------------------------------ error codes (PROTOCOL.md 3.2) */

@@ -291,3 +291,61 @@ WbSimulationMode wb_supervisor_simulation_get_mode(void) {
   sn_reply_free(&rep);
   return (WbSimulationMode)v;
 }
+
+/* ------------------------------------------------------------------ contact points */
+/* No physics here: a node never touches anything, so every query answers "none". The supervisor check
+ * still applies, as for every wb_supervisor_* function. */
+const double *wb_supervisor_node_get_contact_point(WbNodeRef node, int index) {
+  (void)node;
+  (void)index;
+  supervisor("wb_supervisor_node_get_contact_point");
+  return sn_no_values();
+}
+
+WbNodeRef wb_supervisor_node_get_contact_point_node(WbNodeRef node, int index) {
+  (void)node;
+  (void)index;
+  supervisor("wb_supervisor_node_get_contact_point_node");
+  return NULL;
+}
+
+int wb_supervisor_node_get_number_of_contact_points(WbNodeRef node, bool include_descendants) {
+  (void)node;
+  (void)include_descendants;
+  supervisor("wb_supervisor_node_get_number_of_contact_points");
+  return 0;
+}
+
+WbContactPoint *wb_supervisor_node_get_contact_points(WbNodeRef node, bool include_descendants, int *size) {
+  (void)node;
+  (void)include_descendants;
+  if (size != NULL)
+    *size = 0;
+  supervisor("wb_supervisor_node_get_contact_points");
+  return NULL;
+}
+
+void wb_supervisor_node_enable_contact_points_tracking(WbNodeRef node, int sampling_period, bool include_descendants) {
+  (void)node;
+  (void)sampling_period;
+  (void)include_descendants;
+  supervisor("wb_supervisor_node_enable_contact_points_tracking");
+}
+
+void wb_supervisor_node_disable_contact_points_tracking(WbNodeRef node) {
+  (void)node;
+  supervisor("wb_supervisor_node_disable_contact_points_tracking");
+}
+
+void wb_supervisor_node_enable_contact_point_tracking(WbNodeRef node, int sampling_period, bool include_descendants) {
+  (void)node;
+  (void)sampling_period;
+  (void)include_descendants;
+  supervisor("wb_supervisor_node_enable_contact_point_tracking");
+}
+
+void wb_supervisor_node_disable_contact_point_tracking(WbNodeRef node, bool include_descendants) {
+  (void)node;
+  (void)include_descendants;
+  supervisor("wb_supervisor_node_disable_contact_point_tracking");
+}

@@ -6,6 +6,7 @@
 #ifndef WB_SUPERVISOR_H
 #define WB_SUPERVISOR_H
 
+#include "contact_point.h"
 #include "robot.h"
 #include "types.h"
 
@@ -44,6 +45,18 @@ const double *wb_supervisor_field_get_sf_vec3f(WbFieldRef field);
 void wb_supervisor_field_set_sf_vec3f(WbFieldRef field, const double values[3]);
 const double *wb_supervisor_field_get_sf_rotation(WbFieldRef field);
 void wb_supervisor_field_set_sf_rotation(WbFieldRef field, const double values[4]);
+
+/* Contact points: Sensorium has no physics contacts, so there are none (0, NULL, a NaN vector; the
+ * tracking functions do nothing). Webots' "no value" for a node touching nothing. */
+const double *wb_supervisor_node_get_contact_point(WbNodeRef node, int index);
+WbNodeRef wb_supervisor_node_get_contact_point_node(WbNodeRef node, int index);
+int wb_supervisor_node_get_number_of_contact_points(WbNodeRef node, bool include_descendants);
+WbContactPoint *wb_supervisor_node_get_contact_points(WbNodeRef node, bool include_descendants, int *size);
+void wb_supervisor_node_enable_contact_points_tracking(WbNodeRef node, int sampling_period, bool include_descendants);
+void wb_supervisor_node_disable_contact_points_tracking(WbNodeRef node);
+/* Webots' older names (R2023a), kept as Webots keeps them */
+void wb_supervisor_node_enable_contact_point_tracking(WbNodeRef node, int sampling_period, bool include_descendants);
+void wb_supervisor_node_disable_contact_point_tracking(WbNodeRef node, bool include_descendants);
 
 void wb_supervisor_simulation_reset(void);
 void wb_supervisor_simulation_set_mode(WbSimulationMode mode);
