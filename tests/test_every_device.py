@@ -109,3 +109,16 @@ def test_vehicle_classes_import_and_constructing_one_ends_with_one_line(tmp_path
             f"Error: {cls}(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots move "
             "kinematically by two-wheel or skid-steer drives only, so a car-like robot with steered wheels is not "
             "driven."], done.stderr
+
+
+def test_a_node_has_no_contact_points_in_python_either():
+    """No physics contacts (the C client answers the same: 0, NULL, a NaN vector)."""
+    from sensorium.client.webots.controller import ContactPoint, Node
+
+    node = Node(7, "Robot", "car")
+    node.enableContactPointsTracking(16, includeDescendants=True)
+    assert node.getContactPoints() == [] and node.getContactPoints(True) == []
+    assert node.getNumberOfContactPoints(True) == 0 and node.getContactPointNode(0) is None
+    assert all(math.isnan(v) for v in node.getContactPoint(0)) and len(node.getContactPoint(0)) == 3
+    node.disableContactPointsTracking()
+    assert ContactPoint([1.0, 2.0, 3.0], 4).getNodeId() == 4

@@ -3,8 +3,8 @@
  * controller uses them. Prints "key value" lines that tests/test_c_client.py checks.
  *   headers            what needs no server: types, console, strings, system, radio messages, the
  *                      vehicle functions' "no value"
- *   headers online     then attaches to the server: Microphone and Radio (listed, not simulated) and
- *                      the supervisor's contact points
+ *   headers online     then attaches to the server: Microphone and Radio (listed, not simulated), the
+ *                      supervisor's contact points and the robot window's messages (none)
  *   headers driver|car wbu_driver_init() / wbu_car_init(): one line, exit status 1 */
 #include <math.h>
 #include <stdio.h>
@@ -15,6 +15,7 @@
 #include <webots/contact_point.h>
 #include <webots/lidar_point.h>
 #include <webots/microphone.h>
+#include <webots/plugins/robot_window/robot_wwi.h>
 #include <webots/radio.h>
 #include <webots/robot.h>
 #include <webots/supervisor.h>
@@ -93,6 +94,10 @@ static void online(void) {
          points == NULL ? "NULL" : "points", isnan(first[0]) ? "nan" : "value",
          wb_supervisor_node_get_contact_point_node(self, 0) == NULL ? "NULL" : "node");
   wb_supervisor_node_disable_contact_points_tracking(self);
+  wb_robot_wwi_send_text("to the window");
+  size = -1;
+  const char *received = wb_robot_wwi_receive(&size);
+  printf("wwi %s %s %d\n", or_null(wb_robot_wwi_receive_text()), or_null(received), size);
   printf("step %d\n", wb_robot_step(16));
   wb_robot_cleanup();
 }

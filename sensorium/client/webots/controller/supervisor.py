@@ -4,6 +4,7 @@ reset the simulation and change its mode. The robot's world entry needs ``superv
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from sensorium.client import nodes, wb
@@ -75,6 +76,25 @@ class Node:
     def getOrientation(self) -> list[float] | None:
         return wb.wb_supervisor_node_get_orientation(self._ref)
 
+    # -- contact points: Sensorium has no physics contacts, so a node touches nothing (as in the C client)
+    def getContactPoints(self, includeDescendants: bool = False) -> list[ContactPoint]:  # noqa: N803
+        return []
+
+    def enableContactPointsTracking(self, samplingPeriod: int, includeDescendants: bool = False) -> None:  # noqa: N803
+        pass
+
+    def disableContactPointsTracking(self, includeDescendants: bool = False) -> None:  # noqa: N803
+        pass
+
+    def getNumberOfContactPoints(self, includeDescendants: bool = False) -> int:  # noqa: N803
+        return 0
+
+    def getContactPoint(self, index: int) -> list[float]:
+        return [math.nan] * 3
+
+    def getContactPointNode(self, index: int) -> Node | None:
+        return None
+
     id = property(getId)
     def_name = property(getDef)
     type_name = property(getTypeName)
@@ -103,7 +123,8 @@ for _name, _value in nodes.WEBOTS_NODE_TYPES.items():
 @dataclass
 class ContactPoint:
     """Webots' contact point (``Node.getContactPoints``): Sensorium has no physics contacts, so no
-    function returns one; the class exists for ``from controller import ContactPoint``."""
+    function returns one (``getContactPoints()`` is ``[]``); the class exists for ``from controller
+    import ContactPoint``."""
 
     point: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     node_id: int = -1

@@ -6,9 +6,12 @@
 #include <string>
 
 #include <webots/Field.hpp>
+#include <webots/contact_point.h>
 #include <webots/supervisor.h>
 
 namespace webots {
+
+typedef WbContactPoint ContactPoint;
 
 class Node {
 public:
@@ -28,6 +31,18 @@ public:
   }
   const double *getPosition() const { return wb_supervisor_node_get_position(ref_); }
   const double *getOrientation() const { return wb_supervisor_node_get_orientation(ref_); }
+  // no physics contacts here: none (see supervisor.h)
+  ContactPoint *getContactPoints(bool includeDescendants, int *size) const {
+    return wb_supervisor_node_get_contact_points(ref_, includeDescendants, size);
+  }
+  void enableContactPointsTracking(int samplingPeriod, bool includeDescendants = false) const {
+    wb_supervisor_node_enable_contact_points_tracking(ref_, samplingPeriod, includeDescendants);
+  }
+  void disableContactPointsTracking() const { wb_supervisor_node_disable_contact_points_tracking(ref_); }
+  int getNumberOfContactPoints(bool includeDescendants = false) const {
+    return wb_supervisor_node_get_number_of_contact_points(ref_, includeDescendants);
+  }
+  const double *getContactPoint(int index) const { return wb_supervisor_node_get_contact_point(ref_, index); }
 
 private:
   WbNodeRef ref_;
