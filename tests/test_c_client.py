@@ -1,7 +1,10 @@
 """The C controller library (sensorium/client/c) against a live server, built with AddressSanitizer
 and UBSan: Webots-style C controllers read exactly (bit for bit) what the Python client reads on
 the same world, step in lockstep beside Python controllers, are released when SIGKILLed, keep
-their session while computing, and fail with one clear line on a bad URL or a missing server.
+their session while computing, and fail with one clear line on a bad URL or a missing server. Every
+Webots controller header is here and compiles alone as C and C++; the last ones added (console,
+lidar/contact points, string/system helpers, Microphone, Radio, robot window messages, the vehicle
+library's one-line refusal) are used by tests/c/headers.c and tests/c/vehicle_cpp.cpp.
 """
 
 from __future__ import annotations
@@ -131,7 +134,7 @@ NAN_BITS = "7ff8000000000000"
 # ====================================================================== build
 
 def test_library_builds_warning_free_as_shared_and_static_and_headers_stand_alone(tmp_path):
-    _make(f"BUILD={tmp_path}", "check")          # -Wall -Wextra -Werror; every header alone, -std=c99 -pedantic
+    _make(f"BUILD={tmp_path}", "check")   # -Wall -Wextra -Werror; each header alone: C99 -pedantic and C++11
     assert (tmp_path / "libController.a").is_file() and (tmp_path / "libController.so").is_file()
     symbols = subprocess.run(["nm", "-D", "--defined-only", str(tmp_path / "libController.so")],
                              capture_output=True, text=True, check=True).stdout
