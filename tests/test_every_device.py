@@ -122,3 +122,28 @@ def test_a_node_has_no_contact_points_in_python_either():
     assert all(math.isnan(v) for v in node.getContactPoint(0)) and len(node.getContactPoint(0)) == 3
     node.disableContactPointsTracking()
     assert ContactPoint([1.0, 2.0, 3.0], 4).getNodeId() == 4
+
+
+# Webots' Python controller modules (lib/controller/python/controller/*.py) with their main class; left
+# out: constants.py and wb.py (libController bindings, internal to Webots' package) and proto.py (the
+# supervisor's PROTO functions, beyond Sensorium's Supervisor subset).
+WEBOTS_PY_MODULES = {
+    "accelerometer": "Accelerometer", "altimeter": "Altimeter", "ansi_codes": "AnsiCodes", "brake": "Brake",
+    "camera": "Camera", "compass": "Compass", "connector": "Connector", "device": "Device", "display": "Display",
+    "distance_sensor": "DistanceSensor", "emitter": "Emitter", "field": "Field", "gps": "GPS", "gyro": "Gyro",
+    "inertial_unit": "InertialUnit", "joystick": "Joystick", "keyboard": "Keyboard", "led": "LED", "lidar": "Lidar",
+    "lidar_point": "LidarPoint", "light_sensor": "LightSensor", "motion": "Motion", "motor": "Motor",
+    "mouse": "Mouse", "node": "Node", "pen": "Pen", "position_sensor": "PositionSensor", "radar": "Radar",
+    "radar_target": "RadarTarget", "range_finder": "RangeFinder", "receiver": "Receiver", "robot": "Robot",
+    "sensor": "Sensor", "skin": "Skin", "speaker": "Speaker", "supervisor": "Supervisor",
+    "touch_sensor": "TouchSensor", "vacuum_gripper": "VacuumGripper"}
+
+
+def test_every_webots_controller_module_imports_with_its_class():
+    code = ("import importlib, controller\n"
+            f"for module, cls in {WEBOTS_PY_MODULES!r}.items():\n"
+            "    assert getattr(importlib.import_module('controller.' + module), cls) is getattr(controller, cls), module\n"
+            "print('ok')")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                          env={"PYTHONPATH": f"{REPO / 'sensorium' / 'client' / 'webots'}:{REPO}", "PATH": "/usr/bin"})
+    assert done.returncode == 0 and done.stdout == "ok\n", done.stderr
