@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import struct
@@ -141,6 +142,11 @@ def test_library_builds_warning_free_as_shared_and_static_and_headers_stand_alon
     for fn in ("wb_robot_init", "wb_robot_step", "wb_lidar_get_point_cloud", "wb_motor_set_velocity",
                "wb_distance_sensor_get_lookup_table", "wb_light_sensor_get_value"):
         assert f" T {fn}\n" in symbols, fn
+    # every function a header declares is in the library (a controller that compiles also links)
+    declaration = re.compile(r"^(?!\s*#)(?!\s*/?\*)[A-Za-z_][\w \*]*?\b(wbu?_\w+)\s*\(", re.M)
+    declared = {name for h in (CLIB / "include" / "webots").rglob("*.h") for name in declaration.findall(h.read_text())}
+    assert len(declared) > 550 and "wbu_driver_init" in declared and "wb_supervisor_node_get_root" in declared
+    assert sorted(declared - set(re.findall(r" T (\w+)$", symbols, re.M))) == []
 
 
 # Webots' controller headers (include/controller/c/webots and cpp/webots of Webots R2023–R2025), as a
@@ -212,7 +218,7 @@ def test_the_vehicle_library_ends_the_controller_with_one_line(cbin, argv, func)
     assert out[:1] == (["\x1b[1m4 3\x1b[0m"] if argv[0] == "vehicle_cpp" else [])   # the C++ enums are Webots'
 
 
-def test_microphone_and_radio_are_listed_and_a_node_has_no_contact_points(cbin, servers):
+def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_functions(cbin, servers):
     code, out, err = finish(start([cbin["headers"], "online"], servers(HEADERS_WORLD).url("car")))
     assert code == 0, err
     online = out[out.index("car nan nan 0") + 1:]
@@ -221,10 +227,17 @@ def test_microphone_and_radio_are_listed_and_a_node_has_no_contact_points(cbin, 
                       "radio 0 0 nan nan (null)",
                       "contacts 0 0 NULL nan NULL",          # no physics contacts
                       "wwi (null) (null) 0",                 # no robot window
-                      "step 0"]
+                      "step 0",
+                      "supervisor NULL 1 SFRotation -1 -1 nan  1 0",   # beyond the subset: "no value"
+                      "after quit -1 -1"]                   # the simulation ended for this controller
     warned = [line for line in err.splitlines() if "does not simulate" in line]
     assert len(warned) == 2 and "Microphone 'mic'" in warned[0] and "Radio 'radio'" in warned[1], err
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
+    unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
+    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_int32", "movie_is_ready", "node_get_def",
+                                                              "node_get_number_of_fields", "node_get_root",
+                                                              "node_get_velocity")], err   # one line each
+    assert "Warning: wb_supervisor_simulation_quit(3): the server runs on until it is stopped; robot 'car'" in err
 
 
 # ====================================================================== readings, bit for bit

@@ -4,7 +4,8 @@
  *   headers            what needs no server: types, console, strings, system, radio messages, the
  *                      vehicle functions' "no value"
  *   headers online     then attaches to the server: Microphone and Radio (listed, not simulated), the
- *                      supervisor's contact points and the robot window's messages (none)
+ *                      supervisor's contact points, the robot window's messages (none), Supervisor
+ *                      functions Sensorium does not serve, wb_supervisor_simulation_quit()
  *   headers driver|car wbu_driver_init() / wbu_car_init(): one line, exit status 1 */
 #include <math.h>
 #include <stdio.h>
@@ -99,6 +100,16 @@ static void online(void) {
   const char *received = wb_robot_wwi_receive(&size);
   printf("wwi %s %s %d\n", or_null(wb_robot_wwi_receive_text()), or_null(received), size);
   printf("step %d\n", wb_robot_step(16));
+  /* Supervisor functions beyond Sensorium's subset: declared, one error line each, "no value" */
+  WbNodeRef root = wb_supervisor_node_get_root();
+  wb_supervisor_node_get_root();
+  WbFieldRef rotation = wb_supervisor_node_get_field(self, "rotation");
+  printf("supervisor %s %d %s %d %d %s %s %d %d\n", root == NULL ? "NULL" : "root", wb_supervisor_node_get_id(self) > 0,
+         wb_supervisor_field_get_type_name(rotation), wb_supervisor_field_get_count(rotation),
+         wb_supervisor_node_get_number_of_fields(self), isnan(wb_supervisor_node_get_velocity(self)[5]) ? "nan" : "value",
+         wb_supervisor_node_get_def(root), (int)wb_supervisor_movie_is_ready(), (int)wb_supervisor_field_get_mf_int32(rotation, 0));
+  wb_supervisor_simulation_quit(3);
+  printf("after quit %d %d\n", wb_robot_step(16), wb_robot_step(16));
   wb_robot_cleanup();
 }
 

@@ -49,6 +49,17 @@ static sn_robot *supervisor(const char *func) {
   return rb;
 }
 
+void sn_supervisor_unsupported(const char *func, bool *warned) {
+  if (supervisor(func) == NULL || *warned)
+    return;
+  *warned = true;
+  fprintf(stderr,
+          "Error: %s(): not served by Sensorium (its Supervisor finds robots and solids by DEF, reads and sets their "
+          "translation and rotation, reads poses, resets and sets the run mode): ignored, Webots' \"no value\" "
+          "returned.\n",
+          func);
+}
+
 static WbNodeRef node_ref(sn_robot *rb, int64_t id) {
   if (id <= 0)
     return NULL;
@@ -169,6 +180,33 @@ WbFieldRef wb_supervisor_node_get_field(WbNodeRef node, const char *field_name) 
 WbFieldType wb_supervisor_field_get_type(WbFieldRef field) { return field ? field->type : WB_NO_FIELD; }
 
 const char *wb_supervisor_field_get_name(WbFieldRef field) { return field ? field->name : ""; }
+
+const char *wb_supervisor_field_get_type_name(WbFieldRef field) {
+  if (field == NULL)
+    return "";
+  return field->type == WB_SF_VEC3F ? "SFVec3f" : "SFRotation";
+}
+
+int wb_supervisor_field_get_count(WbFieldRef field) {
+  (void)field;
+  return -1; /* Webots' count of a single (SF) field; Sensorium has no MF field */
+}
+
+int wb_supervisor_node_get_id(WbNodeRef node) {
+  return node != NULL ? (int)node->id : -1;
+}
+
+void wb_supervisor_simulation_quit(int status) {
+  const char *func = "wb_supervisor_simulation_quit";
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return;
+  /* The server serves other controllers and runs until it is stopped; for this controller the
+     simulation ends as in Webots: its next steps return -1. */
+  fprintf(stderr, "Warning: %s(%d): the server runs on until it is stopped; robot '%s' "
+          "steps no more (wb_robot_step() returns -1).\n", func, status, rb->name);
+  rb->terminated = true;
+}
 
 typedef struct {
   const struct WbFieldStructPrivate *field;
