@@ -147,3 +147,30 @@ def test_every_webots_controller_module_imports_with_its_class():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
                           env={"PYTHONPATH": f"{REPO / 'sensorium' / 'client' / 'webots'}:{REPO}", "PATH": "/usr/bin"})
     assert done.returncode == 0 and done.stdout == "ok\n", done.stderr
+
+
+def test_python_supervisor_methods_beyond_the_subset_and_simulation_quit(tmp_path):
+    """Webots' Supervisor, Node and Field methods that Sensorium does not serve answer Webots' "no
+    value" with one error line each (the C library's words); simulationQuit ends the steps."""
+    script = tmp_path / "sup.py"
+    script.write_text(
+        "from controller import Supervisor\n"
+        "s = Supervisor()\n"
+        "me = s.getSelf()\n"
+        "rot = me.getField('rotation')\n"
+        "print(s.getRoot(), s.getRoot(), s.movieIsReady(), me.getVelocity()[5] != me.getVelocity()[5], me.getId() > 0,\n"
+        "      rot.getTypeName(), rot.getCount(), repr(rot.getSFString()), rot.getMFVec3f(0), me.getStaticBalance())\n"
+        "print(s.step(16))\n"
+        "s.simulationQuit(3)\n"
+        "print(s.step(16), s.step(16))\n")
+    with serve(REPO / "tests" / "worlds" / "headers.yaml") as server:
+        done = subprocess.run([sys.executable, "-m", "sensorium", "controller", "--url", server.url("car"),
+                               str(script)], capture_output=True, text=True, timeout=120, cwd=str(REPO))
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == ["None None True True True SFRotation -1 '' [nan, nan, nan] False", "0",
+                                        "-1 -1"]
+    unserved = sorted(line.split("(")[0] for line in done.stderr.splitlines() if "not served by Sensorium" in line)
+    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_vec3f", "field_get_sf_string",
+                                                              "movie_is_ready", "node_get_root", "node_get_static_balance",
+                                                              "node_get_velocity")], done.stderr
+    assert "Warning: wb_supervisor_simulation_quit(3): the server runs on until it is stopped; robot 'car'" in done.stderr
