@@ -154,16 +154,15 @@ def test_library_builds_warning_free_as_shared_and_static_and_headers_stand_alon
 # messages (none here). Left out on purpose: the robot window plugins' own headers (robot_window.h,
 # the old robot_wwi.h, plugins/robot_window/default.h and generic*.h, robot_window_utils/*,
 # utils/default_robot_window.h: a headless server has no window), remote_control.h (a plugin's API,
-# not a controller's), differential_wheels.h and vacuum_cup.h (Webots' removed and renamed devices),
-# transform_node_object.h (no function of the API uses it) and Proto.hpp (the supervisor's PROTO
-# functions, beyond Sensorium's Supervisor subset).
+# not a controller's), differential_wheels.h and vacuum_cup.h (Webots' removed and renamed devices) and
+# transform_node_object.h (no function of the API uses it).
 WEBOTS_C_HEADERS = """accelerometer altimeter brake camera camera_recognition_object compass connector console contact_point
     device display distance_sensor emitter gps gyro inertial_unit joystick keyboard led lidar lidar_point light_sensor
     microphone motor mouse mouse_state nodes pen position_sensor radar radar_target radio range_finder receiver robot
     skin speaker supervisor touch_sensor types vacuum_gripper utils/ansi_codes utils/motion utils/string utils/system
     vehicle/car vehicle/driver plugins/robot_window/robot_wwi""".split()
 WEBOTS_CPP_HEADERS = """Accelerometer Altimeter Brake Camera Compass Connector Device Display DistanceSensor Emitter Field GPS Gyro
-    ImageRef InertialUnit Joystick Keyboard LED Lidar LightSensor Motor Mouse Node Pen PositionSensor Radar RangeFinder
+    ImageRef InertialUnit Joystick Keyboard LED Lidar LightSensor Motor Mouse Node Pen PositionSensor Proto Radar RangeFinder
     Receiver Robot Skin Speaker Supervisor TouchSensor VacuumGripper utils/AnsiCodes utils/Motion vehicle/Car
     vehicle/Driver""".split()
 VEHICLE_LINE = ("Error: {func}(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots move "
@@ -445,6 +444,7 @@ def test_supervisor_through_the_cpp_classes(cbin, servers):
     assert head[5:] == ["1", "left", "wheel", "motor", "1", "2"]
     assert float(lines[1]) == pytest.approx(6.28 * 0.016, abs=1e-12)   # position control at maxVelocity, one step
     assert lines[2] == "0 1 nan 0 0 NULL 0"                               # no contact points, no robot window
+    assert lines[3] == "1 1 SFVec3f -1 1 1"       # getRoot/getType beyond the subset; one Field object per field
 
 
 def test_c_client_replays_the_conformance_session(cbin, servers):

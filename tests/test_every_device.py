@@ -125,15 +125,15 @@ def test_a_node_has_no_contact_points_in_python_either():
 
 
 # Webots' Python controller modules (lib/controller/python/controller/*.py) with their main class; left
-# out: constants.py and wb.py (libController bindings, internal to Webots' package) and proto.py (the
-# supervisor's PROTO functions, beyond Sensorium's Supervisor subset).
+# out: constants.py and wb.py (libController bindings, internal to Webots' package). Proto is not in
+# the package's names (as in Webots), only in its module.
 WEBOTS_PY_MODULES = {
     "accelerometer": "Accelerometer", "altimeter": "Altimeter", "ansi_codes": "AnsiCodes", "brake": "Brake",
     "camera": "Camera", "compass": "Compass", "connector": "Connector", "device": "Device", "display": "Display",
     "distance_sensor": "DistanceSensor", "emitter": "Emitter", "field": "Field", "gps": "GPS", "gyro": "Gyro",
     "inertial_unit": "InertialUnit", "joystick": "Joystick", "keyboard": "Keyboard", "led": "LED", "lidar": "Lidar",
     "lidar_point": "LidarPoint", "light_sensor": "LightSensor", "motion": "Motion", "motor": "Motor",
-    "mouse": "Mouse", "node": "Node", "pen": "Pen", "position_sensor": "PositionSensor", "radar": "Radar",
+    "mouse": "Mouse", "node": "Node", "pen": "Pen", "position_sensor": "PositionSensor", "proto": "Proto", "radar": "Radar",
     "radar_target": "RadarTarget", "range_finder": "RangeFinder", "receiver": "Receiver", "robot": "Robot",
     "sensor": "Sensor", "skin": "Skin", "speaker": "Speaker", "supervisor": "Supervisor",
     "touch_sensor": "TouchSensor", "vacuum_gripper": "VacuumGripper"}
@@ -142,7 +142,8 @@ WEBOTS_PY_MODULES = {
 def test_every_webots_controller_module_imports_with_its_class():
     code = ("import importlib, controller\n"
             f"for module, cls in {WEBOTS_PY_MODULES!r}.items():\n"
-            "    assert getattr(importlib.import_module('controller.' + module), cls) is getattr(controller, cls), module\n"
+            "    got = getattr(importlib.import_module('controller.' + module), cls)\n"
+            "    assert got is getattr(controller, cls, got) and got.__name__ == cls, module\n"
             "print('ok')")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
                           env={"PYTHONPATH": f"{REPO / 'sensorium' / 'client' / 'webots'}:{REPO}", "PATH": "/usr/bin"})

@@ -179,6 +179,14 @@ class Supervisor(Robot):
         wb.wb_supervisor_simulation_quit(status)
 
 
+class Proto:
+    """Webots' PROTO of a node (``Node.getProto``): Sensorium does not serve PROTO queries, so none is
+    ever handed out; its methods answer Webots' "no value" with one error line each."""
+
+    def __init__(self, ref: int = 0):
+        self._ref = ref
+
+
 def _unserved(method: str, func: str, value: Any) -> Callable[..., Any]:
     def call(self: object, *args: Any, **kwargs: Any) -> Any:
         wb.supervisor_unserved(func)
@@ -223,6 +231,10 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "restartController": ("node_restart_controller", None), "moveViewpoint": ("node_move_viewpoint", None),
         "setVisibility": ("node_set_visibility", None), "addForce": ("node_add_force", None),
         "addForceWithOffset": ("node_add_force_with_offset", None), "addTorque": ("node_add_torque", None)},
+    Proto: {
+        "getTypeName": ("proto_get_type_name", ""), "isDerived": ("proto_is_derived", False),
+        "getParent": ("proto_get_parent", None), "getField": ("proto_get_field", None),
+        "getFieldByIndex": ("proto_get_field_by_index", None), "getNumberOfFields": ("proto_get_number_of_fields", -1)},
     Field: {
         "getActualField": ("field_get_actual_field", None), "enableSFTracking": ("field_enable_sf_tracking", None),
         "disableSFTracking": ("field_disable_sf_tracking", None), "removeMF": ("field_remove_mf", None),
