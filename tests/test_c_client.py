@@ -1,7 +1,10 @@
 """The C controller library (sensorium/client/c) against a live server, built with AddressSanitizer
 and UBSan: Webots-style C controllers read exactly (bit for bit) what the Python client reads on
 the same world, step in lockstep beside Python controllers, are released when SIGKILLed, keep
-their session while computing, and fail with one clear line on a bad URL or a missing server.
+their session while computing, and fail with one clear line on a bad URL or a missing server. Every
+Webots controller header is here and compiles alone as C and C++; the last ones added (console,
+lidar/contact points, string/system helpers, Microphone, Radio, robot window messages, the vehicle
+library's one-line refusal) are used by tests/c/headers.c and tests/c/vehicle_cpp.cpp.
 """
 
 from __future__ import annotations
@@ -9,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import struct
@@ -32,9 +36,10 @@ ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
 CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
-               "wire_vectors", "every_device"]
+               "wire_vectors", "every_device", "headers"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
+HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -63,7 +68,7 @@ def cbin(tmp_path_factory) -> dict[str, str]:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
         out[name] = str(exe)
-    for name in ("braitenberg_cpp", "supervisor_cpp"):  # the header-only C++ layer
+    for name in ("braitenberg_cpp", "supervisor_cpp", "vehicle_cpp"):  # the header-only C++ layer
         exe = build / name
         cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
                f"-I{CLIB / 'include'}", str(TESTS_C / f"{name}.cpp"), "-o", str(exe), str(build / "libController.a"),
@@ -130,13 +135,108 @@ NAN_BITS = "7ff8000000000000"
 # ====================================================================== build
 
 def test_library_builds_warning_free_as_shared_and_static_and_headers_stand_alone(tmp_path):
-    _make(f"BUILD={tmp_path}", "check")          # -Wall -Wextra -Werror; every header alone, -std=c99 -pedantic
+    _make(f"BUILD={tmp_path}", "check")   # -Wall -Wextra -Werror; each header alone: C99 -pedantic and C++11
     assert (tmp_path / "libController.a").is_file() and (tmp_path / "libController.so").is_file()
     symbols = subprocess.run(["nm", "-D", "--defined-only", str(tmp_path / "libController.so")],
                              capture_output=True, text=True, check=True).stdout
     for fn in ("wb_robot_init", "wb_robot_step", "wb_lidar_get_point_cloud", "wb_motor_set_velocity",
                "wb_distance_sensor_get_lookup_table", "wb_light_sensor_get_value"):
         assert f" T {fn}\n" in symbols, fn
+    # every function a header declares is in the library (a controller that compiles also links)
+    declaration = re.compile(r"^(?!\s*#)(?!\s*/?\*)[A-Za-z_][\w \*]*?\b(wbu?_\w+)\s*\(", re.M)
+    declared = {name for h in (CLIB / "include" / "webots").rglob("*.h") for name in declaration.findall(h.read_text())}
+    assert len(declared) > 550 and "wbu_driver_init" in declared and "wb_supervisor_node_get_root" in declared
+    assert sorted(declared - set(re.findall(r" T (\w+)$", symbols, re.M))) == []
+
+
+# Webots' controller headers (include/controller/c/webots and cpp/webots of Webots R2023–R2025), as a
+# controller includes them; plugins/robot_window/robot_wwi.h is a controller's side of robot window
+# messages (none here). Left out on purpose: the robot window plugins' own headers (robot_window.h,
+# the old robot_wwi.h, plugins/robot_window/default.h and generic*.h, robot_window_utils/*,
+# utils/default_robot_window.h: a headless server has no window), remote_control.h (a plugin's API,
+# not a controller's), differential_wheels.h and vacuum_cup.h (Webots' removed and renamed devices) and
+# transform_node_object.h (no function of the API uses it).
+WEBOTS_C_HEADERS = """accelerometer altimeter brake camera camera_recognition_object compass connector console contact_point
+    device display distance_sensor emitter gps gyro inertial_unit joystick keyboard led lidar lidar_point light_sensor
+    microphone motor mouse mouse_state nodes pen position_sensor radar radar_target radio range_finder receiver robot
+    skin speaker supervisor touch_sensor types vacuum_gripper utils/ansi_codes utils/motion utils/string utils/system
+    vehicle/car vehicle/driver plugins/robot_window/robot_wwi""".split()
+WEBOTS_CPP_HEADERS = """Accelerometer Altimeter Brake Camera Compass Connector Device Display DistanceSensor Emitter Field GPS Gyro
+    ImageRef InertialUnit Joystick Keyboard LED Lidar LightSensor Motor Mouse Node Pen PositionSensor Proto Radar RangeFinder
+    Receiver Robot Skin Speaker Supervisor TouchSensor VacuumGripper utils/AnsiCodes utils/Motion vehicle/Car
+    vehicle/Driver""".split()
+VEHICLE_LINE = ("Error: {func}(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots move "
+                "kinematically by two-wheel or skid-steer drives only, so a car-like robot with steered wheels is not "
+                "driven.")
+
+
+def test_every_webots_controller_header_is_here():
+    """Each compiles alone as C99 and C++11 (the .hpp as C++11, linked): `make check` above."""
+    include = CLIB / "include" / "webots"
+    missing = [h for h in WEBOTS_C_HEADERS if not (include / f"{h}.h").is_file()]
+    missing += [h for h in WEBOTS_CPP_HEADERS if not (include / f"{h}.hpp").is_file()]
+    assert missing == []
+    assert "WbLidarPoint;" in (include / "lidar_point.h").read_text()          # one definition, where Webots has it
+    assert "WbLidarPoint" not in (include / "types.h").read_text()
+    assert '#include "lidar_point.h"' in (include / "lidar.h").read_text()
+    assert '#include "contact_point.h"' in (include / "supervisor.h").read_text()
+
+
+def test_console_strings_system_radio_messages_and_the_vehicle_no_values(cbin):
+    env = {"HEADERS_TEST_VALUE": "v4lue"}
+    full = {k: v for k, v in ENV.items() if k not in ("WEBOTS_INSTANCE_PATH", "HEADERS_TEST_UNSET")}
+    p = subprocess.Popen([cbin["headers"]], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env={**full, **env}, cwd=str(REPO))
+    code, out, err = finish(p)
+    assert code == 0, err
+    assert out == ["lidar_point 1.5 -2 0.25 3 0.125",
+                   "contact_point 1 -2 3.5 7",
+                   "console to stdout",                                     # WB_STDOUT, in order with printf
+                   "strsep [a] [b\\,c] [] [d] end",                        # an escaped delimiter does not split
+                   "replace [three two three] [two one] (null) (null)",
+                   "getenv v4lue (null)",
+                   "short_path /a b/c tmpdir /tmp instance (null)",
+                   "radio_message 5 hello bob refused",
+                   "driver 0 -1 nan -1 0",                                  # not possible; step: the end
+                   "car nan nan 0"]
+    lines = err.splitlines()
+    assert lines[0] == "console to stderr" and len(lines) == 3, err
+    assert lines[1] == "Error: wb_console_print(): unknown stream 3 (WB_STDOUT is 1, WB_STDERR is 2)"
+    assert lines[2].startswith("Error: wb_radio_message_new(): invalid body (-1 bytes")
+
+
+@pytest.mark.parametrize("argv, func", [(["headers", "driver"], "wbu_driver_init"), (["headers", "car"], "wbu_car_init"),
+                                        (["vehicle_cpp", "driver"], "wbu_driver_init"), (["vehicle_cpp"], "wbu_car_init")])
+def test_the_vehicle_library_ends_the_controller_with_one_line(cbin, argv, func):
+    """Before any connection: the URL names a port nobody listens on, and the controller must not
+    wait for it (that would take the library's 30 s timeout, past finish()'s 25 s)."""
+    p = start([cbin[argv[0]], *argv[1:]], "tcp://127.0.0.1:9/car", SENSORIUM_CONTROLLER_TIMEOUT="30")
+    code, out, err = finish(p, timeout=25)
+    assert code == 1 and err.splitlines() == [VEHICLE_LINE.format(func=func)], err
+    assert "returned" not in out and "constructed" not in out
+    assert out[:1] == (["\x1b[1m4 3\x1b[0m"] if argv[0] == "vehicle_cpp" else [])   # the C++ enums are Webots'
+
+
+def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_functions(cbin, servers):
+    code, out, err = finish(start([cbin["headers"], "online"], servers(HEADERS_WORLD).url("car")))
+    assert code == 0, err
+    online = out[out.index("car nan nan 0") + 1:]
+    assert online == ["tags 2 3 omni",                       # Webots' indices: gps, mic, radio, light
+                      "microphone 0 NULL 0",                 # no sound: Webots' "no value"
+                      "radio 0 0 nan nan (null)",
+                      "contacts 0 0 NULL nan NULL",          # no physics contacts
+                      "wwi (null) (null) 0",                 # no robot window
+                      "step 0",
+                      "supervisor NULL 1 SFRotation -1 -1 nan  1 0",   # beyond the subset: "no value"
+                      "after quit -1 -1"]                   # the simulation ended for this controller
+    warned = [line for line in err.splitlines() if "does not simulate" in line]
+    assert len(warned) == 2 and "Microphone 'mic'" in warned[0] and "Radio 'radio'" in warned[1], err
+    assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
+    unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
+    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_int32", "movie_is_ready", "node_get_def",
+                                                              "node_get_number_of_fields", "node_get_root",
+                                                              "node_get_velocity")], err   # one line each
+    assert "Warning: wb_supervisor_simulation_quit(3): the server runs on until it is stopped; robot 'car'" in err
 
 
 # ====================================================================== readings, bit for bit
@@ -343,6 +443,8 @@ def test_supervisor_through_the_cpp_classes(cbin, servers):
     assert head[0] == "C-rover" and head[1] == "5" and [float(v) for v in head[2:5]] == [0.125, 0.25, 0.0]
     assert head[5:] == ["1", "left", "wheel", "motor", "1", "2"]
     assert float(lines[1]) == pytest.approx(6.28 * 0.016, abs=1e-12)   # position control at maxVelocity, one step
+    assert lines[2] == "0 1 nan 0 0 NULL 0"                               # no contact points, no robot window
+    assert lines[3] == "1 1 SFVec3f -1 1 1"       # getRoot/getType beyond the subset; one Field object per field
 
 
 def test_c_client_replays_the_conformance_session(cbin, servers):

@@ -89,3 +89,89 @@ def test_every_class_webots_has_imports_from_controller():
                           env={"PYTHONPATH": f"{REPO / 'sensorium' / 'client' / 'webots'}:{REPO}", "PATH": "/usr/bin"})
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == [str(N["WB_NODE_GPS"]), "-1", "2"]
+
+
+def test_vehicle_classes_import_and_constructing_one_ends_with_one_line(tmp_path):
+    """``from vehicle import Driver, Car`` works (Webots' constants); Sensorium does not simulate the
+    vehicle library, so ``Car()`` / ``Driver()`` end the controller with one line and status 1,
+    before any connection (the URL's port has no server; trying would take the 30 s timeout)."""
+    script = tmp_path / "car_controller.py"
+    script.write_text("import sys\nfrom vehicle import Car, Driver\n"
+                      "print(Car.FOUR_BY_FOUR, Car.WHEEL_REAR_LEFT, Driver.INDICATOR_LEFT, Driver.TORQUE, Driver.FAST,"
+                      " issubclass(Car, Driver), flush=True)\n"
+                      "Driver() if sys.argv[1:] == ['driver'] else Car()\nprint('constructed')\n")
+    for argv, cls in (([], "Car"), (["driver"], "Driver")):
+        done = subprocess.run([sys.executable, "-m", "sensorium", "controller", "--url", "tcp://127.0.0.1:9/car",
+                               str(script), *argv], capture_output=True, text=True, timeout=25, cwd=str(REPO),
+                              env={"PYTHONPATH": str(REPO), "PATH": "/usr/bin", "SENSORIUM_CONTROLLER_TIMEOUT": "30"})
+        assert done.returncode == 1 and done.stdout.split() == ["2", "3", "2", "1", "3", "True"], done
+        assert done.stderr.splitlines() == [
+            f"Error: {cls}(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots move "
+            "kinematically by two-wheel or skid-steer drives only, so a car-like robot with steered wheels is not "
+            "driven."], done.stderr
+
+
+def test_a_node_has_no_contact_points_in_python_either():
+    """No physics contacts (the C client answers the same: 0, NULL, a NaN vector)."""
+    from sensorium.client.webots.controller import ContactPoint, Node
+
+    node = Node(7, "Robot", "car")
+    node.enableContactPointsTracking(16, includeDescendants=True)
+    assert node.getContactPoints() == [] and node.getContactPoints(True) == []
+    assert node.getNumberOfContactPoints(True) == 0 and node.getContactPointNode(0) is None
+    assert all(math.isnan(v) for v in node.getContactPoint(0)) and len(node.getContactPoint(0)) == 3
+    node.disableContactPointsTracking()
+    assert ContactPoint([1.0, 2.0, 3.0], 4).getNodeId() == 4
+
+
+# Webots' Python controller modules (lib/controller/python/controller/*.py) with their main class; left
+# out: constants.py and wb.py (libController bindings, internal to Webots' package). Proto is not in
+# the package's names (as in Webots), only in its module.
+WEBOTS_PY_MODULES = {
+    "accelerometer": "Accelerometer", "altimeter": "Altimeter", "ansi_codes": "AnsiCodes", "brake": "Brake",
+    "camera": "Camera", "compass": "Compass", "connector": "Connector", "device": "Device", "display": "Display",
+    "distance_sensor": "DistanceSensor", "emitter": "Emitter", "field": "Field", "gps": "GPS", "gyro": "Gyro",
+    "inertial_unit": "InertialUnit", "joystick": "Joystick", "keyboard": "Keyboard", "led": "LED", "lidar": "Lidar",
+    "lidar_point": "LidarPoint", "light_sensor": "LightSensor", "motion": "Motion", "motor": "Motor",
+    "mouse": "Mouse", "node": "Node", "pen": "Pen", "position_sensor": "PositionSensor", "proto": "Proto", "radar": "Radar",
+    "radar_target": "RadarTarget", "range_finder": "RangeFinder", "receiver": "Receiver", "robot": "Robot",
+    "sensor": "Sensor", "skin": "Skin", "speaker": "Speaker", "supervisor": "Supervisor",
+    "touch_sensor": "TouchSensor", "vacuum_gripper": "VacuumGripper"}
+
+
+def test_every_webots_controller_module_imports_with_its_class():
+    code = ("import importlib, controller\n"
+            f"for module, cls in {WEBOTS_PY_MODULES!r}.items():\n"
+            "    got = getattr(importlib.import_module('controller.' + module), cls)\n"
+            "    assert got is getattr(controller, cls, got) and got.__name__ == cls, module\n"
+            "print('ok')")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                          env={"PYTHONPATH": f"{REPO / 'sensorium' / 'client' / 'webots'}:{REPO}", "PATH": "/usr/bin"})
+    assert done.returncode == 0 and done.stdout == "ok\n", done.stderr
+
+
+def test_python_supervisor_methods_beyond_the_subset_and_simulation_quit(tmp_path):
+    """Webots' Supervisor, Node and Field methods that Sensorium does not serve answer Webots' "no
+    value" with one error line each (the C library's words); simulationQuit ends the steps."""
+    script = tmp_path / "sup.py"
+    script.write_text(
+        "from controller import Supervisor\n"
+        "s = Supervisor()\n"
+        "me = s.getSelf()\n"
+        "rot = me.getField('rotation')\n"
+        "print(s.getRoot(), s.getRoot(), s.movieIsReady(), me.getVelocity()[5] != me.getVelocity()[5], me.getId() > 0,\n"
+        "      rot.getTypeName(), rot.getCount(), repr(rot.getSFString()), rot.getMFVec3f(0), me.getStaticBalance())\n"
+        "print(s.step(16))\n"
+        "s.simulationQuit(3)\n"
+        "print(s.step(16), s.step(16))\n")
+    with serve(REPO / "tests" / "worlds" / "headers.yaml") as server:
+        done = subprocess.run([sys.executable, "-m", "sensorium", "controller", "--url", server.url("car"),
+                               str(script)], capture_output=True, text=True, timeout=120, cwd=str(REPO))
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == ["None None True True True SFRotation -1 '' [nan, nan, nan] False", "0",
+                                        "-1 -1"]
+    unserved = sorted(line.split("(")[0] for line in done.stderr.splitlines() if "not served by Sensorium" in line)
+    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_vec3f", "field_get_sf_string",
+                                                              "movie_is_ready", "node_get_root", "node_get_static_balance",
+                                                              "node_get_velocity")], done.stderr
+    assert "Warning: wb_supervisor_simulation_quit(3): the server runs on until it is stopped; robot 'car'" in done.stderr

@@ -166,3 +166,28 @@ def wb_supervisor_simulation_set_mode(mode: int) -> None:
 def wb_supervisor_simulation_get_mode() -> int:
     r = _supervisor("wb_supervisor_simulation_get_mode")
     return WB_SUPERVISOR_SIMULATION_MODE_FAST if r is None else int(_call(r, "simulation_get_mode")["value"])
+
+
+def wb_supervisor_simulation_quit(status: int) -> None:
+    """The server serves other controllers and runs until it is stopped; for this controller the
+    simulation ends as in Webots: its next steps return -1."""
+    r = _supervisor("wb_supervisor_simulation_quit")
+    if r is None:
+        return
+    print(f"Warning: wb_supervisor_simulation_quit({status}): the server runs on until it is stopped; robot "
+          f"'{r.name}' steps no more (wb_robot_step() returns -1).", file=sys.stderr)
+    r.terminated = True
+
+
+_unserved_warned: set[str] = set()
+
+
+def supervisor_unserved(func: str) -> None:
+    """A Supervisor function Sensorium does not serve: Webots' error in a Robot controller, else one
+    line the first time it is called (the same words as the C library's)."""
+    if _supervisor(func) is None or func in _unserved_warned:
+        return
+    _unserved_warned.add(func)
+    print(f"Error: {func}(): not served by Sensorium (its Supervisor finds robots and solids by DEF, reads and sets "
+          "their translation and rotation, reads poses, resets and sets the run mode): ignored, Webots' \"no value\" "
+          "returned.", file=sys.stderr)

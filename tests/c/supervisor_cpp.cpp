@@ -1,4 +1,5 @@
 // The Supervisor C++ classes (tests/worlds/cdevices.yaml, robot rover): move buddy, read it back.
+#include <cmath>
 #include <cstdio>
 
 #include <webots/LED.hpp>
@@ -26,6 +27,18 @@ int main() {
               p[1], p[2], supervisor->getLED("led0")->get(), encoder->getMotor()->getName().c_str(),
               encoder->getMotor()->getPositionSensor() == encoder, supervisor->simulationGetMode());
   std::printf("%.17g\n", encoder->getValue());
+  int size = -1;  // no physics contacts, no robot window
+  supervisor->wwiSendText("hello window");
+  bool none = buddy->getContactPoints(false, &size) == 0;
+  std::printf("%d %d %s %d", buddy->getNumberOfContactPoints(true), none,
+              std::isnan(buddy->getContactPoint(0)[2]) ? "nan" : "value", size);
+  size = -1;
+  none = supervisor->wwiReceive(&size) == 0;
+  std::printf(" %d %s %d\n", static_cast<int>(supervisor->wwiReceiveText().size()), none ? "NULL" : "data", size);
+  // beyond Sensorium's subset: Webots' methods, "no value"; the subset's own answers
+  std::printf("%d %d %s %d %d %d\n", supervisor->getRoot() == 0, buddy->getType() == Node::NO_NODE,
+              translation->getTypeName().c_str(), translation->getCount(), buddy->getId() > 0,
+              buddy->getField("translation") == translation);
   delete supervisor;
   return 0;
 }

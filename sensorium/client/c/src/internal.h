@@ -19,6 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <webots/lidar_point.h>
 #include <webots/types.h>
 
 /* ------------------------------------------------------------------ error codes (PROTOCOL.md 3.2) */
@@ -227,6 +228,9 @@ sn_device *sn_sensor_reading(WbDeviceTag tag, sn_kind kind, const char *func, co
 /* A device Sensorium lists but does not simulate: checks that tag is a device of node_type (else
  * Webots' error), prints one warning line per device, returns false. true if tag is simulated. */
 bool sn_unsimulated(WbDeviceTag tag, int node_type, const char *func);
+/* supervisor.c: a Supervisor function Sensorium does not serve: Webots' error in a Robot controller,
+   else one line the first time (*warned) it is called. */
+void sn_supervisor_unsupported(const char *func, bool *warned);
 /* Webots' "no value" for a vector getter: NaN values (16 of them), never NULL. */
 const double *sn_no_values(void);
 /* Webots' node type of a device type name ("DistanceSensor"), WB_NODE_NO_NODE if unknown. */

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include <webots/device.h>
+#include <webots/plugins/robot_window/robot_wwi.h>
 #include <webots/robot.h>
 #include <webots/utils/motion.h>
 
@@ -30,6 +31,25 @@ const char *wb_robot_get_urdf(const char *prefix) {
 void wb_robot_pin_to_static_environment(bool pin) {
   (void)pin;
   sn_robot_get("wb_robot_pin_to_static_environment");
+}
+
+/* No robot window here: messages to it go nowhere, none come from it. */
+void wb_robot_wwi_send(const char *data, int size) {
+  (void)data;
+  (void)size;
+  sn_robot_get("wb_robot_wwi_send");
+}
+
+const char *wb_robot_wwi_receive(int *size) {
+  sn_robot_get("wb_robot_wwi_receive");
+  if (size != NULL)
+    *size = 0;
+  return NULL;
+}
+
+const char *wb_robot_wwi_receive_text(void) {
+  sn_robot_get("wb_robot_wwi_receive_text");
+  return NULL;
 }
 
 const char *wb_robot_get_controller_name(void) {

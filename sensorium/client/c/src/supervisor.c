@@ -49,6 +49,17 @@ static sn_robot *supervisor(const char *func) {
   return rb;
 }
 
+void sn_supervisor_unsupported(const char *func, bool *warned) {
+  if (supervisor(func) == NULL || *warned)
+    return;
+  *warned = true;
+  fprintf(stderr,
+          "Error: %s(): not served by Sensorium (its Supervisor finds robots and solids by DEF, reads and sets their "
+          "translation and rotation, reads poses, resets and sets the run mode): ignored, Webots' \"no value\" "
+          "returned.\n",
+          func);
+}
+
 static WbNodeRef node_ref(sn_robot *rb, int64_t id) {
   if (id <= 0)
     return NULL;
@@ -170,6 +181,33 @@ WbFieldType wb_supervisor_field_get_type(WbFieldRef field) { return field ? fiel
 
 const char *wb_supervisor_field_get_name(WbFieldRef field) { return field ? field->name : ""; }
 
+const char *wb_supervisor_field_get_type_name(WbFieldRef field) {
+  if (field == NULL)
+    return "";
+  return field->type == WB_SF_VEC3F ? "SFVec3f" : "SFRotation";
+}
+
+int wb_supervisor_field_get_count(WbFieldRef field) {
+  (void)field;
+  return -1; /* Webots' count of a single (SF) field; Sensorium has no MF field */
+}
+
+int wb_supervisor_node_get_id(WbNodeRef node) {
+  return node != NULL ? (int)node->id : -1;
+}
+
+void wb_supervisor_simulation_quit(int status) {
+  const char *func = "wb_supervisor_simulation_quit";
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return;
+  /* The server serves other controllers and runs until it is stopped; for this controller the
+     simulation ends as in Webots: its next steps return -1. */
+  fprintf(stderr, "Warning: %s(%d): the server runs on until it is stopped; robot '%s' "
+          "steps no more (wb_robot_step() returns -1).\n", func, status, rb->name);
+  rb->terminated = true;
+}
+
 typedef struct {
   const struct WbFieldStructPrivate *field;
   const double *values;
@@ -290,4 +328,62 @@ WbSimulationMode wb_supervisor_simulation_get_mode(void) {
   int64_t v = sn_int_or(rep.result, "value", 2);
   sn_reply_free(&rep);
   return (WbSimulationMode)v;
+}
+
+/* ------------------------------------------------------------------ contact points */
+/* No physics here: a node never touches anything, so every query answers "none". The supervisor check
+ * still applies, as for every wb_supervisor_* function. */
+const double *wb_supervisor_node_get_contact_point(WbNodeRef node, int index) {
+  (void)node;
+  (void)index;
+  supervisor("wb_supervisor_node_get_contact_point");
+  return sn_no_values();
+}
+
+WbNodeRef wb_supervisor_node_get_contact_point_node(WbNodeRef node, int index) {
+  (void)node;
+  (void)index;
+  supervisor("wb_supervisor_node_get_contact_point_node");
+  return NULL;
+}
+
+int wb_supervisor_node_get_number_of_contact_points(WbNodeRef node, bool include_descendants) {
+  (void)node;
+  (void)include_descendants;
+  supervisor("wb_supervisor_node_get_number_of_contact_points");
+  return 0;
+}
+
+WbContactPoint *wb_supervisor_node_get_contact_points(WbNodeRef node, bool include_descendants, int *size) {
+  (void)node;
+  (void)include_descendants;
+  if (size != NULL)
+    *size = 0;
+  supervisor("wb_supervisor_node_get_contact_points");
+  return NULL;
+}
+
+void wb_supervisor_node_enable_contact_points_tracking(WbNodeRef node, int sampling_period, bool include_descendants) {
+  (void)node;
+  (void)sampling_period;
+  (void)include_descendants;
+  supervisor("wb_supervisor_node_enable_contact_points_tracking");
+}
+
+void wb_supervisor_node_disable_contact_points_tracking(WbNodeRef node) {
+  (void)node;
+  supervisor("wb_supervisor_node_disable_contact_points_tracking");
+}
+
+void wb_supervisor_node_enable_contact_point_tracking(WbNodeRef node, int sampling_period, bool include_descendants) {
+  (void)node;
+  (void)sampling_period;
+  (void)include_descendants;
+  supervisor("wb_supervisor_node_enable_contact_point_tracking");
+}
+
+void wb_supervisor_node_disable_contact_point_tracking(WbNodeRef node, bool include_descendants) {
+  (void)node;
+  (void)include_descendants;
+  supervisor("wb_supervisor_node_disable_contact_point_tracking");
 }

@@ -3,11 +3,16 @@
  * answers Webots' "no value". Written from Webots' documented signatures. */
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include <webots/brake.h>
 #include <webots/connector.h>
 #include <webots/display.h>
+#include <webots/microphone.h>
 #include <webots/radar.h>
+#include <webots/radio.h>
 #include <webots/skin.h>
 #include <webots/speaker.h>
 #include <webots/vacuum_gripper.h>
@@ -392,4 +397,189 @@ void wb_vacuum_gripper_turn_off(WbDeviceTag tag) {
 bool wb_vacuum_gripper_is_on(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_is_on");
   return false;
+}
+
+/* ------------------------------------------------------------------ Microphone */
+void wb_microphone_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_MICROPHONE, "wb_microphone_enable");
+}
+
+void wb_microphone_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_MICROPHONE, "wb_microphone_disable");
+}
+
+int wb_microphone_get_sampling_period(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_MICROPHONE, "wb_microphone_get_sampling_period");
+  return 0;
+}
+
+const void *wb_microphone_get_sample_data(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_MICROPHONE, "wb_microphone_get_sample_data");
+  return NULL;
+}
+
+int wb_microphone_get_sample_size(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_MICROPHONE, "wb_microphone_get_sample_size");
+  return 0;
+}
+
+/* ------------------------------------------------------------------ Radio */
+/* A message is plain data (no device involved): its body bytes and destination, copied. */
+typedef struct {
+  int length;
+  char *body;
+  char *destination;
+} sn_radio_message;
+
+WbRadioMessage wb_radio_message_new(int length, const char *body, const char *destination) {
+  if (length < 0 || (length > 0 && body == NULL)) {
+    fprintf(stderr, "Error: wb_radio_message_new(): invalid body (%d bytes at %p)\n", length, (const void *)body);
+    return NULL;
+  }
+  sn_radio_message *m = calloc(1, sizeof *m);
+  if (m == NULL)
+    return NULL;
+  const char *to = destination != NULL ? destination : "";
+  m->body = malloc((size_t)length + 1);
+  m->destination = malloc(strlen(to) + 1);
+  if (m->body == NULL || m->destination == NULL) {
+    free(m->body);
+    free(m->destination);
+    free(m);
+    return NULL;
+  }
+  if (length > 0)
+    memcpy(m->body, body, (size_t)length);
+  m->body[length] = '\0'; /* a text body reads as a C string too */
+  strcpy(m->destination, to);
+  m->length = length;
+  return m;
+}
+
+void wb_radio_message_delete(WbRadioMessage message) {
+  sn_radio_message *m = message;
+  if (m == NULL)
+    return;
+  free(m->body);
+  free(m->destination);
+  free(m);
+}
+
+const char *wb_radio_message_get_destination(WbRadioMessage message) {
+  return message != NULL ? ((sn_radio_message *)message)->destination : NULL;
+}
+
+int wb_radio_message_get_length(WbRadioMessage message) {
+  return message != NULL ? ((sn_radio_message *)message)->length : 0;
+}
+
+const char *wb_radio_message_get_body(WbRadioMessage message) {
+  return message != NULL ? ((sn_radio_message *)message)->body : NULL;
+}
+
+void wb_radio_enable(WbDeviceTag tag, int sampling_period) {
+  (void)sampling_period;
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_enable");
+}
+
+void wb_radio_disable(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_disable");
+}
+
+void wb_radio_set_address(WbDeviceTag tag, const char *address) {
+  (void)address;
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_address");
+}
+
+const char *wb_radio_get_address(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_get_address");
+  return NULL;
+}
+
+void wb_radio_set_frequency(WbDeviceTag tag, double hz) {
+  (void)hz;
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_frequency");
+}
+
+double wb_radio_get_frequency(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_get_frequency");
+  return NAN;
+}
+
+void wb_radio_set_channel(WbDeviceTag tag, int channel) {
+  (void)channel;
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_channel");
+}
+
+int wb_radio_get_channel(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_get_channel");
+  return 0;
+}
+
+void wb_radio_set_bitrate(WbDeviceTag tag, int bits_per_second) {
+  (void)bits_per_second;
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_bitrate");
+}
+
+int wb_radio_get_bitrate(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_get_bitrate");
+  return 0;
+}
+
+void wb_radio_set_rx_sensitivity(WbDeviceTag tag, double dBm) {
+  (void)dBm;
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_rx_sensitivity");
+}
+
+double wb_radio_get_rx_sensitivity(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_get_rx_sensitivity");
+  return NAN;
+}
+
+void wb_radio_set_tx_power(WbDeviceTag tag, double dBm) {
+  (void)dBm;
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_tx_power");
+}
+
+double wb_radio_get_tx_power(WbDeviceTag tag) {
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_get_tx_power");
+  return NAN;
+}
+
+void wb_radio_set_callback(WbDeviceTag tag, void (*callback)(const WbRadioEvent)) {
+  (void)callback; /* never called: nothing is received */
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_callback");
+}
+
+/* No event is ever made (nothing is received), so these only see events a controller made up. */
+WbDeviceTag wb_radio_event_get_radio(const WbRadioEvent event) {
+  (void)event;
+  return 0;
+}
+
+char *wb_radio_event_get_data(const WbRadioEvent event) {
+  (void)event;
+  return NULL;
+}
+
+int wb_radio_event_get_data_size(const WbRadioEvent event) {
+  (void)event;
+  return 0;
+}
+
+char *wb_radio_event_get_emitter(const WbRadioEvent event) {
+  (void)event;
+  return NULL;
+}
+
+double wb_radio_event_get_rssi(const WbRadioEvent event) {
+  (void)event;
+  return NAN;
+}
+
+void wb_radio_send(WbDeviceTag tag, const WbRadioMessage message, double delay) {
+  (void)message;
+  (void)delay;
+  sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_send");
 }

@@ -1,10 +1,16 @@
 """Webots' ``Supervisor``, ``Node`` and ``Field`` classes — the subset Sensorium serves: find
 robots and solids by name, read and set their ``translation``/``rotation``, their world pose,
-reset the simulation and change its mode. The robot's world entry needs ``supervisor: true``."""
+reset the simulation and change its mode. The robot's world entry needs ``supervisor: true``.
+``simulationQuit`` ends this controller's steps (-1; the server runs on). Every other method of
+Webots' classes is there too: it does nothing, prints one error line the first time and answers
+Webots' "no value" (as the C library's functions)."""
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 from sensorium.client import nodes, wb
 
@@ -35,6 +41,9 @@ class Field:
 
     def getSFRotation(self) -> list[float] | None:
         return wb.wb_supervisor_field_get_sf_rotation(self._ref)
+
+    def getCount(self) -> int:
+        return -1  # Webots' count of a single (SF) field; Sensorium has no MF field
 
     def setSFRotation(self, values: list[float]) -> None:
         wb.wb_supervisor_field_set_sf_rotation(self._ref, values)
@@ -75,6 +84,25 @@ class Node:
     def getOrientation(self) -> list[float] | None:
         return wb.wb_supervisor_node_get_orientation(self._ref)
 
+    # -- contact points: Sensorium has no physics contacts, so a node touches nothing (as in the C client)
+    def getContactPoints(self, includeDescendants: bool = False) -> list[ContactPoint]:  # noqa: N803
+        return []
+
+    def enableContactPointsTracking(self, samplingPeriod: int, includeDescendants: bool = False) -> None:  # noqa: N803
+        pass
+
+    def disableContactPointsTracking(self, includeDescendants: bool = False) -> None:  # noqa: N803
+        pass
+
+    def getNumberOfContactPoints(self, includeDescendants: bool = False) -> int:  # noqa: N803
+        return 0
+
+    def getContactPoint(self, index: int) -> list[float]:
+        return [math.nan] * 3
+
+    def getContactPointNode(self, index: int) -> Node | None:
+        return None
+
     id = property(getId)
     def_name = property(getDef)
     type_name = property(getTypeName)
@@ -103,7 +131,8 @@ for _name, _value in nodes.WEBOTS_NODE_TYPES.items():
 @dataclass
 class ContactPoint:
     """Webots' contact point (``Node.getContactPoints``): Sensorium has no physics contacts, so no
-    function returns one; the class exists for ``from controller import ContactPoint``."""
+    function returns one (``getContactPoints()`` is ``[]``); the class exists for ``from controller
+    import ContactPoint``."""
 
     point: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     node_id: int = -1
@@ -145,3 +174,86 @@ class Supervisor(Robot):
 
     def simulationGetMode(self) -> int:
         return wb.wb_supervisor_simulation_get_mode()
+
+    def simulationQuit(self, status: int) -> None:
+        wb.wb_supervisor_simulation_quit(status)
+
+
+class Proto:
+    """Webots' PROTO of a node (``Node.getProto``): Sensorium does not serve PROTO queries, so none is
+    ever handed out; its methods answer Webots' "no value" with one error line each."""
+
+    def __init__(self, ref: int = 0):
+        self._ref = ref
+
+
+def _unserved(method: str, func: str, value: Any) -> Callable[..., Any]:
+    def call(self: object, *args: Any, **kwargs: Any) -> Any:
+        wb.supervisor_unserved(func)
+        return list(value) if isinstance(value, list) else value
+
+    call.__name__ = call.__qualname__ = method
+    call.__doc__ = f"Not served by Sensorium: one error line, Webots' \"no value\" ({value!r})."
+    return call
+
+
+_NAN = math.nan
+# Webots' methods beyond the subset: Python name -> (the C function it stands for, its "no value")
+_UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
+    Supervisor: {
+        "getRoot": ("node_get_root", None), "getFromId": ("node_get_from_id", None),
+        "getFromDevice": ("node_get_from_device", None), "getSelected": ("node_get_selected", None),
+        "setLabel": ("set_label", None), "simulationResetPhysics": ("simulation_reset_physics", None),
+        "worldLoad": ("world_load", None), "worldSave": ("world_save", False), "worldReload": ("world_reload", None),
+        "exportImage": ("export_image", None), "movieStartRecording": ("movie_start_recording", None),
+        "movieStopRecording": ("movie_stop_recording", None), "movieIsReady": ("movie_is_ready", True),
+        "movieFailed": ("movie_failed", True), "animationStartRecording": ("animation_start_recording", False),
+        "animationStopRecording": ("animation_stop_recording", False),
+        "virtualRealityHeadsetIsUsed": ("virtual_reality_headset_is_used", False),
+        "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3),
+        "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9)},
+    Node: {
+        "getType": ("node_get_type", nodes.WEBOTS_NODE_TYPES["WB_NODE_NO_NODE"]),
+        "getParentNode": ("node_get_parent_node", None), "isProto": ("node_is_proto", False),
+        "getProto": ("node_get_proto", None), "getFromProtoDef": ("node_get_from_proto_def", None),
+        "getNumberOfFields": ("node_get_number_of_fields", -1),
+        "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1),
+        "getFieldByIndex": ("node_get_field_by_index", None), "getBaseNodeField": ("node_get_base_node_field", None),
+        "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None), "remove": ("node_remove", None),
+        "exportString": ("node_export_string", ""), "getPose": ("node_get_pose", [_NAN] * 16),
+        "enablePoseTracking": ("node_enable_pose_tracking", None),
+        "disablePoseTracking": ("node_disable_pose_tracking", None),
+        "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3),
+        "getStaticBalance": ("node_get_static_balance", False), "getVelocity": ("node_get_velocity", [_NAN] * 6),
+        "setVelocity": ("node_set_velocity", None), "saveState": ("node_save_state", None),
+        "loadState": ("node_load_state", None), "resetPhysics": ("node_reset_physics", None),
+        "setJointPosition": ("node_set_joint_position", None),
+        "restartController": ("node_restart_controller", None), "moveViewpoint": ("node_move_viewpoint", None),
+        "setVisibility": ("node_set_visibility", None), "addForce": ("node_add_force", None),
+        "addForceWithOffset": ("node_add_force_with_offset", None), "addTorque": ("node_add_torque", None)},
+    Proto: {
+        "getTypeName": ("proto_get_type_name", ""), "isDerived": ("proto_is_derived", False),
+        "getParent": ("proto_get_parent", None), "getField": ("proto_get_field", None),
+        "getFieldByIndex": ("proto_get_field_by_index", None), "getNumberOfFields": ("proto_get_number_of_fields", -1)},
+    Field: {
+        "getActualField": ("field_get_actual_field", None), "enableSFTracking": ("field_enable_sf_tracking", None),
+        "disableSFTracking": ("field_disable_sf_tracking", None), "removeMF": ("field_remove_mf", None),
+        "removeSF": ("field_remove_sf", None), "importMFNodeFromString": ("field_import_mf_node_from_string", None),
+        "importSFNodeFromString": ("field_import_sf_node_from_string", None)},
+}
+_FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 2, "Vec3f": [_NAN] * 3,
+                    "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
+for _kind, _none in _FIELD_NO_VALUES.items():
+    _c = _kind.lower()
+    _UNSERVED[Field][f"getMF{_kind}"] = (f"field_get_mf_{_c}", _none)
+    if _kind != "Node":
+        _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None)
+        _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None)
+    if _kind not in ("Vec3f", "Rotation"):   # the two field types Sensorium serves
+        _UNSERVED[Field][f"getSF{_kind}"] = (f"field_get_sf_{_c}", _none)
+        if _kind != "Node":
+            _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None)
+for _cls, _methods in _UNSERVED.items():
+    for _method, (_func, _value) in _methods.items():
+        assert not hasattr(_cls, _method), _method        # never hides a served method
+        setattr(_cls, _method, _unserved(_method, "wb_supervisor_" + _func, _value))

@@ -5,18 +5,10 @@
 #include <string>
 
 #include <webots/Device.hpp>
+#include <webots/ImageRef.hpp>
 #include <webots/display.h>
 
 namespace webots {
-
-class ImageRef {
-public:
-  explicit ImageRef(WbImageRef ref) : ref_(ref) {}
-  WbImageRef getRef() const { return ref_; }
-
-private:
-  WbImageRef ref_;
-};
 
 class Display : public Device {
 public:

@@ -36,6 +36,7 @@
 #include <webots/Lidar.hpp>
 #include <webots/LightSensor.hpp>
 #include <webots/Motor.hpp>
+#include <webots/plugins/robot_window/robot_wwi.h>
 #include <webots/robot.h>
 
 namespace webots {
@@ -120,6 +121,14 @@ public:
   int getNumberOfDevices() const { return wb_robot_get_number_of_devices(); }
   Device *getDeviceByIndex(int index) { return internal::deviceFromTag(wb_robot_get_device_by_index(index)); }
   Device *getDevice(const std::string &name) { return internal::deviceFromTag(wb_robot_get_device(name.c_str())); }
+  // robot window messages: none here (headless), see plugins/robot_window/robot_wwi.h
+  void wwiSend(const char *data, int size) { wb_robot_wwi_send(data, size); }
+  void wwiSendText(const std::string &text) { wb_robot_wwi_send(text.c_str(), static_cast<int>(text.size()) + 1); }
+  const char *wwiReceive(int *size) { return wb_robot_wwi_receive(size); }
+  std::string wwiReceiveText() {
+    const char *text = wb_robot_wwi_receive_text();
+    return text != NULL ? text : "";
+  }
   DistanceSensor *getDistanceSensor(const std::string &name) { return typed<DistanceSensor>(name, WB_NODE_DISTANCE_SENSOR); }
   LightSensor *getLightSensor(const std::string &name) { return typed<LightSensor>(name, WB_NODE_LIGHT_SENSOR); }
   Lidar *getLidar(const std::string &name) { return typed<Lidar>(name, WB_NODE_LIDAR); }

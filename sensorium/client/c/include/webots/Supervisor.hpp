@@ -1,4 +1,5 @@
-// Sensorium C++ controller layer: Supervisor (a Robot whose world entry has "supervisor: true").
+// Sensorium C++ controller layer: Supervisor (a Robot whose world entry has "supervisor: true"): Webots'
+// methods, over supervisor.h (what Sensorium serves, and Webots' "no value" for the rest).
 #ifndef WEBOTS_SUPERVISOR_HPP
 #define WEBOTS_SUPERVISOR_HPP
 
@@ -19,26 +20,55 @@ public:
     SIMULATION_MODE_FAST = WB_SUPERVISOR_SIMULATION_MODE_FAST
   };
   Supervisor() {}
-  virtual ~Supervisor() {
-    for (std::map<WbNodeRef, Node *>::iterator it = nodes_.begin(); it != nodes_.end(); ++it)
+  virtual ~Supervisor() {  // the nodes, fields and protos handed out
+    for (std::map<WbNodeRef, Node *>::iterator it = internal::nodes().begin(); it != internal::nodes().end(); ++it)
       delete it->second;
+    internal::nodes().clear();
+    for (std::map<WbFieldRef, Field *>::iterator it = internal::fields().begin(); it != internal::fields().end(); ++it)
+      delete it->second;
+    internal::fields().clear();
+    for (std::map<WbProtoRef, Proto *>::iterator it = internal::protos().begin(); it != internal::protos().end(); ++it)
+      delete it->second;
+    internal::protos().clear();
   }
-  Node *getFromDef(const std::string &name) { return node(wb_supervisor_node_get_from_def(name.c_str())); }
-  Node *getSelf() { return node(wb_supervisor_node_get_self()); }
+  // served by Sensorium
+  Node *getFromDef(const std::string &name) { return Node::findNode(wb_supervisor_node_get_from_def(name.c_str())); }
+  Node *getSelf() { return Node::findNode(wb_supervisor_node_get_self()); }
   void simulationReset() { wb_supervisor_simulation_reset(); }
   void simulationSetMode(SimulationMode mode) { wb_supervisor_simulation_set_mode(static_cast<WbSimulationMode>(mode)); }
   SimulationMode simulationGetMode() const { return static_cast<SimulationMode>(wb_supervisor_simulation_get_mode()); }
-
-private:
-  Node *node(WbNodeRef ref) {
-    if (ref == 0)
-      return 0;
-    Node *&n = nodes_[ref];
-    if (n == 0)
-      n = new Node(ref);
-    return n;
+  void simulationQuit(int status) { wb_supervisor_simulation_quit(status); }  // this controller's steps end
+  // Webots' others: one error line per function, "no value" (see supervisor.h)
+  Node *getRoot() { return Node::findNode(wb_supervisor_node_get_root()); }
+  Node *getFromId(int id) { return Node::findNode(wb_supervisor_node_get_from_id(id)); }
+  Node *getFromDevice(const Device *device) {
+    return Node::findNode(wb_supervisor_node_get_from_device(device ? device->getTag() : 0));
   }
-  std::map<WbNodeRef, Node *> nodes_;
+  Node *getSelected() { return Node::findNode(wb_supervisor_node_get_selected()); }
+  void setLabel(int id, const std::string &label, double xpos, double ypos, double size, int color,
+                double transparency = 0, const std::string &font = "Arial") {
+    wb_supervisor_set_label(id, label.c_str(), xpos, ypos, size, color, transparency, font.c_str());
+  }
+  void simulationResetPhysics() { wb_supervisor_simulation_reset_physics(); }
+  void worldLoad(const std::string &file) { wb_supervisor_world_load(file.c_str()); }
+  bool worldSave() { return wb_supervisor_world_save(NULL); }
+  bool worldSave(const std::string &file) { return wb_supervisor_world_save(file.c_str()); }
+  void worldReload() { wb_supervisor_world_reload(); }
+  void exportImage(const std::string &file, int quality) const { wb_supervisor_export_image(file.c_str(), quality); }
+  void movieStartRecording(const std::string &file, int width, int height, int codec, int quality, int acceleration,
+                           bool caption) const {
+    wb_supervisor_movie_start_recording(file.c_str(), width, height, codec, quality, acceleration, caption);
+  }
+  void movieStopRecording() { wb_supervisor_movie_stop_recording(); }
+  bool movieIsReady() const { return wb_supervisor_movie_is_ready(); }
+  bool movieFailed() const { return wb_supervisor_movie_failed(); }
+  bool animationStartRecording(const std::string &file) { return wb_supervisor_animation_start_recording(file.c_str()); }
+  bool animationStopRecording() { return wb_supervisor_animation_stop_recording(); }
+  bool virtualRealityHeadsetIsUsed() const { return wb_supervisor_virtual_reality_headset_is_used(); }
+  const double *virtualRealityHeadsetGetPosition() const { return wb_supervisor_virtual_reality_headset_get_position(); }
+  const double *virtualRealityHeadsetGetOrientation() const {
+    return wb_supervisor_virtual_reality_headset_get_orientation();
+  }
 };
 
 }  // namespace webots

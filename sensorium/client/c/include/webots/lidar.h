@@ -4,6 +4,7 @@
 #ifndef WB_LIDAR_H
 #define WB_LIDAR_H
 
+#include "lidar_point.h"
 #include "types.h"
 
 #ifdef __cplusplus

@@ -18,6 +18,13 @@
 extern "C" {
 #endif
 
+/* Marks the functions Webots keeps only for old controllers (a call warns, as with Webots). */
+#if defined(__GNUC__) || defined(__clang__)
+#define WB_DEPRECATED __attribute__((deprecated))
+#else
+#define WB_DEPRECATED
+#endif
+
 /* A device handle: 1..N in the robot's device order (sensors, then motors); 0 is "no device". */
 typedef unsigned short WbDeviceTag;
 
@@ -28,15 +35,6 @@ typedef struct WbFieldStructPrivate *WbFieldRef;
 typedef struct WbImageStructPrivate *WbImageRef;
 typedef struct WbMotionStructPrivate *WbMotionRef;
 typedef struct WbProtoInfoStructPrivate *WbProtoRef;
-
-/* One lidar point: the device-frame position of a hit, its layer and its time offset (s). */
-typedef struct {
-  float x;
-  float y;
-  float z;
-  int layer_id;
-  float time;
-} WbLidarPoint;
 
 typedef enum { WB_ROTATIONAL = 0, WB_LINEAR } WbJointType;
 
