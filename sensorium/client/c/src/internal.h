@@ -231,6 +231,12 @@ bool sn_unsimulated(WbDeviceTag tag, int node_type, const char *func);
 /* supervisor.c: a Supervisor function Sensorium does not serve: Webots' error in a Robot controller,
    else one line the first time (*warned) it is called. */
 void sn_supervisor_unsupported(const char *func, bool *warned);
+/* In a Supervisor function Sensorium does not serve: its one error line, the first time only. */
+#define SN_UNSUPPORTED()                         \
+  do {                                           \
+    static bool warned_;                         \
+    sn_supervisor_unsupported(__func__, &warned_); \
+  } while (0)
 /* Webots' "no value" for a vector getter: NaN values (16 of them), never NULL. */
 const double *sn_no_values(void);
 /* Webots' node type of a device type name ("DistanceSensor"), WB_NODE_NO_NODE if unknown. */
