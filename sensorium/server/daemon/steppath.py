@@ -31,6 +31,8 @@ from typing import Any
 
 import zmq
 
+from sensorium.schemas.wire import pack
+
 __all__ = ["PyGate", "gate_for", "native_gate_class", "STEP_PATHS"]
 
 STEP_PATHS = ("auto", "c", "python")
@@ -159,6 +161,25 @@ class PyGate:
                 self.discarding = False
                 return True
         return False
+
+    def send_steps(self, replies: list, pieces: tuple[bytes, bytes, bytes, bytes]) -> None:
+        """:meth:`send` for a world step's replies: a list of frames, or ``(envelope, rid, status,
+        time_ms)`` for the step reply without new values, packed from ``pieces`` (as the C gate does).
+        A bad reply raises before anything is sent."""
+        head, status_key, time_key, tail = pieces
+        out = []
+        for r in replies:
+            if type(r) is list:
+                out.append(r)
+                continue
+            if type(r) is not tuple or len(r) != 4 or type(r[0]) is not list \
+                    or any(type(v) is not int for v in r[1:]):
+                raise TypeError("send_steps: a reply is a list of frames or (envelope: list of bytes, rid, status, "
+                                "time_ms)")
+            envelope, rid, status, time_ms = r
+            out.append(envelope + [b"".join((head, pack(rid), status_key, pack(status), time_key, pack(time_ms),
+                                             tail))])
+        self.send(out)
 
     def send(self, replies: list[list[bytes]]) -> None:
         # frame by frame (what send_multipart does, without its per-call type checks and enum flags)

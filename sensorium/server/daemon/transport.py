@@ -32,7 +32,7 @@ import zmq.utils.z85
 
 from sensorium.schemas.services import MAX_PERIOD_MS
 from sensorium.schemas.wire import HARD_LIMIT, ErrorCode, error_reply
-from sensorium.server.daemon.services import Core
+from sensorium.server.daemon.services import STEP_REPLY_PIECES, Core
 from sensorium.server.daemon.steppath import gate_for
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
@@ -305,17 +305,22 @@ class Transport:
             self.close()
 
     def _serve(self, batch: list, now: float) -> None:
-        """Answer one batch from the gate: recognised steps, other messages, over-long messages."""
+        """Answer one batch from the gate: recognised steps, other messages, over-long messages.
+        Only the last item can be other than a recognised step (the gate ends a batch there), so a
+        batch of steps up to the barrier goes to the core in one call."""
         core = self.core
-        replies: list[list[bytes]] = []
-        for item in batch:
-            kind = type(item)
-            if kind is tuple:
-                replies += core.handle_step(item[0], item[1], item[2], item[3], now)
-            elif kind is list:
-                replies += core.handle(item, now)
-            else:                                        # the identity of a message with too many frames
-                replies.append([item, TOO_MANY_FRAMES])
+        if type(batch[-1]) is tuple:
+            replies = core.handle_steps(batch, now)
+        else:
+            replies = []
+            for item in batch:
+                kind = type(item)
+                if kind is tuple:
+                    replies += core.handle_step(item[0], item[1], item[2], item[3], now)
+                elif kind is list:
+                    replies += core.handle(item, now)
+                else:                                    # the identity of a message with too many frames
+                    replies.append([item, TOO_MANY_FRAMES])
         if replies:
             self.gate.send(replies)
 
@@ -371,10 +376,11 @@ class Transport:
             t = core.next_advance(now)
             if t is None or t > now:
                 return t
-            replies, pubs = core.step_once(now)
+            # the step replies without new values stay (envelope, rid, status, time_ms): the gate packs them
+            replies, pubs = core.step_once_compact(now)
             for frames in pubs:
                 self.xpub.send_multipart(frames, copy=False)
-            self.gate.send(replies)
+            self.gate.send_steps(replies, STEP_REPLY_PIECES)
             if self.stop_at_ms is not None and core.sim.time_ms >= self.stop_at_ms:
                 self.stop()
                 return None
