@@ -732,6 +732,38 @@ fail:
   return NULL;
 }
 
+/* exchange(replies, pieces, wait_ms, waiting, limit) -> list | None: send_steps(replies, pieces)
+ * (skipped when there are none), then receive(wait_ms, waiting, limit), in one call: after the
+ * world step's replies this thread goes straight to waiting for the next requests. (Any work it
+ * did between sending and waiting took a core from the replies' way to the controllers: libzmq's
+ * I/O thread and the controllers' own threads; measured ~1 µs of round trip per µs of it.) */
+static PyObject *Gate_exchange(Gate *g, PyObject *args) {
+  if (PyTuple_GET_SIZE(args) != 5) {
+    PyErr_SetString(PyExc_TypeError, "exchange(replies, pieces, wait_ms, waiting, limit)");
+    return NULL;
+  }
+  PyObject *replies = PyTuple_GET_ITEM(args, 0);
+  Py_ssize_t n = PyObject_Length(replies);
+  if (n < 0)
+    return NULL;
+  if (n > 0) {
+    PyObject *send_args = PyTuple_GetSlice(args, 0, 2);
+    if (send_args == NULL)
+      return NULL;
+    PyObject *r = Gate_send_steps(g, send_args);
+    Py_DECREF(send_args);
+    if (r == NULL)
+      return NULL;
+    Py_DECREF(r);
+  }
+  PyObject *recv_args = PyTuple_GetSlice(args, 2, 5);
+  if (recv_args == NULL)
+    return NULL;
+  PyObject *r = Gate_receive(g, recv_args);
+  Py_DECREF(recv_args);
+  return r;
+}
+
 /* close(): forget the socket (before it is closed: libzmq frees it, so no call may follow). */
 static PyObject *Gate_close(Gate *g, PyObject *Py_UNUSED(arg)) {
   g->sock = NULL;
@@ -754,6 +786,8 @@ static PyMethodDef Gate_methods[] = {
     {"send", (PyCFunction)Gate_send, METH_O, "send(replies): each a list of frames"},
     {"send_steps", (PyCFunction)Gate_send_steps, METH_VARARGS,
      "send_steps(replies, pieces): lists of frames, or (envelope, rid, status, time_ms) step replies"},
+    {"exchange", (PyCFunction)Gate_exchange, METH_VARARGS,
+     "exchange(replies, pieces, wait_ms, waiting, limit): send_steps, then receive, in one call"},
     {"close", (PyCFunction)Gate_close, METH_NOARGS, "forget the socket (call before closing it)"},
     {NULL, NULL, 0, NULL},
 };

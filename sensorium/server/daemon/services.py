@@ -427,7 +427,7 @@ class Core(DeviceServices):
 
     def _step_reply(self, d: StepDone) -> Frames:
         r = self._step_answer(d)
-        return r if type(r) is list else self.plain_step_frames(r)
+        return r if isinstance(r, list) else self.plain_step_frames(r)
 
     def _step_answer(self, d: StepDone) -> Frames | tuple[Frames, int, int, int]:
         """The reply to a step done: its frames, or ``(envelope, rid, status, time_ms)`` for the
@@ -583,7 +583,7 @@ class Core(DeviceServices):
             return True
         if p is None and s.last_step is not None and s.last_step[0] == c.id:
             body = s.last_step[1]
-            if type(body) is tuple:                          # a reply the gate packed: the same bytes
+            if isinstance(body, tuple):                      # a reply the gate packed: the same bytes
                 body = self.plain_step_frames(body)[-1]
             c.extra.append(c.envelope + [body])
             return True

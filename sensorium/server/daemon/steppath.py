@@ -181,6 +181,14 @@ class PyGate:
                                              tail))])
         self.send(out)
 
+    def exchange(self, replies: list, pieces: tuple[bytes, bytes, bytes, bytes], wait_ms: int, waiting: Any,
+                 limit: int) -> list | None:
+        """:meth:`send_steps` (when there are replies), then :meth:`receive`: the transport's hot
+        path goes from sending a world step's replies straight to waiting for the next requests."""
+        if replies:
+            self.send_steps(replies, pieces)
+        return self.receive(wait_ms, waiting, limit)
+
     def send(self, replies: list[list[bytes]]) -> None:
         # frame by frame (what send_multipart does, without its per-call type checks and enum flags)
         send = self.sock.send
