@@ -196,6 +196,29 @@ def test_send_steps_packs_the_plain_step_reply_as_msgpack_does(step_path):
         router.close()
 
 
+@pytest.mark.parametrize("step_path", [pytest.param("c", marks=needs_c), "python"])
+def test_exchange_sends_the_replies_then_receives(step_path):
+    """exchange = send_steps then receive in one call (the transport's hot path); no replies: only
+    the receive."""
+    from sensorium.schemas.wire import ok_reply
+    from sensorium.server.daemon.services import STEP_REPLY_PIECES
+
+    router, dealer, gate = pair(step_path)
+    try:
+        assert gate.exchange([], STEP_REPLY_PIECES, 0, [0], 64) is None
+        body = RECOGNISED[1][0]
+        dealer.send(body)
+        first = gate.exchange([], STEP_REPLY_PIECES, 5000, [0], 64)
+        assert first in ([(0, IDENT, 7, None)], [[IDENT, body]])           # recognised (C) or frames (Python)
+        got = gate.exchange([([IDENT], 7, 0, 16)], STEP_REPLY_PIECES, 0, [0], 64)
+        assert got is None                                                # nothing more came meanwhile
+        assert dealer.poll(5000) and dealer.recv() == ok_reply(7, {"status": 0, "time_ms": 16, "values": {}})
+    finally:
+        gate.close()
+        dealer.close()
+        router.close()
+
+
 def test_python_is_chosen_when_asked_and_bad_choices_are_named(monkeypatch):
     router = zmq.Context.instance().socket(zmq.ROUTER)
     try:
