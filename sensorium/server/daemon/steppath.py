@@ -38,6 +38,7 @@ __all__ = ["PyGate", "gate_for", "native_gate_class", "STEP_PATHS"]
 STEP_PATHS = ("auto", "c", "python")
 _NOBLOCK, _SNDMORE, _RCVTIMEO = int(zmq.NOBLOCK), int(zmq.SNDMORE), int(zmq.RCVTIMEO)
 ZERO_COPY_MIN = 64 * 1024       # replies at least this large are sent zero-copy (PyGate)
+_BAD_REPLY = "send_steps: a reply is a list of frames or (envelope: list of bytes, rid, status, time_ms)"
 
 # libzmq functions the C gate calls, in the order _steppath.bind takes them
 _LIBZMQ = ("zmq_msg_init", "zmq_msg_init_size", "zmq_msg_close", "zmq_msg_data", "zmq_msg_size", "zmq_msg_more",
@@ -172,11 +173,12 @@ class PyGate:
             if type(r) is list:
                 out.append(r)
                 continue
-            if type(r) is not tuple or len(r) != 4 or type(r[0]) is not list \
-                    or any(type(v) is not int for v in r[1:]):
-                raise TypeError("send_steps: a reply is a list of frames or (envelope: list of bytes, rid, status, "
-                                "time_ms)")
+            if type(r) is not tuple or len(r) != 4:
+                raise TypeError(_BAD_REPLY)
             envelope, rid, status, time_ms = r
+            if type(envelope) is not list or type(rid) is not int or type(status) is not int \
+                    or type(time_ms) is not int:
+                raise TypeError(_BAD_REPLY)
             out.append(envelope + [b"".join((head, pack(rid), status_key, pack(status), time_key, pack(time_ms),
                                              tail))])
         self.send(out)
