@@ -161,6 +161,64 @@ def test_a_batch_ends_where_the_world_might_step(step_path):
         router.close()
 
 
+# integers at msgpack's encoding boundaries (fixint, 8, 16, 32, 64 bits; both signs for the status)
+RIDS = [0, 1, 127, 128, 255, 256, 65535, 65536, 2**32 - 1, 2**32, 2**63, 2**64 - 1]
+STATUSES = [0, 5, -1, -32, -33, -128, -129, -32768, -32769, -2**31, -2**31 - 1, -2**63, 2**63 - 1, 2**64 - 1]
+
+
+@pytest.mark.parametrize("step_path", [pytest.param("c", marks=needs_c), "python"])
+def test_send_steps_packs_the_plain_step_reply_as_msgpack_does(step_path):
+    """A world step's replies in one call: (envelope, rid, status, time_ms) becomes exactly
+    ok_reply(rid, {"status", "time_ms", "values": {}}) behind its envelope (a REQ's delimiter too),
+    frames lists go out as they are, in order; a bad batch raises and sends nothing."""
+    from sensorium.schemas.wire import ok_reply
+    from sensorium.server.daemon.services import STEP_REPLY_PIECES
+
+    router, dealer, gate = pair(step_path)
+    try:
+        cases = [(rid, status, t) for rid, status, t in zip(RIDS * 2, STATUSES * 2, reversed(RIDS * 2))]
+        for rid, status, t in cases:
+            gate.send_steps([([IDENT], rid, status, t), [IDENT, b"as is"], ([IDENT, b""], rid, status, t)],
+                            STEP_REPLY_PIECES)
+            want = ok_reply(rid, {"status": status, "time_ms": t, "values": {}})
+            for expected in ([want], [b"as is"], [b"", want]):
+                assert dealer.poll(5000)
+                assert dealer.recv_multipart() == expected, (rid, status, t)
+        for bad in ([([IDENT], 1, 0, 0), ([IDENT], 2**64, 0, 0)], [([IDENT], 1, -2**63 - 1, 0)],
+                    [([IDENT], 1, 0, 0), "x"], [([IDENT], 1, 0.0, 0)], [([IDENT], 1, True, 0)], [(IDENT, 1, 0, 0)]):
+            with pytest.raises((TypeError, OverflowError)):
+                gate.send_steps(bad, STEP_REPLY_PIECES)
+        gate.send_steps([[IDENT, b"after"]], STEP_REPLY_PIECES)
+        assert dealer.poll(5000) and dealer.recv_multipart() == [b"after"]     # nothing of the bad batches came
+    finally:
+        gate.close()
+        dealer.close()
+        router.close()
+
+
+@pytest.mark.parametrize("step_path", [pytest.param("c", marks=needs_c), "python"])
+def test_exchange_sends_the_replies_then_receives(step_path):
+    """exchange = send_steps then receive in one call (the transport's hot path); no replies: only
+    the receive."""
+    from sensorium.schemas.wire import ok_reply
+    from sensorium.server.daemon.services import STEP_REPLY_PIECES
+
+    router, dealer, gate = pair(step_path)
+    try:
+        assert gate.exchange([], STEP_REPLY_PIECES, 0, [0], 64) is None
+        body = RECOGNISED[1][0]
+        dealer.send(body)
+        first = gate.exchange([], STEP_REPLY_PIECES, 5000, [0], 64)
+        assert first in ([(0, IDENT, 7, None)], [[IDENT, body]])           # recognised (C) or frames (Python)
+        got = gate.exchange([([IDENT], 7, 0, 16)], STEP_REPLY_PIECES, 0, [0], 64)
+        assert got is None                                                # nothing more came meanwhile
+        assert dealer.poll(5000) and dealer.recv() == ok_reply(7, {"status": 0, "time_ms": 16, "values": {}})
+    finally:
+        gate.close()
+        dealer.close()
+        router.close()
+
+
 def test_python_is_chosen_when_asked_and_bad_choices_are_named(monkeypatch):
     router = zmq.Context.instance().socket(zmq.ROUTER)
     try:
@@ -239,6 +297,41 @@ def test_a_step_reply_without_values_is_msgpacks_bytes():
     c.shutdown()
     assert c.handle_step(2, IDENT, 5, None, 0.0) == [[IDENT, ok_reply(5, {"status": -1, "time_ms": c.lockstep.time_ms,
                                                                           "values": {}})]]
+
+
+def test_a_batch_of_steps_is_answered_as_one_step_after_the_other():
+    """handle_steps (the C path's batch up to the barrier) == handle_step for each, in order: the
+    common ones queued, a stranger, a repeated id and a second step answered as handle answers."""
+    a, b = core(), core()
+    for c in (a, b):
+        attach(c, IDENT, "bot")
+        attach(c, b"S-other", "bot2")
+    batch = [(0, IDENT, 7, 16), (0, b"S-stranger", 8, None), (0, IDENT, 7, 16), (0, IDENT, 9, None),
+             (2, b"S-other", 3, 32)]
+    one_by_one = [r for item in batch for r in a.handle_step(*item, 0.0)]
+    assert b.handle_steps(batch, 0.0) == one_by_one and len(one_by_one) == 2
+    assert step_all(a) == step_all(b) != []
+    assert a.lockstep.time_ms == b.lockstep.time_ms == 16
+
+
+def test_step_replies_without_values_are_left_for_the_gate_to_pack():
+    """step_once_compact leaves the common reply as (envelope, rid, status, time_ms) and gives a
+    reply with new values as frames; step_once is the same with the former packed; a repeated id
+    after either gets the same bytes again."""
+    c = core()
+    attach(c, IDENT, "bot")
+    attach(c, b"S-other", "bot2")
+    c.handle([IDENT, pk({"id": 2, "service": "/bot/ls/enable", "args": {"value": 32}})], 0.0)
+    c.handle_steps([(0, IDENT, 3, 32), (2, b"S-other", 4, 16)], 0.0)
+    replies, _ = c.step_once_compact(0.0)
+    assert replies == [([b"S-other"], 4, 0, 16)]                         # bot waits for 32 ms; bot2's is plain
+    c.handle_step(2, b"S-other", 5, 16, 0.0)
+    replies, _ = c.step_once_compact(0.0)
+    (values, plain) = replies
+    assert type(values) is list and values[0] == IDENT and msgpack.unpackb(values[1])["result"]["values"]
+    assert plain == ([b"S-other"], 5, 0, 32)
+    assert c.handle_step(2, b"S-other", 5, 16, 0.0) == [c.plain_step_frames(plain)]   # a repeated id
+    assert c.handle_step(0, IDENT, 3, 32, 0.0) == [values]
 
 
 # ---------------------------------------------------------------------- the whole server, both gates
@@ -364,3 +457,25 @@ def test_steps_of_several_controllers_come_in_one_batch_per_world_step():
     assert counts["fast_steps"] == counts["messages"] == 600
     served = batches[first:]
     assert sum(served) == 600 and len(served) < 450 and max(served) == 3, (len(served), max(served))
+
+
+def test_an_extension_built_from_older_sources_is_refused_with_the_rebuild_command(monkeypatch):
+    import sys
+    import types
+
+    from sensorium.server.daemon import steppath
+
+    stale = types.ModuleType("sensorium.server.daemon._steppath")
+
+    class Gate:             # an older build: the receive/send gate without the batched replies
+        def receive(self): ...
+        def send(self): ...
+
+    stale.Gate, stale.MSG_SIZE = Gate, 64
+    monkeypatch.setitem(sys.modules, "sensorium.server.daemon._steppath", stale)
+    monkeypatch.setattr(sys.modules["sensorium.server.daemon"], "_steppath", stale, raising=False)
+    monkeypatch.setattr(steppath, "_native", None)
+    cls, why = steppath.native_gate_class()
+    assert cls is None
+    assert "older sources" in why and "Gate.send_steps" in why and "Gate.exchange" in why and "pip install ." in why
+    monkeypatch.setattr(steppath, "_native", None)      # the next caller looks again

@@ -381,8 +381,9 @@ def point_cloud_topic(tmp: Path, W: int, L: int, steps: int, precision: str) -> 
 def server_cpu_per_step(k: int, steps: int) -> dict:
     """The server's Python per world step without sockets, as the transport loop runs it: the k
     step requests handled from their bytes (``Core.handle``, the pure-Python step path) or handed
-    over parsed (``Core.handle_step``, the C step path), then ``step_once`` (simulation step +
-    lockstep + replies). CPU time of this thread, best of a few repeats."""
+    over parsed in one batch (``Core.handle_steps``, the C step path), then ``step_once``
+    (simulation step + lockstep + replies; ``step_once_compact`` for the C path, whose gate packs
+    the common reply). CPU time of this thread, best of a few repeats."""
     from sensorium.schemas.wire import pack
     from sensorium.server.daemon.services import Core
 
@@ -406,11 +407,11 @@ def server_cpu_per_step(k: int, steps: int) -> dict:
                 if how == "handle":
                     for ident, body in zip(ids, bodies):
                         core.handle([ident, body], now)
-                else:
-                    for i, ident in enumerate(ids):
-                        core.handle_step(i, ident, r, 8, now)
+                else:                            # the C gate's batch up to the barrier, in one call
+                    core.handle_steps([(i, ident, r, 8) for i, ident in enumerate(ids)], now)
                 t1 = time.thread_time()
-                replies, _ = core.step_once(now)
+                # the C path leaves the common reply to the gate to pack; the Python path packs it here
+                replies, _ = core.step_once(now) if how == "handle" else core.step_once_compact(now)
                 t2 = time.thread_time()
                 assert len(replies) == k
                 t_handle += t1 - t0
@@ -602,11 +603,13 @@ def run(cfg: Config) -> Section:
         sec.tables.append(Table("server_cpu", "Server-side Python per world step (no sockets)", [
             "controllers", "step requests", "handle step requests", "step_once (sim + lockstep + replies)", "total",
             "ceiling steps/s"], [
-            [k, "from bytes (`Core.handle`: Python step path)" if how == "handle" else "parsed in C (`Core.handle_step`)",
+            [k, "from bytes (`Core.handle`: Python step path)" if how == "handle" else
+             "parsed in C, one batch (`Core.handle_steps`; replies packed by the C gate)",
              fmt_time(v[how]["handle_s"]), fmt_time(v[how]["step_once_s"]), fmt_time(v[how]["total_s"]),
              f"{1 / v[how]['total_s']:,.0f}"]
             for k, v in cpu.items() for how in ("handle", "handle_step")], [
-            "`Core.handle` / `Core.handle_step` and `Core.step_once` called directly, as the transport loop calls them: "
+            "`Core.handle` / `Core.handle_steps` and `Core.step_once` / `step_once_compact` called directly, as the "
+            "transport loop calls them: "
             "what the server's Python spends per world step before any socket work (CPU time of the thread, best of 5 "
             "repeats). 'ceiling' = 1 / total, the rate one core could sustain.",
         ]))

@@ -66,7 +66,9 @@ class Session:
     pending: PendingStep | None = None
     last_reply_ms: int | None = None     # simulated time of the previous step reply (async dt)
     alive: bool = True
-    last_step: tuple[Any, bytes] | None = None   # (request id, reply body) of the last answered step
+    # (request id, reply body) of the last answered step; the body as (envelope, rid, status, time_ms)
+    # for a step reply without new values (services.Core.plain_step_frames makes its bytes)
+    last_step: tuple[Any, bytes | tuple] | None = None
     stepped: bool = False                # asked for a step at least once
     attached_at: float = 0.0             # wall time of the attach
     slot: int = 0                        # the robot's index in the world (the transport's step path names it so)
@@ -258,6 +260,8 @@ class Lockstep:
         :class:`LockstepError` INVALID_ARGUMENT."""
         if duration is None or (kind == "time_step" and duration == 0):
             return self.basic_time_step
+        if type(duration) is int and duration > 0:          # the common case, checked by type alone
+            return -(-duration // self.basic_time_step) * self.basic_time_step
         if isinstance(duration, bool) or not isinstance(duration, int) or duration <= 0:
             raise LockstepError(ErrorCode.INVALID_ARGUMENT, f"duration must be a positive integer (ms), got {duration!r}")
         return -(-duration // self.basic_time_step) * self.basic_time_step

@@ -82,6 +82,7 @@ _STEP_HEAD = b"\x83\xa2id"
 _STEP_STATUS = b"\xa2ok\xc3\xa6result\x83\xa6status"
 _STEP_TIME = b"\xa7time_ms"
 _STEP_NO_VALUES = b"\xa6values\x80"
+STEP_REPLY_PIECES = (_STEP_HEAD, _STEP_STATUS, _STEP_TIME, _STEP_NO_VALUES)   # the gate's send_steps packs with these
 ARG_CACHE_KEYS = 4            # argument maps of at most this many int/str values are cached once validated
 ARG_CACHE_SIZE = 1024         # validated argument maps kept
 
@@ -204,19 +205,28 @@ class Core(DeviceServices):
         """What :meth:`handle` returns for ``[identity, body]`` when ``body`` is the plain step request
         ``{"id": rid, "service": "/<robot>/robot/step", "args": {} or {"duration": duration}}`` of the
         robot with index ``slot``, already parsed by the transport's C step path (steppath.py); the
-        same checks and handler run, only the decoding and validation of those bytes are skipped.
+        same checks and handler run, only the decoding and validation of those bytes are skipped."""
+        return self.handle_steps(((slot, identity, rid, duration),), now)
+
+    def handle_steps(self, steps: Any, now: float) -> list[Frames]:
+        """:meth:`handle_step` for each ``(slot, identity, rid, duration)`` of ``steps``, in order (the
+        C step path's batch, up to the lockstep barrier): the replies to send now, in one call.
 
         The common case (the caller is the robot's attached socket, no step pending, not a repeated
         id, not quitting) is the handler's own outcome done directly: the step is queued, nothing is
         answered yet. Anything else goes the general way (:meth:`_serve`)."""
         ls = self.lockstep
-        s = ls.session_at(slot)
-        if s is None or s.peer != identity or s.pending is not None or ls.shutting_down \
-                or (s.last_step is not None and s.last_step[0] == rid):
-            return self._serve([identity], identity, None, (slot, rid, duration), now)
-        ls.heard(identity, now)
-        ls.request_step(s, ([identity], rid), duration, now)
-        return []
+        session_at, heard, request_step = ls.session_at, ls.heard, ls.request_step
+        out: list[Frames] = []
+        for slot, identity, rid, duration in steps:
+            s = session_at(slot)
+            if s is None or s.peer != identity or s.pending is not None or ls.shutting_down \
+                    or (s.last_step is not None and s.last_step[0] == rid):
+                out += self._serve([identity], identity, None, (slot, rid, duration), now)
+                continue
+            heard(identity, now)
+            request_step(s, ([identity], rid), duration, now)
+        return out
 
     def step_peers(self) -> list[tuple[bytes, bytes, int]]:
         """(identity, step service, slot) of every attached controller: the step requests the C step
@@ -357,6 +367,14 @@ class Core(DeviceServices):
     def step_once(self, now: float) -> tuple[list[Frames], list[Frames]]:
         """Run one basic step: (step replies, topic messages). The caller checked
         :meth:`next_advance`. Publications come before replies (PROTOCOL §3.7)."""
+        replies, pubs = self.step_once_compact(now)
+        return [r if type(r) is list else self.plain_step_frames(r) for r in replies], pubs
+
+    def step_once_compact(self, now: float) -> tuple[list[Any], list[Frames]]:
+        """:meth:`step_once` with the common step reply (no new value) left as ``(envelope, rid,
+        status, time_ms)``: the transport's gate packs it from :data:`STEP_REPLY_PIECES` (C: once per
+        world step for every controller, without Python per reply). :meth:`plain_step_frames` turns
+        one into the frames :meth:`step_once` returns; every other reply is its frames already."""
         try:
             self.sim.step()
         except Exception as exc:  # noqa: BLE001
@@ -375,7 +393,16 @@ class Core(DeviceServices):
             if self.errors <= 10:
                 self.log(f"internal error while publishing: {type(exc).__name__}: {exc}\n{traceback.format_exc()}")
             pubs = []
-        return [self._step_reply(d) for d in done], pubs
+        answer = self._step_answer
+        return [answer(d) for d in done], pubs
+
+    @staticmethod
+    def plain_step_frames(reply: tuple[Frames, int, int, int]) -> Frames:
+        """``(envelope, rid, status, time_ms)`` → the frames of that step reply without new values:
+        ``ok_reply(rid, {"status": status, "time_ms": time_ms, "values": {}})`` from its pieces."""
+        envelope, rid, status, time_ms = reply
+        return envelope + [b"".join((_STEP_HEAD, pack(rid), _STEP_STATUS, pack(status), _STEP_TIME, pack(time_ms),
+                                     _STEP_NO_VALUES))]
 
     def unheard(self, seconds: float, now: float) -> None:
         """The transport read no requests for ``seconds``: not the sessions' silence (Lockstep.unheard)."""
@@ -399,18 +426,24 @@ class Core(DeviceServices):
             motor.hold()
 
     def _step_reply(self, d: StepDone) -> Frames:
+        r = self._step_answer(d)
+        return r if isinstance(r, list) else self.plain_step_frames(r)
+
+    def _step_answer(self, d: StepDone) -> Frames | tuple[Frames, int, int, int]:
+        """The reply to a step done: its frames, or ``(envelope, rid, status, time_ms)`` for the
+        common step reply without new values (:meth:`plain_step_frames`)."""
         envelope, rid = d.step.reply_to
         if d.step.kind == "time_step":
             body = ok_reply(rid, {"success": d.status != -1})
         else:
             values: dict[str, dict] = {}
-            if d.status != -1 and d.session.alive:
+            if d.status != -1 and d.session.alive and self._controls_by_robot[d.session.robot]:
                 values = self._new_values(d.session)
-            if values:
-                body = self._bounded_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})
-            else:                                 # most replies: no new value; msgpack's bytes, assembled
-                body = b"".join((_STEP_HEAD, pack(rid), _STEP_STATUS, pack(d.status), _STEP_TIME, pack(d.time_ms),
-                                 _STEP_NO_VALUES))
+            if not values:                        # most replies: no new value; the gate packs them
+                plain = (envelope, rid, d.status, d.time_ms)
+                d.session.last_step = (rid, plain)   # kept for a retry of a reply lost in transit
+                return plain
+            body = self._bounded_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})
         d.session.last_step = (rid, body)         # kept for a retry of a reply lost in transit
         return envelope + [body]
 
@@ -549,7 +582,10 @@ class Core(DeviceServices):
             p.reply_to = (c.envelope, c.id)
             return True
         if p is None and s.last_step is not None and s.last_step[0] == c.id:
-            c.extra.append(c.envelope + [s.last_step[1]])
+            body = s.last_step[1]
+            if isinstance(body, tuple):                      # a reply the gate packed: the same bytes
+                body = self.plain_step_frames(body)[-1]
+            c.extra.append(c.envelope + [body])
             return True
         return False
 

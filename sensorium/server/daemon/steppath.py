@@ -31,11 +31,17 @@ from typing import Any
 
 import zmq
 
+from sensorium.schemas.wire import pack
+
 __all__ = ["PyGate", "gate_for", "native_gate_class", "STEP_PATHS"]
 
 STEP_PATHS = ("auto", "c", "python")
 _NOBLOCK, _SNDMORE, _RCVTIMEO = int(zmq.NOBLOCK), int(zmq.SNDMORE), int(zmq.RCVTIMEO)
 ZERO_COPY_MIN = 64 * 1024       # replies at least this large are sent zero-copy (PyGate)
+_BAD_REPLY = "send_steps: a reply is a list of frames or (envelope: list of bytes, rid, status, time_ms)"
+
+# what the transport calls on a gate (PyGate has them all)
+_GATE_METHODS = ("receive", "send", "send_steps", "exchange")
 
 # libzmq functions the C gate calls, in the order _steppath.bind takes them
 _LIBZMQ = ("zmq_msg_init", "zmq_msg_init_size", "zmq_msg_close", "zmq_msg_data", "zmq_msg_size", "zmq_msg_more",
@@ -54,6 +60,11 @@ def native_gate_class() -> tuple[Any, str]:
         from sensorium.server.daemon import _steppath  # type: ignore[attr-defined]
     except ImportError as exc:
         _native = (None, f"the C step path is not built ({exc}); `pip install .` builds it when a C compiler is there")
+        return _native
+    missing = [name for name in _GATE_METHODS if not hasattr(_steppath.Gate, name)]
+    if missing:     # an extension built from older sources (an in-place build not redone)
+        _native = (None, f"the C step path was built from older sources (no Gate.{', Gate.'.join(missing)}); "
+                         "rebuild it: `pip install .` (or `python setup.py build_ext --inplace`)")
         return _native
     try:
         import ctypes
@@ -159,6 +170,34 @@ class PyGate:
                 self.discarding = False
                 return True
         return False
+
+    def send_steps(self, replies: list, pieces: tuple[bytes, bytes, bytes, bytes]) -> None:
+        """:meth:`send` for a world step's replies: a list of frames, or ``(envelope, rid, status,
+        time_ms)`` for the step reply without new values, packed from ``pieces`` (as the C gate does).
+        A bad reply raises before anything is sent."""
+        head, status_key, time_key, tail = pieces
+        out = []
+        for r in replies:
+            if type(r) is list:
+                out.append(r)
+                continue
+            if type(r) is not tuple or len(r) != 4:
+                raise TypeError(_BAD_REPLY)
+            envelope, rid, status, time_ms = r
+            if type(envelope) is not list or type(rid) is not int or type(status) is not int \
+                    or type(time_ms) is not int:
+                raise TypeError(_BAD_REPLY)
+            out.append(envelope + [b"".join((head, pack(rid), status_key, pack(status), time_key, pack(time_ms),
+                                             tail))])
+        self.send(out)
+
+    def exchange(self, replies: list, pieces: tuple[bytes, bytes, bytes, bytes], wait_ms: int, waiting: Any,
+                 limit: int) -> list | None:
+        """:meth:`send_steps` (when there are replies), then :meth:`receive`: the transport's hot
+        path goes from sending a world step's replies straight to waiting for the next requests."""
+        if replies:
+            self.send_steps(replies, pieces)
+        return self.receive(wait_ms, waiting, limit)
 
     def send(self, replies: list[list[bytes]]) -> None:
         # frame by frame (what send_multipart does, without its per-call type checks and enum flags)

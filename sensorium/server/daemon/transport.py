@@ -32,7 +32,7 @@ import zmq.utils.z85
 
 from sensorium.schemas.services import MAX_PERIOD_MS
 from sensorium.schemas.wire import HARD_LIMIT, ErrorCode, error_reply
-from sensorium.server.daemon.services import Core
+from sensorium.server.daemon.services import STEP_REPLY_PIECES, Core
 from sensorium.server.daemon.steppath import gate_for
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
@@ -187,6 +187,8 @@ class Transport:
         self.poller.register(self.xpub, zmq.POLLIN)
         self.poller.register(self._wake_r.fileno(), zmq.POLLIN)
         self.hooks: list[Callable[[], None]] = []
+        # step replies of the last world steps, sent by the next receive (gate.exchange) or _flush
+        self._outbox: list = []
         self.closed = False
 
     # ------------------------------------------------------------------ control
@@ -246,6 +248,7 @@ class Transport:
         try:
             while True:
                 if self._stop_requested and quit_at is None:
+                    self._flush()
                     gate.send(core.shutdown())
                     quit_at = clock() + self.grace_s
                 now = clock()
@@ -254,6 +257,7 @@ class Transport:
                 timed_out = False
                 if gate.discarding:
                     # the rest of an over-long message: nobody else's request can be read meanwhile
+                    self._flush()
                     gate.discard()
                     busy_until = now + HOT_S
                 elif now < busy_until:
@@ -264,7 +268,11 @@ class Transport:
                         peers_generation = lockstep.generation
                     if now - deaf_since > STALL_S:      # a long stretch without reading: not their silence
                         core.unheard(now - deaf_since, now)
-                    batch = gate.receive(wait_ms, lockstep.waiting_slots(), REQUESTS_PER_TURN)
+                    # the last world step's replies, then straight to waiting for the next requests:
+                    # everything the loop does per step is done before the replies leave
+                    replies, self._outbox = self._outbox, []
+                    batch = gate.exchange(replies, STEP_REPLY_PIECES, wait_ms, lockstep.waiting_slots(),
+                                          REQUESTS_PER_TURN)
                     now = deaf_since = clock()
                     if batch is not None:
                         self._serve(batch, now)
@@ -273,6 +281,7 @@ class Transport:
                         busy_until = 0.0                 # nothing for a while: wait on every socket
                         timed_out = True
                 else:
+                    self._flush()
                     if now - deaf_since > STALL_S:
                         core.unheard(now - deaf_since, now)
                     events = poll(self._timeout(now, quit_at))
@@ -302,22 +311,35 @@ class Transport:
                     hook()
                 next_step = self._run_steps(now)
         finally:
+            if not self.router.closed:
+                self._flush()
             self.close()
 
     def _serve(self, batch: list, now: float) -> None:
-        """Answer one batch from the gate: recognised steps, other messages, over-long messages."""
+        """Answer one batch from the gate: recognised steps, other messages, over-long messages.
+        Only the last item can be other than a recognised step (the gate ends a batch there), so a
+        batch of steps up to the barrier goes to the core in one call."""
         core = self.core
-        replies: list[list[bytes]] = []
-        for item in batch:
-            kind = type(item)
-            if kind is tuple:
-                replies += core.handle_step(item[0], item[1], item[2], item[3], now)
-            elif kind is list:
-                replies += core.handle(item, now)
-            else:                                        # the identity of a message with too many frames
-                replies.append([item, TOO_MANY_FRAMES])
+        if type(batch[-1]) is tuple:
+            replies = core.handle_steps(batch, now)
+        else:
+            replies = []
+            for item in batch:
+                kind = type(item)
+                if kind is tuple:
+                    replies += core.handle_step(item[0], item[1], item[2], item[3], now)
+                elif kind is list:
+                    replies += core.handle(item, now)
+                else:                                    # the identity of a message with too many frames
+                    replies.append([item, TOO_MANY_FRAMES])
         if replies:
             self.gate.send(replies)
+
+    def _flush(self) -> None:
+        """Send the step replies still in the outbox (before anything but the busy receive)."""
+        if self._outbox:
+            replies, self._outbox = self._outbox, []
+            self.gate.send_steps(replies, STEP_REPLY_PIECES)
 
     def _look_around(self) -> None:
         """While busy: serve the XPUB and the wake socket if they have something (no waiting)."""
@@ -371,10 +393,13 @@ class Transport:
             t = core.next_advance(now)
             if t is None or t > now:
                 return t
-            replies, pubs = core.step_once(now)
+            self._flush()                               # a world stepping on: the earlier step's replies now
+            # the step replies without new values stay (envelope, rid, status, time_ms): the gate packs
+            # them; they leave with the loop's next receive (gate.exchange), publications first
+            replies, pubs = core.step_once_compact(now)
             for frames in pubs:
                 self.xpub.send_multipart(frames, copy=False)
-            self.gate.send(replies)
+            self._outbox += replies
             if self.stop_at_ms is not None and core.sim.time_ms >= self.stop_at_ms:
                 self.stop()
                 return None
