@@ -217,11 +217,15 @@ class MuJoCo(Peer):
             fs = " ".join(str(int(x)) for x in f.reshape(-1))
             assets.append(f'<mesh name="m{i}" vertex="{vs}" face="{fs}"/>')
             geoms.append(f'<geom type="mesh" mesh="m{i}"/>')
+        self._load(assets, geoms)
+
+    def _load(self, assets: list[str], geoms: list[str]) -> None:
+        """The model from its mesh assets and geoms, and the ray buffers mj_multiRay fills."""
         xml = ("<mujoco><compiler boundmass=\"0.001\" boundinertia=\"0.001\"/><asset>" + "".join(assets)
                + "</asset><worldbody>" + "".join(geoms) + "</worldbody></mujoco>")
-        self.model = mujoco.MjModel.from_xml_string(xml)
-        self.data = mujoco.MjData(self.model)
-        mujoco.mj_forward(self.model, self.data)
+        self.model = self.mj.MjModel.from_xml_string(xml)
+        self.data = self.mj.MjData(self.model)
+        self.mj.mj_forward(self.model, self.data)
         self.pnt = np.asarray(self.O[0], dtype=np.float64)
         self.vec = np.ascontiguousarray(self.D, dtype=np.float64).reshape(-1)
         self.n = len(self.D)
@@ -279,16 +283,7 @@ class MuJoCoPrimitives(MuJoCo):
                 assets.append(f'<mesh name="m{i}" vertex="{" ".join(f"{c:.9g}" for c in v.reshape(-1))}" '
                               f'face="{" ".join(str(int(c)) for c in np.asarray(f).reshape(-1))}"/>')
                 geoms.append(f'<geom type="mesh" mesh="m{i}"/>')
-        xml = ("<mujoco><compiler boundmass=\"0.001\" boundinertia=\"0.001\"/><asset>" + "".join(assets)
-               + "</asset><worldbody>" + "".join(geoms) + "</worldbody></mujoco>")
-        self.model = mujoco.MjModel.from_xml_string(xml)
-        self.data = mujoco.MjData(self.model)
-        mujoco.mj_forward(self.model, self.data)
-        self.pnt = np.asarray(self.O[0], dtype=np.float64)
-        self.vec = np.ascontiguousarray(self.D, dtype=np.float64).reshape(-1)
-        self.n = len(self.D)
-        self.geomid = np.zeros(self.n, dtype=np.int32)
-        self.dist = np.zeros(self.n, dtype=np.float64)
+        self._load(assets, geoms)
 
 
 class PyBullet(Peer):
