@@ -158,9 +158,9 @@ def _role_stepper(rpc: str, robot: str, duration: str) -> None:
     _chunks(lambda: conn.call(service, args), close)
 
 
-def _role_bare_stepper(rpc: str, robot: str, duration: str) -> None:
-    """A bare DEALER stepping a robot in lockstep (pack, send, blocking recv, unpack): the client
-    library's share of a Sensorium round trip is the difference to ``stepper``."""
+def _bare_step_session(rpc: str, robot: str, duration: str):
+    """A bare DEALER attached to ``robot``: (context, socket, session, step), ``step`` one lockstep
+    round trip (pack, send, blocking recv, unpack) without the client library."""
     import msgpack
     import zmq
 
@@ -174,9 +174,19 @@ def _role_bare_stepper(rpc: str, robot: str, duration: str) -> None:
     service, args = f"/{robot}/robot/step", {"duration": int(duration)}
     ids = iter(range(2, 1 << 62))
 
-    def call():
+    def step():
         s.send(packer.pack({"id": next(ids), "service": service, "args": args}))
         msgpack.unpackb(s.recv(), raw=False)
+
+    return ctx, s, session, step
+
+
+def _role_bare_stepper(rpc: str, robot: str, duration: str) -> None:
+    """A bare DEALER stepping a robot in lockstep (pack, send, blocking recv, unpack): the client
+    library's share of a Sensorium round trip is the difference to ``stepper``."""
+    import msgpack
+
+    ctx, s, session, call = _bare_step_session(rpc, robot, duration)
 
     def close():
         s.send(msgpack.packb({"id": 0, "service": "detach", "args": {"session": session}}))
@@ -245,22 +255,7 @@ def _role_controller(rpc: str, robot: str, steps: str, duration: str) -> None:
 def _role_bare_controller(rpc: str, robot: str, steps: str, duration: str) -> None:
     """``controller`` with a bare DEALER instead of the client library (no heartbeat, no retries):
     what the library costs when 8 controllers share 2 cores."""
-    import msgpack
-    import zmq
-
-    ctx = zmq.Context()
-    s = ctx.socket(zmq.DEALER)
-    s.connect(rpc)
-    s.send(msgpack.packb({"id": 1, "service": "attach", "args": {"robot": robot}}))
-    msgpack.unpackb(s.recv())
-    packer = msgpack.Packer()
-    service, args = f"/{robot}/robot/step", {"duration": int(duration)}
-    ids = iter(range(2, 1 << 62))
-
-    def step():
-        s.send(packer.pack({"id": next(ids), "service": service, "args": args}))
-        msgpack.unpackb(s.recv(), raw=False)
-
+    ctx, s, _session, step = _bare_step_session(rpc, robot, duration)
     _bursts(step, int(steps))
     s.close(0)
     ctx.term()
