@@ -422,18 +422,26 @@ class RayEngine(TierTracer):
             normal = None if distance_only else np.empty((n, 3))
             shape = None if distance_only else np.empty(n, dtype=np.int64)
             eps64 = 1e-9 + 1e-14 * big
-            pairs = own = None
-            if movers is not None and isinstance(mount, Mount):
-                # a Mount's pairs, listed for the whole batch up to t_far (a superset of those up to
-                # each ray's nearest static hit), then traced in the blocks beside the static tier
-                # with each ray's own limit: the same hits as tracing them after all blocks
-                *pairs, own = self._mover_pairs(movers, O, D, t_near, t_far,
-                                                t_far if isinstance(t_far, np.ndarray) else np.full(n, t_far), excl,
-                                                mount, own_apart=distance_only and not exact)
-                if movers.R is None:
-                    movers.R = self._rot[movers.index]
-                for tier in movers.tiers:
-                    tier.prepare(exact)
+            listed: dict = {}   # "pairs", "own" once listed (see list_pairs)
+            ready = threading.Event()
+            mounted = movers is not None and isinstance(mount, Mount)
+
+            def list_pairs() -> None:
+                """A Mount's pairs, listed for the whole batch up to t_far (a superset of those up to each
+                ray's nearest static hit), then traced in the blocks beside the static tier with each
+                ray's own limit: the same hits as tracing them after all blocks. Listed on the calling
+                thread while the workers trace their first blocks' static tier."""
+                try:
+                    *pairs, own = self._mover_pairs(movers, O, D, t_near, t_far,
+                                                    t_far if isinstance(t_far, np.ndarray) else np.full(n, t_far),
+                                                    excl, mount, own_apart=distance_only and not exact)
+                    if movers.R is None:
+                        movers.R = self._rot[movers.index]
+                    for tier in movers.tiers:
+                        tier.prepare(exact)
+                    listed.update(pairs=pairs, own=own)
+                finally:
+                    ready.set()
 
             def block(sl: slice) -> None:
                 m = sl.stop - sl.start
@@ -444,6 +452,9 @@ class RayEngine(TierTracer):
                     dist[sl] = h[0]
                     if not distance_only:
                         shape[sl], normal[sl] = h[1], h[2]
+                    if mounted:
+                        ready.wait()
+                    pairs = listed.get("pairs")
                     if pairs is not None and len(pairs[0]):
                         pr, pm, tight = pairs
                         sel = ((pr >= sl.start) & (pr < sl.stop)).nonzero()[0]
@@ -454,10 +465,10 @@ class RayEngine(TierTracer):
                                               None if distance_only else normal[sl], pr[sel] - sl.start, pm[sel],
                                               tight, split=False)
 
-            run(block, parts, threads)
-            if own is not None:   # the own-mount hits, traced once
-                self._apply_own_hits(own, movers, O, D, t_near, t_far, eps64, dist)
-            if movers is not None and pairs is None:   # no Mount: the movers after the blocks, in chunks
+            run(block, parts, threads, list_pairs if mounted else None)
+            if listed.get("own") is not None:   # the own-mount hits, traced once
+                self._apply_own_hits(listed["own"], movers, O, D, t_near, t_far, eps64, dist)
+            if movers is not None and not mounted:   # no Mount: the movers after the blocks, in chunks
                 hits = (dist, shape, normal)
                 for sl in split(n, 1, _CHUNK):
                     self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
