@@ -24,7 +24,8 @@ Speed (measured in ``sensorium bench``, peers section)
   the calls (a 360-ray FAST scan: ~0.6 M instructions, Embree ~0.25 M of them; callgrind).
 * Threads: a cast of >= ``blocks.MIN_RAYS`` rays runs its planes and static tier in blocks on
   ``RayEngine.threads`` threads (default: the cores this process may use; ``SENSORIUM_THREADS``),
-  and so do a lidar's own-body pairs; no ray's answer depends on its block or on the other rays of
+  and so do a lidar's Mount pairs (listed on the calling thread while the workers start on their
+  blocks); no ray's answer depends on its block or on the other rays of
   its batch (world-to-frame rotations are summed in one fixed order, never by BLAS; a curved
   shape's frame as einsum sums it, a sum of zeros being +0.0, whether one shape or several are
   refined together), so the bits are the same on any number of threads.  No BLAS call runs beside
@@ -47,7 +48,9 @@ Architecture
   its box) are dropped; the rest go to ONE Embree call per shared scene.  Rays rigidly mounted on
   movers (``cast(mount=...)``: sensors on robots) never meet their own mount here, and bodies are
   paired before rays; with a :class:`Mount` passed again and again, the pairing is kept between
-  casts as lists with margins (see :mod:`.movers`).
+  casts as lists with margins (see :mod:`.movers`).  A FAST lidar's own-body hits (distances only,
+  scalar limits) are traced once in the body frame and kept with its Mount (``_apply_own_hits``):
+  the per-cast answers, the rounding of the body-frame rays at the first cast aside.
 * Planes are analytic (float64), never triangles, all planes of a ray kind in one (rays x planes)
   computation.
 * Curved primitives are tessellated CIRCUMSCRIBED (true surface inside the shell) and inflated
