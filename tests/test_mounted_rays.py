@@ -334,6 +334,56 @@ def test_a_lidar_mount_that_sees_its_own_body_gives_the_plain_answers_bit_for_bi
     assert np.isfinite(kept.distance[st.own_pr]).mean() > 0.9
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_fast_lidars_own_body_hits_traced_once_are_the_per_cast_answers(threads):
+    """FAST, distances only: the own-body hits of a lidar's Mount are traced once (in the body frame,
+    up to t_far) and kept while the limits stay; as the robot drives and turns, other robots cross
+    its beams and a wall comes nearer than its body for some beams, every distance is the plain
+    cast's bit for bit, also with limits that cut the own-body hits (t_far just around the body's
+    top face) and after the limits change (traced again)."""
+    eng = RayEngine(Precision.FAST)
+    eng.threads = threads
+    eng.add_body([ShapeEntry(Plane(), Pose.identity(), True, True)], Pose.identity())
+    wall = eng.add_body([ShapeEntry(Box((4.0, 0.1, 0.3)), Pose.identity(), True, True)],
+                        Pose(np.eye(3), np.array([0.0, 1.5, 0.15])), movable=True)
+    scout = eng.add_body([ShapeEntry(Box((0.3, 0.2, 0.12)), Pose.identity(), True, True)],
+                         Pose(_rz(0.4), np.array([0.1, 0.2, 0.06])), owner=0, movable=True)
+    other = eng.add_body([ShapeEntry(Cylinder(0.035, 0.05), Pose.identity(), True, True)],
+                         Pose(np.eye(3), np.array([0.6, 0.2, 0.025])), owner=1, movable=True)
+    D_loc = _lidar_beams(W=1440, L=24)          # 34,560 beams: split in blocks on two threads
+    lidar_at = np.array([0.0, 0.0, 0.09])
+    rng = np.random.default_rng(11)
+    for t_far in (6.0, 0.1, 0.12, 6.0):   # the body's top face: 0.1015 away at least (none within 0.1)
+        mount = Mount(np.full(len(D_loc), scout), own=True)
+        for step in range(5):
+            pose = Pose(_rz(0.4 + 0.7 * step), np.array([0.1 + 0.05 * step, 0.2 - 0.03 * step, 0.06]))
+            eng.set_body_pose(scout, pose)
+            eng.set_body_pose(other, Pose(_rz(rng.uniform(0, 6)), pose.apply(np.array([[0.22, 0.0, -0.035]]))[0]
+                                          + [*rng.uniform(-0.05, 0.05, 2), 0.0]))
+            # a thin wall just over the body's edge on some steps: nearer than the body for a few beams
+            wall_at = pose.apply(np.array([[0.16, 0.0, 0.0]]))[0] + [0.0, 0.0, 0.05] if step % 2 else [0.0, 1.5, 0.15]
+            eng.set_body_pose(wall, Pose(pose.rotation @ _rz(math.pi / 2) if step % 2 else np.eye(3), np.array(wall_at)))
+            O = np.broadcast_to(pose.apply(lidar_at[None])[0], D_loc.shape)
+            D = D_loc @ pose.rotation.T
+            plain = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, distance_only=True)
+            kept = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, distance_only=True, mount=mount)
+            assert plain.distance.tobytes() == kept.distance.tobytes()
+        st = mount._state
+        if t_far == 0.1:
+            assert len(st.own_pr) == 0 and st.own_hits is None
+            continue
+        assert st.own_hits is not None and st.own_hits[0] == (0.0, t_far)    # traced once, for these limits
+        assert 0 < len(st.own_hits[1]) <= len(st.own_pr) and np.isfinite(kept.distance[st.own_hits[1]]).all()
+    # a shorter segment: the state is kept, but its own-body hits were traced up to 6 m (per cast again)
+    kept = eng.cast(O, D, 0.0, 0.11, kind=RayKind.VISUAL, distance_only=True, mount=mount)
+    assert mount._state is st and st.own_hits[0] == (0.0, 6.0)
+    assert kept.distance.tobytes() == eng.cast(O, D, 0.0, 0.11, kind=RayKind.VISUAL, distance_only=True).distance.tobytes()
+    # a longer segment than the state was made for: a new state, traced again
+    kept = eng.cast(O, D, 0.0, 7.0, kind=RayKind.VISUAL, distance_only=True, mount=mount)
+    assert mount._state.own_hits[0] == (0.0, 7.0)
+    assert kept.distance.tobytes() == eng.cast(O, D, 0.0, 7.0, kind=RayKind.VISUAL, distance_only=True).distance.tobytes()
+
+
 def test_the_simulation_mounts_a_fixed_lidar_on_its_robots_body():
     world = {"world_info": {"basic_time_step": 32},
              "solids": [{"name": "floor", "geometry": {"type": "plane"}},

@@ -191,6 +191,39 @@ def test_blocks_split_cover_the_batch_and_run_keeps_order():
     assert blocks.run(lambda k: sum(blocks.run(lambda j: j, list(range(k)), 2)), [3, 4, 5], 2) == [3, 6, 10]
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_blocks_run_does_first_work_on_the_calling_thread_beside_the_blocks(threads):
+    """``first`` runs once, on the calling thread, before it takes a block; blocks that need its
+    result wait for it (the engine lists a Mount's pairs so); its exception is raised after the
+    blocks taken are done, and blocks that wait for it are not left hanging."""
+    import threading
+
+    ready, seen = threading.Event(), {}
+
+    def first():
+        seen["thread"] = threading.current_thread()
+        seen["value"] = 10
+        ready.set()
+
+    def block(k):
+        ready.wait(timeout=30)
+        return k + seen["value"]
+
+    assert blocks.run(block, list(range(6)), threads, first) == [k + 10 for k in range(6)]
+    assert seen["thread"] is threading.current_thread()
+
+    ready2 = threading.Event()
+
+    def failing():
+        try:
+            raise KeyError("first failed")
+        finally:
+            ready2.set()
+
+    with pytest.raises(KeyError, match="first failed"):
+        blocks.run(lambda k: ready2.wait(timeout=30) and k, list(range(6)), threads, failing)
+
+
 def test_without_a_compiler_or_switched_off_the_engine_uses_embreex_and_says_why(monkeypatch, tmp_path):
     monkeypatch.setattr(packets, "_state", {})
     monkeypatch.setenv("SENSORIUM_PACKETS", "0")

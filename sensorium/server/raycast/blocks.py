@@ -70,14 +70,17 @@ def _executor(workers: int) -> ThreadPoolExecutor:
         return _pool
 
 
-def run(fn: Callable[[B], T], blocks: Sequence[B], threads: int) -> list[T]:
+def run(fn: Callable[[B], T], blocks: Sequence[B], threads: int, first: Callable[[], None] | None = None) -> list[T]:
     """``[fn(b) for b in blocks]`` on up to ``threads`` threads: the calling thread and pool workers
     take the next block until none is left, and the call returns once every block taken is done.
     A worker that has not started by then (its core busy with another process) finds nothing to do
     and is not waited for, so on a busy machine this costs at most what one thread would. A block's
     exception is raised here. Called from a pool worker (a nested split), the blocks run on that
-    thread."""
+    thread. ``first``: work the calling thread does before it takes a block, while the workers start
+    on theirs (blocks that need its result wait for it themselves); its exception is raised here."""
     if threads <= 1 or len(blocks) <= 1 or threading.current_thread().name.startswith(_PREFIX):
+        if first is not None:
+            first()
         return [fn(b) for b in blocks]
     results: list = [None] * len(blocks)
     errors: list[BaseException] = []
@@ -105,6 +108,12 @@ def run(fn: Callable[[B], T], blocks: Sequence[B], threads: int) -> list[T]:
     pool = _executor(threads - 1)
     for _ in range(min(threads, len(blocks)) - 1):
         pool.submit(work)
+    if first is not None:
+        try:
+            first()
+        except BaseException as exc:  # noqa: BLE001 - raised below, once the blocks taken are done
+            with cond:
+                errors.append(exc)
     work()
     with cond:
         cond.wait_for(lambda: state["busy"] == 0)

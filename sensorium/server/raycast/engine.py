@@ -24,7 +24,8 @@ Speed (measured in ``sensorium bench``, peers section)
   the calls (a 360-ray FAST scan: ~0.6 M instructions, Embree ~0.25 M of them; callgrind).
 * Threads: a cast of >= ``blocks.MIN_RAYS`` rays runs its planes and static tier in blocks on
   ``RayEngine.threads`` threads (default: the cores this process may use; ``SENSORIUM_THREADS``),
-  and so do a lidar's own-body pairs; no ray's answer depends on its block or on the other rays of
+  and so do a lidar's Mount pairs (listed on the calling thread while the workers start on their
+  blocks); no ray's answer depends on its block or on the other rays of
   its batch (world-to-frame rotations are summed in one fixed order, never by BLAS; a curved
   shape's frame as einsum sums it, a sum of zeros being +0.0, whether one shape or several are
   refined together), so the bits are the same on any number of threads.  No BLAS call runs beside
@@ -47,7 +48,9 @@ Architecture
   its box) are dropped; the rest go to ONE Embree call per shared scene.  Rays rigidly mounted on
   movers (``cast(mount=...)``: sensors on robots) never meet their own mount here, and bodies are
   paired before rays; with a :class:`Mount` passed again and again, the pairing is kept between
-  casts as lists with margins (see :mod:`.movers`).
+  casts as lists with margins (see :mod:`.movers`).  A FAST lidar's own-body hits (distances only,
+  scalar limits) are traced once in the body frame and kept with its Mount (``_apply_own_hits``):
+  the per-cast answers, the rounding of the body-frame rays at the first cast aside.
 * Planes are analytic (float64), never triangles, all planes of a ray kind in one (rays x planes)
   computation.
 * Curved primitives are tessellated CIRCUMSCRIBED (true surface inside the shell) and inflated
@@ -422,17 +425,26 @@ class RayEngine(TierTracer):
             normal = None if distance_only else np.empty((n, 3))
             shape = None if distance_only else np.empty(n, dtype=np.int64)
             eps64 = 1e-9 + 1e-14 * big
-            pairs = None
-            if movers is not None and isinstance(mount, Mount):
-                # a Mount's pairs, listed for the whole batch up to t_far (a superset of those up to
-                # each ray's nearest static hit), then traced in the blocks beside the static tier
-                # with each ray's own limit: the same hits as tracing them after all blocks
-                pairs = self._mover_pairs(movers, O, D, t_near, t_far,
-                                          t_far if isinstance(t_far, np.ndarray) else np.full(n, t_far), excl, mount)
-                if movers.R is None:
-                    movers.R = self._rot[movers.index]
-                for tier in movers.tiers:
-                    tier.prepare(exact)
+            listed: dict = {}   # "pairs", "own" once listed (see list_pairs)
+            ready = threading.Event()
+            mounted = movers is not None and isinstance(mount, Mount)
+
+            def list_pairs() -> None:
+                """A Mount's pairs, listed for the whole batch up to t_far (a superset of those up to each
+                ray's nearest static hit), then traced in the blocks beside the static tier with each
+                ray's own limit: the same hits as tracing them after all blocks. Listed on the calling
+                thread while the workers trace their first blocks' static tier."""
+                try:
+                    *pairs, own = self._mover_pairs(movers, O, D, t_near, t_far,
+                                                    t_far if isinstance(t_far, np.ndarray) else np.full(n, t_far),
+                                                    excl, mount, own_apart=distance_only and not exact)
+                    if movers.R is None:
+                        movers.R = self._rot[movers.index]
+                    for tier in movers.tiers:
+                        tier.prepare(exact)
+                    listed.update(pairs=pairs, own=own)
+                finally:
+                    ready.set()
 
             def block(sl: slice) -> None:
                 m = sl.stop - sl.start
@@ -443,6 +455,9 @@ class RayEngine(TierTracer):
                     dist[sl] = h[0]
                     if not distance_only:
                         shape[sl], normal[sl] = h[1], h[2]
+                    if mounted:
+                        ready.wait()
+                    pairs = listed.get("pairs")
                     if pairs is not None and len(pairs[0]):
                         pr, pm, tight = pairs
                         sel = ((pr >= sl.start) & (pr < sl.stop)).nonzero()[0]
@@ -453,8 +468,10 @@ class RayEngine(TierTracer):
                                               None if distance_only else normal[sl], pr[sel] - sl.start, pm[sel],
                                               tight, split=False)
 
-            run(block, parts, threads)
-            if movers is not None and pairs is None:   # no Mount: the movers after the blocks, in chunks
+            run(block, parts, threads, list_pairs if mounted else None)
+            if listed.get("own") is not None:   # the own-mount hits, traced once
+                self._apply_own_hits(listed["own"], movers, O, D, t_near, t_far, eps64, dist)
+            if movers is not None and not mounted:   # no Mount: the movers after the blocks, in chunks
                 hits = (dist, shape, normal)
                 for sl in split(n, 1, _CHUNK):
                     self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
@@ -498,7 +515,8 @@ class RayEngine(TierTracer):
         exact = self._precision is Precision.EXACT
         hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32)
         if movers is not None:
-            self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits, mount=mount)
+            self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits, mount=mount,
+                              own_apart=distance_only and not exact)
         return RayHits(hits[0], hits[2], hits[1])
 
     def _cast_static(self, O, D, t_near, t_far, excl, planes, static, big: float, distance_only: bool = False,
@@ -555,19 +573,58 @@ class RayEngine(TierTracer):
         return t, s, nrm
 
     def _cast_movers(self, mt: _Movers, O, D, t_near, t_far, excl, eps64, exact, dist, shape, normal,
-                     mount=None) -> None:
+                     mount=None, own_apart: bool = False) -> None:
         """Broad phase over all movers, then one trace per shared tier over its (ray, mover) pairs
-        moved into their body frames; improves dist/shape/normal in place."""
+        moved into their body frames; improves dist/shape/normal in place. ``own_apart``: see
+        :meth:`_mover_pairs`."""
         lim = np.minimum(t_far, dist)
-        pr, pm, tight = self._mover_pairs(mt, O, D, t_near, t_far, lim, excl, mount)
+        pr, pm, tight, own = self._mover_pairs(mt, O, D, t_near, t_far, lim, excl, mount, own_apart)
         if len(pr):
             self._trace_pairs(mt, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight)
+        if own is not None:
+            self._apply_own_hits(own, mt, O, D, t_near, t_far, eps64, dist)
 
-    def _mover_pairs(self, mt: _Movers, O, D, t_near, t_far, lim, excl, mount=None) -> tuple:
-        """(rays, mover rows, tight row) of the (ray, mover) pairs whose segment up to ``lim`` can meet
-        the mover (every test is conservative: a larger ``lim`` gives more pairs, never fewer);
+    def _apply_own_hits(self, st, mt: _Movers, O, D, t_near, t_far, eps64: float, dist) -> None:
+        """A FAST lidar's own-mount hits (the Mount's own pairs: its beams that can reach its robot's
+        body) into ``dist``: traced once, in the body frame, up to t_far, and kept in the Mount's state
+        while its limits are the same. A rigidly mounted beam's body-frame ray is the same at every
+        pose up to the rounding of the world round trip (the float32 ray Embree gets changes only when
+        a body-frame coordinate lies within float64 rounding of a float32 rounding boundary), so the
+        nearest of its own-body hit and the other hits is the per-cast answer: a hit the per-cast
+        trace finds before its limit (the nearest other hit, else t_far) is the one traced up to t_far,
+        and one found beyond it never wins (tests/test_mounted_rays.py)."""
+        got = st.own_hits
+        key = (t_near, t_far)
+        if got is None or got[0] != key:
+            rr = st.own_pr
+            row = int(st.own_pm[0])
+            if mt.R is None:
+                mt.R = self._rot[mt.index]
+            Rb, Tb = mt.R[row], mt.T[row]
+            # the rays into the body frame as the per-cast trace moves them (_trace_pairs: one mover)
+            Db = packets.to_frame_rows(D, rr, Rb)
+            if Db is None:
+                Db = _to_frame(D.take(rr, axis=0), Rb)
+            Ob = _one_row(_to_frame(_minus(O[:1], Tb), Rb), len(rr))
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                res = self._trace(mt.tiers[mt.group[row]], Ob, Db, t_near, np.full(len(rr), t_far), -1, eps64,
+                                  False, None, True)
+            t = np.full(len(rr), _INF) if res is None else res[0]
+            hit = (t < _INF).nonzero()[0]
+            st.own_hits = got = (key, rr[hit], t[hit])
+        rows, t = got[1], got[2]
+        if len(rows):
+            cur = dist[rows]
+            np.minimum(cur, t, out=cur)
+            dist[rows] = cur
+
+    def _mover_pairs(self, mt: _Movers, O, D, t_near, t_far, lim, excl, mount=None, own_apart: bool = False) -> tuple:
+        """(rays, mover rows, tight row, own) of the (ray, mover) pairs whose segment up to ``lim`` can
+        meet the mover (every test is conservative: a larger ``lim`` gives more pairs, never fewer);
         ``tight``: a mover row whose pairs are only a Mount's own pairs (tested against its bound
-        when listed), else -1."""
+        when listed), else -1. ``own_apart`` (a FAST cast of distances only): a lidar's own-mount
+        pairs are left out when its Mount keeps their hits (scalar limits, as when its state was
+        made); ``own`` is then that state, for :meth:`_apply_own_hits`, else None."""
         if mt.epoch != self._epoch:  # poses changed since the last cast (rotations gathered when needed)
             mt.T = self._pos[mt.index]
             mt.R = self._rot[mt.index] if mt.anchored else None
@@ -575,7 +632,7 @@ class RayEngine(TierTracer):
             mt.epoch = self._epoch
         C = mt.C
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
-        mounted = mrow = None
+        mounted = mrow = own = None
         tight = -1   # a mover row whose pairs are only a Mount's own pairs (already tested against its bound)
         if mount is not None:
             if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
@@ -591,8 +648,11 @@ class RayEngine(TierTracer):
             elif len(st.mi) and O.strides[0] == 0 and len(st.used) == 1 and not len(st.rest):   # a lidar
                 mrow = st.mrow
                 tight = int(st.used[0])
-                mounted = (*one_origin_pairs(st, mt, C, O, D, t_near, lim, excl, owner, self._epoch, self.counters),
-                           st.rest)
+                if (own_apart and st.limits is not None and st.limits == (t_near, t_far) and len(st.own_pr)
+                        and not np.count_nonzero(st.own_pm != st.own_pm[0])):
+                    own = st
+                mounted = (*one_origin_pairs(st, mt, C, O, D, t_near, lim, excl, owner, self._epoch, self.counters,
+                                             own=own is None), st.rest)
             elif len(st.mi):   # candidates kept between casts; the segment test as _mounted_pairs does it
                 mrow = st.mrow
                 cr, cm = with_own_pairs(st, *mount_candidates(st, mt, C, self._rot, O, D, self._epoch, self.counters))
@@ -619,7 +679,7 @@ class RayEngine(TierTracer):
                 pm = np.concatenate([pm, mounted[1]])
                 order = np.argsort(pr, kind="stable")
                 pr, pm = pr[order], pm[order]
-        return pr, pm, tight
+        return pr, pm, tight, own
 
     def _trace_pairs(self, mt: _Movers, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight: int,
                      split: bool = True) -> None:

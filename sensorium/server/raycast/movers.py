@@ -383,6 +383,7 @@ class _MountState:
     own_pm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))   # their own mount
     merged: tuple = ()    # (pr, pm, candidates with the own pairs) of the last merge
     own_ahead: bool | None = None   # own pairs tested for t >= 0 only (kept while t_near >= 0)
+    own_hits: tuple | None = None   # FAST distances of the own pairs, traced once (RayEngine._own_hits)
 
 
 def mount_state(mount: Mount, mt: _Movers, C: np.ndarray, O: np.ndarray, t_near, t_far, D: np.ndarray | None = None,
@@ -463,12 +464,13 @@ def _own_pairs(st: _MountState, own: np.ndarray, mt: _Movers, O: np.ndarray, D: 
 
 
 def one_origin_pairs(st: _MountState, mt: _Movers, C: np.ndarray, O: np.ndarray, D: np.ndarray, t_near, lim,
-                     excl, owner, epoch: int, counters: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
+                     excl, owner, epoch: int, counters: dict[str, int], own: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """(ray, mover) candidates of a batch from one origin mounted on one body (a lidar): its
     own-mount pairs (decided once) and, per neighbouring mover of the body list (kept as for any
     Mount), the rays whose segment passes within that mover's bounding sphere, tested for all rays
     with one matrix-vector product per neighbour. No ray lists: a lidar's beams fan out in every
-    direction, so a list would hold most of them and cost more to keep than this test."""
+    direction, so a list would hold most of them and cost more to keep than this test. ``own``
+    False: without the own-mount pairs (the caller has their hits already)."""
     if st.epoch != epoch:
         st.epoch = epoch
         if st.C_ref is None or len(C) != len(st.C_ref) or float(np.abs(C - st.C_ref).max()) > st.shift:
@@ -480,7 +482,7 @@ def one_origin_pairs(st: _MountState, mt: _Movers, C: np.ndarray, O: np.ndarray,
         pm = nb[pm]
     else:
         pr = pm = np.zeros(0, dtype=np.int64)
-    if len(st.own_pr):   # pairs of one mover stay in ray order; groups of movers in any order
+    if own and len(st.own_pr):   # pairs of one mover stay in ray order; groups of movers in any order
         pr, pm = np.concatenate([st.own_pr, pr]), np.concatenate([st.own_pm, pm])
     return pr, pm
 

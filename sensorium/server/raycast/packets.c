@@ -717,6 +717,26 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
   return n_hit;
 }
 
+/* A fixed lidar's scan from its beams' distances, rows [0, n) (sensors.py, Lidar.finish): lidar.py's
+ * ranges_from_hits without noise or resolution, then point_xyz, one pass. Per beam v = dist[i]
+ * (times factor[i] for a planar lidar), range = float32(v), +inf unless v >= lo and
+ * range < hi32; with xyz, the point float32(c_k[i] * (double)range) along the point-cloud columns
+ * cx, cy, cz (inf * 0 gives NaN, as numpy's product). Each operation is numpy's, rounded as it
+ * rounds it, so the same bits (tests/test_lidar_native.py). */
+void sp_lidar_scan(size_t n, const double* dist, const double* factor, double lo, float hi32, const double* cx,
+                   const double* cy, const double* cz, float* range, float* xyz) {
+  for (size_t i = 0; i < n; i++) {
+    double v = factor ? dist[i] * factor[i] : dist[i];
+    float r = (float)v;
+    if (!(v >= lo) || r >= hi32) r = INFINITY;
+    range[i] = r;
+    if (xyz) {
+      double rd = (double)r;
+      xyz[3 * i] = (float)(cx[i] * rd); xyz[3 * i + 1] = (float)(cy[i] * rd); xyz[3 * i + 2] = (float)(cz[i] * rd);
+    }
+  }
+}
+
 /* The rows i of the (n,3) directions D with D[i] . v >= thr, into out (ascending); their number.
  * movers.py's cone test of a lidar's beams against a neighbouring body (a conservative test with
  * slack: the rounding of the dot product does not matter). */

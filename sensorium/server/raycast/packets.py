@@ -42,6 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
+from sensorium.server.raycast import blocks
+
 _SOURCE = Path(__file__).with_name("packets.c")
 _lock = threading.Lock()
 _state: dict = {}          # "lib": the loaded helper, or "why": the reason there is none; "embree": its path
@@ -160,6 +162,8 @@ def _load() -> None:
     f, i64 = ctypes.c_float, ctypes.c_int64
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
                                  i, i, vp, vp, vp, vp]
+    lib.sp_lidar_scan.restype = None
+    lib.sp_lidar_scan.argtypes = [sz, vp, vp, d, f, vp, vp, vp, vp, vp]
     lib.sp_to_frame.restype = None
     lib.sp_to_frame.argtypes = [sz, vp, vp, vp, vp]
     lib.sp_cone.restype = sz
@@ -421,3 +425,33 @@ def to_frame_rows(x: np.ndarray, rows: np.ndarray, R: np.ndarray) -> np.ndarray 
     Rc = np.ascontiguousarray(R, dtype=np.float64)
     lib.sp_to_frame(len(rows), address(x), rr.ctypes.data, Rc.ctypes.data, out.ctypes.data)
     return out
+
+
+def lidar_scan(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray, columns=None, xyz: np.ndarray | None = None,
+               factor: np.ndarray | None = None, threads: int = 1) -> bool:
+    """A fixed lidar's range image and point coordinates from its beams' distances in one C pass
+    (``sp_lidar_scan``): ``ranges`` (n,) float32 receives ``ranges_from_hits`` without noise or
+    resolution (``factor``: a planar lidar's depth factors), ``xyz`` (n, 3) float32, when given,
+    ``point_xyz`` of those ranges along ``columns`` (three (n,) float64 columns); the same bits.
+    Large scans in blocks on ``threads`` threads (the GIL is released during each call). False
+    without the helper (nothing written)."""
+    lib = library()
+    if lib is None:
+        return False
+    n = len(dist)
+    arrays = [dist, factor, ranges, xyz, *(columns if xyz is not None else (None, None, None))]
+    for a, dtype, shape in zip(arrays, (np.float64, np.float64, np.float32, np.float32, np.float64, np.float64,
+                                        np.float64), ((n,), (n,), (n,), (n, 3), (n,), (n,), (n,))):
+        if a is not None and (a.dtype != dtype or a.shape != shape or not a.flags.c_contiguous):
+            raise TypeError(f"lidar_scan: {a.dtype} {a.shape} where it reads contiguous {np.dtype(dtype)} {shape}")
+    p_d, p_f, p_r, p_x, p_cx, p_cy, p_cz = (None if a is None else a.ctypes.data for a in arrays)
+    hi32 = float(np.float32(hi))
+
+    def part(sl: slice) -> None:
+        a, m = sl.start, sl.stop - sl.start
+        lib.sp_lidar_scan(m, p_d + 8 * a, None if p_f is None else p_f + 8 * a, lo, hi32,
+                          *((None, None, None) if p_x is None else (p_cx + 8 * a, p_cy + 8 * a, p_cz + 8 * a)),
+                          p_r + 4 * a, None if p_x is None else p_x + 12 * a)
+
+    blocks.run(part, blocks.split(n, threads, 1 << 16), threads)
+    return True

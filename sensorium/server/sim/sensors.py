@@ -23,9 +23,9 @@ from sensorium.server.devices import gps as gps_math
 from sensorium.server.devices import lidar as lmath
 from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
-from sensorium.server.devices.lookup import LookupTable, quantize_sensor
+from sensorium.server.devices.lookup import RESOLUTION_OFF, LookupTable, quantize_sensor
 from sensorium.server.devices.noise import device_rng
-from sensorium.server.raycast import blocks
+from sensorium.server.raycast import blocks, packets
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.sim.own_shapes import cast_local_skipping
 from sensorium.server.world.geometry import Pose
@@ -234,6 +234,8 @@ class Lidar(Device):
         self._cloud_columns: tuple[np.ndarray, ...] | None = None   # point-cloud directions, made on first use
         # planar lidars store depth: a ray must reach max_range in depth, not in length
         factor = lmath.value_factors(self.params, self._all_dirs)
+        # a planar lidar's depth factors (ranges_from_hits' product, made once), None for a cylindrical one
+        self._factor = np.ascontiguousarray(factor, dtype=np.float64).reshape(-1) if self.params.planar else None
         with np.errstate(divide="ignore"):
             t_far = np.where(factor > 0, self.params.max_range / np.where(factor > 0, factor, 1.0), 0.0)
         # one value for every beam (cylindrical): the engine then needs no per-ray limits
@@ -410,12 +412,23 @@ class Lidar(Device):
                 self.point_cloud[index] = pts
                 counters["points_built"] += pts.size
         else:
-            dist = hits[0].distance.reshape(L, self.config.horizontal_resolution)
+            W = self.config.horizontal_resolution
+            dist = hits[0].distance.reshape(L, W)
             if self._own_body is not None:
                 dist = np.minimum(dist, self._own_distances())
-            self.range_image = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
-            if self.point_cloud_enabled:
-                self._xyz = _point_xyz(self.range_image, self._point_columns(), threads)
+            xyz = np.empty((L * W, 3), dtype=np.float32) if self.point_cloud_enabled else None
+            ranges = np.empty((L, W), dtype=np.float32)
+            # nothing moves a value (no noise, no resolution): range image and points in one C pass
+            # where the packet helper is built (the same bits as the two numpy steps below)
+            if self.params.noise > 0.0 or self.params.resolution != RESOLUTION_OFF or not packets.lidar_scan(
+                    np.ascontiguousarray(dist, dtype=np.float64).reshape(-1), self.params.min_range,
+                    self.params.max_range, ranges.reshape(-1), self._point_columns(), xyz, self._factor, threads):
+                ranges = lmath.ranges_from_hits(self.params, dist, self._all_dirs, self._noise_rng())
+                if xyz is not None:
+                    xyz = _point_xyz(ranges, self._point_columns(), threads)
+            self.range_image = ranges
+            if xyz is not None:
+                self._xyz = xyz
                 self._xyz.flags.writeable = False   # messages may hold it
                 self._cloud_time = (now_ms / 1000.0, self.schedule.period_ms / 1000.0)
                 self._records = None
