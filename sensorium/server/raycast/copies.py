@@ -32,6 +32,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayEngine
 from sensorium.server.raycast.exact import _INF, _PRUNE, _param, _take
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind
@@ -137,41 +138,15 @@ class CopyRays:
         # broad phase: each ray against the bounding spheres of its own copy's bodies
         R = self.slots
         centre = pos + np.einsum("crij,rj->cri", rot, anchor)          # (C, R, 3): a conservative test only
-        pr_list, pm_list = [], []
         excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else np.asarray(exclude_slot).reshape(n)
         mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else np.asarray(mount_slot).reshape(n)
-        valid = lim >= lo
-        for r in range(R):
-            if not present[r]:
-                continue
-            cand = valid
-            for skip in (excl, mnt):      # rays that ignore this body (excluded owner, mount)
-                if isinstance(skip, np.ndarray):
-                    cand = cand & (skip != r)
-                elif skip == r:
-                    cand = None
-                    break
-            if cand is None:
-                continue
-            rows = cand.nonzero()[0]
-            if not len(rows):
-                continue
-            every = len(rows) == n          # no ray skips this body: the arrays as they are
-            rc = copy if every else copy[rows]
-            rel = np.ascontiguousarray(centre[:, r]).take(rc, axis=0)
-            rel -= O if every else O.take(rows, axis=0)
-            Dr = D if every else D.take(rows, axis=0)
-            b = np.einsum("ij,ij->i", rel, Dr)
-            e2 = np.einsum("ij,ij->i", rel, rel)
-            tc = np.minimum(np.maximum(b, lo if every else lo[rows]), lim if every else lim[rows])
-            near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)).nonzero()[0]
-            if len(near):
-                pr_list.append(rows[near])
-                pm_list.append(rc[near] * R + r)
-        if not pr_list:
+        got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, lim, excl, mnt) if self.static.native
+               else None)
+        if got is None:
+            got = _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt)
+        pr, pm = got
+        if not len(pr):
             return hits
-        pr = np.concatenate(pr_list)
-        pm = np.concatenate(pm_list)
         self.counters["mover_pairs"] += len(pr)
         # pairs grouped by body, each body's rays in ray order (as the engine's one-mover path sees them)
         order = np.lexsort((pr, pm))
@@ -244,3 +219,42 @@ class CopyRays:
         x = n_all[w]
         normal[rows] = (x[:, 0:1] * Rw[:, :, 0] + x[:, 2:3] * Rw[:, :, 2]) + x[:, 1:2] * Rw[:, :, 1]
         return RayHits(dist, normal, shape)
+
+
+def _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt) -> tuple[np.ndarray, np.ndarray]:
+    """The broad phase of :meth:`CopyRays.cast` in numpy (``packets.copy_pairs`` does it in one C
+    pass): (ray, copy * R + slot) pairs, slot by slot, each slot's rays ascending."""
+    n = len(O)
+    R = len(r2)
+    pr_list, pm_list = [], []
+    valid = lim >= lo
+    for r in range(R):
+        if not present[r]:
+            continue
+        cand = valid
+        for skip in (excl, mnt):      # rays that ignore this body (excluded owner, mount)
+            if isinstance(skip, np.ndarray):
+                cand = cand & (skip != r)
+            elif skip == r:
+                cand = None
+                break
+        if cand is None:
+            continue
+        rows = cand.nonzero()[0]
+        if not len(rows):
+            continue
+        every = len(rows) == n          # no ray skips this body: the arrays as they are
+        rc = copy if every else copy[rows]
+        rel = np.ascontiguousarray(centre[:, r]).take(rc, axis=0)
+        rel -= O if every else O.take(rows, axis=0)
+        Dr = D if every else D.take(rows, axis=0)
+        b = np.einsum("ij,ij->i", rel, Dr)
+        e2 = np.einsum("ij,ij->i", rel, rel)
+        tc = np.minimum(np.maximum(b, lo if every else lo[rows]), lim if every else lim[rows])
+        near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)).nonzero()[0]
+        if len(near):
+            pr_list.append(rows[near])
+            pm_list.append(rc[near] * R + r)
+    if not pr_list:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    return np.concatenate(pr_list), np.concatenate(pm_list)

@@ -166,6 +166,8 @@ def _load() -> None:
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_copy_pairs.restype = sz
+    lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
     _state["lib"] = lib
     _state["embree"] = embree
 
@@ -421,3 +423,34 @@ def to_frame_rows(x: np.ndarray, rows: np.ndarray, R: np.ndarray) -> np.ndarray 
     Rc = np.ascontiguousarray(R, dtype=np.float64)
     lib.sp_to_frame(len(rows), address(x), rr.ctypes.data, Rc.ctypes.data, out.ctypes.data)
     return out
+
+
+def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarray, r2: np.ndarray,
+               present: np.ndarray, lo, lim: np.ndarray, excl, mount) -> tuple[np.ndarray, np.ndarray] | None:
+    """The broad phase of :meth:`.copies.CopyRays.cast` in one C pass (``sp_copy_pairs``): the
+    (ray, copy * R + slot) pairs whose ray comes within the bounding sphere (``centre`` (C, R, 3),
+    ``r2`` (R,)) of a present slot of its own copy, its excluded and mount slots left out, listed
+    slot by slot and ray by ray as the numpy path lists them; or None without the helper. ``lo``,
+    ``excl``, ``mount``: scalars or (n,) arrays; ``lim`` (n,)."""
+    lib = library()
+    if lib is None:
+        return None
+    n = len(O)
+    R = int(r2.shape[0])
+    f64, i64 = np.float64, np.int64
+    O, D = np.ascontiguousarray(O, dtype=f64), np.ascontiguousarray(D, dtype=f64)
+    copy = np.ascontiguousarray(copy, dtype=i64)
+    centre = np.ascontiguousarray(centre, dtype=f64)
+    r2 = np.ascontiguousarray(r2, dtype=f64)
+    present = np.ascontiguousarray(present, dtype=np.uint8)
+    lim = np.ascontiguousarray(lim, dtype=f64)
+    lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
+    ex_a = np.ascontiguousarray(excl, dtype=i64) if isinstance(excl, np.ndarray) else None
+    mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
+    out_ray = np.empty(n * R, dtype=i64)
+    out_body = np.empty(n * R, dtype=i64)
+    k = lib.sp_copy_pairs(n, R, O.ctypes.data, D.ctypes.data, copy.ctypes.data, centre.ctypes.data, r2.ctypes.data,
+                          present.ctypes.data, _ptr(lo_a), 0.0 if lo_a is not None else float(lo), lim.ctypes.data,
+                          _ptr(ex_a), 0 if ex_a is not None else int(excl), _ptr(mn_a),
+                          0 if mn_a is not None else int(mount), out_ray.ctypes.data, out_body.ctypes.data)
+    return out_ray[:k], out_body[:k]
