@@ -166,6 +166,8 @@ def _load() -> None:
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_inside_shells.restype = sz
+    lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_copy_pairs.restype = sz
     lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
     _state["lib"] = lib
@@ -454,3 +456,29 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
                           _ptr(ex_a), 0 if ex_a is not None else int(excl), _ptr(mn_a),
                           0 if mn_a is not None else int(mount), out_ray.ctypes.data, out_body.ctypes.data)
     return out_ray[:k], out_body[:k]
+
+
+def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells) -> tuple[np.ndarray, np.ndarray] | None:
+    """``refine._inside_shell`` of the start points ``Ot + lo D`` for each listed curved slot of
+    ``tier``, in one C pass (``sp_inside_shells``): (rows, slots), slot by slot, rows ascending, the
+    numpy loop's pairs; or None without the helper. ``Ot`` may be one broadcast origin."""
+    lib = library()
+    if lib is None:
+        return None
+    m = len(Ot)
+    f64, i64 = np.float64, np.int64
+    if Ot.strides[0] == 0:
+        O, o_stride = np.ascontiguousarray(Ot[:1], dtype=f64), 0
+    else:
+        O, o_stride = np.ascontiguousarray(Ot, dtype=f64), 3
+    D = np.ascontiguousarray(D, dtype=f64)
+    lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
+    ks = np.asarray(shells, dtype=i64)
+    arrays = [np.ascontiguousarray(getattr(tier, name), dtype=dt) for name, dt in (
+        ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
+    out_row = np.empty(m * len(ks), dtype=i64)
+    out_slot = np.empty(m * len(ks), dtype=i64)
+    k = lib.sp_inside_shells(m, O.ctypes.data, o_stride, D.ctypes.data, _ptr(lo_a),
+                             0.0 if lo_a is not None else float(lo), len(ks), ks.ctypes.data,
+                             *(a.ctypes.data for a in arrays), out_row.ctypes.data, out_slot.ctypes.data)
+    return out_row[:k], out_slot[:k]
