@@ -109,14 +109,16 @@ class CopyRays:
 
     def cast(self, origins, directions, t_near, t_far, kind: RayKind, copy: np.ndarray, rot: np.ndarray,
              pos: np.ndarray, exclude_slot=-1, mount_slot=-1, skip_transparent: bool = False,
-             distance_only: bool = False, directions32=None) -> RayHits:
+             distance_only: bool = False, directions32=None, coherent: bool = False) -> RayHits:
         """Nearest hits of rays of several copies. ``copy``: (n,) the copy of each ray; ``rot``
         (C, R, 3, 3) and ``pos`` (C, R, 3): every copy's robot poses now; ``exclude_slot``: the
         robot (slot) whose body a ray ignores (scalar or (n,); -1 none), as ``exclude_owner``;
         ``mount_slot``: a robot whose body the ray is never paired with (-1 none): the robot a
         sensor is rigidly mounted on, whose hits the caller decides once in the body frame (as
         with ``RayEngine.cast(mount=...)``), or whose body it cannot reach (:meth:`may_reach`).
-        Other arguments as :meth:`RayEngine.cast`."""
+        ``coherent``: the rays come in runs from one origin each (every copy's lidar): traced as
+        the single world traces one lidar's beams (coherent packets, FAST), so each beam gets the
+        single world's answer. Other arguments as :meth:`RayEngine.cast`."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         n = len(O)
@@ -124,7 +126,7 @@ class CopyRays:
         self.counters["casts"] += 1
         self.counters["rays"] += n
         hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
-                                distance_only=distance_only, directions32=directions32)
+                                distance_only=distance_only, directions32=directions32, coherent=coherent)
         if n == 0 or not self.slots:
             return hits
         variant = self.movers._variant(kind, skip_transparent)
@@ -187,7 +189,8 @@ class CopyRays:
                     tn = tn[keep] if isinstance(tn, np.ndarray) else tn
             self.counters["mover_traces"] += 1
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
-                res = self.movers._trace(tier, ob, db, tn, lm, -1, eps64, exact, None, distance_only)
+                res = self.movers._trace(tier, ob, db, tn, lm, -1, eps64, exact, None, distance_only,
+                                         coherent=coherent)
             if res is None:
                 continue
             t_all[sel] = res[0]

@@ -672,21 +672,22 @@ class BatchedSimulation:
     def _cast_requests(self, requests: list[_Rays]) -> list[RayHits]:
         groups: dict[tuple, list[int]] = {}
         for i, r in enumerate(requests):
-            groups.setdefault((int(r.kind), r.skip, r.distance_only), []).append(i)
+            groups.setdefault((int(r.kind), r.skip, r.distance_only, r.coherent), []).append(i)
         out: list[RayHits | None] = [None] * len(requests)
-        for (kind, skip, distance_only), idx in groups.items():
+        for (kind, skip, distance_only, coherent), idx in groups.items():
             reqs = [requests[i] for i in idx]
             if len(reqs) == 1:
                 r = reqs[0]
                 out[idx[0]] = self.rays.cast(r.origins, r.directions, r.t_near, r.t_far, RayKind(kind), r.copy,
-                                             self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32)
+                                             self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32,
+                                             coherent)
                 continue
             sizes = [len(r.origins) for r in reqs]
             h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
                                joined(reqs, sizes, "t_near", np.float64), joined(reqs, sizes, "t_far", np.float64),
                                RayKind(kind), joined(reqs, sizes, "copy", np.int64), self.rot, self.pos,
                                joined(reqs, sizes, "exclude", np.int64), joined(reqs, sizes, "mount", np.int64), skip,
-                               distance_only)
+                               distance_only, coherent=coherent)
             for i, hit in zip(idx, split_hits(h, sizes)):
                 out[i] = hit
         return out   # type: ignore[return-value]
@@ -870,7 +871,7 @@ class BatchedSimulation:
             # a lidar with own shapes never meets its own body in the cast (finish adds those hits)
             mount = slot if lid._own_body is not None else np.tile(self._lidar_skip(col), len(c))
             reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, np.repeat(c, W),
-                              -1, mount, distance_only=True, d32=d.astype(np.float32)))
+                              -1, mount, distance_only=True, d32=d.astype(np.float32), coherent=True))
             state["items"].append((col, c))
         return state, reqs
 
@@ -933,6 +934,7 @@ class _Rays:
     skip: bool = False
     distance_only: bool = False
     d32: np.ndarray | None = None
+    coherent: bool = False     # runs of rays from one origin each (lidars): traced as one lidar's beams
 
 
 class _OnEngine:
