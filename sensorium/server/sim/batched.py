@@ -321,6 +321,7 @@ class BatchedSimulation:
             if lid.rotating:
                 continue
         self._lidar_skips: dict[int, np.ndarray] = {}
+        self._lidar_plan: dict[int, tuple] = {}      # per lidar: (copies, each beam's copy, mount slots)
         self.range_images = [np.zeros((C, d.config.number_of_layers, d.config.horizontal_resolution), dtype=np.float32)
                              for d in self.lidar]
         # light sensors: constants stacked once
@@ -860,20 +861,32 @@ class BatchedSimulation:
             org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
             x, y, z = lid._dir_columns
             W = len(x)
-            dirs = np.empty((len(c), W, 3))
-            for j in range(3):                                                  # _rotate_columns, stacked
-                acc = x[None, :] * rot[:, j, 0, None]
-                acc += y[None, :] * rot[:, j, 1, None]
-                acc += z[None, :] * rot[:, j, 2, None]
-                dirs[:, :, j] = acc
-            d = dirs.reshape(-1, 3)
+            # _rotate_columns, stacked: every copy's (x r_j0 + y r_j1) + z r_j2 at once, (copies, 3, W)
+            acc = x * rot[:, :, 0, None]
+            acc += y * rot[:, :, 1, None]
+            acc += z * rot[:, :, 2, None]
+            d = np.ascontiguousarray(acc.transpose(0, 2, 1)).reshape(-1, 3)
+            O = np.empty((len(c), W, 3))
+            O[...] = org[:, None, :]                                            # each copy's origin, W times
+            ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
-            # a lidar with own shapes never meets its own body in the cast (finish adds those hits)
-            mount = slot if lid._own_body is not None else np.tile(self._lidar_skip(col), len(c))
-            reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, np.repeat(c, W),
+            reqs.append(_Rays(O.reshape(-1, 3), d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
                               -1, mount, distance_only=True, d32=d.astype(np.float32), coherent=True))
             state["items"].append((col, c))
         return state, reqs
+
+    def _lidar_rows(self, col: int, copies: np.ndarray, W: int) -> tuple[np.ndarray, np.ndarray | int]:
+        """Per beam of the scans of ``copies``: its copy, and its mount slot (a lidar with own
+        shapes never meets its own body in the cast: finish adds those hits; else
+        :meth:`_lidar_skip`); kept while the same copies scan (all of them, step after step)."""
+        got = self._lidar_plan.get(col)
+        if got is not None and np.array_equal(got[0], copies):
+            return got[1], got[2]
+        lid = self.lidar[col]
+        ray_copy = np.repeat(copies, W)
+        mount = lid.robot_index if lid._own_body is not None else np.tile(self._lidar_skip(col), len(copies))
+        self._lidar_plan[col] = (copies.copy(), ray_copy, mount)
+        return ray_copy, mount
 
     def _lidar_skip(self, col: int) -> np.ndarray:
         """Per beam: the lidar's own robot slot where the beam can never meet that robot's body
