@@ -861,16 +861,16 @@ class BatchedSimulation:
             org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
             x, y, z = lid._dir_columns
             W = len(x)
-            # _rotate_columns, stacked: every copy's (x r_j0 + y r_j1) + z r_j2 at once, (copies, 3, W)
-            acc = x * rot[:, :, 0, None]
-            acc += y * rot[:, :, 1, None]
-            acc += z * rot[:, :, 2, None]
-            d = np.ascontiguousarray(acc.transpose(0, 2, 1)).reshape(-1, 3)
-            O = np.empty((len(c), W, 3))
-            O[...] = org[:, None, :]                                            # each copy's origin, W times
+            dirs = np.empty((len(c), W, 3))
+            for j in range(3):                                                  # _rotate_columns, stacked
+                acc = x[None, :] * rot[:, j, 0, None]
+                acc += y[None, :] * rot[:, j, 1, None]
+                acc += z[None, :] * rot[:, j, 2, None]
+                dirs[:, :, j] = acc
+            d = dirs.reshape(-1, 3)
             ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
-            reqs.append(_Rays(O.reshape(-1, 3), d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
+            reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
                               -1, mount, distance_only=True, d32=d.astype(np.float32), coherent=True))
             state["items"].append((col, c))
         return state, reqs
