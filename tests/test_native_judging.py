@@ -330,13 +330,26 @@ def test_c_screening_of_starts_inside_curved_shells_is_the_numpy_screening(seed,
     assert rows.tolist() == [0]
     screened = []
     inside0 = packets.inside_shells
-    monkeypatch.setattr(packets, "inside_shells", lambda *a: screened.append(inside0(*a)) or screened[-1])
+    dense = []
+    monkeypatch.setattr(packets, "inside_shells", lambda *a, **k: dense.append(k.get("bound_first")) or
+                        screened.append(inside0(*a, **k)) or screened[-1])
+    # the dense pass (fewer rays): bounding spheres first, then the extents, pairs by row
+    S = O + 0.01 * D
+    cp = tier.c_pos
+    d2 = (S[:, 0:1] - cp[:, 0]) ** 2 + (S[:, 1:2] - cp[:, 1]) ** 2 + (S[:, 2:3] - cp[:, 2]) ** 2
+    inside = np.stack([Refiner._inside_shell(tier, s, S) for s in shells], axis=1)
+    want_rows, want_slots = ((d2 <= tier.c_bound2) & inside).nonzero()
+    rows, slots = packets.inside_shells(tier, O, D, 0.01, shells, bound_first=True)
+    order = np.lexsort((slots, rows))
+    assert rows[order].tolist() == want_rows.tolist() and slots[order].tolist() == want_slots.tolist()
     hits = {}
     for native in (False, True):
         eng.native = native
         h = eng.cast(O, D, 0.01, 6.0, kind=RayKind.BOUNDING)
-        hits[native] = (h.distance, h.normal, h.shape)
+        few = eng.cast(O[:1500], D[:1500], 0.01, 6.0, kind=RayKind.BOUNDING)   # 1,500 x 9 pairs: the dense pass
+        hits[native] = (h.distance, h.normal, h.shape, few.distance, few.normal, few.shape)
     for a, c in zip(hits[False], hits[True]):
         assert a.tobytes() == c.tobytes()
     assert np.isfinite(hits[True][0]).mean() > 0.3
     assert sum(len(r) for r, _ in screened) > 1000       # the C screening found the starts inside shells
+    assert True in dense and False in dense              # both screenings ran: by shell and dense

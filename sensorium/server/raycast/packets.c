@@ -789,12 +789,14 @@ size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const
  * points S[i] = O[i] + lo[i] D[i] inside each listed shell k's extent -- its bounding sphere for a
  * sphere, else the cylinder (rad2, ax) of its vertices in the shape frame -- with the numpy path's
  * operations (refine._inside_shell: S - pos, exact._to_frame's sums (x0 R0j + x1 R1j) + x2 R2j).
- * Pairs shell by shell, rows ascending: row into out_row, k into out_slot; their number (at most
- * m * nk). o_stride 0: one origin for every ray. lo NULL: lo_value for every ray. */
+ * bound_first: a cylinder's or capsule's start point must also lie within its bounding sphere
+ * (bound2; the dense pass of refine.py tests the sphere first, then the extent). Pairs shell by
+ * shell, rows ascending: row into out_row, k into out_slot; their number (at most m * nk).
+ * o_stride 0: one origin for every ray. lo NULL: lo_value for every ray. */
 size_t sp_inside_shells(size_t m, const double* O, size_t o_stride, const double* D, const double* lo,
                         double lo_value, size_t nk, const int64_t* shells, const int64_t* code,
                         const double* pos, const double* rot, const double* bound2, const double* rad2,
-                        const double* ax, int64_t* out_row, int64_t* out_slot) {
+                        const double* ax, int bound_first, int64_t* out_row, int64_t* out_slot) {
   size_t k = 0;
   for (size_t q = 0; q < nk; q++) {
     const int64_t s = shells[q];
@@ -807,9 +809,9 @@ size_t sp_inside_shells(size_t m, const double* O, size_t o_stride, const double
       const double l = lo ? lo[i] : lo_value;
       const double p0 = (o[0] + l * d[0]) - c[0], p1 = (o[1] + l * d[1]) - c[1], p2 = (o[2] + l * d[2]) - c[2];
       int in;
-      if (sphere) {
-        in = (p0 * p0 + p1 * p1) + p2 * p2 <= bound2[s];
-      } else {
+      if (sphere || bound_first) in = (p0 * p0 + p1 * p1) + p2 * p2 <= bound2[s];
+      else in = 1;
+      if (!sphere && in) {
         const double x = (p0 * R[0] + p1 * R[3]) + p2 * R[6];
         const double y = (p0 * R[1] + p1 * R[4]) + p2 * R[7];
         const double z = (p0 * R[2] + p1 * R[5]) + p2 * R[8];

@@ -167,7 +167,7 @@ def _load() -> None:
     lib.sp_analytic.restype = None
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_inside_shells.restype = sz
-    lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
     lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
     _state["lib"] = lib
@@ -458,10 +458,13 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     return out_ray[:k], out_body[:k]
 
 
-def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells) -> tuple[np.ndarray, np.ndarray] | None:
+def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: bool = False
+                  ) -> tuple[np.ndarray, np.ndarray] | None:
     """``refine._inside_shell`` of the start points ``Ot + lo D`` for each listed curved slot of
     ``tier``, in one C pass (``sp_inside_shells``): (rows, slots), slot by slot, rows ascending, the
-    numpy loop's pairs; or None without the helper. ``Ot`` may be one broadcast origin."""
+    numpy loop's pairs; or None without the helper. ``Ot`` may be one broadcast origin.
+    ``bound_first``: the start point must also lie in the slot's bounding sphere (the dense pass's
+    test before the extent)."""
     lib = library()
     if lib is None:
         return None
@@ -480,5 +483,6 @@ def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells) -> tuple[np.n
     out_slot = np.empty(m * len(ks), dtype=i64)
     k = lib.sp_inside_shells(m, O.ctypes.data, o_stride, D.ctypes.data, _ptr(lo_a),
                              0.0 if lo_a is not None else float(lo), len(ks), ks.ctypes.data,
-                             *(a.ctypes.data for a in arrays), out_row.ctypes.data, out_slot.ctypes.data)
+                             *(a.ctypes.data for a in arrays), 1 if bound_first else 0, out_row.ctypes.data,
+                             out_slot.ctypes.data)
     return out_row[:k], out_slot[:k]
