@@ -223,3 +223,78 @@ def test_skid_steer_robots_match_the_single_simulation_with_every_wheel_of_a_sid
             for m in left + right:
                 assert s.robot("rover").device(f"{m} sensor").value == float(bs.value(bs.device("rover", f"{m} sensor"))[c])
     assert bs.value(bs.device("rover", "l2 sensor")).tolist() == bs.value(bs.device("rover", "l0 sensor")).tolist()
+
+
+def test_the_broad_phase_in_c_lists_the_numpy_pairs_and_meets_closed_form_cases():
+    """copies.py's broad phase (each ray against the bounding spheres of its own copy's bodies):
+    packets.copy_pairs (one C pass) lists exactly the pairs of the numpy path, in its order, for
+    rays of several copies with per-ray and scalar excluded / mount slots and per-ray limits; and
+    both pair a ray with a sphere exactly when its segment comes within the radius."""
+    from sensorium.server.raycast import copies, packets
+
+    if packets.library() is None:
+        pytest.skip(packets.status())
+    rng = np.random.default_rng(3)
+    C, R, n = 5, 3, 4000
+    centre = rng.uniform(-1.0, 1.0, (C, R, 3))
+    r2 = np.array([0.25, -1.0, 0.36])                    # slot 1 has no body (never paired)
+    present = r2 >= 0.0
+    O = rng.uniform(-1.5, 1.5, (n, 3))
+    D = rng.normal(size=(n, 3))
+    D /= np.linalg.norm(D, axis=1)[:, None]
+    copy = rng.integers(0, C, n)
+    lim = rng.uniform(0.0, 3.0, n)
+    lim[::7] = np.inf
+    lim[::11] = -1.0                                      # nothing left to look at: never paired
+    for lo, excl, mount in ((0.0, -1, -1), (0.05, 2, -1), (0.0, rng.integers(-1, R, n), 0),
+                            (rng.uniform(0.0, 0.1, n), -1, rng.integers(-1, R, n))):
+        lo_b = np.broadcast_to(np.asarray(lo, dtype=np.float64), (n,))
+        want = copies._pairs(O, D, copy, centre, r2, present, lo_b, lim, excl, mount)
+        got = packets.copy_pairs(O, D, copy, centre, r2, present, lo, lim, excl, mount)
+        assert len(want[0]) > 50
+        assert got[0].tobytes() == want[0].tobytes() and got[1].tobytes() == want[1].tobytes()
+    # closed form: a unit sphere at (2, 0, 0) of copy 1, rays along +x from the origin offset by h in y
+    centre = np.zeros((2, 1, 3))
+    centre[1, 0] = [2.0, 0.0, 0.0]
+    h = np.array([0.0, 0.5, 0.999, 1.001, 2.0])
+    O = np.stack([np.zeros(5), h, np.zeros(5)], axis=1)
+    D = np.tile([1.0, 0.0, 0.0], (5, 1))
+    for cp in (np.ones(5, dtype=np.int64), np.zeros(5, dtype=np.int64)):
+        for lim_v, expect in ((10.0, [0, 1, 2]), (0.5, [])):    # the segment [0, 0.5] stays 1.5 m away
+            lim = np.full(5, lim_v)
+            got = packets.copy_pairs(O, D, cp, centre, np.array([1.0]), np.array([True]), 0.0, lim, -1, -1)
+            want = copies._pairs(O, D, cp, centre, np.array([1.0]), np.array([True]), np.zeros(5), lim, -1, -1)
+            rays = expect if cp[0] == 1 else [0, 1, 2]    # copy 0's sphere is at the origin: around the starts
+            assert got[0].tolist() == want[0].tolist() == rays
+            assert got[1].tolist() == [int(cp[0])] * len(rays)
+
+
+def test_every_copys_lidar_gets_its_single_world_scan_at_many_poses():
+    """The copies' lidar beams go out in one cast traced as the single world traces one lidar
+    (coherent packets in FAST: a beam within float32 rounding of an edge gets the same triangle):
+    at 24 scattered poses with the beams level with the crate's top face (z = 0.2: every beam
+    that meets the crate grazes it), each copy's range image equals a Simulation's with the scout
+    there, bit for bit."""
+    n = 24
+    rng = np.random.default_rng(4)
+    bs = BatchedSimulation(arena(2), n, precision="fast")
+    bs.reset(np.arange(n), [2] * n)
+    scout = bs.slot("scout")
+    ref = bs.device("scout", "lidar")
+    bs.enable(ref, 32)
+    poses = [([float(rng.uniform(0.0, 1.8)), float(rng.uniform(-1.5, 0.3)), 0.2 - 0.09], float(rng.uniform(-3.1, 3.1)))
+             for _ in range(n)]
+    for c, (xyz, yaw) in enumerate(poses):
+        bs.set_pose(c, scout, xyz, rotation=[0, 0, 1, yaw])
+    bs.step()
+    single = Simulation(arena(2), precision="fast")
+    lidar = single.robot("scout").device("lidar")
+    lidar.enable(32)
+    seen = 0
+    for c, (xyz, yaw) in enumerate(poses):
+        single.robot("scout").set_pose(xyz, rotation=[0, 0, 1, yaw])
+        single.step()
+        img = lidar.range_image
+        assert img.tobytes() == bs.range_image(ref)[c].tobytes(), (c, np.flatnonzero(img != bs.range_image(ref)[c])[:5])
+        seen += np.count_nonzero(np.isfinite(img))
+    assert seen > n * 100

@@ -37,6 +37,7 @@ def _columns(n: int, rng) -> tuple[np.ndarray, ...]:
     d = rng.normal(size=(n, 3))
     d[rng.integers(0, n, n // 8), rng.integers(0, 3, n // 8)] = 0.0
     d[rng.integers(0, n, n // 16)] = [0.0, 0.0, -1.0]
+    d[~d.any(axis=1)] = [1.0, 0.0, 0.0]        # a row zeroed three times is no direction
     d /= np.linalg.norm(d, axis=1)[:, None]
     return tuple(np.ascontiguousarray(d[:, k]) for k in range(3))
 

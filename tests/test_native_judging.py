@@ -297,3 +297,59 @@ def test_rows_into_a_body_frame_in_c_are_the_engine_sums():
         for k in (65, 3000):
             rows = np.sort(rng.choice(len(D), k, replace=False)).astype(np.int64)
             assert packets.to_frame_rows(D, rows, R).tobytes() == exact._to_frame(D.take(rows, axis=0), R).tobytes()
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_c_screening_of_starts_inside_curved_shells_is_the_numpy_screening(seed, monkeypatch):
+    """The pre-pass's screening for many rays of many origins (a batched world's copies): the start
+    points inside each shell's extent, listed in one C pass (packets.inside_shells), are those of
+    refine._inside_shell shell by shell, in its order, for scalar and per-ray starts and one shared
+    origin; a point at a sphere's centre is inside it, one just beyond its bound is not; and whole
+    casts of such rays give the numpy path's answers bit for bit."""
+    from sensorium.server.raycast.refine import Refiner
+
+    eng, tier = _tier_of_curved(seed)
+    rng = np.random.default_rng(seed + 7)
+    k = len(tier.c_pos)
+    eyes = tier.c_pos[rng.integers(0, k, 40)] + rng.normal(size=(40, 3)) * 0.4   # many inside, many not
+    O = np.repeat(eyes, 500, axis=0)
+    D = _unit(rng.normal(size=(len(O), 3)))
+    shells = list(range(k))
+    for Ot, lo in ((O, 0.01), (O, rng.uniform(0.0, 0.3, len(O))), (np.broadcast_to(eyes[0], O.shape), 0.2)):
+        S = Ot + (lo[:, None] if isinstance(lo, np.ndarray) else lo) * D
+        masks = [Refiner._inside_shell(tier, s, S).nonzero()[0] for s in shells]
+        want_rows = np.concatenate(masks)
+        want_slots = np.concatenate([np.full(len(r), s) for s, r in zip(shells, masks)])
+        rows, slots = packets.inside_shells(tier, Ot, D, lo, shells)
+        assert rows.tolist() == want_rows.tolist() and slots.tolist() == want_slots.tolist()
+        assert len(rows) > 100 or Ot.strides[0] == 0
+    sph = int(np.flatnonzero(tier.c_code == exact._SPHERE)[0])
+    b = math.sqrt(tier.c_bound2[sph])
+    pts = tier.c_pos[sph] + np.array([[0.0, 0.0, 0.0], [b * 1.001, 0.0, 0.0]])
+    rows, _ = packets.inside_shells(tier, pts, np.tile([0.0, 0.0, 1.0], (2, 1)), 0.0, [sph])
+    assert rows.tolist() == [0]
+    screened = []
+    inside0 = packets.inside_shells
+    dense = []
+    monkeypatch.setattr(packets, "inside_shells", lambda *a, **k: dense.append(k.get("bound_first")) or
+                        screened.append(inside0(*a, **k)) or screened[-1])
+    # the dense pass (fewer rays): bounding spheres first, then the extents, pairs by row
+    S = O + 0.01 * D
+    cp = tier.c_pos
+    d2 = (S[:, 0:1] - cp[:, 0]) ** 2 + (S[:, 1:2] - cp[:, 1]) ** 2 + (S[:, 2:3] - cp[:, 2]) ** 2
+    inside = np.stack([Refiner._inside_shell(tier, s, S) for s in shells], axis=1)
+    want_rows, want_slots = ((d2 <= tier.c_bound2) & inside).nonzero()
+    rows, slots = packets.inside_shells(tier, O, D, 0.01, shells, bound_first=True)
+    order = np.lexsort((slots, rows))
+    assert rows[order].tolist() == want_rows.tolist() and slots[order].tolist() == want_slots.tolist()
+    hits = {}
+    for native in (False, True):
+        eng.native = native
+        h = eng.cast(O, D, 0.01, 6.0, kind=RayKind.BOUNDING)
+        few = eng.cast(O[:1500], D[:1500], 0.01, 6.0, kind=RayKind.BOUNDING)   # 1,500 x 9 pairs: the dense pass
+        hits[native] = (h.distance, h.normal, h.shape, few.distance, few.normal, few.shape)
+    for a, c in zip(hits[False], hits[True]):
+        assert a.tobytes() == c.tobytes()
+    assert np.isfinite(hits[True][0]).mean() > 0.3
+    assert sum(len(r) for r, _ in screened) > 1000       # the C screening found the starts inside shells
+    assert True in dense and False in dense              # both screenings ran: by shell and dense

@@ -32,6 +32,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayEngine
 from sensorium.server.raycast.exact import _INF, _PRUNE, _param, _take
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind
@@ -108,14 +109,16 @@ class CopyRays:
 
     def cast(self, origins, directions, t_near, t_far, kind: RayKind, copy: np.ndarray, rot: np.ndarray,
              pos: np.ndarray, exclude_slot=-1, mount_slot=-1, skip_transparent: bool = False,
-             distance_only: bool = False, directions32=None) -> RayHits:
+             distance_only: bool = False, directions32=None, coherent: bool = False) -> RayHits:
         """Nearest hits of rays of several copies. ``copy``: (n,) the copy of each ray; ``rot``
         (C, R, 3, 3) and ``pos`` (C, R, 3): every copy's robot poses now; ``exclude_slot``: the
         robot (slot) whose body a ray ignores (scalar or (n,); -1 none), as ``exclude_owner``;
         ``mount_slot``: a robot whose body the ray is never paired with (-1 none): the robot a
         sensor is rigidly mounted on, whose hits the caller decides once in the body frame (as
         with ``RayEngine.cast(mount=...)``), or whose body it cannot reach (:meth:`may_reach`).
-        Other arguments as :meth:`RayEngine.cast`."""
+        ``coherent``: the rays come in runs from one origin each (every copy's lidar): traced as
+        the single world traces one lidar's beams (coherent packets, FAST), so each beam gets the
+        single world's answer. Other arguments as :meth:`RayEngine.cast`."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         n = len(O)
@@ -123,7 +126,7 @@ class CopyRays:
         self.counters["casts"] += 1
         self.counters["rays"] += n
         hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
-                                distance_only=distance_only, directions32=directions32)
+                                distance_only=distance_only, directions32=directions32, coherent=coherent)
         if n == 0 or not self.slots:
             return hits
         variant = self.movers._variant(kind, skip_transparent)
@@ -137,41 +140,15 @@ class CopyRays:
         # broad phase: each ray against the bounding spheres of its own copy's bodies
         R = self.slots
         centre = pos + np.einsum("crij,rj->cri", rot, anchor)          # (C, R, 3): a conservative test only
-        pr_list, pm_list = [], []
         excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else np.asarray(exclude_slot).reshape(n)
         mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else np.asarray(mount_slot).reshape(n)
-        valid = lim >= lo
-        for r in range(R):
-            if not present[r]:
-                continue
-            cand = valid
-            for skip in (excl, mnt):      # rays that ignore this body (excluded owner, mount)
-                if isinstance(skip, np.ndarray):
-                    cand = cand & (skip != r)
-                elif skip == r:
-                    cand = None
-                    break
-            if cand is None:
-                continue
-            rows = cand.nonzero()[0]
-            if not len(rows):
-                continue
-            every = len(rows) == n          # no ray skips this body: the arrays as they are
-            rc = copy if every else copy[rows]
-            rel = np.ascontiguousarray(centre[:, r]).take(rc, axis=0)
-            rel -= O if every else O.take(rows, axis=0)
-            Dr = D if every else D.take(rows, axis=0)
-            b = np.einsum("ij,ij->i", rel, Dr)
-            e2 = np.einsum("ij,ij->i", rel, rel)
-            tc = np.minimum(np.maximum(b, lo if every else lo[rows]), lim if every else lim[rows])
-            near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)).nonzero()[0]
-            if len(near):
-                pr_list.append(rows[near])
-                pm_list.append(rc[near] * R + r)
-        if not pr_list:
+        got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, lim, excl, mnt) if self.static.native
+               else None)
+        if got is None:
+            got = _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt)
+        pr, pm = got
+        if not len(pr):
             return hits
-        pr = np.concatenate(pr_list)
-        pm = np.concatenate(pm_list)
         self.counters["mover_pairs"] += len(pr)
         # pairs grouped by body, each body's rays in ray order (as the engine's one-mover path sees them)
         order = np.lexsort((pr, pm))
@@ -212,7 +189,8 @@ class CopyRays:
                     tn = tn[keep] if isinstance(tn, np.ndarray) else tn
             self.counters["mover_traces"] += 1
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
-                res = self.movers._trace(tier, ob, db, tn, lm, -1, eps64, exact, None, distance_only)
+                res = self.movers._trace(tier, ob, db, tn, lm, -1, eps64, exact, None, distance_only,
+                                         coherent=coherent)
             if res is None:
                 continue
             t_all[sel] = res[0]
@@ -244,3 +222,42 @@ class CopyRays:
         x = n_all[w]
         normal[rows] = (x[:, 0:1] * Rw[:, :, 0] + x[:, 2:3] * Rw[:, :, 2]) + x[:, 1:2] * Rw[:, :, 1]
         return RayHits(dist, normal, shape)
+
+
+def _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt) -> tuple[np.ndarray, np.ndarray]:
+    """The broad phase of :meth:`CopyRays.cast` in numpy (``packets.copy_pairs`` does it in one C
+    pass): (ray, copy * R + slot) pairs, slot by slot, each slot's rays ascending."""
+    n = len(O)
+    R = len(r2)
+    pr_list, pm_list = [], []
+    valid = lim >= lo
+    for r in range(R):
+        if not present[r]:
+            continue
+        cand = valid
+        for skip in (excl, mnt):      # rays that ignore this body (excluded owner, mount)
+            if isinstance(skip, np.ndarray):
+                cand = cand & (skip != r)
+            elif skip == r:
+                cand = None
+                break
+        if cand is None:
+            continue
+        rows = cand.nonzero()[0]
+        if not len(rows):
+            continue
+        every = len(rows) == n          # no ray skips this body: the arrays as they are
+        rc = copy if every else copy[rows]
+        rel = np.ascontiguousarray(centre[:, r]).take(rc, axis=0)
+        rel -= O if every else O.take(rows, axis=0)
+        Dr = D if every else D.take(rows, axis=0)
+        b = np.einsum("ij,ij->i", rel, Dr)
+        e2 = np.einsum("ij,ij->i", rel, rel)
+        tc = np.minimum(np.maximum(b, lo if every else lo[rows]), lim if every else lim[rows])
+        near = (e2 - tc * (b + b - tc) <= r2[r] + 1e-9 * (1.0 + e2)).nonzero()[0]
+        if len(near):
+            pr_list.append(rows[near])
+            pm_list.append(rc[near] * R + r)
+    if not pr_list:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    return np.concatenate(pr_list), np.concatenate(pm_list)

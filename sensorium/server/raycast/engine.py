@@ -347,7 +347,7 @@ class RayEngine(TierTracer):
 
     def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
              exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False,
-             directions32=None) -> RayHits:
+             directions32=None, coherent: bool = False) -> RayHits:
         """Nearest hits of rays ``origins + t directions``, t in [t_near, t_far] (scalars or per ray).
 
         ``mount``: optional (n,) body index each ray is rigidly mounted on (-1: none).  Such a ray
@@ -365,7 +365,12 @@ class RayEngine(TierTracer):
         distances.  Origins may be a broadcast array (one origin for all rays), never written.
 
         ``directions32``: optional ``directions.astype(float32)`` the caller keeps (a lidar whose
-        beams did not turn since the last scan); it is handed to Embree instead of rounding again."""
+        beams did not turn since the last scan); it is handed to Embree instead of rounding again.
+
+        ``coherent``: the rays come in runs from one origin each (the lidars of a batched world's
+        copies, one after another): FAST traces them as coherent packets, as it does a one-origin
+        cast, so each ray gets the answer of its own lidar's one-origin cast (Embree's lanes are
+        independent: the packet a ray shares does not change it)."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
@@ -407,11 +412,11 @@ class RayEngine(TierTracer):
             threads = self.threads
             if n <= _CHUNK and (threads <= 1 or n < MIN_RAYS):   # (split's answer: one part)
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
-                                  directions32)
+                                  directions32, coherent)
             parts = split(n, threads, _CHUNK)
             if len(parts) == 1:
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
-                                  directions32)
+                                  directions32, coherent)
             # large batches in blocks: the temporaries (~150 bytes per ray) stay a few MB whatever the
             # batch, and the blocks of the planes and the static tier run side by side on the
             # threads; then the movers, on the whole batch (a Mount keeps its lists for it) or in
@@ -451,7 +456,8 @@ class RayEngine(TierTracer):
                 with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # per thread
                     tn, tf = _param(_take(t_near, sl), m, np.float64, float), _param(_take(t_far, sl), m, np.float64, float)
                     h = self._cast_static(O[sl], D[sl], tn, tf, _param(_take(excl, sl), m, np.int64, int), planes,
-                                          static, big, distance_only, None if directions32 is None else directions32[sl])
+                                          static, big, distance_only, None if directions32 is None else directions32[sl],
+                                          coherent)
                     dist[sl] = h[0]
                     if not distance_only:
                         shape[sl], normal[sl] = h[1], h[2]
@@ -511,16 +517,16 @@ class RayEngine(TierTracer):
         return RayHits(t, normal, shape)
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
-              distance_only: bool = False, d32=None) -> RayHits:
+              distance_only: bool = False, d32=None, coherent: bool = False) -> RayHits:
         exact = self._precision is Precision.EXACT
-        hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32)
+        hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32, coherent)
         if movers is not None:
             self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits, mount=mount,
                               own_apart=distance_only and not exact)
         return RayHits(hits[0], hits[2], hits[1])
 
     def _cast_static(self, O, D, t_near, t_far, excl, planes, static, big: float, distance_only: bool = False,
-                     d32=None) -> tuple:
+                     d32=None, coherent: bool = False) -> tuple:
         """(dist, shape, normal) of the planes and the static tier (shape, normal None when
         ``distance_only``): the part of a cast that blocks of rays run side by side."""
         n = len(O)
@@ -531,7 +537,7 @@ class RayEngine(TierTracer):
         if static is not None:
             lim = t_far if hits is None else np.minimum(t_far, hits[0])
             res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big,
-                              distance_only, d32)
+                              distance_only, d32, coherent)
             if res is not None and hits is None:
                 hits = res
             elif res is not None and distance_only:   # the nearer of plane and mesh (ties: the plane)

@@ -760,3 +760,87 @@ void sp_to_frame(size_t n, const double* x, const int64_t* rows, const double* R
     for (int j = 0; j < 3; j++) o[j] = v[0] * R[j] + v[1] * R[3 + j] + v[2] * R[6 + j];
   }
 }
+
+/* ---- batched copies ---- */
+
+/* copies.py's broad phase: the (ray, body) pairs of rays of many copies of a world, each ray
+ * against the bounding sphere of every robot slot's body in its own copy only. Ray i (origin
+ * O[i], unit direction D[i], interval [lo, lim[i]]) of copy copy[i] is paired with slot r when
+ * r is present, is not the ray's excluded slot nor its mount slot, lim[i] >= lo, and the segment
+ * comes within the sphere (centre[copy[i]][r], r2[r]) -- the numpy path's test, operation for
+ * operation (it is conservative, with a slack of 1e-9 (1 + e2)). Pairs are written slot by slot,
+ * each slot's rays ascending (the numpy path's order): ray into out_ray, copy * R + r into
+ * out_body; returns their number (at most n * R). lo, excl, mnt: per ray when not NULL, else the
+ * scalar value. */
+size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const int64_t* copy,
+                     const double* centre, const double* r2, const uint8_t* present, const double* lo,
+                     double lo_value, const double* lim, const int64_t* excl, int64_t excl_value,
+                     const int64_t* mnt, int64_t mnt_value, int64_t* out_ray, int64_t* out_body) {
+  size_t k = 0;
+  for (size_t r = 0; r < R; r++) {
+    if (!present[r]) continue;
+    if (!excl && excl_value == (int64_t)r) continue;
+    if (!mnt && mnt_value == (int64_t)r) continue;
+    const double rr = r2[r];
+    for (size_t i = 0; i < n; i++) {
+      if (excl && excl[i] == (int64_t)r) continue;
+      if (mnt && mnt[i] == (int64_t)r) continue;
+      const double l = lo ? lo[i] : lo_value;
+      const double f = lim[i];
+      if (!(f >= l)) continue;
+      const int64_t c = copy[i];
+      const double* cc = centre + 3 * ((size_t)c * R + r);
+      const double* o = O + 3 * i;
+      const double* d = D + 3 * i;
+      const double x = cc[0] - o[0], y = cc[1] - o[1], z = cc[2] - o[2];
+      const double b = x * d[0] + y * d[1] + z * d[2];
+      const double e2 = x * x + y * y + z * z;
+      const double tc = np_min(np_max(b, l), f);
+      out_ray[k] = (int64_t)i;
+      out_body[k] = c * (int64_t)R + (int64_t)r;
+      k += e2 - tc * (b + b - tc) <= rr + 1e-9 * (1.0 + e2);
+    }
+  }
+  return k;
+}
+
+/* refine.py's screening of the curved-shell pre-pass, for many rays of many origins (the copies of
+ * a batched world: their origins span the world, so every shell is near some ray): the start
+ * points S[i] = O[i] + lo[i] D[i] inside each listed shell k's extent -- its bounding sphere for a
+ * sphere, else the cylinder (rad2, ax) of its vertices in the shape frame -- with the numpy path's
+ * operations (refine._inside_shell: S - pos, exact._to_frame's sums (x0 R0j + x1 R1j) + x2 R2j).
+ * bound_first: a cylinder's or capsule's start point must also lie within its bounding sphere
+ * (bound2; the dense pass of refine.py tests the sphere first, then the extent). Pairs shell by
+ * shell, rows ascending: row into out_row, k into out_slot; their number (at most m * nk).
+ * o_stride 0: one origin for every ray. lo NULL: lo_value for every ray. */
+size_t sp_inside_shells(size_t m, const double* O, size_t o_stride, const double* D, const double* lo,
+                        double lo_value, size_t nk, const int64_t* shells, const int64_t* code,
+                        const double* pos, const double* rot, const double* bound2, const double* rad2,
+                        const double* ax, int bound_first, int64_t* out_row, int64_t* out_slot) {
+  size_t k = 0;
+  for (size_t q = 0; q < nk; q++) {
+    const int64_t s = shells[q];
+    const double* c = pos + 3 * s;
+    const double* R = rot + 9 * s;
+    const int sphere = code[s] == 1;
+    for (size_t i = 0; i < m; i++) {
+      const double* o = O + o_stride * i;
+      const double* d = D + 3 * i;
+      const double l = lo ? lo[i] : lo_value;
+      const double p0 = (o[0] + l * d[0]) - c[0], p1 = (o[1] + l * d[1]) - c[1], p2 = (o[2] + l * d[2]) - c[2];
+      int in;
+      if (sphere || bound_first) in = (p0 * p0 + p1 * p1) + p2 * p2 <= bound2[s];
+      else in = 1;
+      if (!sphere && in) {
+        const double x = (p0 * R[0] + p1 * R[3]) + p2 * R[6];
+        const double y = (p0 * R[1] + p1 * R[4]) + p2 * R[7];
+        const double z = (p0 * R[2] + p1 * R[5]) + p2 * R[8];
+        in = (x * x + y * y <= rad2[s]) && (fabs(z) <= ax[s]);
+      }
+      out_row[k] = (int64_t)i;
+      out_slot[k] = s;
+      k += in;
+    }
+  }
+  return k;
+}

@@ -170,6 +170,10 @@ def _load() -> None:
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_inside_shells.restype = sz
+    lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
+    lib.sp_copy_pairs.restype = sz
+    lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
     _state["lib"] = lib
     _state["embree"] = embree
 
@@ -455,3 +459,64 @@ def lidar_scan(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray, colum
 
     blocks.run(part, blocks.split(n, threads, 1 << 16), threads)
     return True
+
+
+def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarray, r2: np.ndarray,
+               present: np.ndarray, lo, lim: np.ndarray, excl, mount) -> tuple[np.ndarray, np.ndarray] | None:
+    """The broad phase of :meth:`.copies.CopyRays.cast` in one C pass (``sp_copy_pairs``): the
+    (ray, copy * R + slot) pairs whose ray comes within the bounding sphere (``centre`` (C, R, 3),
+    ``r2`` (R,)) of a present slot of its own copy, its excluded and mount slots left out, listed
+    slot by slot and ray by ray as the numpy path lists them; or None without the helper. ``lo``,
+    ``excl``, ``mount``: scalars or (n,) arrays; ``lim`` (n,)."""
+    lib = library()
+    if lib is None:
+        return None
+    n = len(O)
+    R = int(r2.shape[0])
+    f64, i64 = np.float64, np.int64
+    O, D = np.ascontiguousarray(O, dtype=f64), np.ascontiguousarray(D, dtype=f64)
+    copy = np.ascontiguousarray(copy, dtype=i64)
+    centre = np.ascontiguousarray(centre, dtype=f64)
+    r2 = np.ascontiguousarray(r2, dtype=f64)
+    present = np.ascontiguousarray(present, dtype=np.uint8)
+    lim = np.ascontiguousarray(lim, dtype=f64)
+    lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
+    ex_a = np.ascontiguousarray(excl, dtype=i64) if isinstance(excl, np.ndarray) else None
+    mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
+    out_ray = np.empty(n * R, dtype=i64)
+    out_body = np.empty(n * R, dtype=i64)
+    k = lib.sp_copy_pairs(n, R, O.ctypes.data, D.ctypes.data, copy.ctypes.data, centre.ctypes.data, r2.ctypes.data,
+                          present.ctypes.data, _ptr(lo_a), 0.0 if lo_a is not None else float(lo), lim.ctypes.data,
+                          _ptr(ex_a), 0 if ex_a is not None else int(excl), _ptr(mn_a),
+                          0 if mn_a is not None else int(mount), out_ray.ctypes.data, out_body.ctypes.data)
+    return out_ray[:k], out_body[:k]
+
+
+def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: bool = False
+                  ) -> tuple[np.ndarray, np.ndarray] | None:
+    """``refine._inside_shell`` of the start points ``Ot + lo D`` for each listed curved slot of
+    ``tier``, in one C pass (``sp_inside_shells``): (rows, slots), slot by slot, rows ascending, the
+    numpy loop's pairs; or None without the helper. ``Ot`` may be one broadcast origin.
+    ``bound_first``: the start point must also lie in the slot's bounding sphere (the dense pass's
+    test before the extent)."""
+    lib = library()
+    if lib is None:
+        return None
+    m = len(Ot)
+    f64, i64 = np.float64, np.int64
+    if Ot.strides[0] == 0:
+        O, o_stride = np.ascontiguousarray(Ot[:1], dtype=f64), 0
+    else:
+        O, o_stride = np.ascontiguousarray(Ot, dtype=f64), 3
+    D = np.ascontiguousarray(D, dtype=f64)
+    lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
+    ks = np.asarray(shells, dtype=i64)
+    arrays = [np.ascontiguousarray(getattr(tier, name), dtype=dt) for name, dt in (
+        ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
+    out_row = np.empty(m * len(ks), dtype=i64)
+    out_slot = np.empty(m * len(ks), dtype=i64)
+    k = lib.sp_inside_shells(m, O.ctypes.data, o_stride, D.ctypes.data, _ptr(lo_a),
+                             0.0 if lo_a is not None else float(lo), len(ks), ks.ctypes.data,
+                             *(a.ctypes.data for a in arrays), 1 if bound_first else 0, out_row.ctypes.data,
+                             out_slot.ctypes.data)
+    return out_row[:k], out_slot[:k]

@@ -9,6 +9,7 @@ import threading
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import (
     _BARY_TOL,
     _CAPSULE,
@@ -308,8 +309,24 @@ class Refiner:
                 return None
         else:
             near = None
+        # the screening below in one C pass where the helper is (the same tests and pairs in the same
+        # order; the start points only made once some are inside): shape by shape, each shell's own
+        # extent straight away, or (dense) the bounding spheres and then the extents, by row
+        dense = near is None and len(cp) > 1
+        got = (packets.inside_shells(tier, Ot, D, lo, range(len(cp)) if dense else near if near is not None else [0],
+                                     bound_first=dense) if self.native else None)
+        if got is not None:
+            rows, slots = got
+            if len(rows) == 0:
+                return None
+            if dense:
+                order = np.lexsort((slots, rows))
+                rows, slots = rows[order], slots[order]
+            tight = True
         S = Ot + lo_col * D
-        if near is not None or len(cp) == 1:  # shape by shape, each shell's own extent straight away
+        if got is not None:
+            pass
+        elif near is not None or len(cp) == 1:
             rs, ss = [], []
             for k in (near if near is not None else [0]):
                 r = self._inside_shell(tier, k, S).nonzero()[0]

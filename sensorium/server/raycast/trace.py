@@ -70,23 +70,25 @@ class TierTracer(Refiner):
         return scene.run(o32, d32, far, output=1)
 
     def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
-               distance_only: bool = False, d32=None):
+               distance_only: bool = False, d32=None, coherent: bool = False):
         """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
         for an unanchored tier).  ``distance_only``: FAST may return None for shape and normal
         (the same t; a lidar needs nothing else), and so may EXACT.  ``d32``: ``D`` rounded to
-        float32 when the caller has it."""
+        float32 when the caller has it.  ``coherent``: FAST traces the rays as coherent packets even
+        with several origins (rays in runs from one origin each: the copies' lidars of a batched
+        world; a ray's answer is then the one it gets in a one-origin cast)."""
         if exact:
             res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True, distance_only=distance_only,
                                    d32_all=d32)
             if not np.count_nonzero(res[0] < _INF):
                 return None
             return (res[0], None, None) if distance_only else res
-        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32)
+        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32, coherent)
 
     def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
-                    distance_only: bool = False, d32=None):
+                    distance_only: bool = False, d32=None, coherent: bool = False):
         """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
         self-hits, shells left from inside, excluded owners) are redone by the general loop.
         Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
@@ -167,14 +169,14 @@ class TierTracer(Refiner):
             else:
                 far = float(far)
         if native:   # traversal and judging in one C call (the same values)
-            n_hit, t, shape, normal, redo = self._fast_native(tier, Ot, D, o32, o1, shifted, d32, far, one, start, lim,
-                                                              excl, distance_only)
+            n_hit, t, shape, normal, redo = self._fast_native(tier, Ot, D, o32, o1, shifted, d32, far, one or coherent,
+                                                              start, lim, excl, distance_only)
             if n_hit == 0 and pre is None:
                 return None
         else:
             if o32 is None:
                 o32 = _one_row(o1, m)
-            res = self._run(tier, o32, d32, far, robust=False, coherent=one)
+            res = self._run(tier, o32, d32, far, robust=False, coherent=one or coherent)
             prim = res["primID"]
             hit = prim >= 0
             n_hit = np.count_nonzero(hit)
@@ -229,7 +231,7 @@ class TierTracer(Refiner):
                     shape[r], normal[r] = sp[take], np_[take]
         return t, shape, normal
 
-    def _fast_native(self, tier: _Tier, Ot, D, o32, o1, shifted: bool, d32, far, one: bool, start, lim, excl,
+    def _fast_native(self, tier: _Tier, Ot, D, o32, o1, shifted: bool, d32, far, coherent: bool, start, lim, excl,
                      distance_only: bool):
         """FAST's Embree call and judging (``_judge_fast``, ``_special``) in one call of packets.c:
         (hits, t, shape, normal, redo mask or None), the values of the numpy path. ``o32`` None: one
@@ -280,7 +282,7 @@ class TierTracer(Refiner):
             p_t, p_sp = t.ctypes.data, special.ctypes.data
             p_s, p_n = (None, None) if distance_only else (shape.ctypes.data, normal.ctypes.data)
         n_hit = packets.library().sp_fast_pass(
-            scene.handle, tier.native(False), m, 1 if one else 0, o_ptr, o_stride, sc.p_o1, 1 if shifted else 0,
+            scene.handle, tier.native(False), m, 1 if coherent else 0, o_ptr, o_stride, sc.p_o1, 1 if shifted else 0,
             _F32(start) if shifted else 0.0, addr(d32), far_ptr, far_value, 1 if far is None else 0, ot_ptr,
             ot_stride, sc.p_origin, addr(dd), None if st_arr is None else st_arr.ctypes.data,
             0.0 if st_arr is not None else start, None if lim_arr is None else lim_arr.ctypes.data,

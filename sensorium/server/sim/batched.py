@@ -321,6 +321,7 @@ class BatchedSimulation:
             if lid.rotating:
                 continue
         self._lidar_skips: dict[int, np.ndarray] = {}
+        self._lidar_plan: dict[int, tuple] = {}      # per lidar: (copies, each beam's copy, mount slots)
         self.range_images = [np.zeros((C, d.config.number_of_layers, d.config.horizontal_resolution), dtype=np.float32)
                              for d in self.lidar]
         # light sensors: constants stacked once
@@ -672,21 +673,22 @@ class BatchedSimulation:
     def _cast_requests(self, requests: list[_Rays]) -> list[RayHits]:
         groups: dict[tuple, list[int]] = {}
         for i, r in enumerate(requests):
-            groups.setdefault((int(r.kind), r.skip, r.distance_only), []).append(i)
+            groups.setdefault((int(r.kind), r.skip, r.distance_only, r.coherent), []).append(i)
         out: list[RayHits | None] = [None] * len(requests)
-        for (kind, skip, distance_only), idx in groups.items():
+        for (kind, skip, distance_only, coherent), idx in groups.items():
             reqs = [requests[i] for i in idx]
             if len(reqs) == 1:
                 r = reqs[0]
                 out[idx[0]] = self.rays.cast(r.origins, r.directions, r.t_near, r.t_far, RayKind(kind), r.copy,
-                                             self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32)
+                                             self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32,
+                                             coherent)
                 continue
             sizes = [len(r.origins) for r in reqs]
             h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
                                joined(reqs, sizes, "t_near", np.float64), joined(reqs, sizes, "t_far", np.float64),
                                RayKind(kind), joined(reqs, sizes, "copy", np.int64), self.rot, self.pos,
                                joined(reqs, sizes, "exclude", np.int64), joined(reqs, sizes, "mount", np.int64), skip,
-                               distance_only)
+                               distance_only, coherent=coherent)
             for i, hit in zip(idx, split_hits(h, sizes)):
                 out[i] = hit
         return out   # type: ignore[return-value]
@@ -866,13 +868,25 @@ class BatchedSimulation:
                 acc += z[None, :] * rot[:, j, 2, None]
                 dirs[:, :, j] = acc
             d = dirs.reshape(-1, 3)
+            ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
-            # a lidar with own shapes never meets its own body in the cast (finish adds those hits)
-            mount = slot if lid._own_body is not None else np.tile(self._lidar_skip(col), len(c))
-            reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, np.repeat(c, W),
-                              -1, mount, distance_only=True, d32=d.astype(np.float32)))
+            reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
+                              -1, mount, distance_only=True, d32=d.astype(np.float32), coherent=True))
             state["items"].append((col, c))
         return state, reqs
+
+    def _lidar_rows(self, col: int, copies: np.ndarray, W: int) -> tuple[np.ndarray, np.ndarray | int]:
+        """Per beam of the scans of ``copies``: its copy, and its mount slot (a lidar with own
+        shapes never meets its own body in the cast: finish adds those hits; else
+        :meth:`_lidar_skip`); kept while the same copies scan (all of them, step after step)."""
+        got = self._lidar_plan.get(col)
+        if got is not None and np.array_equal(got[0], copies):
+            return got[1], got[2]
+        lid = self.lidar[col]
+        ray_copy = np.repeat(copies, W)
+        mount = lid.robot_index if lid._own_body is not None else np.tile(self._lidar_skip(col), len(copies))
+        self._lidar_plan[col] = (copies.copy(), ray_copy, mount)
+        return ray_copy, mount
 
     def _lidar_skip(self, col: int) -> np.ndarray:
         """Per beam: the lidar's own robot slot where the beam can never meet that robot's body
@@ -933,6 +947,7 @@ class _Rays:
     skip: bool = False
     distance_only: bool = False
     d32: np.ndarray | None = None
+    coherent: bool = False     # runs of rays from one origin each (lidars): traced as one lidar's beams
 
 
 class _OnEngine:
