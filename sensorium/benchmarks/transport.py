@@ -21,6 +21,7 @@ import numpy as np
 from .common import Config, Plot, Section, Series, Table, Target, fmt_growth, fmt_time, growth, median, pct
 
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
+SERVER_WORK_US = 10      # the 'server work' row: a raw REP busy this long per message
 _servers = itertools.count()
 
 
@@ -141,7 +142,8 @@ def _robots_world(n: int, devices: list[dict] | None = None, step: int = 8) -> d
 def round_trips(tmp: Path, n: int, rounds: int, ipc: bool = False) -> dict[str, np.ndarray]:
     """Request/reply clients, each its own process against its own server process, timed in
     alternating chunks (so load from other jobs hits all of them alike): raw REQ ↔ REP echo (the
-    floor), bare DEALER ↔ minimal Python msgpack ROUTER, the client library's ``Connection`` ↔ that
+    floor), the same REQ ↔ a REP busy :data:`SERVER_WORK_US` µs per message (what a server's
+    per-message work costs a round trip), bare DEALER ↔ minimal Python msgpack ROUTER, the client library's ``Connection`` ↔ that
     ROUTER, and a Sensorium controller ↔ ``sensorium serve`` (lockstep, 1 robot) with each step
     path (``sensorium-c``, ``sensorium-python``), and a bare DEALER stepping against the default one
     (``sensorium-bare``: the server's share without the client library's)."""
@@ -151,6 +153,9 @@ def round_trips(tmp: Path, n: int, rounds: int, ipc: bool = False) -> dict[str, 
         rep = Proc(_role_args("rep-echo", f"ipc://{tmp}/rep" if ipc else "tcp://127.0.0.1"))
         servers.append(rep)
         rep_ep = rep.line().split()[1]
+        work = Proc(_role_args("rep-work", f"ipc://{tmp}/work" if ipc else "tcp://127.0.0.1", str(SERVER_WORK_US)))
+        servers.append(work)
+        work_ep = work.line().split()[1]
         router = Proc(_role_args("router-echo", f"ipc://{tmp}/router" if ipc else "tcp://127.0.0.1"))
         servers.append(router)
         router_ep = router.line().split()[1]
@@ -162,6 +167,7 @@ def round_trips(tmp: Path, n: int, rounds: int, ipc: bool = False) -> dict[str, 
         servers.append(bare)
         clients = {
             "floor": Proc(_role_args("req", rep_ep), stdin=True),
+            "floor-work": Proc(_role_args("req", work_ep), stdin=True),
             "bare": Proc(_role_args("dealer-client", router_ep), stdin=True),
             "conn": Proc(_role_args("conn-client", router_ep), stdin=True),
             **{f"sensorium-{path}": Proc(_role_args("stepper", srv.rpc, "c0", "8"), stdin=True)
@@ -511,6 +517,8 @@ def run(cfg: Config) -> Section:
     for tr, r in (("tcp", rt), ("ipc", rt_ipc)):
         sfx = "" if tr == "tcp" else "_ipc"
         data[f"reqrep_floor{sfx}"] = {"p50_s": median(r["floor"]), "p99_s": pct(r["floor"], 99)}
+        data[f"reqrep_work{sfx}"] = {"p50_s": median(r["floor-work"]), "p99_s": pct(r["floor-work"], 99),
+                                     "work_us": SERVER_WORK_US}
         data[f"python_floor_bare{sfx}"] = {"p50_s": median(r["bare"]), "p99_s": pct(r["bare"], 99)}
         data[f"python_floor{sfx}"] = {"p50_s": median(r["conn"]), "p99_s": pct(r["conn"], 99)}
         for path in paths:
@@ -519,6 +527,7 @@ def run(cfg: Config) -> Section:
         data[f"single{sfx}"] = data[f"single_{best}{sfx}"]
         fl = r["floor"]
         labelled = [("raw pyzmq REQ/REP ping-pong (floor)", fl),
+                    (f"raw REQ ↔ a REP that is busy {SERVER_WORK_US} µs per message (server work)", r["floor-work"]),
                     ("bare DEALER (msgpack, blocking recv) ↔ minimal Python msgpack ROUTER", r["bare"]),
                     ("client library `Connection` ↔ minimal Python msgpack ROUTER (no lockstep)", r["conn"])]
         labelled += [(f"bare DEALER stepping (msgpack, blocking recv) ↔ `sensorium serve`, {best} step path",
@@ -674,7 +683,10 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
         mine = data[f"single_{best}{sfx}"]["p50_s"]
         others = "".join(f"; with the {p} step path {us(data[f'single_{p}{sfx}']['p50_s'] - mine)} more" for p in paths
                          if p != best)
-        why.append(f"{tr} layers (p50): raw REQ ↔ REP {us(fl)}; a bare DEALER stepping against `sensorium serve` "
+        work = data[f"reqrep_work{sfx}"]["p50_s"]
+        why.append(f"{tr} layers (p50): raw REQ ↔ REP {us(fl)}; the same REP busy {SERVER_WORK_US} µs per message "
+                   f"{us(work - fl)} more ({(work - fl) * 1e6 / SERVER_WORK_US:.1f} µs of round trip per µs of server "
+                   f"work); a bare DEALER stepping against `sensorium serve` "
                    f"({best} step path: msgpack, the lockstep, the world step) {us(stepper - fl)} more; the client "
                    f"library's `Connection` instead of that bare DEALER {us(mine - stepper)} more{others}. For "
                    f"reference, a bare DEALER against a do-nothing Python msgpack ROUTER: {us(bare - fl)} above the floor.")
@@ -683,10 +695,19 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
                f"{us(c1['handle_step']['total_s'])} with the step parsed in C. Other work on the machine meanwhile: "
                f"{data['others_cores']['tcp']:.1f} (tcp) and {data['others_cores']['ipc']:.1f} (ipc) cores of 2.")
     if not ok:
-        why.append("MISS: what is left is per-message work on both sides that the raw floor does not do: the client "
-                   "library's Python (request ids, msgpack, retries), and the server's Python step (the simulation "
-                   "step, the lockstep, one reply per controller); each costs a few µs of interpreter time that a "
-                   "busy 2-core machine stretches.")
+        gain = [(data[f"reqrep_work{sfx}"]["p50_s"] - data[f"reqrep_floor{sfx}"]["p50_s"]) * 1e6 / SERVER_WORK_US
+                for sfx in ("", "_ipc")]
+        why.append("MISS: what is left is per-message work on both sides that the raw floor does not do: the server's "
+                   f"Python per step ({us(c1['handle_step']['total_s'])} with the step parsed in C: the simulation step, "
+                   "the lockstep, the reply; the transport loop around it) and the client library's Python (msgpack, "
+                   f"the request's id). In this run a µs of work on a round trip's path cost {gain[0]:.1f} (tcp) / "
+                   f"{gain[1]:.1f} (ipc) µs of round trip (the 'server work' row: a raw REP busy {SERVER_WORK_US} µs per "
+                   "message; below 1 where the work fills time the CPUs would spend waking from idle, above where "
+                   "it delays the next wake-up), so +20 µs holds about "
+                   + " / ".join(f"{20 / g:.0f}" if g > 0 else "∞" for g in gain)
+                   + " µs of such work in all: less than the server's Python step alone plus the client's msgpack. "
+                   "Closing it needs the lockstep's common round (queue the steps, step, answer) without the "
+                   "interpreter; the simulation step itself is Python.")
     sec.targets.append(Target("Lockstep step round trip above raw pyzmq REQ/REP (1 controller, p50; tcp and ipc)",
                               "≤ +20 µs and ≤ 1.4×", ", ".join(parts) + f" [{best} step path]", ok, " ".join(why)))
     ratios = {p: [m[p]["steps_per_s"] / m["raw"]["steps_per_s"] for m in multi] for p in [*paths, "bare"]}

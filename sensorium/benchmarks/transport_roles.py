@@ -41,6 +41,34 @@ def _role_rep_echo(endpoint: str) -> None:
     ctx.term()
 
 
+def _role_rep_work(endpoint: str, work_us: str) -> None:
+    """``rep-echo`` that keeps its thread busy for ``work_us`` µs of wall time per message before
+    answering (a spin on ``perf_counter``): what a server's per-message work costs a round trip on
+    this machine, beyond the work itself (the section's 'server work' row)."""
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.REP)
+    print(f"ready {_bind(s, endpoint)}", flush=True)
+    work = float(work_us) * 1e-6
+    clock = time.perf_counter
+    poller = zmq.Poller()
+    poller.register(s, zmq.POLLIN)
+    while True:
+        if not poller.poll(10_000):
+            break                                    # idle for 10 s: the parent is gone
+        msg = s.recv()
+        if msg == b"quit":
+            s.send(b"bye")
+            break
+        until = clock() + work
+        while clock() < until:
+            pass
+        s.send(msg)
+    s.close(0)
+    ctx.term()
+
+
 def _role_router_echo(endpoint: str) -> None:
     """A minimal Python msgpack server on a ROUTER: answer every request with a step-like ok reply.
     With the client library on the other end, it is the floor of a Python request/reply round trip."""
@@ -284,7 +312,7 @@ def _role_raw_controller(endpoint: str, steps: str) -> None:
 
 
 def main(argv: list[str]) -> None:
-    roles = {"rep-echo": _role_rep_echo, "req": _role_req, "router-echo": _role_router_echo,
+    roles = {"rep-echo": _role_rep_echo, "rep-work": _role_rep_work, "req": _role_req, "router-echo": _role_router_echo,
              "conn-client": _role_conn_client, "dealer-client": _role_dealer_client, "stepper": _role_stepper,
              "bare-stepper": _role_bare_stepper, "bare-controller": _role_bare_controller,
              "pub": _role_pub, "controller": _role_controller, "raw-controller": _role_raw_controller}
