@@ -22,35 +22,22 @@ def _bind(s, endpoint: str) -> str:
 
 def _role_rep_echo(endpoint: str) -> None:
     """Raw pyzmq REP: echo every message (the floor of any request/reply round trip)."""
-    import zmq
-
-    ctx = zmq.Context()
-    s = ctx.socket(zmq.REP)
-    print(f"ready {_bind(s, endpoint)}", flush=True)
-    poller = zmq.Poller()
-    poller.register(s, zmq.POLLIN)
-    while True:
-        if not poller.poll(10_000):
-            break                                    # idle for 10 s: the parent is gone
-        msg = s.recv()
-        if msg == b"quit":
-            s.send(b"bye")
-            break
-        s.send(msg)
-    s.close(0)
-    ctx.term()
+    _serve_rep(endpoint, 0.0)
 
 
 def _role_rep_work(endpoint: str, work_us: str) -> None:
     """``rep-echo`` that keeps its thread busy for ``work_us`` µs of wall time per message before
     answering (a spin on ``perf_counter``): what a server's per-message work costs a round trip on
     this machine, beyond the work itself (the section's 'server work' row)."""
+    _serve_rep(endpoint, float(work_us) * 1e-6)
+
+
+def _serve_rep(endpoint: str, work: float) -> None:
     import zmq
 
     ctx = zmq.Context()
     s = ctx.socket(zmq.REP)
     print(f"ready {_bind(s, endpoint)}", flush=True)
-    work = float(work_us) * 1e-6
     clock = time.perf_counter
     poller = zmq.Poller()
     poller.register(s, zmq.POLLIN)
@@ -61,9 +48,10 @@ def _role_rep_work(endpoint: str, work_us: str) -> None:
         if msg == b"quit":
             s.send(b"bye")
             break
-        until = clock() + work
-        while clock() < until:
-            pass
+        if work:
+            until = clock() + work
+            while clock() < until:
+                pass
         s.send(msg)
     s.close(0)
     ctx.term()
