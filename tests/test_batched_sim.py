@@ -269,6 +269,65 @@ def test_the_broad_phase_in_c_lists_the_numpy_pairs_and_meets_closed_form_cases(
             assert got[1].tolist() == [int(cp[0])] * len(rays)
 
 
+def test_the_contact_broad_phase_in_c_finds_the_numpy_candidates_and_meets_closed_form_cases():
+    """BatchedSimulation._contact's broad phase: packets.contact_near (one C pass) flags exactly the
+    solids, robots and near moves of the numpy path (_contact_near) for many copies' moves at
+    random places (some robots without a footprint, some not moving); and a robot is a candidate
+    of another exactly when their boxes grown by both reaches and radii overlap."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.contact import EPS
+
+    if packets.library() is None:
+        pytest.skip(packets.status())
+    C = 40
+    bs = BatchedSimulation(arena(2), C, precision="fast")
+    ct = bs.contact
+    assert ct is not None and len(ct._obs) > 0 and bs.R == 2
+    rng = np.random.default_rng(7)
+    seen_near: set[bool] = set()
+    for trial in range(6):
+        bs.centres[:, 0] = rng.uniform(-1.2, 1.2, (C, 2))
+        bs.centres[:, 1] = bs.centres[:, 0] + rng.uniform(-0.3, 0.3, (C, 2))
+        copies = np.repeat(np.arange(C), 2)
+        slots = np.tile(np.arange(2), C)
+        keep = rng.random(len(copies)) < 0.8
+        copies, slots = copies[keep], slots[keep]
+        starts = bs.centres[copies, slots].copy()
+        step = rng.normal(scale=0.05 * (trial + 1), size=starts.shape)
+        reach = np.hypot(*step.T) + EPS
+        foot = bs.foot_radius.copy()
+        if trial == 5:                                   # a robot without a footprint hits and is hit by nothing
+            bs.foot_radius[1] = math.nan
+        band_lo = bs.heights[copies, slots] + bs.foot_low[slots]
+        band_hi = bs.heights[copies, slots] + bs.foot_high[slots]
+        grow = np.zeros((C, 2))
+        grow[copies, slots] = reach
+        want = bs._contact_near(copies, slots, starts, reach, band_lo, band_hi, grow)
+        got = packets.contact_near(copies, slots, starts, reach, bs.foot_radius, bs.foot_low, bs.foot_high,
+                                   bs.heights, bs.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS)
+        bs.foot_radius[:] = foot
+        assert got is not None and want[0] is not None and want[1] is not None
+        for w, g in zip(want, got):
+            assert g.dtype == np.bool_ and g.tobytes() == w.tobytes(), trial
+        assert want[1].any() == (trial < 5)
+        seen_near.update(want[2].tolist())
+    assert seen_near == {False, True}
+    # closed form: in copy 0 the two robots dx apart on y = 0, only robot 0 moving (reach q): a
+    # candidate when dx <= q + r0 + r1 (its box grown by reach and its radius meets the other's disc)
+    r0, r1 = float(bs.foot_radius[0]), float(bs.foot_radius[1])
+    q = 0.01
+    for dx, expect in ((q + r0 + r1 - 1e-6, True), (q + r0 + r1 + 1e-6, False)):
+        bs.centres[0] = [[0.0, 0.0], [dx, 0.0]]
+        bs.heights[0] = bs.heights[0, 0]
+        grow = np.zeros((C, 2))
+        grow[0, 0] = q
+        args = (np.array([0]), np.array([0]), np.zeros((1, 2)), np.array([q]))
+        got = packets.contact_near(*args, bs.foot_radius, bs.foot_low, bs.foot_high, bs.heights, bs.centres, grow,
+                                   np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), EPS)
+        assert got is not None
+        assert got[1].tolist() == [[False, expect]] and got[2].tolist() == [expect]
+
+
 def test_every_copys_lidar_gets_its_single_world_scan_at_many_poses():
     """The copies' lidar beams go out in one cast traced as the single world traces one lidar
     (coherent packets in FAST: a beam within float32 rounding of an edge gets the same triangle):

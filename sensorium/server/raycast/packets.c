@@ -844,3 +844,55 @@ size_t sp_inside_shells(size_t m, const double* O, size_t o_stride, const double
   }
   return k;
 }
+
+/* batched.py's contact broad phase (Contact.resolve_all's, for the moving robots of many copies):
+ * move m (robot slot slots[m] of copy copies[m], from starts[m] (xy) with reach[m] = |end - start|
+ * + EPS) against every solid j (its xy box lo/hi (S, 2), its z range zlo/zhi) and every other slot
+ * j of its own copy (centre centres[copy][j] (C, R, 2) before the step, radius foot_radius[j] grown
+ * by grow[copy][j] (C, R): that robot's own reach when it moves this step, else 0), each within
+ * the height band (heights (C, R) + foot_low/foot_high (R)) -- the numpy path's comparisons,
+ * operation for operation (EPS = eps). Writes solid_hit (k, S) and robot_hit (k, R) (0/1; a move
+ * never hits its own slot) and near[m] (any hit); returns the number of near moves. A NaN radius
+ * (a robot without a footprint) hits nothing, as there. */
+size_t sp_contact_near(size_t k, size_t R, size_t S, const int64_t* copies, const int64_t* slots,
+                       const double* starts, const double* reach, const double* foot_radius,
+                       const double* foot_low, const double* foot_high, const double* heights,
+                       const double* centres, const double* grow, const double* lo, const double* hi,
+                       const double* zlo, const double* zhi, double eps, uint8_t* solid_hit,
+                       uint8_t* robot_hit, uint8_t* near) {
+  size_t count = 0;
+  for (size_t m = 0; m < k; m++) {
+    const int64_t c = copies[m], s = slots[m];
+    const double grown = reach[m] + foot_radius[s];
+    const double bl0 = starts[2 * m] - grown, bl1 = starts[2 * m + 1] - grown;
+    const double bh0 = starts[2 * m] + grown, bh1 = starts[2 * m + 1] + grown;
+    const double h = heights[(size_t)c * R + (size_t)s];
+    const double band_lo = h + foot_low[s], band_hi = h + foot_high[s];
+    const double z_above = band_lo + eps, z_below = band_hi - eps;
+    int any = 0;
+    uint8_t* sh = solid_hit + m * S;
+    for (size_t j = 0; j < S; j++) {
+      const int in = lo[2 * j] <= bh0 && lo[2 * j + 1] <= bh1 && hi[2 * j] >= bl0 && hi[2 * j + 1] >= bl1
+                     && zhi[j] > z_above && zlo[j] < z_below;
+      sh[j] = (uint8_t)in;
+      any |= in;
+    }
+    if (R > 1) {
+      uint8_t* rh = robot_hit + m * R;
+      const double* cc = centres + 2 * (size_t)c * R;
+      const double* hc = heights + (size_t)c * R;
+      const double* gc = grow + (size_t)c * R;
+      for (size_t j = 0; j < R; j++) {
+        const double r_all = foot_radius[j] + gc[j];
+        const double x = cc[2 * j], y = cc[2 * j + 1];
+        const int in = (int64_t)j != s && x + r_all >= bl0 && x - r_all <= bh0 && y + r_all >= bl1
+                       && y - r_all <= bh1 && hc[j] + foot_high[j] > z_above && hc[j] + foot_low[j] < z_below;
+        rh[j] = (uint8_t)in;
+        any |= in;
+      }
+    }
+    near[m] = (uint8_t)any;
+    count += (size_t)any;
+  }
+  return count;
+}

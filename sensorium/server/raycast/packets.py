@@ -174,6 +174,8 @@ def _load() -> None:
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
     lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
+    lib.sp_contact_near.restype = sz
+    lib.sp_contact_near.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp]
     _state["lib"] = lib
     _state["embree"] = embree
 
@@ -520,3 +522,31 @@ def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: 
                              *(a.ctypes.data for a in arrays), 1 if bound_first else 0, out_row.ctypes.data,
                              out_slot.ctypes.data)
     return out_row[:k], out_slot[:k]
+
+
+def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reach: np.ndarray,
+                 foot_radius: np.ndarray, foot_low: np.ndarray, foot_high: np.ndarray, heights: np.ndarray,
+                 centres: np.ndarray, grow: np.ndarray, lo: np.ndarray, hi: np.ndarray, zlo: np.ndarray,
+                 zhi: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The contact broad phase of :meth:`.batched.BatchedSimulation._contact` in one C pass
+    (``sp_contact_near``): (solid_hit (k, S), robot_hit (k, R), near (k,)) as bool arrays, the
+    numpy path's comparisons; or None without the helper. Move m is slot ``slots[m]`` of copy
+    ``copies[m]`` leaving ``starts[m]`` with ``reach[m]``; ``heights``/``grow`` (C, R),
+    ``centres`` (C, R, 2); solids: ``lo``/``hi`` (S, 2), ``zlo``/``zhi`` (S,)."""
+    lib = library()
+    if lib is None:
+        return None
+    k, R, S = len(copies), len(foot_radius), len(zlo)
+    f64, i64 = np.float64, np.int64
+    args = [np.ascontiguousarray(a, dtype=dt) for a, dt in (
+        (copies, i64), (slots, i64), (starts, f64), (reach, f64), (foot_radius, f64), (foot_low, f64),
+        (foot_high, f64), (heights, f64), (centres, f64), (grow, f64), (lo, f64), (hi, f64), (zlo, f64), (zhi, f64))]
+    if args[2].shape != (k, 2) or args[8].shape != args[7].shape + (2,) or args[7].shape[1:] != (R,) \
+            or args[9].shape != args[7].shape or args[10].shape != (S, 2) or args[11].shape != (S, 2):
+        raise TypeError("contact_near: inconsistent shapes")
+    solid_hit = np.empty((k, S), dtype=np.bool_)
+    robot_hit = np.zeros((k, R), dtype=np.bool_)
+    near = np.empty(k, dtype=np.bool_)
+    lib.sp_contact_near(k, R, S, *(a.ctypes.data for a in args), float(eps), solid_hit.ctypes.data,
+                        robot_hit.ctypes.data, near.ctypes.data)
+    return solid_hit, robot_hit, near

@@ -41,6 +41,7 @@ from sensorium.server.devices import lidar as lmath
 from sensorium.server.devices import light as light_math
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.devices.noise import device_rng
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
@@ -563,30 +564,25 @@ class BatchedSimulation:
         out = ends.copy()
         reach = np.hypot(*(ends - starts).T) + EPS
         Rr = self.foot_radius[slots]
-        box_lo = starts - (reach + Rr)[:, None]
-        box_hi = starts + (reach + Rr)[:, None]
         band_lo = self.heights[copies, slots] + self.foot_low[slots]
         band_hi = self.heights[copies, slots] + self.foot_high[slots]
-        solid_hit = robot_hit = None
-        near = np.zeros(k, dtype=bool)
-        if len(ct._obs):
-            solid_hit = (np.all((ct._lo[None] <= box_hi[:, None]) & (ct._hi[None] >= box_lo[:, None]), axis=2)
-                         & (ct._zhi[None] > band_lo[:, None] + EPS) & (ct._zlo[None] < band_hi[:, None] - EPS))
-            near |= solid_hit.any(axis=1)
-        if self.R > 1:
-            grow = np.zeros((self.copies, self.R))
-            grow[copies, slots] = reach
-            c = self.centres[copies]                                            # (k, R, 2): before this step
-            r_all = self.foot_radius[None, :] + grow[copies]                     # (k, R)
-            a_lo = self.heights[copies] + self.foot_low[None, :]
-            a_hi = self.heights[copies] + self.foot_high[None, :]
-            with np.errstate(invalid="ignore"):
-                robot_hit = ((c[:, :, 0] + r_all >= box_lo[:, None, 0]) & (c[:, :, 0] - r_all <= box_hi[:, None, 0])
-                             & (c[:, :, 1] + r_all >= box_lo[:, None, 1]) & (c[:, :, 1] - r_all <= box_hi[:, None, 1])
-                             & (a_hi > band_lo[:, None] + EPS) & (a_lo < band_hi[:, None] - EPS))
-            robot_hit[np.arange(k), slots] = False
-            near |= robot_hit.any(axis=1)
+        # where every robot may be during this step: its disc, grown by its own move if it moves
+        grow = np.zeros((self.copies, self.R))
+        grow[copies, slots] = reach
+        native = packets.contact_near(copies, slots, starts, reach, self.foot_radius, self.foot_low, self.foot_high,
+                                      self.heights, self.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS)
+        if native is not None:
+            solid_hit, robot_hit, near = native
+            solid_hit = solid_hit if len(ct._obs) else None
+            robot_hit = robot_hit if self.R > 1 else None
+        else:
+            solid_hit, robot_hit, near = self._contact_near(copies, slots, starts, reach, band_lo, band_hi, grow)
         footless = np.isnan(Rr)
+        if not near.any():
+            # nothing near any move: each ends where Contact._clip without candidates puts it (a
+            # robot without a footprint: at its end), whatever the slot order
+            self.centres[copies, slots] = np.where(footless[:, None], ends, starts + (ends - starts))
+            return out[:, 0], out[:, 1]
         # slot by slot, as Contact.resolve_all takes robots in world order (each sees the earlier
         # slots of its copy where they ended, the later ones where they started)
         for r in np.unique(slots).tolist():
@@ -614,6 +610,34 @@ class BatchedSimulation:
                     self.counters["contacts"] += 1
                     out[m] = p
         return out[:, 0], out[:, 1]
+
+    def _contact_near(self, copies, slots, starts, reach, band_lo, band_hi, grow):
+        """The broad phase of :meth:`_contact` in numpy (packets.contact_near's fallback):
+        (solid_hit (k, S) or None, robot_hit (k, R) or None, near (k,))."""
+        ct = self.contact
+        assert ct is not None
+        k = len(copies)
+        Rr = self.foot_radius[slots]
+        box_lo = starts - (reach + Rr)[:, None]
+        box_hi = starts + (reach + Rr)[:, None]
+        solid_hit = robot_hit = None
+        near = np.zeros(k, dtype=bool)
+        if len(ct._obs):
+            solid_hit = (np.all((ct._lo[None] <= box_hi[:, None]) & (ct._hi[None] >= box_lo[:, None]), axis=2)
+                         & (ct._zhi[None] > band_lo[:, None] + EPS) & (ct._zlo[None] < band_hi[:, None] - EPS))
+            near |= solid_hit.any(axis=1)
+        if self.R > 1:
+            c = self.centres[copies]                                            # (k, R, 2): before this step
+            r_all = self.foot_radius[None, :] + grow[copies]                     # (k, R)
+            a_lo = self.heights[copies] + self.foot_low[None, :]
+            a_hi = self.heights[copies] + self.foot_high[None, :]
+            with np.errstate(invalid="ignore"):
+                robot_hit = ((c[:, :, 0] + r_all >= box_lo[:, None, 0]) & (c[:, :, 0] - r_all <= box_hi[:, None, 0])
+                             & (c[:, :, 1] + r_all >= box_lo[:, None, 1]) & (c[:, :, 1] - r_all <= box_hi[:, None, 1])
+                             & (a_hi > band_lo[:, None] + EPS) & (a_lo < band_hi[:, None] - EPS))
+            robot_hit[np.arange(k), slots] = False
+            near |= robot_hit.any(axis=1)
+        return solid_hit, robot_hit, near
 
     # -- devices
     def _due(self, kind: str, live: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
