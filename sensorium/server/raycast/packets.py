@@ -487,10 +487,12 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
     out_ray = np.empty(n * R, dtype=i64)
     out_body = np.empty(n * R, dtype=i64)
-    k = lib.sp_copy_pairs(n, R, O.ctypes.data, D.ctypes.data, copy.ctypes.data, centre.ctypes.data, r2.ctypes.data,
-                          present.ctypes.data, _ptr(lo_a), 0.0 if lo_a is not None else float(lo), lim.ctypes.data,
-                          _ptr(ex_a), 0 if ex_a is not None else int(excl), _ptr(mn_a),
-                          0 if mn_a is not None else int(mount), out_ray.ctypes.data, out_body.ctypes.data)
+    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_lim, p_ray, p_body = _small_addresses(
+        (O, D, copy, centre, r2, present, lim, out_ray, out_body))
+    k = lib.sp_copy_pairs(n, R, p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
+                          0.0 if lo_a is not None else float(lo), p_lim, _ptr(ex_a),
+                          0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
+                          p_ray, p_body)
     return out_ray[:k], out_body[:k]
 
 
@@ -517,11 +519,30 @@ def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: 
         ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
     out_row = np.empty(m * len(ks), dtype=i64)
     out_slot = np.empty(m * len(ks), dtype=i64)
-    k = lib.sp_inside_shells(m, O.ctypes.data, o_stride, D.ctypes.data, _ptr(lo_a),
-                             0.0 if lo_a is not None else float(lo), len(ks), ks.ctypes.data,
-                             *(a.ctypes.data for a in arrays), 1 if bound_first else 0, out_row.ctypes.data,
-                             out_slot.ctypes.data)
+    p = _small_addresses([O, D, ks, *arrays, out_row, out_slot])
+    k = lib.sp_inside_shells(m, p[0], o_stride, p[1], _ptr(lo_a), 0.0 if lo_a is not None else float(lo), len(ks),
+                             p[2], *p[3:9], 1 if bound_first else 0, p[9], p[10])
     return out_row[:k], out_slot[:k]
+
+
+def _small_addresses(arrays) -> list[int]:
+    """The data addresses of the small arrays a batched pass reads and writes, step after step:
+    ``a.ctypes.data`` costs ~3 us an array, a ctypes view of an array owning its writable buffer
+    ~1 us. Views (a broadcast view would warn on a writable export), read-only and empty arrays
+    take the first way."""
+    out = []
+    for a in arrays:
+        if a.flags.owndata:
+            try:
+                out.append(ctypes.addressof(_BYTE.from_buffer(a)))
+                continue
+            except (TypeError, ValueError, BufferError):
+                pass
+        out.append(a.ctypes.data)
+    return out
+
+
+_BYTE = ctypes.c_char
 
 
 def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reach: np.ndarray,
@@ -547,6 +568,6 @@ def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reac
     solid_hit = np.empty((k, S), dtype=np.bool_)
     robot_hit = np.zeros((k, R), dtype=np.bool_)
     near = np.empty(k, dtype=np.bool_)
-    lib.sp_contact_near(k, R, S, *(a.ctypes.data for a in args), float(eps), solid_hit.ctypes.data,
-                        robot_hit.ctypes.data, near.ctypes.data)
+    p = _small_addresses(args + [solid_hit, robot_hit, near])
+    lib.sp_contact_near(k, R, S, *p[:14], float(eps), *p[14:])
     return solid_hit, robot_hit, near
