@@ -328,6 +328,55 @@ def test_the_contact_broad_phase_in_c_finds_the_numpy_candidates_and_meets_close
         assert got[1].tolist() == [[False, expect]] and got[2].tolist() == [expect]
 
 
+def test_the_wheels_in_c_turn_as_the_numpy_path_and_meet_closed_form_cases():
+    """BatchedSimulation._drive's wheels and drives: packets.drive_wheels (one C pass) advances the
+    wheel angles and gives the moving robots' copies, slots and speeds of the numpy path
+    (_drive_wheels), bit for bit, for velocity and position control (targets reached, passed,
+    NaN), still wheels, skid-steer sides and dt = 0; a wheel 0.1 rad from its target at 5 rad/s
+    turns 0.1 / dt rad/s and stops on it."""
+    from sensorium.server.raycast import packets
+
+    if packets.library() is None:
+        pytest.skip(packets.status())
+    C = 30
+    bs = BatchedSimulation(arena(3), C, precision="fast")
+    rng = np.random.default_rng(11)
+    live = np.array(sorted(rng.choice(C, 24, replace=False)))
+    driven = bs.has_drive.nonzero()[0]
+    assert len(driven) == 2
+    for trial, dt in enumerate((0.032, 0.032, 0.0, 0.016)):
+        bs.velocity[:] = rng.uniform(-6.0, 6.0, (C, bs.R, 2)) * (rng.random((C, bs.R, 2)) < 0.8)
+        bs.wheel_angle[:] = rng.uniform(-3.0, 3.0, (C, bs.R, 2))
+        bs.target[:] = np.where(rng.random((C, bs.R, 2)) < 0.5, math.inf,
+                                bs.wheel_angle + rng.uniform(-0.3, 0.3, (C, bs.R, 2)))
+        bs.target[::5, :, 1] = bs.wheel_angle[::5, :, 1]              # on target: still
+        bs.target[1, :, 0] = math.nan
+        bs.velocity[::3], bs.target[::3] = 0.0, math.inf                  # still robots
+        bs.side_wheels[:] = [[2, 3], [1, 1]] if trial % 2 else [[1, 1], [1, 1]]
+        start = bs.wheel_angle.copy()
+        want = bs._drive_wheels(live, driven, dt)
+        want_angle, bs.wheel_angle[:] = bs.wheel_angle.copy(), start
+        got = packets.drive_wheels(live, driven, bs.target, bs.velocity, bs.wheel_angle, dt, bs.side_wheels,
+                                   bs.wheel_radius, bs.axle)
+        assert got is not None
+        assert bs.wheel_angle.tobytes() == want_angle.tobytes(), trial
+        for w, g in zip(want, got):
+            assert g.dtype == w.dtype and g.tobytes() == w.tobytes(), trial
+        assert 0 < len(got[0]) < len(live) * len(driven) or dt == 0.0
+    # closed form: the left wheel of copy 0's first driven slot 0.1 rad short of its target at 5 rad/s
+    s = int(driven[0])
+    bs.side_wheels[:] = 1
+    bs.wheel_angle[0, s] = [1.0, 0.0]
+    bs.target[0, s] = [1.1, math.inf]
+    bs.velocity[0, s] = [5.0, 0.0]
+    copies, slots, v, w = packets.drive_wheels(np.array([0]), np.array([s]), bs.target, bs.velocity, bs.wheel_angle,
+                                               0.032, bs.side_wheels, bs.wheel_radius, bs.axle)
+    omega = (1.1 - 1.0) / 0.032
+    assert copies.tolist() == [0] and slots.tolist() == [s] and bs.wheel_angle[0, s, 0] == pytest.approx(1.1, abs=1e-15)
+    r, axle = float(bs.wheel_radius[s]), float(bs.axle[s])
+    assert v[0] == pytest.approx(r * omega / 2.0, rel=1e-12) and w[0] == pytest.approx(-r * omega / axle, rel=1e-12)
+
+
 def test_every_copys_lidar_gets_its_single_world_scan_at_many_poses():
     """The copies' lidar beams go out in one cast traced as the single world traces one lidar
     (coherent packets in FAST: a beam within float32 rounding of an edge gets the same triangle):

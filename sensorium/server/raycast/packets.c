@@ -896,3 +896,53 @@ size_t sp_contact_near(size_t k, size_t R, size_t S, const int64_t* copies, cons
   }
   return count;
 }
+
+/* batched.py's wheels and drives of one basic step, for every driven slot driven[d] (d < D) of
+ * every live copy live[l] (l < L): WheelMotor.advance of its left and right wheel (target,
+ * velocity, angle: (C, R, 2); the angle advanced in place), DifferentialDrive.step's side means
+ * (for a slot with a side of several equal wheels, each side 0 + w + ... + w (its count times),
+ * then / count) and its speeds v = r (wl + wr) / 2, w = r (wr - wl) / axle -- the numpy path's
+ * operations, element for element (np.minimum's NaN). The moving robots (a side turning), copy
+ * by copy and slot by slot: their copy, slot, v and w into out_*; returns their number. */
+size_t sp_drive_wheels(size_t L, size_t D, size_t R, const int64_t* live, const int64_t* driven,
+                       const double* target, const double* velocity, double* angle, double dt,
+                       const int64_t* sides, const double* radius, const double* axle, int64_t* out_copy,
+                       int64_t* out_slot, double* out_v, double* out_w) {
+  size_t k = 0;
+  for (size_t l = 0; l < L; l++) {
+    const int64_t c = live[l];
+    for (size_t d = 0; d < D; d++) {
+      const int64_t s = driven[d];
+      const size_t at = ((size_t)c * R + (size_t)s) * 2;
+      const int skid = sides[2 * s] > 1 || sides[2 * s + 1] > 1;
+      double om[2];
+      for (int side = 0; side < 2; side++) {
+        const double tgt = target[at + side], vel = velocity[at + side], ang = angle[at + side];
+        double o;
+        if (isinf(tgt)) {
+          o = vel;
+        } else {
+          const double remaining = tgt - ang;
+          const double speed = dt > 0 ? np_min(fabs(vel), fabs(remaining) / dt) : 0.0;
+          o = remaining != 0.0 ? copysign(speed, remaining) : 0.0;
+        }
+        angle[at + side] = ang + o * dt;
+        if (skid) {
+          const int64_t n = sides[2 * s + side];
+          double acc = 0.0 + o;
+          for (int64_t i = 1; i < n; i++) acc = acc + o;
+          o = acc / (double)n;
+        }
+        om[side] = o;
+      }
+      if (om[0] != 0.0 || om[1] != 0.0) {
+        out_copy[k] = c;
+        out_slot[k] = s;
+        out_v[k] = radius[s] * (om[0] + om[1]) / 2.0;
+        out_w[k] = radius[s] * (om[1] - om[0]) / axle[s];
+        k++;
+      }
+    }
+  }
+  return k;
+}

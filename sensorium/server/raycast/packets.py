@@ -175,6 +175,8 @@ def _load() -> None:
     lib.sp_copy_pairs.restype = sz
     lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
     lib.sp_contact_near.restype = sz
+    lib.sp_drive_wheels.restype = sz
+    lib.sp_drive_wheels.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_contact_near.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp]
     _state["lib"] = lib
     _state["embree"] = embree
@@ -571,3 +573,32 @@ def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reac
     p = _small_addresses(args + [solid_hit, robot_hit, near])
     lib.sp_contact_near(k, R, S, *p[:14], float(eps), *p[14:])
     return solid_hit, robot_hit, near
+
+
+def drive_wheels(live: np.ndarray, driven: np.ndarray, target: np.ndarray, velocity: np.ndarray,
+                 angle: np.ndarray, dt: float, sides: np.ndarray, radius: np.ndarray, axle: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """The wheels and drives of :meth:`.batched.BatchedSimulation._drive` in one C pass
+    (``sp_drive_wheels``): every live copy's driven slots' wheel motors advanced (``angle`` (C, R, 2)
+    written in place), and the moving robots' (copies, slots, v, w) in the numpy path's order and
+    bits; or None without the helper (nothing written). ``target``/``velocity``/``angle`` (C, R, 2),
+    ``sides`` (R, 2) wheels per side, ``radius``/``axle`` (R,)."""
+    lib = library()
+    if lib is None:
+        return None
+    f64, i64 = np.float64, np.int64
+    C, R = angle.shape[:2]
+    for a, dt_, shape in ((target, f64, (C, R, 2)), (velocity, f64, (C, R, 2)), (angle, f64, (C, R, 2)),
+                          (sides, i64, (R, 2)), (radius, f64, (R,)), (axle, f64, (R,))):
+        if a.dtype != dt_ or a.shape != shape or not a.flags.c_contiguous:
+            raise TypeError(f"drive_wheels: {a.dtype} {a.shape} where it reads contiguous {np.dtype(dt_)} {shape}")
+    if not angle.flags.writeable:
+        raise TypeError("drive_wheels: the wheel angles must be writable")
+    live = np.ascontiguousarray(live, dtype=i64)
+    driven = np.ascontiguousarray(driven, dtype=i64)
+    n = len(live) * len(driven)
+    copies, slots = np.empty(n, dtype=i64), np.empty(n, dtype=i64)
+    v, w = np.empty(n), np.empty(n)
+    p = _small_addresses((live, driven, target, velocity, angle, sides, radius, axle, copies, slots, v, w))
+    k = lib.sp_drive_wheels(len(live), len(driven), R, *p[:5], float(dt), *p[5:])
+    return copies[:k], slots[:k], v[:k], w[:k]

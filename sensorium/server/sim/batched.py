@@ -335,6 +335,7 @@ class BatchedSimulation:
             self._l_excl = np.array([d.exclude_self() for d in self.light], dtype=np.int64)
             self._l_res = np.array([float(d.config.resolution) for d in self.light])
             self._l_tables = _by_table(self.light)
+            self._l_table_of = _table_of(self._l_tables, len(self.light))
         # distance sensors: the single simulation's plan over one copy's sensors (groups, own-body hits)
         if self.distance:
             bodies = [self.rays.slot_body[s] for s in range(self.R)]
@@ -350,6 +351,7 @@ class BatchedSimulation:
                 self._d_groups.append((g, where))
             self._d_tables = [(table, np.array([self._d_col[id(self._d_plan.devices[i])] for i in idx.tolist()],
                                                dtype=np.int64)) for table, idx in self._d_plan.tables]
+            self._d_table_of = _table_of(self._d_tables, len(self.distance))
         if self.position:
             wheel = []
             for d in self.position:
@@ -513,6 +515,27 @@ class BatchedSimulation:
             return
         dt = dt_ms / 1000.0
         self.pressing[live] = False
+        got = packets.drive_wheels(live, driven, self.target, self.velocity, self.wheel_angle, dt, self.side_wheels,
+                                   self.wheel_radius, self.axle)
+        copies, slots, v, w = got if got is not None else self._drive_wheels(live, driven, dt)
+        if not len(copies):
+            return
+        x0, y0 = self.x[copies, slots], self.y[copies, slots]
+        x, y, yaw = _arc_steps(x0, y0, self.yaw[copies, slots], v, w, dt)
+        self.yaw[copies, slots] = yaw
+        if self.contact is not None:
+            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
+        self.x[copies, slots], self.y[copies, slots] = x, y
+        # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
+        cos, sin = _cos_sin(yaw)
+        rz = np.zeros((len(yaw), 3, 3))
+        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
+        self.rot[copies, slots] = np.matmul(rz, self.base[copies, slots])
+        self.pos[copies, slots] = np.stack([x, y, self.z[copies, slots]], axis=1)
+
+    def _drive_wheels(self, live: np.ndarray, driven: np.ndarray, dt: float):
+        """The wheels and drives of :meth:`_drive` in numpy (packets.drive_wheels' fallback): the
+        wheel angles advanced, and the moving robots' (copies, slots, v, w)."""
         # WheelMotor.advance, element by element the same arithmetic
         tgt = self.target[live][:, driven]
         vel = self.velocity[live][:, driven]
@@ -534,25 +557,12 @@ class BatchedSimulation:
                 wr[:, j] = _side_mean(wr[:, j], int(counts[j, 1]))
         moving = (wl != 0.0) | (wr != 0.0)                      # (live, driven)
         ci, ri = moving.nonzero()
-        if not len(ci):
-            return
         copies, slots = live[ci], driven[ri]
         wl, wr = wl[ci, ri], wr[ci, ri]
         rad, axle = self.wheel_radius[slots], self.axle[slots]
         v = rad * (wl + wr) / 2.0
         w = rad * (wr - wl) / axle
-        x0, y0 = self.x[copies, slots], self.y[copies, slots]
-        x, y, yaw = _arc_steps(x0, y0, self.yaw[copies, slots], v, w, dt)
-        self.yaw[copies, slots] = yaw
-        if self.contact is not None:
-            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
-        self.x[copies, slots], self.y[copies, slots] = x, y
-        # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
-        cos, sin = _cos_sin(yaw)
-        rz = np.zeros((len(yaw), 3, 3))
-        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
-        self.rot[copies, slots] = np.matmul(rz, self.base[copies, slots])
-        self.pos[copies, slots] = np.stack([x, y, self.z[copies, slots]], axis=1)
+        return copies, slots, v, w
 
     def _contact(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray):
         """Contact.resolve_all per copy: robots in slot order, each against the solids and its own
@@ -560,7 +570,6 @@ class BatchedSimulation:
         narrow phase (Contact._clip). Returns the final xy."""
         ct = self.contact
         assert ct is not None
-        k = len(copies)
         out = ends.copy()
         reach = np.hypot(*(ends - starts).T) + EPS
         Rr = self.foot_radius[slots]
@@ -747,8 +756,9 @@ class BatchedSimulation:
             occluded[s, light] = np.isfinite(hits[0].distance)
         e = light_math.irradiance_from_terms(state["att"], state["direct"], self.lights, occluded, self._l_filter[cols])
         values = np.empty(len(cols))
-        for table, members in self._l_tables:
-            sel = np.isin(cols, members).nonzero()[0]
+        table_of = self._l_table_of[cols]
+        for t, (table, _) in enumerate(self._l_tables):
+            sel = (table_of == t).nonzero()[0]
             if not len(sel):
                 continue
             if len(table) == 0:        # an empty table is the identity, without noise (devices.md §1.2)
@@ -846,8 +856,9 @@ class BatchedSimulation:
         # DistancePlan.output: lookup (by table), each sensor's noise, resolution
         values = np.zeros(len(cols))
         full = ~self._d_empty[cols]
-        for table, members in self._d_tables:
-            sel = (np.isin(cols, members) & full).nonzero()[0]
+        table_of = np.where(full, self._d_table_of[cols], -1)
+        for t, (table, _) in enumerate(self._d_tables):
+            sel = (table_of == t).nonzero()[0]
             if not len(sel):
                 continue
             y, nz = table.interpolate(measured[sel])
@@ -997,6 +1008,14 @@ def _by_table(devices: list) -> list[tuple]:
     for k, d in enumerate(devices):
         out.setdefault(d.table, []).append(k)
     return [(t, np.array(v, dtype=np.int64)) for t, v in out.items()]
+
+
+def _table_of(tables: list[tuple], n: int) -> np.ndarray:
+    """(n,) the index in ``tables`` ((table, device columns) pairs) of each column's table (-1: none)."""
+    out = np.full(n, -1, dtype=np.int64)
+    for t, (_, members) in enumerate(tables):
+        out[members] = t
+    return out
 
 
 def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
