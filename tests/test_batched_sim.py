@@ -377,6 +377,35 @@ def test_the_wheels_in_c_turn_as_the_numpy_path_and_meet_closed_form_cases():
     assert v[0] == pytest.approx(r * omega / 2.0, rel=1e-12) and w[0] == pytest.approx(-r * omega / axle, rel=1e-12)
 
 
+def test_the_lidar_beams_in_c_are_the_numpy_paths_and_meet_closed_form_cases():
+    """BatchedSimulation._plan_lidars' beams: packets.lidar_beams (one C pass) gives the origins,
+    directions and float32 directions of the numpy path (batched._lidar_beams), bit for bit, for
+    many scans of many beams, one beam, no scan; a scan turned 90 degrees about z sends the beam
+    (1, 0, 0) along (0, 1, 0) from its origin."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim import batched
+
+    if packets.library() is None:
+        pytest.skip(packets.status())
+    rng = np.random.default_rng(5)
+    for n, W in ((64, 360), (3, 1), (0, 4)):
+        rot = rng.normal(size=(n, 3, 3))
+        org = rng.normal(size=(n, 3))
+        cols = tuple(rng.normal(size=W) for _ in range(3))
+        want = batched._lidar_beams(rot, org, cols)
+        got = packets.lidar_beams(rot, org, cols)
+        assert got is not None
+        for w, g in zip(want, got):
+            assert g.dtype == w.dtype and g.shape == w.shape == (n * W, 3) and g.tobytes() == w.tobytes()
+    rz = np.array([[[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]])
+    got = packets.lidar_beams(rz, np.array([[1.0, 2.0, 3.0]]),
+                              (np.array([1.0, 0.0]), np.array([0.0, 1.0]), np.array([0.0, 0.0])))
+    assert got is not None
+    o, d, d32 = got
+    assert o.tolist() == [[1.0, 2.0, 3.0]] * 2 and d.tolist() == [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]
+    assert d32.tolist() == d.tolist()
+
+
 def test_every_copys_lidar_gets_its_single_world_scan_at_many_poses():
     """The copies' lidar beams go out in one cast traced as the single world traces one lidar
     (coherent packets in FAST: a beam within float32 rounding of an edge gets the same triangle):

@@ -946,3 +946,28 @@ size_t sp_drive_wheels(size_t L, size_t D, size_t R, const int64_t* live, const 
   }
   return k;
 }
+
+/* batched.py's lidar planning: the beams of n scans of one fixed lidar, W beams each -- beam w of
+ * scan i goes from org[i] along rot[i] (x[w], y[w], z[w]) (_rotate_columns, component j being
+ * (x rot[j][0] + y rot[j][1]) + z rot[j][2], the numpy path's sums) -- written as rows i * W + w
+ * of out_org, out_dir (float64) and out_d32 (the directions rounded to float32). */
+void sp_lidar_beams(size_t n, size_t W, const double* rot, const double* org, const double* x, const double* y,
+                    const double* z, double* out_org, double* out_dir, float* out_d32) {
+  for (size_t i = 0; i < n; i++) {
+    const double* R = rot + 9 * i;
+    const double o0 = org[3 * i], o1 = org[3 * i + 1], o2 = org[3 * i + 2];
+    for (size_t w = 0; w < W; w++) {
+      const size_t r = 3 * (i * W + w);
+      for (int j = 0; j < 3; j++) {
+        double acc = x[w] * R[3 * j];
+        acc += y[w] * R[3 * j + 1];
+        acc += z[w] * R[3 * j + 2];
+        out_dir[r + j] = acc;
+        out_d32[r + j] = (float)acc;
+      }
+      out_org[r] = o0;
+      out_org[r + 1] = o1;
+      out_org[r + 2] = o2;
+    }
+  }
+}

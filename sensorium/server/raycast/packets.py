@@ -176,6 +176,8 @@ def _load() -> None:
     lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
     lib.sp_contact_near.restype = sz
     lib.sp_drive_wheels.restype = sz
+    lib.sp_lidar_beams.restype = None
+    lib.sp_lidar_beams.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_drive_wheels.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_contact_near.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp]
     _state["lib"] = lib
@@ -602,3 +604,24 @@ def drive_wheels(live: np.ndarray, driven: np.ndarray, target: np.ndarray, veloc
     p = _small_addresses((live, driven, target, velocity, angle, sides, radius, axle, copies, slots, v, w))
     k = lib.sp_drive_wheels(len(live), len(driven), R, *p[:5], float(dt), *p[5:])
     return copies[:k], slots[:k], v[:k], w[:k]
+
+
+def lidar_beams(rot: np.ndarray, org: np.ndarray, columns) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The beams of n scans of one fixed lidar in one C pass (``sp_lidar_beams``): (origins, directions,
+    directions as float32), (n * W, 3) each, scan i's beam w at row i * W + w; the directions the
+    sums of :meth:`.batched.BatchedSimulation._plan_lidars`' numpy path (``rot`` (n, 3, 3) @ the
+    beam's (x, y, z) in the sensor frame, ``columns`` three (W,) float64 arrays), bit for bit; or
+    None without the helper."""
+    lib = library()
+    if lib is None:
+        return None
+    f64 = np.float64
+    rot = np.ascontiguousarray(rot, dtype=f64)
+    org = np.ascontiguousarray(org, dtype=f64)
+    x, y, z = (np.ascontiguousarray(c, dtype=f64) for c in columns)
+    n, W = len(rot), len(x)
+    if rot.shape != (n, 3, 3) or org.shape != (n, 3) or y.shape != (W,) or z.shape != (W,):
+        raise TypeError("lidar_beams: inconsistent shapes")
+    out_org, out_dir, out_d32 = np.empty((n * W, 3)), np.empty((n * W, 3)), np.empty((n * W, 3), dtype=np.float32)
+    lib.sp_lidar_beams(n, W, *_small_addresses((rot, org, x, y, z, out_org, out_dir, out_d32)))
+    return out_org, out_dir, out_d32

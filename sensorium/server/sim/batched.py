@@ -894,19 +894,13 @@ class BatchedSimulation:
             rr = self.rot[c, slot]
             rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
             org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
-            x, y, z = lid._dir_columns
-            W = len(x)
-            dirs = np.empty((len(c), W, 3))
-            for j in range(3):                                                  # _rotate_columns, stacked
-                acc = x[None, :] * rot[:, j, 0, None]
-                acc += y[None, :] * rot[:, j, 1, None]
-                acc += z[None, :] * rot[:, j, 2, None]
-                dirs[:, :, j] = acc
-            d = dirs.reshape(-1, 3)
+            W = len(lid._dir_columns[0])
+            got = packets.lidar_beams(rot, org, lid._dir_columns)
+            origins, d, d32 = got if got is not None else _lidar_beams(rot, org, lid._dir_columns)
             ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
-            reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
-                              -1, mount, distance_only=True, d32=d.astype(np.float32), coherent=True))
+            reqs.append(_Rays(origins, d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
+                              -1, mount, distance_only=True, d32=d32, coherent=True))
             state["items"].append((col, c))
         return state, reqs
 
@@ -1016,6 +1010,22 @@ def _table_of(tables: list[tuple], n: int) -> np.ndarray:
     for t, (_, members) in enumerate(tables):
         out[members] = t
     return out
+
+
+def _lidar_beams(rot: np.ndarray, org: np.ndarray, columns) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The beams of n scans of one fixed lidar (packets.lidar_beams' numpy path): origins, directions
+    (rot @ each beam's sensor-frame column, _rotate_columns stacked) and the directions as float32,
+    (n * W, 3) each."""
+    x, y, z = columns
+    W = len(x)
+    dirs = np.empty((len(rot), W, 3))
+    for j in range(3):
+        acc = x[None, :] * rot[:, j, 0, None]
+        acc += y[None, :] * rot[:, j, 1, None]
+        acc += z[None, :] * rot[:, j, 2, None]
+        dirs[:, :, j] = acc
+    d = dirs.reshape(-1, 3)
+    return np.repeat(org, W, axis=0), d, d.astype(np.float32)
 
 
 def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
