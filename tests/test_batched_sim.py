@@ -397,6 +397,11 @@ def test_the_lidar_beams_in_c_are_the_numpy_paths_and_meet_closed_form_cases():
         assert got is not None
         for w, g in zip(want, got):
             assert g.dtype == w.dtype and g.shape == w.shape == (n * W, 3) and g.tobytes() == w.tobytes()
+        buffers = tuple(np.full_like(w, np.nan) for w in want)        # written over, as scan after scan
+        again = packets.lidar_beams(rot, org, cols, buffers)
+        assert again is not None and all(a is b and a.tobytes() == w.tobytes() for a, b, w in zip(again, buffers, want))
+    with pytest.raises(TypeError, match="lidar_beams: writes contiguous float32"):
+        packets.lidar_beams(rot, org, cols, (buffers[0], buffers[1], buffers[1]))
     rz = np.array([[[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]])
     got = packets.lidar_beams(rz, np.array([[1.0, 2.0, 3.0]]),
                               (np.array([1.0, 0.0]), np.array([0.0, 1.0]), np.array([0.0, 0.0])))

@@ -606,12 +606,13 @@ def drive_wheels(live: np.ndarray, driven: np.ndarray, target: np.ndarray, veloc
     return copies[:k], slots[:k], v[:k], w[:k]
 
 
-def lidar_beams(rot: np.ndarray, org: np.ndarray, columns) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+def lidar_beams(rot: np.ndarray, org: np.ndarray, columns, out=None) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """The beams of n scans of one fixed lidar in one C pass (``sp_lidar_beams``): (origins, directions,
     directions as float32), (n * W, 3) each, scan i's beam w at row i * W + w; the directions the
     sums of :meth:`.batched.BatchedSimulation._plan_lidars`' numpy path (``rot`` (n, 3, 3) @ the
     beam's (x, y, z) in the sensor frame, ``columns`` three (W,) float64 arrays), bit for bit; or
-    None without the helper."""
+    None without the helper. ``out``: those three arrays to write (scan after scan the same
+    buffers: fresh ones of a 64-copy scan cost more in page faults than the pass itself)."""
     lib = library()
     if lib is None:
         return None
@@ -622,6 +623,11 @@ def lidar_beams(rot: np.ndarray, org: np.ndarray, columns) -> tuple[np.ndarray, 
     n, W = len(rot), len(x)
     if rot.shape != (n, 3, 3) or org.shape != (n, 3) or y.shape != (W,) or z.shape != (W,):
         raise TypeError("lidar_beams: inconsistent shapes")
-    out_org, out_dir, out_d32 = np.empty((n * W, 3)), np.empty((n * W, 3)), np.empty((n * W, 3), dtype=np.float32)
+    if out is None:
+        out = np.empty((n * W, 3)), np.empty((n * W, 3)), np.empty((n * W, 3), dtype=np.float32)
+    out_org, out_dir, out_d32 = out
+    for a, dt_ in ((out_org, f64), (out_dir, f64), (out_d32, np.float32)):
+        if a.dtype != dt_ or a.shape != (n * W, 3) or not a.flags.c_contiguous or not a.flags.writeable:
+            raise TypeError(f"lidar_beams: writes contiguous {np.dtype(dt_)} {(n * W, 3)}, not {a.dtype} {a.shape}")
     lib.sp_lidar_beams(n, W, *_small_addresses((rot, org, x, y, z, out_org, out_dir, out_d32)))
     return out_org, out_dir, out_d32

@@ -323,6 +323,7 @@ class BatchedSimulation:
                 continue
         self._lidar_skips: dict[int, np.ndarray] = {}
         self._lidar_plan: dict[int, tuple] = {}      # per lidar: (copies, each beam's copy, mount slots)
+        self._lidar_beam_rows: dict[int, tuple] = {}  # per lidar: its beams' buffers (origins, directions, float32)
         self.range_images = [np.zeros((C, d.config.number_of_layers, d.config.horizontal_resolution), dtype=np.float32)
                              for d in self.lidar]
         # light sensors: constants stacked once
@@ -895,7 +896,7 @@ class BatchedSimulation:
             rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
             org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
             W = len(lid._dir_columns[0])
-            got = packets.lidar_beams(rot, org, lid._dir_columns)
+            got = packets.lidar_beams(rot, org, lid._dir_columns, self._lidar_buffers(col, len(c) * W))
             origins, d, d32 = got if got is not None else _lidar_beams(rot, org, lid._dir_columns)
             ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
@@ -903,6 +904,15 @@ class BatchedSimulation:
                               -1, mount, distance_only=True, d32=d32, coherent=True))
             state["items"].append((col, c))
         return state, reqs
+
+    def _lidar_buffers(self, col: int, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The beam origins, directions and float32 directions of lidar ``col``'s scans this step,
+        written over the last step's (each step's rays are cast and finished within the step)."""
+        got = self._lidar_beam_rows.get(col)
+        if got is None or len(got[0]) != rows:
+            got = self._lidar_beam_rows[col] = (np.empty((rows, 3)), np.empty((rows, 3)),
+                                                np.empty((rows, 3), dtype=np.float32))
+        return got
 
     def _lidar_rows(self, col: int, copies: np.ndarray, W: int) -> tuple[np.ndarray, np.ndarray | int]:
         """Per beam of the scans of ``copies``: its copy, and its mount slot (a lidar with own
