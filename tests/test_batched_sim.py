@@ -269,6 +269,148 @@ def test_the_broad_phase_in_c_lists_the_numpy_pairs_and_meets_closed_form_cases(
             assert got[1].tolist() == [int(cp[0])] * len(rays)
 
 
+def test_the_contact_broad_phase_in_c_finds_the_numpy_candidates_and_meets_closed_form_cases():
+    """BatchedSimulation._contact's broad phase: packets.contact_near (one C pass) flags exactly the
+    solids, robots and near moves of the numpy path (_contact_near) for many copies' moves at
+    random places (some robots without a footprint, some not moving); and a robot is a candidate
+    of another exactly when their boxes grown by both reaches and radii overlap."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.contact import EPS
+
+    if packets.library() is None:
+        pytest.skip(packets.status())
+    C = 40
+    bs = BatchedSimulation(arena(2), C, precision="fast")
+    ct = bs.contact
+    assert ct is not None and len(ct._obs) > 0 and bs.R == 2
+    rng = np.random.default_rng(7)
+    seen_near: set[bool] = set()
+    for trial in range(6):
+        bs.centres[:, 0] = rng.uniform(-1.2, 1.2, (C, 2))
+        bs.centres[:, 1] = bs.centres[:, 0] + rng.uniform(-0.3, 0.3, (C, 2))
+        copies = np.repeat(np.arange(C), 2)
+        slots = np.tile(np.arange(2), C)
+        keep = rng.random(len(copies)) < 0.8
+        copies, slots = copies[keep], slots[keep]
+        starts = bs.centres[copies, slots].copy()
+        step = rng.normal(scale=0.05 * (trial + 1), size=starts.shape)
+        reach = np.hypot(*step.T) + EPS
+        foot = bs.foot_radius.copy()
+        if trial == 5:                                   # a robot without a footprint hits and is hit by nothing
+            bs.foot_radius[1] = math.nan
+        band_lo = bs.heights[copies, slots] + bs.foot_low[slots]
+        band_hi = bs.heights[copies, slots] + bs.foot_high[slots]
+        grow = np.zeros((C, 2))
+        grow[copies, slots] = reach
+        want = bs._contact_near(copies, slots, starts, reach, band_lo, band_hi, grow)
+        got = packets.contact_near(copies, slots, starts, reach, bs.foot_radius, bs.foot_low, bs.foot_high,
+                                   bs.heights, bs.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS)
+        bs.foot_radius[:] = foot
+        assert got is not None and want[0] is not None and want[1] is not None
+        for w, g in zip(want, got):
+            assert g.dtype == np.bool_ and g.tobytes() == w.tobytes(), trial
+        assert want[1].any() == (trial < 5)
+        seen_near.update(want[2].tolist())
+    assert seen_near == {False, True}
+    # closed form: in copy 0 the two robots dx apart on y = 0, only robot 0 moving (reach q): a
+    # candidate when dx <= q + r0 + r1 (its box grown by reach and its radius meets the other's disc)
+    r0, r1 = float(bs.foot_radius[0]), float(bs.foot_radius[1])
+    q = 0.01
+    for dx, expect in ((q + r0 + r1 - 1e-6, True), (q + r0 + r1 + 1e-6, False)):
+        bs.centres[0] = [[0.0, 0.0], [dx, 0.0]]
+        bs.heights[0] = bs.heights[0, 0]
+        grow = np.zeros((C, 2))
+        grow[0, 0] = q
+        args = (np.array([0]), np.array([0]), np.zeros((1, 2)), np.array([q]))
+        got = packets.contact_near(*args, bs.foot_radius, bs.foot_low, bs.foot_high, bs.heights, bs.centres, grow,
+                                   np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), EPS)
+        assert got is not None
+        assert got[1].tolist() == [[False, expect]] and got[2].tolist() == [expect]
+
+
+def test_the_wheels_in_c_turn_as_the_numpy_path_and_meet_closed_form_cases():
+    """BatchedSimulation._drive's wheels and drives: packets.drive_wheels (one C pass) advances the
+    wheel angles and gives the moving robots' copies, slots and speeds of the numpy path
+    (_drive_wheels), bit for bit, for velocity and position control (targets reached, passed,
+    NaN), still wheels, skid-steer sides and dt = 0; a wheel 0.1 rad from its target at 5 rad/s
+    turns 0.1 / dt rad/s and stops on it."""
+    from sensorium.server.raycast import packets
+
+    if packets.library() is None:
+        pytest.skip(packets.status())
+    C = 30
+    bs = BatchedSimulation(arena(3), C, precision="fast")
+    rng = np.random.default_rng(11)
+    live = np.array(sorted(rng.choice(C, 24, replace=False)))
+    driven = bs.has_drive.nonzero()[0]
+    assert len(driven) == 2
+    for trial, dt in enumerate((0.032, 0.032, 0.0, 0.016)):
+        bs.velocity[:] = rng.uniform(-6.0, 6.0, (C, bs.R, 2)) * (rng.random((C, bs.R, 2)) < 0.8)
+        bs.wheel_angle[:] = rng.uniform(-3.0, 3.0, (C, bs.R, 2))
+        bs.target[:] = np.where(rng.random((C, bs.R, 2)) < 0.5, math.inf,
+                                bs.wheel_angle + rng.uniform(-0.3, 0.3, (C, bs.R, 2)))
+        bs.target[::5, :, 1] = bs.wheel_angle[::5, :, 1]              # on target: still
+        bs.target[1, :, 0] = math.nan
+        bs.velocity[::3], bs.target[::3] = 0.0, math.inf                  # still robots
+        bs.side_wheels[:] = [[2, 3], [1, 1]] if trial % 2 else [[1, 1], [1, 1]]
+        start = bs.wheel_angle.copy()
+        want = bs._drive_wheels(live, driven, dt)
+        want_angle, bs.wheel_angle[:] = bs.wheel_angle.copy(), start
+        got = packets.drive_wheels(live, driven, bs.target, bs.velocity, bs.wheel_angle, dt, bs.side_wheels,
+                                   bs.wheel_radius, bs.axle)
+        assert got is not None
+        assert bs.wheel_angle.tobytes() == want_angle.tobytes(), trial
+        for w, g in zip(want, got):
+            assert g.dtype == w.dtype and g.tobytes() == w.tobytes(), trial
+        assert 0 < len(got[0]) < len(live) * len(driven) or dt == 0.0
+    # closed form: the left wheel of copy 0's first driven slot 0.1 rad short of its target at 5 rad/s
+    s = int(driven[0])
+    bs.side_wheels[:] = 1
+    bs.wheel_angle[0, s] = [1.0, 0.0]
+    bs.target[0, s] = [1.1, math.inf]
+    bs.velocity[0, s] = [5.0, 0.0]
+    copies, slots, v, w = packets.drive_wheels(np.array([0]), np.array([s]), bs.target, bs.velocity, bs.wheel_angle,
+                                               0.032, bs.side_wheels, bs.wheel_radius, bs.axle)
+    omega = (1.1 - 1.0) / 0.032
+    assert copies.tolist() == [0] and slots.tolist() == [s] and bs.wheel_angle[0, s, 0] == pytest.approx(1.1, abs=1e-15)
+    r, axle = float(bs.wheel_radius[s]), float(bs.axle[s])
+    assert v[0] == pytest.approx(r * omega / 2.0, rel=1e-12) and w[0] == pytest.approx(-r * omega / axle, rel=1e-12)
+
+
+def test_the_lidar_beams_in_c_are_the_numpy_paths_and_meet_closed_form_cases():
+    """BatchedSimulation._plan_lidars' beams: packets.lidar_beams (one C pass) gives the origins,
+    directions and float32 directions of the numpy path (batched._lidar_beams), bit for bit, for
+    many scans of many beams, one beam, no scan; a scan turned 90 degrees about z sends the beam
+    (1, 0, 0) along (0, 1, 0) from its origin."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim import batched
+
+    if packets.library() is None:
+        pytest.skip(packets.status())
+    rng = np.random.default_rng(5)
+    for n, W in ((64, 360), (3, 1), (0, 4)):
+        rot = rng.normal(size=(n, 3, 3))
+        org = rng.normal(size=(n, 3))
+        cols = tuple(rng.normal(size=W) for _ in range(3))
+        want = batched._lidar_beams(rot, org, cols)
+        got = packets.lidar_beams(rot, org, cols)
+        assert got is not None
+        for w, g in zip(want, got):
+            assert g.dtype == w.dtype and g.shape == w.shape == (n * W, 3) and g.tobytes() == w.tobytes()
+        buffers = tuple(np.full_like(w, np.nan) for w in want)        # written over, as scan after scan
+        again = packets.lidar_beams(rot, org, cols, buffers)
+        assert again is not None and all(a is b and a.tobytes() == w.tobytes() for a, b, w in zip(again, buffers, want))
+    with pytest.raises(TypeError, match="lidar_beams: writes contiguous float32"):
+        packets.lidar_beams(rot, org, cols, (buffers[0], buffers[1], buffers[1]))
+    rz = np.array([[[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]])
+    got = packets.lidar_beams(rz, np.array([[1.0, 2.0, 3.0]]),
+                              (np.array([1.0, 0.0]), np.array([0.0, 1.0]), np.array([0.0, 0.0])))
+    assert got is not None
+    o, d, d32 = got
+    assert o.tolist() == [[1.0, 2.0, 3.0]] * 2 and d.tolist() == [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]
+    assert d32.tolist() == d.tolist()
+
+
 def test_every_copys_lidar_gets_its_single_world_scan_at_many_poses():
     """The copies' lidar beams go out in one cast traced as the single world traces one lidar
     (coherent packets in FAST: a beam within float32 rounding of an edge gets the same triangle):

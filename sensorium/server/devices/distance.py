@@ -40,6 +40,9 @@ class DistanceSensorType(IntEnum):
 
 
 SENSOR_TYPES = {"generic": 0, "infra-red": 1, "sonar": 2, "laser": 3}
+_LAST_TYPE = int(max(DistanceSensorType))          # the types are 0 ... _LAST_TYPE, every one known
+_LASER, _SONAR, _INFRA_RED = (int(t) for t in (DistanceSensorType.LASER, DistanceSensorType.SONAR,
+                                               DistanceSensorType.INFRA_RED))
 
 SONAR_MAX_INCIDENCE = 0.392699082
 """A sonar echo counts only when the incidence angle is below this (π/8, as Webots writes it)."""
@@ -154,19 +157,19 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
     r_or_max = np.where(hit, r, rmax)
     w = np.broadcast_to(np.asarray(weights, dtype=np.float64), (S, N))
     types = np.broadcast_to(np.asarray(sensor_type, dtype=np.int64), (S,))
-    known = np.isin(types, [int(t) for t in DistanceSensorType])
-    if not np.all(known):
+    known = (types >= 0) & (types <= _LAST_TYPE)
+    if not known.all():
         raise ValueError(f"unknown sensor type(s) {np.unique(types[~known]).tolist()}")
     out = np.empty(S)
 
     average = np.einsum("sn,sn->s", w, r_or_max)
     out[:] = average  # generic
 
-    m = types == DistanceSensorType.LASER
+    m = types == _LASER
     if np.any(m):
         out[m] = r_or_max[m, 0]
 
-    m = types == DistanceSensorType.SONAR
+    m = types == _SONAR
     if np.any(m):
         u = np.asarray(directions, dtype=np.float64).reshape(S, N, 3)[m]
         nrm = np.asarray(normals, dtype=np.float64).reshape(S, N, 3)[m]
@@ -174,7 +177,7 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
         echo = hit[m] & (beta < SONAR_MAX_INCIDENCE)
         out[m] = np.minimum(np.where(echo, r[m], np.inf).min(axis=1), rmax[m, 0])
 
-    m = types == DistanceSensorType.INFRA_RED
+    m = types == _INFRA_RED
     if np.any(m):
         f = np.ones((S, N)) if reflection is None else np.asarray(reflection, dtype=np.float64).reshape(S, N)
         factor = np.einsum("sn,sn->s", w, np.where(hit, f, 1.0))[m]

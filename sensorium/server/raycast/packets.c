@@ -844,3 +844,130 @@ size_t sp_inside_shells(size_t m, const double* O, size_t o_stride, const double
   }
   return k;
 }
+
+/* batched.py's contact broad phase (Contact.resolve_all's, for the moving robots of many copies):
+ * move m (robot slot slots[m] of copy copies[m], from starts[m] (xy) with reach[m] = |end - start|
+ * + EPS) against every solid j (its xy box lo/hi (S, 2), its z range zlo/zhi) and every other slot
+ * j of its own copy (centre centres[copy][j] (C, R, 2) before the step, radius foot_radius[j] grown
+ * by grow[copy][j] (C, R): that robot's own reach when it moves this step, else 0), each within
+ * the height band (heights (C, R) + foot_low/foot_high (R)) -- the numpy path's comparisons,
+ * operation for operation (EPS = eps). Writes solid_hit (k, S) and robot_hit (k, R) (0/1; a move
+ * never hits its own slot) and near[m] (any hit); returns the number of near moves. A NaN radius
+ * (a robot without a footprint) hits nothing, as there. */
+size_t sp_contact_near(size_t k, size_t R, size_t S, const int64_t* copies, const int64_t* slots,
+                       const double* starts, const double* reach, const double* foot_radius,
+                       const double* foot_low, const double* foot_high, const double* heights,
+                       const double* centres, const double* grow, const double* lo, const double* hi,
+                       const double* zlo, const double* zhi, double eps, uint8_t* solid_hit,
+                       uint8_t* robot_hit, uint8_t* near) {
+  size_t count = 0;
+  for (size_t m = 0; m < k; m++) {
+    const int64_t c = copies[m], s = slots[m];
+    const double grown = reach[m] + foot_radius[s];
+    const double bl0 = starts[2 * m] - grown, bl1 = starts[2 * m + 1] - grown;
+    const double bh0 = starts[2 * m] + grown, bh1 = starts[2 * m + 1] + grown;
+    const double h = heights[(size_t)c * R + (size_t)s];
+    const double band_lo = h + foot_low[s], band_hi = h + foot_high[s];
+    const double z_above = band_lo + eps, z_below = band_hi - eps;
+    int any = 0;
+    uint8_t* sh = solid_hit + m * S;
+    for (size_t j = 0; j < S; j++) {
+      const int in = lo[2 * j] <= bh0 && lo[2 * j + 1] <= bh1 && hi[2 * j] >= bl0 && hi[2 * j + 1] >= bl1
+                     && zhi[j] > z_above && zlo[j] < z_below;
+      sh[j] = (uint8_t)in;
+      any |= in;
+    }
+    if (R > 1) {
+      uint8_t* rh = robot_hit + m * R;
+      const double* cc = centres + 2 * (size_t)c * R;
+      const double* hc = heights + (size_t)c * R;
+      const double* gc = grow + (size_t)c * R;
+      for (size_t j = 0; j < R; j++) {
+        const double r_all = foot_radius[j] + gc[j];
+        const double x = cc[2 * j], y = cc[2 * j + 1];
+        const int in = (int64_t)j != s && x + r_all >= bl0 && x - r_all <= bh0 && y + r_all >= bl1
+                       && y - r_all <= bh1 && hc[j] + foot_high[j] > z_above && hc[j] + foot_low[j] < z_below;
+        rh[j] = (uint8_t)in;
+        any |= in;
+      }
+    }
+    near[m] = (uint8_t)any;
+    count += (size_t)any;
+  }
+  return count;
+}
+
+/* batched.py's wheels and drives of one basic step, for every driven slot driven[d] (d < D) of
+ * every live copy live[l] (l < L): WheelMotor.advance of its left and right wheel (target,
+ * velocity, angle: (C, R, 2); the angle advanced in place), DifferentialDrive.step's side means
+ * (for a slot with a side of several equal wheels, each side 0 + w + ... + w (its count times),
+ * then / count) and its speeds v = r (wl + wr) / 2, w = r (wr - wl) / axle -- the numpy path's
+ * operations, element for element (np.minimum's NaN). The moving robots (a side turning), copy
+ * by copy and slot by slot: their copy, slot, v and w into out_*; returns their number. */
+size_t sp_drive_wheels(size_t L, size_t D, size_t R, const int64_t* live, const int64_t* driven,
+                       const double* target, const double* velocity, double* angle, double dt,
+                       const int64_t* sides, const double* radius, const double* axle, int64_t* out_copy,
+                       int64_t* out_slot, double* out_v, double* out_w) {
+  size_t k = 0;
+  for (size_t l = 0; l < L; l++) {
+    const int64_t c = live[l];
+    for (size_t d = 0; d < D; d++) {
+      const int64_t s = driven[d];
+      const size_t at = ((size_t)c * R + (size_t)s) * 2;
+      const int skid = sides[2 * s] > 1 || sides[2 * s + 1] > 1;
+      double om[2];
+      for (int side = 0; side < 2; side++) {
+        const double tgt = target[at + side], vel = velocity[at + side], ang = angle[at + side];
+        double o;
+        if (isinf(tgt)) {
+          o = vel;
+        } else {
+          const double remaining = tgt - ang;
+          const double speed = dt > 0 ? np_min(fabs(vel), fabs(remaining) / dt) : 0.0;
+          o = remaining != 0.0 ? copysign(speed, remaining) : 0.0;
+        }
+        angle[at + side] = ang + o * dt;
+        if (skid) {
+          const int64_t n = sides[2 * s + side];
+          double acc = 0.0 + o;
+          for (int64_t i = 1; i < n; i++) acc = acc + o;
+          o = acc / (double)n;
+        }
+        om[side] = o;
+      }
+      if (om[0] != 0.0 || om[1] != 0.0) {
+        out_copy[k] = c;
+        out_slot[k] = s;
+        out_v[k] = radius[s] * (om[0] + om[1]) / 2.0;
+        out_w[k] = radius[s] * (om[1] - om[0]) / axle[s];
+        k++;
+      }
+    }
+  }
+  return k;
+}
+
+/* batched.py's lidar planning: the beams of n scans of one fixed lidar, W beams each -- beam w of
+ * scan i goes from org[i] along rot[i] (x[w], y[w], z[w]) (_rotate_columns, component j being
+ * (x rot[j][0] + y rot[j][1]) + z rot[j][2], the numpy path's sums) -- written as rows i * W + w
+ * of out_org, out_dir (float64) and out_d32 (the directions rounded to float32). */
+void sp_lidar_beams(size_t n, size_t W, const double* rot, const double* org, const double* x, const double* y,
+                    const double* z, double* out_org, double* out_dir, float* out_d32) {
+  for (size_t i = 0; i < n; i++) {
+    const double* R = rot + 9 * i;
+    const double o0 = org[3 * i], o1 = org[3 * i + 1], o2 = org[3 * i + 2];
+    for (size_t w = 0; w < W; w++) {
+      const size_t r = 3 * (i * W + w);
+      for (int j = 0; j < 3; j++) {
+        double acc = x[w] * R[3 * j];
+        acc += y[w] * R[3 * j + 1];
+        acc += z[w] * R[3 * j + 2];
+        out_dir[r + j] = acc;
+        out_d32[r + j] = (float)acc;
+      }
+      out_org[r] = o0;
+      out_org[r + 1] = o1;
+      out_org[r + 2] = o2;
+    }
+  }
+}

@@ -174,6 +174,12 @@ def _load() -> None:
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
     lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
+    lib.sp_contact_near.restype = sz
+    lib.sp_drive_wheels.restype = sz
+    lib.sp_lidar_beams.restype = None
+    lib.sp_lidar_beams.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_drive_wheels.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_contact_near.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp]
     _state["lib"] = lib
     _state["embree"] = embree
 
@@ -485,10 +491,12 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
     out_ray = np.empty(n * R, dtype=i64)
     out_body = np.empty(n * R, dtype=i64)
-    k = lib.sp_copy_pairs(n, R, O.ctypes.data, D.ctypes.data, copy.ctypes.data, centre.ctypes.data, r2.ctypes.data,
-                          present.ctypes.data, _ptr(lo_a), 0.0 if lo_a is not None else float(lo), lim.ctypes.data,
-                          _ptr(ex_a), 0 if ex_a is not None else int(excl), _ptr(mn_a),
-                          0 if mn_a is not None else int(mount), out_ray.ctypes.data, out_body.ctypes.data)
+    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_lim, p_ray, p_body = _small_addresses(
+        (O, D, copy, centre, r2, present, lim, out_ray, out_body))
+    k = lib.sp_copy_pairs(n, R, p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
+                          0.0 if lo_a is not None else float(lo), p_lim, _ptr(ex_a),
+                          0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
+                          p_ray, p_body)
     return out_ray[:k], out_body[:k]
 
 
@@ -515,8 +523,111 @@ def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: 
         ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
     out_row = np.empty(m * len(ks), dtype=i64)
     out_slot = np.empty(m * len(ks), dtype=i64)
-    k = lib.sp_inside_shells(m, O.ctypes.data, o_stride, D.ctypes.data, _ptr(lo_a),
-                             0.0 if lo_a is not None else float(lo), len(ks), ks.ctypes.data,
-                             *(a.ctypes.data for a in arrays), 1 if bound_first else 0, out_row.ctypes.data,
-                             out_slot.ctypes.data)
+    p = _small_addresses([O, D, ks, *arrays, out_row, out_slot])
+    k = lib.sp_inside_shells(m, p[0], o_stride, p[1], _ptr(lo_a), 0.0 if lo_a is not None else float(lo), len(ks),
+                             p[2], *p[3:9], 1 if bound_first else 0, p[9], p[10])
     return out_row[:k], out_slot[:k]
+
+
+def _small_addresses(arrays) -> list[int]:
+    """The data addresses of the small arrays a batched pass reads and writes, step after step:
+    ``a.ctypes.data`` costs ~3 us an array, a ctypes view of an array owning its writable buffer
+    ~1 us. Views (a broadcast view would warn on a writable export), read-only and empty arrays
+    take the first way."""
+    out = []
+    for a in arrays:
+        if a.flags.owndata:
+            try:
+                out.append(ctypes.addressof(_BYTE.from_buffer(a)))
+                continue
+            except (TypeError, ValueError, BufferError):
+                pass
+        out.append(a.ctypes.data)
+    return out
+
+
+_BYTE = ctypes.c_char
+
+
+def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reach: np.ndarray,
+                 foot_radius: np.ndarray, foot_low: np.ndarray, foot_high: np.ndarray, heights: np.ndarray,
+                 centres: np.ndarray, grow: np.ndarray, lo: np.ndarray, hi: np.ndarray, zlo: np.ndarray,
+                 zhi: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The contact broad phase of :meth:`.batched.BatchedSimulation._contact` in one C pass
+    (``sp_contact_near``): (solid_hit (k, S), robot_hit (k, R), near (k,)) as bool arrays, the
+    numpy path's comparisons; or None without the helper. Move m is slot ``slots[m]`` of copy
+    ``copies[m]`` leaving ``starts[m]`` with ``reach[m]``; ``heights``/``grow`` (C, R),
+    ``centres`` (C, R, 2); solids: ``lo``/``hi`` (S, 2), ``zlo``/``zhi`` (S,)."""
+    lib = library()
+    if lib is None:
+        return None
+    k, R, S = len(copies), len(foot_radius), len(zlo)
+    f64, i64 = np.float64, np.int64
+    args = [np.ascontiguousarray(a, dtype=dt) for a, dt in (
+        (copies, i64), (slots, i64), (starts, f64), (reach, f64), (foot_radius, f64), (foot_low, f64),
+        (foot_high, f64), (heights, f64), (centres, f64), (grow, f64), (lo, f64), (hi, f64), (zlo, f64), (zhi, f64))]
+    if args[2].shape != (k, 2) or args[8].shape != args[7].shape + (2,) or args[7].shape[1:] != (R,) \
+            or args[9].shape != args[7].shape or args[10].shape != (S, 2) or args[11].shape != (S, 2):
+        raise TypeError("contact_near: inconsistent shapes")
+    solid_hit = np.empty((k, S), dtype=np.bool_)
+    robot_hit = np.zeros((k, R), dtype=np.bool_)
+    near = np.empty(k, dtype=np.bool_)
+    p = _small_addresses(args + [solid_hit, robot_hit, near])
+    lib.sp_contact_near(k, R, S, *p[:14], float(eps), *p[14:])
+    return solid_hit, robot_hit, near
+
+
+def drive_wheels(live: np.ndarray, driven: np.ndarray, target: np.ndarray, velocity: np.ndarray,
+                 angle: np.ndarray, dt: float, sides: np.ndarray, radius: np.ndarray, axle: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """The wheels and drives of :meth:`.batched.BatchedSimulation._drive` in one C pass
+    (``sp_drive_wheels``): every live copy's driven slots' wheel motors advanced (``angle`` (C, R, 2)
+    written in place), and the moving robots' (copies, slots, v, w) in the numpy path's order and
+    bits; or None without the helper (nothing written). ``target``/``velocity``/``angle`` (C, R, 2),
+    ``sides`` (R, 2) wheels per side, ``radius``/``axle`` (R,)."""
+    lib = library()
+    if lib is None:
+        return None
+    f64, i64 = np.float64, np.int64
+    C, R = angle.shape[:2]
+    for a, dt_, shape in ((target, f64, (C, R, 2)), (velocity, f64, (C, R, 2)), (angle, f64, (C, R, 2)),
+                          (sides, i64, (R, 2)), (radius, f64, (R,)), (axle, f64, (R,))):
+        if a.dtype != dt_ or a.shape != shape or not a.flags.c_contiguous:
+            raise TypeError(f"drive_wheels: {a.dtype} {a.shape} where it reads contiguous {np.dtype(dt_)} {shape}")
+    if not angle.flags.writeable:
+        raise TypeError("drive_wheels: the wheel angles must be writable")
+    live = np.ascontiguousarray(live, dtype=i64)
+    driven = np.ascontiguousarray(driven, dtype=i64)
+    n = len(live) * len(driven)
+    copies, slots = np.empty(n, dtype=i64), np.empty(n, dtype=i64)
+    v, w = np.empty(n), np.empty(n)
+    p = _small_addresses((live, driven, target, velocity, angle, sides, radius, axle, copies, slots, v, w))
+    k = lib.sp_drive_wheels(len(live), len(driven), R, *p[:5], float(dt), *p[5:])
+    return copies[:k], slots[:k], v[:k], w[:k]
+
+
+def lidar_beams(rot: np.ndarray, org: np.ndarray, columns, out=None) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The beams of n scans of one fixed lidar in one C pass (``sp_lidar_beams``): (origins, directions,
+    directions as float32), (n * W, 3) each, scan i's beam w at row i * W + w; the directions the
+    sums of :meth:`.batched.BatchedSimulation._plan_lidars`' numpy path (``rot`` (n, 3, 3) @ the
+    beam's (x, y, z) in the sensor frame, ``columns`` three (W,) float64 arrays), bit for bit; or
+    None without the helper. ``out``: those three arrays to write (scan after scan the same
+    buffers: fresh ones of a 64-copy scan cost more in page faults than the pass itself)."""
+    lib = library()
+    if lib is None:
+        return None
+    f64 = np.float64
+    rot = np.ascontiguousarray(rot, dtype=f64)
+    org = np.ascontiguousarray(org, dtype=f64)
+    x, y, z = (np.ascontiguousarray(c, dtype=f64) for c in columns)
+    n, W = len(rot), len(x)
+    if rot.shape != (n, 3, 3) or org.shape != (n, 3) or y.shape != (W,) or z.shape != (W,):
+        raise TypeError("lidar_beams: inconsistent shapes")
+    if out is None:
+        out = np.empty((n * W, 3)), np.empty((n * W, 3)), np.empty((n * W, 3), dtype=np.float32)
+    out_org, out_dir, out_d32 = out
+    for a, dt_ in ((out_org, f64), (out_dir, f64), (out_d32, np.float32)):
+        if a.dtype != dt_ or a.shape != (n * W, 3) or not a.flags.c_contiguous or not a.flags.writeable:
+            raise TypeError(f"lidar_beams: writes contiguous {np.dtype(dt_)} {(n * W, 3)}, not {a.dtype} {a.shape}")
+    lib.sp_lidar_beams(n, W, *_small_addresses((rot, org, x, y, z, out_org, out_dir, out_d32)))
+    return out_org, out_dir, out_d32

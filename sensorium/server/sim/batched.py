@@ -41,6 +41,7 @@ from sensorium.server.devices import lidar as lmath
 from sensorium.server.devices import light as light_math
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.devices.noise import device_rng
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
@@ -322,6 +323,7 @@ class BatchedSimulation:
                 continue
         self._lidar_skips: dict[int, np.ndarray] = {}
         self._lidar_plan: dict[int, tuple] = {}      # per lidar: (copies, each beam's copy, mount slots)
+        self._lidar_beam_rows: dict[int, tuple] = {}  # per lidar: its beams' buffers (origins, directions, float32)
         self.range_images = [np.zeros((C, d.config.number_of_layers, d.config.horizontal_resolution), dtype=np.float32)
                              for d in self.lidar]
         # light sensors: constants stacked once
@@ -334,6 +336,7 @@ class BatchedSimulation:
             self._l_excl = np.array([d.exclude_self() for d in self.light], dtype=np.int64)
             self._l_res = np.array([float(d.config.resolution) for d in self.light])
             self._l_tables = _by_table(self.light)
+            self._l_table_of = _table_of(self._l_tables, len(self.light))
         # distance sensors: the single simulation's plan over one copy's sensors (groups, own-body hits)
         if self.distance:
             bodies = [self.rays.slot_body[s] for s in range(self.R)]
@@ -349,6 +352,7 @@ class BatchedSimulation:
                 self._d_groups.append((g, where))
             self._d_tables = [(table, np.array([self._d_col[id(self._d_plan.devices[i])] for i in idx.tolist()],
                                                dtype=np.int64)) for table, idx in self._d_plan.tables]
+            self._d_table_of = _table_of(self._d_tables, len(self.distance))
         if self.position:
             wheel = []
             for d in self.position:
@@ -512,6 +516,27 @@ class BatchedSimulation:
             return
         dt = dt_ms / 1000.0
         self.pressing[live] = False
+        got = packets.drive_wheels(live, driven, self.target, self.velocity, self.wheel_angle, dt, self.side_wheels,
+                                   self.wheel_radius, self.axle)
+        copies, slots, v, w = got if got is not None else self._drive_wheels(live, driven, dt)
+        if not len(copies):
+            return
+        x0, y0 = self.x[copies, slots], self.y[copies, slots]
+        x, y, yaw = _arc_steps(x0, y0, self.yaw[copies, slots], v, w, dt)
+        self.yaw[copies, slots] = yaw
+        if self.contact is not None:
+            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
+        self.x[copies, slots], self.y[copies, slots] = x, y
+        # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
+        cos, sin = _cos_sin(yaw)
+        rz = np.zeros((len(yaw), 3, 3))
+        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
+        self.rot[copies, slots] = np.matmul(rz, self.base[copies, slots])
+        self.pos[copies, slots] = np.stack([x, y, self.z[copies, slots]], axis=1)
+
+    def _drive_wheels(self, live: np.ndarray, driven: np.ndarray, dt: float):
+        """The wheels and drives of :meth:`_drive` in numpy (packets.drive_wheels' fallback): the
+        wheel angles advanced, and the moving robots' (copies, slots, v, w)."""
         # WheelMotor.advance, element by element the same arithmetic
         tgt = self.target[live][:, driven]
         vel = self.velocity[live][:, driven]
@@ -533,25 +558,12 @@ class BatchedSimulation:
                 wr[:, j] = _side_mean(wr[:, j], int(counts[j, 1]))
         moving = (wl != 0.0) | (wr != 0.0)                      # (live, driven)
         ci, ri = moving.nonzero()
-        if not len(ci):
-            return
         copies, slots = live[ci], driven[ri]
         wl, wr = wl[ci, ri], wr[ci, ri]
         rad, axle = self.wheel_radius[slots], self.axle[slots]
         v = rad * (wl + wr) / 2.0
         w = rad * (wr - wl) / axle
-        x0, y0 = self.x[copies, slots], self.y[copies, slots]
-        x, y, yaw = _arc_steps(x0, y0, self.yaw[copies, slots], v, w, dt)
-        self.yaw[copies, slots] = yaw
-        if self.contact is not None:
-            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
-        self.x[copies, slots], self.y[copies, slots] = x, y
-        # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
-        cos, sin = _cos_sin(yaw)
-        rz = np.zeros((len(yaw), 3, 3))
-        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
-        self.rot[copies, slots] = np.matmul(rz, self.base[copies, slots])
-        self.pos[copies, slots] = np.stack([x, y, self.z[copies, slots]], axis=1)
+        return copies, slots, v, w
 
     def _contact(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray):
         """Contact.resolve_all per copy: robots in slot order, each against the solids and its own
@@ -559,34 +571,28 @@ class BatchedSimulation:
         narrow phase (Contact._clip). Returns the final xy."""
         ct = self.contact
         assert ct is not None
-        k = len(copies)
         out = ends.copy()
         reach = np.hypot(*(ends - starts).T) + EPS
         Rr = self.foot_radius[slots]
-        box_lo = starts - (reach + Rr)[:, None]
-        box_hi = starts + (reach + Rr)[:, None]
         band_lo = self.heights[copies, slots] + self.foot_low[slots]
         band_hi = self.heights[copies, slots] + self.foot_high[slots]
-        solid_hit = robot_hit = None
-        near = np.zeros(k, dtype=bool)
-        if len(ct._obs):
-            solid_hit = (np.all((ct._lo[None] <= box_hi[:, None]) & (ct._hi[None] >= box_lo[:, None]), axis=2)
-                         & (ct._zhi[None] > band_lo[:, None] + EPS) & (ct._zlo[None] < band_hi[:, None] - EPS))
-            near |= solid_hit.any(axis=1)
-        if self.R > 1:
-            grow = np.zeros((self.copies, self.R))
-            grow[copies, slots] = reach
-            c = self.centres[copies]                                            # (k, R, 2): before this step
-            r_all = self.foot_radius[None, :] + grow[copies]                     # (k, R)
-            a_lo = self.heights[copies] + self.foot_low[None, :]
-            a_hi = self.heights[copies] + self.foot_high[None, :]
-            with np.errstate(invalid="ignore"):
-                robot_hit = ((c[:, :, 0] + r_all >= box_lo[:, None, 0]) & (c[:, :, 0] - r_all <= box_hi[:, None, 0])
-                             & (c[:, :, 1] + r_all >= box_lo[:, None, 1]) & (c[:, :, 1] - r_all <= box_hi[:, None, 1])
-                             & (a_hi > band_lo[:, None] + EPS) & (a_lo < band_hi[:, None] - EPS))
-            robot_hit[np.arange(k), slots] = False
-            near |= robot_hit.any(axis=1)
+        # where every robot may be during this step: its disc, grown by its own move if it moves
+        grow = np.zeros((self.copies, self.R))
+        grow[copies, slots] = reach
+        native = packets.contact_near(copies, slots, starts, reach, self.foot_radius, self.foot_low, self.foot_high,
+                                      self.heights, self.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS)
+        if native is not None:
+            solid_hit, robot_hit, near = native
+            solid_hit = solid_hit if len(ct._obs) else None
+            robot_hit = robot_hit if self.R > 1 else None
+        else:
+            solid_hit, robot_hit, near = self._contact_near(copies, slots, starts, reach, band_lo, band_hi, grow)
         footless = np.isnan(Rr)
+        if not near.any():
+            # nothing near any move: each ends where Contact._clip without candidates puts it (a
+            # robot without a footprint: at its end), whatever the slot order
+            self.centres[copies, slots] = np.where(footless[:, None], ends, starts + (ends - starts))
+            return out[:, 0], out[:, 1]
         # slot by slot, as Contact.resolve_all takes robots in world order (each sees the earlier
         # slots of its copy where they ended, the later ones where they started)
         for r in np.unique(slots).tolist():
@@ -614,6 +620,34 @@ class BatchedSimulation:
                     self.counters["contacts"] += 1
                     out[m] = p
         return out[:, 0], out[:, 1]
+
+    def _contact_near(self, copies, slots, starts, reach, band_lo, band_hi, grow):
+        """The broad phase of :meth:`_contact` in numpy (packets.contact_near's fallback):
+        (solid_hit (k, S) or None, robot_hit (k, R) or None, near (k,))."""
+        ct = self.contact
+        assert ct is not None
+        k = len(copies)
+        Rr = self.foot_radius[slots]
+        box_lo = starts - (reach + Rr)[:, None]
+        box_hi = starts + (reach + Rr)[:, None]
+        solid_hit = robot_hit = None
+        near = np.zeros(k, dtype=bool)
+        if len(ct._obs):
+            solid_hit = (np.all((ct._lo[None] <= box_hi[:, None]) & (ct._hi[None] >= box_lo[:, None]), axis=2)
+                         & (ct._zhi[None] > band_lo[:, None] + EPS) & (ct._zlo[None] < band_hi[:, None] - EPS))
+            near |= solid_hit.any(axis=1)
+        if self.R > 1:
+            c = self.centres[copies]                                            # (k, R, 2): before this step
+            r_all = self.foot_radius[None, :] + grow[copies]                     # (k, R)
+            a_lo = self.heights[copies] + self.foot_low[None, :]
+            a_hi = self.heights[copies] + self.foot_high[None, :]
+            with np.errstate(invalid="ignore"):
+                robot_hit = ((c[:, :, 0] + r_all >= box_lo[:, None, 0]) & (c[:, :, 0] - r_all <= box_hi[:, None, 0])
+                             & (c[:, :, 1] + r_all >= box_lo[:, None, 1]) & (c[:, :, 1] - r_all <= box_hi[:, None, 1])
+                             & (a_hi > band_lo[:, None] + EPS) & (a_lo < band_hi[:, None] - EPS))
+            robot_hit[np.arange(k), slots] = False
+            near |= robot_hit.any(axis=1)
+        return solid_hit, robot_hit, near
 
     # -- devices
     def _due(self, kind: str, live: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -723,8 +757,9 @@ class BatchedSimulation:
             occluded[s, light] = np.isfinite(hits[0].distance)
         e = light_math.irradiance_from_terms(state["att"], state["direct"], self.lights, occluded, self._l_filter[cols])
         values = np.empty(len(cols))
-        for table, members in self._l_tables:
-            sel = np.isin(cols, members).nonzero()[0]
+        table_of = self._l_table_of[cols]
+        for t, (table, _) in enumerate(self._l_tables):
+            sel = (table_of == t).nonzero()[0]
             if not len(sel):
                 continue
             if len(table) == 0:        # an empty table is the identity, without noise (devices.md §1.2)
@@ -822,8 +857,9 @@ class BatchedSimulation:
         # DistancePlan.output: lookup (by table), each sensor's noise, resolution
         values = np.zeros(len(cols))
         full = ~self._d_empty[cols]
-        for table, members in self._d_tables:
-            sel = (np.isin(cols, members) & full).nonzero()[0]
+        table_of = np.where(full, self._d_table_of[cols], -1)
+        for t, (table, _) in enumerate(self._d_tables):
+            sel = (table_of == t).nonzero()[0]
             if not len(sel):
                 continue
             y, nz = table.interpolate(measured[sel])
@@ -859,21 +895,24 @@ class BatchedSimulation:
             rr = self.rot[c, slot]
             rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
             org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
-            x, y, z = lid._dir_columns
-            W = len(x)
-            dirs = np.empty((len(c), W, 3))
-            for j in range(3):                                                  # _rotate_columns, stacked
-                acc = x[None, :] * rot[:, j, 0, None]
-                acc += y[None, :] * rot[:, j, 1, None]
-                acc += z[None, :] * rot[:, j, 2, None]
-                dirs[:, :, j] = acc
-            d = dirs.reshape(-1, 3)
+            W = len(lid._dir_columns[0])
+            got = packets.lidar_beams(rot, org, lid._dir_columns, self._lidar_buffers(col, len(c) * W))
+            origins, d, d32 = got if got is not None else _lidar_beams(rot, org, lid._dir_columns)
             ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
-            reqs.append(_Rays(np.repeat(org, W, axis=0), d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
-                              -1, mount, distance_only=True, d32=d.astype(np.float32), coherent=True))
+            reqs.append(_Rays(origins, d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
+                              -1, mount, distance_only=True, d32=d32, coherent=True))
             state["items"].append((col, c))
         return state, reqs
+
+    def _lidar_buffers(self, col: int, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The beam origins, directions and float32 directions of lidar ``col``'s scans this step,
+        written over the last step's (each step's rays are cast and finished within the step)."""
+        got = self._lidar_beam_rows.get(col)
+        if got is None or len(got[0]) != rows:
+            got = self._lidar_beam_rows[col] = (np.empty((rows, 3)), np.empty((rows, 3)),
+                                                np.empty((rows, 3), dtype=np.float32))
+        return got
 
     def _lidar_rows(self, col: int, copies: np.ndarray, W: int) -> tuple[np.ndarray, np.ndarray | int]:
         """Per beam of the scans of ``copies``: its copy, and its mount slot (a lidar with own
@@ -973,6 +1012,30 @@ def _by_table(devices: list) -> list[tuple]:
     for k, d in enumerate(devices):
         out.setdefault(d.table, []).append(k)
     return [(t, np.array(v, dtype=np.int64)) for t, v in out.items()]
+
+
+def _table_of(tables: list[tuple], n: int) -> np.ndarray:
+    """(n,) the index in ``tables`` ((table, device columns) pairs) of each column's table (-1: none)."""
+    out = np.full(n, -1, dtype=np.int64)
+    for t, (_, members) in enumerate(tables):
+        out[members] = t
+    return out
+
+
+def _lidar_beams(rot: np.ndarray, org: np.ndarray, columns) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The beams of n scans of one fixed lidar (packets.lidar_beams' numpy path): origins, directions
+    (rot @ each beam's sensor-frame column, _rotate_columns stacked) and the directions as float32,
+    (n * W, 3) each."""
+    x, y, z = columns
+    W = len(x)
+    dirs = np.empty((len(rot), W, 3))
+    for j in range(3):
+        acc = x[None, :] * rot[:, j, 0, None]
+        acc += y[None, :] * rot[:, j, 1, None]
+        acc += z[None, :] * rot[:, j, 2, None]
+        dirs[:, :, j] = acc
+    d = dirs.reshape(-1, 3)
+    return np.repeat(org, W, axis=0), d, d.astype(np.float32)
 
 
 def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
