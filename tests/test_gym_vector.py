@@ -70,6 +70,26 @@ def test_sub_env_i_is_the_single_env_with_seed_i_across_autoresets(env_id, preci
     assert resets >= 3                                   # every sub-env ended and restarted at least once
 
 
+def test_threads_split_the_copies_casts_with_the_same_bits():
+    """64 copies' lidar beams (23,040 rays) are split over two threads or cast on one: the same
+    observations, rewards and poses; a thread count below one is refused."""
+    envs = [gym.make_vec("sensorium/LidarAvoid-v0", num_envs=64, vectorization_mode="vector_entry_point",
+                         precision="fast", threads=t) for t in (1, 2)]
+    assert [e.unwrapped.sim.rays.static.threads for e in envs] == [1, 2]
+    outs = [e.reset(seed=3) for e in envs]
+    rng = np.random.default_rng(2)
+    for _ in range(4):
+        a = rng.uniform(-1, 1, (64, 2)).astype(np.float32)
+        o1, o2 = (e.step(a) for e in envs)
+        assert _same_obs(o1[0], o2[0]) and o1[1].tobytes() == o2[1].tobytes()
+        assert o1[4]["pose"].tobytes() == o2[4]["pose"].tobytes()
+    assert _same_obs(outs[0][0], outs[1][0])
+    for e in envs:
+        e.close()
+    with pytest.raises(ValueError, match="threads must be >= 1, got 0"):
+        SensoriumVectorEnv(None, ReachLight(), 2, threads=0)
+
+
 def test_make_vec_gives_the_batched_env_with_next_step_autoreset():
     venv = gym.make_vec("sensorium/ReachLight-v0", num_envs=4, vectorization_mode="vector_entry_point")
     assert isinstance(venv.unwrapped, SensoriumVectorEnv)

@@ -157,7 +157,7 @@ class BatchedSimulation:
     """``copies`` independent copies of a world stepped together (see the module docstring)."""
 
     def __init__(self, world: LoadedWorld | wm.World, copies: int, precision: Precision | str = Precision.EXACT,
-                 base_dir: Path | None = None, contact: bool | None = None):
+                 base_dir: Path | None = None, contact: bool | None = None, threads: int | None = None):
         if isinstance(world, wm.World):
             world = from_model(world, base_dir)
         if int(copies) < 1:
@@ -199,6 +199,10 @@ class BatchedSimulation:
                     rough.append(info.roughness)
             else:
                 slot_body.append(None)
+        if threads is not None:       # the cores a large cast may use (RayEngine.threads; same bits on any number)
+            if int(threads) < 1:
+                raise BatchedError(f"threads must be >= 1, got {threads}")
+            self.scene.engine.threads = movers.threads = int(threads)
         self.rays = CopyRays(self.scene.engine, movers, slot_body, n_static)
         self.red = np.array(red + [1.0])              # per hit shape; -1 (no hit) reads the last entry
         self.roughness = np.array(rough + [0.0])
