@@ -6,10 +6,9 @@ helper."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
+from _lidar_room import lidar_room
 
 from sensorium.server.devices import lidar as lmath
 from sensorium.server.raycast import packets
@@ -77,17 +76,9 @@ def test_a_wrong_array_is_refused_not_converted():
 
 
 def _world(**lidar) -> dict:
-    dev = {"device": "Lidar", "name": "l", "pose": {"translation": [0.0, 0.0, 0.4]}, "horizontal_resolution": 360,
-           "number_of_layers": 16, "field_of_view": 2 * math.pi, "vertical_field_of_view": 0.9, "near": 0.02,
-           "min_range": 0.3, "max_range": 2.5}
-    dev.update(lidar)
-    return {"world_info": {"basic_time_step": 16, "random_seed": 4}, "solids": [
-        {"name": "floor", "geometry": {"type": "plane", "size": None}},
-        {"name": "wall", "pose": {"translation": [1.5, 0.0, 0.5]}, "geometry": {"type": "box", "size": [0.2, 4.0, 1.0]}},
-        {"name": "post", "pose": {"translation": [-1.0, 1.0, 0.5]},
-         "geometry": {"type": "cylinder", "radius": 0.2, "height": 1.0}},
-    ], "robots": [{"name": "r", "pose": {"translation": [0.0, 0.0, 0.05]},
-                   "body": {"geometry": {"type": "cylinder", "radius": 0.3, "height": 0.1}}, "devices": [dev]}]}
+    return lidar_room({"horizontal_resolution": 360, "number_of_layers": 16, "vertical_field_of_view": 0.9,
+                       "min_range": 0.3, "max_range": 2.5, **lidar}, wall_x=1.5,
+                      body={"geometry": {"type": "cylinder", "radius": 0.3, "height": 0.1}})
 
 
 @pytest.mark.parametrize("kw", [{}, {"projection": "planar", "field_of_view": 2.0},

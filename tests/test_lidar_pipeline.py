@@ -10,6 +10,7 @@ from collections import Counter
 
 import numpy as np
 import pytest
+from _lidar_room import lidar_room
 
 from sensorium.schemas.wire import pack
 from sensorium.server.daemon.topics import header, lidar_cloud_msg, point_cloud_msg
@@ -123,16 +124,8 @@ def test_float32_directions_kept_by_the_caller():
 
 
 def _lidar_world(**lidar) -> dict:
-    dev = {"device": "Lidar", "name": "l", "pose": {"translation": [0.0, 0.0, 0.4]}, "horizontal_resolution": 180,
-           "number_of_layers": 9, "field_of_view": 2 * math.pi, "vertical_field_of_view": 0.8, "near": 0.02,
-           "min_range": 0.05, "max_range": 6.0}
-    dev.update(lidar)
-    return {"world_info": {"basic_time_step": 16, "random_seed": 4}, "solids": [
-        {"name": "floor", "geometry": {"type": "plane", "size": None}},
-        {"name": "wall", "pose": {"translation": [2.0, 0.0, 0.5]}, "geometry": {"type": "box", "size": [0.2, 4.0, 1.0]}},
-        {"name": "post", "pose": {"translation": [-1.0, 1.0, 0.5]},
-         "geometry": {"type": "cylinder", "radius": 0.2, "height": 1.0}},
-    ], "robots": [{"name": "r", "pose": {"translation": [0.0, 0.0, 0.05]}, "devices": [dev]}]}
+    return lidar_room({"horizontal_resolution": 180, "number_of_layers": 9, "vertical_field_of_view": 0.8,
+                       "min_range": 0.05, "max_range": 6.0, **lidar}, wall_x=2.0)
 
 
 def _reference_image(sim: Simulation, dev) -> np.ndarray:
