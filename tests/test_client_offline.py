@@ -179,6 +179,10 @@ def test_undecodable_request_error_is_raised(server):
         rid = conn.send("get_info")
         conn._outstanding[rid] = "get_info"
         fake = msgpack.packb({"id": None, "ok": False, "error": {"code": 1, "message": "not msgpack"}})
+        # the DEALER's monitor stopped first, as Connection.close does: closed under a live monitor
+        # whose reader then goes, a late handshake event blocks libzmq's I/O thread in its send and
+        # every later tcp socket of the shared context hangs (seen as the next tests' attach timeouts)
+        conn._stop_monitor()
         conn._socket.close(0)
         pair = zmq.Context.instance().socket(zmq.PAIR)
         pair.bind("inproc://fake-reply")
