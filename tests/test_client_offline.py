@@ -173,6 +173,16 @@ def test_late_reply_to_abandoned_request_is_dropped(server):
         assert conn.call("get_info")["world"] == "fake"
 
 
+def test_handshake_monitor_pipe_never_fills(server):
+    """libzmq sends monitor events from its I/O thread and blocks when the pipe is full, which would
+    stall every socket of the shared context; the reader's RCVHWM 0 makes the pipe unbounded, and
+    the monitor still ends after the first handshake."""
+    with Connection(server.endpoint, timeout=20.0) as conn:
+        assert conn._monitor is not None and conn._monitor.getsockopt(zmq.RCVHWM) == 0
+        assert conn.call("get_info")["world"] == "fake"
+        _until(lambda: conn.handshake_problem() is None and conn._monitor is None)
+
+
 def test_undecodable_request_error_is_raised(server):
     with Connection(server.endpoint, timeout=20.0) as conn:
         # a server's id-less error reply (PROTOCOL §3.1) surfaces as its error

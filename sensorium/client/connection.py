@@ -296,10 +296,17 @@ class Connection:
         # of "is the server running?"; dropped after the first successful handshake
         self._monitor: zmq.Socket | None = None
         if self.endpoint.startswith("tcp://"):
-            self._monitor = self._socket.get_monitor_socket(
-                zmq.EVENT_HANDSHAKE_SUCCEEDED | zmq.EVENT_HANDSHAKE_FAILED_PROTOCOL
-                | zmq.EVENT_HANDSHAKE_FAILED_NO_DETAIL | zmq.EVENT_HANDSHAKE_FAILED_AUTH,
-                addr=f"inproc://sensorium-handshake-{secrets.token_hex(8)}")
+            addr = f"inproc://sensorium-handshake-{secrets.token_hex(8)}"
+            self._socket.monitor(addr, zmq.EVENT_HANDSHAKE_SUCCEEDED | zmq.EVENT_HANDSHAKE_FAILED_PROTOCOL
+                                 | zmq.EVENT_HANDSHAKE_FAILED_NO_DETAIL | zmq.EVENT_HANDSHAKE_FAILED_AUTH)
+            # libzmq sends monitor events from its I/O thread with a blocking send: a full pipe (a
+            # wrong key failing every reconnect while nobody waits on a reply) would stall every
+            # socket of the context. RCVHWM 0 before connecting makes the inproc pipe unbounded
+            # (a few bytes per event, read and dropped at the next wait).
+            self._monitor = self._context.socket(zmq.PAIR)
+            self._monitor.setsockopt(zmq.RCVHWM, 0)
+            self._monitor.setsockopt(zmq.LINGER, 0)
+            self._monitor.connect(addr)
         self._handshake_failed = 0                   # the last failed handshake's event (0: none)
         self._socket.connect(self.endpoint)
         self._poller = zmq.Poller()                  # kept for callers that poll the socket themselves
