@@ -9,13 +9,14 @@
 
 #include "internal.h"
 
+/* every function here ignores its arguments (it answers Webots' "no value") */
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+
 void wb_supervisor_world_load(const char *filename) {
-  (void)filename;
   SN_UNSUPPORTED();
 }
 
 bool wb_supervisor_world_save(const char *filename) {
-  (void)filename;
   SN_UNSUPPORTED();
   return false;
 }
@@ -29,31 +30,14 @@ void wb_supervisor_simulation_reset_physics(void) {
 }
 
 void wb_supervisor_set_label(int id, const char *text, double x, double y, double size, int color, double transparency, const char *font) {
-  (void)id;
-  (void)text;
-  (void)x;
-  (void)y;
-  (void)size;
-  (void)color;
-  (void)transparency;
-  (void)font;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_export_image(const char *filename, int quality) {
-  (void)filename;
-  (void)quality;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_movie_start_recording(const char *filename, int width, int height, int codec, int quality, int acceleration, bool caption) {
-  (void)filename;
-  (void)width;
-  (void)height;
-  (void)codec;
-  (void)quality;
-  (void)acceleration;
-  (void)caption;
   SN_UNSUPPORTED();
 }
 
@@ -72,7 +56,6 @@ bool wb_supervisor_movie_failed(void) {
 }
 
 bool wb_supervisor_animation_start_recording(const char *filename) {
-  (void)filename;
   SN_UNSUPPORTED();
   return false;
 }
@@ -88,26 +71,21 @@ WbNodeRef wb_supervisor_node_get_root(void) {
 }
 
 WbNodeRef wb_supervisor_node_get_from_id(int id) {
-  (void)id;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 WbNodeRef wb_supervisor_node_get_from_device(WbDeviceTag tag) {
-  (void)tag;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def) {
-  (void)node;
-  (void)def;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 WbNodeRef wb_supervisor_node_get_parent_node(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return NULL;
 }
@@ -118,520 +96,364 @@ WbNodeRef wb_supervisor_node_get_selected(void) {
 }
 
 WbNodeType wb_supervisor_node_get_type(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return WB_NODE_NO_NODE;
 }
 
 WbFieldRef wb_supervisor_node_get_field_by_index(WbNodeRef node, int index) {
-  (void)node;
-  (void)index;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 int wb_supervisor_node_get_number_of_fields(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return -1;
 }
 
 WbFieldRef wb_supervisor_node_get_base_node_field(WbNodeRef node, const char *field_name) {
-  (void)node;
-  (void)field_name;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 WbFieldRef wb_supervisor_node_get_base_node_field_by_index(WbNodeRef node, int index) {
-  (void)node;
-  (void)index;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 int wb_supervisor_node_get_number_of_base_node_fields(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return -1;
 }
 
 void wb_supervisor_node_remove(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_save_state(WbNodeRef node, const char *state_name) {
-  (void)node;
-  (void)state_name;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_load_state(WbNodeRef node, const char *state_name) {
-  (void)node;
-  (void)state_name;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_set_joint_position(WbNodeRef node, double position, int index) {
-  (void)node;
-  (void)position;
-  (void)index;
   SN_UNSUPPORTED();
 }
 
 WbProtoRef wb_supervisor_node_get_proto(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 const char *wb_supervisor_node_get_def(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return "";
 }
 
 const char *wb_supervisor_node_get_type_name(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return "";
 }
 
 const char *wb_supervisor_node_get_base_type_name(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return "";
 }
 
 bool wb_supervisor_node_is_proto(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return false;
 }
 
 const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 const double *wb_supervisor_node_get_pose(WbNodeRef node, WbNodeRef from_node) {
-  (void)node;
-  (void)from_node;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return false;
 }
 
 const double *wb_supervisor_node_get_velocity(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
-  (void)node;
-  (void)velocity;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_reset_physics(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_restart_controller(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
 }
 
 const char *wb_supervisor_node_export_string(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
   return "";
 }
 
 void wb_supervisor_node_move_viewpoint(WbNodeRef node) {
-  (void)node;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_set_visibility(WbNodeRef node, WbNodeRef from, bool visible) {
-  (void)node;
-  (void)from;
-  (void)visible;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_add_force(WbNodeRef node, const double force[3], bool relative) {
-  (void)node;
-  (void)force;
-  (void)relative;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_add_force_with_offset(WbNodeRef node, const double force[3], const double offset[3], bool relative) {
-  (void)node;
-  (void)force;
-  (void)offset;
-  (void)relative;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_add_torque(WbNodeRef node, const double torque[3], bool relative) {
-  (void)node;
-  (void)torque;
-  (void)relative;
   SN_UNSUPPORTED();
 }
 
 WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 void wb_supervisor_field_enable_sf_tracking(WbFieldRef field, int sampling_period) {
-  (void)field;
-  (void)sampling_period;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_disable_sf_tracking(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_enable_pose_tracking(WbNodeRef node, int sampling_period, WbNodeRef from_node) {
-  (void)node;
-  (void)sampling_period;
-  (void)from_node;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_node_disable_pose_tracking(WbNodeRef node, WbNodeRef from_node) {
-  (void)node;
-  (void)from_node;
   SN_UNSUPPORTED();
 }
 
 bool wb_supervisor_field_get_sf_bool(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
   return false;
 }
 
 int wb_supervisor_field_get_sf_int32(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
   return 0;
 }
 
 double wb_supervisor_field_get_sf_float(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
   return NAN;
 }
 
 const double *wb_supervisor_field_get_sf_vec2f(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 const double *wb_supervisor_field_get_sf_color(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 const char *wb_supervisor_field_get_sf_string(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
   return "";
 }
 
 WbNodeRef wb_supervisor_field_get_sf_node(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 bool wb_supervisor_field_get_mf_bool(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return false;
 }
 
 int wb_supervisor_field_get_mf_int32(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return 0;
 }
 
 double wb_supervisor_field_get_mf_float(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return NAN;
 }
 
 const double *wb_supervisor_field_get_mf_vec2f(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 const double *wb_supervisor_field_get_mf_vec3f(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 const double *wb_supervisor_field_get_mf_color(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 const double *wb_supervisor_field_get_mf_rotation(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
 const char *wb_supervisor_field_get_mf_string(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return "";
 }
 
 WbNodeRef wb_supervisor_field_get_mf_node(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 void wb_supervisor_field_set_sf_bool(WbFieldRef field, bool value) {
-  (void)field;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_sf_int32(WbFieldRef field, int value) {
-  (void)field;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_sf_float(WbFieldRef field, double value) {
-  (void)field;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_sf_vec2f(WbFieldRef field, const double values[2]) {
-  (void)field;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_sf_color(WbFieldRef field, const double values[3]) {
-  (void)field;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_sf_string(WbFieldRef field, const char *value) {
-  (void)field;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_mf_bool(WbFieldRef field, int index, bool value) {
-  (void)field;
-  (void)index;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_mf_int32(WbFieldRef field, int index, int value) {
-  (void)field;
-  (void)index;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_mf_float(WbFieldRef field, int index, double value) {
-  (void)field;
-  (void)index;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_mf_vec2f(WbFieldRef field, int index, const double values[2]) {
-  (void)field;
-  (void)index;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  (void)field;
-  (void)index;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_mf_rotation(WbFieldRef field, int index, const double values[4]) {
-  (void)field;
-  (void)index;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_mf_color(WbFieldRef field, int index, const double values[3]) {
-  (void)field;
-  (void)index;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_set_mf_string(WbFieldRef field, int index, const char *value) {
-  (void)field;
-  (void)index;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_insert_mf_bool(WbFieldRef field, int index, bool value) {
-  (void)field;
-  (void)index;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_insert_mf_int32(WbFieldRef field, int index, int value) {
-  (void)field;
-  (void)index;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_insert_mf_float(WbFieldRef field, int index, double value) {
-  (void)field;
-  (void)index;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_insert_mf_vec2f(WbFieldRef field, int index, const double values[2]) {
-  (void)field;
-  (void)index;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_insert_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  (void)field;
-  (void)index;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_insert_mf_rotation(WbFieldRef field, int index, const double values[4]) {
-  (void)field;
-  (void)index;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_insert_mf_color(WbFieldRef field, int index, const double values[3]) {
-  (void)field;
-  (void)index;
-  (void)values;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_insert_mf_string(WbFieldRef field, int index, const char *value) {
-  (void)field;
-  (void)index;
-  (void)value;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_remove_mf(WbFieldRef field, int index) {
-  (void)field;
-  (void)index;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_import_mf_node_from_string(WbFieldRef field, int position, const char *node_string) {
-  (void)field;
-  (void)position;
-  (void)node_string;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_remove_sf(WbFieldRef field) {
-  (void)field;
   SN_UNSUPPORTED();
 }
 
 void wb_supervisor_field_import_sf_node_from_string(WbFieldRef field, const char *node_string) {
-  (void)field;
-  (void)node_string;
   SN_UNSUPPORTED();
 }
 
 const char *wb_supervisor_proto_get_type_name(WbProtoRef proto) {
-  (void)proto;
   SN_UNSUPPORTED();
   return "";
 }
 
 bool wb_supervisor_proto_is_derived(WbProtoRef proto) {
-  (void)proto;
   SN_UNSUPPORTED();
   return false;
 }
 
 WbProtoRef wb_supervisor_proto_get_parent(WbProtoRef proto) {
-  (void)proto;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 WbFieldRef wb_supervisor_proto_get_field(WbProtoRef proto, const char *field_name) {
-  (void)proto;
-  (void)field_name;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 WbFieldRef wb_supervisor_proto_get_field_by_index(WbProtoRef proto, int index) {
-  (void)proto;
-  (void)index;
   SN_UNSUPPORTED();
   return NULL;
 }
 
 int wb_supervisor_proto_get_number_of_fields(WbProtoRef proto) {
-  (void)proto;
   SN_UNSUPPORTED();
   return -1;
 }
@@ -661,19 +483,15 @@ void wb_supervisor_simulation_revert(void) {
 }
 
 void wb_supervisor_load_world(const char *filename) {
-  (void)filename;
   SN_UNSUPPORTED();
 }
 
 bool wb_supervisor_save_world(const char *filename) {
-  (void)filename;
   SN_UNSUPPORTED();
   return false;
 }
 
 void wb_supervisor_field_remove_mf_node(WbFieldRef field, int position) {
-  (void)field;
-  (void)position;
   SN_UNSUPPORTED();
 }
 
@@ -682,13 +500,6 @@ void wb_supervisor_simulation_physics_reset(void) {
 }
 
 void wb_supervisor_start_movie(const char *file, int width, int height, int codec, int quality, int acceleration, bool caption) {
-  (void)file;
-  (void)width;
-  (void)height;
-  (void)codec;
-  (void)quality;
-  (void)acceleration;
-  (void)caption;
   SN_UNSUPPORTED();
 }
 

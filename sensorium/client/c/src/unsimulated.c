@@ -20,9 +20,11 @@
 
 #include "internal.h"
 
+/* a function here reads only its device tag, never its other arguments */
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+
 /* ------------------------------------------------------------------ Brake */
 void wb_brake_set_damping_constant(WbDeviceTag tag, double damping_constant) {
-  (void)damping_constant;
   sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_set_damping_constant");
 }
 
@@ -43,7 +45,6 @@ WbDeviceTag wb_brake_get_position_sensor(WbDeviceTag tag) {
 
 /* ------------------------------------------------------------------ Connector */
 void wb_connector_enable_presence(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
   sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_enable_presence");
 }
 
@@ -86,29 +87,22 @@ int wb_display_get_height(WbDeviceTag tag) {
 }
 
 void wb_display_set_color(WbDeviceTag tag, int color) {
-  (void)color;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_set_color");
 }
 
 void wb_display_set_alpha(WbDeviceTag tag, double alpha) {
-  (void)alpha;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_set_alpha");
 }
 
 void wb_display_set_opacity(WbDeviceTag tag, double opacity) {
-  (void)opacity;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_set_opacity");
 }
 
 void wb_display_set_font(WbDeviceTag tag, const char *font, int size, bool anti_aliasing) {
-  (void)font;
-  (void)size;
-  (void)anti_aliasing;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_set_font");
 }
 
 void wb_display_attach_camera(WbDeviceTag tag, WbDeviceTag camera_tag) {
-  (void)camera_tag;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_attach_camera");
 }
 
@@ -117,118 +111,70 @@ void wb_display_detach_camera(WbDeviceTag tag) {
 }
 
 void wb_display_draw_pixel(WbDeviceTag tag, int x, int y) {
-  (void)x;
-  (void)y;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_pixel");
 }
 
 void wb_display_draw_line(WbDeviceTag tag, int x1, int y1, int x2, int y2) {
-  (void)x1;
-  (void)y1;
-  (void)x2;
-  (void)y2;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_line");
 }
 
 void wb_display_draw_rectangle(WbDeviceTag tag, int x, int y, int width, int height) {
-  (void)x;
-  (void)y;
-  (void)width;
-  (void)height;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_rectangle");
 }
 
 void wb_display_draw_oval(WbDeviceTag tag, int cx, int cy, int a, int b) {
-  (void)cx;
-  (void)cy;
-  (void)a;
-  (void)b;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_oval");
 }
 
 void wb_display_draw_polygon(WbDeviceTag tag, const int *x, const int *y, int size) {
-  (void)x;
-  (void)y;
-  (void)size;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_polygon");
 }
 
 void wb_display_draw_text(WbDeviceTag tag, const char *text, int x, int y) {
-  (void)text;
-  (void)x;
-  (void)y;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_draw_text");
 }
 
 void wb_display_fill_rectangle(WbDeviceTag tag, int x, int y, int width, int height) {
-  (void)x;
-  (void)y;
-  (void)width;
-  (void)height;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_fill_rectangle");
 }
 
 void wb_display_fill_oval(WbDeviceTag tag, int cx, int cy, int a, int b) {
-  (void)cx;
-  (void)cy;
-  (void)a;
-  (void)b;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_fill_oval");
 }
 
 void wb_display_fill_polygon(WbDeviceTag tag, const int *x, const int *y, int size) {
-  (void)x;
-  (void)y;
-  (void)size;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_fill_polygon");
 }
 
 WbImageRef wb_display_image_new(WbDeviceTag tag, int width, int height, const void *data, int format) {
-  (void)width;
-  (void)height;
-  (void)data;
-  (void)format;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_new");
   return NULL;
 }
 
 WbImageRef wb_display_image_load(WbDeviceTag tag, const char *filename) {
-  (void)filename;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_load");
   return NULL;
 }
 
 WbImageRef wb_display_image_copy(WbDeviceTag tag, int x, int y, int width, int height) {
-  (void)x;
-  (void)y;
-  (void)width;
-  (void)height;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_copy");
   return NULL;
 }
 
 void wb_display_image_paste(WbDeviceTag tag, WbImageRef ir, int x, int y, bool blend) {
-  (void)ir;
-  (void)x;
-  (void)y;
-  (void)blend;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_paste");
 }
 
 void wb_display_image_save(WbDeviceTag tag, WbImageRef ir, const char *filename) {
-  (void)ir;
-  (void)filename;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_save");
 }
 
 void wb_display_image_delete(WbDeviceTag tag, WbImageRef ir) {
-  (void)ir;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_delete");
 }
 
 /* ------------------------------------------------------------------ Radar */
 void wb_radar_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
   sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_enable");
 }
 
@@ -273,16 +219,10 @@ double wb_radar_get_vertical_fov(WbDeviceTag tag) {
 
 /* ------------------------------------------------------------------ Skin */
 void wb_skin_set_bone_orientation(WbDeviceTag tag, int index, const double orientation[4], bool absolute) {
-  (void)index;
-  (void)orientation;
-  (void)absolute;
   sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_set_bone_orientation");
 }
 
 void wb_skin_set_bone_position(WbDeviceTag tag, int index, const double position[3], bool absolute) {
-  (void)index;
-  (void)position;
-  (void)absolute;
   sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_set_bone_position");
 }
 
@@ -292,55 +232,40 @@ int wb_skin_get_bone_count(WbDeviceTag tag) {
 }
 
 const char *wb_skin_get_bone_name(WbDeviceTag tag, int index) {
-  (void)index;
   sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_get_bone_name");
   return "";
 }
 
 const double *wb_skin_get_bone_orientation(WbDeviceTag tag, int index, bool absolute) {
-  (void)index;
-  (void)absolute;
   sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_get_bone_orientation");
   return sn_no_values();
 }
 
 const double *wb_skin_get_bone_position(WbDeviceTag tag, int index, bool absolute) {
-  (void)index;
-  (void)absolute;
   sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_get_bone_position");
   return sn_no_values();
 }
 
 /* ------------------------------------------------------------------ Speaker */
 void wb_speaker_play_sound(WbDeviceTag left, WbDeviceTag right, const char *sound, double volume, double pitch, double balance, bool loop) {
-  (void)right;
-  (void)sound;
-  (void)volume;
-  (void)pitch;
-  (void)balance;
-  (void)loop;
   sn_unsimulated(left, WB_NODE_SPEAKER, "wb_speaker_play_sound");
 }
 
 void wb_speaker_stop(WbDeviceTag tag, const char *sound) {
-  (void)sound;
   sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_stop");
 }
 
 bool wb_speaker_is_sound_playing(WbDeviceTag tag, const char *sound) {
-  (void)sound;
   sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_is_sound_playing");
   return false;
 }
 
 bool wb_speaker_set_engine(WbDeviceTag tag, const char *engine) {
-  (void)engine;
   sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_set_engine");
   return false;
 }
 
 bool wb_speaker_set_language(WbDeviceTag tag, const char *language) {
-  (void)language;
   sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_set_language");
   return false;
 }
@@ -356,8 +281,6 @@ const char *wb_speaker_get_language(WbDeviceTag tag) {
 }
 
 void wb_speaker_speak(WbDeviceTag tag, const char *text, double volume) {
-  (void)text;
-  (void)volume;
   sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_speak");
 }
 
@@ -368,7 +291,6 @@ bool wb_speaker_is_speaking(WbDeviceTag tag) {
 
 /* ------------------------------------------------------------------ VacuumGripper */
 void wb_vacuum_gripper_enable_presence(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
   sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_enable_presence");
 }
 
@@ -401,7 +323,6 @@ bool wb_vacuum_gripper_is_on(WbDeviceTag tag) {
 
 /* ------------------------------------------------------------------ Microphone */
 void wb_microphone_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
   sn_unsimulated(tag, WB_NODE_MICROPHONE, "wb_microphone_enable");
 }
 
@@ -479,7 +400,6 @@ const char *wb_radio_message_get_body(WbRadioMessage message) {
 }
 
 void wb_radio_enable(WbDeviceTag tag, int sampling_period) {
-  (void)sampling_period;
   sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_enable");
 }
 
@@ -488,7 +408,6 @@ void wb_radio_disable(WbDeviceTag tag) {
 }
 
 void wb_radio_set_address(WbDeviceTag tag, const char *address) {
-  (void)address;
   sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_address");
 }
 
@@ -498,7 +417,6 @@ const char *wb_radio_get_address(WbDeviceTag tag) {
 }
 
 void wb_radio_set_frequency(WbDeviceTag tag, double hz) {
-  (void)hz;
   sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_frequency");
 }
 
@@ -508,7 +426,6 @@ double wb_radio_get_frequency(WbDeviceTag tag) {
 }
 
 void wb_radio_set_channel(WbDeviceTag tag, int channel) {
-  (void)channel;
   sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_channel");
 }
 
@@ -518,7 +435,6 @@ int wb_radio_get_channel(WbDeviceTag tag) {
 }
 
 void wb_radio_set_bitrate(WbDeviceTag tag, int bits_per_second) {
-  (void)bits_per_second;
   sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_bitrate");
 }
 
@@ -528,7 +444,6 @@ int wb_radio_get_bitrate(WbDeviceTag tag) {
 }
 
 void wb_radio_set_rx_sensitivity(WbDeviceTag tag, double dBm) {
-  (void)dBm;
   sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_rx_sensitivity");
 }
 
@@ -538,7 +453,6 @@ double wb_radio_get_rx_sensitivity(WbDeviceTag tag) {
 }
 
 void wb_radio_set_tx_power(WbDeviceTag tag, double dBm) {
-  (void)dBm;
   sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_set_tx_power");
 }
 
@@ -554,32 +468,25 @@ void wb_radio_set_callback(WbDeviceTag tag, void (*callback)(const WbRadioEvent)
 
 /* No event is ever made (nothing is received), so these only see events a controller made up. */
 WbDeviceTag wb_radio_event_get_radio(const WbRadioEvent event) {
-  (void)event;
   return 0;
 }
 
 char *wb_radio_event_get_data(const WbRadioEvent event) {
-  (void)event;
   return NULL;
 }
 
 int wb_radio_event_get_data_size(const WbRadioEvent event) {
-  (void)event;
   return 0;
 }
 
 char *wb_radio_event_get_emitter(const WbRadioEvent event) {
-  (void)event;
   return NULL;
 }
 
 double wb_radio_event_get_rssi(const WbRadioEvent event) {
-  (void)event;
   return NAN;
 }
 
 void wb_radio_send(WbDeviceTag tag, const WbRadioMessage message, double delay) {
-  (void)message;
-  (void)delay;
   sn_unsimulated(tag, WB_NODE_RADIO, "wb_radio_send");
 }
