@@ -437,6 +437,18 @@ def to_frame_rows(x: np.ndarray, rows: np.ndarray, R: np.ndarray) -> np.ndarray 
     return out
 
 
+def _check_buffer(func: str, a: np.ndarray, dtype, shape: tuple, writes: bool = False) -> None:
+    """TypeError unless ``a`` is the C-contiguous ``dtype`` array of ``shape`` the C pass ``func``
+    reads (or, ``writes``, writes: then also writable)."""
+    want = np.dtype(dtype)
+    if a.dtype == want and a.shape == shape and a.flags.c_contiguous and (a.flags.writeable or not writes):
+        return
+    if writes:
+        raise TypeError(f"{func}: writes contiguous {want} {shape}, not {a.dtype} {a.shape}"
+                        + ("" if a.flags.writeable else " (read-only)"))
+    raise TypeError(f"{func}: {a.dtype} {a.shape} where it reads contiguous {want} {shape}")
+
+
 def lidar_scan(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray, columns=None, xyz: np.ndarray | None = None,
                factor: np.ndarray | None = None, threads: int = 1) -> bool:
     """A fixed lidar's range image and point coordinates from its beams' distances in one C pass
@@ -450,10 +462,11 @@ def lidar_scan(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray, colum
         return False
     n = len(dist)
     arrays = [dist, factor, ranges, xyz, *(columns if xyz is not None else (None, None, None))]
-    for a, dtype, shape in zip(arrays, (np.float64, np.float64, np.float32, np.float32, np.float64, np.float64,
-                                        np.float64), ((n,), (n,), (n,), (n, 3), (n,), (n,), (n,))):
-        if a is not None and (a.dtype != dtype or a.shape != shape or not a.flags.c_contiguous):
-            raise TypeError(f"lidar_scan: {a.dtype} {a.shape} where it reads contiguous {np.dtype(dtype)} {shape}")
+    for a, dtype, shape, writes in zip(arrays, (np.float64, np.float64, np.float32, np.float32, np.float64, np.float64,
+                                                np.float64), ((n,), (n,), (n,), (n, 3), (n,), (n,), (n,)),
+                                       (False, False, True, True, False, False, False)):
+        if a is not None:
+            _check_buffer("lidar_scan", a, dtype, shape, writes)
     p_d, p_f, p_r, p_x, p_cx, p_cy, p_cz = (None if a is None else a.ctypes.data for a in arrays)
     hi32 = float(np.float32(hi))
 
@@ -590,12 +603,10 @@ def drive_wheels(live: np.ndarray, driven: np.ndarray, target: np.ndarray, veloc
         return None
     f64, i64 = np.float64, np.int64
     C, R = angle.shape[:2]
-    for a, dt_, shape in ((target, f64, (C, R, 2)), (velocity, f64, (C, R, 2)), (angle, f64, (C, R, 2)),
-                          (sides, i64, (R, 2)), (radius, f64, (R,)), (axle, f64, (R,))):
-        if a.dtype != dt_ or a.shape != shape or not a.flags.c_contiguous:
-            raise TypeError(f"drive_wheels: {a.dtype} {a.shape} where it reads contiguous {np.dtype(dt_)} {shape}")
-    if not angle.flags.writeable:
-        raise TypeError("drive_wheels: the wheel angles must be writable")
+    for a, dt_, shape in ((target, f64, (C, R, 2)), (velocity, f64, (C, R, 2)), (sides, i64, (R, 2)),
+                          (radius, f64, (R,)), (axle, f64, (R,))):
+        _check_buffer("drive_wheels", a, dt_, shape)
+    _check_buffer("drive_wheels", angle, f64, (C, R, 2), writes=True)      # advanced in place
     live = np.ascontiguousarray(live, dtype=i64)
     driven = np.ascontiguousarray(driven, dtype=i64)
     n = len(live) * len(driven)
@@ -627,7 +638,6 @@ def lidar_beams(rot: np.ndarray, org: np.ndarray, columns, out=None) -> tuple[np
         out = np.empty((n * W, 3)), np.empty((n * W, 3)), np.empty((n * W, 3), dtype=np.float32)
     out_org, out_dir, out_d32 = out
     for a, dt_ in ((out_org, f64), (out_dir, f64), (out_d32, np.float32)):
-        if a.dtype != dt_ or a.shape != (n * W, 3) or not a.flags.c_contiguous or not a.flags.writeable:
-            raise TypeError(f"lidar_beams: writes contiguous {np.dtype(dt_)} {(n * W, 3)}, not {a.dtype} {a.shape}")
+        _check_buffer("lidar_beams", a, dt_, (n * W, 3), writes=True)
     lib.sp_lidar_beams(n, W, *_small_addresses((rot, org, x, y, z, out_org, out_dir, out_d32)))
     return out_org, out_dir, out_d32
