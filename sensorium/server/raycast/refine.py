@@ -268,6 +268,29 @@ class Refiner:
                     n_loc[g] = ng
         return t, (np.einsum("nij,nj->ni", R, n_loc) if normals else None)
 
+    def _screen_starts(self, tier: _Tier, S, near):
+        """The numpy screening of :meth:`_contained_prepass` (``packets.inside_shells`` does it in one
+        C pass): (rows, slots, tight) of the start points ``S`` that may lie inside a shell, None if
+        none. ``near``: the shells to test one by one, each by its own extent (tight); None with
+        several shells: a dense (rays, shapes) bounding-sphere test (the extents are tested after)."""
+        cp = tier.c_pos
+        if near is not None or len(cp) == 1:
+            rs, ss = [], []
+            for k in (near if near is not None else [0]):
+                r = self._inside_shell(tier, k, S).nonzero()[0]
+                rs.append(r)
+                ss.append(np.full(len(r), k, dtype=np.int64))
+            rows = np.concatenate(rs) if rs else np.zeros(0, dtype=np.int64)
+            if len(rows) == 0:
+                return None
+            return rows, np.concatenate(ss), True
+        dx, dy, dz = S[:, 0:1] - cp[:, 0], S[:, 1:2] - cp[:, 1], S[:, 2:3] - cp[:, 2]
+        cand = dx * dx + dy * dy + dz * dz <= tier.c_bound2
+        if not np.count_nonzero(cand):
+            return None
+        rows, slots = cand.nonzero()
+        return rows, slots, False
+
     def _contained_prepass(self, tier: _Tier, Ot, D, lo, lim, excl):
         """Rays starting inside a curved shell may reach the true surface before any crossing of
         that shell that the cast will see (the exit can lie beyond t_far or a nearer hit found
@@ -324,26 +347,11 @@ class Refiner:
                 rows, slots = rows[order], slots[order]
             tight = True
         S = Ot + lo_col * D
-        if got is not None:
-            pass
-        elif near is not None or len(cp) == 1:
-            rs, ss = [], []
-            for k in (near if near is not None else [0]):
-                r = self._inside_shell(tier, k, S).nonzero()[0]
-                rs.append(r)
-                ss.append(np.full(len(r), k, dtype=np.int64))
-            rows = np.concatenate(rs) if rs else np.zeros(0, dtype=np.int64)
-            if len(rows) == 0:
+        if got is None:
+            screened = self._screen_starts(tier, S, near)
+            if screened is None:
                 return None
-            slots = np.concatenate(ss)
-            tight = True
-        else:  # a dense (rays, shapes) bounding-sphere test, then the shells' own extents
-            dx, dy, dz = S[:, 0:1] - cp[:, 0], S[:, 1:2] - cp[:, 1], S[:, 2:3] - cp[:, 2]
-            cand = dx * dx + dy * dy + dz * dz <= tier.c_bound2
-            if not np.count_nonzero(cand):
-                return None
-            rows, slots = cand.nonzero()
-            tight = False
+            rows, slots, tight = screened
         if len(rows) <= _SCALAR:
             pairs = list(zip(rows.tolist(), slots.tolist()))
             few = sorted({i for i, _ in pairs})
