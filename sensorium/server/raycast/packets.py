@@ -390,6 +390,25 @@ def scratch() -> Scratch:
 SCRATCH = _SCRATCH
 
 
+def _pair_buffers(size: int) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """Two int64 buffers of at least ``size`` entries (and their addresses) that a pair-listing
+    pass writes before its answer is copied out: this thread's, reused call after call up to
+    ``_PAIR_BUFFER`` entries (a 64-copy lidar scan's fresh (rays x slots) arrays, 0.7 MB, cost
+    ~30 us a call in page faults), fresh ones beyond."""
+    if size > _PAIR_BUFFER:
+        a, b = np.empty(size, dtype=np.int64), np.empty(size, dtype=np.int64)
+        return a, b, a.ctypes.data, b.ctypes.data
+    got = getattr(_tls, "pairs", None)
+    if got is None or len(got[0]) < size:
+        m = max(size, 4096)
+        a, b = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
+        got = _tls.pairs = (a, b, a.ctypes.data, b.ctypes.data)
+    return got
+
+
+_PAIR_BUFFER = 1 << 20
+
+
 def address(a: np.ndarray) -> int:
     """``a.ctypes.data`` (~1 us), remembered for the last few small arrays this thread passed (a
     lidar's beams, cast scan after scan); those arrays are kept alive meanwhile."""
@@ -502,15 +521,13 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
     ex_a = np.ascontiguousarray(excl, dtype=i64) if isinstance(excl, np.ndarray) else None
     mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
-    out_ray = np.empty(n * R, dtype=i64)
-    out_body = np.empty(n * R, dtype=i64)
-    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_lim, p_ray, p_body = _small_addresses(
-        (O, D, copy, centre, r2, present, lim, out_ray, out_body))
+    out_ray, out_body, p_ray, p_body = _pair_buffers(n * R)
+    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_lim = _small_addresses((O, D, copy, centre, r2, present, lim))
     k = lib.sp_copy_pairs(n, R, p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
                           0.0 if lo_a is not None else float(lo), p_lim, _ptr(ex_a),
                           0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
                           p_ray, p_body)
-    return out_ray[:k], out_body[:k]
+    return out_ray[:k].copy(), out_body[:k].copy()
 
 
 def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: bool = False
@@ -534,12 +551,11 @@ def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: 
     ks = np.asarray(shells, dtype=i64)
     arrays = [np.ascontiguousarray(getattr(tier, name), dtype=dt) for name, dt in (
         ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
-    out_row = np.empty(m * len(ks), dtype=i64)
-    out_slot = np.empty(m * len(ks), dtype=i64)
-    p = _small_addresses([O, D, ks, *arrays, out_row, out_slot])
+    out_row, out_slot, p_row, p_slot = _pair_buffers(m * len(ks))
+    p = _small_addresses([O, D, ks, *arrays])
     k = lib.sp_inside_shells(m, p[0], o_stride, p[1], _ptr(lo_a), 0.0 if lo_a is not None else float(lo), len(ks),
-                             p[2], *p[3:9], 1 if bound_first else 0, p[9], p[10])
-    return out_row[:k], out_slot[:k]
+                             p[2], *p[3:9], 1 if bound_first else 0, p_row, p_slot)
+    return out_row[:k].copy(), out_slot[:k].copy()
 
 
 def _small_addresses(arrays) -> list[int]:
