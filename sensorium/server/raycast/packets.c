@@ -635,7 +635,8 @@ void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double*
  * hit, as the numpy path's whole-array judging leaves it). Returns the number of hits.
  * Per-ray values come as a pointer, or NULL and one value for all rays: the float32 origins o32
  * (row stride o_stride; NULL: o1, or start32 * d + o1 in float32 when `shifted`, as numpy computes
- * a lidar's shifted origins), the far limits (NULL: far_value, or none when `far_none`), the tier
+ * a lidar's shifted origins; o1 NULL too: the rows of Ot rounded to float32, + start32 * d when
+ * `shifted`, numpy's astype and sum), the far limits (NULL: far_value, or none when `far_none`), the tier
  * frame origins Ot (NULL: `origin`), start, lim, the owner excluded (`has_excl`). */
 size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent, const float* o32, size_t o_stride,
                     const float* o1, int shifted, float start32, const float* d32, const float* far, float far_value,
@@ -660,6 +661,11 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
       if (o32) {
         const float* o = o32 + o_stride * i;
         r.org_x[k] = o[0]; r.org_y[k] = o[1]; r.org_z[k] = o[2];
+      } else if (!o1) {   /* Ot's rows rounded to float32 (numpy's astype), shifted as below */
+        const double* ot = Ot ? Ot + ot_stride * i : origin;
+        const float ox = (float)ot[0], oy = (float)ot[1], oz = (float)ot[2];
+        if (shifted) { r.org_x[k] = ox + start32 * d[0]; r.org_y[k] = oy + start32 * d[1]; r.org_z[k] = oz + start32 * d[2]; }
+        else { r.org_x[k] = ox; r.org_y[k] = oy; r.org_z[k] = oz; }
       } else if (shifted) {
         r.org_x[k] = start32 * d[0] + o1[0]; r.org_y[k] = start32 * d[1] + o1[1]; r.org_z[k] = start32 * d[2] + o1[2];
       } else {
