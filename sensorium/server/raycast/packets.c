@@ -810,6 +810,19 @@ size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const
   return k;
 }
 
+/* The box of n points (rows of an (n,3) array): out[0..2] each column's minimum, out[3..5] its
+ * maximum, NaN when the column holds one (numpy's min and max: refine.py's screening of the starts
+ * of many rays, one pass over the rows where numpy's three column reductions make three). */
+void sp_box3(size_t n, const double* O, double* out) {
+  double lo0 = O[0], lo1 = O[1], lo2 = O[2], hi0 = O[0], hi1 = O[1], hi2 = O[2];
+  for (size_t i = 1; i < n; i++) {
+    const double* o = O + 3 * i;
+    lo0 = np_min(lo0, o[0]); lo1 = np_min(lo1, o[1]); lo2 = np_min(lo2, o[2]);
+    hi0 = np_max(hi0, o[0]); hi1 = np_max(hi1, o[1]); hi2 = np_max(hi2, o[2]);
+  }
+  out[0] = lo0; out[1] = lo1; out[2] = lo2; out[3] = hi0; out[4] = hi1; out[5] = hi2;
+}
+
 /* refine.py's screening of the curved-shell pre-pass, for many rays of many origins (the copies of
  * a batched world: their origins span the world, so every shell is near some ray): the start
  * points S[i] = O[i] + lo[i] D[i] inside each listed shell k's extent -- its bounding sphere for a

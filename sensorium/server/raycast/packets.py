@@ -170,6 +170,8 @@ def _load() -> None:
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_box3.restype = None
+    lib.sp_box3.argtypes = [sz, vp, vp]
     lib.sp_inside_shells.restype = sz
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
@@ -528,6 +530,19 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
                           0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
                           p_ray, p_body)
     return out_ray[:k].copy(), out_body[:k].copy()
+
+
+def box3(O: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(each column's minimum, maximum) of the rows of a C-contiguous float64 (n, 3) array, n >= 1,
+    in one C pass (``sp_box3``: numpy's min and max, NaN propagated); None without the helper or
+    for another array."""
+    lib = library()
+    if lib is None or O.dtype != np.float64 or O.ndim != 2 or O.shape[1] != 3 or not len(O) \
+            or not O.flags.c_contiguous:
+        return None
+    out = np.empty(6)
+    lib.sp_box3(len(O), O.ctypes.data, out.ctypes.data)
+    return out[:3], out[3:]
 
 
 def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: bool = False
