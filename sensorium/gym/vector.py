@@ -122,6 +122,7 @@ class SensoriumVectorEnv(VectorEnv):
                                "AsyncVectorEnv of it)") from None
         self.slot = self.sim.slot(self.agent.robot)
         self.refs = {name: self.sim.check_observable(self.agent.robot, name) for name in self.agent.periods}
+        self._scalars = self._scalar_groups()
         self.basic_time_step = self.sim.basic_time_step
         self.steps_per_action = self.agent.control_period_ms // self.basic_time_step
         self.single_observation_space = self.agent.observation_space
@@ -200,19 +201,37 @@ class SensoriumVectorEnv(VectorEnv):
         v = a * self.agent.vmax if self.agent.actions == "normalized" else a
         self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], copies)
 
-    def _observe(self, copies: np.ndarray | slice = slice(None)):
-        out = {}
+    def _scalar_groups(self) -> list[tuple[str, list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+        """The observed one-value devices by kind: (kind, names, value columns, each one's fill for a
+        missing value (float64), its Box's low and high (float32)), so that :meth:`_observe` reads
+        each kind's columns with one gather and one clip."""
+        groups: dict[str, list] = {}
         for name, box in self.agent.dict_space.spaces.items():
             ref = self.refs[name]
-            if ref.kind == "Lidar":
-                img = self.sim.range_image(ref)[copies]
-                hi = box.high.flat[0]
-                out[name] = np.clip(np.nan_to_num(img, nan=hi, posinf=hi), box.low, box.high).astype(np.float32)
-            else:
-                v = self.sim.value(ref)[copies]
-                fill = box.low[0] if np.isfinite(box.low[0]) else 0.0
-                v = np.where(np.isfinite(v), v, fill)
-                out[name] = np.clip(v.astype(np.float32)[:, None], box.low, box.high)
+            if ref.kind != "Lidar":
+                low = box.low[0]
+                groups.setdefault(ref.kind, []).append((name, ref.column, float(low) if np.isfinite(low) else 0.0,
+                                                        low, box.high[0]))
+        return [(kind, [g[0] for g in items], np.array([g[1] for g in items], dtype=np.int64),
+                 np.array([g[2] for g in items], dtype=np.float64), np.array([g[3] for g in items], dtype=np.float32),
+                 np.array([g[4] for g in items], dtype=np.float32)) for kind, items in groups.items()]
+
+    def _observe(self, copies: np.ndarray | slice = slice(None)):
+        got = {}
+        for kind, names, cols, fill, low, high in self._scalars:
+            # per device the same elementwise steps: a missing value filled, float32, clipped to its Box
+            v = self.sim.values[kind][copies][:, cols]
+            v = np.clip(np.where(np.isfinite(v), v, fill).astype(np.float32), low, high)
+            for j, name in enumerate(names):
+                got[name] = v[:, j:j + 1]
+        out = {}
+        for name, box in self.agent.dict_space.spaces.items():
+            if name in got:
+                out[name] = got[name] if self.agent.flatten else got[name].copy()   # (each its own array)
+                continue
+            img = self.sim.range_image(self.refs[name])[copies]
+            hi = box.high.flat[0]
+            out[name] = np.clip(np.nan_to_num(img, nan=hi, posinf=hi), box.low, box.high).astype(np.float32)
         if self.agent.flatten:
             m = len(next(iter(out.values()))) if out else 0
             return np.concatenate([out[k].reshape(m, -1) for k in self.agent.dict_space.spaces], axis=1).astype(np.float32)
