@@ -813,15 +813,33 @@ size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const
 /* The box of n points (rows of an (n,3) array): out[0..2] each column's minimum, out[3..5] its
  * maximum, NaN when the column holds one (numpy's min and max: refine.py's screening of the starts
  * of many rays, one pass over the rows where numpy's three column reductions make three). */
+#define SP_LO(acc, x) acc = (x) < acc ? (x) : acc
+#define SP_HI(acc, x) acc = (x) > acc ? (x) : acc
 void sp_box3(size_t n, const double* O, double* out) {
-  double lo0 = O[0], lo1 = O[1], lo2 = O[2], hi0 = O[0], hi1 = O[1], hi2 = O[2];
-  for (size_t i = 1; i < n; i++) {
-    const double* o = O + 3 * i;
-    lo0 = np_min(lo0, o[0]); lo1 = np_min(lo1, o[1]); lo2 = np_min(lo2, o[2]);
-    hi0 = np_max(hi0, o[0]); hi1 = np_max(hi1, o[1]); hi2 = np_max(hi2, o[2]);
+  /* two rows a step into separate minima and maxima held in registers (independent chains, no
+     NaN test in them: a comparison with NaN keeps the accumulator), NaN columns flagged apart */
+  double l0 = O[0], l1 = O[1], l2 = O[2], h0 = O[0], h1 = O[1], h2 = O[2];
+  double m0 = l0, m1 = l1, m2 = l2, g0 = h0, g1 = h1, g2 = h2;
+  int n0 = O[0] != O[0], n1 = O[1] != O[1], n2 = O[2] != O[2];
+  size_t i = 1;
+  for (; i + 1 < n; i += 2) {
+    const double* a = O + 3 * i;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], b0 = a[3], b1 = a[4], b2 = a[5];
+    SP_LO(l0, a0); SP_LO(l1, a1); SP_LO(l2, a2); SP_HI(h0, a0); SP_HI(h1, a1); SP_HI(h2, a2);
+    SP_LO(m0, b0); SP_LO(m1, b1); SP_LO(m2, b2); SP_HI(g0, b0); SP_HI(g1, b1); SP_HI(g2, b2);
+    n0 |= (a0 != a0) | (b0 != b0); n1 |= (a1 != a1) | (b1 != b1); n2 |= (a2 != a2) | (b2 != b2);
   }
-  out[0] = lo0; out[1] = lo1; out[2] = lo2; out[3] = hi0; out[4] = hi1; out[5] = hi2;
+  if (i < n) {
+    const double* a = O + 3 * i;
+    SP_LO(l0, a[0]); SP_LO(l1, a[1]); SP_LO(l2, a[2]); SP_HI(h0, a[0]); SP_HI(h1, a[1]); SP_HI(h2, a[2]);
+    n0 |= a[0] != a[0]; n1 |= a[1] != a[1]; n2 |= a[2] != a[2];
+  }
+  SP_LO(l0, m0); SP_LO(l1, m1); SP_LO(l2, m2); SP_HI(h0, g0); SP_HI(h1, g1); SP_HI(h2, g2);
+  out[0] = n0 ? NAN : l0; out[1] = n1 ? NAN : l1; out[2] = n2 ? NAN : l2;
+  out[3] = n0 ? NAN : h0; out[4] = n1 ? NAN : h1; out[5] = n2 ? NAN : h2;
 }
+#undef SP_LO
+#undef SP_HI
 
 /* refine.py's screening of the curved-shell pre-pass, for many rays of many origins (the copies of
  * a batched world: their origins span the world, so every shell is near some ray): the start
