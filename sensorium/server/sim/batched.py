@@ -927,7 +927,13 @@ class BatchedSimulation:
             return got[1], got[2]
         lid = self.lidar[col]
         ray_copy = np.repeat(copies, W)
-        mount = lid.robot_index if lid._own_body is not None else np.tile(self._lidar_skip(col), len(copies))
+        skip = self._lidar_skip(col)
+        if lid._own_body is not None:
+            mount: np.ndarray | int = lid.robot_index
+        elif len(skip) and (skip == skip[0]).all():   # every beam alike: one value (the pairing skips the
+            mount = int(skip[0])                       # slot without reading a value per ray)
+        else:
+            mount = np.tile(skip, len(copies))
         self._lidar_plan[col] = (copies.copy(), ray_copy, mount)
         return ray_copy, mount
 
