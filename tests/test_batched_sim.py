@@ -440,3 +440,25 @@ def test_every_copys_lidar_gets_its_single_world_scan_at_many_poses():
         assert img.tobytes() == bs.range_image(ref)[c].tobytes(), (c, np.flatnonzero(img != bs.range_image(ref)[c])[:5])
         seen += np.count_nonzero(np.isfinite(img))
     assert seen > n * 100
+
+
+def test_noise_streams_give_each_streams_numbers_in_order_whatever_the_block():
+    """A (copy, device) stream's draws through NoiseStreams (next over many streams, take) are
+    device_rng(seed, path)'s standard normals in order, across refills, for any block size."""
+    from sensorium.server.devices.noise import device_rng
+    from sensorium.server.sim.batched import NoiseStreams
+
+    paths = ["r/a", "r/b", "q/c"]
+    want = {(c, d): device_rng(100 + c, paths[d]).standard_normal(700) for c in range(4) for d in range(3)}
+    for block in (64, 100, 256):
+        ns = NoiseStreams(4, paths, block=block)
+        ns.reseed(range(4), [100 + c for c in range(4)])
+        got: dict = {key: [] for key in want}
+        copies, devs = np.array([0, 1, 3, 2, 0]), np.array([0, 2, 1, 1, 1])
+        for _ in range(300):        # several refills of the streams drawn together
+            for k, v in zip(zip(copies.tolist(), devs.tolist()), ns.next(copies, devs).tolist()):
+                got[k].append(v)
+        for k in got:
+            got[k] += ns.take(k[0], k[1], 700 - len(got[k])).tolist()
+        for k, v in want.items():
+            assert np.array(got[k]).tobytes() == v.tobytes(), (block, k)
