@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
+from sensorium.server.raycast import packets
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
@@ -462,3 +463,37 @@ def test_noise_streams_give_each_streams_numbers_in_order_whatever_the_block():
             got[k] += ns.take(k[0], k[1], 700 - len(got[k])).tolist()
         for k, v in want.items():
             assert np.array(got[k]).tobytes() == v.tobytes(), (block, k)
+
+
+@pytest.mark.skipif(packets.library() is None, reason="no compiled helper here")
+def test_distance_sensor_rays_in_c_are_the_numpy_frames_bit_for_bit():
+    """packets.sensor_rays (the batched distance sensors' world rays in one C pass) gives the numpy
+    path's positions, origins and directions (batches._frames_t, _rotate_t) bit for bit, signed zeros
+    included: random and axis-aligned robot and sensor frames, sensors gathered in any order."""
+    from sensorium.server.sim.batches import _frames_t, _rotate_t
+
+    rng = np.random.default_rng(11)
+
+    def frames(m):
+        q = np.linalg.qr(rng.normal(size=(m, 3, 3)))[0]
+        aligned = np.eye(3)[rng.permutation(3)] * rng.choice([-1.0, 1.0], 3)[:, None]
+        q[rng.uniform(size=m) < 0.5] = aligned          # exact zeros: the signed zeros of the sums
+        return q
+
+    C, R, P, G, N, S = 7, 3, 9, 5, 4, 40
+    rot, pos = frames(C * R).reshape(C, R, 3, 3), rng.normal(size=(C, R, 3)) * 10.0
+    local_rot, local_pos = frames(P), rng.normal(size=(P, 3)) * 0.1
+    local_dirs = rng.normal(size=(G, N, 3))
+    local_dirs[:, 0] = [1.0, 0.0, 0.0]
+    c, slot = rng.integers(0, C, S), rng.integers(0, R, S)
+    pi, k = rng.integers(0, P, S), rng.integers(0, G, S)
+    positions, origins, dirs = packets.sensor_rays(c, slot, rot, pos, pi, local_rot, local_pos, k, local_dirs)
+    rot_t, pos_t = _frames_t(np.ascontiguousarray(rot[c, slot].transpose(1, 2, 0)),
+                             np.ascontiguousarray(local_rot.transpose(1, 2, 0)[:, :, pi]),
+                             np.ascontiguousarray(local_pos.T[:, pi]))
+    want_pos = pos_t.T + pos[c, slot]
+    want_dirs = _rotate_t(rot_t, np.ascontiguousarray(local_dirs.transpose(2, 1, 0)[:, :, k]))
+    assert positions.tobytes() == want_pos.tobytes()
+    assert origins.tobytes() == np.repeat(want_pos, N, axis=0).tobytes()
+    assert dirs.tobytes() == want_dirs.tobytes()
+    assert np.count_nonzero(want_dirs == 0.0) > 0            # exact zeros were summed (their signs compared)

@@ -810,6 +810,43 @@ size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const
   return k;
 }
 
+/* batched.py's distance-sensor rays (batches._frames_t and _rotate_t's numpy path, operation for
+ * operation): sensor s of robot slot slots[s] in copy copies[s] (rot (C, R, 3, 3), pos (C, R, 3))
+ * with local frame pi[s] (local_rot (P, 3, 3), local_pos (P, 3)) and local ray directions k[s]
+ * (local_dirs (G, N, 3)): its world frame W = robot rotation A @ local rotation, each entry summed
+ * ((a0 l0 + a1 l1) + a2 l2) + 0.0, its position ((a0 p0 + a2 p2) + a1 p1) + 0.0 + robot position,
+ * each ray W @ d summed ((w0 d0 + w2 d2) + w1 d1) + 0.0. Writes positions (S, 3), every ray's
+ * origin (S * N, 3: its sensor's position) and direction (S * N, 3). Indices are the caller's,
+ * within those arrays. */
+void sp_sensor_rays(size_t S, size_t N, size_t R, const int64_t* copies, const int64_t* slots, const double* rot,
+                    const double* pos, const int64_t* pi, const double* local_rot, const double* local_pos,
+                    const int64_t* k, const double* local_dirs, double* positions, double* origins, double* dirs) {
+  for (size_t s = 0; s < S; s++) {
+    const size_t b = (size_t)copies[s] * R + (size_t)slots[s];
+    const double* A = rot + 9 * b;
+    const double* P = pos + 3 * b;
+    const double* L = local_rot + 9 * (size_t)pi[s];
+    const double* lp = local_pos + 3 * (size_t)pi[s];
+    double W[9], p[3];
+    for (int i = 0; i < 3; i++) {
+      for (int q = 0; q < 3; q++)
+        W[3 * i + q] = ((A[3 * i] * L[q] + A[3 * i + 1] * L[3 + q]) + A[3 * i + 2] * L[6 + q]) + 0.0;
+      p[i] = (((A[3 * i] * lp[0] + A[3 * i + 2] * lp[2]) + A[3 * i + 1] * lp[1]) + 0.0) + P[i];
+      positions[3 * s + (size_t)i] = p[i];
+    }
+    const double* d = local_dirs + 3 * N * (size_t)k[s];
+    for (size_t n = 0; n < N; n++) {
+      const double* dn = d + 3 * n;
+      double* o = dirs + 3 * (N * s + n);
+      double* g = origins + 3 * (N * s + n);
+      for (int i = 0; i < 3; i++) {
+        o[i] = ((W[3 * i] * dn[0] + W[3 * i + 2] * dn[2]) + W[3 * i + 1] * dn[1]) + 0.0;
+        g[i] = p[i];
+      }
+    }
+  }
+}
+
 /* The box of n points (rows of an (n,3) array): out[0..2] each column's minimum, out[3..5] its
  * maximum, NaN when the column holds one (numpy's min and max: refine.py's screening of the starts
  * of many rays, one pass over the rows where numpy's three column reductions make three). */

@@ -170,6 +170,8 @@ def _load() -> None:
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_sensor_rays.restype = None
+    lib.sp_sensor_rays.argtypes = [sz, sz, sz] + [vp] * 12
     lib.sp_box3.restype = None
     lib.sp_box3.argtypes = [sz, vp, vp]
     lib.sp_inside_shells.restype = sz
@@ -530,6 +532,34 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
                           0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
                           p_ray, p_body)
     return out_ray[:k].copy(), out_body[:k].copy()
+
+
+def sensor_rays(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.ndarray, pi: np.ndarray,
+                local_rot: np.ndarray, local_pos: np.ndarray, k: np.ndarray, local_dirs: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The world rays of S distance sensors in one C pass (``sp_sensor_rays``): (positions (S, 3),
+    origins (S * N, 3), directions (S, N, 3)), bit for bit the numpy path of
+    :meth:`.batched.BatchedSimulation._plan_distances` (``batches._frames_t``, ``_rotate_t``). Sensor s
+    is on slot ``slots[s]`` of copy ``copies[s]`` (``rot`` (C, R, 3, 3), ``pos`` (C, R, 3)) with local
+    frame ``pi[s]`` (``local_rot`` (P, 3, 3), ``local_pos`` (P, 3)) and ray directions ``k[s]``
+    (``local_dirs`` (G, N, 3)); every index must lie within its array. None without the helper."""
+    lib = library()
+    if lib is None:
+        return None
+    f64, i64 = np.float64, np.int64
+    S = len(copies)
+    C, R = rot.shape[:2]
+    G, N = local_dirs.shape[:2]
+    for a, shape in ((rot, (C, R, 3, 3)), (pos, (C, R, 3)), (local_rot, (len(local_rot), 3, 3)),
+                     (local_pos, (len(local_rot), 3)), (local_dirs, (G, N, 3))):
+        _check_buffer("sensor_rays", a, f64, shape)
+    idx = [np.ascontiguousarray(a, dtype=i64) for a in (copies, slots, pi, k)]
+    if any(a.shape != (S,) for a in idx):
+        raise TypeError("sensor_rays: inconsistent shapes")
+    positions, origins, dirs = np.empty((S, 3)), np.empty((S * N, 3)), np.empty((S, N, 3))
+    p = _small_addresses([*idx, rot, pos, local_rot, local_pos, local_dirs, positions, origins, dirs])
+    lib.sp_sensor_rays(S, N, R, p[0], p[1], p[4], p[5], p[2], p[6], p[7], p[3], p[8], p[9], p[10], p[11])
+    return positions, origins, dirs
 
 
 def box3(O: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

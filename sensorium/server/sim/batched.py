@@ -811,17 +811,22 @@ class BatchedSimulation:
             pi = g.idx[k]                                  # index in the plan's stacked constants
             c = copies[rows]
             slot = plan.robot[pi]
-            rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
-            rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
-                                     np.ascontiguousarray(plan.local_pos_t[:, pi]))
-            positions = pos_t.T + self.pos[c, slot]
-            dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
             n = g.n
+            got = packets.sensor_rays(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k, g.local_dirs)
+            if got is not None:
+                positions, origins, dirs = got
+            else:
+                rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
+                rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
+                                         np.ascontiguousarray(plan.local_pos_t[:, pi]))
+                positions = pos_t.T + self.pos[c, slot]
+                dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
+                origins = np.repeat(positions, n, axis=0)
             mount = -1
             if g.mount is not None:
                 mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
-            reqs.append(_Rays(np.repeat(positions, n, axis=0), dirs.reshape(-1, 3), 0.0,
+            reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0,
                               g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1),
                               g.kind, np.repeat(c, n), exclude, mount, skip=g.skip))
             state["groups"].append((g, rows, k, c, slot, positions, dirs))
