@@ -360,6 +360,7 @@ class BatchedSimulation:
             self._d_tables = [(table, np.array([self._d_col[id(self._d_plan.devices[i])] for i in idx.tolist()],
                                                dtype=np.int64)) for table, idx in self._d_plan.tables]
             self._d_table_of = _table_of(self._d_tables, len(self.distance))
+            self._own_kept: dict[int, tuple] = {}   # per group: its due sensors' own-body hits (_own_rows)
         if self.position:
             wheel = []
             for d in self.position:
@@ -841,8 +842,7 @@ class BatchedSimulation:
             dist, shape, normal = h.distance, h.shape, h.normal
             own = g.own_hits(self.rays.movers, plan.local_rot, plan.local_pos) if g.mount is not None else None
             if own is not None:   # the nearer of the cast and the ray's own-body hit (decided once)
-                ray = (k[:, None] * n + np.arange(n)).reshape(-1)
-                od, osh, onr = own.distance[ray], own.shape[ray], own.normal[ray]
+                od, osh, onr = self._own_rows(g, own, k)
                 win = (od < dist).nonzero()[0]
                 if len(win):
                     dist, shape, normal = dist.copy(), shape.copy(), normal.copy()
@@ -882,6 +882,15 @@ class BatchedSimulation:
             q = np.trunc(values / np.where(rounded, res, 1.0) + 0.5) * res + 0.0
             values = np.where(rounded, q, values)
         self._store("DistanceSensor", copies, cols, values)
+
+    def _own_rows(self, g, own: RayHits, k: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The own-body hits (distance, shape, normal) of the rays of group ``g``'s sensors ``k``,
+        kept while the same sensors are due (step after step: a gather of every ray's hit less)."""
+        got = self._own_kept.get(id(g))
+        if got is None or got[0] is not own or not np.array_equal(got[1], k):
+            ray = (k[:, None] * g.n + np.arange(g.n)).reshape(-1)
+            got = self._own_kept[id(g)] = (own, k.copy(), own.distance[ray], own.shape[ray], own.normal[ray])
+        return got[2], got[3], got[4]
 
     def _infra_red_terms(self, shape, origins, directions, distance):
         """Scene.infra_red_terms for hits on solids (textures live there); robot shapes read their
