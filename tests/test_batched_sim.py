@@ -299,11 +299,9 @@ def test_the_contact_broad_phase_in_c_finds_the_numpy_candidates_and_meets_close
         foot = bs.foot_radius.copy()
         if trial == 5:                                   # a robot without a footprint hits and is hit by nothing
             bs.foot_radius[1] = math.nan
-        band_lo = bs.heights[copies, slots] + bs.foot_low[slots]
-        band_hi = bs.heights[copies, slots] + bs.foot_high[slots]
         grow = np.zeros((C, 2))
         grow[copies, slots] = reach
-        want = bs._contact_near(copies, slots, starts, reach, band_lo, band_hi, grow)
+        want = bs._contact_near(copies, slots, starts, reach, grow)
         got = packets.contact_near(copies, slots, starts, reach, bs.foot_radius, bs.foot_low, bs.foot_high,
                                    bs.heights, bs.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS)
         bs.foot_radius[:] = foot
@@ -497,3 +495,21 @@ def test_distance_sensor_rays_in_c_are_the_numpy_frames_bit_for_bit():
     assert origins.tobytes() == np.repeat(want_pos, N, axis=0).tobytes()
     assert dirs.tobytes() == want_dirs.tobytes()
     assert np.count_nonzero(want_dirs == 0.0) > 0            # exact zeros were summed (their signs compared)
+
+
+@pytest.mark.parametrize("turning", ["all", "none", "mixed"])
+def test_arc_steps_are_motion_arc_step_bit_for_bit(turning):
+    """The batched drive's arcs (every robot turning, none, some) are motion.arc_step's, robot by robot."""
+    from sensorium.server.sim.batched import _arc_steps
+    from sensorium.server.sim.motion import arc_step
+
+    rng = np.random.default_rng({"all": 1, "none": 2, "mixed": 3}[turning])
+    n, dt = 50, 0.032
+    x, y, yaw, v = rng.uniform(-2, 2, n), rng.uniform(-2, 2, n), rng.uniform(-math.pi, math.pi, n), rng.normal(size=n)
+    w = rng.normal(size=n) * 3.0
+    if turning != "all":
+        w[: n if turning == "none" else n // 2] = rng.choice([0.0, 1e-12, -2e-8], n if turning == "none" else n // 2)
+    got = _arc_steps(x, y, yaw, v, w, dt)
+    want = np.array([arc_step(*a, dt) for a in zip(x.tolist(), y.tolist(), yaw.tolist(), v.tolist(), w.tolist())]).T
+    for g, wa in zip(got, want):
+        assert np.asarray(g).tobytes() == wa.tobytes()

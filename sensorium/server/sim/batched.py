@@ -582,8 +582,6 @@ class BatchedSimulation:
         out = ends.copy()
         reach = np.hypot(*(ends - starts).T) + EPS
         Rr = self.foot_radius[slots]
-        band_lo = self.heights[copies, slots] + self.foot_low[slots]
-        band_hi = self.heights[copies, slots] + self.foot_high[slots]
         # where every robot may be during this step: its disc, grown by its own move if it moves
         grow = np.zeros((self.copies, self.R))
         grow[copies, slots] = reach
@@ -594,13 +592,15 @@ class BatchedSimulation:
             solid_hit = solid_hit if len(ct._obs) else None
             robot_hit = robot_hit if self.R > 1 else None
         else:
-            solid_hit, robot_hit, near = self._contact_near(copies, slots, starts, reach, band_lo, band_hi, grow)
+            solid_hit, robot_hit, near = self._contact_near(copies, slots, starts, reach, grow)
         footless = np.isnan(Rr)
         if not near.any():
             # nothing near any move: each ends where Contact._clip without candidates puts it (a
             # robot without a footprint: at its end), whatever the slot order
             self.centres[copies, slots] = np.where(footless[:, None], ends, starts + (ends - starts))
             return out[:, 0], out[:, 1]
+        band_lo = self.heights[copies, slots] + self.foot_low[slots]
+        band_hi = self.heights[copies, slots] + self.foot_high[slots]
         # slot by slot, as Contact.resolve_all takes robots in world order (each sees the earlier
         # slots of its copy where they ended, the later ones where they started)
         for r in np.unique(slots).tolist():
@@ -629,13 +629,15 @@ class BatchedSimulation:
                     out[m] = p
         return out[:, 0], out[:, 1]
 
-    def _contact_near(self, copies, slots, starts, reach, band_lo, band_hi, grow):
+    def _contact_near(self, copies, slots, starts, reach, grow):
         """The broad phase of :meth:`_contact` in numpy (packets.contact_near's fallback):
         (solid_hit (k, S) or None, robot_hit (k, R) or None, near (k,))."""
         ct = self.contact
         assert ct is not None
         k = len(copies)
         Rr = self.foot_radius[slots]
+        band_lo = self.heights[copies, slots] + self.foot_low[slots]
+        band_hi = self.heights[copies, slots] + self.foot_high[slots]
         box_lo = starts - (reach + Rr)[:, None]
         box_hi = starts + (reach + Rr)[:, None]
         solid_hit = robot_hit = None
@@ -1084,6 +1086,15 @@ def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: 
     """motion.arc_step for many robots, element by element the same float64 operations."""
     dyaw = w * dt
     straight = np.abs(dyaw) < 1e-9
+    n_straight = int(np.count_nonzero(straight))
+    if n_straight == 0:   # every robot turns (or every one goes straight): whole arrays, no gathers
+        r = v / w
+        c1, s1 = _cos_sin(yaw + dyaw)
+        c0, s0 = _cos_sin(yaw)
+        return x + r * (s1 - s0), y - r * (c1 - c0), np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi
+    if n_straight == len(x):
+        cm, sm = _cos_sin(yaw + 0.5 * dyaw)
+        return (x + v * dt * cm, y + v * dt * sm, np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi)
     xo, yo = x.copy(), y.copy()
     s = straight.nonzero()[0]
     if len(s):
