@@ -318,8 +318,8 @@ class BatchedSimulation:
                     paths.append(d.path)
             self._noise_of[kind_name] = cols
         # blocks of up to 256 numbers (a refill is a Python call per stream: ~4 us each, every
-        # block's worth of draws), within ~16 MB of buffer however many copies and streams
-        block = int(min(256, max(64, (2 << 20) // max(1, C * len(paths)))))
+        # block's worth of draws) within ~4 MB of buffer, never fewer than 64 (ReachLight x256: 186)
+        block = int(min(256, max(64, (1 << 19) // max(1, C * len(paths)))))
         self.noise = NoiseStreams(C, paths, block=block)
         # per kind: schedules (period, last update) per copy and the latest values
         self.period = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
