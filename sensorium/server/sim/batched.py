@@ -661,6 +661,10 @@ class BatchedSimulation:
 
     # -- devices
     def _due(self, kind: str, live: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if len(live) == self.copies:    # every copy (live is then 0 ... C-1): the arrays as they are
+            per = self.period[kind]
+            due = (per > 0) & (self.time_ms[:, None] - self.last[kind] >= per)
+            return due.nonzero()
         per = self.period[kind][live]
         due = (per > 0) & (self.time_ms[live][:, None] - self.last[kind][live] >= per)
         ci, di = due.nonzero()
