@@ -249,7 +249,7 @@ class SensoriumVectorEnv(VectorEnv):
         trunc = (self.steps[copies] >= ms) & ~term if ms is not None else np.zeros(len(copies), dtype=bool)
         return reward, term, trunc
 
-    def _info(self, copies: np.ndarray) -> dict[str, np.ndarray]:
+    def _info(self, copies: np.ndarray | slice) -> dict[str, np.ndarray]:
         rot = self.sim.rot[copies, self.slot]
         pos = self.sim.pos[copies, self.slot]
         yaw = np.array(list(map(math.atan2, rot[:, 1, 0].tolist(), rot[:, 0, 0].tolist())))
@@ -258,7 +258,7 @@ class SensoriumVectorEnv(VectorEnv):
 
     def _full_info(self, mask: np.ndarray) -> dict[str, np.ndarray]:
         """Info of every sub-env (Gymnasium's vector layout: one array per key and a ``_key`` mask)."""
-        info = self._info(np.arange(self.num_envs))
+        info = self._info(slice(None))      # every sub-env (views, not gathers)
         out: dict[str, np.ndarray] = {}
         for k, v in info.items():
             out[k] = v
@@ -327,7 +327,7 @@ class SensoriumVectorEnv(VectorEnv):
             self._run(np.zeros(n, dtype=bool), done)
             for g in self._goals[2]:
                 g.reset(ended)
-            fresh = self._info(np.arange(n))
+            fresh = self._info(slice(None))
             for k in ("time_ms", "steps", "pose"):
                 info[k] = fresh[k]
             done = np.zeros(n, dtype=bool)
