@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
+from sensorium.server.raycast import packets
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
@@ -298,11 +299,9 @@ def test_the_contact_broad_phase_in_c_finds_the_numpy_candidates_and_meets_close
         foot = bs.foot_radius.copy()
         if trial == 5:                                   # a robot without a footprint hits and is hit by nothing
             bs.foot_radius[1] = math.nan
-        band_lo = bs.heights[copies, slots] + bs.foot_low[slots]
-        band_hi = bs.heights[copies, slots] + bs.foot_high[slots]
         grow = np.zeros((C, 2))
         grow[copies, slots] = reach
-        want = bs._contact_near(copies, slots, starts, reach, band_lo, band_hi, grow)
+        want = bs._contact_near(copies, slots, starts, reach, grow)
         got = packets.contact_near(copies, slots, starts, reach, bs.foot_radius, bs.foot_low, bs.foot_high,
                                    bs.heights, bs.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS)
         bs.foot_radius[:] = foot
@@ -440,3 +439,77 @@ def test_every_copys_lidar_gets_its_single_world_scan_at_many_poses():
         assert img.tobytes() == bs.range_image(ref)[c].tobytes(), (c, np.flatnonzero(img != bs.range_image(ref)[c])[:5])
         seen += np.count_nonzero(np.isfinite(img))
     assert seen > n * 100
+
+
+def test_noise_streams_give_each_streams_numbers_in_order_whatever_the_block():
+    """A (copy, device) stream's draws through NoiseStreams (next over many streams, take) are
+    device_rng(seed, path)'s standard normals in order, across refills, for any block size."""
+    from sensorium.server.devices.noise import device_rng
+    from sensorium.server.sim.batched import NoiseStreams
+
+    paths = ["r/a", "r/b", "q/c"]
+    want = {(c, d): device_rng(100 + c, paths[d]).standard_normal(700) for c in range(4) for d in range(3)}
+    for block in (64, 100, 256):
+        ns = NoiseStreams(4, paths, block=block)
+        ns.reseed(range(4), [100 + c for c in range(4)])
+        got: dict = {key: [] for key in want}
+        copies, devs = np.array([0, 1, 3, 2, 0]), np.array([0, 2, 1, 1, 1])
+        for _ in range(300):        # several refills of the streams drawn together
+            for k, v in zip(zip(copies.tolist(), devs.tolist()), ns.next(copies, devs).tolist()):
+                got[k].append(v)
+        for k in got:
+            got[k] += ns.take(k[0], k[1], 700 - len(got[k])).tolist()
+        for k, v in want.items():
+            assert np.array(got[k]).tobytes() == v.tobytes(), (block, k)
+
+
+@pytest.mark.skipif(packets.library() is None, reason="no compiled helper here")
+def test_distance_sensor_rays_in_c_are_the_numpy_frames_bit_for_bit():
+    """packets.sensor_rays (the batched distance sensors' world rays in one C pass) gives the numpy
+    path's positions, origins and directions (batches._frames_t, _rotate_t) bit for bit, signed zeros
+    included: random and axis-aligned robot and sensor frames, sensors gathered in any order."""
+    from sensorium.server.sim.batches import _frames_t, _rotate_t
+
+    rng = np.random.default_rng(11)
+
+    def frames(m):
+        q = np.linalg.qr(rng.normal(size=(m, 3, 3)))[0]
+        aligned = np.eye(3)[rng.permutation(3)] * rng.choice([-1.0, 1.0], 3)[:, None]
+        q[rng.uniform(size=m) < 0.5] = aligned          # exact zeros: the signed zeros of the sums
+        return q
+
+    C, R, P, G, N, S = 7, 3, 9, 5, 4, 40
+    rot, pos = frames(C * R).reshape(C, R, 3, 3), rng.normal(size=(C, R, 3)) * 10.0
+    local_rot, local_pos = frames(P), rng.normal(size=(P, 3)) * 0.1
+    local_dirs = rng.normal(size=(G, N, 3))
+    local_dirs[:, 0] = [1.0, 0.0, 0.0]
+    c, slot = rng.integers(0, C, S), rng.integers(0, R, S)
+    pi, k = rng.integers(0, P, S), rng.integers(0, G, S)
+    positions, origins, dirs = packets.sensor_rays(c, slot, rot, pos, pi, local_rot, local_pos, k, local_dirs)
+    rot_t, pos_t = _frames_t(np.ascontiguousarray(rot[c, slot].transpose(1, 2, 0)),
+                             np.ascontiguousarray(local_rot.transpose(1, 2, 0)[:, :, pi]),
+                             np.ascontiguousarray(local_pos.T[:, pi]))
+    want_pos = pos_t.T + pos[c, slot]
+    want_dirs = _rotate_t(rot_t, np.ascontiguousarray(local_dirs.transpose(2, 1, 0)[:, :, k]))
+    assert positions.tobytes() == want_pos.tobytes()
+    assert origins.tobytes() == np.repeat(want_pos, N, axis=0).tobytes()
+    assert dirs.tobytes() == want_dirs.tobytes()
+    assert np.count_nonzero(want_dirs == 0.0) > 0            # exact zeros were summed (their signs compared)
+
+
+@pytest.mark.parametrize("turning", ["all", "none", "mixed"])
+def test_arc_steps_are_motion_arc_step_bit_for_bit(turning):
+    """The batched drive's arcs (every robot turning, none, some) are motion.arc_step's, robot by robot."""
+    from sensorium.server.sim.batched import _arc_steps
+    from sensorium.server.sim.motion import arc_step
+
+    rng = np.random.default_rng({"all": 1, "none": 2, "mixed": 3}[turning])
+    n, dt = 50, 0.032
+    x, y, yaw, v = rng.uniform(-2, 2, n), rng.uniform(-2, 2, n), rng.uniform(-math.pi, math.pi, n), rng.normal(size=n)
+    w = rng.normal(size=n) * 3.0
+    if turning != "all":
+        w[: n if turning == "none" else n // 2] = rng.choice([0.0, 1e-12, -2e-8], n if turning == "none" else n // 2)
+    got = _arc_steps(x, y, yaw, v, w, dt)
+    want = np.array([arc_step(*a, dt) for a in zip(x.tolist(), y.tolist(), yaw.tolist(), v.tolist(), w.tolist())]).T
+    for g, wa in zip(got, want):
+        assert np.asarray(g).tobytes() == wa.tobytes()

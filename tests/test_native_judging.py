@@ -97,6 +97,12 @@ def _casts(eng, robot, aims, seed: int, offset):
             h = eng.cast(eyes, D2, near, far, kind=kind, exclude_owner=excl)
             out += [h.distance, h.normal, h.shape]
             out.append(eng.cast(eyes, D2, near, far, kind=kind, distance_only=True).distance)
+            # many origins well inside the tier's sphere, one start for all rays: the C pass rounds
+            # the rows to float32 and shifts them itself
+            inner = (eyes - off) * 0.4 + off
+            for start in (0.0, 0.01):
+                h = eng.cast(inner, D2, start, far, kind=kind, exclude_owner=excl)
+                out += [h.distance, h.normal, h.shape]
         # starting inside shapes and on surfaces, axis-parallel directions
         starts = aims[rng.integers(0, len(aims), 600)] + rng.normal(size=(600, 3)) * 0.05
         D3 = rng.normal(size=(600, 3))

@@ -238,3 +238,20 @@ def test_without_a_compiler_or_switched_off_the_engine_uses_embreex_and_says_why
     eng = RayEngine(Precision.FAST)                      # still casts, through embreex
     eng.add_body([ShapeEntry(Box((1.0, 1.0, 1.0)), Pose.identity(), True, True)], Pose.identity())
     assert eng.cast(np.array([[0.0, 0.0, 3.0]]), np.array([[0.0, 0.0, -1.0]])).distance[0] == pytest.approx(2.5)
+
+
+@needs_packets
+def test_box3_is_numpys_column_min_and_max():
+    rng = np.random.default_rng(5)
+    for n in (1, 2, 17, 23040):
+        O = rng.normal(size=(n, 3)) * rng.choice([1e-3, 1.0, 1e5], size=(n, 1))
+        lo, hi = packets.box3(O)
+        assert lo.tolist() == [O[:, k].min() for k in range(3)] and hi.tolist() == [O[:, k].max() for k in range(3)]
+    O = rng.normal(size=(50, 3))
+    O[7, 1], O[30, 2], O[3, 0] = np.nan, -np.inf, np.inf      # NaN propagates as numpy's min/max does
+    lo, hi = packets.box3(O)
+    assert np.isnan(lo[1]) and np.isnan(hi[1]) and lo[2] == -np.inf and hi[0] == np.inf
+    assert lo[0] == O[:, 0].min() and hi[2] == O[:, 2].max()
+    # arrays it does not read: None (the caller's numpy path)
+    assert packets.box3(np.asfortranarray(O)) is None and packets.box3(O.astype(np.float32)) is None
+    assert packets.box3(np.zeros((0, 3))) is None

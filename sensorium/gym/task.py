@@ -271,6 +271,7 @@ class _AvoidObstaclesCopies(VectorGoal):
         self.dirs = np.stack([np.cos(angles), np.sin(angles), np.zeros(self.RAYS)], axis=1)
         self.vmax = float(sim.max_wheel[slot, 0])
         self._gap: tuple[int, np.ndarray, np.ndarray] | None = None     # (step key, copies, gaps)
+        self._rays: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None   # (copies, each ray's copy, directions)
 
     def gaps(self, copies: np.ndarray) -> np.ndarray:
         key = int(self.sim.counters["copy_steps"])
@@ -280,8 +281,10 @@ class _AvoidObstaclesCopies(VectorGoal):
         far = r + max(g.near, g.contact_distance) + 1e-6
         n = len(copies)
         origins = np.repeat(self.sim.pos[copies, self.slot], self.RAYS, axis=0)
-        hits = self.sim.cast(np.repeat(copies, self.RAYS), origins, np.tile(self.dirs, (n, 1)), 0.0, far,
-                             kind=RayKind.BOUNDING, exclude_slot=self.slot)
+        if self._rays is None or not np.array_equal(self._rays[0], copies):   # (the same copies step after step)
+            self._rays = (copies.copy(), np.repeat(copies, self.RAYS), np.tile(self.dirs, (n, 1)))
+        hits = self.sim.cast(self._rays[1], origins, self._rays[2], 0.0, far, kind=RayKind.BOUNDING,
+                             exclude_slot=self.slot)
         d = hits.distance.reshape(n, self.RAYS)
         clear = np.where(np.isfinite(d), d, np.inf).min(axis=1)
         clear = np.where(np.isfinite(clear), clear, far)

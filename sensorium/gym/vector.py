@@ -122,6 +122,7 @@ class SensoriumVectorEnv(VectorEnv):
                                "AsyncVectorEnv of it)") from None
         self.slot = self.sim.slot(self.agent.robot)
         self.refs = {name: self.sim.check_observable(self.agent.robot, name) for name in self.agent.periods}
+        self._scalars = self._scalar_groups()
         self.basic_time_step = self.sim.basic_time_step
         self.steps_per_action = self.agent.control_period_ms // self.basic_time_step
         self.single_observation_space = self.agent.observation_space
@@ -200,19 +201,37 @@ class SensoriumVectorEnv(VectorEnv):
         v = a * self.agent.vmax if self.agent.actions == "normalized" else a
         self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], copies)
 
-    def _observe(self, copies: np.ndarray | slice = slice(None)):
-        out = {}
+    def _scalar_groups(self) -> list[tuple[str, list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+        """The observed one-value devices by kind: (kind, names, value columns, each one's fill for a
+        missing value (float64), its Box's low and high (float32)), so that :meth:`_observe` reads
+        each kind's columns with one gather and one clip."""
+        groups: dict[str, list] = {}
         for name, box in self.agent.dict_space.spaces.items():
             ref = self.refs[name]
-            if ref.kind == "Lidar":
-                img = self.sim.range_image(ref)[copies]
-                hi = box.high.flat[0]
-                out[name] = np.clip(np.nan_to_num(img, nan=hi, posinf=hi), box.low, box.high).astype(np.float32)
-            else:
-                v = self.sim.value(ref)[copies]
-                fill = box.low[0] if np.isfinite(box.low[0]) else 0.0
-                v = np.where(np.isfinite(v), v, fill)
-                out[name] = np.clip(v.astype(np.float32)[:, None], box.low, box.high)
+            if ref.kind != "Lidar":
+                low = box.low[0]
+                groups.setdefault(ref.kind, []).append((name, ref.column, float(low) if np.isfinite(low) else 0.0,
+                                                        low, box.high[0]))
+        return [(kind, [g[0] for g in items], np.array([g[1] for g in items], dtype=np.int64),
+                 np.array([g[2] for g in items], dtype=np.float64), np.array([g[3] for g in items], dtype=np.float32),
+                 np.array([g[4] for g in items], dtype=np.float32)) for kind, items in groups.items()]
+
+    def _observe(self, copies: np.ndarray | slice = slice(None)):
+        got = {}
+        for kind, names, cols, fill, low, high in self._scalars:
+            # per device the same elementwise steps: a missing value filled, float32, clipped to its Box
+            v = self.sim.values[kind][copies][:, cols]
+            v = np.clip(np.where(np.isfinite(v), v, fill).astype(np.float32), low, high)
+            for j, name in enumerate(names):
+                got[name] = v[:, j:j + 1]
+        out = {}
+        for name, box in self.agent.dict_space.spaces.items():
+            if name in got:
+                out[name] = got[name] if self.agent.flatten else got[name].copy()   # (each its own array)
+                continue
+            img = self.sim.range_image(self.refs[name])[copies]
+            hi = box.high.flat[0]
+            out[name] = np.clip(np.nan_to_num(img, nan=hi, posinf=hi), box.low, box.high).astype(np.float32)
         if self.agent.flatten:
             m = len(next(iter(out.values()))) if out else 0
             return np.concatenate([out[k].reshape(m, -1) for k in self.agent.dict_space.spaces], axis=1).astype(np.float32)
@@ -230,7 +249,7 @@ class SensoriumVectorEnv(VectorEnv):
         trunc = (self.steps[copies] >= ms) & ~term if ms is not None else np.zeros(len(copies), dtype=bool)
         return reward, term, trunc
 
-    def _info(self, copies: np.ndarray) -> dict[str, np.ndarray]:
+    def _info(self, copies: np.ndarray | slice) -> dict[str, np.ndarray]:
         rot = self.sim.rot[copies, self.slot]
         pos = self.sim.pos[copies, self.slot]
         yaw = np.array(list(map(math.atan2, rot[:, 1, 0].tolist(), rot[:, 0, 0].tolist())))
@@ -239,7 +258,7 @@ class SensoriumVectorEnv(VectorEnv):
 
     def _full_info(self, mask: np.ndarray) -> dict[str, np.ndarray]:
         """Info of every sub-env (Gymnasium's vector layout: one array per key and a ``_key`` mask)."""
-        info = self._info(np.arange(self.num_envs))
+        info = self._info(slice(None))      # every sub-env (views, not gathers)
         out: dict[str, np.ndarray] = {}
         for k, v in info.items():
             out[k] = v
@@ -308,7 +327,7 @@ class SensoriumVectorEnv(VectorEnv):
             self._run(np.zeros(n, dtype=bool), done)
             for g in self._goals[2]:
                 g.reset(ended)
-            fresh = self._info(np.arange(n))
+            fresh = self._info(slice(None))
             for k in ("time_ms", "steps", "pose"):
                 info[k] = fresh[k]
             done = np.zeros(n, dtype=bool)

@@ -21,6 +21,7 @@ __all__ = [
     "DistanceSensorType",
     "SENSOR_TYPES",
     "SONAR_MAX_INCIDENCE",
+    "sonar_incidence",
     "effective_number_of_rays",
     "ray_layout",
     "ray_directions",
@@ -133,6 +134,19 @@ def reflection_factor(red, roughness, occlusion=0.0) -> np.ndarray:
         * (1.0 - 0.5 * np.asarray(occlusion, dtype=np.float64))
 
 
+def sonar_incidence(u: np.ndarray, back: np.ndarray) -> np.ndarray:
+    """The angles (S, N) between rays ``u`` and reversed normals ``back`` (S, N, 3):
+    ``atan2(|u x back|, u . back)`` with ``np.linalg.norm(np.cross(u, back), axis=-1)``'s operations
+    (each component a1 b2 - a2 b1, ..., the squares summed (c0 c0 + c1 c1) + c2 c2 as numpy's
+    reduce over 3 sums them, the root), without their per-call overhead (~45 us on 256 sonars)."""
+    u0, u1, u2 = u[..., 0], u[..., 1], u[..., 2]
+    b0, b1, b2 = back[..., 0], back[..., 1], back[..., 2]
+    c0 = u1 * b2 - u2 * b1
+    c1 = u2 * b0 - u0 * b2
+    c2 = u0 * b1 - u1 * b0
+    return np.arctan2(np.sqrt((c0 * c0 + c1 * c1) + c2 * c2), np.einsum("snk,snk->sn", u, back))
+
+
 def combine_distance_batch(sensor_type, distances, directions, normals, weights, lut_max_range,
                            reflection=None, red_color_sensitivity=1.0) -> np.ndarray:
     """Distance ``D`` (S,) of S sensors with N rays each (spec §3.4).
@@ -161,27 +175,36 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
     if not known.all():
         raise ValueError(f"unknown sensor type(s) {np.unique(types[~known]).tolist()}")
     out = np.empty(S)
+    sonar = types == _SONAR
+    n_sonar = int(np.count_nonzero(sonar))
+    average = None
+    if n_sonar < S:   # generic (and infra-red, laser) read the weighted sum
+        average = np.einsum("sn,sn->s", w, r_or_max)
+        out[:] = average  # generic
 
-    average = np.einsum("sn,sn->s", w, r_or_max)
-    out[:] = average  # generic
+        m = types == _LASER
+        if np.any(m):
+            out[m] = r_or_max[m, 0]
 
-    m = types == _LASER
-    if np.any(m):
-        out[m] = r_or_max[m, 0]
-
-    m = types == _SONAR
-    if np.any(m):
-        u = np.asarray(directions, dtype=np.float64).reshape(S, N, 3)[m]
-        nrm = np.asarray(normals, dtype=np.float64).reshape(S, N, 3)[m]
-        beta = np.arctan2(np.linalg.norm(np.cross(u, -nrm), axis=2), np.einsum("snk,snk->sn", u, -nrm))
-        echo = hit[m] & (beta < SONAR_MAX_INCIDENCE)
-        out[m] = np.minimum(np.where(echo, r[m], np.inf).min(axis=1), rmax[m, 0])
+    if n_sonar:
+        every = n_sonar == S   # (all sonars: the arrays as they are, no gathers)
+        u = np.asarray(directions, dtype=np.float64).reshape(S, N, 3)
+        back = -np.asarray(normals, dtype=np.float64).reshape(S, N, 3)
+        # (contiguous, as a gather leaves them: einsum's kernel depends on the layout)
+        u, back = (np.ascontiguousarray(u), back) if every else (u[sonar], back[sonar])
+        beta = sonar_incidence(u, back)
+        if every:
+            echo = hit & (beta < SONAR_MAX_INCIDENCE)
+            out[:] = np.minimum(np.where(echo, r, np.inf).min(axis=1), rmax[:, 0])
+        else:
+            echo = hit[sonar] & (beta < SONAR_MAX_INCIDENCE)
+            out[sonar] = np.minimum(np.where(echo, r[sonar], np.inf).min(axis=1), rmax[sonar, 0])
 
     m = types == _INFRA_RED
     if np.any(m):
         f = np.ones((S, N)) if reflection is None else np.asarray(reflection, dtype=np.float64).reshape(S, N)
         factor = np.einsum("sn,sn->s", w, np.where(hit, f, 1.0))[m]
-        d = average[m]
+        d = average[m]   # type: ignore[index]  (set: not every sensor is a sonar)
         sens = np.broadcast_to(np.asarray(red_color_sensitivity, dtype=np.float64), (S,))[m]
         out[m] = d + (d / factor - d) * sens
 

@@ -135,7 +135,6 @@ class CopyRays:
             return hits
         dist = hits.distance
         lim = np.minimum(np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,)), dist)
-        lo = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,))
         copy = np.asarray(copy, dtype=np.int64).reshape(n)
         # broad phase: each ray against the bounding spheres of its own copy's bodies
         R = self.slots
@@ -145,6 +144,7 @@ class CopyRays:
         got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, lim, excl, mnt) if self.static.native
                else None)
         if got is None:
+            lo = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,))
             got = _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt)
         pr, pm = got
         if not len(pr):
@@ -167,7 +167,7 @@ class CopyRays:
         s_all = None if distance_only else np.full(len(pr), -1, dtype=np.int64)
         n_all = None if distance_only else np.zeros((len(pr), 3))
         exact = self.movers.precision is Precision.EXACT
-        big = max(float(np.abs(O).max()), 0.0)
+        big = max(float(O.max()), -float(O.min()))     # max |coordinate| (no |O| temporary: 0.5 MB for a lidar)
         eps64 = 1e-9 + 1e-14 * big          # the engine's float64 self-hit threshold for this cast
         done: set[int] = set()
         for r in range(R):

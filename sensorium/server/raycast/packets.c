@@ -635,7 +635,8 @@ void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double*
  * hit, as the numpy path's whole-array judging leaves it). Returns the number of hits.
  * Per-ray values come as a pointer, or NULL and one value for all rays: the float32 origins o32
  * (row stride o_stride; NULL: o1, or start32 * d + o1 in float32 when `shifted`, as numpy computes
- * a lidar's shifted origins), the far limits (NULL: far_value, or none when `far_none`), the tier
+ * a lidar's shifted origins; o1 NULL too: the rows of Ot rounded to float32, + start32 * d when
+ * `shifted`, numpy's astype and sum), the far limits (NULL: far_value, or none when `far_none`), the tier
  * frame origins Ot (NULL: `origin`), start, lim, the owner excluded (`has_excl`). */
 size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent, const float* o32, size_t o_stride,
                     const float* o1, int shifted, float start32, const float* d32, const float* far, float far_value,
@@ -660,6 +661,11 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
       if (o32) {
         const float* o = o32 + o_stride * i;
         r.org_x[k] = o[0]; r.org_y[k] = o[1]; r.org_z[k] = o[2];
+      } else if (!o1) {   /* Ot's rows rounded to float32 (numpy's astype), shifted as below */
+        const double* ot = Ot ? Ot + ot_stride * i : origin;
+        const float ox = (float)ot[0], oy = (float)ot[1], oz = (float)ot[2];
+        if (shifted) { r.org_x[k] = ox + start32 * d[0]; r.org_y[k] = oy + start32 * d[1]; r.org_z[k] = oz + start32 * d[2]; }
+        else { r.org_x[k] = ox; r.org_y[k] = oy; r.org_z[k] = oz; }
       } else if (shifted) {
         r.org_x[k] = start32 * d[0] + o1[0]; r.org_y[k] = start32 * d[1] + o1[1]; r.org_z[k] = start32 * d[2] + o1[2];
       } else {
@@ -803,6 +809,74 @@ size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const
   }
   return k;
 }
+
+/* batched.py's distance-sensor rays (batches._frames_t and _rotate_t's numpy path, operation for
+ * operation): sensor s of robot slot slots[s] in copy copies[s] (rot (C, R, 3, 3), pos (C, R, 3))
+ * with local frame pi[s] (local_rot (P, 3, 3), local_pos (P, 3)) and local ray directions k[s]
+ * (local_dirs (G, N, 3)): its world frame W = robot rotation A @ local rotation, each entry summed
+ * ((a0 l0 + a1 l1) + a2 l2) + 0.0, its position ((a0 p0 + a2 p2) + a1 p1) + 0.0 + robot position,
+ * each ray W @ d summed ((w0 d0 + w2 d2) + w1 d1) + 0.0. Writes positions (S, 3), every ray's
+ * origin (S * N, 3: its sensor's position) and direction (S * N, 3). Indices are the caller's,
+ * within those arrays. */
+void sp_sensor_rays(size_t S, size_t N, size_t R, const int64_t* copies, const int64_t* slots, const double* rot,
+                    const double* pos, const int64_t* pi, const double* local_rot, const double* local_pos,
+                    const int64_t* k, const double* local_dirs, double* positions, double* origins, double* dirs) {
+  for (size_t s = 0; s < S; s++) {
+    const size_t b = (size_t)copies[s] * R + (size_t)slots[s];
+    const double* A = rot + 9 * b;
+    const double* P = pos + 3 * b;
+    const double* L = local_rot + 9 * (size_t)pi[s];
+    const double* lp = local_pos + 3 * (size_t)pi[s];
+    double W[9], p[3];
+    for (int i = 0; i < 3; i++) {
+      for (int q = 0; q < 3; q++)
+        W[3 * i + q] = ((A[3 * i] * L[q] + A[3 * i + 1] * L[3 + q]) + A[3 * i + 2] * L[6 + q]) + 0.0;
+      p[i] = (((A[3 * i] * lp[0] + A[3 * i + 2] * lp[2]) + A[3 * i + 1] * lp[1]) + 0.0) + P[i];
+      positions[3 * s + (size_t)i] = p[i];
+    }
+    const double* d = local_dirs + 3 * N * (size_t)k[s];
+    for (size_t n = 0; n < N; n++) {
+      const double* dn = d + 3 * n;
+      double* o = dirs + 3 * (N * s + n);
+      double* g = origins + 3 * (N * s + n);
+      for (int i = 0; i < 3; i++) {
+        o[i] = ((W[3 * i] * dn[0] + W[3 * i + 2] * dn[2]) + W[3 * i + 1] * dn[1]) + 0.0;
+        g[i] = p[i];
+      }
+    }
+  }
+}
+
+/* The box of n points (rows of an (n,3) array): out[0..2] each column's minimum, out[3..5] its
+ * maximum, NaN when the column holds one (numpy's min and max: refine.py's screening of the starts
+ * of many rays, one pass over the rows where numpy's three column reductions make three). */
+#define SP_LO(acc, x) acc = (x) < acc ? (x) : acc
+#define SP_HI(acc, x) acc = (x) > acc ? (x) : acc
+void sp_box3(size_t n, const double* O, double* out) {
+  /* two rows a step into separate minima and maxima held in registers (independent chains, no
+     NaN test in them: a comparison with NaN keeps the accumulator), NaN columns flagged apart */
+  double l0 = O[0], l1 = O[1], l2 = O[2], h0 = O[0], h1 = O[1], h2 = O[2];
+  double m0 = l0, m1 = l1, m2 = l2, g0 = h0, g1 = h1, g2 = h2;
+  int n0 = O[0] != O[0], n1 = O[1] != O[1], n2 = O[2] != O[2];
+  size_t i = 1;
+  for (; i + 1 < n; i += 2) {
+    const double* a = O + 3 * i;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], b0 = a[3], b1 = a[4], b2 = a[5];
+    SP_LO(l0, a0); SP_LO(l1, a1); SP_LO(l2, a2); SP_HI(h0, a0); SP_HI(h1, a1); SP_HI(h2, a2);
+    SP_LO(m0, b0); SP_LO(m1, b1); SP_LO(m2, b2); SP_HI(g0, b0); SP_HI(g1, b1); SP_HI(g2, b2);
+    n0 |= (a0 != a0) | (b0 != b0); n1 |= (a1 != a1) | (b1 != b1); n2 |= (a2 != a2) | (b2 != b2);
+  }
+  if (i < n) {
+    const double* a = O + 3 * i;
+    SP_LO(l0, a[0]); SP_LO(l1, a[1]); SP_LO(l2, a[2]); SP_HI(h0, a[0]); SP_HI(h1, a[1]); SP_HI(h2, a[2]);
+    n0 |= a[0] != a[0]; n1 |= a[1] != a[1]; n2 |= a[2] != a[2];
+  }
+  SP_LO(l0, m0); SP_LO(l1, m1); SP_LO(l2, m2); SP_HI(h0, g0); SP_HI(h1, g1); SP_HI(h2, g2);
+  out[0] = n0 ? NAN : l0; out[1] = n1 ? NAN : l1; out[2] = n2 ? NAN : l2;
+  out[3] = n0 ? NAN : h0; out[4] = n1 ? NAN : h1; out[5] = n2 ? NAN : h2;
+}
+#undef SP_LO
+#undef SP_HI
 
 /* refine.py's screening of the curved-shell pre-pass, for many rays of many origins (the copies of
  * a batched world: their origins span the world, so every shell is near some ray): the start

@@ -170,6 +170,10 @@ def _load() -> None:
     lib.sp_cone.argtypes = [sz, vp, vp, d, vp]
     lib.sp_analytic.restype = None
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_sensor_rays.restype = None
+    lib.sp_sensor_rays.argtypes = [sz, sz, sz] + [vp] * 12
+    lib.sp_box3.restype = None
+    lib.sp_box3.argtypes = [sz, vp, vp]
     lib.sp_inside_shells.restype = sz
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
@@ -390,6 +394,25 @@ def scratch() -> Scratch:
 SCRATCH = _SCRATCH
 
 
+def _pair_buffers(size: int) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """Two int64 buffers of at least ``size`` entries (and their addresses) that a pair-listing
+    pass writes before its answer is copied out: this thread's, reused call after call up to
+    ``_PAIR_BUFFER`` entries (a 64-copy lidar scan's fresh (rays x slots) arrays, 0.7 MB, cost
+    ~30 us a call in page faults), fresh ones beyond."""
+    if size > _PAIR_BUFFER:
+        a, b = np.empty(size, dtype=np.int64), np.empty(size, dtype=np.int64)
+        return a, b, a.ctypes.data, b.ctypes.data
+    got = getattr(_tls, "pairs", None)
+    if got is None or len(got[0]) < size:
+        m = max(size, 4096)
+        a, b = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
+        got = _tls.pairs = (a, b, a.ctypes.data, b.ctypes.data)
+    return got
+
+
+_PAIR_BUFFER = 1 << 20
+
+
 def address(a: np.ndarray) -> int:
     """``a.ctypes.data`` (~1 us), remembered for the last few small arrays this thread passed (a
     lidar's beams, cast scan after scan); those arrays are kept alive meanwhile."""
@@ -502,15 +525,54 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
     ex_a = np.ascontiguousarray(excl, dtype=i64) if isinstance(excl, np.ndarray) else None
     mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
-    out_ray = np.empty(n * R, dtype=i64)
-    out_body = np.empty(n * R, dtype=i64)
-    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_lim, p_ray, p_body = _small_addresses(
-        (O, D, copy, centre, r2, present, lim, out_ray, out_body))
+    out_ray, out_body, p_ray, p_body = _pair_buffers(n * R)
+    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_lim = _small_addresses((O, D, copy, centre, r2, present, lim))
     k = lib.sp_copy_pairs(n, R, p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
                           0.0 if lo_a is not None else float(lo), p_lim, _ptr(ex_a),
                           0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
                           p_ray, p_body)
-    return out_ray[:k], out_body[:k]
+    return out_ray[:k].copy(), out_body[:k].copy()
+
+
+def sensor_rays(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.ndarray, pi: np.ndarray,
+                local_rot: np.ndarray, local_pos: np.ndarray, k: np.ndarray, local_dirs: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The world rays of S distance sensors in one C pass (``sp_sensor_rays``): (positions (S, 3),
+    origins (S * N, 3), directions (S, N, 3)), bit for bit the numpy path of
+    :meth:`.batched.BatchedSimulation._plan_distances` (``batches._frames_t``, ``_rotate_t``). Sensor s
+    is on slot ``slots[s]`` of copy ``copies[s]`` (``rot`` (C, R, 3, 3), ``pos`` (C, R, 3)) with local
+    frame ``pi[s]`` (``local_rot`` (P, 3, 3), ``local_pos`` (P, 3)) and ray directions ``k[s]``
+    (``local_dirs`` (G, N, 3)); every index must lie within its array. None without the helper."""
+    lib = library()
+    if lib is None:
+        return None
+    f64, i64 = np.float64, np.int64
+    S = len(copies)
+    C, R = rot.shape[:2]
+    G, N = local_dirs.shape[:2]
+    for a, shape in ((rot, (C, R, 3, 3)), (pos, (C, R, 3)), (local_rot, (len(local_rot), 3, 3)),
+                     (local_pos, (len(local_rot), 3)), (local_dirs, (G, N, 3))):
+        _check_buffer("sensor_rays", a, f64, shape)
+    idx = [np.ascontiguousarray(a, dtype=i64) for a in (copies, slots, pi, k)]
+    if any(a.shape != (S,) for a in idx):
+        raise TypeError("sensor_rays: inconsistent shapes")
+    positions, origins, dirs = np.empty((S, 3)), np.empty((S * N, 3)), np.empty((S, N, 3))
+    p = _small_addresses([*idx, rot, pos, local_rot, local_pos, local_dirs, positions, origins, dirs])
+    lib.sp_sensor_rays(S, N, R, p[0], p[1], p[4], p[5], p[2], p[6], p[7], p[3], p[8], p[9], p[10], p[11])
+    return positions, origins, dirs
+
+
+def box3(O: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(each column's minimum, maximum) of the rows of a C-contiguous float64 (n, 3) array, n >= 1,
+    in one C pass (``sp_box3``: numpy's min and max, NaN propagated); None without the helper or
+    for another array."""
+    lib = library()
+    if lib is None or O.dtype != np.float64 or O.ndim != 2 or O.shape[1] != 3 or not len(O) \
+            or not O.flags.c_contiguous:
+        return None
+    out = np.empty(6)
+    lib.sp_box3(len(O), O.ctypes.data, out.ctypes.data)
+    return out[:3], out[3:]
 
 
 def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: bool = False
@@ -534,12 +596,11 @@ def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: 
     ks = np.asarray(shells, dtype=i64)
     arrays = [np.ascontiguousarray(getattr(tier, name), dtype=dt) for name, dt in (
         ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
-    out_row = np.empty(m * len(ks), dtype=i64)
-    out_slot = np.empty(m * len(ks), dtype=i64)
-    p = _small_addresses([O, D, ks, *arrays, out_row, out_slot])
+    out_row, out_slot, p_row, p_slot = _pair_buffers(m * len(ks))
+    p = _small_addresses([O, D, ks, *arrays])
     k = lib.sp_inside_shells(m, p[0], o_stride, p[1], _ptr(lo_a), 0.0 if lo_a is not None else float(lo), len(ks),
-                             p[2], *p[3:9], 1 if bound_first else 0, p[9], p[10])
-    return out_row[:k], out_slot[:k]
+                             p[2], *p[3:9], 1 if bound_first else 0, p_row, p_slot)
+    return out_row[:k].copy(), out_slot[:k].copy()
 
 
 def _small_addresses(arrays) -> list[int]:

@@ -324,8 +324,10 @@ class Refiner:
             # per column: numpy reduces a short inner axis ~10x slower than a contiguous column
             reach = float(lo.max()) if isinstance(lo, np.ndarray) else lo
             Ou = Ot[:1] if Ot.strides[0] == 0 else Ot   # one origin for all rays (a broadcast array)
-            box_lo = np.array([Ou[:, k].min() for k in range(3)]) - reach
-            box_hi = np.array([Ou[:, k].max() for k in range(3)]) + reach
+            box = packets.box3(Ou) if self.native and len(Ou) > 1 else None
+            if box is None:
+                box = np.array([Ou[:, k].min() for k in range(3)]), np.array([Ou[:, k].max() for k in range(3)])
+            box_lo, box_hi = box[0] - reach, box[1] + reach
             gap = cp - np.minimum(np.maximum(cp, box_lo), box_hi)
             near = (_dot(gap, gap) <= tier.c_bound2).nonzero()[0].tolist()
             if not near:

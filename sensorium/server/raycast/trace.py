@@ -109,10 +109,11 @@ class TierTracer(Refiner):
                 lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, lim)
                 lim[pre[0]] = np.minimum(lim[pre[0]], pre[1])
         # one origin: its float32 row o1, as a read-only broadcast o32 once needed (the C pass takes
-        # o1 and the start itself: see _fast_native)
+        # o1 and the start itself: see _fast_native); many origins: the C pass rounds Ot's rows to
+        # float32 itself (and shifts them by a scalar start) unless o32 is needed here first
         native = self.native and m > 0 and tier.native(False) is not None
         o1 = Ot[:1].astype(_F32) if one else None
-        o32 = None if one else Ot.astype(_F32)
+        o32 = None if one or (native and big is not None) else Ot.astype(_F32)
         shared = one
         d32 = D.astype(_F32) if d32 is None else d32   # never written
         start = t_near
@@ -122,7 +123,7 @@ class TierTracer(Refiner):
             big = max(map(abs, ob.ravel().tolist())) if len(ob) <= _SMALL else max(-float(ob.min()), float(ob.max()))
         if big * 1.7321 > tier.radius:
             if o32 is None:
-                o32 = _one_row(o1, m)
+                o32 = _one_row(o1, m) if one else Ot.astype(_F32)
             far_rows = (_dot(o32, o32) > _F32(tier.radius * tier.radius)).nonzero()[0]
             if len(far_rows):  # origin outside the tier's sphere: start at its entry (precision)
                 if shared:
@@ -137,7 +138,7 @@ class TierTracer(Refiner):
                 dead = far_rows[q2 > tier.radius ** 2]
                 o32 += start[:, None] * d32
                 o32[far_rows] = Of + start[far_rows][:, None] * Df
-        shifted = False   # o32 = float32(start) d32 + o1, made in the C pass
+        shifted = False   # o32 = float32(start) d32 + o1 (or + float32(Ot)), made in the C pass
         if not isinstance(start, np.ndarray):
             if start > 0.0 and shared:   # o + s d in float32 (the same sum, operands swapped)
                 if native and o32 is None:
@@ -147,10 +148,15 @@ class TierTracer(Refiner):
                     o32 += o1
                 shared = False
             elif start > 0.0:
-                o32 += _F32(start) * d32
+                if o32 is None:
+                    shifted = True
+                else:
+                    o32 += _F32(start) * d32
         elif dead is None:
             if shared:
                 o32, shared = (_one_row(o1, m) if o32 is None else o32).copy(), False
+            elif o32 is None:
+                o32 = Ot.astype(_F32)
             o32 += start[:, None] * d32
         slack = 1.0 + 2.0 ** -20  # float32 slack so a hit exactly at t_far counts
         if (dead is None or not len(dead)) and (isinstance(lim, np.ndarray) or isinstance(start, np.ndarray)):
@@ -235,7 +241,8 @@ class TierTracer(Refiner):
                      distance_only: bool):
         """FAST's Embree call and judging (``_judge_fast``, ``_special``) in one call of packets.c:
         (hits, t, shape, normal, redo mask or None), the values of the numpy path. ``o32`` None: one
-        origin ``o1``, shifted by ``start`` along each ray when ``shifted``. A small cast writes into
+        origin ``o1``, shifted by ``start`` along each ray when ``shifted``; ``o32`` and ``o1`` None:
+        ``Ot``'s rows rounded to float32 (``Ot.astype(float32)``), shifted likewise. A small cast writes into
         the thread's scratch buffers and passes no array it did not pass before (a lidar's beams):
         its fixed cost is the call."""
         scene, built = tier.scene(False)
@@ -248,7 +255,10 @@ class TierTracer(Refiner):
         addr = packets.address if small else (lambda a: a.ctypes.data)
         if not (d32.flags.c_contiguous and d32.dtype == _F32):
             d32 = np.ascontiguousarray(d32, dtype=_F32)
-        if o32 is None:
+        p_o1 = sc.p_o1
+        if o32 is None and o1 is None:   # Ot's rows, rounded in the C pass
+            o_ptr, o_stride, p_o1 = None, 0, None
+        elif o32 is None:
             sc.o1[:] = o1[0]
             o_ptr, o_stride = None, 0
         elif o32.strides[0] == 0:
@@ -282,7 +292,7 @@ class TierTracer(Refiner):
             p_t, p_sp = t.ctypes.data, special.ctypes.data
             p_s, p_n = (None, None) if distance_only else (shape.ctypes.data, normal.ctypes.data)
         n_hit = packets.library().sp_fast_pass(
-            scene.handle, tier.native(False), m, 1 if coherent else 0, o_ptr, o_stride, sc.p_o1, 1 if shifted else 0,
+            scene.handle, tier.native(False), m, 1 if coherent else 0, o_ptr, o_stride, p_o1, 1 if shifted else 0,
             _F32(start) if shifted else 0.0, addr(d32), far_ptr, far_value, 1 if far is None else 0, ot_ptr,
             ot_stride, sc.p_origin, addr(dd), None if st_arr is None else st_arr.ctypes.data,
             0.0 if st_arr is not None else start, None if lim_arr is None else lim_arr.ctypes.data,

@@ -317,7 +317,10 @@ class BatchedSimulation:
                     cols[k] = self._noise_col[(kind_name, k)] = len(paths)
                     paths.append(d.path)
             self._noise_of[kind_name] = cols
-        self.noise = NoiseStreams(C, paths)
+        # blocks of up to 256 numbers (a refill is a Python call per stream: ~4 us each, every
+        # block's worth of draws) within ~4 MB of buffer, never fewer than 64 (ReachLight x256: 186)
+        block = int(min(256, max(64, (1 << 19) // max(1, C * len(paths)))))
+        self.noise = NoiseStreams(C, paths, block=block)
         # per kind: schedules (period, last update) per copy and the latest values
         self.period = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
         self.last = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
@@ -357,6 +360,7 @@ class BatchedSimulation:
             self._d_tables = [(table, np.array([self._d_col[id(self._d_plan.devices[i])] for i in idx.tolist()],
                                                dtype=np.int64)) for table, idx in self._d_plan.tables]
             self._d_table_of = _table_of(self._d_tables, len(self.distance))
+            self._own_kept: dict[int, tuple] = {}   # per group: its due sensors' own-body hits (_own_rows)
         if self.position:
             wheel = []
             for d in self.position:
@@ -578,8 +582,6 @@ class BatchedSimulation:
         out = ends.copy()
         reach = np.hypot(*(ends - starts).T) + EPS
         Rr = self.foot_radius[slots]
-        band_lo = self.heights[copies, slots] + self.foot_low[slots]
-        band_hi = self.heights[copies, slots] + self.foot_high[slots]
         # where every robot may be during this step: its disc, grown by its own move if it moves
         grow = np.zeros((self.copies, self.R))
         grow[copies, slots] = reach
@@ -590,13 +592,15 @@ class BatchedSimulation:
             solid_hit = solid_hit if len(ct._obs) else None
             robot_hit = robot_hit if self.R > 1 else None
         else:
-            solid_hit, robot_hit, near = self._contact_near(copies, slots, starts, reach, band_lo, band_hi, grow)
+            solid_hit, robot_hit, near = self._contact_near(copies, slots, starts, reach, grow)
         footless = np.isnan(Rr)
         if not near.any():
             # nothing near any move: each ends where Contact._clip without candidates puts it (a
             # robot without a footprint: at its end), whatever the slot order
             self.centres[copies, slots] = np.where(footless[:, None], ends, starts + (ends - starts))
             return out[:, 0], out[:, 1]
+        band_lo = self.heights[copies, slots] + self.foot_low[slots]
+        band_hi = self.heights[copies, slots] + self.foot_high[slots]
         # slot by slot, as Contact.resolve_all takes robots in world order (each sees the earlier
         # slots of its copy where they ended, the later ones where they started)
         for r in np.unique(slots).tolist():
@@ -625,13 +629,15 @@ class BatchedSimulation:
                     out[m] = p
         return out[:, 0], out[:, 1]
 
-    def _contact_near(self, copies, slots, starts, reach, band_lo, band_hi, grow):
+    def _contact_near(self, copies, slots, starts, reach, grow):
         """The broad phase of :meth:`_contact` in numpy (packets.contact_near's fallback):
         (solid_hit (k, S) or None, robot_hit (k, R) or None, near (k,))."""
         ct = self.contact
         assert ct is not None
         k = len(copies)
         Rr = self.foot_radius[slots]
+        band_lo = self.heights[copies, slots] + self.foot_low[slots]
+        band_hi = self.heights[copies, slots] + self.foot_high[slots]
         box_lo = starts - (reach + Rr)[:, None]
         box_hi = starts + (reach + Rr)[:, None]
         solid_hit = robot_hit = None
@@ -655,6 +661,10 @@ class BatchedSimulation:
 
     # -- devices
     def _due(self, kind: str, live: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if len(live) == self.copies:    # every copy (live is then 0 ... C-1): the arrays as they are
+            per = self.period[kind]
+            due = (per > 0) & (self.time_ms[:, None] - self.last[kind] >= per)
+            return due.nonzero()
         per = self.period[kind][live]
         due = (per > 0) & (self.time_ms[live][:, None] - self.last[kind][live] >= per)
         ci, di = due.nonzero()
@@ -808,17 +818,22 @@ class BatchedSimulation:
             pi = g.idx[k]                                  # index in the plan's stacked constants
             c = copies[rows]
             slot = plan.robot[pi]
-            rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
-            rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
-                                     np.ascontiguousarray(plan.local_pos_t[:, pi]))
-            positions = pos_t.T + self.pos[c, slot]
-            dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
             n = g.n
+            got = packets.sensor_rays(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k, g.local_dirs)
+            if got is not None:
+                positions, origins, dirs = got
+            else:
+                rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
+                rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
+                                         np.ascontiguousarray(plan.local_pos_t[:, pi]))
+                positions = pos_t.T + self.pos[c, slot]
+                dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
+                origins = np.repeat(positions, n, axis=0)
             mount = -1
             if g.mount is not None:
                 mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
-            reqs.append(_Rays(np.repeat(positions, n, axis=0), dirs.reshape(-1, 3), 0.0,
+            reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0,
                               g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1),
                               g.kind, np.repeat(c, n), exclude, mount, skip=g.skip))
             state["groups"].append((g, rows, k, c, slot, positions, dirs))
@@ -833,8 +848,7 @@ class BatchedSimulation:
             dist, shape, normal = h.distance, h.shape, h.normal
             own = g.own_hits(self.rays.movers, plan.local_rot, plan.local_pos) if g.mount is not None else None
             if own is not None:   # the nearer of the cast and the ray's own-body hit (decided once)
-                ray = (k[:, None] * n + np.arange(n)).reshape(-1)
-                od, osh, onr = own.distance[ray], own.shape[ray], own.normal[ray]
+                od, osh, onr = self._own_rows(g, own, k)
                 win = (od < dist).nonzero()[0]
                 if len(win):
                     dist, shape, normal = dist.copy(), shape.copy(), normal.copy()
@@ -874,6 +888,15 @@ class BatchedSimulation:
             q = np.trunc(values / np.where(rounded, res, 1.0) + 0.5) * res + 0.0
             values = np.where(rounded, q, values)
         self._store("DistanceSensor", copies, cols, values)
+
+    def _own_rows(self, g, own: RayHits, k: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The own-body hits (distance, shape, normal) of the rays of group ``g``'s sensors ``k``,
+        kept while the same sensors are due (step after step: a gather of every ray's hit less)."""
+        got = self._own_kept.get(id(g))
+        if got is None or got[0] is not own or not np.array_equal(got[1], k):
+            ray = (k[:, None] * g.n + np.arange(g.n)).reshape(-1)
+            got = self._own_kept[id(g)] = (own, k.copy(), own.distance[ray], own.shape[ray], own.normal[ray])
+        return got[2], got[3], got[4]
 
     def _infra_red_terms(self, shape, origins, directions, distance):
         """Scene.infra_red_terms for hits on solids (textures live there); robot shapes read their
@@ -927,7 +950,13 @@ class BatchedSimulation:
             return got[1], got[2]
         lid = self.lidar[col]
         ray_copy = np.repeat(copies, W)
-        mount = lid.robot_index if lid._own_body is not None else np.tile(self._lidar_skip(col), len(copies))
+        skip = self._lidar_skip(col)
+        if lid._own_body is not None:
+            mount: np.ndarray | int = lid.robot_index
+        elif len(skip) and (skip == skip[0]).all():   # every beam alike: one value (the pairing skips the
+            mount = int(skip[0])                       # slot without reading a value per ray)
+        else:
+            mount = np.tile(skip, len(copies))
         self._lidar_plan[col] = (copies.copy(), ray_copy, mount)
         return ray_copy, mount
 
@@ -1061,6 +1090,15 @@ def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: 
     """motion.arc_step for many robots, element by element the same float64 operations."""
     dyaw = w * dt
     straight = np.abs(dyaw) < 1e-9
+    n_straight = int(np.count_nonzero(straight))
+    if n_straight == 0:   # every robot turns (or every one goes straight): whole arrays, no gathers
+        r = v / w
+        c1, s1 = _cos_sin(yaw + dyaw)
+        c0, s0 = _cos_sin(yaw)
+        return x + r * (s1 - s0), y - r * (c1 - c0), np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi
+    if n_straight == len(x):
+        cm, sm = _cos_sin(yaw + 0.5 * dyaw)
+        return (x + v * dt * cm, y + v * dt * sm, np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi)
     xo, yo = x.copy(), y.copy()
     s = straight.nonzero()[0]
     if len(s):
