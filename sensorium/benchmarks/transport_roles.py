@@ -10,6 +10,10 @@ import time
 
 import numpy as np
 
+# a server role quits after this long without a message (its parent gone); the bench starts several
+# `sensorium serve` processes after it, seconds each on a busy machine
+IDLE_MS = 120_000
+
 
 # ============================================================================ subprocess roles
 def _bind(s, endpoint: str) -> str:
@@ -20,9 +24,10 @@ def _bind(s, endpoint: str) -> str:
     return f"{endpoint}:{s.bind_to_random_port(endpoint)}"
 
 
-def _role_rep_echo(endpoint: str) -> None:
-    """Raw pyzmq REP: echo every message (the floor of any request/reply round trip)."""
-    _serve_rep(endpoint, 0.0)
+def _role_rep_echo(endpoint: str, cpu: str = "") -> None:
+    """Raw pyzmq REP: echo every message (the floor of any request/reply round trip). ``cpu``: its
+    thread and ZeroMQ's I/O threads on that CPU, as ``sensorium serve --cpu`` runs (the pinned floor)."""
+    _serve_rep(endpoint, 0.0, int(cpu) if cpu else None)
 
 
 def _role_rep_work(endpoint: str, work_us: str) -> None:
@@ -32,18 +37,21 @@ def _role_rep_work(endpoint: str, work_us: str) -> None:
     _serve_rep(endpoint, float(work_us) * 1e-6)
 
 
-def _serve_rep(endpoint: str, work: float) -> None:
+def _serve_rep(endpoint: str, work: float, cpu: int | None = None) -> None:
     import zmq
 
     ctx = zmq.Context()
+    if cpu is not None:
+        ctx.set(zmq.THREAD_AFFINITY_CPU_ADD, cpu)
+        os.sched_setaffinity(0, {cpu})
     s = ctx.socket(zmq.REP)
     print(f"ready {_bind(s, endpoint)}", flush=True)
     clock = time.perf_counter
     poller = zmq.Poller()
     poller.register(s, zmq.POLLIN)
     while True:
-        if not poller.poll(10_000):
-            break                                    # idle for 10 s: the parent is gone
+        if not poller.poll(IDLE_MS):
+            break                                    # idle that long: the parent is gone
         msg = s.recv()
         if msg == b"quit":
             s.send(b"bye")
@@ -68,7 +76,7 @@ def _role_router_echo(endpoint: str) -> None:
     print(f"ready {_bind(s, endpoint)}", flush=True)
     poller = zmq.Poller()
     poller.register(s, zmq.POLLIN)
-    while poller.poll(10_000):
+    while poller.poll(IDLE_MS):
         frames = s.recv_multipart()
         req = msgpack.unpackb(frames[-1], raw=False)
         if req.get("service") == "quit":

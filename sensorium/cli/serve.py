@@ -68,6 +68,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_world_options(p)
     p.add_argument("--allow-skipped", action="store_true",
                    help="serve a world even when every robot it writes was lost when it loaded (each is listed)")
+    p.add_argument("--cpu", type=int, metavar="N",
+                   help="run the server's loop thread and ZeroMQ's I/O threads on CPU N (Linux): a lockstep round "
+                   "trip is shorter when they share a core (README 'Lockstep latency'); the ray engine's threads "
+                   "still use every core")
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="with --record: only these topics (names, prefixes, globs); they are computed even "
                    "without subscribers (default: every topic)")
@@ -105,7 +109,8 @@ def options(args: argparse.Namespace):
                         allow_outside_meshes=getattr(args, "allow_outside_meshes", False),
                         contact=False if getattr(args, "no_contact", False) else None,
                         controls=getattr(args, "controls", "auto"), curve_keys=getattr(args, "curve_keys", None),
-                        watch=getattr(args, "watch", None), allow_skipped=getattr(args, "allow_skipped", False))
+                        watch=getattr(args, "watch", None), allow_skipped=getattr(args, "allow_skipped", False),
+                        cpu=getattr(args, "cpu", None))
 
 
 def bind_problem(exc: BaseException) -> str:

@@ -15,7 +15,7 @@ from typing import Any
 
 from sensorium.server.daemon.roles import CONTROLS, open_controls
 from sensorium.server.daemon.services import Core
-from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport, load_curve_keys
+from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport, check_cpu, load_curve_keys
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import LoadedWorld, Problem, WorldError, default_world_path, load_world
@@ -40,6 +40,7 @@ class ServeOptions:
     curve_keys: str | None = None     # DIR with server.key_secret: CURVE on both sockets
     watch: list[str] | None = None    # run these "<extern>" robots ([] = every one) as "<none>" (serve --watch)
     allow_skipped: bool = False       # serve a world whose robots were all dropped when it loaded
+    cpu: int | None = None            # run the loop and ZeroMQ's I/O threads on this CPU (serve --cpu)
 
     def check(self) -> None:
         """Raise ValueError naming the first bad option."""
@@ -49,6 +50,8 @@ class ServeOptions:
             raise ValueError(f"--controls must be one of {', '.join(CONTROLS)}, got {self.controls!r}")
         if self.curve_keys:
             load_curve_keys(self.curve_keys)
+        if self.cpu is not None:
+            check_cpu(self.cpu)
 
 
 def build(world: str | Path | None, options: ServeOptions | None = None) -> tuple[Core, Transport]:
@@ -68,7 +71,7 @@ def build(world: str | Path | None, options: ServeOptions | None = None) -> tupl
     sim = Simulation(loaded, opts.precision, contact=opts.contact)
     core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode,
                 open_controls=open_controls(opts.controls, opts.rpc))
-    return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until, curve_secret=secret)
+    return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until, curve_secret=secret, cpu=opts.cpu)
 
 
 def refuse_robotless(loaded: LoadedWorld) -> None:

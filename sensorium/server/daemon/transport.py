@@ -36,7 +36,7 @@ from sensorium.server.daemon.services import STEP_REPLY_PIECES, Core
 from sensorium.server.daemon.steppath import gate_for
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
-           "curve_client_from_env"]
+           "curve_client_from_env", "check_cpu"]
 
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
@@ -60,6 +60,15 @@ def _bindable(url: str) -> str:
     if url.startswith("tcp://") and url.endswith(":0"):
         return url[:-2] + ":*"
     return url
+
+
+def check_cpu(cpu: int) -> None:
+    """ValueError unless this process may run on CPU ``cpu`` and can pin threads (Linux)."""
+    if not hasattr(os, "sched_setaffinity"):
+        raise ValueError("--cpu: pinning threads to a CPU needs Linux")
+    allowed = sorted(os.sched_getaffinity(0))
+    if cpu not in allowed:
+        raise ValueError(f"--cpu {cpu}: this process may run on CPUs {', '.join(map(str, allowed))} only")
 
 
 # ---------------------------------------------------------------------- CURVE (serve --curve-keys DIR)
@@ -132,13 +141,24 @@ class Transport:
     def __init__(self, core: Core, rpc: str = DEFAULT_RPC, pub: str = DEFAULT_PUB, *,
                  hard_limit: int = HARD_LIMIT, pub_hwm: int = 100, grace_s: float = 0.5,
                  context: zmq.Context | None = None, clock: Callable[[], float] = time.monotonic,
-                 stop_at_ms: int | None = None, curve_secret: bytes | None = None, step_path: str | None = None):
+                 stop_at_ms: int | None = None, curve_secret: bytes | None = None, step_path: str | None = None,
+                 cpu: int | None = None):
         self.core = core
         self.stop_at_ms = stop_at_ms          # quit (steps answer -1) once simulated time reaches it
         self.clock = clock
         self.grace_s = grace_s
         self._own_context = context is None
         self.ctx = context or zmq.Context()
+        # --cpu: the loop thread (pinned in run) and ZeroMQ's I/O threads on one core: a request's
+        # hand-over from the I/O thread to the loop and the reply's way back are then wake-ups on
+        # that core, not across cores (the lockstep round trip's cost on a VM; bench transport
+        # section). Set before the first socket starts the I/O threads of a context of our own.
+        if cpu is not None:
+            check_cpu(cpu)
+            if context is not None:
+                raise ValueError("Transport(cpu=...) pins the I/O threads of its own context: pass no context")
+            self.ctx.set(zmq.THREAD_AFFINITY_CPU_ADD, cpu)
+        self.cpu = cpu
         self.router = self.ctx.socket(zmq.ROUTER)
         self.xpub = self.ctx.socket(zmq.XPUB)
         hb = max(1, core.lockstep.heartbeat_ms)
@@ -245,6 +265,7 @@ class Transport:
         next_step: float | None = None               # when the world may step next (None: not by itself)
         deaf_since = clock()                         # the loop last listened to the ROUTER then
         peers_generation = -1
+        pinned = self._pin()
         try:
             while True:
                 if self._stop_requested and quit_at is None:
@@ -311,9 +332,21 @@ class Transport:
                     hook()
                 next_step = self._run_steps(now)
         finally:
+            if pinned is not None:
+                os.sched_setaffinity(0, pinned)
             if not self.router.closed:
                 self._flush()
             self.close()
+
+    def _pin(self) -> set[int] | None:
+        """With ``cpu``: run this (the loop's) thread on it until :meth:`run` ends; the CPUs it
+        had before (threads the loop starts meanwhile inherit the pin; the ray engine's block
+        workers widen theirs back, raycast/blocks.py)."""
+        if self.cpu is None:
+            return None
+        before = os.sched_getaffinity(0)
+        os.sched_setaffinity(0, {self.cpu})
+        return before
 
     def _serve(self, batch: list, now: float) -> None:
         """Answer one batch from the gate: recognised steps, other messages, over-long messages.

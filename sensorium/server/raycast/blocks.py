@@ -57,6 +57,20 @@ def split(n: int, threads: int, chunk: int) -> list[slice]:
     return [slice(a, min(n, a + size)) for a in range(0, n, size)]
 
 
+# the CPUs of the process as it started (before a server pinned its loop thread: serve --cpu)
+_CPUS = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else None
+
+
+def _every_core() -> None:
+    """A block worker runs on every CPU of the process, even when the thread that started the pool
+    was pinned to one (``serve --cpu`` pins the server's loop, whose casts start the pool)."""
+    if _CPUS is not None:
+        try:
+            os.sched_setaffinity(0, _CPUS)
+        except OSError:
+            pass
+
+
 def _executor(workers: int) -> ThreadPoolExecutor:
     global _pool, _workers, _pid
     with _lock:
@@ -65,7 +79,7 @@ def _executor(workers: int) -> ThreadPoolExecutor:
         if _pool is None or _workers < workers:
             if _pool is not None:
                 _pool.shutdown(wait=False)
-            _pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix=_PREFIX)
+            _pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix=_PREFIX, initializer=_every_core)
             _workers = workers
         return _pool
 
