@@ -240,8 +240,8 @@ def multi_runs(tmp: Path, k: int, steps: int, runs: int, bursts: int) -> list[di
             pinned = None if cpu is None else Server(_robots_world(k), tmp, step_path=step_paths()[0], cpu=cpu)
             if pinned is not None:
                 servers.append(pinned)
-            # the floor's REP last: it quits after 10 s without a message (its parent gone), and the
-            # servers above take seconds each to start on a busy machine
+            # the floor's REP last: it quits after transport_roles.IDLE_MS without a message (its
+            # parent gone), and the servers above take seconds each to start on a busy machine
             rep = Proc(_role_args("rep-echo", "tcp://127.0.0.1"))
             servers.append(rep)
             rep_ep = rep.line().split()[1]
@@ -782,8 +782,9 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
               for p in [*paths, "bare", "pinned"] if all(p in m for m in multi)}
     r = ratios[best]
     ok8 = min(r) >= 0.7
+    # (the pinned server's ratios are shown, not judged: no floor pinned the same way runs beside
+    # the 8 controllers, so they would compare a pinned server with an unpinned floor)
     pinned8 = ratios.get("pinned")
-    ok8_pinned = pinned8 is not None and min(pinned8) >= 0.7
     c8 = data["server_cpu"]["8"]
     why8 = [f"{len(multi)} runs, each: 8 raw REQ processes ↔ a do-nothing REP and 8 controller processes ↔ "
             "`sensorium serve` per step path, in alternating bursts. Ratios per run: "
@@ -801,9 +802,7 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
                         f"steps/s vs {n8['raw_steps_per_s']:,.0f} for 8 libzmq REQ processes ↔ a C REP echo "
                         f"({n8['steps_per_s'] / n8['raw_steps_per_s']:.2f}×); the server's busiest thread used "
                         f"{us(n8['server_loop_cpu_per_step_s'])} of CPU per world step.")
-    if ok8_pinned and not ok8:
-        why8.append(f"PASS with `--cpu {pin_cpu()}` only.")
-    if not (ok8 or ok8_pinned):
+    if not ok8:
         why8.append("MISS: on 2 cores the lockstep is a barrier: after each world step all 8 controllers wake at once and "
                     "the next step waits for the last request, while the raw floor's 8 processes overlap freely; each "
                     "message also costs a wake-up of libzmq's I/O threads on both sides (context switches, costly in "
@@ -812,4 +811,4 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
                               "≥ 0.7× in every run", f"{min(r):.2f}–{max(r):.2f}× over {len(r)} runs [{best} step path]"
                               + (f"; with `serve --cpu {pin_cpu()}`: {min(pinned8):.2f}–{max(pinned8):.2f}×"
                                  if pinned8 is not None else ""),
-                              ok8 or ok8_pinned, " ".join(why8)))
+                              ok8, " ".join(why8)))
