@@ -1,7 +1,8 @@
 """Camera recognition (Webots' Recognition node) — pure geometry, camera frame FLU, float64.
 
 An object is a top-level solid or a robot with ``recognition_colors``. From its shapes (their
-bounding shapes if it has any, else all of them — Webots: the boundingObject, else the shapes):
+bounding shapes if it has any, else all of them — Webots: the boundingObjects, else the object's
+bounding sphere):
 
 * ``bounds`` — its axis-aligned box in the camera frame, exact: a box's 8 corners, a mesh's or a
   finite plane's vertices, a sphere's ``c ± r``, a cylinder's ``|a_k|·h/2 + r·√(1 − a_k²)`` and a
@@ -25,9 +26,9 @@ float32 vertical angle ``2·atan(tan(Φ/2)·H/W)``):
 * a box, a mesh or a finite plane by its points: a point in front of the camera (``x > 0``) outside
   a plane is moved onto it by orthogonal projection, plane after plane in that order (so its depth
   changes too); points behind the camera are kept as they are; the shape is seen if one point is
-  in front, and one is inside all four planes or the points cross the view from side to side (outside
-  right and left, never all below or all above) or from bottom to top; its box is that of the moved
-  and kept points;
+  in front, and one is inside all four planes or the points cross the view from side to side (some
+  outside the right plane, some outside the left, some inside the bottom and some inside the top
+  one) or likewise from bottom to top; its box is that of the moved and kept points;
 * a sphere, cylinder or capsule by its centre ``c`` and box: with ``d`` the signed distance from
   ``c`` to a plane (positive inside) and ``e`` half the box's extent across it (y for right/left,
   z for bottom/top), ``d < −e`` hides the shape; else ``e − d`` (when positive) is cut from that

@@ -12,8 +12,8 @@ occlusion test needs (Webots' ``occlusion`` field):
 
 An object's box is, for a planar camera, that of its part in view (Webots clips each shape to the
 view first; a non-planar camera's boxes are whole). An object is in range when that box reaches in
-front of the camera and starts before ``max_range`` (in depth). ``max_objects`` keeps the biggest on the image (``size_on_image`` area; ties in id
-order). The segmentation image: each pixel whose ray's first visible surface belongs to a
+front of the camera and starts before ``max_range`` (in depth). ``max_objects`` keeps the biggest
+on the image (``size_on_image`` area; ties in id order). The segmentation image: each pixel whose ray's first visible surface belongs to a
 recognisable object within ``max_range`` (depth for a planar camera) has the object's first
 recognition colour, the rest black; alpha 255.
 """
