@@ -333,3 +333,18 @@ def test_the_view_planes_use_webots_float32_half_angles():
     assert left[0] / -left[1] == pytest.approx(t32, rel=1e-15) and t32 != math.tan(fov / 2)
     assert rmath.frustum(imaging.ImageGeometry(W, H, 2.0)).shrink_round is False     # wider than pi/2
     assert rmath.frustum(imaging.ImageGeometry(W, H, 1.0, "cylindrical")) is None
+
+
+def test_occlusion_1_aims_at_the_whole_objects_centre_not_the_part_in_view():
+    # y 0.7..1.7 at x = 2: its whole centre (2, 1.2, 0) is out of view, the part in view is centred
+    # at (2.12, 0.99, 0); a small pane at x = 1, y 0.58..0.66 blocks the ray to (2, 1.2, 0) (y = 0.6
+    # at x = 1), not the one to the part in view (y = 0.47 there): the object counts as hidden, as
+    # Webots' ray to the object's origin would find it
+    wide = solid("wide", {"translation": [2.0, 1.2, 0.0]}, {"type": "box", "size": [0.2, 1.0, 0.2]})
+    pane = {"name": "pane", "pose": {"translation": [1.0, 0.62, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.08, 0.1]}}
+    [seen] = recognise(world([wide, pane], {"occlusion": 0}))[1]
+    x_far, y_far = onto_left(2.1, 1.7)
+    assert_box(seen, np.array([1.9, 0.7, -0.1]), np.array([x_far, y_far, 0.1]))
+    assert 0.4 < seen.position[1] / seen.position[0] < 0.5                   # 0.47: under the pane
+    assert recognise(world([wide, pane], {"occlusion": 1}))[1] == []
+    assert len(recognise(world([wide], {"occlusion": 1}))[1]) == 1
