@@ -213,3 +213,138 @@ def test_python_api_through_a_server(tmp_path):
 def test_nested_solids_cannot_carry_recognition_colours():
     with pytest.raises(ValueError, match="recognition_colors are read on top-level solids"):
         wm.Solid.model_validate({"name": "a", "children": [{"name": "b", "recognition_colors": [[1, 0, 0]]}]})
+
+
+# -- clipping to the view (Webots' WbObjectDetection): a planar camera reports the part of an object
+# in view. The view's side planes pass through the camera: left y = t·x, right y = −t·x, top
+# z = tv·x, bottom z = −tv·x (t = tan(FOV/2) exactly, FOV/2 = 0.5 being a float32; tv = t·H/W up
+# to Webots' float32 vertical angle, ~1e-8). A box's corner outside a plane moves onto it square
+# to the plane: onto the left plane (x, Y) -> x' = (x + t·Y)/(1 + t²), y' = t·x'; onto the top
+# plane (x, Z) -> x'' = (x + tv·Z)/(1 + tv²), z'' = tv·x''.
+
+T, TV = math.tan(FOV / 2), math.tan(FOV / 2) * H / W
+
+
+def onto_left(x: float, y: float) -> tuple[float, float]:
+    xp = (x + T * y) / (1 + T * T)
+    return xp, T * xp
+
+
+def onto_top(x: float, z: float) -> tuple[float, float]:
+    xp = (x + TV * z) / (1 + TV * TV)
+    return xp, TV * xp
+
+
+def box_of(points) -> tuple[np.ndarray, np.ndarray]:
+    p = np.array(points, dtype=float)
+    return p.min(axis=0), p.max(axis=0)
+
+
+def assert_box(obj, lo, hi) -> None:
+    """The recognised object is the camera-frame box lo..hi: its position, y/z size and image box."""
+    np.testing.assert_allclose(obj.position, (lo + hi) / 2, atol=1e-7)
+    np.testing.assert_allclose(obj.size, (hi - lo)[1:], atol=1e-7)
+    assert (obj.position_on_image, obj.size_on_image) == webots_box(aabb_corners(lo, hi))
+
+
+def test_a_box_across_the_left_edge_is_clipped_to_the_view_one_inside_is_whole():
+    # 0.2 x 0.6 x 0.4 at (2, 1, 0): y from 0.7 (inside: t·1.9 = 1.04) to 1.3 (outside: t·2.1 = 1.15)
+    edge = solid("edge", {"translation": [2.0, 1.0, 0.0]}, {"type": "box", "size": [0.2, 0.6, 0.4]})
+    inside = solid("inside", {"translation": [3.0, -0.5, 0.1]}, {"type": "box", "size": [0.2, 0.4, 0.6]})
+    _, (e, i) = recognise(world([edge, inside]))
+    # the four corners at y = 1.3 go onto the left plane; the far ones (x = 2.1) reach deepest and widest
+    x_far, y_far = onto_left(2.1, 1.3)
+    assert x_far > 2.1 and y_far < 1.3
+    assert_box(e, np.array([1.9, 0.7, -0.2]), np.array([x_far, y_far, 0.2]))
+    assert e.position_on_image[0] - e.size_on_image[0] / 2 <= 0.5             # it reaches the image's left border
+    assert_box(i, np.array([2.9, -0.7, -0.2]), np.array([3.1, -0.3, 0.4]))     # whole, as before
+
+
+def test_a_sphere_across_the_left_edge_loses_what_sticks_out_webots_way():
+    # radius 0.2 at (2, 1.1, 0): its centre 0.0065 m outside the left plane, measured square to it
+    ball = solid("ball", {"translation": [2.0, 1.1, 0.0]}, {"type": "sphere", "radius": 0.2})
+    _, [b] = recognise(world([ball]))
+    d = (T * 2.0 - 1.1) / math.sqrt(1 + T * T)                       # signed distance to the left plane
+    assert -0.2 < d < 0
+    cut = 0.2 - d
+    assert_box(b, np.array([1.8, 0.9, -0.2]), np.array([2.2, 1.3 - cut, 0.2]))
+    far = solid("far", {"translation": [2.0, T * 2.0 + 0.25 * math.sqrt(1 + T * T), 0.0]}, {"type": "sphere", "radius": 0.2})
+    assert recognise(world([far]))[1] == []                          # 0.25 m beyond the plane > its radius
+
+
+def test_a_box_across_the_top_left_corner_is_clipped_on_both_sides():
+    # a 2 cm card at x = 2 covering y 0.9..1.3 and z 0.6..1.0; the view ends at y = t·x ~ 1.09, z = tv·x ~ 0.82
+    card = solid("card", {"translation": [2.0, 1.1, 0.8]}, {"type": "box", "size": [0.02, 0.4, 0.4]})
+    _, [c] = recognise(world([card]))
+    pts = []
+    for x in (1.99, 2.01):
+        pts.append((x, 0.9, 0.6))                                    # inside
+        xl, yl = onto_left(x, 1.3)
+        pts.append((xl, yl, 0.6))                                    # outside the left plane only
+        xt, zt = onto_top(x, 1.0)
+        pts.append((xt, 0.9, zt))                                    # outside the top plane only
+        assert 1.0 > TV * xl                                         # still above once on the left plane:
+        xlt, zlt = onto_top(xl, 1.0)                                 # then onto the top one (Webots' order:
+        pts.append((xlt, yl, zlt))                                   # right, bottom, left, top)
+    lo, hi = box_of(pts)
+    assert_box(c, lo, hi)
+    assert hi[1] < 1.3 and hi[2] < 1.0
+
+
+def test_an_object_out_of_view_is_not_recognised_even_when_its_box_covers_the_corner():
+    # a thin bar at x = 2 from left of the view (y/(t·x), z/(tv·x)) = (1.5, 0.8) to above it (0.8, 1.5):
+    # it passes outside the view's corner (1, 1), but its box covers it; every corner is out of view
+    a = np.array([1.5 * T * 2, 0.8 * TV * 2])
+    b = np.array([0.8 * T * 2, 1.5 * TV * 2])
+    mid, along = (a + b) / 2, b - a
+    angle = math.atan2(along[1], along[0])
+    bar = solid("bar", {"translation": [2.0, mid[0], mid[1]], "rotation": [1, 0, 0, angle]},
+                {"type": "box", "size": [0.02, float(np.linalg.norm(along)), 0.02]})
+    left = solid("left", {"translation": [2.0, 1.5, 0.0]}, {"type": "box", "size": [0.2, 0.2, 0.2]})  # wholly left
+    assert recognise(world([bar, left]))[1] == []
+
+
+def test_a_bar_across_the_whole_view_is_seen_though_no_corner_is_in_view():
+    # 4 m along y at x = 2: every corner is left or right of the view, yet it crosses it (Webots
+    # keeps it); the corners go onto the side planes, symmetric, and deeper: (x + 2t)/(1 + t²)
+    bar = solid("bar", {"translation": [2.0, 0.0, 0.0]}, {"type": "box", "size": [0.1, 4.0, 0.1]})
+    _, [b] = recognise(world([bar]))
+    near, far = onto_left(1.95, 2.0), onto_left(2.05, 2.0)
+    assert_box(b, np.array([near[0], -far[1], -0.05]), np.array([far[0], far[1], 0.05]))
+    assert (b.position_on_image[0], b.size_on_image[0]) == (32, W - 1)
+
+
+def test_only_the_shapes_in_view_make_the_objects_box():
+    # a solid's second shape wholly out of view adds nothing (Webots merges the shapes in view)
+    two = {**solid("two", {"translation": [2.0, 0.0, 0.0]}, {"type": "box", "size": [0.2, 0.2, 0.2]}),
+           "shapes": [{"pose": {"translation": [0.0, 3.0, 0.0]}, "geometry": {"type": "box", "size": [0.2, 0.2, 0.2]}}]}
+    _, [o] = recognise(world([two]))
+    assert_box(o, np.array([1.9, -0.1, -0.1]), np.array([2.1, 0.1, 0.1]))
+
+
+def test_the_view_planes_use_webots_float32_half_angles():
+    from sensorium.server.devices import recognition as rmath
+
+    fov = 0.7854                                  # Webots' default: fov/2 is not a float32
+    f = rmath.frustum(imaging.ImageGeometry(W, H, fov))
+    assert f is not None and f.shrink_round
+    left = f.normals[rmath.LEFT]
+    t32 = math.tan(float(np.float32(fov / 2)))
+    assert left[0] / -left[1] == pytest.approx(t32, rel=1e-15) and t32 != math.tan(fov / 2)
+    assert rmath.frustum(imaging.ImageGeometry(W, H, 2.0)).shrink_round is False     # wider than pi/2
+    assert rmath.frustum(imaging.ImageGeometry(W, H, 1.0, "cylindrical")) is None
+
+
+def test_occlusion_1_aims_at_the_whole_objects_centre_not_the_part_in_view():
+    # y 0.7..1.7 at x = 2: its whole centre (2, 1.2, 0) is out of view, the part in view is centred
+    # at (2.12, 0.99, 0); a small pane at x = 1, y 0.58..0.66 blocks the ray to (2, 1.2, 0) (y = 0.6
+    # at x = 1), not the one to the part in view (y = 0.47 there): the object counts as hidden, as
+    # Webots' ray to the object's origin would find it
+    wide = solid("wide", {"translation": [2.0, 1.2, 0.0]}, {"type": "box", "size": [0.2, 1.0, 0.2]})
+    pane = {"name": "pane", "pose": {"translation": [1.0, 0.62, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.08, 0.1]}}
+    [seen] = recognise(world([wide, pane], {"occlusion": 0}))[1]
+    x_far, y_far = onto_left(2.1, 1.7)
+    assert_box(seen, np.array([1.9, 0.7, -0.1]), np.array([x_far, y_far, 0.1]))
+    assert 0.4 < seen.position[1] / seen.position[0] < 0.5                   # 0.47: under the pane
+    assert recognise(world([wide, pane], {"occlusion": 1}))[1] == []
+    assert len(recognise(world([wide], {"occlusion": 1}))[1]) == 1

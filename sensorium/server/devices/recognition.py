@@ -1,7 +1,8 @@
 """Camera recognition (Webots' Recognition node) — pure geometry, camera frame FLU, float64.
 
 An object is a top-level solid or a robot with ``recognition_colors``. From its shapes (their
-bounding shapes if it has any, else all of them — Webots: the boundingObject, else the shapes):
+bounding shapes if it has any, else all of them — Webots: the boundingObjects, else the object's
+bounding sphere):
 
 * ``bounds`` — its axis-aligned box in the camera frame, exact: a box's 8 corners, a mesh's or a
   finite plane's vertices, a sphere's ``c ± r``, a cylinder's ``|a_k|·h/2 + r·√(1 − a_k²)`` and a
@@ -15,17 +16,39 @@ bounding shapes if it has any, else all of them — Webots: the boundingObject, 
   mapped as Webots does, ``int((W − 1)·u)``; ``position_on_image = round`` of the middle,
   ``size_on_image = ceil`` of the extent; an object under one pixel in either direction is not
   recognised. A planar camera maps a point behind it to the image corner on its side (Webots).
+
+A planar camera first clips each shape to its view (``frustum``, ``clip_points``, ``clip_round``:
+Webots' ``WbObjectDetection``), so an object across the image border is reported by its part in
+view. The view is four planes through the camera — right, bottom, left, top, in Webots' order —
+at Webots' half angles (rounded to float32 as there: ``tan`` of ``float32(Φ/2)`` and of half the
+float32 vertical angle ``2·atan(tan(Φ/2)·H/W)``):
+
+* a box, a mesh or a finite plane by its points: a point in front of the camera (``x > 0``) outside
+  a plane is moved onto it by orthogonal projection, plane after plane in that order (so its depth
+  changes too); points behind the camera are kept as they are; the shape is seen if one point is
+  in front, and one is inside all four planes or the points cross the view from side to side (some
+  outside the right plane, some outside the left, some inside the bottom and some inside the top
+  one) or likewise from bottom to top; its box is that of the moved and kept points;
+* a sphere, cylinder or capsule by its centre ``c`` and box: with ``d`` the signed distance from
+  ``c`` to a plane (positive inside) and ``e`` half the box's extent across it (y for right/left,
+  z for bottom/top), ``d < −e`` hides the shape; else ``e − d`` (when positive) is cut from that
+  side of the box (for a field of view up to π/2, as in Webots; wider, the box stays whole). This
+  is Webots' approximation: ``d`` is measured square to the slanted plane, not along y or z.
+
+The object's box is the union of its seen shapes' boxes; an object with no seen shape is not recognised.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from .imaging import ImageGeometry
 
-__all__ = ["image_coordinates", "project_on_image", "box_on_image", "shape_bounds"]
+__all__ = ["image_coordinates", "project_on_image", "box_on_image", "shape_bounds", "Frustum", "frustum",
+           "clip_points", "clip_round", "clipped_bounds"]
 
 
 def image_coordinates(p: np.ndarray, g: ImageGeometry) -> np.ndarray:
@@ -83,6 +106,15 @@ def box_on_image(centre: np.ndarray, size: np.ndarray, g: ImageGeometry) -> tupl
     return (int(round((hi[0] + lo[0]) / 2.0)), int(round((hi[1] + lo[1]) / 2.0))), (w, h)
 
 
+def _shape_points(kind: str, params: tuple, R: np.ndarray, c: np.ndarray, points: np.ndarray | None) -> np.ndarray | None:
+    """The camera-frame points whose box is a box's, a mesh's or a finite plane's."""
+    if kind == "box":
+        return (_CORNERS * np.asarray(params[0], dtype=np.float64)) @ R.T + c
+    if kind == "points" and points is not None and len(points):
+        return np.asarray(points, dtype=np.float64) @ R.T + c
+    return None
+
+
 def shape_bounds(kind: str, params: tuple, rotation: np.ndarray, centre: np.ndarray,
                  points: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """``(lo, hi)`` of one shape in the camera frame: ``rotation`` and ``centre`` place the shape's
@@ -90,9 +122,6 @@ def shape_bounds(kind: str, params: tuple, rotation: np.ndarray, centre: np.ndar
     height; axis local z), "points" (``points`` in the shape frame), "unbounded" (None)."""
     R = np.asarray(rotation, dtype=np.float64)
     c = np.asarray(centre, dtype=np.float64)
-    if kind == "box":
-        pts = (_CORNERS * np.asarray(params[0], dtype=np.float64)) @ R.T + c
-        return pts.min(axis=0), pts.max(axis=0)
     if kind == "sphere":
         r = float(params[0])
         return c - r, c + r
@@ -101,7 +130,86 @@ def shape_bounds(kind: str, params: tuple, rotation: np.ndarray, centre: np.ndar
         a = np.abs(R[:, 2])                                   # the axis's components in the camera frame
         half = a * h / 2.0 + (r * np.sqrt(np.maximum(0.0, 1.0 - a * a)) if kind == "cylinder" else r)
         return c - half, c + half
-    if kind == "points" and points is not None and len(points):
-        pts = np.asarray(points, dtype=np.float64) @ R.T + c
-        return pts.min(axis=0), pts.max(axis=0)
-    return None
+    pts = _shape_points(kind, params, R, c, points)
+    return None if pts is None else (pts.min(axis=0), pts.max(axis=0))
+
+
+RIGHT, BOTTOM, LEFT, TOP = range(4)
+
+
+@dataclass(frozen=True, slots=True)
+class Frustum:
+    """A planar camera's view as Webots' recognition clips to it: the unit normals (4, 3) of its side
+    planes through the camera, pointing inwards, in the order right, bottom, left, top (camera frame
+    FLU); ``shrink_round``: spheres, cylinders and capsules are cut to the view (field of view ≤ π/2)."""
+
+    normals: np.ndarray
+    shrink_round: bool
+
+
+def frustum(g: ImageGeometry) -> Frustum | None:
+    """The view a planar camera clips recognised shapes to; None for a non-planar camera (not clipped)."""
+    if not g.planar:
+        return None
+    fov = float(g.field_of_view)
+    # Webots keeps both half angles in float32 (WbObjectDetection::computeFrustumPlanes and
+    # WbWrenCamera::computeFieldOfViewY); the planes follow them to the last bit
+    half_x = float(np.float32(fov / 2.0))
+    half_y = float(np.float32(np.float32(2.0 * math.atan(math.tan(fov * 0.5) / (int(g.width) / int(g.height))))) / 2.0)
+    th, tv = math.tan(half_x), math.tan(half_y)
+    n = np.array([[th, 1.0, 0.0], [tv, 0.0, 1.0], [th, -1.0, 0.0], [tv, 0.0, -1.0]], dtype=np.float64)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    return Frustum(n, fov <= math.pi / 2.0)
+
+
+def clip_points(points: np.ndarray, f: Frustum) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(lo, hi)`` of a shape's camera-frame points (N, 3) clipped to the view (see the module
+    docstring), None when the shape is not in view."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    front = p[p[:, 0] > 0.0].copy()
+    if not len(front):
+        return None
+    outside = np.zeros((len(front), 4), dtype=bool)
+    for j in range(4):                            # plane after plane: a moved point meets the next one moved
+        n = f.normals[j]
+        d = front @ n
+        out = d < 0.0
+        front[out] -= d[out, None] * n
+        outside[:, j] = out
+    if outside.any(axis=1).all():                 # no point inside: the shape must cross the view
+        out_j, in_j = outside.any(axis=0), (~outside).any(axis=0)
+        across = out_j[RIGHT] and out_j[LEFT] and in_j[BOTTOM] and in_j[TOP]
+        up = out_j[BOTTOM] and out_j[TOP] and in_j[RIGHT] and in_j[LEFT]
+        if not (across or up):
+            return None
+    kept = np.vstack([front, p[p[:, 0] <= 0.0]])
+    return kept.min(axis=0), kept.max(axis=0)
+
+
+def clip_round(lo: np.ndarray, hi: np.ndarray, f: Frustum) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(lo, hi)`` of a sphere's, cylinder's or capsule's camera-frame box cut to the view (see the
+    module docstring), None when the shape is not in view (or nothing of its box is left)."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    c, half = (lo + hi) / 2.0, (hi - lo) / 2.0
+    d = f.normals @ c
+    e = half[[1, 2, 1, 2]]
+    if (d < -e).any():
+        return None
+    if not f.shrink_round:
+        return lo, hi
+    cut = np.where(d < e, e - d, 0.0)
+    c = c + 0.5 * np.array([0.0, cut[RIGHT] - cut[LEFT], cut[BOTTOM] - cut[TOP]])
+    half = half - 0.5 * np.array([0.0, cut[RIGHT] + cut[LEFT], cut[BOTTOM] + cut[TOP]])
+    if half[1] <= 0.0 or half[2] <= 0.0:          # Webots would report a negative size (camera inside the shape)
+        return None
+    return c - half, c + half
+
+
+def clipped_bounds(kind: str, params: tuple, rotation: np.ndarray, centre: np.ndarray,
+                   points: np.ndarray | None, f: Frustum) -> tuple[np.ndarray, np.ndarray] | None:
+    """``shape_bounds`` of the shape's part in view (``f``); None when out of view or unbounded."""
+    if kind in ("sphere", "cylinder", "capsule"):
+        b = shape_bounds(kind, params, rotation, centre)
+        return None if b is None else clip_round(b[0], b[1], f)
+    pts = _shape_points(kind, params, np.asarray(rotation, dtype=np.float64), np.asarray(centre, dtype=np.float64), points)
+    return None if pts is None else clip_points(pts, f)

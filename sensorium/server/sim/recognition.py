@@ -4,14 +4,16 @@ objects' shapes from the scene once, places them at each recognition, and casts 
 occlusion test needs (Webots' ``occlusion`` field):
 
 * 0 — no test: every object in range and on the image is recognised;
-* 1 — one ray from the camera to the object's centre: recognised if it reaches the centre or first
-  meets one of the object's own shapes (Webots casts the same ray against bounding objects);
+* 1 — one ray from the camera to the object's centre (that of its whole box, in view or not):
+  recognised if it reaches the centre or first meets one of the object's own shapes (Webots casts a
+  ray to the object's origin against bounding objects);
 * 2 — the image's pixel rays: recognised if at least one pixel sees it (exact at the image's
   resolution; Webots tests the object's outline).
 
-An object is in range when its box reaches in front of the camera and starts before ``max_range``
-(in depth). ``max_objects`` keeps the biggest on the image (``size_on_image`` area; ties in id
-order). The segmentation image: each pixel whose ray's first visible surface belongs to a
+An object's box is, for a planar camera, that of its part in view (Webots clips each shape to the
+view first; a non-planar camera's boxes are whole). An object is in range when that box reaches in
+front of the camera and starts before ``max_range`` (in depth). ``max_objects`` keeps the biggest
+on the image (``size_on_image`` area; ties in id order). The segmentation image: each pixel whose ray's first visible surface belongs to a
 recognisable object within ``max_range`` (depth for a planar camera) has the object's first
 recognition colour, the rest black; alpha 255.
 """
@@ -92,6 +94,7 @@ class Recognizer:
         self.own = own
         self.config = config
         self.geometry = geometry
+        self.frustum = rmath.frustum(geometry)          # None: a non-planar camera's boxes are not clipped
         self.key_of = np.full(len(scene.shapes) + 1, -1, dtype=np.int64)   # shape -> object index (-1: none)
         objects: list[_Object] = []
         by_owner: dict[Any, list[int]] = {}            # one pass over the shapes
@@ -111,19 +114,28 @@ class Recognizer:
         self.objects = objects
         self.first_color = np.array([o.colors[0] for o in objects] + [(0.0, 0.0, 0.0)]).reshape(-1, 3)
 
-    def _box(self, obj: _Object, cam: Pose) -> tuple[np.ndarray, np.ndarray] | None:
-        """The object's box (lo, hi) in the camera frame, None if unbounded."""
+    def _box(self, obj: _Object, cam: Pose) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The object's box (lo, hi) in the camera frame — for a planar camera the union of its
+        shapes' parts in view (Webots' clipping, ``devices/recognition.py``), else of its whole
+        shapes — and the centre of its whole box (the occlusion ray's target); None if a shape is
+        unbounded or nothing of it is in view."""
         owner = self.scene.owner_pose(obj.key)
         inv = cam.rotation.T
-        lo = np.full(3, np.inf)
-        hi = np.full(3, -np.inf)
+        lo, whole_lo = np.full(3, np.inf), np.full(3, np.inf)
+        hi, whole_hi = np.full(3, -np.inf), np.full(3, -np.inf)
         for local, kind, params, points in obj.parts:
-            pose = owner.compose(local)
-            b = rmath.shape_bounds(kind, params, inv @ pose.rotation, inv @ (pose.translation - cam.translation), points)
-            if b is None:
+            if kind == "unbounded":
                 return None
-            lo, hi = np.minimum(lo, b[0]), np.maximum(hi, b[1])
-        return (lo, hi) if np.isfinite(lo).all() else None
+            pose = owner.compose(local)
+            rotation, centre = inv @ pose.rotation, inv @ (pose.translation - cam.translation)
+            whole = rmath.shape_bounds(kind, params, rotation, centre, points)
+            if whole is None:
+                continue
+            whole_lo, whole_hi = np.minimum(whole_lo, whole[0]), np.maximum(whole_hi, whole[1])
+            b = whole if self.frustum is None else rmath.clipped_bounds(kind, params, rotation, centre, points, self.frustum)
+            if b is not None:
+                lo, hi = np.minimum(lo, b[0]), np.maximum(hi, b[1])
+        return (lo, hi, (whole_lo + whole_hi) / 2.0) if np.isfinite(lo).all() else None
 
     def recognise(self, cam: Pose, pixel_objects: np.ndarray | None, counters: Any) -> list[RecognisedObject]:
         """The objects seen from the camera pose ``cam``; ``pixel_objects`` (H·W,) the object index
@@ -135,14 +147,14 @@ class Recognizer:
             box = self._box(obj, cam)
             if box is None:
                 continue
-            lo, hi = box
+            lo, hi, target = box
             if not (hi[0] > 0.0 and lo[0] < c.max_range):
                 continue
             centre, size = (lo + hi) / 2.0, hi - lo
             on_image = rmath.box_on_image(centre, size, self.geometry)
             if on_image is None:
                 continue
-            if c.occlusion == 1 and not self._centre_visible(k, cam, centre, counters):
+            if c.occlusion == 1 and not self._centre_visible(k, cam, target, counters):
                 continue
             if c.occlusion == 2 and k not in seen_by_pixels:
                 continue
