@@ -118,6 +118,8 @@ def test_occlusion_range_image_bounds_and_max_objects():
     _, objs = recognise(world([small, big, target], {"max_objects": 2}))
     # on the image: big (id 3) 0.3 m at 1.85 m > target (id 4) 0.2 m at 2.9 m > small (id 2) 0.1 m at 1.95 m
     assert [o.id for o in objs] == [3, 4]                                           # the two biggest, id order
+    for unlimited in (0, -1):                                                       # Webots trims only when > 0
+        assert [o.id for o in recognise(world([small, big, target], {"max_objects": unlimited}))[1]] == [2, 3, 4]
 
 
 def test_own_robot_is_not_recognised_another_is():

@@ -519,7 +519,7 @@ class Recognition(Strict):
     (and robots) that have ``recognition_colors`` and that it sees (README "Recognition")."""
 
     max_range: float = Field(default=100.0, ge=0.0, description="m: objects farther are not recognised")
-    max_objects: int = Field(default=-1, ge=-1, description="-1: no limit; else the biggest on the image")
+    max_objects: int = Field(default=-1, ge=-1, description="-1 or 0: no limit (as Webots); else the biggest on the image")
     occlusion: int = Field(default=1, ge=0, le=2, description="0 none, 1 the centre's ray, 2 any pixel of the image")
     frame_color: Color = (1.0, 0.0, 0.0)
     frame_thickness: int = Field(default=1, ge=0)
