@@ -8,7 +8,6 @@ a .wbt Fog node is read (the first one only, Webots' resets with warnings)."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -16,8 +15,8 @@ import pytest
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import imaging
-from sensorium.server.world.loader import WorldError, load_world, parse_world
 from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import WorldError, load_world, parse_world
 
 WALL = {"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
         "appearance": {"base_color": [0.8, 0.5, 0.2]}, "recognition_colors": [[0.0, 1.0, 0.0]]}
@@ -181,4 +180,14 @@ def test_a_wbt_fog_gets_webots_resets_with_a_warning(tmp_path: Path, fields, war
     f = loaded.world.fog
     assert f is not None and (f.color, f.visibility_range, f.fog_type) == fog
     assert sum(warning in m for m in loaded.warnings) == 1, loaded.warnings
-    assert math.isfinite(f.visibility_range)
+
+
+def test_the_readme_fog_example_is_a_valid_world():
+    import yaml
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    blocks = [b.split("```", 1)[0] for b in readme.split("```yaml\n")[1:]]
+    (text,) = [b for b in blocks if b.startswith("fog:")]
+    loaded = parse_world(yaml.safe_load(text), source="README", base_dir=Path.cwd())
+    assert loaded.world.fog == wm.Fog(color=(0.7, 0.7, 0.75), visibility_range=8.0, fog_type="EXPONENTIAL")
+    assert Simulation(loaded.world).scene.fog is not None
