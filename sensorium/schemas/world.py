@@ -755,6 +755,20 @@ class Background(Strict):
     _unit = field_validator("sky_color")(_unit_colors)
 
 
+class Fog(Strict):
+    """Webots' Fog node: camera images blend each surface with ``color`` by its distance from the
+    camera (README "Cameras and range finders"); the background, range images, lidars and distance
+    sensors are not fogged. A ``visibility_range`` of 0 disables it (Webots)."""
+
+    color: Color = (1.0, 1.0, 1.0)
+    visibility_range: float = Field(default=0.0, ge=0.0, description="metres; 0 disables the fog (Webots)")
+    fog_type: Literal["LINEAR", "EXPONENTIAL", "EXPONENTIAL2"] = Field(
+        default="LINEAR", description="how the blend grows with the distance d (V the visibility range): LINEAR "
+        "by d/V, EXPONENTIAL by 1 - exp(-d/V), EXPONENTIAL2 by 1 - exp(-(d/V)^2), each raised to 2.2 (Webots)")
+
+    _unit = field_validator("color")(_unit_colors)
+
+
 class World(Strict):
     """A whole world file.
 
@@ -767,6 +781,7 @@ class World(Strict):
     lights: list[Light] = []
     robots: list[Robot] = []
     background: Background = Background()
+    fog: Fog | None = Field(default=None, description="Webots' Fog node (the first one of a .wbt world)")
 
 
 def json_schema() -> dict:

@@ -18,6 +18,13 @@ covers is the background colour. The sum is a radiance in Webots' HDR buffer; th
 Webots' ``hdr_resolve``: ``v = (1 − exp(−L·exposure))^(1/2.2)``; then ``noise`` (Gaussian, σ =
 ``noise`` in [0, 1] units, per channel, clamped: ``color_noise.frag``) and the byte
 ``⌊255·v + ½⌋``. Anti-aliasing averages the radiance of a 2×2 grid of rays per pixel.
+
+Fog (Webots' Fog node, WREN's ``pbr.frag``/``phong.frag``): each surface's radiance is mixed with
+the fog colour (sRGB to linear) in the HDR buffer, before the resolve and the noise, by
+``w = (1 − f)^2.2`` of Webots' fog factor ``f`` at the surface's distance ``d`` from the camera
+(the length of its view-space position: Webots' "point" depth, not the planar depth), ``V`` the
+visibility range: ``f = 1 − d/V`` (LINEAR), ``exp(−d/V)`` (EXPONENTIAL), ``exp(−(d/V)²)``
+(EXPONENTIAL2), clamped to [0, 1]. The background is not fogged (Webots' sky is drawn without it).
 """
 
 from __future__ import annotations
@@ -29,7 +36,7 @@ import numpy as np
 from .light import LightArrays, LightKind
 from .noise import gaussian
 
-__all__ = ["GAMMA", "srgb_to_linear", "radiance", "tone_map", "to_bytes"]
+__all__ = ["GAMMA", "FOG_TYPES", "srgb_to_linear", "radiance", "fog_weight", "fog", "tone_map", "to_bytes"]
 
 GAMMA = 2.2
 """Webots' ``hdr_resolve.frag`` gamma."""
@@ -110,6 +117,36 @@ def radiance(points: np.ndarray, normals: np.ndarray, albedo: np.ndarray, lights
                     weight *= att
             acc += weight[:, None] * lights.color[j]
     return A * acc
+
+
+FOG_TYPES = ("LINEAR", "EXPONENTIAL", "EXPONENTIAL2")
+"""Webots' Fog ``fogType`` values."""
+
+FOG_POWER = 2.2
+"""The power WREN's shaders raise ``1 − f`` to before mixing in the fog colour."""
+
+
+def fog_weight(distance: np.ndarray, visibility_range: float, fog_type: str) -> np.ndarray:
+    """The fog colour's share ``(1 − f)^2.2`` in the radiance of surfaces at ``distance`` (m) from
+    the camera; ``visibility_range`` > 0 (Webots turns the fog off at 0)."""
+    z = np.asarray(distance, dtype=np.float64) / float(visibility_range)
+    if fog_type == "LINEAR":          # Webots: (end − d)·(1/|end − start|), start 0, end V
+        f = 1.0 - z
+    elif fog_type == "EXPONENTIAL":
+        f = np.exp(-z)
+    elif fog_type == "EXPONENTIAL2":
+        f = np.exp(-(z * z))
+    else:
+        raise ValueError(f"unknown fog type {fog_type!r} (one of {', '.join(FOG_TYPES)})")
+    return (1.0 - np.clip(f, 0.0, 1.0)) ** FOG_POWER
+
+
+def fog(radiance: np.ndarray, distance: np.ndarray, color_linear: np.ndarray, visibility_range: float,
+        fog_type: str) -> np.ndarray:
+    """Radiances (S, 3) of surfaces at ``distance`` (S,) mixed with the fog's linear colour (3,) as
+    GLSL's ``mix(L, fog, w)``: ``L·(1 − w) + fog·w``."""
+    w = fog_weight(distance, visibility_range, fog_type)[:, None]
+    return np.asarray(radiance, dtype=np.float64) * (1.0 - w) + np.asarray(color_linear, dtype=np.float64) * w
 
 
 def tone_map(radiance: np.ndarray, exposure: float) -> np.ndarray:

@@ -356,7 +356,8 @@ class Camera(Device):
         """The radiance (N, 3) along every ray: the surfaces it crosses composited front to back
         (semi-transparent ones let ``transparency`` of what is behind through; a closed shape's
         faces are crossed twice and only its entering face is seen, as with back-face culling),
-        the background where nothing is hit. The device's own shapes are never met."""
+        each surface mixed with the world's fog by its distance (``shading.fog``), the background
+        (not fogged) where nothing is hit. The device's own shapes are never met."""
         scene = self._scene
         engine = scene.engine
         origin = pose.translation
@@ -414,6 +415,8 @@ class Camera(Device):
                 albedo = scene.surface_colors(s[seen], np.broadcast_to(origin, (len(kk), 3)), Dk, t[kk])
                 lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
                 L = shading.radiance(P, N, albedo, lights, lit)
+                if scene.fog is not None:     # Webots mixes each surface (not the sky) with the fog colour
+                    L = shading.fog(L, t[kk], *scene.fog)
                 last = layer == MAX_LAYERS
                 a = np.where(last, 0.0, tau[seen])[:, None]
                 out[rr] += weight[rr, None] * (1.0 - a) * L

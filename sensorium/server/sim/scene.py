@@ -191,6 +191,13 @@ class Scene:
         self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
         self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
         self.background = np.asarray(world.background.sky_color, dtype=np.float64)   # what cameras see past everything
+        # Webots' Fog as cameras mix it in: (linear colour, visibility range, type); None without fog or
+        # with a visibility range of 0 (Webots then turns it off), so a world without fog computes nothing more
+        fog = world.fog
+        self.fog: tuple[np.ndarray, float, str] | None = None
+        if fog is not None and fog.visibility_range > 0.0:
+            self.fog = (srgb_to_linear(np.asarray(fog.color, dtype=np.float64)), float(fog.visibility_range),
+                        fog.fog_type)
         self.base_dir = Path(base_dir)
         # what cameras with a Recognition node report: owner (robot index, solid name) -> (the Supervisor's
         # node id: robots 1..R in world order, then the top-level solids; recognition colours; model)

@@ -32,7 +32,7 @@ from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
-SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Fog", "Physics", "ImmersionProperties",
+SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Physics", "ImmersionProperties",
            "ContactProperties", "Damping", "Muscle", "Propeller"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
 # the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
@@ -200,6 +200,27 @@ class Converter:
             info["ink_evaporation"] = evaporation
         self.world["world_info"] = info
 
+    def fog(self, node: Node, f: Fields) -> None:
+        """Webots' Fog, the first one only (Webots warns about the others), with Webots' resets: a
+        negative visibilityRange is 0 (no fog), colour components outside [0, 1] are clamped, an
+        unknown fogType is LINEAR (each with a warning); fogType is read case-blind, as Webots."""
+        if "fog" in self.world:
+            self.warn(node, "only the first Fog node is taken into account (Webots); this one is skipped")
+            return
+        color = f.vec("color", (1.0, 1.0, 1.0))
+        if min(color) < 0.0 or max(color) > 1.0:
+            self.warn(node, f"Fog color {' '.join(f'{c:g}' for c in color)} clamped to [0, 1] (Webots resets it)")
+            color = tuple(min(max(c, 0.0), 1.0) for c in color)
+        visibility = f.num("visibilityRange", 0.0)
+        if visibility < 0.0:
+            self.warn(node, f"Fog visibilityRange {visibility:g} < 0 reset to 0: no fog (Webots)")
+            visibility = 0.0
+        fog_type = f.string("fogType", "LINEAR")
+        if fog_type.upper() not in ("LINEAR", "EXPONENTIAL", "EXPONENTIAL2"):
+            self.warn(node, f"unknown Fog fogType {fog_type!r}: LINEAR, as Webots")
+            fog_type = "LINEAR"
+        self.world["fog"] = {"color": list(color), "visibility_range": visibility, "fog_type": fog_type.upper()}
+
     # ------------------------------------------------------------ the walk
     def visit(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
         if node.proto is not None and node.instance_at is not None:
@@ -224,6 +245,12 @@ class Converter:
             sky = f.rows("skyColor", 3, [(0.0, 0.0, 0.0)])
             self.world["background"] = {"sky_color": list(sky[0]) if sky else [0.0, 0.0, 0.0]}
             self.skipped[t] += 1     # its other fields (textures, luminosity) are not read
+        elif t == "Fog":                 # cameras blend it in
+            if top:
+                self.fog(node, f)
+            else:
+                self.warn(node, "a Fog node counts only at the top level of a world (Webots allows it nowhere "
+                                "else); skipped")
         elif t in SKIPPED:
             self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
