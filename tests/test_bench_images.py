@@ -18,7 +18,9 @@ def test_images_section(tmp_path):
     assert main(["bench", "--quick", "--only", "images", "--out", str(tmp_path)]) == 0
     sec = json.loads((tmp_path / "benchmarks.json").read_text())["sections"]["images"]
     tables = {t["id"]: t for t in sec["tables"]}
-    assert set(tables) == {"images_time", "images_split", "images_counters"}
+    assert set(tables) == {"images_time", "images_split", "images_counters", "images_fog"}
+    assert [r[0] for r in tables["images_fog"]["rows"]] == ["no fog", "LINEAR", "EXPONENTIAL", "EXPONENTIAL2"]
+    assert all(v > 0 for v in sec["data"]["fog"].values())
     for prec in ("fast", "exact"):
         for label, pixels in (("e-puck camera 52×39", 2028), ("camera 640×480", 307200), ("range finder 320×240", 76800)):
             d = sec["data"][prec][label]

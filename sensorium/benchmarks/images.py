@@ -200,6 +200,7 @@ def run(cfg: Config) -> Section:
     counters = Table("images_counters", "Only enabled devices cost anything (sim.counters)",
                      ["precision", "what", "rays_camera", "rays_range_finder", "engine_rays"], counter_rows,
                      ["no device of the arena is enabled but the one named: every ray counted is the image's"])
+    fog_table = _fog_cost(data, base, rounds, out)
     epuck = out["exact"]["e-puck camera 52×39"]
     findings.append(f"an e-puck camera image (52×39) costs {fmt_time(epuck['image_cpu_s'])} of CPU in EXACT "
                     f"({fmt_time(out['fast']['e-puck camera 52×39']['image_cpu_s'])} FAST); a 640×480 image "
@@ -209,4 +210,31 @@ def run(cfg: Config) -> Section:
     if not math.isfinite(epuck["image_s"]):
         findings.append("the e-puck camera could not be timed")
     return Section("images", "Images: cameras and range finders on the ray engine",
-                   intro=__doc__.split("\n\n", 1)[1].strip(), tables=[table, split, counters], findings=findings, data=out)
+                   intro=__doc__.split("\n\n", 1)[1].strip(), tables=[table, split, counters, fog_table], findings=findings, data=out)
+
+
+FOG = {"color": [0.8, 0.8, 0.8], "visibility_range": 3.0}
+
+
+def _fog_cost(data: dict, base: Path, rounds: int, out: dict) -> Table:
+    """The 640×480 camera's image in the same world without and with a Fog (each fog type),
+    interleaved, FAST: what the fog's blend adds (a world without fog computes nothing for it)."""
+    label = "camera 640×480"
+    name = DEVICES[label]["name"]
+    captures: dict = {}
+    for fog_type in (None, "LINEAR", "EXPONENTIAL", "EXPONENTIAL2"):
+        world = data if fog_type is None else {**data, "fog": {**FOG, "fog_type": fog_type}}
+        sim = make_sim(world, "fast", base_dir=base)
+        robot = sim.robot("epuck")
+        dev = robot.device(name)
+        sim.step()
+        captures["no fog" if fog_type is None else fog_type] = (
+            lambda dev=dev, robot=robot, sim=sim: dev._capture_image(dev.world_pose(robot.pose), sim._counters))
+    _, cpu = _interleaved_cpu(captures, rounds)
+    plain = median(cpu["no fog"])
+    rows = [[k, fmt_time(median(v)), f"{median(v) / max(plain, 1e-12):.2f}×"] for k, v in cpu.items()]
+    out["fog"] = {k: median(v) for k, v in cpu.items()}
+    return Table("images_fog", "What a Fog costs a camera image (640×480, FAST)",
+                 ["world", "image (CPU)", "÷ no fog"], rows,
+                 [f"the same arena with a top-level fog ({FOG['visibility_range']} m visibility range) of each type; "
+                  f"one capture of the image, medians of {rounds} interleaved rounds (time.process_time)"])
