@@ -134,21 +134,26 @@ class CopyRays:
         if not present.any():
             return hits
         dist = hits.distance
-        lim = np.minimum(np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,)), dist)
+        far = np.asarray(t_far, dtype=np.float64)
+        far = float(far) if far.ndim == 0 else np.ascontiguousarray(np.broadcast_to(far, (n,)))
+        lim = None   # each ray's limit np.minimum(t_far, dist): made in the C pass, here once needed
         copy = np.asarray(copy, dtype=np.int64).reshape(n)
         # broad phase: each ray against the bounding spheres of its own copy's bodies
         R = self.slots
         centre = pos + np.einsum("crij,rj->cri", rot, anchor)          # (C, R, 3): a conservative test only
         excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else np.asarray(exclude_slot).reshape(n)
         mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else np.asarray(mount_slot).reshape(n)
-        got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, lim, excl, mnt) if self.static.native
-               else None)
+        got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, far, excl, mnt, dist=dist)
+               if self.static.native else None)
         if got is None:
             lo = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,))
+            lim = np.minimum(far, dist)
             got = _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt)
         pr, pm = got
         if not len(pr):
             return hits
+        if lim is None:
+            lim = np.minimum(far, dist)
         self.counters["mover_pairs"] += len(pr)
         # pairs grouped by body, each body's rays in ray order (as the engine's one-mover path sees them)
         order = np.lexsort((pr, pm))

@@ -777,11 +777,13 @@ void sp_to_frame(size_t n, const double* x, const int64_t* rows, const double* R
  * operation (it is conservative, with a slack of 1e-9 (1 + e2)). Pairs are written slot by slot,
  * each slot's rays ascending (the numpy path's order): ray into out_ray, copy * R + r into
  * out_body; returns their number (at most n * R). lo, excl, mnt: per ray when not NULL, else the
- * scalar value. */
+ * scalar value. With dist (n,) given, lim[i] is np.minimum(t_far, dist[i]) made here: t_far the
+ * (n,) lim when not NULL, else lim_value (the caller's limits without their array). */
 size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const int64_t* copy,
                      const double* centre, const double* r2, const uint8_t* present, const double* lo,
-                     double lo_value, const double* lim, const int64_t* excl, int64_t excl_value,
-                     const int64_t* mnt, int64_t mnt_value, int64_t* out_ray, int64_t* out_body) {
+                     double lo_value, const double* lim, double lim_value, const double* dist,
+                     const int64_t* excl, int64_t excl_value, const int64_t* mnt, int64_t mnt_value,
+                     int64_t* out_ray, int64_t* out_body) {
   size_t k = 0;
   for (size_t r = 0; r < R; r++) {
     if (!present[r]) continue;
@@ -792,7 +794,7 @@ size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const
       if (excl && excl[i] == (int64_t)r) continue;
       if (mnt && mnt[i] == (int64_t)r) continue;
       const double l = lo ? lo[i] : lo_value;
-      const double f = lim[i];
+      const double f = dist ? np_min(lim ? lim[i] : lim_value, dist[i]) : lim[i];
       if (!(f >= l)) continue;
       const int64_t c = copy[i];
       const double* cc = centre + 3 * ((size_t)c * R + r);
@@ -1044,4 +1046,18 @@ void sp_lidar_beams(size_t n, size_t W, const double* rot, const double* org, co
       out_org[r + 2] = o2;
     }
   }
+}
+
+/* batched.py's _cos_sin: libm's cos and sin of each of n angles, the calls Python's math.cos and
+ * math.sin make (the single simulation's). Two loops, so that the compiler does not merge a cos and
+ * a sin of one angle into one sincos call (another libm entry point). Returns the number of
+ * infinite angles (math.cos refuses them: the caller then takes Python's way, error included). */
+size_t sp_cos_sin(size_t n, const double* a, double* out_cos, double* out_sin) {
+  size_t inf = 0;
+  for (size_t i = 0; i < n; i++) {
+    out_cos[i] = cos(a[i]);
+    inf += isinf(a[i]) != 0;
+  }
+  for (size_t i = 0; i < n; i++) out_sin[i] = sin(a[i]);
+  return inf;
 }

@@ -172,12 +172,14 @@ def _load() -> None:
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_sensor_rays.restype = None
     lib.sp_sensor_rays.argtypes = [sz, sz, sz] + [vp] * 12
+    lib.sp_cos_sin.restype = sz
+    lib.sp_cos_sin.argtypes = [sz, vp, vp, vp]
     lib.sp_box3.restype = None
     lib.sp_box3.argtypes = [sz, vp, vp]
     lib.sp_inside_shells.restype = sz
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
-    lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
+    lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, d, vp, vp, i64, vp, i64, vp, vp]
     lib.sp_contact_near.restype = sz
     lib.sp_drive_wheels.restype = sz
     lib.sp_lidar_beams.restype = None
@@ -504,12 +506,15 @@ def lidar_scan(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray, colum
 
 
 def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarray, r2: np.ndarray,
-               present: np.ndarray, lo, lim: np.ndarray, excl, mount) -> tuple[np.ndarray, np.ndarray] | None:
+               present: np.ndarray, lo, lim, excl, mount, dist: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray] | None:
     """The broad phase of :meth:`.copies.CopyRays.cast` in one C pass (``sp_copy_pairs``): the
     (ray, copy * R + slot) pairs whose ray comes within the bounding sphere (``centre`` (C, R, 3),
     ``r2`` (R,)) of a present slot of its own copy, its excluded and mount slots left out, listed
     slot by slot and ray by ray as the numpy path lists them; or None without the helper. ``lo``,
-    ``excl``, ``mount``: scalars or (n,) arrays; ``lim`` (n,)."""
+    ``excl``, ``mount``: scalars or (n,) arrays; ``lim`` (n,), or with ``dist`` (n,) the rays' far
+    limits (a scalar or (n,)), each ray's limit then being ``np.minimum(lim, dist)`` (made in the
+    pass: no (n,) temporary)."""
     lib = library()
     if lib is None:
         return None
@@ -521,14 +526,22 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     centre = np.ascontiguousarray(centre, dtype=f64)
     r2 = np.ascontiguousarray(r2, dtype=f64)
     present = np.ascontiguousarray(present, dtype=np.uint8)
-    lim = np.ascontiguousarray(lim, dtype=f64)
+    lim_value = 0.0
+    if dist is not None:
+        dist = np.ascontiguousarray(dist, dtype=f64)
+        if not isinstance(lim, np.ndarray) or lim.ndim == 0:
+            lim, lim_value = None, float(lim)
+    if lim is not None:
+        lim = np.ascontiguousarray(lim, dtype=f64)
+        if lim.shape != (n,):
+            raise TypeError(f"copy_pairs: limits of shape {lim.shape} for {n} rays")
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
     ex_a = np.ascontiguousarray(excl, dtype=i64) if isinstance(excl, np.ndarray) else None
     mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
     out_ray, out_body, p_ray, p_body = _pair_buffers(n * R)
-    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_lim = _small_addresses((O, D, copy, centre, r2, present, lim))
+    p_O, p_D, p_copy, p_centre, p_r2, p_present = _small_addresses((O, D, copy, centre, r2, present))
     k = lib.sp_copy_pairs(n, R, p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
-                          0.0 if lo_a is not None else float(lo), p_lim, _ptr(ex_a),
+                          0.0 if lo_a is not None else float(lo), _ptr(lim), lim_value, _ptr(dist), _ptr(ex_a),
                           0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
                           p_ray, p_body)
     return out_ray[:k].copy(), out_body[:k].copy()
@@ -560,6 +573,21 @@ def sensor_rays(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.
     p = _small_addresses([*idx, rot, pos, local_rot, local_pos, local_dirs, positions, origins, dirs])
     lib.sp_sensor_rays(S, N, R, p[0], p[1], p[4], p[5], p[2], p[6], p[7], p[3], p[8], p[9], p[10], p[11])
     return positions, origins, dirs
+
+
+def cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(cos, sin) of each element of the (n,) float64 array ``a`` through libm's ``cos`` and ``sin``,
+    the functions ``math.cos`` and ``math.sin`` call (``sp_cos_sin``: the same bits as calling them
+    element by element, without the Python floats); None without the helper, for another array, or
+    when an angle is infinite (``math.cos`` refuses it: the caller's Python way says so)."""
+    lib = library()
+    if lib is None or a.dtype != np.float64 or a.ndim != 1:
+        return None
+    a = np.ascontiguousarray(a)
+    c, s = np.empty(len(a)), np.empty(len(a))
+    if lib.sp_cos_sin(len(a), *_small_addresses((a, c, s))):
+        return None
+    return c, s
 
 
 def box3(O: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

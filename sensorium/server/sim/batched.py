@@ -1081,7 +1081,11 @@ def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
 
 def _cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """math.cos and math.sin of each element (the single simulation's libm calls, whatever SIMD
-    routines numpy would pick for np.cos on this machine)."""
+    routines numpy would pick for np.cos on this machine): those libm calls in one C pass where
+    the helper is (packets.cos_sin), else through Python floats."""
+    got = packets.cos_sin(a)
+    if got is not None:
+        return got
     vals = a.tolist()
     return np.array(list(map(math.cos, vals))), np.array(list(map(math.sin, vals)))
 
