@@ -532,7 +532,7 @@ class RayEngine(TierTracer):
         n = len(O)
         exact = self._precision is Precision.EXACT
         eps64 = 1e-9 + 1e-14 * big  # float64 self-hit epsilon: 1e-9 m + ~50 ulps of the largest coordinate
-        hits = (cast_planes(planes, self._epoch, O, D, t_near, t_far, excl, eps64, distance_only)
+        hits = (cast_planes(planes, self._epoch, O, D, t_near, t_far, excl, eps64, distance_only, self.native)
                 if planes is not None else None)
         if static is not None:
             lim = t_far if hits is None else np.minimum(t_far, hits[0])

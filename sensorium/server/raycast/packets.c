@@ -1061,3 +1061,48 @@ size_t sp_cos_sin(size_t n, const double* a, double* out_cos, double* out_sin) {
   for (size_t i = 0; i < n; i++) out_sin[i] = sin(a[i]);
   return inf;
 }
+
+/* planes.py's cast_planes for one axis-aligned plane (a floor), every output it makes, operation
+ * for operation: ray i (origin O + o_stride i, direction D + 3 i) meets the plane (point pt, normal
+ * nz whose only non-zero component is nz[axis] = c) where den = D[axis] (times c unless c is 1)
+ * passes (visual: den < 0, one-sided; else den != 0), t = ((r0 nz0 + r1 nz1) + r2 nz2) / den with
+ * r = pt - o lies in [lo, hi] (per ray when not NULL, else the values), within the size when sized
+ * (|x . ax| <= half[0] and |x . ay| <= half[1], x = t D - r, each dot summed ((x0 a0 + x1 a1) + x2 a2))
+ * and, when check_owner, the plane's owner (-2: none) is not the ray's excluded owner. Writes dist
+ * (t, else inf) and, unless shape is NULL, shape (sid, else -1) and normal (nz times -1 when
+ * den > 0, else 1: toward the origin; 0 rows for misses). Returns the number of rays that passed
+ * every test (cast_planes' count of ok: 0 means "no hit", its None). */
+size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, int axis, double c, int visual,
+                 const double* pt, const double* nz, const double* lo, double lo_value, const double* hi,
+                 double hi_value, int sized, const double* ax, const double* ay, const double* half, int check_owner,
+                 int64_t owner, const int64_t* excl, int64_t excl_value, int64_t sid, double* dist, int64_t* shape,
+                 double* normal) {
+  size_t hits = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double* o = O + o_stride * i;
+    const double* d = D + 3 * i;
+    const double den = c == 1.0 ? d[axis] : d[axis] * c;
+    int ok = visual ? den < 0.0 : den != 0.0;
+    double t = INFINITY;
+    if (ok) {
+      const double r0 = pt[0] - o[0], r1 = pt[1] - o[1], r2 = pt[2] - o[2];
+      t = (r0 * nz[0] + r1 * nz[1] + r2 * nz[2]) / den;
+      ok = t >= (lo ? lo[i] : lo_value) && t <= (hi ? hi[i] : hi_value);
+      if (ok && sized) {
+        const double x0 = t * d[0] - r0, x1 = t * d[1] - r1, x2 = t * d[2] - r2;
+        ok = fabs(x0 * ax[0] + x1 * ax[1] + x2 * ax[2]) <= half[0] && fabs(x0 * ay[0] + x1 * ay[1] + x2 * ay[2]) <= half[1];
+      }
+      if (ok && check_owner) ok = owner != (excl ? excl[i] : excl_value);
+      if (!ok) t = INFINITY;
+    }
+    dist[i] = t;
+    if (shape) {
+      const int hit = t < INFINITY;
+      const double sign = den > 0.0 ? -1.0 : 1.0;
+      shape[i] = hit ? sid : -1;
+      for (int j = 0; j < 3; j++) normal[3 * i + (size_t)j] = hit ? nz[j] * sign : 0.0;
+    }
+    hits += ok != 0;
+  }
+  return hits;
+}

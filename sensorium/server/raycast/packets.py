@@ -172,6 +172,9 @@ def _load() -> None:
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_sensor_rays.restype = None
     lib.sp_sensor_rays.argtypes = [sz, sz, sz] + [vp] * 12
+    lib.sp_plane1.restype = sz
+    lib.sp_plane1.argtypes = [sz, vp, sz, vp, i, d, i, vp, vp, vp, d, vp, d, i, vp, vp, vp, i, i64, vp, i64, i64, vp,
+                              vp, vp]
     lib.sp_cos_sin.restype = sz
     lib.sp_cos_sin.argtypes = [sz, vp, vp, vp]
     lib.sp_box3.restype = None
@@ -573,6 +576,41 @@ def sensor_rays(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.
     p = _small_addresses([*idx, rot, pos, local_rot, local_pos, local_dirs, positions, origins, dirs])
     lib.sp_sensor_rays(S, N, R, p[0], p[1], p[4], p[5], p[2], p[6], p[7], p[3], p[8], p[9], p[10], p[11])
     return positions, origins, dirs
+
+
+def plane1(pl, O: np.ndarray, D: np.ndarray, lo, hi, excl, distance_only: bool):
+    """:func:`.planes.cast_planes` for one axis-aligned plane (``pl.axis >= 0``) in one C pass
+    (``sp_plane1``): its (dist, shape, normal) (shape and normal None with ``distance_only``), None
+    when no ray passes its tests, bit for bit; ``lo`` = max(t_near, eps64) and ``hi`` = t_far
+    (scalars or (n,)); or False without the helper (the caller's numpy path)."""
+    lib = library()
+    if lib is None or D.dtype != np.float64 or O.dtype != np.float64:
+        return False
+    n = len(D)
+    f64 = np.float64
+    if O.strides[0] == 0:
+        O, o_stride = np.ascontiguousarray(O[:1]), 0
+    else:
+        O, o_stride = np.ascontiguousarray(O), 3
+    D = np.ascontiguousarray(D)
+    lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
+    hi_a = np.ascontiguousarray(hi, dtype=f64) if isinstance(hi, np.ndarray) else None
+    check_owner = pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0)
+    ex_a = np.ascontiguousarray(excl, dtype=np.int64) if check_owner and isinstance(excl, np.ndarray) else None
+    dist = np.empty(n)
+    shape = None if distance_only else np.empty(n, dtype=np.int64)
+    normal = None if distance_only else np.empty((n, 3))
+    p_pt, p_nz, p_ax, p_ay, p_half = pl.native_rows()   # the plane's rows, contiguous
+    p = _small_addresses([O, D, dist])
+    k = lib.sp_plane1(n, p[0], o_stride, p[1], pl.axis, float(pl.nz[0, pl.axis]), 1 if pl.visual else 0, p_pt, p_nz,
+                      _ptr(lo_a), 0.0 if lo_a is not None else float(lo), _ptr(hi_a),
+                      0.0 if hi_a is not None else float(hi), 1 if pl.sized else 0, p_ax, p_ay, p_half,
+                      1 if check_owner else 0, int(pl.owner[0]), _ptr(ex_a),
+                      0 if ex_a is not None or not check_owner else int(excl), int(pl.sid[0]), p[2], _ptr(shape),
+                      _ptr(normal))
+    if not k:
+        return None
+    return dist, shape, normal
 
 
 def cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

@@ -996,12 +996,15 @@ class BatchedSimulation:
 
     # ------------------------------------------------------------------ tasks
     def cast(self, copies: np.ndarray, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
-             exclude_slot=-1, skip_transparent: bool = False) -> RayHits:
+             exclude_slot=-1, skip_transparent: bool = False, distance_only: bool = False,
+             coherent: bool = False) -> RayHits:
         """Rays of the named copies (one entry per ray) against each copy's world, as
         ``scene.engine.cast`` of a single simulation (``exclude_slot``: a robot slot whose body
-        the rays ignore, as ``exclude_owner``)."""
+        the rays ignore, as ``exclude_owner``; ``distance_only``, ``coherent``: as
+        :meth:`.CopyRays.cast`)."""
         return self.rays.cast(origins, directions, t_near, t_far, RayKind(kind), np.asarray(copies, dtype=np.int64),
-                              self.rot, self.pos, exclude_slot, -1, skip_transparent)
+                              self.rot, self.pos, exclude_slot, -1, skip_transparent, distance_only=distance_only,
+                              coherent=coherent)
 
 
 @dataclass(slots=True)
