@@ -109,7 +109,7 @@ class CopyRays:
 
     def cast(self, origins, directions, t_near, t_far, kind: RayKind, copy: np.ndarray, rot: np.ndarray,
              pos: np.ndarray, exclude_slot=-1, mount_slot=-1, skip_transparent: bool = False,
-             distance_only: bool = False, directions32=None, coherent: bool = False) -> RayHits:
+             distance_only: bool = False, directions32=None, coherent: bool = False, origin_rows=None) -> RayHits:
         """Nearest hits of rays of several copies. ``copy``: (n,) the copy of each ray; ``rot``
         (C, R, 3, 3) and ``pos`` (C, R, 3): every copy's robot poses now; ``exclude_slot``: the
         robot (slot) whose body a ray ignores (scalar or (n,); -1 none), as ``exclude_owner``;
@@ -118,7 +118,8 @@ class CopyRays:
         with ``RayEngine.cast(mount=...)``), or whose body it cannot reach (:meth:`may_reach`).
         ``coherent``: the rays come in runs from one origin each (every copy's lidar): traced as
         the single world traces one lidar's beams (coherent packets, FAST), so each beam gets the
-        single world's answer. Other arguments as :meth:`RayEngine.cast`."""
+        single world's answer. Other arguments as :meth:`RayEngine.cast` (``origin_rows``: the distinct
+        origins, e.g. every copy's lidar position)."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         n = len(O)
@@ -126,7 +127,8 @@ class CopyRays:
         self.counters["casts"] += 1
         self.counters["rays"] += n
         hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
-                                distance_only=distance_only, directions32=directions32, coherent=coherent)
+                                distance_only=distance_only, directions32=directions32, coherent=coherent,
+                                origin_rows=origin_rows)
         if n == 0 or not self.slots:
             return hits
         variant = self.movers._variant(kind, skip_transparent)

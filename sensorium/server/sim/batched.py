@@ -729,7 +729,7 @@ class BatchedSimulation:
                 r = reqs[0]
                 out[idx[0]] = self.rays.cast(r.origins, r.directions, r.t_near, r.t_far, RayKind(kind), r.copy,
                                              self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32,
-                                             coherent)
+                                             coherent, origin_rows=r.origin_rows)
                 continue
             sizes = [len(r.origins) for r in reqs]
             h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
@@ -928,7 +928,7 @@ class BatchedSimulation:
             ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
             reqs.append(_Rays(origins, d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
-                              -1, mount, distance_only=True, d32=d32, coherent=True))
+                              -1, mount, distance_only=True, d32=d32, coherent=True, origin_rows=org))
             state["items"].append((col, c))
         return state, reqs
 
@@ -1023,6 +1023,7 @@ class _Rays:
     distance_only: bool = False
     d32: np.ndarray | None = None
     coherent: bool = False     # runs of rays from one origin each (lidars): traced as one lidar's beams
+    origin_rows: np.ndarray | None = None   # the distinct origins (the lidars' positions), when known
 
 
 class _OnEngine:
