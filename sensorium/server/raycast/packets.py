@@ -659,13 +659,22 @@ def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: 
         O, o_stride = np.ascontiguousarray(Ot, dtype=f64), 3
     D = np.ascontiguousarray(D, dtype=f64)
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
-    ks = np.asarray(shells, dtype=i64)
-    arrays = [np.ascontiguousarray(getattr(tier, name), dtype=dt) for name, dt in (
-        ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
+    kept = tier.__dict__.get("_native_shells")
+    if kept is None:   # the tier's shells never change: their arrays and addresses made once
+        arrays = [np.ascontiguousarray(getattr(tier, name), dtype=dt) for name, dt in (
+            ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
+        every = np.arange(len(arrays[0]), dtype=i64)
+        kept = tier._native_shells = (arrays, every, [a.ctypes.data for a in (every, *arrays)])
+    every, ptrs = kept[1], kept[2]
+    if isinstance(shells, range) and shells == range(len(every)):   # every shell (the dense pass)
+        ks, p_ks = every, ptrs[0]
+    else:
+        ks = np.asarray(shells, dtype=i64)
+        p_ks = ks.ctypes.data
     out_row, out_slot, p_row, p_slot = _pair_buffers(m * len(ks))
-    p = _small_addresses([O, D, ks, *arrays])
+    p = _small_addresses([O, D])
     k = lib.sp_inside_shells(m, p[0], o_stride, p[1], _ptr(lo_a), 0.0 if lo_a is not None else float(lo), len(ks),
-                             p[2], *p[3:9], 1 if bound_first else 0, p_row, p_slot)
+                             p_ks, *ptrs[1:], 1 if bound_first else 0, p_row, p_slot)
     return out_row[:k].copy(), out_slot[:k].copy()
 
 
