@@ -254,6 +254,17 @@ def test_the_broad_phase_in_c_lists_the_numpy_pairs_and_meets_closed_form_cases(
         got = packets.copy_pairs(O, D, copy, centre, r2, present, lo, lim, excl, mount)
         assert len(want[0]) > 50
         assert got[0].tobytes() == want[0].tobytes() and got[1].tobytes() == want[1].tobytes()
+    # the limits made in the pass from the rays' far limits and their static hits (np.minimum, NaN
+    # included): per-ray and scalar far limits
+    dist = rng.uniform(0.0, 3.0, n)
+    dist[::5] = np.inf
+    dist[::13] = np.nan
+    for far in (lim, 1.7, np.inf):
+        lim_m = np.minimum(far, dist)
+        want = copies._pairs(O, D, copy, centre, r2, present, np.zeros(n), lim_m, -1, -1)
+        got = packets.copy_pairs(O, D, copy, centre, r2, present, 0.0, far, -1, -1, dist=dist)
+        assert len(want[0]) > 50
+        assert got[0].tobytes() == want[0].tobytes() and got[1].tobytes() == want[1].tobytes()
     # closed form: a unit sphere at (2, 0, 0) of copy 1, rays along +x from the origin offset by h in y
     centre = np.zeros((2, 1, 3))
     centre[1, 0] = [2.0, 0.0, 0.0]
@@ -513,3 +524,27 @@ def test_arc_steps_are_motion_arc_step_bit_for_bit(turning):
     want = np.array([arc_step(*a, dt) for a in zip(x.tolist(), y.tolist(), yaw.tolist(), v.tolist(), w.tolist())]).T
     for g, wa in zip(got, want):
         assert np.asarray(g).tobytes() == wa.tobytes()
+
+
+def test_cos_sin_in_c_are_math_cos_and_sin_bit_for_bit():
+    """packets.cos_sin (the batched drive's poses and arcs) gives what math.cos and math.sin give,
+    element by element, on random angles of every magnitude, signed zeros, NaN, multiples of pi and
+    subnormals; an infinite angle is left to the Python way (math.cos refuses it)."""
+    from sensorium.server.sim.batched import _cos_sin
+
+    if packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    rng = np.random.default_rng(7)
+    a = np.concatenate([rng.uniform(-7.0, 7.0, 20000), rng.uniform(-1e6, 1e6, 2000),
+                        10.0 ** rng.uniform(-320, 300, 2000) * rng.choice([-1.0, 1.0], 2000),
+                        [0.0, -0.0, math.nan, math.pi, -math.pi, math.pi / 2, 3 * math.pi / 4, 1e-300, 5e-324, 1e22]])
+    got = packets.cos_sin(a)
+    assert got is not None
+    want = [np.array([f(x) for x in a.tolist()]) for f in (math.cos, math.sin)]
+    for g, w in zip(got, want):
+        assert g.tobytes() == w.tobytes()
+    assert _cos_sin(a[:50])[1].tobytes() == want[1][:50].tobytes()
+    assert packets.cos_sin(np.array([0.5]))[0][0] == math.cos(0.5)
+    assert packets.cos_sin(np.array([0.5, math.inf])) is None
+    with pytest.raises(ValueError):
+        _cos_sin(np.array([0.5, -math.inf]))

@@ -255,3 +255,65 @@ def test_box3_is_numpys_column_min_and_max():
     # arrays it does not read: None (the caller's numpy path)
     assert packets.box3(np.asfortranarray(O)) is None and packets.box3(O.astype(np.float32)) is None
     assert packets.box3(np.zeros((0, 3))) is None
+
+
+@pytest.mark.parametrize("variant", ["bounding", "visual"])
+@pytest.mark.parametrize("floor", ["up", "ceiling", "sized", "owned"])
+def test_one_floor_in_c_is_the_numpy_plane_pass_bit_for_bit(variant, floor):
+    """planes.cast_planes for one axis-aligned plane: packets.plane1 (one C pass; the engine's
+    default) gives the numpy pass's distances, shapes and normals bit for bit (signed zeros of the
+    flipped normals included) -- two-sided and one-sided, a ceiling (normal -z, times -1), a sized
+    plane, an owned plane with per-ray and scalar excluded owners; scattered and one-origin rays,
+    per-ray and scalar limits, NaN and horizontal directions, rays from on the plane -- and None
+    exactly when numpy's is; and meets closed-form distances."""
+    from sensorium.server.raycast import planes as planes_module
+
+    if packets.library() is None:
+        pytest.skip(packets.status())
+    flip = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]])
+    pose = {"up": Pose(np.eye(3), np.array([0.0, 0.0, 0.1])), "ceiling": Pose(flip, np.array([0.0, 0.0, 2.0])),
+            "sized": Pose.identity(), "owned": Pose(np.eye(3), np.array([0.0, 0.0, -0.3]))}[floor]
+    eng = RayEngine(Precision.FAST)
+    eng.add_body([ShapeEntry(Box((0.2, 0.2, 0.2)), Pose.identity(), True, True)], Pose.identity())
+    eng.add_body([ShapeEntry(Plane((3.0, 2.0) if floor == "sized" else None), Pose.identity(), True, True)], pose,
+                 owner=4 if floor == "owned" else -1)
+    rng = np.random.default_rng({"up": 1, "ceiling": 2, "sized": 3, "owned": 4}[floor])
+    n = 3000
+    O = rng.uniform(-2.0, 2.0, (n, 3))
+    O[::9, 2] = pose.translation[2]                # on the plane
+    D = rng.normal(size=(n, 3))
+    D /= np.linalg.norm(D, axis=1)[:, None]
+    D[::7, 2] = 0.0                                 # parallel to it
+    D[5::101] = np.nan
+    eng.cast(O[:1], D[:1], kind=RayKind(variant == "visual"))   # builds and refreshes the plane data
+    pl = eng._plane_set(variant)
+    assert pl is not None and pl.axis == 2
+    one = np.broadcast_to(O[3], O.shape)
+    cases = [(O, 0.0, np.inf, -1), (O, 0.05, 3.0, 4), (one, 0.0, rng.uniform(0.0, 4.0, n), -1),
+             (O, rng.uniform(0.0, 0.5, n), rng.uniform(0.5, 4.0, n), rng.integers(2, 6, n)), (one, 0.0, 0.01, 4)]
+    seen = 0
+    for O_, t_near, t_far, excl in cases:
+        for distance_only in (False, True):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                want = planes_module.cast_planes(pl, eng._epoch, O_, D, t_near, t_far, excl, 1e-9, distance_only)
+                got = planes_module.cast_planes(pl, eng._epoch, O_, D, t_near, t_far, excl, 1e-9, distance_only,
+                                                native=True)
+            if want is None or (distance_only and O_ is one and variant == "visual"):
+                assert (got is None) == (want is None)   # (the lean one-origin path is numpy's on both)
+                if want is None:
+                    continue
+            seen += 1
+            assert got[0].tobytes() == want[0].tobytes()
+            if distance_only:
+                assert got[1] is None and got[2] is None
+            else:
+                assert got[1].tobytes() == want[1].tobytes() and got[2].tobytes() == want[2].tobytes()
+    assert seen >= 6
+    # closed form: straight down (and up) onto the plane from 1 m on its front side
+    z0 = float(pose.translation[2])
+    side = -1.0 if floor == "ceiling" else 1.0
+    Oc = np.array([[0.5, 0.5, z0 + side], [0.5, 0.5, z0 + side]])
+    Dc = np.array([[0.0, 0.0, -side], [0.0, 0.0, side]])
+    got = planes_module.cast_planes(pl, eng._epoch, Oc, Dc, 0.0, np.inf, -1, 1e-9, False, native=True)
+    assert got[0][0] == 1.0 and got[0][1] == np.inf
+    assert got[2][0].tolist() == [0.0, 0.0, side] and got[1][1] == -1

@@ -109,7 +109,7 @@ class CopyRays:
 
     def cast(self, origins, directions, t_near, t_far, kind: RayKind, copy: np.ndarray, rot: np.ndarray,
              pos: np.ndarray, exclude_slot=-1, mount_slot=-1, skip_transparent: bool = False,
-             distance_only: bool = False, directions32=None, coherent: bool = False) -> RayHits:
+             distance_only: bool = False, directions32=None, coherent: bool = False, origin_rows=None) -> RayHits:
         """Nearest hits of rays of several copies. ``copy``: (n,) the copy of each ray; ``rot``
         (C, R, 3, 3) and ``pos`` (C, R, 3): every copy's robot poses now; ``exclude_slot``: the
         robot (slot) whose body a ray ignores (scalar or (n,); -1 none), as ``exclude_owner``;
@@ -118,7 +118,8 @@ class CopyRays:
         with ``RayEngine.cast(mount=...)``), or whose body it cannot reach (:meth:`may_reach`).
         ``coherent``: the rays come in runs from one origin each (every copy's lidar): traced as
         the single world traces one lidar's beams (coherent packets, FAST), so each beam gets the
-        single world's answer. Other arguments as :meth:`RayEngine.cast`."""
+        single world's answer. Other arguments as :meth:`RayEngine.cast` (``origin_rows``: the distinct
+        origins, e.g. every copy's lidar position)."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         n = len(O)
@@ -126,7 +127,8 @@ class CopyRays:
         self.counters["casts"] += 1
         self.counters["rays"] += n
         hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
-                                distance_only=distance_only, directions32=directions32, coherent=coherent)
+                                distance_only=distance_only, directions32=directions32, coherent=coherent,
+                                origin_rows=origin_rows)
         if n == 0 or not self.slots:
             return hits
         variant = self.movers._variant(kind, skip_transparent)
@@ -134,21 +136,26 @@ class CopyRays:
         if not present.any():
             return hits
         dist = hits.distance
-        lim = np.minimum(np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,)), dist)
+        far = np.asarray(t_far, dtype=np.float64)
+        far = float(far) if far.ndim == 0 else np.ascontiguousarray(np.broadcast_to(far, (n,)))
+        lim = None   # each ray's limit np.minimum(t_far, dist): made in the C pass, here once needed
         copy = np.asarray(copy, dtype=np.int64).reshape(n)
         # broad phase: each ray against the bounding spheres of its own copy's bodies
         R = self.slots
         centre = pos + np.einsum("crij,rj->cri", rot, anchor)          # (C, R, 3): a conservative test only
         excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else np.asarray(exclude_slot).reshape(n)
         mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else np.asarray(mount_slot).reshape(n)
-        got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, lim, excl, mnt) if self.static.native
-               else None)
+        got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, far, excl, mnt, dist=dist)
+               if self.static.native else None)
         if got is None:
             lo = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,))
+            lim = np.minimum(far, dist)
             got = _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt)
         pr, pm = got
         if not len(pr):
             return hits
+        if lim is None:
+            lim = np.minimum(far, dist)
         self.counters["mover_pairs"] += len(pr)
         # pairs grouped by body, each body's rays in ray order (as the engine's one-mover path sees them)
         order = np.lexsort((pr, pm))

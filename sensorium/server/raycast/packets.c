@@ -777,11 +777,13 @@ void sp_to_frame(size_t n, const double* x, const int64_t* rows, const double* R
  * operation (it is conservative, with a slack of 1e-9 (1 + e2)). Pairs are written slot by slot,
  * each slot's rays ascending (the numpy path's order): ray into out_ray, copy * R + r into
  * out_body; returns their number (at most n * R). lo, excl, mnt: per ray when not NULL, else the
- * scalar value. */
+ * scalar value. With dist (n,) given, lim[i] is np.minimum(t_far, dist[i]) made here: t_far the
+ * (n,) lim when not NULL, else lim_value (the caller's limits without their array). */
 size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const int64_t* copy,
                      const double* centre, const double* r2, const uint8_t* present, const double* lo,
-                     double lo_value, const double* lim, const int64_t* excl, int64_t excl_value,
-                     const int64_t* mnt, int64_t mnt_value, int64_t* out_ray, int64_t* out_body) {
+                     double lo_value, const double* lim, double lim_value, const double* dist,
+                     const int64_t* excl, int64_t excl_value, const int64_t* mnt, int64_t mnt_value,
+                     int64_t* out_ray, int64_t* out_body) {
   size_t k = 0;
   for (size_t r = 0; r < R; r++) {
     if (!present[r]) continue;
@@ -792,7 +794,7 @@ size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const
       if (excl && excl[i] == (int64_t)r) continue;
       if (mnt && mnt[i] == (int64_t)r) continue;
       const double l = lo ? lo[i] : lo_value;
-      const double f = lim[i];
+      const double f = dist ? np_min(lim ? lim[i] : lim_value, dist[i]) : lim[i];
       if (!(f >= l)) continue;
       const int64_t c = copy[i];
       const double* cc = centre + 3 * ((size_t)c * R + r);
@@ -1044,4 +1046,63 @@ void sp_lidar_beams(size_t n, size_t W, const double* rot, const double* org, co
       out_org[r + 2] = o2;
     }
   }
+}
+
+/* batched.py's _cos_sin: libm's cos and sin of each of n angles, the calls Python's math.cos and
+ * math.sin make (the single simulation's). Two loops, so that the compiler does not merge a cos and
+ * a sin of one angle into one sincos call (another libm entry point). Returns the number of
+ * infinite angles (math.cos refuses them: the caller then takes Python's way, error included). */
+size_t sp_cos_sin(size_t n, const double* a, double* out_cos, double* out_sin) {
+  size_t inf = 0;
+  for (size_t i = 0; i < n; i++) {
+    out_cos[i] = cos(a[i]);
+    inf += isinf(a[i]) != 0;
+  }
+  for (size_t i = 0; i < n; i++) out_sin[i] = sin(a[i]);
+  return inf;
+}
+
+/* planes.py's cast_planes for one axis-aligned plane (a floor), every output it makes, operation
+ * for operation: ray i (origin O + o_stride i, direction D + 3 i) meets the plane (point pt, normal
+ * nz whose only non-zero component is nz[axis] = c) where den = D[axis] (times c unless c is 1)
+ * passes (visual: den < 0, one-sided; else den != 0), t = ((r0 nz0 + r1 nz1) + r2 nz2) / den with
+ * r = pt - o lies in [lo, hi] (per ray when not NULL, else the values), within the size when sized
+ * (|x . ax| <= half[0] and |x . ay| <= half[1], x = t D - r, each dot summed ((x0 a0 + x1 a1) + x2 a2))
+ * and, when check_owner, the plane's owner (-2: none) is not the ray's excluded owner. Writes dist
+ * (t, else inf) and, unless shape is NULL, shape (sid, else -1) and normal (nz times -1 when
+ * den > 0, else 1: toward the origin; 0 rows for misses). Returns the number of rays that passed
+ * every test (cast_planes' count of ok: 0 means "no hit", its None). */
+size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, int axis, double c, int visual,
+                 const double* pt, const double* nz, const double* lo, double lo_value, const double* hi,
+                 double hi_value, int sized, const double* ax, const double* ay, const double* half, int check_owner,
+                 int64_t owner, const int64_t* excl, int64_t excl_value, int64_t sid, double* dist, int64_t* shape,
+                 double* normal) {
+  size_t hits = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double* o = O + o_stride * i;
+    const double* d = D + 3 * i;
+    const double den = c == 1.0 ? d[axis] : d[axis] * c;
+    int ok = visual ? den < 0.0 : den != 0.0;
+    double t = INFINITY;
+    if (ok) {
+      const double r0 = pt[0] - o[0], r1 = pt[1] - o[1], r2 = pt[2] - o[2];
+      t = (r0 * nz[0] + r1 * nz[1] + r2 * nz[2]) / den;
+      ok = t >= (lo ? lo[i] : lo_value) && t <= (hi ? hi[i] : hi_value);
+      if (ok && sized) {
+        const double x0 = t * d[0] - r0, x1 = t * d[1] - r1, x2 = t * d[2] - r2;
+        ok = fabs(x0 * ax[0] + x1 * ax[1] + x2 * ax[2]) <= half[0] && fabs(x0 * ay[0] + x1 * ay[1] + x2 * ay[2]) <= half[1];
+      }
+      if (ok && check_owner) ok = owner != (excl ? excl[i] : excl_value);
+      if (!ok) t = INFINITY;
+    }
+    dist[i] = t;
+    if (shape) {
+      const int hit = t < INFINITY;
+      const double sign = den > 0.0 ? -1.0 : 1.0;
+      shape[i] = hit ? sid : -1;
+      for (int j = 0; j < 3; j++) normal[3 * i + (size_t)j] = hit ? nz[j] * sign : 0.0;
+    }
+    hits += ok != 0;
+  }
+  return hits;
 }

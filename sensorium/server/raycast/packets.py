@@ -172,12 +172,17 @@ def _load() -> None:
     lib.sp_analytic.argtypes = [vp, sz, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_sensor_rays.restype = None
     lib.sp_sensor_rays.argtypes = [sz, sz, sz] + [vp] * 12
+    lib.sp_plane1.restype = sz
+    lib.sp_plane1.argtypes = [sz, vp, sz, vp, i, d, i, vp, vp, vp, d, vp, d, i, vp, vp, vp, i, i64, vp, i64, i64, vp,
+                              vp, vp]
+    lib.sp_cos_sin.restype = sz
+    lib.sp_cos_sin.argtypes = [sz, vp, vp, vp]
     lib.sp_box3.restype = None
     lib.sp_box3.argtypes = [sz, vp, vp]
     lib.sp_inside_shells.restype = sz
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
-    lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, i64, vp, i64, vp, vp]
+    lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, d, vp, vp, i64, vp, i64, vp, vp]
     lib.sp_contact_near.restype = sz
     lib.sp_drive_wheels.restype = sz
     lib.sp_lidar_beams.restype = None
@@ -504,12 +509,15 @@ def lidar_scan(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray, colum
 
 
 def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarray, r2: np.ndarray,
-               present: np.ndarray, lo, lim: np.ndarray, excl, mount) -> tuple[np.ndarray, np.ndarray] | None:
+               present: np.ndarray, lo, lim, excl, mount, dist: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray] | None:
     """The broad phase of :meth:`.copies.CopyRays.cast` in one C pass (``sp_copy_pairs``): the
     (ray, copy * R + slot) pairs whose ray comes within the bounding sphere (``centre`` (C, R, 3),
     ``r2`` (R,)) of a present slot of its own copy, its excluded and mount slots left out, listed
     slot by slot and ray by ray as the numpy path lists them; or None without the helper. ``lo``,
-    ``excl``, ``mount``: scalars or (n,) arrays; ``lim`` (n,)."""
+    ``excl``, ``mount``: scalars or (n,) arrays; ``lim`` (n,), or with ``dist`` (n,) the rays' far
+    limits (a scalar or (n,)), each ray's limit then being ``np.minimum(lim, dist)`` (made in the
+    pass: no (n,) temporary)."""
     lib = library()
     if lib is None:
         return None
@@ -521,14 +529,22 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     centre = np.ascontiguousarray(centre, dtype=f64)
     r2 = np.ascontiguousarray(r2, dtype=f64)
     present = np.ascontiguousarray(present, dtype=np.uint8)
-    lim = np.ascontiguousarray(lim, dtype=f64)
+    lim_value = 0.0
+    if dist is not None:
+        dist = np.ascontiguousarray(dist, dtype=f64)
+        if not isinstance(lim, np.ndarray) or lim.ndim == 0:
+            lim, lim_value = None, float(lim)
+    if lim is not None:
+        lim = np.ascontiguousarray(lim, dtype=f64)
+        if lim.shape != (n,):
+            raise TypeError(f"copy_pairs: limits of shape {lim.shape} for {n} rays")
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
     ex_a = np.ascontiguousarray(excl, dtype=i64) if isinstance(excl, np.ndarray) else None
     mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
     out_ray, out_body, p_ray, p_body = _pair_buffers(n * R)
-    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_lim = _small_addresses((O, D, copy, centre, r2, present, lim))
+    p_O, p_D, p_copy, p_centre, p_r2, p_present = _small_addresses((O, D, copy, centre, r2, present))
     k = lib.sp_copy_pairs(n, R, p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
-                          0.0 if lo_a is not None else float(lo), p_lim, _ptr(ex_a),
+                          0.0 if lo_a is not None else float(lo), _ptr(lim), lim_value, _ptr(dist), _ptr(ex_a),
                           0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
                           p_ray, p_body)
     return out_ray[:k].copy(), out_body[:k].copy()
@@ -562,6 +578,56 @@ def sensor_rays(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.
     return positions, origins, dirs
 
 
+def plane1(pl, O: np.ndarray, D: np.ndarray, lo, hi, excl, distance_only: bool):
+    """:func:`.planes.cast_planes` for one axis-aligned plane (``pl.axis >= 0``) in one C pass
+    (``sp_plane1``): its (dist, shape, normal) (shape and normal None with ``distance_only``), None
+    when no ray passes its tests, bit for bit; ``lo`` = max(t_near, eps64) and ``hi`` = t_far
+    (scalars or (n,)); or False without the helper (the caller's numpy path)."""
+    lib = library()
+    if lib is None or D.dtype != np.float64 or O.dtype != np.float64:
+        return False
+    n = len(D)
+    f64 = np.float64
+    if O.strides[0] == 0:
+        O, o_stride = np.ascontiguousarray(O[:1]), 0
+    else:
+        O, o_stride = np.ascontiguousarray(O), 3
+    D = np.ascontiguousarray(D)
+    lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
+    hi_a = np.ascontiguousarray(hi, dtype=f64) if isinstance(hi, np.ndarray) else None
+    check_owner = pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0)
+    ex_a = np.ascontiguousarray(excl, dtype=np.int64) if check_owner and isinstance(excl, np.ndarray) else None
+    dist = np.empty(n)
+    shape = None if distance_only else np.empty(n, dtype=np.int64)
+    normal = None if distance_only else np.empty((n, 3))
+    p_pt, p_nz, p_ax, p_ay, p_half = pl.native_rows()   # the plane's rows, contiguous
+    p = _small_addresses([O, D, dist])
+    k = lib.sp_plane1(n, p[0], o_stride, p[1], pl.axis, float(pl.nz[0, pl.axis]), 1 if pl.visual else 0, p_pt, p_nz,
+                      _ptr(lo_a), 0.0 if lo_a is not None else float(lo), _ptr(hi_a),
+                      0.0 if hi_a is not None else float(hi), 1 if pl.sized else 0, p_ax, p_ay, p_half,
+                      1 if check_owner else 0, int(pl.owner[0]), _ptr(ex_a),
+                      0 if ex_a is not None or not check_owner else int(excl), int(pl.sid[0]), p[2], _ptr(shape),
+                      _ptr(normal))
+    if not k:
+        return None
+    return dist, shape, normal
+
+
+def cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(cos, sin) of each element of the (n,) float64 array ``a`` through libm's ``cos`` and ``sin``,
+    the functions ``math.cos`` and ``math.sin`` call (``sp_cos_sin``: the same bits as calling them
+    element by element, without the Python floats); None without the helper, for another array, or
+    when an angle is infinite (``math.cos`` refuses it: the caller's Python way says so)."""
+    lib = library()
+    if lib is None or a.dtype != np.float64 or a.ndim != 1:
+        return None
+    a = np.ascontiguousarray(a)
+    c, s = np.empty(len(a)), np.empty(len(a))
+    if lib.sp_cos_sin(len(a), *_small_addresses((a, c, s))):
+        return None
+    return c, s
+
+
 def box3(O: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """(each column's minimum, maximum) of the rows of a C-contiguous float64 (n, 3) array, n >= 1,
     in one C pass (``sp_box3``: numpy's min and max, NaN propagated); None without the helper or
@@ -593,13 +659,22 @@ def inside_shells(tier, Ot: np.ndarray, D: np.ndarray, lo, shells, bound_first: 
         O, o_stride = np.ascontiguousarray(Ot, dtype=f64), 3
     D = np.ascontiguousarray(D, dtype=f64)
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
-    ks = np.asarray(shells, dtype=i64)
-    arrays = [np.ascontiguousarray(getattr(tier, name), dtype=dt) for name, dt in (
-        ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
+    kept = tier.__dict__.get("_native_shells")
+    if kept is None:   # the tier's shells never change: their arrays and addresses made once
+        arrays = [np.ascontiguousarray(getattr(tier, name), dtype=dt) for name, dt in (
+            ("c_code", i64), ("c_pos", f64), ("c_rot", f64), ("c_bound2", f64), ("c_rad2", f64), ("c_ax", f64))]
+        every = np.arange(len(arrays[0]), dtype=i64)
+        kept = tier._native_shells = (arrays, every, [a.ctypes.data for a in (every, *arrays)])
+    every, ptrs = kept[1], kept[2]
+    if isinstance(shells, range) and shells == range(len(every)):   # every shell (the dense pass)
+        ks, p_ks = every, ptrs[0]
+    else:
+        ks = np.asarray(shells, dtype=i64)
+        p_ks = ks.ctypes.data
     out_row, out_slot, p_row, p_slot = _pair_buffers(m * len(ks))
-    p = _small_addresses([O, D, ks, *arrays])
+    p = _small_addresses([O, D])
     k = lib.sp_inside_shells(m, p[0], o_stride, p[1], _ptr(lo_a), 0.0 if lo_a is not None else float(lo), len(ks),
-                             p[2], *p[3:9], 1 if bound_first else 0, p_row, p_slot)
+                             p_ks, *ptrs[1:], 1 if bound_first else 0, p_row, p_slot)
     return out_row[:k].copy(), out_slot[:k].copy()
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import _INF, _mat
 from sensorium.server.raycast.kinds import ShapeEntry
 from sensorium.server.raycast.movers import _Body
@@ -26,6 +27,7 @@ class _Planes:
         half = [(s[0] / 2.0, s[1] / 2.0) if s is not None else (_INF, _INF) for s in sizes]
         self.half = np.array(half).reshape(-1, 2)
         self._poses: list | None = None
+        self._rows: tuple | None = None
         self._epoch = -1
 
     def refresh(self, epoch: int) -> None:
@@ -53,19 +55,36 @@ class _Planes:
                     and np.count_nonzero(b) == 1:
                 self.size_axes = (int(np.argmax(a)), int(np.argmax(b)))
         self._poses = poses
+        self._rows: tuple | None = None
+
+    def native_rows(self) -> tuple:
+        """The addresses of the first plane's point, normal, x and y axes and half sizes as contiguous
+        float64 rows (packets.plane1 reads them; the rows kept with them), made once per refresh that
+        changed them."""
+        if self._rows is None:
+            rows = [np.ascontiguousarray(a[0], dtype=np.float64) for a in (self.pt, self.nz, self.ax, self.ay, self.half)]
+            self._rows = (rows, *(a.ctypes.data for a in rows))
+        return self._rows[1:]
 
 
 
-def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, distance_only: bool = False):
+def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, distance_only: bool = False,
+                native: bool = False):
     """(dist, shape, normal) of the nearest plane hits, or None if no ray hits a plane (shape and
     normal None with ``distance_only``).  Rays sharing one origin (a broadcast array: a lidar)
-    compute the origin's offsets once."""
+    compute the origin's offsets once.  ``native``: one axis-aligned plane (a floor) in one C pass
+    where the helper is (packets.plane1: this function's values, bit for bit)."""
     pl.refresh(epoch)
     n, P = len(O), len(pl.sid)
     if distance_only and pl.axis >= 0 and pl.visual and n > 1 and O.strides[0] == 0 and \
             (not pl.sized or (pl.size_axes is not None and not isinstance(t_far, np.ndarray) and t_far < _INF)) and \
             not (pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0)):
         return _floor_distances(pl, O, D, t_near, t_far, eps64)
+    if native and pl.axis >= 0 and n > 1:
+        lo = np.maximum(t_near, eps64) if isinstance(t_near, np.ndarray) else max(t_near, eps64)
+        got = packets.plane1(pl, O, D, lo, t_far, excl, distance_only)
+        if got is not False:
+            return got
     if pl.axis >= 0:   # one axis-aligned plane (a floor): D . n is one column times the normal's
         # non-zero component, the product's value whatever BLAS does (it adds exact zeros to that
         # one rounded product; see _floor_distances), without a BLAS call (OpenBLAS threads fight

@@ -291,7 +291,7 @@ class Refiner:
         rows, slots = cand.nonzero()
         return rows, slots, False
 
-    def _contained_prepass(self, tier: _Tier, Ot, D, lo, lim, excl):
+    def _contained_prepass(self, tier: _Tier, Ot, D, lo, lim, excl, box=None):
         """Rays starting inside a curved shell may reach the true surface before any crossing of
         that shell that the cast will see (the exit can lie beyond t_far or a nearer hit found
         elsewhere), so those (ray, shape) pairs are intersected analytically up front.  Screening
@@ -299,7 +299,8 @@ class Refiner:
         their origins first (a lidar's rays share one origin); then each shell's own extent (or a
         dense bounding-sphere test against several shells).  So this costs a few numpy calls unless
         some start point really is inside a shell.  Returns None, or (rows, t, global shape,
-        normal toward the origin) of the hits found."""
+        normal toward the origin) of the hits found.  ``box``: the (min, max) per column of ``Ot``
+        when the caller has it (the screening's box, without a pass over the rows)."""
         m = len(Ot)
         if m == 0:
             return None
@@ -324,7 +325,8 @@ class Refiner:
             # per column: numpy reduces a short inner axis ~10x slower than a contiguous column
             reach = float(lo.max()) if isinstance(lo, np.ndarray) else lo
             Ou = Ot[:1] if Ot.strides[0] == 0 else Ot   # one origin for all rays (a broadcast array)
-            box = packets.box3(Ou) if self.native and len(Ou) > 1 else None
+            if box is None:
+                box = packets.box3(Ou) if self.native and len(Ou) > 1 else None
             if box is None:
                 box = np.array([Ou[:, k].min() for k in range(3)]), np.array([Ou[:, k].max() for k in range(3)])
             box_lo, box_hi = box[0] - reach, box[1] + reach

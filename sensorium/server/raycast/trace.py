@@ -70,7 +70,7 @@ class TierTracer(Refiner):
         return scene.run(o32, d32, far, output=1)
 
     def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
-               distance_only: bool = False, d32=None, coherent: bool = False):
+               distance_only: bool = False, d32=None, coherent: bool = False, box=None):
         """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
@@ -78,17 +78,19 @@ class TierTracer(Refiner):
         (the same t; a lidar needs nothing else), and so may EXACT.  ``d32``: ``D`` rounded to
         float32 when the caller has it.  ``coherent``: FAST traces the rays as coherent packets even
         with several origins (rays in runs from one origin each: the copies' lidars of a batched
-        world; a ray's answer is then the one it gets in a one-origin cast)."""
+        world; a ray's answer is then the one it gets in a one-origin cast).  ``box``: FAST's
+        curved-shell pre-pass takes the (min, max) per column of O from it when given (the values
+        it would find; an unanchored tier)."""
         if exact:
             res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True, distance_only=distance_only,
                                    d32_all=d32)
             if not np.count_nonzero(res[0] < _INF):
                 return None
             return (res[0], None, None) if distance_only else res
-        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32, coherent)
+        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32, coherent, box)
 
     def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
-                    distance_only: bool = False, d32=None, coherent: bool = False):
+                    distance_only: bool = False, d32=None, coherent: bool = False, box=None):
         """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
         self-hits, shells left from inside, excluded owners) are redone by the general loop.
         Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
@@ -104,7 +106,7 @@ class TierTracer(Refiner):
         # float64 path (scalar or vectorised) may differ from this one's in the last bit
         if tier.has_curved:  # origins inside a curved shell: analytic first (see the pre-pass)
             lo = np.maximum(t_near, eps64) if isinstance(t_near, np.ndarray) else max(t_near, eps64)
-            pre = self._contained_prepass(tier, Ot, D, lo, lim, excl)
+            pre = self._contained_prepass(tier, Ot, D, lo, lim, excl, None if tier.anchored else box)
             if pre is not None:  # the cast only needs to look before the analytic hits
                 lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, lim)
                 lim[pre[0]] = np.minimum(lim[pre[0]], pre[1])

@@ -729,7 +729,7 @@ class BatchedSimulation:
                 r = reqs[0]
                 out[idx[0]] = self.rays.cast(r.origins, r.directions, r.t_near, r.t_far, RayKind(kind), r.copy,
                                              self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32,
-                                             coherent)
+                                             coherent, origin_rows=r.origin_rows)
                 continue
             sizes = [len(r.origins) for r in reqs]
             h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
@@ -928,7 +928,7 @@ class BatchedSimulation:
             ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
             reqs.append(_Rays(origins, d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
-                              -1, mount, distance_only=True, d32=d32, coherent=True))
+                              -1, mount, distance_only=True, d32=d32, coherent=True, origin_rows=org))
             state["items"].append((col, c))
         return state, reqs
 
@@ -996,12 +996,15 @@ class BatchedSimulation:
 
     # ------------------------------------------------------------------ tasks
     def cast(self, copies: np.ndarray, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
-             exclude_slot=-1, skip_transparent: bool = False) -> RayHits:
+             exclude_slot=-1, skip_transparent: bool = False, distance_only: bool = False,
+             coherent: bool = False) -> RayHits:
         """Rays of the named copies (one entry per ray) against each copy's world, as
         ``scene.engine.cast`` of a single simulation (``exclude_slot``: a robot slot whose body
-        the rays ignore, as ``exclude_owner``)."""
+        the rays ignore, as ``exclude_owner``; ``distance_only``, ``coherent``: as
+        :meth:`.CopyRays.cast`)."""
         return self.rays.cast(origins, directions, t_near, t_far, RayKind(kind), np.asarray(copies, dtype=np.int64),
-                              self.rot, self.pos, exclude_slot, -1, skip_transparent)
+                              self.rot, self.pos, exclude_slot, -1, skip_transparent, distance_only=distance_only,
+                              coherent=coherent)
 
 
 @dataclass(slots=True)
@@ -1020,6 +1023,7 @@ class _Rays:
     distance_only: bool = False
     d32: np.ndarray | None = None
     coherent: bool = False     # runs of rays from one origin each (lidars): traced as one lidar's beams
+    origin_rows: np.ndarray | None = None   # the distinct origins (the lidars' positions), when known
 
 
 class _OnEngine:
@@ -1081,7 +1085,11 @@ def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
 
 def _cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """math.cos and math.sin of each element (the single simulation's libm calls, whatever SIMD
-    routines numpy would pick for np.cos on this machine)."""
+    routines numpy would pick for np.cos on this machine): those libm calls in one C pass where
+    the helper is (packets.cos_sin), else through Python floats."""
+    got = packets.cos_sin(a)
+    if got is not None:
+        return got
     vals = a.tolist()
     return np.array(list(map(math.cos, vals))), np.array(list(map(math.sin, vals)))
 
