@@ -39,3 +39,35 @@ def test_rep_work_echoes_each_message_after_its_work(tmp_path, capsys) -> None:
     finally:
         req.close(0)
         ctx.term()
+
+
+def test_router_raw_echoes_each_clients_bytes_to_that_client(tmp_path, capsys) -> None:
+    """The 'socket pattern' floor: a ROUTER that sends every message back unchanged, to its sender."""
+    from sensorium.benchmarks.transport_roles import _role_router_raw
+
+    endpoint = f"ipc://{tmp_path}/router-raw"
+    server = threading.Thread(target=_role_router_raw, args=(endpoint,), daemon=True)
+    server.start()
+    deadline = time.monotonic() + 30
+    while f"ready {endpoint}" not in capsys.readouterr().out:
+        assert time.monotonic() < deadline, "router-raw did not start"
+        time.sleep(0.01)
+    ctx = zmq.Context()
+    dealers = [ctx.socket(zmq.DEALER) for _ in range(2)]
+    try:
+        for d in dealers:
+            d.setsockopt(zmq.RCVTIMEO, 30_000)
+            d.connect(endpoint)
+        for i in range(5):
+            for k, d in enumerate(dealers):
+                d.send(b"client %d message %d" % (k, i))
+            for k, d in enumerate(dealers):
+                assert d.recv() == b"client %d message %d" % (k, i)     # its own bytes, unchanged
+        dealers[0].send(b"quit")
+        assert dealers[0].recv() == b"quit"
+        server.join(10)
+        assert not server.is_alive()
+    finally:
+        for d in dealers:
+            d.close(0)
+        ctx.term()

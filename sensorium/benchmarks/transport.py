@@ -170,6 +170,9 @@ def round_trips(tmp: Path, n: int, rounds: int, ipc: bool = False) -> dict[str, 
         router = Proc(_role_args("router-echo", f"ipc://{tmp}/router" if ipc else "tcp://127.0.0.1"))
         servers.append(router)
         router_ep = router.line().split()[1]
+        router_raw = Proc(_role_args("router-raw", f"ipc://{tmp}/router-raw" if ipc else "tcp://127.0.0.1"))
+        servers.append(router_raw)
+        router_raw_ep = router_raw.line().split()[1]
         # every server first, then the clients together: a controller that waits silent for longer
         # than 3 heartbeats (while a server starts) would lose its session
         sens = {path: Server(_robots_world(1), tmp, ipc=ipc, step_path=path) for path in step_paths()}
@@ -189,6 +192,7 @@ def round_trips(tmp: Path, n: int, rounds: int, ipc: bool = False) -> dict[str, 
         clients = {
             "floor": Proc(_role_args("req", rep_ep), stdin=True),
             "floor-work": Proc(_role_args("req", work_ep), stdin=True),
+            "pattern": Proc(_role_args("dealer-raw", router_raw_ep), stdin=True),
             "bare": Proc(_role_args("dealer-client", router_ep), stdin=True),
             "conn": Proc(_role_args("conn-client", router_ep), stdin=True),
             **{f"sensorium-{path}": Proc(_role_args("stepper", srv.rpc, "c0", "8"), stdin=True)
@@ -550,6 +554,7 @@ def run(cfg: Config) -> Section:
         data[f"reqrep_floor{sfx}"] = {"p50_s": median(r["floor"]), "p99_s": pct(r["floor"], 99)}
         data[f"reqrep_work{sfx}"] = {"p50_s": median(r["floor-work"]), "p99_s": pct(r["floor-work"], 99),
                                      "work_us": SERVER_WORK_US}
+        data[f"router_floor{sfx}"] = {"p50_s": median(r["pattern"]), "p99_s": pct(r["pattern"], 99)}
         data[f"python_floor_bare{sfx}"] = {"p50_s": median(r["bare"]), "p99_s": pct(r["bare"], 99)}
         data[f"python_floor{sfx}"] = {"p50_s": median(r["conn"]), "p99_s": pct(r["conn"], 99)}
         for path in paths:
@@ -559,6 +564,7 @@ def run(cfg: Config) -> Section:
         fl = r["floor"]
         labelled = [("raw pyzmq REQ/REP ping-pong (floor)", fl),
                     (f"raw REQ ↔ a REP that is busy {SERVER_WORK_US} µs per message (server work)", r["floor-work"]),
+                    ("raw pyzmq DEALER ↔ ROUTER echo (the same bytes, no msgpack)", r["pattern"]),
                     ("bare DEALER (msgpack, blocking recv) ↔ minimal Python msgpack ROUTER", r["bare"]),
                     ("client library `Connection` ↔ minimal Python msgpack ROUTER (no lockstep)", r["conn"])]
         labelled += [(f"bare DEALER stepping (msgpack, blocking recv) ↔ `sensorium serve`, {best} step path",
@@ -744,7 +750,9 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
                    f"work); a bare DEALER stepping against `sensorium serve` "
                    f"({best} step path: msgpack, the lockstep, the world step) {us(stepper - fl)} more; the client "
                    f"library's `Connection` instead of that bare DEALER {us(mine - stepper)} more{others}. For "
-                   f"reference, a bare DEALER against a do-nothing Python msgpack ROUTER: {us(bare - fl)} above the floor.")
+                   f"reference, a bare DEALER against a do-nothing Python msgpack ROUTER: {us(bare - fl)} above the floor; "
+                   f"a raw DEALER ↔ ROUTER echo of the same bytes (the socket pattern a server of several clients "
+                   f"needs, no msgpack): {us(data[f'router_floor{sfx}']['p50_s'] - fl)} above it.")
     c1 = data["server_cpu"]["1"]
     why.append(f"The server's Python per step without sockets (1 controller): {us(c1['handle']['total_s'])} from bytes, "
                f"{us(c1['handle_step']['total_s'])} with the step parsed in C. Other work on the machine meanwhile: "

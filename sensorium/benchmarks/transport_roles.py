@@ -88,6 +88,48 @@ def _role_router_echo(endpoint: str) -> None:
     ctx.term()
 
 
+def _role_router_raw(endpoint: str) -> None:
+    """Raw pyzmq ROUTER echo: every message's frames sent back as received (no msgpack): the
+    request/reply floor of the socket pattern a multi-client server needs, beside REQ ↔ REP's."""
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.ROUTER)
+    print(f"ready {_bind(s, endpoint)}", flush=True)
+    poller = zmq.Poller()
+    poller.register(s, zmq.POLLIN)
+    while poller.poll(IDLE_MS):
+        frames = s.recv_multipart()
+        s.send_multipart(frames)
+        if frames[-1] == b"quit":
+            break
+    s.close(0)
+    ctx.term()
+
+
+def _role_dealer_raw(endpoint: str) -> None:
+    """A raw DEALER ping-pong of a step request's bytes (no msgpack), against ``router-raw``."""
+    import msgpack
+    import zmq
+
+    ctx = zmq.Context()
+    s = ctx.socket(zmq.DEALER)
+    s.connect(endpoint)
+    msg = msgpack.packb({"id": 1, "service": "/c0/robot/step", "args": {"duration": 8}}, use_bin_type=True)
+
+    def call():
+        s.send(msg)
+        s.recv()
+
+    def close():
+        s.send(b"quit")
+        s.recv()
+        s.close(0)
+        ctx.term()
+
+    _chunks(call, close)
+
+
 def _chunks(call, close) -> None:
     """Serve timing requests from stdin: 'run K' → K timed calls, printed as a JSON list of
     seconds; anything else → ``close()`` and stop. (Lets the parent interleave several clients.)"""
@@ -309,6 +351,7 @@ def _role_raw_controller(endpoint: str, steps: str) -> None:
 
 def main(argv: list[str]) -> None:
     roles = {"rep-echo": _role_rep_echo, "rep-work": _role_rep_work, "req": _role_req, "router-echo": _role_router_echo,
+             "router-raw": _role_router_raw, "dealer-raw": _role_dealer_raw,
              "conn-client": _role_conn_client, "dealer-client": _role_dealer_client, "stepper": _role_stepper,
              "bare-stepper": _role_bare_stepper, "bare-controller": _role_bare_controller,
              "pub": _role_pub, "controller": _role_controller, "raw-controller": _role_raw_controller}
