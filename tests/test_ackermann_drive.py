@@ -9,6 +9,7 @@ import math
 
 import pytest
 
+from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 from sensorium.server.sim.motion import ackermann_angles
 from sensorium.server.sim.simulation import Simulation
@@ -202,3 +203,21 @@ def test_the_readme_car_is_a_valid_world_that_circles() -> None:
     radius = 2.6 / math.tan(0.3)
     x, y, _ = pose2d(sim)
     assert math.hypot(x, y + radius) == pytest.approx(radius, abs=1e-9)
+
+
+def test_attach_gives_a_clients_vehicle_library_the_car() -> None:
+    import msgpack
+
+    from sensorium.schemas import services as S
+    from sensorium.server.daemon.services import Core
+
+    core = Core(sim_of(car(max_steering_angle=0.5)), new_token=lambda: "s0", log=lambda *_: None)
+    (frames,) = core.handle([b"A", msgpack.packb({"id": 1, "service": "attach", "args": {"robot": "car"}})], 0.0)
+    reply = msgpack.unpackb(frames[-1])
+    res = S.AttachResult.model_validate(reply["result"])
+    assert res.ackermann_drive is not None and res.ackermann_drive.model_dump() == wm.AckermannDrive(
+        wheelbase=L, track_front=TF, track_rear=TR, front_wheel_radius=RF, rear_wheel_radius=RR, max_wheel_speed=1000.0,
+        max_steering_angle=0.5).model_dump()
+    motors = {d.name: (d.minPosition, d.maxPosition) for d in res.devices if d.type == "RotationalMotor"}
+    assert motors == {"right_steer": (-0.5, 0.5), "left_steer": (-0.5, 0.5), "right_rear_wheel": (0.0, 0.0),
+                      "left_rear_wheel": (0.0, 0.0)}       # Webots: 0 and 0 is no limit (a wheel)
