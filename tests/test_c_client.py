@@ -165,9 +165,9 @@ WEBOTS_CPP_HEADERS = """Accelerometer Altimeter Brake Camera Compass Connector D
     ImageRef InertialUnit Joystick Keyboard LED Lidar LightSensor Motor Mouse Node Pen PositionSensor Proto Radar RangeFinder
     Receiver Robot Skin Speaker Supervisor TouchSensor VacuumGripper utils/AnsiCodes utils/Motion vehicle/Car
     vehicle/Driver""".split()
-VEHICLE_LINE = ("Error: {func}(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots move "
-                "kinematically by two-wheel or skid-steer drives only, so a car-like robot with steered wheels is not "
-                "driven.")
+VEHICLE_LINE = ("Error: {func}(): Sensorium's C vehicle library (Car, Driver) is not implemented: drive a car-like "
+                "robot through its motors (wb_motor_* on right_steer, left_steer and its wheels) or from Python (from "
+                "vehicle import Driver).")
 
 
 def test_every_webots_controller_header_is_here():

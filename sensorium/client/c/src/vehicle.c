@@ -1,8 +1,10 @@
 /* Sensorium C controller library: Webots' car and driver libraries (vehicle/car.h, vehicle/driver.h).
- * Sensorium drives robots kinematically through two-wheel and skid-steer drives only; a car's
- * Ackermann steering, engine, gearbox and lights are not simulated. So wbu_driver_init() and
- * wbu_car_init() say so in one line and end the controller with status 1, before it connects to any
- * server; every other function does nothing and answers Webots' "no value". */
+ * Sensorium drives a car-like robot kinematically (the world's ackermann_drive), and Python's
+ * `from vehicle import Driver, Car` drives it; this C library does not implement the vehicle
+ * library yet. So wbu_driver_init() and wbu_car_init() say so in one line (naming what works: the
+ * car's motors through wb_motor_*, or the Python Driver) and end the controller with status 1,
+ * before it connects to any server; every other function does nothing and answers Webots' "no
+ * value". */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,9 +14,9 @@
 
 static void refuse(const char *func) {
   fprintf(stderr,
-          "Error: %s(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots move "
-          "kinematically by two-wheel or skid-steer drives only, so a car-like robot with steered wheels is not "
-          "driven.\n",
+          "Error: %s(): Sensorium's C vehicle library (Car, Driver) is not implemented: drive a car-like robot "
+          "through its motors (wb_motor_* on right_steer, left_steer and its wheels) or from Python (from vehicle "
+          "import Driver).\n",
           func);
   fflush(stderr);
   exit(1);

@@ -1,7 +1,7 @@
-// Sensorium C++ controller layer: Driver over vehicle/driver.h. Sensorium does not simulate Webots'
-// vehicle library (its robots move by two-wheel or skid-steer drives only): constructing a Driver (or
-// a Car) prints one line saying so and ends the process with status 1 before any connection, since
-// wbu_driver_init() runs before the Supervisor base attaches to a robot.
+// Sensorium C++ controller layer: Driver over vehicle/driver.h. The C vehicle library is not
+// implemented (a car-like robot is driven through its motors, or from Python's vehicle package):
+// constructing a Driver (or a Car) prints one line saying so and ends the process with status 1
+// before any connection, since wbu_driver_init() runs before the Supervisor base attaches to a robot.
 #ifndef WEBOTS_DRIVER_HPP
 #define WEBOTS_DRIVER_HPP
 
