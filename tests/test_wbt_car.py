@@ -78,6 +78,28 @@ def test_a_hinge2_car_maps_to_the_ackermann_drive_and_drives_the_circle(tmp_path
     assert (p[0], p[1]) == pytest.approx((radius * math.sin(phi), -radius + radius * math.cos(phi)), abs=1e-9)
 
 
+def test_wheels_in_slots_and_turned_joint_frames_as_webots_cars_have_them(tmp_path: Path) -> None:
+    # Webots' AckermannVehicle: each joint in a Transform turned about z, its wheel in a Slot, axes in that frame
+    def joint(kind: str, x: float, y: float, turn: float, axis: str, device: str, axis2: str = "") -> str:
+        params = (f'jointParameters HingeJointParameters {{ axis {axis} }} '
+                  + (f'jointParameters2 JointParameters {{ axis {axis2} }} ' if axis2 else ''))
+        wheel = (f'Solid {{ rotation 0 1 0 1.5708 children [ DEF S Shape {{ geometry Cylinder {{ radius {R} height 0.2 }} '
+                 f'}} ] boundingObject USE S }}')
+        return (f'Transform {{ translation {x} {y} 0 rotation 0 0 1 {turn} children [ {kind} {{ {params}'
+                f'device [ RotationalMotor {{ name "{device}" minPosition -0.5 maxPosition 0.5 }} ] '
+                f'endPoint Slot {{ endPoint {wheel} }} }} ] }}\n')
+    front = (joint("Hinge2Joint", L, T / 2, -1.5708, "0 0 -1", "left_steer", "-1 0 0")
+             + joint("Hinge2Joint", L, -T / 2, 1.5708, "0 0 -1", "right_steer", "1 0 0"))
+    rear = (joint("HingeJoint", 0, T / 2, -1.5708, "-1 0 0", "left_rear_wheel")
+            + joint("HingeJoint", 0, -T / 2, 1.5708, "1 0 0", "right_rear_wheel"))
+    w = load_world(write(tmp_path, car(front, rear)))
+    assert not [x for x in w.warnings if "drive" in x]
+    d = w.world.robots[0].ackermann_drive
+    assert d is not None
+    assert d.wheelbase == pytest.approx(L) and d.track_front == pytest.approx(T) and d.track_rear == pytest.approx(T)
+    assert (d.type, d.positive_steers, d.max_steering_angle, d.rear_wheel_radius) == ("propulsion", "right", 0.5, R)
+
+
 def test_vertical_steering_hinges_carrying_driven_wheels_make_a_front_wheel_drive(tmp_path: Path) -> None:
     def front(side: str, y: float) -> str:         # a steering hinge whose end point holds the motorised wheel hinge
         return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor {L} {y} {R} }} '

@@ -27,10 +27,13 @@ import numpy as np
 from sensorium.server.world.wbt.parser import Node
 
 TOL = 1e-6
+AXIS_TOL = 1e-4     # a car's joint axes: Webots' car PROTOs turn their joints' frames by 1.5708 (not pi/2)
 
 
 def wheel_radius(end: Node | None, conv) -> float | None:
     """Radius of a wheel end point: its boundingObject's (else its visual) cylinder or sphere."""
+    while end is not None and end.type == "Slot":      # Webots' cars hold their wheels in Slots
+        end = conv.fields(end).node_("endPoint")
     if end is None:
         return None
     f = conv.fields(end)
@@ -157,7 +160,7 @@ def ackermann_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     signs = []
     for w in steering:
         a = w["axis"] / np.linalg.norm(w["axis"])
-        if np.linalg.norm(np.abs(a) - z) > TOL:
+        if np.linalg.norm(np.abs(a) - z) > AXIS_TOL:
             return None, (f"the steering axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not vertical "
                           "(the robot's z axis)")
         signs.append(a[2] > 0)
@@ -174,7 +177,7 @@ def ackermann_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     right_steer, left_steer = (steering[0], steering[1]) if a0[1] < 0 else (steering[1], steering[0])
     for w in driven:
         a = w["axis"] / np.linalg.norm(w["axis"])
-        if np.linalg.norm(a - np.array([0.0, 1.0, 0.0])) > TOL:
+        if np.linalg.norm(a - np.array([0.0, 1.0, 0.0])) > AXIS_TOL:
             return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not the robot's +y "
                           "(positive wheel speeds must drive forward)")
     front = [w for w in driven if abs(w["centre"][0] - wheelbase) <= TOL]
