@@ -36,10 +36,11 @@ ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
 CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
-               "wire_vectors", "every_device", "headers"]
+               "wire_vectors", "every_device", "headers", "car_driver"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
+CAR_WORLD = REPO / "tests" / "worlds" / "car.yaml"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -165,9 +166,9 @@ WEBOTS_CPP_HEADERS = """Accelerometer Altimeter Brake Camera Compass Connector D
     ImageRef InertialUnit Joystick Keyboard LED Lidar LightSensor Motor Mouse Node Pen PositionSensor Proto Radar RangeFinder
     Receiver Robot Skin Speaker Supervisor TouchSensor VacuumGripper utils/AnsiCodes utils/Motion vehicle/Car
     vehicle/Driver""".split()
-VEHICLE_LINE = ("Error: {func}(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots move "
-                "kinematically by two-wheel or skid-steer drives only, so a car-like robot with steered wheels is not "
-                "driven.")
+VEHICLE_LINE = ("Error: {func}(): robot 'car' has no ackermann_drive: Sensorium's vehicle library drives a car-like robot "
+                "whose world entry has one (README \"World files\"; a .wbt car is mapped when its steering and wheel "
+                "joints are a car's).")
 
 
 def test_every_webots_controller_header_is_here():
@@ -207,14 +208,43 @@ def test_console_strings_system_radio_messages_and_the_vehicle_no_values(cbin):
 
 @pytest.mark.parametrize("argv, func", [(["headers", "driver"], "wbu_driver_init"), (["headers", "car"], "wbu_car_init"),
                                         (["vehicle_cpp", "driver"], "wbu_driver_init"), (["vehicle_cpp"], "wbu_car_init")])
-def test_the_vehicle_library_ends_the_controller_with_one_line(cbin, argv, func):
-    """Before any connection: the URL names a port nobody listens on, and the controller must not
-    wait for it (that would take the library's 30 s timeout, past finish()'s 25 s)."""
-    p = start([cbin[argv[0]], *argv[1:]], "tcp://127.0.0.1:9/car", SENSORIUM_CONTROLLER_TIMEOUT="30")
-    code, out, err = finish(p, timeout=25)
+def test_the_vehicle_library_ends_a_controller_of_a_robot_that_is_not_a_car_with_one_line(cbin, servers, argv, func):
+    p = start([cbin[argv[0]], *argv[1:]], servers(HEADERS_WORLD).url("car"))
+    code, out, err = finish(p)
     assert code == 1 and err.splitlines() == [VEHICLE_LINE.format(func=func)], err
     assert "returned" not in out and "constructed" not in out
     assert out[:1] == (["\x1b[1m4 3\x1b[0m"] if argv[0] == "vehicle_cpp" else [])   # the C++ enums are Webots'
+
+
+def test_a_webots_style_c_driver_controller_drives_the_closed_form_circle(cbin, servers):
+    """tests/c/car_driver.c steers 0.2 rad at 20 km/h: from its first step the car is on the circle of
+    radius L/tan 0.2 about (0, -radius), its rear axle's centre at 20 km/h (the same closed form as the
+    Python Driver's test, tests/test_vehicle_driver.py)."""
+    server = servers(CAR_WORLD, "--heartbeat-ms", "500")
+    code, out, err = finish(start([cbin["car_driver"]], server.url("car")))
+    assert code == 0, err
+    # no engine model: one line per function, the first time only (set_throttle is called twice)
+    assert [line.split("(")[0] for line in err.splitlines()] == ["Warning: wbu_driver_set_throttle",
+                                                                 "Warning: wbu_driver_get_gear"], err
+    (driver,) = [line.split()[1:] for line in out if line.startswith("driver ")]
+    (car,) = [line.split()[1:] for line in out if line.startswith("car ")]
+    L, T, R = 2.6, 1.5, 0.35
+    cot, half = 1 / math.tan(0.2), T / (2 * L)
+    right, left = math.atan(1 / (cot - half)), math.atan(1 / (cot + half))
+    speed, target, angle, t, mode, gear = driver
+    assert float(speed) == pytest.approx(20.0, abs=1e-9) and float(target) == 20.0 and (mode, gear) == ("0", "0")
+    assert float(angle) == pytest.approx((right + left) / 2, abs=1e-12)      # Webots: the steering encoders' mean
+    assert car[:4] == ["1", "2.6000000000000001", "1.5", "0.34999999999999998"] and float(car[4]) == pytest.approx(right, abs=1e-15)
+    radius = L / math.tan(0.2)
+    ratio = (radius - T / 2) / (2 * radius)                                    # Webots' rear differential
+    assert float(car[5]) == pytest.approx(2 * 20 * (1 - ratio) / 3.6 / R, rel=1e-12)
+    assert float(car[6]) > 0                                                   # the encoder rolled forward
+    pose = server.conn.call("/car/robot/get_pose")
+    time_ms = server.conn.call("get_info")["time_ms"]
+    assert float(t) * 1000 == pytest.approx(time_ms)
+    phi = 20 / 3.6 * time_ms / 1000 / radius
+    x, y, _ = pose["translation"]
+    assert (x, y) == pytest.approx((radius * math.sin(phi), -radius + radius * math.cos(phi)), abs=1e-9)
 
 
 def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_functions(cbin, servers):

@@ -1,6 +1,7 @@
 """Wheeled robots beyond two wheels (issue 27): a skid-steer robot (several motorised wheels per
 side, a Pioneer 3-AT written by us) drives kinematically with the same contact as a two-wheel one;
-a car-like robot (steered wheels) gets one line saying why it is not driven. Closed-form checks."""
+a car-like robot (steered wheels) maps to the Ackermann drive (tests/test_wbt_car.py) or gets one line saying
+why it is not driven. Closed-form checks."""
 
 from __future__ import annotations
 
@@ -107,20 +108,25 @@ def test_skid_steer_stops_at_a_wall_like_a_two_wheel_robot(tmp_path: Path) -> No
     assert sim.counters["contacts"] > 0
 
 
-def test_a_car_like_robot_gets_one_line_saying_why(tmp_path: Path) -> None:
+def test_a_car_like_robot_maps_to_the_ackermann_drive_or_gets_one_line(tmp_path: Path) -> None:
     car = ('Robot { name "car" children [\n' + wheel("left rear", 0, Y) + wheel("right rear", 0, -Y)
            + wheel("left steer", 0.3, Y, axis="0 0 1") + wheel("right steer", 0.3, -Y, axis="0 0 1") + '] }\n')
     p = write(tmp_path, car)
     w = load_world(p)
-    assert w.world.robots[0].differential_drive is None
-    (line,) = [x for x in w.warnings if "no differential drive" in x]
-    assert line == (f"{p}:3:1: robot 'car': no differential drive (a car-like robot: motor(s) 'left steer', "
-                    "'right steer' steer (a vertical hinge axis or a Hinge2Joint); Sensorium's kinematic drives are "
-                    "two-wheel and skid-steer, a steered robot is not driven here); the robot will not move")
+    robot = w.world.robots[0]
+    assert robot.differential_drive is None and robot.ackermann_drive == wm.AckermannDrive(
+        wheelbase=0.3, track_front=2 * Y, track_rear=2 * Y, front_wheel_radius=R, rear_wheel_radius=R,
+        type="propulsion", max_wheel_speed=12.3, max_steering_angle=1.5, max_steering_speed=12.3,
+        positive_steers="left", right_steer="right steer", left_steer="left steer", right_rear_wheel="right rear",
+        left_rear_wheel="left rear")
+    assert not [x for x in w.warnings if "drive" in x]
     hinge2 = ('Robot { name "car" children [\n' + wheel("left rear", 0, Y) + wheel("right rear", 0, -Y)
               + wheel("left front", 0.3, Y, joint="Hinge2Joint") + '] }\n')
-    w = load_world(write(tmp_path, hinge2))
-    assert any("a car-like robot: motor(s) 'left front' steer" in x for x in w.warnings)
+    p = write(tmp_path, hinge2)
+    w = load_world(p)
+    (line,) = [x for x in w.warnings if "Ackermann" in x]
+    assert line == (f"{p}:3:1: robot 'car': no Ackermann drive (a car-like robot needs two steered front wheels, it "
+                    "has 1 steering motor(s) ('left front')); the robot will not move")
 
 
 def test_skid_steer_in_a_world_file_and_its_checks() -> None:

@@ -233,6 +233,8 @@ class RobotClient:
         self.supervisor = bool(reply.get("supervisor", False))
         self.model = str(reply.get("model", ""))
         self.custom_data = str(reply.get("custom_data", ""))
+        drive = reply.get("ackermann_drive")          # a car-like robot's geometry (the vehicle library's)
+        self.ackermann_drive: dict | None = dict(drive) if isinstance(drive, dict) else None
         self.keyboard_period = 0
         self._warned_duration = False
         self.devices = [DeviceState(i, d) for i, d in enumerate(reply.get("devices", []))]

@@ -501,6 +501,28 @@ DeviceDescription = Annotated[
 :class:`UnsimulatedDescription` for a device that is listed only."""
 
 
+class AckermannDescription(Result):
+    """A car-like robot's ``ackermann_drive`` (its world entry): what Webots' vehicle library reads
+    from a Car's customData, which the client's ``Driver``/``Car`` work from."""
+
+    wheelbase: float
+    track_front: float
+    track_rear: float
+    front_wheel_radius: float
+    rear_wheel_radius: float
+    type: Literal["traction", "propulsion", "4x4"]
+    max_wheel_speed: float
+    max_steering_angle: float
+    max_steering_speed: float
+    positive_steers: Literal["right", "left"]
+    right_steer: str
+    left_steer: str
+    right_front_wheel: str
+    left_front_wheel: str
+    right_rear_wheel: str
+    left_rear_wheel: str
+
+
 class AttachResult(Result):
     session: str
     robot: str
@@ -512,6 +534,8 @@ class AttachResult(Result):
     supervisor: bool = Field(default=False, description="the world lets this robot's controller use Supervisor services")
     model: str = ""
     custom_data: str = ""
+    ackermann_drive: AckermannDescription | None = Field(default=None, description="a car-like robot's drive "
+                                                        "(the world's ackermann_drive); null for other robots")
 
 
 class TimeResult(Result):

@@ -364,12 +364,12 @@ class Lidar(_Device):
 
 
 class PositionSensor(_Device):
-    """A wheel encoder (Webots PositionSensor on the wheel's HingeJoint): the angle, in radians, of
-    the differential-drive wheel turned by ``motor``. ``pose`` is unused (kept for symmetry)."""
+    """A joint's encoder (Webots PositionSensor on the wheel's or steering HingeJoint): the angle, in
+    radians, of the drive's joint turned by ``motor``. ``pose`` is unused (kept for symmetry)."""
 
     device: Literal["PositionSensor"]
     motor: str | None = Field(default=None, min_length=1,
-                              description="name of the drive's wheel motor whose joint it measures; left out: a "
+                              description="name of the drive's motor whose joint it measures; left out: a "
                                           "sensor on a joint nothing turns here (present, not simulated)")
     noise: float = Field(default=0.0, ge=0.0, description="standard deviation of Gaussian noise (rad)")
     resolution: float = -1.0
@@ -623,8 +623,8 @@ class Receiver(_Radio):
 
 
 class RotationalMotor(_Device):
-    """A wheel motor in Webots' device order: an entry named like one of ``differential_drive``'s
-    motors *is* that motor, at this index of the device list (a drive motor without an entry comes
+    """A drive motor in Webots' device order: an entry named like one of the robot's
+    ``differential_drive``/``ackermann_drive`` motors *is* that motor, at this index of the device list (a drive motor without an entry comes
     after the listed devices). Any other RotationalMotor is present but not simulated (no joint moves
     here). ``pose`` is unused."""
 
@@ -697,6 +697,56 @@ class DifferentialDrive(Strict):
         return self
 
 
+class AckermannDrive(Strict):
+    """Kinematic car-like drive (Webots' Car/AckermannVehicle geometry, no engine, no slip, no
+    physics): two front wheels steered by position-controlled motors, driven wheels by velocity or
+    position control, the robot turning about its origin, which is the centre of the rear axle
+    (x forward, y left). The car follows the bicycle model: its turn radius about the rear axle's
+    centre is ``wheelbase`` times the mean of the front wheels' cotangents (exact for Ackermann
+    angles), its speed the driven wheels' rolling speeds over their distances from the turn centre.
+    Motor names default to Webots' vehicle library's."""
+
+    wheelbase: float = Field(gt=0, description="m, rear axle to front axle")
+    track_front: float = Field(gt=0, description="m, between the front wheels")
+    track_rear: float = Field(gt=0, description="m, between the rear wheels")
+    front_wheel_radius: float = Field(gt=0, description="m")
+    rear_wheel_radius: float = Field(gt=0, description="m")
+    type: Literal["traction", "propulsion", "4x4"] = Field(
+        default="propulsion", description="which wheels have motors (Webots): traction the front ones, propulsion the "
+        "rear ones, 4x4 all four")
+    max_wheel_speed: float = Field(default=100.0, gt=0, description="rad/s, the wheel motors' maxVelocity")
+    max_steering_angle: float = Field(default=0.6, gt=0, lt=math.pi / 2, description="rad, the steering motors' "
+                                      "maxPosition (and -minPosition): Webots clamps set_position to it")
+    max_steering_speed: float = Field(default=10.0, gt=0, description="rad/s, the steering motors' maxVelocity")
+    positive_steers: Literal["right", "left"] = Field(
+        default="right", description="where a positive steering motor position turns the car (Webots' Driver: right)")
+    right_steer: str = Field(default="right_steer", min_length=1)
+    left_steer: str = Field(default="left_steer", min_length=1)
+    right_front_wheel: str = Field(default="right_front_wheel", min_length=1)
+    left_front_wheel: str = Field(default="left_front_wheel", min_length=1)
+    right_rear_wheel: str = Field(default="right_rear_wheel", min_length=1)
+    left_rear_wheel: str = Field(default="left_rear_wheel", min_length=1)
+
+    @property
+    def driven(self) -> list[tuple[str, str]]:
+        """(field, motor name) of the wheels with motors, in Webots' order (right before left)."""
+        front = [("right_front_wheel", self.right_front_wheel), ("left_front_wheel", self.left_front_wheel)]
+        rear = [("right_rear_wheel", self.right_rear_wheel), ("left_rear_wheel", self.left_rear_wheel)]
+        return front if self.type == "traction" else rear if self.type == "propulsion" else front + rear
+
+    @property
+    def motor_fields(self) -> list[tuple[str, str]]:
+        """(field, motor name) of every motor of the drive: the two steering motors, the driven wheels."""
+        return [("right_steer", self.right_steer), ("left_steer", self.left_steer), *self.driven]
+
+    @model_validator(mode="after")
+    def _distinct(self) -> AckermannDrive:
+        names = [m for _, m in self.motor_fields]
+        if len(set(names)) != len(names):
+            raise ValueError(f"every motor of the drive needs its own name, got {names}")
+        return self
+
+
 # ---------------------------------------------------------------- robots and world
 
 class Robot(Strict):
@@ -718,6 +768,8 @@ class Robot(Strict):
     lights: list[Light] = Field(
         default=[], description="lights carried by the robot (location and a SpotLight's direction in its frame)")
     differential_drive: DifferentialDrive | None = None
+    ackermann_drive: AckermannDrive | None = Field(default=None, description="a car-like robot (steered front wheels); "
+                                                   "a robot has one drive at most")
     devices: list[Device] = Field(default=[], description="in Webots' tree order (the order of the device "
                                   "indices); every Webots device type is accepted, those not simulated as present")
     recognition_colors: list[Color] = Field(
@@ -725,6 +777,24 @@ class Robot(Strict):
         "node report this robot")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
+
+    @model_validator(mode="after")
+    def _one_drive(self) -> Robot:
+        if self.differential_drive is not None and self.ackermann_drive is not None:
+            raise ValueError("a robot has one drive at most: give differential_drive or ackermann_drive, not both")
+        return self
+
+    @property
+    def drive_motors(self) -> list[tuple[str, str]]:
+        """(field path inside the robot, motor name) of every motor of the robot's drive."""
+        if self.differential_drive is not None:
+            left, right = self.differential_drive.motor_names
+            out = [("differential_drive.left_motor", left[0]), ("differential_drive.right_motor", right[0])]
+            out += [(f"differential_drive.skid_steer.left[{i}]", m) for i, m in enumerate(left[1:])]
+            return out + [(f"differential_drive.skid_steer.right[{i}]", m) for i, m in enumerate(right[1:])]
+        if self.ackermann_drive is not None:
+            return [(f"ackermann_drive.{f}", m) for f, m in self.ackermann_drive.motor_fields]
+        return []
 
 
 class WorldInfo(Strict):

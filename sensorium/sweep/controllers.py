@@ -8,7 +8,7 @@ Keep state in the closure: each run calls the factory anew, so runs never share 
 A spec names a controller as
 
 * a built-in name: ``idle`` (nothing moves; the recorder still measures every recorded device),
-  ``circle`` (every driven robot drives a circle: left wheel at half, right at full speed),
+  ``circle`` (every two-wheel or skid-steer robot drives a circle: left wheel at half, right at full speed),
   ``spin`` (every driven robot turns in place), ``braitenberg`` (every robot with light sensors
   ``ls0``/``ls1`` turns toward the light, proximity sensors ``ps0..ps7`` push it off walls);
 * ``package.module:function``;
@@ -25,10 +25,17 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from sensorium.server.sim.motion import DifferentialDrive
+
 Step = Callable[[Any], None]
 Factory = Callable[[Any], Step | None]
 
 __all__ = ["BUILTIN", "resolve", "idle", "circle", "spin", "braitenberg"]
+
+
+def _wheeled(robot) -> bool:
+    """The built-ins drive two-wheel and skid-steer robots (a car's steering is left alone)."""
+    return isinstance(robot.drive, DifferentialDrive)
 
 
 def _velocity(robot, left: float, right: float) -> None:
@@ -45,7 +52,7 @@ def idle(sim) -> None:
 
 def circle(sim) -> None:
     for robot in sim.robots.values():
-        if robot.drive is not None:
+        if _wheeled(robot):
             vmax = robot.drive.left.max_velocity
             _velocity(robot, 0.5 * vmax, vmax)
     return None
@@ -53,7 +60,7 @@ def circle(sim) -> None:
 
 def spin(sim) -> None:
     for robot in sim.robots.values():
-        if robot.drive is not None:
+        if _wheeled(robot):
             vmax = robot.drive.left.max_velocity
             _velocity(robot, -0.5 * vmax, 0.5 * vmax)
     return None
@@ -64,7 +71,7 @@ def braitenberg(sim) -> Step:
     dt = sim.basic_time_step
     crew = []
     for robot in sim.robots.values():
-        if robot.drive is None or not {"ls0", "ls1"} <= set(robot.devices):
+        if not _wheeled(robot) or not {"ls0", "ls1"} <= set(robot.devices):
             continue
         eyes = [robot.device("ls0"), robot.device("ls1")]
         ir = [robot.devices[f"ps{i}"] for i in range(8) if f"ps{i}" in robot.devices]

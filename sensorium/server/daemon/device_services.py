@@ -5,6 +5,7 @@ enabling, reading and configuring them. Sans-IO like the core: a :class:`Call` i
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 from sensorium.schemas.devices import KINDS
@@ -72,8 +73,10 @@ class DeviceServices:
 
     @staticmethod
     def _describe_motor(m: Any) -> dict:
-        return {"name": m.name, "type": MOTOR, "maxVelocity": float(m.max_velocity), "minPosition": 0.0,
-                "maxPosition": 0.0, "targetPosition": float(m.target_position), "velocity": float(m.velocity)}
+        limit = float(getattr(m, "max_position", math.inf))      # a car's steering motor has limits
+        limit = 0.0 if math.isinf(limit) else limit              # Webots: 0 and 0 mean none (a wheel)
+        return {"name": m.name, "type": MOTOR, "maxVelocity": float(m.max_velocity), "minPosition": -limit if limit else 0.0,
+                "maxPosition": limit, "targetPosition": float(m.target_position), "velocity": float(m.velocity)}
 
     @staticmethod
     def _lookup_table(dev: Any) -> list[float]:

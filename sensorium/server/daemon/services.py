@@ -521,6 +521,7 @@ class Core(DeviceServices):
                 "heartbeat_ms": self.lockstep.heartbeat_ms, "supervisor": bool(getattr(robot, "supervisor", False)),
                 "model": str(getattr(getattr(robot, "model", None), "model", "")),
                 "custom_data": str(getattr(robot, "custom_data", "")),
+                "ackermann_drive": _ackermann(robot),
                 "devices": self._describe_robot(s.robot)}
 
     def _srv_detach(self, c: Call) -> dict:
@@ -710,3 +711,9 @@ class Core(DeviceServices):
             return supervisor.HANDLERS[item](self.sim, self.lockstep, c.robot, c.args)
         except ValueError as exc:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{item}: {exc}") from None
+
+
+def _ackermann(robot: Any) -> dict | None:
+    """A car-like robot's drive as ``attach`` describes it (its world entry), else None."""
+    drive = getattr(getattr(robot, "model", None), "ackermann_drive", None)
+    return drive.model_dump() if drive is not None else None

@@ -270,6 +270,9 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
         for r in w.robots:
+            if r.ackermann_drive is not None:
+                raise BatchedError(f"{self.loaded.source}: robot {r.name!r} has an ackermann_drive; the batched "
+                                   "simulation drives two-wheel and skid-steer robots only (use Simulation)")
             if r.lights:
                 raise BatchedError(f"{self.loaded.source}: robot {r.name!r} carries lights; the batched simulation "
                                    "shares the lights of all copies (use Simulation)")

@@ -1,5 +1,5 @@
-"""Kinematic wheeled drive (two wheels, or skid steer): Webots-style wheel motors and exact pose
-integration.
+"""Kinematic wheeled drives (two wheels, skid steer, car-like Ackermann steering): Webots-style
+wheel motors and exact pose integration.
 
 No physics: wheels never slip and nothing collides. Over a basic step the wheel speeds are
 constant, so the robot follows an exact circular arc (or a straight segment); integrating the arc
@@ -93,7 +93,47 @@ _TO_ENU = {
 }
 
 
-class DifferentialDrive:
+@dataclass(slots=True)
+class SteeringMotor(WheelMotor):
+    """A steering hinge's RotationalMotor: position control within ``±max_position`` (Webots clamps
+    a target beyond the motor's min/maxPosition to it)."""
+
+    max_position: float = math.inf
+
+    def set_position(self, value: float) -> None:
+        WheelMotor.set_position(self, value)     # (no zero-argument super() in a slots dataclass)
+        self.target_position = min(max(self.target_position, -self.max_position), self.max_position)
+
+
+class PlanarState:
+    """A driven robot's planar state (x, y, yaw) in ENU axes and its pose.
+
+    The robot's rotation is kept as ``Rz(yaw) @ base`` where ``base`` is the part of its initial
+    rotation that is not a turn about the up axis, so a tilted robot keeps its tilt while driving.
+    In a NUE world poses are converted on the way in and out, so the robot drives on the ground
+    plane (normal +y) there."""
+
+    def __init__(self, pose: Pose, up: str = "ENU"):
+        self._to_enu = _TO_ENU[up]
+        self.reset(pose)
+
+    def reset(self, pose: Pose) -> None:
+        """Take over a pose set from outside (initial pose, supervisor set_pose)."""
+        if self._to_enu is not None:
+            pose = Pose(self._to_enu @ pose.rotation, self._to_enu @ pose.translation)
+        forward = pose.rotation[:, 0]
+        self.yaw = math.atan2(forward[1], forward[0])
+        self.base = _rz(-self.yaw) @ pose.rotation
+        self.x, self.y, self.z = (float(v) for v in pose.translation)
+
+    def pose(self) -> Pose:
+        r, t = _rz(self.yaw) @ self.base, np.array([self.x, self.y, self.z])
+        if self._to_enu is not None:
+            r, t = self._to_enu.T @ r, self._to_enu.T @ t
+        return Pose(rotation=r, translation=t)
+
+
+class DifferentialDrive(PlanarState):
     """The drive of one robot: its wheel motors and the robot's planar state (x, y, yaw).
 
     Two wheels, or several per side (skid steer, ``config.skid_steer``): each side rolls at the
@@ -107,7 +147,6 @@ class DifferentialDrive:
     """
 
     def __init__(self, config, pose: Pose, up: str = "ENU"):
-        self._to_enu = _TO_ENU[up]
         self.wheel_radius = float(config.wheel_radius)
         self.axle_length = float(config.axle_length)
         speed = float(config.max_wheel_speed)
@@ -116,16 +155,7 @@ class DifferentialDrive:
         self.right = WheelMotor(config.right_motor, speed)
         self.lefts = [self.left, *(WheelMotor(name, speed) for name in (skid.left if skid else ()))]
         self.rights = [self.right, *(WheelMotor(name, speed) for name in (skid.right if skid else ()))]
-        self.reset(pose)
-
-    def reset(self, pose: Pose) -> None:
-        """Take over a pose set from outside (initial pose, supervisor set_pose)."""
-        if self._to_enu is not None:
-            pose = Pose(self._to_enu @ pose.rotation, self._to_enu @ pose.translation)
-        forward = pose.rotation[:, 0]
-        self.yaw = math.atan2(forward[1], forward[0])
-        self.base = _rz(-self.yaw) @ pose.rotation
-        self.x, self.y, self.z = (float(v) for v in pose.translation)
+        super().__init__(pose, up)
 
     @property
     def motors(self) -> dict[str, WheelMotor]:
@@ -150,8 +180,74 @@ class DifferentialDrive:
         self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
         return self.pose()
 
-    def pose(self) -> Pose:
-        r, t = _rz(self.yaw) @ self.base, np.array([self.x, self.y, self.z])
-        if self._to_enu is not None:
-            r, t = self._to_enu.T @ r, self._to_enu.T @ t
-        return Pose(rotation=r, translation=t)
+
+def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float) -> tuple[float, float]:
+    """(right, left) front wheel angles for a bicycle-model steering angle (positive: to the right),
+    so that both wheels turn about one centre on the rear axle's line (Webots' Driver: Jazar, Vehicle
+    Dynamics, 2009): cot δ_right = cot δ - t/2L, cot δ_left = cot δ + t/2L."""
+    if steering_angle == 0.0:
+        return 0.0, 0.0
+    cot = 1.0 / math.tan(steering_angle)
+    half = track_front / (2.0 * wheelbase)
+    return math.atan(1.0 / (cot - half)), math.atan(1.0 / (cot + half))
+
+
+class AckermannDrive(PlanarState):
+    """A car-like robot: two steered front wheels, driven wheels at the front, the rear or both, the
+    robot's origin at the centre of the rear axle (x forward, y left).
+
+    Bicycle model without slip: the turn centre lies on the rear axle's line at R = L·(cot δ_r +
+    cot δ_l)/2 from its centre (δ: the front wheels' angles, positive to the right), so curvature
+    κ = 2 tan δ_r tan δ_l / (L (tan δ_r + tan δ_l)), exact for Ackermann angles and a compromise
+    for others. A wheel at (x_i, y_i) then rolls at v·s_i with s_i = |(1 - κ_l y_i, κ_l x_i)|
+    (κ_l the curvature to the left), so the rear axle's centre moves at v = Σ r_i ω_i / Σ s_i over
+    the driven wheels. The steering angles used for a step are the motors' at its end (they hold
+    their positions by position control, at most ``max_steering_speed`` fast)."""
+
+    def __init__(self, config, pose: Pose, up: str = "ENU"):
+        self.wheelbase = float(config.wheelbase)
+        self.track_front, self.track_rear = float(config.track_front), float(config.track_rear)
+        self.sign = 1.0 if config.positive_steers == "right" else -1.0
+        self.right_steer = SteeringMotor(config.right_steer, float(config.max_steering_speed))
+        self.left_steer = SteeringMotor(config.left_steer, float(config.max_steering_speed))
+        for m in (self.right_steer, self.left_steer):
+            m.max_position = float(config.max_steering_angle)
+        speed = float(config.max_wheel_speed)
+        L, rf, rr = self.wheelbase, float(config.front_wheel_radius), float(config.rear_wheel_radius)
+        place = {"right_front_wheel": (L, -self.track_front / 2, rf), "left_front_wheel": (L, self.track_front / 2, rf),
+                 "right_rear_wheel": (0.0, -self.track_rear / 2, rr), "left_rear_wheel": (0.0, self.track_rear / 2, rr)}
+        # each driven wheel: its motor, its (x, y) on the car, its radius
+        self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
+        super().__init__(pose, up)
+
+    @property
+    def motors(self) -> dict[str, WheelMotor]:
+        return {m.name: m for m in (self.right_steer, self.left_steer, *(w[0] for w in self.wheels))}
+
+    @property
+    def moving(self) -> bool:
+        return any(w[0].velocity != 0.0 for w in self.wheels)
+
+    def steering(self) -> tuple[float, float]:
+        """The front wheels' angles (right, left), positive to the right."""
+        return self.sign * self.right_steer.position, self.sign * self.left_steer.position
+
+    def curvature(self) -> float:
+        """1/R of the rear axle's centre, positive turning right (0: straight)."""
+        tr, tl = (math.tan(a) for a in self.steering())
+        if tr + tl == 0.0:
+            return 0.0
+        return 2.0 * tr * tl / (self.wheelbase * (tr + tl))
+
+    def step(self, dt_ms: int) -> Pose | None:
+        """Advance one basic step; the new pose, or None when the car did not move."""
+        dt = dt_ms / 1000.0
+        self.right_steer.advance(dt)
+        self.left_steer.advance(dt)
+        rolled = [(motor.advance(dt) * r, x, y) for motor, x, y, r in self.wheels]
+        if all(u == 0.0 for u, _, _ in rolled):
+            return None
+        kl = -self.curvature()          # to the left, as yaw grows
+        v = sum(u for u, _, _ in rolled) / sum(math.hypot(1.0 - kl * y, kl * x) for _, x, y in rolled)
+        self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, v * kl, dt)
+        return self.pose()

@@ -516,7 +516,7 @@ def _rotate_columns(rotation: np.ndarray, columns: tuple[np.ndarray, np.ndarray,
 
 
 class PositionSensor(Device):
-    """A wheel encoder: the angle (rad) of the differential-drive wheel turned by ``config.motor``.
+    """A wheel encoder: the angle (rad) of the drive joint (a wheel, a car's steering) turned by ``config.motor``.
 
     Webots' timing (the first value one sampling period after ``enable``, NaN before), then
     Gaussian ``noise`` (rad) and ``resolution`` as Webots applies them. The simulation binds

@@ -25,7 +25,7 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
 from sensorium.server.sim.contact import Contact
-from sensorium.server.sim.motion import DifferentialDrive, WheelMotor
+from sensorium.server.sim.motion import AckermannDrive, DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
 from sensorium.server.sim.scene import Scene, light_from_model, primitive_from_model, robot_parts, solid_parts
@@ -93,9 +93,12 @@ class RobotState:
             self.devices[d.name] = cls(config=d, robot_index=index, robot_name=model.name,
                                        self_collision=model.self_collision, world_seed=sim.seed,
                                        clock=lambda: sim.time_ms, own_shapes=sim.scene.device_shapes(index, d.name))
-        self.drive = (DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index],
-                                        up=sim.world.world_info.coordinate_system)
-                      if model.differential_drive is not None else None)
+        up = sim.world.world_info.coordinate_system
+        self.drive: DifferentialDrive | AckermannDrive | None = None
+        if model.differential_drive is not None:
+            self.drive = DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index], up=up)
+        elif model.ackermann_drive is not None:
+            self.drive = AckermannDrive(model.ackermann_drive, sim.scene.robot_poses[index], up=up)
         self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
         for dev in self.devices.values():
             dev.bind(self)
@@ -297,7 +300,7 @@ class Simulation:
         if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
-        moved: list[tuple[RobotState, DifferentialDrive, tuple[float, float], Pose]] = []
+        moved: list[tuple[RobotState, DifferentialDrive | AckermannDrive, tuple[float, float], Pose]] = []
         for robot in self._driven:
             drive = robot.drive
             assert drive is not None

@@ -378,14 +378,9 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
     for r_i, robot in enumerate(world.robots):
         rp = f"robots[{r_i}]"
         names = [(f"{rp}.devices[{d_i}].name", d.name) for d_i, d in enumerate(robot.devices)]
-        if robot.differential_drive is not None:
-            # a RotationalMotor entry named like a drive motor is that motor (its place in the device list)
-            listed = {d.name for d in robot.devices if d.device == "RotationalMotor"}
-            left, right = robot.differential_drive.motor_names
-            sides = [("left_motor", left[0]), ("right_motor", right[0])]
-            sides += [(f"skid_steer.left[{i}]", m) for i, m in enumerate(left[1:])]
-            sides += [(f"skid_steer.right[{i}]", m) for i, m in enumerate(right[1:])]
-            names += [(f"{rp}.differential_drive.{side}", m) for side, m in sides if m not in listed]
+        # a RotationalMotor entry named like a drive motor is that motor (its place in the device list)
+        listed = {d.name for d in robot.devices if d.device == "RotationalMotor"}
+        names += [(f"{rp}.{field}", m) for field, m in robot.drive_motors if m not in listed]
         unique(names, "device")
         device_names = {d.name for d in robot.devices}
         for s_i, part in enumerate(robot.shapes):
@@ -404,12 +399,12 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                             f"lookup table inputs must be strictly increasing: input {table[k][0]} "
                             f"follows {table[k - 1][0]}"))
             if isinstance(dev, wm.PositionSensor) and dev.motor is not None:
-                drive = robot.differential_drive
-                motors = tuple(m for side in drive.motor_names for m in side) if drive is not None else ()
+                motors = tuple(m for _, m in robot.drive_motors)
                 if dev.motor not in motors:
+                    kind = ("ackermann_drive" if robot.ackermann_drive is not None else "differential_drive")
                     problems.append(Problem(
-                        f"{dp}.motor", f"{dev.motor!r} is not a wheel motor of this robot's differential_drive "
-                                       f"(motors: {', '.join(repr(m) for m in motors) or 'none: no differential_drive'})"))
+                        f"{dp}.motor", f"{dev.motor!r} is not a motor of this robot's {kind} "
+                                       f"(motors: {', '.join(repr(m) for m in motors) or 'none: no drive'})"))
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
     problems += _check_meshes_and_work(world, base_dir, limits or WorldLimits(), allow_outside_meshes, asset_files)

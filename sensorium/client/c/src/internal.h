@@ -176,6 +176,16 @@ typedef struct {
   int force_feedback_period, torque_feedback_period;
 } sn_device;
 
+/* A car-like robot's drive from the attach reply ("ackermann_drive"): what the vehicle library
+ * (vehicle.c) works from, as Webots' reads a Car's customData. */
+typedef struct {
+  bool present;
+  double wheelbase, track_front, track_rear, front_wheel_radius, rear_wheel_radius;
+  int type;    /* WBU_CAR_TRACTION, WBU_CAR_PROPULSION or WBU_CAR_FOUR_BY_FOUR */
+  double sign; /* 1: a positive steering motor position steers right (Webots' Driver), -1: left */
+  char *motors[6]; /* right_steer, left_steer, right_front_wheel, left_front_wheel, right_rear_wheel, left_rear_wheel */
+} sn_car;
+
 typedef struct {
   sn_conn *conn;
   char *name;
@@ -194,6 +204,7 @@ typedef struct {
   uint64_t pending; /* id of the pending step, 0 if none */
   int n_devices;
   sn_device *devices;
+  sn_car car;
 } sn_robot;
 
 /* The process's robot; exits with a message if wb_robot_init() was not called. */

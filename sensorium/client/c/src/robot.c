@@ -211,12 +211,41 @@ static void free_robot(sn_robot *rb) {
   free(rb->session);
   free(rb->model);
   free(rb->custom_data);
+  for (int i = 0; i < 6; i++)
+    free(rb->car.motors[i]);
   free(rb->prefix);
   sn_conn_close(rb->conn);
   free(rb);
 }
 
 /* ------------------------------------------------------------------ init / cleanup */
+
+/* The attach reply's "ackermann_drive" (a map; nil or absent for a robot that is not a car). */
+static void parse_car(sn_car *car, const msgpack_object *o) {
+  static const char *const motors[6] = {"right_steer",      "left_steer",       "right_front_wheel",
+                                        "left_front_wheel", "right_rear_wheel", "left_rear_wheel"};
+  memset(car, 0, sizeof *car);
+  if (o == NULL || o->type != MSGPACK_OBJECT_MAP)
+    return;
+  car->wheelbase = sn_double_or(o, "wheelbase", NAN);
+  car->track_front = sn_double_or(o, "track_front", NAN);
+  car->track_rear = sn_double_or(o, "track_rear", NAN);
+  car->front_wheel_radius = sn_double_or(o, "front_wheel_radius", NAN);
+  car->rear_wheel_radius = sn_double_or(o, "rear_wheel_radius", NAN);
+  char *type = sn_strdup_obj(sn_get(o, "type"));
+  char *steers = sn_strdup_obj(sn_get(o, "positive_steers"));
+  car->type = type == NULL ? -1 : strcmp(type, "traction") == 0 ? 0 : strcmp(type, "propulsion") == 0 ? 1
+                                : strcmp(type, "4x4") == 0        ? 2 : -1;
+  car->sign = steers != NULL && strcmp(steers, "left") == 0 ? -1.0 : 1.0;
+  free(type);
+  free(steers);
+  bool ok = car->type >= 0 && car->wheelbase > 0 && car->front_wheel_radius > 0 && car->rear_wheel_radius > 0;
+  for (int i = 0; i < 6; i++) {
+    car->motors[i] = sn_strdup_obj(sn_get(o, motors[i]));
+    ok = ok && car->motors[i] != NULL;
+  }
+  car->present = ok;
+}
 
 static int call(sn_conn *c, sn_req *r, uint64_t id, int timeout_ms, sn_reply *out) {
   if (sn_conn_send(c, r, id) != 0) {
@@ -301,6 +330,7 @@ int wb_robot_init(void) {
     rb->model = strdup("");
   if (rb->custom_data == NULL)
     rb->custom_data = strdup("");
+  parse_car(&rb->car, sn_get(res, "ackermann_drive"));
   rb->basic_time_step = (int)sn_int_or(res, "basic_time_step", 0);
   rb->time_ms = sn_int_or(res, "time_ms", 0);
   rb->synchronization = sn_bool_or(res, "synchronization", true);

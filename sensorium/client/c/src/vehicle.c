@@ -1,235 +1,436 @@
-/* Sensorium C controller library: Webots' car and driver libraries (vehicle/car.h, vehicle/driver.h).
- * Sensorium drives robots kinematically through two-wheel and skid-steer drives only; a car's
- * Ackermann steering, engine, gearbox and lights are not simulated. So wbu_driver_init() and
- * wbu_car_init() say so in one line and end the controller with status 1, before it connects to any
- * server; every other function does nothing and answers Webots' "no value". */
+/* Sensorium C controller library: Webots' car and driver libraries (vehicle/car.h, vehicle/driver.h)
+ * over a car-like robot's ordinary motors. The car's geometry comes with the attach reply (the
+ * world's ackermann_drive; Webots reads a Car's customData). wbu_driver_set_steering_angle() turns
+ * the two steering motors to Webots' Ackermann angles, wbu_driver_set_cruising_speed() sets the
+ * driven wheels' velocities by Webots' geometric differentials; the car is kinematic (no engine,
+ * gearbox, brakes, lights or wipers): those functions print one line the first time and answer
+ * Webots' "no value". wbu_car_init()/wbu_driver_init() on a robot without an ackermann_drive print
+ * one line and end the controller with status 1. Before init every function answers "no value". */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
+#include <webots/motor.h>
+#include <webots/position_sensor.h>
+#include <webots/robot.h>
 #include <webots/vehicle/car.h>
 #include <webots/vehicle/driver.h>
 
-static void refuse(const char *func) {
+#include "internal.h"
+
+static struct {
+  bool ready;                  /* wbu_car_init() done */
+  const sn_car *geo;           /* the robot's drive (in its sn_robot) */
+  WbDeviceTag steer[2];        /* right, left */
+  WbDeviceTag steer_sensor[2]; /* 0: none */
+  WbDeviceTag wheel[4];        /* Webots' order: front right, front left, rear right, rear left; 0: no motor */
+  WbDeviceTag wheel_sensor[4]; /* right_front_sensor, ... (Webots' names); 0: none */
+  double angle, right_angle, left_angle, cruising;
+  WbuDriverControlMode mode;
+} g_car;
+
+static void unmodelled(const char *func, bool *said) {
+  if (*said)
+    return;
+  *said = true;
   fprintf(stderr,
-          "Error: %s(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots move "
-          "kinematically by two-wheel or skid-steer drives only, so a car-like robot with steered wheels is not "
-          "driven.\n",
+          "Warning: %s(): not simulated (Sensorium's car is kinematic, a bicycle model of its steering and wheel "
+          "motors: no engine, gearbox, brakes, lights or wipers); it answers Webots' \"no value\".\n",
           func);
   fflush(stderr);
-  exit(1);
 }
+#define UNMODELLED()             \
+  do {                           \
+    static bool said_;           \
+    if (g_car.ready)             \
+      unmodelled(__func__, &said_); \
+  } while (0)
 
-/* ------------------------------------------------------------------ driver */
-bool wbu_driver_initialization_is_possible(void) {
-  return false;
-}
-
-void wbu_driver_init(void) {
-  refuse("wbu_driver_init");
-}
-
-void wbu_driver_cleanup(void) {
-}
-
-int wbu_driver_step(void) {
-  return -1;
-}
-
-void wbu_driver_set_steering_angle(double steering_angle) {
-  (void)steering_angle;
-}
-
-double wbu_driver_get_steering_angle(void) {
-  return NAN;
-}
-
-void wbu_driver_set_cruising_speed(double speed) {
-  (void)speed;
-}
-
-double wbu_driver_get_target_cruising_speed(void) {
-  return NAN;
-}
-
-double wbu_driver_get_current_speed(void) {
-  return NAN;
-}
-
-void wbu_driver_set_throttle(double throttle) {
-  (void)throttle;
-}
-
-double wbu_driver_get_throttle(void) {
-  return NAN;
-}
-
-void wbu_driver_set_brake_intensity(double intensity) {
-  (void)intensity;
-}
-
-double wbu_driver_get_brake_intensity(void) {
-  return NAN;
-}
-
-void wbu_driver_set_indicator(WbuDriverIndicatorState state) {
-  (void)state;
-}
-
-void wbu_driver_set_hazard_flashers(bool state) {
-  (void)state;
-}
-
-WbuDriverIndicatorState wbu_driver_get_indicator(void) {
-  return OFF;
-}
-
-bool wbu_driver_get_hazard_flashers(void) {
-  return false;
-}
-
-void wbu_driver_set_dipped_beams(bool state) {
-  (void)state;
-}
-
-void wbu_driver_set_antifog_lights(bool state) {
-  (void)state;
-}
-
-bool wbu_driver_get_dipped_beams(void) {
-  return false;
-}
-
-bool wbu_driver_get_antifog_lights(void) {
-  return false;
-}
-
-double wbu_driver_get_rpm(void) {
-  return NAN;
-}
-
-int wbu_driver_get_gear(void) {
+/* A device of the robot by name, 0 when it has none (no error line: Webots' car library looks its
+ * optional devices up quietly). */
+static WbDeviceTag quiet_device(const sn_robot *rb, const char *name, sn_kind kind) {
+  for (int i = 0; i < rb->n_devices; i++)
+    if (rb->devices[i].kind == kind && rb->devices[i].simulated && strcmp(rb->devices[i].name, name) == 0)
+      return rb->devices[i].tag;
   return 0;
 }
 
-void wbu_driver_set_gear(int gear) {
-  (void)gear;
-}
-
-int wbu_driver_get_gear_number(void) {
-  return 0;
-}
-
-WbuDriverControlMode wbu_driver_get_control_mode(void) {
-  return UNDEFINED_CONTROL_MODE;
-}
-
-void wbu_driver_set_wiper_mode(WbuDriverWiperMode mode) {
-  (void)mode;
-}
-
-WbuDriverWiperMode wbu_driver_get_wiper_mode(void) {
-  return DOWN;
-}
-
-void wbu_driver_set_brake(double brake) {
-  (void)brake;
-}
-
-double wbu_driver_get_brake(void) {
-  return NAN;
-}
-
-void wbu_driver_set_wipers_mode(wbu_wipers_mode mode) {
-  (void)mode;
-}
-
-wbu_wipers_mode wbu_driver_get_wipers_mode(void) {
-  return DOWN;
+static void ackermann(double angle, double *right, double *left) {
+  if (angle == 0.0) {
+    *right = *left = 0.0;
+    return;
+  }
+  double cot = 1.0 / tan(angle), half = g_car.geo->track_front / (2.0 * g_car.geo->wheelbase);
+  *right = atan(1.0 / (cot - half));
+  *left = atan(1.0 / (cot + half));
 }
 
 /* ------------------------------------------------------------------ car */
+/* wbu_car_init() and wbu_driver_init() (func: which one, for the refusal line). */
+static void car_init(const char *func) {
+  if (g_car.ready)
+    return;
+  wb_robot_init();
+  sn_robot *rb = sn_robot_get(func);
+  if (!rb->car.present) {
+    fprintf(stderr,
+            "Error: %s(): robot '%s' has no ackermann_drive: Sensorium's vehicle library drives a car-like robot whose "
+            "world entry has one (README \"World files\"; a .wbt car is mapped when its steering and wheel joints "
+            "are a car's).\n",
+            func, rb->name);
+    fflush(stderr);
+    exit(1);
+  }
+  g_car.geo = &rb->car;
+  static const char *const sensors[4] = {"right_front_sensor", "left_front_sensor", "right_rear_sensor",
+                                         "left_rear_sensor"};
+  int step = rb->basic_time_step;
+  for (int i = 0; i < 2; i++) {
+    g_car.steer[i] = quiet_device(rb, rb->car.motors[i], SN_MOTOR);
+    g_car.steer_sensor[i] = g_car.steer[i] ? wb_motor_get_position_sensor(g_car.steer[i]) : 0;
+    if (g_car.steer_sensor[i])
+      wb_position_sensor_enable(g_car.steer_sensor[i], step);
+  }
+  for (int i = 0; i < 4; i++) {
+    bool front = i < 2;
+    bool driven = rb->car.type == WBU_CAR_FOUR_BY_FOUR || (front ? rb->car.type == WBU_CAR_TRACTION
+                                                                 : rb->car.type == WBU_CAR_PROPULSION);
+    g_car.wheel[i] = driven ? quiet_device(rb, rb->car.motors[2 + i], SN_MOTOR) : 0;
+    g_car.wheel_sensor[i] = quiet_device(rb, sensors[i], SN_POSITION);
+    if (g_car.wheel_sensor[i])
+      wb_position_sensor_enable(g_car.wheel_sensor[i], step);
+    if (g_car.wheel[i]) { /* velocity control at rest (Webots' wbu_car_init) */
+      wb_motor_set_position(g_car.wheel[i], INFINITY);
+      wb_motor_set_velocity(g_car.wheel[i], 0.0);
+    }
+  }
+  g_car.mode = UNDEFINED_CONTROL_MODE;
+  g_car.ready = true;
+}
+
 void wbu_car_init(void) {
-  refuse("wbu_car_init");
+  car_init("wbu_car_init");
 }
 
 void wbu_car_cleanup(void) {
+  memset(&g_car, 0, sizeof g_car);
 }
 
 WbuCarType wbu_car_get_type(void) {
-  return WBU_CAR_TRACTION;
+  return g_car.ready ? (WbuCarType)g_car.geo->type : WBU_CAR_TRACTION;
 }
 
 WbuCarEngineType wbu_car_get_engine_type(void) {
+  UNMODELLED();
   return WBU_CAR_COMBUSTION_ENGINE;
 }
 
 void wbu_car_set_indicator_period(double period) {
   (void)period;
+  UNMODELLED();
 }
 
 double wbu_car_get_indicator_period(void) {
+  UNMODELLED();
   return NAN;
 }
 
 bool wbu_car_get_backwards_lights(void) {
+  UNMODELLED();
   return false;
 }
 
 bool wbu_car_get_brake_lights(void) {
+  UNMODELLED();
   return false;
 }
 
 double wbu_car_get_track_front(void) {
-  return NAN;
+  return g_car.ready ? g_car.geo->track_front : NAN;
 }
 
 double wbu_car_get_track_rear(void) {
-  return NAN;
+  return g_car.ready ? g_car.geo->track_rear : NAN;
 }
 
 double wbu_car_get_wheelbase(void) {
-  return NAN;
+  return g_car.ready ? g_car.geo->wheelbase : NAN;
 }
 
 double wbu_car_get_front_wheel_radius(void) {
-  return NAN;
+  return g_car.ready ? g_car.geo->front_wheel_radius : NAN;
 }
 
 double wbu_car_get_rear_wheel_radius(void) {
-  return NAN;
+  return g_car.ready ? g_car.geo->rear_wheel_radius : NAN;
 }
 
 double wbu_car_get_wheel_encoder(WbuCarWheelIndex wheel_index) {
-  (void)wheel_index;
-  return NAN;
+  if (!g_car.ready || (int)wheel_index < 0 || (int)wheel_index >= 4 || !g_car.wheel_sensor[wheel_index])
+    return NAN;
+  return wb_position_sensor_get_value(g_car.wheel_sensor[wheel_index]);
 }
 
+/* A driven wheel's speed (rad/s): its commanded velocity, which a kinematic wheel keeps; NaN without a motor. */
 double wbu_car_get_wheel_speed(WbuCarWheelIndex wheel_index) {
-  (void)wheel_index;
-  return NAN;
+  if (!g_car.ready || (int)wheel_index < 0 || (int)wheel_index >= 4 || !g_car.wheel[wheel_index])
+    return NAN;
+  return wb_motor_get_velocity(g_car.wheel[wheel_index]);
 }
 
 void wbu_car_set_left_steering_angle(double angle) {
-  (void)angle;
+  if (!g_car.ready)
+    return;
+  g_car.left_angle = angle;
+  wb_motor_set_position(g_car.steer[1], g_car.geo->sign * angle);
 }
 
 void wbu_car_set_right_steering_angle(double angle) {
-  (void)angle;
+  if (!g_car.ready)
+    return;
+  g_car.right_angle = angle;
+  wb_motor_set_position(g_car.steer[0], g_car.geo->sign * angle);
 }
 
 double wbu_car_get_right_steering_angle(void) {
-  return NAN;
+  return g_car.ready ? g_car.right_angle : NAN;
 }
 
 double wbu_car_get_left_steering_angle(void) {
-  return NAN;
+  return g_car.ready ? g_car.left_angle : NAN;
 }
 
 void wbu_car_enable_limited_slip_differential(bool enable) {
   (void)enable;
+  UNMODELLED();
 }
 
 void wbu_car_enable_indicator_auto_disabling(bool enable) {
   (void)enable;
+  UNMODELLED();
+}
+
+/* ------------------------------------------------------------------ driver */
+bool wbu_driver_initialization_is_possible(void) {
+  return g_car.ready;
+}
+
+void wbu_driver_init(void) {
+  car_init("wbu_driver_init");
+}
+
+void wbu_driver_cleanup(void) {
+  wbu_car_cleanup();
+}
+
+int wbu_driver_step(void) {
+  if (!g_car.ready)
+    return -1;
+  return wb_robot_step((int)wb_robot_get_basic_time_step());
+}
+
+void wbu_driver_set_steering_angle(double steering_angle) {
+  if (!g_car.ready)
+    return;
+  if (isnan(steering_angle)) {
+    fprintf(stderr, "Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument (NaN)\n");
+    return;
+  }
+  g_car.angle = steering_angle;
+  ackermann(steering_angle, &g_car.right_angle, &g_car.left_angle);
+  wb_motor_set_position(g_car.steer[0], g_car.geo->sign * g_car.right_angle);
+  wb_motor_set_position(g_car.steer[1], g_car.geo->sign * g_car.left_angle);
+  if (g_car.mode == SPEED) /* the differential speeds follow the new angles */
+    wbu_driver_set_cruising_speed(g_car.cruising);
+}
+
+/* The mean of the steering encoders (Webots), of the motors' targets where a steering motor has none. */
+double wbu_driver_get_steering_angle(void) {
+  if (!g_car.ready)
+    return NAN;
+  double sum = 0.0;
+  for (int i = 0; i < 2; i++) {
+    double v = g_car.steer_sensor[i] ? wb_position_sensor_get_value(g_car.steer_sensor[i]) : NAN;
+    sum += isnan(v) ? wb_motor_get_target_position(g_car.steer[i]) : v;
+  }
+  return g_car.geo->sign * sum / 2.0;
+}
+
+static double ratio_front(void) {
+  if (g_car.angle == 0.0)
+    return 0.5;
+  double r = g_car.geo->wheelbase / sin(g_car.right_angle), l = g_car.geo->wheelbase / sin(g_car.left_angle);
+  return r / (l + r);
+}
+
+static double ratio_rear(void) {
+  if (g_car.angle == 0.0)
+    return 0.5;
+  double c = g_car.geo->wheelbase / tan(g_car.angle);
+  double r = c - g_car.geo->track_rear / 2, l = c + g_car.geo->track_rear / 2;
+  return r / (l + r);
+}
+
+static double ratio_central(void) {
+  if (g_car.angle == 0.0)
+    return 0.5;
+  double front = g_car.geo->wheelbase / sin(g_car.angle), rear = g_car.geo->wheelbase / tan(g_car.angle);
+  return g_car.geo->rear_wheel_radius / g_car.geo->front_wheel_radius * front / (front + rear);
+}
+
+/* Webots' geometric differentials: each driven pair shares 2 * speed by its wheels' turn radii (a
+ * 4x4's central differential splits front and rear); km/h to rad/s by the wheel radius. */
+void wbu_driver_set_cruising_speed(double speed) {
+  if (!g_car.ready)
+    return;
+  double central = g_car.geo->type == WBU_CAR_FOUR_BY_FOUR ? ratio_central() : 0.5;
+  double ratios[2] = {ratio_front(), ratio_rear()};
+  double shares[2] = {2 * central, 2 * (1 - central)};
+  double radii[2] = {g_car.geo->front_wheel_radius, g_car.geo->rear_wheel_radius};
+  for (int axle = 0; axle < 2; axle++) {
+    double share = g_car.geo->type == WBU_CAR_FOUR_BY_FOUR ? shares[axle] : 1.0;
+    double right = 2 * speed * ratios[axle] * share, left = 2 * speed * (1 - ratios[axle]) * share;
+    if (g_car.wheel[2 * axle])
+      wb_motor_set_velocity(g_car.wheel[2 * axle], right / 3.6 / radii[axle]);
+    if (g_car.wheel[2 * axle + 1])
+      wb_motor_set_velocity(g_car.wheel[2 * axle + 1], left / 3.6 / radii[axle]);
+  }
+  g_car.cruising = speed;
+  g_car.mode = SPEED;
+}
+
+double wbu_driver_get_target_cruising_speed(void) {
+  return g_car.ready ? g_car.cruising : NAN;
+}
+
+/* km/h from the driven wheels (Webots: from their encoders over the last step; a kinematic wheel in
+ * velocity control turns exactly at its command). */
+double wbu_driver_get_current_speed(void) {
+  if (!g_car.ready)
+    return NAN;
+  double radii[2] = {g_car.geo->front_wheel_radius, g_car.geo->rear_wheel_radius}, sum = 0.0;
+  int axles = 0;
+  for (int axle = 0; axle < 2; axle++) {
+    if (!g_car.wheel[2 * axle])
+      continue;
+    sum += 0.5 * (wb_motor_get_velocity(g_car.wheel[2 * axle]) + wb_motor_get_velocity(g_car.wheel[2 * axle + 1])) *
+           radii[axle];
+    axles++;
+  }
+  return axles ? 3.6 * sum / axles : 0.0;
+}
+
+void wbu_driver_set_throttle(double throttle) {
+  (void)throttle;
+  UNMODELLED();
+}
+
+double wbu_driver_get_throttle(void) {
+  UNMODELLED();
+  return NAN;
+}
+
+void wbu_driver_set_brake_intensity(double intensity) {
+  (void)intensity;
+  UNMODELLED();
+}
+
+double wbu_driver_get_brake_intensity(void) {
+  UNMODELLED();
+  return NAN;
+}
+
+void wbu_driver_set_indicator(WbuDriverIndicatorState state) {
+  (void)state;
+  UNMODELLED();
+}
+
+void wbu_driver_set_hazard_flashers(bool state) {
+  (void)state;
+  UNMODELLED();
+}
+
+WbuDriverIndicatorState wbu_driver_get_indicator(void) {
+  UNMODELLED();
+  return OFF;
+}
+
+bool wbu_driver_get_hazard_flashers(void) {
+  UNMODELLED();
+  return false;
+}
+
+void wbu_driver_set_dipped_beams(bool state) {
+  (void)state;
+  UNMODELLED();
+}
+
+void wbu_driver_set_antifog_lights(bool state) {
+  (void)state;
+  UNMODELLED();
+}
+
+bool wbu_driver_get_dipped_beams(void) {
+  UNMODELLED();
+  return false;
+}
+
+bool wbu_driver_get_antifog_lights(void) {
+  UNMODELLED();
+  return false;
+}
+
+double wbu_driver_get_rpm(void) {
+  UNMODELLED();
+  return NAN;
+}
+
+int wbu_driver_get_gear(void) {
+  UNMODELLED();
+  return 0;
+}
+
+void wbu_driver_set_gear(int gear) {
+  (void)gear;
+  UNMODELLED();
+}
+
+int wbu_driver_get_gear_number(void) {
+  UNMODELLED();
+  return 0;
+}
+
+WbuDriverControlMode wbu_driver_get_control_mode(void) {
+  return g_car.ready ? g_car.mode : UNDEFINED_CONTROL_MODE;
+}
+
+void wbu_driver_set_wiper_mode(WbuDriverWiperMode mode) {
+  (void)mode;
+  UNMODELLED();
+}
+
+WbuDriverWiperMode wbu_driver_get_wiper_mode(void) {
+  UNMODELLED();
+  return DOWN;
+}
+
+void wbu_driver_set_brake(double brake) {
+  (void)brake;
+  UNMODELLED();
+}
+
+double wbu_driver_get_brake(void) {
+  UNMODELLED();
+  return NAN;
+}
+
+void wbu_driver_set_wipers_mode(wbu_wipers_mode mode) {
+  (void)mode;
+  UNMODELLED();
+}
+
+wbu_wipers_mode wbu_driver_get_wipers_mode(void) {
+  UNMODELLED();
+  return DOWN;
 }

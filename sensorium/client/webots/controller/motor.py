@@ -1,4 +1,4 @@
-"""Webots' ``Motor`` and ``RotationalMotor`` classes (a differential drive's wheel motors).
+"""Webots' ``Motor`` and ``RotationalMotor`` classes (a drive's wheel and steering motors).
 
 Commands cost no round trip: they are kept by the client and sent with the next ``Robot.step``
 (see :mod:`sensorium.client.wb`), so ``setVelocity`` takes effect at the start of that step.

@@ -1,4 +1,4 @@
-"""Webots' ``PositionSensor`` class (a wheel encoder of the differential drive)."""
+"""Webots' ``PositionSensor`` class (the encoder of a drive's wheel or steering joint)."""
 
 from __future__ import annotations
 

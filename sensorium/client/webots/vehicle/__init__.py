@@ -1,10 +1,11 @@
 """Webots' Python ``vehicle`` package (``from vehicle import Driver, Car``) on Sensorium.
 
-Sensorium does not simulate Webots' vehicle library: its robots move kinematically by two-wheel or
-skid-steer drives only, so a car-like robot with steered wheels is not driven. The classes import
-(with Webots' constants) so a controller file loads; constructing one prints one line saying why and
-exits with status 1, before any connection to a server (no wait, no traceback) — as the C library's
-``wbu_driver_init()`` / ``wbu_car_init()`` do."""
+A car-like robot (its world entry's ``ackermann_drive``, or a .wbt car mapped to one) is driven
+through its ordinary motors: ``Driver.setSteeringAngle`` sets the two steering motors to Webots'
+Ackermann angles, ``setCruisingSpeed`` the driven wheels' velocities by Webots' geometric
+differentials. There is no engine, gearbox, brake, light or wiper model: those functions print one
+line the first time and answer Webots' "no value". On a robot without an ``ackermann_drive`` the
+constructor prints one line and exits with status 1."""
 
 from .car import Car
 from .driver import Driver

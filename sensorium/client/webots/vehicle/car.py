@@ -1,9 +1,16 @@
-"""Webots' ``Car`` class: present for ``from vehicle import Car``; constructing it ends the
-controller with one line (see the package docstring)."""
+"""Webots' ``Car`` class: the ``Driver`` plus the car's read-outs (type, geometry, each front
+wheel's angle, the wheels' encoders and speeds). Engine type, indicator period and the lights are
+not simulated (one line the first time, then Webots' "no value")."""
 
 from __future__ import annotations
 
-from .driver import Driver
+import math
+
+from .driver import Driver, unmodelled
+
+# Webots' wheel indices → (the car's wheel key, the encoder name Webots' car library looks up)
+_WHEELS = (("right_front", "right_front_sensor"), ("left_front", "left_front_sensor"),
+           ("right_rear", "right_rear_sensor"), ("left_rear", "left_rear_sensor"))
 
 
 class Car(Driver):
@@ -19,3 +26,67 @@ class Car(Driver):
     WHEEL_REAR_RIGHT = 2
     WHEEL_REAR_LEFT = 3
     WHEEL_NB = 4
+
+    def getType(self) -> int:  # type: ignore[override]   # Webots' Car.getType is the car's type
+        return {"traction": self.TRACTION, "propulsion": self.PROPULSION, "4x4": self.FOUR_BY_FOUR}[self._geo["type"]]
+
+    def getWheelbase(self) -> float:
+        return float(self._geo["wheelbase"])
+
+    def getTrackFront(self) -> float:
+        return float(self._geo["track_front"])
+
+    def getTrackRear(self) -> float:
+        return float(self._geo["track_rear"])
+
+    def getFrontWheelRadius(self) -> float:
+        return float(self._geo["front_wheel_radius"])
+
+    def getRearWheelRadius(self) -> float:
+        return float(self._geo["rear_wheel_radius"])
+
+    def getRightSteeringAngle(self) -> float:
+        """The right front wheel's commanded angle (positive: right), as Webots' car library."""
+        return self._angles[0]
+
+    def getLeftSteeringAngle(self) -> float:
+        return self._angles[1]
+
+    def setRightSteeringAngle(self, angle: float) -> None:
+        """Turn the right front wheel alone (Webots' car library: no Ackermann geometry applied)."""
+        self._angles = (float(angle), self._angles[1])
+        self._steer[0].setPosition(self._sign * float(angle))
+
+    def setLeftSteeringAngle(self, angle: float) -> None:
+        self._angles = (self._angles[0], float(angle))
+        self._steer[1].setPosition(self._sign * float(angle))
+
+    def getWheelEncoder(self, wheel_index: int) -> float:
+        """The wheel's encoder (rad) by Webots' encoder name, NaN where the car has none."""
+        if not 0 <= wheel_index < self.WHEEL_NB:
+            return math.nan
+        sensor = self.devices.get(_WHEELS[wheel_index][1])
+        return sensor.getValue() if sensor is not None and hasattr(sensor, "getValue") else math.nan
+
+    def getWheelSpeed(self, wheel_index: int) -> float:
+        """A driven wheel's speed (rad/s: its commanded velocity, which a kinematic wheel keeps);
+        NaN for a wheel without a motor."""
+        if not 0 <= wheel_index < self.WHEEL_NB or _WHEELS[wheel_index][0] not in self._wheels:
+            return math.nan
+        return float(self._wheels[_WHEELS[wheel_index][0]][0].getVelocity())
+
+    getEngineType = unmodelled("wbu_car_get_engine_type", COMBUSTION_ENGINE)
+    setIndicatorPeriod = unmodelled("wbu_car_set_indicator_period", None)
+    getIndicatorPeriod = unmodelled("wbu_car_get_indicator_period", 0.0)
+    getBackwardsLights = unmodelled("wbu_car_get_backwards_lights", False)
+    getBrakeLights = unmodelled("wbu_car_get_brake_lights", False)
+    enableLimitedSlipDifferential = unmodelled("wbu_car_enable_limited_slip_differential", None)
+    enableIndicatorAutoDisabling = unmodelled("wbu_car_enable_indicator_auto_disabling", None)
+
+    wheelbase = property(getWheelbase)
+    track_front = property(getTrackFront)
+    track_rear = property(getTrackRear)
+    front_wheel_radius = property(getFrontWheelRadius)
+    rear_wheel_radius = property(getRearWheelRadius)
+    right_steering_angle = property(getRightSteeringAngle, setRightSteeringAngle)
+    left_steering_angle = property(getLeftSteeringAngle, setLeftSteeringAngle)

@@ -1,16 +1,52 @@
-"""Webots' ``Driver`` class: present for ``from vehicle import Driver``; constructing it ends the
-controller with one line (see the package docstring)."""
+"""Webots' ``Driver`` class over a car-like robot's ordinary motors (its world entry's
+``ackermann_drive``): ``setSteeringAngle`` turns the two steering motors to Webots' Ackermann
+angles, ``setCruisingSpeed`` sets the driven wheels' velocities by Webots' geometric differentials,
+``getCurrentSpeed`` reads them back. Sensorium's car is kinematic (no engine, gearbox, brakes,
+lights or wipers): those functions answer Webots' "no value" after one line the first time."""
 
 from __future__ import annotations
 
+import math
+import sys
+from collections.abc import Callable
+from typing import Any
+
+from sensorium.client import wb
 from sensorium.client.webots.controller.supervisor import Supervisor
 
+_UNMODELLED = ("Sensorium's car is kinematic (a bicycle model of its steering and wheel motors): no engine, "
+               "gearbox, brakes, lights or wipers")
 
-def refuse(cls: str) -> SystemExit:
-    """The one-line exit a vehicle constructor raises (status 1; the same words as the C library)."""
-    return SystemExit(f"Error: {cls}(): Sensorium does not simulate Webots' vehicle library (Car, Driver): its robots "
-                      "move kinematically by two-wheel or skid-steer drives only, so a car-like robot with steered "
-                      "wheels is not driven.")
+
+def refuse(cls: str, robot: str) -> SystemExit:
+    """The one-line exit of a vehicle constructor on a robot that is not a car (status 1)."""
+    return SystemExit(f"Error: {cls}(): robot {robot!r} has no ackermann_drive: Sensorium's vehicle library drives a "
+                      "car-like robot whose world entry has one (README \"World files\"; a .wbt car is mapped when its "
+                      "steering and wheel joints are a car's).")
+
+
+def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float) -> tuple[float, float]:
+    """(right, left) front wheel angles for the bicycle-model angle (positive: right), as Webots'
+    Driver computes them: cot δ_right = cot δ - t/2L, cot δ_left = cot δ + t/2L."""
+    if steering_angle == 0.0:
+        return 0.0, 0.0
+    cot, half = 1.0 / math.tan(steering_angle), track_front / (2.0 * wheelbase)
+    return math.atan(1.0 / (cot - half)), math.atan(1.0 / (cot + half))
+
+
+def unmodelled(func: str, answer: Any) -> Callable[..., Any]:
+    """A method standing for the C function ``func`` that does nothing and answers ``answer``,
+    after one line the first time it is called in this process."""
+    said: list[bool] = []
+
+    def method(self: object, *args: Any, **kwargs: Any) -> Any:
+        if not said:
+            said.append(True)
+            print(f"Warning: {func}(): not simulated ({_UNMODELLED}); it answers {answer!r}.", file=sys.stderr)
+        return answer
+
+    method.__doc__ = f"Not simulated (no engine model): one line the first time, then {answer!r}."
+    return method
 
 
 class Driver(Supervisor):
@@ -24,5 +60,146 @@ class Driver(Supervisor):
     NORMAL = 2
     FAST = 3
 
-    def __init__(self) -> None:  # raises before Supervisor.__init__ would look for a server
-        raise refuse(type(self).__name__)
+    def __init__(self) -> None:
+        super().__init__()
+        geo = wb.current().ackermann_drive
+        if geo is None:
+            raise refuse(type(self).__name__, self.getName())
+        self._geo = geo
+        self._sign = 1.0 if geo["positive_steers"] == "right" else -1.0
+        self._steer = [self._motor(geo["right_steer"]), self._motor(geo["left_steer"])]
+        step = int(self.getBasicTimeStep())
+        self._steer_sensors = [m.getPositionSensor() for m in self._steer]
+        # the driven wheels (Webots' order: front right, front left, rear right, rear left), each with its radius
+        axles = {"traction": ("front",), "propulsion": ("rear",), "4x4": ("front", "rear")}[geo["type"]]
+        self._wheels: dict[str, tuple[Any, float]] = {}
+        for axle in axles:
+            for side in ("right", "left"):
+                self._wheels[f"{side}_{axle}"] = (self._motor(geo[f"{side}_{axle}_wheel"]), geo[f"{axle}_wheel_radius"])
+        wheel_sensors = [self.devices.get(f"{side}_{axle}_sensor") for axle in ("front", "rear")
+                         for side in ("right", "left")]
+        for sensor in (*self._steer_sensors, *wheel_sensors):   # as Webots' car library: its encoders on
+            if sensor is not None and type(sensor).__name__ == "PositionSensor":
+                sensor.enable(step)
+        for motor, _ in self._wheels.values():      # velocity control at rest (Webots' wbu_car_init)
+            motor.setPosition(math.inf)
+            motor.setVelocity(0.0)
+        self._angle = 0.0
+        self._angles = (0.0, 0.0)
+        self._cruising = 0.0
+        self._mode: int | None = None
+
+    def _motor(self, name: str) -> Any:
+        motor = self.devices.get(name)
+        if motor is None:       # the server lists every drive motor: only a mismatched server gets here
+            raise SystemExit(f"Error: {type(self).__name__}(): robot {self.getName()!r} has no motor {name!r}.")
+        return motor
+
+    # -- steering
+    def setSteeringAngle(self, steeringAngle: float) -> None:
+        """Turn the front wheels to Webots' Ackermann angles for ``steeringAngle`` (rad, positive:
+        right); the steering motors clamp to their limits. In speed control the wheel speeds follow."""
+        if not isinstance(steeringAngle, (int, float)) or math.isnan(steeringAngle):
+            print("Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument (NaN)",
+                  file=sys.stderr)
+            return
+        self._angle = float(steeringAngle)
+        self._angles = ackermann_angles(self._angle, self._geo["wheelbase"], self._geo["track_front"])
+        for motor, angle in zip(self._steer, self._angles):
+            motor.setPosition(self._sign * angle)
+        if self._mode == self.SPEED:
+            self.setCruisingSpeed(self._cruising)
+
+    def getSteeringAngle(self) -> float:
+        """The mean of the two front wheels' angles (Webots: of the steering encoders; here the
+        motors' targets where a steering motor has no encoder)."""
+        angles = []
+        for motor, sensor in zip(self._steer, self._steer_sensors):
+            value = sensor.getValue() if sensor is not None else math.nan
+            angles.append(value if value == value else motor.getTargetPosition())
+        return self._sign * (angles[0] + angles[1]) / 2.0
+
+    # -- speed
+    def _ratio_front(self) -> float:
+        right, left = self._angles
+        if self._angle == 0.0:
+            return 0.5
+        r_right, r_left = self._geo["wheelbase"] / math.sin(right), self._geo["wheelbase"] / math.sin(left)
+        return r_right / (r_left + r_right)
+
+    def _ratio_rear(self) -> float:
+        if self._angle == 0.0:
+            return 0.5
+        r = self._geo["wheelbase"] / math.tan(self._angle)
+        r_right, r_left = r - self._geo["track_rear"] / 2, r + self._geo["track_rear"] / 2
+        return r_right / (r_left + r_right)
+
+    def _ratio_central(self) -> float:
+        if self._angle == 0.0:
+            return 0.5
+        front, rear = self._geo["wheelbase"] / math.sin(self._angle), self._geo["wheelbase"] / math.tan(self._angle)
+        return self._geo["rear_wheel_radius"] / self._geo["front_wheel_radius"] * front / (front + rear)
+
+    def setCruisingSpeed(self, cruisingSpeed: float) -> None:
+        """Speed control (km/h): each driven wheel's velocity by Webots' geometric differentials
+        (each axle's pair shares 2·speed in proportion to its wheels' turn radii; a 4x4's central
+        differential splits front and rear)."""
+        speed = float(cruisingSpeed)
+        central = self._ratio_central() if self._geo["type"] == "4x4" else 0.5
+        for axle, ratio, share in (("front", self._ratio_front(), 2 * central), ("rear", self._ratio_rear(),
+                                                                                  2 * (1 - central))):
+            if f"right_{axle}" not in self._wheels:
+                continue
+            for side, part in (("right", ratio), ("left", 1 - ratio)):
+                motor, radius = self._wheels[f"{side}_{axle}"]
+                kmh = 2 * speed * part * (share if self._geo["type"] == "4x4" else 1.0)
+                motor.setVelocity(kmh / 3.6 / radius)
+        self._cruising = speed
+        self._mode = self.SPEED
+
+    def getTargetCruisingSpeed(self) -> float:
+        return self._cruising
+
+    def getCurrentSpeed(self) -> float:
+        """km/h from the driven wheels' speeds (Webots: their encoders' last step; a kinematic
+        wheel in velocity control turns exactly at its commanded velocity)."""
+        def axle(name: str) -> float:
+            (right, radius), (left, _) = self._wheels[f"right_{name}"], self._wheels[f"left_{name}"]
+            return 0.5 * (right.getVelocity() + left.getVelocity()) * radius
+        if self._geo["type"] == "4x4":
+            return 3.6 * 0.5 * (axle("front") + axle("rear"))
+        return 3.6 * axle("front" if self._geo["type"] == "traction" else "rear")
+
+    def getControlMode(self) -> int | None:
+        """``SPEED`` once a cruising speed is set, ``None`` before (Webots' undefined mode)."""
+        return self._mode
+
+    def step(self, duration: int | None = None) -> int:
+        """One basic time step (Webots' ``wbu_driver_step``); -1 when the simulation ends."""
+        return super().step(duration)
+
+    # -- no engine, gearbox, brakes, lights or wipers here
+    setThrottle = unmodelled("wbu_driver_set_throttle", None)
+    getThrottle = unmodelled("wbu_driver_get_throttle", 0.0)
+    setBrakeIntensity = unmodelled("wbu_driver_set_brake_intensity", None)
+    getBrakeIntensity = unmodelled("wbu_driver_get_brake_intensity", 0.0)
+    setGear = unmodelled("wbu_driver_set_gear", None)
+    getGear = unmodelled("wbu_driver_get_gear", 0)
+    getGearNumber = unmodelled("wbu_driver_get_gear_number", 0)
+    getRpm = unmodelled("wbu_driver_get_rpm", 0.0)
+    setIndicator = unmodelled("wbu_driver_set_indicator", None)
+    getIndicator = unmodelled("wbu_driver_get_indicator", INDICATOR_OFF)
+    setHazardFlashers = unmodelled("wbu_driver_set_hazard_flashers", None)
+    getHazardFlashers = unmodelled("wbu_driver_get_hazard_flashers", False)
+    setDippedBeams = unmodelled("wbu_driver_set_dipped_beams", None)
+    getDippedBeams = unmodelled("wbu_driver_get_dipped_beams", False)
+    setAntifogLights = unmodelled("wbu_driver_set_antifog_lights", None)
+    getAntifogLights = unmodelled("wbu_driver_get_antifog_lights", False)
+    setWiperMode = unmodelled("wbu_driver_set_wiper_mode", None)
+    getWiperMode = unmodelled("wbu_driver_get_wiper_mode", DOWN)
+
+    # Webots' properties
+    steering_angle = property(getSteeringAngle, setSteeringAngle)
+    target_cruising_speed = property(getTargetCruisingSpeed, setCruisingSpeed)
+    current_speed = property(getCurrentSpeed)
+    control_mode = property(getControlMode)

@@ -4,7 +4,8 @@ Flattening happens here: Pose/Transform/Group frames are composed into the poses
 devices and lights; a top-level Solid becomes a world solid, a Solid inside it one of its
 ``children``; everything inside a Robot (nested Solids, joint end points, device bodies) becomes a
 body shape or a device of the robot, placed relative to the robot. Two motorised HingeJoint wheels
-on one axle become the robot's kinematic ``differential_drive``.
+on one axle become the robot's kinematic ``differential_drive``; steered front wheels (vertical
+hinges or Hinge2Joints) and driven wheels its ``ackermann_drive`` (wbt/drive.py).
 
 Poses keep the file's exact axis-angle values when only one level rotates (so a converted world
 reads bit for bit like its hand-written twin); a pose composed of several rotations is written as
@@ -649,6 +650,7 @@ class Converter:
         skid = drive.get("skid_steer") or {}
         motors = [v for k, v in drive.items() if k in ("left_motor", "right_motor")] + [
             *skid.get("left", ()), *skid.get("right", ())]
+        motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
         seen: Counter[str] = Counter(v for v in motors if v not in listed)
         for dev in robot["devices"]:
             name = dev["name"]
@@ -734,11 +736,11 @@ class Converter:
                 self.warn(node, f"{node.type}.{written}: not read here (the device takes its default)")
         return out
 
-    def joint_devices(self, node: Node, owner: Owner) -> tuple[list[dict], list[dict]]:
-        """A joint's devices in its ``device`` order (Webots lists them before the end point's):
-        (motor entries, position sensor entries)."""
+    def joint_devices(self, node: Node, owner: Owner, field_name: str = "device") -> tuple[list[dict], list[dict]]:
+        """A joint's devices in its ``device`` (or a Hinge2Joint's ``device2``) order (Webots lists
+        them before the end point's): (motor entries, position sensor entries)."""
         motors, sensors = [], []
-        for d in self.fields(node).nodes("device"):
+        for d in self.fields(node).nodes(field_name):
             self.walk(d)
             self.tick(d)
             if d.type == "RotationalMotor":
@@ -765,10 +767,9 @@ class Converter:
         sensors: list[dict] = []
         if owner.kind == "robot":
             _, sensors = self.joint_devices(node, owner)
-        if owner.kind == "robot" and node.type == "Hinge2Joint" and motors:    # a steered wheel (a car)
-            owner.wheels.append({"node": node, "motor": self.fields(motors[0]).string("name", "rotational motor"),
-                                 "steers": True})
-        if owner.kind == "robot" and node.type == "HingeJoint" and motors:
+        if owner.kind == "robot" and node.type == "Hinge2Joint":    # a steered wheel (a car)
+            self.hinge2(node, frame, owner, motors, sensors)
+        elif owner.kind == "robot" and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
             if params is not None:
                 self.typos(params)
@@ -782,33 +783,78 @@ class Converter:
             turn = frame.rotation @ np.asarray(axis)
             owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"),
                                  "steers": abs(turn[2]) > 0.9 * float(np.linalg.norm(turn)),   # a vertical axis
-                                 "max_velocity": m.num("maxVelocity", 10.0),
+                                 "max_velocity": m.num("maxVelocity", 10.0), "limits": _limits(m),
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
         elif motors and node.type != "Hinge2Joint":
             self.warn(node, f"{node.type} motor(s) not part of a wheel: listed, not simulated (joints do not move here)")
-        if sensors and not (owner.kind == "robot" and node.type == "HingeJoint" and motors):
+        if sensors and not (owner.kind == "robot" and node.type in ("HingeJoint", "Hinge2Joint") and motors):
             self.warn(node, "PositionSensor on a joint without a drive wheel motor: listed, reads no value")
         if end is not None:
             if end.type == "SolidReference":
                 return
             self.visit(end, frame, owner)
 
+    def hinge2(self, node: Node, frame: Frame, owner: Owner, motors: list[Node], sensors: list[dict]) -> None:
+        """A Hinge2Joint of a robot: its first axis (``jointParameters``, ``device``) steers, its
+        second (``jointParameters2``, ``device2``) turns the wheel, its end point. Both become
+        entries of the robot's motorised hinges (the drive mapping judges them)."""
+        f = self.fields(node)
+        end = f.node_("endPoint")
+        spin_motors = [d for d in f.nodes("device2") if d.type in MOTORS]
+        _, spin_sensors = self.joint_devices(node, owner, "device2")
+        centre_at = (0.0, 0.0, 0.0)
+        if end is not None and end.type == "Solid":
+            centre_at = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
+        centre = np.asarray(frame.apply(centre_at))
+        for params_field, axis_default, found, found_sensors, steers in (
+                ("jointParameters", (1.0, 0.0, 0.0), motors, sensors, True),
+                ("jointParameters2", (0.0, 0.0, 1.0), spin_motors, spin_sensors, False)):
+            params = f.node_(params_field)
+            if params is not None:
+                self.typos(params)
+            pf = self.fields(params) if params is not None else None
+            axis = pf.vec("axis", axis_default) if pf else axis_default
+            anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf and params_field == "jointParameters" else None
+            if not found:
+                if found_sensors:
+                    self.warn(node, f"PositionSensor on a Hinge2Joint axis without a motor ({params_field}): "
+                                    "listed, reads no value")
+                continue
+            m = self.fields(found[0])
+            turn = frame.rotation @ np.asarray(axis)
+            owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"), "steers": steers,
+                                 "max_velocity": m.num("maxVelocity", 10.0), "limits": _limits(m), "axis": turn,
+                                 "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
+                                 "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
+
     def drive(self, node: Node, robot: Owner) -> None:
-        from sensorium.server.world.wbt.drive import differential_drive
+        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive
 
         wheels = robot.wheels
         if not wheels:
             return
-        drive, why = differential_drive(wheels, self)
-        if drive is None:
-            self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
-            return
-        robot.data["differential_drive"] = drive
+        if any(w["steers"] for w in wheels):      # a car
+            drive, why = ackermann_drive(wheels, self)
+            if drive is None:
+                self.warn(node, f"robot {robot.data['name']!r}: no Ackermann drive ({why}); the robot will not move")
+                return
+            robot.data["ackermann_drive"] = drive
+        else:
+            drive, why = differential_drive(wheels, self)
+            if drive is None:
+                self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
+                return
+            robot.data["differential_drive"] = drive
         for w in wheels:    # the wheels' encoders measure the drive's wheels
             for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]
+
+
+def _limits(motor) -> tuple[float, float]:
+    """A motor's (minPosition, maxPosition); (0, 0) is Webots' "no limits"."""
+    return motor.num("minPosition", 0.0), motor.num("maxPosition", 0.0)
 
 
 def _clean_part(p: dict) -> dict:

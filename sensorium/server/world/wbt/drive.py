@@ -9,8 +9,15 @@ every motorised hinge's axis along the robot's +y and wheels of one radius, and 
 * several wheels per side (skid steer, a Pioneer 3-AT): each side's wheels on one line parallel to
   x, the two lines at the same distance either side of the origin, the wheels' centre under it.
 
-A robot with steered wheels (a motorised hinge with a vertical axis, a Hinge2Joint: a car) is not
-driven. Anything else gets one sentence saying which of these failed.
+A robot with steered wheels (a motorised hinge with a vertical axis, a Hinge2Joint's first axis: a
+car) maps onto the kinematic ``ackermann_drive`` when its geometry is a car's as the world format
+has it: two steering joints on one line parallel to y at x = wheelbase > 0, symmetric about the
+robot's x axis, turning about one vertical axis direction (+z: positive steers left, -z: right);
+driven wheels (motorised hinges with their axis along +y) in pairs either side of the x axis, the
+front pair at the steering joints' x, the rear pair on the robot's y axis (the origin is the centre
+of the rear axle, as in Webots' cars); each axle's wheels of one radius.
+
+Anything else gets one sentence saying which of these failed.
 """
 
 from __future__ import annotations
@@ -20,10 +27,13 @@ import numpy as np
 from sensorium.server.world.wbt.parser import Node
 
 TOL = 1e-6
+AXIS_TOL = 1e-4     # a car's joint axes: Webots' car PROTOs turn their joints' frames by 1.5708 (not pi/2)
 
 
 def wheel_radius(end: Node | None, conv) -> float | None:
     """Radius of a wheel end point: its boundingObject's (else its visual) cylinder or sphere."""
+    while end is not None and end.type == "Slot":      # Webots' cars hold their wheels in Slots
+        end = conv.fields(end).node_("endPoint")
     if end is None:
         return None
     f = conv.fields(end)
@@ -52,11 +62,6 @@ def wheel_radius(end: Node | None, conv) -> float | None:
 def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     """The kinematic drive of a robot's motorised hinges (two wheels, or several per side: skid
     steer), or (None, the sentence saying why not)."""
-    steering = [w for w in wheels if w.get("steers")]
-    if steering:
-        names = ", ".join(repr(w["motor"]) for w in steering)
-        return None, (f"a car-like robot: motor(s) {names} steer (a vertical hinge axis or a Hinge2Joint); Sensorium's "
-                      "kinematic drives are two-wheel and skid-steer, a steered robot is not driven here")
     if len(wheels) < 2:
         return None, f"{len(wheels)} motorised hinge joint; a drive needs two wheels or more, on both sides"
     y = np.array([0.0, 1.0, 0.0])
@@ -136,3 +141,79 @@ def _skid_steer(wheels: list[dict], conv) -> tuple[dict | None, str]:
     return {"wheel_radius": r0, "axle_length": float(yl[0] - yr[0]), "max_wheel_speed": _max_speed(wheels, conv),
             "left_motor": left[0]["motor"], "right_motor": right[0]["motor"],
             "skid_steer": {"left": [w["motor"] for w in left[1:]], "right": [w["motor"] for w in right[1:]]}}, ""
+
+
+STEERING_UNLIMITED = 1.5
+"""rad: the steering limit of a steering motor without position limits (the world format needs one
+below pi/2, where the bicycle model's turn radius reaches 0)."""
+
+
+def ackermann_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
+    """The kinematic Ackermann drive of a car's motorised hinges, or (None, the sentence why not)."""
+    steering = [w for w in wheels if w["steers"]]
+    driven = [w for w in wheels if not w["steers"]]
+    names = ", ".join(repr(w["motor"]) for w in steering)
+    if len(steering) != 2:
+        return None, (f"a car-like robot needs two steered front wheels, it has {len(steering)} steering motor(s) "
+                      f"({names})")
+    z = np.array([0.0, 0.0, 1.0])
+    signs = []
+    for w in steering:
+        a = w["axis"] / np.linalg.norm(w["axis"])
+        if np.linalg.norm(np.abs(a) - z) > AXIS_TOL:
+            return None, (f"the steering axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not vertical "
+                          "(the robot's z axis)")
+        signs.append(a[2] > 0)
+    if signs[0] != signs[1]:
+        return None, f"the steering motors {names} turn about opposite axes (one +z, one -z)"
+    a0, a1 = steering[0]["anchor"], steering[1]["anchor"]
+    if abs(a0[0] - a1[0]) > TOL or abs(a0[1] + a1[1]) > TOL or abs(a0[1]) <= TOL:
+        return None, (f"the steering joints of {names} are not on one front axle parallel to the robot's y axis, "
+                      "symmetric about its x axis")
+    wheelbase = float(a0[0])
+    if wheelbase <= TOL:
+        return None, (f"the steering joints are at x={wheelbase:g}, not ahead of the robot's origin (the origin is "
+                      "the centre of the rear axle)")
+    right_steer, left_steer = (steering[0], steering[1]) if a0[1] < 0 else (steering[1], steering[0])
+    for w in driven:
+        a = w["axis"] / np.linalg.norm(w["axis"])
+        if np.linalg.norm(a - np.array([0.0, 1.0, 0.0])) > AXIS_TOL:
+            return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not the robot's +y "
+                          "(positive wheel speeds must drive forward)")
+    front = [w for w in driven if abs(w["centre"][0] - wheelbase) <= TOL]
+    rear = [w for w in driven if abs(w["centre"][0]) <= TOL]
+    if len(front) + len(rear) != len(driven) or len(front) not in (0, 2) or len(rear) not in (0, 2) or not driven:
+        where = ", ".join(f"{w['motor']!r} at x={w['centre'][0]:g}" for w in driven) or "none"
+        return None, (f"the driven wheels ({where}) are not a pair on the front axle (x={wheelbase:g}), a pair on the "
+                      "rear axle under the robot's origin (x=0), or both")
+    out: dict = {"wheelbase": wheelbase, "track_front": float(abs(a0[1] - a1[1])),
+                 "type": "4x4" if front and rear else "traction" if front else "propulsion",
+                 "positive_steers": "left" if signs[0] else "right",
+                 "right_steer": right_steer["motor"], "left_steer": left_steer["motor"]}
+    radii = {}
+    for axle, pair in (("front", front), ("rear", rear)):
+        if not pair:
+            continue
+        c0, c1 = pair[0]["centre"], pair[1]["centre"]
+        if abs(c0[1] + c1[1]) > TOL or abs(c0[1]) <= TOL:
+            return None, f"the {axle} wheels are not either side of the robot's x axis at the same distance"
+        r, why = _radius(pair, conv)
+        if r is None:
+            return None, f"{axle} wheels: {why}"
+        radii[axle] = r
+        right, left = (pair[0], pair[1]) if c0[1] < 0 else (pair[1], pair[0])
+        out[f"right_{axle}_wheel"], out[f"left_{axle}_wheel"] = right["motor"], left["motor"]
+        if axle == "rear":
+            out["track_rear"] = float(abs(c0[1] - c1[1]))
+    if "front" not in radii:            # the steered wheels' own end points (a Hinge2Joint's wheel)
+        r, _ = _radius(steering, conv)
+        radii["front"] = r if r is not None else radii["rear"]
+    out["front_wheel_radius"], out["rear_wheel_radius"] = radii["front"], radii.get("rear", radii["front"])
+    out.setdefault("track_rear", out["track_front"])
+    out["max_wheel_speed"] = _max_speed(driven, conv)
+    out["max_steering_speed"] = _max_speed(steering, conv)
+    limits = [abs(v) for w in steering for v in w["limits"] if w["limits"] != (0.0, 0.0)]
+    out["max_steering_angle"] = min([*limits, STEERING_UNLIMITED]) if limits else STEERING_UNLIMITED
+    if out["max_steering_angle"] == 0.0:
+        return None, f"the steering motors {names} have a position limit of 0 (they cannot steer)"
+    return out, ""

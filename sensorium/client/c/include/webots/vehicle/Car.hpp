@@ -1,5 +1,5 @@
-// Sensorium C++ controller layer: Car over vehicle/car.h. Not simulated by Sensorium (see Driver.hpp):
-// constructing a Car prints wbu_car_init()'s one line and ends the process with status 1.
+// Sensorium C++ controller layer: Car over vehicle/car.h (see Driver.hpp): constructing a Car on a
+// robot that is not a car prints wbu_car_init()'s one line and ends the process with status 1.
 #ifndef WEBOTS_CAR_HPP
 #define WEBOTS_CAR_HPP
 

@@ -1,7 +1,7 @@
-// Sensorium C++ controller layer: Driver over vehicle/driver.h. Sensorium does not simulate Webots'
-// vehicle library (its robots move by two-wheel or skid-steer drives only): constructing a Driver (or
-// a Car) prints one line saying so and ends the process with status 1 before any connection, since
-// wbu_driver_init() runs before the Supervisor base attaches to a robot.
+// Sensorium C++ controller layer: Driver over vehicle/driver.h (a car-like robot's ackermann_drive).
+// wbu_driver_init() runs before the Supervisor base is built: it attaches to the robot itself (the
+// base's wb_robot_init() then finds it attached) and, on a robot that is not a car, prints one line
+// and ends the process with status 1.
 #ifndef WEBOTS_DRIVER_HPP
 #define WEBOTS_DRIVER_HPP
 
@@ -12,7 +12,7 @@ namespace webots {
 
 namespace internal {
 // A base constructed before Supervisor (bases are built in declaration order): runs the vehicle
-// library's init, which refuses, before wb_robot_init() would look for a server.
+// library's init (which attaches, or refuses a robot that is not a car) first.
 struct VehicleInit {
   explicit VehicleInit(void (*init)(void)) { init(); }
 };

@@ -1,7 +1,8 @@
 /* Sensorium C controller library: Webots' car library (vehicle/car.h, for the Car PROTO and its
- * descendants). Sensorium does not simulate it (see vehicle/driver.h): wbu_car_init() prints one line
- * saying why and exits with status 1; the other functions do nothing and answer Webots' "no value"
- * (NaN, false, the first enumerator). */
+ * descendants) over a car-like robot's ackermann_drive (see vehicle/driver.h): its type, geometry,
+ * front wheels' angles, wheel encoders and speeds. Engine type, indicator period and lights print one
+ * line the first time and answer Webots' "no value"; wbu_car_init() on a robot that is not a car
+ * prints one line and exits with status 1. */
 #ifndef WBU_CAR_H
 #define WBU_CAR_H
 

@@ -1,10 +1,9 @@
 /* Sensorium C controller library: Webots' driver library (vehicle/driver.h, for the Car PROTO and its
- * descendants). Sensorium does not simulate it: its robots move kinematically by two-wheel or
- * skid-steer drives only, and a car's steered wheels, engine and gearbox are not driven.
- * wbu_driver_init() prints one line saying so and exits with status 1 (before any connection: no
- * server is needed, nothing hangs). wbu_driver_initialization_is_possible() is false. The other
- * functions, reachable only without wbu_driver_init(), do nothing and answer Webots' "no value" (NaN,
- * 0, false, the first enumerator; wbu_driver_step(): -1, the end of the simulation). */
+ * descendants) over a car-like robot's motors (the world's ackermann_drive; src/vehicle.c): steering
+ * angle and cruising speed as Webots computes them. No engine, gearbox, brakes, lights or wipers:
+ * those functions print one line the first time and answer Webots' "no value". wbu_driver_init() on
+ * a robot without an ackermann_drive prints one line and exits with status 1. Before init every
+ * function answers "no value" (NaN, 0, false, the first enumerator; wbu_driver_step(): -1). */
 #ifndef WBU_DRIVER_H
 #define WBU_DRIVER_H
 

@@ -1,0 +1,128 @@
+"""Webots' vehicle library (``from vehicle import Driver, Car``) on a car-like robot: a controller
+written in Webots' style runs unchanged against ``sensorium serve`` and the car follows the
+closed-form circle of its steering angle and cruising speed; the Car read-outs; the engine-model
+functions say once that they are not simulated; a robot that is not a car ends the controller with
+one line. Slow: a server and controllers as processes."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from tests._serve import Proc, sensorium, serve
+
+L, T, R = 2.6, 1.5, 0.35
+WORLD = f"""
+world_info: {{basic_time_step: 16}}
+robots:
+  - name: car
+    body: {{geometry: {{type: box, size: [4.2, 1.8, 1.2]}}}}
+    ackermann_drive: {{wheelbase: {L}, track_front: {T}, track_rear: {T}, front_wheel_radius: 0.3,
+                      rear_wheel_radius: {R}, type: propulsion, max_steering_angle: 0.6, max_steering_speed: 100}}
+    devices:
+      - {{device: PositionSensor, name: right_steer_sensor, motor: right_steer}}
+      - {{device: PositionSensor, name: left_steer_sensor, motor: left_steer}}
+      - {{device: PositionSensor, name: right_rear_sensor, motor: right_rear_wheel}}
+      - {{device: PositionSensor, name: left_rear_sensor, motor: left_rear_wheel}}
+  - name: bot
+    synchronization: false
+    pose: {{translation: [0, 30, 0]}}
+    differential_drive: {{}}
+"""
+
+# a controller as a Webots user writes one (only the stop after 400 steps and the prints are the test's)
+DRIVER = """\
+from vehicle import Driver
+
+driver = Driver()
+driver.setSteeringAngle(0.2)
+driver.setCruisingSpeed(20)
+driver.setThrottle(0.5)
+driver.setThrottle(0.7)
+steps = 0
+while driver.step() != -1:
+    steps += 1
+    if steps == 400:
+        break
+print(driver.getCurrentSpeed(), driver.getTargetCruisingSpeed(), driver.getSteeringAngle(), driver.getTime(),
+      driver.getControlMode() == Driver.SPEED, driver.getGear(), flush=True)
+"""
+
+CAR = """\
+from vehicle import Car
+
+car = Car()
+car.step()
+print(car.getType() == Car.PROPULSION, car.getWheelbase(), car.getTrackFront(), car.getFrontWheelRadius(),
+      car.getRearWheelRadius(), flush=True)
+car.setCruisingSpeed(-9)
+car.setSteeringAngle(-0.3)
+for _ in range(3):
+    car.step()
+print(car.getRightSteeringAngle(), car.getLeftSteeringAngle(), car.getWheelSpeed(Car.WHEEL_REAR_LEFT),
+      car.getWheelSpeed(Car.WHEEL_FRONT_LEFT), car.getWheelEncoder(Car.WHEEL_REAR_RIGHT), flush=True)
+"""
+
+
+def _run(server, tmp_path: Path, name: str, source: str, robot: str = "car") -> Proc:
+    script = tmp_path / f"{name}.py"
+    script.write_text(source)
+    proc = Proc(sensorium("controller", str(script), "--url", server.url(robot)))
+    assert proc.wait(120) is not None
+    return proc
+
+
+def _ackermann(delta: float) -> tuple[float, float]:
+    cot, half = 1 / math.tan(delta), T / (2 * L)
+    return math.atan(1 / (cot - half)), math.atan(1 / (cot + half))
+
+
+def test_a_webots_driver_controller_drives_the_closed_form_circle(tmp_path: Path) -> None:
+    world = tmp_path / "car.yaml"
+    world.write_text(WORLD)
+    with serve(world, "--mode", "fast", "--heartbeat-ms", "500") as server:
+        proc = _run(server, tmp_path, "driver", DRIVER)
+        assert proc.returncode == 0, proc.stderr()
+        speed, target, angle, t, mode, gear = proc.stdout().split()
+        assert float(speed) == pytest.approx(20.0, abs=1e-9) and float(target) == 20.0
+        right, left = _ackermann(0.2)
+        assert float(angle) == pytest.approx((right + left) / 2, abs=1e-12)   # Webots: the encoders' mean
+        assert mode == "True" and gear == "0"
+        assert proc.stderr().count("wbu_driver_set_throttle(): not simulated") == 1
+        pose = server.conn.call("/car/robot/get_pose")
+        time_ms = server.conn.call("get_info")["time_ms"]
+    assert float(t) * 1000 == pytest.approx(time_ms)
+    # from its first step the car steers at Webots' angles (steering fast enough to settle in it) and its
+    # rear axle's centre rolls at 20 km/h: a circle of radius L/tan(0.2) about (0, -radius), clockwise
+    radius = L / math.tan(0.2)
+    phi = 20 / 3.6 * time_ms / 1000 / radius
+    x, y, _ = pose["translation"]
+    assert (x, y) == pytest.approx((radius * math.sin(phi), -radius + radius * math.cos(phi)), abs=1e-9)
+    qx, qy, qz, qw = pose["quaternion"]
+    assert math.remainder(2 * math.atan2(qz, qw) + phi, 2 * math.pi) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_car_read_outs_and_a_robot_that_is_not_a_car(tmp_path: Path) -> None:
+    world = tmp_path / "car.yaml"
+    world.write_text(WORLD)
+    with serve(world, "--mode", "fast", "--heartbeat-ms", "500") as server:
+        proc = _run(server, tmp_path, "car", CAR)
+        assert proc.returncode == 0, proc.stderr()
+        first, second = proc.stdout().splitlines()
+        assert first.split() == ["True", str(L), str(T), "0.3", str(R)]
+        right, left = (float(v) for v in second.split()[:2])
+        assert (right, left) == pytest.approx(_ackermann(-0.3), abs=1e-12)
+        # reversing at 9 km/h while turning left: the rear left wheel is the inner one (Webots' rear differential)
+        r = L / math.tan(-0.3)
+        inner = 2 * -9 * (r + T / 2) / (2 * r) / 3.6 / R
+        assert float(second.split()[2]) == pytest.approx(inner, rel=1e-12)
+        assert second.split()[3] == "nan" and float(second.split()[4]) < 0      # no front motor; rolled backwards
+        refused = _run(server, tmp_path, "bot", "from vehicle import Driver\nDriver()\nprint('constructed')\n",
+                       robot="bot")
+    assert refused.returncode == 1 and refused.stdout() == ""
+    assert refused.stderr().strip().splitlines()[-1] == (
+        "Error: Driver(): robot 'bot' has no ackermann_drive: Sensorium's vehicle library drives a car-like robot "
+        "whose world entry has one (README \"World files\"; a .wbt car is mapped when its steering and wheel joints "
+        "are a car's).")

@@ -1,0 +1,144 @@
+"""A car written in a .wbt (our own nodes: Robot, Hinge2Joint/HingeJoint, Solid wheels) maps onto the
+kinematic ``ackermann_drive`` and drives the closed-form circle; a car whose geometry is not the
+drive's gets one line saying why."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.motion import ackermann_angles
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+HEADER = "#VRML_SIM R2023b utf8\n"
+L, T, R = 2.6, 1.5, 0.35          # wheelbase, track, wheel radius
+
+
+def write(tmp_path: Path, body: str) -> Path:
+    p = tmp_path / "car.wbt"
+    p.write_text(HEADER + "WorldInfo { basicTimeStep 16 }\n" + body)
+    return p
+
+
+def solid_wheel(x: float, y: float) -> str:
+    return (f'Solid {{ translation {x} {y} {R} rotation 1 0 0 1.5708 children [ DEF W Shape {{ geometry '
+            f'Cylinder {{ radius {R} height 0.2 }} }} ] boundingObject USE W }}')
+
+
+def rear_wheel(name: str, y: float, x: float = 0.0, axis: str = "0 1 0") -> str:
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor {x} {y} {R} }} '
+            f'device [ RotationalMotor {{ name "{name}" maxVelocity 80 }} '
+            f'PositionSensor {{ name "{name.replace("wheel", "sensor")}" }} ] endPoint {solid_wheel(x, y)} }}\n')
+
+
+def hinge2_front(side: str, y: float, axis: str = "0 0 -1", limit: float = 0.6, x: float = L) -> str:
+    return (f'Hinge2Joint {{ jointParameters HingeJointParameters {{ axis {axis} anchor {x} {y} {R} }} '
+            f'jointParameters2 JointParameters {{ axis 0 1 0 }} '
+            f'device [ RotationalMotor {{ name "{side}_steer" minPosition {-limit} maxPosition {limit} maxVelocity 5 }} '
+            f'PositionSensor {{ name "{side}_steer_sensor" }} ] endPoint {solid_wheel(x, y)} }}\n')
+
+
+def car(front: str, rear: str = rear_wheel("right_rear_wheel", -T / 2) + rear_wheel("left_rear_wheel", T / 2)) -> str:
+    return ('Robot { name "car" controller "<extern>" children [\n'
+            '  Pose { translation 1.3 0 0.6 children [ Shape { geometry Box { size 4 1.6 0.6 } } ] }\n'
+            + front + rear + '] }\n')
+
+
+HINGE2_CAR = car(hinge2_front("right", -T / 2) + hinge2_front("left", T / 2))
+
+
+def test_a_hinge2_car_maps_to_the_ackermann_drive_and_drives_the_circle(tmp_path: Path) -> None:
+    w = load_world(write(tmp_path, HINGE2_CAR))
+    assert not [x for x in w.warnings if "drive" in x]
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive == wm.AckermannDrive(
+        wheelbase=L, track_front=T, track_rear=T, front_wheel_radius=R, rear_wheel_radius=R, type="propulsion",
+        max_wheel_speed=80.0, max_steering_angle=0.6, max_steering_speed=5.0, positive_steers="right")
+    sensors = {d.name: d.motor for d in robot.devices if d.device == "PositionSensor"}
+    assert sensors == {"right_steer_sensor": "right_steer", "left_steer_sensor": "left_steer",
+                       "right_rear_sensor": "right_rear_wheel", "left_rear_sensor": "left_rear_wheel"}
+    sim = Simulation(w)
+    r = sim.robot("car")
+    delta = 0.2
+    right, left = ackermann_angles(delta, L, T)
+    r.motor("right_steer").set_position(right)
+    r.motor("left_steer").set_position(left)
+    sim.run(10)
+    for name in ("right_rear_wheel", "left_rear_wheel"):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(30.0)
+    n = 500
+    sim.run(n)
+    radius, phi = L / math.tan(delta), R * 30.0 * n * 0.016 / (L / math.tan(delta))
+    p = r.pose.translation
+    assert (p[0], p[1]) == pytest.approx((radius * math.sin(phi), -radius + radius * math.cos(phi)), abs=1e-9)
+
+
+def test_wheels_in_slots_and_turned_joint_frames_as_webots_cars_have_them(tmp_path: Path) -> None:
+    # Webots' AckermannVehicle: each joint in a Transform turned about z, its wheel in a Slot, axes in that frame
+    def joint(kind: str, x: float, y: float, turn: float, axis: str, device: str, axis2: str = "") -> str:
+        params = (f'jointParameters HingeJointParameters {{ axis {axis} }} '
+                  + (f'jointParameters2 JointParameters {{ axis {axis2} }} ' if axis2 else ''))
+        wheel = (f'Solid {{ rotation 0 1 0 1.5708 children [ DEF S Shape {{ geometry Cylinder {{ radius {R} height 0.2 }} '
+                 f'}} ] boundingObject USE S }}')
+        return (f'Transform {{ translation {x} {y} 0 rotation 0 0 1 {turn} children [ {kind} {{ {params}'
+                f'device [ RotationalMotor {{ name "{device}" minPosition -0.5 maxPosition 0.5 }} ] '
+                f'endPoint Slot {{ endPoint {wheel} }} }} ] }}\n')
+    front = (joint("Hinge2Joint", L, T / 2, -1.5708, "0 0 -1", "left_steer", "-1 0 0")
+             + joint("Hinge2Joint", L, -T / 2, 1.5708, "0 0 -1", "right_steer", "1 0 0"))
+    rear = (joint("HingeJoint", 0, T / 2, -1.5708, "-1 0 0", "left_rear_wheel")
+            + joint("HingeJoint", 0, -T / 2, 1.5708, "1 0 0", "right_rear_wheel"))
+    w = load_world(write(tmp_path, car(front, rear)))
+    assert not [x for x in w.warnings if "drive" in x]
+    d = w.world.robots[0].ackermann_drive
+    assert d is not None
+    assert d.wheelbase == pytest.approx(L) and d.track_front == pytest.approx(T) and d.track_rear == pytest.approx(T)
+    assert (d.type, d.positive_steers, d.max_steering_angle, d.rear_wheel_radius) == ("propulsion", "right", 0.5, R)
+
+
+def test_vertical_steering_hinges_carrying_driven_wheels_make_a_front_wheel_drive(tmp_path: Path) -> None:
+    def front(side: str, y: float) -> str:         # a steering hinge whose end point holds the motorised wheel hinge
+        return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor {L} {y} {R} }} '
+                f'device [ RotationalMotor {{ name "{side} steer" maxVelocity 4 }} ] '
+                f'endPoint Solid {{ translation {L} {y} {R} children [ HingeJoint {{ jointParameters '
+                f'HingeJointParameters {{ axis 0 1 0 }} device [ RotationalMotor {{ name "{side} wheel" maxVelocity 50 }} ] '
+                f'endPoint Solid {{ rotation 1 0 0 1.5708 children [ DEF F Shape {{ geometry Cylinder {{ radius 0.3 '
+                f'height 0.2 }} }} ] boundingObject USE F }} }} ] }} }}\n')
+    w = load_world(write(tmp_path, car(front("right", -T / 2) + front("left", T / 2), rear="")))
+    assert not [x for x in w.warnings if "drive" in x]
+    d = w.world.robots[0].ackermann_drive
+    assert d is not None and (d.type, d.positive_steers, d.front_wheel_radius, d.rear_wheel_radius) == (
+        "traction", "left", 0.3, 0.3)
+    assert (d.right_steer, d.left_steer, d.right_front_wheel, d.left_front_wheel) == (
+        "right steer", "left steer", "right wheel", "left wheel")
+    assert d.max_steering_angle == 1.5 and d.max_steering_speed == 4.0 and d.max_wheel_speed == 50.0
+
+
+@pytest.mark.parametrize("body, why", [
+    (car(hinge2_front("left", T / 2)),
+     "a car-like robot needs two steered front wheels, it has 1 steering motor(s) ('left_steer')"),
+    (car(hinge2_front("right", -T / 2, axis="0 0.2 -1") + hinge2_front("left", T / 2)),
+     "the steering axis of motor 'right_steer' is [0.0, 0.196116, -0.980581], not vertical (the robot's z axis)"),
+    (car(hinge2_front("right", -T / 2, axis="0 0 1") + hinge2_front("left", T / 2)),
+     "the steering motors 'right_steer', 'left_steer' turn about opposite axes (one +z, one -z)"),
+    (car(hinge2_front("right", -T / 2, x=-L) + hinge2_front("left", T / 2, x=-L)),
+     "the steering joints are at x=-2.6, not ahead of the robot's origin (the origin is the centre of the rear axle)"),
+    (car(hinge2_front("right", -T / 2) + hinge2_front("left", T / 2),
+         rear_wheel("right_rear_wheel", -T / 2, x=-0.4) + rear_wheel("left_rear_wheel", T / 2, x=-0.4)),
+     "the driven wheels ('right_rear_wheel' at x=-0.4, 'left_rear_wheel' at x=-0.4) are not a pair on the front axle "
+     "(x=2.6), a pair on the rear axle under the robot's origin (x=0), or both"),
+    (car(hinge2_front("right", -T / 2) + hinge2_front("left", T / 2),
+         rear_wheel("right_rear_wheel", -T / 2, axis="0 -1 0") + rear_wheel("left_rear_wheel", T / 2)),
+     "wheel axis of motor 'right_rear_wheel' is [0.0, -1.0, 0.0], not the robot's +y (positive wheel speeds must "
+     "drive forward)"),
+])
+def test_a_car_that_is_not_the_drives_gets_one_line(tmp_path: Path, body: str, why: str) -> None:
+    p = write(tmp_path, body)
+    w = load_world(p)
+    assert w.world.robots[0].ackermann_drive is None and w.world.robots[0].differential_drive is None
+    (line,) = [x for x in w.warnings if "Ackermann" in x]
+    assert line == f"{p}:3:1: robot 'car': no Ackermann drive ({why}); the robot will not move"
