@@ -107,29 +107,6 @@ def _role_router_raw(endpoint: str) -> None:
     ctx.term()
 
 
-def _role_dealer_raw(endpoint: str) -> None:
-    """A raw DEALER ping-pong of a step request's bytes (no msgpack), against ``router-raw``."""
-    import msgpack
-    import zmq
-
-    ctx = zmq.Context()
-    s = ctx.socket(zmq.DEALER)
-    s.connect(endpoint)
-    msg = msgpack.packb({"id": 1, "service": "/c0/robot/step", "args": {"duration": 8}}, use_bin_type=True)
-
-    def call():
-        s.send(msg)
-        s.recv()
-
-    def close():
-        s.send(b"quit")
-        s.recv()
-        s.close(0)
-        ctx.term()
-
-    _chunks(call, close)
-
-
 def _chunks(call, close) -> None:
     """Serve timing requests from stdin: 'run K' → K timed calls, printed as a JSON list of
     seconds; anything else → ``close()`` and stop. (Lets the parent interleave several clients.)"""
@@ -185,17 +162,29 @@ def _role_dealer_client(endpoint: str) -> None:
     _chunks(call, close)
 
 
+# a step request's bytes, as the raw floors send them (never decoded: they echo)
+STEP_BYTES = b"\x83\xa2id\x01\xa7service\xae/c0/robot/step\xa4args\x81\xa8duration\x08"
+
+
 def _role_req(endpoint: str) -> None:
-    """Raw pyzmq REQ ping-pong of a step request's size."""
+    """Raw pyzmq REQ ping-pong of a step request's bytes (the floor)."""
+    _raw_ping_pong(endpoint, "REQ")
+
+
+def _role_dealer_raw(endpoint: str) -> None:
+    """The same ping-pong from a raw DEALER (no msgpack), against ``router-raw``."""
+    _raw_ping_pong(endpoint, "DEALER")
+
+
+def _raw_ping_pong(endpoint: str, socket_type: str) -> None:
     import zmq
 
     ctx = zmq.Context()
-    s = ctx.socket(zmq.REQ)
+    s = ctx.socket(getattr(zmq, socket_type))
     s.connect(endpoint)
-    msg = b"\x83\xa2id\x01\xa7service\xaa/c0/robot/step\xa4args\x81\xa8duration\x08"
 
     def call():
-        s.send(msg)
+        s.send(STEP_BYTES)
         s.recv()
 
     def close():
@@ -335,7 +324,7 @@ def _role_raw_controller(endpoint: str, steps: str) -> None:
     ctx = zmq.Context()
     s = ctx.socket(zmq.REQ)
     s.connect(endpoint)
-    msg = b"\x83\xa2id\x01\xa7service\xaa/c0/robot/step\xa4args\x81\xa8duration\x08"
+    msg = STEP_BYTES
     for _ in range(50):
         s.send(msg)
         s.recv()
