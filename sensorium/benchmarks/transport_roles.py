@@ -69,28 +69,25 @@ def _role_router_echo(endpoint: str) -> None:
     """A minimal Python msgpack server on a ROUTER: answer every request with a step-like ok reply.
     With the client library on the other end, it is the floor of a Python request/reply round trip."""
     import msgpack
-    import zmq
 
-    ctx = zmq.Context()
-    s = ctx.socket(zmq.ROUTER)
-    print(f"ready {_bind(s, endpoint)}", flush=True)
-    poller = zmq.Poller()
-    poller.register(s, zmq.POLLIN)
-    while poller.poll(IDLE_MS):
-        frames = s.recv_multipart()
-        req = msgpack.unpackb(frames[-1], raw=False)
+    def answer(body: bytes) -> tuple[bytes | None, bool]:
+        req = msgpack.unpackb(body, raw=False)
         if req.get("service") == "quit":
-            break
-        body = msgpack.packb({"id": req["id"], "ok": True, "result": {"status": 0, "time_ms": 0, "values": {}}},
-                             use_bin_type=True)
-        s.send_multipart(frames[:-1] + [body])
-    s.close(0)
-    ctx.term()
+            return None, True
+        return msgpack.packb({"id": req["id"], "ok": True, "result": {"status": 0, "time_ms": 0, "values": {}}},
+                             use_bin_type=True), False
+
+    _serve_router(endpoint, answer)
 
 
 def _role_router_raw(endpoint: str) -> None:
-    """Raw pyzmq ROUTER echo: every message's frames sent back as received (no msgpack): the
-    request/reply floor of the socket pattern a multi-client server needs, beside REQ ↔ REP's."""
+    """Raw pyzmq ROUTER echo: every message sent back as received (no msgpack): the request/reply
+    floor of the socket pattern a multi-client server needs, beside REQ ↔ REP's."""
+    _serve_router(endpoint, lambda body: (body, body == b"quit"))
+
+
+def _serve_router(endpoint: str, answer) -> None:
+    """A ROUTER answering each request's last frame with ``answer(body)`` = (reply or None, stop)."""
     import zmq
 
     ctx = zmq.Context()
@@ -100,8 +97,10 @@ def _role_router_raw(endpoint: str) -> None:
     poller.register(s, zmq.POLLIN)
     while poller.poll(IDLE_MS):
         frames = s.recv_multipart()
-        s.send_multipart(frames)
-        if frames[-1] == b"quit":
+        reply, stop = answer(frames[-1])
+        if reply is not None:
+            s.send_multipart(frames[:-1] + [reply])
+        if stop:
             break
     s.close(0)
     ctx.term()
