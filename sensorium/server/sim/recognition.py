@@ -13,7 +13,8 @@ occlusion test needs (Webots' ``occlusion`` field):
 An object's box is, for a planar camera, that of its part in view (Webots clips each shape to the
 view first; a non-planar camera's boxes are whole). An object is in range when that box reaches in
 front of the camera and starts before ``max_range`` (in depth). ``max_objects`` (> 0) keeps the biggest
-on the image (``size_on_image`` area; ties in id order). The segmentation image: each pixel whose ray's first visible surface belongs to a
+on the image (``size_on_image`` area), listed biggest first as Webots does (ties in id order); otherwise
+objects come in id order. The segmentation image: each pixel whose ray's first visible surface belongs to a
 recognisable object within ``max_range`` (depth for a planar camera) has the object's first
 recognition colour, the rest black; alpha 255.
 """
@@ -164,7 +165,7 @@ class Recognizer:
                                         obj.model))
         if c.max_objects > 0 and len(out) > c.max_objects:     # Webots: -1 and 0 keep every object
             keep = sorted(range(len(out)), key=lambda i: -out[i].size_on_image[0] * out[i].size_on_image[1])
-            out = [out[i] for i in sorted(keep[:c.max_objects])]
+            out = [out[i] for i in keep[:c.max_objects]]      # biggest first, as Webots lists them then
         return out
 
     def _centre_visible(self, k: int, cam: Pose, centre: np.ndarray, counters: Any) -> bool:
