@@ -166,7 +166,7 @@ def clip_points(points: np.ndarray, f: Frustum) -> tuple[np.ndarray, np.ndarray]
     """``(lo, hi)`` of a shape's camera-frame points (N, 3) clipped to the view (see the module
     docstring), None when the shape is not in view."""
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    front = p[p[:, 0] > 0.0].copy()
+    front = p[p[:, 0] > 0.0]                     # (a boolean index copies)
     if not len(front):
         return None
     outside = np.zeros((len(front), 4), dtype=bool)
@@ -205,11 +205,15 @@ def clip_round(lo: np.ndarray, hi: np.ndarray, f: Frustum) -> tuple[np.ndarray, 
     return c - half, c + half
 
 
-def clipped_bounds(kind: str, params: tuple, rotation: np.ndarray, centre: np.ndarray,
-                   points: np.ndarray | None, f: Frustum) -> tuple[np.ndarray, np.ndarray] | None:
-    """``shape_bounds`` of the shape's part in view (``f``); None when out of view or unbounded."""
-    if kind in ("sphere", "cylinder", "capsule"):
-        b = shape_bounds(kind, params, rotation, centre)
-        return None if b is None else clip_round(b[0], b[1], f)
-    pts = _shape_points(kind, params, np.asarray(rotation, dtype=np.float64), np.asarray(centre, dtype=np.float64), points)
-    return None if pts is None else clip_points(pts, f)
+def clipped_bounds(kind: str, params: tuple, rotation: np.ndarray, centre: np.ndarray, points: np.ndarray | None,
+                   f: Frustum | None) -> tuple[tuple[np.ndarray, np.ndarray] | None, tuple[np.ndarray, np.ndarray] | None]:
+    """``(whole, seen)``: the shape's ``shape_bounds`` and those of its part in view (``f``; the whole
+    box when ``f`` is None), from one placing of its points; ``seen`` None when the shape is out of
+    view, both None when it is unbounded."""
+    R, c = np.asarray(rotation, dtype=np.float64), np.asarray(centre, dtype=np.float64)
+    pts = _shape_points(kind, params, R, c, points)
+    if pts is not None:
+        whole = pts.min(axis=0), pts.max(axis=0)
+        return whole, (whole if f is None else clip_points(pts, f))
+    whole = shape_bounds(kind, params, R, c)               # a sphere, cylinder or capsule (or unbounded)
+    return whole, (whole if whole is None or f is None else clip_round(whole[0], whole[1], f))

@@ -129,11 +129,10 @@ class Recognizer:
                 return None
             pose = owner.compose(local)
             rotation, centre = inv @ pose.rotation, inv @ (pose.translation - cam.translation)
-            whole = rmath.shape_bounds(kind, params, rotation, centre, points)
+            whole, b = rmath.clipped_bounds(kind, params, rotation, centre, points, self.frustum)
             if whole is None:
                 continue
             whole_lo, whole_hi = np.minimum(whole_lo, whole[0]), np.maximum(whole_hi, whole[1])
-            b = whole if self.frustum is None else rmath.clipped_bounds(kind, params, rotation, centre, points, self.frustum)
             if b is not None:
                 lo, hi = np.minimum(lo, b[0]), np.maximum(hi, b[1])
         return (lo, hi, (whole_lo + whole_hi) / 2.0) if np.isfinite(lo).all() else None
