@@ -9,9 +9,9 @@ import math
 
 import pytest
 
+from sensorium.client.webots.vehicle.driver import ackermann_angles
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation
-from sensorium.server.sim.motion import ackermann_angles
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import WorldError, parse_world
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from sensorium.client.webots.vehicle.driver import ackermann_angles
 from sensorium.schemas import world as wm
-from sensorium.server.sim.motion import ackermann_angles
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 

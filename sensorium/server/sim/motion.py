@@ -161,10 +161,6 @@ class DifferentialDrive(PlanarState):
     def motors(self) -> dict[str, WheelMotor]:
         return {m.name: m for m in (*self.lefts, *self.rights)}
 
-    @property
-    def moving(self) -> bool:
-        return any(m.velocity != 0.0 for m in (*self.lefts, *self.rights))
-
     def step(self, dt_ms: int) -> Pose | None:
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
         dt = dt_ms / 1000.0
@@ -179,17 +175,6 @@ class DifferentialDrive(PlanarState):
         w = self.wheel_radius * (wr - wl) / self.axle_length
         self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
         return self.pose()
-
-
-def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float) -> tuple[float, float]:
-    """(right, left) front wheel angles for a bicycle-model steering angle (positive: to the right),
-    so that both wheels turn about one centre on the rear axle's line (Webots' Driver: Jazar, Vehicle
-    Dynamics, 2009): cot δ_right = cot δ - t/2L, cot δ_left = cot δ + t/2L."""
-    if steering_angle == 0.0:
-        return 0.0, 0.0
-    cot = 1.0 / math.tan(steering_angle)
-    half = track_front / (2.0 * wheelbase)
-    return math.atan(1.0 / (cot - half)), math.atan(1.0 / (cot + half))
 
 
 class AckermannDrive(PlanarState):
@@ -208,10 +193,9 @@ class AckermannDrive(PlanarState):
         self.wheelbase = float(config.wheelbase)
         self.track_front, self.track_rear = float(config.track_front), float(config.track_rear)
         self.sign = 1.0 if config.positive_steers == "right" else -1.0
-        self.right_steer = SteeringMotor(config.right_steer, float(config.max_steering_speed))
-        self.left_steer = SteeringMotor(config.left_steer, float(config.max_steering_speed))
-        for m in (self.right_steer, self.left_steer):
-            m.max_position = float(config.max_steering_angle)
+        limit, steer_speed = float(config.max_steering_angle), float(config.max_steering_speed)
+        self.right_steer = SteeringMotor(config.right_steer, steer_speed, max_position=limit)
+        self.left_steer = SteeringMotor(config.left_steer, steer_speed, max_position=limit)
         speed = float(config.max_wheel_speed)
         L, rf, rr = self.wheelbase, float(config.front_wheel_radius), float(config.rear_wheel_radius)
         place = {"right_front_wheel": (L, -self.track_front / 2, rf), "left_front_wheel": (L, self.track_front / 2, rf),
@@ -223,10 +207,6 @@ class AckermannDrive(PlanarState):
     @property
     def motors(self) -> dict[str, WheelMotor]:
         return {m.name: m for m in (self.right_steer, self.left_steer, *(w[0] for w in self.wheels))}
-
-    @property
-    def moving(self) -> bool:
-        return any(w[0].velocity != 0.0 for w in self.wheels)
 
     def steering(self) -> tuple[float, float]:
         """The front wheels' angles (right, left), positive to the right."""

@@ -59,17 +59,24 @@ def wheel_radius(end: Node | None, conv) -> float | None:
     return find(f.node_("boundingObject"), 1.0) or find(end, 1.0)
 
 
+def _axis_off_y(wheels: list[dict], tol: float, why: str) -> str:
+    """The sentence for the first wheel whose axis is not the robot's +y (within ``tol``), else ""."""
+    y = np.array([0.0, 1.0, 0.0])
+    for w in wheels:
+        a = w["axis"] / np.linalg.norm(w["axis"])
+        if np.linalg.norm(a - y) > tol:
+            return f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not the robot's +y ({why})"
+    return ""
+
+
 def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     """The kinematic drive of a robot's motorised hinges (two wheels, or several per side: skid
     steer), or (None, the sentence saying why not)."""
     if len(wheels) < 2:
         return None, f"{len(wheels)} motorised hinge joint; a drive needs two wheels or more, on both sides"
-    y = np.array([0.0, 1.0, 0.0])
-    for w in wheels:
-        a = w["axis"] / np.linalg.norm(w["axis"])
-        if np.linalg.norm(a - y) > TOL:
-            return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not the robot's +y "
-                          "(the kinematic drive needs every axis along +y so that positive speeds drive forward)")
+    off = _axis_off_y(wheels, TOL, "the kinematic drive needs every axis along +y so that positive speeds drive forward")
+    if off:
+        return None, off
     if len(wheels) == 2:
         return _two_wheels(wheels, conv)
     return _skid_steer(wheels, conv)
@@ -175,11 +182,9 @@ def ackermann_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
         return None, (f"the steering joints are at x={wheelbase:g}, not ahead of the robot's origin (the origin is "
                       "the centre of the rear axle)")
     right_steer, left_steer = (steering[0], steering[1]) if a0[1] < 0 else (steering[1], steering[0])
-    for w in driven:
-        a = w["axis"] / np.linalg.norm(w["axis"])
-        if np.linalg.norm(a - np.array([0.0, 1.0, 0.0])) > AXIS_TOL:
-            return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not the robot's +y "
-                          "(positive wheel speeds must drive forward)")
+    off = _axis_off_y(driven, AXIS_TOL, "positive wheel speeds must drive forward")
+    if off:
+        return None, off
     front = [w for w in driven if abs(w["centre"][0] - wheelbase) <= TOL]
     rear = [w for w in driven if abs(w["centre"][0]) <= TOL]
     if len(front) + len(rear) != len(driven) or len(front) not in (0, 2) or len(rear) not in (0, 2) or not driven:
@@ -213,7 +218,7 @@ def ackermann_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     out["max_wheel_speed"] = _max_speed(driven, conv)
     out["max_steering_speed"] = _max_speed(steering, conv)
     limits = [abs(v) for w in steering for v in w["limits"] if w["limits"] != (0.0, 0.0)]
-    out["max_steering_angle"] = min([*limits, STEERING_UNLIMITED]) if limits else STEERING_UNLIMITED
+    out["max_steering_angle"] = min([*limits, STEERING_UNLIMITED])
     if out["max_steering_angle"] == 0.0:
         return None, f"the steering motors {names} have a position limit of 0 (they cannot steer)"
     return out, ""
