@@ -142,3 +142,13 @@ def test_a_car_that_is_not_the_drives_gets_one_line(tmp_path: Path, body: str, w
     assert w.world.robots[0].ackermann_drive is None and w.world.robots[0].differential_drive is None
     (line,) = [x for x in w.warnings if "Ackermann" in x]
     assert line == f"{p}:3:1: robot 'car': no Ackermann drive ({why}); the robot will not move"
+
+
+def test_a_sensor_on_a_steering_axis_without_a_motor_is_said_once(tmp_path: Path) -> None:
+    # the right front Hinge2Joint's steering axis has a PositionSensor but no motor
+    bare = hinge2_front("right", -T / 2).replace(
+        'RotationalMotor { name "right_steer" minPosition -0.6 maxPosition 0.6 maxVelocity 5 } ', "")
+    assert "RotationalMotor" not in bare
+    w = load_world(write(tmp_path, car(bare + hinge2_front("left", T / 2))))
+    said = [x for x in w.warnings if "PositionSensor" in x]
+    assert len(said) == 1 and "Hinge2Joint axis without a motor (jointParameters)" in said[0], said

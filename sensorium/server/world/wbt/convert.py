@@ -789,7 +789,8 @@ class Converter:
                                  "end": end, "frame": frame, "sensors": sensors})
         elif motors and node.type != "Hinge2Joint":
             self.warn(node, f"{node.type} motor(s) not part of a wheel: listed, not simulated (joints do not move here)")
-        if sensors and not (owner.kind == "robot" and node.type in ("HingeJoint", "Hinge2Joint") and motors):
+        # (a robot's Hinge2Joint: hinge2() said which of its axes has sensors but no motor)
+        if sensors and not (owner.kind == "robot" and (node.type == "Hinge2Joint" or (node.type == "HingeJoint" and motors))):
             self.warn(node, "PositionSensor on a joint without a drive wheel motor: listed, reads no value")
         if end is not None:
             if end.type == "SolidReference":
