@@ -578,11 +578,12 @@ def sensor_rays(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.
     return positions, origins, dirs
 
 
-def plane1(pl, O: np.ndarray, D: np.ndarray, lo, hi, excl, distance_only: bool):
+def plane1(pl, O: np.ndarray, D: np.ndarray, lo, hi, excl, check_owner: bool, distance_only: bool):
     """:func:`.planes.cast_planes` for one axis-aligned plane (``pl.axis >= 0``) in one C pass
     (``sp_plane1``): its (dist, shape, normal) (shape and normal None with ``distance_only``), None
     when no ray passes its tests, bit for bit; ``lo`` = max(t_near, eps64) and ``hi`` = t_far
-    (scalars or (n,)); or False without the helper (the caller's numpy path)."""
+    (scalars or (n,)); ``check_owner``: rays skip the plane where it belongs to ``excl`` (cast_planes
+    decides); or False without the helper (the caller's numpy path)."""
     lib = library()
     if lib is None or D.dtype != np.float64 or O.dtype != np.float64:
         return False
@@ -595,7 +596,6 @@ def plane1(pl, O: np.ndarray, D: np.ndarray, lo, hi, excl, distance_only: bool):
     D = np.ascontiguousarray(D)
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
     hi_a = np.ascontiguousarray(hi, dtype=f64) if isinstance(hi, np.ndarray) else None
-    check_owner = pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0)
     ex_a = np.ascontiguousarray(excl, dtype=np.int64) if check_owner and isinstance(excl, np.ndarray) else None
     dist = np.empty(n)
     shape = None if distance_only else np.empty(n, dtype=np.int64)

@@ -55,7 +55,7 @@ class _Planes:
                     and np.count_nonzero(b) == 1:
                 self.size_axes = (int(np.argmax(a)), int(np.argmax(b)))
         self._poses = poses
-        self._rows: tuple | None = None
+        self._rows = None
 
     def native_rows(self) -> tuple:
         """The addresses of the first plane's point, normal, x and y axes and half sizes as contiguous
@@ -76,13 +76,14 @@ def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, dista
     where the helper is (packets.plane1: this function's values, bit for bit)."""
     pl.refresh(epoch)
     n, P = len(O), len(pl.sid)
+    check_owner = pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0)
     if distance_only and pl.axis >= 0 and pl.visual and n > 1 and O.strides[0] == 0 and \
             (not pl.sized or (pl.size_axes is not None and not isinstance(t_far, np.ndarray) and t_far < _INF)) and \
-            not (pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0)):
+            not check_owner:
         return _floor_distances(pl, O, D, t_near, t_far, eps64)
     if native and pl.axis >= 0 and n > 1:
         lo = np.maximum(t_near, eps64) if isinstance(t_near, np.ndarray) else max(t_near, eps64)
-        got = packets.plane1(pl, O, D, lo, t_far, excl, distance_only)
+        got = packets.plane1(pl, O, D, lo, t_far, excl, check_owner, distance_only)
         if got is not False:
             return got
     if pl.axis >= 0:   # one axis-aligned plane (a floor): D . n is one column times the normal's
@@ -111,7 +112,7 @@ def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, dista
         ax, ay = pl.ax, pl.ay
         ok &= (np.abs(x0 * ax[:, 0] + x1 * ax[:, 1] + x2 * ax[:, 2]) <= pl.half[:, 0]) & \
               (np.abs(x0 * ay[:, 0] + x1 * ay[:, 1] + x2 * ay[:, 2]) <= pl.half[:, 1])
-    if pl.owned and not (not isinstance(excl, np.ndarray) and excl < 0):
+    if check_owner:
         ok &= pl.owner != (excl[:, None] if isinstance(excl, np.ndarray) else excl)
     if not np.count_nonzero(ok):
         return None
