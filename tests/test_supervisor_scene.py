@@ -191,3 +191,27 @@ def test_a_webots_supervisor_controller_walks_the_tree_switches_a_light_and_read
     err = ctl.stderr()
     assert "wb_supervisor_field_get_sf_bool() called with wrong field type: SFFloat." in err
     assert "no field 'mass'" in err and "out-of-bound index: 5" in err
+
+
+def test_a_camera_sees_a_light_switched_and_recoloured_at_its_next_image():
+    data = load_world(WORLD).world.model_dump()
+    data["solids"].append({"name": "wall", "pose": {"translation": [3.0, 0.0, 0.5]},
+                           "geometry": {"type": "box", "size": [0.1, 4.0, 2.0]}})     # lit by the lamp at x = 2
+    data["robots"][0]["devices"].append({"device": "Camera", "name": "cam", "width": 8, "height": 8})
+    lv = Live(Simulation(parse_world(data)))
+    lv.ok(A, "attach", {"robot": "judge"})
+    cam = lv.sim.device("judge/cam")
+    cam.enable(16)
+
+    def centre() -> list[int]:
+        lv.step(A, "judge", {"duration": 16})
+        return [int(v) for v in cam.image[4, 4]]          # BGRA
+
+    b, g, r, a = centre()
+    assert b == g == r > 0 and a == 255                  # a white light on a white wall
+    judge(lv, "set_field", {"node": 5, "field": "on", "value": False})    # after the wall (4), the lamp is 5
+    assert lv.sim.scene.top_lights()[0].on is False
+    assert centre() == [0, 0, 0, 255]                    # no light on, no ambient: black
+    judge(lv, "set_field", {"node": 5, "field": "on", "value": True})
+    judge(lv, "set_field", {"node": 5, "field": "color", "value": [0.0, 1.0, 0.0]})
+    assert centre() == [0, g, 0, 255]                    # the green channel of the white light's image

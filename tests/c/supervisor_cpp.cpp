@@ -35,8 +35,8 @@ int main() {
   size = -1;
   none = supervisor->wwiReceive(&size) == 0;
   std::printf(" %d %s %d\n", static_cast<int>(supervisor->wwiReceiveText().size()), none ? "NULL" : "data", size);
-  // beyond Sensorium's subset: Webots' methods, "no value"; the subset's own answers
-  std::printf("%d %d %s %d %d %d\n", supervisor->getRoot() == 0, buddy->getType() == Node::NO_NODE,
+  // beyond what Sensorium serves: Webots' methods, "no value"; then what it serves
+  std::printf("%d %d %s %d %d %d\n", supervisor->getSelected() == 0, buddy->getType() == Node::ROBOT,
               translation->getTypeName().c_str(), translation->getCount(), buddy->getId() > 0,
               buddy->getField("translation") == translation);
   delete supervisor;
