@@ -215,3 +215,38 @@ def test_a_camera_sees_a_light_switched_and_recoloured_at_its_next_image():
     judge(lv, "set_field", {"node": 5, "field": "on", "value": True})
     judge(lv, "set_field", {"node": 5, "field": "color", "value": [0.0, 1.0, 0.0]})
     assert centre() == [0, g, 0, 255]                    # the green channel of the white light's image
+
+
+def test_velocity_of_a_car_on_its_ackermann_circle():
+    """A car (tests/worlds/car.yaml) with its front wheels at Webots' Ackermann angles for δ = 0.2
+    (positive right) and its rear wheels at 5 rad/s: v = r_rear·ω along its heading, turning right at
+    v·tan δ / L (the steering settles within the first step)."""
+    sim = Simulation(load_world(REPO / "tests" / "worlds" / "car.yaml"))
+    car = sim.robot("car")
+    delta, wheelbase, track, radius = 0.2, 2.6, 1.5, 0.35
+    cot = 1.0 / math.tan(delta)
+    car.motor("right_steer").set_position(math.atan(1.0 / (cot - track / (2 * wheelbase))))
+    car.motor("left_steer").set_position(math.atan(1.0 / (cot + track / (2 * wheelbase))))
+    for wheel in ("right_rear_wheel", "left_rear_wheel"):
+        car.motor(wheel).set_position(math.inf)
+        car.motor(wheel).set_velocity(5.0)
+    v = radius * 5.0
+    w = -v * math.tan(delta) / wheelbase
+    for k in range(1, 31):
+        sim.step()
+        yaw = w * DT * k
+        assert car.drive.velocity() == pytest.approx([v * math.cos(yaw), v * math.sin(yaw), 0, 0, 0, w], abs=1e-12)
+
+
+def test_a_robot_stopped_by_kinematic_contact_has_no_linear_velocity():
+    """tests/worlds/webots_api.yaml: the pioneer drives at 0.5 m/s into the wall and stops with its
+    0.2 m body at x = 1.7 (the wall's face at 1.9); pressing on, its velocity is its displacement: 0."""
+    lv = Live()
+    lv.ok(A, "attach", {"robot": "pioneer"})
+    motors = {m: {"position": math.inf, "velocity": 5.0} for m in ("left wheel motor", "right wheel motor")}
+    lv.step(A, "pioneer", {"duration": 32, "motors": motors})
+    assert lv.ok(A, "/pioneer/robot/get_node_velocity", {"node": 1})["value"] == [0.5, 0.0, 0.0, 0.0, 0.0, 0.0]
+    for _ in range(150):
+        lv.step(A, "pioneer", {"duration": 32})
+    assert lv.sim.robot("pioneer").pose.translation[0] == pytest.approx(1.7, abs=1e-9)
+    assert lv.ok(A, "/pioneer/robot/get_node_velocity", {"node": 1})["value"] == [0.0] * 6
