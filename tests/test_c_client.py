@@ -503,6 +503,7 @@ def test_supervisor_through_the_cpp_classes(cbin, servers):
     assert float(lines[1]) == pytest.approx(6.28 * 0.016, abs=1e-12)   # position control at maxVelocity, one step
     assert lines[2] == "0 1 nan 0 0 NULL 0"                               # no contact points, no robot window
     assert lines[3] == "1 1 SFVec3f -1 1 1"       # getSelected unserved, getType served; one Field object per field
+    assert lines[4] == "6 PointLight buddy Group PointLight 0 1"    # rover, buddy, 3 solids, the lamp
 
 
 def test_c_client_replays_the_conformance_session(cbin, servers):
