@@ -80,6 +80,8 @@ def test_fields_by_node_kind_and_their_types():
            ({"node": 4, "field": "color", "value": [1.0, 0.5, 2.0]}, "[0, 1]"),
            ({"node": 4, "field": "attenuation", "value": [0.0, 0.0, 0.0]}, "attenuation"),
            ({"node": 4, "field": "intensity", "value": -1.0}, ">= 0"),
+           ({"node": 4, "field": "location", "value": [1e6, 0.0, 0.0]}, "100000"),
+           ({"node": 5, "field": "direction", "value": [0.0, 0.0, 0.0]}, "direction"),
            ({"node": 5, "field": "location", "value": [0.0, 0.0, 0.0]}, "no field 'location'"),
            ({"node": 1, "field": "name", "value": [0.0, 0.0, 0.0]}, "read-only"),
            ({"node": 0, "field": "children", "value": [0.0, 0.0, 0.0]}, "read-only")]

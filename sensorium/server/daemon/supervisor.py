@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from pydantic import ValidationError
 
-from sensorium.server.daemon.roles import check_pose
+from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.world.poses import matrix_quaternion
 
 MODES = ("pause", "realtime", "fast")     # Webots WB_SUPERVISOR_SIMULATION_MODE_PAUSE = 0, REAL_TIME, FAST
@@ -157,6 +157,9 @@ def _set_light(attr: str, kind: str) -> Setter:
             raise ValueError(f"{kind} {attr}: must be >= 0, got {value}")
         if attr in ("ambient_intensity",) and not 0.0 <= value <= 1.0:
             raise ValueError(f"{kind} {attr}: must be in [0, 1], got {value}")
+        if attr == "location" and any(abs(v) > MAX_COORDINATE_M for v in value):   # as every pose a request sets
+            raise ValueError(f"{kind} location {value} is outside the world bounds "
+                             f"(|coordinate| <= {MAX_COORDINATE_M:g} m)")
         if attr == "color" and not all(0.0 <= c <= 1.0 for c in value):
             raise ValueError(f"{kind} color: each component must be in [0, 1], got {value}")
         try:
