@@ -36,11 +36,12 @@ ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
 CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
-               "wire_vectors", "every_device", "headers", "car_driver"]
+               "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
 CAR_WORLD = REPO / "tests" / "worlds" / "car.yaml"
+SCENE_WORLD = REPO / "tests" / "worlds" / "supervisor_scene.yaml"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -263,9 +264,9 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
     assert len(warned) == 2 and "Microphone 'mic'" in warned[0] and "Radio 'radio'" in warned[1], err
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
     unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
-    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_int32", "movie_is_ready", "node_get_def",
-                                                              "node_get_number_of_fields", "node_get_root",
-                                                              "node_get_velocity")], err   # one line each
+    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_int32", "movie_is_ready",
+                                                              "node_export_string", "node_get_center_of_mass",
+                                                              "node_get_number_of_fields", "node_get_selected")], err
     assert "Warning: wb_supervisor_simulation_quit(3): the server runs on until it is stopped; robot 'car'" in err
 
 
@@ -456,7 +457,7 @@ def test_robot_extras_led_keyboard_and_supervisor(cbin, servers):
     assert got["sim_mode"] == "2" and got["sim_mode_after"] == "1"
     assert [float(v) for v in got["buddy_translation_reset"].split()] == [-0.4, -0.4, 0.0]
     assert got["led0_reset"] == "0"
-    assert "field 'mass' is not supported" in err_r and "wrong type (rotation)" in err_r
+    assert "has no field 'mass' in Sensorium" in err_r and "wrong field type: SFRotation" in err_r
     # the plain robot: supervisor calls refused with Webots' message
     assert dict(line.split(" ", 1) for line in out_b)["buddy_null"] == "1"
     assert "illegal call to wb_supervisor_node_get_from_def() in a 'Robot' controller" in err_b
@@ -467,6 +468,33 @@ def test_robot_extras_led_keyboard_and_supervisor(cbin, servers):
         assert py.by_name["led0"].desc["value"] == 1
 
 
+def test_c_supervisor_walks_the_tree_switches_a_light_and_reads_velocities(cbin, servers):
+    """tests/c/supervisor_scene.c on tests/worlds/supervisor_scene.yaml (its closed forms): the same
+    checkpoints as the Python supervisor of tests/test_supervisor_scene.py, built with sanitizers."""
+    code, out, err = finish(start([cbin["supervisor_scene"]], servers(SCENE_WORLD).url("judge")))
+    assert code == 0, err
+    assert out[0] == "root 0 Group 1 1 5 MFNode"
+    assert out[1:6] == ["node 1 Robot Robot 'JUDGE' judge 0", "node 2 Robot Robot '' runner 0",
+                        "node 3 Solid Solid 'CRATE' crate 0", "node 4 PointLight PointLight '' (none) 0",
+                        "node 5 DirectionalLight DirectionalLight '' (none) 0"]     # lights have no name field
+    assert out[6] == "me 1 1 1 team=red referee 1" and out[7] == "missing 1 1 1 1"
+    lights = out[8].split()
+    assert [float(v) for v in lights[1:4]] == pytest.approx([3.0, 0.0, 8.0 / 4.0], rel=1e-12)
+    assert lights[4:] == ["1", "8", "0"]             # on, intensity; the float read as a bool: "no value"
+    assert out[9] == "color 1 1 1"
+    steps = int(out[10].split()[1])
+    v, w, dt = 0.15, 0.5, 0.016
+    for line, k in ((out[11], steps), (out[12], steps + 1)):
+        key, *vals = line.split()
+        yaw = w * dt * k
+        assert [float(x) for x in vals] == pytest.approx([v * math.cos(yaw), v * math.sin(yaw), 0, 0, 0, w],
+                                                         abs=1e-12), key
+    assert out[13] == "crate 0 0 0 0 0 0" and out[14] == "null nan nan nan nan nan nan"
+    assert "wb_supervisor_field_get_sf_bool() called with wrong field type: SFFloat." in err
+    assert "has no field 'mass' in Sensorium" in err and "out-of-bound index: 5" in err
+    assert "wb_supervisor_node_get_velocity() called with a NULL or invalid 'node' argument." in err
+
+
 def test_supervisor_through_the_cpp_classes(cbin, servers):
     lines = run([cbin["supervisor_cpp"]], servers(CDEVICES).url("rover"))
     head = lines[0].split()
@@ -474,7 +502,8 @@ def test_supervisor_through_the_cpp_classes(cbin, servers):
     assert head[5:] == ["1", "left", "wheel", "motor", "1", "2"]
     assert float(lines[1]) == pytest.approx(6.28 * 0.016, abs=1e-12)   # position control at maxVelocity, one step
     assert lines[2] == "0 1 nan 0 0 NULL 0"                               # no contact points, no robot window
-    assert lines[3] == "1 1 SFVec3f -1 1 1"       # getRoot/getType beyond the subset; one Field object per field
+    assert lines[3] == "1 1 SFVec3f -1 1 1"       # getSelected unserved, getType served; one Field object per field
+    assert lines[4] == "6 PointLight buddy Group PointLight 0 1"    # rover, buddy, 3 solids, the lamp
 
 
 def test_c_client_replays_the_conformance_session(cbin, servers):

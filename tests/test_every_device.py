@@ -148,8 +148,9 @@ def test_python_supervisor_methods_beyond_the_subset_and_simulation_quit(tmp_pat
         "s = Supervisor()\n"
         "me = s.getSelf()\n"
         "rot = me.getField('rotation')\n"
-        "print(s.getRoot(), s.getRoot(), s.movieIsReady(), me.getVelocity()[5] != me.getVelocity()[5], me.getId() > 0,\n"
-        "      rot.getTypeName(), rot.getCount(), repr(rot.getSFString()), rot.getMFVec3f(0), me.getStaticBalance())\n"
+        "print(s.getSelected(), s.getSelected(), s.movieIsReady(), me.getCenterOfMass()[2] != me.getCenterOfMass()[2],\n"
+        "      me.getId() > 0, rot.getTypeName(), rot.getCount(), rot.getSFInt32(), rot.getMFVec3f(0),\n"
+        "      me.getStaticBalance())\n"
         "print(s.step(16))\n"
         "s.simulationQuit(3)\n"
         "print(s.step(16), s.step(16))\n")
@@ -157,10 +158,10 @@ def test_python_supervisor_methods_beyond_the_subset_and_simulation_quit(tmp_pat
         done = subprocess.run([sys.executable, "-m", "sensorium", "controller", "--url", server.url("car"),
                                str(script)], capture_output=True, text=True, timeout=120, cwd=str(REPO))
     assert done.returncode == 0, done.stderr
-    assert done.stdout.splitlines() == ["None None True True True SFRotation -1 '' [nan, nan, nan] False", "0",
+    assert done.stdout.splitlines() == ["None None True True True SFRotation -1 0 [nan, nan, nan] False", "0",
                                         "-1 -1"]
     unserved = sorted(line.split("(")[0] for line in done.stderr.splitlines() if "not served by Sensorium" in line)
-    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_vec3f", "field_get_sf_string",
-                                                              "movie_is_ready", "node_get_root", "node_get_static_balance",
-                                                              "node_get_velocity")], done.stderr
+    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_vec3f", "field_get_sf_int32",
+                                                              "movie_is_ready", "node_get_center_of_mass",
+                                                              "node_get_selected", "node_get_static_balance")], done.stderr
     assert "Warning: wb_supervisor_simulation_quit(3): the server runs on until it is stopped; robot 'car'" in done.stderr

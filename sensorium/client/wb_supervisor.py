@@ -1,17 +1,20 @@
-"""Webots' Supervisor subset as ``wb_supervisor_*`` functions (PROTOCOL.md, Supervisor services).
+"""Webots' Supervisor as ``wb_supervisor_*`` functions (PROTOCOL.md, Supervisor services).
 
 Only a controller of a robot whose world entry has ``supervisor: true`` may call them; any other
-prints Webots' error and gets the null answer (the server refuses too). Nodes are the world's
-robots and solids, found by name (DEF names are the names); a node is an ``int`` id (0 = NULL),
-a field a ``(node, name)`` pair — only ``translation`` and ``rotation`` exist. Every call is one
-round trip, answered at once; setters take effect before the next measurement.
+prints Webots' error and gets the null answer (the server refuses too). Nodes are the world's root
+(Webots' root Group, id 0), robots, top-level solids and top-level lights, found by DEF name (else
+name), by id or through the root's ``children``; a node is its ``int`` id, ``None`` is Webots' NULL.
+A field is a ``(node, name, type)`` tuple (``WB_SF_*``/``WB_MF_NODE``). Every call is one round trip,
+answered at once; setters take effect before the next measurement.
 """
 
 from __future__ import annotations
 
+import math
 import sys
 from typing import Any
 
+from sensorium.client import nodes
 from sensorium.client.connection import ErrorCode, SensoriumError
 from sensorium.client.wb_robot import RobotClient, current
 
@@ -20,12 +23,29 @@ WB_SUPERVISOR_SIMULATION_MODE_REAL_TIME = 1
 WB_SUPERVISOR_SIMULATION_MODE_FAST = 2
 
 WB_NO_FIELD = 0
+WB_SF_BOOL = 1
+WB_SF_INT32 = 2
+WB_SF_FLOAT = 3
+WB_SF_VEC2F = 4
 WB_SF_VEC3F = 5
 WB_SF_ROTATION = 6
+WB_SF_COLOR = 7
+WB_SF_STRING = 8
+WB_SF_NODE = 9
+WB_MF = 0x10
+WB_MF_NODE = 0x19
 
-_FIELD_TYPES = {"translation": WB_SF_VEC3F, "rotation": WB_SF_ROTATION}
+FIELD_TYPES = {"SFBool": WB_SF_BOOL, "SFInt32": WB_SF_INT32, "SFFloat": WB_SF_FLOAT, "SFVec2f": WB_SF_VEC2F,
+               "SFVec3f": WB_SF_VEC3F, "SFRotation": WB_SF_ROTATION, "SFColor": WB_SF_COLOR,
+               "SFString": WB_SF_STRING, "SFNode": WB_SF_NODE, "MFNode": WB_MF_NODE}
+_TYPE_NAMES = {v: k for k, v in FIELD_TYPES.items()}
+# Webots' node type constants of the node kinds Sensorium serves
+NODE_TYPES = {"Group": "WB_NODE_GROUP", "Robot": "WB_NODE_ROBOT", "Solid": "WB_NODE_SOLID",
+              "PointLight": "WB_NODE_POINT_LIGHT", "SpotLight": "WB_NODE_SPOT_LIGHT",
+              "DirectionalLight": "WB_NODE_DIRECTIONAL_LIGHT"}
 
-Field = tuple[int, str]
+Field = tuple[int, str, int]
+_NAN3 = [math.nan] * 3
 
 
 def _supervisor(func: str) -> RobotClient | None:
@@ -42,105 +62,316 @@ def _call(r: RobotClient, item: str, args: dict | None = None) -> dict:
     return r.conn.call(f"/{r.name}/robot/{item}", args)
 
 
-def wb_supervisor_node_get_from_def(name: str) -> int:
-    """The node (robot or solid) of that name, 0 if there is none."""
+def _node_id(reply: dict) -> int | None:
+    """A NodeResult's node id, None for Webots' NULL (type '')."""
+    return int(reply["node"]) if reply.get("type") else None
+
+
+def _checked_node(node: Any, func: str) -> RobotClient | None:
+    """The robot client when the caller is a supervisor and ``node`` a node id; Webots' line otherwise."""
+    r = _supervisor(func)
+    if r is None:
+        return None
+    if node is None or isinstance(node, bool) or not isinstance(node, int) or node < 0:
+        print(f"Error: {func}() called with a NULL or invalid 'node' argument.", file=sys.stderr)
+        return None
+    return r
+
+
+# ---------------------------------------------------------------------- nodes
+
+def node_info(node: Any, func: str) -> dict | None:
+    """The server's description of a node (get_from_id): type, name, DEF, parent; None if there is none."""
+    r = _checked_node(node, func)
+    if r is None:
+        return None
+    info = _call(r, "get_from_id", {"id": int(node)})
+    return info if info.get("type") else None
+
+
+def wb_supervisor_node_get_root() -> int | None:
+    """The root node (Webots' root Group, id 0): its ``children`` are the top-level nodes."""
+    r = _supervisor("wb_supervisor_node_get_root")
+    return None if r is None else _node_id(_call(r, "get_root"))
+
+
+def wb_supervisor_node_get_from_def(name: str) -> int | None:
+    """The node (robot, solid or light) of that DEF name (else name), None if there is none."""
     r = _supervisor("wb_supervisor_node_get_from_def")
     if r is None:
-        return 0
+        return None
     if not isinstance(name, str) or not name:
         print("Error: wb_supervisor_node_get_from_def() called with a NULL or empty 'def' argument.", file=sys.stderr)
-        return 0
-    return int(_call(r, "get_from_def", {"name": name})["node"])
+        return None
+    return _node_id(_call(r, "get_from_def", {"name": name}))
 
 
-def wb_supervisor_node_get_self() -> int:
+def wb_supervisor_node_get_self() -> int | None:
     r = _supervisor("wb_supervisor_node_get_self")
-    return 0 if r is None else int(_call(r, "get_self")["node"])
+    return None if r is None else _node_id(_call(r, "get_self"))
 
 
-def wb_supervisor_node_get_field(node: int, field_name: str) -> Field | None:
-    """``translation`` or ``rotation`` of ``node``; None (with Webots' message) for another name."""
-    if _supervisor("wb_supervisor_node_get_field") is None or not node:
+def wb_supervisor_node_get_from_id(id: int) -> int | None:  # noqa: A002 - Webots' parameter name
+    r = _supervisor("wb_supervisor_node_get_from_id")
+    if r is None:
         return None
-    if field_name not in _FIELD_TYPES:
-        print(f"Error: wb_supervisor_node_get_field(): field {field_name!r} is not supported by Sensorium "
-              f"(only 'translation' and 'rotation').", file=sys.stderr)
+    if isinstance(id, bool) or not isinstance(id, int) or id < 0:
+        print("Error: wb_supervisor_node_get_from_id() called with a negative 'id' argument.", file=sys.stderr)
         return None
-    return (int(node), field_name)
+    if id >= 1 << 31:
+        return None
+    return _node_id(_call(r, "get_from_id", {"id": id}))
+
+
+def wb_supervisor_node_get_id(node: int | None) -> int:
+    return -1 if _checked_node(node, "wb_supervisor_node_get_id") is None else int(node)  # type: ignore[arg-type]
+
+
+def wb_supervisor_node_get_type_name(node: int | None) -> str:
+    info = node_info(node, "wb_supervisor_node_get_type_name")
+    return "" if info is None else str(info["type"])
+
+
+def wb_supervisor_node_get_base_type_name(node: int | None) -> str:
+    """Sensorium keeps no PROTO names: the base type is the type (Robot, Solid, PointLight, ...)."""
+    info = node_info(node, "wb_supervisor_node_get_base_type_name")
+    return "" if info is None else str(info["type"])
+
+
+def wb_supervisor_node_get_type(node: int | None) -> int:
+    info = node_info(node, "wb_supervisor_node_get_type")
+    name = "WB_NODE_NO_NODE" if info is None else NODE_TYPES[info["type"]]
+    return nodes.WEBOTS_NODE_TYPES[name]
+
+
+def wb_supervisor_node_get_def(node: int | None) -> str:
+    info = node_info(node, "wb_supervisor_node_get_def")
+    return "" if info is None else str(info["def_name"])
+
+
+def wb_supervisor_node_get_parent_node(node: int | None) -> int | None:
+    """The root for a top-level node; None for the root."""
+    info = node_info(node, "wb_supervisor_node_get_parent_node")
+    if info is None or int(info["parent"]) < 0:
+        return None
+    return int(info["parent"])
+
+
+def _node_pose(node: int | None, func: str) -> dict | None:
+    r = _checked_node(node, func)
+    return None if r is None else _call(r, "get_node_pose", {"node": int(node)})  # type: ignore[arg-type]
+
+
+def wb_supervisor_node_get_position(node: int | None) -> list[float]:
+    """World position (m) of the node's origin; NaN for a node that has none (the root, a light)."""
+    p = _node_pose(node, "wb_supervisor_node_get_position")
+    return list(_NAN3) if p is None else [float(v) for v in p["position"]]
+
+
+def wb_supervisor_node_get_orientation(node: int | None) -> list[float]:
+    """World rotation matrix of the node, 9 numbers row-major (Webots)."""
+    p = _node_pose(node, "wb_supervisor_node_get_orientation")
+    return [math.nan] * 9 if p is None else [float(v) for v in p["orientation"]]
+
+
+def wb_supervisor_node_get_velocity(node: int | None) -> list[float]:
+    """Linear (m/s) then angular (rad/s) velocity in world axes: a driven robot's from its last step,
+    zeros for anything else (nothing else moves by itself here)."""
+    r = _checked_node(node, "wb_supervisor_node_get_velocity")
+    if r is None:
+        return [math.nan] * 6
+    return [float(v) for v in _call(r, "get_node_velocity", {"node": int(node)})["value"]]  # type: ignore[arg-type]
+
+
+_set_velocity_warned: list[bool] = []
+
+
+def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
+    """No physics: a robot moves only by its wheels (which keep their commands), so a velocity set
+    from outside has nothing to act on; one warning line, ignored."""
+    if _checked_node(node, "wb_supervisor_node_set_velocity") is None or _set_velocity_warned:
+        return
+    _set_velocity_warned.append(True)
+    print("Warning: wb_supervisor_node_set_velocity(): ignored: Sensorium has no physics (robots move by their "
+          "wheels' commands, solids are static).", file=sys.stderr)
+
+
+def wb_supervisor_node_reset_physics(node: int | None) -> None:
+    """Webots zeroes the node's velocities and keeps the motors' commands; without physics there is no
+    momentum to clear (a robot's motion is its wheels' commands): nothing to do."""
+    _checked_node(node, "wb_supervisor_node_reset_physics")
+
+
+def wb_supervisor_simulation_reset_physics() -> None:
+    """As ``wb_supervisor_node_reset_physics`` for every node: nothing to clear without physics."""
+    _supervisor("wb_supervisor_simulation_reset_physics")
+
+
+# ---------------------------------------------------------------------- fields
+
+def wb_supervisor_node_get_field(node: int | None, field_name: str) -> Field | None:
+    """The node's field of that name, None (with one line) when the node has no such field here."""
+    func = "wb_supervisor_node_get_field"
+    r = _checked_node(node, func)
+    if r is None:
+        return None
+    if not isinstance(field_name, str) or not field_name or len(field_name) > 64:
+        print(f"Error: {func}() called with a NULL, empty or invalid 'field_name' argument.", file=sys.stderr)
+        return None
+    got = _call(r, "get_field", {"node": int(node), "field": field_name})  # type: ignore[arg-type]
+    if not got["type"]:
+        print(f"Error: {func}(): node {node} has no field {field_name!r} in Sensorium (README \"Supervisor\" "
+              f"lists the fields of each node kind).", file=sys.stderr)
+        return None
+    return (int(node), field_name, FIELD_TYPES[got["type"]])  # type: ignore[arg-type]
 
 
 def wb_supervisor_field_get_type(field: Field | None) -> int:
-    return WB_NO_FIELD if field is None else _FIELD_TYPES[field[1]]
+    return WB_NO_FIELD if field is None else field[2]
+
+
+def wb_supervisor_field_get_type_name(field: Field | None) -> str:
+    return "" if field is None else _TYPE_NAMES[field[2]]
 
 
 def wb_supervisor_field_get_name(field: Field | None) -> str:
     return "" if field is None else field[1]
 
 
-def _field_get(field: Field | None, name: str, func: str) -> list[float] | None:
+def _field_value(field: Field | None, want: int | None, func: str) -> Any:
+    """The field's value from the server; None after Webots' line for a NULL field or a wrong type."""
     r = _supervisor(func)
-    if r is None or field is None:
+    if r is None:
         return None
-    if field[1] != name:
-        print(f"Error: {func}() called with a field of the wrong type ({field[1]}).", file=sys.stderr)
+    if field is None:
+        print(f"Error: {func}() called with NULL 'field' argument.", file=sys.stderr)
         return None
-    return [float(v) for v in _call(r, "get_field", {"node": field[0], "field": field[1]})["value"]]
+    if want is not None and field[2] != want:
+        print(f"Error: {func}() called with wrong field type: {_TYPE_NAMES[field[2]]}.", file=sys.stderr)
+        return None
+    return _call(r, "get_field", {"node": field[0], "field": field[1]})["value"]
 
 
-def _field_set(field: Field | None, name: str, values: Any, n: int, func: str) -> None:
+def wb_supervisor_field_get_count(field: Field | None) -> int:
+    """Webots: the number of items of an MF field, -1 for a single (SF) field."""
+    func = "wb_supervisor_field_get_count"
     r = _supervisor(func)
-    if r is None or field is None:
-        return
-    if field[1] != name:
-        print(f"Error: {func}() called with a field of the wrong type ({field[1]}).", file=sys.stderr)
-        return
-    try:
-        vals = [float(v) for v in values]
-    except (TypeError, ValueError):
-        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected {n} numbers, got {values!r}") from None
-    if len(vals) != n:
-        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected {n} numbers, got {len(vals)}")
-    _call(r, "set_field", {"node": field[0], "field": field[1], "value": vals})
+    if r is None:
+        return -1
+    if field is None:
+        print(f"Error: {func}() called with NULL 'field' argument.", file=sys.stderr)
+        return -1
+    if not field[2] & WB_MF:
+        return -1
+    return len(_call(r, "get_field", {"node": field[0], "field": field[1]})["value"])
+
+
+def wb_supervisor_field_get_sf_bool(field: Field | None) -> bool:
+    v = _field_value(field, WB_SF_BOOL, "wb_supervisor_field_get_sf_bool")
+    return False if v is None else bool(v)
+
+
+def wb_supervisor_field_get_sf_float(field: Field | None) -> float:
+    v = _field_value(field, WB_SF_FLOAT, "wb_supervisor_field_get_sf_float")
+    return math.nan if v is None else float(v)
+
+
+def wb_supervisor_field_get_sf_string(field: Field | None) -> str:
+    v = _field_value(field, WB_SF_STRING, "wb_supervisor_field_get_sf_string")
+    return "" if v is None else str(v)
+
+
+def _floats(v: Any, n: int) -> list[float] | None:
+    return None if v is None else [float(x) for x in v][:n]
 
 
 def wb_supervisor_field_get_sf_vec3f(field: Field | None) -> list[float] | None:
-    return _field_get(field, "translation", "wb_supervisor_field_get_sf_vec3f")
-
-
-def wb_supervisor_field_set_sf_vec3f(field: Field | None, values: Any) -> None:
-    _field_set(field, "translation", values, 3, "wb_supervisor_field_set_sf_vec3f")
+    return _floats(_field_value(field, WB_SF_VEC3F, "wb_supervisor_field_get_sf_vec3f"), 3)
 
 
 def wb_supervisor_field_get_sf_rotation(field: Field | None) -> list[float] | None:
-    return _field_get(field, "rotation", "wb_supervisor_field_get_sf_rotation")
+    return _floats(_field_value(field, WB_SF_ROTATION, "wb_supervisor_field_get_sf_rotation"), 4)
+
+
+def wb_supervisor_field_get_sf_color(field: Field | None) -> list[float] | None:
+    return _floats(_field_value(field, WB_SF_COLOR, "wb_supervisor_field_get_sf_color"), 3)
+
+
+def wb_supervisor_field_get_mf_node(field: Field | None, index: int) -> int | None:
+    """Item ``index`` of an MFNode field (negative counts from the end, as Webots)."""
+    func = "wb_supervisor_field_get_mf_node"
+    ids = _field_value(field, WB_MF_NODE, func)
+    if ids is None:
+        return None
+    count = len(ids)
+    if isinstance(index, bool) or not isinstance(index, int) or not -count <= index < count:
+        if count == 0:
+            print(f"Error: {func}() called on an empty list.", file=sys.stderr)
+        else:
+            print(f"Error: {func}() called with an out-of-bound index: {index} (should be between {-count} and "
+                  f"{count - 1}).", file=sys.stderr)
+        return None
+    return int(ids[index])
+
+
+def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
+    r = _supervisor(func)
+    if r is None:
+        return
+    if field is None:
+        print(f"Error: {func}() called with NULL 'field' argument.", file=sys.stderr)
+        return
+    if field[2] != want:
+        print(f"Error: {func}() called with wrong field type: {_TYPE_NAMES[field[2]]}.", file=sys.stderr)
+        return
+    if want == WB_SF_BOOL:
+        wire: Any = bool(value)
+    elif want == WB_SF_FLOAT:
+        try:
+            wire = float(value)
+        except (TypeError, ValueError):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected a number, got {value!r}") from None
+    else:
+        n = 4 if want == WB_SF_ROTATION else 3
+        try:
+            wire = [float(v) for v in value]
+        except (TypeError, ValueError):
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected {n} numbers, got {value!r}") from None
+        if len(wire) != n:
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected {n} numbers, got {len(wire)}")
+    if isinstance(wire, float) and not math.isfinite(wire) or isinstance(wire, list) and \
+            not all(math.isfinite(v) for v in wire):
+        print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
+        return
+    _call(r, "set_field", {"node": field[0], "field": field[1], "value": wire})
+
+
+def wb_supervisor_field_set_sf_bool(field: Field | None, value: bool) -> None:
+    _field_set(field, WB_SF_BOOL, value, "wb_supervisor_field_set_sf_bool")
+
+
+def wb_supervisor_field_set_sf_float(field: Field | None, value: float) -> None:
+    _field_set(field, WB_SF_FLOAT, value, "wb_supervisor_field_set_sf_float")
+
+
+def wb_supervisor_field_set_sf_vec3f(field: Field | None, values: Any) -> None:
+    _field_set(field, WB_SF_VEC3F, values, "wb_supervisor_field_set_sf_vec3f")
 
 
 def wb_supervisor_field_set_sf_rotation(field: Field | None, values: Any) -> None:
-    _field_set(field, "rotation", values, 4, "wb_supervisor_field_set_sf_rotation")
+    _field_set(field, WB_SF_ROTATION, values, "wb_supervisor_field_set_sf_rotation")
 
 
-def _node_pose(node: int, func: str) -> dict | None:
-    r = _supervisor(func)
-    if r is None or not node:
-        return None
-    return _call(r, "get_node_pose", {"node": int(node)})
+def wb_supervisor_field_set_sf_color(field: Field | None, values: Any) -> None:
+    _field_set(field, WB_SF_COLOR, values, "wb_supervisor_field_set_sf_color")
 
 
-def wb_supervisor_node_get_position(node: int) -> list[float] | None:
-    """World position (m) of the node's origin."""
-    p = _node_pose(node, "wb_supervisor_node_get_position")
-    return None if p is None else [float(v) for v in p["position"]]
-
-
-def wb_supervisor_node_get_orientation(node: int) -> list[float] | None:
-    """World rotation matrix of the node, 9 numbers row-major (Webots)."""
-    p = _node_pose(node, "wb_supervisor_node_get_orientation")
-    return None if p is None else [float(v) for v in p["orientation"]]
-
+# ---------------------------------------------------------------------- the simulation
 
 def wb_supervisor_simulation_reset() -> None:
     """Robots and solids back to their initial poses, wheel motors to their initial commands,
-    LEDs off, custom data as in the world file; the clock keeps running (see README)."""
+    top-level lights' fields as loaded, LEDs off, custom data as in the world file; the clock keeps
+    running (see README)."""
     r = _supervisor("wb_supervisor_simulation_reset")
     if r is not None:
         _call(r, "simulation_reset")
@@ -188,6 +419,6 @@ def supervisor_unserved(func: str) -> None:
     if _supervisor(func) is None or func in _unserved_warned:
         return
     _unserved_warned.add(func)
-    print(f"Error: {func}(): not served by Sensorium (its Supervisor finds robots and solids by DEF, reads and sets "
-          "their translation and rotation, reads poses, resets and sets the run mode): ignored, Webots' \"no value\" "
-          "returned.", file=sys.stderr)
+    print(f"Error: {func}(): not served by Sensorium (its Supervisor walks the root's children, reads nodes' "
+          "identity, poses, velocities and fields (translation, rotation, name, lights' fields, ...), sets poses "
+          "and lights, resets and sets the run mode): ignored, Webots' \"no value\" returned.", file=sys.stderr)

@@ -26,7 +26,9 @@ MAX_PERIOD_MS = (1 << 31) - 1
 MAX_MOTOR_COMMANDS = 256        # per step request (a robot has a handful of motors)
 MAX_EMITTERS = 256              # emitters named in one step request
 Mode = Literal["fast", "realtime", "pause"]
-FieldName = Literal["translation", "rotation"]
+FieldName = Annotated[str, Field(min_length=1, max_length=64, description=(
+    "a Webots field name (translation, rotation, name, children, on, intensity, color, ...: README "
+    "'Supervisor' lists which node kind has which)"))]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
 
@@ -231,23 +233,31 @@ class StringArgs(Args):
 
 
 class NodeNameArgs(Args):
-    name: str = Field(min_length=1, max_length=4096, description="a robot's or solid's name (DEF names are the names)")
+    name: str = Field(min_length=1, max_length=4096, description="a robot's, solid's or light's DEF name, else its name")
+
+
+class NodeIdArgs(Args):
+    id: int = Field(ge=0, lt=1 << 31, description="a node id (0: the root; Webots wb_supervisor_node_get_from_id)")
+
+
+NodeId = Annotated[int, Field(ge=0, lt=1 << 31, description="a node id from get_root / get_from_def / get_self / "
+                                                           "get_from_id (0: the root)")]
 
 
 class NodeArgs(Args):
-    node: int = Field(ge=1, lt=1 << 31, description="a node id from get_from_def / get_self")
+    node: NodeId
 
 
 class FieldArgs(Args):
-    node: int = Field(ge=1, lt=1 << 31)
+    node: NodeId
     field: FieldName
 
 
 class SetFieldArgs(Args):
-    node: int = Field(ge=1, lt=1 << 31)
+    node: NodeId
     field: FieldName
-    value: list[float] = Field(min_length=3, max_length=4,
-                               description="translation x, y, z (m); rotation axis x, y, z, angle (rad)")
+    value: bool | float | Annotated[list[float], Field(min_length=2, max_length=4)] = Field(
+        description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis x, y, z, angle")
 
 
 class SimulationModeArgs(Args):
@@ -657,9 +667,19 @@ class StringValue(Result):
 
 
 class NodeResult(Result):
-    node: int = Field(description="node id; 0 = no such node (Webots' NULL)")
-    type: Literal["Robot", "Solid", ""]
-    name: str
+    node: int = Field(description="node id (0: the root); with type '' there is no such node (Webots' NULL)")
+    type: Literal["Group", "Robot", "Solid", "PointLight", "SpotLight", "DirectionalLight", ""] = Field(
+        description="Webots' type (and base type) name; '' = no such node")
+    name: str = Field(description="the node's name (a robot's or solid's name field; a light's world-file name)")
+    def_name: str = Field(description="its DEF name ('' without one)")
+    parent: int = Field(description="the parent's node id (0 for a top-level node; -1 for the root and NULL)")
+
+
+class FieldValueResult(Result):
+    type: str = Field(description="Webots' field type name (SFVec3f, SFRotation, SFColor, SFFloat, SFBool, SFString, "
+                                  "MFNode); '' = the node has no such field here (the value is then [])")
+    value: bool | float | str | list[float] | list[int] = Field(
+        description="SFBool bool; SFFloat number; SFString str; SFVec3f/SFColor/SFRotation numbers; MFNode node ids")
 
 
 class NodePoseResult(Result):
@@ -766,9 +786,12 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_model", "robot", NoArgs, StringValue),
     ServiceSpec("get_from_def", "robot", NodeNameArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_self", "robot", NoArgs, NodeResult, attached=True, supervisor=True),
-    ServiceSpec("get_field", "robot", FieldArgs, FloatArrayValue, attached=True, supervisor=True),
+    ServiceSpec("get_root", "robot", NoArgs, NodeResult, attached=True, supervisor=True),
+    ServiceSpec("get_from_id", "robot", NodeIdArgs, NodeResult, attached=True, supervisor=True),
+    ServiceSpec("get_field", "robot", FieldArgs, FieldValueResult, attached=True, supervisor=True),
     ServiceSpec("set_field", "robot", SetFieldArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
+    ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),

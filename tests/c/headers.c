@@ -101,13 +101,14 @@ static void online(void) {
   printf("wwi %s %s %d\n", or_null(wb_robot_wwi_receive_text()), or_null(received), size);
   printf("step %d\n", wb_robot_step(16));
   /* Supervisor functions beyond Sensorium's subset: declared, one error line each, "no value" */
-  WbNodeRef root = wb_supervisor_node_get_root();
-  wb_supervisor_node_get_root();
+  WbNodeRef selected = wb_supervisor_node_get_selected();
+  wb_supervisor_node_get_selected();
   WbFieldRef rotation = wb_supervisor_node_get_field(self, "rotation");
-  printf("supervisor %s %d %s %d %d %s %s %d %d\n", root == NULL ? "NULL" : "root", wb_supervisor_node_get_id(self) > 0,
-         wb_supervisor_field_get_type_name(rotation), wb_supervisor_field_get_count(rotation),
-         wb_supervisor_node_get_number_of_fields(self), isnan(wb_supervisor_node_get_velocity(self)[5]) ? "nan" : "value",
-         wb_supervisor_node_get_def(root), (int)wb_supervisor_movie_is_ready(), (int)wb_supervisor_field_get_mf_int32(rotation, 0));
+  printf("supervisor %s %d %s %d %d %s %s %d %d\n", selected == NULL ? "NULL" : "node",
+         wb_supervisor_node_get_id(self) > 0, wb_supervisor_field_get_type_name(rotation),
+         wb_supervisor_field_get_count(rotation), wb_supervisor_node_get_number_of_fields(self),
+         isnan(wb_supervisor_node_get_center_of_mass(self)[2]) ? "nan" : "value", wb_supervisor_node_export_string(self),
+         (int)wb_supervisor_movie_is_ready(), (int)wb_supervisor_field_get_mf_int32(rotation, 0));
   wb_supervisor_simulation_quit(3);
   printf("after quit %d %d\n", wb_robot_step(16), wb_robot_step(16));
   wb_robot_cleanup();

@@ -35,10 +35,16 @@ int main() {
   size = -1;
   none = supervisor->wwiReceive(&size) == 0;
   std::printf(" %d %s %d\n", static_cast<int>(supervisor->wwiReceiveText().size()), none ? "NULL" : "data", size);
-  // beyond Sensorium's subset: Webots' methods, "no value"; the subset's own answers
-  std::printf("%d %d %s %d %d %d\n", supervisor->getRoot() == 0, buddy->getType() == Node::NO_NODE,
+  // beyond what Sensorium serves: Webots' methods, "no value"; then what it serves
+  std::printf("%d %d %s %d %d %d\n", supervisor->getSelected() == 0, buddy->getType() == Node::ROBOT,
               translation->getTypeName().c_str(), translation->getCount(), buddy->getId() > 0,
               buddy->getField("translation") == translation);
+  // the scene tree, identity and velocities through the C++ classes
+  Field *children = supervisor->getRoot()->getField("children");
+  std::printf("%d %s %s %s %s %g %d\n", children->getCount(), children->getMFNode(-1)->getTypeName().c_str(),
+              children->getMFNode(1)->getField("name")->getSFString().c_str(),
+              buddy->getParentNode()->getTypeName().c_str(), supervisor->getFromId(6)->getBaseTypeName().c_str(),
+              buddy->getVelocity()[0], supervisor->getFromId(6)->getField("on")->getSFBool());
   delete supervisor;
   return 0;
 }

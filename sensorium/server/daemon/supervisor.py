@@ -1,69 +1,106 @@
-"""The Supervisor subset (sans-IO): node handles, ``translation``/``rotation`` fields, poses.
+"""The Supervisor (sans-IO): the scene tree Sensorium has, node identity, fields, poses, velocities.
 
-Nodes are the world's robots and top-level solids, found by DEF name (``def_name``, set from a
-``.wbt`` world's ``DEF``) or else by name.
-A node's id is stable for the life of the server: robots 1..R in world order, then solids. Field
-values are Webots' ``SFVec3f`` (x, y, z) and ``SFRotation`` (axis x, y, z, angle), in the parent
-frame (the world here: nodes are not nested). Setting one field keeps the other (Webots).
+Nodes are what the server simulates at the top of the world: the root (Webots' root Group, id 0,
+whose ``children`` lists the others), the robots (ids 1..R in world order), the top-level solids
+(R+1..R+S) and the world's top-level lights (then on). They are found by DEF name (``def_name``,
+set from a ``.wbt`` world's ``DEF``) or else by name. Ids are stable for the life of the server.
+Everything else of a Webots scene tree (shapes, devices, nested solids, lights carried by a solid
+or robot) is not a node here: Webots' NULL.
+
+Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame (the world: nodes
+are not nested). Setting one field keeps the others (Webots). A field change applies at once; the
+next measurement sees it.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from pydantic import ValidationError
 
-from sensorium.server.daemon.roles import check_pose
+from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.world.poses import matrix_quaternion
 
 MODES = ("pause", "realtime", "fast")     # Webots WB_SUPERVISOR_SIMULATION_MODE_PAUSE = 0, REAL_TIME, FAST
+LIGHTS = ("PointLight", "SpotLight", "DirectionalLight")
 
 
 @dataclass(frozen=True, slots=True)
 class Node:
     id: int
-    type: str          # "Robot" | "Solid"
-    name: str
+    type: str          # "Group" (the root) | "Robot" | "Solid" | "PointLight" | "SpotLight" | "DirectionalLight"
+    name: str          # a robot's or solid's name; a light's world-file name ("" without one)
+    def_name: str      # "" without one
+    key: str | int     # the robot's or solid's name, a light's index among the top-level lights; root: ""
+
+
+ROOT = Node(0, "Group", "", "", "")
 
 
 def _nodes(sim: Any) -> list[Node]:
-    robots = [Node(i + 1, "Robot", name) for i, name in enumerate(sim.robots)]
-    solids = [Node(len(robots) + i + 1, "Solid", name) for i, name in enumerate(sim.scene.solid_poses)]
-    return robots + solids
+    """Every node but the root, in id order (robots, solids, lights): the root's children."""
+    world = getattr(sim, "world", None)
+
+    def def_of(models: list, k: int) -> str:
+        return (getattr(models[k], "def_name", None) or "") if models is not None and k < len(models) else ""
+
+    robots_m = world.robots if world is not None else None
+    solids_m = world.solids if world is not None else None
+    out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name) for i, name in enumerate(sim.robots)]
+    first = len(out) + 1
+    out += [Node(first + j, "Solid", name, def_of(solids_m, j), name) for j, name in enumerate(sim.scene.solid_poses)]
+    top = sim.scene.top_lights()
+    first = len(out) + 1
+    out += [Node(first + k, lt.type, lt.name or "", def_of(top, k), k) for k, lt in enumerate(top)]
+    return out
 
 
 def find_node(sim: Any, name: str) -> Node | None:
-    """The robot or top-level solid whose DEF name (``def_name``) is ``name``, else whose name is."""
+    """The robot, top-level solid or light whose DEF name (``def_name``) is ``name``, else whose name is."""
     nodes = _nodes(sim)
-    world = getattr(sim, "world", None)
-    if world is not None:
-        defs = [getattr(m, "def_name", None) for m in (*world.robots, *world.solids)]
-        for n, d in zip(nodes, defs):
-            if d == name:
-                return n
+    for n in nodes:
+        if n.def_name == name:
+            return n
     for n in nodes:
         if n.name == name:
             return n
     return None
 
 
+def robot_node(sim: Any, robot: str) -> Node | None:
+    return next((n for n in _nodes(sim) if n.type == "Robot" and n.key == robot), None)
+
+
 def node_by_id(sim: Any, node: int) -> Node:
+    if node == 0:
+        return ROOT
     nodes = _nodes(sim)
-    if not 1 <= node <= len(nodes):
-        raise ValueError(f"no node with id {node} (ids 1..{len(nodes)})")
+    if not 0 <= node <= len(nodes):
+        raise ValueError(f"no node with id {node} (ids 0..{len(nodes)}: 0 the root)")
     return nodes[node - 1]
+
+
+def node_from_id(sim: Any, node: int) -> Node | None:
+    """Webots' ``getFromId``: the node, or None (NULL) for an id that is no node."""
+    try:
+        return node_by_id(sim, node)
+    except ValueError:
+        return None
 
 
 def node_ref(sim: Any, node: Node | None) -> dict:
     if node is None:
-        return {"node": 0, "type": "", "name": ""}
-    return {"node": node.id, "type": node.type, "name": node.name}
+        return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
+    return {"node": node.id, "type": node.type, "name": node.name, "def_name": node.def_name,
+            "parent": -1 if node.id == 0 else 0}
 
 
 def _pose(sim: Any, node: Node) -> Any:
-    return sim.robots[node.name].pose if node.type == "Robot" else sim.scene.solid_poses[node.name]
+    return sim.robots[node.key].pose if node.type == "Robot" else sim.scene.solid_poses[node.key]
 
 
 def matrix_axis_angle(r: np.ndarray) -> list[float]:
@@ -76,17 +113,14 @@ def matrix_axis_angle(r: np.ndarray) -> list[float]:
     return [x / n, y / n, z / n, 2.0 * math.atan2(n, w)]
 
 
-def get_field(sim: Any, node: Node, field: str) -> list[float]:
-    pose = _pose(sim, node)
-    if field == "translation":
-        return [float(v) for v in pose.translation]
-    return matrix_axis_angle(pose.rotation)
+# ---------------------------------------------------------------------- fields
+# per node type: Webots field name -> (Webots field type name, getter(sim, node), setter(sim, node, value) or None)
+
+Getter = Callable[[Any, Node], Any]
+Setter = Callable[[Any, Node, Any], None] | None
 
 
-def set_field(sim: Any, node: Node, field: str, value: list[float]) -> None:
-    want = 3 if field == "translation" else 4
-    if len(value) != want:
-        raise ValueError(f"field {field!r} takes {want} numbers, got {len(value)}")
+def _set_pose(sim: Any, node: Node, field: str, value: list[float]) -> None:
     if not all(math.isfinite(v) for v in value):
         raise ValueError(f"field {field!r}: values must be finite")
     if field == "translation":
@@ -95,15 +129,130 @@ def set_field(sim: Any, node: Node, field: str, value: list[float]) -> None:
         raise ValueError("rotation axis must not be zero")
     kwargs = {"translation": value} if field == "translation" else {"translation": None, "rotation": value}
     if node.type == "Robot":
-        sim.robots[node.name].set_pose(**kwargs)
+        sim.robots[node.key].set_pose(**kwargs)
     else:
-        sim.set_solid_pose(node.name, **kwargs)
+        sim.set_solid_pose(node.key, **kwargs)
+
+
+_POSE_FIELDS: dict[str, tuple[str, Getter, Setter]] = {
+    "translation": ("SFVec3f", lambda sim, n: [float(v) for v in _pose(sim, n).translation],
+                    lambda sim, n, v: _set_pose(sim, n, "translation", v)),
+    "rotation": ("SFRotation", lambda sim, n: matrix_axis_angle(_pose(sim, n).rotation),
+                 lambda sim, n, v: _set_pose(sim, n, "rotation", v)),
+}
+
+
+def _solid_model(sim: Any, node: Node) -> Any:
+    return next(s for s in sim.world.solids if s.name == node.key)
+
+
+def _light(sim: Any, node: Node) -> Any:
+    return sim.scene.top_lights()[node.key]
+
+
+def _set_light(attr: str, kind: str) -> Setter:
+    def setter(sim: Any, node: Node, value: Any) -> None:
+        model = _light(sim, node)
+        if attr in ("intensity", "radius", "beam_width", "cut_off_angle") and value < 0:
+            raise ValueError(f"{kind} {attr}: must be >= 0, got {value}")
+        if attr in ("ambient_intensity",) and not 0.0 <= value <= 1.0:
+            raise ValueError(f"{kind} {attr}: must be in [0, 1], got {value}")
+        if attr == "location" and any(abs(v) > MAX_COORDINATE_M for v in value):   # as every pose a request sets
+            raise ValueError(f"{kind} location {value} is outside the world bounds "
+                             f"(|coordinate| <= {MAX_COORDINATE_M:g} m)")
+        if attr == "color" and not all(0.0 <= c <= 1.0 for c in value):
+            raise ValueError(f"{kind} color: each component must be in [0, 1], got {value}")
+        try:
+            changed = type(model).model_validate({**model.model_dump(), attr: value})
+        except ValidationError as e:
+            raise ValueError(f"{kind} {attr}: {e.errors()[0]['msg']}") from None
+        sim.scene.set_top_light(node.key, changed)
+    return setter
+
+
+def _light_fields(kind: str) -> dict[str, tuple[str, Getter, Setter]]:
+    fields = {"on": ("SFBool", "on"), "intensity": ("SFFloat", "intensity"), "color": ("SFColor", "color"),
+              "ambientIntensity": ("SFFloat", "ambient_intensity"), "castShadows": ("SFBool", "cast_shadows")}
+    if kind != "DirectionalLight":
+        fields |= {"location": ("SFVec3f", "location"), "attenuation": ("SFVec3f", "attenuation"),
+                   "radius": ("SFFloat", "radius")}
+    if kind != "PointLight":
+        fields["direction"] = ("SFVec3f", "direction")
+    if kind == "SpotLight":
+        fields |= {"beamWidth": ("SFFloat", "beam_width"), "cutOffAngle": ("SFFloat", "cut_off_angle")}
+
+    def getter(attr: str) -> Getter:
+        def get(sim: Any, node: Node) -> Any:
+            v = getattr(_light(sim, node), attr)
+            return [float(c) for c in v] if isinstance(v, tuple | list) else v
+        return get
+
+    return {name: (t, getter(attr), _set_light(attr, kind)) for name, (t, attr) in fields.items()}
+
+
+FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
+    "Group": {"children": ("MFNode", lambda sim, n: [m.id for m in _nodes(sim)], None)},
+    "Robot": {**_POSE_FIELDS,
+              "name": ("SFString", lambda sim, n: n.name, None),
+              "model": ("SFString", lambda sim, n: sim.robots[n.key].model.model, None),
+              "customData": ("SFString", lambda sim, n: sim.robots[n.key].custom_data, None),
+              "controller": ("SFString", lambda sim, n: sim.robots[n.key].model.controller, None),
+              "supervisor": ("SFBool", lambda sim, n: bool(sim.robots[n.key].supervisor), None),
+              "synchronization": ("SFBool", lambda sim, n: bool(sim.robots[n.key].synchronization), None)},
+    "Solid": {**_POSE_FIELDS,
+              "name": ("SFString", lambda sim, n: n.name, None),
+              "model": ("SFString", lambda sim, n: _solid_model(sim, n).model, None)},
+    **{kind: _light_fields(kind) for kind in LIGHTS},
+}
+_VECTOR_SIZES = {"SFVec3f": 3, "SFColor": 3, "SFRotation": 4}
+
+
+def get_field(sim: Any, node: Node, field: str) -> dict:
+    """``{"type", "value"}``; type '' (and value []) when the node has no such field here."""
+    entry = FIELDS[node.type].get(field)
+    if entry is None:
+        return {"type": "", "value": []}
+    return {"type": entry[0], "value": entry[1](sim, node)}
+
+
+def set_field(sim: Any, node: Node, field: str, value: Any) -> None:
+    entry = FIELDS[node.type].get(field)
+    what = f"{node.type} {node.name or node.id!r}"
+    if entry is None:
+        raise ValueError(f"{what} has no field {field!r} here (fields: {', '.join(FIELDS[node.type])})")
+    kind, _, setter = entry
+    if setter is None:
+        raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here")
+    if kind == "SFBool":
+        ok = isinstance(value, bool)
+    elif kind == "SFFloat":
+        ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    else:
+        ok = isinstance(value, list) and len(value) == _VECTOR_SIZES[kind]
+    if not ok:
+        want = {"SFBool": "true or false", "SFFloat": "a finite number"}.get(kind, f"{_VECTOR_SIZES.get(kind)} numbers")
+        raise ValueError(f"field {field!r} is an {kind}: takes {want}, got {value!r}")
+    if isinstance(value, list) and not all(math.isfinite(v) for v in value):
+        raise ValueError(f"field {field!r}: values must be finite")
+    setter(sim, node, value)
 
 
 def node_pose(sim: Any, node: Node) -> dict:
+    if node.type not in ("Robot", "Solid"):          # Webots: NaN for a node that is no Transform
+        return {"position": [math.nan] * 3, "orientation": [math.nan] * 9}
     pose = _pose(sim, node)
     return {"position": [float(v) for v in pose.translation],
             "orientation": [float(v) for v in np.asarray(pose.rotation).reshape(9)]}
+
+
+def node_velocity(sim: Any, node: Node) -> list[float]:
+    """Webots' ``getVelocity``: a driven robot's from its kinematic drive's last step (world axes,
+    linear m/s then angular rad/s); anything else never moves by itself: zeros."""
+    if node.type == "Robot":
+        drive = sim.robots[node.key].drive
+        if drive is not None:
+            return drive.velocity()
+    return [0.0] * 6
 
 
 # ---------------------------------------------------------------------- the services
@@ -126,10 +275,13 @@ def _set_mode(sim: Any, ls: Any, robot: str, a: Any) -> dict:
 
 HANDLERS = {
     "get_from_def": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, a.name)),
-    "get_self": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, robot)),
-    "get_field": lambda sim, ls, robot, a: {"value": get_field(sim, node_by_id(sim, a.node), a.field)},
+    "get_self": lambda sim, ls, robot, a: node_ref(sim, robot_node(sim, robot)),
+    "get_root": lambda sim, ls, robot, a: node_ref(sim, ROOT),
+    "get_from_id": lambda sim, ls, robot, a: node_ref(sim, node_from_id(sim, a.id)),
+    "get_field": lambda sim, ls, robot, a: get_field(sim, node_by_id(sim, a.node), a.field),
     "set_field": _set_field,
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
+    "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},
     "simulation_reset": _reset,
     "simulation_set_mode": _set_mode,
     "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},

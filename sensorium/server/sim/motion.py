@@ -125,6 +125,22 @@ class PlanarState:
         self.yaw = math.atan2(forward[1], forward[0])
         self.base = _rz(-self.yaw) @ pose.rotation
         self.x, self.y, self.z = (float(v) for v in pose.translation)
+        self.linear = (0.0, 0.0)      # the last step's velocity (ENU x, y, m/s) and turn rate (rad/s)
+        self.turn = 0.0
+
+    def moved(self, v: float, w: float) -> None:
+        """Record the step's motion (v along the heading the step ends with, turn rate w): what
+        :meth:`velocity` reports until the next step. Kinematic contact may replace ``linear``."""
+        self.linear = (v * math.cos(self.yaw), v * math.sin(self.yaw))
+        self.turn = w
+
+    def velocity(self) -> list[float]:
+        """Webots' ``getVelocity``: linear (m/s) then angular (rad/s) velocity in world axes, as at
+        the end of the last step (zeros when the robot did not move)."""
+        lin, ang = np.array([*self.linear, 0.0]), np.array([0.0, 0.0, self.turn])
+        if self._to_enu is not None:
+            lin, ang = self._to_enu.T @ lin, self._to_enu.T @ ang
+        return [float(v) for v in (*lin, *ang)]
 
     def pose(self) -> Pose:
         r, t = _rz(self.yaw) @ self.base, np.array([self.x, self.y, self.z])
@@ -170,10 +186,12 @@ class DifferentialDrive(PlanarState):
             wl = sum(m.advance(dt) for m in self.lefts) / len(self.lefts)
             wr = sum(m.advance(dt) for m in self.rights) / len(self.rights)
         if wl == 0.0 and wr == 0.0:
+            self.moved(0.0, 0.0)
             return None
         v = self.wheel_radius * (wl + wr) / 2.0
         w = self.wheel_radius * (wr - wl) / self.axle_length
         self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
+        self.moved(v, w)
         return self.pose()
 
 
@@ -226,8 +244,10 @@ class AckermannDrive(PlanarState):
         self.left_steer.advance(dt)
         rolled = [(motor.advance(dt) * r, x, y) for motor, x, y, r in self.wheels]
         if all(u == 0.0 for u, _, _ in rolled):
+            self.moved(0.0, 0.0)
             return None
         kl = -self.curvature()          # to the left, as yaw grows
         v = sum(u for u, _, _ in rolled) / sum(math.hypot(1.0 - kl * y, kl * x) for _, x, y in rolled)
         self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, v * kl, dt)
+        self.moved(v, v * kl)
         return self.pose()

@@ -229,6 +229,18 @@ class Scene:
                 out.append(place_light(model, frame.compose(local)))
         return out
 
+    def top_lights(self) -> list:
+        """The world's top-level light models (the world file's ``lights``, in order; the Supervisor's
+        light nodes)."""
+        return [model for model, owner, _ in self._lights if owner is None]
+
+    def set_top_light(self, index: int, model: object) -> None:
+        """Replace top-level light ``index`` (a Supervisor field change): light sensors and cameras
+        recompute their light arrays at their next measurement (``lights_version``)."""
+        k = [i for i, (_, owner, _) in enumerate(self._lights) if owner is None][index]
+        self._lights[k] = (model, None, Pose.identity())
+        self.lights_version += 1
+
     def device_shapes(self, robot: int, device: str) -> frozenset[int]:
         """The shapes (``Scene.shapes`` indices) of a device's own Solid (``of_device``), which its
         visual rays do not see (sim/own_shapes.py)."""

@@ -183,7 +183,7 @@ class Simulation:
         self.radio = Radio([d for d in every if isinstance(d, Emitter)], [d for d in every if isinstance(d, Receiver)],
                            self.scene, self._counters)
         self._initial: dict[str, Any] = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
-                         "solids": dict(self.scene.solid_poses)}
+                         "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights()}
 
     def _build_contact(self) -> Contact:
         base = self.loaded.base_dir
@@ -203,7 +203,7 @@ class Simulation:
 
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, wheel
-        motors to their initial commands and angles, LEDs off, pen ink cleared (the pens keep their
+        motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, pen ink cleared (the pens keep their
         ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file.
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
@@ -223,6 +223,9 @@ class Simulation:
             self.scene.set_solid_pose(name, pose)
             if self.contact is not None:
                 self.contact.update_solid(name, pose)
+        for k, light in enumerate(self._initial["lights"]):    # fields a supervisor changed
+            if self.scene.top_lights()[k] is not light:
+                self.scene.set_top_light(k, light)
         self.scene.clear_ink()          # WbPen::reset clears every paint texture
         self._counters["resets"] += 1
 
@@ -317,6 +320,7 @@ class Simulation:
                     robot, drive, start, _ = moved[k]
                     robot.pressing = True
                     drive.x, drive.y = float(end[0]), float(end[1])
+                    drive.linear = ((drive.x - start[0]) * 1000.0 / dt, (drive.y - start[1]) * 1000.0 / dt)
                     moved[k] = (robot, drive, start, drive.pose())
         for robot, _, _, pose in moved:
             self.scene.set_robot_pose(robot.index, pose)

@@ -1,36 +1,49 @@
-/* Sensorium C controller library: the Supervisor subset (PROTOCOL.md, supervisor services). A
- * WbNodeRef / WbFieldRef points to a small record kept until wb_robot_cleanup(); one record per
- * node id and per (node, field), so the arrays they hold stay valid between calls. */
+/* Sensorium C controller library: the Supervisor (PROTOCOL.md, supervisor services). A WbNodeRef /
+ * WbFieldRef points to a small record kept until wb_robot_cleanup(); one record per node id and per
+ * (node, field name), so the arrays and strings they hold stay valid between calls (until the next
+ * call on the same node or field, as in Webots). Nodes are the root (id 0), robots, top-level solids
+ * and top-level lights; a reply whose type is "" is Webots' NULL. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <webots/nodes.h>
 #include <webots/supervisor.h>
 
 #include "internal.h"
 
 struct WbNodeStructPrivate {
   int64_t id;
+  WbNodeType type;
+  char type_name[24]; /* "Group", "Robot", "Solid", "PointLight", "SpotLight", "DirectionalLight" */
+  char *def_name;     /* "" without one */
+  int64_t parent;     /* 0 for a top-level node, -1 for the root */
   double position[3];
   double orientation[9];
+  double velocity[6];
   struct WbNodeStructPrivate *next;
 };
 
 struct WbFieldStructPrivate {
   int64_t node;
   WbFieldType type;
-  const char *name; /* "translation" or "rotation" */
+  char *name;
   double value[4];
+  char *string; /* an SFString's last value */
   struct WbFieldStructPrivate *next;
 };
 
 void sn_supervisor_free(sn_robot *rb) {
   for (struct WbNodeStructPrivate *n = rb->nodes, *next; n != NULL; n = next) {
     next = n->next;
+    free(n->def_name);
     free(n);
   }
   for (struct WbFieldStructPrivate *f = rb->fields, *next; f != NULL; f = next) {
     next = f->next;
+    free(f->name);
+    free(f->string);
     free(f);
   }
   rb->nodes = rb->fields = NULL;
@@ -49,19 +62,29 @@ static sn_robot *supervisor(const char *func) {
   return rb;
 }
 
+/* the supervisor's robot when node is a node; Webots' line for a NULL one */
+static sn_robot *supervisor_node(WbNodeRef node, const char *func) {
+  sn_robot *rb = supervisor(func);
+  if (rb != NULL && node == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL or invalid 'node' argument.\n", func);
+    return NULL;
+  }
+  return rb;
+}
+
 void sn_supervisor_unsupported(const char *func, bool *warned) {
   if (supervisor(func) == NULL || *warned)
     return;
   *warned = true;
   fprintf(stderr,
-          "Error: %s(): not served by Sensorium (its Supervisor finds robots and solids by DEF, reads and sets their "
-          "translation and rotation, reads poses, resets and sets the run mode): ignored, Webots' \"no value\" "
-          "returned.\n",
+          "Error: %s(): not served by Sensorium (its Supervisor walks the root's children, reads nodes' identity, "
+          "poses, velocities and fields (translation, rotation, name, lights' fields, ...), sets poses and lights, "
+          "resets and sets the run mode): ignored, Webots' \"no value\" returned.\n",
           func);
 }
 
 static WbNodeRef node_ref(sn_robot *rb, int64_t id) {
-  if (id <= 0)
+  if (id < 0)
     return NULL;
   for (struct WbNodeStructPrivate *n = rb->nodes; n != NULL; n = n->next)
     if (n->id == id)
@@ -70,20 +93,51 @@ static WbNodeRef node_ref(sn_robot *rb, int64_t id) {
   if (n == NULL)
     return NULL;
   n->id = id;
+  n->parent = -1;
   n->next = rb->nodes;
   rb->nodes = n;
+  return n;
+}
+
+static const struct {
+  const char *name;
+  WbNodeType type;
+} NODE_TYPES[] = {{"Group", WB_NODE_GROUP},
+                  {"Robot", WB_NODE_ROBOT},
+                  {"Solid", WB_NODE_SOLID},
+                  {"PointLight", WB_NODE_POINT_LIGHT},
+                  {"SpotLight", WB_NODE_SPOT_LIGHT},
+                  {"DirectionalLight", WB_NODE_DIRECTIONAL_LIGHT}};
+
+static bool str_is(const msgpack_object *o, const char *s) {
+  return o != NULL && o->type == MSGPACK_OBJECT_STR && o->via.str.size == strlen(s) &&
+         memcmp(o->via.str.ptr, s, o->via.str.size) == 0;
+}
+
+/* A node reply (PROTOCOL.md): the node's record, its identity refreshed; NULL for type "". */
+static WbNodeRef node_from_reply(sn_robot *rb, sn_reply *rep) {
+  const msgpack_object *type = sn_get(rep->result, "type");
+  WbNodeRef n = NULL;
+  for (size_t i = 0; i < sizeof NODE_TYPES / sizeof NODE_TYPES[0]; i++)
+    if (str_is(type, NODE_TYPES[i].name)) {
+      n = node_ref(rb, sn_int_or(rep->result, "node", -1));
+      if (n == NULL)
+        break;
+      n->type = NODE_TYPES[i].type;
+      snprintf(n->type_name, sizeof n->type_name, "%s", NODE_TYPES[i].name);
+      char *def = sn_strdup_obj(sn_get(rep->result, "def_name"));
+      free(n->def_name);
+      n->def_name = def;
+      n->parent = sn_int_or(rep->result, "parent", -1);
+      break;
+    }
+  sn_reply_free(rep);
   return n;
 }
 
 static void args_name(sn_req *r, const void *arg) {
   sn_req_key(r, "name");
   sn_req_str(r, (const char *)arg);
-}
-
-static WbNodeRef node_from_reply(sn_robot *rb, sn_reply *rep) {
-  WbNodeRef n = node_ref(rb, sn_int_or(rep->result, "node", 0));
-  sn_reply_free(rep);
-  return n;
 }
 
 WbNodeRef wb_supervisor_node_get_from_def(const char *def) {
@@ -101,13 +155,73 @@ WbNodeRef wb_supervisor_node_get_from_def(const char *def) {
   return node_from_reply(rb, &rep);
 }
 
-WbNodeRef wb_supervisor_node_get_self(void) {
-  const char *func = "wb_supervisor_node_get_self";
+static WbNodeRef node_without_args(const char *item, const char *func) {
   sn_robot *rb = supervisor(func);
   sn_reply rep;
-  if (rb == NULL || sn_robot_call(rb, "robot/get_self", 0, NULL, NULL, func, &rep) != 0)
+  if (rb == NULL || sn_robot_call(rb, item, 0, NULL, NULL, func, &rep) != 0)
     return NULL;
   return node_from_reply(rb, &rep);
+}
+
+WbNodeRef wb_supervisor_node_get_self(void) {
+  return node_without_args("robot/get_self", "wb_supervisor_node_get_self");
+}
+
+WbNodeRef wb_supervisor_node_get_root(void) {
+  return node_without_args("robot/get_root", "wb_supervisor_node_get_root");
+}
+
+static void args_id(sn_req *r, const void *arg) {
+  sn_req_key(r, "id");
+  msgpack_pack_int64(&r->pk, *(const int64_t *)arg);
+}
+
+static WbNodeRef node_from_id(int64_t id, const char *func) {
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return NULL;
+  if (id < 0) {
+    fprintf(stderr, "Error: %s() called with a negative 'id' argument.\n", func);
+    return NULL;
+  }
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/get_from_id", 1, args_id, &id, func, &rep) != 0)
+    return NULL;
+  return node_from_reply(rb, &rep);
+}
+
+WbNodeRef wb_supervisor_node_get_from_id(int id) {
+  return node_from_id(id, "wb_supervisor_node_get_from_id");
+}
+
+WbNodeRef wb_supervisor_node_get_parent_node(WbNodeRef node) {
+  const char *func = "wb_supervisor_node_get_parent_node";
+  if (supervisor_node(node, func) == NULL || node->parent < 0)
+    return NULL; /* the root has no parent */
+  return node_from_id(node->parent, func);
+}
+
+int wb_supervisor_node_get_id(WbNodeRef node) {
+  return supervisor_node(node, "wb_supervisor_node_get_id") != NULL ? (int)node->id : -1;
+}
+
+WbNodeType wb_supervisor_node_get_type(WbNodeRef node) {
+  return supervisor_node(node, "wb_supervisor_node_get_type") != NULL ? node->type : WB_NODE_NO_NODE;
+}
+
+const char *wb_supervisor_node_get_type_name(WbNodeRef node) {
+  return supervisor_node(node, "wb_supervisor_node_get_type_name") != NULL ? node->type_name : "";
+}
+
+/* no PROTO names here: a node's type is its base type */
+const char *wb_supervisor_node_get_base_type_name(WbNodeRef node) {
+  return supervisor_node(node, "wb_supervisor_node_get_base_type_name") != NULL ? node->type_name : "";
+}
+
+const char *wb_supervisor_node_get_def(WbNodeRef node) {
+  if (supervisor_node(node, "wb_supervisor_node_get_def") == NULL)
+    return "";
+  return node->def_name != NULL ? node->def_name : "";
 }
 
 static void args_node(sn_req *r, const void *arg) {
@@ -147,30 +261,122 @@ const double *wb_supervisor_node_get_orientation(WbNodeRef node) {
   return node_pose(node, false, "wb_supervisor_node_get_orientation");
 }
 
+/* linear (m/s) then angular (rad/s) velocity in world axes: a driven robot's last step, zeros for
+   anything else; Webots' NaNs for a NULL node */
+const double *wb_supervisor_node_get_velocity(WbNodeRef node) {
+  const char *func = "wb_supervisor_node_get_velocity";
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/get_node_velocity", 1, args_node, &node->id, func, &rep) != 0)
+    return sn_no_values();
+  bool ok = copy_numbers(sn_get(rep.result, "value"), node->velocity, 6);
+  sn_reply_free(&rep);
+  if (!ok)
+    fprintf(stderr, "Error: %s(): malformed reply\n", func);
+  return ok ? node->velocity : sn_no_values();
+}
+
+/* No physics: a robot moves by its wheels (which keep their commands), solids are static; a velocity
+   set from outside has nothing to act on: one warning, ignored. */
+void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
+  (void)velocity;
+  static bool warned;
+  if (supervisor_node(node, "wb_supervisor_node_set_velocity") == NULL || warned)
+    return;
+  warned = true;
+  fprintf(stderr, "Warning: wb_supervisor_node_set_velocity(): ignored: Sensorium has no physics (robots move by "
+                  "their wheels' commands, solids are static).\n");
+}
+
+/* Webots zeroes the node's velocities and keeps the motors' commands; without physics there is no
+   momentum to clear: nothing to do. */
+void wb_supervisor_node_reset_physics(WbNodeRef node) {
+  supervisor_node(node, "wb_supervisor_node_reset_physics");
+}
+
+void wb_supervisor_simulation_reset_physics(void) {
+  supervisor("wb_supervisor_simulation_reset_physics");
+}
+
+void wb_supervisor_simulation_physics_reset(void) {
+  supervisor("wb_supervisor_simulation_physics_reset");
+}
+
+/* ------------------------------------------------------------------ fields */
+static const struct {
+  const char *name;
+  WbFieldType type;
+} FIELD_TYPES[] = {{"SFBool", WB_SF_BOOL},     {"SFFloat", WB_SF_FLOAT},   {"SFVec3f", WB_SF_VEC3F},
+                   {"SFRotation", WB_SF_ROTATION}, {"SFColor", WB_SF_COLOR}, {"SFString", WB_SF_STRING},
+                   {"MFNode", WB_MF_NODE}};
+
+typedef struct {
+  int64_t node;
+  const char *name;
+  int kind; /* 0: no value, 1: bool, 2: double, 3: numbers */
+  bool flag;
+  double number;
+  const double *values;
+  int n;
+} field_args;
+
+static void args_field(sn_req *r, const void *arg) {
+  const field_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "field");
+  sn_req_str(r, a->name);
+  if (a->kind == 0)
+    return;
+  sn_req_key(r, "value");
+  if (a->kind == 1)
+    sn_arg_bool(r, &a->flag);
+  else if (a->kind == 2)
+    msgpack_pack_double(&r->pk, a->number);
+  else {
+    msgpack_pack_array(&r->pk, (size_t)a->n);
+    for (int i = 0; i < a->n; i++)
+      msgpack_pack_double(&r->pk, a->values[i]);
+  }
+}
+
 WbFieldRef wb_supervisor_node_get_field(WbNodeRef node, const char *field_name) {
   const char *func = "wb_supervisor_node_get_field";
-  sn_robot *rb = supervisor(func);
-  if (rb == NULL || node == NULL)
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb == NULL)
     return NULL;
-  WbFieldType type = WB_NO_FIELD;
-  const char *name = NULL;
-  if (field_name != NULL && strcmp(field_name, "translation") == 0)
-    type = WB_SF_VEC3F, name = "translation";
-  else if (field_name != NULL && strcmp(field_name, "rotation") == 0)
-    type = WB_SF_ROTATION, name = "rotation";
-  if (name == NULL) {
-    fprintf(stderr, "Error: %s(): field '%s' is not supported by Sensorium (only 'translation' and 'rotation').\n",
-            func, field_name ? field_name : "(null)");
+  if (field_name == NULL || *field_name == '\0' || strlen(field_name) > 64) {
+    fprintf(stderr, "Error: %s() called with a NULL, empty or invalid 'field_name' argument.\n", func);
     return NULL;
   }
   for (struct WbFieldStructPrivate *f = rb->fields; f != NULL; f = f->next)
-    if (f->node == node->id && f->type == type)
+    if (f->node == node->id && strcmp(f->name, field_name) == 0)
       return f;
-  struct WbFieldStructPrivate *f = calloc(1, sizeof *f);
-  if (f == NULL)
+  field_args a = {node->id, field_name, 0, false, 0.0, NULL, 0};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/get_field", 2, args_field, &a, func, &rep) != 0)
     return NULL;
+  const msgpack_object *type = sn_get(rep.result, "type");
+  WbFieldType t = WB_NO_FIELD;
+  for (size_t i = 0; i < sizeof FIELD_TYPES / sizeof FIELD_TYPES[0]; i++)
+    if (str_is(type, FIELD_TYPES[i].name))
+      t = FIELD_TYPES[i].type;
+  sn_reply_free(&rep);
+  if (t == WB_NO_FIELD) {
+    fprintf(stderr, "Error: %s(): node %d (%s) has no field '%s' in Sensorium (README \"Supervisor\" lists the fields "
+                    "of each node kind).\n", func, (int)node->id, node->type_name, field_name);
+    return NULL;
+  }
+  struct WbFieldStructPrivate *f = calloc(1, sizeof *f);
+  char *name = malloc(strlen(field_name) + 1);
+  if (f == NULL || name == NULL) {
+    free(f);
+    free(name);
+    return NULL;
+  }
+  strcpy(name, field_name);
   f->node = node->id;
-  f->type = type;
+  f->type = t;
   f->name = name;
   f->next = rb->fields;
   rb->fields = f;
@@ -182,20 +388,183 @@ WbFieldType wb_supervisor_field_get_type(WbFieldRef field) { return field ? fiel
 const char *wb_supervisor_field_get_name(WbFieldRef field) { return field ? field->name : ""; }
 
 const char *wb_supervisor_field_get_type_name(WbFieldRef field) {
-  if (field == NULL)
-    return "";
-  return field->type == WB_SF_VEC3F ? "SFVec3f" : "SFRotation";
+  if (field != NULL)
+    for (size_t i = 0; i < sizeof FIELD_TYPES / sizeof FIELD_TYPES[0]; i++)
+      if (FIELD_TYPES[i].type == field->type)
+        return FIELD_TYPES[i].name;
+  return "";
+}
+
+/* The field's value: 0 with rep filled (free it) and *value its "value" object, -1 after Webots' line
+   for a NULL field or a wrong type (type WB_NO_FIELD: any). */
+static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_reply *rep,
+                       const msgpack_object **value) {
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return -1;
+  if (field == NULL) {
+    fprintf(stderr, "Error: %s() called with NULL 'field' argument.\n", func);
+    return -1;
+  }
+  if (type != WB_NO_FIELD && field->type != type) {
+    fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
+    return -1;
+  }
+  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0};
+  if (sn_robot_call(rb, "robot/get_field", 2, args_field, &a, func, rep) != 0)
+    return -1;
+  *value = sn_get(rep->result, "value");
+  return 0;
 }
 
 int wb_supervisor_field_get_count(WbFieldRef field) {
-  (void)field;
-  return -1; /* Webots' count of a single (SF) field; Sensorium has no MF field */
+  sn_reply rep;
+  const msgpack_object *v;
+  if (field == NULL || !(field->type & WB_MF) ||
+      field_value(field, WB_NO_FIELD, "wb_supervisor_field_get_count", &rep, &v) != 0)
+    return -1; /* Webots' count of a single (SF) field */
+  int n = v != NULL && v->type == MSGPACK_OBJECT_ARRAY ? (int)v->via.array.size : -1;
+  sn_reply_free(&rep);
+  return n;
 }
 
-int wb_supervisor_node_get_id(WbNodeRef node) {
-  return node != NULL ? (int)node->id : -1;
+bool wb_supervisor_field_get_sf_bool(WbFieldRef field) {
+  sn_reply rep;
+  const msgpack_object *v;
+  if (field_value(field, WB_SF_BOOL, "wb_supervisor_field_get_sf_bool", &rep, &v) != 0)
+    return false;
+  bool out = v != NULL && v->type == MSGPACK_OBJECT_BOOLEAN && v->via.boolean;
+  sn_reply_free(&rep);
+  return out;
 }
 
+double wb_supervisor_field_get_sf_float(WbFieldRef field) {
+  sn_reply rep;
+  const msgpack_object *v;
+  double out = NAN;
+  if (field_value(field, WB_SF_FLOAT, "wb_supervisor_field_get_sf_float", &rep, &v) != 0)
+    return NAN;
+  if (v == NULL || !sn_as_double(v, &out))
+    out = NAN;
+  sn_reply_free(&rep);
+  return out;
+}
+
+const char *wb_supervisor_field_get_sf_string(WbFieldRef field) {
+  sn_reply rep;
+  const msgpack_object *v;
+  if (field_value(field, WB_SF_STRING, "wb_supervisor_field_get_sf_string", &rep, &v) != 0)
+    return "";
+  char *copy = sn_strdup_obj(v);
+  sn_reply_free(&rep);
+  if (copy == NULL)
+    return "";
+  free(field->string);
+  field->string = copy;
+  return copy;
+}
+
+static const double *field_numbers(WbFieldRef field, WbFieldType type, const char *func) {
+  sn_reply rep;
+  const msgpack_object *v;
+  if (field_value(field, type, func, &rep, &v) != 0)
+    return NULL;
+  bool ok = copy_numbers(v, field->value, type == WB_SF_ROTATION ? 4 : 3);
+  sn_reply_free(&rep);
+  if (!ok)
+    fprintf(stderr, "Error: %s(): malformed reply\n", func);
+  return ok ? field->value : NULL;
+}
+
+const double *wb_supervisor_field_get_sf_vec3f(WbFieldRef field) {
+  return field_numbers(field, WB_SF_VEC3F, "wb_supervisor_field_get_sf_vec3f");
+}
+
+const double *wb_supervisor_field_get_sf_rotation(WbFieldRef field) {
+  return field_numbers(field, WB_SF_ROTATION, "wb_supervisor_field_get_sf_rotation");
+}
+
+const double *wb_supervisor_field_get_sf_color(WbFieldRef field) {
+  return field_numbers(field, WB_SF_COLOR, "wb_supervisor_field_get_sf_color");
+}
+
+/* item index of an MFNode field (negative counts from the end, as Webots) */
+WbNodeRef wb_supervisor_field_get_mf_node(WbFieldRef field, int index) {
+  const char *func = "wb_supervisor_field_get_mf_node";
+  sn_reply rep;
+  const msgpack_object *v;
+  if (field_value(field, WB_MF_NODE, func, &rep, &v) != 0)
+    return NULL;
+  int count = v != NULL && v->type == MSGPACK_OBJECT_ARRAY ? (int)v->via.array.size : 0;
+  int64_t id = -1;
+  if (index < -count || index >= count) {
+    if (count == 0)
+      fprintf(stderr, "Error: %s() called on an empty list.\n", func);
+    else
+      fprintf(stderr, "Error: %s() called with an out-of-bound index: %d (should be between %d and %d).\n", func,
+              index, -count, count - 1);
+  } else if (!sn_as_int64(&v->via.array.ptr[index < 0 ? index + count : index], &id))
+    id = -1;
+  sn_reply_free(&rep);
+  return id < 0 ? NULL : node_from_id(id, func);
+}
+
+static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const char *func) {
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return;
+  if (field == NULL) {
+    fprintf(stderr, "Error: %s() called with NULL 'field' argument.\n", func);
+    return;
+  }
+  if (field->type != type) {
+    fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
+    return;
+  }
+  if (a->kind == 3 && a->values == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL 'values' argument.\n", func);
+    return;
+  }
+  bool finite = a->kind != 2 || isfinite(a->number);
+  for (int i = 0; a->kind == 3 && i < a->n; i++)
+    finite = finite && isfinite(a->values[i]);
+  if (!finite) {
+    fprintf(stderr, "Error: %s() called with a NaN or infinite value.\n", func);
+    return;
+  }
+  a->node = field->node;
+  a->name = field->name;
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/set_field", 3, args_field, a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
+void wb_supervisor_field_set_sf_bool(WbFieldRef field, bool value) {
+  field_args a = {0, NULL, 1, value, 0.0, NULL, 0};
+  field_set(field, WB_SF_BOOL, &a, "wb_supervisor_field_set_sf_bool");
+}
+
+void wb_supervisor_field_set_sf_float(WbFieldRef field, double value) {
+  field_args a = {0, NULL, 2, false, value, NULL, 0};
+  field_set(field, WB_SF_FLOAT, &a, "wb_supervisor_field_set_sf_float");
+}
+
+void wb_supervisor_field_set_sf_vec3f(WbFieldRef field, const double values[3]) {
+  field_args a = {0, NULL, 3, false, 0.0, values, 3};
+  field_set(field, WB_SF_VEC3F, &a, "wb_supervisor_field_set_sf_vec3f");
+}
+
+void wb_supervisor_field_set_sf_rotation(WbFieldRef field, const double values[4]) {
+  field_args a = {0, NULL, 3, false, 0.0, values, 4};
+  field_set(field, WB_SF_ROTATION, &a, "wb_supervisor_field_set_sf_rotation");
+}
+
+void wb_supervisor_field_set_sf_color(WbFieldRef field, const double values[3]) {
+  field_args a = {0, NULL, 3, false, 0.0, values, 3};
+  field_set(field, WB_SF_COLOR, &a, "wb_supervisor_field_set_sf_color");
+}
+
+/* ------------------------------------------------------------------ the simulation */
 void wb_supervisor_simulation_quit(int status) {
   const char *func = "wb_supervisor_simulation_quit";
   sn_robot *rb = supervisor(func);
@@ -206,79 +575,6 @@ void wb_supervisor_simulation_quit(int status) {
   fprintf(stderr, "Warning: %s(%d): the server runs on until it is stopped; robot '%s' "
           "steps no more (wb_robot_step() returns -1).\n", func, status, rb->name);
   rb->terminated = true;
-}
-
-typedef struct {
-  const struct WbFieldStructPrivate *field;
-  const double *values;
-  int n;
-} field_args;
-
-static void args_field(sn_req *r, const void *arg) {
-  const field_args *a = arg;
-  sn_req_key(r, "node");
-  msgpack_pack_int64(&r->pk, a->field->node);
-  sn_req_key(r, "field");
-  sn_req_str(r, a->field->name);
-  if (a->values != NULL) {
-    sn_req_key(r, "value");
-    msgpack_pack_array(&r->pk, (size_t)a->n);
-    for (int i = 0; i < a->n; i++)
-      msgpack_pack_double(&r->pk, a->values[i]);
-  }
-}
-
-static const double *field_get(WbFieldRef field, WbFieldType type, const char *func) {
-  sn_robot *rb = supervisor(func);
-  if (rb == NULL || field == NULL)
-    return NULL;
-  if (field->type != type) {
-    fprintf(stderr, "Error: %s() called with a field of the wrong type (%s).\n", func, field->name);
-    return NULL;
-  }
-  field_args a = {field, NULL, 0};
-  sn_reply rep;
-  if (sn_robot_call(rb, "robot/get_field", 2, args_field, &a, func, &rep) != 0)
-    return NULL;
-  bool ok = copy_numbers(sn_get(rep.result, "value"), field->value, type == WB_SF_VEC3F ? 3 : 4);
-  sn_reply_free(&rep);
-  if (!ok)
-    fprintf(stderr, "Error: %s(): malformed reply\n", func);
-  return ok ? field->value : NULL;
-}
-
-static void field_set(WbFieldRef field, WbFieldType type, const double *values, const char *func) {
-  sn_robot *rb = supervisor(func);
-  if (rb == NULL || field == NULL)
-    return;
-  if (field->type != type) {
-    fprintf(stderr, "Error: %s() called with a field of the wrong type (%s).\n", func, field->name);
-    return;
-  }
-  if (values == NULL) {
-    fprintf(stderr, "Error: %s() called with a NULL 'values' argument.\n", func);
-    return;
-  }
-  field_args a = {field, values, type == WB_SF_VEC3F ? 3 : 4};
-  sn_reply rep;
-  if (sn_robot_call(rb, "robot/set_field", 3, args_field, &a, func, &rep) == 0)
-    sn_reply_free(&rep);
-}
-
-const double *wb_supervisor_field_get_sf_vec3f(WbFieldRef field) {
-  return field_get(field, WB_SF_VEC3F, "wb_supervisor_field_get_sf_vec3f");
-}
-
-void wb_supervisor_field_set_sf_vec3f(WbFieldRef field, const double values[3]) {
-  field_set(field, WB_SF_VEC3F, values, "wb_supervisor_field_set_sf_vec3f");
-}
-
-const double *wb_supervisor_field_get_sf_rotation(WbFieldRef field) {
-  return field_get(field, WB_SF_ROTATION, "wb_supervisor_field_get_sf_rotation");
-}
-
-void wb_supervisor_field_set_sf_rotation(WbFieldRef field, const double values[4]) {
-  field_set(field, WB_SF_ROTATION, values, "wb_supervisor_field_set_sf_rotation");
 }
 
 void wb_supervisor_simulation_reset(void) {

@@ -25,9 +25,6 @@ void wb_supervisor_world_reload(void) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_simulation_reset_physics(void) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_set_label(int id, const char *text, double x, double y, double size, int color, double transparency, const char *font) {
   SN_UNSUPPORTED();
@@ -65,15 +62,7 @@ bool wb_supervisor_animation_stop_recording(void) {
   return false;
 }
 
-WbNodeRef wb_supervisor_node_get_root(void) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
 
-WbNodeRef wb_supervisor_node_get_from_id(int id) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
 
 WbNodeRef wb_supervisor_node_get_from_device(WbDeviceTag tag) {
   SN_UNSUPPORTED();
@@ -85,20 +74,12 @@ WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def)
   return NULL;
 }
 
-WbNodeRef wb_supervisor_node_get_parent_node(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
 
 WbNodeRef wb_supervisor_node_get_selected(void) {
   SN_UNSUPPORTED();
   return NULL;
 }
 
-WbNodeType wb_supervisor_node_get_type(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return WB_NODE_NO_NODE;
-}
 
 WbFieldRef wb_supervisor_node_get_field_by_index(WbNodeRef node, int index) {
   SN_UNSUPPORTED();
@@ -146,20 +127,8 @@ WbProtoRef wb_supervisor_node_get_proto(WbNodeRef node) {
   return NULL;
 }
 
-const char *wb_supervisor_node_get_def(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return "";
-}
 
-const char *wb_supervisor_node_get_type_name(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return "";
-}
 
-const char *wb_supervisor_node_get_base_type_name(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return "";
-}
 
 bool wb_supervisor_node_is_proto(WbNodeRef node) {
   SN_UNSUPPORTED();
@@ -181,18 +150,8 @@ bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
   return false;
 }
 
-const double *wb_supervisor_node_get_velocity(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
 
-void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
-  SN_UNSUPPORTED();
-}
 
-void wb_supervisor_node_reset_physics(WbNodeRef node) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_node_restart_controller(WbNodeRef node) {
   SN_UNSUPPORTED();
@@ -244,35 +203,19 @@ void wb_supervisor_node_disable_pose_tracking(WbNodeRef node, WbNodeRef from_nod
   SN_UNSUPPORTED();
 }
 
-bool wb_supervisor_field_get_sf_bool(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return false;
-}
 
 int wb_supervisor_field_get_sf_int32(WbFieldRef field) {
   SN_UNSUPPORTED();
   return 0;
 }
 
-double wb_supervisor_field_get_sf_float(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return NAN;
-}
 
 const double *wb_supervisor_field_get_sf_vec2f(WbFieldRef field) {
   SN_UNSUPPORTED();
   return sn_no_values();
 }
 
-const double *wb_supervisor_field_get_sf_color(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
 
-const char *wb_supervisor_field_get_sf_string(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return "";
-}
 
 WbNodeRef wb_supervisor_field_get_sf_node(WbFieldRef field) {
   SN_UNSUPPORTED();
@@ -319,30 +262,17 @@ const char *wb_supervisor_field_get_mf_string(WbFieldRef field, int index) {
   return "";
 }
 
-WbNodeRef wb_supervisor_field_get_mf_node(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
 
-void wb_supervisor_field_set_sf_bool(WbFieldRef field, bool value) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_field_set_sf_int32(WbFieldRef field, int value) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_set_sf_float(WbFieldRef field, double value) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_field_set_sf_vec2f(WbFieldRef field, const double values[2]) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_set_sf_color(WbFieldRef field, const double values[3]) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_field_set_sf_string(WbFieldRef field, const char *value) {
   SN_UNSUPPORTED();
@@ -495,9 +425,6 @@ void wb_supervisor_field_remove_mf_node(WbFieldRef field, int position) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_simulation_physics_reset(void) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_start_movie(const char *file, int width, int height, int codec, int quality, int acceleration, bool caption) {
   SN_UNSUPPORTED();

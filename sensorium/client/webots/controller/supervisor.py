@@ -1,6 +1,8 @@
-"""Webots' ``Supervisor``, ``Node`` and ``Field`` classes — the subset Sensorium serves: find
-robots and solids by name, read and set their ``translation``/``rotation``, their world pose,
-reset the simulation and change its mode. The robot's world entry needs ``supervisor: true``.
+"""Webots' ``Supervisor``, ``Node`` and ``Field`` classes — what Sensorium serves: the root and its
+``children`` (robots, top-level solids and lights), nodes by DEF, id or name, their identity (type,
+DEF, parent), fields (``translation``/``rotation`` read and set, ``name``, ``model``, ``customData``,
+lights' ``on``/``intensity``/``color``/... read and set), world poses and velocities; reset the
+simulation and change its mode. The robot's world entry needs ``supervisor: true``.
 ``simulationQuit`` ends this controller's steps (-1; the server runs on). Every other method of
 Webots' classes is there too: it does nothing, prints one error line the first time and answers
 Webots' "no value" (as the C library's functions)."""
@@ -18,10 +20,18 @@ from .robot import Robot
 
 
 class Field:
+    SF_BOOL = wb.WB_SF_BOOL
+    SF_INT32 = wb.WB_SF_INT32
+    SF_FLOAT = wb.WB_SF_FLOAT
+    SF_VEC2F = wb.WB_SF_VEC2F
     SF_VEC3F = wb.WB_SF_VEC3F
     SF_ROTATION = wb.WB_SF_ROTATION
+    SF_COLOR = wb.WB_SF_COLOR
+    SF_STRING = wb.WB_SF_STRING
+    SF_NODE = wb.WB_SF_NODE
+    MF_NODE = wb.WB_MF_NODE
 
-    def __init__(self, ref: tuple[int, str]):
+    def __init__(self, ref: tuple[int, str, int]):
         self._ref = ref
 
     def getName(self) -> str:
@@ -31,58 +41,116 @@ class Field:
         return wb.wb_supervisor_field_get_type(self._ref)
 
     def getTypeName(self) -> str:
-        return "SFVec3f" if self._ref[1] == "translation" else "SFRotation"
+        return wb.wb_supervisor_field_get_type_name(self._ref)
+
+    def getCount(self) -> int:
+        return wb.wb_supervisor_field_get_count(self._ref)
+
+    def getSFBool(self) -> bool:
+        return wb.wb_supervisor_field_get_sf_bool(self._ref)
+
+    def getSFFloat(self) -> float:
+        return wb.wb_supervisor_field_get_sf_float(self._ref)
+
+    def getSFString(self) -> str:
+        return wb.wb_supervisor_field_get_sf_string(self._ref)
 
     def getSFVec3f(self) -> list[float] | None:
         return wb.wb_supervisor_field_get_sf_vec3f(self._ref)
 
-    def setSFVec3f(self, values: list[float]) -> None:
-        wb.wb_supervisor_field_set_sf_vec3f(self._ref, values)
-
     def getSFRotation(self) -> list[float] | None:
         return wb.wb_supervisor_field_get_sf_rotation(self._ref)
 
-    def getCount(self) -> int:
-        return -1  # Webots' count of a single (SF) field; Sensorium has no MF field
+    def getSFColor(self) -> list[float] | None:
+        return wb.wb_supervisor_field_get_sf_color(self._ref)
+
+    def getMFNode(self, index: int) -> Node | None:
+        return _node_of(wb.wb_supervisor_field_get_mf_node(self._ref, index))
+
+    def setSFBool(self, value: bool) -> None:
+        wb.wb_supervisor_field_set_sf_bool(self._ref, value)
+
+    def setSFFloat(self, value: float) -> None:
+        wb.wb_supervisor_field_set_sf_float(self._ref, value)
+
+    def setSFVec3f(self, values: list[float]) -> None:
+        wb.wb_supervisor_field_set_sf_vec3f(self._ref, values)
 
     def setSFRotation(self, values: list[float]) -> None:
         wb.wb_supervisor_field_set_sf_rotation(self._ref, values)
 
+    def setSFColor(self, values: list[float]) -> None:
+        wb.wb_supervisor_field_set_sf_color(self._ref, values)
+
+    _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_FLOAT: getSFFloat, wb.WB_SF_STRING: getSFString,
+                wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor}
+
     name = property(getName)
     type = property(getType)
-    value = property(lambda self: self.getSFVec3f() if self._ref[1] == "translation" else self.getSFRotation())
+
+    @property
+    def value(self) -> Any:
+        """Webots' ``Field.value``: an SF field's value; an MF field's items as a list."""
+        if self._ref[2] == wb.WB_MF_NODE:
+            return [self.getMFNode(i) for i in range(self.getCount())]
+        return Field._GETTERS[self._ref[2]](self)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Field) and other._ref == self._ref
+
+    def __hash__(self) -> int:
+        return hash(self._ref)
 
     def __repr__(self) -> str:
         return f"Field({self._ref[1]!r} of node {self._ref[0]})"
 
 
 class Node:
-    def __init__(self, ref: int, type_name: str = "", name: str = ""):
+    """A node of the scene tree Sensorium has: the root (id 0), a robot, a top-level solid or light."""
+
+    def __init__(self, ref: int, type_name: str = "", name: str = "", def_name: str = "", parent: int = -1):
         self._ref = ref
         self._type_name = type_name
         self._name = name
+        self._def = def_name
+        self._parent = parent
 
     def getId(self) -> int:
         return self._ref
 
     def getDef(self) -> str:
-        return self._name
+        return self._def
 
     def getTypeName(self) -> str:
         return self._type_name
 
     def getBaseTypeName(self) -> str:
-        return self._type_name
+        return self._type_name      # no PROTO names here: a node's type is its base type
+
+    def getType(self) -> int:
+        return nodes.WEBOTS_NODE_TYPES[wb.NODE_TYPES.get(self._type_name, "WB_NODE_NO_NODE")]
+
+    def getParentNode(self) -> Node | None:
+        return _node_of(self._parent) if self._parent >= 0 else None
 
     def getField(self, fieldName: str) -> Field | None:  # noqa: N803 - Webots' parameter name
         ref = wb.wb_supervisor_node_get_field(self._ref, fieldName)
         return None if ref is None else Field(ref)
 
-    def getPosition(self) -> list[float] | None:
+    def getPosition(self) -> list[float]:
         return wb.wb_supervisor_node_get_position(self._ref)
 
-    def getOrientation(self) -> list[float] | None:
+    def getOrientation(self) -> list[float]:
         return wb.wb_supervisor_node_get_orientation(self._ref)
+
+    def getVelocity(self) -> list[float]:
+        return wb.wb_supervisor_node_get_velocity(self._ref)
+
+    def setVelocity(self, velocity: list[float]) -> None:
+        wb.wb_supervisor_node_set_velocity(self._ref, velocity)
+
+    def resetPhysics(self) -> None:
+        wb.wb_supervisor_node_reset_physics(self._ref)
 
     # -- contact points: Sensorium has no physics contacts, so a node touches nothing (as in the C client)
     def getContactPoints(self, includeDescendants: bool = False) -> list[ContactPoint]:  # noqa: N803
@@ -118,9 +186,17 @@ class Node:
 
 
 def _node(ref: dict | None) -> Node | None:
-    if not ref or not ref.get("node"):
+    if not ref or not ref.get("type"):
         return None
-    return Node(int(ref["node"]), str(ref.get("type", "")), str(ref.get("name", "")))
+    return Node(int(ref["node"]), str(ref["type"]), str(ref.get("name", "")), str(ref.get("def_name", "")),
+                int(ref.get("parent", -1)))
+
+
+def _node_of(node: int | None) -> Node | None:
+    """The Node object of a node id (its type, name, DEF and parent from the server)."""
+    if node is None:
+        return None
+    return _node(wb.node_info(node, "wb_supervisor_node_get_from_id"))
 
 
 # Webots' node types as Node class constants (Node.ROBOT, Node.GPS, ...)
@@ -149,15 +225,21 @@ class Supervisor(Robot):
     SIMULATION_MODE_REAL_TIME = wb.WB_SUPERVISOR_SIMULATION_MODE_REAL_TIME
     SIMULATION_MODE_FAST = wb.WB_SUPERVISOR_SIMULATION_MODE_FAST
 
+    def getRoot(self) -> Node | None:
+        return _node_of(wb.wb_supervisor_node_get_root())
+
     def getFromDef(self, name: str) -> Node | None:
         return _node(self._lookup("get_from_def", {"name": name}, "wb_supervisor_node_get_from_def", name))
 
     def getSelf(self) -> Node | None:
         return _node(self._lookup("get_self", None, "wb_supervisor_node_get_self", "self"))
 
+    def getFromId(self, id: int) -> Node | None:  # noqa: A002 - Webots' parameter name
+        return _node_of(wb.wb_supervisor_node_get_from_id(id))
+
     @staticmethod
     def _lookup(item: str, args: dict | None, func: str, name: str) -> dict | None:
-        """The node reference (with its type and name, which the flat API's int id lacks)."""
+        """The node reference (with its type, name, DEF and parent, which the flat API's int id lacks)."""
         r = wb.current()
         if not r.supervisor:
             getattr(wb, func)(*([name] if args else []))      # prints Webots' error, answers NULL
@@ -168,6 +250,9 @@ class Supervisor(Robot):
 
     def simulationReset(self) -> None:
         wb.wb_supervisor_simulation_reset()
+
+    def simulationResetPhysics(self) -> None:
+        wb.wb_supervisor_simulation_reset_physics()
 
     def simulationSetMode(self, mode: int) -> None:
         wb.wb_supervisor_simulation_set_mode(mode)
@@ -201,9 +286,8 @@ _NAN = math.nan
 # Webots' methods beyond the subset: Python name -> (the C function it stands for, its "no value")
 _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
     Supervisor: {
-        "getRoot": ("node_get_root", None), "getFromId": ("node_get_from_id", None),
         "getFromDevice": ("node_get_from_device", None), "getSelected": ("node_get_selected", None),
-        "setLabel": ("set_label", None), "simulationResetPhysics": ("simulation_reset_physics", None),
+        "setLabel": ("set_label", None),
         "worldLoad": ("world_load", None), "worldSave": ("world_save", False), "worldReload": ("world_reload", None),
         "exportImage": ("export_image", None), "movieStartRecording": ("movie_start_recording", None),
         "movieStopRecording": ("movie_stop_recording", None), "movieIsReady": ("movie_is_ready", True),
@@ -213,8 +297,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3),
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9)},
     Node: {
-        "getType": ("node_get_type", nodes.WEBOTS_NODE_TYPES["WB_NODE_NO_NODE"]),
-        "getParentNode": ("node_get_parent_node", None), "isProto": ("node_is_proto", False),
+        "isProto": ("node_is_proto", False),
         "getProto": ("node_get_proto", None), "getFromProtoDef": ("node_get_from_proto_def", None),
         "getNumberOfFields": ("node_get_number_of_fields", -1),
         "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1),
@@ -224,9 +307,8 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "enablePoseTracking": ("node_enable_pose_tracking", None),
         "disablePoseTracking": ("node_disable_pose_tracking", None),
         "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3),
-        "getStaticBalance": ("node_get_static_balance", False), "getVelocity": ("node_get_velocity", [_NAN] * 6),
-        "setVelocity": ("node_set_velocity", None), "saveState": ("node_save_state", None),
-        "loadState": ("node_load_state", None), "resetPhysics": ("node_reset_physics", None),
+        "getStaticBalance": ("node_get_static_balance", False), "saveState": ("node_save_state", None),
+        "loadState": ("node_load_state", None),
         "setJointPosition": ("node_set_joint_position", None),
         "restartController": ("node_restart_controller", None), "moveViewpoint": ("node_move_viewpoint", None),
         "setVisibility": ("node_set_visibility", None), "addForce": ("node_add_force", None),
@@ -245,14 +327,14 @@ _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 
                     "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
 for _kind, _none in _FIELD_NO_VALUES.items():
     _c = _kind.lower()
-    _UNSERVED[Field][f"getMF{_kind}"] = (f"field_get_mf_{_c}", _none)
-    if _kind != "Node":
+    if _kind != "Node":         # getMFNode is served (the root's children)
+        _UNSERVED[Field][f"getMF{_kind}"] = (f"field_get_mf_{_c}", _none)
         _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None)
         _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None)
-    if _kind not in ("Vec3f", "Rotation"):   # the two field types Sensorium serves
+    if _kind in ("Int32", "Vec2f", "Node"):   # the SF field types no node here has
         _UNSERVED[Field][f"getSF{_kind}"] = (f"field_get_sf_{_c}", _none)
-        if _kind != "Node":
-            _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None)
+    if _kind in ("Int32", "Vec2f", "String"):  # SFString fields are read-only here
+        _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None)
 for _cls, _methods in _UNSERVED.items():
     for _method, (_func, _value) in _methods.items():
         assert not hasattr(_cls, _method), _method        # never hides a served method
