@@ -125,19 +125,24 @@ class PlanarState:
         self.yaw = math.atan2(forward[1], forward[0])
         self.base = _rz(-self.yaw) @ pose.rotation
         self.x, self.y, self.z = (float(v) for v in pose.translation)
-        self.linear = (0.0, 0.0)      # the last step's velocity (ENU x, y, m/s) and turn rate (rad/s)
+        # the last step's speed along the heading and turn rate (rad/s); ``linear`` (ENU x, y, m/s)
+        # when kinematic contact replaced the move (its actual displacement), else None
+        self.speed = 0.0
         self.turn = 0.0
+        self.linear: tuple[float, float] | None = None
 
     def moved(self, v: float, w: float) -> None:
         """Record the step's motion (v along the heading the step ends with, turn rate w): what
-        :meth:`velocity` reports until the next step. Kinematic contact may replace ``linear``."""
-        self.linear = (v * math.cos(self.yaw), v * math.sin(self.yaw))
-        self.turn = w
+        :meth:`velocity` reports until the next step (worked out only when asked)."""
+        self.speed, self.turn, self.linear = v, w, None
 
     def velocity(self) -> list[float]:
         """Webots' ``getVelocity``: linear (m/s) then angular (rad/s) velocity in world axes, as at
         the end of the last step (zeros when the robot did not move)."""
-        lin, ang = np.array([*self.linear, 0.0]), np.array([0.0, 0.0, self.turn])
+        linear = self.linear
+        if linear is None:
+            linear = (self.speed * math.cos(self.yaw), self.speed * math.sin(self.yaw))
+        lin, ang = np.array([*linear, 0.0]), np.array([0.0, 0.0, self.turn])
         if self._to_enu is not None:
             lin, ang = self._to_enu.T @ lin, self._to_enu.T @ ang
         return [float(v) for v in (*lin, *ang)]
