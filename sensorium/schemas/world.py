@@ -144,7 +144,34 @@ class Mesh(Strict):
     scale: Vec3 = (1.0, 1.0, 1.0)
 
 
-Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Triangles | Mesh, Field(discriminator="type")]
+class ElevationGrid(Strict):
+    """A height field (Webots' ElevationGrid, R2022a+): ``x_dimension`` × ``y_dimension`` points,
+    the grid spanning local x and y from the origin (``x_spacing``, ``y_spacing`` apart), heights
+    along +z, row-major (``height[j * x_dimension + i]`` is the point at ``(i·x_spacing,
+    j·y_spacing)``). Each cell is two triangles split along its diagonal from ``(i, j)`` to
+    ``(i + 1, j + 1)``, as Webots renders it; rays see those triangles exactly."""
+
+    type: Literal["elevation_grid"]
+    height: tuple[float, ...] = Field(max_length=16_000_000, description="x_dimension × y_dimension heights, "
+                                      "row-major: x fastest, the first at the local origin")
+    x_dimension: int = Field(ge=2, le=1_000_000, description="points along x")
+    x_spacing: float = Field(default=1.0, gt=0, description="distance between points along x (m)")
+    y_dimension: int = Field(ge=2, le=1_000_000, description="points along y")
+    y_spacing: float = Field(default=1.0, gt=0, description="distance between points along y (m)")
+    thickness: float = Field(default=0.0, ge=0, description="Webots' physics depth below the lowest "
+                             "point; read and kept, rays see the surface")
+
+    @model_validator(mode="after")
+    def _height_count(self) -> ElevationGrid:
+        need = self.x_dimension * self.y_dimension
+        if len(self.height) != need:
+            raise ValueError(f"height has {len(self.height):,} values; x_dimension × y_dimension = "
+                             f"{self.x_dimension:,} × {self.y_dimension:,} = {need:,} are needed")
+        return self
+
+
+Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Triangles | Mesh | ElevationGrid,
+                     Field(discriminator="type")]
 
 
 class Texture(Strict):

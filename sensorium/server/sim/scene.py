@@ -23,7 +23,7 @@ from sensorium.server.devices.shading import srgb_to_linear
 from sensorium.server.raycast.engine import Precision, RayEngine, ShapeEntry
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
-from sensorium.server.world.meshes import load_mesh, triangles_mesh
+from sensorium.server.world.meshes import elevation_grid_mesh, load_mesh, triangles_mesh
 from sensorium.server.world.poses import pose_from_model
 from sensorium.server.world.textures import TextureSampler
 
@@ -37,8 +37,8 @@ class ShapeInfo:
     transparency: float
 
 
-def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.Plane | wm.Triangles | wm.Mesh | None,
-                         base_dir: Path) -> geo.Primitive:
+def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.Plane | wm.Triangles | wm.Mesh
+                         | wm.ElevationGrid | None, base_dir: Path) -> geo.Primitive:
     """A validated geometry model → its primitive (``TypeError`` for None or an unknown model)."""
     if isinstance(g, wm.Box):
         return geo.Box(size=tuple(g.size))
@@ -54,6 +54,8 @@ def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.P
         return load_mesh(base_dir / g.url, g.scale)
     if isinstance(g, wm.Triangles):
         return triangles_mesh(g.vertices, g.faces)
+    if isinstance(g, wm.ElevationGrid):
+        return elevation_grid_mesh(g.height, g.x_dimension, g.x_spacing, g.y_dimension, g.y_spacing)
     raise TypeError(f"unknown geometry {g!r}")
 
 

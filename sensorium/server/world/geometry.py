@@ -20,7 +20,7 @@ import numpy as np
 
 __all__ = [
     "Box", "Sphere", "Cylinder", "Capsule", "Plane", "Mesh", "Primitive", "Pose",
-    "tessellate", "triangle_count", "valid_faces", "capsule_segments",
+    "tessellate", "triangle_count", "valid_faces", "capsule_segments", "Terrain", "elevation_grid",
 ]
 
 
@@ -127,6 +127,36 @@ class Mesh:
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "faces", f)
         object.__setattr__(self, "closed", bool(self.closed))
+
+
+@dataclass(frozen=True, eq=False)
+class Terrain(Mesh):
+    """The triangles of a height field (an ElevationGrid): a mesh to the ray engine, ground to the
+    kinematic contact (robots move in a plane; a terrain never stops them, as a floor plane)."""
+
+
+def elevation_grid(height, x_dimension: int, x_spacing: float, y_dimension: int, y_spacing: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, faces) of a height field, float64: point ``(i, j)`` (vertex ``j·x_dimension + i``)
+    at ``(i·x_spacing, j·y_spacing, height[j·x_dimension + i])``; each cell two triangles split
+    along its diagonal from ``(i, j)`` to ``(i + 1, j + 1)`` (WREN's createUnitElevationGrid, the mesh
+    Webots renders: lidars, cameras; its ODE height field splits a cell the same way), wound
+    counter-clockwise seen from +z."""
+    nx, ny = int(x_dimension), int(y_dimension)
+    h = np.asarray(height, dtype=np.float64).reshape(-1)
+    if nx < 2 or ny < 2 or len(h) != nx * ny:
+        raise ValueError(f"an elevation grid needs x, y dimensions >= 2 and x*y heights, got {nx} x {ny}, {len(h)}")
+    v = np.empty((nx * ny, 3), dtype=np.float64)
+    v[:, 0] = np.tile(np.arange(nx, dtype=np.float64) * float(x_spacing), ny)
+    v[:, 1] = np.repeat(np.arange(ny, dtype=np.float64) * float(y_spacing), nx)
+    v[:, 2] = h
+    i, j = np.meshgrid(np.arange(nx - 1, dtype=np.int64), np.arange(ny - 1, dtype=np.int64))
+    a = (j * nx + i).reshape(-1)            # (i, j): the cell's low corner
+    b, c, d = a + 1, a + nx + 1, a + nx      # (i+1, j), (i+1, j+1), (i, j+1)
+    f = np.empty((2 * len(a), 3), dtype=np.int64)
+    f[0::2] = np.stack([a, b, c], axis=1)
+    f[1::2] = np.stack([a, c, d], axis=1)
+    return v, f
 
 
 Primitive = Box | Sphere | Cylinder | Capsule | Plane | Mesh

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-__all__ = ["box_uv", "plane_uv", "sphere_uv", "cylinder_uv", "capsule_uv", "triangle_uv",
+__all__ = ["box_uv", "plane_uv", "sphere_uv", "cylinder_uv", "capsule_uv", "elevation_grid_uv", "triangle_uv",
            "default_triangle_uv", "BOX_FACE_ORDER"]
 
 TOLERANCE = 1e-9             # WbBox::findIntersectedFace's face test (metres)
@@ -80,6 +80,14 @@ def plane_uv(points: np.ndarray, size) -> np.ndarray:
         sx, sy = size
         return np.array([(x / sx + 0.5, -y / sy + 0.5) for x, y, _ in p.tolist()]).reshape(-1, 2)
     return np.stack([p[:, 0] / size[0] + 0.5, -p[:, 1] / size[1] + 0.5], axis=1)
+
+
+def elevation_grid_uv(points: np.ndarray, size: tuple[float, float]) -> np.ndarray:
+    """WbElevationGrid::pickUVCoordinate: ``u = x/W``, ``v = 1 − y/D`` over the grid's extent ``W × D``
+    (the image spans the grid once, its top row along the last row of points; WREN's rendering
+    mesh maps it alike). Both texture sets (the pen's too) are this one."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return np.stack([p[:, 0] / size[0], 1.0 - p[:, 1] / size[1]], axis=1)
 
 
 def sphere_uv(points: np.ndarray, radius: float) -> np.ndarray:

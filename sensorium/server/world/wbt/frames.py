@@ -167,6 +167,9 @@ def bounding_geometry(kind: str, g: dict, scale: tuple[float, float, float]) -> 
         return {**g, "size": [g["size"][0] * ax, g["size"][1] * ay]}
     if kind == "mesh":
         return {**g, "scale": [float(v) for v in scale]}
+    if kind == "elevation_grid":        # WbElevationGrid: |scale| on the spacings, the z scale on the heights
+        return {**g, "x_spacing": g["x_spacing"] * ax, "y_spacing": g["y_spacing"] * ay,
+                "height": [h * scale[2] for h in g["height"]]}
     return _triangles_by(g, np.diag(np.asarray(scale, dtype=np.float64)))
 
 
@@ -188,6 +191,9 @@ def visual_geometry(kind: str, g: dict, frame: Frame) -> tuple[dict | None, str]
             return {**g, "radius": g["radius"] * ax, "height": g["height"] * az}, ""
         if kind == "capsule" and ax == ay == az:
             return {**g, "radius": g["radius"] * ax, "height": g["height"] * az}, ""
+        if kind == "elevation_grid" and min(aligned[0], aligned[1]) > 0:   # not mirrored in x or y
+            return {**g, "x_spacing": g["x_spacing"] * ax, "y_spacing": g["y_spacing"] * ay,
+                    "height": [h * aligned[2] for h in g["height"]]}, ""
     elif kind == "mesh":
         return None, (f"mesh {g['url']!r} under a scale that is not along its own axes (a rotation between "
                       "two non-uniform scales): not supported here; this shape is left out")
@@ -196,6 +202,9 @@ def visual_geometry(kind: str, g: dict, frame: Frame) -> tuple[dict | None, str]
         return _triangles_by(curved_triangles(kind, g), lin), ""
     if kind == "box":
         v, f = geo.tessellate(geo.Box(tuple(g["size"])))
+        return _triangles_by({"type": "triangles", "vertices": v.tolist(), "faces": f.tolist()}, lin), ""
+    if kind == "elevation_grid":        # mirrored or sheared: its triangles, mapped exactly
+        v, f = geo.elevation_grid(g["height"], g["x_dimension"], g["x_spacing"], g["y_dimension"], g["y_spacing"])
         return _triangles_by({"type": "triangles", "vertices": v.tolist(), "faces": f.tolist()}, lin), ""
     if kind == "plane":
         sx, sy = (v / 2.0 for v in g["size"])
