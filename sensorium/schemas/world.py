@@ -102,6 +102,16 @@ class Capsule(Strict):
     subdivision: int = Field(default=12, ge=2, le=256, description="facets per quarter circle")
 
 
+class Cone(Strict):
+    """Webots' Cone: axis along local z, apex at z = +height/2, base disc at z = −height/2. Seen by
+    visual rays only (Webots does not accept a Cone in a boundingObject)."""
+
+    type: Literal["cone"]
+    bottom_radius: float = Field(default=1.0, gt=0)
+    height: float = Field(default=2.0, gt=0)
+    subdivision: int = Field(default=36, ge=3, le=1024, description="sides of the tessellation (FAST)")
+
+
 class Plane(Strict):
     """Normal along local +z. ``size`` null means infinite.
 
@@ -170,7 +180,7 @@ class ElevationGrid(Strict):
         return self
 
 
-Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Triangles | Mesh | ElevationGrid,
+Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Cone | Plane | Triangles | Mesh | ElevationGrid,
                      Field(discriminator="type")]
 
 
@@ -230,6 +240,17 @@ class Shape(Strict):
     geometry: Geometry
     appearance: Appearance | None = None
     seen_by: SeenBy = "both"
+
+    @model_validator(mode="after")
+    def _cone_seen(self) -> Shape:
+        _check_cone_seen(self.geometry, self.seen_by)
+        return self
+
+
+def _check_cone_seen(geometry: object, seen_by: str) -> None:
+    if isinstance(geometry, Cone) and seen_by == "bounding":
+        raise ValueError("a cone is seen by visual rays only (Webots accepts no Cone in a boundingObject): "
+                         "seen_by bounding would hide it (use visual or both)")
 
 
 class Part(Shape):
@@ -323,6 +344,7 @@ class Solid(Strict):
 
     @model_validator(mode="after")
     def _recognised_at_the_top(self) -> Solid:
+        _check_cone_seen(self.geometry, self.seen_by)
         for i, child in enumerate(self.children):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "

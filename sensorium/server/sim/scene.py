@@ -37,8 +37,8 @@ class ShapeInfo:
     transparency: float
 
 
-def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.Plane | wm.Triangles | wm.Mesh
-                         | wm.ElevationGrid | None, base_dir: Path) -> geo.Primitive:
+def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.Cone | wm.Plane | wm.Triangles
+                         | wm.Mesh | wm.ElevationGrid | None, base_dir: Path) -> geo.Primitive:
     """A validated geometry model → its primitive (``TypeError`` for None or an unknown model)."""
     if isinstance(g, wm.Box):
         return geo.Box(size=tuple(g.size))
@@ -48,6 +48,8 @@ def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.P
         return geo.Cylinder(radius=g.radius, height=g.height, subdivision=g.subdivision)
     if isinstance(g, wm.Capsule):
         return geo.Capsule(radius=g.radius, height=g.height, subdivision=g.subdivision)
+    if isinstance(g, wm.Cone):
+        return geo.Cone(bottom_radius=g.bottom_radius, height=g.height, subdivision=g.subdivision)
     if isinstance(g, wm.Plane):
         return geo.Plane(size=None if g.size is None else tuple(g.size))
     if isinstance(g, wm.Mesh):
@@ -78,7 +80,7 @@ def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None
     return ShapeEntry(
         primitive=primitive_from_model(shape.geometry, base_dir),
         local_pose=local if local is not None else Pose.identity(),
-        bounding=shape.seen_by in ("both", "bounding"),
+        bounding=shape.seen_by in ("both", "bounding") and not isinstance(shape.geometry, wm.Cone),   # as Webots
         visual=shape.seen_by in ("both", "visual"),
         transparent=transparent,
     )

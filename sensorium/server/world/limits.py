@@ -209,6 +209,8 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
         return 20 * 4 ** int(geom.subdivision)
     if kind == "cylinder":
         return 4 * int(geom.subdivision)
+    if kind == "cone":
+        return 2 * int(geom.subdivision)
     if kind == "capsule":
         n_az, n_lat = capsule_segments(int(geom.subdivision))
         return 4 * n_az * n_lat
@@ -222,7 +224,7 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
     return len(faces) if faces is not None else 0
 
 
-_GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "plane", "mesh", "triangles", "elevation_grid"}
+_GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh", "triangles", "elevation_grid"}
 
 
 def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> list[str | tuple[str, str]]:

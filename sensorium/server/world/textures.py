@@ -423,6 +423,8 @@ def _primitive_uv(geometry: Any, atlas: bool) -> UvOf:
         return lambda o, d, t: ok(tc.cylinder_uv(points(o, d, t), g.radius, g.height, atlas))
     if isinstance(g, wm.Capsule):
         return lambda o, d, t: ok(tc.capsule_uv(points(o, d, t), g.radius, g.height, g.subdivision))
+    if isinstance(g, wm.Cone):
+        return lambda o, d, t: ok(tc.cone_uv(points(o, d, t), g.bottom_radius, g.height, atlas))
     if isinstance(g, wm.ElevationGrid):       # one mapping for both texture sets (Webots ignores the set)
         size = ((g.x_dimension - 1) * g.x_spacing, (g.y_dimension - 1) * g.y_spacing)
         return lambda o, d, t: ok(tc.elevation_grid_uv(points(o, d, t), size))
@@ -502,6 +504,9 @@ def bounding_radius(geometry: Any, vertices: np.ndarray | None = None, faces: np
         return math.hypot(g.radius, g.height / 2.0)
     if isinstance(g, wm.Capsule):
         return g.height / 2.0 + g.radius
+    if isinstance(g, wm.Cone):                # a disc when no taller than wide (WbCone)
+        r, h = g.bottom_radius, g.height
+        return r if h <= r else h / 2.0 + r * r / (2.0 * h)
     if isinstance(g, wm.ElevationGrid):       # Ritter's sphere of its points, in their order
         from sensorium.server.world.meshes import elevation_grid_mesh
         vertices = elevation_grid_mesh(g.height, g.x_dimension, g.x_spacing, g.y_dimension, g.y_spacing).vertices

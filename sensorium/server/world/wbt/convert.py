@@ -43,7 +43,7 @@ OTHER_DEVICES = {"Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS
 # Webots' default device names (the ``name`` field's default of each node)
 OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "TouchSensor": "touch sensor",
                "VacuumGripper": "vacuum gripper", "LinearMotor": "linear motor", "GPS": "gps"}
-GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh", "ElevationGrid"}
+GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane", "IndexedFaceSet", "Mesh", "ElevationGrid"}
 MAX_GRID_POINTS = 4_000_000    # an ElevationGrid's xDimension × yDimension (8M triangles), before a height is read
 UNSEEN_GEOMETRIES = {"IndexedLineSet", "PointSet"}      # lines and points: no surface a ray could hit
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
@@ -386,9 +386,13 @@ class Converter:
             self.skipped[gnode.type] += 1
             return
         if gnode.type not in GEOMETRIES:
-            self.lose_shape(gnode, f"geometry {gnode.type} is not read here (Box, Sphere, Cylinder, Capsule, Plane, "
-                                   "IndexedFaceSet, Mesh, ElevationGrid): this shape is left out, rays do not see it",
-                            owner)
+            self.lose_shape(gnode, f"geometry {gnode.type} is not read here (Box, Sphere, Cylinder, Capsule, Cone, "
+                                   "Plane, IndexedFaceSet, Mesh, ElevationGrid): this shape is left out, rays do not "
+                                   "see it", owner)
+            return
+        if gnode.type == "Cone" and seen_by == "bounding":
+            self.warn(gnode, "a Cone in a boundingObject: Webots accepts none (no physics geometry); left out, "
+                             "bounding rays do not see it (as in Webots)")
             return
         self.tick(gnode)
         for checked in (node, gnode, f.node_("appearance") if node.type == "Shape" else None):
@@ -516,6 +520,10 @@ class Converter:
             return {"type": t.lower(), "radius": f.num("radius", 1.0) * s, "height": f.num("height", 2.0) * s}, ""
         if t == "Plane":
             return {"type": "plane", "size": [v * s for v in f.vec("size", (1.0, 1.0))]}, ""
+        if t == "Cone":
+            if not all(f.flag(k, True) for k in ("bottom", "side")):
+                self.warn(node, "Cone with bottom/side FALSE: rays see the whole closed cone")
+            return {"type": "cone", "bottom_radius": f.num("bottomRadius", 1.0) * s, "height": f.num("height", 2.0) * s}, ""
         if t == "ElevationGrid":
             return self.elevation_grid(node, f, s)
         if t == "Mesh":

@@ -40,7 +40,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
 
 # tessellation of curved visual shapes under a non-uniform scale (vertices on the true surface)
-CURVED_LEVELS = {"sphere": 4, "cylinder": 64, "capsule": 64}    # icosphere level, sides around the axis
+CURVED_LEVELS = {"sphere": 4, "cylinder": 64, "capsule": 64, "cone": 64}    # icosphere level, sides around the axis
 _ALIGNED_TOL = 1e-12      # off-diagonal terms of the stretch below this (relative) count as aligned axes
 
 
@@ -189,6 +189,8 @@ def visual_geometry(kind: str, g: dict, frame: Frame) -> tuple[dict | None, str]
             return {**g, "radius": g["radius"] * ax}, ""
         if kind == "cylinder" and ax == ay:
             return {**g, "radius": g["radius"] * ax, "height": g["height"] * az}, ""
+        if kind == "cone" and ax == ay and aligned[2] > 0:     # not turned upside down
+            return {**g, "bottom_radius": g["bottom_radius"] * ax, "height": g["height"] * az}, ""
         if kind == "capsule" and ax == ay == az:
             return {**g, "radius": g["radius"] * ax, "height": g["height"] * az}, ""
         if kind == "elevation_grid" and min(aligned[0], aligned[1]) > 0:   # not mirrored in x or y
@@ -198,7 +200,7 @@ def visual_geometry(kind: str, g: dict, frame: Frame) -> tuple[dict | None, str]
         return None, (f"mesh {g['url']!r} under a scale that is not along its own axes (a rotation between "
                       "two non-uniform scales): not supported here; this shape is left out")
     lin = frame.linear()
-    if kind in ("sphere", "cylinder", "capsule"):
+    if kind in ("sphere", "cylinder", "capsule", "cone"):
         return _triangles_by(curved_triangles(kind, g), lin), ""
     if kind == "box":
         v, f = geo.tessellate(geo.Box(tuple(g["size"])))
@@ -215,7 +217,11 @@ def visual_geometry(kind: str, g: dict, frame: Frame) -> tuple[dict | None, str]
 
 
 def curved_triangles(kind: str, g: dict) -> dict:
-    """A sphere, cylinder or capsule as triangles whose vertices lie on its true surface."""
+    """A sphere, cylinder, capsule or cone as triangles whose vertices lie on its true surface."""
+    if kind == "cone":
+        r = float(g["bottom_radius"])
+        v, f = geo.tessellate(geo.Cone(r, float(g["height"]), CURVED_LEVELS["cone"]))
+        return {"type": "triangles", "vertices": _onto_axis_radius(v, r, None).tolist(), "faces": np.asarray(f).tolist()}
     r = float(g["radius"])
     if kind == "sphere":
         v, f = geo.tessellate(geo.Sphere(1.0, CURVED_LEVELS["sphere"]))
