@@ -236,10 +236,15 @@ def test_wbt_bad_and_huge_grids_are_one_line_with_file_and_line(tmp_path: Path, 
     with pytest.raises(WorldError) as exc:
         load_world(p)
     assert str(exc.value) == (f"{p}: line 9, column 9: ElevationGrid.xDimension: 1,000,000 x 1,000,000 = "
-                              "1,000,000,000,000 points: more than 4,000,000 points in one grid are refused")
+                              "1,000,000,000,000 points: more than 4,000,000 points in one grid are refused "
+                              "(raise the limits with --allow-large)")
     assert cli(["validate", str(p)]) == 1
     err = [ln for ln in capsys.readouterr().err.splitlines() if "ElevationGrid" in ln]
     assert len(err) == 1 and "ElevationGrid.xDimension" in err[0] and "line 9" in err[0]
+    p = _wbt(tmp_path, "        xDimension 1500 yDimension 1500\n        height [ 0 ]")   # padded with 0s: 2.25M
+    with pytest.raises(WorldError, match=r"line 9, column 9: ElevationGrid.xDimension: the world's ElevationGrids have "
+                                         r"more than 4,000,000 points together \(each use of a DEF counts"):
+        load_world(p)                                                # used twice (shape and boundingObject)
     p = _wbt(tmp_path, '        xDimension 2 yDimension 2\n        height [ 0 "a" 0 0 ]')
     with pytest.raises(WorldError, match=r"line 10, column 9: ElevationGrid.height: expected numbers"):
         load_world(p)

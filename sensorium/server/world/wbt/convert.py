@@ -44,7 +44,8 @@ OTHER_DEVICES = {"Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS
 OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "TouchSensor": "touch sensor",
                "VacuumGripper": "vacuum gripper", "LinearMotor": "linear motor", "GPS": "gps"}
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane", "IndexedFaceSet", "Mesh", "ElevationGrid"}
-MAX_GRID_POINTS = 4_000_000    # an ElevationGrid's xDimension × yDimension (8M triangles), before a height is read
+MAX_GRID_POINTS = 4_000_000    # ElevationGrid points (xDimension × yDimension, all grids together after DEF/USE:
+                               # ProtoLimits.values), checked before a height is read or padded
 UNSEEN_GEOMETRIES = {"IndexedLineSet", "PointSet"}      # lines and points: no surface a ray could hit
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder", "Camera"}
@@ -73,8 +74,10 @@ class Owner:
 
 
 class Converter:
-    def __init__(self, wbt: WbtFile, source: str, search: Any = None):
+    def __init__(self, wbt: WbtFile, source: str, search: Any = None, max_grid_points: int = MAX_GRID_POINTS):
         self.wbt = wbt
+        self.max_grid_points = max_grid_points
+        self.grid_points = 0               # ElevationGrid points converted so far (each use of a DEF counts)
         self.source = source
         self.search = search               # proto.ProtoSearch: where asset urls resolve (resolve_url)
         self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
@@ -572,12 +575,19 @@ class Converter:
                 self.warn(node, message)
 
         nx, ny = f.integer("xDimension", 0), f.integer("yDimension", 0)
+        cap = self.max_grid_points
         for name, n in (("xDimension", nx), ("yDimension", ny)):
-            if n > MAX_GRID_POINTS:
-                raise f.error(name, f"{n:,} points: more than {MAX_GRID_POINTS:,} points in one grid are refused")
-        if nx * ny > MAX_GRID_POINTS:
-            raise f.error("xDimension", f"{nx:,} x {ny:,} = {nx * ny:,} points: more than {MAX_GRID_POINTS:,} points "
-                                        "in one grid are refused")
+            if n > cap:
+                raise f.error(name, f"{n:,} points: more than {cap:,} points in one grid are refused "
+                                    "(raise the limits with --allow-large)")
+        if nx * ny > cap:
+            raise f.error("xDimension", f"{nx:,} x {ny:,} = {nx * ny:,} points: more than {cap:,} points in one grid "
+                                        "are refused (raise the limits with --allow-large)")
+        if nx >= 2 and ny >= 2:
+            self.grid_points += nx * ny
+            if self.grid_points > cap:
+                raise f.error("xDimension", f"the world's ElevationGrids have more than {cap:,} points together "
+                                            "(each use of a DEF counts; raise the limits with --allow-large)")
         spacing = {}
         for name in ("xSpacing", "ySpacing"):
             spacing[name] = f.num(name, 1.0)
