@@ -234,3 +234,35 @@ def test_yaml_cone_and_its_errors(tmp_path: Path, capsys) -> None:
     f.write_text(yaml.safe_dump({"solids": [{"name": "c", "seen_by": "bounding", "geometry": {"type": "cone"}}]}))
     assert cli(["validate", str(f)]) == 1
     assert "a cone is seen by visual rays only" in capsys.readouterr().err
+
+
+def test_a_world_with_a_cone_batched_is_the_single_simulation() -> None:
+    """A solid holding a cone gets its own tier (numpy-judged); the batched copies of a world with one
+    still read what the single simulation reads, bit for bit (its lidar sees the cone)."""
+    from sensorium.schemas import world as wm
+    from sensorium.server.sim.batched import BatchedSimulation
+    from sensorium.server.world.loader import LoadedWorld, default_world_path
+
+    lw = load_world(default_world_path())
+    cone = wm.Solid(name="cone", pose=wm.Pose(translation=(0.3, 0.3, 0.2)),
+                    geometry=wm.Cone(type="cone", bottom_radius=0.1, height=0.4))
+    worlds = [lw.world.model_copy(update={"solids": [*lw.world.solids, cone], "world_info": lw.world.world_info
+                                          .model_copy(update={"random_seed": s})}) for s in (1, 2)]
+    for prec in ("fast", "exact"):
+        bs = BatchedSimulation(LoadedWorld(world=worlds[0], source=lw.source, base_dir=lw.base_dir), 2, precision=prec)
+        bs.reset(np.arange(2), [1, 2])
+        sims = [Simulation(LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir), precision=prec) for w in worlds]
+        for name in ("lidar", "sonar_front"):
+            bs.enable(bs.device("scout", name), 32)
+            for s in sims:
+                s.robot("scout").device(name).enable(32)
+        for _ in range(4):
+            bs.step()
+            for s in sims:
+                s.step()
+        for c, s in enumerate(sims):
+            single = np.asarray(s.robot("scout").device("lidar").range_image).ravel()
+            assert np.array_equal(single, np.asarray(bs.range_image(bs.device("scout", "lidar"))[c]).ravel())
+        hits = sims[0].scene.engine.cast(np.array([[0.0, 0.0, 0.2]]), np.array([[1.0, 1.0, 0.0]]) / math.sqrt(2),
+                                         kind=RayKind.VISUAL)
+        assert sims[0].scene.shapes[int(hits.shape[0])].name == "cone"

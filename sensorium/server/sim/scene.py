@@ -160,7 +160,11 @@ class Scene:
             self._lights += [(lt, s.name, f) for lt, f in solid_lights(s, Pose.identity())]
             parts = list(solid_parts(s, Pose.identity()))
             if parts:
-                self._solid_body[s.name] = self._add_body(parts, base_dir, pose, owner=-1, movable=False, key=s.name)
+                # a solid holding a cone gets a tier of its own, as a moved solid does: packets.c (which
+                # judges the static tier's hits) does not know cones, so the numpy path judges that tier
+                # alone instead of the whole static geometry
+                cone = any(isinstance(shape.geometry, wm.Cone) for _, _, shape in parts)
+                self._solid_body[s.name] = self._add_body(parts, base_dir, pose, owner=-1, movable=cone, key=s.name)
         self.robot_names = [r.name for r in world.robots]
         self.robot_poses: list[Pose] = []
         self._robot_body: dict[int, int] = {}
