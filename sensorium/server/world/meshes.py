@@ -200,7 +200,7 @@ def elevation_grid_mesh(height: tuple[float, ...], x_dimension: int, x_spacing: 
                            float(y_spacing))
 
 
-@lru_cache(maxsize=16)
+@lru_cache(maxsize=4)      # a grid of the world limit's 4M triangles holds ~300 MB of arrays
 def _elevation_grid(height, x_dimension, x_spacing, y_dimension, y_spacing):
     from sensorium.server.world.geometry import Terrain, elevation_grid
 
