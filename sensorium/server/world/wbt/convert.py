@@ -600,7 +600,7 @@ class Converter:
             thickness = 0.0
         if nx < 2 or ny < 2:
             warn(f"ElevationGrid with xDimension {nx} and yDimension {ny}: fewer than 2 points along an "
-                            "axis is no surface (Webots renders none): nothing to see")
+                 "axis is no surface (Webots renders none): nothing to see")
             return None, ""
         height = f.numbers("height")
         need = nx * ny
@@ -609,7 +609,7 @@ class Converter:
             height = height[:need]
         elif len(height) < need:
             warn(f"ElevationGrid.height: {len(height)} values for {nx} x {ny} = {need} points: the "
-                            f"missing {need - len(height)} are 0, as Webots does")
+                 f"missing {need - len(height)} are 0, as Webots does")
             height = height + [0.0] * (need - len(height))
         return {"type": "elevation_grid", "height": [h * s for h in height], "x_dimension": nx,
                 "x_spacing": spacing["xSpacing"] * s, "y_dimension": ny, "y_spacing": spacing["ySpacing"] * s,
