@@ -102,6 +102,16 @@ class Capsule(Strict):
     subdivision: int = Field(default=12, ge=2, le=256, description="facets per quarter circle")
 
 
+class Cone(Strict):
+    """Webots' Cone: axis along local z, apex at z = +height/2, base disc at z = −height/2. Seen by
+    visual rays only (Webots does not accept a Cone in a boundingObject)."""
+
+    type: Literal["cone"]
+    bottom_radius: float = Field(default=1.0, gt=0)
+    height: float = Field(default=2.0, gt=0)
+    subdivision: int = Field(default=36, ge=3, le=1024, description="sides of the tessellation (FAST)")
+
+
 class Plane(Strict):
     """Normal along local +z. ``size`` null means infinite.
 
@@ -144,7 +154,34 @@ class Mesh(Strict):
     scale: Vec3 = (1.0, 1.0, 1.0)
 
 
-Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Plane | Triangles | Mesh, Field(discriminator="type")]
+class ElevationGrid(Strict):
+    """A height field (Webots' ElevationGrid, R2022a+): ``x_dimension`` × ``y_dimension`` points,
+    the grid spanning local x and y from the origin (``x_spacing``, ``y_spacing`` apart), heights
+    along +z, row-major (``height[j * x_dimension + i]`` is the point at ``(i·x_spacing,
+    j·y_spacing)``). Each cell is two triangles split along its diagonal from ``(i, j)`` to
+    ``(i + 1, j + 1)``, as Webots renders it; rays see those triangles exactly."""
+
+    type: Literal["elevation_grid"]
+    height: tuple[float, ...] = Field(max_length=16_000_000, description="x_dimension × y_dimension heights, "
+                                      "row-major: x fastest, the first at the local origin")
+    x_dimension: int = Field(ge=2, le=1_000_000, description="points along x")
+    x_spacing: float = Field(default=1.0, gt=0, description="distance between points along x (m)")
+    y_dimension: int = Field(ge=2, le=1_000_000, description="points along y")
+    y_spacing: float = Field(default=1.0, gt=0, description="distance between points along y (m)")
+    thickness: float = Field(default=0.0, ge=0, description="Webots' physics depth below the lowest "
+                             "point; read and kept, rays see the surface")
+
+    @model_validator(mode="after")
+    def _height_count(self) -> ElevationGrid:
+        need = self.x_dimension * self.y_dimension
+        if len(self.height) != need:
+            raise ValueError(f"height has {len(self.height):,} values; x_dimension × y_dimension = "
+                             f"{self.x_dimension:,} × {self.y_dimension:,} = {need:,} are needed")
+        return self
+
+
+Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Cone | Plane | Triangles | Mesh | ElevationGrid,
+                     Field(discriminator="type")]
 
 
 class Texture(Strict):
@@ -203,6 +240,17 @@ class Shape(Strict):
     geometry: Geometry
     appearance: Appearance | None = None
     seen_by: SeenBy = "both"
+
+    @model_validator(mode="after")
+    def _cone_seen(self) -> Shape:
+        _check_cone_seen(self.geometry, self.seen_by)
+        return self
+
+
+def _check_cone_seen(geometry: object, seen_by: str) -> None:
+    if isinstance(geometry, Cone) and seen_by == "bounding":
+        raise ValueError("a cone is seen by visual rays only (Webots accepts no Cone in a boundingObject): "
+                         "seen_by bounding would hide it (use visual or both)")
 
 
 class Part(Shape):
@@ -296,6 +344,7 @@ class Solid(Strict):
 
     @model_validator(mode="after")
     def _recognised_at_the_top(self) -> Solid:
+        _check_cone_seen(self.geometry, self.seen_by)
         for i, child in enumerate(self.children):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "

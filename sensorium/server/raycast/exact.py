@@ -1,7 +1,7 @@
 """Float64 kernels and size thresholds of the ray engine.
 
 Row-wise vector helpers, the float64 Moller-Trumbore triangle test, the analytic true-surface
-intersectors of spheres, cylinders and capsules (vectorised, and their bit-identical scalar
+intersectors of spheres, cylinders, capsules and cones (vectorised, and their bit-identical scalar
 twins for a few rays), and the per-cast parameter normalisation.  Pure numpy/math: no Embree.
 """
 
@@ -16,7 +16,7 @@ _INF = np.inf
 _MAX_LOOPS = 32          # continuation iterations per tier and cast
 _BARY_TOL = 1e-9         # barycentric tolerance of float64 triangle tests (relative)
 _LEAK_OFFSET_ULPS = 4.0  # perpendicular offset of the repair copy, in float32 ulps of the tier
-_SPHERE, _CYLINDER, _CAPSULE = 1, 2, 3
+_SPHERE, _CYLINDER, _CAPSULE, _CONE = 1, 2, 3, 4   # a cone: numpy only (packets.c knows the first three)
 # two generic (non axis-aligned) directions used to build a perpendicular for the repair copy
 _AUX1 = np.array([0.5773, 0.2113, 0.7887]) / np.linalg.norm([0.5773, 0.2113, 0.7887])
 _AUX2 = np.array([-0.3, 0.9, 0.1]) / np.linalg.norm([-0.3, 0.9, 0.1])
@@ -184,11 +184,83 @@ def _sphere_roots_into(ts, k, p, d, r):
     _roots_into(ts, k, a, b, c, a * r * r - _dot(x, x))  # |p x d|^2 form: no cancellation far away
 
 
+_CONE_DISC_TOL = (16.0 * 2.0 ** -52) ** 2    # of |p'|² (1 + k²): the cone's discriminant's rounding
+
+
+def _cone_roots_into(ts, k, a, b, c, disc):
+    """``_roots_into`` for a cone's side, whose leading coefficient ``a`` is 0 for a ray parallel to
+    a generating line: then the one root ``c / q`` is kept (a cylinder's ``a`` = 0 has none)."""
+    s = np.sqrt(np.maximum(disc, 0.0))
+    q = -(b + np.copysign(s, b))
+    t1, t2 = ts[:, k], ts[:, k + 1]
+    np.divide(q, a, out=t1)
+    np.divide(c, q, out=t2)
+    np.copyto(t2, t1, where=q == 0.0)
+    np.copyto(t1, _INF, where=~np.isfinite(t1))
+    np.copyto(t2, _INF, where=~np.isfinite(t2))
+    np.copyto(ts[:, k:k + 2], _INF, where=(disc < 0.0)[:, None])
+
+
+def _cone_local(p, d, r, h, lo, hi, normals=True):
+    """``_analytic_local`` of a cone (Webots' Cone: axis z, apex at z = +h, base disc of radius
+    ``r`` at z = −h; ``h`` half the height): the side ``x² + y² = k²(h − z)²`` (k = r / 2h) within
+    −h ≤ z ≤ h (columns 0, 1), the base (column 2). The normal on the side is the gradient
+    ``(x, y, k²(h − z))``, +z at the apex itself; −z on the base.
+
+    The discriminant is ``k²(cx² + cy²) − cz²`` with ``c = p' × d'`` (p' the origin from the apex,
+    z flipped, d' likewise): the same quantity as ``b² − ac`` for this quadratic form, without its
+    cancellation (a ray through the apex has a double root: ``b² − ac`` would lose half the digits
+    of t there, and miss half the time). A discriminant within rounding of 0 below it counts as 0."""
+    m = len(p)
+    col = (lambda x: x[:, None]) if isinstance(h, np.ndarray) else (lambda x: x)  # noqa: E731
+    tol = 1e-12 * (r + h)
+    k = r / (h + h)
+    k2 = k * k
+    px, py, pz, dx, dy, dz = p[:, 0], p[:, 1], p[:, 2], d[:, 0], d[:, 1], d[:, 2]
+    w = h - pz
+    ts = np.empty((m, 3))
+    a = dx * dx + dy * dy - k2 * (dz * dz)
+    b = px * dx + py * dy + k2 * (w * dz)
+    c = px * px + py * py - k2 * (w * w)
+    cx, cy, cz = -(py * dz) - w * dy, w * dx + px * dz, px * dy - py * dx
+    disc = k2 * (cx * cx + cy * cy) - cz * cz
+    near = (disc < 0.0) & (disc >= -_CONE_DISC_TOL * (px * px + py * py + w * w) * (1.0 + k2))
+    np.copyto(disc, 0.0, where=near)
+    _cone_roots_into(ts, 0, a, b, c, disc)
+    side = ts[:, 0:2]
+    z = p[:, 2:3] + side * d[:, 2:3]
+    np.copyto(side, _INF, where=~((z <= col(h + tol)) & (z >= col(-h - tol))))
+    base = ts[:, 2]
+    np.divide(-h - pz, dz, out=base)
+    bx, by = px + base * dx, py + base * dy
+    np.copyto(base, _INF, where=~(np.isfinite(base) & (bx * bx + by * by <= r * r + tol * r)))
+    np.copyto(ts, _INF, where=~((ts >= lo[:, None]) & (ts <= hi[:, None])))
+    if not normals:
+        return ts.min(axis=1), None
+    j = ts.argmin(axis=1)       # first of equal candidates, in column order
+    t = ts[np.arange(m), j]
+    hit = t < _INF
+    t0 = t.copy()
+    np.copyto(t0, 0.0, where=~hit)
+    n = p + t0[:, None] * d            # hit point
+    n[:, 2] = np.where(j == 2, -1.0, k2 * (h - n[:, 2]))
+    n[:, 0:2] *= (j < 2)[:, None]
+    norm = np.sqrt(_dot(n, n))
+    apex = norm == 0.0
+    n[apex] = (0.0, 0.0, 1.0)
+    norm[apex] = 1.0
+    n /= norm[:, None]
+    np.copyto(n, 0.0, where=~hit[:, None])
+    return t, n
+
+
 def _analytic_local(code, p, d, r, h, lo, hi, normals=True):
     """Nearest true-surface hit with lo <= t <= hi, shape-local frame.  ``r`` radius, ``h`` half
-    height (cylinder) or half length of the straight part (capsule), scalars or per-ray arrays;
-    ``lo``, ``hi`` per-ray arrays.  Returns (t, unit normal), +inf / zeros where no hit (normal
-    None without ``normals``: the same t)."""
+    height (cylinder, cone) or half length of the straight part (capsule), scalars or per-ray
+    arrays; ``lo``, ``hi`` per-ray arrays.  Returns (t, unit normal), +inf / zeros where no hit
+    (normal None without ``normals``: the same t)."""
+    if code == _CONE:
+        return _cone_local(p, d, r, h, lo, hi, normals)
     m = len(p)
     col = (lambda x: x[:, None]) if isinstance(h, np.ndarray) else (lambda x: x)  # noqa: E731
     tol = 1e-12 * (r + h)
@@ -310,6 +382,8 @@ def _analytic_one(code: int, p, d, r: float, h: float, lo: float, hi: float):
     px, py, pz = p
     dx, dy, dz = d
     tol = 1e-12 * (r + h)
+    if code == _CONE:
+        return _cone_one(px, py, pz, dx, dy, dz, r, h, tol, lo, hi)
     cands = []
     if code == _SPHERE:
         cx, cy, cz = py * dz - pz * dy, pz * dx - px * dz, px * dy - py * dx
@@ -353,6 +427,49 @@ def _analytic_one(code: int, p, d, r: float, h: float, lo: float, hi: float):
     elif code == _CAPSULE:
         nz -= nz if k < 2 else (h if k < 4 else -h)
     norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+    return best, (nx / norm, ny / norm, nz / norm)
+
+
+def _cone_one(px, py, pz, dx, dy, dz, r: float, h: float, tol: float, lo: float, hi: float):
+    """Scalar twin of ``_cone_local`` (same operations, so the same bits)."""
+    k = r / (h + h)
+    k2 = k * k
+    w = h - pz
+    a = dx * dx + dy * dy - k2 * (dz * dz)
+    b = px * dx + py * dy + k2 * (w * dz)
+    c = px * px + py * py - k2 * (w * w)
+    cx, cy, cz = -(py * dz) - w * dy, w * dx + px * dz, px * dy - py * dx
+    disc = k2 * (cx * cx + cy * cy) - cz * cz
+    if disc < 0.0 and disc >= -_CONE_DISC_TOL * (px * px + py * py + w * w) * (1.0 + k2):
+        disc = 0.0
+    cands = [_INF, _INF, _INF]
+    if disc >= 0.0:
+        q = -(b + math.copysign(math.sqrt(disc), b))
+        t1 = q / a if a != 0.0 else math.copysign(_INF, q) if q != 0.0 else math.nan
+        t2 = c / q if q != 0.0 else t1
+        for j, t in enumerate((t1, t2)):
+            if math.isfinite(t):
+                z = pz + t * dz
+                if z <= h + tol and z >= -h - tol:
+                    cands[j] = t
+    t = (-h - pz) / dz if dz != 0.0 else _INF
+    if math.isfinite(t):
+        bx, by = px + t * dx, py + t * dy
+        if bx * bx + by * by <= r * r + tol * r:
+            cands[2] = t
+    best, j = _INF, -1
+    for i, t in enumerate(cands):   # first of equal candidates, like argmin
+        if lo <= t <= hi and t < best:
+            best, j = t, i
+    if j < 0:
+        return _INF, (0.0, 0.0, 0.0)
+    if j == 2:
+        return best, (0.0, 0.0, -1.0)
+    nx, ny = px + best * dx, py + best * dy
+    nz = k2 * (h - (pz + best * dz))
+    norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if norm == 0.0:
+        return best, (0.0, 0.0, 1.0)
     return best, (nx / norm, ny / norm, nz / norm)
 
 

@@ -13,6 +13,7 @@ from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import (
     _BARY_TOL,
     _CAPSULE,
+    _CONE,
     _CYLINDER,
     _DENSE_PAIRS,
     _F32,
@@ -254,12 +255,13 @@ class Refiner:
         p = np.einsum("nij,ni->nj", R, Ot - tier.c_pos[slots])  # R^T (o - c)
         d = np.einsum("nij,ni->nj", R, D)
         codes = tier.c_code[slots]
-        if n <= _MIXED and np.count_nonzero(codes != codes[0]):   # a few rays, several kinds: one pass
+        if n <= _MIXED and np.count_nonzero(codes != codes[0]) and not np.count_nonzero(codes == _CONE):
+            # a few rays, several kinds (not cones: their own pass below): one pass
             t, n_loc = _analytic_mixed(codes, p, d, tier.c_r[slots], tier.c_h[slots], lo, hi, normals)
             return t, (np.einsum("nij,nj->ni", R, n_loc) if normals else None)
         t = np.full(n, _INF)
         n_loc = np.zeros((n, 3)) if normals else None
-        for code in (_SPHERE, _CYLINDER, _CAPSULE):
+        for code in (_SPHERE, _CYLINDER, _CAPSULE, _CONE):
             g = (codes == code).nonzero()[0]
             if len(g):
                 s = slots[g]

@@ -7,6 +7,7 @@ library embreex loaded).
 
 from __future__ import annotations
 
+import math
 import threading
 
 import numpy as np
@@ -15,7 +16,7 @@ from embreex import rtcore_scene as _rts
 from embreex.mesh_construction import TriangleMesh as _TriangleMesh
 
 from sensorium.server.raycast import packets
-from sensorium.server.raycast.exact import _CAPSULE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
+from sensorium.server.raycast.exact import _CAPSULE, _CONE, _CYLINDER, _F32, _SPHERE, _dot, _mat, _minus, _ulp32
 from sensorium.server.raycast.guards import (
     MAX_CANDIDATES_BASE,
     MAX_CANDIDATES_PER_FLAT_TRIANGLE,
@@ -28,7 +29,7 @@ from sensorium.server.raycast.guards import (
     prisms,
     risky_edges,
 )
-from sensorium.server.world.geometry import Capsule, Cylinder, Mesh, Pose, Primitive, Sphere, tessellate
+from sensorium.server.world.geometry import Capsule, Cone, Cylinder, Mesh, Pose, Primitive, Sphere, tessellate
 
 
 def new_device():
@@ -75,6 +76,19 @@ def _welded(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return v[keep], to[f]
 
 
+def _cone_shell(cone: Cone, a: float) -> np.ndarray:
+    """The shell of a cone with a margin of at least ``a`` everywhere: the tessellation of the cone
+    whose side and base planes lie ``a`` outside the true ones (apex ``a / sin α`` higher, α the
+    half angle; base ``a`` lower), in the cone's frame. Scaling the shell as for a cylinder would
+    leave less than ``a`` near the apex of a slender cone."""
+    r, h = cone.bottom_radius, cone.height
+    slant = math.hypot(r, h)
+    up, down = a * slant / r, a                      # a / sin α, a
+    grown = Cone(r + a * slant / h + a * r / h, h + up + down, cone.subdivision)   # r + a / cos α + a tan α
+    v, _ = tessellate(grown)
+    return v + np.array([0.0, 0.0, (up - down) / 2.0])
+
+
 class _Tier:
     """Triangles of a set of shapes in one Embree scene.  Tier frame = parent frame (world for the
     static tier, body frame for a mover) translated by ``-anchor``."""
@@ -102,7 +116,7 @@ class _Tier:
             verts.append(pose.apply(v))
             faces.append(f + nv)
             tri_shape.append(np.full(len(f), sid, dtype=np.int64))
-            if isinstance(prim, (Sphere, Cylinder, Capsule)):
+            if isinstance(prim, (Sphere, Cylinder, Capsule, Cone)):
                 curved.append((sid, prim, pose, len(verts) - 1, v))
             nv += len(v)
         self.empty = nv == 0
@@ -124,7 +138,10 @@ class _Tier:
         a = 4.0 * self.res
         c_code, c_r, c_h, c_rot, c_pos, c_shape, c_bound, c_rad, c_ax = [], [], [], [], [], [], [], [], []
         for sid, prim, pose, k, v_local in curved:
-            if isinstance(prim, Sphere):
+            if isinstance(prim, Cone):
+                code, r, h = _CONE, prim.bottom_radius, prim.height / 2.0
+                shell = _cone_shell(prim, a)
+            elif isinstance(prim, Sphere):
                 code, r, h, axial = _SPHERE, prim.radius, 0.0, prim.radius
             elif isinstance(prim, Cylinder):
                 code, r, h = _CYLINDER, prim.radius, prim.height / 2.0
@@ -132,7 +149,8 @@ class _Tier:
             else:
                 code, r, h = _CAPSULE, prim.radius, prim.height / 2.0
                 axial = h + r
-            shell = v_local * np.array([1.0 + a / r, 1.0 + a / r, 1.0 + a / axial])
+            if code != _CONE:
+                shell = v_local * np.array([1.0 + a / r, 1.0 + a / r, 1.0 + a / axial])
             verts[k] = pose.apply(shell)
             c_rad.append(float(np.hypot(shell[:, 0], shell[:, 1]).max()))
             c_ax.append(float(np.abs(shell[:, 2]).max()))
@@ -144,6 +162,7 @@ class _Tier:
             c_shape.append(sid)
             c_bound.append(float(np.linalg.norm(verts[k] - pose.translation, axis=1).max()))
         self.has_curved = bool(curved)
+        self.has_cone = _CONE in c_code   # packets.c knows spheres, cylinders and capsules: numpy judges
         del curved   # the shapes' local vertices
         V = np.vstack(verts)
         V -= self.anchor
@@ -324,7 +343,7 @@ class _Tier:
         per mode), or None where its scenes are embreex's. EXACT's needs the refinement data."""
         got = self._native.get(exact)
         if got is None:
-            if not isinstance(self._device, packets.Device):
+            if not isinstance(self._device, packets.Device) or self.has_cone:
                 return None
             got = self._native[exact] = packets.tier_arrays(self, exact)
         return got[1]

@@ -9,7 +9,8 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   corners, an upright cylinder or capsule a point with its radius, a sphere a point with the
   radius of its widest section inside the band, anything else the convex hull of its projected
   vertices (conservative); a vertical infinite plane is a two-sided wall line. Shapes entirely
-  above or below the robot's band (the floor it stands on) are ignored;
+  above or below the robot's band (the floor it stands on) and terrains (ElevationGrids, ground
+  whatever their relief) are ignored;
 * over one basic step the robot's centre moves along the chord from its start to its end pose
   (poses are only observed at the end of steps, and the end point is the exact arc end unless
   contact clips it). The chord is tested against every obstacle near it (an AABB broad phase)
@@ -139,6 +140,8 @@ def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None
 
 def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle | None:
     """A solid's (or robot body's) 2D obstacle at ``pose``; None for a non-vertical plane."""
+    if isinstance(prim, geo.Terrain):
+        return None                              # ground (an ElevationGrid), like a floor plane
     r, t = pose.rotation, pose.translation
     upright = abs(r[2, 2]) >= UPRIGHT
     if isinstance(prim, geo.Plane):

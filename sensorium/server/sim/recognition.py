@@ -32,7 +32,7 @@ from sensorium.server.devices import imaging
 from sensorium.server.devices import recognition as rmath
 from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.scene import primitive_from_model
-from sensorium.server.world.geometry import Pose
+from sensorium.server.world.geometry import Pose, tessellate
 from sensorium.server.world.poses import axis_angle
 
 __all__ = ["RecognisedObject", "Recognizer"]
@@ -84,6 +84,8 @@ def _kind(g: Any, base_dir: Any) -> tuple[str, tuple, np.ndarray | None]:
         return "points", (), np.array([[sx, sy, 0.0], [sx, -sy, 0.0], [-sx, sy, 0.0], [-sx, -sy, 0.0]])
     if isinstance(g, wm.Triangles):
         return "points", (), np.asarray(g.vertices, dtype=np.float64).reshape(-1, 3)
+    if isinstance(g, wm.Cone):   # its tessellation's corners: the circumscribed pyramid (a little larger)
+        return "points", (), np.asarray(tessellate(primitive_from_model(g, base_dir))[0], dtype=np.float64)
     return "points", (), np.asarray(primitive_from_model(g, base_dir).vertices, dtype=np.float64)
 
 

@@ -19,8 +19,8 @@ from functools import lru_cache
 import numpy as np
 
 __all__ = [
-    "Box", "Sphere", "Cylinder", "Capsule", "Plane", "Mesh", "Primitive", "Pose",
-    "tessellate", "triangle_count", "valid_faces", "capsule_segments",
+    "Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane", "Mesh", "Primitive", "Pose",
+    "tessellate", "triangle_count", "valid_faces", "capsule_segments", "Terrain", "elevation_grid",
 ]
 
 
@@ -94,6 +94,23 @@ class Capsule:
 
 
 @dataclass(frozen=True, slots=True)
+class Cone:
+    """Cone, axis local z, centred as Webots' Cone: apex at z = +height/2, base disc of
+    ``bottom_radius`` at z = −height/2.  ``subdivision`` = number of sides of the tessellation."""
+
+    bottom_radius: float
+    height: float
+    subdivision: int = 36
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "bottom_radius", _positive("Cone.bottom_radius", self.bottom_radius))
+        object.__setattr__(self, "height", _positive("Cone.height", self.height))
+        if int(self.subdivision) < 3:
+            raise ValueError(f"Cone.subdivision must be >= 3, got {self.subdivision!r}")
+        object.__setattr__(self, "subdivision", int(self.subdivision))
+
+
+@dataclass(frozen=True, slots=True)
 class Plane:
     """Plane z = 0 with normal local +z, centred; ``size`` = (x, y) extent or None (infinite).
     Planes are intersected analytically by the engine and are never tessellated."""
@@ -129,7 +146,37 @@ class Mesh:
         object.__setattr__(self, "closed", bool(self.closed))
 
 
-Primitive = Box | Sphere | Cylinder | Capsule | Plane | Mesh
+@dataclass(frozen=True, eq=False)
+class Terrain(Mesh):
+    """The triangles of a height field (an ElevationGrid): a mesh to the ray engine, ground to the
+    kinematic contact (robots move in a plane; a terrain never stops them, as a floor plane)."""
+
+
+def elevation_grid(height, x_dimension: int, x_spacing: float, y_dimension: int, y_spacing: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, faces) of a height field, float64: point ``(i, j)`` (vertex ``j·x_dimension + i``)
+    at ``(i·x_spacing, j·y_spacing, height[j·x_dimension + i])``; each cell two triangles split
+    along its diagonal from ``(i, j)`` to ``(i + 1, j + 1)`` (WREN's createUnitElevationGrid, the mesh
+    Webots renders: lidars, cameras; its ODE height field splits a cell the same way), wound
+    counter-clockwise seen from +z."""
+    nx, ny = int(x_dimension), int(y_dimension)
+    h = np.asarray(height, dtype=np.float64).reshape(-1)
+    if nx < 2 or ny < 2 or len(h) != nx * ny:
+        raise ValueError(f"an elevation grid needs x, y dimensions >= 2 and x*y heights, got {nx} x {ny}, {len(h)}")
+    v = np.empty((nx * ny, 3), dtype=np.float64)
+    v[:, 0] = np.tile(np.arange(nx, dtype=np.float64) * float(x_spacing), ny)
+    v[:, 1] = np.repeat(np.arange(ny, dtype=np.float64) * float(y_spacing), nx)
+    v[:, 2] = h
+    i, j = np.meshgrid(np.arange(nx - 1, dtype=np.int64), np.arange(ny - 1, dtype=np.int64))
+    a = (j * nx + i).reshape(-1)            # (i, j): the cell's low corner
+    b, c, d = a + 1, a + nx + 1, a + nx      # (i+1, j), (i+1, j+1), (i, j+1)
+    f = np.empty((2 * len(a), 3), dtype=np.int64)
+    f[0::2] = np.stack([a, b, c], axis=1)
+    f[1::2] = np.stack([a, c, d], axis=1)
+    return v, f
+
+
+Primitive = Box | Sphere | Cylinder | Capsule | Cone | Plane | Mesh
 
 
 # --------------------------------------------------------------------------------------------
@@ -329,6 +376,12 @@ def _cylinder(radius: float, height: float, n: int) -> tuple[np.ndarray, np.ndar
     return _revolve([(0.0, h), (radius, h), (radius, -h), (0.0, -h)], n)
 
 
+def _cone(radius: float, height: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """A pyramid on an n-gon: every section circumscribes the cone's (the ring at the base does)."""
+    h = height / 2.0
+    return _revolve([(0.0, h), (radius, -h), (0.0, -h)], n)
+
+
 def capsule_segments(subdivision: int) -> tuple[int, int]:
     """(azimuthal segments, latitude segments per hemisphere) used for a Capsule tessellation."""
     return 2 * subdivision, max(2, subdivision // 2)
@@ -347,13 +400,15 @@ def _capsule(radius: float, height: float, subdivision: int) -> tuple[np.ndarray
 
 
 @lru_cache(maxsize=256)
-def _tessellate_cached(p: Box | Sphere | Cylinder | Capsule) -> tuple[np.ndarray, np.ndarray]:
+def _tessellate_cached(p: Box | Sphere | Cylinder | Capsule | Cone) -> tuple[np.ndarray, np.ndarray]:
     if isinstance(p, Box):
         v, f = _box(p.size)
     elif isinstance(p, Sphere):
         v, f = _icosphere(p.radius, p.subdivision)
     elif isinstance(p, Cylinder):
         v, f = _cylinder(p.radius, p.height, p.subdivision)
+    elif isinstance(p, Cone):
+        v, f = _cone(p.bottom_radius, p.height, p.subdivision)
     else:
         v, f = _capsule(p.radius, p.height, p.subdivision)
     v.flags.writeable = False
@@ -370,7 +425,7 @@ def tessellate(p: Primitive) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError("planes are intersected analytically and have no tessellation")
     if isinstance(p, Mesh):
         return p.vertices, valid_faces(p.vertices, p.faces)
-    if isinstance(p, (Box, Sphere, Cylinder, Capsule)):
+    if isinstance(p, (Box, Sphere, Cylinder, Capsule, Cone)):
         return _tessellate_cached(p)
     raise TypeError(f"not a primitive: {p!r}")
 
@@ -385,6 +440,8 @@ def triangle_count(p: Primitive) -> int:
         return 20 * 4 ** p.subdivision
     if isinstance(p, Cylinder):
         return 4 * p.subdivision
+    if isinstance(p, Cone):
+        return 2 * p.subdivision
     if isinstance(p, Capsule):
         n_az, n_lat = capsule_segments(p.subdivision)
         return 4 * n_az * n_lat

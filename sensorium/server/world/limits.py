@@ -209,6 +209,8 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
         return 20 * 4 ** int(geom.subdivision)
     if kind == "cylinder":
         return 4 * int(geom.subdivision)
+    if kind == "cone":
+        return 2 * int(geom.subdivision)
     if kind == "capsule":
         n_az, n_lat = capsule_segments(int(geom.subdivision))
         return 4 * n_az * n_lat
@@ -216,11 +218,13 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
         return 0
     if kind == "mesh":
         return mesh_triangles(geom)
+    if kind == "elevation_grid":               # two per cell, counted before any is made
+        return 2 * (int(geom.x_dimension) - 1) * (int(geom.y_dimension) - 1)
     faces = getattr(geom, "faces", None)      # explicit triangle lists
     return len(faces) if faces is not None else 0
 
 
-_GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "plane", "mesh", "triangles"}
+_GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh", "triangles", "elevation_grid"}
 
 
 def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> list[str | tuple[str, str]]:

@@ -300,7 +300,7 @@ def from_model(world: wm.World, base_dir: Path | None = None) -> LoadedWorld:
     return LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
 
 
-_TAGS = {"box", "sphere", "cylinder", "capsule", "plane", "triangles", "mesh", "PointLight", "SpotLight",
+_TAGS = {"box", "sphere", "cylinder", "capsule", "cone", "plane", "triangles", "mesh", "elevation_grid", "PointLight", "SpotLight",
          "DirectionalLight", *wm.DEVICE_TYPES}
 
 

@@ -189,3 +189,20 @@ def _triangles(key):
     faces = np.asarray(key[1], dtype=np.int64).reshape(-1, 3)
     merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
     return Mesh(vertices=vertices, faces=faces, closed=bool(merged.is_watertight))
+
+
+def elevation_grid_mesh(height: tuple[float, ...], x_dimension: int, x_spacing: float, y_dimension: int,
+                        y_spacing: float):
+    """An ElevationGrid's triangles (``geometry.elevation_grid``) → ``geometry.Terrain``; the loader
+    checked its fields and size. Cached on the exact values (the scene, recognition and the viewer
+    each ask for it)."""
+    return _elevation_grid(tuple(float(h) for h in height), int(x_dimension), float(x_spacing), int(y_dimension),
+                           float(y_spacing))
+
+
+@lru_cache(maxsize=4)      # a grid of the world limit's 4M triangles holds ~300 MB of arrays
+def _elevation_grid(height, x_dimension, x_spacing, y_dimension, y_spacing):
+    from sensorium.server.world.geometry import Terrain, elevation_grid
+
+    v, f = elevation_grid(height, x_dimension, x_spacing, y_dimension, y_spacing)
+    return Terrain(vertices=v, faces=f, closed=False)

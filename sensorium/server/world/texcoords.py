@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-__all__ = ["box_uv", "plane_uv", "sphere_uv", "cylinder_uv", "capsule_uv", "triangle_uv",
+__all__ = ["box_uv", "plane_uv", "sphere_uv", "cylinder_uv", "capsule_uv", "cone_uv", "elevation_grid_uv", "triangle_uv",
            "default_triangle_uv", "BOX_FACE_ORDER"]
 
 TOLERANCE = 1e-9             # WbBox::findIntersectedFace's face test (metres)
@@ -80,6 +80,65 @@ def plane_uv(points: np.ndarray, size) -> np.ndarray:
         sx, sy = size
         return np.array([(x / sx + 0.5, -y / sy + 0.5) for x, y, _ in p.tolist()]).reshape(-1, 2)
     return np.stack([p[:, 0] / size[0] + 0.5, -p[:, 1] / size[1] + 0.5], axis=1)
+
+
+def _cone_points(p: np.ndarray, radius: float, half: float) -> tuple[np.ndarray, np.ndarray]:
+    """(points on the true surface, is-base) of a cone (apex at z = +half): a point on the base
+    plane within the disc (within the tolerance) is a base point; any other (a FAST hit on the
+    shell) belongs to the nearer of the side and the base, and is moved onto it (exact points keep
+    their bits)."""
+    tol_r, tol_h = TOLERANCE * max(1.0, radius), TOLERANCE * max(1.0, half)
+    rho = np.hypot(p[:, 0], p[:, 1])
+    d_base = np.abs(p[:, 2] + half)
+    on_base = (d_base <= tol_h) & (rho <= radius + tol_r)
+    slant = math.hypot(radius, 2.0 * half)
+    d_side = (rho * 2.0 * half - (half - p[:, 2]) * radius) / slant      # signed distance to the side's cone
+    base = on_base | ((np.abs(d_side) > tol_r) & (d_base < np.abs(d_side)))
+    q = p.copy()
+    q[base & ~on_base, 2] = -half
+    move = ~base & (np.abs(d_side) > tol_r)
+    if move.any():          # along the side's normal (2 half, ·, radius)/slant in the (rho, z) plane
+        nr, nz = 2.0 * half / slant, radius / slant
+        r_new = rho[move] - d_side[move] * nr
+        z_new = p[move, 2] - d_side[move] * nz
+        scale = np.divide(r_new, rho[move], out=np.zeros(int(move.sum())), where=rho[move] > 0)
+        q[move, 0] *= scale
+        q[move, 1] *= scale
+        q[move, 2] = z_new
+    return q, base
+
+
+def cone_uv(points: np.ndarray, radius: float, height: float, atlas: bool = False) -> np.ndarray:
+    """WbCone::pickUVCoordinate (``atlas``: texture set 1, the pen's: the side's u halved, the
+    base's moved right by 1/2). Base (``z = −h/2``): ``u = (x + r)/(2r)``, ``v = 1 − (r − y)/(2r)``.
+    Side: ``θ = atan(x/−y)`` wrapped to [0, 2π) and moved by π per quadrant as Webots does (so
+    ``θ = atan2(x, −y) + π`` off the axes, and Webots' own values on them), ``u = θ/(2π)``,
+    ``v = 1 − (z + h/2)/h``; the apex reads u = 0."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    q, base = _cone_points(p, radius, height / 2.0)
+    x, y, z = q[:, 0], q[:, 1], q[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        theta = np.arctan(x / -y)
+    theta = np.nan_to_num(theta, nan=0.0)          # the apex (0/0)
+    theta = theta - np.floor(theta / (2.0 * math.pi)) * 2.0 * math.pi
+    my = -y
+    theta = np.where((theta < math.pi) & (x > 0) & (my != 0), theta + math.pi,
+                     np.where((theta > math.pi) & (x < 0) & (my != 0), theta - math.pi, theta))
+    u_side = theta / (2.0 * math.pi)
+    v_side = 1.0 - (z + height / 2.0) / height
+    u_base = (x + radius) / (2.0 * radius)
+    v_base = 1.0 - (-y + radius) / (2.0 * radius)
+    if atlas:
+        u_side, u_base = u_side * 0.5, u_base * 0.5 + 0.5
+    return np.stack([np.where(base, u_base, u_side), np.where(base, v_base, v_side)], axis=1)
+
+
+def elevation_grid_uv(points: np.ndarray, size: tuple[float, float]) -> np.ndarray:
+    """WbElevationGrid::pickUVCoordinate: ``u = x/W``, ``v = 1 − y/D`` over the grid's extent ``W × D``
+    (the image spans the grid once, its top row along the last row of points; WREN's rendering
+    mesh maps it alike). Both texture sets (the pen's too) are this one."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return np.stack([p[:, 0] / size[0], 1.0 - p[:, 1] / size[1]], axis=1)
 
 
 def sphere_uv(points: np.ndarray, radius: float) -> np.ndarray:

@@ -423,6 +423,11 @@ def _primitive_uv(geometry: Any, atlas: bool) -> UvOf:
         return lambda o, d, t: ok(tc.cylinder_uv(points(o, d, t), g.radius, g.height, atlas))
     if isinstance(g, wm.Capsule):
         return lambda o, d, t: ok(tc.capsule_uv(points(o, d, t), g.radius, g.height, g.subdivision))
+    if isinstance(g, wm.Cone):
+        return lambda o, d, t: ok(tc.cone_uv(points(o, d, t), g.bottom_radius, g.height, atlas))
+    if isinstance(g, wm.ElevationGrid):       # one mapping for both texture sets (Webots ignores the set)
+        size = ((g.x_dimension - 1) * g.x_spacing, (g.y_dimension - 1) * g.y_spacing)
+        return lambda o, d, t: ok(tc.elevation_grid_uv(points(o, d, t), size))
     raise TypeError(f"not a primitive: {g!r}")
 
 
@@ -486,7 +491,8 @@ def _next_power_of_2(n: int) -> int:
 def bounding_radius(geometry: Any, vertices: np.ndarray | None = None, faces: np.ndarray | None = None) -> float:
     """Webots' bounding-sphere radius of a geometry (each node's ``recomputeBoundingSphere``): half
     the diagonal of a Box or Plane, a Sphere's radius, ``|(r, h/2)|`` for a Cylinder, ``h/2 + r``
-    for a Capsule, Ritter's sphere of a triangle mesh's corners (WbTriangleMeshGeometry)."""
+    for a Capsule, Ritter's sphere of a triangle mesh's corners (WbTriangleMeshGeometry) or of an
+    ElevationGrid's points (WbElevationGrid)."""
     g = geometry
     if isinstance(g, wm.Box):
         return math.hypot(*g.size) / 2.0
@@ -498,6 +504,13 @@ def bounding_radius(geometry: Any, vertices: np.ndarray | None = None, faces: np
         return math.hypot(g.radius, g.height / 2.0)
     if isinstance(g, wm.Capsule):
         return g.height / 2.0 + g.radius
+    if isinstance(g, wm.Cone):                # a disc when no taller than wide (WbCone)
+        r, h = g.bottom_radius, g.height
+        return r if h <= r else h / 2.0 + r * r / (2.0 * h)
+    if isinstance(g, wm.ElevationGrid):       # Ritter's sphere of its points, in their order
+        from sensorium.server.world.meshes import elevation_grid_mesh
+        vertices = elevation_grid_mesh(g.height, g.x_dimension, g.x_spacing, g.y_dimension, g.y_spacing).vertices
+        faces = np.arange(len(vertices)).reshape(-1, 1)
     assert vertices is not None and faces is not None
     pts = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)].reshape(-1, 3)
     p2 = pts[0]

@@ -49,7 +49,7 @@ def wbt_convert(path: str | Path, *, webots_home: str | Path | None = None, prot
     t1 = time.perf_counter()
     expansion = expand(wbt, search, limits)
     t2 = time.perf_counter()
-    conv = Converter(expansion.as_wbt(), source, expansion.search)
+    conv = Converter(expansion.as_wbt(), source, expansion.search, max_grid_points=limits.values)
     raw = conv.run()
     origin: dict[str, tuple[int, int, str]] = {}
     data = strip_origins(raw, "", origin)

@@ -43,7 +43,9 @@ OTHER_DEVICES = {"Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS
 # Webots' default device names (the ``name`` field's default of each node)
 OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "TouchSensor": "touch sensor",
                "VacuumGripper": "vacuum gripper", "LinearMotor": "linear motor", "GPS": "gps"}
-GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Plane", "IndexedFaceSet", "Mesh"}
+GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane", "IndexedFaceSet", "Mesh", "ElevationGrid"}
+MAX_GRID_POINTS = 4_000_000    # ElevationGrid points (xDimension × yDimension, all grids together after DEF/USE:
+                               # ProtoLimits.values), checked before a height is read or padded
 UNSEEN_GEOMETRIES = {"IndexedLineSet", "PointSet"}      # lines and points: no surface a ray could hit
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder", "Camera"}
@@ -72,8 +74,10 @@ class Owner:
 
 
 class Converter:
-    def __init__(self, wbt: WbtFile, source: str, search: Any = None):
+    def __init__(self, wbt: WbtFile, source: str, search: Any = None, max_grid_points: int = MAX_GRID_POINTS):
         self.wbt = wbt
+        self.max_grid_points = max_grid_points
+        self.grid_points = 0               # ElevationGrid points converted so far (each use of a DEF counts)
         self.source = source
         self.search = search               # proto.ProtoSearch: where asset urls resolve (resolve_url)
         self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
@@ -85,6 +89,7 @@ class Converter:
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
+        self.checked_grids: set[int] = set()   # ElevationGrids sanitised (warned once: a shape and its boundingObject)
         self.constrained: set[int] = set()     # Transforms in boundingObjects whose scale Webots constrains
         self.defs: set[str] = set()        # DEF names kept (def_name)
         self.textured: dict[int, tuple[int, int, str, str]] = {}   # textures not loaded → (line, column, why)
@@ -384,8 +389,13 @@ class Converter:
             self.skipped[gnode.type] += 1
             return
         if gnode.type not in GEOMETRIES:
-            self.lose_shape(gnode, f"geometry {gnode.type} is not read here (Box, Sphere, Cylinder, Capsule, Plane, "
-                                   "IndexedFaceSet, Mesh): this shape is left out, rays do not see it", owner)
+            self.lose_shape(gnode, f"geometry {gnode.type} is not read here (Box, Sphere, Cylinder, Capsule, Cone, "
+                                   "Plane, IndexedFaceSet, Mesh, ElevationGrid): this shape is left out, rays do not "
+                                   "see it", owner)
+            return
+        if gnode.type == "Cone" and seen_by == "bounding":
+            self.warn(gnode, "a Cone in a boundingObject: Webots accepts none (no physics geometry); left out, "
+                             "bounding rays do not see it (as in Webots)")
             return
         self.tick(gnode)
         for checked in (node, gnode, f.node_("appearance") if node.type == "Shape" else None):
@@ -513,6 +523,12 @@ class Converter:
             return {"type": t.lower(), "radius": f.num("radius", 1.0) * s, "height": f.num("height", 2.0) * s}, ""
         if t == "Plane":
             return {"type": "plane", "size": [v * s for v in f.vec("size", (1.0, 1.0))]}, ""
+        if t == "Cone":
+            if not all(f.flag(k, True) for k in ("bottom", "side")):
+                self.warn(node, "Cone with bottom/side FALSE: rays see the whole closed cone")
+            return {"type": "cone", "bottom_radius": f.num("bottomRadius", 1.0) * s, "height": f.num("height", 2.0) * s}, ""
+        if t == "ElevationGrid":
+            return self.elevation_grid(node, f, s)
         if t == "Mesh":
             urls = f.strings("url")
             if not urls:
@@ -545,6 +561,59 @@ class Converter:
         if tex is not None:
             out["tex_coords"], out["tex_coord_faces"] = tex, tex_faces
         return out, ""
+
+    def elevation_grid(self, node: Node, f: Fields, s: float) -> tuple[dict | None, str]:
+        """Webots' ElevationGrid with its sanitising (WbElevationGrid::sanitizeFields, checkHeight):
+        a negative thickness → 0, a non-positive spacing → 1, missing heights are 0 and extra ones
+        ignored, each with a warning naming the field; fewer than 2 points along x or y is no
+        surface (Webots builds none), said. A grid too large is refused before its heights are read."""
+        said = id(node) in self.checked_grids
+        self.checked_grids.add(id(node))
+
+        def warn(message: str) -> None:
+            if not said:
+                self.warn(node, message)
+
+        nx, ny = f.integer("xDimension", 0), f.integer("yDimension", 0)
+        cap = self.max_grid_points
+        for name, n in (("xDimension", nx), ("yDimension", ny)):
+            if n > cap:
+                raise f.error(name, f"{n:,} points: more than {cap:,} points in one grid are refused "
+                                    "(raise the limits with --allow-large)")
+        if nx * ny > cap:
+            raise f.error("xDimension", f"{nx:,} x {ny:,} = {nx * ny:,} points: more than {cap:,} points in one grid "
+                                        "are refused (raise the limits with --allow-large)")
+        if nx >= 2 and ny >= 2:
+            self.grid_points += nx * ny
+            if self.grid_points > cap:
+                raise f.error("xDimension", f"the world's ElevationGrids have more than {cap:,} points together "
+                                            "(each use of a DEF counts; raise the limits with --allow-large)")
+        spacing = {}
+        for name in ("xSpacing", "ySpacing"):
+            spacing[name] = f.num(name, 1.0)
+            if spacing[name] <= 0.0:
+                warn(f"ElevationGrid.{name}: {spacing[name]:g} is not positive: reset to 1, as Webots does")
+                spacing[name] = 1.0
+        thickness = f.num("thickness", 0.0)
+        if thickness < 0.0:
+            warn(f"ElevationGrid.thickness: {thickness:g} is negative: reset to 0, as Webots does")
+            thickness = 0.0
+        if nx < 2 or ny < 2:
+            warn(f"ElevationGrid with xDimension {nx} and yDimension {ny}: fewer than 2 points along an "
+                 "axis is no surface (Webots renders none): nothing to see")
+            return None, ""
+        height = f.numbers("height")
+        need = nx * ny
+        if len(height) > need:
+            warn(f"ElevationGrid.height: {len(height) - need} extra value(s) ignored ({nx} x {ny} points)")
+            height = height[:need]
+        elif len(height) < need:
+            warn(f"ElevationGrid.height: {len(height)} values for {nx} x {ny} = {need} points: the "
+                 f"missing {need - len(height)} are 0, as Webots does")
+            height = height + [0.0] * (need - len(height))
+        return {"type": "elevation_grid", "height": [h * s for h in height], "x_dimension": nx,
+                "x_spacing": spacing["xSpacing"] * s, "y_dimension": ny, "y_spacing": spacing["ySpacing"] * s,
+                "thickness": thickness * s}, ""
 
     # ------------------------------------------------------------ lights
     def light(self, node: Node, frame: Frame, owner: Owner) -> None:

@@ -337,6 +337,8 @@ WEBOTS_FIELDS: dict[str, set[str]] = {
     "Shape": {"appearance", "geometry", "castShadows", "isPickable"},
     "Box": {"size"}, "Sphere": {"radius", "subdivision", "ico"}, "Cylinder": _ROUND, "Capsule": _ROUND,
     "Plane": {"size"}, "Mesh": {"url", "ccw", "name", "materialIndex"},
+    "ElevationGrid": {"height", "xDimension", "xSpacing", "yDimension", "ySpacing", "thickness"},
+    "Cone": {"bottomRadius", "height", "side", "bottom", "subdivision"},
     "IndexedFaceSet": {"coord", "normal", "texCoord", "solid", "ccw", "convex", "normalPerVertex", "coordIndex",
                        "normalIndex", "texCoordIndex", "creaseAngle"},
     "Appearance": {"material", "texture", "textureTransform", "name"},

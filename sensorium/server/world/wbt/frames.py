@@ -40,7 +40,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
 
 # tessellation of curved visual shapes under a non-uniform scale (vertices on the true surface)
-CURVED_LEVELS = {"sphere": 4, "cylinder": 64, "capsule": 64}    # icosphere level, sides around the axis
+CURVED_LEVELS = {"sphere": 4, "cylinder": 64, "capsule": 64, "cone": 64}    # icosphere level, sides around the axis
 _ALIGNED_TOL = 1e-12      # off-diagonal terms of the stretch below this (relative) count as aligned axes
 
 
@@ -167,6 +167,9 @@ def bounding_geometry(kind: str, g: dict, scale: tuple[float, float, float]) -> 
         return {**g, "size": [g["size"][0] * ax, g["size"][1] * ay]}
     if kind == "mesh":
         return {**g, "scale": [float(v) for v in scale]}
+    if kind == "elevation_grid":        # WbElevationGrid: |scale| on the spacings, the z scale on the heights
+        return {**g, "x_spacing": g["x_spacing"] * ax, "y_spacing": g["y_spacing"] * ay,
+                "height": [h * scale[2] for h in g["height"]]}
     return _triangles_by(g, np.diag(np.asarray(scale, dtype=np.float64)))
 
 
@@ -186,16 +189,24 @@ def visual_geometry(kind: str, g: dict, frame: Frame) -> tuple[dict | None, str]
             return {**g, "radius": g["radius"] * ax}, ""
         if kind == "cylinder" and ax == ay:
             return {**g, "radius": g["radius"] * ax, "height": g["height"] * az}, ""
+        if kind == "cone" and ax == ay and aligned[2] > 0:     # not turned upside down
+            return {**g, "bottom_radius": g["bottom_radius"] * ax, "height": g["height"] * az}, ""
         if kind == "capsule" and ax == ay == az:
             return {**g, "radius": g["radius"] * ax, "height": g["height"] * az}, ""
+        if kind == "elevation_grid" and min(aligned[0], aligned[1]) > 0:   # not mirrored in x or y
+            return {**g, "x_spacing": g["x_spacing"] * ax, "y_spacing": g["y_spacing"] * ay,
+                    "height": [h * aligned[2] for h in g["height"]]}, ""
     elif kind == "mesh":
         return None, (f"mesh {g['url']!r} under a scale that is not along its own axes (a rotation between "
                       "two non-uniform scales): not supported here; this shape is left out")
     lin = frame.linear()
-    if kind in ("sphere", "cylinder", "capsule"):
+    if kind in ("sphere", "cylinder", "capsule", "cone"):
         return _triangles_by(curved_triangles(kind, g), lin), ""
     if kind == "box":
         v, f = geo.tessellate(geo.Box(tuple(g["size"])))
+        return _triangles_by({"type": "triangles", "vertices": v.tolist(), "faces": f.tolist()}, lin), ""
+    if kind == "elevation_grid":        # mirrored or sheared: its triangles, mapped exactly
+        v, f = geo.elevation_grid(g["height"], g["x_dimension"], g["x_spacing"], g["y_dimension"], g["y_spacing"])
         return _triangles_by({"type": "triangles", "vertices": v.tolist(), "faces": f.tolist()}, lin), ""
     if kind == "plane":
         sx, sy = (v / 2.0 for v in g["size"])
@@ -206,7 +217,11 @@ def visual_geometry(kind: str, g: dict, frame: Frame) -> tuple[dict | None, str]
 
 
 def curved_triangles(kind: str, g: dict) -> dict:
-    """A sphere, cylinder or capsule as triangles whose vertices lie on its true surface."""
+    """A sphere, cylinder, capsule or cone as triangles whose vertices lie on its true surface."""
+    if kind == "cone":
+        r = float(g["bottom_radius"])
+        v, f = geo.tessellate(geo.Cone(r, float(g["height"]), CURVED_LEVELS["cone"]))
+        return {"type": "triangles", "vertices": _onto_axis_radius(v, r, None).tolist(), "faces": np.asarray(f).tolist()}
     r = float(g["radius"])
     if kind == "sphere":
         v, f = geo.tessellate(geo.Sphere(1.0, CURVED_LEVELS["sphere"]))
