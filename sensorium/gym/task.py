@@ -286,7 +286,8 @@ class _AvoidObstaclesCopies(VectorGoal):
         # each copy's rays from one origin, as clearance() casts them (coherent packets: each ray the
         # single world's answer); only the distances are read
         hits = self.sim.cast(self._rays[1], origins, self._rays[2], 0.0, far, kind=RayKind.BOUNDING,
-                             exclude_slot=self.slot, distance_only=True, coherent=True)
+                             exclude_slot=self.slot, distance_only=True, coherent=True,
+                             run=self.RAYS)
         d = hits.distance.reshape(n, self.RAYS)
         clear = np.where(np.isfinite(d), d, np.inf).min(axis=1)
         clear = np.where(np.isfinite(clear), clear, far)

@@ -771,42 +771,86 @@ void sp_to_frame(size_t n, const double* x, const int64_t* rows, const double* R
 
 /* copies.py's broad phase: the (ray, body) pairs of rays of many copies of a world, each ray
  * against the bounding sphere of every robot slot's body in its own copy only. Ray i (origin
- * O[i], unit direction D[i], interval [lo, lim[i]]) of copy copy[i] is paired with slot r when
- * r is present, is not the ray's excluded slot nor its mount slot, lim[i] >= lo, and the segment
- * comes within the sphere (centre[copy[i]][r], r2[r]) -- the numpy path's test, operation for
- * operation (it is conservative, with a slack of 1e-9 (1 + e2)). Pairs are written slot by slot,
- * each slot's rays ascending (the numpy path's order): ray into out_ray, copy * R + r into
- * out_body; returns their number (at most n * R). lo, excl, mnt: per ray when not NULL, else the
- * scalar value. With dist (n,) given, lim[i] is np.minimum(t_far, dist[i]) made here: t_far the
- * (n,) lim when not NULL, else lim_value (the caller's limits without their array). */
-size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const int64_t* copy,
+ * O[i], unit direction D[i], interval [lo, f]) of copy copy[i] is paired with slot r when r is
+ * present, is not the ray's excluded slot nor its mount slot, f >= lo, and the segment comes
+ * within the sphere (centre[copy[i]][r], r2[r]) -- the numpy path's test, operation for operation
+ * (it is conservative, with a slack of 1e-9 (1 + e2)). The ray's limit f is np.minimum(t_far,
+ * dist[i]) (t_far: lim[i], or lim_value when lim is NULL; dist: its static hit). Pairs are written
+ * slot by slot, each slot's rays ascending (the numpy path's order): ray into out_ray,
+ * copy * R + r into out_body; returns their number (at most n * R). lo, excl, mnt: per ray when not
+ * NULL, else the scalar value.
+ * `run` > 0: the rays come in runs of `run` consecutive rays sharing one origin and one copy (a
+ * lidar's scan, the clearance rays of a copy; the last run may be shorter): the origin's offset
+ * to the sphere centre and its square (the same operations on the same values, so the same bits)
+ * are made once per run, and with scalar lo and t_far a run whose origin lies so far from the
+ * sphere that no segment of length max(|lo|, |t_far|) can reach it, with a margin far above the
+ * rounding of the per-ray test, is passed over: it would give no pair. */
+static inline size_t pair_rays(size_t a, size_t b, size_t R, size_t r, double rr, const double* cc, const double* O,
+                               const double* D, const int64_t* copy, const double* lo, double lo_value,
+                               const double* lim, double lim_value, const double* dist, const int64_t* excl,
+                               const int64_t* mnt, int one, int64_t* out_ray, int64_t* out_body, size_t k) {
+  double x = 0.0, y = 0.0, z = 0.0, e2 = 0.0;
+  int64_t c = 0;
+  if (one) {   /* a run: one origin, one copy */
+    c = copy[a];
+    cc += 3 * ((size_t)c * R + r);
+    const double* o = O + 3 * a;
+    x = cc[0] - o[0]; y = cc[1] - o[1]; z = cc[2] - o[2];
+    e2 = x * x + y * y + z * z;
+  }
+  for (size_t i = a; i < b; i++) {
+    if (excl && excl[i] == (int64_t)r) continue;
+    if (mnt && mnt[i] == (int64_t)r) continue;
+    const double l = lo ? lo[i] : lo_value;
+    const double f = np_min(lim ? lim[i] : lim_value, dist[i]);
+    if (!(f >= l)) continue;
+    if (!one) {
+      c = copy[i];
+      const double* s = cc + 3 * ((size_t)c * R + r);
+      const double* o = O + 3 * i;
+      x = s[0] - o[0]; y = s[1] - o[1]; z = s[2] - o[2];
+      e2 = x * x + y * y + z * z;
+    }
+    const double* d = D + 3 * i;
+    const double bb = x * d[0] + y * d[1] + z * d[2];
+    const double tc = np_min(np_max(bb, l), f);
+    out_ray[k] = (int64_t)i;
+    out_body[k] = c * (int64_t)R + (int64_t)r;
+    k += e2 - tc * (bb + bb - tc) <= rr + 1e-9 * (1.0 + e2);
+  }
+  return k;
+}
+
+size_t sp_copy_pairs(size_t n, size_t R, size_t run, const double* O, const double* D, const int64_t* copy,
                      const double* centre, const double* r2, const uint8_t* present, const double* lo,
                      double lo_value, const double* lim, double lim_value, const double* dist,
                      const int64_t* excl, int64_t excl_value, const int64_t* mnt, int64_t mnt_value,
                      int64_t* out_ray, int64_t* out_body) {
   size_t k = 0;
+  /* the longest segment a ray of a run can test (scalar limits only): |tc| <= max(|lo|, |t_far|) */
+  const double reach = (!lo && !lim) ? np_max(fabs(lo_value), fabs(lim_value)) : INF_D;
   for (size_t r = 0; r < R; r++) {
     if (!present[r]) continue;
     if (!excl && excl_value == (int64_t)r) continue;
     if (!mnt && mnt_value == (int64_t)r) continue;
     const double rr = r2[r];
-    for (size_t i = 0; i < n; i++) {
-      if (excl && excl[i] == (int64_t)r) continue;
-      if (mnt && mnt[i] == (int64_t)r) continue;
-      const double l = lo ? lo[i] : lo_value;
-      const double f = dist ? np_min(lim ? lim[i] : lim_value, dist[i]) : lim[i];
-      if (!(f >= l)) continue;
-      const int64_t c = copy[i];
-      const double* cc = centre + 3 * ((size_t)c * R + r);
-      const double* o = O + 3 * i;
-      const double* d = D + 3 * i;
-      const double x = cc[0] - o[0], y = cc[1] - o[1], z = cc[2] - o[2];
-      const double b = x * d[0] + y * d[1] + z * d[2];
-      const double e2 = x * x + y * y + z * z;
-      const double tc = np_min(np_max(b, l), f);
-      out_ray[k] = (int64_t)i;
-      out_body[k] = c * (int64_t)R + (int64_t)r;
-      k += e2 - tc * (b + b - tc) <= rr + 1e-9 * (1.0 + e2);
+    if (!run) {
+      k = pair_rays(0, n, R, r, rr, centre, O, D, copy, lo, lo_value, lim, lim_value, dist, excl, mnt, 0, out_ray,
+                    out_body, k);
+      continue;
+    }
+    for (size_t a = 0; a < n; a += run) {
+      const size_t b = n - a < run ? n : a + run;
+      if (reach < INF_D) {   /* |c - o - tc d| >= |c - o| - |tc|: far beyond the test's slack */
+        const double* s = centre + 3 * ((size_t)copy[a] * R + r);
+        const double* o = O + 3 * a;
+        const double x = s[0] - o[0], y = s[1] - o[1], z = s[2] - o[2];
+        const double e2 = x * x + y * y + z * z;
+        const double e = sqrt(e2), gap = e - reach;
+        if (gap > 0.0 && gap * gap > rr + 1e-9 * (1.0 + e2) + 1e-12 * (1.0 + (e + reach) * (e + reach))) continue;
+      }
+      k = pair_rays(a, b, R, r, rr, centre, O, D, copy, lo, lo_value, lim, lim_value, dist, excl, mnt, 1, out_ray,
+                    out_body, k);
     }
   }
   return k;

@@ -182,7 +182,7 @@ def _load() -> None:
     lib.sp_inside_shells.restype = sz
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
-    lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, d, vp, vp, i64, vp, i64, vp, vp]
+    lib.sp_copy_pairs.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, d, vp, vp, i64, vp, i64, vp, vp]
     lib.sp_contact_near.restype = sz
     lib.sp_drive_wheels.restype = sz
     lib.sp_lidar_beams.restype = None
@@ -509,15 +509,18 @@ def lidar_scan(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray, colum
 
 
 def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarray, r2: np.ndarray,
-               present: np.ndarray, lo, lim, excl, mount, dist: np.ndarray | None = None
+               present: np.ndarray, lo, far, excl, mount, dist: np.ndarray, run: int = 0
                ) -> tuple[np.ndarray, np.ndarray] | None:
     """The broad phase of :meth:`.copies.CopyRays.cast` in one C pass (``sp_copy_pairs``): the
     (ray, copy * R + slot) pairs whose ray comes within the bounding sphere (``centre`` (C, R, 3),
     ``r2`` (R,)) of a present slot of its own copy, its excluded and mount slots left out, listed
-    slot by slot and ray by ray as the numpy path lists them; or None without the helper. ``lo``,
-    ``excl``, ``mount``: scalars or (n,) arrays; ``lim`` (n,), or with ``dist`` (n,) the rays' far
-    limits (a scalar or (n,)), each ray's limit then being ``np.minimum(lim, dist)`` (made in the
-    pass: no (n,) temporary)."""
+    slot by slot and ray by ray as the numpy path (``copies._pairs``) lists them; or None without
+    the helper. ``lo``, ``excl``, ``mount``: scalars or (n,) arrays; ``far`` the rays' far limits
+    (a scalar or (n,)) and ``dist`` (n,) their static hits: each ray's limit is
+    ``np.minimum(far, dist)``, made in the pass (no (n,) temporary). ``run`` > 0: the rays come in
+    runs of ``run`` consecutive rays sharing one origin and one copy (the last may be shorter):
+    the same pairs, with each run's origin worked out once (a run the spheres are far from is
+    passed over whole)."""
     lib = library()
     if lib is None:
         return None
@@ -529,24 +532,23 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     centre = np.ascontiguousarray(centre, dtype=f64)
     r2 = np.ascontiguousarray(r2, dtype=f64)
     present = np.ascontiguousarray(present, dtype=np.uint8)
-    lim_value = 0.0
-    if dist is not None:
-        dist = np.ascontiguousarray(dist, dtype=f64)
-        if not isinstance(lim, np.ndarray) or lim.ndim == 0:
-            lim, lim_value = None, float(lim)
-    if lim is not None:
-        lim = np.ascontiguousarray(lim, dtype=f64)
+    dist = np.ascontiguousarray(dist, dtype=f64)
+    if dist.shape != (n,):
+        raise TypeError(f"copy_pairs: static hits of shape {dist.shape} for {n} rays")
+    lim = None
+    if isinstance(far, np.ndarray) and far.ndim:
+        lim = np.ascontiguousarray(far, dtype=f64)
         if lim.shape != (n,):
             raise TypeError(f"copy_pairs: limits of shape {lim.shape} for {n} rays")
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
     ex_a = np.ascontiguousarray(excl, dtype=i64) if isinstance(excl, np.ndarray) else None
     mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
     out_ray, out_body, p_ray, p_body = _pair_buffers(n * R)
-    p_O, p_D, p_copy, p_centre, p_r2, p_present = _small_addresses((O, D, copy, centre, r2, present))
-    k = lib.sp_copy_pairs(n, R, p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
-                          0.0 if lo_a is not None else float(lo), _ptr(lim), lim_value, _ptr(dist), _ptr(ex_a),
-                          0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
-                          p_ray, p_body)
+    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_dist = _small_addresses((O, D, copy, centre, r2, present, dist))
+    k = lib.sp_copy_pairs(n, R, max(0, int(run)), p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
+                          0.0 if lo_a is not None else float(lo), _ptr(lim), 0.0 if lim is not None else float(far),
+                          p_dist, _ptr(ex_a), 0 if ex_a is not None else int(excl), _ptr(mn_a),
+                          0 if mn_a is not None else int(mount), p_ray, p_body)
     return out_ray[:k].copy(), out_body[:k].copy()
 
 

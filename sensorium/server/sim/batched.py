@@ -732,14 +732,15 @@ class BatchedSimulation:
                 r = reqs[0]
                 out[idx[0]] = self.rays.cast(r.origins, r.directions, r.t_near, r.t_far, RayKind(kind), r.copy,
                                              self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32,
-                                             coherent, origin_rows=r.origin_rows)
+                                             coherent, origin_rows=r.origin_rows, run=r.run)
                 continue
             sizes = [len(r.origins) for r in reqs]
             h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
                                joined(reqs, sizes, "t_near", np.float64), joined(reqs, sizes, "t_far", np.float64),
                                RayKind(kind), joined(reqs, sizes, "copy", np.int64), self.rot, self.pos,
                                joined(reqs, sizes, "exclude", np.int64), joined(reqs, sizes, "mount", np.int64), skip,
-                               distance_only, coherent=coherent)
+                               distance_only, coherent=coherent,
+                               run=reqs[0].run if all(r.run == reqs[0].run for r in reqs) else 0)
             for i, hit in zip(idx, split_hits(h, sizes)):
                 out[i] = hit
         return out   # type: ignore[return-value]
@@ -838,7 +839,7 @@ class BatchedSimulation:
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0,
                               g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1),
-                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip))
+                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip, run=n))
             state["groups"].append((g, rows, k, c, slot, positions, dirs))
         return state, reqs
 
@@ -931,7 +932,7 @@ class BatchedSimulation:
             ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
             reqs.append(_Rays(origins, d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
-                              -1, mount, distance_only=True, d32=d32, coherent=True, origin_rows=org))
+                              -1, mount, distance_only=True, d32=d32, coherent=True, origin_rows=org, run=W))
             state["items"].append((col, c))
         return state, reqs
 
@@ -1000,14 +1001,14 @@ class BatchedSimulation:
     # ------------------------------------------------------------------ tasks
     def cast(self, copies: np.ndarray, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
              exclude_slot=-1, skip_transparent: bool = False, distance_only: bool = False,
-             coherent: bool = False) -> RayHits:
+             coherent: bool = False, run: int = 0) -> RayHits:
         """Rays of the named copies (one entry per ray) against each copy's world, as
         ``scene.engine.cast`` of a single simulation (``exclude_slot``: a robot slot whose body
-        the rays ignore, as ``exclude_owner``; ``distance_only``, ``coherent``: as
+        the rays ignore, as ``exclude_owner``; ``distance_only``, ``coherent``, ``run``: as
         :meth:`.CopyRays.cast`)."""
         return self.rays.cast(origins, directions, t_near, t_far, RayKind(kind), np.asarray(copies, dtype=np.int64),
                               self.rot, self.pos, exclude_slot, -1, skip_transparent, distance_only=distance_only,
-                              coherent=coherent)
+                              coherent=coherent, run=run)
 
 
 @dataclass(slots=True)
@@ -1027,6 +1028,7 @@ class _Rays:
     d32: np.ndarray | None = None
     coherent: bool = False     # runs of rays from one origin each (lidars): traced as one lidar's beams
     origin_rows: np.ndarray | None = None   # the distinct origins (the lidars' positions), when known
+    run: int = 0   # > 0: runs of this many rays share one origin and one copy (a scan, a sensor's rays)
 
 
 class _OnEngine:
