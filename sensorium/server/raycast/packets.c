@@ -1072,19 +1072,22 @@ size_t sp_drive_wheels(size_t L, size_t D, size_t R, const int64_t* live, const 
  * (x rot[j][0] + y rot[j][1]) + z rot[j][2], the numpy path's sums) -- written as rows i * W + w
  * of out_org, out_dir (float64) and out_d32 (the directions rounded to float32). */
 void sp_lidar_beams(size_t n, size_t W, const double* rot, const double* org, const double* x, const double* y,
-                    const double* z, double* out_org, double* out_dir, float* out_d32) {
+                    const double* z, double* restrict out_org, double* restrict out_dir, float* restrict out_d32) {
   for (size_t i = 0; i < n; i++) {
     const double* R = rot + 9 * i;
+    /* the scan's matrix and origin held in locals: the outputs (restrict: the caller's own
+     * buffers) cannot change them, so each beam is its three sums and stores */
+    const double r00 = R[0], r01 = R[1], r02 = R[2], r10 = R[3], r11 = R[4], r12 = R[5], r20 = R[6], r21 = R[7],
+                 r22 = R[8];
     const double o0 = org[3 * i], o1 = org[3 * i + 1], o2 = org[3 * i + 2];
     for (size_t w = 0; w < W; w++) {
       const size_t r = 3 * (i * W + w);
-      for (int j = 0; j < 3; j++) {
-        double acc = x[w] * R[3 * j];
-        acc += y[w] * R[3 * j + 1];
-        acc += z[w] * R[3 * j + 2];
-        out_dir[r + j] = acc;
-        out_d32[r + j] = (float)acc;
-      }
+      const double xw = x[w], yw = y[w], zw = z[w];
+      double a0 = xw * r00, a1 = xw * r10, a2 = xw * r20;
+      a0 += yw * r01; a1 += yw * r11; a2 += yw * r21;
+      a0 += zw * r02; a1 += zw * r12; a2 += zw * r22;
+      out_dir[r] = a0; out_dir[r + 1] = a1; out_dir[r + 2] = a2;
+      out_d32[r] = (float)a0; out_d32[r + 1] = (float)a1; out_d32[r + 2] = (float)a2;
       out_org[r] = o0;
       out_org[r + 1] = o1;
       out_org[r + 2] = o2;
