@@ -839,7 +839,7 @@ class BatchedSimulation:
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0,
                               g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1),
-                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip, run=n))
+                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip, run=n, origin_rows=positions))
             state["groups"].append((g, rows, k, c, slot, positions, dirs))
         return state, reqs
 
@@ -1001,14 +1001,14 @@ class BatchedSimulation:
     # ------------------------------------------------------------------ tasks
     def cast(self, copies: np.ndarray, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
              exclude_slot=-1, skip_transparent: bool = False, distance_only: bool = False,
-             coherent: bool = False, run: int = 0) -> RayHits:
+             coherent: bool = False, run: int = 0, origin_rows=None) -> RayHits:
         """Rays of the named copies (one entry per ray) against each copy's world, as
         ``scene.engine.cast`` of a single simulation (``exclude_slot``: a robot slot whose body
-        the rays ignore, as ``exclude_owner``; ``distance_only``, ``coherent``, ``run``: as
-        :meth:`.CopyRays.cast`)."""
+        the rays ignore, as ``exclude_owner``; ``distance_only``, ``coherent``, ``run``,
+        ``origin_rows``: as :meth:`.CopyRays.cast`)."""
         return self.rays.cast(origins, directions, t_near, t_far, RayKind(kind), np.asarray(copies, dtype=np.int64),
                               self.rot, self.pos, exclude_slot, -1, skip_transparent, distance_only=distance_only,
-                              coherent=coherent, run=run)
+                              coherent=coherent, run=run, origin_rows=origin_rows)
 
 
 @dataclass(slots=True)
