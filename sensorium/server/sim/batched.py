@@ -993,6 +993,13 @@ class BatchedSimulation:
                 for k, cc in enumerate(c.tolist()):
                     stream = _Stream(self.noise, cc, nc)
                     img[cc] = lmath.ranges_from_hits(lid.params, dist[k], lid._all_dirs, stream)  # type: ignore[arg-type]
+            elif lid._factor is None and lid.params.resolution == RESOLUTION_OFF and (
+                    len(c) == len(img) and (c == np.arange(len(c))).all()):
+                # every copy scanned, nothing moves a value, cylindrical: the whole image in one C
+                # pass where the helper is (ranges_from_hits' bits, as the single Lidar.finish)
+                if not packets.lidar_scan(np.ascontiguousarray(dist, dtype=np.float64).reshape(-1),
+                                          lid.params.min_range, lid.params.max_range, img.reshape(-1)):
+                    img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
             else:   # element by element: every copy's scans in one call
                 img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
             self.last["Lidar"][c, col] = self.time_ms[c]
