@@ -582,6 +582,47 @@ def test_arc_steps_are_motion_arc_step_bit_for_bit(turning):
         assert np.asarray(g).tobytes() == wa.tobytes()
 
 
+def test_arc_steps_in_c_are_the_numpy_arcs_and_poses_bit_for_bit(monkeypatch):
+    """packets.arc_steps (the batched drive: every moving robot's arc and its new yaw's cos and sin
+    in one C pass) gives _arc_steps' x, y, yaw (numpy's products, libm's cos/sin through math.cos
+    and math.sin, numpy's remainder) and math.cos/math.sin of the new yaw, bit for bit: robots all
+    turning, all straight (|w dt| < 1e-9) and mixed; yaws at +-pi and multiples of 2 pi (remainder
+    0), signed zeros, huge angles, NaN speeds; an infinite angle is left to the Python way."""
+    from sensorium.server.sim.batched import _arc_steps, _cos_sin
+
+    if packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    rng = np.random.default_rng(12)
+    n = 5000
+    x, y = rng.uniform(-3.0, 3.0, n), rng.uniform(-3.0, 3.0, n)
+    yaw = np.concatenate([rng.uniform(-math.pi, math.pi, n - 500), rng.uniform(-1e4, 1e4, 490),
+                          [math.pi, -math.pi, 0.0, -0.0, 3 * math.pi, -3 * math.pi, 1e-300, math.pi / 2, 1e15, -1e15]])
+    v = rng.uniform(-1.0, 1.0, n)
+    v[::17] = 0.0
+    v[::29] = -0.0
+    w = rng.uniform(-20.0, 20.0, n)
+    w[::5] = rng.uniform(-1e-7, 1e-7, len(w[::5]))          # straight: |w dt| < 1e-9 for most
+    w[::11] = 0.0
+    w[::13] = -0.0
+    w[7] = np.nan
+    v[9] = np.nan
+    monkeypatch.setattr(packets, "cos_sin", lambda a: None)  # the reference: math.cos / math.sin
+    dt = 0.016
+    turning = np.abs(w * dt) >= 1e-9
+    for rows in (np.arange(n), turning.nonzero()[0], (~turning).nonzero()[0], np.arange(0, n, 3)):
+        args = (x[rows], y[rows], yaw[rows], v[rows], w[rows])
+        want = _arc_steps(*args, dt)
+        want = (*want, *_cos_sin(want[2]))
+        got = packets.arc_steps(*args, dt)
+        assert got is not None and len(rows) > 100
+        for g, r in zip(got, want):
+            assert g.tobytes() == r.tobytes()
+    # remainder 0: the new yaw is -pi (numpy's +0.0 remainder), whose cos is -1
+    got = packets.arc_steps(np.zeros(1), np.zeros(1), np.array([math.pi]), np.zeros(1), np.zeros(1), dt)
+    assert got is not None and got[2][0] == -math.pi and got[3][0] == -1.0
+    assert packets.arc_steps(np.zeros(2), np.zeros(2), np.array([0.0, math.inf]), np.ones(2), np.ones(2), dt) is None
+
+
 def test_cos_sin_in_c_are_math_cos_and_sin_bit_for_bit():
     """packets.cos_sin (the batched drive's poses and arcs) gives what math.cos and math.sin give,
     element by element, on random angles of every magnitude, signed zeros, NaN, multiples of pi and

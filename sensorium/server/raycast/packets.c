@@ -1099,6 +1099,58 @@ void sp_lidar_beams(size_t n, size_t W, const double* rot, const double* org, co
  * math.sin make (the single simulation's). Two loops, so that the compiler does not merge a cos and
  * a sin of one angle into one sincos call (another libm entry point). Returns the number of
  * infinite angles (math.cos refuses them: the caller then takes Python's way, error included). */
+/* numpy's float64 remainder (npy_remainder: fmod, moved to b's sign; a zero takes b's sign) */
+static inline double np_remainder(double a, double b) {
+  double mod = fmod(a, b);
+  if (!b) return mod;
+  if (mod) {
+    if ((b < 0) != (mod < 0)) mod += b;
+  } else {
+    mod = copysign(0.0, b);
+  }
+  return mod;
+}
+
+/* batched.py's _arc_steps (motion.arc_step per robot, element by element the same float64
+ * operations: straight when |w dt| < 1e-9, x + (v dt) cos(yaw + dyaw / 2); else with r = v / w,
+ * x + r (sin(yaw + dyaw) - sin(yaw)), y - r (cos(yaw + dyaw) - cos(yaw)); the new yaw
+ * remainder((yaw + dyaw) + pi, 2 pi) - pi) and then the new yaw's cos and sin (the pose's Rz), the
+ * libm calls math.cos/math.sin make. Returns the number of infinite angles handed to cos or sin
+ * (math.cos refuses them: the caller's Python way says so); the outputs are then not to be used. */
+size_t sp_arc_steps(size_t n, const double* x, const double* y, const double* yaw, const double* v, const double* w,
+                    double dt, double* out_x, double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
+  const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+  size_t inf = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double dyaw = w[i] * dt;
+    if (fabs(dyaw) < 1e-9) {
+      const double mid = yaw[i] + 0.5 * dyaw;
+      const double cm = cos(mid);
+      const double sm = sin(mid);
+      inf += isinf(mid) != 0;
+      out_x[i] = x[i] + v[i] * dt * cm;
+      out_y[i] = y[i] + v[i] * dt * sm;
+    } else {
+      const double r = v[i] / w[i];
+      const double a1 = yaw[i] + dyaw;
+      const double c1 = cos(a1);
+      const double s1 = sin(a1);
+      const double c0 = cos(yaw[i]);
+      const double s0 = sin(yaw[i]);
+      inf += (isinf(a1) != 0) + (isinf(yaw[i]) != 0);
+      out_x[i] = x[i] + r * (s1 - s0);
+      out_y[i] = y[i] - r * (c1 - c0);
+    }
+    out_yaw[i] = np_remainder(yaw[i] + dyaw + pi, two_pi) - pi;
+  }
+  for (size_t i = 0; i < n; i++) {
+    out_cos[i] = cos(out_yaw[i]);
+    inf += isinf(out_yaw[i]) != 0;
+  }
+  for (size_t i = 0; i < n; i++) out_sin[i] = sin(out_yaw[i]);
+  return inf;
+}
+
 size_t sp_cos_sin(size_t n, const double* a, double* out_cos, double* out_sin) {
   size_t inf = 0;
   for (size_t i = 0; i < n; i++) {

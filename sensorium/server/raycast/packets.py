@@ -175,6 +175,8 @@ def _load() -> None:
     lib.sp_plane1.restype = sz
     lib.sp_plane1.argtypes = [sz, vp, sz, vp, i, d, i, vp, vp, vp, d, vp, d, i, vp, vp, vp, i, i64, vp, i64, i64, vp,
                               vp, vp]
+    lib.sp_arc_steps.restype = sz
+    lib.sp_arc_steps.argtypes = [sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp]
     lib.sp_cos_sin.restype = sz
     lib.sp_cos_sin.argtypes = [sz, vp, vp, vp]
     lib.sp_box3.restype = None
@@ -653,6 +655,29 @@ def analytic(tier, slots: np.ndarray, O: np.ndarray, D: np.ndarray, lo: np.ndarr
     lib.sp_analytic(st, m, s64.ctypes.data, O.ctypes.data, D.ctypes.data, lo.ctypes.data, hi.ctypes.data,
                     t.ctypes.data, _ptr(n))
     return t, n
+
+
+def arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """:func:`.batched._arc_steps` and the new yaws' cos and sin (the poses' Rz, ``_cos_sin``) in one C
+    pass (``sp_arc_steps``): (x, y, yaw, cos yaw, sin yaw) of n robots, the numpy path's bits (its
+    operations element by element, libm's cos/sin as math.cos/math.sin, numpy's remainder); None
+    without the helper, for other arrays, or when an angle is infinite (math.cos refuses it: the
+    caller's Python way says so)."""
+    lib = library()
+    if lib is None:
+        return None
+    n = len(x)
+    ins = []
+    for a in (x, y, yaw, v, w):
+        if a.dtype != np.float64 or a.shape != (n,):
+            return None
+        ins.append(np.ascontiguousarray(a))
+    outs = [np.empty(n) for _ in range(5)]
+    p = _small_addresses(ins + outs)
+    if lib.sp_arc_steps(n, *p[:5], float(dt), *p[5:]):
+        return None
+    return outs[0], outs[1], outs[2], outs[3], outs[4]
 
 
 def box3(O: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

@@ -533,13 +533,18 @@ class BatchedSimulation:
         if not len(copies):
             return
         x0, y0 = self.x[copies, slots], self.y[copies, slots]
-        x, y, yaw = _arc_steps(x0, y0, self.yaw[copies, slots], v, w, dt)
+        yaw0 = self.yaw[copies, slots]
+        arc = packets.arc_steps(x0, y0, yaw0, v, w, dt)   # (with the new yaws' cos, sin: one C pass)
+        if arc is not None:
+            x, y, yaw, cos, sin = arc
+        else:
+            x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
+            cos, sin = _cos_sin(yaw)
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
             x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
         self.x[copies, slots], self.y[copies, slots] = x, y
         # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
-        cos, sin = _cos_sin(yaw)
         rz = np.zeros((len(yaw), 3, 3))
         rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
         self.rot[copies, slots] = np.matmul(rz, self.base[copies, slots])
