@@ -124,9 +124,10 @@ class TierTracer(Refiner):
         # float64 path (scalar or vectorised) may differ from this one's in the last bit
         if tier.has_curved:  # origins inside a curved shell: analytic first (see the pre-pass)
             lo = np.maximum(t_near, eps64) if isinstance(t_near, np.ndarray) else max(t_near, eps64)
-            if rows is not None and not tier.anchored and not isinstance(lo, np.ndarray) and not _near_shells(
-                    tier, rows, lo):
-                pass   # no start point can lie in a shell: the pre-pass would find nothing
+            if rows is not None and 4 * len(rows) <= m and not tier.anchored and not isinstance(lo, np.ndarray) \
+                    and not _near_shells(tier, rows, lo):
+                pass   # no start point can lie in a shell: the pre-pass would find nothing (screened by
+                # the rows where they are a few per ray: a lidar's 360, a sonar's 5, not an e-puck's 3)
             else:
                 pre = self._contained_prepass(tier, Ot, D, lo, lim, excl, None if tier.anchored else box)
             if pre is not None:  # the cast only needs to look before the analytic hits
