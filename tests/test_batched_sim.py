@@ -645,3 +645,30 @@ def test_cos_sin_in_c_are_math_cos_and_sin_bit_for_bit():
     assert packets.cos_sin(np.array([0.5, math.inf])) is None
     with pytest.raises(ValueError):
         _cos_sin(np.array([0.5, -math.inf]))
+
+
+def test_a_kind_never_enabled_is_never_due_and_enabling_it_later_measures_on_its_period():
+    """Devices of a kind no copy ever enabled are not looked at (nothing is due: no measurement,
+    values stay NaN); enabling one later in some copies measures it there on its period from
+    that moment, as a single simulation does, and disabling it again (period 0) stops it."""
+    bs = BatchedSimulation(arena(3), 4, precision="fast")
+    ref = bs.device("epuck", "ls0")
+    bs.run(3)
+    assert bs.counters["measurements"] == 0 and np.isnan(bs.value(ref)).all()
+    dt = bs.basic_time_step
+    period = 4 * dt
+    bs.enable(ref, period, copies=[1, 2])              # due 4 basic steps from now
+    bs.run(3)
+    assert bs.counters["measurements"] == 0
+    bs.run(1)
+    assert bs.counters["measurements"] == 2
+    values = bs.value(ref)
+    assert np.isnan(values[[0, 3]]).all() and np.isfinite(values[[1, 2]]).all()
+    single = Simulation(arena(3), precision="fast")
+    single.run(3)
+    single.robot("epuck").device("ls0").enable(period)
+    single.run(4)
+    assert single.robot("epuck").device("ls0").value == float(values[1])
+    bs.enable(ref, 0, copies=[1, 2])
+    bs.run(8)
+    assert bs.counters["measurements"] == 2

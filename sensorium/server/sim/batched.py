@@ -326,6 +326,8 @@ class BatchedSimulation:
         self.noise = NoiseStreams(C, paths, block=block)
         # per kind: schedules (period, last update) per copy and the latest values
         self.period = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
+        # per kind: whether enable() ever gave one of its devices a period (else none is ever due)
+        self._enabled = dict.fromkeys(lists, False)
         self.last = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
         self.values = {k: np.full((C, len(v)), math.nan) for k, v in lists.items() if k != "Lidar"}
         for lid in self.lidar:
@@ -497,6 +499,8 @@ class BatchedSimulation:
                                "the batched simulation (use Simulation)")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         self.period[ref.kind][idx, ref.column] = int(period_ms)
+        if period_ms > 0:
+            self._enabled[ref.kind] = True
         self.last[ref.kind][idx, ref.column] = self.time_ms[idx]
 
     # ------------------------------------------------------------------ stepping
@@ -669,6 +673,8 @@ class BatchedSimulation:
 
     # -- devices
     def _due(self, kind: str, live: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if not self._enabled[kind]:   # never enabled: every period is 0, nothing is due
+            return _NONE, _NONE
         if len(live) == self.copies:    # every copy (live is then 0 ... C-1): the arrays as they are
             per = self.period[kind]
             due = (per > 0) & (self.time_ms[:, None] - self.last[kind] >= per)
@@ -1058,6 +1064,10 @@ class _Stream:
 
     def standard_normal(self, count: int) -> np.ndarray:
         return self.bank.take(self.copy, self.column, int(count))
+
+
+_NONE = np.zeros(0, dtype=np.int64)
+_NONE.setflags(write=False)
 
 
 def _by_table(devices: list) -> list[tuple]:
