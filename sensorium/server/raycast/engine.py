@@ -375,7 +375,9 @@ class RayEngine(TierTracer):
         ``origin_rows``: optional (k, 3) float64 array of the rays' distinct origins -- every ray's
         origin is one of its rows and every row is some ray's origin (the scan origins of a batched
         lidar cast) -- from which the cast takes the largest coordinate and the box of the origins
-        (the same values) instead of passes over all n rows."""
+        (the same values) instead of passes over all n rows; where they are a few per ray, FAST
+        also screens the curved shells' pre-pass by them (unit directions, as that pre-pass's
+        one-origin screen assumes: every start point lies within t_near of its row)."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
