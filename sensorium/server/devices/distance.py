@@ -175,7 +175,6 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
     S, N = r.shape
     rmax = np.broadcast_to(np.asarray(lut_max_range, dtype=np.float64), (S,))[:, None]
     hit = np.isfinite(r) & (r <= rmax)
-    r_or_max = np.where(hit, r, rmax)
     types = _per_sensor(sensor_type, S)
     known = (types >= 0) & (types <= _LAST_TYPE)
     if not known.all():
@@ -187,6 +186,7 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
     w: np.ndarray | None = None   # the weights (S, N): read by the weighted sums only
     if n_sonar < S:   # generic (and infra-red, laser) read the weighted sum
         w = np.broadcast_to(np.asarray(weights, dtype=np.float64), (S, N))
+        r_or_max = np.where(hit, r, rmax)   # (what the weighted sums and lasers read; sonars do not)
         average = np.einsum("sn,sn->s", w, r_or_max)
         out[:] = average  # generic
 
