@@ -294,3 +294,30 @@ def test_single_env_on_the_batched_engine_equals_the_rebuilt_simulation(env_id):
             orr, rr, tr_, trr, ir = rebuilt.step(a)
             assert _same_obs(ob, orr) and (rb, tb, trb) == (rr, tr_, trr) and ib["time_ms"] == ir["time_ms"]
             done = tb or trb
+
+
+def test_range_image_observations_clip_nan_and_infinities_as_the_box_clip_does():
+    """A lidar's observation: its range image with NaN and +inf as the Box's high, -inf as its low,
+    clipped to the Box (np.clip of nan_to_num, the single env's steps), bit for bit, for images
+    holding NaN, +-inf, signed zeros, subnormals, values below, inside and beyond the range; both
+    for the whole batch and one sub-env (fails if the uniform-bounds path changes a value)."""
+    venv = gym.make_vec("sensorium/LidarAvoid-v0", num_envs=3, vectorization_mode="vector_entry_point",
+                        precision="fast").unwrapped
+    venv.reset(seed=0)
+    name = next(k for k, ref in venv.refs.items() if ref.kind == "Lidar")
+    assert name in venv._image_bounds                      # the lidar's Box: 0 .. max range everywhere
+    box = venv.agent.dict_space.spaces[name]
+    img = venv.sim.range_image(venv.refs[name])
+    rng = np.random.default_rng(2)
+    special = np.array([np.nan, np.inf, -np.inf, -0.0, 0.0, 1e-45, -1e-45, -3.0, 1e30, box.high.flat[0],
+                        np.nextafter(box.high.flat[0], np.float32(np.inf))], dtype=np.float32)
+    img[...] = rng.uniform(-1.0, 1.5 * float(box.high.flat[0]), img.shape).astype(np.float32)
+    flat = img.reshape(-1)
+    flat[rng.integers(0, flat.size, 200)] = rng.choice(special, 200)
+    hi = box.high.flat[0]
+    want = np.clip(np.nan_to_num(img, nan=hi, posinf=hi), box.low, box.high).astype(np.float32)
+    got = venv._observe()[name]
+    assert got.dtype == np.float32 and got.tobytes() == want.tobytes()
+    assert np.isnan(img).any() and np.isinf(img).any()
+    one = venv._observe(np.array([1]))[name]
+    assert one.tobytes() == want[1:2].tobytes()

@@ -210,6 +210,42 @@ def test_c_analytic_gives_the_numpy_answers_bit_for_bit(seed, m):
             assert 0.2 < np.isfinite(t).mean() < 0.95                          # hits and misses
 
 
+@pytest.mark.parametrize("distance_only", [False, True])
+def test_fast_general_loop_refines_shells_left_from_inside_in_c_with_the_numpy_answers(distance_only, monkeypatch):
+    """FAST's general loop (the rays _trace_fast redoes: a curved shell hit from inside) takes the
+    true surface from packets.analytic: t, shapes and normals bit for bit those of the numpy
+    ``_analytic`` (the helper switched off), for rays from inside and outside spheres, cylinders
+    and capsules, with limits cutting some hits; and the C pass is the one used."""
+    rng = np.random.default_rng(8)
+    eng, tier = _tier_of_curved(3)
+    eng.precision = Precision.FAST
+    m = 3000
+    slots = rng.integers(0, len(tier.c_code), m)
+    c = tier.c_pos[slots]
+    O = c + rng.uniform(-0.15, 0.15, (m, 3))
+    O[m // 2:] = c[m // 2:] + rng.uniform(-2.0, 2.0, (m - m // 2, 3))
+    D = _unit(rng.normal(size=(m, 3)))
+    lim = np.where(rng.random(m) < 0.7, rng.uniform(0.05, 4.0, m), np.inf)
+    eps64 = 1e-9 + 1e-14 * float(np.abs(O).max())
+    calls = []
+    real = packets.analytic
+
+    def counted(*a, **k):
+        calls.append(len(a[1]))
+        return real(*a, **k)
+
+    monkeypatch.setattr(packets, "analytic", counted)
+    with np.errstate(all="ignore"):
+        got = eng._trace_loop(tier, O, D, 0.0, lim, -1, eps64, exact=False, distance_only=distance_only)
+    assert sum(calls) >= 40                                  # shells left from inside, refined in C
+    monkeypatch.setattr(packets, "analytic", lambda *a, **k: None)
+    with np.errstate(all="ignore"):
+        want = eng._trace_loop(tier, O, D, 0.0, lim, -1, eps64, exact=False, distance_only=distance_only)
+    for g, w in zip(got, want):
+        assert g.tobytes() == w.tobytes()
+    assert 0.3 < np.isfinite(got[0]).mean() < 1.0
+
+
 def test_numpy_minimum_semantics_the_c_code_follows():
     """packets.c's np_min/np_max and its float32 comparisons follow numpy: NaN wins, the second
     operand on ties (signed zeros), float32 arrays compared with Python floats in float32."""

@@ -361,3 +361,56 @@ def test_origin_rows_give_the_cast_without_them_bit_for_bit(threads):
         for t_far in (np.inf, 0.5 + 1e-7):
             inside = eng.cast(O, D, 0.0, t_far, kind=RayKind.VISUAL, origin_rows=rows).distance[:W]
             assert np.allclose(inside, 0.5, atol=1e-9)
+
+
+def test_origin_rows_far_from_every_curved_shell_pass_the_pre_pass_by(monkeypatch):
+    """A cast whose origin rows all lie beyond reach of every curved shell (the scouts of many
+    copies scanning an arena) is screened by those rows alone: the curved-shell pre-pass is not
+    run, with the same distances, shapes and normals as the cast without rows; rows whose start
+    points (t_near along the ray) can enter a shell -- one just outside the sphere with rays
+    starting 0.2 m in -- still run it, and those rays meet the sphere from within (closed form)."""
+    eng = RayEngine(Precision.FAST)
+    eng.add_body([ShapeEntry(Plane(), Pose.identity(), True, True)], Pose.identity())
+    eng.add_body([ShapeEntry(Sphere(0.5), Pose.identity(), True, True)], Pose(np.eye(3), np.array([1.0, 0.0, 0.6])))
+    eng.add_body([ShapeEntry(Cylinder(0.3, 1.0), Pose.identity(), True, True)],
+                 Pose(np.eye(3), np.array([-1.0, 1.0, 0.5])))
+    calls = []
+    real = eng._contained_prepass
+
+    def counted(*a, **k):
+        calls.append(len(a[1]))
+        return real(*a, **k)
+
+    monkeypatch.setattr(eng, "_contained_prepass", counted)
+    rng = np.random.default_rng(9)
+    rows = np.array([[2.5, 2.5, 0.3], [-2.5, -2.0, 0.8], [2.4, -2.2, 0.1], [-0.2, 2.7, 1.0]] * 10)
+    rows += rng.uniform(-0.1, 0.1, rows.shape)
+    W = 128
+    O = np.repeat(rows, W, axis=0)
+    D = _unit(rng.normal(size=(len(O), 3)))
+    for t_near, t_far in ((0.0, np.inf), (0.02, 6.0)):
+        for distance_only in (False, True):
+            calls.clear()
+            want = eng.cast(O, D, t_near, t_far, kind=RayKind.VISUAL, distance_only=distance_only)
+            assert calls                                              # without rows: screened ray by ray
+            calls.clear()
+            got = eng.cast(O, D, t_near, t_far, kind=RayKind.VISUAL, distance_only=distance_only, origin_rows=rows)
+            assert not calls                                          # passed by
+            assert got.distance.tobytes() == want.distance.tobytes()
+            if not distance_only:
+                assert got.shape.tobytes() == want.shape.tobytes() and got.normal.tobytes() == want.normal.tobytes()
+            assert 0.3 < np.isfinite(got.distance).mean()
+    # one row 0.1 m outside the sphere: rays toward its centre starting 0.2 m along begin inside it
+    near_row = np.array([[1.0, -0.6, 0.6]])
+    rows2 = np.concatenate([rows, near_row])
+    Dn = _unit(np.array([[0.0, 1.0, 0.0]]) + rng.normal(scale=0.05, size=(W, 3)))
+    O2 = np.concatenate([O, np.repeat(near_row, W, axis=0)])
+    D2 = np.concatenate([D, Dn])
+    calls.clear()
+    want = eng.cast(O2, D2, 0.2, 6.0, kind=RayKind.VISUAL)
+    got = eng.cast(O2, D2, 0.2, 6.0, kind=RayKind.VISUAL, origin_rows=rows2)
+    assert calls and got.distance.tobytes() == want.distance.tobytes() and got.normal.tobytes() == want.normal.tobytes()
+    # from within: the far side of the sphere, |o + t d - c| = 0.5
+    t = got.distance[len(O):]
+    p = near_row + t[:, None] * Dn - np.array([1.0, 0.0, 0.6])
+    assert np.allclose(np.linalg.norm(p, axis=1), 0.5, atol=1e-9) and (t > 0.6).all()

@@ -280,13 +280,15 @@ class _AvoidObstaclesCopies(VectorGoal):
         g, r = self.goal, self.radius
         far = r + max(g.near, g.contact_distance) + 1e-6
         n = len(copies)
-        origins = np.repeat(self.sim.pos[copies, self.slot], self.RAYS, axis=0)
+        rows = self.sim.pos[copies, self.slot]
+        origins = np.repeat(rows, self.RAYS, axis=0)
         if self._rays is None or not np.array_equal(self._rays[0], copies):   # (the same copies step after step)
             self._rays = (copies.copy(), np.repeat(copies, self.RAYS), np.tile(self.dirs, (n, 1)))
         # each copy's rays from one origin, as clearance() casts them (coherent packets: each ray the
         # single world's answer); only the distances are read
         hits = self.sim.cast(self._rays[1], origins, self._rays[2], 0.0, far, kind=RayKind.BOUNDING,
-                             exclude_slot=self.slot, distance_only=True, coherent=True)
+                             exclude_slot=self.slot, distance_only=True, coherent=True,
+                             run=self.RAYS, origin_rows=rows)
         d = hits.distance.reshape(n, self.RAYS)
         clear = np.where(np.isfinite(d), d, np.inf).min(axis=1)
         clear = np.where(np.isfinite(clear), clear, far)

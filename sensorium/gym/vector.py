@@ -123,6 +123,7 @@ class SensoriumVectorEnv(VectorEnv):
         self.slot = self.sim.slot(self.agent.robot)
         self.refs = {name: self.sim.check_observable(self.agent.robot, name) for name in self.agent.periods}
         self._scalars = self._scalar_groups()
+        self._image_bounds = self._uniform_image_bounds()
         self.basic_time_step = self.sim.basic_time_step
         self.steps_per_action = self.agent.control_period_ms // self.basic_time_step
         self.single_observation_space = self.agent.observation_space
@@ -216,6 +217,25 @@ class SensoriumVectorEnv(VectorEnv):
                  np.array([g[2] for g in items], dtype=np.float64), np.array([g[3] for g in items], dtype=np.float32),
                  np.array([g[4] for g in items], dtype=np.float32)) for kind, items in groups.items()]
 
+    def _uniform_image_bounds(self) -> dict[str, tuple[np.float32, np.float32]]:
+        """Per observed range image whose Box has one finite low and one high over every entry (a
+        lidar's 0 and maximum range) with low <= high, high > 0: those two float32 bounds. Clipping
+        to them gives the clip to the Box of :meth:`_observe` with its nan_to_num's +inf (and NaN)
+        -> high and -inf -> -3.4e38 -> low, element by element the same values, once the NaNs are
+        set to high and a zero at a zero low bound is that bound's zero (numpy's clip against an
+        array returns the bound on a tie, against a number the value: -0.0 vs 0.0), so that path
+        clips against two numbers (tests/test_gym_vector.py compares the two bit for bit)."""
+        out = {}
+        for name, box in self.agent.dict_space.spaces.items():
+            if self.refs[name].kind != "Lidar":
+                continue
+            low, high = np.asarray(box.low, dtype=np.float32), np.asarray(box.high, dtype=np.float32)
+            lo, hi = low.flat[0], high.flat[0]
+            if (np.isfinite(lo) and lo <= hi and hi > 0.0 and lo > np.finfo(np.float32).min
+                    and (low == lo).all() and (high == hi).all()):
+                out[name] = (lo, hi)
+        return out
+
     def _observe(self, copies: np.ndarray | slice = slice(None)):
         got = {}
         for kind, names, cols, fill, low, high in self._scalars:
@@ -230,6 +250,16 @@ class SensoriumVectorEnv(VectorEnv):
                 out[name] = got[name] if self.agent.flatten else got[name].copy()   # (each its own array)
                 continue
             img = self.sim.range_image(self.refs[name])[copies]
+            bounds = self._image_bounds.get(name)
+            if bounds is not None:   # (see _uniform_image_bounds: the same values, two passes fewer)
+                v = np.clip(img, bounds[0], bounds[1])
+                nan = np.isnan(v)
+                if nan.any():
+                    v[nan] = bounds[1]
+                if bounds[0] == 0.0:   # a zero at the low bound is the bound's zero (as the Box's array clip gives it)
+                    v[v == 0.0] = bounds[0]
+                out[name] = v
+                continue
             hi = box.high.flat[0]
             out[name] = np.clip(np.nan_to_num(img, nan=hi, posinf=hi), box.low, box.high).astype(np.float32)
         if self.agent.flatten:

@@ -147,6 +147,13 @@ def sonar_incidence(u: np.ndarray, back: np.ndarray) -> np.ndarray:
     return np.arctan2(np.sqrt((c0 * c0 + c1 * c1) + c2 * c2), np.einsum("snk,snk->sn", u, back))
 
 
+def _per_sensor(sensor_type, S: int) -> np.ndarray:
+    """(S,) int64 sensor types from a scalar or an (S,) array (as it is when it already is one)."""
+    if isinstance(sensor_type, np.ndarray) and sensor_type.dtype == np.int64 and sensor_type.shape == (S,):
+        return sensor_type
+    return np.broadcast_to(np.asarray(sensor_type, dtype=np.int64), (S,))
+
+
 def combine_distance_batch(sensor_type, distances, directions, normals, weights, lut_max_range,
                            reflection=None, red_color_sensitivity=1.0) -> np.ndarray:
     """Distance ``D`` (S,) of S sensors with N rays each (spec §3.4).
@@ -168,9 +175,7 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
     S, N = r.shape
     rmax = np.broadcast_to(np.asarray(lut_max_range, dtype=np.float64), (S,))[:, None]
     hit = np.isfinite(r) & (r <= rmax)
-    r_or_max = np.where(hit, r, rmax)
-    w = np.broadcast_to(np.asarray(weights, dtype=np.float64), (S, N))
-    types = np.broadcast_to(np.asarray(sensor_type, dtype=np.int64), (S,))
+    types = _per_sensor(sensor_type, S)
     known = (types >= 0) & (types <= _LAST_TYPE)
     if not known.all():
         raise ValueError(f"unknown sensor type(s) {np.unique(types[~known]).tolist()}")
@@ -178,12 +183,15 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
     sonar = types == _SONAR
     n_sonar = int(np.count_nonzero(sonar))
     average = None
+    w: np.ndarray | None = None   # the weights (S, N): read by the weighted sums only
     if n_sonar < S:   # generic (and infra-red, laser) read the weighted sum
+        w = np.broadcast_to(np.asarray(weights, dtype=np.float64), (S, N))
+        r_or_max = np.where(hit, r, rmax)   # (what the weighted sums and lasers read; sonars do not)
         average = np.einsum("sn,sn->s", w, r_or_max)
         out[:] = average  # generic
 
         m = types == _LASER
-        if np.any(m):
+        if np.count_nonzero(m):
             out[m] = r_or_max[m, 0]
 
     if n_sonar:
@@ -201,8 +209,9 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
             out[sonar] = np.minimum(np.where(echo, r[sonar], np.inf).min(axis=1), rmax[sonar, 0])
 
     m = types == _INFRA_RED
-    if np.any(m):
+    if np.count_nonzero(m):
         f = np.ones((S, N)) if reflection is None else np.asarray(reflection, dtype=np.float64).reshape(S, N)
+        assert w is not None   # (set: not every sensor is a sonar)
         factor = np.einsum("sn,sn->s", w, np.where(hit, f, 1.0))[m]
         d = average[m]   # type: ignore[index]  (set: not every sensor is a sonar)
         sens = np.broadcast_to(np.asarray(red_color_sensitivity, dtype=np.float64), (S,))[m]

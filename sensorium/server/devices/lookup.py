@@ -123,7 +123,7 @@ class LookupTable:
             return np.full(v.shape, y[0]), np.full(v.shape, n[0])
         if self._increasing:
             # sorted inputs: Webots' bisection lands on the bracket searchsorted finds
-            lo = np.clip(np.searchsorted(x, v, side="right") - 1, 0, m - 2)
+            lo = np.minimum(np.maximum(np.searchsorted(x, v, side="right") - 1, 0), m - 2)   # (np.clip's values)
             hi = lo + 1
         else:
             lo = np.zeros(v.shape, dtype=np.intp)

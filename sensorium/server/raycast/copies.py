@@ -109,7 +109,8 @@ class CopyRays:
 
     def cast(self, origins, directions, t_near, t_far, kind: RayKind, copy: np.ndarray, rot: np.ndarray,
              pos: np.ndarray, exclude_slot=-1, mount_slot=-1, skip_transparent: bool = False,
-             distance_only: bool = False, directions32=None, coherent: bool = False, origin_rows=None) -> RayHits:
+             distance_only: bool = False, directions32=None, coherent: bool = False, origin_rows=None,
+             run: int = 0) -> RayHits:
         """Nearest hits of rays of several copies. ``copy``: (n,) the copy of each ray; ``rot``
         (C, R, 3, 3) and ``pos`` (C, R, 3): every copy's robot poses now; ``exclude_slot``: the
         robot (slot) whose body a ray ignores (scalar or (n,); -1 none), as ``exclude_owner``;
@@ -118,8 +119,10 @@ class CopyRays:
         with ``RayEngine.cast(mount=...)``), or whose body it cannot reach (:meth:`may_reach`).
         ``coherent``: the rays come in runs from one origin each (every copy's lidar): traced as
         the single world traces one lidar's beams (coherent packets, FAST), so each beam gets the
-        single world's answer. Other arguments as :meth:`RayEngine.cast` (``origin_rows``: the distinct
-        origins, e.g. every copy's lidar position)."""
+        single world's answer. ``run`` > 0: the rays come in runs of ``run`` consecutive rays sharing
+        one origin and one copy (a copy's lidar scan, its clearance rays): the broad phase works each
+        run's origin out once (the same pairs). Other arguments as :meth:`RayEngine.cast`
+        (``origin_rows``: the distinct origins, e.g. every copy's lidar position)."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         n = len(O)
@@ -145,7 +148,7 @@ class CopyRays:
         centre = pos + np.einsum("crij,rj->cri", rot, anchor)          # (C, R, 3): a conservative test only
         excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else np.asarray(exclude_slot).reshape(n)
         mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else np.asarray(mount_slot).reshape(n)
-        got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, far, excl, mnt, dist=dist)
+        got = (packets.copy_pairs(O, D, copy, centre, r2, present, t_near, far, excl, mnt, dist, run)
                if self.static.native else None)
         if got is None:
             lo = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,))

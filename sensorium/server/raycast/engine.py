@@ -375,7 +375,9 @@ class RayEngine(TierTracer):
         ``origin_rows``: optional (k, 3) float64 array of the rays' distinct origins -- every ray's
         origin is one of its rows and every row is some ray's origin (the scan origins of a batched
         lidar cast) -- from which the cast takes the largest coordinate and the box of the origins
-        (the same values) instead of passes over all n rows."""
+        (the same values) instead of passes over all n rows; where they are a few per ray, FAST
+        also screens the curved shells' pre-pass by them (unit directions, as that pre-pass's
+        one-origin screen assumes: every start point lies within t_near of its row)."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
@@ -407,12 +409,14 @@ class RayEngine(TierTracer):
         if n == 0:
             return RayHits(np.zeros(0), np.zeros((0, 3)), np.zeros(0, dtype=np.int64))
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
-        box = None
+        box = rows = None
         if O.strides[0] == 0:   # one origin for all rays (a broadcast array)
             big = max(map(abs, O[0].tolist()))
         elif origin_rows is not None and n > _SMALL:   # the same rows' values: the same max, min and box
             rows = np.asarray(origin_rows, dtype=np.float64)
-            box = (rows.min(axis=0), rows.max(axis=0))
+            box = packets.box3(rows) if self.native else None   # (one C pass: numpy reduces 3 columns slowly)
+            if box is None:
+                box = (rows.min(axis=0), rows.max(axis=0))   # (rows also screen the curved shells: _trace_fast)
             big = max(float(box[1].max()), -float(box[0].min()))
         else:
             big = max(map(abs, O.ravel().tolist())) if n <= _SMALL else max(float(O.max()), -float(O.min()))
@@ -422,11 +426,11 @@ class RayEngine(TierTracer):
             threads = self.threads
             if n <= _CHUNK and (threads <= 1 or n < MIN_RAYS):   # (split's answer: one part)
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
-                                  directions32, coherent, box)
+                                  directions32, coherent, box, rows)
             parts = split(n, threads, _CHUNK)
             if len(parts) == 1:
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
-                                  directions32, coherent, box)
+                                  directions32, coherent, box, rows)
             # large batches in blocks: the temporaries (~150 bytes per ray) stay a few MB whatever the
             # batch, and the blocks of the planes and the static tier run side by side on the
             # threads; then the movers, on the whole batch (a Mount keeps its lists for it) or in
@@ -527,19 +531,21 @@ class RayEngine(TierTracer):
         return RayHits(t, normal, shape)
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
-              distance_only: bool = False, d32=None, coherent: bool = False, box=None) -> RayHits:
+              distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None) -> RayHits:
         exact = self._precision is Precision.EXACT
-        hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32, coherent, box)
+        hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32, coherent, box,
+                                 rows)
         if movers is not None:
             self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits, mount=mount,
                               own_apart=distance_only and not exact)
         return RayHits(hits[0], hits[2], hits[1])
 
     def _cast_static(self, O, D, t_near, t_far, excl, planes, static, big: float, distance_only: bool = False,
-                     d32=None, coherent: bool = False, box=None) -> tuple:
+                     d32=None, coherent: bool = False, box=None, rows=None) -> tuple:
         """(dist, shape, normal) of the planes and the static tier (shape, normal None when
         ``distance_only``): the part of a cast that blocks of rays run side by side. ``box``: the
-        (min, max) per column of the origins when the caller has it (see ``origin_rows``)."""
+        (min, max) per column of the origins when the caller has it, ``rows`` the distinct origins
+        themselves (see ``origin_rows``)."""
         n = len(O)
         exact = self._precision is Precision.EXACT
         eps64 = 1e-9 + 1e-14 * big  # float64 self-hit epsilon: 1e-9 m + ~50 ulps of the largest coordinate
@@ -548,7 +554,8 @@ class RayEngine(TierTracer):
         if static is not None:
             lim = t_far if hits is None else np.minimum(t_far, hits[0])
             res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big,
-                              distance_only, d32, coherent, None if static.anchored else box)
+                              distance_only, d32, coherent, None if static.anchored else box,
+                              None if static.anchored else rows)
             if res is not None and hits is None:
                 hits = res
             elif res is not None and distance_only:   # the nearer of plane and mesh (ties: the plane)

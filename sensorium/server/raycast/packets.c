@@ -771,42 +771,86 @@ void sp_to_frame(size_t n, const double* x, const int64_t* rows, const double* R
 
 /* copies.py's broad phase: the (ray, body) pairs of rays of many copies of a world, each ray
  * against the bounding sphere of every robot slot's body in its own copy only. Ray i (origin
- * O[i], unit direction D[i], interval [lo, lim[i]]) of copy copy[i] is paired with slot r when
- * r is present, is not the ray's excluded slot nor its mount slot, lim[i] >= lo, and the segment
- * comes within the sphere (centre[copy[i]][r], r2[r]) -- the numpy path's test, operation for
- * operation (it is conservative, with a slack of 1e-9 (1 + e2)). Pairs are written slot by slot,
- * each slot's rays ascending (the numpy path's order): ray into out_ray, copy * R + r into
- * out_body; returns their number (at most n * R). lo, excl, mnt: per ray when not NULL, else the
- * scalar value. With dist (n,) given, lim[i] is np.minimum(t_far, dist[i]) made here: t_far the
- * (n,) lim when not NULL, else lim_value (the caller's limits without their array). */
-size_t sp_copy_pairs(size_t n, size_t R, const double* O, const double* D, const int64_t* copy,
+ * O[i], unit direction D[i], interval [lo, f]) of copy copy[i] is paired with slot r when r is
+ * present, is not the ray's excluded slot nor its mount slot, f >= lo, and the segment comes
+ * within the sphere (centre[copy[i]][r], r2[r]) -- the numpy path's test, operation for operation
+ * (it is conservative, with a slack of 1e-9 (1 + e2)). The ray's limit f is np.minimum(t_far,
+ * dist[i]) (t_far: lim[i], or lim_value when lim is NULL; dist: its static hit). Pairs are written
+ * slot by slot, each slot's rays ascending (the numpy path's order): ray into out_ray,
+ * copy * R + r into out_body; returns their number (at most n * R). lo, excl, mnt: per ray when not
+ * NULL, else the scalar value.
+ * `run` > 0: the rays come in runs of `run` consecutive rays sharing one origin and one copy (a
+ * lidar's scan, the clearance rays of a copy; the last run may be shorter): the origin's offset
+ * to the sphere centre and its square (the same operations on the same values, so the same bits)
+ * are made once per run, and with scalar lo and t_far a run whose origin lies so far from the
+ * sphere that no segment of length max(|lo|, |t_far|) can reach it, with a margin far above the
+ * rounding of the per-ray test, is passed over: it would give no pair. */
+static inline size_t pair_rays(size_t a, size_t b, size_t R, size_t r, double rr, const double* cc, const double* O,
+                               const double* D, const int64_t* copy, const double* lo, double lo_value,
+                               const double* lim, double lim_value, const double* dist, const int64_t* excl,
+                               const int64_t* mnt, int one, int64_t* out_ray, int64_t* out_body, size_t k) {
+  double x = 0.0, y = 0.0, z = 0.0, e2 = 0.0;
+  int64_t c = 0;
+  if (one) {   /* a run: one origin, one copy */
+    c = copy[a];
+    cc += 3 * ((size_t)c * R + r);
+    const double* o = O + 3 * a;
+    x = cc[0] - o[0]; y = cc[1] - o[1]; z = cc[2] - o[2];
+    e2 = x * x + y * y + z * z;
+  }
+  for (size_t i = a; i < b; i++) {
+    if (excl && excl[i] == (int64_t)r) continue;
+    if (mnt && mnt[i] == (int64_t)r) continue;
+    const double l = lo ? lo[i] : lo_value;
+    const double f = np_min(lim ? lim[i] : lim_value, dist[i]);
+    if (!(f >= l)) continue;
+    if (!one) {
+      c = copy[i];
+      const double* s = cc + 3 * ((size_t)c * R + r);
+      const double* o = O + 3 * i;
+      x = s[0] - o[0]; y = s[1] - o[1]; z = s[2] - o[2];
+      e2 = x * x + y * y + z * z;
+    }
+    const double* d = D + 3 * i;
+    const double bb = x * d[0] + y * d[1] + z * d[2];
+    const double tc = np_min(np_max(bb, l), f);
+    out_ray[k] = (int64_t)i;
+    out_body[k] = c * (int64_t)R + (int64_t)r;
+    k += e2 - tc * (bb + bb - tc) <= rr + 1e-9 * (1.0 + e2);
+  }
+  return k;
+}
+
+size_t sp_copy_pairs(size_t n, size_t R, size_t run, const double* O, const double* D, const int64_t* copy,
                      const double* centre, const double* r2, const uint8_t* present, const double* lo,
                      double lo_value, const double* lim, double lim_value, const double* dist,
                      const int64_t* excl, int64_t excl_value, const int64_t* mnt, int64_t mnt_value,
                      int64_t* out_ray, int64_t* out_body) {
   size_t k = 0;
+  /* the longest segment a ray of a run can test (scalar limits only): |tc| <= max(|lo|, |t_far|) */
+  const double reach = (!lo && !lim) ? np_max(fabs(lo_value), fabs(lim_value)) : INF_D;
   for (size_t r = 0; r < R; r++) {
     if (!present[r]) continue;
     if (!excl && excl_value == (int64_t)r) continue;
     if (!mnt && mnt_value == (int64_t)r) continue;
     const double rr = r2[r];
-    for (size_t i = 0; i < n; i++) {
-      if (excl && excl[i] == (int64_t)r) continue;
-      if (mnt && mnt[i] == (int64_t)r) continue;
-      const double l = lo ? lo[i] : lo_value;
-      const double f = dist ? np_min(lim ? lim[i] : lim_value, dist[i]) : lim[i];
-      if (!(f >= l)) continue;
-      const int64_t c = copy[i];
-      const double* cc = centre + 3 * ((size_t)c * R + r);
-      const double* o = O + 3 * i;
-      const double* d = D + 3 * i;
-      const double x = cc[0] - o[0], y = cc[1] - o[1], z = cc[2] - o[2];
-      const double b = x * d[0] + y * d[1] + z * d[2];
-      const double e2 = x * x + y * y + z * z;
-      const double tc = np_min(np_max(b, l), f);
-      out_ray[k] = (int64_t)i;
-      out_body[k] = c * (int64_t)R + (int64_t)r;
-      k += e2 - tc * (b + b - tc) <= rr + 1e-9 * (1.0 + e2);
+    if (!run) {
+      k = pair_rays(0, n, R, r, rr, centre, O, D, copy, lo, lo_value, lim, lim_value, dist, excl, mnt, 0, out_ray,
+                    out_body, k);
+      continue;
+    }
+    for (size_t a = 0; a < n; a += run) {
+      const size_t b = n - a < run ? n : a + run;
+      if (reach < INF_D) {   /* |c - o - tc d| >= |c - o| - |tc|: far beyond the test's slack */
+        const double* s = centre + 3 * ((size_t)copy[a] * R + r);
+        const double* o = O + 3 * a;
+        const double x = s[0] - o[0], y = s[1] - o[1], z = s[2] - o[2];
+        const double e2 = x * x + y * y + z * z;
+        const double e = sqrt(e2), gap = e - reach;
+        if (gap > 0.0 && gap * gap > rr + 1e-9 * (1.0 + e2) + 1e-12 * (1.0 + (e + reach) * (e + reach))) continue;
+      }
+      k = pair_rays(a, b, R, r, rr, centre, O, D, copy, lo, lo_value, lim, lim_value, dist, excl, mnt, 1, out_ray,
+                    out_body, k);
     }
   }
   return k;
@@ -1028,19 +1072,22 @@ size_t sp_drive_wheels(size_t L, size_t D, size_t R, const int64_t* live, const 
  * (x rot[j][0] + y rot[j][1]) + z rot[j][2], the numpy path's sums) -- written as rows i * W + w
  * of out_org, out_dir (float64) and out_d32 (the directions rounded to float32). */
 void sp_lidar_beams(size_t n, size_t W, const double* rot, const double* org, const double* x, const double* y,
-                    const double* z, double* out_org, double* out_dir, float* out_d32) {
+                    const double* z, double* restrict out_org, double* restrict out_dir, float* restrict out_d32) {
   for (size_t i = 0; i < n; i++) {
     const double* R = rot + 9 * i;
+    /* the scan's matrix and origin held in locals: the outputs (restrict: the caller's own
+     * buffers) cannot change them, so each beam is its three sums and stores */
+    const double r00 = R[0], r01 = R[1], r02 = R[2], r10 = R[3], r11 = R[4], r12 = R[5], r20 = R[6], r21 = R[7],
+                 r22 = R[8];
     const double o0 = org[3 * i], o1 = org[3 * i + 1], o2 = org[3 * i + 2];
     for (size_t w = 0; w < W; w++) {
       const size_t r = 3 * (i * W + w);
-      for (int j = 0; j < 3; j++) {
-        double acc = x[w] * R[3 * j];
-        acc += y[w] * R[3 * j + 1];
-        acc += z[w] * R[3 * j + 2];
-        out_dir[r + j] = acc;
-        out_d32[r + j] = (float)acc;
-      }
+      const double xw = x[w], yw = y[w], zw = z[w];
+      double a0 = xw * r00, a1 = xw * r10, a2 = xw * r20;
+      a0 += yw * r01; a1 += yw * r11; a2 += yw * r21;
+      a0 += zw * r02; a1 += zw * r12; a2 += zw * r22;
+      out_dir[r] = a0; out_dir[r + 1] = a1; out_dir[r + 2] = a2;
+      out_d32[r] = (float)a0; out_d32[r + 1] = (float)a1; out_d32[r + 2] = (float)a2;
       out_org[r] = o0;
       out_org[r + 1] = o1;
       out_org[r + 2] = o2;
@@ -1052,6 +1099,58 @@ void sp_lidar_beams(size_t n, size_t W, const double* rot, const double* org, co
  * math.sin make (the single simulation's). Two loops, so that the compiler does not merge a cos and
  * a sin of one angle into one sincos call (another libm entry point). Returns the number of
  * infinite angles (math.cos refuses them: the caller then takes Python's way, error included). */
+/* numpy's float64 remainder (npy_remainder: fmod, moved to b's sign; a zero takes b's sign) */
+static inline double np_remainder(double a, double b) {
+  double mod = fmod(a, b);
+  if (!b) return mod;
+  if (mod) {
+    if ((b < 0) != (mod < 0)) mod += b;
+  } else {
+    mod = copysign(0.0, b);
+  }
+  return mod;
+}
+
+/* batched.py's _arc_steps (motion.arc_step per robot, element by element the same float64
+ * operations: straight when |w dt| < 1e-9, x + (v dt) cos(yaw + dyaw / 2); else with r = v / w,
+ * x + r (sin(yaw + dyaw) - sin(yaw)), y - r (cos(yaw + dyaw) - cos(yaw)); the new yaw
+ * remainder((yaw + dyaw) + pi, 2 pi) - pi) and then the new yaw's cos and sin (the pose's Rz), the
+ * libm calls math.cos/math.sin make. Returns the number of infinite angles handed to cos or sin
+ * (math.cos refuses them: the caller's Python way says so); the outputs are then not to be used. */
+size_t sp_arc_steps(size_t n, const double* x, const double* y, const double* yaw, const double* v, const double* w,
+                    double dt, double* out_x, double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
+  const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+  size_t inf = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double dyaw = w[i] * dt;
+    if (fabs(dyaw) < 1e-9) {
+      const double mid = yaw[i] + 0.5 * dyaw;
+      const double cm = cos(mid);
+      const double sm = sin(mid);
+      inf += isinf(mid) != 0;
+      out_x[i] = x[i] + v[i] * dt * cm;
+      out_y[i] = y[i] + v[i] * dt * sm;
+    } else {
+      const double r = v[i] / w[i];
+      const double a1 = yaw[i] + dyaw;
+      const double c1 = cos(a1);
+      const double s1 = sin(a1);
+      const double c0 = cos(yaw[i]);
+      const double s0 = sin(yaw[i]);
+      inf += (isinf(a1) != 0) + (isinf(yaw[i]) != 0);
+      out_x[i] = x[i] + r * (s1 - s0);
+      out_y[i] = y[i] - r * (c1 - c0);
+    }
+    out_yaw[i] = np_remainder(yaw[i] + dyaw + pi, two_pi) - pi;
+  }
+  for (size_t i = 0; i < n; i++) {
+    out_cos[i] = cos(out_yaw[i]);
+    inf += isinf(out_yaw[i]) != 0;
+  }
+  for (size_t i = 0; i < n; i++) out_sin[i] = sin(out_yaw[i]);
+  return inf;
+}
+
 size_t sp_cos_sin(size_t n, const double* a, double* out_cos, double* out_sin) {
   size_t inf = 0;
   for (size_t i = 0; i < n; i++) {

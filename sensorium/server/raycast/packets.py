@@ -175,6 +175,8 @@ def _load() -> None:
     lib.sp_plane1.restype = sz
     lib.sp_plane1.argtypes = [sz, vp, sz, vp, i, d, i, vp, vp, vp, d, vp, d, i, vp, vp, vp, i, i64, vp, i64, i64, vp,
                               vp, vp]
+    lib.sp_arc_steps.restype = sz
+    lib.sp_arc_steps.argtypes = [sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp]
     lib.sp_cos_sin.restype = sz
     lib.sp_cos_sin.argtypes = [sz, vp, vp, vp]
     lib.sp_box3.restype = None
@@ -182,7 +184,7 @@ def _load() -> None:
     lib.sp_inside_shells.restype = sz
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
-    lib.sp_copy_pairs.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, d, vp, vp, i64, vp, i64, vp, vp]
+    lib.sp_copy_pairs.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, d, vp, vp, i64, vp, i64, vp, vp]
     lib.sp_contact_near.restype = sz
     lib.sp_drive_wheels.restype = sz
     lib.sp_lidar_beams.restype = None
@@ -509,15 +511,18 @@ def lidar_scan(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray, colum
 
 
 def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarray, r2: np.ndarray,
-               present: np.ndarray, lo, lim, excl, mount, dist: np.ndarray | None = None
+               present: np.ndarray, lo, far, excl, mount, dist: np.ndarray, run: int = 0
                ) -> tuple[np.ndarray, np.ndarray] | None:
     """The broad phase of :meth:`.copies.CopyRays.cast` in one C pass (``sp_copy_pairs``): the
     (ray, copy * R + slot) pairs whose ray comes within the bounding sphere (``centre`` (C, R, 3),
     ``r2`` (R,)) of a present slot of its own copy, its excluded and mount slots left out, listed
-    slot by slot and ray by ray as the numpy path lists them; or None without the helper. ``lo``,
-    ``excl``, ``mount``: scalars or (n,) arrays; ``lim`` (n,), or with ``dist`` (n,) the rays' far
-    limits (a scalar or (n,)), each ray's limit then being ``np.minimum(lim, dist)`` (made in the
-    pass: no (n,) temporary)."""
+    slot by slot and ray by ray as the numpy path (``copies._pairs``) lists them; or None without
+    the helper. ``lo``, ``excl``, ``mount``: scalars or (n,) arrays; ``far`` the rays' far limits
+    (a scalar or (n,)) and ``dist`` (n,) their static hits: each ray's limit is
+    ``np.minimum(far, dist)``, made in the pass (no (n,) temporary). ``run`` > 0: the rays come in
+    runs of ``run`` consecutive rays sharing one origin and one copy (the last may be shorter):
+    the same pairs, with each run's origin worked out once (a run the spheres are far from is
+    passed over whole)."""
     lib = library()
     if lib is None:
         return None
@@ -529,24 +534,23 @@ def copy_pairs(O: np.ndarray, D: np.ndarray, copy: np.ndarray, centre: np.ndarra
     centre = np.ascontiguousarray(centre, dtype=f64)
     r2 = np.ascontiguousarray(r2, dtype=f64)
     present = np.ascontiguousarray(present, dtype=np.uint8)
-    lim_value = 0.0
-    if dist is not None:
-        dist = np.ascontiguousarray(dist, dtype=f64)
-        if not isinstance(lim, np.ndarray) or lim.ndim == 0:
-            lim, lim_value = None, float(lim)
-    if lim is not None:
-        lim = np.ascontiguousarray(lim, dtype=f64)
+    dist = np.ascontiguousarray(dist, dtype=f64)
+    if dist.shape != (n,):
+        raise TypeError(f"copy_pairs: static hits of shape {dist.shape} for {n} rays")
+    lim = None
+    if isinstance(far, np.ndarray) and far.ndim:
+        lim = np.ascontiguousarray(far, dtype=f64)
         if lim.shape != (n,):
             raise TypeError(f"copy_pairs: limits of shape {lim.shape} for {n} rays")
     lo_a = np.ascontiguousarray(lo, dtype=f64) if isinstance(lo, np.ndarray) else None
     ex_a = np.ascontiguousarray(excl, dtype=i64) if isinstance(excl, np.ndarray) else None
     mn_a = np.ascontiguousarray(mount, dtype=i64) if isinstance(mount, np.ndarray) else None
     out_ray, out_body, p_ray, p_body = _pair_buffers(n * R)
-    p_O, p_D, p_copy, p_centre, p_r2, p_present = _small_addresses((O, D, copy, centre, r2, present))
-    k = lib.sp_copy_pairs(n, R, p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
-                          0.0 if lo_a is not None else float(lo), _ptr(lim), lim_value, _ptr(dist), _ptr(ex_a),
-                          0 if ex_a is not None else int(excl), _ptr(mn_a), 0 if mn_a is not None else int(mount),
-                          p_ray, p_body)
+    p_O, p_D, p_copy, p_centre, p_r2, p_present, p_dist = _small_addresses((O, D, copy, centre, r2, present, dist))
+    k = lib.sp_copy_pairs(n, R, max(0, int(run)), p_O, p_D, p_copy, p_centre, p_r2, p_present, _ptr(lo_a),
+                          0.0 if lo_a is not None else float(lo), _ptr(lim), 0.0 if lim is not None else float(far),
+                          p_dist, _ptr(ex_a), 0 if ex_a is not None else int(excl), _ptr(mn_a),
+                          0 if mn_a is not None else int(mount), p_ray, p_body)
     return out_ray[:k].copy(), out_body[:k].copy()
 
 
@@ -626,6 +630,54 @@ def cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     if lib.sp_cos_sin(len(a), *_small_addresses((a, c, s))):
         return None
     return c, s
+
+
+def analytic(tier, slots: np.ndarray, O: np.ndarray, D: np.ndarray, lo: np.ndarray, hi: np.ndarray, normals: bool
+             ) -> tuple[np.ndarray, np.ndarray | None] | None:
+    """``refine._analytic`` (the true-surface hit of curved shapes, tier-frame rays: (t, tier-frame
+    unit normal or None without ``normals``)) in one C pass (``sp_analytic``, the judging passes'
+    own: the same bits, tests/test_native_judging.py), for the few rays the general loop refines
+    in FAST (~40 numpy calls a ray otherwise); None without the helper or the tier's struct."""
+    lib = library()
+    st = tier.native(False) if lib is not None else None
+    if st is None:
+        return None
+    f64 = np.float64
+    m = len(slots)
+    s64 = np.ascontiguousarray(slots, dtype=np.int64)
+    O, D = np.ascontiguousarray(O, dtype=f64), np.ascontiguousarray(D, dtype=f64)
+    lo = np.ascontiguousarray(np.broadcast_to(np.asarray(lo, dtype=f64), (m,)))
+    hi = np.ascontiguousarray(np.broadcast_to(np.asarray(hi, dtype=f64), (m,)))
+    if O.shape != (m, 3) or D.shape != (m, 3):
+        raise TypeError(f"analytic: rays of shapes {O.shape}, {D.shape} for {m} slots")
+    t = np.empty(m)
+    n = np.empty((m, 3)) if normals else None
+    lib.sp_analytic(st, m, s64.ctypes.data, O.ctypes.data, D.ctypes.data, lo.ctypes.data, hi.ctypes.data,
+                    t.ctypes.data, _ptr(n))
+    return t, n
+
+
+def arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """:func:`.batched._arc_steps` and the new yaws' cos and sin (the poses' Rz, ``_cos_sin``) in one C
+    pass (``sp_arc_steps``): (x, y, yaw, cos yaw, sin yaw) of n robots, the numpy path's bits (its
+    operations element by element, libm's cos/sin as math.cos/math.sin, numpy's remainder); None
+    without the helper, for other arrays, or when an angle is infinite (math.cos refuses it: the
+    caller's Python way says so)."""
+    lib = library()
+    if lib is None:
+        return None
+    n = len(x)
+    ins = []
+    for a in (x, y, yaw, v, w):
+        if a.dtype != np.float64 or a.shape != (n,):
+            return None
+        ins.append(np.ascontiguousarray(a))
+    outs = [np.empty(n) for _ in range(5)]
+    p = _small_addresses(ins + outs)
+    if lib.sp_arc_steps(n, *p[:5], float(dt), *p[5:]):
+        return None
+    return outs[0], outs[1], outs[2], outs[3], outs[4]
 
 
 def box3(O: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

@@ -51,6 +51,23 @@ def _rows_ptr(x: np.ndarray) -> tuple:
     return a, a.ctypes.data, 3
 
 
+def _near_shells(tier: _Tier, rows: np.ndarray, lo: float) -> bool:
+    """Whether a start point ``o + lo d`` (unit ``d``) of a ray from one of the origins ``rows``
+    (tier frame) may lie in a curved shell's bounding sphere: the pre-pass's screen of one origin
+    (``refine._contained_prepass``: centre distance <= (bound + lo) (1 + 1e-9)) for each row. False:
+    every start point lies outside every shell, so the pre-pass, which looks only at start points
+    inside a shell, finds nothing (a lidar scanning from 64 copies' robots, a sensor's rays)."""
+    kept = tier.__dict__.get("_shell_spheres")
+    if kept is None:   # the shells never change: centres and screening radii made once
+        kept = tier._shell_spheres = (np.ascontiguousarray(tier.c_pos, dtype=np.float64), np.sqrt(tier.c_bound2))
+    c, bound = kept
+    dx = rows[:, 0:1] - c[:, 0]
+    dy = rows[:, 1:2] - c[:, 1]
+    dz = rows[:, 2:3] - c[:, 2]
+    # (a NaN or infinite origin: never near, as its start points are in no shell for the pre-pass)
+    return bool(np.count_nonzero(np.sqrt(dx * dx + dy * dy + dz * dz) <= (bound + lo) * (1.0 + 1e-9)))
+
+
 class TierTracer(Refiner):
     """Per-tier tracing methods of :class:`~sensorium.server.raycast.engine.RayEngine`."""
 
@@ -70,7 +87,7 @@ class TierTracer(Refiner):
         return scene.run(o32, d32, far, output=1)
 
     def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
-               distance_only: bool = False, d32=None, coherent: bool = False, box=None):
+               distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None):
         """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
@@ -80,17 +97,18 @@ class TierTracer(Refiner):
         with several origins (rays in runs from one origin each: the copies' lidars of a batched
         world; a ray's answer is then the one it gets in a one-origin cast).  ``box``: FAST's
         curved-shell pre-pass takes the (min, max) per column of O from it when given (the values
-        it would find; an unanchored tier)."""
+        it would find; an unanchored tier); ``rows``: O's distinct rows (every ray's origin is one
+        of them), whose distance to the curved shells can rule the pre-pass out."""
         if exact:
             res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True, distance_only=distance_only,
                                    d32_all=d32)
             if not np.count_nonzero(res[0] < _INF):
                 return None
             return (res[0], None, None) if distance_only else res
-        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32, coherent, box)
+        return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32, coherent, box, rows)
 
     def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
-                    distance_only: bool = False, d32=None, coherent: bool = False, box=None):
+                    distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None):
         """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
         self-hits, shells left from inside, excluded owners) are redone by the general loop.
         Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
@@ -106,7 +124,12 @@ class TierTracer(Refiner):
         # float64 path (scalar or vectorised) may differ from this one's in the last bit
         if tier.has_curved:  # origins inside a curved shell: analytic first (see the pre-pass)
             lo = np.maximum(t_near, eps64) if isinstance(t_near, np.ndarray) else max(t_near, eps64)
-            pre = self._contained_prepass(tier, Ot, D, lo, lim, excl, None if tier.anchored else box)
+            if rows is not None and 4 * len(rows) <= m and not tier.anchored and not isinstance(lo, np.ndarray) \
+                    and not _near_shells(tier, rows, lo):
+                pass   # no start point can lie in a shell: the pre-pass would find nothing (screened by
+                # the rows where they are a few per ray: a lidar's 360, a sonar's 5, not an e-puck's 3)
+            else:
+                pre = self._contained_prepass(tier, Ot, D, lo, lim, excl, None if tier.anchored else box)
             if pre is not None:  # the cast only needs to look before the analytic hits
                 lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, lim)
                 lim[pre[0]] = np.minimum(lim[pre[0]], pre[1])
@@ -621,7 +644,11 @@ class TierTracer(Refiner):
                     if len(tdo):
                         rr = rows[tdo]
                         sl = slot[cv[tdo]]
-                        ta, na = self._analytic(tier, sl, Ot[rr], D[rr], lo[rr], lim[rr], not distance_only)
+                        # (in C where the helper is: the same bits, without ~40 numpy calls a ray)
+                        got = (packets.analytic(tier, sl, Ot[rr], D[rr], lo[rr], lim[rr], not distance_only)
+                               if self.native else None)
+                        ta, na = got if got is not None else self._analytic(tier, sl, Ot[rr], D[rr], lo[rr], lim[rr],
+                                                                            not distance_only)
                         found = np.isfinite(ta)
                         better = found & (ta < best_t[rr])
                         r = rr[better]

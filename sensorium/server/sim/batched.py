@@ -326,6 +326,8 @@ class BatchedSimulation:
         self.noise = NoiseStreams(C, paths, block=block)
         # per kind: schedules (period, last update) per copy and the latest values
         self.period = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
+        # per kind: whether enable() ever gave one of its devices a period (else none is ever due)
+        self._enabled = dict.fromkeys(lists, False)
         self.last = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
         self.values = {k: np.full((C, len(v)), math.nan) for k, v in lists.items() if k != "Lidar"}
         for lid in self.lidar:
@@ -497,6 +499,8 @@ class BatchedSimulation:
                                "the batched simulation (use Simulation)")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         self.period[ref.kind][idx, ref.column] = int(period_ms)
+        if period_ms > 0:
+            self._enabled[ref.kind] = True
         self.last[ref.kind][idx, ref.column] = self.time_ms[idx]
 
     # ------------------------------------------------------------------ stepping
@@ -533,13 +537,18 @@ class BatchedSimulation:
         if not len(copies):
             return
         x0, y0 = self.x[copies, slots], self.y[copies, slots]
-        x, y, yaw = _arc_steps(x0, y0, self.yaw[copies, slots], v, w, dt)
+        yaw0 = self.yaw[copies, slots]
+        arc = packets.arc_steps(x0, y0, yaw0, v, w, dt)   # (with the new yaws' cos, sin: one C pass)
+        if arc is not None:
+            x, y, yaw, cos, sin = arc
+        else:
+            x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
+            cos, sin = _cos_sin(yaw)
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
             x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
         self.x[copies, slots], self.y[copies, slots] = x, y
         # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
-        cos, sin = _cos_sin(yaw)
         rz = np.zeros((len(yaw), 3, 3))
         rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
         self.rot[copies, slots] = np.matmul(rz, self.base[copies, slots])
@@ -664,6 +673,8 @@ class BatchedSimulation:
 
     # -- devices
     def _due(self, kind: str, live: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if not self._enabled[kind]:   # never enabled: every period is 0, nothing is due
+            return _NONE, _NONE
         if len(live) == self.copies:    # every copy (live is then 0 ... C-1): the arrays as they are
             per = self.period[kind]
             due = (per > 0) & (self.time_ms[:, None] - self.last[kind] >= per)
@@ -732,14 +743,15 @@ class BatchedSimulation:
                 r = reqs[0]
                 out[idx[0]] = self.rays.cast(r.origins, r.directions, r.t_near, r.t_far, RayKind(kind), r.copy,
                                              self.rot, self.pos, r.exclude, r.mount, skip, distance_only, r.d32,
-                                             coherent, origin_rows=r.origin_rows)
+                                             coherent, origin_rows=r.origin_rows, run=r.run)
                 continue
             sizes = [len(r.origins) for r in reqs]
             h = self.rays.cast(np.concatenate([r.origins for r in reqs]), np.concatenate([r.directions for r in reqs]),
                                joined(reqs, sizes, "t_near", np.float64), joined(reqs, sizes, "t_far", np.float64),
                                RayKind(kind), joined(reqs, sizes, "copy", np.int64), self.rot, self.pos,
                                joined(reqs, sizes, "exclude", np.int64), joined(reqs, sizes, "mount", np.int64), skip,
-                               distance_only, coherent=coherent)
+                               distance_only, coherent=coherent,
+                               run=reqs[0].run if all(r.run == reqs[0].run for r in reqs) else 0)
             for i, hit in zip(idx, split_hits(h, sizes)):
                 out[i] = hit
         return out   # type: ignore[return-value]
@@ -838,7 +850,7 @@ class BatchedSimulation:
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0,
                               g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1),
-                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip))
+                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip, run=n, origin_rows=positions))
             state["groups"].append((g, rows, k, c, slot, positions, dirs))
         return state, reqs
 
@@ -931,7 +943,7 @@ class BatchedSimulation:
             ray_copy, mount = self._lidar_rows(col, c, W)
             t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
             reqs.append(_Rays(origins, d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
-                              -1, mount, distance_only=True, d32=d32, coherent=True, origin_rows=org))
+                              -1, mount, distance_only=True, d32=d32, coherent=True, origin_rows=org, run=W))
             state["items"].append((col, c))
         return state, reqs
 
@@ -992,6 +1004,13 @@ class BatchedSimulation:
                 for k, cc in enumerate(c.tolist()):
                     stream = _Stream(self.noise, cc, nc)
                     img[cc] = lmath.ranges_from_hits(lid.params, dist[k], lid._all_dirs, stream)  # type: ignore[arg-type]
+            elif lid._factor is None and lid.params.resolution == RESOLUTION_OFF and (
+                    len(c) == len(img) and (c == np.arange(len(c))).all()):
+                # every copy scanned, nothing moves a value, cylindrical: the whole image in one C
+                # pass where the helper is (ranges_from_hits' bits, as the single Lidar.finish)
+                if not packets.lidar_scan(np.ascontiguousarray(dist, dtype=np.float64).reshape(-1),
+                                          lid.params.min_range, lid.params.max_range, img.reshape(-1)):
+                    img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
             else:   # element by element: every copy's scans in one call
                 img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
             self.last["Lidar"][c, col] = self.time_ms[c]
@@ -1000,14 +1019,14 @@ class BatchedSimulation:
     # ------------------------------------------------------------------ tasks
     def cast(self, copies: np.ndarray, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
              exclude_slot=-1, skip_transparent: bool = False, distance_only: bool = False,
-             coherent: bool = False) -> RayHits:
+             coherent: bool = False, run: int = 0, origin_rows=None) -> RayHits:
         """Rays of the named copies (one entry per ray) against each copy's world, as
         ``scene.engine.cast`` of a single simulation (``exclude_slot``: a robot slot whose body
-        the rays ignore, as ``exclude_owner``; ``distance_only``, ``coherent``: as
-        :meth:`.CopyRays.cast`)."""
+        the rays ignore, as ``exclude_owner``; ``distance_only``, ``coherent``, ``run``,
+        ``origin_rows``: as :meth:`.CopyRays.cast`)."""
         return self.rays.cast(origins, directions, t_near, t_far, RayKind(kind), np.asarray(copies, dtype=np.int64),
                               self.rot, self.pos, exclude_slot, -1, skip_transparent, distance_only=distance_only,
-                              coherent=coherent)
+                              coherent=coherent, run=run, origin_rows=origin_rows)
 
 
 @dataclass(slots=True)
@@ -1027,6 +1046,7 @@ class _Rays:
     d32: np.ndarray | None = None
     coherent: bool = False     # runs of rays from one origin each (lidars): traced as one lidar's beams
     origin_rows: np.ndarray | None = None   # the distinct origins (the lidars' positions), when known
+    run: int = 0   # > 0: runs of this many rays share one origin and one copy (a scan, a sensor's rays)
 
 
 class _OnEngine:
@@ -1044,6 +1064,10 @@ class _Stream:
 
     def standard_normal(self, count: int) -> np.ndarray:
         return self.bank.take(self.copy, self.column, int(count))
+
+
+_NONE = np.zeros(0, dtype=np.int64)
+_NONE.setflags(write=False)
 
 
 def _by_table(devices: list) -> list[tuple]:
