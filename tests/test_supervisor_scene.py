@@ -252,3 +252,30 @@ def test_a_robot_stopped_by_kinematic_contact_has_no_linear_velocity():
         lv.step(A, "pioneer", {"duration": 32})
     assert lv.sim.robot("pioneer").pose.translation[0] == pytest.approx(1.7, abs=1e-9)
     assert lv.ok(A, "/pioneer/robot/get_node_velocity", {"node": 1})["value"] == [0.0] * 6
+
+
+def test_a_wbt_light_is_found_by_its_def_and_switched_through_it(tmp_path):
+    """A .wbt world's top-level light keeps its DEF (getFromDef finds it, as in Webots); a DEF
+    already taken by an earlier node stays with that node. The LightSensor facing the lamp at 2 m
+    (attenuation 1 0 0, intensity 3) reads 3, then 0 once the lamp found by DEF is switched off."""
+    path = tmp_path / "lamp.wbt"
+    path.write_text(
+        "#VRML_SIM R2023b utf8\n"
+        "DEF LAMP PointLight { location 2 0 0.5 intensity 3 attenuation 1 0 0 }\n"
+        "DEF SUN DirectionalLight { direction 0 0 -1 on FALSE }\n"
+        "DEF JUDGE Robot { translation 0 0 0.5 name \"judge\" supervisor TRUE controller \"<extern>\"\n"
+        "  children [ LightSensor { name \"eye\" lookupTable [ 0 0 0, 100 100 0 ] } ] }\n"
+        "DEF LAMP Solid { translation 5 5 0 name \"second\" }\n")
+    lv = Live(Simulation(load_world(path)))
+    lv.ok(A, "attach", {"robot": "judge"})
+    lamp = judge(lv, "get_from_def", {"name": "LAMP"})
+    assert (lamp["type"], lamp["def_name"]) == ("PointLight", "LAMP")
+    assert judge(lv, "get_from_def", {"name": "SUN"})["type"] == "DirectionalLight"
+    assert judge(lv, "get_from_def", {"name": "second"})["def_name"] == ""   # the DEF stayed with the lamp
+    eye = lv.sim.device("judge/eye")
+    eye.enable(16)
+    lv.step(A, "judge", {"duration": 16})
+    assert eye.value == pytest.approx(3.0, rel=1e-12)
+    judge(lv, "set_field", {"node": lamp["node"], "field": "on", "value": False})
+    lv.step(A, "judge", {"duration": 16})
+    assert eye.value == 0.0

@@ -269,6 +269,7 @@ class Part(Shape):
 
 class _Light(Strict):
     name: str | None = None
+    def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
     ambient_intensity: float = 0.0
     intensity: float = 1.0
     color: Color = (1.0, 1.0, 1.0)

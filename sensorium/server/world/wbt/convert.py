@@ -342,7 +342,7 @@ class Converter:
             self.warn(node, message)
 
     def def_name(self, node: Node, data: dict) -> None:
-        """Keep a robot's or top-level solid's DEF (getFromDef); a DEF reused later keeps its first node."""
+        """Keep a robot's, top-level solid's or top-level light's DEF (getFromDef); a DEF reused later keeps its first node."""
         if node.def_name is not None and node.def_name not in self.defs:
             self.defs.add(node.def_name)
             data["def_name"] = node.def_name
@@ -624,6 +624,8 @@ class Converter:
         if node.type == "SpotLight":
             data["direction"] = [float(v) for v in frame.rotation @ np.asarray(data["direction"])]
         data["_at"] = self.at(node)
+        if owner.kind == "world":
+            self.def_name(node, data)
         owner.data.setdefault("lights", []).append(data) if owner.kind != "world" else self.world["lights"].append(data)
 
     # ------------------------------------------------------------ solids and robots
