@@ -163,15 +163,22 @@ def _moller_trumbore(o, d, v0, e1, e2, tol=_BARY_TOL):
 # silenced once per cast (see RayEngine.cast).
 
 
-def _roots_into(ts, k, a, b, c, disc):
-    """Both roots of a t^2 + 2 b t + c = 0 into ts[:, k] and ts[:, k+1], given disc = b^2 - a c
-    (computed stably by the caller); +inf where there is no real root."""
+def _root_pair(ts, k, a, b, c, disc):
+    """The roots q / a and c / q of a t^2 + 2 b t + c = 0 (q = -(b + sign(b) sqrt(disc)), the
+    cancellation-free pair) into ts[:, k] and ts[:, k+1], unfiltered; returns those two columns."""
     s = np.sqrt(np.maximum(disc, 0.0))
     q = -(b + np.copysign(s, b))
     t1, t2 = ts[:, k], ts[:, k + 1]
     np.divide(q, a, out=t1)
     np.divide(c, q, out=t2)
     np.copyto(t2, t1, where=q == 0.0)
+    return t1, t2
+
+
+def _roots_into(ts, k, a, b, c, disc):
+    """Both roots of a t^2 + 2 b t + c = 0 into ts[:, k] and ts[:, k+1], given disc = b^2 - a c
+    (computed stably by the caller); +inf where there is no real root."""
+    t1, _ = _root_pair(ts, k, a, b, c, disc)
     bad = (disc < 0.0) | ~np.isfinite(t1)
     np.copyto(ts[:, k:k + 2], _INF, where=bad[:, None])
 
@@ -190,12 +197,7 @@ _CONE_DISC_TOL = (16.0 * 2.0 ** -52) ** 2    # of |p'|² (1 + k²): the cone's d
 def _cone_roots_into(ts, k, a, b, c, disc):
     """``_roots_into`` for a cone's side, whose leading coefficient ``a`` is 0 for a ray parallel to
     a generating line: then the one root ``c / q`` is kept (a cylinder's ``a`` = 0 has none)."""
-    s = np.sqrt(np.maximum(disc, 0.0))
-    q = -(b + np.copysign(s, b))
-    t1, t2 = ts[:, k], ts[:, k + 1]
-    np.divide(q, a, out=t1)
-    np.divide(c, q, out=t2)
-    np.copyto(t2, t1, where=q == 0.0)
+    t1, t2 = _root_pair(ts, k, a, b, c, disc)
     np.copyto(t1, _INF, where=~np.isfinite(t1))
     np.copyto(t2, _INF, where=~np.isfinite(t2))
     np.copyto(ts[:, k:k + 2], _INF, where=(disc < 0.0)[:, None])
