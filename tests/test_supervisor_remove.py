@@ -1,0 +1,147 @@
+"""A Supervisor's ``node.remove()`` (Webots' ``wb_supervisor_node_remove``) for top-level solids and
+lights, against the closed forms tests/worlds/supervisor_remove.yaml explains: every ray kind
+(distance sensor, lidar, range finder, camera recognition, light occlusion) and kinematic contact
+stop seeing a removed solid from the next step, light sensors stop counting a removed light; node
+ids stay stable (a removed one answers NULL and is never reused); robots and the root are refused;
+``simulationReset`` does not bring removed nodes back (Webots' reset matrix: only a world reload does)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from test_multiprocess import REPO
+from test_supervisor import A, Live
+
+from sensorium.schemas.wire import ErrorCode
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+WORLD = REPO / "tests" / "worlds" / "supervisor_remove.yaml"
+BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB = range(1, 8)      # node ids: robots, solids, lights in world order
+NULL = {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
+
+
+def _live(precision: str = "exact") -> Live:
+    lv = Live(Simulation(load_world(WORLD), precision=precision))
+    lv.ok(A, "attach", {"robot": "boss"})
+    for name in ("ds", "lidar", "depth", "cam", "eye", "shaded"):
+        lv.sim.device(f"boss/{name}").enable(16)
+    lv.sim.device("boss/cam").recognition_enable(16)
+    return lv
+
+
+def boss(lv: Live, item: str, args: dict | None = None):
+    return lv.ok(A, f"/boss/robot/{item}", args)
+
+
+def readings(lv: Live) -> dict:
+    lv.step(A, "boss", {"duration": 16})
+    dev = lv.sim.device
+    return {"ds": dev("boss/ds").value, "lidar": np.asarray(dev("boss/lidar").range_image, dtype=np.float64)[0],
+            "depth": float(dev("boss/depth").range_image[3, 4]), "eye": dev("boss/eye").value,
+            "shaded": dev("boss/shaded").value, "seen": [o.id for o in dev("boss/cam").objects]}
+
+
+@pytest.mark.parametrize("precision", ["exact", "fast"])
+def test_every_sensor_stops_seeing_a_removed_solid_at_the_next_step(precision):
+    lv = _live(precision)
+    before = readings(lv)
+    assert before["ds"] == pytest.approx(1.0, abs=1e-9)
+    assert before["lidar"][2] == pytest.approx(1.0, abs=1e-6)
+    assert before["depth"] == pytest.approx(1.0, abs=1e-6)
+    assert before["seen"] == [CRATE]
+    assert (before["eye"], before["shaded"]) == (pytest.approx(7.0), pytest.approx(4.0))   # the lamp behind the crate
+    assert boss(lv, "remove_node", {"node": CRATE}) == {"success": True}
+    after = readings(lv)
+    assert after["ds"] == pytest.approx(3.0, abs=1e-9)                    # the wall behind it
+    np.testing.assert_allclose(after["lidar"], 3.0 * before["lidar"], rtol=1e-6)
+    assert after["depth"] == pytest.approx(3.0, abs=1e-6)
+    assert after["seen"] == []                                           # the wall has no recognition colour
+    assert (after["eye"], after["shaded"]) == (pytest.approx(7.0), pytest.approx(7.0))   # the lamp now in sight
+
+
+def test_a_removed_light_is_no_longer_counted():
+    lv = _live()
+    boss(lv, "remove_node", {"node": CRATE})
+    assert readings(lv)["eye"] == pytest.approx(7.0)
+    boss(lv, "remove_node", {"node": BULB})                   # its term: 1 / 0.5^2 = 4
+    got = readings(lv)
+    assert (got["eye"], got["shaded"]) == (pytest.approx(3.0), pytest.approx(3.0))
+    boss(lv, "remove_node", {"node": LAMP})
+    assert readings(lv)["eye"] == 0.0
+
+
+def test_ids_stay_stable_and_a_removed_node_answers_null():
+    lv = _live()
+    children = boss(lv, "get_field", {"node": 0, "field": "children"})["value"]
+    assert children == [BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB]
+    boss(lv, "remove_node", {"node": CRATE})
+    boss(lv, "remove_node", {"node": LAMP})
+    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == [BOSS, ROVER, WALL, GATE, BULB]
+    assert boss(lv, "get_from_id", {"id": CRATE}) == NULL
+    assert boss(lv, "get_from_id", {"id": LAMP}) == NULL
+    assert boss(lv, "get_from_def", {"name": "CRATE"}) == NULL
+    assert boss(lv, "get_from_def", {"name": "crate"}) == NULL
+    assert boss(lv, "get_from_def", {"name": "lamp"}) == NULL
+    gate, bulb = boss(lv, "get_from_def", {"name": "GATE"}), boss(lv, "get_from_id", {"id": BULB})
+    assert (gate["node"], gate["name"], bulb["node"], bulb["name"]) == (GATE, "gate", BULB, "bulb")
+    assert boss(lv, "get_field", {"node": GATE, "field": "translation"})["value"] == [1.1, -2.0, 0.25]
+    # the removed node's id: every request on it is one line naming it
+    msg = lv.err(A, "/boss/robot/get_field", {"node": CRATE, "field": "translation"}, ErrorCode.INVALID_ARGUMENT)
+    assert msg == "get_field: node 4 (Solid 'crate') was removed"
+    msg = lv.err(A, "/boss/robot/remove_node", {"node": CRATE}, ErrorCode.INVALID_ARGUMENT)
+    assert msg == "remove_node: node 4 (Solid 'crate') was removed"
+    assert lv.sim.scene.solid_poses.keys() == {"wall", "gate"}      # what the topics and scene views publish
+
+
+def test_robots_and_the_root_cannot_be_removed():
+    lv = _live()
+    msg = lv.err(A, "/boss/robot/remove_node", {"node": ROVER}, ErrorCode.INVALID_ARGUMENT)
+    assert msg == ("remove_node: robot 'rover' (node 2) cannot be removed here: only top-level solids and lights can "
+                   "(a departure from Webots, which removes robots too)")
+    lv.err(A, "/boss/robot/remove_node", {"node": BOSS}, ErrorCode.INVALID_ARGUMENT)
+    assert lv.err(A, "/boss/robot/remove_node", {"node": 0}, ErrorCode.INVALID_ARGUMENT) == \
+        "remove_node: the root node cannot be removed"
+    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == list(range(1, 8))
+
+
+def test_a_robot_blocked_by_a_box_drives_through_once_it_is_removed():
+    lv = _live()
+    rover = lv.sim.robot("rover")
+    for m in rover.motors.values():
+        m.target_position, m.velocity = math.inf, 5.0                     # 0.5 m/s along +x
+    for _ in range(150):                                                  # 2.4 s: 1.2 m, the gate at 0.8
+        lv.step(A, "boss", {"duration": 16})
+    assert rover.pose.translation[0] == pytest.approx(0.8, abs=1e-9)
+    boss(lv, "remove_node", {"node": GATE})
+    for _ in range(300):                                                  # 4.8 s more: to the wall
+        lv.step(A, "boss", {"duration": 16})
+    assert rover.pose.translation[0] == pytest.approx(2.8, abs=1e-9)
+    assert rover.pose.translation[1] == pytest.approx(-2.0, abs=1e-9)
+
+
+def test_simulation_reset_does_not_bring_removed_nodes_back():
+    lv = _live()
+    boss(lv, "set_field", {"node": GATE, "field": "translation", "value": [1.1, -3.0, 0.25]})
+    boss(lv, "set_field", {"node": LAMP, "field": "intensity", "value": 5.0})
+    boss(lv, "remove_node", {"node": CRATE})
+    boss(lv, "remove_node", {"node": BULB})
+    assert readings(lv)["eye"] == pytest.approx(5.0)
+    boss(lv, "simulation_reset")
+    got = readings(lv)
+    assert got["ds"] == pytest.approx(3.0, abs=1e-9)                      # the crate stays removed
+    assert got["eye"] == pytest.approx(3.0)                               # lamp's intensity as loaded, no bulb
+    assert boss(lv, "get_field", {"node": GATE, "field": "translation"})["value"] == [1.1, -2.0, 0.25]
+    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == [BOSS, ROVER, WALL, GATE, LAMP]
+    assert boss(lv, "get_from_id", {"id": CRATE}) == NULL
+
+
+def test_a_moved_solid_can_be_removed():
+    """A solid a supervisor moved is in the movers' tier, not the static one: removal takes it out there."""
+    lv = _live()
+    boss(lv, "set_field", {"node": CRATE, "field": "translation", "value": [2.1, 0.0, 0.25]})
+    assert readings(lv)["ds"] == pytest.approx(2.0, abs=1e-9)
+    boss(lv, "remove_node", {"node": CRATE})
+    assert readings(lv)["ds"] == pytest.approx(3.0, abs=1e-9)
