@@ -7,11 +7,14 @@ ids stay stable (a removed one answers NULL and is never reused); robots and the
 
 from __future__ import annotations
 
+import json
 import math
+import sys
 
 import numpy as np
 import pytest
-from test_multiprocess import REPO
+from _serve import Proc, sensorium
+from test_multiprocess import CONTROLLERS, REPO, start_server
 from test_supervisor import A, Live
 
 from sensorium.schemas.wire import ErrorCode
@@ -145,3 +148,87 @@ def test_a_moved_solid_can_be_removed():
     assert readings(lv)["ds"] == pytest.approx(2.0, abs=1e-9)
     boss(lv, "remove_node", {"node": CRATE})
     assert readings(lv)["ds"] == pytest.approx(3.0, abs=1e-9)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_webots_supervisor_controller_removes_a_solid_and_a_light(tmp_path):
+    """tests/controllers/supervisor_remove.py through ``sensorium serve``: ``node.remove()`` as in Webots."""
+    server = start_server(WORLD, tmp_path, "--mode", "pause")
+    try:
+        ctl = Proc(sensorium("controller", str(CONTROLLERS / "supervisor_remove.py"), "--url", server.url("boss")))
+        try:
+            server.wait_attached({"boss"})
+            server.conn.call("set_mode", {"mode": "fast"})
+            assert ctl.wait(120) == 0, ctl.stderr()
+        finally:
+            ctl.kill()
+    finally:
+        server.stop()
+    out = json.loads(ctl.out[-1])
+    assert out["before"] == [pytest.approx(1.0, abs=1e-9), pytest.approx(7.0), 7]
+    assert out["after"] == [pytest.approx(3.0, abs=1e-9), pytest.approx(3.0), 5]
+    assert out["gone"] == [True, True, GATE, True]
+    assert ("Error: wb_supervisor_node_remove(): remove_node: robot 'rover' (node 2) cannot be removed here: only "
+            "top-level solids and lights can (a departure from Webots, which removes robots too).") in ctl.stderr()
+
+
+def _top_fields(data: bytes) -> list[tuple[int, bytes]]:
+    """A protobuf message's top-level length-delimited fields (number, payload): enough to tell a
+    SceneUpdate's deletions (field 1) from its entities (field 2) without a protobuf library."""
+    out, i = [], 0
+
+    def varint() -> int:
+        nonlocal i
+        v = shift = 0
+        while True:
+            b = data[i]
+            i += 1
+            v |= (b & 0x7F) << shift
+            shift += 7
+            if b < 0x80:
+                return v
+
+    while i < len(data):
+        key = varint()
+        assert key & 7 == 2, key                      # SceneUpdate's fields are all messages
+        n = varint()
+        out.append((key >> 3, data[i:i + n]))
+        i += n
+    return out
+
+
+def test_the_foxglove_scene_drops_and_deletes_a_removed_solid():
+    """The live viewer's scene (serve --foxglove: scene_update with the simulation's solid poses): a
+    removed solid is not drawn and is deleted from a viewer that drew it; the others are still drawn."""
+    from sensorium.server.recording.frames import bodies
+    from sensorium.server.recording.scene3d import scene_update
+
+    sim = Simulation(load_world(WORLD))
+
+    def scene() -> tuple[list[bytes], list[bytes]]:
+        fields = _top_fields(scene_update(sim.world, sim.loaded.base_dir, 0, dict(sim.scene.solid_poses)).encode())
+        return [p for f, p in fields if f == 1], [p for f, p in fields if f == 2]
+
+    deletions, entities = scene()
+    assert deletions == [] and sum(b"solid/crate" in e for e in entities) == 1
+    sim.remove_solid("crate")
+    deletions, entities = scene()
+    assert len(deletions) == 1 and b"solid/crate" in deletions[0]
+    assert not any(b"solid/crate" in e for e in entities)
+    assert sum(b"solid/wall" in e for e in entities) == 1 and sum(b"solid/gate" in e for e in entities) == 1
+    assert [b.entity_id for b in bodies(sim.world, dict(sim.scene.solid_poses))] == [
+        "solid/wall", "solid/gate", "robot/rover"]
+
+
+def test_in_process_removal_names_what_is_wrong():
+    sim = Simulation(load_world(WORLD))
+    sim.remove_solid("crate")
+    sim.remove_light(1)
+    with pytest.raises(KeyError, match="no solid 'crate'"):
+        sim.remove_solid("crate")
+    with pytest.raises(KeyError, match=r"no top-level light 1 \(the world has 2; removed: \[1\]\)"):
+        sim.remove_light(1)
+    with pytest.raises(KeyError, match="no top-level light 2"):
+        sim.remove_light(2)
+    sim.reset()                                        # removed nodes stay removed
+    assert set(sim.scene.solid_poses) == {"wall", "gate"} and sim.scene.removed_lights == {1}

@@ -39,6 +39,8 @@ from foxglove.messages import (
     Pose,
     Quaternion,
     SceneEntity,
+    SceneEntityDeletion,
+    SceneEntityDeletionType,
     SceneUpdate,
     SpherePrimitive,
     Timestamp,
@@ -157,7 +159,8 @@ def _light_entity(entity_id: str, frame_id: str, frame_locked: bool, light: Any,
 def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
                  solid_poses: dict[str, Any] | None = None) -> SceneUpdate:
     """The whole world as one ``SceneUpdate``. ``solid_poses`` (name → geometry ``Pose``) overrides
-    the file's pose of a solid that was moved since loading (its children and lights move with it)."""
+    the file's pose of a solid that was moved since loading (its children and lights move with it);
+    a solid it leaves out was removed (a Supervisor's ``node.remove()``): not drawn, and deleted."""
     base = Path(base_dir)
     budget = [MAX_SCENE_TRIANGLES]
     entities: list[SceneEntity] = []
@@ -171,7 +174,12 @@ def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
                                 frame_locked=body.frame_locked))
     for entity_id, frame_id, locked, light in lights(world, solid_poses):
         entities.append(_light_entity(entity_id, frame_id, locked, light, stamp_ns))
-    return SceneUpdate(entities=entities)
+    # a solid a Supervisor removed (in the world, not in solid_poses): deleted from a viewer that drew it
+    # (whatever its timestamp: a removed solid never comes back, its name is never reused)
+    gone = [] if solid_poses is None else [s.name for s in world.solids if s.name not in solid_poses]
+    deletions = [SceneEntityDeletion(timestamp=Timestamp(2**32 - 1, 0), type=SceneEntityDeletionType.MatchingId,
+                                     id=f"solid/{name}") for name in gone]
+    return SceneUpdate(deletions=deletions, entities=entities)
 
 
 def frame_transforms(robot: str, stamp_ns: int, translation: Iterable[float], quaternion: Iterable[float],

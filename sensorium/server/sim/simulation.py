@@ -289,6 +289,10 @@ class Simulation:
     def remove_light(self, index: int) -> None:
         """Take top-level light ``index`` (the world's ``lights`` order) out for good: light sensors
         and cameras stop counting it from their next measurement; a reset does not bring it back."""
+        count = len(self.scene.top_lights())
+        if not 0 <= index < count or index in self.scene.removed_lights:
+            raise KeyError(f"no top-level light {index} (the world has {count}; removed: "
+                           f"{sorted(self.scene.removed_lights) or 'none'})")
         self.scene.remove_top_light(index)
 
     @property
