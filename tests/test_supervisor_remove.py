@@ -199,14 +199,15 @@ def _top_fields(data: bytes) -> list[tuple[int, bytes]]:
 
 def test_the_foxglove_scene_drops_and_deletes_a_removed_solid():
     """The live viewer's scene (serve --foxglove: scene_update with the simulation's solid poses): a
-    removed solid is not drawn and is deleted from a viewer that drew it; the others are still drawn."""
+    removed solid or light is not drawn and is deleted from a viewer that drew it; the others are still drawn."""
     from sensorium.server.recording.frames import bodies
     from sensorium.server.recording.scene3d import scene_update
 
     sim = Simulation(load_world(WORLD))
 
     def scene() -> tuple[list[bytes], list[bytes]]:
-        fields = _top_fields(scene_update(sim.world, sim.loaded.base_dir, 0, dict(sim.scene.solid_poses)).encode())
+        fields = _top_fields(scene_update(sim.world, sim.loaded.base_dir, 0, dict(sim.scene.solid_poses),
+                                          sim.scene.removed_lights).encode())
         return [p for f, p in fields if f == 1], [p for f, p in fields if f == 2]
 
     deletions, entities = scene()
@@ -218,6 +219,11 @@ def test_the_foxglove_scene_drops_and_deletes_a_removed_solid():
     assert sum(b"solid/wall" in e for e in entities) == 1 and sum(b"solid/gate" in e for e in entities) == 1
     assert [b.entity_id for b in bodies(sim.world, dict(sim.scene.solid_poses))] == [
         "solid/wall", "solid/gate", "robot/rover"]
+    assert sum(b"light/bulb" in e for e in entities) == 1
+    sim.remove_light(1)                                     # bulb
+    deletions, entities = scene()
+    assert len(deletions) == 2 and b"solid/crate" in deletions[0] and b"light/bulb" in deletions[1]
+    assert not any(b"light/bulb" in e for e in entities) and sum(b"light/lamp" in e for e in entities) == 1
 
 
 def test_in_process_removal_names_what_is_wrong():
@@ -232,3 +238,39 @@ def test_in_process_removal_names_what_is_wrong():
         sim.remove_light(2)
     sim.reset()                                        # removed nodes stay removed
     assert set(sim.scene.solid_poses) == {"wall", "gate"} and sim.scene.removed_lights == {1}
+
+
+def test_the_live_viewer_resends_the_scene_when_a_node_is_removed():
+    """serve --foxglove: removing a solid, then a light, broadcasts the scene again each time."""
+    import time
+
+    from sensorium.server.daemon.services import Core
+    from sensorium.server.daemon.transport import Transport
+    from sensorium.server.viewer.bridge import FoxgloveBridge
+
+    sim = Simulation(load_world(WORLD), precision="fast")
+    core = Core(sim)
+    transport = Transport(core, "tcp://127.0.0.1:0", "tcp://127.0.0.1:0")
+    bridge = FoxgloveBridge.for_core(core, transport, "127.0.0.1", 0)
+    try:
+        sent: list[int | None] = []
+        bridge._work = lambda: sent.extend(bridge._scene_for) or bridge._scene_for.clear()  # record, do not send
+        first = bridge.scene_bytes()
+        bridge._subscribed(7, "/scene", +1)
+        transport.hooks[0]()                           # the loop's pass: demand applied, poses noted
+        expected: list[int | None] = [7]
+        for remove in (lambda: sim.remove_solid("crate"), lambda: sim.remove_light(1)):
+            remove()
+            transport.hooks[0]()
+            expected.append(None)
+            deadline = time.monotonic() + 30
+            while len(sent) < len(expected) and time.monotonic() < deadline:
+                time.sleep(0.01)
+            assert sent == expected                    # the subscriber's own copy, then a broadcast each
+        assert b"solid/crate" in first and b"light/bulb" in first
+        transport.hooks[0]()
+        assert sent == expected and not bridge._scene_for     # nothing removed since: nothing resent
+        assert len(bridge.scene_bytes()) < len(first)
+    finally:
+        bridge.close()
+        transport.close()

@@ -85,7 +85,7 @@ def bodies(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Itera
     for s in world.solids:
         if solid_poses is not None and s.name not in solid_poses:
             continue
-        top = solid_poses.get(s.name) if solid_poses is not None else pose_from_model(s.pose)
+        top = solid_poses[s.name] if solid_poses is not None else pose_from_model(s.pose)
         parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in solid_parts(s, top)]
         if parts:
             yield Body(f"solid/{s.name}", WORLD_FRAME, "solid", False, parts)
@@ -117,7 +117,7 @@ def lights(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Itera
     for s in world.solids:
         if solid_poses is not None and s.name not in solid_poses:     # removed, with its lights
             continue
-        top = solid_poses.get(s.name) if solid_poses is not None else pose_from_model(s.pose)
+        top = solid_poses[s.name] if solid_poses is not None else pose_from_model(s.pose)
         for j, (lt, local) in enumerate(solid_lights(s, Pose.identity())):
             yield unique(lt.name or f"{s.name}/light{j}"), WORLD_FRAME, False, place_light(lt, top.compose(local))
     for r in world.robots:
