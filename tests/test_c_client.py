@@ -36,12 +36,14 @@ ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
 CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
-               "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene"]
+               "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene",
+               "supervisor_remove"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
 CAR_WORLD = REPO / "tests" / "worlds" / "car.yaml"
 SCENE_WORLD = REPO / "tests" / "worlds" / "supervisor_scene.yaml"
+REMOVE_WORLD = REPO / "tests" / "worlds" / "supervisor_remove.yaml"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -493,6 +495,26 @@ def test_c_supervisor_walks_the_tree_switches_a_light_and_reads_velocities(cbin,
     assert "wb_supervisor_field_get_sf_bool() called with wrong field type: SFFloat." in err
     assert "has no field 'mass' in Sensorium" in err and "out-of-bound index: 5" in err
     assert "wb_supervisor_node_get_velocity() called with a NULL or invalid 'node' argument." in err
+
+
+def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
+    """tests/c/supervisor_remove.c on tests/worlds/supervisor_remove.yaml (its closed forms), built with
+    sanitizers: the distance sensor reads the crate at 1 m, then the wall at 3 m; the light sensor 3 + 4
+    (lamp and bulb), then 3; the root's 7 children become 5; the crate's id answers NULL, the gate keeps
+    its id; a robot and the root are refused with one line each; a reset brings nothing back."""
+    code, out, err = finish(start([cbin["supervisor_remove"]], servers(REMOVE_WORLD).url("boss")))
+    assert code == 0, err
+    key, *vals = out[0].split()
+    assert key == "before" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 7], abs=1e-9)
+    key, *vals = out[1].split()
+    assert key == "after" and [float(v) for v in vals] == pytest.approx([3.0, 3.0, 5], abs=1e-9)
+    assert out[2] == "gone 4 1 1 5"
+    key, *vals = out[3].split()
+    assert key == "reset" and [float(v) for v in vals] == pytest.approx([3.0, 5], abs=1e-9)
+    assert ("Error: wb_supervisor_node_remove(): INVALID_ARGUMENT: remove_node: robot 'rover' (node 2) cannot be "
+            "removed here") in err
+    assert "Error: wb_supervisor_node_remove(): INVALID_ARGUMENT: remove_node: the root node cannot be removed" in err
+    assert "wb_supervisor_node_remove() called with a NULL or invalid 'node' argument." in err
 
 
 def test_supervisor_through_the_cpp_classes(cbin, servers):

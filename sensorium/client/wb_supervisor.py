@@ -183,6 +183,23 @@ def wb_supervisor_node_get_velocity(node: int | None) -> list[float]:
     return [float(v) for v in _call(r, "get_node_velocity", {"node": int(node)})["value"]]  # type: ignore[arg-type]
 
 
+def wb_supervisor_node_remove(node: int | None) -> None:
+    """Take a top-level solid or light out of the world for good: from the next step no sensor sees
+    it and robots drive through where it stood; its id answers NULL from then on and is never reused;
+    ``simulationReset`` does not bring it back (Webots). The root and robots cannot be removed here
+    (one error line, nothing removed: a departure from Webots, which removes robots too)."""
+    func = "wb_supervisor_node_remove"
+    r = _checked_node(node, func)
+    if r is None:
+        return
+    try:
+        _call(r, "remove_node", {"node": int(node)})  # type: ignore[arg-type]
+    except SensoriumError as err:      # the root, a robot, a node already removed: the server's line
+        if err.code != ErrorCode.INVALID_ARGUMENT:
+            raise
+        print(f"Error: {func}(): {err.message}.", file=sys.stderr)
+
+
 _set_velocity_warned: list[bool] = []
 
 

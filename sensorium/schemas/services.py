@@ -792,6 +792,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("set_field", "robot", SetFieldArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
+    ServiceSpec("remove_node", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),

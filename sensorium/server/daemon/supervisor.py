@@ -3,7 +3,8 @@
 Nodes are what the server simulates at the top of the world: the root (Webots' root Group, id 0,
 whose ``children`` lists the others), the robots (ids 1..R in world order), the top-level solids
 (R+1..R+S) and the world's top-level lights (then on). They are found by DEF name (``def_name``,
-set from a ``.wbt`` world's ``DEF``) or else by name. Ids are stable for the life of the server.
+set from a ``.wbt`` world's ``DEF``) or else by name. Ids are stable for the life of the server:
+a removed solid or light keeps its id, which then answers NULL and is never given to another node.
 Everything else of a Webots scene tree (shapes, devices, nested solids, lights carried by a solid
 or robot) is not a node here: Webots' NULL.
 
@@ -41,8 +42,9 @@ class Node:
 ROOT = Node(0, "Group", "", "", "")
 
 
-def _nodes(sim: Any) -> list[Node]:
-    """Every node but the root, in id order (robots, solids, lights): the root's children."""
+def _all_nodes(sim: Any) -> list[Node]:
+    """Every node the world loaded with but the root, in id order (robots, solids, lights), removed
+    ones included: a node's id is its place here, so it never changes and is never reused."""
     world = getattr(sim, "world", None)
 
     def def_of(models: list, k: int) -> str:
@@ -52,11 +54,22 @@ def _nodes(sim: Any) -> list[Node]:
     solids_m = world.solids if world is not None else None
     out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name) for i, name in enumerate(sim.robots)]
     first = len(out) + 1
-    out += [Node(first + j, "Solid", name, def_of(solids_m, j), name) for j, name in enumerate(sim.scene.solid_poses)]
+    out += [Node(first + j, "Solid", name, def_of(solids_m, j), name) for j, name in enumerate(sim.scene.solid_names)]
     top = sim.scene.top_lights()
     first = len(out) + 1
     out += [Node(first + k, lt.type, lt.name or "", def_of(top, k), k) for k, lt in enumerate(top)]
     return out
+
+
+def _removed(sim: Any, node: Node) -> bool:
+    if node.type == "Solid":
+        return node.key not in sim.scene.solid_poses
+    return node.type in LIGHTS and node.key in sim.scene.removed_lights
+
+
+def _nodes(sim: Any) -> list[Node]:
+    """The nodes in the world now, in id order: the root's children."""
+    return [n for n in _all_nodes(sim) if not _removed(sim, n)]
 
 
 def find_node(sim: Any, name: str) -> Node | None:
@@ -78,10 +91,13 @@ def robot_node(sim: Any, robot: str) -> Node | None:
 def node_by_id(sim: Any, node: int) -> Node:
     if node == 0:
         return ROOT
-    nodes = _nodes(sim)
+    nodes = _all_nodes(sim)
     if not 0 <= node <= len(nodes):
         raise ValueError(f"no node with id {node} (ids 0..{len(nodes)}: 0 the root)")
-    return nodes[node - 1]
+    found = nodes[node - 1]
+    if _removed(sim, found):
+        raise ValueError(f"node {node} ({found.type} {found.name or found.key!r}) was removed")
+    return found
 
 
 def node_from_id(sim: Any, node: int) -> Node | None:
@@ -263,6 +279,26 @@ def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     return {"success": True}
 
 
+def remove_node(sim: Any, node: Node) -> None:
+    """Webots' ``node.remove()`` for what is a node here: a top-level solid or light. The root and
+    robots are refused (a robot's controller, devices and lockstep slot cannot leave a running
+    server here; Webots removes a robot, the calling one at the end of the step)."""
+    if node.type == "Solid":
+        sim.remove_solid(node.key)
+    elif node.type in LIGHTS:
+        sim.remove_light(node.key)
+    elif node.type == "Robot":
+        raise ValueError(f"robot {node.name!r} (node {node.id}) cannot be removed here: only top-level "
+                         "solids and lights can (a departure from Webots, which removes robots too)")
+    else:
+        raise ValueError("the root node cannot be removed")
+
+
+def _remove(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    remove_node(sim, node_by_id(sim, a.node))
+    return {"success": True}
+
+
 def _reset(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     sim.reset()
     return {"success": True}
@@ -282,6 +318,7 @@ HANDLERS = {
     "set_field": _set_field,
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},
+    "remove_node": _remove,
     "simulation_reset": _reset,
     "simulation_set_mode": _set_mode,
     "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},

@@ -237,6 +237,8 @@ class RayEngine(TierTracer):
 
     def set_body_pose(self, body: int, pose: Pose) -> None:
         b = self._bodies[body]
+        if b.removed:
+            raise ValueError(f"body {body} was removed")
         b.pose = pose
         self._epoch += 1
         self._rot[body] = pose.rotation
@@ -246,6 +248,23 @@ class RayEngine(TierTracer):
             self._movers.append(b)
             self._static.clear()
             self._mover_tables.clear()
+
+    def remove_body(self, body: int) -> None:
+        """Take a body out of every ray query for good (a Supervisor's ``node.remove()``): a mover
+        leaves the movers' tables, a static body the static tier (rebuilt on the next cast, as a
+        static body's first move does). Its index and shape ids stay (never reused), so every other
+        body's and shape's number is unchanged; casts in a world that never removes do no more work."""
+        b = self._bodies[body]
+        if b.removed:
+            return
+        b.removed = True
+        self._epoch += 1
+        self._planes.clear()
+        if b.mover:
+            self._movers.remove(b)
+            self._mover_tables.clear()
+        else:
+            self._static.clear()
 
     def shape_owner(self, shape: int) -> int:
         return int(self._owner_of[shape])
@@ -289,7 +308,7 @@ class RayEngine(TierTracer):
 
     def _static_tier(self, variant: str) -> _Tier | None:
         if variant not in self._static:
-            statics = [b for b in self._bodies if not b.mover]
+            statics = [b for b in self._bodies if not b.mover and not b.removed]
             if variant == _V_OPAQUE and not self._has_transparent(statics):
                 self._static[variant] = self._static_tier(_V_BOUNDING)
             else:
@@ -337,7 +356,7 @@ class RayEngine(TierTracer):
 
     def _plane_set(self, variant: str) -> _Planes | None:
         if variant not in self._planes:
-            items = [(sid, b) for b in self._bodies for sid in b.shapes
+            items = [(sid, b) for b in self._bodies if not b.removed for sid in b.shapes
                      if isinstance(self._entries[sid].primitive, Plane) and _sees(self._entries[sid], variant)]
             self._planes[variant] = (_Planes(items, self._entries, self._owner_of, variant == _V_VISUAL)
                                      if items else None)

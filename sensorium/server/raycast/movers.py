@@ -211,6 +211,7 @@ class _Body:
     mover: bool
     index: int
     tiers: dict = field(default_factory=dict)  # variant -> shared body-frame _Tier (movers only)
+    removed: bool = False      # taken out of every query (RayEngine.remove_body)
 
     @property
     def first(self) -> int:

@@ -79,11 +79,13 @@ class Body:
 def bodies(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Iterator[Body]:
     """Every solid and robot body to draw, with every shape: ``ghost`` marks a bounding-only shape
     (Webots' invisible boundingObject, seen only by generic/sonar/laser rays), drawn translucent.
-    ``solid_poses`` overrides where a solid is now."""
+    ``solid_poses`` overrides where a solid is now; a solid it leaves out was removed (Supervisor)."""
     from sensorium.server.sim.scene import robot_parts, solid_parts
 
     for s in world.solids:
-        top = (solid_poses or {}).get(s.name) or pose_from_model(s.pose)
+        if solid_poses is not None and s.name not in solid_poses:
+            continue
+        top = solid_poses[s.name] if solid_poses is not None else pose_from_model(s.pose)
         parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in solid_parts(s, top)]
         if parts:
             yield Body(f"solid/{s.name}", WORLD_FRAME, "solid", False, parts)
@@ -113,7 +115,9 @@ def lights(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Itera
     for i, lt in enumerate(world.lights):
         yield unique(lt.name or f"light{i}"), WORLD_FRAME, False, lt
     for s in world.solids:
-        top = (solid_poses or {}).get(s.name) or pose_from_model(s.pose)
+        if solid_poses is not None and s.name not in solid_poses:     # removed, with its lights
+            continue
+        top = solid_poses[s.name] if solid_poses is not None else pose_from_model(s.pose)
         for j, (lt, local) in enumerate(solid_lights(s, Pose.identity())):
             yield unique(lt.name or f"{s.name}/light{j}"), WORLD_FRAME, False, place_light(lt, top.compose(local))
     for r in world.robots:

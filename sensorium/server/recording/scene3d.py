@@ -23,6 +23,7 @@ Everything here is pure: world model in, ``foxglove.messages`` objects out (enco
 from __future__ import annotations
 
 from collections.abc import Iterable
+from collections.abc import Set as AbstractSet
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +40,8 @@ from foxglove.messages import (
     Pose,
     Quaternion,
     SceneEntity,
+    SceneEntityDeletion,
+    SceneEntityDeletionType,
     SceneUpdate,
     SpherePrimitive,
     Timestamp,
@@ -155,9 +158,11 @@ def _light_entity(entity_id: str, frame_id: str, frame_locked: bool, light: Any,
 
 
 def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
-                 solid_poses: dict[str, Any] | None = None) -> SceneUpdate:
+                 solid_poses: dict[str, Any] | None = None, removed_lights: AbstractSet[int] = frozenset()) -> SceneUpdate:
     """The whole world as one ``SceneUpdate``. ``solid_poses`` (name → geometry ``Pose``) overrides
-    the file's pose of a solid that was moved since loading (its children and lights move with it)."""
+    the file's pose of a solid that was moved since loading (its children and lights move with it);
+    a solid it leaves out was removed (a Supervisor's ``node.remove()``): not drawn, and deleted, as
+    the world's top-level lights of ``removed_lights`` (indices in ``world.lights``)."""
     base = Path(base_dir)
     budget = [MAX_SCENE_TRIANGLES]
     entities: list[SceneEntity] = []
@@ -169,9 +174,17 @@ def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
                 merged.setdefault(key, []).extend(prims)
         entities.append(_entity(body.frame_id, body.entity_id, stamp_ns, merged, body.kind,
                                 frame_locked=body.frame_locked))
-    for entity_id, frame_id, locked, light in lights(world, solid_poses):
+    # what a Supervisor removed (a solid in the world, not in solid_poses; a top-level light): deleted
+    # from a viewer that drew it (whatever its timestamp: a removed node never comes back)
+    gone = [] if solid_poses is None else [f"solid/{s.name}" for s in world.solids if s.name not in solid_poses]
+    for k, (entity_id, frame_id, locked, light) in enumerate(lights(world, solid_poses)):
+        if k < len(world.lights) and k in removed_lights:       # the world's top-level lights come first
+            gone.append(entity_id)
+            continue
         entities.append(_light_entity(entity_id, frame_id, locked, light, stamp_ns))
-    return SceneUpdate(entities=entities)
+    deletions = [SceneEntityDeletion(timestamp=Timestamp(2**32 - 1, 0), type=SceneEntityDeletionType.MatchingId,
+                                     id=entity_id) for entity_id in gone]
+    return SceneUpdate(deletions=deletions, entities=entities)
 
 
 def frame_transforms(robot: str, stamp_ns: int, translation: Iterable[float], quaternion: Iterable[float],

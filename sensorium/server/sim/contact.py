@@ -326,6 +326,12 @@ class Contact:
         if hasattr(self, "feet"):
             self._rebuild()
 
+    def remove_solid(self, name: str) -> None:
+        """A solid removed by a Supervisor: no longer an obstacle."""
+        for i in range(len(self.prims.pop(name, ()))):
+            self.solids.pop((name, i), None)
+        self._rebuild()
+
     def _rebuild(self) -> None:
         obs = list(self.solids.values())
         self._obs = obs

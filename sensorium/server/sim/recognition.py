@@ -146,6 +146,8 @@ class Recognizer:
         out: list[RecognisedObject] = []
         seen_by_pixels = set(np.unique(pixel_objects).tolist()) if pixel_objects is not None else set()
         for k, obj in enumerate(self.objects):
+            if obj.key not in self.scene.recognisable:     # removed by a Supervisor
+                continue
             box = self._box(obj, cam)
             if box is None:
                 continue

@@ -192,6 +192,7 @@ class Scene:
         self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         self.lights_version = 0        # changes whenever a light moves with its owner
+        self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
         # infra-red reads these per hit shape; -1 (no hit) indexes the trailing "no hit" entry
         self.red = np.array([s.red for s in self.shapes] + [1.0])
         self.roughness = np.array([s.roughness for s in self.shapes] + [0.0])
@@ -229,9 +230,12 @@ class Scene:
     def world_lights(self) -> list:
         """Every light model with its location and direction in world coordinates (now)."""
         out = []
+        top = -1
         for model, owner, local in self._lights:
             if owner is None:
-                out.append(model)
+                top += 1
+                if top not in self.removed_lights:
+                    out.append(model)
             else:
                 frame = self.robot_poses[owner] if isinstance(owner, int) else self.solid_poses[owner]
                 out.append(place_light(model, frame.compose(local)))
@@ -248,6 +252,31 @@ class Scene:
         k = [i for i, (_, owner, _) in enumerate(self._lights) if owner is None][index]
         self._lights[k] = (model, None, Pose.identity())
         self.lights_version += 1
+
+    def remove_top_light(self, index: int) -> None:
+        """Take top-level light ``index`` out for good (a Supervisor's ``node.remove()``): light
+        sensors and cameras stop counting it at their next measurement (``lights_version``). Its
+        index stays its own (``top_lights`` keeps every loaded light; the Supervisor's ids are stable)."""
+        if index not in self.removed_lights:
+            self.removed_lights.add(index)
+            self.lights_version += 1
+
+    def remove_solid(self, name: str) -> None:
+        """Take top-level solid ``name`` out for good (a Supervisor's ``node.remove()``): its body
+        leaves the ray engine (every ray kind stops seeing it at the next cast), its pose leaves
+        ``solid_poses`` (topics and scene views), recognition stops listing it and lights it carries
+        go out. Its shape ids stay (never reused)."""
+        if name not in self.solid_poses:
+            raise KeyError(name)
+        del self.solid_poses[name]
+        body = self._solid_body.pop(name, None)
+        if body is not None:
+            self.engine.remove_body(body)
+        self.recognisable.pop(name, None)
+        if name in self._attached:
+            self._lights = [entry for entry in self._lights if entry[1] != name]
+            self._attached.discard(name)
+            self.lights_version += 1
 
     def device_shapes(self, robot: int, device: str) -> frozenset[int]:
         """The shapes (``Scene.shapes`` indices) of a device's own Solid (``of_device``), which its

@@ -220,6 +220,8 @@ class Simulation:
                     dev.set(0, self.time_ms)
         self.radio.reset()
         for name, pose in self._initial["solids"].items():
+            if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
+                continue
             self.scene.set_solid_pose(name, pose)
             if self.contact is not None:
                 self.contact.update_solid(name, pose)
@@ -273,6 +275,25 @@ class Simulation:
         self.scene.set_solid_pose(name, pose)
         if self.contact is not None:
             self.contact.update_solid(name, pose)
+
+    def remove_solid(self, name: str) -> None:
+        """Take a top-level solid out of the world for good (Webots' ``node.remove()``): from the
+        next measurement no sensor sees it, kinematic contact no longer stops robots at it, and
+        ``simulationReset`` does not bring it back (Webots' reset adds no removed node)."""
+        if name not in self.scene.solid_poses:
+            raise KeyError(f"no solid {name!r}")
+        self.scene.remove_solid(name)
+        if self.contact is not None:
+            self.contact.remove_solid(name)
+
+    def remove_light(self, index: int) -> None:
+        """Take top-level light ``index`` (the world's ``lights`` order) out for good: light sensors
+        and cameras stop counting it from their next measurement; a reset does not bring it back."""
+        count = len(self.scene.top_lights())
+        if not 0 <= index < count or index in self.scene.removed_lights:
+            raise KeyError(f"no top-level light {index} (the world has {count}; removed: "
+                           f"{sorted(self.scene.removed_lights) or 'none'})")
+        self.scene.remove_top_light(index)
 
     @property
     def counters(self) -> dict[str, int]:

@@ -42,6 +42,7 @@ import threading
 import time
 from collections import Counter, deque
 from collections.abc import Callable, Iterable
+from collections.abc import Set as AbstractSet
 from pathlib import Path
 from typing import Any, cast
 
@@ -227,7 +228,8 @@ class FoxgloveBridge:
     def __init__(self, topic_types: dict[str, str], world: wm.World | None = None, base_dir: str | Path = ".", *,
                  host: str = "127.0.0.1", port: int = DEFAULT_PORT, name: str = "sensorium",
                  on_demand: Callable[[set[str]], None] | None = None, wake: Callable[[], None] | None = None,
-                 solid_poses: Callable[[], dict[str, Any]] | None = None, queue_size: int | None = None,
+                 solid_poses: Callable[[], dict[str, Any]] | None = None,
+                 removed_lights: Callable[[], AbstractSet[int]] | None = None, queue_size: int | None = None,
                  backlog: int | None = None, distro: str = "jazzy", status: Callable[[], str | None] | None = None,
                  largest_message: int = 0):
         try:
@@ -246,6 +248,7 @@ class FoxgloveBridge:
         self.on_demand = on_demand
         self.wake = wake or (lambda: None)
         self.solid_poses = solid_poses
+        self.removed_lights = removed_lights          # the world's top-level lights a Supervisor removed
         self.ctx = foxglove.Context()
         self.types: dict[str, str] = {}            # topic -> channel schema name
         self.unsupported: dict[str, str] = {}      # topic -> its type the distro lacks
@@ -277,6 +280,7 @@ class FoxgloveBridge:
         self._scene_bytes: bytes | None = None
         self._scene_key: Any = None
         self._seen_poses: list[Any] = []
+        self._seen_removed_lights = 0
         # data path
         self._queue: deque[tuple[str, str, bytes, int]] = deque()
         # bounded in bytes, not only in messages: a 16-layer lidar's cloud is ~260 KB, and 256 of
@@ -329,7 +333,8 @@ class FoxgloveBridge:
         bridge = cls({t.name: t.type for t in topics.topics}, sim.world, getattr(loaded, "base_dir", "."),
                      host=host, port=port, name=f"sensorium {core.world_name}",
                      on_demand=topics.set_viewer_demand, wake=transport.wake,
-                     solid_poses=lambda: dict(sim.scene.solid_poses), status=lambda: waiting_message(core),
+                     solid_poses=lambda: dict(sim.scene.solid_poses),
+                     removed_lights=lambda: frozenset(sim.scene.removed_lights), status=lambda: waiting_message(core),
                      largest_message=largest_message(sim.world), **kw)
         topics.set_viewer(bridge.record)
         transport.hooks.append(lambda: bridge.pump(sim.time_ms * 1_000_000))
@@ -433,11 +438,14 @@ class FoxgloveBridge:
                     self._event.set()
         if self.solid_poses is not None and self._subs.get(SCENE_TOPIC, 0) > 0:
             poses = list(self.solid_poses().values())
-            if len(poses) != len(self._seen_poses) or any(a is not b for a, b in zip(poses, self._seen_poses)):
+            removed = len(self.removed_lights()) if self.removed_lights is not None else 0
+            if len(poses) != len(self._seen_poses) or any(a is not b for a, b in zip(poses, self._seen_poses)) \
+                    or removed != self._seen_removed_lights:
                 if self._seen_poses:
                     self._scene_for.append(None)
                     self._event.set()
                 self._seen_poses = poses
+                self._seen_removed_lights = removed
         if self._dirty:
             with self._lock:
                 self._dirty = False
@@ -537,9 +545,11 @@ class FoxgloveBridge:
         if self.world is None:
             return b""
         poses = self.solid_poses() if self.solid_poses is not None else None
-        key = tuple((n, p.translation.tobytes(), p.rotation.tobytes()) for n, p in (poses or {}).items())
+        removed = frozenset(self.removed_lights()) if self.removed_lights is not None else frozenset()
+        key = (tuple((n, p.translation.tobytes(), p.rotation.tobytes()) for n, p in (poses or {}).items()),
+               tuple(sorted(removed)))
         if self._scene_bytes is None or key != self._scene_key:
-            self._scene_bytes = self._scene_mod.scene_update(self.world, self.base_dir, 0, poses).encode()
+            self._scene_bytes = self._scene_mod.scene_update(self.world, self.base_dir, 0, poses, removed).encode()
             self._scene_key = key
         return self._scene_bytes
 

@@ -276,6 +276,18 @@ const double *wb_supervisor_node_get_velocity(WbNodeRef node) {
   return ok ? node->velocity : sn_no_values();
 }
 
+/* Webots' node.remove() for a top-level solid or light: no sensor sees it from the next step and its
+   id answers NULL from then on (never reused); the root and robots are refused with the server's one
+   line (a departure from Webots, which removes robots too). The node's record stays until cleanup. */
+void wb_supervisor_node_remove(WbNodeRef node) {
+  const char *func = "wb_supervisor_node_remove";
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/remove_node", 1, args_node, &node->id, func, &rep) != 0)
+    return;
+  sn_reply_free(&rep);
+}
+
 /* No physics: a robot moves by its wheels (which keep their commands), solids are static; a velocity
    set from outside has nothing to act on: one warning, ignored. */
 void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {

@@ -106,10 +106,6 @@ int wb_supervisor_node_get_number_of_base_node_fields(WbNodeRef node) {
   return -1;
 }
 
-void wb_supervisor_node_remove(WbNodeRef node) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_node_save_state(WbNodeRef node, const char *state_name) {
   SN_UNSUPPORTED();
 }

@@ -152,6 +152,9 @@ class Node:
     def resetPhysics(self) -> None:
         wb.wb_supervisor_node_reset_physics(self._ref)
 
+    def remove(self) -> None:
+        wb.wb_supervisor_node_remove(self._ref)
+
     # -- contact points: Sensorium has no physics contacts, so a node touches nothing (as in the C client)
     def getContactPoints(self, includeDescendants: bool = False) -> list[ContactPoint]:  # noqa: N803
         return []
@@ -302,7 +305,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "getNumberOfFields": ("node_get_number_of_fields", -1),
         "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1),
         "getFieldByIndex": ("node_get_field_by_index", None), "getBaseNodeField": ("node_get_base_node_field", None),
-        "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None), "remove": ("node_remove", None),
+        "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None),
         "exportString": ("node_export_string", ""), "getPose": ("node_get_pose", [_NAN] * 16),
         "enablePoseTracking": ("node_enable_pose_tracking", None),
         "disablePoseTracking": ("node_disable_pose_tracking", None),

@@ -1,0 +1,41 @@
+/* A Webots-style C supervisor removing nodes (tests/worlds/supervisor_remove.yaml, its closed forms):
+ * the distance sensor reads the crate, then the wall behind it once the crate is removed; the light
+ * sensor loses the bulb's term; the removed nodes answer NULL; a robot and the root are refused.
+ * Prints "key values" lines for tests/test_c_client.py. */
+#include <stdio.h>
+
+#include <webots/distance_sensor.h>
+#include <webots/light_sensor.h>
+#include <webots/robot.h>
+#include <webots/supervisor.h>
+
+int main(void) {
+  wb_robot_init();
+  int dt = (int)wb_robot_get_basic_time_step();
+  WbDeviceTag ds = wb_robot_get_device("ds"), eye = wb_robot_get_device("eye");
+  wb_distance_sensor_enable(ds, dt);
+  wb_light_sensor_enable(eye, dt);
+  WbFieldRef children = wb_supervisor_node_get_field(wb_supervisor_node_get_root(), "children");
+
+  wb_robot_step(dt);
+  printf("before %.17g %.17g %d\n", wb_distance_sensor_get_value(ds), wb_light_sensor_get_value(eye),
+         wb_supervisor_field_get_count(children));
+  WbNodeRef crate = wb_supervisor_node_get_from_def("CRATE");
+  int crate_id = wb_supervisor_node_get_id(crate);
+  wb_supervisor_node_remove(crate);
+  wb_supervisor_node_remove(wb_supervisor_node_get_from_def("bulb"));
+  wb_robot_step(dt);
+  printf("after %.17g %.17g %d\n", wb_distance_sensor_get_value(ds), wb_light_sensor_get_value(eye),
+         wb_supervisor_field_get_count(children));
+  printf("gone %d %d %d %d\n", crate_id, wb_supervisor_node_get_from_def("CRATE") == NULL,
+         wb_supervisor_node_get_from_id(crate_id) == NULL,
+         wb_supervisor_node_get_id(wb_supervisor_node_get_from_def("GATE")));
+  wb_supervisor_node_remove(wb_supervisor_node_get_from_def("rover")); /* refused: one line */
+  wb_supervisor_node_remove(wb_supervisor_node_get_root());            /* refused: one line */
+  wb_supervisor_node_remove(NULL);                                     /* Webots' NULL line */
+  wb_supervisor_simulation_reset();
+  wb_robot_step(dt);
+  printf("reset %.17g %d\n", wb_distance_sensor_get_value(ds), wb_supervisor_field_get_count(children));
+  wb_robot_cleanup();
+  return 0;
+}

@@ -1,0 +1,26 @@
+"""A Webots-style supervisor removing nodes (tests/test_supervisor_remove.py; tests/worlds/
+supervisor_remove.yaml explains the closed forms). Written as for Webots; prints one JSON line."""
+
+import json
+
+from controller import Supervisor
+
+robot = Supervisor()
+timestep = int(robot.getBasicTimeStep())
+ds, eye = robot.getDevice("ds"), robot.getDevice("eye")
+ds.enable(timestep)
+eye.enable(timestep)
+children = robot.getRoot().getField("children")
+
+robot.step(timestep)
+before = [ds.getValue(), eye.getValue(), children.getCount()]
+crate = robot.getFromDef("CRATE")
+crate_id = crate.getId()
+crate.remove()
+robot.getFromDef("bulb").remove()
+robot.getFromDef("rover").remove()          # refused: one line, nothing removed
+robot.step(timestep)
+after = [ds.getValue(), eye.getValue(), children.getCount()]
+gone = [robot.getFromDef("CRATE") is None, robot.getFromId(crate_id) is None, robot.getFromDef("GATE").getId(),
+        robot.getFromDef("rover") is not None]
+print(json.dumps({"before": before, "after": after, "gone": gone}), flush=True)
