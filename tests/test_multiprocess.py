@@ -40,6 +40,24 @@ def start_server(world: Path, tmp: Path, *extra: str) -> Served:
     return server
 
 
+def run_paused(world: Path, tmp: Path, script: str, robot: str) -> Proc:
+    """Serve ``world`` paused, run the controller ``tests/controllers/<script>`` on ``robot`` once
+    it is attached (the world then runs fast), and return its finished process (exit status 0
+    checked; its stdout in ``.out``)."""
+    server = start_server(world, tmp, "--mode", "pause")
+    try:
+        ctl = Proc(sensorium("controller", str(CONTROLLERS / script), "--url", server.url(robot)))
+        try:
+            server.wait_attached({robot})
+            server.conn.call("set_mode", {"mode": "fast"})
+            assert ctl.wait(120) == 0, ctl.stderr()
+        finally:
+            ctl.kill()
+    finally:
+        server.stop()
+    return ctl
+
+
 @pytest.fixture
 def servers():
     started: list[Served] = []

@@ -13,8 +13,7 @@ import sys
 
 import numpy as np
 import pytest
-from _serve import Proc, sensorium
-from test_multiprocess import CONTROLLERS, REPO, start_server
+from test_multiprocess import REPO, run_paused
 from test_supervisor import A, Live
 
 from sensorium.schemas.wire import ErrorCode
@@ -153,17 +152,7 @@ def test_a_moved_solid_can_be_removed():
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
 def test_a_webots_supervisor_controller_removes_a_solid_and_a_light(tmp_path):
     """tests/controllers/supervisor_remove.py through ``sensorium serve``: ``node.remove()`` as in Webots."""
-    server = start_server(WORLD, tmp_path, "--mode", "pause")
-    try:
-        ctl = Proc(sensorium("controller", str(CONTROLLERS / "supervisor_remove.py"), "--url", server.url("boss")))
-        try:
-            server.wait_attached({"boss"})
-            server.conn.call("set_mode", {"mode": "fast"})
-            assert ctl.wait(120) == 0, ctl.stderr()
-        finally:
-            ctl.kill()
-    finally:
-        server.stop()
+    ctl = run_paused(WORLD, tmp_path, "supervisor_remove.py", "boss")
     out = json.loads(ctl.out[-1])
     assert out["before"] == [pytest.approx(1.0, abs=1e-9), pytest.approx(7.0), 7]
     assert out["after"] == [pytest.approx(3.0, abs=1e-9), pytest.approx(3.0), 5]

@@ -12,8 +12,7 @@ import math
 import sys
 
 import pytest
-from _serve import Proc, sensorium
-from test_multiprocess import CONTROLLERS, REPO, start_server
+from test_multiprocess import REPO, run_paused
 from test_supervisor import A, Live
 
 from sensorium.schemas.wire import ErrorCode
@@ -157,17 +156,7 @@ def test_velocity_in_a_nue_world_is_in_world_axes():
 
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
 def test_a_webots_supervisor_controller_walks_the_tree_switches_a_light_and_reads_velocities(tmp_path):
-    server = start_server(WORLD, tmp_path, "--mode", "pause")
-    try:
-        ctl = Proc(sensorium("controller", str(CONTROLLERS / "supervisor_scene.py"), "--url", server.url("judge")))
-        try:
-            server.wait_attached({"judge"})
-            server.conn.call("set_mode", {"mode": "fast"})
-            assert ctl.wait(120) == 0, ctl.stderr()
-        finally:
-            ctl.kill()
-    finally:
-        server.stop()
+    ctl = run_paused(WORLD, tmp_path, "supervisor_scene.py", "judge")
     out = {d["tag"]: d for d in (json.loads(line) for line in ctl.out)}
     tree, lights, vel = out["tree"], out["lights"], out["velocity"]
     assert tree["root"] == [0, "Group", True, True] and tree["count"] == 5 and tree["last"] == "DirectionalLight"

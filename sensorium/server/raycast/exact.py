@@ -414,10 +414,7 @@ def _analytic_one(code: int, p, d, r: float, h: float, lo: float, hi: float):
                 for t in _roots_one(a3, px * dx + py * dy + qz * dz, px * px + py * py + qz * qz - r * r,
                                     a3 * r * r - (cx * cx + cy * cy + cz * cz)):
                     cands.append(t if t < _INF and sign * (pz + t * dz) >= h - tol else _INF)
-    best, k = _INF, -1
-    for j, t in enumerate(cands):   # first of equal candidates, like argmin
-        if lo <= t <= hi and t < best:
-            best, k = t, j
+    best, k = _nearest(cands, lo, hi)
     if k < 0:
         return _INF, (0.0, 0.0, 0.0)
     nx, ny, nz = px + best * dx, py + best * dy, pz + best * dz
@@ -430,6 +427,16 @@ def _analytic_one(code: int, p, d, r: float, h: float, lo: float, hi: float):
         nz -= nz if k < 2 else (h if k < 4 else -h)
     norm = math.sqrt(nx * nx + ny * ny + nz * nz)
     return best, (nx / norm, ny / norm, nz / norm)
+
+
+def _nearest(cands: list[float], lo: float, hi: float) -> tuple[float, int]:
+    """(the nearest candidate in [lo, hi], its index; the first of equal ones, like argmin), or
+    (inf, -1) when none is."""
+    best, k = _INF, -1
+    for j, t in enumerate(cands):
+        if lo <= t <= hi and t < best:
+            best, k = t, j
+    return best, k
 
 
 def _cone_one(px, py, pz, dx, dy, dz, r: float, h: float, tol: float, lo: float, hi: float):
@@ -459,10 +466,7 @@ def _cone_one(px, py, pz, dx, dy, dz, r: float, h: float, tol: float, lo: float,
         bx, by = px + t * dx, py + t * dy
         if bx * bx + by * by <= r * r + tol * r:
             cands[2] = t
-    best, j = _INF, -1
-    for i, t in enumerate(cands):   # first of equal candidates, like argmin
-        if lo <= t <= hi and t < best:
-            best, j = t, i
+    best, j = _nearest(cands, lo, hi)
     if j < 0:
         return _INF, (0.0, 0.0, 0.0)
     if j == 2:
