@@ -5,7 +5,8 @@ runs those, ``pytest -m "slow or not slow"`` (or ``SENSORIUM_SLOW=1``) everythin
 A test is slow when its module runs servers and controllers as processes (``SLOW_MODULES``), when
 it starts a subprocess itself or through a helper or fixture of its module (found in the module's
 source: a function or class that mentions ``subprocess``/``Popen`` or starts one with tests/_serve.py
-— ``Proc(``, ``Served(``, ``serve(`` — or calls one that does), or when it is listed in
+— ``Proc(``, ``Served(``, ``serve(`` — or test_multiprocess's ``start_server(``/``run_paused(``, or
+calls one that does), or when it is listed in
 ``SLOW_TESTS`` (long single-process runs, worker pools).
 """
 
@@ -29,7 +30,8 @@ SLOW_TESTS = {
 }
 
 
-SPAWNS = re.compile(r"subprocess|Popen|\b(?:Proc|Served|serve)\(")     # tests/_serve.py starts processes
+# tests/_serve.py's helpers and test_multiprocess's (imported by other modules) start processes
+SPAWNS = re.compile(r"subprocess|Popen|\b(?:Proc|Served|serve|start_server|run_paused)\(")
 
 
 @cache
