@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import threading
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -89,33 +90,47 @@ def test_a_stalled_viewer_never_blocks_record(bridge):
 
 
 
-def test_moved_solid_resends_the_scene_to_everyone():
+@contextmanager
+def scene_sends(sim):
+    """A Foxglove bridge on ``sim``'s core and transport whose scene sends are recorded, not sent:
+    yields (bridge, pass_, sent). ``pass_(k)`` runs the transport loop's pass (demand applied,
+    poses and removals noted), then waits until ``k`` sends are recorded: a subscriber's id for
+    its own copy, None for a broadcast."""
     from sensorium.server.daemon.services import Core
     from sensorium.server.daemon.transport import Transport
-    from sensorium.server.sim.simulation import Simulation
 
-    sim = Simulation.from_file(WORLD, precision="fast")
-    core = Core(sim)
-    transport = Transport(core, "tcp://127.0.0.1:0", "tcp://127.0.0.1:0")
-    bridge = FoxgloveBridge.for_core(core, transport, "127.0.0.1", 0)
-    try:
-        sent: list[int | None] = []
-        bridge._work = lambda: sent.extend(bridge._scene_for) or bridge._scene_for.clear()  # record, do not send
-        before = bridge.scene_bytes()
-        bridge._subscribed(7, "/scene", +1)
-        transport.hooks[0]()                           # the loop's pass: demand applied, poses noted
-        sim.set_solid_pose("wall", (1.5, 0.0, 0.25))
+    transport = Transport(Core(sim), "tcp://127.0.0.1:0", "tcp://127.0.0.1:0")
+    bridge = FoxgloveBridge.for_core(transport.core, transport, "127.0.0.1", 0)
+    sent: list[int | None] = []
+    bridge._work = lambda: sent.extend(bridge._scene_for) or bridge._scene_for.clear()  # record, do not send
+
+    def pass_(k: int = 0) -> None:
         transport.hooks[0]()
         deadline = time.monotonic() + 30
-        while len(sent) < 2 and time.monotonic() < deadline:
+        while len(sent) < k and time.monotonic() < deadline:
             time.sleep(0.01)
-        assert sent == [7, None]                       # the subscriber's own copy, then a broadcast
-        assert bridge.scene_bytes() != before          # the wall is drawn at its new place
-        transport.hooks[0]()                           # pump queues synchronously, so this is final
-        assert sent == [7, None] and not bridge._scene_for   # nothing moved since: nothing resent
+
+    try:
+        yield bridge, pass_, sent
     finally:
         bridge.close()
         transport.close()
+
+
+def test_moved_solid_resends_the_scene_to_everyone():
+    from sensorium.server.sim.simulation import Simulation
+
+    sim = Simulation.from_file(WORLD, precision="fast")
+    with scene_sends(sim) as (bridge, pass_, sent):
+        before = bridge.scene_bytes()
+        bridge._subscribed(7, "/scene", +1)
+        pass_()
+        sim.set_solid_pose("wall", (1.5, 0.0, 0.25))
+        pass_(2)
+        assert sent == [7, None]                       # the subscriber's own copy, then a broadcast
+        assert bridge.scene_bytes() != before          # the wall is drawn at its new place
+        pass_()                                        # pump queues synchronously, so this is final
+        assert sent == [7, None] and not bridge._scene_for   # nothing moved since: nothing resent
 
 
 
