@@ -317,3 +317,48 @@ def test_one_floor_in_c_is_the_numpy_plane_pass_bit_for_bit(variant, floor):
     got = planes_module.cast_planes(pl, eng._epoch, Oc, Dc, 0.0, np.inf, -1, 1e-9, False, native=True)
     assert got[0][0] == 1.0 and got[0][1] == np.inf
     assert got[2][0].tolist() == [0.0, 0.0, side] and got[1][1] == -1
+
+
+def test_a_large_fast_cast_is_split_over_threads_inside_the_c_pass(monkeypatch):
+    """A FAST cast of >= MIN_RAYS rays through the packet path is one C call that traces parts of
+    the batch on `threads` POSIX threads (no Python blocks around it): 16,421 rays (not a whole
+    number of packets), many origins and one origin, with normals and without, give the same bits
+    on 1, 2, 3 and 5 threads, and the call asked for them."""
+    if packets.library() is None:
+        pytest.skip(f"packet path off: {packets.status()}")
+    lib = packets.library()
+    asked: list[tuple[int, int]] = []
+    real = lib.sp_fast_pass
+
+    def spy(*args):
+        asked.append((args[2], args[-1]))      # (rays, threads)
+        return real(*args)
+
+    monkeypatch.setattr(lib, "sp_fast_pass", spy)
+    rng = np.random.default_rng(11)
+    n = blocks.MIN_RAYS + 37
+    D = rng.normal(size=(n, 3))
+    D /= np.linalg.norm(D, axis=1)[:, None]
+    O_many = rng.uniform(-2.5, 2.5, (n, 3)) * [1, 1, 0.3] + [0, 0, 0.5]
+    O_one = np.broadcast_to(np.array([0.2, -0.1, 0.4]), (n, 3))
+    D_wall = D * [0.2, 0.0, 0.2] + [0.0, 1.0, 0.0]      # toward the long wall at y = 3: most rays hit it
+    D_wall /= np.linalg.norm(D_wall, axis=1)[:, None]
+    D_wall[::4] = D[::4]                                  # and a quarter anywhere: some miss
+    O_wall = np.broadcast_to(np.array([0.0, 2.0, 1.0]), (n, 3))
+    results = {}
+    for threads in (1, 2, 3, 5):
+        eng, _ = _scene(Precision.FAST)
+        eng.threads = threads
+        asked.clear()
+        out = []
+        for O, DD in ((O_many, D), (O_one, D), (O_wall, D_wall)):
+            h = eng.cast(O, DD, 0.0, 6.0, kind=RayKind.VISUAL)
+            out += [h.distance, h.normal, h.shape]
+            out.append(eng.cast(O, DD, 0.0, 6.0, kind=RayKind.VISUAL, distance_only=True).distance)
+        assert [t for m, t in asked if m == n] == [threads] * 6   # the static tier's passes: one call each
+        results[threads] = out
+    assert np.isfinite(results[1][0]).mean() > 0.3
+    assert 0.5 < np.isfinite(results[1][8]).mean() < 1.0     # most hit (the C pass's whole-array judging)
+    for threads, out in results.items():
+        for a, b in zip(results[1], out):
+            assert a.tobytes() == b.tobytes(), threads

@@ -71,6 +71,11 @@ def _every_core() -> None:
             pass
 
 
+def in_block() -> bool:
+    """Whether the calling thread is a block worker (a nested split runs on it alone)."""
+    return threading.current_thread().name.startswith(_PREFIX)
+
+
 def _executor(workers: int) -> ThreadPoolExecutor:
     global _pool, _workers, _pid
     with _lock:
@@ -92,7 +97,7 @@ def run(fn: Callable[[B], T], blocks: Sequence[B], threads: int, first: Callable
     exception is raised here. Called from a pool worker (a nested split), the blocks run on that
     thread. ``first``: work the calling thread does before it takes a block, while the workers start
     on theirs (blocks that need its result wait for it themselves); its exception is raised here."""
-    if threads <= 1 or len(blocks) <= 1 or threading.current_thread().name.startswith(_PREFIX):
+    if threads <= 1 or len(blocks) <= 1 or in_block():
         if first is not None:
             first()
         return [fn(b) for b in blocks]

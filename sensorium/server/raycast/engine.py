@@ -25,7 +25,10 @@ Speed (measured in ``sensorium bench``, peers section)
 * Threads: a cast of >= ``blocks.MIN_RAYS`` rays runs its planes and static tier in blocks on
   ``RayEngine.threads`` threads (default: the cores this process may use; ``SENSORIUM_THREADS``),
   and so do a lidar's Mount pairs (listed on the calling thread while the workers start on their
-  blocks); no ray's answer depends on its block or on the other rays of
+  blocks). A FAST cast of up to ``_CHUNK`` rays through the packet path is one C pass instead,
+  which traces parts of the batch on POSIX threads itself (packets.c, ``sp_fast_pass``): Python
+  blocks would each repeat the cast's Python stages (measured: LidarAvoid x64's 23,040 beams were
+  slower on 2 threads than on 1 that way). No ray's answer depends on its block or on the other rays of
   its batch (world-to-frame rotations are summed in one fixed order, never by BLAS; a curved
   shape's frame as einsum sums it, a sum of zeros being +0.0, whether one shape or several are
   refined together), so the bits are the same on any number of threads.  No BLAS call runs beside
@@ -443,7 +446,10 @@ class RayEngine(TierTracer):
         # costs as much as a few numpy calls, so the helpers do not open their own)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             threads = self.threads
-            if n <= _CHUNK and (threads <= 1 or n < MIN_RAYS):   # (split's answer: one part)
+            # one part: split's answer, or a FAST cast through the packet path, whose C pass splits
+            # its rays over the threads itself (no block's Python around it)
+            if n <= _CHUNK and (threads <= 1 or n < MIN_RAYS or (self._precision is Precision.FAST and self.native
+                                                                   and packets.library() is not None)):
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
                                   directions32, coherent, box, rows)
             parts = split(n, threads, _CHUNK)

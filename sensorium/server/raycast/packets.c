@@ -12,6 +12,7 @@
  * releases the GIL, so two threads trace two halves of a batch at once.
  */
 #include <dlfcn.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -638,12 +639,34 @@ void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double*
  * a lidar's shifted origins; o1 NULL too: the rows of Ot rounded to float32, + start32 * d when
  * `shifted`, numpy's astype and sum), the far limits (NULL: far_value, or none when `far_none`), the tier
  * frame origins Ot (NULL: `origin`), start, lim, the owner excluded (`has_excl`). */
-size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent, const float* o32, size_t o_stride,
-                    const float* o1, int shifted, float start32, const float* d32, const float* far, float far_value,
-                    int far_none, const double* Ot, size_t ot_stride, const double* origin, const double* D,
-                    const double* start, double start_value, const double* lim, double lim_value, int lim_min,
-                    const int64_t* excl, int64_t excl_value, int has_excl, int distance_only, double* t_out,
-                    int64_t* s_out, double* n_out, uint8_t* special) {
+/* One FAST pass's arguments (sp_fast_pass), shared by the threads that trace parts of it. */
+struct fast_job {
+  void* scene; const struct sp_tier* T; size_t m; int coherent; const float* o32; size_t o_stride;
+  const float* o1; int shifted; float start32; const float* d32; const float* far; float far_value;
+  int far_none; const double* Ot; size_t ot_stride; const double* origin; const double* D;
+  const double* start; double start_value; const double* lim; double lim_value; int lim_min;
+  const int64_t* excl; int64_t excl_value; int has_excl; int distance_only; double* t_out;
+  int64_t* s_out; double* n_out; uint8_t* special;
+};
+
+/* A part of a FAST pass: the rays [a0, a1) (a0 a multiple of 16, so every packet holds the rays it
+ * holds in one pass over all: Embree's lanes are independent anyway); its number of hits. */
+struct fast_part { const struct fast_job* job; size_t a0, a1, n_hit; };
+
+static void* fast_range(void* arg) {
+  struct fast_part* P = arg;
+  const struct fast_job* J = P->job;
+  void* scene = J->scene; const struct sp_tier* T = J->T; const int coherent = J->coherent;
+  const float* o32 = J->o32; const size_t o_stride = J->o_stride; const float* o1 = J->o1;
+  const int shifted = J->shifted; const float start32 = J->start32; const float* d32 = J->d32;
+  const float* far = J->far; const float far_value = J->far_value; const int far_none = J->far_none;
+  const double* Ot = J->Ot; const size_t ot_stride = J->ot_stride; const double* origin = J->origin;
+  const double* D = J->D; const double* start = J->start; const double start_value = J->start_value;
+  const double* lim = J->lim; const double lim_value = J->lim_value; const int lim_min = J->lim_min;
+  const int64_t* excl = J->excl; const int64_t excl_value = J->excl_value; const int has_excl = J->has_excl;
+  const int distance_only = J->distance_only; double* t_out = J->t_out; int64_t* s_out = J->s_out;
+  double* n_out = J->n_out; uint8_t* special = J->special;
+  const size_t m = P->a1;
   struct ray_hit16 r;
   struct intersect_args args;
   packet_init(&r, &args, coherent);
@@ -652,7 +675,7 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
   const float eps32 = (float)T->eps;
   const float graze = (float)(1e-5 * T->ng_max);
   const float far1 = far_none ? 1e37f : far_value;
-  for (size_t a = 0; a < m; a += 16) {
+  for (size_t a = P->a0; a < m; a += 16) {
     int mk = m - a < 16 ? (int)(m - a) : 16;
     for (int k = 0; k < 16; k++) {
       size_t i = a + (k < mk ? (size_t)k : 0);
@@ -715,6 +738,45 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
       if (has_excl && T->tri_owner[tri] == (excl ? excl[i] : excl_value)) sp = 1;
       special[i] = (uint8_t)sp;
     }
+  }
+  P->n_hit = n_hit;
+  return NULL;
+}
+
+/* FAST: trace.py's _trace_fast from the Embree call to its judging (see above the struct). With
+ * `threads` > 1 and enough rays, the rays are split in `threads` parts traced side by side (POSIX
+ * threads; the caller takes the first part): every ray's answer is the one a single pass gives. */
+size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent, const float* o32, size_t o_stride,
+                    const float* o1, int shifted, float start32, const float* d32, const float* far, float far_value,
+                    int far_none, const double* Ot, size_t ot_stride, const double* origin, const double* D,
+                    const double* start, double start_value, const double* lim, double lim_value, int lim_min,
+                    const int64_t* excl, int64_t excl_value, int has_excl, int distance_only, double* t_out,
+                    int64_t* s_out, double* n_out, uint8_t* special, int threads) {
+  struct fast_job J = {scene, T, m, coherent, o32, o_stride, o1, shifted, start32, d32, far, far_value, far_none, Ot,
+                       ot_stride, origin, D, start, start_value, lim, lim_value, lim_min, excl, excl_value, has_excl,
+                       distance_only, t_out, s_out, n_out, special};
+  enum { MAX_THREADS = 64, MIN_PART = 4096 };
+  if (threads > MAX_THREADS) threads = MAX_THREADS;
+  if (threads > 1 && m / (size_t)threads < MIN_PART) threads = (int)(m / MIN_PART);
+  if (threads < 1) threads = 1;
+  struct fast_part parts[MAX_THREADS];
+  pthread_t tid[MAX_THREADS];
+  int started[MAX_THREADS];
+  size_t packs = (m + 15) / 16;
+  for (int k = 0; k < threads; k++) {
+    parts[k].job = &J;
+    parts[k].a0 = 16 * (packs * (size_t)k / (size_t)threads);
+    parts[k].a1 = k + 1 == threads ? m : 16 * (packs * (size_t)(k + 1) / (size_t)threads);
+    parts[k].n_hit = 0;
+  }
+  for (int k = 1; k < threads; k++)   /* a thread that cannot start: its part is traced here below */
+    started[k] = pthread_create(&tid[k], NULL, fast_range, &parts[k]) == 0;
+  fast_range(&parts[0]);
+  size_t n_hit = parts[0].n_hit;
+  for (int k = 1; k < threads; k++) {
+    if (started[k]) pthread_join(tid[k], NULL);
+    else fast_range(&parts[k]);
+    n_hit += parts[k].n_hit;
   }
   if (!distance_only && 2 * n_hit >= m) {   /* the whole-array judging's misses: -0.0 normals */
     for (size_t i = 0; i < m; i++)

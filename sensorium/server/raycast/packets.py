@@ -95,7 +95,8 @@ def _compile(out: Path) -> str | None:
     fd, tmp = tempfile.mkstemp(suffix=".so", dir=out.parent)
     os.close(fd)
     # no fused multiply-adds and no fast-math: the judging in C rounds every operation as numpy does
-    cmd = [*cc.split(), "-O2", "-ffp-contract=off", "-fno-fast-math", "-shared", "-fPIC", "-o", tmp, str(_SOURCE), "-lm"]
+    cmd = [*cc.split(), "-O2", "-ffp-contract=off", "-fno-fast-math", "-shared", "-fPIC", "-pthread", "-o", tmp,
+           str(_SOURCE), "-lm"]
     if sys.platform.startswith("linux"):
         cmd.append("-ldl")
     try:
@@ -161,7 +162,7 @@ def _load() -> None:
     lib.sp_fast_pass.restype = sz
     f, i64 = ctypes.c_float, ctypes.c_int64
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
-                                 i, i, vp, vp, vp, vp]
+                                 i, i, vp, vp, vp, vp, i]
     lib.sp_lidar_scan.restype = None
     lib.sp_lidar_scan.argtypes = [sz, vp, vp, d, f, vp, vp, vp, vp, vp]
     lib.sp_to_frame.restype = None

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from sensorium.server.raycast import packets
+from sensorium.server.raycast.blocks import MIN_RAYS, in_block
 from sensorium.server.raycast.exact import (
     _BARY_TOL,
     _F32,
@@ -73,6 +74,7 @@ class TierTracer(Refiner):
 
     counters: dict[str, int]
     native: bool   # judge (and in EXACT refine) hits in packets.c where the packet path is on
+    threads: int   # a FAST pass of >= MIN_RAYS rays is split over this many threads inside packets.c
 
     def _run(self, tier: _Tier, o32, d32, far, robust: bool, coherent: bool = False):
         """One Embree call; ``coherent``: rays from one origin (a FAST lidar scan), traced as coherent
@@ -323,7 +325,8 @@ class TierTracer(Refiner):
             0.0 if st_arr is not None else start, None if lim_arr is None else lim_arr.ctypes.data,
             0.0 if lim_arr is not None else lim, 1 if isinstance(lim, np.ndarray) or lim != _INF else 0,
             None if ex_arr is None else ex_arr.ctypes.data, 0 if ex_arr is not None or not has_excl else excl,
-            1 if has_excl else 0, 1 if distance_only else 0, p_t, p_s, p_n, p_sp)
+            1 if has_excl else 0, 1 if distance_only else 0, p_t, p_s, p_n, p_sp,
+            self.threads if m >= MIN_RAYS and not in_block() else 1)
         if small:
             t = sc.t[:m].copy()
             shape = None if distance_only else sc.s[:m].copy()
