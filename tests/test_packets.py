@@ -362,3 +362,13 @@ def test_a_large_fast_cast_is_split_over_threads_inside_the_c_pass(monkeypatch):
     for threads, out in results.items():
         for a, b in zip(results[1], out):
             assert a.tobytes() == b.tobytes(), threads
+
+
+def test_work_inside_a_block_knows_it_is_in_a_block():
+    """A block's work (on a pool worker or on run()'s calling thread) sees in_block(), so a FAST
+    pass inside it traces on that thread alone (no threads of its own beside the blocks); outside
+    run() it does not."""
+    assert not blocks.in_block()
+    seen = blocks.run(lambda k: blocks.in_block(), list(range(6)), 2)
+    assert seen == [True] * 6
+    assert not blocks.in_block()

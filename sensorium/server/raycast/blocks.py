@@ -71,9 +71,13 @@ def _every_core() -> None:
             pass
 
 
+_local = threading.local()   # .working: the calling thread of run() is taking blocks
+
+
 def in_block() -> bool:
-    """Whether the calling thread is a block worker (a nested split runs on it alone)."""
-    return threading.current_thread().name.startswith(_PREFIX)
+    """Whether the calling thread is tracing a block (a pool worker, or run()'s caller while it
+    takes blocks beside them): work nested in a block stays on that thread."""
+    return getattr(_local, "working", False) or threading.current_thread().name.startswith(_PREFIX)
 
 
 def _executor(workers: int) -> ThreadPoolExecutor:
@@ -133,7 +137,11 @@ def run(fn: Callable[[B], T], blocks: Sequence[B], threads: int, first: Callable
         except BaseException as exc:  # noqa: BLE001 - raised below, once the blocks taken are done
             with cond:
                 errors.append(exc)
-    work()
+    _local.working = True
+    try:
+        work()
+    finally:
+        _local.working = False
     with cond:
         cond.wait_for(lambda: state["busy"] == 0)
     if errors:
