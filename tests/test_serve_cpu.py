@@ -107,3 +107,26 @@ def test_block_workers_started_from_a_pinned_thread_use_every_cpu(monkeypatch):
 
 if __name__ == "__main__":
     sys.exit(pytest.main([__file__, "-v"]))
+
+
+@needs_two
+def test_the_packet_helpers_threads_keep_every_cpu_of_a_pinned_caller():
+    """A thread pinned to one CPU (the loop of `serve --cpu`) that starts a FAST pass on several
+    threads: the pass's threads run on every CPU the process started with, as the block workers do
+    (read back from a thread the helper starts the same way)."""
+    from sensorium.server.raycast import packets
+
+    if packets.library() is None:
+        pytest.skip(f"packet path off: {packets.status()}")
+    seen: dict[str, int] = {}
+
+    def pinned() -> None:
+        os.sched_setaffinity(0, {linux_cpus[-1]})
+        seen["caller"] = len(os.sched_getaffinity(0))
+        seen["pass"] = packets.library().sp_probe_worker_cpus()
+
+    t = threading.Thread(target=pinned)
+    t.start()
+    t.join(timeout=60)
+    assert seen == {"caller": 1, "pass": len(blocks.process_cpus())}
+    assert len(blocks.process_cpus()) == len(linux_cpus) >= 2

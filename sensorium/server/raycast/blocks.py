@@ -61,6 +61,12 @@ def split(n: int, threads: int, chunk: int) -> list[slice]:
 _CPUS = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else None
 
 
+def process_cpus() -> list[int]:
+    """The CPUs of the process as it started (empty where the platform does not say): where block
+    workers and the packet helper's threads run, whichever CPU the calling thread was pinned to."""
+    return sorted(_CPUS or ())
+
+
 def _every_core() -> None:
     """A block worker runs on every CPU of the process, even when the thread that started the pool
     was pinned to one (``serve --cpu`` pins the server's loop, whose casts start the pool)."""

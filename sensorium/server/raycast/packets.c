@@ -11,6 +11,10 @@
  * below follow Embree 4's public API, rtcore_*.h). No Python API: called through ctypes, which
  * releases the GIL, so two threads trace two halves of a batch at once.
  */
+#ifdef __linux__
+#define _GNU_SOURCE   /* pthread_setaffinity_np: the pass's threads run on the process's CPUs */
+#include <sched.h>
+#endif
 #include <dlfcn.h>
 #include <pthread.h>
 #include <stddef.h>
@@ -743,6 +747,57 @@ static void* fast_range(void* arg) {
   return NULL;
 }
 
+#ifdef __linux__
+static cpu_set_t worker_cpus;
+static int worker_cpus_set = 0;
+#endif
+
+/* The CPUs a pass's threads run on (the process's CPUs as it started: a server that pinned its
+ * loop thread to one CPU, `serve --cpu`, still traces its large casts on every CPU); n = 0: the
+ * caller's. Returns 1 where threads can be placed (Linux), else 0. */
+int sp_set_worker_cpus(size_t n, const int32_t* cpus) {
+#ifdef __linux__
+  CPU_ZERO(&worker_cpus);
+  for (size_t k = 0; k < n; k++)
+    if (cpus[k] >= 0 && cpus[k] < CPU_SETSIZE) CPU_SET(cpus[k], &worker_cpus);
+  worker_cpus_set = n > 0;
+  return 1;
+#else
+  (void)n; (void)cpus;
+  return 0;
+#endif
+}
+
+static void place_thread(void) {
+#ifdef __linux__
+  if (worker_cpus_set) pthread_setaffinity_np(pthread_self(), sizeof worker_cpus, &worker_cpus);
+#endif
+}
+
+static void* fast_thread(void* arg) {
+  place_thread();
+  return fast_range(arg);
+}
+
+static void* probe_thread(void* arg) {
+  place_thread();
+#ifdef __linux__
+  cpu_set_t got;
+  if (pthread_getaffinity_np(pthread_self(), sizeof got, &got) == 0) *(int*)arg = CPU_COUNT(&got);
+#endif
+  return NULL;
+}
+
+/* The number of CPUs a pass's thread may run on, read back in a thread started as the pass starts
+ * them (tests); -1 where unknown. */
+int sp_probe_worker_cpus(void) {
+  int n = -1;
+  pthread_t t;
+  if (pthread_create(&t, NULL, probe_thread, &n) != 0) return -1;
+  pthread_join(t, NULL);
+  return n;
+}
+
 /* FAST: trace.py's _trace_fast from the Embree call to its judging (see above the struct). With
  * `threads` > 1 and enough rays, the rays are split in `threads` parts traced side by side (POSIX
  * threads; the caller takes the first part): every ray's answer is the one a single pass gives. */
@@ -770,7 +825,7 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
     parts[k].n_hit = 0;
   }
   for (int k = 1; k < threads; k++)   /* a thread that cannot start: its part is traced here below */
-    started[k] = pthread_create(&tid[k], NULL, fast_range, &parts[k]) == 0;
+    started[k] = pthread_create(&tid[k], NULL, fast_thread, &parts[k]) == 0;
   fast_range(&parts[0]);
   size_t n_hit = parts[0].n_hit;
   for (int k = 1; k < threads; k++) {

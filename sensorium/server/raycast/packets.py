@@ -163,6 +163,12 @@ def _load() -> None:
     f, i64 = ctypes.c_float, ctypes.c_int64
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
                                  i, i, vp, vp, vp, vp, i]
+    lib.sp_set_worker_cpus.restype = i
+    lib.sp_set_worker_cpus.argtypes = [sz, vp]
+    lib.sp_probe_worker_cpus.restype = i
+    lib.sp_probe_worker_cpus.argtypes = []
+    cpus = blocks.process_cpus()        # sp_fast_pass's threads keep them, as the block workers do
+    lib.sp_set_worker_cpus(len(cpus), (ctypes.c_int32 * max(1, len(cpus)))(*cpus))
     lib.sp_lidar_scan.restype = None
     lib.sp_lidar_scan.argtypes = [sz, vp, vp, d, f, vp, vp, vp, vp, vp]
     lib.sp_to_frame.restype = None
