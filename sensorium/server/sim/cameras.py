@@ -387,7 +387,8 @@ class Camera(Device):
             hit = np.isfinite(t)
             miss = (~hit).nonzero()[0]
             if len(miss):
-                out[rows[miss]] += weight[rows[miss], None] * self._background
+                rm = rows[miss]
+                shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], self._background))
             k = hit.nonzero()[0]
             if len(k) == 0:
                 break
@@ -406,21 +407,31 @@ class Camera(Device):
             seen = (~leaving).nonzero()[0]
             if len(seen):
                 kk, rr = k[seen], r[seen]
-                Dk = D[kk] if len(kk) < len(D) else D
-                P = origin + t[kk, None] * Dk
-                N = normal[kk] if len(kk) < len(D) else normal
+                whole = len(kk) == len(D)
+                Dk = D if whole else shading.take_rows(D, kk)
+                tk = t if whole else t.take(kk)
+                P = np.empty((len(kk), 3))          # origin + t D, column by column
+                for ch in range(3):
+                    np.multiply(tk, Dk[:, ch], out=P[:, ch])
+                    P[:, ch] += origin[ch]
+                N = normal if whole else shading.take_rows(normal, kk)
                 back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
                 if back.any():         # facing the camera
-                    N = np.where(back[:, None], -N, N)
-                albedo = scene.surface_colors(s[seen], np.broadcast_to(origin, (len(kk), 3)), Dk, t[kk])
+                    bk = back.nonzero()[0]
+                    N = N.copy() if whole else N
+                    N[bk] = np.negative(shading.take_rows(N, bk))
+                albedo = scene.surface_colors(s[seen], np.broadcast_to(origin, (len(kk), 3)), Dk, tk)
                 lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
                 L = shading.radiance(P, N, albedo, lights, lit)
                 if scene.fog is not None:     # Webots mixes each surface (not the sky) with the fog colour
-                    L = shading.fog(L, t[kk], *scene.fog)
+                    L = shading.fog(L, tk, *scene.fog)
                 last = layer == MAX_LAYERS
-                a = np.where(last, 0.0, tau[seen])[:, None]
-                out[rr] += weight[rr, None] * (1.0 - a) * L
-                weight[rr] *= a[:, 0]
+                a = np.where(last, 0.0, tau[seen])
+                share = weight[rr] * (1.0 - a)
+                for ch in range(3):    # (weight (1 - a)) L, column by column
+                    L[:, ch] *= share
+                shading.add_to_rows(out, rr, L)
+                weight[rr] *= a
             # the rays that go on: through a transparent surface (entering or leaving it)
             go = clear & (layer < MAX_LAYERS)
             if not go.any():
