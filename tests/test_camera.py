@@ -80,6 +80,32 @@ def test_a_flat_wall_lit_by_a_point_light_has_the_light_models_colour(precision)
     assert len(np.unique(want[..., 0])) > 10           # a gradient, not a constant
 
 
+def test_a_large_image_is_shaded_in_blocks_on_threads_with_the_same_closed_form_pixels():
+    # 320 x 240 = 76,800 pixels: radiance in blocks of shading.BLOCK rows, on 1 or 2 threads (the
+    # blocks side by side): the closed-form wall of the test above, and the same bytes either way
+    from sensorium.server.devices import shading
+
+    cam = {"width": 320, "height": 240, "field_of_view": 1.0}
+    assert cam["width"] * cam["height"] > 2 * shading.BLOCK
+    light = {"type": "PointLight", "location": [1.0, 0.3, -0.2], "intensity": 1.5, "attenuation": [0, 0, 1],
+             "color": [1.0, 0.9, 0.8]}
+    d = rays(cam)[0]
+    P = d * (1.95 / d[..., :1])
+    v = np.array(light["location"]) - P
+    dist = np.linalg.norm(v, axis=-1)
+    want = expected_bytes(ALBEDO * (1.5 * (-v[..., 0] / dist) / dist**2)[..., None] * np.array(light["color"]))
+    images = []
+    for threads in (1, 2):
+        sim = Simulation(world(cam, [WALL], [light]), precision="exact")
+        sim.scene.engine.threads = threads
+        camera = sim.device("r/cam")
+        camera.enable(16)
+        sim.run(1)
+        images.append(camera.image.copy())
+    np.testing.assert_array_equal(rgb(images[0]), want)
+    assert images[0].tobytes() == images[1].tobytes()
+
+
 def test_spot_light_cut_off_and_ambient():
     cam = {"width": 31, "height": 31, "field_of_view": 1.2}
     spot = {"type": "SpotLight", "location": [0.5, 0.0, 0.0], "direction": [1, 0, 0], "intensity": 2.0,

