@@ -110,3 +110,32 @@ def test_replay_says_interrupted_after_ctrl_c_not_finished(tmp_path):
     lines = rp.stderr().splitlines()
     assert any(line.startswith("sensorium: replay interrupted after ") for line in lines), lines
     assert not any("replay finished" in line for line in lines), lines
+
+
+def test_version_says_which_compiled_paths_are_active(monkeypatch, capsys):
+    import pytest
+
+    from sensorium import __version__
+    from sensorium.cli import main
+    from sensorium.server.daemon import steppath
+    from sensorium.server.raycast import packets
+
+    monkeypatch.setattr(packets, "_state", {})
+    monkeypatch.setenv("SENSORIUM_PACKETS", "0")
+    monkeypatch.setattr(steppath, "_native", (None, "the C step path is not built (no module)"))
+    with pytest.raises(SystemExit) as done:
+        main(["--version"])
+    assert done.value.code == 0
+    assert capsys.readouterr().out.splitlines() == [
+        f"sensorium {__version__}", "step path: Python (the C step path is not built (no module))",
+        "ray traversal: embreex, one ray per call (off (SENSORIUM_PACKETS=0))"]
+    # and what this installation has (the C step path: setup.py build_ext; packets.c: a compiler)
+    monkeypatch.setattr(packets, "_state", {})
+    monkeypatch.delenv("SENSORIUM_PACKETS")
+    monkeypatch.setattr(steppath, "_native", None)
+    gate, why = steppath.native_gate_class()
+    with pytest.raises(SystemExit):
+        main(["--version"])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == ("step path: C (sensorium.server.daemon._steppath)" if gate is not None else f"step path: Python ({why})")
+    assert lines[2] == f"ray traversal: {packets.status()}"

@@ -181,6 +181,37 @@ def test_render_draws_the_robot_and_the_light_where_they_are():
     assert tuple(img2[int(row) + 1, int(col) - 1]) != (0, 255, 0)
 
 
+def test_render_draws_a_moved_solid_where_it_is_and_a_removed_one_no_more():
+    w = room().model_dump(mode="json", exclude_none=True)
+    w["lights"] = []
+    grey, red, blue = (0.5, 0.5, 0.5), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)
+    w["solids"] += [{"name": "floor", "geometry": {"type": "plane", "size": [2.0, 2.0]},
+                     "appearance": {"base_color": list(grey)}},
+                    {"name": "crate", "pose": {"translation": [0.5, -0.5, 0.05]},
+                     "geometry": {"type": "box", "size": [0.2, 0.2, 0.1]}, "appearance": {"base_color": list(red)}},
+                    {"name": "block", "pose": {"translation": [-0.5, -0.5, 0.05]},
+                     "geometry": {"type": "box", "size": [0.2, 0.2, 0.1]}, "appearance": {"base_color": list(blue)}}]
+    env = SensoriumEnv(wm.World.model_validate(w), Task(observations=[]), render_mode="rgb_array", render_size=200)
+    env.reset(seed=0)
+    floor, crate, block = (128, 128, 128), (255, 0, 0), (0, 0, 255)
+
+    def at(img, x, y):
+        col, row = env._renderer._px(np.array([[x, y]]))[0]
+        return tuple(int(v) for v in img[int(row), int(col)])
+
+    img = env.render()
+    assert at(img, 0.5, -0.5) == crate and at(img, -0.5, -0.5) == block and at(img, -0.5, 0.5) == floor
+    layer = env._renderer._static
+    env.render()
+    assert env._renderer._static is layer              # nothing changed: the static layer is not drawn again
+    env.sim.remove_solid("crate")
+    img = env.render()
+    assert at(img, 0.5, -0.5) == floor and at(img, -0.5, -0.5) == block
+    env.sim.set_solid_pose("block", [-0.5, 0.5, 0.05])
+    img = env.render()
+    assert at(img, -0.5, -0.5) == floor and at(img, -0.5, 0.5) == block and at(img, 0.5, -0.5) == floor
+
+
 @pytest.mark.parametrize("vector_cls", [SyncVectorEnv, AsyncVectorEnv])
 def test_vector_envs_step_in_lockstep_with_single_envs(vector_cls):
     n = 3

@@ -241,6 +241,24 @@ def test_without_a_compiler_or_switched_off_the_engine_uses_embreex_and_says_why
 
 
 @needs_packets
+def test_a_helper_built_beforehand_is_used_without_a_compiler_on_another_kernel(monkeypatch, tmp_path):
+    """What the Docker image does: packets.c compiled at image build into SENSORIUM_CACHE_DIR; the
+    containers (no compiler, maybe another kernel) load that library."""
+    monkeypatch.setenv("SENSORIUM_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(packets.tempfile, "gettempdir", lambda: str(tmp_path / "tmp"))
+    monkeypatch.setattr(packets, "_state", {})
+    assert packets.library() is not None                         # built here, into the cache
+    built = sorted((tmp_path / "cache").glob("packets-*.so"))
+    assert [p.name for p in built] == [f"packets-{packets.build_key()}.so"]
+    monkeypatch.setattr(packets, "_state", {})
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    monkeypatch.setattr(packets.platform, "platform", lambda *a, **k: "Linux-9.9.9-other-kernel-x86_64")
+    monkeypatch.setattr(packets.platform, "release", lambda: "9.9.9-other-kernel")
+    assert packets.library() is not None and packets.status().startswith("Embree packets of 16")
+    assert sorted((tmp_path / "cache").glob("packets-*.so")) == built   # found, not rebuilt
+
+
+@needs_packets
 def test_box3_is_numpys_column_min_and_max():
     rng = np.random.default_rng(5)
     for n in (1, 2, 17, 23040):

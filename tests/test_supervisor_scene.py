@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import sys
 
 import pytest
@@ -268,3 +269,47 @@ def test_a_wbt_light_is_found_by_its_def_and_switched_through_it(tmp_path):
     judge(lv, "set_field", {"node": lamp["node"], "field": "on", "value": False})
     lv.step(A, "judge", {"duration": 16})
     assert eye.value == 0.0
+
+
+@pytest.mark.parametrize(("field", "attr", "value"), [("intensity", "intensity", -0.5),
+                                                      ("ambientIntensity", "ambient_intensity", 1.5),
+                                                      ("ambientIntensity", "ambient_intensity", -0.1),
+                                                      ("cutOffAngle", "cut_off_angle", 1.6),
+                                                      ("beamWidth", "beam_width", -0.2),
+                                                      ("color", "color", [0.0, 1.2, 0.0])])
+def test_a_light_setter_refuses_what_the_world_file_flags_with_the_same_words(field, attr, value):
+    """One table of Webots' ranges (world.LIGHT_RANGES): the Supervisor's setter refuses a value outside
+    with the words the loader's warning (or the file's error) uses, and the light keeps its value. (A
+    file's beam_width above pi/2 is above its cut-off: lowered to it, as Webots; a negative radius is
+    the schema's own error: both refused by the setter too, test_a_light_setter_refuses_the_rest.)"""
+    from sensorium.server.daemon import supervisor
+    from sensorium.server.world.loader import WorldError
+
+    spot = {"type": "SpotLight", "name": "spot", "location": [0, 0, 1], "cut_off_angle": 1.0, "beam_width": 0.5}
+    sim = Simulation(parse_world({"lights": [spot]}))
+    node = supervisor.find_node(sim, "spot")
+    with pytest.raises(ValueError) as refused:
+        supervisor.set_field(sim, node, field, value)
+    try:
+        said = parse_world({"lights": [{**spot, attr: value}]}).warnings
+    except WorldError as exc:
+        said = [str(exc)]
+    words = str(refused.value).removeprefix(f"SpotLight {attr}: ")
+    assert words.startswith(("must be", "colour components")) and any(words in line for line in said), (words, said)
+    assert supervisor.get_field(sim, node, field)["value"] == {"cut_off_angle": 1.0, "beam_width": 0.5}.get(
+        attr, {"intensity": 1.0, "ambient_intensity": 0.0, "radius": 100.0, "color": [1.0, 1.0, 1.0]}.get(attr))
+
+
+def test_a_light_setter_refuses_the_rest_of_webots_ranges():
+    from sensorium.server.daemon import supervisor
+
+    sim = Simulation(parse_world({"lights": [{"type": "SpotLight", "name": "spot", "location": [0, 0, 1]}]}))
+    node = supervisor.find_node(sim, "spot")
+    for field, value, words in (("beamWidth", 1.6, "beam_width: must be within [0, pi/2], got 1.6"),
+                                ("radius", -1.0, "radius: must be >= 0, got -1.0")):
+        with pytest.raises(ValueError, match=re.escape(words)):
+            supervisor.set_field(sim, node, field, value)
+    supervisor.set_field(sim, node, "beamWidth", math.pi / 2)       # the bounds themselves are taken
+    supervisor.set_field(sim, node, "cutOffAngle", 0.0)
+    assert supervisor.get_field(sim, node, "cutOffAngle")["value"] == 0.0
+

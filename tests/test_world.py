@@ -112,6 +112,41 @@ def test_sanitising_warns() -> None:
     assert any("lights[1].ambient_intensity" in x for x in loaded.warnings)
 
 
+def test_light_values_outside_webots_ranges_are_reset_with_one_warning_naming_the_light() -> None:
+    loaded = parse_world({"lights": [
+        {"type": "PointLight", "name": "lamp", "intensity": -2, "ambient_intensity": -0.5},
+        {"type": "SpotLight", "name": "spot", "cut_off_angle": 2.5, "beam_width": -1},
+        {"type": "DirectionalLight", "ambient_intensity": 3},
+    ]})
+    lamp, spot, sun = loaded.world.lights
+    assert (lamp.intensity, lamp.ambient_intensity) == (1.0, 0.0)        # WbLight's reset values
+    assert (spot.cut_off_angle, spot.beam_width) == (math.pi / 2, 0.0)   # WbSpotLight's
+    assert sun.ambient_intensity == 1.0
+    assert loaded.warnings == [
+        "lights[0] (lamp).ambient_intensity: must be within [0, 1], got -0.5, reset to 0",
+        "lights[0] (lamp).intensity: must be >= 0, got -2.0, reset to 1",
+        "lights[1] (spot).cut_off_angle: must be within [0, pi/2], got 2.5, reset to pi/2",
+        "lights[1] (spot).beam_width: must be within [0, pi/2], got -1.0, reset to 0",
+        "lights[2].ambient_intensity: must be within [0, 1], got 3.0, reset to 1",
+    ]
+    # the bounds themselves pass untouched
+    edge = parse_world({"lights": [{"type": "SpotLight", "ambient_intensity": 1.0, "intensity": 0.0,
+                                    "cut_off_angle": math.pi / 2, "beam_width": math.pi / 2}]})
+    assert edge.warnings == [] and edge.world.lights[0].cut_off_angle == math.pi / 2
+
+
+@pytest.mark.parametrize("where", ["lights", "solid", "robot"])
+def test_light_colour_outside_unit_range_is_an_error_naming_the_light(where: str) -> None:
+    light = {"type": "SpotLight", "name": "spot", "color": [1, 0.5, 1.5]}
+    data = {"lights": {"lights": [light]},
+            "solid": {"solids": [{"name": "post", "lights": [light]}]},
+            "robot": {"robots": [_robot([], lights=[light])]}}[where]
+    path = {"lights": "lights[0]", "solid": "solids[0] (post).lights[0]", "robot": "robots[0] (r).lights[0]"}[where]
+    with pytest.raises(WorldError) as info:
+        parse_world(data, source="w.yaml")
+    assert str(info.value) == f"w.yaml: {path} (spot).color: colour components must be within [0, 1], got [1.0, 0.5, 1.5]"
+
+
 def test_infrared_spelling_normalised() -> None:
     w = parse_world({"robots": [_robot([{"device": "DistanceSensor", "name": "d", "type": "InfraRed"}])]}).world
     assert w.robots[0].devices[0].type == "infra-red"
@@ -249,6 +284,26 @@ def test_cli_validate_ok_and_failure(tmp_path: Path) -> None:
     assert f"{bad}: lights[0].attenuation: attenuation 0 0 0" in res.stderr
     assert f"{bad}: robots[0] (r).devices[0] (s):" in res.stderr
     assert "INVALID (2 problems)" in res.stderr
+
+
+def test_cli_validate_light_colour_out_of_range_yaml_error_wbt_clamped_as_webots(tmp_path: Path) -> None:
+    yml = tmp_path / "bad.yaml"
+    yml.write_text("lights:\n  - {type: PointLight, name: lamp, color: [2, 0, 0]}\n")
+    res = _cli("validate", str(yml))
+    assert res.returncode == 1 and "Traceback" not in res.stderr
+    assert [line for line in res.stderr.splitlines() if "INVALID" not in line] == [
+        f"{yml}: lights[0] (lamp).color: colour components must be within [0, 1], got [2.0, 0.0, 0.0]"]
+    # a Webots world loads as in Webots: its light's colour clamped, its negative intensity reset to 1,
+    # each with a warning at the light's line
+    wbt = tmp_path / "lamp.wbt"
+    wbt.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 32 }\n"
+                   "DEF LAMP PointLight {\n  color 1 0.5 -0.1\n  intensity -3\n}\n")
+    res = _cli("validate", str(wbt))
+    assert res.returncode == 0 and "Traceback" not in res.stderr
+    assert f"{wbt}:3:10: PointLight color 1 0.5 -0.1 clamped to [0, 1] (Webots resets it)" in res.stdout + res.stderr
+    assert f"{wbt}:3:10: PointLight (lights[0].intensity): must be >= 0, got -3.0, reset to 1" in res.stdout + res.stderr
+    lamp = load_world(wbt).world.lights[0]
+    assert (lamp.color, lamp.intensity) == ((1.0, 0.5, 0.0), 1.0)
 
 
 def test_cli_info_default_world() -> None:

@@ -306,11 +306,36 @@ def _export_proto_args(args: argparse.Namespace) -> None:
         os.environ["SENSORIUM_PROTO_PATH"] = os.pathsep.join([*args.proto_path, *before])
 
 
+def compiled_paths() -> list[str]:
+    """Which optional compiled paths this installation runs, one line each, with why not: the
+    lockstep's C step path (built by setup.py at install) and the ray engine's packet helper
+    (packets.c, compiled on first use). Without them the same answers come from slower paths."""
+    from sensorium.server.daemon.steppath import native_gate_class
+    from sensorium.server.raycast import packets
+
+    gate, why = native_gate_class()
+    step = f"C ({gate.__module__})" if gate is not None else f"Python ({why})"
+    return [f"step path: {step}", f"ray traversal: {packets.status()}"]
+
+
+class _VersionAction(argparse.Action):
+    """``--version``: the version, then :func:`compiled_paths` (worked out only when asked)."""
+
+    def __init__(self, option_strings, dest, version: str, **kwargs):
+        super().__init__(option_strings, dest, default=argparse.SUPPRESS, **kwargs)
+        self.version = version
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print("\n".join([self.version, *compiled_paths()]), flush=True)
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sensorium", description="Headless sensor simulator with Webots device semantics.")
     from sensorium import __version__
 
-    parser.add_argument("--version", action="version", version=f"sensorium {__version__}")
+    parser.add_argument("--version", action=_VersionAction, nargs=0, version=f"sensorium {__version__}",
+                        help="show the version and which compiled (C) paths are active, and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (help_text, add_args, target) in _COMMANDS.items():
         p = sub.add_parser(name, help=help_text, description=help_text)

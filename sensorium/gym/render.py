@@ -16,7 +16,6 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
 from sensorium.server.world.geometry import Plane, Pose, tessellate
-from sensorium.server.world.poses import pose_from_model
 
 BACKGROUND = (40, 40, 46)
 
@@ -52,17 +51,47 @@ def _color(shape: wm.Shape | wm.Solid) -> tuple[int, int, int]:
 
 
 class TopDown:
-    """Renders ``sim`` at ``size`` x ``size`` pixels; the solids are drawn once (at their poses when
-    the renderer is made), robots and lights (which may ride on them) at every call."""
+    """Renders ``sim`` at ``size`` x ``size`` pixels. The solids are drawn into a static layer, drawn
+    again only when the scene's ``solids_version`` changes (a solid moved or removed); robots and
+    lights (which may ride on them) at every call. The view (centre and scale) is fixed when the
+    renderer is made, so frames of one episode line up; a solid moved outside it is cut off."""
 
     def __init__(self, sim, size: int = 256, margin: float = 0.1):
         self.sim = sim
         self.size = int(size)
-        base = sim.loaded.base_dir
+        # each robot: its body shapes' vertices in the robot frame, with their colours
+        self._robot_parts: list[list[tuple[np.ndarray, tuple[int, int, int]]]] = []
+        for r in sim.world.robots:
+            parts = []
+            for _, local, shape in robot_parts(r):
+                prim = primitive_from_model(shape.geometry, sim.loaded.base_dir)
+                if not isinstance(prim, Plane):
+                    parts.append((local.apply(tessellate(prim)[0]), _color(shape)))
+            self._robot_parts.append(parts)
+        floors, static = self._solid_polygons()
+        pts = [h for _, h, _ in static] + [f for f, _ in floors]
+        pts += [np.asarray(rb.pose.translation[:2])[None, :] for rb in sim.robots.values()]
+        pts += [np.array([lt.location[:2]]) for lt in sim.scene.world_lights() if lt.type != "DirectionalLight"]
+        allp = np.concatenate(pts) if pts else np.zeros((1, 2))
+        lo, hi = allp.min(axis=0), allp.max(axis=0)
+        span = float(max(hi[0] - lo[0], hi[1] - lo[1], 1e-3)) * (1.0 + 2.0 * margin)
+        self.center = 0.5 * (lo + hi)
+        self.scale = self.size / span           # pixels per metre
+        self._static = self._draw_static(floors, static)
+        self._static_version = sim.scene.solids_version
+
+    def _solid_polygons(self) -> tuple[list[tuple[np.ndarray, tuple[int, int, int]]],
+                                       list[tuple[float, np.ndarray, tuple[int, int, int]]]]:
+        """The solids' shapes at their poses now (a removed solid has none): sized planes as
+        (corners xy, colour), every other shape as (top z, hull xy, colour), lowest top first."""
+        base = self.sim.loaded.base_dir
+        poses = self.sim.scene.solid_poses
         static: list[tuple[float, np.ndarray, tuple[int, int, int]]] = []   # (top z, hull, colour)
         floors: list[tuple[np.ndarray, tuple[int, int, int]]] = []
-        for solid in sim.world.solids:
-            frame = sim.scene.solid_poses.get(solid.name) or pose_from_model(solid.pose)
+        for solid in self.sim.world.solids:
+            frame = poses.get(solid.name)
+            if frame is None:               # removed by a Supervisor
+                continue
             for _, local, shape in solid_parts(solid, Pose.identity()):
                 prim = primitive_from_model(shape.geometry, base)
                 pose = frame.compose(local)
@@ -76,30 +105,16 @@ class TopDown:
                 w = pose.apply(tessellate(prim)[0])
                 static.append((float(w[:, 2].max()), _hull(w[:, :2]), _color(shape)))
         static.sort(key=lambda item: item[0])
-        # each robot: its body shapes' vertices in the robot frame, with their colours
-        self._robot_parts: list[list[tuple[np.ndarray, tuple[int, int, int]]]] = []
-        for r in sim.world.robots:
-            parts = []
-            for _, local, shape in robot_parts(r):
-                prim = primitive_from_model(shape.geometry, base)
-                if not isinstance(prim, Plane):
-                    parts.append((local.apply(tessellate(prim)[0]), _color(shape)))
-            self._robot_parts.append(parts)
-        pts = [h for _, h, _ in static] + [f for f, _ in floors]
-        pts += [np.asarray(rb.pose.translation[:2])[None, :] for rb in sim.robots.values()]
-        pts += [np.array([lt.location[:2]]) for lt in sim.scene.world_lights() if lt.type != "DirectionalLight"]
-        allp = np.concatenate(pts) if pts else np.zeros((1, 2))
-        lo, hi = allp.min(axis=0), allp.max(axis=0)
-        span = float(max(hi[0] - lo[0], hi[1] - lo[1], 1e-3)) * (1.0 + 2.0 * margin)
-        self.center = 0.5 * (lo + hi)
-        self.scale = self.size / span           # pixels per metre
+        return floors, static
+
+    def _draw_static(self, floors, static) -> np.ndarray:
         img = np.empty((self.size, self.size, 3), dtype=np.uint8)
         img[:] = BACKGROUND
         for poly, col in floors:
             self._fill(img, _hull(poly), col)
         for _, poly, col in static:
             self._fill(img, poly, col)
-        self._static = img
+        return img
 
     # -------------------------------------------------------------------------------- drawing
     def _px(self, xy: np.ndarray) -> np.ndarray:
@@ -138,6 +153,10 @@ class TopDown:
         img[pts[ok, 1], pts[ok, 0]] = color
 
     def render(self) -> np.ndarray:
+        version = self.sim.scene.solids_version
+        if version != self._static_version:       # a solid moved or was removed since the last drawing
+            self._static = self._draw_static(*self._solid_polygons())
+            self._static_version = version
         img = self._static.copy()
         for lt in self.sim.scene.world_lights():
             if lt.type != "DirectionalLight" and lt.on:

@@ -7,7 +7,7 @@ and its ``RobotState``. The vector environment hands them these views of one cop
 
 * ``CopySim``: ``time_ms``, ``basic_time_step``, ``world``, ``loaded``, ``robots`` / ``robot(name)``,
   ``run(steps)`` / ``step()`` (this copy alone),
-  ``scene`` (``world_lights()``, ``solid_poses``, and ``engine.cast(...)`` casting in this copy only:
+  ``scene`` (``world_lights()``, ``solid_poses``, ``solids_version``, and ``engine.cast(...)`` casting in this copy only:
   ``exclude_owner`` is a robot index, as in the single simulation);
 * ``CopyRobot``: ``name``, ``index``, ``model``, ``pose``, ``set_pose(...)``, ``motors`` /
   ``motor(name)``, ``drive.left`` / ``drive.right`` and ``drive.lefts`` / ``drive.rights`` (every
@@ -154,6 +154,10 @@ class _Scene:
 
     def world_lights(self) -> list:
         return self._s.scene.world_lights()
+
+    @property
+    def solids_version(self) -> int:
+        return self._s.scene.solids_version
 
 
 class CopySim:

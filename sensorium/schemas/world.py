@@ -26,7 +26,7 @@ def _unit_colors(v: Color | list[Color]) -> Color | list[Color]:
     """A colour, or each of a list of colours, with every component within [0, 1]."""
     for c in v if isinstance(v, list) else [v]:
         if min(c) < 0 or max(c) > 1:
-            raise ValueError("colour components must be within [0, 1]")
+            raise ValueError(f"colour components must be within [0, 1], got {[float(x) for x in c]}")
     return v
 
 
@@ -267,20 +267,60 @@ class Part(Shape):
 # ---------------------------------------------------------------- lights
 
 
+# Webots' ranges of the lights' number fields (WbLight, WbPointLight, WbSpotLight): a world file's value
+# outside is reset by the loader with a warning as Webots does (loader.sanitize, to Webots' reset value),
+# except radius (a schema error here); the Supervisor's setters refuse one (daemon/supervisor.py). The colour
+# must be within [0, 1] like every colour of a YAML world (Webots clamps it, as the .wbt converter does).
+LIGHT_RANGES: dict[str, tuple[float, float]] = {
+    "ambient_intensity": (0.0, 1.0),
+    "intensity": (0.0, math.inf),
+    "radius": (0.0, math.inf),
+    "beam_width": (0.0, math.pi / 2),
+    "cut_off_angle": (0.0, math.pi / 2),
+}
+
+
+def _range_text(lo: float, hi: float) -> str:
+    def num(v: float) -> str:
+        return "pi/2" if v == math.pi / 2 else f"{v:g}"
+    return f">= {num(lo)}" if hi == math.inf else f"within [{num(lo)}, {num(hi)}]"
+
+
+def light_value_problem(field: str, value: object) -> str | None:
+    """What is wrong with ``value`` for light field ``field`` (snake_case) against Webots' range, or
+    None: a number outside ``LIGHT_RANGES``, a colour component outside [0, 1]."""
+    if field == "color":
+        try:
+            _unit_colors(tuple(value))  # type: ignore[arg-type]   # one colour (a list is a list of colours)
+        except ValueError as exc:
+            return str(exc)
+        return None
+    bounds = LIGHT_RANGES.get(field)
+    if bounds is None or not isinstance(value, int | float) or bounds[0] <= value <= bounds[1]:
+        return None
+    return f"must be {_range_text(*bounds)}, got {value}"
+
+
+def _range_doc(field: str) -> str:
+    return f"{_range_text(*LIGHT_RANGES[field])} (outside: reset with a warning, as Webots)"
+
+
 class _Light(Strict):
     name: str | None = None
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
-    ambient_intensity: float = 0.0
-    intensity: float = 1.0
-    color: Color = (1.0, 1.0, 1.0)
+    ambient_intensity: float = Field(default=0.0, description=_range_doc("ambient_intensity"))
+    intensity: float = Field(default=1.0, description=_range_doc("intensity"))
+    color: Color = Field(default=(1.0, 1.0, 1.0), description="each component within [0, 1]")
     on: bool = True
     cast_shadows: bool = False  # rendering only in Webots; kept for file compatibility
+
+    _unit = field_validator("color")(_unit_colors)
 
 
 class _Attenuated(_Light):
     attenuation: Vec3 = (1.0, 0.0, 0.0)
     location: Vec3 = (0.0, 0.0, 0.0)
-    radius: float = Field(default=100.0, ge=0.0, description="unused by sensors (Webots)")
+    radius: float = Field(default=100.0, ge=LIGHT_RANGES["radius"][0], description="unused by sensors (Webots)")
 
     @field_validator("attenuation")
     @classmethod
@@ -299,8 +339,9 @@ class PointLight(_Attenuated):
 class SpotLight(_Attenuated):
     type: Literal["SpotLight"]
     direction: Vec3 = (0.0, 0.0, -1.0)
-    beam_width: float = 1.570796
-    cut_off_angle: float = 0.785398
+    beam_width: float = Field(default=1.570796, description=_range_doc("beam_width") + "; above cut_off_angle: "
+                              "set to it with a warning")
+    cut_off_angle: float = Field(default=0.785398, description=_range_doc("cut_off_angle"))
 
     _nonzero = field_validator("direction")(_nonzero_direction)
 

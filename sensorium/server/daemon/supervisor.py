@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from pydantic import ValidationError
 
+from sensorium.schemas import world as wm
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.world.poses import matrix_quaternion
 
@@ -169,15 +170,12 @@ def _light(sim: Any, node: Node) -> Any:
 def _set_light(attr: str, kind: str) -> Setter:
     def setter(sim: Any, node: Node, value: Any) -> None:
         model = _light(sim, node)
-        if attr in ("intensity", "radius", "beam_width", "cut_off_angle") and value < 0:
-            raise ValueError(f"{kind} {attr}: must be >= 0, got {value}")
-        if attr in ("ambient_intensity",) and not 0.0 <= value <= 1.0:
-            raise ValueError(f"{kind} {attr}: must be in [0, 1], got {value}")
+        problem = wm.light_value_problem(attr, value)      # Webots' ranges, as the world file's
+        if problem is not None:
+            raise ValueError(f"{kind} {attr}: {problem}")
         if attr == "location" and any(abs(v) > MAX_COORDINATE_M for v in value):   # as every pose a request sets
             raise ValueError(f"{kind} location {value} is outside the world bounds "
                              f"(|coordinate| <= {MAX_COORDINATE_M:g} m)")
-        if attr == "color" and not all(0.0 <= c <= 1.0 for c in value):
-            raise ValueError(f"{kind} color: each component must be in [0, 1], got {value}")
         try:
             changed = type(model).model_validate({**model.model_dump(), attr: value})
         except ValidationError as e:

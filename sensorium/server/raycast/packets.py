@@ -113,6 +113,14 @@ def _compile(out: Path) -> str | None:
             os.unlink(tmp)
 
 
+def build_key() -> str:
+    """The cached library's key: the source, the machine, its C library and Python. Not the kernel
+    (``platform.platform()`` names it): a library built into an image (docker/Dockerfile) is found
+    by the containers that run it on other kernels."""
+    abi = f"{sys.platform}-{platform.machine()}-{'-'.join(platform.libc_ver())}-{sys.version}"
+    return hashlib.sha256(_SOURCE.read_bytes() + abi.encode()).hexdigest()[:16]
+
+
 def _load() -> None:
     if os.environ.get("SENSORIUM_PACKETS", "1") == "0":
         _state["why"] = "off (SENSORIUM_PACKETS=0)"
@@ -121,8 +129,7 @@ def _load() -> None:
     if not embree:
         _state["why"] = "no Embree 4 library found beside embreex"
         return
-    src = _SOURCE.read_bytes()
-    key = hashlib.sha256(src + platform.platform().encode() + sys.version.encode()).hexdigest()[:16]
+    key = build_key()
     lib_path = None
     for folder in (_cache_dir(), Path(tempfile.gettempdir()) / f"sensorium-{os.getuid() if hasattr(os, 'getuid') else 0}"):
         path = folder / f"packets-{key}.so"

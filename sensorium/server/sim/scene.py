@@ -192,6 +192,7 @@ class Scene:
         self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         self.lights_version = 0        # changes whenever a light moves with its owner
+        self.solids_version = 0        # changes whenever a top-level solid moves or is removed (gym's TopDown)
         self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
         # infra-red reads these per hit shape; -1 (no hit) indexes the trailing "no hit" entry
         self.red = np.array([s.red for s in self.shapes] + [1.0])
@@ -269,6 +270,7 @@ class Scene:
         if name not in self.solid_poses:
             raise KeyError(name)
         del self.solid_poses[name]
+        self.solids_version += 1
         body = self._solid_body.pop(name, None)
         if body is not None:
             self.engine.remove_body(body)
@@ -298,6 +300,8 @@ class Scene:
     def set_solid_pose(self, name: str, pose: Pose) -> None:
         if name not in self.solid_poses:
             raise KeyError(name)
+        if pose is not self.solid_poses[name]:     # a reset hands back the same pose of a solid never moved
+            self.solids_version += 1
         self.solid_poses[name] = pose
         if name in self._attached:
             self.lights_version += 1

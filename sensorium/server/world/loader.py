@@ -496,24 +496,35 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
     warnings: list[str] = []
 
     def fix_light(p: str, lt: Any) -> Any:
+        # Webots' resets of a value outside its range (wm.LIGHT_RANGES): WbLight::updateAmbientIntensity,
+        # updateIntensity, WbSpotLight::updateCutOffAngle, updateBeamWidth
+        if lt.name:
+            p = f"{p} ({lt.name})"
         upd: dict[str, Any] = {}
-        if not 0.0 <= lt.ambient_intensity <= 1.0:
-            upd["ambient_intensity"] = 1.0 if lt.ambient_intensity > 1 else 0.0
-            warnings.append(f"{p}.ambient_intensity: {lt.ambient_intensity} outside [0, 1], reset to {upd['ambient_intensity']}")
-        if lt.intensity < 0:
-            upd["intensity"] = 1.0
-            warnings.append(f"{p}.intensity: negative, reset to 1")
+
+        def outside(field: str) -> bool:
+            return wm.light_value_problem(field, getattr(lt, field)) is not None
+
+        def reset(field: str, value: float, shown: str) -> None:
+            warnings.append(f"{p}.{field}: {wm.light_value_problem(field, getattr(lt, field))}, reset to {shown}")
+            upd[field] = value
+
+        if outside("ambient_intensity"):
+            value = 1.0 if lt.ambient_intensity > 1 else 0.0
+            reset("ambient_intensity", value, f"{value:g}")
+        if outside("intensity"):
+            reset("intensity", 1.0, "1")
         amb = upd.get("ambient_intensity", lt.ambient_intensity)
         if isinstance(lt, (wm.PointLight, wm.SpotLight)) and tuple(lt.attenuation) != (1.0, 0.0, 0.0) and amb != 0:
             upd["ambient_intensity"] = 0.0
             warnings.append(f"{p}.ambient_intensity: forced to 0 because attenuation is not 1 0 0 (Webots rule)")
         if isinstance(lt, wm.SpotLight):
-            cut = lt.cut_off_angle
-            if not 0.0 <= cut <= math.pi / 2:
-                cut = math.pi / 2
-                upd["cut_off_angle"] = cut
-                warnings.append(f"{p}.cut_off_angle: outside [0, pi/2], reset to pi/2")
-            if lt.beam_width > cut:
+            if outside("cut_off_angle"):
+                reset("cut_off_angle", math.pi / 2, "pi/2")
+            cut = upd.get("cut_off_angle", lt.cut_off_angle)
+            if lt.beam_width < 0:
+                reset("beam_width", 0.0, "0")
+            elif lt.beam_width > cut:
                 upd["beam_width"] = cut
                 warnings.append(f"{p}.beam_width: {lt.beam_width} > cut_off_angle, set to {cut}")
         return lt.model_copy(update=upd) if upd else lt

@@ -619,6 +619,10 @@ class Converter:
     def light(self, node: Node, frame: Frame, owner: Owner) -> None:
         self.tick(node)
         data = fx.light(node, self.fields(node))
+        if wm.light_value_problem("color", data["color"]) is not None:     # WbLight::updateColor
+            self.warn(node, f"{node.type} color {' '.join(f'{c:g}' for c in data['color'])} clamped to [0, 1] "
+                            "(Webots resets it)")
+            data["color"] = [min(max(c, 0.0), 1.0) for c in data["color"]]
         if "location" in data:
             data["location"] = frame.apply(data["location"])
         if node.type == "SpotLight":
