@@ -37,7 +37,7 @@ CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene",
-               "supervisor_remove"]
+               "supervisor_remove", "supervisor_import"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
@@ -515,6 +515,28 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
             "removed here") in err
     assert "Error: wb_supervisor_node_remove(): INVALID_ARGUMENT: remove_node: the root node cannot be removed" in err
     assert "wb_supervisor_node_remove() called with a NULL or invalid 'node' argument." in err
+
+
+def test_c_supervisor_imports_a_solid_and_a_light(cbin, servers):
+    """tests/c/supervisor_import.c on tests/worlds/supervisor_remove.yaml (its closed forms), built with
+    sanitizers: the distance sensor reads the crate at 1 m, then the imported box at 0.5 m; the light
+    sensor 7, then 7 + 16; the root's 7 children become 9 (the light first); the box is node 8 (DEF
+    BALL), the light 9; removing both restores 1 m, 7 and 7 children; a robot and a bad string are
+    refused with the server's one line each, a NULL field with Webots' line."""
+    code, out, err = finish(start([cbin["supervisor_import"]], servers(REMOVE_WORLD).url("boss")))
+    assert code == 0, err
+    key, *vals = out[0].split()
+    assert key == "before" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 7], abs=1e-9)
+    key, *vals = out[1].split()
+    assert key == "after" and [float(v) for v in vals] == pytest.approx([0.5, 23.0, 9], abs=1e-9)
+    assert out[2] == "ids 8 9 BALL Solid"
+    key, *vals = out[3].split()
+    assert key == "removed" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 7, 1], abs=1e-9)
+    assert ("Error: wb_supervisor_field_import_mf_node_from_string(): INVALID_ARGUMENT: import_node_from_string: "
+            "node string:1:1: Robot: a robot cannot be imported here") in err
+    assert ("Error: wb_supervisor_field_import_mf_node_from_string(): INVALID_ARGUMENT: import_node_from_string: "
+            "node string:2:3: Solid.translation: expected 3 numbers, got 1") in err
+    assert "wb_supervisor_field_import_mf_node_from_string() called with NULL 'field' argument." in err
 
 
 def test_supervisor_through_the_cpp_classes(cbin, servers):

@@ -383,6 +383,39 @@ def wb_supervisor_field_set_sf_color(field: Field | None, values: Any) -> None:
     _field_set(field, WB_SF_COLOR, values, "wb_supervisor_field_set_sf_color")
 
 
+def wb_supervisor_field_import_mf_node_from_string(field: Field | None, position: int, node_string: str) -> None:
+    """Webots' ``importMFNodeFromString`` into the root's ``children``: the string's solids (or PROTO
+    instances that are solids, of PROTOs the world file declares) and lights join the world from the
+    next step, inserted at ``position`` (0 first, -1 last, as Webots). The new nodes have new ids
+    (never a removed node's) and are found by DEF; ``node.remove()`` removes them and
+    ``simulationReset`` does too (Webots). A robot, a node that is neither a solid nor a light, or a
+    string that does not read (the server's line names where: ``node string:LINE:COL``) is refused
+    with one error line and nothing changes."""
+    func = "wb_supervisor_field_import_mf_node_from_string"
+    r = _supervisor(func)
+    if r is None:
+        return
+    if field is None:
+        print(f"Error: {func}() called with NULL 'field' argument.", file=sys.stderr)
+        return
+    if field[2] != WB_MF_NODE:
+        print(f"Error: {func}() called with wrong field type: {_TYPE_NAMES[field[2]]}.", file=sys.stderr)
+        return
+    if not isinstance(node_string, str) or not node_string:
+        print(f"Error: {func}() called with a NULL or empty 'node_string' argument.", file=sys.stderr)
+        return
+    if isinstance(position, bool) or not isinstance(position, int) or not -(1 << 31) <= position < 1 << 31:
+        print(f"Error: {func}() called with an invalid 'position' argument: {position!r}.", file=sys.stderr)
+        return
+    try:
+        _call(r, "import_node_from_string", {"node": field[0], "field": field[1], "position": position,
+                                             "node_string": node_string})
+    except SensoriumError as err:      # a robot, a bad string, limits: the server's line
+        if err.code != ErrorCode.INVALID_ARGUMENT:
+            raise
+        print(f"Error: {func}(): {err.message}.", file=sys.stderr)
+
+
 # ---------------------------------------------------------------------- the simulation
 
 def wb_supervisor_simulation_reset() -> None:

@@ -260,6 +260,20 @@ class SetFieldArgs(Args):
         description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis x, y, z, angle")
 
 
+class ImportNodeArgs(Args):
+    node: NodeId = Field(description="the node whose field takes the nodes: the root (0) here")
+    field: FieldName = Field(description="its MFNode field: 'children'")
+    position: int = Field(ge=-(1 << 31), lt=1 << 31, description=(
+        "where in the list: 0 first, -1 after the last, -2 before the last (Webots); past an end: that end"))
+    node_string: str = Field(max_length=1 << 24, description=(
+        "Webots nodes as a .wbt file writes them: solids (or PROTO instances that are solids, of PROTOs the "
+        "world file declares) and lights"))
+
+
+class IntArrayValue(Result):
+    value: list[int]
+
+
 class SimulationModeArgs(Args):
     mode: int = Field(ge=0, le=2, description="Webots WB_SUPERVISOR_SIMULATION_MODE_*: 0 pause, 1 real time, 2 fast")
 
@@ -793,6 +807,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("remove_node", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("import_node_from_string", "robot", ImportNodeArgs, IntArrayValue, attached=True, supervisor=True),
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),

@@ -62,13 +62,14 @@ def build(world: str | Path | None, options: ServeOptions | None = None) -> tupl
     opts.check()
     secret = load_curve_keys(opts.curve_keys)[1] if opts.curve_keys else None
     path = Path(world) if world else default_world_path()
-    loaded = load_world(path, limits=WorldLimits.large() if opts.allow_large else WorldLimits(),
-                        allow_outside_meshes=opts.allow_outside_meshes)
+    limits = WorldLimits.large() if opts.allow_large else WorldLimits()
+    loaded = load_world(path, limits=limits, allow_outside_meshes=opts.allow_outside_meshes)
     if not opts.allow_skipped:
         refuse_robotless(loaded)
     if opts.watch is not None:
         loaded = watched(loaded, opts.watch)
-    sim = Simulation(loaded, opts.precision, contact=opts.contact)
+    sim = Simulation(loaded, opts.precision, contact=opts.contact, limits=limits,   # imports: the same bounds
+                     allow_outside_meshes=opts.allow_outside_meshes)
     core = Core(sim, heartbeat_ms=opts.heartbeat_ms, mode=opts.mode,
                 open_controls=open_controls(opts.controls, opts.rpc))
     return core, Transport(core, opts.rpc, opts.pub, stop_at_ms=opts.until, curve_secret=secret, cpu=opts.cpu)

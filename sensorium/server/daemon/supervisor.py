@@ -44,21 +44,33 @@ ROOT = Node(0, "Group", "", "", "")
 
 
 def _all_nodes(sim: Any) -> list[Node]:
-    """Every node the world loaded with but the root, in id order (robots, solids, lights), removed
-    ones included: a node's id is its place here, so it never changes and is never reused."""
+    """Every node the world has had but the root, in id order (the robots, solids and lights it
+    loaded with, then the nodes a Supervisor imported, in import order), removed ones included: a
+    node's id is its place here, so it never changes and is never reused."""
     world = getattr(sim, "world", None)
 
     def def_of(models: list, k: int) -> str:
         return (getattr(models[k], "def_name", None) or "") if models is not None and k < len(models) else ""
 
+    imported = getattr(sim, "imported", [])
     robots_m = world.robots if world is not None else None
     solids_m = world.solids if world is not None else None
+    names = sim.scene.solid_names
+    loaded_solids = len(names) - sum(kind == "Solid" for kind, _ in imported)
+    top = sim.scene.top_lights()
+    loaded_lights = len(top) - sum(kind != "Solid" for kind, _ in imported)
     out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name) for i, name in enumerate(sim.robots)]
     first = len(out) + 1
-    out += [Node(first + j, "Solid", name, def_of(solids_m, j), name) for j, name in enumerate(sim.scene.solid_names)]
-    top = sim.scene.top_lights()
+    out += [Node(first + j, "Solid", names[j], def_of(solids_m, j), names[j]) for j in range(loaded_solids)]
     first = len(out) + 1
-    out += [Node(first + k, lt.type, lt.name or "", def_of(top, k), k) for k, lt in enumerate(top)]
+    out += [Node(first + k, top[k].type, top[k].name or "", def_of(top, k), k) for k in range(loaded_lights)]
+    for kind, key in imported:
+        if kind == "Solid":
+            j = names.index(key)
+            out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key))
+        else:
+            lt = top[int(key)]
+            out.append(Node(len(out) + 1, lt.type, lt.name or "", def_of(top, int(key)), key))
     return out
 
 
@@ -69,8 +81,18 @@ def _removed(sim: Any, node: Node) -> bool:
 
 
 def _nodes(sim: Any) -> list[Node]:
-    """The nodes in the world now, in id order: the root's children."""
+    """The nodes in the world now, in id order."""
     return [n for n in _all_nodes(sim) if not _removed(sim, n)]
+
+
+def root_children(sim: Any) -> list[Node]:
+    """The root's ``children`` in their order: id order, imported nodes where they were inserted."""
+    nodes = _nodes(sim)
+    order = getattr(sim, "root_order", None)
+    if not order:
+        return nodes
+    by_id = {n.id: n for n in nodes}
+    return [by_id[i] for i in order if i in by_id]
 
 
 def find_node(sim: Any, name: str) -> Node | None:
@@ -205,7 +227,7 @@ def _light_fields(kind: str) -> dict[str, tuple[str, Getter, Setter]]:
 
 
 FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
-    "Group": {"children": ("MFNode", lambda sim, n: [m.id for m in _nodes(sim)], None)},
+    "Group": {"children": ("MFNode", lambda sim, n: [m.id for m in root_children(sim)], None)},
     "Robot": {**_POSE_FIELDS,
               "name": ("SFString", lambda sim, n: n.name, None),
               "model": ("SFString", lambda sim, n: sim.robots[n.key].model.model, None),
@@ -297,6 +319,36 @@ def _remove(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     return {"success": True}
 
 
+def insert_index(position: int, count: int) -> int:
+    """Webots' import position in a list of ``count`` nodes: 0 the first place, -1 after the last,
+    -2 before the last, ...; a position past either end is the nearest end (the root's children
+    here leave out the nodes Sensorium does not simulate: WorldInfo, Viewpoint, Background, ...)."""
+    index = position if position >= 0 else count + 1 + position
+    return min(max(index, 0), count)
+
+
+def import_nodes(sim: Any, node: Node, field: str, position: int, text: str) -> list[int]:
+    """Webots' ``importMFNodeFromString`` on the root's ``children``: the string's solids and
+    lights join the world from the next measurement, inserted at ``position`` (Webots' rule,
+    :func:`insert_index`); returns their new ids. Any other field is refused (Sensorium's nodes
+    have no other MFNode field); a string that cannot be imported changes nothing (one line)."""
+    if node.id != 0 or field != "children":
+        what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
+        raise ValueError(f"field {field!r} of {what}: nodes are imported into the root's 'children' only here")
+    current = [n.id for n in root_children(sim)]
+    index = insert_index(position, len(current))
+    added = [node_id for _, _, node_id in sim.import_nodes(text)]
+    sim.root_order = current[:index] + added + current[index:]
+    return added
+
+
+def _import(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    try:                         # ImportRefused is a ValueError: one line, nothing changed
+        return {"value": import_nodes(sim, node_by_id(sim, a.node), a.field, a.position, a.node_string)}
+    except (KeyError, OSError, RecursionError) as exc:     # never a traceback for a controller's string
+        raise ValueError(f"the node string cannot be imported: {exc}") from None
+
+
 def _reset(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     sim.reset()
     return {"success": True}
@@ -317,6 +369,7 @@ HANDLERS = {
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},
     "remove_node": _remove,
+    "import_node_from_string": _import,
     "simulation_reset": _reset,
     "simulation_set_mode": _set_mode,
     "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},

@@ -199,7 +199,7 @@ class RayEngine(TierTracer):
         self._planes: dict[str, _Planes | None] = {}
         self._mover_tables: dict[str, _Movers | None] = {}
         self._shared: dict[tuple, _Tier | None] = {}   # body-frame tiers by (variant, shapes)
-        self._epoch = 0                                 # bumped by every set_body_pose
+        self._epoch = 0                                 # bumped by every set_body_pose, add and removal
         self.threads = available()   # threads a large cast may use (see .blocks; 1: the calling thread only)
         self.native = True   # judge and refine hits in packets.c where the packet path is on (the same answers)
         self._counting = threading.Lock()
@@ -230,6 +230,7 @@ class RayEngine(TierTracer):
         self._bodies.append(_Body(list(range(first, len(self._entries))), pose, int(owner), bool(movable), body))
         self._rot = np.concatenate([self._rot, pose.rotation[None]])
         self._pos = np.concatenate([self._pos, pose.translation[None]])
+        self._epoch += 1               # a body added while casting (a Supervisor's import): caches rebuild
         self._planes.clear()
         if movable:
             self._movers.append(self._bodies[-1])

@@ -208,6 +208,7 @@ class Camera(Device):
         self.segmentation_image = np.zeros((c.height, c.width, 4), dtype=np.uint8)
         self.segmentation_image[:, :, 3] = 255
         self._recognizer: Any = None
+        self._recognizer_shapes = -1      # the scene's shapes_version it was built for
         self._centre_rays: MountedRays | None = None
         self._image_at = self._segmentation_at = -1      # the measurement that made the latest of each
         self._seg_bytes: tuple[int, bytes] = (-1, b"")
@@ -330,8 +331,10 @@ class Camera(Device):
 
         rc = self.config.recognition
         assert rc is not None
-        if self._recognizer is None:
+        shapes = getattr(self._scene, "shapes_version", 0)      # changed by a Supervisor's import
+        if self._recognizer is None or self._recognizer_shapes != shapes:
             self._recognizer = Recognizer(self._scene, self.robot_index, rc, self.geometry)
+            self._recognizer_shapes = shapes
         rec = self._recognizer
         pixels = None
         if rc.occlusion == 2 or self.segmentation_enabled:

@@ -326,6 +326,14 @@ class Contact:
         if hasattr(self, "feet"):
             self._rebuild()
 
+    def add_solid(self, name: str, shapes: list[tuple[geo.Primitive, Pose, bool]], pose: Pose) -> None:
+        """A solid a Supervisor imported: an obstacle from now on (its bounding shapes: (primitive,
+        pose in the solid's frame, seen by bounding rays), as the constructor takes them)."""
+        prims = [(prim, local) for prim, local, bounding in shapes if bounding]
+        if prims:
+            self.prims[name] = prims
+            self.update_solid(name, pose)
+
     def remove_solid(self, name: str) -> None:
         """A solid removed by a Supervisor: no longer an obstacle."""
         for i in range(len(self.prims.pop(name, ()))):

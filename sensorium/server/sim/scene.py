@@ -150,7 +150,8 @@ class Scene:
         self.solid_names = [s.name for s in world.solids]
         self._solid_body: dict[str, int] = {}
         self.solid_poses: dict[str, Pose] = {}
-        self.triangle_count = 0
+        self.triangle_count = 0            # of the bodies in the world now (a removed solid's leave the count)
+        self._solid_triangles: dict[str, int] = {}
         self._parts: list[tuple[str | int | None, Pose, wm.Shape | wm.Solid]] = []   # per shape: owner, frame, model
         # lights: (model, owner, pose in the owner's frame); owner None = world, str = solid, int = robot
         self._lights: list[tuple[object, str | int | None, Pose]] = [(lt, None, Pose.identity()) for lt in world.lights]
@@ -194,12 +195,8 @@ class Scene:
         self.lights_version = 0        # changes whenever a light moves with its owner
         self.solids_version = 0        # changes whenever a top-level solid moves or is removed (gym's TopDown)
         self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
-        # infra-red reads these per hit shape; -1 (no hit) indexes the trailing "no hit" entry
-        self.red = np.array([s.red for s in self.shapes] + [1.0])
-        self.roughness = np.array([s.roughness for s in self.shapes] + [0.0])
-        # cameras read these (sim/cameras.py): base colour (white without appearance) and transparency
-        self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
-        self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
+        self.shapes_version = 0        # changes whenever a Supervisor adds shapes (cameras' recognition rebuilds)
+        self._shape_arrays()
         self.background = np.asarray(world.background.sky_color, dtype=np.float64)   # what cameras see past everything
         # Webots' Fog as cameras mix it in: (linear colour, visibility range, type); None without fog or
         # with a visibility range of 0 (Webots then turns it off), so a world without fog computes nothing more
@@ -220,11 +217,24 @@ class Scene:
                 self.recognisable[sd.name] = (len(world.robots) + 1 + j, [tuple(c) for c in sd.recognition_colors],
                                               sd.model)
 
+    def _shape_arrays(self) -> None:
+        """The per-shape arrays devices index by hit shape (-1, no hit, reads the trailing entry)."""
+        # infra-red reads these per hit shape
+        self.red = np.array([s.red for s in self.shapes] + [1.0])
+        self.roughness = np.array([s.roughness for s in self.shapes] + [0.0])
+        # cameras read these (sim/cameras.py): base colour (white without appearance) and transparency
+        self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
+        self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
+
     def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool,
-                  key: str | int | None = None) -> int:
-        entries = [_entry(shape, base_dir, local) for _, local, shape in parts]
+                  key: str | int | None = None, entries: list[ShapeEntry] | None = None) -> int:
+        if entries is None:
+            entries = [_entry(shape, base_dir, local) for _, local, shape in parts]
         self._parts += [(key, local, shape) for _, local, shape in parts]
-        self.triangle_count += sum(geo.triangle_count(e.primitive) for e in entries)
+        triangles = sum(geo.triangle_count(e.primitive) for e in entries)
+        self.triangle_count += triangles
+        if isinstance(key, str):
+            self._solid_triangles[key] = triangles
         self.shapes += [_shape_info(name, owner, shape) for name, _, shape in parts]
         return self.engine.add_body(entries, pose, owner=owner, movable=movable)
 
@@ -274,11 +284,58 @@ class Scene:
         body = self._solid_body.pop(name, None)
         if body is not None:
             self.engine.remove_body(body)
+        self.triangle_count -= self._solid_triangles.pop(name, 0)
         self.recognisable.pop(name, None)
         if name in self._attached:
             self._lights = [entry for entry in self._lights if entry[1] != name]
             self._attached.discard(name)
             self.lights_version += 1
+
+    def solid_entries(self, solid: wm.Solid) -> tuple[list, list[ShapeEntry]]:
+        """A top-level solid's parts (``solid_parts``) and their ray-engine entries, built before
+        anything changes (a mesh that cannot be read raises here, the scene untouched)."""
+        parts = list(solid_parts(solid, Pose.identity()))
+        return parts, [_entry(shape, self._base_dir, local) for _, local, shape in parts]
+
+    def add_solid(self, solid: wm.Solid, node_id: int, prepared: tuple[list, list[ShapeEntry]] | None = None) -> None:
+        """A top-level solid a Supervisor imported (``importMFNodeFromString``): its body joins the
+        ray engine (every ray kind sees it from the next cast), its pose ``solid_poses``, its
+        lights the light arrays, its recognition colours the cameras' objects (as Supervisor node
+        ``node_id``). Its shape ids follow every existing one (none is ever reused)."""
+        name = solid.name
+        if name in self.solid_poses or name in self.solid_names:
+            raise KeyError(f"a solid named {name!r} exists or existed")
+        parts, entries = prepared if prepared is not None else self.solid_entries(solid)
+        pose = pose_from_model(solid.pose)
+        self.solid_names.append(name)
+        self.solid_poses[name] = pose
+        if parts:
+            cone = any(isinstance(shape.geometry, wm.Cone) for _, _, shape in parts)
+            self._solid_body[name] = self._add_body(parts, self._base_dir, pose, owner=-1, movable=cone, key=name,
+                                                    entries=entries)
+            self._shape_arrays()
+            models = [(shape.geometry, shape.appearance) for _, _, shape in parts]
+            if self.textures is not None:
+                self.textures.extend(models)
+            elif any(a is not None and a.texture is not None for _, a in models):
+                self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
+                                               ink_evaporation=self._ink_evaporation)
+            self.shapes_version += 1
+        carried = [(lt, name, f) for lt, f in solid_lights(solid, Pose.identity())]
+        if carried:
+            self._lights += carried
+            self._attached.add(name)
+            self.lights_version += 1
+        if solid.recognition_colors:
+            self.recognisable[name] = (node_id, [tuple(c) for c in solid.recognition_colors], solid.model)
+
+    def add_top_light(self, model: object) -> int:
+        """A top-level light a Supervisor imported: light sensors and cameras count it from their
+        next measurement. Returns its index among the top-level lights (after every existing one)."""
+        index = len(self.top_lights())
+        self._lights.append((model, None, Pose.identity()))
+        self.lights_version += 1
+        return index
 
     def device_shapes(self, robot: int, device: str) -> frozenset[int]:
         """The shapes (``Scene.shapes`` indices) of a device's own Solid (``of_device``), which its

@@ -156,11 +156,22 @@ class StepReport:
 
 class Simulation:
     def __init__(self, world: LoadedWorld | wm.World, precision: Precision | str = Precision.EXACT,
-                 base_dir: Path | None = None, contact: bool | None = None):
-        """``contact``: kinematic contact on/off (default: the world's ``world_info.contact``)."""
+                 base_dir: Path | None = None, contact: bool | None = None, *, limits: WorldLimits | None = None,
+                 allow_outside_meshes: bool = False):
+        """``contact``: kinematic contact on/off (default: the world's ``world_info.contact``);
+        ``limits``/``allow_outside_meshes``: what a Supervisor's imported nodes may add (the world's
+        load settings; default ``WorldLimits()``)."""
         loaded = from_model(world, base_dir) if isinstance(world, wm.World) else world
         self.loaded = loaded
-        self.world = loaded.world
+        # solids and lists of its own: a Supervisor's imports append to them (the loaded world stays as read)
+        self.world = loaded.world.model_copy(update={"solids": list(loaded.world.solids),
+                                                    "lights": list(loaded.world.lights)})
+        self.limits = limits or WorldLimits()
+        self.allow_outside_meshes = allow_outside_meshes
+        self.imported: list[tuple[str, str | int]] = []     # (node type, key) of each node a Supervisor imported
+        self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
+                                                            # a node was imported (None: id order)
+        self._import_protos: Any = None                     # the world's EXTERNPROTO declarations, read once
         self.basic_time_step = self.world.world_info.basic_time_step
         self.seed = self.world.world_info.random_seed
         self.time_ms = 0
@@ -202,7 +213,8 @@ class Simulation:
             self.contact.place(index, pose)
 
     def reset(self) -> None:
-        """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, wheel
+        """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
+        Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, pen ink cleared (the pens keep their
         ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file.
         The clock keeps running (the lockstep's time never goes back) and devices keep their
@@ -225,6 +237,11 @@ class Simulation:
             self.scene.set_solid_pose(name, pose)
             if self.contact is not None:
                 self.contact.update_solid(name, pose)
+        for kind, key in self.imported:         # Webots' reset removes the nodes a Supervisor imported
+            if kind == "Solid" and key in self.scene.solid_poses:
+                self.remove_solid(str(key))
+            elif kind != "Solid" and key not in self.scene.removed_lights:
+                self.remove_light(int(key))
         for k, light in enumerate(self._initial["lights"]):    # fields a supervisor changed
             if self.scene.top_lights()[k] is not light:
                 self.scene.set_top_light(k, light)
@@ -241,7 +258,7 @@ class Simulation:
         sensors would notice (a robot, a device, a shape) is also one ``WorldLossWarning``."""
         loaded = load_world(path, limits=limits, allow_outside_meshes=allow_outside_meshes)
         warn_losses(loaded.report)
-        return cls(loaded, precision, contact=contact)
+        return cls(loaded, precision, contact=contact, limits=limits, allow_outside_meshes=allow_outside_meshes)
 
     # ------------------------------------------------------------------ access
     @property
@@ -294,6 +311,48 @@ class Simulation:
             raise KeyError(f"no top-level light {index} (the world has {count}; removed: "
                            f"{sorted(self.scene.removed_lights) or 'none'})")
         self.scene.remove_top_light(index)
+
+    def next_node_id(self) -> int:
+        """The Supervisor id the next imported node gets: after every node the world has had (robots,
+        solids and top-level lights, removed ones included), so no id is ever reused."""
+        return 1 + len(self.robots) + len(self.scene.solid_names) + len(self.scene.top_lights())
+
+    def import_nodes(self, text: str) -> list[tuple[str, str | int, int]]:
+        """Webots' ``importMFNodeFromString`` into the root's children: the string's nodes (solids,
+        PROTO instances that are solids, lights; sim/imports.py) join the world, in order, from the
+        next measurement (every ray kind, kinematic contact, light sensors, cameras' recognition).
+        Returns each as (node type, key: solid name or top-level light index, Supervisor id). A
+        string that cannot be imported raises ``ImportRefused`` (one line) and nothing changes."""
+        from sensorium.server.sim.imports import check_additions, read_node_string, world_protos
+        from sensorium.server.world.geometry import triangle_count
+        from sensorium.server.world.limits import ProtoLimits
+
+        if self._import_protos is None:
+            self._import_protos = world_protos(self.loaded, ProtoLimits.matching(self.limits))
+        nodes = read_node_string(text, self.loaded, self.world, taken=set(self.scene.solid_names), limits=self.limits,
+                                 allow_outside_meshes=self.allow_outside_meshes, protos=self._import_protos)
+        prepared = [self.scene.solid_entries(n.model) if n.type == "Solid" else None for n in nodes]
+        added = sum(triangle_count(e.primitive) for p in prepared if p is not None for e in p[1])
+        check_additions(self.world, set(self.scene.solid_poses), len(self.scene.world_lights()),
+                        self.scene.triangle_count, added, nodes, self.limits)
+        out: list[tuple[str, str | int, int]] = []
+        for node, prep in zip(nodes, prepared):
+            node_id = self.next_node_id()
+            if prep is not None:
+                solid = node.model
+                self.world.solids.append(solid)
+                self.scene.add_solid(solid, node_id, prep)
+                if self.contact is not None:
+                    pose = self.scene.solid_poses[solid.name]
+                    self.contact.add_solid(solid.name, [(e.primitive, local, shape.seen_by in ("both", "bounding"))
+                                                        for (_, local, shape), e in zip(*prep)], pose)
+                key: str | int = solid.name
+            else:
+                self.world.lights.append(node.model)
+                key = self.scene.add_top_light(node.model)
+            self.imported.append((node.type, key))
+            out.append((node.type, key, node_id))
+        return out
 
     @property
     def counters(self) -> dict[str, int]:

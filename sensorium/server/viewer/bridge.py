@@ -280,7 +280,7 @@ class FoxgloveBridge:
         self._scene_bytes: bytes | None = None
         self._scene_key: Any = None
         self._seen_poses: list[Any] = []
-        self._seen_removed_lights = 0
+        self._seen_removed_lights = (0, len(world.lights) if world is not None else 0)
         # data path
         self._queue: deque[tuple[str, str, bytes, int]] = deque()
         # bounded in bytes, not only in messages: a 16-layer lidar's cloud is ~260 KB, and 256 of
@@ -438,7 +438,9 @@ class FoxgloveBridge:
                     self._event.set()
         if self.solid_poses is not None and self._subs.get(SCENE_TOPIC, 0) > 0:
             poses = list(self.solid_poses().values())
-            removed = len(self.removed_lights()) if self.removed_lights is not None else 0
+            # lights removed or imported (a Supervisor's) change the scene too
+            removed = (len(self.removed_lights()) if self.removed_lights is not None else 0,
+                       len(self.world.lights) if self.world is not None else 0)
             if len(poses) != len(self._seen_poses) or any(a is not b for a, b in zip(poses, self._seen_poses)) \
                     or removed != self._seen_removed_lights:
                 if self._seen_poses:
@@ -547,7 +549,7 @@ class FoxgloveBridge:
         poses = self.solid_poses() if self.solid_poses is not None else None
         removed = frozenset(self.removed_lights()) if self.removed_lights is not None else frozenset()
         key = (tuple((n, p.translation.tobytes(), p.rotation.tobytes()) for n, p in (poses or {}).items()),
-               tuple(sorted(removed)))
+               tuple(sorted(removed)), len(self.world.lights))
         if self._scene_bytes is None or key != self._scene_key:
             self._scene_bytes = self._scene_mod.scene_update(self.world, self.base_dir, 0, poses, removed).encode()
             self._scene_key = key

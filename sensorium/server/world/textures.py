@@ -651,7 +651,6 @@ class TextureSampler:
 
     def __init__(self, shapes: list[tuple[Any, wm.Appearance | None]], base_dir: Path, *,
                  ink_evaporation: float = 0.0, ink_texels_max: int = INK_TEXELS_MAX):
-        self.models = shapes
         self.base_dir = Path(base_dir)
         self.shapes: dict[int, ShapeTexture] = {}
         self.ink: dict[int, InkLayer] = {}
@@ -662,25 +661,35 @@ class TextureSampler:
         self._uv: dict[tuple[int, bool], UvOf] = {}
         self._locators: dict[int, TriangleLocator] = {}
         self._meshes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        images: dict[Path, np.ndarray] = {}
-
-        def image(t: wm.Texture | None) -> TextureImage | None:
-            if t is None:
-                return None
-            path = resolve_texture_url(t.url, base_dir, allow_outside=True)
-            if path not in images:
-                images[path] = load_image(path, t.url)
-            return TextureImage(images[path], t.repeat_s, t.repeat_t)
-
-        for i, (_, app) in enumerate(shapes):
-            if app is not None and app.texture is not None:
-                base = image(app.texture)
-                assert base is not None
-                self.shapes[i] = ShapeTexture(base, image(app.roughness_map), image(app.occlusion_map),
-                                              app.texture_transform)
-        self.textured = np.zeros(len(shapes) + 1, dtype=bool)
-        self.textured[list(self.shapes)] = True
+        self._images: dict[Path, np.ndarray] = {}
+        self.models: list[tuple[Any, wm.Appearance | None]] = []
+        self.textured = np.zeros(1, dtype=bool)
+        self.extend(shapes)
         self.lookups = 0
+
+    def _image(self, t: wm.Texture | None) -> TextureImage | None:
+        if t is None:
+            return None
+        path = resolve_texture_url(t.url, self.base_dir, allow_outside=True)
+        if path not in self._images:
+            self._images[path] = load_image(path, t.url)
+        return TextureImage(self._images[path], t.repeat_s, t.repeat_t)
+
+    def extend(self, shapes: list[tuple[Any, wm.Appearance | None]]) -> None:
+        """Shapes numbered after the existing ones (a Supervisor's imported solid): their images
+        are read; the ink of existing shapes is kept."""
+        first = len(self.models)
+        self.models = [*self.models, *shapes]
+        for i, (_, app) in enumerate(shapes, start=first):
+            if app is not None and app.texture is not None:
+                base = self._image(app.texture)
+                assert base is not None
+                self.shapes[i] = ShapeTexture(base, self._image(app.roughness_map), self._image(app.occlusion_map),
+                                              app.texture_transform)
+        textured = np.zeros(len(self.models) + 1, dtype=bool)
+        textured[:first] = self.textured[:first]        # the trailing "no hit" entry stays False
+        textured[list(self.shapes)] = True
+        self.textured = textured
 
     def __bool__(self) -> bool:
         return bool(self.shapes) or bool(self.ink)

@@ -576,6 +576,51 @@ void wb_supervisor_field_set_sf_color(WbFieldRef field, const double values[3]) 
   field_set(field, WB_SF_COLOR, &a, "wb_supervisor_field_set_sf_color");
 }
 
+typedef struct {
+  int64_t node;
+  const char *field;
+  int position;
+  const char *node_string;
+} import_args;
+
+static void args_import(sn_req *r, const void *arg) {
+  const import_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "field");
+  sn_req_str(r, a->field);
+  sn_req_key(r, "position");
+  msgpack_pack_int(&r->pk, a->position);
+  sn_req_key(r, "node_string");
+  sn_req_str(r, a->node_string);
+}
+
+/* Webots' import into the root's children: the string's solids and lights join the world from the
+   next step at position (0 first, -1 last); a robot, another node kind or a string that does not read
+   is refused with the server's one line (it names node string:LINE:COL), nothing changed. */
+void wb_supervisor_field_import_mf_node_from_string(WbFieldRef field, int position, const char *node_string) {
+  const char *func = "wb_supervisor_field_import_mf_node_from_string";
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return;
+  if (field == NULL) {
+    fprintf(stderr, "Error: %s() called with NULL 'field' argument.\n", func);
+    return;
+  }
+  if (field->type != WB_MF_NODE) {
+    fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
+    return;
+  }
+  if (node_string == NULL || *node_string == '\0') {
+    fprintf(stderr, "Error: %s() called with a NULL or empty 'node_string' argument.\n", func);
+    return;
+  }
+  import_args a = {field->node, field->name, position, node_string};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/import_node_from_string", 4, args_import, &a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
 /* ------------------------------------------------------------------ the simulation */
 void wb_supervisor_simulation_quit(int status) {
   const char *func = "wb_supervisor_simulation_quit";

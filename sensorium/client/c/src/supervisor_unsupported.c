@@ -342,10 +342,6 @@ void wb_supervisor_field_remove_mf(WbFieldRef field, int index) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_import_mf_node_from_string(WbFieldRef field, int position, const char *node_string) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_field_remove_sf(WbFieldRef field) {
   SN_UNSUPPORTED();
 }

@@ -82,6 +82,9 @@ class Field:
     def setSFColor(self, values: list[float]) -> None:
         wb.wb_supervisor_field_set_sf_color(self._ref, values)
 
+    def importMFNodeFromString(self, position: int, nodeString: str) -> None:  # noqa: N803 - Webots' name
+        wb.wb_supervisor_field_import_mf_node_from_string(self._ref, position, nodeString)
+
     _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_FLOAT: getSFFloat, wb.WB_SF_STRING: getSFString,
                 wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor}
 
@@ -323,7 +326,8 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
     Field: {
         "getActualField": ("field_get_actual_field", None), "enableSFTracking": ("field_enable_sf_tracking", None),
         "disableSFTracking": ("field_disable_sf_tracking", None), "removeMF": ("field_remove_mf", None),
-        "removeSF": ("field_remove_sf", None), "importMFNodeFromString": ("field_import_mf_node_from_string", None),
+        "removeSF": ("field_remove_sf", None),
+        # no node here has an SFNode field to import into (the root's children are its only node field)
         "importSFNodeFromString": ("field_import_sf_node_from_string", None)},
 }
 _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 2, "Vec3f": [_NAN] * 3,

@@ -1,0 +1,216 @@
+"""A Supervisor's ``importMFNodeFromString``: a node string read as the top-level nodes of a world
+file are (the ``.wbt`` parser with its bounds, PROTO expansion, the converter, the world model's
+validation and sanitising), each node one solid or light.
+
+Pure: a string in, world models out (or one ``ImportRefused`` line naming what is wrong and where:
+``node string:LINE:COL`` for the string, ``FILE:LINE:COL`` inside a PROTO file). Nothing of the
+running simulation changes here; :meth:`Simulation.import_nodes` adds what this returns.
+
+As Webots, a PROTO instance must be of a PROTO the world file declares (``EXTERNPROTO`` or
+``IMPORTABLE EXTERNPROTO``; Sensorium's built-in stand-ins need none), a solid whose name is taken
+is renamed ``name(1)``, ``name(2)``, ... (Webots' name clash rule), and every node of the string is
+imported in order. Departures: a robot (a ``Robot`` or a PROTO that is one, or a solid holding
+one) is refused, as are nodes that are neither a solid nor a light (``Transform``, ``Group``,
+``Shape`` at the top, ``WorldInfo``, ...); a ``USE`` names a ``DEF`` of the string only.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+from typing import Any
+
+from sensorium.schemas import world as wm
+from sensorium.server.world.limits import ProtoLimits, WorldLimits
+from sensorium.server.world.loader import LoadedWorld, WorldError, _wbt_problem, parse_world
+from sensorium.server.world.wbt.convert import Converter, Owner, strip_origins
+from sensorium.server.world.wbt.frames import Frame
+from sensorium.server.world.wbt.parser import (
+    ExternProto,
+    Parser,
+    Tokens,
+    WbtFile,
+    WbtSyntaxError,
+    parse_header,
+)
+
+LABEL = "node string"           # how errors name the string (file:line:col style)
+_NAME = "<importMFNodeFromString>"   # its pseudo file, in the world's folder: relative urls resolve there
+DEFAULT_VERSION = "R2023b"      # the Webots version webots:// urls of a YAML world's imports refer to
+
+
+class ImportRefused(ValueError):
+    """A node string that is not imported: one line, what is wrong and where."""
+
+
+@dataclass(frozen=True)
+class ImportedNode:
+    type: str           # "Solid" or the light's type (PointLight, SpotLight, DirectionalLight)
+    model: Any          # wm.Solid or the light model, validated and sanitised
+
+
+@dataclass
+class _WorldProtos:
+    """What a world file declares for its imports: EXTERNPROTO declarations and its version tag."""
+
+    version: str
+    declarations: list[ExternProto]
+
+
+def world_protos(loaded: LoadedWorld, limits: ProtoLimits) -> _WorldProtos:
+    """The EXTERNPROTO declarations at the head of a ``.wbt`` world (read once by the caller;
+    a YAML world declares none)."""
+    if not loaded.source.lower().endswith(".wbt") or not loaded.text:
+        return _WorldProtos(DEFAULT_VERSION, [])
+    text = loaded.text.decode("utf-8", errors="replace")
+    year, letter = parse_header(text, loaded.source)
+    parser = Parser(Tokens(text, loaded.source), loaded.source, limits=limits)
+    decls: list[ExternProto] = []
+    while True:             # declarations come before the first node (Webots writes them there)
+        tok = parser.peek()
+        importable = tok.kind == "name" and tok.text == "IMPORTABLE" and parser.peek(1).text == "EXTERNPROTO"
+        if importable:
+            parser.take()
+            tok = parser.peek()
+        if not (tok.kind == "name" and tok.text == "EXTERNPROTO"):
+            break
+        parser.take()
+        url = parser.expect("str", "a quoted url after EXTERNPROTO").text[1:-1]
+        # importable for the expansion: an import uses some of them, the others are not checked again
+        decls.append(ExternProto(url, tok.line, tok.col, True))
+    return _WorldProtos(f"R{year}{letter}", decls)
+
+
+class _Converter(Converter):
+    """The converter with Webots' name clash rule against every solid name the world has had."""
+
+    def __init__(self, *args: Any, taken: set[str], **kwargs: Any):
+        super().__init__(*args, **kwargs)
+        self.taken = set(taken)
+
+    def unique_name(self, name: str) -> str:
+        unique, k = name, 0
+        while unique in self.taken:
+            k += 1
+            unique = f"{name}({k})"
+        self.taken.add(unique)
+        return unique
+
+
+def _shown(message: str, source: str) -> str:
+    return message.replace(source, LABEL)
+
+
+def _syntax(exc: WbtSyntaxError, source: str) -> ImportRefused:
+    where = LABEL if exc.source == source else exc.source
+    at = f"{where}:{exc.line}:{exc.col}" if exc.line else where
+    return ImportRefused(f"{at}: {_shown(exc.message, source)}")
+
+
+def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: set[str], limits: WorldLimits,
+                     allow_outside_meshes: bool = False, protos: _WorldProtos | None = None) -> list[ImportedNode]:
+    """The nodes of ``text`` as world models, in order (``ImportRefused`` for anything that is not
+    imported). ``taken``: every solid name the world has had (removed ones included: names are
+    never reused); ``limits``: the world's (the string alone stays within them; what it adds to
+    the world is checked by the caller)."""
+    if not isinstance(text, str):
+        raise ImportRefused(f"the node string must be a string, got {type(text).__name__}")
+    size = len(text.encode("utf-8", errors="surrogatepass"))
+    if size > limits.file_bytes:
+        raise ImportRefused(f"a node string of {size:,} bytes, more than the world file limit of "
+                            f"{limits.file_bytes:,} (raise the limits with --allow-large)")
+    proto_limits = ProtoLimits.matching(limits)
+    source = str(loaded.base_dir / _NAME)
+    try:
+        protos = protos or world_protos(loaded, proto_limits)
+        wbt = Parser(Tokens(text, source), source, limits=proto_limits).file(protos.version, text)
+        if wbt.declarations or wbt.protos:
+            at = wbt.declarations[0] if wbt.declarations else wbt.protos[0]
+            raise ImportRefused(f"{LABEL}:{at.line}:{at.col}: a node string declares no PROTO: declare it in the "
+                                "world file (IMPORTABLE EXTERNPROTO), as Webots requires")
+        if not wbt.nodes:
+            raise ImportRefused(f"{LABEL}: no node in it (e.g. 'Solid {{ ... }}')")
+        wbt = WbtFile(protos.version, wbt.nodes, [], source, list(protos.declarations))
+        return _convert(wbt, source, loaded, world, taken, limits, proto_limits, allow_outside_meshes)
+    except WbtSyntaxError as exc:           # ProtoError too: in the string or a PROTO file
+        raise _syntax(exc, source) from None
+
+
+def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, taken: set[str], limits: WorldLimits,
+             proto_limits: ProtoLimits, allow_outside_meshes: bool) -> list[ImportedNode]:
+    from sensorium.server.world.proto import ProtoSearch, expand
+
+    expansion = expand(wbt, ProtoSearch.create(loaded.base_dir), proto_limits)
+    conv = _Converter(expansion.as_wbt(), source, expansion.search, max_grid_points=proto_limits.values, taken=taken)
+    conv.world["world_info"] = {"coordinate_system": world.world_info.coordinate_system}
+    top = Owner("world", {})
+    kinds: list[str] = []
+    for written, node in zip(wbt.nodes, expansion.nodes):
+        solids, lights = len(conv.world["solids"]), len(conv.world["lights"])
+        what = written.type if written.type == node.type else f"{written.type} (a {node.type})"
+        at = f"{LABEL}:{written.line}:{written.col}"
+        conv.visit(node, Frame.identity(), top, top=True)
+        if conv.world["robots"]:
+            held = "" if node.type == "Robot" else f" (it holds robot {conv.world['robots'][0]['name']!r})"
+            raise ImportRefused(f"{at}: {what}: a robot cannot be imported here{held}: a departure from Webots, "
+                                "which imports robots too (write it in the world file)")
+        if conv.losses:
+            hint = " (a PROTO must be declared in the world file: IMPORTABLE EXTERNPROTO)" \
+                if "not a built-in node or PROTO" in conv.losses[0].text else ""
+            raise ImportRefused(_shown(conv.losses[0].text, source).replace("; skipped (with everything inside it)", "")
+                                + hint)
+        made = [("Solid", s) for s in conv.world["solids"][solids:]] + \
+               [(lt["type"], lt) for lt in conv.world["lights"][lights:]]
+        if len(made) != 1 or top.parts or conv.world["world_info"].keys() - {"coordinate_system"}:
+            raise ImportRefused(f"{at}: {what}: not importable here: a node string holds solids (Solid, or a PROTO "
+                                "that is one) and lights (PointLight, SpotLight, DirectionalLight) only")
+        kinds.append(made[0][0])
+    origin: dict[str, tuple[int, int, str]] = {}
+    data = strip_origins({"solids": conv.world["solids"], "lights": conv.world["lights"]}, "", origin)
+    data["world_info"] = {"coordinate_system": world.world_info.coordinate_system}
+    try:
+        fragment = parse_world(data, source=LABEL, base_dir=loaded.base_dir, limits=limits,
+                               allow_outside_meshes=allow_outside_meshes, asset_files=conv.asset_files).world
+    except WorldError as exc:
+        first = _wbt_problem(exc.problems[0], origin)
+        more = f" (and {len(exc.problems) - 1} more)" if len(exc.problems) > 1 else ""
+        if first.path.startswith("line "):      # placed at the string's node it came from
+            where = first.path.replace("line ", f"{LABEL}:", 1).replace(", column ", ":", 1)
+        else:
+            where = f"{LABEL}: {first.path}" if first.path else LABEL
+        raise ImportRefused(f"{where}: {_shown(first.message, source)}{more}") from None
+    queue: Counter[str] = Counter()
+    out = []
+    for kind in kinds:
+        group = "Solid" if kind == "Solid" else "light"
+        models = fragment.solids if group == "Solid" else fragment.lights
+        out.append(ImportedNode(kind, models[queue[group]]))
+        queue[group] += 1
+    return out
+
+
+def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles_now: int, triangles_added: int,
+                    nodes: list[ImportedNode], limits: WorldLimits) -> None:
+    """The world with ``nodes`` added stays within its limits (solids with their nested children,
+    lights, triangles), else ``ImportRefused`` saying by how much."""
+
+    def count(solid: wm.Solid) -> tuple[int, int]:
+        n, lights = 1, len(solid.lights)
+        for child in solid.children:
+            dn, dl = count(child)
+            n, lights = n + dn, lights + dl
+        return n, lights
+
+    def over(what: str, now: int, added: int, cap: int) -> None:
+        if now + added > cap:
+            raise ImportRefused(f"importing it would bring the world to {now + added:,} {what} ({now:,} now, "
+                                f"{added:,} added), more than the limit of {cap:,} (raise the limits with --allow-large)")
+
+    solids_now = sum(count(s)[0] for s in world.solids if s.name in alive)
+    added = [count(n.model) if n.type == "Solid" else (0, 1) for n in nodes]
+    over("solids (nested children included)", solids_now, sum(a[0] for a in added), limits.solids)
+    over("lights", lights_now, sum(a[1] for a in added), limits.lights)
+    over("triangles", triangles_now, triangles_added, limits.triangles)
+
+
+__all__ = ["ImportRefused", "ImportedNode", "read_node_string", "check_additions", "world_protos"]
