@@ -672,3 +672,91 @@ def test_a_kind_never_enabled_is_never_due_and_enabling_it_later_measures_on_its
     bs.enable(ref, 0, copies=[1, 2])
     bs.run(8)
     assert bs.counters["measurements"] == 2
+
+
+def _hills(seed: int) -> wm.World:
+    """Two robots with bodies (contact between them and a wall) on a floor with a rough terrain and a
+    ramp on it: they climb, cross ridges, drive off onto the floor."""
+    rng = np.random.default_rng(99)
+    nx = ny = 9
+    rough = rng.uniform(0.0, 0.3, nx * ny)
+    rough[[0, nx - 1, -nx, -1]] = 0.0
+    ramp = [0.2 * i * 0.5 for j in range(5) for i in range(5)]
+    body = {"geometry": {"type": "cylinder", "radius": 0.1, "height": 0.08}}
+    devices = [{"device": "DistanceSensor", "name": "front", "pose": {"translation": [0.1, 0.0, 0.02]},
+                "lookup_table": [[0, 0, 0], [2, 2, 0]]},
+               {"device": "DistanceSensor", "name": "down", "pose": {"translation": [0.05, 0.0, 0.0],
+                                                                     "rotation": [0, 1, 0, 1.2]},
+                "lookup_table": [[0, 0, 0], [2, 2, 0.01]]},
+               {"device": "Lidar", "name": "lidar", "horizontal_resolution": 64, "number_of_layers": 3,
+                "field_of_view": 3.0, "vertical_field_of_view": 0.3, "max_range": 4.0},
+               {"device": "PositionSensor", "name": "enc", "motor": "left wheel motor"}]
+    drive = {"wheel_radius": 0.05, "axle_length": 0.25, "max_wheel_speed": 12.0}
+    return wm.World.model_validate({
+        "world_info": {"random_seed": seed},
+        "solids": [{"name": "floor", "geometry": {"type": "plane"}},
+                   {"name": "rough", "pose": {"translation": [-2.0, -2.0, 0.0], "rotation": [0, 0, 1, 0.3]},
+                    "geometry": {"type": "elevation_grid", "height": rough.tolist(), "x_dimension": nx,
+                                 "x_spacing": 0.5, "y_dimension": ny, "y_spacing": 0.5}},
+                   {"name": "ramp", "pose": {"translation": [1.5, -1.0, 0.0]},
+                    "geometry": {"type": "elevation_grid", "height": ramp, "x_dimension": 5, "x_spacing": 0.5,
+                                 "y_dimension": 5, "y_spacing": 0.5}},
+                   {"name": "wall", "pose": {"translation": [3.2, 0.0, 0.5]}, "geometry": {"type": "box", "size": [0.1, 6, 1]}}],
+        "robots": [{"name": "a", "pose": {"translation": [-0.3, -0.2, 0.3], "rotation": [0, 0, 1, 0.4]},
+                    "body": body, "differential_drive": drive, "devices": devices},
+                   {"name": "b", "pose": {"translation": [1.2, 0.3, 0.06], "rotation": [0, 0, 1, -0.2]},
+                    "body": body, "differential_drive": drive, "devices": devices}]})
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_copies_riding_terrains_are_the_single_simulation_bit_for_bit(precision):
+    """Robots riding a rough terrain and a ramp (heights, attitudes, contact bands), random wheel
+    commands, a supervisor move onto a slope: every copy's poses, distance readings, range images
+    and encoders equal a Simulation's with that copy's seed after every step, bit for bit."""
+    seeds = [3, 4, 5]
+    bs = BatchedSimulation(_hills(0), len(seeds), precision=precision)
+    bs.reset(np.arange(3), seeds)
+    sims = [Simulation(_hills(s), precision=precision) for s in seeds]
+    names = ["front", "down", "lidar", "enc"]
+    for robot in ("a", "b"):
+        for n in names:
+            bs.enable(bs.device(robot, n), 32)
+            for s in sims:
+                s.robot(robot).device(n).enable(32)
+    rng = np.random.default_rng(1)
+    tilted = 0
+    for step in range(120):
+        if step % 12 == 0:
+            for robot in ("a", "b"):
+                slot = bs.slot(robot)
+                lr = rng.uniform(-12.0, 12.0, (3, 2)) if step % 24 else np.full((3, 2), 10.0)
+                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
+                for c, s in enumerate(sims):
+                    _drive_single(s, robot, float(lr[c, 0]), float(lr[c, 1]))
+        if step == 60:                        # a supervisor puts copy 1's robot a onto the ramp's slope
+            bs.set_pose(1, bs.slot("a"), [2.3, -0.5, 0.5])
+            sims[1].robot("a").set_pose([2.3, -0.5, 0.5])
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot in ("a", "b"):
+                slot = bs.slot(robot)
+                pose = s.robot(robot).pose
+                assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
+                assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
+                tilted += abs(pose.rotation[2, 2]) < 1.0 - 1e-6
+                for n in names:
+                    ref, dev = bs.device(robot, n), s.robot(robot).device(n)
+                    if ref.kind == "Lidar":
+                        assert dev.range_image.tobytes() == bs.range_image(ref)[c].tobytes(), (step, c, n)
+                    else:
+                        assert _same_value(dev.value, float(bs.value(ref)[c])), (step, c, robot, n)
+    assert tilted > 100                       # they did ride slopes
+    assert bs.ground is not None and len({float(z) for z in bs.pos[:, :, 2].ravel()}) > 3
+
+
+def _drive_single(sim: Simulation, robot: str, left: float, right: float) -> None:
+    for m in sim.robot(robot).motors.values():
+        m.set_position(math.inf)
+    sim.robot(robot).drive.left.set_velocity(left)
+    sim.robot(robot).drive.right.set_velocity(right)

@@ -321,3 +321,61 @@ def test_range_image_observations_clip_nan_and_infinities_as_the_box_clip_does()
     assert np.isnan(img).any() and np.isinf(img).any()
     one = venv._observe(np.array([1]))[name]
     assert one.tobytes() == want[1:2].tobytes()
+
+
+def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
+    """A hilly world (a random terrain on a floor, a ramp): random starts keep the world-file
+    clearance above the ground where they land; the vector env's sub-env i and the single env with
+    seed 5 + i agree on observations, rewards and poses (heights and attitudes included) across
+    autoresets, and the robots did ride slopes."""
+    from sensorium.gym.task import random_start
+    from sensorium.schemas import world as wm
+
+    rng = np.random.default_rng(3)
+    heights = rng.uniform(0.0, 0.4, 81)
+    world = wm.World.model_validate({
+        "solids": [{"name": "floor", "geometry": {"type": "plane"}},
+                   {"name": "hills", "pose": {"translation": [-2.0, -2.0, 0.0]},
+                    "geometry": {"type": "elevation_grid", "height": heights.tolist(), "x_dimension": 9,
+                                 "x_spacing": 0.5, "y_dimension": 9, "y_spacing": 0.5}}],
+        "robots": [{"name": "rover", "pose": {"translation": [0.1, 0.2, 0.5]},
+                    "body": {"geometry": {"type": "cylinder", "radius": 0.08, "height": 0.05}},
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 15.0},
+                    "devices": [{"device": "DistanceSensor", "name": "ahead", "lookup_table": [[0, 0, 0], [3, 3, 0]],
+                                 "pose": {"rotation": [0, 1, 0, 0.3]}},
+                                {"device": "Lidar", "name": "scan", "horizontal_resolution": 32,
+                                 "number_of_layers": 2, "vertical_field_of_view": 0.2, "max_range": 3.0}]}]})
+    task = Task(robot="rover", observations=["ahead", "scan"], max_steps=15, start=random_start((-1.5, 1.5), (-1.5, 1.5)))
+    n = 3
+    venv = SensoriumVectorEnv(world, task, n, precision="exact")
+    singles = [SensoriumEnv(world, task, precision="exact", engine="simulation") for _ in range(n)]
+    obs, info = venv.reset(seed=5)
+    for i, env in enumerate(singles):
+        o, inf = env.reset(seed=5 + i)
+        assert _same_obs(_row(obs, i), o) and inf["pose"].tobytes() == info["pose"][i].tobytes()
+    sim = singles[0].sim
+    ground = sim.ground
+    x, y, z = sim.robot("rover").pose.translation
+    assert abs(z - (ground.at(x, y)[0] + 0.5 - ground.at(0.1, 0.2)[0])) <= 1e-12      # the clearance kept
+    rng = np.random.default_rng(2)
+    done = np.zeros(n, dtype=bool)
+    tilted = resets = 0
+    for t in range(40):
+        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        a[:, 0] = np.abs(a[:, 0])
+        a[:, 1] = a[:, 0]                                 # straight on: over the hills
+        vobs, vr, vte, vtr, vinfo = venv.step(a)
+        for i, env in enumerate(singles):
+            if done[i]:
+                o, inf = env.reset()
+                r, te, tr = 0.0, False, False
+                resets += 1
+            else:
+                o, r, te, tr, inf = env.step(a[i])
+            assert _same_obs(_row(vobs, i), o), (t, i)
+            assert (r, te, tr) == (vr[i], vte[i], vtr[i]), (t, i)
+            assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
+            tilted += abs(env.sim.robot("rover").pose.rotation[2, 2]) < 1.0 - 1e-6
+            done[i] = te or tr
+    venv.close()
+    assert resets >= 3 and tilted > 30

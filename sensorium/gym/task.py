@@ -106,7 +106,9 @@ def body_radius(robot, base_dir=None) -> float:
 
 class random_start:
     """``Task.start``: put the robot at a uniformly random (x, y, yaw) in the given ranges, at its
-    world-file height. Draws from the environment's seeded generator, so a seed fixes the start."""
+    world-file height (in a world with terrains: its world-file clearance above the ground there,
+    so it rides the terrain from where it lands). Draws from the environment's seeded generator,
+    so a seed fixes the start."""
 
     def __init__(self, x: tuple[float, float], y: tuple[float, float], yaw: tuple[float, float] = (-math.pi, math.pi)):
         self.x, self.y, self.yaw = x, y, yaw
@@ -116,6 +118,12 @@ class random_start:
         x = rng.uniform(*self.x)
         y = rng.uniform(*self.y)
         yaw = rng.uniform(*self.yaw)
+        ground = getattr(sim, "ground", None)
+        if ground is not None:
+            here = ground.at(float(robot.pose.translation[0]), float(robot.pose.translation[1]))
+            there = ground.at(x, y)
+            if here is not None and there is not None:
+                z = there[0] + (z - here[0])
         robot.set_pose([x, y, z], rotation=[0.0, 0.0, 1.0, yaw])
 
 

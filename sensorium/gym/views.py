@@ -5,7 +5,7 @@ A :class:`~sensorium.gym.task.Task`'s ``start(sim, robot, rng)`` (and a reward o
 without a vectorised form) is written against :class:`~sensorium.server.sim.simulation.Simulation`
 and its ``RobotState``. The vector environment hands them these views of one copy instead:
 
-* ``CopySim``: ``time_ms``, ``basic_time_step``, ``world``, ``loaded``, ``robots`` / ``robot(name)``,
+* ``CopySim``: ``time_ms``, ``basic_time_step``, ``world``, ``loaded``, ``ground``, ``robots`` / ``robot(name)``,
   ``run(steps)`` / ``step()`` (this copy alone),
   ``scene`` (``world_lights()``, ``solid_poses``, ``solids_version``, and ``engine.cast(...)`` casting in this copy only:
   ``exclude_owner`` is a robot index, as in the single simulation);
@@ -169,6 +169,7 @@ class CopySim:
         self.loaded = sim.loaded
         self.basic_time_step = sim.basic_time_step
         self.scene = _Scene(sim, copy)
+        self.ground = sim.ground           # the terrains robots ride (shared by every copy; None without)
         self.robots = {name: CopyRobot(sim, copy, i) for i, name in enumerate(sim.robot_names)}
 
     @property

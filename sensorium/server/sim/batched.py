@@ -46,7 +46,8 @@ from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
-from sensorium.server.sim.motion import DifferentialDrive
+from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
+from sensorium.server.sim.motion import DifferentialDrive, _rz
 from sensorium.server.sim.scene import Scene, _entry, _shape_info, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import DistanceSensor, Lidar, LightSensor, PositionSensor
 from sensorium.server.sim.simulation import lights_from_models
@@ -225,8 +226,10 @@ class BatchedSimulation:
             if r.differential_drive else {} for r in w.robots]
         self.side_wheels = np.array([[len(n) for n in r.differential_drive.motor_names] if r.differential_drive
                                      else [1, 1] for r in w.robots], dtype=np.int64)
-        self._templates = [DifferentialDrive(r.differential_drive, self.initial[i]) if r.differential_drive else None
-                           for i, r in enumerate(w.robots)]
+        # the terrains robots ride (sim/ground.py; None in a world without one: heights never change)
+        self.ground = Ground.from_world(w, self.scene.solid_poses, None)
+        self._templates = [DifferentialDrive(r.differential_drive, self.initial[i], ground=self.ground)
+                           if r.differential_drive else None for i, r in enumerate(w.robots)]
         # -- per copy state
         self.time_ms = np.zeros(C, dtype=np.int64)
         self.rot = np.zeros((C, R, 3, 3))
@@ -240,6 +243,11 @@ class BatchedSimulation:
         self.velocity = np.zeros((C, R, 2))
         self.wheel_angle = np.zeros((C, R, 2))
         self.pressing = np.zeros((C, R), dtype=bool)
+        # riding the ground (PlanarState.rest, z0, slope): NaN rest is nothing under it when placed
+        self.rest = np.full((C, R), math.nan)
+        self.z0 = np.zeros((C, R))
+        self.slope = np.zeros((C, R, 2))
+        self.tilted = np.zeros((C, R), dtype=bool)
         # -- kinematic contact: the solids' obstacles once, the robots' discs per copy
         use_contact = w.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = None
@@ -436,12 +444,12 @@ class BatchedSimulation:
             raise ValueError(f"reset: {len(idx)} copies but {len(world_seeds)} world seeds")
         self.time_ms[idx] = 0
         for r, pose in enumerate(self.initial):
-            self.rot[idx, r] = pose.rotation
-            self.pos[idx, r] = pose.translation
             tpl = self._templates[r]
             if tpl is not None:
-                self.x[idx, r], self.y[idx, r], self.z[idx, r], self.yaw[idx, r] = tpl.x, tpl.y, tpl.z, tpl.yaw
-                self.base[idx, r] = tpl.base
+                self._take_template(idx, r, tpl)
+                pose = tpl.placed(pose)
+            self.rot[idx, r] = pose.rotation
+            self.pos[idx, r] = pose.translation
             if self.contact is not None:
                 self.centres[idx, r] = pose.translation[:2]
                 self.heights[idx, r] = pose.translation[2]
@@ -462,18 +470,30 @@ class BatchedSimulation:
     def set_pose(self, copy: int, slot: int, translation=None, rotation=None, quaternion=None) -> None:
         """Move a robot of one copy (supervisor-style, no contact check), as ``RobotState.set_pose``."""
         check_pose(translation, rotation, quaternion)
-        pose = moved_pose(self.pose(copy, slot), translation, rotation, quaternion)
+        current = self.pose(copy, slot)
+        if self.tilted[copy, slot]:   # its own rotation, without the ground's attitude (PlanarState.own_pose)
+            current = Pose(_rz(float(self.yaw[copy, slot])) @ self.base[copy, slot], current.translation)
+        pose = moved_pose(current, translation, rotation, quaternion)
+        tpl = self._templates[slot]
+        if tpl is not None:
+            tpl.reset(pose)       # the single simulation's own arithmetic (yaw, base, the ground under it)
+            self._take_template(np.array([copy]), slot, tpl)
+            pose = tpl.placed(pose)
+            tpl.reset(self.initial[slot])
         self.rot[copy, slot] = pose.rotation
         self.pos[copy, slot] = pose.translation
         if self.contact is not None:
             self.centres[copy, slot] = pose.translation[:2]
             self.heights[copy, slot] = pose.translation[2]
-        tpl = self._templates[slot]
-        if tpl is not None:
-            tpl.reset(pose)       # the single simulation's own arithmetic (yaw, base)
-            self.x[copy, slot], self.y[copy, slot], self.z[copy, slot], self.yaw[copy, slot] = tpl.x, tpl.y, tpl.z, tpl.yaw
-            self.base[copy, slot] = tpl.base
-            tpl.reset(self.initial[slot])
+
+    def _take_template(self, idx: np.ndarray, slot: int, tpl: DifferentialDrive) -> None:
+        """The copies' drive state of a slot from a template drive just reset to a pose."""
+        self.x[idx, slot], self.y[idx, slot], self.z[idx, slot], self.yaw[idx, slot] = tpl.x, tpl.y, tpl.z, tpl.yaw
+        self.base[idx, slot] = tpl.base
+        self.rest[idx, slot] = math.nan if tpl.rest is None else tpl.rest
+        self.z0[idx, slot] = tpl.z0
+        self.tilted[idx, slot] = tpl.slope is not None
+        self.slope[idx, slot] = tpl.slope if tpl.slope is not None else (0.0, 0.0)
 
     def set_wheels(self, slot: int, left, right, copies=None) -> None:
         """Velocity control of a slot's wheels (rad/s, clamped to the maximum as Webots does) in the
@@ -548,11 +568,34 @@ class BatchedSimulation:
         if self.contact is not None:
             x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
         self.x[copies, slots], self.y[copies, slots] = x, y
+        if self.ground is not None:
+            self._ride(copies, slots, x, y)
         # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
         rz = np.zeros((len(yaw), 3, 3))
         rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
-        self.rot[copies, slots] = np.matmul(rz, self.base[copies, slots])
+        rot = np.matmul(rz, self.base[copies, slots])
+        if self.ground is not None:   # on a slope: the ground's attitude (ground_rotation, as PlanarState.pose)
+            k = self.tilted[copies, slots].nonzero()[0]
+            if len(k):
+                c, r = copies[k], slots[k]
+                rot[k] = ground_rotation(self.slope[c, r, 0], self.slope[c, r, 1], cos[k], sin[k], self.base[c, r])
+        self.rot[copies, slots] = rot
         self.pos[copies, slots] = np.stack([x, y, self.z[copies, slots]], axis=1)
+
+    def _ride(self, copies: np.ndarray, slots: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
+        """PlanarState.settle for the moved robots placed over ground: height and slope under them."""
+        assert self.ground is not None
+        k = (~np.isnan(self.rest[copies, slots])).nonzero()[0]
+        if not len(k):
+            return
+        c, r = copies[k], slots[k]
+        found, h, gx, gy = self.ground.under(x[k], y[k])
+        self.z[c, r] = ride_height(self.z[c, r], self.z0[c, r], self.rest[c, r], found, h)
+        self.tilted[c, r] = found & ((gx != 0.0) | (gy != 0.0))
+        self.slope[c, r, 0] = np.where(found, gx, 0.0)
+        self.slope[c, r, 1] = np.where(found, gy, 0.0)
+        if self.contact is not None:
+            self.heights[c, r] = self.z[c, r]
 
     def _drive_wheels(self, live: np.ndarray, driven: np.ndarray, dt: float):
         """The wheels and drives of :meth:`_drive` in numpy (packets.drive_wheels' fallback): the

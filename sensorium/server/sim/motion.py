@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sensorium.server.sim.ground import Ground, ground_angular_velocity, ground_rotation, ride_height
 from sensorium.server.world.geometry import Pose
 
 _TWO_PI = 2.0 * math.pi
@@ -111,10 +112,17 @@ class PlanarState:
     The robot's rotation is kept as ``Rz(yaw) @ base`` where ``base`` is the part of its initial
     rotation that is not a turn about the up axis, so a tilted robot keeps its tilt while driving.
     In a NUE world poses are converted on the way in and out, so the robot drives on the ground
-    plane (normal +y) there."""
+    plane (normal +y) there.
 
-    def __init__(self, pose: Pose, up: str = "ENU"):
+    With a ``ground`` (a world with terrains, sim/ground.py) the robot rides it: :meth:`settle`,
+    after each planar move, sets its height to the ground under its origin plus the clearance it
+    was placed with, and over a sloped triangle its rotation becomes ``ground_rotation(slope, yaw)
+    @ base`` (the ground's roll and pitch, the drive's yaw). A robot placed over nothing keeps its
+    height wherever it goes, as without a ground."""
+
+    def __init__(self, pose: Pose, up: str = "ENU", ground: Ground | None = None):
         self._to_enu = _TO_ENU[up]
+        self.ground = ground
         self.reset(pose)
 
     def reset(self, pose: Pose) -> None:
@@ -130,6 +138,44 @@ class PlanarState:
         self.speed = 0.0
         self.turn = 0.0
         self.linear: tuple[float, float] | None = None
+        # riding the ground: its height where the robot was placed (None: nothing under it, or no
+        # ground in the world), the robot's height then, the slope under it (None: level)
+        self.rest: float | None = None
+        self.z0 = self.z
+        self.slope: tuple[float, float] | None = None
+        if self.ground is not None:
+            under = self.ground.at(self.x, self.y)
+            if under is not None:
+                self.rest = under[0]
+                self.slope = under[1:] if (under[1] or under[2]) else None
+
+    def settle(self) -> None:
+        """Ride the ground after a planar move (nothing to do without one)."""
+        if self.ground is None or self.rest is None:
+            return
+        under = self.ground.at(self.x, self.y)
+        if under is None:
+            self.slope = None         # nothing under it: it keeps its height, upright
+            return
+        h, gx, gy = under
+        self.z = float(ride_height(self.z, self.z0, self.rest, True, h))
+        self.slope = (gx, gy) if (gx or gy) else None
+
+    def placed(self, pose: Pose) -> Pose:
+        """The pose a robot put at ``pose`` (just :meth:`reset` there) takes: ``pose`` itself, or
+        over a slope the ground's attitude (its height is kept)."""
+        return pose if self.slope is None else self.pose()
+
+    def own_pose(self) -> Pose:
+        """The pose without the ground's attitude (``Rz(yaw) @ base``): what a supervisor move of
+        the translation alone keeps as the rotation, so a robot on a slope is not tilted twice."""
+        if self.slope is None:
+            return self.pose()
+        slope, self.slope = self.slope, None
+        try:
+            return self.pose()
+        finally:
+            self.slope = slope
 
     def moved(self, v: float, w: float) -> None:
         """Record the step's motion (v along the heading the step ends with, turn rate w): what
@@ -142,13 +188,22 @@ class PlanarState:
         linear = self.linear
         if linear is None:
             linear = (self.speed * math.cos(self.yaw), self.speed * math.sin(self.yaw))
-        lin, ang = np.array([*linear, 0.0]), np.array([0.0, 0.0, self.turn])
+        if self.slope is None:
+            lin, ang = np.array([*linear, 0.0]), np.array([0.0, 0.0, self.turn])
+        else:                         # along the plane under it, turning about its normal
+            gx, gy = self.slope
+            lin = np.array([*linear, gx * linear[0] + gy * linear[1]])
+            ang = np.array(ground_angular_velocity(gx, gy, math.cos(self.yaw), math.sin(self.yaw), self.turn))
         if self._to_enu is not None:
             lin, ang = self._to_enu.T @ lin, self._to_enu.T @ ang
         return [float(v) for v in (*lin, *ang)]
 
     def pose(self) -> Pose:
-        r, t = _rz(self.yaw) @ self.base, np.array([self.x, self.y, self.z])
+        if self.slope is None:
+            r = _rz(self.yaw) @ self.base
+        else:
+            r = ground_rotation(self.slope[0], self.slope[1], math.cos(self.yaw), math.sin(self.yaw), self.base)
+        t = np.array([self.x, self.y, self.z])
         if self._to_enu is not None:
             r, t = self._to_enu.T @ r, self._to_enu.T @ t
         return Pose(rotation=r, translation=t)
@@ -167,7 +222,7 @@ class DifferentialDrive(PlanarState):
     robot drives on the ground plane (normal +y) there.
     """
 
-    def __init__(self, config, pose: Pose, up: str = "ENU"):
+    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None):
         self.wheel_radius = float(config.wheel_radius)
         self.axle_length = float(config.axle_length)
         speed = float(config.max_wheel_speed)
@@ -176,7 +231,7 @@ class DifferentialDrive(PlanarState):
         self.right = WheelMotor(config.right_motor, speed)
         self.lefts = [self.left, *(WheelMotor(name, speed) for name in (skid.left if skid else ()))]
         self.rights = [self.right, *(WheelMotor(name, speed) for name in (skid.right if skid else ()))]
-        super().__init__(pose, up)
+        super().__init__(pose, up, ground)
 
     @property
     def motors(self) -> dict[str, WheelMotor]:
@@ -212,7 +267,7 @@ class AckermannDrive(PlanarState):
     the driven wheels. The steering angles used for a step are the motors' at its end (they hold
     their positions by position control, at most ``max_steering_speed`` fast)."""
 
-    def __init__(self, config, pose: Pose, up: str = "ENU"):
+    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None):
         self.wheelbase = float(config.wheelbase)
         self.track_front, self.track_rear = float(config.track_front), float(config.track_rear)
         self.sign = 1.0 if config.positive_steers == "right" else -1.0
@@ -225,7 +280,7 @@ class AckermannDrive(PlanarState):
                  "right_rear_wheel": (0.0, -self.track_rear / 2, rr), "left_rear_wheel": (0.0, self.track_rear / 2, rr)}
         # each driven wheel: its motor, its (x, y) on the car, its radius
         self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
-        super().__init__(pose, up)
+        super().__init__(pose, up, ground)
 
     @property
     def motors(self) -> dict[str, WheelMotor]:

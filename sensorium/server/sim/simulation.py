@@ -12,6 +12,7 @@ Nothing is computed for a device that is disabled.
 
 from __future__ import annotations
 
+import warnings
 from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -25,7 +26,8 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
 from sensorium.server.sim.contact import Contact
-from sensorium.server.sim.motion import AckermannDrive, DifferentialDrive, WheelMotor
+from sensorium.server.sim.ground import Ground, GroundWarning
+from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
 from sensorium.server.sim.scene import Scene, light_from_model, primitive_from_model, robot_parts, solid_parts
@@ -94,11 +96,15 @@ class RobotState:
                                        self_collision=model.self_collision, world_seed=sim.seed,
                                        clock=lambda: sim.time_ms, own_shapes=sim.scene.device_shapes(index, d.name))
         up = sim.world.world_info.coordinate_system
+        self.initial_pose = sim.scene.robot_poses[index]     # as the world file places it (reset puts it back there)
         self.drive: DifferentialDrive | AckermannDrive | None = None
         if model.differential_drive is not None:
-            self.drive = DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index], up=up)
+            self.drive = DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index], up=up,
+                                           ground=sim.ground)
         elif model.ackermann_drive is not None:
-            self.drive = AckermannDrive(model.ackermann_drive, sim.scene.robot_poses[index], up=up)
+            self.drive = AckermannDrive(model.ackermann_drive, sim.scene.robot_poses[index], up=up, ground=sim.ground)
+        if self.drive is not None and self.drive.slope is not None:   # placed on a slope: its attitude
+            sim.scene.set_robot_pose(index, self.drive.pose())
         self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
         for dev in self.devices.values():
             dev.bind(self)
@@ -128,12 +134,16 @@ class RobotState:
         """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
         setters); the next measurement sees it there. Translation and rotation are independent
         (Webots): leave one out (``None``) and it keeps its current value. Non-finite values or a
-        translation beyond ``limits.MAX_COORDINATE_M`` raise ValueError and the robot stays."""
+        translation beyond ``limits.MAX_COORDINATE_M`` raise ValueError and the robot stays.
+        A driven robot set over a terrain rides it from there (sim/ground.py): the height given is
+        its clearance, the rotation its own (upright) one, the ground's attitude applied over it."""
         check_pose(translation, rotation, quaternion)
-        pose = moved_pose(self.pose, translation, rotation, quaternion)
-        self._sim.place_robot(self.index, pose)
+        current = self.drive.own_pose() if self.drive is not None and self.drive.slope is not None else self.pose
+        pose = moved_pose(current, translation, rotation, quaternion)
         if self.drive is not None:
             self.drive.reset(pose)
+            pose = self.drive.placed(pose)
+        self._sim.place_robot(self.index, pose)
 
     def motor(self, name: str) -> WheelMotor:
         try:
@@ -177,10 +187,13 @@ class Simulation:
         self.time_ms = 0
         self.step_count = 0
         self.scene = Scene(self.world, loaded.base_dir, precision)
+        self.ground = Ground.from_world(self.world, self.scene.solid_poses, _TO_ENU[self.world.world_info.coordinate_system])
         self.lights = lights_from_models(self.scene.world_lights())
         self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
+        if self.ground is not None:
+            self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
         self._counters: Counter[str] = Counter()
         self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[Device]] | None = None
@@ -193,8 +206,21 @@ class Simulation:
         every = list(self.all_devices())
         self.radio = Radio([d for d in every if isinstance(d, Emitter)], [d for d in every if isinstance(d, Receiver)],
                            self.scene, self._counters)
-        self._initial: dict[str, Any] = {"robots": [(r.pose, r.custom_data) for r in self.robots.values()],
+        self._initial: dict[str, Any] = {"robots": [(r.initial_pose, r.custom_data) for r in self.robots.values()],
                          "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights()}
+
+    def _warn_ground(self) -> None:
+        """One GroundWarning per thing a driven robot will not ride on: a tilted terrain, a robot
+        that starts over no ground (it keeps its height: terrains never lift it)."""
+        assert self.ground is not None
+        for name in self.ground.tilted_terrains():
+            warnings.warn(f"{self.loaded.source}: solid {name!r}: its ElevationGrid is tilted (its local z is not "
+                          "the world's up): not ground, robots keep their height over it", GroundWarning, stacklevel=3)
+        for r in self._driven:
+            if r.drive is not None and r.drive.rest is None:
+                warnings.warn(f"{self.loaded.source}: robot {r.name!r} starts over no ground (no upright terrain or "
+                              "floor plane under its origin): it keeps its height, terrains do not lift it",
+                              GroundWarning, stacklevel=3)
 
     def _build_contact(self) -> Contact:
         base = self.loaded.base_dir
@@ -224,9 +250,9 @@ class Simulation:
             if robot.drive is not None:
                 for m in robot.drive.motors.values():
                     m.target_position, m.velocity, m.position = 0.0, m.max_velocity, 0.0
-            self.place_robot(robot.index, pose)
-            if robot.drive is not None:
                 robot.drive.reset(pose)
+                pose = robot.drive.placed(pose)
+            self.place_robot(robot.index, pose)
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
                     dev.set(0, self.time_ms)
@@ -237,6 +263,8 @@ class Simulation:
             self.scene.set_solid_pose(name, pose)
             if self.contact is not None:
                 self.contact.update_solid(name, pose)
+            if self.ground is not None:
+                self.ground.update_solid(name, pose)
         for kind, key in self.imported:         # Webots' reset removes the nodes a Supervisor imported
             if kind == "Solid" and key in self.scene.solid_poses:
                 self.remove_solid(str(key))
@@ -292,6 +320,8 @@ class Simulation:
         self.scene.set_solid_pose(name, pose)
         if self.contact is not None:
             self.contact.update_solid(name, pose)
+        if self.ground is not None:
+            self.ground.update_solid(name, pose)
 
     def remove_solid(self, name: str) -> None:
         """Take a top-level solid out of the world for good (Webots' ``node.remove()``): from the
@@ -302,6 +332,8 @@ class Simulation:
         self.scene.remove_solid(name)
         if self.contact is not None:
             self.contact.remove_solid(name)
+        if self.ground is not None:
+            self.ground.remove_solid(name)
 
     def remove_light(self, index: int) -> None:
         """Take top-level light ``index`` (the world's ``lights`` order) out for good: light sensors
@@ -402,6 +434,13 @@ class Simulation:
                     drive.x, drive.y = float(end[0]), float(end[1])
                     drive.linear = ((drive.x - start[0]) * 1000.0 / dt, (drive.y - start[1]) * 1000.0 / dt)
                     moved[k] = (robot, drive, start, drive.pose())
+        if self.ground is not None:   # ride the ground where the (clipped) move ended
+            for k, (robot, drive, start, _) in enumerate(moved):
+                if drive.rest is not None:
+                    drive.settle()
+                    moved[k] = (robot, drive, start, drive.pose())
+                    if self.contact is not None:
+                        self.contact.heights[robot.index] = moved[k][3].translation[2]
         for robot, _, _, pose in moved:
             self.scene.set_robot_pose(robot.index, pose)
         poses = self.scene.robot_poses

@@ -1,0 +1,255 @@
+"""The ground driven robots ride on: terrains (ElevationGrids) and the floor planes around them.
+
+No physics: a driven robot keeps the clearance it was placed with above the ground under its
+origin. After each step's planar move its height is ``ground(x, y) + clearance`` and, over a
+sloped triangle, its attitude is the ground's (:func:`ground_rotation`): its up axis is the
+triangle's normal and its heading the drive's yaw. Over nothing it keeps its height, upright.
+
+What counts as ground (seen by bounding rays, as kinematic contact reads the world):
+
+* an ElevationGrid whose local z is the world's up (a grid turned about the vertical, or not at
+  all): its surface is each cell's two triangles split from point ``(i, j)`` to ``(i + 1, j + 1)``,
+  the triangles rays see, evaluated in float64 from the grid's own vertex coordinates; it covers
+  its closed extent ``[0, (x_dimension − 1)·x_spacing] × [0, (y_dimension − 1)·y_spacing]`` and
+  nothing beyond;
+* a Plane facing up (its local z the world's up): a floor at its height, everywhere (bounding rays
+  and Webots' physics take every plane as infinite, whatever its size).
+
+Where several cover a point the highest is the ground (the first in world order on a tie). On a
+line shared by two triangles (a cell's diagonal or edge, a grid point) both triangles give the
+same height, bit for bit (the barycentric weights below make the shared terms identical); the
+slope there is the triangle on the +x / +y side (the lower triangle ``s ≥ t`` on the diagonal,
+the last cell on the grid's far edges). Every function here is element-wise float64 arithmetic
+that gives the same bits on a scalar and on any array, so the batched simulation's copies ride
+exactly as the single simulation's robot does.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.world.geometry import Pose
+
+__all__ = ["Ground", "GroundWarning", "ground_rotation", "ride_height"]
+
+UPRIGHT_TOL = 1e-12     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
+
+
+class GroundWarning(UserWarning):
+    """Something a driven robot will not ride on (a tilted terrain) or a robot with no ground
+    under it in a world that has terrains: one line saying what and why."""
+
+
+@dataclass(slots=True)
+class _Grid:
+    """An ElevationGrid in the solid's frame: its vertex coordinates and heights."""
+
+    xs: np.ndarray          # (nx,) i·x_spacing, as the mesh's vertices
+    ys: np.ndarray          # (ny,)
+    heights: np.ndarray     # (ny, nx)
+
+
+@dataclass(slots=True)
+class _Surface:
+    """One piece of ground placed in the world (ENU axes): a grid, or a floor plane (``grid`` None)."""
+
+    solid: str
+    local: Pose                       # in the solid's frame
+    grid: _Grid | None
+    # its world placement (set by Ground.place): origin and the turn about the vertical
+    tx: float = 0.0
+    ty: float = 0.0
+    tz: float = 0.0
+    r00: float = 1.0
+    r01: float = 0.0
+    r10: float = 0.0
+    r11: float = 1.0
+    upright: bool = True
+
+
+def _is_upright(r: np.ndarray) -> bool:
+    return (abs(r[0, 2]) <= UPRIGHT_TOL and abs(r[1, 2]) <= UPRIGHT_TOL and abs(r[2, 0]) <= UPRIGHT_TOL
+            and abs(r[2, 1]) <= UPRIGHT_TOL and r[2, 2] > 0.0)
+
+
+class Ground:
+    """The world's ground (see the module docstring); :meth:`under` samples it at points."""
+
+    def __init__(self, surfaces: list[_Surface], poses: dict[str, Pose], to_enu: np.ndarray | None):
+        self._surfaces = surfaces
+        self._to_enu = to_enu
+        self._poses = dict(poses)
+        for s in surfaces:
+            self._place(s)
+
+    @classmethod
+    def from_world(cls, world: wm.World, solid_poses: dict[str, Pose], to_enu: np.ndarray | None) -> Ground | None:
+        """The ground of a world with at least one terrain seen by bounding rays (None otherwise:
+        robots then keep their heights, as they always did). ``solid_poses``: the top-level solids'
+        world poses; ``to_enu``: world axes to ENU (None in an ENU world)."""
+        from sensorium.server.sim.scene import solid_parts
+
+        surfaces: list[_Surface] = []
+        for s in world.solids:
+            for _, local, shape in solid_parts(s, Pose.identity()):
+                if shape.seen_by not in ("both", "bounding"):
+                    continue
+                g = shape.geometry
+                if isinstance(g, wm.ElevationGrid):
+                    xs = np.arange(g.x_dimension, dtype=np.float64) * float(g.x_spacing)
+                    ys = np.arange(g.y_dimension, dtype=np.float64) * float(g.y_spacing)
+                    h = np.asarray(g.height, dtype=np.float64).reshape(g.y_dimension, g.x_dimension)
+                    surfaces.append(_Surface(s.name, local, _Grid(xs, ys, h)))
+                elif isinstance(g, wm.Plane):
+                    surfaces.append(_Surface(s.name, local, None))
+        if not any(s.grid is not None for s in surfaces):
+            return None
+        return cls(surfaces, solid_poses, to_enu)
+
+    def tilted_terrains(self) -> list[str]:
+        """The solids holding a grid that is not upright (not ground: robots keep their height over it)."""
+        return [s.solid for s in self._surfaces if s.grid is not None and not s.upright]
+
+    def _place(self, s: _Surface) -> None:
+        pose = self._poses[s.solid].compose(s.local)
+        r, t = pose.rotation, pose.translation
+        if self._to_enu is not None:
+            r, t = self._to_enu @ r, self._to_enu @ t
+        s.upright = _is_upright(r)
+        s.tx, s.ty, s.tz = (float(v) for v in t)
+        s.r00, s.r01, s.r10, s.r11 = float(r[0, 0]), float(r[0, 1]), float(r[1, 0]), float(r[1, 1])
+
+    def update_solid(self, name: str, pose: Pose) -> None:
+        """A solid moved (supervisor): its pieces of ground move with it."""
+        if name not in self._poses:
+            return
+        self._poses[name] = pose
+        for s in self._surfaces:
+            if s.solid == name:
+                self._place(s)
+
+    def remove_solid(self, name: str) -> None:
+        """A solid removed (supervisor): no longer ground."""
+        self._surfaces = [s for s in self._surfaces if s.solid != name]
+        self._poses.pop(name, None)
+
+    def under(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The ground under points (ENU x, y arrays): ``(found, z, gx, gy)`` — whether any covers
+        each point, its height there and its slope (dz/dx, dz/dy in ENU axes; 0 on floors)."""
+        x = np.asarray(x, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        best = np.full(x.shape, -math.inf)
+        gx = np.zeros(x.shape)
+        gy = np.zeros(x.shape)
+        found = np.zeros(x.shape, dtype=bool)
+        for s in self._surfaces:
+            if not s.upright:
+                continue
+            if s.grid is None:                   # an infinite floor
+                z = np.full(x.shape, s.tz)
+                take = z > best
+                best = np.where(take, z, best)
+                gx = np.where(take, 0.0, gx)
+                gy = np.where(take, 0.0, gy)
+                found |= take
+                continue
+            ex, ey = x - s.tx, y - s.ty
+            u = s.r00 * ex + s.r10 * ey          # the point in the grid's frame (R^T (p - t))
+            v = s.r01 * ex + s.r11 * ey
+            g = s.grid
+            cover = (u >= 0.0) & (u <= g.xs[-1]) & (v >= 0.0) & (v <= g.ys[-1])
+            if not cover.any():
+                continue
+            k = cover.nonzero()
+            h, gu, gv = grid_height(g, u[k], v[k])
+            z = s.tz + h
+            take = z > best[k]
+            kk = tuple(a[take] for a in k)
+            best[kk] = z[take]
+            gx[kk] = s.r00 * gu[take] + s.r01 * gv[take]      # the slope turns with the grid
+            gy[kk] = s.r10 * gu[take] + s.r11 * gv[take]
+            found[kk] = True
+        return found, best, gx, gy
+
+    def at(self, x: float, y: float) -> tuple[float, float, float] | None:
+        """:meth:`under` at one point: ``(z, gx, gy)`` or None (the same arithmetic, so the same bits)."""
+        found, z, gx, gy = self.under(np.array([x]), np.array([y]))
+        if not found[0]:
+            return None
+        return float(z[0]), float(gx[0]), float(gy[0])
+
+
+def cell_of(grid: _Grid, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The cell holding each point of the grid's extent: ``xs[i] <= u < xs[i + 1]`` (the last cell
+    also holds its far edge), likewise j."""
+    i = np.clip(np.searchsorted(grid.xs, u, side="right") - 1, 0, len(grid.xs) - 2)
+    j = np.clip(np.searchsorted(grid.ys, v, side="right") - 1, 0, len(grid.ys) - 2)
+    return i, j
+
+
+def triangle_height(grid: _Grid, i: np.ndarray, j: np.ndarray, lower: np.ndarray, u: np.ndarray,
+                    v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Height and slope (along local x, y) at (u, v) of cell (i, j)'s lower triangle (points
+    (i, j), (i+1, j), (i+1, j+1)) where ``lower``, else its upper one ((i, j), (i+1, j+1), (i, j+1)).
+
+    Barycentric weights from the cell's own vertex coordinates: s, t in the cell; lower
+    ``(1−s)·a + (s−t)·b + t·c``, upper ``(1−t)·a + s·c + (t−s)·d``. On the diagonal (s = t) both are
+    ``(1−s)·a + s·c`` plus an exact 0; on a cell edge the neighbour's weights are the same terms, so
+    a shared point gets one height whichever triangle is asked."""
+    x0, x1 = grid.xs[i], grid.xs[i + 1]
+    y0, y1 = grid.ys[j], grid.ys[j + 1]
+    s = (u - x0) / (x1 - x0)
+    t = (v - y0) / (y1 - y0)
+    H = grid.heights
+    a, b, c, d = H[j, i], H[j, i + 1], H[j + 1, i + 1], H[j + 1, i]
+    h = np.where(lower, (1.0 - s) * a + (s - t) * b + t * c, (1.0 - t) * a + s * c + (t - s) * d)
+    gu = np.where(lower, (b - a) / (x1 - x0), (c - d) / (x1 - x0))
+    gv = np.where(lower, (c - b) / (y1 - y0), (d - a) / (y1 - y0))
+    return h, gu, gv
+
+
+def grid_height(grid: _Grid, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Height and local slope of the grid's surface at points of its extent (see :func:`cell_of`;
+    the lower triangle on the diagonal)."""
+    i, j = cell_of(grid, u, v)
+    s = (u - grid.xs[i]) / (grid.xs[i + 1] - grid.xs[i])
+    t = (v - grid.ys[j]) / (grid.ys[j + 1] - grid.ys[j])
+    return triangle_height(grid, i, j, s >= t, u, v)
+
+
+def ride_height(z_last, z0, rest, found, h):
+    """A driven robot's height over the ground sampled under it: ``h + (z0 − rest)`` (its clearance
+    kept), exactly ``z0`` over ground as high as where it was placed, its last height over nothing.
+    Scalars or arrays, the same bits."""
+    return np.where(found, np.where(h == rest, z0, h + (z0 - rest)), z_last)
+
+
+def ground_rotation(gx, gy, c, s, base: np.ndarray) -> np.ndarray:
+    """A robot's rotation on a ground of slope (gx, gy) with heading (cos, sin) = (c, s): ``A @ base``
+    where A's columns are the forward axis ``f ∝ (c, s, gx·c + gy·s)`` (in the ground plane, seen
+    from above along the heading), ``n × f`` and the ground's normal ``n ∝ (−gx, −gy, 1)``; so the
+    roll and pitch are the ground's and the yaw the drive's. Element-wise (any leading shape, with
+    ``base`` (..., 3, 3)), each entry summed in one fixed order: the same bits for one robot or many."""
+    k = gx * c + gy * s
+    fl = np.sqrt(c * c + s * s + k * k)
+    fx, fy, fz = c / fl, s / fl, k / fl
+    nl = np.sqrt(gx * gx + gy * gy + 1.0)
+    nx, ny, nz = -gx / nl, -gy / nl, 1.0 / nl
+    lx, ly, lz = ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx
+    a = ((fx, lx, nx), (fy, ly, ny), (fz, lz, nz))
+    rows = [np.stack([a[r][0] * base[..., 0, col] + a[r][1] * base[..., 1, col] + a[r][2] * base[..., 2, col]
+                      for col in range(3)], axis=-1) for r in range(3)]
+    return np.stack(rows, axis=-2)
+
+
+def ground_angular_velocity(gx: float, gy: float, c: float, s: float, turn: float) -> tuple[float, float, float]:
+    """The angular velocity (ENU) of a robot turning at ``turn`` rad/s on a plane of slope (gx, gy)
+    with heading (c, s): it turns about the plane's normal, ``turn·(−gx, −gy, 1)/(1 + k²)`` with k
+    the slope along its heading (its yaw turns at ``turn``; 0 slope: ``(0, 0, turn)``)."""
+    k = gx * c + gy * s
+    w = turn / (1.0 + k * k)
+    return -gx * w, -gy * w, w
