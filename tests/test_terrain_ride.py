@@ -391,3 +391,23 @@ def test_a_grid_turned_about_the_vertical_is_ridden_in_its_own_axes() -> None:
         x, y, z = r.pose.translation
         assert abs(z - (SLOPE * y + CLEAR)) <= 1e-12
         assert np.abs(r.pose.rotation - _attitude(0.0, SLOPE, r.drive.yaw)).max() <= 1e-12
+
+
+def test_a_terrain_a_supervisor_imports_is_seen_but_not_ridden() -> None:
+    """importMFNodeFromString adds an ElevationGrid that rays see, but the ground is the world file's:
+    a robot driving over the imported ramp keeps its height, upright (README, Riding terrains)."""
+    sim = _sim([FLOOR], at=(-0.5, 0.0))
+    heights = " ".join(str(SLOPE * i * DX) for j in range(5) for i in range(5))
+    sim.import_nodes(f"Solid {{ name \"ramp\" translation 0 -1 0 children [ Shape {{ geometry ElevationGrid {{ "
+                     f"xDimension 5 xSpacing {DX} yDimension 5 ySpacing {DX} height [ {heights} ] }} }} ] "
+                     f"boundingObject ElevationGrid {{ xDimension 5 xSpacing {DX} yDimension 5 ySpacing {DX} "
+                     f"height [ {heights} ] }} }}")
+    down = sim.scene.engine.cast(np.array([[1.0, 0.0, 5.0]]), np.array([[0.0, 0.0, -1.0]]))
+    assert math.isclose(float(down.distance[0]), 5.0 - SLOPE * 1.0, rel_tol=0, abs_tol=1e-9)   # the ramp is there
+    before = sim.robot("r").pose
+    _drive(sim, 5.0, 5.0)
+    sim.run(100)
+    after = sim.robot("r").pose
+    assert after.translation[0] > 1.0                     # it drove onto the ramp ...
+    assert after.translation[2] == before.translation[2]  # ... and kept its height
+    np.testing.assert_array_equal(after.rotation, before.rotation)
