@@ -255,8 +255,9 @@ def wb_supervisor_field_get_name(field: Field | None) -> str:
     return "" if field is None else field[1]
 
 
-def _field_value(field: Field | None, want: int | None, func: str) -> Any:
-    """The field's value from the server; None after Webots' line for a NULL field or a wrong type."""
+def _field_robot(field: Field | None, want: int | None, func: str):
+    """The supervisor robot for a call on ``field`` of type ``want`` (None: any), or None after
+    Webots' line for a NULL field or a wrong type."""
     r = _supervisor(func)
     if r is None:
         return None
@@ -266,6 +267,15 @@ def _field_value(field: Field | None, want: int | None, func: str) -> Any:
     if want is not None and field[2] != want:
         print(f"Error: {func}() called with wrong field type: {_TYPE_NAMES[field[2]]}.", file=sys.stderr)
         return None
+    return r
+
+
+def _field_value(field: Field | None, want: int | None, func: str) -> Any:
+    """The field's value from the server; None after Webots' line for a NULL field or a wrong type."""
+    r = _field_robot(field, want, func)
+    if r is None:
+        return None
+    assert field is not None
     return _call(r, "get_field", {"node": field[0], "field": field[1]})["value"]
 
 
@@ -332,15 +342,10 @@ def wb_supervisor_field_get_mf_node(field: Field | None, index: int) -> int | No
 
 
 def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
-    r = _supervisor(func)
+    r = _field_robot(field, want, func)
     if r is None:
         return
-    if field is None:
-        print(f"Error: {func}() called with NULL 'field' argument.", file=sys.stderr)
-        return
-    if field[2] != want:
-        print(f"Error: {func}() called with wrong field type: {_TYPE_NAMES[field[2]]}.", file=sys.stderr)
-        return
+    assert field is not None
     if want == WB_SF_BOOL:
         wire: Any = bool(value)
     elif want == WB_SF_FLOAT:
@@ -392,15 +397,10 @@ def wb_supervisor_field_import_mf_node_from_string(field: Field | None, position
     string that does not read (the server's line names where: ``node string:LINE:COL``) is refused
     with one error line and nothing changes."""
     func = "wb_supervisor_field_import_mf_node_from_string"
-    r = _supervisor(func)
+    r = _field_robot(field, WB_MF_NODE, func)
     if r is None:
         return
-    if field is None:
-        print(f"Error: {func}() called with NULL 'field' argument.", file=sys.stderr)
-        return
-    if field[2] != WB_MF_NODE:
-        print(f"Error: {func}() called with wrong field type: {_TYPE_NAMES[field[2]]}.", file=sys.stderr)
-        return
+    assert field is not None
     if not isinstance(node_string, str) or not node_string:
         print(f"Error: {func}() called with a NULL or empty 'node_string' argument.", file=sys.stderr)
         return

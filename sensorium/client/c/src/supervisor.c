@@ -407,21 +407,30 @@ const char *wb_supervisor_field_get_type_name(WbFieldRef field) {
   return "";
 }
 
+/* The supervisor robot for a call on `field` of `type` (WB_NO_FIELD: any), or NULL after Webots'
+   line for a NULL field or a wrong type. */
+static sn_robot *field_robot(WbFieldRef field, WbFieldType type, const char *func) {
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return NULL;
+  if (field == NULL) {
+    fprintf(stderr, "Error: %s() called with NULL 'field' argument.\n", func);
+    return NULL;
+  }
+  if (type != WB_NO_FIELD && field->type != type) {
+    fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
+    return NULL;
+  }
+  return rb;
+}
+
 /* The field's value: 0 with rep filled (free it) and *value its "value" object, -1 after Webots' line
    for a NULL field or a wrong type (type WB_NO_FIELD: any). */
 static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_reply *rep,
                        const msgpack_object **value) {
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = field_robot(field, type, func);
   if (rb == NULL)
     return -1;
-  if (field == NULL) {
-    fprintf(stderr, "Error: %s() called with NULL 'field' argument.\n", func);
-    return -1;
-  }
-  if (type != WB_NO_FIELD && field->type != type) {
-    fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
-    return -1;
-  }
   field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0};
   if (sn_robot_call(rb, "robot/get_field", 2, args_field, &a, func, rep) != 0)
     return -1;
@@ -522,17 +531,9 @@ WbNodeRef wb_supervisor_field_get_mf_node(WbFieldRef field, int index) {
 }
 
 static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const char *func) {
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = field_robot(field, type, func);
   if (rb == NULL)
     return;
-  if (field == NULL) {
-    fprintf(stderr, "Error: %s() called with NULL 'field' argument.\n", func);
-    return;
-  }
-  if (field->type != type) {
-    fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
-    return;
-  }
   if (a->kind == 3 && a->values == NULL) {
     fprintf(stderr, "Error: %s() called with a NULL 'values' argument.\n", func);
     return;
@@ -600,17 +601,9 @@ static void args_import(sn_req *r, const void *arg) {
    is refused with the server's one line (it names node string:LINE:COL), nothing changed. */
 void wb_supervisor_field_import_mf_node_from_string(WbFieldRef field, int position, const char *node_string) {
   const char *func = "wb_supervisor_field_import_mf_node_from_string";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = field_robot(field, WB_MF_NODE, func);
   if (rb == NULL)
     return;
-  if (field == NULL) {
-    fprintf(stderr, "Error: %s() called with NULL 'field' argument.\n", func);
-    return;
-  }
-  if (field->type != WB_MF_NODE) {
-    fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
-    return;
-  }
   if (node_string == NULL || *node_string == '\0') {
     fprintf(stderr, "Error: %s() called with a NULL or empty 'node_string' argument.\n", func);
     return;
