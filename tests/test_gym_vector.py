@@ -29,16 +29,43 @@ def _row(obs: dict, i: int) -> dict:
     return {k: v[i] for k, v in obs.items()}
 
 
+def _reset_both(venv, singles, seed: int) -> None:
+    """The vector env reset with ``seed`` and single env i with ``seed + i``: the same first
+    observations and poses."""
+    obs, info = venv.reset(seed=seed)
+    for i, env in enumerate(singles):
+        o, inf = env.reset(seed=seed + i)
+        assert _same_obs(_row(obs, i), o) and inf["pose"].tobytes() == info["pose"][i].tobytes()
+
+
+def _step_both(venv, singles, a: np.ndarray, done: np.ndarray, t: int) -> int:
+    """One step of the vector env (NEXT_STEP autoreset) and of each single env (reset() after an
+    ended episode) with actions ``a``: the same observations, rewards, flags, clocks and poses;
+    ``done`` updated. Returns the number of single envs reset."""
+    resets = 0
+    vobs, vr, vte, vtr, vinfo = venv.step(a)
+    for i, env in enumerate(singles):
+        if done[i]:
+            o, inf = env.reset()
+            r, te, tr = 0.0, False, False
+            resets += 1
+        else:
+            o, r, te, tr, inf = env.step(a[i])
+        assert _same_obs(_row(vobs, i), o), (t, i)
+        assert (r, te, tr) == (vr[i], vte[i], vtr[i]), (t, i)
+        assert inf["time_ms"] == vinfo["time_ms"][i] and inf["steps"] == vinfo["steps"][i], (t, i)
+        assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
+        done[i] = te or tr
+    return resets
+
+
 def _lockstep(env_id: str, precision: str, n: int, steps: int, max_steps: int, seed: int = 5):
     """The vector env and n single envs (seeds seed + i) fed the same actions; NEXT_STEP autoreset
     on one side, reset() after an ended episode on the other. Returns the number of resets seen."""
     venv = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", precision=precision,
                         max_steps=max_steps)
     singles = [gym.make(env_id, precision=precision, max_steps=max_steps, engine="simulation") for _ in range(n)]
-    obs, info = venv.reset(seed=seed)
-    for i, env in enumerate(singles):
-        o, inf = env.reset(seed=seed + i)
-        assert _same_obs(_row(obs, i), o) and inf["pose"].tobytes() == info["pose"][i].tobytes()
+    _reset_both(venv, singles, seed)
     rng = np.random.default_rng(1)
     done = np.zeros(n, dtype=bool)
     resets = 0
@@ -46,19 +73,7 @@ def _lockstep(env_id: str, precision: str, n: int, steps: int, max_steps: int, s
         a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
         if t % 20 < 10:
             a[:, 1] = a[:, 0] = 1.0                       # full speed ahead: walls, contact, terminations
-        vobs, vr, vte, vtr, vinfo = venv.step(a)
-        for i, env in enumerate(singles):
-            if done[i]:
-                o, inf = env.reset()
-                r, te, tr = 0.0, False, False
-                resets += 1
-            else:
-                o, r, te, tr, inf = env.step(a[i])
-            assert _same_obs(_row(vobs, i), o), (t, i)
-            assert (r, te, tr) == (vr[i], vte[i], vtr[i]), (t, i)
-            assert inf["time_ms"] == vinfo["time_ms"][i] and inf["steps"] == vinfo["steps"][i]
-            assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes()
-            done[i] = te or tr
+        resets += _step_both(venv, singles, a, done, t)
     venv.close()
     return resets
 
@@ -349,10 +364,7 @@ def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
     n = 3
     venv = SensoriumVectorEnv(world, task, n, precision="exact")
     singles = [SensoriumEnv(world, task, precision="exact", engine="simulation") for _ in range(n)]
-    obs, info = venv.reset(seed=5)
-    for i, env in enumerate(singles):
-        o, inf = env.reset(seed=5 + i)
-        assert _same_obs(_row(obs, i), o) and inf["pose"].tobytes() == info["pose"][i].tobytes()
+    _reset_both(venv, singles, 5)
     sim = singles[0].sim
     ground = sim.ground
     x, y, z = sim.robot("rover").pose.translation
@@ -364,18 +376,7 @@ def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
         a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
         a[:, 0] = np.abs(a[:, 0])
         a[:, 1] = a[:, 0]                                 # straight on: over the hills
-        vobs, vr, vte, vtr, vinfo = venv.step(a)
-        for i, env in enumerate(singles):
-            if done[i]:
-                o, inf = env.reset()
-                r, te, tr = 0.0, False, False
-                resets += 1
-            else:
-                o, r, te, tr, inf = env.step(a[i])
-            assert _same_obs(_row(vobs, i), o), (t, i)
-            assert (r, te, tr) == (vr[i], vte[i], vtr[i]), (t, i)
-            assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
-            tilted += abs(env.sim.robot("rover").pose.rotation[2, 2]) < 1.0 - 1e-6
-            done[i] = te or tr
+        resets += _step_both(venv, singles, a, done, t)
+        tilted += sum(abs(env.sim.robot("rover").pose.rotation[2, 2]) < 1.0 - 1e-6 for env in singles)
     venv.close()
     assert resets >= 3 and tilted > 30

@@ -19,7 +19,7 @@ import pytest
 from _protos import HEADER, proto_file
 from test_multiprocess import run_paused
 from test_supervisor import A, Live
-from test_supervisor_remove import BOSS, BULB, CRATE, GATE, LAMP, NULL, ROVER, WALL, WORLD, readings
+from test_supervisor_remove import BOSS, BULB, CRATE, GATE, LAMP, NULL, ROVER, WALL, WORLD, _live, boss, readings
 
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.sim.imports import ImportRefused
@@ -33,19 +33,6 @@ BOX = ("DEF BALL Solid { translation 1.6 0 0.25 name \"ball\" recognitionColors 
 # a light on the sensors' axis, 0.25 m ahead: 1 / 0.25^2 = 16 (attenuation 0 0 1)
 LIGHT = "DEF SPARK PointLight { location 0.25 0 0.1 intensity 1 attenuation 0 0 1 }"
 FIRST = 8                                   # the first imported node's id: after the 7 the world loaded with
-
-
-def _live(precision: str = "exact", **kw) -> Live:
-    lv = Live(Simulation(load_world(WORLD), precision=precision, **kw))
-    lv.ok(A, "attach", {"robot": "boss"})
-    for name in ("ds", "lidar", "depth", "cam", "eye", "shaded"):
-        lv.sim.device(f"boss/{name}").enable(16)
-    lv.sim.device("boss/cam").recognition_enable(16)
-    return lv
-
-
-def boss(lv: Live, item: str, args: dict | None = None):
-    return lv.ok(A, f"/boss/robot/{item}", args)
 
 
 def imports(lv: Live, text: str, position: int = -1) -> list[int]:

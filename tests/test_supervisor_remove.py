@@ -25,8 +25,9 @@ BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB = range(1, 8)      # node ids: robots
 NULL = {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
 
 
-def _live(precision: str = "exact") -> Live:
-    lv = Live(Simulation(load_world(WORLD), precision=precision))
+def _live(precision: str = "exact", **kw) -> Live:
+    """The world in process with the boss attached and its devices enabled (``kw``: Simulation's)."""
+    lv = Live(Simulation(load_world(WORLD), precision=precision, **kw))
     lv.ok(A, "attach", {"robot": "boss"})
     for name in ("ds", "lidar", "depth", "cam", "eye", "shaded"):
         lv.sim.device(f"boss/{name}").enable(16)
