@@ -210,6 +210,11 @@ def test_render_draws_a_moved_solid_where_it_is_and_a_removed_one_no_more():
     env.sim.set_solid_pose("block", [-0.5, 0.5, 0.05])
     img = env.render()
     assert at(img, -0.5, -0.5) == floor and at(img, -0.5, 0.5) == block and at(img, 0.5, -0.5) == floor
+    # a solid a Supervisor imports is drawn from the next frame (a green box where the crate was)
+    env.sim.import_nodes('Solid { name "gift" translation 0.5 -0.5 0.05 children [ Shape { appearance '
+                         'PBRAppearance { baseColor 0 1 0 } geometry Box { size 0.2 0.2 0.1 } } ] }')
+    img = env.render()
+    assert at(img, 0.5, -0.5) == (0, 255, 0) and at(img, -0.5, 0.5) == block
 
 
 @pytest.mark.parametrize("vector_cls", [SyncVectorEnv, AsyncVectorEnv])

@@ -52,7 +52,7 @@ def _color(shape: wm.Shape | wm.Solid) -> tuple[int, int, int]:
 
 class TopDown:
     """Renders ``sim`` at ``size`` x ``size`` pixels. The solids are drawn into a static layer, drawn
-    again only when the scene's ``solids_version`` changes (a solid moved or removed); robots and
+    again only when the scene's ``solids_version`` changes (a solid moved, imported or removed); robots and
     lights (which may ride on them) at every call. The view (centre and scale) is fixed when the
     renderer is made, so frames of one episode line up; a solid moved outside it is cut off."""
 
@@ -154,7 +154,7 @@ class TopDown:
 
     def render(self) -> np.ndarray:
         version = self.sim.scene.solids_version
-        if version != self._static_version:       # a solid moved or was removed since the last drawing
+        if version != self._static_version:       # a solid moved, was imported or removed since the last drawing
             self._static = self._draw_static(*self._solid_polygons())
             self._static_version = version
         img = self._static.copy()

@@ -193,7 +193,7 @@ class Scene:
         self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         self.lights_version = 0        # changes whenever a light moves with its owner
-        self.solids_version = 0        # changes whenever a top-level solid moves or is removed (gym's TopDown)
+        self.solids_version = 0        # changes whenever a top-level solid moves, is added or removed (gym's TopDown)
         self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
         self.shapes_version = 0        # changes whenever a Supervisor adds shapes (cameras' recognition rebuilds)
         self._shape_arrays()
@@ -309,6 +309,7 @@ class Scene:
         pose = pose_from_model(solid.pose)
         self.solid_names.append(name)
         self.solid_poses[name] = pose
+        self.solids_version += 1
         if parts:
             cone = any(isinstance(shape.geometry, wm.Cone) for _, _, shape in parts)
             self._solid_body[name] = self._add_body(parts, self._base_dir, pose, owner=-1, movable=cone, key=name,
