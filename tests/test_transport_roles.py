@@ -3,12 +3,18 @@ its thread busy for the stated time (what the row measures depends on that)."""
 
 from __future__ import annotations
 
+import shutil
+import subprocess
 import threading
 import time
+from pathlib import Path
 
+import pytest
 import zmq
 
 from sensorium.benchmarks.transport_roles import _role_rep_work
+
+C_DIR = Path(__file__).resolve().parents[1] / "sensorium" / "benchmarks" / "c"
 
 
 def test_rep_work_echoes_each_message_after_its_work(tmp_path, capsys) -> None:
@@ -71,3 +77,43 @@ def test_router_raw_echoes_each_clients_bytes_to_that_client(tmp_path, capsys) -
         for d in dealers:
             d.close(0)
         ctx.term()
+
+
+@pytest.mark.slow
+def test_c_router_echo_sends_every_frame_back_to_its_sender(tmp_path) -> None:
+    """The bench's C pattern row: rep_echo.c with `router` echoes each DEALER's message, every frame in
+    order, to that DEALER only (and without it stays a REP echo)."""
+    cc = shutil.which("cc")
+    if cc is None or not Path("/usr/include/zmq.h").exists():
+        pytest.skip("no C compiler or libzmq headers")
+    exe = tmp_path / "rep_echo"
+    subprocess.run([cc, "-std=c11", "-O2", "-Wall", "-Werror", str(C_DIR / "rep_echo.c"), "-o", str(exe), "-lzmq"],
+                   check=True, timeout=120)
+    ctx = zmq.Context()
+    procs, socks = [], []
+    try:
+        for mode, kind in (("router", zmq.DEALER), ("rep", zmq.REQ)):
+            p = subprocess.Popen([str(exe), "tcp://127.0.0.1:*", mode], stdout=subprocess.PIPE, text=True)
+            procs.append(p)
+            endpoint = p.stdout.readline().split()[1]             # "ready ENDPOINT" once bound
+            pair = [ctx.socket(kind) for _ in range(2 if mode == "router" else 1)]
+            socks += pair
+            for s in pair:
+                s.setsockopt(zmq.RCVTIMEO, 30_000)
+                s.connect(endpoint)
+            for i in range(3):
+                if mode == "router":
+                    for k, s in enumerate(pair):
+                        s.send_multipart([b"client %d" % k, b"frame %d" % i])
+                    for k, s in enumerate(pair):
+                        assert s.recv_multipart() == [b"client %d" % k, b"frame %d" % i]
+                else:
+                    pair[0].send(b"step %d" % i)
+                    assert pair[0].recv() == b"step %d" % i
+    finally:
+        for s in socks:
+            s.close(0)
+        ctx.term()
+        for p in procs:
+            p.kill()
+            p.wait(10)

@@ -297,11 +297,13 @@ def lockstep_multi(rpc: str, k: int, steps: int, step: int = 8, raw: bool = Fals
                         _role_args("controller", rpc, f"c{i}", str(steps), str(step)), stdin=True) for i in range(k)])
 
 
-def native_multi(exes: dict[str, str], rpc: str, k: int, steps: int, step: int = 8, raw: bool = False) -> dict:
+def native_multi(exes: dict[str, str], rpc: str, k: int, steps: int, step: int = 8, raw: bool = False,
+                 socket: str = "req") -> dict:
     """:func:`lockstep_multi` with the C processes of :mod:`.native`: ``k`` C controllers (the C client
-    library's ``wb_robot_step``) on robots c0…, or (``raw``) ``k`` libzmq REQ clients of a REP at ``rpc``."""
+    library's ``wb_robot_step``) on robots c0…, or (``raw``) ``k`` libzmq REQ (``socket="dealer"``:
+    DEALER) clients of an echo server at ``rpc``."""
     if raw:
-        return _multi([Proc([exes["raw_req"], rpc, str(steps)], stdin=True) for _ in range(k)])
+        return _multi([Proc([exes["raw_req"], rpc, str(steps), socket], stdin=True) for _ in range(k)])
     return _multi([Proc([exes["controller"], str(steps), str(step)], stdin=True,
                         env={"SENSORIUM_CONTROLLER_URL": f"{rpc}/c{i}"}) for i in range(k)])
 
@@ -487,7 +489,11 @@ def native_rows(tmp: Path, cfg: Config, data: dict, rows: list, steps: int, floo
         cfg.log(f"  transport: C rows skipped ({why})")
         data["native"] = {"skipped": why}
         return
-    out: dict = {}
+    out: dict = {"pattern": _c_pattern(exes, steps)}
+    pat = out["pattern"]
+    rows.append(["C: 1 libzmq DEALER ↔ one C ROUTER echo (the multi-client pattern in C; rounds alternating with a "
+                 f"C REQ ↔ C REP echo at {fmt_time(pat['reqrep_p50_s'])} p50)", 1, fmt_time(pat["p50_s"]),
+                 fmt_time(pat["p99_s"]), "–", f"{pat['p50_s'] / floor_s:.2f}×", "–"])
     for k in (1, 8):
         rep = Proc([exes["rep_echo"]])
         try:
@@ -521,6 +527,26 @@ def native_rows(tmp: Path, cfg: Config, data: dict, rows: list, steps: int, floo
             cfg.log(f"  transport: {k} C controllers, {path} step path: {m['steps_per_s']:.0f} steps/s vs "
                     f"C REQ/REP {raw['steps_per_s']:.0f}")
     data["native"] = out
+
+
+def _c_pattern(exes: dict[str, str], steps: int, rounds: int = 4) -> dict:
+    """One C DEALER against a C ROUTER echo and one C REQ against a C REP echo, in alternating rounds
+    (load from other jobs hits both alike): p50/p99 of each. What the socket pattern a server of
+    several clients needs (ROUTER) costs by itself, without Python on either side."""
+    servers = {"router": Proc([exes["rep_echo"], "tcp://127.0.0.1:*", "router"]), "rep": Proc([exes["rep_echo"]])}
+    rtt: dict[str, list] = {"router": [], "rep": []}
+    try:
+        eps = {name: srv.line().split()[1] for name, srv in servers.items()}
+        for _ in range(rounds):
+            for name, socket in (("rep", "req"), ("router", "dealer")):
+                rtt[name].append(native_multi(exes, eps[name], 1, max(100, steps // rounds), raw=True,
+                                              socket=socket)["rtt"])
+    finally:
+        for srv in servers.values():
+            srv.stop()
+    router, rep = np.concatenate(rtt["router"]), np.concatenate(rtt["rep"])
+    return {"p50_s": median(router), "p99_s": pct(router, 99), "reqrep_p50_s": median(rep),
+            "reqrep_p99_s": pct(rep, 99)}
 
 
 # ============================================================================ section
@@ -751,8 +777,14 @@ def _targets(sec: Section, data: dict, multi: list[dict], paths: list[str], best
                    f"({best} step path: msgpack, the lockstep, the world step) {us(stepper - fl)} more; the client "
                    f"library's `Connection` instead of that bare DEALER {us(mine - stepper)} more{others}. For "
                    f"reference, a bare DEALER against a do-nothing Python msgpack ROUTER: {us(bare - fl)} above the floor; "
-                   f"a raw DEALER ↔ ROUTER echo of the same bytes (the socket pattern a server of several clients "
-                   f"needs, no msgpack): {us(data[f'router_floor{sfx}']['p50_s'] - fl)} above it.")
+                   f"a raw pyzmq DEALER ↔ ROUTER echo of the same bytes (no msgpack): "
+                   f"{us(data[f'router_floor{sfx}']['p50_s'] - fl)} above it.")
+    pat = data.get("native", {}).get("pattern")
+    if pat:
+        why.append(f"That pyzmq ROUTER's extra is pyzmq's multipart calls (a frame at a time, each a Python call), not "
+                   f"the socket pattern: in C, in alternating rounds, a DEALER ↔ ROUTER echo took {us(pat['p50_s'])} "
+                   f"and a REQ ↔ REP echo {us(pat['reqrep_p50_s'])} (tcp, p50). The server's C step path reads and "
+                   "answers the ROUTER in C.")
     c1 = data["server_cpu"]["1"]
     why.append(f"The server's Python per step without sockets (1 controller): {us(c1['handle']['total_s'])} from bytes, "
                f"{us(c1['handle_step']['total_s'])} with the step parsed in C. Other work on the machine meanwhile: "

@@ -1,5 +1,6 @@
 /* The raw floor of controller.c: a libzmq REQ socket doing step-sized ping-pongs with a
- * do-nothing REP server. Usage: raw_req ENDPOINT STEPS */
+ * do-nothing REP server, or with `dealer` a DEALER doing them with rep_echo's ROUTER.
+ * Usage: raw_req ENDPOINT STEPS [req|dealer] */
 #include "timing.h" /* first: it sets _POSIX_C_SOURCE */
 #include <string.h>
 #include <zmq.h>
@@ -18,12 +19,12 @@ static int ping(void *arg) {
 }
 
 int main(int argc, char **argv) {
-  if (argc != 3) {
-    fprintf(stderr, "usage: raw_req ENDPOINT STEPS\n");
+  if (argc != 3 && argc != 4) {
+    fprintf(stderr, "usage: raw_req ENDPOINT STEPS [req|dealer]\n");
     return 2;
   }
   void *ctx = zmq_ctx_new();
-  sock = zmq_socket(ctx, ZMQ_REQ);
+  sock = zmq_socket(ctx, argc == 4 && strcmp(argv[3], "dealer") == 0 ? ZMQ_DEALER : ZMQ_REQ);
   int linger = 0;
   zmq_setsockopt(sock, ZMQ_LINGER, &linger, sizeof linger);
   if (zmq_connect(sock, argv[1]) != 0) {
