@@ -438,8 +438,9 @@ class BatchedSimulation:
         return self.values[ref.kind][:, ref.column]
 
     def reading(self, ref: DeviceRef, what: str) -> np.ndarray:
-        """Another reading of a GPS (``speed``, ``speed_vector``) or an inertial unit
-        (``quaternion``) in every copy, as the single simulation's attribute of that name."""
+        """A reading of a GPS (``values``, ``speed``, ``speed_vector``), a compass (``values``) or an
+        inertial unit (``roll_pitch_yaw``, ``quaternion``) in every copy, as the single simulation's
+        attribute of that name."""
         return self.kinematic.reading(ref.kind, ref.column, what)
 
     def range_image(self, ref: DeviceRef) -> np.ndarray:
