@@ -8,7 +8,9 @@ Observation: a ``Dict`` with one ``Box`` per observed sensor (LEDs are not obser
 or distance sensor is a float32 ``(1,)`` box bounded by its lookup table's output column (values are clipped into it:
 relative lookup noise is Gaussian and could leave it); a lidar is its float32 ``(layers,
 width)`` range image bounded by ``[0, max_range]``, with "no hit" (``inf`` in Webots) given as
-``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians; a camera
+``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians; a GPS its
+position, a compass its north vector, an inertial unit its roll, pitch, yaw: float32 ``(3,)`` boxes
+(:func:`_space`; a disabled axis's NaN reads the box's low bound, as any missing value); a camera
 (only when named in ``Task.observations``: images are not observed by default) is a uint8
 ``(height, width, 3)`` RGB box, a range finder (likewise) its float32 ``(height, width)`` range image
 in ``[0, max_range]`` with "no hit" as ``max_range``.
@@ -51,6 +53,7 @@ from sensorium.gym.task import Task
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.limits import MAX_COORDINATE_M
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
 from sensorium.server.world.report import warn_losses
 
@@ -118,7 +121,7 @@ class Agent:
                 raise ValueError(f"task observation {n!r}: sampling period must be > 0 ms, got {p}")
         self.periods = periods
         self.warmup_steps = max((math.ceil(p / basic) for p in periods.values()), default=0)
-        self.dict_space = spaces.Dict({n: _space(devices[n]) for n in periods})
+        self.dict_space = spaces.Dict({n: _space(devices[n], w.world_info) for n in periods})
         self.flatten = bool(flatten)
         self.observation_space: spaces.Space = (spaces.flatten_space(self.dict_space) if self.flatten
                                                 else self.dict_space)
@@ -172,6 +175,10 @@ class Agent:
             elif dev.kind in ("Lidar", "RangeFinder"):
                 img = np.nan_to_num(dev.range_image, nan=box.high.flat[0], posinf=box.high.flat[0])
                 out[n] = np.clip(img, box.low, box.high).astype(np.float32)
+            elif dev.kind in VECTOR_READINGS:              # (3,): a missing value (a disabled axis) as a scalar's
+                v = np.asarray(getattr(dev, VECTOR_READINGS[dev.kind]), dtype=np.float64)
+                out[n] = np.clip(np.where(np.isfinite(v), v, missing_fill(box.low)).astype(np.float32), box.low,
+                                 box.high)
             else:
                 v = dev.value if math.isfinite(dev.value) else (box.low[0] if np.isfinite(box.low[0]) else 0.0)
                 out[n] = np.clip(np.array([v], dtype=np.float32), box.low, box.high)
@@ -191,8 +198,18 @@ class Agent:
                 "pose": np.array([pose.translation[0], pose.translation[1], math.atan2(fwd[1], fwd[0])])}
 
 
-OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "Camera", "RangeFinder")
+OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "GPS", "Compass", "InertialUnit",
+              "Camera", "RangeFinder")
 IMAGES = ("Camera", "RangeFinder")
+VECTOR_READINGS = {"GPS": "values", "Compass": "values", "InertialUnit": "roll_pitch_yaw"}
+"""The kinds observed as a float32 ``(3,)`` box, and the device reading each observes (a GPS its
+position, a compass its north vector, an inertial unit its roll, pitch, yaw)."""
+
+
+def missing_fill(low: np.ndarray) -> np.ndarray:
+    """What an observation reads for a missing value (NaN: no value yet, a disabled axis): its box's
+    low bound where that is finite, else 0 (float64, per entry)."""
+    return np.where(np.isfinite(low), np.asarray(low, dtype=np.float64), 0.0)
 
 DEFAULT_PRECISION = "fast"
 """The Gymnasium environments' default ray precision (single, vector and PettingZoo alike, so the
@@ -205,9 +222,23 @@ edges, where float32 traversal can slip between triangles; 45 % differed by floa
 ACTION_MODES = ("normalized", "wheel")
 
 
-def _space(cfg) -> spaces.Box:
+def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
     if cfg.device == "PositionSensor":          # a wheel angle (rad): unbounded
         return spaces.Box(-np.inf, np.inf, shape=(1,), dtype=np.float32)
+    if cfg.device == "GPS":                     # a position within the world bounds about gps_reference
+        ref = np.asarray(world_info.gps_reference, dtype=np.float64)
+        low, high = ref - MAX_COORDINATE_M, ref + MAX_COORDINATE_M
+        if world_info.gps_coordinate_system == "WGS84":          # latitude, longitude (degrees), altitude
+            low[:2], high[:2] = (-90.0, -180.0), (90.0, 180.0)
+        return spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
+    if cfg.device == "InertialUnit":            # roll, pitch, yaw (rad)
+        half = np.float32(math.pi / 2)
+        pi = np.float32(math.pi)
+        return spaces.Box(np.array([-pi, -half, -pi], dtype=np.float32), np.array([pi, half, pi], dtype=np.float32),
+                          dtype=np.float32)
+    if cfg.device == "Compass":                 # north through the lookup table (none: the unit vector)
+        out = [row[1] for row in cfg.lookup_table] or [-1.0, 1.0]
+        return spaces.Box(np.float32(min(out)), np.float32(max(out)), shape=(3,), dtype=np.float32)
     if cfg.device == "Camera":
         return spaces.Box(0, 255, shape=(cfg.height, cfg.width, 3), dtype=np.uint8)
     if cfg.device == "RangeFinder":

@@ -45,7 +45,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from sensorium.gym.env import DEFAULT_PRECISION, Agent, load
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, load, missing_fill
 from sensorium.gym.render import TopDown
 from sensorium.gym.task import Task, VectorGoal, never, zero
 from sensorium.gym.views import CopySim
@@ -203,16 +203,16 @@ class SensoriumVectorEnv(VectorEnv):
         self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], copies)
 
     def _scalar_groups(self) -> list[tuple[str, list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-        """The observed one-value devices by kind: (kind, names, value columns, each one's fill for a
-        missing value (float64), its Box's low and high (float32)), so that :meth:`_observe` reads
-        each kind's columns with one gather and one clip."""
+        """The observed devices whose values are ``sim.values`` (one value, or three: a GPS, a
+        compass, an inertial unit) by kind: (kind, names, value columns, each one's fill for a
+        missing value (float64), its Box's low and high (float32); (devices,) for one value, (devices,
+        3) for three), so that :meth:`_observe` reads each kind's columns with one gather and one clip."""
         groups: dict[str, list] = {}
         for name, box in self.agent.dict_space.spaces.items():
             ref = self.refs[name]
             if ref.kind != "Lidar":
-                low = box.low[0]
-                groups.setdefault(ref.kind, []).append((name, ref.column, float(low) if np.isfinite(low) else 0.0,
-                                                        low, box.high[0]))
+                low, high = (box.low[0], box.high[0]) if box.shape == (1,) else (box.low, box.high)
+                groups.setdefault(ref.kind, []).append((name, ref.column, missing_fill(low), low, high))
         return [(kind, [g[0] for g in items], np.array([g[1] for g in items], dtype=np.int64),
                  np.array([g[2] for g in items], dtype=np.float64), np.array([g[3] for g in items], dtype=np.float32),
                  np.array([g[4] for g in items], dtype=np.float32)) for kind, items in groups.items()]
@@ -243,7 +243,7 @@ class SensoriumVectorEnv(VectorEnv):
             v = self.sim.values[kind][copies][:, cols]
             v = np.clip(np.where(np.isfinite(v), v, fill).astype(np.float32), low, high)
             for j, name in enumerate(names):
-                got[name] = v[:, j:j + 1]
+                got[name] = v[:, j:j + 1] if v.ndim == 2 else v[:, j]
         out = {}
         for name, box in self.agent.dict_space.spaces.items():
             if name in got:

@@ -12,9 +12,10 @@ and its ``RobotState``. The vector environment hands them these views of one cop
 * ``CopyRobot``: ``name``, ``index``, ``model``, ``pose``, ``set_pose(...)``, ``motors`` /
   ``motor(name)``, ``drive.left`` / ``drive.right`` and ``drive.lefts`` / ``drive.rights`` (every
   wheel of a side: ``set_position``, ``set_velocity``, ``velocity``, ``position``,
-  ``max_velocity``), ``device(name).enable(period)`` / ``.value``. The batched simulation drives a
-  skid-steer robot's wheels of one side together: its wheels of a side share one state, so
-  commanding one of them commands its side.
+  ``max_velocity``), ``device(name).enable(period)`` / ``.value`` (a GPS's ``.values``, ``.speed``,
+  ``.speed_vector``, a compass's ``.values``, an inertial unit's ``.roll_pitch_yaw``, ``.quaternion``).
+  The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
+  side share one state, so commanding one of them commands its side.
 
 Anything else a callable reaches for raises AttributeError naming the view.
 """
@@ -28,6 +29,7 @@ import numpy as np
 
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.batched_kinematic import READINGS
 
 __all__ = ["CopySim", "CopyRobot"]
 
@@ -92,6 +94,9 @@ class _Device:
         return self._s.range_image(self.ref)[self._c]
 
     def __getattr__(self, name: str) -> Any:
+        ref = self.__dict__.get("ref")
+        if ref is not None and name in READINGS.get(ref.kind, ()):   # a GPS's values, speed, ...: this copy's
+            return self._s.reading(ref, name)[self._c].copy()
         # the device's constants (config, params, table, ...) from its template in the batched simulation
         return getattr(self._s.template(self.ref), name)
 

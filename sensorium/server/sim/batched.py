@@ -17,13 +17,14 @@ every device model runs once over all copies' devices of a kind.
 Copy ``c`` reproduces :class:`~sensorium.server.sim.simulation.Simulation` built from the world
 with copy c's seed, bit for bit, for what it simulates: the drive (the same float64 arc, the same
 3x3 products), kinematic contact (the same broad phase per copy, the same narrow phase), light
-sensors, distance sensors, fixed lidars and wheel encoders, each device's noise drawn from its own
+sensors, distance sensors, fixed lidars, wheel encoders, GPS (local coordinates), compasses and
+inertial units (batched_kinematic.py), each device's noise drawn from its own
 stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in the same
 order). Tests compare it with the single simulation step by step.
 
-Not simulated here (use :class:`Simulation`): rotating lidars, cameras and range finders, the kinds
-without an observation (LEDs, GPS, IMU, pens, ...), lights carried by robots, textured robot bodies,
-NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
+Not simulated here (use :class:`Simulation`): rotating lidars, cameras and range finders, a GPS in a
+WGS84 world, gyros, accelerometers, altimeters, the kinds without an observation (LEDs, pens, ...),
+lights carried by robots, textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
 
 from __future__ import annotations
@@ -44,6 +45,7 @@ from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
+from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
 from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
@@ -58,7 +60,7 @@ from sensorium.server.world.poses import moved_pose, pose_from_model
 
 __all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS", "check_observable"]
 
-SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor")
+SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", *kin.KINDS)
 _TWO_PI = 2.0 * math.pi
 
 
@@ -66,14 +68,15 @@ class BatchedError(ValueError):
     """The world uses something the batched simulation does not simulate (the message says what)."""
 
 
-def _refusal(robot: str, config) -> str | None:
-    """Why the batched simulation does not measure a device (its world-file model), or None."""
+def _refusal(robot: str, config, world_info: wm.WorldInfo) -> str | None:
+    """Why the batched simulation does not measure a device (its world-file model) in a world
+    with this world_info, or None."""
     if config.device not in SUPPORTED_KINDS:
         return (f"robot {robot!r}: device {config.name!r} is a {config.device}; the batched simulation measures "
                 f"{', '.join(SUPPORTED_KINDS)} (use Simulation)")
     if config.device == "Lidar" and config.type == "rotating":
         return f"{robot}/{config.name}: rotating lidars are not simulated by the batched simulation (use Simulation)"
-    return None
+    return kin.refusal(robot, config, world_info)
 
 
 def check_observable(world: wm.World, robot: str, names: Iterable[str]) -> None:
@@ -82,7 +85,7 @@ def check_observable(world: wm.World, robot: str, names: Iterable[str]) -> None:
     is built (names it does not know are left to the caller)."""
     devices = {d.name: d for r in world.robots if r.name == robot for d in r.devices}
     for name in names:
-        why = _refusal(robot, devices[name]) if name in devices else None
+        why = _refusal(robot, devices[name], world.world_info) if name in devices else None
         if why:
             raise BatchedError(why)
 
@@ -298,13 +301,14 @@ class BatchedSimulation:
         self.distance: list[DistanceSensor] = []
         self.lidar: list[Lidar] = []
         self.position: list[PositionSensor] = []
-        lists = {"LightSensor": self.light, "DistanceSensor": self.distance, "Lidar": self.lidar,
-                 "PositionSensor": self.position}
+        lists: dict[str, list] = {"LightSensor": self.light, "DistanceSensor": self.distance, "Lidar": self.lidar,
+                                  "PositionSensor": self.position, **{k: [] for k in kin.KINDS}}
         classes = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar,
-                   "PositionSensor": PositionSensor}
+                   "PositionSensor": PositionSensor, **kin.CLASSES}
+        self._lists = lists
         for slot, r in enumerate(self.world.robots):
             for d in r.devices:
-                if d.device not in lists:
+                if d.device not in lists or kin.refusal(r.name, d, self.world.world_info):
                     continue
                 dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
                                         world_seed=0, clock=lambda: 0,
@@ -324,7 +328,8 @@ class BatchedSimulation:
             cols = np.full(len(devs), -1, dtype=np.int64)
             for k, d in enumerate(devs):
                 table = getattr(d, "table", None)
-                if (table is not None and table.has_noise) or float(getattr(d.config, "noise", 0.0) or 0.0) > 0.0:
+                if ((table is not None and table.has_noise) or float(getattr(d.config, "noise", 0.0) or 0.0) > 0.0
+                        or kin.draws_noise(d.config)):
                     cols[k] = self._noise_col[(kind_name, k)] = len(paths)
                     paths.append(d.path)
             self._noise_of[kind_name] = cols
@@ -337,7 +342,10 @@ class BatchedSimulation:
         # per kind: whether enable() ever gave one of its devices a period (else none is ever due)
         self._enabled = dict.fromkeys(lists, False)
         self.last = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
-        self.values = {k: np.full((C, len(v)), math.nan) for k, v in lists.items() if k != "Lidar"}
+        self.values = {k: np.full((C, len(v), *kin.SHAPES.get(k, ())), math.nan) for k, v in lists.items()
+                       if k != "Lidar"}
+        # GPS, Compass, InertialUnit (batched_kinematic.py): their constants and their state beyond values
+        self.kinematic = kin.KinematicDevices(self, lists)
         for lid in self.lidar:
             if lid.rotating:
                 continue
@@ -405,29 +413,35 @@ class BatchedSimulation:
         if ref is None:
             kinds = {d.name: d for d in self.world.robots[slot].devices}
             if name in kinds:
-                raise BatchedError(_refusal(robot, kinds[name]) or f"{robot}/{name}: not measured")
+                raise BatchedError(_refusal(robot, kinds[name], self.world.world_info) or f"{robot}/{name}: not measured")
             raise KeyError(f"robot {robot!r} has no device {name!r} (devices: {', '.join(kinds)})")
         return ref
 
     def check_observable(self, robot: str, name: str) -> DeviceRef:
         """The device, if the batched simulation measures it (else BatchedError saying why)."""
         ref = self.device(robot, name)
-        why = _refusal(robot, self.template(ref).config)
+        why = _refusal(robot, self.template(ref).config, self.world.world_info)
         if why:
             raise BatchedError(why)
         return ref
 
     def template(self, ref: DeviceRef):
         """The device object holding a device's constants (config, lookup table, lidar params)."""
-        return {"LightSensor": self.light, "DistanceSensor": self.distance, "Lidar": self.lidar,
-                "PositionSensor": self.position}[ref.kind][ref.column]
+        return self._lists[ref.kind][ref.column]
 
     def pose(self, copy: int, slot: int) -> Pose:
         return Pose(self.rot[copy, slot], self.pos[copy, slot])
 
     def value(self, ref: DeviceRef) -> np.ndarray:
-        """The latest values of a light, distance or position sensor in every copy: (copies,)."""
+        """The latest values of a device in every copy: (copies,) for a light, distance or position
+        sensor, (copies, 3) for a GPS (position), a compass (north) or an inertial unit (roll, pitch, yaw)."""
         return self.values[ref.kind][:, ref.column]
+
+    def reading(self, ref: DeviceRef, what: str) -> np.ndarray:
+        """A reading of a GPS (``values``, ``speed``, ``speed_vector``), a compass (``values``) or an
+        inertial unit (``roll_pitch_yaw``, ``quaternion``) in every copy, as the single simulation's
+        attribute of that name."""
+        return self.kinematic.reading(ref.kind, ref.column, what)
 
     def range_image(self, ref: DeviceRef) -> np.ndarray:
         """A lidar's latest range images in every copy: (copies, layers, width) float32."""
@@ -464,6 +478,7 @@ class BatchedSimulation:
             v[idx] = math.nan
         for img in self.range_images:
             img[idx] = 0.0
+        self.kinematic.reset(idx)
         self.noise.reseed(idx.tolist(), world_seeds)
         self.counters["resets"] += len(idx)
 
@@ -542,6 +557,7 @@ class BatchedSimulation:
         self.counters["copy_steps"] += len(live)
         self._drive(live, dt)
         self._measure_positions(live)
+        self.kinematic.measure(live)
         self._measure_rays(live, dt)
 
     # -- motion

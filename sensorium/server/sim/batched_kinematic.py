@@ -1,0 +1,336 @@
+"""GPS, Compass and InertialUnit in the batched simulation: every copy's due devices of a kind
+measured together, from the copies' end-of-step poses, bit for bit what the single simulation's
+devices (sim/sensors.py, on the pure models of devices/gps.py and devices/orientation.py) give.
+
+How the bits are kept:
+
+* float64 ``+ - * / sqrt`` are exactly rounded alike in numpy and in Python, so those are done on
+  whole arrays in the single models' order of operations;
+* the small products the single models leave to numpy's ``@`` (Pose.compose's 3x3 products, a
+  compass's ``Rᵀ·north``, a norm's dot product) go through ``np.matmul`` on stacks of the same
+  3x3 / 3-vector operands: numpy hands each item to the same BLAS call as the 2-D product, so the
+  summation order (and any fused multiply-add) is the same;
+* ``atan2``, ``asin``, ``sin``, ``cos`` and ``pow`` are libm's (``math``, Python's ``**``) per
+  element, never numpy's vectorised ufuncs, whose SIMD routines may round differently on this
+  machine (``x ** 2`` included: numpy's scalar power calls libm's ``pow``, which is not ``x * x``);
+* each device's noise comes from its own stream (``NoiseStreams``), taken in the order the single
+  model draws it.
+
+Not here: a GPS in a WGS84 world (the inverse UTM series is not vectorised: refused with one
+line), Gyro, Accelerometer, Altimeter (refused as any kind the batched simulation does not
+measure). The batched simulation itself only runs ENU worlds; the roll / pitch / yaw conventions
+of both are here (:func:`roll_pitch_yaw`) and tested against the single model.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from sensorium.server.devices import orientation as orient
+from sensorium.server.devices.lookup import RESOLUTION_OFF
+from sensorium.server.sim.sensors import GPS, Compass, InertialUnit
+
+__all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal",
+           "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions"]
+
+KINDS = ("GPS", "Compass", "InertialUnit")
+CLASSES: dict[str, type] = {"GPS": GPS, "Compass": Compass, "InertialUnit": InertialUnit}
+SHAPES = {"GPS": (3,), "Compass": (3,), "InertialUnit": (3,)}
+"""The shape of one device's value (``BatchedSimulation.values[kind]`` is (copies, devices, *shape)):
+a GPS's position, a compass's north vector, an inertial unit's roll, pitch, yaw."""
+READINGS = {"GPS": ("values", "speed", "speed_vector"), "Compass": ("values",),
+            "InertialUnit": ("roll_pitch_yaw", "quaternion")}
+"""What a device of each kind reads (the single simulation's attributes of the same names)."""
+
+
+def refusal(robot: str, config: Any, world_info: Any) -> str | None:
+    """Why the batched simulation does not measure a device of these kinds in this world, or None."""
+    if config.device == "GPS" and world_info.gps_coordinate_system == "WGS84":
+        return (f"{robot}/{config.name}: a GPS in a WGS84 world (world_info.gps_coordinate_system) is not "
+                "simulated by the batched simulation, only local coordinates (use Simulation)")
+    return None
+
+
+def draws_noise(config: Any) -> bool:
+    """Whether a device of these kinds ever draws from its noise stream (a compass: its table)."""
+    if config.device == "GPS":
+        return config.accuracy > 0.0 or config.speed_noise > 0.0
+    if config.device == "InertialUnit":
+        return config.noise > 0.0
+    return False
+
+
+def _libm(fn, *columns: np.ndarray) -> np.ndarray:
+    """``fn`` (a ``math`` function, libm's) of each element: the single models' scalar calls."""
+    flat = [c.reshape(-1).tolist() for c in columns]
+    return np.array(list(map(fn, *flat)), dtype=np.float64).reshape(columns[0].shape)
+
+
+def _dots(v: np.ndarray) -> np.ndarray:
+    """``v[i] @ v[i]`` per row, through the same BLAS dot product as the 1-D ``@`` of a contiguous
+    vector (np.matmul of stacked row and column vectors gives each item to it; BLAS may sum a
+    strided vector in another order, so the rows are made contiguous first)."""
+    v = np.ascontiguousarray(v)
+    return np.matmul(v[:, None, :], v[:, :, None])[:, 0, 0]
+
+
+def _quantize(v: np.ndarray, res: np.ndarray) -> np.ndarray:
+    """lookup.quantize_sensor per row (``res`` (k,), RESOLUTION_OFF: unchanged)."""
+    on = res != RESOLUTION_OFF
+    if not on.any():
+        return v
+    r = np.where(on, res, 1.0).reshape((-1,) + (1,) * (v.ndim - 1))
+    return np.where(on.reshape(r.shape), np.trunc(v / r + 0.5) * r + 0.0, v)
+
+
+def matrix_quaternions(m: np.ndarray) -> np.ndarray:
+    """poses.matrix_quaternion of each (k, 3, 3) rotation: (k, 4) (x, y, z, w), w >= 0. Shepperd's
+    four branches each computed with its operations, the one the scalar code takes kept."""
+    m00, m11, m22 = m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]
+    tr = m00 + m11 + m22
+    with np.errstate(invalid="ignore", divide="ignore"):        # the branches not taken
+        s0 = np.sqrt(tr + 1.0) * 2.0
+        s1 = np.sqrt(1.0 + m00 - m11 - m22) * 2.0
+        s2 = np.sqrt(1.0 + m11 - m00 - m22) * 2.0
+        s3 = np.sqrt(1.0 + m22 - m00 - m11) * 2.0
+        d21, d02, d10 = m[:, 2, 1] - m[:, 1, 2], m[:, 0, 2] - m[:, 2, 0], m[:, 1, 0] - m[:, 0, 1]
+        a01, a02, a12 = m[:, 0, 1] + m[:, 1, 0], m[:, 0, 2] + m[:, 2, 0], m[:, 1, 2] + m[:, 2, 1]
+        branches = [  # (w, x, y, z) of each branch
+            (0.25 * s0, d21 / s0, d02 / s0, d10 / s0),
+            (d21 / s1, 0.25 * s1, a01 / s1, a02 / s1),
+            (d02 / s2, a01 / s2, 0.25 * s2, a12 / s2),
+            (d10 / s3, a02 / s3, a12 / s3, 0.25 * s3),
+        ]
+    first = tr > 0.0
+    second = ~first & (m00 > m11) & (m00 > m22)
+    third = ~first & ~second & (m11 > m22)
+    pick = np.where(first, 0, np.where(second, 1, np.where(third, 2, 3)))
+    wxyz = np.stack([np.choose(pick, [b[j] for b in branches]) for j in range(4)], axis=1)
+    q = wxyz[:, [1, 2, 3, 0]]
+    q = q / np.sqrt(_dots(q))[:, None]                   # q /= np.linalg.norm(q)
+    return np.where((q[:, 3] < 0.0)[:, None], -q, q)
+
+
+def _axis_turns(angles: np.ndarray) -> np.ndarray:
+    """The noise turn of orientation.inertial_quaternion for rows of three angles (k, 3): the
+    quaternions about x, y, z multiplied in that order, as (4, k) columns."""
+    k = len(angles)
+    half = angles / 2.0
+    s, c = _libm(math.sin, half), _libm(math.cos, half)
+    qs = []
+    for axis in range(3):
+        q = np.zeros((4, k))
+        q[axis] = s[:, axis]
+        q[3] = c[:, axis]
+        qs.append(q)
+    return orient.quaternion_multiply(orient.quaternion_multiply(qs[0], qs[1]), qs[2])
+
+
+def inertial_quaternions(q: np.ndarray, gauss: np.ndarray | None, noise: np.ndarray, x_axis: np.ndarray,
+                         y_axis: np.ndarray, z_axis: np.ndarray, resolution: np.ndarray) -> np.ndarray:
+    """orientation.inertial_quaternion of each row: ``q`` (k, 4) world rotations, ``gauss`` (k, 3)
+    the standard normals of the rows with ``noise`` != 0 (any value elsewhere), the per-row fields."""
+    out = np.array(q, dtype=np.float64)
+    noisy = (noise != 0.0).nonzero()[0]
+    if len(noisy):
+        assert gauss is not None
+        angles = noise[noisy, None] * math.pi * gauss[noisy]       # noise * math.pi * G, left to right
+        out[noisy] = orient.quaternion_multiply(out[noisy].T, _axis_turns(angles)).T
+    off = (~(x_axis & y_axis & z_axis)).nonzero()[0]
+    if len(off):
+        o = out[off]
+        sq = [_libm(lambda v: v ** 2, o[:, j]) for j in range(3)]  # numpy's scalar ** 2: libm's pow
+        half = _libm(math.atan2, np.sqrt(sq[0] + sq[1] + sq[2]), o[:, 3])
+        axis = o[:, :3].copy()
+        axis[~x_axis[off], 0] = 0.0                                  # Webots' mapping: y -> z, z -> y
+        axis[~y_axis[off], 2] = 0.0
+        axis[~z_axis[off], 1] = 0.0
+        norm = np.sqrt(_dots(axis))
+        zero = norm == 0.0
+        with np.errstate(invalid="ignore", divide="ignore"):
+            turned = axis / norm[:, None] * _libm(math.sin, half)[:, None]
+        o = np.concatenate([turned, _libm(math.cos, half)[:, None]], axis=1)
+        o[zero] = (0.0, 0.0, 0.0, 1.0)
+        out[off] = o
+    out = np.where((out[:, 3] < 0.0)[:, None], -out, out)
+    return _quantize(out, resolution)
+
+
+def roll_pitch_yaw(q: np.ndarray, axes: str = "ENU") -> np.ndarray:
+    """orientation.roll_pitch_yaw of each (k, 4) quaternion: (k, 3) roll, pitch, yaw."""
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+
+    def asin_clamped(v: np.ndarray) -> np.ndarray:     # max(-1, min(1, v)) as Python compares (NaN -> 1)
+        return _libm(lambda a: math.asin(max(-1.0, min(1.0, a))), v)
+
+    if axes == "NUE":
+        yaw = _libm(math.atan2, 2 * y * w - 2 * x * z, 1 - 2 * y * y - 2 * z * z)
+        roll = _libm(math.atan2, 2 * x * w - 2 * y * z, 1 - 2 * x * x - 2 * z * z)
+        pitch = asin_clamped(2 * x * y + 2 * z * w)
+    else:
+        roll = _libm(math.atan2, 2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+        pitch = asin_clamped(2.0 * (w * y - z * x))
+        yaw = _libm(math.atan2, 2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return np.stack([roll, pitch, yaw], axis=1)
+
+
+class KinematicDevices:
+    """The GPS, Compass and InertialUnit devices of a batched simulation: their constants stacked
+    per kind, their state beyond ``values`` (a GPS's speed, speed vector, noise state and previous
+    position; an inertial unit's quaternion) per copy, and :meth:`measure` for one step.
+
+    ``sim`` is the BatchedSimulation (its poses, clocks, schedules, values, noise bank);
+    ``devices`` its template devices of each kind, in column order."""
+
+    def __init__(self, sim: Any, devices: dict[str, list]):
+        self.sim = sim
+        self.devices = {k: devices.get(k, []) for k in KINDS}
+        C = sim.copies
+        wi = sim.world.world_info
+        self.axes = wi.coordinate_system
+        self.reference = np.array(wi.gps_reference, dtype=np.float64)
+        self.north = orient.north_vector(self.axes)
+        self.slot = {k: np.array([d.robot_index for d in v], dtype=np.int64) for k, v in self.devices.items()}
+        self.local_rot = {k: np.array([d.local_pose.rotation for d in v]).reshape(-1, 3, 3)
+                          for k, v in self.devices.items()}
+        self.local_pos = {k: np.array([d.local_pose.translation for d in v]).reshape(-1, 3)
+                          for k, v in self.devices.items()}
+        self.resolution = {k: np.array([float(d.config.resolution) for d in v]) for k, v in self.devices.items()}
+        gps = [d.config for d in self.devices["GPS"]]
+        self.accuracy = np.array([c.accuracy for c in gps], dtype=np.float64)
+        self.correlation = np.array([c.noise_correlation for c in gps], dtype=np.float64)
+        self.speed_noise = np.array([c.speed_noise for c in gps], dtype=np.float64)
+        self.speed_resolution = np.array([c.speed_resolution for c in gps], dtype=np.float64)
+        n = len(gps)
+        self.speed = np.full((C, n), math.nan)
+        self.speed_vector = np.full((C, n, 3), math.nan)
+        self.gps_noise = np.zeros((C, n, 3))                 # each GPS's Gauss-Markov state
+        self.previous = np.zeros((C, n, 3))                  # the translation at its previous measurement
+        self.has_previous = np.zeros((C, n), dtype=bool)
+        units = [d.config for d in self.devices["InertialUnit"]]
+        self.unit_noise = np.array([c.noise for c in units], dtype=np.float64)
+        self.unit_axes = [np.array([getattr(c, a) for c in units], dtype=bool) for a in ("x_axis", "y_axis", "z_axis")]
+        self.quaternion = np.full((C, len(units), 4), math.nan)
+        self.compass_axes = [np.array([c.config.x_axis, c.config.y_axis, c.config.z_axis], dtype=bool)
+                             for c in self.devices["Compass"]]
+
+    # ------------------------------------------------------------------ state
+    def reset(self, idx: np.ndarray) -> None:
+        """The named copies' state as a freshly built world's (``values`` are the simulation's)."""
+        self.speed[idx] = math.nan
+        self.speed_vector[idx] = math.nan
+        self.gps_noise[idx] = 0.0
+        self.previous[idx] = 0.0
+        self.has_previous[idx] = False
+        self.quaternion[idx] = math.nan
+
+    def reading(self, kind: str, column: int, what: str) -> np.ndarray:
+        """A device's reading ``what`` (one of READINGS[kind]) in every copy: (copies, ...)."""
+        if what not in READINGS.get(kind, ()):
+            raise AttributeError(f"a {kind} has no reading {what!r} (readings: {', '.join(READINGS.get(kind, ()))})")
+        if what in ("values", "roll_pitch_yaw"):
+            return self.sim.values[kind][:, column]
+        return {"speed": self.speed, "speed_vector": self.speed_vector, "quaternion": self.quaternion}[what][:, column]
+
+    # ------------------------------------------------------------------ measuring
+    def measure(self, live: np.ndarray) -> None:
+        """Every due device of these kinds in the copies ``live``, at their end-of-step poses."""
+        for kind, fn in (("GPS", self._gps), ("Compass", self._compass), ("InertialUnit", self._unit)):
+            if self.devices[kind]:
+                copies, cols = self.sim._due(kind, live)
+                if len(copies):
+                    self.sim._store(kind, copies, cols, fn(copies, cols))
+
+    def _frames(self, kind: str, copies: np.ndarray, cols: np.ndarray, translation: bool = True):
+        """Device.world_pose of each due device: robot pose ∘ local pose, as Pose.compose computes it
+        (rotation R·Rl, translation R·tl + t), stacked."""
+        slot = self.slot[kind][cols]
+        rr = np.ascontiguousarray(self.sim.rot[copies, slot])       # contiguous 3x3s, as a Pose holds them
+        rot = np.matmul(rr, self.local_rot[kind][cols])
+        if not translation:
+            return rot, None
+        return rot, np.matmul(rr, self.local_pos[kind][cols][:, :, None])[:, :, 0] + self.sim.pos[copies, slot]
+
+    def _gauss(self, kind: str, copies: np.ndarray, cols: np.ndarray, count: int) -> np.ndarray:
+        """(k, count) standard normals: ``count`` in order from each (copy, device) stream."""
+        streams = self.sim._noise_of[kind][cols]
+        return np.stack([self.sim.noise.next(copies, streams) for _ in range(count)], axis=1)
+
+    def _gps(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """GPS.measure (devices/gps.py position, speed_vector, speed) in local coordinates."""
+        sim = self.sim
+        _, t = self._frames("GPS", copies, cols)
+        assert t is not None
+        elapsed = sim.time_ms[copies] - sim.last["GPS"][copies, cols]
+        p = t + self.reference
+        acc = self.accuracy[cols]
+        rows = (acc != 0.0).nonzero()[0]
+        if len(rows):                    # the Gauss-Markov noise: three normals per measurement
+            c, d = copies[rows], cols[rows]
+            corr = self.correlation[d]
+            ratio = np.array([cr ** e if cr != 0.0 else 0.0
+                              for cr, e in zip(corr.tolist(), (elapsed[rows] / 1000.0).tolist())], dtype=np.float64)
+            state = self.gps_noise[c, d] * ratio[:, None]
+            state = state + np.sqrt(1.0 - ratio * ratio)[:, None] * self._gauss("GPS", c, d, 3)
+            self.gps_noise[c, d] = state
+            p[rows] = p[rows] + acc[rows, None] * state
+        p = _quantize(p, self.resolution["GPS"][cols])
+        known = self.has_previous[copies, cols] & (elapsed > 0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            vec = np.where(known[:, None], (t - self.previous[copies, cols]) * (1000.0 / elapsed)[:, None], math.nan)
+        self.previous[copies, cols] = t
+        self.has_previous[copies, cols] = True
+        self.speed_vector[copies, cols] = vec
+        speed = np.sqrt(_dots(vec))
+        sn = self.speed_noise[cols]
+        rows = (sn > 0.0).nonzero()[0]
+        if len(rows):                    # one more normal, after the position's
+            g = self._gauss("GPS", copies[rows], cols[rows], 1)[:, 0]
+            speed[rows] = speed[rows] * (1.0 + sn[rows] * g)
+        self.speed[copies, cols] = _quantize(speed, self.speed_resolution[cols])
+        return p
+
+    def _compass(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Compass.measure (orientation.compass_values): north in the device frame through each
+        compass's lookup table, its noise, its resolution; NaN on a disabled axis."""
+        rot, _ = self._frames("Compass", copies, cols, translation=False)
+        local = np.matmul(rot.transpose(0, 2, 1), self.north[:, None])[:, :, 0]     # Rᵀ·north
+        local = local / np.sqrt(_dots(local))[:, None]
+        out = np.full((len(copies), 3), math.nan)
+        streams = self.sim._noise_of["Compass"]
+        for col in np.unique(cols).tolist():
+            sel = (cols == col).nonzero()[0]
+            on = self.compass_axes[col].nonzero()[0]
+            if not len(on):
+                continue
+            v = local[sel][:, on]
+            table = self.devices["Compass"][col].table
+            if len(table):               # LookupTable.lookup: interpolated, then y (1 + n G) per noisy entry
+                v, nz = table.interpolate(v)
+                for j in range(len(on)):  # the entries in C order: each row's axes in turn
+                    noisy = (nz[:, j] != 0.0).nonzero()[0]
+                    if len(noisy):
+                        g = self.sim.noise.next(copies[sel][noisy], np.full(len(noisy), streams[col]))
+                        v[noisy, j] = v[noisy, j] * (1.0 + nz[noisy, j] * g)
+            res = self.resolution["Compass"][col]
+            if res != RESOLUTION_OFF:
+                v = np.trunc(v / res + 0.5) * res + 0.0
+            out[np.ix_(sel, on)] = v
+        return out
+
+    def _unit(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """InertialUnit.measure: the quaternion (orientation.inertial_quaternion) and roll, pitch, yaw."""
+        rot, _ = self._frames("InertialUnit", copies, cols, translation=False)
+        noise = self.unit_noise[cols]
+        noisy = (noise != 0.0).nonzero()[0]
+        gauss = None
+        if len(noisy):
+            gauss = np.zeros((len(cols), 3))
+            gauss[noisy] = self._gauss("InertialUnit", copies[noisy], cols[noisy], 3)
+        x, y, z = (a[cols] for a in self.unit_axes)
+        q = inertial_quaternions(matrix_quaternions(rot), gauss, noise, x, y, z, self.resolution["InertialUnit"][cols])
+        self.quaternion[copies, cols] = q
+        return roll_pitch_yaw(q, self.axes)

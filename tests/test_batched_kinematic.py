@@ -1,0 +1,290 @@
+"""GPS, Compass and InertialUnit in the batched simulation (sensorium/server/sim/batched_kinematic.py):
+every copy bit-identical to the single Simulation with its seed, closed-form readings, the vector
+environment observing them, and what stays refused."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import orientation as orient
+from sensorium.server.sim import batched_kinematic as kin
+from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_observable
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, load_world
+from sensorium.server.world.poses import matrix_quaternion, quaternion_matrix
+
+WORLD = Path(__file__).parent / "worlds" / "kinematic.yaml"
+PERIODS = {"rover": {"gps": 48, "plain_gps": 16, "compass": 32, "plain_compass": 16, "imu": 48, "flat_imu": 16,
+                     "plain_imu": 16},
+           "scout": {"gps": 32, "compass": 16, "imu": 16}}
+
+
+def _world(seed: int) -> LoadedWorld:
+    lw = load_world(WORLD)
+    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
+    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+
+
+def _readings(bs: BatchedSimulation, sim: Simulation, copy: int, robot: str, name: str):
+    """(what, single simulation's value, batched value) of every reading of a device."""
+    ref, dev = bs.device(robot, name), sim.robot(robot).device(name)
+    whats = kin.READINGS[ref.kind]
+    return [(w, np.asarray(getattr(dev, w), dtype=np.float64), bs.reading(ref, w)[copy]) for w in whats]
+
+
+def _drive(sim: Simulation, robot: str, left: float, right: float) -> None:
+    for m in sim.robot(robot).motors.values():
+        m.set_position(math.inf)
+    sim.robot(robot).drive.left.set_velocity(left)
+    sim.robot(robot).drive.right.set_velocity(right)
+
+
+def test_every_copy_reads_its_gps_compasses_and_inertial_units_as_the_single_simulation():
+    """Two robots driving on a floor and a ramp with random, per-copy wheel commands; GPS with
+    Gauss-Markov noise, speed noise and resolutions, compasses with noisy lookup tables and a
+    disabled axis, inertial units with noise, resolution, disabled axes and tilted mounts, at
+    different periods; a supervisor move and a reset with a new seed on the way: after every basic
+    step every reading of every copy equals that of a Simulation built with that copy's seed, bit
+    for bit (NaNs and signed zeros included)."""
+    seeds = [5, 6, 7, 8]
+    bs = BatchedSimulation(_world(0), len(seeds))
+    bs.reset(np.arange(len(seeds)), seeds)
+    sims = [Simulation(_world(s)) for s in seeds]
+
+    def enable(copy: int) -> None:
+        for robot, names in PERIODS.items():
+            for n, p in names.items():
+                bs.enable(bs.device(robot, n), p, copies=[copy])
+                sims[copy].robot(robot).device(n).enable(p)
+
+    for c in range(len(seeds)):
+        enable(c)
+    rng = np.random.default_rng(0)
+    seen = {"tilted": 0, "nan": 0, "speed": 0}
+    for step in range(160):
+        if step % 10 == 0:
+            for robot in PERIODS:
+                slot = bs.slot(robot)
+                vmax = float(bs.max_wheel[slot, 0])
+                lr = rng.uniform(-vmax, vmax, (len(seeds), 2))
+                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
+                for c, s in enumerate(sims):
+                    _drive(s, robot, float(lr[c, 0]), float(lr[c, 1]))
+        if step == 70:                          # a supervisor move onto the ramp in copy 2
+            bs.set_pose(2, bs.slot("rover"), [0.9, -0.3, 0.5])
+            sims[2].robot("rover").set_pose([0.9, -0.3, 0.5])
+        if step == 100:                         # copy 1 as a new world with another seed
+            bs.reset([1], [42])
+            sims[1] = Simulation(_world(42))
+            enable(1)
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            assert s.time_ms == bs.time_ms[c]
+            seen["tilted"] += abs(s.robot("rover").pose.rotation[2, 2]) < 1.0 - 1e-6
+            for robot, names in PERIODS.items():
+                for n in names:
+                    for what, want, got in _readings(bs, s, c, robot, n):
+                        assert want.tobytes() == got.tobytes(), (step, c, robot, n, what, want, got)
+                        seen["nan"] += int(np.isnan(got).any())
+            seen["speed"] += math.isfinite(s.robot("rover").device("gps").speed)
+    assert seen["tilted"] > 50 and seen["nan"] > 0 and seen["speed"] > 100    # ramps, disabled axes, speeds
+    # the noise is each copy's own: the same device reads differently in different copies
+    gps = bs.value(bs.device("scout", "gps"))
+    assert len({row.tobytes() for row in gps}) == len(seeds)
+
+
+def _flat(yaws: list[float], translation=(1.0, 2.0, 0.0)) -> wm.World:
+    """A robot with plain devices (no noise, no table) at a height of 0, turned by each yaw in turn."""
+    devices = [{"device": "GPS", "name": "gps", "pose": {"translation": [0.02, -0.01, 0.05]}},
+               {"device": "Compass", "name": "compass"},
+               {"device": "InertialUnit", "name": "imu"}]
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 8, "gps_reference": [100.0, -20.0, 5.0], "contact": False},
+        "robots": [{"name": "bot", "pose": {"translation": list(translation), "rotation": [0, 0, 1, yaws[0]]},
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 10.0},
+                    "devices": devices}]})
+
+
+def test_known_headings_give_the_closed_form_compass_inertial_unit_and_gps_readings():
+    """Copy c turned to yaw ψ_c (Rz(ψ) about up): the compass reads north in the robot frame,
+    (sin ψ, cos ψ, 0); the inertial unit (0, 0, ψ); the GPS the mount point R·t + p plus the
+    world's gps_reference. At ψ = 0 all of it is exact; driving straight at v, the GPS speed is v
+    and its speed vector v·(cos ψ, sin ψ, 0)."""
+    yaws = [0.0, 0.5, -1.2, 2.9, -3.0]
+    bs = BatchedSimulation(_world_model_loaded(_flat(yaws)), len(yaws))
+    for c, yaw in enumerate(yaws):
+        bs.set_pose(c, 0, rotation=[0, 0, 1, yaw])
+    for name in ("gps", "compass", "imu"):
+        bs.enable(bs.device("bot", name), 8)
+    bs.step()
+    compass = bs.value(bs.device("bot", "compass"))
+    rpy = bs.value(bs.device("bot", "imu"))
+    gps = bs.value(bs.device("bot", "gps"))
+    assert compass[0].tolist() == [0.0, 1.0, 0.0] and rpy[0].tolist() == [0.0, 0.0, 0.0]
+    assert gps[0].tolist() == [1.0 + 0.02 + 100.0, 2.0 - 0.01 - 20.0, 0.05 + 5.0]
+    for c, yaw in enumerate(yaws):
+        s, co = math.sin(yaw), math.cos(yaw)
+        np.testing.assert_allclose(compass[c], [s, co, 0.0], rtol=0, atol=1e-15)
+        np.testing.assert_allclose(rpy[c], [0.0, 0.0, yaw], rtol=0, atol=1e-15)
+        np.testing.assert_allclose(gps[c], [1.0 + 0.02 * co + 0.01 * s + 100.0, 2.0 + 0.02 * s - 0.01 * co - 20.0,
+                                            5.05], rtol=0, atol=1e-12)
+    # straight ahead at 4 rad/s on 5 cm wheels: 0.2 m/s along the heading
+    bs.set_wheels(0, np.full(len(yaws), 4.0), np.full(len(yaws), 4.0))
+    bs.run(3)
+    ref = bs.device("bot", "gps")
+    np.testing.assert_allclose(bs.reading(ref, "speed"), 0.2, rtol=1e-12)
+    want = np.stack([0.2 * np.cos(yaws), 0.2 * np.sin(yaws), np.zeros(len(yaws))], axis=1)
+    np.testing.assert_allclose(bs.reading(ref, "speed_vector"), want, rtol=0, atol=1e-12)
+
+
+def _world_model_loaded(w: wm.World) -> LoadedWorld:
+    return LoadedWorld(world=w, source="<test>", base_dir=Path.cwd())
+
+
+def _rotations(n: int, rng: np.random.Generator) -> np.ndarray:
+    """Random rotations, and half turns about each axis and between axes (Shepperd's four branches)."""
+    qs = list(rng.standard_normal((n, 4)))
+    qs += [np.array(q, dtype=float) for q in ([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1, 1, 0, 0.01],
+                                               [0, 1, 1, 0.02], [1, 0, 1, 0.0], [0, 0, 0, 1])]
+    return np.array([quaternion_matrix(q) for q in qs])
+
+
+@pytest.mark.parametrize("axes", ["ENU", "NUE"])
+def test_the_stacked_orientation_formulas_are_the_single_models_bit_for_bit(axes):
+    """matrix_quaternions, inertial_quaternions (noise, every disabled-axis combination, resolution)
+    and roll_pitch_yaw in both conventions over many rotations: element for element the bits of
+    poses.matrix_quaternion, orientation.inertial_quaternion and orientation.roll_pitch_yaw."""
+    rng = np.random.default_rng(4)
+    R = _rotations(3000, rng)
+    k = len(R)
+    q = kin.matrix_quaternions(R)
+    want_q = np.array([matrix_quaternion(r) for r in R])
+    assert q.tobytes() == want_q.tobytes()
+    noise = np.where(rng.random(k) < 0.5, 0.02, 0.0)
+    gauss = rng.standard_normal((k, 3))
+    x, y, z = (rng.random(k) < 0.7 for _ in range(3))
+    res = np.where(rng.random(k) < 0.3, 0.001, -1.0)
+    got = kin.inertial_quaternions(want_q, gauss, noise, x, y, z, res)
+    for i in range(k):
+        stream = _Replay(gauss[i])
+        want = orient.inertial_quaternion(want_q[i], noise=float(noise[i]), rng=stream if noise[i] else None,  # type: ignore[arg-type]
+                                          x_axis=bool(x[i]), y_axis=bool(y[i]), z_axis=bool(z[i]),
+                                          resolution=float(res[i]))
+        assert want.tobytes() == got[i].tobytes(), i
+    rpy = kin.roll_pitch_yaw(got, axes)
+    assert rpy.tobytes() == np.array([orient.roll_pitch_yaw(g, axes) for g in got]).tobytes()
+    assert (~(x & y & z)).sum() > 500 and (noise > 0).sum() > 500 and (res > 0).sum() > 500
+
+
+class _Replay:
+    """A stand-in random stream giving three given normals."""
+
+    def __init__(self, values: np.ndarray):
+        self.values = values
+
+    def standard_normal(self, count: int) -> np.ndarray:
+        assert count == 3
+        return self.values.copy()
+
+
+def test_what_stays_refused_is_said_in_one_line():
+    """A GPS in a WGS84 world, a gyro, an accelerometer: one line naming the device and why, when
+    asked for (device, check_observable) and before anything is built (the world-level check)."""
+    lw = load_world(WORLD)
+    w = lw.world
+    robots = [r.model_dump(mode="json", exclude_none=True) for r in w.robots]
+    robots[0]["devices"] += [{"device": "Gyro", "name": "gyro"}, {"device": "Accelerometer", "name": "acc"}]
+    wgs = wm.World.model_validate({**w.model_dump(mode="json", exclude_none=True), "robots": robots,
+                                   "world_info": {**w.world_info.model_dump(mode="json"),
+                                                  "gps_coordinate_system": "WGS84",
+                                                  "gps_reference": [46.5, 6.6, 400.0]}})
+    for call in (lambda: check_observable(wgs, "rover", ["compass", "gps"]),
+                 lambda: BatchedSimulation(wgs, 2, base_dir=lw.base_dir).device("rover", "gps")):
+        with pytest.raises(BatchedError) as e:
+            call()
+        assert str(e.value) == ("rover/gps: a GPS in a WGS84 world (world_info.gps_coordinate_system) is not "
+                                "simulated by the batched simulation, only local coordinates (use Simulation)")
+    bs = BatchedSimulation(wgs, 2, base_dir=lw.base_dir)
+    assert bs.device("rover", "compass").kind == "Compass"       # the other kinds are measured there
+    for name, kind in (("gyro", "Gyro"), ("acc", "Accelerometer")):
+        with pytest.raises(BatchedError, match=f"device '{name}' is a {kind}; the batched simulation measures "
+                                               r".*GPS, Compass, InertialUnit \(use Simulation\)$"):
+            bs.device("rover", name)
+
+
+gym = pytest.importorskip("gymnasium")
+
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+
+from sensorium.gym import SensoriumEnv, Task  # noqa: E402
+from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
+
+OBSERVED = {"gps": 32, "compass": 16, "imu": 16, "flat_imu": 32}
+
+
+def _task() -> Task:
+    return Task(robot="rover", observations=OBSERVED, control_period_ms=32, max_steps=25)
+
+
+def test_the_vector_env_observes_them_as_the_single_env_and_passes_the_checker():
+    """A task observing a noisy GPS, a compass with a table and a disabled axis and two inertial
+    units: (3,) float32 boxes; every sub-env of the vector env equals the single env (rebuilt
+    Simulation, and the one-copy batched engine) with its seed, observations and info bit for bit,
+    across autoresets; a sub-env passes Gymnasium's checker without a warning."""
+    n = 3
+    venv = SensoriumVectorEnv(WORLD, _task(), n)
+    space = venv.single_observation_space
+    assert {k: space[k].shape for k in OBSERVED} == dict.fromkeys(OBSERVED, (3,))
+    assert space["imu"].high.tolist() == np.array([math.pi, math.pi / 2, math.pi], dtype=np.float32).tolist()
+    assert space["compass"].low.tolist() == [-100.0] * 3 and space["compass"].high.tolist() == [100.0] * 3
+    singles = [SensoriumEnv(WORLD, _task(), engine=e) for e in ("simulation", "batched", "simulation")]
+    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
+    obs, _ = venv.reset(seed=9)
+    for i, env in enumerate(singles):
+        o, _ = env.reset(seed=9 + i)
+        assert all(o[k].tobytes() == obs[k][i].tobytes() for k in OBSERVED), i
+    assert obs["compass"][:, 1].tolist() == [-100.0] * n          # the disabled y axis: the box's low bound
+    rng = np.random.default_rng(3)
+    done = np.zeros(n, dtype=bool)
+    ended = 0
+    for t in range(60):
+        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        vobs, vr, vte, vtr, vinfo = venv.step(a)
+        for i, env in enumerate(singles):
+            if done[i]:
+                o, r, te, tr = env.reset()[0], 0.0, False, False
+                ended += 1
+            else:
+                o, r, te, tr, inf = env.step(a[i])
+                assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
+            assert all(o[k].tobytes() == vobs[k][i].tobytes() for k in OBSERVED), (t, i)
+            assert (r, te, tr) == (vr[i], vte[i], vtr[i])
+            done[i] = te or tr
+    assert ended >= n                                           # autoresets happened
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(venv.sub_env(1), skip_render_check=True)            # (no registered id: no spec to remake)
+        check_env(SensoriumVectorEnv(WORLD, _task(), 2, flatten=True).sub_env(0), skip_render_check=True)
+    venv.close()
+
+
+def test_the_vector_env_refuses_a_wgs84_gps_in_one_line():
+    lw = load_world(WORLD)
+    w = lw.world
+    wgs = w.model_copy(update={"world_info": w.world_info.model_copy(update={"gps_coordinate_system": "WGS84",
+                                                                              "gps_reference": (46.5, 6.6, 400.0)})})
+    with pytest.raises(BatchedError) as e:
+        SensoriumVectorEnv(LoadedWorld(world=wgs, source=lw.source, base_dir=lw.base_dir), _task(), 2)
+    msg = str(e.value)
+    assert "\n" not in msg and msg.startswith("rover/gps: a GPS in a WGS84 world") and "SensoriumEnv can" in msg
+    env = SensoriumEnv(LoadedWorld(world=wgs, source=lw.source, base_dir=lw.base_dir), _task(), engine="auto")
+    assert env.engine == "simulation"                          # the single env runs it on a Simulation
+    obs, _ = env.reset(seed=0)
+    assert 46.0 < obs["gps"][0] < 47.0 and 6.0 < obs["gps"][1] < 7.0   # latitude, longitude
