@@ -19,6 +19,14 @@ One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
   pairs of one template tier in ONE call -- a hundred robots' pairs cost one Embree call, not a
   hundred.
 
+A FAST cast whose data allows it takes a lean path (:meth:`CopyRays._lean_cast`): the planes (one
+axis-aligned plane, a floor), the static tier and the broad phase in ONE C call (``sp_copy_cast``)
+instead of RayEngine.cast's Python stages around the same C passes (the origins' box, pointers,
+per-ray limits, the merge): the same answers, bit for bit (tests/test_copy_lean.py). The stages it
+does not do are ruled out from the cast's data, never from who casts: an origin row within reach of
+a curved shell (the pre-pass), origins outside the static tier's sphere, several or tilted planes,
+an anchored tier, per-ray t_near; any of them, EXACT, or no packet helper: the general path.
+
 Per ray, the answer is the single world's: the same static tier, the same body-frame rays, the
 same tiers. What depends on the batch is only what the engine itself takes from a whole cast: the
 float64 self-hit threshold ``1e-9 m + 1e-14 max|O|`` (max over the cast's origins, so a hit closer
@@ -300,8 +308,11 @@ class CopyRays:
             if static.has_curved:   # the pre-pass must be ruled out by the origins' rows (in the call)
                 if rows is None or 4 * len(rows) > n:
                     return None
-                c, bound = shell_spheres(static)
-                J.n_shells, J.shell_c, J.shell_bound = len(c), c.ctypes.data, bound.ctypes.data
+                kept = static.__dict__.get("_shell_ptrs")
+                if kept is None:   # (the shells never change: their addresses taken once)
+                    c, bound = shell_spheres(static)
+                    kept = static._shell_ptrs = (len(c), c.ctypes.data, bound.ctypes.data)
+                J.n_shells, J.shell_c, J.shell_bound = kept
             scene, built = static.scene(False)
             if built:
                 st._count("bvh_builds", built)
