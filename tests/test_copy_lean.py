@@ -74,7 +74,8 @@ def test_lidar_scans_that_hit_and_graze_the_other_robot_answer_as_the_general_pa
     bs, centres = _copies(n)
     O, D, copy, rows = _scan(centres)
     W = len(D) // n
-    t_far = 6.0 if far == "scalar" else np.linspace(2.0, 6.0, len(D))
+    # (per ray: a strided view, as a caller may pass one)
+    t_far = 6.0 if far == "scalar" else np.linspace(2.0, 6.0, 2 * len(D))[::2]
     scout = bs.slot("scout")
     pairs = bs.rays.counters["mover_pairs"]
     lean, general = _both(bs, O, D, 0.02, t_far, RayKind.VISUAL, copy, bs.rot, bs.pos, -1, scout,

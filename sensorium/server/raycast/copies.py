@@ -324,6 +324,7 @@ class CopyRays:
             arrays.append(np.ascontiguousarray(directions32))
         far_arr = isinstance(tf, np.ndarray)
         if far_arr:
+            tf = np.ascontiguousarray(tf)     # (a strided view: read as rows of 8 bytes in C)
             arrays.append(tf)
         if rows is not None:
             arrays.append(rows)
