@@ -19,6 +19,14 @@ One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
   pairs of one template tier in ONE call -- a hundred robots' pairs cost one Embree call, not a
   hundred.
 
+A FAST cast whose data allows it takes a lean path (:meth:`CopyRays._lean_cast`): the planes (one
+axis-aligned plane, a floor), the static tier and the broad phase in ONE C call (``sp_copy_cast``)
+instead of RayEngine.cast's Python stages around the same C passes (the origins' box, pointers,
+per-ray limits, the merge): the same answers, bit for bit (tests/test_copy_lean.py). The stages it
+does not do are ruled out from the cast's data, never from who casts: an origin row within reach of
+a curved shell (the pre-pass), origins outside the static tier's sphere, several or tilted planes,
+an anchored tier, per-ray t_near; any of them, EXACT, or no packet helper: the general path.
+
 Per ray, the answer is the single world's: the same static tier, the same body-frame rays, the
 same tiers. What depends on the batch is only what the engine itself takes from a whole cast: the
 float64 self-hit threshold ``1e-9 m + 1e-14 max|O|`` (max over the cast's origins, so a hit closer
@@ -28,14 +36,18 @@ has between casts of different sizes.
 
 from __future__ import annotations
 
+import ctypes
+import threading
 from collections.abc import Sequence
 
 import numpy as np
 
 from sensorium.server.raycast import packets
+from sensorium.server.raycast.blocks import MIN_RAYS, in_block
 from sensorium.server.raycast.engine import RayEngine
-from sensorium.server.raycast.exact import _INF, _PRUNE, _param, _take
+from sensorium.server.raycast.exact import _CHUNK, _INF, _PRUNE, _SMALL, _param, _take
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind
+from sensorium.server.raycast.trace import shell_spheres
 
 __all__ = ["CopyRays"]
 
@@ -57,7 +69,9 @@ class CopyRays:
         self.shape_offset = int(shape_offset)
         self.slots = len(self.slot_body)
         self._spheres: dict[str, tuple] = {}     # per variant: (tier per slot, anchor (R,3), r2 (R,), has body (R,))
-        self.counters = {"casts": 0, "rays": 0, "mover_pairs": 0, "mover_traces": 0}
+        self.counters = {"casts": 0, "rays": 0, "mover_pairs": 0, "mover_traces": 0, "lean_casts": 0}
+        self.lean = True     # FAST casts through sp_copy_cast where their data allows (False: the general path)
+        self._local = threading.local()   # per thread: the lean path's job struct and scratch buffers
 
     @property
     def precision(self) -> Precision:
@@ -81,7 +95,11 @@ class CopyRays:
                 if tier is not None:
                     anchor[r] = tier.anchor
                     r2[r] = tier.radius * tier.radius
-            got = self._spheres[variant] = (tiers, anchor, r2, r2 >= 0.0)
+            present = r2 >= 0.0
+            # (the lean path's view of them: contiguous arrays and their addresses, made once)
+            native = (anchor, r2, present.astype(np.uint8), bool(present.any()))
+            got = self._spheres[variant] = (tiers, anchor, r2, present,
+                                            (*native[:3], [a.ctypes.data for a in native[:3]], native[3]))
         return got
 
     def may_reach(self, slot: int, kind: RayKind, origins, directions, t_near, t_far,
@@ -129,22 +147,29 @@ class CopyRays:
         t_near = _param(t_near, n, np.float64, float)     # uniform -> scalar, as the engine normalises it
         self.counters["casts"] += 1
         self.counters["rays"] += n
+        lean = (self._lean_cast(O, D, n, t_near, t_far, kind, copy, rot, pos, exclude_slot, mount_slot,
+                                skip_transparent, distance_only, directions32, coherent, origin_rows, run)
+                if self.lean and self.static.native and self.static._precision is Precision.FAST else None)
+        if lean is not None:
+            hits, pr, pm, far = lean
+            if pr is None:
+                return hits
+            tiers = self._slot_tiers(self.movers._variant(kind, skip_transparent))[0]
+            return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent)
         hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
                                 distance_only=distance_only, directions32=directions32, coherent=coherent,
                                 origin_rows=origin_rows)
         if n == 0 or not self.slots:
             return hits
         variant = self.movers._variant(kind, skip_transparent)
-        tiers, anchor, r2, present = self._slot_tiers(variant)
+        tiers, anchor, r2, present, _ = self._slot_tiers(variant)
         if not present.any():
             return hits
         dist = hits.distance
         far = np.asarray(t_far, dtype=np.float64)
         far = float(far) if far.ndim == 0 else np.ascontiguousarray(np.broadcast_to(far, (n,)))
-        lim = None   # each ray's limit np.minimum(t_far, dist): made in the C pass, here once needed
         copy = np.asarray(copy, dtype=np.int64).reshape(n)
         # broad phase: each ray against the bounding spheres of its own copy's bodies
-        R = self.slots
         centre = pos + np.einsum("crij,rj->cri", rot, anchor)          # (C, R, 3): a conservative test only
         excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else np.asarray(exclude_slot).reshape(n)
         mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else np.asarray(mount_slot).reshape(n)
@@ -152,13 +177,20 @@ class CopyRays:
                if self.static.native else None)
         if got is None:
             lo = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,))
-            lim = np.minimum(far, dist)
-            got = _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt)
+            got = _pairs(O, D, copy, centre, r2, present, lo, np.minimum(far, dist), excl, mnt)
         pr, pm = got
         if not len(pr):
             return hits
-        if lim is None:
-            lim = np.minimum(far, dist)
+        return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent)
+
+    def _mover_pass(self, hits: RayHits, O: np.ndarray, D: np.ndarray, t_near, far, pr: np.ndarray, pm: np.ndarray,
+                    tiers: list, rot: np.ndarray, pos: np.ndarray, distance_only: bool, coherent: bool) -> RayHits:
+        """The mover pass of :meth:`cast` over the broad phase's (ray, copy * R + slot) pairs: each
+        pair into its body's frame, one trace per template tier, the nearest body hit per ray where
+        it is nearer than the static one (``hits``)."""
+        R = self.slots
+        dist = hits.distance
+        lim = np.minimum(far, dist)
         self.counters["mover_pairs"] += len(pr)
         # pairs grouped by body, each body's rays in ray order (as the engine's one-mover path sees them)
         order = np.lexsort((pr, pm))
@@ -232,6 +264,156 @@ class CopyRays:
         x = n_all[w]
         normal[rows] = (x[:, 0:1] * Rw[:, :, 0] + x[:, 2:3] * Rw[:, :, 2]) + x[:, 1:2] * Rw[:, :, 1]
         return RayHits(dist, normal, shape)
+
+    def _lean_cast(self, O: np.ndarray, D: np.ndarray, n: int, t_near, t_far, kind: RayKind, copy, rot, pos,
+                   exclude_slot, mount_slot, skip_transparent: bool, distance_only: bool, directions32, coherent: bool,
+                   origin_rows, run: int) -> tuple | None:
+        """A FAST cast's static pass and broad phase in one C call (``sp_copy_cast``): (hits, pairs'
+        rays or None, pairs' bodies, far) with the general path's values, or None where its data
+        needs a stage the call does not do (several or tilted planes, an anchored tier, a curved
+        shell near an origin, origins outside the tier's sphere, per-ray t_near, ...): the general
+        path then answers. The engine's Python around its C passes -- parameter checks, the origins'
+        box, the planes' and the tier's pointers, each ray's limits, the merge -- is what it saves."""
+        lib = packets.library()
+        st = self.static
+        if lib is None or not 2 <= n <= _CHUNK or isinstance(t_near, np.ndarray) or st._movers \
+                or O.shape != (n, 3) or D.shape != (n, 3) or not O.flags.c_contiguous:
+            return None
+        if directions32 is not None and (directions32.dtype != np.float32 or directions32.shape != (n, 3)):
+            return None    # (the general path says what is wrong)
+        variant = self.movers._variant(kind, skip_transparent)
+        planes = st._plane_set(variant)     # (built on the first cast after a change, as the engine does)
+        static = st._static_tier(variant)
+        J, keep = self._job(n)
+        tf = _param(t_far, n, np.float64, float)
+        rows = None
+        if origin_rows is not None and n > _SMALL:    # the engine's box of the origins from their rows
+            rows = np.ascontiguousarray(origin_rows, dtype=np.float64)
+            if rows.ndim != 2 or rows.shape[1] != 3 or not len(rows):
+                return None
+        J.plane = 0
+        if planes is not None:
+            planes.refresh(st._epoch)
+            if planes.axis < 0:
+                return None
+            J.plane, J.axis, J.c, J.visual, J.sized, J.sid = (1, planes.axis, float(planes.nz[0, planes.axis]),
+                                                             int(planes.visual), int(planes.sized), int(planes.sid[0]))
+            J.pt, J.nz, J.ax, J.ay, J.half = planes.native_rows()
+        J.scene = None
+        if static is not None:
+            tier = static.native(False)
+            if static.anchored or tier is None:
+                return None
+            J.n_shells = 0
+            if static.has_curved:   # the pre-pass must be ruled out by the origins' rows (in the call)
+                if rows is None or 4 * len(rows) > n:
+                    return None
+                kept = static.__dict__.get("_shell_ptrs")
+                if kept is None:   # (the shells never change: their addresses taken once)
+                    c, bound = shell_spheres(static)
+                    kept = static._shell_ptrs = (len(c), c.ctypes.data, bound.ctypes.data)
+                J.n_shells, J.shell_c, J.shell_bound = kept
+            scene, built = static.scene(False)
+            if built:
+                st._count("bvh_builds", built)
+            J.scene, J.T, J.radius = scene.handle, tier, static.radius
+        if not D.flags.c_contiguous:
+            D = np.ascontiguousarray(D)
+        arrays = [O, D]
+        if directions32 is not None:
+            arrays.append(np.ascontiguousarray(directions32))
+        far_arr = isinstance(tf, np.ndarray)
+        if far_arr:
+            tf = np.ascontiguousarray(tf)     # (a strided view: read as rows of 8 bytes in C)
+            arrays.append(tf)
+        if rows is not None:
+            arrays.append(rows)
+        t = np.empty(n)
+        arrays.append(t)
+        if not distance_only:
+            s, nrm = np.empty(n, dtype=np.int64), np.empty((n, 3))
+            arrays += [s, nrm]
+        sphere_ptrs, present = self._slot_tiers(variant)[4][3:]
+        pairs = present and self.slots > 0
+        if pairs:
+            R = self.slots
+            C = len(rot)
+            rot = np.ascontiguousarray(rot, dtype=np.float64)
+            pos = np.ascontiguousarray(pos, dtype=np.float64)
+            if rot.shape != (C, R, 3, 3) or pos.shape != (C, R, 3):
+                return None
+            copy = np.ascontiguousarray(copy, dtype=np.int64).reshape(n)
+            arrays += [copy, rot, pos]
+            excl = exclude_slot if isinstance(exclude_slot, (int, np.integer)) else \
+                np.ascontiguousarray(exclude_slot, dtype=np.int64).reshape(n)
+            mnt = mount_slot if isinstance(mount_slot, (int, np.integer)) else \
+                np.ascontiguousarray(mount_slot, dtype=np.int64).reshape(n)
+            for a in (excl, mnt):
+                if isinstance(a, np.ndarray):
+                    arrays.append(a)
+            out_ray, out_body, p_ray, p_body = packets.pair_buffers(n * R)
+            if len(keep["centre"]) < C * R * 3:
+                keep["centre"] = np.empty(C * R * 3)
+                keep["p_centre"] = keep["centre"].ctypes.data
+        p = iter(packets.addresses(arrays))
+        J.n, J.O, J.D = n, next(p), next(p)
+        J.d32 = next(p) if directions32 is not None else None
+        J.near, J.distance_only, J.coherent, J.run = t_near, int(distance_only), int(coherent), max(0, int(run))
+        J.far, J.far_value = (next(p), 0.0) if far_arr else (None, tf)
+        J.threads = st.threads if n >= MIN_RAYS and not in_block() else 1
+        J.n_rows, J.rows = (len(rows), next(p)) if rows is not None else (0, None)
+        J.t = next(p)
+        J.s, J.nrm = (None, None) if distance_only else (next(p), next(p))
+        J.R = 0
+        if pairs:
+            J.C, J.R = C, R
+            J.copy, J.rot, J.pos = next(p), next(p), next(p)
+            J.excl, J.excl_value = (next(p), 0) if isinstance(excl, np.ndarray) else (None, int(excl))
+            J.mnt, J.mnt_value = (next(p), 0) if isinstance(mnt, np.ndarray) else (None, int(mnt))
+            J.anchor, J.r2, J.present = sphere_ptrs
+            J.centre, J.out_ray, J.out_body = keep["p_centre"], p_ray, p_body
+        job = keep["address"]
+        got = lib.sp_copy_cast(job)
+        if got < 0:
+            return None
+        st.counters["rays_cast"] += n
+        self.counters["lean_casts"] += 1
+        if static is not None:
+            st._count("embree_calls", 1)
+        if got == 1:   # rays FAST judges in the general loop (trace.py's redo), then the merge and pairs
+            redo = keep["special"][:n].view(bool).nonzero()[0]
+            tt, ss, nn = (t, None if distance_only else s, None if distance_only else nrm) if J.into_out else (
+                keep["st_t"][:n], keep["st_s"][:n], keep["st_n"][:n])
+            lim = tf if J.plane_hits == 0 else keep["lim"][:n]
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
+                t2, s2, n2 = st._trace_loop(static, O[redo], D[redo], t_near, _take(lim, redo), -1, J.eps64, exact=False)
+            tt[redo] = t2
+            if not distance_only:
+                ss[redo], nn[redo] = s2, n2
+            lib.sp_copy_finish(job)
+        hits = RayHits(t, None, None) if distance_only else RayHits(t, nrm, s)
+        k = J.n_pairs
+        if not k:
+            return hits, None, None, tf
+        return hits, out_ray[:k].copy(), out_body[:k].copy(), tf
+
+    def _job(self, n: int) -> tuple:
+        """This thread's :class:`packets.CopyJob` and its scratch buffers (grown to the largest cast
+        seen: no new pages cast after cast), their addresses set in the job once."""
+        local = self._local
+        keep = getattr(local, "keep", None)
+        if keep is None or keep["cap"] < n:
+            cap = max(n, 1024)
+            J = keep["job"] if keep is not None else packets.CopyJob()
+            keep = {"job": J, "address": ctypes.addressof(J), "cap": cap, "lim": np.empty(cap),
+                    "far32": np.empty(cap, dtype=np.float32), "st_t": np.empty(cap),
+                    "st_s": np.empty(cap, dtype=np.int64), "st_n": np.empty((cap, 3)),
+                    "special": np.empty(cap, dtype=np.uint8), "d32": np.empty((cap, 3), dtype=np.float32),
+                    "centre": np.empty(0), "p_centre": None}
+            J.lim, J.far32, J.st_t, J.st_s, J.st_n, J.special, J.d32_buf = (
+                keep[name].ctypes.data for name in ("lim", "far32", "st_t", "st_s", "st_n", "special", "d32"))
+            local.keep = keep
+        return keep["job"], keep
 
 
 def _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt) -> tuple[np.ndarray, np.ndarray]:

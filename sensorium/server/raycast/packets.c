@@ -840,6 +840,187 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
   return n_hit;
 }
 
+/* ---- a batched (CopyRays) cast in one call ----
+ * copies.py's lean path: the planes, the static tier and the movers' broad phase of
+ * CopyRays.cast for a FAST cast whose stages reduce, from its data, to sp_plane1 (one axis-aligned
+ * plane, or none), one sp_fast_pass and sp_copy_pairs -- with the values the engine's Python
+ * around them computes (the largest origin coordinate, the self-hit epsilon, each ray's limit and
+ * float32 far limit, the merge of plane and mesh hits), each operation as numpy rounds it. The
+ * stages of RayEngine.cast that this data rules out (origins outside the tier's sphere, start points
+ * near a curved shell: the pre-pass) are screened first, conservatively: where one may apply, the
+ * call returns -1 having written no output, and copies.py takes the general path. Every field is
+ * 8 bytes (copies.py's ctypes mirror). */
+struct sp_copy_job {
+  /* rays: origins O and directions D (n, 3); d32 the directions in float32, or NULL: rounded here
+     into d32_buf; t_near one value; t_far per ray (far) or one value; rows: the distinct origins
+     (n_rows of them) or NULL */
+  int64_t n; const double* O; const double* D; const float* d32; float* d32_buf;
+  double near; const double* far; double far_value; int64_t distance_only; int64_t coherent; int64_t threads;
+  int64_t n_rows; const double* rows;
+  /* the plane (plane != 0): sp_plane1's arguments */
+  int64_t plane; int64_t axis; double c; int64_t visual; const double* pt; const double* nz; int64_t sized;
+  const double* ax; const double* ay; const double* half; int64_t sid;
+  /* the static tier (scene NULL: none); its curved shells' centres and screening radii */
+  void* scene; const struct sp_tier* T; double radius; int64_t n_shells; const double* shell_c;
+  const double* shell_bound;
+  /* scratch, n rows each: each ray's limit, its float32 far limit, the tier's hits, the redo flags */
+  double* lim; float* far32; double* st_t; int64_t* st_s; double* st_n; uint8_t* special;
+  /* outputs (s, nrm NULL when distance_only) */
+  double* t; int64_t* s; double* nrm;
+  /* the movers' broad phase (R = 0: none): C copies of R slots, rot (C, R, 3, 3), pos (C, R, 3),
+     each slot's sphere anchor (R, 3) and r2, centre (C, R, 3) written here */
+  int64_t C; int64_t R; int64_t run; const int64_t* copy; const double* rot; const double* pos;
+  const double* anchor; const double* r2; const uint8_t* present; double* centre; const int64_t* excl;
+  int64_t excl_value; const int64_t* mnt; int64_t mnt_value; int64_t* out_ray; int64_t* out_body;
+  /* results */
+  double big; double eps64; int64_t plane_hits; int64_t n_hit; int64_t n_special; int64_t into_out;
+  int64_t n_pairs;
+};
+
+size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, int axis, double c, int visual,
+                 const double* pt, const double* nz, const double* lo, double lo_value, const double* hi,
+                 double hi_value, int sized, const double* ax, const double* ay, const double* half, int check_owner,
+                 int64_t owner, const int64_t* excl, int64_t excl_value, int64_t sid, double* dist, int64_t* shape,
+                 double* normal);
+size_t sp_copy_pairs(size_t n, size_t R, size_t run, const double* O, const double* D, const int64_t* copy,
+                     const double* centre, const double* r2, const uint8_t* present, const double* lo,
+                     double lo_value, const double* lim, double lim_value, const double* dist,
+                     const int64_t* excl, int64_t excl_value, const int64_t* mnt, int64_t mnt_value,
+                     int64_t* out_ray, int64_t* out_body);
+
+/* The merge of the tier's hits into the plane's (engine._cast_static) and the broad phase
+ * (copies.py: each slot's sphere centre pos + rot @ anchor, summed as einsum sums it, then
+ * sp_copy_pairs against the merged distances); the number of pairs. */
+int64_t sp_copy_finish(struct sp_copy_job* J) {
+  const size_t n = (size_t)J->n;
+  if (J->plane_hits > 0 && J->n_hit > 0) {
+    if (J->distance_only) {
+      for (size_t i = 0; i < n; i++) J->t[i] = np_min(J->t[i], J->st_t[i]);
+    } else {
+      for (size_t i = 0; i < n; i++)
+        if (J->st_t[i] < J->t[i]) {
+          J->t[i] = J->st_t[i]; J->s[i] = J->st_s[i];
+          J->nrm[3 * i] = J->st_n[3 * i]; J->nrm[3 * i + 1] = J->st_n[3 * i + 1]; J->nrm[3 * i + 2] = J->st_n[3 * i + 2];
+        }
+    }
+  }
+  J->n_pairs = 0;
+  if (J->R <= 0) return 0;
+  const size_t R = (size_t)J->R, CR = (size_t)J->C * R;
+  for (size_t b = 0; b < CR; b++) {
+    const double* M = J->rot + 9 * b;
+    const double* a = J->anchor + 3 * (b % R);
+    for (int i = 0; i < 3; i++) {
+      double acc = 0.0;
+      acc += M[3 * i] * a[0]; acc += M[3 * i + 1] * a[1]; acc += M[3 * i + 2] * a[2];
+      J->centre[3 * b + (size_t)i] = J->pos[3 * b + (size_t)i] + acc;
+    }
+  }
+  J->n_pairs = (int64_t)sp_copy_pairs(n, R, (size_t)J->run, J->O, J->D, J->copy, J->centre, J->r2, J->present, NULL,
+                                      J->near, J->far, J->far_value, J->t, J->excl, J->excl_value, J->mnt,
+                                      J->mnt_value, J->out_ray, J->out_body);
+  return J->n_pairs;
+}
+
+/* The cast: -1 where the general path must answer (nothing written but scratch); 1 where some rays
+ * need the general loop's redo (the special flags; copies.py redoes them, then sp_copy_finish); 0
+ * done (the broad phase's pairs in n_pairs). */
+int64_t sp_copy_cast(struct sp_copy_job* J) {
+  const size_t n = (size_t)J->n;
+  /* the largest |coordinate| of the origins (RayEngine.cast: over the distinct rows when given) */
+  const double* src = J->rows ? J->rows : J->O;
+  const size_t ns = J->rows ? (size_t)J->n_rows : n;
+  double lo = INF_D, hi = -INF_D;
+  for (size_t k = 0; k < 3 * ns; k++) {
+    const double x = src[k];
+    if (!(x - x == 0.0)) return -1;   /* NaN or infinite: the general path */
+    if (x < lo) lo = x;
+    if (x > hi) hi = x;
+  }
+  const double big = -lo > hi ? -lo : hi;
+  const double eps64 = 1e-9 + 1e-14 * big;
+  const double lo_near = eps64 > J->near ? eps64 : J->near;   /* max(t_near, eps64) */
+  J->big = big; J->eps64 = eps64;
+  const struct sp_tier* T = J->T;
+  if (J->scene) {
+    /* origins outside the tier's sphere (trace.py clips them): a float32 test with margin */
+    if (big * 1.7321 > J->radius) {
+      const double thr = (double)(float)(J->radius * J->radius) * (1.0 - 1e-5);
+      for (size_t k = 0; k < ns; k++) {
+        const double x = (double)(float)src[3 * k], y = (double)(float)src[3 * k + 1], z = (double)(float)src[3 * k + 2];
+        if (x * x + y * y + z * z > thr) return -1;
+      }
+    }
+    /* a start point maybe in a curved shell's sphere (trace._near_shells, the same operations) */
+    for (size_t k = 0; k < ns && J->n_shells > 0; k++) {
+      const double* o = src + 3 * k;
+      for (int64_t q = 0; q < J->n_shells; q++) {
+        const double* c = J->shell_c + 3 * q;
+        const double dx = o[0] - c[0], dy = o[1] - c[1], dz = o[2] - c[2];
+        if (sqrt(dx * dx + dy * dy + dz * dz) <= (J->shell_bound[q] + lo_near) * (1.0 + 1e-9)) return -1;
+      }
+    }
+  }
+  /* the plane (cast_planes -> packets.plane1): its hits straight into the outputs */
+  int64_t k = 0;
+  if (J->plane)
+    k = (int64_t)sp_plane1(n, J->O, 3, J->D, (int)J->axis, J->c, (int)J->visual, J->pt, J->nz, NULL, lo_near, J->far,
+                           J->far_value, (int)J->sized, J->ax, J->ay, J->half, 0, 0, NULL, 0, J->sid, J->t,
+                           J->distance_only ? NULL : J->s, J->nrm);
+  J->plane_hits = k;
+  J->n_hit = 0; J->n_special = 0; J->into_out = k == 0;
+  if (!J->scene) {
+    if (!J->plane) {   /* nothing to hit: engine._cast_static's empty answer */
+      for (size_t i = 0; i < n; i++) {
+        J->t[i] = INF_D;
+        if (!J->distance_only) { J->s[i] = -1; J->nrm[3 * i] = J->nrm[3 * i + 1] = J->nrm[3 * i + 2] = 0.0; }
+      }
+    }
+    return sp_copy_finish(J), 0;
+  }
+  /* each ray's limit: t_far, or np.minimum(t_far, plane hit) once a plane was hit; FAST's float32
+     far limit from it (trace.py: (lim - start) * slack, per ray or one value) */
+  const double slack = 1.0 + 0x1p-20;
+  const double* lim = NULL;
+  double lim_value = J->far_value;
+  if (k > 0) {
+    for (size_t i = 0; i < n; i++) J->lim[i] = np_min(J->far ? J->far[i] : J->far_value, J->t[i]);
+    lim = J->lim;
+  } else if (J->far) {
+    lim = J->far;
+  }
+  const float* far32 = NULL;
+  float far_value32 = 0.0f;
+  int far_none = 0;
+  if (lim) {
+    for (size_t i = 0; i < n; i++) J->far32[i] = (float)((J->near == 0.0 ? lim[i] : lim[i] - J->near) * slack);
+    far32 = J->far32;
+  } else {
+    const double f = (lim_value - J->near) * slack;
+    far_none = f == INF_D;
+    far_value32 = far_none ? 0.0f : (float)f;
+  }
+  const float* d32 = J->d32;
+  if (!d32) {
+    for (size_t i = 0; i < 3 * n; i++) J->d32_buf[i] = (float)J->D[i];
+    d32 = J->d32_buf;
+  }
+  const int shifted = J->near > 0.0;
+  double* tt = k > 0 ? J->st_t : J->t;
+  int64_t* ss = J->distance_only ? NULL : (k > 0 ? J->st_s : J->s);
+  double* nn = J->distance_only ? NULL : (k > 0 ? J->st_n : J->nrm);
+  const int lim_min = lim != NULL || lim_value != INF_D;
+  J->n_hit = (int64_t)sp_fast_pass(J->scene, T, n, (int)J->coherent, NULL, 0, NULL, shifted, shifted ? (float)J->near : 0.0f,
+                                   d32, far32, far_value32, far_none, J->O, 3, J->O, J->D, NULL, J->near, lim,
+                                   lim ? 0.0 : lim_value, lim_min, NULL, 0, 0, (int)J->distance_only, tt, ss, nn,
+                                   J->special, (int)J->threads);
+  int64_t sp = 0;
+  for (size_t i = 0; i < n; i++) sp += J->special[i];
+  J->n_special = sp;
+  if (sp) return 1;
+  return sp_copy_finish(J), 0;
+}
+
 /* A fixed lidar's scan from its beams' distances, rows [0, n) (sensors.py, Lidar.finish): lidar.py's
  * ranges_from_hits without noise or resolution, then point_xyz, one pass. Per beam v = dist[i]
  * (times factor[i] for a planar lidar), range = float32(v), +inf unless v >= lo and

@@ -199,6 +199,10 @@ def _load() -> None:
     lib.sp_inside_shells.argtypes = [sz, vp, sz, vp, vp, d, sz, vp, vp, vp, vp, vp, vp, vp, i, vp, vp]
     lib.sp_copy_pairs.restype = sz
     lib.sp_copy_pairs.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, d, vp, d, vp, vp, i64, vp, i64, vp, vp]
+    lib.sp_copy_cast.restype = i64
+    lib.sp_copy_cast.argtypes = [vp]
+    lib.sp_copy_finish.restype = i64
+    lib.sp_copy_finish.argtypes = [vp]
     lib.sp_contact_near.restype = sz
     lib.sp_drive_wheels.restype = sz
     lib.sp_lidar_beams.restype = None
@@ -336,6 +340,28 @@ class Scene:
             res.update(geomID=out[2 * n:3 * n].view(np.int32), u=out[3 * n:4 * n], v=out[4 * n:5 * n],
                        Ng=out[5 * n:].reshape(n, 3))
         return res
+
+
+class CopyJob(ctypes.Structure):
+    """``struct sp_copy_job`` of packets.c: one batched cast's arguments, scratch and results for
+    ``sp_copy_cast`` / ``sp_copy_finish`` (copies.py's lean path; every field 8 bytes)."""
+
+    _fields_ = [(name, ctypes.c_double if kind == "d" else ctypes.c_int64 if kind == "i" else ctypes.c_void_p)
+                for name, kind in (
+                    ("n", "i"), ("O", "p"), ("D", "p"), ("d32", "p"), ("d32_buf", "p"), ("near", "d"), ("far", "p"),
+                    ("far_value", "d"), ("distance_only", "i"), ("coherent", "i"), ("threads", "i"), ("n_rows", "i"),
+                    ("rows", "p"),
+                    ("plane", "i"), ("axis", "i"), ("c", "d"), ("visual", "i"), ("pt", "p"), ("nz", "p"), ("sized", "i"),
+                    ("ax", "p"), ("ay", "p"), ("half", "p"), ("sid", "i"),
+                    ("scene", "p"), ("T", "p"), ("radius", "d"), ("n_shells", "i"), ("shell_c", "p"),
+                    ("shell_bound", "p"),
+                    ("lim", "p"), ("far32", "p"), ("st_t", "p"), ("st_s", "p"), ("st_n", "p"), ("special", "p"),
+                    ("t", "p"), ("s", "p"), ("nrm", "p"),
+                    ("C", "i"), ("R", "i"), ("run", "i"), ("copy", "p"), ("rot", "p"), ("pos", "p"), ("anchor", "p"),
+                    ("r2", "p"), ("present", "p"), ("centre", "p"), ("excl", "p"), ("excl_value", "i"), ("mnt", "p"),
+                    ("mnt_value", "i"), ("out_ray", "p"), ("out_body", "p"),
+                    ("big", "d"), ("eps64", "d"), ("plane_hits", "i"), ("n_hit", "i"), ("n_special", "i"),
+                    ("into_out", "i"), ("n_pairs", "i"))]
 
 
 class TierArrays(ctypes.Structure):
@@ -762,6 +788,8 @@ def _small_addresses(arrays) -> list[int]:
 
 
 _BYTE = ctypes.c_char
+pair_buffers = _pair_buffers         # (copies.py's lean path fills them through sp_copy_cast)
+addresses = _small_addresses
 
 
 def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reach: np.ndarray,

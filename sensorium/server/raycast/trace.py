@@ -52,16 +52,23 @@ def _rows_ptr(x: np.ndarray) -> tuple:
     return a, a.ctypes.data, 3
 
 
+def shell_spheres(tier: _Tier) -> tuple[np.ndarray, np.ndarray]:
+    """(centres (k, 3), screening radii (k,)) of the tier's curved shells, contiguous float64, made
+    once (the shells never change): what :func:`_near_shells` screens start points against."""
+    kept = tier.__dict__.get("_shell_spheres")
+    if kept is None:
+        kept = tier._shell_spheres = (np.ascontiguousarray(tier.c_pos, dtype=np.float64),
+                                      np.ascontiguousarray(np.sqrt(tier.c_bound2), dtype=np.float64))
+    return kept
+
+
 def _near_shells(tier: _Tier, rows: np.ndarray, lo: float) -> bool:
     """Whether a start point ``o + lo d`` (unit ``d``) of a ray from one of the origins ``rows``
     (tier frame) may lie in a curved shell's bounding sphere: the pre-pass's screen of one origin
     (``refine._contained_prepass``: centre distance <= (bound + lo) (1 + 1e-9)) for each row. False:
     every start point lies outside every shell, so the pre-pass, which looks only at start points
     inside a shell, finds nothing (a lidar scanning from 64 copies' robots, a sensor's rays)."""
-    kept = tier.__dict__.get("_shell_spheres")
-    if kept is None:   # the shells never change: centres and screening radii made once
-        kept = tier._shell_spheres = (np.ascontiguousarray(tier.c_pos, dtype=np.float64), np.sqrt(tier.c_bound2))
-    c, bound = kept
+    c, bound = shell_spheres(tier)
     dx = rows[:, 0:1] - c[:, 0]
     dy = rows[:, 1:2] - c[:, 1]
     dz = rows[:, 2:3] - c[:, 2]
