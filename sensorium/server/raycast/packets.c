@@ -1322,3 +1322,110 @@ size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, in
   }
   return hits;
 }
+
+/* batched.py's _drive up to the contact narrow phase, in one pass over the state arrays (their
+ * addresses in a[], see DriveStep in packets.py): the live copies' robots stop pressing; their
+ * wheels and drives (sp_drive_wheels); the moving robots' arcs (sp_arc_steps, from x, y, yaw
+ * gathered) and their new yaws written; with contact, each move's reach hypot(end - start) + eps
+ * (np.hypot is libm's hypot), the grown discs (grow: 0, then the movers' reach) and the broad phase
+ * (sp_contact_near). When no move is near anything, the moves end where Contact._clip without
+ * candidates puts them (start + (end - start); a robot without a footprint: at its end): centres,
+ * x and y written; else nothing more is written (the caller's narrow phase). Then each move's Rz
+ * (its new yaw's cos and sin) and its base, gathered, for the pose's product. status[0]: infinite
+ * angles (the outputs are then not to be used: the caller's Python way says so), status[1]: near
+ * moves. Returns the number of moves. */
+size_t sp_drive_step(size_t L, const int64_t* live, size_t D, const int64_t* driven, size_t C, size_t R, size_t S,
+                     double dt, double eps, int contact, void* const* a, int64_t* status) {
+  const double* target = a[0];
+  const double* velocity = a[1];
+  double* angle = a[2];
+  const int64_t* sides = a[3];
+  const double* radius = a[4];
+  const double* axle = a[5];
+  double* x = a[6];
+  double* y = a[7];
+  double* yaw = a[8];
+  uint8_t* pressing = a[9];
+  int64_t* mc = a[10];
+  int64_t* ms = a[11];
+  double* v = a[12];
+  double* w = a[13];
+  double* starts = a[14];   /* (k, 2) */
+  double* ends = a[15];     /* (k, 2) */
+  double* x0 = a[16];       /* scratch: (k,) x, y, yaw gathered, then the arcs' outputs */
+  double* y0 = a[17];
+  double* yaw0 = a[18];
+  double* x1 = a[19];
+  double* y1 = a[20];
+  double* yaw1 = a[21];
+  double* cs = a[22];
+  double* sn = a[23];
+  double* rz = a[24];       /* (k, 3, 3) */
+  const double* base = a[25];
+  double* base_g = a[26];   /* (k, 3, 3) */
+  status[0] = status[1] = 0;
+  for (size_t l = 0; l < L; l++) memset(pressing + (size_t)live[l] * R, 0, R);
+  const size_t k = sp_drive_wheels(L, D, R, live, driven, target, velocity, angle, dt, sides, radius, axle, mc, ms,
+                                   v, w);
+  if (!k) return 0;
+  for (size_t m = 0; m < k; m++) {
+    const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+    x0[m] = x[at];
+    y0[m] = y[at];
+    yaw0[m] = yaw[at];
+  }
+  status[0] = (int64_t)sp_arc_steps(k, x0, y0, yaw0, v, w, dt, x1, y1, yaw1, cs, sn);
+  if (status[0]) return k;
+  for (size_t m = 0; m < k; m++) {
+    const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+    yaw[at] = yaw1[m];
+    starts[2 * m] = x0[m];
+    starts[2 * m + 1] = y0[m];
+    ends[2 * m] = x1[m];
+    ends[2 * m + 1] = y1[m];
+    double* r = rz + 9 * m;
+    r[0] = cs[m]; r[1] = -sn[m]; r[2] = 0.0;
+    r[3] = sn[m]; r[4] = cs[m]; r[5] = 0.0;
+    r[6] = 0.0; r[7] = 0.0; r[8] = 1.0;
+    memcpy(base_g + 9 * m, base + 9 * at, 9 * sizeof(double));
+  }
+  if (contact) {
+    double* reach = a[27];
+    double* grow = a[28];     /* (C, R) */
+    const double* foot_radius = a[29];
+    double* centres = a[33];  /* (C, R, 2) */
+    memset(grow, 0, C * R * sizeof(double));
+    for (size_t m = 0; m < k; m++) {
+      reach[m] = hypot(x1[m] - x0[m], y1[m] - y0[m]) + eps;
+      grow[(size_t)mc[m] * R + (size_t)ms[m]] = reach[m];
+    }
+    status[1] = (int64_t)sp_contact_near(k, R, S, mc, ms, starts, reach, foot_radius, a[30], a[31], a[32], centres,
+                                         grow, a[34], a[35], a[36], a[37], eps, a[38], a[39], a[40]);
+    if (status[1]) return k;
+    for (size_t m = 0; m < k; m++) {
+      const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+      const int bare = isnan(foot_radius[ms[m]]);
+      centres[2 * at] = bare ? x1[m] : x0[m] + (x1[m] - x0[m]);
+      centres[2 * at + 1] = bare ? y1[m] : y0[m] + (y1[m] - y0[m]);
+    }
+  }
+  for (size_t m = 0; m < k; m++) {
+    const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+    x[at] = x1[m];
+    y[at] = y1[m];
+  }
+  return k;
+}
+
+/* batched.py's _drive after the product: move m's rotation rot_in[m] (k, 3, 3) and position
+ * (x, y, z of its copy and slot, (C, R) each) written into rot (C, R, 3, 3) and pos (C, R, 3). */
+void sp_pose_scatter(size_t k, size_t R, const int64_t* mc, const int64_t* ms, const double* rot_in, const double* x,
+                     const double* y, const double* z, double* rot, double* pos) {
+  for (size_t m = 0; m < k; m++) {
+    const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+    memcpy(rot + 9 * at, rot_in + 9 * m, 9 * sizeof(double));
+    pos[3 * at] = x[at];
+    pos[3 * at + 1] = y[at];
+    pos[3 * at + 2] = z[at];
+  }
+}

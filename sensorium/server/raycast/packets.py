@@ -843,3 +843,94 @@ def lidar_beams(rot: np.ndarray, org: np.ndarray, columns, out=None) -> tuple[np
         _check_buffer("lidar_beams", a, dt_, (n * W, 3), writes=True)
     lib.sp_lidar_beams(n, W, *_small_addresses((rot, org, x, y, z, out_org, out_dir, out_d32)))
     return out_org, out_dir, out_d32
+
+
+class DriveStep:
+    """:meth:`.batched.BatchedSimulation._drive` up to the contact narrow phase in one C pass
+    (``sp_drive_step``) and its last writes in another (``sp_pose_scatter``), over the simulation's
+    state arrays, whose addresses are taken once (the simulation writes them in place, never
+    rebinds them; the contact's solid arrays are re-read when a Supervisor rebuilds them). After
+    :meth:`run` returned k moves, their copies, slots, starts and ends, the broad phase (when
+    ``status[1]``: some move is near something) and the Rz and base of each lie in the first k
+    rows of this object's arrays. :func:`drive_step` makes one, or None without the helper."""
+
+    def __init__(self, lib, state: dict[str, np.ndarray], contact: dict[str, np.ndarray] | None):
+        self.lib = lib
+        self.state = state
+        C, R = state["x"].shape
+        self.C, self.R = C, R
+        n = C * R
+        i64 = np.int64
+        self.copies, self.slots = np.empty(n, dtype=i64), np.empty(n, dtype=i64)
+        self.v, self.w = np.empty(n), np.empty(n)
+        self.starts, self.ends = np.empty((n, 2)), np.empty((n, 2))
+        self.gathered = [np.empty(n) for _ in range(8)]   # x0, y0, yaw0, x1, y1, yaw1, cos, sin
+        self.cos, self.sin = self.gathered[6], self.gathered[7]
+        self.rz, self.base, self.rot = np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3, 3))
+        self.status = np.zeros(2, dtype=i64)
+        self.contact = contact
+        S = self.S = 0   # (the solids' count, set by run)
+        self.reach, self.grow = np.empty(n), np.empty((C, R))
+        self.solid_hit = np.zeros((n, S), dtype=np.bool_)
+        self.robot_hit = np.zeros((n, R), dtype=np.bool_)
+        self.near = np.zeros(n, dtype=np.bool_)
+        for name, dt_, shape in (("target", np.float64, (C, R, 2)), ("velocity", np.float64, (C, R, 2)),
+                                 ("sides", i64, (R, 2)), ("radius", np.float64, (R,)), ("axle", np.float64, (R,)),
+                                 ("base", np.float64, (C, R, 3, 3)), ("z", np.float64, (C, R))):
+            _check_buffer("drive_step", state[name], dt_, shape)
+        for name, dt_, shape in (("angle", np.float64, (C, R, 2)), ("x", np.float64, (C, R)),
+                                 ("y", np.float64, (C, R)), ("yaw", np.float64, (C, R)),
+                                 ("pressing", np.bool_, (C, R)), ("rot", np.float64, (C, R, 3, 3)),
+                                 ("pos", np.float64, (C, R, 3))):
+            _check_buffer("drive_step", state[name], dt_, shape, writes=True)
+        arrays = [state[k] for k in ("target", "velocity", "angle", "sides", "radius", "axle", "x", "y", "yaw",
+                                     "pressing")]
+        arrays += [self.copies, self.slots, self.v, self.w, self.starts, self.ends, *self.gathered, self.rz,
+                   state["base"], self.base, self.reach, self.grow]
+        if contact is not None:
+            for name, shape in (("foot_radius", (R,)), ("foot_low", (R,)), ("foot_high", (R,)),
+                                ("heights", (C, R))):
+                _check_buffer("drive_step", contact[name], np.float64, shape)
+            _check_buffer("drive_step", contact["centres"], np.float64, (C, R, 2), writes=True)
+            arrays += [contact[k] for k in ("foot_radius", "foot_low", "foot_high", "heights", "centres")]
+        self.ptrs = (ctypes.c_void_p * 41)(*(a.ctypes.data for a in arrays))
+        self._solids: tuple = ()
+        self.p_status = self.status.ctypes.data
+        self.p_scatter = [a.ctypes.data for a in (self.copies, self.slots, self.rot, state["x"], state["y"],
+                                                  state["z"], state["rot"], state["pos"])]
+        vp, sz, d = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
+        lib.sp_drive_step.restype = sz
+        lib.sp_drive_step.argtypes = [sz, vp, sz, vp, sz, sz, sz, d, d, ctypes.c_int, vp, vp]
+        lib.sp_pose_scatter.restype = None
+        lib.sp_pose_scatter.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]
+
+    def run(self, live: np.ndarray, driven: np.ndarray, dt: float, eps: float, solids=None) -> int:
+        """One basic step of the live copies' driven slots (int64 arrays); ``solids``: the contact's
+        (lo, hi, zlo, zhi) arrays (None: no contact). Returns the number of moves."""
+        if solids is not None and (len(self._solids) != 4 or any(a is not b for a, b in zip(solids, self._solids))):
+            for a, shape in zip(solids, ((len(solids[2]), 2), (len(solids[2]), 2), (len(solids[2]),),
+                                         (len(solids[2]),))):
+                _check_buffer("drive_step", a, np.float64, shape)
+            S = len(solids[2])
+            if S != self.S:
+                self.S = S
+                self.solid_hit = np.zeros((self.C * self.R, S), dtype=np.bool_)
+            self._solids = tuple(solids)
+            for j, a in enumerate((*solids, self.solid_hit, self.robot_hit, self.near)):
+                self.ptrs[34 + j] = a.ctypes.data
+        live = np.ascontiguousarray(live, dtype=np.int64)
+        return self.lib.sp_drive_step(len(live), live.ctypes.data, len(driven), driven.ctypes.data, self.C, self.R,
+                                      self.S, dt, eps, 0 if solids is None else 1, self.ptrs, self.p_status)
+
+    def scatter(self, k: int) -> None:
+        """Move m's rotation (``self.rot[m]``) and its (x, y, z) written into the state's rot and pos."""
+        p = self.p_scatter
+        self.lib.sp_pose_scatter(k, self.R, p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+
+
+def drive_step(state: dict[str, np.ndarray], contact: dict[str, np.ndarray] | None) -> DriveStep | None:
+    """A :class:`DriveStep` over these state arrays, or None without the helper."""
+    lib = library()
+    if lib is None:
+        return None
+    return DriveStep(lib, state, contact)

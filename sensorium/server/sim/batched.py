@@ -211,6 +211,7 @@ class BatchedSimulation:
         # -- robots: initial poses and drives (the template state every reset starts from)
         self.initial = [pose_from_model(r.pose) for r in w.robots]
         self.has_drive = np.array([r.differential_drive is not None for r in w.robots], dtype=bool)
+        self._driven = self.has_drive.nonzero()[0]
         self.wheel_radius = np.array([r.differential_drive.wheel_radius if r.differential_drive else 0.0
                                       for r in w.robots], dtype=np.float64)
         self.axle = np.array([r.differential_drive.axle_length if r.differential_drive else 1.0
@@ -546,41 +547,80 @@ class BatchedSimulation:
 
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:
-        driven = self.has_drive.nonzero()[0]
+        driven = self._driven
         if not len(driven):
             return
         dt = dt_ms / 1000.0
-        self.pressing[live] = False
-        got = packets.drive_wheels(live, driven, self.target, self.velocity, self.wheel_angle, dt, self.side_wheels,
-                                   self.wheel_radius, self.axle)
-        copies, slots, v, w = got if got is not None else self._drive_wheels(live, driven, dt)
-        if not len(copies):
+        step = self._drive_pass()
+        if step is None:
+            self._drive_numpy(live, driven, dt)
             return
-        x0, y0 = self.x[copies, slots], self.y[copies, slots]
-        yaw0 = self.yaw[copies, slots]
-        arc = packets.arc_steps(x0, y0, yaw0, v, w, dt)   # (with the new yaws' cos, sin: one C pass)
-        if arc is not None:
-            x, y, yaw, cos, sin = arc
-        else:
-            x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
-            cos, sin = _cos_sin(yaw)
-        self.yaw[copies, slots] = yaw
-        if self.contact is not None:
-            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
-        self.x[copies, slots], self.y[copies, slots] = x, y
+        ct = self.contact
+        k = step.run(live, driven, dt, EPS, None if ct is None else (ct._lo, ct._hi, ct._zlo, ct._zhi))
+        if not k:
+            return
+        copies, slots = step.copies[:k], step.slots[:k]
+        if step.status[0]:   # an infinite angle: math.cos refuses it, as in the single simulation
+            g = step.gathered
+            _cos_sin(_arc_steps(g[0][:k], g[1][:k], g[2][:k], step.v[:k], step.w[:k], dt)[2])
+            raise ValueError("math domain error")
+        if step.status[1]:   # a move near something: the narrow phase, slot by slot
+            x, y = self._narrow(copies, slots, step.starts[:k], step.ends[:k],
+                                step.solid_hit[:k] if len(ct._obs) else None, step.robot_hit[:k] if self.R > 1 else None,
+                                step.near[:k])
+            self.x[copies, slots], self.y[copies, slots] = x, y
+        self._place(copies, slots, step.rz[:k], step.base[:k], step.cos[:k], step.sin[:k], step.rot[:k])
+        step.scatter(k)
+
+    def _drive_pass(self) -> packets.DriveStep | None:
+        """The C pass of :meth:`_drive` over this simulation's state (made once), None without the helper."""
+        got = self.__dict__.get("_drive_step", False)
+        if got is False:
+            contact = None
+            if self.contact is not None:
+                contact = {"foot_radius": self.foot_radius, "foot_low": self.foot_low, "foot_high": self.foot_high,
+                           "heights": self.heights, "centres": self.centres}
+            got = self._drive_step = packets.drive_step(
+                {"target": self.target, "velocity": self.velocity, "angle": self.wheel_angle,
+                 "sides": self.side_wheels, "radius": self.wheel_radius, "axle": self.axle, "x": self.x, "y": self.y,
+                 "yaw": self.yaw, "z": self.z, "pressing": self.pressing, "base": self.base, "rot": self.rot,
+                 "pos": self.pos}, contact)
+        return got
+
+    def _place(self, copies: np.ndarray, slots: np.ndarray, rz: np.ndarray, base: np.ndarray, cos: np.ndarray,
+               sin: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """The moved robots' ride over the ground (x, y written) and their rotations into ``out``:
+        DifferentialDrive.pose's Rz(yaw) @ base (the same 3x3 products, stacked), on a slope with
+        the ground's attitude (ground_rotation, as PlanarState.pose)."""
         if self.ground is not None:
-            self._ride(copies, slots, x, y)
-        # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
-        rz = np.zeros((len(yaw), 3, 3))
-        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
-        rot = np.matmul(rz, self.base[copies, slots])
-        if self.ground is not None:   # on a slope: the ground's attitude (ground_rotation, as PlanarState.pose)
+            self._ride(copies, slots, self.x[copies, slots], self.y[copies, slots])
+        rot = np.matmul(rz, base, out=out)
+        if self.ground is not None:
             k = self.tilted[copies, slots].nonzero()[0]
             if len(k):
                 c, r = copies[k], slots[k]
                 rot[k] = ground_rotation(self.slope[c, r, 0], self.slope[c, r, 1], cos[k], sin[k], self.base[c, r])
+        return rot
+
+    def _drive_numpy(self, live: np.ndarray, driven: np.ndarray, dt: float) -> None:
+        """:meth:`_drive` without the C helper (the same values)."""
+        self.pressing[live] = False
+        copies, slots, v, w = self._drive_wheels(live, driven, dt)
+        if not len(copies):
+            return
+        x0, y0 = self.x[copies, slots], self.y[copies, slots]
+        yaw0 = self.yaw[copies, slots]
+        x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
+        cos, sin = _cos_sin(yaw)
+        self.yaw[copies, slots] = yaw
+        if self.contact is not None:
+            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
+        self.x[copies, slots], self.y[copies, slots] = x, y
+        rz = np.zeros((len(yaw), 3, 3))
+        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
+        rot = self._place(copies, slots, rz, self.base[copies, slots], cos, sin, np.empty((len(yaw), 3, 3)))
         self.rot[copies, slots] = rot
-        self.pos[copies, slots] = np.stack([x, y, self.z[copies, slots]], axis=1)
+        self.pos[copies, slots] = np.stack([self.x[copies, slots], self.y[copies, slots], self.z[copies, slots]], axis=1)
 
     def _ride(self, copies: np.ndarray, slots: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
         """PlanarState.settle for the moved robots placed over ground: height and slope under them."""
@@ -634,7 +674,6 @@ class BatchedSimulation:
         narrow phase (Contact._clip). Returns the final xy."""
         ct = self.contact
         assert ct is not None
-        out = ends.copy()
         reach = np.hypot(*(ends - starts).T) + EPS
         Rr = self.foot_radius[slots]
         # where every robot may be during this step: its disc, grown by its own move if it moves
@@ -648,40 +687,57 @@ class BatchedSimulation:
             robot_hit = robot_hit if self.R > 1 else None
         else:
             solid_hit, robot_hit, near = self._contact_near(copies, slots, starts, reach, grow)
-        footless = np.isnan(Rr)
         if not near.any():
             # nothing near any move: each ends where Contact._clip without candidates puts it (a
             # robot without a footprint: at its end), whatever the slot order
-            self.centres[copies, slots] = np.where(footless[:, None], ends, starts + (ends - starts))
-            return out[:, 0], out[:, 1]
-        band_lo = self.heights[copies, slots] + self.foot_low[slots]
-        band_hi = self.heights[copies, slots] + self.foot_high[slots]
-        # slot by slot, as Contact.resolve_all takes robots in world order (each sees the earlier
-        # slots of its copy where they ended, the later ones where they started)
-        for r in np.unique(slots).tolist():
-            mine = slots == r
-            bare = (mine & footless).nonzero()[0]
-            self.centres[copies[bare], r] = ends[bare]
-            # nothing near: Contact._clip without candidates moves to start + (end - start)
-            free = (mine & ~near & ~footless).nonzero()[0]
-            self.centres[copies[free], r] = starts[free] + (ends[free] - starts[free])
-            for m in (mine & near & ~footless).nonzero()[0].tolist():
-                # candidates as resolve_all lists them: solids, then robots, in index order
-                cands = ([ct._in_band(ct._obs[j], float(band_lo[m]), float(band_hi[m]))
-                          for j in solid_hit[m].nonzero()[0].tolist()] if solid_hit is not None else [])
-                cm = int(copies[m])
-                if robot_hit is not None:
-                    for j in robot_hit[m].nonzero()[0].tolist():
-                        cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
-                                              float(self.foot_radius[j]),
-                                              (float(self.heights[cm, j] + self.foot_low[j]),
-                                               float(self.heights[cm, j] + self.foot_high[j]))))
-                p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
-                self.centres[cm, r] = p
-                if clipped:
-                    self.pressing[cm, r] = True
-                    self.counters["contacts"] += 1
-                    out[m] = p
+            self.centres[copies, slots] = np.where(np.isnan(Rr)[:, None], ends, starts + (ends - starts))
+            return ends[:, 0], ends[:, 1]
+        return self._narrow(copies, slots, starts, ends, solid_hit, robot_hit, near)
+
+    def _narrow(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+                solid_hit: np.ndarray | None, robot_hit: np.ndarray | None, near: np.ndarray):
+        """The narrow phase of :meth:`_contact` once the broad phase found a move near something:
+        Contact._clip of each near move (centres written); returns the final xy."""
+        ct = self.contact
+        assert ct is not None
+        out = ends.copy()
+        Rr = self.foot_radius[slots]
+        footless = np.isnan(Rr)
+        # copies are independent: the moves of copies where nothing is near end where Contact._clip
+        # without candidates puts them, all at once; the others' in slot order, as Contact.resolve_all
+        # takes robots in world order (each sees the earlier slots of its copy where they ended, the
+        # later ones where they started)
+        hot = np.isin(copies, copies[near])
+        cold = (~hot).nonzero()[0]
+        if len(cold):
+            self.centres[copies[cold], slots[cold]] = np.where(footless[cold, None], ends[cold],
+                                                               starts[cold] + (ends[cold] - starts[cold]))
+        order = hot.nonzero()[0]
+        for m in order[np.argsort(slots[order], kind="stable")].tolist():
+            cm, r = int(copies[m]), int(slots[m])
+            if footless[m]:
+                self.centres[cm, r] = ends[m]
+                continue
+            if not near[m]:
+                self.centres[cm, r] = starts[m] + (ends[m] - starts[m])
+                continue
+            lo = float(self.heights[cm, r] + self.foot_low[r])
+            hi = float(self.heights[cm, r] + self.foot_high[r])
+            # candidates as resolve_all lists them: solids, then robots, in index order
+            cands = ([ct._in_band(ct._obs[j], lo, hi) for j in solid_hit[m].nonzero()[0].tolist()]
+                     if solid_hit is not None else [])
+            if robot_hit is not None:
+                for j in robot_hit[m].nonzero()[0].tolist():
+                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
+                                          float(self.foot_radius[j]),
+                                          (float(self.heights[cm, j] + self.foot_low[j]),
+                                           float(self.heights[cm, j] + self.foot_high[j]))))
+            p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
+            self.centres[cm, r] = p
+            if clipped:
+                self.pressing[cm, r] = True
+                self.counters["contacts"] += 1
+                out[m] = p
         return out[:, 0], out[:, 1]
 
     def _contact_near(self, copies, slots, starts, reach, grow):
