@@ -295,3 +295,30 @@ def test_batch_sonar_incidence_is_the_cross_product_formula_bit_for_bit(mixed):
     ref = np.minimum(np.where(echo, r[m], np.inf).min(axis=1), rmax[m])
     assert got[m].tobytes() == ref.tobytes()
     assert 0 < np.count_nonzero(echo) < echo.size                 # the limit decides some rays
+
+
+def test_a_kept_combine_plan_gives_combine_distance_batch_bit_for_bit():
+    """combine_planned with a CombinePlan made once (the batched simulation keeps one while the
+    same sensors are due) returns combine_distance_batch's values bit for bit, step after step,
+    for a mix of every sensor type with hits, misses and grazing sonar echoes."""
+    from sensorium.server.devices.distance import CombinePlan, combine_planned
+
+    rng = np.random.default_rng(8)
+    S, N = 40, 5
+    types = rng.integers(0, 4, S)
+    weights = rng.uniform(0.0, 1.0, (S, N))
+    rmax = rng.uniform(0.5, 2.0, S)
+    sens = rng.uniform(0.0, 1.0, S)
+    plan = CombinePlan(types, weights, rmax, sens, S, N)
+    for _ in range(5):
+        r = rng.uniform(0.0, 2.5, (S, N))
+        r[rng.uniform(size=(S, N)) < 0.2] = np.inf
+        u = rng.normal(size=(S, N, 3))
+        u /= np.linalg.norm(u, axis=2, keepdims=True)
+        nrm = -u + rng.normal(scale=0.5, size=(S, N, 3))
+        nrm /= np.linalg.norm(nrm, axis=2, keepdims=True)
+        refl = rng.uniform(0.2, 1.0, (S, N))
+        want = combine_distance_batch(types, r, u, nrm, weights, rmax, refl, sens)
+        assert combine_planned(plan, r, u, nrm, refl).tobytes() == want.tobytes()
+    with pytest.raises(ValueError, match="unknown sensor type"):
+        CombinePlan(np.array([0, 7]), weights[:2], rmax[:2], sens[:2], 2, N)

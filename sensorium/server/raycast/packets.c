@@ -1429,3 +1429,42 @@ void sp_pose_scatter(size_t k, size_t R, const int64_t* mc, const int64_t* ms, c
     pos[3 * at + 2] = z[at];
   }
 }
+
+/* lookup.py's LookupTable.interpolate for a table of m >= 2 rows with strictly increasing inputs x:
+ * for each of the count values v, the bracket numpy's searchsorted(x, v, side="right") - 1 gives
+ * (NaN sorts last), clamped to [0, m - 2]; u = (v - x[lo]) / span (0 for a zero span), y and n
+ * interpolated as (1 - u) y[lo] + u y[hi]; below or at x[0] the first row's, at or above the last
+ * input the last row's -- the numpy path's operations, element by element. */
+void sp_lookup(size_t count, const double* v, size_t m, const double* x, const double* y, const double* n,
+               double* out_y, double* out_n) {
+  for (size_t i = 0; i < count; i++) {
+    const double vi = v[i];
+    size_t lo;
+    if (vi != vi) {
+      lo = m - 2;
+    } else {
+      size_t a = 0, b = m;   /* the first input above vi */
+      while (a < b) {
+        const size_t mid = (a + b) / 2;
+        if (x[mid] <= vi) a = mid + 1;
+        else b = mid;
+      }
+      lo = a == 0 ? 0 : a - 1;
+      if (lo > m - 2) lo = m - 2;
+    }
+    const size_t hi = lo + 1;
+    const double span = x[hi] - x[lo];
+    const double u = span != 0.0 ? (vi - x[lo]) / span : 0.0;
+    double oy = (1.0 - u) * y[lo] + u * y[hi];
+    double on = (1.0 - u) * n[lo] + u * n[hi];
+    if (vi <= x[0]) {
+      oy = y[0];
+      on = n[0];
+    } else if (vi >= x[m - 1]) {
+      oy = y[m - 1];
+      on = n[m - 1];
+    }
+    out_y[i] = oy;
+    out_n[i] = on;
+  }
+}

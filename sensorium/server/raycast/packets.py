@@ -934,3 +934,30 @@ def drive_step(state: dict[str, np.ndarray], contact: dict[str, np.ndarray] | No
     if lib is None:
         return None
     return DriveStep(lib, state, contact)
+
+
+def lookup(table, values: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """``table.interpolate(values)`` (a :class:`.lookup.LookupTable` of two rows or more with strictly
+    increasing inputs, (n,) float64 values) in one C pass (``sp_lookup``: the same operations, the
+    same bits); None without the helper or for another table or array."""
+    lib = library()
+    if lib is None or len(table) < 2 or not table._increasing or values.dtype != np.float64 or values.ndim != 1:
+        return None
+    got = _tables.get(id(table))
+    if got is None or got[0] is not table:
+        if not getattr(lib, "_lookup_typed", False):
+            vp, sz = ctypes.c_void_p, ctypes.c_size_t
+            lib.sp_lookup.restype = None
+            lib.sp_lookup.argtypes = [sz, vp, sz, vp, vp, vp, vp, vp]
+            lib._lookup_typed = True
+        rows = [np.ascontiguousarray(a) for a in (table._x, table._y, table._n)]
+        got = _tables[id(table)] = (table, rows, [a.ctypes.data for a in rows])
+    values = np.ascontiguousarray(values)
+    out_y, out_n = np.empty(len(values)), np.empty(len(values))
+    p = got[2]
+    lib.sp_lookup(len(values), values.ctypes.data, len(got[1][0]), p[0], p[1], p[2], out_y.ctypes.data,
+                  out_n.ctypes.data)
+    return out_y, out_n
+
+
+_tables: dict[int, tuple] = {}   # per lookup table (tables are immutable): its rows and their addresses

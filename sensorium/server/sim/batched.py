@@ -375,6 +375,7 @@ class BatchedSimulation:
                                                dtype=np.int64)) for table, idx in self._d_plan.tables]
             self._d_table_of = _table_of(self._d_tables, len(self.distance))
             self._own_kept: dict[int, tuple] = {}   # per group: its due sensors' own-body hits (_own_rows)
+            self._combine_kept: dict[int, tuple] = {}   # per group: its due sensors' CombinePlan
         if self.position:
             wheel = []
             for d in self.position:
@@ -983,9 +984,8 @@ class BatchedSimulation:
                 else:
                     shade = dmath.reflection_factor(self.red[sh], self.roughness[sh])
                 reflection = np.where(sh >= 0, shade, 1.0)
-            measured[rows] = dmath.combine_distance_batch(
-                g.types[k], dist, dirs, normal.reshape(S, n, 3), g.weights[k], g.lut_max_range[k], reflection,
-                g.sensitivity[k])
+            measured[rows] = dmath.combine_planned(self._combine_plan(g, k, S, n), dist, dirs,
+                                                   normal.reshape(S, n, 3), reflection)
         # DistancePlan.output: lookup (by table), each sensor's noise, resolution
         values = np.zeros(len(cols))
         full = ~self._d_empty[cols]
@@ -994,7 +994,9 @@ class BatchedSimulation:
             sel = (table_of == t).nonzero()[0]
             if not len(sel):
                 continue
-            y, nz = table.interpolate(measured[sel])
+            m = measured[sel]
+            got = packets.lookup(table, m)
+            y, nz = got if got is not None else table.interpolate(m)
             values[sel] = self._noisy(y, nz, "DistanceSensor", copies[sel], cols[sel])
         res = self._d_res[cols]
         rounded = full & (res != RESOLUTION_OFF)
@@ -1002,6 +1004,15 @@ class BatchedSimulation:
             q = np.trunc(values / np.where(rounded, res, 1.0) + 0.5) * res + 0.0
             values = np.where(rounded, q, values)
         self._store("DistanceSensor", copies, cols, values)
+
+    def _combine_plan(self, g, k: np.ndarray, S: int, n: int) -> dmath.CombinePlan:
+        """combine_distance_batch's constants for group ``g``'s sensors ``k``, kept while the same
+        sensors are due (step after step)."""
+        got = self._combine_kept.get(id(g))
+        if got is None or not np.array_equal(got[0], k):
+            plan = dmath.CombinePlan(g.types[k], g.weights[k], g.lut_max_range[k], g.sensitivity[k], S, n)
+            got = self._combine_kept[id(g)] = (k.copy(), plan)
+        return got[1]
 
     def _own_rows(self, g, own: RayHits, k: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The own-body hits (distance, shape, normal) of the rays of group ``g``'s sensors ``k``,
