@@ -1468,3 +1468,9 @@ void sp_lookup(size_t count, const double* v, size_t m, const double* x, const d
     out_n[i] = on;
   }
 }
+
+/* libm's atan2 of n pairs (y[i * ys], x[i * xs]) into out[i * os]: the calls math.atan2 makes
+ * (vector.py's poses' yaw). */
+void sp_atan2(size_t n, const double* y, size_t ys, const double* x, size_t xs, double* out, size_t os) {
+  for (size_t i = 0; i < n; i++) out[i * os] = atan2(y[i * ys], x[i * xs]);
+}

@@ -961,3 +961,26 @@ def lookup(table, values: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 _tables: dict[int, tuple] = {}   # per lookup table (tables are immutable): its rows and their addresses
+
+
+def atan2(y: np.ndarray, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray | None:
+    """``math.atan2`` of each pair of the (n,) float64 arrays ``y``, ``x`` in one C pass (``sp_atan2``:
+    libm's atan2, the function math.atan2 calls: the same bits, without the Python floats), into
+    ``out`` when given; strided views allowed (positive strides of whole elements, ``out`` too).
+    None without the helper or for other arrays (nothing written)."""
+    lib = library()
+    if lib is None:
+        return None
+    if out is None:
+        out = np.empty(y.shape)
+    if not out.flags.writeable or not all(a.dtype == np.float64 and a.ndim == 1 and a.shape == y.shape
+                                          and a.strides[0] > 0 and a.strides[0] % 8 == 0 for a in (y, x, out)):
+        return None
+    if not getattr(lib, "_atan2_typed", False):
+        vp, sz = ctypes.c_void_p, ctypes.c_size_t
+        lib.sp_atan2.restype = None
+        lib.sp_atan2.argtypes = [sz, vp, sz, vp, sz, vp, sz]
+        lib._atan2_typed = True
+    lib.sp_atan2(len(y), y.ctypes.data, y.strides[0] // 8, x.ctypes.data, x.strides[0] // 8, out.ctypes.data,
+                 out.strides[0] // 8)
+    return out

@@ -344,6 +344,7 @@ class BatchedSimulation:
                 continue
         self._lidar_skips: dict[int, np.ndarray] = {}
         self._lidar_plan: dict[int, tuple] = {}      # per lidar: (copies, each beam's copy, mount slots)
+        self._lidar_due: tuple | None = None          # the due lidars' scans (_lidar_scans)
         self._lidar_beam_rows: dict[int, tuple] = {}  # per lidar: its beams' buffers (origins, directions, float32)
         self.range_images = [np.zeros((C, d.config.number_of_layers, d.config.horizontal_resolution), dtype=np.float32)
                              for d in self.lidar]
@@ -376,6 +377,7 @@ class BatchedSimulation:
             self._d_table_of = _table_of(self._d_tables, len(self.distance))
             self._own_kept: dict[int, tuple] = {}   # per group: its due sensors' own-body hits (_own_rows)
             self._combine_kept: dict[int, tuple] = {}   # per group: its due sensors' CombinePlan
+            self._d_rows: tuple | None = None            # the due sensors' rows (_distance_rows)
         if self.position:
             wheel = []
             for d in self.position:
@@ -923,16 +925,7 @@ class BatchedSimulation:
         plan = self._d_plan
         state = {"copies": copies, "cols": cols, "groups": []}
         reqs: list[_Rays] = []
-        for g, where in self._d_groups:
-            # the group's sensors among the due ones: (row in the due list, index in the group)
-            k = where[cols]
-            rows = (k >= 0).nonzero()[0]
-            if not len(rows):
-                continue
-            k = k[rows]
-            pi = g.idx[k]                                  # index in the plan's stacked constants
-            c = copies[rows]
-            slot = plan.robot[pi]
+        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy in self._distance_rows(copies, cols):
             n = g.n
             got = packets.sensor_rays(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k, g.local_dirs)
             if got is not None:
@@ -944,15 +937,39 @@ class BatchedSimulation:
                 positions = pos_t.T + self.pos[c, slot]
                 dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
                 origins = np.repeat(positions, n, axis=0)
-            mount = -1
+            reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0, t_far, g.kind, ray_copy, exclude, mount, skip=g.skip,
+                              run=n, origin_rows=positions))
+            state["groups"].append((g, rows, k, c, slot, positions, dirs))
+        return state, reqs
+
+    def _distance_rows(self, copies: np.ndarray, cols: np.ndarray) -> list[tuple]:
+        """Per plan group with due sensors: (group, rows in the due list, index in the group, index
+        in the plan's stacked constants, copy, slot, each ray's excluded and mount slot, far limit
+        and copy), kept while the same sensors of the same copies are due (step after step)."""
+        kept = self._d_rows
+        if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols):
+            return kept[2]
+        plan = self._d_plan
+        out = []
+        for g, where in self._d_groups:
+            # the group's sensors among the due ones: (row in the due list, index in the group)
+            k = where[cols]
+            rows = (k >= 0).nonzero()[0]
+            if not len(rows):
+                continue
+            k = k[rows]
+            pi = g.idx[k]                                  # index in the plan's stacked constants
+            c = copies[rows]
+            slot = plan.robot[pi]
+            n = g.n
+            mount: np.ndarray | int = -1
             if g.mount is not None:
                 mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
-            reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0,
-                              g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1),
-                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip, run=n, origin_rows=positions))
-            state["groups"].append((g, rows, k, c, slot, positions, dirs))
-        return state, reqs
+            t_far = g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1)
+            out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n)))
+        self._d_rows = (copies.copy(), cols.copy(), out)
+        return out
 
     def _finish_distance(self, state: dict, hits: list[RayHits]) -> None:
         plan = self._d_plan
@@ -1040,9 +1057,8 @@ class BatchedSimulation:
     def _plan_lidars(self, copies: np.ndarray, cols: np.ndarray):
         reqs: list[_Rays] = []
         state = {"items": []}
-        for col in sorted(set(cols.tolist())):
+        for col, c, ray_copy, mount, t_far, every in self._lidar_scans(copies, cols):
             lid = self.lidar[col]
-            c = copies[cols == col]
             slot = lid.robot_index
             rr = self.rot[c, slot]
             rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
@@ -1050,12 +1066,28 @@ class BatchedSimulation:
             W = len(lid._dir_columns[0])
             got = packets.lidar_beams(rot, org, lid._dir_columns, self._lidar_buffers(col, len(c) * W))
             origins, d, d32 = got if got is not None else _lidar_beams(rot, org, lid._dir_columns)
-            ray_copy, mount = self._lidar_rows(col, c, W)
-            t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
             reqs.append(_Rays(origins, d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
                               -1, mount, distance_only=True, d32=d32, coherent=True, origin_rows=org, run=W))
-            state["items"].append((col, c))
+            state["items"].append((col, c, every))
         return state, reqs
+
+    def _lidar_scans(self, copies: np.ndarray, cols: np.ndarray) -> list[tuple]:
+        """Per due lidar: (column, the copies scanning, each beam's copy, mount slot(s), far limit,
+        whether every copy scans, in order), kept while the same lidars of the same copies are due."""
+        kept = self._lidar_due
+        if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols):
+            return kept[2]
+        out = []
+        for col in sorted(set(cols.tolist())):
+            lid = self.lidar[col]
+            c = copies[cols == col]
+            W = len(lid._dir_columns[0])
+            ray_copy, mount = self._lidar_rows(col, c, W)
+            t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
+            every = len(c) == self.copies and bool((c == np.arange(len(c))).all())
+            out.append((col, c, ray_copy, mount, t_far, every))
+        self._lidar_due = (copies.copy(), cols.copy(), out)
+        return out
 
     def _lidar_buffers(self, col: int, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The beam origins, directions and float32 directions of lidar ``col``'s scans this step,
@@ -1102,7 +1134,7 @@ class BatchedSimulation:
         return got
 
     def _finish_lidar(self, state: dict, hits: list[RayHits]) -> None:
-        for (col, c), h in zip(state["items"], hits):
+        for (col, c, every), h in zip(state["items"], hits):
             lid = self.lidar[col]
             L, W = lid.config.number_of_layers, lid.config.horizontal_resolution
             dist = h.distance.reshape(len(c), L, W)
@@ -1114,8 +1146,7 @@ class BatchedSimulation:
                 for k, cc in enumerate(c.tolist()):
                     stream = _Stream(self.noise, cc, nc)
                     img[cc] = lmath.ranges_from_hits(lid.params, dist[k], lid._all_dirs, stream)  # type: ignore[arg-type]
-            elif lid._factor is None and lid.params.resolution == RESOLUTION_OFF and (
-                    len(c) == len(img) and (c == np.arange(len(c))).all()):
+            elif lid._factor is None and lid.params.resolution == RESOLUTION_OFF and every:
                 # every copy scanned, nothing moves a value, cylindrical: the whole image in one C
                 # pass where the helper is (ranges_from_hits' bits, as the single Lidar.finish)
                 if not packets.lidar_scan(np.ascontiguousarray(dist, dtype=np.float64).reshape(-1),
