@@ -204,11 +204,18 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
     return combine_planned(plan, r, directions, normals, reflection)
 
 
-def combine_planned(plan: CombinePlan, r: np.ndarray, directions, normals, reflection=None) -> np.ndarray:
-    """:func:`combine_distance_batch` with its constants derived (``r``: the (S, N) float64 distances)."""
+def combine_planned(plan: CombinePlan, r: np.ndarray, directions, normals, reflection=None, native=None) -> np.ndarray:
+    """:func:`combine_distance_batch` with its constants derived (``r``: the (S, N) float64 distances).
+    ``native``: an object whose ``cross_norm(u, back)`` and ``sonar_nearest(r, beta, rmax,
+    max_incidence)`` do the every-sonar path's steps around its arctan2 in C with the same
+    operations (raycast/packets.py's), each returning None to leave them to numpy."""
     S, N = plan.S, plan.N
     r = np.asarray(r, dtype=np.float64)
     rmax = plan.rmax
+    if native is not None and plan.n_sonar == S:
+        got = _sonars_native(native, r, directions, normals, rmax, S, N)
+        if got is not None:
+            return got
     hit = np.isfinite(r) & (r <= rmax)
     out = np.empty(S)
     sonar = plan.sonar
@@ -246,3 +253,16 @@ def combine_planned(plan: CombinePlan, r: np.ndarray, directions, normals, refle
         out[m] = d + (d / factor - d) * plan.sens
 
     return out
+
+
+def _sonars_native(native, r: np.ndarray, directions, normals, rmax: np.ndarray, S: int, N: int) -> np.ndarray | None:
+    """:func:`combine_planned` for sensors that are all sonars, its steps around the arctan2 (the
+    cross products' norms, the nearest echoes) in C with the same operations; None to leave it all
+    to numpy."""
+    u = np.ascontiguousarray(np.asarray(directions, dtype=np.float64).reshape(S, N, 3))
+    back = -np.asarray(normals, dtype=np.float64).reshape(S, N, 3)
+    cross = native.cross_norm(u, back)
+    if cross is None:
+        return None
+    beta = np.arctan2(cross, np.einsum("snk,snk->sn", u, back))     # (sonar_incidence's)
+    return native.sonar_nearest(r, beta, rmax[:, 0], SONAR_MAX_INCIDENCE)

@@ -1474,3 +1474,34 @@ void sp_lookup(size_t count, const double* v, size_t m, const double* x, const d
 void sp_atan2(size_t n, const double* y, size_t ys, const double* x, size_t xs, double* out, size_t os) {
   for (size_t i = 0; i < n; i++) out[i * os] = atan2(y[i * ys], x[i * xs]);
 }
+
+/* distance.py's sonar_incidence without its last two steps: for each of n rays, |u x back| with
+ * the numpy path's operations (each component a1 b2 - a2 b1, ..., the squares summed
+ * (c0 c0 + c1 c1) + c2 c2, the root); u and back (n, 3). */
+void sp_cross_norm(size_t n, const double* u, const double* back, double* out) {
+  for (size_t i = 0; i < n; i++) {
+    const double u0 = u[3 * i], u1 = u[3 * i + 1], u2 = u[3 * i + 2];
+    const double b0 = back[3 * i], b1 = back[3 * i + 1], b2 = back[3 * i + 2];
+    const double c0 = u1 * b2 - u2 * b1;
+    const double c1 = u2 * b0 - u0 * b2;
+    const double c2 = u0 * b1 - u1 * b0;
+    out[i] = sqrt((c0 * c0 + c1 * c1) + c2 * c2);
+  }
+}
+
+/* distance.py's combine for S sonars of N rays once the incidence angles beta (S, N) are known:
+ * a ray echoes when its distance r is finite, within rmax[s] and beta < max_incidence; each
+ * sonar's nearest echo (inf: none), then np.minimum with rmax[s] (NaN propagated as there). */
+void sp_sonar_nearest(size_t S, size_t N, const double* r, const double* beta, const double* rmax,
+                      double max_incidence, double* out) {
+  for (size_t s = 0; s < S; s++) {
+    double m = INFINITY;
+    for (size_t j = 0; j < N; j++) {
+      const double d = r[s * N + j];
+      const int echo = isfinite(d) && d <= rmax[s] && beta[s * N + j] < max_incidence;
+      const double v = echo ? d : INFINITY;
+      m = np_min(m, v);
+    }
+    out[s] = np_min(m, rmax[s]);
+  }
+}

@@ -984,3 +984,44 @@ def atan2(y: np.ndarray, x: np.ndarray, out: np.ndarray | None = None) -> np.nda
     lib.sp_atan2(len(y), y.ctypes.data, y.strides[0] // 8, x.ctypes.data, x.strides[0] // 8, out.ctypes.data,
                  out.strides[0] // 8)
     return out
+
+
+def _typed(lib, name: str, argtypes: list) -> None:
+    """Declare one of the appended C functions' arguments (once; they return nothing)."""
+    func = getattr(lib, name)
+    if func.argtypes is None:
+        func.restype = None
+        func.argtypes = argtypes
+
+
+def cross_norm(u: np.ndarray, back: np.ndarray) -> np.ndarray | None:
+    """``|u x back|`` of each row of the (S, N, 3) float64 arrays (``sp_cross_norm``: distance.py's
+    sonar_incidence's operations before its arctan2), (S, N); None without the helper or for
+    other arrays."""
+    lib = library()
+    if lib is None or u.dtype != np.float64 or back.dtype != np.float64 or u.shape != back.shape or u.ndim != 3 \
+            or u.shape[2] != 3:
+        return None
+    _typed(lib, "sp_cross_norm", [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p])
+    u, back = np.ascontiguousarray(u), np.ascontiguousarray(back)
+    out = np.empty(u.shape[:2])
+    lib.sp_cross_norm(out.size, u.ctypes.data, back.ctypes.data, out.ctypes.data)
+    return out
+
+
+def sonar_nearest(r: np.ndarray, beta: np.ndarray, rmax: np.ndarray, max_incidence: float) -> np.ndarray | None:
+    """Each of S sonars' reading from its N rays' distances ``r`` and incidence angles ``beta``
+    ((S, N) float64) and its range ``rmax`` ((S,)): distance.py's every-sonar combine after the
+    angles, in one C pass (``sp_sonar_nearest``, the same comparisons); None without the helper or
+    for other arrays."""
+    lib = library()
+    if lib is None or r.dtype != np.float64 or beta.dtype != np.float64 or rmax.dtype != np.float64 \
+            or r.ndim != 2 or beta.shape != r.shape or rmax.shape != r.shape[:1]:
+        return None
+    vp, sz = ctypes.c_void_p, ctypes.c_size_t
+    _typed(lib, "sp_sonar_nearest", [sz, sz, vp, vp, vp, ctypes.c_double, vp])
+    r, beta, rmax = np.ascontiguousarray(r), np.ascontiguousarray(beta), np.ascontiguousarray(rmax)
+    out = np.empty(len(r))
+    lib.sp_sonar_nearest(r.shape[0], r.shape[1], r.ctypes.data, beta.ctypes.data, rmax.ctypes.data,
+                         float(max_incidence), out.ctypes.data)
+    return out

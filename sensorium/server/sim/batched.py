@@ -1002,7 +1002,7 @@ class BatchedSimulation:
                     shade = dmath.reflection_factor(self.red[sh], self.roughness[sh])
                 reflection = np.where(sh >= 0, shade, 1.0)
             measured[rows] = dmath.combine_planned(self._combine_plan(g, k, S, n), dist, dirs,
-                                                   normal.reshape(S, n, 3), reflection)
+                                                   normal.reshape(S, n, 3), reflection, packets)
         # DistancePlan.output: lookup (by table), each sensor's noise, resolution
         values = np.zeros(len(cols))
         full = ~self._d_empty[cols]
