@@ -562,6 +562,12 @@ def test_distance_sensor_rays_in_c_are_the_numpy_frames_bit_for_bit():
     assert origins.tobytes() == np.repeat(want_pos, N, axis=0).tobytes()
     assert dirs.tobytes() == want_dirs.tobytes()
     assert np.count_nonzero(want_dirs == 0.0) > 0            # exact zeros were summed (their signs compared)
+    # the kept pass (packets.SensorRays: the same sensors step after step) reads the poses written
+    # in place since it was made, and gives sensor_rays' answer for them
+    kept = packets.sensor_rays_of(c, slot, rot, pos, pi, local_rot, local_pos, k, local_dirs)
+    rot[:], pos[:] = frames(C * R).reshape(C, R, 3, 3), rng.normal(size=(C, R, 3))
+    for got, want in zip(kept(), packets.sensor_rays(c, slot, rot, pos, pi, local_rot, local_pos, k, local_dirs)):
+        assert got.tobytes() == want.tobytes()
 
 
 @pytest.mark.parametrize("turning", ["all", "none", "mixed"])

@@ -1025,3 +1025,42 @@ def sonar_nearest(r: np.ndarray, beta: np.ndarray, rmax: np.ndarray, max_inciden
     lib.sp_sonar_nearest(r.shape[0], r.shape[1], r.ctypes.data, beta.ctypes.data, rmax.ctypes.data,
                          float(max_incidence), out.ctypes.data)
     return out
+
+
+class SensorRays:
+    """:func:`sensor_rays` of fixed sensors (the same copies, slots, frames and directions step after
+    step: a batched step's due distance sensors) over arrays written in place (the poses): their
+    checks and addresses made once, each call one C pass into fresh outputs."""
+
+    def __init__(self, lib, copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.ndarray, pi: np.ndarray,
+                 local_rot: np.ndarray, local_pos: np.ndarray, k: np.ndarray, local_dirs: np.ndarray):
+        f64, i64 = np.float64, np.int64
+        self.lib = lib
+        self.S = S = len(copies)
+        C, self.R = rot.shape[:2]
+        G, self.N = local_dirs.shape[:2]
+        for a, shape in ((rot, (C, self.R, 3, 3)), (pos, (C, self.R, 3)), (local_rot, (len(local_rot), 3, 3)),
+                         (local_pos, (len(local_rot), 3)), (local_dirs, (G, self.N, 3))):
+            _check_buffer("sensor_rays", a, f64, shape)
+        idx = [np.ascontiguousarray(a, dtype=i64) for a in (copies, slots, pi, k)]
+        if any(a.shape != (S,) for a in idx):
+            raise TypeError("sensor_rays: inconsistent shapes")
+        self.kept = (*idx, rot, pos, local_rot, local_pos, local_dirs)
+        p = [a.ctypes.data for a in self.kept]
+        self.args = (p[0], p[1], p[4], p[5], p[2], p[6], p[7], p[3], p[8])
+
+    def __call__(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        S, N = self.S, self.N
+        positions, origins, dirs = np.empty((S, 3)), np.empty((S * N, 3)), np.empty((S, N, 3))
+        self.lib.sp_sensor_rays(S, N, self.R, *self.args, *_small_addresses((positions, origins, dirs)))
+        return positions, origins, dirs
+
+
+def sensor_rays_of(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.ndarray, pi: np.ndarray,
+                   local_rot: np.ndarray, local_pos: np.ndarray, k: np.ndarray, local_dirs: np.ndarray
+                   ) -> SensorRays | None:
+    """A :class:`SensorRays` of these sensors (arguments as :func:`sensor_rays`), or None without the helper."""
+    lib = library()
+    if lib is None:
+        return None
+    return SensorRays(lib, copies, slots, rot, pos, pi, local_rot, local_pos, k, local_dirs)

@@ -925,11 +925,10 @@ class BatchedSimulation:
         plan = self._d_plan
         state = {"copies": copies, "cols": cols, "groups": []}
         reqs: list[_Rays] = []
-        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy in self._distance_rows(copies, cols):
+        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy, native in self._distance_rows(copies, cols):
             n = g.n
-            got = packets.sensor_rays(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k, g.local_dirs)
-            if got is not None:
-                positions, origins, dirs = got
+            if native is not None:   # packets.sensor_rays of these sensors
+                positions, origins, dirs = native()
             else:
                 rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
                 rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
@@ -945,7 +944,8 @@ class BatchedSimulation:
     def _distance_rows(self, copies: np.ndarray, cols: np.ndarray) -> list[tuple]:
         """Per plan group with due sensors: (group, rows in the due list, index in the group, index
         in the plan's stacked constants, copy, slot, each ray's excluded and mount slot, far limit
-        and copy), kept while the same sensors of the same copies are due (step after step)."""
+        and copy, their world rays' C pass or None), kept while the same sensors of the same copies
+        are due (step after step)."""
         kept = self._d_rows
         if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols):
             return kept[2]
@@ -967,7 +967,9 @@ class BatchedSimulation:
                 mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             t_far = g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1)
-            out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n)))
+            native = packets.sensor_rays_of(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k,
+                                            g.local_dirs)
+            out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n), native))
         self._d_rows = (copies.copy(), cols.copy(), out)
         return out
 
