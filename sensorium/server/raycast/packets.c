@@ -1505,3 +1505,37 @@ void sp_sonar_nearest(size_t S, size_t N, const double* r, const double* beta, c
     out[s] = np_min(m, rmax[s]);
   }
 }
+
+/* task.py's AvoidObstacles for many copies after the clearance cast: copy i's gap is the nearest
+ * finite distance of its `rays` rays (d (n, rays)), far when none, minus the body radius -- the
+ * numpy path's comparisons and its one subtraction (np.where / min / np.where, NaN propagated as
+ * numpy's min propagates it). */
+void sp_clearance_gaps(size_t n, size_t rays, const double* d, double far, double radius, double* gap) {
+  for (size_t i = 0; i < n; i++) {
+    double m = INFINITY;
+    for (size_t j = 0; j < rays; j++) {
+      const double v = d[i * rays + j];
+      m = np_min(m, isfinite(v) ? v : INFINITY);
+    }
+    gap[i] = (isfinite(m) ? m : far) - radius;
+  }
+}
+
+/* task.py's AvoidObstacles reward for n copies: wheel speeds wl, wr (velocity (C, R, 2) at copy
+ * copies[i], slot `slot`) over vmax, v = 0.5 (wl + wr), dv = |wl - wr| / 2, p = min(max(1 - gap / near,
+ * 0), 1), r = v (1 - sqrt(dv)) (1 - p), minus the penalty when gap < contact -- the numpy path's
+ * operations, element by element (np.maximum/np.minimum's NaN). */
+void sp_avoid_reward(size_t n, const int64_t* copies, size_t R, size_t slot, const double* velocity, double vmax,
+                     const double* gap, double near, double contact, double penalty, double* out) {
+  for (size_t i = 0; i < n; i++) {
+    const double* vel = velocity + ((size_t)copies[i] * R + slot) * 2;
+    const double wl = vel[0] / vmax, wr = vel[1] / vmax;
+    const double v = 0.5 * (wl + wr);
+    const double dv = fabs(wl - wr) / 2.0;
+    const double q = 1.0 - gap[i] / near;
+    const double lo = (q > 0.0 || q != q) ? q : 0.0;          /* np.maximum(q, 0.0) */
+    const double p = (lo < 1.0 || lo != lo) ? lo : 1.0;       /* np.minimum(.., 1.0) */
+    const double r = v * (1.0 - sqrt(dv)) * (1.0 - p);
+    out[i] = gap[i] < contact ? r - penalty : r;
+  }
+}

@@ -1064,3 +1064,40 @@ def sensor_rays_of(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: 
     if lib is None:
         return None
     return SensorRays(lib, copies, slots, rot, pos, pi, local_rot, local_pos, k, local_dirs)
+
+
+def clearance_gaps(d: np.ndarray, far: float, radius: float) -> np.ndarray | None:
+    """AvoidObstacles' gaps from its clearance cast's distances ``d`` ((n, rays) float64): each row's
+    nearest finite distance (``far`` when none) minus ``radius``, in one C pass
+    (``sp_clearance_gaps``, task.py's numpy operations); None without the helper or for another array."""
+    lib = library()
+    if lib is None or d.dtype != np.float64 or d.ndim != 2:
+        return None
+    vp, sz, f = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
+    _typed(lib, "sp_clearance_gaps", [sz, sz, vp, f, f, vp])
+    d = np.ascontiguousarray(d)
+    gap = np.empty(len(d))
+    lib.sp_clearance_gaps(d.shape[0], d.shape[1], d.ctypes.data, float(far), float(radius), gap.ctypes.data)
+    return gap
+
+
+def avoid_reward(copies: np.ndarray, slot: int, velocity: np.ndarray, vmax: float, gap: np.ndarray, near: float,
+                 contact: float, penalty: float) -> np.ndarray | None:
+    """AvoidObstacles' reward of the named copies (int64 ``copies``, their robot ``slot``'s wheel
+    ``velocity`` (C, R, 2), their ``gap`` (n,)) in one C pass (``sp_avoid_reward``, task.py's numpy
+    operations element by element); None without the helper or for other arrays."""
+    lib = library()
+    if lib is None or copies.dtype != np.int64 or gap.dtype != np.float64 or gap.shape != copies.shape \
+            or copies.ndim != 1:
+        return None
+    C, R = velocity.shape[:2]
+    _check_buffer("avoid_reward", velocity, np.float64, (C, R, 2))
+    if not 0 <= slot < R or (len(copies) and not (0 <= int(copies.min()) and int(copies.max()) < C)):
+        raise IndexError(f"avoid_reward: slot {slot} or copies outside ({C}, {R})")
+    vp, sz, f = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
+    _typed(lib, "sp_avoid_reward", [sz, vp, sz, sz, vp, f, vp, f, f, f, vp])
+    copies, gap = np.ascontiguousarray(copies), np.ascontiguousarray(gap)
+    out = np.empty(len(copies))
+    lib.sp_avoid_reward(len(copies), copies.ctypes.data, R, int(slot), velocity.ctypes.data, float(vmax),
+                        gap.ctypes.data, float(near), float(contact), float(penalty), out.ctypes.data)
+    return out
