@@ -838,3 +838,59 @@ def test_the_drive_in_c_moves_every_copy_as_the_numpy_drive_with_contacts_and_te
     assert fast.counters["contacts"] > 20
     assert closest == pytest.approx(0.16, abs=1e-6)             # a and b touched (radii 0.08 each)
     assert tilted > 50                                           # robots rode the ramp
+
+
+def test_distance_sensors_of_every_kind_and_table_match_the_single_simulation_as_due_sets_change():
+    """Distance sensors of every type on one robot, sharing and not sharing tables (two noisy, one
+    empty: value 0), with and without resolution, on periods of 16, 32
+    and 48 ms so that the due set changes from step to step (the kept rows, plans and outputs are
+    remade each time): every copy's values equal a Simulation's with that copy's seed, bit for bit."""
+    near = [[0.0, 0.0, 0.0], [1.0, 100.0, 0.0], [2.0, 150.0, 0.0]]
+    devices = [
+        {"device": "DistanceSensor", "name": "generic", "lookup_table": near, "resolution": 0.5,
+         "number_of_rays": 4, "aperture": 0.3},
+        {"device": "DistanceSensor", "name": "ir", "type": "infra-red", "lookup_table": [[0, 1000, 0.02], [0.5, 0, 0.05]],
+         "number_of_rays": 3, "aperture": 0.2, "pose": {"rotation": [0, 0, 1, 0.7]}},
+        {"device": "DistanceSensor", "name": "sonar", "type": "sonar", "lookup_table": near, "number_of_rays": 5,
+         "aperture": 0.5, "pose": {"rotation": [0, 0, 1, -0.5]}},
+        {"device": "DistanceSensor", "name": "laser", "type": "laser", "lookup_table": [[0, 0, 0], [3, 30, 0]],
+         "resolution": 0.1, "pose": {"rotation": [0, 0, 1, 3.0]}},
+        {"device": "DistanceSensor", "name": "far", "lookup_table": [[0.2, 80, 0.01], [1.5, 10, 0.0], [3.0, 5, 0.02]],
+         "pose": {"rotation": [0, 0, 1, 1.6]}},
+        {"device": "DistanceSensor", "name": "blank", "lookup_table": []},
+    ]
+    periods = {"generic": 16, "ir": 32, "sonar": 48, "laser": 16, "far": 32, "blank": 48}
+    world = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "random_seed": 0},
+        "solids": [{"name": "floor", "geometry": {"type": "plane"}},
+                   {"name": "box", "pose": {"translation": [0.6, 0.1, 0.1]}, "geometry": {"type": "box", "size": [0.2, 0.6, 0.2]}},
+                   {"name": "post", "pose": {"translation": [-0.5, 0.4, 0.2]},
+                    "geometry": {"type": "cylinder", "radius": 0.1, "height": 0.4}}],
+        "robots": [{"name": "r", "pose": {"translation": [0, 0, 0.05]},
+                    "body": {"geometry": {"type": "cylinder", "radius": 0.05, "height": 0.05}},
+                    "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.1, "max_wheel_speed": 10.0},
+                    "devices": devices}]})
+    seeds = [21, 22, 23]
+    bs = BatchedSimulation(world, len(seeds))
+    bs.reset(np.arange(3), seeds)
+    sims = [Simulation(world.model_copy(update={"world_info": world.world_info.model_copy(update={"random_seed": s})}))
+            for s in seeds]
+    for name, period in periods.items():
+        bs.enable(bs.device("r", name), period)
+        for s in sims:
+            s.robot("r").device(name).enable(period)
+    rng = np.random.default_rng(6)
+    for step in range(60):
+        if step % 10 == 0:
+            lr = rng.uniform(-10.0, 10.0, (3, 2))
+            bs.set_wheels(0, lr[:, 0], lr[:, 1])
+            for c, s in enumerate(sims):
+                _drive_single(s, "r", float(lr[c, 0]), float(lr[c, 1]))
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for name in periods:
+                want = s.robot("r").device(name).value
+                assert _same_value(want, float(bs.value(bs.device("r", name))[c])), (step, c, name, want)
+    assert bs.value(bs.device("r", "blank")).tolist() == [0.0, 0.0, 0.0]
+    assert len(set(bs.value(bs.device("r", "ir")).tolist())) == 3        # each copy's own noise

@@ -377,7 +377,7 @@ class BatchedSimulation:
             self._d_table_of = _table_of(self._d_tables, len(self.distance))
             self._own_kept: dict[int, tuple] = {}   # per group: its due sensors' own-body hits (_own_rows)
             self._combine_kept: dict[int, tuple] = {}   # per group: its due sensors' CombinePlan
-            self._d_rows: tuple | None = None            # the due sensors' rows (_distance_rows)
+            self._d_rows: list | None = None             # the due sensors' rows (_distance_rows)
         if self.position:
             wheel = []
             for d in self.position:
@@ -925,7 +925,9 @@ class BatchedSimulation:
         plan = self._d_plan
         state = {"copies": copies, "cols": cols, "groups": []}
         reqs: list[_Rays] = []
-        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy, native in self._distance_rows(copies, cols):
+        groups = self._distance_rows(copies, cols)
+        state["kept"] = self._d_rows
+        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy, native in groups:
             n = g.n
             if native is not None:   # packets.sensor_rays of these sensors
                 positions, origins, dirs = native()
@@ -970,7 +972,7 @@ class BatchedSimulation:
             native = packets.sensor_rays_of(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k,
                                             g.local_dirs)
             out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n), native))
-        self._d_rows = (copies.copy(), cols.copy(), out)
+        self._d_rows = [copies.copy(), cols.copy(), out, None]    # (the outputs: _distance_outputs)
         return out
 
     def _finish_distance(self, state: dict, hits: list[RayHits]) -> None:
@@ -1007,22 +1009,39 @@ class BatchedSimulation:
                                                    normal.reshape(S, n, 3), reflection, packets)
         # DistancePlan.output: lookup (by table), each sensor's noise, resolution
         values = np.zeros(len(cols))
-        full = ~self._d_empty[cols]
-        table_of = np.where(full, self._d_table_of[cols], -1)
-        for t, (table, _) in enumerate(self._d_tables):
-            sel = (table_of == t).nonzero()[0]
-            if not len(sel):
-                continue
-            m = measured[sel]
+        by_table, res, rounded = self._distance_outputs(state["kept"])
+        for table, sel, sel_copies, sel_cols in by_table:
+            m = measured if sel is None else measured[sel]
             got = packets.lookup(table, m)
             y, nz = got if got is not None else table.interpolate(m)
-            values[sel] = self._noisy(y, nz, "DistanceSensor", copies[sel], cols[sel])
-        res = self._d_res[cols]
-        rounded = full & (res != RESOLUTION_OFF)
-        if np.count_nonzero(rounded):
+            y = self._noisy(y, nz, "DistanceSensor", sel_copies, sel_cols)
+            if sel is None:
+                values = np.array(y, dtype=np.float64)
+            else:
+                values[sel] = y
+        if rounded is not None:
             q = np.trunc(values / np.where(rounded, res, 1.0) + 0.5) * res + 0.0
             values = np.where(rounded, q, values)
         self._store("DistanceSensor", copies, cols, values)
+
+    def _distance_outputs(self, kept: list) -> tuple:
+        """The due distance sensors' outputs by table ((table, rows or None for every row, their
+        copies, their columns) per table in use), resolutions and which are rounded (None: none),
+        kept with their rows (``kept``: :meth:`_distance_rows`' record of the due set)."""
+        if kept[3] is None:
+            copies, cols = kept[0], kept[1]
+            full = ~self._d_empty[cols]
+            table_of = np.where(full, self._d_table_of[cols], -1)
+            by_table = []
+            for t, (table, _) in enumerate(self._d_tables):
+                sel = (table_of == t).nonzero()[0]
+                if len(sel):
+                    by_table.append((None if len(sel) == len(cols) else sel, copies[sel], cols[sel], table))
+            res = self._d_res[cols]
+            rounded = full & (res != RESOLUTION_OFF)
+            kept[3] = ([(table, sel, c, k) for sel, c, k, table in by_table], res,
+                       rounded if np.count_nonzero(rounded) else None)
+        return kept[3]
 
     def _combine_plan(self, g, k: np.ndarray, S: int, n: int) -> dmath.CombinePlan:
         """combine_distance_batch's constants for group ``g``'s sensors ``k``, kept while the same
