@@ -710,7 +710,9 @@ class BatchedSimulation:
         # without candidates puts them, all at once; the others' in slot order, as Contact.resolve_all
         # takes robots in world order (each sees the earlier slots of its copy where they ended, the
         # later ones where they started)
-        hot = np.isin(copies, copies[near])
+        hot_copy = np.zeros(self.copies, dtype=bool)
+        hot_copy[copies[near]] = True
+        hot = hot_copy[copies]
         cold = (~hot).nonzero()[0]
         if len(cold):
             self.centres[copies[cold], slots[cold]] = np.where(footless[cold, None], ends[cold],
