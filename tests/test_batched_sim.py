@@ -562,6 +562,12 @@ def test_distance_sensor_rays_in_c_are_the_numpy_frames_bit_for_bit():
     assert origins.tobytes() == np.repeat(want_pos, N, axis=0).tobytes()
     assert dirs.tobytes() == want_dirs.tobytes()
     assert np.count_nonzero(want_dirs == 0.0) > 0            # exact zeros were summed (their signs compared)
+    # the kept pass (packets.SensorRays: the same sensors step after step) reads the poses written
+    # in place since it was made, and gives sensor_rays' answer for them
+    kept = packets.sensor_rays_of(c, slot, rot, pos, pi, local_rot, local_pos, k, local_dirs)
+    rot[:], pos[:] = frames(C * R).reshape(C, R, 3, 3), rng.normal(size=(C, R, 3))
+    for got, want in zip(kept(), packets.sensor_rays(c, slot, rot, pos, pi, local_rot, local_pos, k, local_dirs)):
+        assert got.tobytes() == want.tobytes()
 
 
 @pytest.mark.parametrize("turning", ["all", "none", "mixed"])
@@ -760,3 +766,131 @@ def _drive_single(sim: Simulation, robot: str, left: float, right: float) -> Non
         m.set_position(math.inf)
     sim.robot(robot).drive.left.set_velocity(left)
     sim.robot(robot).drive.right.set_velocity(right)
+
+
+def _crowd(seed: int) -> wm.World:
+    """Three robots with bodies close together (a skid-steer one among them) between walls, a
+    sphere and a ramp: they run into the walls, the sphere and one another."""
+    ramp = [0.15 * i * 0.5 for j in range(4) for i in range(4)]
+    drive = {"wheel_radius": 0.05, "axle_length": 0.25, "max_wheel_speed": 14.0}
+    skid = {**drive, "left_motor": "l0", "right_motor": "r0", "skid_steer": {"left": ["l1"], "right": ["r1"]}}
+    return wm.World.model_validate({
+        "world_info": {"random_seed": seed, "basic_time_step": 16},
+        "solids": [{"name": "floor", "geometry": {"type": "plane"}},
+                   {"name": "ramp", "pose": {"translation": [-0.3, 0.2, 0.0]},
+                    "geometry": {"type": "elevation_grid", "height": ramp, "x_dimension": 4, "x_spacing": 0.3,
+                                 "y_dimension": 4, "y_spacing": 0.3}},
+                   {"name": "east", "pose": {"translation": [0.9, 0.0, 0.25]},
+                    "geometry": {"type": "box", "size": [0.1, 3, 0.5]}},
+                   {"name": "west", "pose": {"translation": [-0.9, 0.0, 0.25], "rotation": [0, 0, 1, 0.3]},
+                    "geometry": {"type": "box", "size": [0.1, 3, 0.5]}},
+                   {"name": "ball", "pose": {"translation": [0.0, -0.45, 0.1]},
+                    "geometry": {"type": "sphere", "radius": 0.12}}],
+        "robots": [{"name": "a", "pose": {"translation": [-0.2, 0.0, 0.05]},
+                    "body": {"geometry": {"type": "cylinder", "radius": 0.08, "height": 0.08}},
+                    "differential_drive": drive},
+                   {"name": "b", "pose": {"translation": [0.2, 0.0, 0.05], "rotation": [0, 0, 1, math.pi]},
+                    "body": {"geometry": {"type": "cylinder", "radius": 0.08, "height": 0.08}},
+                    "differential_drive": drive},
+                   {"name": "c", "pose": {"translation": [0.0, 0.35, 0.06], "rotation": [0, 0, 1, -1.5]},
+                    "body": {"geometry": {"type": "box", "size": [0.2, 0.12, 0.1]}},
+                    "differential_drive": skid}]})
+
+
+def test_the_drive_in_c_moves_every_copy_as_the_numpy_drive_with_contacts_and_terrain():
+    """The batched drive's C pass (wheels, arcs, the contact broad phase, the poses: one pass,
+    then the narrow phase where a move is near something) against its numpy path, over 12 copies
+    of three robots crowded between walls, a sphere and a ramp (one skid-steer), random wheel
+    commands and random copies sitting steps out: after every step every state array is the
+    same, bit for bit; robots clip on walls and on one another (two discs end touching: their
+    centres the sum of their radii apart)."""
+    if packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    n = 12
+    fast, ref = BatchedSimulation(_crowd(1), n), BatchedSimulation(_crowd(1), n)
+    ref._drive_step = None                       # the numpy path
+    rng = np.random.default_rng(5)
+    for bs in (fast, ref):
+        bs.reset(np.arange(n), list(range(n)))
+    starts = rng.uniform(-0.05, 0.05, (n, 3, 2))
+    for bs in (fast, ref):
+        for c in range(n):
+            for r in range(3):
+                p = bs.pos[c, r]
+                bs.set_pose(c, r, [p[0] + starts[c, r, 0], p[1] + starts[c, r, 1], p[2]])
+    closest, tilted = math.inf, 0
+    for step in range(150):
+        if step % 10 == 0:
+            lr = rng.uniform(-14.0, 14.0, (3, n, 2))
+            lr[:2, :, :] = np.abs(lr[:2, :, :]) * (step % 30 == 0) + lr[:2] * (step % 30 != 0)   # a and b: at each other
+            for bs in (fast, ref):
+                for r in range(3):
+                    bs.set_wheels(r, lr[r, :, 0], lr[r, :, 1])
+        active = rng.uniform(size=n) > 0.2
+        fast.step(active)
+        ref.step(active)
+        for name in ("x", "y", "z", "yaw", "rot", "pos", "centres", "heights", "pressing", "wheel_angle", "tilted"):
+            assert getattr(fast, name).tobytes() == getattr(ref, name).tobytes(), (step, name)
+        assert fast.counters == ref.counters
+        gap = np.hypot(*(fast.centres[:, 0] - fast.centres[:, 1]).T).min()
+        closest = min(closest, float(gap))
+        tilted += int(np.count_nonzero(fast.tilted))
+    assert fast.counters["contacts"] > 20
+    assert closest == pytest.approx(0.16, abs=1e-6)             # a and b touched (radii 0.08 each)
+    assert tilted > 50                                           # robots rode the ramp
+
+
+def test_distance_sensors_of_every_kind_and_table_match_the_single_simulation_as_due_sets_change():
+    """Distance sensors of every type on one robot, sharing and not sharing tables (two noisy, one
+    empty: value 0), with and without resolution, on periods of 16, 32
+    and 48 ms so that the due set changes from step to step (the kept rows, plans and outputs are
+    remade each time): every copy's values equal a Simulation's with that copy's seed, bit for bit."""
+    near = [[0.0, 0.0, 0.0], [1.0, 100.0, 0.0], [2.0, 150.0, 0.0]]
+    devices = [
+        {"device": "DistanceSensor", "name": "generic", "lookup_table": near, "resolution": 0.5,
+         "number_of_rays": 4, "aperture": 0.3},
+        {"device": "DistanceSensor", "name": "ir", "type": "infra-red", "lookup_table": [[0, 1000, 0.02], [0.5, 0, 0.05]],
+         "number_of_rays": 3, "aperture": 0.2, "pose": {"rotation": [0, 0, 1, 0.7]}},
+        {"device": "DistanceSensor", "name": "sonar", "type": "sonar", "lookup_table": near, "number_of_rays": 5,
+         "aperture": 0.5, "pose": {"rotation": [0, 0, 1, -0.5]}},
+        {"device": "DistanceSensor", "name": "laser", "type": "laser", "lookup_table": [[0, 0, 0], [3, 30, 0]],
+         "resolution": 0.1, "pose": {"rotation": [0, 0, 1, 3.0]}},
+        {"device": "DistanceSensor", "name": "far", "lookup_table": [[0.2, 80, 0.01], [1.5, 10, 0.0], [3.0, 5, 0.02]],
+         "pose": {"rotation": [0, 0, 1, 1.6]}},
+        {"device": "DistanceSensor", "name": "blank", "lookup_table": []},
+    ]
+    periods = {"generic": 16, "ir": 32, "sonar": 48, "laser": 16, "far": 32, "blank": 48}
+    world = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "random_seed": 0},
+        "solids": [{"name": "floor", "geometry": {"type": "plane"}},
+                   {"name": "box", "pose": {"translation": [0.6, 0.1, 0.1]}, "geometry": {"type": "box", "size": [0.2, 0.6, 0.2]}},
+                   {"name": "post", "pose": {"translation": [-0.5, 0.4, 0.2]},
+                    "geometry": {"type": "cylinder", "radius": 0.1, "height": 0.4}}],
+        "robots": [{"name": "r", "pose": {"translation": [0, 0, 0.05]},
+                    "body": {"geometry": {"type": "cylinder", "radius": 0.05, "height": 0.05}},
+                    "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.1, "max_wheel_speed": 10.0},
+                    "devices": devices}]})
+    seeds = [21, 22, 23]
+    bs = BatchedSimulation(world, len(seeds))
+    bs.reset(np.arange(3), seeds)
+    sims = [Simulation(world.model_copy(update={"world_info": world.world_info.model_copy(update={"random_seed": s})}))
+            for s in seeds]
+    for name, period in periods.items():
+        bs.enable(bs.device("r", name), period)
+        for s in sims:
+            s.robot("r").device(name).enable(period)
+    rng = np.random.default_rng(6)
+    for step in range(60):
+        if step % 10 == 0:
+            lr = rng.uniform(-10.0, 10.0, (3, 2))
+            bs.set_wheels(0, lr[:, 0], lr[:, 1])
+            for c, s in enumerate(sims):
+                _drive_single(s, "r", float(lr[c, 0]), float(lr[c, 1]))
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for name in periods:
+                want = s.robot("r").device(name).value
+                assert _same_value(want, float(bs.value(bs.device("r", name))[c])), (step, c, name, want)
+    assert bs.value(bs.device("r", "blank")).tolist() == [0.0, 0.0, 0.0]
+    assert len(set(bs.value(bs.device("r", "ir")).tolist())) == 3        # each copy's own noise

@@ -380,3 +380,42 @@ def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
         tilted += sum(abs(env.sim.robot("rover").pose.rotation[2, 2]) < 1.0 - 1e-6 for env in singles)
     venv.close()
     assert resets >= 3 and tilted > 30
+
+
+def test_the_avoid_obstacles_reward_in_c_is_the_numpy_reward_bit_for_bit(monkeypatch):
+    """AvoidObstacles' vectorised reward and termination with their C passes (packets.clearance_gaps,
+    packets.avoid_reward) equal the numpy path's, bit for bit, step after step while 16 robots drive
+    at full speed, turn and reverse into the arena's walls: free rewards, partial proximity, contact
+    penalties and terminations all occur."""
+    from sensorium.server.raycast import packets
+
+    if packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    n = 16
+    venv = gym.make_vec("sensorium/AvoidObstacles-v0", num_envs=n, vectorization_mode="vector_entry_point",
+                        precision="fast")
+    goal = venv.unwrapped._goals[0]
+    copies = np.arange(n)
+    venv.reset(seed=4)
+    sim = venv.unwrapped.sim
+    for c in range(n):        # heading east, 2 cm to 40 cm from the east wall's face (x = 2.0)
+        sim.set_pose(c, venv.unwrapped.slot, [1.93 - 0.025 * c, -1.5 + 0.2 * c, 0.01], rotation=[0, 0, 1, 0.0])
+    rng = np.random.default_rng(4)
+    seen = {"penalty": 0, "partial": 0, "free": 0}
+    for step in range(80):
+        a = np.ones((n, 2)) if step % 20 < 14 else rng.uniform(-1.0, 1.0, (n, 2))
+        venv.step(a.astype(np.float32))
+        goal._gap = None
+        got = goal.reward(copies), goal.terminated(copies), goal.gaps(copies).copy()
+        with monkeypatch.context() as m:
+            m.setattr(packets, "clearance_gaps", lambda *args: None)
+            m.setattr(packets, "avoid_reward", lambda *args: None)
+            goal._gap = None
+            want = goal.reward(copies), goal.terminated(copies), goal.gaps(copies).copy()
+        for g, w in zip(got, want):
+            assert g.tobytes() == w.tobytes(), step
+        gap = want[2]
+        seen["penalty"] += int(np.count_nonzero(gap < goal.goal.contact_distance))
+        seen["partial"] += int(np.count_nonzero((gap > goal.goal.contact_distance) & (gap < goal.goal.near)))
+        seen["free"] += int(np.count_nonzero(gap >= goal.goal.near))
+    assert min(seen.values()) > 0, seen

@@ -185,3 +185,32 @@ def test_device_streams_are_deterministic_and_independent():
     # the documented derivation
     import hashlib
     assert device_seed(42, "robot/ds0") == int.from_bytes(hashlib.sha256(b"42/robot/ds0").digest(), "big")
+
+
+def test_the_lookup_in_c_is_interpolate_bit_for_bit():
+    """packets.lookup (the batched distance sensors' table lookup in one C pass) gives
+    LookupTable.interpolate's y and n, bit for bit: values inside the table, on every input, at
+    and beyond both ends, infinities, NaN, signed zeros; tables of 2 and of many rows with noise;
+    and refuses what it does not handle (unsorted inputs, one row) so the caller interpolates."""
+    from sensorium.server.raycast import packets
+
+    if packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    rng = np.random.default_rng(4)
+    xs = np.sort(rng.uniform(-2.0, 5.0, 40))
+    tables = [LookupTable([[0.0, 0.0, 0.0], [3.0, 3.0, 0.0]]), TABLE,
+              LookupTable([[float(x), float(y), float(n)] for x, y, n in zip(xs, rng.uniform(-9, 9, 40),
+                                                                                 rng.uniform(0, 0.2, 40))])]
+    for t in tables:
+        knots = np.array([r[0] for r in t.rows])
+        v = np.concatenate([rng.uniform(knots[0] - 1.0, knots[-1] + 1.0, 3000), knots, np.nextafter(knots, -9.0),
+                            np.nextafter(knots, 9.0), [math.inf, -math.inf, math.nan, 0.0, -0.0]])
+        got = packets.lookup(t, v)
+        want = t.interpolate(v)
+        assert got is not None
+        assert got[0].tobytes() == want[0].tobytes() and got[1].tobytes() == want[1].tobytes()
+    # closed form: halfway between (0.1, 10) and (0.5, 50) is 30; clamped outside
+    y, _ = packets.lookup(TABLE, np.array([0.3, -1.0, 7.0]))
+    assert y.tolist() == [pytest.approx(30.0, abs=1e-12), 10.0, 20.0]
+    assert packets.lookup(LookupTable([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [2.0, 5.0, 0.0]]), np.zeros(3)) is None
+    assert packets.lookup(LookupTable([[1.0, 2.0, 0.0]]), np.zeros(3)) is None

@@ -390,3 +390,24 @@ def test_work_inside_a_block_knows_it_is_in_a_block():
     seen = blocks.run(lambda k: blocks.in_block(), list(range(6)), 2)
     assert seen == [True] * 6
     assert not blocks.in_block()
+
+
+@needs_packets
+def test_atan2_in_c_is_math_atan2_bit_for_bit():
+    """packets.atan2 (the vector env's poses' yaw) gives math.atan2 of every pair, bit for bit:
+    random angles' cos/sin (the rotation entries it reads), signed zeros, infinities, NaN, tiny
+    and huge values; strided views in and out; closed form atan2(1, 1) = pi / 4."""
+    rng = np.random.default_rng(3)
+    a = rng.uniform(-math.pi, math.pi, 4000)
+    special = [0.0, -0.0, 1.0, -1.0, math.inf, -math.inf, math.nan, 1e-310, -1e-310, 1e300]
+    ys = np.concatenate([np.sin(a), np.repeat(special, len(special))])
+    xs = np.concatenate([np.cos(a), np.tile(special, len(special))])
+    rot = np.zeros((len(ys), 3, 3))
+    rot[:, 1, 0], rot[:, 0, 0] = ys, xs
+    out = np.zeros((len(ys), 3))
+    got = packets.atan2(rot[:, 1, 0], rot[:, 0, 0], out[:, 2])
+    want = np.array([math.atan2(y, x) for y, x in zip(ys.tolist(), xs.tolist())])
+    assert got is not None and got.base is out
+    assert out[:, 2].tobytes() == want.tobytes() and not out[:, :2].any()
+    assert packets.atan2(np.ones(1), np.ones(1))[0] == math.pi / 4
+    assert packets.atan2(np.ones(2, dtype=np.float32), np.ones(2, dtype=np.float32)) is None

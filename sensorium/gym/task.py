@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayKind
 
 __all__ = ["Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start", "VectorGoal"]
@@ -289,7 +290,9 @@ class _AvoidObstaclesCopies(VectorGoal):
         far = r + max(g.near, g.contact_distance) + 1e-6
         n = len(copies)
         rows = self.sim.pos[copies, self.slot]
-        origins = np.repeat(rows, self.RAYS, axis=0)
+        origins = np.empty((n, self.RAYS, 3))
+        origins[:] = rows[:, None, :]                                    # (np.repeat's rows)
+        origins = origins.reshape(-1, 3)
         if self._rays is None or not np.array_equal(self._rays[0], copies):   # (the same copies step after step)
             self._rays = (copies.copy(), np.repeat(copies, self.RAYS), np.tile(self.dirs, (n, 1)))
         # each copy's rays from one origin, as clearance() casts them (coherent packets: each ray the
@@ -298,19 +301,25 @@ class _AvoidObstaclesCopies(VectorGoal):
                              exclude_slot=self.slot, distance_only=True, coherent=True,
                              run=self.RAYS, origin_rows=rows)
         d = hits.distance.reshape(n, self.RAYS)
-        clear = np.where(np.isfinite(d), d, np.inf).min(axis=1)
-        clear = np.where(np.isfinite(clear), clear, far)
-        gap = clear - r
+        gap = packets.clearance_gaps(d, far, r)   # (these steps in one C pass)
+        if gap is None:
+            clear = np.where(np.isfinite(d), d, np.inf).min(axis=1)
+            clear = np.where(np.isfinite(clear), clear, far)
+            gap = clear - r
         self._gap = (key, copies.copy(), gap)
         return gap
 
     def reward(self, copies: np.ndarray) -> np.ndarray:
         g = self.goal
+        gap = self.gaps(copies)
+        got = packets.avoid_reward(copies, self.slot, self.sim.velocity, self.vmax, gap, g.near, g.contact_distance,
+                                   g.contact_penalty)     # (the steps below in one C pass)
+        if got is not None:
+            return got
         vel = self.sim.velocity[copies, self.slot]
         wl, wr = vel[:, 0] / self.vmax, vel[:, 1] / self.vmax
         v = 0.5 * (wl + wr)
         dv = np.abs(wl - wr) / 2.0
-        gap = self.gaps(copies)
         p = np.minimum(np.maximum(1.0 - gap / g.near, 0.0), 1.0)
         r = v * (1.0 - np.sqrt(dv)) * (1.0 - p)
         return np.where(gap < g.contact_distance, r - g.contact_penalty, r)

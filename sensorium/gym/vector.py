@@ -50,6 +50,7 @@ from sensorium.gym.render import TopDown
 from sensorium.gym.task import Task, VectorGoal, never, zero
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
+from sensorium.server.raycast import packets
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_observable
 from sensorium.server.world.loader import LoadedWorld
 
@@ -282,9 +283,12 @@ class SensoriumVectorEnv(VectorEnv):
     def _info(self, copies: np.ndarray | slice) -> dict[str, np.ndarray]:
         rot = self.sim.rot[copies, self.slot]
         pos = self.sim.pos[copies, self.slot]
-        yaw = np.array(list(map(math.atan2, rot[:, 1, 0].tolist(), rot[:, 0, 0].tolist())))
-        return {"time_ms": self.sim.time_ms[copies].copy(), "steps": self.steps[copies].copy(),
-                "pose": np.stack([pos[:, 0], pos[:, 1], yaw], axis=1)}
+        pose = np.empty((len(pos), 3))
+        pose[:, :2] = pos[:, :2]
+        # the yaw as math.atan2 gives it (the single environment's): libm's atan2 in one C pass
+        if packets.atan2(rot[:, 1, 0], rot[:, 0, 0], pose[:, 2]) is None:
+            pose[:, 2] = list(map(math.atan2, rot[:, 1, 0].tolist(), rot[:, 0, 0].tolist()))
+        return {"time_ms": self.sim.time_ms[copies].copy(), "steps": self.steps[copies].copy(), "pose": pose}
 
     def _full_info(self, mask: np.ndarray) -> dict[str, np.ndarray]:
         """Info of every sub-env (Gymnasium's vector layout: one array per key and a ``_key`` mask)."""

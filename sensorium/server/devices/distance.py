@@ -28,6 +28,8 @@ __all__ = [
     "ray_weights",
     "reflection_factor",
     "combine_distance_batch",
+    "CombinePlan",
+    "combine_planned",
 ]
 
 
@@ -154,6 +156,31 @@ def _per_sensor(sensor_type, S: int) -> np.ndarray:
     return np.broadcast_to(np.asarray(sensor_type, dtype=np.int64), (S,))
 
 
+class CombinePlan:
+    """The per-sensor constants :func:`combine_distance_batch` derives from its arguments before
+    reading any ray (types checked, masks, the weights and ranges shaped), for S sensors of N rays:
+    a batched simulation keeps one while the same sensors are due and hands it to
+    :func:`combine_planned` step after step (the same operations on the rays, the same values)."""
+
+    __slots__ = ("S", "N", "rmax", "sonar", "n_sonar", "w", "laser", "n_laser", "infra_red", "n_infra_red", "sens")
+
+    def __init__(self, sensor_type, weights, lut_max_range, red_color_sensitivity, S: int, N: int):
+        self.S, self.N = S, N
+        self.rmax = np.broadcast_to(np.asarray(lut_max_range, dtype=np.float64), (S,))[:, None]
+        types = _per_sensor(sensor_type, S)
+        known = (types >= 0) & (types <= _LAST_TYPE)
+        if not known.all():
+            raise ValueError(f"unknown sensor type(s) {np.unique(types[~known]).tolist()}")
+        self.sonar = types == _SONAR
+        self.n_sonar = int(np.count_nonzero(self.sonar))
+        self.w = np.broadcast_to(np.asarray(weights, dtype=np.float64), (S, N)) if self.n_sonar < S else None
+        self.laser = types == _LASER
+        self.n_laser = int(np.count_nonzero(self.laser))
+        self.infra_red = types == _INFRA_RED
+        self.n_infra_red = int(np.count_nonzero(self.infra_red))
+        self.sens = np.broadcast_to(np.asarray(red_color_sensitivity, dtype=np.float64), (S,))[self.infra_red]
+
+
 def combine_distance_batch(sensor_type, distances, directions, normals, weights, lut_max_range,
                            reflection=None, red_color_sensitivity=1.0) -> np.ndarray:
     """Distance ``D`` (S,) of S sensors with N rays each (spec §3.4).
@@ -173,26 +200,35 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
     if r.ndim != 2:
         raise ValueError("distances must be (S, N)")
     S, N = r.shape
-    rmax = np.broadcast_to(np.asarray(lut_max_range, dtype=np.float64), (S,))[:, None]
+    plan = CombinePlan(sensor_type, weights, lut_max_range, red_color_sensitivity, S, N)
+    return combine_planned(plan, r, directions, normals, reflection)
+
+
+def combine_planned(plan: CombinePlan, r: np.ndarray, directions, normals, reflection=None, native=None) -> np.ndarray:
+    """:func:`combine_distance_batch` with its constants derived (``r``: the (S, N) float64 distances).
+    ``native``: an object whose ``cross_norm(u, back)`` and ``sonar_nearest(r, beta, rmax,
+    max_incidence)`` do the every-sonar path's steps around its arctan2 in C with the same
+    operations (raycast/packets.py's), each returning None to leave them to numpy."""
+    S, N = plan.S, plan.N
+    r = np.asarray(r, dtype=np.float64)
+    rmax = plan.rmax
+    if native is not None and plan.n_sonar == S:
+        got = _sonars_native(native, r, directions, normals, rmax, S, N)
+        if got is not None:
+            return got
     hit = np.isfinite(r) & (r <= rmax)
-    types = _per_sensor(sensor_type, S)
-    known = (types >= 0) & (types <= _LAST_TYPE)
-    if not known.all():
-        raise ValueError(f"unknown sensor type(s) {np.unique(types[~known]).tolist()}")
     out = np.empty(S)
-    sonar = types == _SONAR
-    n_sonar = int(np.count_nonzero(sonar))
+    sonar = plan.sonar
+    n_sonar = plan.n_sonar
     average = None
-    w: np.ndarray | None = None   # the weights (S, N): read by the weighted sums only
+    w = plan.w   # the weights (S, N): read by the weighted sums only
     if n_sonar < S:   # generic (and infra-red, laser) read the weighted sum
-        w = np.broadcast_to(np.asarray(weights, dtype=np.float64), (S, N))
         r_or_max = np.where(hit, r, rmax)   # (what the weighted sums and lasers read; sonars do not)
         average = np.einsum("sn,sn->s", w, r_or_max)
         out[:] = average  # generic
 
-        m = types == _LASER
-        if np.count_nonzero(m):
-            out[m] = r_or_max[m, 0]
+        if plan.n_laser:
+            out[plan.laser] = r_or_max[plan.laser, 0]
 
     if n_sonar:
         every = n_sonar == S   # (all sonars: the arrays as they are, no gathers)
@@ -208,13 +244,25 @@ def combine_distance_batch(sensor_type, distances, directions, normals, weights,
             echo = hit[sonar] & (beta < SONAR_MAX_INCIDENCE)
             out[sonar] = np.minimum(np.where(echo, r[sonar], np.inf).min(axis=1), rmax[sonar, 0])
 
-    m = types == _INFRA_RED
-    if np.count_nonzero(m):
+    if plan.n_infra_red:
+        m = plan.infra_red
         f = np.ones((S, N)) if reflection is None else np.asarray(reflection, dtype=np.float64).reshape(S, N)
         assert w is not None   # (set: not every sensor is a sonar)
         factor = np.einsum("sn,sn->s", w, np.where(hit, f, 1.0))[m]
         d = average[m]   # type: ignore[index]  (set: not every sensor is a sonar)
-        sens = np.broadcast_to(np.asarray(red_color_sensitivity, dtype=np.float64), (S,))[m]
-        out[m] = d + (d / factor - d) * sens
+        out[m] = d + (d / factor - d) * plan.sens
 
     return out
+
+
+def _sonars_native(native, r: np.ndarray, directions, normals, rmax: np.ndarray, S: int, N: int) -> np.ndarray | None:
+    """:func:`combine_planned` for sensors that are all sonars, its steps around the arctan2 (the
+    cross products' norms, the nearest echoes) in C with the same operations; None to leave it all
+    to numpy."""
+    u = np.ascontiguousarray(np.asarray(directions, dtype=np.float64).reshape(S, N, 3))
+    back = -np.asarray(normals, dtype=np.float64).reshape(S, N, 3)
+    cross = native.cross_norm(u, back)
+    if cross is None:
+        return None
+    beta = np.arctan2(cross, np.einsum("snk,snk->sn", u, back))     # (sonar_incidence's)
+    return native.sonar_nearest(r, beta, rmax[:, 0], SONAR_MAX_INCIDENCE)

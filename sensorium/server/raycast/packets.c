@@ -1503,3 +1503,220 @@ size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, in
   }
   return hits;
 }
+
+/* batched.py's _drive up to the contact narrow phase, in one pass over the state arrays (their
+ * addresses in a[], see DriveStep in packets.py): the live copies' robots stop pressing; their
+ * wheels and drives (sp_drive_wheels); the moving robots' arcs (sp_arc_steps, from x, y, yaw
+ * gathered) and their new yaws written; with contact, each move's reach hypot(end - start) + eps
+ * (np.hypot is libm's hypot), the grown discs (grow: 0, then the movers' reach) and the broad phase
+ * (sp_contact_near). When no move is near anything, the moves end where Contact._clip without
+ * candidates puts them (start + (end - start); a robot without a footprint: at its end): centres,
+ * x and y written; else nothing more is written (the caller's narrow phase). Then each move's Rz
+ * (its new yaw's cos and sin) and its base, gathered, for the pose's product. status[0]: infinite
+ * angles (the outputs are then not to be used: the caller's Python way says so), status[1]: near
+ * moves. Returns the number of moves. */
+size_t sp_drive_step(size_t L, const int64_t* live, size_t D, const int64_t* driven, size_t C, size_t R, size_t S,
+                     double dt, double eps, int contact, void* const* a, int64_t* status) {
+  const double* target = a[0];
+  const double* velocity = a[1];
+  double* angle = a[2];
+  const int64_t* sides = a[3];
+  const double* radius = a[4];
+  const double* axle = a[5];
+  double* x = a[6];
+  double* y = a[7];
+  double* yaw = a[8];
+  uint8_t* pressing = a[9];
+  int64_t* mc = a[10];
+  int64_t* ms = a[11];
+  double* v = a[12];
+  double* w = a[13];
+  double* starts = a[14];   /* (k, 2) */
+  double* ends = a[15];     /* (k, 2) */
+  double* x0 = a[16];       /* scratch: (k,) x, y, yaw gathered, then the arcs' outputs */
+  double* y0 = a[17];
+  double* yaw0 = a[18];
+  double* x1 = a[19];
+  double* y1 = a[20];
+  double* yaw1 = a[21];
+  double* cs = a[22];
+  double* sn = a[23];
+  double* rz = a[24];       /* (k, 3, 3) */
+  const double* base = a[25];
+  double* base_g = a[26];   /* (k, 3, 3) */
+  status[0] = status[1] = 0;
+  for (size_t l = 0; l < L; l++) memset(pressing + (size_t)live[l] * R, 0, R);
+  const size_t k = sp_drive_wheels(L, D, R, live, driven, target, velocity, angle, dt, sides, radius, axle, mc, ms,
+                                   v, w);
+  if (!k) return 0;
+  for (size_t m = 0; m < k; m++) {
+    const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+    x0[m] = x[at];
+    y0[m] = y[at];
+    yaw0[m] = yaw[at];
+  }
+  status[0] = (int64_t)sp_arc_steps(k, x0, y0, yaw0, v, w, dt, x1, y1, yaw1, cs, sn);
+  if (status[0]) return k;
+  for (size_t m = 0; m < k; m++) {
+    const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+    yaw[at] = yaw1[m];
+    starts[2 * m] = x0[m];
+    starts[2 * m + 1] = y0[m];
+    ends[2 * m] = x1[m];
+    ends[2 * m + 1] = y1[m];
+    double* r = rz + 9 * m;
+    r[0] = cs[m]; r[1] = -sn[m]; r[2] = 0.0;
+    r[3] = sn[m]; r[4] = cs[m]; r[5] = 0.0;
+    r[6] = 0.0; r[7] = 0.0; r[8] = 1.0;
+    memcpy(base_g + 9 * m, base + 9 * at, 9 * sizeof(double));
+  }
+  if (contact) {
+    double* reach = a[27];
+    double* grow = a[28];     /* (C, R) */
+    const double* foot_radius = a[29];
+    double* centres = a[33];  /* (C, R, 2) */
+    memset(grow, 0, C * R * sizeof(double));
+    for (size_t m = 0; m < k; m++) {
+      reach[m] = hypot(x1[m] - x0[m], y1[m] - y0[m]) + eps;
+      grow[(size_t)mc[m] * R + (size_t)ms[m]] = reach[m];
+    }
+    status[1] = (int64_t)sp_contact_near(k, R, S, mc, ms, starts, reach, foot_radius, a[30], a[31], a[32], centres,
+                                         grow, a[34], a[35], a[36], a[37], eps, a[38], a[39], a[40]);
+    if (status[1]) return k;
+    for (size_t m = 0; m < k; m++) {
+      const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+      const int bare = isnan(foot_radius[ms[m]]);
+      centres[2 * at] = bare ? x1[m] : x0[m] + (x1[m] - x0[m]);
+      centres[2 * at + 1] = bare ? y1[m] : y0[m] + (y1[m] - y0[m]);
+    }
+  }
+  for (size_t m = 0; m < k; m++) {
+    const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+    x[at] = x1[m];
+    y[at] = y1[m];
+  }
+  return k;
+}
+
+/* batched.py's _drive after the product: move m's rotation rot_in[m] (k, 3, 3) and position
+ * (x, y, z of its copy and slot, (C, R) each) written into rot (C, R, 3, 3) and pos (C, R, 3). */
+void sp_pose_scatter(size_t k, size_t R, const int64_t* mc, const int64_t* ms, const double* rot_in, const double* x,
+                     const double* y, const double* z, double* rot, double* pos) {
+  for (size_t m = 0; m < k; m++) {
+    const size_t at = (size_t)mc[m] * R + (size_t)ms[m];
+    memcpy(rot + 9 * at, rot_in + 9 * m, 9 * sizeof(double));
+    pos[3 * at] = x[at];
+    pos[3 * at + 1] = y[at];
+    pos[3 * at + 2] = z[at];
+  }
+}
+
+/* lookup.py's LookupTable.interpolate for a table of m >= 2 rows with strictly increasing inputs x:
+ * for each of the count values v, the bracket numpy's searchsorted(x, v, side="right") - 1 gives
+ * (NaN sorts last), clamped to [0, m - 2]; u = (v - x[lo]) / span (0 for a zero span), y and n
+ * interpolated as (1 - u) y[lo] + u y[hi]; below or at x[0] the first row's, at or above the last
+ * input the last row's -- the numpy path's operations, element by element. */
+void sp_lookup(size_t count, const double* v, size_t m, const double* x, const double* y, const double* n,
+               double* out_y, double* out_n) {
+  for (size_t i = 0; i < count; i++) {
+    const double vi = v[i];
+    size_t lo;
+    if (vi != vi) {
+      lo = m - 2;
+    } else {
+      size_t a = 0, b = m;   /* the first input above vi */
+      while (a < b) {
+        const size_t mid = (a + b) / 2;
+        if (x[mid] <= vi) a = mid + 1;
+        else b = mid;
+      }
+      lo = a == 0 ? 0 : a - 1;
+      if (lo > m - 2) lo = m - 2;
+    }
+    const size_t hi = lo + 1;
+    const double span = x[hi] - x[lo];
+    const double u = span != 0.0 ? (vi - x[lo]) / span : 0.0;
+    double oy = (1.0 - u) * y[lo] + u * y[hi];
+    double on = (1.0 - u) * n[lo] + u * n[hi];
+    if (vi <= x[0]) {
+      oy = y[0];
+      on = n[0];
+    } else if (vi >= x[m - 1]) {
+      oy = y[m - 1];
+      on = n[m - 1];
+    }
+    out_y[i] = oy;
+    out_n[i] = on;
+  }
+}
+
+/* libm's atan2 of n pairs (y[i * ys], x[i * xs]) into out[i * os]: the calls math.atan2 makes
+ * (vector.py's poses' yaw). */
+void sp_atan2(size_t n, const double* y, size_t ys, const double* x, size_t xs, double* out, size_t os) {
+  for (size_t i = 0; i < n; i++) out[i * os] = atan2(y[i * ys], x[i * xs]);
+}
+
+/* distance.py's sonar_incidence without its last two steps: for each of n rays, |u x back| with
+ * the numpy path's operations (each component a1 b2 - a2 b1, ..., the squares summed
+ * (c0 c0 + c1 c1) + c2 c2, the root); u and back (n, 3). */
+void sp_cross_norm(size_t n, const double* u, const double* back, double* out) {
+  for (size_t i = 0; i < n; i++) {
+    const double u0 = u[3 * i], u1 = u[3 * i + 1], u2 = u[3 * i + 2];
+    const double b0 = back[3 * i], b1 = back[3 * i + 1], b2 = back[3 * i + 2];
+    const double c0 = u1 * b2 - u2 * b1;
+    const double c1 = u2 * b0 - u0 * b2;
+    const double c2 = u0 * b1 - u1 * b0;
+    out[i] = sqrt((c0 * c0 + c1 * c1) + c2 * c2);
+  }
+}
+
+/* distance.py's combine for S sonars of N rays once the incidence angles beta (S, N) are known:
+ * a ray echoes when its distance r is finite, within rmax[s] and beta < max_incidence; each
+ * sonar's nearest echo (inf: none), then np.minimum with rmax[s] (NaN propagated as there). */
+void sp_sonar_nearest(size_t S, size_t N, const double* r, const double* beta, const double* rmax,
+                      double max_incidence, double* out) {
+  for (size_t s = 0; s < S; s++) {
+    double m = INFINITY;
+    for (size_t j = 0; j < N; j++) {
+      const double d = r[s * N + j];
+      const int echo = isfinite(d) && d <= rmax[s] && beta[s * N + j] < max_incidence;
+      const double v = echo ? d : INFINITY;
+      m = np_min(m, v);
+    }
+    out[s] = np_min(m, rmax[s]);
+  }
+}
+
+/* task.py's AvoidObstacles for many copies after the clearance cast: copy i's gap is the nearest
+ * finite distance of its `rays` rays (d (n, rays)), far when none, minus the body radius -- the
+ * numpy path's comparisons and its one subtraction (np.where / min / np.where, NaN propagated as
+ * numpy's min propagates it). */
+void sp_clearance_gaps(size_t n, size_t rays, const double* d, double far, double radius, double* gap) {
+  for (size_t i = 0; i < n; i++) {
+    double m = INFINITY;
+    for (size_t j = 0; j < rays; j++) {
+      const double v = d[i * rays + j];
+      m = np_min(m, isfinite(v) ? v : INFINITY);
+    }
+    gap[i] = (isfinite(m) ? m : far) - radius;
+  }
+}
+
+/* task.py's AvoidObstacles reward for n copies: wheel speeds wl, wr (velocity (C, R, 2) at copy
+ * copies[i], slot `slot`) over vmax, v = 0.5 (wl + wr), dv = |wl - wr| / 2, p = min(max(1 - gap / near,
+ * 0), 1), r = v (1 - sqrt(dv)) (1 - p), minus the penalty when gap < contact -- the numpy path's
+ * operations, element by element (np.maximum/np.minimum's NaN). */
+void sp_avoid_reward(size_t n, const int64_t* copies, size_t R, size_t slot, const double* velocity, double vmax,
+                     const double* gap, double near, double contact, double penalty, double* out) {
+  for (size_t i = 0; i < n; i++) {
+    const double* vel = velocity + ((size_t)copies[i] * R + slot) * 2;
+    const double wl = vel[0] / vmax, wr = vel[1] / vmax;
+    const double v = 0.5 * (wl + wr);
+    const double dv = fabs(wl - wr) / 2.0;
+    const double q = 1.0 - gap[i] / near;
+    const double lo = (q > 0.0 || q != q) ? q : 0.0;          /* np.maximum(q, 0.0) */
+    const double p = (lo < 1.0 || lo != lo) ? lo : 1.0;       /* np.minimum(.., 1.0) */
+    const double r = v * (1.0 - sqrt(dv)) * (1.0 - p);
+    out[i] = gap[i] < contact ? r - penalty : r;
+  }
+}

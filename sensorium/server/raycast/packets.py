@@ -871,3 +871,261 @@ def lidar_beams(rot: np.ndarray, org: np.ndarray, columns, out=None) -> tuple[np
         _check_buffer("lidar_beams", a, dt_, (n * W, 3), writes=True)
     lib.sp_lidar_beams(n, W, *_small_addresses((rot, org, x, y, z, out_org, out_dir, out_d32)))
     return out_org, out_dir, out_d32
+
+
+class DriveStep:
+    """:meth:`.batched.BatchedSimulation._drive` up to the contact narrow phase in one C pass
+    (``sp_drive_step``) and its last writes in another (``sp_pose_scatter``), over the simulation's
+    state arrays, whose addresses are taken once (the simulation writes them in place, never
+    rebinds them; the contact's solid arrays are re-read when a Supervisor rebuilds them). After
+    :meth:`run` returned k moves, their copies, slots, starts and ends, the broad phase (when
+    ``status[1]``: some move is near something) and the Rz and base of each lie in the first k
+    rows of this object's arrays. :func:`drive_step` makes one, or None without the helper."""
+
+    def __init__(self, lib, state: dict[str, np.ndarray], contact: dict[str, np.ndarray] | None):
+        self.lib = lib
+        self.state = state
+        C, R = state["x"].shape
+        self.C, self.R = C, R
+        n = C * R
+        i64 = np.int64
+        self.copies, self.slots = np.empty(n, dtype=i64), np.empty(n, dtype=i64)
+        self.v, self.w = np.empty(n), np.empty(n)
+        self.starts, self.ends = np.empty((n, 2)), np.empty((n, 2))
+        self.gathered = [np.empty(n) for _ in range(8)]   # x0, y0, yaw0, x1, y1, yaw1, cos, sin
+        self.cos, self.sin = self.gathered[6], self.gathered[7]
+        self.rz, self.base, self.rot = np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3, 3))
+        self.status = np.zeros(2, dtype=i64)
+        self.contact = contact
+        S = self.S = 0   # (the solids' count, set by run)
+        self.reach, self.grow = np.empty(n), np.empty((C, R))
+        self.solid_hit = np.zeros((n, S), dtype=np.bool_)
+        self.robot_hit = np.zeros((n, R), dtype=np.bool_)
+        self.near = np.zeros(n, dtype=np.bool_)
+        for name, dt_, shape in (("target", np.float64, (C, R, 2)), ("velocity", np.float64, (C, R, 2)),
+                                 ("sides", i64, (R, 2)), ("radius", np.float64, (R,)), ("axle", np.float64, (R,)),
+                                 ("base", np.float64, (C, R, 3, 3)), ("z", np.float64, (C, R))):
+            _check_buffer("drive_step", state[name], dt_, shape)
+        for name, dt_, shape in (("angle", np.float64, (C, R, 2)), ("x", np.float64, (C, R)),
+                                 ("y", np.float64, (C, R)), ("yaw", np.float64, (C, R)),
+                                 ("pressing", np.bool_, (C, R)), ("rot", np.float64, (C, R, 3, 3)),
+                                 ("pos", np.float64, (C, R, 3))):
+            _check_buffer("drive_step", state[name], dt_, shape, writes=True)
+        arrays = [state[k] for k in ("target", "velocity", "angle", "sides", "radius", "axle", "x", "y", "yaw",
+                                     "pressing")]
+        arrays += [self.copies, self.slots, self.v, self.w, self.starts, self.ends, *self.gathered, self.rz,
+                   state["base"], self.base, self.reach, self.grow]
+        if contact is not None:
+            for name, shape in (("foot_radius", (R,)), ("foot_low", (R,)), ("foot_high", (R,)),
+                                ("heights", (C, R))):
+                _check_buffer("drive_step", contact[name], np.float64, shape)
+            _check_buffer("drive_step", contact["centres"], np.float64, (C, R, 2), writes=True)
+            arrays += [contact[k] for k in ("foot_radius", "foot_low", "foot_high", "heights", "centres")]
+        self.ptrs = (ctypes.c_void_p * 41)(*(a.ctypes.data for a in arrays))
+        self._solids: tuple = ()
+        self.p_status = self.status.ctypes.data
+        self.p_scatter = [a.ctypes.data for a in (self.copies, self.slots, self.rot, state["x"], state["y"],
+                                                  state["z"], state["rot"], state["pos"])]
+        vp, sz, d = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
+        lib.sp_drive_step.restype = sz
+        lib.sp_drive_step.argtypes = [sz, vp, sz, vp, sz, sz, sz, d, d, ctypes.c_int, vp, vp]
+        lib.sp_pose_scatter.restype = None
+        lib.sp_pose_scatter.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]
+
+    def run(self, live: np.ndarray, driven: np.ndarray, dt: float, eps: float, solids=None) -> int:
+        """One basic step of the live copies' driven slots (int64 arrays); ``solids``: the contact's
+        (lo, hi, zlo, zhi) arrays (None: no contact). Returns the number of moves."""
+        if solids is not None and (len(self._solids) != 4 or any(a is not b for a, b in zip(solids, self._solids))):
+            for a, shape in zip(solids, ((len(solids[2]), 2), (len(solids[2]), 2), (len(solids[2]),),
+                                         (len(solids[2]),))):
+                _check_buffer("drive_step", a, np.float64, shape)
+            S = len(solids[2])
+            if S != self.S:
+                self.S = S
+                self.solid_hit = np.zeros((self.C * self.R, S), dtype=np.bool_)
+            self._solids = tuple(solids)
+            for j, a in enumerate((*solids, self.solid_hit, self.robot_hit, self.near)):
+                self.ptrs[34 + j] = a.ctypes.data
+        live = np.ascontiguousarray(live, dtype=np.int64)
+        return self.lib.sp_drive_step(len(live), live.ctypes.data, len(driven), driven.ctypes.data, self.C, self.R,
+                                      self.S, dt, eps, 0 if solids is None else 1, self.ptrs, self.p_status)
+
+    def scatter(self, k: int) -> None:
+        """Move m's rotation (``self.rot[m]``) and its (x, y, z) written into the state's rot and pos."""
+        p = self.p_scatter
+        self.lib.sp_pose_scatter(k, self.R, p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+
+
+def drive_step(state: dict[str, np.ndarray], contact: dict[str, np.ndarray] | None) -> DriveStep | None:
+    """A :class:`DriveStep` over these state arrays, or None without the helper."""
+    lib = library()
+    if lib is None:
+        return None
+    return DriveStep(lib, state, contact)
+
+
+def lookup(table, values: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """``table.interpolate(values)`` (a :class:`.lookup.LookupTable` of two rows or more with strictly
+    increasing inputs, (n,) float64 values) in one C pass (``sp_lookup``: the same operations, the
+    same bits); None without the helper or for another table or array."""
+    lib = library()
+    if lib is None or len(table) < 2 or not table._increasing or values.dtype != np.float64 or values.ndim != 1:
+        return None
+    got = _tables.get(id(table))
+    if got is None or got[0] is not table:
+        if not getattr(lib, "_lookup_typed", False):
+            vp, sz = ctypes.c_void_p, ctypes.c_size_t
+            lib.sp_lookup.restype = None
+            lib.sp_lookup.argtypes = [sz, vp, sz, vp, vp, vp, vp, vp]
+            lib._lookup_typed = True
+        rows = [np.ascontiguousarray(a) for a in (table._x, table._y, table._n)]
+        got = _tables[id(table)] = (table, rows, [a.ctypes.data for a in rows])
+    values = np.ascontiguousarray(values)
+    out_y, out_n = np.empty(len(values)), np.empty(len(values))
+    p = got[2]
+    lib.sp_lookup(len(values), values.ctypes.data, len(got[1][0]), p[0], p[1], p[2], out_y.ctypes.data,
+                  out_n.ctypes.data)
+    return out_y, out_n
+
+
+_tables: dict[int, tuple] = {}   # per lookup table (tables are immutable): its rows and their addresses
+
+
+def atan2(y: np.ndarray, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray | None:
+    """``math.atan2`` of each pair of the (n,) float64 arrays ``y``, ``x`` in one C pass (``sp_atan2``:
+    libm's atan2, the function math.atan2 calls: the same bits, without the Python floats), into
+    ``out`` when given; strided views allowed (positive strides of whole elements, ``out`` too).
+    None without the helper or for other arrays (nothing written)."""
+    lib = library()
+    if lib is None:
+        return None
+    if out is None:
+        out = np.empty(y.shape)
+    if not out.flags.writeable or not all(a.dtype == np.float64 and a.ndim == 1 and a.shape == y.shape
+                                          and a.strides[0] > 0 and a.strides[0] % 8 == 0 for a in (y, x, out)):
+        return None
+    if not getattr(lib, "_atan2_typed", False):
+        vp, sz = ctypes.c_void_p, ctypes.c_size_t
+        lib.sp_atan2.restype = None
+        lib.sp_atan2.argtypes = [sz, vp, sz, vp, sz, vp, sz]
+        lib._atan2_typed = True
+    lib.sp_atan2(len(y), y.ctypes.data, y.strides[0] // 8, x.ctypes.data, x.strides[0] // 8, out.ctypes.data,
+                 out.strides[0] // 8)
+    return out
+
+
+def _typed(lib, name: str, argtypes: list) -> None:
+    """Declare one of the appended C functions' arguments (once; they return nothing)."""
+    func = getattr(lib, name)
+    if func.argtypes is None:
+        func.restype = None
+        func.argtypes = argtypes
+
+
+def cross_norm(u: np.ndarray, back: np.ndarray) -> np.ndarray | None:
+    """``|u x back|`` of each row of the (S, N, 3) float64 arrays (``sp_cross_norm``: distance.py's
+    sonar_incidence's operations before its arctan2), (S, N); None without the helper or for
+    other arrays."""
+    lib = library()
+    if lib is None or u.dtype != np.float64 or back.dtype != np.float64 or u.shape != back.shape or u.ndim != 3 \
+            or u.shape[2] != 3:
+        return None
+    _typed(lib, "sp_cross_norm", [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p])
+    u, back = np.ascontiguousarray(u), np.ascontiguousarray(back)
+    out = np.empty(u.shape[:2])
+    lib.sp_cross_norm(out.size, u.ctypes.data, back.ctypes.data, out.ctypes.data)
+    return out
+
+
+def sonar_nearest(r: np.ndarray, beta: np.ndarray, rmax: np.ndarray, max_incidence: float) -> np.ndarray | None:
+    """Each of S sonars' reading from its N rays' distances ``r`` and incidence angles ``beta``
+    ((S, N) float64) and its range ``rmax`` ((S,)): distance.py's every-sonar combine after the
+    angles, in one C pass (``sp_sonar_nearest``, the same comparisons); None without the helper or
+    for other arrays."""
+    lib = library()
+    if lib is None or r.dtype != np.float64 or beta.dtype != np.float64 or rmax.dtype != np.float64 \
+            or r.ndim != 2 or beta.shape != r.shape or rmax.shape != r.shape[:1]:
+        return None
+    vp, sz = ctypes.c_void_p, ctypes.c_size_t
+    _typed(lib, "sp_sonar_nearest", [sz, sz, vp, vp, vp, ctypes.c_double, vp])
+    r, beta, rmax = np.ascontiguousarray(r), np.ascontiguousarray(beta), np.ascontiguousarray(rmax)
+    out = np.empty(len(r))
+    lib.sp_sonar_nearest(r.shape[0], r.shape[1], r.ctypes.data, beta.ctypes.data, rmax.ctypes.data,
+                         float(max_incidence), out.ctypes.data)
+    return out
+
+
+class SensorRays:
+    """:func:`sensor_rays` of fixed sensors (the same copies, slots, frames and directions step after
+    step: a batched step's due distance sensors) over arrays written in place (the poses): their
+    checks and addresses made once, each call one C pass into fresh outputs."""
+
+    def __init__(self, lib, copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.ndarray, pi: np.ndarray,
+                 local_rot: np.ndarray, local_pos: np.ndarray, k: np.ndarray, local_dirs: np.ndarray):
+        f64, i64 = np.float64, np.int64
+        self.lib = lib
+        self.S = S = len(copies)
+        C, self.R = rot.shape[:2]
+        G, self.N = local_dirs.shape[:2]
+        for a, shape in ((rot, (C, self.R, 3, 3)), (pos, (C, self.R, 3)), (local_rot, (len(local_rot), 3, 3)),
+                         (local_pos, (len(local_rot), 3)), (local_dirs, (G, self.N, 3))):
+            _check_buffer("sensor_rays", a, f64, shape)
+        idx = [np.ascontiguousarray(a, dtype=i64) for a in (copies, slots, pi, k)]
+        if any(a.shape != (S,) for a in idx):
+            raise TypeError("sensor_rays: inconsistent shapes")
+        self.kept = (*idx, rot, pos, local_rot, local_pos, local_dirs)
+        p = [a.ctypes.data for a in self.kept]
+        self.args = (p[0], p[1], p[4], p[5], p[2], p[6], p[7], p[3], p[8])
+
+    def __call__(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        S, N = self.S, self.N
+        positions, origins, dirs = np.empty((S, 3)), np.empty((S * N, 3)), np.empty((S, N, 3))
+        self.lib.sp_sensor_rays(S, N, self.R, *self.args, *_small_addresses((positions, origins, dirs)))
+        return positions, origins, dirs
+
+
+def sensor_rays_of(copies: np.ndarray, slots: np.ndarray, rot: np.ndarray, pos: np.ndarray, pi: np.ndarray,
+                   local_rot: np.ndarray, local_pos: np.ndarray, k: np.ndarray, local_dirs: np.ndarray
+                   ) -> SensorRays | None:
+    """A :class:`SensorRays` of these sensors (arguments as :func:`sensor_rays`), or None without the helper."""
+    lib = library()
+    if lib is None:
+        return None
+    return SensorRays(lib, copies, slots, rot, pos, pi, local_rot, local_pos, k, local_dirs)
+
+
+def clearance_gaps(d: np.ndarray, far: float, radius: float) -> np.ndarray | None:
+    """AvoidObstacles' gaps from its clearance cast's distances ``d`` ((n, rays) float64): each row's
+    nearest finite distance (``far`` when none) minus ``radius``, in one C pass
+    (``sp_clearance_gaps``, task.py's numpy operations); None without the helper or for another array."""
+    lib = library()
+    if lib is None or d.dtype != np.float64 or d.ndim != 2:
+        return None
+    vp, sz, f = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
+    _typed(lib, "sp_clearance_gaps", [sz, sz, vp, f, f, vp])
+    d = np.ascontiguousarray(d)
+    gap = np.empty(len(d))
+    lib.sp_clearance_gaps(d.shape[0], d.shape[1], d.ctypes.data, float(far), float(radius), gap.ctypes.data)
+    return gap
+
+
+def avoid_reward(copies: np.ndarray, slot: int, velocity: np.ndarray, vmax: float, gap: np.ndarray, near: float,
+                 contact: float, penalty: float) -> np.ndarray | None:
+    """AvoidObstacles' reward of the named copies (int64 ``copies``, their robot ``slot``'s wheel
+    ``velocity`` (C, R, 2), their ``gap`` (n,)) in one C pass (``sp_avoid_reward``, task.py's numpy
+    operations element by element); None without the helper or for other arrays."""
+    lib = library()
+    if lib is None or copies.dtype != np.int64 or gap.dtype != np.float64 or gap.shape != copies.shape \
+            or copies.ndim != 1:
+        return None
+    C, R = velocity.shape[:2]
+    _check_buffer("avoid_reward", velocity, np.float64, (C, R, 2))
+    if not 0 <= slot < R or (len(copies) and not (0 <= int(copies.min()) and int(copies.max()) < C)):
+        raise IndexError(f"avoid_reward: slot {slot} or copies outside ({C}, {R})")
+    vp, sz, f = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
+    _typed(lib, "sp_avoid_reward", [sz, vp, sz, sz, vp, f, vp, f, f, f, vp])
+    copies, gap = np.ascontiguousarray(copies), np.ascontiguousarray(gap)
+    out = np.empty(len(copies))
+    lib.sp_avoid_reward(len(copies), copies.ctypes.data, R, int(slot), velocity.ctypes.data, float(vmax),
+                        gap.ctypes.data, float(near), float(contact), float(penalty), out.ctypes.data)
+    return out

@@ -214,6 +214,7 @@ class BatchedSimulation:
         # -- robots: initial poses and drives (the template state every reset starts from)
         self.initial = [pose_from_model(r.pose) for r in w.robots]
         self.has_drive = np.array([r.differential_drive is not None for r in w.robots], dtype=bool)
+        self._driven = self.has_drive.nonzero()[0]
         self.wheel_radius = np.array([r.differential_drive.wheel_radius if r.differential_drive else 0.0
                                       for r in w.robots], dtype=np.float64)
         self.axle = np.array([r.differential_drive.axle_length if r.differential_drive else 1.0
@@ -351,6 +352,7 @@ class BatchedSimulation:
                 continue
         self._lidar_skips: dict[int, np.ndarray] = {}
         self._lidar_plan: dict[int, tuple] = {}      # per lidar: (copies, each beam's copy, mount slots)
+        self._lidar_due: tuple | None = None          # the due lidars' scans (_lidar_scans)
         self._lidar_beam_rows: dict[int, tuple] = {}  # per lidar: its beams' buffers (origins, directions, float32)
         self.range_images = [np.zeros((C, d.config.number_of_layers, d.config.horizontal_resolution), dtype=np.float32)
                              for d in self.lidar]
@@ -382,6 +384,8 @@ class BatchedSimulation:
                                                dtype=np.int64)) for table, idx in self._d_plan.tables]
             self._d_table_of = _table_of(self._d_tables, len(self.distance))
             self._own_kept: dict[int, tuple] = {}   # per group: its due sensors' own-body hits (_own_rows)
+            self._combine_kept: dict[int, tuple] = {}   # per group: its due sensors' CombinePlan
+            self._d_rows: list | None = None             # the due sensors' rows (_distance_rows)
         if self.position:
             wheel = []
             for d in self.position:
@@ -562,41 +566,80 @@ class BatchedSimulation:
 
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:
-        driven = self.has_drive.nonzero()[0]
+        driven = self._driven
         if not len(driven):
             return
         dt = dt_ms / 1000.0
-        self.pressing[live] = False
-        got = packets.drive_wheels(live, driven, self.target, self.velocity, self.wheel_angle, dt, self.side_wheels,
-                                   self.wheel_radius, self.axle)
-        copies, slots, v, w = got if got is not None else self._drive_wheels(live, driven, dt)
-        if not len(copies):
+        step = self._drive_pass()
+        if step is None:
+            self._drive_numpy(live, driven, dt)
             return
-        x0, y0 = self.x[copies, slots], self.y[copies, slots]
-        yaw0 = self.yaw[copies, slots]
-        arc = packets.arc_steps(x0, y0, yaw0, v, w, dt)   # (with the new yaws' cos, sin: one C pass)
-        if arc is not None:
-            x, y, yaw, cos, sin = arc
-        else:
-            x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
-            cos, sin = _cos_sin(yaw)
-        self.yaw[copies, slots] = yaw
-        if self.contact is not None:
-            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
-        self.x[copies, slots], self.y[copies, slots] = x, y
+        ct = self.contact
+        k = step.run(live, driven, dt, EPS, None if ct is None else (ct._lo, ct._hi, ct._zlo, ct._zhi))
+        if not k:
+            return
+        copies, slots = step.copies[:k], step.slots[:k]
+        if step.status[0]:   # an infinite angle: math.cos refuses it, as in the single simulation
+            g = step.gathered
+            _cos_sin(_arc_steps(g[0][:k], g[1][:k], g[2][:k], step.v[:k], step.w[:k], dt)[2])
+            raise ValueError("math domain error")
+        if step.status[1]:   # a move near something: the narrow phase, slot by slot
+            x, y = self._narrow(copies, slots, step.starts[:k], step.ends[:k],
+                                step.solid_hit[:k] if len(ct._obs) else None, step.robot_hit[:k] if self.R > 1 else None,
+                                step.near[:k])
+            self.x[copies, slots], self.y[copies, slots] = x, y
+        self._place(copies, slots, step.rz[:k], step.base[:k], step.cos[:k], step.sin[:k], step.rot[:k])
+        step.scatter(k)
+
+    def _drive_pass(self) -> packets.DriveStep | None:
+        """The C pass of :meth:`_drive` over this simulation's state (made once), None without the helper."""
+        got = self.__dict__.get("_drive_step", False)
+        if got is False:
+            contact = None
+            if self.contact is not None:
+                contact = {"foot_radius": self.foot_radius, "foot_low": self.foot_low, "foot_high": self.foot_high,
+                           "heights": self.heights, "centres": self.centres}
+            got = self._drive_step = packets.drive_step(
+                {"target": self.target, "velocity": self.velocity, "angle": self.wheel_angle,
+                 "sides": self.side_wheels, "radius": self.wheel_radius, "axle": self.axle, "x": self.x, "y": self.y,
+                 "yaw": self.yaw, "z": self.z, "pressing": self.pressing, "base": self.base, "rot": self.rot,
+                 "pos": self.pos}, contact)
+        return got
+
+    def _place(self, copies: np.ndarray, slots: np.ndarray, rz: np.ndarray, base: np.ndarray, cos: np.ndarray,
+               sin: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """The moved robots' ride over the ground (x, y written) and their rotations into ``out``:
+        DifferentialDrive.pose's Rz(yaw) @ base (the same 3x3 products, stacked), on a slope with
+        the ground's attitude (ground_rotation, as PlanarState.pose)."""
         if self.ground is not None:
-            self._ride(copies, slots, x, y)
-        # DifferentialDrive.pose: Rz(yaw) @ base (the same 3x3 products, stacked), (x, y, z)
-        rz = np.zeros((len(yaw), 3, 3))
-        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
-        rot = np.matmul(rz, self.base[copies, slots])
-        if self.ground is not None:   # on a slope: the ground's attitude (ground_rotation, as PlanarState.pose)
+            self._ride(copies, slots, self.x[copies, slots], self.y[copies, slots])
+        rot = np.matmul(rz, base, out=out)
+        if self.ground is not None:
             k = self.tilted[copies, slots].nonzero()[0]
             if len(k):
                 c, r = copies[k], slots[k]
                 rot[k] = ground_rotation(self.slope[c, r, 0], self.slope[c, r, 1], cos[k], sin[k], self.base[c, r])
+        return rot
+
+    def _drive_numpy(self, live: np.ndarray, driven: np.ndarray, dt: float) -> None:
+        """:meth:`_drive` without the C helper (the same values)."""
+        self.pressing[live] = False
+        copies, slots, v, w = self._drive_wheels(live, driven, dt)
+        if not len(copies):
+            return
+        x0, y0 = self.x[copies, slots], self.y[copies, slots]
+        yaw0 = self.yaw[copies, slots]
+        x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
+        cos, sin = _cos_sin(yaw)
+        self.yaw[copies, slots] = yaw
+        if self.contact is not None:
+            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
+        self.x[copies, slots], self.y[copies, slots] = x, y
+        rz = np.zeros((len(yaw), 3, 3))
+        rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
+        rot = self._place(copies, slots, rz, self.base[copies, slots], cos, sin, np.empty((len(yaw), 3, 3)))
         self.rot[copies, slots] = rot
-        self.pos[copies, slots] = np.stack([x, y, self.z[copies, slots]], axis=1)
+        self.pos[copies, slots] = np.stack([self.x[copies, slots], self.y[copies, slots], self.z[copies, slots]], axis=1)
 
     def _ride(self, copies: np.ndarray, slots: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
         """PlanarState.settle for the moved robots placed over ground: height and slope under them."""
@@ -650,7 +693,6 @@ class BatchedSimulation:
         narrow phase (Contact._clip). Returns the final xy."""
         ct = self.contact
         assert ct is not None
-        out = ends.copy()
         reach = np.hypot(*(ends - starts).T) + EPS
         Rr = self.foot_radius[slots]
         # where every robot may be during this step: its disc, grown by its own move if it moves
@@ -664,40 +706,59 @@ class BatchedSimulation:
             robot_hit = robot_hit if self.R > 1 else None
         else:
             solid_hit, robot_hit, near = self._contact_near(copies, slots, starts, reach, grow)
-        footless = np.isnan(Rr)
         if not near.any():
             # nothing near any move: each ends where Contact._clip without candidates puts it (a
             # robot without a footprint: at its end), whatever the slot order
-            self.centres[copies, slots] = np.where(footless[:, None], ends, starts + (ends - starts))
-            return out[:, 0], out[:, 1]
-        band_lo = self.heights[copies, slots] + self.foot_low[slots]
-        band_hi = self.heights[copies, slots] + self.foot_high[slots]
-        # slot by slot, as Contact.resolve_all takes robots in world order (each sees the earlier
-        # slots of its copy where they ended, the later ones where they started)
-        for r in np.unique(slots).tolist():
-            mine = slots == r
-            bare = (mine & footless).nonzero()[0]
-            self.centres[copies[bare], r] = ends[bare]
-            # nothing near: Contact._clip without candidates moves to start + (end - start)
-            free = (mine & ~near & ~footless).nonzero()[0]
-            self.centres[copies[free], r] = starts[free] + (ends[free] - starts[free])
-            for m in (mine & near & ~footless).nonzero()[0].tolist():
-                # candidates as resolve_all lists them: solids, then robots, in index order
-                cands = ([ct._in_band(ct._obs[j], float(band_lo[m]), float(band_hi[m]))
-                          for j in solid_hit[m].nonzero()[0].tolist()] if solid_hit is not None else [])
-                cm = int(copies[m])
-                if robot_hit is not None:
-                    for j in robot_hit[m].nonzero()[0].tolist():
-                        cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
-                                              float(self.foot_radius[j]),
-                                              (float(self.heights[cm, j] + self.foot_low[j]),
-                                               float(self.heights[cm, j] + self.foot_high[j]))))
-                p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
-                self.centres[cm, r] = p
-                if clipped:
-                    self.pressing[cm, r] = True
-                    self.counters["contacts"] += 1
-                    out[m] = p
+            self.centres[copies, slots] = np.where(np.isnan(Rr)[:, None], ends, starts + (ends - starts))
+            return ends[:, 0], ends[:, 1]
+        return self._narrow(copies, slots, starts, ends, solid_hit, robot_hit, near)
+
+    def _narrow(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+                solid_hit: np.ndarray | None, robot_hit: np.ndarray | None, near: np.ndarray):
+        """The narrow phase of :meth:`_contact` once the broad phase found a move near something:
+        Contact._clip of each near move (centres written); returns the final xy."""
+        ct = self.contact
+        assert ct is not None
+        out = ends.copy()
+        Rr = self.foot_radius[slots]
+        footless = np.isnan(Rr)
+        # copies are independent: the moves of copies where nothing is near end where Contact._clip
+        # without candidates puts them, all at once; the others' in slot order, as Contact.resolve_all
+        # takes robots in world order (each sees the earlier slots of its copy where they ended, the
+        # later ones where they started)
+        hot_copy = np.zeros(self.copies, dtype=bool)
+        hot_copy[copies[near]] = True
+        hot = hot_copy[copies]
+        cold = (~hot).nonzero()[0]
+        if len(cold):
+            self.centres[copies[cold], slots[cold]] = np.where(footless[cold, None], ends[cold],
+                                                               starts[cold] + (ends[cold] - starts[cold]))
+        order = hot.nonzero()[0]
+        for m in order[np.argsort(slots[order], kind="stable")].tolist():
+            cm, r = int(copies[m]), int(slots[m])
+            if footless[m]:
+                self.centres[cm, r] = ends[m]
+                continue
+            if not near[m]:
+                self.centres[cm, r] = starts[m] + (ends[m] - starts[m])
+                continue
+            lo = float(self.heights[cm, r] + self.foot_low[r])
+            hi = float(self.heights[cm, r] + self.foot_high[r])
+            # candidates as resolve_all lists them: solids, then robots, in index order
+            cands = ([ct._in_band(ct._obs[j], lo, hi) for j in solid_hit[m].nonzero()[0].tolist()]
+                     if solid_hit is not None else [])
+            if robot_hit is not None:
+                for j in robot_hit[m].nonzero()[0].tolist():
+                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
+                                          float(self.foot_radius[j]),
+                                          (float(self.heights[cm, j] + self.foot_low[j]),
+                                           float(self.heights[cm, j] + self.foot_high[j]))))
+            p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
+            self.centres[cm, r] = p
+            if clipped:
+                self.pressing[cm, r] = True
+                self.counters["contacts"] += 1
+                out[m] = p
         return out[:, 0], out[:, 1]
 
     def _contact_near(self, copies, slots, starts, reach, grow):
@@ -882,6 +943,34 @@ class BatchedSimulation:
         plan = self._d_plan
         state = {"copies": copies, "cols": cols, "groups": []}
         reqs: list[_Rays] = []
+        groups = self._distance_rows(copies, cols)
+        state["kept"] = self._d_rows
+        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy, native in groups:
+            n = g.n
+            if native is not None:   # packets.sensor_rays of these sensors
+                positions, origins, dirs = native()
+            else:
+                rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
+                rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
+                                         np.ascontiguousarray(plan.local_pos_t[:, pi]))
+                positions = pos_t.T + self.pos[c, slot]
+                dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
+                origins = np.repeat(positions, n, axis=0)
+            reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0, t_far, g.kind, ray_copy, exclude, mount, skip=g.skip,
+                              run=n, origin_rows=positions))
+            state["groups"].append((g, rows, k, c, slot, positions, dirs))
+        return state, reqs
+
+    def _distance_rows(self, copies: np.ndarray, cols: np.ndarray) -> list[tuple]:
+        """Per plan group with due sensors: (group, rows in the due list, index in the group, index
+        in the plan's stacked constants, copy, slot, each ray's excluded and mount slot, far limit
+        and copy, their world rays' C pass or None), kept while the same sensors of the same copies
+        are due (step after step)."""
+        kept = self._d_rows
+        if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols):
+            return kept[2]
+        plan = self._d_plan
+        out = []
         for g, where in self._d_groups:
             # the group's sensors among the due ones: (row in the due list, index in the group)
             k = where[cols]
@@ -893,25 +982,16 @@ class BatchedSimulation:
             c = copies[rows]
             slot = plan.robot[pi]
             n = g.n
-            got = packets.sensor_rays(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k, g.local_dirs)
-            if got is not None:
-                positions, origins, dirs = got
-            else:
-                rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
-                rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
-                                         np.ascontiguousarray(plan.local_pos_t[:, pi]))
-                positions = pos_t.T + self.pos[c, slot]
-                dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
-                origins = np.repeat(positions, n, axis=0)
-            mount = -1
+            mount: np.ndarray | int = -1
             if g.mount is not None:
                 mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
-            reqs.append(_Rays(origins, dirs.reshape(-1, 3), 0.0,
-                              g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1),
-                              g.kind, np.repeat(c, n), exclude, mount, skip=g.skip, run=n, origin_rows=positions))
-            state["groups"].append((g, rows, k, c, slot, positions, dirs))
-        return state, reqs
+            t_far = g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1)
+            native = packets.sensor_rays_of(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k,
+                                            g.local_dirs)
+            out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n), native))
+        self._d_rows = [copies.copy(), cols.copy(), out, None]    # (the outputs: _distance_outputs)
+        return out
 
     def _finish_distance(self, state: dict, hits: list[RayHits]) -> None:
         plan = self._d_plan
@@ -943,25 +1023,52 @@ class BatchedSimulation:
                 else:
                     shade = dmath.reflection_factor(self.red[sh], self.roughness[sh])
                 reflection = np.where(sh >= 0, shade, 1.0)
-            measured[rows] = dmath.combine_distance_batch(
-                g.types[k], dist, dirs, normal.reshape(S, n, 3), g.weights[k], g.lut_max_range[k], reflection,
-                g.sensitivity[k])
+            measured[rows] = dmath.combine_planned(self._combine_plan(g, k, S, n), dist, dirs,
+                                                   normal.reshape(S, n, 3), reflection, packets)
         # DistancePlan.output: lookup (by table), each sensor's noise, resolution
         values = np.zeros(len(cols))
-        full = ~self._d_empty[cols]
-        table_of = np.where(full, self._d_table_of[cols], -1)
-        for t, (table, _) in enumerate(self._d_tables):
-            sel = (table_of == t).nonzero()[0]
-            if not len(sel):
-                continue
-            y, nz = table.interpolate(measured[sel])
-            values[sel] = self._noisy(y, nz, "DistanceSensor", copies[sel], cols[sel])
-        res = self._d_res[cols]
-        rounded = full & (res != RESOLUTION_OFF)
-        if np.count_nonzero(rounded):
+        by_table, res, rounded = self._distance_outputs(state["kept"])
+        for table, sel, sel_copies, sel_cols in by_table:
+            m = measured if sel is None else measured[sel]
+            got = packets.lookup(table, m)
+            y, nz = got if got is not None else table.interpolate(m)
+            y = self._noisy(y, nz, "DistanceSensor", sel_copies, sel_cols)
+            if sel is None:
+                values = np.array(y, dtype=np.float64)
+            else:
+                values[sel] = y
+        if rounded is not None:
             q = np.trunc(values / np.where(rounded, res, 1.0) + 0.5) * res + 0.0
             values = np.where(rounded, q, values)
         self._store("DistanceSensor", copies, cols, values)
+
+    def _distance_outputs(self, kept: list) -> tuple:
+        """The due distance sensors' outputs by table ((table, rows or None for every row, their
+        copies, their columns) per table in use), resolutions and which are rounded (None: none),
+        kept with their rows (``kept``: :meth:`_distance_rows`' record of the due set)."""
+        if kept[3] is None:
+            copies, cols = kept[0], kept[1]
+            full = ~self._d_empty[cols]
+            table_of = np.where(full, self._d_table_of[cols], -1)
+            by_table = []
+            for t, (table, _) in enumerate(self._d_tables):
+                sel = (table_of == t).nonzero()[0]
+                if len(sel):
+                    by_table.append((None if len(sel) == len(cols) else sel, copies[sel], cols[sel], table))
+            res = self._d_res[cols]
+            rounded = full & (res != RESOLUTION_OFF)
+            kept[3] = ([(table, sel, c, k) for sel, c, k, table in by_table], res,
+                       rounded if np.count_nonzero(rounded) else None)
+        return kept[3]
+
+    def _combine_plan(self, g, k: np.ndarray, S: int, n: int) -> dmath.CombinePlan:
+        """combine_distance_batch's constants for group ``g``'s sensors ``k``, kept while the same
+        sensors are due (step after step)."""
+        got = self._combine_kept.get(id(g))
+        if got is None or not np.array_equal(got[0], k):
+            plan = dmath.CombinePlan(g.types[k], g.weights[k], g.lut_max_range[k], g.sensitivity[k], S, n)
+            got = self._combine_kept[id(g)] = (k.copy(), plan)
+        return got[1]
 
     def _own_rows(self, g, own: RayHits, k: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The own-body hits (distance, shape, normal) of the rays of group ``g``'s sensors ``k``,
@@ -989,9 +1096,8 @@ class BatchedSimulation:
     def _plan_lidars(self, copies: np.ndarray, cols: np.ndarray):
         reqs: list[_Rays] = []
         state = {"items": []}
-        for col in sorted(set(cols.tolist())):
+        for col, c, ray_copy, mount, t_far, every in self._lidar_scans(copies, cols):
             lid = self.lidar[col]
-            c = copies[cols == col]
             slot = lid.robot_index
             rr = self.rot[c, slot]
             rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
@@ -999,12 +1105,28 @@ class BatchedSimulation:
             W = len(lid._dir_columns[0])
             got = packets.lidar_beams(rot, org, lid._dir_columns, self._lidar_buffers(col, len(c) * W))
             origins, d, d32 = got if got is not None else _lidar_beams(rot, org, lid._dir_columns)
-            ray_copy, mount = self._lidar_rows(col, c, W)
-            t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
             reqs.append(_Rays(origins, d, lid.params.near, t_far, RayKind.VISUAL, ray_copy,
                               -1, mount, distance_only=True, d32=d32, coherent=True, origin_rows=org, run=W))
-            state["items"].append((col, c))
+            state["items"].append((col, c, every))
         return state, reqs
+
+    def _lidar_scans(self, copies: np.ndarray, cols: np.ndarray) -> list[tuple]:
+        """Per due lidar: (column, the copies scanning, each beam's copy, mount slot(s), far limit,
+        whether every copy scans, in order), kept while the same lidars of the same copies are due."""
+        kept = self._lidar_due
+        if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols):
+            return kept[2]
+        out = []
+        for col in sorted(set(cols.tolist())):
+            lid = self.lidar[col]
+            c = copies[cols == col]
+            W = len(lid._dir_columns[0])
+            ray_copy, mount = self._lidar_rows(col, c, W)
+            t_far = lid._t_far if not isinstance(lid._t_far, np.ndarray) else np.tile(lid._t_far.reshape(-1), len(c))
+            every = len(c) == self.copies and bool((c == np.arange(len(c))).all())
+            out.append((col, c, ray_copy, mount, t_far, every))
+        self._lidar_due = (copies.copy(), cols.copy(), out)
+        return out
 
     def _lidar_buffers(self, col: int, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The beam origins, directions and float32 directions of lidar ``col``'s scans this step,
@@ -1051,7 +1173,7 @@ class BatchedSimulation:
         return got
 
     def _finish_lidar(self, state: dict, hits: list[RayHits]) -> None:
-        for (col, c), h in zip(state["items"], hits):
+        for (col, c, every), h in zip(state["items"], hits):
             lid = self.lidar[col]
             L, W = lid.config.number_of_layers, lid.config.horizontal_resolution
             dist = h.distance.reshape(len(c), L, W)
@@ -1063,8 +1185,7 @@ class BatchedSimulation:
                 for k, cc in enumerate(c.tolist()):
                     stream = _Stream(self.noise, cc, nc)
                     img[cc] = lmath.ranges_from_hits(lid.params, dist[k], lid._all_dirs, stream)  # type: ignore[arg-type]
-            elif lid._factor is None and lid.params.resolution == RESOLUTION_OFF and (
-                    len(c) == len(img) and (c == np.arange(len(c))).all()):
+            elif lid._factor is None and lid.params.resolution == RESOLUTION_OFF and every:
                 # every copy scanned, nothing moves a value, cylindrical: the whole image in one C
                 # pass where the helper is (ranges_from_hits' bits, as the single Lidar.finish)
                 if not packets.lidar_scan(np.ascontiguousarray(dist, dtype=np.float64).reshape(-1),
