@@ -58,9 +58,10 @@ def test_images_are_not_observed_unless_named():
 
 
 def test_the_auto_engine_runs_image_tasks_on_the_simulation_with_the_same_episodes():
-    """The batched engine does not simulate cameras and range finders: engine="auto" (the PettingZoo
-    env's default) runs such a task on the rebuilt Simulation, giving engine="simulation"'s episode
-    bit for bit; engine="batched" and the batched vector env refuse it in one line saying what to use."""
+    """The batched engine does not simulate cameras: engine="auto" (the PettingZoo env's default)
+    runs a task observing one on the rebuilt Simulation, giving engine="simulation"'s episode bit for
+    bit; engine="batched" and the batched vector env refuse it in one line saying what to use. A
+    range finder alone runs batched (tests/test_batched_depth.py)."""
     from sensorium.gym import SensoriumParallelEnv
     from sensorium.gym.vector import SensoriumVectorEnv
     from sensorium.server.sim.batched import BatchedError
@@ -79,17 +80,17 @@ def test_the_auto_engine_runs_image_tasks_on_the_simulation_with_the_same_episod
             b, rb, *_ = ref.step(act)
             assert ra == rb
     assert SensoriumParallelEnv(world(), {"bot": task}).engine == "simulation"
-    for name, kind in (("cam", "Camera"), ("depth", "RangeFinder")):
-        one = Task(robot="bot", observations=[name])
-        with pytest.raises(BatchedError, match=rf"^robot 'bot': device '{name}' is a {kind}; the batched simulation "
-                                               r"measures .* \(use Simulation\)$"):
-            SensoriumEnv(world(), one, engine="batched")
-        with pytest.raises(BatchedError) as e:
-            SensoriumVectorEnv(world(), one, 2)
-        assert str(e.value) == (f"robot 'bot': device '{name}' is a {kind}; the batched simulation measures "
-                                "LightSensor, DistanceSensor, Lidar, PositionSensor, GPS, Compass, InertialUnit: the "
-                                "batched vector environment "
-                                "cannot run this task (SensoriumEnv can: gymnasium.vector.SyncVectorEnv or "
-                                "AsyncVectorEnv of it)")
+    one = Task(robot="bot", observations=["cam"])
+    with pytest.raises(BatchedError, match=r"^robot 'bot': device 'cam' is a Camera; the batched simulation "
+                                           r"measures .* \(use Simulation\)$"):
+        SensoriumEnv(world(), one, engine="batched")
+    with pytest.raises(BatchedError) as e:
+        SensoriumVectorEnv(world(), one, 2)
+    assert str(e.value) == ("robot 'bot': device 'cam' is a Camera; the batched simulation measures "
+                            "LightSensor, DistanceSensor, Lidar, PositionSensor, GPS, Compass, InertialUnit, "
+                            "RangeFinder: the batched vector environment "
+                            "cannot run this task (SensoriumEnv can: gymnasium.vector.SyncVectorEnv or "
+                            "AsyncVectorEnv of it)")
+    assert SensoriumEnv(world(), Task(robot="bot", observations=["depth", "ds"]), engine="auto").engine == "batched"
     # the same robot observed without its images runs batched (its camera is never computed)
     assert SensoriumEnv(world(), Task(robot="bot", observations=["ds"]), engine="auto").engine == "batched"

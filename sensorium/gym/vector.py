@@ -56,6 +56,9 @@ from sensorium.server.world.loader import LoadedWorld
 
 __all__ = ["SensoriumVectorEnv", "SubEnv"]
 
+RANGE_IMAGES = ("Lidar", "RangeFinder")
+"""The observed kinds whose observation is a range image (``sim.range_image``), not ``sim.values``."""
+
 
 class _PerCopy(VectorGoal):
     """A reward/termination callable without a vectorised form: called once per copy with views."""
@@ -211,7 +214,7 @@ class SensoriumVectorEnv(VectorEnv):
         groups: dict[str, list] = {}
         for name, box in self.agent.dict_space.spaces.items():
             ref = self.refs[name]
-            if ref.kind != "Lidar":
+            if ref.kind not in RANGE_IMAGES:
                 low, high = (box.low[0], box.high[0]) if box.shape == (1,) else (box.low, box.high)
                 groups.setdefault(ref.kind, []).append((name, ref.column, missing_fill(low), low, high))
         return [(kind, [g[0] for g in items], np.array([g[1] for g in items], dtype=np.int64),
@@ -228,7 +231,7 @@ class SensoriumVectorEnv(VectorEnv):
         clips against two numbers (tests/test_gym_vector.py compares the two bit for bit)."""
         out = {}
         for name, box in self.agent.dict_space.spaces.items():
-            if self.refs[name].kind != "Lidar":
+            if self.refs[name].kind not in RANGE_IMAGES:
                 continue
             low, high = np.asarray(box.low, dtype=np.float32), np.asarray(box.high, dtype=np.float32)
             lo, hi = low.flat[0], high.flat[0]

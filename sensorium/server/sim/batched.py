@@ -18,11 +18,11 @@ Copy ``c`` reproduces :class:`~sensorium.server.sim.simulation.Simulation` built
 with copy c's seed, bit for bit, for what it simulates: the drive (the same float64 arc, the same
 3x3 products), kinematic contact (the same broad phase per copy, the same narrow phase), light
 sensors, distance sensors, fixed lidars, wheel encoders, GPS (local coordinates), compasses and
-inertial units (batched_kinematic.py), each device's noise drawn from its own
-stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in the same
+inertial units (batched_kinematic.py), range finders (batched_depth.py), each device's noise drawn
+from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in the same
 order). Tests compare it with the single simulation step by step.
 
-Not simulated here (use :class:`Simulation`): rotating lidars, cameras and range finders, a GPS in a
+Not simulated here (use :class:`Simulation`): rotating lidars, cameras, a GPS in a
 WGS84 world, gyros, accelerometers, altimeters, the kinds without an observation (LEDs, pens, ...),
 lights carried by robots, textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
@@ -45,6 +45,7 @@ from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
+from sensorium.server.sim import batched_depth as depth
 from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
@@ -60,7 +61,7 @@ from sensorium.server.world.poses import moved_pose, pose_from_model
 
 __all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS", "check_observable"]
 
-SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", *kin.KINDS)
+SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", *kin.KINDS, *depth.KINDS)
 _TWO_PI = 2.0 * math.pi
 
 
@@ -303,9 +304,9 @@ class BatchedSimulation:
         self.lidar: list[Lidar] = []
         self.position: list[PositionSensor] = []
         lists: dict[str, list] = {"LightSensor": self.light, "DistanceSensor": self.distance, "Lidar": self.lidar,
-                                  "PositionSensor": self.position, **{k: [] for k in kin.KINDS}}
+                                  "PositionSensor": self.position, **{k: [] for k in (*kin.KINDS, *depth.KINDS)}}
         classes = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar,
-                   "PositionSensor": PositionSensor, **kin.CLASSES}
+                   "PositionSensor": PositionSensor, **kin.CLASSES, **depth.CLASSES}
         self._lists = lists
         for slot, r in enumerate(self.world.robots):
             for d in r.devices:
@@ -344,9 +345,11 @@ class BatchedSimulation:
         self._enabled = dict.fromkeys(lists, False)
         self.last = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
         self.values = {k: np.full((C, len(v), *kin.SHAPES.get(k, ())), math.nan) for k, v in lists.items()
-                       if k != "Lidar"}
+                       if k not in ("Lidar", *depth.KINDS)}
         # GPS, Compass, InertialUnit (batched_kinematic.py): their constants and their state beyond values
         self.kinematic = kin.KinematicDevices(self, lists)
+        # range finders (batched_depth.py): their pixel rays' constants, every copy's images
+        self.depth = depth.DepthDevices(self, lists["RangeFinder"])
         for lid in self.lidar:
             if lid.rotating:
                 continue
@@ -448,7 +451,10 @@ class BatchedSimulation:
         return self.kinematic.reading(ref.kind, ref.column, what)
 
     def range_image(self, ref: DeviceRef) -> np.ndarray:
-        """A lidar's latest range images in every copy: (copies, layers, width) float32."""
+        """A lidar's latest range images in every copy, (copies, layers, width) float32, or a range
+        finder's, (copies, height, width) float32."""
+        if ref.kind in depth.KINDS:
+            return self.depth.images[ref.column]
         return self.range_images[ref.column]
 
     # ------------------------------------------------------------------ control
@@ -483,6 +489,7 @@ class BatchedSimulation:
         for img in self.range_images:
             img[idx] = 0.0
         self.kinematic.reset(idx)
+        self.depth.reset(idx)
         self.noise.reseed(idx.tolist(), world_seeds)
         self.counters["resets"] += len(idx)
 
@@ -841,6 +848,10 @@ class BatchedSimulation:
             ic, icol = self._due("Lidar", live)
             if len(ic):
                 work.append(("lidar", self._plan_lidars(ic, icol)))
+        if self.depth.devices:
+            rc, rcol = self._due("RangeFinder", live)
+            if len(rc):
+                work.append(("depth", self.depth.plan(rc, rcol)))
         if not work:
             return
         # one cast per (ray kind, transparency rule, distance only), every copy's rays together
@@ -1195,6 +1206,9 @@ class BatchedSimulation:
                 img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
             self.last["Lidar"][c, col] = self.time_ms[c]
             self.counters["measurements"] += len(c)
+
+    def _finish_depth(self, state: dict, hits: list[RayHits]) -> None:
+        self.depth.finish(state, hits)
 
     # ------------------------------------------------------------------ tasks
     def cast(self, copies: np.ndarray, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,

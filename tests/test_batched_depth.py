@@ -1,0 +1,265 @@
+"""RangeFinders in the batched simulation (sensorium/server/sim/batched_depth.py): every copy's depth
+images bit-identical to the single Simulation with its seed (noise included), closed-form depths,
+copies blind to each other's robots, the noise streams' draws, the vector environment observing
+them, and cameras still refused."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices.noise import device_rng
+from sensorium.server.sim import batched_depth
+from sensorium.server.sim.batched import BatchedError, BatchedSimulation, NoiseStreams
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, load_world
+
+WORLD = Path(__file__).parent / "worlds" / "depth.yaml"
+PERIODS = {"rover": {"depth": 32, "wide": 16, "housed": 48}, "scout": {"eye": 16}}
+BOTH = ["fast", "exact"]
+
+
+def _world(seed: int) -> LoadedWorld:
+    lw = load_world(WORLD)
+    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
+    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+
+
+def _drive(sim: Simulation, robot: str, left: float, right: float) -> None:
+    for m in sim.robot(robot).motors.values():
+        m.set_position(math.inf)
+    sim.robot(robot).drive.left.set_velocity(left)
+    sim.robot(robot).drive.right.set_velocity(right)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_every_copy_captures_its_range_finders_as_the_single_simulation(precision: str):
+    """Two robots driving among a wall, a post and a crate with random per-copy wheel commands;
+    range finders planar (noise, resolution, min_range, near), cylindrical (noise, tilted), spherical
+    (resolution) and one housed in a box of its own, at different periods; a reset of one copy with
+    a new seed on the way: after every basic step every image of every copy equals that of a
+    Simulation built with that copy's seed, bit for bit (zeros before the first capture, +inf for
+    no hit)."""
+    seeds = [5, 6, 7]
+    bs = BatchedSimulation(_world(0), len(seeds), precision=precision)
+    bs.reset(np.arange(len(seeds)), seeds)
+    sims = [Simulation(_world(s), precision=precision) for s in seeds]
+
+    def enable(copy: int) -> None:
+        for robot, names in PERIODS.items():
+            for n, p in names.items():
+                bs.enable(bs.device(robot, n), p, copies=[copy])
+                sims[copy].robot(robot).device(n).enable(p)
+
+    for c in range(len(seeds)):
+        enable(c)
+    rng = np.random.default_rng(1)
+    seen = {"inf": 0, "finite": 0, "zeros": 0, "near": 0}
+    for step in range(90):
+        if step % 10 == 0:
+            for robot in PERIODS:
+                slot = bs.slot(robot)
+                vmax = 0.3 * float(bs.max_wheel[slot, 0])
+                lr = rng.uniform(-vmax, vmax, (len(seeds), 2))
+                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
+                for c, s in enumerate(sims):
+                    _drive(s, robot, float(lr[c, 0]), float(lr[c, 1]))
+        if step == 50:                          # copy 1 as a new world with another seed
+            bs.reset([1], [42])
+            sims[1] = Simulation(_world(42), precision=precision)
+            enable(1)
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot, names in PERIODS.items():
+                for n in names:
+                    want = s.robot(robot).device(n).range_image
+                    got = bs.range_image(bs.device(robot, n))[c]
+                    assert got.dtype == np.float32 and got.shape == want.shape
+                    assert want.tobytes() == got.tobytes(), (step, c, robot, n)
+                    seen["inf"] += int(np.isinf(got).any())
+                    seen["finite"] += int(np.isfinite(got).any())
+                    seen["zeros"] += int(not got.any())
+            seen["near"] += int((bs.range_image(bs.device("rover", "wide"))[c] < 0.05).any())   # its own robot
+    assert seen["inf"] > 100 and seen["finite"] > 100 and seen["zeros"] > 0 and seen["near"] > 0
+    # the noise is each copy's own: the same device's images differ between copies
+    depth = bs.range_image(bs.device("rover", "depth"))
+    assert len({img.tobytes() for img in depth}) == len(seeds)
+
+
+def _facing(d: list[float], projection: str, noise: float = 0.0) -> wm.World:
+    """A robot without a body whose range finder (11 x 5 pixels, at the robot's origin, 0.1 m up)
+    faces a wide wall whose face is the plane x = 2."""
+    dev = {"device": "RangeFinder", "name": "rf", "pose": {"translation": [0.0, 0.0, 0.1]}, "width": 11, "height": 5,
+           "field_of_view": 1.0, "projection": projection, "min_range": 0.01, "max_range": 5.0, "noise": noise}
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 8, "contact": False},
+        "solids": [{"name": "wall", "pose": {"translation": [2.5, 0.0, 0.0]},
+                    "geometry": {"type": "box", "size": [1.0, 40.0, 40.0]}}],
+        "robots": [{"name": "bot", "pose": {"translation": [2.0 - d[0], 0.0, 0.0]},
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 10.0},
+                    "devices": [dev]}]})
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_range_finder_facing_a_wall_reads_the_closed_form_depths(precision: str):
+    """Copy c stands d_c from a wall, facing it. Planar: every pixel reads the depth d_c (the distance
+    to the device's image plane). Cylindrical: the distance along the ray, d_c / cos(a_j) along the
+    middle row (elevation 0), a_j = (1/2 - (j + 1/2)/W) fov the column's azimuth."""
+    d = [0.5, 1.0, 1.7, 3.2]
+    tol = 2e-7 if precision == "exact" else 2e-6
+    for projection in ("planar", "cylindrical"):
+        bs = BatchedSimulation(LoadedWorld(world=_facing(d, projection), source="<test>", base_dir=Path.cwd()),
+                               len(d), precision=precision)
+        for c, dc in enumerate(d):
+            bs.set_pose(c, 0, translation=[2.0 - dc, 0.0, 0.0])
+        ref = bs.device("bot", "rf")
+        bs.enable(ref, 8)
+        assert not bs.range_image(ref).any()                      # zeros before the first image (Webots)
+        bs.step()
+        img = bs.range_image(ref).astype(np.float64)
+        for c, dc in enumerate(d):
+            if projection == "planar":
+                np.testing.assert_allclose(img[c], dc, rtol=tol)
+            else:
+                a = (0.5 - (np.arange(11) + 0.5) / 11) * 1.0
+                np.testing.assert_allclose(img[c, 2], dc / np.cos(a), rtol=tol)
+                assert (img[c, 0] > img[c, 2]).all()               # rows above look up: farther
+
+
+def test_copies_never_see_each_others_robots():
+    """The scout parked 0.5 m in front of the rover in copy 0, and off to a corner in
+    copy 1 (both copies with world seed 0): each copy's images are those of a Simulation with its
+    scout where that copy has it, bit for bit, and copy 0's show the scout (near pixels) where copy
+    1's, with the same noise, do not -- copy 1's rover does not see copy 0's scout."""
+    lw = _world(0)
+    bs = BatchedSimulation(lw, 2, precision="exact")
+    bs.reset([0, 1], [0, 0])
+    rover = bs.pose(0, bs.slot("rover"))
+    fwd = rover.rotation[:, 0]
+    ahead = rover.translation + 0.5 * fwd
+    places = [([float(ahead[0]), float(ahead[1]), 0.0], [0, 0, 1, math.atan2(fwd[1], fwd[0])]),
+              ([-1.5, 1.5, 0.0], [0, 0, 1, 0.0])]
+    names = ("depth", "wide", "housed")
+    singles = []
+    for c, (t, r) in enumerate(places):
+        bs.set_pose(c, bs.slot("scout"), translation=t, rotation=r)
+        single = Simulation(lw, precision="exact")
+        single.robot("scout").set_pose(t, r)
+        for n in names:
+            single.robot("rover").device(n).enable(16)
+        singles.append(single)
+    for n in names:
+        bs.enable(bs.device("rover", n), 16)
+    for _ in range(3):
+        bs.step()
+        for c, single in enumerate(singles):
+            single.step()
+            for n in names:
+                got = bs.range_image(bs.device("rover", n))[c]
+                assert got.tobytes() == single.robot("rover").device(n).range_image.tobytes(), (c, n)
+    # the noiseless housed device: the pixels on copy 0's scout (its near face 0.33 m ahead) read
+    # nearer than copy 1's (the floor there), every other pixel the same
+    img = bs.range_image(bs.device("rover", "housed"))
+    differ = img[0] != img[1]
+    assert differ.sum() >= 4 and (img[0][differ] < 0.35).all() and (img[1][differ] > img[0][differ] + 0.1).all()
+
+
+def test_noise_draws_continue_each_stream_in_order_whatever_the_block_sizes():
+    """An image draws one normal per valid pixel: batched_depth.draw takes what the bank buffered,
+    then the rest straight from the stream, leaving the bank to go on from there -- the same numbers,
+    in the same order, as one generator drawing them all, with single draws (NoiseStreams.next) and
+    block refills in between, and after a reseed the stream from its start again."""
+    bank = NoiseStreams(2, ["r/a", "r/b"], block=64)
+    bank.reseed([0, 1], [11, 12])
+    ref = {(c, d): device_rng(11 + c, p) for c in (0, 1) for d, p in enumerate(["r/a", "r/b"])}
+    got: dict = {k: [] for k in ref}
+    for size in (1, 3, 200, 0, 61, 64, 1, 500, 2):
+        for (c, d) in ref:
+            if size == 1:
+                got[(c, d)].append(bank.next(np.array([c]), np.array([d])))
+            else:
+                got[(c, d)].append(batched_depth.draw(bank, c, d, size))
+    for k, rng in ref.items():
+        seq = np.concatenate(got[k])
+        assert seq.tobytes() == rng.standard_normal(len(seq)).tobytes(), k
+    bank.reseed([1], [12])
+    assert batched_depth.draw(bank, 1, 0, 100).tobytes() == device_rng(12, "r/a").standard_normal(100).tobytes()
+
+
+gym = pytest.importorskip("gymnasium")
+
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+
+from sensorium.gym import SensoriumEnv, Task  # noqa: E402
+from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
+
+OBSERVED = {"depth": 32, "wide": 32}
+
+
+def _task() -> Task:
+    return Task(robot="rover", observations=OBSERVED, control_period_ms=32, max_steps=20)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_the_vector_env_observes_range_finders_as_the_single_env(precision: str):
+    """A task observing a noisy planar and a noisy cylindrical range finder: float32 (height, width)
+    boxes in [0, max_range]; every sub-env equals the single env (rebuilt Simulation, and the one-copy
+    batched engine, which "auto" now picks) with its seed, observations, rewards and poses bit for
+    bit, across autoresets; "no hit" reads max_range; a sub-env passes Gymnasium's checker."""
+    n = 3
+    venv = SensoriumVectorEnv(WORLD, _task(), n, precision=precision)
+    space = venv.single_observation_space
+    assert space["depth"].shape == (12, 16) and space["wide"].shape == (6, 24)
+    assert space["depth"].dtype == np.float32 and space["depth"].high.max() == np.float32(2.5)
+    singles = [SensoriumEnv(WORLD, _task(), precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
+    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
+    obs, _ = venv.reset(seed=4)
+    for i, env in enumerate(singles):
+        o, _ = env.reset(seed=4 + i)
+        assert all(o[k].tobytes() == obs[k][i].tobytes() for k in OBSERVED), i
+    assert (obs["depth"] == np.float32(2.5)).any() and (obs["depth"] < 2.5).any()   # no hit: max_range
+    rng = np.random.default_rng(5)
+    done = np.zeros(n, dtype=bool)
+    ended = 0
+    for t in range(45):
+        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        vobs, vr, vte, vtr, vinfo = venv.step(a)
+        for i, env in enumerate(singles):
+            if done[i]:
+                o, r, te, tr = env.reset()[0], 0.0, False, False
+                ended += 1
+            else:
+                o, r, te, tr, inf = env.step(a[i])
+                assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
+            assert all(o[k].tobytes() == vobs[k][i].tobytes() for k in OBSERVED), (t, i)
+            assert (r, te, tr) == (vr[i], vte[i], vtr[i])
+            done[i] = te or tr
+        assert all(space[k].contains(vobs[k][0]) for k in OBSERVED)
+    assert ended >= n                                           # autoresets happened
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(venv.sub_env(1), skip_render_check=True)
+    venv.close()
+
+
+def test_a_camera_stays_refused_in_one_line():
+    lw = load_world(WORLD)
+    data = lw.world.model_dump(mode="json", exclude_none=True)
+    data["robots"][0]["devices"].append({"device": "Camera", "name": "cam", "width": 8, "height": 6})
+    world = LoadedWorld(world=wm.World.model_validate(data), source=lw.source, base_dir=lw.base_dir)
+    with pytest.raises(BatchedError) as e:
+        SensoriumVectorEnv(world, Task(robot="rover", observations=["depth", "cam"]), 2)
+    msg = str(e.value)
+    assert "\n" not in msg and msg.startswith("robot 'rover': device 'cam' is a Camera; the batched simulation "
+                                              "measures ") and "RangeFinder" in msg and "SensoriumEnv can" in msg
+    bs = BatchedSimulation(world, 2)
+    with pytest.raises(BatchedError, match=r"device 'cam' is a Camera; .* \(use Simulation\)$"):
+        bs.device("rover", "cam")
+    assert bs.device("rover", "depth").kind == "RangeFinder"
+    assert SensoriumEnv(world, Task(robot="rover", observations=["depth", "cam"]), engine="auto").engine == "simulation"
