@@ -87,7 +87,8 @@ def test_the_auto_engine_runs_image_tasks_on_the_simulation_with_the_same_episod
         with pytest.raises(BatchedError) as e:
             SensoriumVectorEnv(world(), one, 2)
         assert str(e.value) == (f"robot 'bot': device '{name}' is a {kind}; the batched simulation measures "
-                                "LightSensor, DistanceSensor, Lidar, PositionSensor, GPS, Compass, InertialUnit: the "
+                                "LightSensor, DistanceSensor, Lidar, PositionSensor, GPS, Compass, InertialUnit, Gyro, "
+                                "Accelerometer: the "
                                 "batched vector environment "
                                 "cannot run this task (SensoriumEnv can: gymnasium.vector.SyncVectorEnv or "
                                 "AsyncVectorEnv of it)")
