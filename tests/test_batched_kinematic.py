@@ -1,6 +1,7 @@
-"""GPS, Compass and InertialUnit in the batched simulation (sensorium/server/sim/batched_kinematic.py):
-every copy bit-identical to the single Simulation with its seed, closed-form readings, the vector
-environment observing them, and what stays refused."""
+"""GPS, Compass, InertialUnit, Gyro and Accelerometer in the batched simulation
+(sensorium/server/sim/batched_kinematic.py): every copy bit-identical to the single Simulation with its
+seed (with the C helper and without it), closed-form readings, the C passes against the ``math`` path,
+the vector environment observing them, and what stays refused."""
 
 from __future__ import annotations
 
@@ -12,7 +13,9 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
+from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
+from sensorium.server.raycast import packets
 from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_observable
 from sensorium.server.sim.simulation import Simulation
@@ -21,8 +24,8 @@ from sensorium.server.world.poses import matrix_quaternion, quaternion_matrix
 
 WORLD = Path(__file__).parent / "worlds" / "kinematic.yaml"
 PERIODS = {"rover": {"gps": 48, "plain_gps": 16, "compass": 32, "plain_compass": 16, "imu": 48, "flat_imu": 16,
-                     "plain_imu": 16},
-           "scout": {"gps": 32, "compass": 16, "imu": 16}}
+                     "plain_imu": 16, "gyro": 16, "plain_gyro": 32, "acc": 16, "plain_acc": 48},
+           "scout": {"gps": 32, "compass": 16, "imu": 16, "gyro": 16, "acc": 32}}
 
 
 def _world(seed: int) -> LoadedWorld:
@@ -45,13 +48,27 @@ def _drive(sim: Simulation, robot: str, left: float, right: float) -> None:
     sim.robot(robot).drive.right.set_velocity(right)
 
 
-def test_every_copy_reads_its_gps_compasses_and_inertial_units_as_the_single_simulation():
+@pytest.fixture(params=["helper", "math"])
+def native(request, monkeypatch):
+    """The batched kinematic passes in C (the packets helper) or, with ``SENSORIUM_PACKETS=0``, their
+    ``math`` fallback."""
+    if request.param == "math":
+        monkeypatch.setattr(packets, "_state", {})
+        monkeypatch.setenv("SENSORIUM_PACKETS", "0")
+        assert packets.library() is None
+    elif packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    return request.param
+
+
+def test_every_copy_reads_its_kinematic_devices_as_the_single_simulation(native):
     """Two robots driving on a floor and a ramp with random, per-copy wheel commands; GPS with
     Gauss-Markov noise, speed noise and resolutions, compasses with noisy lookup tables and a
-    disabled axis, inertial units with noise, resolution, disabled axes and tilted mounts, at
-    different periods; a supervisor move and a reset with a new seed on the way: after every basic
-    step every reading of every copy equals that of a Simulation built with that copy's seed, bit
-    for bit (NaNs and signed zeros included)."""
+    disabled axis, inertial units with noise, resolution, disabled axes and tilted mounts, gyros
+    and accelerometers with noisy tables, resolutions, disabled axes, tilted and offset mounts, at
+    different periods; a supervisor move, a re-enable and a reset with a new seed on the way: after
+    every basic step every reading of every copy equals that of a Simulation built with that copy's
+    seed, bit for bit (NaNs and signed zeros included), with the C helper and without it."""
     seeds = [5, 6, 7, 8]
     bs = BatchedSimulation(_world(0), len(seeds))
     bs.reset(np.arange(len(seeds)), seeds)
@@ -66,7 +83,7 @@ def test_every_copy_reads_its_gps_compasses_and_inertial_units_as_the_single_sim
     for c in range(len(seeds)):
         enable(c)
     rng = np.random.default_rng(0)
-    seen = {"tilted": 0, "nan": 0, "speed": 0}
+    seen = {"tilted": 0, "nan": 0, "speed": 0, "turn": 0, "jolt": 0}
     for step in range(160):
         if step % 10 == 0:
             for robot in PERIODS:
@@ -83,6 +100,10 @@ def test_every_copy_reads_its_gps_compasses_and_inertial_units_as_the_single_sim
             bs.reset([1], [42])
             sims[1] = Simulation(_world(42))
             enable(1)
+        if step == 120:                         # copy 3's gyro and accelerometer start their poses over
+            for n, p in (("acc", 32), ("gyro", 48)):
+                bs.enable(bs.device("scout", n), p, copies=[3])
+                sims[3].robot("scout").device(n).enable(p)
         bs.step()
         for c, s in enumerate(sims):
             s.step()
@@ -94,7 +115,10 @@ def test_every_copy_reads_its_gps_compasses_and_inertial_units_as_the_single_sim
                         assert want.tobytes() == got.tobytes(), (step, c, robot, n, what, want, got)
                         seen["nan"] += int(np.isnan(got).any())
             seen["speed"] += math.isfinite(s.robot("rover").device("gps").speed)
-    assert seen["tilted"] > 50 and seen["nan"] > 0 and seen["speed"] > 100    # ramps, disabled axes, speeds
+            seen["turn"] += bool(abs(s.robot("rover").device("plain_gyro").values[2]) > 1.0)
+            seen["jolt"] += bool(abs(s.robot("rover").device("plain_acc").values[0]) > 1.0)
+    # ramps, disabled axes, speeds, turns and accelerations (wheel changes, the move, the reset)
+    assert seen["tilted"] > 50 and seen["nan"] > 0 and seen["speed"] > 100 and seen["turn"] > 100 and seen["jolt"] > 3
     # the noise is each copy's own: the same device reads differently in different copies
     gps = bs.value(bs.device("scout", "gps"))
     assert len({row.tobytes() for row in gps}) == len(seeds)
@@ -194,13 +218,118 @@ class _Replay:
         return self.values.copy()
 
 
+def _spinner(gravity: float = 9.81) -> wm.World:
+    """A robot on a flat floor with a gyro and an accelerometer at its centre, a gyro tilted on its
+    mount and an accelerometer 5 cm ahead of the centre (no noise, no table)."""
+    devices = [{"device": "Gyro", "name": "gyro"}, {"device": "Accelerometer", "name": "acc"},
+               {"device": "Gyro", "name": "tilted_gyro", "pose": {"rotation": [1, 0, 0, math.pi / 2]}},
+               {"device": "Accelerometer", "name": "ahead", "pose": {"translation": [0.05, 0.0, 0.0]}}]
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 8, "gravity": gravity, "contact": False},
+        "solids": [{"name": "floor", "geometry": {"type": "plane", "size": [10.0, 10.0]}}],
+        "robots": [{"name": "bot", "pose": {"translation": [0.5, -0.2, 0.0], "rotation": [0, 0, 1, 0.4]},
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 10.0},
+                    "devices": devices}]})
+
+
+def test_a_robot_turning_in_place_reads_its_rate_and_at_rest_reads_gravity():
+    """Copy c turns in place at ω_c = r·2u/axle (wheels -u, +u): the gyro reads (0, 0, ω) (x and y
+    exactly 0, z to the model's rounding), the gyro turned a quarter about x (its y axis is the world's
+    up) reads (0, ω, 0) up to rounding; the accelerometer at the
+    centre reads (0, 0, g), the one 5 cm ahead the second difference of a circle, 2r(cos δ - 1)/dt²
+    along (cos δ, -sin δ) in its frame (δ = ω·dt), plus g on z. At rest both read (0, 0, g) exactly,
+    g the world's gravity (3.71 here); the first reading after enable assumes rest."""
+    speeds = [0.0, 1.0, -2.5, 6.0]
+    bs = BatchedSimulation(_world_model_loaded(_spinner(3.71)), len(speeds))
+    for name in ("gyro", "acc", "tilted_gyro", "ahead"):
+        bs.enable(bs.device("bot", name), 8)
+    u = np.array(speeds)
+    bs.set_wheels(0, -u, u)
+    bs.step()
+    for name in ("acc", "ahead"):                      # one pose after enable: rest
+        assert bs.value(bs.device("bot", name)).tolist() == [[0.0, 0.0, 3.71]] * len(speeds)
+    dt = 0.008
+    for _ in range(5):
+        bs.step()
+        omega = 0.05 * 2.0 * u / 0.2
+        gyro = bs.value(bs.device("bot", "gyro"))
+        assert (gyro[:, :2] == 0.0).all() and gyro[0].tolist() == [0.0, 0.0, 0.0]
+        np.testing.assert_allclose(gyro[:, 2], omega, rtol=1e-9, atol=0)
+        np.testing.assert_allclose(bs.value(bs.device("bot", "tilted_gyro")),
+                                   np.stack([0 * omega, omega, 0 * omega], axis=1), rtol=0, atol=1e-9)
+        assert bs.value(bs.device("bot", "acc")).tolist() == [[0.0, 0.0, 3.71]] * len(speeds)
+        d = omega * dt
+        k = 2.0 * 0.05 * (np.cos(d) - 1.0) / dt ** 2
+        want = np.stack([k * np.cos(d), -k * np.sin(d), np.full(len(d), 3.71)], axis=1)
+        np.testing.assert_allclose(bs.value(bs.device("bot", "ahead")), want, rtol=0, atol=1e-9)
+    # ≈ -ω²r towards the centre: 3 rad/s at 5 cm, a real centripetal pull (not a rounding residue)
+    assert bs.value(bs.device("bot", "ahead"))[3, 0] == pytest.approx(-3.0 ** 2 * 0.05, rel=1e-3)
+    sim = Simulation(_world_model_loaded(_spinner()))                  # the single model agrees at rest
+    acc = sim.robot("bot").device("acc")
+    acc.enable(8)
+    sim.run(4)
+    assert acc.values.tolist() == [0.0, 0.0, 9.81]
+
+
+def _rotation_pairs(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation pairs: random, equal, turned by tiny angles (below and above 1e-6 rad), by about
+    and exactly half a turn, about each axis."""
+    a = _rotations(800, rng)
+    b = _rotations(800, rng)
+    pairs = [(a, b), (a, a.copy())]
+    for angle in (1e-9, 5e-7, 2e-6, 1e-3, 0.5, math.pi - 1e-7, math.pi):
+        axes = rng.standard_normal((len(a), 3))
+        turn = np.array([quaternion_matrix([*(ax / np.linalg.norm(ax) * math.sin(angle / 2)), math.cos(angle / 2)])
+                         for ax in axes])
+        pairs.append((a, np.matmul(a, turn)))
+    return np.concatenate([p[0] for p in pairs]), np.concatenate([p[1] for p in pairs])
+
+
+def test_the_c_passes_are_the_math_path_and_the_single_models_bit_for_bit():
+    """The helper's passes (packets.c, batched kinematic devices) against the ``math`` fallback and
+    the single models element by element: the gyro's rate of every rotation pair (equal, tiny,
+    large and half turns), roll/pitch/yaw in both conventions, the inertial unit's noise and
+    disabled-axis turns, the GPS correlation ratios (0, 1, a zero exponent included)."""
+    if packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    rng = np.random.default_rng(11)
+    r0, r1 = _rotation_pairs(rng)
+    got = kin.angular_velocities(r0, r1, 0.016)
+    assert got.tobytes() == kin.angular_velocities(r0, r1, 0.016, native=False).tobytes()
+    assert got.tobytes() == np.array([motion_math.angular_velocity(a, b, 0.016) for a, b in zip(r0, r1)]).tobytes()
+    assert (np.abs(got).max(axis=1) == 0.0).sum() >= 800                 # the equal pairs read 0
+    q = kin.matrix_quaternions(_rotations(2000, rng))
+    k = len(q)
+    noise = np.where(rng.random(k) < 0.5, 0.02, 0.0)
+    gauss = rng.standard_normal((k, 3))
+    x, y, z = (rng.random(k) < 0.6 for _ in range(3))
+    res = np.where(rng.random(k) < 0.3, 0.001, -1.0)
+    out = kin.inertial_quaternions(q, gauss, noise, x, y, z, res)
+    assert out.tobytes() == kin.inertial_quaternions(q, gauss, noise, x, y, z, res, native=False).tobytes()
+    for axes in ("ENU", "NUE"):
+        for quats in (q, out, np.array([[0.0, 0.0, 0.0, 1.0], [0.0, 0.7071067811865476, 0.0, 0.7071067811865476],
+                                        [math.nan, 0.0, 0.0, 1.0], [0.0, -0.0, -0.0, 1.0]])):
+            rpy = kin.roll_pitch_yaw(quats, axes)
+            assert rpy.tobytes() == kin.roll_pitch_yaw(quats, axes, native=False).tobytes()
+            assert rpy.tobytes() == np.array([orient.roll_pitch_yaw(v, axes) for v in quats]).tobytes()
+    corr = np.array([0.0, 1.0, 0.7, 0.7, 0.3, 1e-300, 0.999])
+    expo = np.array([0.032, 0.5, 0.0, 0.016, 2.5, 0.048, 1000.0])
+    ratios = kin.correlation_ratios(corr, expo)
+    assert ratios.tobytes() == kin.correlation_ratios(corr, expo, native=False).tobytes()
+    assert ratios[:3].tolist() == [0.0, 1.0, 1.0]
+    # inputs the Python way treats specially are left to it: the helper declines them
+    assert packets.half_angles(np.array([[math.inf, 0.0, 0.0, 1.0]])) is None
+    assert packets.correlation_ratios(np.array([-0.5]), np.array([1.0])) is None
+
+
 def test_what_stays_refused_is_said_in_one_line():
-    """A GPS in a WGS84 world, a gyro, an accelerometer: one line naming the device and why, when
-    asked for (device, check_observable) and before anything is built (the world-level check)."""
+    """A GPS in a WGS84 world, an altimeter: one line naming the device and why, when asked for
+    (device, check_observable) and before anything is built (the world-level check); gyros and
+    accelerometers are measured."""
     lw = load_world(WORLD)
     w = lw.world
     robots = [r.model_dump(mode="json", exclude_none=True) for r in w.robots]
-    robots[0]["devices"] += [{"device": "Gyro", "name": "gyro"}, {"device": "Accelerometer", "name": "acc"}]
+    robots[0]["devices"] += [{"device": "Altimeter", "name": "altimeter"}]
     wgs = wm.World.model_validate({**w.model_dump(mode="json", exclude_none=True), "robots": robots,
                                    "world_info": {**w.world_info.model_dump(mode="json"),
                                                   "gps_coordinate_system": "WGS84",
@@ -212,11 +341,12 @@ def test_what_stays_refused_is_said_in_one_line():
         assert str(e.value) == ("rover/gps: a GPS in a WGS84 world (world_info.gps_coordinate_system) is not "
                                 "simulated by the batched simulation, only local coordinates (use Simulation)")
     bs = BatchedSimulation(wgs, 2, base_dir=lw.base_dir)
-    assert bs.device("rover", "compass").kind == "Compass"       # the other kinds are measured there
-    for name, kind in (("gyro", "Gyro"), ("acc", "Accelerometer")):
-        with pytest.raises(BatchedError, match=f"device '{name}' is a {kind}; the batched simulation measures "
-                                               r".*GPS, Compass, InertialUnit(, [A-Za-z]+)* \(use Simulation\)$"):
-            bs.device("rover", name)
+    for name, kind in (("compass", "Compass"), ("gyro", "Gyro"), ("acc", "Accelerometer")):
+        assert bs.device("rover", name).kind == kind              # the other kinds are measured there
+    check_observable(wgs, "rover", ["compass", "gyro", "acc", "imu"])
+    with pytest.raises(BatchedError, match="device 'altimeter' is a Altimeter; the batched simulation measures "
+                                           r".*GPS, Compass, InertialUnit, Gyro, Accelerometer(, [A-Za-z]+)* \(use Simulation\)$"):
+        bs.device("rover", "altimeter")
 
 
 gym = pytest.importorskip("gymnasium")
@@ -226,7 +356,8 @@ from gymnasium.utils.env_checker import check_env  # noqa: E402
 from sensorium.gym import SensoriumEnv, Task  # noqa: E402
 from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
 
-OBSERVED = {"gps": 32, "compass": 16, "imu": 16, "flat_imu": 32}
+OBSERVED = {"gps": 32, "compass": 16, "imu": 16, "flat_imu": 32, "gyro": 16, "acc": 32, "plain_gyro": 16,
+            "plain_acc": 16}
 
 
 def _task() -> Task:
@@ -234,8 +365,10 @@ def _task() -> Task:
 
 
 def test_the_vector_env_observes_them_as_the_single_env_and_passes_the_checker():
-    """A task observing a noisy GPS, a compass with a table and a disabled axis and two inertial
-    units: (3,) float32 boxes; every sub-env of the vector env equals the single env (rebuilt
+    """A task observing a noisy GPS, a compass with a table and a disabled axis, two inertial units,
+    gyros and accelerometers with and without tables: (3,) float32 boxes (a table's output column;
+    without one, ±π/dt for a gyro and the world's coordinate limits' bound for an accelerometer);
+    every sub-env of the vector env equals the single env (rebuilt
     Simulation, and the one-copy batched engine) with its seed, observations and info bit for bit,
     across autoresets; a sub-env passes Gymnasium's checker without a warning."""
     n = 3
@@ -244,6 +377,9 @@ def test_the_vector_env_observes_them_as_the_single_env_and_passes_the_checker()
     assert {k: space[k].shape for k in OBSERVED} == dict.fromkeys(OBSERVED, (3,))
     assert space["imu"].high.tolist() == np.array([math.pi, math.pi / 2, math.pi], dtype=np.float32).tolist()
     assert space["compass"].low.tolist() == [-100.0] * 3 and space["compass"].high.tolist() == [100.0] * 3
+    assert space["gyro"].high.tolist() == [40.0] * 3 and space["acc"].low.tolist() == [-100.0] * 3
+    assert space["plain_gyro"].high.tolist() == [np.float32(math.pi / 0.016)] * 3
+    assert space["plain_acc"].low.tolist() == [np.float32(-(4 * math.sqrt(3) * 1e5 / 0.016 ** 2 + 9.81))] * 3
     singles = [SensoriumEnv(WORLD, _task(), engine=e) for e in ("simulation", "batched", "simulation")]
     assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
     obs, _ = venv.reset(seed=9)
@@ -251,6 +387,7 @@ def test_the_vector_env_observes_them_as_the_single_env_and_passes_the_checker()
         o, _ = env.reset(seed=9 + i)
         assert all(o[k].tobytes() == obs[k][i].tobytes() for k in OBSERVED), i
     assert obs["compass"][:, 1].tolist() == [-100.0] * n          # the disabled y axis: the box's low bound
+    assert obs["acc"][:, 1].tolist() == [-100.0] * n
     rng = np.random.default_rng(3)
     done = np.zeros(n, dtype=bool)
     ended = 0

@@ -88,7 +88,7 @@ def test_the_auto_engine_runs_image_tasks_on_the_simulation_with_the_same_episod
         SensoriumVectorEnv(world(), one, 2)
     assert str(e.value) == ("robot 'bot': device 'cam' is a Camera; the batched simulation measures "
                             "LightSensor, DistanceSensor, Lidar, PositionSensor, GPS, Compass, InertialUnit, "
-                            "RangeFinder: the batched vector environment "
+                            "Gyro, Accelerometer, RangeFinder: the batched vector environment "
                             "cannot run this task (SensoriumEnv can: gymnasium.vector.SyncVectorEnv or "
                             "AsyncVectorEnv of it)")
     assert SensoriumEnv(world(), Task(robot="bot", observations=["depth", "ds"]), engine="auto").engine == "batched"

@@ -9,8 +9,9 @@ or distance sensor is a float32 ``(1,)`` box bounded by its lookup table's outpu
 relative lookup noise is Gaussian and could leave it); a lidar is its float32 ``(layers,
 width)`` range image bounded by ``[0, max_range]``, with "no hit" (``inf`` in Webots) given as
 ``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians; a GPS its
-position, a compass its north vector, an inertial unit its roll, pitch, yaw: float32 ``(3,)`` boxes
-(:func:`_space`; a disabled axis's NaN reads the box's low bound, as any missing value); a camera
+position, a compass its north vector, an inertial unit its roll, pitch, yaw, a gyro its angular
+velocity, an accelerometer its specific force: float32 ``(3,)`` boxes (:func:`_space`; a disabled
+axis's NaN reads the box's low bound, as any missing value); a camera
 (only when named in ``Task.observations``: images are not observed by default) is a uint8
 ``(height, width, 3)`` RGB box, a range finder (likewise) its float32 ``(height, width)`` range image
 in ``[0, max_range]`` with "no hit" as ``max_range``.
@@ -199,11 +200,13 @@ class Agent:
 
 
 OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "GPS", "Compass", "InertialUnit",
-              "Camera", "RangeFinder")
+              "Gyro", "Accelerometer", "Camera", "RangeFinder")
 IMAGES = ("Camera", "RangeFinder")
-VECTOR_READINGS = {"GPS": "values", "Compass": "values", "InertialUnit": "roll_pitch_yaw"}
+VECTOR_READINGS = {"GPS": "values", "Compass": "values", "InertialUnit": "roll_pitch_yaw", "Gyro": "values",
+                   "Accelerometer": "values"}
 """The kinds observed as a float32 ``(3,)`` box, and the device reading each observes (a GPS its
-position, a compass its north vector, an inertial unit its roll, pitch, yaw)."""
+position, a compass its north vector, an inertial unit its roll, pitch, yaw, a gyro its angular
+velocity, an accelerometer its specific force)."""
 
 
 def missing_fill(low: np.ndarray) -> np.ndarray:
@@ -220,6 +223,17 @@ were identical, and 0.4 % of LidarAvoid's lidar ranges differed by more than 1 m
 edges, where float32 traversal can slip between triangles; 45 % differed by float32 rounding,
 < 1e-5 m). Pass ``precision="exact"`` for Webots-exact rays."""
 ACTION_MODES = ("normalized", "wheel")
+
+
+def motion_bound(device: str, world_info: wm.WorldInfo) -> float:
+    """The largest magnitude a Gyro or an Accelerometer without a lookup table reads on an axis
+    (devices/motion_sensors.py): a gyro turns at most half a turn in a basic step ``dt``, so
+    ``π / dt`` rad/s; an accelerometer reads the second difference of positions within the world's
+    coordinate limits (±MAX_COORDINATE_M on each axis: ``|a| <= 4·√3·M / dt²``) plus gravity."""
+    dt = world_info.basic_time_step / 1000.0
+    if device == "Gyro":
+        return math.pi / dt
+    return 4.0 * math.sqrt(3.0) * MAX_COORDINATE_M / (dt * dt) + float(world_info.gravity)
 
 
 def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
@@ -239,6 +253,11 @@ def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
     if cfg.device == "Compass":                 # north through the lookup table (none: the unit vector)
         out = [row[1] for row in cfg.lookup_table] or [-1.0, 1.0]
         return spaces.Box(np.float32(min(out)), np.float32(max(out)), shape=(3,), dtype=np.float32)
+    if cfg.device in ("Gyro", "Accelerometer"):   # through the lookup table (none: what the motion can give)
+        out = [row[1] for row in cfg.lookup_table]
+        low, high = (min(out), max(out)) if out else (-motion_bound(cfg.device, world_info),
+                                                       motion_bound(cfg.device, world_info))
+        return spaces.Box(np.float32(low), np.float32(high), shape=(3,), dtype=np.float32)
     if cfg.device == "Camera":
         return spaces.Box(0, 255, shape=(cfg.height, cfg.width, 3), dtype=np.uint8)
     if cfg.device == "RangeFinder":

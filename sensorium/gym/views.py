@@ -13,7 +13,8 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   ``motor(name)``, ``drive.left`` / ``drive.right`` and ``drive.lefts`` / ``drive.rights`` (every
   wheel of a side: ``set_position``, ``set_velocity``, ``velocity``, ``position``,
   ``max_velocity``), ``device(name).enable(period)`` / ``.value`` (a GPS's ``.values``, ``.speed``,
-  ``.speed_vector``, a compass's ``.values``, an inertial unit's ``.roll_pitch_yaw``, ``.quaternion``).
+  ``.speed_vector``, a compass's, a gyro's or an accelerometer's ``.values``, an inertial unit's
+  ``.roll_pitch_yaw``, ``.quaternion``).
   The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
   side share one state, so commanding one of them commands its side.
 

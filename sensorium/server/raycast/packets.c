@@ -1720,3 +1720,107 @@ void sp_avoid_reward(size_t n, const int64_t* copies, size_t R, size_t slot, con
     out[i] = gap[i] < contact ? r - penalty : r;
   }
 }
+
+/* ------------------------------------------------------------------------------------------------
+ * batched kinematic devices (sim/batched_kinematic.py): the per-element libm calls of the GPS,
+ * inertial unit and gyro models, so that every copy's device costs no Python float. Each is the
+ * function Python's math module (or numpy's scalar power) calls, with the same arguments in the
+ * same order, and the arithmetic around it is the numpy path's, element by element (no fused
+ * multiply-adds: -ffp-contract=off). A non-zero return means an input the Python way treats
+ * specially (an infinite angle math.sin refuses, a base Python's ** would not give to pow): the
+ * caller then takes that way.
+ * --------------------------------------------------------------------------------------------- */
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* math.atan2 (CPython's m_atan2): NaNs, infinities and zeros decided before libm's atan2 */
+static double py_atan2(double y, double x) {
+  if (isnan(x) || isnan(y)) return NAN;
+  if (isinf(y)) {
+    if (isinf(x)) return copysign(copysign(1.0, x) == 1.0 ? 0.25 * M_PI : 0.75 * M_PI, y);
+    return copysign(0.5 * M_PI, y);
+  }
+  if (isinf(x) || y == 0.0) return copysign(1.0, x) == 1.0 ? copysign(0.0, y) : copysign(M_PI, y);
+  return atan2(y, x);
+}
+
+/* Python's max(-1.0, min(1.0, v)): NaN gives 1.0 */
+static inline double py_clamp1(double v) {
+  const double m = v < 1.0 ? v : 1.0;
+  return m > -1.0 ? m : -1.0;
+}
+
+/* orientation.roll_pitch_yaw of n (x, y, z, w) rows q: (roll, pitch, yaw) rows, ENU or (nue) NUE */
+void sp_roll_pitch_yaw(size_t n, const double* q, int nue, double* out) {
+  for (size_t i = 0; i < n; i++) {
+    const double x = q[4 * i], y = q[4 * i + 1], z = q[4 * i + 2], w = q[4 * i + 3];
+    double* o = out + 3 * i;
+    if (nue) {
+      o[2] = py_atan2(2.0 * y * w - 2.0 * x * z, 1.0 - 2.0 * y * y - 2.0 * z * z);
+      o[0] = py_atan2(2.0 * x * w - 2.0 * y * z, 1.0 - 2.0 * x * x - 2.0 * z * z);
+      o[1] = asin(py_clamp1(2.0 * x * y + 2.0 * z * w));
+    } else {
+      o[0] = py_atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
+      o[1] = asin(py_clamp1(2.0 * (w * y - z * x)));
+      o[2] = py_atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+    }
+  }
+}
+
+/* the exponent 2 of orientation.inertial_quaternion's squares, out of the compiler's sight: pow(v,
+ * 2.0) with a constant 2 is folded into v * v, which is not what numpy's scalar power calls */
+static volatile double pow_two = 2.0;
+
+/* inertial_quaternion's half angle of n (x, y, z, w) rows: atan2(sqrt(x**2 + y**2 + z**2), w),
+ * each square libm's pow(v, 2) as numpy's scalar power computes it; non-zero for a non-finite
+ * component (left to the Python way) */
+size_t sp_half_angles(size_t n, const double* q, double* out) {
+  const double two = pow_two;
+  size_t odd = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double* r = q + 4 * i;
+    odd += !isfinite(r[0]) || !isfinite(r[1]) || !isfinite(r[2]) || !isfinite(r[3]);
+    out[i] = py_atan2(sqrt(pow(r[0], two) + pow(r[1], two) + pow(r[2], two)), r[3]);
+  }
+  return odd;
+}
+
+/* gps.position's Gauss-Markov ratio: correlation ** exponent (Python's float power: libm's pow for
+ * a positive finite base and a finite exponent), 0 where the correlation is 0; non-zero for any
+ * other base or exponent (left to the Python way) */
+size_t sp_correlation_ratios(size_t n, const double* corr, const double* expo, double* out) {
+  size_t odd = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double c = corr[i], e = expo[i];
+    if (c == 0.0) {
+      out[i] = 0.0;
+      continue;
+    }
+    odd += !(c > 0.0) || !isfinite(c) || !isfinite(e);
+    out[i] = e == 0.0 || c == 1.0 ? 1.0 : pow(c, e);
+  }
+  return odd;
+}
+
+/* motion_sensors.angular_velocity of n turns rel = r0^T r1 (row-major 3x3s, the numpy products):
+ * the rotation vector over dt (s), rows of 3 */
+void sp_gyro(size_t n, const double* rel, double dt, double* out) {
+  for (size_t i = 0; i < n; i++) {
+    const double* m = rel + 9 * i;
+    double* o = out + 3 * i;
+    const double angle = acos(py_clamp1(((m[0] + m[4] + m[8]) - 1.0) / 2.0));
+    const double v0 = m[7] - m[5], v1 = m[2] - m[6], v2 = m[3] - m[1];
+    if (angle < 1e-6) {
+      o[0] = v0 / 2.0 / dt;
+      o[1] = v1 / 2.0 / dt;
+      o[2] = v2 / 2.0 / dt;
+    } else {
+      const double f = angle / (2.0 * sin(angle));
+      o[0] = v0 * f / dt;
+      o[1] = v1 * f / dt;
+      o[2] = v2 * f / dt;
+    }
+  }
+}

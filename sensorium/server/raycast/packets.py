@@ -1129,3 +1129,90 @@ def avoid_reward(copies: np.ndarray, slot: int, velocity: np.ndarray, vmax: floa
     lib.sp_avoid_reward(len(copies), copies.ctypes.data, R, int(slot), velocity.ctypes.data, float(vmax),
                         gap.ctypes.data, float(near), float(contact), float(penalty), out.ctypes.data)
     return out
+
+
+# ---------------------------------------------------------------- batched kinematic devices
+# (sim/batched_kinematic.py: the libm calls of the GPS, inertial unit and gyro models per element)
+
+def _kinematic_library():
+    """The helper with the batched kinematic passes' signatures declared (once), or None."""
+    lib = library()
+    if lib is None or getattr(lib, "_kinematic_declared", False):
+        return lib
+    sz, d, i, vp = ctypes.c_size_t, ctypes.c_double, ctypes.c_int, ctypes.c_void_p
+    lib.sp_roll_pitch_yaw.restype = None
+    lib.sp_roll_pitch_yaw.argtypes = [sz, vp, i, vp]
+    lib.sp_half_angles.restype = sz
+    lib.sp_half_angles.argtypes = [sz, vp, vp]
+    lib.sp_correlation_ratios.restype = sz
+    lib.sp_correlation_ratios.argtypes = [sz, vp, vp, vp]
+    lib.sp_gyro.restype = None
+    lib.sp_gyro.argtypes = [sz, vp, d, vp]
+    lib._kinematic_declared = True
+    return lib
+
+
+def _rows(a: np.ndarray, width: int) -> np.ndarray | None:
+    """``a`` as a C-contiguous float64 (n, width) array, or None for another array."""
+    if a.dtype != np.float64 or a.ndim != 2 or a.shape[1] != width:
+        return None
+    return np.ascontiguousarray(a)
+
+
+def roll_pitch_yaw(q: np.ndarray, nue: bool) -> np.ndarray | None:
+    """orientation.roll_pitch_yaw of each (x, y, z, w) row of the (n, 4) float64 ``q`` in one C pass
+    (``sp_roll_pitch_yaw``: libm's atan2 and asin as math.atan2 and math.asin call them, the
+    arithmetic around them the numpy path's): (n, 3) roll, pitch, yaw; None without the helper or
+    for another array."""
+    lib = _kinematic_library()
+    q = _rows(q, 4) if lib is not None else None
+    if q is None:
+        return None
+    out = np.empty((len(q), 3))
+    p = _small_addresses((q, out))
+    lib.sp_roll_pitch_yaw(len(q), p[0], 1 if nue else 0, p[1])
+    return out
+
+
+def half_angles(q: np.ndarray) -> np.ndarray | None:
+    """orientation.inertial_quaternion's half angle ``atan2(sqrt(x**2 + y**2 + z**2), w)`` of each row
+    of the (n, 4) float64 ``q`` in one C pass (``sp_half_angles``, each square libm's pow as numpy's
+    scalar power calls it); None without the helper, for another array or a non-finite component."""
+    lib = _kinematic_library()
+    q = _rows(q, 4) if lib is not None else None
+    if q is None:
+        return None
+    out = np.empty(len(q))
+    if lib.sp_half_angles(len(q), *_small_addresses((q, out))):
+        return None
+    return out
+
+
+def correlation_ratios(corr: np.ndarray, exponent: np.ndarray) -> np.ndarray | None:
+    """gps.position's ``correlation ** exponent`` (0 where the correlation is 0) of two (n,) float64
+    arrays in one C pass (``sp_correlation_ratios``: libm's pow, as Python's float power calls it for a
+    positive base); None without the helper, for other arrays, or for a base or exponent Python's
+    power treats otherwise."""
+    lib = _kinematic_library()
+    if lib is None or corr.dtype != np.float64 or exponent.dtype != np.float64 or corr.ndim != 1 \
+            or exponent.shape != corr.shape:
+        return None
+    c, e = np.ascontiguousarray(corr), np.ascontiguousarray(exponent)
+    out = np.empty(len(c))
+    if lib.sp_correlation_ratios(len(c), *_small_addresses((c, e, out))):
+        return None
+    return out
+
+
+def gyro_rates(rel: np.ndarray, dt: float) -> np.ndarray | None:
+    """motion_sensors.angular_velocity of each turn ``rel`` ((n, 3, 3) float64, r0ᵀ·r1 as numpy
+    multiplied them) over ``dt`` seconds in one C pass (``sp_gyro``: libm's acos and sin as math.acos
+    and math.sin call them): (n, 3); None without the helper or for another array."""
+    lib = _kinematic_library()
+    if lib is None or rel.dtype != np.float64 or rel.ndim != 3 or rel.shape[1:] != (3, 3):
+        return None
+    rel = np.ascontiguousarray(rel)
+    out = np.empty((len(rel), 3))
+    p = _small_addresses((rel, out))
+    lib.sp_gyro(len(rel), p[0], float(dt), p[1])
+    return out

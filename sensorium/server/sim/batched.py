@@ -17,13 +17,13 @@ every device model runs once over all copies' devices of a kind.
 Copy ``c`` reproduces :class:`~sensorium.server.sim.simulation.Simulation` built from the world
 with copy c's seed, bit for bit, for what it simulates: the drive (the same float64 arc, the same
 3x3 products), kinematic contact (the same broad phase per copy, the same narrow phase), light
-sensors, distance sensors, fixed lidars, wheel encoders, GPS (local coordinates), compasses and
-inertial units (batched_kinematic.py), range finders (batched_depth.py), each device's noise drawn
-from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in the same
-order). Tests compare it with the single simulation step by step.
+sensors, distance sensors, fixed lidars, wheel encoders, GPS (local coordinates), compasses,
+inertial units, gyros and accelerometers (batched_kinematic.py), range finders (batched_depth.py), each
+device's noise drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the
+same numbers, in the same order). Tests compare it with the single simulation step by step.
 
 Not simulated here (use :class:`Simulation`): rotating lidars, cameras, a GPS in a
-WGS84 world, gyros, accelerometers, altimeters, the kinds without an observation (LEDs, pens, ...),
+WGS84 world, altimeters, the kinds without an observation (LEDs, pens, ...),
 lights carried by robots, textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
 
@@ -441,7 +441,8 @@ class BatchedSimulation:
 
     def value(self, ref: DeviceRef) -> np.ndarray:
         """The latest values of a device in every copy: (copies,) for a light, distance or position
-        sensor, (copies, 3) for a GPS (position), a compass (north) or an inertial unit (roll, pitch, yaw)."""
+        sensor, (copies, 3) for a GPS (position), a compass (north), an inertial unit (roll, pitch,
+        yaw), a gyro (rad/s) or an accelerometer (m/s²)."""
         return self.values[ref.kind][:, ref.column]
 
     def reading(self, ref: DeviceRef, what: str) -> np.ndarray:
@@ -548,6 +549,7 @@ class BatchedSimulation:
         if period_ms > 0:
             self._enabled[ref.kind] = True
         self.last[ref.kind][idx, ref.column] = self.time_ms[idx]
+        self.kinematic.enabled(ref.kind, ref.column, idx)
 
     # ------------------------------------------------------------------ stepping
     def run(self, steps: int, active: np.ndarray | None = None) -> None:

@@ -1,25 +1,36 @@
-"""GPS, Compass and InertialUnit in the batched simulation: every copy's due devices of a kind
-measured together, from the copies' end-of-step poses, bit for bit what the single simulation's
-devices (sim/sensors.py, on the pure models of devices/gps.py and devices/orientation.py) give.
+"""GPS, Compass, InertialUnit, Gyro and Accelerometer in the batched simulation: every copy's due
+devices of a kind measured together, from the copies' end-of-step poses, bit for bit what the
+single simulation's devices (sim/sensors.py, on the pure models of devices/gps.py,
+devices/orientation.py and devices/motion_sensors.py) give.
 
 How the bits are kept:
 
 * float64 ``+ - * / sqrt`` are exactly rounded alike in numpy and in Python, so those are done on
   whole arrays in the single models' order of operations;
 * the small products the single models leave to numpy's ``@`` (Pose.compose's 3x3 products, a
-  compass's ``Rᵀ·north``, a norm's dot product) go through ``np.matmul`` on stacks of the same
-  3x3 / 3-vector operands: numpy hands each item to the same BLAS call as the 2-D product, so the
-  summation order (and any fused multiply-add) is the same;
-* ``atan2``, ``asin``, ``sin``, ``cos`` and ``pow`` are libm's (``math``, Python's ``**``) per
-  element, never numpy's vectorised ufuncs, whose SIMD routines may round differently on this
-  machine (``x ** 2`` included: numpy's scalar power calls libm's ``pow``, which is not ``x * x``);
+  compass's ``Rᵀ·north``, a gyro's ``R₀ᵀ·R₁``, an accelerometer's ``Rᵀ·(a + g·up)``, a norm's dot
+  product) go through ``np.matmul`` on stacks of the same 3x3 / 3-vector operands: numpy hands each
+  item to the same BLAS call as the 2-D product, so the summation order (and any fused
+  multiply-add) is the same;
+* ``atan2``, ``asin``, ``acos``, ``sin``, ``cos`` and ``pow`` are libm's per element, never numpy's
+  vectorised ufuncs, whose SIMD routines may round differently on this machine (``x ** 2``
+  included: numpy's scalar power calls libm's ``pow``, which is not ``x * x``): in one C pass per
+  kind where the packets helper is built (raycast/packets.c, "batched kinematic devices": the
+  very functions Python's ``math`` calls, the arithmetic around them element by element), else
+  through ``math`` and Python floats (``native=False``, and ``SENSORIUM_PACKETS=0``);
 * each device's noise comes from its own stream (``NoiseStreams``), taken in the order the single
   model draws it.
 
+A gyro or an accelerometer differences the device's world poses after the last basic steps since
+it was enabled (_MotionSensor in sim/sensors.py): the copies' end-of-step robot poses of the last
+two steps are kept for every slot, and per device the robot's pose when it was enabled and how
+many poses it has seen since (1 at ``enable``, at most 3), so its poses are composed only when it
+is due.
+
 Not here: a GPS in a WGS84 world (the inverse UTM series is not vectorised: refused with one
-line), Gyro, Accelerometer, Altimeter (refused as any kind the batched simulation does not
-measure). The batched simulation itself only runs ENU worlds; the roll / pitch / yaw conventions
-of both are here (:func:`roll_pitch_yaw`) and tested against the single model.
+line), Altimeter (refused as any kind the batched simulation does not measure). The batched
+simulation itself only runs ENU worlds; the roll / pitch / yaw conventions of both are here
+(:func:`roll_pitch_yaw`) and tested against the single model.
 """
 
 from __future__ import annotations
@@ -29,20 +40,27 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
-from sensorium.server.sim.sensors import GPS, Compass, InertialUnit
+from sensorium.server.raycast import packets
+from sensorium.server.sim.sensors import GPS, Accelerometer, Compass, Gyro, InertialUnit
 
 __all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal",
-           "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions"]
+           "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions", "angular_velocities",
+           "correlation_ratios"]
 
-KINDS = ("GPS", "Compass", "InertialUnit")
-CLASSES: dict[str, type] = {"GPS": GPS, "Compass": Compass, "InertialUnit": InertialUnit}
-SHAPES = {"GPS": (3,), "Compass": (3,), "InertialUnit": (3,)}
+KINDS = ("GPS", "Compass", "InertialUnit", "Gyro", "Accelerometer")
+MOTION = ("Gyro", "Accelerometer")
+"""The kinds that read the motion over the last basic steps (their poses tracked every step)."""
+CLASSES: dict[str, type] = {"GPS": GPS, "Compass": Compass, "InertialUnit": InertialUnit, "Gyro": Gyro,
+                            "Accelerometer": Accelerometer}
+SHAPES = dict.fromkeys(KINDS, (3,))
 """The shape of one device's value (``BatchedSimulation.values[kind]`` is (copies, devices, *shape)):
-a GPS's position, a compass's north vector, an inertial unit's roll, pitch, yaw."""
+a GPS's position, a compass's north vector, an inertial unit's roll, pitch, yaw, a gyro's angular
+velocity, an accelerometer's specific force."""
 READINGS = {"GPS": ("values", "speed", "speed_vector"), "Compass": ("values",),
-            "InertialUnit": ("roll_pitch_yaw", "quaternion")}
+            "InertialUnit": ("roll_pitch_yaw", "quaternion"), "Gyro": ("values",), "Accelerometer": ("values",)}
 """What a device of each kind reads (the single simulation's attributes of the same names)."""
 
 
@@ -67,6 +85,23 @@ def _libm(fn, *columns: np.ndarray) -> np.ndarray:
     """``fn`` (a ``math`` function, libm's) of each element: the single models' scalar calls."""
     flat = [c.reshape(-1).tolist() for c in columns]
     return np.array(list(map(fn, *flat)), dtype=np.float64).reshape(columns[0].shape)
+
+
+def _sin_cos(a: np.ndarray, native: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """(math.sin, math.cos) of each element: libm's, in one C pass where the helper is."""
+    got = packets.cos_sin(np.ascontiguousarray(a.reshape(-1))) if native and a.dtype == np.float64 else None
+    if got is not None:
+        return got[1].reshape(a.shape), got[0].reshape(a.shape)
+    return _libm(math.sin, a), _libm(math.cos, a)
+
+
+def correlation_ratios(corr: np.ndarray, exponent: np.ndarray, native: bool = True) -> np.ndarray:
+    """gps.position's ``correlation ** (elapsed / 1000)`` (0 for a correlation of 0) per row."""
+    got = packets.correlation_ratios(corr, exponent) if native else None
+    if got is not None:
+        return got
+    return np.array([cr ** e if cr != 0.0 else 0.0 for cr, e in zip(corr.tolist(), exponent.tolist())],
+                    dtype=np.float64)
 
 
 def _dots(v: np.ndarray) -> np.ndarray:
@@ -114,12 +149,12 @@ def matrix_quaternions(m: np.ndarray) -> np.ndarray:
     return np.where((q[:, 3] < 0.0)[:, None], -q, q)
 
 
-def _axis_turns(angles: np.ndarray) -> np.ndarray:
+def _axis_turns(angles: np.ndarray, native: bool = True) -> np.ndarray:
     """The noise turn of orientation.inertial_quaternion for rows of three angles (k, 3): the
     quaternions about x, y, z multiplied in that order, as (4, k) columns."""
     k = len(angles)
     half = angles / 2.0
-    s, c = _libm(math.sin, half), _libm(math.cos, half)
+    s, c = _sin_cos(half, native)
     qs = []
     for axis in range(3):
         q = np.zeros((4, k))
@@ -130,37 +165,45 @@ def _axis_turns(angles: np.ndarray) -> np.ndarray:
 
 
 def inertial_quaternions(q: np.ndarray, gauss: np.ndarray | None, noise: np.ndarray, x_axis: np.ndarray,
-                         y_axis: np.ndarray, z_axis: np.ndarray, resolution: np.ndarray) -> np.ndarray:
+                         y_axis: np.ndarray, z_axis: np.ndarray, resolution: np.ndarray,
+                         native: bool = True) -> np.ndarray:
     """orientation.inertial_quaternion of each row: ``q`` (k, 4) world rotations, ``gauss`` (k, 3)
-    the standard normals of the rows with ``noise`` != 0 (any value elsewhere), the per-row fields."""
+    the standard normals of the rows with ``noise`` != 0 (any value elsewhere), the per-row fields.
+    ``native=False``: the libm calls through ``math`` (the helper's fallback)."""
     out = np.array(q, dtype=np.float64)
     noisy = (noise != 0.0).nonzero()[0]
     if len(noisy):
         assert gauss is not None
         angles = noise[noisy, None] * math.pi * gauss[noisy]       # noise * math.pi * G, left to right
-        out[noisy] = orient.quaternion_multiply(out[noisy].T, _axis_turns(angles)).T
+        out[noisy] = orient.quaternion_multiply(out[noisy].T, _axis_turns(angles, native)).T
     off = (~(x_axis & y_axis & z_axis)).nonzero()[0]
     if len(off):
         o = out[off]
-        sq = [_libm(lambda v: v ** 2, o[:, j]) for j in range(3)]  # numpy's scalar ** 2: libm's pow
-        half = _libm(math.atan2, np.sqrt(sq[0] + sq[1] + sq[2]), o[:, 3])
+        half = packets.half_angles(o) if native else None
+        if half is None:
+            sq = [_libm(lambda v: v ** 2, o[:, j]) for j in range(3)]  # numpy's scalar ** 2: libm's pow
+            half = _libm(math.atan2, np.sqrt(sq[0] + sq[1] + sq[2]), o[:, 3])
         axis = o[:, :3].copy()
         axis[~x_axis[off], 0] = 0.0                                  # Webots' mapping: y -> z, z -> y
         axis[~y_axis[off], 2] = 0.0
         axis[~z_axis[off], 1] = 0.0
         norm = np.sqrt(_dots(axis))
         zero = norm == 0.0
+        sin, cos = _sin_cos(half, native)
         with np.errstate(invalid="ignore", divide="ignore"):
-            turned = axis / norm[:, None] * _libm(math.sin, half)[:, None]
-        o = np.concatenate([turned, _libm(math.cos, half)[:, None]], axis=1)
+            turned = axis / norm[:, None] * sin[:, None]
+        o = np.concatenate([turned, cos[:, None]], axis=1)
         o[zero] = (0.0, 0.0, 0.0, 1.0)
         out[off] = o
     out = np.where((out[:, 3] < 0.0)[:, None], -out, out)
     return _quantize(out, resolution)
 
 
-def roll_pitch_yaw(q: np.ndarray, axes: str = "ENU") -> np.ndarray:
+def roll_pitch_yaw(q: np.ndarray, axes: str = "ENU", native: bool = True) -> np.ndarray:
     """orientation.roll_pitch_yaw of each (k, 4) quaternion: (k, 3) roll, pitch, yaw."""
+    got = packets.roll_pitch_yaw(q, axes == "NUE") if native else None
+    if got is not None:
+        return got
     x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
 
     def asin_clamped(v: np.ndarray) -> np.ndarray:     # max(-1, min(1, v)) as Python compares (NaN -> 1)
@@ -177,10 +220,27 @@ def roll_pitch_yaw(q: np.ndarray, axes: str = "ENU") -> np.ndarray:
     return np.stack([roll, pitch, yaw], axis=1)
 
 
+def angular_velocities(r0: np.ndarray, r1: np.ndarray, dt_s: float, native: bool = True) -> np.ndarray:
+    """motion_sensors.angular_velocity of each pair of (k, 3, 3) world rotations: (k, 3) rad/s in
+    the frame of ``r1``."""
+    rel = np.matmul(np.ascontiguousarray(r0).transpose(0, 2, 1), r1)     # r0.T @ r1, item by item
+    got = packets.gyro_rates(rel, dt_s) if native else None
+    if got is not None:
+        return got
+    trace = rel[:, 0, 0] + rel[:, 1, 1] + rel[:, 2, 2]                   # np.trace: summed left to right
+    angle = _libm(lambda t: math.acos(max(-1.0, min(1.0, (t - 1.0) / 2.0))), trace)
+    v = np.stack([rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0], rel[:, 1, 0] - rel[:, 0, 1]], axis=1)
+    small = angle < 1e-6                                                  # sin(angle) ~ angle: the skew part
+    with np.errstate(invalid="ignore", divide="ignore"):
+        turned = v * (angle / (2.0 * _libm(math.sin, angle)))[:, None] / dt_s
+    return np.where(small[:, None], v / 2.0 / dt_s, turned)
+
+
 class KinematicDevices:
-    """The GPS, Compass and InertialUnit devices of a batched simulation: their constants stacked
-    per kind, their state beyond ``values`` (a GPS's speed, speed vector, noise state and previous
-    position; an inertial unit's quaternion) per copy, and :meth:`measure` for one step.
+    """The GPS, Compass, InertialUnit, Gyro and Accelerometer devices of a batched simulation: their
+    constants stacked per kind, their state beyond ``values`` (a GPS's speed, speed vector, noise
+    state and previous position; an inertial unit's quaternion; the poses a gyro or an
+    accelerometer differences) per copy, and :meth:`measure` for one step.
 
     ``sim`` is the BatchedSimulation (its poses, clocks, schedules, values, noise bank);
     ``devices`` its template devices of each kind, in column order."""
@@ -214,8 +274,22 @@ class KinematicDevices:
         self.unit_noise = np.array([c.noise for c in units], dtype=np.float64)
         self.unit_axes = [np.array([getattr(c, a) for c in units], dtype=bool) for a in ("x_axis", "y_axis", "z_axis")]
         self.quaternion = np.full((C, len(units), 4), math.nan)
-        self.compass_axes = [np.array([c.config.x_axis, c.config.y_axis, c.config.z_axis], dtype=bool)
-                             for c in self.devices["Compass"]]
+        # the kinds read through a lookup table per enabled axis (axes_through_table): each device's axes on
+        self.axes_on = {k: [np.array([d.config.x_axis, d.config.y_axis, d.config.z_axis], dtype=bool).nonzero()[0]
+                            for d in self.devices[k]] for k in ("Compass", *MOTION)}
+        # Gyro and Accelerometer: every slot's end-of-step poses of the copy's last two steps, and per
+        # device the robot's pose when it was enabled and how many poses it has seen (_MotionSensor._poses)
+        self.dt_s = sim.basic_time_step / 1000.0
+        self.gravity_up = float(wi.gravity) * motion_math.up_vector(self.axes)
+        self.tracking = any(self.devices[k] for k in MOTION)
+        R = sim.R
+        self.last_rot = np.zeros((C, R, 3, 3))
+        self.last_pos = np.zeros((C, R, 3))
+        self.last2_rot = np.zeros((C, R, 3, 3))
+        self.last2_pos = np.zeros((C, R, 3))
+        self.seen = {k: np.zeros((C, len(self.devices[k])), dtype=np.int64) for k in MOTION}
+        self.enable_rot = {k: np.zeros((C, len(self.devices[k]), 3, 3)) for k in MOTION}
+        self.enable_pos = {k: np.zeros((C, len(self.devices[k]), 3)) for k in MOTION}
 
     # ------------------------------------------------------------------ state
     def reset(self, idx: np.ndarray) -> None:
@@ -226,6 +300,17 @@ class KinematicDevices:
         self.previous[idx] = 0.0
         self.has_previous[idx] = False
         self.quaternion[idx] = math.nan
+        for k in MOTION:
+            self.seen[k][idx] = 0
+
+    def enabled(self, kind: str, column: int, idx) -> None:
+        """``enable`` of a device in the copies ``idx``: a gyro or an accelerometer starts its poses
+        over from the robot's pose now (_MotionSensor.enable)."""
+        if kind in MOTION:
+            slot = self.slot[kind][column]
+            self.seen[kind][idx, column] = 1
+            self.enable_rot[kind][idx, column] = self.sim.rot[idx, slot]
+            self.enable_pos[kind][idx, column] = self.sim.pos[idx, slot]
 
     def reading(self, kind: str, column: int, what: str) -> np.ndarray:
         """A device's reading ``what`` (one of READINGS[kind]) in every copy: (copies, ...)."""
@@ -237,12 +322,56 @@ class KinematicDevices:
 
     # ------------------------------------------------------------------ measuring
     def measure(self, live: np.ndarray) -> None:
-        """Every due device of these kinds in the copies ``live``, at their end-of-step poses."""
-        for kind, fn in (("GPS", self._gps), ("Compass", self._compass), ("InertialUnit", self._unit)):
+        """Every due device of these kinds in the copies ``live``, at their end-of-step poses; then
+        the poses gyros and accelerometers keep (every step, as the single simulation's ``track``)."""
+        for kind, fn in (("GPS", self._gps), ("Compass", self._compass), ("InertialUnit", self._unit),
+                         ("Gyro", self._gyro), ("Accelerometer", self._accelerometer)):
             if self.devices[kind]:
                 copies, cols = self.sim._due(kind, live)
                 if len(copies):
                     self.sim._store(kind, copies, cols, fn(copies, cols))
+        if self.tracking:
+            self._track(live)
+
+    def _track(self, live: np.ndarray) -> None:
+        """The step's end poses join the kept ones (a pose list is at most 3 long)."""
+        sim = self.sim
+        for k in MOTION:
+            if self.devices[k]:
+                self.seen[k][live] = np.minimum(self.seen[k][live] + 1, 3)
+        self.last2_rot[live] = self.last_rot[live]
+        self.last2_pos[live] = self.last_pos[live]
+        self.last_pos[live] = sim.pos[live]
+        self.last_rot[live] = sim.rot[live]
+
+    def _poses(self, kind: str, copies: np.ndarray, cols: np.ndarray):
+        """The device poses of a due gyro or accelerometer as its pose list holds them after this
+        step's: (n, (rotation, translation) of the robot at each of the last three poses, newest last),
+        ``n`` the list's length (2 or 3) and each robot pose chosen among this step's, the kept ones
+        and the pose when it was enabled."""
+        sim = self.sim
+        slot = self.slot[kind][cols]
+        before = self.seen[kind][copies, cols]
+        n = np.minimum(before + 1, 3)
+        now_rot, now_pos = sim.rot[copies, slot], sim.pos[copies, slot]
+        e_rot, e_pos = self.enable_rot[kind][copies, cols], self.enable_pos[kind][copies, cols]
+        # poses[-2]: the enable pose after one step, else the previous step's end (this one's before any)
+        one, two = (n == 2), (n >= 3)
+        prev_rot = np.where(two[:, None, None], self.last_rot[copies, slot], np.where(one[:, None, None], e_rot, now_rot))
+        prev_pos = np.where(two[:, None], self.last_pos[copies, slot], np.where(one[:, None], e_pos, now_pos))
+        # poses[-3] (three known): the enable pose two steps after it, else the end of the step before last
+        older = before >= 3
+        first_rot = np.where(older[:, None, None], self.last2_rot[copies, slot], e_rot)
+        first_pos = np.where(older[:, None], self.last2_pos[copies, slot], e_pos)
+        return n, (now_rot, now_pos), (prev_rot, prev_pos), (first_rot, first_pos)
+
+    def _compose(self, kind: str, cols: np.ndarray, rot: np.ndarray, pos: np.ndarray | None):
+        """Device.world_pose from robot poses (rotation R·Rl, translation R·tl + t; None: no translation)."""
+        rr = np.ascontiguousarray(rot)
+        r = np.matmul(rr, self.local_rot[kind][cols])
+        if pos is None:
+            return r, None
+        return r, np.matmul(rr, self.local_pos[kind][cols][:, :, None])[:, :, 0] + pos
 
     def _frames(self, kind: str, copies: np.ndarray, cols: np.ndarray, translation: bool = True):
         """Device.world_pose of each due device: robot pose ∘ local pose, as Pose.compose computes it
@@ -271,8 +400,7 @@ class KinematicDevices:
         if len(rows):                    # the Gauss-Markov noise: three normals per measurement
             c, d = copies[rows], cols[rows]
             corr = self.correlation[d]
-            ratio = np.array([cr ** e if cr != 0.0 else 0.0
-                              for cr, e in zip(corr.tolist(), (elapsed[rows] / 1000.0).tolist())], dtype=np.float64)
+            ratio = correlation_ratios(corr, elapsed[rows] / 1000.0)
             state = self.gps_noise[c, d] * ratio[:, None]
             state = state + np.sqrt(1.0 - ratio * ratio)[:, None] * self._gauss("GPS", c, d, 3)
             self.gps_noise[c, d] = state
@@ -299,15 +427,21 @@ class KinematicDevices:
         rot, _ = self._frames("Compass", copies, cols, translation=False)
         local = np.matmul(rot.transpose(0, 2, 1), self.north[:, None])[:, :, 0]     # Rᵀ·north
         local = local / np.sqrt(_dots(local))[:, None]
+        return self._through_tables("Compass", copies, cols, local)
+
+    def _through_tables(self, kind: str, copies: np.ndarray, cols: np.ndarray, raw: np.ndarray) -> np.ndarray:
+        """motion_sensors.axes_through_table of each row: each enabled axis through the device's
+        lookup table (its noise from its own stream, in axis order), then its resolution; NaN on a
+        disabled axis."""
         out = np.full((len(copies), 3), math.nan)
-        streams = self.sim._noise_of["Compass"]
+        streams = self.sim._noise_of[kind]
         for col in np.unique(cols).tolist():
             sel = (cols == col).nonzero()[0]
-            on = self.compass_axes[col].nonzero()[0]
+            on = self.axes_on[kind][col]
             if not len(on):
                 continue
-            v = local[sel][:, on]
-            table = self.devices["Compass"][col].table
+            v = raw[sel][:, on]
+            table = self.devices[kind][col].table
             if len(table):               # LookupTable.lookup: interpolated, then y (1 + n G) per noisy entry
                 v, nz = table.interpolate(v)
                 for j in range(len(on)):  # the entries in C order: each row's axes in turn
@@ -315,11 +449,33 @@ class KinematicDevices:
                     if len(noisy):
                         g = self.sim.noise.next(copies[sel][noisy], np.full(len(noisy), streams[col]))
                         v[noisy, j] = v[noisy, j] * (1.0 + nz[noisy, j] * g)
-            res = self.resolution["Compass"][col]
+            res = self.resolution[kind][col]
             if res != RESOLUTION_OFF:
                 v = np.trunc(v / res + 0.5) * res + 0.0
             out[np.ix_(sel, on)] = v
         return out
+
+    def _gyro(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Gyro.measure: the turn from the device's previous pose to this step's over one basic step."""
+        n, (now_rot, _), (prev_rot, _), _ = self._poses("Gyro", copies, cols)
+        r1, _ = self._compose("Gyro", cols, now_rot, None)
+        r0, _ = self._compose("Gyro", cols, prev_rot, None)
+        return self._through_tables("Gyro", copies, cols, angular_velocities(r0, r1, self.dt_s))
+
+    def _accelerometer(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Accelerometer.measure: the second difference of the device's last three positions (rest
+        until three are known) plus gravity, in the device frame (specific_force)."""
+        n, (now_rot, now_pos), (prev_rot, prev_pos), (first_rot, first_pos) = self._poses("Accelerometer", copies, cols)
+        rot, p2 = self._compose("Accelerometer", cols, now_rot, now_pos)
+        _, p1 = self._compose("Accelerometer", cols, prev_rot, prev_pos)
+        _, p0 = self._compose("Accelerometer", cols, first_rot, first_pos)
+        assert p0 is not None and p1 is not None and p2 is not None
+        rest = (n < 3)[:, None]                          # fewer than three poses: p0 = p1 = p2
+        p0, p1 = np.where(rest, p2, p0), np.where(rest, p2, p1)
+        dt = self.dt_s
+        a = (p2 - 2.0 * p1 + p0) / (dt * dt)
+        force = np.matmul(rot.transpose(0, 2, 1), (a + self.gravity_up)[:, :, None])[:, :, 0]
+        return self._through_tables("Accelerometer", copies, cols, force)
 
     def _unit(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """InertialUnit.measure: the quaternion (orientation.inertial_quaternion) and roll, pitch, yaw."""
