@@ -133,22 +133,64 @@ def _throughput(cfg: Config, sec: Section, gym) -> None:
         f"LidarAvoid x64 {lidar[1]:,.0f}; EXACT costs {100 * (1 - reach_x[1] / reach[1]):.0f} % (ReachLight) and "
         f"{100 * (1 - lidar_x[1] / lidar[1]):.0f} % (LidarAvoid) of FAST's throughput"
         + (f"; MuJoCo Hopper-v5 {hop[1]:,.0f} (a physics step, no sensors)." if hop else "."))
-    from sensorium.server.raycast import packets
 
     sec.findings.append(
         f"LidarAvoid x64 with its casts allowed two threads: {lidar_2[0]:,.0f} env steps per wall s, "
         f"{lidar_2[1]:,.0f} per CPU s ({lidar_2[0] / lidar[0]:.2f}x / {lidar_2[1] / lidar[1]:.2f}x one thread): "
         "the copies' lidar beams (23,040 rays) are split over the threads, the rest of the step stays on one "
         "(the env's `threads` option; its default is the cores).")
+    _lidar_budget(cfg, sec, gym, hop[1] if hop else None)
+
+
+def _lidar_budget(cfg: Config, sec: Section, gym, hopper_cpu_rate: float | None) -> None:
+    """Where a LidarAvoid x64 step's CPU goes: the batched casts (``CopyRays.cast``: the packet
+    traversal, the judging in C and the Python around them) against the rest of the step, and what 5x
+    Hopper leaves per step. Measured in its own run (the wrapper's timer calls are not in the
+    throughput rows above)."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.raycast.copies import CopyRays
+
+    env = gym.make_vec(LIDAR, num_envs=64, vectorization_mode="vector_entry_point", precision="fast", threads=1)
+    cast = CopyRays.cast
+    spent = [0.0, 0]
+
+    def timed(self, *args, **kw):
+        t0 = time.thread_time()
+        try:
+            return cast(self, *args, **kw)
+        finally:
+            spent[0] += time.thread_time() - t0
+            spent[1] += 1
+
+    try:
+        env.reset(seed=0)
+        env.action_space.seed(0)
+        acts = [env.action_space.sample() for _ in range(64)]
+        for k in range(50):
+            env.step(acts[k % 64])
+        CopyRays.cast = timed                                # type: ignore[method-assign]
+        steps = cfg.pick(1000, 200)
+        c0 = time.thread_time()
+        for k in range(steps):
+            env.step(acts[k % 64])
+        step_s = (time.thread_time() - c0) / steps
+    finally:
+        CopyRays.cast = cast                                 # type: ignore[method-assign]
+        env.close()
+    cast_s = spent[0] / steps
+    sec.data["lidar_budget"] = {"step_cpu_s": step_s, "casts_cpu_s": cast_s, "casts_per_step": spent[1] / steps,
+                                "hopper_cpu_rate": hopper_cpu_rate}
+    budget = "" if not hopper_cpu_rate else (
+        f" 5x MuJoCo Hopper ({hopper_cpu_rate:,.0f} env steps per CPU s in the rows above) leaves "
+        f"{64 / (5 * hopper_cpu_rate) * 1e3:.2f} ms per step of 64 copies: the casts alone take "
+        f"{100 * cast_s * 5 * hopper_cpu_rate / 64:.0f} % of it.")
     sec.findings.append(
-        "What bounds LidarAvoid: every copy's rays go out in one cast per ray kind through the engine's packet "
-        f"traversal ({packets.status()}); the copies' broad phase, the curved-shell screening, the beams, the "
-        "wheels and the contact broad phase are C passes of the same helper (the numpy path's bits). In a "
-        "profile of 64 copies (2026-12-03) the casts are then ~55-60 % of a step (Embree's traversal of the "
-        "23,040 beams ~1 ms of it), the rest Python and numpy that stay there for their bits: arcs and poses "
-        "(libm's sin/cos, as the single env), distance finishing (einsum, arctan2), the contact narrow phase "
-        "(math.hypot), the task's reward and observations. 5x Hopper (~1.6 ms per step of 64 copies) needs "
-        "the whole batched step compiled, those functions included.")
+        f"What bounds LidarAvoid x64 (FAST, one thread; a run of {steps:,} steps with the batched casts timed): "
+        f"{step_s * 1e3:.2f} ms of CPU per env step, of which {cast_s * 1e3:.2f} ms ({100 * cast_s / step_s:.0f} %) "
+        f"in the {spent[1] / steps:.0f} batched casts (lidar beams, sonars, the reward's clearance: the packet "
+        f"traversal ({packets.status().split(' through ')[0]}), the judging in C and the Python around them), the rest the drive, "
+        "device finishing, the task's reward and observations (C passes and numpy keeping the single env's "
+        "bits)." + budget)
 
 
 def _scaling(cfg: Config, sec: Section, gym) -> None:
