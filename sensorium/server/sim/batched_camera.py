@@ -1,0 +1,308 @@
+"""Cameras (RGB images) in the batched simulation: every copy's due cameras rendered bit for bit as
+the single simulation's Camera (sim/cameras.py, on the pure model devices/shading.py) renders them.
+
+A camera's pixel rays go the range finder's way (batched_depth.py): the single device's rays
+(``imaging.pixel_directions`` with its samples, ``clip_limits``), turned into each copy's world by
+the same column sums from the same stacked ``Pose.compose``, cast as runs from one origin per
+copy in a cast of their own (each camera's rays, every copy's; never joined to other rays: a
+joined cast can move a FAST answer by a float32 step), meeting only their own copy's robots; a
+camera housed in shapes of its own meets its robot's body once, in the body frame
+(``OwnBodyRays``), as the single device does.
+
+The shading is the single camera's, on every copy's rows at once: each step is elementwise
+(``origin + t·D`` with the row's own copy's origin, the back-face flip, ``shading.radiance`` per
+row, ``shading.fog``, the background, ``tone_map``), so concatenated rows give each row's bits.
+Where the single device makes a call on its own image's rows that is not elementwise (a texture
+lookup per textured shape, a body-frame normal turned by a 3x3 product, the 2x2 samples' mean),
+it is made here per copy, on the same rows. Noise: each (copy, camera) draws its own stream
+(``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order, as
+``shading.to_bytes`` draws it.
+
+Not rendered here yet (refused in one line when a camera is observed, :func:`refusal`):
+semi-transparent surfaces (their layers) and shadows (lights with ``castShadows``). Recognition and
+segmentation are not measured: the batched cameras refuse enabling them, and changing the exposure
+(the world file's exposure is used).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import imaging, shading
+from sensorium.server.raycast import packets
+from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.sim.batched_depth import _Draws, _tiled
+from sensorium.server.sim.cameras import Camera, _shade, camera_lights
+from sensorium.server.sim.own_shapes import OwnBodyRays
+from sensorium.server.sim.scene import _base_color, robot_parts, solid_parts
+from sensorium.server.world.geometry import Pose
+
+__all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera", "refusal"]
+
+USE = "use Simulation"
+
+
+class BatchedCamera(Camera):
+    """A camera template of the batched simulation (its constants): what it does not measure
+    there is refused, never silently kept on the template."""
+
+    def recognition_enable(self, period_ms: int) -> None:
+        raise ValueError(f"{self.path}: batched cameras do not measure recognition ({USE})")
+
+    def enable_segmentation(self, on: bool) -> None:
+        raise ValueError(f"{self.path}: batched cameras do not measure segmentation ({USE})")
+
+    def set_exposure(self, exposure: float) -> None:
+        raise ValueError(f"{self.path}: batched cameras keep the world file's exposure ({USE})")
+
+
+KINDS = ("Camera",)
+CLASSES: dict[str, type] = {"Camera": BatchedCamera}
+
+
+def _solid_lights(solids: list[wm.Solid]) -> Iterator[Any]:
+    for s in solids:
+        yield from s.lights
+        yield from _solid_lights(s.children)
+
+
+def _shapes(world: wm.World) -> Iterator[tuple[str, Any]]:
+    """(name, shape model) of every shape of the world: solids (with their children) and robots."""
+    for s in world.solids:
+        for name, _, shape in solid_parts(s, Pose.identity()):
+            yield name, shape
+    for r in world.robots:
+        for name, _, shape in robot_parts(r):
+            yield name, shape
+
+
+def refusal(robot: str, config: Any, world: wm.World) -> str | None:
+    """Why the batched simulation does not render a camera (its world-file model) in this world,
+    or None: a light that is on and casts shadows, a semi-transparent surface a camera can see."""
+    if config.device != "Camera":
+        return None
+    where = f"{robot}/{config.name}"
+    for light in [*world.lights, *_solid_lights(world.solids)]:
+        if light.on and light.cast_shadows:
+            what = light.name or light.def_name or light.type
+            return f"{where}: batched cameras do not render shadows yet: light {what!r} casts shadows ({USE})"
+    for name, shape in _shapes(world):
+        a = shape.appearance
+        if a is not None and a.transparency > 0.0 and shape.seen_by in ("both", "visual"):
+            return (f"{where}: batched cameras do not render semi-transparent surfaces yet: shape {name!r} has "
+                    f"transparency {a.transparency:g} ({USE})")
+    return None
+
+
+class _Device:
+    """One camera's constants, made once (the single Camera._prepare's calls)."""
+
+    def __init__(self, template: BatchedCamera):
+        self.template = template
+        c = template.config
+        self.height, self.width = int(c.height), int(c.width)
+        self.samples = len(template._samples)
+        dirs = imaging.pixel_directions(template.geometry, template._samples)
+        self.dirs = np.ascontiguousarray(dirs.reshape(-1, 3))
+        self.n = len(self.dirs)                      # rays per image: samples x pixels
+        self.columns = tuple(np.ascontiguousarray(self.dirs[:, k]) for k in range(3))
+        factors = imaging.depth_factors(template.geometry, dirs)
+        self.limits = imaging.clip_limits(template.geometry, factors, c.near, c.far if c.far > 0 else math.inf)
+        self.exposure = float(c.exposure)
+        self.own: OwnBodyRays | None = None
+        self.skip: np.ndarray | int | None = None
+        self.plan: tuple | None = None
+
+
+class CameraDevices:
+    """The batched simulation's cameras: constants per device, BGRA images per copy."""
+
+    def __init__(self, sim: Any, devices: list[BatchedCamera]):
+        self.sim = sim
+        self.devices = [_Device(d) for d in devices]
+        self.images = [np.zeros((sim.copies, d.height, d.width, 4), dtype=np.uint8) for d in self.devices]
+        for img in self.images:
+            img[..., 3] = 255
+        self._buffers: dict[int, tuple] = {}
+        scene = sim.scene
+        self.lights = camera_lights(scene.world_lights())[0] if devices else None   # static: shared by all copies
+        # per hit shape (static shapes, then the robots' as CopyRays numbers them; -1 reads the last): the
+        # base colour a camera sees (robot bodies are never textured in the batched simulation)
+        colors = [_base_color(shape) for _, _, shape in (scene.part(i) for i in range(sim.n_static_shapes))]
+        colors += [_base_color(shape) for r in sim.world.robots for _, _, shape in robot_parts(r)]
+        self.colors = np.array(colors + [(1.0, 1.0, 1.0)], dtype=np.float64).reshape(-1, 3)
+
+    def reset(self, idx: np.ndarray) -> None:
+        """Black (alpha 255) before the first image (Webots), as a freshly built device."""
+        for img in self.images:
+            img[idx] = 0
+            img[idx, :, :, 3] = 255
+
+    # -- planning: each due camera's rays of every copy, cast in finish
+    def plan(self, copies: np.ndarray, cols: np.ndarray) -> tuple[dict, list]:
+        from sensorium.server.sim.batched import _lidar_beams  # (batched.py imports this module)
+
+        sim = self.sim
+        items = []
+        for col in sorted(set(cols.tolist())):
+            dev = self.devices[col]
+            c = copies[cols == col]
+            slot = dev.template.robot_index
+            local = dev.template.local_pose
+            rr = sim.rot[c, slot]
+            rot = np.matmul(rr, local.rotation)                                  # Pose.compose, stacked
+            org = np.matmul(rr, local.translation[None, :, None])[:, :, 0] + sim.pos[c, slot]
+            got = packets.lidar_beams(rot, org, dev.columns, self._beam_buffers(col, len(c) * dev.n))
+            origins, d, d32 = got if got is not None else _lidar_beams(rot, org, dev.columns)
+            items.append((col, c, org, origins, d, d32))
+        return {"items": items}, []
+
+    def _beam_buffers(self, col: int, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        got = self._buffers.get(col)
+        if got is None or len(got[0]) != rows:
+            got = self._buffers[col] = (np.empty((rows, 3)), np.empty((rows, 3)), np.empty((rows, 3), dtype=np.float32))
+        return got
+
+    def _rows(self, col: int, copies: np.ndarray) -> tuple:
+        """Per ray of the images of ``copies``: its copy, its mount slot and its limits (kept)."""
+        dev = self.devices[col]
+        if dev.plan is not None and np.array_equal(dev.plan[0], copies):
+            return dev.plan[1:]
+        k = len(copies)
+        mount = self._mount(col)
+        if isinstance(mount, np.ndarray):
+            mount = np.tile(mount, k)
+        t_near, t_far = dev.limits
+        dev.plan = (copies.copy(), np.repeat(copies, dev.n), mount, _tiled(t_near, k), _tiled(t_far, k))
+        return dev.plan[1:]
+
+    def _mount(self, col: int) -> np.ndarray | int:
+        """As ``DepthDevices._mount``: the robot a camera's rays skip in the world cast (its own,
+        met apart, when it has shapes of its own; else per pixel where the ray can never reach it)."""
+        dev = self.devices[col]
+        if dev.skip is None:
+            tpl = dev.template
+            slot = tpl.robot_index
+            body = self.sim.rays.slot_body[slot]
+            if tpl.own_shapes and body is not None:
+                dev.own = OwnBodyRays(body, tpl.local_pose, dev.dirs, *dev.limits, tpl.own_shapes)
+                dev.skip = slot
+            else:
+                local = tpl.local_pose
+                d = dev.dirs @ local.rotation.T
+                reach = self.sim.rays.may_reach(slot, RayKind.VISUAL, np.broadcast_to(local.translation, d.shape), d,
+                                                *dev.limits)
+                skip = np.where(reach, -1, slot).astype(np.int64)
+                dev.skip = int(skip[0]) if (skip == skip[0]).all() else skip
+        return dev.skip
+
+    # -- finishing: cast, shade, the images
+    def finish(self, state: dict, hits: list[RayHits]) -> None:
+        sim = self.sim
+        for col, c, org, origins, d, d32 in state["items"]:
+            dev = self.devices[col]
+            ray_copy, mount, t_near, t_far = self._rows(col, c)
+            h = sim.rays.cast(origins, d, t_near, t_far, RayKind.VISUAL, ray_copy, sim.rot, sim.pos, -1, mount, False,
+                              False, d32, True, origin_rows=org, run=dev.n)
+            sim.counters["measurements"] += len(c)
+            self._image(col, c, org, d, self._with_own_body(col, c, h))
+            sim.last["Camera"][c, col] = sim.time_ms[c]
+
+    def _with_own_body(self, col: int, copies: np.ndarray, h: RayHits) -> RayHits:
+        """A housed camera's hits: the nearer of the world cast and its robot's body (OwnBodyRays.cast,
+        per copy: the body-frame normal turned by that copy's robot rotation, on the same rows)."""
+        dev = self.devices[col]
+        if dev.own is None:
+            return h
+        b = dev.own.body_hits(self.sim.rays.movers)
+        assert b.shape is not None and b.normal is not None and h.shape is not None and h.normal is not None
+        dist, shape, normal = h.distance.copy(), h.shape.copy(), h.normal.copy()
+        offset = self.sim.rays.shape_offset
+        slot = dev.template.robot_index
+        for k, cc in enumerate(copies.tolist()):
+            a = k * dev.n
+            win = (b.distance < dist[a:a + dev.n]).nonzero()[0]
+            if not len(win):
+                continue
+            dist[a + win] = b.distance[win]
+            shape[a + win] = offset + b.shape[win]
+            normal[a + win] = b.normal[win] @ self.sim.rot[cc, slot].T          # body frame -> world
+        return RayHits(dist, normal, shape)
+
+    def _albedo(self, shape: np.ndarray, org: np.ndarray, row_copy: np.ndarray, D: np.ndarray,
+                t: np.ndarray) -> np.ndarray:
+        """``Scene.surface_colors`` of hits of every copy: base colours by shape; a textured static
+        shape's texels per copy, on the rows the single camera would pass (its image's hits)."""
+        col = np.take(self.colors, shape, axis=0)
+        scene = self.sim.scene
+        sampler = scene.textures
+        if sampler is None:
+            return col
+        static = shape < self.sim.n_static_shapes
+        textured = np.zeros(len(shape), dtype=bool)
+        textured[static] = sampler.textured[shape[static]]
+        rows = textured.nonzero()[0]
+        for q in np.unique(row_copy[rows]).tolist():
+            rq = rows[row_copy[rows] == q]
+            col[rq] = scene.surface_colors(shape[rq], np.broadcast_to(org[q], (len(rq), 3)), D[rq], t[rq])
+        return col
+
+    def _image(self, col: int, copies: np.ndarray, org: np.ndarray, dirs: np.ndarray, hits: RayHits) -> None:
+        """Camera._capture_image and the first layer of Camera._render (every surface opaque, no
+        shadows: refusal) for each copy's rays, rows of all copies at once."""
+        sim = self.sim
+        dev = self.devices[col]
+        cfg = dev.template.config
+        scene = sim.scene
+        k = len(copies)
+        n = len(dirs)
+        out = np.zeros((n, 3))
+        weight = np.ones(n)
+        t, shape, normal = hits.distance, hits.shape, hits.normal
+        assert shape is not None and normal is not None
+        hit = np.isfinite(t)
+        miss = (~hit).nonzero()[0]
+        if len(miss):
+            shading.add_to_rows(out, miss, shading.scaled_rows(weight[miss], scene.background))
+        kk = hit.nonzero()[0]
+        if len(kk):
+            row_copy = kk // dev.n                     # each hit's copy (its index in ``copies``)
+            Dk = shading.take_rows(dirs, kk)
+            tk = t.take(kk)
+            P = np.empty((len(kk), 3))                 # origin + t D, column by column
+            for ch in range(3):
+                np.multiply(tk, Dk[:, ch], out=P[:, ch])
+                P[:, ch] += org[row_copy, ch]
+            N = shading.take_rows(normal, kk)
+            back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+            if back.any():                             # facing the camera
+                bk = back.nonzero()[0]
+                N[bk] = np.negative(shading.take_rows(N, bk))
+            s = shape.take(kk)
+            albedo = self._albedo(s, org, row_copy, Dk, tk)
+            L = _shade(P, N, albedo, self.lights, None, scene.engine.threads)
+            if scene.fog is not None:
+                L = shading.fog(L, tk, *scene.fog)
+            share = weight[kk] * (1.0 - np.zeros(len(kk)))   # (opaque: transparency 0, as the single's share)
+            for ch in range(3):
+                L[:, ch] *= share
+            shading.add_to_rows(out, kk, L)
+        S = dev.samples
+        if S > 1:     # supersampling, per copy as the single camera averages its image's rays
+            per = out.reshape(k, S * dev.height * dev.width, 3)
+            out = np.concatenate([per[q].reshape(S, -1, 3).mean(axis=0) for q in range(k)])
+        v = shading.tone_map(out, dev.exposure).reshape(k, dev.height, dev.width, 3)
+        rng = None
+        if cfg.noise > 0:
+            rng = _Draws(sim.noise, copies.tolist(), sim._noise_col[("Camera", col)], [v[0].size] * k)
+        rgb = shading.to_bytes(v, cfg.noise, rng)      # type: ignore[arg-type]
+        img = self.images[col]
+        img[copies, :, :, 0] = rgb[..., 2]
+        img[copies, :, :, 1] = rgb[..., 1]
+        img[copies, :, :, 2] = rgb[..., 0]
+        img[copies, :, :, 3] = 255
