@@ -99,9 +99,32 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
         seen["sky"] += int((dome[..., :3] == sky).all(axis=-1).any())
     assert seen["black"] > 0 and seen["sky"] > 0 and seen["textured"] > 0
     assert bs.camera.devices[1].own is not None            # "housed" meets its robot apart, blind to its box
+    pano = bs.camera.devices[2].skip                       # some of pano's rays meet its own robot's mast
+    assert isinstance(pano, np.ndarray) and 0 < (pano < 0).sum() < len(pano)
     # the noise is each copy's own: the same camera's images differ between copies
     eye = bs.image(bs.device("rover", "eye"))
     assert len({img.tobytes() for img in eye}) == len(seeds)
+
+
+def test_the_rays_skipping_their_robot_never_meet_it(texture_dir: Path):
+    """batched_camera._may_meet_parts (a camera's rays that may meet one of its robot's shapes; the
+    others skip that robot in every copy's cast): 4,000 random rays from inside the rover's box (its
+    cameras' places) that meet its body, cast in the body frame, are all kept, and most that do not
+    are dropped."""
+    from sensorium.server.raycast.engine import RayKind
+    from sensorium.server.sim.batched_camera import _may_meet_parts
+
+    bs = BatchedSimulation(_world(0, texture_dir), 1)
+    body = bs.rays.slot_body[0]
+    rng = np.random.default_rng(3)
+    for origin in ([0.07, 0.0, 0.1], [0.0, 0.0, 0.14], [0.09, 0.0, 0.08]):
+        D = rng.normal(size=(4000, 3))
+        D /= np.linalg.norm(D, axis=1)[:, None]
+        O = np.broadcast_to(np.array(origin), D.shape)
+        meets = np.isfinite(bs.rays.movers.cast_local(body, O, D, 0.0, np.inf, kind=RayKind.VISUAL).distance)
+        kept = _may_meet_parts(bs.world.robots[0], bs.loaded.base_dir, O, D, 0.0, np.inf)
+        assert meets.any() and kept[meets].all(), origin
+        assert (~kept[~meets]).mean() > 0.5, origin
 
 
 def _facing(d: list[float], fog: bool) -> wm.World:

@@ -39,8 +39,8 @@ from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import _Draws, _tiled
 from sensorium.server.sim.cameras import Camera, _shade, camera_lights
 from sensorium.server.sim.own_shapes import OwnBodyRays
-from sensorium.server.sim.scene import _base_color, robot_parts, solid_parts
-from sensorium.server.world.geometry import Pose
+from sensorium.server.sim.scene import _base_color, primitive_from_model, robot_parts, solid_parts
+from sensorium.server.world.geometry import Pose, tessellate
 
 __all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera", "refusal"]
 
@@ -97,6 +97,33 @@ def refusal(robot: str, config: Any, world: wm.World) -> str | None:
             return (f"{where}: batched cameras do not render semi-transparent surfaces yet: shape {name!r} has "
                     f"transparency {a.transparency:g} ({USE})")
     return None
+
+
+def _may_meet_parts(robot: wm.Robot, base_dir: Any, origins: np.ndarray, directions: np.ndarray, t_near, t_far,
+                    margin: float = 1e-6) -> np.ndarray:
+    """Which rays, given in the robot's body frame, may meet one of its shapes: the box of each
+    shape's tessellation (curved ones circumscribed: it holds the analytic surface) grown by
+    ``margin``, as ``CopyRays.may_reach`` tests the whole body's box (conservative for the same rays
+    moved into the frame from any pose). A camera sits inside its robot's box, rarely inside one
+    of its shapes' boxes: most of its pixel rays can then skip their robot in every copy's cast."""
+    O = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+    D = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    lo_t = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (len(D),)) - margin
+    hi_t = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (len(D),)) + margin
+    out = np.zeros(len(D), dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Dn = np.where(D == 0.0, 1e-300, D)
+        for _, local, shape in robot_parts(robot):
+            try:
+                v = tessellate(primitive_from_model(shape.geometry, base_dir))[0]
+            except ValueError:             # a plane: unbounded
+                return np.ones(len(D), dtype=bool)
+            w = local.apply(v)
+            ta, tb = (w.min(axis=0) - margin - O) / Dn, (w.max(axis=0) + margin - O) / Dn
+            t0 = np.maximum(np.minimum(ta, tb).max(axis=1), lo_t)
+            t1 = np.minimum(np.maximum(ta, tb).min(axis=1), hi_t)
+            out |= t0 <= t1
+    return out
 
 
 class _Device:
@@ -195,8 +222,10 @@ class CameraDevices:
             else:
                 local = tpl.local_pose
                 d = dev.dirs @ local.rotation.T
-                reach = self.sim.rays.may_reach(slot, RayKind.VISUAL, np.broadcast_to(local.translation, d.shape), d,
-                                                *dev.limits)
+                o = np.broadcast_to(local.translation, d.shape)
+                reach = self.sim.rays.may_reach(slot, RayKind.VISUAL, o, d, *dev.limits)
+                if reach.any():     # a camera inside its robot's box: which rays may meet one of its shapes
+                    reach &= _may_meet_parts(self.sim.world.robots[slot], self.sim.loaded.base_dir, o, d, *dev.limits)
                 skip = np.where(reach, -1, slot).astype(np.int64)
                 dev.skip = int(skip[0]) if (skip == skip[0]).all() else skip
         return dev.skip
@@ -247,8 +276,10 @@ class CameraDevices:
         textured = np.zeros(len(shape), dtype=bool)
         textured[static] = sampler.textured[shape[static]]
         rows = textured.nonzero()[0]
-        for q in np.unique(row_copy[rows]).tolist():
-            rq = rows[row_copy[rows] == q]
+        of = row_copy[rows]                  # nondecreasing: the hits come copy after copy
+        cuts = np.flatnonzero(of[1:] != of[:-1]) + 1
+        for rq in np.split(rows, cuts) if len(rows) else ():
+            q = int(row_copy[rq[0]])
             col[rq] = scene.surface_colors(shape[rq], np.broadcast_to(org[q], (len(rq), 3)), D[rq], t[rq])
         return col
 
