@@ -183,8 +183,9 @@ def test_a_camera_facing_a_lit_matte_wall_reads_the_shading_models_value(precisi
 def test_copies_never_see_each_others_robots(texture_dir: Path):
     """The scout parked 0.5 m in front of the rover in copy 0 and off in a corner in copy 1 (both
     copies with world seed 0): each copy's images are those of a Simulation with its scout where
-    that copy has it, byte for byte, and the noiseless housed camera's pixels differ between the two
-    copies where copy 0's scout (magenta) is in view: copy 1's rover does not see copy 0's scout."""
+    that copy has it, byte for byte (shadows included: the lamp and the sun cast them), and the
+    noiseless housed camera's pixels differ between the two copies only where copy 0's scout
+    (magenta) or its shadow (darker) is in view: copy 1's rover sees neither."""
     lw = _world(0, texture_dir)
     bs = BatchedSimulation(lw, 2, precision="exact")
     bs.reset([0, 1], [0, 0])
@@ -215,14 +216,50 @@ def test_copies_never_see_each_others_robots(texture_dir: Path):
     differ = (img[0] != img[1]).any(axis=-1)
     assert differ.sum() >= 4
     b, g, r = img[0][differ][:, 0], img[0][differ][:, 1], img[0][differ][:, 2]
-    assert ((r > g) & (b > g)).all()                  # the scout's magenta where copy 0 sees it
+    magenta = (r > g + 30) & (b > g + 30)               # the scout where copy 0 sees it
+    shade = img[0][differ].sum(axis=-1) < img[1][differ].sum(axis=-1)    # or its shadow: darker
+    assert magenta.any() and (magenta | shade).all()
 
 
-def _shadowed(base: Path) -> LoadedWorld:
-    lw = _world(0, base)
-    w = lw.world
-    lights = [w.lights[0], w.lights[1].model_copy(update={"cast_shadows": True})]
-    return LoadedWorld(world=w.model_copy(update={"lights": lights}), source=lw.source, base_dir=base)
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_robot_shadows_the_wall_in_its_own_copy_only(precision: str):
+    """The lit matte wall, now under a directional light along (1, 0.5, 0) that casts shadows, and a
+    second robot, a 0.1 m box: in copy 0 it stands between the wall's centre point and the light
+    (out of the centre pixel's ray), in copy 1 far off. Copy 0's centre pixel reads the ambient term
+    alone, albedo x 0.2; copy 1's the full albedo x (0.2 + 0.7 N.L), N.L = 1/sqrt(1.25); each copy's
+    image is the single Simulation's with that robot where the copy has it, byte for byte."""
+    w = _facing([1.0], fog=False)
+    data = w.model_dump(mode="json", exclude_none=True)
+    data["lights"] = [{"type": "DirectionalLight", "direction": [1, 0.5, 0], "intensity": 0.7,
+                       "ambient_intensity": 0.2, "cast_shadows": True}]
+    data["robots"].append({"name": "blocker", "pose": {"translation": [5.0, 5.0, 0.0]},
+                           "shapes": [{"pose": {"translation": [0, 0, 0.1]},
+                                       "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}}]})
+    lw = LoadedWorld(world=wm.World.model_validate(data), source="<test>", base_dir=Path.cwd())
+    bs = BatchedSimulation(lw, 2, precision=precision)
+    places = [[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]]
+    ref = bs.device("bot", "cam")
+    bs.enable(ref, 8)
+    singles = []
+    for c, t in enumerate(places):
+        bs.set_pose(c, bs.slot("blocker"), translation=t)
+        single = Simulation(lw, precision=precision)
+        single.robot("blocker").set_pose(t)
+        single.robot("bot").device("cam").enable(8)
+        singles.append(single)
+    bs.step()
+    img = bs.image(ref)
+    for c, single in enumerate(singles):
+        single.step()
+        assert img[c].tobytes() == single.robot("bot").device("cam").image.tobytes(), c
+    albedo = np.array([0.6, 0.3, 0.15])
+
+    def byte(x: np.ndarray) -> np.ndarray:
+        return np.floor(255.0 * (1.0 - np.exp(-x * 1.3)) ** (1.0 / 2.2) + 0.5)
+
+    rgb = img[:, 2, 5, 2::-1].astype(np.float64)
+    assert (rgb[0] == byte(albedo * 0.2)).all()
+    assert (rgb[1] == byte(albedo * (0.2 + 0.7 / math.sqrt(1.25)))).all()
 
 
 def _glass(base: Path) -> LoadedWorld:
@@ -235,16 +272,12 @@ def _glass(base: Path) -> LoadedWorld:
 
 
 def test_what_batched_cameras_do_not_render_is_refused_in_one_line(texture_dir: Path):
-    """Shadows (a light that casts them) and semi-transparent surfaces: observing a camera refuses
-    in one line naming the camera, the light or shape and what to use; the rest of the world runs
-    (a camera not observed is never computed); recognition, segmentation and exposure changes of a
-    batched camera are refused rather than kept on its template."""
-    bs = BatchedSimulation(_shadowed(texture_dir), 2)
-    with pytest.raises(BatchedError) as e:
-        bs.device("rover", "eye")
-    assert str(e.value) == ("rover/eye: batched cameras do not render shadows yet: light 'sun' casts shadows "
-                            "(use Simulation)")
+    """Semi-transparent surfaces: observing a camera in such a world refuses in one line naming the
+    camera, the shape and what to use; the rest of the world runs (a camera not observed is never
+    computed); recognition, segmentation and exposure changes of a batched camera are refused rather
+    than kept on its template."""
     bs = BatchedSimulation(_glass(texture_dir), 2)
+    bs.step()                                              # the world runs (its cameras are not computed)
     with pytest.raises(BatchedError) as e:
         bs.check_observable("scout", "dome")
     assert str(e.value) == ("scout/dome: batched cameras do not render semi-transparent surfaces yet: shape "
@@ -316,9 +349,9 @@ def test_the_vector_env_observes_cameras_as_the_single_env(precision: str, textu
 
 def test_the_vector_env_refuses_an_observed_camera_it_cannot_render(texture_dir: Path):
     with pytest.raises(BatchedError) as e:
-        SensoriumVectorEnv(_shadowed(texture_dir), _task(), 2)
-    assert str(e.value) == ("rover/eye: batched cameras do not render shadows yet: light 'sun' casts shadows: the "
-                            "batched vector environment cannot run this task (SensoriumEnv can: "
+        SensoriumVectorEnv(_glass(texture_dir), _task(), 2)
+    assert str(e.value) == ("rover/eye: batched cameras do not render semi-transparent surfaces yet: shape 'crate' "
+                            "has transparency 0.4: the batched vector environment cannot run this task (SensoriumEnv can: "
                             "gymnasium.vector.SyncVectorEnv or AsyncVectorEnv of it)")
     # the single env's "auto" engine runs such a task on the rebuilt Simulation
-    assert SensoriumEnv(_shadowed(texture_dir), _task(), engine="auto").engine == "simulation"
+    assert SensoriumEnv(_glass(texture_dir), _task(), engine="auto").engine == "simulation"

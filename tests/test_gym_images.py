@@ -58,11 +58,11 @@ def test_images_are_not_observed_unless_named():
 
 
 def test_the_auto_engine_runs_image_tasks_batched_with_the_same_episodes():
-    """The batched engine simulates cameras (opaque surfaces, no shadows: batched_camera.py):
+    """The batched engine simulates cameras (opaque surfaces: batched_camera.py):
     engine="auto" (the PettingZoo env's default) runs a task observing one on the one-copy batched
-    simulation, giving engine="simulation"'s episode bit for bit. A camera in a world whose light
-    casts shadows is refused by engine="batched" and the batched vector env in one line saying what
-    to use, and "auto" then runs the rebuilt Simulation."""
+    simulation, giving engine="simulation"'s episode bit for bit. A camera in a world with a
+    semi-transparent surface is refused by engine="batched" and the batched vector env in one line
+    saying what to use, and "auto" then runs the rebuilt Simulation."""
     from sensorium.gym import SensoriumParallelEnv
     from sensorium.gym.vector import SensoriumVectorEnv
     from sensorium.server.sim.batched import BatchedError
@@ -81,16 +81,18 @@ def test_the_auto_engine_runs_image_tasks_batched_with_the_same_episodes():
             b, rb, *_ = ref.step(act)
             assert ra == rb
     assert SensoriumParallelEnv(world(), {"bot": task}).engine == "batched"
-    shadows = world().model_copy(update={"lights": [world().lights[0].model_copy(update={"cast_shadows": True})]})
+    wall = world().solids[0]
+    glass = wall.model_copy(update={"appearance": wall.appearance.model_copy(update={"transparency": 0.5})})
+    glassy = world().model_copy(update={"solids": [glass]})
     one = Task(robot="bot", observations=["cam"])
-    assert SensoriumEnv(shadows, one, engine="auto").engine == "simulation"
-    with pytest.raises(BatchedError, match=r"^bot/cam: batched cameras do not render shadows yet: light "
-                                           r"'PointLight' casts shadows \(use Simulation\)$"):
-        SensoriumEnv(shadows, one, engine="batched")
+    assert SensoriumEnv(glassy, one, engine="auto").engine == "simulation"
+    with pytest.raises(BatchedError, match=r"^bot/cam: batched cameras do not render semi-transparent surfaces yet: "
+                                           r"shape 'wall' has transparency 0.5 \(use Simulation\)$"):
+        SensoriumEnv(glassy, one, engine="batched")
     with pytest.raises(BatchedError) as e:
-        SensoriumVectorEnv(shadows, one, 2)
-    assert str(e.value) == ("bot/cam: batched cameras do not render shadows yet: light 'PointLight' casts shadows: "
-                            "the batched vector environment cannot run this task (SensoriumEnv can: "
+        SensoriumVectorEnv(glassy, one, 2)
+    assert str(e.value) == ("bot/cam: batched cameras do not render semi-transparent surfaces yet: shape 'wall' has "
+                            "transparency 0.5: the batched vector environment cannot run this task (SensoriumEnv can: "
                             "gymnasium.vector.SyncVectorEnv or AsyncVectorEnv of it)")
     assert SensoriumEnv(world(), Task(robot="bot", observations=["depth", "ds"]), engine="auto").engine == "batched"
     # the same robot observed without its images runs batched (its camera is never computed)

@@ -14,12 +14,15 @@ The shading is the single camera's, on every copy's rows at once: each step is e
 row, ``shading.fog``, the background, ``tone_map``), so concatenated rows give each row's bits.
 Where the single device makes a call on its own image's rows that is not elementwise (a texture
 lookup per textured shape, a body-frame normal turned by a 3x3 product, the 2x2 samples' mean),
-it is made here per copy, on the same rows. Noise: each (copy, camera) draws its own stream
+it is made here per copy, on the same rows. Shadows (lights with ``castShadows``) are the single
+camera's rays from each surface point towards each shadow-casting light, cast per copy and light
+as the single camera casts them: a ray leaving a surface is told from a self-hit by thresholds
+that depend on the cast's origins, so another copy's points must not share its cast. Noise: each (copy, camera) draws its own stream
 (``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order, as
 ``shading.to_bytes`` draws it.
 
 Not rendered here yet (refused in one line when a camera is observed, :func:`refusal`):
-semi-transparent surfaces (their layers) and shadows (lights with ``castShadows``). Recognition and
+semi-transparent surfaces (their layers). Recognition and
 segmentation are not measured: the batched cameras refuse enabling them, and changing the exposure
 (the world file's exposure is used).
 """
@@ -34,6 +37,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import imaging, shading
+from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import _Draws, _tiled
@@ -65,12 +69,6 @@ KINDS = ("Camera",)
 CLASSES: dict[str, type] = {"Camera": BatchedCamera}
 
 
-def _solid_lights(solids: list[wm.Solid]) -> Iterator[Any]:
-    for s in solids:
-        yield from s.lights
-        yield from _solid_lights(s.children)
-
-
 def _shapes(world: wm.World) -> Iterator[tuple[str, Any]]:
     """(name, shape model) of every shape of the world: solids (with their children) and robots."""
     for s in world.solids:
@@ -83,14 +81,10 @@ def _shapes(world: wm.World) -> Iterator[tuple[str, Any]]:
 
 def refusal(robot: str, config: Any, world: wm.World) -> str | None:
     """Why the batched simulation does not render a camera (its world-file model) in this world,
-    or None: a light that is on and casts shadows, a semi-transparent surface a camera can see."""
+    or None: a semi-transparent surface a camera can see."""
     if config.device != "Camera":
         return None
     where = f"{robot}/{config.name}"
-    for light in [*world.lights, *_solid_lights(world.solids)]:
-        if light.on and light.cast_shadows:
-            what = light.name or light.def_name or light.type
-            return f"{where}: batched cameras do not render shadows yet: light {what!r} casts shadows ({USE})"
     for name, shape in _shapes(world):
         a = shape.appearance
         if a is not None and a.transparency > 0.0 and shape.seen_by in ("both", "visual"):
@@ -157,7 +151,8 @@ class CameraDevices:
             img[..., 3] = 255
         self._buffers: dict[int, tuple] = {}
         scene = sim.scene
-        self.lights = camera_lights(scene.world_lights())[0] if devices else None   # static: shared by all copies
+        # the lights that are on and which cast shadows: static, shared by all copies
+        self.lights, self.shadows = camera_lights(scene.world_lights()) if devices else (None, np.zeros(0, dtype=bool))
         # per hit shape (static shapes, then the robots' as CopyRays numbers them; -1 reads the last): the
         # base colour a camera sees (robot bodies are never textured in the batched simulation)
         colors = [_base_color(shape) for _, _, shape in (scene.part(i) for i in range(sim.n_static_shapes))]
@@ -283,9 +278,34 @@ class CameraDevices:
             col[rq] = scene.surface_colors(shape[rq], np.broadcast_to(org[q], (len(rq), 3)), D[rq], t[rq])
         return col
 
+    def _shadows(self, P: np.ndarray, N: np.ndarray, row_copy: np.ndarray, copies: np.ndarray) -> np.ndarray:
+        """Camera._shadows of each copy's hits, copy by copy (its rows, in order): (rows, lights) False
+        where a shadow-casting light is hidden from the point by a visible shape of that copy (its
+        segment to the light, 1000 m towards a directional one); only lit, facing pairs cast. Each
+        copy's shadow rays of a light are a cast of their own, as the single camera's: rays leaving a
+        surface are judged against self-hits with thresholds that depend on the cast's origins."""
+        sim = self.sim
+        lights = self.lights
+        assert lights is not None
+        lit = np.ones((len(P), len(lights)), dtype=bool)
+        cuts = np.flatnonzero(row_copy[1:] != row_copy[:-1]) + 1
+        for rq in np.split(np.arange(len(P)), cuts) if len(P) else ():
+            q = int(copies[row_copy[rq[0]]])
+            Pq, Nq = P[rq], N[rq]
+            direct = light_math.light_terms(Pq, Nq, lights)[1]
+            unit, length = light_math.occlusion_segments_many(Pq, lights)
+            for j in self.shadows.nonzero()[0].tolist():
+                i = (direct[:, j] > 0.0).nonzero()[0]
+                if len(i) == 0:
+                    continue
+                h = sim.rays.cast(Pq[i], unit[i, j], 0.0, length[i, j], RayKind.VISUAL, np.full(len(i), q, dtype=np.int64),
+                                  sim.rot, sim.pos, -1, -1, False, distance_only=True)
+                lit[rq[i], j] = ~(h.distance <= length[i, j])
+        return lit
+
     def _image(self, col: int, copies: np.ndarray, org: np.ndarray, dirs: np.ndarray, hits: RayHits) -> None:
-        """Camera._capture_image and the first layer of Camera._render (every surface opaque, no
-        shadows: refusal) for each copy's rays, rows of all copies at once."""
+        """Camera._capture_image and the first layer of Camera._render (every surface opaque:
+        refusal) for each copy's rays, rows of all copies at once."""
         sim = self.sim
         dev = self.devices[col]
         cfg = dev.template.config
@@ -316,7 +336,8 @@ class CameraDevices:
                 N[bk] = np.negative(shading.take_rows(N, bk))
             s = shape.take(kk)
             albedo = self._albedo(s, org, row_copy, Dk, tk)
-            L = _shade(P, N, albedo, self.lights, None, scene.engine.threads)
+            lit = self._shadows(P, N, row_copy, copies) if self.shadows.any() else None
+            L = _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
             if scene.fog is not None:
                 L = shading.fog(L, tk, *scene.fog)
             share = weight[kk] * (1.0 - np.zeros(len(kk)))   # (opaque: transparency 0, as the single's share)
