@@ -19,12 +19,12 @@ with copy c's seed, bit for bit, for what it simulates: the drive (the same floa
 3x3 products), kinematic contact (the same broad phase per copy, the same narrow phase), light
 sensors, distance sensors, fixed lidars, wheel encoders, GPS (local coordinates), compasses,
 inertial units, gyros and accelerometers (batched_kinematic.py), range finders (batched_depth.py), cameras
-(batched_camera.py: opaque surfaces), each
+(batched_camera.py), each
 device's noise drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the
 same numbers, in the same order). Tests compare it with the single simulation step by step.
 
-Not simulated here (use :class:`Simulation`): rotating lidars, cameras seeing semi-transparent
-surfaces, camera recognition, a GPS in a
+Not simulated here (use :class:`Simulation`): rotating lidars, camera recognition and
+segmentation, a GPS in a
 WGS84 world, altimeters, the kinds without an observation (LEDs, pens, ...),
 lights carried by robots, textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
@@ -72,15 +72,15 @@ class BatchedError(ValueError):
     """The world uses something the batched simulation does not simulate (the message says what)."""
 
 
-def _refusal(robot: str, config, world: wm.World) -> str | None:
-    """Why the batched simulation does not measure a device (its world-file model) in this world,
-    or None."""
+def _refusal(robot: str, config, world_info: wm.WorldInfo) -> str | None:
+    """Why the batched simulation does not measure a device (its world-file model) in a world
+    with this world_info, or None."""
     if config.device not in SUPPORTED_KINDS:
         return (f"robot {robot!r}: device {config.name!r} is a {config.device}; the batched simulation measures "
                 f"{', '.join(SUPPORTED_KINDS)} (use Simulation)")
     if config.device == "Lidar" and config.type == "rotating":
         return f"{robot}/{config.name}: rotating lidars are not simulated by the batched simulation (use Simulation)"
-    return kin.refusal(robot, config, world.world_info) or cam.refusal(robot, config, world)
+    return kin.refusal(robot, config, world_info)
 
 
 def check_observable(world: wm.World, robot: str, names: Iterable[str]) -> None:
@@ -89,7 +89,7 @@ def check_observable(world: wm.World, robot: str, names: Iterable[str]) -> None:
     is built (names it does not know are left to the caller)."""
     devices = {d.name: d for r in world.robots if r.name == robot for d in r.devices}
     for name in names:
-        why = _refusal(robot, devices[name], world) if name in devices else None
+        why = _refusal(robot, devices[name], world.world_info) if name in devices else None
         if why:
             raise BatchedError(why)
 
@@ -313,8 +313,7 @@ class BatchedSimulation:
         self._lists = lists
         for slot, r in enumerate(self.world.robots):
             for d in r.devices:
-                if (d.device not in lists or kin.refusal(r.name, d, self.world.world_info)
-                        or cam.refusal(r.name, d, self.world)):
+                if d.device not in lists or kin.refusal(r.name, d, self.world.world_info):
                     continue
                 dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
                                         world_seed=0, clock=lambda: 0,
@@ -426,14 +425,14 @@ class BatchedSimulation:
         if ref is None:
             kinds = {d.name: d for d in self.world.robots[slot].devices}
             if name in kinds:
-                raise BatchedError(_refusal(robot, kinds[name], self.world) or f"{robot}/{name}: not measured")
+                raise BatchedError(_refusal(robot, kinds[name], self.world.world_info) or f"{robot}/{name}: not measured")
             raise KeyError(f"robot {robot!r} has no device {name!r} (devices: {', '.join(kinds)})")
         return ref
 
     def check_observable(self, robot: str, name: str) -> DeviceRef:
         """The device, if the batched simulation measures it (else BatchedError saying why)."""
         ref = self.device(robot, name)
-        why = _refusal(robot, self.template(ref).config, self.world)
+        why = _refusal(robot, self.template(ref).config, self.world.world_info)
         if why:
             raise BatchedError(why)
         return ref

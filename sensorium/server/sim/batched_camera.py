@@ -17,20 +17,20 @@ lookup per textured shape, a body-frame normal turned by a 3x3 product, the 2x2 
 it is made here per copy, on the same rows. Shadows (lights with ``castShadows``) are the single
 camera's rays from each surface point towards each shadow-casting light, cast per copy and light
 as the single camera casts them: a ray leaving a surface is told from a self-hit by thresholds
-that depend on the cast's origins, so another copy's points must not share its cast. Noise: each (copy, camera) draws its own stream
-(``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order, as
-``shading.to_bytes`` draws it.
+that depend on the cast's origins, so another copy's points must not share its cast. In a world
+with semi-transparent surfaces each copy's image is composited as the single camera composites it
+(``Camera._render``'s layers, from the copies' first cast): the rays going on past a surface are
+cast for that copy alone, from its camera with per-ray limits. Noise: each (copy, camera) draws its
+own stream (``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order,
+as ``shading.to_bytes`` draws it.
 
-Not rendered here yet (refused in one line when a camera is observed, :func:`refusal`):
-semi-transparent surfaces (their layers). Recognition and
-segmentation are not measured: the batched cameras refuse enabling them, and changing the exposure
-(the world file's exposure is used).
+Recognition and segmentation are not measured (the gym envs observe neither): the batched cameras
+refuse enabling them, and changing the exposure (the world file's exposure is used).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -41,12 +41,12 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import _Draws, _tiled
-from sensorium.server.sim.cameras import Camera, _shade, camera_lights
-from sensorium.server.sim.own_shapes import OwnBodyRays
-from sensorium.server.sim.scene import _base_color, primitive_from_model, robot_parts, solid_parts
-from sensorium.server.world.geometry import Pose, tessellate
+from sensorium.server.sim.cameras import MAX_LAYERS, Camera, _shade, camera_lights
+from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
+from sensorium.server.sim.scene import _base_color, primitive_from_model, robot_parts
+from sensorium.server.world.geometry import tessellate
 
-__all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera", "refusal"]
+__all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera"]
 
 USE = "use Simulation"
 
@@ -67,30 +67,6 @@ class BatchedCamera(Camera):
 
 KINDS = ("Camera",)
 CLASSES: dict[str, type] = {"Camera": BatchedCamera}
-
-
-def _shapes(world: wm.World) -> Iterator[tuple[str, Any]]:
-    """(name, shape model) of every shape of the world: solids (with their children) and robots."""
-    for s in world.solids:
-        for name, _, shape in solid_parts(s, Pose.identity()):
-            yield name, shape
-    for r in world.robots:
-        for name, _, shape in robot_parts(r):
-            yield name, shape
-
-
-def refusal(robot: str, config: Any, world: wm.World) -> str | None:
-    """Why the batched simulation does not render a camera (its world-file model) in this world,
-    or None: a semi-transparent surface a camera can see."""
-    if config.device != "Camera":
-        return None
-    where = f"{robot}/{config.name}"
-    for name, shape in _shapes(world):
-        a = shape.appearance
-        if a is not None and a.transparency > 0.0 and shape.seen_by in ("both", "visual"):
-            return (f"{where}: batched cameras do not render semi-transparent surfaces yet: shape {name!r} has "
-                    f"transparency {a.transparency:g} ({USE})")
-    return None
 
 
 def _may_meet_parts(robot: wm.Robot, base_dir: Any, origins: np.ndarray, directions: np.ndarray, t_near, t_far,
@@ -118,6 +94,26 @@ def _may_meet_parts(robot: wm.Robot, base_dir: Any, origins: np.ndarray, directi
             t1 = np.minimum(np.maximum(ta, tb).min(axis=1), hi_t)
             out |= t0 <= t1
     return out
+
+
+class _CopyEngine:
+    """One copy's world as a ray engine's ``cast`` (what ``cast_skipping`` calls): the copies' cast
+    with that copy's rays alone."""
+
+    def __init__(self, sim: Any, copy: int):
+        self.sim, self.copy = sim, copy
+
+    def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.VISUAL, exclude_owner=-1,
+             directions32=None) -> RayHits:
+        sim = self.sim
+        copy = np.full(len(directions), self.copy, dtype=np.int64)
+        return sim.rays.cast(origins, directions, t_near, t_far, kind, copy, sim.rot, sim.pos, exclude_owner, -1,
+                             False, directions32=directions32)
+
+
+def _rows_of(hits: RayHits, a: int, b: int) -> RayHits:
+    assert hits.shape is not None and hits.normal is not None
+    return RayHits(hits.distance[a:b], hits.normal[a:b], hits.shape[a:b])
 
 
 class _Device:
@@ -154,10 +150,14 @@ class CameraDevices:
         # the lights that are on and which cast shadows: static, shared by all copies
         self.lights, self.shadows = camera_lights(scene.world_lights()) if devices else (None, np.zeros(0, dtype=bool))
         # per hit shape (static shapes, then the robots' as CopyRays numbers them; -1 reads the last): the
-        # base colour a camera sees (robot bodies are never textured in the batched simulation)
-        colors = [_base_color(shape) for _, _, shape in (scene.part(i) for i in range(sim.n_static_shapes))]
-        colors += [_base_color(shape) for r in sim.world.robots for _, _, shape in robot_parts(r)]
-        self.colors = np.array(colors + [(1.0, 1.0, 1.0)], dtype=np.float64).reshape(-1, 3)
+        # base colour a camera sees (robot bodies are never textured in the batched simulation) and the
+        # transparency
+        models = [scene.part(i)[2] for i in range(sim.n_static_shapes)]
+        models += [shape for r in sim.world.robots for _, _, shape in robot_parts(r)]
+        self.colors = np.array([_base_color(m) for m in models] + [(1.0, 1.0, 1.0)], dtype=np.float64).reshape(-1, 3)
+        self.transparency = np.array([m.appearance.transparency if m.appearance is not None else 0.0
+                                      for m in models] + [0.0])
+        self.clear = bool((self.transparency > 0.0).any())     # semi-transparent surfaces: layers per copy
 
     def reset(self, idx: np.ndarray) -> None:
         """Black (alpha 255) before the first image (Webots), as a freshly built device."""
@@ -304,13 +304,21 @@ class CameraDevices:
         return lit
 
     def _image(self, col: int, copies: np.ndarray, org: np.ndarray, dirs: np.ndarray, hits: RayHits) -> None:
-        """Camera._capture_image and the first layer of Camera._render (every surface opaque:
-        refusal) for each copy's rays, rows of all copies at once."""
-        sim = self.sim
+        """Camera._capture_image of each copy's rays (``hits``: the copies' cast, copy after copy)."""
         dev = self.devices[col]
-        cfg = dev.template.config
-        scene = sim.scene
         k = len(copies)
+        if self.clear:     # semi-transparent surfaces: each copy's layers as the single camera's
+            out = np.concatenate([self._layers(col, copies[q:q + 1], org[q], dirs[q * dev.n:(q + 1) * dev.n],
+                                               _rows_of(hits, q * dev.n, (q + 1) * dev.n)) for q in range(k)])
+        else:
+            out = self._opaque(col, copies, org, dirs, hits)
+        self._finish_image(col, copies, out)
+
+    def _opaque(self, col: int, copies: np.ndarray, org: np.ndarray, dirs: np.ndarray, hits: RayHits) -> np.ndarray:
+        """The radiance of every copy's rays in a world without semi-transparent surfaces: the first
+        layer of Camera._render, rows of all copies at once."""
+        dev = self.devices[col]
+        scene = self.sim.scene
         n = len(dirs)
         out = np.zeros((n, 3))
         weight = np.ones(n)
@@ -344,6 +352,110 @@ class CameraDevices:
             for ch in range(3):
                 L[:, ch] *= share
             shading.add_to_rows(out, kk, L)
+        return out
+
+    def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits) -> np.ndarray:
+        """Camera._render of one copy's rays (``hits``: its first layer, from the copies' cast): the
+        surfaces each ray crosses composited front to back, its rays going on past semi-transparent
+        surfaces cast for this copy alone (as the single camera casts them, from its origin with
+        per-ray limits), blind to the camera's own shapes."""
+        sim = self.sim
+        scene = sim.scene
+        dev = self.devices[col]
+        engine = _CopyEngine(sim, int(copy[0]))
+        own = frozenset(sim.rays.shape_offset + i for i in dev.template.own_shapes)
+        n = len(dirs)
+        t_near, t_far = dev.limits
+        tn = tf = inside = None
+        out = np.zeros((n, 3))
+        weight = np.ones(n)
+        rows = np.arange(n)
+        for layer in range(MAX_LAYERS + 1):
+            if layer == 0:
+                D = dirs
+            else:                       # on past semi-transparent surfaces
+                assert tn is not None and tf is not None
+                D = dirs[rows]
+                O = np.broadcast_to(origin, D.shape)
+                if own:
+                    hits = cast_skipping(engine, O, D, tn[rows], tf[rows], own)
+                else:
+                    hits = engine.cast(O, D, tn[rows], tf[rows], kind=RayKind.VISUAL, exclude_owner=-1)
+            t, shape, normal = hits.distance, hits.shape, hits.normal
+            assert shape is not None and normal is not None
+            hit = np.isfinite(t)
+            miss = (~hit).nonzero()[0]
+            if len(miss):
+                rm = rows[miss]
+                shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], scene.background))
+            k = hit.nonzero()[0]
+            if len(k) == 0:
+                break
+            r, s = rows[k], shape[k]
+            tau = self.transparency[s]
+            clear = tau > 0.0
+            leaving = np.zeros(len(k), dtype=bool)
+            any_clear = bool(clear.any())
+            if any_clear and inside is None:
+                inside = np.full((n, MAX_LAYERS), -1, dtype=np.int64)
+                tn = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,)).copy()
+                tf = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))
+            if any_clear:              # a transparent shape the ray is already in: its far face
+                assert inside is not None
+                leaving = clear & (inside[r] == s[:, None]).any(axis=1)
+            seen = (~leaving).nonzero()[0]
+            if len(seen):
+                kk, rr = k[seen], r[seen]
+                whole = len(kk) == len(D)
+                Dk = D if whole else shading.take_rows(D, kk)
+                tk = t if whole else t.take(kk)
+                P = np.empty((len(kk), 3))
+                for ch in range(3):
+                    np.multiply(tk, Dk[:, ch], out=P[:, ch])
+                    P[:, ch] += origin[ch]
+                N = normal if whole else shading.take_rows(normal, kk)
+                back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+                if back.any():
+                    bk = back.nonzero()[0]
+                    N = N.copy() if whole else N
+                    N[bk] = np.negative(shading.take_rows(N, bk))
+                zeros = np.zeros(len(kk), dtype=np.int64)
+                albedo = self._albedo(s[seen], origin[None, :], zeros, Dk, tk)
+                lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
+                L = _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
+                if scene.fog is not None:
+                    L = shading.fog(L, tk, *scene.fog)
+                last = layer == MAX_LAYERS
+                a = np.where(last, 0.0, tau[seen])
+                share = weight[rr] * (1.0 - a)
+                for ch in range(3):
+                    L[:, ch] *= share
+                shading.add_to_rows(out, rr, L)
+                weight[rr] *= a
+            go = clear & (layer < MAX_LAYERS)
+            if not go.any():
+                break
+            assert inside is not None and tn is not None
+            g = go.nonzero()[0]
+            rg, sg = r[g], s[g]
+            ent = ~leaving[g]
+            if ent.any():
+                free = np.argmax(inside[rg[ent]] < 0, axis=1)
+                inside[rg[ent], free] = sg[ent]
+            if (~ent).any():
+                lv = rg[~ent]
+                inside[lv] = np.where(inside[lv] == sg[~ent][:, None], -1, inside[lv])
+            tn[rg] = t[k[g]] * (1.0 + 1e-12) + 1e-7      # just past this surface (the single camera's step)
+            rows = rg
+        return out
+
+    def _finish_image(self, col: int, copies: np.ndarray, out: np.ndarray) -> None:
+        """Camera._capture_image from the radiance of every copy's rays: the samples' mean, the
+        resolve, the noise, BGRA bytes."""
+        sim = self.sim
+        dev = self.devices[col]
+        cfg = dev.template.config
+        k = len(copies)
         S = dev.samples
         if S > 1:     # supersampling, per copy as the single camera averages its image's rays
             per = out.reshape(k, S * dev.height * dev.width, 3)
