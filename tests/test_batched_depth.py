@@ -1,7 +1,7 @@
 """RangeFinders in the batched simulation (sensorium/server/sim/batched_depth.py): every copy's depth
 images bit-identical to the single Simulation with its seed (noise included), closed-form depths,
 copies blind to each other's robots, the noise streams' draws, the vector environment observing
-them, and cameras still refused."""
+them, and a camera measured next to them."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ import pytest
 from sensorium.schemas import world as wm
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.sim import batched_depth
-from sensorium.server.sim.batched import BatchedError, BatchedSimulation, NoiseStreams
+from sensorium.server.sim.batched import BatchedSimulation, NoiseStreams
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
 
@@ -248,18 +248,15 @@ def test_the_vector_env_observes_range_finders_as_the_single_env(precision: str)
     venv.close()
 
 
-def test_a_camera_stays_refused_in_one_line():
+def test_a_camera_is_measured_next_to_the_range_finders():
+    """Cameras are measured by the batched simulation now (tests/test_batched_camera.py): a task
+    observing a range finder and a camera runs batched, "auto" included."""
     lw = load_world(WORLD)
     data = lw.world.model_dump(mode="json", exclude_none=True)
     data["robots"][0]["devices"].append({"device": "Camera", "name": "cam", "width": 8, "height": 6})
     world = LoadedWorld(world=wm.World.model_validate(data), source=lw.source, base_dir=lw.base_dir)
-    with pytest.raises(BatchedError) as e:
-        SensoriumVectorEnv(world, Task(robot="rover", observations=["depth", "cam"]), 2)
-    msg = str(e.value)
-    assert "\n" not in msg and msg.startswith("robot 'rover': device 'cam' is a Camera; the batched simulation "
-                                              "measures ") and "RangeFinder" in msg and "SensoriumEnv can" in msg
     bs = BatchedSimulation(world, 2)
-    with pytest.raises(BatchedError, match=r"device 'cam' is a Camera; .* \(use Simulation\)$"):
-        bs.device("rover", "cam")
-    assert bs.device("rover", "depth").kind == "RangeFinder"
-    assert SensoriumEnv(world, Task(robot="rover", observations=["depth", "cam"]), engine="auto").engine == "simulation"
+    assert bs.device("rover", "cam").kind == "Camera" and bs.device("rover", "depth").kind == "RangeFinder"
+    venv = SensoriumVectorEnv(world, Task(robot="rover", observations=["depth", "cam"]), 2)
+    assert venv.single_observation_space["cam"].shape == (6, 8, 3)
+    assert SensoriumEnv(world, Task(robot="rover", observations=["depth", "cam"]), engine="auto").engine == "batched"

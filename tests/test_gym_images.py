@@ -57,18 +57,17 @@ def test_images_are_not_observed_unless_named():
     env.close()
 
 
-def test_the_auto_engine_runs_image_tasks_on_the_simulation_with_the_same_episodes():
-    """The batched engine does not simulate cameras: engine="auto" (the PettingZoo env's default)
-    runs a task observing one on the rebuilt Simulation, giving engine="simulation"'s episode bit for
-    bit; engine="batched" and the batched vector env refuse it in one line saying what to use. A
-    range finder alone runs batched (tests/test_batched_depth.py)."""
+def test_the_auto_engine_runs_image_tasks_batched_with_the_same_episodes():
+    """The batched engine simulates cameras (batched_camera.py):
+    engine="auto" (the PettingZoo env's default) runs a task observing one on the one-copy batched
+    simulation, giving engine="simulation"'s episode bit for bit; engine="batched" and the batched
+    vector env take it, semi-transparent surfaces included."""
     from sensorium.gym import SensoriumParallelEnv
     from sensorium.gym.vector import SensoriumVectorEnv
-    from sensorium.server.sim.batched import BatchedError
 
     task = Task(robot="bot", observations=["cam", "depth", "ds"], max_steps=5)
     auto, ref = SensoriumEnv(world(), task, engine="auto"), SensoriumEnv(world(), task, engine="simulation")
-    assert auto.engine == "simulation"
+    assert auto.engine == "batched"
     rng = np.random.default_rng(0)
     for seed in (4, None):
         a, _ = auto.reset(seed=seed)
@@ -79,18 +78,13 @@ def test_the_auto_engine_runs_image_tasks_on_the_simulation_with_the_same_episod
             a, ra, *_ = auto.step(act)
             b, rb, *_ = ref.step(act)
             assert ra == rb
-    assert SensoriumParallelEnv(world(), {"bot": task}).engine == "simulation"
-    one = Task(robot="bot", observations=["cam"])
-    with pytest.raises(BatchedError, match=r"^robot 'bot': device 'cam' is a Camera; the batched simulation "
-                                           r"measures .* \(use Simulation\)$"):
-        SensoriumEnv(world(), one, engine="batched")
-    with pytest.raises(BatchedError) as e:
-        SensoriumVectorEnv(world(), one, 2)
-    assert str(e.value) == ("robot 'bot': device 'cam' is a Camera; the batched simulation measures "
-                            "LightSensor, DistanceSensor, Lidar, PositionSensor, GPS, Compass, InertialUnit, "
-                            "Gyro, Accelerometer, RangeFinder: the batched vector environment "
-                            "cannot run this task (SensoriumEnv can: gymnasium.vector.SyncVectorEnv or "
-                            "AsyncVectorEnv of it)")
+    assert SensoriumParallelEnv(world(), {"bot": task}).engine == "batched"
+    # a semi-transparent wall too (tests/test_batched_camera.py compares such images byte for byte)
+    wall = world().solids[0]
+    glass = wall.model_copy(update={"appearance": wall.appearance.model_copy(update={"transparency": 0.5})})
+    glassy = world().model_copy(update={"solids": [glass]})
+    assert SensoriumEnv(glassy, Task(robot="bot", observations=["cam"]), engine="batched").engine == "batched"
+    assert SensoriumVectorEnv(glassy, Task(robot="bot", observations=["cam"]), 2).num_envs == 2
     assert SensoriumEnv(world(), Task(robot="bot", observations=["depth", "ds"]), engine="auto").engine == "batched"
     # the same robot observed without its images runs batched (its camera is never computed)
     assert SensoriumEnv(world(), Task(robot="bot", observations=["ds"]), engine="auto").engine == "batched"

@@ -214,7 +214,7 @@ class SensoriumVectorEnv(VectorEnv):
         groups: dict[str, list] = {}
         for name, box in self.agent.dict_space.spaces.items():
             ref = self.refs[name]
-            if ref.kind not in RANGE_IMAGES:
+            if ref.kind not in RANGE_IMAGES and ref.kind != "Camera":
                 low, high = (box.low[0], box.high[0]) if box.shape == (1,) else (box.low, box.high)
                 groups.setdefault(ref.kind, []).append((name, ref.column, missing_fill(low), low, high))
         return [(kind, [g[0] for g in items], np.array([g[1] for g in items], dtype=np.int64),
@@ -253,7 +253,11 @@ class SensoriumVectorEnv(VectorEnv):
             if name in got:
                 out[name] = got[name] if self.agent.flatten else got[name].copy()   # (each its own array)
                 continue
-            img = self.sim.range_image(self.refs[name])[copies]
+            ref = self.refs[name]
+            if ref.kind == "Camera":      # BGRA -> RGB, as the single env's observation
+                out[name] = np.ascontiguousarray(self.sim.image(ref)[copies][..., 2::-1])
+                continue
+            img = self.sim.range_image(ref)[copies]
             bounds = self._image_bounds.get(name)
             if bounds is not None:   # (see _uniform_image_bounds: the same values, two passes fewer)
                 v = np.clip(img, bounds[0], bounds[1])

@@ -94,6 +94,11 @@ class _Device:
     def range_image(self) -> np.ndarray:
         return self._s.range_image(self.ref)[self._c]
 
+    @property
+    def image(self) -> np.ndarray:
+        """A camera's latest BGRA image in this copy."""
+        return self._s.image(self.ref)[self._c]
+
     def __getattr__(self, name: str) -> Any:
         ref = self.__dict__.get("ref")
         if ref is not None and name in READINGS.get(ref.kind, ()):   # a GPS's values, speed, ...: this copy's

@@ -18,11 +18,13 @@ Copy ``c`` reproduces :class:`~sensorium.server.sim.simulation.Simulation` built
 with copy c's seed, bit for bit, for what it simulates: the drive (the same float64 arc, the same
 3x3 products), kinematic contact (the same broad phase per copy, the same narrow phase), light
 sensors, distance sensors, fixed lidars, wheel encoders, GPS (local coordinates), compasses,
-inertial units, gyros and accelerometers (batched_kinematic.py), range finders (batched_depth.py), each
+inertial units, gyros and accelerometers (batched_kinematic.py), range finders (batched_depth.py), cameras
+(batched_camera.py), each
 device's noise drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the
 same numbers, in the same order). Tests compare it with the single simulation step by step.
 
-Not simulated here (use :class:`Simulation`): rotating lidars, cameras, a GPS in a
+Not simulated here (use :class:`Simulation`): rotating lidars, camera recognition and
+segmentation, a GPS in a
 WGS84 world, altimeters, the kinds without an observation (LEDs, pens, ...),
 lights carried by robots, textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
@@ -45,6 +47,7 @@ from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
+from sensorium.server.sim import batched_camera as cam
 from sensorium.server.sim import batched_depth as depth
 from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
@@ -61,7 +64,7 @@ from sensorium.server.world.poses import moved_pose, pose_from_model
 
 __all__ = ["BatchedSimulation", "BatchedError", "DeviceRef", "NoiseStreams", "SUPPORTED_KINDS", "check_observable"]
 
-SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", *kin.KINDS, *depth.KINDS)
+SUPPORTED_KINDS = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", *kin.KINDS, *depth.KINDS, *cam.KINDS)
 _TWO_PI = 2.0 * math.pi
 
 
@@ -304,9 +307,9 @@ class BatchedSimulation:
         self.lidar: list[Lidar] = []
         self.position: list[PositionSensor] = []
         lists: dict[str, list] = {"LightSensor": self.light, "DistanceSensor": self.distance, "Lidar": self.lidar,
-                                  "PositionSensor": self.position, **{k: [] for k in (*kin.KINDS, *depth.KINDS)}}
+                                  "PositionSensor": self.position, **{k: [] for k in (*kin.KINDS, *depth.KINDS, *cam.KINDS)}}
         classes = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar,
-                   "PositionSensor": PositionSensor, **kin.CLASSES, **depth.CLASSES}
+                   "PositionSensor": PositionSensor, **kin.CLASSES, **depth.CLASSES, **cam.CLASSES}
         self._lists = lists
         for slot, r in enumerate(self.world.robots):
             for d in r.devices:
@@ -345,11 +348,13 @@ class BatchedSimulation:
         self._enabled = dict.fromkeys(lists, False)
         self.last = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
         self.values = {k: np.full((C, len(v), *kin.SHAPES.get(k, ())), math.nan) for k, v in lists.items()
-                       if k not in ("Lidar", *depth.KINDS)}
+                       if k not in ("Lidar", *depth.KINDS, *cam.KINDS)}
         # GPS, Compass, InertialUnit (batched_kinematic.py): their constants and their state beyond values
         self.kinematic = kin.KinematicDevices(self, lists)
         # range finders (batched_depth.py): their pixel rays' constants, every copy's images
         self.depth = depth.DepthDevices(self, lists["RangeFinder"])
+        # cameras (batched_camera.py): their pixel rays' constants, every copy's BGRA images
+        self.camera = cam.CameraDevices(self, lists["Camera"])
         for lid in self.lidar:
             if lid.rotating:
                 continue
@@ -458,6 +463,11 @@ class BatchedSimulation:
             return self.depth.images[ref.column]
         return self.range_images[ref.column]
 
+    def image(self, ref: DeviceRef) -> np.ndarray:
+        """A camera's latest images in every copy, (copies, height, width, 4) uint8 BGRA (as
+        ``Camera.image``: black, alpha 255, before the first one)."""
+        return self.camera.images[ref.column]
+
     # ------------------------------------------------------------------ control
     def reset(self, copies: np.ndarray | Sequence[int], world_seeds: Sequence[int]) -> None:
         """The named copies as a world freshly built with these world seeds: clock 0, robots at
@@ -491,6 +501,7 @@ class BatchedSimulation:
             img[idx] = 0.0
         self.kinematic.reset(idx)
         self.depth.reset(idx)
+        self.camera.reset(idx)
         self.noise.reseed(idx.tolist(), world_seeds)
         self.counters["resets"] += len(idx)
 
@@ -854,6 +865,10 @@ class BatchedSimulation:
             rc, rcol = self._due("RangeFinder", live)
             if len(rc):
                 work.append(("depth", self.depth.plan(rc, rcol)))
+        if self.camera.devices:
+            cc, ccol = self._due("Camera", live)
+            if len(cc):
+                work.append(("camera", self.camera.plan(cc, ccol)))
         if not work:
             return
         # one cast per (ray kind, transparency rule, distance only), every copy's rays together
@@ -1211,6 +1226,9 @@ class BatchedSimulation:
 
     def _finish_depth(self, state: dict, hits: list[RayHits]) -> None:
         self.depth.finish(state, hits)
+
+    def _finish_camera(self, state: dict, hits: list[RayHits]) -> None:
+        self.camera.finish(state, hits)
 
     # ------------------------------------------------------------------ tasks
     def cast(self, copies: np.ndarray, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,

@@ -1,0 +1,472 @@
+"""Cameras (RGB images) in the batched simulation: every copy's due cameras rendered bit for bit as
+the single simulation's Camera (sim/cameras.py, on the pure model devices/shading.py) renders them.
+
+A camera's pixel rays go the range finder's way (batched_depth.py): the single device's rays
+(``imaging.pixel_directions`` with its samples, ``clip_limits``), turned into each copy's world by
+the same column sums from the same stacked ``Pose.compose``, cast as runs from one origin per
+copy in a cast of their own (each camera's rays, every copy's; never joined to other rays: a
+joined cast can move a FAST answer by a float32 step), meeting only their own copy's robots; a
+camera housed in shapes of its own meets its robot's body once, in the body frame
+(``OwnBodyRays``), as the single device does.
+
+The shading is the single camera's, on every copy's rows at once: each step is elementwise
+(``origin + t·D`` with the row's own copy's origin, the back-face flip, ``shading.radiance`` per
+row, ``shading.fog``, the background, ``tone_map``), so concatenated rows give each row's bits.
+Where the single device makes a call on its own image's rows that is not elementwise (a texture
+lookup per textured shape, a body-frame normal turned by a 3x3 product, the 2x2 samples' mean),
+it is made here per copy, on the same rows. Shadows (lights with ``castShadows``) are the single
+camera's rays from each surface point towards each shadow-casting light, cast per copy and light
+as the single camera casts them: a ray leaving a surface is told from a self-hit by thresholds
+that depend on the cast's origins, so another copy's points must not share its cast. In a world
+with semi-transparent surfaces each copy's image is composited as the single camera composites it
+(``Camera._render``'s layers, from the copies' first cast): the rays going on past a surface are
+cast for that copy alone, from its camera with per-ray limits. Noise: each (copy, camera) draws its
+own stream (``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order,
+as ``shading.to_bytes`` draws it.
+
+Recognition and segmentation are not measured (the gym envs observe neither): the batched cameras
+refuse enabling them, and changing the exposure (the world file's exposure is used).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import imaging, shading
+from sensorium.server.devices import light as light_math
+from sensorium.server.raycast import packets
+from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.sim.batched_depth import _Draws, _tiled
+from sensorium.server.sim.cameras import MAX_LAYERS, Camera, _shade, camera_lights
+from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
+from sensorium.server.sim.scene import _base_color, primitive_from_model, robot_parts
+from sensorium.server.world.geometry import tessellate
+
+__all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera"]
+
+USE = "use Simulation"
+
+
+class BatchedCamera(Camera):
+    """A camera template of the batched simulation (its constants): what it does not measure
+    there is refused, never silently kept on the template."""
+
+    def recognition_enable(self, period_ms: int) -> None:
+        raise ValueError(f"{self.path}: batched cameras do not measure recognition ({USE})")
+
+    def enable_segmentation(self, on: bool) -> None:
+        raise ValueError(f"{self.path}: batched cameras do not measure segmentation ({USE})")
+
+    def set_exposure(self, exposure: float) -> None:
+        raise ValueError(f"{self.path}: batched cameras keep the world file's exposure ({USE})")
+
+
+KINDS = ("Camera",)
+CLASSES: dict[str, type] = {"Camera": BatchedCamera}
+
+
+def _may_meet_parts(robot: wm.Robot, base_dir: Any, origins: np.ndarray, directions: np.ndarray, t_near, t_far,
+                    margin: float = 1e-6) -> np.ndarray:
+    """Which rays, given in the robot's body frame, may meet one of its shapes: the box of each
+    shape's tessellation (curved ones circumscribed: it holds the analytic surface) grown by
+    ``margin``, as ``CopyRays.may_reach`` tests the whole body's box (conservative for the same rays
+    moved into the frame from any pose). A camera sits inside its robot's box, rarely inside one
+    of its shapes' boxes: most of its pixel rays can then skip their robot in every copy's cast."""
+    O = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+    D = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    lo_t = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (len(D),)) - margin
+    hi_t = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (len(D),)) + margin
+    out = np.zeros(len(D), dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Dn = np.where(D == 0.0, 1e-300, D)
+        for _, local, shape in robot_parts(robot):
+            try:
+                v = tessellate(primitive_from_model(shape.geometry, base_dir))[0]
+            except ValueError:             # a plane: unbounded
+                return np.ones(len(D), dtype=bool)
+            w = local.apply(v)
+            ta, tb = (w.min(axis=0) - margin - O) / Dn, (w.max(axis=0) + margin - O) / Dn
+            t0 = np.maximum(np.minimum(ta, tb).max(axis=1), lo_t)
+            t1 = np.minimum(np.maximum(ta, tb).min(axis=1), hi_t)
+            out |= t0 <= t1
+    return out
+
+
+class _CopyEngine:
+    """One copy's world as a ray engine's ``cast`` (what ``cast_skipping`` calls): the copies' cast
+    with that copy's rays alone."""
+
+    def __init__(self, sim: Any, copy: int):
+        self.sim, self.copy = sim, copy
+
+    def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.VISUAL, exclude_owner=-1,
+             directions32=None) -> RayHits:
+        sim = self.sim
+        copy = np.full(len(directions), self.copy, dtype=np.int64)
+        return sim.rays.cast(origins, directions, t_near, t_far, kind, copy, sim.rot, sim.pos, exclude_owner, -1,
+                             False, directions32=directions32)
+
+
+def _rows_of(hits: RayHits, a: int, b: int) -> RayHits:
+    assert hits.shape is not None and hits.normal is not None
+    return RayHits(hits.distance[a:b], hits.normal[a:b], hits.shape[a:b])
+
+
+class _Device:
+    """One camera's constants, made once (the single Camera._prepare's calls)."""
+
+    def __init__(self, template: BatchedCamera):
+        self.template = template
+        c = template.config
+        self.height, self.width = int(c.height), int(c.width)
+        self.samples = len(template._samples)
+        dirs = imaging.pixel_directions(template.geometry, template._samples)
+        self.dirs = np.ascontiguousarray(dirs.reshape(-1, 3))
+        self.n = len(self.dirs)                      # rays per image: samples x pixels
+        self.columns = tuple(np.ascontiguousarray(self.dirs[:, k]) for k in range(3))
+        factors = imaging.depth_factors(template.geometry, dirs)
+        self.limits = imaging.clip_limits(template.geometry, factors, c.near, c.far if c.far > 0 else math.inf)
+        self.exposure = float(c.exposure)
+        self.own: OwnBodyRays | None = None
+        self.skip: np.ndarray | int | None = None
+        self.plan: tuple | None = None
+
+
+class CameraDevices:
+    """The batched simulation's cameras: constants per device, BGRA images per copy."""
+
+    def __init__(self, sim: Any, devices: list[BatchedCamera]):
+        self.sim = sim
+        self.devices = [_Device(d) for d in devices]
+        self.images = [np.zeros((sim.copies, d.height, d.width, 4), dtype=np.uint8) for d in self.devices]
+        for img in self.images:
+            img[..., 3] = 255
+        self._buffers: dict[int, tuple] = {}
+        scene = sim.scene
+        # the lights that are on and which cast shadows: static, shared by all copies
+        self.lights, self.shadows = camera_lights(scene.world_lights()) if devices else (None, np.zeros(0, dtype=bool))
+        # per hit shape (static shapes, then the robots' as CopyRays numbers them; -1 reads the last): the
+        # base colour a camera sees (robot bodies are never textured in the batched simulation) and the
+        # transparency
+        models = [scene.part(i)[2] for i in range(sim.n_static_shapes)]
+        models += [shape for r in sim.world.robots for _, _, shape in robot_parts(r)]
+        self.colors = np.array([_base_color(m) for m in models] + [(1.0, 1.0, 1.0)], dtype=np.float64).reshape(-1, 3)
+        self.transparency = np.array([m.appearance.transparency if m.appearance is not None else 0.0
+                                      for m in models] + [0.0])
+        self.clear = bool((self.transparency > 0.0).any())     # semi-transparent surfaces: layers per copy
+
+    def reset(self, idx: np.ndarray) -> None:
+        """Black (alpha 255) before the first image (Webots), as a freshly built device."""
+        for img in self.images:
+            img[idx] = 0
+            img[idx, :, :, 3] = 255
+
+    # -- planning: each due camera's rays of every copy, cast in finish
+    def plan(self, copies: np.ndarray, cols: np.ndarray) -> tuple[dict, list]:
+        from sensorium.server.sim.batched import _lidar_beams  # (batched.py imports this module)
+
+        sim = self.sim
+        items = []
+        for col in sorted(set(cols.tolist())):
+            dev = self.devices[col]
+            c = copies[cols == col]
+            slot = dev.template.robot_index
+            local = dev.template.local_pose
+            rr = sim.rot[c, slot]
+            rot = np.matmul(rr, local.rotation)                                  # Pose.compose, stacked
+            org = np.matmul(rr, local.translation[None, :, None])[:, :, 0] + sim.pos[c, slot]
+            got = packets.lidar_beams(rot, org, dev.columns, self._beam_buffers(col, len(c) * dev.n))
+            origins, d, d32 = got if got is not None else _lidar_beams(rot, org, dev.columns)
+            items.append((col, c, org, origins, d, d32))
+        return {"items": items}, []
+
+    def _beam_buffers(self, col: int, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        got = self._buffers.get(col)
+        if got is None or len(got[0]) != rows:
+            got = self._buffers[col] = (np.empty((rows, 3)), np.empty((rows, 3)), np.empty((rows, 3), dtype=np.float32))
+        return got
+
+    def _rows(self, col: int, copies: np.ndarray) -> tuple:
+        """Per ray of the images of ``copies``: its copy, its mount slot and its limits (kept)."""
+        dev = self.devices[col]
+        if dev.plan is not None and np.array_equal(dev.plan[0], copies):
+            return dev.plan[1:]
+        k = len(copies)
+        mount = self._mount(col)
+        if isinstance(mount, np.ndarray):
+            mount = np.tile(mount, k)
+        t_near, t_far = dev.limits
+        dev.plan = (copies.copy(), np.repeat(copies, dev.n), mount, _tiled(t_near, k), _tiled(t_far, k))
+        return dev.plan[1:]
+
+    def _mount(self, col: int) -> np.ndarray | int:
+        """As ``DepthDevices._mount``: the robot a camera's rays skip in the world cast (its own,
+        met apart, when it has shapes of its own; else per pixel where the ray can never reach it)."""
+        dev = self.devices[col]
+        if dev.skip is None:
+            tpl = dev.template
+            slot = tpl.robot_index
+            body = self.sim.rays.slot_body[slot]
+            if tpl.own_shapes and body is not None:
+                dev.own = OwnBodyRays(body, tpl.local_pose, dev.dirs, *dev.limits, tpl.own_shapes)
+                dev.skip = slot
+            else:
+                local = tpl.local_pose
+                d = dev.dirs @ local.rotation.T
+                o = np.broadcast_to(local.translation, d.shape)
+                reach = self.sim.rays.may_reach(slot, RayKind.VISUAL, o, d, *dev.limits)
+                if reach.any():     # a camera inside its robot's box: which rays may meet one of its shapes
+                    reach &= _may_meet_parts(self.sim.world.robots[slot], self.sim.loaded.base_dir, o, d, *dev.limits)
+                skip = np.where(reach, -1, slot).astype(np.int64)
+                dev.skip = int(skip[0]) if (skip == skip[0]).all() else skip
+        return dev.skip
+
+    # -- finishing: cast, shade, the images
+    def finish(self, state: dict, hits: list[RayHits]) -> None:
+        sim = self.sim
+        for col, c, org, origins, d, d32 in state["items"]:
+            dev = self.devices[col]
+            ray_copy, mount, t_near, t_far = self._rows(col, c)
+            h = sim.rays.cast(origins, d, t_near, t_far, RayKind.VISUAL, ray_copy, sim.rot, sim.pos, -1, mount, False,
+                              False, d32, True, origin_rows=org, run=dev.n)
+            sim.counters["measurements"] += len(c)
+            self._image(col, c, org, d, self._with_own_body(col, c, h))
+            sim.last["Camera"][c, col] = sim.time_ms[c]
+
+    def _with_own_body(self, col: int, copies: np.ndarray, h: RayHits) -> RayHits:
+        """A housed camera's hits: the nearer of the world cast and its robot's body (OwnBodyRays.cast,
+        per copy: the body-frame normal turned by that copy's robot rotation, on the same rows)."""
+        dev = self.devices[col]
+        if dev.own is None:
+            return h
+        b = dev.own.body_hits(self.sim.rays.movers)
+        assert b.shape is not None and b.normal is not None and h.shape is not None and h.normal is not None
+        dist, shape, normal = h.distance.copy(), h.shape.copy(), h.normal.copy()
+        offset = self.sim.rays.shape_offset
+        slot = dev.template.robot_index
+        for k, cc in enumerate(copies.tolist()):
+            a = k * dev.n
+            win = (b.distance < dist[a:a + dev.n]).nonzero()[0]
+            if not len(win):
+                continue
+            dist[a + win] = b.distance[win]
+            shape[a + win] = offset + b.shape[win]
+            normal[a + win] = b.normal[win] @ self.sim.rot[cc, slot].T          # body frame -> world
+        return RayHits(dist, normal, shape)
+
+    def _albedo(self, shape: np.ndarray, org: np.ndarray, row_copy: np.ndarray, D: np.ndarray,
+                t: np.ndarray) -> np.ndarray:
+        """``Scene.surface_colors`` of hits of every copy: base colours by shape; a textured static
+        shape's texels per copy, on the rows the single camera would pass (its image's hits)."""
+        col = np.take(self.colors, shape, axis=0)
+        scene = self.sim.scene
+        sampler = scene.textures
+        if sampler is None:
+            return col
+        static = shape < self.sim.n_static_shapes
+        textured = np.zeros(len(shape), dtype=bool)
+        textured[static] = sampler.textured[shape[static]]
+        rows = textured.nonzero()[0]
+        of = row_copy[rows]                  # nondecreasing: the hits come copy after copy
+        cuts = np.flatnonzero(of[1:] != of[:-1]) + 1
+        for rq in np.split(rows, cuts) if len(rows) else ():
+            q = int(row_copy[rq[0]])
+            col[rq] = scene.surface_colors(shape[rq], np.broadcast_to(org[q], (len(rq), 3)), D[rq], t[rq])
+        return col
+
+    def _shadows(self, P: np.ndarray, N: np.ndarray, row_copy: np.ndarray, copies: np.ndarray) -> np.ndarray:
+        """Camera._shadows of each copy's hits, copy by copy (its rows, in order): (rows, lights) False
+        where a shadow-casting light is hidden from the point by a visible shape of that copy (its
+        segment to the light, 1000 m towards a directional one); only lit, facing pairs cast. Each
+        copy's shadow rays of a light are a cast of their own, as the single camera's: rays leaving a
+        surface are judged against self-hits with thresholds that depend on the cast's origins."""
+        sim = self.sim
+        lights = self.lights
+        assert lights is not None
+        lit = np.ones((len(P), len(lights)), dtype=bool)
+        cuts = np.flatnonzero(row_copy[1:] != row_copy[:-1]) + 1
+        for rq in np.split(np.arange(len(P)), cuts) if len(P) else ():
+            q = int(copies[row_copy[rq[0]]])
+            Pq, Nq = P[rq], N[rq]
+            direct = light_math.light_terms(Pq, Nq, lights)[1]
+            unit, length = light_math.occlusion_segments_many(Pq, lights)
+            for j in self.shadows.nonzero()[0].tolist():
+                i = (direct[:, j] > 0.0).nonzero()[0]
+                if len(i) == 0:
+                    continue
+                h = sim.rays.cast(Pq[i], unit[i, j], 0.0, length[i, j], RayKind.VISUAL, np.full(len(i), q, dtype=np.int64),
+                                  sim.rot, sim.pos, -1, -1, False, distance_only=True)
+                lit[rq[i], j] = ~(h.distance <= length[i, j])
+        return lit
+
+    def _image(self, col: int, copies: np.ndarray, org: np.ndarray, dirs: np.ndarray, hits: RayHits) -> None:
+        """Camera._capture_image of each copy's rays (``hits``: the copies' cast, copy after copy)."""
+        dev = self.devices[col]
+        k = len(copies)
+        if self.clear:     # semi-transparent surfaces: each copy's layers as the single camera's
+            out = np.concatenate([self._layers(col, copies[q:q + 1], org[q], dirs[q * dev.n:(q + 1) * dev.n],
+                                               _rows_of(hits, q * dev.n, (q + 1) * dev.n)) for q in range(k)])
+        else:
+            out = self._opaque(col, copies, org, dirs, hits)
+        self._finish_image(col, copies, out)
+
+    def _opaque(self, col: int, copies: np.ndarray, org: np.ndarray, dirs: np.ndarray, hits: RayHits) -> np.ndarray:
+        """The radiance of every copy's rays in a world without semi-transparent surfaces: the first
+        layer of Camera._render, rows of all copies at once."""
+        dev = self.devices[col]
+        scene = self.sim.scene
+        n = len(dirs)
+        out = np.zeros((n, 3))
+        weight = np.ones(n)
+        t, shape, normal = hits.distance, hits.shape, hits.normal
+        assert shape is not None and normal is not None
+        hit = np.isfinite(t)
+        miss = (~hit).nonzero()[0]
+        if len(miss):
+            shading.add_to_rows(out, miss, shading.scaled_rows(weight[miss], scene.background))
+        kk = hit.nonzero()[0]
+        if len(kk):
+            row_copy = kk // dev.n                     # each hit's copy (its index in ``copies``)
+            Dk = shading.take_rows(dirs, kk)
+            tk = t.take(kk)
+            P = np.empty((len(kk), 3))                 # origin + t D, column by column
+            for ch in range(3):
+                np.multiply(tk, Dk[:, ch], out=P[:, ch])
+                P[:, ch] += org[row_copy, ch]
+            N = shading.take_rows(normal, kk)
+            back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+            if back.any():                             # facing the camera
+                bk = back.nonzero()[0]
+                N[bk] = np.negative(shading.take_rows(N, bk))
+            s = shape.take(kk)
+            albedo = self._albedo(s, org, row_copy, Dk, tk)
+            lit = self._shadows(P, N, row_copy, copies) if self.shadows.any() else None
+            L = _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
+            if scene.fog is not None:
+                L = shading.fog(L, tk, *scene.fog)
+            share = weight[kk] * (1.0 - np.zeros(len(kk)))   # (opaque: transparency 0, as the single's share)
+            for ch in range(3):
+                L[:, ch] *= share
+            shading.add_to_rows(out, kk, L)
+        return out
+
+    def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits) -> np.ndarray:
+        """Camera._render of one copy's rays (``hits``: its first layer, from the copies' cast): the
+        surfaces each ray crosses composited front to back, its rays going on past semi-transparent
+        surfaces cast for this copy alone (as the single camera casts them, from its origin with
+        per-ray limits), blind to the camera's own shapes."""
+        sim = self.sim
+        scene = sim.scene
+        dev = self.devices[col]
+        engine = _CopyEngine(sim, int(copy[0]))
+        own = frozenset(sim.rays.shape_offset + i for i in dev.template.own_shapes)
+        n = len(dirs)
+        t_near, t_far = dev.limits
+        tn = tf = inside = None
+        out = np.zeros((n, 3))
+        weight = np.ones(n)
+        rows = np.arange(n)
+        for layer in range(MAX_LAYERS + 1):
+            if layer == 0:
+                D = dirs
+            else:                       # on past semi-transparent surfaces
+                assert tn is not None and tf is not None
+                D = dirs[rows]
+                O = np.broadcast_to(origin, D.shape)
+                if own:
+                    hits = cast_skipping(engine, O, D, tn[rows], tf[rows], own)
+                else:
+                    hits = engine.cast(O, D, tn[rows], tf[rows], kind=RayKind.VISUAL, exclude_owner=-1)
+            t, shape, normal = hits.distance, hits.shape, hits.normal
+            assert shape is not None and normal is not None
+            hit = np.isfinite(t)
+            miss = (~hit).nonzero()[0]
+            if len(miss):
+                rm = rows[miss]
+                shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], scene.background))
+            k = hit.nonzero()[0]
+            if len(k) == 0:
+                break
+            r, s = rows[k], shape[k]
+            tau = self.transparency[s]
+            clear = tau > 0.0
+            leaving = np.zeros(len(k), dtype=bool)
+            any_clear = bool(clear.any())
+            if any_clear and inside is None:
+                inside = np.full((n, MAX_LAYERS), -1, dtype=np.int64)
+                tn = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,)).copy()
+                tf = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))
+            if any_clear:              # a transparent shape the ray is already in: its far face
+                assert inside is not None
+                leaving = clear & (inside[r] == s[:, None]).any(axis=1)
+            seen = (~leaving).nonzero()[0]
+            if len(seen):
+                kk, rr = k[seen], r[seen]
+                whole = len(kk) == len(D)
+                Dk = D if whole else shading.take_rows(D, kk)
+                tk = t if whole else t.take(kk)
+                P = np.empty((len(kk), 3))
+                for ch in range(3):
+                    np.multiply(tk, Dk[:, ch], out=P[:, ch])
+                    P[:, ch] += origin[ch]
+                N = normal if whole else shading.take_rows(normal, kk)
+                back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+                if back.any():
+                    bk = back.nonzero()[0]
+                    N = N.copy() if whole else N
+                    N[bk] = np.negative(shading.take_rows(N, bk))
+                zeros = np.zeros(len(kk), dtype=np.int64)
+                albedo = self._albedo(s[seen], origin[None, :], zeros, Dk, tk)
+                lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
+                L = _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
+                if scene.fog is not None:
+                    L = shading.fog(L, tk, *scene.fog)
+                last = layer == MAX_LAYERS
+                a = np.where(last, 0.0, tau[seen])
+                share = weight[rr] * (1.0 - a)
+                for ch in range(3):
+                    L[:, ch] *= share
+                shading.add_to_rows(out, rr, L)
+                weight[rr] *= a
+            go = clear & (layer < MAX_LAYERS)
+            if not go.any():
+                break
+            assert inside is not None and tn is not None
+            g = go.nonzero()[0]
+            rg, sg = r[g], s[g]
+            ent = ~leaving[g]
+            if ent.any():
+                free = np.argmax(inside[rg[ent]] < 0, axis=1)
+                inside[rg[ent], free] = sg[ent]
+            if (~ent).any():
+                lv = rg[~ent]
+                inside[lv] = np.where(inside[lv] == sg[~ent][:, None], -1, inside[lv])
+            tn[rg] = t[k[g]] * (1.0 + 1e-12) + 1e-7      # just past this surface (the single camera's step)
+            rows = rg
+        return out
+
+    def _finish_image(self, col: int, copies: np.ndarray, out: np.ndarray) -> None:
+        """Camera._capture_image from the radiance of every copy's rays: the samples' mean, the
+        resolve, the noise, BGRA bytes."""
+        sim = self.sim
+        dev = self.devices[col]
+        cfg = dev.template.config
+        k = len(copies)
+        S = dev.samples
+        if S > 1:     # supersampling, per copy as the single camera averages its image's rays
+            per = out.reshape(k, S * dev.height * dev.width, 3)
+            out = np.concatenate([per[q].reshape(S, -1, 3).mean(axis=0) for q in range(k)])
+        v = shading.tone_map(out, dev.exposure).reshape(k, dev.height, dev.width, 3)
+        rng = None
+        if cfg.noise > 0:
+            rng = _Draws(sim.noise, copies.tolist(), sim._noise_col[("Camera", col)], [v[0].size] * k)
+        rgb = shading.to_bytes(v, cfg.noise, rng)      # type: ignore[arg-type]
+        img = self.images[col]
+        img[copies, :, :, 0] = rgb[..., 2]
+        img[copies, :, :, 1] = rgb[..., 1]
+        img[copies, :, :, 2] = rgb[..., 0]
+        img[copies, :, :, 3] = 255

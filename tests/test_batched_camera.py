@@ -1,0 +1,359 @@
+"""Cameras in the batched simulation (sensorium/server/sim/batched_camera.py): every copy's RGB
+images bit-identical to the single Simulation with its seed (noise, exposure, anti-aliasing, fog,
+textures, every light type, shadows, semi-transparent surfaces, a housed camera, the other robot in
+view), closed-form pixels (lit, fogged, shadowed), copies blind to each other's robots, the vector
+environment observing them, and the refusal of recognition."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, load_world
+
+WORLD = Path(__file__).parent / "worlds" / "camera.yaml"
+PERIODS = {"rover": {"eye": 32, "housed": 16, "pano": 48}, "scout": {"dome": 16}}
+BOTH = ["fast", "exact"]
+
+
+@pytest.fixture(scope="module")
+def texture_dir(tmp_path_factory) -> Path:
+    """The floor's texture: 8 x 8 texels of seeded random colours (written here, not committed)."""
+    from PIL import Image
+    d = tmp_path_factory.mktemp("camera_world")
+    texels = np.random.default_rng(7).integers(0, 256, (8, 8, 3), dtype=np.uint8)
+    Image.fromarray(texels, "RGB").save(d / "checker.png")
+    (d / WORLD.name).write_text(WORLD.read_text())
+    return d
+
+
+def _world(seed: int, base: Path, **update) -> LoadedWorld:
+    lw = load_world(base / WORLD.name)
+    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed}),
+                                    **update})
+    return LoadedWorld(world=w, source=lw.source, base_dir=base)
+
+
+def _drive(sim: Simulation, robot: str, left: float, right: float) -> None:
+    for m in sim.robot(robot).motors.values():
+        m.set_position(math.inf)
+    sim.robot(robot).drive.left.set_velocity(left)
+    sim.robot(robot).drive.right.set_velocity(right)
+
+
+def _glass(seed: int, base: Path) -> LoadedWorld:
+    """The camera world with a semi-transparent crate (0.4) and a semi-transparent scout (0.5)."""
+    lw = _world(seed, base)
+    w = lw.world
+    crate = w.solids[2]
+    glass = crate.model_copy(update={"appearance": crate.appearance.model_copy(update={"transparency": 0.4})})
+    scout = w.robots[1]
+    body = scout.body.model_copy(update={"appearance": scout.body.appearance.model_copy(update={"transparency": 0.5})})
+    return LoadedWorld(world=w.model_copy(update={"solids": [*w.solids[:2], glass, *w.solids[3:]],
+                                                  "robots": [w.robots[0], scout.model_copy(update={"body": body})]}),
+                       source=lw.source, base_dir=base)
+
+
+@pytest.mark.parametrize("glass", [False, True])
+@pytest.mark.parametrize("precision", BOTH)
+def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str, glass: bool, texture_dir: Path):
+    """Two robots driving among a textured floor, a crate, a wall and a lamp, under a point, a spot
+    and a directional light (two casting shadows) in fog, with random per-copy wheel commands;
+    cameras planar (noise, exposure, anti-aliasing), housed in a box of its own, cylindrical (noise,
+    far) and spherical (anti-aliasing) at different periods; a reset of one copy with a new seed on
+    the way; with ``glass`` the crate and the scout are semi-transparent (rays go on past them):
+    after every basic step every image of every copy equals that of a Simulation built with that
+    copy's seed, byte for byte (black before the first capture)."""
+    seeds = [5, 6, 7]
+    make = _glass if glass else _world
+    bs = BatchedSimulation(make(0, texture_dir), len(seeds), precision=precision)
+    bs.reset(np.arange(len(seeds)), seeds)
+    sims = [Simulation(make(s, texture_dir), precision=precision) for s in seeds]
+
+    def enable(copy: int) -> None:
+        for robot, names in PERIODS.items():
+            for n, p in names.items():
+                bs.enable(bs.device(robot, n), p, copies=[copy])
+                sims[copy].robot(robot).device(n).enable(p)
+
+    for c in range(len(seeds)):
+        enable(c)
+    through = []                                 # the casts of rays going on past a semi-transparent surface
+    cast = bs.rays.cast
+
+    def counted(origins, *args, **kwargs):
+        if origins.strides[0] == 0:              # (from one camera's origin with per-ray limits: _layers)
+            through.append(len(origins))
+        return cast(origins, *args, **kwargs)
+
+    bs.rays.cast = counted                       # type: ignore[method-assign]
+    rng = np.random.default_rng(1)
+    seen = {"black": 0, "sky": 0, "textured": 0}
+    for step in range(70):
+        if step % 10 == 0:
+            for robot in PERIODS:
+                slot = bs.slot(robot)
+                vmax = 0.3 * float(bs.max_wheel[slot, 0])
+                lr = rng.uniform(-vmax, vmax, (len(seeds), 2))
+                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
+                for c, s in enumerate(sims):
+                    _drive(s, robot, float(lr[c, 0]), float(lr[c, 1]))
+        if step == 40:                          # copy 1 as a new world with another seed
+            bs.reset([1], [42])
+            sims[1] = Simulation(make(42, texture_dir), precision=precision)
+            enable(1)
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot, names in PERIODS.items():
+                for n in names:
+                    want = s.robot(robot).device(n).image
+                    got = bs.image(bs.device(robot, n))[c]
+                    assert got.dtype == np.uint8 and got.shape == want.shape
+                    assert want.tobytes() == got.tobytes(), (step, c, robot, n, np.abs(want.astype(int) - got).max())
+                    seen["black"] += int(not got[..., :3].any())
+            seen["textured"] += s.counters.get("texture_lookups", 0) > 0
+        sky = np.floor(255.0 * (1.0 - np.exp(-np.array([0.3, 0.5, 0.8]))) ** (1 / 2.2) + 0.5)[::-1]   # BGR
+        dome = bs.image(bs.device("scout", "dome"))            # noiseless: the sky's exact bytes somewhere
+        seen["sky"] += int((dome[..., :3] == sky).all(axis=-1).any())
+    assert seen["black"] > 0 and seen["sky"] > 0 and seen["textured"] > 0
+    assert (sum(through) > 1000) if glass else not through
+    assert bs.camera.devices[1].own is not None            # "housed" meets its robot apart, blind to its box
+    pano = bs.camera.devices[2].skip                       # some of pano's rays meet its own robot's mast
+    assert isinstance(pano, np.ndarray) and 0 < (pano < 0).sum() < len(pano)
+    # the noise is each copy's own: the same camera's images differ between copies
+    eye = bs.image(bs.device("rover", "eye"))
+    assert len({img.tobytes() for img in eye}) == len(seeds)
+
+
+def test_the_rays_skipping_their_robot_never_meet_it(texture_dir: Path):
+    """batched_camera._may_meet_parts (a camera's rays that may meet one of its robot's shapes; the
+    others skip that robot in every copy's cast): 4,000 random rays from inside the rover's box (its
+    cameras' places) that meet its body, cast in the body frame, are all kept, and most that do not
+    are dropped."""
+    from sensorium.server.raycast.engine import RayKind
+    from sensorium.server.sim.batched_camera import _may_meet_parts
+
+    bs = BatchedSimulation(_world(0, texture_dir), 1)
+    body = bs.rays.slot_body[0]
+    rng = np.random.default_rng(3)
+    for origin in ([0.07, 0.0, 0.1], [0.0, 0.0, 0.14], [0.09, 0.0, 0.08]):
+        D = rng.normal(size=(4000, 3))
+        D /= np.linalg.norm(D, axis=1)[:, None]
+        O = np.broadcast_to(np.array(origin), D.shape)
+        meets = np.isfinite(bs.rays.movers.cast_local(body, O, D, 0.0, np.inf, kind=RayKind.VISUAL).distance)
+        kept = _may_meet_parts(bs.world.robots[0], bs.loaded.base_dir, O, D, 0.0, np.inf)
+        assert meets.any() and kept[meets].all(), origin
+        assert (~kept[~meets]).mean() > 0.5, origin
+
+
+def _facing(d: list[float], fog: bool) -> wm.World:
+    """A robot without a body whose camera (11 x 5 pixels, 0.1 m up, exposure 1.3) faces a wide matte
+    wall (the plane x = 2, albedo (0.6, 0.3, 0.15)) lit head-on by a directional light (intensity
+    0.7, ambient 0.2); with fog: LINEAR, visibility 8 m, colour 0.5 grey."""
+    dev = {"device": "Camera", "name": "cam", "pose": {"translation": [0.0, 0.0, 0.1]}, "width": 11, "height": 5,
+           "field_of_view": 1.0, "exposure": 1.3}
+    extra = {"fog": {"color": [0.5, 0.5, 0.5], "visibility_range": 8.0, "fog_type": "LINEAR"}} if fog else {}
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 8, "contact": False}, **extra,
+        "lights": [{"type": "DirectionalLight", "direction": [1, 0, 0], "intensity": 0.7, "ambient_intensity": 0.2}],
+        "solids": [{"name": "wall", "pose": {"translation": [2.5, 0.0, 0.0]},
+                    "geometry": {"type": "box", "size": [1.0, 40.0, 40.0]},
+                    "appearance": {"base_color": [0.6, 0.3, 0.15]}}],
+        "robots": [{"name": "bot", "pose": {"translation": [2.0 - d[0], 0.0, 0.0]},
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 10.0},
+                    "devices": [dev]}]})
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_camera_facing_a_lit_matte_wall_reads_the_shading_models_value(precision: str):
+    """Copy c stands d_c from the wall, facing it. The surface's radiance is albedo x (ambient +
+    intensity x N.L) with N.L = 1, the same in every pixel without fog; with LINEAR fog the centre
+    pixel (its ray along x, d_c long) is mixed with the fog's linear colour by w = (d_c/V)^2.2. The
+    byte is floor(255 (1 - exp(-L exposure))^(1/2.2) + 1/2) (shading.py's model, written out here)."""
+    d = [0.5, 1.0, 2.5, 4.0]
+    albedo = np.array([0.6, 0.3, 0.15])
+    L = albedo * (0.2 + 0.7 * 1.0)
+
+    def byte(x: np.ndarray) -> np.ndarray:
+        return np.floor(255.0 * (1.0 - np.exp(-x * 1.3)) ** (1.0 / 2.2) + 0.5)
+
+    fog_lin = ((0.5 + 0.055) / 1.055) ** 2.4
+    for fog in (False, True):
+        bs = BatchedSimulation(LoadedWorld(world=_facing(d, fog), source="<test>", base_dir=Path.cwd()), len(d),
+                               precision=precision)
+        for c, dc in enumerate(d):
+            bs.set_pose(c, 0, translation=[2.0 - dc, 0.0, 0.0])
+        ref = bs.device("bot", "cam")
+        bs.enable(ref, 8)
+        img = bs.image(ref)
+        assert not img[..., :3].any() and (img[..., 3] == 255).all()     # black before the first image (Webots)
+        bs.step()
+        rgb = img[..., 2::-1].astype(np.float64)
+        for c, dc in enumerate(d):
+            if not fog:
+                assert (rgb[c] == byte(L)).all(), c
+            else:
+                w = (dc / 8.0) ** 2.2
+                assert (rgb[c, 2, 5] == byte(L * (1.0 - w) + fog_lin * w)).all(), c
+        if fog:                                       # the farther the wall, the greyer its centre
+            assert len({img[c, 2, 5].tobytes() for c in range(len(d))}) == len(d)
+
+
+def test_copies_never_see_each_others_robots(texture_dir: Path):
+    """The scout parked 0.5 m in front of the rover in copy 0 and off in a corner in copy 1 (both
+    copies with world seed 0): each copy's images are those of a Simulation with its scout where
+    that copy has it, byte for byte (shadows included: the lamp and the sun cast them), and the
+    noiseless housed camera's pixels differ between the two copies only where copy 0's scout
+    (magenta) or its shadow (darker) is in view: copy 1's rover sees neither."""
+    lw = _world(0, texture_dir)
+    bs = BatchedSimulation(lw, 2, precision="exact")
+    bs.reset([0, 1], [0, 0])
+    rover = bs.pose(0, bs.slot("rover"))
+    fwd = rover.rotation[:, 0]
+    ahead = rover.translation + 0.5 * fwd
+    places = [([float(ahead[0]), float(ahead[1]), 0.0], [0, 0, 1, math.atan2(fwd[1], fwd[0])]),
+              ([-2.5, 2.5, 0.0], [0, 0, 1, 0.0])]
+    names = ("eye", "housed", "pano")
+    singles = []
+    for c, (t, r) in enumerate(places):
+        bs.set_pose(c, bs.slot("scout"), translation=t, rotation=r)
+        single = Simulation(lw, precision="exact")
+        single.robot("scout").set_pose(t, r)
+        for n in names:
+            single.robot("rover").device(n).enable(16)
+        singles.append(single)
+    for n in names:
+        bs.enable(bs.device("rover", n), 16)
+    for _ in range(3):
+        bs.step()
+        for c, single in enumerate(singles):
+            single.step()
+            for n in names:
+                got = bs.image(bs.device("rover", n))[c]
+                assert got.tobytes() == single.robot("rover").device(n).image.tobytes(), (c, n)
+    img = bs.image(bs.device("rover", "housed")).astype(np.int64)
+    differ = (img[0] != img[1]).any(axis=-1)
+    assert differ.sum() >= 4
+    b, g, r = img[0][differ][:, 0], img[0][differ][:, 1], img[0][differ][:, 2]
+    magenta = (r > g + 30) & (b > g + 30)               # the scout where copy 0 sees it
+    shade = img[0][differ].sum(axis=-1) < img[1][differ].sum(axis=-1)    # or its shadow: darker
+    assert magenta.any() and (magenta | shade).all()
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_robot_shadows_the_wall_in_its_own_copy_only(precision: str):
+    """The lit matte wall, now under a directional light along (1, 0.5, 0) that casts shadows, and a
+    second robot, a 0.1 m box: in copy 0 it stands between the wall's centre point and the light
+    (out of the centre pixel's ray), in copy 1 far off. Copy 0's centre pixel reads the ambient term
+    alone, albedo x 0.2; copy 1's the full albedo x (0.2 + 0.7 N.L), N.L = 1/sqrt(1.25); each copy's
+    image is the single Simulation's with that robot where the copy has it, byte for byte."""
+    w = _facing([1.0], fog=False)
+    data = w.model_dump(mode="json", exclude_none=True)
+    data["lights"] = [{"type": "DirectionalLight", "direction": [1, 0.5, 0], "intensity": 0.7,
+                       "ambient_intensity": 0.2, "cast_shadows": True}]
+    data["robots"].append({"name": "blocker", "pose": {"translation": [5.0, 5.0, 0.0]},
+                           "shapes": [{"pose": {"translation": [0, 0, 0.1]},
+                                       "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}}]})
+    lw = LoadedWorld(world=wm.World.model_validate(data), source="<test>", base_dir=Path.cwd())
+    bs = BatchedSimulation(lw, 2, precision=precision)
+    places = [[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]]
+    ref = bs.device("bot", "cam")
+    bs.enable(ref, 8)
+    singles = []
+    for c, t in enumerate(places):
+        bs.set_pose(c, bs.slot("blocker"), translation=t)
+        single = Simulation(lw, precision=precision)
+        single.robot("blocker").set_pose(t)
+        single.robot("bot").device("cam").enable(8)
+        singles.append(single)
+    bs.step()
+    img = bs.image(ref)
+    for c, single in enumerate(singles):
+        single.step()
+        assert img[c].tobytes() == single.robot("bot").device("cam").image.tobytes(), c
+    albedo = np.array([0.6, 0.3, 0.15])
+
+    def byte(x: np.ndarray) -> np.ndarray:
+        return np.floor(255.0 * (1.0 - np.exp(-x * 1.3)) ** (1.0 / 2.2) + 0.5)
+
+    rgb = img[:, 2, 5, 2::-1].astype(np.float64)
+    assert (rgb[0] == byte(albedo * 0.2)).all()
+    assert (rgb[1] == byte(albedo * (0.2 + 0.7 / math.sqrt(1.25)))).all()
+
+
+def test_recognition_segmentation_and_exposure_changes_are_refused_in_one_line(texture_dir: Path):
+    """The batched simulation does not measure a camera's recognition or segmentation (the gym envs
+    observe neither) and keeps the world file's exposure: asking a batched camera (its template, as
+    a task callable's copy view reaches it) for them raises one line saying what to use, and
+    changes nothing."""
+    bs = BatchedSimulation(_world(0, texture_dir), 1)
+    tpl = bs.template(bs.device("rover", "eye"))
+    for call in (lambda: tpl.recognition_enable(16), lambda: tpl.enable_segmentation(True),
+                 lambda: tpl.set_exposure(2.0)):
+        with pytest.raises(ValueError, match=r"^rover/eye: batched cameras .*\(use Simulation\)$"):
+            call()
+    assert tpl.exposure == 1.6
+
+
+gym = pytest.importorskip("gymnasium")
+
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+
+from sensorium.gym import SensoriumEnv, Task  # noqa: E402
+from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
+
+OBSERVED = {"eye": 32, "housed": 32}
+
+
+def _task() -> Task:
+    return Task(robot="rover", observations=OBSERVED, control_period_ms=32, max_steps=15)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_the_vector_env_observes_cameras_as_the_single_env(precision: str, texture_dir: Path):
+    """A task observing a noisy anti-aliased camera and a housed one: uint8 (height, width, 3) RGB
+    boxes; every sub-env equals the single env (rebuilt Simulation, and the one-copy batched engine,
+    which "auto" now picks) with its seed, observations, rewards and poses bit for bit, across
+    autoresets; a sub-env passes Gymnasium's checker."""
+    n = 3
+    world = _world(3, texture_dir)
+    venv = SensoriumVectorEnv(world, _task(), n, precision=precision)
+    space = venv.single_observation_space
+    assert space["eye"].shape == (12, 16, 3) and space["eye"].dtype == np.uint8
+    singles = [SensoriumEnv(world, _task(), precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
+    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
+    obs, _ = venv.reset(seed=4)
+    for i, env in enumerate(singles):
+        o, _ = env.reset(seed=4 + i)
+        assert all(o[k].tobytes() == obs[k][i].tobytes() for k in OBSERVED), i
+    rng = np.random.default_rng(5)
+    done = np.zeros(n, dtype=bool)
+    ended = 0
+    for t in range(35):
+        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        vobs, vr, vte, vtr, vinfo = venv.step(a)
+        for i, env in enumerate(singles):
+            if done[i]:
+                o, r, te, tr = env.reset()[0], 0.0, False, False
+                ended += 1
+            else:
+                o, r, te, tr, inf = env.step(a[i])
+                assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
+            assert all(o[k].tobytes() == vobs[k][i].tobytes() for k in OBSERVED), (t, i)
+            assert (r, te, tr) == (vr[i], vte[i], vtr[i])
+            done[i] = te or tr
+        assert all(space[k].contains(vobs[k][0]) for k in OBSERVED)
+        assert vobs["eye"][0].std() > 5.0                     # a picture, not a flat colour
+    assert ended >= n                                           # autoresets happened
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(venv.sub_env(1), skip_render_check=True)
+    venv.close()
