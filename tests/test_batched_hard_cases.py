@@ -18,6 +18,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from sensorium.schemas import world as wm
 from sensorium.server.devices import orientation
 from sensorium.server.devices.distance import CombinePlan, combine_planned
 from sensorium.server.devices.lookup import LookupTable
@@ -128,6 +129,60 @@ def test_an_arena_translated_to_the_world_limit_is_the_single_simulation_bit_for
     assert np.all(np.abs(bs.pos[:, :, 0] - shift[0]) < 2.0)
     lidar = bs.range_image(bs.device("scout", "lidar"))
     assert np.isfinite(lidar).mean() > 0.9 and lidar[np.isfinite(lidar)].max() < 6.0
+
+
+def counterweighted(seed: int, beams: int = 360) -> LoadedWorld:
+    """The arena at x = 1e5 m plus a post at x = -1e5 m: the static tier's geometry then lies around
+    the origin (unanchored: float32 coordinates of ~1e5, ~8 mm apart), its sphere ~1e5 m; the
+    scout's lidar of ``beams`` beams."""
+    lw = arena(seed, (1e5, 0.0, 0.0))
+    post = wm.World.model_validate({"solids": [{"name": "post", "pose": {"translation": [-1e5, 0.0, 0.5]},
+                                                "geometry": {"type": "box", "size": [0.2, 0.2, 1.0]}}]}).solids[0]
+    robots = [r.model_copy(update={"devices": [d.model_copy(update={"horizontal_resolution": beams})
+                                               if d.device == "Lidar" else d for d in r.devices]})
+              for r in lw.world.robots]
+    return LoadedWorld(world=lw.world.model_copy(update={"solids": [*lw.world.solids, post], "robots": robots}),
+                       source=lw.source, base_dir=lw.base_dir)
+
+
+@pytest.mark.parametrize("beams", [360, 352])
+def test_lidar_copies_far_from_the_origin_in_an_unanchored_tier_are_the_single_simulation(beams):
+    """Four copies of the counterweighted world (the lean cast taken at 1e5 m): every copy's lidar
+    scan equals its single simulation's bit for bit. With 360 beams (not a multiple of 16) a
+    coherent packet used to span two copies' lidars, and at this float32 resolution a beam's answer
+    depended on its packet's other beams: copy 3's beam read a curved pillar's tessellated shell
+    (1.92 m) where its one-origin cast reads the pillar (1.96 m). Each run is now packed as its own
+    cast packs it (352 beams: the runs were already aligned)."""
+    seeds = [1, 2, 3, 4]
+    bs, sims = _pair([counterweighted(s, beams) for s in seeds], seeds)
+    tier = bs.rays.static._static_tier(bs.rays.movers._variant(RayKind.VISUAL, False))
+    assert not tier.anchored and tier.radius > 1e5
+    _drive_lockstep(bs, sims, 24)
+    assert bs.rays.counters["lean_casts"] > 0
+
+
+@needs_c
+@pytest.mark.parametrize("threads", [1, 2])
+def test_coherent_runs_of_many_origins_are_each_runs_one_origin_cast(threads):
+    """200 lidar scans of 360 beams (72,000 rays: the engine's blocks) from origins around x = 1e5 m,
+    cast at once as coherent runs, on one thread or two: each beam's distance is its scan's
+    one-origin cast's, bit for bit."""
+    bs = BatchedSimulation(counterweighted(1), 1, precision="fast")
+    static = bs.rays.static
+    static.threads = threads
+    rng = np.random.default_rng(7)
+    k, W = 200, 360
+    rows = np.column_stack([1e5 + rng.uniform(-1.9, 1.9, k), rng.uniform(-1.9, 1.9, k), np.full(k, 0.15)])
+    a = np.pi - (np.arange(W) + 0.5) * (2 * np.pi / W)
+    dirs = np.column_stack([np.cos(a), np.sin(a), np.zeros(W)])
+    O = np.repeat(rows, W, axis=0)
+    D = np.tile(dirs, (k, 1))
+    every = static.cast(O, D, 0.02, 6.0, kind=RayKind.VISUAL, distance_only=True, coherent=True, origin_rows=rows,
+                        run=W).distance.reshape(k, W)
+    for j in range(k):
+        one = static.cast(np.broadcast_to(rows[j], (W, 3)), dirs, 0.02, 6.0, kind=RayKind.VISUAL,
+                          distance_only=True).distance
+        assert one.tobytes() == every[j].tobytes(), (j, np.flatnonzero(one != every[j]))
 
 
 # ------------------------------------------------------------------ the lean cast's sphere test
