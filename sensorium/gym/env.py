@@ -156,7 +156,9 @@ class Agent:
         if a.shape != (2,) or not np.all(np.isfinite(a)):
             what = "values in [-1, 1]" if self.actions == "normalized" else "wheel velocities"
             raise ValueError(f"{self.robot}: action must be 2 finite {what} (left, right), got {action!r}")
-        return a * self.vmax if self.actions == "normalized" else a
+        # a normalized action beyond [-1, 1] asks for more than the wheels give: clipped before the
+        # scaling, which is the motors' clamp for any finite value (1e308 * vmax would overflow to inf)
+        return np.clip(a, -1.0, 1.0) * self.vmax if self.actions == "normalized" else a
 
     def act(self, sim: Simulation, action) -> None:
         v = self.wheel_velocities(action)

@@ -203,7 +203,8 @@ class SensoriumVectorEnv(VectorEnv):
         if not np.isfinite(a).all():
             bad = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
             raise ValueError(f"sub-env {int(copies[bad])}: action must be 2 finite values, got {actions[bad]!r}")
-        v = a * self.agent.vmax if self.agent.actions == "normalized" else a
+        # (clipped as the single env clips it: the motors' clamp, without an overflow to inf)
+        v = np.clip(a, -1.0, 1.0) * self.agent.vmax if self.agent.actions == "normalized" else a
         self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], copies)
 
     def _scalar_groups(self) -> list[tuple[str, list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:

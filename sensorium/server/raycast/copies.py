@@ -158,7 +158,7 @@ class CopyRays:
             return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent)
         hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
                                 distance_only=distance_only, directions32=directions32, coherent=coherent,
-                                origin_rows=origin_rows)
+                                origin_rows=origin_rows, run=run)
         if n == 0 or not self.slots:
             return hits
         variant = self.movers._variant(kind, skip_transparent)

@@ -129,7 +129,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from sensorium.server.raycast import packets
-from sensorium.server.raycast.blocks import MIN_RAYS, available, run, split
+from sensorium.server.raycast.blocks import MIN_RAYS, available, split
+from sensorium.server.raycast.blocks import run as run_blocks
 from sensorium.server.raycast.exact import (
     _CHUNK,
     _DENSE_PAIRS,
@@ -370,7 +371,7 @@ class RayEngine(TierTracer):
 
     def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
              exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False,
-             directions32=None, coherent: bool = False, origin_rows=None) -> RayHits:
+             directions32=None, coherent: bool = False, origin_rows=None, run: int = 0) -> RayHits:
         """Nearest hits of rays ``origins + t directions``, t in [t_near, t_far] (scalars or per ray).
 
         ``mount``: optional (n,) body index each ray is rigidly mounted on (-1: none).  Such a ray
@@ -392,8 +393,10 @@ class RayEngine(TierTracer):
 
         ``coherent``: the rays come in runs from one origin each (the lidars of a batched world's
         copies, one after another): FAST traces them as coherent packets, as it does a one-origin
-        cast, so each ray gets the answer of its own lidar's one-origin cast (Embree's lanes are
-        independent: the packet a ray shares does not change it).
+        cast. ``run`` > 0: the runs' length; each run is then packed as its own one-origin cast packs
+        it (a packet never spans two runs), so each ray gets the answer of its own lidar's one-origin
+        cast -- a coherent packet's traversal can change a lane's answer with the packet's other rays
+        (seen in FAST's float32 far from the origin), so this holds only with ``run``.
 
         ``origin_rows``: optional (k, 3) float64 array of the rays' distinct origins -- every ray's
         origin is one of its rows and every row is some ray's origin (the scan origins of a batched
@@ -452,11 +455,14 @@ class RayEngine(TierTracer):
             if n <= _CHUNK and (threads <= 1 or n < MIN_RAYS or (self._precision is Precision.FAST and self.native
                                                                    and packets.library() is not None)):
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
-                                  directions32, coherent, box, rows)
+                                  directions32, coherent, box, rows, run)
             parts = split(n, threads, _CHUNK)
+            if coherent and run > 0:   # blocks start where runs start (each run packed as its own cast)
+                size = -(-parts[0].stop // run) * run
+                parts = [slice(a, min(n, a + size)) for a in range(0, n, size)]
             if len(parts) == 1:
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
-                                  directions32, coherent, box, rows)
+                                  directions32, coherent, box, rows, run)
             # large batches in blocks: the temporaries (~150 bytes per ray) stay a few MB whatever the
             # batch, and the blocks of the planes and the static tier run side by side on the
             # threads; then the movers, on the whole batch (a Mount keeps its lists for it) or in
@@ -497,7 +503,7 @@ class RayEngine(TierTracer):
                     tn, tf = _param(_take(t_near, sl), m, np.float64, float), _param(_take(t_far, sl), m, np.float64, float)
                     h = self._cast_static(O[sl], D[sl], tn, tf, _param(_take(excl, sl), m, np.int64, int), planes,
                                           static, big, distance_only, None if directions32 is None else directions32[sl],
-                                          coherent)
+                                          coherent, run=run)
                     dist[sl] = h[0]
                     if not distance_only:
                         shape[sl], normal[sl] = h[1], h[2]
@@ -514,7 +520,7 @@ class RayEngine(TierTracer):
                                               None if distance_only else normal[sl], pr[sel] - sl.start, pm[sel],
                                               tight, split=False)
 
-            run(block, parts, threads, list_pairs if mounted else None)
+            run_blocks(block, parts, threads, list_pairs if mounted else None)
             if listed.get("own") is not None:   # the own-mount hits, traced once
                 self._apply_own_hits(listed["own"], movers, O, D, t_near, t_far, eps64, dist)
             if movers is not None and not mounted:   # no Mount: the movers after the blocks, in chunks
@@ -557,17 +563,18 @@ class RayEngine(TierTracer):
         return RayHits(t, normal, shape)
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
-              distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None) -> RayHits:
+              distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None,
+              run: int = 0) -> RayHits:
         exact = self._precision is Precision.EXACT
         hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32, coherent, box,
-                                 rows)
+                                 rows, run)
         if movers is not None:
             self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits, mount=mount,
                               own_apart=distance_only and not exact)
         return RayHits(hits[0], hits[2], hits[1])
 
     def _cast_static(self, O, D, t_near, t_far, excl, planes, static, big: float, distance_only: bool = False,
-                     d32=None, coherent: bool = False, box=None, rows=None) -> tuple:
+                     d32=None, coherent: bool = False, box=None, rows=None, run: int = 0) -> tuple:
         """(dist, shape, normal) of the planes and the static tier (shape, normal None when
         ``distance_only``): the part of a cast that blocks of rays run side by side. ``box``: the
         (min, max) per column of the origins when the caller has it, ``rows`` the distinct origins
@@ -581,7 +588,7 @@ class RayEngine(TierTracer):
             lim = t_far if hits is None else np.minimum(t_far, hits[0])
             res = self._trace(static, O, D, t_near, lim, excl, eps64, exact, None if static.anchored else big,
                               distance_only, d32, coherent, None if static.anchored else box,
-                              None if static.anchored else rows)
+                              None if static.anchored else rows, run)
             if res is not None and hits is None:
                 hits = res
             elif res is not None and distance_only:   # the nearer of plane and mesh (ties: the plane)
@@ -609,7 +616,7 @@ class RayEngine(TierTracer):
                 return self._trace(tier, O[sl], D[sl], _take(t_near, sl), lim[sl], -1, eps64, exact, None,
                                    distance_only)
 
-        outs = run(block, parts, self.threads)
+        outs = run_blocks(block, parts, self.threads)
         if all(o is None for o in outs):
             return None
         t = np.full(m, _INF)

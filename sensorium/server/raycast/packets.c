@@ -650,11 +650,11 @@ struct fast_job {
   int far_none; const double* Ot; size_t ot_stride; const double* origin; const double* D;
   const double* start; double start_value; const double* lim; double lim_value; int lim_min;
   const int64_t* excl; int64_t excl_value; int has_excl; int distance_only; double* t_out;
-  int64_t* s_out; double* n_out; uint8_t* special;
+  int64_t* s_out; double* n_out; uint8_t* special; size_t run;
 };
 
-/* A part of a FAST pass: the rays [a0, a1) (a0 a multiple of 16, so every packet holds the rays it
- * holds in one pass over all: Embree's lanes are independent anyway); its number of hits. */
+/* A part of a FAST pass: the rays [a0, a1) (a0 a multiple of 16, or of the run: every packet holds
+ * the rays it holds in one pass over all); its number of hits. */
 struct fast_part { const struct fast_job* job; size_t a0, a1, n_hit; };
 
 static void* fast_range(void* arg) {
@@ -670,6 +670,7 @@ static void* fast_range(void* arg) {
   const int64_t* excl = J->excl; const int64_t excl_value = J->excl_value; const int has_excl = J->has_excl;
   const int distance_only = J->distance_only; double* t_out = J->t_out; int64_t* s_out = J->s_out;
   double* n_out = J->n_out; uint8_t* special = J->special;
+  const size_t run = coherent ? J->run : 0;
   const size_t m = P->a1;
   struct ray_hit16 r;
   struct intersect_args args;
@@ -679,8 +680,13 @@ static void* fast_range(void* arg) {
   const float eps32 = (float)T->eps;
   const float graze = (float)(1e-5 * T->ng_max);
   const float far1 = far_none ? 1e37f : far_value;
-  for (size_t a = P->a0; a < m; a += 16) {
-    int mk = m - a < 16 ? (int)(m - a) : 16;
+  for (size_t a = P->a0, next; a < m; a = next) {
+    /* a coherent packet never spans two runs: each run is packed from its first ray, as its own
+       one-origin cast packs it -- a coherent packet's traversal can change a lane's answer with the
+       packet's other rays (seen far from the origin, where float32 is coarse) */
+    next = a + 16 < m ? a + 16 : m;
+    if (run > 0 && (a / run + 1) * run < next) next = (a / run + 1) * run;
+    int mk = (int)(next - a);
     for (int k = 0; k < 16; k++) {
       size_t i = a + (k < mk ? (size_t)k : 0);
       const float* d = d32 + 3 * i;
@@ -800,16 +806,18 @@ int sp_probe_worker_cpus(void) {
 
 /* FAST: trace.py's _trace_fast from the Embree call to its judging (see above the struct). With
  * `threads` > 1 and enough rays, the rays are split in `threads` parts traced side by side (POSIX
- * threads; the caller takes the first part): every ray's answer is the one a single pass gives. */
+ * threads; the caller takes the first part): every ray's answer is the one a single pass gives.
+ * `run` > 0 with `coherent`: the rays come in runs of `run` from one origin each (a batched world's
+ * lidars), each packed from its own first ray, as its one-origin cast packs it. */
 size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent, const float* o32, size_t o_stride,
                     const float* o1, int shifted, float start32, const float* d32, const float* far, float far_value,
                     int far_none, const double* Ot, size_t ot_stride, const double* origin, const double* D,
                     const double* start, double start_value, const double* lim, double lim_value, int lim_min,
                     const int64_t* excl, int64_t excl_value, int has_excl, int distance_only, double* t_out,
-                    int64_t* s_out, double* n_out, uint8_t* special, int threads) {
+                    int64_t* s_out, double* n_out, uint8_t* special, int threads, size_t run) {
   struct fast_job J = {scene, T, m, coherent, o32, o_stride, o1, shifted, start32, d32, far, far_value, far_none, Ot,
                        ot_stride, origin, D, start, start_value, lim, lim_value, lim_min, excl, excl_value, has_excl,
-                       distance_only, t_out, s_out, n_out, special};
+                       distance_only, t_out, s_out, n_out, special, run};
   enum { MAX_THREADS = 64, MIN_PART = 4096 };
   if (threads > MAX_THREADS) threads = MAX_THREADS;
   if (threads > 1 && m / (size_t)threads < MIN_PART) threads = (int)(m / MIN_PART);
@@ -817,11 +825,12 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
   struct fast_part parts[MAX_THREADS];
   pthread_t tid[MAX_THREADS];
   int started[MAX_THREADS];
-  size_t packs = (m + 15) / 16;
+  /* the parts start where packets start: at a packet of 16, or at a run when coherent runs are given */
+  const size_t unit = coherent && run > 0 ? run : 16, packs = (m + unit - 1) / unit;
   for (int k = 0; k < threads; k++) {
     parts[k].job = &J;
-    parts[k].a0 = 16 * (packs * (size_t)k / (size_t)threads);
-    parts[k].a1 = k + 1 == threads ? m : 16 * (packs * (size_t)(k + 1) / (size_t)threads);
+    parts[k].a0 = unit * (packs * (size_t)k / (size_t)threads);
+    parts[k].a1 = k + 1 == threads ? m : unit * (packs * (size_t)(k + 1) / (size_t)threads);
     parts[k].n_hit = 0;
   }
   for (int k = 1; k < threads; k++)   /* a thread that cannot start: its part is traced here below */
@@ -1013,7 +1022,7 @@ int64_t sp_copy_cast(struct sp_copy_job* J) {
   J->n_hit = (int64_t)sp_fast_pass(J->scene, T, n, (int)J->coherent, NULL, 0, NULL, shifted, shifted ? (float)J->near : 0.0f,
                                    d32, far32, far_value32, far_none, J->O, 3, J->O, J->D, NULL, J->near, lim,
                                    lim ? 0.0 : lim_value, lim_min, NULL, 0, 0, (int)J->distance_only, tt, ss, nn,
-                                   J->special, (int)J->threads);
+                                   J->special, (int)J->threads, (size_t)J->run);
   int64_t sp = 0;
   for (size_t i = 0; i < n; i++) sp += J->special[i];
   J->n_special = sp;
