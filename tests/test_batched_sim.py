@@ -894,3 +894,46 @@ def test_distance_sensors_of_every_kind_and_table_match_the_single_simulation_as
                 assert _same_value(want, float(bs.value(bs.device("r", name))[c])), (step, c, name, want)
     assert bs.value(bs.device("r", "blank")).tolist() == [0.0, 0.0, 0.0]
     assert len(set(bs.value(bs.device("r", "ir")).tolist())) == 3        # each copy's own noise
+
+
+def test_the_due_scan_in_c_lists_the_pairs_numpy_lists():
+    """packets.DueScan (BatchedSimulation._due over every copy in one C pass) against _due's numpy
+    steps on clocks, last times and periods drawn at random (disabled devices, periods just
+    elapsed, just not, far past), also after the arrays are written in place between scans (it
+    reads them, not copies); and a batched simulation's _due with and without it."""
+    from sensorium.server.raycast import packets
+
+    if packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    rng = np.random.default_rng(11)
+    C, D = 37, 5
+    time = rng.integers(0, 400, C).astype(np.int64)
+    last = np.zeros((C, D), dtype=np.int64)
+    per = np.zeros((C, D), dtype=np.int64)
+    scan = packets.due_scan(time, last, per)
+    assert scan is not None
+    for _ in range(20):
+        per[...] = rng.choice([0, 8, 16, 32, 64], (C, D))
+        last[...] = time[:, None] - rng.integers(0, 80, (C, D))
+        time += rng.integers(0, 3, C)
+        want = ((per > 0) & (time[:, None] - last >= per)).nonzero()
+        got = scan()
+        assert got[0].dtype == np.int64 and got[1].dtype == np.int64
+        assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+        assert 0 < len(got[0]) < C * D
+    bs = BatchedSimulation(arena(3), 4, precision="fast")
+    bs.reset(np.arange(4), [3] * 4)
+    ref = bs.device("epuck", "ps0")
+    bs.enable(ref, 64, np.array([1, 3]))
+    bs.enable(ref, 32, np.array([0]))
+    every = np.arange(4)
+    seen = set()
+    for _ in range(6):
+        bs.time_ms += 16          # (the clocks moved on, in place, as step moves them)
+        got = bs._due("DistanceSensor", every)
+        saved, bs._due_scans = bs._due_scans, {"DistanceSensor": None}
+        want = bs._due("DistanceSensor", every)
+        bs._due_scans = saved
+        assert all(np.array_equal(g, w) for g, w in zip(got, want))
+        seen.add(tuple(got[0].tolist()))
+    assert bs._due_scans["DistanceSensor"] is not None and {(0,), (0, 1, 3)} <= seen

@@ -123,6 +123,40 @@ def test_sonar_rays_with_the_floor_per_ray_exclusions_and_mounts_answer_as_the_g
     assert z[on_floor] == pytest.approx(np.zeros(np.count_nonzero(on_floor)), abs=1e-12)
 
 
+def test_the_kept_static_fields_follow_a_changed_static_world():
+    """The lean job's plane and static-tier fields are kept between casts (CopyRays._static_fields):
+    after a wall is removed (the static tier rebuilt) and then the floor (no plane left), the next
+    lean cast answers as the general path in the changed world, not with the kept pointers (a
+    field kept past the change fails it)."""
+    n = 3
+    bs, centres = _copies(n)
+    st = bs.rays.static
+    rows = centres - np.array([L, 0.0, -0.04])
+    W = 120
+    a = np.arange(W) * (2.0 * math.pi / W)
+    dirs = np.tile(np.stack([np.cos(a), np.sin(a), np.where(np.arange(W) % 2, -0.08, 0.0)], axis=1), (n, 1))
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+    O = np.repeat(rows, W, axis=0)
+    copy = np.repeat(np.arange(n), W)
+    args = (O, dirs, 0.0, 6.0, RayKind.BOUNDING, copy, bs.rot, bs.pos, -1, -1)
+    first, general = _both(bs, *args, origin_rows=rows, run=W)
+    _same(first, general)
+    floor_shape = next(i for i, e in enumerate(st._entries) if type(e.primitive).__name__ == "Plane")
+    on_floor = first.shape == floor_shape
+    on_wall = ~on_floor & (first.shape >= 0) & (first.shape < bs.rays.shape_offset)   # (a solid, not a robot)
+    assert on_floor.any() and on_wall.any()
+    wall_shape = int(first.shape[on_wall][0])
+    st.remove_body(st._shape_body[wall_shape])
+    no_wall, general = _both(bs, *args, origin_rows=rows, run=W)
+    _same(no_wall, general)
+    assert not (no_wall.shape == wall_shape).any() and (no_wall.shape == floor_shape).any()
+    st.remove_body(st._shape_body[floor_shape])
+    no_floor, general = _both(bs, *args, origin_rows=rows, run=W)
+    _same(no_floor, general)
+    assert not (no_floor.shape == floor_shape).any()
+    assert (no_floor.distance[on_floor] > first.distance[on_floor]).all()   # past where the floor was
+
+
 def test_rays_from_a_crates_faces_take_the_redo_and_answer_as_the_general_path(monkeypatch):
     """Origins on the crate's side faces (t_near 0): rays into the crate first meet the face they
     start on (a possible self-hit, which FAST redoes in the general loop) and then its far side."""

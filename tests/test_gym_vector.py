@@ -336,6 +336,34 @@ def test_range_image_observations_clip_nan_and_infinities_as_the_box_clip_does()
     assert np.isnan(img).any() and np.isinf(img).any()
     one = venv._observe(np.array([1]))[name]
     assert one.tobytes() == want[1:2].tobytes()
+    from sensorium.server.raycast import packets
+    if packets.library() is not None:   # (the C pass answered, not the numpy steps)
+        assert packets.box_clip32(img, *venv._image_bounds[name]).tobytes() == want.tobytes()
+
+
+@pytest.mark.parametrize("low", [0.0, -0.0, -2.5, 1.0])
+def test_the_range_image_clip_in_c_is_the_numpy_steps_bit_for_bit(low):
+    """packets.box_clip32 (the vector env's range-image observation in one C pass) against
+    _observe's numpy steps -- np.clip to two float32 bounds, NaN -> high, a zero -> a zero low bound
+    -- for NaN, infinities, signed zeros, subnormals, ties at both bounds and values inside and
+    beyond, with a zero, a negative zero, a negative and a positive low bound."""
+    from sensorium.server.raycast import packets
+
+    if packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    lo, hi = np.float32(low), np.float32(4.0)
+    rng = np.random.default_rng(7)
+    img = rng.uniform(-5.0, 6.0, (4, 3, 50)).astype(np.float32)
+    special = np.array([np.nan, np.inf, -np.inf, -0.0, 0.0, 1e-45, -1e-45, lo, hi, np.nextafter(hi, np.float32(9)),
+                        np.nextafter(lo, np.float32(-9))], dtype=np.float32)
+    img.reshape(-1)[rng.integers(0, img.size, 300)] = rng.choice(special, 300)
+    want = np.clip(img, lo, hi)
+    want[np.isnan(want)] = hi
+    if lo == 0.0:
+        want[want == 0.0] = lo
+    got = packets.box_clip32(img, lo, hi)
+    assert got is not None and got.dtype == np.float32 and got.tobytes() == want.tobytes()
+    assert packets.box_clip32(img[:, :, ::2], lo, hi) is None    # (a strided view: the numpy steps)
 
 
 def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
@@ -384,7 +412,7 @@ def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
 
 def test_the_avoid_obstacles_reward_in_c_is_the_numpy_reward_bit_for_bit(monkeypatch):
     """AvoidObstacles' vectorised reward and termination with their C passes (packets.clearance_gaps,
-    packets.avoid_reward) equal the numpy path's, bit for bit, step after step while 16 robots drive
+    packets.avoid_reward, and both in one call: packets.AvoidOutcome) equal the numpy path's, bit for bit, step after step while 16 robots drive
     at full speed, turn and reverse into the arena's walls: free rewards, partial proximity, contact
     penalties and terminations all occur."""
     from sensorium.server.raycast import packets
@@ -406,14 +434,18 @@ def test_the_avoid_obstacles_reward_in_c_is_the_numpy_reward_bit_for_bit(monkeyp
         a = np.ones((n, 2)) if step % 20 < 14 else rng.uniform(-1.0, 1.0, (n, 2))
         venv.step(a.astype(np.float32))
         goal._gap = None
+        assert goal._passes is not None     # (gaps, reward and terminations in one C call)
         got = goal.reward(copies), goal.terminated(copies), goal.gaps(copies).copy()
-        with monkeypatch.context() as m:
+        with monkeypatch.context() as m:     # the two C passes, one call each
+            m.setattr(goal, "_passes", None)
+            goal._gap = None
+            apart = goal.reward(copies), goal.terminated(copies), goal.gaps(copies).copy()
             m.setattr(packets, "clearance_gaps", lambda *args: None)
             m.setattr(packets, "avoid_reward", lambda *args: None)
             goal._gap = None
             want = goal.reward(copies), goal.terminated(copies), goal.gaps(copies).copy()
-        for g, w in zip(got, want):
-            assert g.tobytes() == w.tobytes(), step
+        for g, a, w in zip(got, apart, want):
+            assert g.tobytes() == w.tobytes() and a.tobytes() == w.tobytes(), step
         gap = want[2]
         seen["penalty"] += int(np.count_nonzero(gap < goal.goal.contact_distance))
         seen["partial"] += int(np.count_nonzero((gap > goal.goal.contact_distance) & (gap < goal.goal.near)))

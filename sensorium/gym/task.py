@@ -279,13 +279,21 @@ class _AvoidObstaclesCopies(VectorGoal):
         angles = np.arange(self.RAYS) * (2.0 * math.pi / self.RAYS)     # clearance()'s directions, bit for bit
         self.dirs = np.stack([np.cos(angles), np.sin(angles), np.zeros(self.RAYS)], axis=1)
         self.vmax = float(sim.max_wheel[slot, 0])
-        self._gap: tuple[int, np.ndarray, np.ndarray] | None = None     # (step key, copies, gaps)
+        self._gap: tuple | None = None     # (step key, copies, gaps, terminations or None)
+        self._passes = packets.avoid_outcome(sim.velocity)   # (None without the C helper)
         self._rays: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None   # (copies, each ray's copy, directions)
 
     def gaps(self, copies: np.ndarray) -> np.ndarray:
+        return self._outcome(copies, False)[0]
+
+    def _outcome(self, copies: np.ndarray, reward: bool) -> tuple:
+        """(gaps, reward or None, terminated or None) of these copies now; the gaps (and the
+        terminations) kept for the step. ``reward``: also the reward, from the same C call as the
+        gaps when they are cast now."""
         key = int(self.sim.counters["copy_steps"])
-        if self._gap is not None and self._gap[0] == key and np.array_equal(self._gap[1], copies):
-            return self._gap[2]
+        kept = self._gap
+        if kept is not None and kept[0] == key and np.array_equal(kept[1], copies):
+            return kept[2], None, kept[3]
         g, r = self.goal, self.radius
         far = r + max(g.near, g.contact_distance) + 1e-6
         n = len(copies)
@@ -301,17 +309,25 @@ class _AvoidObstaclesCopies(VectorGoal):
                              exclude_slot=self.slot, distance_only=True, coherent=True,
                              run=self.RAYS, origin_rows=rows)
         d = hits.distance.reshape(n, self.RAYS)
-        gap = packets.clearance_gaps(d, far, r)   # (these steps in one C pass)
-        if gap is None:
-            clear = np.where(np.isfinite(d), d, np.inf).min(axis=1)
-            clear = np.where(np.isfinite(clear), clear, far)
-            gap = clear - r
-        self._gap = (key, copies.copy(), gap)
-        return gap
+        got = None
+        if reward and self._passes is not None:   # gaps, reward and terminations in one C call
+            got = self._passes(d, far, r, np.asarray(copies), self.slot, self.vmax, g.near, g.contact_distance,
+                               g.contact_penalty)
+        if got is None:
+            gap = packets.clearance_gaps(d, far, r)   # (these steps in one C pass)
+            if gap is None:
+                clear = np.where(np.isfinite(d), d, np.inf).min(axis=1)
+                clear = np.where(np.isfinite(clear), clear, far)
+                gap = clear - r
+            got = (gap, None, None)
+        self._gap = (key, copies.copy(), got[0], got[2])
+        return got
 
     def reward(self, copies: np.ndarray) -> np.ndarray:
         g = self.goal
-        gap = self.gaps(copies)
+        gap, reward, _ = self._outcome(copies, True)
+        if reward is not None:
+            return reward
         got = packets.avoid_reward(copies, self.slot, self.sim.velocity, self.vmax, gap, g.near, g.contact_distance,
                                    g.contact_penalty)     # (the steps below in one C pass)
         if got is not None:
@@ -325,4 +341,5 @@ class _AvoidObstaclesCopies(VectorGoal):
         return np.where(gap < g.contact_distance, r - g.contact_penalty, r)
 
     def terminated(self, copies: np.ndarray) -> np.ndarray:
-        return self.gaps(copies) < self.goal.contact_distance
+        gap, _, term = self._outcome(copies, False)
+        return term.copy() if term is not None else gap < self.goal.contact_distance

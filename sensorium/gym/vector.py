@@ -138,6 +138,8 @@ class SensoriumVectorEnv(VectorEnv):
         self._rngs = [seeding.np_random()[0] for _ in range(n)]
         self.steps = np.zeros(n, dtype=np.int64)
         self._autoreset = np.zeros(n, dtype=bool)
+        self._every = np.arange(n)      # (every sub-env, in order: the usual step's copies; never written)
+        self._every.flags.writeable = False
         self._needs_reset = np.ones(n, dtype=bool)       # before the first reset: stepping is an error
         self._obs_cache: Any = None
         self._renderers: dict[int, TopDown] = {}
@@ -205,7 +207,8 @@ class SensoriumVectorEnv(VectorEnv):
             raise ValueError(f"sub-env {int(copies[bad])}: action must be 2 finite values, got {actions[bad]!r}")
         # (clipped as the single env clips it: the motors' clamp, without an overflow to inf)
         v = np.clip(a, -1.0, 1.0) * self.agent.vmax if self.agent.actions == "normalized" else a
-        self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], copies)
+        # (every copy in order: the simulation's own default, a slice rather than a gather)
+        self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], None if copies is self._every else copies)
 
     def _scalar_groups(self) -> list[tuple[str, list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
         """The observed devices whose values are ``sim.values`` (one value, or three: a GPS, a
@@ -261,6 +264,10 @@ class SensoriumVectorEnv(VectorEnv):
             img = self.sim.range_image(ref)[copies]
             bounds = self._image_bounds.get(name)
             if bounds is not None:   # (see _uniform_image_bounds: the same values, two passes fewer)
+                clipped = packets.box_clip32(img, bounds[0], bounds[1])   # (the steps below in one C pass)
+                if clipped is not None:
+                    out[name] = clipped
+                    continue
                 v = np.clip(img, bounds[0], bounds[1])
                 nan = np.isnan(v)
                 if nan.any():
@@ -343,21 +350,27 @@ class SensoriumVectorEnv(VectorEnv):
             raise RuntimeError(f"sub-envs {self._autoreset.nonzero()[0].tolist()} ended: reset them "
                                "(options={'reset_mask': ...}) before stepping (autoreset is disabled)")
         stepping = ~resetting
-        moving = stepping.nonzero()[0]
-        self._act(moving, actions[moving])
-        if resetting.any():
+        if not resetting.any():   # every sub-env steps (the usual step): the arrays without gathers
+            self._act(self._every, actions)
+            self._run(stepping, resetting)
+            self.steps += 1
+            r, te, tr = self._outcome(self._every)
+            rewards = np.array(r, dtype=np.float64)
+            terms, truncs = np.array(te, dtype=bool), np.array(tr, dtype=bool)
+        else:
+            moving = stepping.nonzero()[0]
+            self._act(moving, actions[moving])
             self._begin_reset(resetting.nonzero()[0], [None] * int(resetting.sum()))
-        self._run(stepping, resetting)
-        rewards = np.zeros(n)
-        terms = np.zeros(n, dtype=bool)
-        truncs = np.zeros(n, dtype=bool)
-        if resetting.any():
+            self._run(stepping, resetting)
+            rewards = np.zeros(n)
+            terms = np.zeros(n, dtype=bool)
+            truncs = np.zeros(n, dtype=bool)
             for g in self._goals[2]:
                 g.reset(resetting.nonzero()[0])
-        self.steps[moving] += 1
-        if len(moving):
-            r, te, tr = self._outcome(moving)
-            rewards[moving], terms[moving], truncs[moving] = r, te, tr
+            self.steps[moving] += 1
+            if len(moving):
+                r, te, tr = self._outcome(moving)
+                rewards[moving], terms[moving], truncs[moving] = r, te, tr
         done = terms | truncs
         info = self._full_info(np.ones(n, dtype=bool))
         if self.autoreset_mode == AutoresetMode.SAME_STEP and done.any():

@@ -72,6 +72,7 @@ class CopyRays:
         self.counters = {"casts": 0, "rays": 0, "mover_pairs": 0, "mover_traces": 0, "lean_casts": 0}
         self.lean = True     # FAST casts through sp_copy_cast where their data allows (False: the general path)
         self._local = threading.local()   # per thread: the lean path's job struct and scratch buffers
+        self._static_kept: dict[str, tuple] = {}   # per variant: the lean job's static fields (_static_fields)
 
     @property
     def precision(self) -> Precision:
@@ -282,8 +283,10 @@ class CopyRays:
         if directions32 is not None and (directions32.dtype != np.float32 or directions32.shape != (n, 3)):
             return None    # (the general path says what is wrong)
         variant = self.movers._variant(kind, skip_transparent)
-        planes = st._plane_set(variant)     # (built on the first cast after a change, as the engine does)
-        static = st._static_tier(variant)
+        fields = self._static_fields(st, variant)
+        if fields is None:
+            return None
+        plane, scene, curved, static, spheres = fields
         J, keep = self._job(n)
         tf = _param(t_far, n, np.float64, float)
         rows = None
@@ -291,32 +294,17 @@ class CopyRays:
             rows = np.ascontiguousarray(origin_rows, dtype=np.float64)
             if rows.ndim != 2 or rows.shape[1] != 3 or not len(rows):
                 return None
-        J.plane = 0
-        if planes is not None:
-            planes.refresh(st._epoch)
-            if planes.axis < 0:
-                return None
-            J.plane, J.axis, J.c, J.visual, J.sized, J.sid = (1, planes.axis, float(planes.nz[0, planes.axis]),
-                                                             int(planes.visual), int(planes.sized), int(planes.sid[0]))
-            J.pt, J.nz, J.ax, J.ay, J.half = planes.native_rows()
-        J.scene = None
-        if static is not None:
-            tier = static.native(False)
-            if static.anchored or tier is None:
-                return None
-            J.n_shells = 0
-            if static.has_curved:   # the pre-pass must be ruled out by the origins' rows (in the call)
-                if rows is None or 4 * len(rows) > n:
-                    return None
-                kept = static.__dict__.get("_shell_ptrs")
-                if kept is None:   # (the shells never change: their addresses taken once)
-                    c, bound = shell_spheres(static)
-                    kept = static._shell_ptrs = (len(c), c.ctypes.data, bound.ctypes.data)
-                J.n_shells, J.shell_c, J.shell_bound = kept
-            scene, built = static.scene(False)
-            if built:
-                st._count("bvh_builds", built)
-            J.scene, J.T, J.radius = scene.handle, tier, static.radius
+        if curved is not None and (rows is None or 4 * len(rows) > n):
+            return None    # (the pre-pass must be ruled out by the origins' rows, in the call)
+        if plane is None:
+            J.plane = 0
+        else:
+            J.plane, J.axis, J.c, J.visual, J.sized, J.sid, J.pt, J.nz, J.ax, J.ay, J.half = plane
+        if scene is None:
+            J.scene = None
+        else:
+            J.scene, J.T, J.radius = scene
+            J.n_shells, J.shell_c, J.shell_bound = curved if curved is not None else (0, None, None)
         if not D.flags.c_contiguous:
             D = np.ascontiguousarray(D)
         arrays = [O, D]
@@ -333,7 +321,7 @@ class CopyRays:
         if not distance_only:
             s, nrm = np.empty(n, dtype=np.int64), np.empty((n, 3))
             arrays += [s, nrm]
-        sphere_ptrs, present = self._slot_tiers(variant)[4][3:]
+        sphere_ptrs, present = spheres
         pairs = present and self.slots > 0
         if pairs:
             R = self.slots
@@ -396,6 +384,45 @@ class CopyRays:
         if not k:
             return hits, None, None, tf
         return hits, out_ray[:k].copy(), out_body[:k].copy(), tf
+
+    def _static_fields(self, st: RayEngine, variant: str) -> tuple | None:
+        """The lean job's fields of ``variant``'s planes and static tier -- (plane's or None, the
+        tier's (scene, tier, radius) or None, its shells' (count, centres, bounds) or None when it
+        has no curved shell, the tier, the slots' spheres' addresses and whether any has a body) -- or None where the lean path cannot take them (several or tilted
+        planes, an anchored tier, no native tier). Worked out on the first cast and again after
+        the static engine changed (its epoch, or a rebuilt plane set or tier): cast after cast the
+        same pointers, their look-ups saved."""
+        planes = st._plane_set(variant)     # (built on the first cast after a change, as the engine does)
+        static = st._static_tier(variant)
+        kept = self._static_kept.get(variant)
+        if kept is not None and kept[0] == st._epoch and kept[1] is planes and kept[2] is static:
+            return kept[3]
+        fields: tuple | None = None
+        plane = scene = curved = None
+        ok = True
+        if planes is not None:
+            planes.refresh(st._epoch)
+            ok = planes.axis >= 0
+            if ok:
+                plane = (1, planes.axis, float(planes.nz[0, planes.axis]), int(planes.visual), int(planes.sized),
+                         int(planes.sid[0]), *planes.native_rows())
+        if ok and static is not None:
+            tier = static.native(False)
+            ok = not static.anchored and tier is not None
+            if ok:
+                if static.has_curved:
+                    curved = static.__dict__.get("_shell_ptrs")
+                    if curved is None:   # (the shells never change: their addresses taken once)
+                        c, bound = shell_spheres(static)
+                        curved = static._shell_ptrs = (len(c), c.ctypes.data, bound.ctypes.data)
+                sc, built = static.scene(False)
+                if built:
+                    st._count("bvh_builds", built)
+                scene = (sc.handle, tier, static.radius)
+        if ok:
+            fields = (plane, scene, curved, static, self._slot_tiers(variant)[4][3:])
+        self._static_kept[variant] = (st._epoch, planes, static, fields)
+        return fields
 
     def _job(self, n: int) -> tuple:
         """This thread's :class:`packets.CopyJob` and its scratch buffers (grown to the largest cast

@@ -1833,3 +1833,57 @@ void sp_gyro(size_t n, const double* rel, double dt, double* out) {
     }
   }
 }
+
+/* ------------------------------------------------------------------------------------------------
+ * batched step, round 2: passes that replace a few numpy calls of the vector env's step each
+ * (gym/vector.py, gym/task.py, sim/batched.py), element by element the numpy operations' values.
+ */
+
+/* gym/vector.py's clip of a range image to its Box's two float32 bounds lo <= hi (hi > 0): numpy's
+ * clip (its maximum then minimum, a NaN kept), NaN -> hi, and where lo is a zero, a zero -> lo. */
+void sp_box_clip32(size_t n, const float* in, float lo, float hi, float* out) {
+  const int zero_lo = lo == 0.0f;
+  for (size_t i = 0; i < n; i++) {
+    float v = in[i];
+    if (v != v) {
+      out[i] = hi;
+      continue;
+    }
+    v = v > lo ? v : lo;
+    v = v < hi ? v : hi;
+    out[i] = zero_lo && v == 0.0f ? lo : v;
+  }
+}
+
+/* AvoidObstacles' outcome of n copies in one call: sp_clearance_gaps of the clearance cast's
+ * distances d (n, rays) into gap, then sp_avoid_reward into reward and gap < contact into term.
+ * Returns 1 (nothing written) when a copy lies outside [0, C). */
+int sp_avoid_outcome(size_t n, size_t rays, const double* d, double far, double radius, const int64_t* copies,
+                     size_t C, size_t R, size_t slot, const double* velocity, double vmax, double near,
+                     double contact, double penalty, double* gap, double* reward, uint8_t* term) {
+  for (size_t i = 0; i < n; i++)
+    if (copies[i] < 0 || (size_t)copies[i] >= C) return 1;
+  sp_clearance_gaps(n, rays, d, far, radius, gap);
+  sp_avoid_reward(n, copies, R, slot, velocity, vmax, gap, near, contact, penalty, reward);
+  for (size_t i = 0; i < n; i++) term[i] = gap[i] < contact;
+  return 0;
+}
+
+/* batched.py's _due over every copy: the (copy, column) pairs, row by row as numpy's nonzero lists
+ * them, where per > 0 and time - last >= per (int64, numpy's wrap-around); their number. */
+size_t sp_due(size_t C, size_t D, const int64_t* time, const int64_t* last, const int64_t* per, int64_t* out_c,
+              int64_t* out_d) {
+  size_t k = 0;
+  for (size_t c = 0; c < C; c++) {
+    const uint64_t t = (uint64_t)time[c];
+    for (size_t d = 0; d < D; d++) {
+      const int64_t p = per[c * D + d];
+      if (p > 0 && (int64_t)(t - (uint64_t)last[c * D + d]) >= p) {
+        out_c[k] = (int64_t)c;
+        out_d[k] = (int64_t)d;
+        k++;
+      }
+    }
+  }
+  return k;
+}

@@ -1216,3 +1216,123 @@ def gyro_rates(rel: np.ndarray, dt: float) -> np.ndarray | None:
     p = _small_addresses((rel, out))
     lib.sp_gyro(len(rel), p[0], float(dt), p[1])
     return out
+
+
+# ---------------------------------------------------------------- batched step, round 2
+# (the vector env's step: a few numpy calls each in one C pass, their signatures and the kept
+# arrays' checks made once, so that a call costs its pass and little else)
+
+def _round2_library():
+    """The helper with round 2's signatures declared (once), or None."""
+    lib = library()
+    if lib is None or getattr(lib, "_round2_declared", False):
+        return lib
+    sz, d, f, vp = ctypes.c_size_t, ctypes.c_double, ctypes.c_float, ctypes.c_void_p
+    lib.sp_box_clip32.restype = None
+    lib.sp_box_clip32.argtypes = [sz, vp, f, f, vp]
+    lib.sp_avoid_outcome.restype = ctypes.c_int
+    lib.sp_avoid_outcome.argtypes = [sz, sz, vp, d, d, vp, sz, sz, sz, vp, d, d, d, d, vp, vp, vp]
+    _typed(lib, "sp_clearance_gaps", [sz, sz, vp, d, d, vp])
+    _typed(lib, "sp_avoid_reward", [sz, vp, sz, sz, vp, d, vp, d, d, d, vp])
+    lib._round2_declared = True
+    return lib
+
+
+def box_clip32(img: np.ndarray, lo: float, hi: float) -> np.ndarray | None:
+    """A fresh float32 copy of ``img`` clipped to [lo, hi] (float32 bounds, lo <= hi, hi > 0) with a
+    NaN set to ``hi`` and, where ``lo`` is a zero, a zero set to ``lo``: the steps of
+    :meth:`.gym.vector.SensoriumVectorEnv._observe` for a range image (np.clip's values, its NaN
+    kept until set) in one C pass (``sp_box_clip32``); None without the helper or for another array."""
+    lib = _round2_library()
+    if lib is None or img.dtype != np.float32 or not img.flags.c_contiguous:
+        return None
+    out = np.empty(img.shape, dtype=np.float32)
+    lib.sp_box_clip32(img.size, img.ctypes.data, float(lo), float(hi), out.ctypes.data)
+    return out
+
+
+class AvoidOutcome:
+    """AvoidObstacles' gaps, reward and termination of the named copies from their clearance cast
+    (``sp_avoid_outcome``: ``sp_clearance_gaps`` then ``sp_avoid_reward``, the vectorised goal's C
+    passes) over one simulation's wheel velocities (C, R, 2), which the simulation writes in place
+    and never rebinds: that array's checks and address made once."""
+
+    def __init__(self, lib, velocity: np.ndarray):
+        self.lib = lib
+        self.C, self.R = velocity.shape[:2]
+        _check_buffer("avoid_outcome", velocity, np.float64, (self.C, self.R, 2))
+        self.velocity = velocity
+        self.p_velocity = velocity.ctypes.data
+
+    def __call__(self, d: np.ndarray, far: float, radius: float, copies: np.ndarray, slot: int, vmax: float,
+                 near: float, contact: float, penalty: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """(gap, reward, terminated) of copies ``copies`` (int64 (n,)) whose clearance distances are
+        ``d`` ((n, rays) float64), their robot in ``slot``; None for other arrays."""
+        n = len(copies)
+        if d.dtype != np.float64 or d.ndim != 2 or d.shape[0] != n or copies.dtype != np.int64 or copies.ndim != 1:
+            return None
+        if not 0 <= slot < self.R:
+            raise IndexError(f"avoid_outcome: slot {slot} outside [0, {self.R})")
+        d, copies = np.ascontiguousarray(d), np.ascontiguousarray(copies)
+        gap, reward, term = np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+        p = _small_addresses((d, copies, gap, reward, term))
+        if self.lib.sp_avoid_outcome(n, d.shape[1], p[0], far, radius, p[1], self.C, self.R, slot, self.p_velocity,
+                                     vmax, near, contact, penalty, p[2], p[3], p[4]):
+            raise IndexError(f"avoid_outcome: a copy outside [0, {self.C})")
+        return gap, reward, term
+
+
+def avoid_outcome(velocity: np.ndarray) -> AvoidOutcome | None:
+    """An :class:`AvoidOutcome` over this velocity array, or None without the helper."""
+    lib = _round2_library()
+    if lib is None:
+        return None
+    return AvoidOutcome(lib, velocity)
+
+
+def lidar_ranges(dist: np.ndarray, lo: float, hi: float, ranges: np.ndarray) -> bool:
+    """:func:`lidar_scan` of a cylindrical scan without noise, resolution or points on one thread
+    (``dist`` (n,) float64, ``ranges`` (n,) float32 written), its one C call made directly; False
+    without the helper (nothing written)."""
+    lib = library()
+    if lib is None:
+        return False
+    n = len(dist)
+    _check_buffer("lidar_ranges", dist, np.float64, (n,))
+    _check_buffer("lidar_ranges", ranges, np.float32, (n,), writes=True)
+    lib.sp_lidar_scan(n, dist.ctypes.data, None, lo, float(np.float32(hi)), None, None, None, ranges.ctypes.data, None)
+    return True
+
+
+class DueScan:
+    """:meth:`.batched.BatchedSimulation._due` of one device kind over every copy in one C pass
+    (``sp_due``): the (copies, columns) whose period is positive and elapsed, in numpy's nonzero
+    order, over the simulation's clocks (C,) and the kind's last times and periods (C, D), int64
+    arrays it writes in place and never rebinds (their checks and addresses made once)."""
+
+    def __init__(self, lib, time: np.ndarray, last: np.ndarray, period: np.ndarray):
+        self.lib = lib
+        self.C, self.D = last.shape
+        for a, shape in ((time, (self.C,)), (last, (self.C, self.D)), (period, (self.C, self.D))):
+            _check_buffer("due_scan", a, np.int64, shape)
+        self.kept = (time, last, period)
+        self.p = [a.ctypes.data for a in self.kept]
+
+    def __call__(self) -> tuple[np.ndarray, np.ndarray]:
+        n = self.C * self.D
+        copies, cols = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+        p = self.p
+        k = self.lib.sp_due(self.C, self.D, p[0], p[1], p[2], *_small_addresses((copies, cols)))
+        return copies[:k], cols[:k]
+
+
+def due_scan(time: np.ndarray, last: np.ndarray, period: np.ndarray) -> DueScan | None:
+    """A :class:`DueScan` over these arrays, or None without the helper."""
+    lib = _round2_library()
+    if lib is None:
+        return None
+    if lib.sp_due.argtypes is None:
+        vp, sz = ctypes.c_void_p, ctypes.c_size_t
+        lib.sp_due.restype = sz
+        lib.sp_due.argtypes = [sz, sz, vp, vp, vp, vp, vp]
+    return DueScan(lib, time, last, period)

@@ -240,6 +240,8 @@ class BatchedSimulation:
                            if r.differential_drive else None for i, r in enumerate(w.robots)]
         # -- per copy state
         self.time_ms = np.zeros(C, dtype=np.int64)
+        self._every_copy = np.arange(C)             # (step's live copies when every copy steps; never written)
+        self._every_copy.flags.writeable = False
         self.rot = np.zeros((C, R, 3, 3))
         self.pos = np.zeros((C, R, 3))
         self.yaw = np.zeros((C, R))
@@ -347,6 +349,7 @@ class BatchedSimulation:
         # per kind: whether enable() ever gave one of its devices a period (else none is ever due)
         self._enabled = dict.fromkeys(lists, False)
         self.last = {k: np.zeros((C, len(v)), dtype=np.int64) for k, v in lists.items()}
+        self._due_scans: dict[str, packets.DueScan | None] = {}   # per kind: _due's C pass over every copy
         self.values = {k: np.full((C, len(v), *kin.SHAPES.get(k, ())), math.nan) for k, v in lists.items()
                        if k not in ("Lidar", *depth.KINDS, *cam.KINDS)}
         # GPS, Compass, InertialUnit (batched_kinematic.py): their constants and their state beyond values
@@ -571,12 +574,16 @@ class BatchedSimulation:
         """One basic time step of the copies in ``active`` ((copies,) bool; default all): clocks,
         wheels and drives, contact, then every due device measured at the end-of-step poses."""
         C = self.copies
-        act = np.ones(C, dtype=bool) if active is None else np.asarray(active, dtype=bool).reshape(C)
-        live = act.nonzero()[0]
-        if not len(live):
-            return
+        act = None if active is None else np.asarray(active, dtype=bool).reshape(C)
         dt = self.basic_time_step
-        self.time_ms[live] += dt
+        if act is None or act.all():    # every copy (a training step's usual case): no gathers
+            live = self._every_copy
+            self.time_ms += dt
+        else:
+            live = act.nonzero()[0]
+            if not len(live):
+                return
+            self.time_ms[live] += dt
         self.counters["steps"] += 1
         self.counters["copy_steps"] += len(live)
         self._drive(live, dt)
@@ -749,10 +756,12 @@ class BatchedSimulation:
         hot_copy = np.zeros(self.copies, dtype=bool)
         hot_copy[copies[near]] = True
         hot = hot_copy[copies]
-        cold = (~hot).nonzero()[0]
-        if len(cold):
-            self.centres[copies[cold], slots[cold]] = np.where(footless[cold, None], ends[cold],
-                                                               starts[cold] + (ends[cold] - starts[cold]))
+        cold = ~hot
+        # (every move's end worked out, element by element the cold ones' values, then those kept)
+        moved = starts + (ends - starts)
+        if footless.any():
+            moved = np.where(footless[:, None], ends, moved)
+        self.centres[copies[cold], slots[cold]] = moved[cold]
         order = hot.nonzero()[0]
         for m in order[np.argsort(slots[order], kind="stable")].tolist():
             cm, r = int(copies[m]), int(slots[m])
@@ -816,6 +825,11 @@ class BatchedSimulation:
         if not self._enabled[kind]:   # never enabled: every period is 0, nothing is due
             return _NONE, _NONE
         if len(live) == self.copies:    # every copy (live is then 0 ... C-1): the arrays as they are
+            scan = self._due_scans.get(kind, False)
+            if scan is False:
+                scan = self._due_scans[kind] = packets.due_scan(self.time_ms, self.last[kind], self.period[kind])
+            if scan is not None:    # (the steps below in one C pass)
+                return scan()
             per = self.period[kind]
             due = (per > 0) & (self.time_ms[:, None] - self.last[kind] >= per)
             return due.nonzero()
@@ -1216,12 +1230,15 @@ class BatchedSimulation:
             elif lid._factor is None and lid.params.resolution == RESOLUTION_OFF and every:
                 # every copy scanned, nothing moves a value, cylindrical: the whole image in one C
                 # pass where the helper is (ranges_from_hits' bits, as the single Lidar.finish)
-                if not packets.lidar_scan(np.ascontiguousarray(dist, dtype=np.float64).reshape(-1),
-                                          lid.params.min_range, lid.params.max_range, img.reshape(-1)):
+                if not packets.lidar_ranges(np.ascontiguousarray(dist, dtype=np.float64).reshape(-1),
+                                            lid.params.min_range, lid.params.max_range, img.reshape(-1)):
                     img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
             else:   # element by element: every copy's scans in one call
                 img[c] = lmath.ranges_from_hits(lid.params, dist, lid._all_dirs, None)
-            self.last["Lidar"][c, col] = self.time_ms[c]
+            if every:
+                self.last["Lidar"][:, col] = self.time_ms
+            else:
+                self.last["Lidar"][c, col] = self.time_ms[c]
             self.counters["measurements"] += len(c)
 
     def _finish_depth(self, state: dict, hits: list[RayHits]) -> None:
