@@ -17,6 +17,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "camera.yaml"
 PERIODS = {"rover": {"eye": 32, "housed": 16, "pano": 48}, "scout": {"dome": 16}}
@@ -134,12 +135,12 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
 
 
 def test_the_rays_skipping_their_robot_never_meet_it(texture_dir: Path):
-    """batched_camera._may_meet_parts (a camera's rays that may meet one of its robot's shapes; the
+    """batched_depth.may_meet_parts (a camera's rays that may meet one of its robot's shapes; the
     others skip that robot in every copy's cast): 4,000 random rays from inside the rover's box (its
     cameras' places) that meet its body, cast in the body frame, are all kept, and most that do not
     are dropped."""
     from sensorium.server.raycast.engine import RayKind
-    from sensorium.server.sim.batched_camera import _may_meet_parts
+    from sensorium.server.sim.batched_depth import may_meet_parts
 
     bs = BatchedSimulation(_world(0, texture_dir), 1)
     body = bs.rays.slot_body[0]
@@ -149,7 +150,7 @@ def test_the_rays_skipping_their_robot_never_meet_it(texture_dir: Path):
         D /= np.linalg.norm(D, axis=1)[:, None]
         O = np.broadcast_to(np.array(origin), D.shape)
         meets = np.isfinite(bs.rays.movers.cast_local(body, O, D, 0.0, np.inf, kind=RayKind.VISUAL).distance)
-        kept = _may_meet_parts(bs.world.robots[0], bs.loaded.base_dir, O, D, 0.0, np.inf)
+        kept = may_meet_parts(bs.world.robots[0], bs.loaded.base_dir, O, D, 0.0, np.inf)
         assert meets.any() and kept[meets].all(), origin
         assert (~kept[~meets]).mean() > 0.5, origin
 
@@ -330,26 +331,14 @@ def test_the_vector_env_observes_cameras_as_the_single_env(precision: str, textu
     assert space["eye"].shape == (12, 16, 3) and space["eye"].dtype == np.uint8
     singles = [SensoriumEnv(world, _task(), precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
     assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
-    obs, _ = venv.reset(seed=4)
-    for i, env in enumerate(singles):
-        o, _ = env.reset(seed=4 + i)
-        assert all(o[k].tobytes() == obs[k][i].tobytes() for k in OBSERVED), i
+    _reset_both(venv, singles, 4)
     rng = np.random.default_rng(5)
     done = np.zeros(n, dtype=bool)
     ended = 0
     for t in range(35):
         a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
-        vobs, vr, vte, vtr, vinfo = venv.step(a)
-        for i, env in enumerate(singles):
-            if done[i]:
-                o, r, te, tr = env.reset()[0], 0.0, False, False
-                ended += 1
-            else:
-                o, r, te, tr, inf = env.step(a[i])
-                assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
-            assert all(o[k].tobytes() == vobs[k][i].tobytes() for k in OBSERVED), (t, i)
-            assert (r, te, tr) == (vr[i], vte[i], vtr[i])
-            done[i] = te or tr
+        resets, vobs = _step_both(venv, singles, a, done, t)
+        ended += resets
         assert all(space[k].contains(vobs[k][0]) for k in OBSERVED)
         assert vobs["eye"][0].std() > 5.0                     # a picture, not a flat colour
     assert ended >= n                                           # autoresets happened

@@ -18,6 +18,7 @@ from sensorium.server.sim import batched_depth
 from sensorium.server.sim.batched import BatchedSimulation, NoiseStreams
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "depth.yaml"
 PERIODS = {"rover": {"depth": 32, "wide": 16, "housed": 48}, "scout": {"eye": 16}}
@@ -219,27 +220,15 @@ def test_the_vector_env_observes_range_finders_as_the_single_env(precision: str)
     assert space["depth"].dtype == np.float32 and space["depth"].high.max() == np.float32(2.5)
     singles = [SensoriumEnv(WORLD, _task(), precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
     assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
-    obs, _ = venv.reset(seed=4)
-    for i, env in enumerate(singles):
-        o, _ = env.reset(seed=4 + i)
-        assert all(o[k].tobytes() == obs[k][i].tobytes() for k in OBSERVED), i
+    obs = _reset_both(venv, singles, 4)
     assert (obs["depth"] == np.float32(2.5)).any() and (obs["depth"] < 2.5).any()   # no hit: max_range
     rng = np.random.default_rng(5)
     done = np.zeros(n, dtype=bool)
     ended = 0
     for t in range(45):
         a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
-        vobs, vr, vte, vtr, vinfo = venv.step(a)
-        for i, env in enumerate(singles):
-            if done[i]:
-                o, r, te, tr = env.reset()[0], 0.0, False, False
-                ended += 1
-            else:
-                o, r, te, tr, inf = env.step(a[i])
-                assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
-            assert all(o[k].tobytes() == vobs[k][i].tobytes() for k in OBSERVED), (t, i)
-            assert (r, te, tr) == (vr[i], vte[i], vtr[i])
-            done[i] = te or tr
+        resets, vobs = _step_both(venv, singles, a, done, t)
+        ended += resets
         assert all(space[k].contains(vobs[k][0]) for k in OBSERVED)
     assert ended >= n                                           # autoresets happened
     with warnings.catch_warnings():

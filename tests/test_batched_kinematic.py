@@ -21,6 +21,7 @@ from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
 from sensorium.server.world.poses import matrix_quaternion, quaternion_matrix
+from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "kinematic.yaml"
 PERIODS = {"rover": {"gps": 48, "plain_gps": 16, "compass": 32, "plain_compass": 16, "imu": 48, "flat_imu": 16,
@@ -382,10 +383,7 @@ def test_the_vector_env_observes_them_as_the_single_env_and_passes_the_checker()
     assert space["plain_acc"].low.tolist() == [np.float32(-(4 * math.sqrt(3) * 1e5 / 0.016 ** 2 + 9.81))] * 3
     singles = [SensoriumEnv(WORLD, _task(), engine=e) for e in ("simulation", "batched", "simulation")]
     assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
-    obs, _ = venv.reset(seed=9)
-    for i, env in enumerate(singles):
-        o, _ = env.reset(seed=9 + i)
-        assert all(o[k].tobytes() == obs[k][i].tobytes() for k in OBSERVED), i
+    obs = _reset_both(venv, singles, 9)
     assert obs["compass"][:, 1].tolist() == [-100.0] * n          # the disabled y axis: the box's low bound
     assert obs["acc"][:, 1].tolist() == [-100.0] * n
     rng = np.random.default_rng(3)
@@ -393,17 +391,8 @@ def test_the_vector_env_observes_them_as_the_single_env_and_passes_the_checker()
     ended = 0
     for t in range(60):
         a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
-        vobs, vr, vte, vtr, vinfo = venv.step(a)
-        for i, env in enumerate(singles):
-            if done[i]:
-                o, r, te, tr = env.reset()[0], 0.0, False, False
-                ended += 1
-            else:
-                o, r, te, tr, inf = env.step(a[i])
-                assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
-            assert all(o[k].tobytes() == vobs[k][i].tobytes() for k in OBSERVED), (t, i)
-            assert (r, te, tr) == (vr[i], vte[i], vtr[i])
-            done[i] = te or tr
+        resets, vobs = _step_both(venv, singles, a, done, t)
+        ended += resets
     assert ended >= n                                           # autoresets happened
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -29,19 +29,20 @@ def _row(obs: dict, i: int) -> dict:
     return {k: v[i] for k, v in obs.items()}
 
 
-def _reset_both(venv, singles, seed: int) -> None:
+def _reset_both(venv, singles, seed: int) -> dict:
     """The vector env reset with ``seed`` and single env i with ``seed + i``: the same first
-    observations and poses."""
+    observations and poses. Returns the vector env's observations."""
     obs, info = venv.reset(seed=seed)
     for i, env in enumerate(singles):
         o, inf = env.reset(seed=seed + i)
         assert _same_obs(_row(obs, i), o) and inf["pose"].tobytes() == info["pose"][i].tobytes()
+    return obs
 
 
-def _step_both(venv, singles, a: np.ndarray, done: np.ndarray, t: int) -> int:
+def _step_both(venv, singles, a: np.ndarray, done: np.ndarray, t: int) -> tuple[int, dict]:
     """One step of the vector env (NEXT_STEP autoreset) and of each single env (reset() after an
     ended episode) with actions ``a``: the same observations, rewards, flags, clocks and poses;
-    ``done`` updated. Returns the number of single envs reset."""
+    ``done`` updated. Returns the number of single envs reset and the vector env's observations."""
     resets = 0
     vobs, vr, vte, vtr, vinfo = venv.step(a)
     for i, env in enumerate(singles):
@@ -56,7 +57,7 @@ def _step_both(venv, singles, a: np.ndarray, done: np.ndarray, t: int) -> int:
         assert inf["time_ms"] == vinfo["time_ms"][i] and inf["steps"] == vinfo["steps"][i], (t, i)
         assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
         done[i] = te or tr
-    return resets
+    return resets, vobs
 
 
 def _lockstep(env_id: str, precision: str, n: int, steps: int, max_steps: int, seed: int = 5):
@@ -73,7 +74,7 @@ def _lockstep(env_id: str, precision: str, n: int, steps: int, max_steps: int, s
         a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
         if t % 20 < 10:
             a[:, 1] = a[:, 0] = 1.0                       # full speed ahead: walls, contact, terminations
-        resets += _step_both(venv, singles, a, done, t)
+        resets += _step_both(venv, singles, a, done, t)[0]
     venv.close()
     return resets
 
@@ -404,7 +405,7 @@ def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
         a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
         a[:, 0] = np.abs(a[:, 0])
         a[:, 1] = a[:, 0]                                 # straight on: over the hills
-        resets += _step_both(venv, singles, a, done, t)
+        resets += _step_both(venv, singles, a, done, t)[0]
         tilted += sum(abs(env.sim.robot("rover").pose.rotation[2, 2]) < 1.0 - 1e-6 for env in singles)
     venv.close()
     assert resets >= 3 and tilted > 30

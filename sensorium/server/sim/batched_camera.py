@@ -35,16 +35,13 @@ from typing import Any
 
 import numpy as np
 
-from sensorium.schemas import world as wm
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
-from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayHits, RayKind
-from sensorium.server.sim.batched_depth import _Draws, _tiled
+from sensorium.server.sim.batched_depth import PixelDevices, _Draws
 from sensorium.server.sim.cameras import MAX_LAYERS, Camera, _shade, camera_lights
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import _base_color, primitive_from_model, robot_parts
-from sensorium.server.world.geometry import tessellate
+from sensorium.server.sim.scene import _base_color, robot_parts
 
 __all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera"]
 
@@ -67,33 +64,6 @@ class BatchedCamera(Camera):
 
 KINDS = ("Camera",)
 CLASSES: dict[str, type] = {"Camera": BatchedCamera}
-
-
-def _may_meet_parts(robot: wm.Robot, base_dir: Any, origins: np.ndarray, directions: np.ndarray, t_near, t_far,
-                    margin: float = 1e-6) -> np.ndarray:
-    """Which rays, given in the robot's body frame, may meet one of its shapes: the box of each
-    shape's tessellation (curved ones circumscribed: it holds the analytic surface) grown by
-    ``margin``, as ``CopyRays.may_reach`` tests the whole body's box (conservative for the same rays
-    moved into the frame from any pose). A camera sits inside its robot's box, rarely inside one
-    of its shapes' boxes: most of its pixel rays can then skip their robot in every copy's cast."""
-    O = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
-    D = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
-    lo_t = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (len(D),)) - margin
-    hi_t = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (len(D),)) + margin
-    out = np.zeros(len(D), dtype=bool)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        Dn = np.where(D == 0.0, 1e-300, D)
-        for _, local, shape in robot_parts(robot):
-            try:
-                v = tessellate(primitive_from_model(shape.geometry, base_dir))[0]
-            except ValueError:             # a plane: unbounded
-                return np.ones(len(D), dtype=bool)
-            w = local.apply(v)
-            ta, tb = (w.min(axis=0) - margin - O) / Dn, (w.max(axis=0) + margin - O) / Dn
-            t0 = np.maximum(np.minimum(ta, tb).max(axis=1), lo_t)
-            t1 = np.minimum(np.maximum(ta, tb).min(axis=1), hi_t)
-            out |= t0 <= t1
-    return out
 
 
 class _CopyEngine:
@@ -136,16 +106,14 @@ class _Device:
         self.plan: tuple | None = None
 
 
-class CameraDevices:
+class CameraDevices(PixelDevices):
     """The batched simulation's cameras: constants per device, BGRA images per copy."""
 
     def __init__(self, sim: Any, devices: list[BatchedCamera]):
-        self.sim = sim
-        self.devices = [_Device(d) for d in devices]
+        super().__init__(sim, [_Device(d) for d in devices])
         self.images = [np.zeros((sim.copies, d.height, d.width, 4), dtype=np.uint8) for d in self.devices]
         for img in self.images:
             img[..., 3] = 255
-        self._buffers: dict[int, tuple] = {}
         scene = sim.scene
         # the lights that are on and which cast shadows: static, shared by all copies
         self.lights, self.shadows = camera_lights(scene.world_lights()) if devices else (None, np.zeros(0, dtype=bool))
@@ -167,63 +135,11 @@ class CameraDevices:
 
     # -- planning: each due camera's rays of every copy, cast in finish
     def plan(self, copies: np.ndarray, cols: np.ndarray) -> tuple[dict, list]:
-        from sensorium.server.sim.batched import _lidar_beams  # (batched.py imports this module)
-
-        sim = self.sim
         items = []
         for col in sorted(set(cols.tolist())):
-            dev = self.devices[col]
             c = copies[cols == col]
-            slot = dev.template.robot_index
-            local = dev.template.local_pose
-            rr = sim.rot[c, slot]
-            rot = np.matmul(rr, local.rotation)                                  # Pose.compose, stacked
-            org = np.matmul(rr, local.translation[None, :, None])[:, :, 0] + sim.pos[c, slot]
-            got = packets.lidar_beams(rot, org, dev.columns, self._beam_buffers(col, len(c) * dev.n))
-            origins, d, d32 = got if got is not None else _lidar_beams(rot, org, dev.columns)
-            items.append((col, c, org, origins, d, d32))
+            items.append((col, c, *self._beams(col, c)))
         return {"items": items}, []
-
-    def _beam_buffers(self, col: int, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        got = self._buffers.get(col)
-        if got is None or len(got[0]) != rows:
-            got = self._buffers[col] = (np.empty((rows, 3)), np.empty((rows, 3)), np.empty((rows, 3), dtype=np.float32))
-        return got
-
-    def _rows(self, col: int, copies: np.ndarray) -> tuple:
-        """Per ray of the images of ``copies``: its copy, its mount slot and its limits (kept)."""
-        dev = self.devices[col]
-        if dev.plan is not None and np.array_equal(dev.plan[0], copies):
-            return dev.plan[1:]
-        k = len(copies)
-        mount = self._mount(col)
-        if isinstance(mount, np.ndarray):
-            mount = np.tile(mount, k)
-        t_near, t_far = dev.limits
-        dev.plan = (copies.copy(), np.repeat(copies, dev.n), mount, _tiled(t_near, k), _tiled(t_far, k))
-        return dev.plan[1:]
-
-    def _mount(self, col: int) -> np.ndarray | int:
-        """As ``DepthDevices._mount``: the robot a camera's rays skip in the world cast (its own,
-        met apart, when it has shapes of its own; else per pixel where the ray can never reach it)."""
-        dev = self.devices[col]
-        if dev.skip is None:
-            tpl = dev.template
-            slot = tpl.robot_index
-            body = self.sim.rays.slot_body[slot]
-            if tpl.own_shapes and body is not None:
-                dev.own = OwnBodyRays(body, tpl.local_pose, dev.dirs, *dev.limits, tpl.own_shapes)
-                dev.skip = slot
-            else:
-                local = tpl.local_pose
-                d = dev.dirs @ local.rotation.T
-                o = np.broadcast_to(local.translation, d.shape)
-                reach = self.sim.rays.may_reach(slot, RayKind.VISUAL, o, d, *dev.limits)
-                if reach.any():     # a camera inside its robot's box: which rays may meet one of its shapes
-                    reach &= _may_meet_parts(self.sim.world.robots[slot], self.sim.loaded.base_dir, o, d, *dev.limits)
-                skip = np.where(reach, -1, slot).astype(np.int64)
-                dev.skip = int(skip[0]) if (skip == skip[0]).all() else skip
-        return dev.skip
 
     # -- finishing: cast, shade, the images
     def finish(self, state: dict, hits: list[RayHits]) -> None:

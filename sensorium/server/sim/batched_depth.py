@@ -25,7 +25,8 @@ lidar's way (``BatchedSimulation._plan_lidars``):
   is taken from the bank's buffer and then straight from the stream (:func:`draw`), the same
   numbers in the same order whatever the block sizes.
 
-Cameras stay with the single simulation (shading, transparency layers, shadows, recognition).
+What range finders and cameras (batched_camera.py) share -- the pixel rays of every capturing copy,
+their rows and the mount -- is :class:`PixelDevices`.
 """
 
 from __future__ import annotations
@@ -34,13 +35,16 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.schemas import world as wm
 from sensorium.server.devices import imaging
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.cameras import RangeFinder
 from sensorium.server.sim.own_shapes import OwnBodyRays
+from sensorium.server.sim.scene import primitive_from_model, robot_parts
+from sensorium.server.world.geometry import tessellate
 
-__all__ = ["KINDS", "CLASSES", "DepthDevices", "draw"]
+__all__ = ["KINDS", "CLASSES", "DepthDevices", "PixelDevices", "draw", "may_meet_parts"]
 
 KINDS = ("RangeFinder",)
 CLASSES: dict[str, type] = {"RangeFinder": RangeFinder}
@@ -106,43 +110,60 @@ class _Device:
         self.plan: tuple | None = None                   # (copies, each ray's copy, mount, t_near, t_far) kept
 
 
-class DepthDevices:
-    """The batched simulation's range finders: constants per device, images per copy."""
+def may_meet_parts(robot: wm.Robot, base_dir: Any, origins: np.ndarray, directions: np.ndarray, t_near, t_far,
+                    margin: float = 1e-6) -> np.ndarray:
+    """Which rays, given in the robot's body frame, may meet one of its shapes: the box of each
+    shape's tessellation (curved ones circumscribed: it holds the analytic surface) grown by
+    ``margin``, as ``CopyRays.may_reach`` tests the whole body's box (conservative for the same rays
+    moved into the frame from any pose). A camera sits inside its robot's box, rarely inside one
+    of its shapes' boxes: most of its pixel rays can then skip their robot in every copy's cast
+    (a pixel ray that may meet none of them has the same answer without its robot)."""
+    O = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+    D = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    lo_t = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (len(D),)) - margin
+    hi_t = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (len(D),)) + margin
+    out = np.zeros(len(D), dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Dn = np.where(D == 0.0, 1e-300, D)
+        for _, local, shape in robot_parts(robot):
+            try:
+                v = tessellate(primitive_from_model(shape.geometry, base_dir))[0]
+            except ValueError:             # a plane: unbounded
+                return np.ones(len(D), dtype=bool)
+            w = local.apply(v)
+            ta, tb = (w.min(axis=0) - margin - O) / Dn, (w.max(axis=0) + margin - O) / Dn
+            t0 = np.maximum(np.minimum(ta, tb).max(axis=1), lo_t)
+            t1 = np.minimum(np.maximum(ta, tb).min(axis=1), hi_t)
+            out |= t0 <= t1
+    return out
 
-    def __init__(self, sim: Any, devices: list[RangeFinder]):
+
+class PixelDevices:
+    """What the batched range finders and cameras share: each device's pixel rays turned into every
+    capturing copy's world (the single device's ``Pose.compose`` and column sums, stacked), the rays'
+    copies, mount and limits kept while the same copies capture, and the mount decided once. A
+    device's constants (``devices[col]``) have ``template``, ``n`` (rays per image), ``dirs``,
+    ``columns``, ``limits`` and the kept ``own``, ``skip``, ``plan``."""
+
+    def __init__(self, sim: Any, devices: list):
         self.sim = sim
-        self.devices = [_Device(d) for d in devices]
-        self.images = [np.zeros((sim.copies, d.height, d.width), dtype=np.float32) for d in self.devices]
+        self.devices = devices
         self._buffers: dict[int, tuple] = {}
 
-    def reset(self, idx: np.ndarray) -> None:
-        """Zeros before the first image (Webots), as a freshly built device."""
-        for img in self.images:
-            img[idx] = 0.0
-
-    # -- planning: every copy's pixel rays of each due device
-    def plan(self, copies: np.ndarray, cols: np.ndarray) -> tuple[dict, list]:
-        """(state, no joined requests): each device's rays of every copy, cast by :meth:`finish`
-        in a cast of their own (see the module docstring)."""
-        from sensorium.server.sim.batched import _lidar_beams, _Rays  # (batched.py imports this module)
+    def _beams(self, col: int, copies: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(each copy's device origin, the rays' origins, directions, float32 directions)."""
+        from sensorium.server.sim.batched import _lidar_beams  # (batched.py imports this module)
 
         sim = self.sim
-        state: dict = {"items": []}
-        for col in sorted(set(cols.tolist())):
-            dev = self.devices[col]
-            c = copies[cols == col]
-            slot = dev.template.robot_index
-            local = dev.template.local_pose
-            rr = sim.rot[c, slot]
-            rot = np.matmul(rr, local.rotation)                                  # Pose.compose, stacked
-            org = np.matmul(rr, local.translation[None, :, None])[:, :, 0] + sim.pos[c, slot]
-            got = packets.lidar_beams(rot, org, dev.columns, self._beam_buffers(col, len(c) * dev.n))
-            origins, d, d32 = got if got is not None else _lidar_beams(rot, org, dev.columns)
-            ray_copy, mount, t_near, t_far = self._rows(col, c)
-            state["items"].append((col, c, _Rays(origins, d, t_near, t_far, RayKind.VISUAL, ray_copy, -1, mount,
-                                                 distance_only=True, d32=d32, coherent=True, origin_rows=org,
-                                                 run=dev.n)))
-        return state, []
+        dev = self.devices[col]
+        slot = dev.template.robot_index
+        local = dev.template.local_pose
+        rr = sim.rot[copies, slot]
+        rot = np.matmul(rr, local.rotation)                                  # Pose.compose, stacked
+        org = np.matmul(rr, local.translation[None, :, None])[:, :, 0] + sim.pos[copies, slot]
+        got = packets.lidar_beams(rot, org, dev.columns, self._beam_buffers(col, len(copies) * dev.n))
+        origins, d, d32 = got if got is not None else _lidar_beams(rot, org, dev.columns)
+        return org, origins, d, d32
 
     def _beam_buffers(self, col: int, rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         got = self._buffers.get(col)
@@ -166,7 +187,7 @@ class DepthDevices:
 
     def _mount(self, col: int) -> np.ndarray | int:
         """The slot a device's pixel rays are never paired with in the world cast: its robot's, for
-        a device with shapes of its own (that body is met apart, :meth:`_own_distances`), else per
+        a device with shapes of its own (that body is met apart, in the body frame: ``own``), else per
         pixel its robot's where the ray can never meet that body, -1 where it may (it sees its robot)."""
         dev = self.devices[col]
         if dev.skip is None:
@@ -179,11 +200,43 @@ class DepthDevices:
             else:
                 local = tpl.local_pose
                 d = dev.dirs @ local.rotation.T
-                reach = self.sim.rays.may_reach(slot, RayKind.VISUAL, np.broadcast_to(local.translation, d.shape), d,
-                                                *dev.limits)
+                o = np.broadcast_to(local.translation, d.shape)
+                reach = self.sim.rays.may_reach(slot, RayKind.VISUAL, o, d, *dev.limits)
+                if reach.any():     # a device inside its robot's box: which rays may meet one of its shapes
+                    reach &= may_meet_parts(self.sim.world.robots[slot], self.sim.loaded.base_dir, o, d, *dev.limits)
                 skip = np.where(reach, -1, slot).astype(np.int64)
                 dev.skip = int(skip[0]) if (skip == skip[0]).all() else skip
         return dev.skip
+
+
+class DepthDevices(PixelDevices):
+    """The batched simulation's range finders: constants per device, images per copy."""
+
+    def __init__(self, sim: Any, devices: list[RangeFinder]):
+        super().__init__(sim, [_Device(d) for d in devices])
+        self.images = [np.zeros((sim.copies, d.height, d.width), dtype=np.float32) for d in self.devices]
+
+    def reset(self, idx: np.ndarray) -> None:
+        """Zeros before the first image (Webots), as a freshly built device."""
+        for img in self.images:
+            img[idx] = 0.0
+
+    # -- planning: every copy's pixel rays of each due device
+    def plan(self, copies: np.ndarray, cols: np.ndarray) -> tuple[dict, list]:
+        """(state, no joined requests): each device's rays of every copy, cast by :meth:`finish`
+        in a cast of their own (see the module docstring)."""
+        from sensorium.server.sim.batched import _Rays  # (batched.py imports this module)
+
+        state: dict = {"items": []}
+        for col in sorted(set(cols.tolist())):
+            dev = self.devices[col]
+            c = copies[cols == col]
+            org, origins, d, d32 = self._beams(col, c)
+            ray_copy, mount, t_near, t_far = self._rows(col, c)
+            state["items"].append((col, c, _Rays(origins, d, t_near, t_far, RayKind.VISUAL, ray_copy, -1, mount,
+                                                 distance_only=True, d32=d32, coherent=True, origin_rows=org,
+                                                 run=dev.n)))
+        return state, []
 
     def _own_distances(self, col: int) -> np.ndarray | None:
         """Each pixel's distance to its robot's body other than the device's own shapes (a device
