@@ -39,7 +39,7 @@ from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
-from sensorium.server.sim.cameras import MAX_LAYERS, Camera, _shade, camera_lights
+from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import _base_color, robot_parts
 
@@ -272,98 +272,29 @@ class CameraDevices(PixelDevices):
 
     def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits) -> np.ndarray:
         """Camera._render of one copy's rays (``hits``: its first layer, from the copies' cast): the
-        surfaces each ray crosses composited front to back, its rays going on past semi-transparent
-        surfaces cast for this copy alone (as the single camera casts them, from its origin with
-        per-ray limits), blind to the camera's own shapes."""
+        single camera's :func:`composite`, its rays going on past semi-transparent surfaces cast for
+        this copy alone (as the single camera casts them, from its origin with per-ray limits),
+        blind to the camera's own shapes."""
         sim = self.sim
         scene = sim.scene
         dev = self.devices[col]
         engine = _CopyEngine(sim, int(copy[0]))
         own = frozenset(sim.rays.shape_offset + i for i in dev.template.own_shapes)
-        n = len(dirs)
-        t_near, t_far = dev.limits
-        tn = tf = inside = None
-        out = np.zeros((n, 3))
-        weight = np.ones(n)
-        rows = np.arange(n)
-        for layer in range(MAX_LAYERS + 1):
-            if layer == 0:
-                D = dirs
-            else:                       # on past semi-transparent surfaces
-                assert tn is not None and tf is not None
-                D = dirs[rows]
-                O = np.broadcast_to(origin, D.shape)
-                if own:
-                    hits = cast_skipping(engine, O, D, tn[rows], tf[rows], own)
-                else:
-                    hits = engine.cast(O, D, tn[rows], tf[rows], kind=RayKind.VISUAL, exclude_owner=-1)
-            t, shape, normal = hits.distance, hits.shape, hits.normal
-            assert shape is not None and normal is not None
-            hit = np.isfinite(t)
-            miss = (~hit).nonzero()[0]
-            if len(miss):
-                rm = rows[miss]
-                shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], scene.background))
-            k = hit.nonzero()[0]
-            if len(k) == 0:
-                break
-            r, s = rows[k], shape[k]
-            tau = self.transparency[s]
-            clear = tau > 0.0
-            leaving = np.zeros(len(k), dtype=bool)
-            any_clear = bool(clear.any())
-            if any_clear and inside is None:
-                inside = np.full((n, MAX_LAYERS), -1, dtype=np.int64)
-                tn = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,)).copy()
-                tf = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))
-            if any_clear:              # a transparent shape the ray is already in: its far face
-                assert inside is not None
-                leaving = clear & (inside[r] == s[:, None]).any(axis=1)
-            seen = (~leaving).nonzero()[0]
-            if len(seen):
-                kk, rr = k[seen], r[seen]
-                whole = len(kk) == len(D)
-                Dk = D if whole else shading.take_rows(D, kk)
-                tk = t if whole else t.take(kk)
-                P = np.empty((len(kk), 3))
-                for ch in range(3):
-                    np.multiply(tk, Dk[:, ch], out=P[:, ch])
-                    P[:, ch] += origin[ch]
-                N = normal if whole else shading.take_rows(normal, kk)
-                back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
-                if back.any():
-                    bk = back.nonzero()[0]
-                    N = N.copy() if whole else N
-                    N[bk] = np.negative(shading.take_rows(N, bk))
-                zeros = np.zeros(len(kk), dtype=np.int64)
-                albedo = self._albedo(s[seen], origin[None, :], zeros, Dk, tk)
-                lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
-                L = _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
-                if scene.fog is not None:
-                    L = shading.fog(L, tk, *scene.fog)
-                last = layer == MAX_LAYERS
-                a = np.where(last, 0.0, tau[seen])
-                share = weight[rr] * (1.0 - a)
-                for ch in range(3):
-                    L[:, ch] *= share
-                shading.add_to_rows(out, rr, L)
-                weight[rr] *= a
-            go = clear & (layer < MAX_LAYERS)
-            if not go.any():
-                break
-            assert inside is not None and tn is not None
-            g = go.nonzero()[0]
-            rg, sg = r[g], s[g]
-            ent = ~leaving[g]
-            if ent.any():
-                free = np.argmax(inside[rg[ent]] < 0, axis=1)
-                inside[rg[ent], free] = sg[ent]
-            if (~ent).any():
-                lv = rg[~ent]
-                inside[lv] = np.where(inside[lv] == sg[~ent][:, None], -1, inside[lv])
-            tn[rg] = t[k[g]] * (1.0 + 1e-12) + 1e-7      # just past this surface (the single camera's step)
-            rows = rg
-        return out
+
+        def cast_on(D: np.ndarray, tn: np.ndarray, tf: np.ndarray) -> RayHits:
+            O = np.broadcast_to(origin, D.shape)
+            if own:
+                return cast_skipping(engine, O, D, tn, tf, own)
+            return engine.cast(O, D, tn, tf, kind=RayKind.VISUAL, exclude_owner=-1)
+
+        def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
+            zeros = np.zeros(len(s), dtype=np.int64)
+            albedo = self._albedo(s, origin[None, :], zeros, D, t)
+            lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
+            return _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
+
+        return composite(origin, dirs, hits, dev.limits, cast_on, self.transparency, scene.background, scene.fog,
+                         surface)
 
     def _finish_image(self, col: int, copies: np.ndarray, out: np.ndarray) -> None:
         """Camera._capture_image from the radiance of every copy's rays: the samples' mean, the

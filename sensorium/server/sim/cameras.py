@@ -27,7 +27,7 @@ from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info"]
+__all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info", "composite"]
 
 
 class MountedRays:
@@ -172,6 +172,96 @@ class RangeFinder(Device):
 
 MAX_LAYERS = 8
 """Semi-transparent surfaces composited along one ray; the next surface is taken as opaque."""
+
+def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tuple[Any, Any], cast_on,
+              transparency: np.ndarray, background: np.ndarray, fog, surface) -> np.ndarray:
+    """The radiance (N, 3) along every ray of a camera at ``origin``: the surfaces it crosses
+    composited front to back (semi-transparent ones let ``transparency`` of what is behind through;
+    a closed shape's faces are crossed twice and only its entering face is seen, as with back-face
+    culling), each surface mixed with the ``fog`` (``shading.fog``'s arguments, or None) by its
+    distance, the ``background`` (not fogged) where nothing is hit. ``first``: the rays' first hits
+    within ``limits``; ``cast_on(D, t_near, t_far)``: the hits of rays from ``origin`` going on past
+    a semi-transparent surface; ``surface(shape, P, N, D, t)``: the radiance (n, 3) of the surfaces
+    seen, before fog. The single camera and the batched one (per copy) share it."""
+    n = len(dirs)
+    t_near, t_far = limits
+    tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
+    out = np.zeros((n, 3))            # when a ray first goes through a semi-transparent surface
+    weight = np.ones(n)
+    rows = np.arange(n)
+    for layer in range(MAX_LAYERS + 1):
+        if layer == 0:
+            D, hits = dirs, first
+        else:                       # on past semi-transparent surfaces
+            assert tn is not None and tf is not None
+            D = dirs[rows]
+            hits = cast_on(D, tn[rows], tf[rows])
+        t, shape, normal = hits.distance, hits.shape, hits.normal
+        assert shape is not None and normal is not None
+        hit = np.isfinite(t)
+        miss = (~hit).nonzero()[0]
+        if len(miss):
+            rm = rows[miss]
+            shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], background))
+        k = hit.nonzero()[0]
+        if len(k) == 0:
+            break
+        r, s = rows[k], shape[k]
+        tau = transparency[s]
+        clear = tau > 0.0
+        leaving = np.zeros(len(k), dtype=bool)
+        any_clear = bool(clear.any())
+        if any_clear and inside is None:
+            inside = np.full((n, MAX_LAYERS), -1, dtype=np.int64)
+            tn = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,)).copy()
+            tf = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))
+        if any_clear:              # a transparent shape the ray is already in: its far face
+            assert inside is not None
+            leaving = clear & (inside[r] == s[:, None]).any(axis=1)
+        seen = (~leaving).nonzero()[0]
+        if len(seen):
+            kk, rr = k[seen], r[seen]
+            whole = len(kk) == len(D)
+            Dk = D if whole else shading.take_rows(D, kk)
+            tk = t if whole else t.take(kk)
+            P = np.empty((len(kk), 3))          # origin + t D, column by column
+            for ch in range(3):
+                np.multiply(tk, Dk[:, ch], out=P[:, ch])
+                P[:, ch] += origin[ch]
+            N = normal if whole else shading.take_rows(normal, kk)
+            back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+            if back.any():         # facing the camera
+                bk = back.nonzero()[0]
+                N = N.copy() if whole else N
+                N[bk] = np.negative(shading.take_rows(N, bk))
+            L = surface(s[seen], P, N, Dk, tk)
+            if fog is not None:           # Webots mixes each surface (not the sky) with the fog colour
+                L = shading.fog(L, tk, *fog)
+            last = layer == MAX_LAYERS
+            a = np.where(last, 0.0, tau[seen])
+            share = weight[rr] * (1.0 - a)
+            for ch in range(3):    # (weight (1 - a)) L, column by column
+                L[:, ch] *= share
+            shading.add_to_rows(out, rr, L)
+            weight[rr] *= a
+        # the rays that go on: through a transparent surface (entering or leaving it)
+        go = clear & (layer < MAX_LAYERS)
+        if not go.any():
+            break
+        assert inside is not None and tn is not None
+        g = go.nonzero()[0]
+        rg, sg = r[g], s[g]
+        ent = ~leaving[g]
+        if ent.any():            # entering: remember the shape (in its first free slot)
+            free = np.argmax(inside[rg[ent]] < 0, axis=1)
+            inside[rg[ent], free] = sg[ent]
+        if (~ent).any():         # leaving: forget it
+            lv = rg[~ent]
+            inside[lv] = np.where(inside[lv] == sg[~ent][:, None], -1, inside[lv])
+        tn[rg] = t[k[g]] * (1.0 + 1e-12) + 1e-7      # just past this surface
+        rows = rg
+    return out
+
 
 def camera_lights(models: list) -> tuple[light_math.LightArrays, np.ndarray]:
     """The lights that are on (world frame) and which of them cast shadows (Webots' castShadows)."""
@@ -373,102 +463,32 @@ class Camera(Device):
         self.image = image
 
     def _render(self, pose: Pose, rays: MountedRays, counters: Any) -> np.ndarray:
-        """The radiance (N, 3) along every ray: the surfaces it crosses composited front to back
-        (semi-transparent ones let ``transparency`` of what is behind through; a closed shape's
-        faces are crossed twice and only its entering face is seen, as with back-face culling),
-        each surface mixed with the world's fog by its distance (``shading.fog``), the background
-        (not fogged) where nothing is hit. The device's own shapes are never met."""
+        """The radiance (N, 3) along every ray (:func:`composite`); the device's own shapes are
+        never met."""
         scene = self._scene
         engine = scene.engine
         origin = pose.translation
         dirs = rays.at(pose.rotation)[0]
-        n = len(dirs)
-        t_near, t_far = self._limits
-        tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
-        out = np.zeros((n, 3))            # when a ray first goes through a semi-transparent surface
-        weight = np.ones(n)
-        rows = np.arange(n)
         lights, shadows = self._light_arrays()
-        for layer in range(MAX_LAYERS + 1):
-            if layer == 0:
-                D = dirs
-                hits = _cast_pixels(self, rays, pose, self._limits)
-            else:                       # on past semi-transparent surfaces
-                assert tn is not None and tf is not None
-                D = dirs[rows]
-                if self.own_shapes:
-                    hits = cast_skipping(engine, np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows], self.own_shapes)
-                else:
-                    hits = engine.cast(np.broadcast_to(origin, D.shape), D, tn[rows], tf[rows], kind=RayKind.VISUAL,
-                                       exclude_owner=-1)
-            counters["rays_camera"] += len(rows)
+        first = _cast_pixels(self, rays, pose, self._limits)
+        counters["rays_camera"] += len(dirs)
+        counters["cast_calls"] += 1
+
+        def cast_on(D: np.ndarray, tn: np.ndarray, tf: np.ndarray) -> RayHits:
+            counters["rays_camera"] += len(D)
             counters["cast_calls"] += 1
-            t, shape, normal = hits.distance, hits.shape, hits.normal
-            hit = np.isfinite(t)
-            miss = (~hit).nonzero()[0]
-            if len(miss):
-                rm = rows[miss]
-                shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], self._background))
-            k = hit.nonzero()[0]
-            if len(k) == 0:
-                break
-            r, s = rows[k], shape[k]
-            tau = scene.transparency[s]
-            clear = tau > 0.0
-            leaving = np.zeros(len(k), dtype=bool)
-            any_clear = bool(clear.any())
-            if any_clear and inside is None:
-                inside = np.full((n, MAX_LAYERS), -1, dtype=np.int64)
-                tn = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,)).copy()
-                tf = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))
-            if any_clear:              # a transparent shape the ray is already in: its far face
-                assert inside is not None
-                leaving = clear & (inside[r] == s[:, None]).any(axis=1)
-            seen = (~leaving).nonzero()[0]
-            if len(seen):
-                kk, rr = k[seen], r[seen]
-                whole = len(kk) == len(D)
-                Dk = D if whole else shading.take_rows(D, kk)
-                tk = t if whole else t.take(kk)
-                P = np.empty((len(kk), 3))          # origin + t D, column by column
-                for ch in range(3):
-                    np.multiply(tk, Dk[:, ch], out=P[:, ch])
-                    P[:, ch] += origin[ch]
-                N = normal if whole else shading.take_rows(normal, kk)
-                back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
-                if back.any():         # facing the camera
-                    bk = back.nonzero()[0]
-                    N = N.copy() if whole else N
-                    N[bk] = np.negative(shading.take_rows(N, bk))
-                albedo = scene.surface_colors(s[seen], np.broadcast_to(origin, (len(kk), 3)), Dk, tk)
-                lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
-                L = _shade(P, N, albedo, lights, lit, engine.threads)
-                if scene.fog is not None:     # Webots mixes each surface (not the sky) with the fog colour
-                    L = shading.fog(L, tk, *scene.fog)
-                last = layer == MAX_LAYERS
-                a = np.where(last, 0.0, tau[seen])
-                share = weight[rr] * (1.0 - a)
-                for ch in range(3):    # (weight (1 - a)) L, column by column
-                    L[:, ch] *= share
-                shading.add_to_rows(out, rr, L)
-                weight[rr] *= a
-            # the rays that go on: through a transparent surface (entering or leaving it)
-            go = clear & (layer < MAX_LAYERS)
-            if not go.any():
-                break
-            assert inside is not None and tn is not None
-            g = go.nonzero()[0]
-            rg, sg = r[g], s[g]
-            ent = ~leaving[g]
-            if ent.any():            # entering: remember the shape (in its first free slot)
-                free = np.argmax(inside[rg[ent]] < 0, axis=1)
-                inside[rg[ent], free] = sg[ent]
-            if (~ent).any():         # leaving: forget it
-                lv = rg[~ent]
-                inside[lv] = np.where(inside[lv] == sg[~ent][:, None], -1, inside[lv])
-            tn[rg] = t[k[g]] * (1.0 + 1e-12) + 1e-7      # just past this surface
-            rows = rg
-        return out
+            O = np.broadcast_to(origin, D.shape)
+            if self.own_shapes:
+                return cast_skipping(engine, O, D, tn, tf, self.own_shapes)
+            return engine.cast(O, D, tn, tf, kind=RayKind.VISUAL, exclude_owner=-1)
+
+        def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
+            albedo = scene.surface_colors(s, np.broadcast_to(origin, (len(s), 3)), D, t)
+            lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
+            return _shade(P, N, albedo, lights, lit, engine.threads)
+
+        return composite(origin, dirs, first, self._limits, cast_on, scene.transparency, self._background, scene.fog,
+                         surface)
 
     def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
                  counters: Any) -> np.ndarray:
