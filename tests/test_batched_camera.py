@@ -17,6 +17,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_batched_depth import scout_ahead_in_copy_0
 from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "camera.yaml"
@@ -214,32 +215,7 @@ def test_copies_never_see_each_others_robots(texture_dir: Path):
     that copy has it, byte for byte (shadows included: the lamp and the sun cast them), and the
     noiseless housed camera's pixels differ between the two copies only where copy 0's scout
     (magenta) or its shadow (darker) is in view: copy 1's rover sees neither."""
-    lw = _world(0, texture_dir)
-    bs = BatchedSimulation(lw, 2, precision="exact")
-    bs.reset([0, 1], [0, 0])
-    rover = bs.pose(0, bs.slot("rover"))
-    fwd = rover.rotation[:, 0]
-    ahead = rover.translation + 0.5 * fwd
-    places = [([float(ahead[0]), float(ahead[1]), 0.0], [0, 0, 1, math.atan2(fwd[1], fwd[0])]),
-              ([-2.5, 2.5, 0.0], [0, 0, 1, 0.0])]
-    names = ("eye", "housed", "pano")
-    singles = []
-    for c, (t, r) in enumerate(places):
-        bs.set_pose(c, bs.slot("scout"), translation=t, rotation=r)
-        single = Simulation(lw, precision="exact")
-        single.robot("scout").set_pose(t, r)
-        for n in names:
-            single.robot("rover").device(n).enable(16)
-        singles.append(single)
-    for n in names:
-        bs.enable(bs.device("rover", n), 16)
-    for _ in range(3):
-        bs.step()
-        for c, single in enumerate(singles):
-            single.step()
-            for n in names:
-                got = bs.image(bs.device("rover", n))[c]
-                assert got.tobytes() == single.robot("rover").device(n).image.tobytes(), (c, n)
+    bs = scout_ahead_in_copy_0(_world(0, texture_dir), ("eye", "housed", "pano"), (-2.5, 2.5), "image")
     img = bs.image(bs.device("rover", "housed")).astype(np.int64)
     differ = (img[0] != img[1]).any(axis=-1)
     assert differ.sum() >= 4

@@ -133,20 +133,19 @@ def test_a_range_finder_facing_a_wall_reads_the_closed_form_depths(precision: st
                 assert (img[c, 0] > img[c, 2]).all()               # rows above look up: farther
 
 
-def test_copies_never_see_each_others_robots():
-    """The scout parked 0.5 m in front of the rover in copy 0, and off to a corner in
-    copy 1 (both copies with world seed 0): each copy's images are those of a Simulation with its
-    scout where that copy has it, bit for bit, and copy 0's show the scout (near pixels) where copy
-    1's, with the same noise, do not -- copy 1's rover does not see copy 0's scout."""
-    lw = _world(0)
+def scout_ahead_in_copy_0(lw: LoadedWorld, names: tuple[str, ...], corner: tuple[float, float],
+                          reading: str) -> BatchedSimulation:
+    """Two copies of ``lw`` (world seed 0) with the scout parked 0.5 m in front of the rover in copy 0
+    and at ``corner`` in copy 1, the rover's devices ``names`` enabled, stepped 3 times beside two
+    Simulations with their scout placed alike: each copy's images (``reading``: "range_image" or
+    "image") equal its Simulation's, byte for byte, every step. Returns the batched simulation."""
     bs = BatchedSimulation(lw, 2, precision="exact")
     bs.reset([0, 1], [0, 0])
     rover = bs.pose(0, bs.slot("rover"))
     fwd = rover.rotation[:, 0]
     ahead = rover.translation + 0.5 * fwd
     places = [([float(ahead[0]), float(ahead[1]), 0.0], [0, 0, 1, math.atan2(fwd[1], fwd[0])]),
-              ([-1.5, 1.5, 0.0], [0, 0, 1, 0.0])]
-    names = ("depth", "wide", "housed")
+              ([corner[0], corner[1], 0.0], [0, 0, 1, 0.0])]
     singles = []
     for c, (t, r) in enumerate(places):
         bs.set_pose(c, bs.slot("scout"), translation=t, rotation=r)
@@ -162,8 +161,17 @@ def test_copies_never_see_each_others_robots():
         for c, single in enumerate(singles):
             single.step()
             for n in names:
-                got = bs.range_image(bs.device("rover", n))[c]
-                assert got.tobytes() == single.robot("rover").device(n).range_image.tobytes(), (c, n)
+                got = getattr(bs, reading)(bs.device("rover", n))[c]
+                assert got.tobytes() == getattr(single.robot("rover").device(n), reading).tobytes(), (c, n)
+    return bs
+
+
+def test_copies_never_see_each_others_robots():
+    """The scout parked 0.5 m in front of the rover in copy 0, and off to a corner in
+    copy 1 (both copies with world seed 0): each copy's images are those of a Simulation with its
+    scout where that copy has it, bit for bit, and copy 0's show the scout (near pixels) where copy
+    1's, with the same noise, do not -- copy 1's rover does not see copy 0's scout."""
+    bs = scout_ahead_in_copy_0(_world(0), ("depth", "wide", "housed"), (-1.5, 1.5), "range_image")
     # the noiseless housed device: the pixels on copy 0's scout (its near face 0.33 m ahead) read
     # nearer than copy 1's (the floor there), every other pixel the same
     img = bs.range_image(bs.device("rover", "housed"))

@@ -27,7 +27,7 @@ from sensorium.server.raycast.kinds import RayKind
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
-from tests.test_batched_sim import EPUCK, SCOUT, _same_value
+from tests.test_batched_sim import EPUCK, SCOUT, _assert_same, _same_value, _wheels_both
 
 HAVE_C = packets.library() is not None
 needs_c = pytest.mark.skipif(not HAVE_C, reason=f"no packet path here: {packets.status()}")
@@ -72,33 +72,6 @@ def _pair(worlds: list[LoadedWorld], seeds: list[int], precision: str = "fast", 
 def _set_pose_both(bs, sims, c: int, robot: str, translation, yaw: float) -> None:
     bs.set_pose(c, bs.slot(robot), translation, rotation=[0, 0, 1, yaw])
     sims[c].robot(robot).set_pose(translation, [0, 0, 1, yaw])
-
-
-def _wheels_both(bs, sims, robot: str, lr: np.ndarray) -> None:
-    slot = bs.slot(robot)
-    bs.set_wheels(slot, lr[:, 0], lr[:, 1])
-    for c, s in enumerate(sims):
-        for m in s.robot(robot).motors.values():
-            m.set_position(math.inf)
-        s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
-        s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
-
-
-def _assert_same(bs, sims, step) -> None:
-    """Every copy's clock, poses, values and range images are its Simulation's, bit for bit."""
-    for c, s in enumerate(sims):
-        assert bs.time_ms[c] == s.time_ms
-        for robot, names in (("epuck", EPUCK), ("scout", SCOUT)):
-            slot = bs.slot(robot)
-            pose = s.robot(robot).pose
-            assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
-            assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
-            for n in names:
-                ref, dev = bs.device(robot, n), s.robot(robot).device(n)
-                if ref.kind == "Lidar":
-                    assert dev.range_image.tobytes() == bs.range_image(ref)[c].tobytes(), (step, c, n)
-                else:
-                    assert _same_value(dev.value, float(bs.value(ref)[c])), (step, c, n, dev.value)
 
 
 def _drive_lockstep(bs, sims, steps: int, seed: int = 0) -> None:

@@ -28,6 +28,33 @@ def _same_value(a: float, b: float) -> bool:
     return a == b or (math.isnan(a) and math.isnan(b))
 
 
+def _wheels_both(bs, sims, robot: str, lr: np.ndarray) -> None:
+    slot = bs.slot(robot)
+    bs.set_wheels(slot, lr[:, 0], lr[:, 1])
+    for c, s in enumerate(sims):
+        for m in s.robot(robot).motors.values():
+            m.set_position(math.inf)
+        s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
+        s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
+
+
+def _assert_same(bs, sims, step) -> None:
+    """Every copy's clock, poses, values and range images are its Simulation's, bit for bit."""
+    for c, s in enumerate(sims):
+        assert bs.time_ms[c] == s.time_ms
+        for robot, names in (("epuck", EPUCK), ("scout", SCOUT)):
+            slot = bs.slot(robot)
+            pose = s.robot(robot).pose
+            assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
+            assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
+            for n in names:
+                ref, dev = bs.device(robot, n), s.robot(robot).device(n)
+                if ref.kind == "Lidar":
+                    assert dev.range_image.tobytes() == bs.range_image(ref)[c].tobytes(), (step, c, n)
+                else:
+                    assert _same_value(dev.value, float(bs.value(ref)[c])), (step, c, n, dev.value)
+
+
 @pytest.mark.parametrize("precision", ["fast", "exact"])
 def test_every_copy_is_the_single_simulation_with_its_seed(precision):
     """Both robots drive (into walls, at each other); every observable device of both is enabled
@@ -47,30 +74,13 @@ def test_every_copy_is_the_single_simulation_with_its_seed(precision):
     for step in range(48):
         if step % 4 == 0:
             for robot in ("epuck", "scout"):
-                slot = bs.slot(robot)
-                vmax = float(bs.max_wheel[slot, 0])
-                lr = rng.uniform(-vmax, vmax, (3, 2)) if step % 16 else np.full((3, 2), 0.9 * vmax)
-                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
-                for c, s in enumerate(sims):
-                    for m in s.robot(robot).motors.values():
-                        m.set_position(math.inf)
-                    s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
-                    s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
+                vmax = float(bs.max_wheel[bs.slot(robot), 0])
+                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (3, 2)) if step % 16
+                             else np.full((3, 2), 0.9 * vmax))
         bs.step()
-        for c, s in enumerate(sims):
+        for s in sims:
             s.step()
-            assert bs.time_ms[c] == s.time_ms
-            for robot, names in (("epuck", EPUCK), ("scout", SCOUT)):
-                slot = bs.slot(robot)
-                pose = s.robot(robot).pose
-                assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
-                assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
-                for n in names:
-                    ref, dev = bs.device(robot, n), s.robot(robot).device(n)
-                    if ref.kind == "Lidar":
-                        assert dev.range_image.tobytes() == bs.range_image(ref)[c].tobytes(), (step, c, n)
-                    else:
-                        assert _same_value(dev.value, float(bs.value(ref)[c])), (step, c, n, dev.value)
+        _assert_same(bs, sims, step)
     # the copies differ from one another (own noise streams), and the IR noise was drawn
     ps = bs.value(bs.device("epuck", "ps0"))
     assert len(set(ps.tolist())) == 3
