@@ -131,7 +131,8 @@ def test_lidar_copies_far_from_the_origin_in_an_unanchored_tier_are_the_single_s
     tier = bs.rays.static._static_tier(bs.rays.movers._variant(RayKind.VISUAL, False))
     assert not tier.anchored and tier.radius > 1e5
     _drive_lockstep(bs, sims, 24)
-    assert bs.rays.counters["lean_casts"] > 0
+    if HAVE_C:        # the lean cast needs the packet helper (SENSORIUM_PACKETS=0: none)
+        assert bs.rays.counters["lean_casts"] > 0
 
 
 @needs_c
