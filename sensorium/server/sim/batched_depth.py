@@ -14,7 +14,8 @@ lidar's way (``BatchedSimulation._plan_lidars``):
   a cast of their own, not joined to the step's other rays of their kind: a joined cast has one
   form of ``t_near`` for all its rays (per ray when they differ), and FAST starts a ray's float32
   traversal at ``t_near`` by a per-ray or a scalar sum that differ in the last bit. A device sees its own robot, except
-  where a pixel can never reach it (decided once: ``CopyRays.may_reach``), and a device with shapes
+  where a pixel can never reach it (decided once: ``CopyRays.may_reach``, then each of the robot's
+  shapes' boxes, :func:`may_meet_parts`), and a device with shapes
   of its own (``of_device``) meets its robot's body once, in the body frame, blind to those shapes
   (``OwnBodyRays.body_hits`` on the movers' engine, as the single device does on its scene's);
 * ``imaging.range_values`` makes every copy's image in one call: its per-pixel steps (a product,
