@@ -18,6 +18,7 @@ from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
 from tests.test_batched_depth import scout_ahead_in_copy_0
+from tests.test_batched_sim import _enable_both, _wheels_both
 from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "camera.yaml"
@@ -41,13 +42,6 @@ def _world(seed: int, base: Path, **update) -> LoadedWorld:
     w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed}),
                                     **update})
     return LoadedWorld(world=w, source=lw.source, base_dir=base)
-
-
-def _drive(sim: Simulation, robot: str, left: float, right: float) -> None:
-    for m in sim.robot(robot).motors.values():
-        m.set_position(math.inf)
-    sim.robot(robot).drive.left.set_velocity(left)
-    sim.robot(robot).drive.right.set_velocity(right)
 
 
 def _glass(seed: int, base: Path) -> LoadedWorld:
@@ -79,14 +73,8 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
     bs.reset(np.arange(len(seeds)), seeds)
     sims = [Simulation(make(s, texture_dir), precision=precision) for s in seeds]
 
-    def enable(copy: int) -> None:
-        for robot, names in PERIODS.items():
-            for n, p in names.items():
-                bs.enable(bs.device(robot, n), p, copies=[copy])
-                sims[copy].robot(robot).device(n).enable(p)
-
     for c in range(len(seeds)):
-        enable(c)
+        _enable_both(bs, sims, PERIODS, c)
     through = []                                 # the casts of rays going on past a semi-transparent surface
     cast = bs.rays.cast
 
@@ -101,16 +89,12 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
     for step in range(70):
         if step % 10 == 0:
             for robot in PERIODS:
-                slot = bs.slot(robot)
-                vmax = 0.3 * float(bs.max_wheel[slot, 0])
-                lr = rng.uniform(-vmax, vmax, (len(seeds), 2))
-                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
-                for c, s in enumerate(sims):
-                    _drive(s, robot, float(lr[c, 0]), float(lr[c, 1]))
+                vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
+                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
         if step == 40:                          # copy 1 as a new world with another seed
             bs.reset([1], [42])
             sims[1] = Simulation(make(42, texture_dir), precision=precision)
-            enable(1)
+            _enable_both(bs, sims, PERIODS, 1)
         bs.step()
         for c, s in enumerate(sims):
             s.step()

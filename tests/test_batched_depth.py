@@ -18,6 +18,7 @@ from sensorium.server.sim import batched_depth
 from sensorium.server.sim.batched import BatchedSimulation, NoiseStreams
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_batched_sim import _enable_both, _wheels_both
 from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "depth.yaml"
@@ -29,13 +30,6 @@ def _world(seed: int) -> LoadedWorld:
     lw = load_world(WORLD)
     w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
     return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
-
-
-def _drive(sim: Simulation, robot: str, left: float, right: float) -> None:
-    for m in sim.robot(robot).motors.values():
-        m.set_position(math.inf)
-    sim.robot(robot).drive.left.set_velocity(left)
-    sim.robot(robot).drive.right.set_velocity(right)
 
 
 @pytest.mark.parametrize("precision", BOTH)
@@ -51,29 +45,19 @@ def test_every_copy_captures_its_range_finders_as_the_single_simulation(precisio
     bs.reset(np.arange(len(seeds)), seeds)
     sims = [Simulation(_world(s), precision=precision) for s in seeds]
 
-    def enable(copy: int) -> None:
-        for robot, names in PERIODS.items():
-            for n, p in names.items():
-                bs.enable(bs.device(robot, n), p, copies=[copy])
-                sims[copy].robot(robot).device(n).enable(p)
-
     for c in range(len(seeds)):
-        enable(c)
+        _enable_both(bs, sims, PERIODS, c)
     rng = np.random.default_rng(1)
     seen = {"inf": 0, "finite": 0, "zeros": 0, "near": 0}
     for step in range(90):
         if step % 10 == 0:
             for robot in PERIODS:
-                slot = bs.slot(robot)
-                vmax = 0.3 * float(bs.max_wheel[slot, 0])
-                lr = rng.uniform(-vmax, vmax, (len(seeds), 2))
-                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
-                for c, s in enumerate(sims):
-                    _drive(s, robot, float(lr[c, 0]), float(lr[c, 1]))
+                vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
+                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
         if step == 50:                          # copy 1 as a new world with another seed
             bs.reset([1], [42])
             sims[1] = Simulation(_world(42), precision=precision)
-            enable(1)
+            _enable_both(bs, sims, PERIODS, 1)
         bs.step()
         for c, s in enumerate(sims):
             s.step()

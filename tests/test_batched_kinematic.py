@@ -21,6 +21,7 @@ from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
 from sensorium.server.world.poses import matrix_quaternion, quaternion_matrix
+from tests.test_batched_sim import _enable_both, _wheels_both
 from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "kinematic.yaml"
@@ -40,13 +41,6 @@ def _readings(bs: BatchedSimulation, sim: Simulation, copy: int, robot: str, nam
     ref, dev = bs.device(robot, name), sim.robot(robot).device(name)
     whats = kin.READINGS[ref.kind]
     return [(w, np.asarray(getattr(dev, w), dtype=np.float64), bs.reading(ref, w)[copy]) for w in whats]
-
-
-def _drive(sim: Simulation, robot: str, left: float, right: float) -> None:
-    for m in sim.robot(robot).motors.values():
-        m.set_position(math.inf)
-    sim.robot(robot).drive.left.set_velocity(left)
-    sim.robot(robot).drive.right.set_velocity(right)
 
 
 @pytest.fixture(params=["helper", "math"])
@@ -75,32 +69,22 @@ def test_every_copy_reads_its_kinematic_devices_as_the_single_simulation(native)
     bs.reset(np.arange(len(seeds)), seeds)
     sims = [Simulation(_world(s)) for s in seeds]
 
-    def enable(copy: int) -> None:
-        for robot, names in PERIODS.items():
-            for n, p in names.items():
-                bs.enable(bs.device(robot, n), p, copies=[copy])
-                sims[copy].robot(robot).device(n).enable(p)
-
     for c in range(len(seeds)):
-        enable(c)
+        _enable_both(bs, sims, PERIODS, c)
     rng = np.random.default_rng(0)
     seen = {"tilted": 0, "nan": 0, "speed": 0, "turn": 0, "jolt": 0}
     for step in range(160):
         if step % 10 == 0:
             for robot in PERIODS:
-                slot = bs.slot(robot)
-                vmax = float(bs.max_wheel[slot, 0])
-                lr = rng.uniform(-vmax, vmax, (len(seeds), 2))
-                bs.set_wheels(slot, lr[:, 0], lr[:, 1])
-                for c, s in enumerate(sims):
-                    _drive(s, robot, float(lr[c, 0]), float(lr[c, 1]))
+                vmax = float(bs.max_wheel[bs.slot(robot), 0])
+                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
         if step == 70:                          # a supervisor move onto the ramp in copy 2
             bs.set_pose(2, bs.slot("rover"), [0.9, -0.3, 0.5])
             sims[2].robot("rover").set_pose([0.9, -0.3, 0.5])
         if step == 100:                         # copy 1 as a new world with another seed
             bs.reset([1], [42])
             sims[1] = Simulation(_world(42))
-            enable(1)
+            _enable_both(bs, sims, PERIODS, 1)
         if step == 120:                         # copy 3's gyro and accelerometer start their poses over
             for n, p in (("acc", 32), ("gyro", 48)):
                 bs.enable(bs.device("scout", n), p, copies=[3])

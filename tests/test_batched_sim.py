@@ -38,6 +38,14 @@ def _wheels_both(bs, sims, robot: str, lr: np.ndarray) -> None:
         s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
 
 
+def _enable_both(bs, sims, periods: dict, copy: int) -> None:
+    """Every device of ``periods`` ({robot: {device: ms}}) enabled in one copy and in its Simulation."""
+    for robot, names in periods.items():
+        for n, p in names.items():
+            bs.enable(bs.device(robot, n), p, copies=[copy])
+            sims[copy].robot(robot).device(n).enable(p)
+
+
 def _assert_same(bs, sims, step) -> None:
     """Every copy's clock, poses, values and range images are its Simulation's, bit for bit."""
     for c, s in enumerate(sims):
