@@ -209,6 +209,26 @@ def _load() -> None:
     lib.sp_lidar_beams.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_drive_wheels.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_contact_near.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp]
+    # the batched step's passes (DriveStep, lookup, atan2, the sonars, AvoidObstacles, the due scan,
+    # the observation clip) and the batched kinematic devices' libm passes
+    for name, restype, argtypes in (
+            ("sp_drive_step", sz, [sz, vp, sz, vp, sz, sz, sz, d, d, i, vp, vp]),
+            ("sp_pose_scatter", None, [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]),
+            ("sp_lookup", None, [sz, vp, sz, vp, vp, vp, vp, vp]),
+            ("sp_atan2", None, [sz, vp, sz, vp, sz, vp, sz]),
+            ("sp_cross_norm", None, [sz, vp, vp, vp]),
+            ("sp_sonar_nearest", None, [sz, sz, vp, vp, vp, d, vp]),
+            ("sp_clearance_gaps", None, [sz, sz, vp, d, d, vp]),
+            ("sp_avoid_reward", None, [sz, vp, sz, sz, vp, d, vp, d, d, d, vp]),
+            ("sp_avoid_outcome", i, [sz, sz, vp, d, d, vp, sz, sz, sz, vp, d, d, d, d, vp, vp, vp]),
+            ("sp_box_clip32", None, [sz, vp, f, f, vp]),
+            ("sp_due", sz, [sz, sz, vp, vp, vp, vp, vp]),
+            ("sp_roll_pitch_yaw", None, [sz, vp, i, vp]),
+            ("sp_half_angles", sz, [sz, vp, vp]),
+            ("sp_correlation_ratios", sz, [sz, vp, vp, vp]),
+            ("sp_gyro", None, [sz, vp, d, vp])):
+        func = getattr(lib, name)
+        func.restype, func.argtypes = restype, argtypes
     _state["lib"] = lib
     _state["embree"] = embree
 
@@ -926,11 +946,6 @@ class DriveStep:
         self.p_status = self.status.ctypes.data
         self.p_scatter = [a.ctypes.data for a in (self.copies, self.slots, self.rot, state["x"], state["y"],
                                                   state["z"], state["rot"], state["pos"])]
-        vp, sz, d = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
-        lib.sp_drive_step.restype = sz
-        lib.sp_drive_step.argtypes = [sz, vp, sz, vp, sz, sz, sz, d, d, ctypes.c_int, vp, vp]
-        lib.sp_pose_scatter.restype = None
-        lib.sp_pose_scatter.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]
 
     def run(self, live: np.ndarray, driven: np.ndarray, dt: float, eps: float, solids=None) -> int:
         """One basic step of the live copies' driven slots (int64 arrays); ``solids``: the contact's
@@ -973,11 +988,6 @@ def lookup(table, values: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         return None
     got = _tables.get(id(table))
     if got is None or got[0] is not table:
-        if not getattr(lib, "_lookup_typed", False):
-            vp, sz = ctypes.c_void_p, ctypes.c_size_t
-            lib.sp_lookup.restype = None
-            lib.sp_lookup.argtypes = [sz, vp, sz, vp, vp, vp, vp, vp]
-            lib._lookup_typed = True
         rows = [np.ascontiguousarray(a) for a in (table._x, table._y, table._n)]
         got = _tables[id(table)] = (table, rows, [a.ctypes.data for a in rows])
     values = np.ascontiguousarray(values)
@@ -1004,22 +1014,9 @@ def atan2(y: np.ndarray, x: np.ndarray, out: np.ndarray | None = None) -> np.nda
     if not out.flags.writeable or not all(a.dtype == np.float64 and a.ndim == 1 and a.shape == y.shape
                                           and a.strides[0] > 0 and a.strides[0] % 8 == 0 for a in (y, x, out)):
         return None
-    if not getattr(lib, "_atan2_typed", False):
-        vp, sz = ctypes.c_void_p, ctypes.c_size_t
-        lib.sp_atan2.restype = None
-        lib.sp_atan2.argtypes = [sz, vp, sz, vp, sz, vp, sz]
-        lib._atan2_typed = True
     lib.sp_atan2(len(y), y.ctypes.data, y.strides[0] // 8, x.ctypes.data, x.strides[0] // 8, out.ctypes.data,
                  out.strides[0] // 8)
     return out
-
-
-def _typed(lib, name: str, argtypes: list) -> None:
-    """Declare one of the appended C functions' arguments (once; they return nothing)."""
-    func = getattr(lib, name)
-    if func.argtypes is None:
-        func.restype = None
-        func.argtypes = argtypes
 
 
 def cross_norm(u: np.ndarray, back: np.ndarray) -> np.ndarray | None:
@@ -1030,7 +1027,6 @@ def cross_norm(u: np.ndarray, back: np.ndarray) -> np.ndarray | None:
     if lib is None or u.dtype != np.float64 or back.dtype != np.float64 or u.shape != back.shape or u.ndim != 3 \
             or u.shape[2] != 3:
         return None
-    _typed(lib, "sp_cross_norm", [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p])
     u, back = np.ascontiguousarray(u), np.ascontiguousarray(back)
     out = np.empty(u.shape[:2])
     lib.sp_cross_norm(out.size, u.ctypes.data, back.ctypes.data, out.ctypes.data)
@@ -1046,8 +1042,6 @@ def sonar_nearest(r: np.ndarray, beta: np.ndarray, rmax: np.ndarray, max_inciden
     if lib is None or r.dtype != np.float64 or beta.dtype != np.float64 or rmax.dtype != np.float64 \
             or r.ndim != 2 or beta.shape != r.shape or rmax.shape != r.shape[:1]:
         return None
-    vp, sz = ctypes.c_void_p, ctypes.c_size_t
-    _typed(lib, "sp_sonar_nearest", [sz, sz, vp, vp, vp, ctypes.c_double, vp])
     r, beta, rmax = np.ascontiguousarray(r), np.ascontiguousarray(beta), np.ascontiguousarray(rmax)
     out = np.empty(len(r))
     lib.sp_sonar_nearest(r.shape[0], r.shape[1], r.ctypes.data, beta.ctypes.data, rmax.ctypes.data,
@@ -1101,8 +1095,6 @@ def clearance_gaps(d: np.ndarray, far: float, radius: float) -> np.ndarray | Non
     lib = library()
     if lib is None or d.dtype != np.float64 or d.ndim != 2:
         return None
-    vp, sz, f = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
-    _typed(lib, "sp_clearance_gaps", [sz, sz, vp, f, f, vp])
     d = np.ascontiguousarray(d)
     gap = np.empty(len(d))
     lib.sp_clearance_gaps(d.shape[0], d.shape[1], d.ctypes.data, float(far), float(radius), gap.ctypes.data)
@@ -1122,8 +1114,6 @@ def avoid_reward(copies: np.ndarray, slot: int, velocity: np.ndarray, vmax: floa
     _check_buffer("avoid_reward", velocity, np.float64, (C, R, 2))
     if not 0 <= slot < R or (len(copies) and not (0 <= int(copies.min()) and int(copies.max()) < C)):
         raise IndexError(f"avoid_reward: slot {slot} or copies outside ({C}, {R})")
-    vp, sz, f = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_double
-    _typed(lib, "sp_avoid_reward", [sz, vp, sz, sz, vp, f, vp, f, f, f, vp])
     copies, gap = np.ascontiguousarray(copies), np.ascontiguousarray(gap)
     out = np.empty(len(copies))
     lib.sp_avoid_reward(len(copies), copies.ctypes.data, R, int(slot), velocity.ctypes.data, float(vmax),
@@ -1133,24 +1123,6 @@ def avoid_reward(copies: np.ndarray, slot: int, velocity: np.ndarray, vmax: floa
 
 # ---------------------------------------------------------------- batched kinematic devices
 # (sim/batched_kinematic.py: the libm calls of the GPS, inertial unit and gyro models per element)
-
-def _kinematic_library():
-    """The helper with the batched kinematic passes' signatures declared (once), or None."""
-    lib = library()
-    if lib is None or getattr(lib, "_kinematic_declared", False):
-        return lib
-    sz, d, i, vp = ctypes.c_size_t, ctypes.c_double, ctypes.c_int, ctypes.c_void_p
-    lib.sp_roll_pitch_yaw.restype = None
-    lib.sp_roll_pitch_yaw.argtypes = [sz, vp, i, vp]
-    lib.sp_half_angles.restype = sz
-    lib.sp_half_angles.argtypes = [sz, vp, vp]
-    lib.sp_correlation_ratios.restype = sz
-    lib.sp_correlation_ratios.argtypes = [sz, vp, vp, vp]
-    lib.sp_gyro.restype = None
-    lib.sp_gyro.argtypes = [sz, vp, d, vp]
-    lib._kinematic_declared = True
-    return lib
-
 
 def _rows(a: np.ndarray, width: int) -> np.ndarray | None:
     """``a`` as a C-contiguous float64 (n, width) array, or None for another array."""
@@ -1164,7 +1136,7 @@ def roll_pitch_yaw(q: np.ndarray, nue: bool) -> np.ndarray | None:
     (``sp_roll_pitch_yaw``: libm's atan2 and asin as math.atan2 and math.asin call them, the
     arithmetic around them the numpy path's): (n, 3) roll, pitch, yaw; None without the helper or
     for another array."""
-    lib = _kinematic_library()
+    lib = library()
     q = _rows(q, 4) if lib is not None else None
     if q is None:
         return None
@@ -1178,7 +1150,7 @@ def half_angles(q: np.ndarray) -> np.ndarray | None:
     """orientation.inertial_quaternion's half angle ``atan2(sqrt(x**2 + y**2 + z**2), w)`` of each row
     of the (n, 4) float64 ``q`` in one C pass (``sp_half_angles``, each square libm's pow as numpy's
     scalar power calls it); None without the helper, for another array or a non-finite component."""
-    lib = _kinematic_library()
+    lib = library()
     q = _rows(q, 4) if lib is not None else None
     if q is None:
         return None
@@ -1193,7 +1165,7 @@ def correlation_ratios(corr: np.ndarray, exponent: np.ndarray) -> np.ndarray | N
     arrays in one C pass (``sp_correlation_ratios``: libm's pow, as Python's float power calls it for a
     positive base); None without the helper, for other arrays, or for a base or exponent Python's
     power treats otherwise."""
-    lib = _kinematic_library()
+    lib = library()
     if lib is None or corr.dtype != np.float64 or exponent.dtype != np.float64 or corr.ndim != 1 \
             or exponent.shape != corr.shape:
         return None
@@ -1208,7 +1180,7 @@ def gyro_rates(rel: np.ndarray, dt: float) -> np.ndarray | None:
     """motion_sensors.angular_velocity of each turn ``rel`` ((n, 3, 3) float64, r0ᵀ·r1 as numpy
     multiplied them) over ``dt`` seconds in one C pass (``sp_gyro``: libm's acos and sin as math.acos
     and math.sin call them): (n, 3); None without the helper or for another array."""
-    lib = _kinematic_library()
+    lib = library()
     if lib is None or rel.dtype != np.float64 or rel.ndim != 3 or rel.shape[1:] != (3, 3):
         return None
     rel = np.ascontiguousarray(rel)
@@ -1222,28 +1194,12 @@ def gyro_rates(rel: np.ndarray, dt: float) -> np.ndarray | None:
 # (the vector env's step: a few numpy calls each in one C pass, their signatures and the kept
 # arrays' checks made once, so that a call costs its pass and little else)
 
-def _round2_library():
-    """The helper with round 2's signatures declared (once), or None."""
-    lib = library()
-    if lib is None or getattr(lib, "_round2_declared", False):
-        return lib
-    sz, d, f, vp = ctypes.c_size_t, ctypes.c_double, ctypes.c_float, ctypes.c_void_p
-    lib.sp_box_clip32.restype = None
-    lib.sp_box_clip32.argtypes = [sz, vp, f, f, vp]
-    lib.sp_avoid_outcome.restype = ctypes.c_int
-    lib.sp_avoid_outcome.argtypes = [sz, sz, vp, d, d, vp, sz, sz, sz, vp, d, d, d, d, vp, vp, vp]
-    _typed(lib, "sp_clearance_gaps", [sz, sz, vp, d, d, vp])
-    _typed(lib, "sp_avoid_reward", [sz, vp, sz, sz, vp, d, vp, d, d, d, vp])
-    lib._round2_declared = True
-    return lib
-
-
 def box_clip32(img: np.ndarray, lo: float, hi: float) -> np.ndarray | None:
     """A fresh float32 copy of ``img`` clipped to [lo, hi] (float32 bounds, lo <= hi, hi > 0) with a
     NaN set to ``hi`` and, where ``lo`` is a zero, a zero set to ``lo``: the steps of
     :meth:`.gym.vector.SensoriumVectorEnv._observe` for a range image (np.clip's values, its NaN
     kept until set) in one C pass (``sp_box_clip32``); None without the helper or for another array."""
-    lib = _round2_library()
+    lib = library()
     if lib is None or img.dtype != np.float32 or not img.flags.c_contiguous:
         return None
     out = np.empty(img.shape, dtype=np.float32)
@@ -1284,7 +1240,7 @@ class AvoidOutcome:
 
 def avoid_outcome(velocity: np.ndarray) -> AvoidOutcome | None:
     """An :class:`AvoidOutcome` over this velocity array, or None without the helper."""
-    lib = _round2_library()
+    lib = library()
     if lib is None:
         return None
     return AvoidOutcome(lib, velocity)
@@ -1328,11 +1284,7 @@ class DueScan:
 
 def due_scan(time: np.ndarray, last: np.ndarray, period: np.ndarray) -> DueScan | None:
     """A :class:`DueScan` over these arrays, or None without the helper."""
-    lib = _round2_library()
+    lib = library()
     if lib is None:
         return None
-    if lib.sp_due.argtypes is None:
-        vp, sz = ctypes.c_void_p, ctypes.c_size_t
-        lib.sp_due.restype = sz
-        lib.sp_due.argtypes = [sz, sz, vp, vp, vp, vp, vp]
     return DueScan(lib, time, last, period)
