@@ -253,13 +253,10 @@ def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
         return spaces.Box(np.array([-pi, -half, -pi], dtype=np.float32), np.array([pi, half, pi], dtype=np.float32),
                           dtype=np.float32)
     if cfg.device == "Compass":                 # north through the lookup table (none: the unit vector)
-        out = [row[1] for row in cfg.lookup_table] or [-1.0, 1.0]
-        return spaces.Box(np.float32(min(out)), np.float32(max(out)), shape=(3,), dtype=np.float32)
+        return _table_box(cfg, (3,), (-1.0, 1.0))
     if cfg.device in ("Gyro", "Accelerometer"):   # through the lookup table (none: what the motion can give)
-        out = [row[1] for row in cfg.lookup_table]
-        low, high = (min(out), max(out)) if out else (-motion_bound(cfg.device, world_info),
-                                                       motion_bound(cfg.device, world_info))
-        return spaces.Box(np.float32(low), np.float32(high), shape=(3,), dtype=np.float32)
+        bound = motion_bound(cfg.device, world_info)
+        return _table_box(cfg, (3,), (-bound, bound))
     if cfg.device == "Camera":
         return spaces.Box(0, 255, shape=(cfg.height, cfg.width, 3), dtype=np.uint8)
     if cfg.device == "RangeFinder":
@@ -267,8 +264,15 @@ def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
     if cfg.device == "Lidar":
         return spaces.Box(0.0, np.float32(cfg.max_range), shape=(cfg.number_of_layers, cfg.horizontal_resolution),
                           dtype=np.float32)
-    out = [row[1] for row in cfg.lookup_table] or [0.0]
-    return spaces.Box(np.float32(min(out)), np.float32(max(out)), shape=(1,), dtype=np.float32)
+    return _table_box(cfg, (1,), (0.0, 0.0))
+
+
+def _table_box(cfg, shape: tuple[int, ...], without: tuple[float, float]) -> spaces.Box:
+    """A float32 Box bounded by the device's lookup table's output column (``without``: the bounds
+    when it has no table)."""
+    out = [row[1] for row in cfg.lookup_table]
+    low, high = (min(out), max(out)) if out else without
+    return spaces.Box(np.float32(low), np.float32(high), shape=shape, dtype=np.float32)
 
 
 ENGINES = ("auto", "batched", "simulation")
