@@ -350,27 +350,22 @@ class SensoriumVectorEnv(VectorEnv):
             raise RuntimeError(f"sub-envs {self._autoreset.nonzero()[0].tolist()} ended: reset them "
                                "(options={'reset_mask': ...}) before stepping (autoreset is disabled)")
         stepping = ~resetting
-        if not resetting.any():   # every sub-env steps (the usual step): the arrays without gathers
-            self._act(self._every, actions)
-            self._run(stepping, resetting)
-            self.steps += 1
-            r, te, tr = self._outcome(self._every)
-            rewards = np.array(r, dtype=np.float64)
-            terms, truncs = np.array(te, dtype=bool), np.array(tr, dtype=bool)
-        else:
-            moving = stepping.nonzero()[0]
-            self._act(moving, actions[moving])
-            self._begin_reset(resetting.nonzero()[0], [None] * int(resetting.sum()))
-            self._run(stepping, resetting)
-            rewards = np.zeros(n)
-            terms = np.zeros(n, dtype=bool)
-            truncs = np.zeros(n, dtype=bool)
-            for g in self._goals[2]:
-                g.reset(resetting.nonzero()[0])
-            self.steps[moving] += 1
-            if len(moving):
-                r, te, tr = self._outcome(moving)
-                rewards[moving], terms[moving], truncs[moving] = r, te, tr
+        resets = resetting.nonzero()[0]
+        # the usual step (no sub-env resets): every sub-env in order, the arrays without gathers
+        moving = self._every if not len(resets) else stepping.nonzero()[0]
+        self._act(moving, actions if moving is self._every else actions[moving])
+        if len(resets):
+            self._begin_reset(resets, [None] * len(resets))
+        self._run(stepping, resetting)
+        for g in self._goals[2] if len(resets) else ():
+            g.reset(resets)
+        self.steps[moving] += 1
+        rewards = np.zeros(n)
+        terms = np.zeros(n, dtype=bool)
+        truncs = np.zeros(n, dtype=bool)
+        if len(moving):
+            r, te, tr = self._outcome(moving)
+            rewards[moving], terms[moving], truncs[moving] = r, te, tr
         done = terms | truncs
         info = self._full_info(np.ones(n, dtype=bool))
         if self.autoreset_mode == AutoresetMode.SAME_STEP and done.any():
