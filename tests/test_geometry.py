@@ -157,3 +157,14 @@ def test_pose_axis_angle_convention():
 def test_pose_far_translation_keeps_float64():
     p = Pose(np.eye(3), [1e6 + 0.123456789, 0, 0])
     assert p.apply(np.zeros((1, 3)))[0, 0] == 1e6 + 0.123456789
+
+
+def test_a_tiny_or_huge_rotation_axis_gives_the_rotation_of_its_direction():
+    """An axis whose squares underflow to subnormals (found by test_raycast_properties: a sphere
+    turned about (0, 0, 1.55e-158) was scaled by ~1e-8 in EXACT) or overflow: the same matrix as the
+    unit axis of its direction, bit for bit."""
+    for axis, unit in (((0.0, 0.0, 1.552331975405721e-158), (0.0, 0.0, 1.0)), ((0.0, -1e-320, 0.0), (0.0, -1.0, 0.0)),
+                       ((1e300, 1e300, 0.0), (1.0, 1.0, 0.0))):
+        got = Pose.from_axis_angle(axis, 1.0).rotation
+        assert got.tobytes() == Pose.from_axis_angle(unit, 1.0).rotation.tobytes(), axis
+        assert np.abs(got @ got.T - np.eye(3)).max() < 1e-15

@@ -218,9 +218,16 @@ class Pose:
     def from_axis_angle(axis, angle: float, translation=(0.0, 0.0, 0.0)) -> Pose:
         """Pose from a rotation axis (need not be unit) and angle in radians (Webots convention)."""
         a = np.asarray(axis, dtype=np.float64)
-        n = float(np.linalg.norm(a))
-        if n == 0.0:
+        with np.errstate(over="ignore", under="ignore"):
+            n = float(np.linalg.norm(a))
+        if n == 0.0 and not a.any():
             return Pose(np.eye(3), translation)
+        if not 1e-150 < n < 1e150:
+            # a tiny or huge axis: its squares underflow to subnormals (a norm off by far more than
+            # an ulp, so the matrix is no rotation) or overflow; scaled to [-1, 1] first, as
+            # poses.axis_angle_matrix does (ordinary axes keep their one division, and their bits)
+            a = a / float(np.max(np.abs(a)))
+            n = float(np.linalg.norm(a))
         x, y, z = a / n
         c, s = math.cos(angle), math.sin(angle)
         k = 1.0 - c
