@@ -308,13 +308,13 @@ def test_the_c_passes_are_the_math_path_and_the_single_models_bit_for_bit():
 
 
 def test_what_stays_refused_is_said_in_one_line():
-    """A GPS in a WGS84 world, an altimeter: one line naming the device and why, when asked for
-    (device, check_observable) and before anything is built (the world-level check); gyros and
-    accelerometers are measured."""
+    """A GPS in a WGS84 world, a kind without a value (an LED): one line naming the device and why,
+    when asked for (device, check_observable) and before anything is built (the world-level check);
+    gyros, accelerometers and altimeters are measured."""
     lw = load_world(WORLD)
     w = lw.world
     robots = [r.model_dump(mode="json", exclude_none=True) for r in w.robots]
-    robots[0]["devices"] += [{"device": "Altimeter", "name": "altimeter"}]
+    robots[0]["devices"] += [{"device": "Altimeter", "name": "altimeter"}, {"device": "LED", "name": "led"}]
     wgs = wm.World.model_validate({**w.model_dump(mode="json", exclude_none=True), "robots": robots,
                                    "world_info": {**w.world_info.model_dump(mode="json"),
                                                   "gps_coordinate_system": "WGS84",
@@ -326,12 +326,12 @@ def test_what_stays_refused_is_said_in_one_line():
         assert str(e.value) == ("rover/gps: a GPS in a WGS84 world (world_info.gps_coordinate_system) is not "
                                 "simulated by the batched simulation, only local coordinates (use Simulation)")
     bs = BatchedSimulation(wgs, 2, base_dir=lw.base_dir)
-    for name, kind in (("compass", "Compass"), ("gyro", "Gyro"), ("acc", "Accelerometer")):
+    for name, kind in (("compass", "Compass"), ("gyro", "Gyro"), ("acc", "Accelerometer"), ("altimeter", "Altimeter")):
         assert bs.device("rover", name).kind == kind              # the other kinds are measured there
-    check_observable(wgs, "rover", ["compass", "gyro", "acc", "imu"])
-    with pytest.raises(BatchedError, match="device 'altimeter' is a Altimeter; the batched simulation measures "
+    check_observable(wgs, "rover", ["compass", "gyro", "acc", "imu", "altimeter"])
+    with pytest.raises(BatchedError, match="device 'led' is a LED; the batched simulation measures "
                                            r".*GPS, Compass, InertialUnit, Gyro, Accelerometer(, [A-Za-z]+)* \(use Simulation\)$"):
-        bs.device("rover", "altimeter")
+        bs.device("rover", "led")
 
 
 gym = pytest.importorskip("gymnasium")
