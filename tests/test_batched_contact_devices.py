@@ -1,7 +1,8 @@
 """Bumpers (TouchSensor) and altimeters in the batched simulation and the Gymnasium envs
 (sensorium/server/sim/batched_kinematic.py, sensorium/gym/env.py): every copy bit-identical to the
 single Simulation with its seed, closed-form readings (a robot pushing against a wall, at rest, at a
-known height), the single and vector envs observing them alike, and a force sensor refused."""
+known height, a WGS84 GPS at the reference), the single and vector envs observing them alike, and a
+force sensor refused; a GPS in a WGS84 world, bit-identical too."""
 
 from __future__ import annotations
 
@@ -155,6 +156,74 @@ def test_a_robot_driven_into_a_wall_reads_its_bumper_while_pushing_and_its_heigh
         dev.enable(16)
         sim.step()
         assert dev.value == 0.05 + 0.04 + offset
+
+
+def _wgs84(seed: int, reference: tuple[float, float, float]) -> LoadedWorld:
+    lw = _world(seed)
+    info = lw.world.world_info.model_copy(update={"gps_coordinate_system": "WGS84", "gps_reference": reference})
+    return LoadedWorld(world=lw.world.model_copy(update={"world_info": info}), source=lw.source, base_dir=lw.base_dir)
+
+
+@pytest.mark.parametrize("reference", [(46.5, 6.6, 400.0), (-33.9, 151.2, 20.0), (0.0, -179.99, -5.0)])
+def test_every_copy_reads_its_wgs84_gps_as_the_single_simulation(native, reference):  # noqa: F811
+    """A WGS84 world (north and south of the equator, at the antimeridian): the robots driving into
+    walls and one another with noisy, correlated, quantised and plain GPS and the altimeters; after
+    every step every GPS's latitude / longitude / altitude, speed and speed vector and every
+    altimeter of every copy equal a Simulation's with that copy's seed, bit for bit, with the C
+    helper and without it."""
+    seeds = [11, 12, 13]
+    bs = BatchedSimulation(_wgs84(0, reference), len(seeds))
+    bs.reset(np.arange(len(seeds)), seeds)
+    sims = [Simulation(_wgs84(s, reference)) for s in seeds]
+    periods = {"a": {"gps": 32, "plain_gps": 16, "altimeter": 16}, "b": {"gps": 16, "altimeter": 48}}
+    for c in range(len(seeds)):
+        _enable_both(bs, sims, periods, c)
+    rng = np.random.default_rng(9)
+    for step in range(100):
+        if step % 20 == 0:
+            for robot in periods:
+                ahead, turn = rng.uniform(-14.0, 14.0, (len(seeds), 1)), rng.uniform(-3.0, 3.0, (len(seeds), 1))
+                _wheels_both(bs, sims, robot, np.concatenate([ahead - turn, ahead + turn], axis=1))
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot, names in periods.items():
+                for n in names:
+                    ref, dev = bs.device(robot, n), s.robot(robot).device(n)
+                    for what in ("value",) if ref.kind == "Altimeter" else ("values", "speed", "speed_vector"):
+                        want = np.asarray(getattr(dev, what), dtype=np.float64)
+                        assert want.tobytes() == bs.reading(ref, what)[c].tobytes(), (step, c, robot, n, what)
+    lat_lon = bs.value(bs.device("a", "plain_gps"))[:, :2]
+    assert (np.abs(lat_lon - reference[:2]) < 1e-4).all() and (bs.value(bs.device("a", "gps"))[:, 2] > reference[2]).all()
+
+
+def test_a_wgs84_gps_at_the_reference_reads_the_reference():
+    """A GPS at the world's origin reads the reference latitude and longitude (to the inverse UTM
+    series' round trip, < 1e-8° here) and its altitude exactly; 100 m east and 200 m north of it
+    (copy 1) the single model's forward projection of its reading is the reference's UTM east + 100 m
+    and north + 200 m (to 1 mm); the single simulation reads the same bits."""
+    from sensorium.server.devices.gps import Utm
+
+    w = _walled(wgs84=True)
+    robot = w.robots[0].model_copy(update={"devices": [
+        wm.GPS.model_validate({"device": "GPS", "name": "gps", "pose": {"translation": [0.0, 0.0, -0.05]}})]})
+    loaded = _loaded(w.model_copy(update={"robots": [robot], "solids": []}))
+    bs = BatchedSimulation(loaded, 2)
+    bs.set_pose(1, 0, [100.0, 200.0, 0.05])
+    gps = bs.device("bot", "gps")
+    bs.enable(gps, 16)
+    bs.step()
+    got = bs.value(gps)
+    assert abs(got[0, 0] - 46.5) < 1e-8 and abs(got[0, 1] - 6.6) < 1e-8 and got[0, 2] == 400.0
+    utm = Utm(46.5, 6.6)
+    north, east = utm.north_east(46.5, 6.6)
+    n1, e1 = utm.north_east(float(got[1, 0]), float(got[1, 1]))
+    assert abs(e1 - (east + 100.0)) < 1e-3 and abs(n1 - (north + 200.0)) < 1e-3 and got[1, 2] == 400.0
+    sim = Simulation(loaded)
+    dev = sim.robot("bot").device("gps")
+    dev.enable(16)
+    sim.step()
+    assert dev.values.tobytes() == got[0].tobytes()
 
 
 def test_the_batched_simulation_refuses_a_force_sensor_in_one_line():

@@ -28,8 +28,11 @@ two steps are kept for every slot, and per device the robot's pose when it was e
 many poses it has seen since (1 at ``enable``, at most 3), so its poses are composed only when it
 is due.
 
-Not here: a GPS in a WGS84 world (the inverse UTM series is not vectorised: refused with one
-line), a force or force-3d TouchSensor (NaN without physics: refused with one line). The batched
+A GPS in a WGS84 world adds the reference's UTM east / north and altitude (computed once, by the
+single model's call) and reads its rows back to latitude / longitude by the single model's inverse
+UTM series, called row by row (:func:`wgs84_positions`).
+
+Not here: a force or force-3d TouchSensor (NaN without physics: refused with one line). The batched
 simulation itself only runs ENU worlds; the roll / pitch / yaw conventions of both are here
 (:func:`roll_pitch_yaw`) and tested against the single model.
 """
@@ -41,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.server.devices import gps as gps_math
 from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
@@ -68,13 +72,33 @@ READINGS = {"GPS": ("values", "speed", "speed_vector"), "Compass": ("values",),
 
 def refusal(robot: str, config: Any, world_info: Any) -> str | None:
     """Why the batched simulation does not measure a device of these kinds in this world, or None."""
-    if config.device == "GPS" and world_info.gps_coordinate_system == "WGS84":
-        return (f"{robot}/{config.name}: a GPS in a WGS84 world (world_info.gps_coordinate_system) is not "
-                "simulated by the batched simulation, only local coordinates (use Simulation)")
     if config.device == "TouchSensor" and config.type != "bumper":
         return (f"{robot}/{config.name}: a {config.type} TouchSensor reads NaN without physics; the batched "
                 "simulation measures bumpers only (use Simulation)")
     return None
+
+
+def gps_reference(world_info: Any) -> tuple[np.ndarray, gps_math.Utm | None]:
+    """What gps.position adds to a GPS's (ENU) translation, and the UTM zone its WGS84 values are
+    read back in (None in local coordinates): gps_reference itself, or in a WGS84 world the reference
+    latitude / longitude as UTM east / north (the single model's own call) and its altitude."""
+    ref = np.array(world_info.gps_reference, dtype=np.float64)
+    if world_info.gps_coordinate_system != "WGS84":
+        return ref, None
+    utm = gps_math.Utm(float(ref[0]), float(ref[1]))
+    north, east = utm.north_east(float(ref[0]), float(ref[1]))
+    return np.array([east, north, float(ref[2])], dtype=np.float64), utm
+
+
+def wgs84_positions(utm: gps_math.Utm, p: np.ndarray) -> np.ndarray:
+    """gps.position's last step for rows of (east, north, up): (latitude°, longitude°, altitude) by the
+    single model's inverse UTM series, row by row (its sin, tan, pow and friends are libm's through
+    ``math``, whose bits numpy's vectorised routines need not give)."""
+    out = np.empty_like(p)
+    for k, (east, north, up) in enumerate(p.tolist()):
+        out[k, 0], out[k, 1] = utm.latitude_longitude(north, east)
+        out[k, 2] = up
+    return out
 
 
 def draws_noise(config: Any) -> bool:
@@ -259,7 +283,7 @@ class KinematicDevices:
         C = sim.copies
         wi = sim.world.world_info
         self.axes = wi.coordinate_system
-        self.reference = np.array(wi.gps_reference, dtype=np.float64)
+        self.reference, self.utm = gps_reference(wi)
         self.north = orient.north_vector(self.axes)
         self.slot = {k: np.array([d.robot_index for d in v], dtype=np.int64) for k, v in self.devices.items()}
         self.local_rot = {k: np.array([d.local_pose.rotation for d in v]).reshape(-1, 3, 3)
@@ -418,6 +442,8 @@ class KinematicDevices:
             self.gps_noise[c, d] = state
             p[rows] = p[rows] + acc[rows, None] * state
         p = _quantize(p, self.resolution["GPS"][cols])
+        if self.utm is not None:
+            p = wgs84_positions(self.utm, p)
         known = self.has_previous[copies, cols] & (elapsed > 0)
         with np.errstate(invalid="ignore", divide="ignore"):
             vec = np.where(known[:, None], (t - self.previous[copies, cols]) * (1000.0 / elapsed)[:, None], math.nan)
