@@ -297,3 +297,36 @@ def test_a_force_sensor_is_not_an_observation():
         env = make(Task(robot="c"))
         assert sorted(env.single_observation_space.spaces if hasattr(env, "single_observation_space")
                       else env.observation_space.spaces) == ["altimeter", "bumper"]
+
+
+def test_the_parallel_env_observes_every_robots_bumper_on_both_engines():
+    """Every robot of the bumpers world an agent with the default observations (bumpers and
+    altimeters; robot c's force sensor left out): the batched engine ("auto" picks it) and the rebuilt
+    Simulation give the same observations, rewards and flags, bit for bit, full speed into the walls
+    and one another, some bumpers reading 1; PettingZoo's API test passes."""
+    pytest.importorskip("pettingzoo")
+    from pettingzoo.test import parallel_api_test
+
+    from sensorium.gym import SensoriumParallelEnv
+    from tests.test_gym_vector import _same_obs
+
+    def make(engine):
+        return SensoriumParallelEnv(WORLD, {r: Task(robot=r, control_period_ms=32, max_steps=60) for r in "abc"},
+                                    engine=engine)
+
+    batched, rebuilt = make("auto"), make("simulation")
+    assert batched._batched is not None and sorted(batched.observation_spaces["c"].spaces) == ["altimeter", "bumper"]
+    parallel_api_test(make("auto"), num_cycles=20)
+    rng = np.random.default_rng(7)
+    ob, _ = batched.reset(seed=3)
+    orr, _ = rebuilt.reset(seed=3)
+    pressed = 0
+    while batched.agents:
+        assert batched.agents == rebuilt.agents and all(_same_obs(ob[a], orr[a]) for a in batched.agents)
+        pressed += sum(int(ob[a]["bumper"][0] == 1.0) for a in batched.agents)
+        acts = {a: (np.ones(2) if rng.random() < 0.7 else rng.uniform(-1, 1, 2)).astype(np.float32)
+                for a in batched.agents}
+        ob, rb, tb, trb, _ = batched.step(acts)
+        orr, rr, tr_, trr, _ = rebuilt.step(acts)
+        assert (rb, tb, trb) == (rr, tr_, trr)
+    assert pressed > 10
