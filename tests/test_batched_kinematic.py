@@ -308,30 +308,27 @@ def test_the_c_passes_are_the_math_path_and_the_single_models_bit_for_bit():
 
 
 def test_what_stays_refused_is_said_in_one_line():
-    """A GPS in a WGS84 world, an altimeter: one line naming the device and why, when asked for
-    (device, check_observable) and before anything is built (the world-level check); gyros and
-    accelerometers are measured."""
+    """A kind without a value (an LED): one line naming the device and why, when asked for (device,
+    check_observable) and before anything is built (the world-level check); in a WGS84 world GPS,
+    compasses, gyros, accelerometers, inertial units and altimeters are measured."""
     lw = load_world(WORLD)
     w = lw.world
     robots = [r.model_dump(mode="json", exclude_none=True) for r in w.robots]
-    robots[0]["devices"] += [{"device": "Altimeter", "name": "altimeter"}]
+    robots[0]["devices"] += [{"device": "Altimeter", "name": "altimeter"}, {"device": "LED", "name": "led"}]
     wgs = wm.World.model_validate({**w.model_dump(mode="json", exclude_none=True), "robots": robots,
                                    "world_info": {**w.world_info.model_dump(mode="json"),
                                                   "gps_coordinate_system": "WGS84",
                                                   "gps_reference": [46.5, 6.6, 400.0]}})
-    for call in (lambda: check_observable(wgs, "rover", ["compass", "gps"]),
-                 lambda: BatchedSimulation(wgs, 2, base_dir=lw.base_dir).device("rover", "gps")):
-        with pytest.raises(BatchedError) as e:
-            call()
-        assert str(e.value) == ("rover/gps: a GPS in a WGS84 world (world_info.gps_coordinate_system) is not "
-                                "simulated by the batched simulation, only local coordinates (use Simulation)")
     bs = BatchedSimulation(wgs, 2, base_dir=lw.base_dir)
-    for name, kind in (("compass", "Compass"), ("gyro", "Gyro"), ("acc", "Accelerometer")):
-        assert bs.device("rover", name).kind == kind              # the other kinds are measured there
-    check_observable(wgs, "rover", ["compass", "gyro", "acc", "imu"])
-    with pytest.raises(BatchedError, match="device 'altimeter' is a Altimeter; the batched simulation measures "
-                                           r".*GPS, Compass, InertialUnit, Gyro, Accelerometer(, [A-Za-z]+)* \(use Simulation\)$"):
-        bs.device("rover", "altimeter")
+    for name, kind in (("gps", "GPS"), ("compass", "Compass"), ("gyro", "Gyro"), ("acc", "Accelerometer"),
+                       ("altimeter", "Altimeter")):
+        assert bs.device("rover", name).kind == kind
+    check_observable(wgs, "rover", ["gps", "compass", "gyro", "acc", "imu", "altimeter"])
+    want = (r"^robot 'rover': device 'led' is a LED; the batched simulation measures "
+            r".*GPS, Compass, InertialUnit, Gyro, Accelerometer(, [A-Za-z]+)* \(use Simulation\)$")
+    for call in (lambda: check_observable(wgs, "rover", ["compass", "led"]), lambda: bs.device("rover", "led")):
+        with pytest.raises(BatchedError, match=want):
+            call()
 
 
 gym = pytest.importorskip("gymnasium")
@@ -385,16 +382,26 @@ def test_the_vector_env_observes_them_as_the_single_env_and_passes_the_checker()
     venv.close()
 
 
-def test_the_vector_env_refuses_a_wgs84_gps_in_one_line():
+def test_the_envs_observe_a_wgs84_gps_alike():
+    """In a WGS84 world the vector env runs a GPS too (latitude, longitude, altitude): every sub-env
+    equals the single env (rebuilt Simulation, and the batched engine "auto" now picks) with its
+    seed, bit for bit, across autoresets; the readings are near the reference (46.5°, 6.6°)."""
     lw = load_world(WORLD)
     w = lw.world
-    wgs = w.model_copy(update={"world_info": w.world_info.model_copy(update={"gps_coordinate_system": "WGS84",
-                                                                              "gps_reference": (46.5, 6.6, 400.0)})})
-    with pytest.raises(BatchedError) as e:
-        SensoriumVectorEnv(LoadedWorld(world=wgs, source=lw.source, base_dir=lw.base_dir), _task(), 2)
-    msg = str(e.value)
-    assert "\n" not in msg and msg.startswith("rover/gps: a GPS in a WGS84 world") and "SensoriumEnv can" in msg
-    env = SensoriumEnv(LoadedWorld(world=wgs, source=lw.source, base_dir=lw.base_dir), _task(), engine="auto")
-    assert env.engine == "simulation"                          # the single env runs it on a Simulation
-    obs, _ = env.reset(seed=0)
-    assert 46.0 < obs["gps"][0] < 47.0 and 6.0 < obs["gps"][1] < 7.0   # latitude, longitude
+    wgs = LoadedWorld(world=w.model_copy(update={"world_info": w.world_info.model_copy(
+        update={"gps_coordinate_system": "WGS84", "gps_reference": (46.5, 6.6, 400.0)})}),
+        source=lw.source, base_dir=lw.base_dir)
+    n = 2
+    venv = SensoriumVectorEnv(wgs, _task(), n)
+    singles = [SensoriumEnv(wgs, _task(), engine=e) for e in ("simulation", "auto")]
+    assert [e.engine for e in singles] == ["simulation", "batched"]
+    obs = _reset_both(venv, singles, 2)
+    assert (np.abs(obs["gps"][:, :2] - [46.5, 6.6]) < 1e-4).all()
+    assert venv.single_observation_space["gps"].low[:2].tolist() == [-90.0, -180.0]
+    rng = np.random.default_rng(8)
+    done = np.zeros(n, dtype=bool)
+    ended = 0
+    for t in range(40):
+        ended += _step_both(venv, singles, rng.uniform(-1, 1, (n, 2)).astype(np.float32), done, t)[0]
+    assert ended >= n
+    venv.close()

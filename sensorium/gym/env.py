@@ -11,7 +11,10 @@ width)`` range image bounded by ``[0, max_range]``, with "no hit" (``inf`` in We
 ``max_range``; a position sensor (wheel encoder) is an unbounded ``(1,)`` box in radians; a GPS its
 position, a compass its north vector, an inertial unit its roll, pitch, yaw, a gyro its angular
 velocity, an accelerometer its specific force: float32 ``(3,)`` boxes (:func:`_space`; a disabled
-axis's NaN reads the box's low bound, as any missing value); a camera
+axis's NaN reads the box's low bound, as any missing value); a bumper (TouchSensor) a float32 ``(1,)``
+box in [0, 1] (1 while its robot pushes against something), an altimeter its height, a float32
+``(1,)`` box within the world bounds (a force TouchSensor reads NaN without physics: left out by
+default, refused when named); a camera
 (only when named in ``Task.observations``: images are not observed by default) is a uint8
 ``(height, width, 3)`` RGB box, a range finder (likewise) its float32 ``(height, width)`` range image
 in ``[0, max_range]`` with "no hit" as ``max_range``.
@@ -107,7 +110,8 @@ class Agent:
         actuators = {d.name for d in model.devices if d.device not in OBSERVABLE}
         obs = task.observations
         if obs is None:              # images cost a ray per pixel: observed only when named
-            periods = {n: self.control_period_ms for n, d in devices.items() if d.device not in IMAGES}
+            periods = {n: self.control_period_ms for n, d in devices.items()
+                       if d.device not in IMAGES and not _without_value(d)}
         elif isinstance(obs, dict):
             periods = {str(k): int(v) for k, v in obs.items()}
         else:
@@ -120,6 +124,9 @@ class Agent:
                                  f"(sensors: {', '.join(devices) or 'none'})")
             if p <= 0:
                 raise ValueError(f"task observation {n!r}: sampling period must be > 0 ms, got {p}")
+            if _without_value(devices[n]):
+                raise ValueError(f"task observation {n!r}: robot {name!r}'s {n} is a {devices[n].type} TouchSensor, "
+                                 "which reads NaN without physics (only a bumper is an observation)")
         self.periods = periods
         self.warmup_steps = max((math.ceil(p / basic) for p in periods.values()), default=0)
         self.dict_space = spaces.Dict({n: _space(devices[n], w.world_info) for n in periods})
@@ -202,13 +209,19 @@ class Agent:
 
 
 OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "GPS", "Compass", "InertialUnit",
-              "Gyro", "Accelerometer", "Camera", "RangeFinder")
+              "Gyro", "Accelerometer", "TouchSensor", "Altimeter", "Camera", "RangeFinder")
 IMAGES = ("Camera", "RangeFinder")
 VECTOR_READINGS = {"GPS": "values", "Compass": "values", "InertialUnit": "roll_pitch_yaw", "Gyro": "values",
                    "Accelerometer": "values"}
 """The kinds observed as a float32 ``(3,)`` box, and the device reading each observes (a GPS its
 position, a compass its north vector, an inertial unit its roll, pitch, yaw, a gyro its angular
 velocity, an accelerometer its specific force)."""
+
+
+def _without_value(cfg) -> bool:
+    """A device whose reading is never a value here: a force or force-3d TouchSensor (NaN without
+    physics; a bumper is observed)."""
+    return cfg.device == "TouchSensor" and cfg.type != "bumper"
 
 
 def missing_fill(low: np.ndarray) -> np.ndarray:
@@ -257,6 +270,12 @@ def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
     if cfg.device in ("Gyro", "Accelerometer"):   # through the lookup table (none: what the motion can give)
         bound = motion_bound(cfg.device, world_info)
         return _table_box(cfg, (3,), (-bound, bound))
+    if cfg.device == "TouchSensor":             # a bumper: 1 while pushing against something, else 0
+        return spaces.Box(np.float32(0.0), np.float32(1.0), shape=(1,), dtype=np.float32)
+    if cfg.device == "Altimeter":               # a height within the world bounds (+ a WGS84 reference altitude)
+        offset = float(world_info.gps_reference[2]) if world_info.gps_coordinate_system == "WGS84" else 0.0
+        return spaces.Box(np.float32(offset - MAX_COORDINATE_M), np.float32(offset + MAX_COORDINATE_M), shape=(1,),
+                          dtype=np.float32)
     if cfg.device == "Camera":
         return spaces.Box(0, 255, shape=(cfg.height, cfg.width, 3), dtype=np.uint8)
     if cfg.device == "RangeFinder":

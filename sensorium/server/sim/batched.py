@@ -17,16 +17,13 @@ every device model runs once over all copies' devices of a kind.
 Copy ``c`` reproduces :class:`~sensorium.server.sim.simulation.Simulation` built from the world
 with copy c's seed, bit for bit, for what it simulates: the drive (the same float64 arc, the same
 3x3 products), kinematic contact (the same broad phase per copy, the same narrow phase), light
-sensors, distance sensors, fixed lidars, wheel encoders, GPS (local coordinates), compasses,
-inertial units, gyros and accelerometers (batched_kinematic.py), range finders (batched_depth.py), cameras
-(batched_camera.py), each
-device's noise drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the
+sensors, distance sensors, fixed lidars, wheel encoders, GPS (local or WGS84 coordinates), compasses,
+inertial units, gyros, accelerometers, bumpers and altimeters (batched_kinematic.py), range finders
+(batched_depth.py), cameras (batched_camera.py), each device's noise drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the
 same numbers, in the same order). Tests compare it with the single simulation step by step.
 
 Not simulated here (use :class:`Simulation`): rotating lidars, camera recognition and
-segmentation, a GPS in a
-WGS84 world, altimeters, the kinds without an observation (LEDs, pens, ...),
-lights carried by robots, textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
+segmentation, force TouchSensors, the kinds without an observation (LEDs, pens, ...), lights carried by robots, textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
-"""GPS, Compass, InertialUnit, Gyro and Accelerometer in the batched simulation: every copy's due
-devices of a kind measured together, from the copies' end-of-step poses, bit for bit what the
+"""GPS, Compass, InertialUnit, Gyro, Accelerometer, TouchSensor (bumper) and Altimeter in the
+batched simulation: every copy's due devices of a kind measured together, from the copies'
+end-of-step poses (a bumper: from the copy's contact state, ``pressing``), bit for bit what the
 single simulation's devices (sim/sensors.py, on the pure models of devices/gps.py,
 devices/orientation.py and devices/motion_sensors.py) give.
 
@@ -27,8 +28,11 @@ two steps are kept for every slot, and per device the robot's pose when it was e
 many poses it has seen since (1 at ``enable``, at most 3), so its poses are composed only when it
 is due.
 
-Not here: a GPS in a WGS84 world (the inverse UTM series is not vectorised: refused with one
-line), Altimeter (refused as any kind the batched simulation does not measure). The batched
+A GPS in a WGS84 world adds the reference's UTM east / north and altitude (computed once, by the
+single model's call) and reads its rows back to latitude / longitude by the single model's inverse
+UTM series, called row by row (:func:`wgs84_positions`).
+
+Not here: a force or force-3d TouchSensor (NaN without physics: refused with one line). The batched
 simulation itself only runs ENU worlds; the roll / pitch / yaw conventions of both are here
 (:func:`roll_pitch_yaw`) and tested against the single model.
 """
@@ -40,36 +44,61 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.server.devices import gps as gps_math
 from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.raycast import packets
-from sensorium.server.sim.sensors import GPS, Accelerometer, Compass, Gyro, InertialUnit
+from sensorium.server.sim.sensors import GPS, Accelerometer, Altimeter, Compass, Gyro, InertialUnit, TouchSensor
 
 __all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal",
            "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions", "angular_velocities",
            "correlation_ratios"]
 
-KINDS = ("GPS", "Compass", "InertialUnit", "Gyro", "Accelerometer")
+KINDS = ("GPS", "Compass", "InertialUnit", "Gyro", "Accelerometer", "TouchSensor", "Altimeter")
 MOTION = ("Gyro", "Accelerometer")
 """The kinds that read the motion over the last basic steps (their poses tracked every step)."""
 CLASSES: dict[str, type] = {"GPS": GPS, "Compass": Compass, "InertialUnit": InertialUnit, "Gyro": Gyro,
-                            "Accelerometer": Accelerometer}
-SHAPES = dict.fromkeys(KINDS, (3,))
+                            "Accelerometer": Accelerometer, "TouchSensor": TouchSensor, "Altimeter": Altimeter}
+SHAPES = {k: (3,) for k in ("GPS", "Compass", "InertialUnit", "Gyro", "Accelerometer")}
 """The shape of one device's value (``BatchedSimulation.values[kind]`` is (copies, devices, *shape)):
 a GPS's position, a compass's north vector, an inertial unit's roll, pitch, yaw, a gyro's angular
-velocity, an accelerometer's specific force."""
+velocity, an accelerometer's specific force; a bumper's and an altimeter's value is one number."""
 READINGS = {"GPS": ("values", "speed", "speed_vector"), "Compass": ("values",),
-            "InertialUnit": ("roll_pitch_yaw", "quaternion"), "Gyro": ("values",), "Accelerometer": ("values",)}
+            "InertialUnit": ("roll_pitch_yaw", "quaternion"), "Gyro": ("values",), "Accelerometer": ("values",),
+            "TouchSensor": ("value",), "Altimeter": ("value",)}
 """What a device of each kind reads (the single simulation's attributes of the same names)."""
 
 
 def refusal(robot: str, config: Any, world_info: Any) -> str | None:
     """Why the batched simulation does not measure a device of these kinds in this world, or None."""
-    if config.device == "GPS" and world_info.gps_coordinate_system == "WGS84":
-        return (f"{robot}/{config.name}: a GPS in a WGS84 world (world_info.gps_coordinate_system) is not "
-                "simulated by the batched simulation, only local coordinates (use Simulation)")
+    if config.device == "TouchSensor" and config.type != "bumper":
+        return (f"{robot}/{config.name}: a {config.type} TouchSensor reads NaN without physics; the batched "
+                "simulation measures bumpers only (use Simulation)")
     return None
+
+
+def gps_reference(world_info: Any) -> tuple[np.ndarray, gps_math.Utm | None]:
+    """What gps.position adds to a GPS's (ENU) translation, and the UTM zone its WGS84 values are
+    read back in (None in local coordinates): gps_reference itself, or in a WGS84 world the reference
+    latitude / longitude as UTM east / north (the single model's own call) and its altitude."""
+    ref = np.array(world_info.gps_reference, dtype=np.float64)
+    if world_info.gps_coordinate_system != "WGS84":
+        return ref, None
+    utm = gps_math.Utm(float(ref[0]), float(ref[1]))
+    north, east = utm.north_east(float(ref[0]), float(ref[1]))
+    return np.array([east, north, float(ref[2])], dtype=np.float64), utm
+
+
+def wgs84_positions(utm: gps_math.Utm, p: np.ndarray) -> np.ndarray:
+    """gps.position's last step for rows of (east, north, up): (latitude°, longitude°, altitude) by the
+    single model's inverse UTM series, row by row (its sin, tan, pow and friends are libm's through
+    ``math``, whose bits numpy's vectorised routines need not give)."""
+    out = np.empty_like(p)
+    for k, (east, north, up) in enumerate(p.tolist()):
+        out[k, 0], out[k, 1] = utm.latitude_longitude(north, east)
+        out[k, 2] = up
+    return out
 
 
 def draws_noise(config: Any) -> bool:
@@ -78,6 +107,8 @@ def draws_noise(config: Any) -> bool:
         return config.accuracy > 0.0 or config.speed_noise > 0.0
     if config.device == "InertialUnit":
         return config.noise > 0.0
+    if config.device == "Altimeter":
+        return config.accuracy > 0.0
     return False
 
 
@@ -237,7 +268,8 @@ def angular_velocities(r0: np.ndarray, r1: np.ndarray, dt_s: float, native: bool
 
 
 class KinematicDevices:
-    """The GPS, Compass, InertialUnit, Gyro and Accelerometer devices of a batched simulation: their
+    """The GPS, Compass, InertialUnit, Gyro, Accelerometer, TouchSensor and Altimeter devices of a
+    batched simulation: their
     constants stacked per kind, their state beyond ``values`` (a GPS's speed, speed vector, noise
     state and previous position; an inertial unit's quaternion; the poses a gyro or an
     accelerometer differences) per copy, and :meth:`measure` for one step.
@@ -251,7 +283,7 @@ class KinematicDevices:
         C = sim.copies
         wi = sim.world.world_info
         self.axes = wi.coordinate_system
-        self.reference = np.array(wi.gps_reference, dtype=np.float64)
+        self.reference, self.utm = gps_reference(wi)
         self.north = orient.north_vector(self.axes)
         self.slot = {k: np.array([d.robot_index for d in v], dtype=np.int64) for k, v in self.devices.items()}
         self.local_rot = {k: np.array([d.local_pose.rotation for d in v]).reshape(-1, 3, 3)
@@ -274,6 +306,9 @@ class KinematicDevices:
         self.unit_noise = np.array([c.noise for c in units], dtype=np.float64)
         self.unit_axes = [np.array([getattr(c, a) for c in units], dtype=bool) for a in ("x_axis", "y_axis", "z_axis")]
         self.quaternion = np.full((C, len(units), 4), math.nan)
+        # Altimeter: the height along up (ENU: z) plus the reference altitude in a WGS84 world
+        self.altitude_offset = float(wi.gps_reference[2]) if wi.gps_coordinate_system == "WGS84" else 0.0
+        self.altimeter_accuracy = np.array([d.config.accuracy for d in self.devices["Altimeter"]], dtype=np.float64)
         # the kinds read through a lookup table per enabled axis (axes_through_table): each device's axes on
         self.axes_on = {k: [np.array([d.config.x_axis, d.config.y_axis, d.config.z_axis], dtype=bool).nonzero()[0]
                             for d in self.devices[k]] for k in ("Compass", *MOTION)}
@@ -316,7 +351,7 @@ class KinematicDevices:
         """A device's reading ``what`` (one of READINGS[kind]) in every copy: (copies, ...)."""
         if what not in READINGS.get(kind, ()):
             raise AttributeError(f"a {kind} has no reading {what!r} (readings: {', '.join(READINGS.get(kind, ()))})")
-        if what in ("values", "roll_pitch_yaw"):
+        if what in ("values", "roll_pitch_yaw", "value"):
             return self.sim.values[kind][:, column]
         return {"speed": self.speed, "speed_vector": self.speed_vector, "quaternion": self.quaternion}[what][:, column]
 
@@ -325,7 +360,8 @@ class KinematicDevices:
         """Every due device of these kinds in the copies ``live``, at their end-of-step poses; then
         the poses gyros and accelerometers keep (every step, as the single simulation's ``track``)."""
         for kind, fn in (("GPS", self._gps), ("Compass", self._compass), ("InertialUnit", self._unit),
-                         ("Gyro", self._gyro), ("Accelerometer", self._accelerometer)):
+                         ("Gyro", self._gyro), ("Accelerometer", self._accelerometer), ("TouchSensor", self._bumper),
+                         ("Altimeter", self._altimeter)):
             if self.devices[kind]:
                 copies, cols = self.sim._due(kind, live)
                 if len(copies):
@@ -406,6 +442,8 @@ class KinematicDevices:
             self.gps_noise[c, d] = state
             p[rows] = p[rows] + acc[rows, None] * state
         p = _quantize(p, self.resolution["GPS"][cols])
+        if self.utm is not None:
+            p = wgs84_positions(self.utm, p)
         known = self.has_previous[copies, cols] & (elapsed > 0)
         with np.errstate(invalid="ignore", divide="ignore"):
             vec = np.where(known[:, None], (t - self.previous[copies, cols]) * (1000.0 / elapsed)[:, None], math.nan)
@@ -490,3 +528,20 @@ class KinematicDevices:
         q = inertial_quaternions(matrix_quaternions(rot), gauss, noise, x, y, z, self.resolution["InertialUnit"][cols])
         self.quaternion[copies, cols] = q
         return roll_pitch_yaw(q, self.axes)
+
+    def _bumper(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """TouchSensor.measure of a bumper: 1 where the copy's robot pushed against something in this
+        step (kinematic contact clipped its move: ``pressing``), else 0."""
+        return np.where(self.sim.pressing[copies, self.slot["TouchSensor"][cols]], 1.0, 0.0)
+
+    def _altimeter(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Altimeter.measure: the device's height (+ the WGS84 reference altitude), its Gaussian
+        accuracy noise (one normal from its stream), its resolution."""
+        _, t = self._frames("Altimeter", copies, cols)
+        assert t is not None
+        v = t[:, 2] + self.altitude_offset
+        acc = self.altimeter_accuracy[cols]
+        rows = (acc > 0.0).nonzero()[0]
+        if len(rows):
+            v[rows] = v[rows] + acc[rows] * self._gauss("Altimeter", copies[rows], cols[rows], 1)[:, 0]
+        return _quantize(v, self.resolution["Altimeter"][cols])
