@@ -6,8 +6,9 @@ What the single device does, per copy:
 
 * while enabled (any positive sampling period: the head turns every basic step whatever the
   period) the head moves by ``-2π·f·dt`` and the step samples the columns ``rotating_sweep`` gives
-  for the head angle before it -- the same call here, made once per distinct head angle (copies
-  reset or enabled at different times sit at different angles);
+  for the head angle before it -- the same call here, made once per distinct head angle and kept
+  with the sector's beams (copies reset or enabled at different times sit at different angles;
+  every episode's heads pass the same angles again);
 * the head angle is the copy's own: 0 in a freshly built (reset) copy, held while disabled, and
   continued from there when enabled again; columns not swept yet keep their last value (zeros
   after a reset);
@@ -37,7 +38,9 @@ from sensorium.server.sim.sensors import Lidar
 
 __all__ = ["RotatingLidars"]
 
-_SWEEPS_KEPT = 4096   # sweeps kept per lidar (keyed by head angle); cleared when full
+# sectors kept per lidar (keyed by head angle: every episode's heads pass the same angles again),
+# up to this many beams in all (~24 MB of beam columns); cleared when full
+_SECTOR_BEAMS_KEPT = 1 << 20
 
 
 class RotatingLidars:
@@ -51,6 +54,7 @@ class RotatingLidars:
         self.mask = np.array([lid.rotating for lid in lidars], dtype=bool)   # per lidar column
         self.head = np.zeros((sim.copies, len(lidars)))   # per copy and lidar column: the head angle (rad)
         self._sweeps: dict[int, dict[float, _Sector]] = {k: {} for k in self.columns}   # per lidar, by head angle
+        self._kept_beams = dict.fromkeys(self.columns, 0)   # per lidar: the beams of its kept sectors
         self._skips: dict[int, np.ndarray] = {}
         self._beam_rows: dict[tuple[int, int], tuple] = {}   # per (lidar, sector length): beam buffers
 
@@ -64,11 +68,15 @@ class RotatingLidars:
         kept = self._sweeps[col]
         got = kept.get(head)
         if got is None:
-            if len(kept) >= _SWEEPS_KEPT:
-                kept.clear()
             lid = self.lidars[col]
             sweep = lmath.rotating_sweep(lid.params, head, lid.frequency, dt_ms)
-            got = kept[head] = _Sector(lid, sweep, self._skip(col))
+            got = _Sector(lid, sweep, self._skip(col))
+            beams = lid.config.number_of_layers * max(1, len(sweep.columns))
+            if self._kept_beams[col] + beams > _SECTOR_BEAMS_KEPT:
+                kept.clear()
+                self._kept_beams[col] = 0
+            kept[head] = got
+            self._kept_beams[col] += beams
         return got
 
     def _skip(self, col: int) -> np.ndarray:
