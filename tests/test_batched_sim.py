@@ -160,13 +160,10 @@ def test_what_the_batched_simulation_does_not_simulate_is_refused_with_a_reason(
         BatchedSimulation(nue, 2, base_dir=lw.base_dir)
     robots = [r.model_dump(mode="json", exclude_none=True) for r in w.robots]
     robots[0]["devices"].append({"device": "LED", "name": "led0"})
-    robots[1]["devices"][0].update(type="rotating", name="lidar")
     lit = wm.World.model_validate({**w.model_dump(mode="json", exclude_none=True), "robots": robots})
     bs = BatchedSimulation(lit, 2, base_dir=lw.base_dir)
     with pytest.raises(BatchedError, match="is a LED"):
         bs.device("epuck", "led0")
-    with pytest.raises(BatchedError, match="rotating lidars"):
-        bs.enable(bs.device("scout", "lidar"), 32)
     with pytest.raises(KeyError, match="no device 'nope'"):
         bs.device("epuck", "nope")
 

@@ -275,20 +275,20 @@ def test_auto_engine_falls_back_to_the_simulation_for_what_the_batched_one_does_
     from sensorium.server.world.loader import default_world_path, load_world
 
     lw = load_world(default_world_path())
-    robots = [r.model_dump(mode="json", exclude_none=True) for r in lw.world.robots]
-    robots[1]["devices"][0]["type"] = "rotating"                  # the scout's lidar
-    w = lw.world.model_validate({**lw.world.model_dump(mode="json", exclude_none=True), "robots": robots})
+    data = lw.world.model_dump(mode="json", exclude_none=True)
+    data["world_info"]["gps_coordinate_system"] = "WGS84"
+    data["robots"][1]["devices"].append({"device": "GPS", "name": "gps"})      # the scout's
     from sensorium.server.world.loader import LoadedWorld
 
-    world = LoadedWorld(world=w, source="rotating", base_dir=lw.base_dir)
-    task = Task(robot="scout", observations={"lidar": 64}, control_period_ms=64)
+    world = LoadedWorld(world=lw.world.model_validate(data), source="wgs84", base_dir=lw.base_dir)
+    task = Task(robot="scout", observations={"gps": 64}, control_period_ms=64)
     env = SensoriumEnv(world, task, engine="auto")
     assert env.engine == "simulation"
     obs, _ = env.reset(seed=0)
-    assert obs["lidar"].shape == (1, 360)
-    with pytest.raises(BatchedError, match="rotating lidars"):
+    assert obs["gps"].shape == (3,)
+    with pytest.raises(BatchedError, match="WGS84"):
         SensoriumEnv(world, task, engine="batched")
-    with pytest.raises(BatchedError, match="rotating lidars"):
+    with pytest.raises(BatchedError, match="WGS84"):
         SensoriumVectorEnv(world, task, 2).reset(seed=0)
     assert SensoriumEnv(world, Task(robot="epuck", observations=["ps0"]), engine="auto").engine == "batched"
 

@@ -307,7 +307,7 @@ def batched_engine(loaded: LoadedWorld, agents: list[Agent], precision: str, eng
     if engine == "simulation":
         return None
     try:
-        for ag in agents:              # an observed camera, a rotating lidar: nothing built
+        for ag in agents:              # e.g. an observed GPS in a WGS84 world: nothing built
             check_observable(loaded.world, ag.robot, ag.periods)
         sim = BatchedSimulation(loaded, 1, precision=precision)
         for ag in agents:

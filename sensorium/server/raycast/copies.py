@@ -156,7 +156,7 @@ class CopyRays:
             if pr is None:
                 return hits
             tiers = self._slot_tiers(self.movers._variant(kind, skip_transparent))[0]
-            return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent)
+            return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent, run)
         hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
                                 distance_only=distance_only, directions32=directions32, coherent=coherent,
                                 origin_rows=origin_rows, run=run)
@@ -182,13 +182,15 @@ class CopyRays:
         pr, pm = got
         if not len(pr):
             return hits
-        return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent)
+        return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent, run)
 
     def _mover_pass(self, hits: RayHits, O: np.ndarray, D: np.ndarray, t_near, far, pr: np.ndarray, pm: np.ndarray,
-                    tiers: list, rot: np.ndarray, pos: np.ndarray, distance_only: bool, coherent: bool) -> RayHits:
+                    tiers: list, rot: np.ndarray, pos: np.ndarray, distance_only: bool, coherent: bool,
+                    run: int = 0) -> RayHits:
         """The mover pass of :meth:`cast` over the broad phase's (ray, copy * R + slot) pairs: each
         pair into its body's frame, one trace per template tier, the nearest body hit per ray where
-        it is nearer than the static one (``hits``)."""
+        it is nearer than the static one (``hits``). Coherent runs (``run`` > 0): each body's pairs
+        of one copy are a trace of their own (:meth:`_trace_bodies`)."""
         R = self.slots
         dist = hits.distance
         lim = np.minimum(far, dist)
@@ -223,19 +225,15 @@ class CopyRays:
                 continue
             ob, db, rr = Ob[sel], Db[sel], pr[sel]
             tn, lm = _take(t_near, rr) if isinstance(t_near, np.ndarray) else t_near, lim[rr]
-            if len(sel) >= _PRUNE:     # many pairs: drop those missing the tier's tight bound (conservative)
-                keep = tier.may_hit(ob, db, tn, lm).nonzero()[0]
-                if len(keep) < len(sel):
-                    if not len(keep):
-                        continue
-                    sel, ob, db, lm = sel[keep], ob[keep], db[keep], lm[keep]
-                    tn = tn[keep] if isinstance(tn, np.ndarray) else tn
-            self.counters["mover_traces"] += 1
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
-                res = self.movers._trace(tier, ob, db, tn, lm, -1, eps64, exact, None, distance_only,
-                                         coherent=coherent)
+            if coherent and run > 0 and not exact:   # (EXACT's answers never depend on packets)
+                res = self._trace_bodies(tier, ob, db, tn, lm, pm[sel], eps64, exact, distance_only)
+            else:
+                res = self._trace_pairs(tier, ob, db, tn, lm, eps64, exact, distance_only, coherent)
             if res is None:
                 continue
+            keep, res = res
+            if keep is not None:
+                sel = sel[keep]
             t_all[sel] = res[0]
             if not distance_only:
                 body = np.array([self.movers._bodies[self.slot_body[q]].first if self.slot_body[q] is not None else 0
@@ -265,6 +263,48 @@ class CopyRays:
         x = n_all[w]
         normal[rows] = (x[:, 0:1] * Rw[:, :, 0] + x[:, 2:3] * Rw[:, :, 2]) + x[:, 1:2] * Rw[:, :, 1]
         return RayHits(dist, normal, shape)
+
+    def _trace_pairs(self, tier, ob, db, tn, lm, eps64: float, exact: bool, distance_only: bool, coherent: bool):
+        """One trace of a tier's pairs (in its body frames): (kept rows or None, the trace's
+        answers), None when nothing is hit; many pairs: those missing the tier's tight bound
+        dropped first (conservative)."""
+        keep = None
+        if len(ob) >= _PRUNE:
+            keep = tier.may_hit(ob, db, tn, lm).nonzero()[0]
+            if len(keep) == len(ob):
+                keep = None
+            elif not len(keep):
+                return None
+            else:
+                ob, db, lm = ob[keep], db[keep], lm[keep]
+                tn = tn[keep] if isinstance(tn, np.ndarray) else tn
+        self.counters["mover_traces"] += 1
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
+            res = self.movers._trace(tier, ob, db, tn, lm, -1, eps64, exact, None, distance_only, coherent=coherent)
+        return None if res is None else (keep, res)
+
+    def _trace_bodies(self, tier, ob, db, tn, lm, pm: np.ndarray, eps64: float, exact: bool, distance_only: bool):
+        """:meth:`_trace_pairs` of coherent runs (a lidar's beams in every copy): each body's pairs
+        of one copy (``pm``: copy * R + slot, in blocks, rays in order) traced on their own, as the
+        single world traces one lidar's pairs with one body (a coherent packet's traversal can
+        change a lane's answer with the packet's other rays: packets never mix two copies' beams)."""
+        cuts = (np.flatnonzero(pm[1:] != pm[:-1]) + 1).tolist()
+        t = np.full(len(ob), _INF)
+        s = None if distance_only else np.full(len(ob), -1, dtype=np.int64)
+        nrm = None if distance_only else np.zeros((len(ob), 3))
+        hit = False
+        for a, b in zip([0, *cuts], [*cuts, len(ob)]):
+            got = self._trace_pairs(tier, ob[a:b], db[a:b], tn[a:b] if isinstance(tn, np.ndarray) else tn, lm[a:b],
+                                    eps64, exact, distance_only, True)
+            if got is None:
+                continue
+            hit = True
+            keep, res = got
+            rows = np.arange(a, b) if keep is None else a + keep
+            t[rows] = res[0]
+            if not distance_only:
+                s[rows], nrm[rows] = res[1], res[2]
+        return (None, (t, s, nrm)) if hit else None
 
     def _lean_cast(self, O: np.ndarray, D: np.ndarray, n: int, t_near, t_far, kind: RayKind, copy, rot, pos,
                    exclude_slot, mount_slot, skip_transparent: bool, distance_only: bool, directions32, coherent: bool,

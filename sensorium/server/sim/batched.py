@@ -17,13 +17,15 @@ every device model runs once over all copies' devices of a kind.
 Copy ``c`` reproduces :class:`~sensorium.server.sim.simulation.Simulation` built from the world
 with copy c's seed, bit for bit, for what it simulates: the drive (the same float64 arc, the same
 3x3 products), kinematic contact (the same broad phase per copy, the same narrow phase), light
-sensors, distance sensors, fixed lidars, wheel encoders, GPS (local or WGS84 coordinates), compasses,
-inertial units, gyros, accelerometers, bumpers and altimeters (batched_kinematic.py), range finders
-(batched_depth.py), cameras (batched_camera.py), each device's noise drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the
-same numbers, in the same order). Tests compare it with the single simulation step by step.
+sensors, distance sensors, lidars (rotating ones: batched_lidar.py), wheel encoders, GPS (local or WGS84
+coordinates), compasses, inertial units, gyros, accelerometers, bumpers and altimeters
+(batched_kinematic.py), range finders (batched_depth.py), cameras (batched_camera.py), each device's noise
+drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in
+the same order). Tests compare it with the single simulation step by step.
 
-Not simulated here (use :class:`Simulation`): rotating lidars, camera recognition and
-segmentation, force TouchSensors, the kinds without an observation (LEDs, pens, ...), lights carried by robots, textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
+Not simulated here (use :class:`Simulation`): camera recognition and segmentation, force TouchSensors,
+the kinds without an observation (LEDs, pens, ...), lights carried by robots, textured robot bodies, NUE
+worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKi
 from sensorium.server.sim import batched_camera as cam
 from sensorium.server.sim import batched_depth as depth
 from sensorium.server.sim import batched_kinematic as kin
+from sensorium.server.sim import batched_lidar
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
 from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
@@ -75,8 +78,6 @@ def _refusal(robot: str, config, world_info: wm.WorldInfo) -> str | None:
     if config.device not in SUPPORTED_KINDS:
         return (f"robot {robot!r}: device {config.name!r} is a {config.device}; the batched simulation measures "
                 f"{', '.join(SUPPORTED_KINDS)} (use Simulation)")
-    if config.device == "Lidar" and config.type == "rotating":
-        return f"{robot}/{config.name}: rotating lidars are not simulated by the batched simulation (use Simulation)"
     return kin.refusal(robot, config, world_info)
 
 
@@ -355,9 +356,8 @@ class BatchedSimulation:
         self.depth = depth.DepthDevices(self, lists["RangeFinder"])
         # cameras (batched_camera.py): their pixel rays' constants, every copy's BGRA images
         self.camera = cam.CameraDevices(self, lists["Camera"])
-        for lid in self.lidar:
-            if lid.rotating:
-                continue
+        # rotating lidars (batched_lidar.py): every copy's head; None without one (nothing to filter)
+        self.rotating_lidars = batched_lidar.RotatingLidars(self, self.lidar) if any(d.rotating for d in self.lidar) else None
         self._lidar_skips: dict[int, np.ndarray] = {}
         self._lidar_plan: dict[int, tuple] = {}      # per lidar: (copies, each beam's copy, mount slots)
         self._lidar_due: tuple | None = None          # the due lidars' scans (_lidar_scans)
@@ -499,6 +499,8 @@ class BatchedSimulation:
             v[idx] = math.nan
         for img in self.range_images:
             img[idx] = 0.0
+        if self.rotating_lidars is not None:
+            self.rotating_lidars.reset(idx)
         self.kinematic.reset(idx)
         self.depth.reset(idx)
         self.camera.reset(idx)
@@ -552,9 +554,6 @@ class BatchedSimulation:
         copy's clock (0 disables)."""
         if isinstance(period_ms, bool) or not isinstance(period_ms, (int, np.integer)) or period_ms < 0:
             raise ValueError(f"sampling period must be an integer >= 0 ms, got {period_ms!r}")
-        if ref.kind == "Lidar" and self.lidar[ref.column].rotating:
-            raise BatchedError(f"{self.robot_names[ref.slot]}/{ref.name}: rotating lidars are not simulated by "
-                               "the batched simulation (use Simulation)")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         self.period[ref.kind][idx, ref.column] = int(period_ms)
         if period_ms > 0:
@@ -870,6 +869,12 @@ class BatchedSimulation:
                 work.append(("distance", self._plan_distances(dc, dcol)))
         if self.lidar:
             ic, icol = self._due("Lidar", live)
+            if self.rotating_lidars is not None:   # due every step while enabled: planned apart
+                fixed = (~self.rotating_lidars.mask[icol]).nonzero()[0]
+                ic, icol = ic[fixed], icol[fixed]
+                swept = self.rotating_lidars.plan(live, dt)
+                if swept[0]["items"]:
+                    work.append(("rotating_lidar", swept))
             if len(ic):
                 work.append(("lidar", self._plan_lidars(ic, icol)))
         if self.depth.devices:
@@ -894,9 +899,11 @@ class BatchedSimulation:
     def _cast_requests(self, requests: list[_Rays]) -> list[RayHits]:
         groups: dict[tuple, list[int]] = {}
         for i, r in enumerate(requests):
-            groups.setdefault((int(r.kind), r.skip, r.distance_only, r.coherent), []).append(i)
+            # a lidar's scans (coherent runs) are a cast of their own, as the single simulation casts
+            # each lidar: joined, runs of another length or another t_near would change FAST's packets
+            groups.setdefault((int(r.kind), r.skip, r.distance_only, r.coherent, i if r.coherent else -1), []).append(i)
         out: list[RayHits | None] = [None] * len(requests)
-        for (kind, skip, distance_only, coherent), idx in groups.items():
+        for (kind, skip, distance_only, coherent, _), idx in groups.items():
             reqs = [requests[i] for i in idx]
             if len(reqs) == 1:
                 r = reqs[0]
@@ -1206,8 +1213,9 @@ class BatchedSimulation:
             x, y, z = lid._dir_columns
             local = lid.local_pose
             dirs = np.stack([x, y, z], axis=1) @ local.rotation.T
+            far = lid._t_far.reshape(-1) if isinstance(lid._t_far, np.ndarray) else lid._t_far   # (L, W): planar
             reach = self.rays.may_reach(slot, RayKind.VISUAL, np.broadcast_to(local.translation, dirs.shape), dirs,
-                                        lid.params.near, lid._t_far)
+                                        lid.params.near, far)
             got = self._lidar_skips[col] = np.where(reach, -1, slot).astype(np.int64)
         return got
 
@@ -1237,6 +1245,9 @@ class BatchedSimulation:
             else:
                 self.last["Lidar"][c, col] = self.time_ms[c]
             self.counters["measurements"] += len(c)
+
+    def _finish_rotating_lidar(self, state: dict, hits: list[RayHits]) -> None:
+        self.rotating_lidars.finish(state, hits)   # type: ignore[union-attr]
 
     def _finish_depth(self, state: dict, hits: list[RayHits]) -> None:
         self.depth.finish(state, hits)

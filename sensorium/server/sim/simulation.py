@@ -551,11 +551,15 @@ class Simulation:
         for i, r in enumerate(requests):
             self._counters[f"rays_{r.tag}"] += len(r)
             if len(r):
-                groups.setdefault((int(r.kind), r.skip_transparent, r.distance_only), []).append(i)
+                # a lidar's scan is a cast of its own: its answer never depends on which other lidars
+                # are due this step (FAST traces a one-origin scan as coherent packets, a joined cast
+                # as incoherent ones, which can differ for a beam grazing an edge)
+                lone = i if r.tag == "lidar" else -1
+                groups.setdefault((int(r.kind), r.skip_transparent, r.distance_only, lone), []).append(i)
             else:
                 results[i] = RayHits(np.empty(0), np.empty((0, 3)), np.empty(0, dtype=np.int64))
         engine = self.scene.engine
-        for (kind, skip, distance_only), idx in groups.items():
+        for (kind, skip, distance_only, _), idx in groups.items():
             reqs = [requests[i] for i in idx]
             sizes = [len(r) for r in reqs]
             self._counters["cast_calls"] += 1
