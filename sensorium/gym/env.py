@@ -201,7 +201,6 @@ class Agent:
         # (a steering angle beyond the limit is the limit: tan of a huge angle would steer anywhere)
         return np.array([min(max(a[0], -self.max_steer), self.max_steer), a[1]])
 
-
     def steering_positions(self, angle: float) -> tuple[float, float]:
         """A car's steering motors' positions (right, left) for a steering angle (rad, positive
         left): Webots' Driver's Ackermann angles (motion.ackermann_angles takes positive right),
