@@ -323,3 +323,43 @@ def test_avoid_obstacles_reward_refuses_a_car_in_one_line():
     env = SensoriumEnv(WORLD, Task(robot="car", terminated=goal.terminated))
     env.reset(seed=0)
     assert env.step(np.zeros(2, dtype=np.float32))[2] is False
+
+
+def test_set_wheels_on_a_car_says_how_to_command_it():
+    sim = BatchedSimulation(load_world(WORLD), 2)
+    with pytest.raises(ValueError, match=r"^car: a car-like robot has no left and right wheels: command it with "
+                                         r"cars.command"):
+        sim.set_wheels(sim.slot("car"), [1.0, 1.0], [1.0, 1.0])
+
+
+def test_the_registered_car_task_is_checked_and_batched_bit_for_bit():
+    """sensorium/CarReachLight-v0 (the bundled car_park world): the checker without warnings on the
+    single env and a sub-env, and sub-env i equals gym.make's env with seed 3 + i, autoresets included."""
+    import sensorium.gym  # noqa: F401  (registers the ids)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(gym.make("sensorium/CarReachLight-v0").unwrapped)
+        venv = gym.make_vec("sensorium/CarReachLight-v0", num_envs=2, vectorization_mode="vector_entry_point",
+                            render_mode="rgb_array", max_steps=15)
+        check_env(venv.unwrapped.sub_env(1), skip_render_check=False)
+    singles = [gym.make("sensorium/CarReachLight-v0", max_steps=15).unwrapped for _ in range(2)]
+    obs, _ = venv.reset(seed=3)
+    for i, env in enumerate(singles):
+        assert _same({k: v[i] for k, v in obs.items()}, env.reset(seed=3 + i)[0])
+    rng = np.random.default_rng(0)
+    done = np.zeros(2, dtype=bool)
+    moved = 0.0
+    for t in range(40):
+        a = rng.uniform(-1, 1, (2, 2)).astype(np.float32)
+        a[:, 1] = np.abs(a[:, 1])                        # forward
+        vobs, vr, vte, vtr, vinfo = venv.step(a)
+        for i, env in enumerate(singles):
+            if done[i]:
+                o, r, te, tr = env.reset()[0], 0.0, False, False
+            else:
+                o, r, te, tr, inf = env.step(a[i])
+                moved += abs(r)
+            assert _same({k: v[i] for k, v in vobs.items()}, o) and (r, te, tr) == (vr[i], vte[i], vtr[i]), (t, i)
+            done[i] = te or tr
+    assert moved > 0.0                                    # the progress reward moved

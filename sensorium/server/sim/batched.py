@@ -544,6 +544,9 @@ class BatchedSimulation:
         """Velocity control of a slot's wheels (rad/s, clamped to the maximum as Webots does) in the
         named copies (default: all): ``setPosition(inf)`` and ``setVelocity`` of every wheel motor of
         each side (a skid-steer robot's too)."""
+        if self.cars is not None and slot in self.cars.car_of:
+            raise ValueError(f"{self.robot_names[slot]}: a car-like robot has no left and right wheels: "
+                             "command it with cars.command(slot, right, left, wheel)")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         vmax = self.max_wheel[slot]
         left = np.asarray(left, dtype=np.float64)
