@@ -1,6 +1,6 @@
 """Car-like robots (kinematic Ackermann steering): the front wheels' angles for a steering angle, the
 bicycle model's circle about the turn centre on the rear axle's line, straight driving, the motors'
-limits, contact at a wall, the world file's checks and the batched simulation's refusal.
+limits, contact at a wall, the world file's checks and the batched simulation's copies.
 Closed-form checks."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import pytest
 
 from sensorium.client.webots.vehicle.driver import ackermann_angles
 from sensorium.schemas import world as wm
-from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import WorldError, parse_world
 
@@ -175,11 +175,25 @@ def test_world_file_checks_name_the_field() -> None:
         parse_world({"robots": [clash]})
 
 
-def test_batched_simulation_refuses_a_car() -> None:
-    w = parse_world({"robots": [car()]})
-    with pytest.raises(BatchedError, match="robot 'car' has an ackermann_drive; the batched simulation drives "
-                                           "two-wheel and skid-steer robots only"):
-        BatchedSimulation(w, copies=2)
+def test_batched_simulation_circles_a_car_as_the_simulation() -> None:
+    """The batched simulation drives cars (sensorium/server/sim/batched_car.py; tests/test_car_agent.py
+    compares whole RL episodes): the closed-form circle's poses, bit for bit, in every copy."""
+    w = parse_world({"world_info": {"basic_time_step": 16}, "robots": [car(type="4x4")]})
+    sim, batched = Simulation(w), BatchedSimulation(w, copies=3)
+    assert batched.cars is not None
+    right, left = ackermann_angles(-0.3, L, TF)
+    batched.cars.command(0, right, left, 12.0)
+    sim.robot("car").motor("right_steer").set_position(right)
+    sim.robot("car").motor("left_steer").set_position(left)
+    for name in ("right_front_wheel", "left_front_wheel", "right_rear_wheel", "left_rear_wheel"):
+        sim.robot("car").motor(name).set_position(math.inf)
+        sim.robot("car").motor(name).set_velocity(12.0)
+    for _ in range(200):
+        sim.step()
+        batched.step()
+        for c in range(3):
+            assert batched.pose(c, 0).translation.tobytes() == sim.robot("car").pose.translation.tobytes()
+            assert batched.pose(c, 0).rotation.tobytes() == sim.robot("car").pose.rotation.tobytes()
 
 
 def test_the_readme_car_is_a_valid_world_that_circles() -> None:

@@ -5,9 +5,11 @@
     from sensorium.gym import SensoriumEnv, Task, ReachLight
     env = SensoriumEnv("my_world.yaml", Task(robot="epuck", observations={"ls0": 32}, reward=ReachLight(), ...))
 
-Registered ids (all on the embedded arena world): ``sensorium/ReachLight-v0`` (e-puck, light and
+Registered ids (on the embedded arena world): ``sensorium/ReachLight-v0`` (e-puck, light and
 infra-red sensors, drive to the lamp), ``sensorium/AvoidObstacles-v0`` (e-puck, infra-red sensors,
-explore without contact), ``sensorium/LidarAvoid-v0`` (scout, 360-ray lidar + sonars).
+explore without contact), ``sensorium/LidarAvoid-v0`` (scout, 360-ray lidar + sonars); on the
+car_park world ``sensorium/CarReachLight-v0`` (a car-like robot: (steering, speed) actions, light
+sensors and sonars, drive to the lamp).
 ``SensoriumParallelEnv`` (PettingZoo) runs several robots of one world as agents.
 
 Batched: ``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` gives a
@@ -42,6 +44,7 @@ def __getattr__(name: str):
 
 for _id, _fn in (("sensorium/ReachLight-v0", "reach_light"),
                  ("sensorium/AvoidObstacles-v0", "avoid_obstacles"),
-                 ("sensorium/LidarAvoid-v0", "lidar_avoid")):
+                 ("sensorium/LidarAvoid-v0", "lidar_avoid"),
+                 ("sensorium/CarReachLight-v0", "car_reach_light")):
     if _id not in registry:
         register(id=_id, entry_point=f"sensorium.gym.tasks:{_fn}", vector_entry_point=f"sensorium.gym.tasks:{_fn}_vector")

@@ -28,6 +28,16 @@ the symmetric, normalised box training libraries and Gymnasium's checker recomme
 Either way a velocity beyond the maximum is clamped, as Webots does. One action lasts
 ``control_period_ms``.
 
+A car-like robot (``ackermann_drive``) acts with float32 ``(2,)`` = steering, speed. Normalised:
+steering in ``[-1, 1]`` times ``max_steering_angle``, **+1 turning left** (counter-clockwise seen from
+above, as ROS's REP 103, whatever the motors' ``positive_steers``), speed in ``[-1, 1]`` times
+``max_wheel_speed`` for every driven wheel (+1 forward); ``actions="wheel"``: the steering angle
+(rad, positive left, beyond ``±max_steering_angle`` the limit) and the wheels' velocity (rad/s).
+The steering angle is the bicycle model's: the two steering motors are set to Webots' Driver's
+Ackermann angles for it (``cot δ_inner = cot δ - track_front/2L``, outer ``+``), which their
+``max_steering_angle`` limit clamps (near full lock the inner wheel stops at the limit), and turn
+there at ``max_steering_speed`` (position control), so a new steering takes a few steps to reach.
+
 ``reset(seed=s)`` restarts the world with a world seed drawn from the environment's generator
 seeded with ``s``: every device noise stream, the start pose drawn by ``Task.start`` and the clock
 restart exactly, so the same seed and actions give a bit-identical episode. ``engine``: where the
@@ -56,6 +66,7 @@ from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
+from sensorium.server.sim.motion import ackermann_angles
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.limits import MAX_COORDINATE_M
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
@@ -91,15 +102,17 @@ class Agent:
         robots = {r.name: r for r in w.robots}
         name = task.robot or default_robot
         if name is None:
-            driven = [r.name for r in w.robots if r.differential_drive is not None]
+            driven = [r.name for r in w.robots if r.differential_drive is not None or r.ackermann_drive is not None]
             if not driven:
-                raise ValueError(f"{loaded.source}: no robot with a differential_drive to act as the agent")
+                raise ValueError(f"{loaded.source}: no robot with a differential_drive or an ackermann_drive to act "
+                                 "as the agent")
             name = driven[0]
         if name not in robots:
             raise ValueError(f"{loaded.source}: task robot {name!r} not in the world (robots: {', '.join(robots)})")
         model = robots[name]
-        if model.differential_drive is None:
-            raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive to act with")
+        if model.differential_drive is None and model.ackermann_drive is None:
+            raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive or ackermann_drive "
+                             "to act with")
         self.robot = name
         ctrl = task.control_period_ms or basic
         if ctrl <= 0 or ctrl % basic:
@@ -133,16 +146,28 @@ class Agent:
         self.flatten = bool(flatten)
         self.observation_space: spaces.Space = (spaces.flatten_space(self.dict_space) if self.flatten
                                                 else self.dict_space)
-        self.vmax = vmax = float(model.differential_drive.max_wheel_speed)
+        # a car-like robot acts with (steering, speed): see :meth:`commands`
+        self.car: wm.AckermannDrive | None = model.ackermann_drive
+        if self.car is None:
+            assert model.differential_drive is not None
+            self.vmax = vmax = float(model.differential_drive.max_wheel_speed)
+            raw = spaces.Box(-vmax, vmax, shape=(2,), dtype=np.float32)
+        else:
+            self.vmax = float(self.car.max_wheel_speed)
+            self.max_steer = float(self.car.max_steering_angle)
+            self.scale = np.array([self.max_steer, self.vmax])
+            raw = spaces.Box(-self.scale.astype(np.float32), self.scale.astype(np.float32), dtype=np.float32)
         self.action_space = (spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32) if actions == "normalized"
-                             else spaces.Box(-vmax, vmax, shape=(2,), dtype=np.float32))
+                             else raw)
 
     def start(self, sim: Simulation, rng: np.random.Generator) -> None:
         """After a rebuild: start pose, wheels at rest in velocity control, devices enabled."""
         robot = sim.robot(self.robot)
         if self.task.start is not None:
             self.task.start(sim, robot, rng)
-        for m in robot.motors.values():
+        # (a car's steering motors stay as built: position control at 0, at max_steering_speed)
+        wheels = robot.motors.values() if self.car is None else [robot.motors[n] for _, n in self.car.driven]
+        for m in wheels:
             m.set_position(math.inf)
             m.set_velocity(0.0)
         for n, p in self.periods.items():
@@ -157,19 +182,46 @@ class Agent:
                 owners.append(owner)
                 owner.reset(sim, robot)
 
-    def wheel_velocities(self, action) -> np.ndarray:
-        """An action -> (left, right) wheel velocities (rad/s, float64; clamped later by the motors)."""
+    def commands(self, action) -> np.ndarray:
+        """An action -> float64 (2,): (left, right) wheel velocities (rad/s), or a car's (steering
+        angle (rad, positive left), driven wheels' velocity (rad/s)); clamped later by the motors."""
         a = np.asarray(action, dtype=np.float64).reshape(-1)
         if a.shape != (2,) or not np.all(np.isfinite(a)):
-            what = "values in [-1, 1]" if self.actions == "normalized" else "wheel velocities"
-            raise ValueError(f"{self.robot}: action must be 2 finite {what} (left, right), got {action!r}")
+            what = ("values in [-1, 1]" if self.actions == "normalized"
+                    else "wheel velocities" if self.car is None else "values (rad, rad/s)")
+            names = "left, right" if self.car is None else "steering, speed"
+            # (the values as a list: an array's repr would break the line)
+            raise ValueError(f"{self.robot}: action must be 2 finite {what} ({names}), got {a.tolist()!r}")
         # a normalized action beyond [-1, 1] asks for more than the wheels give: clipped before the
         # scaling, which is the motors' clamp for any finite value (1e308 * vmax would overflow to inf)
-        return np.clip(a, -1.0, 1.0) * self.vmax if self.actions == "normalized" else a
+        if self.car is None:
+            return np.clip(a, -1.0, 1.0) * self.vmax if self.actions == "normalized" else a
+        if self.actions == "normalized":
+            return np.clip(a, -1.0, 1.0) * self.scale
+        # (a steering angle beyond the limit is the limit: tan of a huge angle would steer anywhere)
+        return np.array([min(max(a[0], -self.max_steer), self.max_steer), a[1]])
+
+    def steering_positions(self, angle: float) -> tuple[float, float]:
+        """A car's steering motors' positions (right, left) for a steering angle (rad, positive
+        left): Webots' Driver's Ackermann angles (motion.ackermann_angles takes positive right),
+        in the motors' sense (``positive_steers``); the motors clamp them to ±max_steering_angle."""
+        car = self.car
+        assert car is not None
+        right, left = ackermann_angles(-angle, float(car.wheelbase), float(car.track_front))
+        sign = 1.0 if car.positive_steers == "right" else -1.0
+        return sign * right, sign * left
 
     def act(self, sim: Simulation, action) -> None:
-        v = self.wheel_velocities(action)
-        drive = sim.robot(self.robot).drive
+        v = self.commands(action)
+        robot = sim.robot(self.robot)
+        if self.car is not None:
+            right, left = self.steering_positions(float(v[0]))
+            robot.motors[self.car.right_steer].set_position(right)
+            robot.motors[self.car.left_steer].set_position(left)
+            for _, name in self.car.driven:
+                robot.motors[name].set_velocity(float(v[1]))
+            return
+        drive = robot.drive
         for m in drive.lefts:        # every wheel of a side (a skid-steer robot has several)
             m.set_velocity(float(v[0]))
         for m in drive.rights:

@@ -55,7 +55,7 @@ def zero(sim, robot, obs) -> float:
 class Task:
     """The agent's task in a world.
 
-    ``robot``: the agent (default: the first robot with a differential drive).
+    ``robot``: the agent (default: the first robot with a differential drive or an ackermann drive).
     ``observations``: device name -> sampling period in ms, or a list of names (sampled every
     control period); default: every device of the robot, sampled every control period.
     ``control_period_ms``: simulated time per action, a multiple of the world's basic step
@@ -220,6 +220,10 @@ class _ReachLightCopies(VectorGoal):
         return self.distance(copies) < self.goal.radius
 
 
+_NO_WHEEL_PAIR = ("AvoidObstacles' reward reads a left and a right wheel speed: robot {!r} has no differential_drive "
+                  "(a car-like robot: write a reward for it; AvoidObstacles().terminated works)")
+
+
 class AvoidObstacles:
     """Explore without touching anything: per action, ``v (1 - sqrt(|dv|)) (1 - p)`` with ``v`` the
     mean wheel speed and ``dv`` the wheel speed difference (both / max wheel speed) and ``p`` the
@@ -246,6 +250,8 @@ class AvoidObstacles:
 
     def reward(self, sim, robot, obs) -> float:
         drive = robot.drive
+        if robot.model.differential_drive is None:
+            raise ValueError(_NO_WHEEL_PAIR.format(robot.name))
         vmax = drive.left.max_velocity
         wl, wr = drive.left.velocity / vmax, drive.right.velocity / vmax
         v = 0.5 * (wl + wr)
@@ -279,6 +285,7 @@ class _AvoidObstaclesCopies(VectorGoal):
         angles = np.arange(self.RAYS) * (2.0 * math.pi / self.RAYS)     # clearance()'s directions, bit for bit
         self.dirs = np.stack([np.cos(angles), np.sin(angles), np.zeros(self.RAYS)], axis=1)
         self.vmax = float(sim.max_wheel[slot, 0])
+        self.wheels = sim.world.robots[slot].differential_drive is not None    # (a car has no wheel pair)
         self._gap: tuple | None = None     # (step key, copies, gaps, terminations or None)
         self._passes = packets.avoid_outcome(sim.velocity)   # (None without the C helper)
         self._rays: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None   # (copies, each ray's copy, directions)
@@ -324,6 +331,8 @@ class _AvoidObstaclesCopies(VectorGoal):
         return got
 
     def reward(self, copies: np.ndarray) -> np.ndarray:
+        if not self.wheels:
+            raise ValueError(_NO_WHEEL_PAIR.format(self.sim.robot_names[self.slot]))
         g = self.goal
         gap, reward, _ = self._outcome(copies, True)
         if reward is not None:

@@ -1,4 +1,5 @@
-"""Ready-made environments on the embedded arena world (the registered Gymnasium ids).
+"""Ready-made environments on the embedded arena world and, for a car, the car_park world (the
+registered Gymnasium ids).
 
 Each id has a single environment (``entry_point``: :class:`~sensorium.gym.env.SensoriumEnv`) and a
 batched vector environment (``vector_entry_point``: :class:`~sensorium.gym.vector.SensoriumVectorEnv`,
@@ -38,6 +39,19 @@ def lidar_avoid_task(max_steps: int = 1000) -> Task:
                 start=random_start((-0.3, 0.3), (-0.2, 0.6)))
 
 
+def car_reach_light_task(max_steps: int = 400) -> Task:
+    """car (car_park world): drive the car-like robot (steering, speed) from a random start in the
+    west half to the lamp over the free bay in the north-east, seeing two light sensors, three
+    sonars and a compass every 64 ms (two basic steps); arrival within 0.6 m ends the episode."""
+    goal = ReachLight("lamp", radius=0.6)
+    return Task(robot="car", observations={n: 64 for n in CAR_SENSORS}, control_period_ms=64,
+                max_steps=max_steps, reward=goal, terminated=goal.terminated,
+                start=random_start((-4.0, -1.5), (-3.0, 3.0)))
+
+
+CAR_SENSORS = ["light_left", "light_right", "sonar_front", "sonar_left", "sonar_right", "compass"]
+
+
 def reach_light(world=None, render_mode=None, max_steps: int = 400, **kw) -> SensoriumEnv:
     return SensoriumEnv(world, reach_light_task(max_steps), render_mode=render_mode, **kw)
 
@@ -48,6 +62,16 @@ def avoid_obstacles(world=None, render_mode=None, max_steps: int = 1000, **kw) -
 
 def lidar_avoid(world=None, render_mode=None, max_steps: int = 1000, **kw) -> SensoriumEnv:
     return SensoriumEnv(world, lidar_avoid_task(max_steps), render_mode=render_mode, **kw)
+
+
+def car_reach_light(world=None, render_mode=None, max_steps: int = 400, **kw) -> SensoriumEnv:
+    return SensoriumEnv(world or car_park(), car_reach_light_task(max_steps), render_mode=render_mode, **kw)
+
+
+def car_park():
+    from sensorium.worlds import world_path
+
+    return world_path("car_park")
 
 
 def _vector(task: Task, world, num_envs: int, render_mode, **kw):
@@ -69,6 +93,11 @@ def lidar_avoid_vector(num_envs: int = 1, world=None, render_mode=None, max_step
     return _vector(lidar_avoid_task(max_steps), world, num_envs, render_mode, **kw)
 
 
+def car_reach_light_vector(num_envs: int = 1, world=None, render_mode=None, max_steps: int = 400, **kw):
+    return _vector(car_reach_light_task(max_steps), world or car_park(), num_envs, render_mode, **kw)
+
+
 reach_light.__doc__ = reach_light_task.__doc__
+car_reach_light.__doc__ = car_reach_light_task.__doc__
 avoid_obstacles.__doc__ = avoid_obstacles_task.__doc__
 lidar_avoid.__doc__ = lidar_avoid_task.__doc__

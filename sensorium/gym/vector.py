@@ -25,7 +25,7 @@ rewards and flags (tests compare them step by step, resets included).
 * ``sub_env(i)``: sub-environment *i* as a plain ``gymnasium.Env`` (reset and step it alone; for
   checkers and tests).
 * Options as ``SensoriumEnv``: ``actions`` (``"normalized"``: [-1, 1], the default; ``"wheel"``:
-  rad/s), ``flatten`` (one Box), ``precision``; a task's reward and termination use their
+  rad/s; a car-like agent's (steering, speed) as there), ``flatten`` (one Box), ``precision``; a task's reward and termination use their
   vectorised form when they have one (``ReachLight``, ``AvoidObstacles``, :mod:`.task`), else
   they are called per copy with views of that copy.
 * ``threads``: the threads a cast of >= 16,384 rays (all copies' lidar beams) may be split over
@@ -185,7 +185,11 @@ class SensoriumVectorEnv(VectorEnv):
             for c in copies.tolist():
                 view = self._view(c)
                 self.task.start(view, view.robot(self.agent.robot), self._rngs[c])
-        self.sim.set_wheels(self.slot, np.zeros(len(copies)), np.zeros(len(copies)), copies)
+        if self.agent.car is None:
+            self.sim.set_wheels(self.slot, np.zeros(len(copies)), np.zeros(len(copies)), copies)
+        else:       # a car: its driven wheels at rest in velocity control (its steering as built)
+            assert self.sim.cars is not None
+            self.sim.cars.roll(self.slot, np.zeros(len(copies)), copies)
         for name, period in self.agent.periods.items():
             self.sim.enable(self.refs[name], period, copies)
         self.steps[copies] = 0
@@ -205,10 +209,28 @@ class SensoriumVectorEnv(VectorEnv):
         if not np.isfinite(a).all():
             bad = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
             raise ValueError(f"sub-env {int(copies[bad])}: action must be 2 finite values, got {actions[bad]!r}")
+        if self.agent.car is not None:
+            self._act_car(copies, a)
+            return
         # (clipped as the single env clips it: the motors' clamp, without an overflow to inf)
         v = np.clip(a, -1.0, 1.0) * self.agent.vmax if self.agent.actions == "normalized" else a
         # (every copy in order: the simulation's own default, a slice rather than a gather)
         self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], None if copies is self._every else copies)
+
+    def _act_car(self, copies: np.ndarray, a: np.ndarray) -> None:
+        """A car's actions (Agent.commands, row by row the single env's values): its steering motors
+        to the Ackermann angles, its driven wheels to the speed."""
+        assert self.sim.cars is not None
+        if not len(copies):
+            return
+        ag = self.agent
+        if ag.actions == "normalized":
+            cmd = np.clip(a, -1.0, 1.0) * ag.scale
+        else:
+            cmd = a.copy()
+            cmd[:, 0] = np.minimum(np.maximum(a[:, 0], -ag.max_steer), ag.max_steer)
+        right, left = (np.array(side) for side in zip(*map(ag.steering_positions, cmd[:, 0].tolist())))
+        self.sim.cars.command(self.slot, right, left, cmd[:, 1], None if copies is self._every else copies)
 
     def _scalar_groups(self) -> list[tuple[str, list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
         """The observed devices whose values are ``sim.values`` (one value, or three: a GPS, a

@@ -16,7 +16,8 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   ``.speed_vector``, a compass's, a gyro's or an accelerometer's ``.values``, an inertial unit's
   ``.roll_pitch_yaw``, ``.quaternion``; a bumper's or an altimeter's ``.value``).
   The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
-  side share one state, so commanding one of them commands its side.
+  side share one state, so commanding one of them commands its side. A car-like robot has
+  ``motors`` (its steering and driven wheels) and no ``drive``.
 
 Anything else a callable reaches for raises AttributeError naming the view.
 """
@@ -76,6 +77,39 @@ class _Drive:
         return {m.name: m for m in (*self.lefts, *self.rights)}
 
 
+class _CarMotor:
+    """A car's steering or driven-wheel motor in one copy (batched_car.CarDrives)."""
+
+    def __init__(self, sim: BatchedSimulation, copy: int, slot: int, name: str):
+        assert sim.cars is not None
+        self._cars, self._c = sim.cars, copy
+        self._k, self._j = sim.cars.column(slot, name)
+        self.name = name
+        self.max_velocity = float(sim.cars.max_velocity[self._k, self._j])
+
+    @property
+    def velocity(self) -> float:
+        return float(self._cars.velocity[self._c, self._k, self._j])
+
+    @property
+    def position(self) -> float:
+        return float(self._cars.angle[self._c, self._k, self._j])
+
+    @property
+    def target_position(self) -> float:
+        return float(self._cars.target[self._c, self._k, self._j])
+
+    def set_position(self, value: float) -> None:
+        if not isinstance(value, (int, float)) or math.isnan(value):
+            raise ValueError(f"motor {self.name!r}: position must be a number or inf, got {value!r}")
+        self._cars.set_position(self._c, self._k, self._j, float(value))
+
+    def set_velocity(self, value: float) -> None:
+        if not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ValueError(f"motor {self.name!r}: velocity must be a finite number, got {value!r}")
+        self._cars.set_velocity(self._c, self._k, self._j, float(value))
+
+
 class _Device:
     def __init__(self, sim: BatchedSimulation, copy: int, slot: int, name: str):
         self._s, self._c = sim, copy
@@ -117,7 +151,10 @@ class CopyRobot:
         self.model = sim.world.robots[slot]
         if sim.has_drive[slot]:
             self.drive: _Drive | None = _Drive(sim, copy, slot)
-            self.motors = self.drive.motors
+            self.motors: dict[str, _Motor | _CarMotor] = dict(self.drive.motors)
+        elif sim.cars is not None and slot in sim.cars.car_of:     # a car: its motors (no drive view)
+            self.drive = None
+            self.motors = {name: _CarMotor(sim, copy, slot, name) for name in sim.cars.columns[sim.cars.car_of[slot]]}
         else:
             self.drive = None
             self.motors = {}
@@ -129,7 +166,7 @@ class CopyRobot:
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         self._s.set_pose(self._c, self.index, translation, rotation, quaternion)
 
-    def motor(self, name: str) -> _Motor:
+    def motor(self, name: str) -> _Motor | _CarMotor:
         try:
             return self.motors[name]
         except KeyError:

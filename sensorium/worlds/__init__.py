@@ -1,6 +1,7 @@
 """The bundled example worlds: ``arena`` (the default), ``warehouse``, ``lighting``,
 ``line_following`` (YAML; its floor texture in ``textures/``, made by :mod:`.line_loop`),
-``blob_chase`` (a camera and a red ball, for ``example:blob_follower``) and
+``blob_chase`` (a camera and a red ball, for ``example:blob_follower``), ``car_park`` (a car-like
+robot and a lamp, for ``sensorium/CarReachLight-v0``) and
 ``epuck.wbt`` (a Webots world).
 
 Every command and :func:`sensorium.server.world.loader.load_world` also take a bundled world's bare

@@ -26,6 +26,9 @@ the same order). Tests compare it with the single simulation step by step.
 Not simulated here (use :class:`Simulation`): camera recognition and segmentation, force TouchSensors,
 the kinds without an observation (LEDs, pens, ...), lights carried by robots, textured robot bodies, NUE
 worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
+Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
+(``sim.cars.command``; their encoders read its motors), their moves through the same arc, contact
+and placing as the other robots.
 """
 
 from __future__ import annotations
@@ -50,10 +53,11 @@ from sensorium.server.sim import batched_camera as cam
 from sensorium.server.sim import batched_depth as depth
 from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim import batched_lidar
+from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
 from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
-from sensorium.server.sim.motion import DifferentialDrive, _rz
+from sensorium.server.sim.motion import AckermannDrive, DifferentialDrive, PlanarState, _rz
 from sensorium.server.sim.scene import Scene, _entry, _shape_info, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import DistanceSensor, Lidar, LightSensor, PositionSensor
 from sensorium.server.sim.simulation import lights_from_models
@@ -234,8 +238,12 @@ class BatchedSimulation:
                                      else [1, 1] for r in w.robots], dtype=np.int64)
         # the terrains robots ride (sim/ground.py; None in a world without one: heights never change)
         self.ground = Ground.from_world(w, self.scene.solid_poses, None)
-        self._templates = [DifferentialDrive(r.differential_drive, self.initial[i], ground=self.ground)
-                           if r.differential_drive else None for i, r in enumerate(w.robots)]
+        self._templates: list[PlanarState | None] = [
+            DifferentialDrive(r.differential_drive, self.initial[i], ground=self.ground) if r.differential_drive
+            else AckermannDrive(r.ackermann_drive, self.initial[i], ground=self.ground) if r.ackermann_drive
+            else None for i, r in enumerate(w.robots)]
+        # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
+        self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
         # -- per copy state
         self.time_ms = np.zeros(C, dtype=np.int64)
         self._every_copy = np.arange(C)             # (step's live copies when every copy steps; never written)
@@ -259,7 +267,7 @@ class BatchedSimulation:
         # -- kinematic contact: the solids' obstacles once, the robots' discs per copy
         use_contact = w.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = None
-        if use_contact and self.has_drive.any():
+        if use_contact and (self.has_drive.any() or self.cars is not None):
             solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
@@ -286,9 +294,6 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
         for r in w.robots:
-            if r.ackermann_drive is not None:
-                raise BatchedError(f"{self.loaded.source}: robot {r.name!r} has an ackermann_drive; the batched "
-                                   "simulation drives two-wheel and skid-steer robots only (use Simulation)")
             if r.lights:
                 raise BatchedError(f"{self.loaded.source}: robot {r.name!r} carries lights; the batched simulation "
                                    "shares the lights of all copies (use Simulation)")
@@ -491,6 +496,8 @@ class BatchedSimulation:
         self.target[idx] = 0.0
         self.velocity[idx] = self.max_wheel
         self.wheel_angle[idx] = 0.0
+        if self.cars is not None:
+            self.cars.reset(idx)
         self.pressing[idx] = False
         for k in self.period:
             self.period[k][idx] = 0
@@ -526,7 +533,7 @@ class BatchedSimulation:
             self.centres[copy, slot] = pose.translation[:2]
             self.heights[copy, slot] = pose.translation[2]
 
-    def _take_template(self, idx: np.ndarray, slot: int, tpl: DifferentialDrive) -> None:
+    def _take_template(self, idx: np.ndarray, slot: int, tpl: PlanarState) -> None:
         """The copies' drive state of a slot from a template drive just reset to a pose."""
         self.x[idx, slot], self.y[idx, slot], self.z[idx, slot], self.yaw[idx, slot] = tpl.x, tpl.y, tpl.z, tpl.yaw
         self.base[idx, slot] = tpl.base
@@ -539,6 +546,9 @@ class BatchedSimulation:
         """Velocity control of a slot's wheels (rad/s, clamped to the maximum as Webots does) in the
         named copies (default: all): ``setPosition(inf)`` and ``setVelocity`` of every wheel motor of
         each side (a skid-steer robot's too)."""
+        if self.cars is not None and slot in self.cars.car_of:
+            raise ValueError(f"{self.robot_names[slot]}: a car-like robot has no left and right wheels: "
+                             "command it with cars.command(slot, right, left, wheel)")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         vmax = self.max_wheel[slot]
         left = np.asarray(left, dtype=np.float64)
@@ -590,6 +600,9 @@ class BatchedSimulation:
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:
         driven = self._driven
+        if self.cars is not None:     # car-like robots (batched_car.py): their moves join the numpy path's
+            self._drive_numpy(live, driven, dt_ms / 1000.0)
+            return
         if not len(driven):
             return
         dt = dt_ms / 1000.0
@@ -648,6 +661,9 @@ class BatchedSimulation:
         """:meth:`_drive` without the C helper (the same values)."""
         self.pressing[live] = False
         copies, slots, v, w = self._drive_wheels(live, driven, dt)
+        if self.cars is not None:     # the cars' moves too, sorted into slot order below where it matters (_narrow)
+            cars = self.cars.step(live, dt)
+            copies, slots, v, w = (np.concatenate(pair) for pair in zip((copies, slots, v, w), cars))
         if not len(copies):
             return
         x0, y0 = self.x[copies, slots], self.y[copies, slots]
@@ -843,6 +859,8 @@ class BatchedSimulation:
         wheel = self._p_wheel[cols]
         slot = self._p_slot[cols]
         v = np.where(wheel >= 0, self.wheel_angle[copies, slot, np.maximum(wheel, 0)], 0.0)
+        if self.cars is not None:     # a car's motor's encoder (its steering or a driven wheel)
+            self.cars.read_encoders(self.position, copies, cols, v)
         plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself
         for k in (~plain).nonzero()[0].tolist():
             col = int(cols[k])

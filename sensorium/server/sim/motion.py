@@ -255,6 +255,16 @@ class DifferentialDrive(PlanarState):
         return self.pose()
 
 
+def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float) -> tuple[float, float]:
+    """(right, left) front wheel angles for the bicycle model's angle ``steering_angle`` (positive:
+    right), as Webots' Driver sets them: cot δ_right = cot δ - t/2L, cot δ_left = cot δ + t/2L (the
+    client's vehicle library computes the same, sensorium/client/webots/vehicle/driver.py)."""
+    if steering_angle == 0.0:
+        return 0.0, 0.0
+    cot, half = 1.0 / math.tan(steering_angle), track_front / (2.0 * wheelbase)
+    return math.atan(1.0 / (cot - half)), math.atan(1.0 / (cot + half))
+
+
 class AckermannDrive(PlanarState):
     """A car-like robot: two steered front wheels, driven wheels at the front, the rear or both, the
     robot's origin at the centre of the rear axle (x forward, y left).
