@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import lidar as lmath
@@ -25,6 +27,11 @@ from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import from_model
 
 BOTH = ["fast", "exact"]
+
+
+def _rounded(lo: float, hi: float):
+    """Floats in [lo, hi] to 9 decimals (a world file refuses magnitudes below 1e-30 other than 0)."""
+    return st.floats(lo, hi).map(lambda v: min(max(round(v, 9), lo), hi))
 
 
 # ---------------------------------------------------------------------------------- rotating lidars
@@ -127,6 +134,21 @@ def test_rotating_lidar_hard_cases_equal_the_single_simulation_and_the_closed_fo
             assert (np.delete(img, swept, axis=1) == 0.0).all(), (k, c)
         seen_swept = max(seen_swept, len(swept))
     assert seen_swept >= 1
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@given(W=st.integers(1, 64), L=st.integers(1, 4), f=st.floats(0.05, 60.0), dt=st.sampled_from([8, 16, 32, 64]),
+       yaw=_rounded(-math.pi, math.pi), x=_rounded(-1e5 + 2.0, 1e5 - 2.0), y=_rounded(-1e5 + 2.0, 1e5 - 2.0))
+def test_any_rotating_lidar_anywhere_sweeps_as_the_single_simulation(W, L, f, dt, yaw, x, y):
+    """Property: a rotating lidar of any width and layer count turning at any frequency (a sliver of a
+    column to several turns a step) on any basic step, anywhere in the world bounds, heading anywhere:
+    after every one of 5 steps both copies' images and head angles equal the single simulation's."""
+    bs, sims = _lidar_pair([yaw, -yaw], "fast", W=W, L=L, f=f, f_max=60.0, dt=dt, origin=(x, y))
+    for k in range(5):
+        bs.step()
+        for s in sims:
+            s.step()
+        _same_lidar(bs, sims, [0, 1], k)
 
 
 def test_256_copies_reset_on_the_step_their_sector_wraps_read_as_fresh_simulations():
@@ -271,6 +293,27 @@ def test_wgs84_gps_hard_references_equal_the_single_simulation(where: str, noisy
         assert up == reference[2] and bs.value(alt)[c] == reference[2]
 
 
+@settings(max_examples=25, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@given(lat=_rounded(-89.0, 89.0), lon=_rounded(-180.0, 180.0), alt=_rounded(-500.0, 9000.0),
+       east=_rounded(-1e5, 1e5), north=_rounded(-1e5, 1e5))
+def test_a_wgs84_gps_anywhere_reads_as_the_single_simulation(lat, lon, alt, east, north):
+    """Property: any reference on Earth (short of the poles), the GPS at it and anywhere within 100 km
+    of it, noisy (0.5 m, correlated, speed noise) and quantised (1 cm): latitude, longitude, altitude, speed and speed vector equal the
+    single simulation's bit for bit (whatever the series gives so far from its zone)."""
+    reference = (lat, lon, alt)
+    bs, sims = _gps_pair(reference, 0.5, 0.01, [1, 2] + [3] * (len(OFFSETS) - 2))
+    bs.set_pose(1, 0, [east, north, 0.0])
+    sims[1].robot("bot").set_pose([east, north, 0.0])
+    gps = bs.device("bot", "gps")
+    for _ in range(2):
+        bs.step()
+        for c in (0, 1):
+            sims[c].step()
+            dev = sims[c].robot("bot").device("gps")
+            for what in ("values", "speed", "speed_vector"):
+                assert np.asarray(getattr(dev, what), dtype=np.float64).tobytes() == bs.reading(gps, what)[c].tobytes()
+
+
 def test_wgs84_gps_across_the_equator_and_the_antimeridian():
     """Closed forms at the awkward places: with a reference 1e-9° south of the equator (false northing
     10,000 km) on zone 31's central meridian (3°E, scale 0.9996), a GPS 100 m north reads latitude
@@ -367,6 +410,22 @@ def test_a_robot_meeting_a_wall_at_a_grazing_angle_slides_along_it_pressing():
     assert first == math.ceil(reach) - 1
     assert bs.pos[0, 0, 0] == pytest.approx(FACE - R, abs=1e-9)
     assert bs.pos[0, 0, 1] == pytest.approx(400 * 0.008 * math.cos(a), abs=1e-9)
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@given(a=st.floats(1e-6, 1.5), before=st.floats(0.2, 5.0))
+def test_any_grazing_angle_presses_from_contact_on_and_slides(a: float, before: float):
+    """Property: heading ``a`` rad into the wall, ``before`` steps of travel away from it (8 mm a step,
+    so 0.008·sin a·before m): the bumper reads 0 before the step that reaches the wall and 1 on every
+    step from it on, the robot slides along the face (x = 0.5 to 1e-9, never through) and keeps the
+    along-wall part of every move (y = 20·0.008·cos a after 20 steps, to 1e-9)."""
+    gap = 0.008 * math.sin(a) * before
+    bs, v = _bumper_run([(FACE - R - gap, 0.0, math.pi / 2 - a)], [(10.0, 10.0)], 20)
+    first = int(np.argmax(v[:, 0] == 1.0))
+    assert v[first, 0] == 1.0 and (v[:first, 0] == 0.0).all() and (v[first:, 0] == 1.0).all()
+    assert abs(first - before) <= 1.0
+    assert bs.pos[0, 0, 0] == pytest.approx(FACE - R, abs=1e-9) and bs.pos[0, 0, 0] <= FACE - R + 1e-9
+    assert bs.pos[0, 0, 1] == pytest.approx(20 * 0.008 * math.cos(a), abs=1e-9)
 
 
 def test_a_robot_driving_along_a_wall_it_touches_keeps_going_without_pressing():
