@@ -165,7 +165,7 @@ def test_256_copies_reset_on_the_step_their_sector_wraps_read_as_fresh_simulatio
     dev0 = sims[0].robot("bot").device("head")
     params, freq = dev0.params, dev0.frequency
     resets = {"after": 0, "before": 0}
-    for step in range(45):
+    for step in range(20):
         before = [s.robot("bot").device("head").head_angle for s in sims]
         # copies whose next sweep wraps, reset first (every 3rd copy): they start over at head 0
         wrap_next = [c for c in range(0, C, 3)
