@@ -252,8 +252,8 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
         nrm = side * ob.normal
         gap = abs(dist) - rho
         rate = float(nrm @ d)
-        if gap <= EPS:
-            return (0.0, nrm) if rate < 0.0 else (math.inf, None)
+        if gap <= EPS:       # touching: an impact when the move goes in by more than the tolerance
+            return (0.0, nrm) if rate < -EPS or gap + rate < -EPS else (math.inf, None)
         if rate >= 0.0 or gap + rate > 0.0:
             return math.inf, None
         return gap / -rate, nrm
@@ -261,7 +261,9 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
     rad = ob.radius + rho
     dist, normal = _closest_on_hull(p, pts)
     if dist - rad <= EPS:                            # touching (or overlapping) now
-        if float(normal @ d) < 0.0:
+        # an impact when the move goes in by more than the tolerance; a slide's leftover (the
+        # rounding of its projection, ~1e-19 m inward) is none: taken for one, it stalled the robot
+        if float(normal @ d) < -EPS:
             return 0.0, normal
         end_dist, _ = _closest_on_hull(p + d, pts)
         return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
