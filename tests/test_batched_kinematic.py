@@ -397,11 +397,30 @@ def test_the_envs_observe_a_wgs84_gps_alike():
     assert [e.engine for e in singles] == ["simulation", "batched"]
     obs = _reset_both(venv, singles, 2)
     assert (np.abs(obs["gps"][:, :2] - [46.5, 6.6]) < 1e-4).all()
-    assert venv.single_observation_space["gps"].low[:2].tolist() == [-90.0, -180.0]
+    assert venv.single_observation_space["gps"].low[:2].tolist() == [-90.0, -360.0]
     rng = np.random.default_rng(8)
     done = np.zeros(n, dtype=bool)
     ended = 0
     for t in range(40):
         ended += _step_both(venv, singles, rng.uniform(-1, 1, (n, 2)).astype(np.float32), done, t)[0]
     assert ended >= n
+    venv.close()
+
+
+def test_a_wgs84_longitude_past_the_antimeridian_is_observed_as_read():
+    """East of the antimeridian a WGS84 GPS reads longitudes past 180 (unwrapped, as in Webots): the
+    observation keeps them (its box allows +-360), the same in both envs -- clipped to 180, a robot
+    there would silently read the meridian."""
+    lw = load_world(WORLD)
+    w = lw.world
+    moved = [r.model_copy(update={"pose": r.pose.model_copy(update={"translation": (
+        r.pose.translation[0] + 200.0, *r.pose.translation[1:])})}) for r in w.robots]   # 200 m east
+    wgs = LoadedWorld(world=w.model_copy(update={"robots": moved, "world_info": w.world_info.model_copy(
+        update={"gps_coordinate_system": "WGS84", "gps_reference": (10.0, 179.999, 0.0)})}),
+        source=lw.source, base_dir=lw.base_dir)
+    venv = SensoriumVectorEnv(wgs, _task(), 1)
+    single = SensoriumEnv(wgs, _task())
+    obs = _reset_both(venv, [single], 1)
+    lon = float(obs["gps"][0, 1])
+    assert 180.0005 < lon < 180.003      # 200 m east at 10 deg N: ~0.00183 deg past 179.999
     venv.close()

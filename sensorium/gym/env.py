@@ -310,7 +310,8 @@ def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
         ref = np.asarray(world_info.gps_reference, dtype=np.float64)
         low, high = ref - MAX_COORDINATE_M, ref + MAX_COORDINATE_M
         if world_info.gps_coordinate_system == "WGS84":          # latitude, longitude (degrees), altitude
-            low[:2], high[:2] = (-90.0, -180.0), (90.0, 180.0)
+            # longitudes are not wrapped (as in Webots): east of the antimeridian they pass 180
+            low[:2], high[:2] = (-90.0, -360.0), (90.0, 360.0)
         return spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
     if cfg.device == "InertialUnit":            # roll, pitch, yaw (rad)
         half = np.float32(math.pi / 2)
