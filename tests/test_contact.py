@@ -259,12 +259,14 @@ def _same(got, want) -> bool:
 
 def _moves_near(rng, ob: C.Obstacle, rho: float, count: int):
     """Moves aimed at the obstacle's grown boundary: random ones, grazing a vertex circle at
-    radius (1 + delta), and ending on (or a hair before or past) a vertex circle or an offset edge."""
+    radius (1 + delta), ending on (or a hair before or past) a vertex circle or an offset edge,
+    and starting there (within a few EPS: touching or not)."""
     rad = ob.radius + rho
     pts = ob.points
     deltas = (0.0, 1e-16, -1e-16, 1e-13, -1e-13, 1e-10, -1e-10, 1e-7, -1e-7, 1e-5, -1e-5)
+    offsets = (0.0, 5e-10, -5e-10, 1e-9, -1e-9, 1.5e-9, -1.5e-9, 3e-9, 1e-8)
     for _ in range(count):
-        kind = rng.integers(4)
+        kind = rng.integers(6)
         u = rng.normal(size=2)
         u /= np.hypot(*u)
         length = 10.0 ** rng.uniform(-4, 0.5)
@@ -280,6 +282,18 @@ def _moves_near(rng, ob: C.Obstacle, rho: float, count: int):
             t_end = rng.choice([1.0, 1.0 - 1e-12, 1.0 + 1e-12, 0.5, 2.0])
             p = closest - t_end * length * u
             yield p, u * length
+            continue
+        if kind >= 4:       # starting on the grown boundary, give or take a few EPS
+            w = rng.normal(size=2)
+            w /= np.hypot(*w)
+            start = c + (rad + offsets[rng.integers(len(offsets))]) * w
+            if kind == 5 and len(pts) >= 2:     # on an offset edge instead
+                i = rng.integers(len(pts))
+                a, b = pts[i], pts[(i + 1) % len(pts)]
+                e = b - a
+                out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
+                start = a + rng.uniform(0.0, 1.0) * e + (rad + offsets[rng.integers(len(offsets))]) * out
+            yield start, u * length
             continue
         if kind == 2:       # ending on a vertex circle (a hair before or past it)
             w = rng.normal(size=2)
@@ -299,7 +313,7 @@ def _moves_near(rng, ob: C.Obstacle, rho: float, count: int):
 @pytest.mark.parametrize("seed", range(6))
 def test_time_of_impact_skips_give_the_exhaustive_answer_bit_for_bit(seed):
     rng = np.random.default_rng(seed)
-    finite = skipped_any = 0
+    finite = skipped_any = touching = clear = 0
     for _ in range(60):
         n = int(rng.integers(1, 14))
         scale = 10.0 ** rng.uniform(-2, 1)
@@ -312,10 +326,12 @@ def test_time_of_impact_skips_give_the_exhaustive_answer_bit_for_bit(seed):
             want = _reference_toi(p, d, ob, rho)
             assert _same(got, want), (pts.tolist(), ob.radius, rho, p.tolist(), d.tolist(), got, want)
             finite += math.isfinite(want[0])
+            touching += C._closest_on_hull(p, pts)[0] - (ob.radius + rho) <= C.EPS
+            clear += C._clear_of(float(p[0]), float(p[1]), C._hull_data(ob, ob.radius + rho)[1])
             rad = ob.radius + rho
             skipped_any += any(C._circle_beyond(float(p[0] - x), float(p[1] - y), float(d[0]), float(d[1]),
                                                 float(d @ d), rad) for x, y in pts.tolist())
-    assert finite > 1000 and skipped_any > 1000   # both outcomes, many times: the skips were exercised
+    assert finite > 1000 and skipped_any > 1000 and touching > 300 and clear > 1000   # every outcome, many times
 
 
 def test_time_of_impact_keeps_its_answers_through_a_solid_s_cached_edges():

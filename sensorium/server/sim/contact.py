@@ -63,6 +63,9 @@ class Obstacle:
         if self.normal is not None:
             self.lo = np.full(2, -math.inf)
             self.hi = np.full(2, math.inf)
+        elif len(self.points) == 1:     # one point (a robot's disc, a pillar): it is its min and max
+            self.lo = self.points[0] - self.radius
+            self.hi = self.points[0] + self.radius
         else:
             self.lo = self.points.min(axis=0) - self.radius
             self.hi = self.points.max(axis=0) + self.radius
@@ -267,12 +270,13 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
     rad = ob.radius + rho
     v, edges = _hull_data(ob, rad)
     px, py = float(p[0]), float(p[1])
-    dist, normal = _closest_on_list(px, py, v)
-    if dist - rad <= EPS:                            # touching (or overlapping) now
-        if float(normal @ d) < 0.0:
-            return 0.0, normal
-        end_dist, _ = _closest_on_hull(p + d, pts)
-        return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
+    if not _clear_of(px, py, edges):                 # (clear: not touching, the distance not needed)
+        dist, normal = _closest_on_list(px, py, v)
+        if dist - rad <= EPS:                        # touching (or overlapping) now
+            if float(normal @ d) < 0.0:
+                return 0.0, normal
+            end_dist, _ = _closest_on_hull(p + d, pts)
+            return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
     best: float = math.inf
     best_n: np.ndarray | None = None
     dx, dy = float(d[0]), float(d[1])
@@ -318,6 +322,19 @@ def _hull_data(ob: Obstacle, rad: float) -> tuple[list, list]:
                 edges.append((A, B, out, float(A[0]), float(A[1]), float(out[0]), float(out[1])))
         got = ob.grown[rad] = (pts.tolist(), edges)
     return got
+
+
+def _clear_of(px: float, py: float, edges: list) -> bool:
+    """Whether (px, py) is certainly more than EPS outside the hull grown by its radius, whose
+    offset edges (:func:`_hull_data`, counter-clockwise) are ``edges``: outside an offset edge's
+    line by more than EPS plus 1e-9 of the coordinates (far above their rounding). The distance to
+    a convex hull is at least the distance to any of its edges' lines (a segment's two sides: its
+    line), so _closest_on_list would find it not touching. No edges (a point): False."""
+    for _, _, _, ax, ay, ox, oy in edges:
+        wx, wy = px - ax, py - ay
+        if wx * ox + wy * oy > EPS + 1e-9 * (1.0 + abs(ax) + abs(ay) + abs(wx) + abs(wy)):
+            return True
+    return False
 
 
 def _circle_beyond(fx: float, fy: float, dx: float, dy: float, a: float, rad: float) -> bool:
