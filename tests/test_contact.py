@@ -313,7 +313,7 @@ def _moves_near(rng, ob: C.Obstacle, rho: float, count: int):
 @pytest.mark.parametrize("seed", range(6))
 def test_time_of_impact_skips_give_the_exhaustive_answer_bit_for_bit(seed):
     rng = np.random.default_rng(seed)
-    finite = skipped_any = touching = clear = 0
+    finite = skipped_any = touching = clear = swept = 0
     for _ in range(60):
         n = int(rng.integers(1, 14))
         scale = 10.0 ** rng.uniform(-2, 1)
@@ -326,12 +326,15 @@ def test_time_of_impact_skips_give_the_exhaustive_answer_bit_for_bit(seed):
             want = _reference_toi(p, d, ob, rho)
             assert _same(got, want), (pts.tolist(), ob.radius, rho, p.tolist(), d.tolist(), got, want)
             finite += math.isfinite(want[0])
-            touching += C._closest_on_hull(p, pts)[0] - (ob.radius + rho) <= C.EPS
-            clear += C._clear_of(float(p[0]), float(p[1]), C._hull_data(ob, ob.radius + rho)[1])
             rad = ob.radius + rho
+            touching += C._closest_on_hull(p, pts)[0] - (ob.radius + rho) <= C.EPS
+            got_clear = C._clear_of(float(p[0]), float(p[1]), float(d[0]), float(d[1]), C._hull_data(ob, rad)[1])
+            clear += got_clear == 1
+            swept += got_clear == C._SWEPT_CLEAR
             skipped_any += any(C._circle_beyond(float(p[0] - x), float(p[1] - y), float(d[0]), float(d[1]),
                                                 float(d @ d), rad) for x, y in pts.tolist())
-    assert finite > 1000 and skipped_any > 1000 and touching > 300 and clear > 1000   # every outcome, many times
+    # every outcome, many times
+    assert finite > 1000 and skipped_any > 1000 and touching > 300 and clear > 300 and swept > 300
 
 
 def test_time_of_impact_keeps_its_answers_through_a_solid_s_cached_edges():

@@ -270,7 +270,11 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
     rad = ob.radius + rho
     v, edges = _hull_data(ob, rad)
     px, py = float(p[0]), float(p[1])
-    if not _clear_of(px, py, edges):                 # (clear: not touching, the distance not needed)
+    dx, dy = float(d[0]), float(d[1])
+    clear = _clear_of(px, py, dx, dy, edges)
+    if clear == _SWEPT_CLEAR:
+        return math.inf, None
+    if not clear:                                    # (clear: not touching, the distance not needed)
         dist, normal = _closest_on_list(px, py, v)
         if dist - rad <= EPS:                        # touching (or overlapping) now
             if float(normal @ d) < 0.0:
@@ -279,7 +283,6 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
             return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
     best: float = math.inf
     best_n: np.ndarray | None = None
-    dx, dy = float(d[0]), float(d[1])
     a = float(d @ d)
     # Each vertex circle and offset edge whose answer is certainly inf or beyond the move (s > 1:
     # never the answer) is skipped on a float test with margins far above its rounding (see
@@ -324,17 +327,30 @@ def _hull_data(ob: Obstacle, rad: float) -> tuple[list, list]:
     return got
 
 
-def _clear_of(px: float, py: float, edges: list) -> bool:
-    """Whether (px, py) is certainly more than EPS outside the hull grown by its radius, whose
-    offset edges (:func:`_hull_data`, counter-clockwise) are ``edges``: outside an offset edge's
-    line by more than EPS plus 1e-9 of the coordinates (far above their rounding). The distance to
-    a convex hull is at least the distance to any of its edges' lines (a segment's two sides: its
-    line), so _closest_on_list would find it not touching. No edges (a point): False."""
+_SWEPT_CLEAR = 2
+
+
+def _clear_of(px: float, py: float, dx: float, dy: float, edges: list) -> int:
+    """How certainly the move from (px, py) by (dx, dy) keeps clear of the hull grown by its
+    radius, whose offset edges (:func:`_hull_data`, counter-clockwise) are ``edges``. 1: the start
+    is more than EPS outside an offset edge's line, plus 1e-9 of the coordinates (far above their
+    rounding) -- the distance to a convex hull is at least the distance to any of its edges' lines
+    (a segment's two sides: its line), so _closest_on_list would find it not touching.
+    _SWEPT_CLEAR: the start and the end are both outside one offset edge's line by 1e-6 (1 + the
+    coordinates' differences): the grown hull (its vertex circles, its offset edges) lies inside
+    that line's half-plane, so the whole move stays farther than that from every feature, and the
+    exact tests, whose rounding is ~3e-8 of those lengths at worst (a graze), answer inf or s > 1:
+    no impact. 0: neither (no edges, a point: 0)."""
+    clear = 0
     for _, _, _, ax, ay, ox, oy in edges:
         wx, wy = px - ax, py - ay
-        if wx * ox + wy * oy > EPS + 1e-9 * (1.0 + abs(ax) + abs(ay) + abs(wx) + abs(wy)):
-            return True
-    return False
+        side = wx * ox + wy * oy
+        if side > EPS + 1e-9 * (1.0 + abs(ax) + abs(ay) + abs(wx) + abs(wy)):
+            clear = 1
+            m = 1e-6 * (1.0 + abs(wx) + abs(wy) + abs(dx) + abs(dy))
+            if side > m and side + (dx * ox + dy * oy) > m:
+                return _SWEPT_CLEAR
+    return clear
 
 
 def _circle_beyond(fx: float, fy: float, dx: float, dy: float, a: float, rad: float) -> bool:
