@@ -320,7 +320,7 @@ def test_time_of_impact_skips_give_the_exhaustive_answer_bit_for_bit(seed):
         centre = rng.uniform(-1, 1, size=2) * (1000.0 if rng.random() < 0.2 else 1.0)
         pts = C._hull(centre + rng.normal(size=(n, 2)) * scale)
         ob = C.Obstacle("ob", -1, pts, float(rng.choice([0.0, rng.uniform(0.0, 0.3)])), (0.0, 1.0))
-        rho = float(rng.uniform(0.005, 0.5))
+        rho = float(rng.uniform(0.005, 0.5) if rng.random() < 0.85 else rng.uniform(5.0, 100.0))   # (a few huge robots)
         for p, d in _moves_near(rng, ob, rho, 120):
             got = C.time_of_impact(p, d, ob, rho)
             want = _reference_toi(p, d, ob, rho)
@@ -328,7 +328,7 @@ def test_time_of_impact_skips_give_the_exhaustive_answer_bit_for_bit(seed):
             finite += math.isfinite(want[0])
             rad = ob.radius + rho
             touching += C._closest_on_hull(p, pts)[0] - (ob.radius + rho) <= C.EPS
-            got_clear = C._clear_of(float(p[0]), float(p[1]), float(d[0]), float(d[1]), C._hull_data(ob, rad)[1])
+            got_clear = C._clear_of(float(p[0]), float(p[1]), float(d[0]), float(d[1]), rad, C._hull_data(ob, rad)[1])
             clear += got_clear == 1
             swept += got_clear == C._SWEPT_CLEAR
             skipped_any += any(C._circle_beyond(float(p[0] - x), float(p[1] - y), float(d[0]), float(d[1]),

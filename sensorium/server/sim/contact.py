@@ -15,7 +15,9 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   (poses are only observed at the end of steps, and the end point is the exact arc end unless
   contact clips it). The chord is tested against every obstacle near it (an AABB broad phase)
   in closed form — segment vs. offset edges and vertex circles of ``obstacle ⊕ disc(R)`` — so a
-  fast robot at a grazing angle cannot tunnel, whatever the step length.
+  fast robot at a grazing angle cannot tunnel, whatever the step length. Features the chord
+  certainly cannot reach (plain float screens, margins far above the tests' rounding) are not
+  tested: the answer of testing them all, bit for bit.
 
 On contact the robot stops at the contact point and the rest of its displacement is projected on
 the contact's tangent (slide), up to three times per step (corners). A robot pushed straight into
@@ -271,7 +273,7 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
     v, edges = _hull_data(ob, rad)
     px, py = float(p[0]), float(p[1])
     dx, dy = float(d[0]), float(d[1])
-    clear = _clear_of(px, py, dx, dy, edges)
+    clear = _clear_of(px, py, dx, dy, rad, edges)
     if clear == _SWEPT_CLEAR:
         return math.inf, None
     if not clear:                                    # (clear: not touching, the distance not needed)
@@ -330,14 +332,14 @@ def _hull_data(ob: Obstacle, rad: float) -> tuple[list, list]:
 _SWEPT_CLEAR = 2
 
 
-def _clear_of(px: float, py: float, dx: float, dy: float, edges: list) -> int:
-    """How certainly the move from (px, py) by (dx, dy) keeps clear of the hull grown by its
-    radius, whose offset edges (:func:`_hull_data`, counter-clockwise) are ``edges``. 1: the start
+def _clear_of(px: float, py: float, dx: float, dy: float, rad: float, edges: list) -> int:
+    """How certainly the move from (px, py) by (dx, dy) keeps clear of the hull grown by ``rad``,
+    whose offset edges (:func:`_hull_data`, counter-clockwise) are ``edges``. 1: the start
     is more than EPS outside an offset edge's line, plus 1e-9 of the coordinates (far above their
     rounding) -- the distance to a convex hull is at least the distance to any of its edges' lines
     (a segment's two sides: its line), so _closest_on_list would find it not touching.
-    _SWEPT_CLEAR: the start and the end are both outside one offset edge's line by 1e-6 (1 + the
-    coordinates' differences): the grown hull (its vertex circles, its offset edges) lies inside
+    _SWEPT_CLEAR: the start and the end are both outside one offset edge's line by 1e-6 (1 + rad
+    + the coordinates' differences): the grown hull (its vertex circles, its offset edges) lies inside
     that line's half-plane, so the whole move stays farther than that from every feature, and the
     exact tests, whose rounding is ~3e-8 of those lengths at worst (a graze), answer inf or s > 1:
     no impact. 0: neither (no edges, a point: 0)."""
@@ -347,7 +349,7 @@ def _clear_of(px: float, py: float, dx: float, dy: float, edges: list) -> int:
         side = wx * ox + wy * oy
         if side > EPS + 1e-9 * (1.0 + abs(ax) + abs(ay) + abs(wx) + abs(wy)):
             clear = 1
-            m = 1e-6 * (1.0 + abs(wx) + abs(wy) + abs(dx) + abs(dy))
+            m = 1e-6 * (1.0 + rad + abs(wx) + abs(wy) + abs(dx) + abs(dy))
             if side > m and side + (dx * ox + dy * oy) > m:
                 return _SWEPT_CLEAR
     return clear
