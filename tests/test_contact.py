@@ -214,3 +214,134 @@ def test_random_crowds_never_penetrate(seed):
             for j in range(i + 1, len(robots)):
                 assert np.hypot(*(pos[i] - pos[j])) >= robots[i][1] + robots[j][1] - 1e-9
     assert sim.counters["contacts"] > 0
+
+
+# ---------------------------------------------------------------------- time_of_impact's skips
+# The hull path skips vertex circles and offset edges whose answer is certainly inf or beyond the
+# move (s > 1) on float tests with margins (contact._circle_beyond, _edge_beyond) and keeps each
+# obstacle's offset edges (_hull_data). _reference_toi is the path as it was before: every feature
+# tested with numpy, every call; both must give the same (s, normal), bit for bit.
+
+def _reference_toi(p, d, ob, rho):
+    pts = ob.points
+    rad = ob.radius + rho
+    dist, normal = C._closest_on_hull(p, pts)
+    if dist - rad <= C.EPS:                  # touching: an impact when the move goes in by more than EPS
+        if float(normal @ d) < -C.EPS:
+            return 0.0, normal
+        end_dist, _ = C._closest_on_hull(p + d, pts)
+        return (0.0, normal) if end_dist - rad < -C.EPS else (math.inf, None)
+    best, best_n = math.inf, None
+    n = len(pts)
+    for i in range(n):
+        s = C._ray_circle(p, d, pts[i], rad)
+        if s < best:
+            best, best_n = s, (p + s * d - pts[i]) / rad
+    if n >= 2:
+        for i in range(n):
+            a, b = pts[i], pts[(i + 1) % n]
+            e = b - a
+            out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
+            s = C._ray_segment(p, d, a + rad * out, b + rad * out, out)
+            if s < best:
+                best, best_n = s, out
+    if best > 1.0:
+        return math.inf, None
+    return best, best_n
+
+
+def _same(got, want) -> bool:
+    (s1, n1), (s2, n2) = got, want
+    if np.float64(s1).tobytes() != np.float64(s2).tobytes():
+        return False
+    return (n1 is None and n2 is None) or (n1 is not None and n2 is not None and n1.tobytes() == n2.tobytes())
+
+
+def _moves_near(rng, ob: C.Obstacle, rho: float, count: int):
+    """Moves aimed at the obstacle's grown boundary: random ones, grazing a vertex circle at
+    radius (1 + delta), ending on (or a hair before or past) a vertex circle or an offset edge,
+    and starting there (within a few EPS: touching or not)."""
+    rad = ob.radius + rho
+    pts = ob.points
+    deltas = (0.0, 1e-16, -1e-16, 1e-13, -1e-13, 1e-10, -1e-10, 1e-7, -1e-7, 1e-5, -1e-5)
+    offsets = (0.0, 5e-10, -5e-10, 1e-9, -1e-9, 1.5e-9, -1.5e-9, 3e-9, 1e-8)
+    for _ in range(count):
+        kind = rng.integers(6)
+        u = rng.normal(size=2)
+        u /= np.hypot(*u)
+        length = 10.0 ** rng.uniform(-4, 0.5)
+        if kind == 0:       # anywhere around
+            p = pts.mean(axis=0) + rng.uniform(-3, 3, size=2)
+            yield p, u * length
+            continue
+        c = pts[rng.integers(len(pts))]
+        if kind == 1:       # a line passing at rad (1 + delta) from a vertex, its closest point near the end
+            side = np.array([-u[1], u[0]])
+            h = rad * (1.0 + deltas[rng.integers(len(deltas))])
+            closest = c + h * side
+            t_end = rng.choice([1.0, 1.0 - 1e-12, 1.0 + 1e-12, 0.5, 2.0])
+            p = closest - t_end * length * u
+            yield p, u * length
+            continue
+        if kind >= 4:       # starting on the grown boundary, give or take a few EPS
+            w = rng.normal(size=2)
+            w /= np.hypot(*w)
+            start = c + (rad + offsets[rng.integers(len(offsets))]) * w
+            if kind == 5 and len(pts) >= 2:     # on an offset edge instead
+                i = rng.integers(len(pts))
+                a, b = pts[i], pts[(i + 1) % len(pts)]
+                e = b - a
+                out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
+                start = a + rng.uniform(0.0, 1.0) * e + (rad + offsets[rng.integers(len(offsets))]) * out
+            yield start, u * length
+            continue
+        if kind == 2:       # ending on a vertex circle (a hair before or past it)
+            w = rng.normal(size=2)
+            q = c + rad * (1.0 + deltas[rng.integers(len(deltas))]) * w / np.hypot(*w)
+        else:               # ending on an offset edge
+            if len(pts) < 2:
+                continue
+            i = rng.integers(len(pts))
+            a, b = pts[i], pts[(i + 1) % len(pts)]
+            e = b - a
+            out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
+            q = a + rng.uniform(-0.01, 1.01) * e + rad * (1.0 + deltas[rng.integers(len(deltas))]) * out
+        p = q - u * length
+        yield p, u * length
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_time_of_impact_skips_give_the_exhaustive_answer_bit_for_bit(seed):
+    rng = np.random.default_rng(seed)
+    finite = skipped_any = touching = clear = swept = 0
+    for _ in range(60):
+        n = int(rng.integers(1, 14))
+        scale = 10.0 ** rng.uniform(-2, 1)
+        centre = rng.uniform(-1, 1, size=2) * (1000.0 if rng.random() < 0.2 else 1.0)
+        pts = C._hull(centre + rng.normal(size=(n, 2)) * scale)
+        ob = C.Obstacle("ob", -1, pts, float(rng.choice([0.0, rng.uniform(0.0, 0.3)])), (0.0, 1.0))
+        rho = float(rng.uniform(0.005, 0.5) if rng.random() < 0.85 else rng.uniform(5.0, 100.0))   # (a few huge robots)
+        for p, d in _moves_near(rng, ob, rho, 120):
+            got = C.time_of_impact(p, d, ob, rho)
+            want = _reference_toi(p, d, ob, rho)
+            assert _same(got, want), (pts.tolist(), ob.radius, rho, p.tolist(), d.tolist(), got, want)
+            finite += math.isfinite(want[0])
+            rad = ob.radius + rho
+            touching += C._closest_on_hull(p, pts)[0] - (ob.radius + rho) <= C.EPS
+            got_clear = C._clear_of(float(p[0]), float(p[1]), float(d[0]), float(d[1]), rad, C._hull_data(ob, rad)[1])
+            clear += got_clear == 1
+            swept += got_clear == C._SWEPT_CLEAR
+            skipped_any += any(C._circle_beyond(float(p[0] - x), float(p[1] - y), float(d[0]), float(d[1]),
+                                                float(d @ d), rad) for x, y in pts.tolist())
+    # every outcome, many times
+    assert finite > 1000 and skipped_any > 1000 and touching > 300 and clear > 300 and swept > 300
+
+
+def test_time_of_impact_keeps_its_answers_through_a_solid_s_cached_edges():
+    box = C.obstacle("box", -1, geo.Box((2.0, 2.0, 1.0)), Pose.identity())
+    first = C.time_of_impact(np.array([3.0, 0.3]), np.array([-4.0, 0.0]), box, 0.5)
+    again = C.time_of_impact(np.array([3.0, 0.3]), np.array([-4.0, 0.0]), box, 0.5)
+    assert first[0] == again[0] == pytest.approx(0.375) and np.array_equal(first[1], [1.0, 0.0])
+    first[1][0] = 7.0                       # the caller's normal is its own: the cached edge is unchanged
+    assert np.array_equal(C.time_of_impact(np.array([3.0, 0.3]), np.array([-4.0, 0.0]), box, 0.5)[1], [1.0, 0.0])
+    assert list(box.grown) == [0.5]         # one entry per grown radius

@@ -227,3 +227,50 @@ def test_without_the_packet_helper_the_batched_cast_answers_as_the_lean_path(mon
     assert off.rays.counters["lean_casts"] == 0 and off.rays.counters["mover_pairs"] > 0
     _same(lean, plain)
     assert plain.distance.reshape(n, W)[:, 0] == pytest.approx(L - R_EPUCK, abs=2e-4)
+
+
+@pytest.mark.parametrize("rows_given", [True, False])
+@pytest.mark.parametrize("distance_only", [True, False])
+def test_rays_from_many_origins_aimed_at_a_curved_shell_answer_as_the_general_path(rows_given, distance_only):
+    """A few rays per origin (an e-puck's 3 per sensor: more than a quarter as many origins as rays)
+    or no origin rows at all, aimed at the arena's sphere (radius 0.12 m at (-0.8, 0.9, 0.12)) from
+    around it, none within reach of it: the call screens every origin against the shells itself and
+    answers (the general path runs its pre-pass over every ray and finds nothing); the same bits,
+    the sphere's true surface where a ray meets it. One origin inside the sphere: the general path."""
+    bs, _ = _copies(4)
+    rng = np.random.default_rng(7)
+    centre = np.array([-0.8, 0.9, 0.12])
+    k = 300                                        # origins, 0.2-0.6 m from the sphere's centre
+    ang = rng.uniform(0.0, 2.0 * math.pi, k)
+    dist = rng.uniform(0.2, 0.6, k)
+    rows = centre + np.stack([dist * np.cos(ang), dist * np.sin(ang), rng.uniform(-0.05, 0.05, k)], axis=1)
+    spread = np.array([-0.2, 0.0, 0.2])            # three rays per origin about the direction to the centre
+    toward = np.arctan2(centre[1] - rows[:, 1], centre[0] - rows[:, 0])
+    a = (toward[:, None] + spread[None, :]).reshape(-1)
+    D = np.stack([np.cos(a), np.sin(a), np.zeros(len(a))], axis=1)
+    O = np.repeat(rows, 3, axis=0)
+    copy = np.repeat(np.arange(k) % 4, 3)
+    kw = {"origin_rows": rows, "run": 3} if rows_given else {}
+    lean, general = _both(bs, O, D, 0.0, 1.5, RayKind.BOUNDING, copy, bs.rot, bs.pos, -1, -1, False, distance_only, **kw)
+    _same(lean, general)
+    # the middle ray of each origin heads for the centre: it meets the true sphere 0.12 m short of it
+    gap = np.linalg.norm((rows - centre)[:, :2], axis=1)
+    hit = np.hypot(gap, (rows - centre)[:, 2])
+    mid = lean.distance[1::3]
+    straight = np.abs((rows - centre)[:, 2]) < 1e-9
+    assert np.isfinite(mid).all() and (mid <= hit - 0.11).all()
+    assert np.count_nonzero(straight) == 0 or np.allclose(mid[straight], hit[straight] - 0.12, atol=1e-9)
+    # an origin inside the sphere (0.115 m from its centre): the general path answers (its pre-pass)
+    rows2 = rows.copy()
+    rows2[5] = centre + np.array([0.115, 0.0, 0.0])
+    O2 = np.repeat(rows2, 3, axis=0)
+    kw2 = {"origin_rows": rows2, "run": 3} if rows_given else {}
+    before = bs.rays.counters["lean_casts"]
+    got = bs.rays.cast(O2, D, 0.0, 1.5, RayKind.BOUNDING, copy, bs.rot, bs.pos, -1, -1, False, distance_only, **kw2)
+    assert bs.rays.counters["lean_casts"] == before
+    bs.rays.lean = False
+    try:
+        _same(got, bs.rays.cast(O2, D, 0.0, 1.5, RayKind.BOUNDING, copy, bs.rot, bs.pos, -1, -1, False, distance_only,
+                                **kw2))
+    finally:
+        bs.rays.lean = True

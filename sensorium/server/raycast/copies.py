@@ -334,8 +334,6 @@ class CopyRays:
             rows = np.ascontiguousarray(origin_rows, dtype=np.float64)
             if rows.ndim != 2 or rows.shape[1] != 3 or not len(rows):
                 return None
-        if curved is not None and (rows is None or 4 * len(rows) > n):
-            return None    # (the pre-pass must be ruled out by the origins' rows, in the call)
         if plane is None:
             J.plane = 0
         else:

@@ -767,16 +767,19 @@ class BatchedSimulation:
         # later ones where they started)
         hot_copy = np.zeros(self.copies, dtype=bool)
         hot_copy[copies[near]] = True
-        hot = hot_copy[copies]
-        cold = ~hot
-        # (every move's end worked out, element by element the cold ones' values, then those kept)
+        hot = hot_copy[copies].nonzero()[0]
+        # every move's end as the cold ones end (element by element), written for all moves at once;
+        # the hot ones' centres as they were kept aside (a robot not yet resolved is where it started)
+        # and each overwritten when its turn comes
         moved = starts + (ends - starts)
         if footless.any():
             moved = np.where(footless[:, None], ends, moved)
-        self.centres[copies[cold], slots[cold]] = moved[cold]
-        order = hot.nonzero()[0]
-        for m in order[np.argsort(slots[order], kind="stable")].tolist():
+        hot_list = hot.tolist()
+        waiting = {(int(copies[m]), int(slots[m])): self.centres[copies[m], slots[m]].copy() for m in hot_list}
+        self.centres[copies, slots] = moved
+        for m in (hot[np.argsort(slots[hot], kind="stable")].tolist() if len(hot_list) > 1 else hot_list):
             cm, r = int(copies[m]), int(slots[m])
+            del waiting[cm, r]
             if footless[m]:
                 self.centres[cm, r] = ends[m]
                 continue
@@ -790,7 +793,8 @@ class BatchedSimulation:
                      if solid_hit is not None else [])
             if robot_hit is not None:
                 for j in robot_hit[m].nonzero()[0].tolist():
-                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[cm, j][None, :].copy(),
+                    at = waiting.get((cm, j))
+                    cands.append(Obstacle(f"robot {j}", int(j), (self.centres[cm, j] if at is None else at)[None, :].copy(),
                                           float(self.foot_radius[j]),
                                           (float(self.heights[cm, j] + self.foot_low[j]),
                                            float(self.heights[cm, j] + self.foot_high[j]))))

@@ -15,7 +15,9 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   (poses are only observed at the end of steps, and the end point is the exact arc end unless
   contact clips it). The chord is tested against every obstacle near it (an AABB broad phase)
   in closed form — segment vs. offset edges and vertex circles of ``obstacle ⊕ disc(R)`` — so a
-  fast robot at a grazing angle cannot tunnel, whatever the step length.
+  fast robot at a grazing angle cannot tunnel, whatever the step length. Features the chord
+  certainly cannot reach (plain float screens, margins far above the tests' rounding) are not
+  tested: the answer of testing them all, bit for bit.
 
 On contact the robot stops at the contact point and the rest of its displacement is projected on
 the contact's tangent (slide), up to three times per step (corners). A robot pushed straight into
@@ -56,11 +58,16 @@ class Obstacle:
     sphere: bool = False                    # a sphere: its section depends on the height band
     lo: np.ndarray = field(default_factory=lambda: np.zeros(2))
     hi: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    # per grown radius: the vertices as floats and the edges offset by it (_hull_data; points never change)
+    grown: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.normal is not None:
             self.lo = np.full(2, -math.inf)
             self.hi = np.full(2, math.inf)
+        elif len(self.points) == 1:     # one point (a robot's disc, a pillar): it is its min and max
+            self.lo = self.points[0] - self.radius
+            self.hi = self.points[0] + self.radius
         else:
             self.lo = self.points.min(axis=0) - self.radius
             self.hi = self.points.max(axis=0) + self.radius
@@ -182,8 +189,11 @@ def sphere_radius_in_band(center_z: float, radius: float, low: float, high: floa
 def _closest_on_hull(p: np.ndarray, pts: np.ndarray) -> tuple[float, np.ndarray]:
     """Signed distance from ``p`` to the convex hull ``pts`` (negative inside) and the outward
     unit normal at the closest feature. Scalar float64 arithmetic: hulls have a few vertices."""
-    px, py = float(p[0]), float(p[1])
-    v = pts.tolist()
+    return _closest_on_list(float(p[0]), float(p[1]), pts.tolist())
+
+
+def _closest_on_list(px: float, py: float, v: list) -> tuple[float, np.ndarray]:
+    """:func:`_closest_on_hull` of the point (px, py) and the hull's vertices as a list of [x, y]."""
     n = len(v)
     if n == 1:
         dx, dy = px - v[0][0], py - v[0][1]
@@ -215,10 +225,11 @@ def _closest_on_hull(p: np.ndarray, pts: np.ndarray) -> tuple[float, np.ndarray]
     return best, np.array(best_n)
 
 
-def _ray_circle(p: np.ndarray, d: np.ndarray, c: np.ndarray, rho: float) -> float:
-    """First s >= 0 where p + s·d enters the circle (c, rho); inf if never."""
+def _ray_circle(p: np.ndarray, d: np.ndarray, c: np.ndarray, rho: float, a: float | None = None) -> float:
+    """First s >= 0 where p + s·d enters the circle (c, rho); inf if never (``a``: d @ d when known)."""
     f = p - c
-    a = float(d @ d)
+    if a is None:
+        a = float(d @ d)
     b = float(f @ d)
     cc = float(f @ f) - rho * rho
     if a == 0.0 or b >= 0.0:
@@ -259,32 +270,125 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
         return gap / -rate, nrm
     pts = ob.points
     rad = ob.radius + rho
-    dist, normal = _closest_on_hull(p, pts)
-    if dist - rad <= EPS:                            # touching (or overlapping) now
-        # an impact when the move goes in by more than the tolerance; a slide's leftover (the
-        # rounding of its projection, ~1e-19 m inward) is none: taken for one, it stalled the robot
-        if float(normal @ d) < -EPS:
-            return 0.0, normal
-        end_dist, _ = _closest_on_hull(p + d, pts)
-        return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
+    v, edges = _hull_data(ob, rad)
+    px, py = float(p[0]), float(p[1])
+    dx, dy = float(d[0]), float(d[1])
+    clear = _clear_of(px, py, dx, dy, rad, edges)
+    if clear == _SWEPT_CLEAR:
+        return math.inf, None
+    if not clear:                                    # (clear: not touching, the distance not needed)
+        dist, normal = _closest_on_list(px, py, v)
+        if dist - rad <= EPS:                        # touching (or overlapping) now
+            # an impact when the move goes in by more than the tolerance; a slide's leftover (the
+            # rounding of its projection, ~1e-19 m inward) is none: taken for one, it stalled the robot
+            if float(normal @ d) < -EPS:
+                return 0.0, normal
+            end_dist, _ = _closest_on_hull(p + d, pts)
+            return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
     best: float = math.inf
     best_n: np.ndarray | None = None
-    n = len(pts)
-    for i in range(n):
-        s = _ray_circle(p, d, pts[i], rad)
-        if s < best:
-            best, best_n = s, (p + s * d - pts[i]) / rad
-    if n >= 2:
-        for i in range(n):                           # a segment (n = 2) gets both sides: a→b and b→a
-            a, b = pts[i], pts[(i + 1) % n]
-            e = b - a
-            out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
-            s = _ray_segment(p, d, a + rad * out, b + rad * out, out)
+    a = float(d @ d)
+    # Each vertex circle and offset edge whose answer is certainly inf or beyond the move (s > 1:
+    # never the answer) is skipped on a float test with margins far above its rounding (see
+    # _circle_beyond, _edge_beyond); the others get the exact test, in the same order: the same
+    # answer, bit for bit, for a few float operations instead of a dozen numpy calls per feature.
+    if a != 0.0:                                     # (a == 0: every circle test answers inf)
+        for i, (cx, cy) in enumerate(v):
+            if _circle_beyond(px - cx, py - cy, dx, dy, a, rad):
+                continue
+            s = _ray_circle(p, d, pts[i], rad, a)
             if s < best:
-                best, best_n = s, out
+                best, best_n = s, (p + s * d - pts[i]) / rad
+    for A, B, out, ax, ay, ox, oy in edges:          # a segment (n = 2) gets both sides: a→b and b→a
+        if _edge_beyond(ax - px, ay - py, dx, dy, ox, oy):
+            continue
+        s = _ray_segment(p, d, A, B, out)
+        if s < best:
+            best, best_n = s, out.copy()
     if best > 1.0:
         return math.inf, None
     return best, best_n
+
+
+def _hull_data(ob: Obstacle, rad: float) -> tuple[list, list]:
+    """``ob``'s vertices as [x, y] floats and, with 2 vertices or more, its edges a→b offset
+    outward by ``rad``: (a + rad·out, b + rad·out, out, and their floats a + rad·out, out), the
+    same numpy operations :func:`time_of_impact` did per call; made once per (obstacle, rad) --
+    a solid's obstacle lives as long as the solid stays put, and a robot's grown radius is fixed."""
+    got = ob.grown.get(rad)
+    if got is None:
+        pts = ob.points
+        n = len(pts)
+        edges = []
+        if n >= 2:
+            for i in range(n):
+                a, b = pts[i], pts[(i + 1) % n]
+                e = b - a
+                out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
+                A, B = a + rad * out, b + rad * out
+                edges.append((A, B, out, float(A[0]), float(A[1]), float(out[0]), float(out[1])))
+        got = ob.grown[rad] = (pts.tolist(), edges)
+    return got
+
+
+_SWEPT_CLEAR = 2
+
+
+def _clear_of(px: float, py: float, dx: float, dy: float, rad: float, edges: list) -> int:
+    """How certainly the move from (px, py) by (dx, dy) keeps clear of the hull grown by ``rad``,
+    whose offset edges (:func:`_hull_data`, counter-clockwise) are ``edges``. 1: the start
+    is more than EPS outside an offset edge's line, plus 1e-9 of the coordinates (far above their
+    rounding) -- the distance to a convex hull is at least the distance to any of its edges' lines
+    (a segment's two sides: its line), so _closest_on_list would find it not touching.
+    _SWEPT_CLEAR: the start and the end are both outside one offset edge's line by 1e-6 (1 + rad
+    + the coordinates' differences): the grown hull (its vertex circles, its offset edges) lies inside
+    that line's half-plane, so the whole move stays farther than that from every feature, and the
+    exact tests, whose rounding is ~3e-8 of those lengths at worst (a graze), answer inf or s > 1:
+    no impact. 0: neither (no edges, a point: 0)."""
+    clear = 0
+    for _, _, _, ax, ay, ox, oy in edges:
+        wx, wy = px - ax, py - ay
+        side = wx * ox + wy * oy
+        if side > EPS + 1e-9 * (1.0 + abs(ax) + abs(ay) + abs(wx) + abs(wy)):
+            clear = 1
+            m = 1e-6 * (1.0 + rad + abs(wx) + abs(wy) + abs(dx) + abs(dy))
+            if side > m and side + (dx * ox + dy * oy) > m:
+                return _SWEPT_CLEAR
+    return clear
+
+
+def _circle_beyond(fx: float, fy: float, dx: float, dy: float, a: float, rad: float) -> bool:
+    """Whether :func:`_ray_circle` (f = p - c = (fx, fy), these exact: elementwise differences;
+    ``a`` its d @ d) certainly answers inf or s > 1. Its dot products may round differently (BLAS,
+    fused) from these plain ones: all within a few ulps of |f||d|, far inside the margins. Not
+    approaching (b >= 0): inf. Else the move's segment [p, p + d] keeps its distance to c
+    above the circle's radius by 1e-5 (1 + |f|²) m² squared: the line misses (computed disc < 0,
+    whose rounding is ~1e-15 |f|² a) or enters beyond the move's end by more than the rounding
+    of the computed entry (at most ~3e-8 |f| m when grazing). NaN answers False."""
+    b = fx * dx + fy * dy
+    if b > 1e-12 * (abs(fx * dx) + abs(fy * dy)):
+        return True
+    t = -b / a
+    t = 0.0 if not t > 0.0 else (1.0 if t > 1.0 else t)
+    qx, qy = fx + t * dx, fy + t * dy
+    return qx * qx + qy * qy > rad * rad + 1e-5 * (1.0 + fx * fx + fy * fy)
+
+
+def _edge_beyond(wx: float, wy: float, dx: float, dy: float, ox: float, oy: float) -> bool:
+    """Whether :func:`_ray_segment` (w = a - p = (wx, wy), exact: elementwise; out = (ox, oy))
+    certainly answers inf or s > 1: moving away from the edge's line (dn = d·out > 0: inf), or
+    crossing it behind the start (num = w·out > 0 with dn < 0: s < 0, inf) or beyond the end (num
+    < dn < 0 with a margin: the computed s = num/dn > 1). Margins 1e-12 of each dot product's
+    terms, far above their rounding in any order (BLAS, fused); NaN answers False."""
+    dn = dx * ox + dy * oy
+    tol_dn = 1e-12 * (abs(dx * ox) + abs(dy * oy))
+    if dn > tol_dn:
+        return True
+    num = wx * ox + wy * oy
+    tol_num = 1e-12 * (abs(wx * ox) + abs(wy * oy))
+    if num > tol_num and num > 1e-290 * abs(dn):     # (s < 0, not rounded to -0.0)
+        return True
+    return num < dn - (tol_num + tol_dn + 1e-12 * abs(dn))
 
 
 # ---------------------------------------------------------------------- the resolver
