@@ -19,7 +19,7 @@ from sensorium.server.sim.batched import BatchedSimulation, NoiseStreams
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
 from tests.test_batched_sim import _enable_both, _wheels_both
-from tests.test_gym_vector import _reset_both, _step_both
+from tests.test_gym_vector import _random_steps, _reset_both
 
 WORLD = Path(__file__).parent / "worlds" / "depth.yaml"
 PERIODS = {"rover": {"depth": 32, "wide": 16, "housed": 48}, "scout": {"eye": 16}}
@@ -214,15 +214,7 @@ def test_the_vector_env_observes_range_finders_as_the_single_env(precision: str)
     assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
     obs = _reset_both(venv, singles, 4)
     assert (obs["depth"] == np.float32(2.5)).any() and (obs["depth"] < 2.5).any()   # no hit: max_range
-    rng = np.random.default_rng(5)
-    done = np.zeros(n, dtype=bool)
-    ended = 0
-    for t in range(45):
-        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
-        resets, vobs = _step_both(venv, singles, a, done, t)
-        ended += resets
-        assert all(space[k].contains(vobs[k][0]) for k in OBSERVED)
-    assert ended >= n                                           # autoresets happened
+    assert _random_steps(venv, singles, OBSERVED, 45) >= n       # autoresets happened
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(venv.sub_env(1), skip_render_check=True)

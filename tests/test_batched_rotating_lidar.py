@@ -17,7 +17,7 @@ from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, from_model, load_world
 from tests.test_batched_sim import _enable_both, _wheels_both
-from tests.test_gym_vector import _reset_both, _step_both
+from tests.test_gym_vector import _random_steps, _reset_both
 
 WORLD = Path(__file__).parent / "worlds" / "rotating_lidar.yaml"
 # sampling periods: a multiple of the 16 ms step and ones that are not (the head turns every step anyway)
@@ -175,19 +175,13 @@ def test_the_vector_env_observes_rotating_lidars_as_the_single_env(precision: st
     assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
     obs = _reset_both(venv, singles, 4)
     assert (obs["spin"] == 0.0).any() and (obs["spin"] > 0.0).any()     # a part swept, the rest not yet
-    rng = np.random.default_rng(5)
-    done = np.zeros(n, dtype=bool)
-    ended = 0
-    for t in range(50):
-        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+    def reset_sub_env_0(t: int) -> None:
         if t == 7:                                   # sub-env 0's episode ends early: resets out of phase
             vobs, _ = venv.reset(options={"reset_mask": np.array([True, False, False])})
             o, _ = singles[0].reset()
             assert all(o[k].tobytes() == vobs[k][0].tobytes() for k in OBSERVED)
-        resets, vobs = _step_both(venv, singles, a, done, t)
-        ended += resets
-        assert all(space[k].contains(vobs[k][0]) for k in OBSERVED)
-    assert ended >= n                                           # autoresets happened
+
+    assert _random_steps(venv, singles, OBSERVED, 50, before=reset_sub_env_0) >= n     # autoresets happened
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(venv.sub_env(1), skip_render_check=True)

@@ -26,6 +26,7 @@ from sensorium.server.sim.batched import BatchedSimulation  # noqa: E402
 from sensorium.server.sim.motion import ackermann_angles  # noqa: E402
 from sensorium.server.sim.simulation import Simulation  # noqa: E402
 from sensorium.server.world.loader import load_world, parse_world  # noqa: E402
+from tests.test_gym_vector import _reset_both, _step_both  # noqa: E402
 
 WORLD = Path(__file__).parent / "worlds" / "cars.yaml"
 L, TF, TR, RF, RR = 0.5, 0.36, 0.38, 0.08, 0.09      # the open-field car's geometry (m)
@@ -161,10 +162,7 @@ def test_sub_env_i_is_the_single_env_with_seed_i_across_autoresets(robot, action
     n, seed = 3, 11
     venv = SensoriumVectorEnv(WORLD, task(robot), n, actions=actions)
     singles = [SensoriumEnv(WORLD, task(robot), actions=actions, engine="simulation") for _ in range(n)]
-    obs, info = venv.reset(seed=seed)
-    for i, env in enumerate(singles):
-        o, inf = env.reset(seed=seed + i)
-        assert _same({k: v[i] for k, v in obs.items()}, o) and _same(inf["pose"], info["pose"][i])
+    _reset_both(venv, singles, seed)
     space = singles[0].action_space
     rng = np.random.default_rng(2)
     done = np.zeros(n, dtype=bool)
@@ -173,19 +171,9 @@ def test_sub_env_i_is_the_single_env_with_seed_i_across_autoresets(robot, action
         a = rng.uniform(space.low, space.high, (n, 2)).astype(np.float32)
         if t % 20 < 10:
             a[:, 1] = space.high[1]                         # full speed ahead
-        vobs, vr, vte, vtr, vinfo = venv.step(a)
-        for i, env in enumerate(singles):
-            if done[i]:
-                o, inf = env.reset()
-                r, te, tr = 0.0, False, False
-                resets += 1
-            else:
-                o, r, te, tr, inf = env.step(a[i])
-            assert _same({k: v[i] for k, v in vobs.items()}, o), (t, i)
-            assert (r, te, tr) == (vr[i], vte[i], vtr[i]), (t, i)
-            assert inf["time_ms"] == vinfo["time_ms"][i] and _same(inf["pose"], vinfo["pose"][i]), (t, i)
-            done[i] = te or tr
-            pressed += int(o["bumper"][0] == 1.0)
+        got, vobs = _step_both(venv, singles, a, done, t)
+        resets += got
+        pressed += int((vobs["bumper"][:, 0] == 1.0).sum())
     assert resets >= 3 and pressed > 0                      # episodes restarted; cars pushed against things
 
 

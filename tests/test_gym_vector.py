@@ -60,6 +60,24 @@ def _step_both(venv, singles, a: np.ndarray, done: np.ndarray, t: int) -> tuple[
     return resets, vobs
 
 
+def _random_steps(venv, singles, keys, steps: int, seed: int = 5, before=None) -> int:
+    """``steps`` random actions through the vector env and the single envs (:func:`_step_both`), each
+    sub-env 0 observation of ``keys`` within its box; ``before(t)`` runs ahead of step t (after its
+    actions are drawn). Returns the number of single envs reset."""
+    space = venv.single_observation_space
+    rng = np.random.default_rng(seed)
+    done = np.zeros(venv.num_envs, dtype=bool)
+    ended = 0
+    for t in range(steps):
+        a = rng.uniform(-1, 1, (venv.num_envs, 2)).astype(np.float32)
+        if before is not None:
+            before(t)
+        resets, vobs = _step_both(venv, singles, a, done, t)
+        ended += resets
+        assert all(space[k].contains(vobs[k][0]) for k in keys)
+    return ended
+
+
 def _lockstep(env_id: str, precision: str, n: int, steps: int, max_steps: int, seed: int = 5):
     """The vector env and n single envs (seeds seed + i) fed the same actions; NEXT_STEP autoreset
     on one side, reset() after an ended episode on the other. Returns the number of resets seen."""
