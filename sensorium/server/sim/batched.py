@@ -8,8 +8,9 @@
     sim.value(k)                                     # (copies,) the readings
 
 A copy is the whole world: every robot of the world file (its *slots*), its own clock, poses,
-wheel motors, device schedules, values and noise streams; only what never moves (solids, planes,
-lights) is shared and built once. A step advances the copies named in ``active`` by one basic
+wheel motors, device schedules, values and noise streams, the lights its robots carry (at its poses:
+batched_lights.py); only what never moves (solids, planes, the world's and solids' lights) is shared
+and built once. A step advances the copies named in ``active`` by one basic
 time step and measures their due devices; the rays of all copies go out in one cast per ray kind
 (:class:`~sensorium.server.raycast.copies.CopyRays`: copies never see each other's robots), and
 every device model runs once over all copies' devices of a kind.
@@ -24,8 +25,7 @@ drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in 
 the same order). Tests compare it with the single simulation step by step.
 
 Not simulated here (use :class:`Simulation`): camera recognition and segmentation, force TouchSensors,
-the kinds without an observation (LEDs, pens, ...), lights carried by robots, textured robot bodies, NUE
-worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
+the kinds without an observation (LEDs, pens, ...), textured robot bodies, NUE worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
 (``sim.cars.command``; their encoders read its motors), their moves through the same arc, contact
 and placing as the other robots.
@@ -54,6 +54,7 @@ from sensorium.server.sim import batched_depth as depth
 from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim import batched_lidar
 from sensorium.server.sim.batched_car import CarDrives
+from sensorium.server.sim.batched_lights import CarriedLights
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
 from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
@@ -181,6 +182,8 @@ class BatchedSimulation:
         # -- what never moves, once: the solids' scene (static tier, planes), the lights
         self.scene = Scene(w.model_copy(update={"robots": []}), base, precision)
         self.lights = lights_from_models(self.scene.world_lights())
+        # lights carried by robots: each copy's at its robots' poses (batched_lights.py); None without any
+        self.carried = CarriedLights(w, self.scene.world_lights()) if any(r.lights for r in w.robots) else None
         n_static = len(self.scene.shapes)
         # -- one template body per robot slot (movable), the copies' robots are its poses
         self.robot_names = [r.name for r in w.robots]
@@ -294,9 +297,6 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
         for r in w.robots:
-            if r.lights:
-                raise BatchedError(f"{self.loaded.source}: robot {r.name!r} carries lights; the batched simulation "
-                                   "shares the lights of all copies (use Simulation)")
             for _, _, shape in robot_parts(r):
                 a = shape.appearance
                 if a is not None and (getattr(a, "texture", None) or getattr(a, "roughness_map", None)
@@ -952,17 +952,23 @@ class BatchedSimulation:
         rot = compose_rotations(rr, self._l_rot[cols])
         positions = np.einsum("sij,sj->si", rr, self._l_pos[cols]) + rt
         normals = rot[:, :, 0]
-        att, direct = light_math.light_terms(positions, normals, self.lights)
-        state = {"copies": copies, "cols": cols, "att": att, "direct": direct, "pairs": None}
-        if self.lights.count == 0 or not self._l_occl[cols].any():
+        # each row's copy's lights: the shared arrays, or with robots' lights at that copy's poses
+        lights = self.lights if self.carried is None else self.carried.rows(self.rot, self.pos, copies)
+        att, direct = light_math.light_terms(positions, normals, lights)
+        state = {"copies": copies, "cols": cols, "att": att, "direct": direct, "pairs": None, "lights": lights}
+        if lights.count == 0 or not self._l_occl[cols].any():
             return state, []
         mask = (direct > 0.0) & self._l_occl[cols][:, None]
         s, light = np.nonzero(mask)
         if s.size == 0:
             return state, []
         state["pairs"] = (s, light)
-        unit, length = light_math.occlusion_segments_many(positions[s], self.lights)
-        rows = np.arange(s.size)
+        if self.carried is None:
+            unit, length = light_math.occlusion_segments_many(positions[s], lights)
+            rows = np.arange(s.size)
+        else:        # per-row lights: every row's segments (elementwise: the same values), the pairs' rows
+            unit, length = light_math.occlusion_segments_many(positions, lights)   # type: ignore[arg-type]
+            rows = s
         return state, [_Rays(positions[s], unit[rows, light], 0.0, length[rows, light], RayKind.BOUNDING,
                              copies[s], self._l_excl[cols][s], -1)]
 
@@ -972,7 +978,8 @@ class BatchedSimulation:
         if state["pairs"] is not None:
             s, light = state["pairs"]
             occluded[s, light] = np.isfinite(hits[0].distance)
-        e = light_math.irradiance_from_terms(state["att"], state["direct"], self.lights, occluded, self._l_filter[cols])
+        e = light_math.irradiance_from_terms(state["att"], state["direct"], state["lights"], occluded,
+                                             self._l_filter[cols])
         values = np.empty(len(cols))
         table_of = self._l_table_of[cols]
         for t, (table, _) in enumerate(self._l_tables):

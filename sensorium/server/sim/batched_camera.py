@@ -24,6 +24,10 @@ cast for that copy alone, from its camera with per-ray limits. Noise: each (copy
 own stream (``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order,
 as ``shading.to_bytes`` draws it.
 
+Lights carried by robots (batched_lights.py) light only their own copy: in such a world each copy's
+rows are shaded, and its shadow rays aimed, with that copy's light arrays (the fixed lights, then
+its robots' at its poses: the single camera's arrays).
+
 Recognition and segmentation are not measured (the gym envs observe neither): the batched cameras
 refuse enabling them, and changing the exposure (the world file's exposure is used).
 """
@@ -115,8 +119,11 @@ class CameraDevices(PixelDevices):
         for img in self.images:
             img[..., 3] = 255
         scene = sim.scene
-        # the lights that are on and which cast shadows: static, shared by all copies
+        # the lights that are on and which cast shadows: static, shared by all copies; with lights carried by
+        # robots, each copy's own (_lights_of), fixed then carried as the single camera lists them
         self.lights, self.shadows = camera_lights(scene.world_lights()) if devices else (None, np.zeros(0, dtype=bool))
+        if devices and sim.carried is not None:
+            self.shadows = sim.carried.cast_shadows
         # per hit shape (static shapes, then the robots' as CopyRays numbers them; -1 reads the last): the
         # base colour a camera sees (robot bodies are never textured in the batched simulation) and the
         # transparency
@@ -126,6 +133,14 @@ class CameraDevices(PixelDevices):
         self.transparency = np.array([m.appearance.transparency if m.appearance is not None else 0.0
                                       for m in models] + [0.0])
         self.clear = bool((self.transparency > 0.0).any())     # semi-transparent surfaces: layers per copy
+
+    def _lights_of(self, copy: int) -> light_math.LightArrays:
+        """The lights copy ``copy`` (a copy of the simulation) shades with: its robots' at its poses."""
+        sim = self.sim
+        if sim.carried is None:
+            assert self.lights is not None
+            return self.lights
+        return sim.carried.arrays(sim.rot, sim.pos, copy)
 
     def reset(self, idx: np.ndarray) -> None:
         """Black (alpha 255) before the first image (Webots), as a freshly built device."""
@@ -201,12 +216,11 @@ class CameraDevices(PixelDevices):
         copy's shadow rays of a light are a cast of their own, as the single camera's: rays leaving a
         surface are judged against self-hits with thresholds that depend on the cast's origins."""
         sim = self.sim
-        lights = self.lights
-        assert lights is not None
-        lit = np.ones((len(P), len(lights)), dtype=bool)
+        lit = np.ones((len(P), len(self.shadows)), dtype=bool)
         cuts = np.flatnonzero(row_copy[1:] != row_copy[:-1]) + 1
         for rq in np.split(np.arange(len(P)), cuts) if len(P) else ():
             q = int(copies[row_copy[rq[0]]])
+            lights = self._lights_of(q)
             Pq, Nq = P[rq], N[rq]
             direct = light_math.light_terms(Pq, Nq, lights)[1]
             unit, length = light_math.occlusion_segments_many(Pq, lights)
@@ -261,13 +275,28 @@ class CameraDevices(PixelDevices):
             s = shape.take(kk)
             albedo = self._albedo(s, org, row_copy, Dk, tk)
             lit = self._shadows(P, N, row_copy, copies) if self.shadows.any() else None
-            L = _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
+            L = self._shade_copies(P, N, albedo, lit, row_copy, copies)
             if scene.fog is not None:
                 L = shading.fog(L, tk, *scene.fog)
             share = weight[kk] * (1.0 - np.zeros(len(kk)))   # (opaque: transparency 0, as the single's share)
             for ch in range(3):
                 L[:, ch] *= share
             shading.add_to_rows(out, kk, L)
+        return out
+
+    def _shade_copies(self, P: np.ndarray, N: np.ndarray, albedo: np.ndarray, lit: np.ndarray | None,
+                      row_copy: np.ndarray, copies: np.ndarray) -> np.ndarray:
+        """``_shade`` of every copy's rows: all at once under shared lights; copy by copy (its rows, each
+        shaded alone: every row's value is the one a single call gives) under its robots' lights."""
+        threads = self.sim.scene.engine.threads
+        if self.sim.carried is None:
+            assert self.lights is not None
+            return _shade(P, N, albedo, self.lights, lit, threads)
+        out = np.empty((len(P), 3))
+        cuts = np.flatnonzero(row_copy[1:] != row_copy[:-1]) + 1
+        for rq in np.split(np.arange(len(P)), cuts) if len(P) else ():
+            lights = self._lights_of(int(copies[row_copy[rq[0]]]))
+            out[rq] = _shade(P[rq], N[rq], albedo[rq], lights, None if lit is None else lit[rq], threads)
         return out
 
     def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits) -> np.ndarray:
@@ -291,7 +320,7 @@ class CameraDevices(PixelDevices):
             zeros = np.zeros(len(s), dtype=np.int64)
             albedo = self._albedo(s, origin[None, :], zeros, D, t)
             lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
-            return _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
+            return _shade(P, N, albedo, self._lights_of(int(copy[0])), lit, scene.engine.threads)
 
         return composite(origin, dirs, hits, dev.limits, cast_on, self.transparency, scene.background, scene.fog,
                          surface)
