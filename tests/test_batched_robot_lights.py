@@ -208,3 +208,111 @@ def test_reach_light_toward_a_robots_beacon_takes_each_copys_beacon():
     goal = venv._goals[0]
     assert goal.targets is not None and len({goal.targets[c].tobytes() for c in range(n)}) == n   # each its own
     assert np.array(terminated).any()                  # some arrived at their leader's beacon
+
+
+# ---------------------------------------------------------------- textured robot bodies
+
+TEXTURED = Path(__file__).parent / "worlds" / "textured_robots.yaml"
+TEXTURED_PERIODS = {"viewer": {"ir0": 16, "ir1": 32, "ir2": 16, "eye": 32}}
+
+
+@pytest.fixture(scope="module")
+def textured_dir(tmp_path_factory) -> Path:
+    """The world's images, seeded random texels (written here, not committed): paint.png 8 x 6 RGB,
+    rough.png 4 x 4 RGB (the roughness and occlusion maps), checker.png 8 x 8 (the floor)."""
+    from PIL import Image
+    d = tmp_path_factory.mktemp("textured_robots")
+    rng = np.random.default_rng(13)
+    for name, (h, w) in (("paint.png", (6, 8)), ("rough.png", (4, 4)), ("checker.png", (8, 8))):
+        Image.fromarray(rng.integers(0, 256, (h, w, 3), dtype=np.uint8), "RGB").save(d / name)
+    (d / TEXTURED.name).write_text(TEXTURED.read_text())
+    return d
+
+
+def _textured(seed: int, base: Path) -> LoadedWorld:
+    lw = load_world(base / TEXTURED.name)
+    info = lw.world.world_info.model_copy(update={"random_seed": seed})
+    return LoadedWorld(world=lw.world.model_copy(update={"world_info": info}), source=lw.source, base_dir=base)
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_textured_robot_bodies_read_as_in_the_single_simulation(precision: str, textured_dir: Path):
+    """A robot whose box body has a texture (repeated, transformed), a roughness map and an occlusion
+    map, with a textured cylinder on top, driving slowly in front of a viewer with three infra-red
+    sensors and a camera, over a textured floor, per-copy wheel commands, copy 2 reset on the way:
+    every infra-red value and camera image of every copy, every step, equals the single
+    simulation's with that copy's seed, bit for bit; the body's and the dome's texels were looked
+    up, and the copies' images differ (each its own pose of the painted robot)."""
+    seeds = [3, 4, 9]
+    bs = BatchedSimulation(_textured(0, textured_dir), len(seeds), precision=precision)
+    bs.reset(np.arange(len(seeds)), seeds)
+    sims = [Simulation(_textured(s, textured_dir), precision=precision) for s in seeds]
+    assert bs.robot_textures is not None
+    for c in range(len(seeds)):
+        _enable_both(bs, sims, TEXTURED_PERIODS, c)
+    rng = np.random.default_rng(2)
+    textures = bs.robot_textures
+    looked_up: list[int] = []                    # the robot shapes whose texels a copy read
+    world_to_shape = textures.world_to_shape
+
+    def counted(copy: int):
+        inverse = world_to_shape(copy)
+
+        def shape_pose(shape: int):
+            if shape >= textures.n_static:
+                looked_up.append(shape)
+            return inverse(shape)
+        return shape_pose
+
+    textures.world_to_shape = counted            # type: ignore[method-assign]
+    for step in range(40):
+        if step % 10 == 0:
+            for robot in ("painted", "viewer"):
+                lr = rng.uniform(-2.0, 2.0, (len(seeds), 2))
+                _wheels_both(bs, sims, robot, lr if robot == "painted" else 0.2 * lr)
+        if step == 20:
+            bs.reset([2], [77])
+            sims[2] = Simulation(_textured(77, textured_dir), precision=precision)
+            _enable_both(bs, sims, TEXTURED_PERIODS, 2)
+        bs.step()
+        for s in sims:
+            s.step()
+        for c, s in enumerate(sims):
+            viewer = s.robot("viewer")
+            for n in ("ir0", "ir1", "ir2"):
+                want, got = viewer.device(n).value, float(bs.value(bs.device("viewer", n))[c])
+                assert want == got or (math.isnan(want) and math.isnan(got)), (step, c, n, want, got)
+            want_img = viewer.device("eye").image
+            assert want_img.tobytes() == bs.image(bs.device("viewer", "eye"))[c].tobytes(), (step, c)
+    n = textures.n_static
+    assert {n, n + 1} <= set(looked_up)        # the box body and the dome were read, each many times
+    assert min(looked_up.count(n), looked_up.count(n + 1)) > 10
+    assert len({img.tobytes() for img in bs.image(bs.device("viewer", "eye"))}) == len(seeds)
+
+
+def test_a_textured_robot_body_is_read_at_each_copys_pose(textured_dir: Path):
+    """The painted robot turned differently in two copies, a noiseless infra-red sensor's single ray
+    straight at its body: each copy's value is that of a Simulation with the robot placed so, and the
+    two differ (a different texel under the ray), so the texture is read at each copy's own pose."""
+    lw = _textured(1, textured_dir)
+    viewer = lw.world.robots[1]
+    ray = {"device": "DistanceSensor", "name": "probe", "type": "infra-red", "pose": {"translation": [0.05, 0.0, 0.05]},
+           "lookup_table": [[0.0, 1000.0, 0.0], [0.6, 0.0, 0.0]]}
+    viewer = viewer.model_copy(update={"devices": [wm.DistanceSensor.model_validate(ray)]})
+    world = lw.world.model_copy(update={"robots": [lw.world.robots[0], viewer]})
+    one = LoadedWorld(world=world, source=lw.source, base_dir=textured_dir)
+    yaws = [0.1, 0.9]
+    bs = BatchedSimulation(one, len(yaws))
+    painted, ref = bs.slot("painted"), bs.device("viewer", "probe")
+    for c, yaw in enumerate(yaws):
+        bs.set_pose(c, painted, translation=[0.25, 0.0, 0.0], rotation=[0, 0, 1, yaw])
+    bs.enable(ref, 16)
+    bs.step()
+    got = bs.value(ref)
+    for c, yaw in enumerate(yaws):
+        s = Simulation(one)
+        s.robot("painted").set_pose(translation=[0.25, 0.0, 0.0], rotation=[0, 0, 1, yaw])
+        s.robot("viewer").device("probe").enable(16)
+        s.step()
+        assert s.robot("viewer").device("probe").value == float(got[c])
+    assert got[0] != got[1]

@@ -24,7 +24,8 @@ cast for that copy alone, from its camera with per-ray limits. Noise: each (copy
 own stream (``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order,
 as ``shading.to_bytes`` draws it.
 
-Lights carried by robots (batched_lights.py) light only their own copy: in such a world each copy's
+A textured robot body's texels are looked up per copy at that copy's pose of the shape
+(batched_textures.py). Lights carried by robots (batched_lights.py) light only their own copy: in such a world each copy's
 rows are shaded, and its shadow rays aimed, with that copy's light arrays (the fixed lights, then
 its robots' at its poses: the single camera's arrays).
 
@@ -45,7 +46,7 @@ from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
 from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import _base_color, robot_parts
+from sensorium.server.sim.scene import _base_color, robot_parts, surface_colors
 
 __all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera"]
 
@@ -125,7 +126,7 @@ class CameraDevices(PixelDevices):
         if devices and sim.carried is not None:
             self.shadows = sim.carried.cast_shadows
         # per hit shape (static shapes, then the robots' as CopyRays numbers them; -1 reads the last): the
-        # base colour a camera sees (robot bodies are never textured in the batched simulation) and the
+        # base colour a camera sees (a textured shape's texels come on top: _albedo) and the
         # transparency
         models = [scene.part(i)[2] for i in range(sim.n_static_shapes)]
         models += [shape for r in sim.world.robots for _, _, shape in robot_parts(r)]
@@ -190,23 +191,34 @@ class CameraDevices(PixelDevices):
         return RayHits(dist, normal, shape)
 
     def _albedo(self, shape: np.ndarray, org: np.ndarray, row_copy: np.ndarray, D: np.ndarray,
-                t: np.ndarray) -> np.ndarray:
-        """``Scene.surface_colors`` of hits of every copy: base colours by shape; a textured static
-        shape's texels per copy, on the rows the single camera would pass (its image's hits)."""
+                t: np.ndarray, copies: np.ndarray) -> np.ndarray:
+        """``Scene.surface_colors`` of hits of every copy: base colours by shape; a textured shape's
+        texels per copy (a solid's, or a robot body's at that copy's pose: batched_textures.py), on the
+        rows the single camera would pass (its image's hits)."""
         col = np.take(self.colors, shape, axis=0)
-        scene = self.sim.scene
+        sim = self.sim
+        scene = sim.scene
         sampler = scene.textures
         if sampler is None:
             return col
-        static = shape < self.sim.n_static_shapes
+        robots = sim.robot_textures
         textured = np.zeros(len(shape), dtype=bool)
-        textured[static] = sampler.textured[shape[static]]
+        if robots is not None:        # the sampler numbers every shape, robots' included
+            textured = sampler.textured[shape]
+        else:
+            static = shape < sim.n_static_shapes
+            textured[static] = sampler.textured[shape[static]]
         rows = textured.nonzero()[0]
         of = row_copy[rows]                  # nondecreasing: the hits come copy after copy
         cuts = np.flatnonzero(of[1:] != of[:-1]) + 1
         for rq in np.split(rows, cuts) if len(rows) else ():
             q = int(row_copy[rq[0]])
-            col[rq] = scene.surface_colors(shape[rq], np.broadcast_to(org[q], (len(rq), 3)), D[rq], t[rq])
+            o = np.broadcast_to(org[q], (len(rq), 3))
+            if robots is None:
+                col[rq] = scene.surface_colors(shape[rq], o, D[rq], t[rq])
+            else:
+                col[rq] = surface_colors(self.colors, sampler, robots.world_to_shape(int(copies[q])), shape[rq], o,
+                                         D[rq], t[rq])
         return col
 
     def _shadows(self, P: np.ndarray, N: np.ndarray, row_copy: np.ndarray, copies: np.ndarray) -> np.ndarray:
@@ -273,7 +285,7 @@ class CameraDevices(PixelDevices):
                 bk = back.nonzero()[0]
                 N[bk] = np.negative(shading.take_rows(N, bk))
             s = shape.take(kk)
-            albedo = self._albedo(s, org, row_copy, Dk, tk)
+            albedo = self._albedo(s, org, row_copy, Dk, tk, copies)
             lit = self._shadows(P, N, row_copy, copies) if self.shadows.any() else None
             L = self._shade_copies(P, N, albedo, lit, row_copy, copies)
             if scene.fog is not None:
@@ -318,7 +330,7 @@ class CameraDevices(PixelDevices):
 
         def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
             zeros = np.zeros(len(s), dtype=np.int64)
-            albedo = self._albedo(s, origin[None, :], zeros, D, t)
+            albedo = self._albedo(s, origin[None, :], zeros, D, t, copy)
             lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
             return _shade(P, N, albedo, self._lights_of(int(copy[0])), lit, scene.engine.threads)
 
