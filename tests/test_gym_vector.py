@@ -294,20 +294,19 @@ def test_auto_engine_falls_back_to_the_simulation_for_what_the_batched_one_does_
 
     lw = load_world(default_world_path())
     data = lw.world.model_dump(mode="json", exclude_none=True)
-    # a robot carrying a lamp: the batched simulation shares one set of lights among its copies
-    data["robots"][1]["lights"] = [{"type": "PointLight", "name": "headlamp", "location": [0.1, 0.0, 0.1],
-                                    "intensity": 0.5}]
+    # a NUE world: the batched simulation drives robots in ENU worlds only
+    data["world_info"]["coordinate_system"] = "NUE"
     from sensorium.server.world.loader import LoadedWorld
 
-    world = LoadedWorld(world=lw.world.model_validate(data), source="lamp", base_dir=lw.base_dir)
+    world = LoadedWorld(world=lw.world.model_validate(data), source="nue", base_dir=lw.base_dir)
     task = Task(robot="scout", observations={"lidar": 64}, control_period_ms=64)
     env = SensoriumEnv(world, task, engine="auto")
     assert env.engine == "simulation"
     obs, _ = env.reset(seed=0)
     assert obs["lidar"].shape == (1, 360)
-    with pytest.raises(BatchedError, match="carries lights"):
+    with pytest.raises(BatchedError, match="ENU worlds only"):
         SensoriumEnv(world, task, engine="batched")
-    with pytest.raises(BatchedError, match="carries lights"):
+    with pytest.raises(BatchedError, match="ENU worlds only"):
         SensoriumVectorEnv(world, task, 2).reset(seed=0)
     assert SensoriumEnv(lw, Task(robot="scout", observations={"lidar": 64}), engine="auto").engine == "batched"
 

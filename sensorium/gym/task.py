@@ -36,6 +36,7 @@ import numpy as np
 
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayKind
+from sensorium.server.sim.batched_lights import copy_world_lights
 
 __all__ = ["Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start", "VectorGoal"]
 
@@ -146,7 +147,11 @@ class ReachLight:
         self._previous = math.inf
 
     def target(self, sim) -> np.ndarray:
-        for lt in sim.scene.world_lights():          # also lights carried by solids and robots, placed
+        return self.target_among(sim.scene.world_lights())   # also lights carried by solids and robots, placed
+
+    def target_among(self, lights: list) -> np.ndarray:
+        """The (x, y) of the light this goal drives to among light models placed in the world."""
+        for lt in lights:
             if lt.type == "DirectionalLight":
                 continue
             if self.light is None or lt.name == self.light:
@@ -199,14 +204,23 @@ class VectorGoal:
 class _ReachLightCopies(VectorGoal):
     def __init__(self, goal: ReachLight, sim, slot: int):
         self.goal, self.sim, self.slot = goal, sim, slot
-        self.target = goal.target(sim)
+        # in a world whose robots carry lights the light may be one of them: each copy's own place, taken
+        # at its reset as the single env takes it (None: one target, the world's fixed light, for all)
+        self.targets: np.ndarray | None = np.zeros((sim.copies, 2)) if any(r.lights for r in sim.world.robots) else None
+        self.target = goal.target(sim) if self.targets is None else np.zeros(2)
         self.previous = np.full(sim.copies, math.inf)
 
     def distance(self, copies: np.ndarray) -> np.ndarray:
         p = self.sim.pos[copies, self.slot]
+        if self.targets is not None:
+            t = self.targets[copies]
+            return np.hypot(p[:, 0] - t[:, 0], p[:, 1] - t[:, 1])
         return np.hypot(p[:, 0] - self.target[0], p[:, 1] - self.target[1])
 
     def reset(self, copies: np.ndarray) -> None:
+        if self.targets is not None:
+            for c in copies.tolist():
+                self.targets[c] = self.goal.target_among(copy_world_lights(self.sim, c))
         self.previous[copies] = self.distance(copies)
 
     def reward(self, copies: np.ndarray) -> np.ndarray:

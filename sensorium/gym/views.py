@@ -32,6 +32,7 @@ import numpy as np
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.batched_kinematic import READINGS
+from sensorium.server.sim.batched_lights import copy_world_lights
 
 __all__ = ["CopySim", "CopyRobot"]
 
@@ -197,11 +198,13 @@ class _Engine:
 class _Scene:
     def __init__(self, sim: BatchedSimulation, copy: int):
         self._s = sim
+        self._copy = copy
         self.engine = _Engine(sim, copy)
         self.solid_poses = sim.scene.solid_poses
 
     def world_lights(self) -> list:
-        return self._s.scene.world_lights()
+        """The copy's lights: the fixed ones, then its robots' at its poses."""
+        return copy_world_lights(self._s, self._copy)
 
     @property
     def solids_version(self) -> int:

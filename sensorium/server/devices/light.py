@@ -144,12 +144,18 @@ class LightArrays:
         return cls.from_lights(())
 
 
+def _per_point(a: np.ndarray) -> np.ndarray:
+    """A light field (n, 3) shared by every point as (1, n, 3); (S, n, 3), one row per point (the
+    batched simulation's lights carried by robots, sim/batched_lights.py), as it is."""
+    return a if a.ndim == 3 else a[None, :, :]
+
+
 def _vectors(points: np.ndarray, lights: LightArrays):
     """For S points: unnormalised sensor→light vectors v (S,n,3), |v| (S,n), unit L (S,n,3; 0 where
     |v| = 0) and distances d (S,n; 1000 for directional lights)."""
     directional = lights.kind == LightKind.DIRECTIONAL
-    v = lights.position[None, :, :] - points[:, None, :]
-    v = np.where(directional[None, :, None], -lights.direction[None, :, :], v)
+    v = _per_point(lights.position) - points[:, None, :]
+    v = np.where(directional[None, :, None], -_per_point(lights.direction), v)
     length = np.linalg.norm(v, axis=2)
     safe = np.where(length > 0.0, length, 1.0)
     unit = v / safe[:, :, None]
@@ -171,7 +177,7 @@ def _terms(P: np.ndarray, N: np.ndarray, lights: LightArrays) -> tuple[np.ndarra
     spot = np.ones(c.shape)
     is_spot = lights.kind == LightKind.SPOT
     if np.any(is_spot):
-        R = -lights.direction[None, :, :]
+        R = -_per_point(lights.direction)
         alpha = np.arctan2(np.linalg.norm(np.cross(unit, R), axis=2), np.einsum("snk,snk->sn", unit, R))
         bw, co = lights.beam_width[None, :], lights.cut_off_angle[None, :]
         with np.errstate(divide="ignore", invalid="ignore"):

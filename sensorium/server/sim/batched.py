@@ -8,8 +8,9 @@
     sim.value(k)                                     # (copies,) the readings
 
 A copy is the whole world: every robot of the world file (its *slots*), its own clock, poses,
-wheel motors, device schedules, values and noise streams; only what never moves (solids, planes,
-lights) is shared and built once. A step advances the copies named in ``active`` by one basic
+wheel motors, device schedules, values and noise streams, the lights its robots carry (at its poses:
+batched_lights.py); only what never moves (solids, planes, the world's and solids' lights) is shared
+and built once. A step advances the copies named in ``active`` by one basic
 time step and measures their due devices; the rays of all copies go out in one cast per ray kind
 (:class:`~sensorium.server.raycast.copies.CopyRays`: copies never see each other's robots), and
 every device model runs once over all copies' devices of a kind.
@@ -24,8 +25,8 @@ drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in 
 the same order). Tests compare it with the single simulation step by step.
 
 Not simulated here (use :class:`Simulation`): camera recognition and segmentation, force TouchSensors,
-the kinds without an observation (LEDs, pens, ...), lights carried by robots, textured robot bodies, NUE
-worlds. A skid-steer robot's wheels of one side are driven together (``set_wheels``).
+the kinds without an observation (LEDs, pens, ...), NUE worlds. Textured robot bodies are read per copy
+(batched_textures.py). A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
 (``sim.cars.command``; their encoders read its motors), their moves through the same arc, contact
 and placing as the other robots.
@@ -54,11 +55,21 @@ from sensorium.server.sim import batched_depth as depth
 from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim import batched_lidar
 from sensorium.server.sim.batched_car import CarDrives
+from sensorium.server.sim.batched_lights import CarriedLights
+from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
 from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
 from sensorium.server.sim.motion import AckermannDrive, DifferentialDrive, PlanarState, _rz
-from sensorium.server.sim.scene import Scene, _entry, _shape_info, primitive_from_model, robot_parts, solid_parts
+from sensorium.server.sim.scene import (
+    Scene,
+    _entry,
+    _shape_info,
+    infra_red_terms,
+    primitive_from_model,
+    robot_parts,
+    solid_parts,
+)
 from sensorium.server.sim.sensors import DistanceSensor, Lidar, LightSensor, PositionSensor
 from sensorium.server.sim.simulation import lights_from_models
 from sensorium.server.world.geometry import Pose
@@ -181,6 +192,8 @@ class BatchedSimulation:
         # -- what never moves, once: the solids' scene (static tier, planes), the lights
         self.scene = Scene(w.model_copy(update={"robots": []}), base, precision)
         self.lights = lights_from_models(self.scene.world_lights())
+        # lights carried by robots: each copy's at its robots' poses (batched_lights.py); None without any
+        self.carried = CarriedLights(w, self.scene.world_lights()) if any(r.lights for r in w.robots) else None
         n_static = len(self.scene.shapes)
         # -- one template body per robot slot (movable), the copies' robots are its poses
         self.robot_names = [r.name for r in w.robots]
@@ -217,6 +230,8 @@ class BatchedSimulation:
         self.red = np.array(red + [1.0])              # per hit shape; -1 (no hit) reads the last entry
         self.roughness = np.array(rough + [0.0])
         self.n_static_shapes = n_static
+        # textured robot bodies: their template shapes join the scene's texture sampler, looked up per copy
+        self.robot_textures = RobotTextures(self) if any(textured_robot(r) for r in w.robots) else None
         # -- robots: initial poses and drives (the template state every reset starts from)
         self.initial = [pose_from_model(r.pose) for r in w.robots]
         self.has_drive = np.array([r.differential_drive is not None for r in w.robots], dtype=bool)
@@ -293,16 +308,6 @@ class BatchedSimulation:
         if w.world_info.coordinate_system != "ENU":
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
-        for r in w.robots:
-            if r.lights:
-                raise BatchedError(f"{self.loaded.source}: robot {r.name!r} carries lights; the batched simulation "
-                                   "shares the lights of all copies (use Simulation)")
-            for _, _, shape in robot_parts(r):
-                a = shape.appearance
-                if a is not None and (getattr(a, "texture", None) or getattr(a, "roughness_map", None)
-                                      or getattr(a, "occlusion_map", None)):
-                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r} has a textured body; the batched "
-                                       "simulation reads textures of solids only (use Simulation)")
 
     def _build_devices(self) -> None:
         C = self.copies
@@ -952,17 +957,23 @@ class BatchedSimulation:
         rot = compose_rotations(rr, self._l_rot[cols])
         positions = np.einsum("sij,sj->si", rr, self._l_pos[cols]) + rt
         normals = rot[:, :, 0]
-        att, direct = light_math.light_terms(positions, normals, self.lights)
-        state = {"copies": copies, "cols": cols, "att": att, "direct": direct, "pairs": None}
-        if self.lights.count == 0 or not self._l_occl[cols].any():
+        # each row's copy's lights: the shared arrays, or with robots' lights at that copy's poses
+        lights = self.lights if self.carried is None else self.carried.rows(self.rot, self.pos, copies)
+        att, direct = light_math.light_terms(positions, normals, lights)
+        state = {"copies": copies, "cols": cols, "att": att, "direct": direct, "pairs": None, "lights": lights}
+        if lights.count == 0 or not self._l_occl[cols].any():
             return state, []
         mask = (direct > 0.0) & self._l_occl[cols][:, None]
         s, light = np.nonzero(mask)
         if s.size == 0:
             return state, []
         state["pairs"] = (s, light)
-        unit, length = light_math.occlusion_segments_many(positions[s], self.lights)
-        rows = np.arange(s.size)
+        if self.carried is None:
+            unit, length = light_math.occlusion_segments_many(positions[s], lights)
+            rows = np.arange(s.size)
+        else:        # per-row lights: every row's segments (elementwise: the same values), the pairs' rows
+            unit, length = light_math.occlusion_segments_many(positions, lights)   # type: ignore[arg-type]
+            rows = s
         return state, [_Rays(positions[s], unit[rows, light], 0.0, length[rows, light], RayKind.BOUNDING,
                              copies[s], self._l_excl[cols][s], -1)]
 
@@ -972,7 +983,8 @@ class BatchedSimulation:
         if state["pairs"] is not None:
             s, light = state["pairs"]
             occluded[s, light] = np.isfinite(hits[0].distance)
-        e = light_math.irradiance_from_terms(state["att"], state["direct"], self.lights, occluded, self._l_filter[cols])
+        e = light_math.irradiance_from_terms(state["att"], state["direct"], state["lights"], occluded,
+                                             self._l_filter[cols])
         values = np.empty(len(cols))
         table_of = self._l_table_of[cols]
         for t, (table, _) in enumerate(self._l_tables):
@@ -1083,10 +1095,10 @@ class BatchedSimulation:
             if g.kind == RayKind.VISUAL:
                 sh = shape.reshape(S, n)
                 textures = self.scene.textures
-                if textures is not None and np.count_nonzero(textures.textured[np.where(shape < self.n_static_shapes,
-                                                                                        shape, -1)]):
+                probe = shape if self.robot_textures is not None else np.where(shape < self.n_static_shapes, shape, -1)
+                if textures is not None and np.count_nonzero(textures.textured[probe]):
                     red, rough, occl = self._infra_red_terms(shape, np.repeat(positions, n, axis=0),
-                                                             dirs.reshape(-1, 3), dist.reshape(-1))
+                                                             dirs.reshape(-1, 3), dist.reshape(-1), np.repeat(c, n))
                     shade = dmath.reflection_factor(red, rough, occl).reshape(S, n)
                 else:
                     shade = dmath.reflection_factor(self.red[sh], self.roughness[sh])
@@ -1147,9 +1159,9 @@ class BatchedSimulation:
             got = self._own_kept[id(g)] = (own, k.copy(), own.distance[ray], own.shape[ray], own.normal[ray])
         return got[2], got[3], got[4]
 
-    def _infra_red_terms(self, shape, origins, directions, distance):
-        """Scene.infra_red_terms for hits on solids (textures live there); robot shapes read their
-        colour (robot bodies are never textured here)."""
+    def _infra_red_terms(self, shape, origins, directions, distance, ray_copy):
+        """Scene.infra_red_terms for hits on solids; on a textured robot body, per copy with that copy's
+        world-to-shape poses (batched_textures.py); other robot shapes read their colour."""
         red, rough = self.red[shape], self.roughness[shape]
         occl = np.zeros(len(shape))
         on_static = (shape >= 0) & (shape < self.n_static_shapes)
@@ -1158,6 +1170,14 @@ class BatchedSimulation:
             r2, g2, o2 = self.scene.infra_red_terms(shape[rows], origins[rows], directions[rows], distance[rows])
             red, rough = red.copy(), rough.copy()
             red[rows], rough[rows], occl[rows] = r2, g2, o2
+        textures = self.robot_textures
+        if textures is not None:
+            rows = ((shape >= self.n_static_shapes) & textures.sampler.textured[shape]).nonzero()[0]
+            for q in sorted(set(ray_copy[rows].tolist())):
+                rq = rows[ray_copy[rows] == q]
+                red[rq], rough[rq], occl[rq] = infra_red_terms(self.red, self.roughness, textures.sampler,
+                                                               textures.world_to_shape(q), shape[rq], origins[rq],
+                                                               directions[rq], distance[rq])
         return red, rough, occl
 
     # fixed lidars (Lidar.plan/finish over every copy's due lidars)

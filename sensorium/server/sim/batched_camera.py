@@ -24,6 +24,11 @@ cast for that copy alone, from its camera with per-ray limits. Noise: each (copy
 own stream (``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order,
 as ``shading.to_bytes`` draws it.
 
+A textured robot body's texels are looked up per copy at that copy's pose of the shape
+(batched_textures.py). Lights carried by robots (batched_lights.py) light only their own copy: in such a world each copy's
+rows are shaded, and its shadow rays aimed, with that copy's light arrays (the fixed lights, then
+its robots' at its poses: the single camera's arrays).
+
 Recognition and segmentation are not measured (the gym envs observe neither): the batched cameras
 refuse enabling them, and changing the exposure (the world file's exposure is used).
 """
@@ -41,7 +46,7 @@ from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
 from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import _base_color, robot_parts
+from sensorium.server.sim.scene import _base_color, robot_parts, surface_colors
 
 __all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera"]
 
@@ -115,10 +120,13 @@ class CameraDevices(PixelDevices):
         for img in self.images:
             img[..., 3] = 255
         scene = sim.scene
-        # the lights that are on and which cast shadows: static, shared by all copies
+        # the lights that are on and which cast shadows: static, shared by all copies; with lights carried by
+        # robots, each copy's own (_lights_of), fixed then carried as the single camera lists them
         self.lights, self.shadows = camera_lights(scene.world_lights()) if devices else (None, np.zeros(0, dtype=bool))
+        if devices and sim.carried is not None:
+            self.shadows = sim.carried.cast_shadows
         # per hit shape (static shapes, then the robots' as CopyRays numbers them; -1 reads the last): the
-        # base colour a camera sees (robot bodies are never textured in the batched simulation) and the
+        # base colour a camera sees (a textured shape's texels come on top: _albedo) and the
         # transparency
         models = [scene.part(i)[2] for i in range(sim.n_static_shapes)]
         models += [shape for r in sim.world.robots for _, _, shape in robot_parts(r)]
@@ -126,6 +134,14 @@ class CameraDevices(PixelDevices):
         self.transparency = np.array([m.appearance.transparency if m.appearance is not None else 0.0
                                       for m in models] + [0.0])
         self.clear = bool((self.transparency > 0.0).any())     # semi-transparent surfaces: layers per copy
+
+    def _lights_of(self, copy: int) -> light_math.LightArrays:
+        """The lights copy ``copy`` (a copy of the simulation) shades with: its robots' at its poses."""
+        sim = self.sim
+        if sim.carried is None:
+            assert self.lights is not None
+            return self.lights
+        return sim.carried.arrays(sim.rot, sim.pos, copy)
 
     def reset(self, idx: np.ndarray) -> None:
         """Black (alpha 255) before the first image (Webots), as a freshly built device."""
@@ -175,23 +191,34 @@ class CameraDevices(PixelDevices):
         return RayHits(dist, normal, shape)
 
     def _albedo(self, shape: np.ndarray, org: np.ndarray, row_copy: np.ndarray, D: np.ndarray,
-                t: np.ndarray) -> np.ndarray:
-        """``Scene.surface_colors`` of hits of every copy: base colours by shape; a textured static
-        shape's texels per copy, on the rows the single camera would pass (its image's hits)."""
+                t: np.ndarray, copies: np.ndarray) -> np.ndarray:
+        """``Scene.surface_colors`` of hits of every copy: base colours by shape; a textured shape's
+        texels per copy (a solid's, or a robot body's at that copy's pose: batched_textures.py), on the
+        rows the single camera would pass (its image's hits)."""
         col = np.take(self.colors, shape, axis=0)
-        scene = self.sim.scene
+        sim = self.sim
+        scene = sim.scene
         sampler = scene.textures
         if sampler is None:
             return col
-        static = shape < self.sim.n_static_shapes
+        robots = sim.robot_textures
         textured = np.zeros(len(shape), dtype=bool)
-        textured[static] = sampler.textured[shape[static]]
+        if robots is not None:        # the sampler numbers every shape, robots' included
+            textured = sampler.textured[shape]
+        else:
+            static = shape < sim.n_static_shapes
+            textured[static] = sampler.textured[shape[static]]
         rows = textured.nonzero()[0]
         of = row_copy[rows]                  # nondecreasing: the hits come copy after copy
         cuts = np.flatnonzero(of[1:] != of[:-1]) + 1
         for rq in np.split(rows, cuts) if len(rows) else ():
             q = int(row_copy[rq[0]])
-            col[rq] = scene.surface_colors(shape[rq], np.broadcast_to(org[q], (len(rq), 3)), D[rq], t[rq])
+            o = np.broadcast_to(org[q], (len(rq), 3))
+            if robots is None:
+                col[rq] = scene.surface_colors(shape[rq], o, D[rq], t[rq])
+            else:
+                col[rq] = surface_colors(self.colors, sampler, robots.world_to_shape(int(copies[q])), shape[rq], o,
+                                         D[rq], t[rq])
         return col
 
     def _shadows(self, P: np.ndarray, N: np.ndarray, row_copy: np.ndarray, copies: np.ndarray) -> np.ndarray:
@@ -201,12 +228,11 @@ class CameraDevices(PixelDevices):
         copy's shadow rays of a light are a cast of their own, as the single camera's: rays leaving a
         surface are judged against self-hits with thresholds that depend on the cast's origins."""
         sim = self.sim
-        lights = self.lights
-        assert lights is not None
-        lit = np.ones((len(P), len(lights)), dtype=bool)
+        lit = np.ones((len(P), len(self.shadows)), dtype=bool)
         cuts = np.flatnonzero(row_copy[1:] != row_copy[:-1]) + 1
         for rq in np.split(np.arange(len(P)), cuts) if len(P) else ():
             q = int(copies[row_copy[rq[0]]])
+            lights = self._lights_of(q)
             Pq, Nq = P[rq], N[rq]
             direct = light_math.light_terms(Pq, Nq, lights)[1]
             unit, length = light_math.occlusion_segments_many(Pq, lights)
@@ -259,15 +285,30 @@ class CameraDevices(PixelDevices):
                 bk = back.nonzero()[0]
                 N[bk] = np.negative(shading.take_rows(N, bk))
             s = shape.take(kk)
-            albedo = self._albedo(s, org, row_copy, Dk, tk)
+            albedo = self._albedo(s, org, row_copy, Dk, tk, copies)
             lit = self._shadows(P, N, row_copy, copies) if self.shadows.any() else None
-            L = _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
+            L = self._shade_copies(P, N, albedo, lit, row_copy, copies)
             if scene.fog is not None:
                 L = shading.fog(L, tk, *scene.fog)
             share = weight[kk] * (1.0 - np.zeros(len(kk)))   # (opaque: transparency 0, as the single's share)
             for ch in range(3):
                 L[:, ch] *= share
             shading.add_to_rows(out, kk, L)
+        return out
+
+    def _shade_copies(self, P: np.ndarray, N: np.ndarray, albedo: np.ndarray, lit: np.ndarray | None,
+                      row_copy: np.ndarray, copies: np.ndarray) -> np.ndarray:
+        """``_shade`` of every copy's rows: all at once under shared lights; copy by copy (its rows, each
+        shaded alone: every row's value is the one a single call gives) under its robots' lights."""
+        threads = self.sim.scene.engine.threads
+        if self.sim.carried is None:
+            assert self.lights is not None
+            return _shade(P, N, albedo, self.lights, lit, threads)
+        out = np.empty((len(P), 3))
+        cuts = np.flatnonzero(row_copy[1:] != row_copy[:-1]) + 1
+        for rq in np.split(np.arange(len(P)), cuts) if len(P) else ():
+            lights = self._lights_of(int(copies[row_copy[rq[0]]]))
+            out[rq] = _shade(P[rq], N[rq], albedo[rq], lights, None if lit is None else lit[rq], threads)
         return out
 
     def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits) -> np.ndarray:
@@ -289,9 +330,9 @@ class CameraDevices(PixelDevices):
 
         def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
             zeros = np.zeros(len(s), dtype=np.int64)
-            albedo = self._albedo(s, origin[None, :], zeros, D, t)
+            albedo = self._albedo(s, origin[None, :], zeros, D, t, copy)
             lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
-            return _shade(P, N, albedo, self.lights, lit, scene.engine.threads)
+            return _shade(P, N, albedo, self._lights_of(int(copy[0])), lit, scene.engine.threads)
 
         return composite(origin, dirs, hits, dev.limits, cast_on, self.transparency, scene.background, scene.fog,
                          surface)

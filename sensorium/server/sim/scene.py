@@ -11,7 +11,7 @@ without textures): ``infra_red_terms`` turns hits into the colour terms of Webot
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -139,6 +139,67 @@ def light_from_model(m) -> light_math.Light:
     if m.type == "SpotLight":
         fields.update(beam_width=m.beam_width, cut_off_angle=m.cut_off_angle)
     return light_math.Light(**fields)
+
+
+def surface_colors(colors: np.ndarray, sampler: TextureSampler | None, world_to_shape: Callable[[int], Pose],
+                   shape: np.ndarray, origins: np.ndarray, directions: np.ndarray, distance: np.ndarray) -> np.ndarray:
+    """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): the base colour,
+    times the texel of a textured shape converted from sRGB to linear (Webots' shaders;
+    where picking fails, 1), blended with a pen's ink as infra-red reads it
+    (``(1 − c)·colour + c·ink``). ``colors``: base colours per shape (a trailing white for −1);
+    ``world_to_shape``: a shape's world-to-shape pose now."""
+    col = np.take(colors, shape, axis=0)   # (faster than fancy indexing of (n, 3) rows)
+    if sampler is None:
+        return col
+    hit = sampler.textured[shape].nonzero()[0]
+    on = shape[hit]
+    for s in sorted(set(on.tolist())):
+        rows = hit[on == s]
+        inv = world_to_shape(s)
+        o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
+        uv, picked = sampler.uv(s, o, d, distance[rows])
+        sampler.lookups += len(rows)
+        uv = np.where(picked[:, None], uv, 0.0)
+        base = col[rows]
+        if s in sampler.shapes:
+            texel = srgb_to_linear(sampler.texels(s, uv, "base"))
+            base = base * np.where(picked[:, None], texel, 1.0)
+        layer = sampler.ink.get(s)
+        if layer is not None:
+            ink, c = layer.pick(uv)
+            c = np.where(picked, c.astype(np.float64), 0.0)[:, None]
+            base = (1.0 - c) * base + c * ink
+        col[rows] = base
+    return col
+
+
+def infra_red_terms(red_of: np.ndarray, roughness_of: np.ndarray, sampler: TextureSampler | None,
+                    world_to_shape: Callable[[int], Pose], shape: np.ndarray, origins: np.ndarray,
+                    directions: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(red, roughness, occlusion) an infra-red ray reads at its hit (WbShape::pickColor):
+    ``red = base_color.r·(1 − transparency)·texel.r`` on textured shapes (the texel at Webots'
+    texture coordinates of the hit, in the shape's frame, float64), the shape's red elsewhere;
+    roughness from a roughness map where there is one; occlusion from an occlusion map (else 0).
+    ``shape`` −1 (no hit) reads the trailing "no hit" entries of ``red_of`` and ``roughness_of``
+    (per shape); ``world_to_shape``: a shape's world-to-shape pose now."""
+    red = red_of[shape]
+    rough = roughness_of[shape]
+    occl = np.zeros(len(shape))
+    if sampler is None:
+        return red, rough, occl
+    hit = sampler.textured[shape].nonzero()[0]
+    on = shape[hit]
+    for s in sorted(set(on.tolist())):
+        rows = hit[on == s] if len(hit) > 1 else hit
+        inv = world_to_shape(s)
+        o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
+        read, rmap, omap, picked = sampler.infra_red(s, o, d, distance[rows], red[rows])
+        red[rows] = read
+        if rmap is not None:
+            rough[rows] = rmap if picked is None else np.where(picked, rmap, rough[rows])
+        if omap is not None:
+            occl[rows] = omap if picked is None else np.where(picked, omap, 0.0)
+    return red, rough, occl
 
 
 class Scene:
@@ -413,58 +474,12 @@ class Scene:
 
     def surface_colors(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                        distance: np.ndarray) -> np.ndarray:
-        """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): the base colour,
-        times the texel of a textured shape converted from sRGB to linear (Webots' shaders;
-        where picking fails, 1), blended with a pen's ink as infra-red reads it
-        (``(1 − c)·colour + c·ink``)."""
-        col = np.take(self.colors, shape, axis=0)   # (faster than fancy indexing of (n, 3) rows)
-        sampler = self.textures
-        if sampler is None:
-            return col
-        hit = sampler.textured[shape].nonzero()[0]
-        on = shape[hit]
-        for s in sorted(set(on.tolist())):
-            rows = hit[on == s]
-            inv = self._world_to_shape(s)
-            o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
-            uv, picked = sampler.uv(s, o, d, distance[rows])
-            sampler.lookups += len(rows)
-            uv = np.where(picked[:, None], uv, 0.0)
-            base = col[rows]
-            if s in sampler.shapes:
-                texel = srgb_to_linear(sampler.texels(s, uv, "base"))
-                base = base * np.where(picked[:, None], texel, 1.0)
-            layer = sampler.ink.get(s)
-            if layer is not None:
-                ink, c = layer.pick(uv)
-                c = np.where(picked, c.astype(np.float64), 0.0)[:, None]
-                base = (1.0 - c) * base + c * ink
-            col[rows] = base
-        return col
+        """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): see
+        :func:`surface_colors`."""
+        return surface_colors(self.colors, self.textures, self._world_to_shape, shape, origins, directions, distance)
 
     def infra_red_terms(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                         distance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(red, roughness, occlusion) an infra-red ray reads at its hit (WbShape::pickColor):
-        ``red = base_color.r·(1 − transparency)·texel.r`` on textured shapes (the texel at Webots'
-        texture coordinates of the hit, in the shape's frame, float64), the shape's red elsewhere;
-        roughness from a roughness map where there is one; occlusion from an occlusion map (else 0).
-        ``shape`` −1 (no hit) reads the trailing "no hit" entries."""
-        red = self.red[shape]
-        rough = self.roughness[shape]
-        occl = np.zeros(len(shape))
-        sampler = self.textures
-        if sampler is None:
-            return red, rough, occl
-        hit = sampler.textured[shape].nonzero()[0]
-        on = shape[hit]
-        for s in sorted(set(on.tolist())):
-            rows = hit[on == s] if len(hit) > 1 else hit
-            inv = self._world_to_shape(s)
-            o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
-            read, rmap, omap, picked = sampler.infra_red(s, o, d, distance[rows], red[rows])
-            red[rows] = read
-            if rmap is not None:
-                rough[rows] = rmap if picked is None else np.where(picked, rmap, rough[rows])
-            if omap is not None:
-                occl[rows] = omap if picked is None else np.where(picked, omap, 0.0)
-        return red, rough, occl
+        """(red, roughness, occlusion) an infra-red ray reads at its hit: see :func:`infra_red_terms`."""
+        return infra_red_terms(self.red, self.roughness, self.textures, self._world_to_shape, shape, origins,
+                               directions, distance)

@@ -1,0 +1,127 @@
+"""Lights carried by robots in the batched simulation: each copy's at that copy's robot pose.
+
+The single simulation's light arrays (``lights_from_models(scene.world_lights())``) list the world's
+lights and the solids' (fixed here: the batched simulation never moves a solid), then every robot's
+lights that are on, robot after robot, each placed by ``place_light(model, robot pose ∘ identity)``.
+Copy c's arrays are the same list with copy c's robot poses: the fixed lights shared by every copy,
+the carried ones placed per copy with the same numpy calls on stacks (``Pose.compose`` with the
+identity, then ``location @ R.T + t`` and ``direction @ R.T``, each a matmul of the same shapes), so
+the bits are the single simulation's.
+
+Light sensors take :class:`RowLights`: per sensor row, its copy's positions and directions (the
+math of devices/light.py broadcasts them as it broadcasts shared ones). Cameras shade a copy's rows
+with that copy's :class:`~sensorium.server.devices.light.LightArrays` (:meth:`CarriedLights.arrays`),
+built from the same ``Light`` values as the single camera's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import light as light_math
+from sensorium.server.sim.scene import light_from_model, place_light
+from sensorium.server.world.geometry import Pose
+
+__all__ = ["CarriedLights", "RowLights", "copy_world_lights"]
+
+_EYE = np.eye(3)
+_ZERO = np.zeros(3)
+
+
+@dataclass(frozen=True)
+class RowLights:
+    """Lights as devices/light.py's ``light_terms``/``occlusion_segments_many``/``irradiance_from_terms``
+    read them, with positions and directions per row (S, n, 3): each sensor's copy's lights."""
+
+    kind: np.ndarray               # (n,)
+    position: np.ndarray           # (S, n, 3)
+    direction: np.ndarray          # (S, n, 3), unit for spot and directional lights
+    attenuation: np.ndarray        # (n, 3)
+    intensity: np.ndarray          # (n,)
+    ambient_intensity: np.ndarray  # (n,)
+    color: np.ndarray              # (n, 3)
+    beam_width: np.ndarray         # (n,)
+    cut_off_angle: np.ndarray      # (n,)
+
+    def __len__(self) -> int:
+        return len(self.kind)
+
+    @property
+    def count(self) -> int:
+        return len(self.kind)
+
+
+class CarriedLights:
+    """The world's fixed lights (shared) and its robots' lights that are on (placed per copy)."""
+
+    def __init__(self, world: wm.World, fixed_models: list):
+        on = [m for m in fixed_models if m.on]
+        self._fixed = [light_from_model(m) for m in on]
+        carried = [(i, m) for i, r in enumerate(world.robots) for m in r.lights if m.on]
+        self._carried = [light_from_model(m) for _, m in carried]
+        self.slots = np.array([i for i, _ in carried], dtype=np.int64)
+        self.count = len(carried)
+        # the carried lights' fields in their robot's frame: which of them move (Webots: a directional
+        # light's direction stays in world axes wherever it is attached)
+        self._located = np.array([hasattr(m, "location") for _, m in carried], dtype=bool)
+        self._aimed = np.array([m.type == "SpotLight" for _, m in carried], dtype=bool)
+        self._local_pos = np.array([lt.position for lt in self._carried], dtype=np.float64).reshape(-1, 3)
+        self._local_dir = np.array([lt.direction for lt in self._carried], dtype=np.float64).reshape(-1, 3)
+        self.shared = light_math.LightArrays.from_lights(self._fixed + self._carried)   # constants (poses aside)
+        self.cast_shadows = np.array([bool(m.cast_shadows) for m in on] + [bool(m.cast_shadows) for _, m in carried],
+                                     dtype=bool)
+        self._oriented = self.shared.kind != light_math.LightKind.POINT
+        self._n_fixed = len(self._fixed)
+
+    def placed(self, rot: np.ndarray, pos: np.ndarray, copies: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The carried lights' positions and raw (unnormalised) directions in the world of each of
+        ``copies`` (k,): (k, m, 3) each, as ``place_light`` gives them for that copy's robot poses."""
+        k = len(copies)
+        R = rot[copies[:, None], self.slots[None, :]]                 # (k, m, 3, 3)
+        t = pos[copies[:, None], self.slots[None, :]]
+        Rc = np.matmul(R, _EYE)                                       # robot pose ∘ identity (Pose.compose)
+        tc = np.matmul(R, _ZERO) + t
+        Rt = Rc.transpose(0, 1, 3, 2)
+        where = np.broadcast_to(self._local_pos[None, :, None, :], (k, self.count, 1, 3))
+        aim = np.broadcast_to(self._local_dir[None, :, None, :], (k, self.count, 1, 3))
+        p = np.matmul(where, Rt)[:, :, 0, :] + tc                     # location @ R.T + t (Pose.apply)
+        d = np.matmul(aim, Rt)[:, :, 0, :]                            # direction @ R.T (Pose.apply_dirs)
+        p = np.where(self._located[None, :, None], p, self._local_pos[None])
+        d = np.where(self._aimed[None, :, None], d, self._local_dir[None])
+        return p, d
+
+    def rows(self, rot: np.ndarray, pos: np.ndarray, copies: np.ndarray) -> RowLights:
+        """Every light of each row's copy (``copies``: a copy per row), fixed then carried."""
+        S = len(copies)
+        p, d = self.placed(rot, pos, copies)
+        shared = self.shared
+        norm = np.linalg.norm(d, axis=2)                              # LightArrays' normalisation, per row
+        d = np.where(self._oriented[None, self._n_fixed:, None],
+                     d / np.where(norm > 0.0, norm, 1.0)[:, :, None], d)
+        position = np.concatenate([np.broadcast_to(shared.position[None, :self._n_fixed], (S, self._n_fixed, 3)), p],
+                                  axis=1)
+        direction = np.concatenate([np.broadcast_to(shared.direction[None, :self._n_fixed], (S, self._n_fixed, 3)),
+                                    d], axis=1)
+        return RowLights(shared.kind, position, direction, shared.attenuation, shared.intensity,
+                         shared.ambient_intensity, shared.color, shared.beam_width, shared.cut_off_angle)
+
+    def arrays(self, rot: np.ndarray, pos: np.ndarray, copy: int) -> light_math.LightArrays:
+        """Copy ``copy``'s lights as the single simulation's arrays: the same ``Light`` values."""
+        p, d = self.placed(rot, pos, np.array([copy], dtype=np.int64))
+        moved = [replace(lt, position=tuple(float(v) for v in p[0, k]), direction=tuple(float(v) for v in d[0, k]))
+                 for k, lt in enumerate(self._carried)]
+        return light_math.LightArrays.from_lights(self._fixed + moved)
+
+
+def copy_world_lights(sim, copy: int) -> list:
+    """``Scene.world_lights`` of copy ``copy`` of a batched simulation: the fixed lights' models, then
+    every robot's lights placed at that copy's robot poses (what a task reads, e.g. a light's place)."""
+    out = list(sim.scene.world_lights())
+    for slot, robot in enumerate(sim.world.robots):
+        if robot.lights:
+            frame = sim.pose(copy, slot).compose(Pose.identity())
+            out += [place_light(m, frame) for m in robot.lights]
+    return out
