@@ -134,6 +134,27 @@ class _Device:
         """A camera's latest BGRA image in this copy."""
         return self._s.image(self.ref)[self._c]
 
+    def recognition_enable(self, period_ms: int) -> None:
+        """A camera's recognition in this copy (batched_recognition.py)."""
+        self._s.recognition_enable(self.ref, period_ms, copies=[self._c])
+
+    def enable_segmentation(self, on: bool) -> None:
+        self._s.enable_segmentation(self.ref, on, copies=[self._c])
+
+    @property
+    def recognition_objects(self) -> list:
+        """A camera's latest recognised objects in this copy (``Camera.objects``)."""
+        return self._s.recognition_objects(self.ref, self._c)
+
+    @property
+    def objects(self) -> list:
+        return self.recognition_objects
+
+    @property
+    def segmentation_image(self) -> np.ndarray:
+        """A camera's latest BGRA segmentation image in this copy."""
+        return self._s.segmentation_image(self.ref)[self._c]
+
     def __getattr__(self, name: str) -> Any:
         ref = self.__dict__.get("ref")
         if ref is not None and name in READINGS.get(ref.kind, ()):   # a GPS's values, speed, ...: this copy's
