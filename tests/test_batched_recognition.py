@@ -1,6 +1,6 @@
 """Camera recognition and segmentation in the batched simulation (sim/batched_recognition.py): every
 copy's recognised objects and segmentation images equal to the single Simulation's with its seed
-(occlusion 0, 1 and 2, max_objects, a housed camera, a recognisable robot driving in view, a reset on
+(occlusion 0, 1 and 2, max_objects, a housed camera behind a post of its robot, a recognisable robot driving in view, a reset on
 the way), copies blind to each other's robots, a copy's view reading them, and the one-line refusals."""
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from tests.test_batched_sim import _wheels_both
 
 WORLD = Path(__file__).parent / "worlds" / "recognition.yaml"
 # {robot: {camera: (recognition period ms, segmentation)}}
-CAMERAS = {"rover": {"eye": (16, True), "wide": (32, True), "housed": (48, False)}, "scout": {"dome": (16, True)}}
+CAMERAS = {"rover": {"eye": (16, True), "wide": (32, True), "housed": (48, True)}, "scout": {"dome": (16, False)}}
 SCOUT_BGRA = (179, 51, 204, 255)       # floor(255 * (0.8, 0.2, 0.7) + 0.5), blue first
 
 
@@ -86,6 +86,7 @@ def test_every_copy_recognises_as_the_single_simulation(precision: str):
     assert seen["ids"] == {1, 2, 5, 6}           # both robots (each in the other's view), the crate and the ball
     assert SCOUT_BGRA in seen["colours"] and (0, 0, 0, 255) in seen["colours"]
     assert differ > 10                           # the copies drive apart
+    assert bs.recognition.devices[bs.device("rover", "housed").column].own is not None   # its post met apart
     assert bs.recognition_objects(bs.device("rover", "eye"), 2) == sims[2].robot("rover").device("eye").objects
 
 
@@ -132,12 +133,93 @@ def test_refusals_are_one_clear_line():
     eye = bs.device("rover", "eye")
     with pytest.raises(ValueError, match="needs the recognition enabled first"):
         bs.enable_segmentation(eye, True)
-    with pytest.raises(ValueError, match="rover/housed: .*no segmentation"):
-        bs.recognition_enable(bs.device("rover", "housed"), 16)
-        bs.enable_segmentation(bs.device("rover", "housed"), True)
+    dome = bs.device("scout", "dome")
+    bs.recognition_enable(dome, 16)
+    with pytest.raises(ValueError, match="^scout/dome: this camera's Recognition node has no segmentation"):
+        bs.enable_segmentation(dome, True)
+    with pytest.raises(ValueError, match="^rover/plain: this camera has no Recognition node$"):
+        bs.recognition_enable(bs.device("rover", "plain"), 16)
     with pytest.raises(ValueError, match="sampling period must be"):
         bs.recognition_enable(eye, -1)
     with pytest.raises(ValueError, match="enabled per copy"):
         bs.template(eye).recognition_enable(16)
     with pytest.raises(ValueError, match="exposure"):
         bs.template(eye).set_exposure(2.0)
+
+
+gym = pytest.importorskip("gymnasium")
+
+from sensorium.gym import SensoriumEnv, Task  # noqa: E402
+from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
+from tests.test_gym_vector import _reset_both, _step_both  # noqa: E402
+
+OBSERVED = {"eye/segmentation": 32, "eye": 32, "wide/segmentation": 64}
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_the_envs_observe_segmentation_images(precision: str):
+    """A task naming "<camera>/segmentation": a uint8 (height, width, 3) RGB box of the segmentation
+    image beside the camera's own image; every vector sub-env equals the single env (rebuilt
+    Simulation, and the one-copy batched engine) with its seed, bit for bit, across autoresets, and
+    the scout's colour is observed."""
+    task = Task(robot="rover", observations=OBSERVED, control_period_ms=32, max_steps=12)
+    world = _world(3)
+    n = 3
+    venv = SensoriumVectorEnv(world, task, n, precision=precision)
+    space = venv.single_observation_space
+    assert space["eye/segmentation"].shape == (24, 32, 3) and space["eye/segmentation"].dtype == np.uint8
+    assert space["wide/segmentation"].shape == (12, 24, 3)
+    singles = [SensoriumEnv(world, task, precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
+    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
+    obs = _reset_both(venv, singles, 4)
+    assert (obs["eye/segmentation"][0] == SCOUT_BGRA[2::-1]).all(axis=-1).any()
+    rng = np.random.default_rng(5)
+    done = np.zeros(n, dtype=bool)
+    ended = 0
+    for t in range(30):
+        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        resets, vobs = _step_both(venv, singles, a, done, t)
+        ended += resets
+        assert all(space[k].contains(vobs[k][0]) for k in OBSERVED)
+    assert ended >= n
+    venv.close()
+
+
+def test_a_segmentation_observation_needs_a_segmenting_camera():
+    for name, why in (("plain/segmentation", "camera 'plain' has no Recognition node with segmentation: true"),
+                      ("nose/segmentation", "robot 'rover' has no camera 'nose'")):
+        with pytest.raises(ValueError, match=f"^task observation '{name}': {why}"):
+            SensoriumEnv(_world(3), Task(robot="rover", observations=[name]))
+
+
+def _see_robots(sim, robot, rng) -> None:
+    robot.device("eye").recognition_enable(32)
+
+
+def test_task_callables_read_recognition_objects_on_both_engines():
+    """A task enabling recognition in ``start`` and rewarding what the camera recognises (the
+    recognised ids summed, plus the first object's depth): the vector env's per-copy views give every
+    sub-env the single env's rewards (rebuilt Simulation, one-copy batched engine), bit for bit, across
+    autoresets; the scout is seen."""
+    given: list[float] = []
+
+    def robots_seen(sim, robot, obs) -> float:
+        objs = robot.device("eye").recognition_objects
+        given.append(float(sum(o.id for o in objs)) + (objs[0].position[0] if objs else 0.0))
+        return given[-1]
+
+    task = Task(robot="rover", observations={"eye/segmentation": 32}, control_period_ms=32, max_steps=10,
+                start=_see_robots, reward=robots_seen)
+    world = _world(3)
+    venv = SensoriumVectorEnv(world, task, 2)
+    singles = [SensoriumEnv(world, task, engine=e) for e in ("simulation", "auto")]
+    assert [e.engine for e in singles] == ["simulation", "batched"]
+    _reset_both(venv, singles, 9)
+    rng = np.random.default_rng(6)
+    done = np.zeros(2, dtype=bool)
+    ended = 0
+    for t in range(25):
+        ended += _step_both(venv, singles, rng.uniform(-1, 1, (2, 2)).astype(np.float32), done, t)[0]
+    assert ended >= 2
+    assert any(r >= 2.0 for r in given) and len(set(given)) > 5      # the scout (id 2) seen, rewards vary
+    venv.close()

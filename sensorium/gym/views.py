@@ -14,7 +14,9 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   wheel of a side: ``set_position``, ``set_velocity``, ``velocity``, ``position``,
   ``max_velocity``), ``device(name).enable(period)`` / ``.value`` (a GPS's ``.values``, ``.speed``,
   ``.speed_vector``, a compass's, a gyro's or an accelerometer's ``.values``, an inertial unit's
-  ``.roll_pitch_yaw``, ``.quaternion``; a bumper's or an altimeter's ``.value``).
+  ``.roll_pitch_yaw``, ``.quaternion``; a bumper's or an altimeter's ``.value``; a camera's ``.image``,
+  ``.recognition_enable(period)``, ``.enable_segmentation(on)``, ``.recognition_objects`` (or
+  ``.objects``) and ``.segmentation_image``: this copy's, batched_recognition.py).
   The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
   side share one state, so commanding one of them commands its side. A car-like robot has
   ``motors`` (its steering and driven wheels) and no ``drive``.
