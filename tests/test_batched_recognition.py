@@ -80,10 +80,12 @@ def test_every_copy_recognises_as_the_single_simulation(precision: str):
                     seg = bs.segmentation_image(ref)[c]
                     assert seg.tobytes() == cam.segmentation_image.tobytes(), (step, c, robot, name)
                     seen["ids"] |= {o.id for o in got}
+                    seen.setdefault(name, set()).update(o.id for o in got)
                     seen["colours"] |= {tuple(p) for p in np.unique(seg.reshape(-1, 4), axis=0).tolist()}
         eye = bs.device("rover", "eye")
         differ += len({repr(bs.recognition_objects(eye, c)) for c in range(len(seeds))}) > 1
-    assert seen["ids"] == {1, 2, 5, 6}           # both robots (each in the other's view), the crate and the ball
+    assert seen["ids"] == {1, 2, 5, 6, 7}        # both robots (each in the other's view), the crate, the ball, the box
+    assert 7 in seen["housed"] and 7 not in seen["eye"] | seen["wide"]   # occlusion 0 lists the box behind the wall
     assert SCOUT_BGRA in seen["colours"] and (0, 0, 0, 255) in seen["colours"]
     assert differ > 10                           # the copies drive apart
     assert bs.recognition.devices[bs.device("rover", "housed").column].own is not None   # its post met apart

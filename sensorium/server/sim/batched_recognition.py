@@ -9,42 +9,29 @@ every due copy are one cast of their own, as the batched camera's image rays are
 the same stacked ``Pose.compose``, its robot's body met apart for a housed camera), meeting only that
 copy's robots. The objects are the single Recognizer's, run per copy on :class:`_CopyScene`: the
 world's shapes numbered as the single scene numbers them (solids, then the robots'), the Supervisor's
-node ids (robots 1..R, then the top-level solids), each robot's pose in that copy, and occlusion rays
-cast in that copy alone (its camera's robot excluded, as the single cast excludes it).
+node ids (robots 1..R, then the top-level solids), each robot's pose in that copy. The occlusion rays
+(occlusion 1: one per candidate object, to its centre) of every due copy of a camera are one cast,
+each ray meeting only its copy's world, its camera's robot excluded, as the single camera casts it
+alone.
 """
 
 from __future__ import annotations
 
 import math
-from collections import defaultdict
 from typing import Any
 
 import numpy as np
 
 from sensorium.server.devices import imaging
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.batched_camera import own_body_hits
 from sensorium.server.sim.batched_depth import PixelDevices
-from sensorium.server.sim.recognition import RecognisedObject, Recognizer
+from sensorium.server.sim.recognition import RecognisedObject, Recognizer, occlusion_ray
 from sensorium.server.sim.scene import robot_parts
 from sensorium.server.sim.sensors import _check_period
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["RecognitionDevices"]
-
-
-class _CopyEngine:
-    """One copy's world as the ray engine a Recognizer casts its occlusion rays on."""
-
-    def __init__(self, sim: Any, copy: int):
-        self.sim, self.copy = sim, copy
-
-    def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.VISUAL, exclude_owner=-1,
-             **_ignored) -> RayHits:
-        sim = self.sim
-        n = len(directions)
-        return sim.rays.cast(origins, directions, np.full(n, float(t_near)), np.full(n, float(t_far)), kind,
-                             np.full(n, self.copy, dtype=np.int64), sim.rot, sim.pos, exclude_owner)
 
 
 class _CopyScene:
@@ -78,10 +65,6 @@ class _CopyScene:
         if isinstance(key, str):
             return self.sim.scene.solid_poses[key]
         return self.sim.pose(self.copy, key)
-
-    @property
-    def engine(self) -> _CopyEngine:
-        return _CopyEngine(self.sim, self.copy)
 
 
 class _Centres:
@@ -179,17 +162,45 @@ class RecognitionDevices(PixelDevices):
             rec = self._recognizers[col] = Recognizer(self.scene, tpl.robot_index, rc, tpl.geometry)
         segment = self.segmentation[copies, col]
         pixels = self._pixel_objects(col, copies, rec) if (rc.occlusion == 2 or segment.any()) else None
-        counters: defaultdict[str, int] = defaultdict(int)
         assert self.scene is not None
+        seen = []
         for k, c in enumerate(copies.tolist()):
             self.scene.copy = c
             pose = sim.pose(c, tpl.robot_index).compose(tpl.local_pose)      # Device.world_pose
             mine = None if pixels is None else pixels[k]
-            self.objects[c][col] = rec.recognise(pose, mine, counters)
+            seen.append((pose, rec.candidates(pose, mine)))
             if segment[k]:
                 assert mine is not None
                 self.images[col][c] = rec.segmentation(mine, dev.height, dev.width)
+        if rc.occlusion == 1:
+            seen = self._occlusion(col, copies, rec, seen)
+        for c, (_, found) in zip(copies.tolist(), seen):
+            self.objects[c][col] = rec.trim([o for _, o, _ in found])
         self.last[copies, col] = sim.time_ms[copies]
+
+    def _occlusion(self, col: int, copies: np.ndarray, rec: Recognizer, seen: list) -> list:
+        """Occlusion 1 of every copy's candidates (Recognizer._centre_visible): their rays to the
+        objects' centres, each in its copy alone, its camera's robot excluded, in one cast."""
+        sim = self.sim
+        rows, origins, dirs, far = [], [], [], []
+        for q, (pose, found) in enumerate(seen):
+            for i, (_, _, target) in enumerate(found):
+                ray = occlusion_ray(pose, target)
+                if ray is not None:
+                    rows.append((q, i))
+                    origins.append(pose.translation)
+                    dirs.append(ray[0])
+                    far.append(ray[1])
+        hidden: set[tuple[int, int]] = set()
+        if rows:
+            ray_copy = copies[np.array([q for q, _ in rows], dtype=np.int64)]
+            h = sim.rays.cast(np.array(origins), np.array(dirs), 0.0, np.array(far), RayKind.VISUAL, ray_copy, sim.rot,
+                              sim.pos, self.devices[col].template.robot_index)
+            assert h.shape is not None
+            for j, (q, i) in enumerate(rows):
+                if not rec.reached(seen[q][1][i][0], float(h.distance[j]), int(h.shape[j])):
+                    hidden.add((q, i))
+        return [(pose, [f for i, f in enumerate(found) if (q, i) not in hidden]) for q, (pose, found) in enumerate(seen)]
 
     def _pixel_objects(self, col: int, copies: np.ndarray, rec: Recognizer) -> np.ndarray:
         """(copies, H·W): the recognisable object (index, -1 none) each pixel centre's ray sees
