@@ -2,7 +2,7 @@
 images bit-identical to the single Simulation with its seed (noise, exposure, anti-aliasing, fog,
 textures, every light type, shadows, semi-transparent surfaces, a housed camera, the other robot in
 view), closed-form pixels (lit, fogged, shadowed), copies blind to each other's robots, the vector
-environment observing them, and the refusal of recognition."""
+environment observing them, and the template's refusals (recognition: test_batched_recognition.py)."""
 
 from __future__ import annotations
 
@@ -250,18 +250,23 @@ def test_a_robot_shadows_the_wall_in_its_own_copy_only(precision: str):
     assert (rgb[1] == byte(albedo * (0.2 + 0.7 / math.sqrt(1.25)))).all()
 
 
-def test_recognition_segmentation_and_exposure_changes_are_refused_in_one_line(texture_dir: Path):
-    """The batched simulation does not measure a camera's recognition or segmentation (the gym envs
-    observe neither) and keeps the world file's exposure: asking a batched camera (its template, as
-    a task callable's copy view reaches it) for them raises one line saying what to use, and
-    changes nothing."""
+def test_template_recognition_and_exposure_changes_are_refused_in_one_line(texture_dir: Path):
+    """A batched camera's template (its constants) refuses enabling recognition or segmentation
+    (per copy: BatchedSimulation.recognition_enable, batched_recognition.py) and changing the exposure
+    (the world file's is kept), in one line, changing nothing; a camera without a Recognition node
+    refuses recognition through the simulation too."""
     bs = BatchedSimulation(_world(0, texture_dir), 1)
-    tpl = bs.template(bs.device("rover", "eye"))
-    for call in (lambda: tpl.recognition_enable(16), lambda: tpl.enable_segmentation(True),
-                 lambda: tpl.set_exposure(2.0)):
-        with pytest.raises(ValueError, match=r"^rover/eye: batched cameras .*\(use Simulation\)$"):
+    ref = bs.device("rover", "eye")
+    tpl = bs.template(ref)
+    for call in (lambda: tpl.recognition_enable(16), lambda: tpl.enable_segmentation(True)):
+        with pytest.raises(ValueError, match=r"^rover/eye: a batched camera's \w+ is enabled per copy \(Batched"):
             call()
+    with pytest.raises(ValueError, match=r"^rover/eye: batched cameras keep the world file's exposure \(use Simulation\)$"):
+        tpl.set_exposure(2.0)
     assert tpl.exposure == 1.6
+    with pytest.raises(ValueError, match=r"^rover/eye: this camera has no Recognition node$"):
+        bs.recognition_enable(ref, 16)
+    assert not bs.recognition.period.any()
 
 
 gym = pytest.importorskip("gymnasium")

@@ -17,7 +17,9 @@ box in [0, 1] (1 while its robot pushes against something), an altimeter its hei
 default, refused when named); a camera
 (only when named in ``Task.observations``: images are not observed by default) is a uint8
 ``(height, width, 3)`` RGB box, a range finder (likewise) its float32 ``(height, width)`` range image
-in ``[0, max_range]`` with "no hit" as ``max_range``.
+in ``[0, max_range]`` with "no hit" as ``max_range``; ``"<camera>/segmentation"`` (named, of a camera
+whose Recognition node has ``segmentation: true``) its segmentation image, a uint8 ``(height, width, 3)``
+RGB box (recognition and segmentation enabled at the observation's period; black before the first).
 ``flatten=True``: one float32 ``Box`` instead, the Dict's boxes flattened and concatenated in its
 (sorted) key order, as ``gymnasium.wrappers.FlattenObservation`` gives.
 
@@ -130,6 +132,9 @@ class Agent:
         else:
             periods = {str(n): self.control_period_ms for n in obs}
         for n, p in periods.items():
+            if n.endswith(SEGMENTATION):
+                _check_segmentation(n, name, devices)
+                continue
             if n in actuators:
                 raise ValueError(f"task observation {n!r}: robot {name!r}'s {n} is not a sensor")
             if n not in devices:
@@ -142,7 +147,7 @@ class Agent:
                                  "which reads NaN without physics (only a bumper is an observation)")
         self.periods = periods
         self.warmup_steps = max((math.ceil(p / basic) for p in periods.values()), default=0)
-        self.dict_space = spaces.Dict({n: _space(devices[n], w.world_info) for n in periods})
+        self.dict_space = spaces.Dict({n: _space(devices[device_of(n)], w.world_info) for n in periods})
         self.flatten = bool(flatten)
         self.observation_space: spaces.Space = (spaces.flatten_space(self.dict_space) if self.flatten
                                                 else self.dict_space)
@@ -171,7 +176,12 @@ class Agent:
             m.set_position(math.inf)
             m.set_velocity(0.0)
         for n, p in self.periods.items():
-            robot.device(n).enable(p)
+            if n.endswith(SEGMENTATION):
+                cam = robot.device(device_of(n))
+                cam.recognition_enable(p)
+                cam.enable_segmentation(True)
+            else:
+                robot.device(n).enable(p)
 
     def reset_callables(self, sim: Simulation) -> None:
         robot = sim.robot(self.robot)
@@ -231,8 +241,10 @@ class Agent:
         robot = sim.robot(self.robot)
         out = {}
         for n, box in self.dict_space.spaces.items():
-            dev = robot.device(n)
-            if dev.kind == "Camera":                       # BGRA -> RGB
+            dev = robot.device(device_of(n))
+            if n.endswith(SEGMENTATION):                   # BGRA -> RGB
+                out[n] = np.ascontiguousarray(dev.segmentation_image[:, :, 2::-1])
+            elif dev.kind == "Camera":                     # BGRA -> RGB
                 out[n] = np.ascontiguousarray(dev.image[:, :, 2::-1])
             elif dev.kind in ("Lidar", "RangeFinder"):
                 img = np.nan_to_num(dev.range_image, nan=box.high.flat[0], posinf=box.high.flat[0])
@@ -263,6 +275,22 @@ class Agent:
 OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "GPS", "Compass", "InertialUnit",
               "Gyro", "Accelerometer", "TouchSensor", "Altimeter", "Camera", "RangeFinder")
 IMAGES = ("Camera", "RangeFinder")
+SEGMENTATION = "/segmentation"     # "<camera>/segmentation": the camera's segmentation image observed
+
+
+def device_of(observation: str) -> str:
+    """The device an observation name reads (a camera's for ``"<camera>/segmentation"``)."""
+    return observation.removesuffix(SEGMENTATION)
+
+
+def _check_segmentation(observation: str, robot: str, devices: dict) -> None:
+    cam = devices.get(device_of(observation))
+    if cam is None or cam.device != "Camera":
+        raise ValueError(f"task observation {observation!r}: robot {robot!r} has no camera "
+                         f"{device_of(observation)!r} (sensors: {', '.join(devices) or 'none'})")
+    if cam.recognition is None or not cam.recognition.segmentation:
+        raise ValueError(f"task observation {observation!r}: camera {cam.name!r} has no Recognition node with "
+                         "segmentation: true")
 VECTOR_READINGS = {"GPS": "values", "Compass": "values", "InertialUnit": "roll_pitch_yaw", "Gyro": "values",
                    "Accelerometer": "values"}
 """The kinds observed as a float32 ``(3,)`` box, and the device reading each observes (a GPS its
@@ -361,11 +389,11 @@ def batched_engine(loaded: LoadedWorld, agents: list[Agent], precision: str, eng
         return None
     try:
         for ag in agents:              # e.g. an observed GPS in a WGS84 world: nothing built
-            check_observable(loaded.world, ag.robot, ag.periods)
+            check_observable(loaded.world, ag.robot, map(device_of, ag.periods))
         sim = BatchedSimulation(loaded, 1, precision=precision)
         for ag in agents:
             for name in ag.periods:
-                sim.check_observable(ag.robot, name)
+                sim.check_observable(ag.robot, device_of(name))
     except BatchedError:
         if engine == "batched":
             raise

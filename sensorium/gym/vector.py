@@ -45,7 +45,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from sensorium.gym.env import DEFAULT_PRECISION, Agent, load, missing_fill
+from sensorium.gym.env import DEFAULT_PRECISION, SEGMENTATION, Agent, device_of, load, missing_fill
 from sensorium.gym.render import TopDown
 from sensorium.gym.task import Task, VectorGoal, never, zero
 from sensorium.gym.views import CopySim
@@ -118,14 +118,14 @@ class SensoriumVectorEnv(VectorEnv):
         self.precision = precision
         self.agent = Agent(self.loaded, self.task, actions=actions, flatten=flatten)
         try:      # what the batched simulation does not simulate: one line, before anything is built
-            check_observable(self.loaded.world, self.agent.robot, self.agent.periods)
+            check_observable(self.loaded.world, self.agent.robot, map(device_of, self.agent.periods))
             self.sim = BatchedSimulation(self.loaded, n, precision=precision, threads=threads)
         except BatchedError as e:
             raise BatchedError(f"{str(e).removesuffix(' (use Simulation)')}: the batched vector environment cannot "
                                "run this task (SensoriumEnv can: gymnasium.vector.SyncVectorEnv or "
                                "AsyncVectorEnv of it)") from None
         self.slot = self.sim.slot(self.agent.robot)
-        self.refs = {name: self.sim.check_observable(self.agent.robot, name) for name in self.agent.periods}
+        self.refs = {name: self.sim.check_observable(self.agent.robot, device_of(name)) for name in self.agent.periods}
         self._scalars = self._scalar_groups()
         self._image_bounds = self._uniform_image_bounds()
         self.basic_time_step = self.sim.basic_time_step
@@ -191,7 +191,11 @@ class SensoriumVectorEnv(VectorEnv):
             assert self.sim.cars is not None
             self.sim.cars.roll(self.slot, np.zeros(len(copies)), copies)
         for name, period in self.agent.periods.items():
-            self.sim.enable(self.refs[name], period, copies)
+            if name.endswith(SEGMENTATION):
+                self.sim.recognition_enable(self.refs[name], period, copies)
+                self.sim.enable_segmentation(self.refs[name], True, copies)
+            else:
+                self.sim.enable(self.refs[name], period, copies)
         self.steps[copies] = 0
         self._needs_reset[copies] = False
 
@@ -281,7 +285,8 @@ class SensoriumVectorEnv(VectorEnv):
                 continue
             ref = self.refs[name]
             if ref.kind == "Camera":      # BGRA -> RGB, as the single env's observation
-                out[name] = np.ascontiguousarray(self.sim.image(ref)[copies][..., 2::-1])
+                bgra = self.sim.segmentation_image(ref) if name.endswith(SEGMENTATION) else self.sim.image(ref)
+                out[name] = np.ascontiguousarray(bgra[copies][..., 2::-1])
                 continue
             img = self.sim.range_image(ref)[copies]
             bounds = self._image_bounds.get(name)

@@ -14,7 +14,9 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   wheel of a side: ``set_position``, ``set_velocity``, ``velocity``, ``position``,
   ``max_velocity``), ``device(name).enable(period)`` / ``.value`` (a GPS's ``.values``, ``.speed``,
   ``.speed_vector``, a compass's, a gyro's or an accelerometer's ``.values``, an inertial unit's
-  ``.roll_pitch_yaw``, ``.quaternion``; a bumper's or an altimeter's ``.value``).
+  ``.roll_pitch_yaw``, ``.quaternion``; a bumper's or an altimeter's ``.value``; a camera's ``.image``,
+  ``.recognition_enable(period)``, ``.enable_segmentation(on)``, ``.recognition_objects`` (or
+  ``.objects``) and ``.segmentation_image``: this copy's, batched_recognition.py).
   The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
   side share one state, so commanding one of them commands its side. A car-like robot has
   ``motors`` (its steering and driven wheels) and no ``drive``.
@@ -133,6 +135,27 @@ class _Device:
     def image(self) -> np.ndarray:
         """A camera's latest BGRA image in this copy."""
         return self._s.image(self.ref)[self._c]
+
+    def recognition_enable(self, period_ms: int) -> None:
+        """A camera's recognition in this copy (batched_recognition.py)."""
+        self._s.recognition_enable(self.ref, period_ms, copies=[self._c])
+
+    def enable_segmentation(self, on: bool) -> None:
+        self._s.enable_segmentation(self.ref, on, copies=[self._c])
+
+    @property
+    def recognition_objects(self) -> list:
+        """A camera's latest recognised objects in this copy (``Camera.objects``)."""
+        return self._s.recognition_objects(self.ref, self._c)
+
+    @property
+    def objects(self) -> list:
+        return self.recognition_objects
+
+    @property
+    def segmentation_image(self) -> np.ndarray:
+        """A camera's latest BGRA segmentation image in this copy."""
+        return self._s.segmentation_image(self.ref)[self._c]
 
     def __getattr__(self, name: str) -> Any:
         ref = self.__dict__.get("ref")

@@ -24,7 +24,8 @@ coordinates), compasses, inertial units, gyros, accelerometers, bumpers and alti
 drawn from its own stream (``device_rng(seed, "robot/device")``, drawn ahead in blocks: the same numbers, in
 the same order). Tests compare it with the single simulation step by step.
 
-Not simulated here (use :class:`Simulation`): camera recognition and segmentation, force TouchSensors,
+Camera recognition and segmentation: batched_recognition.py (per copy, enabled with
+:meth:`BatchedSimulation.recognition_enable`). Not simulated here (use :class:`Simulation`): force TouchSensors,
 the kinds without an observation (LEDs, pens, ...), NUE worlds. Textured robot bodies are read per copy
 (batched_textures.py). A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
@@ -54,6 +55,7 @@ from sensorium.server.sim import batched_camera as cam
 from sensorium.server.sim import batched_depth as depth
 from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim import batched_lidar
+from sensorium.server.sim import batched_recognition as recog
 from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batched_lights import CarriedLights
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
@@ -366,6 +368,8 @@ class BatchedSimulation:
         self.depth = depth.DepthDevices(self, lists["RangeFinder"])
         # cameras (batched_camera.py): their pixel rays' constants, every copy's BGRA images
         self.camera = cam.CameraDevices(self, lists["Camera"])
+        # their recognition and segmentation (batched_recognition.py): schedules, objects, images per copy
+        self.recognition = recog.RecognitionDevices(self, lists["Camera"])
         # rotating lidars (batched_lidar.py): every copy's head; None without one (nothing to filter)
         self.rotating_lidars = batched_lidar.RotatingLidars(self, self.lidar) if any(d.rotating for d in self.lidar) else None
         self._lidar_skips: dict[int, np.ndarray] = {}
@@ -478,6 +482,31 @@ class BatchedSimulation:
         ``Camera.image``: black, alpha 255, before the first one)."""
         return self.camera.images[ref.column]
 
+    def recognition_enable(self, ref: DeviceRef, period_ms: int, copies=None) -> None:
+        """A camera's ``recognition_enable(period)`` in the named copies (default: all), counted from
+        each copy's clock (0 disables it, and the segmentation with it)."""
+        self.recognition.enable(self._camera_column(ref), period_ms, slice(None) if copies is None
+                                else np.asarray(copies, dtype=np.int64))
+
+    def enable_segmentation(self, ref: DeviceRef, on: bool, copies=None) -> None:
+        """A camera's ``enable_segmentation(on)`` in the named copies (default: all)."""
+        self.recognition.enable_segmentation(self._camera_column(ref), on, slice(None) if copies is None
+                                             else np.asarray(copies, dtype=np.int64))
+
+    def recognition_objects(self, ref: DeviceRef, copy: int) -> list:
+        """A camera's latest recognised objects in one copy (``Camera.objects``: RecognisedObject)."""
+        return list(self.recognition.objects[copy][self._camera_column(ref)])
+
+    def segmentation_image(self, ref: DeviceRef) -> np.ndarray:
+        """A camera's latest segmentation images in every copy, (copies, height, width, 4) uint8 BGRA
+        (as ``Camera.segmentation_image``: black, alpha 255, before the first one)."""
+        return self.recognition.images[self._camera_column(ref)]
+
+    def _camera_column(self, ref: DeviceRef) -> int:
+        if ref.kind != "Camera":
+            raise ValueError(f"{self.robot_names[ref.slot]}/{ref.name}: a {ref.kind} has no recognition")
+        return ref.column
+
     # ------------------------------------------------------------------ control
     def reset(self, copies: np.ndarray | Sequence[int], world_seeds: Sequence[int]) -> None:
         """The named copies as a world freshly built with these world seeds: clock 0, robots at
@@ -516,6 +545,7 @@ class BatchedSimulation:
         self.kinematic.reset(idx)
         self.depth.reset(idx)
         self.camera.reset(idx)
+        self.recognition.reset(idx)
         self.noise.reseed(idx.tolist(), world_seeds)
         self.counters["resets"] += len(idx)
 
@@ -601,6 +631,7 @@ class BatchedSimulation:
         self._measure_positions(live)
         self.kinematic.measure(live)
         self._measure_rays(live, dt)
+        self.recognition.measure(live)
 
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:

@@ -29,8 +29,8 @@ A textured robot body's texels are looked up per copy at that copy's pose of the
 rows are shaded, and its shadow rays aimed, with that copy's light arrays (the fixed lights, then
 its robots' at its poses: the single camera's arrays).
 
-Recognition and segmentation are not measured (the gym envs observe neither): the batched cameras
-refuse enabling them, and changing the exposure (the world file's exposure is used).
+Recognition and segmentation are batched_recognition.py's (enabled per copy through the simulation,
+never on the template). Changing the exposure is refused (the world file's exposure is used).
 """
 
 from __future__ import annotations
@@ -48,9 +48,10 @@ from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composit
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import _base_color, robot_parts, surface_colors
 
-__all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera"]
+__all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera", "own_body_hits"]
 
 USE = "use Simulation"
+PER_COPY = "BatchedSimulation.recognition_enable / enable_segmentation, or a copy's view"
 
 
 class BatchedCamera(Camera):
@@ -58,10 +59,10 @@ class BatchedCamera(Camera):
     there is refused, never silently kept on the template."""
 
     def recognition_enable(self, period_ms: int) -> None:
-        raise ValueError(f"{self.path}: batched cameras do not measure recognition ({USE})")
+        raise ValueError(f"{self.path}: a batched camera's recognition is enabled per copy ({PER_COPY})")
 
     def enable_segmentation(self, on: bool) -> None:
-        raise ValueError(f"{self.path}: batched cameras do not measure segmentation ({USE})")
+        raise ValueError(f"{self.path}: a batched camera's segmentation is enabled per copy ({PER_COPY})")
 
     def set_exposure(self, exposure: float) -> None:
         raise ValueError(f"{self.path}: batched cameras keep the world file's exposure ({USE})")
@@ -109,6 +110,30 @@ class _Device:
         self.own: OwnBodyRays | None = None
         self.skip: np.ndarray | int | None = None
         self.plan: tuple | None = None
+
+
+def own_body_hits(pixels: PixelDevices, col: int, copies: np.ndarray, h: RayHits) -> RayHits:
+    """A housed device's hits (``pixels.devices[col]``, the copies' cast): the nearer of the world cast
+    and its robot's body (OwnBodyRays.cast, per copy: the body-frame normal turned by that copy's robot
+    rotation, on the same rows)."""
+    dev = pixels.devices[col]
+    if dev.own is None:
+        return h
+    sim = pixels.sim
+    b = dev.own.body_hits(sim.rays.movers)
+    assert b.shape is not None and b.normal is not None and h.shape is not None and h.normal is not None
+    dist, shape, normal = h.distance.copy(), h.shape.copy(), h.normal.copy()
+    offset = sim.rays.shape_offset
+    slot = dev.template.robot_index
+    for k, cc in enumerate(copies.tolist()):
+        a = k * dev.n
+        win = (b.distance < dist[a:a + dev.n]).nonzero()[0]
+        if not len(win):
+            continue
+        dist[a + win] = b.distance[win]
+        shape[a + win] = offset + b.shape[win]
+        normal[a + win] = b.normal[win] @ sim.rot[cc, slot].T          # body frame -> world
+    return RayHits(dist, normal, shape)
 
 
 class CameraDevices(PixelDevices):
@@ -170,25 +195,7 @@ class CameraDevices(PixelDevices):
             sim.last["Camera"][c, col] = sim.time_ms[c]
 
     def _with_own_body(self, col: int, copies: np.ndarray, h: RayHits) -> RayHits:
-        """A housed camera's hits: the nearer of the world cast and its robot's body (OwnBodyRays.cast,
-        per copy: the body-frame normal turned by that copy's robot rotation, on the same rows)."""
-        dev = self.devices[col]
-        if dev.own is None:
-            return h
-        b = dev.own.body_hits(self.sim.rays.movers)
-        assert b.shape is not None and b.normal is not None and h.shape is not None and h.normal is not None
-        dist, shape, normal = h.distance.copy(), h.shape.copy(), h.normal.copy()
-        offset = self.sim.rays.shape_offset
-        slot = dev.template.robot_index
-        for k, cc in enumerate(copies.tolist()):
-            a = k * dev.n
-            win = (b.distance < dist[a:a + dev.n]).nonzero()[0]
-            if not len(win):
-                continue
-            dist[a + win] = b.distance[win]
-            shape[a + win] = offset + b.shape[win]
-            normal[a + win] = b.normal[win] @ self.sim.rot[cc, slot].T          # body frame -> world
-        return RayHits(dist, normal, shape)
+        return own_body_hits(self, col, copies, h)
 
     def _albedo(self, shape: np.ndarray, org: np.ndarray, row_copy: np.ndarray, D: np.ndarray,
                 t: np.ndarray, copies: np.ndarray) -> np.ndarray:

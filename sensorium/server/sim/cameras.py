@@ -346,6 +346,11 @@ class Camera(Device):
             raise ValueError(f"exposure must be a finite number >= 0, got {exposure!r}")
         self.exposure = float(exposure)
 
+    @property
+    def recognition_objects(self) -> list[Any]:
+        """The latest recognised objects (``objects``), by the name a batched copy's view gives them."""
+        return self.objects
+
     def readings(self) -> dict:
         return {"image": self.image}
 

@@ -89,6 +89,16 @@ def _kind(g: Any, base_dir: Any) -> tuple[str, tuple, np.ndarray | None]:
     return "points", (), np.asarray(primitive_from_model(g, base_dir).vertices, dtype=np.float64)
 
 
+def occlusion_ray(cam: Pose, centre: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """The occlusion ray (world direction, length) from the camera at ``cam`` to a camera-frame
+    point, None when the point is the camera's own place (seen)."""
+    d = cam.rotation @ centre
+    dist = float(np.linalg.norm(d))
+    if dist == 0.0:
+        return None
+    return d / dist, dist
+
+
 class Recognizer:
     """The recognisable objects of a scene as one camera (on robot ``own``) sees them."""
 
@@ -142,8 +152,16 @@ class Recognizer:
     def recognise(self, cam: Pose, pixel_objects: np.ndarray | None, counters: Any) -> list[RecognisedObject]:
         """The objects seen from the camera pose ``cam``; ``pixel_objects`` (H·W,) the object index
         each pixel sees (-1 none), needed for occlusion 2."""
+        seen = self.candidates(cam, pixel_objects)
+        if self.config.occlusion == 1:
+            seen = [s for s in seen if self._centre_visible(s[0], cam, s[2], counters)]
+        return self.trim([s[1] for s in seen])
+
+    def candidates(self, cam: Pose, pixel_objects: np.ndarray | None) -> list[tuple[int, RecognisedObject, np.ndarray]]:
+        """(object index, object, its occlusion ray's target in the camera frame) of every object in
+        range, on the image and (occlusion 2) seen by a pixel: those occlusion 1 then tests."""
         c = self.config
-        out: list[RecognisedObject] = []
+        out: list[tuple[int, RecognisedObject, np.ndarray]] = []
         seen_by_pixels = set(np.unique(pixel_objects).tolist()) if pixel_objects is not None else set()
         for k, obj in enumerate(self.objects):
             if obj.key not in self.scene.recognisable:     # removed by a Supervisor
@@ -158,29 +176,36 @@ class Recognizer:
             on_image = rmath.box_on_image(centre, size, self.geometry)
             if on_image is None:
                 continue
-            if c.occlusion == 1 and not self._centre_visible(k, cam, target, counters):
-                continue
             if c.occlusion == 2 and k not in seen_by_pixels:
                 continue
             orientation = axis_angle(cam.rotation.T @ self.scene.owner_pose(obj.key).rotation)
-            out.append(RecognisedObject(obj.id, tuple(float(v) for v in centre), tuple(float(v) for v in orientation),  # type: ignore[arg-type]
-                                        (float(size[1]), float(size[2])), on_image[0], on_image[1], obj.colors,
-                                        obj.model))
+            out.append((k, RecognisedObject(obj.id, tuple(float(v) for v in centre), tuple(float(v) for v in orientation),  # type: ignore[arg-type]
+                                            (float(size[1]), float(size[2])), on_image[0], on_image[1], obj.colors,
+                                            obj.model), target))
+        return out
+
+    def trim(self, out: list[RecognisedObject]) -> list[RecognisedObject]:
+        """``max_objects`` (> 0) keeps the biggest on the image, biggest first."""
+        c = self.config
         if c.max_objects > 0 and len(out) > c.max_objects:     # Webots: -1 and 0 keep every object
             keep = sorted(range(len(out)), key=lambda i: -out[i].size_on_image[0] * out[i].size_on_image[1])
             out = [out[i] for i in keep[:c.max_objects]]      # biggest first, as Webots lists them then
         return out
 
     def _centre_visible(self, k: int, cam: Pose, centre: np.ndarray, counters: Any) -> bool:
-        d = cam.rotation @ centre
-        dist = float(np.linalg.norm(d))
-        if dist == 0.0:
+        ray = occlusion_ray(cam, centre)
+        if ray is None:
             return True
-        hits = self.scene.engine.cast(cam.translation.reshape(1, 3), (d / dist).reshape(1, 3), 0.0, dist,
+        hits = self.scene.engine.cast(cam.translation.reshape(1, 3), ray[0].reshape(1, 3), 0.0, ray[1],
                                       kind=RayKind.VISUAL, exclude_owner=self.own)
         counters["rays_camera"] += 1
         counters["cast_calls"] += 1
-        return not math.isfinite(float(hits.distance[0])) or int(self.key_of[int(hits.shape[0])]) == k
+        return self.reached(k, float(hits.distance[0]), int(hits.shape[0]))
+
+    def reached(self, k: int, distance: float, shape: int) -> bool:
+        """Object ``k``'s occlusion ray (its hit: distance, shape) reached it: nothing in the way, or
+        the object itself first."""
+        return not math.isfinite(distance) or int(self.key_of[shape]) == k
 
     def segmentation(self, pixel_objects: np.ndarray, height: int, width: int) -> np.ndarray:
         """BGRA (H, W, 4): each pixel the first recognition colour of the object it sees, else black."""
