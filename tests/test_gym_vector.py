@@ -288,27 +288,26 @@ def test_pettingzoo_env_on_the_batched_engine_equals_the_rebuilt_simulation(prec
             assert batched._batched.scene.engine.counters["bvh_builds"] == builds     # the reset rebuilt nothing
 
 
-def test_auto_engine_falls_back_to_the_simulation_for_what_the_batched_one_does_not_simulate():
+def test_auto_engine_falls_back_to_the_simulation_for_what_the_batched_one_does_not_simulate(monkeypatch):
+    """Every kind a task can observe is batched now (NUE worlds too: test_batched_nue.py), so the
+    refusal is made here by taking lidars out of the batched kinds: "auto" falls back to a rebuilt
+    Simulation, "batched" and the vector env say why in one line."""
+    from sensorium.server.sim import batched
     from sensorium.server.sim.batched import BatchedError
     from sensorium.server.world.loader import default_world_path, load_world
 
     lw = load_world(default_world_path())
-    data = lw.world.model_dump(mode="json", exclude_none=True)
-    # a NUE world: the batched simulation drives robots in ENU worlds only
-    data["world_info"]["coordinate_system"] = "NUE"
-    from sensorium.server.world.loader import LoadedWorld
-
-    world = LoadedWorld(world=lw.world.model_validate(data), source="nue", base_dir=lw.base_dir)
     task = Task(robot="scout", observations={"lidar": 64}, control_period_ms=64)
-    env = SensoriumEnv(world, task, engine="auto")
+    assert SensoriumEnv(lw, task, engine="auto").engine == "batched"
+    monkeypatch.setattr(batched, "SUPPORTED_KINDS", tuple(k for k in batched.SUPPORTED_KINDS if k != "Lidar"))
+    env = SensoriumEnv(lw, task, engine="auto")
     assert env.engine == "simulation"
     obs, _ = env.reset(seed=0)
     assert obs["lidar"].shape == (1, 360)
-    with pytest.raises(BatchedError, match="ENU worlds only"):
-        SensoriumEnv(world, task, engine="batched")
-    with pytest.raises(BatchedError, match="ENU worlds only"):
-        SensoriumVectorEnv(world, task, 2).reset(seed=0)
-    assert SensoriumEnv(lw, Task(robot="scout", observations={"lidar": 64}), engine="auto").engine == "batched"
+    with pytest.raises(BatchedError, match="device 'lidar' is a Lidar"):
+        SensoriumEnv(lw, task, engine="batched")
+    with pytest.raises(BatchedError, match="is a Lidar.*the batched vector environment cannot run this task"):
+        SensoriumVectorEnv(lw, task, 2).reset(seed=0)
 
 
 @pytest.mark.parametrize("env_id", ["sensorium/AvoidObstacles-v0", "sensorium/LidarAvoid-v0"])

@@ -26,11 +26,15 @@ the same order). Tests compare it with the single simulation step by step.
 
 Camera recognition and segmentation: batched_recognition.py (per copy, enabled with
 :meth:`BatchedSimulation.recognition_enable`). Not simulated here (use :class:`Simulation`): force TouchSensors,
-the kinds without an observation (LEDs, pens, ...), NUE worlds. Textured robot bodies are read per copy
+the kinds without an observation (LEDs, pens, ...). Textured robot bodies are read per copy
 (batched_textures.py). A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
 (``sim.cars.command``; their encoders read its motors), their moves through the same arc, contact
 and placing as the other robots.
+
+In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
+simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
+worlds take the numpy drive pass (the C pass writes ENU poses).
 """
 
 from __future__ import annotations
@@ -60,9 +64,9 @@ from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batched_lights import CarriedLights
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
-from sensorium.server.sim.contact import EPS, Contact, Obstacle, robot_footprint
+from sensorium.server.sim.contact import EPS, Contact, Obstacle, enu_body, enu_pose, robot_footprint
 from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
-from sensorium.server.sim.motion import AckermannDrive, DifferentialDrive, PlanarState, _rz
+from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, PlanarState, _rz
 from sensorium.server.sim.scene import (
     Scene,
     _entry,
@@ -190,6 +194,9 @@ class BatchedSimulation:
         self.copies = C = int(copies)
         self.basic_time_step = w.world_info.basic_time_step
         self._check_supported()
+        # world axes -> ENU (None in an ENU world): the drive state is ENU, as PlanarState's
+        up = w.world_info.coordinate_system
+        self.to_enu: np.ndarray | None = _TO_ENU[up]
         base = world.base_dir
         # -- what never moves, once: the solids' scene (static tier, planes), the lights
         self.scene = Scene(w.model_copy(update={"robots": []}), base, precision)
@@ -254,10 +261,10 @@ class BatchedSimulation:
         self.side_wheels = np.array([[len(n) for n in r.differential_drive.motor_names] if r.differential_drive
                                      else [1, 1] for r in w.robots], dtype=np.int64)
         # the terrains robots ride (sim/ground.py; None in a world without one: heights never change)
-        self.ground = Ground.from_world(w, self.scene.solid_poses, None)
+        self.ground = Ground.from_world(w, self.scene.solid_poses, self.to_enu)
         self._templates: list[PlanarState | None] = [
-            DifferentialDrive(r.differential_drive, self.initial[i], ground=self.ground) if r.differential_drive
-            else AckermannDrive(r.ackermann_drive, self.initial[i], ground=self.ground) if r.ackermann_drive
+            DifferentialDrive(r.differential_drive, self.initial[i], up=up, ground=self.ground) if r.differential_drive
+            else AckermannDrive(r.ackermann_drive, self.initial[i], up=up, ground=self.ground) if r.ackermann_drive
             else None for i, r in enumerate(w.robots)]
         # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
         self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
@@ -288,10 +295,11 @@ class BatchedSimulation:
             solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
-            self.contact = Contact(solids, [])
-            feet = [robot_footprint([(primitive_from_model(shape.geometry, base), local)
-                                     for _, local, shape in robot_parts(r) if shape.seen_by in ("both", "bounding")])
-                    for r in w.robots]
+            self.contact = Contact(solids, [], self.to_enu)
+            feet = [robot_footprint(enu_body([(primitive_from_model(shape.geometry, base), local)
+                                              for _, local, shape in robot_parts(r)
+                                              if shape.seen_by in ("both", "bounding")], self.initial[i], self.to_enu))
+                    for i, r in enumerate(w.robots)]
             self.feet = feet
             nan = math.nan
             self.foot_radius = np.array([f.radius if f else nan for f in feet])
@@ -307,8 +315,8 @@ class BatchedSimulation:
     # ------------------------------------------------------------------ building
     def _check_supported(self) -> None:
         w = self.world
-        if w.world_info.coordinate_system != "ENU":
-            raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU worlds only "
+        if w.world_info.coordinate_system not in _TO_ENU:
+            raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
 
     def _build_devices(self) -> None:
@@ -525,8 +533,9 @@ class BatchedSimulation:
             self.rot[idx, r] = pose.rotation
             self.pos[idx, r] = pose.translation
             if self.contact is not None:
-                self.centres[idx, r] = pose.translation[:2]
-                self.heights[idx, r] = pose.translation[2]
+                at = enu_pose(pose, self.to_enu).translation
+                self.centres[idx, r] = at[:2]
+                self.heights[idx, r] = at[2]
         self.target[idx] = 0.0
         self.velocity[idx] = self.max_wheel
         self.wheel_angle[idx] = 0.0
@@ -554,7 +563,8 @@ class BatchedSimulation:
         check_pose(translation, rotation, quaternion)
         current = self.pose(copy, slot)
         if self.tilted[copy, slot]:   # its own rotation, without the ground's attitude (PlanarState.own_pose)
-            current = Pose(_rz(float(self.yaw[copy, slot])) @ self.base[copy, slot], current.translation)
+            own = _rz(float(self.yaw[copy, slot])) @ self.base[copy, slot]
+            current = Pose(own if self.to_enu is None else self.to_enu.T @ own, current.translation)
         pose = moved_pose(current, translation, rotation, quaternion)
         tpl = self._templates[slot]
         if tpl is not None:
@@ -565,8 +575,9 @@ class BatchedSimulation:
         self.rot[copy, slot] = pose.rotation
         self.pos[copy, slot] = pose.translation
         if self.contact is not None:
-            self.centres[copy, slot] = pose.translation[:2]
-            self.heights[copy, slot] = pose.translation[2]
+            at = enu_pose(pose, self.to_enu).translation
+            self.centres[copy, slot] = at[:2]
+            self.heights[copy, slot] = at[2]
 
     def _take_template(self, idx: np.ndarray, slot: int, tpl: PlanarState) -> None:
         """The copies' drive state of a slot from a template drive just reset to a pose."""
@@ -636,7 +647,9 @@ class BatchedSimulation:
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:
         driven = self._driven
-        if self.cars is not None:     # car-like robots (batched_car.py): their moves join the numpy path's
+        if self.cars is not None or self.to_enu is not None:
+            # car-like robots (batched_car.py): their moves join the numpy path's; a NUE world's
+            # poses are turned into its axes there (the C pass writes ENU poses)
             self._drive_numpy(live, driven, dt_ms / 1000.0)
             return
         if not len(driven):
@@ -713,8 +726,13 @@ class BatchedSimulation:
         rz = np.zeros((len(yaw), 3, 3))
         rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
         rot = self._place(copies, slots, rz, self.base[copies, slots], cos, sin, np.empty((len(yaw), 3, 3)))
+        pos = np.stack([self.x[copies, slots], self.y[copies, slots], self.z[copies, slots]], axis=1)
+        if self.to_enu is not None:   # PlanarState.pose's to_enu.T @ r, to_enu.T @ t (0/1 entries: exact, any order)
+            back = self.to_enu.T
+            rot = np.matmul(back, rot)
+            pos = np.matmul(back, pos[:, :, None])[:, :, 0]
         self.rot[copies, slots] = rot
-        self.pos[copies, slots] = np.stack([self.x[copies, slots], self.y[copies, slots], self.z[copies, slots]], axis=1)
+        self.pos[copies, slots] = pos
 
     def _ride(self, copies: np.ndarray, slots: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
         """PlanarState.settle for the moved robots placed over ground: height and slope under them."""

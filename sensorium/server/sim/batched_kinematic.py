@@ -32,9 +32,9 @@ A GPS in a WGS84 world adds the reference's UTM east / north and altitude (compu
 single model's call) and reads its rows back to latitude / longitude by the single model's inverse
 UTM series, called row by row (:func:`wgs84_positions`).
 
-Not here: a force or force-3d TouchSensor (NaN without physics: refused with one line). The batched
-simulation itself only runs ENU worlds; the roll / pitch / yaw conventions of both are here
-(:func:`roll_pitch_yaw`) and tested against the single model.
+Not here: a force or force-3d TouchSensor (NaN without physics: refused with one line). ENU and NUE
+worlds: the roll / pitch / yaw conventions of both are here (:func:`roll_pitch_yaw`), a WGS84 GPS and
+an altimeter read east / north / up along the world's axes, tested against the single model.
 """
 
 from __future__ import annotations
@@ -79,25 +79,30 @@ def refusal(robot: str, config: Any, world_info: Any) -> str | None:
 
 
 def gps_reference(world_info: Any) -> tuple[np.ndarray, gps_math.Utm | None]:
-    """What gps.position adds to a GPS's (ENU) translation, and the UTM zone its WGS84 values are
-    read back in (None in local coordinates): gps_reference itself, or in a WGS84 world the reference
-    latitude / longitude as UTM east / north (the single model's own call) and its altitude."""
+    """What gps.position adds to a GPS's translation, and the UTM zone its WGS84 values are read
+    back in (None in local coordinates): gps_reference itself, or in a WGS84 world the reference
+    latitude / longitude as UTM east / north and its altitude (the single model's own call), each
+    along its world axis (ENU: x, y, z; NUE: z, x, y)."""
     ref = np.array(world_info.gps_reference, dtype=np.float64)
     if world_info.gps_coordinate_system != "WGS84":
         return ref, None
     utm = gps_math.Utm(float(ref[0]), float(ref[1]))
     north, east = utm.north_east(float(ref[0]), float(ref[1]))
-    return np.array([east, north, float(ref[2])], dtype=np.float64), utm
+    axes = world_info.coordinate_system
+    out = np.empty(3)
+    out[axes.index("E")], out[axes.index("N")], out[axes.index("U")] = east, north, float(ref[2])
+    return out, utm
 
 
-def wgs84_positions(utm: gps_math.Utm, p: np.ndarray) -> np.ndarray:
-    """gps.position's last step for rows of (east, north, up): (latitude°, longitude°, altitude) by the
-    single model's inverse UTM series, row by row (its sin, tan, pow and friends are libm's through
-    ``math``, whose bits numpy's vectorised routines need not give)."""
+def wgs84_positions(utm: gps_math.Utm, p: np.ndarray, axes: str = "ENU") -> np.ndarray:
+    """gps.position's last step for rows of world positions (``axes``: which is east, north, up):
+    (latitude°, longitude°, altitude) by the single model's inverse UTM series, row by row (its sin,
+    tan, pow and friends are libm's through ``math``, whose bits numpy's vectorised routines need not give)."""
+    e, n, u = axes.index("E"), axes.index("N"), axes.index("U")
     out = np.empty_like(p)
-    for k, (east, north, up) in enumerate(p.tolist()):
-        out[k, 0], out[k, 1] = utm.latitude_longitude(north, east)
-        out[k, 2] = up
+    for k, row in enumerate(p.tolist()):
+        out[k, 0], out[k, 1] = utm.latitude_longitude(row[n], row[e])
+        out[k, 2] = row[u]
     return out
 
 
@@ -306,7 +311,7 @@ class KinematicDevices:
         self.unit_noise = np.array([c.noise for c in units], dtype=np.float64)
         self.unit_axes = [np.array([getattr(c, a) for c in units], dtype=bool) for a in ("x_axis", "y_axis", "z_axis")]
         self.quaternion = np.full((C, len(units), 4), math.nan)
-        # Altimeter: the height along up (ENU: z) plus the reference altitude in a WGS84 world
+        # Altimeter: the height along up (ENU: z, NUE: y) plus the reference altitude in a WGS84 world
         self.altitude_offset = float(wi.gps_reference[2]) if wi.gps_coordinate_system == "WGS84" else 0.0
         self.altimeter_accuracy = np.array([d.config.accuracy for d in self.devices["Altimeter"]], dtype=np.float64)
         # the kinds read through a lookup table per enabled axis (axes_through_table): each device's axes on
@@ -443,7 +448,7 @@ class KinematicDevices:
             p[rows] = p[rows] + acc[rows, None] * state
         p = _quantize(p, self.resolution["GPS"][cols])
         if self.utm is not None:
-            p = wgs84_positions(self.utm, p)
+            p = wgs84_positions(self.utm, p, self.axes)
         known = self.has_previous[copies, cols] & (elapsed > 0)
         with np.errstate(invalid="ignore", divide="ignore"):
             vec = np.where(known[:, None], (t - self.previous[copies, cols]) * (1000.0 / elapsed)[:, None], math.nan)
@@ -539,7 +544,7 @@ class KinematicDevices:
         accuracy noise (one normal from its stream), its resolution."""
         _, t = self._frames("Altimeter", copies, cols)
         assert t is not None
-        v = t[:, 2] + self.altitude_offset
+        v = t[:, self.axes.index("U")] + self.altitude_offset
         acc = self.altimeter_accuracy[cols]
         rows = (acc > 0.0).nonzero()[0]
         if len(rows):

@@ -145,6 +145,28 @@ def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None
     return Footprint(max(f.radius for f in feet), min(f.z_low for f in feet), max(f.z_high for f in feet))
 
 
+def enu_pose(pose: Pose, to_enu: np.ndarray | None) -> Pose:
+    """``pose`` in ENU axes (itself in an ENU world, ``to_enu`` None): in a NUE world contact
+    works in the drives' ENU frame."""
+    if to_enu is None:
+        return pose
+    return Pose(to_enu @ pose.rotation, to_enu @ pose.translation)
+
+
+def enu_body(parts: list[tuple[geo.Primitive, Pose]], pose: Pose,
+             to_enu: np.ndarray | None) -> list[tuple[geo.Primitive, Pose]]:
+    """A robot's body shapes for its footprint: as given in an ENU world; in a NUE world turned by
+    the robot's rotation without its turn about up (PlanarState.base), so a robot whose own frame
+    is y-up (base ``to_enu``) or z-up (base identity) gets the same footprint about ENU's up."""
+    if to_enu is None:
+        return parts
+    r = to_enu @ pose.rotation
+    yaw = math.atan2(r[1, 0], r[0, 0])
+    c, s = math.cos(yaw), math.sin(yaw)
+    base = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]) @ r      # Rz(-yaw) @ r
+    return [(prim, Pose(base, np.zeros(3)).compose(local)) for prim, local in parts]
+
+
 def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle | None:
     """A solid's (or robot body's) 2D obstacle at ``pose``; None for a non-vertical plane."""
     if isinstance(prim, geo.Terrain):
@@ -397,11 +419,14 @@ class Contact:
     """The world's static obstacles plus the robots' discs; :meth:`resolve` clips one robot's move."""
 
     def __init__(self, solids: list[tuple[str, geo.Primitive, Pose, Pose, bool]],
-                 robots: list[tuple[list[tuple[geo.Primitive, Pose]], Pose]]):
+                 robots: list[tuple[list[tuple[geo.Primitive, Pose]], Pose]], to_enu: np.ndarray | None = None):
         """``solids``: one entry per shape — (solid name, primitive, pose in the solid's frame, the
         solid's world pose, seen by bounding rays); a solid made of several shapes (or with nested
         children) gives several entries under one name, moved together. ``robots``: (body shapes
-        with their poses in the robot frame, initial pose) in world order."""
+        with their poses in the robot frame, initial pose) in world order. ``to_enu``: world axes to
+        ENU (None in an ENU world): contact is solved in ENU, where the drives keep their planar
+        state, so every pose given (here, :meth:`update_solid`, :meth:`place`) is turned into it."""
+        self._to_enu = to_enu
         self.prims: dict[str, list[tuple[geo.Primitive, Pose]]] = {}
         first_pose: dict[str, Pose] = {}
         for name, prim, local, pose, bounding in solids:
@@ -411,18 +436,20 @@ class Contact:
         self.solids: dict[tuple[str, int], Obstacle] = {}
         for name, pose in first_pose.items():
             self.update_solid(name, pose)
-        self.feet: list[Footprint | None] = [robot_footprint(parts) for parts, _ in robots]
+        self.feet: list[Footprint | None] = [robot_footprint(enu_body(parts, pose, to_enu)) for parts, pose in robots]
         nan = math.nan                            # robots without a footprint never match the broad phase
         self._radius = np.array([f.radius if f else nan for f in self.feet], dtype=np.float64)
         self._z_low = np.array([f.z_low if f else nan for f in self.feet], dtype=np.float64)
         self._z_high = np.array([f.z_high if f else nan for f in self.feet], dtype=np.float64)
-        self.centres = np.array([[p.translation[0], p.translation[1]] for _, p in robots], dtype=np.float64).reshape(-1, 2)
-        self.heights = np.array([p.translation[2] for _, p in robots], dtype=np.float64)
+        starts = [enu_pose(p, to_enu).translation for _, p in robots]
+        self.centres = np.array([[t[0], t[1]] for t in starts], dtype=np.float64).reshape(-1, 2)
+        self.heights = np.array([t[2] for t in starts], dtype=np.float64)
         self.contacts = 0                         # robot-steps whose motion was clipped
         self.checks = 0                           # narrow-phase obstacle tests
         self._rebuild()
 
     def update_solid(self, name: str, pose: Pose) -> None:
+        pose = enu_pose(pose, self._to_enu)
         for i, (prim, local) in enumerate(self.prims.get(name, ())):
             ob = obstacle(name, -1, prim, pose.compose(local))
             if ob is None:
@@ -456,6 +483,7 @@ class Contact:
 
     def place(self, index: int, pose: Pose) -> None:
         """A robot was moved from outside (set_pose, reset): no contact check, as in Webots."""
+        pose = enu_pose(pose, self._to_enu)
         self.centres[index] = pose.translation[:2]
         self.heights[index] = pose.translation[2]
 

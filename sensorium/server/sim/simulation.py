@@ -230,7 +230,7 @@ class Simulation:
         robots = [([(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(r)
                     if shape.seen_by in ("both", "bounding")], self.scene.robot_poses[i])
                   for i, r in enumerate(self.world.robots)]
-        return Contact(solids, robots)
+        return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system])
 
     def place_robot(self, index: int, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check)."""
@@ -440,7 +440,7 @@ class Simulation:
                     drive.settle()
                     moved[k] = (robot, drive, start, drive.pose())
                     if self.contact is not None:
-                        self.contact.heights[robot.index] = moved[k][3].translation[2]
+                        self.contact.heights[robot.index] = drive.z    # (ENU, as contact works)
         for robot, _, _, pose in moved:
             self.scene.set_robot_pose(robot.index, pose)
         poses = self.scene.robot_poses
