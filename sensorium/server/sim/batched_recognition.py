@@ -27,7 +27,7 @@ from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.batched_camera import own_body_hits
 from sensorium.server.sim.batched_depth import PixelDevices
 from sensorium.server.sim.recognition import RecognisedObject, Recognizer, occlusion_ray
-from sensorium.server.sim.scene import robot_parts
+from sensorium.server.sim.scene import recognisable_owners, robot_parts
 from sensorium.server.sim.sensors import _check_period
 from sensorium.server.world.geometry import Pose
 
@@ -48,15 +48,7 @@ class _CopyScene:
         self._parts = [scene.part(i) for i in range(sim.n_static_shapes)]
         self._parts += [(r, local, shape) for r, robot in enumerate(world.robots) for _, local, shape in robot_parts(robot)]
         self.shapes = self._parts                     # (a Recognizer counts them)
-        # the single scene's Supervisor node ids: robots 1..R in world order, then the top-level solids
-        self.recognisable: dict[str | int, tuple[int, list, str]] = {}
-        for i, r in enumerate(world.robots):
-            if r.recognition_colors:
-                self.recognisable[i] = (i + 1, [tuple(c) for c in r.recognition_colors], r.model)
-        for j, sd in enumerate(world.solids):
-            if sd.recognition_colors:
-                self.recognisable[sd.name] = (len(world.robots) + 1 + j, [tuple(c) for c in sd.recognition_colors],
-                                              sd.model)
+        self.recognisable = recognisable_owners(world)     # the single scene's Supervisor node ids
 
     def part(self, shape: int) -> tuple:
         return self._parts[shape]

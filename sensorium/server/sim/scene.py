@@ -202,6 +202,21 @@ def infra_red_terms(red_of: np.ndarray, roughness_of: np.ndarray, sampler: Textu
     return red, rough, occl
 
 
+
+def recognisable_owners(world) -> dict[str | int, tuple[int, list, str]]:
+    """What cameras with a Recognition node report: owner (robot index, solid name) -> (the
+    Supervisor's node id: robots 1..R in world order, then the top-level solids; recognition colours;
+    model)."""
+    out: dict[str | int, tuple[int, list, str]] = {}
+    for i, r in enumerate(world.robots):
+        if r.recognition_colors:
+            out[i] = (i + 1, [tuple(c) for c in r.recognition_colors], r.model)
+    for j, sd in enumerate(world.solids):
+        if sd.recognition_colors:
+            out[sd.name] = (len(world.robots) + 1 + j, [tuple(c) for c in sd.recognition_colors], sd.model)
+    return out
+
+
 class Scene:
     """Geometry and poses of a world; the only owner of the ray engine."""
 
@@ -267,16 +282,7 @@ class Scene:
             self.fog = (srgb_to_linear(np.asarray(fog.color, dtype=np.float64)), float(fog.visibility_range),
                         fog.fog_type)
         self.base_dir = Path(base_dir)
-        # what cameras with a Recognition node report: owner (robot index, solid name) -> (the Supervisor's
-        # node id: robots 1..R in world order, then the top-level solids; recognition colours; model)
-        self.recognisable: dict[str | int, tuple[int, list, str]] = {}
-        for i, r in enumerate(world.robots):
-            if r.recognition_colors:
-                self.recognisable[i] = (i + 1, [tuple(c) for c in r.recognition_colors], r.model)
-        for j, sd in enumerate(world.solids):
-            if sd.recognition_colors:
-                self.recognisable[sd.name] = (len(world.robots) + 1 + j, [tuple(c) for c in sd.recognition_colors],
-                                              sd.model)
+        self.recognisable = recognisable_owners(world)
 
     def _shape_arrays(self) -> None:
         """The per-shape arrays devices index by hit shape (-1, no hit, reads the trailing entry)."""
