@@ -32,26 +32,15 @@ _ZERO = np.zeros(3)
 
 
 @dataclass(frozen=True)
-class RowLights:
-    """Lights as devices/light.py's ``light_terms``/``occlusion_segments_many``/``irradiance_from_terms``
-    read them, with positions and directions per row (S, n, 3): each sensor's copy's lights."""
+class RowLights(light_math.LightArrays):
+    """:class:`~sensorium.server.devices.light.LightArrays` with ``position`` and ``direction`` per row
+    (S, n, 3): each sensor's copy's lights, as devices/light.py's ``light_terms``,
+    ``occlusion_segments_many`` and ``irradiance_from_terms`` read them. Made from the shared arrays
+    (validated and normalised there) and directions normalised per row by :meth:`CarriedLights.rows`,
+    so nothing is checked or reshaped again here."""
 
-    kind: np.ndarray               # (n,)
-    position: np.ndarray           # (S, n, 3)
-    direction: np.ndarray          # (S, n, 3), unit for spot and directional lights
-    attenuation: np.ndarray        # (n, 3)
-    intensity: np.ndarray          # (n,)
-    ambient_intensity: np.ndarray  # (n,)
-    color: np.ndarray              # (n, 3)
-    beam_width: np.ndarray         # (n,)
-    cut_off_angle: np.ndarray      # (n,)
-
-    def __len__(self) -> int:
-        return len(self.kind)
-
-    @property
-    def count(self) -> int:
-        return len(self.kind)
+    def __post_init__(self) -> None:
+        pass
 
 
 class CarriedLights:
