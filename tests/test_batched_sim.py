@@ -609,7 +609,8 @@ def test_arc_steps_in_c_are_the_numpy_arcs_and_poses_bit_for_bit(monkeypatch):
     and math.sin, numpy's remainder) and math.cos/math.sin of the new yaw, bit for bit: robots all
     turning, all straight (|w dt| < 1e-9) and mixed; yaws at +-pi and multiples of 2 pi (remainder
     0), signed zeros, huge angles, NaN speeds; an infinite angle is left to the Python way."""
-    from sensorium.server.sim.batched import _arc_steps, _cos_sin
+    from sensorium.server.sim.batched import _arc_steps
+    from sensorium.server.sim.batched_kinematic import libm_cos_sin as _cos_sin
 
     if packets.library() is None:
         pytest.skip(f"no packets helper: {packets.status()}")
@@ -648,7 +649,7 @@ def test_cos_sin_in_c_are_math_cos_and_sin_bit_for_bit():
     """packets.cos_sin (the batched drive's poses and arcs) gives what math.cos and math.sin give,
     element by element, on random angles of every magnitude, signed zeros, NaN, multiples of pi and
     subnormals; an infinite angle is left to the Python way (math.cos refuses it)."""
-    from sensorium.server.sim.batched import _cos_sin
+    from sensorium.server.sim.batched_kinematic import libm_cos_sin as _cos_sin
 
     if packets.library() is None:
         pytest.skip(f"no packets helper: {packets.status()}")

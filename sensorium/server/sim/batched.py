@@ -666,7 +666,7 @@ class BatchedSimulation:
         copies, slots = step.copies[:k], step.slots[:k]
         if step.status[0]:   # an infinite angle: math.cos refuses it, as in the single simulation
             g = step.gathered
-            _cos_sin(_arc_steps(g[0][:k], g[1][:k], g[2][:k], step.v[:k], step.w[:k], dt)[2])
+            kin.libm_cos_sin(_arc_steps(g[0][:k], g[1][:k], g[2][:k], step.v[:k], step.w[:k], dt)[2])
             raise ValueError("math domain error")
         if step.status[1]:   # a move near something: the narrow phase, slot by slot
             x, y = self._narrow(copies, slots, step.starts[:k], step.ends[:k],
@@ -718,7 +718,7 @@ class BatchedSimulation:
         x0, y0 = self.x[copies, slots], self.y[copies, slots]
         yaw0 = self.yaw[copies, slots]
         x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
-        cos, sin = _cos_sin(yaw)
+        cos, sin = kin.libm_cos_sin(yaw)
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
             x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
@@ -1440,17 +1440,6 @@ def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
     return acc / n
 
 
-def _cos_sin(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """math.cos and math.sin of each element (the single simulation's libm calls, whatever SIMD
-    routines numpy would pick for np.cos on this machine): those libm calls in one C pass where
-    the helper is (packets.cos_sin), else through Python floats."""
-    got = packets.cos_sin(a)
-    if got is not None:
-        return got
-    vals = a.tolist()
-    return np.array(list(map(math.cos, vals))), np.array(list(map(math.sin, vals)))
-
-
 def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):
     """motion.arc_step for many robots, element by element the same float64 operations."""
     dyaw = w * dt
@@ -1458,24 +1447,24 @@ def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: 
     n_straight = int(np.count_nonzero(straight))
     if n_straight == 0:   # every robot turns (or every one goes straight): whole arrays, no gathers
         r = v / w
-        c1, s1 = _cos_sin(yaw + dyaw)
-        c0, s0 = _cos_sin(yaw)
+        c1, s1 = kin.libm_cos_sin(yaw + dyaw)
+        c0, s0 = kin.libm_cos_sin(yaw)
         return x + r * (s1 - s0), y - r * (c1 - c0), np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi
     if n_straight == len(x):
-        cm, sm = _cos_sin(yaw + 0.5 * dyaw)
+        cm, sm = kin.libm_cos_sin(yaw + 0.5 * dyaw)
         return (x + v * dt * cm, y + v * dt * sm, np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi)
     xo, yo = x.copy(), y.copy()
     s = straight.nonzero()[0]
     if len(s):
         mid = yaw[s] + 0.5 * dyaw[s]
-        cm, sm = _cos_sin(mid)
+        cm, sm = kin.libm_cos_sin(mid)
         xo[s] = x[s] + v[s] * dt * cm
         yo[s] = y[s] + v[s] * dt * sm
     t = (~straight).nonzero()[0]
     if len(t):
         r = v[t] / w[t]
-        c1, s1 = _cos_sin(yaw[t] + dyaw[t])
-        c0, s0 = _cos_sin(yaw[t])
+        c1, s1 = kin.libm_cos_sin(yaw[t] + dyaw[t])
+        c0, s0 = kin.libm_cos_sin(yaw[t])
         xo[t] = x[t] + r * (s1 - s0)
         yo[t] = y[t] - r * (c1 - c0)
     return xo, yo, np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi

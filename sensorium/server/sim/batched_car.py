@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.sim.batched_kinematic import libm_each
 
 __all__ = ["CarDrives", "MOTORS"]
 
@@ -129,10 +130,10 @@ class CarDrives:
             kl = -self._curvature(copies, k)
             # sum(u) / sum(hypot(1 - κ y, κ x)), summed as Python's sum (0 + a + b ...)
             u_sum = 0.0 + rolled[:, 0]
-            h_sum = 0.0 + _hypot(1.0 - kl * self.wheel_y[k, 0], kl * self.wheel_x[k, 0])
+            h_sum = 0.0 + libm_each(math.hypot, 1.0 - kl * self.wheel_y[k, 0], kl * self.wheel_x[k, 0])
             for j in range(1, n - 2):
                 u_sum = u_sum + rolled[:, j]
-                h_sum = h_sum + _hypot(1.0 - kl * self.wheel_y[k, j], kl * self.wheel_x[k, j])
+                h_sum = h_sum + libm_each(math.hypot, 1.0 - kl * self.wheel_y[k, j], kl * self.wheel_x[k, j])
             v = u_sum / h_sum
             out.append((copies, np.full(len(copies), self.slots[k], dtype=np.int64), v, v * kl))
         if not out:
@@ -156,8 +157,8 @@ class CarDrives:
     def _curvature(self, copies: np.ndarray, k: int) -> np.ndarray:
         """AckermannDrive.curvature of car k in these copies (1/R, positive turning right)."""
         sign = self.sign[k]
-        tr = _tan(sign * self.angle[copies, k, 0])
-        tl = _tan(sign * self.angle[copies, k, 1])
+        tr = libm_each(math.tan, sign * self.angle[copies, k, 0])
+        tl = libm_each(math.tan, sign * self.angle[copies, k, 1])
         s = tr + tl
         with np.errstate(divide="ignore", invalid="ignore"):
             curv = 2.0 * tr * tl / (self.wheelbase[k] * s)
@@ -179,10 +180,3 @@ class CarDrives:
         if len(mine):
             values[mine] = self.angle[copies[mine], car[mine, 0], car[mine, 1]]
 
-
-def _tan(a: np.ndarray) -> np.ndarray:
-    return np.array(list(map(math.tan, a.tolist())), dtype=np.float64)
-
-
-def _hypot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.array(list(map(math.hypot, a.tolist(), b.tolist())), dtype=np.float64)

@@ -51,8 +51,8 @@ from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.raycast import packets
 from sensorium.server.sim.sensors import GPS, Accelerometer, Altimeter, Compass, Gyro, InertialUnit, TouchSensor
 
-__all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal",
-           "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions", "angular_velocities",
+__all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal", "libm_each",
+           "libm_cos_sin", "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions", "angular_velocities",
            "correlation_ratios"]
 
 KINDS = ("GPS", "Compass", "InertialUnit", "Gyro", "Accelerometer", "TouchSensor", "Altimeter")
@@ -117,18 +117,20 @@ def draws_noise(config: Any) -> bool:
     return False
 
 
-def _libm(fn, *columns: np.ndarray) -> np.ndarray:
-    """``fn`` (a ``math`` function, libm's) of each element: the single models' scalar calls."""
+def libm_each(fn, *columns: np.ndarray) -> np.ndarray:
+    """``fn`` (a ``math`` function, libm's) of each element: the single models' scalar calls (numpy's
+    float64 routines may round differently on this machine)."""
     flat = [c.reshape(-1).tolist() for c in columns]
     return np.array(list(map(fn, *flat)), dtype=np.float64).reshape(columns[0].shape)
 
 
-def _sin_cos(a: np.ndarray, native: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """(math.sin, math.cos) of each element: libm's, in one C pass where the helper is."""
+def libm_cos_sin(a: np.ndarray, native: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """(math.cos, math.sin) of each element: libm's, in one C pass where the helper is
+    (packets.cos_sin), else through Python floats."""
     got = packets.cos_sin(np.ascontiguousarray(a.reshape(-1))) if native and a.dtype == np.float64 else None
     if got is not None:
-        return got[1].reshape(a.shape), got[0].reshape(a.shape)
-    return _libm(math.sin, a), _libm(math.cos, a)
+        return got[0].reshape(a.shape), got[1].reshape(a.shape)
+    return libm_each(math.cos, a), libm_each(math.sin, a)
 
 
 def correlation_ratios(corr: np.ndarray, exponent: np.ndarray, native: bool = True) -> np.ndarray:
@@ -190,7 +192,7 @@ def _axis_turns(angles: np.ndarray, native: bool = True) -> np.ndarray:
     quaternions about x, y, z multiplied in that order, as (4, k) columns."""
     k = len(angles)
     half = angles / 2.0
-    s, c = _sin_cos(half, native)
+    c, s = libm_cos_sin(half, native)
     qs = []
     for axis in range(3):
         q = np.zeros((4, k))
@@ -217,15 +219,15 @@ def inertial_quaternions(q: np.ndarray, gauss: np.ndarray | None, noise: np.ndar
         o = out[off]
         half = packets.half_angles(o) if native else None
         if half is None:
-            sq = [_libm(lambda v: v ** 2, o[:, j]) for j in range(3)]  # numpy's scalar ** 2: libm's pow
-            half = _libm(math.atan2, np.sqrt(sq[0] + sq[1] + sq[2]), o[:, 3])
+            sq = [libm_each(lambda v: v ** 2, o[:, j]) for j in range(3)]  # numpy's scalar ** 2: libm's pow
+            half = libm_each(math.atan2, np.sqrt(sq[0] + sq[1] + sq[2]), o[:, 3])
         axis = o[:, :3].copy()
         axis[~x_axis[off], 0] = 0.0                                  # Webots' mapping: y -> z, z -> y
         axis[~y_axis[off], 2] = 0.0
         axis[~z_axis[off], 1] = 0.0
         norm = np.sqrt(_dots(axis))
         zero = norm == 0.0
-        sin, cos = _sin_cos(half, native)
+        cos, sin = libm_cos_sin(half, native)
         with np.errstate(invalid="ignore", divide="ignore"):
             turned = axis / norm[:, None] * sin[:, None]
         o = np.concatenate([turned, cos[:, None]], axis=1)
@@ -243,16 +245,16 @@ def roll_pitch_yaw(q: np.ndarray, axes: str = "ENU", native: bool = True) -> np.
     x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
 
     def asin_clamped(v: np.ndarray) -> np.ndarray:     # max(-1, min(1, v)) as Python compares (NaN -> 1)
-        return _libm(lambda a: math.asin(max(-1.0, min(1.0, a))), v)
+        return libm_each(lambda a: math.asin(max(-1.0, min(1.0, a))), v)
 
     if axes == "NUE":
-        yaw = _libm(math.atan2, 2 * y * w - 2 * x * z, 1 - 2 * y * y - 2 * z * z)
-        roll = _libm(math.atan2, 2 * x * w - 2 * y * z, 1 - 2 * x * x - 2 * z * z)
+        yaw = libm_each(math.atan2, 2 * y * w - 2 * x * z, 1 - 2 * y * y - 2 * z * z)
+        roll = libm_each(math.atan2, 2 * x * w - 2 * y * z, 1 - 2 * x * x - 2 * z * z)
         pitch = asin_clamped(2 * x * y + 2 * z * w)
     else:
-        roll = _libm(math.atan2, 2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+        roll = libm_each(math.atan2, 2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
         pitch = asin_clamped(2.0 * (w * y - z * x))
-        yaw = _libm(math.atan2, 2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        yaw = libm_each(math.atan2, 2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
     return np.stack([roll, pitch, yaw], axis=1)
 
 
@@ -264,11 +266,11 @@ def angular_velocities(r0: np.ndarray, r1: np.ndarray, dt_s: float, native: bool
     if got is not None:
         return got
     trace = rel[:, 0, 0] + rel[:, 1, 1] + rel[:, 2, 2]                   # np.trace: summed left to right
-    angle = _libm(lambda t: math.acos(max(-1.0, min(1.0, (t - 1.0) / 2.0))), trace)
+    angle = libm_each(lambda t: math.acos(max(-1.0, min(1.0, (t - 1.0) / 2.0))), trace)
     v = np.stack([rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0], rel[:, 1, 0] - rel[:, 0, 1]], axis=1)
     small = angle < 1e-6                                                  # sin(angle) ~ angle: the skew part
     with np.errstate(invalid="ignore", divide="ignore"):
-        turned = v * (angle / (2.0 * _libm(math.sin, angle)))[:, None] / dt_s
+        turned = v * (angle / (2.0 * libm_each(math.sin, angle)))[:, None] / dt_s
     return np.where(small[:, None], v / 2.0 / dt_s, turned)
 
 
