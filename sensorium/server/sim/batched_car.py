@@ -21,6 +21,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched_kinematic import libm_each
+from sensorium.server.sim.motion import wheel_places
 
 __all__ = ["CarDrives", "MOTORS"]
 
@@ -50,18 +51,14 @@ class CarDrives:
         for k, (_, r) in enumerate(cars):
             a = r.ackermann_drive
             assert a is not None
-            L = float(a.wheelbase)
-            place = {"right_front_wheel": (L, -float(a.track_front) / 2, float(a.front_wheel_radius)),
-                     "left_front_wheel": (L, float(a.track_front) / 2, float(a.front_wheel_radius)),
-                     "right_rear_wheel": (0.0, -float(a.track_rear) / 2, float(a.rear_wheel_radius)),
-                     "left_rear_wheel": (0.0, float(a.track_rear) / 2, float(a.rear_wheel_radius))}
+            place = wheel_places(a)
             self.columns.append({name: j for j, (_, name) in enumerate(a.motor_fields)})
             self.n_wheels[k] = len(a.driven)
             self.max_velocity[k, :2] = float(a.max_steering_speed)
             self.max_velocity[k, 2:2 + len(a.driven)] = float(a.max_wheel_speed)
             self.limit[k] = float(a.max_steering_angle)
             self.sign[k] = 1.0 if a.positive_steers == "right" else -1.0
-            self.wheelbase[k] = L
+            self.wheelbase[k] = float(a.wheelbase)
             for j, (field, _) in enumerate(a.driven):
                 self.wheel_x[k, j], self.wheel_y[k, j], self.wheel_r[k, j] = place[field]
         self.target = np.zeros((copies, K, MOTORS))       # inf: velocity control

@@ -265,6 +265,15 @@ def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float
     return math.atan(1.0 / (cot - half)), math.atan(1.0 / (cot + half))
 
 
+def wheel_places(config) -> dict[str, tuple[float, float, float]]:
+    """A car's wheels by drive field: (x, y) on the car (the rear axle's centre at the origin, x
+    forward, y left) and radius."""
+    L, tf, tr = float(config.wheelbase), float(config.track_front), float(config.track_rear)
+    rf, rr = float(config.front_wheel_radius), float(config.rear_wheel_radius)
+    return {"right_front_wheel": (L, -tf / 2, rf), "left_front_wheel": (L, tf / 2, rf),
+            "right_rear_wheel": (0.0, -tr / 2, rr), "left_rear_wheel": (0.0, tr / 2, rr)}
+
+
 class AckermannDrive(PlanarState):
     """A car-like robot: two steered front wheels, driven wheels at the front, the rear or both, the
     robot's origin at the centre of the rear axle (x forward, y left).
@@ -285,9 +294,7 @@ class AckermannDrive(PlanarState):
         self.right_steer = SteeringMotor(config.right_steer, steer_speed, max_position=limit)
         self.left_steer = SteeringMotor(config.left_steer, steer_speed, max_position=limit)
         speed = float(config.max_wheel_speed)
-        L, rf, rr = self.wheelbase, float(config.front_wheel_radius), float(config.rear_wheel_radius)
-        place = {"right_front_wheel": (L, -self.track_front / 2, rf), "left_front_wheel": (L, self.track_front / 2, rf),
-                 "right_rear_wheel": (0.0, -self.track_rear / 2, rr), "left_rear_wheel": (0.0, self.track_rear / 2, rr)}
+        place = wheel_places(config)
         # each driven wheel: its motor, its (x, y) on the car, its radius
         self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
         super().__init__(pose, up, ground)
