@@ -40,77 +40,64 @@ __all__ = ["CopySim", "CopyRobot"]
 
 
 class _Motor:
-    def __init__(self, sim: BatchedSimulation, copy: int, slot: int, name: str):
-        self._s, self._c, self._r, self._w = sim, copy, slot, sim.wheel_side[slot][name]
+    """A motor in one copy, over the batched state arrays that hold it (``target``, ``velocity``,
+    ``angle`` at ``index``): a wheel of a drive, or a car's steering or driven-wheel motor
+    (batched_car.CarDrives; a steering motor's target clamped to +-``limit``)."""
+
+    def __init__(self, name: str, max_velocity: float, arrays: tuple[np.ndarray, np.ndarray, np.ndarray],
+                 index: tuple[int, int, int], limit: float = math.inf):
         self.name = name
-        self.max_velocity = float(sim.max_wheel[slot, self._w])
+        self.max_velocity = max_velocity
+        self._target, self._velocity, self._angle = arrays
+        self._i = index
+        self._limit = limit
+
+    @classmethod
+    def wheel(cls, sim: BatchedSimulation, copy: int, slot: int, name: str) -> _Motor:
+        w = sim.wheel_side[slot][name]
+        return cls(name, float(sim.max_wheel[slot, w]), (sim.target, sim.velocity, sim.wheel_angle), (copy, slot, w))
+
+    @classmethod
+    def car(cls, sim: BatchedSimulation, copy: int, slot: int, name: str) -> _Motor:
+        cars = sim.cars
+        assert cars is not None
+        k, j = cars.column(slot, name)
+        return cls(name, float(cars.max_velocity[k, j]), (cars.target, cars.velocity, cars.angle), (copy, k, j),
+                   float(cars.limit[k]) if j < 2 else math.inf)
 
     @property
     def velocity(self) -> float:
-        return float(self._s.velocity[self._c, self._r, self._w])
+        return float(self._velocity[self._i])
 
     @property
     def position(self) -> float:
-        return float(self._s.wheel_angle[self._c, self._r, self._w])
+        return float(self._angle[self._i])
 
     @property
     def target_position(self) -> float:
-        return float(self._s.target[self._c, self._r, self._w])
+        return float(self._target[self._i])
 
     def set_position(self, value: float) -> None:
         if not isinstance(value, (int, float)) or math.isnan(value):
             raise ValueError(f"motor {self.name!r}: position must be a number or inf, got {value!r}")
-        self._s.target[self._c, self._r, self._w] = float(value)
+        self._target[self._i] = float(min(max(value, -self._limit), self._limit))
 
     def set_velocity(self, value: float) -> None:
         if not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ValueError(f"motor {self.name!r}: velocity must be a finite number, got {value!r}")
-        self._s.velocity[self._c, self._r, self._w] = float(min(max(value, -self.max_velocity), self.max_velocity))
+        self._velocity[self._i] = float(min(max(value, -self.max_velocity), self.max_velocity))
 
 
 class _Drive:
     def __init__(self, sim: BatchedSimulation, copy: int, slot: int):
         left, right = sim.world.robots[slot].differential_drive.motor_names
-        self.lefts = [_Motor(sim, copy, slot, name) for name in left]
-        self.rights = [_Motor(sim, copy, slot, name) for name in right]
+        self.lefts = [_Motor.wheel(sim, copy, slot, name) for name in left]
+        self.rights = [_Motor.wheel(sim, copy, slot, name) for name in right]
         self.left, self.right = self.lefts[0], self.rights[0]
 
     @property
     def motors(self) -> dict[str, _Motor]:
         return {m.name: m for m in (*self.lefts, *self.rights)}
-
-
-class _CarMotor:
-    """A car's steering or driven-wheel motor in one copy (batched_car.CarDrives)."""
-
-    def __init__(self, sim: BatchedSimulation, copy: int, slot: int, name: str):
-        assert sim.cars is not None
-        self._cars, self._c = sim.cars, copy
-        self._k, self._j = sim.cars.column(slot, name)
-        self.name = name
-        self.max_velocity = float(sim.cars.max_velocity[self._k, self._j])
-
-    @property
-    def velocity(self) -> float:
-        return float(self._cars.velocity[self._c, self._k, self._j])
-
-    @property
-    def position(self) -> float:
-        return float(self._cars.angle[self._c, self._k, self._j])
-
-    @property
-    def target_position(self) -> float:
-        return float(self._cars.target[self._c, self._k, self._j])
-
-    def set_position(self, value: float) -> None:
-        if not isinstance(value, (int, float)) or math.isnan(value):
-            raise ValueError(f"motor {self.name!r}: position must be a number or inf, got {value!r}")
-        self._cars.set_position(self._c, self._k, self._j, float(value))
-
-    def set_velocity(self, value: float) -> None:
-        if not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ValueError(f"motor {self.name!r}: velocity must be a finite number, got {value!r}")
-        self._cars.set_velocity(self._c, self._k, self._j, float(value))
 
 
 class _Device:
@@ -175,10 +162,10 @@ class CopyRobot:
         self.model = sim.world.robots[slot]
         if sim.has_drive[slot]:
             self.drive: _Drive | None = _Drive(sim, copy, slot)
-            self.motors: dict[str, _Motor | _CarMotor] = dict(self.drive.motors)
+            self.motors: dict[str, _Motor] = dict(self.drive.motors)
         elif sim.cars is not None and slot in sim.cars.car_of:     # a car: its motors (no drive view)
             self.drive = None
-            self.motors = {name: _CarMotor(sim, copy, slot, name) for name in sim.cars.columns[sim.cars.car_of[slot]]}
+            self.motors = {name: _Motor.car(sim, copy, slot, name) for name in sim.cars.columns[sim.cars.car_of[slot]]}
         else:
             self.drive = None
             self.motors = {}
@@ -190,7 +177,7 @@ class CopyRobot:
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         self._s.set_pose(self._c, self.index, translation, rotation, quaternion)
 
-    def motor(self, name: str) -> _Motor | _CarMotor:
+    def motor(self, name: str) -> _Motor:
         try:
             return self.motors[name]
         except KeyError:
