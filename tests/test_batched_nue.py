@@ -15,6 +15,7 @@ from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix
+from tests._motors import command_motors, random_motor_commands
 
 # ENU -> NUE (x north, y up, z east): the rows of NUE's axes in ENU
 TO_NUE = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
@@ -190,6 +191,7 @@ def test_the_vector_env_in_a_nue_world_is_the_single_env_across_autoresets():
 
     from sensorium.gym import SensoriumEnv, Task
     from sensorium.gym.vector import SensoriumVectorEnv
+    from tests.test_gym_vector import _reset_both, _step_both
 
     world = nue_arena(0)
     task = Task(robot="scout", observations=["lidar", "sonar_front", "gps", "compass", "imu"], max_steps=12,
@@ -197,28 +199,12 @@ def test_the_vector_env_in_a_nue_world_is_the_single_env_across_autoresets():
     n = 3
     venv = SensoriumVectorEnv(world, task, n, precision="fast")
     singles = [SensoriumEnv(world, task, precision="fast", engine="simulation") for _ in range(n)]
-    obs, info = venv.reset(seed=5)
-    for i, env in enumerate(singles):
-        o, inf = env.reset(seed=5 + i)
-        assert all(np.asarray(o[k]).tobytes() == np.asarray(obs[k][i]).tobytes() for k in o)
-        assert inf["pose"].tobytes() == info["pose"][i].tobytes()
+    _reset_both(venv, singles, 5)
     rng = np.random.default_rng(2)
     done = np.zeros(n, dtype=bool)
     resets = 0
     for t in range(40):
-        a = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
-        vobs, vr, vte, vtr, vinfo = venv.step(a)
-        for i, env in enumerate(singles):
-            if done[i]:
-                o, inf = env.reset()
-                r, te, tr = 0.0, False, False
-                resets += 1
-            else:
-                o, r, te, tr, inf = env.step(a[i])
-            assert all(np.asarray(o[k]).tobytes() == np.asarray(vobs[k][i]).tobytes() for k in o), (t, i)
-            assert (r, te, tr) == (vr[i], vte[i], vtr[i]), (t, i)
-            assert inf["pose"].tobytes() == vinfo["pose"][i].tobytes(), (t, i)
-            done[i] = te or tr
+        resets += _step_both(venv, singles, rng.uniform(-1, 1, (n, 2)).astype(np.float32), done, t)[0]
     assert resets >= 3
     venv.close()
     assert SensoriumEnv(world, task, engine="auto").engine == "batched"
@@ -255,22 +241,12 @@ def test_cars_and_a_terrain_in_a_nue_world_are_the_single_simulation_step_by_ste
     rode = 0
     for t in range(120):
         if t % 15 == 0:
-            cmds = {(r.name, m): (rng.uniform(-0.7, 0.7), rng.uniform(-40, 40), rng.random() < 0.3)
-                    for r in loaded.world.robots for _, m in r.drive_motors}
+            cmds = random_motor_commands(rng, loaded.world)
         if t == 60:
             for s in (sim, view):
                 s.robot("van").set_pose(translation=(TO_NUE @ [0.0, -1.0, 0.1]).tolist())
         for s in (sim, view):
-            for (name, m), (pos, vel, hold) in cmds.items():
-                motor = s.robot(name).motors[m]
-                if "steer" in m or m in ("rs", "ls"):
-                    motor.set_position(pos)
-                elif hold:
-                    motor.set_position(pos * 10)
-                    motor.set_velocity(abs(vel))
-                else:
-                    motor.set_position(math.inf)
-                    motor.set_velocity(vel)
+            command_motors(s, cmds)
             s.step()
         for name in sim.robots:
             pose = sim.robot(name).pose

@@ -26,6 +26,7 @@ from sensorium.server.sim.batched import BatchedSimulation  # noqa: E402
 from sensorium.server.sim.motion import ackermann_angles  # noqa: E402
 from sensorium.server.sim.simulation import Simulation  # noqa: E402
 from sensorium.server.world.loader import load_world, parse_world  # noqa: E402
+from tests._motors import command_motors, random_motor_commands  # noqa: E402
 from tests.test_gym_vector import _reset_both, _step_both  # noqa: E402
 
 WORLD = Path(__file__).parent / "worlds" / "cars.yaml"
@@ -212,22 +213,12 @@ def test_the_batched_simulation_drives_cars_as_the_simulation_step_by_step():
                 r.device(d.name).enable(32)
     for t in range(120):
         if t % 15 == 0:
-            cmds = {(r.name, m): (rng.uniform(-0.7, 0.7), rng.uniform(-40, 40), rng.random() < 0.3)
-                    for r in loaded.world.robots for _, m in r.drive_motors}
+            cmds = random_motor_commands(rng, loaded.world)
         if t == 60:
             for s in (sim, view):
                 s.robot("van").set_pose(translation=[0.0, -1.0, 0.1])
         for s in (sim, view):
-            for (name, m), (pos, vel, hold) in cmds.items():
-                motor = s.robot(name).motors[m]
-                if "steer" in m or m in ("rs", "ls"):
-                    motor.set_position(pos)
-                elif hold:
-                    motor.set_position(pos * 10)
-                    motor.set_velocity(abs(vel))
-                else:
-                    motor.set_position(math.inf)
-                    motor.set_velocity(vel)
+            command_motors(s, cmds)
             s.step()
         for name in sim.robots:
             assert sim.robot(name).pose.rotation.tobytes() == view.robot(name).pose.rotation.tobytes(), (t, name)
