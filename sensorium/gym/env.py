@@ -202,6 +202,11 @@ class Agent:
             names = "left, right" if self.car is None else "steering, speed"
             # (the values as a list: an array's repr would break the line)
             raise ValueError(f"{self.robot}: action must be 2 finite {what} ({names}), got {a.tolist()!r}")
+        return self.scaled(a)
+
+    def scaled(self, a: np.ndarray) -> np.ndarray:
+        """Finite float64 actions (..., 2) -> the commands of :meth:`commands`, row by row (the vector
+        env's actions of every sub-env at once)."""
         # a normalized action beyond [-1, 1] asks for more than the wheels give: clipped before the
         # scaling, which is the motors' clamp for any finite value (1e308 * vmax would overflow to inf)
         if self.car is None:
@@ -209,7 +214,9 @@ class Agent:
         if self.actions == "normalized":
             return np.clip(a, -1.0, 1.0) * self.scale
         # (a steering angle beyond the limit is the limit: tan of a huge angle would steer anywhere)
-        return np.array([min(max(a[0], -self.max_steer), self.max_steer), a[1]])
+        out = a.copy()
+        out[..., 0] = np.minimum(np.maximum(a[..., 0], -self.max_steer), self.max_steer)
+        return out
 
     def steering_positions(self, angle: float) -> tuple[float, float]:
         """A car's steering motors' positions (right, left) for a steering angle (rad, positive

@@ -213,28 +213,15 @@ class SensoriumVectorEnv(VectorEnv):
         if not np.isfinite(a).all():
             bad = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
             raise ValueError(f"sub-env {int(copies[bad])}: action must be 2 finite values, got {actions[bad]!r}")
-        if self.agent.car is not None:
-            self._act_car(copies, a)
-            return
-        # (clipped as the single env clips it: the motors' clamp, without an overflow to inf)
-        v = np.clip(a, -1.0, 1.0) * self.agent.vmax if self.agent.actions == "normalized" else a
+        cmd = self.agent.scaled(a)          # (the single env's commands, row by row)
         # (every copy in order: the simulation's own default, a slice rather than a gather)
-        self.sim.set_wheels(self.slot, v[:, 0], v[:, 1], None if copies is self._every else copies)
-
-    def _act_car(self, copies: np.ndarray, a: np.ndarray) -> None:
-        """A car's actions (Agent.commands, row by row the single env's values): its steering motors
-        to the Ackermann angles, its driven wheels to the speed."""
-        assert self.sim.cars is not None
-        if not len(copies):
-            return
-        ag = self.agent
-        if ag.actions == "normalized":
-            cmd = np.clip(a, -1.0, 1.0) * ag.scale
-        else:
-            cmd = a.copy()
-            cmd[:, 0] = np.minimum(np.maximum(a[:, 0], -ag.max_steer), ag.max_steer)
-        right, left = (np.array(side) for side in zip(*map(ag.steering_positions, cmd[:, 0].tolist())))
-        self.sim.cars.command(self.slot, right, left, cmd[:, 1], None if copies is self._every else copies)
+        which = None if copies is self._every else copies
+        if self.agent.car is None:
+            self.sim.set_wheels(self.slot, cmd[:, 0], cmd[:, 1], which)
+        elif len(copies):       # a car: its steering motors to the Ackermann angles, its driven wheels to the speed
+            assert self.sim.cars is not None
+            right, left = (np.array(side) for side in zip(*map(self.agent.steering_positions, cmd[:, 0].tolist())))
+            self.sim.cars.command(self.slot, right, left, cmd[:, 1], which)
 
     def _scalar_groups(self) -> list[tuple[str, list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
         """The observed devices whose values are ``sim.values`` (one value, or three: a GPS, a
