@@ -55,7 +55,6 @@ class RotatingLidars:
         self.head = np.zeros((sim.copies, len(lidars)))   # per copy and lidar column: the head angle (rad)
         self._sweeps: dict[int, dict[float, _Sector]] = {k: {} for k in self.columns}   # per lidar, by head angle
         self._kept_beams = dict.fromkeys(self.columns, 0)   # per lidar: the beams of its kept sectors
-        self._skips: dict[int, np.ndarray] = {}
         self._beam_rows: dict[tuple[int, int], tuple] = {}   # per (lidar, sector length): beam buffers
 
     def reset(self, idx: np.ndarray) -> None:
@@ -70,29 +69,13 @@ class RotatingLidars:
         if got is None:
             lid = self.lidars[col]
             sweep = lmath.rotating_sweep(lid.params, head, lid.frequency, dt_ms)
-            got = _Sector(lid, sweep, self._skip(col))
+            got = _Sector(lid, sweep, self.sim._lidar_skip(col))   # (the fixed lidars' own-body test, decided once)
             beams = lid.config.number_of_layers * max(1, len(sweep.columns))
             if self._kept_beams[col] + beams > _SECTOR_BEAMS_KEPT:
                 kept.clear()
                 self._kept_beams[col] = 0
             kept[head] = got
             self._kept_beams[col] += beams
-        return got
-
-    def _skip(self, col: int) -> np.ndarray:
-        """Per beam (L·W, layer-major): its robot's slot where the beam can never meet that robot's
-        body (beams do not move in the lidar frame: the head's yaw is the column azimuth), else -1.
-        Decided once."""
-        got = self._skips.get(col)
-        if got is None:
-            lid = self.lidars[col]
-            slot = lid.robot_index
-            local = lid.local_pose
-            dirs = np.stack(lid._dir_columns, axis=1) @ local.rotation.T
-            far = lid._t_far.reshape(-1) if isinstance(lid._t_far, np.ndarray) else lid._t_far
-            reach = self.sim.rays.may_reach(slot, RayKind.VISUAL, np.broadcast_to(local.translation, dirs.shape), dirs,
-                                            lid.params.near, far)
-            got = self._skips[col] = np.where(reach, -1, slot).astype(np.int64)
         return got
 
     # -- planning: each step's sectors
