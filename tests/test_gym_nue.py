@@ -1,0 +1,271 @@
+"""The gym helpers in NUE worlds (x north, y up, z east; Webots before R2022a): ``info["pose"]``,
+``random_start``, ``clearance``, ``ReachLight``, ``AvoidObstacles`` (and their vectorised forms)
+and ``render()`` read the world's ENU view (sensorium/gym/frame.py).
+
+Twins: an ENU world and the same world written in NUE axes (every top-level translation, light
+location and direction permuted, every rotation turned by the permutation as an exact quaternion
+product; the robots' own frames and devices unchanged) give the same episodes."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+
+from sensorium.gym import SensoriumEnv, Task
+from sensorium.gym.frame import ENU_AXES, enu_axes
+from sensorium.gym.task import AvoidObstacles, ReachLight, clearance, random_start
+from sensorium.gym.vector import SensoriumVectorEnv
+from sensorium.gym.views import CopySim
+from sensorium.schemas import world as wm
+from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.motion import _TO_ENU
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
+from sensorium.server.world.poses import pose_from_model
+from tests.test_gym_vector import _reset_both, _step_both
+
+TO_NUE = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])    # ENU -> NUE axes
+TO_NUE_Q = (-0.5, -0.5, -0.5, 0.5)     # its quaternion (x, y, z, w): quaternion_matrix gives TO_NUE exactly
+IDENTITY_Q = [0.0, 0.0, 0.0, 1.0]
+
+
+def _qmul(a, b) -> list[float]:
+    """Hamilton product a b of quaternions (x, y, z, w)."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return [aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz]
+
+
+def _nue(v) -> list[float]:
+    """An ENU vector's NUE components (north, up, east): a permutation, exact."""
+    return [v[1], v[2], v[0]]
+
+
+def nue_twin(world: wm.World) -> wm.World:
+    """``world`` (ENU) written in NUE axes: the same place for everything. Checks that every
+    top-level pose came out exactly the permuted ENU pose (rotations whose quaternion product with
+    TO_NUE_Q is exact: the identity, half turns about z, the (1, 1, 1) third turn)."""
+    data = copy.deepcopy(world.model_dump(mode="json", exclude_none=True))
+    data["world_info"]["coordinate_system"] = "NUE"
+    for item in data.get("solids", []) + data.get("robots", []):
+        pose = item.setdefault("pose", {})
+        assert "rotation" not in pose, "twins take quaternions (axis-angle rotations are not exact)"
+        pose["translation"] = _nue(pose.get("translation", [0.0, 0.0, 0.0]))
+        pose["quaternion"] = _qmul(TO_NUE_Q, pose.get("quaternion", IDENTITY_Q))
+    for light in data.get("lights", []):
+        for key in ("location", "direction"):
+            if key in light:
+                light[key] = _nue(light[key])
+    twin = wm.World.model_validate(data)
+    for a, b in zip(world.solids + world.robots, twin.solids + twin.robots):
+        pa, pb = pose_from_model(a.pose), pose_from_model(b.pose)
+        assert (TO_NUE @ pa.rotation == pb.rotation).all() and (TO_NUE @ pa.translation == pb.translation).all(), a.name
+    return twin
+
+
+def arena_twins() -> tuple[LoadedWorld, LoadedWorld]:
+    """The embedded arena with its rotations made exact (the crate turned half a turn, the bollard
+    a third turn about (1, 1, 1), the e-puck facing east, the scout west) and its NUE twin."""
+    lw = load_world(default_world_path())
+    data = lw.world.model_dump(mode="json", exclude_none=True)
+    exact = {"crate": [0.0, 0.0, 1.0, 0.0], "bollard": [0.5, 0.5, 0.5, 0.5], "scout": [0.0, 0.0, 1.0, 0.0]}
+    for item in data["solids"] + data["robots"]:
+        item["pose"].pop("rotation", None)
+        if item["name"] in exact:
+            item["pose"]["quaternion"] = exact[item["name"]]
+    enu = wm.World.model_validate(data)
+    return (LoadedWorld(world=enu, source="arena_enu", base_dir=lw.base_dir),
+            LoadedWorld(world=nue_twin(enu), source="arena_nue", base_dir=lw.base_dir))
+
+
+def _goal_task(goal: str, start: bool, max_steps: int | None = None) -> Task:
+    if goal == "reach":
+        g: ReachLight | AvoidObstacles = ReachLight("lamp", radius=0.2)
+        robot, obs = "epuck", ["ls0", "ls1", *[f"ps{i}" for i in range(8)]]
+    else:
+        g = AvoidObstacles(near=0.3)
+        robot, obs = "scout", ["lidar", "sonar_front", "sonar_left", "sonar_right", "sonar_back"]
+    return Task(robot=robot, observations=obs, control_period_ms=64, max_steps=max_steps, reward=g,
+                terminated=g.terminated, start=random_start((-0.5, 0.5), (-0.3, 0.3)) if start else None)
+
+
+def _close(a, b, tol: float) -> bool:
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    return a.shape == b.shape and (np.array_equal(a, b) if tol == 0.0 else bool(np.all(np.abs(a - b) <= tol)))
+
+
+# ------------------------------------------------------------------------------ the ENU view itself
+
+def test_enu_axes_index_the_simulations_own_world_to_enu_permutation():
+    enu, nue = arena_twins()
+    assert enu_axes(enu.world) == ENU_AXES == (0, 1, 2)
+    axes = enu_axes(nue.world)
+    assert axes == (2, 0, 1)                              # east is z, north x, up y
+    v = np.array([1.5, -2.25, 3.125])
+    assert (v[list(axes)] == _TO_ENU["NUE"] @ v).all()
+
+
+def _upright_world(rotation: list[float] | None) -> wm.World:
+    """A NUE world: a robot whose own frame is y up (Webots before R2022a) at north 1, height 0.04,
+    east 2 (``rotation``: its axis-angle, None facing north), a lamp at north 3, height 0.5, east 4;
+    a wall whose west face is 0.55 m east of the robot; a floor."""
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "coordinate_system": "NUE"},
+        "solids": [{"name": "floor", "pose": {"quaternion": list(TO_NUE_Q)}, "geometry": {"type": "plane"}},
+                   {"name": "wall", "pose": {"translation": [1.0, 0.1, 2.6]},
+                    "geometry": {"type": "box", "size": [2.0, 0.2, 0.1]}}],
+        "lights": [{"type": "PointLight", "name": "lamp", "location": [3.0, 0.5, 4.0]}],
+        "robots": [{"name": "bot", "pose": {"translation": [1.0, 0.04, 2.0],
+                                            **({"rotation": rotation} if rotation else {})},
+                    "body": {"geometry": {"type": "sphere", "radius": 0.04}},
+                    "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 10.0},
+                    "devices": [{"device": "DistanceSensor", "name": "ahead", "lookup_table": [[0, 0, 0], [2, 2, 0]]}]}]})
+
+
+@pytest.mark.parametrize("rotation, yaw", [(None, math.pi / 2), ([0.0, 1.0, 0.0, math.pi / 2], math.pi),
+                                           ([0.0, 1.0, 0.0, -math.pi / 2], 0.0)])
+def test_info_pose_in_a_nue_world_is_east_north_and_the_yaw_about_up(rotation, yaw):
+    """Closed form: a robot at north 1, east 2 gives info["pose"] (2, 1, yaw), its heading's angle
+    counter-clockwise about up from east -- facing north π/2, turned a quarter about y (its x axis
+    to -z) west: π, the other way east: 0 -- in the single env (both engines) and the vector env."""
+    world = _upright_world(rotation)
+    task = Task(robot="bot", observations=["ahead"], max_steps=None)
+    infos = [SensoriumEnv(world, task, engine=engine).reset(seed=0)[1]["pose"] for engine in ("simulation", "batched")]
+    venv = SensoriumVectorEnv(world, task, 2)
+    infos += list(venv.reset(seed=0)[1]["pose"])
+    for pose in infos:
+        assert pose[0] == 2.0 and pose[1] == 1.0
+        assert abs(math.remainder(pose[2] - yaw, 2.0 * math.pi)) <= 1e-15, pose
+    assert len({p.tobytes() for p in infos}) == 1
+
+
+def test_clearance_in_a_nue_world_casts_on_the_ground_plane():
+    """Closed form: the wall's west face is 0.55 m east of the robot (world +z), the floor 0.04 m
+    below it: clearance is 0.55 (its rays lie in the x-z plane; rays in the x-y plane would see the
+    floor at 0.04 and miss the wall), in a Simulation and in a batched copy, and AvoidObstacles'
+    vectorised gap is the single env's."""
+    world = _upright_world(None)
+    sim = Simulation(LoadedWorld(world=world, source="nue", base_dir=default_world_path().parent))
+    view = CopySim(BatchedSimulation(world, 2), 1)
+    for s in (sim, view):
+        assert clearance(s, s.robot("bot")) == pytest.approx(0.55, abs=1e-12)
+        assert clearance(s, s.robot("bot"), max_distance=0.5) == 0.5
+    goal = AvoidObstacles(near=1.0)
+    gap = goal._gap(sim, sim.robot("bot"))
+    assert gap == pytest.approx(0.55 - 0.04, abs=1e-12)                # less the body's radius
+    vec = goal.vectorized(view._s, 0)
+    assert vec.gaps(np.array([0, 1])).tolist() == [gap, gap]
+
+
+def test_reach_light_measures_the_horizontal_distance_in_a_nue_world():
+    """Closed form: the lamp is 2 m east and 2 m north of the robot and 0.46 m above it: ReachLight
+    measures sqrt(8) (east and north, not north and height), as its vectorised form does."""
+    world = _upright_world(None)
+    sim = Simulation(world)
+    goal = ReachLight("lamp")
+    assert goal.distance(sim, sim.robot("bot")) == math.hypot(2.0, 2.0)
+    bs = BatchedSimulation(world, 3)
+    vec = goal.vectorized(bs, 0)
+    vec.reset(np.arange(3))
+    assert vec.distance(np.arange(3)).tolist() == [math.hypot(2.0, 2.0)] * 3
+
+
+# ------------------------------------------------------------------------------ random_start
+
+@pytest.mark.parametrize("own_up", ["z", "y"])
+def test_random_start_in_a_nue_world_keeps_the_robot_upright_and_at_its_height(own_up):
+    """A robot whose own frame is z up (the arena twin's scout, facing west) or y up (Webots before
+    R2022a's robots: facing north at the identity): random_start draws east from its x range,
+    north from its y range and the yaw, as the ENU world's start draws them (the same generator
+    calls); the robot lands at (north, its height, east), its own up axis along the world's y,
+    its own x axis level at the drawn yaw about up from east -- in a Simulation and a batched copy."""
+    if own_up == "z":
+        world, robot, up_col = arena_twins()[1], "scout", 2
+    else:
+        world, robot, up_col = LoadedWorld(world=_upright_world(None), source="nue", base_dir=default_world_path().parent), "bot", 1
+    start = random_start((-0.5, 0.5), (-0.3, 0.3))
+    sims = [Simulation(world), CopySim(BatchedSimulation(world, 2), 1)]
+    height = float(sims[0].robot(robot).pose.translation[1])
+    for seed in range(20):
+        want = np.random.default_rng(seed)
+        east, north, yaw = want.uniform(-0.5, 0.5), want.uniform(-0.3, 0.3), want.uniform(-math.pi, math.pi)
+        for s in sims:
+            start(s, s.robot(robot), np.random.default_rng(seed))
+            pose = s.robot(robot).pose
+            assert pose.translation.tolist() == [north, height, east]
+            r = pose.rotation
+            assert np.abs(r[:, up_col] - [0.0, 1.0, 0.0]).max() <= 1e-15, (seed, r)
+            assert abs(r[1, 0]) <= 1e-15                                   # forward level
+            assert abs(math.remainder(math.atan2(r[0, 0], r[2, 0]) - yaw, 2.0 * math.pi)) <= 1e-15
+            assert abs(np.linalg.det(r) - 1.0) <= 1e-14                     # a rotation (to rounding)
+        assert sims[0].robot(robot).pose.rotation.tobytes() == sims[1].robot(robot).pose.rotation.tobytes()
+
+
+# ------------------------------------------------------------------------------ twins
+
+@pytest.mark.parametrize("engine", ["simulation", "batched"])
+@pytest.mark.parametrize("goal", ["reach", "avoid"])
+@pytest.mark.parametrize("start", [False, True])
+def test_an_enu_world_and_its_nue_twin_give_the_same_single_env_episode(goal, start, engine):
+    """The arena and its NUE twin, the same seed and actions (EXACT rays): info["pose"], rewards,
+    terminations, clearance and every observation step by step are the same values -- exactly
+    from the world-file start; with random_start within 1e-9 (its NUE rotation is a quaternion,
+    the ENU one the axis-angle turn about z: the two agree to rounding, 1e-16)."""
+    enu, nue = arena_twins()
+    tol = 1e-9 if start else 0.0
+    envs = [SensoriumEnv(w, _goal_task(goal, start), precision="exact", engine=engine) for w in (enu, nue)]
+    (o1, i1), (o2, i2) = (env.reset(seed=7) for env in envs)
+    rng = np.random.default_rng(3)
+    moved = 0.0
+    for t in range(120):
+        assert _close(i1["pose"], i2["pose"], tol), (t, i1["pose"], i2["pose"])
+        assert all(_close(o1[k], o2[k], tol) for k in o1), t
+        robot = envs[0].agent.robot
+        c1, c2 = (clearance(env.sim, env.sim.robot(robot)) for env in envs)
+        assert _close(c1, c2, tol), t
+        a = rng.uniform(-1.0, 1.0, 2).astype(np.float32)
+        a[:] = np.abs(a) if t % 30 < 20 else a          # mostly forward: into walls and obstacles
+        (o1, r1, te1, tr1, i1), (o2, r2, te2, tr2, i2) = (env.step(a) for env in envs)
+        assert _close(r1, r2, tol) and te1 == te2 and tr1 == tr2, (t, r1, r2, te1, te2)
+        moved = max(moved, float(np.hypot(*(i1["pose"][:2]))))
+        if te1:
+            break
+    assert moved > 0.1
+
+
+@pytest.mark.parametrize("goal", ["reach", "avoid"])
+def test_an_enu_world_and_its_nue_twin_give_the_same_vector_env_episodes(goal):
+    """The batched vector env on the arena and on its NUE twin with random starts, ReachLight's or
+    AvoidObstacles' vectorised form: the same rewards, flags, poses and observations (within 1e-9,
+    random_start's rounding) across autoresets; and on the NUE twin every sub-env is the single
+    env with its seed, bit for bit (observations, rewards, flags, clocks, poses)."""
+    enu, nue = arena_twins()
+    n = 3
+    # (each env its own task: a goal keeps its previous distance)
+    venvs = [SensoriumVectorEnv(w, _goal_task(goal, True, max_steps=15), n, precision="exact") for w in (enu, nue)]
+    (o1, i1), (o2, i2) = (v.reset(seed=5) for v in venvs)
+    rng = np.random.default_rng(2)
+    ended = 0
+    for t in range(45):
+        assert _close(i1["pose"], i2["pose"], 1e-9), t
+        assert all(_close(o1[k], o2[k], 1e-9) for k in o1), t
+        a = rng.uniform(-1.0, 1.0, (n, 2)).astype(np.float32)
+        (o1, r1, te1, tr1, i1), (o2, r2, te2, tr2, i2) = (v.step(a) for v in venvs)
+        assert _close(r1, r2, 1e-9) and (te1 == te2).all() and (tr1 == tr2).all(), (t, r1, r2)
+        ended += int((te1 | tr1).sum())
+    assert ended >= 3
+    venvs[0].close()
+    singles = [SensoriumEnv(nue, _goal_task(goal, True, max_steps=15), precision="exact", engine="simulation")
+               for _ in range(n)]
+    _reset_both(venvs[1], singles, 5)
+    rng = np.random.default_rng(2)
+    done = np.zeros(n, dtype=bool)
+    resets = 0
+    for t in range(45):
+        resets += _step_both(venvs[1], singles, rng.uniform(-1.0, 1.0, (n, 2)).astype(np.float32), done, t)[0]
+    venvs[1].close()
+    assert resets >= 3
