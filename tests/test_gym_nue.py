@@ -117,7 +117,7 @@ def _upright_world(rotation: list[float] | None) -> wm.World:
         "world_info": {"basic_time_step": 16, "coordinate_system": "NUE"},
         "solids": [{"name": "floor", "pose": {"quaternion": list(TO_NUE_Q)}, "geometry": {"type": "plane"}},
                    {"name": "wall", "pose": {"translation": [1.0, 0.1, 2.6]},
-                    "geometry": {"type": "box", "size": [2.0, 0.2, 0.1]}}],
+                    "geometry": {"type": "box", "size": [2.0, 0.2, 0.1]}, "appearance": {"base_color": [0.5, 0.5, 0.5]}}],
         "lights": [{"type": "PointLight", "name": "lamp", "location": [3.0, 0.5, 4.0]}],
         "robots": [{"name": "bot", "pose": {"translation": [1.0, 0.04, 2.0],
                                             **({"rotation": rotation} if rotation else {})},
@@ -269,3 +269,92 @@ def test_an_enu_world_and_its_nue_twin_give_the_same_vector_env_episodes(goal):
         resets += _step_both(venvs[1], singles, rng.uniform(-1.0, 1.0, (n, 2)).astype(np.float32), done, t)[0]
     venvs[1].close()
     assert resets >= 3
+
+
+def _hills() -> wm.World:
+    """An ENU world of hills (a random terrain on a floor) and a rover with a distance sensor and a
+    two-layer lidar (tests/test_gym_vector.py's hilly world)."""
+    heights = np.random.default_rng(3).uniform(0.0, 0.4, 81)
+    return wm.World.model_validate({
+        "solids": [{"name": "floor", "geometry": {"type": "plane"}},
+                   {"name": "hills", "pose": {"translation": [-2.0, -2.0, 0.0]},
+                    "geometry": {"type": "elevation_grid", "height": heights.tolist(), "x_dimension": 9,
+                                 "x_spacing": 0.5, "y_dimension": 9, "y_spacing": 0.5}}],
+        "robots": [{"name": "rover", "pose": {"translation": [0.1, 0.2, 0.5]},
+                    "body": {"geometry": {"type": "cylinder", "radius": 0.08, "height": 0.05}},
+                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 15.0},
+                    "devices": [{"device": "DistanceSensor", "name": "ahead", "lookup_table": [[0, 0, 0], [3, 3, 0]],
+                                 "pose": {"rotation": [0, 1, 0, 0.3]}},
+                                {"device": "Lidar", "name": "scan", "horizontal_resolution": 32,
+                                 "number_of_layers": 2, "vertical_field_of_view": 0.2, "max_range": 3.0}]}]})
+
+
+def test_random_starts_on_a_nue_terrain_keep_the_clearance_and_ride_it_as_the_enu_twin():
+    """Hills and their NUE twin: random_start in NUE lands the rover at its world-file clearance
+    (0.5 m less the ground under its world-file place) above the ground where it lands, measured
+    along y; driving over the hills, the twins' poses (heights and attitudes included), lidar and
+    distance readings agree within 1e-9 step by step, and the NUE vector env's sub-envs are its
+    single envs bit for bit across autoresets."""
+    enu = _hills()
+    nue = nue_twin(enu)
+
+    def task() -> Task:
+        return Task(robot="rover", observations=["ahead", "scan"], max_steps=15,
+                    start=random_start((-1.5, 1.5), (-1.5, 1.5)))
+
+    envs = [SensoriumEnv(w, task(), precision="exact") for w in (enu, nue)]
+    (o1, _), (o2, _) = (env.reset(seed=9) for env in envs)
+    ground = envs[1].sim.ground
+    north, up, east = envs[1].sim.robot("rover").pose.translation
+    assert abs(up - (ground.at(east, north)[0] + 0.5 - ground.at(0.1, 0.2)[0])) <= 1e-12
+    tilted = 0
+    for t in range(15):
+        a = np.full(2, 0.8, dtype=np.float32)
+        (o1, r1, te1, tr1, i1), (o2, r2, te2, tr2, i2) = (env.step(a) for env in envs)
+        p1, p2 = (env.sim.robot("rover").pose for env in envs)
+        assert _close(p1.translation, TO_NUE.T @ p2.translation, 1e-9), t
+        assert _close(p1.rotation, TO_NUE.T @ p2.rotation, 1e-9), t
+        assert _close(i1["pose"], i2["pose"], 1e-9) and all(_close(o1[k], o2[k], 1e-9) for k in o1), t
+        tilted += abs(p2.rotation[1, 2]) < 1.0 - 1e-6          # the rover's own z off the world's up (y)
+    assert tilted > 5
+    n = 3
+    venv = SensoriumVectorEnv(nue, task(), n, precision="exact")
+    singles = [SensoriumEnv(nue, task(), precision="exact", engine="simulation") for _ in range(n)]
+    _reset_both(venv, singles, 5)
+    rng = np.random.default_rng(2)
+    done = np.zeros(n, dtype=bool)
+    resets = 0
+    for t in range(40):
+        a = np.repeat(np.abs(rng.uniform(-1.0, 1.0, (n, 1))), 2, axis=1).astype(np.float32)   # straight on
+        resets += _step_both(venv, singles, a, done, t)[0]
+    venv.close()
+    assert resets >= 3
+
+
+def test_render_of_a_nue_world_is_its_enu_twins_image():
+    """render() looks down the up axis with east to the right and north up: the arena and its NUE
+    twin give the same top-down image after the same random start and actions, in the single env
+    (both engines) and the vector env; and in a NUE world a lamp east and north of the robot is
+    drawn right of and above it."""
+    enu, nue = arena_twins()
+    images = []
+    for w in (enu, nue):
+        for engine in ("simulation", "batched"):
+            env = SensoriumEnv(w, _goal_task("avoid", True), render_mode="rgb_array", precision="exact", engine=engine)
+            env.reset(seed=4)
+            for _ in range(6):
+                env.step(np.array([0.6, 1.0], dtype=np.float32))
+            images.append(env.render())
+        venv = SensoriumVectorEnv(w, _goal_task("avoid", True), 2, render_mode="rgb_array", precision="exact")
+        venv.reset(seed=4)
+        for _ in range(6):
+            venv.step(np.tile(np.array([0.6, 1.0], dtype=np.float32), (2, 1)))
+        images.append(venv.render()[0])
+    assert all(img.tobytes() == images[0].tobytes() for img in images[1:])
+    assert len(np.unique(images[0].reshape(-1, 3), axis=0)) > 5           # walls, floor, objects, robots
+    env = SensoriumEnv(_upright_world(None), Task(robot="bot", observations=["ahead"]), render_mode="rgb_array")
+    env.reset(seed=0)
+    img = env.render()
+    lamp = np.argwhere((img == (255, 230, 40)).all(axis=2)).mean(axis=0)       # (row, column)
+    body = np.argwhere((img == (255, 255, 255)).all(axis=2)).mean(axis=0)      # the (white) robot and its heading
+    assert lamp[1] > body[1] + 10 and lamp[0] < body[0] - 10
