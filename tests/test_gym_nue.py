@@ -358,3 +358,29 @@ def test_render_of_a_nue_world_is_its_enu_twins_image():
     lamp = np.argwhere((img == (255, 230, 40)).all(axis=2)).mean(axis=0)       # (row, column)
     body = np.argwhere((img == (255, 255, 255)).all(axis=2)).mean(axis=0)      # the (white) robot and its heading
     assert lamp[1] > body[1] + 10 and lamp[0] < body[0] - 10
+
+
+def test_the_pettingzoo_env_on_a_nue_twin_gives_the_same_agents_episodes():
+    """SensoriumParallelEnv with both arena robots as agents (the e-puck to the lamp, the scout
+    avoiding obstacles, random starts) on the arena and its NUE twin: every agent's pose info,
+    reward, flags and observations agree step by step (within 1e-9, random_start's rounding)."""
+    pytest.importorskip("pettingzoo")
+    from sensorium.gym.multi import SensoriumParallelEnv
+
+    def tasks() -> dict[str, Task]:
+        return {"epuck": _goal_task("reach", True, max_steps=40), "scout": _goal_task("avoid", True, max_steps=40)}
+
+    envs = [SensoriumParallelEnv(w, tasks(), precision="exact") for w in arena_twins()]
+    (o1, i1), (o2, i2) = (env.reset(seed=11) for env in envs)
+    rng = np.random.default_rng(6)
+    steps = 0
+    while envs[0].agents:
+        assert envs[0].agents == envs[1].agents
+        for a in envs[0].agents:
+            assert _close(i1[a]["pose"], i2[a]["pose"], 1e-9) and all(_close(o1[a][k], o2[a][k], 1e-9) for k in o1[a])
+        acts = {a: rng.uniform(-1.0, 1.0, 2).astype(np.float32) for a in envs[0].agents}
+        (o1, r1, te1, tr1, i1), (o2, r2, te2, tr2, i2) = (env.step(acts) for env in envs)
+        for a in acts:
+            assert _close(r1[a], r2[a], 1e-9) and te1[a] == te2[a] and tr1[a] == tr2[a], (steps, a)
+        steps += 1
+    assert steps >= 10
