@@ -156,9 +156,34 @@ def test_clearance_in_a_nue_world_casts_on_the_ground_plane():
         assert clearance(s, s.robot("bot"), max_distance=0.5) == 0.5
     goal = AvoidObstacles(near=1.0)
     gap = goal._gap(sim, sim.robot("bot"))
-    assert gap == pytest.approx(0.55 - 0.04, abs=1e-12)                # less the body's radius
+    # less the body's radius as contact sees it: the y-up sphere turned into ENU, its circumscribed sphere
+    assert gap == pytest.approx(0.55 - 0.04 * math.sqrt(2.0), abs=1e-12)
     vec = goal.vectorized(view._s, 0)
     assert vec.gaps(np.array([0, 1])).tolist() == [gap, gap]
+
+
+@pytest.mark.parametrize("own_up", ["y", "z"])
+def test_avoid_obstacles_takes_the_body_radius_the_nue_contact_takes(own_up):
+    """AvoidObstacles' gap is the clearance less the robot's body radius as the kinematic contact
+    sees it: in a NUE world the radius of its body turned into ENU (contact.enu_body) -- a box robot
+    built y up (0.1 x 0.3 x 0.1, 0.3 tall) or z up (turned by the NUE twin's exact rotation) gets
+    the contact's own disc, the single and the vectorised goal alike."""
+    size = [0.1, 0.3, 0.1] if own_up == "y" else [0.1, 0.1, 0.3]
+    pose = {"translation": [0.0, 0.15, 0.0]} if own_up == "y" else {"translation": [0.0, 0.15, 0.0], "quaternion": list(TO_NUE_Q)}
+    world = wm.World.model_validate({
+        "world_info": {"coordinate_system": "NUE"},
+        "robots": [{"name": "bot", "pose": pose, "body": {"geometry": {"type": "box", "size": size}},
+                    "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 10.0}}]})
+    bs = BatchedSimulation(world, 1)
+    contact_radius = float(bs.foot_radius[0])
+    goal = AvoidObstacles()
+    assert goal.vectorized(bs, 0).radius == contact_radius
+    sim = Simulation(world)
+    free = goal._gap(sim, sim.robot("bot"))                      # nothing around: the clearance is its far end
+    assert free == pytest.approx(max(goal.near, goal.contact_distance) + 1e-6, abs=1e-12)
+    assert goal._radius == contact_radius
+    if own_up == "z":
+        assert contact_radius == math.hypot(0.05, 0.05)           # the ENU robot's disc, exactly
 
 
 def test_reach_light_measures_the_horizontal_distance_in_a_nue_world():

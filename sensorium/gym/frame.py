@@ -20,19 +20,25 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
 
-__all__ = ["ENU_AXES", "enu_axes", "planar_pose", "horizontal_directions", "upright_quaternion"]
+__all__ = ["ENU_AXES", "to_enu", "enu_axes", "planar_pose", "horizontal_directions", "upright_quaternion"]
 
 ENU_AXES = (0, 1, 2)
 """An ENU world's east, north and up axes: its own x, y, z."""
 
 
+def to_enu(world: wm.World) -> np.ndarray | None:
+    """The simulation's world-to-ENU permutation matrix for the world's ``coordinate_system``
+    (ENU = matrix @ world; None in an ENU world)."""
+    return _TO_ENU[world.world_info.coordinate_system]
+
+
 def enu_axes(world: wm.World) -> tuple[int, int, int]:
     """The world axes that are east, north and up (``ENU_AXES`` in an ENU world; in a NUE world
-    (2, 0, 1): east is z, north x, up y): the rows of the simulation's world-to-ENU permutation."""
-    to_enu = _TO_ENU[world.world_info.coordinate_system]
-    if to_enu is None:
+    (2, 0, 1): east is z, north x, up y): the rows of :func:`to_enu`."""
+    turn = to_enu(world)
+    if turn is None:
         return ENU_AXES
-    east, north, up = (int(np.flatnonzero(row)[0]) for row in to_enu)
+    east, north, up = (int(np.flatnonzero(row)[0]) for row in turn)
     return east, north, up
 
 

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from sensorium.gym.frame import ENU_AXES, enu_axes, horizontal_directions, upright_quaternion
+from sensorium.gym.frame import ENU_AXES, enu_axes, horizontal_directions, to_enu, upright_quaternion
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.batched_lights import copy_world_lights
@@ -88,16 +88,21 @@ def clearance(sim, robot, rays: int = 32, max_distance: float = 1.0) -> float:
     return float(d.min()) if d.size else float(max_distance)
 
 
-def body_radius(robot, base_dir=None) -> float:
+def body_radius(robot, base_dir=None, world=None) -> float:
     """Horizontal radius of the disc about the robot's origin that contains its body shapes, as the
-    kinematic contact sees it (0 without a body)."""
+    kinematic contact sees it (0 without a body): in a NUE ``world`` about the world's up (y), its
+    body turned as its world-file rotation stands it (contact.enu_body)."""
     from pathlib import Path
 
-    from sensorium.server.sim.contact import robot_footprint
+    from sensorium.server.sim.contact import enu_body, robot_footprint
     from sensorium.server.sim.scene import primitive_from_model, robot_parts
+    from sensorium.server.world.poses import pose_from_model
 
     base = Path(base_dir) if base_dir is not None else Path.cwd()
     parts = [(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(robot.model)]
+    turn = to_enu(world) if world is not None else None
+    if turn is not None:
+        parts = enu_body(parts, pose_from_model(robot.model.pose), turn)
     foot = robot_footprint(parts)
     return float(foot.radius) if foot is not None else 0.0
 
@@ -275,7 +280,7 @@ class AvoidObstacles:
     def _gap(self, sim, robot) -> float:
         key = (id(sim), robot.index)
         if self._radius_key != key:
-            self._radius_key, self._radius = key, body_radius(robot, sim.loaded.base_dir)
+            self._radius_key, self._radius = key, body_radius(robot, sim.loaded.base_dir, sim.world)
         r = self._radius
         return clearance(sim, robot, max_distance=r + max(self.near, self.contact_distance) + 1e-6) - r
 
@@ -312,7 +317,7 @@ class _AvoidObstaclesCopies(VectorGoal):
 
     def __init__(self, goal: AvoidObstacles, sim, slot: int):
         self.goal, self.sim, self.slot = goal, sim, slot
-        self.radius = body_radius(SimpleNamespace(model=sim.world.robots[slot]), sim.loaded.base_dir)
+        self.radius = body_radius(SimpleNamespace(model=sim.world.robots[slot]), sim.loaded.base_dir, sim.world)
         self.dirs = horizontal_directions(enu_axes(sim.world), self.RAYS)   # clearance()'s directions
         self.vmax = float(sim.max_wheel[slot, 0])
         self.wheels = sim.world.robots[slot].differential_drive is not None    # (a car has no wheel pair)
