@@ -409,3 +409,20 @@ def test_the_pettingzoo_env_on_a_nue_twin_gives_the_same_agents_episodes():
             assert _close(r1[a], r2[a], 1e-9) and te1[a] == te2[a] and tr1[a] == tr2[a], (steps, a)
         steps += 1
     assert steps >= 10
+
+
+def test_render_draws_a_y_up_nue_robots_heading_from_its_horizontal_extent():
+    """The heading line of a robot is 1.4 times its body's reach on its own level axes: for a NUE
+    robot built y up (a 0.1 x 0.3 x 0.1 box, 0.3 tall, facing north) 1.4 x 0.05 m, not its height."""
+    data = _upright_world(None).model_dump(mode="json", exclude_none=True)
+    data["robots"][0]["body"] = {"geometry": {"type": "box", "size": [0.1, 0.3, 0.1]},
+                                 "appearance": {"base_color": [0.0, 0.0, 1.0]}}
+    data["robots"][0]["pose"]["translation"][1] = 0.15
+    data["solids"][0]["appearance"] = {"base_color": [0.3, 0.3, 0.3]}        # (a floor without one is white)
+    env = SensoriumEnv(wm.World.model_validate(data), Task(robot="bot", observations=["ahead"]), render_mode="rgb_array")
+    env.reset(seed=0)
+    img = env.render()
+    rows, cols = np.nonzero((img == (255, 255, 255)).all(axis=2))   # the heading line alone (the body is blue)
+    assert len(set(cols.tolist())) == 1                              # straight up the image: north
+    length = rows.max() - rows.min() + 1
+    assert abs(length - 1.4 * 0.05 * env._renderer.scale) <= 1.5, (length, env._renderer.scale)

@@ -20,7 +20,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
 
-__all__ = ["ENU_AXES", "to_enu", "enu_axes", "planar_pose", "horizontal_directions", "upright_quaternion"]
+__all__ = ["ENU_AXES", "to_enu", "enu_axes", "planar_pose", "horizontal_directions", "own_up", "upright_quaternion"]
 
 ENU_AXES = (0, 1, 2)
 """An ENU world's east, north and up axes: its own x, y, z."""
@@ -59,14 +59,20 @@ def horizontal_directions(axes: tuple[int, int, int], count: int) -> np.ndarray:
     return dirs
 
 
+def own_up(axes: tuple[int, int, int], rotation: np.ndarray) -> tuple[int, float]:
+    """A robot's own up axis at ``rotation``: which of its own y (1) and z (2) axes is closer to the
+    world's up, and its sign (+1 pointing up). Its own x is its forward, never up."""
+    up = rotation[axes[2], :]                        # the world's up component of each own axis
+    k = 1 if abs(up[1]) > abs(up[2]) else 2
+    return k, (1.0 if up[k] >= 0.0 else -1.0)
+
+
 def upright_quaternion(axes: tuple[int, int, int], rotation: np.ndarray, yaw: float) -> tuple[float, float, float, float]:
     """The rotation (a quaternion, x y z w) of a robot whose pose has ``rotation`` turned upright
     and to ``yaw`` (counter-clockwise about up from east): its own x axis (forward) level at that
     heading, and whichever of its own y and z axes is closer to the world's up (its up axis) along
     the world's up -- a NUE robot built y-up (Webots before R2022a) and one built z-up both stand."""
-    enu = rotation[list(axes), :]                    # the rotation seen in ENU axes (rows permuted: exact)
-    k = 1 if abs(enu[2, 1]) > abs(enu[2, 2]) else 2   # its own axis closest to up
-    s = 1.0 if enu[2, k] >= 0.0 else -1.0
+    k, s = own_up(axes, rotation)
     # own frame -> a frame facing east on level ground: x forward, the up axis up, the third right-handed
     level = np.zeros((3, 3))
     level[0, 0] = 1.0

@@ -15,10 +15,11 @@ from typing import Any
 
 import numpy as np
 
-from sensorium.gym.frame import enu_axes
+from sensorium.gym.frame import ENU_AXES, enu_axes, own_up
 from sensorium.schemas import world as wm
 from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
 from sensorium.server.world.geometry import Plane, Pose, tessellate
+from sensorium.server.world.poses import pose_from_model
 
 BACKGROUND = (40, 40, 46)
 
@@ -62,11 +63,18 @@ class TopDown:
     def __init__(self, sim, size: int = 256, margin: float = 0.1):
         self.sim = sim
         self.size = int(size)
-        e, n, self._up = enu_axes(sim.world)
+        axes = enu_axes(sim.world)
+        e, n, self._up = axes
         self._ground = [e, n]          # the world axes drawn to the right and up the image
-        # each robot: its body shapes' vertices in the robot frame, with their colours
+        # each robot: its body shapes' vertices in the robot frame, with their colours, and its own
+        # horizontal axes (x and y; in a NUE world x and the one of y, z its world-file pose has level)
         self._robot_parts: list[list[tuple[np.ndarray, tuple[int, int, int]]]] = []
+        self._robot_level: list[list[int]] = []
         for r in sim.world.robots:
+            level = [0, 1]
+            if axes != ENU_AXES:
+                level = [0, 3 - own_up(axes, pose_from_model(r.pose).rotation)[0]]
+            self._robot_level.append(level)
             parts = []
             for _, local, shape in robot_parts(r):
                 prim = primitive_from_model(shape.geometry, sim.loaded.base_dir)
@@ -168,13 +176,13 @@ class TopDown:
         for lt in self.sim.scene.world_lights():
             if lt.type != "DirectionalLight" and lt.on:
                 self._disc(img, np.asarray(lt.location)[self._ground], 4, (255, 230, 40))
-        for rb, parts in zip(self.sim.robots.values(), self._robot_parts):
+        for rb, parts, level in zip(self.sim.robots.values(), self._robot_parts, self._robot_level):
             pose = rb.pose
             reach = 4.0 / self.scale
             if parts:
                 for v, col in parts:
                     self._fill(img, _hull(pose.apply(v)[:, self._ground]), col)
-                reach = max(max(float(np.abs(v[:, :2]).max()) for v, _ in parts), 2.0 / self.scale)
+                reach = max(max(float(np.abs(v[:, level]).max()) for v, _ in parts), 2.0 / self.scale)
             else:
                 self._disc(img, pose.translation[self._ground], 3, (200, 200, 200))
             at = pose.translation[self._ground]
