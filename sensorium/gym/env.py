@@ -64,6 +64,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from sensorium.gym.frame import enu_axes, planar_pose
 from sensorium.gym.render import TopDown, TopDownRendering
 from sensorium.gym.task import Task
 from sensorium.gym.views import CopySim
@@ -100,6 +101,7 @@ class Agent:
         self.task = task
         self.actions = actions
         w = loaded.world
+        self.axes = enu_axes(w)       # the world's east, north, up (info["pose"] is in them)
         basic = w.world_info.basic_time_step
         robots = {r.name: r for r in w.robots}
         name = task.robot or default_robot
@@ -273,10 +275,11 @@ class Agent:
         return reward, terminated, bool(truncated)
 
     def info(self, sim: Simulation, steps: int) -> dict[str, Any]:
+        """``time_ms``, ``steps`` and ``pose``: the robot's (east, north, yaw) in the world's ENU view
+        (:mod:`sensorium.gym.frame`; in an ENU world its x, y and heading about z)."""
         pose = sim.robot(self.robot).pose
-        fwd = pose.rotation[:, 0]
         return {"time_ms": sim.time_ms, "steps": steps,
-                "pose": np.array([pose.translation[0], pose.translation[1], math.atan2(fwd[1], fwd[0])])}
+                "pose": np.array(planar_pose(self.axes, pose.translation, pose.rotation))}
 
 
 OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "GPS", "Compass", "InertialUnit",

@@ -1,9 +1,11 @@
 """Top-down RGB picture of a simulation (``env.render()``): numpy only, no GUI, no OpenGL.
 
-Every shape (of solids, their nested children and multi-shape bodies) is drawn as the convex hull of its tessellation projected on the world's xy plane,
-filled with its ``base_color``, lowest top first (so a tall wall covers the floor); sized planes
+Every shape (of solids, their nested children and multi-shape bodies) is drawn as the convex hull of its tessellation projected on the world's
+ground plane, filled with its ``base_color``, lowest top first (so a tall wall covers the floor); sized planes
 (floors) are drawn first. Robots are drawn on top with a white heading line, lights as yellow
-dots. The view covers the bounding box of everything drawn plus a margin; image row 0 is +y.
+dots. The view looks down the world's up axis with east to the right and north up (the world's
+ENU view, :mod:`sensorium.gym.frame`: in an ENU world +x right, +y up the image; in a NUE world +z
+right, +x up); it covers the bounding box of everything drawn plus a margin.
 """
 
 from __future__ import annotations
@@ -13,9 +15,11 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.gym.frame import ENU_AXES, enu_axes, own_up
 from sensorium.schemas import world as wm
 from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
 from sensorium.server.world.geometry import Plane, Pose, tessellate
+from sensorium.server.world.poses import pose_from_model
 
 BACKGROUND = (40, 40, 46)
 
@@ -59,9 +63,18 @@ class TopDown:
     def __init__(self, sim, size: int = 256, margin: float = 0.1):
         self.sim = sim
         self.size = int(size)
-        # each robot: its body shapes' vertices in the robot frame, with their colours
+        axes = enu_axes(sim.world)
+        e, n, self._up = axes
+        self._ground = [e, n]          # the world axes drawn to the right and up the image
+        # each robot: its body shapes' vertices in the robot frame, with their colours, and its own
+        # horizontal axes (x and y; in a NUE world x and the one of y, z its world-file pose has level)
         self._robot_parts: list[list[tuple[np.ndarray, tuple[int, int, int]]]] = []
+        self._robot_level: list[list[int]] = []
         for r in sim.world.robots:
+            level = [0, 1]
+            if axes != ENU_AXES:
+                level = [0, 3 - own_up(axes, pose_from_model(r.pose).rotation)[0]]
+            self._robot_level.append(level)
             parts = []
             for _, local, shape in robot_parts(r):
                 prim = primitive_from_model(shape.geometry, sim.loaded.base_dir)
@@ -70,8 +83,9 @@ class TopDown:
             self._robot_parts.append(parts)
         floors, static = self._solid_polygons()
         pts = [h for _, h, _ in static] + [f for f, _ in floors]
-        pts += [np.asarray(rb.pose.translation[:2])[None, :] for rb in sim.robots.values()]
-        pts += [np.array([lt.location[:2]]) for lt in sim.scene.world_lights() if lt.type != "DirectionalLight"]
+        pts += [np.asarray(rb.pose.translation[self._ground])[None, :] for rb in sim.robots.values()]
+        pts += [np.asarray(lt.location)[self._ground][None, :] for lt in sim.scene.world_lights()
+                if lt.type != "DirectionalLight"]
         allp = np.concatenate(pts) if pts else np.zeros((1, 2))
         lo, hi = allp.min(axis=0), allp.max(axis=0)
         span = float(max(hi[0] - lo[0], hi[1] - lo[1], 1e-3)) * (1.0 + 2.0 * margin)
@@ -83,10 +97,11 @@ class TopDown:
     def _solid_polygons(self) -> tuple[list[tuple[np.ndarray, tuple[int, int, int]]],
                                        list[tuple[float, np.ndarray, tuple[int, int, int]]]]:
         """The solids' shapes at their poses now (a removed solid has none): sized planes as
-        (corners xy, colour), every other shape as (top z, hull xy, colour), lowest top first."""
+        (corners on the ground plane, colour), every other shape as (top along up, hull on the
+        ground plane, colour), lowest top first."""
         base = self.sim.loaded.base_dir
         poses = self.sim.scene.solid_poses
-        static: list[tuple[float, np.ndarray, tuple[int, int, int]]] = []   # (top z, hull, colour)
+        static: list[tuple[float, np.ndarray, tuple[int, int, int]]] = []   # (top, hull, colour)
         floors: list[tuple[np.ndarray, tuple[int, int, int]]] = []
         for solid in self.sim.world.solids:
             frame = poses.get(solid.name)
@@ -100,10 +115,10 @@ class TopDown:
                         continue
                     sx, sy = prim.size[0] / 2.0, prim.size[1] / 2.0
                     corners = pose.apply(np.array([[-sx, -sy, 0], [sx, -sy, 0], [sx, sy, 0], [-sx, sy, 0]], float))
-                    floors.append((corners[:, :2], _color(shape)))
+                    floors.append((corners[:, self._ground], _color(shape)))
                     continue
                 w = pose.apply(tessellate(prim)[0])
-                static.append((float(w[:, 2].max()), _hull(w[:, :2]), _color(shape)))
+                static.append((float(w[:, self._up].max()), _hull(w[:, self._ground]), _color(shape)))
         static.sort(key=lambda item: item[0])
         return floors, static
 
@@ -118,7 +133,7 @@ class TopDown:
 
     # -------------------------------------------------------------------------------- drawing
     def _px(self, xy: np.ndarray) -> np.ndarray:
-        """World xy (n, 2) -> pixel coordinates (column, row) as floats."""
+        """Ground-plane points (east, north) (n, 2) -> pixel coordinates (column, row) as floats."""
         rel = (np.asarray(xy, dtype=np.float64) - self.center) * self.scale
         return np.stack([rel[..., 0] + self.size / 2.0, self.size / 2.0 - rel[..., 1]], axis=-1)
 
@@ -160,19 +175,20 @@ class TopDown:
         img = self._static.copy()
         for lt in self.sim.scene.world_lights():
             if lt.type != "DirectionalLight" and lt.on:
-                self._disc(img, np.asarray(lt.location[:2]), 4, (255, 230, 40))
-        for rb, parts in zip(self.sim.robots.values(), self._robot_parts):
+                self._disc(img, np.asarray(lt.location)[self._ground], 4, (255, 230, 40))
+        for rb, parts, level in zip(self.sim.robots.values(), self._robot_parts, self._robot_level):
             pose = rb.pose
             reach = 4.0 / self.scale
             if parts:
                 for v, col in parts:
-                    self._fill(img, _hull(pose.apply(v)[:, :2]), col)
-                reach = max(max(float(np.abs(v[:, :2]).max()) for v, _ in parts), 2.0 / self.scale)
+                    self._fill(img, _hull(pose.apply(v)[:, self._ground]), col)
+                reach = max(max(float(np.abs(v[:, level]).max()) for v, _ in parts), 2.0 / self.scale)
             else:
-                self._disc(img, pose.translation[:2], 3, (200, 200, 200))
-            fwd = pose.rotation[:2, 0]
+                self._disc(img, pose.translation[self._ground], 3, (200, 200, 200))
+            at = pose.translation[self._ground]
+            fwd = pose.rotation[self._ground, 0]
             norm = math.hypot(*fwd) or 1.0
-            self._line(img, pose.translation[:2], pose.translation[:2] + fwd / norm * reach * 1.4, (255, 255, 255))
+            self._line(img, at, at + fwd / norm * reach * 1.4, (255, 255, 255))
         return img
 
 

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from sensorium.gym.frame import ENU_AXES, enu_axes, horizontal_directions, to_enu, upright_quaternion
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.batched_lights import copy_world_lights
@@ -74,34 +75,34 @@ class Task:
 
 # ------------------------------------------------------------------------------------------ helpers
 
-def _planar(pose) -> tuple[float, float, float]:
-    fwd = pose.rotation[:, 0]
-    return float(pose.translation[0]), float(pose.translation[1]), math.atan2(fwd[1], fwd[0])
-
-
 def clearance(sim, robot, rays: int = 32, max_distance: float = 1.0) -> float:
     """Smallest distance (m) from the robot's centre to anything seen by bounding rays, over
-    ``rays`` horizontal directions at the centre's height, ignoring the robot's own body; at most
-    ``max_distance``. Obstacles entirely below or above the centre are not seen."""
+    ``rays`` horizontal directions (on the world's ground plane: normal to y in a NUE world) at the
+    centre's height, ignoring the robot's own body; at most ``max_distance``. Obstacles entirely
+    below or above the centre are not seen."""
     pose = robot.pose
-    angles = np.arange(rays) * (2.0 * math.pi / rays)
-    dirs = np.stack([np.cos(angles), np.sin(angles), np.zeros(rays)], axis=1)
+    dirs = horizontal_directions(enu_axes(sim.world), rays)
     origins = np.broadcast_to(pose.translation, dirs.shape)
     hits = sim.scene.engine.cast(origins, dirs, 0.0, max_distance, kind=RayKind.BOUNDING, exclude_owner=robot.index)
     d = hits.distance[np.isfinite(hits.distance)]
     return float(d.min()) if d.size else float(max_distance)
 
 
-def body_radius(robot, base_dir=None) -> float:
+def body_radius(robot, base_dir=None, world=None) -> float:
     """Horizontal radius of the disc about the robot's origin that contains its body shapes, as the
-    kinematic contact sees it (0 without a body)."""
+    kinematic contact sees it (0 without a body): in a NUE ``world`` about the world's up (y), its
+    body turned as its world-file rotation stands it (contact.enu_body)."""
     from pathlib import Path
 
-    from sensorium.server.sim.contact import robot_footprint
+    from sensorium.server.sim.contact import enu_body, robot_footprint
     from sensorium.server.sim.scene import primitive_from_model, robot_parts
+    from sensorium.server.world.poses import pose_from_model
 
     base = Path(base_dir) if base_dir is not None else Path.cwd()
     parts = [(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(robot.model)]
+    turn = to_enu(world) if world is not None else None
+    if turn is not None:
+        parts = enu_body(parts, pose_from_model(robot.model.pose), turn)
     foot = robot_footprint(parts)
     return float(foot.radius) if foot is not None else 0.0
 
@@ -110,23 +111,37 @@ class random_start:
     """``Task.start``: put the robot at a uniformly random (x, y, yaw) in the given ranges, at its
     world-file height (in a world with terrains: its world-file clearance above the ground there,
     so it rides the terrain from where it lands). Draws from the environment's seeded generator,
-    so a seed fixes the start."""
+    so a seed fixes the start.
+
+    The ranges are the world's ENU view (:mod:`sensorium.gym.frame`): ``x`` east, ``y`` north, ``yaw``
+    counter-clockwise about up from east. In an ENU world the robot's rotation becomes the turn
+    ``yaw`` about z; in a NUE world (x north, y up, z east) ``x`` ranges over the world's z, ``y``
+    over its x, the height is kept along y, and the robot stands upright (the one of its own y and
+    z axes that was closer to up along the world's y) with its own x axis at ``yaw``."""
 
     def __init__(self, x: tuple[float, float], y: tuple[float, float], yaw: tuple[float, float] = (-math.pi, math.pi)):
         self.x, self.y, self.yaw = x, y, yaw
 
     def __call__(self, sim, robot, rng: np.random.Generator) -> None:
-        z = float(robot.pose.translation[2])
+        axes = enu_axes(sim.world)
+        e, n, u = axes
+        now = robot.pose
+        z = float(now.translation[u])
         x = rng.uniform(*self.x)
         y = rng.uniform(*self.y)
         yaw = rng.uniform(*self.yaw)
-        ground = getattr(sim, "ground", None)
+        ground = getattr(sim, "ground", None)         # (in ENU axes in any world)
         if ground is not None:
-            here = ground.at(float(robot.pose.translation[0]), float(robot.pose.translation[1]))
+            here = ground.at(float(now.translation[e]), float(now.translation[n]))
             there = ground.at(x, y)
             if here is not None and there is not None:
                 z = there[0] + (z - here[0])
-        robot.set_pose([x, y, z], rotation=[0.0, 0.0, 1.0, yaw])
+        if axes == ENU_AXES:
+            robot.set_pose([x, y, z], rotation=[0.0, 0.0, 1.0, yaw])
+            return
+        place = [0.0, 0.0, 0.0]
+        place[e], place[n], place[u] = x, y, z
+        robot.set_pose(place, quaternion=upright_quaternion(axes, now.rotation, yaw))
 
 
 # ------------------------------------------------------------------------------------------ examples
@@ -147,22 +162,27 @@ class ReachLight:
         self._previous = math.inf
 
     def target(self, sim) -> np.ndarray:
-        return self.target_among(sim.scene.world_lights())   # also lights carried by solids and robots, placed
+        # also lights carried by solids and robots, placed
+        return self.target_among(sim.scene.world_lights(), enu_axes(sim.world))
 
-    def target_among(self, lights: list) -> np.ndarray:
-        """The (x, y) of the light this goal drives to among light models placed in the world."""
+    def target_among(self, lights: list, axes: tuple[int, int, int] = ENU_AXES) -> np.ndarray:
+        """The (east, north) of the light this goal drives to among light models placed in the
+        world (``axes``: the world's east, north and up, :func:`~sensorium.gym.frame.enu_axes`)."""
         for lt in lights:
             if lt.type == "DirectionalLight":
                 continue
             if self.light is None or lt.name == self.light:
-                return np.array(lt.location[:2], dtype=np.float64)
+                return np.array([lt.location[axes[0]], lt.location[axes[1]]], dtype=np.float64)
         raise ValueError(f"ReachLight: the world has no point or spot light named {self.light!r}"
                          if self.light else "ReachLight: the world has no point or spot light")
 
     def distance(self, sim, robot) -> float:
+        """The robot's horizontal distance to the light (on the ground plane, east and north)."""
         if self._target is None:
             self._target = self.target(sim)
-        return float(np.hypot(*(robot.pose.translation[:2] - self._target)))
+        e, n, _ = enu_axes(sim.world)
+        t = robot.pose.translation
+        return float(np.hypot(t[e] - self._target[0], t[n] - self._target[1]))
 
     def reset(self, sim, robot) -> None:
         self._target = self.target(sim)
@@ -209,18 +229,20 @@ class _ReachLightCopies(VectorGoal):
         self.targets: np.ndarray | None = np.zeros((sim.copies, 2)) if any(r.lights for r in sim.world.robots) else None
         self.target = goal.target(sim) if self.targets is None else np.zeros(2)
         self.previous = np.full(sim.copies, math.inf)
+        self.axes = enu_axes(sim.world)
 
     def distance(self, copies: np.ndarray) -> np.ndarray:
         p = self.sim.pos[copies, self.slot]
+        e, n, _ = self.axes
         if self.targets is not None:
             t = self.targets[copies]
-            return np.hypot(p[:, 0] - t[:, 0], p[:, 1] - t[:, 1])
-        return np.hypot(p[:, 0] - self.target[0], p[:, 1] - self.target[1])
+            return np.hypot(p[:, e] - t[:, 0], p[:, n] - t[:, 1])
+        return np.hypot(p[:, e] - self.target[0], p[:, n] - self.target[1])
 
     def reset(self, copies: np.ndarray) -> None:
         if self.targets is not None:
             for c in copies.tolist():
-                self.targets[c] = self.goal.target_among(copy_world_lights(self.sim, c))
+                self.targets[c] = self.goal.target_among(copy_world_lights(self.sim, c), self.axes)
         self.previous[copies] = self.distance(copies)
 
     def reward(self, copies: np.ndarray) -> np.ndarray:
@@ -258,7 +280,7 @@ class AvoidObstacles:
     def _gap(self, sim, robot) -> float:
         key = (id(sim), robot.index)
         if self._radius_key != key:
-            self._radius_key, self._radius = key, body_radius(robot, sim.loaded.base_dir)
+            self._radius_key, self._radius = key, body_radius(robot, sim.loaded.base_dir, sim.world)
         r = self._radius
         return clearance(sim, robot, max_distance=r + max(self.near, self.contact_distance) + 1e-6) - r
 
@@ -295,9 +317,8 @@ class _AvoidObstaclesCopies(VectorGoal):
 
     def __init__(self, goal: AvoidObstacles, sim, slot: int):
         self.goal, self.sim, self.slot = goal, sim, slot
-        self.radius = body_radius(SimpleNamespace(model=sim.world.robots[slot]), sim.loaded.base_dir)
-        angles = np.arange(self.RAYS) * (2.0 * math.pi / self.RAYS)     # clearance()'s directions, bit for bit
-        self.dirs = np.stack([np.cos(angles), np.sin(angles), np.zeros(self.RAYS)], axis=1)
+        self.radius = body_radius(SimpleNamespace(model=sim.world.robots[slot]), sim.loaded.base_dir, sim.world)
+        self.dirs = horizontal_directions(enu_axes(sim.world), self.RAYS)   # clearance()'s directions
         self.vmax = float(sim.max_wheel[slot, 0])
         self.wheels = sim.world.robots[slot].differential_drive is not None    # (a car has no wheel pair)
         self._gap: tuple | None = None     # (step key, copies, gaps, terminations or None)

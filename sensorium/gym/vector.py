@@ -313,10 +313,14 @@ class SensoriumVectorEnv(VectorEnv):
         rot = self.sim.rot[copies, self.slot]
         pos = self.sim.pos[copies, self.slot]
         pose = np.empty((len(pos), 3))
-        pose[:, :2] = pos[:, :2]
+        e, n, _ = self.agent.axes              # (east, north, yaw) as the single env's frame.planar_pose
+        if e == 0 and n == 1:
+            pose[:, :2] = pos[:, :2]
+        else:
+            pose[:, 0], pose[:, 1] = pos[:, e], pos[:, n]
         # the yaw as math.atan2 gives it (the single environment's): libm's atan2 in one C pass
-        if packets.atan2(rot[:, 1, 0], rot[:, 0, 0], pose[:, 2]) is None:
-            pose[:, 2] = list(map(math.atan2, rot[:, 1, 0].tolist(), rot[:, 0, 0].tolist()))
+        if packets.atan2(rot[:, n, 0], rot[:, e, 0], pose[:, 2]) is None:
+            pose[:, 2] = list(map(math.atan2, rot[:, n, 0].tolist(), rot[:, e, 0].tolist()))
         return {"time_ms": self.sim.time_ms[copies].copy(), "steps": self.steps[copies].copy(), "pose": pose}
 
     def _full_info(self, mask: np.ndarray) -> dict[str, np.ndarray]:
