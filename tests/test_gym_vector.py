@@ -120,8 +120,31 @@ def test_threads_split_the_copies_casts_with_the_same_bits():
     assert _same_obs(outs[0][0], outs[1][0])
     for e in envs:
         e.close()
-    with pytest.raises(ValueError, match="threads must be >= 1, got 0"):
+    with pytest.raises(ValueError, match="threads must be an integer >= 1 or None, got 0"):
         SensoriumVectorEnv(None, ReachLight(), 2, threads=0)
+
+
+@pytest.mark.parametrize("kw, message", [({"num_envs": 2.5}, "num_envs must be an integer >= 1, got 2.5"),
+                                         ({"num_envs": 0}, "num_envs must be an integer >= 1, got 0"),
+                                         ({"num_envs": True}, "num_envs must be an integer >= 1, got True"),
+                                         ({"num_envs": 2, "threads": 1.5}, "threads must be an integer >= 1")])
+def test_counts_that_are_not_whole_numbers_are_refused(kw, message):
+    """A float count was cut to an integer silently (2.5 copies made 2)."""
+    with pytest.raises(ValueError, match=message):
+        gym.make_vec("sensorium/ReachLight-v0", vectorization_mode="vector_entry_point", **kw)
+
+
+def test_seeds_that_are_not_integers_are_refused_and_numpy_integers_are_seeds():
+    venv = gym.make_vec("sensorium/ReachLight-v0", num_envs=3, vectorization_mode="vector_entry_point")
+    for seed, message in ((1.5, "seed must be an integer, a list"), ([1, 2.5, None], "a seed must be an integer or "
+                                                                                        "None, got 2.5"),
+                          ("7", "seed must be an integer, a list"), ([1, 2], "2 seeds for num_envs=3")):
+        with pytest.raises(ValueError, match=message):
+            venv.reset(seed=seed)
+    a = venv.reset(seed=np.int64(4))[0]
+    b = venv.reset(seed=[4, 5, 6])[0]
+    assert all(np.array_equal(a[k], b[k]) for k in a)    # an int s seeds sub-env i with s + i
+    venv.close()
 
 
 def test_make_vec_gives_the_batched_env_with_next_step_autoreset():

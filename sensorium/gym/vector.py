@@ -92,6 +92,12 @@ def _owner(fn):
     return getattr(fn, "__self__", None)
 
 
+def _whole(value) -> bool:
+    """An integer (Python's or numpy's), not a bool: what counts and seeds must be (a float would be
+    cut to an integer silently)."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
 class SensoriumVectorEnv(VectorEnv):
     """N copies of a world stepped in one batched simulation (see the module docstring)."""
 
@@ -102,10 +108,10 @@ class SensoriumVectorEnv(VectorEnv):
                  flatten: bool = False, autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
                  render_mode: str | None = None, render_size: int = 256, threads: int | None = None,
                  **_spec_kwargs):
-        if int(num_envs) < 1:
-            raise ValueError(f"num_envs must be >= 1, got {num_envs}")
-        if threads is not None and int(threads) < 1:
-            raise ValueError(f"threads must be >= 1, got {threads}")
+        if not _whole(num_envs) or num_envs < 1:
+            raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
+        if threads is not None and (not _whole(threads) or threads < 1):
+            raise ValueError(f"threads must be an integer >= 1 or None, got {threads!r}")
         self.loaded = load(world)
         self.task = task or Task()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -337,12 +343,18 @@ class SensoriumVectorEnv(VectorEnv):
         n = self.num_envs
         if seed is None:
             seeds: list[int | None] = [None] * n
-        elif isinstance(seed, (int, np.integer)):
+        elif _whole(seed):
             seeds = [int(seed) + i for i in range(n)]
-        else:
+        elif isinstance(seed, (list, tuple, np.ndarray)):
             seeds = list(seed)
             if len(seeds) != n:
                 raise ValueError(f"reset: {len(seeds)} seeds for num_envs={n}")
+            bad = [s for s in seeds if s is not None and not _whole(s)]
+            if bad:
+                raise ValueError(f"reset: a seed must be an integer or None, got {bad[0]!r}")
+        else:
+            raise ValueError(f"reset: seed must be an integer, a list of num_envs integers (or None), or None; "
+                             f"got {seed!r}")
         mask = np.ones(n, dtype=bool)
         if options is not None and "reset_mask" in options:
             mask = np.asarray(options["reset_mask"])
