@@ -39,10 +39,11 @@ every array step by step, autoresets included); ``reset(seed=s)`` gives sub-env 
 from __future__ import annotations
 
 import multiprocessing as mp
+import select
 import signal
 import traceback
 import weakref
-from multiprocessing.connection import Connection, wait
+from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
@@ -63,8 +64,9 @@ __all__ = ["SensoriumWorkersEnv", "WorkerError", "check_workers", "split"]
 CLOSE_WAIT_S = 5.0
 """How long close() lets a worker finish on its own before it is terminated."""
 
-BASE_INFO = ("time_ms", "steps", "pose")
-"""The info keys of every step and reset (SensoriumVectorEnv's), each with its ``_key`` mask."""
+BASE_INFO = {"time_ms": ((), np.dtype(np.int64)), "steps": ((), np.dtype(np.int64)), "pose": ((3,), np.dtype(np.float64))}
+"""The info keys of every step and reset (SensoriumVectorEnv's: shape of one copy, dtype), each with its
+``_key`` mask: they go through shared memory; any other key (SAME_STEP's final ones) through the pipe."""
 
 
 class WorkerError(RuntimeError):
@@ -101,17 +103,31 @@ def _layout(agent: Agent) -> list[tuple[str | None, tuple[int, ...], np.dtype]]:
     space = agent.observation_space
     if isinstance(space, spaces.Box):
         return [(None, tuple(space.shape), np.dtype(space.dtype))]
-    return [(k, tuple(b.shape), np.dtype(b.dtype)) for k, b in agent.dict_space.spaces.items()]
+    return [(k, tuple(b.shape or ()), np.dtype(b.dtype)) for k, b in agent.dict_space.spaces.items()]
+
+
+def _shapes(layout) -> dict[str | None, tuple[tuple[int, ...], np.dtype]]:
+    """Every shared array's shape of one copy and dtype: the observation's arrays, actions, rewards,
+    flags, and the infos' arrays and masks."""
+    shapes: dict[str | None, tuple[tuple[int, ...], np.dtype]] = {key: (shape, dtype) for key, shape, dtype in layout}
+    shapes.update({"@actions": ((2,), np.dtype(np.float64)), "@rewards": ((), np.dtype(np.float64)),
+                   "@terminations": ((), np.dtype(bool)), "@truncations": ((), np.dtype(bool))})
+    for key, (shape, dtype) in BASE_INFO.items():
+        shapes["@" + key], shapes["@_" + key] = (shape, dtype), ((), np.dtype(bool))
+    return shapes
+
+
+def _buffers(ctx, layout, n: int) -> dict:
+    """The shared buffers (raw bytes, zeroed), one per array of :func:`_shapes`."""
+    return {key: ctx.RawArray("B", max(1, n * int(np.prod(shape, dtype=np.int64)) * dtype.itemsize))
+            for key, (shape, dtype) in _shapes(layout).items()}
 
 
 def _arrays(raws: dict, layout, n: int) -> dict:
-    """numpy views of the shared buffers: the observation's arrays, then actions, rewards and flags."""
-    shapes = {key: (shape, dtype) for key, shape, dtype in layout}
-    shapes.update({"@actions": ((2,), np.dtype(np.float64)), "@rewards": ((), np.dtype(np.float64)),
-                   "@terminations": ((), np.dtype(bool)), "@truncations": ((), np.dtype(bool))})
+    """numpy views of the shared buffers, each (n, *shape of one copy)."""
     return {key: np.frombuffer(memoryview(raws[key]).cast("B"), dtype=dtype,
                                count=n * int(np.prod(shape, dtype=np.int64))).reshape(n, *shape)
-            for key, (shape, dtype) in shapes.items()}
+            for key, (shape, dtype) in _shapes(layout).items()}
 
 
 # ---------------------------------------------------------------------- the worker process
@@ -151,6 +167,17 @@ def _serve(conn: Connection, payload: bytes, lo: int, hi: int, raws: dict, layou
                 raise TypeError(f"observation {key or '(flat)'}: {got.dtype}, the space says {dtype}")
             mine[key][...] = got
 
+    def shared_info(info: dict) -> dict:
+        """Write the usual info arrays to shared memory; the rest (what the pipe carries) returned."""
+        rest = dict(info)
+        for key in BASE_INFO:
+            value, mask, out = rest.get(key), rest.get("_" + key), mine["@" + key]
+            if (isinstance(value, np.ndarray) and value.dtype == out.dtype and value.shape == out.shape
+                    and isinstance(mask, np.ndarray) and mask.dtype == np.bool_ and mask.shape == (hi - lo,)):
+                out[...], mine["@_" + key][...] = value, mask
+                del rest[key], rest["_" + key]
+        return rest
+
     while True:
         try:
             what, arg = conn.recv()
@@ -166,13 +193,14 @@ def _serve(conn: Connection, payload: bytes, lo: int, hi: int, raws: dict, layou
                 mine["@rewards"][...] = rew
                 mine["@terminations"][...] = term
                 mine["@truncations"][...] = trunc
-                reply: Any = info
+                reply: Any = shared_info(info)
             elif what == "reset":
-                obs, reply = env.reset(**arg)
+                obs, info = env.reset(**arg)
                 publish(obs)
+                reply = shared_info(info)
             elif what == "peek":        # a reset of other workers' copies: ours as they are (not reset)
                 publish(env._observe())
-                reply = env._full_info(np.zeros(hi - lo, dtype=bool))
+                reply = shared_info(env._full_info(np.zeros(hi - lo, dtype=bool)))
             elif what == "render":
                 reply = env.render()
             else:
@@ -266,10 +294,7 @@ class SensoriumWorkersEnv(VectorEnv):
         self._autoreset = np.zeros(n, dtype=bool)
 
         ctx = mp.get_context("spawn")
-        raws = {key: ctx.RawArray("B", max(1, n * int(np.prod(shape, dtype=np.int64)) * dtype.itemsize))
-                for key, shape, dtype in self._layout}
-        raws.update({"@actions": ctx.RawArray("B", n * 16), "@rewards": ctx.RawArray("B", n * 8),
-                     "@terminations": ctx.RawArray("B", n), "@truncations": ctx.RawArray("B", n)})
+        raws = _buffers(ctx, self._layout, n)
         self._shared = _arrays(raws, self._layout, n)
         payload = cloudpickle.dumps((loaded, task, {
             "precision": precision, "actions": actions, "flatten": flatten, "autoreset_mode": self.autoreset_mode,
@@ -284,6 +309,13 @@ class SensoriumWorkersEnv(VectorEnv):
             theirs.close()
             self._procs.append(proc)
             self._conns.append(mine)
+        # every worker's pipe and process watched together, registered once (a step polls them)
+        self._poller = select.poll()
+        self._fds: dict[int, tuple[int, bool]] = {}
+        for w, (proc, conn) in enumerate(zip(self._procs, self._conns)):
+            for fd, is_pipe in ((conn.fileno(), True), (proc.sentinel, False)):
+                self._poller.register(fd, select.POLLIN)
+                self._fds[fd] = (w, is_pipe)
         try:
             self._call([("start", None)] * self.workers, send=False)
         except BaseException:
@@ -313,36 +345,33 @@ class SensoriumWorkersEnv(VectorEnv):
             raise WorkerError(f"{self._broken}: the environment is closed; build a new one")
         if self.closed:
             raise RuntimeError("the environment is closed")
-        pending = [w for w, r in enumerate(requests) if r is not None]
+        whats = [r[0] if r is not None else "" for r in requests]
+        waiting = {w for w, r in enumerate(requests) if r is not None}
         replies: list = [None] * self.workers
-        errors: list[str] = []
+        errors: list[tuple[int, str]] = []
         try:
-            for w in pending if send else ():
+            for w in sorted(waiting) if send else ():
                 try:
                     self._conns[w].send(requests[w])
                 except OSError:
-                    raise self._died(w, requests[w][0]) from None
-            waiting = set(pending)
+                    raise self._died(w, whats[w]) from None
             while waiting:
-                handles: dict[Any, int] = {}
-                for w in waiting:
-                    handles[self._conns[w]] = w
-                    handles[self._procs[w].sentinel] = w
-                for h in wait(list(handles)):
-                    w = handles[h]
+                for fd, _ in self._poller.poll():
+                    w, is_pipe = self._fds[fd]
+                    what = whats[w] or "another worker's call"
+                    if not is_pipe:     # a process ended (any worker's: the env is broken), unless its reply is still to read
+                        if w in waiting and self._conns[w].poll():
+                            continue
+                        raise self._died(w, what)
                     if w not in waiting:
                         continue
-                    what = requests[w][0]
-                    conn = self._conns[w]
-                    if not conn.poll():         # its process ended and it said nothing
-                        raise self._died(w, what)
                     try:
-                        status, reply = conn.recv()
+                        status, reply = self._conns[w].recv()
                     except (EOFError, OSError):
                         raise self._died(w, what) from None
                     waiting.discard(w)
                     if status == "error":
-                        errors.append(f"{self._name(w)} failed in {what}: {reply}")
+                        errors.append((w, f"{self._name(w)} failed in {what}: {reply}"))
                     replies[w] = reply
         except WorkerError:
             raise
@@ -352,10 +381,32 @@ class SensoriumWorkersEnv(VectorEnv):
             raise
         if errors:
             self._needs_reset[:] = True
+            errors.sort()
             more = f" (and {len(errors) - 1} more worker(s) failed)" if len(errors) > 1 else ""
-            after = "" if requests[pending[0]][0] == "start" else "; reset() before stepping again"
-            raise WorkerError(errors[0] + more + after)
+            after = "" if whats[errors[0][0]] == "start" else "; reset() before stepping again"
+            raise WorkerError(errors[0][1] + more + after)
         return replies
+
+    def _infos(self, replies: list[dict], obs=None) -> dict:
+        """The info of every sub-env: the usual arrays from shared memory, the rest from the replies
+        (with ``obs``, the step's observation: SAME_STEP's final keys completed for every worker)."""
+        sh = self._shared
+        if not any(replies):        # the usual case: every worker's info in shared memory
+            out = {}
+            for key in BASE_INFO:
+                out[key], out["_" + key] = sh["@" + key].copy(), sh["@_" + key].copy()
+            return out
+        parts = []
+        for reply, (lo, hi) in zip(replies, self.slices):
+            part = {}
+            for key in BASE_INFO:
+                if key not in reply:
+                    part[key], part["_" + key] = sh["@" + key][lo:hi], sh["@_" + key][lo:hi]
+            part.update(reply)
+            parts.append(part)
+        if obs is not None and any("final_obs" in p for p in parts):
+            parts = [_with_final(p, _part(obs, lo, hi), hi - lo) for p, (lo, hi) in zip(parts, self.slices)]
+        return _concat(parts)
 
     def _observations(self):
         sh = self._shared
@@ -390,7 +441,7 @@ class SensoriumWorkersEnv(VectorEnv):
         infos = self._call(requests)
         self._needs_reset[mask] = False
         self._autoreset[mask] = False
-        return self._observations(), _concat(infos)
+        return self._observations(), self._infos(infos)
 
     def step(self, actions):
         n = self.num_envs
@@ -416,10 +467,9 @@ class SensoriumWorkersEnv(VectorEnv):
         rewards = self._shared["@rewards"].copy()
         terms = self._shared["@terminations"].copy()
         truncs = self._shared["@truncations"].copy()
-        if any("final_obs" in info for info in infos):      # SAME_STEP: some worker's copies ended
-            infos = [_with_final(info, _part(obs, lo, hi), hi - lo) for info, (lo, hi) in zip(infos, self.slices)]
+        info = self._infos(infos, obs)
         self._autoreset = (terms | truncs) if self.autoreset_mode != AutoresetMode.SAME_STEP else np.zeros(n, bool)
-        return obs, rewards, terms, truncs, _concat(infos)
+        return obs, rewards, terms, truncs, info
 
     def render(self):
         """Top-down images of every sub-env (``render_mode="rgb_array"``), a tuple of (H, W, 3) uint8."""
