@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import inspect
 import math
 import multiprocessing as mp
 import os
@@ -23,6 +24,10 @@ from sensorium.gym.workers import SensoriumWorkersEnv, WorkerError, split  # noq
 slow = pytest.mark.slow        # these start worker processes
 REACH, LIDAR = "sensorium/ReachLight-v0", "sensorium/LidarAvoid-v0"
 WAIT_S = 120.0                 # a generous bound for a call that must not hang (the machine is shared)
+
+
+LAMBDA_LINE = inspect.currentframe().f_lineno + 1     # (the line the error message must name)
+DIVIDES_BY_ZERO = lambda sim, robot, obs: 1.0 / (float(robot.pose.translation[2]) * 0.0)  # noqa: E731
 
 
 def _make(env_id: str, n: int, workers: int, **kw):
@@ -171,8 +176,7 @@ def test_a_custom_task_with_lambdas_runs_through_the_workers_with_the_same_value
 @slow
 def test_a_workers_exception_and_a_bad_action_are_one_clear_error():
     task = Task(robot="epuck", observations={"ls0": 64}, control_period_ms=64, max_steps=5,
-                reward=lambda sim, robot, obs: 1.0 / (float(robot.pose.translation[2]) * 0.0),
-                terminated=ReachLight("lamp").terminated)
+                reward=DIVIDES_BY_ZERO, terminated=ReachLight("lamp").terminated)
     envs = SensoriumWorkersEnv(None, task, 5, workers=2)
     try:
         with pytest.raises(RuntimeError, match="call reset"):
@@ -187,7 +191,7 @@ def test_a_workers_exception_and_a_bad_action_are_one_clear_error():
         assert "\n" not in text
         assert text.startswith(f"worker 0 of 2 (sub-envs 0-2, pid {envs.pids[0]}) failed in step: "
                                "ZeroDivisionError: float division by zero (at ")
-        assert " in <lambda>)" in text                        # where the task's callable raised
+        assert f"(at <lambda>, line {LAMBDA_LINE} of the file defining it)" in text   # where the task's callable raised
         assert "(and 1 more worker(s) failed); reset() before stepping again" in text
         with pytest.raises(RuntimeError, match="call reset"):
             envs.step(np.zeros((5, 2)))

@@ -24,9 +24,9 @@ every array step by step, autoresets included); ``reset(seed=s)`` gives sub-env 
   to the network.
 * Cores: each worker's batched env casts on one thread (``threads`` defaults to 1 here: k workers
   already keep k cores busy); pass ``threads`` to change it.
-* Data: observations, rewards, terminations, truncations and actions go through shared memory
-  (one copy in, one copy out per step; the returned arrays are the caller's own); the small infos
-  (and ``final_obs`` in ``SAME_STEP`` mode) go through the pipes.
+* Data: observations, rewards, terminations, truncations, actions and the usual infos go through
+  shared memory (one copy in, one copy out per step; the returned arrays are the caller's own);
+  ``SAME_STEP``'s ``final_obs``/``final_info`` go through the pipes.
 * Failure: an exception in a worker (a task's callable raising, ...) is raised here as one
   :class:`WorkerError` naming the worker, its sub-envs and the original error (and where it was
   raised); the env then wants a ``reset()``. A worker that dies makes the call waiting on it raise
@@ -132,11 +132,14 @@ def _arrays(raws: dict, layout, n: int) -> dict:
 
 # ---------------------------------------------------------------------- the worker process
 def _where(exc: BaseException) -> str:
-    """Where an exception was raised: the innermost frame's file:line and function."""
+    """Where an exception was raised: the innermost frame's file:line and function (a function
+    cloudpickle sent by value, e.g. a lambda of the parent's script, keeps its lines but not its file)."""
     frames = traceback.extract_tb(exc.__traceback__)
     if not frames:
         return ""
     f = frames[-1]
+    if f.filename == "<dynamic-code>":
+        return f" (at {f.name}, line {f.lineno} of the file defining it)"
     return f" (at {Path(f.filename).name}:{f.lineno} in {f.name})"
 
 
