@@ -8,7 +8,10 @@ import math
 import multiprocessing as mp
 import os
 import signal
+import subprocess
+import sys
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -232,4 +235,24 @@ def test_close_and_garbage_collection_leave_no_worker_behind():
     dropped.reset(seed=0)
     del dropped
     gc.collect()
+    assert all(map(_gone, pids))
+
+
+@pytest.mark.parametrize("ending", ["exit", "SIGKILL"])
+def test_no_worker_outlives_its_parent_whether_it_exits_without_close_or_is_killed(ending):
+    script = (
+        "import os, sys, gymnasium as gym, sensorium.gym\n"
+        "envs = gym.make_vec('sensorium/ReachLight-v0', num_envs=2, vectorization_mode='vector_entry_point', workers=2)\n"
+        "envs.reset(seed=0)\n"
+        "print(*envs.pids, flush=True)\n"
+        + ("os.kill(os.getpid(), 9)\n" if ending == "SIGKILL" else "")
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=WAIT_S,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    assert done.returncode == (-signal.SIGKILL if ending == "SIGKILL" else 0), done.stderr
+    pids = [int(p) for p in done.stdout.split()]
+    assert len(pids) == 2
+    deadline = time.monotonic() + WAIT_S       # (a killed parent's workers end when their pipe closes)
+    while not all(map(_gone, pids)) and time.monotonic() < deadline:
+        time.sleep(0.05)
     assert all(map(_gone, pids))
