@@ -3,8 +3,10 @@ registered Gymnasium ids).
 
 Each id has a single environment (``entry_point``: :class:`~sensorium.gym.env.SensoriumEnv`) and a
 batched vector environment (``vector_entry_point``: :class:`~sensorium.gym.vector.SensoriumVectorEnv`,
-what ``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` returns);
-sub-environment *i* of the vector environment equals the single environment with the same seed.
+what ``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` returns;
+with ``workers=k`` > 1 a :class:`~sensorium.gym.workers.SensoriumWorkersEnv`, the copies split over
+k processes); sub-environment *i* of the vector environment equals the single environment with the
+same seed.
 """
 
 from __future__ import annotations
@@ -74,10 +76,14 @@ def car_park():
     return world_path("car_park")
 
 
-def _vector(task: Task, world, num_envs: int, render_mode, **kw):
+def _vector(task: Task, world, num_envs: int, render_mode, workers: int = 1, **kw):
+    """The batched vector env; ``workers=k`` > 1: k processes of it side by side (:mod:`.workers`)."""
     from sensorium.gym.vector import SensoriumVectorEnv  # imported on use: the single envs do not need it
+    from sensorium.gym.workers import SensoriumWorkersEnv, check_workers
 
     kw.pop("max_episode_steps", None)        # make_vec passes the spec's (None here: tasks truncate themselves)
+    if check_workers(workers, num_envs) > 1:
+        return SensoriumWorkersEnv(world, task, num_envs, workers=workers, render_mode=render_mode, **kw)
     return SensoriumVectorEnv(world, task, num_envs, render_mode=render_mode, **kw)
 
 
