@@ -100,6 +100,7 @@ def test_the_copies_are_split_in_contiguous_slices_differing_by_at_most_one():
     ("2", 4, "workers must be a whole number of processes, got '2'"),
     (True, 4, "workers must be a whole number of processes, got True"),
     (5, 3, "workers=5 is more than num_envs=3: each worker needs at least one copy"),
+    (2, 2.5, "num_envs must be an integer >= 1, got 2.5"),       # (the one-process env's checks)
 ])
 def test_refused_workers_say_why_in_one_line_before_any_process_starts(workers, num_envs, why):
     for make in (lambda: _make(REACH, num_envs, workers),

@@ -98,6 +98,46 @@ def _whole(value) -> bool:
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
+def check_counts(num_envs: Any, threads: Any) -> int:
+    """``num_envs`` as an int, or ValueError (one line) when it or ``threads`` (None: the default) is
+    not a whole number >= 1."""
+    if not _whole(num_envs) or num_envs < 1:
+        raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
+    if threads is not None and (not _whole(threads) or threads < 1):
+        raise ValueError(f"threads must be an integer >= 1 or None, got {threads!r}")
+    return int(num_envs)
+
+
+def reset_seeds(seed: Any, n: int) -> list[int | None]:
+    """Each sub-env's seed for ``reset(seed=...)``: an int s gives sub-env i the seed s + i, a list
+    one seed (or None) per sub-env, None none; ValueError (one line) for anything else."""
+    if seed is None:
+        return [None] * n
+    if _whole(seed):
+        return [int(seed) + i for i in range(n)]
+    if not isinstance(seed, (list, tuple, np.ndarray)):
+        raise ValueError(f"reset: seed must be an integer, a list of num_envs integers (or None), or None; "
+                         f"got {seed!r}")
+    seeds = list(seed)
+    if len(seeds) != n:
+        raise ValueError(f"reset: {len(seeds)} seeds for num_envs={n}")
+    bad = [s for s in seeds if s is not None and not _whole(s)]
+    if bad:
+        raise ValueError(f"reset: a seed must be an integer or None, got {bad[0]!r}")
+    return [None if s is None else int(s) for s in seeds]
+
+
+def reset_mask(options: dict | None, n: int) -> np.ndarray:
+    """The sub-envs a reset resets: ``options["reset_mask"]`` (a bool array of shape (n,) with a True
+    value; ValueError otherwise), or all of them."""
+    if options is None or "reset_mask" not in options:
+        return np.ones(n, dtype=bool)
+    mask = np.asarray(options["reset_mask"])
+    if mask.shape != (n,) or mask.dtype != np.bool_ or not mask.any():
+        raise ValueError(f"options['reset_mask'] must be a bool array of shape ({n},) with a True value")
+    return mask
+
+
 class SensoriumVectorEnv(VectorEnv):
     """N copies of a world stepped in one batched simulation (see the module docstring)."""
 
@@ -108,10 +148,7 @@ class SensoriumVectorEnv(VectorEnv):
                  flatten: bool = False, autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
                  render_mode: str | None = None, render_size: int = 256, threads: int | None = None,
                  **_spec_kwargs):
-        if not _whole(num_envs) or num_envs < 1:
-            raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
-        if threads is not None and (not _whole(threads) or threads < 1):
-            raise ValueError(f"threads must be an integer >= 1 or None, got {threads!r}")
+        check_counts(num_envs, threads)
         self.loaded = load(world)
         self.task = task or Task()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -341,25 +378,8 @@ class SensoriumVectorEnv(VectorEnv):
     # ------------------------------------------------------------------ gymnasium API
     def reset(self, *, seed: int | list[int | None] | None = None, options: dict | None = None):
         n = self.num_envs
-        if seed is None:
-            seeds: list[int | None] = [None] * n
-        elif _whole(seed):
-            seeds = [int(seed) + i for i in range(n)]
-        elif isinstance(seed, (list, tuple, np.ndarray)):
-            seeds = list(seed)
-            if len(seeds) != n:
-                raise ValueError(f"reset: {len(seeds)} seeds for num_envs={n}")
-            bad = [s for s in seeds if s is not None and not _whole(s)]
-            if bad:
-                raise ValueError(f"reset: a seed must be an integer or None, got {bad[0]!r}")
-        else:
-            raise ValueError(f"reset: seed must be an integer, a list of num_envs integers (or None), or None; "
-                             f"got {seed!r}")
-        mask = np.ones(n, dtype=bool)
-        if options is not None and "reset_mask" in options:
-            mask = np.asarray(options["reset_mask"])
-            if mask.shape != (n,) or mask.dtype != np.bool_ or not mask.any():
-                raise ValueError(f"options['reset_mask'] must be a bool array of shape ({n},) with a True value")
+        seeds = reset_seeds(seed, n)
+        mask = reset_mask(options, n)
         copies = mask.nonzero()[0]
         self._begin_reset(copies, [seeds[c] for c in copies.tolist()])
         self._run(np.zeros(n, dtype=bool), mask)

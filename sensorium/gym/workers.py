@@ -55,6 +55,7 @@ from gymnasium.vector.utils import batch_space
 
 from sensorium.gym.env import DEFAULT_PRECISION, Agent, device_of, load
 from sensorium.gym.task import Task
+from sensorium.gym.vector import check_counts, reset_mask, reset_seeds
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedError, check_observable
 from sensorium.server.world.loader import LoadedWorld
@@ -79,7 +80,7 @@ def check_workers(workers: Any, num_envs: Any) -> int:
         raise ValueError(f"workers must be a whole number of processes, got {workers!r}")
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
-    if int(num_envs) < workers:
+    if check_counts(num_envs, None) < workers:
         raise ValueError(f"workers={workers} is more than num_envs={num_envs}: each worker needs at least one copy")
     return int(workers)
 
@@ -266,11 +267,8 @@ class SensoriumWorkersEnv(VectorEnv):
         self._procs: list = []
         self._conns: list[Connection] = []
         self._broken = ""
-        if int(num_envs) < 1:
-            raise ValueError(f"num_envs must be >= 1, got {num_envs}")
+        check_counts(num_envs, threads)
         self.workers = check_workers(workers, num_envs)
-        if threads is not None and int(threads) < 1:
-            raise ValueError(f"threads must be >= 1, got {threads}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
         self.autoreset_mode = AutoresetMode(autoreset_mode)
@@ -420,19 +418,8 @@ class SensoriumWorkersEnv(VectorEnv):
     # ------------------------------------------------------------------ gymnasium API
     def reset(self, *, seed: int | list[int | None] | None = None, options: dict | None = None):
         n = self.num_envs
-        if seed is None:
-            seeds: list[int | None] = [None] * n
-        elif isinstance(seed, (int, np.integer)):
-            seeds = [int(seed) + i for i in range(n)]
-        else:
-            seeds = list(seed)
-            if len(seeds) != n:
-                raise ValueError(f"reset: {len(seeds)} seeds for num_envs={n}")
-        mask = np.ones(n, dtype=bool)
-        if options is not None and "reset_mask" in options:
-            mask = np.asarray(options["reset_mask"])
-            if mask.shape != (n,) or mask.dtype != np.bool_ or not mask.any():
-                raise ValueError(f"options['reset_mask'] must be a bool array of shape ({n},) with a True value")
+        seeds = reset_seeds(seed, n)
+        mask = reset_mask(options, n)
         requests: list[tuple[str, Any] | None] = []
         for lo, hi in self.slices:
             part = mask[lo:hi]
