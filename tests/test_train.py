@@ -42,6 +42,41 @@ def test_sb3_adapter_passes_sb3s_checker_and_hands_over_terminal_observations():
         assert info["episode"]["l"] == 3 and not info["episode"]["reached"]
 
 
+@pytest.mark.slow      # worker processes
+def test_sb3_adapter_with_worker_processes_gives_the_one_process_steps():
+    """``SB3VecEnv(..., workers=2)``: the copies in two processes, the same observations, rewards,
+    dones and SB3 infos (terminal observations, episodes) as one process, step by step."""
+    pytest.importorskip("stable_baselines3")
+    from sensorium.gym.sb3 import SB3VecEnv
+    from sensorium.gym.tasks import reach_light_task
+
+    envs = [SB3VecEnv(reach_light_task(max_steps=4), 5, seed=2, workers=k) for k in (1, 2)]
+    try:
+        outs = [e.reset() for e in envs]
+        assert outs[0].tobytes() == outs[1].tobytes()
+        rng = np.random.default_rng(4)
+        ended = 0
+        for _ in range(10):
+            a = rng.uniform(-1, 1, (5, 2)).astype(np.float32)
+            got = []
+            for e in envs:
+                e.step_async(a)
+                got.append(e.step_wait())
+            (o1, r1, d1, i1), (o2, r2, d2, i2) = got
+            assert o1.tobytes() == o2.tobytes() and r1.tobytes() == r2.tobytes() and (d1 == d2).all()
+            for a1, a2 in zip(i1, i2):
+                assert a1.keys() == a2.keys() and a1.get("episode") == a2.get("episode")
+                if "terminal_observation" in a1:
+                    assert a1["terminal_observation"].tobytes() == a2["terminal_observation"].tobytes()
+            ended += int(d1.sum())
+        assert ended >= 10                       # episodes of 4 steps: every copy ended twice
+        with pytest.raises(NotImplementedError, match="other processes"):
+            envs[1].env_method("render")
+    finally:
+        for e in envs:
+            e.close()
+
+
 def test_evolution_strategy_on_ray_actors_equals_the_same_workers_in_process():
     """Two Ray actors (Ray bound to 127.0.0.1), each holding a batched env of 4 copies, feed the
     learner; the parameters and every return equal those of the same workers run in this process."""

@@ -2,6 +2,7 @@
 
     from sensorium.gym.sb3 import SB3VecEnv
     venv = SB3VecEnv(sensorium.gym.tasks.reach_light_task(), num_envs=16, seed=0)   # flattened obs
+    venv = SB3VecEnv(task, num_envs=64, seed=0, workers=2)     # the copies in 2 processes
     model = stable_baselines3.PPO("MlpPolicy", venv).learn(200_000)
 
 Stable-Baselines3 has its own vector API: it resets a sub-env inside the step that ends its
@@ -22,6 +23,7 @@ from stable_baselines3.common.vec_env import VecEnv
 
 from sensorium.gym.task import Task
 from sensorium.gym.vector import SensoriumVectorEnv
+from sensorium.gym.workers import SensoriumWorkersEnv, check_workers
 
 __all__ = ["SB3VecEnv"]
 
@@ -29,9 +31,12 @@ __all__ = ["SB3VecEnv"]
 class SB3VecEnv(VecEnv):
     """``num_envs`` copies of ``world``/``task`` in one batched simulation, for Stable-Baselines3."""
 
-    def __init__(self, task: Task, num_envs: int, world=None, seed: int | None = None, flatten: bool = True, **kw):
-        self.venv = SensoriumVectorEnv(world, task, num_envs, flatten=flatten, autoreset_mode=AutoresetMode.SAME_STEP,
-                                       **kw)
+    def __init__(self, task: Task, num_envs: int, world=None, seed: int | None = None, flatten: bool = True,
+                 workers: int = 1, **kw):
+        kw.update(flatten=flatten, autoreset_mode=AutoresetMode.SAME_STEP)
+        # workers=k > 1: the copies in k worker processes (sensorium.gym.workers; the same episodes)
+        self.venv = (SensoriumWorkersEnv(world, task, num_envs, workers=workers, **kw)
+                     if check_workers(workers, num_envs) > 1 else SensoriumVectorEnv(world, task, num_envs, **kw))
         super().__init__(num_envs, self.venv.single_observation_space, self.venv.single_action_space)
         self._seed = seed
         self._actions: np.ndarray | None = None
@@ -77,6 +82,8 @@ class SB3VecEnv(VecEnv):
         setattr(self.venv, attr_name, value)
 
     def env_method(self, method_name: str, *args, indices=None, **kwargs) -> list[Any]:
+        if not isinstance(self.venv, SensoriumVectorEnv):
+            raise NotImplementedError("env_method: the sub-envs of workers=k > 1 live in other processes")
         return [getattr(self.venv.sub_env(i), method_name)(*args, **kwargs) for i in self._indices(indices)]
 
     def env_is_wrapped(self, wrapper_class, indices=None) -> list[bool]:
