@@ -25,7 +25,7 @@ from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
 from sensorium.server.world.poses import pose_from_model
-from tests.test_gym_vector import _reset_both, _step_both
+from tests.test_gym_vector import _reset_both, _step_both, hills_world
 
 TO_NUE = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])    # ENU -> NUE axes
 TO_NUE_Q = (-0.5, -0.5, -0.5, 0.5)     # its quaternion (x, y, z, w): quaternion_matrix gives TO_NUE exactly
@@ -299,19 +299,7 @@ def test_an_enu_world_and_its_nue_twin_give_the_same_vector_env_episodes(goal):
 def _hills() -> wm.World:
     """An ENU world of hills (a random terrain on a floor) and a rover with a distance sensor and a
     two-layer lidar (tests/test_gym_vector.py's hilly world)."""
-    heights = np.random.default_rng(3).uniform(0.0, 0.4, 81)
-    return wm.World.model_validate({
-        "solids": [{"name": "floor", "geometry": {"type": "plane"}},
-                   {"name": "hills", "pose": {"translation": [-2.0, -2.0, 0.0]},
-                    "geometry": {"type": "elevation_grid", "height": heights.tolist(), "x_dimension": 9,
-                                 "x_spacing": 0.5, "y_dimension": 9, "y_spacing": 0.5}}],
-        "robots": [{"name": "rover", "pose": {"translation": [0.1, 0.2, 0.5]},
-                    "body": {"geometry": {"type": "cylinder", "radius": 0.08, "height": 0.05}},
-                    "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2, "max_wheel_speed": 15.0},
-                    "devices": [{"device": "DistanceSensor", "name": "ahead", "lookup_table": [[0, 0, 0], [3, 3, 0]],
-                                 "pose": {"rotation": [0, 1, 0, 0.3]}},
-                                {"device": "Lidar", "name": "scan", "horizontal_resolution": 32,
-                                 "number_of_layers": 2, "vertical_field_of_view": 0.2, "max_range": 3.0}]}]})
+    return hills_world()
 
 
 def test_random_starts_on_a_nue_terrain_keep_the_clearance_and_ride_it_as_the_enu_twin():

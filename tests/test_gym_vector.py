@@ -407,17 +407,13 @@ def test_the_range_image_clip_in_c_is_the_numpy_steps_bit_for_bit(low):
     assert packets.box_clip32(img[:, :, ::2], lo, hi) is None    # (a strided view: the numpy steps)
 
 
-def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
-    """A hilly world (a random terrain on a floor, a ramp): random starts keep the world-file
-    clearance above the ground where they land; the vector env's sub-env i and the single env with
-    seed 5 + i agree on observations, rewards and poses (heights and attitudes included) across
-    autoresets, and the robots did ride slopes."""
-    from sensorium.gym.task import random_start
+def hills_world():
+    """An ENU world of hills (a random terrain on a floor) and a rover with a distance sensor and a
+    two-layer lidar (also tests/test_gym_nue.py's, turned into NUE there)."""
     from sensorium.schemas import world as wm
 
-    rng = np.random.default_rng(3)
-    heights = rng.uniform(0.0, 0.4, 81)
-    world = wm.World.model_validate({
+    heights = np.random.default_rng(3).uniform(0.0, 0.4, 81)
+    return wm.World.model_validate({
         "solids": [{"name": "floor", "geometry": {"type": "plane"}},
                    {"name": "hills", "pose": {"translation": [-2.0, -2.0, 0.0]},
                     "geometry": {"type": "elevation_grid", "height": heights.tolist(), "x_dimension": 9,
@@ -429,6 +425,16 @@ def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
                                  "pose": {"rotation": [0, 1, 0, 0.3]}},
                                 {"device": "Lidar", "name": "scan", "horizontal_resolution": 32,
                                  "number_of_layers": 2, "vertical_field_of_view": 0.2, "max_range": 3.0}]}]})
+
+
+def test_sub_envs_riding_a_terrain_are_the_single_envs_bit_for_bit():
+    """A hilly world (a random terrain on a floor, a ramp): random starts keep the world-file
+    clearance above the ground where they land; the vector env's sub-env i and the single env with
+    seed 5 + i agree on observations, rewards and poses (heights and attitudes included) across
+    autoresets, and the robots did ride slopes."""
+    from sensorium.gym.task import random_start
+
+    world = hills_world()
     task = Task(robot="rover", observations=["ahead", "scan"], max_steps=15, start=random_start((-1.5, 1.5), (-1.5, 1.5)))
     n = 3
     venv = SensoriumVectorEnv(world, task, n, precision="exact")
