@@ -22,6 +22,26 @@ def test_ppo_on_the_batched_env_reaches_the_lamp():
     assert curve["return"][-1] > curve["return"][0] + 30
 
 
+@pytest.mark.parametrize("argv, why", [(["--envs", "1", "--workers", "2"], "--workers must be between 1 and --envs (1)"),
+                                       (["--envs", "0"], "--steps and --envs must be >= 1")])
+def test_train_ppo_refuses_bad_counts_in_one_line(argv, why, capsys):
+    from sensorium.gym.examples.train_ppo import main
+
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2 and why in capsys.readouterr().err
+
+
+def test_train_ppo_says_when_no_episode_ended_yet(capsys):
+    """A run too short for any episode to end printed a traceback (IndexError) instead of its summary."""
+    pytest.importorskip("stable_baselines3")
+    pytest.importorskip("torch")
+    from sensorium.gym.examples.train_ppo import main
+
+    assert main(["--steps", "256", "--envs", "4"]) == 0      # (one rollout: 4 x 256 steps, no episode ends)
+    assert "no episode ended yet (train longer)" in capsys.readouterr().out
+
+
 def test_sb3_adapter_passes_sb3s_checker_and_hands_over_terminal_observations():
     pytest.importorskip("stable_baselines3")
     from stable_baselines3.common.env_checker import check_env

@@ -21,9 +21,11 @@ from pathlib import Path
 import numpy as np
 
 
-def train(steps: int = 150_000, envs: int = 16, seed: int = 0, precision: str = "fast", log=print) -> dict:
+def train(steps: int = 150_000, envs: int = 16, seed: int = 0, precision: str = "fast", log=print,
+          workers: int = 1) -> dict:
     """Train and return the learning curve: env steps, mean episode return and reached fraction per
-    rollout, plus the wall time and env steps/s."""
+    rollout, plus the wall time and env steps/s. ``workers`` > 1: the copies in that many worker
+    processes (the same episodes; wall time gained only where cores are free)."""
     import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import BaseCallback
@@ -32,7 +34,7 @@ def train(steps: int = 150_000, envs: int = 16, seed: int = 0, precision: str = 
     from sensorium.gym.tasks import reach_light_task
 
     torch.set_num_threads(1)
-    venv = SB3VecEnv(reach_light_task(), envs, seed=seed, precision=precision)
+    venv = SB3VecEnv(reach_light_task(), envs, seed=seed, precision=precision, workers=workers)
     curve: dict[str, list] = {"steps": [], "return": [], "reached": [], "episodes": []}
 
     class Curve(BaseCallback):
@@ -98,12 +100,18 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--envs", type=int, default=16, help="copies in the batched env (default 16)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--precision", choices=["fast", "exact"], default="fast")
+    p.add_argument("--workers", type=int, default=1, help="worker processes holding the copies (default 1)")
     p.add_argument("--png", type=Path, help="write the learning curve here")
     p.add_argument("--json", type=Path, help="write the curve as JSON here")
     a = p.parse_args(argv)
-    curve = train(a.steps, a.envs, a.seed, a.precision)
-    print(f"trained {a.steps} env steps in {curve['wall_s']:.0f} s ({curve['steps_per_s']:.0f} env steps/s); "
-          f"last rollout: {100 * curve['reached'][-1]:.0f} % of episodes reached the lamp")
+    if a.steps < 1 or a.envs < 1:
+        p.error(f"--steps and --envs must be >= 1 (got {a.steps} and {a.envs})")
+    if not 1 <= a.workers <= a.envs:
+        p.error(f"--workers must be between 1 and --envs ({a.envs}), got {a.workers}")
+    curve = train(a.steps, a.envs, a.seed, a.precision, workers=a.workers)
+    last = (f"last rollout: {100 * curve['reached'][-1]:.0f} % of episodes reached the lamp" if curve["reached"]
+            else "no episode ended yet (train longer)")
+    print(f"trained {a.steps} env steps in {curve['wall_s']:.0f} s ({curve['steps_per_s']:.0f} env steps/s); {last}")
     if a.png:
         plot(curve, a.png)
         print(f"wrote {a.png}")
