@@ -271,6 +271,20 @@ def test_pettingzoo_parallel_env_passes_the_api_test_and_moves_each_robot_exactl
     assert infos["bot"]["pose"][0] == pytest.approx(21 * step_m, abs=1e-12)
 
 
+@pytest.mark.parametrize("argv, why", [(["--env", "nope"], "--env 'nope' is not a registered sensorium id"),
+                                       (["--env", "CartPole-v1"], "is not a registered sensorium id"),
+                                       (["--steps", "0"], "--steps and every --envs size must be >= 1"),
+                                       (["--envs", "2", "-1"], "--steps and every --envs size must be >= 1")])
+def test_random_policy_example_refuses_bad_arguments_in_one_line(argv, why, capsys):
+    """An unknown id came out as gymnasium's traceback, --steps 0 as a ZeroDivisionError, a negative
+    count as negative rates."""
+    from sensorium.gym.examples.random_policy import main
+
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2 and why in capsys.readouterr().err
+
+
 def test_example_loop_reports_steps_per_second_and_is_deterministic():
     from sensorium.gym.examples.random_policy import run
 

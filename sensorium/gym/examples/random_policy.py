@@ -85,6 +85,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--envs", type=int, nargs="+", default=[1, 2, 4], help="vector sizes (default 1 2 4)")
     p.add_argument("--policy", choices=["random", "scripted"], default="scripted")
     args = p.parse_args(argv)
+    if args.steps < 1 or min(args.envs) < 1:
+        p.error(f"--steps and every --envs size must be >= 1 (got {args.steps} and {args.envs})")
+    if args.env not in gym.registry or not args.env.startswith("sensorium/"):
+        ids = ", ".join(sorted(k for k in gym.registry if k.startswith("sensorium/")))
+        p.error(f"--env {args.env!r} is not a registered sensorium id ({ids})")
     rows = [run(args.env, 0, args.steps, policy=args.policy)]
     for n in args.envs:
         for mode in ("sync", "async", "batched"):
