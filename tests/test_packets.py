@@ -411,3 +411,30 @@ def test_atan2_in_c_is_math_atan2_bit_for_bit():
     assert out[:, 2].tobytes() == want.tobytes() and not out[:, :2].any()
     assert packets.atan2(np.ones(1), np.ones(1))[0] == math.pi / 4
     assert packets.atan2(np.ones(2, dtype=np.float32), np.ones(2, dtype=np.float32)) is None
+
+
+@needs_packets
+@pytest.mark.parametrize("base, landmark", [((0.0, 0.0, 0.0), False), ((1e4, 5e3, 0.0), False),
+                                            ((1e4, 5e3, 0.0), True), ((1e6, -7e5, 3e2), True)],
+                         ids=["origin", "far", "far-coarse-frame", "1e6-coarse-frame"])
+def test_exact_on_adversarial_edge_rays_is_embreexs_on_both_paths(base, landmark, monkeypatch):
+    """EXACT through the packet path (incoherent packets, judged in C) and through embreex (one ray
+    per call, judged in numpy), on test_exact_guards.py's rays aimed at shared edges, box edges,
+    corners, a seam and an open mesh's boundary, nudged by 0 to 1e-5 m, near and far from the
+    origin: every distance, normal and shape the same bit for bit. (Where two triangles meet at
+    the same float32 distance, EXACT's answer is the float64 plane of the one Embree reports: the
+    traversal must be embreex's, which is why EXACT never traces coherent packets.)"""
+    from tests.test_exact_guards import _engine, _rays
+
+    base = np.array(base)
+    with monkeypatch.context() as m:
+        m.setattr(packets, "library", lambda: None)
+        ref = _engine(base, landmark)
+        want = [ref.cast(O + base, D) for O, D in (_rays(s) for s in (1, 2))]
+    eng = _engine(base, landmark)
+    for (O, D), w in zip((_rays(s) for s in (1, 2)), want):
+        got = eng.cast(O + base, D)
+        assert got.distance.tobytes() == w.distance.tobytes()
+        assert got.normal.tobytes() == w.normal.tobytes() and got.shape.tobytes() == w.shape.tobytes()
+        assert np.isfinite(w.distance).mean() > 0.5
+    assert eng.counters["embree_calls"] > 0 and ref.counters["embree_calls"] > 0
