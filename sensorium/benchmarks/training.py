@@ -20,6 +20,8 @@ import os
 import time
 import tracemalloc
 
+import numpy as np
+
 from .common import Config, Plot, Section, Series, Table, Target, median
 
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
@@ -178,6 +180,28 @@ def _throughput(cfg: Config, sec: Section, gym) -> None:
     _lidar_budget(cfg, sec, gym, hop[1] if hop else None)
 
 
+def _bare_traversal(captured: tuple, repeats: int) -> float | None:
+    """CPU seconds of one bare packet traversal of a captured lidar cast's rays: the static tier's
+    FAST Embree scene, float32 rays, coherent packets of 16, only distances and triangles out (None
+    without the packet path or where the cast's tier is anchored)."""
+    from sensorium.server.raycast import packets
+
+    rays, origins, directions, far, kind, skip = captured
+    static = rays.static._static_tier(rays.movers._variant(kind, skip))
+    if packets.library() is None or static is None or static.anchored:
+        return None
+    scene, _ = static.scene(False)
+    if not isinstance(scene, packets.Scene):
+        return None
+    o32, d32 = origins.astype(np.float32), directions.astype(np.float32)
+    far32 = np.broadcast_to(np.asarray(far, dtype=np.float32), (len(d32),)).copy()
+    scene.run(o32, d32, far32, output=0, coherent=True)     # warm
+    t0 = time.thread_time()
+    for _ in range(repeats):
+        scene.run(o32, d32, far32, output=0, coherent=True)
+    return (time.thread_time() - t0) / repeats
+
+
 def _lidar_budget(cfg: Config, sec: Section, gym, hopper_cpu_rate: float | None) -> None:
     """Where a LidarAvoid x64 step's CPU goes: the batched casts (``CopyRays.cast``: the packet
     traversal, the judging in C and the Python around them) against the rest of the step, and what 5x
@@ -189,8 +213,12 @@ def _lidar_budget(cfg: Config, sec: Section, gym, hopper_cpu_rate: float | None)
     env = gym.make_vec(LIDAR, num_envs=64, vectorization_mode="vector_entry_point", precision="fast", threads=1)
     cast = CopyRays.cast
     spent = [0.0, 0]
+    beams: list = []   # one step's lidar cast (the copies' beams): (CopyRays, origins, directions, far, kind, skip)
 
     def timed(self, *args, **kw):
+        if not beams and len(args[0]) >= 16384:
+            skip = args[10] if len(args) > 10 else kw.get("skip_transparent", False)
+            beams.append((self, np.array(args[0]), np.array(args[1]), args[3], args[4], bool(skip)))
         t0 = time.thread_time()
         try:
             return cast(self, *args, **kw)
@@ -214,12 +242,19 @@ def _lidar_budget(cfg: Config, sec: Section, gym, hopper_cpu_rate: float | None)
         CopyRays.cast = cast                                 # type: ignore[method-assign]
         env.close()
     cast_s = spent[0] / steps
+    bare_s = _bare_traversal(beams[0], cfg.pick(200, 40)) if beams else None
     sec.data["lidar_budget"] = {"step_cpu_s": step_s, "casts_cpu_s": cast_s, "casts_per_step": spent[1] / steps,
-                                "hopper_cpu_rate": hopper_cpu_rate}
+                                "hopper_cpu_rate": hopper_cpu_rate, "bare_traversal_cpu_s": bare_s,
+                                "beams": len(beams[0][2]) if beams else None}
     budget = "" if not hopper_cpu_rate else (
         f" 5x MuJoCo Hopper ({hopper_cpu_rate:,.0f} env steps per CPU s in the rows above) leaves "
         f"{64 / (5 * hopper_cpu_rate) * 1e3:.2f} ms per step of 64 copies: the casts alone take "
         f"{100 * cast_s * 5 * hopper_cpu_rate / 64:.0f} % of it.")
+    if bare_s is not None:
+        budget += (f" The bare traversal of the same step's {len(beams[0][2]):,} lidar beams (one call of Embree's "
+                   f"coherent rtcIntersect16 packets over them, no judging, no Python around it) takes "
+                   f"{bare_s * 1e3:.2f} ms" + ("" if not hopper_cpu_rate else
+                                              f", {100 * bare_s * 5 * hopper_cpu_rate / 64:.0f} % of that budget") + ".")
     sec.findings.append(
         f"What bounds LidarAvoid x64 (FAST, one thread; a run of {steps:,} steps with the batched casts timed): "
         f"{step_s * 1e3:.2f} ms of CPU per env step, of which {cast_s * 1e3:.2f} ms ({100 * cast_s / step_s:.0f} %) "
