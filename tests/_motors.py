@@ -1,9 +1,11 @@
-"""Random motor commands for the step-by-step comparisons of cars and two-wheel robots
-(tests/test_car_agent.py, tests/test_batched_nue.py)."""
+"""Random motor commands for the step-by-step comparisons of cars and two-wheel robots, and the
+comparison of a robot's every reading (tests/test_car_agent.py, tests/test_batched_nue.py)."""
 
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 
 def random_motor_commands(rng, world) -> dict:
@@ -26,3 +28,14 @@ def command_motors(sim, cmds: dict) -> None:
         else:
             motor.set_position(math.inf)
             motor.set_velocity(vel)
+
+
+def assert_same_readings(sim, view, name: str, tag) -> None:
+    """Every device of robot ``name`` reads the same bits in ``sim`` and ``view`` (vector readings
+    as ``values``, an InertialUnit's as ``roll_pitch_yaw``, the rest as ``value``)."""
+    for d in sim.robot(name).model.devices:
+        a, b = sim.robot(name).device(d.name), view.robot(name).device(d.name)
+        what = "values" if hasattr(a, "values") and d.device != "PositionSensor" else "value"
+        if d.device == "InertialUnit":
+            what = "roll_pitch_yaw"
+        assert np.asarray(getattr(a, what)).tobytes() == np.asarray(getattr(b, what)).tobytes(), (tag, d.name)

@@ -15,7 +15,8 @@ from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix
-from tests._motors import command_motors, random_motor_commands
+from tests._motors import assert_same_readings, command_motors, random_motor_commands
+from tests.test_batched_sim import _assert_same, _wheels_both
 
 # ENU -> NUE (x north, y up, z east): the rows of NUE's axes in ENU
 TO_NUE = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
@@ -65,43 +66,6 @@ def nue_arena(seed: int, wgs84: bool = False) -> LoadedWorld:
     return LoadedWorld(world=wm.World.model_validate(data), source="nue_arena", base_dir=lw.base_dir)
 
 
-def _wheels_both(bs, sims, robot: str, lr: np.ndarray) -> None:
-    bs.set_wheels(bs.slot(robot), lr[:, 0], lr[:, 1])
-    for c, s in enumerate(sims):
-        for m in s.robot(robot).motors.values():
-            m.set_position(math.inf)
-        s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
-        s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
-
-
-def _same(a, b) -> bool:
-    return np.asarray(a, dtype=np.float64).tobytes() == np.asarray(b, dtype=np.float64).tobytes()
-
-
-def _assert_same(bs, sims, step) -> None:
-    for c, s in enumerate(sims):
-        assert bs.time_ms[c] == s.time_ms
-        for robot, names in (("epuck", EPUCK), ("scout", SCOUT + MOTION)):
-            slot = bs.slot(robot)
-            pose = s.robot(robot).pose
-            assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
-            assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
-            for n in names:
-                ref, dev = bs.device(robot, n), s.robot(robot).device(n)
-                if ref.kind == "Lidar":
-                    assert dev.range_image.tobytes() == bs.range_image(ref)[c].tobytes(), (step, c, n)
-                elif ref.kind == "GPS":
-                    for what in ("values", "speed", "speed_vector"):
-                        assert _same(getattr(dev, what), bs.reading(ref, what)[c]), (step, c, n, what)
-                elif ref.kind == "InertialUnit":
-                    for what in ("roll_pitch_yaw", "quaternion"):
-                        assert _same(getattr(dev, what), bs.reading(ref, what)[c]), (step, c, n, what)
-                elif ref.kind in ("Compass", "Gyro", "Accelerometer"):
-                    assert _same(dev.values, bs.value(ref)[c]), (step, c, n)
-                else:
-                    assert _same(dev.value, bs.value(ref)[c]), (step, c, n, dev.value)
-
-
 @pytest.mark.parametrize("precision", ["fast", "exact"])
 @pytest.mark.parametrize("wgs84", [False, True])
 def test_every_copy_of_a_nue_world_is_the_single_simulation_with_its_seed(precision, wgs84):
@@ -134,7 +98,7 @@ def test_every_copy_of_a_nue_world_is_the_single_simulation_with_its_seed(precis
         for s in sims:
             s.step()
             pressed += s.robot("scout").pressing
-        _assert_same(bs, sims, step)
+        _assert_same(bs, sims, step, (("epuck", EPUCK), ("scout", SCOUT + MOTION)))
         assert (bs.pressing[:, bs.slot("scout")] == [s.robot("scout").pressing for s in sims]).all()
     # the robots moved on NUE's ground plane (x north, z east): their heights (y) never changed
     assert (bs.pos[:, :, 1] == np.array([r.pose.translation[1] for r in sims[0].world.robots])).all()
@@ -253,10 +217,5 @@ def test_cars_and_a_terrain_in_a_nue_world_are_the_single_simulation_step_by_ste
             assert pose.rotation.tobytes() == view.robot(name).pose.rotation.tobytes(), (t, name)
             assert pose.translation.tobytes() == view.robot(name).pose.translation.tobytes(), (t, name)
             rode += abs(pose.rotation[1, 1]) < 1.0 - 1e-9       # tilted off NUE's up (y): on the ramp
-            for d in sim.robot(name).model.devices:
-                a, b = sim.robot(name).device(d.name), view.robot(name).device(d.name)
-                what = "values" if hasattr(a, "values") and d.device != "PositionSensor" else "value"
-                if d.device == "InertialUnit":
-                    what = "roll_pitch_yaw"
-                assert np.asarray(getattr(a, what)).tobytes() == np.asarray(getattr(b, what)).tobytes(), (t, d.name)
+            assert_same_readings(sim, view, name, t)
     assert rode > 0

@@ -46,11 +46,16 @@ def _enable_both(bs, sims, periods: dict, copy: int) -> None:
             sims[copy].robot(robot).device(n).enable(p)
 
 
-def _assert_same(bs, sims, step) -> None:
-    """Every copy's clock, poses, values and range images are its Simulation's, bit for bit."""
+def _same_bits(a, b) -> bool:
+    return np.asarray(a, dtype=np.float64).tobytes() == np.asarray(b, dtype=np.float64).tobytes()
+
+
+def _assert_same(bs, sims, step, robots=(("epuck", EPUCK), ("scout", SCOUT))) -> None:
+    """Every copy's clock, poses, values and range images are its Simulation's, bit for bit, for the
+    devices ``robots`` names ((robot, [device, ...]), ...)."""
     for c, s in enumerate(sims):
         assert bs.time_ms[c] == s.time_ms
-        for robot, names in (("epuck", EPUCK), ("scout", SCOUT)):
+        for robot, names in robots:
             slot = bs.slot(robot)
             pose = s.robot(robot).pose
             assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
@@ -59,8 +64,16 @@ def _assert_same(bs, sims, step) -> None:
                 ref, dev = bs.device(robot, n), s.robot(robot).device(n)
                 if ref.kind == "Lidar":
                     assert dev.range_image.tobytes() == bs.range_image(ref)[c].tobytes(), (step, c, n)
+                elif ref.kind == "GPS":
+                    for what in ("values", "speed", "speed_vector"):
+                        assert _same_bits(getattr(dev, what), bs.reading(ref, what)[c]), (step, c, n, what)
+                elif ref.kind == "InertialUnit":
+                    for what in ("roll_pitch_yaw", "quaternion"):
+                        assert _same_bits(getattr(dev, what), bs.reading(ref, what)[c]), (step, c, n, what)
+                elif ref.kind in ("Compass", "Gyro", "Accelerometer"):
+                    assert _same_bits(dev.values, bs.value(ref)[c]), (step, c, n)
                 else:
-                    assert _same_value(dev.value, float(bs.value(ref)[c])), (step, c, n, dev.value)
+                    assert _same_bits(dev.value, bs.value(ref)[c]), (step, c, n, dev.value)
 
 
 @pytest.mark.parametrize("precision", ["fast", "exact"])

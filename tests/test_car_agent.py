@@ -26,7 +26,7 @@ from sensorium.server.sim.batched import BatchedSimulation  # noqa: E402
 from sensorium.server.sim.motion import ackermann_angles  # noqa: E402
 from sensorium.server.sim.simulation import Simulation  # noqa: E402
 from sensorium.server.world.loader import load_world, parse_world  # noqa: E402
-from tests._motors import command_motors, random_motor_commands  # noqa: E402
+from tests._motors import assert_same_readings, command_motors, random_motor_commands  # noqa: E402
 from tests.test_gym_vector import _reset_both, _step_both  # noqa: E402
 
 WORLD = Path(__file__).parent / "worlds" / "cars.yaml"
@@ -223,12 +223,7 @@ def test_the_batched_simulation_drives_cars_as_the_simulation_step_by_step():
         for name in sim.robots:
             assert sim.robot(name).pose.rotation.tobytes() == view.robot(name).pose.rotation.tobytes(), (t, name)
             assert sim.robot(name).pose.translation.tobytes() == view.robot(name).pose.translation.tobytes()
-            for d in sim.robot(name).model.devices:
-                a, b = sim.robot(name).device(d.name), view.robot(name).device(d.name)
-                what = "values" if hasattr(a, "values") and d.device != "PositionSensor" else "value"
-                if d.device == "InertialUnit":
-                    what = "roll_pitch_yaw"
-                assert np.asarray(getattr(a, what)).tobytes() == np.asarray(getattr(b, what)).tobytes(), (t, d.name)
+            assert_same_readings(sim, view, name, t)
 
 
 def test_the_checker_passes_without_warnings():
