@@ -125,6 +125,17 @@ def samples(fn: Callable[[], Any], repeat: int, warmup: int = 1, min_total_s: fl
             gc.enable()
 
 
+def process_cpu_s(pid: int) -> float:
+    """User + system CPU seconds of process ``pid`` so far (Linux ``/proc/<pid>/stat``; 0 where it
+    cannot be read)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return 0.0
+
+
 def median(xs) -> float:
     return float(np.median(np.asarray(xs, dtype=np.float64))) if len(xs) else float("nan")
 

@@ -22,9 +22,7 @@ import tracemalloc
 
 import numpy as np
 
-from .common import Config, Plot, Section, Series, Table, Target, median
-
-CLOCK_TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+from .common import Config, Plot, Section, Series, Table, Target, median, process_cpu_s
 
 REACH, LIDAR = "sensorium/ReachLight-v0", "sensorium/LidarAvoid-v0"
 
@@ -45,7 +43,7 @@ class _Runner:
 
     def cpu_s(self) -> float:
         """CPU seconds of this process and of the env's worker processes (if any)."""
-        return time.process_time() + sum(map(_process_cpu_s, self.pids))
+        return time.process_time() + sum(map(process_cpu_s, self.pids))
 
     def run(self, seconds: float) -> None:
         env, acts = self.env, self.actions
@@ -65,16 +63,6 @@ class _Runner:
 
     def close(self) -> None:
         self.env.close()
-
-
-def _process_cpu_s(pid: int) -> float:
-    """User + system CPU seconds of a process (Linux ``/proc``; 0 where it cannot be read)."""
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            fields = f.read().rsplit(")", 1)[1].split()
-    except OSError:
-        return 0.0
-    return (int(fields[11]) + int(fields[12])) / CLOCK_TICKS
 
 
 def _throughput(cfg: Config, sec: Section, gym) -> None:

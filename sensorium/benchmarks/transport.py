@@ -18,7 +18,20 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import Config, Plot, Section, Series, Table, Target, fmt_growth, fmt_time, growth, median, pct
+from .common import (
+    Config,
+    Plot,
+    Section,
+    Series,
+    Table,
+    Target,
+    fmt_growth,
+    fmt_time,
+    growth,
+    median,
+    pct,
+    process_cpu_s,
+)
 
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
 SERVER_WORK_US = 10      # the 'server work' row: a raw REP busy this long per message
@@ -51,22 +64,14 @@ class OthersCPU:
         except (OSError, ValueError):
             return float("nan")
 
-    @staticmethod
-    def _cpu(pid: int) -> float:
-        try:
-            f = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-            return (int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK")
-        except (OSError, ValueError, IndexError):
-            return 0.0
-
     def start(self, pids: list[int]) -> None:
         self.t0, self.busy0 = time.perf_counter(), self._busy()
-        self.ours0 = {pid: self._cpu(pid) for pid in [os.getpid(), *pids]}
+        self.ours0 = {pid: process_cpu_s(pid) for pid in [os.getpid(), *pids]}
 
     def cores(self) -> float:
         """Cores busy with other work since :meth:`start` (call while the measured processes live)."""
         wall = time.perf_counter() - self.t0
-        ours = sum(self._cpu(pid) - c for pid, c in self.ours0.items())
+        ours = sum(process_cpu_s(pid) - c for pid, c in self.ours0.items())
         return max(0.0, (self._busy() - self.busy0 - ours) / wall) if wall > 0 else float("nan")
 
 
