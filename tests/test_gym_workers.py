@@ -22,7 +22,7 @@ from gymnasium.vector import AutoresetMode  # noqa: E402
 import sensorium.gym  # noqa: E402,F401  (registers the ids)
 from sensorium.gym import ReachLight, Task  # noqa: E402
 from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
-from sensorium.gym.workers import SensoriumWorkersEnv, WorkerError, split  # noqa: E402
+from sensorium.gym.workers import PARENT_WATCH_S, SPIN_S, SensoriumWorkersEnv, WorkerError, split  # noqa: E402
 
 slow = pytest.mark.slow        # these start worker processes
 REACH, LIDAR = "sensorium/ReachLight-v0", "sensorium/LidarAvoid-v0"
@@ -222,6 +222,42 @@ def test_a_killed_worker_makes_the_next_step_raise_and_takes_the_others_down():
 
 
 @slow
+def test_a_worker_killed_while_the_parent_waits_for_its_step_is_seen_and_named():
+    # every copy's reward sleeps, so both workers are inside their step when worker 1 is killed
+    slow_reward = lambda sim, robot, obs: time.sleep(1.5) or 0.0  # noqa: E731
+    task = Task(robot="epuck", observations={"ls0": 64}, control_period_ms=64, max_steps=5, reward=slow_reward)
+    envs = SensoriumWorkersEnv(None, task, 2, workers=2)
+    try:
+        envs.reset(seed=0)
+        pid = envs.pids[1]
+        threading.Timer(0.5, os.kill, (pid, signal.SIGKILL)).start()
+        err = _within(lambda: envs.step(np.zeros((2, 2))))
+        assert isinstance(err, WorkerError)
+        assert str(err) == (f"worker 1 of 2 (sub-envs 1-1, pid {pid}) died during step (killed by signal SIGKILL): "
+                            "the environment is closed; build a new one")
+        assert all(map(_gone, envs.pids))
+    finally:
+        envs.close()
+
+
+@slow
+def test_workers_asleep_between_steps_wake_for_the_next_one_with_the_same_values():
+    # past the poll (SPIN_S) and past a sleeping worker's check on its parent (PARENT_WATCH_S)
+    ref, envs = _make(REACH, 4, 1, max_steps=6), _make(REACH, 4, 2, max_steps=6)
+    try:
+        _same(envs.reset(seed=3), ref.reset(seed=3), "reset")
+        rng = np.random.default_rng(5)
+        for t, pause in enumerate([0.0, 10 * SPIN_S, 2.5 * PARENT_WATCH_S, 0.0, 2.5 * PARENT_WATCH_S]):
+            time.sleep(pause)
+            a = rng.uniform(-1, 1, (4, 2)).astype(np.float32)
+            _same(envs.step(a), ref.step(a), f"step {t} after {pause:g} s")
+        assert not any(map(_gone, envs.pids))
+    finally:
+        ref.close()
+        envs.close()
+
+
+@slow
 def test_close_and_garbage_collection_leave_no_worker_behind():
     envs = _make(LIDAR, 3, 3, max_steps=5)
     pids = envs.pids
@@ -253,7 +289,7 @@ def test_no_worker_outlives_its_parent_whether_it_exits_without_close_or_is_kill
     assert done.returncode == (-signal.SIGKILL if ending == "SIGKILL" else 0), done.stderr
     pids = [int(p) for p in done.stdout.split()]
     assert len(pids) == 2
-    deadline = time.monotonic() + WAIT_S       # (a killed parent's workers end when their pipe closes)
+    deadline = time.monotonic() + WAIT_S       # (an orphaned worker ends within PARENT_WATCH_S)
     while not all(map(_gone, pids)) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert all(map(_gone, pids))

@@ -66,6 +66,8 @@ class _Runner:
 
 
 def _throughput(cfg: Config, sec: Section, gym) -> None:
+    from sensorium.gym.workers import SPIN_S
+
     rounds = cfg.pick(5, 2)
     chunk = cfg.pick(1.5, 0.4)
     def batched(env_id: str, n: int, precision: str, threads: int = 1, workers: int = 1):
@@ -163,7 +165,8 @@ def _throughput(cfg: Config, sec: Section, gym) -> None:
         f"workers=2 (the copies in two worker processes): ReachLight x256 {reach_w[0]:,.0f} env steps per wall s "
         f"({reach_w[0] / reach[0]:.2f}x one process), LidarAvoid x64 {lidar_w[0]:,.0f} ({lidar_w[0] / lidar[0]:.2f}x); "
         f"per CPU s of the parent and both workers {reach_w[1]:,.0f} and {lidar_w[1]:,.0f} (each worker repeats the "
-        f"batched step's fixed cost for half the copies, and the parent's hand-over is added). {os.cpu_count()} cores, "
+        f"batched step's fixed cost for half the copies, polls up to {SPIN_S * 1e3:.1f} ms for the next step before it "
+        f"sleeps, and the parent's hand-over is added). {os.cpu_count()} cores, "
         f"load average {load:.1f} when the run began: two workers gain wall time only where a second core is free.")
     _lidar_budget(cfg, sec, gym, hop[1] if hop else None)
 

@@ -20,8 +20,15 @@ every array step by step, autoresets included); ``reset(seed=s)`` gives sub-env 
   forked from a process that may hold Embree/TBB/BLAS threads), so, as for any spawn-started
   process, a script building the env must keep its top level behind ``if __name__ == "__main__":``.
   The world and the task reach the workers through cloudpickle (a custom ``Task`` with lambdas
-  works). The workers talk only to this process, over pipes and shared memory: nothing is bound
-  to the network.
+  works). The workers talk only to this process, over pipes, semaphores and shared memory: nothing
+  is bound to the network.
+* Hand-over: a step's actions and results go through shared memory and each worker's pair of
+  semaphores (go, done), without pickling; a call with arguments (reset, render) also carries them
+  on the worker's pipe. After answering, a worker polls for its next command for up to
+  :data:`SPIN_S` before it sleeps: the parent's turn between two steps is usually shorter, and a
+  sleeping process woken costs more (on the 2-core VM of docs/benchmarks.md, ReachLight x256 on two
+  workers: 1.80 ms per step over pipes, 1.40 ms this way). That poll is at most :data:`SPIN_S` of a
+  core per step when the caller takes longer between steps.
 * Cores: each worker's batched env casts on one thread (``threads`` defaults to 1 here: k workers
   already keep k cores busy); pass ``threads`` to change it.
 * Data: observations, rewards, terminations, truncations, actions and the usual infos go through
@@ -30,8 +37,9 @@ every array step by step, autoresets included); ``reset(seed=s)`` gives sub-env 
 * Failure: an exception in a worker (a task's callable raising, ...) is raised here as one
   :class:`WorkerError` naming the worker, its sub-envs and the original error (and where it was
   raised); the env then wants a ``reset()``. A worker that dies makes the call waiting on it raise
-  (its exit is watched together with its pipe: no hang), and the env is then unusable. ``close()``,
-  garbage collection and interpreter exit end the worker processes.
+  (the parent looks at the workers' processes every :data:`WATCH_S` while it waits: no hang), and
+  the env is then unusable. ``close()``, garbage collection and interpreter exit end the worker
+  processes; a worker whose parent is gone ends within :data:`PARENT_WATCH_S`.
 * ``workers=1`` in ``make_vec`` is today's ``SensoriumVectorEnv`` in this process; this class with
   ``workers=1`` is one worker process.
 """
@@ -39,8 +47,9 @@ every array step by step, autoresets included); ``reset(seed=s)`` gives sub-env 
 from __future__ import annotations
 
 import multiprocessing as mp
-import select
+import os
 import signal
+import time
 import traceback
 import weakref
 from multiprocessing.connection import Connection
@@ -68,6 +77,25 @@ CLOSE_WAIT_S = 5.0
 BASE_INFO = {"time_ms": ((), np.dtype(np.int64)), "steps": ((), np.dtype(np.int64)), "pose": ((3,), np.dtype(np.float64))}
 """The info keys of every step and reset (SensoriumVectorEnv's: shape of one copy, dtype), each with its
 ``_key`` mask: they go through shared memory; any other key (SAME_STEP's final ones) through the pipe."""
+
+
+SPIN_S = 200e-6
+"""How long a worker that answered polls for its next command before it sleeps (see the module's
+docstring: hand-over); 0 when there are more workers than CPUs this process may use (a polling
+worker would then hold a core another worker needs)."""
+
+WATCH_S = 0.05
+"""While the parent waits for replies, it checks this often that every worker is alive."""
+
+PARENT_WATCH_S = 0.2
+"""A sleeping worker checks this often that its parent is alive (orphaned, it ends)."""
+
+# A worker's command (shared memory, written before its go semaphore is released): a step (nothing on
+# the pipe), or a call whose (name, argument) waits on the pipe. Its reply's status (written before
+# its done semaphore is released): done, nothing more; done, the reply on the pipe; failed, the error
+# on the pipe.
+_STEP, _CALL = 1, 2
+_DONE, _DONE_PIPE, _FAILED = 0, 1, 2
 
 
 class WorkerError(RuntimeError):
@@ -149,10 +177,33 @@ def _describe(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text}{_where(exc)}"
 
 
-def _serve(conn: Connection, payload: bytes, lo: int, hi: int, raws: dict, layout, n: int) -> None:
-    """A worker: build the batched env of copies [lo, hi) and answer the parent's calls until it
-    says close (or its pipe ends: the parent is gone)."""
+def _wait_for_command(go, parent: int, spin_s: float) -> bool:
+    """A worker's wait for its go semaphore: polled for ``spin_s``, then slept on; False when the
+    parent is gone (checked every :data:`PARENT_WATCH_S` while asleep)."""
+    start = time.perf_counter()
+    while not go.acquire(False):
+        if time.perf_counter() - start > spin_s:
+            while not go.acquire(timeout=PARENT_WATCH_S):
+                if os.getppid() != parent:
+                    return False
+            return True
+    return True
+
+
+def _serve(conn: Connection, go, done, control, w: int, spin_s: float, payload: bytes, lo: int, hi: int,
+           raws: dict, layout, n: int) -> None:
+    """Worker ``w``: build the batched env of copies [lo, hi) and answer the parent's commands until
+    it says close (or it is gone)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)     # Ctrl-C is the parent's: it closes us
+    parent = os.getppid()
+    command, status = _control(control)
+
+    def answer(code: int, message: Any = None) -> None:
+        if code != _DONE:
+            conn.send(message)
+        status[w] = code
+        done.release()
+
     try:
         from sensorium.gym.vector import SensoriumVectorEnv
 
@@ -160,9 +211,9 @@ def _serve(conn: Connection, payload: bytes, lo: int, hi: int, raws: dict, layou
         env = SensoriumVectorEnv(loaded, task, hi - lo, **options)
         mine = {key: a[lo:hi] for key, a in _arrays(raws, layout, n).items()}
     except Exception as exc:  # noqa: BLE001 - every failure goes to the parent as one message
-        conn.send(("error", _describe(exc)))
+        answer(_FAILED, _describe(exc))
         return
-    conn.send(("ok", None))
+    answer(_DONE)
 
     def publish(obs) -> None:
         for key, _, dtype in layout:
@@ -183,10 +234,16 @@ def _serve(conn: Connection, payload: bytes, lo: int, hi: int, raws: dict, layou
         return rest
 
     while True:
-        try:
-            what, arg = conn.recv()
-        except (EOFError, OSError):
+        if not _wait_for_command(go, parent, spin_s):
             return
+        arg: Any
+        if command[w] == _STEP:
+            what, arg = "step", None
+        else:
+            try:
+                what, arg = conn.recv()
+            except (EOFError, OSError):
+                return
         if what == "close":
             env.close()
             return
@@ -197,29 +254,39 @@ def _serve(conn: Connection, payload: bytes, lo: int, hi: int, raws: dict, layou
                 mine["@rewards"][...] = rew
                 mine["@terminations"][...] = term
                 mine["@truncations"][...] = trunc
-                reply: Any = shared_info(info)
+                rest = shared_info(info)
+                code, reply = (_DONE_PIPE, rest) if rest else (_DONE, None)
             elif what == "reset":
                 obs, info = env.reset(**arg)
                 publish(obs)
-                reply = shared_info(info)
+                code, reply = _DONE_PIPE, shared_info(info)
             elif what == "peek":        # a reset of other workers' copies: ours as they are (not reset)
                 publish(env._observe())
-                reply = shared_info(env._full_info(np.zeros(hi - lo, dtype=bool)))
+                code, reply = _DONE_PIPE, shared_info(env._full_info(np.zeros(hi - lo, dtype=bool)))
             elif what == "render":
-                reply = env.render()
+                code, reply = _DONE_PIPE, env.render()
             else:
                 raise ValueError(f"unknown call {what!r}")
         except Exception as exc:  # noqa: BLE001
-            conn.send(("error", _describe(exc)))
+            answer(_FAILED, _describe(exc))
             continue
-        conn.send(("ok", reply))
+        answer(code, reply)
 
 
-def _shutdown(procs: list, conns: list[Connection]) -> None:
+def _control(control) -> tuple[np.ndarray, np.ndarray]:
+    """The shared (command, status) arrays of every worker, views of ``control`` (2k int64)."""
+    both = np.frombuffer(memoryview(control).cast("B"), dtype=np.int64)
+    k = len(both) // 2
+    return both[:k], both[k:]
+
+
+def _shutdown(procs: list, conns: list[Connection], gos: list, command: np.ndarray) -> None:
     """End the workers: ask each to close, then terminate (and kill) whatever is still running."""
-    for c in conns:
+    for w, c in enumerate(conns):
         try:
+            command[w] = _CALL
             c.send(("close", None))
+            gos[w].release()
         except (OSError, ValueError):
             pass
     for p in procs:
@@ -297,26 +364,26 @@ class SensoriumWorkersEnv(VectorEnv):
         ctx = mp.get_context("spawn")
         raws = _buffers(ctx, self._layout, n)
         self._shared = _arrays(raws, self._layout, n)
+        control = ctx.RawArray("q", 2 * self.workers)
+        self._command, self._status = _control(control)
+        self._gos = [ctx.Semaphore(0) for _ in range(self.workers)]
+        self._dones = [ctx.Semaphore(0) for _ in range(self.workers)]
         payload = cloudpickle.dumps((loaded, task, {
             "precision": precision, "actions": actions, "flatten": flatten, "autoreset_mode": self.autoreset_mode,
             "render_mode": render_mode, "render_size": render_size, "threads": threads}))
-        # (the finalizer holds the processes and pipes, not self: garbage collection and exit end them)
-        self._finalizer = weakref.finalize(self, _shutdown, self._procs, self._conns)
+        # (the finalizer holds the processes, pipes and semaphores, not self: garbage collection and exit end them)
+        self._finalizer = weakref.finalize(self, _shutdown, self._procs, self._conns, self._gos, self._command)
+        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        spin_s = SPIN_S if self.workers <= cpus else 0.0
         for w, (lo, hi) in enumerate(self.slices):
             mine, theirs = ctx.Pipe()
-            proc = ctx.Process(target=_serve, args=(theirs, payload, lo, hi, raws, self._layout, n),
+            proc = ctx.Process(target=_serve, args=(theirs, self._gos[w], self._dones[w], control, w, spin_s, payload,
+                                                    lo, hi, raws, self._layout, n),
                                name=f"sensorium-worker-{w}", daemon=True)
             proc.start()
             theirs.close()
             self._procs.append(proc)
             self._conns.append(mine)
-        # every worker's pipe and process watched together, registered once (a step polls them)
-        self._poller = select.poll()
-        self._fds: dict[int, tuple[int, bool]] = {}
-        for w, (proc, conn) in enumerate(zip(self._procs, self._conns)):
-            for fd, is_pipe in ((conn.fileno(), True), (proc.sentinel, False)):
-                self._poller.register(fd, select.POLLIN)
-                self._fds[fd] = (w, is_pipe)
         try:
             self._call([("start", None)] * self.workers, send=False)
         except BaseException:
@@ -340,43 +407,46 @@ class SensoriumWorkersEnv(VectorEnv):
         return WorkerError(f"{self._broken}: the environment is closed; build a new one")
 
     def _call(self, requests: list[tuple[str, Any] | None], send: bool = True) -> list:
-        """Send each worker its (call, argument) (None: none) and wait for every reply, watching each
-        worker's pipe and its process together (a worker that dies is seen at once)."""
+        """Send each worker its (call, argument) (None: none) and wait for every reply, looking at
+        the workers' processes every :data:`WATCH_S` meanwhile (a worker that dies is seen then)."""
         if self._broken:
             raise WorkerError(f"{self._broken}: the environment is closed; build a new one")
         if self.closed:
             raise RuntimeError("the environment is closed")
         whats = [r[0] if r is not None else "" for r in requests]
-        waiting = {w for w, r in enumerate(requests) if r is not None}
+        waiting = [w for w, r in enumerate(requests) if r is not None]
         replies: list = [None] * self.workers
         errors: list[tuple[int, str]] = []
         try:
-            for w in sorted(waiting) if send else ():
-                try:
-                    self._conns[w].send(requests[w])
-                except OSError:
-                    raise self._died(w, whats[w]) from None
-            while waiting:
-                for fd, _ in self._poller.poll():
-                    w, is_pipe = self._fds[fd]
-                    what = whats[w] or "another worker's call"
-                    if not is_pipe:     # a process ended (any worker's: the env is broken), unless its reply is still to read
-                        if w in waiting and self._conns[w].poll():
-                            continue
-                        raise self._died(w, what)
-                    if w not in waiting:
-                        continue
+            for w in waiting if send else ():
+                request = requests[w]
+                assert request is not None
+                if request[0] == "step":          # the arguments are in shared memory
+                    self._command[w] = _STEP
+                else:
+                    self._command[w] = _CALL
                     try:
-                        status, reply = self._conns[w].recv()
+                        self._conns[w].send(request)
+                    except OSError:
+                        raise self._died(w, whats[w]) from None
+                self._gos[w].release()
+            answered: set[int] = set()        # replies seen while checking on a dead worker
+            for w in waiting:
+                while w not in answered and not self._dones[w].acquire(timeout=WATCH_S):
+                    self._watch(waiting, answered, whats)
+                code = int(self._status[w])
+                reply: Any = {}
+                if code != _DONE:
+                    try:
+                        reply = self._conns[w].recv()
                     except (EOFError, OSError):
-                        raise self._died(w, what) from None
-                    waiting.discard(w)
-                    if status == "error":
-                        errors.append((w, f"{self._name(w)} failed in {what}: {reply}"))
-                    replies[w] = reply
+                        raise self._died(w, whats[w]) from None
+                if code == _FAILED:
+                    errors.append((w, f"{self._name(w)} failed in {whats[w]}: {reply}"))
+                replies[w] = reply
         except WorkerError:
             raise
-        except BaseException:         # interrupted while replies were owed: the pipes are out of step
+        except BaseException:         # interrupted while replies were owed: the workers are out of step
             self._broken = "an earlier call was interrupted"
             self._finalizer()
             raise
@@ -387,6 +457,17 @@ class SensoriumWorkersEnv(VectorEnv):
             after = "" if whats[errors[0][0]] == "start" else "; reset() before stepping again"
             raise WorkerError(errors[0][1] + more + after)
         return replies
+
+    def _watch(self, waiting: list[int], answered: set[int], whats: list[str]) -> None:
+        """Raise for a worker process that ended (any worker's: the env is broken), unless it is one
+        whose reply is still to read (then noted in ``answered``)."""
+        for v, proc in enumerate(self._procs):
+            if proc.exitcode is None or v in answered:
+                continue
+            if v in waiting and self._dones[v].acquire(False):
+                answered.add(v)
+                continue
+            raise self._died(v, whats[v] or "another worker's call")
 
     def _infos(self, replies: list[dict], obs=None) -> dict:
         """The info of every sub-env: the usual arrays from shared memory, the rest from the replies
