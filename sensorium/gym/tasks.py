@@ -84,6 +84,8 @@ def _vector(task: Task, world, num_envs: int, render_mode, workers: int = 1, **k
     kw.pop("max_episode_steps", None)        # make_vec passes the spec's (None here: tasks truncate themselves)
     if check_workers(workers, num_envs) > 1:
         return SensoriumWorkersEnv(world, task, num_envs, workers=workers, render_mode=render_mode, **kw)
+    if "poll_s" in kw:
+        raise ValueError("poll_s is the worker processes' poll: it needs workers=k > 1")
     return SensoriumVectorEnv(world, task, num_envs, render_mode=render_mode, **kw)
 
 

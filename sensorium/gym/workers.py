@@ -24,16 +24,12 @@ every array step by step, autoresets included); ``reset(seed=s)`` gives sub-env 
   is bound to the network.
 * Hand-over: a step's actions and results go through shared memory and each worker's pair of
   semaphores (go, done), without pickling; a call with arguments (reset, render) also carries them
-  on the worker's pipe. After answering, a worker polls for its next command for up to
-  :data:`SPIN_S` before it sleeps: the parent's turn between two steps is usually shorter, and a
-  sleeping process woken costs more (on the 2-core VM of docs/benchmarks.md, ReachLight x256 on two
-  workers: 1.80 ms per step over pipes, 1.40 ms this way). That poll is at most :data:`SPIN_S` of a
-  core per step when the caller takes longer between steps.
-* Cores: each worker's batched env casts on one thread (``threads`` defaults to 1 here: k workers
-  already keep k cores busy); pass ``threads`` to change it.
-* Data: observations, rewards, terminations, truncations, actions and the usual infos go through
-  shared memory (one copy in, one copy out per step; the returned arrays are the caller's own);
-  ``SAME_STEP``'s ``final_obs``/``final_info`` go through the pipes.
+  on the worker's pipe. After answering, a worker polls for its next command for up to ``poll_s``
+  (default :data:`POLL_S`; 0 when there are more workers than CPUs) before it sleeps: the parent's
+  turn between two steps is usually shorter, and waking a sleeping process costs more (the
+  training section of docs/benchmarks.md measures two workers with and without it). The poll costs
+  at most ``poll_s`` of a core per step when the caller takes longer between steps (a policy's
+  forward pass): pass ``poll_s=0`` to spend none.
 * Failure: an exception in a worker (a task's callable raising, ...) is raised here as one
   :class:`WorkerError` naming the worker, its sub-envs and the original error (and where it was
   raised); the env then wants a ``reset()``. A worker that dies makes the call waiting on it raise
@@ -69,7 +65,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedError, check_observable
 from sensorium.server.world.loader import LoadedWorld
 
-__all__ = ["SensoriumWorkersEnv", "WorkerError", "check_workers", "split"]
+__all__ = ["SensoriumWorkersEnv", "WorkerError", "check_poll", "check_workers", "split"]
 
 CLOSE_WAIT_S = 5.0
 """How long close() lets a worker finish on its own before it is terminated."""
@@ -79,10 +75,13 @@ BASE_INFO = {"time_ms": ((), np.dtype(np.int64)), "steps": ((), np.dtype(np.int6
 ``_key`` mask: they go through shared memory; any other key (SAME_STEP's final ones) through the pipe."""
 
 
-SPIN_S = 200e-6
-"""How long a worker that answered polls for its next command before it sleeps (see the module's
-docstring: hand-over); 0 when there are more workers than CPUs this process may use (a polling
-worker would then hold a core another worker needs)."""
+POLL_S = 200e-6
+"""How long a worker that answered polls for its next command before it sleeps, by default (see the
+module's docstring: hand-over); 0 when there are more workers than CPUs this process may use (a
+polling worker would then hold a core another worker needs)."""
+
+MAX_POLL_S = 0.01
+"""The longest ``poll_s`` accepted."""
 
 WATCH_S = 0.05
 """While the parent waits for replies, it checks this often that every worker is alive."""
@@ -111,6 +110,18 @@ def check_workers(workers: Any, num_envs: Any) -> int:
     if check_counts(num_envs, None) < workers:
         raise ValueError(f"workers={workers} is more than num_envs={num_envs}: each worker needs at least one copy")
     return int(workers)
+
+
+def check_poll(poll_s: Any, workers: int) -> float:
+    """A worker's poll in seconds: ``None`` is :data:`POLL_S` (0 when there are more workers than
+    CPUs this process may use); else a number in [0, :data:`MAX_POLL_S`], or ValueError (one line)."""
+    if poll_s is None:
+        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        return POLL_S if workers <= cpus else 0.0
+    if isinstance(poll_s, bool) or not isinstance(poll_s, (int, float, np.integer, np.floating)) \
+            or not 0.0 <= float(poll_s) <= MAX_POLL_S:
+        raise ValueError(f"poll_s must be a number of seconds in [0, {MAX_POLL_S:g}], got {poll_s!r}")
+    return float(poll_s)
 
 
 def split(num_envs: int, workers: int) -> list[tuple[int, int]]:
@@ -177,12 +188,12 @@ def _describe(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text}{_where(exc)}"
 
 
-def _wait_for_command(go, parent: int, spin_s: float) -> bool:
-    """A worker's wait for its go semaphore: polled for ``spin_s``, then slept on; False when the
+def _wait_for_command(go, parent: int, poll_s: float) -> bool:
+    """A worker's wait for its go semaphore: polled for ``poll_s``, then slept on; False when the
     parent is gone (checked every :data:`PARENT_WATCH_S` while asleep)."""
     start = time.perf_counter()
     while not go.acquire(False):
-        if time.perf_counter() - start > spin_s:
+        if time.perf_counter() - start > poll_s:
             while not go.acquire(timeout=PARENT_WATCH_S):
                 if os.getppid() != parent:
                     return False
@@ -190,7 +201,7 @@ def _wait_for_command(go, parent: int, spin_s: float) -> bool:
     return True
 
 
-def _serve(conn: Connection, go, done, control, w: int, spin_s: float, payload: bytes, lo: int, hi: int,
+def _serve(conn: Connection, go, done, control, w: int, poll_s: float, payload: bytes, lo: int, hi: int,
            raws: dict, layout, n: int) -> None:
     """Worker ``w``: build the batched env of copies [lo, hi) and answer the parent's commands until
     it says close (or it is gone)."""
@@ -234,7 +245,7 @@ def _serve(conn: Connection, go, done, control, w: int, spin_s: float, payload: 
         return rest
 
     while True:
-        if not _wait_for_command(go, parent, spin_s):
+        if not _wait_for_command(go, parent, poll_s):
             return
         arg: Any
         if command[w] == _STEP:
@@ -330,7 +341,7 @@ class SensoriumWorkersEnv(VectorEnv):
                  num_envs: int = 1, *, workers: int = 2, precision: str = DEFAULT_PRECISION,
                  actions: str = "normalized", flatten: bool = False,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP, render_mode: str | None = None,
-                 render_size: int = 256, threads: int | None = 1, **_spec_kwargs):
+                 render_size: int = 256, threads: int | None = 1, poll_s: float | None = None, **_spec_kwargs):
         self._procs: list = []
         self._conns: list[Connection] = []
         self._broken = ""
@@ -373,11 +384,10 @@ class SensoriumWorkersEnv(VectorEnv):
             "render_mode": render_mode, "render_size": render_size, "threads": threads}))
         # (the finalizer holds the processes, pipes and semaphores, not self: garbage collection and exit end them)
         self._finalizer = weakref.finalize(self, _shutdown, self._procs, self._conns, self._gos, self._command)
-        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-        spin_s = SPIN_S if self.workers <= cpus else 0.0
+        poll_s = check_poll(poll_s, self.workers)
         for w, (lo, hi) in enumerate(self.slices):
             mine, theirs = ctx.Pipe()
-            proc = ctx.Process(target=_serve, args=(theirs, self._gos[w], self._dones[w], control, w, spin_s, payload,
+            proc = ctx.Process(target=_serve, args=(theirs, self._gos[w], self._dones[w], control, w, poll_s, payload,
                                                     lo, hi, raws, self._layout, n),
                                name=f"sensorium-worker-{w}", daemon=True)
             proc.start()
