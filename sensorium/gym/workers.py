@@ -201,12 +201,11 @@ def _wait_for_command(go, parent: int, poll_s: float) -> bool:
     return True
 
 
-def _serve(conn: Connection, go, done, control, w: int, poll_s: float, payload: bytes, lo: int, hi: int,
-           raws: dict, layout, n: int) -> None:
+def _serve(conn: Connection, go, done, control, w: int, poll_s: float, parent: int, payload: bytes, lo: int,
+           hi: int, raws: dict, layout, n: int) -> None:
     """Worker ``w``: build the batched env of copies [lo, hi) and answer the parent's commands until
-    it says close (or it is gone)."""
+    it says close (or the parent, process ``parent``, is gone)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)     # Ctrl-C is the parent's: it closes us
-    parent = os.getppid()
     command, status = _control(control)
 
     def answer(code: int, message: Any = None) -> None:
@@ -387,8 +386,8 @@ class SensoriumWorkersEnv(VectorEnv):
         poll_s = check_poll(poll_s, self.workers)
         for w, (lo, hi) in enumerate(self.slices):
             mine, theirs = ctx.Pipe()
-            proc = ctx.Process(target=_serve, args=(theirs, self._gos[w], self._dones[w], control, w, poll_s, payload,
-                                                    lo, hi, raws, self._layout, n),
+            proc = ctx.Process(target=_serve, args=(theirs, self._gos[w], self._dones[w], control, w, poll_s,
+                                                    os.getpid(), payload, lo, hi, raws, self._layout, n),
                                name=f"sensorium-worker-{w}", daemon=True)
             proc.start()
             theirs.close()
