@@ -24,12 +24,11 @@ every array step by step, autoresets included); ``reset(seed=s)`` gives sub-env 
   is bound to the network.
 * Hand-over: a step's actions and results go through shared memory and each worker's pair of
   semaphores (go, done), without pickling; a call with arguments (reset, render) also carries them
-  on the worker's pipe. After answering, a worker polls for its next command for up to ``poll_s``
-  (default :data:`POLL_S`; 0 when there are more workers than CPUs) before it sleeps: the parent's
-  turn between two steps is usually shorter, and waking a sleeping process costs more (the
-  training section of docs/benchmarks.md measures two workers with and without it). The poll costs
-  at most ``poll_s`` of a core per step when the caller takes longer between steps (a policy's
-  forward pass): pass ``poll_s=0`` to spend none.
+  on the worker's pipe. A worker that answered sleeps on its semaphore until the next command; with
+  ``poll_s`` > 0 it first polls for it that long (at most :data:`MAX_POLL_S`), which can save the
+  wake-up when the caller's turn between two steps is shorter (the training section of
+  docs/benchmarks.md measures two workers with and without a poll) and costs up to ``poll_s`` of a
+  core per step when it is longer (a policy's forward pass). It pays only with a free core per worker.
 * Failure: an exception in a worker (a task's callable raising, ...) is raised here as one
   :class:`WorkerError` naming the worker, its sub-envs and the original error (and where it was
   raised); the env then wants a ``reset()``. A worker that dies makes the call waiting on it raise
@@ -75,11 +74,6 @@ BASE_INFO = {"time_ms": ((), np.dtype(np.int64)), "steps": ((), np.dtype(np.int6
 ``_key`` mask: they go through shared memory; any other key (SAME_STEP's final ones) through the pipe."""
 
 
-POLL_S = 200e-6
-"""How long a worker that answered polls for its next command before it sleeps, by default (see the
-module's docstring: hand-over); 0 when there are more workers than CPUs this process may use (a
-polling worker would then hold a core another worker needs)."""
-
 MAX_POLL_S = 0.01
 """The longest ``poll_s`` accepted."""
 
@@ -112,12 +106,8 @@ def check_workers(workers: Any, num_envs: Any) -> int:
     return int(workers)
 
 
-def check_poll(poll_s: Any, workers: int) -> float:
-    """A worker's poll in seconds: ``None`` is :data:`POLL_S` (0 when there are more workers than
-    CPUs this process may use); else a number in [0, :data:`MAX_POLL_S`], or ValueError (one line)."""
-    if poll_s is None:
-        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-        return POLL_S if workers <= cpus else 0.0
+def check_poll(poll_s: Any) -> float:
+    """A worker's poll in seconds: a number in [0, :data:`MAX_POLL_S`], or ValueError (one line)."""
     if isinstance(poll_s, bool) or not isinstance(poll_s, (int, float, np.integer, np.floating)) \
             or not 0.0 <= float(poll_s) <= MAX_POLL_S:
         raise ValueError(f"poll_s must be a number of seconds in [0, {MAX_POLL_S:g}], got {poll_s!r}")
@@ -340,7 +330,7 @@ class SensoriumWorkersEnv(VectorEnv):
                  num_envs: int = 1, *, workers: int = 2, precision: str = DEFAULT_PRECISION,
                  actions: str = "normalized", flatten: bool = False,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP, render_mode: str | None = None,
-                 render_size: int = 256, threads: int | None = 1, poll_s: float | None = None, **_spec_kwargs):
+                 render_size: int = 256, threads: int | None = 1, poll_s: float = 0.0, **_spec_kwargs):
         self._procs: list = []
         self._conns: list[Connection] = []
         self._broken = ""
@@ -383,7 +373,7 @@ class SensoriumWorkersEnv(VectorEnv):
             "render_mode": render_mode, "render_size": render_size, "threads": threads}))
         # (the finalizer holds the processes, pipes and semaphores, not self: garbage collection and exit end them)
         self._finalizer = weakref.finalize(self, _shutdown, self._procs, self._conns, self._gos, self._command)
-        poll_s = check_poll(poll_s, self.workers)
+        poll_s = check_poll(poll_s)
         for w, (lo, hi) in enumerate(self.slices):
             mine, theirs = ctx.Pipe()
             proc = ctx.Process(target=_serve, args=(theirs, self._gos[w], self._dones[w], control, w, poll_s,
