@@ -336,6 +336,7 @@ class SensoriumWorkersEnv(VectorEnv):
         self._broken = ""
         check_counts(num_envs, threads)
         self.workers = check_workers(workers, num_envs)
+        poll_s = check_poll(poll_s)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
         self.autoreset_mode = AutoresetMode(autoreset_mode)
@@ -373,7 +374,6 @@ class SensoriumWorkersEnv(VectorEnv):
             "render_mode": render_mode, "render_size": render_size, "threads": threads}))
         # (the finalizer holds the processes, pipes and semaphores, not self: garbage collection and exit end them)
         self._finalizer = weakref.finalize(self, _shutdown, self._procs, self._conns, self._gos, self._command)
-        poll_s = check_poll(poll_s)
         for w, (lo, hi) in enumerate(self.slices):
             mine, theirs = ctx.Pipe()
             proc = ctx.Process(target=_serve, args=(theirs, self._gos[w], self._dones[w], control, w, poll_s,
