@@ -131,6 +131,18 @@ def test_a_bad_poll_is_refused_in_one_line_before_any_process_starts(poll_s):
     assert mp.active_children() == []
 
 
+def test_stable_baselines3s_env_takes_the_poll_only_with_workers():
+    pytest.importorskip("stable_baselines3")
+    from sensorium.gym.sb3 import SB3VecEnv
+
+    task = sensorium.gym.tasks.reach_light_task()
+    with pytest.raises(ValueError, match=r"^poll_s is the worker processes' poll: it needs workers=k > 1$"):
+        SB3VecEnv(task, 4, workers=1, poll_s=0.0)
+    with pytest.raises(ValueError, match=r"^poll_s must be a number of seconds in \[0, 0.01\], got -1$"):
+        SB3VecEnv(task, 4, workers=2, poll_s=-1)
+    assert mp.active_children() == []
+
+
 def test_a_poll_in_range_is_taken_as_seconds():
     assert check_poll(0) == 0.0 and check_poll(np.float32(0.001)) == pytest.approx(0.001)
     assert check_poll(MAX_POLL_S) == MAX_POLL_S

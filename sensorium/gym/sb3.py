@@ -23,7 +23,7 @@ from stable_baselines3.common.vec_env import VecEnv
 
 from sensorium.gym.task import Task
 from sensorium.gym.vector import SensoriumVectorEnv
-from sensorium.gym.workers import SensoriumWorkersEnv, check_workers
+from sensorium.gym.workers import SensoriumWorkersEnv, check_workers, one_process
 
 __all__ = ["SB3VecEnv"]
 
@@ -36,7 +36,8 @@ class SB3VecEnv(VecEnv):
         kw.update(flatten=flatten, autoreset_mode=AutoresetMode.SAME_STEP)
         # workers=k > 1: the copies in k worker processes (sensorium.gym.workers; the same episodes)
         self.venv = (SensoriumWorkersEnv(world, task, num_envs, workers=workers, **kw)
-                     if check_workers(workers, num_envs) > 1 else SensoriumVectorEnv(world, task, num_envs, **kw))
+                     if check_workers(workers, num_envs) > 1
+                     else SensoriumVectorEnv(world, task, num_envs, **one_process(kw)))
         super().__init__(num_envs, self.venv.single_observation_space, self.venv.single_action_space)
         self._seed = seed
         self._actions: np.ndarray | None = None

@@ -79,14 +79,12 @@ def car_park():
 def _vector(task: Task, world, num_envs: int, render_mode, workers: int = 1, **kw):
     """The batched vector env; ``workers=k`` > 1: k processes of it side by side (:mod:`.workers`)."""
     from sensorium.gym.vector import SensoriumVectorEnv  # imported on use: the single envs do not need it
-    from sensorium.gym.workers import SensoriumWorkersEnv, check_workers
+    from sensorium.gym.workers import SensoriumWorkersEnv, check_workers, one_process
 
     kw.pop("max_episode_steps", None)        # make_vec passes the spec's (None here: tasks truncate themselves)
     if check_workers(workers, num_envs) > 1:
         return SensoriumWorkersEnv(world, task, num_envs, workers=workers, render_mode=render_mode, **kw)
-    if "poll_s" in kw:
-        raise ValueError("poll_s is the worker processes' poll: it needs workers=k > 1")
-    return SensoriumVectorEnv(world, task, num_envs, render_mode=render_mode, **kw)
+    return SensoriumVectorEnv(world, task, num_envs, render_mode=render_mode, **one_process(kw))
 
 
 def reach_light_vector(num_envs: int = 1, world=None, render_mode=None, max_steps: int = 400, **kw):

@@ -64,7 +64,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedError, check_observable
 from sensorium.server.world.loader import LoadedWorld
 
-__all__ = ["SensoriumWorkersEnv", "WorkerError", "check_poll", "check_workers", "split"]
+__all__ = ["SensoriumWorkersEnv", "WorkerError", "check_poll", "check_workers", "one_process", "split"]
 
 CLOSE_WAIT_S = 5.0
 """How long close() lets a worker finish on its own before it is terminated."""
@@ -112,6 +112,14 @@ def check_poll(poll_s: Any) -> float:
             or not 0.0 <= float(poll_s) <= MAX_POLL_S:
         raise ValueError(f"poll_s must be a number of seconds in [0, {MAX_POLL_S:g}], got {poll_s!r}")
     return float(poll_s)
+
+
+def one_process(kw: dict) -> dict:
+    """``kw`` for the one-process env (``workers=1``): ValueError (one line) if it holds ``poll_s``,
+    which only worker processes have."""
+    if "poll_s" in kw:
+        raise ValueError("poll_s is the worker processes' poll: it needs workers=k > 1")
+    return kw
 
 
 def split(num_envs: int, workers: int) -> list[tuple[int, int]]:
