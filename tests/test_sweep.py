@@ -17,6 +17,7 @@ from sensorium.server.recording.reader import Recording
 from sensorium.sweep import SpecError, parse_spec, run_sweep
 from sensorium.sweep.run import build_world, run_one
 from sensorium.sweep.spec import RunSpec, parse_path, set_path
+from tests._ray import ray_or_skip
 
 R, VMAX, AXLE = 0.0205, 6.28, 0.052
 
@@ -40,7 +41,7 @@ def room_world(path: Path, noise: float = 0.05) -> Path:
 @pytest.fixture(scope="module")
 def local_ray():
     """One local Ray (2 CPUs, loopback) for the module's Ray tests: starting Ray takes seconds."""
-    ray = pytest.importorskip("ray")
+    ray = ray_or_skip()
     from sensorium.sweep.engines import init_ray
 
     started = not ray.is_initialized()

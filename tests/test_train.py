@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests._ray import ray_or_skip
+
 pytest.importorskip("gymnasium")
 
 
@@ -100,7 +102,7 @@ def test_sb3_adapter_with_worker_processes_gives_the_one_process_steps():
 def test_evolution_strategy_on_ray_actors_equals_the_same_workers_in_process():
     """Two Ray actors (Ray bound to 127.0.0.1), each holding a batched env of 4 copies, feed the
     learner; the parameters and every return equal those of the same workers run in this process."""
-    pytest.importorskip("ray")
+    ray_or_skip()
     from sensorium.gym.ray_train import train_es
 
     kw = dict(task="reach_light", workers=2, copies=4, iterations=2, max_steps=15, seed=3)
