@@ -104,6 +104,43 @@ def test_observation_and_action_bounds_come_from_the_world():
         SensoriumEnv(None, Task(robot="ghost"))
 
 
+@pytest.mark.parametrize("kw, why", [
+    ({"precision": "exakt"}, "precision must be one of fast, exact, got 'exakt'"),
+    ({"precision": None}, "precision must be one of fast, exact, got None"),
+    ({"render_size": 0}, "render_size must be an integer number of pixels from 1 to 4096, got 0"),
+    ({"render_size": -5}, "render_size must be an integer number of pixels from 1 to 4096, got -5"),
+    ({"render_size": 64.5}, "render_size must be an integer number of pixels from 1 to 4096, got 64.5"),
+    ({"render_size": 10**6}, "render_size must be an integer number of pixels from 1 to 4096, got 1000000"),
+    ({"task": Task(max_steps=0)}, "task max_steps must be a whole number of actions >= 1, or None (never truncated), got 0"),
+    ({"task": Task(max_steps=-1)}, "task max_steps must be a whole number of actions >= 1, or None (never truncated), got -1"),
+    ({"task": Task(max_steps=2.5)}, "task max_steps must be a whole number of actions >= 1, or None (never truncated), got 2.5"),
+    ({"task": Task(control_period_ms=0)}, "task control_period_ms=0 must be a positive multiple of the world's basic_time_step (32 ms)"),
+    ({"task": Task(control_period_ms=64.0)}, "task control_period_ms=64.0 must be a positive multiple of the world's basic_time_step (32 ms)"),
+])
+def test_bad_options_are_refused_when_the_env_is_made_in_every_kind_of_env(kw, why):
+    """Before: a wrong precision failed at the first reset with "'exakt' is not a valid Precision", a
+    render_size of 0 with a ZeroDivisionError at the first render (10**6: a 2.7 TiB allocation),
+    max_steps=0 or -1 truncated every episode at its first step, 2.5 truncated at the third, and
+    control_period_ms=0 silently meant one basic step."""
+    from sensorium.gym import SensoriumParallelEnv
+    from sensorium.gym.vector import SensoriumVectorEnv
+    from sensorium.gym.workers import SensoriumWorkersEnv
+
+    task = kw.pop("task", Task(robot="epuck"))
+    makers = [lambda: SensoriumEnv(None, task, **kw), lambda: SensoriumVectorEnv(None, task, 2, **kw),
+              lambda: SensoriumWorkersEnv(None, task, 2, workers=2, **kw)]
+    if task.robot is not None:
+        makers.append(lambda: SensoriumParallelEnv(None, {"epuck": task}, **kw))
+    for make in makers:
+        with pytest.raises(ValueError) as e:
+            make()
+        assert str(e.value) == why
+    ok = SensoriumEnv(None, Task(robot="epuck", max_steps=1), render_mode="rgb_array", render_size=np.int64(3))
+    ok.reset(seed=0)
+    assert ok.render().shape == (3, 3, 3)
+    assert ok.step(ok.action_space.sample())[3] is True            # max_steps=1: truncated after one action
+
+
 def test_lidar_observation_matches_the_square_room_in_closed_form():
     # above the body: a Webots lidar sees its own robot
     lidar = {"device": "Lidar", "name": "lidar", "horizontal_resolution": 64, "field_of_view": 2 * math.pi,

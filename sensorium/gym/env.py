@@ -65,10 +65,11 @@ import numpy as np
 from gymnasium import spaces
 
 from sensorium.gym.frame import enu_axes, planar_pose
-from sensorium.gym.render import TopDown, TopDownRendering
+from sensorium.gym.render import TopDown, TopDownRendering, check_render_size
 from sensorium.gym.task import Task
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
+from sensorium.server.raycast.kinds import Precision
 from sensorium.server.sim.motion import ackermann_angles
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.limits import MAX_COORDINATE_M
@@ -118,11 +119,15 @@ class Agent:
             raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive or ackermann_drive "
                              "to act with")
         self.robot = name
-        ctrl = task.control_period_ms or basic
-        if ctrl <= 0 or ctrl % basic:
+        ctrl = basic if task.control_period_ms is None else task.control_period_ms
+        if isinstance(ctrl, bool) or not isinstance(ctrl, (int, np.integer)) or ctrl <= 0 or ctrl % basic:
             raise ValueError(f"task control_period_ms={ctrl} must be a positive multiple of the world's "
                              f"basic_time_step ({basic} ms)")
         self.control_period_ms = int(ctrl)
+        steps = task.max_steps
+        if steps is not None and (isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1):
+            raise ValueError(f"task max_steps must be a whole number of actions >= 1, or None (never truncated), "
+                             f"got {steps!r}")
         devices = {d.name: d for d in model.devices if d.device in OBSERVABLE}
         actuators = {d.name for d in model.devices if d.device not in OBSERVABLE}
         obs = task.observations
@@ -388,6 +393,15 @@ def _table_box(cfg, shape: tuple[int, ...], without: tuple[float, float]) -> spa
 ENGINES = ("auto", "batched", "simulation")
 
 
+def check_precision(value) -> str:
+    """``precision`` as "fast" or "exact"; a ValueError naming it otherwise (the single env builds its
+    simulation at reset, so it is checked when the env is made)."""
+    choices = [p.value for p in Precision]
+    if not isinstance(value, str) or value not in choices:
+        raise ValueError(f"precision must be one of {', '.join(choices)}, got {value!r}")
+    return value
+
+
 def batched_engine(loaded: LoadedWorld, agents: list[Agent], precision: str, engine: str):
     """The one-copy batched simulation the environments run on (``engine`` "batched", or "auto"
     when it simulates the world and every observed device), None for a rebuilt Simulation."""
@@ -431,8 +445,8 @@ class SensoriumEnv(TopDownRendering, gym.Env):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
         self.render_mode = render_mode
-        self.precision = precision
-        self.render_size = render_size
+        self.precision = precision = check_precision(precision)
+        self.render_size = check_render_size(render_size)
         self.basic_time_step = self.loaded.world.world_info.basic_time_step
         self.agent = Agent(self.loaded, self.task, actions=actions, flatten=flatten)
         self.robot_name = self.agent.robot

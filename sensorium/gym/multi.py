@@ -28,8 +28,8 @@ import numpy as np
 from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
-from sensorium.gym.env import DEFAULT_PRECISION, Agent, batched_engine, load, rebuild
-from sensorium.gym.render import TopDown, TopDownRendering
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, batched_engine, check_precision, load, rebuild
+from sensorium.gym.render import TopDown, TopDownRendering, check_render_size
 from sensorium.gym.task import Task
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
@@ -55,8 +55,8 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
         self.render_mode = render_mode
-        self.precision = precision
-        self.render_size = render_size
+        self.precision = precision = check_precision(precision)
+        self.render_size = check_render_size(render_size)
         self._agents = {name: Agent(self.loaded, task, default_robot=name, actions=actions) for name, task in tasks.items()}
         for name, ag in self._agents.items():
             if ag.robot != name:

@@ -54,6 +54,17 @@ def _color(shape: wm.Shape | wm.Solid) -> tuple[int, int, int]:
     return tuple(int(round(255 * min(max(v, 0.0), 1.0))) for v in c)  # type: ignore[return-value]
 
 
+MAX_RENDER_SIZE = 4096
+"""The largest ``render_size`` (pixels a side: a 4096 x 4096 RGB image is 48 MiB)."""
+
+
+def check_render_size(value) -> int:
+    """``render_size`` as an int in [1, MAX_RENDER_SIZE]; a ValueError naming it otherwise."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_RENDER_SIZE:
+        raise ValueError(f"render_size must be an integer number of pixels from 1 to {MAX_RENDER_SIZE}, got {value!r}")
+    return int(value)
+
+
 class TopDown:
     """Renders ``sim`` at ``size`` x ``size`` pixels. The solids are drawn into a static layer, drawn
     again only when the scene's ``solids_version`` changes (a solid moved, imported or removed); robots and
@@ -62,7 +73,7 @@ class TopDown:
 
     def __init__(self, sim, size: int = 256, margin: float = 0.1):
         self.sim = sim
-        self.size = int(size)
+        self.size = check_render_size(size)
         axes = enu_axes(sim.world)
         e, n, self._up = axes
         self._ground = [e, n]          # the world axes drawn to the right and up the image

@@ -45,8 +45,8 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from sensorium.gym.env import DEFAULT_PRECISION, SEGMENTATION, Agent, device_of, load, missing_fill
-from sensorium.gym.render import TopDown
+from sensorium.gym.env import DEFAULT_PRECISION, SEGMENTATION, Agent, check_precision, device_of, load, missing_fill
+from sensorium.gym.render import TopDown, check_render_size
 from sensorium.gym.task import Task, VectorGoal, never, zero
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
@@ -156,9 +156,9 @@ class SensoriumVectorEnv(VectorEnv):
         self.autoreset_mode = AutoresetMode(autoreset_mode)
         self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode}
         self.render_mode = render_mode
-        self.render_size = render_size
+        self.render_size = check_render_size(render_size)
         self.num_envs = n = int(num_envs)
-        self.precision = precision
+        self.precision = precision = check_precision(precision)
         self.agent = Agent(self.loaded, self.task, actions=actions, flatten=flatten)
         try:      # what the batched simulation does not simulate: one line, before anything is built
             check_observable(self.loaded.world, self.agent.robot, map(device_of, self.agent.periods))

@@ -57,7 +57,8 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from sensorium.gym.env import DEFAULT_PRECISION, Agent, device_of, load
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, check_precision, device_of, load
+from sensorium.gym.render import check_render_size
 from sensorium.gym.task import Task
 from sensorium.gym.vector import check_counts, reset_mask, reset_seeds
 from sensorium.schemas import world as wm
@@ -345,6 +346,7 @@ class SensoriumWorkersEnv(VectorEnv):
         check_counts(num_envs, threads)
         self.workers = check_workers(workers, num_envs)
         poll_s = check_poll(poll_s)
+        precision, render_size = check_precision(precision), check_render_size(render_size)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
         self.autoreset_mode = AutoresetMode(autoreset_mode)
