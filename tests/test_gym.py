@@ -306,6 +306,11 @@ def test_pettingzoo_parallel_env_passes_the_api_test_and_moves_each_robot_exactl
     obs, rewards, terms, truncs, infos = env.step({"bot": np.array([3.0, 3.0], np.float32)})
     assert env.sim.robot("bot2").pose.translation[0] == pytest.approx(20 * step_m, abs=1e-12)   # stopped
     assert infos["bot"]["pose"][0] == pytest.approx(21 * step_m, abs=1e-12)
+    # an action for a name that is no agent (a typo) is refused, not dropped unseen; one for an agent
+    # that has ended is ignored, as PettingZoo's loops may still pass it
+    with pytest.raises(ValueError, match=r"^an action for 'bott', which is not an agent \(agents: bot, bot2\)$"):
+        env.step({"bot": np.zeros(2, np.float32), "bott": np.zeros(2, np.float32)})
+    env.step({"bot": np.zeros(2, np.float32), "bot2": np.zeros(2, np.float32)})
 
 
 @pytest.mark.parametrize("argv, why", [(["--env", "nope"], "--env 'nope' is not a registered sensorium id"),

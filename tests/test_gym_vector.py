@@ -498,3 +498,23 @@ def test_the_avoid_obstacles_reward_in_c_is_the_numpy_reward_bit_for_bit(monkeyp
         seen["partial"] += int(np.count_nonzero((gap > goal.goal.contact_distance) & (gap < goal.goal.near)))
         seen["free"] += int(np.count_nonzero(gap >= goal.goal.near))
     assert min(seen.values()) > 0, seen
+
+
+def test_a_closed_env_lets_its_simulation_go_and_says_so_when_used():
+    """Before: close() kept the batched simulation (its scenes and arrays) and step() went on
+    stepping it."""
+    import gc
+    import weakref
+
+    env = SensoriumVectorEnv(None, Task(robot="epuck", observations=["ls0"]), 2, render_mode="rgb_array")
+    env.reset(seed=0)
+    sub = env.sub_env(1)
+    sim = weakref.ref(env.sim)
+    env.close()
+    gc.collect()
+    assert sim() is None
+    for use in (lambda: env.step(np.zeros((2, 2), np.float32)), lambda: env.reset(seed=0), env.render,
+                lambda: sub.reset(seed=0), lambda: sub.step(np.zeros(2, np.float32))):
+        with pytest.raises(RuntimeError, match="^the environment is closed; build a new one$"):
+            use()
+    env.close()                                  # a second close is harmless

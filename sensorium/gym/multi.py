@@ -106,6 +106,9 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
     def step(self, actions: Mapping[str, np.ndarray]):
         if self.sim is None:
             raise RuntimeError("call reset() before step()")
+        for a in actions:           # a misspelt agent's action would be dropped unseen
+            if a not in self._agents:
+                raise ValueError(f"an action for {a!r}, which is not an agent (agents: {', '.join(self.possible_agents)})")
         for a in self.agents:
             if a not in actions:
                 raise ValueError(f"no action for agent {a!r} (agents: {', '.join(self.agents)})")

@@ -377,6 +377,7 @@ class SensoriumVectorEnv(VectorEnv):
 
     # ------------------------------------------------------------------ gymnasium API
     def reset(self, *, seed: int | list[int | None] | None = None, options: dict | None = None):
+        self._check_open()
         n = self.num_envs
         seeds = reset_seeds(seed, n)
         mask = reset_mask(options, n)
@@ -389,6 +390,7 @@ class SensoriumVectorEnv(VectorEnv):
         return self._observe(), self._full_info(mask)
 
     def step(self, actions):
+        self._check_open()
         n = self.num_envs
         if self._needs_reset.any():
             raise RuntimeError("call reset() before step()")
@@ -441,6 +443,7 @@ class SensoriumVectorEnv(VectorEnv):
         return tuple(self.render_copy(i) for i in range(self.num_envs))
 
     def render_copy(self, i: int) -> np.ndarray:
+        self._check_open()
         r = self._renderers.get(i)
         if r is None:
             r = self._renderers[i] = TopDown(self._view(i), self.render_size)
@@ -448,6 +451,11 @@ class SensoriumVectorEnv(VectorEnv):
 
     def close_extras(self, **kwargs) -> None:
         self._renderers.clear()
+        self.sim = None      # type: ignore[assignment]  # the copies' scenes and arrays go with it
+
+    def _check_open(self) -> None:
+        if self.closed:
+            raise RuntimeError("the environment is closed; build a new one")
 
     def sub_env(self, i: int) -> SubEnv:
         """Sub-environment ``i`` as a plain ``gymnasium.Env`` (see :class:`SubEnv`)."""
@@ -457,6 +465,7 @@ class SensoriumVectorEnv(VectorEnv):
 
     # the one-copy paths the SubEnv view uses
     def _reset_one(self, i: int, seed: int | None):
+        self._check_open()
         mask = np.zeros(self.num_envs, dtype=bool)
         mask[i] = True
         self._begin_reset(np.array([i]), [seed])
@@ -467,6 +476,7 @@ class SensoriumVectorEnv(VectorEnv):
         return self._last_obs_of(i), {k: v[0] for k, v in self._info(np.array([i])).items()}
 
     def _step_one(self, i: int, action):
+        self._check_open()
         if self._needs_reset[i]:
             raise RuntimeError("call reset() before step()")
         mask = np.zeros(self.num_envs, dtype=bool)
