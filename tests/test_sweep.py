@@ -90,6 +90,15 @@ def test_bad_specs_are_one_clear_error():
                       ({"record": "yes"}, "record")]:
         with pytest.raises(SpecError, match=msg):
             parse_spec(data)
+    # the work a spec asks for is bounded before anything is listed (a count of 10**9 seeds built a
+    # list of 10**9 integers, then as many runs)
+    from sensorium.sweep.spec import MAX_RUNS
+    with pytest.raises(SpecError, match=rf"^<spec>: seeds.count: at most {MAX_RUNS} runs in a sweep, got 1000000000$"):
+        parse_spec({"seeds": {"count": 10**9}})
+    with pytest.raises(SpecError, match=rf"^<spec>: 100200 runs \(worlds x parameter values x controllers x seeds\); "
+                                        rf"a sweep holds at most {MAX_RUNS}$"):
+        parse_spec({"seeds": {"count": 501}, "parameters": {"a.b": [1, 2], "c": list(range(100))}})
+    assert len(parse_spec({"seeds": {"count": 500}, "parameters": {"a.b": [1, 2], "c": list(range(100))}}).runs(None)) == MAX_RUNS
     s = parse_spec({"worlds": ["w.yaml"], "seeds": {"start": 5, "count": 3}, "parameters": {"a.b": [1, 2]},
                     "controllers": ["idle", "spin"]}, base_dir=Path("/tmp"))
     runs = s.runs("/out")

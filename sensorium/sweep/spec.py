@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -82,6 +83,10 @@ class SweepSpec:
         return out
 
 
+MAX_RUNS = 100_000
+"""The most runs a sweep may hold (its cross product): a stray digit in a seed count or a value list
+is refused in one line, not listed into memory and started."""
+
 _KEYS = {"worlds", "seeds", "duration_ms", "parameters", "controllers", "record"}
 
 
@@ -134,6 +139,8 @@ def parse_spec(data: Any, source: str = "<spec>", base_dir: Path | None = None) 
         start = seeds.get("start", 0)
         if not isinstance(start, int) or isinstance(start, bool):
             raise SpecError(f"{source}: seeds.start must be an integer")
+        if seeds["count"] > MAX_RUNS:
+            raise SpecError(f"{source}: seeds.count: at most {MAX_RUNS} runs in a sweep, got {seeds['count']}")
         seeds = list(range(start, start + seeds["count"]))
     if isinstance(seeds, int) and not isinstance(seeds, bool):
         seeds = [seeds]
@@ -169,6 +176,10 @@ def parse_spec(data: Any, source: str = "<spec>", base_dir: Path | None = None) 
         record = True
     if not isinstance(record, bool):
         raise SpecError(f"{source}: record: true, false or {{topics: [...]}}, got {record!r}")
+    runs = len(worlds) * math.prod(len(v) for v in params.values()) * len(controllers) * len(seeds)
+    if runs > MAX_RUNS:
+        raise SpecError(f"{source}: {runs} runs (worlds x parameter values x controllers x seeds); a sweep holds "
+                        f"at most {MAX_RUNS}")
     return SweepSpec(worlds=[_resolve(w, base_dir) for w in worlds], seeds=list(seeds), duration_ms=duration,
                      parameters={str(k): list(v) for k, v in params.items()},
                      controllers=[_resolve_controller(c, base_dir) for c in controllers],
