@@ -81,6 +81,29 @@ def test_supervisor_pose_on_a_slope():
     assert sim.device("r/alt").value == 2.0
 
 
+def test_a_supervisor_move_or_a_reset_is_a_jump_not_motion():
+    """Webots' gyro and accelerometer read the bodies' velocities, which a Supervisor move keeps and
+    a simulation reset zeroes: moving or resetting a turning robot is no turn of 30 rad/s nor an
+    acceleration of 1,000 m/s² (it was read so: the jump over one step, then back)."""
+    sim = make()
+    drive(sim, 2.0, 6.0)
+    v, w = R_WHEEL * 8.0 / 2, R_WHEEL * 4.0 / AXLE          # 0.08 m/s, 0.8 rad/s: radius 0.1 m
+    mag = 2.0 * (v / w) * (1.0 - math.cos(w * DT)) / DT ** 2
+    turning = [mag * math.sin(w * DT), mag * math.cos(w * DT), G]
+    sim.run(20)
+    acc, gyro = sim.device("r/acc"), sim.device("r/gyro")
+    np.testing.assert_allclose(acc.values, turning, atol=1e-7)
+    for move in (lambda: sim.robot("r").set_pose([1.0, -2.0, 0.0], [0.0, 0.0, 1.0, 2.5]), sim.reset):
+        move()
+        drive(sim, 2.0, 6.0)                                # (a reset puts the wheels back to rest)
+        sim.step()                                          # rest assumed for the acceleration, as at enable
+        np.testing.assert_allclose(gyro.values, [0.0, 0.0, w], atol=1e-9)
+        np.testing.assert_allclose(acc.values, [0.0, 0.0, G], atol=1e-12)
+        sim.run(2)                                          # then the turn's own values again
+        np.testing.assert_allclose(gyro.values, [0.0, 0.0, w], atol=1e-9)
+        np.testing.assert_allclose(acc.values, turning, atol=1e-7)
+
+
 def test_nue_world_gravity_and_height():
     sim = make(world_info={"coordinate_system": "NUE", "gravity": 3.7},
                pose={"translation": [0.0, 0.5, 0.0], "rotation": [1, 0, 0, -math.pi / 2]})

@@ -578,6 +578,7 @@ class BatchedSimulation:
             at = enu_pose(pose, self.to_enu).translation
             self.centres[copy, slot] = at[:2]
             self.heights[copy, slot] = at[2]
+        self.kinematic.placed(copy, slot)     # a jump, not motion, for its gyros and accelerometers
 
     def _take_template(self, idx: np.ndarray, slot: int, tpl: PlanarState) -> None:
         """The copies' drive state of a slot from a template drive just reset to a pose."""

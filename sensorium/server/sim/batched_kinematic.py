@@ -354,6 +354,13 @@ class KinematicDevices:
             self.enable_rot[kind][idx, column] = self.sim.rot[idx, slot]
             self.enable_pos[kind][idx, column] = self.sim.pos[idx, slot]
 
+    def placed(self, copy: int, slot: int) -> None:
+        """A robot of one copy was put somewhere from outside (``set_pose``): its gyros and
+        accelerometers start their poses over from there (_MotionSensor.placed)."""
+        for kind in MOTION:
+            for column in np.nonzero(self.slot[kind] == slot)[0].tolist():
+                self.enabled(kind, column, np.array([copy]))
+
     def reading(self, kind: str, column: int, what: str) -> np.ndarray:
         """A device's reading ``what`` (one of READINGS[kind]) in every copy: (copies, ...)."""
         if what not in READINGS.get(kind, ()):

@@ -759,6 +759,12 @@ class _MotionSensor(Device):
     def track(self) -> None:
         self._poses = [*self._poses[-2:], self.world_pose(self._robot.pose)]
 
+    def placed(self) -> None:
+        """The robot was put somewhere from outside (a Supervisor move, a simulation reset): a jump,
+        not motion (Webots' gyro and accelerometer read the bodies' velocities, which a move keeps
+        and a reset zeroes), so the poses start over from there, as at ``enable``."""
+        self._poses = [self.world_pose(self._robot.pose)]
+
     def _through_table(self, raw: np.ndarray) -> np.ndarray:
         c = self.config
         table = self.table

@@ -191,6 +191,7 @@ class Simulation:
         self.lights = lights_from_models(self.scene.world_lights())
         self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
+        self._by_index = list(self.robots.values())
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         if self.ground is not None:
             self._warn_ground()
@@ -233,10 +234,14 @@ class Simulation:
         return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system])
 
     def place_robot(self, index: int, pose: Pose) -> None:
-        """Put a robot somewhere from outside (no contact check)."""
+        """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
+        jump, not motion: their poses start over from there (_MotionSensor.placed)."""
         self.scene.set_robot_pose(index, pose)
         if self.contact is not None:
             self.contact.place(index, pose)
+        for dev in self._by_index[index].devices.values():
+            if dev.tracks_motion:
+                dev.placed()          # type: ignore[attr-defined]
 
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
