@@ -644,6 +644,11 @@ class GPS(Device):
         self.speed = gps_math.speed(self.speed_vector, noise=c.speed_noise, rng=rng, resolution=c.speed_resolution)
         self._mark(now_ms)
 
+    def restart(self) -> None:
+        """A simulation reset: no previous position, so the next value's speed is NaN, as the first
+        one's (Webots' WbGps::reset; its device without physics)."""
+        self._previous = None
+
     def readings(self) -> dict:
         return {"values": self.values, "speed": self.speed, "speed_vector": self.speed_vector}
 

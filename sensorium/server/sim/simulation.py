@@ -32,6 +32,7 @@ from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
 from sensorium.server.sim.scene import Scene, light_from_model, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
+    GPS,
     LED,
     Device,
     DistanceSensor,
@@ -247,7 +248,8 @@ class Simulation:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file.
+        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file, GPS speeds
+        NaN at their next value (no previous position, as Webots' WbGps::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
         for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):
@@ -261,6 +263,8 @@ class Simulation:
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
                     dev.set(0, self.time_ms)
+                elif isinstance(dev, GPS):
+                    dev.restart()
         self.radio.reset()
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
