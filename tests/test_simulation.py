@@ -480,6 +480,29 @@ def test_probe_json_lines() -> None:
     assert rows[1]["range_image"]["shape"] == [1, 360] and rows[1]["time_ms"] == 32
 
 
+def test_probe_enables_all_devices_of_every_kind(tmp_path) -> None:
+    """``probe --enable all:P`` on a world with an altimeter, an emitter and a receiver: it ended in
+    a traceback (AttributeError: 'Altimeter' object has no attribute 'readings'); every device
+    kind the simulation makes now says what it reads."""
+    from sensorium.schemas.devices import KINDS
+    from sensorium.server.sim.sensors import Device, device_class
+
+    for name in KINDS:
+        cls = device_class(name)
+        if cls is not None and issubclass(cls, Device):     # (a motor is the drive's, never enabled)
+            assert callable(getattr(cls, "readings", None)), name
+    (tmp_path / "w.yaml").write_text(json.dumps({
+        "world_info": {"basic_time_step": 32},
+        "robots": [{"name": "a", "devices": [{"device": "Altimeter", "name": "alt"}, {"device": "Emitter", "name": "em"}]},
+                   {"name": "b", "devices": [{"device": "Receiver", "name": "rx"}]}]}))
+    res = subprocess.run([sys.executable, "-m", "sensorium", "probe", str(tmp_path / "w.yaml"), "--steps", "2",
+                          "--json", "--enable", "all:32"], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    rows = [json.loads(line) for line in res.stdout.splitlines()]
+    assert [(r["step"], r["device"]) for r in rows] == [(k, d) for k in (1, 2) for d in ("alt", "em", "rx")]
+    assert rows[0]["value"] == 0.0 and rows[1]["range"] == -1.0 and rows[2]["queue_length"] == 0.0
+
+
 def test_probe_rejects_bad_enable() -> None:
     res = subprocess.run([sys.executable, "-m", "sensorium", "probe", "--enable", "epuck/nope:32"],
                          capture_output=True, text=True, timeout=120)

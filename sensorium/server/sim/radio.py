@@ -126,6 +126,11 @@ class Emitter(Device):
             return False
         return True
 
+    def readings(self) -> dict:
+        """What ``sensorium probe`` shows (numbers as floats, as other readings): the channel and
+        range packets leave with now."""
+        return {"channel": float(self.channel), "range": self.range}
+
     @property
     def byte_rate(self) -> float:
         """Bytes per millisecond the controller may send (Webots: baudRate / byteSize / 1000); -1: unlimited."""
@@ -189,6 +194,10 @@ class Receiver(Device):
     @property
     def queue_length(self) -> int:
         return len(self.ready)
+
+    def readings(self) -> dict:
+        """What ``sensorium probe`` shows (the packets stay for the controller): how many are ready."""
+        return {"queue_length": float(self.queue_length)}
 
     def step_reading(self) -> dict:
         return {"packets": [p.as_wire() for p in self.take()]}

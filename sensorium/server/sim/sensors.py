@@ -849,6 +849,9 @@ class Altimeter(Device):
         self.value = v
         self._mark(now_ms)
 
+    def readings(self) -> dict:
+        return {"value": self.value}
+
     def describe(self) -> dict:
         return {"accuracy": float(self.config.accuracy), "resolution": float(self.config.resolution)}
 
