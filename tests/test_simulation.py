@@ -548,6 +548,24 @@ def test_velocity_clamped_and_position_control_stops_at_target() -> None:
         sim.robot("r").motor("x")
 
 
+def test_encoder_resolution_is_webots_discretize() -> None:
+    """A PositionSensor's resolution is Webots' discretize, (int)(v/res + 0.5)·res, as for the
+    other sensors: a wheel turned back to -1.4 rad reads -1.0 with res 0.5, and 1.25 rad reads 1.5
+    (they read -1.5 and 1.0: Python's round, which rounds halves to even and negatives
+    symmetrically)."""
+    data = {"world_info": {"basic_time_step": 16},
+            "robots": [{"name": "r", "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 10},
+                        "devices": [{"device": "PositionSensor", "name": "enc", "motor": "left wheel motor",
+                                     "resolution": 0.5}]}]}
+    sim = Simulation(parse_world(data))
+    m, enc = sim.robot("r").motor("left wheel motor"), sim.device("r/enc")
+    enc.enable(16)
+    for target, webots in ((-1.4, -1.0), (1.25, 1.5), (-0.2, 0.0), (0.75, 1.0), (-2.75, -2.5)):
+        m.set_position(target)
+        sim.run(100)
+        assert m.position == target and enc.value == webots, (target, enc.value)
+
+
 def test_circle_stays_on_circle_for_a_million_steps() -> None:
     from sensorium.server.sim.motion import arc_step
 
