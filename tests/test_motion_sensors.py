@@ -104,6 +104,22 @@ def test_a_supervisor_move_or_a_reset_is_a_jump_not_motion():
         np.testing.assert_allclose(acc.values, turning, atol=1e-7)
 
 
+@pytest.mark.parametrize("axes, up", [("ENU", 2), ("NUE", 1)])
+def test_altimeter_adds_the_reference_altitude_in_local_coordinates_too(axes, up):
+    """Webots' WbAltimeter adds the gps_reference's up component in local coordinates (its third
+    value in WGS84), as the GPS adds the reference: a robot 0.3 m up under a local reference
+    (100, 7, -20) reads 0.3 + the reference's up value (it read 0.3, while its GPS read 0.3 + it)."""
+    ref = [100.0, 7.0, -20.0]
+    pose = [0.0, 0.0, 0.3] if axes == "ENU" else [0.0, 0.3, 0.0]
+    sim = make(world_info={"coordinate_system": axes, "gps_reference": ref}, pose={"translation": pose})
+    sim.step()
+    assert sim.device("r/alt").value == 0.3 + ref[up]
+    sim = make(world_info={"coordinate_system": axes, "gps_reference": [46.5, 6.6, 372.0],
+                           "gps_coordinate_system": "WGS84"}, pose={"translation": pose})
+    sim.step()
+    assert sim.device("r/alt").value == 0.3 + 372.0
+
+
 def test_nue_world_gravity_and_height():
     sim = make(world_info={"coordinate_system": "NUE", "gravity": 3.7},
                pose={"translation": [0.0, 0.5, 0.0], "rotation": [1, 0, 0, -math.pi / 2]})

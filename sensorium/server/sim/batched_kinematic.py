@@ -49,7 +49,16 @@ from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.raycast import packets
-from sensorium.server.sim.sensors import GPS, Accelerometer, Altimeter, Compass, Gyro, InertialUnit, TouchSensor
+from sensorium.server.sim.sensors import (
+    GPS,
+    Accelerometer,
+    Altimeter,
+    Compass,
+    Gyro,
+    InertialUnit,
+    TouchSensor,
+    altitude_offset,
+)
 
 __all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal", "libm_each",
            "libm_cos_sin", "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions", "angular_velocities",
@@ -313,8 +322,8 @@ class KinematicDevices:
         self.unit_noise = np.array([c.noise for c in units], dtype=np.float64)
         self.unit_axes = [np.array([getattr(c, a) for c in units], dtype=bool) for a in ("x_axis", "y_axis", "z_axis")]
         self.quaternion = np.full((C, len(units), 4), math.nan)
-        # Altimeter: the height along up (ENU: z, NUE: y) plus the reference altitude in a WGS84 world
-        self.altitude_offset = float(wi.gps_reference[2]) if wi.gps_coordinate_system == "WGS84" else 0.0
+        # Altimeter: the height along up (ENU: z, NUE: y) plus the reference altitude (Altimeter's)
+        self.altitude_offset = altitude_offset(wi)
         self.altimeter_accuracy = np.array([d.config.accuracy for d in self.devices["Altimeter"]], dtype=np.float64)
         # the kinds read through a lookup table per enabled axis (axes_through_table): each device's axes on
         self.axes_on = {k: [np.array([d.config.x_axis, d.config.y_axis, d.config.z_axis], dtype=bool).nonzero()[0]
@@ -549,7 +558,7 @@ class KinematicDevices:
         return np.where(self.sim.pressing[copies, self.slot["TouchSensor"][cols]], 1.0, 0.0)
 
     def _altimeter(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """Altimeter.measure: the device's height (+ the WGS84 reference altitude), its Gaussian
+        """Altimeter.measure: the device's height (+ the reference altitude), its Gaussian
         accuracy noise (one normal from its stream), its resolution."""
         _, t = self._frames("Altimeter", copies, cols)
         assert t is not None

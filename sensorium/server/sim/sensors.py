@@ -820,9 +820,19 @@ class Gyro(_MotionSensor):
         self._mark(now_ms)
 
 
+def altitude_offset(world_info: Any) -> float:
+    """What an Altimeter adds to its height along up: the ``gps_reference``'s altitude -- its third
+    value in a WGS84 world, its up component (ENU: z, NUE: y) in local coordinates, as Webots'
+    WbAltimeter (and so as the GPS, which adds the reference in local coordinates too)."""
+    ref = world_info.gps_reference
+    if world_info.gps_coordinate_system == "WGS84":
+        return float(ref[2])
+    return float(ref[world_info.coordinate_system.index("U")])
+
+
 class Altimeter(Device):
-    """Webots Altimeter: the device's height along the up axis (+ the WGS84 reference altitude),
-    Gaussian ``accuracy`` noise, ``resolution``; NaN before the first value."""
+    """Webots Altimeter: the device's height along the up axis plus the reference altitude
+    (:func:`altitude_offset`), Gaussian ``accuracy`` noise, ``resolution``; NaN before the first value."""
 
     kinematic = True
 
@@ -837,7 +847,7 @@ class Altimeter(Device):
         self._robot = robot
         wi = robot.world_info
         self._up = wi.coordinate_system.index("U")
-        self._offset = float(wi.gps_reference[2]) if wi.gps_coordinate_system == "WGS84" else 0.0
+        self._offset = altitude_offset(wi)
 
     def measure(self, now_ms: int) -> None:
         c = self.config
