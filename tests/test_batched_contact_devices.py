@@ -252,7 +252,7 @@ def _task(observations=None) -> Task:
 
 def test_the_envs_observe_bumpers_and_altimeters_alike_and_pass_the_checker():
     """A bumper is a float32 (1,) box [0, 1], an altimeter a float32 (1,) box of the world's ±100 km
-    about 0; every sub-env of the vector env equals the single env (rebuilt Simulation, and the
+    about the reference altitude (the local gps_reference's up value, 30 m, as the altimeter adds it); every sub-env of the vector env equals the single env (rebuilt Simulation, and the
     one-copy batched engine) with its seed, observations and info bit for bit, across autoresets, with
     full-speed runs into the walls (the bumper reads 1 in some of them); both envs pass Gymnasium's
     checker without a warning."""
@@ -261,7 +261,7 @@ def test_the_envs_observe_bumpers_and_altimeters_alike_and_pass_the_checker():
     space = venv.single_observation_space
     assert {k: space[k].shape for k in OBSERVED} == dict.fromkeys(OBSERVED, (1,))
     assert (space["bumper"].low.tolist(), space["bumper"].high.tolist()) == ([0.0], [1.0])
-    assert (space["altimeter"].low.tolist(), space["altimeter"].high.tolist()) == ([-1e5], [1e5])
+    assert (space["altimeter"].low.tolist(), space["altimeter"].high.tolist()) == ([-1e5 + 30.0], [1e5 + 30.0])
     singles = [SensoriumEnv(WORLD, _task(), engine=e) for e in ("simulation", "batched", "simulation")]
     assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
     obs = _reset_both(venv, singles, 4)

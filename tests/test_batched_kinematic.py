@@ -153,6 +153,22 @@ def test_known_headings_give_the_closed_form_compass_inertial_unit_and_gps_readi
     np.testing.assert_allclose(bs.reading(ref, "speed_vector"), want, rtol=0, atol=1e-12)
 
 
+def test_an_altimeter_reads_the_local_reference_altitude_as_the_single_simulation():
+    """In local coordinates the altimeter adds the gps_reference's up component (Webots'
+    WbAltimeter): every copy, bit for bit the single simulation, and the closed form."""
+    w = _flat([0.0, 1.0], translation=(1.0, 2.0, 0.25))
+    robot = w.robots[0].model_copy(update={"devices": [*w.robots[0].devices, wm.Altimeter(device="Altimeter", name="alt")]})
+    w = w.model_copy(update={"robots": [robot]})
+    bs = BatchedSimulation(_world_model_loaded(w), 2)
+    bs.enable(bs.device("bot", "alt"), 8)
+    sim = Simulation(w)
+    sim.device("bot/alt").enable(8)
+    bs.step()
+    sim.step()
+    assert sim.device("bot/alt").value == 0.25 + 5.0
+    assert bs.value(bs.device("bot", "alt")).tolist() == [0.25 + 5.0] * 2
+
+
 def _world_model_loaded(w: wm.World) -> LoadedWorld:
     return LoadedWorld(world=w, source="<test>", base_dir=Path.cwd())
 

@@ -216,6 +216,32 @@ def test_wheel_encoders_with_noise_and_resolution_match_the_single_simulation():
     assert bs.value(bs.device("bot", "left"))[0] == pytest.approx(2.0 * 0.016 * 30, abs=1e-12)   # rad turned
 
 
+def test_wheel_encoder_resolution_backwards_matches_the_single_simulation_and_webots():
+    """Wheels turning backwards under an encoder with a resolution: Webots' discretize,
+    (int)(v/res + 0.5)·res (toward zero for negatives), in both simulations, bit for bit."""
+    world = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16},
+        "robots": [{"name": "bot", "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 6.0},
+                    "devices": [{"device": "PositionSensor", "name": "enc", "motor": "left wheel motor",
+                                 "resolution": 0.1}]}]})
+    bs = BatchedSimulation(world, 1)
+    bs.reset([0], [0])
+    sim = Simulation(world)
+    bs.enable(bs.device("bot", "enc"), 16)
+    sim.device("bot/enc").enable(16)
+    bs.set_wheels(0, np.array([-3.0]), np.array([-3.0]))
+    for m in sim.robot("bot").motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(-3.0)
+    for k in range(1, 41):
+        bs.step()
+        sim.step()
+        angle = sim.robot("bot").motor("left wheel motor").position
+        assert angle == pytest.approx(-0.048 * k, abs=1e-12)
+        want = math.trunc(angle / 0.1 + 0.5) * 0.1 + 0.0
+        assert sim.device("bot/enc").value == want == float(bs.value(bs.device("bot", "enc"))[0]), k
+
+
 def test_skid_steer_robots_match_the_single_simulation_with_every_wheel_of_a_side_driven():
     """Three wheels per side (the side's speed is the mean of its wheels, summed as the single
     simulation sums them) and an encoder on every wheel: poses and encoder values bit for bit."""

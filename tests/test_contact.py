@@ -139,6 +139,62 @@ def test_moved_solid_is_seen_and_set_pose_is_not_checked():
     assert xy(sim, "r")[0] == pytest.approx(3.016, abs=1e-12)
 
 
+def test_a_robot_placed_overlapping_a_solid_or_a_robot_can_back_out():
+    """Contact does not check a pose set from outside (world file, Supervisor move): a robot put
+    1-5 cm into a wall used to be held there for good unless one step took it fully clear (at
+    3.2 mm per step it never moved again, backing away or sliding along). Now a move that ends
+    no deeper than it starts is free, and one going deeper is still stopped."""
+    start = 1.9 - R + 0.03                                 # 3 cm into the wall's face x = 1.9
+    sim = world([WALL], [robot("r", start, 0.0)])
+    drive(sim, "r", -1.0)                                  # backing away, 3.2 mm per step
+    sim.run(20)
+    assert xy(sim, "r")[0] == pytest.approx(start - 20 * 0.0032, abs=1e-12)
+    assert sim.counters["contacts"] == 0
+    sim = world([WALL], [robot("r", start, 0.0, yaw=math.pi / 2)])
+    drive(sim, "r", 1.0)                                   # sliding along the wall, still in it
+    sim.run(20)
+    assert xy(sim, "r") == pytest.approx([start, 20 * 0.0032], abs=1e-12)
+    sim = world([WALL], [robot("r", start, 0.0)])
+    drive(sim, "r", 1.0)                                   # deeper in: stopped where it is
+    sim.run(5)
+    assert xy(sim, "r")[0] == start and sim.counters["contacts"] == 5
+    # two robots placed 5 cm into each other part; a vertical plane (a wall line) lets go too
+    sim = world([], [robot("a", 0.0, 0.0), robot("b", 2 * R - 0.05, 0.0, yaw=math.pi)])
+    drive(sim, "a", -1.0)
+    drive(sim, "b", -1.0)
+    sim.run(10)
+    assert xy(sim, "b")[0] - xy(sim, "a")[0] == pytest.approx(2 * R - 0.05 + 20 * 0.0032, abs=1e-12)
+    plane = {"name": "w", "pose": {"translation": [1.0, 0.0, 0.0], "rotation": [0, 1, 0, math.pi / 2]},
+             "geometry": {"type": "plane", "size": [4.0, 4.0]}}
+    sim = world([plane], [robot("r", 1.0 - R + 0.03, 0.0)])
+    drive(sim, "r", -1.0)
+    sim.run(10)
+    assert xy(sim, "r")[0] == pytest.approx(1.0 - R + 0.03 - 10 * 0.0032, abs=1e-12)
+
+
+def test_overlapping_moves_never_go_deeper():
+    """From random starts inside a box's grown footprint (up to 10 cm deep), random moves: the
+    robot ends no deeper than it started (a move straight out of it is never stopped)."""
+    box = C.obstacle("b", -1, geo.Box((0.6, 0.3, 1.0)), Pose.from_axis_angle((0, 0, 1), 0.4, (0.2, -0.1, 0.0)))
+    c = C.Contact([], [], None)
+    half, yaw, centre = np.array([0.3, 0.15]), 0.4, np.array([0.2, -0.1])
+    rng = np.random.default_rng(3)
+    freed = 0
+    for _ in range(400):
+        p = centre + rng.uniform(-0.5, 0.5, 2)
+        depth = R - _rect_distance(p, centre, yaw, half)
+        if not 0.0 < depth < 0.1:
+            continue
+        d = rng.normal(size=2) * 10.0 ** rng.uniform(-4, 0)
+        end, clipped = c._clip(p.copy(), d, R, [box])
+        assert R - _rect_distance(end, centre, yaw, half) <= depth + 1e-9
+        out = C._closest_on_hull(p, box.points)[1]
+        end, clipped = c._clip(p.copy(), 0.01 * out, R, [box])
+        freed += not clipped
+        assert not clipped and end == pytest.approx(p + 0.01 * out, abs=1e-15)
+    assert freed > 50
+
+
 def test_time_of_impact_closed_forms():
     box = C.obstacle("b", -1, geo.Box((2.0, 2.0, 1.0)), Pose.identity())
     # a point 0.5 from the box's corner region, moving diagonally in: hits the rounded corner
@@ -230,7 +286,7 @@ def _reference_toi(p, d, ob, rho):
         if float(normal @ d) < -C.EPS:
             return 0.0, normal
         end_dist, _ = C._closest_on_hull(p + d, pts)
-        return (0.0, normal) if end_dist - rad < -C.EPS else (math.inf, None)
+        return (0.0, normal) if end_dist - rad < min(dist - rad, 0.0) - C.EPS else (math.inf, None)
     best, best_n = math.inf, None
     n = len(pts)
     for i in range(n):

@@ -62,6 +62,26 @@ def test_straight_line():
     assert g.speed == pytest.approx(0.1, abs=1e-12)
 
 
+def test_a_simulation_reset_leaves_no_previous_position():
+    """Webots' WbGps::reset forgets the previous position: the first value after a simulation
+    reset has a NaN speed, as the first value after enable (it read the jump back to the start
+    over one period: 2 m/s for a robot at 0.1 m/s), then the speed of the motion again."""
+    sim = make()
+    drive(sim, 5.0, 5.0)                                              # v = 0.1 m/s along +x
+    g = sim.device("r/gps")
+    g.enable(32)
+    sim.run(40)                                                       # 0.64 m along +x
+    assert g.speed == pytest.approx(0.1, abs=1e-12)
+    sim.reset()                                                       # back at (1, 2), wheels at rest
+    drive(sim, 5.0, 5.0)
+    sim.run(2)
+    assert g.values[0] == pytest.approx(1.0 + 0.1 * 0.032, abs=1e-12)
+    assert math.isnan(g.speed) and np.isnan(g.speed_vector).all()
+    sim.run(2)
+    assert g.speed == pytest.approx(0.1, abs=1e-12)
+    np.testing.assert_allclose(g.speed_vector, [0.1, 0.0, 0.0], atol=1e-12)
+
+
 def test_constant_turn_reads_the_chord():
     sim = make({"pose": {"translation": [0.05, 0.0, 0.0]}})
     drive(sim, 2.0, 6.0)                  # v = R(ωl+ωr)/2 = 0.08 m/s, ω = R(ωr-ωl)/L = 0.8 rad/s

@@ -81,6 +81,45 @@ def test_supervisor_pose_on_a_slope():
     assert sim.device("r/alt").value == 2.0
 
 
+def test_a_supervisor_move_or_a_reset_is_a_jump_not_motion():
+    """Webots' gyro and accelerometer read the bodies' velocities, which a Supervisor move keeps and
+    a simulation reset zeroes: moving or resetting a turning robot is no turn of 30 rad/s nor an
+    acceleration of 1,000 m/s² (it was read so: the jump over one step, then back)."""
+    sim = make()
+    drive(sim, 2.0, 6.0)
+    v, w = R_WHEEL * 8.0 / 2, R_WHEEL * 4.0 / AXLE          # 0.08 m/s, 0.8 rad/s: radius 0.1 m
+    mag = 2.0 * (v / w) * (1.0 - math.cos(w * DT)) / DT ** 2
+    turning = [mag * math.sin(w * DT), mag * math.cos(w * DT), G]
+    sim.run(20)
+    acc, gyro = sim.device("r/acc"), sim.device("r/gyro")
+    np.testing.assert_allclose(acc.values, turning, atol=1e-7)
+    for move in (lambda: sim.robot("r").set_pose([1.0, -2.0, 0.0], [0.0, 0.0, 1.0, 2.5]), sim.reset):
+        move()
+        drive(sim, 2.0, 6.0)                                # (a reset puts the wheels back to rest)
+        sim.step()                                          # rest assumed for the acceleration, as at enable
+        np.testing.assert_allclose(gyro.values, [0.0, 0.0, w], atol=1e-9)
+        np.testing.assert_allclose(acc.values, [0.0, 0.0, G], atol=1e-12)
+        sim.run(2)                                          # then the turn's own values again
+        np.testing.assert_allclose(gyro.values, [0.0, 0.0, w], atol=1e-9)
+        np.testing.assert_allclose(acc.values, turning, atol=1e-7)
+
+
+@pytest.mark.parametrize("axes, up", [("ENU", 2), ("NUE", 1)])
+def test_altimeter_adds_the_reference_altitude_in_local_coordinates_too(axes, up):
+    """Webots' WbAltimeter adds the gps_reference's up component in local coordinates (its third
+    value in WGS84), as the GPS adds the reference: a robot 0.3 m up under a local reference
+    (100, 7, -20) reads 0.3 + the reference's up value (it read 0.3, while its GPS read 0.3 + it)."""
+    ref = [100.0, 7.0, -20.0]
+    pose = [0.0, 0.0, 0.3] if axes == "ENU" else [0.0, 0.3, 0.0]
+    sim = make(world_info={"coordinate_system": axes, "gps_reference": ref}, pose={"translation": pose})
+    sim.step()
+    assert sim.device("r/alt").value == 0.3 + ref[up]
+    sim = make(world_info={"coordinate_system": axes, "gps_reference": [46.5, 6.6, 372.0],
+                           "gps_coordinate_system": "WGS84"}, pose={"translation": pose})
+    sim.step()
+    assert sim.device("r/alt").value == 0.3 + 372.0
+
+
 def test_nue_world_gravity_and_height():
     sim = make(world_info={"coordinate_system": "NUE", "gravity": 3.7},
                pose={"translation": [0.0, 0.5, 0.0], "rotation": [1, 0, 0, -math.pi / 2]})

@@ -261,6 +261,27 @@ def test_infra_red_needs_a_clear_line_but_the_two_robots_never_block_it():
     assert not ir_heard(sim)
 
 
+@pytest.mark.parametrize("precision", ["exact", "fast"])
+def test_the_receiving_robots_own_shapes_never_block_however_many(precision):
+    """Webots: the receiving robot's structure never blocks. A receiver behind 4 of its robot's
+    own boxes (8 surfaces on the line) was read as blocked: the line of sight gave up after 8
+    re-casts past them. A wall among them (a third party's) still blocks."""
+    def sim_of(boxes, solids=()):
+        shapes = [{"pose": {"translation": [0.05 + 0.04 * k, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.3, 0.1]}}
+                  for k in range(boxes)]
+        w = world(tx={"type": "infra-red"}, rx={"type": "infra-red", "pose": {"translation": [-0.1, 0.0, 0.0]}},
+                  b_pose={"translation": [2.0, 0.0, 0.1], "rotation": [0, 0, 1, math.pi]}, b_extra={"shapes": shapes},
+                  solids=solids).world
+        return Simulation(w, precision=precision)
+
+    for boxes in (1, 4, 12):
+        sim = sim_of(boxes)
+        assert ir_heard(sim), boxes
+        assert sim.counters["rays_radio"] >= 2 * boxes + 1      # one cast past each surface, one clear
+    wall = {"name": "wall", "pose": {"translation": [1.8, 0.0, 0.1]}, "geometry": {"type": "box", "size": [0.01, 1, 1]}}
+    assert not ir_heard(sim_of(12, [wall]))                    # (x 1.8: behind 5 of its boxes, seen from a)
+
+
 # ---------------------------------------------------------------------- bounds and reset
 
 def test_queues_are_bounded_and_drops_counted(monkeypatch):

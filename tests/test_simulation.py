@@ -480,6 +480,29 @@ def test_probe_json_lines() -> None:
     assert rows[1]["range_image"]["shape"] == [1, 360] and rows[1]["time_ms"] == 32
 
 
+def test_probe_enables_all_devices_of_every_kind(tmp_path) -> None:
+    """``probe --enable all:P`` on a world with an altimeter, an emitter and a receiver: it ended in
+    a traceback (AttributeError: 'Altimeter' object has no attribute 'readings'); every device
+    kind the simulation makes now says what it reads."""
+    from sensorium.schemas.devices import KINDS
+    from sensorium.server.sim.sensors import Device, device_class
+
+    for name in KINDS:
+        cls = device_class(name)
+        if cls is not None and issubclass(cls, Device):     # (a motor is the drive's, never enabled)
+            assert callable(getattr(cls, "readings", None)), name
+    (tmp_path / "w.yaml").write_text(json.dumps({
+        "world_info": {"basic_time_step": 32},
+        "robots": [{"name": "a", "devices": [{"device": "Altimeter", "name": "alt"}, {"device": "Emitter", "name": "em"}]},
+                   {"name": "b", "devices": [{"device": "Receiver", "name": "rx"}]}]}))
+    res = subprocess.run([sys.executable, "-m", "sensorium", "probe", str(tmp_path / "w.yaml"), "--steps", "2",
+                          "--json", "--enable", "all:32"], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    rows = [json.loads(line) for line in res.stdout.splitlines()]
+    assert [(r["step"], r["device"]) for r in rows] == [(k, d) for k in (1, 2) for d in ("alt", "em", "rx")]
+    assert rows[0]["value"] == 0.0 and rows[1]["range"] == -1.0 and rows[2]["queue_length"] == 0.0
+
+
 def test_probe_rejects_bad_enable() -> None:
     res = subprocess.run([sys.executable, "-m", "sensorium", "probe", "--enable", "epuck/nope:32"],
                          capture_output=True, text=True, timeout=120)
@@ -523,6 +546,24 @@ def test_velocity_clamped_and_position_control_stops_at_target() -> None:
         m.set_velocity(math.nan)
     with pytest.raises(KeyError, match="no motor 'x'"):
         sim.robot("r").motor("x")
+
+
+def test_encoder_resolution_is_webots_discretize() -> None:
+    """A PositionSensor's resolution is Webots' discretize, (int)(v/res + 0.5)·res, as for the
+    other sensors: a wheel turned back to -1.4 rad reads -1.0 with res 0.5, and 1.25 rad reads 1.5
+    (they read -1.5 and 1.0: Python's round, which rounds halves to even and negatives
+    symmetrically)."""
+    data = {"world_info": {"basic_time_step": 16},
+            "robots": [{"name": "r", "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 10},
+                        "devices": [{"device": "PositionSensor", "name": "enc", "motor": "left wheel motor",
+                                     "resolution": 0.5}]}]}
+    sim = Simulation(parse_world(data))
+    m, enc = sim.robot("r").motor("left wheel motor"), sim.device("r/enc")
+    enc.enable(16)
+    for target, webots in ((-1.4, -1.0), (1.25, 1.5), (-0.2, 0.0), (0.75, 1.0), (-2.75, -2.5)):
+        m.set_position(target)
+        sim.run(100)
+        assert m.position == target and enc.value == webots, (target, enc.value)
 
 
 def test_circle_stays_on_circle_for_a_million_steps() -> None:

@@ -71,6 +71,7 @@ from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.raycast.kinds import Precision
 from sensorium.server.sim.motion import ackermann_angles
+from sensorium.server.sim.sensors import altitude_offset
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.limits import MAX_COORDINATE_M
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world
@@ -368,8 +369,8 @@ def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
         return _table_box(cfg, (3,), (-bound, bound))
     if cfg.device == "TouchSensor":             # a bumper: 1 while pushing against something, else 0
         return spaces.Box(np.float32(0.0), np.float32(1.0), shape=(1,), dtype=np.float32)
-    if cfg.device == "Altimeter":               # a height within the world bounds (+ a WGS84 reference altitude)
-        offset = float(world_info.gps_reference[2]) if world_info.gps_coordinate_system == "WGS84" else 0.0
+    if cfg.device == "Altimeter":               # a height within the world bounds (+ the reference altitude)
+        offset = altitude_offset(world_info)
         return spaces.Box(np.float32(offset - MAX_COORDINATE_M), np.float32(offset + MAX_COORDINATE_M), shape=(1,),
                           dtype=np.float32)
     if cfg.device == "Camera":

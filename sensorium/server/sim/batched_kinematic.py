@@ -49,7 +49,16 @@ from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.raycast import packets
-from sensorium.server.sim.sensors import GPS, Accelerometer, Altimeter, Compass, Gyro, InertialUnit, TouchSensor
+from sensorium.server.sim.sensors import (
+    GPS,
+    Accelerometer,
+    Altimeter,
+    Compass,
+    Gyro,
+    InertialUnit,
+    TouchSensor,
+    altitude_offset,
+)
 
 __all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal", "libm_each",
            "libm_cos_sin", "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions", "angular_velocities",
@@ -313,8 +322,8 @@ class KinematicDevices:
         self.unit_noise = np.array([c.noise for c in units], dtype=np.float64)
         self.unit_axes = [np.array([getattr(c, a) for c in units], dtype=bool) for a in ("x_axis", "y_axis", "z_axis")]
         self.quaternion = np.full((C, len(units), 4), math.nan)
-        # Altimeter: the height along up (ENU: z, NUE: y) plus the reference altitude in a WGS84 world
-        self.altitude_offset = float(wi.gps_reference[2]) if wi.gps_coordinate_system == "WGS84" else 0.0
+        # Altimeter: the height along up (ENU: z, NUE: y) plus the reference altitude (Altimeter's)
+        self.altitude_offset = altitude_offset(wi)
         self.altimeter_accuracy = np.array([d.config.accuracy for d in self.devices["Altimeter"]], dtype=np.float64)
         # the kinds read through a lookup table per enabled axis (axes_through_table): each device's axes on
         self.axes_on = {k: [np.array([d.config.x_axis, d.config.y_axis, d.config.z_axis], dtype=bool).nonzero()[0]
@@ -353,6 +362,13 @@ class KinematicDevices:
             self.seen[kind][idx, column] = 1
             self.enable_rot[kind][idx, column] = self.sim.rot[idx, slot]
             self.enable_pos[kind][idx, column] = self.sim.pos[idx, slot]
+
+    def placed(self, copy: int, slot: int) -> None:
+        """A robot of one copy was put somewhere from outside (``set_pose``): its gyros and
+        accelerometers start their poses over from there (_MotionSensor.placed)."""
+        for kind in MOTION:
+            for column in np.nonzero(self.slot[kind] == slot)[0].tolist():
+                self.enabled(kind, column, np.array([copy]))
 
     def reading(self, kind: str, column: int, what: str) -> np.ndarray:
         """A device's reading ``what`` (one of READINGS[kind]) in every copy: (copies, ...)."""
@@ -542,7 +558,7 @@ class KinematicDevices:
         return np.where(self.sim.pressing[copies, self.slot["TouchSensor"][cols]], 1.0, 0.0)
 
     def _altimeter(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """Altimeter.measure: the device's height (+ the WGS84 reference altitude), its Gaussian
+        """Altimeter.measure: the device's height (+ the reference altitude), its Gaussian
         accuracy noise (one normal from its stream), its resolution."""
         _, t = self._frames("Altimeter", copies, cols)
         assert t is not None

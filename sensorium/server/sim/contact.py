@@ -286,7 +286,8 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
         gap = abs(dist) - rho
         rate = float(nrm @ d)
         if gap <= EPS:       # touching: an impact when the move goes in by more than the tolerance
-            return (0.0, nrm) if rate < -EPS or gap + rate < -EPS else (math.inf, None)
+            # (overlapping, as a move from outside may leave it: deeper than it already is)
+            return (0.0, nrm) if rate < -EPS or gap + rate < min(gap, 0.0) - EPS else (math.inf, None)
         if rate >= 0.0 or gap + rate > 0.0:
             return math.inf, None
         return gap / -rate, nrm
@@ -302,11 +303,15 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
         dist, normal = _closest_on_list(px, py, v)
         if dist - rad <= EPS:                        # touching (or overlapping) now
             # an impact when the move goes in by more than the tolerance; a slide's leftover (the
-            # rounding of its projection, ~1e-19 m inward) is none: taken for one, it stalled the robot
+            # rounding of its projection, ~1e-19 m inward) is none: taken for one, it stalled the robot.
+            # Overlapping (a robot placed so from outside: world file, Supervisor move, reset), the
+            # move is free unless it ends deeper than it starts, so the robot can back out or slide
+            # out (the signed distance to a convex set is convex: a move that does not start inward
+            # never goes deeper on the way)
             if float(normal @ d) < -EPS:
                 return 0.0, normal
             end_dist, _ = _closest_on_hull(p + d, pts)
-            return (0.0, normal) if end_dist - rad < -EPS else (math.inf, None)
+            return (0.0, normal) if end_dist - rad < min(dist - rad, 0.0) - EPS else (math.inf, None)
     best: float = math.inf
     best_n: np.ndarray | None = None
     a = float(d @ d)

@@ -32,7 +32,8 @@ __all__ = ["Emitter", "Receiver", "Radio", "Packet", "Received", "MAX_QUEUED_PAC
 
 MAX_QUEUED_PACKETS = 16_384
 MAX_QUEUED_BYTES = 4 << 20
-OCCLUSION_ROUNDS = 8          # rays re-cast past the receiving robot's own shapes (then: blocked)
+OCCLUSION_ROUNDS = 8          # rays re-cast past the receiving robot's own shapes beyond two per shape
+                              # (FAST's float32 may meet a surface again; then: blocked)
 
 
 @dataclass(frozen=True, slots=True)
@@ -126,6 +127,11 @@ class Emitter(Device):
             return False
         return True
 
+    def readings(self) -> dict:
+        """What ``sensorium probe`` shows (numbers as floats, as other readings): the channel and
+        range packets leave with now."""
+        return {"channel": float(self.channel), "range": self.range}
+
     @property
     def byte_rate(self) -> float:
         """Bytes per millisecond the controller may send (Webots: baudRate / byteSize / 1000); -1: unlimited."""
@@ -190,6 +196,10 @@ class Receiver(Device):
     def queue_length(self) -> int:
         return len(self.ready)
 
+    def readings(self) -> dict:
+        """What ``sensorium probe`` shows (the packets stay for the controller): how many are ready."""
+        return {"queue_length": float(self.queue_length)}
+
     def step_reading(self) -> dict:
         return {"packets": [p.as_wire() for p in self.take()]}
 
@@ -209,6 +219,7 @@ class Radio:
         self.scene = scene
         self.counters = counters
         self._in_flight: list[tuple[Packet, Emitter, Receiver]] = []
+        self._own_shapes: dict[int, int] = {}     # robot index -> its shapes in the scene (counted once)
 
     def __bool__(self) -> bool:
         return bool(self.emitters)              # (packets leave an emitter even when nobody listens)
@@ -303,7 +314,14 @@ class Radio:
         todo = [i for i in range(n) if length[i] > 0.0]
         start = np.zeros(n)
         engine, shapes = self.scene.engine, self.scene.shapes
-        for _ in range(OCCLUSION_ROUNDS):
+        # a line enters and leaves each of the receiving robot's shapes once (convex ones): two casts
+        # per shape may stop there before the receiver (a robot's shapes never change)
+        for i in todo:
+            robot = segments[i][3]
+            if robot not in self._own_shapes:
+                self._own_shapes[robot] = sum(1 for s in shapes if s.owner == robot)
+        rounds = OCCLUSION_ROUNDS + 2 * max((self._own_shapes[segments[i][3]] for i in todo), default=0)
+        for _ in range(rounds):
             if not todo:
                 break
             idx = np.array(todo)

@@ -539,8 +539,8 @@ class PositionSensor(Device):
         if noise > 0.0:
             v += float(self.rng.normal(0.0, noise))
         res = float(self.config.resolution)
-        if res > 0.0:
-            v = round(v / res) * res
+        if res > 0.0:                 # Webots' discretize: (int)(v/res + 0.5)·res, as other sensors
+            v = float(quantize_sensor(v, res))
         self.value = v
         self._mark(now_ms)
 
@@ -643,6 +643,11 @@ class GPS(Device):
         self._previous = np.array(t, dtype=np.float64)
         self.speed = gps_math.speed(self.speed_vector, noise=c.speed_noise, rng=rng, resolution=c.speed_resolution)
         self._mark(now_ms)
+
+    def restart(self) -> None:
+        """A simulation reset: no previous position, so the next value's speed is NaN, as the first
+        one's (Webots' WbGps::reset; its device without physics)."""
+        self._previous = None
 
     def readings(self) -> dict:
         return {"values": self.values, "speed": self.speed, "speed_vector": self.speed_vector}
@@ -759,6 +764,12 @@ class _MotionSensor(Device):
     def track(self) -> None:
         self._poses = [*self._poses[-2:], self.world_pose(self._robot.pose)]
 
+    def placed(self) -> None:
+        """The robot was put somewhere from outside (a Supervisor move, a simulation reset): a jump,
+        not motion (Webots' gyro and accelerometer read the bodies' velocities, which a move keeps
+        and a reset zeroes), so the poses start over from there, as at ``enable``."""
+        self._poses = [self.world_pose(self._robot.pose)]
+
     def _through_table(self, raw: np.ndarray) -> np.ndarray:
         c = self.config
         table = self.table
@@ -809,9 +820,19 @@ class Gyro(_MotionSensor):
         self._mark(now_ms)
 
 
+def altitude_offset(world_info: Any) -> float:
+    """What an Altimeter adds to its height along up: the ``gps_reference``'s altitude -- its third
+    value in a WGS84 world, its up component (ENU: z, NUE: y) in local coordinates, as Webots'
+    WbAltimeter (and so as the GPS, which adds the reference in local coordinates too)."""
+    ref = world_info.gps_reference
+    if world_info.gps_coordinate_system == "WGS84":
+        return float(ref[2])
+    return float(ref[world_info.coordinate_system.index("U")])
+
+
 class Altimeter(Device):
-    """Webots Altimeter: the device's height along the up axis (+ the WGS84 reference altitude),
-    Gaussian ``accuracy`` noise, ``resolution``; NaN before the first value."""
+    """Webots Altimeter: the device's height along the up axis plus the reference altitude
+    (:func:`altitude_offset`), Gaussian ``accuracy`` noise, ``resolution``; NaN before the first value."""
 
     kinematic = True
 
@@ -826,7 +847,7 @@ class Altimeter(Device):
         self._robot = robot
         wi = robot.world_info
         self._up = wi.coordinate_system.index("U")
-        self._offset = float(wi.gps_reference[2]) if wi.gps_coordinate_system == "WGS84" else 0.0
+        self._offset = altitude_offset(wi)
 
     def measure(self, now_ms: int) -> None:
         c = self.config
@@ -837,6 +858,9 @@ class Altimeter(Device):
             v = float(quantize_sensor(v, c.resolution))
         self.value = v
         self._mark(now_ms)
+
+    def readings(self) -> dict:
+        return {"value": self.value}
 
     def describe(self) -> dict:
         return {"accuracy": float(self.config.accuracy), "resolution": float(self.config.resolution)}

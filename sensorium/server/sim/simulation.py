@@ -32,6 +32,7 @@ from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
 from sensorium.server.sim.scene import Scene, light_from_model, primitive_from_model, robot_parts, solid_parts
 from sensorium.server.sim.sensors import (
+    GPS,
     LED,
     Device,
     DistanceSensor,
@@ -191,6 +192,7 @@ class Simulation:
         self.lights = lights_from_models(self.scene.world_lights())
         self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
+        self._by_index = list(self.robots.values())
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         if self.ground is not None:
             self._warn_ground()
@@ -233,16 +235,21 @@ class Simulation:
         return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system])
 
     def place_robot(self, index: int, pose: Pose) -> None:
-        """Put a robot somewhere from outside (no contact check)."""
+        """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
+        jump, not motion: their poses start over from there (_MotionSensor.placed)."""
         self.scene.set_robot_pose(index, pose)
         if self.contact is not None:
             self.contact.place(index, pose)
+        for dev in self._by_index[index].devices.values():
+            if dev.tracks_motion:
+                dev.placed()          # type: ignore[attr-defined]
 
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file.
+        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file, GPS speeds
+        NaN at their next value (no previous position, as Webots' WbGps::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
         for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):
@@ -256,6 +263,8 @@ class Simulation:
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
                     dev.set(0, self.time_ms)
+                elif isinstance(dev, GPS):
+                    dev.restart()
         self.radio.reset()
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
