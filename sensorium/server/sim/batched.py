@@ -50,7 +50,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import distance as dmath
 from sensorium.server.devices import lidar as lmath
 from sensorium.server.devices import light as light_math
-from sensorium.server.devices.lookup import RESOLUTION_OFF
+from sensorium.server.devices.lookup import RESOLUTION_OFF, quantize_sensor
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.copies import CopyRays
@@ -927,8 +927,8 @@ class BatchedSimulation:
             if noise > 0.0:
                 g = self.noise.take(int(copies[k]), self._noise_col[("PositionSensor", col)], 1)[0]
                 v[k] = v[k] + float(0.0 + noise * g)
-            if res > 0.0:
-                v[k] = round(float(v[k]) / res) * res
+            if res > 0.0:   # (the single simulation's quantize_sensor, Webots' discretize)
+                v[k] = quantize_sensor(float(v[k]), res)
         self.values["PositionSensor"][copies, cols] = v
         self.last["PositionSensor"][copies, cols] = self.time_ms[copies]
         self.counters["measurements"] += len(copies)

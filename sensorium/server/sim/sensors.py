@@ -539,8 +539,8 @@ class PositionSensor(Device):
         if noise > 0.0:
             v += float(self.rng.normal(0.0, noise))
         res = float(self.config.resolution)
-        if res > 0.0:
-            v = round(v / res) * res
+        if res > 0.0:   # Webots' discretize (spec §1.3), not round(): halves and negative angles differ
+            v = quantize_sensor(v, res)
         self.value = v
         self._mark(now_ms)
 
