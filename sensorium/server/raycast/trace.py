@@ -546,8 +546,10 @@ class TierTracer(Refiner):
                 prim2 = self._run(tier, o2, d32, far32, robust=True)["primID"]
                 sus = ((prim2 >= 0) & (prim2 != prim)).nonzero()[0]
                 if len(sus):
+                    # (never before lo: the surface a ray starts on is no repair, only a continued ray)
                     ok, t2, tri2 = self._refine_triangles(tier, oa[sus], da[sus], prim2[sus].astype(np.int64),
-                                                          sa[sus] - eps, lim[view][sus] + eps)
+                                                          np.maximum(sa[sus] - eps, lo[view][sus]),
+                                                          lim[view][sus] + eps)
                     t_sus = np.where(prim[sus] >= 0, sa[sus] + tf[sus], _INF)
                     fix = ok & ((prim[sus] < 0) | (t2 < t_sus - eps))
                     if np.count_nonzero(fix):
