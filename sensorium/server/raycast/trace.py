@@ -469,9 +469,9 @@ class TierTracer(Refiner):
         else:
             Ot = O
         # Embree's start along the ray: eps before t_near, not before eps (FAST: it redoes its
-        # self-hits from there) or 1e-6 m (EXACT, the floor of eps: a room-sized tier starts where
-        # it always did). EXACT judges a self-hit in float64 (t < lo) and continues past it, so in a
-        # coarse tier (eps ~ 3 cm in a static tier spanning 1e5 m) a surface nearer than eps is seen
+        # self-hits from there) or 1e-6 m (EXACT: the floor of eps; a room's tier has eps of a few
+        # um). EXACT judges a self-hit in float64 (t < lo) and continues past it, so in a coarse
+        # tier (eps ~ 3 cm in a static tier spanning 1e5 m) a surface nearer than eps is seen
         first = min(eps, 1e-6) if exact else eps
         if isinstance(t_near, np.ndarray):       # accepted hits: lo <= t <= lim
             lo = np.maximum(t_near, eps64)
