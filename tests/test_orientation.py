@@ -170,3 +170,56 @@ def test_messages_export_to_ros2():
                                                                                 "quaternion", sim.time_ms)))
     assert imu.orientation.w == sim.device("r/imu").quaternion[3]
     assert imu.orientation_covariance[0] == pytest.approx((0.001 * math.pi) ** 2)
+
+
+def _webots_to_quaternion(m: np.ndarray) -> np.ndarray:
+    """Webots' WbMatrix3::toQuaternion as its branches compute it, returned as (x, y, z, w)."""
+    m = m.reshape(-1)
+    tr = m[0] + m[4] + m[8]
+    if tr >= 0.0:
+        s = 2.0 * math.sqrt(tr + 1.0)
+        return np.array([(m[7] - m[5]) / s, (m[2] - m[6]) / s, (m[3] - m[1]) / s, 0.25 * s])
+    if m[0] > m[4] and m[0] > m[8]:
+        s = 2.0 * math.sqrt(1.0 + m[0] - m[4] - m[8])
+        return np.array([0.25 * s, (m[1] + m[3]) / s, (m[6] + m[2]) / s, (m[7] - m[5]) / s])
+    if m[4] > m[8]:
+        s = 2.0 * math.sqrt(1.0 + m[4] - m[8] - m[0])
+        return np.array([(m[1] + m[3]) / s, 0.25 * s, (m[5] + m[7]) / s, (m[2] - m[6]) / s])
+    s = 2.0 * math.sqrt(1.0 + m[8] - m[0] - m[4])
+    return np.array([(m[2] + m[6]) / s, (m[5] + m[7]) / s, 0.25 * s, (m[3] - m[1]) / s])
+
+
+@pytest.mark.parametrize("axis, angle", [((0, 0, 1), -2.97), ((0, 0, 1), 2.5), ((0, 0, 1), -1.0), ((1, 0, 0), -2.2),
+                                         ((0, 1, 0), -2.6), ((1, 2, -1), -2.9), ((-1, 1, 3), 3.1), ((0, 0, 1), 0.0)])
+def test_quaternion_has_webots_sign_and_resolution_rounds_those_components(axis, angle):
+    """Webots' quaternion is WbMatrix3::toQuaternion's: w > 0 for a turn up to 120°, else the
+    component of the largest diagonal term > 0 (a robot yawed by -170° reads z > 0, w < 0). It was
+    always given w >= 0 here: the opposite sign there, and with a resolution (components rounded by
+    discretize, asymmetric for negatives) another rotation, so other roll/pitch/yaw: -170° read
+    -163.8° at resolution 0.1, where Webots reads 180°. The batched simulation reads the same."""
+    from sensorium.server.devices.lookup import quantize_sensor
+    from sensorium.server.sim.batched import BatchedSimulation
+    from sensorium.server.world.poses import axis_angle_matrix
+
+    rot = np.asarray(axis_angle_matrix(axis, angle))
+    for res in (-1.0, 0.1):
+        data = {"world_info": {"basic_time_step": 16, "contact": False},
+                "robots": [{"name": "r", "pose": {"rotation": [*axis, angle]},
+                            "devices": [{"device": "InertialUnit", "name": "imu", "resolution": res}]}]}
+        world = wm.World.model_validate(data)
+        sim, bs = Simulation(world), BatchedSimulation(world, 1)
+        sim.device("r/imu").enable(16)
+        bs.enable(bs.device("r", "imu"), 16)
+        sim.step()
+        bs.step()
+        want = _webots_to_quaternion(rot)
+        if res > 0:
+            want = np.array([quantize_sensor(float(v), res) for v in want])
+        imu = sim.device("r/imu")
+        np.testing.assert_allclose(imu.quaternion, want, atol=1e-12)
+        x, y, z, w = want
+        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        assert imu.roll_pitch_yaw[2] == pytest.approx(yaw, abs=1e-12)
+        assert bs.reading(bs.device("r", "imu"), "quaternion")[0].tobytes() == imu.quaternion.tobytes()
+    if (axis, angle) == ((0, 0, 1), -2.97):
+        assert imu.quaternion[2] == 1.0 and imu.quaternion[3] == 0.0 and imu.roll_pitch_yaw[2] == pytest.approx(math.pi)

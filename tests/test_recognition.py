@@ -40,13 +40,19 @@ def recognise(w: wm.World, segmentation=False) -> tuple[Simulation, list]:
 
 
 def webots_box(corners: np.ndarray) -> tuple[tuple[int, int], tuple[int, int]]:
-    """Webots' projectOnImage of camera-frame corners (planar), then round/ceil of the extent."""
+    """Webots' projectOnImage of camera-frame corners (planar), then round/ceil of the extent (C's
+    round: a half goes up, away from zero)."""
     t = math.tan(FOV / 2)
     u = np.clip(0.5 - 0.5 * (corners[:, 1] / np.abs(corners[:, 0])) / t, 0, 1)
     v = np.clip(0.5 - 0.5 * (corners[:, 2] / np.abs(corners[:, 0])) / (t * H / W), 0, 1)
     pu, pv = ((W - 1) * u).astype(int), ((H - 1) * v).astype(int)
-    return (round((pu.max() + pu.min()) / 2), round((pv.max() + pv.min()) / 2)), \
+    return (c_round((pu.max() + pu.min()) / 2), c_round((pv.max() + pv.min()) / 2)), \
         (math.ceil(pu.max() - pu.min()), math.ceil(pv.max() - pv.min()))
+
+
+def c_round(x: float) -> int:
+    """C's round(): halves away from zero."""
+    return int(math.copysign(math.floor(abs(x) + 0.5), x))
 
 
 def aabb_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -67,6 +73,25 @@ def test_box_position_size_and_box_on_image():
     assert obj.orientation == (0.0, 0.0, 1.0, 0.0)
     lo, hi = np.array([1.9, 0.1, -0.4]), np.array([2.1, 0.5, 0.2])
     assert (obj.position_on_image, obj.size_on_image) == webots_box(aabb_corners(lo, hi))
+
+
+def test_the_middle_on_the_image_rounds_halves_up_as_webots():
+    """Webots' position on the image is C's round() of the middle of the corners' pixels: a half
+    goes up (away from zero). Python's round() took it to the even pixel, so an object whose pixels
+    spanned an odd sum with an even pixel just before its middle was reported one pixel left (up)."""
+    t = math.tan(FOV / 2)
+    differs = 0
+    for y in np.linspace(-0.6, 0.6, 25):
+        box = solid("crate", {"translation": [2.0, float(y), float(y) / 2]}, {"type": "box", "size": [0.2, 0.37, 0.29]})
+        _, [obj] = recognise(world([box]))
+        corners = aabb_corners(np.array([1.9, y - 0.185, y / 2 - 0.145]), np.array([2.1, y + 0.185, y / 2 + 0.145]))
+        assert (obj.position_on_image, obj.size_on_image) == webots_box(corners)
+        u = np.clip(0.5 - 0.5 * (corners[:, 1] / corners[:, 0]) / t, 0, 1)
+        v = np.clip(0.5 - 0.5 * (corners[:, 2] / corners[:, 0]) / (t * H / W), 0, 1)
+        for p in (((W - 1) * u).astype(int), ((H - 1) * v).astype(int)):
+            twice = int(p.max() + p.min())
+            differs += twice % 2 == 1 and (twice // 2) % 2 == 0     # round() would have gone down
+    assert differs >= 3
 
 
 def test_rotated_box_and_cylinder_bounds_are_exact():

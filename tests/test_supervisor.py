@@ -199,6 +199,39 @@ def test_position_sensor_noise_and_resolution():
         assert abs(left - 3.0 * 0.032 * k) < 0.025 + 5 * 0.01                # within resolution + 5 sigma
 
 
+def test_position_sensor_resolution_is_webots_discretize_also_backwards():
+    """Webots rounds an encoder with WbMathsUtilities::discretize, ``(int)(v/res + 0.5)·res`` (C's
+    cast truncates toward zero), as the light and distance sensors. Python's round() was used: a
+    wheel turning backwards read one step more negative (-1.92 steps: -2 instead of Webots' -1). The
+    batched simulation reads the same values."""
+    from sensorium.schemas import world as wm
+    from sensorium.server.sim.batched import BatchedSimulation
+
+    res, w = 0.05, -3.0
+    world = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "contact": False},
+        "robots": [{"name": "bot", "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05,
+                                                          "max_wheel_speed": 10.0},
+                    "devices": [{"device": "PositionSensor", "name": "enc", "motor": "left wheel motor",
+                                 "resolution": res}]}]})
+    sim, bs = Simulation(world), BatchedSimulation(world, 1)
+    sim.robot("bot").device("enc").enable(16)
+    bs.enable(bs.device("bot", "enc"), 16)
+    for m in sim.robot("bot").motors.values():
+        m.set_position(math.inf)
+    sim.robot("bot").drive.left.set_velocity(w)
+    bs.set_wheels(0, np.array([w]), np.array([0.0]))
+    for k in range(1, 40):
+        sim.step()
+        bs.step()
+        angle = w * 0.016 * k
+        want = int(angle / res + 0.5) * res + 0.0
+        got = sim.robot("bot").device("enc").value
+        assert got == pytest.approx(want, abs=1e-12), (k, angle, got, want)
+        assert float(bs.value(bs.device("bot", "enc"))[0]) == got
+    assert got == pytest.approx(-1.8, abs=1e-12)   # -1.872 rad = -37.44 steps: Webots' -36 (round() gave -37)
+
+
 def test_in_process_pose_setters_keep_what_is_left_out():
     sim = Simulation(load_world(WORLD))
     rover = sim.robot("rover")

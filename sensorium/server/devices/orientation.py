@@ -2,7 +2,9 @@
 
 InertialUnit (``WbInertialUnit`` + the controller's ``inertial_unit.c``):
 
-* the quaternion (x, y, z, w) of the device's rotation in world axes (w >= 0 here);
+* the quaternion (x, y, z, w) of the device's rotation in world axes, of the sign Webots'
+  ``WbMatrix3::toQuaternion`` gives it (:func:`webots_sign`: w > 0 for a turn up to 120°, else the
+  component of the matrix's largest diagonal term > 0);
 * ``noise`` > 0: the rotation is turned, in the device frame, by three Gaussian angles of
   standard deviation ``noise·π`` about its x, y and z axes;
 * an axis switched off (``xAxis``/``yAxis``/``zAxis`` false) zeroes one component of the
@@ -30,7 +32,8 @@ import numpy as np
 from sensorium.server.devices.lookup import LookupTable, quantize_sensor
 from sensorium.server.devices.motion_sensors import axes_through_table
 
-__all__ = ["compass_values", "inertial_quaternion", "north_vector", "quaternion_multiply", "roll_pitch_yaw"]
+__all__ = ["compass_values", "inertial_quaternion", "north_vector", "quaternion_multiply", "roll_pitch_yaw",
+           "webots_sign"]
 
 
 def quaternion_multiply(a, b) -> np.ndarray:
@@ -73,11 +76,24 @@ def inertial_quaternion(q, *, noise: float = 0.0, rng: np.random.Generator | Non
         norm = math.sqrt(float(axis @ axis))
         out = np.array([0.0, 0.0, 0.0, 1.0]) if norm == 0.0 else np.array([*(axis / norm * math.sin(half)),
                                                                            math.cos(half)])
-    if out[3] < 0.0:
-        out = -out
+    out = webots_sign(out)
     if resolution != -1.0:
         out = np.asarray(quantize_sensor(out, resolution), dtype=np.float64)
     return out
+
+
+def webots_sign(q: np.ndarray) -> np.ndarray:
+    """Unit quaternions (..., 4) (x, y, z, w), each as ``q`` or ``-q``: the one Webots'
+    ``WbMatrix3::toQuaternion`` returns for its rotation matrix (whose diagonal is ``2w² − 1 + 2x²``,
+    ``… + 2y²``, ``… + 2z²``, its trace ``4w² − 1``): w > 0 where the trace is >= 0, else the
+    component of the largest diagonal term > 0 (x, then y, then z, ties as its strict tests break
+    them). Webots discretizes these components (``resolution``), so the sign changes the values."""
+    q = np.asarray(q, dtype=np.float64)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    ww = 2.0 * w * w
+    m0, m4, m8 = -1.0 + 2.0 * x * x + ww, -1.0 + 2.0 * y * y + ww, -1.0 + 2.0 * z * z + ww
+    key = np.where(m0 + m4 + m8 >= 0.0, w, np.where((m0 > m4) & (m0 > m8), x, np.where(m4 > m8, y, z)))
+    return np.where((key < 0.0)[..., None], -q, q)
 
 
 def roll_pitch_yaw(q, axes: str = "ENU") -> np.ndarray:

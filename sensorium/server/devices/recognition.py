@@ -13,7 +13,7 @@ bounding sphere):
 * on the image (``box_on_image``, Webots' ``WbCamera::setRecognizedObjectProperties``): its 8
   corners (and, for a non-planar camera, its centre) projected by ``project_on_image``, whose image
   coordinates are the inverse of the camera's pixel rays (``imaging.py``), clamped to the image and
-  mapped as Webots does, ``int((W − 1)·u)``; ``position_on_image = round`` of the middle,
+  mapped as Webots does, ``int((W − 1)·u)``; ``position_on_image`` = C's ``round`` (halves up) of the middle,
   ``size_on_image = ceil`` of the extent; an object under one pixel in either direction is not
   recognised. A planar camera maps a point behind it to the image corner on its side (Webots).
 
@@ -103,7 +103,9 @@ def box_on_image(centre: np.ndarray, size: np.ndarray, g: ImageGeometry) -> tupl
     w, h = int(math.ceil(hi[0] - lo[0])), int(math.ceil(hi[1] - lo[1]))
     if w < 1 or h < 1:
         return None
-    return (int(round((hi[0] + lo[0]) / 2.0)), int(round((hi[1] + lo[1]) / 2.0))), (w, h)
+    # C's round(): halves away from zero (Python's round() takes them to the even integer: one pixel
+    # off for every other object whose extent is odd), exact on these halves of non-negative integers
+    return (int(math.floor((hi[0] + lo[0]) / 2.0 + 0.5)), int(math.floor((hi[1] + lo[1]) / 2.0 + 0.5))), (w, h)
 
 
 def _shape_points(kind: str, params: tuple, R: np.ndarray, c: np.ndarray, points: np.ndarray | None) -> np.ndarray | None:

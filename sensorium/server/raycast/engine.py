@@ -107,10 +107,13 @@ Precision
   float64 ray hits that triangle or a neighbour (``counters["leak_repairs"]``).
 
 Epsilons (per tier; res = float32 spacing at the tier's radius in the anchored frame)
-* ``eps`` = max(1e-6 m, 8 res): self-hit distance and continuation step.  EXACT casts start
-  ``eps`` along the ray.  FAST casts start at t_near; a hit closer than ``eps`` whose plane passes
-  within 2 eps of the origin is a self-hit and is redone from ``eps``.  So a sensor flush with a
-  surface never reports that surface at t ~ 0.  A room-sized world gives eps = 1e-6 m.
+* ``eps`` = max(1e-6 m, 8 res): self-hit distance and continuation step.  EXACT casts start at
+  max(t_near - eps, 1e-6 m): a hit its float64 refinement puts before the limit below (the
+  surface a ray starts on) is continued from ``eps`` past it, and a surface nearer than ``eps``
+  is seen (a static tier spanning 1e5 m has eps ~ 3 cm).  FAST casts start at t_near; a hit closer than
+  ``eps`` whose plane passes within 2 eps of the origin is a self-hit and is redone from ``eps``.
+  So a sensor flush with a surface never reports that surface at t ~ 0.  A room-sized world gives
+  eps = 1e-6 m.
 * Refined (EXACT) and analytic hits must also satisfy t >= t_near and t >= 1e-9 m + 1e-14 max|O|.
 
 Known limits (measure-zero in practice)

@@ -508,7 +508,7 @@ void sp_exact_pass(void* scene, const struct sp_tier* T, size_t m, const double*
   for (;;) {
     while (lanes < 16 && next < m) {   /* refill the packet with the next rays */
       if (alive[next]) {
-        lane_row[lanes] = next; lane_delta[lanes] = eps; lane_pass[lanes] = 0;
+        lane_row[lanes] = next; lane_delta[lanes] = 0.25 * eps; lane_pass[lanes] = 0;
         lanes++;
       }
       next++;

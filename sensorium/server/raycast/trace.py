@@ -468,12 +468,17 @@ class TierTracer(Refiner):
             Ot = _one_row(O[:1] - tier.anchor, m) if O.strides[0] == 0 and m else _minus(O, tier.anchor)
         else:
             Ot = O
+        # Embree's start along the ray: eps before t_near, not before eps (FAST: it redoes its
+        # self-hits from there) or 1e-6 m (EXACT: the floor of eps; a room's tier has eps of a few
+        # um). EXACT judges a self-hit in float64 (t < lo) and continues past it, so in a coarse
+        # tier (eps ~ 3 cm in a static tier spanning 1e5 m) a surface nearer than eps is seen
+        first = min(eps, 1e-6) if exact else eps
         if isinstance(t_near, np.ndarray):       # accepted hits: lo <= t <= lim
             lo = np.maximum(t_near, eps64)
-            seg = np.maximum(t_near - eps, eps)   # Embree start along the ray
+            seg = np.maximum(t_near - eps, first)
         else:
             lo = np.full(m, max(t_near, eps64))
-            seg = np.full(m, max(t_near - eps, eps))
+            seg = np.full(m, max(t_near - eps, first))
         lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, float(lim))
         excl_arr = None
         if tier.owned:
@@ -541,8 +546,10 @@ class TierTracer(Refiner):
                 prim2 = self._run(tier, o2, d32, far32, robust=True)["primID"]
                 sus = ((prim2 >= 0) & (prim2 != prim)).nonzero()[0]
                 if len(sus):
+                    # (never before lo: the surface a ray starts on is no repair, only a continued ray)
                     ok, t2, tri2 = self._refine_triangles(tier, oa[sus], da[sus], prim2[sus].astype(np.int64),
-                                                          sa[sus] - eps, lim[view][sus] + eps)
+                                                          np.maximum(sa[sus] - eps, lo[view][sus]),
+                                                          lim[view][sus] + eps)
                     t_sus = np.where(prim[sus] >= 0, sa[sus] + tf[sus], _INF)
                     fix = ok & ((prim[sus] < 0) | (t2 < t_sus - eps))
                     if np.count_nonzero(fix):
@@ -683,8 +690,8 @@ class TierTracer(Refiner):
             rows = act[ci]
             te = t_e[ci]
             stuck = te < seg[rows] + eps                  # no progress: widen the step
-            if delta is None:
-                delta = np.full(m, eps)
+            if delta is None:   # (EXACT: a first step of eps past a hit stuck at its start, a self-hit from 0)
+                delta = np.full(m, 0.25 * eps if exact else eps)
             delta[rows] = np.where(stuck, delta[rows] * 4.0, eps)
             seg[rows] = np.maximum(te, seg[rows]) + delta[rows]
             act = rows[seg[rows] <= lim[rows] + eps]

@@ -242,7 +242,7 @@ def inertial_quaternions(q: np.ndarray, gauss: np.ndarray | None, noise: np.ndar
         o = np.concatenate([turned, cos[:, None]], axis=1)
         o[zero] = (0.0, 0.0, 0.0, 1.0)
         out[off] = o
-    out = np.where((out[:, 3] < 0.0)[:, None], -out, out)
+    out = orient.webots_sign(out)
     return _quantize(out, resolution)
 
 
