@@ -511,6 +511,10 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     assert out[2] == "gone 4 1 1 5"
     key, *vals = out[3].split()
     assert key == "reset" and [float(v) for v in vals] == pytest.approx([3.0, 5], abs=1e-9)
+    assert out[4] == "removed_pose nan nan nan nan nan nan"          # Webots' NaNs, never NULL
+    assert ("Error: wb_supervisor_node_get_position(): INVALID_ARGUMENT: get_node_pose: node 4 (Solid 'crate') was "
+            "removed") in err
+    assert "Error: wb_supervisor_node_get_orientation() called with a NULL or invalid 'node' argument." in err
     assert ("Error: wb_supervisor_node_remove(): INVALID_ARGUMENT: remove_node: robot 'rover' (node 2) cannot be "
             "removed here") in err
     assert "Error: wb_supervisor_node_remove(): INVALID_ARGUMENT: remove_node: the root node cannot be removed" in err

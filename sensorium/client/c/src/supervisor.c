@@ -238,19 +238,19 @@ static bool copy_numbers(const msgpack_object *list, double *out, uint32_t n) {
   return true;
 }
 
+/* Webots never answers NULL here: a NULL, removed or refused node (or a Robot controller) gets its
+   line and NaNs */
 static const double *node_pose(WbNodeRef node, bool position, const char *func) {
-  sn_robot *rb = supervisor(func);
-  if (rb == NULL || node == NULL)
-    return NULL;
+  sn_robot *rb = supervisor_node(node, func);
   sn_reply rep;
-  if (sn_robot_call(rb, "robot/get_node_pose", 1, args_node, &node->id, func, &rep) != 0)
-    return NULL;
+  if (rb == NULL || sn_robot_call(rb, "robot/get_node_pose", 1, args_node, &node->id, func, &rep) != 0)
+    return sn_no_values();
   bool ok = position ? copy_numbers(sn_get(rep.result, "position"), node->position, 3)
                      : copy_numbers(sn_get(rep.result, "orientation"), node->orientation, 9);
   sn_reply_free(&rep);
   if (!ok)
     fprintf(stderr, "Error: %s(): malformed reply\n", func);
-  return ok ? (position ? node->position : node->orientation) : NULL;
+  return ok ? (position ? node->position : node->orientation) : sn_no_values();
 }
 
 const double *wb_supervisor_node_get_position(WbNodeRef node) {
