@@ -23,4 +23,9 @@ robot.step(timestep)
 after = [ds.getValue(), eye.getValue(), children.getCount()]
 gone = [robot.getFromDef("CRATE") is None, robot.getFromId(crate_id) is None, robot.getFromDef("GATE").getId(),
         robot.getFromDef("rover") is not None]
-print(json.dumps({"before": before, "after": after, "gone": gone}), flush=True)
+# calls on the removed crate and a refused light value: Webots' line and "no value", the controller runs on
+intensity = robot.getFromDef("lamp").getField("intensity")
+intensity.setSFFloat(-1.0)
+refused = [crate.getPosition(), crate.getOrientation()[:2], crate.getVelocity()[:2], crate.getField("translation"),
+           intensity.getSFFloat(), robot.step(timestep)]
+print(json.dumps({"before": before, "after": after, "gone": gone, "refused": refused}), flush=True)
