@@ -412,6 +412,8 @@ def test_every_getter_matches_the_python_client(cbin, servers):
         assert got["error.bad_tag_value"] == got["error.bad_tag_name"] == got["error.wrong_kind"] == "1"
         assert got["error.bad_step"] == "-1" and got["robot.step"] == "0"
         assert "step duration must be >= 0 ms" in err and "invalid device tag 9999" in err
+        assert f'Warning: wb_robot_get_device(): robot "{robot}" has no device "no such device".' in err
+        assert f"Error: wb_robot_get_device_by_index(): index {want['robot.number_of_devices']} is outside" in err
         assert float(got["robot.time_after"]) * 1000 == pytest.approx(want["robot.basic_time_step"])
         begun, again, status, t = got["pipelined"].split(",")          # a second step_begin is refused
         assert (begun, again, status) == ("0", "-1", "0") and float(t) * 1000 == pytest.approx(2 * want["robot.basic_time_step"])

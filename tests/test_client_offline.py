@@ -354,8 +354,13 @@ def test_flat_api(global_robot, capsys):
     assert wb.wb_robot_get_name() == "r1" and wb.wb_robot_get_basic_time_step() == 32.0
     assert wb.wb_robot_get_number_of_devices() == 3
     ls, ds, lid = (wb.wb_robot_get_device(n) for n in ("ls", "ds", "lid"))
-    assert (ls, ds, lid) == (1, 2, 3) and wb.wb_robot_get_device("nope") == 0
-    assert wb.wb_robot_get_device_by_index(2) == lid and wb.wb_robot_get_device_by_index(3) == 0
+    assert (ls, ds, lid) == (1, 2, 3) and capsys.readouterr().err == ""
+    assert wb.wb_robot_get_device("nope") == 0                         # Webots warns: a misspelt name shows
+    assert capsys.readouterr().err == 'Warning: wb_robot_get_device(): robot "r1" has no device "nope".\n'
+    assert wb.wb_robot_get_device("") == 0 and "NULL or empty name" in capsys.readouterr().err
+    assert wb.wb_robot_get_device_by_index(2) == lid and capsys.readouterr().err == ""
+    assert wb.wb_robot_get_device_by_index(3) == wb.wb_robot_get_device_by_index(-1) == 0
+    assert capsys.readouterr().err.count("wb_robot_get_device_by_index(): index") == 2
     assert wb.wb_device_get_name(ds) == "ds"
     with pytest.raises(SensoriumError) as err:
         wb.wb_lidar_get_fov(ls)

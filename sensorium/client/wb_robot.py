@@ -644,13 +644,25 @@ def wb_robot_get_number_of_devices() -> int:
 
 
 def wb_robot_get_device(name: str) -> int:
-    """The device's tag, 0 if the robot has no such device."""
-    return current().tag_of(name)
+    """The device's tag; 0, with a warning as in Webots, if the robot has no such device."""
+    r = current()
+    if not isinstance(name, str) or not name:
+        print(f"Error: wb_robot_get_device() called with a NULL or empty name ({name!r}).", file=sys.stderr)
+        return 0
+    tag = r.tag_of(name)
+    if tag == 0:
+        print(f'Warning: wb_robot_get_device(): robot "{r.name}" has no device "{name}".', file=sys.stderr)
+    return tag
 
 
 def wb_robot_get_device_by_index(index: int) -> int:
+    """The tag of device ``index`` (Webots' device order); 0, with Webots' error, outside the range."""
     devices = current().devices
-    return devices[index].tag if 0 <= index < len(devices) else 0
+    if isinstance(index, int) and not isinstance(index, bool) and 0 <= index < len(devices):
+        return devices[index].tag
+    print(f"Error: wb_robot_get_device_by_index(): index {index!r} is outside [0, {len(devices) - 1}].",
+          file=sys.stderr)
+    return 0
 
 
 def wb_device_get_name(tag: int) -> str:
