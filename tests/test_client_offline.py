@@ -613,6 +613,35 @@ def test_motor_class(server, monkeypatch, capsys):
         controller.Robot.created = None
 
 
+def test_numpy_scalars_are_numbers_as_in_webots(server, monkeypatch):
+    """An RL policy's actions are numpy float32s and configs hold numpy ints: Webots' ctypes wrappers
+    take them (c_double / c_int convert them), so setVelocity(action[0]), enable(np.int64(32)) and
+    step(np.int64(32)) work; they are sent as plain numbers."""
+    np = pytest.importorskip("numpy")
+    monkeypatch.setenv("SENSORIUM_CONTROLLER_URL", f"{server.endpoint}/r2")
+    try:
+        wb.wb_robot_init()
+        left, ds = wb.wb_robot_get_device(LEFT), wb.wb_robot_get_device("ds")
+        action = np.array([1.5, -0.25], dtype=np.float32)
+        wb.wb_motor_set_position(left, np.float64(np.inf))
+        wb.wb_motor_set_velocity(left, action[0])
+        wb.wb_distance_sensor_enable(ds, np.int64(32))
+        assert wb.wb_distance_sensor_get_sampling_period(ds) == 32
+        assert wb.wb_robot_step(np.int32(32)) == 0
+        sent = _step_args(server)[-1]
+        assert sent == {"duration": 32, "motors": {LEFT: {"position": math.inf, "velocity": 1.5}}}
+        assert type(sent["duration"]) is int and type(sent["motors"][LEFT]["velocity"]) is float
+        wb.wb_motor_set_position(left, action[1])
+        assert wb.wb_motor_get_target_position(left) == -0.25
+        for bad in (np.bool_(True), "1.5", None):
+            with pytest.raises(SensoriumError):
+                wb.wb_motor_set_velocity(left, bad)
+        with pytest.raises(SensoriumError):
+            wb.wb_robot_step(np.float32(32.5))
+    finally:
+        wb.wb_robot_cleanup()
+
+
 # ====================================================================== topics
 
 def _frames(topic: str, msg_type: str, seq: int, body: dict) -> list[bytes]:

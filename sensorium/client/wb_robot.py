@@ -9,6 +9,7 @@ from __future__ import annotations
 import atexit
 import functools
 import math
+import numbers
 import sys
 from collections import deque
 from collections.abc import Callable
@@ -115,6 +116,27 @@ def _flat_table(table: Any) -> list[float]:
 
 def _float(v: Any, default: float) -> float:
     return default if v is None else float(v)
+
+
+def whole_ms(v: Any) -> int | None:
+    """``v`` as an ``int`` when it is a whole number: an int or a numpy integer (Webots' ctypes
+    ``c_int`` takes both), or an integral float (``step(robot.getBasicTimeStep())``); None otherwise
+    (a bool, a fraction, not a number)."""
+    if isinstance(v, bool):
+        return None
+    if isinstance(v, numbers.Integral):
+        return int(v)
+    if isinstance(v, numbers.Real) and float(v).is_integer():
+        return int(float(v))
+    return None
+
+
+def real(v: Any) -> float | None:
+    """``v`` as a ``float`` when it is a real number (a numpy float32 from an action array too, as
+    Webots' ctypes ``c_double`` takes it); None for a bool or anything else."""
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return None
+    return float(v)
 
 
 class NoValue(Exception):
@@ -260,11 +282,10 @@ class RobotClient:
             return -1
         if duration is None:
             duration = self.basic_time_step
-        if isinstance(duration, bool) or not isinstance(duration, int):
-            if isinstance(duration, float) and float(duration).is_integer():
-                duration = int(duration)
-            else:
-                raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be an integer (ms), got {duration!r}")
+        whole = whole_ms(duration)
+        if whole is None:
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be an integer (ms), got {duration!r}")
+        duration = whole
         if duration < 0:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be >= 0 ms, got {duration}")
         if duration % self.basic_time_step and not self._warned_duration:
@@ -443,11 +464,10 @@ class RobotClient:
             self._expect_success(self.rpc(dev, item, {"value": value}), func)
 
     def enable(self, dev: DeviceState, period: int, func: str) -> None:
-        if isinstance(period, bool) or not isinstance(period, int):
-            if isinstance(period, float) and float(period).is_integer():
-                period = int(period)
-            else:
-                raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer (ms), got {period!r}")
+        whole = whole_ms(period)
+        if whole is None:
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer (ms), got {period!r}")
+        period = whole
         if period < 0:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): negative sampling period {period}")
         self.device_set(dev, "enable", period, func)
@@ -470,9 +490,10 @@ class RobotClient:
     def set_motor_position(self, dev: DeviceState, position: float, func: str) -> None:
         """Webots' ``setPosition``: a target (rad), or ±inf for velocity control; NaN is printed
         and ignored (Webots)."""
-        if isinstance(position, bool) or not isinstance(position, (int, float)):
+        number = real(position)
+        if number is None:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'position' must be a number, got {position!r}")
-        position = float(position)
+        position = number
         if math.isnan(position):
             print(f"Error: {func}() called with an invalid 'position' argument (NaN).", file=sys.stderr)
             return
@@ -482,9 +503,10 @@ class RobotClient:
     def set_motor_velocity(self, dev: DeviceState, velocity: float, func: str) -> None:
         """Webots' ``setVelocity``: clamped to ``maxVelocity`` with Webots' warning; NaN, and a
         negative velocity in position control, are printed and ignored (Webots)."""
-        if isinstance(velocity, bool) or not isinstance(velocity, (int, float)):
+        number = real(velocity)
+        if number is None:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'velocity' must be a number, got {velocity!r}")
-        velocity = float(velocity)
+        velocity = number
         if math.isnan(velocity):
             print(f"Error: {func}() called with an invalid 'velocity' argument (NaN).", file=sys.stderr)
             return
