@@ -160,7 +160,9 @@ def test_a_webots_supervisor_controller_removes_a_solid_and_a_light(tmp_path):
     assert out["gone"] == [True, True, GATE, True]
     nan = [math.nan] * 3                                 # the removed crate, the refused intensity: no traceback
     assert out["refused"] == [pytest.approx(nan, nan_ok=True), pytest.approx(nan[:2], nan_ok=True),
-                              pytest.approx(nan[:2], nan_ok=True), None, 3.0, 0]
+                              pytest.approx(nan[:2], nan_ok=True), None, 3.0, [1.1, -2.0, 0.25], 0]
+    assert "Error: wb_supervisor_field_set_sf_vec3f(): expected 3 numbers, got 2." in ctl.stderr()
+    assert "Error: wb_supervisor_field_set_sf_rotation(): expected 4 numbers, got '0 0 1 0'." in ctl.stderr()
     assert "Error: wb_supervisor_node_get_position(): get_node_pose: node 4 (Solid 'crate') was removed." in ctl.stderr()
     assert ("Error: wb_supervisor_field_set_sf_float(): set_field: PointLight intensity: must be >= 0, got -1.0."
             in ctl.stderr())

@@ -363,21 +363,25 @@ def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
     if r is None:
         return
     assert field is not None
+    # a value of the wrong shape is printed and ignored, as Webots' Python Field does (no exception)
     if want == WB_SF_BOOL:
         wire: Any = bool(value)
     elif want == WB_SF_FLOAT:
         try:
             wire = float(value)
         except (TypeError, ValueError):
-            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected a number, got {value!r}") from None
+            print(f"Error: {func}(): expected a number, got {value!r}.", file=sys.stderr)
+            return
     else:
         n = 4 if want == WB_SF_ROTATION else 3
         try:
             wire = [float(v) for v in value]
         except (TypeError, ValueError):
-            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected {n} numbers, got {value!r}") from None
+            print(f"Error: {func}(): expected {n} numbers, got {value!r}.", file=sys.stderr)
+            return
         if len(wire) != n:
-            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected {n} numbers, got {len(wire)}")
+            print(f"Error: {func}(): expected {n} numbers, got {len(wire)}.", file=sys.stderr)
+            return
     if isinstance(wire, float) and not math.isfinite(wire) or isinstance(wire, list) and \
             not all(math.isfinite(v) for v in wire):
         print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)

@@ -26,6 +26,9 @@ gone = [robot.getFromDef("CRATE") is None, robot.getFromId(crate_id) is None, ro
 # calls on the removed crate and a refused light value: Webots' line and "no value", the controller runs on
 intensity = robot.getFromDef("lamp").getField("intensity")
 intensity.setSFFloat(-1.0)
+gate = robot.getFromDef("GATE").getField("translation")
+gate.setSFVec3f([5.0, 5.0])                 # one number short: Webots' Python prints and ignores it
+robot.getFromDef("GATE").getField("rotation").setSFRotation("0 0 1 0")
 refused = [crate.getPosition(), crate.getOrientation()[:2], crate.getVelocity()[:2], crate.getField("translation"),
-           intensity.getSFFloat(), robot.step(timestep)]
+           intensity.getSFFloat(), gate.getSFVec3f(), robot.step(timestep)]
 print(json.dumps({"before": before, "after": after, "gone": gone, "refused": refused}), flush=True)
