@@ -613,6 +613,16 @@ def test_motor_class(server, monkeypatch, capsys):
         controller.Robot.created = None
 
 
+def test_gps_degrees_minutes_seconds_text_as_the_c_library_also_for_nan():
+    """The C library's text (libController's sprintf of truncated degrees and minutes); a GPS value
+    before its first sample is NaN and must not raise (math.trunc does): the C text again."""
+    convert = wb.wb_gps_convert_to_degrees_minutes_seconds
+    assert convert(46.5202) == "46\u00b0 31\u2032 12.72\u2033"
+    assert convert(-1.5) == "-1\u00b0 -30\u2032 0.00\u2033"
+    assert convert(math.nan) == "nan\u00b0 nan\u2032 nan\u2033"
+    assert convert(math.inf) == "inf\u00b0 -nan\u2032 -nan\u2033"          # glibc prints the NaN's sign
+
+
 def test_numpy_scalars_are_numbers_as_in_webots(server, monkeypatch):
     """An RL policy's actions are numpy float32s and configs hold numpy ints: Webots' ctypes wrappers
     take them (c_double / c_int convert them), so setVelocity(action[0]), enable(np.int64(32)) and
