@@ -72,7 +72,7 @@ def cbin(tmp_path_factory) -> dict[str, str]:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
         out[name] = str(exe)
-    for name in ("braitenberg_cpp", "supervisor_cpp", "vehicle_cpp"):  # the header-only C++ layer
+    for name in ("braitenberg_cpp", "supervisor_cpp", "vehicle_cpp", "camera_cpp"):  # the header-only C++ layer
         exe = build / name
         cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
                f"-I{CLIB / 'include'}", str(TESTS_C / f"{name}.cpp"), "-o", str(exe), str(build / "libController.a"),
@@ -554,6 +554,18 @@ def test_supervisor_through_the_cpp_classes(cbin, servers):
     assert lines[2] == "0 1 nan 0 0 NULL 0"                               # no contact points, no robot window
     assert lines[3] == "1 1 SFVec3f -1 1 1"       # getSelected unserved, getType served; one Field object per field
     assert lines[4] == "6 PointLight buddy Group PointLight 0 1"    # rover, buddy, 3 solids, the lamp
+
+
+def test_webots_cpp_camera_and_range_finder_names(cbin, servers):
+    """tests/c/camera_cpp.cpp: Webots' C++ Camera::imageGetRed/…/imageGetGrey, getRecognition*,
+    RangeFinder::rangeImageGetDepth and Robot::getProjectPath/getWorldPath/getUrdf compile and answer
+    as the C functions do; the centre depth pixel sees the crate's face 1 m away."""
+    lines = run([cbin["camera_cpp"]], servers(REMOVE_WORLD).url("boss"))
+    assert lines[0] == "depth 1 1"
+    assert lines[1] == "pixel 1 1"
+    period, n, same, first, segmentation = (int(v) for v in lines[2].split()[1:])
+    assert (period, same, segmentation) == (16, 1, 0) and n >= 1 and first > 0
+    assert lines[3] == "paths [] [] []"
 
 
 def test_c_client_replays_the_conformance_session(cbin, servers):
