@@ -32,7 +32,7 @@ robot.getFromDef("GATE").getField("rotation").setSFRotation("0 0 1 0")
 wall = robot.getFromDef("wall").getField("translation")
 wall.value = [3.2, 0.0, 0.25]               # Webots' Field.value setter: the SFVec3f setter
 children.value = []                         # an MF field is not set this way: one line
-moved = [wall.value, robot.getFromDef("wall").getPosition(), children.getCount()]
+moved = [wall.value, robot.getFromDef("wall").getPosition(), children.getCount(), children.count, wall.type_name]
 refused = [crate.getPosition(), crate.getOrientation()[:2], crate.getVelocity()[:2], crate.getField("translation"),
            intensity.getSFFloat(), gate.getSFVec3f(), robot.step(timestep)]
 print(json.dumps({"before": before, "after": after, "gone": gone, "refused": refused, "moved": moved}), flush=True)

@@ -91,6 +91,8 @@ class Field:
 
     name = property(getName)
     type = property(getType)
+    type_name = property(getTypeName)
+    count = property(getCount)
 
     _SETTERS = {wb.WB_SF_BOOL: "setSFBool", wb.WB_SF_FLOAT: "setSFFloat", wb.WB_SF_STRING: "setSFString",
                 wb.WB_SF_VEC3F: "setSFVec3f", wb.WB_SF_ROTATION: "setSFRotation", wb.WB_SF_COLOR: "setSFColor"}
