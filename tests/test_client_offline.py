@@ -425,6 +425,14 @@ def test_flat_lidar(global_robot, capsys):
     assert wb.wb_lidar_get_frequency(lid) == 12.5 and global_robot.robots["r1"]["lid"].frequency == 12.5
     with pytest.raises(SensoriumError):
         wb.wb_lidar_set_frequency(lid, 30.0)
+    # numpy scalars (an index or a rate from an array) are numbers here, as Webots' ctypes takes them
+    assert wb.wb_lidar_get_layer_range_image(lid, np.int64(1)).tolist() == img[COLUMNS:].tolist()
+    wb.wb_lidar_set_frequency(lid, np.float32(10.0))
+    assert wb.wb_lidar_get_frequency(lid) == 10.0 and type(global_robot.robots["r1"]["lid"].frequency) is float
+    with pytest.raises(SensoriumError):
+        wb.wb_lidar_get_layer_range_image(lid, 1.0)                   # a layer is an integer
+    wb.wb_keyboard_enable(np.int32(32))
+    assert wb.wb_keyboard_get_sampling_period() == 32
     wb.wb_lidar_disable_point_cloud(lid)
     assert wb.wb_lidar_get_point_cloud(lid) is None
 

@@ -131,6 +131,11 @@ def whole_ms(v: Any) -> int | None:
     return None
 
 
+def integer(v: Any) -> int | None:
+    """``v`` as an ``int`` when it is an integer (a numpy integer too); None otherwise (a bool, a float)."""
+    return int(v) if isinstance(v, numbers.Integral) and not isinstance(v, bool) else None
+
+
 def real(v: Any) -> float | None:
     """``v`` as a ``float`` when it is a real number (a numpy float32 from an action array too, as
     Webots' ctypes ``c_double`` takes it); None for a bool or anything else."""
@@ -481,10 +486,11 @@ class RobotClient:
 
     def set_frequency(self, dev: DeviceState, frequency: float, func: str) -> None:
         lo, hi = self.constant(dev, "min_frequency"), self.constant(dev, "max_frequency")
-        if not (isinstance(frequency, (int, float)) and lo <= frequency <= hi):
+        number = real(frequency)
+        if number is None or not lo <= number <= hi:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): frequency {frequency!r} outside [{lo:g}, {hi:g}] Hz")
-        self.device_set(dev, "set_frequency", float(frequency), func)
-        dev._consts["frequency"] = float(frequency)
+        self.device_set(dev, "set_frequency", number, func)
+        dev._consts["frequency"] = number
 
     # -- motors: buffered, sent with the next step request
     def set_motor_position(self, dev: DeviceState, position: float, func: str) -> None:
@@ -736,10 +742,11 @@ def wb_robot_get_type() -> str:
 # ---------------------------------------------------------------------- keyboard (no key is ever pressed)
 
 def wb_keyboard_enable(sampling_period: int) -> None:
-    if isinstance(sampling_period, bool) or not isinstance(sampling_period, int) or sampling_period < 0:
+    period = whole_ms(sampling_period)
+    if period is None or period < 0:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT,
                              f"wb_keyboard_enable(): sampling period must be an integer >= 0 (ms), got {sampling_period!r}")
-    current().keyboard_period = sampling_period
+    current().keyboard_period = period
 
 
 def wb_keyboard_disable() -> None:
