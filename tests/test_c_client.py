@@ -514,6 +514,7 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     key, *vals = out[3].split()
     assert key == "reset" and [float(v) for v in vals] == pytest.approx([3.0, 5], abs=1e-9)
     assert out[4] == "removed_pose nan nan nan nan nan nan"          # Webots' NaNs, never NULL
+    assert out[5] == "custom_data []"                                   # the reset restored the world's (none)
     assert ("Error: wb_supervisor_node_get_position(): INVALID_ARGUMENT: get_node_pose: node 4 (Solid 'crate') was "
             "removed") in err
     assert "Error: wb_supervisor_node_get_orientation() called with a NULL or invalid 'node' argument." in err
