@@ -72,7 +72,7 @@ def cbin(tmp_path_factory) -> dict[str, str]:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
         out[name] = str(exe)
-    for name in ("braitenberg_cpp", "supervisor_cpp", "vehicle_cpp"):  # the header-only C++ layer
+    for name in ("braitenberg_cpp", "supervisor_cpp", "vehicle_cpp", "camera_cpp"):  # the header-only C++ layer
         exe = build / name
         cmd = ["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
                f"-I{CLIB / 'include'}", str(TESTS_C / f"{name}.cpp"), "-o", str(exe), str(build / "libController.a"),
@@ -412,6 +412,8 @@ def test_every_getter_matches_the_python_client(cbin, servers):
         assert got["error.bad_tag_value"] == got["error.bad_tag_name"] == got["error.wrong_kind"] == "1"
         assert got["error.bad_step"] == "-1" and got["robot.step"] == "0"
         assert "step duration must be >= 0 ms" in err and "invalid device tag 9999" in err
+        assert f'Warning: wb_robot_get_device(): robot "{robot}" has no device "no such device".' in err
+        assert f"Error: wb_robot_get_device_by_index(): index {want['robot.number_of_devices']} is outside" in err
         assert float(got["robot.time_after"]) * 1000 == pytest.approx(want["robot.basic_time_step"])
         begun, again, status, t = got["pipelined"].split(",")          # a second step_begin is refused
         assert (begun, again, status) == ("0", "-1", "0") and float(t) * 1000 == pytest.approx(2 * want["robot.basic_time_step"])
@@ -511,6 +513,11 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     assert out[2] == "gone 4 1 1 5"
     key, *vals = out[3].split()
     assert key == "reset" and [float(v) for v in vals] == pytest.approx([3.0, 5], abs=1e-9)
+    assert out[4] == "removed_pose nan nan nan nan nan nan"          # Webots' NaNs, never NULL
+    assert out[5] == "custom_data []"                                   # the reset restored the world's (none)
+    assert ("Error: wb_supervisor_node_get_position(): INVALID_ARGUMENT: get_node_pose: node 4 (Solid 'crate') was "
+            "removed") in err
+    assert "Error: wb_supervisor_node_get_orientation() called with a NULL or invalid 'node' argument." in err
     assert ("Error: wb_supervisor_node_remove(): INVALID_ARGUMENT: remove_node: robot 'rover' (node 2) cannot be "
             "removed here") in err
     assert "Error: wb_supervisor_node_remove(): INVALID_ARGUMENT: remove_node: the root node cannot be removed" in err
@@ -548,6 +555,18 @@ def test_supervisor_through_the_cpp_classes(cbin, servers):
     assert lines[2] == "0 1 nan 0 0 NULL 0"                               # no contact points, no robot window
     assert lines[3] == "1 1 SFVec3f -1 1 1"       # getSelected unserved, getType served; one Field object per field
     assert lines[4] == "6 PointLight buddy Group PointLight 0 1"    # rover, buddy, 3 solids, the lamp
+
+
+def test_webots_cpp_camera_and_range_finder_names(cbin, servers):
+    """tests/c/camera_cpp.cpp: Webots' C++ Camera::imageGetRed/…/imageGetGrey, getRecognition*,
+    RangeFinder::rangeImageGetDepth and Robot::getProjectPath/getWorldPath/getUrdf compile and answer
+    as the C functions do; the centre depth pixel sees the crate's face 1 m away."""
+    lines = run([cbin["camera_cpp"]], servers(REMOVE_WORLD).url("boss"))
+    assert lines[0] == "depth 1 1"
+    assert lines[1] == "pixel 1 1"
+    period, n, same, first, segmentation = (int(v) for v in lines[2].split()[1:])
+    assert (period, same, segmentation) == (16, 1, 0) and n >= 1 and first > 0
+    assert lines[3] == "paths [] [] []"
 
 
 def test_c_client_replays_the_conformance_session(cbin, servers):

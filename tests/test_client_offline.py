@@ -354,8 +354,13 @@ def test_flat_api(global_robot, capsys):
     assert wb.wb_robot_get_name() == "r1" and wb.wb_robot_get_basic_time_step() == 32.0
     assert wb.wb_robot_get_number_of_devices() == 3
     ls, ds, lid = (wb.wb_robot_get_device(n) for n in ("ls", "ds", "lid"))
-    assert (ls, ds, lid) == (1, 2, 3) and wb.wb_robot_get_device("nope") == 0
-    assert wb.wb_robot_get_device_by_index(2) == lid and wb.wb_robot_get_device_by_index(3) == 0
+    assert (ls, ds, lid) == (1, 2, 3) and capsys.readouterr().err == ""
+    assert wb.wb_robot_get_device("nope") == 0                         # Webots warns: a misspelt name shows
+    assert capsys.readouterr().err == 'Warning: wb_robot_get_device(): robot "r1" has no device "nope".\n'
+    assert wb.wb_robot_get_device("") == 0 and "NULL or empty name" in capsys.readouterr().err
+    assert wb.wb_robot_get_device_by_index(2) == lid and capsys.readouterr().err == ""
+    assert wb.wb_robot_get_device_by_index(3) == wb.wb_robot_get_device_by_index(-1) == 0
+    assert capsys.readouterr().err.count("wb_robot_get_device_by_index(): index") == 2
     assert wb.wb_device_get_name(ds) == "ds"
     with pytest.raises(SensoriumError) as err:
         wb.wb_lidar_get_fov(ls)
@@ -420,6 +425,14 @@ def test_flat_lidar(global_robot, capsys):
     assert wb.wb_lidar_get_frequency(lid) == 12.5 and global_robot.robots["r1"]["lid"].frequency == 12.5
     with pytest.raises(SensoriumError):
         wb.wb_lidar_set_frequency(lid, 30.0)
+    # numpy scalars (an index or a rate from an array) are numbers here, as Webots' ctypes takes them
+    assert wb.wb_lidar_get_layer_range_image(lid, np.int64(1)).tolist() == img[COLUMNS:].tolist()
+    wb.wb_lidar_set_frequency(lid, np.float32(10.0))
+    assert wb.wb_lidar_get_frequency(lid) == 10.0 and type(global_robot.robots["r1"]["lid"].frequency) is float
+    with pytest.raises(SensoriumError):
+        wb.wb_lidar_get_layer_range_image(lid, 1.0)                   # a layer is an integer
+    wb.wb_keyboard_enable(np.int32(32))
+    assert wb.wb_keyboard_get_sampling_period() == 32
     wb.wb_lidar_disable_point_cloud(lid)
     assert wb.wb_lidar_get_point_cloud(lid) is None
 
@@ -606,6 +619,45 @@ def test_motor_class(server, monkeypatch, capsys):
     finally:
         wb.wb_robot_cleanup()
         controller.Robot.created = None
+
+
+def test_gps_degrees_minutes_seconds_text_as_the_c_library_also_for_nan():
+    """The C library's text (libController's sprintf of truncated degrees and minutes); a GPS value
+    before its first sample is NaN and must not raise (math.trunc does): the C text again."""
+    convert = wb.wb_gps_convert_to_degrees_minutes_seconds
+    assert convert(46.5202) == "46\u00b0 31\u2032 12.72\u2033"
+    assert convert(-1.5) == "-1\u00b0 -30\u2032 0.00\u2033"
+    assert convert(math.nan) == "nan\u00b0 nan\u2032 nan\u2033"
+    assert convert(math.inf) == "inf\u00b0 -nan\u2032 -nan\u2033"          # glibc prints the NaN's sign
+
+
+def test_numpy_scalars_are_numbers_as_in_webots(server, monkeypatch):
+    """An RL policy's actions are numpy float32s and configs hold numpy ints: Webots' ctypes wrappers
+    take them (c_double / c_int convert them), so setVelocity(action[0]), enable(np.int64(32)) and
+    step(np.int64(32)) work; they are sent as plain numbers."""
+    np = pytest.importorskip("numpy")
+    monkeypatch.setenv("SENSORIUM_CONTROLLER_URL", f"{server.endpoint}/r2")
+    try:
+        wb.wb_robot_init()
+        left, ds = wb.wb_robot_get_device(LEFT), wb.wb_robot_get_device("ds")
+        action = np.array([1.5, -0.25], dtype=np.float32)
+        wb.wb_motor_set_position(left, np.float64(np.inf))
+        wb.wb_motor_set_velocity(left, action[0])
+        wb.wb_distance_sensor_enable(ds, np.int64(32))
+        assert wb.wb_distance_sensor_get_sampling_period(ds) == 32
+        assert wb.wb_robot_step(np.int32(32)) == 0
+        sent = _step_args(server)[-1]
+        assert sent == {"duration": 32, "motors": {LEFT: {"position": math.inf, "velocity": 1.5}}}
+        assert type(sent["duration"]) is int and type(sent["motors"][LEFT]["velocity"]) is float
+        wb.wb_motor_set_position(left, action[1])
+        assert wb.wb_motor_get_target_position(left) == -0.25
+        for bad in (np.bool_(True), "1.5", None):
+            with pytest.raises(SensoriumError):
+                wb.wb_motor_set_velocity(left, bad)
+        with pytest.raises(SensoriumError):
+            wb.wb_robot_step(np.float32(32.5))
+    finally:
+        wb.wb_robot_cleanup()
 
 
 # ====================================================================== topics

@@ -158,6 +158,16 @@ def test_a_webots_supervisor_controller_removes_a_solid_and_a_light(tmp_path):
     assert out["before"] == [pytest.approx(1.0, abs=1e-9), pytest.approx(7.0), 7]
     assert out["after"] == [pytest.approx(3.0, abs=1e-9), pytest.approx(3.0), 5]
     assert out["gone"] == [True, True, GATE, True]
+    nan = [math.nan] * 3                                 # the removed crate, the refused intensity: no traceback
+    assert out["refused"] == [pytest.approx(nan, nan_ok=True), pytest.approx(nan[:2], nan_ok=True),
+                              pytest.approx(nan[:2], nan_ok=True), None, 3.0, [1.1, -2.0, 0.25], 0]
+    assert out["moved"] == [[3.2, 0.0, 0.25], [3.2, 0.0, 0.25], 5, 5, "SFVec3f"]
+    assert "Error: Field.value: the MFNode field 'children' cannot be set as a whole." in ctl.stderr()
+    assert "Error: wb_supervisor_field_set_sf_vec3f(): expected 3 numbers, got 2." in ctl.stderr()
+    assert "Error: wb_supervisor_field_set_sf_rotation(): expected 4 numbers, got '0 0 1 0'." in ctl.stderr()
+    assert "Error: wb_supervisor_node_get_position(): get_node_pose: node 4 (Solid 'crate') was removed." in ctl.stderr()
+    assert ("Error: wb_supervisor_field_set_sf_float(): set_field: PointLight intensity: must be >= 0, got -1.0."
+            in ctl.stderr())
     assert ("Error: wb_supervisor_node_remove(): remove_node: robot 'rover' (node 2) cannot be removed here: only "
             "top-level solids and lights can (a departure from Webots, which removes robots too).") in ctl.stderr()
 

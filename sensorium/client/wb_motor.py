@@ -18,6 +18,7 @@ from sensorium.client.wb_robot import (
     _float,
     answers,
     current,
+    integer,
 )
 
 _NAN = math.nan
@@ -231,8 +232,10 @@ def wb_led_set(tag: int, value: int) -> None:
     is printed and ignored (Webots)."""
     r = current()
     dev = _led(tag, "wb_led_set")
-    if isinstance(value, bool) or not isinstance(value, int):
+    whole = integer(value)
+    if whole is None:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_led_set(): value must be an integer, got {value!r}")
+    value = whole
     colors = len(dev.desc.get("color", [])) // 3
     hi = 0xFFFFFF if dev.desc.get("gradual") else colors
     if not 0 <= value <= hi:

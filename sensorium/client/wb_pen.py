@@ -16,7 +16,7 @@ import math
 import sys
 
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import DeviceState, current
+from sensorium.client.wb_robot import DeviceState, current, integer, real
 
 PEN = "Pen"
 
@@ -48,10 +48,13 @@ def wb_pen_write(tag: int, write: bool) -> None:
 def wb_pen_set_ink_color(tag: int, color: int, density: float) -> None:
     """The ink from the next basic step: ``color`` 0xRRGGBB, ``density`` 0 (transparent) to 1 (opaque)."""
     func = "wb_pen_set_ink_color"
-    if isinstance(color, bool) or not isinstance(color, int):
+    rgb = integer(color)
+    if rgb is None:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): color must be an integer 0xRRGGBB, got {color!r}")
-    if isinstance(density, bool) or not isinstance(density, (int, float)):
+    amount = real(density)
+    if amount is None:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): density must be a number, got {density!r}")
+    color, density = rgb, amount
     dev = _pen(tag, func)
     r = current()
     if dev is None or r.terminated:

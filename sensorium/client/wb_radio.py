@@ -17,7 +17,16 @@ import sys
 from typing import Any
 
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import EMITTER, RECEIVER, DeviceState, current, sensor_enable, sensor_period
+from sensorium.client.wb_robot import (
+    EMITTER,
+    RECEIVER,
+    DeviceState,
+    current,
+    integer,
+    real,
+    sensor_enable,
+    sensor_period,
+)
 
 
 def _emitter(tag: int, func: str) -> DeviceState:
@@ -29,7 +38,7 @@ def _receiver(tag: int, func: str) -> DeviceState:
 
 
 def _allowed(dev: DeviceState, channel: int, func: str) -> bool:
-    if isinstance(channel, bool) or not isinstance(channel, int) or channel < -1:
+    if integer(channel) is None or channel < -1:
         print(f"Error: {func}() called with an invalid channel={channel}. Please use a channel inside the range "
               "[-1,inf).", file=sys.stderr)
         return False
@@ -73,7 +82,7 @@ def wb_emitter_get_buffer_size(tag: int) -> int:
 def wb_emitter_set_channel(tag: int, channel: int) -> None:
     dev = _emitter(tag, "wb_emitter_set_channel")
     if _allowed(dev, channel, "wb_emitter_set_channel"):
-        dev.channel = channel
+        dev.channel = int(channel)
 
 
 def wb_emitter_get_channel(tag: int) -> int:
@@ -83,9 +92,11 @@ def wb_emitter_get_channel(tag: int) -> int:
 def wb_emitter_set_range(tag: int, range: float) -> None:  # noqa: A002 - Webots' parameter name
     """-1 (or more than ``maxRange``) sets ``maxRange``; other negative values are refused."""
     dev = _emitter(tag, "wb_emitter_set_range")
-    if isinstance(range, bool) or not isinstance(range, (int, float)) or (range < 0.0 and range != -1.0) or math.isnan(range):
+    number = real(range)
+    if number is None or (number < 0.0 and number != -1.0) or math.isnan(number):
         print(f"Error: wb_emitter_set_range(): invalid range={range} argument.", file=sys.stderr)
         return
+    range = number
     cap = float(dev.desc.get("max_range", -1.0))
     if range == -1.0:
         dev.range = cap
@@ -118,6 +129,7 @@ def wb_receiver_set_channel(tag: int, channel: int) -> None:
     dev = _receiver(tag, "wb_receiver_set_channel")
     if channel == dev.channel or not _allowed(dev, channel, "wb_receiver_set_channel"):
         return
+    channel = int(channel)
     r.device_set(dev, "set_channel", channel, "wb_receiver_set_channel")
     dev.channel = channel
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import atexit
 import functools
 import math
+import numbers
 import sys
 from collections import deque
 from collections.abc import Callable
@@ -115,6 +116,32 @@ def _flat_table(table: Any) -> list[float]:
 
 def _float(v: Any, default: float) -> float:
     return default if v is None else float(v)
+
+
+def whole_ms(v: Any) -> int | None:
+    """``v`` as an ``int`` when it is a whole number: an int or a numpy integer (Webots' ctypes
+    ``c_int`` takes both), or an integral float (``step(robot.getBasicTimeStep())``); None otherwise
+    (a bool, a fraction, not a number)."""
+    if isinstance(v, bool):
+        return None
+    if isinstance(v, numbers.Integral):
+        return int(v)
+    if isinstance(v, numbers.Real) and float(v).is_integer():
+        return int(float(v))
+    return None
+
+
+def integer(v: Any) -> int | None:
+    """``v`` as an ``int`` when it is an integer (a numpy integer too); None otherwise (a bool, a float)."""
+    return int(v) if isinstance(v, numbers.Integral) and not isinstance(v, bool) else None
+
+
+def real(v: Any) -> float | None:
+    """``v`` as a ``float`` when it is a real number (a numpy float32 from an action array too, as
+    Webots' ctypes ``c_double`` takes it); None for a bool or anything else."""
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return None
+    return float(v)
 
 
 class NoValue(Exception):
@@ -260,11 +287,10 @@ class RobotClient:
             return -1
         if duration is None:
             duration = self.basic_time_step
-        if isinstance(duration, bool) or not isinstance(duration, int):
-            if isinstance(duration, float) and float(duration).is_integer():
-                duration = int(duration)
-            else:
-                raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be an integer (ms), got {duration!r}")
+        whole = whole_ms(duration)
+        if whole is None:
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be an integer (ms), got {duration!r}")
+        duration = whole
         if duration < 0:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"step duration must be >= 0 ms, got {duration}")
         if duration % self.basic_time_step and not self._warned_duration:
@@ -443,11 +469,10 @@ class RobotClient:
             self._expect_success(self.rpc(dev, item, {"value": value}), func)
 
     def enable(self, dev: DeviceState, period: int, func: str) -> None:
-        if isinstance(period, bool) or not isinstance(period, int):
-            if isinstance(period, float) and float(period).is_integer():
-                period = int(period)
-            else:
-                raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer (ms), got {period!r}")
+        whole = whole_ms(period)
+        if whole is None:
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period must be an integer (ms), got {period!r}")
+        period = whole
         if period < 0:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): negative sampling period {period}")
         self.device_set(dev, "enable", period, func)
@@ -461,18 +486,20 @@ class RobotClient:
 
     def set_frequency(self, dev: DeviceState, frequency: float, func: str) -> None:
         lo, hi = self.constant(dev, "min_frequency"), self.constant(dev, "max_frequency")
-        if not (isinstance(frequency, (int, float)) and lo <= frequency <= hi):
+        number = real(frequency)
+        if number is None or not lo <= number <= hi:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): frequency {frequency!r} outside [{lo:g}, {hi:g}] Hz")
-        self.device_set(dev, "set_frequency", float(frequency), func)
-        dev._consts["frequency"] = float(frequency)
+        self.device_set(dev, "set_frequency", number, func)
+        dev._consts["frequency"] = number
 
     # -- motors: buffered, sent with the next step request
     def set_motor_position(self, dev: DeviceState, position: float, func: str) -> None:
         """Webots' ``setPosition``: a target (rad), or ±inf for velocity control; NaN is printed
         and ignored (Webots)."""
-        if isinstance(position, bool) or not isinstance(position, (int, float)):
+        number = real(position)
+        if number is None:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'position' must be a number, got {position!r}")
-        position = float(position)
+        position = number
         if math.isnan(position):
             print(f"Error: {func}() called with an invalid 'position' argument (NaN).", file=sys.stderr)
             return
@@ -482,9 +509,10 @@ class RobotClient:
     def set_motor_velocity(self, dev: DeviceState, velocity: float, func: str) -> None:
         """Webots' ``setVelocity``: clamped to ``maxVelocity`` with Webots' warning; NaN, and a
         negative velocity in position control, are printed and ignored (Webots)."""
-        if isinstance(velocity, bool) or not isinstance(velocity, (int, float)):
+        number = real(velocity)
+        if number is None:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'velocity' must be a number, got {velocity!r}")
-        velocity = float(velocity)
+        velocity = number
         if math.isnan(velocity):
             print(f"Error: {func}() called with an invalid 'velocity' argument (NaN).", file=sys.stderr)
             return
@@ -644,13 +672,25 @@ def wb_robot_get_number_of_devices() -> int:
 
 
 def wb_robot_get_device(name: str) -> int:
-    """The device's tag, 0 if the robot has no such device."""
-    return current().tag_of(name)
+    """The device's tag; 0, with a warning as in Webots, if the robot has no such device."""
+    r = current()
+    if not isinstance(name, str) or not name:
+        print(f"Error: wb_robot_get_device() called with a NULL or empty name ({name!r}).", file=sys.stderr)
+        return 0
+    tag = r.tag_of(name)
+    if tag == 0:
+        print(f'Warning: wb_robot_get_device(): robot "{r.name}" has no device "{name}".', file=sys.stderr)
+    return tag
 
 
 def wb_robot_get_device_by_index(index: int) -> int:
+    """The tag of device ``index`` (Webots' device order); 0, with Webots' error, outside the range."""
     devices = current().devices
-    return devices[index].tag if 0 <= index < len(devices) else 0
+    if isinstance(index, int) and not isinstance(index, bool) and 0 <= index < len(devices):
+        return devices[index].tag
+    print(f"Error: wb_robot_get_device_by_index(): index {index!r} is outside [0, {len(devices) - 1}].",
+          file=sys.stderr)
+    return 0
 
 
 def wb_device_get_name(tag: int) -> str:
@@ -702,10 +742,11 @@ def wb_robot_get_type() -> str:
 # ---------------------------------------------------------------------- keyboard (no key is ever pressed)
 
 def wb_keyboard_enable(sampling_period: int) -> None:
-    if isinstance(sampling_period, bool) or not isinstance(sampling_period, int) or sampling_period < 0:
+    period = whole_ms(sampling_period)
+    if period is None or period < 0:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT,
                              f"wb_keyboard_enable(): sampling period must be an integer >= 0 (ms), got {sampling_period!r}")
-    current().keyboard_period = sampling_period
+    current().keyboard_period = period
 
 
 def wb_keyboard_disable() -> None:

@@ -16,6 +16,7 @@ from sensorium.client.wb_robot import (
     DeviceState,
     RobotClient,
     current,
+    integer,
     sensor_enable,
     sensor_period,
     sensor_reading,
@@ -113,9 +114,10 @@ def _lidar_constant(tag: int, key: str, func: str) -> Any:
 
 def _check_layer(r: RobotClient, dev: DeviceState, layer: int, func: str) -> int:
     layers = r.constant(dev, "number_of_layers")
-    if isinstance(layer, bool) or not isinstance(layer, int) or not 0 <= layer < layers:
+    index = integer(layer)
+    if index is None or not 0 <= index < layers:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): layer {layer!r} outside [0, {layers - 1}]")
-    return layer
+    return index
 
 
 def wb_lidar_enable(tag: int, sampling_period: int) -> None:

@@ -62,6 +62,19 @@ def _call(r: RobotClient, item: str, args: dict | None = None) -> dict:
     return r.conn.call(f"/{r.name}/robot/{item}", args)
 
 
+def _answer(r: RobotClient, item: str, args: dict | None, func: str) -> dict | None:
+    """The server's answer, or None after its line when it refuses the request (a removed node, a
+    light's value out of its range, a zero rotation axis): Webots prints and answers its "no value"
+    there, it does not stop the controller."""
+    try:
+        return _call(r, item, args)
+    except SensoriumError as err:
+        if err.code != ErrorCode.INVALID_ARGUMENT:
+            raise
+        print(f"Error: {func}(): {err.message}.", file=sys.stderr)
+        return None
+
+
 def _node_id(reply: dict) -> int | None:
     """A NodeResult's node id, None for Webots' NULL (type '')."""
     return int(reply["node"]) if reply.get("type") else None
@@ -159,7 +172,7 @@ def wb_supervisor_node_get_parent_node(node: int | None) -> int | None:
 
 def _node_pose(node: int | None, func: str) -> dict | None:
     r = _checked_node(node, func)
-    return None if r is None else _call(r, "get_node_pose", {"node": int(node)})  # type: ignore[arg-type]
+    return None if r is None else _answer(r, "get_node_pose", {"node": int(node)}, func)  # type: ignore[arg-type]
 
 
 def wb_supervisor_node_get_position(node: int | None) -> list[float]:
@@ -177,10 +190,10 @@ def wb_supervisor_node_get_orientation(node: int | None) -> list[float]:
 def wb_supervisor_node_get_velocity(node: int | None) -> list[float]:
     """Linear (m/s) then angular (rad/s) velocity in world axes: a driven robot's from its last step,
     zeros for anything else (nothing else moves by itself here)."""
-    r = _checked_node(node, "wb_supervisor_node_get_velocity")
-    if r is None:
-        return [math.nan] * 6
-    return [float(v) for v in _call(r, "get_node_velocity", {"node": int(node)})["value"]]  # type: ignore[arg-type]
+    func = "wb_supervisor_node_get_velocity"
+    r = _checked_node(node, func)
+    got = None if r is None else _answer(r, "get_node_velocity", {"node": int(node)}, func)  # type: ignore[arg-type]
+    return [math.nan] * 6 if got is None else [float(v) for v in got["value"]]
 
 
 def wb_supervisor_node_remove(node: int | None) -> None:
@@ -235,7 +248,9 @@ def wb_supervisor_node_get_field(node: int | None, field_name: str) -> Field | N
     if not isinstance(field_name, str) or not field_name or len(field_name) > 64:
         print(f"Error: {func}() called with a NULL, empty or invalid 'field_name' argument.", file=sys.stderr)
         return None
-    got = _call(r, "get_field", {"node": int(node), "field": field_name})  # type: ignore[arg-type]
+    got = _answer(r, "get_field", {"node": int(node), "field": field_name}, func)  # type: ignore[arg-type]
+    if got is None:
+        return None
     if not got["type"]:
         print(f"Error: {func}(): node {node} has no field {field_name!r} in Sensorium (README \"Supervisor\" "
               f"lists the fields of each node kind).", file=sys.stderr)
@@ -276,7 +291,8 @@ def _field_value(field: Field | None, want: int | None, func: str) -> Any:
     if r is None:
         return None
     assert field is not None
-    return _call(r, "get_field", {"node": field[0], "field": field[1]})["value"]
+    got = _answer(r, "get_field", {"node": field[0], "field": field[1]}, func)
+    return None if got is None else got["value"]
 
 
 def wb_supervisor_field_get_count(field: Field | None) -> int:
@@ -290,7 +306,8 @@ def wb_supervisor_field_get_count(field: Field | None) -> int:
         return -1
     if not field[2] & WB_MF:
         return -1
-    return len(_call(r, "get_field", {"node": field[0], "field": field[1]})["value"])
+    got = _answer(r, "get_field", {"node": field[0], "field": field[1]}, func)
+    return -1 if got is None else len(got["value"])
 
 
 def wb_supervisor_field_get_sf_bool(field: Field | None) -> bool:
@@ -346,26 +363,30 @@ def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
     if r is None:
         return
     assert field is not None
+    # a value of the wrong shape is printed and ignored, as Webots' Python Field does (no exception)
     if want == WB_SF_BOOL:
         wire: Any = bool(value)
     elif want == WB_SF_FLOAT:
         try:
             wire = float(value)
         except (TypeError, ValueError):
-            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected a number, got {value!r}") from None
+            print(f"Error: {func}(): expected a number, got {value!r}.", file=sys.stderr)
+            return
     else:
         n = 4 if want == WB_SF_ROTATION else 3
         try:
             wire = [float(v) for v in value]
         except (TypeError, ValueError):
-            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected {n} numbers, got {value!r}") from None
+            print(f"Error: {func}(): expected {n} numbers, got {value!r}.", file=sys.stderr)
+            return
         if len(wire) != n:
-            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): expected {n} numbers, got {len(wire)}")
+            print(f"Error: {func}(): expected {n} numbers, got {len(wire)}.", file=sys.stderr)
+            return
     if isinstance(wire, float) and not math.isfinite(wire) or isinstance(wire, list) and \
             not all(math.isfinite(v) for v in wire):
         print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
         return
-    _call(r, "set_field", {"node": field[0], "field": field[1], "value": wire})
+    _answer(r, "set_field", {"node": field[0], "field": field[1], "value": wire}, func)
 
 
 def wb_supervisor_field_set_sf_bool(field: Field | None, value: bool) -> None:

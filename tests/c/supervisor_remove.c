@@ -1,6 +1,6 @@
 /* A Webots-style C supervisor removing nodes (tests/worlds/supervisor_remove.yaml, its closed forms):
  * the distance sensor reads the crate, then the wall behind it once the crate is removed; the light
- * sensor loses the bulb's term; the removed nodes answer NULL; a robot and the root are refused.
+ * sensor loses the bulb's term; the removed nodes answer NULL (their poses NaN); a robot and the root are refused.
  * Prints "key values" lines for tests/test_c_client.py. */
 #include <stdio.h>
 
@@ -33,9 +33,15 @@ int main(void) {
   wb_supervisor_node_remove(wb_supervisor_node_get_from_def("rover")); /* refused: one line */
   wb_supervisor_node_remove(wb_supervisor_node_get_root());            /* refused: one line */
   wb_supervisor_node_remove(NULL);                                     /* Webots' NULL line */
+  wb_robot_set_custom_data("changed");                                 /* the reset restores it */
   wb_supervisor_simulation_reset();
   wb_robot_step(dt);
   printf("reset %.17g %d\n", wb_distance_sensor_get_value(ds), wb_supervisor_field_get_count(children));
+  /* Webots never answers NULL for a pose: a removed or NULL node reads NaNs (and gets one line) */
+  const double *p = wb_supervisor_node_get_position(crate), *o = wb_supervisor_node_get_orientation(crate);
+  const double *q = wb_supervisor_node_get_position(NULL), *r = wb_supervisor_node_get_orientation(NULL);
+  printf("removed_pose %g %g %g %g %g %g\n", p[0], p[2], o[0], o[8], q[1], r[4]);
+  printf("custom_data [%s]\n", wb_robot_get_custom_data());
   wb_robot_cleanup();
   return 0;
 }

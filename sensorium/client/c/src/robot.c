@@ -627,17 +627,24 @@ int wb_robot_get_number_of_devices(void) { return sn_robot_get("wb_robot_get_num
 
 WbDeviceTag wb_robot_get_device(const char *name) {
   sn_robot *rb = sn_robot_get("wb_robot_get_device");
-  if (name == NULL)
+  if (name == NULL || name[0] == '\0') {
+    fprintf(stderr, "Error: wb_robot_get_device() called with a NULL or empty name.\n");
     return 0;
+  }
   for (int i = 0; i < rb->n_devices; i++)
     if (strcmp(rb->devices[i].name, name) == 0)
       return rb->devices[i].tag;
+  /* Webots warns too: a misspelt name would otherwise only show as a later "invalid device tag 0" */
+  fprintf(stderr, "Warning: wb_robot_get_device(): robot \"%s\" has no device \"%s\".\n", rb->name, name);
   return 0;
 }
 
 WbDeviceTag wb_robot_get_device_by_index(int index) {
   sn_robot *rb = sn_robot_get("wb_robot_get_device_by_index");
-  return index >= 0 && index < rb->n_devices ? rb->devices[index].tag : 0;
+  if (index >= 0 && index < rb->n_devices)
+    return rb->devices[index].tag;
+  fprintf(stderr, "Error: wb_robot_get_device_by_index(): index %d is outside [0, %d].\n", index, rb->n_devices - 1);
+  return 0;
 }
 
 /* ------------------------------------------------------------------ device helpers */

@@ -238,19 +238,19 @@ static bool copy_numbers(const msgpack_object *list, double *out, uint32_t n) {
   return true;
 }
 
+/* Webots never answers NULL here: a NULL, removed or refused node (or a Robot controller) gets its
+   line and NaNs */
 static const double *node_pose(WbNodeRef node, bool position, const char *func) {
-  sn_robot *rb = supervisor(func);
-  if (rb == NULL || node == NULL)
-    return NULL;
+  sn_robot *rb = supervisor_node(node, func);
   sn_reply rep;
-  if (sn_robot_call(rb, "robot/get_node_pose", 1, args_node, &node->id, func, &rep) != 0)
-    return NULL;
+  if (rb == NULL || sn_robot_call(rb, "robot/get_node_pose", 1, args_node, &node->id, func, &rep) != 0)
+    return sn_no_values();
   bool ok = position ? copy_numbers(sn_get(rep.result, "position"), node->position, 3)
                      : copy_numbers(sn_get(rep.result, "orientation"), node->orientation, 9);
   sn_reply_free(&rep);
   if (!ok)
     fprintf(stderr, "Error: %s(): malformed reply\n", func);
-  return ok ? (position ? node->position : node->orientation) : NULL;
+  return ok ? (position ? node->position : node->orientation) : sn_no_values();
 }
 
 const double *wb_supervisor_node_get_position(WbNodeRef node) {
@@ -642,6 +642,15 @@ void wb_supervisor_simulation_reset(void) {
       d->cmd_position = d->cmd_velocity = false;
     } else if (d->kind == SN_LED)
       d->led_value = 0;
+  }
+  /* the robot's customData is a field the reset restores too: read it again (the Python client does) */
+  if (sn_robot_call(rb, "robot/get_custom_data", 0, NULL, NULL, func, &rep) != 0)
+    return;
+  char *data = sn_strdup_obj(sn_get(rep.result, "value"));
+  sn_reply_free(&rep);
+  if (data != NULL) {
+    free(rb->custom_data);
+    rb->custom_data = data;
   }
 }
 

@@ -10,6 +10,7 @@ Webots' "no value" (as the C library's functions)."""
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -90,6 +91,11 @@ class Field:
 
     name = property(getName)
     type = property(getType)
+    type_name = property(getTypeName)
+    count = property(getCount)
+
+    _SETTERS = {wb.WB_SF_BOOL: "setSFBool", wb.WB_SF_FLOAT: "setSFFloat", wb.WB_SF_STRING: "setSFString",
+                wb.WB_SF_VEC3F: "setSFVec3f", wb.WB_SF_ROTATION: "setSFRotation", wb.WB_SF_COLOR: "setSFColor"}
 
     @property
     def value(self) -> Any:
@@ -97,6 +103,17 @@ class Field:
         if self._ref[2] == wb.WB_MF_NODE:
             return [self.getMFNode(i) for i in range(self.getCount())]
         return Field._GETTERS[self._ref[2]](self)
+
+    @value.setter
+    def value(self, value: Any) -> None:
+        """Webots' ``field.value = ...``: the setter of the field's type (``translation.value = [x, y, z]``);
+        an MF field is not set this way (one error line, as in Webots)."""
+        setter = Field._SETTERS.get(self._ref[2])
+        if setter is None:
+            print(f"Error: Field.value: the {self.getTypeName()} field {self.getName()!r} cannot be set as a whole.",
+                  file=sys.stderr)
+            return
+        getattr(self, setter)(value)
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Field) and other._ref == self._ref

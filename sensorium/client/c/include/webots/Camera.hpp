@@ -9,6 +9,8 @@
 
 namespace webots {
 
+typedef WbCameraRecognitionObject CameraRecognitionObject;
+
 class Camera : public Device {
 public:
   explicit Camera(WbDeviceTag tag) : Device(tag) {}
@@ -43,6 +45,24 @@ public:
   bool recognitionIsSegmentationEnabled() const { return wb_camera_recognition_is_segmentation_enabled(tag_); }
   const unsigned char *recognitionGetSegmentationImage() const { return wb_camera_recognition_get_segmentation_image(tag_); }
   int recognitionSaveSegmentationImage(const std::string &filename, int quality) { return wb_camera_recognition_save_segmentation_image(tag_, filename.c_str(), quality); }
+  // Webots' C++ names of the recognition functions (the ones above are kept for existing code)
+  int getRecognitionSamplingPeriod() const { return wb_camera_recognition_get_sampling_period(tag_); }
+  int getRecognitionNumberOfObjects() const { return wb_camera_recognition_get_number_of_objects(tag_); }
+  const CameraRecognitionObject *getRecognitionObjects() const { return wb_camera_recognition_get_objects(tag_); }
+  bool hasRecognitionSegmentation() const { return wb_camera_recognition_has_segmentation(tag_); }
+  void enableRecognitionSegmentation() { wb_camera_recognition_enable_segmentation(tag_); }
+  void disableRecognitionSegmentation() { wb_camera_recognition_disable_segmentation(tag_); }
+  bool isRecognitionSegmentationEnabled() const { return wb_camera_recognition_is_segmentation_enabled(tag_); }
+  const unsigned char *getRecognitionSegmentationImage() const { return wb_camera_recognition_get_segmentation_image(tag_); }
+  int saveRecognitionSegmentationImage(const std::string &filename, int quality) const {
+    return wb_camera_recognition_save_segmentation_image(tag_, filename.c_str(), quality);
+  }
+  // pixels of a BGRA image (getImage())
+  static unsigned char imageGetRed(const unsigned char *image, int width, int x, int y) { return wb_camera_image_get_red(image, width, x, y); }
+  static unsigned char imageGetGreen(const unsigned char *image, int width, int x, int y) { return wb_camera_image_get_green(image, width, x, y); }
+  static unsigned char imageGetBlue(const unsigned char *image, int width, int x, int y) { return wb_camera_image_get_blue(image, width, x, y); }
+  static unsigned char imageGetGray(const unsigned char *image, int width, int x, int y) { return wb_camera_image_get_gray(image, width, x, y); }
+  static unsigned char imageGetGrey(const unsigned char *image, int width, int x, int y) { return wb_camera_image_get_grey(image, width, x, y); }
 };
 
 }  // namespace webots

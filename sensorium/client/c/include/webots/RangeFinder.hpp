@@ -22,6 +22,9 @@ public:
   double getMinRange() const { return wb_range_finder_get_min_range(tag_); }
   double getMaxRange() const { return wb_range_finder_get_max_range(tag_); }
   int saveImage(const std::string &filename, int quality) { return wb_range_finder_save_image(tag_, filename.c_str(), quality); }
+  static float rangeImageGetDepth(const float *image, int width, int x, int y) {
+    return wb_range_finder_image_get_depth(image, width, x, y);
+  }
 };
 
 }  // namespace webots

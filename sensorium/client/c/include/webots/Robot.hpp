@@ -118,6 +118,10 @@ public:
   bool getSynchronization() const { return wb_robot_get_synchronization(); }
   bool getSupervisor() const { return wb_robot_get_supervisor(); }
   Mode getMode() const { return static_cast<Mode>(wb_robot_get_mode()); }
+  void setMode(Mode mode, const char *arg) { wb_robot_set_mode(static_cast<WbRobotMode>(mode), arg); }
+  std::string getProjectPath() const { return wb_robot_get_project_path(); }
+  std::string getWorldPath() const { return wb_robot_get_world_path(); }
+  std::string getUrdf(std::string prefix = "") const { return wb_robot_get_urdf(prefix.c_str()); }
   int getNumberOfDevices() const { return wb_robot_get_number_of_devices(); }
   Device *getDeviceByIndex(int index) { return internal::deviceFromTag(wb_robot_get_device_by_index(index)); }
   Device *getDevice(const std::string &name) { return internal::deviceFromTag(wb_robot_get_device(name.c_str())); }
