@@ -390,6 +390,13 @@ def test_errors_in_generated_text_point_at_the_template_line(tmp_path: Path) -> 
     # the generated "radius oops }" reads as a node type without its '{': reported where the '}' is written
     assert str(exc.value).startswith(f"{tmp_path / 'Gen.proto'}:7:79: expected '{{' after node type oops, found '}}'")
     assert "(in the text PROTO Gen's template generated)" in str(exc.value)
+    # a template computing NaN (0 / 0) or Infinity is named as such where the template writes it
+    for expr, text in (("fields.r.value * NaN", "NaN"), ("fields.r.value / 0", "Infinity"), ("-1 / 0", "-Infinity")):
+        proto_file(tmp_path, "Gen", f"[ field SFFloat r 1 ]\n{{\n  Solid {{ translation 0 0 %<= {expr} >% }}\n}}",
+                   header=JS)
+        with pytest.raises(ProtoError) as exc:
+            expanded(w)
+        assert str(exc.value).startswith(f"{tmp_path / 'Gen.proto'}:5:27: number '{text}' is not finite"), str(exc.value)
     # a plain text error after a template piece maps character for character
     proto_file(tmp_path, "Gen", "[ ]\n{\n  Solid { %<= '' >%\n    name 'x' }\n}", header=JS)
     with pytest.raises(ProtoError) as exc:

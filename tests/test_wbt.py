@@ -117,6 +117,14 @@ def test_validate_and_info_accept_wbt(capsys) -> None:
     ("Solid { translation 1 2 3 } }\n", 2, 29, "expected a node, found '}'"),
     ("Solid { 12 }\n", 2, 9, "expected a field name or '}' in Solid (line 2), found '12'"),
     ("Solid { name 'x' }\n", 2, 14, "unexpected character \"'\""),
+    # a non-finite number is named where it is written (it was read as a field name or node type)
+    ("Solid { translation 0 0 nan }\n", 2, 25, "number 'nan' is not finite (a world's numbers must be finite)"),
+    ("Solid { translation Inf 0 0 }\n", 2, 21, "number 'Inf' is not finite (a world's numbers must be finite)"),
+    ("Solid { translation 0 0 -infinity }\n", 2, 25,
+     "number '-infinity' is not finite (a world's numbers must be finite)"),
+    ("Robot { children [ DistanceSensor { aperture NaN } ] }\n", 2, 46,
+     "number 'NaN' is not finite (a world's numbers must be finite)"),
+    ("Solid { name -x }\n", 2, 14, "unexpected character '-'"),
     ("PROTO X [ field SFFoo a 1 ] { Group { } }\n", 2, 17, "PROTO X: unknown field type 'SFFoo' (one of SFBool, "
      "SFInt32, SFFloat, SFVec2f, SFVec3f, SFRotation, SFColor, SFString, SFNode, MFBool, MFInt32, MFFloat, MFVec2f, "
      "MFVec3f, MFRotation, MFColor, MFString, MFNode)"),
