@@ -217,6 +217,34 @@ def test_hinge_wheels_become_a_differential_drive(tmp_path: Path) -> None:
                                       left_motor="left wheel motor", right_motor="right wheel motor")
 
 
+def test_slots_hold_wheels_and_devices(tmp_path: Path) -> None:
+    # Slot is a Webots base node: its endPoint (a Slot again, a wheel, a device) sits in the Slot's
+    # parent frame; it was an unknown node, so the wheels' shapes and the devices were lost
+    def wheel(side: str, y: float) -> str:
+        return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0.02 }} '
+                f'device [ RotationalMotor {{ name "{side}" }} ] endPoint Slot {{ type "wheel" endPoint Solid {{ '
+                f'translation 0 {y} 0.02 rotation 1 0 0 1.5707963267948966 name "{side} wheel" '
+                f'children [ DEF W{side} Shape {{ geometry Cylinder {{ radius 0.03 height 0.01 }} }} ] '
+                f'boundingObject USE W{side} }} }} }}\n')
+    p = write(tmp_path, 'Robot { translation 1 0 0 name "r" children [\n' + wheel("left", 0.05) + wheel("right", -0.05)
+              + 'Pose { translation 0 0 0.1 rotation 0 0 1 0.5 children [ Slot { type "x" endPoint Slot { type "x" '
+                'endPoint DistanceSensor { translation 0.2 0 0 name "ds" } } } ] }\n] }\n'
+              + 'Solid { name "post" children [ Slot { endPoint Solid { translation 0 0 1 name "top" '
+                'children [ Shape { geometry Box { size 1 1 1 } } ] } } ] }\n')
+    w = load_world(p)
+    assert not w.report.losses and not w.warnings, w.warnings
+    (robot,) = w.world.robots
+    assert robot.differential_drive == wm.DifferentialDrive(wheel_radius=0.03, axle_length=0.1, max_wheel_speed=10.0,
+                                                            left_motor="left", right_motor="right")
+    assert [s.pose.translation for s in robot.shapes] == [(0.0, 0.05, 0.02), (0.0, -0.05, 0.02)]
+    assert [s.seen_by for s in robot.shapes] == ["both", "both"]
+    ds = next(d for d in robot.devices if d.name == "ds")
+    assert ds.pose.translation == pytest.approx((0.2 * math.cos(0.5), 0.2 * math.sin(0.5), 0.1), abs=1e-15)
+    (post,) = w.world.solids
+    (top,) = post.children
+    assert top.name == "top" and top.pose.translation == (0.0, 0.0, 1.0) and len(top.shapes) == 1
+
+
 @pytest.mark.parametrize("kwargs, why", [
     (dict(axis_left="0 -1 0"), "wheel axis of motor 'left wheel motor' is [0.0, -1.0, 0.0], not the robot's +y"),
     (dict(anchor_x=0.02), "the axle midpoint is at x=0.02, y=0 in the robot frame, not under the robot's origin"),

@@ -278,6 +278,10 @@ class Converter:
         elif t == "Group":
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
+        elif t == "Slot":                # Webots' base node: its endPoint sits in the Slot's parent frame
+            end = f.node_("endPoint")
+            if end is not None:
+                self.visit(end, frame, owner)
         elif t in ("Pose", "Transform"):
             inner = self.child_frame(node, frame)
             for child in f.nodes("children"):

@@ -333,7 +333,7 @@ WEBOTS_FIELDS: dict[str, set[str]] = {
     "Solid": _SOLID, "Robot": _ROBOT,
     "Pose": {"translation", "rotation", "children", "translationStep", "rotationStep"},
     "Transform": {"translation", "rotation", "scale", "children", "translationStep", "rotationStep"},
-    "Group": {"children"},
+    "Group": {"children"}, "Slot": {"type", "endPoint"},
     "Shape": {"appearance", "geometry", "castShadows", "isPickable"},
     "Box": {"size"}, "Sphere": {"radius", "subdivision", "ico"}, "Cylinder": _ROUND, "Capsule": _ROUND,
     "Plane": {"size"}, "Mesh": {"url", "ccw", "name", "materialIndex"},
