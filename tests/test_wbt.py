@@ -103,6 +103,14 @@ def test_convert_round_trip(tmp_path: Path, capsys) -> None:
     assert cli(["convert", str(HERE / "full.wbt"), str(out), "--force"]) == 0
 
 
+def test_convert_that_cannot_write_leaves_no_file_behind(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "out.yaml"
+    out.mkdir()                      # a folder where the output should go: refused, and no out.yaml.tmp left
+    assert cli(["convert", str(HERE / "full.wbt"), str(out), "--force"]) == 1
+    assert capsys.readouterr().err.strip().splitlines()[-1] == f"{out}: cannot write: Is a directory"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.yaml"] and not any(out.iterdir())
+
+
 def test_validate_and_info_accept_wbt(capsys) -> None:
     assert cli(["validate", str(HERE / "full.wbt")]) == 0
     assert capsys.readouterr().out.strip().endswith("full.wbt: OK")
