@@ -256,6 +256,23 @@ Bar { }
     assert bar.shapes[0].geometry == wm.Box(type="box", size=(0.25, 1.0, 1.0))
 
 
+def test_instances_are_counted_where_they_sit_in_the_world(tmp_path: Path) -> None:
+    # a sub-PROTO written once in a PROTO body, or as a slot's default, is one instance per robot
+    # (it was counted once: its expansion is shared), a derived PROTO counts its base, a USE counts
+    proto_file(tmp_path, "Glass", "[ ] { Shape { geometry Sphere { radius 0.01 } } }")
+    proto_file(tmp_path, "Eye", "[ field SFString name \"eye\" ] { DistanceSensor { name IS name children [ Glass { } ] } }",
+               header='EXTERNPROTO "Glass.proto"\n')
+    proto_file(tmp_path, "Base", "[ field SFString name \"b\" field MFNode slot [ Eye { } ] ] "
+                                 "{ Robot { name IS name children [ Eye { name \"front\" } Group { children IS slot } ] } }",
+               header='EXTERNPROTO "Eye.proto"\n')
+    proto_file(tmp_path, "Bot", "[ field SFString name \"bot\" ] { Base { name IS name } }", header='EXTERNPROTO "Base.proto"\n')
+    w = world_file(tmp_path, 'Bot { name "a" }\nBot { name "b" }\nDEF C Bot { name "c" }\n'
+                             'Pose { translation 1 0 0 children [ USE C ] }\n', ["Bot.proto"])
+    uses = {u.name: u.instances for u in expanded(w).protos}
+    assert uses == {"Bot": 4, "Base": 4, "Eye": 8, "Glass": 8}
+    assert sum(len(r.devices) for r in load_world(w).world.robots) == 8
+
+
 def test_a_cycle_between_protos_defined_in_the_world_names_its_chain(tmp_path: Path) -> None:
     w = world_file(tmp_path, "PROTO A [ ] { B { } }\nPROTO B [ ] { A { } }\nA { }\n")
     with pytest.raises(ProtoError) as exc:

@@ -147,43 +147,65 @@ class _Expander:
 
     def check_size(self, nodes: list[Node]) -> None:
         """Nodes and values of the expanded tree, each DEF/USE or shared copy counted (what the
-        converter walks), stopped at the bound."""
-        weight: dict[int, tuple[int, int]] = {}
+        converter walks), stopped at the bound; and the instances of each PROTO, counted alike."""
+        Uses = dict[str, int] | None
+        weight: dict[int, tuple[int, int, Uses]] = {}
         lim = self.limits
         total_n = total_v = 0
+        total_uses: dict[str, int] = {}
 
-        def of(node: Node) -> tuple[int, int]:
+        def add(into: Uses, more: Uses, times: int = 1) -> Uses:
+            if not more:
+                return into
+            out = dict(into) if into else {}
+            for k, c in more.items():
+                out[k] = out.get(k, 0) + c * times
+            return out
+
+        def of(node: Node) -> tuple[int, int, Uses]:
             key = id(node)
             if key in weight:
                 return weight[key]
             n, v = 1, 0
+            uses: Uses = None
+            own = node.__dict__.get("uses")
+            if own:
+                uses = {}
+                for k in own:
+                    uses[k] = uses.get(k, 0) + 1
             for value in node.fields.values():
-                dn, dv = of_value(value)
-                n, v = n + dn, v + dv
-            weight[key] = (n, v)
-            return n, v
+                dn, dv, du = of_value(value)
+                n, v, uses = n + dn, v + dv, add(uses, du)
+            weight[key] = (n, v, uses)
+            return n, v, uses
 
-        def of_value(value: Any) -> tuple[int, int]:
+        def of_value(value: Any) -> tuple[int, int, Uses]:
             if isinstance(value, Node):
                 return of(value)
             if isinstance(value, list):
                 n = v = 0
+                uses: Uses = None
                 for x in value:
-                    dn, dv = of_value(x)
-                    n, v = n + dn, v + dv
-                return n, v
+                    dn, dv, du = of_value(x)
+                    n, v, uses = n + dn, v + dv, add(uses, du)
+                return n, v, uses
             if isinstance(value, tuple):
-                return 0, len(value)
-            return 0, 0 if value is None else 1
+                return 0, len(value), None
+            return 0, 0 if value is None else 1, None
 
         for top in nodes:
-            n, v = of(top)
+            n, v, uses = of(top)
             total_n, total_v = total_n + n, total_v + v
             if total_n > lim.nodes or total_v > lim.values:
                 what = f"{lim.nodes:,} nodes" if total_n > lim.nodes else f"{lim.values:,} values"
                 raise ProtoError(top.source or self.world, top.line, top.col,
                                  f"the world holds more than {what} once PROTO instances are expanded and DEF/USE "
                                  "copies counted (raise the limits with --allow-large)")
+            for k, c in (uses or {}).items():
+                total_uses[k] = total_uses.get(k, 0) + c
+        for k, c in total_uses.items():
+            if k in self.uses:
+                self.uses[k].instances = c
 
     def unused_declarations(self) -> None:
         scope = self.scopes[self.world]
@@ -343,8 +365,10 @@ class _Expander:
         inner = (*chain, proto.name)
         root = self.substitute(body, proto, values, given, chain)
         out = self.node(root, inner, depth)
-        self.uses[f"{proto.source}\0{proto.name}"].instances += 1
-        return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col))
+        # the PROTOs this node stands for (a derived PROTO's base too), counted where it sits in the
+        # expanded tree (check_size): an expansion shared by several places is several instances
+        uses = (f"{proto.source}\0{proto.name}", *out.__dict__.get("uses", ()))
+        return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col), uses=uses)
 
     def values(self, node: Node, proto: ProtoDef, chain: tuple[str, ...]) -> tuple[dict[str, Any], set[str]]:
         """The instance's value of every field of ``proto``, checked."""
