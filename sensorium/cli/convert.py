@@ -50,6 +50,7 @@ def convert(args: argparse.Namespace) -> int:
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, out)
     except OSError as exc:
+        tmp.unlink(missing_ok=True)    # (a directory named OUT, a full disk: no half-written file left behind)
         print(f"{out}: cannot write: {exc.strerror or exc}", file=sys.stderr)
         return 1
     print(f"{out}: written ({len(data.get('solids', []))} solids, {len(data.get('lights', []))} lights, "

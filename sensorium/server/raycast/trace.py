@@ -468,17 +468,12 @@ class TierTracer(Refiner):
             Ot = _one_row(O[:1] - tier.anchor, m) if O.strides[0] == 0 and m else _minus(O, tier.anchor)
         else:
             Ot = O
-        # Embree's start along the ray: eps before t_near, not before 0 (EXACT) or eps (FAST). EXACT
-        # judges a self-hit in float64 (t < lo) and continues past it, so a surface nearer than eps
-        # (up to centimetres in a static tier spanning 1e5 m) is still seen; FAST redoes its
-        # self-hits from eps here
-        first = 0.0 if exact else eps
         if isinstance(t_near, np.ndarray):       # accepted hits: lo <= t <= lim
             lo = np.maximum(t_near, eps64)
-            seg = np.maximum(t_near - eps, first)
+            seg = np.maximum(t_near - eps, eps)   # Embree start along the ray
         else:
             lo = np.full(m, max(t_near, eps64))
-            seg = np.full(m, max(t_near - eps, first))
+            seg = np.full(m, max(t_near - eps, eps))
         lim = np.array(lim, dtype=np.float64) if isinstance(lim, np.ndarray) else np.full(m, float(lim))
         excl_arr = None
         if tier.owned:
