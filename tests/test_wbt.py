@@ -253,6 +253,30 @@ def test_slots_hold_wheels_and_devices(tmp_path: Path) -> None:
     assert top.name == "top" and top.pose.translation == (0.0, 0.0, 1.0) and len(top.shapes) == 1
 
 
+def test_a_propeller_lists_its_motor_and_shows_its_slow_helix(tmp_path: Path) -> None:
+    # a drone's controller asks for its propeller motors: they were skipped with the Propeller node
+    # (getDevice found nothing), and so were the helices rays see
+    def prop(name: str, x: float) -> str:
+        return (f'Propeller {{ shaftAxis 0 0 1 centerOfThrust {x} 0 0.1 device RotationalMotor {{ name "{name}" '
+                f'maxVelocity 600 }} fastHelix Solid {{ translation {x} 0 0.1 children [ Shape {{ geometry Cylinder '
+                f'{{ radius 0.2 height 0.001 }} }} ] }} slowHelix Solid {{ translation {x} 0 0.1 children [ Shape {{ '
+                f'geometry Box {{ size 0.2 0.02 0.005 }} }} ] }} }}\n')
+    p = write(tmp_path, 'Robot { name "drone" children [\n' + prop("front propeller", 0.2) + 'GPS { }\n'
+              + prop("rear propeller", -0.2) + '] }\n')
+    w = load_world(p)
+    assert not w.report.losses
+    assert [x.split(": ", 1)[1] for x in w.warnings] == [
+        "Propeller: its motor is listed, its thrust and torque are not simulated (joints do not move here)"] * 2
+    (robot,) = w.world.robots
+    assert [(d.device, d.name) for d in robot.devices] == [
+        ("RotationalMotor", "front propeller"), ("GPS", "gps"), ("RotationalMotor", "rear propeller")]
+    assert [(s.geometry.type, s.pose.translation) for s in robot.shapes] == [
+        ("box", (0.2, 0.0, 0.1)), ("box", (-0.2, 0.0, 0.1))]       # the slow helices (at rest), not the fast ones
+    entries = Simulation(w).robot("drone").device_list     # what a controller's getDevice finds (not simulated)
+    assert [(e.name, e.simulated) for e in entries if e.name.endswith("propeller")] == [
+        ("front propeller", False), ("rear propeller", False)]
+
+
 @pytest.mark.parametrize("kwargs, why", [
     (dict(axis_left="0 -1 0"), "wheel axis of motor 'left wheel motor' is [0.0, -1.0, 0.0], not the robot's +y"),
     (dict(anchor_x=0.02), "the axle midpoint is at x=0.02, y=0 in the robot frame, not under the robot's origin"),

@@ -34,7 +34,7 @@ MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
 SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Physics", "ImmersionProperties",
-           "ContactProperties", "Damping", "Muscle", "Propeller"}
+           "ContactProperties", "Damping", "Muscle"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
 # the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
 OTHER_DEVICES = {"Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
@@ -278,6 +278,15 @@ class Converter:
         elif t == "Group":
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
+        elif t == "Propeller":           # a robot's motor (listed: controllers ask for it) and its helix
+            if owner.kind == "robot":
+                self.joint_devices(node, owner)
+                if f.node_("device") is not None:
+                    self.warn(node, "Propeller: its motor is listed, its thrust and torque are not simulated (joints "
+                                    "do not move here)")
+            helix = f.node_("slowHelix")     # what Webots shows below fastHelixThreshold (at rest)
+            if helix is not None:
+                self.visit(helix, frame, owner)
         elif t == "Slot":                # Webots' base node: its endPoint sits in the Slot's parent frame
             end = f.node_("endPoint")
             if end is not None:

@@ -334,6 +334,8 @@ WEBOTS_FIELDS: dict[str, set[str]] = {
     "Pose": {"translation", "rotation", "children", "translationStep", "rotationStep"},
     "Transform": {"translation", "rotation", "scale", "children", "translationStep", "rotationStep"},
     "Group": {"children"}, "Slot": {"type", "endPoint"},
+    "Propeller": {"shaftAxis", "centerOfThrust", "thrustConstants", "torqueConstants", "fastHelixThreshold", "device",
+                  "fastHelix", "slowHelix"},
     "Shape": {"appearance", "geometry", "castShadows", "isPickable"},
     "Box": {"size"}, "Sphere": {"radius", "subdivision", "ico"}, "Cylinder": _ROUND, "Capsule": _ROUND,
     "Plane": {"size"}, "Mesh": {"url", "ccw", "name", "materialIndex"},
