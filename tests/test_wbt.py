@@ -154,6 +154,16 @@ def test_header_required_and_old_versions_refused(tmp_path: Path) -> None:
         load_world(p)
 
 
+def test_only_the_first_world_info_counts(tmp_path: Path) -> None:
+    # Webots reads the first WorldInfo and warns about the others; the last one silently won
+    p = write(tmp_path, 'WorldInfo { basicTimeStep 8 randomSeed 3 }\nSolid { }\nWorldInfo { basicTimeStep 64 }\n')
+    w = load_world(p)
+    info = w.world.world_info
+    assert (info.basic_time_step, info.random_seed) == (8, 3)
+    assert w.warnings == [f"{p}:4:1: duplicate WorldInfo node: only the first one counts (as in Webots); this one is "
+                          "skipped"]
+
+
 def test_nesting_depth_bounded(tmp_path: Path) -> None:
     deep = "Group { children [ " * (MAX_DEPTH + 5) + "]  }" * (MAX_DEPTH + 5)
     with pytest.raises(WorldError, match=f"nested deeper than {MAX_DEPTH} levels"):

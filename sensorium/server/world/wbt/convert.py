@@ -246,7 +246,11 @@ class Converter:
         if t == "WorldInfo":
             if not top:
                 raise self.error(node, "WorldInfo must be a top-level node")
-            self.world_info(node)
+            if "basic_time_step" in self.world["world_info"]:    # Webots reads the first one
+                self.warn(node, "duplicate WorldInfo node: only the first one counts (as in Webots); this one is "
+                                "skipped")
+            else:
+                self.world_info(node)
         elif t == "Background" and top and f.has("skyColor"):     # what cameras see past everything
             sky = f.rows("skyColor", 3, [(0.0, 0.0, 0.0)])
             self.world["background"] = {"sky_color": list(sky[0]) if sky else [0.0, 0.0, 0.0]}
