@@ -133,6 +133,15 @@ def test_validate_and_info_accept_wbt(capsys) -> None:
     ("Robot { children [ DistanceSensor { aperture NaN } ] }\n", 2, 46,
      "number 'NaN' is not finite (a world's numbers must be finite)"),
     ("Solid { name -x }\n", 2, 14, "unexpected character '-'"),
+    # an IndexedFaceSet's indices are whole numbers, -1 the only negative one (2.5 was read as 2,
+    # -2 as the end of a face)
+    ("Shape { geometry IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0 ] } coordIndex [ 0 1 2.5 -1 ] } }\n",
+     2, 86, "IndexedFaceSet.coordIndex: expected integers, got 2.5"),
+    ("Shape { geometry IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0, 1 1 0 ] } "
+     "coordIndex [ 0 1 2 -2 1 3 2 -1 ] } }\n", 2, 93, "IndexedFaceSet.coordIndex: -2 is not a vertex index (-1 ends a face)"),
+    ("Shape { geometry IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0 ] } coordIndex [ 0 1 2 -1 ] "
+     "texCoord TextureCoordinate { point [ 0 0, 1 0, 0 1 ] } texCoordIndex [ 0 1 1.5 -1 ] } }\n", 2, 165,
+     "IndexedFaceSet.texCoordIndex: expected integers, got 1.5"),
     ("PROTO X [ field SFFoo a 1 ] { Group { } }\n", 2, 17, "PROTO X: unknown field type 'SFFoo' (one of SFBool, "
      "SFInt32, SFFloat, SFVec2f, SFVec3f, SFRotation, SFColor, SFString, SFNode, MFBool, MFInt32, MFFloat, MFVec2f, "
      "MFVec3f, MFRotation, MFColor, MFString, MFNode)"),

@@ -557,7 +557,9 @@ class Converter:
         # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
         coord = f.node_("coord")
         points = self.fields(coord).rows("point", 3, []) if coord is not None else []
-        index = [int(i) for i in f.numbers("coordIndex")]
+        index = f.integers("coordIndex")
+        if index and min(index) < -1:
+            raise f.error("coordIndex", f"{min(index)} is not a vertex index (-1 ends a face)")
         tex, tex_index = fx.tex_coords(node, f, len(index), self.warn)
         faces: list[list[int]] = []
         tex_faces: list[list[int]] = []
