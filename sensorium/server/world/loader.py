@@ -318,6 +318,18 @@ def format_path(loc: tuple[Any, ...]) -> str:
     return out
 
 
+def _choices(loc: tuple[Any, ...]) -> tuple[str, ...]:
+    """The kinds a ``device``/``type`` key accepts where ``loc`` points (a device, geometry or light)."""
+    keys = [p for p in loc if isinstance(p, str)]
+    if keys and keys[-1] == "geometry":
+        return ("box", "sphere", "cylinder", "capsule", "cone", "plane", "triangles", "mesh", "elevation_grid")
+    if "devices" in keys:
+        return tuple(wm.DEVICE_TYPES)
+    if keys and keys[-1] == "lights":
+        return ("PointLight", "SpotLight", "DirectionalLight")
+    return ()
+
+
 def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
     loc = tuple(err.get("loc", ()))
     msg = err.get("msg", "invalid")
@@ -326,6 +338,14 @@ def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
         msg = "unknown key (check spelling; field names are Webots' names in snake_case)"
     elif kind in ("finite_number",):
         msg = f"expected a finite number, got {quote(err.get('input'))}"
+    elif kind in ("union_tag_not_found", "union_tag_invalid"):     # no (or an unknown) ``device:``/``type:``
+        ctx = err.get("ctx") or {}
+        key = str(ctx.get("discriminator", "")).strip("'")
+        kinds = ", ".join(_choices(loc))
+        if kind == "union_tag_not_found":
+            msg = f"no {key!r} key: it says what this is" + (f" (one of: {kinds})" if kinds else "")
+        else:
+            msg = f"{key} {quote(ctx.get('tag'))} is not one of: {kinds or ctx.get('expected_tags', '')}"
     elif "input" in err and kind not in ("missing", "union_tag_invalid", "union_tag_not_found") and not isinstance(err["input"], (dict, list)):
         msg = f"{msg} (got {quote(err['input'])})"
     if len(msg) > 400:
