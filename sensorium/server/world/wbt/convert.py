@@ -330,11 +330,16 @@ class Converter:
         elif t in GEOMETRIES:
             self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
         else:
+            from sensorium.server.world.proto.interface import BASE_NODES
+
             named = node.fields.get("name")
             robot_like = any(k in node.fields for k in ROBOT_ONLY_FIELDS)   # a robot PROTO instance, surely
-            self.drop(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
-                            f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}", "robot" if robot_like else "node",
-                      named if isinstance(named, str) else t)
+            if t in BASE_NODES:      # a Webots node (Fluid, Billboard, ...), not a PROTO whose file is missing
+                why = f"{t}: a Webots node not read here (or not in its place); skipped (with everything inside it)"
+            else:
+                why = (f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
+                       f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
+            self.drop(node, why, "robot" if robot_like else "node", named if isinstance(named, str) else t)
 
     def scaled_solid(self, node: Node, owner: Owner) -> None:
         """A Solid (a robot, a device, a joint's end point) under a Transform that scales: Webots
