@@ -271,6 +271,13 @@ def test_instances_are_counted_where_they_sit_in_the_world(tmp_path: Path) -> No
     uses = {u.name: u.instances for u in expanded(w).protos}
     assert uses == {"Bot": 4, "Base": 4, "Eye": 8, "Glass": 8}
     assert sum(len(r.devices) for r in load_world(w).world.robots) == 8
+    # built-in stand-ins (their files not found) are counted too (they were x0)
+    w = world_file(tmp_path / "stand", 'WoodenBox { }\nDEF B WoodenBox { translation 1 0 0.3 }\nPose { children [ USE B ] }\n'
+                                       'RectangleArena { }\n', ["webots://projects/objects/factory/containers/protos/"
+                                                                 "WoodenBox.proto", "webots://projects/objects/floors/"
+                                                                                   "protos/RectangleArena.proto"])
+    uses = {u.name: (u.instances, u.builtin) for u in expanded(w).protos}
+    assert uses == {"WoodenBox": (3, True), "RectangleArena": (1, True)}
 
 
 def test_a_cycle_between_protos_defined_in_the_world_names_its_chain(tmp_path: Path) -> None:

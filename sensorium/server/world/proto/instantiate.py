@@ -153,6 +153,7 @@ class _Expander:
         lim = self.limits
         total_n = total_v = 0
         total_uses: dict[str, int] = {}
+        stand_ins = set(self.stand_ins)
 
         def add(into: Uses, more: Uses, times: int = 1) -> Uses:
             if not more:
@@ -169,6 +170,8 @@ class _Expander:
             n, v = 1, 0
             uses: Uses = None
             own = node.__dict__.get("uses")
+            if node.type in stand_ins:      # a built-in stand-in (RectangleArena, ...) the converter expands
+                own = (*(own or ()), f"\0{node.type}")
             if own:
                 uses = {}
                 for k in own:
