@@ -275,6 +275,14 @@ def test_slots_hold_wheels_and_devices(tmp_path: Path) -> None:
     (post,) = w.world.solids
     (top,) = post.children
     assert top.name == "top" and top.pose.translation == (0.0, 0.0, 1.0) and len(top.shapes) == 1
+    # anchors left at their default (0 0 0): the wheels' places come from the Solids inside the Slots,
+    # as from end points without Slots (the drive was refused: "both wheels are at the same place")
+    p = write(tmp_path, 'Robot { name "r" children [\n' + (wheel("left", 0.05) + wheel("right", -0.05)).replace(
+        "anchor 0 0.05 0.02 ", "").replace("anchor 0 -0.05 0.02 ", "") + '] }\n')
+    assert "anchor" not in p.read_text()
+    w = load_world(p)
+    assert not w.warnings, w.warnings
+    assert w.world.robots[0].differential_drive == robot.differential_drive
 
 
 def test_a_propeller_lists_its_motor_and_shows_its_slow_helix(tmp_path: Path) -> None:

@@ -877,8 +877,9 @@ class Converter:
             anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
             m = self.fields(motors[0])
             centre = anchor
-            if end is not None and end.type == "Solid":
-                centre = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
+            wheel = self.slotted(end)
+            if wheel is not None and wheel.type == "Solid":
+                centre = self.fields(wheel).vec("translation", (0.0, 0.0, 0.0))
             turn = frame.rotation @ np.asarray(axis)
             owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"),
                                  "steers": abs(turn[2]) > 0.9 * float(np.linalg.norm(turn)),   # a vertical axis
@@ -896,6 +897,12 @@ class Converter:
                 return
             self.visit(end, frame, owner)
 
+    def slotted(self, end: Node | None) -> Node | None:
+        """A joint's end point, through the Slots that hold it (a Slot adds no frame)."""
+        while end is not None and end.type == "Slot":
+            end = self.fields(end).node_("endPoint")
+        return end
+
     def hinge2(self, node: Node, frame: Frame, owner: Owner, motors: list[Node], sensors: list[dict]) -> None:
         """A Hinge2Joint of a robot: its first axis (``jointParameters``, ``device``) steers, its
         second (``jointParameters2``, ``device2``) turns the wheel, its end point. Both become
@@ -905,8 +912,9 @@ class Converter:
         spin_motors = [d for d in f.nodes("device2") if d.type in MOTORS]
         _, spin_sensors = self.joint_devices(node, owner, "device2")
         centre_at = (0.0, 0.0, 0.0)
-        if end is not None and end.type == "Solid":
-            centre_at = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
+        wheel = self.slotted(end)
+        if wheel is not None and wheel.type == "Solid":
+            centre_at = self.fields(wheel).vec("translation", (0.0, 0.0, 0.0))
         centre = np.asarray(frame.apply(centre_at))
         for params_field, axis_default, found, found_sensors, steers in (
                 ("jointParameters", (1.0, 0.0, 0.0), motors, sensors, True),
