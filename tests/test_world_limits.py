@@ -310,6 +310,18 @@ def test_a_key_repeated_in_a_mapping_is_refused_at_its_line(tmp_path: Path, text
     assert load_yaml("a: &a {x: 1}\nb: &b {y: 2}\nc: {<<: *a, <<: *b, x: 3}\n")["c"] == {"x": 3, "y": 2}
 
 
+def test_a_key_repeated_in_a_json_object_is_refused_at_its_line(tmp_path: Path) -> None:
+    # json.loads keeps the last value in silence (the first robot name was lost)
+    p = tmp_path / "w.json"
+    p.write_text('{"world_info": {"name": "a", "basic_time_step": 16},\n "robots": [{"name": "r",\n   "name": "s"}]}\n')
+    with pytest.raises(WorldError) as err:
+        load_world(p)
+    assert str(err.value) == (f"{p}: line 3, column 4: not valid JSON: found duplicate key 'name' (while constructing "
+                              "a mapping at line 2, column 13)")
+    p.write_text(json.dumps({"robots": [{"name": "r"}], "lights": []}))
+    assert [r.name for r in load_world(p).world.robots] == ["r"]
+
+
 def test_bad_text_is_a_world_error(tmp_path: Path) -> None:
     cases = {"nul.yaml": b"robots: [\0]\n", "bad.yaml": b"robots: [unclosed\n", "date.yaml": b"x: 2001-13-45\n",
              "latin1.yaml": b"name: \xff\xfe\n", "bad.json": b"{", "tab.yaml": b"a:\n\t- b\n"}

@@ -115,8 +115,21 @@ def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: W
     limits = limits or WorldLimits()
     try:
         if json_format:
-            return json.loads(text)
+            try:
+                return json.loads(text, object_pairs_hook=_json_object)
+            except _DuplicateKey as dup:
+                try:                          # where: the YAML reader (JSON is YAML) names its line and column
+                    load_yaml(text, WorldLimits.large())
+                except yaml.YAMLError as exc:
+                    if "duplicate key" in str(exc):
+                        raise WorldError(source, [Problem("", syntax_problem(exc).replace("YAML", "JSON"))]) from None
+                except Exception:  # noqa: BLE001 - any other reading: the line is not known, the key is
+                    pass
+                raise WorldError(source, [Problem("", f"not valid JSON: found duplicate key {dup.args[0]!r} (a "
+                                                      "key repeated in one object)")]) from None
         return load_yaml(text, limits)        # bounded while it is read (nesting, aliases, robots, ...)
+    except WorldError:
+        raise
     except LimitError as exc:
         raise WorldError(source, [Problem(exc.path, exc.message)]) from None
     except RecursionError:
@@ -129,6 +142,21 @@ def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: W
         if len(detail) > 300:
             detail = detail[:300] + "…"
         raise WorldError(source, [Problem("", f"not valid YAML/JSON: {detail}")]) from None
+
+
+class _DuplicateKey(ValueError):
+    """A key repeated in one JSON object (json.loads keeps the last value in silence)."""
+
+
+def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out = dict(pairs)
+    if len(out) != len(pairs):
+        seen: set[str] = set()
+        for key, _ in pairs:
+            if key in seen:
+                raise _DuplicateKey(key)
+            seen.add(key)
+    return out
 
 
 def bundled_or_path(path: str | Path) -> Path:
