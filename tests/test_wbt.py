@@ -103,6 +103,28 @@ def test_convert_round_trip(tmp_path: Path, capsys) -> None:
     assert cli(["convert", str(HERE / "full.wbt"), str(out), "--force"]) == 0
 
 
+def test_convert_into_another_folder_keeps_texture_urls_working(tmp_path: Path, capsys) -> None:
+    # texture urls were written as in the .wbt (relative to it), so the converted world named files
+    # that are not there; mesh urls were already made relative to the output
+    from PIL import Image
+
+    (tmp_path / "textures").mkdir()
+    Image.new("RGB", (4, 4), (255, 0, 0)).save(tmp_path / "textures" / "floor.png")
+    src = write(tmp_path, 'Solid { children [ Shape { appearance PBRAppearance { baseColorMap ImageTexture { url '
+                          '"textures/floor.png" } occlusionMap ImageTexture { url "textures/floor.png" } } '
+                          'geometry Plane { size 2 2 } } ] }\n')
+    out = tmp_path / "out" / "w.yaml"
+    out.parent.mkdir()
+    assert cli(["convert", str(src), str(out)]) == 0
+    assert "note: 1 mesh or texture url(s) leave" in capsys.readouterr().err
+    (shape,) = load_world(out, allow_outside_meshes=True).world.solids[0].shapes
+    assert shape.appearance.texture.url == shape.appearance.occlusion_map.url == "../textures/floor.png"
+    assert (out.parent / shape.appearance.texture.url).resolve() == (tmp_path / "textures" / "floor.png").resolve()
+    beside = tmp_path / "w.yaml"                           # converted beside it: the url as written
+    assert cli(["convert", str(src), str(beside)]) == 0
+    assert load_world(beside).world.solids[0].shapes[0].appearance.texture.url == "textures/floor.png"
+
+
 def test_convert_that_cannot_write_leaves_no_file_behind(tmp_path: Path, capsys) -> None:
     out = tmp_path / "out.yaml"
     out.mkdir()                      # a folder where the output should go: refused, and no out.yaml.tmp left
