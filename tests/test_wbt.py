@@ -175,6 +175,12 @@ def test_syntax_errors_name_file_line_column(tmp_path: Path, body: str, line: in
     assert str(exc.value) == f"{p}: line {line}, column {col}: {what}"
 
 
+def test_a_node_type_spelt_like_a_number_is_a_node(tmp_path: Path) -> None:
+    p = write(tmp_path, "Group { children [ Inf { } ] }\n")        # followed by '{': a node (here unknown)
+    (loss,) = load_world(p).report.losses
+    assert loss.where == f"{p}:2:20" and loss.why.startswith("Inf: not a built-in node or PROTO here")
+
+
 def test_header_required_and_old_versions_refused(tmp_path: Path) -> None:
     p = tmp_path / "old.wbt"
     p.write_text("#VRML_SIM R2021b utf8\nWorldInfo { }\n")

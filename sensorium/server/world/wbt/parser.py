@@ -378,9 +378,10 @@ class Parser:
 
     def nonfinite(self) -> None:
         """Refuse ``nan``, ``inf`` or ``infinity`` (any case, signed) where a value may be next: they
-        would otherwise be read as a field name or a node type, and the error would name something else."""
+        would otherwise be read as a field name or a node type, and the error would name something else
+        (a node type, followed by '{', is left alone: a PROTO may be called Inf)."""
         tok = self.peek()
-        if tok.kind == "name" and tok.text.lower() in ("nan", "inf", "infinity"):
+        if tok.kind == "name" and tok.text.lower() in ("nan", "inf", "infinity") and self.peek(1).kind != "{":
             raise self.error(tok, f"number {quote(tok.text, 40)} is not finite (a world's numbers must be finite)")
 
     def number(self, tok: Token) -> float:
