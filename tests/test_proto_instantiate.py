@@ -233,6 +233,60 @@ Pair { }
     assert (a.shapes[0].geometry.size, b.shapes[0].geometry.size) == ((0.1, 0.1, 1.0), (0.1, 0.1, 2.0))
 
 
+def test_several_proto_definitions_in_one_world_keep_their_own_bodies(tmp_path: Path) -> None:
+    # two PROTOs written in the world file, plain and templated alike: each instance is its own
+    # PROTO's body (the second PROTO was read as the first one's body, a cube becoming a ball)
+    w = world_file(tmp_path, """PROTO Ball [ field SFVec3f translation 0 0 0 ] { Solid { translation IS translation name "ball" children [ Shape { geometry Sphere { radius 0.5 } } ] } }
+PROTO Cube [ field SFVec3f translation 0 0 0 ] { Solid { translation IS translation name "cube" children [ Shape { geometry Box { size 1 1 1 } } ] } }
+PROTO Dot [ field SFFloat k 0.25 ] { Solid { name "dot" children [ Shape { geometry Sphere { radius %<= fields.k.value >% } } ] } }
+PROTO Bar [ field SFFloat k 0.25 ] { Solid { name "bar" children [ Shape { geometry Box { size %<= fields.k.value >% 1 1 } } ] } }
+Ball { translation 1 0 0 }
+Cube { translation 2 0 0 }
+Dot { }
+Bar { }
+""")
+    loaded = load_world(w)
+    assert not loaded.report.warnings
+    ball, cube, dot, bar = loaded.world.solids
+    assert [s.name for s in (ball, cube, dot, bar)] == ["ball", "cube", "dot", "bar"]
+    assert ball.shapes[0].geometry == wm.Sphere(type="sphere", radius=0.5)
+    assert cube.shapes[0].geometry == wm.Box(type="box", size=(1.0, 1.0, 1.0))
+    assert cube.pose.translation == (2.0, 0.0, 0.0)
+    assert dot.shapes[0].geometry == wm.Sphere(type="sphere", radius=0.25)
+    assert bar.shapes[0].geometry == wm.Box(type="box", size=(0.25, 1.0, 1.0))
+
+
+def test_instances_are_counted_where_they_sit_in_the_world(tmp_path: Path) -> None:
+    # a sub-PROTO written once in a PROTO body, or as a slot's default, is one instance per robot
+    # (it was counted once: its expansion is shared), a derived PROTO counts its base, a USE counts
+    proto_file(tmp_path, "Glass", "[ ] { Shape { geometry Sphere { radius 0.01 } } }")
+    proto_file(tmp_path, "Eye", "[ field SFString name \"eye\" ] { DistanceSensor { name IS name children [ Glass { } ] } }",
+               header='EXTERNPROTO "Glass.proto"\n')
+    proto_file(tmp_path, "Base", "[ field SFString name \"b\" field MFNode slot [ Eye { } ] ] "
+                                 "{ Robot { name IS name children [ Eye { name \"front\" } Group { children IS slot } ] } }",
+               header='EXTERNPROTO "Eye.proto"\n')
+    proto_file(tmp_path, "Bot", "[ field SFString name \"bot\" ] { Base { name IS name } }", header='EXTERNPROTO "Base.proto"\n')
+    w = world_file(tmp_path, 'Bot { name "a" }\nBot { name "b" }\nDEF C Bot { name "c" }\n'
+                             'Pose { translation 1 0 0 children [ USE C ] }\n', ["Bot.proto"])
+    uses = {u.name: u.instances for u in expanded(w).protos}
+    assert uses == {"Bot": 4, "Base": 4, "Eye": 8, "Glass": 8}
+    assert sum(len(r.devices) for r in load_world(w).world.robots) == 8
+    # built-in stand-ins (their files not found) are counted too (they were x0)
+    w = world_file(tmp_path / "stand", 'WoodenBox { }\nDEF B WoodenBox { translation 1 0 0.3 }\nPose { children [ USE B ] }\n'
+                                       'RectangleArena { }\n', ["webots://projects/objects/factory/containers/protos/"
+                                                                 "WoodenBox.proto", "webots://projects/objects/floors/"
+                                                                                   "protos/RectangleArena.proto"])
+    uses = {u.name: (u.instances, u.builtin) for u in expanded(w).protos}
+    assert uses == {"WoodenBox": (3, True), "RectangleArena": (1, True)}
+
+
+def test_a_cycle_between_protos_defined_in_the_world_names_its_chain(tmp_path: Path) -> None:
+    w = world_file(tmp_path, "PROTO A [ ] { B { } }\nPROTO B [ ] { A { } }\nA { }\n")
+    with pytest.raises(ProtoError) as exc:
+        expanded(w)
+    assert str(exc.value) == f"{w}:3:15: PROTO A instantiates itself: A → B → A"
+
+
 @pytest.mark.parametrize("body, where, what", [
     ("[ field SFFloat a 1 ] { Solid { name IS b } }", "Bad.proto:2:51",
      "IS b: PROTO Bad has no field b (its fields: a)"),

@@ -107,6 +107,45 @@ def test_proto_path_tree_cache_layout_and_project_protos(tmp_path: Path, monkeyp
     assert [n.type for n in expanded(w).nodes] == ["DistanceSensor", "Group", "Solid"]
 
 
+def test_meshes_in_webots_asset_cache_are_read(tmp_path: Path, monkeypatch) -> None:
+    # a cached file has no suffix (its name is the SHA-1 of its url): its format is read from its
+    # first bytes; the world was refused ("unsupported mesh format ''")
+    import struct
+
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
+    cache = tmp_path / "assets-R2023b"
+    cache.mkdir()
+    base = f"{RAW}/R2023b/projects/objects/acme/protos"
+    (cache / hashlib.sha1(f"{base}/Crate.proto".encode()).hexdigest()).write_text(
+        HEADER + 'PROTO Crate [ ] { Solid { name "crate" children [ Shape { geometry Mesh { url "meshes/crate.obj" } } '
+        'Pose { translation 0 0 1 children [ Shape { geometry Mesh { url "meshes/lid.stl" } } ] } ] } }\n')
+    (cache / hashlib.sha1(f"{base}/meshes/crate.obj".encode()).hexdigest()).write_text(
+        "# a tetrahedron\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    triangle = struct.pack("<12f", 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 2, 0) + b"\0\0"     # binary STL: one triangle
+    (cache / hashlib.sha1(f"{base}/meshes/lid.stl".encode()).hexdigest()).write_bytes(
+        b"solid header that is not ascii".ljust(80, b" ") + struct.pack("<I", 1) + triangle)
+    w = world_file(tmp_path / "w", "Crate { }\n", ["webots://projects/objects/acme/protos/Crate.proto"])
+    loaded = load_world(w, proto_path=[cache])
+    assert not loaded.report.losses
+    (crate,) = loaded.world.solids
+    assert [s.pose.translation for s in crate.shapes] == [(0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
+    from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.meshes import load_mesh
+
+    Simulation(loaded)                  # the scene reads the same files
+
+    obj, stl = (load_mesh(s.geometry.url) for s in crate.shapes)
+    assert (len(obj.faces), len(stl.faces)) == (4, 1)
+    assert stl.vertices.max(axis=0).tolist() == [2.0, 2.0, 0.0]
+    # a cached file that is no mesh is one line naming the url
+    lid = cache / hashlib.sha1(f"{base}/meshes/lid.stl".encode()).hexdigest()
+    lid.write_bytes(b"\x00\x01 not a mesh")
+    with pytest.raises(WorldError) as exc:
+        load_world(w, proto_path=[cache])
+    assert str(exc.value).startswith(f"{w}: line 3, column 1 (Mesh of PROTO Crate, converted as solids[0].shapes[1]."
+                                     f"geometry.url): mesh file {lid} has no suffix and is not a mesh format read here")
+
+
 def test_cache_log_names_the_urls(tmp_path: Path) -> None:
     """A cache folder's log.txt ('HASH URL' lines, as Webots writes it) tells what a file stands for."""
     cache = tmp_path / "assets"

@@ -359,6 +359,9 @@ def test_lua_templates_get_one_line(tmp_path: Path) -> None:
     ("undefinedFunction();", 7, "template error: ReferenceError"),
     ("import * as x from 'wbfoo.js';", 7, "import of module 'wbfoo': not available here"),
     ("wbfile.readTextFile('/etc/passwd');", 7, "wbfile.readTextFile: templates have no file access here"),
+    # imported as Webots' templates do, wbfile answers its calls alike (the import itself was refused)
+    ("import * as wbfile from 'wbfile.js';\nwbfile.fileExists('x');", 8, "wbfile.fileExists: templates have no file access"),
+    ("import { readTextFile } from 'wbfile.js'; readTextFile('x');", 7, "wbfile.readTextFile: templates have no file"),
 ])
 def test_template_errors_point_at_the_template_line(tmp_path: Path, code: str, line: int, what: str) -> None:
     proto_file(tmp_path, "Bad", f"""[
@@ -373,6 +376,18 @@ def test_template_errors_point_at_the_template_line(tmp_path: Path, code: str, l
         expanded(w)
     assert str(exc.value).startswith(f"{tmp_path / 'Bad.proto'}:{line}:"), str(exc.value)
     assert what in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_template_importing_wbfile_without_calling_it_loads(tmp_path: Path) -> None:
+    proto_file(tmp_path, "Maybe", """[ field SFString file "" ]
+{
+  %< import * as wbfile from 'wbfile.js';
+     const r = fields.file.value === '' ? 0.25 : Number(wbfile.readTextFile(fields.file.value)); >%
+  Solid { children [ Shape { geometry Sphere { radius %<= r >% } } ] }
+}""", header=JS)
+    w = world_file(tmp_path, "Maybe { }\n", ["Maybe.proto"])
+    (solid,) = load_world(w).world.solids
+    assert solid.shapes[0].geometry.radius == 0.25
 
 
 def test_errors_in_generated_text_point_at_the_template_line(tmp_path: Path) -> None:
@@ -390,6 +405,13 @@ def test_errors_in_generated_text_point_at_the_template_line(tmp_path: Path) -> 
     # the generated "radius oops }" reads as a node type without its '{': reported where the '}' is written
     assert str(exc.value).startswith(f"{tmp_path / 'Gen.proto'}:7:79: expected '{{' after node type oops, found '}}'")
     assert "(in the text PROTO Gen's template generated)" in str(exc.value)
+    # a template computing NaN (0 / 0) or Infinity is named as such where the template writes it
+    for expr, text in (("fields.r.value * NaN", "NaN"), ("fields.r.value / 0", "Infinity"), ("-1 / 0", "-Infinity")):
+        proto_file(tmp_path, "Gen", f"[ field SFFloat r 1 ]\n{{\n  Solid {{ translation 0 0 %<= {expr} >% }}\n}}",
+                   header=JS)
+        with pytest.raises(ProtoError) as exc:
+            expanded(w)
+        assert str(exc.value).startswith(f"{tmp_path / 'Gen.proto'}:5:27: number '{text}' is not finite"), str(exc.value)
     # a plain text error after a template piece maps character for character
     proto_file(tmp_path, "Gen", "[ ]\n{\n  Solid { %<= '' >%\n    name 'x' }\n}", header=JS)
     with pytest.raises(ProtoError) as exc:

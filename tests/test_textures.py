@@ -522,6 +522,18 @@ def test_huge_images_are_rejected_with_the_limit(tmp_path: Path) -> None:
         parse_world(_textured("big.png"), base_dir=tmp_path, limits=WorldLimits(texture_file_bytes=100))
     parse_world(_textured("big.png"), base_dir=tmp_path)
     assert WorldLimits.large().texture_pixels > WorldLimits().texture_pixels
+    # an image past Pillow's own bomb guard (2 x 178,956,970 pixels; a 48 kB PNG) is judged by the
+    # world's limits from its header: Pillow's message answered first, and refused what --allow-large allows
+    from sensorium.server.world.textures import image_header
+
+    Image.new("1", (20_000, 20_000)).save(tmp_path / "bomb.png", optimize=True)
+    with pytest.raises(WorldError) as exc:
+        parse_world(_textured("bomb.png"), base_dir=tmp_path)
+    assert [p.message for p in exc.value.problems] == [
+        "texture 'bomb.png' has 20000x20000 = 400,000,000 pixels, more than the limit of 16,777,216 (raise the limits "
+        "with --allow-large)"]
+    assert image_header(tmp_path / "bomb.png", "bomb.png") == ("PNG", 20_000, 20_000)      # nothing decoded
+    assert Image.MAX_IMAGE_PIXELS is not None                                              # Pillow's guard is back
 
 
 def test_tex_coord_problems_are_named(tmp_path: Path) -> None:

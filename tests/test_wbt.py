@@ -103,6 +103,36 @@ def test_convert_round_trip(tmp_path: Path, capsys) -> None:
     assert cli(["convert", str(HERE / "full.wbt"), str(out), "--force"]) == 0
 
 
+def test_convert_into_another_folder_keeps_texture_urls_working(tmp_path: Path, capsys) -> None:
+    # texture urls were written as in the .wbt (relative to it), so the converted world named files
+    # that are not there; mesh urls were already made relative to the output
+    from PIL import Image
+
+    (tmp_path / "textures").mkdir()
+    Image.new("RGB", (4, 4), (255, 0, 0)).save(tmp_path / "textures" / "floor.png")
+    src = write(tmp_path, 'Solid { children [ Shape { appearance PBRAppearance { baseColorMap ImageTexture { url '
+                          '"textures/floor.png" } occlusionMap ImageTexture { url "textures/floor.png" } } '
+                          'geometry Plane { size 2 2 } } ] }\n')
+    out = tmp_path / "out" / "w.yaml"
+    out.parent.mkdir()
+    assert cli(["convert", str(src), str(out)]) == 0
+    assert "note: 1 mesh or texture url(s) leave" in capsys.readouterr().err
+    (shape,) = load_world(out, allow_outside_meshes=True).world.solids[0].shapes
+    assert shape.appearance.texture.url == shape.appearance.occlusion_map.url == "../textures/floor.png"
+    assert (out.parent / shape.appearance.texture.url).resolve() == (tmp_path / "textures" / "floor.png").resolve()
+    beside = tmp_path / "w.yaml"                           # converted beside it: the url as written
+    assert cli(["convert", str(src), str(beside)]) == 0
+    assert load_world(beside).world.solids[0].shapes[0].appearance.texture.url == "textures/floor.png"
+
+
+def test_convert_that_cannot_write_leaves_no_file_behind(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "out.yaml"
+    out.mkdir()                      # a folder where the output should go: refused, and no out.yaml.tmp left
+    assert cli(["convert", str(HERE / "full.wbt"), str(out), "--force"]) == 1
+    assert capsys.readouterr().err.strip().splitlines()[-1] == f"{out}: cannot write: Is a directory"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.yaml"] and not any(out.iterdir())
+
+
 def test_validate_and_info_accept_wbt(capsys) -> None:
     assert cli(["validate", str(HERE / "full.wbt")]) == 0
     assert capsys.readouterr().out.strip().endswith("full.wbt: OK")
@@ -117,6 +147,23 @@ def test_validate_and_info_accept_wbt(capsys) -> None:
     ("Solid { translation 1 2 3 } }\n", 2, 29, "expected a node, found '}'"),
     ("Solid { 12 }\n", 2, 9, "expected a field name or '}' in Solid (line 2), found '12'"),
     ("Solid { name 'x' }\n", 2, 14, "unexpected character \"'\""),
+    # a non-finite number is named where it is written (it was read as a field name or node type)
+    ("Solid { translation 0 0 nan }\n", 2, 25, "number 'nan' is not finite (a world's numbers must be finite)"),
+    ("Solid { translation Inf 0 0 }\n", 2, 21, "number 'Inf' is not finite (a world's numbers must be finite)"),
+    ("Solid { translation 0 0 -infinity }\n", 2, 25,
+     "number '-infinity' is not finite (a world's numbers must be finite)"),
+    ("Robot { children [ DistanceSensor { aperture NaN } ] }\n", 2, 46,
+     "number 'NaN' is not finite (a world's numbers must be finite)"),
+    ("Solid { name -x }\n", 2, 14, "unexpected character '-'"),
+    # an IndexedFaceSet's indices are whole numbers, -1 the only negative one (2.5 was read as 2,
+    # -2 as the end of a face)
+    ("Shape { geometry IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0 ] } coordIndex [ 0 1 2.5 -1 ] } }\n",
+     2, 86, "IndexedFaceSet.coordIndex: expected integers, got 2.5"),
+    ("Shape { geometry IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0, 1 1 0 ] } "
+     "coordIndex [ 0 1 2 -2 1 3 2 -1 ] } }\n", 2, 93, "IndexedFaceSet.coordIndex: -2 is not a vertex index (-1 ends a face)"),
+    ("Shape { geometry IndexedFaceSet { coord Coordinate { point [ 0 0 0, 1 0 0, 0 1 0 ] } coordIndex [ 0 1 2 -1 ] "
+     "texCoord TextureCoordinate { point [ 0 0, 1 0, 0 1 ] } texCoordIndex [ 0 1 1.5 -1 ] } }\n", 2, 165,
+     "IndexedFaceSet.texCoordIndex: expected integers, got 1.5"),
     ("PROTO X [ field SFFoo a 1 ] { Group { } }\n", 2, 17, "PROTO X: unknown field type 'SFFoo' (one of SFBool, "
      "SFInt32, SFFloat, SFVec2f, SFVec3f, SFRotation, SFColor, SFString, SFNode, MFBool, MFInt32, MFFloat, MFVec2f, "
      "MFVec3f, MFRotation, MFColor, MFString, MFNode)"),
@@ -128,6 +175,12 @@ def test_syntax_errors_name_file_line_column(tmp_path: Path, body: str, line: in
     assert str(exc.value) == f"{p}: line {line}, column {col}: {what}"
 
 
+def test_a_node_type_spelt_like_a_number_is_a_node(tmp_path: Path) -> None:
+    p = write(tmp_path, "Group { children [ Inf { } ] }\n")        # followed by '{': a node (here unknown)
+    (loss,) = load_world(p).report.losses
+    assert loss.where == f"{p}:2:20" and loss.why.startswith("Inf: not a built-in node or PROTO here")
+
+
 def test_header_required_and_old_versions_refused(tmp_path: Path) -> None:
     p = tmp_path / "old.wbt"
     p.write_text("#VRML_SIM R2021b utf8\nWorldInfo { }\n")
@@ -136,6 +189,16 @@ def test_header_required_and_old_versions_refused(tmp_path: Path) -> None:
     p.write_text("WorldInfo { }\n")
     with pytest.raises(WorldError, match="not a Webots world"):
         load_world(p)
+
+
+def test_only_the_first_world_info_counts(tmp_path: Path) -> None:
+    # Webots reads the first WorldInfo and warns about the others; the last one silently won
+    p = write(tmp_path, 'WorldInfo { basicTimeStep 8 randomSeed 3 }\nSolid { }\nWorldInfo { basicTimeStep 64 }\n')
+    w = load_world(p)
+    info = w.world.world_info
+    assert (info.basic_time_step, info.random_seed) == (8, 3)
+    assert w.warnings == [f"{p}:4:1: duplicate WorldInfo node: only the first one counts (as in Webots); this one is "
+                          "skipped"]
 
 
 def test_nesting_depth_bounded(tmp_path: Path) -> None:
@@ -166,6 +229,11 @@ def test_unknown_proto_is_skipped_with_its_position(tmp_path: Path) -> None:
     p = write(tmp_path, 'EXTERNPROTO "https://example.org/E-puck.proto"\nE-puck {\n  translation 0 0 0\n}\n')
     with pytest.raises(WorldError, match=r'line 2, column 1: EXTERNPROTO E-puck: "https://example.org/E-puck.proto" not found'):
         load_world(p)
+    # a Webots node not read here is said to be one (not a PROTO whose file is missing)
+    p = write(tmp_path, 'Fluid { name "water" children [ Shape { geometry Box { size 1 1 0.1 } } ] }\n')
+    (loss,) = load_world(p).report.losses
+    assert (loss.name, loss.where, loss.why) == (
+        "water", f"{p}:2:1", "Fluid: a Webots node not read here (or not in its place); skipped (with everything inside it)")
 
 
 def test_device_through_nested_rotated_poses_closed_form(tmp_path: Path) -> None:
@@ -207,6 +275,66 @@ def test_hinge_wheels_become_a_differential_drive(tmp_path: Path) -> None:
     dd = w.world.robots[0].differential_drive
     assert dd == wm.DifferentialDrive(wheel_radius=0.03, axle_length=0.1, max_wheel_speed=10.0,
                                       left_motor="left wheel motor", right_motor="right wheel motor")
+
+
+def test_slots_hold_wheels_and_devices(tmp_path: Path) -> None:
+    # Slot is a Webots base node: its endPoint (a Slot again, a wheel, a device) sits in the Slot's
+    # parent frame; it was an unknown node, so the wheels' shapes and the devices were lost
+    def wheel(side: str, y: float) -> str:
+        return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0.02 }} '
+                f'device [ RotationalMotor {{ name "{side}" }} ] endPoint Slot {{ type "wheel" endPoint Solid {{ '
+                f'translation 0 {y} 0.02 rotation 1 0 0 1.5707963267948966 name "{side} wheel" '
+                f'children [ DEF W{side} Shape {{ geometry Cylinder {{ radius 0.03 height 0.01 }} }} ] '
+                f'boundingObject USE W{side} }} }} }}\n')
+    p = write(tmp_path, 'Robot { translation 1 0 0 name "r" children [\n' + wheel("left", 0.05) + wheel("right", -0.05)
+              + 'Pose { translation 0 0 0.1 rotation 0 0 1 0.5 children [ Slot { type "x" endPoint Slot { type "x" '
+                'endPoint DistanceSensor { translation 0.2 0 0 name "ds" } } } ] }\n] }\n'
+              + 'Solid { name "post" children [ Slot { endPoint Solid { translation 0 0 1 name "top" '
+                'children [ Shape { geometry Box { size 1 1 1 } } ] } } ] }\n')
+    w = load_world(p)
+    assert not w.report.losses and not w.warnings, w.warnings
+    (robot,) = w.world.robots
+    assert robot.differential_drive == wm.DifferentialDrive(wheel_radius=0.03, axle_length=0.1, max_wheel_speed=10.0,
+                                                            left_motor="left", right_motor="right")
+    assert [s.pose.translation for s in robot.shapes] == [(0.0, 0.05, 0.02), (0.0, -0.05, 0.02)]
+    assert [s.seen_by for s in robot.shapes] == ["both", "both"]
+    ds = next(d for d in robot.devices if d.name == "ds")
+    assert ds.pose.translation == pytest.approx((0.2 * math.cos(0.5), 0.2 * math.sin(0.5), 0.1), abs=1e-15)
+    (post,) = w.world.solids
+    (top,) = post.children
+    assert top.name == "top" and top.pose.translation == (0.0, 0.0, 1.0) and len(top.shapes) == 1
+    # anchors left at their default (0 0 0): the wheels' places come from the Solids inside the Slots,
+    # as from end points without Slots (the drive was refused: "both wheels are at the same place")
+    p = write(tmp_path, 'Robot { name "r" children [\n' + (wheel("left", 0.05) + wheel("right", -0.05)).replace(
+        "anchor 0 0.05 0.02 ", "").replace("anchor 0 -0.05 0.02 ", "") + '] }\n')
+    assert "anchor" not in p.read_text()
+    w = load_world(p)
+    assert not w.warnings, w.warnings
+    assert w.world.robots[0].differential_drive == robot.differential_drive
+
+
+def test_a_propeller_lists_its_motor_and_shows_its_slow_helix(tmp_path: Path) -> None:
+    # a drone's controller asks for its propeller motors: they were skipped with the Propeller node
+    # (getDevice found nothing), and so were the helices rays see
+    def prop(name: str, x: float) -> str:
+        return (f'Propeller {{ shaftAxis 0 0 1 centerOfThrust {x} 0 0.1 device RotationalMotor {{ name "{name}" '
+                f'maxVelocity 600 }} fastHelix Solid {{ translation {x} 0 0.1 children [ Shape {{ geometry Cylinder '
+                f'{{ radius 0.2 height 0.001 }} }} ] }} slowHelix Solid {{ translation {x} 0 0.1 children [ Shape {{ '
+                f'geometry Box {{ size 0.2 0.02 0.005 }} }} ] }} }}\n')
+    p = write(tmp_path, 'Robot { name "drone" children [\n' + prop("front propeller", 0.2) + 'GPS { }\n'
+              + prop("rear propeller", -0.2) + '] }\n')
+    w = load_world(p)
+    assert not w.report.losses
+    assert [x.split(": ", 1)[1] for x in w.warnings] == [
+        "Propeller: its motor is listed, its thrust and torque are not simulated (joints do not move here)"] * 2
+    (robot,) = w.world.robots
+    assert [(d.device, d.name) for d in robot.devices] == [
+        ("RotationalMotor", "front propeller"), ("GPS", "gps"), ("RotationalMotor", "rear propeller")]
+    assert [(s.geometry.type, s.pose.translation) for s in robot.shapes] == [
+        ("box", (0.2, 0.0, 0.1)), ("box", (-0.2, 0.0, 0.1))]       # the slow helices (at rest), not the fast ones
+    entries = Simulation(w).robot("drone").device_list     # what a controller's getDevice finds (not simulated)
+    assert [(e.name, e.simulated) for e in entries if e.name.endswith("propeller")] == [
+        ("front propeller", False), ("rear propeller", False)]
 
 
 @pytest.mark.parametrize("kwargs, why", [

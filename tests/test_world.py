@@ -188,6 +188,23 @@ def test_unknown_keys_rejected() -> None:
     assert ("colour", "unknown key (check spelling; field names are Webots' names in snake_case)") in probs
 
 
+def test_a_missing_or_unknown_kind_names_the_key_and_the_kinds() -> None:
+    # pydantic's "Unable to extract tag using discriminator 'device'" did not say what to write
+    from sensorium.schemas import world as wm
+
+    probs = _problems({"solids": [{"name": "s", "geometry": {"radius": 1}}, {"name": "t", "geometry": {"type": "ball"}}],
+                       "lights": [{"location": [0, 0, 1]}],
+                       "robots": [_robot([{"name": "x"}, {"device": "Sonar", "name": "y"}])]})
+    geometries = "box, sphere, cylinder, capsule, cone, plane, triangles, mesh, elevation_grid"
+    devices = ", ".join(wm.DEVICE_TYPES)
+    assert sorted(probs) == sorted([
+        ("solids[0].geometry", f"no 'type' key: it says what this is (one of: {geometries})"),
+        ("solids[1].geometry", f"type 'ball' is not one of: {geometries}"),
+        ("lights[0]", "no 'type' key: it says what this is (one of: PointLight, SpotLight, DirectionalLight)"),
+        ("robots[0].devices[0]", f"no 'device' key: it says what this is (one of: {devices})"),
+        ("robots[0].devices[1]", f"device 'Sonar' is not one of: {devices}")])
+
+
 def test_attenuation_zero_rejected() -> None:
     probs = _problems({"lights": [{"type": "PointLight", "attenuation": [0, 0, 0]}]})
     assert probs == [("lights[0].attenuation", "attenuation 0 0 0 would give infinite irradiance; use 1 0 0 for none")]

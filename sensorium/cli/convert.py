@@ -41,7 +41,7 @@ def convert(args: argparse.Namespace) -> int:
     if out is not None and out.suffix.lower() == ".json":
         text = json.dumps(data, indent=2) + "\n"
     else:
-        text = f"# Converted from {src.name} by `sensorium convert` (mesh urls relative to this file).\n" + dump_yaml(data)
+        text = f"# Converted from {src.name} by `sensorium convert` (mesh and texture urls relative to this file).\n" + dump_yaml(data)
     if out is None:
         sys.stdout.write(text)
         return 0
@@ -50,23 +50,28 @@ def convert(args: argparse.Namespace) -> int:
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, out)
     except OSError as exc:
+        tmp.unlink(missing_ok=True)    # (a directory named OUT, a full disk: no half-written file left behind)
         print(f"{out}: cannot write: {exc.strerror or exc}", file=sys.stderr)
         return 1
     print(f"{out}: written ({len(data.get('solids', []))} solids, {len(data.get('lights', []))} lights, "
           f"{len(data.get('robots', []))} robots)")
     outside = sorted({u for u in _mesh_urls(data) if Path(u).is_absolute() or u.startswith("..")})
     if outside:
-        print(f"note: {len(outside)} mesh url(s) leave {out.parent or '.'} (e.g. {outside[0]}): load the world with "
-              "--allow-outside-meshes, or move the meshes next to it", file=sys.stderr)
+        print(f"note: {len(outside)} mesh or texture url(s) leave {out.parent or '.'} (e.g. {outside[0]}): load the "
+              "world with --allow-outside-meshes, or move the files next to it", file=sys.stderr)
     return 0
 
 
 def _mesh_urls(data: object):
-    """Every mesh url of a world-file dict."""
+    """Every mesh and texture url of a world-file dict."""
+    from sensorium.server.world.wbt.emit import TEXTURE_KEYS
+
     if isinstance(data, dict):
         if data.get("type") == "mesh" and isinstance(data.get("url"), str):
             yield data["url"]
-        for v in data.values():
+        for k, v in data.items():
+            if k in TEXTURE_KEYS and isinstance(v, dict) and isinstance(v.get("url"), str):
+                yield v["url"]
             yield from _mesh_urls(v)
     elif isinstance(data, list):
         for v in data:

@@ -115,8 +115,21 @@ def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: W
     limits = limits or WorldLimits()
     try:
         if json_format:
-            return json.loads(text)
+            try:
+                return json.loads(text, object_pairs_hook=_json_object)
+            except _DuplicateKey as dup:
+                try:                          # where: the YAML reader (JSON is YAML) names its line and column
+                    load_yaml(text, WorldLimits.large())
+                except yaml.YAMLError as exc:
+                    if "duplicate key" in str(exc):
+                        raise WorldError(source, [Problem("", syntax_problem(exc).replace("YAML", "JSON"))]) from None
+                except Exception:  # noqa: BLE001 - any other reading: the line is not known, the key is
+                    pass
+                raise WorldError(source, [Problem("", f"not valid JSON: found duplicate key {dup.args[0]!r} (a "
+                                                      "key repeated in one object)")]) from None
         return load_yaml(text, limits)        # bounded while it is read (nesting, aliases, robots, ...)
+    except WorldError:
+        raise
     except LimitError as exc:
         raise WorldError(source, [Problem(exc.path, exc.message)]) from None
     except RecursionError:
@@ -129,6 +142,21 @@ def parse_text(text: bytes, source: str, *, json_format: bool = False, limits: W
         if len(detail) > 300:
             detail = detail[:300] + "…"
         raise WorldError(source, [Problem("", f"not valid YAML/JSON: {detail}")]) from None
+
+
+class _DuplicateKey(ValueError):
+    """A key repeated in one JSON object (json.loads keeps the last value in silence)."""
+
+
+def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out = dict(pairs)
+    if len(out) != len(pairs):
+        seen: set[str] = set()
+        for key, _ in pairs:
+            if key in seen:
+                raise _DuplicateKey(key)
+            seen.add(key)
+    return out
 
 
 def bundled_or_path(path: str | Path) -> Path:
@@ -318,6 +346,18 @@ def format_path(loc: tuple[Any, ...]) -> str:
     return out
 
 
+def _choices(loc: tuple[Any, ...]) -> tuple[str, ...]:
+    """The kinds a ``device``/``type`` key accepts where ``loc`` points (a device, geometry or light)."""
+    keys = [p for p in loc if isinstance(p, str)]
+    if keys and keys[-1] == "geometry":
+        return ("box", "sphere", "cylinder", "capsule", "cone", "plane", "triangles", "mesh", "elevation_grid")
+    if "devices" in keys:
+        return tuple(wm.DEVICE_TYPES)
+    if keys and keys[-1] == "lights":
+        return ("PointLight", "SpotLight", "DirectionalLight")
+    return ()
+
+
 def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
     loc = tuple(err.get("loc", ()))
     msg = err.get("msg", "invalid")
@@ -326,6 +366,14 @@ def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
         msg = "unknown key (check spelling; field names are Webots' names in snake_case)"
     elif kind in ("finite_number",):
         msg = f"expected a finite number, got {quote(err.get('input'))}"
+    elif kind in ("union_tag_not_found", "union_tag_invalid"):     # no (or an unknown) ``device:``/``type:``
+        ctx = err.get("ctx") or {}
+        key = str(ctx.get("discriminator", "")).strip("'")
+        kinds = ", ".join(_choices(loc))
+        if kind == "union_tag_not_found":
+            msg = f"no {key!r} key: it says what this is" + (f" (one of: {kinds})" if kinds else "")
+        else:
+            msg = f"{key} {quote(ctx.get('tag'))} is not one of: {kinds or ctx.get('expected_tags', '')}"
     elif "input" in err and kind not in ("missing", "union_tag_invalid", "union_tag_not_found") and not isinstance(err["input"], (dict, list)):
         msg = f"{msg} (got {quote(err['input'])})"
     if len(msg) > 400:

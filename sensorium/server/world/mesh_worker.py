@@ -6,7 +6,8 @@ to judge watertightness included). A world file names its meshes, so a hostile o
 ``validate`` exhaust the machine. Here the reading runs under ``RLIMIT_AS``: past the limit the
 reader fails (``MemoryError``) or the process dies, and the parent reports one line.
 
-Run as ``python -I mesh_worker.py PATH SX SY SZ MEMORY_BYTES``. It imports numpy and trimesh,
+Run as ``python -I mesh_worker.py PATH SX SY SZ MEMORY_BYTES [FORMAT]`` (FORMAT: ``stl``, ``obj``, ...;
+by default the file's suffix). It imports numpy and trimesh,
 never sensorium. Reply on stdout: a 4-byte big-endian length and a JSON header — ``{"ok": true,
 "vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3 float64 and NF×3 int64 (native
 order), or ``{"ok": false, "kind": "memory" | "error", "error": "..."}``.
@@ -29,13 +30,14 @@ def _reply(header, *arrays):
 
 def main():
     path, sx, sy, sz, memory = sys.argv[1], *map(float, sys.argv[2:5]), int(sys.argv[5])
+    kind = sys.argv[6] if len(sys.argv) > 6 and sys.argv[6] else None
     resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
     resource.setrlimit(resource.RLIMIT_CPU, (300, 300))       # a reader that never ends is stopped too
     try:
         import numpy as np
         import trimesh
 
-        loaded = trimesh.load(path, force="mesh", process=False)
+        loaded = trimesh.load(path, file_type=kind, force="mesh", process=False)
         vertices = np.ascontiguousarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
         faces = np.ascontiguousarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
         del loaded

@@ -65,14 +65,19 @@ def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1
     name = display if display is not None else str(path)
     if not path.is_file():
         raise MeshFileError(f"mesh file not found: {name}")
-    if path.suffix.lower() not in SUPPORTED:
+    kind = mesh_format(path)
+    if kind is None and not path.suffix:
+        raise MeshFileError(f"mesh file {name} has no suffix and is not a mesh format read here "
+                            f"(expected one of {sorted(SUPPORTED)})")
+    if kind is None:
         raise MeshFileError(f"unsupported mesh format {path.suffix!r} (expected one of {sorted(SUPPORTED)})")
     try:
         stat = path.stat()
         key = (str(path), stat.st_mtime_ns, tuple(float(s) for s in scale))
         mesh = _CACHE.get(key)
         if mesh is None:
-            mesh = _load(*key, memory if memory is not None else DEFAULT_LOAD_MEMORY, stat.st_size, max_triangles)
+            mesh = _load(*key, memory if memory is not None else DEFAULT_LOAD_MEMORY, stat.st_size, max_triangles,
+                         kind)
             _CACHE[key] = mesh
             while len(_CACHE) > 64:
                 _CACHE.popitem(last=False)
@@ -83,22 +88,57 @@ def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1
         raise MeshFileError(str(exc).replace(str(path), name)) from None
 
 
+def mesh_format(path: Path) -> str | None:
+    """The format of a mesh file (``stl``, ``obj``, ...): its suffix's; for a file without one
+    (Webots' asset cache names each file by the SHA-1 of its url), what its first bytes show. None:
+    not a format read here."""
+    suffix = path.suffix.lower()
+    if suffix:
+        return suffix[1:] if suffix in SUPPORTED else None
+    try:
+        with open(path, "rb") as f:
+            head = f.read(512)
+        size = path.stat().st_size
+    except OSError:
+        return None
+    if head[:4] == b"glTF":
+        return "glb"
+    if head[:3] == b"ply":
+        return "ply"
+    if len(head) >= 84 and size == 84 + 50 * int.from_bytes(head[80:84], "little"):
+        return "stl"                   # binary STL: an 80-byte header, a count, 50 bytes per triangle
+    text = head.lstrip()
+    if text.startswith(b"solid"):
+        return "stl"
+    if text.split(maxsplit=1)[:1] in ([b"OFF"], [b"COFF"], [b"NOFF"]):
+        return "off"
+    if text.startswith(b"{") and b'"asset"' in head:
+        return "gltf"
+    lines = text.splitlines() if size <= len(head) else text.splitlines()[:-1]    # (the last one may be cut)
+    words = {line.split(maxsplit=1)[0] for line in lines if line.strip()}
+    if words and words <= {b"#", b"v", b"vt", b"vn", b"vp", b"f", b"o", b"g", b"s", b"l", b"usemtl", b"mtllib"} \
+            and b"v" in words:
+        return "obj"
+    return None
+
+
 # meshes read, by (resolved path, modification time, scale), the 64 most recently used (whatever
 # memory bound they were read under: validating and building read each file once)
 _CACHE: OrderedDict[tuple[str, int, tuple[float, ...]], Any] = OrderedDict()
 
 
-def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: int, max_triangles: int | None):
+def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: int, max_triangles: int | None,
+          kind: str):
     from sensorium.server.world.geometry import Mesh
 
     if size > IN_PROCESS_BYTES:
-        vertices, faces, closed = _read_in_worker(path, scale, memory, max_triangles)
+        vertices, faces, closed = _read_in_worker(path, scale, memory, max_triangles, kind)
         vertices *= np.asarray(scale, dtype=np.float64)
         return Mesh(vertices=vertices, faces=faces, closed=closed)
     import trimesh
 
     try:
-        loaded = trimesh.load(path, force="mesh", process=False)
+        loaded = trimesh.load(path, file_type=kind, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for bad files
         raise MeshFileError(f"cannot read mesh {path}: {exc}") from None
     vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
@@ -117,7 +157,7 @@ def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: i
 
 
 def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
-                    max_triangles: int | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
+                    max_triangles: int | None = None, kind: str | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
     """(vertices, faces, closed) of a mesh file read by :mod:`.mesh_worker` within ``memory`` bytes."""
     import json
     import os
@@ -128,7 +168,8 @@ def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
     worker = Path(__file__).with_name("mesh_worker.py")
     env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
     env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
-    proc = subprocess.Popen([sys.executable, "-I", str(worker), path, *map(repr, scale), str(memory)],
+    proc = subprocess.Popen([sys.executable, "-I", str(worker), path, *map(repr, scale), str(memory),
+                             kind or Path(path).suffix.lower()[1:]],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=env,
                             close_fds=True)
     assert proc.stdout is not None

@@ -93,6 +93,8 @@ def image_header(path: Path, display: str) -> tuple[str, int, int]:
     """(format, width, height) from the file's header only (nothing decoded)."""
     from PIL import Image, UnidentifiedImageError
 
+    old = Image.MAX_IMAGE_PIXELS       # the caller checks the world's pixel limits on this header: Pillow's
+    Image.MAX_IMAGE_PIXELS = None      # own bomb guard (at 179 million) would answer first, with its message
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -102,6 +104,8 @@ def image_header(path: Path, display: str) -> tuple[str, int, int]:
         raise TextureFileError(f"texture file {display!r} is not a PNG or JPEG image") from None
     except (OSError, ValueError, Image.DecompressionBombError) as exc:
         raise TextureFileError(f"texture file {display!r} cannot be read: {exc}") from None
+    finally:
+        Image.MAX_IMAGE_PIXELS = old
     if fmt not in FORMATS:
         raise TextureFileError(f"texture file {display!r} is a {fmt} image; Webots reads PNG and JPEG only")
     if w < 1 or h < 1:

@@ -13,7 +13,8 @@ The result is what ``yaml.load`` with YAML 1.2 booleans gave (``true``/``false``
 field name ``on`` stays a string): YAML 1.1 numbers, null, merge keys (``<<``; explicit keys win,
 then the first merged mapping), timestamps, ``!!str``/``!!int``/``!!float``/``!!bool``/``!!null``/
 ``!!binary``/``!!timestamp`` tags. Departures (refused with a line and column): an alias inside
-the node it names (a recursive structure), and the ``!!set``/``!!omap``/``!!pairs`` collection tags.
+the node it names (a recursive structure), a key repeated in one mapping (YAML requires keys to be
+unique; PyYAML kept the last value in silence), and the ``!!set``/``!!omap``/``!!pairs`` collection tags.
 Errors are PyYAML's (``yaml.MarkedYAMLError``, with a mark) or :class:`~.limits.LimitError`.
 """
 
@@ -118,7 +119,7 @@ class _Frame:
     """An open mapping or sequence."""
 
     __slots__ = ("items", "is_map", "key", "has_key", "anchor", "start", "mark", "role", "count", "path",
-                 "merges", "counted")
+                 "merges", "counted", "keys")
 
     def __init__(self, is_map: bool, anchor: str | None, start: int, mark: Any, role: str, path: str,
                  counted: bool):
@@ -134,6 +135,7 @@ class _Frame:
         self.count = 0                          # items so far (counted sequences)
         self.path = path
         self.merges: list[tuple[Any, Any]] = []
+        self.keys: set[Any] | None = None       # a mapping's keys so far (a repeated key is refused)
 
 
 # (parent role, key) → the role of the container under that key; items of a counted sequence get
@@ -254,6 +256,13 @@ def _build(parser: Any, limits: WorldLimits) -> Any:
                                        event.start_mark)
             frame.key = "=" if node is _VALUE_KEY else node
             frame.has_key = True
+            if node is not _MERGE_KEY:
+                if frame.keys is None:
+                    frame.keys = set()
+                elif frame.key in frame.keys:
+                    raise ConstructorError("while constructing a mapping", frame.mark,
+                                           f"found duplicate key {_show_key(frame.key)}", event.start_mark)
+                frame.keys.add(frame.key)
         else:
             if node is _VALUE_KEY or node is _MERGE_KEY:
                 raise _no_constructor(event)
@@ -263,6 +272,11 @@ def _build(parser: Any, limits: WorldLimits) -> Any:
                 frame.items.append((frame.key, node))
             frame.key = None
             frame.has_key = False
+
+
+def _show_key(key: Any) -> str:
+    text = repr(key)
+    return text if len(text) <= 60 else text[:60] + "…"
 
 
 def _count(frame: _Frame, totals: dict[str, int], caps: dict[str, int], event: Any) -> None:

@@ -127,9 +127,9 @@ class _Expander:
         self.stand_ins: dict[str, tuple[str, int, int]] = {}
         self.memo: dict[int, tuple[Node, Node]] = {}       # id(node) → (node, its expansion)
         self.outer: dict[int, tuple[str, ...]] = {}        # nodes an instance passed in → the chain they were written in
-        self.bodies: dict[tuple[str, str], Node] = {}      # (PROTO file, generated text) → parsed root
+        self.bodies: dict[tuple[str, int, str], Node] = {}  # (PROTO file, body offset, generated text) → parsed root
         self.is_holders: dict[int, tuple[Node, bool]] = {}  # id(body node) → (node, whether an IS is under it)
-        self.rendered: dict[tuple[str, str], tpl.Rendered] = {}
+        self.rendered: dict[tuple[str, int, str], tpl.Rendered] = {}
         self.budget = tpl.Budget(limits.template_total_seconds)
         self.instances = 0
         self.timings = {"proto files": 0.0, "template": 0.0}   # wall seconds (``sensorium bench --only loading``)
@@ -147,43 +147,68 @@ class _Expander:
 
     def check_size(self, nodes: list[Node]) -> None:
         """Nodes and values of the expanded tree, each DEF/USE or shared copy counted (what the
-        converter walks), stopped at the bound."""
-        weight: dict[int, tuple[int, int]] = {}
+        converter walks), stopped at the bound; and the instances of each PROTO, counted alike."""
+        Uses = dict[str, int] | None
+        weight: dict[int, tuple[int, int, Uses]] = {}
         lim = self.limits
         total_n = total_v = 0
+        total_uses: dict[str, int] = {}
+        stand_ins = set(self.stand_ins)
 
-        def of(node: Node) -> tuple[int, int]:
+        def add(into: Uses, more: Uses, times: int = 1) -> Uses:
+            if not more:
+                return into
+            out = dict(into) if into else {}
+            for k, c in more.items():
+                out[k] = out.get(k, 0) + c * times
+            return out
+
+        def of(node: Node) -> tuple[int, int, Uses]:
             key = id(node)
             if key in weight:
                 return weight[key]
             n, v = 1, 0
+            uses: Uses = None
+            own = node.__dict__.get("uses")
+            if node.type in stand_ins:      # a built-in stand-in (RectangleArena, ...) the converter expands
+                own = (*(own or ()), f"\0{node.type}")
+            if own:
+                uses = {}
+                for k in own:
+                    uses[k] = uses.get(k, 0) + 1
             for value in node.fields.values():
-                dn, dv = of_value(value)
-                n, v = n + dn, v + dv
-            weight[key] = (n, v)
-            return n, v
+                dn, dv, du = of_value(value)
+                n, v, uses = n + dn, v + dv, add(uses, du)
+            weight[key] = (n, v, uses)
+            return n, v, uses
 
-        def of_value(value: Any) -> tuple[int, int]:
+        def of_value(value: Any) -> tuple[int, int, Uses]:
             if isinstance(value, Node):
                 return of(value)
             if isinstance(value, list):
                 n = v = 0
+                uses: Uses = None
                 for x in value:
-                    dn, dv = of_value(x)
-                    n, v = n + dn, v + dv
-                return n, v
+                    dn, dv, du = of_value(x)
+                    n, v, uses = n + dn, v + dv, add(uses, du)
+                return n, v, uses
             if isinstance(value, tuple):
-                return 0, len(value)
-            return 0, 0 if value is None else 1
+                return 0, len(value), None
+            return 0, 0 if value is None else 1, None
 
         for top in nodes:
-            n, v = of(top)
+            n, v, uses = of(top)
             total_n, total_v = total_n + n, total_v + v
             if total_n > lim.nodes or total_v > lim.values:
                 what = f"{lim.nodes:,} nodes" if total_n > lim.nodes else f"{lim.values:,} values"
                 raise ProtoError(top.source or self.world, top.line, top.col,
                                  f"the world holds more than {what} once PROTO instances are expanded and DEF/USE "
                                  "copies counted (raise the limits with --allow-large)")
+            for k, c in (uses or {}).items():
+                total_uses[k] = total_uses.get(k, 0) + c
+        for k, c in total_uses.items():
+            if k in self.uses:
+                self.uses[k].instances = c
 
     def unused_declarations(self) -> None:
         scope = self.scopes[self.world]
@@ -343,8 +368,10 @@ class _Expander:
         inner = (*chain, proto.name)
         root = self.substitute(body, proto, values, given, chain)
         out = self.node(root, inner, depth)
-        self.uses[f"{proto.source}\0{proto.name}"].instances += 1
-        return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col))
+        # the PROTOs this node stands for (a derived PROTO's base too), counted where it sits in the
+        # expanded tree (check_size): an expansion shared by several places is several instances
+        uses = (f"{proto.source}\0{proto.name}", *out.__dict__.get("uses", ()))
+        return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col), uses=uses)
 
     def values(self, node: Node, proto: ProtoDef, chain: tuple[str, ...]) -> tuple[dict[str, Any], set[str]]:
         """The instance's value of every field of ``proto``, checked."""
@@ -389,7 +416,7 @@ class _Expander:
     def body(self, node: Node, proto: ProtoDef, values: dict[str, Any]) -> Node:
         """The PROTO's body as nodes (with IsRefs): generated by its template when it has one."""
         if not proto.is_template:
-            key = (proto.source, "")
+            key = (proto.source, proto.body_offset, "")    # a world file may define several PROTOs
             if key not in self.bodies:
                 tokens = Tokens(proto.text, proto.source, proto.lines, proto.body_offset, proto.body_end)
                 self.bodies[key] = self.parse_body(tokens, proto)
@@ -401,7 +428,7 @@ class _Expander:
             f"{n}: {{value: {self.js(proto.fields[n], values[n])}, defaultValue: {self.js(proto.fields[n], proto.fields[n].default)}}}"
             for n in names) + "}"
         deterministic = "nonDeterministic" not in proto.tags
-        key = (proto.source, fields_js + "\0" + self.coordinate_system)
+        key = (proto.source, proto.body_offset, fields_js + "\0" + self.coordinate_system)
         rendered = self.rendered.get(key) if deterministic else None
         if rendered is None:
             context = self.context(proto)
@@ -416,7 +443,7 @@ class _Expander:
                 if level in ("error", "warn") and len(self.warnings) < 1000:
                     self.warnings.append(f"{proto.source}:{proto.line}:{proto.col}: PROTO {proto.name} (instance at "
                                          f"{node.source or self.world}:{node.line}): template says: {message}")
-        bkey = (proto.source, rendered.text)
+        bkey = (proto.source, proto.body_offset, rendered.text)
         if bkey not in self.bodies:
             try:
                 self.bodies[bkey] = self.parse_body(Tokens(rendered.text, proto.source, rendered.lines), proto)

@@ -56,7 +56,7 @@ Math.random = (function () {
   let s = 0x2545F491;                         // xorshift32, fixed seed: runs are reproducible
   return function () { s ^= s << 13; s ^= s >>> 17; s ^= s << 5; return (s >>> 0) / 4294967296; };
 })();
-globalThis.__mods = {};
+globalThis.__mods = {wbfile: globalThis.wbfile};
 """
 
 
@@ -226,7 +226,7 @@ def _program(body: str, fields_js: str, context_js: str, max_chars: int, source:
         else:
             code, code_at = body[start + 2:end], start + 2
             for what, mod, m in _imports_of(code):
-                if mod not in MODULES:
+                if mod not in MODULES and mod != "wbfile":     # (wbfile: imported as Webots' templates do)
                     line, col = file_lines.at(body_offset + code_at + m.start())
                     raise ProtoError(source, line, col, f"PROTO {proto}: import of module {short(mod)!r}: not "
                                      f"available here (modules: {', '.join(m + '.js' for m in MODULES)})")

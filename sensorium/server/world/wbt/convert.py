@@ -34,7 +34,7 @@ MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
 SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Physics", "ImmersionProperties",
-           "ContactProperties", "Damping", "Muscle", "Propeller"}
+           "ContactProperties", "Damping", "Muscle"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
 # the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
 OTHER_DEVICES = {"Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS",
@@ -246,7 +246,11 @@ class Converter:
         if t == "WorldInfo":
             if not top:
                 raise self.error(node, "WorldInfo must be a top-level node")
-            self.world_info(node)
+            if "basic_time_step" in self.world["world_info"]:    # Webots reads the first one
+                self.warn(node, "duplicate WorldInfo node: only the first one counts (as in Webots); this one is "
+                                "skipped")
+            else:
+                self.world_info(node)
         elif t == "Background" and top and f.has("skyColor"):     # what cameras see past everything
             sky = f.rows("skyColor", 3, [(0.0, 0.0, 0.0)])
             self.world["background"] = {"sky_color": list(sky[0]) if sky else [0.0, 0.0, 0.0]}
@@ -278,6 +282,19 @@ class Converter:
         elif t == "Group":
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
+        elif t == "Propeller":           # a robot's motor (listed: controllers ask for it) and its helix
+            if owner.kind == "robot":
+                self.joint_devices(node, owner)
+                if f.node_("device") is not None:
+                    self.warn(node, "Propeller: its motor is listed, its thrust and torque are not simulated (joints "
+                                    "do not move here)")
+            helix = f.node_("slowHelix")     # what Webots shows below fastHelixThreshold (at rest)
+            if helix is not None:
+                self.visit(helix, frame, owner)
+        elif t == "Slot":                # Webots' base node: its endPoint sits in the Slot's parent frame
+            end = f.node_("endPoint")
+            if end is not None:
+                self.visit(end, frame, owner)
         elif t in ("Pose", "Transform"):
             inner = self.child_frame(node, frame)
             for child in f.nodes("children"):
@@ -313,11 +330,16 @@ class Converter:
         elif t in GEOMETRIES:
             self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
         else:
+            from sensorium.server.world.proto.interface import BASE_NODES
+
             named = node.fields.get("name")
             robot_like = any(k in node.fields for k in ROBOT_ONLY_FIELDS)   # a robot PROTO instance, surely
-            self.drop(node, f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
-                            f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}", "robot" if robot_like else "node",
-                      named if isinstance(named, str) else t)
+            if t in BASE_NODES:      # a Webots node (Fluid, Billboard, ...), not a PROTO whose file is missing
+                why = f"{t}: a Webots node not read here (or not in its place); skipped (with everything inside it)"
+            else:
+                why = (f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
+                       f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
+            self.drop(node, why, "robot" if robot_like else "node", named if isinstance(named, str) else t)
 
     def scaled_solid(self, node: Node, owner: Owner) -> None:
         """A Solid (a robot, a device, a joint's end point) under a Transform that scales: Webots
@@ -540,7 +562,9 @@ class Converter:
         # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
         coord = f.node_("coord")
         points = self.fields(coord).rows("point", 3, []) if coord is not None else []
-        index = [int(i) for i in f.numbers("coordIndex")]
+        index = f.integers("coordIndex")
+        if index and min(index) < -1:
+            raise f.error("coordIndex", f"{min(index)} is not a vertex index (-1 ends a face)")
         tex, tex_index = fx.tex_coords(node, f, len(index), self.warn)
         faces: list[list[int]] = []
         tex_faces: list[list[int]] = []
@@ -853,8 +877,9 @@ class Converter:
             anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
             m = self.fields(motors[0])
             centre = anchor
-            if end is not None and end.type == "Solid":
-                centre = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
+            wheel = self.slotted(end)
+            if wheel is not None and wheel.type == "Solid":
+                centre = self.fields(wheel).vec("translation", (0.0, 0.0, 0.0))
             turn = frame.rotation @ np.asarray(axis)
             owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"),
                                  "steers": abs(turn[2]) > 0.9 * float(np.linalg.norm(turn)),   # a vertical axis
@@ -872,6 +897,12 @@ class Converter:
                 return
             self.visit(end, frame, owner)
 
+    def slotted(self, end: Node | None) -> Node | None:
+        """A joint's end point, through the Slots that hold it (a Slot adds no frame)."""
+        while end is not None and end.type == "Slot":
+            end = self.fields(end).node_("endPoint")
+        return end
+
     def hinge2(self, node: Node, frame: Frame, owner: Owner, motors: list[Node], sensors: list[dict]) -> None:
         """A Hinge2Joint of a robot: its first axis (``jointParameters``, ``device``) steers, its
         second (``jointParameters2``, ``device2``) turns the wheel, its end point. Both become
@@ -881,8 +912,9 @@ class Converter:
         spin_motors = [d for d in f.nodes("device2") if d.type in MOTORS]
         _, spin_sensors = self.joint_devices(node, owner, "device2")
         centre_at = (0.0, 0.0, 0.0)
-        if end is not None and end.type == "Solid":
-            centre_at = self.fields(end).vec("translation", (0.0, 0.0, 0.0))
+        wheel = self.slotted(end)
+        if wheel is not None and wheel.type == "Solid":
+            centre_at = self.fields(wheel).vec("translation", (0.0, 0.0, 0.0))
         centre = np.asarray(frame.apply(centre_at))
         for params_field, axis_default, found, found_sensors, steers in (
                 ("jointParameters", (1.0, 0.0, 0.0), motors, sensors, True),

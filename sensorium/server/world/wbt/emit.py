@@ -1,4 +1,4 @@
-"""The converted world as a file: mesh urls made relative to where it is written, compact YAML."""
+"""The converted world as a file: mesh and texture urls made relative to where it is written, compact YAML."""
 
 from __future__ import annotations
 
@@ -28,18 +28,31 @@ def dump_yaml(data: Any) -> str:
     return yaml.dump(data, Dumper=_Dumper, sort_keys=False, width=120)
 
 
+TEXTURE_KEYS = ("texture", "roughness_map", "occlusion_map")     # an appearance's image files
+
+
 def _rebase(data: Any, src_dir: Path, out_dir: Path) -> Any:
     if isinstance(data, dict):
         if data.get("type") == "mesh" and isinstance(data.get("url"), str):
-            target = (src_dir / data["url"]).resolve()
-            return {**data, "url": Path(os.path.relpath(target, out_dir)).as_posix()}
-        return {k: _rebase(v, src_dir, out_dir) for k, v in data.items()}
+            return {**data, "url": _relative(data["url"], src_dir, out_dir)}
+        return {k: _rebase_texture(v, src_dir, out_dir) if k in TEXTURE_KEYS else _rebase(v, src_dir, out_dir)
+                for k, v in data.items()}
     if isinstance(data, list):
         return [_rebase(v, src_dir, out_dir) for v in data]
     return data
 
 
+def _relative(url: str, src_dir: Path, out_dir: Path) -> str:
+    return Path(os.path.relpath((src_dir / url).resolve(), out_dir)).as_posix()
+
+
+def _rebase_texture(texture: Any, src_dir: Path, out_dir: Path) -> Any:
+    if isinstance(texture, dict) and isinstance(texture.get("url"), str) and "://" not in texture["url"]:
+        return {**texture, "url": _relative(texture["url"], src_dir, out_dir)}
+    return texture
+
+
 def converted_world(src: str | Path, out_dir: Path) -> dict:
-    """The world-file dict of a .wbt file, mesh urls relative to ``out_dir``."""
+    """The world-file dict of a .wbt file, mesh and texture urls relative to ``out_dir``."""
     data, _, _ = wbt_to_dict(src)
     return _rebase(data, Path(src).resolve().parent, out_dir.resolve())

@@ -36,6 +36,15 @@ class Fields:
             raise self.error(name, f"expected an integer, got {v}")
         return int(v)
 
+    def integers(self, name: str) -> list[int]:
+        """An MFInt32 field (``coordIndex``): every value a whole number."""
+        out = []
+        for v in self.numbers(name):
+            if v != int(v):
+                raise self.error(name, f"expected integers, got {v}")
+            out.append(int(v))
+        return out
+
     def vec(self, name: str, default: tuple[float, ...]) -> tuple[float, ...]:
         v = self.node.fields.get(name, default)
         if isinstance(v, float | int) and not isinstance(v, bool):
@@ -298,7 +307,7 @@ def tex_coords(node: Node, f: Fields, n_index: int, warn) -> tuple[list[list[flo
     points = [list(p) for p in Fields(tnode, f.source).rows("point", 2, [])] if tnode is not None else []
     if not points:
         return None, None
-    index = [int(i) for i in f.numbers("texCoordIndex")] or [int(i) for i in f.numbers("coordIndex")]
+    index = f.integers("texCoordIndex") or f.integers("coordIndex")
     if len(index) != n_index:
         warn(node, f"IndexedFaceSet: texCoordIndex has {len(index)} entries for {n_index} in coordIndex: "
                    "Webots' default texture mapping applies")
@@ -333,7 +342,9 @@ WEBOTS_FIELDS: dict[str, set[str]] = {
     "Solid": _SOLID, "Robot": _ROBOT,
     "Pose": {"translation", "rotation", "children", "translationStep", "rotationStep"},
     "Transform": {"translation", "rotation", "scale", "children", "translationStep", "rotationStep"},
-    "Group": {"children"},
+    "Group": {"children"}, "Slot": {"type", "endPoint"},
+    "Propeller": {"shaftAxis", "centerOfThrust", "thrustConstants", "torqueConstants", "fastHelixThreshold", "device",
+                  "fastHelix", "slowHelix"},
     "Shape": {"appearance", "geometry", "castShadows", "isPickable"},
     "Box": {"size"}, "Sphere": {"radius", "subdivision", "ico"}, "Cylinder": _ROUND, "Capsule": _ROUND,
     "Plane": {"size"}, "Mesh": {"url", "ccw", "name", "materialIndex"},

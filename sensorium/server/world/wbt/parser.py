@@ -45,6 +45,9 @@ _TOKEN = re.compile(r"""
 """, re.VERBOSE | re.DOTALL)
 
 
+_SIGNED_NONFINITE = re.compile(r"[+-](?:nan|inf(?:inity)?)(?![^\s,\[\]{}])", re.IGNORECASE)
+
+
 class WbtSyntaxError(Exception):
     """A .wbt file that cannot be read; the message is ``FILE:LINE:COL: what`` (one line, short)."""
 
@@ -175,6 +178,9 @@ class Tokens:
             elif kind == "bad":
                 line, col = lines.at(m.start())
                 what = "unterminated string" if value == '"' else f"unexpected character {value!r}"
+                signed = _SIGNED_NONFINITE.match(self.text, m.start(), self.end) if value in "+-" else None
+                if signed:
+                    what = f"number {quote(signed.group(), 40)} is not finite (a world's numbers must be finite)"
                 raise WbtSyntaxError(self.source, line, col, what)
             else:
                 items.append(Token(kind, value, m.start(), lines))  # type: ignore[arg-type]
@@ -340,6 +346,7 @@ class Parser:
             nums = []
             while self.peek().kind == "num":
                 nums.append(self.number(self.take()))
+            self.nonfinite()
             self.values += len(nums)
             self._grew(tok)
             return nums[0] if len(nums) == 1 else tuple(nums)
@@ -355,6 +362,7 @@ class Parser:
             self.values += 1
             self._grew(tok)
             return unquote(self.take().text)
+        self.nonfinite()
         if tok.kind == "name":
             if tok.text in ("TRUE", "FALSE"):
                 self.take()
@@ -367,6 +375,14 @@ class Parser:
         if tok.kind == "tmpl":
             raise self.error(tok, "template statement (%< ... >%) outside a PROTO body")
         raise self.error(tok, f"expected a value, found {_describe(tok)}")
+
+    def nonfinite(self) -> None:
+        """Refuse ``nan``, ``inf`` or ``infinity`` (any case, signed) where a value may be next: they
+        would otherwise be read as a field name or a node type, and the error would name something else
+        (a node type, followed by '{', is left alone: a PROTO may be called Inf)."""
+        tok = self.peek()
+        if tok.kind == "name" and tok.text.lower() in ("nan", "inf", "infinity") and self.peek(1).kind != "{":
+            raise self.error(tok, f"number {quote(tok.text, 40)} is not finite (a world's numbers must be finite)")
 
     def number(self, tok: Token) -> float:
         text = tok.text
