@@ -122,6 +122,8 @@ def whole_ms(v: Any) -> int | None:
     """``v`` as an ``int`` when it is a whole number: an int or a numpy integer (Webots' ctypes
     ``c_int`` takes both), or an integral float (``step(robot.getBasicTimeStep())``); None otherwise
     (a bool, a fraction, not a number)."""
+    if type(v) is int:            # the step loop's case, before the slower ABC checks
+        return v
     if isinstance(v, bool):
         return None
     if isinstance(v, numbers.Integral):
