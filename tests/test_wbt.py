@@ -75,6 +75,23 @@ def test_full_wbt_is_its_yaml_twin_bit_for_bit() -> None:
     assert len(set(watcher)) > 10
 
 
+def test_a_world_file_with_a_byte_order_mark_loads_as_without(tmp_path: Path) -> None:
+    """A UTF-8 byte-order mark, as some Windows editors write, made the header check fail ("not a
+    Webots world: the first line must be ...")."""
+    body = HEADER + "WorldInfo { basicTimeStep 16 }\nSolid { translation 1 2 3 boundingObject Box { size 1 1 1 } }\n"
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    plain, marked = tmp_path / "a" / "w.wbt", tmp_path / "b" / "w.wbt"
+    plain.write_text(body, encoding="utf-8")
+    marked.write_bytes(b"\xef\xbb\xbf" + body.encode())
+    a, b = load_world(plain).world, load_world(marked).world
+    assert b.world_info.basic_time_step == 16 and b.model_dump() == a.model_dump()
+    bad = tmp_path / "bad.wbt"      # an invalid byte after the mark is still placed at its own line and column
+    bad.write_bytes(b"\xef\xbb\xbf" + HEADER.encode() + b"WorldInfo {}\nSolid { name \"a\xffb\" }\n")
+    with pytest.raises(WorldError, match=r"bad.wbt: line 3, column 16: not valid UTF-8$"):
+        load_world(bad)
+
+
 def test_skipped_nodes_summarised_once() -> None:
     w = load_world(HERE / "full.wbt")
     summary = [x for x in w.warnings if "skipped nodes that do not matter" in x]

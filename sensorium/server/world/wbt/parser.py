@@ -455,6 +455,8 @@ def read_text(path: str | Path, what: str, max_bytes: int) -> str:
         data = path.read_bytes()
     except OSError as exc:
         raise WbtSyntaxError(source, 0, 0, f"cannot read {what} file: {exc.strerror or exc}") from None
+    if data.startswith(b"\xef\xbb\xbf"):    # a byte-order mark (some Windows editors write one): dropped
+        data = data[3:]
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
