@@ -25,6 +25,7 @@ from hypothesis import strategies as st
 
 from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import WorldError, load_world, parse_world
+from sensorium.server.world.yamlload import load_yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 MESH = ROOT / "sensorium" / "worlds" / "meshes" / "rock.stl"
@@ -122,6 +123,26 @@ def test_triangles_are_counted_in_closed_form_and_from_mesh_files(tmp_path: Path
 def test_numbers_that_cannot_be_computed_with_are_refused_with_their_path(data, path, words) -> None:
     probs = problems(data)
     assert any(p.startswith(path) and words in m for p, m in probs), probs
+
+
+@pytest.mark.parametrize(("data", "path", "message"), [
+    ({"world_info": {"name": "w", "basic_time_step": True}}, "world_info", "basic_time_step: expected a number, got True"),
+    ({"solids": [{"name": "s", "pose": {"translation": [0, False, 0]}, "geometry": {"type": "box"}}]},
+     "solids[0].pose", "translation: expected a number, got False"),
+    ({"robots": [robot({"device": "DistanceSensor", "name": "d", "lookup_table": [[0, 0, 0], [1, 1000, True]]})]},
+     "robots[0].devices[0]", "lookup_table: expected a number, got True"),
+    ({"solids": [{"name": "s", "geometry": {"type": "elevation_grid", "x_dimension": 2, "y_dimension": 2,
+                                           "height": [0, 0, True, 0]}}]}, "solids[0].geometry", "height: expected a number, got True"),
+])
+def test_a_bool_where_a_number_is_due_is_refused_not_read_as_0_or_1(data, path, message) -> None:
+    """pydantic's lax mode read `basic_time_step: true` as a 1 ms step, without a word."""
+    assert problems(data) == [(path, message)]
+
+
+def test_a_number_written_as_a_string_is_still_the_number() -> None:
+    # YAML 1.1 reads 1e-3 (no dot) as a string; it has always meant the number
+    world = parse_world(load_yaml("solids: [{name: s, geometry: {type: sphere, radius: 1e-3}}]"))
+    assert world.world.solids[0].geometry.radius == 0.001
 
 
 def test_strings_and_names_are_bounded_and_errors_quote_a_prefix() -> None:

@@ -12,7 +12,9 @@ radians, time in integer milliseconds.
 from __future__ import annotations
 
 import math
-from typing import Annotated, ClassVar, Literal
+import types
+import typing
+from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
@@ -36,10 +38,45 @@ def _nonzero_direction(v: Vec3) -> Vec3:
     return v
 
 
+def _not_a_number(value: Any, tp: Any) -> tuple[Any] | None:
+    """``(v,)`` for the first bool in ``value`` where the annotation ``tp`` wants a number, else
+    None. Pydantic's lax mode reads ``true`` as 1: a YAML ``basic_time_step: true`` became a 1 ms
+    step without a word. (A string that spells a number stays one: YAML 1.1 reads ``1e-3``, without
+    a dot, as a string, and pydantic's reading of it is the number meant.)"""
+    if tp is float or tp is int:
+        return (value,) if isinstance(value, bool) else None
+    origin, args = typing.get_origin(tp), typing.get_args(tp)
+    if origin is Annotated:
+        return _not_a_number(value, args[0])
+    if origin is typing.Union or origin is types.UnionType:
+        kinds = [a for a in args if a is not type(None)]
+        return _not_a_number(value, kinds[0]) if len(kinds) == 1 else None   # (X | None only)
+    if origin not in (tuple, list) or not isinstance(value, (list, tuple)) or not args:
+        return None
+    if origin is list or (len(args) == 2 and args[1] is Ellipsis):
+        if args[0] is float or args[0] is int:      # a long run of numbers (heights): its types at C speed
+            if bool not in set(map(type, value)):
+                return None
+        return next((bad for v in value if (bad := _not_a_number(v, args[0])) is not None), None)
+    return next((bad for v, a in zip(value, args) if (bad := _not_a_number(v, a)) is not None), None)
+
+
 class Strict(BaseModel):
-    """Base: unknown keys are errors, NaN/inf rejected everywhere, models immutable."""
+    """Base: unknown keys are errors, NaN/inf rejected everywhere, models immutable, and a bool where
+    a number is due is refused (not read as 0 or 1)."""
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _numbers_are_numbers(cls, data: Any) -> Any:
+        if isinstance(data, dict):
+            fields = cls.model_fields
+            for name, value in data.items():
+                field = fields.get(name)
+                if field is not None and (bad := _not_a_number(value, field.annotation)) is not None:
+                    raise ValueError(f"{name}: expected a number, got {bad[0]!r}")
+        return data
 
 
 class Pose(Strict):
