@@ -92,6 +92,14 @@ def test_a_world_file_with_a_byte_order_mark_loads_as_without(tmp_path: Path) ->
         load_world(bad)
 
 
+def test_an_indexed_face_set_without_coord_says_so(tmp_path: Path) -> None:
+    """It said "vertex index outside 0..-1"."""
+    w = tmp_path / "w.wbt"
+    w.write_text(HEADER + "WorldInfo {}\nSolid {\n  children [ Shape { geometry IndexedFaceSet { coordIndex [0 1 2 -1] } } ]\n}\n")
+    with pytest.raises(WorldError, match=r"line 4, column 31 .*geometry.vertices\): no vertices for its 1 face\(s\) to index"):
+        load_world(w)
+
+
 def test_skipped_nodes_summarised_once() -> None:
     w = load_world(HERE / "full.wbt")
     summary = [x for x in w.warnings if "skipped nodes that do not matter" in x]

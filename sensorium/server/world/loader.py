@@ -532,6 +532,8 @@ def all_geometries(world: wm.World) -> Iterator[tuple[str, Any]]:
 def _check_geometry(geom: Any, path: str, base_dir: Path) -> list[Problem]:
     if isinstance(geom, wm.Triangles):
         n = len(geom.vertices)
+        if n == 0 and geom.faces:          # (a .wbt IndexedFaceSet without its coord)
+            return [Problem(f"{path}.vertices", f"no vertices for its {len(geom.faces)} face(s) to index")]
         for i, face in enumerate(geom.faces):
             if min(face) < 0 or max(face) >= n:
                 return [Problem(f"{path}.faces[{i}]", f"vertex index outside 0..{n - 1}: {list(face)}")]
