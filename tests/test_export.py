@@ -175,6 +175,14 @@ def test_refuses_to_overwrite_and_unknown_distro(recording, tmp_path):
         export_ros2(src, tmp_path / "y", distro="noetic")
 
 
+def test_topics_that_match_nothing_are_refused(recording, tmp_path):
+    """A typo in --topics wrote an empty bag and exited 0."""
+    src, _ = recording
+    with pytest.raises(ExportError, match=r"--topics /epuck/ps9/value: no topic of .* matches it \(closest: /epuck/"):
+        export_ros2(src, tmp_path / "bag", topics=["/scout", "/epuck/ps9/value"])
+    assert not (tmp_path / "bag").exists()
+
+
 def test_cli_export(recording, tmp_path):
     src, items = recording
     out = tmp_path / "cli_bag"

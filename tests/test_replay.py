@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import signal
+import subprocess
 import threading
 import time
 from contextlib import contextmanager
@@ -257,6 +258,27 @@ def test_subscription_prefixes():
     assert subscription_prefixes(["/epuck/ps1"]) == [b"/epuck/ps1\0", b"/epuck/ps1/"]
     assert subscription_prefixes(["/epuck/"]) == [b"/epuck/"]
     assert subscription_prefixes(["/epuck/ps*"]) == [b"/epuck/ps"]
+
+
+def test_topics_that_match_nothing_are_refused(rec_path, ctx, tmp_path):
+    """A typo in --topics gave an empty replay or recording and exit 0 without a word."""
+    path, _ = rec_path
+    with pytest.raises(ValueError, match=r"--topics /epcuk: no topic of .*rec\.mcap matches it \(closest: "):
+        Replayer(str(path), topics=["/epuck/ps*", "/epcuk"], context=ctx)
+    with running(path, ctx, lockstep=True) as (r, th):
+        th.start()
+        out = tmp_path / "typo.mcap"
+        live = LiveRecorder(out, connect=r.rpc_endpoint, topics=["/scout", "/scuot/lidar"], context=ctx)
+        with pytest.raises(ValueError, match=r"--topics /scuot/lidar: no topic of the server at tcp://"):
+            live.open()
+        assert not out.exists()                      # nothing written
+        live = LiveRecorder(out, connect=r.rpc_endpoint, topics=["/scout", "/epuck/ps1"], context=ctx)
+        live.open()                                  # prefixes and exact names that match are fine
+        live.close()
+    proc = subprocess.run(sensorium("replay", str(path), "--rpc", ANY, "--pub", ANY, "--topics", "/nosuch"),
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.startswith("sensorium replay: --topics /nosuch: no topic of ") and "Traceback" not in proc.stderr
 
 
 def test_record_connect_keeps_up_zero_gaps(rec_path, ctx, tmp_path):

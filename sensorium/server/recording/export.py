@@ -42,6 +42,7 @@ import numpy as np
 
 from sensorium.schemas.devices import KINDS
 from sensorium.server.recording import cdr
+from sensorium.server.recording.envelope import unmatched_topics
 from sensorium.server.recording.reader import Recording
 
 DISTROS = ("humble", "jazzy")
@@ -404,6 +405,9 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
         if progress:
             rec.check()                     # damaged chunks found first: the total counts what will be read
         report.total = sum(t.count for t in rec.topics()) if progress else 0
+        problem = unmatched_topics(topics, [t.topic for t in rec.topics()], str(src))
+        if problem:
+            raise ExportError(problem)
         meta = rec.metadata().get("sensorium", {})
         world = rec.world()
         try:

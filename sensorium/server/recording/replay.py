@@ -35,7 +35,7 @@ from sensorium.schemas.wire import (
     parse_request,
     stamp,
 )
-from sensorium.server.recording.envelope import pack_envelope, topic_matcher
+from sensorium.server.recording.envelope import pack_envelope, topic_matcher, unmatched_topics
 from sensorium.server.recording.reader import RecordedMessage, Recording
 from sensorium.server.recording.scan import Damage
 
@@ -105,6 +105,10 @@ class Replayer:
         skip_clock = clock_hz is not None
         self._match = lambda t: match(t) and not (skip_clock and t == CLOCK_TOPIC)
         infos = self.recording.topics()
+        problem = unmatched_topics(topics, [t.topic for t in infos], self.path)
+        if problem:
+            self.recording.close()
+            raise ValueError(problem)
         self.topic_types = {t.topic: t.ros_type for t in infos if self._match(t.topic)}
         times = [(t.first_ns, t.last_ns) for t in infos
                  if self._match(t.topic) and t.first_ns is not None and t.last_ns is not None]
