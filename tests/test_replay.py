@@ -235,6 +235,25 @@ def test_lockstep(rec_path, ctx):
         assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 0})["error"]["code"] == 5
 
 
+def test_lockstep_refuses_times_it_could_not_answer(rec_path, ctx):
+    """A step or seek to a time past 2^64 ns was taken, and from then on every request (get_info,
+    get_state) was answered INTERNAL 'OverflowError': one bad request wedged the replay."""
+    path, _ = rec_path
+    with running(path, ctx, lockstep=True) as (r, th):
+        th.start()
+        for service, args in (("/replay/step", {"duration": 2**64 - 1}), ("/replay/step", {"duration": 2**31}),
+                              ("/replay/seek", {"time_ms": 2**64 - 1}), ("/replay/seek", {"time_ms": 2**53})):
+            reply = call(ctx, r.rpc_endpoint, service, args)
+            assert not reply["ok"] and reply["error"]["code"] == 5, (service, args, reply)
+        state = call(ctx, r.rpc_endpoint, "/replay/get_state")
+        assert state["ok"] and state["result"]["time_ms"] == 0
+        near_end = (2**63 - 1) // 1_000_000 - 10
+        assert call(ctx, r.rpc_endpoint, "/replay/seek", {"time_ms": near_end})["ok"]
+        assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 20})["error"]["code"] == 5
+        assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 10})["result"]["time_ms"] == near_end + 10
+        assert call(ctx, r.rpc_endpoint, "get_info")["ok"]
+
+
 def test_cli_replay_announces_and_finishes(rec_path, ctx):
     path, items = rec_path
     with Served(sensorium("replay", str(path), "--pub", ANY, "--rpc", ANY, "--rate", "0", "--wait", "--topics",

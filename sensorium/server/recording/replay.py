@@ -26,6 +26,7 @@ from typing import IO, Any
 
 import zmq
 
+from sensorium.schemas.services import MAX_PERIOD_MS
 from sensorium.schemas.wire import (
     ErrorCode,
     RequestError,
@@ -43,6 +44,9 @@ CLOCK_TOPIC = "/clock"
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
+# the latest replay time a step or seek may reach: its nanoseconds fit a ROS stamp's int64 (and
+# every reply's msgpack integers); beyond it the replay's state could no longer be sent at all
+MAX_TIME_MS = ((1 << 63) - 1) // 1_000_000
 
 
 def _fmt_s(ns: int | float) -> str:
@@ -316,8 +320,11 @@ class Replayer:
     # lockstep
     def _step(self, args: dict) -> dict:
         duration = args.get("duration", self.basic_time_step)
-        if not isinstance(duration, int) or isinstance(duration, bool) or duration <= 0:
-            raise RequestError(ErrorCode.INVALID_ARGUMENT, "duration: a positive integer number of ms is required")
+        if not isinstance(duration, int) or isinstance(duration, bool) or not 0 < duration <= MAX_PERIOD_MS:
+            raise RequestError(ErrorCode.INVALID_ARGUMENT,
+                               f"duration: a positive integer number of ms up to {MAX_PERIOD_MS} is required")
+        if self.time_ns + duration * 1_000_000 > MAX_TIME_MS * 1_000_000:
+            raise RequestError(ErrorCode.INVALID_ARGUMENT, f"duration: the replay time would pass {MAX_TIME_MS} ms")
         self.time_ns += duration * 1_000_000
         n = self._emit_until(self.time_ns)
         if self.clock_hz is not None and (self._last_clock_ns is None or self.time_ns > self._last_clock_ns):
@@ -328,8 +335,8 @@ class Replayer:
 
     def _seek(self, args: dict) -> dict:
         t = args.get("time_ms")
-        if not isinstance(t, int) or isinstance(t, bool) or t < 0:
-            raise RequestError(ErrorCode.INVALID_ARGUMENT, "time_ms: a non-negative integer is required")
+        if not isinstance(t, int) or isinstance(t, bool) or not 0 <= t <= MAX_TIME_MS:
+            raise RequestError(ErrorCode.INVALID_ARGUMENT, f"time_ms: an integer from 0 to {MAX_TIME_MS} is required")
         self.time_ns = t * 1_000_000
         lo = self.time_ns + 1  # messages at exactly time_ms count as already emitted
         if self.start_ns is not None:
