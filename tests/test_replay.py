@@ -201,6 +201,23 @@ def test_free_running_services(rec_path, ctx):
     assert seqs == list(range(32))
 
 
+def test_extreme_rates_keep_the_replay_running(rec_path, ctx):
+    """/replay/set_rate {value: 1e-300} killed the replay (OverflowError in its poll) and 1e308 too
+    (an infinite playhead): one request of any client ended it for everyone."""
+    path, _ = rec_path
+    with running(path, ctx, rate=1.0, wait_subscriber=True, topics=["/epuck/ls0"]) as (r, th):
+        sub = subscriber(ctx, r.pub_endpoint)
+        th.start()
+        assert call(ctx, r.rpc_endpoint, "/replay/set_rate", {"value": 1e-300})["ok"]
+        first = drain(sub, idle=0.5)
+        assert th.is_alive() and call(ctx, r.rpc_endpoint, "/replay/get_state")["result"]["rate"] == 1e-300
+        assert call(ctx, r.rpc_endpoint, "/replay/set_rate", {"value": 1e308})["ok"]
+        rest = drain(sub, idle=0.5, limit=32 - len(first))
+        th.join(10)
+        assert not th.is_alive() and r.done            # it ran to its end
+    assert [msgpack.unpackb(f[1])["seq"] for _t, f in first + rest] == list(range(32))
+
+
 def test_lockstep(rec_path, ctx):
     path, items = rec_path
     with running(path, ctx, lockstep=True) as (r, th):

@@ -209,8 +209,9 @@ class Replayer:
 
     # ------------------------------------------------------------------ RPC
     def _service(self, timeout_s: float) -> None:
-        """Wait up to ``timeout_s`` for requests or subscriptions and handle them."""
-        timeout_ms = max(0, int(math.ceil(timeout_s * 1000)))
+        """Wait up to ``timeout_s`` (at most a second: callers wait in a loop) for requests or
+        subscriptions and handle them."""
+        timeout_ms = max(0, int(math.ceil(min(timeout_s, 1.0) * 1000)))
         events = dict(self._poller.poll(timeout_ms))
         assert self.pub is not None, "bind() first"
         if self.pub in events:
@@ -352,7 +353,8 @@ class Replayer:
             return self._paused_at_ns
         if self.rate <= 0:
             return self.time_ns
-        return int(self._base_ns + (now - self._wall0) * self.rate * 1e9)
+        # saturated: a huge rate (set_rate {value: 1e308}) makes this infinite, never an error
+        return int(min(self._base_ns + (now - self._wall0) * self.rate * 1e9, MAX_TIME_MS * 1_000_000))
 
     def _wall_of(self, t_ns: int) -> float:
         return self._wall0 + (t_ns - self._base_ns) / (self.rate * 1e9)
