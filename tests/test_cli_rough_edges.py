@@ -54,6 +54,28 @@ def test_a_bad_yaml_argument_to_call_names_its_position():
         "expected ',' or '}', but got '<stream end>'"]
 
 
+def test_call_args_msgpack_cannot_carry_are_one_line_naming_the_value():
+    """A YAML date, a set or an integer beyond 64 bits in ARGS ended `sensorium call` in a msgpack
+    traceback; a non-string key got the server's misleading 'not a msgpack document'."""
+    import pytest
+
+    from sensorium.cli.services import parse_args_text
+
+    for text, said in (("{a: 2020-01-01}", "the date value '2020-01-01' at a cannot be sent"),
+                       ("{a: [1, {b: 99999999999999999999999}]}", "the integer at a[1].b does not fit in 64 bits"),
+                       ("{translation: [1, 2, !!set {x}]}", "the set value \"{'x'}\" at translation[2] cannot be sent"),
+                       ("{1: fast}", "key 1 is not a string")):
+        with pytest.raises(ValueError) as exc:
+            parse_args_text(text)
+        assert str(exc.value).startswith(f"ARGS {text!r}: {said}"), str(exc.value)
+    assert parse_args_text('{a: "2020-01-01", b: -9223372036854775808, c: 18446744073709551615, d: [.inf, null]}') == {
+        "a": "2020-01-01", "b": -(1 << 63), "c": (1 << 64) - 1, "d": [float("inf"), None]}
+    r = run("call", "get_info", "{when: 2020-01-01}", "--url", "tcp://127.0.0.1:1")
+    assert r.returncode == 2 and r.stderr.strip().splitlines() == [
+        "sensorium call: ARGS '{when: 2020-01-01}': the date value '2020-01-01' at when cannot be sent (write it in "
+        "quotes for a string)"]
+
+
 def test_services_marks_supervisor_only_services_and_replay_shows_arguments(tmp_path):
     import signal
 
