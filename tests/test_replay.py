@@ -317,6 +317,15 @@ def test_topics_that_match_nothing_are_refused(rec_path, ctx, tmp_path):
     assert proc.stderr.startswith("sensorium replay: --topics /nosuch: no topic of ") and "Traceback" not in proc.stderr
 
 
+def test_a_port_out_of_range_is_refused_not_wrapped(rec_path, ctx):
+    """replay --rpc tcp://127.0.0.1:99999 bound port 34463 (libzmq wraps it)."""
+    path, _ = rec_path
+    with pytest.raises(ValueError, match=r"^--rpc tcp://127.0.0.1:99999: the port must be 0 to 65535"):
+        Replayer(str(path), rpc="tcp://127.0.0.1:99999", context=ctx)
+    with pytest.raises(ValueError, match=r"^--pub tcp://127.0.0.1:-1: the port must be 0 to 65535"):
+        Replayer(str(path), pub="tcp://127.0.0.1:-1", rpc=None, context=ctx)
+
+
 def test_record_connect_keeps_up_zero_gaps(rec_path, ctx, tmp_path):
     path, items = rec_path
     out = tmp_path / "sub.mcap"

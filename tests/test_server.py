@@ -446,3 +446,25 @@ def test_deterministic_and_sigterm(ctx):
     finally:
         assert a.stop(signal.SIGTERM) == 0
         assert b.stop(signal.SIGTERM) == 0
+
+
+def test_a_port_out_of_range_is_refused_not_wrapped():
+    """libzmq binds tcp://127.0.0.1:99999 as port 34463 (and :-1 as 65535): serve answered on a
+    port nobody asked for. Now one line naming the option, exit 2, before the world loads."""
+    import subprocess
+
+    from _serve import child_env, sensorium
+
+    from sensorium.server.daemon.serve import ServeOptions
+
+    for rpc, said in (("tcp://127.0.0.1:99999", "got '99999'"), ("tcp://127.0.0.1:-1", "got '-1'"),
+                      ("tcp://127.0.0.1", "no port")):
+        with pytest.raises(ValueError, match=f"^--rpc {rpc}: .*{said}"):
+            ServeOptions(rpc=rpc).check()
+    for ok in ("tcp://127.0.0.1:0", "tcp://127.0.0.1:*", "tcp://[::1]:65535", "ipc:///tmp/x"):
+        ServeOptions(rpc=ok, pub=ok).check()
+    r = subprocess.run(sensorium("serve", str(WORLD), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:65536"),
+                       capture_output=True, text=True, timeout=120, env=child_env())
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.strip().splitlines() == ["sensorium serve: --pub tcp://127.0.0.1:65536: the port must be 0 to "
+                                             "65535 (0 or * for a free one), got '65536'"]

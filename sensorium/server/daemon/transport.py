@@ -36,7 +36,7 @@ from sensorium.server.daemon.services import STEP_REPLY_PIECES, Core
 from sensorium.server.daemon.steppath import gate_for
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
-           "curve_client_from_env", "check_cpu"]
+           "curve_client_from_env", "check_cpu", "endpoint_problem"]
 
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
@@ -60,6 +60,19 @@ def _bindable(url: str) -> str:
     if url.startswith("tcp://") and url.endswith(":0"):
         return url[:-2] + ":*"
     return url
+
+
+def endpoint_problem(url: str) -> str | None:
+    """Why a ``tcp://HOST:PORT`` endpoint to bind has a port out of range (libzmq would take port
+    99999 as 34463 and -1 as 65535, silently binding another port than asked), else None."""
+    if not url.startswith("tcp://"):
+        return None
+    _host, sep, port = url[len("tcp://"):].rpartition(":")
+    if not sep or port.endswith("]"):
+        return f"{url}: no port (tcp://HOST:PORT; 0 or * for a free one)"
+    if port == "*" or (port.isdigit() and int(port) <= 65535):
+        return None
+    return f"{url}: the port must be 0 to 65535 (0 or * for a free one), got {port!r}"
 
 
 def check_cpu(cpu: int) -> None:

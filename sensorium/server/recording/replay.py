@@ -36,6 +36,7 @@ from sensorium.schemas.wire import (
     parse_request,
     stamp,
 )
+from sensorium.server.daemon.transport import endpoint_problem
 from sensorium.server.recording.envelope import pack_envelope, topic_matcher, unmatched_topics
 from sensorium.server.recording.reader import RecordedMessage, Recording
 from sensorium.server.recording.scan import Damage
@@ -67,6 +68,10 @@ class Replayer:
                  on_damage: Callable[[Damage], None] | None = None):
         if rate < 0 or not math.isfinite(rate):
             raise ValueError("rate must be >= 0 (0: as fast as possible)")
+        for flag, url in (("--pub", pub), ("--rpc", rpc)):
+            problem = endpoint_problem(url) if url else None
+            if problem:
+                raise ValueError(f"{flag} {problem}")
         self.path = str(path)
         self.recording = Recording(path, on_damage=on_damage)     # a damaged chunk is skipped and said
         self.pub_url, self.rpc_url = pub, rpc
