@@ -76,6 +76,39 @@ def test_call_args_msgpack_cannot_carry_are_one_line_naming_the_value():
         "quotes for a string)"]
 
 
+def test_numbers_out_of_range_are_refused_by_the_parser(capsys):
+    """--start nan / --end inf ended replay and export in a traceback; --duration -1 recorded
+    nothing and --max-messages 0 one message; hz --window -5 was an IndexError, --window 0 printed
+    nothing; negative timeouts and rates of /clock were taken as given."""
+    import pytest
+
+    from sensorium.cli import build_parser
+
+    parser = build_parser()
+    for argv, said in ((["replay", "r.mcap", "--start", "nan"], "argument --start: must be a finite number >= 0, got 'nan'"),
+                       (["replay", "r.mcap", "--end", "inf"], "argument --end: must be a finite number >= 0, got 'inf'"),
+                       (["replay", "r.mcap", "--clock", "-5"], "argument --clock: must be a finite number > 0, got '-5'"),
+                       (["replay", "r.mcap", "--sndhwm", "-1"], "argument --sndhwm: must be an integer >= 0, got '-1'"),
+                       (["export", "r.mcap", "out", "--ros2", "--start", "nan"], "argument --start: must be a finite"),
+                       (["record", "r.mcap", "--duration", "-1"], "argument --duration: must be a finite number > 0"),
+                       (["record", "r.mcap", "--max-messages", "0"], "argument --max-messages: must be an integer >= 1"),
+                       (["record", "r.mcap", "--chunk-size", "-1"], "argument --chunk-size: must be an integer >= 1"),
+                       (["hz", "/clock", "--window", "-5"], "argument --window: must be an integer >= 1, got '-5'"),
+                       (["hz", "/clock", "--every", "0"], "argument --every: must be a finite number > 0, got '0'"),
+                       (["hz", "/clock", "--duration", "-1"], "argument --duration: must be a finite number > 0"),
+                       (["echo", "/clock", "--count", "0"], "argument --count: must be an integer >= 1, got '0'"),
+                       (["echo", "/clock", "--timeout", "-1"], "argument --timeout: must be a finite number > 0"),
+                       (["call", "get_info", "--timeout", "nan"], "argument --timeout: must be a finite number > 0"),
+                       (["topics", "--timeout", "0"], "argument --timeout: must be a finite number > 0, got '0'"),
+                       (["echo", "/clock", "--count", "x"], "argument --count: invalid integer value: 'x'")):
+        with pytest.raises(SystemExit) as exc:
+            parser.parse_args(argv)
+        err = capsys.readouterr().err
+        assert exc.value.code == 2 and said in err.strip().splitlines()[-1], (argv, err)
+    args = parser.parse_args(["replay", "r.mcap", "--rate", "0", "--start", "1.5", "--clock", "--sndhwm", "0"])
+    assert (args.rate, args.start, args.clock, args.sndhwm) == (0.0, 1.5, 40.0, 0)
+
+
 def test_services_marks_supervisor_only_services_and_replay_shows_arguments(tmp_path):
     import signal
 

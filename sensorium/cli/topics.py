@@ -38,7 +38,9 @@ def add_endpoint_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--pub", metavar="URL",
                    help=f"topic endpoint to subscribe to (default: the server's, else {DEFAULT_PUB_ENDPOINT})")
     p.add_argument("--rpc", help=argparse.SUPPRESS)            # deprecated spelling of --url
-    p.add_argument("--timeout", type=float, metavar="S",
+    from sensorium.cli import positive_seconds
+
+    p.add_argument("--timeout", type=positive_seconds, metavar="S",
                    help=f"exit 1 if no message arrives for S seconds (default: {DEFAULT_WAIT_S:g} s when no server "
                         "answers, else wait)")
 
