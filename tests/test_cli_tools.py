@@ -153,6 +153,14 @@ def test_hz_measures_the_simulated_rate_exactly(free):
     assert "/clock: average rate" in text.stdout and "std dev" in text.stdout
 
 
+def test_hz_says_why_nothing_came_within_its_duration(arena):
+    """hz --duration 1 against a paused world exited 1 without a word."""
+    res = cli("hz", "/clock", "--url", arena.rpc, "--duration", "1")
+    assert res.returncode == 1 and res.stdout == ""
+    assert res.stderr.strip().splitlines() == [f"sensorium hz: nothing on '/clock' from {arena.pub} for 1 s: the server "
+                                               "is paused (sensorium call set_mode '{mode: fast}')"]
+
+
 def test_topics_json(arena):
     res = cli("topics", "--url", arena.rpc, "--json")
     data = json.loads(res.stdout)

@@ -268,7 +268,11 @@ def hz(args: argparse.Namespace) -> int:
                 next_report = now + args.every
                 _report(rates, args.json)
     _report(rates, args.json)
-    return 0 if rates else 1
+    if not rates:               # --duration ended it before a message came: say why, as --timeout does
+        print(no_message("hz", ", ".join(repr(t) for t in args.topics), url, args.duration,
+                         ask_server(view.rpc) if view.info else view), file=sys.stderr)
+        return 1
+    return 0
 
 
 def _report(rates: dict[str, Rate], as_json: bool) -> None:
