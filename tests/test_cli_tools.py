@@ -183,6 +183,11 @@ def test_services_lists_every_service_with_arguments(arena):
     text = cli("services", "--url", arena.rpc, "--robot", "scout")
     assert "scout/lidar (Lidar):" in text.stdout and "/epuck/" not in text.stdout
     assert "  /scout/lidar/enable  {value: int}  [attached controller only]" in text.stdout
+    # a robot the world does not have: one line naming the robots (it printed nothing, exit 0)
+    typo = cli("services", "--url", arena.rpc, "--robot", "epcuk")
+    assert typo.returncode == 1 and typo.stdout == ""
+    assert typo.stderr.strip().splitlines() == ["sensorium services: no robot 'epcuk' (robots: epuck, scout; "
+                                                "'server' for the server's own services)"]
 
 
 def test_call_from_the_shell(arena):

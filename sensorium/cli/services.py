@@ -32,6 +32,11 @@ def services(args: argparse.Namespace) -> int:
         print(f"sensorium services: {exc}", file=sys.stderr)
         return 1
     if args.robot:                        # one robot's services, or 'server' for the server's own
+        robots = list(dict.fromkeys(str(s["robot"]) for s in listed if s.get("robot") is not None))
+        if args.robot != "server" and args.robot not in robots:
+            print(f"sensorium services: no robot {args.robot!r} (robots: {', '.join(robots) or 'none'}; "
+                  "'server' for the server's own services)", file=sys.stderr)
+            return 1
         listed = [s for s in listed if s.get("robot") == (None if args.robot == "server" else args.robot)]
     if args.json:
         print(dumps({"services": listed}))
