@@ -183,6 +183,14 @@ def test_topics_that_match_nothing_are_refused(recording, tmp_path):
     assert not (tmp_path / "bag").exists()
 
 
+def test_end_before_start_is_refused(recording, tmp_path):
+    """export --start 5 --end 1 wrote an empty bag and exited 0 (replay refuses the same)."""
+    src, _ = recording
+    with pytest.raises(ExportError, match="^--end is before --start$"):
+        export_ros2(src, tmp_path / "bag", start_ns=5_000_000_000, end_ns=1_000_000_000)
+    assert not (tmp_path / "bag").exists()
+
+
 def test_cli_export(recording, tmp_path):
     src, items = recording
     out = tmp_path / "cli_bag"

@@ -396,6 +396,8 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
     fmt = fmt or ("mcap" if out.suffix == ".mcap" else "bag")
     if fmt not in ("bag", "mcap"):
         raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
+    if start_ns is not None and end_ns is not None and end_ns < start_ns:
+        raise ExportError("--end is before --start")          # as replay says: an empty bag is no answer
     if out.exists() or out.is_symlink():
         raise ExportError(f"{out} exists already; not overwriting")
     typestore = typestore_for(distro)
