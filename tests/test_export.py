@@ -191,6 +191,44 @@ def test_end_before_start_is_refused(recording, tmp_path):
     assert not (tmp_path / "bag").exists()
 
 
+class _Terminated(Exception):
+    """What SIGTERM raises in these tests when the command under test does not handle it."""
+
+
+@pytest.mark.parametrize("name", ["bag", "one.mcap"])
+def test_sigterm_mid_export_removes_the_output(recording, tmp_path, monkeypatch, capsys, name):
+    """README: 'export removes what it wrote if it fails or is interrupted; only SIGKILL or a power
+    loss can leave a half-written bag'. SIGTERM (systemd, docker stop, timeout) killed export at
+    once, leaving the half-written bag behind."""
+    import argparse
+    import os
+    import signal
+
+    from sensorium.cli import progress
+    from sensorium.cli.recording import export_cmd
+
+    class SignalAtFirstMessage(progress._Quiet):
+        def update(self, n: float = 1) -> None:
+            if (tmp_path / name).exists():           # the output is being written: SIGTERM now
+                os.kill(os.getpid(), signal.SIGTERM)
+
+    def terminated(signum, frame):
+        raise _Terminated
+
+    monkeypatch.setattr(progress, "bar", lambda *a, **k: SignalAtFirstMessage())
+    previous = signal.signal(signal.SIGTERM, terminated)     # without the fix the test fails, not pytest
+    try:
+        src, _ = recording
+        args = argparse.Namespace(file=str(src), out=str(tmp_path / name), ros2=True, distro="jazzy", format=None,
+                                  pointcloud2=False, no_views=True, topics=None, start=None, end=None)
+        assert export_cmd(args) == 130
+    finally:
+        assert signal.signal(signal.SIGTERM, previous) is terminated        # put back after the export
+    assert not (tmp_path / name).exists()
+    assert capsys.readouterr().err.strip().splitlines()[-1] == (f"sensorium export: interrupted; {tmp_path / name} "
+                                                                "removed (nothing partial is kept)")
+
+
 def test_cli_export(recording, tmp_path):
     src, items = recording
     out = tmp_path / "cli_bag"
