@@ -252,6 +252,24 @@ def test_lockstep(rec_path, ctx):
         assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 0})["error"]["code"] == 5
 
 
+def test_unknown_argument_names_are_refused_as_the_server_does(rec_path, ctx):
+    """/replay/step {durations: 320} (a typo) stepped the default 32 ms and answered ok."""
+    path, _ = rec_path
+    with running(path, ctx, lockstep=True) as (r, th):
+        th.start()
+        bad = call(ctx, r.rpc_endpoint, "/replay/step", {"durations": 320})
+        assert bad["error"] == {"code": 5, "message": "/replay/step: unknown argument 'durations' (it takes duration)"}
+        bad = call(ctx, r.rpc_endpoint, "/replay/get_state", {"verbose": True})
+        assert bad["error"] == {"code": 5, "message": "/replay/get_state: unknown argument 'verbose' (it takes none)"}
+        assert call(ctx, r.rpc_endpoint, "/replay/get_state")["result"]["time_ms"] == 0       # nothing moved
+        assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 64})["result"]["time_ms"] == 64
+        assert call(ctx, r.rpc_endpoint, "ping", {"session": "abc"})["ok"]      # what clients send to a server
+    with running(path, ctx, rate=0, wait_subscriber=True) as (r, th):
+        th.start()
+        bad = call(ctx, r.rpc_endpoint, "/replay/set_rate", {"rate": 2})
+        assert bad["error"] == {"code": 5, "message": "/replay/set_rate: unknown argument 'rate' (it takes value)"}
+
+
 def test_lockstep_refuses_times_it_could_not_answer(rec_path, ctx):
     """A step or seek to a time past 2^64 ns was taken, and from then on every request (get_info,
     get_state) was answered INTERNAL 'OverflowError': one bad request wedged the replay."""

@@ -258,11 +258,15 @@ class Replayer:
                 "mode": "lockstep" if self.lockstep else "replay",
                 "subscriptions": sorted(s.decode("utf-8", "replace") for s in self.subscriptions)}
 
+    def service_names(self) -> list[str]:
+        """The services of this mode, as ``get_info`` lists them."""
+        return ["get_info", "get_services", "ping", "/replay/get_state", "/replay/quit",
+                *(["/replay/step", "/replay/seek"] if self.lockstep
+                  else ["/replay/pause", "/replay/resume", "/replay/set_rate"])]
+
     def info(self) -> dict:
         world = self.meta.get("world") or self.meta.get("world_file") or ""
-        services = ["get_info", "get_services", "ping", "/replay/get_state", "/replay/quit"]
-        services += (["/replay/step", "/replay/seek"] if self.lockstep
-                     else ["/replay/pause", "/replay/resume", "/replay/set_rate"])
+        services = self.service_names()
         topics = [{"name": k, "type": v} for k, v in sorted(self.topic_types.items())]
         if self.clock_hz is not None:
             topics.append({"name": CLOCK_TOPIC, "type": CLOCK_TYPE})
@@ -289,6 +293,12 @@ class Replayer:
                              for n in self.info()["services"]]}
 
     def _dispatch(self, service: str, args: dict) -> dict:
+        if service != "ping" and service in self.service_names():     # ping may carry a session (§3.3)
+            known = {name.rstrip("?") for name in self.SERVICE_ARGS.get(service, {})}
+            unknown = sorted(str(k) for k in args if k not in known)
+            if unknown:                # as the server does (PROTOCOL.md §3.1): a typo never passes silently
+                raise RequestError(ErrorCode.INVALID_ARGUMENT, f"{service}: unknown argument {unknown[0]!r}"
+                                   + (f" (it takes {', '.join(sorted(known))})" if known else " (it takes none)"))
         if service == "get_info":
             return self.info()
         if service == "get_services":
