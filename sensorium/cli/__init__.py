@@ -260,7 +260,9 @@ def _schemas_args(p: argparse.ArgumentParser) -> None:
 def _demo_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("world", nargs="?", help="world file (default: the embedded arena world)")
     p.add_argument("--duration", type=float, default=60.0, metavar="S", help="simulated seconds (default 60)")
-    p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go")
+    p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go "
+                   "(a previous demo's are replaced)")
+    p.add_argument("--force", action="store_true", help="replace files of the same names in DIR that no demo wrote")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
