@@ -183,6 +183,16 @@ def test_topics_that_match_nothing_are_refused(recording, tmp_path):
     assert not (tmp_path / "bag").exists()
 
 
+def test_a_ros2_bag_is_refused_not_exported_empty(recording, tmp_path):
+    """Exporting a ROS 2 bag (what export writes, or ros2 bag record) wrote an empty bag, exit 0."""
+    src, _ = recording
+    bag = tmp_path / "ros2.mcap"
+    export_ros2(src, bag)
+    with pytest.raises(ExportError, match=r"ros2\.mcap is not a Sensorium recording \(MCAP profile 'ros2'; channels "):
+        export_ros2(bag, tmp_path / "again")
+    assert not (tmp_path / "again").exists()
+
+
 def test_end_before_start_is_refused(recording, tmp_path):
     """export --start 5 --end 1 wrote an empty bag and exited 0 (replay refuses the same)."""
     src, _ = recording

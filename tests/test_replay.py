@@ -335,6 +335,19 @@ def test_topics_that_match_nothing_are_refused(rec_path, ctx, tmp_path):
     assert proc.stderr.startswith("sensorium replay: --topics /nosuch: no topic of ") and "Traceback" not in proc.stderr
 
 
+def test_a_ros2_bag_is_refused_not_replayed_empty(rec_path, ctx, tmp_path):
+    """Replaying a ROS 2 bag (sensorium export's output) published nothing and said 'replay
+    finished: 0 messages'."""
+    pytest.importorskip("mcap_ros2")
+    from sensorium.server.recording.export import export_ros2
+
+    path, _ = rec_path
+    bag = tmp_path / "ros2.mcap"
+    export_ros2(path, bag)
+    with pytest.raises(ValueError, match=r"ros2\.mcap is not a Sensorium recording \(MCAP profile 'ros2'"):
+        Replayer(str(bag), context=ctx)
+
+
 def test_a_port_out_of_range_is_refused_not_wrapped(rec_path, ctx):
     """replay --rpc tcp://127.0.0.1:99999 bound port 34463 (libzmq wraps it)."""
     path, _ = rec_path

@@ -407,7 +407,7 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
         if progress:
             rec.check()                     # damaged chunks found first: the total counts what will be read
         report.total = sum(t.count for t in rec.topics()) if progress else 0
-        problem = unmatched_topics(topics, [t.topic for t in rec.topics()], str(src))
+        problem = rec.foreign() or unmatched_topics(topics, [t.topic for t in rec.topics()], str(src))
         if problem:
             raise ExportError(problem)
         meta = rec.metadata().get("sensorium", {})

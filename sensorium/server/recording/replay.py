@@ -74,6 +74,10 @@ class Replayer:
                 raise ValueError(f"{flag} {problem}")
         self.path = str(path)
         self.recording = Recording(path, on_damage=on_damage)     # a damaged chunk is skipped and said
+        foreign = self.recording.foreign()
+        if foreign:                 # a ROS 2 bag: it would replay 0 messages without a word
+            self.recording.close()
+            raise ValueError(foreign)
         self.pub_url, self.rpc_url = pub, rpc
         self.rate = float(rate)
         self.loop = loop
