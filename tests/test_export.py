@@ -193,6 +193,21 @@ def test_a_ros2_bag_is_refused_not_exported_empty(recording, tmp_path):
     assert not (tmp_path / "again").exists()
 
 
+def test_info_says_a_ros2_bag_is_no_sensorium_recording(recording, tmp_path, capsys):
+    """`sensorium info` of a ROS 2 bag said 'Messages: 0' (its thousands of CDR messages are not
+    published bodies) without saying why."""
+    from sensorium.cli.recording import print_info
+
+    src, _ = recording
+    bag = tmp_path / "ros2.mcap"
+    export_ros2(src, bag)
+    capsys.readouterr()
+    assert print_info(bag) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith(f"Not Sensorium:     {bag} is not a Sensorium recording (MCAP profile 'ros2'"), first
+    assert print_info(src) == 0 and "Not Sensorium" not in capsys.readouterr().out
+
+
 def test_end_before_start_is_refused(recording, tmp_path):
     """export --start 5 --end 1 wrote an empty bag and exited 0 (replay refuses the same)."""
     src, _ = recording

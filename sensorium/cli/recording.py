@@ -291,6 +291,8 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
     if s.get("unnamed_messages"):
         lines.append(("Unnamed", f"{s['unnamed_messages']} message records on channels defined only in a "
                                  "damaged chunk (bodies or Foxglove views: not counted)"))
+    if s.get("foreign"):            # a ROS 2 bag: its messages are none of the published bodies counted here
+        lines.insert(0, ("Not Sensorium", s["foreign"]))
     for key, value in lines:
         print(f"{key + ':' if key else '':<19}{value}")
     topics = s["topics"]

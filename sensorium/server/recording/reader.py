@@ -501,6 +501,7 @@ class Recording:
             "attachments": [{"name": a.name, "media_type": a.media_type, "size_bytes": len(a.data)} for a in atts],
             "damaged": [d.line() for d in self.damaged],
             "unnamed_messages": self.unnamed,
+            "foreign": self.foreign(),        # not a Sensorium recording: why (its messages are not counted)
         }
         if self.truncated:
             why = stopped or self.error
