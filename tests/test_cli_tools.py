@@ -82,6 +82,21 @@ def test_echo_without_a_server_times_out_with_a_message():
     assert default.returncode == 1 and "for 5 s" in default.stderr, default.stderr
 
 
+def test_endpoints_zeromq_refuses_are_one_line():
+    """echo/hz --pub bogus://x (or tcp://HOST without a port), and --url bogus://x (taken for a topic
+    endpoint), ended in a ZMQError traceback."""
+    for cmd, extra in (("echo", ["--timeout", "1"]), ("hz", ["--duration", "1"])):
+        for pub in ("bogus://x", "tcp://127.0.0.1"):
+            res = cli(cmd, "/clock", "--pub", pub, *extra)
+            lines = res.stderr.strip().splitlines()
+            assert res.returncode == 1 and len(lines) == 1, res.stderr
+            assert lines[0].startswith(f"sensorium {cmd}: cannot subscribe to {pub}: "), lines
+        res = cli(cmd, "/clock", "--url", "bogus://x", *extra)
+        assert res.returncode == 2 and res.stderr.strip().splitlines() == [
+            f"sensorium {cmd}: BAD_URL: controller URL 'bogus://x': unsupported scheme 'bogus' (use tcp://, ipc:// "
+            "or a robot name)"]
+
+
 def test_one_flag_one_meaning_and_the_old_spellings_still_work(free, tmp_path):
     """--url is the RPC endpoint for every client command, --pub a topic endpoint; echo/hz's --rpc,
     echo/hz's --url given a topic endpoint, and record's --connect keep working with one line."""
