@@ -357,6 +357,18 @@ def test_a_port_out_of_range_is_refused_not_wrapped(rec_path, ctx):
         Replayer(str(path), pub="tcp://127.0.0.1:-1", rpc=None, context=ctx)
 
 
+def test_an_ipc_path_that_is_a_file_or_both_sockets_is_refused(rec_path, ctx, tmp_path):
+    """replay --pub ipc://FILE deleted FILE (libzmq unlinks the path before binding)."""
+    path, _ = rec_path
+    precious = tmp_path / "notes.txt"
+    precious.write_text("keep me")
+    with pytest.raises(ValueError, match="exists and is not a socket: not replacing it"):
+        Replayer(str(path), pub=f"ipc://{precious}", rpc=None, context=ctx)
+    assert precious.read_text() == "keep me"
+    with pytest.raises(ValueError, match="^--rpc and --pub are the same endpoint"):
+        Replayer(str(path), pub=f"ipc://{tmp_path}/s", rpc=f"ipc://{tmp_path}/s", context=ctx)
+
+
 def test_record_connect_keeps_up_zero_gaps(rec_path, ctx, tmp_path):
     path, items = rec_path
     out = tmp_path / "sub.mcap"

@@ -55,6 +55,8 @@ class ServeOptions:
             problem = endpoint_problem(url)
             if problem:
                 raise ValueError(f"{flag} {problem}")
+        if self.rpc == self.pub and not self.rpc.endswith((":0", ":*")):   # ipc: the second bind would take the path
+            raise ValueError(f"--rpc and --pub are the same endpoint {self.rpc}: give each its own")
         if self.heartbeat_ms <= 0:
             raise ValueError("--heartbeat-ms must be > 0")
         if self.controls not in CONTROLS:

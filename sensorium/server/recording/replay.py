@@ -72,6 +72,8 @@ class Replayer:
             problem = endpoint_problem(url) if url else None
             if problem:
                 raise ValueError(f"{flag} {problem}")
+        if pub == rpc and not pub.endswith((":0", ":*")):          # ipc: the second bind would take the path
+            raise ValueError(f"--rpc and --pub are the same endpoint {pub}: give each its own")
         self.path = str(path)
         self.recording = Recording(path, on_damage=on_damage)     # a damaged chunk is skipped and said
         foreign = self.recording.foreign()
