@@ -54,6 +54,61 @@ def test_a_bad_yaml_argument_to_call_names_its_position():
         "expected ',' or '}', but got '<stream end>'"]
 
 
+def test_call_args_msgpack_cannot_carry_are_one_line_naming_the_value():
+    """A YAML date, a set or an integer beyond 64 bits in ARGS ended `sensorium call` in a msgpack
+    traceback; a non-string key got the server's misleading 'not a msgpack document'."""
+    import pytest
+
+    from sensorium.cli.services import parse_args_text
+
+    for text, said in (("{a: 2020-01-01}", "the date value '2020-01-01' at a cannot be sent"),
+                       ("{a: [1, {b: 99999999999999999999999}]}", "the integer at a[1].b does not fit in 64 bits"),
+                       ("{translation: [1, 2, !!set {x}]}", "the set value \"{'x'}\" at translation[2] cannot be sent"),
+                       ("{1: fast}", "key 1 is not a string")):
+        with pytest.raises(ValueError) as exc:
+            parse_args_text(text)
+        assert str(exc.value).startswith(f"ARGS {text!r}: {said}"), str(exc.value)
+    assert parse_args_text('{a: "2020-01-01", b: -9223372036854775808, c: 18446744073709551615, d: [.inf, null]}') == {
+        "a": "2020-01-01", "b": -(1 << 63), "c": (1 << 64) - 1, "d": [float("inf"), None]}
+    r = run("call", "get_info", "{when: 2020-01-01}", "--url", "tcp://127.0.0.1:1")
+    assert r.returncode == 2 and r.stderr.strip().splitlines() == [
+        "sensorium call: ARGS '{when: 2020-01-01}': the date value '2020-01-01' at when cannot be sent (write it in "
+        "quotes for a string)"]
+
+
+def test_numbers_out_of_range_are_refused_by_the_parser(capsys):
+    """--start nan / --end inf ended replay and export in a traceback; --duration -1 recorded
+    nothing and --max-messages 0 one message; hz --window -5 was an IndexError, --window 0 printed
+    nothing; negative timeouts and rates of /clock were taken as given."""
+    import pytest
+
+    from sensorium.cli import build_parser
+
+    parser = build_parser()
+    for argv, said in ((["replay", "r.mcap", "--start", "nan"], "argument --start: must be a finite number >= 0, got 'nan'"),
+                       (["replay", "r.mcap", "--end", "inf"], "argument --end: must be a finite number >= 0, got 'inf'"),
+                       (["replay", "r.mcap", "--clock", "-5"], "argument --clock: must be a finite number > 0, got '-5'"),
+                       (["replay", "r.mcap", "--sndhwm", "-1"], "argument --sndhwm: must be an integer >= 0, got '-1'"),
+                       (["export", "r.mcap", "out", "--ros2", "--start", "nan"], "argument --start: must be a finite"),
+                       (["record", "r.mcap", "--duration", "-1"], "argument --duration: must be a finite number > 0"),
+                       (["record", "r.mcap", "--max-messages", "0"], "argument --max-messages: must be an integer >= 1"),
+                       (["record", "r.mcap", "--chunk-size", "-1"], "argument --chunk-size: must be an integer >= 1"),
+                       (["hz", "/clock", "--window", "-5"], "argument --window: must be an integer >= 1, got '-5'"),
+                       (["hz", "/clock", "--every", "0"], "argument --every: must be a finite number > 0, got '0'"),
+                       (["hz", "/clock", "--duration", "-1"], "argument --duration: must be a finite number > 0"),
+                       (["echo", "/clock", "--count", "0"], "argument --count: must be an integer >= 1, got '0'"),
+                       (["echo", "/clock", "--timeout", "-1"], "argument --timeout: must be a finite number > 0"),
+                       (["call", "get_info", "--timeout", "nan"], "argument --timeout: must be a finite number > 0"),
+                       (["topics", "--timeout", "0"], "argument --timeout: must be a finite number > 0, got '0'"),
+                       (["echo", "/clock", "--count", "x"], "argument --count: invalid integer value: 'x'")):
+        with pytest.raises(SystemExit) as exc:
+            parser.parse_args(argv)
+        err = capsys.readouterr().err
+        assert exc.value.code == 2 and said in err.strip().splitlines()[-1], (argv, err)
+    args = parser.parse_args(["replay", "r.mcap", "--rate", "0", "--start", "1.5", "--clock", "--sndhwm", "0"])
+    assert (args.rate, args.start, args.clock, args.sndhwm) == (0.0, 1.5, 40.0, 0)
+
+
 def test_services_marks_supervisor_only_services_and_replay_shows_arguments(tmp_path):
     import signal
 

@@ -82,6 +82,21 @@ def test_echo_without_a_server_times_out_with_a_message():
     assert default.returncode == 1 and "for 5 s" in default.stderr, default.stderr
 
 
+def test_endpoints_zeromq_refuses_are_one_line():
+    """echo/hz --pub bogus://x (or tcp://HOST without a port), and --url bogus://x (taken for a topic
+    endpoint), ended in a ZMQError traceback."""
+    for cmd, extra in (("echo", ["--timeout", "1"]), ("hz", ["--duration", "1"])):
+        for pub in ("bogus://x", "tcp://127.0.0.1"):
+            res = cli(cmd, "/clock", "--pub", pub, *extra)
+            lines = res.stderr.strip().splitlines()
+            assert res.returncode == 1 and len(lines) == 1, res.stderr
+            assert lines[0].startswith(f"sensorium {cmd}: cannot subscribe to {pub}: "), lines
+        res = cli(cmd, "/clock", "--url", "bogus://x", *extra)
+        assert res.returncode == 2 and res.stderr.strip().splitlines() == [
+            f"sensorium {cmd}: BAD_URL: controller URL 'bogus://x': unsupported scheme 'bogus' (use tcp://, ipc:// "
+            "or a robot name)"]
+
+
 def test_one_flag_one_meaning_and_the_old_spellings_still_work(free, tmp_path):
     """--url is the RPC endpoint for every client command, --pub a topic endpoint; echo/hz's --rpc,
     echo/hz's --url given a topic endpoint, and record's --connect keep working with one line."""
@@ -153,6 +168,14 @@ def test_hz_measures_the_simulated_rate_exactly(free):
     assert "/clock: average rate" in text.stdout and "std dev" in text.stdout
 
 
+def test_hz_says_why_nothing_came_within_its_duration(arena):
+    """hz --duration 1 against a paused world exited 1 without a word."""
+    res = cli("hz", "/clock", "--url", arena.rpc, "--duration", "1")
+    assert res.returncode == 1 and res.stdout == ""
+    assert res.stderr.strip().splitlines() == [f"sensorium hz: nothing on '/clock' from {arena.pub} for 1 s: the server "
+                                               "is paused (sensorium call set_mode '{mode: fast}')"]
+
+
 def test_topics_json(arena):
     res = cli("topics", "--url", arena.rpc, "--json")
     data = json.loads(res.stdout)
@@ -175,6 +198,11 @@ def test_services_lists_every_service_with_arguments(arena):
     text = cli("services", "--url", arena.rpc, "--robot", "scout")
     assert "scout/lidar (Lidar):" in text.stdout and "/epuck/" not in text.stdout
     assert "  /scout/lidar/enable  {value: int}  [attached controller only]" in text.stdout
+    # a robot the world does not have: one line naming the robots (it printed nothing, exit 0)
+    typo = cli("services", "--url", arena.rpc, "--robot", "epcuk")
+    assert typo.returncode == 1 and typo.stdout == ""
+    assert typo.stderr.strip().splitlines() == ["sensorium services: no robot 'epcuk' (robots: epuck, scout; "
+                                                "'server' for the server's own services)"]
 
 
 def test_call_from_the_shell(arena):

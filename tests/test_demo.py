@@ -81,6 +81,26 @@ def test_demo_refuses_an_invalid_world_with_one_line(tmp_path: Path, text: str, 
     assert "Traceback" not in res.stderr
 
 
+def test_demo_never_replaces_files_no_demo_wrote_unless_forced(tmp_path: Path) -> None:
+    """`sensorium demo --out DIR` deleted DIR/demo.mcap and overwrote DIR/server.log (and the other
+    logs, arena.png) whoever had written them. A previous demo's own files are still replaced."""
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "demo.mcap").write_text("my recording")
+    (out / "server.log").write_text("my log")
+    res = _sensorium("demo", "--out", str(out), "--duration", "1", timeout=60)
+    assert res.returncode == 1 and res.stderr.strip().splitlines() == [
+        f"sensorium demo: {out} already holds demo.mcap, server.log, not written by a demo: not overwriting "
+        "(--force to replace them, or --out another folder)"]
+    assert (out / "demo.mcap").read_text() == "my recording" and (out / "server.log").read_text() == "my log"
+    assert sorted(p.name for p in out.iterdir()) == ["demo.mcap", "server.log"]
+    forced = _sensorium("demo", "--out", str(out), "--duration", "1", "--force")
+    assert forced.returncode == 0, forced.stderr
+    assert (out / "demo.mcap").read_bytes().startswith(b"\x89MCAP")
+    again = _sensorium("demo", "--out", str(out), "--duration", "1")          # the demo's own files: replaced
+    assert again.returncode == 0, again.stderr
+
+
 def test_demo_refuses_a_missing_world(tmp_path: Path) -> None:
     res = _sensorium("demo", str(tmp_path / "nope.yaml"), "--out", str(tmp_path / "d"), timeout=60)
     assert res.returncode == 1 and "nope.yaml" in res.stderr and len(res.stderr.strip().splitlines()) == 1

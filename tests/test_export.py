@@ -175,6 +175,85 @@ def test_refuses_to_overwrite_and_unknown_distro(recording, tmp_path):
         export_ros2(src, tmp_path / "y", distro="noetic")
 
 
+def test_topics_that_match_nothing_are_refused(recording, tmp_path):
+    """A typo in --topics wrote an empty bag and exited 0."""
+    src, _ = recording
+    with pytest.raises(ExportError, match=r"--topics /epuck/ps9/value: no topic of .* matches it \(closest: /epuck/"):
+        export_ros2(src, tmp_path / "bag", topics=["/scout", "/epuck/ps9/value"])
+    assert not (tmp_path / "bag").exists()
+
+
+def test_a_ros2_bag_is_refused_not_exported_empty(recording, tmp_path):
+    """Exporting a ROS 2 bag (what export writes, or ros2 bag record) wrote an empty bag, exit 0."""
+    src, _ = recording
+    bag = tmp_path / "ros2.mcap"
+    export_ros2(src, bag)
+    with pytest.raises(ExportError, match=r"ros2\.mcap is not a Sensorium recording \(MCAP profile 'ros2'; channels "):
+        export_ros2(bag, tmp_path / "again")
+    assert not (tmp_path / "again").exists()
+
+
+def test_info_says_a_ros2_bag_is_no_sensorium_recording(recording, tmp_path, capsys):
+    """`sensorium info` of a ROS 2 bag said 'Messages: 0' (its thousands of CDR messages are not
+    published bodies) without saying why."""
+    from sensorium.cli.recording import print_info
+
+    src, _ = recording
+    bag = tmp_path / "ros2.mcap"
+    export_ros2(src, bag)
+    capsys.readouterr()
+    assert print_info(bag) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith(f"Not Sensorium:     {bag} is not a Sensorium recording (MCAP profile 'ros2'"), first
+    assert print_info(src) == 0 and "Not Sensorium" not in capsys.readouterr().out
+
+
+def test_end_before_start_is_refused(recording, tmp_path):
+    """export --start 5 --end 1 wrote an empty bag and exited 0 (replay refuses the same)."""
+    src, _ = recording
+    with pytest.raises(ExportError, match="^--end is before --start$"):
+        export_ros2(src, tmp_path / "bag", start_ns=5_000_000_000, end_ns=1_000_000_000)
+    assert not (tmp_path / "bag").exists()
+
+
+class _Terminated(Exception):
+    """What SIGTERM raises in these tests when the command under test does not handle it."""
+
+
+@pytest.mark.parametrize("name", ["bag", "one.mcap"])
+def test_sigterm_mid_export_removes_the_output(recording, tmp_path, monkeypatch, capsys, name):
+    """README: 'export removes what it wrote if it fails or is interrupted; only SIGKILL or a power
+    loss can leave a half-written bag'. SIGTERM (systemd, docker stop, timeout) killed export at
+    once, leaving the half-written bag behind."""
+    import argparse
+    import os
+    import signal
+
+    from sensorium.cli import progress
+    from sensorium.cli.recording import export_cmd
+
+    class SignalAtFirstMessage(progress._Quiet):
+        def update(self, n: float = 1) -> None:
+            if (tmp_path / name).exists():           # the output is being written: SIGTERM now
+                os.kill(os.getpid(), signal.SIGTERM)
+
+    def terminated(signum, frame):
+        raise _Terminated
+
+    monkeypatch.setattr(progress, "bar", lambda *a, **k: SignalAtFirstMessage())
+    previous = signal.signal(signal.SIGTERM, terminated)     # without the fix the test fails, not pytest
+    try:
+        src, _ = recording
+        args = argparse.Namespace(file=str(src), out=str(tmp_path / name), ros2=True, distro="jazzy", format=None,
+                                  pointcloud2=False, no_views=True, topics=None, start=None, end=None)
+        assert export_cmd(args) == 130
+    finally:
+        assert signal.signal(signal.SIGTERM, previous) is terminated        # put back after the export
+    assert not (tmp_path / name).exists()
+    assert capsys.readouterr().err.strip().splitlines()[-1] == (f"sensorium export: interrupted; {tmp_path / name} "
+                                                                "removed (nothing partial is kept)")
+
+
 def test_cli_export(recording, tmp_path):
     src, items = recording
     out = tmp_path / "cli_bag"

@@ -185,6 +185,10 @@ def test_layout_command(tmp_path):
     assert bundled.returncode == 0, bundled.stderr
     assert "/scout/lidar/laser_scan" in json.loads((tmp_path / "arena.json").read_text())["content"]["items"][0][
         "content"]["config"]["topics"]
+    # an output that cannot be written: one line (it was a FileNotFoundError / IsADirectoryError traceback)
+    for bad, why in ((tmp_path / "no" / "such" / "dir.json", "No such file or directory"), (tmp_path, "Is a directory")):
+        r = run("arena", "-o", str(bad), "--force")
+        assert r.returncode == 1 and r.stderr.strip().splitlines() == [f"sensorium layout: cannot write {bad}: {why}"]
 
 
 def test_grown_world_format_is_drawn_where_rays_see_it():

@@ -14,7 +14,7 @@ from pathlib import Path
 import msgpack
 import pytest
 import zmq
-from _serve import serve
+from _serve import child_env, serve
 
 from sensorium.server.recording.live import LiveRecorder
 from sensorium.server.recording.reader import Recording
@@ -134,6 +134,18 @@ def test_serve_record_and_determinism(server_factory, tmp_path):
     # the moved scout changed what the lidar saw: the recording reflects the command
     scans = [m[4] for m in a if m[0] == "/scout/lidar/laser_scan"]
     assert scans[9] != scans[11]
+
+
+def test_serve_record_refuses_topics_that_match_nothing(tmp_path):
+    """serve --record --topics with a typo recorded 0 messages without a word."""
+    out = tmp_path / "typo.mcap"
+    proc = subprocess.run([PY, "-m", "sensorium", "serve", "--rpc", f"ipc://{tmp_path}/r", "--pub", f"ipc://{tmp_path}/p",
+                           "--record", str(out), "--topics", "/epuck", "/scout/sonar"],
+                          capture_output=True, text=True, timeout=120, env=child_env())
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.startswith("sensorium serve: --topics /scout/sonar: no topic of world 'arena' matches it "
+                                  "(closest: "), proc.stderr
+    assert "/scout/sonar_left/value" in proc.stderr and not out.exists()
 
 
 def test_record_connect_keeps_up_then_kill_9(server_factory, tmp_path):

@@ -88,3 +88,40 @@ def test_recover_never_overwrites_and_reports_bad_input_in_one_line(tmp_path):
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and r.stderr.count("\n") == 1 and "not an MCAP file" in r.stderr
     assert not (tmp_path / "o.mcap").exists() and not (tmp_path / "o.mcap.part").exists()
+
+
+class _Terminated(Exception):
+    """What SIGTERM raises in this test when recover does not handle it."""
+
+
+def test_sigterm_mid_recover_leaves_no_part_file(tmp_path, monkeypatch, capsys):
+    """README: 'recover writes OUT.part and renames it when complete; only SIGKILL or a power loss
+    can leave OUT.part behind'. SIGTERM killed recover at once and left OUT.part."""
+    import argparse
+    import os
+    import signal
+
+    from _recdata import make_recording
+
+    from sensorium.cli.recording import recover_cmd
+    from sensorium.server.recording import recover as recover_module
+
+    src = tmp_path / "run.mcap"
+    make_recording(src, steps=8)
+
+    class SignalAtFirstMessage(recover_module.Writer):
+        def add_message(self, *args, **kwargs):
+            os.kill(os.getpid(), signal.SIGTERM)
+            return super().add_message(*args, **kwargs)
+
+    def terminated(signum, frame):
+        raise _Terminated
+
+    monkeypatch.setattr(recover_module, "Writer", SignalAtFirstMessage)
+    previous = signal.signal(signal.SIGTERM, terminated)
+    try:
+        assert recover_cmd(argparse.Namespace(file=str(src), out=str(tmp_path / "out.mcap"), force=False)) == 130
+    finally:
+        assert signal.signal(signal.SIGTERM, previous) is terminated
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.mcap"]
+    assert capsys.readouterr().err.strip().splitlines() == ["sensorium recover: interrupted; nothing written"]

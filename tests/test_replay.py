@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import signal
+import subprocess
 import threading
 import time
 from contextlib import contextmanager
@@ -200,6 +201,23 @@ def test_free_running_services(rec_path, ctx):
     assert seqs == list(range(32))
 
 
+def test_extreme_rates_keep_the_replay_running(rec_path, ctx):
+    """/replay/set_rate {value: 1e-300} killed the replay (OverflowError in its poll) and 1e308 too
+    (an infinite playhead): one request of any client ended it for everyone."""
+    path, _ = rec_path
+    with running(path, ctx, rate=1.0, wait_subscriber=True, topics=["/epuck/ls0"]) as (r, th):
+        sub = subscriber(ctx, r.pub_endpoint)
+        th.start()
+        assert call(ctx, r.rpc_endpoint, "/replay/set_rate", {"value": 1e-300})["ok"]
+        first = drain(sub, idle=0.5)
+        assert th.is_alive() and call(ctx, r.rpc_endpoint, "/replay/get_state")["result"]["rate"] == 1e-300
+        assert call(ctx, r.rpc_endpoint, "/replay/set_rate", {"value": 1e308})["ok"]
+        rest = drain(sub, idle=0.5, limit=32 - len(first))
+        th.join(10)
+        assert not th.is_alive() and r.done            # it ran to its end
+    assert [msgpack.unpackb(f[1])["seq"] for _t, f in first + rest] == list(range(32))
+
+
 def test_lockstep(rec_path, ctx):
     path, items = rec_path
     with running(path, ctx, lockstep=True) as (r, th):
@@ -234,6 +252,43 @@ def test_lockstep(rec_path, ctx):
         assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 0})["error"]["code"] == 5
 
 
+def test_unknown_argument_names_are_refused_as_the_server_does(rec_path, ctx):
+    """/replay/step {durations: 320} (a typo) stepped the default 32 ms and answered ok."""
+    path, _ = rec_path
+    with running(path, ctx, lockstep=True) as (r, th):
+        th.start()
+        bad = call(ctx, r.rpc_endpoint, "/replay/step", {"durations": 320})
+        assert bad["error"] == {"code": 5, "message": "/replay/step: unknown argument 'durations' (it takes duration)"}
+        bad = call(ctx, r.rpc_endpoint, "/replay/get_state", {"verbose": True})
+        assert bad["error"] == {"code": 5, "message": "/replay/get_state: unknown argument 'verbose' (it takes none)"}
+        assert call(ctx, r.rpc_endpoint, "/replay/get_state")["result"]["time_ms"] == 0       # nothing moved
+        assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 64})["result"]["time_ms"] == 64
+        assert call(ctx, r.rpc_endpoint, "ping", {"session": "abc"})["ok"]      # what clients send to a server
+    with running(path, ctx, rate=0, wait_subscriber=True) as (r, th):
+        th.start()
+        bad = call(ctx, r.rpc_endpoint, "/replay/set_rate", {"rate": 2})
+        assert bad["error"] == {"code": 5, "message": "/replay/set_rate: unknown argument 'rate' (it takes value)"}
+
+
+def test_lockstep_refuses_times_it_could_not_answer(rec_path, ctx):
+    """A step or seek to a time past 2^64 ns was taken, and from then on every request (get_info,
+    get_state) was answered INTERNAL 'OverflowError': one bad request wedged the replay."""
+    path, _ = rec_path
+    with running(path, ctx, lockstep=True) as (r, th):
+        th.start()
+        for service, args in (("/replay/step", {"duration": 2**64 - 1}), ("/replay/step", {"duration": 2**31}),
+                              ("/replay/seek", {"time_ms": 2**64 - 1}), ("/replay/seek", {"time_ms": 2**53})):
+            reply = call(ctx, r.rpc_endpoint, service, args)
+            assert not reply["ok"] and reply["error"]["code"] == 5, (service, args, reply)
+        state = call(ctx, r.rpc_endpoint, "/replay/get_state")
+        assert state["ok"] and state["result"]["time_ms"] == 0
+        near_end = (2**63 - 1) // 1_000_000 - 10
+        assert call(ctx, r.rpc_endpoint, "/replay/seek", {"time_ms": near_end})["ok"]
+        assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 20})["error"]["code"] == 5
+        assert call(ctx, r.rpc_endpoint, "/replay/step", {"duration": 10})["result"]["time_ms"] == near_end + 10
+        assert call(ctx, r.rpc_endpoint, "get_info")["ok"]
+
+
 def test_cli_replay_announces_and_finishes(rec_path, ctx):
     path, items = rec_path
     with Served(sensorium("replay", str(path), "--pub", ANY, "--rpc", ANY, "--rate", "0", "--wait", "--topics",
@@ -257,6 +312,61 @@ def test_subscription_prefixes():
     assert subscription_prefixes(["/epuck/ps1"]) == [b"/epuck/ps1\0", b"/epuck/ps1/"]
     assert subscription_prefixes(["/epuck/"]) == [b"/epuck/"]
     assert subscription_prefixes(["/epuck/ps*"]) == [b"/epuck/ps"]
+
+
+def test_topics_that_match_nothing_are_refused(rec_path, ctx, tmp_path):
+    """A typo in --topics gave an empty replay or recording and exit 0 without a word."""
+    path, _ = rec_path
+    with pytest.raises(ValueError, match=r"--topics /epcuk: no topic of .*rec\.mcap matches it \(closest: "):
+        Replayer(str(path), topics=["/epuck/ps*", "/epcuk"], context=ctx)
+    with running(path, ctx, lockstep=True) as (r, th):
+        th.start()
+        out = tmp_path / "typo.mcap"
+        live = LiveRecorder(out, connect=r.rpc_endpoint, topics=["/scout", "/scuot/lidar"], context=ctx)
+        with pytest.raises(ValueError, match=r"--topics /scuot/lidar: no topic of the server at tcp://"):
+            live.open()
+        assert not out.exists()                      # nothing written
+        live = LiveRecorder(out, connect=r.rpc_endpoint, topics=["/scout", "/epuck/ps1"], context=ctx)
+        live.open()                                  # prefixes and exact names that match are fine
+        live.close()
+    proc = subprocess.run(sensorium("replay", str(path), "--rpc", ANY, "--pub", ANY, "--topics", "/nosuch"),
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.startswith("sensorium replay: --topics /nosuch: no topic of ") and "Traceback" not in proc.stderr
+
+
+def test_a_ros2_bag_is_refused_not_replayed_empty(rec_path, ctx, tmp_path):
+    """Replaying a ROS 2 bag (sensorium export's output) published nothing and said 'replay
+    finished: 0 messages'."""
+    pytest.importorskip("mcap_ros2")
+    from sensorium.server.recording.export import export_ros2
+
+    path, _ = rec_path
+    bag = tmp_path / "ros2.mcap"
+    export_ros2(path, bag)
+    with pytest.raises(ValueError, match=r"ros2\.mcap is not a Sensorium recording \(MCAP profile 'ros2'"):
+        Replayer(str(bag), context=ctx)
+
+
+def test_a_port_out_of_range_is_refused_not_wrapped(rec_path, ctx):
+    """replay --rpc tcp://127.0.0.1:99999 bound port 34463 (libzmq wraps it)."""
+    path, _ = rec_path
+    with pytest.raises(ValueError, match=r"^--rpc tcp://127.0.0.1:99999: the port must be 0 to 65535"):
+        Replayer(str(path), rpc="tcp://127.0.0.1:99999", context=ctx)
+    with pytest.raises(ValueError, match=r"^--pub tcp://127.0.0.1:-1: the port must be 0 to 65535"):
+        Replayer(str(path), pub="tcp://127.0.0.1:-1", rpc=None, context=ctx)
+
+
+def test_an_ipc_path_that_is_a_file_or_both_sockets_is_refused(rec_path, ctx, tmp_path):
+    """replay --pub ipc://FILE deleted FILE (libzmq unlinks the path before binding)."""
+    path, _ = rec_path
+    precious = tmp_path / "notes.txt"
+    precious.write_text("keep me")
+    with pytest.raises(ValueError, match="exists and is not a socket: not replacing it"):
+        Replayer(str(path), pub=f"ipc://{precious}", rpc=None, context=ctx)
+    assert precious.read_text() == "keep me"
+    with pytest.raises(ValueError, match="^--rpc and --pub are the same endpoint"):
+        Replayer(str(path), pub=f"ipc://{tmp_path}/s", rpc=f"ipc://{tmp_path}/s", context=ctx)
 
 
 def test_record_connect_keeps_up_zero_gaps(rec_path, ctx, tmp_path):

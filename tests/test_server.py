@@ -446,3 +446,55 @@ def test_deterministic_and_sigterm(ctx):
     finally:
         assert a.stop(signal.SIGTERM) == 0
         assert b.stop(signal.SIGTERM) == 0
+
+
+def test_a_port_out_of_range_is_refused_not_wrapped():
+    """libzmq binds tcp://127.0.0.1:99999 as port 34463 (and :-1 as 65535): serve answered on a
+    port nobody asked for. Now one line naming the option, exit 2, before the world loads."""
+    import subprocess
+
+    from _serve import child_env, sensorium
+
+    from sensorium.server.daemon.serve import ServeOptions
+
+    for rpc, said in (("tcp://127.0.0.1:99999", "got '99999'"), ("tcp://127.0.0.1:-1", "got '-1'"),
+                      ("tcp://127.0.0.1", "no port")):
+        with pytest.raises(ValueError, match=f"^--rpc {rpc}: .*{said}"):
+            ServeOptions(rpc=rpc).check()
+    for ok in ("tcp://127.0.0.1:0", "tcp://127.0.0.1:*", "tcp://[::1]:65535"):
+        ServeOptions(rpc=ok, pub="tcp://127.0.0.1:0").check()
+    r = subprocess.run(sensorium("serve", str(WORLD), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:65536"),
+                       capture_output=True, text=True, timeout=120, env=child_env())
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.strip().splitlines() == ["sensorium serve: --pub tcp://127.0.0.1:65536: the port must be 0 to "
+                                             "65535 (0 or * for a free one), got '65536'"]
+
+
+def test_an_ipc_path_in_use_or_not_a_socket_is_refused(tmp_path):
+    """libzmq unlinks whatever is at an ipc:// path before binding: serve --rpc ipc://FILE deleted
+    the user's FILE, and a second server on another's path cut the first off from its clients (its
+    socket file replaced, then removed when the second quit). rpc = pub took the path twice."""
+    import socket
+
+    from sensorium.server.daemon.serve import ServeOptions
+
+    precious = tmp_path / "notes.txt"
+    precious.write_text("keep me")
+    with pytest.raises(ValueError, match=f"^--rpc ipc://{precious}: {precious} exists and is not a socket: not "
+                                         "replacing it$"):
+        ServeOptions(rpc=f"ipc://{precious}", pub="tcp://127.0.0.1:0").check()
+    assert precious.read_text() == "keep me"
+    live = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)        # another server's socket, listening
+    live.bind(str(tmp_path / "live"))
+    live.listen(1)
+    stale = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)       # a socket file whose server died
+    stale.bind(str(tmp_path / "stale"))
+    stale.close()
+    try:
+        with pytest.raises(ValueError, match=f"^--pub ipc://{tmp_path}/live: another process listens there"):
+            ServeOptions(rpc="tcp://127.0.0.1:0", pub=f"ipc://{tmp_path}/live").check()
+        ServeOptions(rpc=f"ipc://{tmp_path}/stale", pub=f"ipc://{tmp_path}/new").check()   # replaced, as before
+    finally:
+        live.close()
+    with pytest.raises(ValueError, match="^--rpc and --pub are the same endpoint ipc://"):
+        ServeOptions(rpc=f"ipc://{tmp_path}/same", pub=f"ipc://{tmp_path}/same").check()

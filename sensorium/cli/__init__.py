@@ -82,7 +82,7 @@ def _echo_args(p: argparse.ArgumentParser) -> None:
 
     p.add_argument("topic", help="topic, e.g. /epuck/ps0/value; a name ending in '/' is a prefix, '' is all")
     add_endpoint_args(p)
-    p.add_argument("--count", type=int, help="stop after N messages")
+    p.add_argument("--count", type=at_least(1), metavar="N", help="stop after N messages")
     p.add_argument("--full", action="store_true", help="print arrays in full (default: summarised)")
     p.add_argument("--json", action="store_true", help="one JSON object per message (arrays in full)")
 
@@ -93,16 +93,16 @@ def _hz_args(p: argparse.ArgumentParser) -> None:
 
     p.add_argument("topics", nargs="+", metavar="TOPIC", help="topics (a name ending in '/' is a prefix)")
     add_endpoint_args(p)
-    p.add_argument("--window", type=int, default=1000, metavar="N", help="messages per statistic (default 1000)")
-    p.add_argument("--every", type=float, default=1.0, metavar="S", help="report every S seconds (default 1)")
-    p.add_argument("--duration", type=float, metavar="S", help="stop after S seconds (default: until Ctrl-C)")
+    p.add_argument("--window", type=at_least(1), default=1000, metavar="N", help="messages per statistic (default 1000)")
+    p.add_argument("--every", type=positive_seconds, default=1.0, metavar="S", help="report every S seconds (default 1)")
+    p.add_argument("--duration", type=positive_seconds, metavar="S", help="stop after S seconds (default: until Ctrl-C)")
     p.add_argument("--json", action="store_true", help="one JSON object per topic and report")
 
 
 @command("topics", "list a running server's topics and their types", "sensorium.cli.topics:topics")
 def _topics_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--url", help="RPC endpoint (default tcp://127.0.0.1:5560)")
-    p.add_argument("--timeout", type=float, default=5.0, help="seconds to wait for the server (default 5)")
+    p.add_argument("--timeout", type=positive_seconds, default=5.0, help="seconds to wait for the server (default 5)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
 
 
@@ -111,7 +111,7 @@ def _topics_args(p: argparse.ArgumentParser) -> None:
 def _services_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--url", help="RPC endpoint (default tcp://127.0.0.1:5560)")
     p.add_argument("--robot", help="only this robot's services ('server': the server's own)")
-    p.add_argument("--timeout", type=float, default=5.0, help="seconds to wait for the server (default 5)")
+    p.add_argument("--timeout", type=positive_seconds, default=5.0, help="seconds to wait for the server (default 5)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
 
 
@@ -120,7 +120,7 @@ def _call_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("service", help="service name, e.g. get_info, set_mode, /epuck/robot/get_pose")
     p.add_argument("args", nargs="?", help="arguments as JSON or YAML flow style, e.g. '{mode: fast}'")
     p.add_argument("--url", help="RPC endpoint (default tcp://127.0.0.1:5560)")
-    p.add_argument("--timeout", type=float, default=5.0, help="seconds to wait for the reply (default 5)")
+    p.add_argument("--timeout", type=positive_seconds, default=5.0, help="seconds to wait for the reply (default 5)")
     p.add_argument("--full", action="store_true", help="print arrays in full (default: summarised)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
@@ -137,19 +137,39 @@ def _record_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--topics", nargs="+", metavar="TOPIC",
                    help="record only these topics: exact names, path prefixes (/epuck) or globs (/epuck/ps*)")
     p.add_argument("--world", metavar="FILE", help="world file to attach to the recording")
-    p.add_argument("--duration", type=float, metavar="S", help="stop after S wall-clock seconds")
-    p.add_argument("--max-messages", type=int, metavar="N", help="stop after N messages")
-    p.add_argument("--rcvhwm", type=int, default=1000, help="receive high-water mark, messages (default 1000)")
-    p.add_argument("--chunk-size", type=int, default=1 << 20, help="MCAP chunk size in bytes (default 1 MiB)")
+    p.add_argument("--duration", type=positive_seconds, metavar="S", help="stop after S wall-clock seconds")
+    p.add_argument("--max-messages", type=at_least(1), metavar="N", help="stop after N messages")
+    p.add_argument("--rcvhwm", type=at_least(0), default=1000, help="receive high-water mark, messages (default 1000)")
+    p.add_argument("--chunk-size", type=at_least(1), default=1 << 20, help="MCAP chunk size in bytes (default 1 MiB)")
     p.add_argument("--json", action="store_true", help="print the final summary as JSON")
     p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
 
 
 def _seconds(text: str) -> float:
+    """A finite number >= 0 (seconds, a rate): NaN and inf ended replay and export in a traceback."""
     value = float(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError("must be >= 0")
+    if not 0 <= value < float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
     return value
+
+
+def positive_seconds(text: str) -> float:
+    """A finite number > 0 (a timeout, a duration, a period, a frequency)."""
+    value = float(text)
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
+    return value
+
+
+def at_least(low: int) -> Callable[[str], int]:
+    """An integer >= ``low`` (a count, a window, a size)."""
+    def parse(text: str) -> int:
+        value = int(text)
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be an integer >= {low}, got {text!r}")
+        return value
+    parse.__name__ = "integer"          # argparse's "invalid integer value: 'x'" for a non-number
+    return parse
 
 
 @command("replay", "republish a recording like a live server (free-running or lockstep)",
@@ -161,7 +181,7 @@ def _replay_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="replay only these topics (names, prefixes, globs)")
     p.add_argument("--start", type=_seconds, metavar="S", help="start at S seconds of simulation time")
     p.add_argument("--end", type=_seconds, metavar="E", help="stop after E seconds of simulation time")
-    p.add_argument("--clock", type=float, nargs="?", const=40.0, metavar="HZ",
+    p.add_argument("--clock", type=positive_seconds, nargs="?", const=40.0, metavar="HZ",
                    help="publish /clock (rosgraph_msgs/Clock) at HZ wall-clock Hz (default 40) instead of a recorded /clock")
     p.add_argument("--lockstep", action="store_true",
                    help="publish only when a client calls /replay/step {duration} (see PROTOCOL.md, Replay)")
@@ -173,7 +193,7 @@ def _replay_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--delay", type=_seconds, default=0.0, metavar="S", help="wait S seconds before starting (and between loops)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress line on stderr (default: on a terminal, for long files)")
-    p.add_argument("--sndhwm", type=int, default=1000, help="send high-water mark per subscriber (default 1000)")
+    p.add_argument("--sndhwm", type=at_least(0), default=1000, help="send high-water mark per subscriber (default 1000)")
     p.add_argument("--nodrop", action="store_true", help="wait for slow subscribers instead of dropping messages")
 
 
@@ -240,7 +260,9 @@ def _schemas_args(p: argparse.ArgumentParser) -> None:
 def _demo_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("world", nargs="?", help="world file (default: the embedded arena world)")
     p.add_argument("--duration", type=float, default=60.0, metavar="S", help="simulated seconds (default 60)")
-    p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go")
+    p.add_argument("--out", default="sensorium-demo", metavar="DIR", help="where the recording, picture and logs go "
+                   "(a previous demo's are replaced)")
+    p.add_argument("--force", action="store_true", help="replace files of the same names in DIR that no demo wrote")
     p.add_argument("--precision", choices=["fast", "exact"], default="exact")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,

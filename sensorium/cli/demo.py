@@ -15,7 +15,8 @@ def main(args: argparse.Namespace) -> int:
     out = Path(args.out)
     try:
         result = run_demo(args.world, args.duration, out, precision=args.precision,
-                          log=lambda text: print(text, file=sys.stderr, flush=True), progress=args.progress)
+                          log=lambda text: print(text, file=sys.stderr, flush=True), progress=args.progress,
+                          overwrite=getattr(args, "force", False))
     except DemoError as exc:
         print(f"sensorium demo: {exc}", file=sys.stderr)
         return 1

@@ -171,12 +171,13 @@ def export_cmd(args: argparse.Namespace) -> int:
         progress.update(1)
 
     try:
-        report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
-                             pointcloud2=args.pointcloud2, topics=args.topics or None,
-                             views=not getattr(args, "no_views", False),
-                             start_ns=None if args.start is None else int(round(args.start * 1e9)),
-                             end_ns=None if args.end is None else int(round(args.end * 1e9)),
-                             progress=advance, on_damage=damage_printer("export", args.file))
+        with sigterm_as_interrupt():    # SIGTERM/SIGHUP too: what was written is removed, as for Ctrl-C
+            report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
+                                 pointcloud2=args.pointcloud2, topics=args.topics or None,
+                                 views=not getattr(args, "no_views", False),
+                                 start_ns=None if args.start is None else int(round(args.start * 1e9)),
+                                 end_ns=None if args.end is None else int(round(args.end * 1e9)),
+                                 progress=advance, on_damage=damage_printer("export", args.file))
     except (OSError, McapError) as exc:
         progress.close()
         print(f"sensorium export: {file_error(args.file, exc)}", file=sys.stderr)
@@ -205,7 +206,8 @@ def recover_cmd(args: argparse.Namespace) -> int:
     from sensorium.server.recording.recover import recover
 
     try:
-        r = recover(args.file, args.out, overwrite=args.force, on_damage=damage_printer("recover", args.file))
+        with sigterm_as_interrupt():    # SIGTERM/SIGHUP too: OUT.part is removed, as for Ctrl-C
+            r = recover(args.file, args.out, overwrite=args.force, on_damage=damage_printer("recover", args.file))
     except (FileExistsError, ValueError) as exc:
         print(f"sensorium recover: {exc}", file=sys.stderr)
         return 1
@@ -289,6 +291,8 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
     if s.get("unnamed_messages"):
         lines.append(("Unnamed", f"{s['unnamed_messages']} message records on channels defined only in a "
                                  "damaged chunk (bodies or Foxglove views: not counted)"))
+    if s.get("foreign"):            # a ROS 2 bag: its messages are none of the published bodies counted here
+        lines.insert(0, ("Not Sensorium", s["foreign"]))
     for key, value in lines:
         print(f"{key + ':' if key else '':<19}{value}")
     topics = s["topics"]

@@ -157,7 +157,15 @@ def main(args: argparse.Namespace) -> int:
         public = load_curve_keys(args.curve_keys)[0]
         print(f"sensorium serve: CURVE on; clients need SENSORIUM_CURVE_SERVERKEY={z85_hex(public)}", file=sys.stderr)
     if getattr(args, "record", None):
+        from sensorium.server.recording.envelope import unmatched_topics
         from sensorium.server.recording.writer import recorder_for_server
+
+        problem = unmatched_topics(getattr(args, "topics", None), [t.name for t in server.core.topics.topics],
+                                   f"world '{server.core.world_name}'")
+        if problem:             # a typo would record nothing at all
+            server.close()
+            print(f"sensorium serve: {problem}", file=sys.stderr)
+            return 1
         try:
             want_views = getattr(args, "record_format", "foxglove") == "foxglove"
             server.attach_recorder(recorder_for_server(args.record, server.core, getattr(args, "topics", None),

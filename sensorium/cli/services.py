@@ -32,6 +32,11 @@ def services(args: argparse.Namespace) -> int:
         print(f"sensorium services: {exc}", file=sys.stderr)
         return 1
     if args.robot:                        # one robot's services, or 'server' for the server's own
+        robots = list(dict.fromkeys(str(s["robot"]) for s in listed if s.get("robot") is not None))
+        if args.robot != "server" and args.robot not in robots:
+            print(f"sensorium services: no robot {args.robot!r} (robots: {', '.join(robots) or 'none'}; "
+                  "'server' for the server's own services)", file=sys.stderr)
+            return 1
         listed = [s for s in listed if s.get("robot") == (None if args.robot == "server" else args.robot)]
     if args.json:
         print(dumps({"services": listed}))
@@ -71,7 +76,37 @@ def parse_args_text(text: str | None) -> dict[str, Any]:
             raise ValueError(f"ARGS {text!r} is neither JSON nor YAML{where}: {problem}") from None
     if not isinstance(value, dict):
         raise ValueError(f"ARGS must be a mapping such as '{{\"mode\": \"fast\"}}', got {text!r}")
+    problem = _unsendable(value, "")
+    if problem:
+        raise ValueError(f"ARGS {text!r}: {problem}")
     return value
+
+
+def _unsendable(value: Any, where: str) -> str | None:
+    """What in a parsed ARGS value msgpack cannot carry to the server (a YAML date, a set, an
+    integer beyond 64 bits, a key that is not a string), naming where; None when all of it can."""
+    at = f" at {where[1:]}" if where else ""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if not isinstance(key, str):
+                return f"key {key!r}{at} is not a string (write it in quotes)"
+            problem = _unsendable(item, f"{where}.{key}")
+            if problem:
+                return problem
+        return None
+    if isinstance(value, list):
+        for k, item in enumerate(value):
+            problem = _unsendable(item, f"{where}[{k}]")
+            if problem:
+                return problem
+        return None
+    if isinstance(value, bool) or value is None or isinstance(value, (str, float, bytes)):
+        return None
+    if isinstance(value, int):
+        if -(1 << 63) <= value < (1 << 64):
+            return None
+        return f"the integer{at} does not fit in 64 bits"
+    return f"the {type(value).__name__} value {str(value)!r}{at} cannot be sent (write it in quotes for a string)"
 
 
 def call(args: argparse.Namespace) -> int:

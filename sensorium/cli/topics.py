@@ -38,7 +38,9 @@ def add_endpoint_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--pub", metavar="URL",
                    help=f"topic endpoint to subscribe to (default: the server's, else {DEFAULT_PUB_ENDPOINT})")
     p.add_argument("--rpc", help=argparse.SUPPRESS)            # deprecated spelling of --url
-    p.add_argument("--timeout", type=float, metavar="S",
+    from sensorium.cli import positive_seconds
+
+    p.add_argument("--timeout", type=positive_seconds, metavar="S",
                    help=f"exit 1 if no message arrives for S seconds (default: {DEFAULT_WAIT_S:g} s when no server "
                         "answers, else wait)")
 
@@ -117,6 +119,20 @@ def no_message(cmd: str, what: str, url: str, waited: float, view: ServerView) -
     return f"sensorium {cmd}: nothing on {what} from {url} for {waited:g} s: {why_silent(view)}"
 
 
+def _subscribe(cmd: str, url: str, topics: list[str], **kwargs: Any) -> Any:
+    """A :class:`Subscriber` on ``url``, or None after one line saying why it cannot connect there
+    (an unsupported scheme, no port: ZeroMQ refuses the endpoint)."""
+    import zmq
+
+    from sensorium.client.topics import Subscriber
+
+    try:
+        return Subscriber(url, *topics, **kwargs)
+    except (zmq.ZMQError, ValueError) as exc:
+        print(f"sensorium {cmd}: cannot subscribe to {url}: {exc}", file=sys.stderr)
+        return None
+
+
 def _setup(cmd: str, names: list[str], args: argparse.Namespace) -> tuple[ServerView, str] | int:
     """Ask the server, check the names; returns (view, topic endpoint) or an exit code."""
     rpc = args.url
@@ -125,6 +141,12 @@ def _setup(cmd: str, names: list[str], args: argparse.Namespace) -> tuple[Server
               "services and call)", file=sys.stderr)
         rpc = rpc or args.rpc
     pub = args.pub
+    if rpc:
+        try:
+            parse_controller_url(rpc)
+        except SensoriumError as exc:       # not an endpoint at all: never taken for a topic endpoint
+            print(f"sensorium {cmd}: {exc}", file=sys.stderr)
+            return 2
     view = ask_server(rpc) if (rpc or not pub) else ServerView("")
     if view.info is None and args.url and not pub and not args.rpc:
         # the old meaning of echo/hz --url: a topic endpoint (nothing answers RPCs there)
@@ -167,8 +189,6 @@ def format_message(msg: Any, full: bool = False) -> str:
 
 
 def echo(args: argparse.Namespace) -> int:
-    from sensorium.client.topics import Subscriber
-
     setup = _setup("echo", [args.topic], args)
     if isinstance(setup, int):
         return setup
@@ -177,7 +197,10 @@ def echo(args: argparse.Namespace) -> int:
     count = 0
     noted = False
     last = time.monotonic()
-    with Subscriber(url, args.topic) as sub:
+    sub = _subscribe("echo", url, [args.topic])
+    if sub is None:
+        return 1
+    with sub:
         while args.count is None or count < args.count:
             wait = 0.25 if limit is None else max(0.0, min(0.25, limit - (time.monotonic() - last)))
             msg = sub.recv(timeout=wait)
@@ -238,8 +261,6 @@ class Rate:
 
 
 def hz(args: argparse.Namespace) -> int:
-    from sensorium.client.topics import Subscriber
-
     setup = _setup("hz", args.topics, args)
     if isinstance(setup, int):
         return setup
@@ -249,7 +270,10 @@ def hz(args: argparse.Namespace) -> int:
     start = last = next_report = time.monotonic()
     next_report += args.every
     noted = False
-    with Subscriber(url, *args.topics, decode_arrays=False) as sub:
+    sub = _subscribe("hz", url, list(args.topics), decode_arrays=False)
+    if sub is None:
+        return 1
+    with sub:
         while args.duration is None or time.monotonic() - start < args.duration:
             msg = sub.recv(timeout=0.05)
             now = time.monotonic()
@@ -266,7 +290,11 @@ def hz(args: argparse.Namespace) -> int:
                 next_report = now + args.every
                 _report(rates, args.json)
     _report(rates, args.json)
-    return 0 if rates else 1
+    if not rates:               # --duration ended it before a message came: say why, as --timeout does
+        print(no_message("hz", ", ".join(repr(t) for t in args.topics), url, args.duration,
+                         ask_server(view.rpc) if view.info else view), file=sys.stderr)
+        return 1
+    return 0
 
 
 def _report(rates: dict[str, Rate], as_json: bool) -> None:

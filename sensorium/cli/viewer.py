@@ -41,6 +41,10 @@ def layout_cmd(args: argparse.Namespace) -> int:
     if out is None:
         print(text)
     else:
-        out.write_text(text + "\n")
+        try:
+            out.write_text(text + "\n")
+        except OSError as exc:      # a missing folder, a directory, no permission: one line, no traceback
+            print(f"sensorium layout: cannot write {out}: {exc.strerror or exc}", file=sys.stderr)
+            return 1
         print(f"sensorium: wrote {out} (Foxglove: Layouts, Import from file)", file=sys.stderr)
     return 0

@@ -150,10 +150,21 @@ class _Progress:
             self.bar.close()
 
 
+DEMO_MARK = ".sensorium-demo"      # in a folder the demo wrote: its files there are the demo's own
+
+
+def demo_outputs(out_dir: Path) -> list[Path]:
+    """The files a demo run writes in ``out_dir``."""
+    return [out_dir / name for name in ("demo.mcap", "server.log", *(f"{c.robot}.log" for c in CONTROLLERS),
+                                        "arena.png")]
+
+
 def run_demo(world: str | None, duration_s: float, out_dir: Path, precision: str = "exact",
              timeout_s: float = 600.0, log: Callable[[str], None] = print, progress: bool | None = None,
-             draw: bool = True) -> DemoResult:
-    """Run the demo; raises :class:`DemoError` (one line) if it cannot run or a process fails to start."""
+             draw: bool = True, overwrite: bool = False) -> DemoResult:
+    """Run the demo; raises :class:`DemoError` (one line) if it cannot run or a process fails to start.
+    A previous demo's files in ``out_dir`` (marked by :data:`DEMO_MARK`) are replaced; files of the
+    same names that no demo wrote only with ``overwrite``."""
     from sensorium.client.connection import Connection, SensoriumError
     from sensorium.server.world.loader import WorldError, default_world_path, load_world
 
@@ -169,8 +180,14 @@ def run_demo(world: str | None, duration_s: float, out_dir: Path, precision: str
         raise DemoError(f"{world_path}: cannot run the demo's controllers on this world: {'; '.join(problems)}")
     if not (duration_s > 0 and math.isfinite(duration_s)):
         raise DemoError(f"--duration must be a positive number of seconds, got {duration_s:g}")
+    taken = [p.name for p in demo_outputs(out_dir) if p.exists() or p.is_symlink()]
+    if taken and not overwrite and not (out_dir / DEMO_MARK).is_file():
+        raise DemoError(f"{out_dir} already holds {', '.join(taken)}, not written by a demo: not overwriting "
+                        "(--force to replace them, or --out another folder)")
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
+        (out_dir / DEMO_MARK).write_text("written by `sensorium demo`: the next demo run with this --out replaces "
+                                         f"{', '.join(p.name for p in demo_outputs(out_dir))}\n")
     except OSError as exc:
         raise DemoError(f"cannot create the output directory {out_dir}: {exc.strerror or exc}") from None
     recording = out_dir / "demo.mcap"

@@ -15,7 +15,14 @@ from typing import Any
 
 from sensorium.server.daemon.roles import CONTROLS, open_controls
 from sensorium.server.daemon.services import Core
-from sensorium.server.daemon.transport import DEFAULT_PUB, DEFAULT_RPC, Transport, check_cpu, load_curve_keys
+from sensorium.server.daemon.transport import (
+    DEFAULT_PUB,
+    DEFAULT_RPC,
+    Transport,
+    check_cpu,
+    endpoint_problem,
+    load_curve_keys,
+)
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import LoadedWorld, Problem, WorldError, default_world_path, load_world
@@ -44,6 +51,12 @@ class ServeOptions:
 
     def check(self) -> None:
         """Raise ValueError naming the first bad option."""
+        for flag, url in (("--rpc", self.rpc), ("--pub", self.pub)):
+            problem = endpoint_problem(url)
+            if problem:
+                raise ValueError(f"{flag} {problem}")
+        if self.rpc == self.pub and not self.rpc.endswith((":0", ":*")):   # ipc: the second bind would take the path
+            raise ValueError(f"--rpc and --pub are the same endpoint {self.rpc}: give each its own")
         if self.heartbeat_ms <= 0:
             raise ValueError("--heartbeat-ms must be > 0")
         if self.controls not in CONTROLS:

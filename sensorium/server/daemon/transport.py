@@ -36,7 +36,7 @@ from sensorium.server.daemon.services import STEP_REPLY_PIECES, Core
 from sensorium.server.daemon.steppath import gate_for
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
-           "curve_client_from_env", "check_cpu"]
+           "curve_client_from_env", "check_cpu", "endpoint_problem"]
 
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
@@ -60,6 +60,44 @@ def _bindable(url: str) -> str:
     if url.startswith("tcp://") and url.endswith(":0"):
         return url[:-2] + ":*"
     return url
+
+
+def endpoint_problem(url: str) -> str | None:
+    """Why an endpoint cannot be bound as asked, else None: a ``tcp://`` port out of range (libzmq
+    would take port 99999 as 34463 and -1 as 65535, silently binding another port than asked), an
+    ``ipc://`` path that is a file but no socket, or a socket another process listens on (libzmq
+    unlinks whatever is at the path before it binds: the file would be deleted, the other server
+    cut off from its clients)."""
+    if url.startswith("ipc://"):
+        return _ipc_problem(url, url[len("ipc://"):])
+    if not url.startswith("tcp://"):
+        return None
+    _host, sep, port = url[len("tcp://"):].rpartition(":")
+    if not sep or port.endswith("]"):
+        return f"{url}: no port (tcp://HOST:PORT; 0 or * for a free one)"
+    if port == "*" or (port.isdigit() and int(port) <= 65535):
+        return None
+    return f"{url}: the port must be 0 to 65535 (0 or * for a free one), got {port!r}"
+
+
+def _ipc_problem(url: str, path: str) -> str | None:
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return None                             # nothing there (or not reachable: bind says why)
+    import stat
+
+    if not stat.S_ISSOCK(mode):
+        return f"{url}: {path} exists and is not a socket: not replacing it"
+    probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    probe.settimeout(1.0)
+    try:
+        probe.connect(path)
+    except OSError:
+        return None                             # a socket file nobody listens on: left by a server that died
+    finally:
+        probe.close()
+    return f"{url}: another process listens there (another server?); choose another path"
 
 
 def check_cpu(cpu: int) -> None:

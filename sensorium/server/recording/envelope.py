@@ -6,6 +6,7 @@ The on-disk layout is described in :mod:`.writer`.
 
 from __future__ import annotations
 
+import difflib
 import fnmatch
 from collections.abc import Callable, Iterable
 from pathlib import Path
@@ -67,6 +68,24 @@ def topic_matcher(patterns: Iterable[str] | None) -> Callable[[str], bool]:
         return hit
 
     return match
+
+
+def unmatched_topics(patterns: Iterable[str] | None, topics: Iterable[str], where: str) -> str | None:
+    """One line naming the first ``--topics`` pattern that matches none of ``topics`` (those of
+    ``where``: a recording, a world, a server), with the closest names; None when every pattern matches some topic: a typo in ``--topics`` would
+    otherwise give an empty recording, replay or export without a word."""
+    names = sorted(set(topics))
+    for pattern in patterns or []:
+        if not pattern:
+            continue
+        match = topic_matcher([pattern])
+        if any(match(t) for t in names):
+            continue
+        near = difflib.get_close_matches(pattern, names, n=3, cutoff=0.5)
+        hint = (f"closest: {', '.join(near)}" if near else
+                f"topics: {', '.join(names[:6])}{' ...' if len(names) > 6 else ''}" if names else "there are none")
+        return f"--topics {pattern}: no topic of {where} matches it ({hint})"
+    return None
 
 
 

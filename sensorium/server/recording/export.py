@@ -42,6 +42,7 @@ import numpy as np
 
 from sensorium.schemas.devices import KINDS
 from sensorium.server.recording import cdr
+from sensorium.server.recording.envelope import unmatched_topics
 from sensorium.server.recording.reader import Recording
 
 DISTROS = ("humble", "jazzy")
@@ -395,6 +396,8 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
     fmt = fmt or ("mcap" if out.suffix == ".mcap" else "bag")
     if fmt not in ("bag", "mcap"):
         raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
+    if start_ns is not None and end_ns is not None and end_ns < start_ns:
+        raise ExportError("--end is before --start")          # as replay says: an empty bag is no answer
     if out.exists() or out.is_symlink():
         raise ExportError(f"{out} exists already; not overwriting")
     typestore = typestore_for(distro)
@@ -404,6 +407,9 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
         if progress:
             rec.check()                     # damaged chunks found first: the total counts what will be read
         report.total = sum(t.count for t in rec.topics()) if progress else 0
+        problem = rec.foreign() or unmatched_topics(topics, [t.topic for t in rec.topics()], str(src))
+        if problem:
+            raise ExportError(problem)
         meta = rec.metadata().get("sensorium", {})
         world = rec.world()
         try:

@@ -24,7 +24,7 @@ import msgpack
 import zmq
 
 from sensorium.server.daemon.transport import curve_client_from_env
-from sensorium.server.recording.envelope import DEFAULT_CHUNK_SIZE, topic_matcher
+from sensorium.server.recording.envelope import DEFAULT_CHUNK_SIZE, topic_matcher, unmatched_topics
 from sensorium.server.recording.writer import McapRecorder
 
 __all__ = ["LiveRecorder", "GapTracker", "subscription_prefixes", "rpc_call"]
@@ -167,6 +167,12 @@ class LiveRecorder:
             if not self.pub:
                 raise ValueError("nothing to record from: give a server (connect) or a topic endpoint (pub)")
             self.pub_endpoint = self.pub
+        listed = self.info.get("topics")
+        if self.topics and isinstance(listed, list):     # a server's topics are known: a typo records nothing
+            problem = unmatched_topics(self.topics, [str(t.get("name")) for t in listed if isinstance(t, dict)],
+                                       f"the server at {rpc}")
+            if problem:
+                raise ValueError(problem)
         world_text, world_name = b"", ""
         world_model, base_dir = None, Path(".")
         if self.world:

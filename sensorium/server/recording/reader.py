@@ -22,7 +22,13 @@ from mcap.records import Attachment, Channel, ChunkIndex, Header, Message, Messa
 from mcap.summary import Summary
 
 from sensorium.server.recording import foxglove_views as fxv
-from sensorium.server.recording.envelope import MESSAGE_ENCODING, SEQ_MODULUS, pack_envelope, topic_matcher
+from sensorium.server.recording.envelope import (
+    MESSAGE_ENCODING,
+    PROFILE,
+    SEQ_MODULUS,
+    pack_envelope,
+    topic_matcher,
+)
 from sensorium.server.recording.scan import Damage, DamagedRecord, McapScan, ScanReport
 
 __all__ = ["Recording", "RecordedMessage", "TopicInfo", "Damage", "iter_messages", "summarize", "McapError"]
@@ -284,6 +290,18 @@ class Recording:
             return self._file.header()
         return self._scan()["header"]
 
+    def foreign(self) -> str | None:
+        """Why this MCAP file is no Sensorium recording, or None: another profile and channels, but
+        none of published bodies (a ROS 2 bag: replay and export would read 0 messages from it)."""
+        header = self.header()
+        profile = header.profile if header is not None else ""
+        channels = self.channel_topics()
+        if profile == PROFILE or not channels or self.topics():
+            return None
+        return (f"{self.path} is not a Sensorium recording (MCAP profile {profile!r}; channels "
+                f"{', '.join(channels[:3])}{' ...' if len(channels) > 3 else ''}): it holds no published message "
+                "bodies (a ROS 2 bag, such as sensorium export writes, plays with ros2 bag play or in Foxglove)")
+
     def _indexed_records(self, indexes: list, record: type, what: str) -> list:
         """The records an index points at (metadata or attachments), read at their offsets; a
         damaged one is reported and left out."""
@@ -483,6 +501,7 @@ class Recording:
             "attachments": [{"name": a.name, "media_type": a.media_type, "size_bytes": len(a.data)} for a in atts],
             "damaged": [d.line() for d in self.damaged],
             "unnamed_messages": self.unnamed,
+            "foreign": self.foreign(),        # not a Sensorium recording: why (its messages are not counted)
         }
         if self.truncated:
             why = stopped or self.error

@@ -26,6 +26,7 @@ from typing import IO, Any
 
 import zmq
 
+from sensorium.schemas.services import MAX_PERIOD_MS
 from sensorium.schemas.wire import (
     ErrorCode,
     RequestError,
@@ -35,7 +36,8 @@ from sensorium.schemas.wire import (
     parse_request,
     stamp,
 )
-from sensorium.server.recording.envelope import pack_envelope, topic_matcher
+from sensorium.server.daemon.transport import endpoint_problem
+from sensorium.server.recording.envelope import pack_envelope, topic_matcher, unmatched_topics
 from sensorium.server.recording.reader import RecordedMessage, Recording
 from sensorium.server.recording.scan import Damage
 
@@ -43,6 +45,9 @@ CLOCK_TOPIC = "/clock"
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
+# the latest replay time a step or seek may reach: its nanoseconds fit a ROS stamp's int64 (and
+# every reply's msgpack integers); beyond it the replay's state could no longer be sent at all
+MAX_TIME_MS = ((1 << 63) - 1) // 1_000_000
 
 
 def _fmt_s(ns: int | float) -> str:
@@ -63,8 +68,18 @@ class Replayer:
                  on_damage: Callable[[Damage], None] | None = None):
         if rate < 0 or not math.isfinite(rate):
             raise ValueError("rate must be >= 0 (0: as fast as possible)")
+        for flag, url in (("--pub", pub), ("--rpc", rpc)):
+            problem = endpoint_problem(url) if url else None
+            if problem:
+                raise ValueError(f"{flag} {problem}")
+        if pub == rpc and not pub.endswith((":0", ":*")):          # ipc: the second bind would take the path
+            raise ValueError(f"--rpc and --pub are the same endpoint {pub}: give each its own")
         self.path = str(path)
         self.recording = Recording(path, on_damage=on_damage)     # a damaged chunk is skipped and said
+        foreign = self.recording.foreign()
+        if foreign:                 # a ROS 2 bag: it would replay 0 messages without a word
+            self.recording.close()
+            raise ValueError(foreign)
         self.pub_url, self.rpc_url = pub, rpc
         self.rate = float(rate)
         self.loop = loop
@@ -105,6 +120,10 @@ class Replayer:
         skip_clock = clock_hz is not None
         self._match = lambda t: match(t) and not (skip_clock and t == CLOCK_TOPIC)
         infos = self.recording.topics()
+        problem = unmatched_topics(topics, [t.topic for t in infos], self.path)
+        if problem:
+            self.recording.close()
+            raise ValueError(problem)
         self.topic_types = {t.topic: t.ros_type for t in infos if self._match(t.topic)}
         times = [(t.first_ns, t.last_ns) for t in infos
                  if self._match(t.topic) and t.first_ns is not None and t.last_ns is not None]
@@ -201,8 +220,9 @@ class Replayer:
 
     # ------------------------------------------------------------------ RPC
     def _service(self, timeout_s: float) -> None:
-        """Wait up to ``timeout_s`` for requests or subscriptions and handle them."""
-        timeout_ms = max(0, int(math.ceil(timeout_s * 1000)))
+        """Wait up to ``timeout_s`` (at most a second: callers wait in a loop) for requests or
+        subscriptions and handle them."""
+        timeout_ms = max(0, int(math.ceil(min(timeout_s, 1.0) * 1000)))
         events = dict(self._poller.poll(timeout_ms))
         assert self.pub is not None, "bind() first"
         if self.pub in events:
@@ -244,11 +264,15 @@ class Replayer:
                 "mode": "lockstep" if self.lockstep else "replay",
                 "subscriptions": sorted(s.decode("utf-8", "replace") for s in self.subscriptions)}
 
+    def service_names(self) -> list[str]:
+        """The services of this mode, as ``get_info`` lists them."""
+        return ["get_info", "get_services", "ping", "/replay/get_state", "/replay/quit",
+                *(["/replay/step", "/replay/seek"] if self.lockstep
+                  else ["/replay/pause", "/replay/resume", "/replay/set_rate"])]
+
     def info(self) -> dict:
         world = self.meta.get("world") or self.meta.get("world_file") or ""
-        services = ["get_info", "get_services", "ping", "/replay/get_state", "/replay/quit"]
-        services += (["/replay/step", "/replay/seek"] if self.lockstep
-                     else ["/replay/pause", "/replay/resume", "/replay/set_rate"])
+        services = self.service_names()
         topics = [{"name": k, "type": v} for k, v in sorted(self.topic_types.items())]
         if self.clock_hz is not None:
             topics.append({"name": CLOCK_TOPIC, "type": CLOCK_TYPE})
@@ -275,6 +299,12 @@ class Replayer:
                              for n in self.info()["services"]]}
 
     def _dispatch(self, service: str, args: dict) -> dict:
+        if service != "ping" and service in self.service_names():     # ping may carry a session (§3.3)
+            known = {name.rstrip("?") for name in self.SERVICE_ARGS.get(service, {})}
+            unknown = sorted(str(k) for k in args if k not in known)
+            if unknown:                # as the server does (PROTOCOL.md §3.1): a typo never passes silently
+                raise RequestError(ErrorCode.INVALID_ARGUMENT, f"{service}: unknown argument {unknown[0]!r}"
+                                   + (f" (it takes {', '.join(sorted(known))})" if known else " (it takes none)"))
         if service == "get_info":
             return self.info()
         if service == "get_services":
@@ -312,8 +342,11 @@ class Replayer:
     # lockstep
     def _step(self, args: dict) -> dict:
         duration = args.get("duration", self.basic_time_step)
-        if not isinstance(duration, int) or isinstance(duration, bool) or duration <= 0:
-            raise RequestError(ErrorCode.INVALID_ARGUMENT, "duration: a positive integer number of ms is required")
+        if not isinstance(duration, int) or isinstance(duration, bool) or not 0 < duration <= MAX_PERIOD_MS:
+            raise RequestError(ErrorCode.INVALID_ARGUMENT,
+                               f"duration: a positive integer number of ms up to {MAX_PERIOD_MS} is required")
+        if self.time_ns + duration * 1_000_000 > MAX_TIME_MS * 1_000_000:
+            raise RequestError(ErrorCode.INVALID_ARGUMENT, f"duration: the replay time would pass {MAX_TIME_MS} ms")
         self.time_ns += duration * 1_000_000
         n = self._emit_until(self.time_ns)
         if self.clock_hz is not None and (self._last_clock_ns is None or self.time_ns > self._last_clock_ns):
@@ -324,8 +357,8 @@ class Replayer:
 
     def _seek(self, args: dict) -> dict:
         t = args.get("time_ms")
-        if not isinstance(t, int) or isinstance(t, bool) or t < 0:
-            raise RequestError(ErrorCode.INVALID_ARGUMENT, "time_ms: a non-negative integer is required")
+        if not isinstance(t, int) or isinstance(t, bool) or not 0 <= t <= MAX_TIME_MS:
+            raise RequestError(ErrorCode.INVALID_ARGUMENT, f"time_ms: an integer from 0 to {MAX_TIME_MS} is required")
         self.time_ns = t * 1_000_000
         lo = self.time_ns + 1  # messages at exactly time_ms count as already emitted
         if self.start_ns is not None:
@@ -341,7 +374,8 @@ class Replayer:
             return self._paused_at_ns
         if self.rate <= 0:
             return self.time_ns
-        return int(self._base_ns + (now - self._wall0) * self.rate * 1e9)
+        # saturated: a huge rate (set_rate {value: 1e308}) makes this infinite, never an error
+        return int(min(self._base_ns + (now - self._wall0) * self.rate * 1e9, MAX_TIME_MS * 1_000_000))
 
     def _wall_of(self, t_ns: int) -> float:
         return self._wall0 + (t_ns - self._base_ns) / (self.rate * 1e9)
