@@ -498,3 +498,5 @@ def test_an_ipc_path_in_use_or_not_a_socket_is_refused(tmp_path):
         live.close()
     with pytest.raises(ValueError, match="^--rpc and --pub are the same endpoint ipc://"):
         ServeOptions(rpc=f"ipc://{tmp_path}/same", pub=f"ipc://{tmp_path}/same").check()
+    with pytest.raises(ValueError, match=r"^--until must be a simulated time >= 0 ms, got -5$"):   # it stopped at once
+        ServeOptions(rpc="tcp://127.0.0.1:0", pub="tcp://127.0.0.1:0", until=-5).check()

@@ -59,6 +59,8 @@ class ServeOptions:
             raise ValueError(f"--rpc and --pub are the same endpoint {self.rpc}: give each its own")
         if self.heartbeat_ms <= 0:
             raise ValueError("--heartbeat-ms must be > 0")
+        if self.until is not None and self.until < 0:     # it stopped at once, with exit 0
+            raise ValueError(f"--until must be a simulated time >= 0 ms, got {self.until}")
         if self.controls not in CONTROLS:
             raise ValueError(f"--controls must be one of {', '.join(CONTROLS)}, got {self.controls!r}")
         if self.curve_keys:
