@@ -194,3 +194,18 @@ def test_version_says_which_compiled_paths_are_active(monkeypatch, capsys):
     lines = capsys.readouterr().out.splitlines()
     assert lines[1] == ("step path: C (sensorium.server.daemon._steppath)" if gate is not None else f"step path: Python ({why})")
     assert lines[2] == f"ray traversal: {packets.status()}"
+
+
+def test_serve_refuses_recording_options_without_a_recording(capsys):
+    """--topics, --force and --record-format without --record did nothing, without a word."""
+    from sensorium.cli import build_parser
+    from sensorium.cli.serve import main
+
+    parser = build_parser()
+    for extra, said in ((["--topics", "/clock"], "--topics is for --record FILE, which is not given"),
+                        (["--force"], "--force is for --record FILE, which is not given"),
+                        (["--record-format", "msgpack", "--topics", "/x"],
+                         "--topics and --record-format are for --record FILE, which is not given")):
+        args = parser.parse_args(["serve", "arena", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0", *extra])
+        assert main(args) == 2
+        assert capsys.readouterr().err.strip().splitlines() == [f"sensorium serve: {said}"]

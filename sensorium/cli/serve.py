@@ -137,6 +137,13 @@ def main(args: argparse.Namespace) -> int:
         print(f"sensorium serve: {exc}", file=sys.stderr)
         return 2
     record = getattr(args, "record", None)
+    if not record:          # options of the recording, given without one, did nothing without a word
+        given = [flag for flag, on in (("--topics", getattr(args, "topics", None)), ("--force", getattr(args, "force", False)),
+                                       ("--record-format", getattr(args, "record_format", "foxglove") != "foxglove")) if on]
+        if given:
+            print(f"sensorium serve: {' and '.join(given)} {'is' if len(given) == 1 else 'are'} for --record FILE, "
+                  "which is not given", file=sys.stderr)
+            return 2
     if record and os.path.exists(record) and not getattr(args, "force", False):
         print(f"sensorium serve: {record} exists already; not overwriting (--force to replace it)", file=sys.stderr)
         return 1
