@@ -15,6 +15,7 @@ import zmq
 from _recdata import STEP_NS, TOPICS, make_recording, published
 from _serve import Proc, Served, sensorium
 
+from sensorium.schemas.wire import HARD_LIMIT
 from sensorium.server.recording.envelope import pack_envelope
 from sensorium.server.recording.live import LiveRecorder, subscription_prefixes
 from sensorium.server.recording.reader import Recording
@@ -268,6 +269,29 @@ def test_unknown_argument_names_are_refused_as_the_server_does(rec_path, ctx):
         th.start()
         bad = call(ctx, r.rpc_endpoint, "/replay/set_rate", {"rate": 2})
         assert bad["error"] == {"code": 5, "message": "/replay/set_rate: unknown argument 'rate' (it takes value)"}
+
+
+def test_the_replays_request_socket_is_bounded_as_the_servers(rec_path, ctx):
+    """The replay's ROUTER read messages of any size and frame count into memory (the live server's
+    has ZMQ_MAXMSGSIZE and a frame cap)."""
+    path, _ = rec_path
+    with running(path, ctx, lockstep=True) as (r, th):
+        th.start()
+        many = ctx.socket(zmq.DEALER)
+        many.setsockopt(zmq.LINGER, 0)
+        many.connect(r.rpc_endpoint)
+        many.send_multipart([b""] * 20 + [msgpack.packb({"id": 1, "service": "ping", "args": {}})])
+        assert many.poll(5000)
+        reply = msgpack.unpackb(many.recv_multipart()[-1])
+        assert reply["error"]["code"] == 8 and "at most 16 frames" in reply["error"]["message"]
+        big = ctx.socket(zmq.DEALER)
+        big.setsockopt(zmq.LINGER, 0)
+        big.connect(r.rpc_endpoint)
+        big.send(b"\x00" * (HARD_LIMIT + 1))          # over the hard cap: libzmq drops the peer, unread
+        assert not big.poll(500)
+        many.close()
+        big.close()
+        assert call(ctx, r.rpc_endpoint, "/replay/get_state")["result"]["time_ms"] == 0      # still serving
 
 
 def test_lockstep_refuses_times_it_could_not_answer(rec_path, ctx):

@@ -28,6 +28,7 @@ import zmq
 
 from sensorium.schemas.services import MAX_PERIOD_MS
 from sensorium.schemas.wire import (
+    HARD_LIMIT,
     ErrorCode,
     RequestError,
     error_reply,
@@ -36,7 +37,7 @@ from sensorium.schemas.wire import (
     parse_request,
     stamp,
 )
-from sensorium.server.daemon.transport import endpoint_problem
+from sensorium.server.daemon.transport import MAX_FRAMES, SUB_LIMIT, TOO_MANY_FRAMES, endpoint_problem
 from sensorium.server.recording.envelope import pack_envelope, topic_matcher, unmatched_topics
 from sensorium.server.recording.reader import RecordedMessage, Recording
 from sensorium.server.recording.scan import Damage
@@ -151,11 +152,13 @@ class Replayer:
         self.pub.setsockopt(zmq.SNDHWM, self._sndhwm)
         if self._nodrop:
             self.pub.setsockopt(zmq.XPUB_NODROP, 1)
+        self.pub.setsockopt(zmq.MAXMSGSIZE, SUB_LIMIT)          # the live server's bounds (transport.py)
         self.pub.bind(self.pub_url)
         self.pub_endpoint = self.pub.getsockopt_string(zmq.LAST_ENDPOINT)
         if self.rpc_url:
             self.rpc = self._ctx.socket(zmq.ROUTER)
             self.rpc.setsockopt(zmq.LINGER, 500)
+            self.rpc.setsockopt(zmq.MAXMSGSIZE, HARD_LIMIT)    # a larger message drops its peer, unread
             self.rpc.bind(self.rpc_url)
             self.rpc_endpoint = self.rpc.getsockopt_string(zmq.LAST_ENDPOINT)
         self._poller = zmq.Poller()
@@ -242,6 +245,9 @@ class Replayer:
                 except zmq.Again:
                     break
                 if len(frames) < 2:
+                    continue
+                if len(frames) > MAX_FRAMES:
+                    self.rpc.send_multipart([frames[0], TOO_MANY_FRAMES])
                     continue
                 reply = self._handle(frames[-1])
                 self.rpc.send_multipart(frames[:-1] + [reply])
