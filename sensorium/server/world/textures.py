@@ -741,6 +741,17 @@ class TextureSampler:
         uv, picked = self._uv_of(shape, atlas)(origins, directions, t)
         return uv, np.ones(len(uv), dtype=bool) if picked is None else picked
 
+    def ink_uv(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray, uv: np.ndarray
+               ) -> np.ndarray:
+        """Where a camera sees the ink of hits on ``shape`` (Webots' shaders sample the paint
+        texture at ``penTexUv``, texture set 1: where the pen painted): ``uv`` (set 0, as given)
+        where the two sets coincide, else the hits' set-1 coordinates (a Box's atlas, a Cylinder's
+        or a Cone's halves, an IndexedFaceSet without texture coordinates)."""
+        g = self.models[shape][0]
+        if isinstance(g, wm.Box | wm.Cylinder | wm.Cone) or (isinstance(g, wm.Triangles) and g.tex_coords is None):
+            return self.uv(shape, origins, directions, t, atlas=True)[0]
+        return uv
+
     def texels(self, shape: int, uv: np.ndarray, which: str = "base", channel: int | None = None) -> np.ndarray:
         """Colours of ``shape``'s ``which`` map ("base", "roughness", "occlusion") at ``uv``
         (the TextureTransform applied, then the map's wrap, nearest texel)."""
