@@ -547,8 +547,8 @@ class InkLayer:
 
     Its size is the shape's image size (an untextured shape: from its bounding sphere radius r,
     ``32 + 992·r/10`` texels, 1024 beyond 10 m, to the nearest power of two) times the geometry's
-    factor for texture set 1 (Box 4 x 2, Cylinder 2 x 2, triangles without texture coordinates 4 x 2,
-    else 1 x 1). A pen's lead of size L covers a disc ``⌊L·w₀/r⌋`` texels across, ``w₀`` being
+    factor for texture set 1 (Box 4 x 2, Cylinder 2 x 2, Cone 2 x 1, triangles without texture
+    coordinates 4 x 2, else 1 x 1). A pen's lead of size L covers a disc ``⌊L·w₀/r⌋`` texels across, ``w₀`` being
     that size before the factor (``original_width``) and ``r`` the bounding radius.
 
     ``evaporating`` (the world's ``ink_evaporation`` > 0): each texel also keeps its ink as a double
@@ -783,7 +783,7 @@ class TextureSampler:
                 nxt = _next_power_of_2(int(size))
                 w = h = int(nxt / 2 if abs(nxt - size) > abs(nxt / 2 - size) else nxt)
             fx, fy = ((4, 2) if isinstance(g, wm.Box) or (isinstance(g, wm.Triangles) and g.tex_coords is None)
-                      else (2, 2) if isinstance(g, wm.Cylinder) else (1, 1))
+                      else (2, 2) if isinstance(g, wm.Cylinder) else (2, 1) if isinstance(g, wm.Cone) else (1, 1))
             used = sum(layer.texels for layer in self.ink.values())
             if used + w * fx * h * fy > self.ink_texels_max:
                 self.ink_refused.add(shape)
