@@ -19,7 +19,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
-from sensorium.server.devices.shading import srgb_to_linear
+from sensorium.server.devices.shading import background_radiance, srgb_to_linear
 from sensorium.server.raycast.engine import Precision, RayEngine, ShapeEntry
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
@@ -273,7 +273,8 @@ class Scene:
         self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
         self.shapes_version = 0        # changes whenever a Supervisor adds shapes (cameras' recognition rebuilds)
         self._shape_arrays()
-        self.background = np.asarray(world.background.sky_color, dtype=np.float64)   # what cameras see past everything
+        # what cameras see past everything: the HDR radiance Webots clears with (shows as the sky colour)
+        self.background = background_radiance(world.background.sky_color)
         # Webots' Fog as cameras mix it in: (linear colour, visibility range, type); None without fog or
         # with a visibility range of 0 (Webots then turns it off), so a world without fog computes nothing more
         fog = world.fog
