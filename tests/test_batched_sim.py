@@ -181,6 +181,33 @@ def test_what_the_batched_simulation_does_not_simulate_is_refused_with_a_reason(
         bs.device("epuck", "nope")
 
 
+def test_a_writing_pen_whose_ink_a_sensor_would_read_is_refused():
+    """The batched simulation lays no pen ink: a world where a writing pen's ink would be read (an
+    infra-red sensor, a camera) is refused in one line; it used to run, its infra-red sensor reading
+    the bare floor (10 here) where the single simulation reads the ink (50)."""
+    down = [0.0, 1.0, 0.0, math.pi / 2]
+    ir = {"device": "DistanceSensor", "name": "ir", "type": "infra-red", "lookup_table": [[0, 0, 0], [1, 1000, 0]],
+          "pose": {"translation": [0, 0, 0.01], "rotation": down}}
+
+    def world(pen: dict, reader: dict) -> wm.World:
+        return wm.World.model_validate({
+            "world_info": {"contact": False}, "robots": [{"name": "r", "devices": [pen, reader]}],
+            "solids": [{"name": "floor", "geometry": {"type": "plane", "size": [1, 1]}, "appearance": {}}]})
+
+    pen = {"device": "Pen", "name": "pen", "pose": {"translation": [0, 0, 0.05]}, "ink_density": 1.0}
+    sim = Simulation(world(pen, ir))
+    sim.device("r/ir").enable(16)
+    sim.step()
+    assert sim.device("r/ir").value == pytest.approx(50.0)          # 0.01 m over black ink: 0.01 / 0.2
+    with pytest.raises(BatchedError, match="pen 'pen' writes.*r/ir would not see it"):
+        BatchedSimulation(world(pen, ir), 2)
+    with pytest.raises(BatchedError, match="r/cam would not see it"):
+        BatchedSimulation(world(pen, {"device": "Camera", "name": "cam"}), 2)
+    # a pen that does not write, or a writing pen no sensor reads, is no difference
+    BatchedSimulation(world({**pen, "write": False}, ir), 2)
+    BatchedSimulation(world(pen, {**ir, "type": "generic"}), 2)
+
+
 def test_wheel_encoders_with_noise_and_resolution_match_the_single_simulation():
     world = wm.World.model_validate({
         "world_info": {"basic_time_step": 16, "random_seed": 0},

@@ -176,10 +176,19 @@ def test_semi_transparent_surfaces_are_composited_front_to_back(pane_geometry):
 
 
 def test_background_and_far_plane():
+    """Webots clears a camera's HDR buffer with the sky colour reverse tone mapped
+    (WbBackground::applyColorToWren: -ln(1.000000001 - c^2.2)), so at exposure 1 the background
+    pixels are the sky colour's bytes (51, 102, 255 here; they were the tone map of the colour
+    itself, 117, 161, 207); at another exposure they are the resolve of that radiance."""
     cam = {"width": 4, "height": 3, "field_of_view": 0.5, "far": 1.0}
     amb = {"type": "DirectionalLight", "direction": [1, 0, 0], "intensity": 0.0, "ambient_intensity": 1.0}
-    _, img = shoot(world(cam, [WALL], [amb], background={"sky_color": [0.2, 0.4, 1.0]}))
-    np.testing.assert_array_equal(rgb(img), np.broadcast_to(expected_bytes([0.2, 0.4, 1.0]), (3, 4, 3)))
+    sky = {"sky_color": [0.2, 0.4, 1.0]}
+    _, img = shoot(world(cam, [WALL], [amb], background=sky))
+    np.testing.assert_array_equal(rgb(img), np.broadcast_to([51, 102, 255], (3, 4, 3)))
+    hdr = -np.log(1.000000001 - np.array([0.2, 0.4, 1.0]) ** 2.2)
+    _, img = shoot(world({**cam, "exposure": 0.5}, [WALL], [amb], background=sky))
+    np.testing.assert_array_equal(rgb(img), np.broadcast_to(expected_bytes(hdr, 0.5), (3, 4, 3)))
+    assert expected_bytes(hdr, 0.5).tolist() == [37, 76, 255]
     _, img = shoot(world({**cam, "far": 0.0}, [WALL], [amb], background={"sky_color": [0.2, 0.4, 1.0]}))
     np.testing.assert_array_equal(rgb(img), np.broadcast_to(expected_bytes(ALBEDO), (3, 4, 3)))
 

@@ -270,6 +270,31 @@ def test_ink_on_a_box_face_is_read_where_webots_reads_it(precision: str) -> None
     assert v["centre"] == pytest.approx(reading(1.0), rel=tol(precision))
 
 
+@pytest.mark.parametrize("precision", PRECISIONS)
+def test_a_camera_sees_ink_on_a_box_face_where_the_pen_painted_it(precision: str) -> None:
+    """Webots' shaders sample the paint texture at texture set 1 (``penTexUv``), the coordinates
+    the pen painted at: a camera above the box of the test above sees the black stroke on the top
+    face's centre, in the middle of its image (it used to read set 0, as infra-red does, and
+    showed the stroke up and to the right of the middle, at a = 0.627, b = 0.746)."""
+    box = {"name": "box", "pose": {"translation": [0.0, 0.0, 0.1]}, "geometry": {"type": "box", "size": [0.4, 0.4, 0.2]},
+           "appearance": {"base_color": [1, 1, 1]}}
+    down = [-1.0, 1.0, 1.0, 2.0 * math.pi / 3.0]     # +x to world -z, the image's top to world +y
+    cam = {"device": "Camera", "name": "cam", "width": 33, "height": 33, "field_of_view": 0.5,
+           "pose": {"translation": [0.0, 0.0, 1.0], "rotation": down}}
+    data = {"world_info": {"contact": False}, "solids": [box],
+            "lights": [{"type": "DirectionalLight", "direction": [0, 0, -1]}],
+            "robots": [{"name": "r", "devices": [pen(z=0.5, ink_density=1.0, lead_size=0.03), cam]}]}
+    sim = Simulation(parse_world(data), precision)
+    sim.device("r/cam").enable(16)
+    sim.step()
+    assert np.count_nonzero(sim.scene.textures.ink[0].density) == 29       # a disc 7 texels across
+    red = sim.device("r/cam").image[:, :, 2]
+    rows, cols = np.nonzero(red < 100)
+    assert red[16, 16] == 0 and len(rows) > 4
+    assert abs(rows.mean() - 16) < 1.0 and abs(cols.mean() - 16) < 1.0
+    assert red[2, 2] > 200                              # the rest of the face is white and lit
+
+
 # ------------------------------------------------------------------ evaporation and reset
 
 def test_ink_evaporates_as_webots_inkEvaporation_and_reset_clears_it() -> None:  # noqa: N802

@@ -612,7 +612,8 @@ def test_ink_layer_sizes_discs_and_atlas(tmp_path: Path) -> None:
     board(tmp_path)
     models = [(wm.Plane(type="plane", size=(0.15, 0.15)), None),
               (wm.Box(type="box", size=(1.0, 1.0, 1.0)), wm.Appearance(texture=wm.Texture(url="board.png"))),
-              (wm.Cylinder(type="cylinder", radius=0.1, height=0.2), None)]
+              (wm.Cylinder(type="cylinder", radius=0.1, height=0.2), None),
+              (wm.Cone(type="cone", bottom_radius=0.1, height=0.2), None)]
     sampler = TextureSampler(models, tmp_path)
     # an untextured plane of radius 0.106 m: 32 + 992 * 0.0106 = 42.5 texels -> the nearer power of two, 32
     assert sampler.ink_layer(0).density.shape == (32, 32)
@@ -621,7 +622,10 @@ def test_ink_layer_sizes_discs_and_atlas(tmp_path: Path) -> None:
     # a cylinder of radius |(0.1, 0.1)|: 32 + 992 * 0.01414 = 46.0 -> 32 (|64 - 46| > |32 - 46|), times 2 x 2
     assert sampler.ink_layer(2).density.shape == (64, 64)
     assert bounding_radius(models[2][0]) == pytest.approx(math.hypot(0.1, 0.1))
-    assert sampler.textured[[0, 1, 2, 3]].tolist() == [True, True, True, False]
+    # a cone (WbCone::nonRecursiveTextureSizeFactor 2 x 1: the side on the left half, the base on the
+    # right) of bounding radius 0.1 + 0.01/0.4 = 0.125: 32 + 992 * 0.0125 = 44.4 -> 32, times 2 x 1
+    assert sampler.ink_layer(3).density.shape == (32, 64)
+    assert sampler.textured[[0, 1, 2, 3, 4]].tolist() == [True, True, True, True, False]
     # a lead of 5 texels across (0.05 x 32 / 0.32): a disc of radius 2 (13 texels) around (u w, v h)
     layer = InkLayer(32, 32, 32, 0.32)
     assert layer.lead_texels(0.05) == 5

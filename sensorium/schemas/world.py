@@ -946,7 +946,7 @@ class WorldInfo(Strict):
 
 class Background(Strict):
     """Webots' Background node: what a camera sees where no shape is (``skyColor``'s first colour,
-    through the camera's tone mapping as Webots clears its image with it)."""
+    which Webots clears the HDR image with reverse tone mapped: at exposure 1 it shows as itself)."""
 
     sky_color: Color = (0.0, 0.0, 0.0)
 

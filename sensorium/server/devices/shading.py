@@ -14,7 +14,8 @@ converted from sRGB to linear as Webots' shaders do (``SRGBtoLINEAR``).
 
 Semi-transparent surfaces are composited front to back (Webots' alpha blending: a surface of
 ``transparency`` τ adds ``(1 − τ)·L`` and lets ``τ`` of what is behind through); what no surface
-covers is the background colour. The sum is a radiance in Webots' HDR buffer; the pixel is
+covers is the background (:func:`background_radiance`: the sky colour reverse tone mapped, as
+Webots clears its HDR buffer). The sum is a radiance in Webots' HDR buffer; the pixel is
 Webots' ``hdr_resolve``: ``v = (1 − exp(−L·exposure))^(1/2.2)``; then ``noise`` (Gaussian, σ =
 ``noise`` in [0, 1] units, per channel, clamped: ``color_noise.frag``) and the byte
 ``⌊255·v + ½⌋``. Anti-aliasing averages the radiance of a 2×2 grid of rays per pixel.
@@ -36,11 +37,20 @@ import numpy as np
 from .light import LightArrays, LightKind
 from .noise import gaussian
 
-__all__ = ["GAMMA", "FOG_TYPES", "srgb_to_linear", "radiance", "fog_weight", "fog", "tone_map", "to_bytes", "take_rows",
+__all__ = ["GAMMA", "FOG_TYPES", "background_radiance", "srgb_to_linear", "radiance", "fog_weight", "fog", "tone_map", "to_bytes", "take_rows",
            "add_to_rows", "scaled_rows"]
 
 GAMMA = 2.2
 """Webots' ``hdr_resolve.frag`` gamma."""
+
+
+def background_radiance(sky_color) -> np.ndarray:
+    """The radiance Webots clears a camera's HDR buffer with for a Background ``skyColor``
+    (``WbBackground::applyColorToWren``): the colour de-gamma'd (``c^2.2``) and reverse tone mapped,
+    ``−ln(1.000000001 − c^2.2)`` (over the Viewpoint's exposure, 1 here), so that the resolve at
+    exposure 1 shows the sky colour itself."""
+    c = np.asarray(sky_color, dtype=np.float64)
+    return -np.log(1.000000001 - c ** GAMMA)
 
 
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:

@@ -26,7 +26,8 @@ the same order). Tests compare it with the single simulation step by step.
 
 Camera recognition and segmentation: batched_recognition.py (per copy, enabled with
 :meth:`BatchedSimulation.recognition_enable`). Not simulated here (use :class:`Simulation`): force TouchSensors,
-the kinds without an observation (LEDs, pens, ...). Textured robot bodies are read per copy
+the kinds without an observation (LEDs, pens, ...): pens lay no ink, so a world with a writing pen
+and an infra-red sensor or a camera to see its ink is refused. Textured robot bodies are read per copy
 (batched_textures.py). A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
 (``sim.cars.command``; their encoders read its motors), their moves through the same arc, contact
@@ -318,6 +319,15 @@ class BatchedSimulation:
         if w.world_info.coordinate_system not in _TO_ENU:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
+        # pens lay no ink here: a world whose ink infra-red sensors or cameras would read is refused,
+        # not run with readings that silently differ from the single simulation's
+        pens = [(r.name, d.name) for r in w.robots for d in r.devices if d.device == "Pen" and d.write]
+        readers = [(r.name, d.name) for r in w.robots for d in r.devices
+                   if d.device == "Camera" or (d.device == "DistanceSensor" and d.type == "infra-red")]
+        if pens and readers:
+            raise BatchedError(f"{self.loaded.source}: robot {pens[0][0]!r}: pen {pens[0][1]!r} writes, and the batched "
+                               f"simulation lays no ink, so {readers[0][0]}/{readers[0][1]} would not see it (use "
+                               "Simulation, or the pen's write: false)")
 
     def _build_devices(self) -> None:
         C = self.copies

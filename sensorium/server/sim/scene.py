@@ -19,7 +19,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
-from sensorium.server.devices.shading import srgb_to_linear
+from sensorium.server.devices.shading import background_radiance, srgb_to_linear
 from sensorium.server.raycast.engine import Precision, RayEngine, ShapeEntry
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
@@ -145,8 +145,8 @@ def surface_colors(colors: np.ndarray, sampler: TextureSampler | None, world_to_
                    shape: np.ndarray, origins: np.ndarray, directions: np.ndarray, distance: np.ndarray) -> np.ndarray:
     """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): the base colour,
     times the texel of a textured shape converted from sRGB to linear (Webots' shaders;
-    where picking fails, 1), blended with a pen's ink as infra-red reads it
-    (``(1 − c)·colour + c·ink``). ``colors``: base colours per shape (a trailing white for −1);
+    where picking fails, 1), blended with a pen's ink (``(1 − c)·colour + c·ink``) read where the
+    pen painted it (texture set 1, as Webots' shaders; infra-red reads it at set 0). ``colors``: base colours per shape (a trailing white for −1);
     ``world_to_shape``: a shape's world-to-shape pose now."""
     col = np.take(colors, shape, axis=0)   # (faster than fancy indexing of (n, 3) rows)
     if sampler is None:
@@ -165,8 +165,8 @@ def surface_colors(colors: np.ndarray, sampler: TextureSampler | None, world_to_
             texel = srgb_to_linear(sampler.texels(s, uv, "base"))
             base = base * np.where(picked[:, None], texel, 1.0)
         layer = sampler.ink.get(s)
-        if layer is not None:
-            ink, c = layer.pick(uv)
+        if layer is not None:     # the paint texture as Webots' shaders sample it: at texture set 1
+            ink, c = layer.pick(np.where(picked[:, None], sampler.ink_uv(s, o, d, distance[rows], uv), 0.0))
             c = np.where(picked, c.astype(np.float64), 0.0)[:, None]
             base = (1.0 - c) * base + c * ink
         col[rows] = base
@@ -273,7 +273,8 @@ class Scene:
         self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
         self.shapes_version = 0        # changes whenever a Supervisor adds shapes (cameras' recognition rebuilds)
         self._shape_arrays()
-        self.background = np.asarray(world.background.sky_color, dtype=np.float64)   # what cameras see past everything
+        # what cameras see past everything: the HDR radiance Webots clears with (shows as the sky colour)
+        self.background = background_radiance(world.background.sky_color)
         # Webots' Fog as cameras mix it in: (linear colour, visibility range, type); None without fog or
         # with a visibility range of 0 (Webots then turns it off), so a world without fog computes nothing more
         fog = world.fog

@@ -547,8 +547,8 @@ class InkLayer:
 
     Its size is the shape's image size (an untextured shape: from its bounding sphere radius r,
     ``32 + 992·r/10`` texels, 1024 beyond 10 m, to the nearest power of two) times the geometry's
-    factor for texture set 1 (Box 4 x 2, Cylinder 2 x 2, triangles without texture coordinates 4 x 2,
-    else 1 x 1). A pen's lead of size L covers a disc ``⌊L·w₀/r⌋`` texels across, ``w₀`` being
+    factor for texture set 1 (Box 4 x 2, Cylinder 2 x 2, Cone 2 x 1, triangles without texture
+    coordinates 4 x 2, else 1 x 1). A pen's lead of size L covers a disc ``⌊L·w₀/r⌋`` texels across, ``w₀`` being
     that size before the factor (``original_width``) and ``r`` the bounding radius.
 
     ``evaporating`` (the world's ``ink_evaporation`` > 0): each texel also keeps its ink as a double
@@ -741,6 +741,17 @@ class TextureSampler:
         uv, picked = self._uv_of(shape, atlas)(origins, directions, t)
         return uv, np.ones(len(uv), dtype=bool) if picked is None else picked
 
+    def ink_uv(self, shape: int, origins: np.ndarray, directions: np.ndarray, t: np.ndarray, uv: np.ndarray
+               ) -> np.ndarray:
+        """Where a camera sees the ink of hits on ``shape`` (Webots' shaders sample the paint
+        texture at ``penTexUv``, texture set 1: where the pen painted): ``uv`` (set 0, as given)
+        where the two sets coincide, else the hits' set-1 coordinates (a Box's atlas, a Cylinder's
+        or a Cone's halves, an IndexedFaceSet without texture coordinates)."""
+        g = self.models[shape][0]
+        if isinstance(g, wm.Box | wm.Cylinder | wm.Cone) or (isinstance(g, wm.Triangles) and g.tex_coords is None):
+            return self.uv(shape, origins, directions, t, atlas=True)[0]
+        return uv
+
     def texels(self, shape: int, uv: np.ndarray, which: str = "base", channel: int | None = None) -> np.ndarray:
         """Colours of ``shape``'s ``which`` map ("base", "roughness", "occlusion") at ``uv``
         (the TextureTransform applied, then the map's wrap, nearest texel)."""
@@ -772,7 +783,7 @@ class TextureSampler:
                 nxt = _next_power_of_2(int(size))
                 w = h = int(nxt / 2 if abs(nxt - size) > abs(nxt / 2 - size) else nxt)
             fx, fy = ((4, 2) if isinstance(g, wm.Box) or (isinstance(g, wm.Triangles) and g.tex_coords is None)
-                      else (2, 2) if isinstance(g, wm.Cylinder) else (1, 1))
+                      else (2, 2) if isinstance(g, wm.Cylinder) else (2, 1) if isinstance(g, wm.Cone) else (1, 1))
             used = sum(layer.texels for layer in self.ink.values())
             if used + w * fx * h * fy > self.ink_texels_max:
                 self.ink_refused.add(shape)
