@@ -351,3 +351,10 @@ def test_unsimulated_devices_are_accepted_with_their_model_and_nothing_else() ->
         ("Display", "display", "Logitech"), ("RotationalMotor", "left wheel motor", ""), ("GPS", "gps", "")]
     probs = _problems({"robots": [_robot([{"device": "Display", "name": "display", "width": 64}])]})
     assert probs and probs[0][0].startswith("robots[0].devices[0]") and "width" in probs[0][0] + probs[0][1]
+
+
+def test_a_validators_message_that_states_the_value_does_not_state_it_twice() -> None:
+    probs = _problems({"robots": [_robot([{"device": "Emitter", "name": "e", "range": 0},
+                                          {"device": "Emitter", "name": "f", "aperture": 7}])]})
+    assert probs == [("robots[0].devices[0].range", "range must be -1 (unlimited) or > 0, got 0.0"),
+                     ("robots[0].devices[1].aperture", "aperture must be -1 or within [0, 2*pi], got 7.0")]
