@@ -358,3 +358,9 @@ def test_a_validators_message_that_states_the_value_does_not_state_it_twice() ->
                                           {"device": "Emitter", "name": "f", "aperture": 7}])]})
     assert probs == [("robots[0].devices[0].range", "range must be -1 (unlimited) or > 0, got 0.0"),
                      ("robots[0].devices[1].aperture", "aperture must be -1 or within [0, 2*pi], got 7.0")]
+
+
+def test_pydantics_own_message_that_says_got_still_shows_the_value() -> None:
+    probs = _problems({"world_info": {"basic_time_step": 32.5}})
+    assert probs == [("world_info.basic_time_step",
+                      "Input should be a valid integer, got a number with a fractional part (got 32.5)")]

@@ -375,7 +375,8 @@ def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
         else:
             msg = f"{key} {quote(ctx.get('tag'))} is not one of: {kinds or ctx.get('expected_tags', '')}"
     elif ("input" in err and kind not in ("missing", "union_tag_invalid", "union_tag_not_found")
-          and not isinstance(err["input"], (dict, list)) and ", got " not in msg):   # a validator's own message may say it
+          and not isinstance(err["input"], (dict, list))
+          and not (kind == "value_error" and ", got " in msg)):   # our validators' messages say what they got
         msg = f"{msg} (got {quote(err['input'])})"
     if len(msg) > 400:
         msg = msg[:400] + "…"
