@@ -89,6 +89,18 @@ def test_defaults_are_webots_defaults() -> None:
     assert w.world_info.basic_time_step == 32
 
 
+def test_a_spotlight_with_webots_defaults_loads_without_a_warning(tmp_path: Path) -> None:
+    # WbSpotLight clamps its default beamWidth (pi/2) to the default cutOffAngle (pi/4) silently; a
+    # beam width written above the cut-off is still reported
+    loaded = parse_world({"lights": [{"type": "SpotLight"}, {"type": "SpotLight", "cut_off_angle": 0.5, "beam_width": 0.7}]})
+    assert [x.beam_width for x in loaded.world.lights] == [0.785398, 0.5]
+    assert loaded.warnings == ["lights[1].beam_width: 0.7 > cut_off_angle, set to 0.5"]
+    wbt = tmp_path / "spot.wbt"
+    wbt.write_text("#VRML_SIM R2023b utf8\nWorldInfo { }\nSpotLight { }\n")
+    from_wbt = load_world(wbt)
+    assert from_wbt.world.lights[0].beam_width == 0.785398 and from_wbt.warnings == []
+
+
 def test_sanitising_warns() -> None:
     loaded = parse_world({"lights": [
         {"type": "PointLight", "ambient_intensity": 1.5},

@@ -578,7 +578,8 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
                 reset("beam_width", 0.0, "0")
             elif lt.beam_width > cut:
                 upd["beam_width"] = cut
-                warnings.append(f"{p}.beam_width: {lt.beam_width} > cut_off_angle, set to {cut}")
+                if lt.beam_width != wm.SpotLight.model_fields["beam_width"].default:   # Webots' defaults: silent, as there
+                    warnings.append(f"{p}.beam_width: {lt.beam_width} > cut_off_angle, set to {cut}")
         return lt.model_copy(update=upd) if upd else lt
 
     def fix_device(p: str, dev: Any) -> Any:
