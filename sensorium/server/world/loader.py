@@ -382,7 +382,12 @@ def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
         msg = msg[:400] + "…"
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
+    if kind == "value_error" and (bad := _BOOL_FIELD.match(msg)):   # the model's check names its field: in the path
+        loc, msg = (*loc, bad[1]), bad[2]
     return Problem(format_path(loc), msg)
+
+
+_BOOL_FIELD = re.compile(r"(\w+): (expected a number, got (?:True|False))$")   # schemas.world.Strict
 
 
 def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None = None,
