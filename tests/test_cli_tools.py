@@ -244,3 +244,14 @@ def test_server_says_once_that_it_waits(tmp_path: Path):
         s.stop()
         err = s.stderr()
     assert err.count("waiting for a controller to attach to robot 'epuck' or 'scout'") == 1
+
+
+def test_the_controller_help_names_every_bundled_example():
+    from sensorium.cli import build_parser
+    from sensorium.cli.client import EXAMPLES_DIR
+
+    parser = build_parser()
+    sub = next(a for a in parser._subparsers._group_actions if a.choices).choices["controller"]   # noqa: SLF001
+    text = " ".join(sub.format_help().split())
+    names = sorted(p.stem for p in EXAMPLES_DIR.glob("[!_]*.py"))
+    assert len(names) >= 6 and all(f"example:{n}" in text for n in names), (names, text)

@@ -59,6 +59,27 @@ def test_world_example_loads_and_its_devices_see_the_world(tmp_path):
     assert len(hits) > 0 and hits.min() == pytest.approx(math.cos(0.3) - 0.05, abs=1e-3)
 
 
+def world_blocks() -> list[str]:
+    """The YAML blocks of the README's world-file sections (before "## In-process Python API")."""
+    text = README.read_text().split("## In-process Python API")[0]
+    return re.findall(r"```yaml\n(.*?)```", text, flags=re.S)
+
+
+@pytest.mark.parametrize("index", range(len(world_blocks())))
+def test_every_world_yaml_block_loads_without_a_warning(index):
+    """Each YAML block of the world sections, a whole world or a fragment (a device, a list of
+    devices, fog and background), loads as it is written, with nothing reset: a reader copies them."""
+    import yaml
+
+    data = yaml.safe_load(world_blocks()[index])
+    if isinstance(data, dict) and "device" in data:
+        data = [data]
+    if isinstance(data, list):
+        data = {"robots": [{"name": "r", "devices": data}]}
+    loaded = parse_world(data, source="README", base_dir=README.parent / "sensorium" / "worlds")
+    assert loaded.warnings == []
+
+
 @pytest.mark.parametrize("index", range(len(blocks("python"))))
 def test_python_blocks_run_from_any_directory(tmp_path, index):
     code = blocks("python")[index].replace("tcp://127.0.0.1:5561", "tcp://127.0.0.1:1")   # no server: recv times out

@@ -309,7 +309,27 @@ def test_a_light_setter_refuses_the_rest_of_webots_ranges():
                                 ("radius", -1.0, "radius: must be >= 0, got -1.0")):
         with pytest.raises(ValueError, match=re.escape(words)):
             supervisor.set_field(sim, node, field, value)
-    supervisor.set_field(sim, node, "beamWidth", math.pi / 2)       # the bounds themselves are taken
+    supervisor.set_field(sim, node, "cutOffAngle", math.pi / 2)     # the bounds themselves are taken
+    supervisor.set_field(sim, node, "beamWidth", math.pi / 2)
     supervisor.set_field(sim, node, "cutOffAngle", 0.0)
     assert supervisor.get_field(sim, node, "cutOffAngle")["value"] == 0.0
+
+
+def test_a_spotlights_cut_off_below_its_beam_width_lowers_the_beam_and_a_beam_above_the_cut_off_is_refused():
+    """WbSpotLight: a cutOffAngle set below the beamWidth lowers the beam width to it (silently); a
+    beamWidth set above the cutOffAngle is reset by Webots with a warning, refused here (one line) as
+    every value outside Webots' ranges. The world file's zero-direction error keeps its own words."""
+    from sensorium.server.daemon import supervisor
+
+    sim = Simulation(parse_world({"lights": [{"type": "SpotLight", "name": "spot", "location": [0, 0, 1],
+                                              "cut_off_angle": 1.0, "beam_width": 0.5}]}))
+    node = supervisor.find_node(sim, "spot")
+    supervisor.set_field(sim, node, "cutOffAngle", 0.25)
+    assert [supervisor.get_field(sim, node, f)["value"] for f in ("cutOffAngle", "beamWidth")] == [0.25, 0.25]
+    with pytest.raises(ValueError, match=re.escape("SpotLight beam_width: must be <= cut_off_angle (0.25), got 0.3")):
+        supervisor.set_field(sim, node, "beamWidth", 0.3)
+    assert supervisor.get_field(sim, node, "beamWidth")["value"] == 0.25
+    with pytest.raises(ValueError) as refused:
+        supervisor.set_field(sim, node, "direction", [0.0, 0.0, 0.0])
+    assert str(refused.value) == "SpotLight direction: direction must not be the zero vector"
 

@@ -449,6 +449,11 @@ def test_builtin_protos(tmp_path: Path) -> None:
     assert box.shapes[0].appearance.roughness == 0.5
     assert wooden.name == "wooden box" and wooden.shapes[0].geometry.size == (0.2, 3.0, 0.2)   # clamped like the PROTO
     assert [r.name for r in w.robots] == ["robot", "robot(1)"]
+    # the PROTOs' Solids set a model (what camera recognition reports); SolidBox passes its recognitionColors
+    assert (box.model, wooden.model, box.recognition_colors, wooden.recognition_colors) == ("box", "wooden box", [], [])
+    p = write(tmp_path, 'WorldInfo { }\nSolidBox { recognitionColors [ 1 0 0, 0 1 0 ] }\n')
+    (box,) = load_world(p).world.solids
+    assert box.recognition_colors == [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0)] and box.model == "box"
 
 
 @contextlib.contextmanager

@@ -89,6 +89,18 @@ def test_defaults_are_webots_defaults() -> None:
     assert w.world_info.basic_time_step == 32
 
 
+def test_a_spotlight_with_webots_defaults_loads_without_a_warning(tmp_path: Path) -> None:
+    # WbSpotLight clamps its default beamWidth (pi/2) to the default cutOffAngle (pi/4) silently; a
+    # beam width written above the cut-off is still reported
+    loaded = parse_world({"lights": [{"type": "SpotLight"}, {"type": "SpotLight", "cut_off_angle": 0.5, "beam_width": 0.7}]})
+    assert [x.beam_width for x in loaded.world.lights] == [0.785398, 0.5]
+    assert loaded.warnings == ["lights[1].beam_width: 0.7 > cut_off_angle, set to 0.5"]
+    wbt = tmp_path / "spot.wbt"
+    wbt.write_text("#VRML_SIM R2023b utf8\nWorldInfo { }\nSpotLight { }\n")
+    from_wbt = load_world(wbt)
+    assert from_wbt.world.lights[0].beam_width == 0.785398 and from_wbt.warnings == []
+
+
 def test_sanitising_warns() -> None:
     loaded = parse_world({"lights": [
         {"type": "PointLight", "ambient_intensity": 1.5},
@@ -351,3 +363,16 @@ def test_unsimulated_devices_are_accepted_with_their_model_and_nothing_else() ->
         ("Display", "display", "Logitech"), ("RotationalMotor", "left wheel motor", ""), ("GPS", "gps", "")]
     probs = _problems({"robots": [_robot([{"device": "Display", "name": "display", "width": 64}])]})
     assert probs and probs[0][0].startswith("robots[0].devices[0]") and "width" in probs[0][0] + probs[0][1]
+
+
+def test_a_validators_message_that_states_the_value_does_not_state_it_twice() -> None:
+    probs = _problems({"robots": [_robot([{"device": "Emitter", "name": "e", "range": 0},
+                                          {"device": "Emitter", "name": "f", "aperture": 7}])]})
+    assert probs == [("robots[0].devices[0].range", "range must be -1 (unlimited) or > 0, got 0.0"),
+                     ("robots[0].devices[1].aperture", "aperture must be -1 or within [0, 2*pi], got 7.0")]
+
+
+def test_pydantics_own_message_that_says_got_still_shows_the_value() -> None:
+    probs = _problems({"world_info": {"basic_time_step": 32.5}})
+    assert probs == [("world_info.basic_time_step",
+                      "Input should be a valid integer, got a number with a fractional part (got 32.5)")]

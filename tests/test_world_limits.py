@@ -126,13 +126,13 @@ def test_numbers_that_cannot_be_computed_with_are_refused_with_their_path(data, 
 
 
 @pytest.mark.parametrize(("data", "path", "message"), [
-    ({"world_info": {"name": "w", "basic_time_step": True}}, "world_info", "basic_time_step: expected a number, got True"),
+    ({"world_info": {"name": "w", "basic_time_step": True}}, "world_info.basic_time_step", "expected a number, got True"),
     ({"solids": [{"name": "s", "pose": {"translation": [0, False, 0]}, "geometry": {"type": "box"}}]},
-     "solids[0].pose", "translation: expected a number, got False"),
+     "solids[0].pose.translation", "expected a number, got False"),
     ({"robots": [robot({"device": "DistanceSensor", "name": "d", "lookup_table": [[0, 0, 0], [1, 1000, True]]})]},
-     "robots[0].devices[0]", "lookup_table: expected a number, got True"),
+     "robots[0].devices[0].lookup_table", "expected a number, got True"),
     ({"solids": [{"name": "s", "geometry": {"type": "elevation_grid", "x_dimension": 2, "y_dimension": 2,
-                                           "height": [0, 0, True, 0]}}]}, "solids[0].geometry", "height: expected a number, got True"),
+                                           "height": [0, 0, True, 0]}}]}, "solids[0].geometry.height", "expected a number, got True"),
 ])
 def test_a_bool_where_a_number_is_due_is_refused_not_read_as_0_or_1(data, path, message) -> None:
     """pydantic's lax mode read `basic_time_step: true` as a 1 ms step, without a word."""

@@ -1,7 +1,7 @@
 """Loading: how long a world takes from file to a simulation, per stage.
 
 A PROTO-heavy Webots world (``tests/worlds/proto/fifty_minipucks.wbt``: 50 e-puck-like PROTO robots
-built by JavaScript templates and sub-PROTOs, 500 instances, 1 450 devices), the same world as the
+built by JavaScript templates and sub-PROTOs, 500 instances, 1 550 devices), the same world as the
 Sensorium YAML file ``sensorium convert`` writes, and a one-robot PROTO world, loaded in turn (A B C
 A B C …, so the machine's load hits them alike). Stages, wall clock (``LoadedWorld.timings``):
 parse (the .wbt text), proto files (reading and parsing PROTO files), instantiate (PROTO expansion
@@ -46,7 +46,7 @@ def run(cfg: Config) -> Section:
 
     sec = Section("loading", "Loading worlds: PROTO expansion, conversion, validation, scene", intro=(
         "A PROTO-heavy Webots world (`tests/worlds/proto/fifty_minipucks.wbt`: 50 e-puck-like PROTO robots built "
-        "by JavaScript templates and sub-PROTOs, 500 instances, 1 450 devices), the same world as the YAML file "
+        "by JavaScript templates and sub-PROTOs, 500 instances, 1 550 devices), the same world as the YAML file "
         "`sensorium convert` writes, and a one-robot PROTO world, loaded in turn (A B C A B C …). Stages, wall "
         "clock (`LoadedWorld.timings`): parse (the .wbt text), proto files (reading and parsing PROTO files), "
         "instantiate (PROTO expansion without templates), template (QuickJS runs, the worker's start included), "

@@ -65,7 +65,8 @@ def _probe_args(p: argparse.ArgumentParser) -> None:
 def _controller_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("script", help="controller: a Python script (uses `from controller import Robot`), an executable "
                    "(e.g. a C controller linked against sensorium/client/c), or example:NAME for a bundled example "
-                   "(example:light_follower, example:wanderer, example:braitenberg)")
+                   "(example:light_follower, example:wanderer, example:braitenberg, example:line_follower, "
+                   "example:pen_drawer, example:blob_follower)")
     p.add_argument("--robot", help="robot name (default: the URL's robot, or the world's only robot)")
     p.add_argument("--url", help="RPC endpoint or controller URL, e.g. tcp://127.0.0.1:5560 or "
                    "tcp://host:5560/epuck (default: $SENSORIUM_CONTROLLER_URL, $WEBOTS_CONTROLLER_URL, "

@@ -201,7 +201,11 @@ def _set_light(attr: str, kind: str) -> Setter:
         try:
             changed = type(model).model_validate({**model.model_dump(), attr: value})
         except ValidationError as e:
-            raise ValueError(f"{kind} {attr}: {e.errors()[0]['msg']}") from None
+            raise ValueError(f"{kind} {attr}: {e.errors()[0]['msg'].removeprefix('Value error, ')}") from None
+        if kind == "SpotLight" and changed.beam_width > changed.cut_off_angle:
+            if attr == "beam_width":      # Webots resets it to the cut-off with a warning: refused, as other ranges
+                raise ValueError(f"{kind} {attr}: must be <= cut_off_angle ({changed.cut_off_angle}), got {value}")
+            changed = changed.model_copy(update={"beam_width": changed.cut_off_angle})   # WbSpotLight: silently
         sim.scene.set_top_light(node.key, changed)
     return setter
 

@@ -374,13 +374,20 @@ def _problem_from_pydantic(err: Mapping[str, Any]) -> Problem:
             msg = f"no {key!r} key: it says what this is" + (f" (one of: {kinds})" if kinds else "")
         else:
             msg = f"{key} {quote(ctx.get('tag'))} is not one of: {kinds or ctx.get('expected_tags', '')}"
-    elif "input" in err and kind not in ("missing", "union_tag_invalid", "union_tag_not_found") and not isinstance(err["input"], (dict, list)):
+    elif ("input" in err and kind not in ("missing", "union_tag_invalid", "union_tag_not_found")
+          and not isinstance(err["input"], (dict, list))
+          and not (kind == "value_error" and ", got " in msg)):   # our validators' messages say what they got
         msg = f"{msg} (got {quote(err['input'])})"
     if len(msg) > 400:
         msg = msg[:400] + "…"
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
+    if kind == "value_error" and (bad := _BOOL_FIELD.match(msg)):   # the model's check names its field: in the path
+        loc, msg = (*loc, bad[1]), bad[2]
     return Problem(format_path(loc), msg)
+
+
+_BOOL_FIELD = re.compile(r"(\w+): (expected a number, got (?:True|False))$")   # schemas.world.Strict
 
 
 def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None = None,
@@ -576,7 +583,8 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
                 reset("beam_width", 0.0, "0")
             elif lt.beam_width > cut:
                 upd["beam_width"] = cut
-                warnings.append(f"{p}.beam_width: {lt.beam_width} > cut_off_angle, set to {cut}")
+                if lt.beam_width != wm.SpotLight.model_fields["beam_width"].default:   # Webots' defaults: silent, as there
+                    warnings.append(f"{p}.beam_width: {lt.beam_width} > cut_off_angle, set to {cut}")
         return lt.model_copy(update=upd) if upd else lt
 
     def fix_device(p: str, dev: Any) -> Any:

@@ -18,9 +18,9 @@ def _node(type_: str, at: Node, **fields) -> Node:
     return Node(type_, dict(fields), at.line, at.col, source=at.source)
 
 
-def _solid(at: Node, f: Fields, name: str, items: list, translation=(0.0, 0.0, 0.0)) -> Node:
+def _solid(at: Node, f: Fields, name: str, items: list, translation=(0.0, 0.0, 0.0), **extra) -> Node:
     """A Solid from (pose translation, geometry, appearance, bounding) items; ``bounding`` True = the
-    same geometry is the bounding object (seen by both kinds of ray)."""
+    same geometry is the bounding object (seen by both kinds of ray); ``extra``: more Solid fields."""
     visual, bounding = [], []
     for t, geometry, appearance, bound in items:
         shape = _node("Shape", at, geometry=geometry, appearance=appearance)
@@ -29,7 +29,7 @@ def _solid(at: Node, f: Fields, name: str, items: list, translation=(0.0, 0.0, 0
             bounding.append(_node("Pose", at, translation=t, children=[geometry]))
     return _node("Solid", at, translation=f.vec("translation", translation),
                  rotation=f.vec("rotation", (0.0, 0.0, 1.0, 0.0)), name=f.string("name", name),
-                 children=visual, boundingObject=_node("Group", at, children=bounding))
+                 children=visual, boundingObject=_node("Group", at, children=bounding), **extra)
 
 
 def _appearance(f: Fields, name: str, default: Node | None = None) -> Node | None:
@@ -66,14 +66,16 @@ def floor(node: Node, f: Fields, system: str) -> Node:
 def solid_box(node: Node, f: Fields, system: str) -> Node:
     size = _positive(f, "size", (2.0, 2.0, 2.0))
     default = _node("PBRAppearance", node, roughness=0.5, metalness=0.0)   # its textured default, untextured
+    colors = {"recognitionColors": node.fields["recognitionColors"]} if f.has("recognitionColors") else {}
     return _solid(node, f, "box", [((0.0, 0.0, 0.0), _node("Box", node, size=size), _appearance(f, "appearance", default),
-                                    f.flag("enableBoundingObject", True))], translation=(0.0, 0.0, 1.0))
+                                    f.flag("enableBoundingObject", True))], translation=(0.0, 0.0, 1.0),
+                  model="box", **colors)    # the PROTO's Solid: model "box", recognitionColors IS recognitionColors
 
 
 def wooden_box(node: Node, f: Fields, system: str) -> Node:
     size = tuple(min(max(v, 0.01), 3.0) for v in f.vec("size", (0.6, 0.6, 0.6)))   # the PROTO clamps to [0.01, 3]
     return _solid(node, f, "wooden box", [((0.0, 0.0, 0.0), _node("Box", node, size=size), None, True)],
-                  translation=(0.0, 0.0, 0.3))
+                  translation=(0.0, 0.0, 0.3), model="wooden box")   # the PROTO's Solid has model "wooden box"
 
 
 # TexturedBackgroundLight: per background texture, (direction (NUE axes), colour, intensity, on)
