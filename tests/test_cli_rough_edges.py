@@ -112,6 +112,23 @@ def test_replay_says_interrupted_after_ctrl_c_not_finished(tmp_path):
     assert not any("replay finished" in line for line in lines), lines
 
 
+def test_step_path_variable_shows_in_version_and_a_bad_one_stops_serve_in_one_line(monkeypatch, capsys):
+    """SENSORIUM_STEP_PATH=python: --version said 'C' while the server ran Python; a bad value made
+    serve end in a traceback."""
+    import pytest
+
+    from sensorium.cli import main
+
+    monkeypatch.setenv("SENSORIUM_STEP_PATH", "python")
+    with pytest.raises(SystemExit):
+        main(["--version"])
+    assert capsys.readouterr().out.splitlines()[1] == "step path: Python (SENSORIUM_STEP_PATH=python)"
+    monkeypatch.setenv("SENSORIUM_STEP_PATH", "bogus")
+    assert main(["serve", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"]) == 2
+    err = capsys.readouterr().err
+    assert err == "sensorium serve: SENSORIUM_STEP_PATH / step_path must be one of auto, c, python, got 'bogus'\n"
+
+
 def test_version_says_which_compiled_paths_are_active(monkeypatch, capsys):
     import pytest
 

@@ -128,11 +128,13 @@ def main(args: argparse.Namespace) -> int:
     import zmq
 
     from sensorium.server.daemon.serve import Server
+    from sensorium.server.daemon.steppath import step_path_choice
     from sensorium.server.world.loader import WorldError
 
     try:
         opts = options(args)
         opts.check()
+        step_path_choice()                      # SENSORIUM_STEP_PATH, before anything is built
     except ValueError as exc:
         print(f"sensorium serve: {exc}", file=sys.stderr)
         return 2
