@@ -127,6 +127,12 @@ def test_step_path_variable_shows_in_version_and_a_bad_one_stops_serve_in_one_li
     assert main(["serve", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"]) == 2
     err = capsys.readouterr().err
     assert err == "sensorium serve: SENSORIUM_STEP_PATH / step_path must be one of auto, c, python, got 'bogus'\n"
+    from sensorium.server.daemon import steppath
+
+    monkeypatch.setattr(steppath, "_native", (None, "the C step path is not built (no module)"))
+    monkeypatch.setenv("SENSORIUM_STEP_PATH", "c")
+    assert main(["serve", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"]) == 2
+    assert capsys.readouterr().err == "sensorium serve: SENSORIUM_STEP_PATH=c: the C step path is not built (no module)\n"
 
 
 def test_version_says_which_compiled_paths_are_active(monkeypatch, capsys):
