@@ -244,12 +244,11 @@ def test_closing_with_a_viewer_connected_logs_no_traceback(caplog):
 
     b = FoxgloveBridge(TYPES, load_world(WORLD).world, WORLD.parent, port=0)
     try:
-        ws = connect(f"ws://127.0.0.1:{b.port}", subprotocols=["foxglove.sdk.v1"], open_timeout=10)
-        ws.recv(timeout=10)                                   # serverInfo: the viewer is connected
-        with caplog.at_level(logging.ERROR, logger="asyncio"):
-            b.close()
-            time.sleep(0.5)
-        ws.close()
+        with connect(f"ws://127.0.0.1:{b.port}", subprotocols=["foxglove.sdk.v1"], open_timeout=10) as ws:
+            ws.recv(timeout=10)                               # serverInfo: the viewer is connected
+            with caplog.at_level(logging.ERROR, logger="asyncio"):
+                b.close()
+                time.sleep(0.5)
     finally:
         b.close()
     assert not [r for r in caplog.records if r.name == "asyncio"], [r.getMessage() for r in caplog.records]
