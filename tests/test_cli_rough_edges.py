@@ -167,6 +167,38 @@ def test_replay_says_interrupted_after_ctrl_c_not_finished(tmp_path):
     assert not any("replay finished" in line for line in lines), lines
 
 
+def test_step_path_variable_shows_in_version_and_a_bad_one_stops_serve_in_one_line(monkeypatch, capsys):
+    """SENSORIUM_STEP_PATH=python: --version said 'C' while the server ran Python; a bad value made
+    serve end in a traceback."""
+    import pytest
+
+    from sensorium.cli import main
+
+    monkeypatch.setenv("SENSORIUM_STEP_PATH", "python")
+    with pytest.raises(SystemExit):
+        main(["--version"])
+    assert capsys.readouterr().out.splitlines()[1] == "step path: Python (SENSORIUM_STEP_PATH=python)"
+    monkeypatch.setenv("SENSORIUM_STEP_PATH", "bogus")
+    assert main(["serve", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"]) == 2
+    err = capsys.readouterr().err
+    assert err == "sensorium serve: SENSORIUM_STEP_PATH / step_path must be one of auto, c, python, got 'bogus'\n"
+    from sensorium.server.daemon import steppath
+
+    monkeypatch.setattr(steppath, "_native", (None, "the C step path is not built (no module)"))
+    monkeypatch.setenv("SENSORIUM_STEP_PATH", "c")
+    assert main(["serve", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"]) == 2
+    assert capsys.readouterr().err == "sensorium serve: SENSORIUM_STEP_PATH=c: the C step path is not built (no module)\n"
+
+
+def test_serve_topics_without_record_is_refused_in_one_line(capsys):
+    """serve --topics without --record was silently ignored (every topic served, nothing recorded)."""
+    from sensorium.cli import main
+
+    assert main(["serve", "--topics", "/epuck", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"]) == 2
+    assert capsys.readouterr().err == ("sensorium serve: --topics chooses what --record records: give --record "
+                                       "FILE.mcap too (without it every topic is served)\n")
+
+
 def test_version_says_which_compiled_paths_are_active(monkeypatch, capsys):
     import pytest
 

@@ -237,3 +237,22 @@ def test_grown_world_format_is_drawn_where_rays_see_it():
     from sensorium.server.recording.scene3d import scene_update
 
     assert len(scene_update(loaded.world, loaded.base_dir).encode()) > 1000
+
+
+def test_closing_with_a_viewer_connected_logs_no_traceback(caplog):
+    """Stopping the server while a viewer was connected printed asyncio's 'Exception in callback'
+    traceback (its cancelled connection task) once per viewer."""
+    import logging
+
+    from websockets.sync.client import connect
+
+    b = FoxgloveBridge(TYPES, load_world(WORLD).world, WORLD.parent, port=0)
+    try:
+        with connect(f"ws://127.0.0.1:{b.port}", subprotocols=["foxglove.sdk.v1"], open_timeout=10) as ws:
+            ws.recv(timeout=10)                               # serverInfo: the viewer is connected
+            with caplog.at_level(logging.ERROR, logger="asyncio"):
+                b.close()
+                time.sleep(0.5)
+    finally:
+        b.close()
+    assert not [r for r in caplog.records if r.name == "asyncio"], [r.getMessage() for r in caplog.records]

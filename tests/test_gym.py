@@ -327,6 +327,16 @@ def test_random_policy_example_refuses_bad_arguments_in_one_line(argv, why, caps
     assert e.value.code == 2 and why in capsys.readouterr().err
 
 
+def test_random_policy_example_help_says_what_it_reports(capsys):
+    """--help cut its description mid-sentence at the docstring's first line break ('...; reports')."""
+    from sensorium.gym.examples.random_policy import main
+
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "reports environment steps per second" in out
+
+
 def test_example_loop_reports_steps_per_second_and_is_deterministic():
     from sensorium.gym.examples.random_policy import run
 

@@ -215,6 +215,28 @@ def test_a_custom_task_with_lambdas_runs_through_the_workers_with_the_same_value
 
 
 @slow
+def test_render_at_the_default_size_returns_every_image():
+    """A worker's render reply (2 x 256x256x3 bytes) is larger than a pipe holds: the worker wrote it
+    before signalling its answer and the parent read only after the signal, so render() hung."""
+    envs = _make(REACH, 4, 2, render_mode="rgb_array")
+    ref = gym.make_vec(REACH, num_envs=4, vectorization_mode="vector_entry_point", render_mode="rgb_array")
+    try:
+        envs.reset(seed=0)
+        ref.reset(seed=0)
+        images: list = []
+        t = threading.Thread(target=lambda: images.append(envs.render()), daemon=True)
+        t.start()
+        t.join(WAIT_S)
+        assert not t.is_alive(), f"render() did not return within {WAIT_S:g} s"
+        assert len(images[0]) == 4 and images[0][0].shape == (256, 256, 3)
+        _same(images[0], ref.render(), "render")
+    finally:
+        ref.close()
+        if images:
+            envs.close()
+
+
+@slow
 def test_a_workers_exception_and_a_bad_action_are_one_clear_error():
     task = Task(robot="epuck", observations={"ls0": 64}, control_period_ms=64, max_steps=5,
                 reward=DIVIDES_BY_ZERO, terminated=ReachLight("lamp").terminated)

@@ -67,3 +67,4 @@ def test_a_server_restart_starts_a_new_file(server_factory, tmp_path):  # noqa: 
     info = subprocess.run([PY, "-m", "sensorium", "info", str(tmp_path / "run-3.mcap")], capture_output=True,
                           text=True, timeout=60)
     assert "Continues from:" in info.stdout and "run.mcap" in info.stdout
+    assert "record --url" in info.stdout and "--connect" not in info.stdout   # not the deprecated spelling

@@ -44,7 +44,8 @@ def test_set_pose_and_counters_need_the_supervisor_role_when_controls_are_closed
     for peer in (B, C):              # the rover's own controller, an unattached caller
         msg = lv.err(peer, "/rover/robot/set_pose", {"translation": [1.0, 2.0, 0.0]}, ErrorCode.NOT_SUPERVISOR)
         assert "supervisor: true" in msg
-        lv.err(peer, "get_counters", {}, ErrorCode.NOT_SUPERVISOR)
+        msg = lv.err(peer, "get_counters", {}, ErrorCode.NOT_SUPERVISOR)
+        assert "world-wide control" in msg and "changes the world" not in msg   # it only reads
     assert lv.ok(C, "/rover/robot/get_pose") == before             # nobody moved it
     assert lv.ok(A, "/rover/robot/set_pose", {"translation": [1.0, 2.0, 0.0]}) == {"success": True}
     assert lv.ok(C, "/rover/robot/get_pose")["translation"] == [1.0, 2.0, 0.0]

@@ -204,6 +204,25 @@ def test_detach_and_reattach(h):
     assert ok(h.call(B, "attach", {"robot": "bot"}))["session"] == "s1"
 
 
+def test_reattached_controller_gets_no_reading_of_the_previous_one(h):
+    """A new controller's first value is its own first sample (NaN before, as in Webots), not the
+    last reading a previous controller of the robot left in the device."""
+    s = ok(h.call(A, "attach", {"robot": "bot"}))["session"]
+    ok(h.call(A, "/bot/ls/enable", {"value": 64}))
+    rid = h.send(A, "/bot/robot/step", {"duration": 64})
+    h.run()
+    assert set(ok(h.reply(rid))["values"]) == {"ls"}                          # sampled at 64
+    ok(h.call(A, "detach", {"session": s}))
+    ok(h.call(B, "attach", {"robot": "bot"}))
+    ok(h.call(B, "/bot/ls/enable", {"value": 64}))
+    rid = h.send(B, "/bot/robot/step", {})                                   # 96: not sampled yet
+    h.run()
+    assert ok(h.reply(rid))["values"] == {}
+    rid = h.send(B, "/bot/robot/step", {})                                   # 128: its first sample
+    h.run()
+    assert ok(h.reply(rid))["values"]["ls"]["value"] == pytest.approx(100.128)
+
+
 def test_silent_controller_released(h):
     core = h.core
     ok(h.call(A, "attach", {"robot": "bot"}))

@@ -333,11 +333,16 @@ def compiled_paths() -> list[str]:
     """Which optional compiled paths this installation runs, one line each, with why not: the
     lockstep's C step path (built by setup.py at install) and the ray engine's packet helper
     (packets.c, compiled on first use). Without them the same answers come from slower paths."""
-    from sensorium.server.daemon.steppath import native_gate_class
+    from sensorium.server.daemon.steppath import native_gate_class, step_path_choice
     from sensorium.server.raycast import packets
 
     gate, why = native_gate_class()
-    step = f"C ({gate.__module__})" if gate is not None else f"Python ({why})"
+    try:
+        if step_path_choice() == "python":
+            gate, why = None, "SENSORIUM_STEP_PATH=python"
+        step = f"C ({gate.__module__})" if gate is not None else f"Python ({why})"
+    except ValueError as exc:
+        step = f"none ({exc}: serve refuses to start)"
     return [f"step path: {step}", f"ray traversal: {packets.status()}"]
 
 

@@ -275,7 +275,7 @@ def print_info(path: str | os.PathLike, as_json: bool = False) -> int:
     if session.get("started_at"):
         lines.append(("Recorded", session["started_at"]))
     if session.get("previous_file"):
-        lines.append(("Continues from", f"{session['previous_file']} (the server restarted; record --connect)"))
+        lines.append(("Continues from", f"{session['previous_file']} (the server restarted; record --url)"))
     restart = s["metadata"].get("server_restart", {})
     if restart.get("next_file"):
         lines.append(("Continues in", f"{restart['next_file']} (the server restarted: {restart.get('topic', '?')} "

@@ -208,10 +208,12 @@ def _serve(conn: Connection, go, done, control, w: int, poll_s: float, parent: i
     command, status = _control(control)
 
     def answer(code: int, message: Any = None) -> None:
-        if code != _DONE:
-            conn.send(message)
+        # signal first, then send: the parent reads the pipe only once signalled, and a reply larger
+        # than the pipe holds (render's images) would block this send forever
         status[w] = code
         done.release()
+        if code != _DONE:
+            conn.send(message)
 
     try:
         from sensorium.gym.vector import SensoriumVectorEnv

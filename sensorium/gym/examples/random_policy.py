@@ -79,7 +79,7 @@ def run(env_id: str, n_envs: int, steps: int, mode: str = "sync", policy: str = 
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     p.add_argument("--env", default="sensorium/ReachLight-v0", help="a registered sensorium/* id")
     p.add_argument("--steps", type=int, default=300, help="vector steps per measurement (default 300)")
     p.add_argument("--envs", type=int, nargs="+", default=[1, 2, 4], help="vector sizes (default 1 2 4)")

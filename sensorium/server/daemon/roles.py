@@ -62,5 +62,5 @@ def has_supervisor_role(sim: Any, lockstep: Any, peer: bytes) -> bool:
 
 
 def denied(service: str) -> str:
-    return (f"{service} changes the world for everyone: attach a robot with 'supervisor: true' first, "
+    return (f"{service} is a world-wide control: attach a robot with 'supervisor: true' first, "
             f"or run the server with --controls open")

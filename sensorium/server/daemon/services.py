@@ -514,7 +514,9 @@ class Core(DeviceServices):
         s = self.lockstep.attach(c.args.robot, c.peer, c.now)
         self._announced = False                     # say it again once the world waits again
         self.topics.release_robot(s.robot)          # a new controller starts from scratch
-        self._seen[s.token] = {}
+        # readings taken before it attached (a previous controller's) are not its own: never sent
+        self._seen[s.token] = {ctl.path: getattr(ctl.device, "measurements", 0)
+                               for ctl in self._robot_controls(s.robot)}
         robot = self.sim.robots[s.robot]
         return {"session": s.token, "robot": s.robot, "basic_time_step": self.sim.basic_time_step,
                 "time_ms": self.sim.time_ms, "synchronization": bool(robot.synchronization),

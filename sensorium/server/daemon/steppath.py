@@ -85,13 +85,19 @@ def native_gate_class() -> tuple[Any, str]:
     return _native
 
 
+def step_path_choice(step_path: str | None = None) -> str:
+    """``step_path`` or ``SENSORIUM_STEP_PATH`` (default ``auto``), checked: ValueError for another value."""
+    choice = (step_path or os.environ.get("SENSORIUM_STEP_PATH") or "auto").strip().lower()
+    if choice not in STEP_PATHS:
+        raise ValueError(f"SENSORIUM_STEP_PATH / step_path must be one of {', '.join(STEP_PATHS)}, got {choice!r}")
+    return choice
+
+
 def gate_for(sock: zmq.Socket, *, max_frames: int, max_request: int, max_duration: int, discard_budget: int,
              step_path: str | None = None) -> Any:
     """The gate for ``sock``: C when built and allowed (``step_path`` or ``SENSORIUM_STEP_PATH``:
     ``auto``, ``c``, ``python``), else :class:`PyGate`. ValueError for ``c`` without the extension."""
-    choice = (step_path or os.environ.get("SENSORIUM_STEP_PATH") or "auto").strip().lower()
-    if choice not in STEP_PATHS:
-        raise ValueError(f"SENSORIUM_STEP_PATH / step_path must be one of {', '.join(STEP_PATHS)}, got {choice!r}")
+    choice = step_path_choice(step_path)
     if choice != "python":
         cls, why = native_gate_class()
         if cls is not None:

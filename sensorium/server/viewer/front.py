@@ -174,6 +174,8 @@ class SubprotocolFront:
                     pass
         except (ConnectionError, OSError):
             pass
+        except asyncio.CancelledError:     # close() with the viewer connected: ends quietly (no traceback)
+            pass
         finally:
             self.connections -= 1
             for w in (writer, up_writer):
