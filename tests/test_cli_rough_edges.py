@@ -190,15 +190,6 @@ def test_step_path_variable_shows_in_version_and_a_bad_one_stops_serve_in_one_li
     assert capsys.readouterr().err == "sensorium serve: SENSORIUM_STEP_PATH=c: the C step path is not built (no module)\n"
 
 
-def test_serve_topics_without_record_is_refused_in_one_line(capsys):
-    """serve --topics without --record was silently ignored (every topic served, nothing recorded)."""
-    from sensorium.cli import main
-
-    assert main(["serve", "--topics", "/epuck", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"]) == 2
-    assert capsys.readouterr().err == ("sensorium serve: --topics chooses what --record records: give --record "
-                                       "FILE.mcap too (without it every topic is served)\n")
-
-
 def test_version_says_which_compiled_paths_are_active(monkeypatch, capsys):
     import pytest
 

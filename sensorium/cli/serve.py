@@ -134,9 +134,6 @@ def main(args: argparse.Namespace) -> int:
     try:
         opts = options(args)
         opts.check()
-        if getattr(args, "topics", None) and not getattr(args, "record", None):
-            raise ValueError("--topics chooses what --record records: give --record FILE.mcap too "
-                             "(without it every topic is served)")
         if step_path_choice() == "c" and native_gate_class()[0] is None:   # SENSORIUM_STEP_PATH, checked early
             raise ValueError(f"SENSORIUM_STEP_PATH=c: {native_gate_class()[1]}")
     except ValueError as exc:
