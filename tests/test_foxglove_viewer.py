@@ -242,17 +242,28 @@ def test_grown_world_format_is_drawn_where_rays_see_it():
 def test_closing_with_a_viewer_connected_logs_no_traceback(caplog):
     """Stopping the server while a viewer was connected printed asyncio's 'Exception in callback'
     traceback (its cancelled connection task) once per viewer."""
+    import base64
     import logging
-
-    from websockets.sync.client import connect
+    import os
+    import socket
 
     b = FoxgloveBridge(TYPES, load_world(WORLD).world, WORLD.parent, port=0)
     try:
-        with connect(f"ws://127.0.0.1:{b.port}", subprotocols=["foxglove.sdk.v1"], open_timeout=10) as ws:
-            ws.recv(timeout=10)                               # serverInfo: the viewer is connected
+        # a viewer: the WebSocket upgrade by hand (no client library in the test extras)
+        with socket.create_connection(("127.0.0.1", b.port), timeout=10) as ws:
+            key = base64.b64encode(os.urandom(16)).decode()
+            ws.sendall((f"GET / HTTP/1.1\r\nHost: 127.0.0.1:{b.port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                        f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n"
+                        "Sec-WebSocket-Protocol: foxglove.sdk.v1\r\n\r\n").encode())
+            got = b""
+            while b"\r\n\r\n" not in got or len(got) <= got.index(b"\r\n\r\n") + 4:   # the head, then serverInfo
+                chunk = ws.recv(65536)
+                assert chunk, got
+                got += chunk
+            assert got.startswith(b"HTTP/1.1 101"), got[:200]
             with caplog.at_level(logging.ERROR, logger="asyncio"):
                 b.close()
-                time.sleep(0.5)
+                time.sleep(0.5)                               # (late callbacks would log within it)
     finally:
         b.close()
     assert not [r for r in caplog.records if r.name == "asyncio"], [r.getMessage() for r in caplog.records]
