@@ -66,7 +66,7 @@ from gymnasium import spaces
 
 from sensorium.gym.frame import enu_axes, planar_pose
 from sensorium.gym.render import TopDown, TopDownRendering, check_render_size
-from sensorium.gym.task import Task
+from sensorium.gym.task import Task, whole
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.raycast.kinds import Precision
@@ -121,12 +121,12 @@ class Agent:
                              "to act with")
         self.robot = name
         ctrl = basic if task.control_period_ms is None else task.control_period_ms
-        if isinstance(ctrl, bool) or not isinstance(ctrl, (int, np.integer)) or ctrl <= 0 or ctrl % basic:
+        if not whole(ctrl) or ctrl <= 0 or ctrl % basic:
             raise ValueError(f"task control_period_ms={ctrl} must be a positive multiple of the world's "
                              f"basic_time_step ({basic} ms)")
         self.control_period_ms = int(ctrl)
         steps = task.max_steps
-        if steps is not None and (isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1):
+        if steps is not None and (not whole(steps) or steps < 1):
             raise ValueError(f"task max_steps must be a whole number of actions >= 1, or None (never truncated), "
                              f"got {steps!r}")
         devices = {d.name: d for d in model.devices if d.device in OBSERVABLE}

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.gym.frame import ENU_AXES, enu_axes, own_up
+from sensorium.gym.task import whole
 from sensorium.schemas import world as wm
 from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
 from sensorium.server.world.geometry import Plane, Pose, tessellate
@@ -60,7 +61,7 @@ MAX_RENDER_SIZE = 4096
 
 def check_render_size(value) -> int:
     """``render_size`` as an int in [1, MAX_RENDER_SIZE]; a ValueError naming it otherwise."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_RENDER_SIZE:
+    if not whole(value) or not 1 <= value <= MAX_RENDER_SIZE:
         raise ValueError(f"render_size must be an integer number of pixels from 1 to {MAX_RENDER_SIZE}, got {value!r}")
     return int(value)
 

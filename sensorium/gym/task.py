@@ -44,6 +44,12 @@ __all__ = ["Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random
 StepFn = Callable[[Any, Any, dict], Any]
 
 
+def whole(value: Any) -> bool:
+    """An integer (Python's or numpy's), not a bool: what counts, sizes, periods and seeds must be
+    (a float would be cut to an integer silently)."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
 def never(sim, robot, obs) -> bool:
     """A termination that never happens (episodes end by truncation only)."""
     return False

@@ -47,7 +47,7 @@ from gymnasium.vector.utils import batch_space
 
 from sensorium.gym.env import DEFAULT_PRECISION, SEGMENTATION, Agent, check_precision, device_of, load, missing_fill
 from sensorium.gym.render import TopDown, check_render_size
-from sensorium.gym.task import Task, VectorGoal, never, zero
+from sensorium.gym.task import Task, VectorGoal, never, whole, zero
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.raycast import packets
@@ -92,18 +92,12 @@ def _owner(fn):
     return getattr(fn, "__self__", None)
 
 
-def _whole(value) -> bool:
-    """An integer (Python's or numpy's), not a bool: what counts and seeds must be (a float would be
-    cut to an integer silently)."""
-    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
-
-
 def check_counts(num_envs: Any, threads: Any) -> int:
     """``num_envs`` as an int, or ValueError (one line) when it or ``threads`` (None: the default) is
     not a whole number >= 1."""
-    if not _whole(num_envs) or num_envs < 1:
+    if not whole(num_envs) or num_envs < 1:
         raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
-    if threads is not None and (not _whole(threads) or threads < 1):
+    if threads is not None and (not whole(threads) or threads < 1):
         raise ValueError(f"threads must be an integer >= 1 or None, got {threads!r}")
     return int(num_envs)
 
@@ -113,7 +107,7 @@ def reset_seeds(seed: Any, n: int) -> list[int | None]:
     one seed (or None) per sub-env, None none; ValueError (one line) for anything else."""
     if seed is None:
         return [None] * n
-    if _whole(seed):
+    if whole(seed):
         return [int(seed) + i for i in range(n)]
     if not isinstance(seed, (list, tuple, np.ndarray)):
         raise ValueError(f"reset: seed must be an integer, a list of num_envs integers (or None), or None; "
@@ -121,7 +115,7 @@ def reset_seeds(seed: Any, n: int) -> list[int | None]:
     seeds = list(seed)
     if len(seeds) != n:
         raise ValueError(f"reset: {len(seeds)} seeds for num_envs={n}")
-    bad = [s for s in seeds if s is not None and not _whole(s)]
+    bad = [s for s in seeds if s is not None and not whole(s)]
     if bad:
         raise ValueError(f"reset: a seed must be an integer or None, got {bad[0]!r}")
     return [None if s is None else int(s) for s in seeds]

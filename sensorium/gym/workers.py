@@ -59,7 +59,7 @@ from gymnasium.vector.utils import batch_space
 
 from sensorium.gym.env import DEFAULT_PRECISION, Agent, check_precision, device_of, load
 from sensorium.gym.render import check_render_size
-from sensorium.gym.task import Task
+from sensorium.gym.task import Task, whole
 from sensorium.gym.vector import check_counts, reset_mask, reset_seeds
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedError, check_observable
@@ -98,7 +98,7 @@ class WorkerError(RuntimeError):
 
 def check_workers(workers: Any, num_envs: Any) -> int:
     """``workers`` as an int, or ValueError (one line) when it is not a whole number in [1, num_envs]."""
-    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)):
+    if not whole(workers):
         raise ValueError(f"workers must be a whole number of processes, got {workers!r}")
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
