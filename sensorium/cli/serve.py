@@ -128,14 +128,11 @@ def main(args: argparse.Namespace) -> int:
     import zmq
 
     from sensorium.server.daemon.serve import Server
-    from sensorium.server.daemon.steppath import native_gate_class, step_path_choice
     from sensorium.server.world.loader import WorldError
 
     try:
         opts = options(args)
         opts.check()
-        if step_path_choice() == "c" and native_gate_class()[0] is None:   # SENSORIUM_STEP_PATH, checked early
-            raise ValueError(f"SENSORIUM_STEP_PATH=c: {native_gate_class()[1]}")
     except ValueError as exc:
         print(f"sensorium serve: {exc}", file=sys.stderr)
         return 2

@@ -15,6 +15,7 @@ from typing import Any
 
 from sensorium.server.daemon.roles import CONTROLS, open_controls
 from sensorium.server.daemon.services import Core
+from sensorium.server.daemon.steppath import chosen_gate_class
 from sensorium.server.daemon.transport import (
     DEFAULT_PUB,
     DEFAULT_RPC,
@@ -67,6 +68,7 @@ class ServeOptions:
             load_curve_keys(self.curve_keys)
         if self.cpu is not None:
             check_cpu(self.cpu)
+        chosen_gate_class()             # SENSORIUM_STEP_PATH: an unknown value, or c without the extension
 
 
 def build(world: str | Path | None, options: ServeOptions | None = None) -> tuple[Core, Transport]:

@@ -33,7 +33,7 @@ import zmq
 
 from sensorium.schemas.wire import pack
 
-__all__ = ["PyGate", "gate_for", "native_gate_class", "STEP_PATHS"]
+__all__ = ["PyGate", "chosen_gate_class", "gate_for", "native_gate_class", "step_path_choice", "STEP_PATHS"]
 
 STEP_PATHS = ("auto", "c", "python")
 _NOBLOCK, _SNDMORE, _RCVTIMEO = int(zmq.NOBLOCK), int(zmq.SNDMORE), int(zmq.RCVTIMEO)
@@ -93,17 +93,25 @@ def step_path_choice(step_path: str | None = None) -> str:
     return choice
 
 
+def chosen_gate_class(step_path: str | None = None) -> Any:
+    """The C gate class a transport will use (``step_path`` or ``SENSORIUM_STEP_PATH``: ``auto``,
+    ``c``, ``python``), None for :class:`PyGate`. ValueError for another choice, or for ``c``
+    without the extension (checked before a world is loaded: ``ServeOptions.check``)."""
+    choice = step_path_choice(step_path)
+    if choice == "python":
+        return None
+    cls, why = native_gate_class()
+    if cls is None and choice == "c":
+        raise ValueError(f"{'step_path' if step_path else 'SENSORIUM_STEP_PATH'}=c: {why}")
+    return cls
+
+
 def gate_for(sock: zmq.Socket, *, max_frames: int, max_request: int, max_duration: int, discard_budget: int,
              step_path: str | None = None) -> Any:
-    """The gate for ``sock``: C when built and allowed (``step_path`` or ``SENSORIUM_STEP_PATH``:
-    ``auto``, ``c``, ``python``), else :class:`PyGate`. ValueError for ``c`` without the extension."""
-    choice = step_path_choice(step_path)
-    if choice != "python":
-        cls, why = native_gate_class()
-        if cls is not None:
-            return cls(sock, sock.underlying, max_frames, max_request, max_duration, discard_budget)
-        if choice == "c":
-            raise ValueError(why)
+    """The gate for ``sock``: C when built and allowed (:func:`chosen_gate_class`), else :class:`PyGate`."""
+    cls = chosen_gate_class(step_path)
+    if cls is not None:
+        return cls(sock, sock.underlying, max_frames, max_request, max_duration, discard_budget)
     return PyGate(sock, max_frames=max_frames, discard_budget=discard_budget)
 
 
