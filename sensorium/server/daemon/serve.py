@@ -21,7 +21,7 @@ from sensorium.server.daemon.transport import (
     DEFAULT_RPC,
     Transport,
     check_cpu,
-    endpoint_problem,
+    check_endpoints,
     load_curve_keys,
 )
 from sensorium.server.sim.simulation import Simulation
@@ -52,12 +52,7 @@ class ServeOptions:
 
     def check(self) -> None:
         """Raise ValueError naming the first bad option."""
-        for flag, url in (("--rpc", self.rpc), ("--pub", self.pub)):
-            problem = endpoint_problem(url)
-            if problem:
-                raise ValueError(f"{flag} {problem}")
-        if self.rpc == self.pub and not self.rpc.endswith((":0", ":*")):   # ipc: the second bind would take the path
-            raise ValueError(f"--rpc and --pub are the same endpoint {self.rpc}: give each its own")
+        check_endpoints(("--rpc", self.rpc), ("--pub", self.pub))
         if self.heartbeat_ms <= 0:
             raise ValueError("--heartbeat-ms must be > 0")
         if self.until is not None and self.until < 0:     # it stopped at once, with exit 0

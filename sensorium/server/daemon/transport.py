@@ -36,7 +36,7 @@ from sensorium.server.daemon.services import STEP_REPLY_PIECES, Core
 from sensorium.server.daemon.steppath import gate_for
 
 __all__ = ["Transport", "DEFAULT_RPC", "DEFAULT_PUB", "generate_curve_keys", "load_curve_keys", "curve_server",
-           "curve_client_from_env", "check_cpu", "endpoint_problem"]
+           "curve_client_from_env", "check_cpu", "check_endpoints", "endpoint_problem"]
 
 DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
@@ -78,6 +78,20 @@ def endpoint_problem(url: str) -> str | None:
     if port == "*" or (port.isdigit() and int(port) <= 65535):
         return None
     return f"{url}: the port must be 0 to 65535 (0 or * for a free one), got {port!r}"
+
+
+def check_endpoints(*endpoints: tuple[str, str | None]) -> None:
+    """ValueError naming the first of the (flag, url) endpoints to bind that cannot be bound as asked
+    (:func:`endpoint_problem`; a None url is not bound), or two of them that are the same (on ipc the
+    second bind would take the path from the first)."""
+    for flag, url in endpoints:
+        problem = endpoint_problem(url) if url else None
+        if problem:
+            raise ValueError(f"{flag} {problem}")
+    urls = [url for _, url in endpoints if url and not url.endswith((":0", ":*"))]
+    for i, url in enumerate(urls):
+        if url in urls[:i]:
+            raise ValueError(f"--rpc and --pub are the same endpoint {url}: give each its own")
 
 
 def _ipc_problem(url: str, path: str) -> str | None:

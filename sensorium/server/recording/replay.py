@@ -37,7 +37,7 @@ from sensorium.schemas.wire import (
     parse_request,
     stamp,
 )
-from sensorium.server.daemon.transport import MAX_FRAMES, SUB_LIMIT, TOO_MANY_FRAMES, endpoint_problem
+from sensorium.server.daemon.transport import MAX_FRAMES, SUB_LIMIT, TOO_MANY_FRAMES, check_endpoints
 from sensorium.server.recording.envelope import pack_envelope, topic_matcher, unmatched_topics
 from sensorium.server.recording.reader import RecordedMessage, Recording
 from sensorium.server.recording.scan import Damage
@@ -69,12 +69,7 @@ class Replayer:
                  on_damage: Callable[[Damage], None] | None = None):
         if rate < 0 or not math.isfinite(rate):
             raise ValueError("rate must be >= 0 (0: as fast as possible)")
-        for flag, url in (("--pub", pub), ("--rpc", rpc)):
-            problem = endpoint_problem(url) if url else None
-            if problem:
-                raise ValueError(f"{flag} {problem}")
-        if pub == rpc and not pub.endswith((":0", ":*")):          # ipc: the second bind would take the path
-            raise ValueError(f"--rpc and --pub are the same endpoint {pub}: give each its own")
+        check_endpoints(("--pub", pub), ("--rpc", rpc))
         self.path = str(path)
         self.recording = Recording(path, on_damage=on_damage)     # a damaged chunk is skipped and said
         foreign = self.recording.foreign()
