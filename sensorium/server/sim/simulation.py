@@ -144,7 +144,7 @@ class RobotState:
         if self.drive is not None:
             self.drive.reset(pose)
             pose = self.drive.placed(pose)
-        self._sim.place_robot(self.index, pose)
+        self._sim.place_robot(self, pose)
 
     def motor(self, name: str) -> WheelMotor:
         try:
@@ -192,7 +192,6 @@ class Simulation:
         self.lights = lights_from_models(self.scene.world_lights())
         self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
-        self._by_index = list(self.robots.values())
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         if self.ground is not None:
             self._warn_ground()
@@ -234,13 +233,13 @@ class Simulation:
                   for i, r in enumerate(self.world.robots)]
         return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system])
 
-    def place_robot(self, index: int, pose: Pose) -> None:
+    def place_robot(self, robot: RobotState, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
         jump, not motion: their poses start over from there (_MotionSensor.placed)."""
-        self.scene.set_robot_pose(index, pose)
+        self.scene.set_robot_pose(robot.index, pose)
         if self.contact is not None:
-            self.contact.place(index, pose)
-        for dev in self._by_index[index].devices.values():
+            self.contact.place(robot.index, pose)
+        for dev in robot.devices.values():
             if dev.tracks_motion:
                 dev.placed()          # type: ignore[attr-defined]
 
@@ -259,7 +258,7 @@ class Simulation:
                     m.target_position, m.velocity, m.position = 0.0, m.max_velocity, 0.0
                 robot.drive.reset(pose)
                 pose = robot.drive.placed(pose)
-            self.place_robot(robot.index, pose)
+            self.place_robot(robot, pose)
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
                     dev.set(0, self.time_ms)
