@@ -16,6 +16,7 @@ import json
 import math
 import re
 import time
+import typing
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -346,15 +347,20 @@ def format_path(loc: tuple[Any, ...]) -> str:
     return out
 
 
+def _tags(union: Any, key: str) -> tuple[str, ...]:
+    """The values of ``key`` a discriminated union of the schema accepts (each model's ``Literal``)."""
+    return tuple(typing.get_args(m.model_fields[key].annotation)[0] for m in typing.get_args(typing.get_args(union)[0]))
+
+
 def _choices(loc: tuple[Any, ...]) -> tuple[str, ...]:
     """The kinds a ``device``/``type`` key accepts where ``loc`` points (a device, geometry or light)."""
     keys = [p for p in loc if isinstance(p, str)]
     if keys and keys[-1] == "geometry":
-        return ("box", "sphere", "cylinder", "capsule", "cone", "plane", "triangles", "mesh", "elevation_grid")
+        return _tags(wm.Geometry, "type")
     if "devices" in keys:
         return tuple(wm.DEVICE_TYPES)
     if keys and keys[-1] == "lights":
-        return ("PointLight", "SpotLight", "DirectionalLight")
+        return _tags(wm.Light, "type")
     return ()
 
 
