@@ -424,7 +424,7 @@ def test_the_contact_broad_phase_in_c_finds_the_numpy_candidates_and_meets_close
     random places (some robots without a footprint, some not moving); and a robot is a candidate
     of another exactly when their boxes grown by both reaches and radii overlap."""
     from sensorium.server.raycast import packets
-    from sensorium.server.sim.contact import EPS
+    from sensorium.server.sim.contact import EPS, FLOOR
 
     if packets.library() is None:
         pytest.skip(packets.status())
@@ -451,7 +451,7 @@ def test_the_contact_broad_phase_in_c_finds_the_numpy_candidates_and_meets_close
         grow[copies, slots] = reach
         want = bs._contact_near(copies, slots, starts, reach, grow)
         got = packets.contact_near(copies, slots, starts, reach, bs.foot_radius, bs.foot_low, bs.foot_high,
-                                   bs.heights, bs.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS)
+                                   bs.heights, bs.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS, FLOOR)
         bs.foot_radius[:] = foot
         assert got is not None and want[0] is not None and want[1] is not None
         for w, g in zip(want, got):
@@ -470,7 +470,7 @@ def test_the_contact_broad_phase_in_c_finds_the_numpy_candidates_and_meets_close
         grow[0, 0] = q
         args = (np.array([0]), np.array([0]), np.zeros((1, 2)), np.array([q]))
         got = packets.contact_near(*args, bs.foot_radius, bs.foot_low, bs.foot_high, bs.heights, bs.centres, grow,
-                                   np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), EPS)
+                                   np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), EPS, FLOOR)
         assert got is not None
         assert got[1].tolist() == [[False, expect]] and got[2].tolist() == [expect]
 

@@ -1282,15 +1282,17 @@ size_t sp_inside_shells(size_t m, const double* O, size_t o_stride, const double
  * + EPS) against every solid j (its xy box lo/hi (S, 2), its z range zlo/zhi) and every other slot
  * j of its own copy (centre centres[copy][j] (C, R, 2) before the step, radius foot_radius[j] grown
  * by grow[copy][j] (C, R): that robot's own reach when it moves this step, else 0), each within
- * the height band (heights (C, R) + foot_low/foot_high (R)) -- the numpy path's comparisons,
- * operation for operation (EPS = eps). Writes solid_hit (k, S) and robot_hit (k, R) (0/1; a move
- * never hits its own slot) and near[m] (any hit); returns the number of near moves. A NaN radius
- * (a robot without a footprint) hits nothing, as there. */
+ * the height band (heights (C, R) + foot_low/foot_high (R)), a solid only when its top rises more
+ * than floor_tol above the band's bottom (contact.FLOOR: lower, it is the ground the robot rests on)
+ * -- the numpy path's comparisons, operation for operation (EPS = eps, FLOOR = floor_tol). Writes
+ * solid_hit (k, S) and robot_hit (k, R) (0/1; a move never hits its own slot) and near[m] (any
+ * hit); returns the number of near moves. A NaN radius (a robot without a footprint) hits nothing,
+ * as there. */
 size_t sp_contact_near(size_t k, size_t R, size_t S, const int64_t* copies, const int64_t* slots,
                        const double* starts, const double* reach, const double* foot_radius,
                        const double* foot_low, const double* foot_high, const double* heights,
                        const double* centres, const double* grow, const double* lo, const double* hi,
-                       const double* zlo, const double* zhi, double eps, uint8_t* solid_hit,
+                       const double* zlo, const double* zhi, double eps, double floor_tol, uint8_t* solid_hit,
                        uint8_t* robot_hit, uint8_t* near) {
   size_t count = 0;
   for (size_t m = 0; m < k; m++) {
@@ -1300,12 +1302,12 @@ size_t sp_contact_near(size_t k, size_t R, size_t S, const int64_t* copies, cons
     const double bh0 = starts[2 * m] + grown, bh1 = starts[2 * m + 1] + grown;
     const double h = heights[(size_t)c * R + (size_t)s];
     const double band_lo = h + foot_low[s], band_hi = h + foot_high[s];
-    const double z_above = band_lo + eps, z_below = band_hi - eps;
+    const double z_above = band_lo + eps, z_below = band_hi - eps, z_floor = band_lo + floor_tol;
     int any = 0;
     uint8_t* sh = solid_hit + m * S;
     for (size_t j = 0; j < S; j++) {
       const int in = lo[2 * j] <= bh0 && lo[2 * j + 1] <= bh1 && hi[2 * j] >= bl0 && hi[2 * j + 1] >= bl1
-                     && zhi[j] > z_above && zlo[j] < z_below;
+                     && zhi[j] > z_floor && zlo[j] < z_below;
       sh[j] = (uint8_t)in;
       any |= in;
     }
@@ -1530,7 +1532,7 @@ size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, in
  * angles (the outputs are then not to be used: the caller's Python way says so), status[1]: near
  * moves. Returns the number of moves. */
 size_t sp_drive_step(size_t L, const int64_t* live, size_t D, const int64_t* driven, size_t C, size_t R, size_t S,
-                     double dt, double eps, int contact, void* const* a, int64_t* status) {
+                     double dt, double eps, double floor_tol, int contact, void* const* a, int64_t* status) {
   const double* target = a[0];
   const double* velocity = a[1];
   double* angle = a[2];
@@ -1595,7 +1597,7 @@ size_t sp_drive_step(size_t L, const int64_t* live, size_t D, const int64_t* dri
       grow[(size_t)mc[m] * R + (size_t)ms[m]] = reach[m];
     }
     status[1] = (int64_t)sp_contact_near(k, R, S, mc, ms, starts, reach, foot_radius, a[30], a[31], a[32], centres,
-                                         grow, a[34], a[35], a[36], a[37], eps, a[38], a[39], a[40]);
+                                         grow, a[34], a[35], a[36], a[37], eps, floor_tol, a[38], a[39], a[40]);
     if (status[1]) return k;
     for (size_t m = 0; m < k; m++) {
       const size_t at = (size_t)mc[m] * R + (size_t)ms[m];

@@ -208,11 +208,12 @@ def _load() -> None:
     lib.sp_lidar_beams.restype = None
     lib.sp_lidar_beams.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_drive_wheels.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp, vp, vp]
-    lib.sp_contact_near.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp]
+    lib.sp_contact_near.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, d, d, vp, vp,
+                                    vp]
     # the batched step's passes (DriveStep, lookup, atan2, the sonars, AvoidObstacles, the due scan,
     # the observation clip) and the batched kinematic devices' libm passes
     for name, restype, argtypes in (
-            ("sp_drive_step", sz, [sz, vp, sz, vp, sz, sz, sz, d, d, i, vp, vp]),
+            ("sp_drive_step", sz, [sz, vp, sz, vp, sz, sz, sz, d, d, d, i, vp, vp]),
             ("sp_pose_scatter", None, [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]),
             ("sp_lookup", None, [sz, vp, sz, vp, vp, vp, vp, vp]),
             ("sp_atan2", None, [sz, vp, sz, vp, sz, vp, sz]),
@@ -815,12 +816,14 @@ addresses = _small_addresses
 def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reach: np.ndarray,
                  foot_radius: np.ndarray, foot_low: np.ndarray, foot_high: np.ndarray, heights: np.ndarray,
                  centres: np.ndarray, grow: np.ndarray, lo: np.ndarray, hi: np.ndarray, zlo: np.ndarray,
-                 zhi: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+                 zhi: np.ndarray, eps: float, floor: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """The contact broad phase of :meth:`.batched.BatchedSimulation._contact` in one C pass
     (``sp_contact_near``): (solid_hit (k, S), robot_hit (k, R), near (k,)) as bool arrays, the
     numpy path's comparisons; or None without the helper. Move m is slot ``slots[m]`` of copy
     ``copies[m]`` leaving ``starts[m]`` with ``reach[m]``; ``heights``/``grow`` (C, R),
-    ``centres`` (C, R, 2); solids: ``lo``/``hi`` (S, 2), ``zlo``/``zhi`` (S,)."""
+    ``centres`` (C, R, 2); solids: ``lo``/``hi`` (S, 2), ``zlo``/``zhi`` (S,); ``eps`` and
+    ``floor``: contact.EPS and contact.FLOOR (a solid whose top is at most ``floor`` above a band's
+    bottom is no candidate)."""
     lib = library()
     if lib is None:
         return None
@@ -836,7 +839,7 @@ def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reac
     robot_hit = np.zeros((k, R), dtype=np.bool_)
     near = np.empty(k, dtype=np.bool_)
     p = _small_addresses(args + [solid_hit, robot_hit, near])
-    lib.sp_contact_near(k, R, S, *p[:14], float(eps), *p[14:])
+    lib.sp_contact_near(k, R, S, *p[:14], float(eps), float(floor), *p[14:])
     return solid_hit, robot_hit, near
 
 
@@ -947,9 +950,10 @@ class DriveStep:
         self.p_scatter = [a.ctypes.data for a in (self.copies, self.slots, self.rot, state["x"], state["y"],
                                                   state["z"], state["rot"], state["pos"])]
 
-    def run(self, live: np.ndarray, driven: np.ndarray, dt: float, eps: float, solids=None) -> int:
-        """One basic step of the live copies' driven slots (int64 arrays); ``solids``: the contact's
-        (lo, hi, zlo, zhi) arrays (None: no contact). Returns the number of moves."""
+    def run(self, live: np.ndarray, driven: np.ndarray, dt: float, eps: float, floor: float, solids=None) -> int:
+        """One basic step of the live copies' driven slots (int64 arrays); ``eps``, ``floor``:
+        contact.EPS and contact.FLOOR; ``solids``: the contact's (lo, hi, zlo, zhi) arrays (None: no
+        contact). Returns the number of moves."""
         if solids is not None and (len(self._solids) != 4 or any(a is not b for a, b in zip(solids, self._solids))):
             for a, shape in zip(solids, ((len(solids[2]), 2), (len(solids[2]), 2), (len(solids[2]),),
                                          (len(solids[2]),))):
@@ -963,7 +967,8 @@ class DriveStep:
                 self.ptrs[34 + j] = a.ctypes.data
         live = np.ascontiguousarray(live, dtype=np.int64)
         return self.lib.sp_drive_step(len(live), live.ctypes.data, len(driven), driven.ctypes.data, self.C, self.R,
-                                      self.S, dt, eps, 0 if solids is None else 1, self.ptrs, self.p_status)
+                                      self.S, dt, eps, floor, 0 if solids is None else 1, self.ptrs,
+                                      self.p_status)
 
     def scatter(self, k: int) -> None:
         """Move m's rotation (``self.rot[m]``) and its (x, y, z) written into the state's rot and pos."""

@@ -65,7 +65,7 @@ from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batched_lights import CarriedLights
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
-from sensorium.server.sim.contact import EPS, Contact, Obstacle, enu_body, enu_pose, robot_footprint
+from sensorium.server.sim.contact import EPS, FLOOR, Contact, Obstacle, enu_body, enu_pose, robot_footprint
 from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, PlanarState, _rz
 from sensorium.server.sim.scene import (
@@ -671,7 +671,7 @@ class BatchedSimulation:
             self._drive_numpy(live, driven, dt)
             return
         ct = self.contact
-        k = step.run(live, driven, dt, EPS, None if ct is None else (ct._lo, ct._hi, ct._zlo, ct._zhi))
+        k = step.run(live, driven, dt, EPS, FLOOR, None if ct is None else (ct._lo, ct._hi, ct._zlo, ct._zhi))
         if not k:
             return
         copies, slots = step.copies[:k], step.slots[:k]
@@ -803,7 +803,8 @@ class BatchedSimulation:
         grow = np.zeros((self.copies, self.R))
         grow[copies, slots] = reach
         native = packets.contact_near(copies, slots, starts, reach, self.foot_radius, self.foot_low, self.foot_high,
-                                      self.heights, self.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS)
+                                      self.heights, self.centres, grow, ct._lo, ct._hi, ct._zlo, ct._zhi, EPS,
+                                      FLOOR)
         if native is not None:
             solid_hit, robot_hit, near = native
             solid_hit = solid_hit if len(ct._obs) else None
@@ -886,7 +887,7 @@ class BatchedSimulation:
         near = np.zeros(k, dtype=bool)
         if len(ct._obs):
             solid_hit = (np.all((ct._lo[None] <= box_hi[:, None]) & (ct._hi[None] >= box_lo[:, None]), axis=2)
-                         & (ct._zhi[None] > band_lo[:, None] + EPS) & (ct._zlo[None] < band_hi[:, None] - EPS))
+                         & (ct._zhi[None] > band_lo[:, None] + FLOOR) & (ct._zlo[None] < band_hi[:, None] - EPS))
             near |= solid_hit.any(axis=1)
         if self.R > 1:
             c = self.centres[copies]                                            # (k, R, 2): before this step

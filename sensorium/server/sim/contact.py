@@ -9,8 +9,16 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   corners, an upright cylinder or capsule a point with its radius, a sphere a point with the
   radius of its widest section inside the band, anything else the convex hull of its projected
   vertices (conservative); a vertical infinite plane is a two-sided wall line. Shapes entirely
-  above or below the robot's band (the floor it stands on) and terrains (ElevationGrids, ground
-  whatever their relief) are ignored;
+  above or below the robot's band and terrains (ElevationGrids, ground whatever their relief) are
+  ignored, and so is a solid whose top is at most ``FLOOR`` (1 mm) above the bottom of the band:
+  the floor the robot rests on or has sunk into (a Box or any solid used as the floor), not an
+  obstacle. Webots' soft contacts let a settled robot sink into its floor -- worlds saved from
+  Webots put an e-puck at z = -6.4e-05 m, tens of µm, and heavier robots a fraction of a mm --
+  and a robot sunk so into a floor Box would otherwise start inside it and never drive toward
+  its centre. A millimetre covers those settled poses several times over and stays below
+  anything a robot's body should be stopped by; a solid rising more than that into the band is
+  an obstacle. Robots' bodies meet one another without the tolerance (robots never stand on
+  robots);
 * over one basic step the robot's centre moves along the chord from its start to its end pose
   (poses are only observed at the end of steps, and the end point is the exact arc end unless
   contact clips it). The chord is tested against every obstacle near it (an AABB broad phase)
@@ -38,6 +46,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 
 EPS = 1e-9            # m: "touching" tolerance
+FLOOR = 1e-3          # m: a solid whose top is at most this above a robot band's bottom is its floor
 BACK_OFF = 1e-12      # m: contact points are placed this far outside, never on or inside
 MAX_SLIDES = 3
 UPRIGHT = 1.0 - 1e-12
@@ -511,7 +520,7 @@ class Contact:
         band_hi = self.heights[idx] + self._z_high[idx]
         if len(self._obs):
             solid_hit = (np.all((self._lo[None] <= box_hi[:, None]) & (self._hi[None] >= box_lo[:, None]), axis=2)
-                         & (self._zhi[None] > band_lo[:, None] + EPS) & (self._zlo[None] < band_hi[:, None] - EPS))
+                         & (self._zhi[None] > band_lo[:, None] + FLOOR) & (self._zlo[None] < band_hi[:, None] - EPS))
         robot_hit = None
         if len(self.feet) > 1:
             # where every robot may be during this step: its disc, grown by its own move if it moves
