@@ -144,13 +144,15 @@ def test_single_and_batched_numpy_and_c_move_alike_on_a_floor_box(monkeypatch):
     """Random wheel commands on a sunk robot pair among a floor box, a 5 cm block, a 0.5 mm plate
     (ground) and a 2 mm step (an obstacle): each copy of the batched simulation -- its C pass, its
     numpy drive with the C broad phase, its numpy broad phase -- is the single simulation with its
-    seed, pose for pose, bit for bit, and contacts happen."""
+    seed, pose for pose, bit for bit; contacts happen, and robots drive deeper into the floor box
+    (which the box held them from before it counted as their floor)."""
     n, modes = _modes()
     sims = [Simulation(_floor_world()) for _ in range(n)]
     rng = np.random.default_rng(4)
     for bs in (b for _, b in modes):
         bs.reset(np.arange(n), list(range(n)))
     real_near = packets.contact_near
+    deeper = 0                    # single-simulation steps that took a robot deeper into the floor box
     for step in range(160):
         if step % 16 == 0:
             lr = rng.uniform(-3.0, 12.0, (2, n, 2))
@@ -165,7 +167,9 @@ def test_single_and_batched_numpy_and_c_move_alike_on_a_floor_box(monkeypatch):
             bs.step()
         monkeypatch.setattr(packets, "contact_near", real_near)
         for s in sims:
+            before = [3.0 - np.abs(xy(s, name)).max() for name in ("a", "b")]
             s.step()
+            deeper += sum(3.0 - np.abs(xy(s, name)).max() > b + 1e-6 for name, b in zip(("a", "b"), before))
         for mode, bs in modes:
             for c, s in enumerate(sims):
                 for r, name in enumerate(("a", "b")):
@@ -174,6 +178,7 @@ def test_single_and_batched_numpy_and_c_move_alike_on_a_floor_box(monkeypatch):
                     assert pose.rotation.tobytes() == bs.rot[c, r].tobytes(), (mode, step, c, name)
     contacts = sum(s.counters["contacts"] for s in sims)
     assert contacts > 0 and all(bs.counters["contacts"] == contacts for _, bs in modes)
+    assert deeper > 100
 
 
 def test_the_c_broad_phase_applies_the_floor_tolerance_as_numpy_does():
