@@ -15,6 +15,10 @@ What counts as ground (seen by bounding rays, as kinematic contact reads the wor
 * a Plane facing up (its local z the world's up): a floor at its height, everywhere (bounding rays
   and Webots' physics take every plane as infinite, whatever its size).
 
+Other solids are not ridden: over a Box used as the floor a robot keeps its height, which is what a
+Plane floor gives in a world without terrains (there is no Ground then); kinematic contact takes
+such a floor, its top at most ``contact.FLOOR`` above the robot's band bottom, as ground too.
+
 Where several cover a point the highest is the ground (the first in world order on a tie). On a
 line shared by two triangles (a cell's diagonal or edge, a grid point) both triangles give the
 same height, bit for bit (the barycentric weights below make the shared terms identical); the
