@@ -123,3 +123,21 @@ def test_batched_copies_render_alpha_as_the_single_camera(images, precision, tex
         _, want = shoot(wc, precision, base_dir=images)
         assert want.tobytes() == bs.image(ref)[c].tobytes(), c
         assert len(np.unique(want.reshape(-1, 4), axis=0)) >= (3 if texture == "half.png" else 2)   # the plate in view
+
+
+@pytest.mark.parametrize("quads", [8, 9])
+def test_past_eight_see_through_layers_the_next_surface_is_drawn_opaque(images, quads):
+    """MAX_LAYERS = 8: a ray goes on past 8 clear texels (the wall behind shows); a 9th clear quad in
+    its way is drawn with its texel's colour (red, whose alpha is 0), never cast past."""
+    from PIL import Image
+
+    from sensorium.server.sim.cameras import MAX_LAYERS
+    assert MAX_LAYERS == 8
+    Image.fromarray(np.full((2, 2, 4), (255, 0, 0, 0), dtype=np.uint8), "RGBA").save(images / "red_clear.png")
+    stack = [{**_quad("red_clear.png"), "name": f"q{i}", "pose": {"translation": [1.0 + 0.05 * i, 0, 0],
+                                                                  "rotation": [0, 1, 0, -math.pi / 2]}}
+             for i in range(quads)]
+    sim, img = shoot(world(CAM, [WALL, *stack], [AMBIENT]), base_dir=images)
+    want = 0.5 * ALBEDO if quads == 8 else 0.5 * _lin((255, 0, 0))
+    np.testing.assert_array_equal(rgb(img), np.broadcast_to(expected_bytes(want), (6, 6, 3)))
+    assert sim.counters["rays_camera"] == 36 * (quads + 1 if quads == 8 else quads)
