@@ -16,7 +16,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world import texcoords as tc
 from sensorium.server.world.loader import WorldError, load_world, parse_world
-from sensorium.server.world.textures import TextureImage, TriangleLocator, load_image, transform_uv
+from sensorium.server.world.textures import TextureImage, TriangleLocator, load_alpha, load_image, transform_uv
 
 DOWN = [0.0, 1.0, 0.0, math.pi / 2]      # a device's +x axis turned to world -z
 H = 0.0625                               # sensor height above the floor (exact in binary)
@@ -491,6 +491,34 @@ def test_image_modes_read_as_webots(tmp_path: Path) -> None:
     jpg = tmp_path / "j.jpg"
     Image.fromarray(np.full((8, 8, 3), 128, dtype=np.uint8)).save(jpg, quality=100)
     assert abs(int(load_image(jpg)[4, 4, 0]) - 128) <= 1
+
+
+def test_alpha_is_kept_apart_for_cameras(tmp_path: Path) -> None:
+    """load_alpha: an RGBA, grey-alpha or palette image with transparency, or an RGB colour key, gives
+    its alpha (cameras blend with it); an alpha of 255 everywhere, RGB, grey and JPEG give None."""
+    rgba = tmp_path / "a.png"
+    Image.fromarray(np.array([[[200, 10, 20, 0], [1, 2, 3, 128]]], dtype=np.uint8), "RGBA").save(rgba)
+    assert load_alpha(rgba).tolist() == [[0, 128]] and load_image(rgba).tolist() == [[[200, 10, 20], [1, 2, 3]]]
+    opaque = tmp_path / "o.png"
+    Image.fromarray(np.full((2, 2, 4), 255, dtype=np.uint8), "RGBA").save(opaque)
+    assert load_alpha(opaque) is None
+    la = tmp_path / "la.png"
+    Image.fromarray(np.array([[[77, 10]]], dtype=np.uint8), "LA").save(la)
+    assert load_alpha(la).tolist() == [[10]]
+    pal = tmp_path / "p.png"
+    im = Image.new("P", (2, 1))
+    im.putpalette([0, 0, 0, 255, 0, 0] + [0] * 762)
+    im.putpixel((1, 0), 1)
+    im.save(pal, transparency=0)
+    assert load_alpha(pal).tolist() == [[0, 255]] and load_image(pal).tolist() == [[[0, 0, 0], [255, 0, 0]]]
+    key = tmp_path / "k.png"
+    Image.fromarray(np.array([[[5, 6, 7], [9, 9, 9]]], dtype=np.uint8)).save(key, transparency=(5, 6, 7))
+    assert load_alpha(key).tolist() == [[0, 255]]
+    for name, mode in (("rgb.png", "RGB"), ("g.png", "L")):
+        Image.new(mode, (2, 2)).save(tmp_path / name)
+        assert load_alpha(tmp_path / name) is None
+    Image.new("RGB", (8, 8)).save(tmp_path / "j.jpg")
+    assert load_alpha(tmp_path / "j.jpg") is None
 
 
 def _textured(url: str) -> dict:

@@ -224,7 +224,8 @@ Geometry = Annotated[Box | Sphere | Cylinder | Capsule | Cone | Plane | Triangle
 class Texture(Strict):
     """An image on a surface (Webots' ImageTexture): a PNG or JPEG file, path relative to the world
     file (confined to its folder like meshes). Infra-red sensors read the texel under each hit,
-    nearest texel, alpha ignored (Webots' pickColor). A bare string is taken as the url."""
+    nearest texel, alpha ignored (Webots' pickColor); cameras see through transparent texels
+    (alpha times 1 - transparency, as Webots' shaders). A bare string is taken as the url."""
 
     url: str = Field(min_length=1)
     repeat_s: bool = True

@@ -46,7 +46,7 @@ from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
 from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import _base_color, robot_parts, surface_colors
+from sensorium.server.sim.scene import _base_color, robot_parts, surface_colors, surface_opacity
 
 __all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera", "own_body_hits"]
 
@@ -256,9 +256,10 @@ class CameraDevices(PixelDevices):
         """Camera._capture_image of each copy's rays (``hits``: the copies' cast, copy after copy)."""
         dev = self.devices[col]
         k = len(copies)
-        if self.clear:     # semi-transparent surfaces: each copy's layers as the single camera's
+        alpha = self._alpha_shapes()
+        if self.clear or alpha is not None:     # semi-transparent surfaces or texels: each copy's layers
             out = np.concatenate([self._layers(col, copies[q:q + 1], org[q], dirs[q * dev.n:(q + 1) * dev.n],
-                                               _rows_of(hits, q * dev.n, (q + 1) * dev.n)) for q in range(k)])
+                                               _rows_of(hits, q * dev.n, (q + 1) * dev.n), alpha) for q in range(k)])
         else:
             out = self._opaque(col, copies, org, dirs, hits)
         self._finish_image(col, copies, out)
@@ -318,11 +319,24 @@ class CameraDevices(PixelDevices):
             out[rq] = _shade(P[rq], N[rq], albedo[rq], lights, None if lit is None else lit[rq], threads)
         return out
 
-    def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits) -> np.ndarray:
+    def _alpha_shapes(self) -> np.ndarray | None:
+        """Per hit shape (static shapes, then the robots'; −1 last): whether its image has
+        transparent texels (``Scene.alpha_shapes`` over this scene's sampler); None without any."""
+        sampler = self.sim.scene.textures
+        if sampler is None or not sampler.has_alpha:
+            return None
+        flags = np.zeros(len(self.colors), dtype=bool)
+        m = min(len(sampler.alpha), len(flags)) - 1       # the sampler numbers the robots' shapes when textured
+        flags[:m] = sampler.alpha[:m]
+        return flags
+
+    def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits,
+                alpha_shapes: np.ndarray | None = None) -> np.ndarray:
         """Camera._render of one copy's rays (``hits``: its first layer, from the copies' cast): the
-        single camera's :func:`composite`, its rays going on past semi-transparent surfaces cast for
-        this copy alone (as the single camera casts them, from its origin with per-ray limits),
-        blind to the camera's own shapes."""
+        single camera's :func:`composite`, its rays going on past semi-transparent surfaces (and
+        see-through texels: ``alpha_shapes``, their alpha read at this copy's poses) cast for this
+        copy alone (as the single camera casts them, from its origin with per-ray limits), blind to
+        the camera's own shapes."""
         sim = self.sim
         scene = sim.scene
         dev = self.devices[col]
@@ -341,8 +355,17 @@ class CameraDevices(PixelDevices):
             lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
             return _shade(P, N, albedo, self._lights_of(int(copy[0])), lit, scene.engine.threads)
 
+        alpha = None
+        if alpha_shapes is not None:
+            robots = sim.robot_textures
+            to_shape = scene._world_to_shape if robots is None else robots.world_to_shape(int(copy[0]))
+
+            def opacity(s: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
+                return surface_opacity(scene.textures, to_shape, s, np.broadcast_to(origin, (len(s), 3)), D, t)
+
+            alpha = (alpha_shapes, opacity)
         return composite(origin, dirs, hits, dev.limits, cast_on, self.transparency, scene.background, scene.fog,
-                         surface)
+                         surface, alpha)
 
     def _finish_image(self, col: int, copies: np.ndarray, out: np.ndarray) -> None:
         """Camera._capture_image from the radiance of every copy's rays: the samples' mean, the

@@ -171,10 +171,12 @@ class RangeFinder(Device):
 # ---------------------------------------------------------------------------------- Camera
 
 MAX_LAYERS = 8
-"""Semi-transparent surfaces composited along one ray; the next surface is taken as opaque."""
+"""Semi-transparent surfaces (or see-through texels) composited along one ray: a ray goes on past at
+most this many; the surface it meets after them is taken as opaque (its colour, even where its
+texel is clear), so a pixel never costs more than ``MAX_LAYERS + 1`` casts."""
 
 def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tuple[Any, Any], cast_on,
-              transparency: np.ndarray, background: np.ndarray, fog, surface) -> np.ndarray:
+              transparency: np.ndarray, background: np.ndarray, fog, surface, alpha=None) -> np.ndarray:
     """The radiance (N, 3) along every ray of a camera at ``origin``: the surfaces it crosses
     composited front to back (semi-transparent ones let ``transparency`` of what is behind through;
     a closed shape's faces are crossed twice and only its entering face is seen, as with back-face
@@ -182,7 +184,11 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
     distance, the ``background`` (not fogged) where nothing is hit. ``first``: the rays' first hits
     within ``limits``; ``cast_on(D, t_near, t_far)``: the hits of rays from ``origin`` going on past
     a semi-transparent surface; ``surface(shape, P, N, D, t)``: the radiance (n, 3) of the surfaces
-    seen, before fog. The single camera and the batched one (per copy) share it."""
+    seen, before fog. ``alpha``: None in a world without alpha textures, else ``(shapes, opacity)``:
+    ``shapes[s]`` whether shape s's image has transparent texels, ``opacity(shape, D, t)`` the
+    texel alpha (n,) at hits on such shapes; a hit there lets ``1 − (1 − transparency)·alpha``
+    through (Webots' final alpha), and a fully clear texel is not shaded. The single camera and the
+    batched one (per copy) share it."""
     n = len(dirs)
     t_near, t_far = limits
     tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
@@ -209,6 +215,13 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
         r, s = rows[k], shape[k]
         tau = transparency[s]
         clear = tau > 0.0
+        textured = None                # the hits on shapes with transparent texels (an alpha world only)
+        if alpha is not None:
+            textured = alpha[0][s]
+            if textured.any():
+                clear = clear | textured     # may let light through: entering and leaving as above
+            else:
+                textured = None
         leaving = np.zeros(len(k), dtype=bool)
         any_clear = bool(clear.any())
         if any_clear and inside is None:
@@ -219,6 +232,14 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
             assert inside is not None
             leaving = clear & (inside[r] == s[:, None]).any(axis=1)
         seen = (~leaving).nonzero()[0]
+        if textured is not None:   # each entering hit's own transparency: 1 - (1 - tau) alpha
+            ta = (textured & ~leaving).nonzero()[0]
+            if len(ta):
+                ka = k[ta]
+                tau[ta] = 1.0 - (1.0 - tau[ta]) * alpha[1](s[ta], D.take(ka, axis=0), t.take(ka))
+            clear = leaving | (tau > 0.0)      # an opaque texel stops the ray
+            if layer < MAX_LAYERS:             # a clear texel adds nothing: not shaded
+                seen = seen[tau[seen] < 1.0]
         if len(seen):
             kk, rr = k[seen], r[seen]
             whole = len(kk) == len(D)
@@ -492,8 +513,15 @@ class Camera(Device):
             lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
             return _shade(P, N, albedo, lights, lit, engine.threads)
 
+        alpha = None
+        shapes = scene.alpha_shapes              # None unless an image has transparent texels
+        if shapes is not None:
+            def opacity(s: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
+                return scene.surface_opacity(s, np.broadcast_to(origin, (len(s), 3)), D, t)
+
+            alpha = (shapes, opacity)
         return composite(origin, dirs, first, self._limits, cast_on, scene.transparency, self._background, scene.fog,
-                         surface)
+                         surface, alpha)
 
     def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
                  counters: Any) -> np.ndarray:

@@ -173,6 +173,25 @@ def surface_colors(colors: np.ndarray, sampler: TextureSampler | None, world_to_
     return col
 
 
+def surface_opacity(sampler: TextureSampler, world_to_shape: Callable[[int], Pose], shape: np.ndarray,
+                    origins: np.ndarray, directions: np.ndarray, distance: np.ndarray) -> np.ndarray:
+    """The texture alpha (n,) a camera sees at hits on shapes whose image has transparent texels
+    (``sampler.alpha``; 1 on every other shape and where picking fails): the texel's alpha at the
+    coordinates :func:`surface_colors` reads its colour at (Webots' shaders take the texel's alpha
+    as the fragment's, times ``1 − transparency``; the pen's ink changes colours only)."""
+    out = np.ones(len(shape))
+    hit = sampler.alpha[shape].nonzero()[0]
+    on = shape[hit]
+    for s in sorted(set(on.tolist())):
+        rows = hit[on == s]
+        inv = world_to_shape(s)
+        o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
+        uv, picked = sampler.uv(s, o, d, distance[rows])
+        uv = np.where(picked[:, None], uv, 0.0)
+        out[rows] = np.where(picked, sampler.opacity(s, uv), 1.0)
+    return out
+
+
 def infra_red_terms(red_of: np.ndarray, roughness_of: np.ndarray, sampler: TextureSampler | None,
                     world_to_shape: Callable[[int], Pose], shape: np.ndarray, origins: np.ndarray,
                     directions: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -484,6 +503,19 @@ class Scene:
         """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): see
         :func:`surface_colors`."""
         return surface_colors(self.colors, self.textures, self._world_to_shape, shape, origins, directions, distance)
+
+    @property
+    def alpha_shapes(self) -> np.ndarray | None:
+        """Per shape (−1 last, False): whether its image has transparent texels; None in a world
+        without any (cameras then composite only what ``transparency`` asks for)."""
+        t = self.textures
+        return t.alpha if t is not None and t.has_alpha else None
+
+    def surface_opacity(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
+                        distance: np.ndarray) -> np.ndarray:
+        """The texture alpha (n,) a camera sees at hits: see :func:`surface_opacity`."""
+        assert self.textures is not None
+        return surface_opacity(self.textures, self._world_to_shape, shape, origins, directions, distance)
 
     def infra_red_terms(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                         distance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

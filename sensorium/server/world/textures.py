@@ -4,7 +4,9 @@ What Webots does, and so what this does (sources: ``WbImageTexture.cpp``, ``WbAp
 ``WbPbrAppearance.cpp``, ``WbAbstractAppearance.cpp``, ``WbTextureTransform.cpp``,
 ``wren/TextureTransform.{hpp,cpp}``, ``WbShape.cpp`` ``pickColor``; docs/textures.md restates them):
 
-* an image is read once (PNG or JPEG), converted to 8-bit RGB; alpha is never read by sensors;
+* an image is read once (PNG or JPEG), converted to 8-bit RGB; alpha is never read by sensors
+  (``pickColor``), only by cameras (:meth:`TextureSampler.opacity`: Webots draws a texture whose
+  image uses alpha translucent, its alpha times ``1 − transparency``: phong.frag, pbr.frag);
 * a lookup takes the geometry's ``(u, v)`` (:mod:`.texcoords`), applies the appearance's
   TextureTransform (X3D order: translation, then rotation and scale about ``center``; Webots'
   wren matrix ``−C·S·R·C·T`` with its flipped ``v``), wraps each coordinate (``repeatS``/``repeatT``:
@@ -43,7 +45,7 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.world import texcoords as tc
 
-__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "load_image", "check_textures",
+__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "load_image", "load_alpha", "check_textures",
            "TextureImage", "transform_uv", "TextureSampler", "TriangleLocator", "texture_urls"]
 
 FORMATS = {"PNG": "PNG", "JPEG": "JPEG", "MPO": "JPEG"}     # Pillow's format → what Webots calls it
@@ -115,6 +117,17 @@ def image_header(path: Path, display: str) -> tuple[str, int, int]:
 
 def load_image(path: Path, display: str | None = None) -> np.ndarray:
     """The image as a read-only ``(h, w, 3)`` uint8 RGB array, top row first (cached)."""
+    return _decoded(path, display)[0]
+
+
+def load_alpha(path: Path, display: str | None = None) -> np.ndarray | None:
+    """The image's alpha channel as a read-only ``(h, w)`` uint8 array, top row first (cached with
+    :func:`load_image`), or None when it has none or every pixel's alpha is 255 (it then draws as an
+    RGB image would: what a camera sees of it is the same)."""
+    return _decoded(path, display)[1]
+
+
+def _decoded(path: Path, display: str | None) -> tuple[np.ndarray, np.ndarray | None]:
     path = Path(path).resolve()
     st = path.stat()
     try:
@@ -123,8 +136,11 @@ def load_image(path: Path, display: str | None = None) -> np.ndarray:
         raise TextureFileError(str(exc).replace(str(path), display or str(path))) from None
 
 
+_ALPHA_MODES = ("RGBA", "LA", "PA", "RGBa", "La")
+
+
 @lru_cache(maxsize=16)
-def _decode(path: str, _mtime: int, _size: int) -> np.ndarray:
+def _decode(path: str, _mtime: int, _size: int) -> tuple[np.ndarray, np.ndarray | None]:
     from PIL import Image
 
     old = Image.MAX_IMAGE_PIXELS       # the world limits were checked on the header; Pillow's own
@@ -134,19 +150,27 @@ def _decode(path: str, _mtime: int, _size: int) -> np.ndarray:
             warnings.simplefilter("ignore")
             with Image.open(path) as im:
                 im.load()
+                alpha = None
                 if im.mode in ("I;16", "I;16B", "I;16L", "I"):    # 16-bit grey: rounded to 8 bits
                     a = np.clip(np.asarray(im, dtype=np.int64), 0, 65535)
                     grey = ((a * 255 + 32767) // 65535).astype(np.uint8)
                     rgb = np.repeat(grey[..., None], 3, axis=2)
                 else:
                     rgb = np.asarray(im.convert("RGB"), dtype=np.uint8)
+                    # an alpha channel, or a palette's or colour key's transparency (PNG tRNS): what Qt
+                    # reads as an image that uses alpha (WbImageTexture: the texture is then translucent)
+                    if im.mode in _ALPHA_MODES or "transparency" in im.info:
+                        alpha = np.asarray(im.convert("RGBA"), dtype=np.uint8)[..., 3]
+                        alpha = None if bool((alpha == 255).all()) else np.ascontiguousarray(alpha)
     except (OSError, ValueError, SyntaxError) as exc:
         raise TextureFileError(f"texture file {path} cannot be decoded: {exc}") from None
     finally:
         Image.MAX_IMAGE_PIXELS = old
     rgb = np.ascontiguousarray(rgb)
     rgb.flags.writeable = False
-    return rgb
+    if alpha is not None:
+        alpha.flags.writeable = False
+    return rgb, alpha
 
 
 # ------------------------------------------------------------------------------------ the world
@@ -240,6 +264,7 @@ class TextureImage:
     rgb: np.ndarray            # (h, w, 3) uint8, top row first
     repeat_s: bool = True
     repeat_t: bool = True
+    alpha: np.ndarray | None = None     # (h, w) uint8 where the image has transparent texels (load_alpha)
 
     def texel_index(self, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(row, column) of the nearest texel (WbImageTexture::pickColor's wrap and index)."""
@@ -274,6 +299,16 @@ class TextureImage:
         row, col = self.texel_index(uv)
         px = self.rgb[row, col] if channel is None else self.rgb[row, col, channel]
         return px / 255.0
+
+    def opacity(self, uv: np.ndarray) -> np.ndarray:
+        """The texels' alpha ``(n,)`` in [0, 1] (``byte / 255``; 1 without an alpha channel), read as
+        :meth:`texels` reads colours."""
+        uv = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+        if self.alpha is None:
+            return np.ones(len(uv))
+        uv = np.where(np.isnan(uv), 0.0, uv)
+        row, col = self.texel_index(uv)
+        return self.alpha[row, col] / 255.0
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
@@ -665,9 +700,11 @@ class TextureSampler:
         self._uv: dict[tuple[int, bool], UvOf] = {}
         self._locators: dict[int, TriangleLocator] = {}
         self._meshes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        self._images: dict[Path, np.ndarray] = {}
+        self._images: dict[Path, tuple[np.ndarray, np.ndarray | None]] = {}
         self.models: list[tuple[Any, wm.Appearance | None]] = []
         self.textured = np.zeros(1, dtype=bool)
+        self.alpha = np.zeros(1, dtype=bool)
+        self.has_alpha = False
         self.extend(shapes)
         self.lookups = 0
 
@@ -676,8 +713,9 @@ class TextureSampler:
             return None
         path = resolve_texture_url(t.url, self.base_dir, allow_outside=True)
         if path not in self._images:
-            self._images[path] = load_image(path, t.url)
-        return TextureImage(self._images[path], t.repeat_s, t.repeat_t)
+            self._images[path] = (load_image(path, t.url), load_alpha(path, t.url))
+        rgb, alpha = self._images[path]
+        return TextureImage(rgb, t.repeat_s, t.repeat_t, alpha)
 
     def extend(self, shapes: list[tuple[Any, wm.Appearance | None]]) -> None:
         """Shapes numbered after the existing ones (a Supervisor's imported solid): their images
@@ -694,6 +732,12 @@ class TextureSampler:
         textured[:first] = self.textured[:first]        # the trailing "no hit" entry stays False
         textured[list(self.shapes)] = True
         self.textured = textured
+        # the shapes whose base image has transparent texels (cameras see through them; infra-red,
+        # lidars and range finders do not read alpha, as Webots)
+        alpha = np.zeros(len(self.models) + 1, dtype=bool)
+        alpha[[s for s, st in self.shapes.items() if st.base.alpha is not None]] = True
+        self.alpha = alpha
+        self.has_alpha = bool(alpha.any())
 
     def __bool__(self) -> bool:
         return bool(self.shapes) or bool(self.ink)
@@ -760,6 +804,12 @@ class TextureSampler:
         if img is None:
             raise KeyError(f"shape {shape} has no {which} map")
         return img.texels(transform_uv(np.asarray(uv, dtype=np.float64).reshape(-1, 2), st.transform), channel)
+
+    def opacity(self, shape: int, uv: np.ndarray) -> np.ndarray:
+        """The alpha ``(n,)`` in [0, 1] of ``shape``'s base image at ``uv`` (the TextureTransform
+        applied, then the wrap, nearest texel, as :meth:`texels`); 1 without an alpha channel."""
+        st = self.shapes[shape]
+        return st.base.opacity(transform_uv(np.asarray(uv, dtype=np.float64).reshape(-1, 2), st.transform))
 
     # ---- ink
 
