@@ -154,8 +154,8 @@ def _unchanged(lv: Live) -> tuple:
     ("Crate { }", "node string:1:1: Crate: not a built-in node or PROTO here."),
     ("Transform { children [ Shape { geometry Box { } } ] }", "node string:1:1: Transform: not importable here"),
     ("WorldInfo { }", "node string:1:1: WorldInfo: not importable here"),
-    ("Solid {\n children [ Shape { geometry Box { size 1 -1 1 } } ] }",
-     "node string:2:30 (Box, converted as solids[0].shapes[0].geometry.size): every box size component must be > 0"),
+    ("Solid {\n children [ PointLight { attenuation 0 0 0 } ] }",
+     "node string:2:13 (PointLight, converted as solids[0].lights[0].attenuation): attenuation 0 0 0 would give"),
     ("Solid { children [ USE WHEEL ] }", "node string:1:24: USE WHEEL: no DEF WHEEL before this point"),
     ('EXTERNPROTO "Crate.proto"\nCrate { }', "node string:1:1: a node string declares no PROTO"),
     ("", "node string: no node in it"),
@@ -168,6 +168,14 @@ def test_bad_strings_are_refused_with_one_line_and_nothing_changes(text, expecte
     assert refused(lv, text).startswith(expected)
     assert _unchanged(lv) == was
     assert imports(lv, BOX) == [FIRST + 1]
+
+
+def test_a_value_webots_resets_is_reset_on_import_as_in_a_world_file():
+    """A node string reads as a .wbt world does: a Box size Webots resets is 1 1 1 (world/wbt/resets.py)."""
+    lv = _live()
+    imports(lv, 'Solid { name "odd" children [ Shape { geometry Box { size 1 -1 1 } } ] }')
+    (odd,) = [s for s in lv.sim.world.solids if s.name == "odd"]
+    assert odd.shapes[0].geometry.size == (1.0, 1.0, 1.0)
 
 
 def test_only_the_roots_children_take_nodes():

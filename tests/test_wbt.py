@@ -237,11 +237,12 @@ def test_field_errors_point_at_the_node(tmp_path: Path) -> None:
     with pytest.raises(WorldError) as exc:
         load_world(p)
     assert str(exc.value) == f"{p}: line 5, column 9: Solid.translation: expected 3 numbers, got 2 numbers"
-    p = write(tmp_path, 'Solid {\n  children [ Shape { geometry Box { size 1 -2 1 } } ]\n}\n')
+    # a value Webots takes but Sensorium cannot (an infinite irradiance): placed at the node it came from
+    p = write(tmp_path, 'Solid {\n  children [ PointLight { attenuation 0 0 0 } ]\n}\n')
     with pytest.raises(WorldError) as exc:
         load_world(p)
-    assert str(exc.value).startswith(f"{p}: line 3, column 31 (Box, converted as solids[0].shapes[0].geometry.size): ")
-    assert "every box size component must be > 0" in str(exc.value)
+    assert str(exc.value).startswith(f"{p}: line 3, column 14 (PointLight, converted as solids[0].lights[0].attenuation): ")
+    assert "attenuation 0 0 0 would give infinite irradiance" in str(exc.value)
 
 
 def test_unknown_proto_is_skipped_with_its_position(tmp_path: Path) -> None:

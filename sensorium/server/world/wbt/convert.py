@@ -98,6 +98,7 @@ class Converter:
         self.instances: list[tuple[str, tuple[str, int, int]]] = []   # PROTO instances being walked (name, at)
         self.asset_files: set[Path] = set()   # asset files outside the world's folder this world may read
         self.losses: list[Loss] = []      # robots, sensor devices and sensor-visible shapes lost (report.py)
+        self.resets_said: set[str] = set()   # Webots' field resets told (a node USEd twice: once)
 
     # ------------------------------------------------------------ messages
     def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
@@ -130,6 +131,14 @@ class Converter:
     def warn(self, node: Node, message: str) -> None:
         self.warnings.append(f"{self.where(node)}: {message}")
 
+    def field_reset(self, node: Node, name: str, message: str) -> None:
+        """A field value Webots would not use, reset as Webots does (wbt/resets.py): one warning at
+        the field's line, said once however often the node is used."""
+        line = f"{self.where(node, node.field_pos.get(name))}: {message}"
+        if line not in self.resets_said:
+            self.resets_said.add(line)
+            self.warnings.append(line)
+
     def drop(self, node: Node, message: str, kind: str, name: str = "", robot: str = "") -> None:
         """A loss that changes what sensors read (``kind``: a robot, a sensor device, a solid or
         shape sensors see, an unknown node): a warning that ``validate`` counts as an error unless
@@ -143,7 +152,7 @@ class Converter:
         self.drop(node, message, "shape", owner.data.get("name", "") if owner.kind != "world" else "")
 
     def fields(self, node: Node) -> Fields:
-        return Fields(node, node.source or self.source)
+        return Fields(node, node.source or self.source, self.field_reset)
 
     def error(self, node: Node, message: str) -> WbtSyntaxError:
         return WbtSyntaxError(node.source or self.source, node.line, node.col, message)
@@ -252,7 +261,7 @@ class Converter:
             else:
                 self.world_info(node)
         elif t == "Background" and top and f.has("skyColor"):     # what cameras see past everything
-            sky = f.rows("skyColor", 3, [(0.0, 0.0, 0.0)])
+            sky = f.colors("skyColor", [(0.0, 0.0, 0.0)])
             self.world["background"] = {"sky_color": list(sky[0]) if sky else [0.0, 0.0, 0.0]}
             self.skipped[t] += 1     # its other fields (textures, luminosity) are not read
         elif t == "Fog":                 # cameras blend it in
@@ -438,7 +447,7 @@ class Converter:
         part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
         if seen_by == "visual":
             app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note,
-                                lambda n, u: self.asset(n, u, "texture"))
+                                lambda n, u: self.asset(n, u, "texture"), self.field_reset)
             if app is not None:
                 part["appearance"] = app
             owner.keys[key] = part
@@ -535,20 +544,24 @@ class Converter:
     def base_geometry(self, node: Node, s: float) -> tuple[dict | None, str]:
         f = self.fields(node)
         t = node.type
+        # sizes Webots resets (each node's sanitizeFields): a non-positive one is 1, a Box's or a
+        # Plane's size with any non-positive component all ones
         if t == "Box":
-            return {"type": "box", "size": [v * s for v in f.vec("size", (2.0, 2.0, 2.0))]}, ""
+            return {"type": "box", "size": [v * s for v in f.positive_vec("size", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0))]}, ""
         if t == "Sphere":
-            return {"type": "sphere", "radius": f.num("radius", 1.0) * s}, ""
+            return {"type": "sphere", "radius": f.positive("radius", 1.0) * s}, ""
         if t in ("Cylinder", "Capsule"):
             if not all(f.flag(k, True) for k in ("bottom", "side", "top")):
                 self.warn(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
-            return {"type": t.lower(), "radius": f.num("radius", 1.0) * s, "height": f.num("height", 2.0) * s}, ""
+            return {"type": t.lower(), "radius": f.positive("radius", 1.0) * s,
+                    "height": f.positive("height", 2.0) * s}, ""
         if t == "Plane":
-            return {"type": "plane", "size": [v * s for v in f.vec("size", (1.0, 1.0))]}, ""
+            return {"type": "plane", "size": [v * s for v in f.positive_vec("size", (1.0, 1.0), (1.0, 1.0))]}, ""
         if t == "Cone":
             if not all(f.flag(k, True) for k in ("bottom", "side")):
                 self.warn(node, "Cone with bottom/side FALSE: rays see the whole closed cone")
-            return {"type": "cone", "bottom_radius": f.num("bottomRadius", 1.0) * s, "height": f.num("height", 2.0) * s}, ""
+            return {"type": "cone", "bottom_radius": f.positive("bottomRadius", 1.0) * s,
+                    "height": f.positive("height", 2.0) * s}, ""
         if t == "ElevationGrid":
             return self.elevation_grid(node, f, s)
         if t == "Mesh":
@@ -668,7 +681,7 @@ class Converter:
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
             self.def_name(node, data)
-            colors = f.rows("recognitionColors", 3, [])        # what cameras with a Recognition node report
+            colors = f.colors("recognitionColors", [])        # what cameras with a Recognition node report
             if colors:
                 data["recognition_colors"] = [list(c) for c in colors]
             if f.string("model", ""):
@@ -724,7 +737,7 @@ class Converter:
                     data[key] = value
             elif value != defaults[key]:
                 self.warn(node, f"Robot field {key}: not supported by this version; ignored")
-        colors = f.rows("recognitionColors", 3, [])
+        colors = f.colors("recognitionColors", [])
         if colors:
             data["recognition_colors"] = [list(c) for c in colors]
         data["_at"] = self.at(node)

@@ -4,17 +4,77 @@ the wrong shape is an error naming file, line and column."""
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from typing import Any
 
+from sensorium.server.world.wbt import resets
 from sensorium.server.world.wbt.parser import Node, WbtSyntaxError
+
+# told of each value Webots would reset: (node, field, "Sphere.radius: 0 is not > 0; using 1 (as Webots does)")
+Reset = Callable[[Node, str, str], None]
 
 
 class Fields:
-    """Typed getters on one node; errors point at the field (or the node when it is absent)."""
+    """Typed getters on one node; errors point at the field (or the node when it is absent).
 
-    def __init__(self, node: Node, source: str):
+    The checked getters (``positive``, ``within``, ``color``, ...) apply Webots' resets (resets.py):
+    a value Webots would not use is replaced by the one it uses and ``reset`` is told; without a
+    ``reset`` to tell, such a value is an error."""
+
+    def __init__(self, node: Node, source: str, reset: Reset | None = None):
         self.node = node
         self.source = source
+        self.reset = reset
+
+    def sub(self, node: Node) -> Fields:
+        """The fields of a node held by this one (its Material, Recognition, ...), told alike."""
+        return Fields(node, node.source or self.source, self.reset)
+
+    def used(self, name: str, written: Any, used: Any, why: str) -> Any:
+        """``used`` in place of ``written`` (``why``: what is wrong with it; "" when nothing is),
+        ``reset`` told; an error when there is no ``reset`` to tell."""
+        if not why:
+            return used
+        if self.reset is None:
+            raise self.error(name, f"{resets.shown(written)} {why}")
+        self.reset(self.node, name, f"{self.node.type}.{name}: {resets.shown(written)} {why}; "
+                                    f"using {resets.shown(used)} (as Webots does)")
+        return used
+
+    def positive(self, name: str, default: float, reset: float = 1.0) -> float:
+        """A number that must be > 0 (else ``reset``)."""
+        v = self.num(name, default)
+        return float(self.used(name, v, *resets.positive(v, reset)))
+
+    def non_negative(self, name: str, default: float, reset: float = 0.0) -> float:
+        """A number that must be >= 0 (else ``reset``)."""
+        v = self.num(name, default)
+        return float(self.used(name, v, *resets.non_negative(v, reset)))
+
+    def within(self, name: str, default: float, lo: float, hi: float, reset: float) -> float:
+        """A number within [lo, hi] (else ``reset``)."""
+        v = self.num(name, default)
+        return float(self.used(name, v, *resets.within(v, lo, hi, reset)))
+
+    def positive_vec(self, name: str, default: tuple[float, ...], reset: tuple[float, ...]) -> tuple[float, ...]:
+        """A vector whose components must all be > 0 (else the whole of it is ``reset``)."""
+        v = self.vec(name, default)
+        return tuple(self.used(name, v, *resets.positive_vector(v, reset)))
+
+    def color(self, name: str, default: tuple[float, float, float]) -> tuple[float, ...]:
+        """An SFColor, each component clamped to [0, 1]."""
+        v = self.vec(name, default)
+        return tuple(self.used(name, v, *resets.color(v)))
+
+    def colors(self, name: str, default: list[tuple[float, ...]]) -> list[tuple[float, ...]]:
+        """An MFColor, each component of each colour clamped to [0, 1] (one message for the field)."""
+        rows = self.rows(name, 3, default)
+        fixed = [resets.color(r)[0] for r in rows]
+        if fixed != [tuple(r) for r in rows]:
+            flat = [x for r in rows for x in r]
+            self.used(name, flat, [x for r in fixed for x in r], "has components outside [0, 1]")
+        return fixed
 
     def error(self, name: str | None, message: str) -> WbtSyntaxError:
         line, col = self.node.field_pos.get(name, (self.node.line, self.node.col)) if name else (self.node.line, self.node.col)
@@ -115,6 +175,37 @@ class Fields:
         return [tuple(flat[i:i + width]) for i in range(0, len(flat), width)]
 
 
+def _projection(f: Fields) -> str:
+    """A Camera's or RangeFinder's projection; an unknown one is planar (WbAbstractCamera::updateProjection)."""
+    projection = f.string("projection", "planar")
+    if projection not in ("planar", "spherical", "cylindrical"):
+        projection = f.used("projection", projection, "planar", "is not planar, spherical or cylindrical")
+    return projection
+
+
+def _field_of_view(f: Fields, projection: str, default: float) -> float:
+    """A camera's, range finder's or lidar's fieldOfView: a non-positive one, or one over pi with a
+    planar projection, is 0.7854 (WbAbstractCamera::updateFieldOfView)."""
+    fov = f.positive("fieldOfView", default, 0.7854)
+    if projection == "planar" and fov > math.pi:
+        fov = f.used("fieldOfView", fov, 0.7854, "is > pi with a planar projection")
+    return fov
+
+
+def _max_range(f: Fields, min_range: float, default: float) -> float:
+    """A lidar's maxRange: one not above minRange is minRange + 1 (WbLidar::updateMaxRange)."""
+    max_range = f.num("maxRange", default)
+    if max_range <= min_range:
+        max_range = f.used("maxRange", max_range, min_range + 1.0, f"is not > minRange {min_range:g}")
+    return max_range
+
+
+def _positive_int(f: Fields, name: str, default: int, reset: int) -> int:
+    """An SFInt32 that must be > 0 (else ``reset``, told as ``Fields.positive``)."""
+    value = f.integer(name, default)
+    return int(f.positive(name, default, reset)) if value <= 0 else value
+
+
 def _show(v: Any) -> str:
     if isinstance(v, Node):
         return f"a {v.type} node"
@@ -135,9 +226,13 @@ def light(node: Node, f: Fields) -> dict:
                            "on": f.flag("on", True),
                            "cast_shadows": f.flag("castShadows", False)}
     if node.type != "DirectionalLight":
-        out["attenuation"] = list(f.vec("attenuation", (1.0, 0.0, 0.0)))
+        attenuation = f.vec("attenuation", (1.0, 0.0, 0.0))
+        if min(attenuation) < 0:     # Webots makes it 0 0 0 (WbPointLight::updateAttenuation): no finite light
+            raise f.error("attenuation", f"{resets.shown(attenuation)} has a negative component: Webots resets it to "
+                                         "0 0 0, an infinite irradiance, which is refused here (1 0 0 is no attenuation)")
+        out["attenuation"] = list(attenuation)
         out["location"] = list(f.vec("location", (0.0, 0.0, 0.0)))
-        out["radius"] = f.num("radius", 100.0)
+        out["radius"] = f.non_negative("radius", 100.0, 0.0)      # WbPointLight/WbSpotLight::updateRadius
     if node.type != "PointLight":
         out["direction"] = list(f.vec("direction", (0.0, 0.0, -1.0)))
     if node.type == "SpotLight":
@@ -156,55 +251,67 @@ def device(node: Node, f: Fields) -> dict:
                 "resolution": f.num("resolution", -1.0), "red_color_sensitivity": f.num("redColorSensitivity", 1.0)}
     if t == "LightSensor":
         return {"device": t, "lookup_table": [list(r) for r in f.rows("lookupTable", 3, [(0.0, 0.0, 0.0), (1.0, 1000.0, 0.0)])],
-                "color_filter": list(f.vec("colorFilter", (1.0, 1.0, 1.0))), "occlusion": f.flag("occlusion", False),
+                "color_filter": list(f.color("colorFilter", (1.0, 1.0, 1.0))), "occlusion": f.flag("occlusion", False),
                 "resolution": f.num("resolution", -1.0)}
+    # Webots' resets (WbAbstractCamera, WbLidar, WbRangeFinder, WbCamera, WbRenderingDevice update
+    # functions): a non-positive near or minRange is 0.01, a negative noise 0, ...
     if t == "Lidar":
+        projection = f.string("projection", "cylindrical")
+        lidar_type = f.string("type", "fixed")
+        if lidar_type.lower() not in ("fixed", "rotating"):       # WbLidar::updateType
+            lidar_type = f.used("type", lidar_type, "fixed", "is neither fixed nor rotating")
+        vertical = f.positive("verticalFieldOfView", 0.2, 0.1)   # WbLidar::updateVerticalFieldOfView
+        if vertical > math.pi:
+            vertical = f.used("verticalFieldOfView", vertical, math.pi, "is > pi")
+        min_range = f.positive("minRange", 0.01, 0.01)
+        min_frequency = f.positive("minFrequency", 1.0, 0.01)
         return {"device": t, "tilt_angle": f.num("tiltAngle", 0.0),
-                "horizontal_resolution": f.integer("horizontalResolution", 512),
-                "field_of_view": f.num("fieldOfView", 1.5708),
-                "vertical_field_of_view": f.num("verticalFieldOfView", 0.2),
-                "number_of_layers": f.integer("numberOfLayers", 4), "near": f.num("near", 0.01),
-                "min_range": f.num("minRange", 0.01), "max_range": f.num("maxRange", 1.0),
-                "type": f.string("type", "fixed"), "projection": f.string("projection", "cylindrical"),
-                "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0),
-                "default_frequency": f.num("defaultFrequency", 10.0), "min_frequency": f.num("minFrequency", 1.0),
-                "max_frequency": f.num("maxFrequency", 25.0)}
+                "horizontal_resolution": _positive_int(f, "horizontalResolution", 512, 1),
+                "field_of_view": _field_of_view(f, projection, 1.5708), "vertical_field_of_view": vertical,
+                "number_of_layers": _positive_int(f, "numberOfLayers", 4, 1), "near": f.positive("near", 0.01, 0.01),
+                "min_range": min_range, "max_range": _max_range(f, min_range, 1.0),
+                "type": lidar_type, "projection": projection,
+                "noise": f.non_negative("noise", 0.0, 0.0), "resolution": f.num("resolution", -1.0),
+                "default_frequency": f.positive("defaultFrequency", 10.0, min_frequency), "min_frequency": min_frequency,
+                "max_frequency": f.positive("maxFrequency", 25.0, min_frequency)}
     if t == "RangeFinder":
-        projection = f.string("projection", "planar")
+        projection = _projection(f)
         if f.flag("spherical", False) and projection == "planar":    # deprecated in R2023 (WbRangeFinder::init)
             projection = "cylindrical"
-        return {"device": t, "field_of_view": f.num("fieldOfView", 0.785398), "width": f.integer("width", 64),
-                "height": f.integer("height", 64), "projection": projection, "near": f.num("near", 0.01),
-                "min_range": f.num("minRange", 0.01), "max_range": f.num("maxRange", 1.0),
-                "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
+        return {"device": t, "field_of_view": _field_of_view(f, projection, 0.785398),
+                "width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1),
+                "projection": projection, "near": f.positive("near", 0.01, 0.01),
+                "min_range": f.positive("minRange", 0.01, 0.01), "max_range": f.num("maxRange", 1.0),
+                "noise": f.non_negative("noise", 0.0, 0.0), "resolution": f.num("resolution", -1.0)}
     if t == "Camera":
-        projection = f.string("projection", "planar")
+        projection = _projection(f)
         if f.flag("spherical", False) and projection == "planar":    # deprecated in R2023
             projection = "spherical"
-        out = {"device": t, "field_of_view": f.num("fieldOfView", 0.785398), "width": f.integer("width", 64),
-               "height": f.integer("height", 64), "projection": projection, "near": f.num("near", 0.01),
-               "far": f.num("far", 0.0), "exposure": f.num("exposure", 1.0),
-               "anti_aliasing": f.flag("antiAliasing", False), "noise": f.num("noise", 0.0)}
+        out = {"device": t, "field_of_view": _field_of_view(f, projection, 0.785398),
+               "width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1),
+               "projection": projection, "near": f.positive("near", 0.01, 0.01),
+               "far": f.non_negative("far", 0.0, 0.0), "exposure": f.non_negative("exposure", 1.0, 1.0),
+               "anti_aliasing": f.flag("antiAliasing", False), "noise": f.non_negative("noise", 0.0, 0.0)}
         rec = f.node_("recognition")
         if rec is not None:
-            rf = Fields(rec, f.source)
+            rf = f.sub(rec)
             out["recognition"] = {"max_range": rf.num("maxRange", 100.0), "max_objects": rf.integer("maxObjects", -1),
-                                  "occlusion": rf.integer("occlusion", 1), "frame_color": list(rf.vec("frameColor", (1.0, 0.0, 0.0))),
+                                  "occlusion": rf.integer("occlusion", 1), "frame_color": list(rf.color("frameColor", (1.0, 0.0, 0.0))),
                                   "frame_thickness": rf.integer("frameThickness", 1),
                                   "segmentation": rf.flag("segmentation", False)}
         return out
     if t == "PositionSensor":
         return {"device": t, "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
     if t == "LED":
-        colours = f.rows("color", 3, [(1.0, 0.0, 0.0)])
+        colours = f.colors("color", [(1.0, 0.0, 0.0)])
         return {"device": t, "color": [list(c) for c in colours], "gradual": f.flag("gradual", False)}
     raise AssertionError(t)
 
 
 def pen(f: Fields) -> dict:
     """A Pen's fields in the world format's names (Webots' defaults; its colour clamped to [0, 1]
-    as an SFColor is, its density left to the loader's Webots clamping)."""
-    colour = [min(max(c, 0.0), 1.0) for c in f.vec("inkColor", (0.0, 0.0, 0.0))]
+    as an SFColor is, with a warning; its density left to the loader's Webots clamping)."""
+    colour = list(f.color("inkColor", (0.0, 0.0, 0.0)))
     return {"ink_color": colour, "ink_density": f.num("inkDensity", 0.5), "lead_size": max(f.num("leadSize", 0.002), 0.0),
             "max_distance": f.num("maxDistance", 0.0), "write": f.flag("write", True)}
 
@@ -216,7 +323,7 @@ DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light senso
 
 # ---------------------------------------------------------------- appearance
 
-def appearance(node: Node | None, source: str, warn, resolve=None) -> dict | None:
+def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset | None = None) -> dict | None:
     """Appearance / PBRAppearance → the world format's appearance (what infra-red sensors read).
 
     As Webots' pickColor: a PBRAppearance is ``baseColor × (1 − transparency)`` times its
@@ -226,13 +333,16 @@ def appearance(node: Node | None, source: str, warn, resolve=None) -> dict | Non
     that cannot be loaded here (missing file, not PNG/JPEG, webots:// or remote url) is noted with
     ``warn(node, "texture: <why>")`` and read as Webots reads a texture it could not load.
     ``resolve(node, url) -> (url or None, why)``: where a url of a PROTO file or ``webots://`` is
-    (the converter's asset resolution); without it urls are relative to ``source``."""
+    (the converter's asset resolution); without it urls are relative to ``source``. Values Webots
+    resets (a colour outside [0, 1], a transparency or roughness outside [0, 1]) are reset as there,
+    ``reset`` told of each (``Fields``)."""
     if node is None:
         return None
-    f = Fields(node, source)
-    if node.type == "PBRAppearance":
-        out: dict[str, Any] = {"base_color": list(f.vec("baseColor", (1.0, 1.0, 1.0))),
-                               "transparency": f.num("transparency", 0.0), "roughness": f.num("roughness", 0.0)}
+    f = Fields(node, source, reset)
+    if node.type == "PBRAppearance":     # WbPbrAppearance::sanitizeFields: 0 for either outside [0, 1]
+        out: dict[str, Any] = {"base_color": list(f.color("baseColor", (1.0, 1.0, 1.0))),
+                               "transparency": f.within("transparency", 0.0, 0.0, 1.0, 0.0),
+                               "roughness": f.within("roughness", 0.0, 0.0, 1.0, 0.0)}
         base = image_texture(f.node_("baseColorMap"), source, warn, resolve)
         if base is not None:
             out["texture"] = base
@@ -247,10 +357,11 @@ def appearance(node: Node | None, source: str, warn, resolve=None) -> dict | Non
         texture = image_texture(f.node_("texture"), source, warn, resolve)
         out = {"base_color": [1.0, 1.0, 1.0]}
         if material is not None:
-            m = Fields(material, source)
+            m = f.sub(material)        # WbMaterial::updateTransparency: 0.5 for one outside [0, 1]
+            diffuse = m.color("diffuseColor", (0.8, 0.8, 0.8))
             if texture is None:
-                out["base_color"] = list(m.vec("diffuseColor", (0.8, 0.8, 0.8)))
-            out["transparency"] = m.num("transparency", 0.0)
+                out["base_color"] = list(diffuse)
+            out["transparency"] = m.within("transparency", 0.0, 0.0, 1.0, 0.5)
         if texture is not None:
             out["texture"] = texture
             _texture_transform(f, source, out)
