@@ -171,11 +171,27 @@ def test_bad_strings_are_refused_with_one_line_and_nothing_changes(text, expecte
 
 
 def test_a_value_webots_resets_is_reset_on_import_as_in_a_world_file():
-    """A node string reads as a .wbt world does: a Box size Webots resets is 1 1 1 (world/wbt/resets.py)."""
+    """A node string reads as a .wbt world does: a Box size Webots resets is 1 1 1 (world/wbt/resets.py),
+    and the server's log says so once, placed in the string (Webots prints it in its console)."""
     lv = _live()
+    logged: list[str] = []
+    lv.core.log = logged.append
     imports(lv, 'Solid { name "odd" children [ Shape { geometry Box { size 1 -1 1 } } ] }')
     (odd,) = [s for s in lv.sim.world.solids if s.name == "odd"]
     assert odd.shapes[0].geometry.size == (1.0, 1.0, 1.0)
+    assert logged == ["robot 'boss': import_node_from_string: node string:1:54: Box.size: 1 -1 1 has a component "
+                      "that is not > 0; using 1 1 1 (as Webots does)"]
+    imports(lv, 'Solid { name "fine" children [ Shape { geometry Box { size 1 1 1 } } ] }')
+    assert len(logged) == 1                 # a string with nothing to correct logs nothing
+
+
+def test_in_process_imports_give_their_corrections():
+    sim = _live().sim
+    corrected: list[str] = []
+    sim.import_nodes('Solid { name "ball" children [ Shape { geometry Sphere { radius 0 } } ] }', corrected)
+    assert corrected == ["node string:1:58: Sphere.radius: 0 is not > 0; using 1 (as Webots does)"]
+    (ball,) = [s for s in sim.world.solids if s.name == "ball"]
+    assert ball.shapes[0].geometry.radius == 1.0
 
 
 def test_only_the_roots_children_take_nodes():

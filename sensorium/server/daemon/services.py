@@ -710,9 +710,12 @@ class Core(DeviceServices):
     def _supervisor(self, item: str, c: Call) -> dict:
         """Every Supervisor service: :data:`supervisor.HANDLERS` (ValueError → INVALID_ARGUMENT)."""
         try:
-            return supervisor.HANDLERS[item](self.sim, self.lockstep, c.robot, c.args)
+            out = supervisor.HANDLERS[item](self.sim, self.lockstep, c.robot, c.args)
         except ValueError as exc:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{item}: {exc}") from None
+        for line in out.pop(supervisor.LOG, ()):
+            self.log_error(f"robot {c.robot!r}: {item}: {line}")
+        return out
 
 
 def _ackermann(robot: Any) -> dict | None:

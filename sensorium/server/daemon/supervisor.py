@@ -331,26 +331,35 @@ def insert_index(position: int, count: int) -> int:
     return min(max(index, 0), count)
 
 
-def import_nodes(sim: Any, node: Node, field: str, position: int, text: str) -> list[int]:
+def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
+                 warnings: list[str] | None = None) -> list[int]:
     """Webots' ``importMFNodeFromString`` on the root's ``children``: the string's solids and
     lights join the world from the next measurement, inserted at ``position`` (Webots' rule,
     :func:`insert_index`); returns their new ids. Any other field is refused (Sensorium's nodes
-    have no other MFNode field); a string that cannot be imported changes nothing (one line)."""
+    have no other MFNode field); a string that cannot be imported changes nothing (one line).
+    ``warnings`` gets the values corrected as Webots corrects them (Webots prints them in its console)."""
     if node.id != 0 or field != "children":
         what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
         raise ValueError(f"field {field!r} of {what}: nodes are imported into the root's 'children' only here")
     current = [n.id for n in root_children(sim)]
     index = insert_index(position, len(current))
-    added = [node_id for _, _, node_id in sim.import_nodes(text)]
+    added = [node_id for _, _, node_id in sim.import_nodes(text, warnings)]
     sim.root_order = current[:index] + added + current[index:]
     return added
 
 
 def _import(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    corrected: list[str] = []
     try:                         # ImportRefused is a ValueError: one line, nothing changed
-        return {"value": import_nodes(sim, node_by_id(sim, a.node), a.field, a.position, a.node_string)}
+        added = import_nodes(sim, node_by_id(sim, a.node), a.field, a.position, a.node_string, corrected)
+        return {"value": added, LOG: corrected}
     except (KeyError, OSError, RecursionError) as exc:     # never a traceback for a controller's string
         raise ValueError(f"the node string cannot be imported: {exc}") from None
+
+
+LOG = "log"
+"""A handler's reply may carry lines for the server's log under this key (the core logs and drops
+them): what Webots would print in its console, e.g. an imported node's corrected values."""
 
 
 def _reset(sim: Any, ls: Any, robot: str, a: Any) -> dict:

@@ -22,7 +22,7 @@ from typing import Any
 
 from sensorium.schemas import world as wm
 from sensorium.server.world.limits import ProtoLimits, WorldLimits
-from sensorium.server.world.loader import LoadedWorld, WorldError, _wbt_problem, parse_world
+from sensorium.server.world.loader import LoadedWorld, WorldError, _wbt_problem, _wbt_warning, parse_world
 from sensorium.server.world.wbt.convert import Converter, Owner, strip_origins
 from sensorium.server.world.wbt.frames import Frame
 from sensorium.server.world.wbt.parser import (
@@ -108,11 +108,14 @@ def _syntax(exc: WbtSyntaxError, source: str) -> ImportRefused:
 
 
 def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: set[str], limits: WorldLimits,
-                     allow_outside_meshes: bool = False, protos: _WorldProtos | None = None) -> list[ImportedNode]:
+                     allow_outside_meshes: bool = False, protos: _WorldProtos | None = None,
+                     warnings: list[str] | None = None) -> list[ImportedNode]:
     """The nodes of ``text`` as world models, in order (``ImportRefused`` for anything that is not
     imported). ``taken``: every solid name the world has had (removed ones included: names are
     never reused); ``limits``: the world's (the string alone stays within them; what it adds to
-    the world is checked by the caller)."""
+    the world is checked by the caller). ``warnings``: given, it gets one line per value corrected
+    as Webots corrects it (a ``Sphere { radius 0 }`` gets radius 1, as in a world file), placed in
+    the string."""
     if not isinstance(text, str):
         raise ImportRefused(f"the node string must be a string, got {type(text).__name__}")
     size = len(text.encode("utf-8", errors="surrogatepass"))
@@ -131,13 +134,14 @@ def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: 
         if not wbt.nodes:
             raise ImportRefused(f"{LABEL}: no node in it (e.g. 'Solid {{ ... }}')")
         wbt = WbtFile(protos.version, wbt.nodes, [], source, list(protos.declarations))
-        return _convert(wbt, source, loaded, world, taken, limits, proto_limits, allow_outside_meshes)
+        return _convert(wbt, source, loaded, world, taken, limits, proto_limits, allow_outside_meshes,
+                        [] if warnings is None else warnings)
     except WbtSyntaxError as exc:           # ProtoError too: in the string or a PROTO file
         raise _syntax(exc, source) from None
 
 
 def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, taken: set[str], limits: WorldLimits,
-             proto_limits: ProtoLimits, allow_outside_meshes: bool) -> list[ImportedNode]:
+             proto_limits: ProtoLimits, allow_outside_meshes: bool, warnings: list[str]) -> list[ImportedNode]:
     from sensorium.server.world.proto import ProtoSearch, expand
 
     expansion = expand(wbt, ProtoSearch.create(loaded.base_dir), proto_limits)
@@ -169,8 +173,9 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     data = strip_origins({"solids": conv.world["solids"], "lights": conv.world["lights"]}, "", origin)
     data["world_info"] = {"coordinate_system": world.world_info.coordinate_system}
     try:
-        fragment = parse_world(data, source=LABEL, base_dir=loaded.base_dir, limits=limits,
-                               allow_outside_meshes=allow_outside_meshes, asset_files=conv.asset_files).world
+        parsed = parse_world(data, source=LABEL, base_dir=loaded.base_dir, limits=limits,
+                             allow_outside_meshes=allow_outside_meshes, asset_files=conv.asset_files)
+        fragment = parsed.world
     except WorldError as exc:
         first = _wbt_problem(exc.problems[0], origin)
         more = f" (and {len(exc.problems) - 1} more)" if len(exc.problems) > 1 else ""
@@ -179,6 +184,8 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
         else:
             where = f"{LABEL}: {first.path}" if first.path else LABEL
         raise ImportRefused(f"{where}: {_shown(first.message, source)}{more}") from None
+    warnings += [_shown(w, source) for w in conv.warnings]
+    warnings += [_wbt_warning(w, origin, LABEL) for w in parsed.warnings]
     queue: Counter[str] = Counter()
     out = []
     for kind in kinds:

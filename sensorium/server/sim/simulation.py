@@ -357,12 +357,13 @@ class Simulation:
         solids and top-level lights, removed ones included), so no id is ever reused."""
         return 1 + len(self.robots) + len(self.scene.solid_names) + len(self.scene.top_lights())
 
-    def import_nodes(self, text: str) -> list[tuple[str, str | int, int]]:
+    def import_nodes(self, text: str, warnings: list[str] | None = None) -> list[tuple[str, str | int, int]]:
         """Webots' ``importMFNodeFromString`` into the root's children: the string's nodes (solids,
         PROTO instances that are solids, lights; sim/imports.py) join the world, in order, from the
         next measurement (every ray kind, kinematic contact, light sensors, cameras' recognition).
         Returns each as (node type, key: solid name or top-level light index, Supervisor id). A
-        string that cannot be imported raises ``ImportRefused`` (one line) and nothing changes."""
+        string that cannot be imported raises ``ImportRefused`` (one line) and nothing changes.
+        ``warnings``: given, it gets one line per value corrected as Webots corrects it."""
         from sensorium.server.sim.imports import check_additions, read_node_string, world_protos
         from sensorium.server.world.geometry import triangle_count
         from sensorium.server.world.limits import ProtoLimits
@@ -370,7 +371,8 @@ class Simulation:
         if self._import_protos is None:
             self._import_protos = world_protos(self.loaded, ProtoLimits.matching(self.limits))
         nodes = read_node_string(text, self.loaded, self.world, taken=set(self.scene.solid_names), limits=self.limits,
-                                 allow_outside_meshes=self.allow_outside_meshes, protos=self._import_protos)
+                                 allow_outside_meshes=self.allow_outside_meshes, protos=self._import_protos,
+                                 warnings=warnings)
         prepared = [self.scene.solid_entries(n.model) if n.type == "Solid" else None for n in nodes]
         added = sum(triangle_count(e.primitive) for p in prepared if p is not None for e in p[1])
         check_additions(self.world, set(self.scene.solid_poses), len(self.scene.world_lights()),

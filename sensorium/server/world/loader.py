@@ -264,11 +264,7 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
                              allow_outside_meshes=allow_outside_meshes, asset_files=conv.asset_files)
     except WorldError as exc:
         raise WorldError(source, [_wbt_problem(p, origin) for p in exc.problems]) from None
-    placed = []
-    for w in loaded.warnings:   # sanitising warnings start with the converted path: add the .wbt line
-        where, _, message = w.partition(": ")
-        at = _origin_of(where, origin)
-        placed.append(f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w)
+    placed = [_wbt_warning(w, origin, source) for w in loaded.warnings]
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
                        warnings=[*warnings, *placed], losses=conv.losses, asset_files=conv.asset_files,
                        timings={**conv.timings, "validate": time.perf_counter() - t0})
@@ -283,6 +279,14 @@ def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int,
         cut = max(key.rfind("."), key.rfind("["))
         key = key[:cut] if cut > 0 else ""
     return None
+
+
+def _wbt_warning(w: str, origin: dict[str, tuple[int, int, str]], source: str) -> str:
+    """A warning of the converted world (the loader's resets start with the converted path),
+    placed at the .wbt node it came from."""
+    where, _, message = w.partition(": ")
+    at = _origin_of(where, origin)
+    return f"{source}:{at[0]}:{at[1]}: {at[2]} ({where}): {message}" if at else w
 
 
 def _wbt_problem(p: Problem, origin: dict[str, tuple[int, int, str]]) -> Problem:
