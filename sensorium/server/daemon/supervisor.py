@@ -200,6 +200,8 @@ def _set_light(attr: str, kind: str) -> Setter:
                              f"(|coordinate| <= {MAX_COORDINATE_M:g} m)")
         try:
             changed = type(model).model_validate({**model.model_dump(), attr: value})
+            if attr == "direction" and kind == "SpotLight":    # the new direction, in world axes, for light
+                changed = changed.model_copy(update={"light_sensor_direction": None})   # sensors as for cameras
         except ValidationError as e:
             raise ValueError(f"{kind} {attr}: {e.errors()[0]['msg'].removeprefix('Value error, ')}") from None
         if kind == "SpotLight" and changed.beam_width > changed.cut_off_angle:
