@@ -76,30 +76,55 @@ def _batched(lw: LoadedWorld, robot: str = "probe", name: str = "ls", copies: in
     return bs.value(ref)
 
 
-def test_wbt_spot_light_in_two_rotated_poses_light_sensor_turns_it_by_the_inner_pose_only(tmp_path: Path):
-    """Pose (translation 0 0 1, Rx 90) > Pose (translation 0 0.5 0, Ry 90) > SpotLight: the light stands
-    at (0, 0, 1.5) (both frames' translations and rotations compose for the location); the probe's
-    sensor reads the down-aimed spot's falloff value, not 0 (the composed axis, sideways, would leave
-    it outside the cone). Cameras get the composed axis (+y). Single and batched read the same."""
-    lw = _wbt(tmp_path, f"""
+NESTINGS = {
+    "Pose > Pose": f"""
 Pose {{
   translation 0 0 1
   rotation 1 0 0 {HALF_PI!r}
   children [ Pose {{ translation 0 0.5 0 rotation 0 1 0 {HALF_PI!r} children [ {SPOT_WBT} ] }} ]
-}}
-{PROBE_WBT}""")
-    spot = lw.world.lights[0]
-    np.testing.assert_allclose(spot.location, (0.0, 0.0, 1.5), atol=1e-15)
-    np.testing.assert_allclose(spot.direction, (0.0, 1.0, 0.0), atol=1e-15)                # cameras: Rx Ry d
-    np.testing.assert_allclose(spot.light_sensor_direction, (0.0, 0.0, -1.0), atol=1e-15)  # sensors: Ry d
-    want = _expected_down_spot()
-    assert _single(lw) == pytest.approx(want, rel=1e-12)
-    np.testing.assert_allclose(_batched(lw), [want, want], rtol=1e-12)
+}}""",
+    "Solid > Pose": f"""
+Solid {{
+  translation 0 0 1
+  rotation 1 0 0 {HALF_PI!r}
+  children [ Pose {{ translation 0 0.5 0 rotation 0 1 0 {HALF_PI!r} children [ {SPOT_WBT} ] }} ]
+}}""",
+    "Solid > Solid": f"""
+Solid {{
+  translation 0 0 1
+  rotation 1 0 0 {HALF_PI!r}
+  children [ Solid {{ translation 0 0.5 0 rotation 0 1 0 {HALF_PI!r} name "inner" children [ {SPOT_WBT} ] }} ]
+}}""",
+    "Solid > Pose > Solid": f"""
+Solid {{
+  translation 0 0 1
+  rotation 1 0 0 {HALF_PI!r}
+  children [ Pose {{ translation 0 0.5 0 rotation 1 0 0 0.3 children [
+    Solid {{ rotation 0 1 0 {HALF_PI!r} name "inner" children [ {SPOT_WBT} ] }} ] }} ]
+}}""",
+}
+# the cameras' axis: Rx(90 deg) Ry(90 deg) +x = +y; with the middle Pose's Rx(0.3): Rx(90 deg + 0.3) -z
+CAMERA_AXIS = {name: (0.0, 1.0, 0.0) for name in NESTINGS} | {"Solid > Pose > Solid": (0.0, math.cos(0.3), math.sin(0.3))}
+
+
+@pytest.mark.parametrize("nesting", list(NESTINGS))
+def test_wbt_spot_light_in_two_turned_frames_light_sensor_turns_it_by_the_nearest_pose_only(tmp_path: Path,
+                                                                                          nesting: str):
+    """Outer frame (translation 0 0 1, Rx 90) > inner (translation 0 0.5 0, Ry 90; the nearest Pose or
+    Solid of the light; or a Pose (translation 0 0.5 0, Rx 0.3) > Solid (Ry 90)) > SpotLight: the light stands at (0, 0, 1.5) (both frames' translations and
+    rotations compose for the location); the probe's sensor reads the down-aimed spot's falloff value,
+    not 0 (the composed axis, sideways, would leave it outside the cone). Cameras get the composed axis
+    (+y). Single and batched read the same."""
+    lw = _wbt(tmp_path, NESTINGS[nesting] + PROBE_WBT)
     s = Simulation(lw)
     (cam,) = s.scene.world_lights()
     (sen,) = s.scene.sensor_lights()
-    np.testing.assert_allclose(cam.direction, (0.0, 1.0, 0.0), atol=1e-15)
-    np.testing.assert_allclose(sen.direction, (0.0, 0.0, -1.0), atol=1e-15)
+    np.testing.assert_allclose(cam.location, (0.0, 0.0, 1.5), atol=1e-15)
+    np.testing.assert_allclose(cam.direction, CAMERA_AXIS[nesting], atol=1e-15)    # cameras: every frame
+    np.testing.assert_allclose(sen.direction, (0.0, 0.0, -1.0), atol=1e-15)   # light sensors: Ry d
+    want = _expected_down_spot()
+    assert _single(lw) == pytest.approx(want, rel=1e-12)
+    np.testing.assert_allclose(_batched(lw), [want, want], rtol=1e-12)
 
 
 def test_wbt_spot_light_in_one_pose_needs_no_sensor_axis(tmp_path: Path):
