@@ -376,3 +376,31 @@ Pose {{
     supervisor.set_field(sim, node, "direction", [0.0, 0.0, -1.0])
     sim.step()
     assert ls.value == pytest.approx(want, rel=1e-12)
+
+
+def test_a_supervisor_keeps_ambient_intensity_and_attenuation_exclusive():
+    """WbPointLight/WbSpotLight::checkAmbientAndAttenuationExclusivity runs on every change of either
+    field: a new attenuation other than 1 0 0 sets the ambient intensity to 0 (the probe, behind which
+    the light stands, then reads 0 instead of the ambient 0.5); an ambient intensity set while the
+    attenuation is not 1 0 0 is reset by Webots, refused here (one line) as other resets are."""
+    from sensorium.server.daemon import supervisor
+
+    sim = Simulation(from_model(_probe_world([
+        {"type": "PointLight", "name": "p", "location": [-1, 0, 0.1], "ambient_intensity": 0.5},
+        {"type": "SpotLight", "name": "s", "location": [-1, 0, 0.1], "attenuation": [0, 0, 1]}])))
+    ls = sim.robot("probe").device("ls")
+    ls.enable(8)
+    sim.step()
+    assert ls.value == pytest.approx(0.5, rel=1e-12)
+    p, s = supervisor.find_node(sim, "p"), supervisor.find_node(sim, "s")
+    supervisor.set_field(sim, p, "attenuation", [0.0, 0.0, 1.0])
+    assert supervisor.get_field(sim, p, "ambientIntensity")["value"] == 0.0
+    sim.step()
+    assert ls.value == 0.0
+    with pytest.raises(ValueError, match=r"SpotLight ambient_intensity: must be 0 while attenuation is not 1 0 0"):
+        supervisor.set_field(sim, s, "ambientIntensity", 0.3)
+    assert supervisor.get_field(sim, s, "ambientIntensity")["value"] == 0.0
+    supervisor.set_field(sim, s, "attenuation", [1.0, 0.0, 0.0])
+    supervisor.set_field(sim, s, "ambientIntensity", 0.3)           # allowed again: attenuation 1 0 0
+    sim.step()
+    assert ls.value == pytest.approx(0.3, rel=1e-12)

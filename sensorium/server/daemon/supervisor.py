@@ -208,6 +208,14 @@ def _set_light(attr: str, kind: str) -> Setter:
             if attr == "beam_width":      # Webots resets it to the cut-off with a warning: refused, as other ranges
                 raise ValueError(f"{kind} {attr}: must be <= cut_off_angle ({changed.cut_off_angle}), got {value}")
             changed = changed.model_copy(update={"beam_width": changed.cut_off_angle})   # WbSpotLight: silently
+        if kind in ("PointLight", "SpotLight") and changed.ambient_intensity != 0.0 \
+                and tuple(changed.attenuation) != (1.0, 0.0, 0.0):
+            # checkAmbientAndAttenuationExclusivity: Webots sets the ambient intensity to 0 (a warning); the
+            # ambient intensity set itself is refused, as other resets; a new attenuation zeroes it
+            if attr == "ambient_intensity":
+                raise ValueError(f"{kind} {attr}: must be 0 while attenuation is not 1 0 0 (Webots' rule), "
+                                 f"got {value}")
+            changed = changed.model_copy(update={"ambient_intensity": 0.0})
         sim.scene.set_top_light(node.key, changed)
     return setter
 
