@@ -380,8 +380,18 @@ class SpotLight(_Attenuated):
     beam_width: float = Field(default=1.570796, description=_range_doc("beam_width") + "; above cut_off_angle: "
                               "set to it with a warning")
     cut_off_angle: float = Field(default=0.785398, description=_range_doc("cut_off_angle"))
+    light_sensor_direction: Vec3 | None = Field(
+        default=None, description="the beam axis light sensors use, in world axes, fixed (Webots' LightSensor turns "
+        "`direction` by the own rotation of the nearest enclosing Pose or Solid only, cameras by every enclosing "
+        "frame); unset: `direction` placed as cameras see it, except a light of a nested solid (`children`): "
+        "`direction` turned by that solid's own pose rotation. The .wbt import sets it for a spot light inside Poses")
 
     _nonzero = field_validator("direction")(_nonzero_direction)
+
+    @field_validator("light_sensor_direction")
+    @classmethod
+    def _sensor_axis(cls, v: Vec3 | None) -> Vec3 | None:
+        return None if v is None else _nonzero_direction(v)
 
 
 class DirectionalLight(_Light):

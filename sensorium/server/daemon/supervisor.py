@@ -200,12 +200,22 @@ def _set_light(attr: str, kind: str) -> Setter:
                              f"(|coordinate| <= {MAX_COORDINATE_M:g} m)")
         try:
             changed = type(model).model_validate({**model.model_dump(), attr: value})
+            if attr == "direction" and kind == "SpotLight":    # the new direction, in world axes, for light
+                changed = changed.model_copy(update={"light_sensor_direction": None})   # sensors as for cameras
         except ValidationError as e:
             raise ValueError(f"{kind} {attr}: {e.errors()[0]['msg'].removeprefix('Value error, ')}") from None
         if kind == "SpotLight" and changed.beam_width > changed.cut_off_angle:
             if attr == "beam_width":      # Webots resets it to the cut-off with a warning: refused, as other ranges
                 raise ValueError(f"{kind} {attr}: must be <= cut_off_angle ({changed.cut_off_angle}), got {value}")
             changed = changed.model_copy(update={"beam_width": changed.cut_off_angle})   # WbSpotLight: silently
+        if kind in ("PointLight", "SpotLight") and changed.ambient_intensity != 0.0 \
+                and tuple(changed.attenuation) != (1.0, 0.0, 0.0):
+            # checkAmbientAndAttenuationExclusivity: Webots sets the ambient intensity to 0 (a warning); the
+            # ambient intensity set itself is refused, as other resets; a new attenuation zeroes it
+            if attr == "ambient_intensity":
+                raise ValueError(f"{kind} {attr}: must be 0 while attenuation is not 1 0 0 (Webots' rule), "
+                                 f"got {value}")
+            changed = changed.model_copy(update={"ambient_intensity": 0.0})
         sim.scene.set_top_light(node.key, changed)
     return setter
 

@@ -1,8 +1,11 @@
 """LightSensor irradiance (spec §2.2) — pure math, world frame, float64.
 
 The simulation builds one :class:`LightArrays` from every light that is ON (lights that are off
-contribute nothing, not even ambient), with positions and directions already in world coordinates
-(the SpotLight ``direction`` rotated as spec §2.2 says). For a sensor at ``p`` with normal ``N``
+contribute nothing, not even ambient), with positions and directions already in world coordinates.
+A SpotLight's axis depends on the consumer, as in Webots: light sensors get it turned by the nearest
+enclosing Pose's own rotation only (``WbLightSensor::computeLightMeasurement``;
+``Scene.sensor_lights``), cameras by every enclosing frame (WREN's ``SpotLight::update``;
+``Scene.world_lights``). For a sensor at ``p`` with normal ``N``
 (its local +x axis in world), per light:
 
 * point/spot: ``L = (q - p)/d``, ``d = |q - p|``, ``att = 1/(a1 + a2 d + a3 d²)``;

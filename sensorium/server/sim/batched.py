@@ -201,7 +201,7 @@ class BatchedSimulation:
         base = world.base_dir
         # -- what never moves, once: the solids' scene (static tier, planes), the lights
         self.scene = Scene(w.model_copy(update={"robots": []}), base, precision)
-        self.lights = lights_from_models(self.scene.world_lights())
+        self.lights = lights_from_models(self.scene.sensor_lights())
         # lights carried by robots: each copy's at its robots' poses (batched_lights.py); None without any
         self.carried = CarriedLights(w, self.scene.world_lights()) if any(r.lights for r in w.robots) else None
         n_static = len(self.scene.shapes)

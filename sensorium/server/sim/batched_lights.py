@@ -1,6 +1,6 @@
 """Lights carried by robots in the batched simulation: each copy's at that copy's robot pose.
 
-The single simulation's light arrays (``lights_from_models(scene.world_lights())``) list the world's
+The single simulation's light arrays (``lights_from_models(scene.sensor_lights())``) list the world's
 lights and the solids' (fixed here: the batched simulation never moves a solid), then every robot's
 lights that are on, robot after robot, each placed by ``place_light(model, robot pose ∘ identity)``.
 Copy c's arrays are the same list with copy c's robot poses: the fixed lights shared by every copy,
@@ -9,9 +9,11 @@ identity, then ``location @ R.T + t`` and ``direction @ R.T``, each a matmul of 
 the bits are the single simulation's.
 
 Light sensors take :class:`RowLights`: per sensor row, its copy's positions and directions (the
-math of devices/light.py broadcasts them as it broadcasts shared ones). Cameras shade a copy's rows
-with that copy's :class:`~sensorium.server.devices.light.LightArrays` (:meth:`CarriedLights.arrays`),
-built from the same ``Light`` values as the single camera's.
+math of devices/light.py broadcasts them as it broadcasts shared ones), a spot light's axis as the
+single simulation's ``Scene.sensor_lights`` gives it (``light_sensor_direction``, when set, stays in
+world axes). Cameras shade a copy's rows with that copy's
+:class:`~sensorium.server.devices.light.LightArrays` (:meth:`CarriedLights.arrays`), built from the
+same ``Light`` values as the single camera's (``Scene.world_lights``).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
-from sensorium.server.sim.scene import light_from_model, place_light
+from sensorium.server.sim.scene import for_light_sensors, light_from_model, place_light
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["CarriedLights", "RowLights", "copy_world_lights"]
@@ -48,26 +50,36 @@ class CarriedLights:
 
     def __init__(self, world: wm.World, fixed_models: list):
         on = [m for m in fixed_models if m.on]
-        self._fixed = [light_from_model(m) for m in on]
+        self._fixed = [light_from_model(m) for m in on]                        # as cameras see them
+        sensor_fixed = [light_from_model(for_light_sensors(m)) for m in on]   # as light sensors see them
         carried = [(i, m) for i, r in enumerate(world.robots) for m in r.lights if m.on]
         self._carried = [light_from_model(m) for _, m in carried]
+        sensor_carried = [light_from_model(for_light_sensors(m)) for _, m in carried]
         self.slots = np.array([i for i, _ in carried], dtype=np.int64)
         self.count = len(carried)
         # the carried lights' fields in their robot's frame: which of them move (Webots: a directional
-        # light's direction stays in world axes wherever it is attached)
+        # light's direction stays in world axes wherever it is attached; for light sensors, so does a spot
+        # light's light_sensor_direction)
         self._located = np.array([hasattr(m, "location") for _, m in carried], dtype=bool)
         self._aimed = np.array([m.type == "SpotLight" for _, m in carried], dtype=bool)
+        self._sensor_aimed = np.array([m.type == "SpotLight" and m.light_sensor_direction is None for _, m in carried],
+                                      dtype=bool)
         self._local_pos = np.array([lt.position for lt in self._carried], dtype=np.float64).reshape(-1, 3)
         self._local_dir = np.array([lt.direction for lt in self._carried], dtype=np.float64).reshape(-1, 3)
-        self.shared = light_math.LightArrays.from_lights(self._fixed + self._carried)   # constants (poses aside)
+        self._sensor_dir = np.array([lt.direction for lt in sensor_carried], dtype=np.float64).reshape(-1, 3)
+        # the light sensors' arrays: constants (poses aside)
+        self.shared = light_math.LightArrays.from_lights(sensor_fixed + sensor_carried)
         self.cast_shadows = np.array([bool(m.cast_shadows) for m in on] + [bool(m.cast_shadows) for _, m in carried],
                                      dtype=bool)
         self._oriented = self.shared.kind != light_math.LightKind.POINT
         self._n_fixed = len(self._fixed)
 
-    def placed(self, rot: np.ndarray, pos: np.ndarray, copies: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def placed(self, rot: np.ndarray, pos: np.ndarray, copies: np.ndarray, sensors: bool = False
+               ) -> tuple[np.ndarray, np.ndarray]:
         """The carried lights' positions and raw (unnormalised) directions in the world of each of
-        ``copies`` (k,): (k, m, 3) each, as ``place_light`` gives them for that copy's robot poses."""
+        ``copies`` (k,): (k, m, 3) each, as ``place_light`` gives them for that copy's robot poses
+        (``sensors``: the directions as ``for_light_sensors`` then gives them)."""
+        local_dir, aimed = (self._sensor_dir, self._sensor_aimed) if sensors else (self._local_dir, self._aimed)
         k = len(copies)
         R = rot[copies[:, None], self.slots[None, :]]                 # (k, m, 3, 3)
         t = pos[copies[:, None], self.slots[None, :]]
@@ -75,17 +87,18 @@ class CarriedLights:
         tc = np.matmul(R, _ZERO) + t
         Rt = Rc.transpose(0, 1, 3, 2)
         where = np.broadcast_to(self._local_pos[None, :, None, :], (k, self.count, 1, 3))
-        aim = np.broadcast_to(self._local_dir[None, :, None, :], (k, self.count, 1, 3))
+        aim = np.broadcast_to(local_dir[None, :, None, :], (k, self.count, 1, 3))
         p = np.matmul(where, Rt)[:, :, 0, :] + tc                     # location @ R.T + t (Pose.apply)
         d = np.matmul(aim, Rt)[:, :, 0, :]                            # direction @ R.T (Pose.apply_dirs)
         p = np.where(self._located[None, :, None], p, self._local_pos[None])
-        d = np.where(self._aimed[None, :, None], d, self._local_dir[None])
+        d = np.where(aimed[None, :, None], d, local_dir[None])
         return p, d
 
     def rows(self, rot: np.ndarray, pos: np.ndarray, copies: np.ndarray) -> RowLights:
-        """Every light of each row's copy (``copies``: a copy per row), fixed then carried."""
+        """Every light of each row's copy (``copies``: a copy per row), fixed then carried, as light
+        sensors see them."""
         S = len(copies)
-        p, d = self.placed(rot, pos, copies)
+        p, d = self.placed(rot, pos, copies, sensors=True)
         shared = self.shared
         norm = np.linalg.norm(d, axis=2)                              # LightArrays' normalisation, per row
         d = np.where(self._oriented[None, self._n_fixed:, None],

@@ -3,7 +3,8 @@
 Every top-level solid is one static body (until it is moved) holding its own shapes and those of
 its nested children, poses composed at load time; every robot is one movable body (its body
 shapes). Lights attached to a solid or robot are kept with their local frame and placed in the
-world on demand (``world_lights``). The global shape index returned by the ray engine indexes ``Scene.shapes``, which
+world on demand (``world_lights``; ``sensor_lights`` for light sensors, whose spot axes follow
+Webots' LightSensor rather than its renderer). The global shape index returned by the ray engine indexes ``Scene.shapes``, which
 carries what the devices need: owner robot, and the red channel and roughness infra-red sensors
 read. Textured shapes also have a sampler (``Scene.textures``, world/textures.py; None in a world
 without textures): ``infra_red_terms`` turns hits into the colour terms of Webots' pickColor.
@@ -96,12 +97,35 @@ def solid_parts(solid: wm.Solid, frame: Pose) -> Iterator[tuple[str, Pose, wm.Sh
         yield from solid_parts(child, frame.compose(pose_from_model(child.pose)))
 
 
-def solid_lights(solid: wm.Solid, frame: Pose) -> Iterator[tuple[wm.PointLight | wm.SpotLight | wm.DirectionalLight, Pose]]:
-    """Every light fixed to a solid or its children, with its frame relative to the top solid."""
+def solid_lights(solid: wm.Solid, frame: Pose, nested: bool = False
+                 ) -> Iterator[tuple[wm.PointLight | wm.SpotLight | wm.DirectionalLight, Pose]]:
+    """Every light fixed to a solid or its children, with its frame relative to the top solid. A
+    nested child's spot lights get the axis light sensors use (``sensor_aimed``: its own rotation)."""
+    own = pose_from_model(solid.pose) if nested else None
     for lt in solid.lights:
-        yield lt, frame
+        yield (lt if own is None else sensor_aimed(lt, own)), frame
     for child in solid.children:
-        yield from solid_lights(child, frame.compose(pose_from_model(child.pose)))
+        yield from solid_lights(child, frame.compose(pose_from_model(child.pose)), True)
+
+
+def sensor_aimed(model, own: Pose):
+    """A spot light of a nested solid with the beam axis Webots' LightSensor uses: ``direction``
+    turned by that solid's own rotation only (``WbLightSensor::computeLightMeasurement`` turns it by
+    the nearest enclosing Pose's ``rotation`` field, not by the frames above it; cameras, like
+    Webots' renderer, turn it by all of them: ``place_light``). A light that has the axis already
+    (``light_sensor_direction``, e.g. from a .wbt file) keeps it."""
+    if model.type != "SpotLight" or model.light_sensor_direction is not None:
+        return model
+    aim = tuple(float(v) for v in own.apply_dirs(np.asarray(model.direction)))
+    return model.model_copy(update={"light_sensor_direction": aim})
+
+
+def for_light_sensors(model):
+    """A placed light model (``place_light``) as light sensors see it: a spot light's
+    ``light_sensor_direction``, when it has one, is its direction (world axes, fixed)."""
+    if model.type != "SpotLight" or model.light_sensor_direction is None:
+        return model
+    return model.model_copy(update={"direction": model.light_sensor_direction})
 
 
 def robot_parts(robot: wm.Robot) -> Iterator[tuple[str, Pose, wm.Shape]]:
@@ -115,7 +139,9 @@ def place_light(model, pose: Pose):
     """A light model with ``location``/``direction`` moved from its owner's frame to the world.
 
     A DirectionalLight's direction stays in world axes wherever it is attached (as in Webots, whose
-    renderer ignores a directional light's parent transform)."""
+    renderer ignores a directional light's parent transform). A SpotLight's direction is turned by
+    the whole frame, as Webots' renderer turns it (what cameras see); light sensors read
+    ``for_light_sensors`` of the result."""
     upd: dict = {}
     if hasattr(model, "location"):
         upd["location"] = tuple(float(v) for v in pose.apply(np.asarray(model.location)))
@@ -338,6 +364,11 @@ class Scene:
                 frame = self.robot_poses[owner] if isinstance(owner, int) else self.solid_poses[owner]
                 out.append(place_light(model, frame.compose(local)))
         return out
+
+    def sensor_lights(self) -> list:
+        """``world_lights`` as light sensors see them (``for_light_sensors``: a spot light's axis by
+        Webots' LightSensor rule)."""
+        return [for_light_sensors(m) for m in self.world_lights()]
 
     def top_lights(self) -> list:
         """The world's top-level light models (the world file's ``lights``, in order; the Supervisor's

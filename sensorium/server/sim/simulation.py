@@ -189,7 +189,7 @@ class Simulation:
         self.step_count = 0
         self.scene = Scene(self.world, loaded.base_dir, precision)
         self.ground = Ground.from_world(self.world, self.scene.solid_poses, _TO_ENU[self.world.world_info.coordinate_system])
-        self.lights = lights_from_models(self.scene.world_lights())
+        self.lights = lights_from_models(self.scene.sensor_lights())
         self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
@@ -490,7 +490,7 @@ class Simulation:
         work: list[tuple[Any, list[RayRequest]]] = []
         if lights:
             if self._lights_version != self.scene.lights_version:  # a light moved with its owner
-                self.lights = lights_from_models(self.scene.world_lights())
+                self.lights = lights_from_models(self.scene.sensor_lights())
                 self._lights_version = self.scene.lights_version
             batch = LightBatch(lights, poses, self.lights)
             work.append((batch, batch.plan()))

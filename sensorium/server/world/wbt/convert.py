@@ -663,7 +663,12 @@ class Converter:
         if "location" in data:
             data["location"] = frame.apply(data["location"])
         if node.type == "SpotLight":
-            data["direction"] = [float(v) for v in frame.rotation @ np.asarray(data["direction"])]
+            field = np.asarray(data["direction"])
+            data["direction"] = [float(v) for v in frame.rotation @ field]    # as the renderer turns it
+            if frame.own_rotation is not None:    # WbLightSensor: turned by the nearest Pose's own rotation only
+                aim = [float(v) for v in frame.own_rotation @ field]
+                if owner.kind != "world" or aim != data["direction"]:
+                    data["light_sensor_direction"] = aim
         data["_at"] = self.at(node)
         if owner.kind == "world":
             self.def_name(node, data)
@@ -692,7 +697,9 @@ class Converter:
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
-        self.solid_contents(node, Frame.identity(), mine)
+        # a nested solid's spot lights: a LightSensor turns them by this solid's own rotation (not the Poses above)
+        own = Frame.identity() if owner.kind == "world" else Frame(np.eye(3), np.zeros(3), own_rotation=inner.own_rotation)
+        self.solid_contents(node, own, mine)
         out = self.solid_dict(mine, data)
         out["_at"] = self.at(node)
         if owner.kind == "world":

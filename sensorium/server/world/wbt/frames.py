@@ -56,6 +56,8 @@ class Frame:
     aa: tuple[float, float, float, float] | None = (0.0, 0.0, 1.0, 0.0)
     stretch: np.ndarray | None = None
     webots_scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    own_rotation: np.ndarray | None = None   # the last Pose/Transform/Solid's own rotation (``then``); None
+                                             # at an owner's identity frame (what a LightSensor turns a spot by)
 
     @staticmethod
     def identity() -> Frame:
@@ -91,7 +93,7 @@ class Frame:
             off = stretch - np.diag(np.diag(stretch))
             if not off.any() and stretch[0, 0] == stretch[1, 1] == stretch[2, 2]:
                 s, stretch = s * float(stretch[0, 0]), None
-        return Frame(self.rotation @ r2, t, s, aa, stretch, webots)  # type: ignore[arg-type]
+        return Frame(self.rotation @ r2, t, s, aa, stretch, webots, r2)  # type: ignore[arg-type]
 
     def compose(self, inner: Frame) -> Frame:
         """``inner`` (a rigid frame given relative to this one) in this frame's parent."""
@@ -104,7 +106,7 @@ class Frame:
             aa = None
         local = inner.translation if self.stretch is None else self.stretch @ inner.translation
         t = self.rotation @ (self.scale * local) + self.translation
-        return Frame(self.rotation @ inner.rotation, t, self.scale * inner.scale, aa)
+        return Frame(self.rotation @ inner.rotation, t, self.scale * inner.scale, aa, own_rotation=inner.own_rotation)
 
     def apply(self, p) -> list[float]:
         local = np.asarray(p, dtype=np.float64)
