@@ -578,6 +578,27 @@ def test_c_client_replays_the_conformance_session(cbin, servers):
     assert lines == session["lines"]
 
 
+def test_infinite_velocity_is_clamped_alike_in_process_and_by_both_clients(cbin, servers):
+    """setVelocity(+/-inf): the C and Python clients clamp it to maxVelocity (with Webots' warning,
+    WbMotor::setVelocity's rule); the in-process API raised instead, so the lines the simulation
+    computes for this script (server/sim/conformance.py) could not even be made. Now all three agree,
+    in velocity control and as position control's speed limit."""
+    from sensorium.server.sim import conformance
+
+    script = ["enable", "left encoder", "16", "enable", "right encoder", "16", "enable", "gps", "16",
+              "pos", "left wheel motor", "inf", "pos", "right wheel motor", "inf",
+              "vel", "left wheel motor", "inf", "vel", "right wheel motor", "-inf", "step", "16", "3",
+              "pos", "left wheel motor", "0.25", "vel", "left wheel motor", "inf", "step", "32", "2"]
+    expected = conformance.expected_lines(script=script)
+    server = servers(conformance.WORLD)
+    c_code, c_lines, c_err = finish(start([cbin["script"], *script], server.url(conformance.ROBOT)))
+    assert c_code == 0, c_err
+    assert c_lines == expected
+    assert "The requested velocity inf exceeds 'maxVelocity'" in c_err
+    assert "The requested velocity -inf exceeds 'maxVelocity'" in c_err
+    assert python_script(servers(conformance.WORLD).url(conformance.ROBOT), *script) == expected
+
+
 def test_c_and_mixed_controllers_replay_the_radio_session(cbin, servers):
     """sensorium/schemas/conformance/radio.json: two C controllers, then a C rover and a Python buddy,
     talk by radio and print exactly the lines computed from the simulation (packets, signal
