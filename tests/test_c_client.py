@@ -503,7 +503,8 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     """tests/c/supervisor_remove.c on tests/worlds/supervisor_remove.yaml (its closed forms), built with
     sanitizers: the distance sensor reads the crate at 1 m, then the wall at 3 m; the light sensor 3 + 4
     (lamp and bulb), then 3; the root's 7 children become 5; the crate's id answers NULL, the gate keeps
-    its id; a robot and the root are refused with one line each; a reset brings nothing back."""
+    its id; a robot and the root are refused with one line each; a reset brings nothing back; the removed
+    crate's type name, DEF and parent read Webots' "no value" with its line."""
     code, out, err = finish(start([cbin["supervisor_remove"]], servers(REMOVE_WORLD).url("boss")))
     assert code == 0, err
     key, *vals = out[0].split()
@@ -515,6 +516,11 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     assert key == "reset" and [float(v) for v in vals] == pytest.approx([3.0, 5], abs=1e-9)
     assert out[4] == "removed_pose nan nan nan nan nan nan"          # Webots' NaNs, never NULL
     assert out[5] == "custom_data []"                                   # the reset restored the world's (none)
+    # the crate kept its type name "Solid" and DEF "CRATE" after remove(); Webots' libController drops a
+    # removed node from its list, so every reader of its identity prints its line and answers "no value"
+    assert out[6] == "stale [] [] 0 [] 1 live Solid GATE"
+    for func in ("get_type_name", "get_base_type_name", "get_type", "get_def", "get_parent_node"):
+        assert f"Error: wb_supervisor_node_{func}() called with a NULL or invalid 'node' argument." in err
     assert ("Error: wb_supervisor_node_get_position(): INVALID_ARGUMENT: get_node_pose: node 4 (Solid 'crate') was "
             "removed") in err
     assert "Error: wb_supervisor_node_get_orientation() called with a NULL or invalid 'node' argument." in err
