@@ -214,6 +214,9 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="export only these topics")
     p.add_argument("--start", type=_seconds, metavar="S", help="from S seconds of simulation time")
     p.add_argument("--end", type=_seconds, metavar="E", help="up to E seconds of simulation time")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite OUT if it exists (a file or a rosbag2 directory; replaced only once the new "
+                   "export is complete)")
 
 
 @command("recover", "rewrite a truncated recording (writer killed, disk full) as a complete, indexed MCAP file",

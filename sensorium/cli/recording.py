@@ -170,6 +170,7 @@ def export_cmd(args: argparse.Namespace) -> int:
             progress.total = total
         progress.update(1)
 
+    existed = os.path.lexists(args.out)     # with --force: an interrupted export leaves it as it was
     try:
         with sigterm_as_interrupt():    # SIGTERM/SIGHUP too: what was written is removed, as for Ctrl-C
             report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
@@ -177,7 +178,8 @@ def export_cmd(args: argparse.Namespace) -> int:
                                  views=not getattr(args, "no_views", False),
                                  start_ns=None if args.start is None else int(round(args.start * 1e9)),
                                  end_ns=None if args.end is None else int(round(args.end * 1e9)),
-                                 progress=advance, on_damage=damage_printer("export", args.file))
+                                 progress=advance, on_damage=damage_printer("export", args.file),
+                                 overwrite=getattr(args, "force", False))
     except (OSError, McapError) as exc:
         progress.close()
         print(f"sensorium export: {file_error(args.file, exc)}", file=sys.stderr)
@@ -188,7 +190,8 @@ def export_cmd(args: argparse.Namespace) -> int:
         return 1
     except KeyboardInterrupt:
         progress.close()
-        print(f"sensorium export: interrupted; {args.out} removed (nothing partial is kept)", file=sys.stderr)
+        kept = "left as it was" if existed else "removed"
+        print(f"sensorium export: interrupted; {args.out} {kept} (nothing partial is kept)", file=sys.stderr)
         return 130
     progress.close()
     warning = truncation_warning(report)
