@@ -328,6 +328,90 @@ def test_sigterm_mid_export_removes_the_output(recording, tmp_path, monkeypatch,
                                                                 f"{kept} (nothing partial is kept)")
 
 
+MESH_WORLD = b"""world_info: {name: meshy, basic_time_step: 32, random_seed: 7}
+solids: [{name: tri, pose: {translation: [1, 0, 0.1]}, geometry: {type: mesh, url: tri.obj}}]
+robots: [{name: epuck, devices: [{device: LightSensor, name: ls0}]}]
+"""
+
+# The child runs `sensorium export` as python -m sensorium does, with an import hook that holds it
+# inside the import of MODULE: it says so with a file, then waits for the file saying the test has
+# sent SIGINT. So the signal lands inside that import every time, without guessing at timings.
+_HELD_IMPORT = """
+import os, sys, time
+module, ready, sent = sys.argv.pop(1), sys.argv.pop(1), sys.argv.pop(1)
+class Hold:
+    def find_spec(self, name, path=None, target=None):
+        if name == module:
+            sys.meta_path.remove(self)
+            open(ready, "w").close()
+            while not os.path.exists(sent):
+                time.sleep(0.005)
+            time.sleep(0.05)
+        return None
+sys.meta_path.insert(0, Hold())
+from sensorium.cli import main
+sys.exit(main())
+"""
+
+
+@pytest.fixture(scope="module")
+def mesh_recording(tmp_path_factory):
+    """A recording whose world has a mesh: exporting its /scene imports trimesh."""
+    from _recdata import published
+
+    from sensorium.server.recording.writer import McapRecorder
+
+    path = tmp_path_factory.mktemp("mesh") / "mesh.mcap"
+    with McapRecorder(path, MESH_WORLD, "meshy.yaml", {"seed": "7", "world": "meshy"}, None, 4096) as rec:
+        rec._writer.add_attachment(create_time=0, log_time=0, name="tri.obj", media_type="model/obj",
+                                   data=b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+        for item in published(8, TOPICS):
+            rec.record(*item)
+    return path
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
+@pytest.mark.parametrize("module, existing, line", [
+    # the CLI's own imports (cli/recording.py's) ended in a traceback
+    ("sensorium.server.recording.live", False, "sensorium export: interrupted"),
+    # trimesh imports trimesh.path under `except BaseException`: the interrupt was swallowed and the
+    # export ran to its end, exit 0
+    ("trimesh.path", False, "sensorium export: interrupted; {out} removed (nothing partial is kept)"),
+    ("trimesh.path", True, "sensorium export: interrupted; {out} left as it was (nothing partial is kept)"),
+])
+def test_ctrl_c_inside_an_import_exits_130_with_one_line(mesh_recording, tmp_path, module, existing, line):
+    """Ctrl-C at any moment of `sensorium export`, here inside an import: exit 130, one line, no
+    partial output (an existing one replaced with --force left as it was)."""
+    import os
+    import signal
+    import time
+
+    out = tmp_path / "out.mcap"
+    if existing:
+        out.write_bytes(b"old")
+    ready, sent = tmp_path / "ready", tmp_path / "sent"
+    p = subprocess.Popen([sys.executable, "-c", _HELD_IMPORT, module, str(ready), str(sent), "export",
+                          str(mesh_recording), str(out), "--ros2", *(["--force"] if existing else [])],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not ready.exists():                   # the child is inside the import
+            assert p.poll() is None and time.monotonic() < deadline, p.communicate()
+            time.sleep(0.01)
+        p.send_signal(signal.SIGINT)
+        sent.touch()
+        stdout, stderr = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.communicate()
+    assert p.returncode == 130, stderr
+    assert stderr.strip().splitlines() == [line.format(out=out)] and stdout == ""
+    assert (out.read_bytes() == b"old") if existing else not out.exists()
+    assert sorted(os.listdir(tmp_path)) == sorted(["ready", "sent", *(["out.mcap"] if existing else [])])
+
+
 def test_cli_export(recording, tmp_path):
     src, items = recording
     out = tmp_path / "cli_bag"
