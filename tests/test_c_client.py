@@ -503,7 +503,8 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     """tests/c/supervisor_remove.c on tests/worlds/supervisor_remove.yaml (its closed forms), built with
     sanitizers: the distance sensor reads the crate at 1 m, then the wall at 3 m; the light sensor 3 + 4
     (lamp and bulb), then 3; the root's 7 children become 5; the crate's id answers NULL, the gate keeps
-    its id; a robot and the root are refused with one line each; a reset brings nothing back."""
+    its id; a robot and the root are refused with one line each; a reset brings nothing back; the removed
+    crate's type name, DEF and parent read Webots' "no value" with its line."""
     code, out, err = finish(start([cbin["supervisor_remove"]], servers(REMOVE_WORLD).url("boss")))
     assert code == 0, err
     key, *vals = out[0].split()
@@ -515,6 +516,11 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     assert key == "reset" and [float(v) for v in vals] == pytest.approx([3.0, 5], abs=1e-9)
     assert out[4] == "removed_pose nan nan nan nan nan nan"          # Webots' NaNs, never NULL
     assert out[5] == "custom_data []"                                   # the reset restored the world's (none)
+    # the crate kept its type name "Solid" and DEF "CRATE" after remove(); Webots' libController drops a
+    # removed node from its list, so every reader of its identity prints its line and answers "no value"
+    assert out[6] == "stale [] [] 0 [] 1 live Solid GATE"
+    for func in ("get_type_name", "get_base_type_name", "get_type", "get_def", "get_parent_node"):
+        assert f"Error: wb_supervisor_node_{func}() called with a NULL or invalid 'node' argument." in err
     assert ("Error: wb_supervisor_node_get_position(): INVALID_ARGUMENT: get_node_pose: node 4 (Solid 'crate') was "
             "removed") in err
     assert "Error: wb_supervisor_node_get_orientation() called with a NULL or invalid 'node' argument." in err
@@ -576,6 +582,27 @@ def test_c_client_replays_the_conformance_session(cbin, servers):
     lines = run([sys.executable, "-m", "sensorium", "controller", "--url", server.url(session["robot"]), cbin["script"],
                  *session["script"]])
     assert lines == session["lines"]
+
+
+def test_infinite_velocity_is_clamped_alike_in_process_and_by_both_clients(cbin, servers):
+    """setVelocity(+/-inf): the C and Python clients clamp it to maxVelocity (with Webots' warning,
+    WbMotor::setVelocity's rule); the in-process API raised instead, so the lines the simulation
+    computes for this script (server/sim/conformance.py) could not even be made. Now all three agree,
+    in velocity control and as position control's speed limit."""
+    from sensorium.server.sim import conformance
+
+    script = ["enable", "left encoder", "16", "enable", "right encoder", "16", "enable", "gps", "16",
+              "pos", "left wheel motor", "inf", "pos", "right wheel motor", "inf",
+              "vel", "left wheel motor", "inf", "vel", "right wheel motor", "-inf", "step", "16", "3",
+              "pos", "left wheel motor", "0.25", "vel", "left wheel motor", "inf", "step", "32", "2"]
+    expected = conformance.expected_lines(script=script)
+    server = servers(conformance.WORLD)
+    c_code, c_lines, c_err = finish(start([cbin["script"], *script], server.url(conformance.ROBOT)))
+    assert c_code == 0, c_err
+    assert c_lines == expected
+    assert "The requested velocity inf exceeds 'maxVelocity'" in c_err
+    assert "The requested velocity -inf exceeds 'maxVelocity'" in c_err
+    assert python_script(servers(conformance.WORLD).url(conformance.ROBOT), *script) == expected
 
 
 def test_c_and_mixed_controllers_replay_the_radio_session(cbin, servers):

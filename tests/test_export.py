@@ -175,6 +175,69 @@ def test_refuses_to_overwrite_and_unknown_distro(recording, tmp_path):
         export_ros2(src, tmp_path / "y", distro="noetic")
 
 
+def test_overwrite_replaces_a_file_or_a_bag_only_once_complete(recording, tmp_path):
+    """export had no way to replace an existing output (export_ros2(overwrite=True), `--force`): it
+    replaces a file or a rosbag2 directory with a complete export, moved over it at the end; a failed
+    export leaves the old output as it was and nothing beside it; a directory that is no bag, and the
+    recording itself, are never replaced."""
+    src, items = recording
+    one = tmp_path / "one.mcap"
+    one.write_bytes(b"old")
+    with pytest.raises(ExportError, match=r"one\.mcap exists already; not overwriting \(--force to replace it\)$"):
+        export_ros2(src, one)
+    assert one.read_bytes() == b"old"
+    export_ros2(src, one, overwrite=True, topics=["/epuck"])
+    with open(one, "rb") as f:
+        topics = {c.topic for c in make_reader(f).get_summary().channels.values()}
+    assert topics == {t for t in TOPICS if t.startswith("/epuck/")}
+    bag = tmp_path / "bag"
+    export_ros2(src, bag, topics=["/clock"])
+    export_ros2(src, bag, overwrite=True, topics=["/epuck"])          # a bag over a bag: files renamed inside
+    with AnyReader([bag]) as reader:
+        assert {c.topic for c in reader.connections} == {t for t in TOPICS if t.startswith("/epuck/")}
+    assert sorted(p.name for p in bag.iterdir()) == ["bag.mcap", "metadata.yaml"]
+    export_ros2(src, one, overwrite=True, fmt="bag")                   # a bag where a file was
+    assert (one / "metadata.yaml").is_file()
+
+    def fail(done: int, total: int) -> None:
+        if done == 5:
+            raise RuntimeError("disk on fire")
+
+    before = sorted((p.name, p.stat().st_size) for p in bag.iterdir())
+    with pytest.raises(RuntimeError, match="disk on fire"):
+        export_ros2(src, bag, overwrite=True, progress=fail)
+    assert sorted((p.name, p.stat().st_size) for p in bag.iterdir()) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bag", "one.mcap"]      # no staging directory left
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "photos" / "cat.jpg").write_bytes(b"cat")
+    with pytest.raises(ExportError, match=r"photos is a directory but no rosbag2 bag \(no metadata\.yaml\)"):
+        export_ros2(src, tmp_path / "photos", overwrite=True)
+    assert (tmp_path / "photos" / "cat.jpg").read_bytes() == b"cat"
+    copy = tmp_path / "rec.mcap"
+    copy.write_bytes(Path(src).read_bytes())
+    with pytest.raises(ExportError, match=r"rec\.mcap is the recording being exported; not replacing it"):
+        export_ros2(copy, copy, overwrite=True)
+    assert copy.read_bytes() == Path(src).read_bytes()
+
+
+def test_cli_export_force(recording, tmp_path):
+    """`sensorium export ... --force` (documented in --help, as convert's, record's and recover's)."""
+    src, _ = recording
+    out = tmp_path / "out.mcap"
+    out.write_bytes(b"old")
+    cmd = [sys.executable, "-m", "sensorium", "export", str(src), str(out), "--ros2", "--topics", "/clock"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1 and proc.stderr.strip() == (f"sensorium export: {out} exists already; not "
+                                                            "overwriting (--force to replace it)")
+    assert out.read_bytes() == b"old"
+    proc = subprocess.run([*cmd, "--force"], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert out.read_bytes()[:8] == b"\x89MCAP0\r\n"
+    helped = subprocess.run([sys.executable, "-m", "sensorium", "export", "--help"], capture_output=True, text=True,
+                            timeout=60)
+    assert "--force" in helped.stdout and "overwrite OUT if it exists" in " ".join(helped.stdout.split())
+
+
 def test_topics_that_match_nothing_are_refused(recording, tmp_path):
     """A typo in --topics wrote an empty bag and exited 0."""
     src, _ = recording
@@ -220,11 +283,13 @@ class _Terminated(Exception):
     """What SIGTERM raises in these tests when the command under test does not handle it."""
 
 
+@pytest.mark.parametrize("replacing", [False, True])
 @pytest.mark.parametrize("name", ["bag", "one.mcap"])
-def test_sigterm_mid_export_removes_the_output(recording, tmp_path, monkeypatch, capsys, name):
+def test_sigterm_mid_export_removes_the_output(recording, tmp_path, monkeypatch, capsys, name, replacing):
     """README: 'export removes what it wrote if it fails or is interrupted; only SIGKILL or a power
     loss can leave a half-written bag'. SIGTERM (systemd, docker stop, timeout) killed export at
-    once, leaving the half-written bag behind."""
+    once, leaving the half-written bag behind. With --force over an existing output, that output is
+    left as it was (the new one was being written beside it)."""
     import argparse
     import os
     import signal
@@ -241,17 +306,110 @@ def test_sigterm_mid_export_removes_the_output(recording, tmp_path, monkeypatch,
         raise _Terminated
 
     monkeypatch.setattr(progress, "bar", lambda *a, **k: SignalAtFirstMessage())
+    if replacing:
+        old = tmp_path / name if name.endswith(".mcap") else tmp_path / name / "metadata.yaml"
+        old.parent.mkdir(exist_ok=True)
+        old.write_bytes(b"old")
     previous = signal.signal(signal.SIGTERM, terminated)     # without the fix the test fails, not pytest
     try:
         src, _ = recording
         args = argparse.Namespace(file=str(src), out=str(tmp_path / name), ros2=True, distro="jazzy", format=None,
-                                  pointcloud2=False, no_views=True, topics=None, start=None, end=None)
+                                  pointcloud2=False, no_views=True, topics=None, start=None, end=None,
+                                  force=replacing)
         assert export_cmd(args) == 130
     finally:
         assert signal.signal(signal.SIGTERM, previous) is terminated        # put back after the export
-    assert not (tmp_path / name).exists()
+    if replacing:
+        assert old.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == [name]
+    else:
+        assert not (tmp_path / name).exists()
+    kept = "left as it was" if replacing else "removed"
     assert capsys.readouterr().err.strip().splitlines()[-1] == (f"sensorium export: interrupted; {tmp_path / name} "
-                                                                "removed (nothing partial is kept)")
+                                                                f"{kept} (nothing partial is kept)")
+
+
+MESH_WORLD = b"""world_info: {name: meshy, basic_time_step: 32, random_seed: 7}
+solids: [{name: tri, pose: {translation: [1, 0, 0.1]}, geometry: {type: mesh, url: tri.obj}}]
+robots: [{name: epuck, devices: [{device: LightSensor, name: ls0}]}]
+"""
+
+# The child runs `sensorium export` as python -m sensorium does, with an import hook that holds it
+# inside the import of MODULE: it says so with a file, then waits for the file saying the test has
+# sent SIGINT. So the signal lands inside that import every time, without guessing at timings.
+_HELD_IMPORT = """
+import os, sys, time
+module, ready, sent = sys.argv.pop(1), sys.argv.pop(1), sys.argv.pop(1)
+class Hold:
+    def find_spec(self, name, path=None, target=None):
+        if name == module:
+            sys.meta_path.remove(self)
+            open(ready, "w").close()
+            while not os.path.exists(sent):
+                time.sleep(0.005)
+            time.sleep(0.05)
+        return None
+sys.meta_path.insert(0, Hold())
+from sensorium.cli import main
+sys.exit(main())
+"""
+
+
+@pytest.fixture(scope="module")
+def mesh_recording(tmp_path_factory):
+    """A recording whose world has a mesh: exporting its /scene imports trimesh."""
+    from _recdata import published
+
+    from sensorium.server.recording.writer import McapRecorder
+
+    path = tmp_path_factory.mktemp("mesh") / "mesh.mcap"
+    with McapRecorder(path, MESH_WORLD, "meshy.yaml", {"seed": "7", "world": "meshy"}, None, 4096) as rec:
+        rec._writer.add_attachment(create_time=0, log_time=0, name="tri.obj", media_type="model/obj",
+                                   data=b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+        for item in published(8, TOPICS):
+            rec.record(*item)
+    return path
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
+@pytest.mark.parametrize("module, existing, line", [
+    # the CLI's own imports (cli/recording.py's) ended in a traceback
+    ("sensorium.server.recording.live", False, "sensorium export: interrupted"),
+    # trimesh imports trimesh.path under `except BaseException`: the interrupt was swallowed and the
+    # export ran to its end, exit 0
+    ("trimesh.path", False, "sensorium export: interrupted; {out} removed (nothing partial is kept)"),
+    ("trimesh.path", True, "sensorium export: interrupted; {out} left as it was (nothing partial is kept)"),
+])
+def test_ctrl_c_inside_an_import_exits_130_with_one_line(mesh_recording, tmp_path, module, existing, line):
+    """Ctrl-C at any moment of `sensorium export`, here inside an import: exit 130, one line, no
+    partial output (an existing one replaced with --force left as it was)."""
+    import os
+    import signal
+    import time
+
+    out = tmp_path / "out.mcap"
+    if existing:
+        out.write_bytes(b"old")
+    ready, sent = tmp_path / "ready", tmp_path / "sent"
+    p = subprocess.Popen([sys.executable, "-c", _HELD_IMPORT, module, str(ready), str(sent), "export",
+                          str(mesh_recording), str(out), "--ros2", *(["--force"] if existing else [])],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not ready.exists():                   # the child is inside the import
+            assert p.poll() is None and time.monotonic() < deadline, p.communicate()
+            time.sleep(0.01)
+        p.send_signal(signal.SIGINT)
+        sent.touch()
+        stdout, stderr = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.communicate()
+    assert p.returncode == 130, stderr
+    assert stderr.strip().splitlines() == [line.format(out=out)] and stdout == ""
+    assert (out.read_bytes() == b"old") if existing else not out.exists()
+    assert sorted(os.listdir(tmp_path)) == sorted(["ready", "sent", *(["out.mcap"] if existing else [])])
 
 
 def test_cli_export(recording, tmp_path):

@@ -316,6 +316,28 @@ def test_reset_forgets_packets():
     assert [p.data for p in rx.take()] == [b"y"]
 
 
+def test_reset_keeps_the_channels_set_at_run_time():
+    """Webots' simulationReset does not restore an Emitter's or Receiver's ``channel`` field set by
+    ``setChannel``: WbEmitter::reset / WbReceiver::reset only clear the message queues, and the
+    reset matrix of Webots' Supervisor reference resets fields only on a world reload. So after
+    ``sim.reset()`` the emitter still sends on channel 4 (the world file says 3) and the receiver
+    still listens on 4 (the world file says 3); only the queued packets are gone."""
+    sim = world(tx={"channel": 3}, rx={"channel": 3})
+    tx, rx = sim.device("a/tx"), sim.device("b/rx")
+    rx.enable(16)
+    tx.set_channel(4)
+    rx.set_channel(4)
+    tx.send(b"before")
+    sim.reset()
+    assert (tx.channel, rx.channel) == (4, 4)
+    assert delivered(sim) == []                          # the queued packet is gone
+    tx.send(b"after")
+    assert [p.data for p in delivered(sim)] == [b"after"]
+    rx.set_channel(3)                                    # the world file's channel no longer hears it
+    tx.send(b"unheard")
+    assert delivered(sim) == []
+
+
 # ---------------------------------------------------------------------- through the server
 
 _ids = iter(range(1, 1 << 30))

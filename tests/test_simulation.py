@@ -542,10 +542,35 @@ def test_velocity_clamped_and_position_control_stops_at_target() -> None:
     m.set_position(1.0)                            # position control at speed 10 rad/s
     sim.run(20)
     assert m.position == pytest.approx(1.0, abs=1e-12)
-    with pytest.raises(ValueError, match="finite"):
+    with pytest.raises(ValueError, match="must be a number"):
         m.set_velocity(math.nan)
     with pytest.raises(KeyError, match="no motor 'x'"):
         sim.robot("r").motor("x")
+
+
+def test_infinite_velocity_is_clamped_to_max_velocity_as_the_clients_do() -> None:
+    """set_velocity(inf) raised ValueError in process where the Python and C clients clamp it to
+    maxVelocity (Webots' WbMotor::setVelocity clamps any |v| > maxVelocity, inf included):
+    velocity control at +inf/-inf turns the wheel at +/-maxVelocity, position control at inf moves
+    toward the target at maxVelocity. tests/test_c_client.py runs the same commands through both
+    clients and compares them with this simulation's lines."""
+    sim = _driven()
+    left, right = sim.robot("r").motor("left wheel motor"), sim.robot("r").motor("right wheel motor")
+    left.set_position(math.inf)
+    right.set_position(math.inf)
+    left.set_velocity(math.inf)
+    right.set_velocity(-math.inf)
+    assert (left.velocity, right.velocity) == (10.0, -10.0)
+    sim.run(5)
+    assert (left.position, right.position) == (pytest.approx(10.0 * 0.08), pytest.approx(-10.0 * 0.08))
+    left.set_position(0.0)
+    left.set_velocity(float("inf"))            # position control: the speed limit is maxVelocity
+    assert left.velocity == 10.0
+    sim.run(5)
+    assert left.position == pytest.approx(0.0, abs=1e-12)
+    for bad in (math.nan, "fast", True):
+        with pytest.raises(ValueError, match="must be a number"):
+            left.set_velocity(bad)             # type: ignore[arg-type]
 
 
 def test_encoder_resolution_is_webots_discretize() -> None:

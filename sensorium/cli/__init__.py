@@ -214,6 +214,9 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="export only these topics")
     p.add_argument("--start", type=_seconds, metavar="S", help="from S seconds of simulation time")
     p.add_argument("--end", type=_seconds, metavar="E", help="up to E seconds of simulation time")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite OUT if it exists (a file or a rosbag2 directory; replaced only once the new "
+                   "export is complete)")
 
 
 @command("recover", "rewrite a truncated recording (writer killed, disk full) as a complete, indexed MCAP file",
@@ -375,19 +378,28 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if not getattr(args, "_target", None):
-        parser.print_help()
-        return 2
-    module_name, func_name = args._target.split(":")
-    _export_proto_args(args)
     import importlib
 
-    func: Handler = getattr(importlib.import_module(module_name), func_name)
+    from sensorium.cli.interrupts import Interrupts
+
+    name = "sensorium"
     try:
+        # Ctrl-C while the command line is parsed and the command's modules import (a second or
+        # more): 130 and one line, never a traceback from inside an import nor an interrupt a
+        # library's import guard swallows
+        with Interrupts():
+            parser = build_parser()
+            args = parser.parse_args(argv)
+            if not getattr(args, "_target", None):
+                parser.print_help()
+                return 2
+            name = f"sensorium {args.command}"
+            module_name, func_name = args._target.split(":")
+            _export_proto_args(args)
+            func: Handler = getattr(importlib.import_module(module_name), func_name)
         return int(func(args) or 0)
     except KeyboardInterrupt:
+        print(f"{name}: interrupted", file=sys.stderr, flush=True)
         return 130
     except BrokenPipeError:
         return 0

@@ -156,41 +156,56 @@ def replay_cmd(args: argparse.Namespace) -> int:
 
 
 def export_cmd(args: argparse.Namespace) -> int:
-    from sensorium.server.recording.export import ExportError, export_ros2, print_report, truncation_warning
+    """``sensorium export``. Ctrl-C (SIGTERM, SIGHUP) at any moment exits 130 with one line and no
+    partial output, also while a library imports (cli/interrupts.py: none can swallow it)."""
+    from sensorium.cli.interrupts import Interrupts
 
     if not args.ros2:
         print("sensorium export: say which format: --ros2 (the only one so far)", file=sys.stderr)
         return 2
-    from sensorium.cli.progress import bar
-
-    progress = bar(None, "export", "msg")
-
-    def advance(done: int, total: int) -> None:
-        if total and getattr(progress, "total", None) != total:
-            progress.total = total
-        progress.update(1)
-
+    existed = os.path.lexists(args.out)     # with --force: an interrupted export leaves it as it was
+    signals = tuple(s for s in (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", None)) if s is not None)
+    progress = None
     try:
-        with sigterm_as_interrupt():    # SIGTERM/SIGHUP too: what was written is removed, as for Ctrl-C
-            report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
-                                 pointcloud2=args.pointcloud2, topics=args.topics or None,
-                                 views=not getattr(args, "no_views", False),
-                                 start_ns=None if args.start is None else int(round(args.start * 1e9)),
-                                 end_ns=None if args.end is None else int(round(args.end * 1e9)),
-                                 progress=advance, on_damage=damage_printer("export", args.file))
-    except (OSError, McapError) as exc:
-        progress.close()
-        print(f"sensorium export: {file_error(args.file, exc)}", file=sys.stderr)
-        return 1
-    except ExportError as exc:
-        progress.close()
-        print(f"sensorium export: {exc}", file=sys.stderr)
-        return 1
+        with Interrupts(signals) as ctrl:   # what was written is removed, as for Ctrl-C
+            from sensorium.cli.progress import bar
+            from sensorium.server.recording.export import ExportError, export_ros2, print_report, truncation_warning
+
+            progress = bar(None, "export", "msg")
+
+            def advance(done: int, total: int) -> None:
+                ctrl.check()                # an interrupt a library caught stops the export here
+                if total and getattr(progress, "total", None) != total:
+                    progress.total = total
+                progress.update(1)
+
+            try:
+                report = export_ros2(args.file, args.out, distro=args.distro, fmt=args.format,
+                                     pointcloud2=args.pointcloud2, topics=args.topics or None,
+                                     views=not getattr(args, "no_views", False),
+                                     start_ns=None if args.start is None else int(round(args.start * 1e9)),
+                                     end_ns=None if args.end is None else int(round(args.end * 1e9)),
+                                     progress=advance, on_damage=damage_printer("export", args.file),
+                                     overwrite=getattr(args, "force", False))
+            except (OSError, McapError) as exc:
+                progress.close()
+                print(f"sensorium export: {file_error(args.file, exc)}", file=sys.stderr)
+                return 1
+            except ExportError as exc:
+                progress.close()
+                print(f"sensorium export: {exc}", file=sys.stderr)
+                return 1
+            progress.close()
+            if ctrl.received:               # arrived after the last message, or a library caught it
+                print(f"sensorium export: interrupted after the export completed; {args.out} is complete",
+                      file=sys.stderr)
+                return 130
     except KeyboardInterrupt:
-        progress.close()
-        print(f"sensorium export: interrupted; {args.out} removed (nothing partial is kept)", file=sys.stderr)
+        if progress is not None:
+            progress.close()
+        kept = "left as it was" if existed else "removed"
+        print(f"sensorium export: interrupted; {args.out} {kept} (nothing partial is kept)", file=sys.stderr)
         return 130
-    progress.close()
     warning = truncation_warning(report)
     if warning:
         print(f"sensorium export: {warning}", file=sys.stderr, flush=True)

@@ -102,6 +102,20 @@ def node_info(node: Any, func: str) -> dict | None:
     return info if info.get("type") else None
 
 
+def _live_node_info(node: Any, func: str) -> dict | None:
+    """:func:`node_info` for the functions that read a node's identity: a node the server no longer
+    has (removed by ``remove()``, here or by another supervisor) gets Webots' line and None, as
+    libController answers for a node reference it dropped from its list."""
+    r = _checked_node(node, func)
+    if r is None:
+        return None
+    info = _call(r, "get_from_id", {"id": int(node)})
+    if not info.get("type"):
+        print(f"Error: {func}() called with a NULL or invalid 'node' argument.", file=sys.stderr)
+        return None
+    return info
+
+
 def wb_supervisor_node_get_root() -> int | None:
     """The root node (Webots' root Group, id 0): its ``children`` are the top-level nodes."""
     r = _supervisor("wb_supervisor_node_get_root")
@@ -141,30 +155,30 @@ def wb_supervisor_node_get_id(node: int | None) -> int:
 
 
 def wb_supervisor_node_get_type_name(node: int | None) -> str:
-    info = node_info(node, "wb_supervisor_node_get_type_name")
+    info = _live_node_info(node, "wb_supervisor_node_get_type_name")
     return "" if info is None else str(info["type"])
 
 
 def wb_supervisor_node_get_base_type_name(node: int | None) -> str:
     """Sensorium keeps no PROTO names: the base type is the type (Robot, Solid, PointLight, ...)."""
-    info = node_info(node, "wb_supervisor_node_get_base_type_name")
+    info = _live_node_info(node, "wb_supervisor_node_get_base_type_name")
     return "" if info is None else str(info["type"])
 
 
 def wb_supervisor_node_get_type(node: int | None) -> int:
-    info = node_info(node, "wb_supervisor_node_get_type")
+    info = _live_node_info(node, "wb_supervisor_node_get_type")
     name = "WB_NODE_NO_NODE" if info is None else NODE_TYPES[info["type"]]
     return nodes.WEBOTS_NODE_TYPES[name]
 
 
 def wb_supervisor_node_get_def(node: int | None) -> str:
-    info = node_info(node, "wb_supervisor_node_get_def")
+    info = _live_node_info(node, "wb_supervisor_node_get_def")
     return "" if info is None else str(info["def_name"])
 
 
 def wb_supervisor_node_get_parent_node(node: int | None) -> int | None:
     """The root for a top-level node; None for the root."""
-    info = node_info(node, "wb_supervisor_node_get_parent_node")
+    info = _live_node_info(node, "wb_supervisor_node_get_parent_node")
     if info is None or int(info["parent"]) < 0:
         return None
     return int(info["parent"])

@@ -1,6 +1,7 @@
 /* A Webots-style C supervisor removing nodes (tests/worlds/supervisor_remove.yaml, its closed forms):
  * the distance sensor reads the crate, then the wall behind it once the crate is removed; the light
- * sensor loses the bulb's term; the removed nodes answer NULL (their poses NaN); a robot and the root are refused.
+ * sensor loses the bulb's term; the removed nodes answer NULL (their poses NaN, their type names ""); a robot and
+ * the root are refused.
  * Prints "key values" lines for tests/test_c_client.py. */
 #include <stdio.h>
 
@@ -42,6 +43,12 @@ int main(void) {
   const double *q = wb_supervisor_node_get_position(NULL), *r = wb_supervisor_node_get_orientation(NULL);
   printf("removed_pose %g %g %g %g %g %g\n", p[0], p[2], o[0], o[8], q[1], r[4]);
   printf("custom_data [%s]\n", wb_robot_get_custom_data());
+  /* a removed node's identity: Webots' line and its "no value" each, not what the node was */
+  WbNodeRef gate = wb_supervisor_node_get_from_def("GATE");
+  printf("stale [%s] [%s] %d [%s] %d live %s %s\n", wb_supervisor_node_get_type_name(crate),
+         wb_supervisor_node_get_base_type_name(crate), (int)wb_supervisor_node_get_type(crate),
+         wb_supervisor_node_get_def(crate), wb_supervisor_node_get_parent_node(crate) == NULL,
+         wb_supervisor_node_get_type_name(gate), wb_supervisor_node_get_def(gate));
   wb_robot_cleanup();
   return 0;
 }

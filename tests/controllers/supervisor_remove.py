@@ -35,4 +35,8 @@ children.value = []                         # an MF field is not set this way: o
 moved = [wall.value, robot.getFromDef("wall").getPosition(), children.getCount(), children.count, wall.type_name]
 refused = [crate.getPosition(), crate.getOrientation()[:2], crate.getVelocity()[:2], crate.getField("translation"),
            intensity.getSFFloat(), gate.getSFVec3f(), robot.step(timestep)]
-print(json.dumps({"before": before, "after": after, "gone": gone, "refused": refused, "moved": moved}), flush=True)
+# the removed crate's identity: Webots' line and "no value" each (it answered "Solid" and "CRATE")
+stale = [crate.getTypeName(), crate.getBaseTypeName(), crate.getType(), crate.getDef(), crate.getParentNode(),
+         robot.getFromDef("GATE").getTypeName()]
+print(json.dumps({"before": before, "after": after, "gone": gone, "refused": refused, "moved": moved,
+                  "stale": stale}), flush=True)

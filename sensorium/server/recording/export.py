@@ -30,8 +30,10 @@ fields the body lacks are zero. ``pointcloud2=True`` turns ``sensor_msgs/msg/Poi
 from __future__ import annotations
 
 import array
+import os
 import struct
 import sys
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -383,12 +385,15 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
                 pointcloud2: bool = False, topics: list[str] | None = None,
                 start_ns: int | None = None, end_ns: int | None = None, views: bool = True,
                 progress: Callable[[int, int], None] | None = None,
-                on_damage: Callable[[Any], None] | None = None) -> ExportReport:
+                on_damage: Callable[[Any], None] | None = None, overwrite: bool = False) -> ExportReport:
     """Export ``src`` to ``out``. ``fmt`` is ``"bag"`` (rosbag2 directory, via rosbags) or
     ``"mcap"`` (single file, via mcap-ros2-support); by default ``.mcap`` outputs are single files.
     ``views``: add ``/tf_static``, ``/tf`` and ``/scene`` from the recorded world (:mod:`.ros_views`).
     ``progress(done, total)`` is called as messages are read (total: the recording's message count).
     A damaged part of ``src`` is skipped and passed to ``on_damage`` (a :class:`~.scan.Damage`).
+    ``overwrite``: replace an existing ``out`` (a file, or a directory holding a rosbag2 bag's
+    ``metadata.yaml``; never ``src`` itself): the export is written beside it and takes its place
+    only when complete, so a failed or interrupted export leaves the old one as it was.
     Never leaves a partial output: if the export fails or is interrupted, what it wrote is removed."""
     out = Path(out)
     if distro not in DISTROS:
@@ -398,8 +403,9 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
         raise ExportError(f"unknown format {fmt!r} (bag or mcap)")
     if start_ns is not None and end_ns is not None and end_ns < start_ns:
         raise ExportError("--end is before --start")          # as replay says: an empty bag is no answer
-    if out.exists() or out.is_symlink():
-        raise ExportError(f"{out} exists already; not overwriting")
+    replacing = out.exists() or out.is_symlink()
+    if replacing:
+        _check_replaceable(Path(src), out, overwrite)
     typestore = typestore_for(distro)
     report = ExportReport(out=out, distro=distro, fmt=fmt)
     with Recording(src, on_damage=on_damage) as rec:
@@ -412,15 +418,26 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
             raise ExportError(problem)
         meta = rec.metadata().get("sensorium", {})
         world = rec.world()
+        # a replacement is written in a fresh directory beside OUT (same file system), under OUT's
+        # name (a bag names its files after its directory), and moved over OUT when complete
+        staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".export", dir=out.parent)) if replacing else None
+        target = out if staging is None else staging / out.name
         try:
             if fmt == "bag":
-                _write_rosbag2(rec, out, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns, views)
+                _write_rosbag2(rec, target, typestore, distro, topics, pointcloud2, report, meta, start_ns, end_ns,
+                               views)
             else:
-                _write_single(rec, out, typestore, topics, pointcloud2, report, meta, world, distro, start_ns, end_ns,
-                              views)
+                _write_single(rec, target, typestore, topics, pointcloud2, report, meta, world, distro, start_ns,
+                              end_ns, views)
+            if staging is not None:
+                if target.is_dir() or (out.is_dir() and not out.is_symlink()):
+                    _remove_output(out)             # os.replace moves a file over a file only
+                os.replace(target, out)
         except BaseException:
-            _remove_output(out)
+            _remove_output(staging if staging is not None else out)
             raise
+        if staging is not None:
+            _remove_output(staging)
         report.size_bytes = rec.path.stat().st_size
         report.damaged = list(rec.damaged)
         if rec.truncated:
@@ -429,8 +446,20 @@ def export_ros2(src: str | Path, out: str | Path, *, distro: str = "jazzy", fmt:
     return report
 
 
+def _check_replaceable(src: Path, out: Path, overwrite: bool) -> None:
+    """Raise :class:`ExportError` unless ``overwrite`` allows replacing the existing ``out``: a file
+    or a rosbag2 bag (a directory holding ``metadata.yaml``), never the recording being exported."""
+    if not overwrite:
+        raise ExportError(f"{out} exists already; not overwriting (--force to replace it)")
+    if src.exists() and out.resolve() == src.resolve():
+        raise ExportError(f"{out} is the recording being exported; not replacing it")
+    if out.is_dir() and not out.is_symlink() and not (out / "metadata.yaml").is_file():
+        raise ExportError(f"{out} is a directory but no rosbag2 bag (no metadata.yaml); not replacing it")
+
+
 def _remove_output(out: Path) -> None:
-    """Remove what a failed export wrote at ``out`` (it did not exist before: export_ros2 checks)."""
+    """Remove ``out``, a file or a directory tree: what a failed export wrote (a new output or its
+    staging directory), or the output a complete replacement takes the place of."""
     import shutil
 
     try:

@@ -48,9 +48,11 @@ class WheelMotor:
         self.target_position = float(value)
 
     def set_velocity(self, value: float) -> None:
-        if not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ValueError(f"motor {self.name!r}: velocity must be a finite number, got {value!r}")
-        # Webots clamps to maxVelocity (with a warning)
+        """Webots' ``setVelocity``: a speed above ``maxVelocity``, infinite ones included, is clamped
+        to it (WbMotor warns; the clients print that warning, this API clamps silently); NaN raises."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
+            raise ValueError(f"motor {self.name!r}: velocity must be a number (inf is clamped to maxVelocity), "
+                             f"got {value!r}")
         self.velocity = float(min(max(value, -self.max_velocity), self.max_velocity))
 
     def advance(self, dt_s: float) -> float:

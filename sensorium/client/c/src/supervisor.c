@@ -126,8 +126,12 @@ static WbNodeRef node_from_reply(sn_robot *rb, sn_reply *rep) {
       n->type = NODE_TYPES[i].type;
       snprintf(n->type_name, sizeof n->type_name, "%s", NODE_TYPES[i].name);
       char *def = sn_strdup_obj(sn_get(rep->result, "def_name"));
-      free(n->def_name);
-      n->def_name = def;
+      if (def != NULL && n->def_name != NULL && strcmp(def, n->def_name) == 0)
+        free(def); /* unchanged: the string a caller holds stays valid (the readers ask again each time) */
+      else {
+        free(n->def_name);
+        n->def_name = def;
+      }
       n->parent = sn_int_or(rep->result, "parent", -1);
       break;
     }
@@ -194,9 +198,27 @@ WbNodeRef wb_supervisor_node_get_from_id(int id) {
   return node_from_id(id, "wb_supervisor_node_get_from_id");
 }
 
+/* The node with its identity (type, DEF, parent) asked again of the server, for the functions that
+   read it: a node the server no longer has (removed by wb_supervisor_node_remove, here or by another
+   supervisor) gets Webots' line and NULL, as libController answers for a reference it dropped; its
+   record forgets the type it had. */
+static WbNodeRef live_node(WbNodeRef node, const char *func) {
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/get_from_id", 1, args_id, &node->id, func, &rep) != 0)
+    return NULL;
+  if (node_from_reply(rb, &rep) == NULL) {
+    node->type = WB_NODE_NO_NODE;
+    node->type_name[0] = '\0';
+    fprintf(stderr, "Error: %s() called with a NULL or invalid 'node' argument.\n", func);
+    return NULL;
+  }
+  return node;
+}
+
 WbNodeRef wb_supervisor_node_get_parent_node(WbNodeRef node) {
   const char *func = "wb_supervisor_node_get_parent_node";
-  if (supervisor_node(node, func) == NULL || node->parent < 0)
+  if (live_node(node, func) == NULL || node->parent < 0)
     return NULL; /* the root has no parent */
   return node_from_id(node->parent, func);
 }
@@ -206,20 +228,20 @@ int wb_supervisor_node_get_id(WbNodeRef node) {
 }
 
 WbNodeType wb_supervisor_node_get_type(WbNodeRef node) {
-  return supervisor_node(node, "wb_supervisor_node_get_type") != NULL ? node->type : WB_NODE_NO_NODE;
+  return live_node(node, "wb_supervisor_node_get_type") != NULL ? node->type : WB_NODE_NO_NODE;
 }
 
 const char *wb_supervisor_node_get_type_name(WbNodeRef node) {
-  return supervisor_node(node, "wb_supervisor_node_get_type_name") != NULL ? node->type_name : "";
+  return live_node(node, "wb_supervisor_node_get_type_name") != NULL ? node->type_name : "";
 }
 
 /* no PROTO names here: a node's type is its base type */
 const char *wb_supervisor_node_get_base_type_name(WbNodeRef node) {
-  return supervisor_node(node, "wb_supervisor_node_get_base_type_name") != NULL ? node->type_name : "";
+  return live_node(node, "wb_supervisor_node_get_base_type_name") != NULL ? node->type_name : "";
 }
 
 const char *wb_supervisor_node_get_def(WbNodeRef node) {
-  if (supervisor_node(node, "wb_supervisor_node_get_def") == NULL)
+  if (live_node(node, "wb_supervisor_node_get_def") == NULL)
     return "";
   return node->def_name != NULL ? node->def_name : "";
 }

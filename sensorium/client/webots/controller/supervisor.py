@@ -126,32 +126,33 @@ class Field:
 
 
 class Node:
-    """A node of the scene tree Sensorium has: the root (id 0), a robot, a top-level solid or light."""
+    """A node of the scene tree Sensorium has: the root (id 0), a robot, a top-level solid or light.
+    ``type_name`` and ``name`` are what it was when found (its ``repr``); the getters ask again."""
 
-    def __init__(self, ref: int, type_name: str = "", name: str = "", def_name: str = "", parent: int = -1):
+    def __init__(self, ref: int, type_name: str = "", name: str = ""):
         self._ref = ref
         self._type_name = type_name
         self._name = name
-        self._def = def_name
-        self._parent = parent
 
     def getId(self) -> int:
         return self._ref
 
+    # the identity readers ask the server, as Webots' Node class asks libController: a removed
+    # node answers Webots' line and its "no value" ('', WB_NODE_NO_NODE, None), not what it was
     def getDef(self) -> str:
-        return self._def
+        return wb.wb_supervisor_node_get_def(self._ref)
 
     def getTypeName(self) -> str:
-        return self._type_name
+        return wb.wb_supervisor_node_get_type_name(self._ref)
 
     def getBaseTypeName(self) -> str:
-        return self._type_name      # no PROTO names here: a node's type is its base type
+        return wb.wb_supervisor_node_get_base_type_name(self._ref)  # no PROTO names here: the type
 
     def getType(self) -> int:
-        return nodes.WEBOTS_NODE_TYPES[wb.NODE_TYPES.get(self._type_name, "WB_NODE_NO_NODE")]
+        return wb.wb_supervisor_node_get_type(self._ref)
 
     def getParentNode(self) -> Node | None:
-        return _node_of(self._parent) if self._parent >= 0 else None
+        return _node_of(wb.wb_supervisor_node_get_parent_node(self._ref))
 
     def getField(self, fieldName: str) -> Field | None:  # noqa: N803 - Webots' parameter name
         ref = wb.wb_supervisor_node_get_field(self._ref, fieldName)
@@ -211,8 +212,7 @@ class Node:
 def _node(ref: dict | None) -> Node | None:
     if not ref or not ref.get("type"):
         return None
-    return Node(int(ref["node"]), str(ref["type"]), str(ref.get("name", "")), str(ref.get("def_name", "")),
-                int(ref.get("parent", -1)))
+    return Node(int(ref["node"]), str(ref["type"]), str(ref.get("name", "")))
 
 
 def _node_of(node: int | None) -> Node | None:
