@@ -518,7 +518,7 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     assert out[5] == "custom_data []"                                   # the reset restored the world's (none)
     # the crate kept its type name "Solid" and DEF "CRATE" after remove(); Webots' libController drops a
     # removed node from its list, so every reader of its identity prints its line and answers "no value"
-    assert out[6] == "stale [] [] 0 [] 1 live Solid GATE"
+    assert out[6] == "stale [] [] 0 [] 1 -1 live Solid GATE"
     for func in ("get_type_name", "get_base_type_name", "get_type", "get_def", "get_parent_node"):
         assert f"Error: wb_supervisor_node_{func}() called with a NULL or invalid 'node' argument." in err
     assert ("Error: wb_supervisor_node_get_position(): INVALID_ARGUMENT: get_node_pose: node 4 (Solid 'crate') was "

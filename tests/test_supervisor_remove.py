@@ -162,8 +162,8 @@ def test_a_webots_supervisor_controller_removes_a_solid_and_a_light(tmp_path):
     assert out["refused"] == [pytest.approx(nan, nan_ok=True), pytest.approx(nan[:2], nan_ok=True),
                               pytest.approx(nan[:2], nan_ok=True), None, 3.0, [1.1, -2.0, 0.25], 0]
     assert out["moved"] == [[3.2, 0.0, 0.25], [3.2, 0.0, 0.25], 5, 5, "SFVec3f"]
-    assert out["stale"] == ["", "", 0, "", None, "Solid"]        # it answered "Solid", "Solid", 24, "CRATE", root
-    for func in ("get_type_name", "get_base_type_name", "get_type", "get_def", "get_parent_node"):
+    assert out["stale"] == ["", "", 0, "", None, -1, "Solid"]    # it answered "Solid", "Solid", 24, "CRATE", root, 4
+    for func in ("get_type_name", "get_base_type_name", "get_type", "get_def", "get_parent_node", "get_id"):
         assert f"Error: wb_supervisor_node_{func}() called with a NULL or invalid 'node' argument." in ctl.stderr()
     assert "Error: Field.value: the MFNode field 'children' cannot be set as a whole." in ctl.stderr()
     assert "Error: wb_supervisor_field_set_sf_vec3f(): expected 3 numbers, got 2." in ctl.stderr()

@@ -151,7 +151,7 @@ def wb_supervisor_node_get_from_id(id: int) -> int | None:  # noqa: A002 - Webot
 
 
 def wb_supervisor_node_get_id(node: int | None) -> int:
-    return -1 if _checked_node(node, "wb_supervisor_node_get_id") is None else int(node)  # type: ignore[arg-type]
+    return -1 if _live_node_info(node, "wb_supervisor_node_get_id") is None else int(node)  # type: ignore[arg-type]
 
 
 def wb_supervisor_node_get_type_name(node: int | None) -> str:

@@ -45,9 +45,10 @@ int main(void) {
   printf("custom_data [%s]\n", wb_robot_get_custom_data());
   /* a removed node's identity: Webots' line and its "no value" each, not what the node was */
   WbNodeRef gate = wb_supervisor_node_get_from_def("GATE");
-  printf("stale [%s] [%s] %d [%s] %d live %s %s\n", wb_supervisor_node_get_type_name(crate),
+  printf("stale [%s] [%s] %d [%s] %d %d live %s %s\n", wb_supervisor_node_get_type_name(crate),
          wb_supervisor_node_get_base_type_name(crate), (int)wb_supervisor_node_get_type(crate),
          wb_supervisor_node_get_def(crate), wb_supervisor_node_get_parent_node(crate) == NULL,
+         wb_supervisor_node_get_id(crate),
          wb_supervisor_node_get_type_name(gate), wb_supervisor_node_get_def(gate));
   wb_robot_cleanup();
   return 0;

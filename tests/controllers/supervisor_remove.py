@@ -37,6 +37,6 @@ refused = [crate.getPosition(), crate.getOrientation()[:2], crate.getVelocity()[
            intensity.getSFFloat(), gate.getSFVec3f(), robot.step(timestep)]
 # the removed crate's identity: Webots' line and "no value" each (it answered "Solid" and "CRATE")
 stale = [crate.getTypeName(), crate.getBaseTypeName(), crate.getType(), crate.getDef(), crate.getParentNode(),
-         robot.getFromDef("GATE").getTypeName()]
+         crate.getId(), robot.getFromDef("GATE").getTypeName()]
 print(json.dumps({"before": before, "after": after, "gone": gone, "refused": refused, "moved": moved,
                   "stale": stale}), flush=True)

@@ -224,7 +224,7 @@ WbNodeRef wb_supervisor_node_get_parent_node(WbNodeRef node) {
 }
 
 int wb_supervisor_node_get_id(WbNodeRef node) {
-  return supervisor_node(node, "wb_supervisor_node_get_id") != NULL ? (int)node->id : -1;
+  return live_node(node, "wb_supervisor_node_get_id") != NULL ? (int)node->id : -1;
 }
 
 WbNodeType wb_supervisor_node_get_type(WbNodeRef node) {

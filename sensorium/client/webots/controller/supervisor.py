@@ -134,11 +134,11 @@ class Node:
         self._type_name = type_name
         self._name = name
 
-    def getId(self) -> int:
-        return self._ref
-
     # the identity readers ask the server, as Webots' Node class asks libController: a removed
-    # node answers Webots' line and its "no value" ('', WB_NODE_NO_NODE, None), not what it was
+    # node answers Webots' line and its "no value" ('', WB_NODE_NO_NODE, None, -1), not what it was
+    def getId(self) -> int:
+        return wb.wb_supervisor_node_get_id(self._ref)
+
     def getDef(self) -> str:
         return wb.wb_supervisor_node_get_def(self._ref)
 
