@@ -269,3 +269,18 @@ def test_many_poses_of_a_robot_plate_every_copy_its_single_world(precision):
                 "segmentation": eye.device("cam").segmentation_image}
         want.update({d: np.asarray(eye.device(d).value) for d in DISTANCES})
         _assert_same(_readings(bs, c), want, c)
+
+
+@pytest.mark.parametrize("size", [None, (2.0, 1.5)])
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_a_robot_carrying_the_worlds_only_plane_level(precision, size):
+    """The world's one plane is a level platform the board carries (the single world then takes its
+    one-axis-aligned-plane passes: the C pass, the lidar's floor pass): each copy the same readings."""
+    board = [plane("platform", (0, 0, -0.15), [0, 0, 1, 0], size, (0.9, 0.8, 0.7))]
+    w = world(board_shapes=board, floor=False)
+    lower = [0.6, 0.0, -0.05]
+    bs = _run_batched(w, 2, precision, {1: lower})
+    _assert_same(_readings(bs, 0), _single(w, precision), 0)
+    _assert_same(_readings(bs, 1), _single(w, precision, lower), 1)
+    lidar = bs.range_image(bs.device("eye", "lidar"))
+    assert np.isfinite(lidar[0]).any() and lidar[0].tobytes() != lidar[1].tobytes()
