@@ -11,6 +11,12 @@ only with the bodies of its own copy.
 
 One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
 
+* the robots' planes first (the template bodies' ``plane`` parts, analytic, never in a tier): each ray
+  against its own copy's, each plane at that copy's pose as the single world composes it, with that
+  world's float64 plane arithmetic (:func:`.planes.plane_terms`), its excluded slot's planes left out
+  (a mount does not hide them: the single world casts planes with every ray); the static pass then
+  goes only up to a ray's robot-plane hit, as that world's tiers go only up to its planes' hits, and
+  a robot's plane wins a tie with a static tier's hit, never with a static plane (ordered first);
 * the static pass is one :meth:`RayEngine.cast` of all the rays on ``static`` (which has no movers);
 * the mover pass pairs each ray with the bodies of its copy (a dense (rays x slots) bounding-sphere
   test: the copy gives the candidates, no grid), drops its excluded owner and its mount, moves each
@@ -47,7 +53,9 @@ from sensorium.server.raycast.blocks import MIN_RAYS, in_block
 from sensorium.server.raycast.engine import RayEngine
 from sensorium.server.raycast.exact import _CHUNK, _INF, _PRUNE, _SMALL, _param, _take
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind
+from sensorium.server.raycast.planes import plane_terms
 from sensorium.server.raycast.trace import shell_spheres
+from sensorium.server.world.geometry import Plane, Pose
 
 __all__ = ["CopyRays"]
 
@@ -73,6 +81,8 @@ class CopyRays:
         self.lean = True     # FAST casts through sp_copy_cast where their data allows (False: the general path)
         self._local = threading.local()   # per thread: the lean path's job struct and scratch buffers
         self._static_kept: dict[str, tuple] = {}   # per variant: the lean job's static fields (_static_fields)
+        self._planes: dict[str, tuple | None] = {}   # per variant: the robots' planes (_robot_planes)
+        self._plane_kept: dict[int, tuple] = {}      # the copies' robot planes in the world (_plane_poses)
 
     @property
     def precision(self) -> Precision:
@@ -148,11 +158,19 @@ class CopyRays:
         t_near = _param(t_near, n, np.float64, float)     # uniform -> scalar, as the engine normalises it
         self.counters["casts"] += 1
         self.counters["rays"] += n
+        # the robots' planes first, each ray against its own copy's (the single world casts its planes
+        # before its tiers, every tier then up to the nearest plane hit): the static pass up to them
+        planes = self._robot_plane_pass(O, D, n, t_near, t_far, kind, skip_transparent, copy, rot, pos, exclude_slot,
+                                        distance_only) if n and self.slots else None
+        if planes is not None:
+            t_far = np.minimum(t_far, planes[0])
         lean = (self._lean_cast(O, D, n, t_near, t_far, kind, copy, rot, pos, exclude_slot, mount_slot,
                                 skip_transparent, distance_only, directions32, coherent, origin_rows, run)
                 if self.lean and self.static.native and self.static._precision is Precision.FAST else None)
         if lean is not None:
             hits, pr, pm, far = lean
+            if planes is not None:
+                hits = self._with_planes(hits, planes)
             if pr is None:
                 return hits
             tiers = self._slot_tiers(self.movers._variant(kind, skip_transparent))[0]
@@ -160,6 +178,8 @@ class CopyRays:
         hits = self.static.cast(O, D, t_near, t_far, kind=kind, skip_transparent=skip_transparent,
                                 distance_only=distance_only, directions32=directions32, coherent=coherent,
                                 origin_rows=origin_rows, run=run)
+        if planes is not None:
+            hits = self._with_planes(hits, planes)
         if n == 0 or not self.slots:
             return hits
         variant = self.movers._variant(kind, skip_transparent)
@@ -183,6 +203,116 @@ class CopyRays:
         if not len(pr):
             return hits
         return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent, run)
+
+    def _robot_planes(self, variant: str) -> tuple | None:
+        """The robots' planes ``variant`` sees, as the template bodies carry them: (the movers'
+        :class:`_Planes`, each plane's slot), None when no robot has one."""
+        got = self._planes.get(variant, False)
+        if got is False:
+            pl = self.movers._plane_set(variant)
+            got = None
+            if pl is not None:
+                slot_of = {b: r for r, b in enumerate(self.slot_body) if b is not None}
+                got = (pl, np.array([slot_of[b.index] for b in pl.bodies], dtype=np.int64))
+            self._planes[variant] = got
+        return got
+
+    def _plane_poses(self, pl, slots: np.ndarray, rot: np.ndarray, pos: np.ndarray) -> tuple:
+        """Every copy's robot planes in the world: (point, normal, x axis, y axis), each (C, K, 3),
+        each plane's pose the single world's ``body pose.compose(local pose)`` (the same call: the
+        same bits), made again only for the copies whose robots carrying one moved."""
+        r_now = np.ascontiguousarray(rot[:, slots]).reshape(len(rot), -1)
+        p_now = np.ascontiguousarray(pos[:, slots]).reshape(len(pos), -1)
+        kept = self._plane_kept.get(id(pl))
+        C, K = len(rot), len(slots)
+        if kept is None or kept[0].shape != r_now.shape:
+            out = tuple(np.empty((C, K, 3)) for _ in range(4))
+            todo = range(C)
+        else:
+            r_was, p_was, out = kept   # (bits compared: a signed zero is a change)
+            todo = np.flatnonzero((r_now.view(np.int64) != r_was.view(np.int64)).any(axis=1)
+                                  | (p_now.view(np.int64) != p_was.view(np.int64)).any(axis=1)).tolist()
+        for c in todo:
+            for k, (r, local) in enumerate(zip(slots.tolist(), pl.local)):
+                w = Pose(rot[c, r], pos[c, r]).compose(local)
+                out[0][c, k], out[1][c, k], out[2][c, k], out[3][c, k] = (
+                    w.translation, w.rotation[:, 2], w.rotation[:, 0], w.rotation[:, 1])
+        self._plane_kept[id(pl)] = (r_now, p_now, out)
+        return out
+
+    def _robot_plane_pass(self, O: np.ndarray, D: np.ndarray, n: int, t_near, t_far, kind: RayKind,
+                          skip_transparent: bool, copy, rot: np.ndarray, pos: np.ndarray, exclude_slot,
+                          distance_only: bool) -> tuple | None:
+        """The nearest hit of each ray on its own copy's robots' planes (never another copy's), with
+        the single world's plane arithmetic (:func:`.planes.plane_terms`, each (ray, plane) on its
+        own: the bits of that world's cast_planes): (dist (n,), shape (n,), normal (n, 3)) with inf,
+        -1 and zeros where it meets none (shape and normal None with ``distance_only``), None when
+        no ray meets one. A ray's excluded slot hides that robot's planes (its owner, as
+        ``exclude_owner`` does); a mount does not (the single world casts planes with every ray).
+        Dense: every ray against its copy's K planes, in blocks of rays (bounded temporaries)."""
+        got = self._robot_planes(self.movers._variant(kind, skip_transparent))
+        if got is None:
+            return None
+        pl, slots = got
+        world = self._plane_poses(pl, slots, rot, pos)
+        copy = np.asarray(copy, dtype=np.int64).reshape(n)
+        big = max(float(O.max()), -float(O.min()))
+        eps64 = 1e-9 + 1e-14 * big          # the engine's float64 self-hit threshold for this cast
+        near = np.broadcast_to(np.maximum(t_near, eps64), (n,)) if isinstance(t_near, np.ndarray) else \
+            max(t_near, eps64)
+        far = np.asarray(t_far, dtype=np.float64)
+        far = float(far) if far.ndim == 0 else np.broadcast_to(far, (n,))
+        excl = None if isinstance(exclude_slot, (int, np.integer)) and exclude_slot < 0 else (
+            int(exclude_slot) if isinstance(exclude_slot, (int, np.integer)) else
+            np.broadcast_to(np.asarray(exclude_slot, dtype=np.int64).reshape(-1), (n,)))
+        dist = np.full(n, _INF)
+        shape = None if distance_only else np.full(n, -1, dtype=np.int64)
+        normal = None if distance_only else np.zeros((n, 3))
+        hit = False
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
+            for a in range(0, n, _CHUNK):
+                sl = slice(a, min(n, a + _CHUNK))
+                got = _plane_block(pl, slots, world, O[sl], D[sl], copy[sl],
+                                   near[sl, None] if isinstance(near, np.ndarray) else near,
+                                   far[sl, None] if isinstance(far, np.ndarray) else far,
+                                   excl[sl, None] if isinstance(excl, np.ndarray) else excl, distance_only)
+                if got is None:
+                    continue
+                hit = True
+                dist[sl] = got[0]
+                if not distance_only:
+                    shape[sl], normal[sl] = got[1], got[2]
+        if not hit:
+            return None
+        if shape is not None:
+            shape[shape >= 0] += self.shape_offset
+        return dist, shape, normal
+
+    def _with_planes(self, hits: RayHits, planes: tuple) -> RayHits:
+        """The static pass's hits with the robots' plane hits: a robot's plane is nearer, or as near
+        as a static tier's hit (the single world keeps its planes' hits on ties with a tier), but
+        never wins a tie with a static plane (those come first among that world's planes)."""
+        t, s, nrm = planes
+        dist = hits.distance
+        win = t < dist
+        if s is not None:
+            assert hits.shape is not None and hits.normal is not None
+            entries = self.static._entries
+            tie = (t == dist).nonzero()[0]
+            if len(tie):
+                st = hits.shape[tie]
+                win[tie] = [k < 0 or not isinstance(entries[k].primitive, Plane) for k in st.tolist()]
+        rows = win.nonzero()[0]
+        if not len(rows):
+            return hits
+        dist = dist.copy()
+        dist[rows] = t[rows]
+        if s is None:
+            return RayHits(dist, hits.normal, hits.shape)
+        assert hits.shape is not None and hits.normal is not None
+        shape, normal = hits.shape.copy(), hits.normal.copy()
+        shape[rows], normal[rows] = s[rows], nrm[rows]
+        return RayHits(dist, normal, shape)
 
     def _mover_pass(self, hits: RayHits, O: np.ndarray, D: np.ndarray, t_near, far, pr: np.ndarray, pm: np.ndarray,
                     tiers: list, rot: np.ndarray, pos: np.ndarray, distance_only: bool, coherent: bool,
@@ -479,6 +609,45 @@ class CopyRays:
                 keep[name].ctypes.data for name in ("lim", "far32", "st_t", "st_s", "st_n", "special", "d32"))
             local.keep = keep
         return keep["job"], keep
+
+
+def _plane_block(pl, slots: np.ndarray, world: tuple, O: np.ndarray, D: np.ndarray, copy: np.ndarray, lo, hi, excl,
+                 distance_only: bool) -> tuple | None:
+    """A block of :meth:`CopyRays._robot_plane_pass`: its rays against their copies' planes ``world``
+    ((C, K, 3) points, normals, x and y axes), limits ``lo``, ``hi`` and excluded slots ``excl``
+    (scalars or (m, 1); None: none). (dist, movers' shape index or -1, normal) of the nearest, None
+    when no ray of the block meets one."""
+    m = len(O)
+    PT, NZ, AX, AY = world
+    nz = NZ.take(copy, axis=0)                     # (m, K, 3): each ray its copy's planes
+    nz0, nz1, nz2 = nz[:, :, 0], nz[:, :, 1], nz[:, :, 2]
+    den = (D[:, 0:1] * nz0 + D[:, 1:2] * nz1) + D[:, 2:3] * nz2      # cast_planes' sum, element by element
+    ok = den < 0.0 if pl.visual else den != 0.0
+    if excl is not None:
+        ok &= slots != excl
+    if not np.count_nonzero(ok):
+        return None
+    pt = PT.take(copy, axis=0)
+    axes = [None, None]
+    if pl.sized:
+        axes = [(a[:, :, 0], a[:, :, 1], a[:, :, 2]) for a in (AX.take(copy, axis=0), AY.take(copy, axis=0))]
+    t = plane_terms(O, D, (pt[:, :, 0], pt[:, :, 1], pt[:, :, 2]), (nz0, nz1, nz2), axes[0], axes[1],
+                    (pl.half[:, 0], pl.half[:, 1]), den, ok, lo, hi, pl.sized)
+    if not np.count_nonzero(ok):
+        return None
+    np.copyto(t, _INF, where=~ok)
+    col = np.argmin(t, axis=1)        # the nearest plane; ties keep the first (the single world's order)
+    ar = np.arange(m)
+    dist = t[ar, col]
+    if distance_only:
+        return dist, None, None
+    hit = (dist < _INF).nonzero()[0]
+    shape = np.full(m, -1, dtype=np.int64)
+    normal = np.zeros((m, 3))
+    c = col[hit]
+    shape[hit] = pl.sid[c]
+    normal[hit] = nz[hit, c] * (1.0 - 2.0 * (den[hit, c] > 0.0))[:, None]   # toward the origin
+    return dist, shape, normal
 
 
 def _pairs(O, D, copy, centre, r2, present, lo, lim, excl, mnt) -> tuple[np.ndarray, np.ndarray]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from sensorium.server.raycast import packets
-from sensorium.server.raycast.exact import _INF, _mat
+from sensorium.server.raycast.exact import _INF
 from sensorium.server.raycast.kinds import ShapeEntry
 from sensorium.server.raycast.movers import _Body
 
@@ -43,7 +43,6 @@ class _Planes:
         self.ax = np.array([w.rotation[:, 0] for w in world])
         self.ay = np.array([w.rotation[:, 1] for w in world])
         self.pt = np.array([w.translation for w in world])
-        self.nz_t = np.ascontiguousarray(self.nz.T)
         # one axis-aligned plane (a floor): its normal's only non-zero component, else -1; when sized,
         # also the world axes of its x and y (each a unit axis), else None
         zero = self.nz == 0.0
@@ -66,6 +65,27 @@ class _Planes:
             self._rows = (rows, *(a.ctypes.data for a in rows))
         return self._rows[1:]
 
+
+
+def plane_terms(O, D, pt, nz, ax, ay, half, den, ok, lo, hi, sized: bool) -> np.ndarray:
+    """The distances ``t`` of rays ``O + t D`` ((n, 3) rows; O may be one row) to planes through
+    ``pt`` with normals ``nz`` (each a sequence of 3 coordinate arrays that broadcast with the (n, 1)
+    columns of O and D: (P,) for planes every ray meets, (n, K) for planes per ray), ``den`` = D . nz,
+    and ``ok`` (updated in place) -- the rays' candidates, then those hitting within [lo, hi] and,
+    when ``sized``, within the half sizes ``half`` (2 arrays) along ``ax``, ``ay``. The one float64
+    arithmetic every plane pass runs, element by element in a fixed order (the single world's
+    cast_planes and the copies' robot planes, CopyRays: the same bits)."""
+    # rel = P - O column by column, then rel . nz: exact far from the origin (no cancellation)
+    r0 = pt[0] - O[:, 0:1]
+    r1 = pt[1] - O[:, 1:2]
+    r2 = pt[2] - O[:, 2:3]
+    t = (r0 * nz[0] + r1 * nz[1] + r2 * nz[2]) / den
+    ok &= (t >= lo) & (t <= hi)
+    if sized and np.count_nonzero(ok):  # hit point in the plane frame within the size
+        x0, x1, x2 = t * D[:, 0:1] - r0, t * D[:, 1:2] - r1, t * D[:, 2:3] - r2
+        ok &= (np.abs(x0 * ax[0] + x1 * ax[1] + x2 * ax[2]) <= half[0]) & \
+              (np.abs(x0 * ay[0] + x1 * ay[1] + x2 * ay[2]) <= half[1])
+    return t
 
 
 def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, distance_only: bool = False,
@@ -92,26 +112,18 @@ def cast_planes(pl: _Planes, epoch: int, O, D, t_near, t_far, excl, eps64, dista
         # the engine's block threads: ~10x slower on a busy 2-core machine)
         c = float(pl.nz[0, pl.axis])
         den = (D[:, pl.axis] if c == 1.0 else D[:, pl.axis] * c).reshape(n, 1)
-    else:
-        den = _mat(D, pl.nz_t)                           # (n, P)
+    else:   # (n, P), each element summed in one fixed order, as plane_terms sums it (never BLAS: its
+        # fused multiply-adds would make a ray's answer depend on the cast's shape)
+        nz = pl.nz
+        den = (D[:, 0:1] * nz[:, 0] + D[:, 1:2] * nz[:, 1]) + D[:, 2:3] * nz[:, 2]
     ok = den < 0.0 if pl.visual else den != 0.0
     if not np.count_nonzero(ok):  # e.g. horizontal rays over a floor
         return None
     lo = np.maximum(t_near, eps64)[:, None] if isinstance(t_near, np.ndarray) else max(t_near, eps64)
     hi = t_far[:, None] if isinstance(t_far, np.ndarray) else t_far
-    # rel = P - O column by column, then rel . nz: exact far from the origin (no cancellation)
     Oo = O[:1] if O.strides[0] == 0 else O   # one origin: (1, P) offsets, the same values
-    r0 = pl.pt[:, 0] - Oo[:, 0:1]
-    r1 = pl.pt[:, 1] - Oo[:, 1:2]
-    r2 = pl.pt[:, 2] - Oo[:, 2:3]
     nz = pl.nz
-    t = (r0 * nz[:, 0] + r1 * nz[:, 1] + r2 * nz[:, 2]) / den
-    ok &= (t >= lo) & (t <= hi)
-    if pl.sized and np.count_nonzero(ok):  # hit point in the plane frame within the size
-        x0, x1, x2 = t * D[:, 0:1] - r0, t * D[:, 1:2] - r1, t * D[:, 2:3] - r2
-        ax, ay = pl.ax, pl.ay
-        ok &= (np.abs(x0 * ax[:, 0] + x1 * ax[:, 1] + x2 * ax[:, 2]) <= pl.half[:, 0]) & \
-              (np.abs(x0 * ay[:, 0] + x1 * ay[:, 1] + x2 * ay[:, 2]) <= pl.half[:, 1])
+    t = plane_terms(Oo, D, pl.pt.T, nz.T, pl.ax.T, pl.ay.T, pl.half.T, den, ok, lo, hi, pl.sized)
     if check_owner:
         ok &= pl.owner != (excl[:, None] if isinstance(excl, np.ndarray) else excl)
     if not np.count_nonzero(ok):
