@@ -232,3 +232,37 @@ def test_serve_refuses_recording_options_without_a_recording(capsys):
         args = parser.parse_args(["serve", "arena", "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0", *extra])
         assert main(args) == 2
         assert capsys.readouterr().err.strip().splitlines() == [f"sensorium serve: {said}"]
+
+
+def test_a_warning_about_the_users_world_is_one_line(tmp_path):
+    """A GroundWarning (a robot over no ground in a world with a terrain) printed by a command is one
+    line, ``sensorium: warning: ...``, not Python's form with our source file and code line."""
+    import yaml
+
+    ramp = {"name": "ramp", "pose": {"translation": [40.0, 40.0, 0.0]},
+            "geometry": {"type": "elevation_grid", "x_dimension": 2, "y_dimension": 2, "x_spacing": 1.0,
+                         "y_spacing": 1.0, "height": [0.0, 0.1, 0.0, 0.1]}}
+    robot = {"name": "r", "pose": {"translation": [0.0, 0.0, 0.05]},
+             "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05}}
+    world = tmp_path / "w.yaml"
+    world.write_text(yaml.safe_dump({"solids": [ramp], "robots": [robot]}))
+    r = run("probe", str(world))
+    lines = r.stderr.splitlines()
+    assert lines[0] == (f"sensorium: warning: {world}: robot 'r' starts over no ground (no upright terrain or floor "
+                        "plane under its origin): it keeps its height, terrains do not lift it"), r.stderr
+    assert "GroundWarning" not in r.stderr and ".py:" not in r.stderr
+
+
+def test_other_libraries_warnings_keep_pythons_form(monkeypatch, capsys):
+    import warnings
+
+    from sensorium.cli import one_line_warnings
+    from sensorium.server.sim.ground import GroundWarning
+
+    python_form: list[tuple] = []
+    monkeypatch.setattr(warnings, "showwarning", lambda *a, **k: python_form.append(a))
+    one_line_warnings()
+    warnings.showwarning(GroundWarning("over no ground"), GroundWarning, "ground.py", 1)
+    warnings.showwarning(DeprecationWarning("a library's own"), DeprecationWarning, "lib.py", 7)
+    assert capsys.readouterr().err == "sensorium: warning: over no ground\n"
+    assert [(str(m), c, f, n) for m, c, f, n, *_ in python_form] == [("a library's own", DeprecationWarning, "lib.py", 7)]

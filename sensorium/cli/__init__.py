@@ -377,6 +377,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def one_line_warnings() -> None:
+    """Sensorium's own warnings (``GroundWarning``, ``WorldLossWarning``: facts about the user's
+    world) print as one line, ``sensorium: warning: ...``, not in Python's form (our source file,
+    line and code); other libraries' warnings keep Python's form."""
+    import warnings
+
+    python_form = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if category.__module__.startswith("sensorium."):
+            print(f"sensorium: warning: {message}", file=sys.stderr if file is None else file, flush=True)
+        else:
+            python_form(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+
+
 def main(argv: list[str] | None = None) -> int:
     import importlib
 
@@ -397,6 +414,7 @@ def main(argv: list[str] | None = None) -> int:
             module_name, func_name = args._target.split(":")
             _export_proto_args(args)
             func: Handler = getattr(importlib.import_module(module_name), func_name)
+        one_line_warnings()
         return int(func(args) or 0)
     except KeyboardInterrupt:
         print(f"{name}: interrupted", file=sys.stderr, flush=True)
