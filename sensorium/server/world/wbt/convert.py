@@ -88,6 +88,7 @@ class Converter:
         self.solid_names: Counter[str] = Counter()
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
+        self.device_depth = 0              # > 0 while inside a device's children (its joints are no wheels)
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
         self.checked_grids: set[int] = set()   # ElevationGrids sanitised (warned once: a shape and its boundingObject)
         self.constrained: set[int] = set()     # Transforms in boundingObjects whose scale Webots constrains
@@ -803,13 +804,17 @@ class Converter:
             owner.data["devices"].append(data)
             self.device_contents(node, inner, owner, data)
             return
-        self.solid_contents(node, inner, owner)
+        self.device_contents(node, inner, owner, None)
 
     def device_contents(self, node: Node, frame: Frame, owner: Owner, device: dict | None) -> None:
         """A device's own Solid contents: robot body shapes marked as the device's own (its visual
         rays do not see them, sim/own_shapes.py), the innermost device's for nested ones."""
         start = len(owner.parts)
-        self.solid_contents(node, frame, owner)
+        self.device_depth += 1
+        try:
+            self.solid_contents(node, frame, owner)
+        finally:
+            self.device_depth -= 1
         if device is not None:
             for part in owner.parts[start:]:
                 part.setdefault("_device", device)
@@ -879,9 +884,12 @@ class Converter:
         sensors: list[dict] = []
         if owner.kind == "robot":
             _, sensors = self.joint_devices(node, owner)
-        if owner.kind == "robot" and node.type == "Hinge2Joint":    # a steered wheel (a car)
+        # a joint inside a device (a lidar's spinning turret, a camera's pan-tilt) moves the device,
+        # never the robot: it is no wheel, whatever its axis (Webots has no notion of a drive either)
+        wheeled = owner.kind == "robot" and not self.device_depth
+        if wheeled and node.type == "Hinge2Joint":    # a steered wheel (a car)
             self.hinge2(node, frame, owner, motors, sensors)
-        elif owner.kind == "robot" and node.type == "HingeJoint" and motors:
+        elif wheeled and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
             if params is not None:
                 self.typos(params)
@@ -900,10 +908,11 @@ class Converter:
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
-        elif motors and node.type != "Hinge2Joint":
-            self.warn(node, f"{node.type} motor(s) not part of a wheel: listed, not simulated (joints do not move here)")
+        elif motors and (node.type != "Hinge2Joint" or not wheeled):
+            self.warn(node, f"{node.type} motor(s) not part of a wheel{' (inside a device)' if owner.kind == 'robot' and not wheeled else ''}: "
+                            "listed, not simulated (joints do not move here)")
         # (a robot's Hinge2Joint: hinge2() said which of its axes has sensors but no motor)
-        if sensors and not (owner.kind == "robot" and (node.type == "Hinge2Joint" or (node.type == "HingeJoint" and motors))):
+        if sensors and not (wheeled and (node.type == "Hinge2Joint" or (node.type == "HingeJoint" and motors))):
             self.warn(node, "PositionSensor on a joint without a drive wheel motor: listed, reads no value")
         if end is not None:
             if end.type == "SolidReference":
