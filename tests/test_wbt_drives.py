@@ -173,3 +173,30 @@ def test_a_devices_own_motorised_joints_are_no_wheels(tmp_path: Path) -> None:
     assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == ["left wheel", "right wheel"]
     assert not [x for x in w.warnings if "drive" in x]
     assert len([x for x in w.warnings if "not part of a wheel (inside a device)" in x]) == 2
+
+
+def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> None:
+    """A gripper's lift arm (a motorised hinge along the robot's +y, like the wheels, its end point a
+    box with slider fingers: nothing round to roll on) on a two-wheel robot: the robot keeps its
+    two-wheel drive (three "wheels", one on the x axis, made no drive at all), the arm's motor is
+    listed with one warning at its joint, the wheel encoders measure their wheels."""
+    arm = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor -0.01 0 0.022 }\n'
+           '  device [ RotationalMotor { name "lift" } PositionSensor { name "lift sensor" } ]\n'
+           '  endPoint Solid { translation -0.01 0 0.022 children [\n'
+           '    SliderJoint { jointParameters JointParameters { axis 1 0 0 }\n'
+           '      device [ LinearMotor { name "grip" } ] endPoint Solid { translation 0 0 -0.048 } }\n'
+           '  ] boundingObject Pose { translation 0 0 -0.021 children [ Box { size 0.068 0.008 0.052 } ] } } }\n')
+    body = ('Robot { name "khepera" children [\n' + arm + wheel("left wheel", 0, 0.026)
+            + wheel("right wheel", 0, -0.026) + '] }\n')
+    p = write(tmp_path, body)
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=0.052, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert [(d.name, d.device) for d in robot.devices][:3] == [
+        ("lift", "RotationalMotor"), ("lift sensor", "PositionSensor"), ("grip", "LinearMotor")]
+    assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == [None, "left wheel", "right wheel"]
+    assert not [x for x in w.warnings if "drive" in x]
+    assert f"{p}:4:1: HingeJoint motor 'lift' is no wheel (its end point has no cylinder or sphere to roll on): " \
+           "listed, not simulated (joints do not move here)" in w.warnings
+    assert sorted(Simulation(w).robot("khepera").motors) == ["left wheel", "right wheel"]   # the lift is not one

@@ -960,7 +960,7 @@ class Converter:
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
     def drive(self, node: Node, robot: Owner) -> None:
-        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive
+        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive, wheel_radius
 
         wheels = robot.wheels
         if not wheels:
@@ -973,6 +973,18 @@ class Converter:
             robot.data["ackermann_drive"] = drive
         else:
             drive, why = differential_drive(wheels, self)
+            # a motorised hinge whose end point has nothing round to roll on (a gripper's lift arm, a
+            # flipper) is no wheel: the drive is the wheels without it, if they make one
+            rolling = [w for w in wheels if wheel_radius(w["end"], self) is not None] if drive is None else wheels
+            if 2 <= len(rolling) < len(wheels):
+                drive, _ = differential_drive(rolling, self)
+                if drive is not None:
+                    for w in wheels:
+                        if not any(w is r for r in rolling):
+                            self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel (its end point has no "
+                                                 "cylinder or sphere to roll on): listed, not simulated (joints do "
+                                                 "not move here)")
+                    wheels = rolling
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return
