@@ -288,6 +288,9 @@ Robot {
     assert d.value == pytest.approx(1000 * 0.35, abs=1e-9)
 
 
+_ROLLER = "Solid { children [ Shape { geometry Cylinder { radius 0.03 height 0.01 } } ] }"
+
+
 def _two_wheels(axis_left: str = "0 1 0", anchor_x: float = 0.0, extra: str = "") -> str:
     def wheel(side: str, y: float, axis: str) -> str:
         return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor {anchor_x} {y} 0.02 }} '
@@ -366,9 +369,12 @@ def test_a_propeller_lists_its_motor_and_shows_its_slow_helix(tmp_path: Path) ->
 @pytest.mark.parametrize("kwargs, why", [
     (dict(axis_left="0 -1 0"), "wheel axis of motor 'left wheel motor' is [0.0, -1.0, 0.0], not the robot's +y"),
     (dict(anchor_x=0.02), "the axle midpoint is at x=0.02, y=0 in the robot frame, not under the robot's origin"),
-    (dict(extra='HingeJoint { device [ RotationalMotor { name "third" } ] }\n'),
+    # a third motorised hinge that is a wheel (its end point has a cylinder to roll on): a hinge
+    # with nothing round at its end is no wheel and leaves the other two their drive (test_wbt_drives.py)
+    (dict(extra=f'HingeJoint {{ device [ RotationalMotor {{ name "third" }} ] endPoint {_ROLLER} }}\n'),
      "wheel axis of motor 'third' is [1.0, 0.0, 0.0], not the robot's +y"),
-    (dict(extra='HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } device [ RotationalMotor { name "third" } ] }\n'),
+    (dict(extra='HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } device [ RotationalMotor { name '
+                f'"third" }} ] endPoint {_ROLLER} }}\n'),
      "3 motorised wheels, not all on either side of the robot's x axis"),
 ])
 def test_no_drive_says_why(tmp_path: Path, kwargs: dict, why: str) -> None:
