@@ -745,3 +745,56 @@ def test_simulated_device_kinds_read_their_own_fields(tmp_path: Path) -> None:
     assert compass.lookup_table == [(-1.0, -1.0, 0.0), (1.0, 1.0, 0.0)] and compass.y_axis is False
     assert alt.accuracy == 0.2
     assert any("Altimeter.wobble: not read here" in x for x in w.warnings)
+
+
+def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
+    """A tracked robot written as Webots' Track sample is: each Track's motor is in the Track's
+    ``device`` field and its wheels are TrackWheels, placed at (position.x, 0, position.y) in the
+    Track's frame (WbTrackWheel). The motors were silently missing (getDevice found nothing) and the
+    wheels were dropped as unknown nodes; now the motors are listed (not simulated: tracks do not
+    move here) with one warning per Track, the wheels' shapes are where Webots draws them, and the
+    belt Webots animates along them is in the skipped summary."""
+    def track(side: str, y: float) -> str:
+        return (f'Track {{ translation 0 {y} 0 name "{side} track" children [\n'
+                f'  TrackWheel {{ position -0.15 0.0075 radius 0.046 children [ Shape {{ geometry Cylinder {{ '
+                f'radius 0.046 height 0.015 }} }} ] }}\n'
+                f'  TrackWheel {{ position 0.0925 -0.044 radius 0.02 children [ Pose {{ rotation 1 0 0 1.5708 '
+                f'children [ Shape {{ geometry Sphere {{ radius 0.02 }} }} ] }} ] }}\n'
+                f'] device [ LinearMotor {{ name "{side} motor" }} PositionSensor {{ name "{side} sensor" }} ]\n'
+                f'  animatedGeometry Shape {{ geometry Box {{ size 0.022 0.015 0.0025 }} }} geometriesCount 40 }}\n')
+    p = write(tmp_path, 'Robot { name "tank" translation 0 0 0.07 children [\n'
+              'Shape { geometry Box { size 0.3 0.13 0.08 } }\n' + track("left", 0.07) + track("right", -0.07) + '] }\n')
+    w = load_world(p)
+    assert not w.report.losses
+    (robot,) = w.world.robots
+    assert [(d.device, d.name) for d in robot.devices] == [
+        ("LinearMotor", "left motor"), ("PositionSensor", "left sensor"),
+        ("LinearMotor", "right motor"), ("PositionSensor", "right sensor")]
+    assert [(s.geometry.type, s.pose.translation) for s in robot.shapes] == [
+        ("box", (0.0, 0.0, 0.0)), ("cylinder", (-0.15, 0.07, 0.0075)), ("sphere", (0.0925, 0.07, -0.044)),
+        ("cylinder", (-0.15, -0.07, 0.0075)), ("sphere", (0.0925, -0.07, -0.044))]
+    assert [x for x in w.warnings if "Track" in x] == [
+        f"{p}:4:1: Track 'left track': its devices are listed, not simulated (tracks do not move here)",
+        f"{p}:9:1: Track 'right track': its devices are listed, not simulated (tracks do not move here)",
+        f"{p}: skipped nodes that do not matter to these sensors: Track.animatedGeometry x2"]
+    entries = Simulation(w).robot("tank").device_list     # what a controller's getDevice finds (not simulated)
+    assert [(e.name, e.simulated) for e in entries if e.name.endswith("motor")] == [
+        ("left motor", False), ("right motor", False)]
+
+
+def test_a_device_not_simulated_is_said_in_the_load_report(tmp_path: Path) -> None:
+    """A Radar, Display or Speaker is listed (a controller's getDevice finds it, its functions
+    answer Webots' "no value") but not simulated: the load report says so, one line each at the
+    device's own place, so `validate` no longer answers a plain OK for a world whose radar reads
+    nothing."""
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+              'Radar { maxRange 1.5 }\nDisplay { name "screen" width 14 height 14 }\nGPS { }\nSpeaker { }\n] }\n')
+    w = load_world(p)
+    assert not w.report.losses
+    assert w.warnings == [
+        f"{p}:3:1: Radar 'radar' of robot 'r': listed (a controller finds it), not simulated here: its functions "
+        "answer Webots' \"no value\"",
+        f"{p}:4:1: Display 'screen' of robot 'r': listed (a controller finds it), not simulated here: its functions "
+        "answer Webots' \"no value\"",
+        f"{p}:6:1: Speaker 'speaker' of robot 'r': listed (a controller finds it), not simulated here: its functions "
+        "answer Webots' \"no value\""]

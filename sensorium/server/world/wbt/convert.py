@@ -284,6 +284,16 @@ class Converter:
                     data = self.unsimulated(node, inner, owner)
                     if t == "Pen":             # a Pen keeps its fields (simulated: it inks)
                         data.update(fx.pen(f))
+                    elif t in wm.UNSIMULATED_DEVICE_TYPES:
+                        self.warn(node, f"{t} {data['name']!r} of robot {owner.data['name']!r}: listed (a controller "
+                                        "finds it), not simulated here: its functions answer Webots' \"no value\"")
+                elif t == "Track":           # a Solid whose device field holds its motor (and sensor, brake)
+                    if f.node_("animatedGeometry") is not None:     # the belt Webots draws along its wheels
+                        self.skipped["Track.animatedGeometry"] += 1
+                    motors, sensors = self.joint_devices(node, owner)
+                    if motors or sensors or f.nodes("device"):
+                        self.warn(node, f"Track {f.string('name', 'solid')!r}: its devices are listed, not simulated "
+                                        "(tracks do not move here)")
                 self.device_contents(node, inner, owner, data)
             else:     # a device outside a robot is still a Solid whose shapes rays see
                 self.warn(node, f"{t} outside a Robot: not a device here (devices belong to robots); its shapes "
@@ -307,6 +317,11 @@ class Converter:
                 self.visit(end, frame, owner)
         elif t in ("Pose", "Transform"):
             inner = self.child_frame(node, frame)
+            for child in f.nodes("children"):
+                self.visit(child, inner, owner)
+        elif t == "TrackWheel":          # a Pose at (position.x, 0, position.y) in its Track's frame (Webots)
+            px, py = f.vec("position", (0.0, 0.0))
+            inner = frame.then((px, 0.0, py), (0.0, 0.0, 1.0, 0.0), (1.0, 1.0, 1.0))
             for child in f.nodes("children"):
                 self.visit(child, inner, owner)
         elif t == "Shape":
