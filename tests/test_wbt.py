@@ -798,3 +798,29 @@ def test_a_device_not_simulated_is_said_in_the_load_report(tmp_path: Path) -> No
         "answer Webots' \"no value\"",
         f"{p}:6:1: Speaker 'speaker' of robot 'r': listed (a controller finds it), not simulated here: its functions "
         "answer Webots' \"no value\""]
+
+
+def test_world_info_gravity_and_gps_coordinates_are_read(tmp_path: Path) -> None:
+    """WorldInfo's gravity (what an accelerometer at rest reads), gpsCoordinateSystem and
+    gpsReference were left out of a .wbt world without a word: a WGS84 world's GPS read local
+    metres and a Mars world's accelerometer read the Earth's gravity."""
+    p = write(tmp_path, 'WorldInfo { gravity 3.71 gpsCoordinateSystem "WGS84" gpsReference 40.67 -73.94 10 }\n'
+                        'Robot { name "r" children [ GPS { } Accelerometer { } ] }\n')
+    w = load_world(p)
+    info = w.world.world_info
+    assert (info.gravity, info.gps_coordinate_system, info.gps_reference) == (3.71, "WGS84", (40.67, -73.94, 10.0))
+    sim = Simulation(w)
+    gps, acc = sim.device("r/gps"), sim.device("r/accelerometer")
+    gps.enable(32)
+    acc.enable(32)
+    sim.step()
+    assert gps.values == pytest.approx([40.67, -73.94, 10.0], abs=1e-9)    # the reference is the world's origin
+    assert acc.values == pytest.approx([0.0, 0.0, 3.71], abs=1e-12)
+    # local coordinates: the reference is added; another name is local, as Webots reads it, with a warning
+    p = write(tmp_path, 'WorldInfo { gpsCoordinateSystem "UTM" gpsReference 1 2 3 }\nRobot { name "r" children [ GPS { } ] }\n')
+    w = load_world(p)
+    assert (w.world.world_info.gps_coordinate_system, w.world.world_info.gps_reference) == ("local", (1.0, 2.0, 3.0))
+    assert w.warnings == [f"{p}:2:1: WorldInfo.gpsCoordinateSystem 'UTM' is neither \"WGS84\" nor \"local\": local "
+                          "coordinates, as Webots returns for any value but \"WGS84\""]
+    with pytest.raises(WorldError, match=r"gravity: -9.81 < 0 \(gravity pointing up\) is not supported here"):
+        load_world(write(tmp_path, 'WorldInfo { gravity -9.81 }\n'))

@@ -214,6 +214,21 @@ class Converter:
         evaporation = f.num("inkEvaporation", 0.0)
         if evaporation > 0.0:          # Webots' pen ink fading (a value <= 0 never evaporates)
             info["ink_evaporation"] = evaporation
+        gravity = f.num("gravity", 9.81)        # what an accelerometer at rest reads (a Mars world: 3.71)
+        if gravity < 0.0:
+            raise f.error("gravity", f"{gravity:g} < 0 (gravity pointing up) is not supported here")
+        if gravity != 9.81:
+            info["gravity"] = gravity
+        gps = f.string("gpsCoordinateSystem", "local")     # what GPS devices read (Webots: WGS84, else local)
+        if gps not in ("local", "WGS84"):
+            self.warn(node, f"WorldInfo.gpsCoordinateSystem {gps!r} is neither \"WGS84\" nor \"local\": local "
+                            "coordinates, as Webots returns for any value but \"WGS84\"")
+            gps = "local"
+        if gps != "local":
+            info["gps_coordinate_system"] = gps
+        reference = f.vec("gpsReference", (0.0, 0.0, 0.0))
+        if tuple(reference) != (0.0, 0.0, 0.0):
+            info["gps_reference"] = list(reference)
         self.world["world_info"] = info
 
     def fog(self, node: Node, f: Fields) -> None:
