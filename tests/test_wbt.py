@@ -824,3 +824,36 @@ def test_world_info_gravity_and_gps_coordinates_are_read(tmp_path: Path) -> None
                           "coordinates, as Webots returns for any value but \"WGS84\""]
     with pytest.raises(WorldError, match=r"gravity: -9.81 < 0 \(gravity pointing up\) is not supported here"):
         load_world(write(tmp_path, 'WorldInfo { gravity -9.81 }\n'))
+
+
+def test_a_device_inside_its_robots_body_is_said(tmp_path: Path) -> None:
+    """A range finder mounted just under the top of its robot's body cylinder (as Webots' own
+    range-finder sample is): Webots culls the cylinder seen from inside and the device sees out;
+    here the cylinder is seen from inside (README: a device inside a closed shape), and the load
+    report now says so at the device, naming the shape. A device outside the body, an infra-red
+    sensor inside a cylinder (Webots' picking sees cylinders from inside too) and the device's own
+    housing are not reported."""
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+              'Pose { translation 0 0 0.0415 children [ Shape { geometry Cylinder { radius 0.045 height 0.08 } } ] }\n'
+              'RangeFinder { translation 0.031 0 0.08 children [ Shape { geometry Box { size 0.01 0.01 0.01 } } ] }\n'
+              'Camera { translation 0.031 0 0.09 }\n'
+              'DistanceSensor { translation 0.03 0 0.05 type "infra-red" }\n'
+              '] }\n')
+    w = load_world(p)
+    assert w.warnings == [
+        f"{p}:4:1: RangeFinder 'range-finder' of robot 'r' is inside the robot's cylinder (written at line 3, column 59): "
+        "its rays see that shape from inside, where Webots' never do (back faces culled); mount the device outside it "
+        "or make the shape part of the device's Solid"]
+
+
+def test_camera_fields_the_renderer_uses_and_rays_do_not_are_said(tmp_path: Path) -> None:
+    """Lens distortion, motion blur and the other image effects of Webots' renderer (README: what a
+    rasterising GPU gives that this does not) were dropped from a .wbt camera without a word; each
+    one a world writes (with a value that does something in Webots) is now one warning."""
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+              'Camera { lens Lens { radialCoefficients 0.2 0 } motionBlur 100 bloomThreshold -1 zoom NULL }\n'
+              'RangeFinder { motionBlur 0 }\n] }\n')
+    w = load_world(p)
+    assert w.warnings == [
+        f"{p}:3:1: Camera 'camera' of robot 'r': {field} is not rendered here; the image is Webots' without it"
+        for field in ("lens (lens distortion)", "motionBlur (motion blur)")]

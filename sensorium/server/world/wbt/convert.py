@@ -27,6 +27,7 @@ from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
 from sensorium.server.world.wbt.fields import Fields
 from sensorium.server.world.wbt.frames import Frame, bounding_constraint, bounding_geometry, visual_geometry
+from sensorium.server.world.wbt.inside import enclosing_shapes, unread_image_fields
 from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
@@ -89,6 +90,7 @@ class Converter:
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.device_depth = 0              # > 0 while inside a device's children (its joints are no wheels)
+        self.device_where: dict[int, str] = {}   # id(device entry) -> where its node is written
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
         self.checked_grids: set[int] = set()   # ElevationGrids sanitised (warned once: a shape and its boundingObject)
         self.constrained: set[int] = set()     # Transforms in boundingObjects whose scale Webots constrains
@@ -781,9 +783,25 @@ class Converter:
         for part in data.get("shapes", ()):      # the device's final name (after unique_devices)
             if "_device" in part:
                 part["of_device"] = part.pop("_device")["name"]
+        self.devices_inside(data)
         if not data["devices"]:
             del data["devices"]
         self.world["robots"].append(data)
+
+    def devices_inside(self, robot: dict) -> None:
+        """One warning for each visual device whose origin is inside one of its robot's closed
+        shapes, which Webots never sees from there and rays here do (wbt/inside.py)."""
+        for dev in robot["devices"]:
+            where = self.device_where.get(id(dev))
+            if where is None:
+                continue
+            for part in enclosing_shapes(robot, dev):
+                line, col, _ = part.get("_at", (0, 0, ""))
+                at = f" (written at line {line}, column {col})" if line else ""
+                self.warnings.append(
+                    f"{where}: {dev['device']} {dev['name']!r} of robot {robot['name']!r} is inside the robot's "
+                    f"{part['geometry']['type']}{at}: its rays see that shape from inside, where Webots' never do "
+                    "(back faces culled); mount the device outside it or make the shape part of the device's Solid")
 
     def unique_devices(self, robot: dict) -> None:
         """Device names address topics and services, so a repeated one gets a suffix (Webots warns
@@ -829,8 +847,12 @@ class Converter:
             if model:
                 data["model"] = model
             data["_at"] = self.at(node)
+            self.device_where[id(data)] = self.where(node)
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
+            for name, what in unread_image_fields(node.type, node.fields):
+                self.warn(node, f"{node.type} {data['name']!r} of robot {owner.data['name']!r}: {name} ({what}) is "
+                                "not rendered here; the image is Webots' without it")
             owner.data["devices"].append(data)
             self.device_contents(node, inner, owner, data)
             return
