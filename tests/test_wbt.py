@@ -857,3 +857,21 @@ def test_camera_fields_the_renderer_uses_and_rays_do_not_are_said(tmp_path: Path
     assert w.warnings == [
         f"{p}:3:1: Camera 'camera' of robot 'r': {field} is not rendered here; the image is Webots' without it"
         for field in ("lens (lens distortion)", "motionBlur (motion blur)")]
+
+
+def test_a_robots_battery_and_a_charger_are_said(tmp_path: Path) -> None:
+    """Webots' battery sample: a robot with a ``battery`` (its controller reads the battery sensor)
+    and Chargers around it. The battery was dropped without a word (its sensor reads NaN here) and
+    a Charger was called a device outside a robot; both are now one plain line, the Charger's shapes
+    kept as a solid."""
+    p = write(tmp_path, 'Robot { name "r" battery [ 50, 100, 30 ] cpuConsumption 0.5 }\n'
+              'Charger { name "charger0" battery [ 100, 100, 3 ] children [ Shape { geometry Cylinder { radius 0.1 '
+              'height 0.3 } } ] }\n')
+    w = load_world(p)
+    assert not w.report.losses
+    assert w.warnings == [
+        f"{p}:2:1: Robot 'r': battery 50, 100, 30 is not simulated here: its battery sensor reads NaN, as a Webots "
+        "robot without a battery",
+        f"{p}:3:1: Charger 'charger0': recharging is not simulated (robots have no battery here); its shapes and "
+        "lights are kept as a solid"]
+    assert [(s.name, [x.geometry.type for x in s.shapes]) for s in w.world.solids] == [("charger0", ["cylinder"])]

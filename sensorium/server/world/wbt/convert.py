@@ -292,6 +292,10 @@ class Converter:
             self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
             self.scaled_solid(node, owner)
+        elif t == "Charger":             # a Solid that recharges robots' batteries (no battery here)
+            self.warn(node, f"Charger {f.string('name', 'solid')!r}: recharging is not simulated (robots have no "
+                            "battery here); its shapes and lights are kept as a solid")
+            self.solid(node, frame, owner, "solid")
         elif t in OTHER_DEVICES:
             if owner.kind == "robot":
                 inner = self.child_frame(node, frame)
@@ -773,6 +777,10 @@ class Converter:
         colors = f.colors("recognitionColors", [])
         if colors:
             data["recognition_colors"] = [list(c) for c in colors]
+        battery = f.numbers("battery") if "battery" in node.fields else []
+        if battery:        # Webots: current energy, maximum, recharge speed; its battery sensor reads the first
+            self.warn(node, f"Robot {unique!r}: battery {', '.join(f'{v:g}' for v in battery)} is not simulated here: "
+                            "its battery sensor reads NaN, as a Webots robot without a battery")
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.solid_contents(node, Frame.identity(), mine)
