@@ -875,3 +875,21 @@ def test_a_robots_battery_and_a_charger_are_said(tmp_path: Path) -> None:
         f"{p}:3:1: Charger 'charger0': recharging is not simulated (robots have no battery here); its shapes and "
         "lights are kept as a solid"]
     assert [(s.name, [x.geometry.type for x in s.shapes]) for s in w.world.solids] == [("charger0", ["cylinder"])]
+
+
+def test_robot_self_collision_is_read(tmp_path: Path) -> None:
+    """Robot.selfCollision was not read from a .wbt world: a generic distance sensor never saw its
+    own robot's bounding objects, as if it were FALSE (README: ODE-style rays skip the whole robot
+    unless ``self_collision``)."""
+    def world(flag: str) -> str:
+        return (f'Robot {{ name "r" selfCollision {flag} children [\n'
+                'DistanceSensor { lookupTable [ 0 0 0, 1 1000 0 ] }\n'
+                'Solid { translation 0.5 0 0 boundingObject Box { size 0.1 1 1 } }\n] }\n')
+    for flag, expected in (("TRUE", 450.0), ("FALSE", 1000.0)):
+        w = load_world(write(tmp_path, world(flag)))
+        assert w.world.robots[0].self_collision is (flag == "TRUE")
+        sim = Simulation(w)
+        ds = sim.device("r/distance sensor")
+        ds.enable(32)
+        sim.step()
+        assert ds.value == pytest.approx(expected)

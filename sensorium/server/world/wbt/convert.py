@@ -777,6 +777,8 @@ class Converter:
         colors = f.colors("recognitionColors", [])
         if colors:
             data["recognition_colors"] = [list(c) for c in colors]
+        if f.flag("selfCollision", False):    # its generic, sonar and laser sensors see its own bounding objects
+            data["self_collision"] = True
         battery = f.numbers("battery") if "battery" in node.fields else []
         if battery:        # Webots: current energy, maximum, recharge speed; its battery sensor reads the first
             self.warn(node, f"Robot {unique!r}: battery {', '.join(f'{v:g}' for v in battery)} is not simulated here: "
