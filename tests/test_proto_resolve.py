@@ -201,6 +201,12 @@ def test_builtin_stand_ins_when_the_file_is_missing_and_the_real_one_when_found(
     loaded = load_world(w, webots_home=home)
     assert loaded.world.solids[0].name == "real arena"
     assert not [x for x in loaded.warnings if "RectangleArena" in x]
+    # an installation was given but does not hold TexturedBackground: the note says where it looked
+    # (it used to ask for the --webots-home the user had just given)
+    notes = [x for x in loaded.warnings if "PROTO files not found" in x]
+    assert notes == [f"{w}:3:1: PROTO files not found: TexturedBackground skipped (no effect on these sensors) (not in "
+                     f"the Webots installation {home} nor the --proto-path folders: a complete installation (or "
+                     "--proto-path) gives Webots' own)"]
 
 
 def test_unused_declarations_that_are_missing_are_a_warning(tmp_path: Path) -> None:

@@ -288,6 +288,9 @@ Robot {
     assert d.value == pytest.approx(1000 * 0.35, abs=1e-9)
 
 
+_ROLLER = "Solid { children [ Shape { geometry Cylinder { radius 0.03 height 0.01 } } ] }"
+
+
 def _two_wheels(axis_left: str = "0 1 0", anchor_x: float = 0.0, extra: str = "") -> str:
     def wheel(side: str, y: float, axis: str) -> str:
         return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor {anchor_x} {y} 0.02 }} '
@@ -366,9 +369,12 @@ def test_a_propeller_lists_its_motor_and_shows_its_slow_helix(tmp_path: Path) ->
 @pytest.mark.parametrize("kwargs, why", [
     (dict(axis_left="0 -1 0"), "wheel axis of motor 'left wheel motor' is [0.0, -1.0, 0.0], not the robot's +y"),
     (dict(anchor_x=0.02), "the axle midpoint is at x=0.02, y=0 in the robot frame, not under the robot's origin"),
-    (dict(extra='HingeJoint { device [ RotationalMotor { name "third" } ] }\n'),
+    # a third motorised hinge that is a wheel (its end point has a cylinder to roll on): a hinge
+    # with nothing round at its end is no wheel and leaves the other two their drive (test_wbt_drives.py)
+    (dict(extra=f'HingeJoint {{ device [ RotationalMotor {{ name "third" }} ] endPoint {_ROLLER} }}\n'),
      "wheel axis of motor 'third' is [1.0, 0.0, 0.0], not the robot's +y"),
-    (dict(extra='HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } device [ RotationalMotor { name "third" } ] }\n'),
+    (dict(extra='HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } device [ RotationalMotor { name '
+                f'"third" }} ] endPoint {_ROLLER} }}\n'),
      "3 motorised wheels, not all on either side of the robot's x axis"),
 ])
 def test_no_drive_says_why(tmp_path: Path, kwargs: dict, why: str) -> None:
@@ -739,3 +745,151 @@ def test_simulated_device_kinds_read_their_own_fields(tmp_path: Path) -> None:
     assert compass.lookup_table == [(-1.0, -1.0, 0.0), (1.0, 1.0, 0.0)] and compass.y_axis is False
     assert alt.accuracy == 0.2
     assert any("Altimeter.wobble: not read here" in x for x in w.warnings)
+
+
+def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
+    """A tracked robot written as Webots' Track sample is: each Track's motor is in the Track's
+    ``device`` field and its wheels are TrackWheels, placed at (position.x, 0, position.y) in the
+    Track's frame (WbTrackWheel). The motors were silently missing (getDevice found nothing) and the
+    wheels were dropped as unknown nodes; now the motors are listed (not simulated: tracks do not
+    move here) with one warning per Track, the wheels' shapes are where Webots draws them, and the
+    belt Webots animates along them is in the skipped summary."""
+    def track(side: str, y: float) -> str:
+        return (f'Track {{ translation 0 {y} 0 name "{side} track" children [\n'
+                f'  TrackWheel {{ position -0.15 0.0075 radius 0.046 children [ Shape {{ geometry Cylinder {{ '
+                f'radius 0.046 height 0.015 }} }} ] }}\n'
+                f'  TrackWheel {{ position 0.0925 -0.044 radius 0.02 children [ Pose {{ rotation 1 0 0 1.5708 '
+                f'children [ Shape {{ geometry Sphere {{ radius 0.02 }} }} ] }} ] }}\n'
+                f'] device [ LinearMotor {{ name "{side} motor" }} PositionSensor {{ name "{side} sensor" }} ]\n'
+                f'  animatedGeometry Shape {{ geometry Box {{ size 0.022 0.015 0.0025 }} }} geometriesCount 40 }}\n')
+    p = write(tmp_path, 'Robot { name "tank" translation 0 0 0.07 children [\n'
+              'Shape { geometry Box { size 0.3 0.13 0.08 } }\n' + track("left", 0.07) + track("right", -0.07) + '] }\n')
+    w = load_world(p)
+    assert not w.report.losses
+    (robot,) = w.world.robots
+    assert [(d.device, d.name) for d in robot.devices] == [
+        ("LinearMotor", "left motor"), ("PositionSensor", "left sensor"),
+        ("LinearMotor", "right motor"), ("PositionSensor", "right sensor")]
+    assert [(s.geometry.type, s.pose.translation) for s in robot.shapes] == [
+        ("box", (0.0, 0.0, 0.0)), ("cylinder", (-0.15, 0.07, 0.0075)), ("sphere", (0.0925, 0.07, -0.044)),
+        ("cylinder", (-0.15, -0.07, 0.0075)), ("sphere", (0.0925, -0.07, -0.044))]
+    assert [x for x in w.warnings if "Track" in x] == [
+        f"{p}:4:1: Track 'left track': its devices are listed, not simulated (tracks do not move here)",
+        f"{p}:9:1: Track 'right track': its devices are listed, not simulated (tracks do not move here)",
+        f"{p}: skipped nodes that do not matter to these sensors: Track.animatedGeometry x2"]
+    entries = Simulation(w).robot("tank").device_list     # what a controller's getDevice finds (not simulated)
+    assert [(e.name, e.simulated) for e in entries if e.name.endswith("motor")] == [
+        ("left motor", False), ("right motor", False)]
+
+
+def test_a_device_not_simulated_is_said_in_the_load_report(tmp_path: Path) -> None:
+    """A Radar, Display or Speaker is listed (a controller's getDevice finds it, its functions
+    answer Webots' "no value") but not simulated: the load report says so, one line each at the
+    device's own place, so `validate` no longer answers a plain OK for a world whose radar reads
+    nothing."""
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+              'Radar { maxRange 1.5 }\nDisplay { name "screen" width 14 height 14 }\nGPS { }\nSpeaker { }\n] }\n')
+    w = load_world(p)
+    assert not w.report.losses
+    assert w.warnings == [
+        f"{p}:3:1: Radar 'radar' of robot 'r': listed (a controller finds it), not simulated here: its functions "
+        "answer Webots' \"no value\"",
+        f"{p}:4:1: Display 'screen' of robot 'r': listed (a controller finds it), not simulated here: its functions "
+        "answer Webots' \"no value\"",
+        f"{p}:6:1: Speaker 'speaker' of robot 'r': listed (a controller finds it), not simulated here: its functions "
+        "answer Webots' \"no value\""]
+
+
+def test_world_info_gravity_and_gps_coordinates_are_read(tmp_path: Path) -> None:
+    """WorldInfo's gravity (what an accelerometer at rest reads), gpsCoordinateSystem and
+    gpsReference were left out of a .wbt world without a word: a WGS84 world's GPS read local
+    metres and a Mars world's accelerometer read the Earth's gravity."""
+    p = write(tmp_path, 'WorldInfo { gravity 3.71 gpsCoordinateSystem "WGS84" gpsReference 40.67 -73.94 10 }\n'
+                        'Robot { name "r" children [ GPS { } Accelerometer { } ] }\n')
+    w = load_world(p)
+    info = w.world.world_info
+    assert (info.gravity, info.gps_coordinate_system, info.gps_reference) == (3.71, "WGS84", (40.67, -73.94, 10.0))
+    sim = Simulation(w)
+    gps, acc = sim.device("r/gps"), sim.device("r/accelerometer")
+    gps.enable(32)
+    acc.enable(32)
+    sim.step()
+    assert gps.values == pytest.approx([40.67, -73.94, 10.0], abs=1e-9)    # the reference is the world's origin
+    assert acc.values == pytest.approx([0.0, 0.0, 3.71], abs=1e-12)
+    # local coordinates: the reference is added; another name is local, as Webots reads it, with a warning
+    p = write(tmp_path, 'WorldInfo { gpsCoordinateSystem "UTM" gpsReference 1 2 3 }\nRobot { name "r" children [ GPS { } ] }\n')
+    w = load_world(p)
+    assert (w.world.world_info.gps_coordinate_system, w.world.world_info.gps_reference) == ("local", (1.0, 2.0, 3.0))
+    assert w.warnings == [f"{p}:2:1: WorldInfo.gpsCoordinateSystem 'UTM' is neither \"WGS84\" nor \"local\": local "
+                          "coordinates, as Webots returns for any value but \"WGS84\""]
+    with pytest.raises(WorldError, match=r"gravity: -9.81 < 0 \(gravity pointing up\) is not supported here"):
+        load_world(write(tmp_path, 'WorldInfo { gravity -9.81 }\n'))
+
+
+def test_a_device_inside_its_robots_body_is_said(tmp_path: Path) -> None:
+    """A range finder mounted just under the top of its robot's body cylinder (as Webots' own
+    range-finder sample is): Webots culls the cylinder seen from inside and the device sees out;
+    here the cylinder is seen from inside (README: a device inside a closed shape), and the load
+    report now says so at the device, naming the shape. A device outside the body, an infra-red
+    sensor inside a cylinder (Webots' picking sees cylinders from inside too) and the device's own
+    housing are not reported."""
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+              'Pose { translation 0 0 0.0415 children [ Shape { geometry Cylinder { radius 0.045 height 0.08 } } ] }\n'
+              'RangeFinder { translation 0.031 0 0.08 children [ Shape { geometry Box { size 0.01 0.01 0.01 } } ] }\n'
+              'Camera { translation 0.031 0 0.09 }\n'
+              'DistanceSensor { translation 0.03 0 0.05 type "infra-red" }\n'
+              '] }\n')
+    w = load_world(p)
+    assert w.warnings == [
+        f"{p}:4:1: RangeFinder 'range-finder' of robot 'r' is inside the robot's cylinder (written at line 3, column 59): "
+        "its rays see that shape from inside, where Webots' never do (back faces culled); mount the device outside it "
+        "or make the shape part of the device's Solid"]
+
+
+def test_camera_fields_the_renderer_uses_and_rays_do_not_are_said(tmp_path: Path) -> None:
+    """Lens distortion, motion blur and the other image effects of Webots' renderer (README: what a
+    rasterising GPU gives that this does not) were dropped from a .wbt camera without a word; each
+    one a world writes (with a value that does something in Webots) is now one warning."""
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+              'Camera { lens Lens { radialCoefficients 0.2 0 } motionBlur 100 bloomThreshold -1 zoom NULL }\n'
+              'RangeFinder { motionBlur 0 }\n] }\n')
+    w = load_world(p)
+    assert w.warnings == [
+        f"{p}:3:1: Camera 'camera' of robot 'r': {field} is not rendered here; the image is Webots' without it"
+        for field in ("lens (lens distortion)", "motionBlur (motion blur)")]
+
+
+def test_a_robots_battery_and_a_charger_are_said(tmp_path: Path) -> None:
+    """Webots' battery sample: a robot with a ``battery`` (its controller reads the battery sensor)
+    and Chargers around it. The battery was dropped without a word (its sensor reads NaN here) and
+    a Charger was called a device outside a robot; both are now one plain line, the Charger's shapes
+    kept as a solid."""
+    p = write(tmp_path, 'Robot { name "r" battery [ 50, 100, 30 ] cpuConsumption 0.5 }\n'
+              'Charger { name "charger0" battery [ 100, 100, 3 ] children [ Shape { geometry Cylinder { radius 0.1 '
+              'height 0.3 } } ] }\n')
+    w = load_world(p)
+    assert not w.report.losses
+    assert w.warnings == [
+        f"{p}:2:1: Robot 'r': battery 50, 100, 30 is not simulated here: its battery sensor reads NaN, as a Webots "
+        "robot without a battery",
+        f"{p}:3:1: Charger 'charger0': recharging is not simulated (robots have no battery here); its shapes and "
+        "lights are kept as a solid"]
+    assert [(s.name, [x.geometry.type for x in s.shapes]) for s in w.world.solids] == [("charger0", ["cylinder"])]
+
+
+def test_robot_self_collision_is_read(tmp_path: Path) -> None:
+    """Robot.selfCollision was not read from a .wbt world: a generic distance sensor never saw its
+    own robot's bounding objects, as if it were FALSE (README: ODE-style rays skip the whole robot
+    unless ``self_collision``)."""
+    def world(flag: str) -> str:
+        return (f'Robot {{ name "r" selfCollision {flag} children [\n'
+                'DistanceSensor { lookupTable [ 0 0 0, 1 1000 0 ] }\n'
+                'Solid { translation 0.5 0 0 boundingObject Box { size 0.1 1 1 } }\n] }\n')
+    for flag, expected in (("TRUE", 450.0), ("FALSE", 1000.0)):
+        w = load_world(write(tmp_path, world(flag)))
+        assert w.world.robots[0].self_collision is (flag == "TRUE")
+        sim = Simulation(w)
+        ds = sim.device("r/distance sensor")
+        ds.enable(32)
+        sim.step()
+        assert ds.value == pytest.approx(expected)

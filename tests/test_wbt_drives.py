@@ -138,3 +138,65 @@ def test_skid_steer_in_a_world_file_and_its_checks() -> None:
     data["robots"][0]["differential_drive"]["skid_steer"]["right"] = ["fl"]
     with pytest.raises(WorldError, match="every wheel motor needs its own name"):
         parse_world(data)
+
+
+def test_a_devices_own_motorised_joints_are_no_wheels(tmp_path: Path) -> None:
+    """A spinning lidar (a turret and its belt wheel turned by motors inside the Lidar's children,
+    about the robot's vertical axis) on a two-wheel robot, written as a PROTO of our own: the
+    devices' joints move the device, never the robot, so the two wheels still make the drive (they
+    were taken for a car's steering joints and the robot lost its drive) and the wheel encoders
+    still measure their motors; the turret's motors are listed with one warning."""
+    protos = tmp_path / "protos"
+    protos.mkdir()
+    (protos / "SpinLidar.proto").write_text(
+        HEADER + "# template language: javascript\n"
+        'PROTO SpinLidar [ field SFString name "spin" ]\n{\n  Lidar {\n    name IS name\n    children [\n'
+        '      Pose { rotation 1 0 0 1.5708 children [\n'
+        '        HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 }\n'
+        "          device [ RotationalMotor { name %<= '\"' + fields.name.value + '_turret\"' >% } ]\n"
+        '          endPoint Solid { children [ Shape { geometry Box { size 0.02 0.01 0.02 } } ] } }\n'
+        '        HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor -0.04 0 0 }\n'
+        "          device [ RotationalMotor { name %<= '\"' + fields.name.value + '_belt\"' >% } ]\n"
+        '          endPoint Solid { translation -0.04 0 0 } }\n'
+        '      ] }\n    ]\n    horizontalResolution 36\n    fieldOfView 6.28\n    numberOfLayers 1\n  }\n}\n')
+    body = ('EXTERNPROTO "protos/SpinLidar.proto"\n'
+            'Robot { name "burger" children [\n'
+            '  Transform { translation -0.03 0 0.15 children [ SpinLidar { } ] }\n'
+            + wheel("left wheel", 0, 0.08) + wheel("right wheel", 0, -0.08) + '] }\n')
+    w = load_world(write(tmp_path, body))
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive is None
+    assert robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=0.16, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert [(d.name, d.device) for d in robot.devices][:3] == [
+        ("spin", "Lidar"), ("spin_turret", "RotationalMotor"), ("spin_belt", "RotationalMotor")]
+    assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == ["left wheel", "right wheel"]
+    assert not [x for x in w.warnings if "drive" in x]
+    assert len([x for x in w.warnings if "not part of a wheel (inside a device)" in x]) == 2
+
+
+def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> None:
+    """A gripper's lift arm (a motorised hinge along the robot's +y, like the wheels, its end point a
+    box with slider fingers: nothing round to roll on) on a two-wheel robot: the robot keeps its
+    two-wheel drive (three "wheels", one on the x axis, made no drive at all), the arm's motor is
+    listed with one warning at its joint, the wheel encoders measure their wheels."""
+    arm = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor -0.01 0 0.022 }\n'
+           '  device [ RotationalMotor { name "lift" } PositionSensor { name "lift sensor" } ]\n'
+           '  endPoint Solid { translation -0.01 0 0.022 children [\n'
+           '    SliderJoint { jointParameters JointParameters { axis 1 0 0 }\n'
+           '      device [ LinearMotor { name "grip" } ] endPoint Solid { translation 0 0 -0.048 } }\n'
+           '  ] boundingObject Pose { translation 0 0 -0.021 children [ Box { size 0.068 0.008 0.052 } ] } } }\n')
+    body = ('Robot { name "khepera" children [\n' + arm + wheel("left wheel", 0, 0.026)
+            + wheel("right wheel", 0, -0.026) + '] }\n')
+    p = write(tmp_path, body)
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=0.052, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert [(d.name, d.device) for d in robot.devices][:3] == [
+        ("lift", "RotationalMotor"), ("lift sensor", "PositionSensor"), ("grip", "LinearMotor")]
+    assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == [None, "left wheel", "right wheel"]
+    assert not [x for x in w.warnings if "drive" in x]
+    assert f"{p}:4:1: HingeJoint motor 'lift' is no wheel (its end point has no cylinder or sphere to roll on): " \
+           "listed, not simulated (joints do not move here)" in w.warnings
+    assert sorted(Simulation(w).robot("khepera").motors) == ["left wheel", "right wheel"]   # the lift is not one

@@ -291,8 +291,11 @@ class _Expander:
         skipped = sorted(n for n in self.stand_ins if n not in BUILTIN_PROTOS)
         parts = ([f"Sensorium's built-in stand-ins used for {', '.join(built)}"] if built else []) + \
                 ([f"{', '.join(skipped)} skipped (no effect on these sensors)"] if skipped else [])
-        self.warnings.append(f"{source}:{line}:{col}: PROTO files not found: {'; '.join(parts)} (give --webots-home "
-                             "or WEBOTS_HOME to use Webots' own)")
+        home = self.search.home
+        hint = ("give --webots-home or WEBOTS_HOME to use Webots' own" if home is None else
+                f"not in the Webots installation {home} nor the --proto-path folders: a complete installation "
+                "(or --proto-path) gives Webots' own")
+        self.warnings.append(f"{source}:{line}:{col}: PROTO files not found: {'; '.join(parts)} ({hint})")
 
     def version_note(self, path: Path, decl: ExternProto) -> None:
         home = self.search.home

@@ -27,6 +27,7 @@ from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
 from sensorium.server.world.wbt.fields import Fields
 from sensorium.server.world.wbt.frames import Frame, bounding_constraint, bounding_geometry, visual_geometry
+from sensorium.server.world.wbt.inside import enclosing_shapes, unread_image_fields
 from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
@@ -88,6 +89,8 @@ class Converter:
         self.solid_names: Counter[str] = Counter()
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
+        self.device_depth = 0              # > 0 while inside a device's children (its joints are no wheels)
+        self.device_where: dict[int, str] = {}   # id(device entry) -> where its node is written
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
         self.checked_grids: set[int] = set()   # ElevationGrids sanitised (warned once: a shape and its boundingObject)
         self.constrained: set[int] = set()     # Transforms in boundingObjects whose scale Webots constrains
@@ -213,6 +216,21 @@ class Converter:
         evaporation = f.num("inkEvaporation", 0.0)
         if evaporation > 0.0:          # Webots' pen ink fading (a value <= 0 never evaporates)
             info["ink_evaporation"] = evaporation
+        gravity = f.num("gravity", 9.81)        # what an accelerometer at rest reads (a Mars world: 3.71)
+        if gravity < 0.0:
+            raise f.error("gravity", f"{gravity:g} < 0 (gravity pointing up) is not supported here")
+        if gravity != 9.81:
+            info["gravity"] = gravity
+        gps = f.string("gpsCoordinateSystem", "local")     # what GPS devices read (Webots: WGS84, else local)
+        if gps not in ("local", "WGS84"):
+            self.warn(node, f"WorldInfo.gpsCoordinateSystem {gps!r} is neither \"WGS84\" nor \"local\": local "
+                            "coordinates, as Webots returns for any value but \"WGS84\"")
+            gps = "local"
+        if gps != "local":
+            info["gps_coordinate_system"] = gps
+        reference = f.vec("gpsReference", (0.0, 0.0, 0.0))
+        if tuple(reference) != (0.0, 0.0, 0.0):
+            info["gps_reference"] = list(reference)
         self.world["world_info"] = info
 
     def fog(self, node: Node, f: Fields) -> None:
@@ -274,6 +292,10 @@ class Converter:
             self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
             self.scaled_solid(node, owner)
+        elif t == "Charger":             # a Solid that recharges robots' batteries (no battery here)
+            self.warn(node, f"Charger {f.string('name', 'solid')!r}: recharging is not simulated (robots have no "
+                            "battery here); its shapes and lights are kept as a solid")
+            self.solid(node, frame, owner, "solid")
         elif t in OTHER_DEVICES:
             if owner.kind == "robot":
                 inner = self.child_frame(node, frame)
@@ -283,6 +305,16 @@ class Converter:
                     data = self.unsimulated(node, inner, owner)
                     if t == "Pen":             # a Pen keeps its fields (simulated: it inks)
                         data.update(fx.pen(f))
+                    elif t in wm.UNSIMULATED_DEVICE_TYPES:
+                        self.warn(node, f"{t} {data['name']!r} of robot {owner.data['name']!r}: listed (a controller "
+                                        "finds it), not simulated here: its functions answer Webots' \"no value\"")
+                elif t == "Track":           # a Solid whose device field holds its motor (and sensor, brake)
+                    if f.node_("animatedGeometry") is not None:     # the belt Webots draws along its wheels
+                        self.skipped["Track.animatedGeometry"] += 1
+                    motors, sensors = self.joint_devices(node, owner)
+                    if motors or sensors or f.nodes("device"):
+                        self.warn(node, f"Track {f.string('name', 'solid')!r}: its devices are listed, not simulated "
+                                        "(tracks do not move here)")
                 self.device_contents(node, inner, owner, data)
             else:     # a device outside a robot is still a Solid whose shapes rays see
                 self.warn(node, f"{t} outside a Robot: not a device here (devices belong to robots); its shapes "
@@ -306,6 +338,11 @@ class Converter:
                 self.visit(end, frame, owner)
         elif t in ("Pose", "Transform"):
             inner = self.child_frame(node, frame)
+            for child in f.nodes("children"):
+                self.visit(child, inner, owner)
+        elif t == "TrackWheel":          # a Pose at (position.x, 0, position.y) in its Track's frame (Webots)
+            px, py = f.vec("position", (0.0, 0.0))
+            inner = frame.then((px, 0.0, py), (0.0, 0.0, 1.0, 0.0), (1.0, 1.0, 1.0))
             for child in f.nodes("children"):
                 self.visit(child, inner, owner)
         elif t == "Shape":
@@ -747,6 +784,12 @@ class Converter:
         colors = f.colors("recognitionColors", [])
         if colors:
             data["recognition_colors"] = [list(c) for c in colors]
+        if f.flag("selfCollision", False):    # its generic, sonar and laser sensors see its own bounding objects
+            data["self_collision"] = True
+        battery = f.numbers("battery") if "battery" in node.fields else []
+        if battery:        # Webots: current energy, maximum, recharge speed; its battery sensor reads the first
+            self.warn(node, f"Robot {unique!r}: battery {', '.join(f'{v:g}' for v in battery)} is not simulated here: "
+                            "its battery sensor reads NaN, as a Webots robot without a battery")
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.solid_contents(node, Frame.identity(), mine)
@@ -757,9 +800,25 @@ class Converter:
         for part in data.get("shapes", ()):      # the device's final name (after unique_devices)
             if "_device" in part:
                 part["of_device"] = part.pop("_device")["name"]
+        self.devices_inside(data)
         if not data["devices"]:
             del data["devices"]
         self.world["robots"].append(data)
+
+    def devices_inside(self, robot: dict) -> None:
+        """One warning for each visual device whose origin is inside one of its robot's closed
+        shapes, which Webots never sees from there and rays here do (wbt/inside.py)."""
+        for dev in robot["devices"]:
+            where = self.device_where.get(id(dev))
+            if where is None:
+                continue
+            for part in enclosing_shapes(robot, dev):
+                line, col, _ = part.get("_at", (0, 0, ""))
+                at = f" (written at line {line}, column {col})" if line else ""
+                self.warnings.append(
+                    f"{where}: {dev['device']} {dev['name']!r} of robot {robot['name']!r} is inside the robot's "
+                    f"{part['geometry']['type']}{at}: its rays see that shape from inside, where Webots' never do "
+                    "(back faces culled); mount the device outside it or make the shape part of the device's Solid")
 
     def unique_devices(self, robot: dict) -> None:
         """Device names address topics and services, so a repeated one gets a suffix (Webots warns
@@ -805,18 +864,26 @@ class Converter:
             if model:
                 data["model"] = model
             data["_at"] = self.at(node)
+            self.device_where[id(data)] = self.where(node)
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
+            for name, what in unread_image_fields(node.type, node.fields):
+                self.warn(node, f"{node.type} {data['name']!r} of robot {owner.data['name']!r}: {name} ({what}) is "
+                                "not rendered here; the image is Webots' without it")
             owner.data["devices"].append(data)
             self.device_contents(node, inner, owner, data)
             return
-        self.solid_contents(node, inner, owner)
+        self.device_contents(node, inner, owner, None)
 
     def device_contents(self, node: Node, frame: Frame, owner: Owner, device: dict | None) -> None:
         """A device's own Solid contents: robot body shapes marked as the device's own (its visual
         rays do not see them, sim/own_shapes.py), the innermost device's for nested ones."""
         start = len(owner.parts)
-        self.solid_contents(node, frame, owner)
+        self.device_depth += 1
+        try:
+            self.solid_contents(node, frame, owner)
+        finally:
+            self.device_depth -= 1
         if device is not None:
             for part in owner.parts[start:]:
                 part.setdefault("_device", device)
@@ -886,9 +953,12 @@ class Converter:
         sensors: list[dict] = []
         if owner.kind == "robot":
             _, sensors = self.joint_devices(node, owner)
-        if owner.kind == "robot" and node.type == "Hinge2Joint":    # a steered wheel (a car)
+        # a joint inside a device (a lidar's spinning turret, a camera's pan-tilt) moves the device,
+        # never the robot: it is no wheel, whatever its axis (Webots has no notion of a drive either)
+        wheeled = owner.kind == "robot" and not self.device_depth
+        if wheeled and node.type == "Hinge2Joint":    # a steered wheel (a car)
             self.hinge2(node, frame, owner, motors, sensors)
-        elif owner.kind == "robot" and node.type == "HingeJoint" and motors:
+        elif wheeled and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
             if params is not None:
                 self.typos(params)
@@ -907,10 +977,11 @@ class Converter:
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
-        elif motors and node.type != "Hinge2Joint":
-            self.warn(node, f"{node.type} motor(s) not part of a wheel: listed, not simulated (joints do not move here)")
+        elif motors and (node.type != "Hinge2Joint" or not wheeled):
+            self.warn(node, f"{node.type} motor(s) not part of a wheel{' (inside a device)' if owner.kind == 'robot' and not wheeled else ''}: "
+                            "listed, not simulated (joints do not move here)")
         # (a robot's Hinge2Joint: hinge2() said which of its axes has sensors but no motor)
-        if sensors and not (owner.kind == "robot" and (node.type == "Hinge2Joint" or (node.type == "HingeJoint" and motors))):
+        if sensors and not (wheeled and (node.type == "Hinge2Joint" or (node.type == "HingeJoint" and motors))):
             self.warn(node, "PositionSensor on a joint without a drive wheel motor: listed, reads no value")
         if end is not None:
             if end.type == "SolidReference":
@@ -958,7 +1029,7 @@ class Converter:
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
     def drive(self, node: Node, robot: Owner) -> None:
-        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive
+        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive, wheel_radius
 
         wheels = robot.wheels
         if not wheels:
@@ -971,6 +1042,18 @@ class Converter:
             robot.data["ackermann_drive"] = drive
         else:
             drive, why = differential_drive(wheels, self)
+            # a motorised hinge whose end point has nothing round to roll on (a gripper's lift arm, a
+            # flipper) is no wheel: the drive is the wheels without it, if they make one
+            rolling = [w for w in wheels if wheel_radius(w["end"], self) is not None] if drive is None else wheels
+            if 2 <= len(rolling) < len(wheels):
+                drive, _ = differential_drive(rolling, self)
+                if drive is not None:
+                    for w in wheels:
+                        if not any(w is r for r in rolling):
+                            self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel (its end point has no "
+                                                 "cylinder or sphere to roll on): listed, not simulated (joints do "
+                                                 "not move here)")
+                    wheels = rolling
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return

@@ -1,0 +1,97 @@
+"""What a .wbt device's rays meet differently here, said at load time.
+
+* A visual device (camera, range finder, lidar, infra-red distance sensor) whose origin lies inside
+  one of its robot's closed shapes: Webots never sees that shape (its renderer culls back faces, its
+  infra-red picking finds no hit from inside a Box or Sphere), while here every shape that is not
+  the device's own (``of_device``) is seen from inside too (README, "a device inside a closed
+  shape"). Webots' own range-finder sample mounts its device 1.5 mm under the top of the robot's
+  body cylinder: its image was the cylinder's wall, 14 mm away, with no word why.
+* The image fields of a Camera or RangeFinder that Webots' renderer uses and Sensorium does not
+  (lens distortion, motion blur, ...): the README lists them; the load report now names the ones a
+  world writes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sensorium.server.world.poses import pose_from_values
+
+RENDERED = {"Camera", "RangeFinder", "Lidar"}        # rasterised in Webots: every closed shape is culled from inside
+PICKED = {"box", "sphere"}                           # Webots' infra-red picking: no hit from inside these
+CLOSED = {"box", "sphere", "cylinder", "capsule"}
+EPS = 1e-9
+
+# field -> (Webots' default, what it does there); a Node-valued field's default is None (NULL)
+UNREAD_IMAGE_FIELDS = {
+    "Camera": {"lens": (None, "lens distortion"), "focus": (None, "depth of field"), "zoom": (None, "zoom"),
+               "lensFlare": (None, "lens flares"), "motionBlur": (0.0, "motion blur"),
+               "noiseMaskUrl": ("", "a noise mask image"), "bloomThreshold": (-1.0, "bloom"),
+               "ambientOcclusionRadius": (0.0, "ambient occlusion")},
+    "RangeFinder": {"lens": (None, "lens distortion"), "motionBlur": (0.0, "motion blur")},
+}
+
+
+def unread_image_fields(kind: str, written: dict) -> list[tuple[str, str]]:
+    """(field, what it does in Webots) for a Camera's or RangeFinder's fields written with a value
+    Webots' renderer uses and Sensorium does not."""
+    out = []
+    for name, (default, what) in UNREAD_IMAGE_FIELDS.get(kind, {}).items():
+        if name not in written:
+            continue
+        value = written[name]
+        if default is None:
+            if value is None:
+                continue
+        elif isinstance(default, float):
+            if isinstance(value, (int, float)) and float(value) == default:
+                continue
+        elif value in (default, (default,), [default]):
+            continue
+        out.append((name, what))
+    return out
+
+
+def _local(pose: dict, point: np.ndarray) -> np.ndarray:
+    p = pose_from_values(pose["translation"], pose.get("rotation"), pose.get("quaternion"))
+    return p.rotation.T @ (point - p.translation)
+
+
+def contains(geometry: dict, p: np.ndarray) -> bool:
+    """Whether ``p`` (in the shape's frame) is strictly inside a closed primitive."""
+    t = geometry.get("type")
+    if set(geometry) - {"type", "size", "radius", "height", "subdivision"}:    # scaled or stretched: not judged
+        return False
+    if t == "box":
+        return bool(np.all(np.abs(p) < np.asarray(geometry["size"], dtype=np.float64) / 2.0 - EPS))
+    if t == "sphere":
+        return float(np.linalg.norm(p)) < geometry["radius"] - EPS
+    if t == "cylinder":
+        return float(np.hypot(p[0], p[1])) < geometry["radius"] - EPS and abs(p[2]) < geometry["height"] / 2.0 - EPS
+    if t == "capsule":
+        z = min(max(p[2], -geometry["height"] / 2.0), geometry["height"] / 2.0)
+        return float(np.linalg.norm(p - np.array([0.0, 0.0, z]))) < geometry["radius"] - EPS
+    return False
+
+
+def enclosing_shapes(robot: dict, device: dict) -> list[dict]:
+    """The robot's shapes (not the device's own, not bounding-only) that hold the device's origin
+    and that the device's rays would not see in Webots."""
+    kind = device["device"]
+    if kind in RENDERED:
+        kinds = CLOSED
+    elif kind == "DistanceSensor" and device.get("type") == "infra-red":
+        kinds = PICKED
+    else:
+        return []
+    origin = np.asarray(device.get("pose", {}).get("translation", (0.0, 0.0, 0.0)), dtype=np.float64)
+    out = []
+    for part in robot.get("shapes", ()):
+        geometry = part.get("geometry", {})
+        if part.get("seen_by") == "bounding" or geometry.get("type") not in kinds:
+            continue
+        if part.get("of_device") == device["name"]:
+            continue
+        if contains(geometry, _local(part["pose"], origin)):
+            out.append(part)
+    return out
