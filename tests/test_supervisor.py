@@ -262,3 +262,12 @@ def test_info_summary_lists_encoders_leds_and_supervisor():
     lines = {d["name"]: d["summary"] for d in pioneer["devices"]}
     assert lines["left wheel sensor"] == "PositionSensor on 'left wheel motor' noise 0 resolution -1"
     assert lines["led0"] == "LED 2 colours" and lines["rgb"] == "LED gradual"
+
+
+def test_info_summary_names_an_encoder_on_a_joint_nothing_turns():
+    """A PositionSensor whose joint no drive turns (a gripper's arm) says so, not "on None"."""
+    from sensorium.schemas import world as wm
+    from sensorium.server.sim.summary import device_line
+
+    assert device_line(wm.PositionSensor(device="PositionSensor", name="arm sensor")) == \
+        "PositionSensor on a joint nothing turns here (present, reads 0 rad)"

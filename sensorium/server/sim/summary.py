@@ -21,6 +21,8 @@ def device_line(d) -> str:
     if isinstance(d, wm.LightSensor):
         return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
     if isinstance(d, wm.PositionSensor):
+        if d.motor is None:
+            return "PositionSensor on a joint nothing turns here (present, reads 0 rad)"
         return f"PositionSensor on {d.motor!r} noise {d.noise:g} resolution {d.resolution:g}"
     if isinstance(d, wm.LED):
         return f"LED {'gradual' if d.gradual else f'{len(d.color)} colours'}"
