@@ -8,7 +8,9 @@ filter, per RGB channel ``c``::
 
 ``att`` the light's attenuation ``1/(a1 + a2 d + a3 d²)`` (1 for a directional light), ``Ia`` its
 ambient intensity, ``I`` its intensity, ``spot`` Webots' spot cut-off factor, ``lit`` 0 where a
-shadow-casting light is occluded, ``C`` its colour; ``N`` faces the camera (both faces of a surface
+shadow-casting light is occluded and, for a point or spot light, where the point is farther than
+its ``radius`` (``d > radius``: WREN's phong.frag and pbr.frag skip the light there; its ambient
+term stays, WREN's ambient light being the scene's; light sensors ignore ``radius``), ``C`` its colour; ``N`` faces the camera (both faces of a surface
 are lit as seen). The albedo is the shape's ``base_color`` times its texture's texel, the texel
 converted from sRGB to linear as Webots' shaders do (``SRGBtoLINEAR``).
 
@@ -135,6 +137,9 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                         alpha = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * rx + uy * ry + uz * rz)
                         factor[band] = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, (alpha - co) / (bw - co)))
                     direct *= factor
+                radius = float(lights.radius[j])
+                if radius < length.max():      # WREN: no direct term beyond the radius (ambient is the scene's)
+                    direct[length > radius] = 0.0
             if lit is not None:
                 direct = np.where(lit[:, j], direct, 0.0)
             weight = direct
