@@ -22,6 +22,8 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld
+from tests.test_batched_camera import PERIODS, WORLD, _world
+from tests.test_batched_sim import _enable_both
 
 WALL = {"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
         "appearance": {"base_color": [1.0, 1.0, 1.0]}}
@@ -124,15 +126,16 @@ def test_light_sensors_ignore_the_radius():
 
 def _facing(radius: float) -> LoadedWorld:
     """A bodiless robot whose camera faces the white wall; it carries a point light at the camera
-    (``radius``); a fixed spot light behind it along +x (radius 3) and the ambient light."""
+    (``radius``); a fixed spot light behind it along +x (radius 3) and the ambient light; the two
+    cast shadows (nothing hides them: shadow rays go out, from what lies within reach only)."""
     dev = {"device": "Camera", "name": "cam", "width": 11, "height": 5, "field_of_view": 1.0}
     w = wm.World.model_validate({
         "world_info": {"basic_time_step": 8, "contact": False},
-        "lights": [AMBIENT, {**spot(3.0), "location": [-1.0, 0.0, 0.0], "intensity": 0.4}],
+        "lights": [AMBIENT, {**spot(3.0), "location": [-1.0, 0.0, 0.0], "intensity": 0.4, "cast_shadows": True}],
         "solids": [WALL],
         "robots": [{"name": "bot", "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2,
                                                           "max_wheel_speed": 10.0},
-                    "lights": [point(radius, intensity=0.6)], "devices": [dev]}]})
+                    "lights": [point(radius, intensity=0.6, cast_shadows=True)], "devices": [dev]}]})
     return LoadedWorld(world=w, source="<test>", base_dir=Path.cwd())
 
 
@@ -164,3 +167,68 @@ def test_every_copy_cuts_as_the_single_simulation(precision: str):
         L = 0.3 + (0.6 if 1.95 - xc <= 1.0 else 0.0) + (0.4 if 1.95 + 1.0 <= 3.0 else 0.0)
         np.testing.assert_array_equal(centre[c], byte(np.full(3, L)), err_msg=str(c))
     assert len({img[c].tobytes() for c in range(len(x))}) >= 4
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_no_shadow_ray_goes_towards_a_light_out_of_reach(precision: str):
+    """The point light at the camera now casts shadows: a shadow ray goes from every pixel's surface
+    while the wall is within its radius, from those within it when the radius crosses the image,
+    from none beyond it; the image is the one without shadows each time (nothing hides the light)."""
+    d, _ = rays()
+    u = np.unique(d)
+    across = float(u[len(u) // 2] + u[len(u) // 2 + 1]) / 2.0
+    for radius, casting in ((10.0, d.size), (across, int((d <= across).sum())), (1.0, 0)):
+        assert casting in (0, d.size) or 0 < casting < d.size
+        sim = Simulation(world([AMBIENT, point(radius, cast_shadows=True)]), precision=precision)
+        cam = sim.device("r/cam")
+        cam.enable(16)
+        sim.run(1)
+        assert sim.counters["rays_camera"] == d.size + casting, radius
+        got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+        np.testing.assert_array_equal(got, shoot(world([AMBIENT, point(radius)]), precision))
+
+
+@pytest.fixture(scope="module")
+def camera_dir(tmp_path_factory) -> Path:
+    """tests/test_batched_camera.py's camera world folder: the world and its floor's texture."""
+    from PIL import Image
+    d = tmp_path_factory.mktemp("camera_world")
+    texels = np.random.default_rng(7).integers(0, 256, (8, 8, 3), dtype=np.uint8)
+    Image.fromarray(texels, "RGB").save(d / "checker.png")
+    (d / WORLD.name).write_text(WORLD.read_text())
+    return d
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_the_camera_world_with_short_radii_is_the_single_simulations_in_every_copy(precision: str, camera_dir: Path):
+    """tests/worlds/camera.yaml with the spot light's radius 1.5 m and the lamp's shadow-casting bulb's
+    0.9 m (both cut across the cameras' views): every copy's images equal those of
+    a Simulation with its seed, byte for byte, and differ from the default radii's."""
+    def short(seed: int) -> LoadedWorld:
+        lw = _world(seed, camera_dir)
+        w = lw.world
+        lights = [w.lights[0].model_copy(update={"radius": 1.5}), *w.lights[1:]]
+        lamp = w.solids[3]
+        lamp = lamp.model_copy(update={"lights": [lamp.lights[0].model_copy(update={"radius": 0.9})]})
+        return LoadedWorld(world=w.model_copy(update={"lights": lights, "solids": [*w.solids[:3], lamp, *w.solids[4:]]}),
+                           source=lw.source, base_dir=lw.base_dir)
+
+    seeds = [5, 6]
+    bs = BatchedSimulation(short(0), len(seeds), precision=precision)
+    bs.reset(np.arange(len(seeds)), seeds)
+    sims = [Simulation(short(s), precision=precision) for s in seeds]
+    default = Simulation(_world(seeds[0], camera_dir), precision=precision)
+    for c in range(len(seeds)):
+        _enable_both(bs, sims, PERIODS, c)
+    default.robot("rover").device("eye").enable(PERIODS["rover"]["eye"])
+    differs = 0
+    for _ in range(6):
+        bs.step()
+        default.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot, names in PERIODS.items():
+                for n in names:
+                    assert bs.image(bs.device(robot, n))[c].tobytes() == s.robot(robot).device(n).image.tobytes()
+        differs += default.robot("rover").device("eye").image.tobytes() != sims[0].robot("rover").device("eye").image.tobytes()
+    assert differs > 0
