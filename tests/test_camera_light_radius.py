@@ -232,3 +232,18 @@ def test_the_camera_world_with_short_radii_is_the_single_simulations_in_every_co
                     assert bs.image(bs.device(robot, n))[c].tobytes() == s.robot(robot).device(n).image.tobytes()
         differs += default.robot("rover").device("eye").image.tobytes() != sims[0].robot("rover").device("eye").image.tobytes()
     assert differs > 0
+
+
+def test_a_radius_changed_while_running_is_seen_at_the_next_image():
+    """A Supervisor's change of a light's ``radius`` (``Scene.set_top_light``, as its field setter
+    calls it): the camera's next image is cut by the new radius, and lit again when it grows."""
+    sim = Simulation(world([AMBIENT, point(None)]), precision="exact")
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    sim.run(1)
+    today = cam.image.copy()
+    lamp = sim.scene.top_lights()[1]
+    for radius, want in ((1.0, shoot(world([AMBIENT]))), (5.0, today[:, :, [2, 1, 0]].astype(np.int64))):
+        sim.scene.set_top_light(1, lamp.model_copy(update={"radius": radius}))
+        sim.run(1)
+        np.testing.assert_array_equal(cam.image[:, :, [2, 1, 0]].astype(np.int64), want)
