@@ -358,7 +358,9 @@ class _Light(Strict):
 class _Attenuated(_Light):
     attenuation: Vec3 = (1.0, 0.0, 0.0)
     location: Vec3 = (0.0, 0.0, 0.0)
-    radius: float = Field(default=100.0, ge=LIGHT_RANGES["radius"][0], description="unused by sensors (Webots)")
+    radius: float = Field(default=100.0, ge=LIGHT_RANGES["radius"][0],
+                          description="cameras: no direct light from it on a surface farther than this (m; Webots' "
+                          "renderer); light sensors ignore it (Webots)")
 
     @field_validator("attenuation")
     @classmethod

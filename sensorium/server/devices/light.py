@@ -65,6 +65,8 @@ class Light:
 
     ``position`` is ignored for directional lights, ``direction`` for point lights,
     ``attenuation`` for directional lights, ``beam_width``/``cut_off_angle`` for non-spot lights.
+    ``radius`` (point/spot) is read by cameras only (``shading.py``: no direct term farther than
+    it, as Webots' renderer); light sensors ignore it, as Webots' LightSensor does.
     """
 
     kind: LightKind
@@ -76,6 +78,7 @@ class Light:
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
     beam_width: float = 1.570796
     cut_off_angle: float = 0.785398
+    radius: float = 100.0
 
 
 @dataclass(frozen=True)
@@ -93,6 +96,7 @@ class LightArrays:
     color: np.ndarray              # (n, 3)
     beam_width: np.ndarray         # (n,)
     cut_off_angle: np.ndarray      # (n,)
+    radius: np.ndarray | None = None   # (n,) point/spot, cameras only; None: +inf (no cut); directional: unused
 
     def __post_init__(self) -> None:
         kind = np.asarray(self.kind, dtype=np.int64).reshape(-1)
@@ -105,6 +109,10 @@ class LightArrays:
                for f in ("intensity", "ambient_intensity", "beam_width", "cut_off_angle")}
         if not all(np.all(np.isfinite(a)) for a in (*vec.values(), *sca.values())):
             raise ValueError("light fields must be finite")
+        radius = np.full(n, np.inf) if self.radius is None else np.asarray(self.radius, dtype=np.float64).reshape(n)
+        if not np.all(radius >= 0.0):
+            raise ValueError("light radius must be >= 0")
+        sca["radius"] = radius
         local = kind != LightKind.DIRECTIONAL
         att = vec["attenuation"]
         if np.any(local & (np.any(att < 0.0, axis=1) | np.all(att == 0.0, axis=1))):
@@ -140,7 +148,8 @@ class LightArrays:
                    position=col("position", (n, 3)), direction=col("direction", (n, 3)),
                    attenuation=col("attenuation", (n, 3)), intensity=col("intensity", (n,)),
                    ambient_intensity=col("ambient_intensity", (n,)), color=col("color", (n, 3)),
-                   beam_width=col("beam_width", (n,)), cut_off_angle=col("cut_off_angle", (n,)))
+                   beam_width=col("beam_width", (n,)), cut_off_angle=col("cut_off_angle", (n,)),
+                   radius=col("radius", (n,)))
 
     @classmethod
     def empty(cls) -> LightArrays:

@@ -8,7 +8,9 @@ filter, per RGB channel ``c``::
 
 ``att`` the light's attenuation ``1/(a1 + a2 d + a3 d²)`` (1 for a directional light), ``Ia`` its
 ambient intensity, ``I`` its intensity, ``spot`` Webots' spot cut-off factor, ``lit`` 0 where a
-shadow-casting light is occluded, ``C`` its colour; ``N`` faces the camera (both faces of a surface
+shadow-casting light is occluded and, for a point or spot light, where the point is farther than
+its ``radius`` (``d > radius``: WREN's phong.frag and pbr.frag skip the light there; its ambient
+term stays, WREN's ambient light being the scene's; light sensors ignore ``radius``), ``C`` its colour; ``N`` faces the camera (both faces of a surface
 are lit as seen). The albedo is the shape's ``base_color`` times its texture's texel, the texel
 converted from sRGB to linear as Webots' shaders do (``SRGBtoLINEAR``).
 
@@ -37,8 +39,8 @@ import numpy as np
 from .light import LightArrays, LightKind
 from .noise import gaussian
 
-__all__ = ["GAMMA", "FOG_TYPES", "background_radiance", "srgb_to_linear", "radiance", "fog_weight", "fog", "tone_map", "to_bytes", "take_rows",
-           "add_to_rows", "scaled_rows"]
+__all__ = ["GAMMA", "FOG_TYPES", "background_radiance", "srgb_to_linear", "radiance", "within_radius", "fog_weight", "fog",
+           "tone_map", "to_bytes", "take_rows", "add_to_rows", "scaled_rows"]
 
 GAMMA = 2.2
 """Webots' ``hdr_resolve.frag`` gamma."""
@@ -108,9 +110,7 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                 att: np.ndarray | None = None
                 length = None
             else:
-                qx, qy, qz = (float(c) for c in lights.position[j])
-                vx, vy, vz = qx - px, qy - py, qz - pz
-                length = np.sqrt(vx * vx + vy * vy + vz * vz)
+                vx, vy, vz, length = _to_light(px, py, pz, lights.position[j])
                 a1, a2, a3 = (float(c) for c in lights.attenuation[j])
                 att = 1.0 / (a1 + length * (a2 + a3 * length)) if (a2 or a3) else None
                 if att is None and a1 != 1.0:
@@ -135,6 +135,9 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                         alpha = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * rx + uy * ry + uz * rz)
                         factor[band] = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, (alpha - co) / (bw - co)))
                     direct *= factor
+                radius = float(lights.radius[j])
+                if radius < length.max():      # WREN: no direct term beyond the radius (ambient is the scene's)
+                    direct[length > radius] = 0.0
             if lit is not None:
                 direct = np.where(lit[:, j], direct, 0.0)
             weight = direct
@@ -150,6 +153,27 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
     for ch in range(3):
         np.multiply(A[:, ch], acc[ch], out=out[:, ch])
     return out
+
+
+def _to_light(px: np.ndarray, py: np.ndarray, pz: np.ndarray, q) -> tuple[np.ndarray, ...]:
+    """The vectors from points (their coordinate columns) to a light at ``q`` and their lengths."""
+    qx, qy, qz = (float(c) for c in q)
+    vx, vy, vz = qx - px, qy - py, qz - pz
+    return vx, vy, vz, np.sqrt(vx * vx + vy * vy + vz * vz)
+
+
+def within_radius(points: np.ndarray, lights: LightArrays, j: int) -> np.ndarray | None:
+    """Which of S points (S, 3) light ``j`` may give a direct term by its ``radius`` (distance ≤
+    radius, :func:`radiance`'s arithmetic, so the same points): a bool per point, or None when all
+    of them (a directional light; a radius beyond every point). A camera casts shadow rays only
+    towards these: what lies beyond gets nothing from the light, shadowed or not."""
+    if int(lights.kind[j]) == LightKind.DIRECTIONAL or len(points) == 0:
+        return None
+    radius = float(lights.radius[j])
+    length = _to_light(points[:, 0], points[:, 1], points[:, 2], lights.position[j])[3]
+    if not radius < length.max():
+        return None
+    return ~(length > radius)
 
 
 FOG_TYPES = ("LINEAR", "EXPONENTIAL", "EXPONENTIAL2")

@@ -245,6 +245,9 @@ class CameraDevices(PixelDevices):
             unit, length = light_math.occlusion_segments_many(Pq, lights)
             for j in self.shadows.nonzero()[0].tolist():
                 i = (direct[:, j] > 0.0).nonzero()[0]
+                near = shading.within_radius(Pq[i], lights, j)      # beyond the light's radius: unlit anyway
+                if near is not None:
+                    i = i[near]
                 if len(i) == 0:
                     continue
                 h = sim.rays.cast(Pq[i], unit[i, j], 0.0, length[i, j], RayKind.VISUAL, np.full(len(i), q, dtype=np.int64),

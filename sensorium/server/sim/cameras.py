@@ -532,6 +532,9 @@ class Camera(Device):
         unit, length = light_math.occlusion_segments_many(P, lights)
         for j in shadows.nonzero()[0].tolist():
             i = (direct[:, j] > 0.0).nonzero()[0]
+            near = shading.within_radius(P[i], lights, j)       # beyond the light's radius: unlit anyway
+            if near is not None:
+                i = i[near]
             if len(i) == 0:
                 continue
             hits = self._scene.engine.cast(P[i], unit[i, j], 0.0, length[i, j], kind=RayKind.VISUAL, exclude_owner=-1,

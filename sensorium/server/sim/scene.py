@@ -159,7 +159,7 @@ def light_from_model(m) -> light_math.Light:
     server/devices/light.py computes with it."""
     fields = dict(kind=_LIGHT_KINDS[m.type], intensity=m.intensity, ambient_intensity=m.ambient_intensity, color=m.color)
     if m.type != "DirectionalLight":
-        fields.update(position=m.location, attenuation=m.attenuation)
+        fields.update(position=m.location, attenuation=m.attenuation, radius=m.radius)
     if m.type != "PointLight":
         fields.update(direction=m.direction)
     if m.type == "SpotLight":
