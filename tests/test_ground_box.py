@@ -282,3 +282,47 @@ def test_random_start_from_under_a_table_keeps_the_robots_clearance_above_its_ow
     random_start((-0.9, -0.5), (-0.5, 0.5))(sim, r, np.random.default_rng(2))
     assert -0.9 <= r.pose.translation[0] <= -0.5
     assert r.pose.translation[2] == DECK + (z0 - DECK) and r.drive.rest == DECK
+
+
+def _reference_under(g: gmod.Ground, x: float, y: float, ceiling: float) -> tuple[bool, float, float, float]:
+    """The rule spelled out: every surface in world order, the first of the highest eligible."""
+    best, slope, found = -math.inf, (0.0, 0.0), False
+    for s in g._surfaces:
+        if not s.upright:
+            continue
+        if s.half is not None:
+            ex, ey = x - s.tx, y - s.ty
+            u, v = s.r00 * ex + s.r10 * ey, s.r01 * ex + s.r11 * ey
+            if abs(u) <= s.hu and abs(v) <= s.hv and s.tz <= ceiling and s.tz > best:
+                best, slope, found = s.tz, (0.0, 0.0), True
+        else:
+            f, z, gx, gy = gmod.Ground([s], g._poses, None).under(np.array([x]), np.array([y]))
+            if f[0] and z[0] > best:
+                best, slope, found = float(z[0]), (float(gx[0]), float(gy[0])), True
+    return found, best, *slope
+
+
+def test_all_box_tops_at_once_are_the_rule_in_world_order_with_ties_moves_and_removals() -> None:
+    """Ground.under takes every box top at once; its answer is the rule taken surface by surface in
+    world order (the first of the highest eligible; ties between boxes, the floor plane and the ramp
+    at the same height included), at random points and ceilings; a box a supervisor moves or removes
+    is ground where it went, or no longer."""
+    rng = np.random.default_rng(11)
+    boxes = []
+    for k in range(25):
+        h = float(rng.choice([0.0, 0.3, 0.5, 0.05 * k]))          # ties with the plane and the deck
+        box = _box(f"b{k}", (float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)), h - 0.05), (0.8, 0.6, 0.1))
+        box["pose"]["rotation"] = [0, 0, 1, float(rng.uniform(-3, 3))]
+        boxes.append(box)
+    sim = _sim(_shelf(extra=tuple(boxes)), at=(-1.9, 0.0, DECK + HALF))
+    g = sim.ground
+    x, y = rng.uniform(-2.5, 2.5, 400), rng.uniform(-2.5, 2.5, 400)
+    ceiling = rng.choice([-1.0, 0.0, 0.3, 0.5, 0.9, math.inf], 400)
+    found, z, gx, gy = g.under(x, y, ceiling)
+    for k in range(400):
+        want = _reference_under(g, float(x[k]), float(y[k]), float(ceiling[k]))
+        assert (bool(found[k]), float(z[k]), float(gx[k]), float(gy[k])) == want, k
+    sim.set_solid_pose("deck", [4.0, 0.0, 0.35])                    # top 0.4 around x = 4
+    assert g.at(4.0, 0.0, 1.0)[0] == 0.35 + 0.05 and g.at(-1.0, 0.0, 1.0)[0] == 0.0
+    sim.remove_solid("deck")
+    assert g.at(4.0, 0.0, 1.0)[0] == 0.0

@@ -112,6 +112,8 @@ class Ground:
 
     def __init__(self, surfaces: list[_Surface], poses: dict[str, Pose], to_enu: np.ndarray | None):
         self._surfaces = surfaces
+        self._boxes: tuple[np.ndarray, ...] | None = None      # _box_table's, made again when stale
+        self._boxes_stale = True
         self._to_enu = to_enu
         self._poses = dict(poses)
         for s in surfaces:
@@ -155,6 +157,7 @@ class Ground:
             r, t = self._to_enu @ r, self._to_enu @ t
         if s.half is not None:
             self._place_box(s, r, t)
+            self._boxes_stale = True
             return
         s.upright = _is_upright(r)
         s.tx, s.ty, s.tz = (float(v) for v in t)
@@ -191,6 +194,7 @@ class Ground:
     def remove_solid(self, name: str) -> None:
         """A solid removed (supervisor): no longer ground."""
         self._surfaces = [s for s in self._surfaces if s.solid != name]
+        self._boxes_stale = True
         self._poses.pop(name, None)
 
     def under(self, x: np.ndarray, y: np.ndarray,
@@ -207,18 +211,9 @@ class Ground:
         gx = np.zeros(x.shape)
         gy = np.zeros(x.shape)
         found = np.zeros(x.shape, dtype=bool)
-        for s in self._surfaces:
-            if not s.upright:
-                continue
-            if s.half is not None:               # a box's top: over its footprint, up to the ceiling
-                ex, ey = x - s.tx, y - s.ty
-                u = s.r00 * ex + s.r10 * ey
-                v = s.r01 * ex + s.r11 * ey
-                take = (np.abs(u) <= s.hu) & (np.abs(v) <= s.hv) & (s.tz <= ceiling) & (s.tz > best)
-                best = np.where(take, s.tz, best)
-                gx = np.where(take, 0.0, gx)
-                gy = np.where(take, 0.0, gy)
-                found |= take
+        first = np.full(x.shape, len(self._surfaces))     # the world-order index of each point's ground
+        for i, s in enumerate(self._surfaces):
+            if not s.upright or s.half is not None:     # (box tops: all at once below)
                 continue
             if s.grid is None:                   # an infinite floor
                 z = np.full(x.shape, s.tz)
@@ -226,6 +221,7 @@ class Ground:
                 best = np.where(take, z, best)
                 gx = np.where(take, 0.0, gx)
                 gy = np.where(take, 0.0, gy)
+                first = np.where(take, i, first)
                 found |= take
                 continue
             ex, ey = x - s.tx, y - s.ty
@@ -243,8 +239,38 @@ class Ground:
             best[kk] = z[take]
             gx[kk] = s.r00 * gu[take] + s.r01 * gv[take]      # the slope turns with the grid
             gy[kk] = s.r10 * gu[take] + s.r11 * gv[take]
+            first[kk] = i
             found[kk] = True
+        boxes = self._box_table()
+        if boxes is not None and x.size:
+            # every box top at every point (points x boxes): over its footprint and not above the
+            # point's ceiling; each point's highest, the first in world order on a tie (argmax), then
+            # against the other surfaces' winner as the one loop in world order would have it
+            order, tx, ty, tz, a, b, c, d, hu, hv = boxes
+            ex, ey = x[..., None] - tx, y[..., None] - ty
+            u = a * ex + b * ey                  # the point in the box's horizontal axes
+            v = c * ex + d * ey
+            ok = (np.abs(u) <= hu) & (np.abs(v) <= hv) & (tz <= ceiling[..., None])
+            zb = np.where(ok, tz, -math.inf)
+            j = np.argmax(zb, axis=-1)
+            top = np.take_along_axis(zb, j[..., None], axis=-1)[..., 0]
+            take = ok.any(axis=-1) & ((top > best) | ((top == best) & (order[j] < first)))
+            best = np.where(take, top, best)
+            gx = np.where(take, 0.0, gx)
+            gy = np.where(take, 0.0, gy)
+            found |= take
         return found, best, gx, gy
+
+    def _box_table(self) -> tuple[np.ndarray, ...] | None:
+        """The upright boxes' tops as arrays (world-order index, tx, ty, top, r00, r10, r01, r11,
+        hu, hv), made once per change of the surfaces; None without one."""
+        if self._boxes_stale:
+            self._boxes_stale = False
+            rows = [(i, s.tx, s.ty, s.tz, s.r00, s.r10, s.r01, s.r11, s.hu, s.hv)
+                    for i, s in enumerate(self._surfaces) if s.half is not None and s.upright]
+            self._boxes = None if not rows else (np.array([r[0] for r in rows], dtype=np.int64),
+                                                 *np.array([r[1:] for r in rows], dtype=np.float64).T)
+        return self._boxes
 
     def at(self, x: float, y: float, ceiling: float = math.inf) -> tuple[float, float, float] | None:
         """:meth:`under` at one point: ``(z, gx, gy)`` or None (the same arithmetic, so the same bits)."""
