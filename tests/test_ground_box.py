@@ -22,6 +22,7 @@ from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import parse_world
+from tests.test_batched_nue import TO_NUE, _to_nue
 
 SLOPE = 0.25
 DX = 0.5
@@ -231,19 +232,25 @@ def _world(seed: int) -> wm.World:
                    _robot("c", (-0.8, 3.1, DECK + HALF), 0.05)]})
 
 
-@pytest.mark.parametrize("c_drive", [True, False])
-def test_copies_riding_box_floors_and_terrains_are_the_single_simulation_bit_for_bit(c_drive):
+@pytest.mark.parametrize("c_drive,nue", [(True, False), (False, False), (True, True)])
+def test_copies_riding_box_floors_and_terrains_are_the_single_simulation_bit_for_bit(c_drive, nue):
     """Three robots on the deck, the ramp and the step/kerb, random wheel commands, a supervisor move
     onto the table in one copy: every copy's poses equal a Simulation's after every step, bit for
-    bit, through the C drive and the numpy one."""
+    bit, through the C drive and the numpy one; and the same world written in NUE axes (y up), where
+    robot b, starting on the ramp's slope, has its upright footprint in both (its world-file pose)."""
     if c_drive and packets.library() is None:
         pytest.skip(f"no packets helper: {packets.status()}")
+
+    def world(seed: int) -> wm.World:
+        return wm.World.model_validate(_to_nue(_world(seed))) if nue else _world(seed)
+
+    up = 1 if nue else 2
     seeds = [3, 4, 5]
-    bs = BatchedSimulation(_world(0), len(seeds))
+    bs = BatchedSimulation(world(0), len(seeds))
     if not c_drive:
         bs._drive_step = None
     bs.reset(np.arange(3), seeds)
-    sims = [Simulation(_world(s)) for s in seeds]
+    sims = [Simulation(world(s)) for s in seeds]
     rng = np.random.default_rng(7)
     heights: set[float] = set()
     for step in range(150):
@@ -257,8 +264,9 @@ def test_copies_riding_box_floors_and_terrains_are_the_single_simulation_bit_for
                     s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
                     s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
         if step == 70:
-            bs.set_pose(1, bs.slot("a"), [-1.5, 0.0, 0.8 + HALF])
-            sims[1].robot("a").set_pose([-1.5, 0.0, 0.8 + HALF])
+            onto = (TO_NUE @ np.array([-1.5, 0.0, 0.8 + HALF])).tolist() if nue else [-1.5, 0.0, 0.8 + HALF]
+            bs.set_pose(1, bs.slot("a"), onto)
+            sims[1].robot("a").set_pose(onto)
         bs.step()
         for c, s in enumerate(sims):
             s.step()
@@ -267,8 +275,9 @@ def test_copies_riding_box_floors_and_terrains_are_the_single_simulation_bit_for
                 pose = s.robot(robot).pose
                 assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
                 assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
-                heights.add(float(pose.translation[2]))
+                heights.add(float(pose.translation[up]))
     assert DECK + HALF in heights and len(heights) > 10
+    assert sims[1].robot("a").drive.rest == pytest.approx(0.78 + 0.04 / 2, abs=1e-15)   # put on the table: it rides it
 
 
 def test_random_start_from_under_a_table_keeps_the_robots_clearance_above_its_own_ground() -> None:

@@ -238,9 +238,11 @@ class Simulation:
         solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                    shape.seen_by in ("both", "bounding"))
                   for s in self.world.solids for _, local, shape in solid_parts(s, Pose.identity())]
+        # each robot at its world-file pose: its footprint is taken upright (enu_body), not tilted by
+        # the slope it may start on (the batched simulation's feet, from the same poses)
         robots = [([(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(r)
-                    if shape.seen_by in ("both", "bounding")], self.scene.robot_poses[i])
-                  for i, r in enumerate(self.world.robots)]
+                    if shape.seen_by in ("both", "bounding")], self.robots[r.name].initial_pose)
+                  for r in self.world.robots]
         return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system])
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
