@@ -1,4 +1,5 @@
-"""The ground driven robots ride on: terrains (ElevationGrids) and the floor planes around them.
+"""The ground driven robots ride on: terrains (ElevationGrids) and the floor planes and box floors
+around them.
 
 No physics: a driven robot keeps the clearance it was placed with above the ground under its
 origin. After each step's planar move its height is ``ground(x, y) + clearance`` and, over a
@@ -31,9 +32,11 @@ ground it rides a box is either ground or an obstacle, never both -- a robot is 
 what contact stops it at (a table top above it, a kerb 1 cm up), and the box it rides always
 stays eligible (it never drops through a box floor onto a plane or terrain below). A box lower
 than its body (under the band, which contact lets pass beneath) is climbed onto at once, as
-wheels would; no step above the band is: the kinematic model has no wheels to climb a kerb
-with. Terrains and planes are ground whatever their height (contact never stops a robot at
-them), as before.
+wheels would; no step reaching more than 1 mm into the band is: the kinematic model has no
+wheels to climb a kerb with. (A robot whose body reaches below the ground it rides has its
+ceiling at that ground + FLOOR: a box top between its band bottom + FLOOR and that ceiling would
+be both, but contact (when on) keeps its disc, and so its origin, off it.) Terrains and planes are ground
+whatever their height (contact never stops a robot at them), as before.
 
 Other solids are not ridden. In a world without terrains there is no Ground at all: robots keep
 their heights over Box floors and Planes alike.
@@ -43,8 +46,8 @@ line shared by two triangles (a cell's diagonal or edge, a grid point) both tria
 same height, bit for bit (the barycentric weights below make the shared terms identical); the
 slope there is the triangle on the +x / +y side (the lower triangle ``s ≥ t`` on the diagonal,
 the last cell on the grid's far edges). Every function here is element-wise float64 arithmetic
-that gives the same bits on a scalar and on any array, so the batched simulation's copies ride
-exactly as the single simulation's robot does.
+that gives the same bits on a scalar and on any array (the box tops, taken all at once, per point
+too), so the batched simulation's copies ride exactly as the single simulation's robot does.
 """
 
 from __future__ import annotations
