@@ -38,6 +38,7 @@ from sensorium.gym.frame import ENU_AXES, enu_axes, horizontal_directions, to_en
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.batched_lights import copy_world_lights
+from sensorium.server.sim.ground import placing_ceiling
 
 __all__ = ["Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start", "VectorGoal"]
 
@@ -116,7 +117,9 @@ def body_radius(robot, base_dir=None, world=None) -> float:
 class random_start:
     """``Task.start``: put the robot at a uniformly random (x, y, yaw) in the given ranges, at its
     world-file height (in a world with terrains: its world-file clearance above the ground there,
-    so it rides the terrain from where it lands). Draws from the environment's seeded generator,
+    so it rides the terrain from where it lands: its ground here is the highest under it not above
+    its origin + 1 mm (a box top it stands on, not a table above it), there the highest ground at
+    (x, y), a table's top included: keep the ranges off tables). Draws from the environment's seeded generator,
     so a seed fixes the start.
 
     The ranges are the world's ENU view (:mod:`sensorium.gym.frame`): ``x`` east, ``y`` north, ``yaw``
@@ -137,8 +140,8 @@ class random_start:
         y = rng.uniform(*self.y)
         yaw = rng.uniform(*self.yaw)
         ground = getattr(sim, "ground", None)         # (in ENU axes in any world)
-        if ground is not None:
-            here = ground.at(float(now.translation[e]), float(now.translation[n]))
+        if ground is not None:      # its ground here (box tops up to its origin + 1 mm), the highest there
+            here = ground.at(float(now.translation[e]), float(now.translation[n]), placing_ceiling(z, 0.0))
             there = ground.at(x, y)
             if here is not None and there is not None:
                 z = there[0] + (z - here[0])

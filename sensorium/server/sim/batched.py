@@ -66,7 +66,7 @@ from sensorium.server.sim.batched_lights import CarriedLights
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, FLOOR, Contact, Obstacle, enu_body, enu_pose, robot_footprint
-from sensorium.server.sim.ground import Ground, ground_rotation, ride_height
+from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, support_ceiling
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, PlanarState, _rz
 from sensorium.server.sim.scene import (
     Scene,
@@ -263,9 +263,16 @@ class BatchedSimulation:
                                      else [1, 1] for r in w.robots], dtype=np.int64)
         # the terrains robots ride (sim/ground.py; None in a world without one: heights never change)
         self.ground = Ground.from_world(w, self.scene.solid_poses, self.to_enu)
+        # each robot's band bottom below its origin (its support ceiling's, ground.band_low; 0 without a ground)
+        self.band_low = np.array([band_low([(primitive_from_model(shape.geometry, base), local)
+                                            for _, local, shape in robot_parts(r) if shape.seen_by in ("both", "bounding")],
+                                           self.initial[i], self.to_enu) if self.ground is not None else 0.0
+                                  for i, r in enumerate(w.robots)], dtype=np.float64)
         self._templates: list[PlanarState | None] = [
-            DifferentialDrive(r.differential_drive, self.initial[i], up=up, ground=self.ground) if r.differential_drive
-            else AckermannDrive(r.ackermann_drive, self.initial[i], up=up, ground=self.ground) if r.ackermann_drive
+            DifferentialDrive(r.differential_drive, self.initial[i], up=up, ground=self.ground,
+                              band_low=float(self.band_low[i])) if r.differential_drive
+            else AckermannDrive(r.ackermann_drive, self.initial[i], up=up, ground=self.ground,
+                                band_low=float(self.band_low[i])) if r.ackermann_drive
             else None for i, r in enumerate(w.robots)]
         # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
         self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
@@ -752,7 +759,8 @@ class BatchedSimulation:
         if not len(k):
             return
         c, r = copies[k], slots[k]
-        found, h, gx, gy = self.ground.under(x[k], y[k])
+        ceiling = support_ceiling(self.z[c, r], self.band_low[r], self.z0[c, r], self.rest[c, r])
+        found, h, gx, gy = self.ground.under(x[k], y[k], ceiling)
         self.z[c, r] = ride_height(self.z[c, r], self.z0[c, r], self.rest[c, r], found, h)
         self.tilted[c, r] = found & ((gx != 0.0) | (gy != 0.0))
         self.slope[c, r, 0] = np.where(found, gx, 0.0)

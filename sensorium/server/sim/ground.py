@@ -1,4 +1,5 @@
-"""The ground driven robots ride on: terrains (ElevationGrids) and the floor planes around them.
+"""The ground driven robots ride on: terrains (ElevationGrids) and the floor planes and box floors
+around them.
 
 No physics: a driven robot keeps the clearance it was placed with above the ground under its
 origin. After each step's planar move its height is ``ground(x, y) + clearance`` and, over a
@@ -13,19 +14,40 @@ What counts as ground (seen by bounding rays, as kinematic contact reads the wor
   its closed extent ``[0, (x_dimension − 1)·x_spacing] × [0, (y_dimension − 1)·y_spacing]`` and
   nothing beyond;
 * a Plane facing up (its local z the world's up): a floor at its height, everywhere (bounding rays
-  and Webots' physics take every plane as infinite, whatever its size).
+  and Webots' physics take every plane as infinite, whatever its size);
+* the top of a Box whose faces are horizontal and vertical (one of its local axes the world's up,
+  within UPRIGHT_TOL; turned about the vertical or not): a floor at its top over its closed
+  footprint rectangle -- a slab used as the floor, a raised platform, a step -- but only *for a
+  robot whose support ceiling it does not exceed* (below).
 
-Other solids are not ridden: over a Box used as the floor a robot keeps its height, which is what a
-Plane floor gives in a world without terrains (there is no Ground then); kinematic contact takes
-such a floor, its top at most ``contact.FLOOR`` above the robot's band bottom, as ground too.
+The support rule (box tops only). A box top is ground for a robot only if it is not above the
+robot's **support ceiling**, ``max(band bottom, the ground it rides) + contact.FLOOR``: its
+body's height band bottom (the bottom of the disc kinematic contact gives it, ``z + z_low``;
+its origin for a robot with no body) or the height of the ground it rides now (``z − clearance``),
+whichever is higher, plus the 1 mm floor tolerance; placed or moved by a supervisor it has only
+its band bottom. This is kinematic contact's own floor line, taken with the same operations
+(``band_lo + FLOOR``, contact.py): a solid whose top is above it is an obstacle contact stops the
+robot at, one whose top is not is its floor, so for a robot whose body does not reach below the
+ground it rides a box is either ground or an obstacle, never both -- a robot is never lifted onto
+what contact stops it at (a table top above it, a kerb 1 cm up), and the box it rides always
+stays eligible (it never drops through a box floor onto a plane or terrain below). A box lower
+than its body (under the band, which contact lets pass beneath) is climbed onto at once, as
+wheels would; no step reaching more than 1 mm into the band is: the kinematic model has no
+wheels to climb a kerb with. (A robot whose body reaches below the ground it rides has its
+ceiling at that ground + FLOOR: a box top between its band bottom + FLOOR and that ceiling would
+be both, but contact (when on) keeps its disc, and so its origin, off it.) Terrains and planes are ground
+whatever their height (contact never stops a robot at them), as before.
+
+Other solids are not ridden. In a world without terrains there is no Ground at all: robots keep
+their heights over Box floors and Planes alike.
 
 Where several cover a point the highest is the ground (the first in world order on a tie). On a
 line shared by two triangles (a cell's diagonal or edge, a grid point) both triangles give the
 same height, bit for bit (the barycentric weights below make the shared terms identical); the
 slope there is the triangle on the +x / +y side (the lower triangle ``s ≥ t`` on the diagonal,
 the last cell on the grid's far edges). Every function here is element-wise float64 arithmetic
-that gives the same bits on a scalar and on any array, so the batched simulation's copies ride
-exactly as the single simulation's robot does.
+that gives the same bits on a scalar and on any array (the box tops, taken all at once, per point
+too), so the batched simulation's copies ride exactly as the single simulation's robot does.
 """
 
 from __future__ import annotations
@@ -36,9 +58,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.sim.contact import FLOOR, enu_body, robot_footprint
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["Ground", "GroundWarning", "ground_rotation", "ride_height"]
+__all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "placing_ceiling", "ride_height",
+           "support_ceiling"]
 
 UPRIGHT_TOL = 1e-12     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 
@@ -59,11 +83,17 @@ class _Grid:
 
 @dataclass(slots=True)
 class _Surface:
-    """One piece of ground placed in the world (ENU axes): a grid, or a floor plane (``grid`` None)."""
+    """One piece of ground placed in the world (ENU axes): a grid, a box's top (``half``: its half
+    sizes), or a floor plane (neither)."""
 
     solid: str
     local: Pose                       # in the solid's frame
     grid: _Grid | None
+    half: tuple[float, float, float] | None = None
+    # a box: its top (tz) and its footprint, |u| <= hu and |v| <= hv with u = r00·ex + r10·ey and
+    # v = r01·ex + r11·ey (its two horizontal local axes)
+    hu: float = 0.0
+    hv: float = 0.0
     # its world placement (set by Ground.place): origin and the turn about the vertical
     tx: float = 0.0
     ty: float = 0.0
@@ -85,6 +115,8 @@ class Ground:
 
     def __init__(self, surfaces: list[_Surface], poses: dict[str, Pose], to_enu: np.ndarray | None):
         self._surfaces = surfaces
+        self._boxes: tuple[np.ndarray, ...] | None = None      # _box_table's, made again when stale
+        self._boxes_stale = True
         self._to_enu = to_enu
         self._poses = dict(poses)
         for s in surfaces:
@@ -110,6 +142,9 @@ class Ground:
                     surfaces.append(_Surface(s.name, local, _Grid(xs, ys, h)))
                 elif isinstance(g, wm.Plane):
                     surfaces.append(_Surface(s.name, local, None))
+                elif isinstance(g, wm.Box):
+                    sx, sy, sz = (float(v) / 2.0 for v in g.size)
+                    surfaces.append(_Surface(s.name, local, None, (sx, sy, sz)))
         if not any(s.grid is not None for s in surfaces):
             return None
         return cls(surfaces, solid_poses, to_enu)
@@ -123,9 +158,32 @@ class Ground:
         r, t = pose.rotation, pose.translation
         if self._to_enu is not None:
             r, t = self._to_enu @ r, self._to_enu @ t
+        if s.half is not None:
+            self._place_box(s, r, t)
+            self._boxes_stale = True
+            return
         s.upright = _is_upright(r)
         s.tx, s.ty, s.tz = (float(v) for v in t)
         s.r00, s.r01, s.r10, s.r11 = float(r[0, 0]), float(r[0, 1]), float(r[1, 0]), float(r[1, 1])
+
+    @staticmethod
+    def _place_box(s: _Surface, r: np.ndarray, t: np.ndarray) -> None:
+        """A box's top and footprint: ground only if one of its local axes is the world's up (its
+        faces horizontal and vertical). Its top is the highest of its corners' heights computed as
+        contact.obstacle computes them (``corners @ r.T + t``), so both judge the same number."""
+        assert s.half is not None
+        up = [k for k in range(3) if abs(r[0, k]) <= UPRIGHT_TOL and abs(r[1, k]) <= UPRIGHT_TOL
+              and all(abs(r[2, j]) <= UPRIGHT_TOL for j in range(3) if j != k)]
+        s.upright = bool(up)
+        if not up:
+            return
+        i, j = (a for a in range(3) if a != up[0])
+        hx, hy, hz = s.half
+        corners = np.array([[x, y, z] for x in (-hx, hx) for y in (-hy, hy) for z in (-hz, hz)])
+        s.tx, s.ty = float(t[0]), float(t[1])
+        s.tz = float((corners @ r.T + t)[:, 2].max())
+        s.r00, s.r10, s.r01, s.r11 = float(r[0, i]), float(r[1, i]), float(r[0, j]), float(r[1, j])
+        s.hu, s.hv = s.half[i], s.half[j]
 
     def update_solid(self, name: str, pose: Pose) -> None:
         """A solid moved (supervisor): its pieces of ground move with it."""
@@ -139,19 +197,26 @@ class Ground:
     def remove_solid(self, name: str) -> None:
         """A solid removed (supervisor): no longer ground."""
         self._surfaces = [s for s in self._surfaces if s.solid != name]
+        self._boxes_stale = True
         self._poses.pop(name, None)
 
-    def under(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """The ground under points (ENU x, y arrays): ``(found, z, gx, gy)`` — whether any covers
-        each point, its height there and its slope (dz/dx, dz/dy in ENU axes; 0 on floors)."""
+    def under(self, x: np.ndarray, y: np.ndarray,
+              ceiling: np.ndarray | float = math.inf) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The ground under points (ENU x, y arrays) for robots whose support ceilings are
+        ``ceiling`` (:func:`support_ceiling`, :func:`placing_ceiling`: a box top above it is not
+        ground there; the robots always give theirs, the default inf is the ground seen from above):
+        ``(found, z, gx, gy)`` — whether any covers each point, its height there and its slope
+        (dz/dx, dz/dy in ENU axes; 0 on floors)."""
         x = np.asarray(x, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)
+        ceiling = np.broadcast_to(np.asarray(ceiling, dtype=np.float64), x.shape)
         best = np.full(x.shape, -math.inf)
         gx = np.zeros(x.shape)
         gy = np.zeros(x.shape)
         found = np.zeros(x.shape, dtype=bool)
-        for s in self._surfaces:
-            if not s.upright:
+        first = np.full(x.shape, len(self._surfaces))     # the world-order index of each point's ground
+        for i, s in enumerate(self._surfaces):
+            if not s.upright or s.half is not None:     # (box tops: all at once below)
                 continue
             if s.grid is None:                   # an infinite floor
                 z = np.full(x.shape, s.tz)
@@ -159,6 +224,7 @@ class Ground:
                 best = np.where(take, z, best)
                 gx = np.where(take, 0.0, gx)
                 gy = np.where(take, 0.0, gy)
+                first = np.where(take, i, first)
                 found |= take
                 continue
             ex, ey = x - s.tx, y - s.ty
@@ -176,12 +242,42 @@ class Ground:
             best[kk] = z[take]
             gx[kk] = s.r00 * gu[take] + s.r01 * gv[take]      # the slope turns with the grid
             gy[kk] = s.r10 * gu[take] + s.r11 * gv[take]
+            first[kk] = i
             found[kk] = True
+        boxes = self._box_table()
+        if boxes is not None and x.size:
+            # every box top at every point (points x boxes): over its footprint and not above the
+            # point's ceiling; each point's highest, the first in world order on a tie (argmax), then
+            # against the other surfaces' winner as the one loop in world order would have it
+            order, tx, ty, tz, a, b, c, d, hu, hv = boxes
+            ex, ey = x[..., None] - tx, y[..., None] - ty
+            u = a * ex + b * ey                  # the point in the box's horizontal axes
+            v = c * ex + d * ey
+            ok = (np.abs(u) <= hu) & (np.abs(v) <= hv) & (tz <= ceiling[..., None])
+            zb = np.where(ok, tz, -math.inf)
+            j = np.argmax(zb, axis=-1)
+            top = np.take_along_axis(zb, j[..., None], axis=-1)[..., 0]
+            take = ok.any(axis=-1) & ((top > best) | ((top == best) & (order[j] < first)))
+            best = np.where(take, top, best)
+            gx = np.where(take, 0.0, gx)
+            gy = np.where(take, 0.0, gy)
+            found |= take
         return found, best, gx, gy
 
-    def at(self, x: float, y: float) -> tuple[float, float, float] | None:
+    def _box_table(self) -> tuple[np.ndarray, ...] | None:
+        """The upright boxes' tops as arrays (world-order index, tx, ty, top, r00, r10, r01, r11,
+        hu, hv), made once per change of the surfaces; None without one."""
+        if self._boxes_stale:
+            self._boxes_stale = False
+            rows = [(i, s.tx, s.ty, s.tz, s.r00, s.r10, s.r01, s.r11, s.hu, s.hv)
+                    for i, s in enumerate(self._surfaces) if s.half is not None and s.upright]
+            self._boxes = None if not rows else (np.array([r[0] for r in rows], dtype=np.int64),
+                                                 *np.array([r[1:] for r in rows], dtype=np.float64).T)
+        return self._boxes
+
+    def at(self, x: float, y: float, ceiling: float = math.inf) -> tuple[float, float, float] | None:
         """:meth:`under` at one point: ``(z, gx, gy)`` or None (the same arithmetic, so the same bits)."""
-        found, z, gx, gy = self.under(np.array([x]), np.array([y]))
+        found, z, gx, gy = self.under(np.array([x]), np.array([y]), np.array([ceiling]))
         if not found[0]:
             return None
         return float(z[0]), float(gx[0]), float(gy[0])
@@ -223,6 +319,28 @@ def grid_height(grid: _Grid, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, 
     s = (u - grid.xs[i]) / (grid.xs[i + 1] - grid.xs[i])
     t = (v - grid.ys[j]) / (grid.ys[j + 1] - grid.ys[j])
     return triangle_height(grid, i, j, s >= t, u, v)
+
+
+def band_low(parts: list, pose: Pose, to_enu: np.ndarray | None) -> float:
+    """The bottom of a robot's height band relative to its origin, as kinematic contact takes it
+    (``robot_footprint(enu_body(...)).z_low``: its bounding body shapes, ``parts`` as (primitive,
+    pose in the robot frame), at its initial ``pose``); 0.0 (its origin) for a robot with no body."""
+    foot = robot_footprint(enu_body(parts, pose, to_enu))
+    return 0.0 if foot is None else foot.z_low
+
+
+def placing_ceiling(z, low):
+    """The support ceiling of a robot placed at height ``z`` (band bottom ``z + low``): it rides no
+    ground yet, so its band bottom alone, plus FLOOR. Scalars or arrays, the same bits."""
+    return (z + low) + FLOOR
+
+
+def support_ceiling(z, low, z0, rest):
+    """The support ceiling of a robot riding the ground (height ``z``, band bottom ``z + low``,
+    placed at ``z0`` over ground at ``rest``): ``max(z + low, z − (z0 − rest)) + FLOOR``, its band
+    bottom or the ground it rides, whichever is higher, plus FLOOR (module docstring). Scalars or
+    arrays, the same bits."""
+    return np.maximum(z + low, z - (z0 - rest)) + FLOOR
 
 
 def ride_height(z_last, z0, rest, found, h):

@@ -13,7 +13,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sensorium.server.sim.ground import Ground, ground_angular_velocity, ground_rotation, ride_height
+from sensorium.server.sim.ground import (
+    Ground,
+    ground_angular_velocity,
+    ground_rotation,
+    placing_ceiling,
+    ride_height,
+    support_ceiling,
+)
 from sensorium.server.world.geometry import Pose
 
 _TWO_PI = 2.0 * math.pi
@@ -120,11 +127,14 @@ class PlanarState:
     after each planar move, sets its height to the ground under its origin plus the clearance it
     was placed with, and over a sloped triangle its rotation becomes ``ground_rotation(slope, yaw)
     @ base`` (the ground's roll and pitch, the drive's yaw). A robot placed over nothing keeps its
-    height wherever it goes, as without a ground."""
+    height wherever it goes, as without a ground. ``band_low``: the bottom of its body's height
+    band below its origin (ground.band_low), which with its height makes its support ceiling: box
+    tops above it are not its ground (ground.py's support rule)."""
 
-    def __init__(self, pose: Pose, up: str = "ENU", ground: Ground | None = None):
+    def __init__(self, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
         self._to_enu = _TO_ENU[up]
         self.ground = ground
+        self.band_low = band_low
         self.reset(pose)
 
     def reset(self, pose: Pose) -> None:
@@ -146,7 +156,8 @@ class PlanarState:
         self.z0 = self.z
         self.slope: tuple[float, float] | None = None
         if self.ground is not None:
-            under = self.ground.at(self.x, self.y)
+            ceiling = placing_ceiling(np.array([self.z]), np.array([self.band_low]))
+            under = self.ground.at(self.x, self.y, float(ceiling[0]))
             if under is not None:
                 self.rest = under[0]
                 self.slope = under[1:] if (under[1] or under[2]) else None
@@ -155,7 +166,9 @@ class PlanarState:
         """Ride the ground after a planar move (nothing to do without one)."""
         if self.ground is None or self.rest is None:
             return
-        under = self.ground.at(self.x, self.y)
+        ceiling = support_ceiling(np.array([self.z]), np.array([self.band_low]), np.array([self.z0]),
+                                  np.array([self.rest]))
+        under = self.ground.at(self.x, self.y, float(ceiling[0]))
         if under is None:
             self.slope = None         # nothing under it: it keeps its height, upright
             return
@@ -224,7 +237,7 @@ class DifferentialDrive(PlanarState):
     robot drives on the ground plane (normal +y) there.
     """
 
-    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None):
+    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
         self.wheel_radius = float(config.wheel_radius)
         self.axle_length = float(config.axle_length)
         speed = float(config.max_wheel_speed)
@@ -233,7 +246,7 @@ class DifferentialDrive(PlanarState):
         self.right = WheelMotor(config.right_motor, speed)
         self.lefts = [self.left, *(WheelMotor(name, speed) for name in (skid.left if skid else ()))]
         self.rights = [self.right, *(WheelMotor(name, speed) for name in (skid.right if skid else ()))]
-        super().__init__(pose, up, ground)
+        super().__init__(pose, up, ground, band_low)
 
     @property
     def motors(self) -> dict[str, WheelMotor]:
@@ -288,7 +301,7 @@ class AckermannDrive(PlanarState):
     the driven wheels. The steering angles used for a step are the motors' at its end (they hold
     their positions by position control, at most ``max_steering_speed`` fast)."""
 
-    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None):
+    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
         self.wheelbase = float(config.wheelbase)
         self.track_front, self.track_rear = float(config.track_front), float(config.track_rear)
         self.sign = 1.0 if config.positive_steers == "right" else -1.0
@@ -299,7 +312,7 @@ class AckermannDrive(PlanarState):
         place = wheel_places(config)
         # each driven wheel: its motor, its (x, y) on the car, its radius
         self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
-        super().__init__(pose, up, ground)
+        super().__init__(pose, up, ground, band_low)
 
     @property
     def motors(self) -> dict[str, WheelMotor]:

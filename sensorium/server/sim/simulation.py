@@ -26,7 +26,7 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
 from sensorium.server.sim.contact import Contact
-from sensorium.server.sim.ground import Ground, GroundWarning
+from sensorium.server.sim.ground import Ground, GroundWarning, band_low
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
@@ -99,11 +99,13 @@ class RobotState:
         up = sim.world.world_info.coordinate_system
         self.initial_pose = sim.scene.robot_poses[index]     # as the world file places it (reset puts it back there)
         self.drive: DifferentialDrive | AckermannDrive | None = None
+        low = sim.band_low(index) if sim.ground is not None else 0.0     # (its support ceiling: sim/ground.py)
         if model.differential_drive is not None:
             self.drive = DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index], up=up,
-                                           ground=sim.ground)
+                                           ground=sim.ground, band_low=low)
         elif model.ackermann_drive is not None:
-            self.drive = AckermannDrive(model.ackermann_drive, sim.scene.robot_poses[index], up=up, ground=sim.ground)
+            self.drive = AckermannDrive(model.ackermann_drive, sim.scene.robot_poses[index], up=up, ground=sim.ground,
+                                        band_low=low)
         if self.drive is not None and self.drive.slope is not None:   # placed on a slope: its attitude
             sim.scene.set_robot_pose(index, self.drive.pose())
         self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
@@ -219,18 +221,28 @@ class Simulation:
                           "the world's up): not ground, robots keep their height over it", GroundWarning, stacklevel=3)
         for r in self._driven:
             if r.drive is not None and r.drive.rest is None:
-                warnings.warn(f"{self.loaded.source}: robot {r.name!r} starts over no ground (no upright terrain or "
-                              "floor plane under its origin): it keeps its height, terrains do not lift it",
+                warnings.warn(f"{self.loaded.source}: robot {r.name!r} starts over no ground (no upright terrain, "
+                              "floor plane or box top at most 1 mm above its body's bottom under its origin): "
+                              "it keeps its height, terrains do not lift it",
                               GroundWarning, stacklevel=3)
+
+    def band_low(self, index: int) -> float:
+        """Robot ``index``'s band bottom below its origin, as contact takes it (ground.band_low)."""
+        base = self.loaded.base_dir
+        parts = [(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(self.world.robots[index])
+                 if shape.seen_by in ("both", "bounding")]
+        return band_low(parts, self.scene.robot_poses[index], _TO_ENU[self.world.world_info.coordinate_system])
 
     def _build_contact(self) -> Contact:
         base = self.loaded.base_dir
         solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                    shape.seen_by in ("both", "bounding"))
                   for s in self.world.solids for _, local, shape in solid_parts(s, Pose.identity())]
+        # each robot at its world-file pose: its footprint is taken upright (enu_body), not tilted by
+        # the slope it may start on (the batched simulation's feet, from the same poses)
         robots = [([(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(r)
-                    if shape.seen_by in ("both", "bounding")], self.scene.robot_poses[i])
-                  for i, r in enumerate(self.world.robots)]
+                    if shape.seen_by in ("both", "bounding")], self.robots[r.name].initial_pose)
+                  for r in self.world.robots]
         return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system])
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
