@@ -497,6 +497,12 @@ def test_c_supervisor_walks_the_tree_switches_a_light_and_reads_velocities(cbin,
     assert "wb_supervisor_field_get_sf_bool() called with wrong field type: SFFloat." in err
     assert "has no field 'mass' in Sensorium" in err and "out-of-bound index: 5" in err
     assert "wb_supervisor_node_get_velocity() called with a NULL or invalid 'node' argument." in err
+    from test_supervisor_scene import _pose_checks
+    got = {line.split()[0]: [float(v) for v in line.split()[1:]] for line in out[15:]}
+    _pose_checks(got["position"], got["orientation"], got["pose"], got["crate_from_me"], got["me_from_lamp"],
+                 got["crate_from_root"], got["lamp_pose"])
+    assert all(math.isnan(v) for v in got["null_pose"]) and "not served" not in err
+    assert "wb_supervisor_node_get_pose() called with a NULL or invalid 'node' argument." in err
 
 
 def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):

@@ -136,11 +136,6 @@ const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
   return sn_no_values();
 }
 
-const double *wb_supervisor_node_get_pose(WbNodeRef node, WbNodeRef from_node) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
-
 bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
   SN_UNSUPPORTED();
   return false;
