@@ -245,6 +245,21 @@ def wb_supervisor_node_get_pose(node: int | None, from_node: int | None = None) 
     return out + [0.0, 0.0, 0.0, 1.0]
 
 
+def wb_supervisor_node_enable_pose_tracking(node: int | None, sampling_period: int,
+                                            from_node: int | None = None) -> None:
+    """Webots streams a tracked pose every sampling period; :func:`wb_supervisor_node_get_pose` asks
+    the server at each call here, so tracking changes nothing: accepted after Webots' checks."""
+    func = "wb_supervisor_node_enable_pose_tracking"
+    if sampling_period < 0:
+        print(f"Error: {func}() called with negative sampling period.", file=sys.stderr)
+        return
+    _checked_node(node, func)
+
+
+def wb_supervisor_node_disable_pose_tracking(node: int | None, from_node: int | None = None) -> None:
+    _checked_node(node, "wb_supervisor_node_disable_pose_tracking")
+
+
 def wb_supervisor_node_get_velocity(node: int | None) -> list[float]:
     """Linear (m/s) then angular (rad/s) velocity in world axes: a driven robot's from its last step,
     zeros for anything else (nothing else moves by itself here)."""

@@ -86,6 +86,7 @@ int main(void) {
   /* poses (Webots' 4x4 row-major transforms): the judge's in the world, the crate's seen from the
      judge; a light has none; from a light or the root: the world's frame (Webots' rule) */
   WbNodeRef crate = wb_supervisor_node_get_from_def("CRATE");
+  wb_supervisor_node_enable_pose_tracking(crate, dt, me); /* accepted: get_pose asks at each call here */
   vec("position", wb_supervisor_node_get_position(me), 3);
   vec("orientation", wb_supervisor_node_get_orientation(me), 9);
   vec("pose", wb_supervisor_node_get_pose(me, NULL), 16);

@@ -343,6 +343,23 @@ const double *wb_supervisor_node_get_pose(WbNodeRef node, WbNodeRef from_node) {
   return node->pose;
 }
 
+/* Webots streams a tracked pose every sampling period; wb_supervisor_node_get_pose asks the server
+   at each call here, so tracking changes nothing: accepted after Webots' checks */
+void wb_supervisor_node_enable_pose_tracking(WbNodeRef node, int sampling_period, WbNodeRef from_node) {
+  const char *func = "wb_supervisor_node_enable_pose_tracking";
+  (void)from_node;
+  if (sampling_period < 0) {
+    fprintf(stderr, "Error: %s() called with negative sampling period.\n", func);
+    return;
+  }
+  supervisor_node(node, func);
+}
+
+void wb_supervisor_node_disable_pose_tracking(WbNodeRef node, WbNodeRef from_node) {
+  (void)from_node;
+  supervisor_node(node, "wb_supervisor_node_disable_pose_tracking");
+}
+
 /* linear (m/s) then angular (rad/s) velocity in world axes: a driven robot's last step, zeros for
    anything else; Webots' NaNs for a NULL node */
 const double *wb_supervisor_node_get_velocity(WbNodeRef node) {

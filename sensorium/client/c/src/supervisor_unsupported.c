@@ -186,14 +186,6 @@ void wb_supervisor_field_disable_sf_tracking(WbFieldRef field) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_node_enable_pose_tracking(WbNodeRef node, int sampling_period, WbNodeRef from_node) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_node_disable_pose_tracking(WbNodeRef node, WbNodeRef from_node) {
-  SN_UNSUPPORTED();
-}
-
 
 int wb_supervisor_field_get_sf_int32(WbFieldRef field) {
   SN_UNSUPPORTED();
