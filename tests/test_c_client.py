@@ -37,7 +37,7 @@ CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene",
-               "supervisor_remove", "supervisor_import"]
+               "supervisor_remove", "supervisor_import", "ignores_minus_one"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
@@ -261,7 +261,7 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
                       "wwi (null) (null) 0",                 # no robot window
                       "step 0",
                       "supervisor NULL 1 SFRotation -1 -1 nan  1 0",   # beyond the subset: "no value"
-                      "after quit -1 -1"]                   # the simulation ended for this controller
+                      "after quit -1"]     # the simulation ended for this controller: the next step ends it
     warned = [line for line in err.splitlines() if "does not simulate" in line]
     assert len(warned) == 2 and "Microphone 'mic'" in warned[0] and "Radio 'radio'" in warned[1], err
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
@@ -497,6 +497,12 @@ def test_c_supervisor_walks_the_tree_switches_a_light_and_reads_velocities(cbin,
     assert "wb_supervisor_field_get_sf_bool() called with wrong field type: SFFloat." in err
     assert "has no field 'mass' in Sensorium" in err and "out-of-bound index: 5" in err
     assert "wb_supervisor_node_get_velocity() called with a NULL or invalid 'node' argument." in err
+    from test_supervisor_scene import _pose_checks
+    got = {line.split()[0]: [float(v) for v in line.split()[1:]] for line in out[15:]}
+    _pose_checks(got["position"], got["orientation"], got["pose"], got["crate_from_me"], got["me_from_lamp"],
+                 got["crate_from_root"], got["lamp_pose"])
+    assert all(math.isnan(v) for v in got["null_pose"]) and "not served" not in err
+    assert "wb_supervisor_node_get_pose() called with a NULL or invalid 'node' argument." in err
 
 
 def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
@@ -736,6 +742,15 @@ def test_sigkilled_c_controller_releases_its_robot_and_server_quit_ends_steps(cb
     code, lines, err = finish(bee, 30)
     assert code == 0, err
     assert fields(lines[-1])["status"] == "-1" and all(fields(x)["status"] == "0" for x in lines[:-1])
+
+
+def test_a_c_loop_that_ignores_minus_one_ends_at_the_next_step(cbin, servers):
+    """libController's end of a controller: the step after the -1 (the server stopped at --until)
+    ends the process with status 0 (tests/c/ignores_minus_one.c; the Python twin in
+    tests/test_controller_end.py)."""
+    code, lines, err = finish(start([cbin["ignores_minus_one"]], servers(ARENA, "--until", "160").url("epuck")), 60)
+    assert code == 0, err
+    assert lines[-1] == "-1" and lines[:-1] and set(lines[:-1]) == {"0"}, lines
 
 
 def test_c_controller_ends_its_loop_when_the_server_dies(cbin, servers):

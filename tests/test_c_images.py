@@ -69,3 +69,45 @@ def test_camera_bytes_match_python(reader):
     assert len(first) == 4 * 16 * 12 and len(set(first[2::4])) > 5      # a picture, not a flat colour
     assert " objects=1 [4 ball " in c_out[1]                             # the ball: robots 1, solids 2.. in order
     assert "wb_camera_get_image() called for a disabled device" in c_err
+
+
+def _read_hdr(path) -> tuple[int, int, list[float]]:
+    """A flat-scanline Radiance picture's size and its pixels' red channel, decoded (``m·2^(e−136)``)."""
+    import math
+    data = path.read_bytes()
+    head, _, body = data.partition(b"\n\n")
+    assert head.startswith(b"#?RADIANCE\n") and b"FORMAT=32-bit_rle_rgbe" in head
+    size, _, pixels = body.partition(b"\n")
+    _, h, _, w = size.split()
+    assert len(pixels) == 4 * int(h) * int(w)
+    vals = []
+    for i in range(0, len(pixels), 4):
+        r, g, b, e = pixels[i:i + 4]
+        assert r == g == b
+        vals.append(0.0 if e == 0 else math.ldexp(r, e - 136))
+    return int(w), int(h), vals
+
+
+def test_range_finder_saves_webots_hdr_in_c_and_python(reader, tmp_path):
+    """Webots' sample range_finder controller saves its depth as ``.hdr`` (a float grey Radiance
+    picture of (depth − minRange)/maxRange clamped to [0, 1]); ``.tiff`` answers Webots' line and -1."""
+    import struct
+    c_dir, py_dir = tmp_path / "c", tmp_path / "py"
+    c_dir.mkdir()
+    py_dir.mkdir()
+    with serve(WORLD, env=SAN_ENV) as s:
+        c_out, c_err = _run([reader, "depth", "2", str(c_dir)], s.url("bot"))
+    with serve(WORLD, env=SAN_ENV) as s:
+        py_out, py_err = _run([sys.executable, "-m", "sensorium", "controller", "--url", s.url("bot"),
+                               str(REPO / "tests" / "controllers" / "image_reader.py"), "depth", "2", str(py_dir)],
+                              s.url("bot"))
+    assert c_out == py_out and c_out[-2:] == ["# hdr 0", "# tiff -1"]
+    line = "wb_range_finder_save_image(): .tiff image not supported anymore, use .hdr instead."
+    assert line in c_err and line in py_err
+    assert (c_dir / "depth.hdr").read_bytes() == (py_dir / "depth.hdr").read_bytes()
+    w, h, vals = _read_hdr(c_dir / "depth.hdr")
+    assert (w, h) == (12, 8)
+    depth = struct.unpack(f"<{w * h}f", bytes.fromhex(c_out[-5].split("=")[1]))
+    want = [min(max((d - 0.05) / 3.0, 0.0), 1.0) for d in depth]
+    assert any(0.0 < v < 1.0 for v in want)                 # the wall and the floor, not a blank picture
+    assert vals == pytest.approx(want, rel=1 / 128, abs=1e-30)     # RGBE keeps 8 bits of mantissa

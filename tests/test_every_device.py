@@ -141,7 +141,8 @@ def test_every_webots_controller_module_imports_with_its_class():
 
 def test_python_supervisor_methods_beyond_the_subset_and_simulation_quit(tmp_path):
     """Webots' Supervisor, Node and Field methods that Sensorium does not serve answer Webots' "no
-    value" with one error line each (the C library's words); simulationQuit ends the steps."""
+    value" with one error line each (the C library's words); simulationQuit ends the steps: the next one
+    answers -1, the one after ends the controller with status 0 (libController's rule)."""
     script = tmp_path / "sup.py"
     script.write_text(
         "from controller import Supervisor\n"
@@ -153,13 +154,14 @@ def test_python_supervisor_methods_beyond_the_subset_and_simulation_quit(tmp_pat
         "      me.getStaticBalance())\n"
         "print(s.step(16))\n"
         "s.simulationQuit(3)\n"
-        "print(s.step(16), s.step(16))\n")
+        "print(s.step(16))\n"
+        "print('not reached', s.step(16))\n")          # libController: the step after the -1 ends the process
     with serve(REPO / "tests" / "worlds" / "headers.yaml") as server:
         done = subprocess.run([sys.executable, "-m", "sensorium", "controller", "--url", server.url("car"),
                                str(script)], capture_output=True, text=True, timeout=120, cwd=str(REPO))
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == ["None None True True True SFRotation -1 0 [nan, nan, nan] False", "0",
-                                        "-1 -1"]
+                                        "-1"]
     unserved = sorted(line.split("(")[0] for line in done.stderr.splitlines() if "not served by Sensorium" in line)
     assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_vec3f", "field_get_sf_int32",
                                                               "movie_is_ready", "node_get_center_of_mass",

@@ -333,3 +333,31 @@ def test_a_spotlights_cut_off_below_its_beam_width_lowers_the_beam_and_a_beam_ab
         supervisor.set_field(sim, node, "direction", [0.0, 0.0, 0.0])
     assert str(refused.value) == "SpotLight direction: direction must not be the zero vector"
 
+
+
+def _pose_checks(position: list[float], orientation: list[float], me: list[float], crate_from_me: list[float],
+                 me_from_lamp: list[float], crate_from_root: list[float], lamp: list[float]) -> None:
+    """Webots' getPose: [R | t; 0 0 0 1] row-major in the world; seen from another node, that node's
+    inverse transform first; from a light or the root (no Pose): the world's frame; NaN for a light."""
+    r = [orientation[0:3], orientation[3:6], orientation[6:9]]
+    assert me == [*r[0], position[0], *r[1], position[1], *r[2], position[2], 0.0, 0.0, 0.0, 1.0]
+    assert me_from_lamp == me
+    assert crate_from_root == [1, 0, 0, 5.0, 0, 1, 0, 5.0, 0, 0, 1, 0.1, 0, 0, 0, 1]
+    d = [5.0 - position[0], 5.0 - position[1], 0.1 - position[2]]
+    want = []
+    for i in range(3):
+        want += [r[0][i], r[1][i], r[2][i], sum(r[k][i] * d[k] for k in range(3))]
+    assert crate_from_me == pytest.approx(want + [0, 0, 0, 1], abs=1e-12)
+    assert all(math.isnan(v) for v in lamp) and len(lamp) == 16
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_webots_supervisor_reads_poses_with_get_pose(tmp_path):
+    """Node.getPose (wb_supervisor_node_get_pose), which Webots' own controllers use for relative
+    poses: served from the nodes' positions and orientations, not Webots' "no value"."""
+    ctl = run_paused(WORLD, tmp_path, "supervisor_scene.py", "judge")
+    pose = {d["tag"]: d for d in (json.loads(line) for line in ctl.out)}["pose"]
+    assert pose["position"][2] == pytest.approx(0.5) and abs(pose["orientation"][1]) > 0.1     # it has turned
+    _pose_checks(pose["position"], pose["orientation"], pose["me"], pose["crate_from_me"], pose["me_from_lamp"],
+                 pose["crate_from_root"], pose["lamp"])
+    assert "not served" not in ctl.stderr()

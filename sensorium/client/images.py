@@ -1,8 +1,11 @@
 """Saving images as Webots' ``save_image`` functions do: PNG written here (zlib only, the client
-stays light), JPEG through Pillow when it is installed. Returns Webots' 0 / -1."""
+stays light), JPEG through Pillow when it is installed, a range finder's Radiance HDR (``.hdr``)
+written here. Returns Webots' 0 / -1."""
 
 from __future__ import annotations
 
+import array
+import math
 import struct
 import sys
 import zlib
@@ -28,14 +31,46 @@ def bgra_to_rgb(bgra: bytes) -> bytes:
     return bytes(out)
 
 
+def hdr_bytes(grey: list[float], width: int, height: int) -> bytes:
+    """A Radiance picture (``#?RADIANCE``, 32-bit RGBE, flat scanlines, top row first) of ``grey``:
+    each value in r, g and b, as the grey HDR Webots' range finder writes. A value ``v`` is stored as
+    the mantissa byte ``int(m·256)`` thrice and the exponent byte ``e + 128`` (``v = m·2^e``,
+    ``frexp``) after its rounding to float32 (Webots' float image); 0 (and anything below 1e-32) as
+    four zeros, the format's rule."""
+    out = bytearray(4 * len(grey))
+    for i, v in enumerate(array.array("f", grey)):
+        if v >= 1e-32:
+            m, e = math.frexp(v)
+            c = int(m * 256.0)
+            out[4 * i:4 * i + 4] = bytes((c, c, c, e + 128))
+    return f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n".encode() + bytes(out)
+
+
+def check_save(func: str, filename: str, quality: int) -> bool:
+    """Webots' argument checks of every ``save_image``: a filename, a quality in 1..100."""
+    if not filename:
+        print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
+        return False
+    if isinstance(quality, bool) or not isinstance(quality, int) or not 1 <= quality <= 100:
+        print(f"Error: {func}() called with invalid 'quality' argument.", file=sys.stderr)
+        return False
+    return True
+
+
+def write_file(func: str, filename: str, data: bytes) -> int:
+    try:
+        with open(filename, "wb") as f:
+            f.write(data)
+    except OSError as exc:
+        print(f"Error: {func}(): cannot write {filename!r}: {exc.strerror or exc}", file=sys.stderr)
+        return -1
+    return 0
+
+
 def save_rgb(func: str, filename: str, quality: int, rgb: bytes, width: int, height: int) -> int:
     """Webots' checks and formats: ``.png``, ``.jpg``/``.jpeg`` (quality 1..100); -1 with Webots'
     message on a bad argument, an unknown extension or a file that cannot be written."""
-    if not filename:
-        print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
-        return -1
-    if isinstance(quality, bool) or not isinstance(quality, int) or not 1 <= quality <= 100:
-        print(f"Error: {func}() called with invalid 'quality' argument.", file=sys.stderr)
+    if not check_save(func, filename, quality):
         return -1
     lower = str(filename).lower()
     try:
@@ -56,9 +91,7 @@ def save_rgb(func: str, filename: str, quality: int, rgb: bytes, width: int, hei
             print(f"Error: {func}(): unsupported image format of {filename!r} (use .png, .jpg or .jpeg).",
                   file=sys.stderr)
             return -1
-        with open(filename, "wb") as f:
-            f.write(data)
     except OSError as exc:
         print(f"Error: {func}(): cannot write {filename!r}: {exc.strerror or exc}", file=sys.stderr)
         return -1
-    return 0
+    return write_file(func, filename, data)

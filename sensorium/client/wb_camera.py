@@ -106,25 +106,40 @@ def wb_range_finder_image_get_depth(image: Any, width: int, x: int, y: int) -> f
     return float(image[y * width + x])
 
 
-def depth_gray(buf: bytes, near: float, max_range: float) -> bytes:
-    """Webots' range-finder PNG/JPEG: grey ``(unsigned char)(255·clamp((v − near)/maxRange, 0, 1))``
-    (``near`` = the device's minRange, as Webots' library has it), as RGB bytes."""
-    out = bytearray()
+def depth_scale(buf: bytes, near: float, max_range: float) -> list[float]:
+    """Webots' range-finder picture values: ``clamp((v − near)/maxRange, 0, 1)`` (``near`` = the
+    device's minRange, as Webots' library has it)."""
+    out = []
     for v in arrays.float32_list(buf):
         g = (v - near) / max_range
-        g = 1.0 if not g <= 1.0 else (0.0 if g < 0.0 else g)     # NaN and inf: 1 (as the C comparisons)
-        out += bytes((int(g * 255.0),)) * 3
-    return bytes(out)
+        out.append(1.0 if not g <= 1.0 else (0.0 if g < 0.0 else g))     # NaN and inf: 1 (as the C comparisons)
+    return out
+
+
+def depth_gray(buf: bytes, near: float, max_range: float) -> bytes:
+    """Webots' range-finder PNG/JPEG: grey ``(unsigned char)(255·clamp((v − near)/maxRange, 0, 1))``,
+    as RGB bytes."""
+    return b"".join(bytes((int(g * 255.0),)) * 3 for g in depth_scale(buf, near, max_range))
 
 
 def wb_range_finder_save_image(tag: int, filename: str, quality: int) -> int:
-    """PNG (or JPEG with Pillow) of the latest range image in Webots' grey scale; 0 or -1."""
+    """The latest range image in Webots' scale (``(depth − minRange)/maxRange`` clamped to [0, 1]):
+    a grey PNG (or JPEG with Pillow), or Webots' float grey Radiance ``.hdr``; ``.tif``/``.tiff``
+    answer Webots' "not supported anymore" line; 0 or -1."""
     func = "wb_range_finder_save_image"
     dev = _rf(tag, func)
     buf = range_finder_bytes(tag, func)
     w, h = int(dev.desc.get("width", 0)), int(dev.desc.get("height", 0))
-    max_range = float(dev.desc.get("maxRange", math.inf))
-    return images.save_rgb(func, filename, quality, depth_gray(buf, float(dev.desc.get("minRange", 0.0)), max_range), w, h)
+    near, max_range = float(dev.desc.get("minRange", 0.0)), float(dev.desc.get("maxRange", math.inf))
+    lower = str(filename).lower() if filename else ""
+    if lower.endswith((".hdr", ".tif", ".tiff")):
+        if not images.check_save(func, filename, quality):
+            return -1
+        if not lower.endswith(".hdr"):
+            print(f"Error: {func}(): .tiff image not supported anymore, use .hdr instead.", file=sys.stderr)
+            return -1
+        return images.write_file(func, filename, images.hdr_bytes(depth_scale(buf, near, max_range), w, h))
+    return images.save_rgb(func, filename, quality, depth_gray(buf, near, max_range), w, h)
 
 
 # ---------------------------------------------------------------------- camera

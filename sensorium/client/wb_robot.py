@@ -246,6 +246,7 @@ class RobotClient:
         self.conn = Connection(target.endpoint, timeout=timeout, context=context)
         self.pending: int | None = None
         self.terminated = False
+        self.quit_returned = False              # a step has answered -1 for the termination (wb_robot_step)
         self.closed = False
         try:
             name = target.robot if target.robot is not None else self._only_robot()
@@ -641,16 +642,38 @@ def wb_robot_cleanup() -> None:
         robot.close()
 
 
+def _ended(r: RobotClient) -> None:
+    """libController's end of a controller: once a step has answered -1 because the simulation ended
+    for it (the server quit, stopped at ``--until`` or went away, ``simulationQuit``), the next step
+    cleans up and ends the process with status 0, so a loop that ignores -1 does not spin forever."""
+    if r.terminated and r.pending is None:
+        if r.quit_returned:
+            wb_robot_cleanup()
+            raise SystemExit(0)
+        r.quit_returned = True                  # this step's -1 is the first (simulationQuit)
+
+
+def _noted(r: RobotClient, status: int) -> int:
+    if status == -1 and r.terminated:
+        r.quit_returned = True
+    return status
+
+
 def wb_robot_step(duration: int | None = None) -> int:
-    return current().step(duration)
+    r = current()
+    _ended(r)
+    return _noted(r, r.step(duration))
 
 
 def wb_robot_step_begin(duration: int | None = None) -> int:
-    return current().step_begin(duration)
+    r = current()
+    _ended(r)
+    return _noted(r, r.step_begin(duration))
 
 
 def wb_robot_step_end() -> int:
-    return current().step_end()
+    r = current()
+    return _noted(r, r.step_end())
 
 
 def wb_robot_get_time() -> float:

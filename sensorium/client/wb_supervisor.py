@@ -201,6 +201,65 @@ def wb_supervisor_node_get_orientation(node: int | None) -> list[float]:
     return [math.nan] * 9 if p is None else [float(v) for v in p["orientation"]]
 
 
+def _pose_matrix(p: dict) -> list[float] | None:
+    """A get_node_pose answer as Webots' 4×4 row-major transform; None for a node with no pose."""
+    t, r = [float(v) for v in p["position"]], [float(v) for v in p["orientation"]]
+    if any(math.isnan(v) for v in t + r):
+        return None
+    return [*r[0:3], t[0], *r[3:6], t[1], *r[6:9], t[2], 0.0, 0.0, 0.0, 1.0]
+
+
+def wb_supervisor_node_get_pose(node: int | None, from_node: int | None = None) -> list[float]:
+    """Webots' 4×4 transform of ``node`` (16 numbers, row-major: rotation and translation, then
+    0 0 0 1) in the frame of ``from_node``: the world's for None and, as Webots' server answers a
+    "from" node that is no Pose, for the root or a light. NaN for a node with no pose (the root, a
+    light), as its position; Webots' line and NaN for a NULL, invalid or removed node."""
+    func = "wb_supervisor_node_get_pose"
+    nan16 = [math.nan] * 16
+    if _supervisor(func) is None:
+        return nan16
+    if from_node is not None and (isinstance(from_node, bool) or not isinstance(from_node, int) or from_node < 0):
+        print(f"Error: {func}() called with a NULL or invalid 'from_node' argument.", file=sys.stderr)
+        return nan16
+    base = None
+    if from_node is not None:
+        got = _node_pose(from_node, func)
+        if got is None:
+            return nan16
+        base = _pose_matrix(got)
+    to = _node_pose(node, func)
+    m = None if to is None else _pose_matrix(to)
+    if m is None:
+        return nan16
+    if base is None:
+        return m
+    # inverse(base) · m: the rotation Rbᵀ·R, the translation Rbᵀ·(t − tb)
+    rb = [base[0:3], base[4:7], base[8:11]]
+    tb = [base[3], base[7], base[11]]
+    rm = [m[0:3], m[4:7], m[8:11]]
+    d = [m[3] - tb[0], m[7] - tb[1], m[11] - tb[2]]
+    out: list[float] = []
+    for i in range(3):
+        out += [sum(rb[k][i] * rm[k][j] for k in range(3)) for j in range(3)]
+        out.append(sum(rb[k][i] * d[k] for k in range(3)))
+    return out + [0.0, 0.0, 0.0, 1.0]
+
+
+def wb_supervisor_node_enable_pose_tracking(node: int | None, sampling_period: int,
+                                            from_node: int | None = None) -> None:
+    """Webots streams a tracked pose every sampling period; :func:`wb_supervisor_node_get_pose` asks
+    the server at each call here, so tracking changes nothing: accepted after Webots' checks."""
+    func = "wb_supervisor_node_enable_pose_tracking"
+    if sampling_period < 0:
+        print(f"Error: {func}() called with negative sampling period.", file=sys.stderr)
+        return
+    _checked_node(node, func)
+
+
+def wb_supervisor_node_disable_pose_tracking(node: int | None, from_node: int | None = None) -> None:
+    _checked_node(node, "wb_supervisor_node_disable_pose_tracking")
+
+
 def wb_supervisor_node_get_velocity(node: int | None) -> list[float]:
     """Linear (m/s) then angular (rad/s) velocity in world axes: a driven robot's from its last step,
     zeros for anything else (nothing else moves by itself here)."""

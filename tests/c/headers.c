@@ -5,7 +5,8 @@
  *                      vehicle functions' "no value"
  *   headers online     then attaches to the server: Microphone and Radio (listed, not simulated), the
  *                      supervisor's contact points, the robot window's messages (none), Supervisor
- *                      functions Sensorium does not serve, wb_supervisor_simulation_quit()
+ *                      functions Sensorium does not serve, wb_supervisor_simulation_quit() (its next
+ *                      step answers -1, the one after ends the process with status 0)
  *   headers driver|car wbu_driver_init() / wbu_car_init(): one line, exit status 1 */
 #include <math.h>
 #include <stdio.h>
@@ -110,7 +111,10 @@ static void online(void) {
          isnan(wb_supervisor_node_get_center_of_mass(self)[2]) ? "nan" : "value", wb_supervisor_node_export_string(self),
          (int)wb_supervisor_movie_is_ready(), (int)wb_supervisor_field_get_mf_int32(rotation, 0));
   wb_supervisor_simulation_quit(3);
-  printf("after quit %d %d\n", wb_robot_step(16), wb_robot_step(16));
+  printf("after quit %d\n", wb_robot_step(16)); /* -1, then the next step ends the process (libController) */
+  fflush(stdout);
+  wb_robot_step(16);
+  printf("not reached\n");
   wb_robot_cleanup();
 }
 

@@ -1,7 +1,9 @@
 /* Image devices reader: image_reader NAME STEPS. Enables the named range finder or camera at the
  * basic step and prints a line per step: "T STATUS NAME=<hex of the image bytes>", then
  * "# info W H FOV ..." (%.17g) and "# save R" (the return of its save_image into a directory that
- * does not exist: -1). The twin of tests/controllers/image_reader.py. */
+ * does not exist: -1); for a range finder, given a directory DIR as a third argument, also
+ * "# hdr R" (saving DIR/depth.hdr) and "# tiff R" (DIR/depth.tiff: Webots' -1).
+ * The twin of tests/controllers/image_reader.py. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -76,6 +78,13 @@ int main(int argc, char **argv) {
     printf("# info %d %d %.17g %.17g %.17g\n", w, h, wb_range_finder_get_fov(tag), wb_range_finder_get_min_range(tag),
            wb_range_finder_get_max_range(tag));
     printf("# save %d\n", wb_range_finder_save_image(tag, "/nonexistent-dir/x.png", 100));
+    if (argc > 3) {
+      char path[4096];
+      snprintf(path, sizeof path, "%s/depth.hdr", argv[3]);
+      printf("# hdr %d\n", wb_range_finder_save_image(tag, path, 100));
+      snprintf(path, sizeof path, "%s/depth.tiff", argv[3]);
+      printf("# tiff %d\n", wb_range_finder_save_image(tag, path, 100));
+    }
   }
   wb_robot_cleanup();
   return 0;

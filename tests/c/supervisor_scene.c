@@ -82,6 +82,19 @@ int main(void) {
   vec("after_reset", wb_supervisor_node_get_velocity(me), 6);
   vec("crate", wb_supervisor_node_get_velocity(wb_supervisor_node_get_from_def("CRATE")), 6);
   vec("null", wb_supervisor_node_get_velocity(NULL), 6);
+
+  /* poses (Webots' 4x4 row-major transforms): the judge's in the world, the crate's seen from the
+     judge; a light has none; from a light or the root: the world's frame (Webots' rule) */
+  WbNodeRef crate = wb_supervisor_node_get_from_def("CRATE");
+  wb_supervisor_node_enable_pose_tracking(crate, dt, me); /* accepted: get_pose asks at each call here */
+  vec("position", wb_supervisor_node_get_position(me), 3);
+  vec("orientation", wb_supervisor_node_get_orientation(me), 9);
+  vec("pose", wb_supervisor_node_get_pose(me, NULL), 16);
+  vec("crate_from_me", wb_supervisor_node_get_pose(crate, me), 16);
+  vec("me_from_lamp", wb_supervisor_node_get_pose(me, lamp), 16);
+  vec("crate_from_root", wb_supervisor_node_get_pose(crate, root), 16);
+  vec("lamp_pose", wb_supervisor_node_get_pose(lamp, NULL), 16);
+  vec("null_pose", wb_supervisor_node_get_pose(NULL, me), 16);
   wb_robot_cleanup();
   return 0;
 }

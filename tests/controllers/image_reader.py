@@ -55,4 +55,7 @@ else:
     print(f"# info {w} {h} {wb.wb_range_finder_get_fov(tag):.17g} {wb.wb_range_finder_get_min_range(tag):.17g} "
           f"{wb.wb_range_finder_get_max_range(tag):.17g}")
     print(f"# save {wb.wb_range_finder_save_image(tag, '/nonexistent-dir/x.png', 100)}")
+    if len(sys.argv) > 3:                  # a directory: Webots' float grey .hdr, and its refused .tiff
+        print(f"# hdr {wb.wb_range_finder_save_image(tag, sys.argv[3] + '/depth.hdr', 100)}")
+        print(f"# tiff {wb.wb_range_finder_save_image(tag, sys.argv[3] + '/depth.tiff', 100)}")
 wb.wb_robot_cleanup()

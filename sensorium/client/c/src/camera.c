@@ -3,6 +3,7 @@
  * first image, Webots' black for a camera), so the pointers handed out stay valid until
  * wb_robot_cleanup(). Written from Webots' documented signatures and behaviour. */
 #define _POSIX_C_SOURCE 200809L
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -270,16 +271,58 @@ static int write_png(const char *filename, const unsigned char *rgb, int width, 
   return ret;
 }
 
-/* Webots' argument checks; PNG only here (JPEG needs a codec this library does not carry). */
-static int save_rgb(const char *func, const char *filename, int quality, const unsigned char *rgb, int w, int h) {
+/* Webots' argument checks of every save_image: a filename, a quality in 1..100 (0: a camera's PNG,
+   whose quality Webots ignores). */
+static int check_save(const char *func, const char *filename, int quality) {
   if (filename == NULL || filename[0] == '\0') {
     fprintf(stderr, "Error: %s() called with NULL or empty 'filename' argument.\n", func);
     return -1;
   }
-  if (quality != 0 && (quality < 1 || quality > 100)) { /* 0: a camera's PNG, whose quality Webots ignores */
+  if (quality != 0 && (quality < 1 || quality > 100)) {
     fprintf(stderr, "Error: %s() called with invalid 'quality' argument.\n", func);
     return -1;
   }
+  return 0;
+}
+
+/* Whether filename ends with ext (lower case, with its dot), in any case. */
+static int has_extension(const char *filename, const char *ext) {
+  size_t n = strlen(filename), k = strlen(ext);
+  if (n < k)
+    return 0;
+  for (size_t i = 0; i < k; i++)
+    if (tolower((unsigned char)filename[n - k + i]) != ext[i])
+      return 0;
+  return 1;
+}
+
+/* A Radiance picture (#?RADIANCE, 32-bit RGBE, flat scanlines, top row first) of grey values, each
+   in r, g and b: v = m 2^e (frexp) stored as int(m 256) thrice and e + 128; below 1e-32 four zeros. */
+static int write_hdr(const char *filename, const float *grey, int width, int height) {
+  FILE *f = fopen(filename, "wb");
+  if (f == NULL)
+    return -1;
+  int ok = fprintf(f, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n", height, width) > 0;
+  size_t n = (size_t)width * (size_t)height;
+  for (size_t j = 0; ok && j < n; j++) {
+    unsigned char px[4] = {0, 0, 0, 0};
+    if (grey[j] >= 1e-32f) {
+      int e;
+      double m = frexp(grey[j], &e);
+      px[0] = px[1] = px[2] = (unsigned char)(m * 256.0);
+      px[3] = (unsigned char)(e + 128);
+    }
+    ok = fwrite(px, 1, 4, f) == 4;
+  }
+  if (fclose(f) != 0)
+    ok = 0;
+  return ok ? 0 : -1;
+}
+
+/* Webots' argument checks; PNG only here (JPEG needs a codec this library does not carry). */
+static int save_rgb(const char *func, const char *filename, int quality, const unsigned char *rgb, int w, int h) {
+  if (check_save(func, filename, quality) != 0)
+    return -1;
   size_t n = strlen(filename);
   if (n < 4 || (strcmp(filename + n - 4, ".png") != 0 && strcmp(filename + n - 4, ".PNG") != 0)) {
     fprintf(stderr, "Error: %s(): only .png images can be saved by this library ('%s').\n", func, filename);
@@ -345,15 +388,36 @@ int wb_range_finder_save_image(WbDeviceTag tag, const char *filename, int qualit
     return -1;
   struct sn_imaging *im = d->imaging;
   size_t n = (size_t)im->width * (size_t)im->height;
-  unsigned char *rgb = malloc(3 * n);
-  if (rgb == NULL)
+  int hdr = filename != NULL && has_extension(filename, ".hdr");
+  if (filename != NULL && (hdr || has_extension(filename, ".tif") || has_extension(filename, ".tiff"))) {
+    if (check_save(func, filename, quality == 0 ? -1 : quality) != 0) /* Webots: 1..100 here */
+      return -1;
+    if (!hdr) {
+      fprintf(stderr, "Error: %s(): .tiff image not supported anymore, use .hdr instead.\n", func);
+      return -1;
+    }
+  }
+  float *grey = malloc(sizeof(float) * (n ? n : 1));
+  unsigned char *rgb = malloc(3 * (n ? n : 1));
+  if (grey == NULL || rgb == NULL) {
+    free(grey);
+    free(rgb);
     return -1;
+  }
   for (size_t j = 0; j < n; j++) {
     double v = (im->range[j] - im->min_range) / im->max_range;
     v = !(v <= 1.0) ? 1.0 : v < 0.0 ? 0.0 : v;
+    grey[j] = (float)v;
     rgb[3 * j] = rgb[3 * j + 1] = rgb[3 * j + 2] = (unsigned char)(v * 255.0);
   }
-  int ret = save_rgb(func, filename, quality, rgb, im->width, im->height);
+  int ret;
+  if (hdr) {
+    ret = write_hdr(filename, grey, im->width, im->height);
+    if (ret != 0)
+      fprintf(stderr, "Error: %s(): cannot write '%s'.\n", func, filename);
+  } else
+    ret = save_rgb(func, filename, quality, rgb, im->width, im->height);
+  free(grey);
   free(rgb);
   return ret;
 }

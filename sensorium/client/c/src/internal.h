@@ -198,6 +198,7 @@ typedef struct {
   bool synchronization;
   bool supervisor;
   bool terminated;
+  bool quit_returned; /* a step answered -1 for the termination: the next one ends the process */
   bool warned_duration;
   int keyboard_period;
   void *nodes, *fields; /* supervisor handles handed out (supervisor.c) */

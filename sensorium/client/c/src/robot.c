@@ -471,8 +471,15 @@ int wb_robot_step_begin(int duration) {
     fprintf(stderr, "Error: wb_robot_step_begin(): a step is already pending: call wb_robot_step_end() first\n");
     return -1;
   }
-  if (rb->terminated)
+  if (rb->terminated) {
+    /* libController's end of a controller: once a step has answered -1 because the simulation ended
+       for it (the server quit, stopped or went away, simulation_quit), the next step ends the process
+       with status 0 (the atexit cleanup detaches), so a loop that ignores -1 does not spin forever */
+    if (rb->quit_returned)
+      exit(EXIT_SUCCESS);
+    rb->quit_returned = true;
     return -1;
+  }
   if (duration < 0) {
     fprintf(stderr, "Error: wb_robot_step(): step duration must be >= 0 ms, got %d\n", duration);
     return -1;
@@ -528,15 +535,24 @@ int wb_robot_step_begin(int duration) {
   if (rc != 0) {
     fprintf(stderr, "sensorium: cannot send the step request to %s; ending the controller's steps\n",
             sn_conn_endpoint(rb->conn));
-    rb->terminated = true;
+    rb->terminated = rb->quit_returned = true;
     return -1;
   }
   rb->pending = id;
   return 0;
 }
 
+static int step_end(sn_robot *rb);
+
 int wb_robot_step_end(void) {
   sn_robot *rb = sn_robot_get("wb_robot_step_end");
+  int status = step_end(rb);
+  if (status == -1 && rb->terminated)
+    rb->quit_returned = true;
+  return status;
+}
+
+static int step_end(sn_robot *rb) {
   if (rb->pending == 0) {
     if (!rb->terminated)
       fprintf(stderr, "Error: wb_robot_step_end(): no step pending: call wb_robot_step_begin() first\n");

@@ -22,6 +22,7 @@ struct WbNodeStructPrivate {
   double position[3];
   double orientation[9];
   double velocity[6];
+  double pose[16];
   struct WbNodeStructPrivate *next;
 };
 
@@ -281,6 +282,82 @@ const double *wb_supervisor_node_get_position(WbNodeRef node) {
 
 const double *wb_supervisor_node_get_orientation(WbNodeRef node) {
   return node_pose(node, false, "wb_supervisor_node_get_orientation");
+}
+
+/* node's 4x4 row-major world transform into m: 1 when it has one, 0 when it has none (the root, a
+   light: NaN position), -1 after the error line (a NULL, removed or refused node) */
+static int world_pose(WbNodeRef node, const char *func, double m[16]) {
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/get_node_pose", 1, args_node, &node->id, func, &rep) != 0)
+    return -1;
+  double t[3], r[9];
+  bool ok = copy_numbers(sn_get(rep.result, "position"), t, 3) && copy_numbers(sn_get(rep.result, "orientation"), r, 9);
+  sn_reply_free(&rep);
+  if (!ok) {
+    fprintf(stderr, "Error: %s(): malformed reply\n", func);
+    return -1;
+  }
+  for (int i = 0; i < 3; i++) {
+    if (isnan(t[i]))
+      return 0;
+    for (int j = 0; j < 3; j++)
+      m[4 * i + j] = r[3 * i + j];
+    m[4 * i + 3] = t[i];
+  }
+  m[12] = m[13] = m[14] = 0.0;
+  m[15] = 1.0;
+  return 1;
+}
+
+/* Webots' 4x4 row-major transform of node in from_node's frame: the world's for NULL and, as Webots'
+   server answers a "from" node that is no Pose, for the root or a light; NaN for a node with no pose
+   (as its position), Webots' line and NaN for a NULL, invalid or removed node */
+const double *wb_supervisor_node_get_pose(WbNodeRef node, WbNodeRef from_node) {
+  const char *func = "wb_supervisor_node_get_pose";
+  double base[16], m[16];
+  int has_base = 0;
+  if (from_node != NULL && (has_base = world_pose(from_node, func, base)) < 0)
+    return sn_no_values();
+  if (world_pose(node, func, m) != 1)
+    return sn_no_values();
+  if (has_base != 1) {
+    memcpy(node->pose, m, sizeof m);
+    return node->pose;
+  }
+  /* inverse(base) . m: the rotation Rb^T R, the translation Rb^T (t - tb) */
+  for (int i = 0; i < 3; i++) {
+    for (int j = 0; j < 3; j++) {
+      double v = 0.0;
+      for (int k = 0; k < 3; k++)
+        v += base[4 * k + i] * m[4 * k + j];
+      node->pose[4 * i + j] = v;
+    }
+    double v = 0.0;
+    for (int k = 0; k < 3; k++)
+      v += base[4 * k + i] * (m[4 * k + 3] - base[4 * k + 3]);
+    node->pose[4 * i + 3] = v;
+  }
+  node->pose[12] = node->pose[13] = node->pose[14] = 0.0;
+  node->pose[15] = 1.0;
+  return node->pose;
+}
+
+/* Webots streams a tracked pose every sampling period; wb_supervisor_node_get_pose asks the server
+   at each call here, so tracking changes nothing: accepted after Webots' checks */
+void wb_supervisor_node_enable_pose_tracking(WbNodeRef node, int sampling_period, WbNodeRef from_node) {
+  const char *func = "wb_supervisor_node_enable_pose_tracking";
+  (void)from_node;
+  if (sampling_period < 0) {
+    fprintf(stderr, "Error: %s() called with negative sampling period.\n", func);
+    return;
+  }
+  supervisor_node(node, func);
+}
+
+void wb_supervisor_node_disable_pose_tracking(WbNodeRef node, WbNodeRef from_node) {
+  (void)from_node;
+  supervisor_node(node, "wb_supervisor_node_disable_pose_tracking");
 }
 
 /* linear (m/s) then angular (rad/s) velocity in world axes: a driven robot's last step, zeros for

@@ -136,11 +136,6 @@ const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
   return sn_no_values();
 }
 
-const double *wb_supervisor_node_get_pose(WbNodeRef node, WbNodeRef from_node) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
-
 bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
   SN_UNSUPPORTED();
   return false;
@@ -188,14 +183,6 @@ void wb_supervisor_field_enable_sf_tracking(WbFieldRef field, int sampling_perio
 }
 
 void wb_supervisor_field_disable_sf_tracking(WbFieldRef field) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_node_enable_pose_tracking(WbNodeRef node, int sampling_period, WbNodeRef from_node) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_node_disable_pose_tracking(WbNodeRef node, WbNodeRef from_node) {
   SN_UNSUPPORTED();
 }
 

@@ -164,6 +164,18 @@ class Node:
     def getOrientation(self) -> list[float]:
         return wb.wb_supervisor_node_get_orientation(self._ref)
 
+    def getPose(self, fromNode: Node | None = None) -> list[float]:  # noqa: N803 - Webots' parameter name
+        """Webots' 4×4 row-major transform of this node in ``fromNode``'s frame (the world's by default)."""
+        return wb.wb_supervisor_node_get_pose(self._ref, None if fromNode is None else fromNode._ref)
+
+    def enablePoseTracking(self, samplingPeriod: int, fromNode: Node | None = None) -> None:  # noqa: N803
+        """Accepted: :meth:`getPose` asks the server at each call here (Webots streams tracked poses)."""
+        wb.wb_supervisor_node_enable_pose_tracking(self._ref, samplingPeriod,
+                                                   None if fromNode is None else fromNode._ref)
+
+    def disablePoseTracking(self, fromNode: Node | None = None) -> None:  # noqa: N803
+        wb.wb_supervisor_node_disable_pose_tracking(self._ref, None if fromNode is None else fromNode._ref)
+
     def getVelocity(self) -> list[float]:
         return wb.wb_supervisor_node_get_velocity(self._ref)
 
@@ -326,9 +338,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1),
         "getFieldByIndex": ("node_get_field_by_index", None), "getBaseNodeField": ("node_get_base_node_field", None),
         "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None),
-        "exportString": ("node_export_string", ""), "getPose": ("node_get_pose", [_NAN] * 16),
-        "enablePoseTracking": ("node_enable_pose_tracking", None),
-        "disablePoseTracking": ("node_disable_pose_tracking", None),
+        "exportString": ("node_export_string", ""),
         "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3),
         "getStaticBalance": ("node_get_static_balance", False), "saveState": ("node_save_state", None),
         "loadState": ("node_load_state", None),
