@@ -120,12 +120,19 @@ def sensor_aimed(model, own: Pose):
     return model.model_copy(update={"light_sensor_direction": aim})
 
 
-def led_light(model, frame: Pose):
-    """A light of an LED (its ``lights``, in the LED's ``frame``) as the LED holds it before its first
-    ``set``: off and black (``WbLed::postFinalize``: value 0). A spot light's light-sensor axis is
-    turned by the LED's own rotation, as a nested solid's (``sensor_aimed``: the LED is the nearest
-    enclosing Pose)."""
-    return sensor_aimed(model, frame).model_copy(update={"on": False, "color": (0.0, 0.0, 0.0)})
+def robot_led_lights(robot: wm.Robot) -> list[tuple[str, list]]:
+    """Each LED of ``robot`` holding lights, with its lights in the robot's frame (``place_light`` by the
+    LED's pose) as the LED holds them before its first ``set``: off and black (``WbLed::postFinalize``:
+    value 0). A spot light's light-sensor axis is turned by the LED's own rotation, as a nested solid's
+    (``sensor_aimed``: the LED is the nearest enclosing Pose). The robot carries them from there as it
+    carries its own ``lights`` (the batched simulation's ``CarriedLights`` too)."""
+    out = []
+    for d in robot.devices:
+        if isinstance(d, wm.LED) and d.lights:
+            frame = pose_from_model(d.pose)
+            out.append((d.name, [place_light(sensor_aimed(lt, frame), frame).model_copy(
+                update={"on": False, "color": (0.0, 0.0, 0.0)}) for lt in d.lights]))
+    return out
 
 
 def for_light_sensors(model):
@@ -304,12 +311,9 @@ class Scene:
             pose = pose_from_model(r.pose)
             self.robot_poses.append(pose)
             self._lights += [(lt, i, Pose.identity()) for lt in r.lights]
-            for d in r.devices:          # an LED's lights: off and black until the LED is set (WbLed)
-                if isinstance(d, wm.LED) and d.lights:
-                    frame = pose_from_model(d.pose)
-                    models = [led_light(lt, frame) for lt in d.lights]
-                    self._led_lights[(i, d.name)] = models
-                    self._lights += [(m, i, frame) for m in models]
+            for name, models in robot_led_lights(r):    # off and black until the LED is set (WbLed)
+                self._led_lights[(i, name)] = models
+                self._lights += [(m, i, Pose.identity()) for m in models]
             parts = list(robot_parts(r))
             if parts:
                 first = len(self.shapes)
