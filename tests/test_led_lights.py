@@ -203,3 +203,36 @@ def test_a_wbt_led_holding_a_point_light(tmp_path, first):
     assert read(sim) == pytest.approx(closed_form(COLORS[2]), rel=1e-12)
     sim.device("bot/led").set(0, sim.time_ms)
     assert read(sim) == 0.0
+
+
+def test_a_python_controllers_led_set_lights_the_sensor(tmp_path):
+    import yaml
+    from _inproc import inproc_server
+
+    from sensorium.client import wb
+    w = sensor_world()
+    w = w.model_copy(update={"robots": [w.robots[0].model_copy(update={"synchronization": True})]})
+    path = tmp_path / "led.yaml"
+    path.write_text(yaml.safe_dump(w.model_dump(mode="json", exclude_defaults=True)))
+    with inproc_server(heartbeat_ms=5000, world=path) as (_core, transport):
+        wb.wb_robot_init(f"{transport.rpc_endpoint}/bot")
+        try:
+            from controller import Robot
+        except ImportError:
+            from sensorium.client.webots.controller import Robot
+        try:
+            robot = Robot()
+            ls, led = robot.getDevice("ls"), robot.getDevice("led")
+            ls.enable(16)
+            robot.step(16)
+            assert ls.getValue() == 0.0
+            led.set(2)
+            robot.step(16)
+            assert led.get() == 2 and ls.getValue() == pytest.approx(closed_form(COLORS[1]), rel=1e-12)
+            led.set(0)
+            robot.step(16)
+            assert ls.getValue() == 0.0
+        finally:
+            wb.wb_robot_cleanup()
+            from sensorium.client.webots.controller.robot import Robot as _R
+            _R.created = None
