@@ -516,13 +516,22 @@ class PositionSensor(_Device):
     resolution: float = -1.0
 
 
+LedLight = Annotated[PointLight | SpotLight, Field(discriminator="type")]
+
+
 class LED(_Device):
     """Webots LED: ``set(i)`` lights colour ``i`` (1-based, 0 = off) of ``color``; a ``gradual`` LED
-    takes a 0xRRGGBB value instead. Sensors do not see it (no light is emitted)."""
+    takes a 0xRRGGBB value instead. Its ``lights`` (Webots' PointLight/SpotLight children of the LED)
+    are on exactly while the LED is (value != 0) and take its colour (WbLed): light sensors and cameras
+    see them then; their own ``on`` and ``color`` are overridden (off and black until the first
+    ``set``, and again after a reset)."""
 
     device: Literal["LED"]
     color: list[Color] = Field(default=[(1.0, 0.0, 0.0)], max_length=1024)
     gradual: bool = False
+    lights: list[LedLight] = Field(
+        default=[], description="point and spot lights switched by the LED, in its own frame (`location` and a "
+        "SpotLight's `direction` relative to the LED's `pose`); their `on` and `color` are the LED's")
 
     _unit = field_validator("color")(_unit_colors)
 

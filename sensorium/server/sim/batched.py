@@ -26,7 +26,8 @@ the same order). Tests compare it with the single simulation step by step.
 
 Camera recognition and segmentation: batched_recognition.py (per copy, enabled with
 :meth:`BatchedSimulation.recognition_enable`). Not simulated here (use :class:`Simulation`): force TouchSensors,
-the kinds without an observation (LEDs, pens, ...): pens lay no ink, so a world with a writing pen
+the kinds without an observation (pens, ...; LEDs are set with ``set_led``, their lights light each copy
+while on there, batched_lights.py): pens lay no ink, so a world with a writing pen
 and an infra-red sensor or a camera to see its ink is refused. Textured robot bodies are read per copy
 (batched_textures.py). A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
@@ -62,7 +63,7 @@ from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim import batched_lidar
 from sensorium.server.sim import batched_recognition as recog
 from sensorium.server.sim.batched_car import CarDrives
-from sensorium.server.sim.batched_lights import CarriedLights
+from sensorium.server.sim.batched_lights import CarriedLights, has_carried_lights
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import EPS, FLOOR, Contact, Obstacle, enu_body, enu_pose, robot_footprint
@@ -77,7 +78,7 @@ from sensorium.server.sim.scene import (
     robot_parts,
     solid_parts,
 )
-from sensorium.server.sim.sensors import DistanceSensor, Lidar, LightSensor, PositionSensor
+from sensorium.server.sim.sensors import LED, DistanceSensor, Lidar, LightSensor, PositionSensor
 from sensorium.server.sim.simulation import lights_from_models
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import check_pose
@@ -203,7 +204,8 @@ class BatchedSimulation:
         self.scene = Scene(w.model_copy(update={"robots": []}), base, precision)
         self.lights = lights_from_models(self.scene.sensor_lights())
         # lights carried by robots: each copy's at its robots' poses (batched_lights.py); None without any
-        self.carried = CarriedLights(w, self.scene.world_lights()) if any(r.lights for r in w.robots) else None
+        self.carried = (CarriedLights(w, self.scene.world_lights(), C) if any(has_carried_lights(r) for r in w.robots)
+                        else None)
         n_static = len(self.scene.shapes)
         # -- one template body per robot slot (movable), the copies' robots are its poses
         self.robot_names = [r.name for r in w.robots]
@@ -348,6 +350,15 @@ class BatchedSimulation:
         classes = {"LightSensor": LightSensor, "DistanceSensor": DistanceSensor, "Lidar": Lidar,
                    "PositionSensor": PositionSensor, **kin.CLASSES, **depth.CLASSES, **cam.CLASSES}
         self._lists = lists
+        # LEDs: a template each (the single LED's checks and colour), their values per copy
+        self._leds: dict[tuple[int, str], tuple[int, LED]] = {}
+        for slot, r in enumerate(self.world.robots):
+            for d in r.devices:
+                if d.device == "LED":
+                    self._leds[(slot, d.name)] = (len(self._leds), LED(config=d, robot_index=slot, robot_name=r.name,
+                                                                        self_collision=False, world_seed=0,
+                                                                        clock=lambda: 0))
+        self.led_value = np.zeros((C, len(self._leds)), dtype=np.int64)
         for slot, r in enumerate(self.world.robots):
             for d in r.devices:
                 if d.device not in lists or kin.refusal(r.name, d, self.world.world_info):
@@ -559,6 +570,10 @@ class BatchedSimulation:
         if self.cars is not None:
             self.cars.reset(idx)
         self.pressing[idx] = False
+        self.led_value[idx] = 0                 # LEDs off, their lights too (WbLed::reset)
+        if self.carried is not None:
+            for slot, name in self.carried.leds:
+                self.carried.switch_led(slot, name, idx, False, (0.0, 0.0, 0.0))
         for k in self.period:
             self.period[k][idx] = 0
             self.last[k][idx] = 0
@@ -605,6 +620,27 @@ class BatchedSimulation:
         self.z0[idx, slot] = tpl.z0
         self.tilted[idx, slot] = tpl.slope is not None
         self.slope[idx, slot] = tpl.slope if tpl.slope is not None else (0.0, 0.0)
+
+    def set_led(self, slot: int, name: str, value: int, copies=None) -> None:
+        """``LED.set(value)`` of robot ``slot``'s LED ``name`` in the named copies (default: all): the
+        single simulation's checks and colour; its lights (if any) light those copies exactly while it
+        is on, in its colour (WbLed)."""
+        col, led = self._led(slot, name)
+        led.set(value, 0)                       # the single LED's checks (ValueError) and colour
+        idx = np.arange(self.copies) if copies is None else np.asarray(copies, dtype=np.int64).reshape(-1)
+        self.led_value[idx, col] = int(value)
+        if self.carried is not None:
+            self.carried.switch_led(slot, name, idx, led.value != 0, led.light_color())
+
+    def led_value_of(self, slot: int, name: str) -> np.ndarray:
+        """``LED.get()`` of robot ``slot``'s LED ``name`` in every copy (C,)."""
+        return self.led_value[:, self._led(slot, name)[0]].copy()
+
+    def _led(self, slot: int, name: str) -> tuple[int, LED]:
+        got = self._leds.get((slot, name))
+        if got is None:
+            raise KeyError(f"robot {self.robot_names[slot]!r} has no LED {name!r}")
+        return got
 
     def set_wheels(self, slot: int, left, right, copies=None) -> None:
         """Velocity control of a slot's wheels (rad/s, clamped to the maximum as Webots does) in the
@@ -1020,6 +1056,22 @@ class BatchedSimulation:
 
     # light sensors (LightBatch over every copy's due sensors)
     def _plan_lights(self, copies: np.ndarray, cols: np.ndarray):
+        if self.carried is None or not self.carried.switched:
+            return self._plan_light_rows(copies, cols)
+        # LEDs' lights: the rows of copies whose LEDs are alike (on, colours) share their lights
+        keys = [self.carried.key(int(c)) for c in copies]
+        order: dict[bytes, list[int]] = {}
+        for row, k in enumerate(keys):
+            order.setdefault(k, []).append(row)
+        groups, requests = [], []
+        for rows in order.values():
+            r = np.array(rows, dtype=np.int64)
+            state, reqs = self._plan_light_rows(copies[r], cols[r])
+            groups.append((r, state, len(reqs)))
+            requests += reqs
+        return {"copies": copies, "cols": cols, "groups": groups}, requests
+
+    def _plan_light_rows(self, copies: np.ndarray, cols: np.ndarray):
         slot = self._l_slot[cols]
         rr = self.rot[copies, slot]
         rt = self.pos[copies, slot]
@@ -1046,14 +1098,24 @@ class BatchedSimulation:
         return state, [_Rays(positions[s], unit[rows, light], 0.0, length[rows, light], RayKind.BOUNDING,
                              copies[s], self._l_excl[cols][s], -1)]
 
-    def _finish_light(self, state: dict, hits: list[RayHits]) -> None:
-        copies, cols = state["copies"], state["cols"]
+    def _irradiance(self, state: dict, hits: list[RayHits]) -> np.ndarray:
         occluded = np.zeros(state["att"].shape, dtype=bool)
         if state["pairs"] is not None:
             s, light = state["pairs"]
             occluded[s, light] = np.isfinite(hits[0].distance)
-        e = light_math.irradiance_from_terms(state["att"], state["direct"], state["lights"], occluded,
-                                             self._l_filter[cols])
+        return light_math.irradiance_from_terms(state["att"], state["direct"], state["lights"], occluded,
+                                                self._l_filter[state["cols"]])
+
+    def _finish_light(self, state: dict, hits: list[RayHits]) -> None:
+        copies, cols = state["copies"], state["cols"]
+        if "groups" in state:
+            e = np.empty(len(cols))
+            k = 0
+            for rows, sub, n in state["groups"]:
+                e[rows] = self._irradiance(sub, hits[k:k + n])
+                k += n
+        else:
+            e = self._irradiance(state, hits)
         values = np.empty(len(cols))
         table_of = self._l_table_of[cols]
         for t, (table, _) in enumerate(self._l_tables):

@@ -148,8 +148,9 @@ class CameraDevices(PixelDevices):
         # the lights that are on and which cast shadows: static, shared by all copies; with lights carried by
         # robots, each copy's own (_lights_of), fixed then carried as the single camera lists them
         self.lights, self.shadows = camera_lights(scene.world_lights()) if devices else (None, np.zeros(0, dtype=bool))
+        self._fixed_shadows = self.shadows
         if devices and sim.carried is not None:
-            self.shadows = sim.carried.cast_shadows
+            self.shadows = sim.carried.cast_shadows     # every light a copy may have (LEDs' ones all on)
         # per hit shape (static shapes, then the robots' as CopyRays numbers them; -1 reads the last): the
         # base colour a camera sees (a textured shape's texels come on top: _albedo) and the
         # transparency
@@ -243,7 +244,9 @@ class CameraDevices(PixelDevices):
             Pq, Nq = P[rq], N[rq]
             direct = light_math.light_terms(Pq, Nq, lights)[1]
             unit, length = light_math.occlusion_segments_many(Pq, lights)
-            for j in self.shadows.nonzero()[0].tolist():
+            # the copy's own lights (with LEDs' lights: those on in it) are the first columns
+            casting = self.shadows if sim.carried is None else sim.carried.shadows(q, self._fixed_shadows)
+            for j in casting.nonzero()[0].tolist():
                 i = (direct[:, j] > 0.0).nonzero()[0]
                 near = shading.within_radius(Pq[i], lights, j)      # beyond the light's radius: unlit anyway
                 if near is not None:
@@ -319,7 +322,8 @@ class CameraDevices(PixelDevices):
         cuts = np.flatnonzero(row_copy[1:] != row_copy[:-1]) + 1
         for rq in np.split(np.arange(len(P)), cuts) if len(P) else ():
             lights = self._lights_of(int(copies[row_copy[rq[0]]]))
-            out[rq] = _shade(P[rq], N[rq], albedo[rq], lights, None if lit is None else lit[rq], threads)
+            out[rq] = _shade(P[rq], N[rq], albedo[rq], lights, None if lit is None else lit[rq, :lights.count],
+                             threads)
         return out
 
     def _alpha_shapes(self) -> np.ndarray | None:
@@ -356,7 +360,8 @@ class CameraDevices(PixelDevices):
             zeros = np.zeros(len(s), dtype=np.int64)
             albedo = self._albedo(s, origin[None, :], zeros, D, t, copy)
             lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
-            return _shade(P, N, albedo, self._lights_of(int(copy[0])), lit, scene.engine.threads)
+            lights = self._lights_of(int(copy[0]))
+            return _shade(P, N, albedo, lights, None if lit is None else lit[:, :lights.count], scene.engine.threads)
 
         alpha = None
         if alpha_shapes is not None:

@@ -8,6 +8,11 @@ the carried ones placed per copy with the same numpy calls on stacks (``Pose.com
 identity, then ``location @ R.T + t`` and ``direction @ R.T``, each a matmul of the same shapes), so
 the bits are the single simulation's.
 
+A robot's LEDs' lights (``robot_led_lights``: in the robot's frame, listed after its own lights, as
+the single scene lists them) are carried the same way and are on in a copy exactly while that copy's
+LED is, in its colour (``BatchedSimulation.set_led``): the copies whose LEDs are alike (:meth:`CarriedLights.key`)
+share the single simulation's arrays of the lights that are on, light sensors' rows grouped by it.
+
 Light sensors take :class:`RowLights`: per sensor row, its copy's positions and directions (the
 math of devices/light.py broadcasts them as it broadcasts shared ones), a spot light's axis as the
 single simulation's ``Scene.sensor_lights`` gives it (``light_sensor_direction``, when set, stays in
@@ -24,10 +29,10 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
-from sensorium.server.sim.scene import for_light_sensors, light_from_model, place_light
+from sensorium.server.sim.scene import for_light_sensors, light_from_model, place_light, robot_led_lights
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["CarriedLights", "RowLights", "copy_world_lights"]
+__all__ = ["CarriedLights", "RowLights", "copy_world_lights", "has_carried_lights"]
 
 _EYE = np.eye(3)
 _ZERO = np.zeros(3)
@@ -45,16 +50,41 @@ class RowLights(light_math.LightArrays):
         pass
 
 
-class CarriedLights:
-    """The world's fixed lights (shared) and its robots' lights that are on (placed per copy)."""
+def has_carried_lights(robot: wm.Robot) -> bool:
+    """Whether a robot carries lights: its own or its LEDs'."""
+    return bool(robot.lights) or any(getattr(d, "lights", None) for d in robot.devices)
 
-    def __init__(self, world: wm.World, fixed_models: list):
+
+class CarriedLights:
+    """The world's fixed lights (shared) and its robots' lights that are on (placed per copy), each
+    robot's own lights then its LEDs' (``robot_led_lights``, in the robot's frame), which are on in a
+    copy exactly while that copy's LED is, in its colour (:meth:`switch`)."""
+
+    def __init__(self, world: wm.World, fixed_models: list, copies: int = 1):
         on = [m for m in fixed_models if m.on]
         self._fixed = [light_from_model(m) for m in on]                        # as cameras see them
         sensor_fixed = [light_from_model(for_light_sensors(m)) for m in on]   # as light sensors see them
-        carried = [(i, m) for i, r in enumerate(world.robots) for m in r.lights if m.on]
+        carried: list[tuple[int, object]] = []
+        switch: list[int] = []           # per carried light: its LED's column, -1 for a robot's own light
+        self.leds: dict[tuple[int, str], int] = {}     # (robot slot, LED name) -> its column
+        for i, r in enumerate(world.robots):
+            own = [(i, m) for m in r.lights if m.on]
+            carried += own
+            switch += [-1] * len(own)
+            for name, models in robot_led_lights(r):
+                switch += [len(self.leds)] * len(models)
+                self.leds[(i, name)] = len(self.leds)
+                carried += [(i, m) for m in models]
+        self.switch = np.array(switch, dtype=np.int64)
+        self.switched = bool(self.leds)
+        # per copy and LED: on, and the colour its lights take (WbLed); none is on before a set
+        self.led_on = np.zeros((copies, len(self.leds)), dtype=bool)
+        self.led_color = np.zeros((copies, len(self.leds), 3))
+        self._groups: dict[bytes, tuple[np.ndarray, light_math.LightArrays, list, np.ndarray]] = {}
         self._carried = [light_from_model(m) for _, m in carried]
         sensor_carried = [light_from_model(for_light_sensors(m)) for _, m in carried]
+        self._sensor_carried = sensor_carried
+        self._sensor_fixed = sensor_fixed
         self.slots = np.array([i for i, _ in carried], dtype=np.int64)
         self.count = len(carried)
         # the carried lights' fields in their robot's frame: which of them move (Webots: a directional
@@ -73,6 +103,50 @@ class CarriedLights:
                                      dtype=bool)
         self._oriented = self.shared.kind != light_math.LightKind.POINT
         self._n_fixed = len(self._fixed)
+        self._cast = np.array([bool(m.cast_shadows) for _, m in carried], dtype=bool)
+
+    # ------------------------------------------------------------------ LEDs
+    def switch_led(self, slot: int, name: str, copies: np.ndarray, on: bool, color: tuple[float, float, float]) -> None:
+        """LED ``name`` of robot ``slot`` in ``copies`` set: its lights on or off, in ``color``."""
+        col = self.leds.get((slot, name))
+        if col is None:
+            return
+        self.led_on[copies, col] = on
+        self.led_color[copies, col] = color
+        if len(self._groups) > 256:        # a gradual LED can take 16M colours: the cache stays small
+            self._groups.clear()
+
+    def _visible(self, copy: int) -> np.ndarray:
+        """Which carried lights are on in ``copy``: the robots' own, and the lights of its LEDs that are on."""
+        sw = self.switch
+        return (sw < 0) | self.led_on[copy, np.maximum(sw, 0)]
+
+    def key(self, copy: int) -> bytes:
+        """A copy's LED state (which are on, their colours): copies of one key light alike."""
+        return self.led_on[copy].tobytes() + self.led_color[copy].tobytes()
+
+    def group(self, copy: int) -> tuple[np.ndarray, light_math.LightArrays, list, np.ndarray]:
+        """The carried lights on in ``copy`` (indices), the light sensors' arrays of them with the fixed
+        ones (the single simulation's ``lights_from_models(sensor_lights())``: the same ``Light``
+        values in the same order), the camera's ``Light`` values of them and which cast shadows."""
+        k = self.key(copy)
+        got = self._groups.get(k)
+        if got is None:
+            sel = np.flatnonzero(self._visible(copy))
+            colors = [None if self.switch[j] < 0 else tuple(float(v) for v in self.led_color[copy, self.switch[j]])
+                      for j in range(len(self.switch))]
+            sensor = [lt if colors[j] is None else replace(lt, color=colors[j])
+                      for j, lt in enumerate(self._sensor_carried)]
+            camera = [lt if colors[j] is None else replace(lt, color=colors[j]) for j, lt in enumerate(self._carried)]
+            arrays = light_math.LightArrays.from_lights(self._sensor_fixed + [sensor[j] for j in sel])
+            got = self._groups[k] = (sel, arrays, [camera[j] for j in sel], self._cast[sel])
+        return got
+
+    def shadows(self, copy: int, fixed: np.ndarray) -> np.ndarray:
+        """Which of ``copy``'s lights (fixed ones, then its carried ones that are on) cast shadows."""
+        if not self.switched:
+            return self.cast_shadows
+        return np.concatenate([fixed, self.group(copy)[3]])
 
     def placed(self, rot: np.ndarray, pos: np.ndarray, copies: np.ndarray, sensors: bool = False
                ) -> tuple[np.ndarray, np.ndarray]:
@@ -96,13 +170,18 @@ class CarriedLights:
 
     def rows(self, rot: np.ndarray, pos: np.ndarray, copies: np.ndarray) -> RowLights:
         """Every light of each row's copy (``copies``: a copy per row), fixed then carried, as light
-        sensors see them."""
+        sensors see them. With LEDs' lights, the rows' copies share one LED state (:meth:`key`)."""
         S = len(copies)
         p, d = self.placed(rot, pos, copies, sensors=True)
         shared = self.shared
+        if self.switched:
+            sel, shared, _, _ = self.group(int(copies[0]))
+            p, d = p[:, sel], d[:, sel]
+            oriented = self._oriented[self._n_fixed:][sel]
+        else:
+            oriented = self._oriented[self._n_fixed:]
         norm = np.linalg.norm(d, axis=2)                              # LightArrays' normalisation, per row
-        d = np.where(self._oriented[None, self._n_fixed:, None],
-                     d / np.where(norm > 0.0, norm, 1.0)[:, :, None], d)
+        d = np.where(oriented[None, :, None], d / np.where(norm > 0.0, norm, 1.0)[:, :, None], d)
         position = np.concatenate([np.broadcast_to(shared.position[None, :self._n_fixed], (S, self._n_fixed, 3)), p],
                                   axis=1)
         direction = np.concatenate([np.broadcast_to(shared.direction[None, :self._n_fixed], (S, self._n_fixed, 3)),
@@ -113,8 +192,12 @@ class CarriedLights:
     def arrays(self, rot: np.ndarray, pos: np.ndarray, copy: int) -> light_math.LightArrays:
         """Copy ``copy``'s lights as the single simulation's arrays: the same ``Light`` values."""
         p, d = self.placed(rot, pos, np.array([copy], dtype=np.int64))
+        if self.switched:
+            sel, _, carried, _ = self.group(copy)
+        else:
+            sel, carried = np.arange(self.count), self._carried
         moved = [replace(lt, position=tuple(float(v) for v in p[0, k]), direction=tuple(float(v) for v in d[0, k]))
-                 for k, lt in enumerate(self._carried)]
+                 for k, lt in zip(sel.tolist(), carried)]
         return light_math.LightArrays.from_lights(self._fixed + moved)
 
 
@@ -122,8 +205,14 @@ def copy_world_lights(sim, copy: int) -> list:
     """``Scene.world_lights`` of copy ``copy`` of a batched simulation: the fixed lights' models, then
     every robot's lights placed at that copy's robot poses (what a task reads, e.g. a light's place)."""
     out = list(sim.scene.world_lights())
+    carried = sim.carried
     for slot, robot in enumerate(sim.world.robots):
-        if robot.lights:
+        models = list(robot.lights)
+        for name, lights in robot_led_lights(robot):
+            col = carried.leds[(slot, name)]
+            on, color = bool(carried.led_on[copy, col]), tuple(float(v) for v in carried.led_color[copy, col])
+            models += [m.model_copy(update={"on": on, "color": color}) if on else m for m in lights]
+        if models:
             frame = sim.pose(copy, slot).compose(Pose.identity())
-            out += [place_light(m, frame) for m in robot.lights]
+            out += [place_light(m, frame) for m in models]
     return out

@@ -120,6 +120,21 @@ def sensor_aimed(model, own: Pose):
     return model.model_copy(update={"light_sensor_direction": aim})
 
 
+def robot_led_lights(robot: wm.Robot) -> list[tuple[str, list]]:
+    """Each LED of ``robot`` holding lights, with its lights in the robot's frame (``place_light`` by the
+    LED's pose) as the LED holds them before its first ``set``: off and black (``WbLed::postFinalize``:
+    value 0). A spot light's light-sensor axis is turned by the LED's own rotation, as a nested solid's
+    (``sensor_aimed``: the LED is the nearest enclosing Pose). The robot carries them from there as it
+    carries its own ``lights`` (the batched simulation's ``CarriedLights`` too)."""
+    out = []
+    for d in robot.devices:
+        if isinstance(d, wm.LED) and d.lights:
+            frame = pose_from_model(d.pose)
+            out.append((d.name, [place_light(sensor_aimed(lt, frame), frame).model_copy(
+                update={"on": False, "color": (0.0, 0.0, 0.0)}) for lt in d.lights]))
+    return out
+
+
 def for_light_sensors(model):
     """A placed light model (``place_light``) as light sensors see it: a spot light's
     ``light_sensor_direction``, when it has one, is its direction (world axes, fixed)."""
@@ -276,6 +291,7 @@ class Scene:
         self._parts: list[tuple[str | int | None, Pose, wm.Shape | wm.Solid]] = []   # per shape: owner, frame, model
         # lights: (model, owner, pose in the owner's frame); owner None = world, str = solid, int = robot
         self._lights: list[tuple[object, str | int | None, Pose]] = [(lt, None, Pose.identity()) for lt in world.lights]
+        self._led_lights: dict[tuple[int, str], list] = {}   # (robot, LED) -> its lights' models now
         for s in world.solids:
             pose = pose_from_model(s.pose)
             self.solid_poses[s.name] = pose
@@ -295,6 +311,9 @@ class Scene:
             pose = pose_from_model(r.pose)
             self.robot_poses.append(pose)
             self._lights += [(lt, i, Pose.identity()) for lt in r.lights]
+            for name, models in robot_led_lights(r):    # off and black until the LED is set (WbLed)
+                self._led_lights[(i, name)] = models
+                self._lights += [(m, i, Pose.identity()) for m in models]
             parts = list(robot_parts(r))
             if parts:
                 first = len(self.shapes)
@@ -369,6 +388,19 @@ class Scene:
         """``world_lights`` as light sensors see them (``for_light_sensors``: a spot light's axis by
         Webots' LightSensor rule)."""
         return [for_light_sensors(m) for m in self.world_lights()]
+
+    def set_led_lights(self, robot: int, led: str, on: bool, color: tuple[float, float, float]) -> None:
+        """An LED's new state (``WbLed::setMaterialsAndLightsColor``): its lights take ``color`` and are
+        on exactly when ``on``; light sensors and cameras recompute their light arrays at their next
+        measurement (``lights_version``). Nothing changes (nor is recomputed) when the state is the same."""
+        old = self._led_lights.get((robot, led))
+        if not old or all(m.on == on and m.color == color for m in old):
+            return
+        new = [m.model_copy(update={"on": on, "color": color}) for m in old]
+        swap = {id(a): b for a, b in zip(old, new)}
+        self._lights = [(swap.get(id(m), m), owner, local) for m, owner, local in self._lights]
+        self._led_lights[(robot, led)] = new
+        self.lights_version += 1
 
     def top_lights(self) -> list:
         """The world's top-level light models (the world file's ``lights``, in order; the Supervisor's

@@ -553,12 +553,20 @@ class PositionSensor(Device):
 
 
 class LED(Device):
-    """Webots LED: ``value`` 0 (off) or a colour index 1..n; a gradual LED holds 0xRRGGBB. It emits
-    no light that sensors see. Each ``set`` counts as a new measurement (its topic publishes it)."""
+    """Webots LED: ``value`` 0 (off) or a colour index 1..n; a gradual LED holds 0xRRGGBB. Its
+    ``lights`` (if any) are on exactly while the value is not 0, in its colour (``light_color``), and
+    light sensors and cameras see them then. Each ``set`` counts as a new measurement (its topic
+    publishes it)."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
         self.value = 0
+        self._switch: Callable[[bool, tuple[float, float, float]], None] | None = None
+
+    def bind(self, robot: Any) -> None:
+        if self.config.lights:
+            scene, index, name = robot.scene, self.robot_index, self.name
+            self._switch = lambda on, color: scene.set_led_lights(index, name, on, color)
 
     def set(self, value: int, now_ms: int) -> None:
         c = self.config
@@ -570,6 +578,18 @@ class LED(Device):
             raise ValueError(f"LED {self.name!r}: value {value} is not {what}")
         self.value = int(value)
         self._mark(now_ms)
+        if self._switch is not None:
+            self._switch(self.value != 0, self.light_color())
+
+    def light_color(self) -> tuple[float, float, float]:
+        """The colour its lights take: ``rgb`` as ``WbLed::setMaterialsAndLightsColor`` computes it, in
+        single precision (its ``float r, g, b``: a gradual LED's byte / 255.0f, a colour of the list
+        rounded to float)."""
+        v, c = self.value, self.config
+        if v != 0 and c.gradual:
+            return tuple(float(np.float32((v >> s) & 255) / np.float32(255.0))   # type: ignore[return-value]
+                         for s in (16, 8, 0))
+        return tuple(float(np.float32(x)) for x in self.rgb())  # type: ignore[return-value]
 
     def rgb(self) -> tuple[float, float, float]:
         """The colour shown (0, 0, 0 when off)."""

@@ -25,7 +25,8 @@ def device_line(d) -> str:
             return "PositionSensor on a joint nothing turns here (present, reads 0 rad)"
         return f"PositionSensor on {d.motor!r} noise {d.noise:g} resolution {d.resolution:g}"
     if isinstance(d, wm.LED):
-        return f"LED {'gradual' if d.gradual else f'{len(d.color)} colours'}"
+        lights = f", {len(d.lights)} light(s) on while it is" if d.lights else ""
+        return f"LED {'gradual' if d.gradual else f'{len(d.color)} colours'}{lights}"
     return d.device
 
 

@@ -171,6 +171,8 @@ def check_counts(data: Any, limits: WorldLimits) -> None:
         if isinstance(robot, dict):
             over(f"robots[{i}].devices", len(items(robot.get("devices"))), limits.devices_per_robot, "devices")
     lights = len(items(data.get("lights"))) + sum(len(items(r.get("lights"))) for r in robots if isinstance(r, dict))
+    lights += sum(len(items(d.get("lights"))) for r in robots if isinstance(r, dict)    # an LED's lights
+                  for d in items(r.get("devices")) if isinstance(d, dict))
     solids = 0
     todo = list(items(data.get("solids")))
     while todo and solids <= limits.solids:

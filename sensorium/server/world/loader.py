@@ -531,6 +531,9 @@ def all_lights(world: wm.World) -> Iterator[tuple[str, Any]]:
     for r_i, robot in enumerate(world.robots):
         for i, lt in enumerate(robot.lights):
             yield f"robots[{r_i}].lights[{i}]", lt
+        for d_i, dev in enumerate(robot.devices):      # an LED's lights
+            for i, lt in enumerate(getattr(dev, "lights", ())):
+                yield f"robots[{r_i}].devices[{d_i}].lights[{i}]", lt
 
 
 def all_geometries(world: wm.World) -> Iterator[tuple[str, Any]]:
@@ -647,6 +650,8 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
             if not lo <= dev.default_frequency <= hi:
                 upd["default_frequency"] = min(max(dev.default_frequency, lo), hi)
                 warnings.append(f"{p}.default_frequency: outside [min_frequency, max_frequency], clamped")
+        if isinstance(dev, wm.LED) and dev.lights:
+            upd["lights"] = [fix_light(f"{p}.lights[{i}]", lt) for i, lt in enumerate(dev.lights)]
         return dev.model_copy(update=upd) if upd else dev
 
     def fix_solid(p: str, solid: wm.Solid) -> wm.Solid:

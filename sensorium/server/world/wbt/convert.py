@@ -91,6 +91,7 @@ class Converter:
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.device_depth = 0              # > 0 while inside a device's children (its joints are no wheels)
         self.device_where: dict[int, str] = {}   # id(device entry) -> where its node is written
+        self.led_of: dict[int, tuple[dict, Frame]] = {}   # id(light node) -> (its LED's entry, the LED's frame)
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
         self.checked_grids: set[int] = set()   # ElevationGrids sanitised (warned once: a shape and its boundingObject)
         self.constrained: set[int] = set()     # Transforms in boundingObjects whose scale Webots constrains
@@ -709,7 +710,29 @@ class Converter:
         data["_at"] = self.at(node)
         if owner.kind == "world":
             self.def_name(node, data)
+        led = self.led_of.get(id(node))
+        if led is not None:       # switched by an LED: in the LED's frame, in its lights
+            entry, at = led
+            back = at.rotation.T
+            if "location" in data:
+                data["location"] = [float(v) for v in back @ (np.asarray(data["location"]) - at.translation)]
+            if node.type == "SpotLight":
+                data["direction"] = [float(v) for v in back @ np.asarray(data["direction"])]
+            entry.setdefault("lights", []).append(data)
+            return
         owner.data.setdefault("lights", []).append(data) if owner.kind != "world" else self.world["lights"].append(data)
+
+    def led_lights(self, node: Node) -> list[Node]:
+        """The lights an LED switches (``WbLed::findMaterialsAndLights``): only its first child counts; a
+        PointLight or SpotLight there, or every one inside it at any depth when it is a Group, Pose,
+        Transform or Solid (Webots' groups)."""
+        def inside(n: Node) -> list[Node]:
+            if n.type in ("PointLight", "SpotLight"):
+                return [n]
+            if n.type in ("Group", "Pose", "Transform", "Solid"):
+                return [lt for child in self.fields(n).nodes("children") for lt in inside(child)]
+            return []
+        return inside(self.fields(node).nodes("children")[0]) if self.fields(node).nodes("children") else []
 
     # ------------------------------------------------------------ solids and robots
     def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> None:
@@ -871,6 +894,8 @@ class Converter:
                 self.warn(node, f"{node.type} {data['name']!r} of robot {owner.data['name']!r}: {name} ({what}) is "
                                 "not rendered here; the image is Webots' without it")
             owner.data["devices"].append(data)
+            if node.type == "LED":
+                self.led_of.update((id(lt), (data, inner)) for lt in self.led_lights(node))
             self.device_contents(node, inner, owner, data)
             return
         self.device_contents(node, inner, owner, None)
