@@ -22,7 +22,7 @@ LEDS = [
                  "ambient_intensity": 0.03},
                 {"type": "SpotLight", "location": [0.08, 0, 0], "direction": [1, 0.2, -0.3], "intensity": 2.0,
                  "attenuation": [1, 0.5, 0.8], "beam_width": 0.4, "cut_off_angle": 0.8}]},
-    {"device": "LED", "name": "rgb", "gradual": True, "pose": {"translation": [-0.05, 0.03, 0.1]},
+    {"device": "LED", "name": "rgb", "gradual": True, "color": [], "pose": {"translation": [-0.05, 0.03, 0.1]},
      "lights": [{"type": "PointLight", "intensity": 0.9, "attenuation": [0.5, 0.0, 1.0]}]},
     {"device": "LED", "name": "plain"},
 ]

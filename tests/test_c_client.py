@@ -449,6 +449,7 @@ def test_robot_extras_led_keyboard_and_supervisor(cbin, servers):
     assert got["custom_data_after"] == "gain=3;from C" and got["mode"] == "0" and got["buddy_null"] == "0"
     assert got["led0_initial"] == "0" and got["led0"] == f"2 rgb {0x336699}"
     assert "value 3 out of range [0, 2] for LED 'led0'" in err_r
+    assert got["dim"] == "128" and f"value {0x336699} out of range [0, 255] for LED 'dim'" in err_r
     assert got["keyboard_disabled_key"] == "-1" and got["keyboard"] == "16 -1" and got["keyboard_after"] == "0"
     assert got["self_null"] == "0 missing_null 1 same_ref 1"
     assert got["fields"] == "5 translation 6 rotation bogus_null 1"

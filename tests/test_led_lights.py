@@ -72,13 +72,31 @@ def test_on_is_the_same_as_a_robot_light_of_the_leds_colour_bit_for_bit():
 
 
 def test_a_gradual_led_gives_its_lights_its_0xRRGGBB_colour():
-    sim = Simulation(sensor_world({"gradual": True, "lights": [{"type": "PointLight", "intensity": I,
-                                                                "attenuation": [0, 0, 1]}]}))
+    sim = Simulation(sensor_world({"gradual": True, "color": [], "lights": [{"type": "PointLight", "intensity": I,
+                                                                             "attenuation": [0, 0, 1]}]}))
     sim.device("bot/ls").enable(16)
     sim.device("bot/led").set(0x336699, 0)
     rgb8 = [np.float32(b) / np.float32(255.0) for b in (0x33, 0x66, 0x99)]
     assert read(sim) == pytest.approx(closed_form(rgb8), rel=1e-12)
     assert sim.scene.world_lights()[0].color == tuple(float(v) for v in rgb8)
+
+
+def test_a_gradual_led_with_one_colour_is_a_dimmer_of_it():
+    """WbLed's monochrome LED: gradual with one colour (Webots' default list is red) takes an
+    intensity 0..255: its lights get value/255.0f times that colour, in single precision."""
+    light = [{"type": "PointLight", "intensity": I, "attenuation": [0, 0, 1]}]
+    for listed in ({}, {"color": [[0.2, 0.6, 1.0]]}):
+        sim = Simulation(sensor_world({"gradual": True, **listed, "lights": light}))
+        colour = listed.get("color", [[1.0, 0.0, 0.0]])[0]
+        sim.device("bot/ls").enable(16)
+        led = sim.device("bot/led")
+        led.set(128, 0)
+        i = np.float32(128) / np.float32(255.0)
+        want = [np.float32(float(i) * c) for c in colour]
+        assert read(sim) == pytest.approx(closed_form(want), rel=1e-12)
+        assert led.rgb() == pytest.approx([128 / 255.0 * c for c in colour], abs=1e-15)
+        with pytest.raises(ValueError, match="an intensity 0..255"):
+            led.set(256, 0)
 
 
 def test_an_led_spot_light_points_from_the_leds_frame():

@@ -228,7 +228,7 @@ def _led(tag: int, func: str) -> DeviceState:
 
 def wb_led_set(tag: int, value: int) -> None:
     """0 switches the LED off; 1..n lights colour n of its ``color`` list; a gradual LED takes
-    0xRRGGBB. Sent at once (the ``/<robot>/<led>/value`` topic publishes it); a value out of range
+    0xRRGGBB (no colour listed) or an intensity 0..255 of its one colour. Sent at once (the ``/<robot>/<led>/value`` topic publishes it); a value out of range
     is printed and ignored (Webots)."""
     r = current()
     dev = _led(tag, "wb_led_set")
@@ -237,7 +237,7 @@ def wb_led_set(tag: int, value: int) -> None:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_led_set(): value must be an integer, got {value!r}")
     value = whole
     colors = len(dev.desc.get("color", [])) // 3
-    hi = 0xFFFFFF if dev.desc.get("gradual") else colors
+    hi = (0xFFFFFF if colors == 0 else 255) if dev.desc.get("gradual") else colors
     if not 0 <= value <= hi:
         print(f"Error: wb_led_set(): value {value} out of range [0, {hi}] for LED {dev.name!r}.", file=sys.stderr)
         return

@@ -521,7 +521,8 @@ LedLight = Annotated[PointLight | SpotLight, Field(discriminator="type")]
 
 class LED(_Device):
     """Webots LED: ``set(i)`` lights colour ``i`` (1-based, 0 = off) of ``color``; a ``gradual`` LED
-    takes a 0xRRGGBB value instead. Its ``lights`` (Webots' PointLight/SpotLight children of the LED)
+    takes a 0xRRGGBB value instead when ``color`` is empty (``color: []``: an RGB LED), else an
+    intensity 0..255 of its first colour (a monochrome LED; the default colour is red, as in Webots). Its ``lights`` (Webots' PointLight/SpotLight children of the LED)
     are on exactly while the LED is (value != 0) and take its colour (WbLed): light sensors and cameras
     see them then; their own ``on`` and ``color`` are overridden (off and black until the first
     ``set``, and again after a reset)."""

@@ -41,6 +41,10 @@ int main(void) {
   wb_led_set(led0, 3); /* out of range: message, ignored */
   wb_led_set(rgb, 0x336699);
   printf("led0 %d rgb %d\n", wb_led_get(led0), wb_led_get(rgb));
+  WbDeviceTag dim = wb_robot_get_device("dim");
+  wb_led_set(dim, 128);
+  wb_led_set(dim, 0x336699); /* a monochrome LED's intensity is 0..255: message, ignored */
+  printf("dim %d\n", wb_led_get(dim));
   printf("keyboard_disabled_key %d\n", wb_keyboard_get_key());
   wb_keyboard_enable(dt);
   printf("keyboard %d %d\n", wb_keyboard_get_sampling_period(), wb_keyboard_get_key());

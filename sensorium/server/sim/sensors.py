@@ -552,8 +552,15 @@ class PositionSensor(Device):
         return {"motor": c.motor, "noise": float(c.noise), "resolution": float(c.resolution)}
 
 
+def led_value_bound(gradual: bool, colours: int) -> int:
+    """The largest value an LED takes (Webots' LED page): a colour index up to ``colours``; a
+    gradual LED 0xFFFFFF (RGB: no colour listed) or 255 (monochrome: an intensity of its colour)."""
+    return (0xFFFFFF if colours == 0 else 255) if gradual else colours
+
+
 class LED(Device):
-    """Webots LED: ``value`` 0 (off) or a colour index 1..n; a gradual LED holds 0xRRGGBB. Its
+    """Webots LED: ``value`` 0 (off) or a colour index 1..n; a gradual LED holds 0xRRGGBB when its
+    ``color`` list is empty, else an intensity 0..255 of its first colour (WbLed's monochrome LED). Its
     ``lights`` (if any) are on exactly while the value is not 0, in its colour (``light_color``), and
     light sensors and cameras see them then. Each ``set`` counts as a new measurement (its topic
     publishes it)."""
@@ -572,9 +579,10 @@ class LED(Device):
         c = self.config
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
             raise ValueError(f"LED value must be an integer, got {value!r}")
-        hi = 0xFFFFFF if c.gradual else len(c.color)
+        hi = led_value_bound(c.gradual, len(c.color))
         if not 0 <= value <= hi:
-            what = "a 0xRRGGBB colour" if c.gradual else f"0 (off) or a colour index 1..{len(c.color)}"
+            what = ("a 0xRRGGBB colour" if not c.color else "an intensity 0..255") if c.gradual else \
+                f"0 (off) or a colour index 1..{len(c.color)}"
             raise ValueError(f"LED {self.name!r}: value {value} is not {what}")
         self.value = int(value)
         self._mark(now_ms)
@@ -583,12 +591,15 @@ class LED(Device):
 
     def light_color(self) -> tuple[float, float, float]:
         """The colour its lights take: ``rgb`` as ``WbLed::setMaterialsAndLightsColor`` computes it, in
-        single precision (its ``float r, g, b``: a gradual LED's byte / 255.0f, a colour of the list
-        rounded to float)."""
+        single precision (its ``float r, g, b``: an RGB LED's byte / 255.0f; a monochrome one's
+        intensity value / 255.0f times its colour; a colour of the list rounded to float)."""
         v, c = self.value, self.config
         if v != 0 and c.gradual:
-            return tuple(float(np.float32((v >> s) & 255) / np.float32(255.0))   # type: ignore[return-value]
-                         for s in (16, 8, 0))
+            if not c.color:
+                return tuple(float(np.float32((v >> s) & 255) / np.float32(255.0))   # type: ignore[return-value]
+                             for s in (16, 8, 0))
+            i = np.float32(v) / np.float32(255.0)
+            return tuple(float(np.float32(float(i) * x)) for x in c.color[0])  # type: ignore[return-value]
         return tuple(float(np.float32(x)) for x in self.rgb())  # type: ignore[return-value]
 
     def rgb(self) -> tuple[float, float, float]:
@@ -596,8 +607,10 @@ class LED(Device):
         v, c = self.value, self.config
         if v == 0:
             return (0.0, 0.0, 0.0)
-        if c.gradual:
+        if c.gradual and not c.color:
             return (((v >> 16) & 255) / 255.0, ((v >> 8) & 255) / 255.0, (v & 255) / 255.0)
+        if c.gradual:
+            return tuple(v / 255.0 * float(x) for x in c.color[0])  # type: ignore[return-value]
         return tuple(float(x) for x in c.color[v - 1])  # type: ignore[return-value]
 
     def readings(self) -> dict:

@@ -54,7 +54,8 @@ void wb_led_set(WbDeviceTag tag, int value) {
   sn_device *d = sn_device_get(tag, SN_LED, "wb_led_set");
   if (d == NULL)
     return;
-  int hi = d->led_gradual ? 0xFFFFFF : d->led_colors;
+  /* a gradual LED: 0xRRGGBB without a colour, else an intensity 0..255 of its colour (Webots' LED page) */
+  int hi = d->led_gradual ? (d->led_colors == 0 ? 0xFFFFFF : 255) : d->led_colors;
   if (value < 0 || value > hi) {
     fprintf(stderr, "Error: wb_led_set(): value %d out of range [0, %d] for LED '%s'.\n", value, hi, d->name);
     return;
