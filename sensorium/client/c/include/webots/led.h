@@ -8,7 +8,7 @@
 extern "C" {
 #endif
 
-void wb_led_set(WbDeviceTag tag, int value); /* 0 off, 1..n colour n; 0xRRGGBB for a gradual LED */
+void wb_led_set(WbDeviceTag tag, int value); /* 0 off, 1..n colour n; gradual: 0xRRGGBB (no colour) or 0..255 */
 int wb_led_get(WbDeviceTag tag);
 
 #ifdef __cplusplus
