@@ -98,3 +98,18 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:  # no
             f"sensorium: {len(node)} Foxglove/Node test(s) skipped ({why}): install Node.js, run `npm ci` in "
             f"{Path(__file__).parent / 'js'}, then run pytest again (CI sets SENSORIUM_REQUIRE_NODE=1 to fail instead)",
             yellow=True)
+
+
+@pytest.fixture(scope="module")
+def texture_dir(tmp_path_factory) -> Path:
+    """tests/worlds/camera.yaml's folder with its floor's texture: 8 x 8 texels of seeded random colours
+    (written here, not committed; tests/test_batched_camera.py and test_camera_light_radius.py)."""
+    import numpy as np
+    from PIL import Image
+
+    world = Path(__file__).parent / "worlds" / "camera.yaml"
+    d = tmp_path_factory.mktemp("camera_world")
+    texels = np.random.default_rng(7).integers(0, 256, (8, 8, 3), dtype=np.uint8)
+    Image.fromarray(texels, "RGB").save(d / "checker.png")
+    (d / world.name).write_text(world.read_text())
+    return d

@@ -26,17 +26,6 @@ PERIODS = {"rover": {"eye": 32, "housed": 16, "pano": 48}, "scout": {"dome": 16}
 BOTH = ["fast", "exact"]
 
 
-@pytest.fixture(scope="module")
-def texture_dir(tmp_path_factory) -> Path:
-    """The floor's texture: 8 x 8 texels of seeded random colours (written here, not committed)."""
-    from PIL import Image
-    d = tmp_path_factory.mktemp("camera_world")
-    texels = np.random.default_rng(7).integers(0, 256, (8, 8, 3), dtype=np.uint8)
-    Image.fromarray(texels, "RGB").save(d / "checker.png")
-    (d / WORLD.name).write_text(WORLD.read_text())
-    return d
-
-
 def _world(seed: int, base: Path, **update) -> LoadedWorld:
     lw = load_world(base / WORLD.name)
     w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed}),

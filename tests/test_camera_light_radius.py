@@ -22,7 +22,7 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld
-from tests.test_batched_camera import PERIODS, WORLD, _world
+from tests.test_batched_camera import PERIODS, _world
 from tests.test_batched_sim import _enable_both
 
 WALL = {"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
@@ -188,24 +188,15 @@ def test_no_shadow_ray_goes_towards_a_light_out_of_reach(precision: str):
         np.testing.assert_array_equal(got, shoot(world([AMBIENT, point(radius)]), precision))
 
 
-@pytest.fixture(scope="module")
-def camera_dir(tmp_path_factory) -> Path:
-    """tests/test_batched_camera.py's camera world folder: the world and its floor's texture."""
-    from PIL import Image
-    d = tmp_path_factory.mktemp("camera_world")
-    texels = np.random.default_rng(7).integers(0, 256, (8, 8, 3), dtype=np.uint8)
-    Image.fromarray(texels, "RGB").save(d / "checker.png")
-    (d / WORLD.name).write_text(WORLD.read_text())
-    return d
 
 
 @pytest.mark.parametrize("precision", BOTH)
-def test_the_camera_world_with_short_radii_is_the_single_simulations_in_every_copy(precision: str, camera_dir: Path):
+def test_the_camera_world_with_short_radii_is_the_single_simulations_in_every_copy(precision: str, texture_dir: Path):
     """tests/worlds/camera.yaml with the spot light's radius 1.5 m and the lamp's shadow-casting bulb's
     0.9 m (both cut across the cameras' views): every copy's images equal those of
     a Simulation with its seed, byte for byte, and differ from the default radii's."""
     def short(seed: int) -> LoadedWorld:
-        lw = _world(seed, camera_dir)
+        lw = _world(seed, texture_dir)
         w = lw.world
         lights = [w.lights[0].model_copy(update={"radius": 1.5}), *w.lights[1:]]
         lamp = w.solids[3]
@@ -217,7 +208,7 @@ def test_the_camera_world_with_short_radii_is_the_single_simulations_in_every_co
     bs = BatchedSimulation(short(0), len(seeds), precision=precision)
     bs.reset(np.arange(len(seeds)), seeds)
     sims = [Simulation(short(s), precision=precision) for s in seeds]
-    default = Simulation(_world(seeds[0], camera_dir), precision=precision)
+    default = Simulation(_world(seeds[0], texture_dir), precision=precision)
     for c in range(len(seeds)):
         _enable_both(bs, sims, PERIODS, c)
     default.robot("rover").device("eye").enable(PERIODS["rover"]["eye"])

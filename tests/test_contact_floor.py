@@ -19,6 +19,7 @@ from sensorium.server.sim import contact as C
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, parse_world
+from tests.test_contact import drive, xy
 
 R = 0.2
 STEP = 0.016                     # m per basic step at 5 rad/s
@@ -35,16 +36,6 @@ def robot(name, x, y, z, yaw=0.0):
 
 def loaded(solids, robots) -> LoadedWorld:
     return parse_world({"world_info": {"basic_time_step": 32}, "solids": list(solids), "robots": list(robots)})
-
-
-def drive(sim, name, left, right=None):
-    for m, w in zip(sim.robot(name).motors.values(), (left, left if right is None else right)):
-        m.set_position(math.inf)
-        m.set_velocity(w)
-
-
-def xy(sim, name):
-    return sim.robot(name).pose.translation[:2].copy()
 
 
 def test_the_tolerance_is_a_millimetre():

@@ -192,15 +192,9 @@ def surface_colors(colors: np.ndarray, sampler: TextureSampler | None, world_to_
     col = np.take(colors, shape, axis=0)   # (faster than fancy indexing of (n, 3) rows)
     if sampler is None:
         return col
-    hit = sampler.textured[shape].nonzero()[0]
-    on = shape[hit]
-    for s in sorted(set(on.tolist())):
-        rows = hit[on == s]
-        inv = world_to_shape(s)
-        o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
-        uv, picked = sampler.uv(s, o, d, distance[rows])
+    for s, rows, o, d, uv, picked in _texel_coords(sampler, sampler.textured, world_to_shape, shape, origins,
+                                                   directions, distance):
         sampler.lookups += len(rows)
-        uv = np.where(picked[:, None], uv, 0.0)
         base = col[rows]
         if s in sampler.shapes:
             texel = srgb_to_linear(sampler.texels(s, uv, "base"))
@@ -221,16 +215,25 @@ def surface_opacity(sampler: TextureSampler, world_to_shape: Callable[[int], Pos
     coordinates :func:`surface_colors` reads its colour at (Webots' shaders take the texel's alpha
     as the fragment's, times ``1 − transparency``; the pen's ink changes colours only)."""
     out = np.ones(len(shape))
-    hit = sampler.alpha[shape].nonzero()[0]
+    for s, rows, _, _, uv, picked in _texel_coords(sampler, sampler.alpha, world_to_shape, shape, origins,
+                                                   directions, distance):
+        out[rows] = np.where(picked, sampler.opacity(s, uv), 1.0)
+    return out
+
+
+def _texel_coords(sampler: TextureSampler, chosen: np.ndarray, world_to_shape: Callable[[int], Pose],
+                  shape: np.ndarray, origins: np.ndarray, directions: np.ndarray, distance: np.ndarray):
+    """Per shape ``s`` with ``chosen[s]`` among the hits, in shape order: ``(s, rows, o, d, uv,
+    picked)`` -- its hits' rows, their rays in the shape's frame, and the texture coordinates (0
+    where picking fails, ``picked`` False) that colours and alpha are both read at."""
+    hit = chosen[shape].nonzero()[0]
     on = shape[hit]
     for s in sorted(set(on.tolist())):
         rows = hit[on == s]
         inv = world_to_shape(s)
         o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
         uv, picked = sampler.uv(s, o, d, distance[rows])
-        uv = np.where(picked[:, None], uv, 0.0)
-        out[rows] = np.where(picked, sampler.opacity(s, uv), 1.0)
-    return out
+        yield s, rows, o, d, np.where(picked[:, None], uv, 0.0), picked
 
 
 def infra_red_terms(red_of: np.ndarray, roughness_of: np.ndarray, sampler: TextureSampler | None,
