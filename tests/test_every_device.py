@@ -63,7 +63,7 @@ def check_lines(lines: list[str], stderr: str) -> None:
     assert got["send"][:3] == ["1", "1", "2"] and got["led"] == ["2"] and got["receiver"][:2] == ["0", "1"]
     assert got["wheel"][1] == "0" and math.isnan(_bits(got["wheel"][2])[0])
     assert got["radar"] == ["0", "0", "1"] and got["brake"] == ["0", "1"] and got["connector"] == ["-1", "0"]
-    assert got["display"] == ["0", "0"] and got["skin"] == ["0", "1"] and got["speaker"] == ["0", "1"]
+    assert got["display"] == ["64", "64"] and got["skin"] == ["0", "1"] and got["speaker"] == ["0", "1"]
     assert got["gripper"] == ["0", "0"] and got["linear"][0] == "1" and got["arm"][0] == "0"
     assert got["joystick"] == ["0", "-1"] and got["mouse"] == ["1", "0"] and got["battery"] == ["1"]
     assert got["wait"] == ["0", "112"]       # WB_EVENT_NO_EVENT after 100 ms rounded up to whole 16 ms steps

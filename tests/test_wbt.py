@@ -795,7 +795,7 @@ def test_a_device_not_simulated_is_said_in_the_load_report(tmp_path: Path) -> No
         f"{p}:3:1: Radar 'radar' of robot 'r': listed (a controller finds it), not simulated here: its functions "
         "answer Webots' \"no value\"",
         f"{p}:4:1: Display 'screen' of robot 'r': listed (a controller finds it), not simulated here: its functions "
-        "answer Webots' \"no value\"",
+        "answer Webots' \"no value\" (its width and height are the world's)",
         f"{p}:6:1: Speaker 'speaker' of robot 'r': listed (a controller finds it), not simulated here: its functions "
         "answer Webots' \"no value\""]
 

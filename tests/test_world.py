@@ -361,8 +361,13 @@ def test_unsimulated_devices_are_accepted_with_their_model_and_nothing_else() ->
     loaded = parse_world({"robots": [_robot(devices, differential_drive={})]}, source="w.yaml", base_dir=Path.cwd())
     assert [(d.device, d.name, d.model) for d in loaded.world.robots[0].devices] == [
         ("Display", "display", "Logitech"), ("RotationalMotor", "left wheel motor", ""), ("GPS", "gps", "")]
-    probs = _problems({"robots": [_robot([{"device": "Display", "name": "display", "width": 64}])]})
+    probs = _problems({"robots": [_robot([{"device": "Speaker", "name": "speaker", "width": 64}])]})
     assert probs and probs[0][0].startswith("robots[0].devices[0]") and "width" in probs[0][0] + probs[0][1]
+    # a Display keeps its size (wb_display_get_width/height), Webots' 64 x 64 by default, at least 1
+    ok = parse_world({"robots": [_robot([{"device": "Display", "name": "d", "width": 320}])]}, source="w.yaml",
+                     base_dir=Path.cwd())
+    assert (ok.world.robots[0].devices[0].width, ok.world.robots[0].devices[0].height) == (320, 64)
+    assert _problems({"robots": [_robot([{"device": "Display", "name": "d", "width": 0}])]})
 
 
 def test_a_validators_message_that_states_the_value_does_not_state_it_twice() -> None:

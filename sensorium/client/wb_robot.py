@@ -415,15 +415,16 @@ class RobotClient:
                 dev.queue_bytes += len(data)
 
     # ------------------------------------------------------------------ devices
-    def device(self, tag: int, kind: str | None, func: str) -> DeviceState:
+    def device(self, tag: int, kind: str | None, func: str, listed: bool = False) -> DeviceState:
         """The device of ``tag`` if it is a ``kind`` (``None``: any). A listed-only device of that
-        kind prints its one warning and raises :class:`NoValue` (see :func:`answers`)."""
+        kind prints its one warning and raises :class:`NoValue` (see :func:`answers`), unless
+        ``listed`` (the caller answers from its description: a Display's size)."""
         if isinstance(tag, int) and not isinstance(tag, bool) and 1 <= tag <= len(self.devices):
             dev = self.devices[tag - 1]
             if kind is None:
                 return dev
             if dev.kind == kind or (kind == ROTATIONAL_MOTOR and dev.kind == LINEAR_MOTOR):
-                if not dev.simulated:
+                if not dev.simulated and not listed:
                     self.warn_unsimulated(dev, func)
                     raise NoValue(func)
                 return dev

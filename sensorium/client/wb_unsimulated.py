@@ -3,12 +3,19 @@ Display, Radar, Skin, Speaker, VacuumGripper): each checks its tag names a devic
 prints the device's one warning line and answers Webots' "no value" (NaN, ``None`` for NULL, 0,
 False). Camera, RangeFinder and Pen have their own modules.
 
+A Display draws nothing but answers its world size (``wb_display_get_width``/``get_height``, no
+warning), and ``wb_display_image_new``/``image_copy`` give a usable image reference (a number that
+``image_paste``/``image_save``/``image_delete`` take); ``wb_display_image_save`` says once per
+Display that it writes no file.
+
 The functions are made from :data:`NO_VALUE` (C name -> (device type, answer)); a device of the
 type that the server does simulate (none today) would get real functions instead."""
 
 from __future__ import annotations
 
+import itertools
 import math
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -39,8 +46,6 @@ NO_VALUE: dict[str, tuple[str, Any]] = {
     "wb_connector_unlock": ("Connector", None),
     "wb_connector_is_locked": ("Connector", False),
     # Display
-    "wb_display_get_width": ("Display", 0),
-    "wb_display_get_height": ("Display", 0),
     "wb_display_set_color": ("Display", None),
     "wb_display_set_alpha": ("Display", None),
     "wb_display_set_opacity": ("Display", None),
@@ -56,11 +61,8 @@ NO_VALUE: dict[str, tuple[str, Any]] = {
     "wb_display_fill_rectangle": ("Display", None),
     "wb_display_fill_oval": ("Display", None),
     "wb_display_fill_polygon": ("Display", None),
-    "wb_display_image_new": ("Display", None),
     "wb_display_image_load": ("Display", None),
-    "wb_display_image_copy": ("Display", None),
     "wb_display_image_paste": ("Display", None),
-    "wb_display_image_save": ("Display", None),
     "wb_display_image_delete": ("Display", None),
     # Radar
     "wb_radar_enable": ("Radar", None),
@@ -121,3 +123,56 @@ def wb_speaker_play_sound(left: int, right: int, sound: str, volume: float, pitc
     current().device(left, "Speaker", "wb_speaker_play_sound")
     if right and right != left:
         current().device(right, "Speaker", "wb_speaker_play_sound")
+
+
+def _display(tag: int, func: str) -> Any:
+    """The Display of ``tag`` (its description), without the "not simulated" line."""
+    return current().device(tag, "Display", func, listed=True)
+
+
+@answers(0)
+def wb_display_get_width(tag: int) -> int:
+    """The world's width (pixels) of the Display: it draws nothing, but its size is known."""
+    return int(_display(tag, "wb_display_get_width").desc.get("width", 0))
+
+
+@answers(0)
+def wb_display_get_height(tag: int) -> int:
+    """The world's height (pixels) of the Display."""
+    return int(_display(tag, "wb_display_get_height").desc.get("height", 0))
+
+
+_image_refs = itertools.count(1)
+
+
+def _image_ref(tag: int, func: str) -> int | None:
+    dev = _display(tag, func)
+    current().warn_unsimulated(dev, func)
+    return next(_image_refs)
+
+
+@answers(None)
+def wb_display_image_new(tag: int, width: int, height: int, data: Any = None, format: int = WB_IMAGE_RGB) -> int | None:
+    """A usable image reference (nothing is stored: no image is drawn here)."""
+    return _image_ref(tag, "wb_display_image_new")
+
+
+@answers(None)
+def wb_display_image_copy(tag: int, x: int, y: int, width: int, height: int) -> int | None:
+    """A usable image reference (of no pixels: the Display draws nothing here)."""
+    return _image_ref(tag, "wb_display_image_copy")
+
+
+_save_warned: set[tuple[int, int]] = set()
+
+
+@answers(None)
+def wb_display_image_save(tag: int, ref: Any, filename: str) -> None:
+    """No file is written (nothing is drawn); said once per Display, naming the file."""
+    c = current()
+    dev = _display(tag, "wb_display_image_save")
+    c.warn_unsimulated(dev, "wb_display_image_save")
+    if (id(c), dev.tag) not in _save_warned:
+        _save_warned.add((id(c), dev.tag))
+        print(f"Warning: wb_display_image_save(): Display '{dev.name}' draws no image here: "
+              f"{str(filename)!r} is not written.", file=sys.stderr)

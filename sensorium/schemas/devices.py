@@ -255,5 +255,8 @@ register(DeviceKind(
 
 # ---------------------------------------------------------------------- listed, not simulated (yet)
 
+# (a Display keeps its width and height: its model is schemas.world.Display, its attach entry a
+# DisplayDescription; still no implementation, so its functions answer "no value")
 for _t in wm.UNSIMULATED_DEVICE_TYPES:
-    register(DeviceKind(_t, None))
+    register(DeviceKind(_t, getattr(wm, _t) if _t in wm.LISTED_WITH_FIELDS else None,
+                        description=f"{_t}Description" if _t in wm.LISTED_WITH_FIELDS else None))

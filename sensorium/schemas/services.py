@@ -336,6 +336,14 @@ class UnsimulatedDescription(_Entry):
     simulated: bool = False
 
 
+class DisplayDescription(UnsimulatedDescription):
+    """A Display: listed, not simulated (nothing is drawn), its size the world's."""
+
+    type: Literal["Display"]
+    width: int = Field(description="pixels (wb_display_get_width)")
+    height: int = Field(description="pixels (wb_display_get_height)")
+
+
 class LightSensorDescription(_Entry):
     type: Literal["LightSensor"]
     sampling_period: int
@@ -506,7 +514,9 @@ class PenDescription(_Entry):
 
 def _description_tag(v: Any) -> str:
     get = v.get if isinstance(v, dict) else (lambda k, d=None: getattr(v, k, d))
-    return str(get("type", "")) if get("simulated", True) else "unsimulated"
+    if get("simulated", True):
+        return str(get("type", ""))
+    return "unsimulated Display" if get("type", "") == "Display" else "unsimulated"
 
 
 DeviceDescription = Annotated[
@@ -519,10 +529,11 @@ DeviceDescription = Annotated[
     | Annotated[TouchSensorDescription, Tag("TouchSensor")] | Annotated[PenDescription, Tag("Pen")]
     | Annotated[RangeFinderDescription, Tag("RangeFinder")] | Annotated[CameraDescription, Tag("Camera")]
     | Annotated[EmitterDescription, Tag("Emitter")] | Annotated[ReceiverDescription, Tag("Receiver")]
-    | Annotated[UnsimulatedDescription, Tag("unsimulated")],
+    | Annotated[DisplayDescription, Tag("unsimulated Display")] | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
-:class:`UnsimulatedDescription` for a device that is listed only."""
+:class:`UnsimulatedDescription` for a device that is listed only (:class:`DisplayDescription`
+for a Display, which keeps its size)."""
 
 
 class AckermannDescription(Result):

@@ -789,18 +789,34 @@ UNSIMULATED_DEVICE_TYPES = (
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
 
 
+class Display(_Device):
+    """Webots Display: listed, not simulated (no image is drawn), but its size is the world's, as
+    ``wb_display_get_width``/``get_height`` answer it (Webots' Display.wrl defaults; a size below 1
+    is set to 1 by Webots, WbRenderingDevice::updateWidth/updateHeight)."""
+
+    device: Literal["Display"]
+    width: int = Field(default=64, ge=1, le=1 << 16, description="pixels (wb_display_get_width)")
+    height: int = Field(default=64, ge=1, le=1 << 16, description="pixels (wb_display_get_height)")
+
+
+LISTED_WITH_FIELDS = ("Display",)
+"""Unsimulated types whose own fields a world file keeps (a model of their own, above): their
+``attach`` description carries them."""
+_NO_FIELDS = tuple(t for t in UNSIMULATED_DEVICE_TYPES if t not in LISTED_WITH_FIELDS)
+
+
 class UnsimulatedDevice(_Device):
     """A Webots device that Sensorium does not simulate: present in the robot's device list (its
     index, type, name and model are Webots'), its functions answer Webots' "no value" (NaN, NULL, 0)
     with one warning per device. Only ``device``, ``name``, ``model`` and ``pose`` are accepted: the
     device's other Webots fields come with its model (the .wbt converter leaves them out)."""
 
-    device: Literal[UNSIMULATED_DEVICE_TYPES]  # type: ignore[valid-type]
+    device: Literal[_NO_FIELDS]  # type: ignore[valid-type]
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
                    | Accelerometer | Gyro | Altimeter | TouchSensor | Emitter | Receiver | RotationalMotor | Pen
-                   | RangeFinder | Camera | UnsimulatedDevice,
+                   | RangeFinder | Camera | Display | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",

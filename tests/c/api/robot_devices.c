@@ -48,7 +48,7 @@ int main(void) {
   ts_assert_pointer_null(wb_radar_get_targets(radar), "no radar targets array");
   ts_assert_double_equal(wb_radar_get_max_range(radar), NAN, "radar range: no value");
   wb_display_draw_text(display, "hello", 0, 0);
-  ts_assert_int_equal(wb_display_get_width(display), 0, "display width: no value");
+  ts_assert_int_equal(wb_display_get_width(display), 64, "display width: the world's (Webots' default)");
   wb_motor_set_velocity(lift, 1.0);
   ts_assert_int_equal(wb_motor_get_type(lift), WB_LINEAR, "a linear motor's type");
   ts_assert_double_equal(wb_motor_get_velocity(lift), NAN, "linear motor velocity: no value");

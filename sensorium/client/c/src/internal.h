@@ -174,6 +174,9 @@ typedef struct {
   bool cmd_position, cmd_velocity; /* to send with the next step */
   bool warned_physics;             /* a physics-only motor function was called (one warning) */
   int force_feedback_period, torque_feedback_period;
+  /* Display (listed, not simulated): the world's size; whether image_save said it writes no file */
+  int display_width, display_height;
+  bool warned_image_save;
 } sn_device;
 
 /* A car-like robot's drive from the attach reply ("ackermann_drive"): what the vehicle library

@@ -124,6 +124,10 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
   for (int i = 0; i < 4; i++)
     d->quaternion[i] = NAN;
   d->gps_speed = NAN;
+  if (d->node_type == WB_NODE_DISPLAY) { /* listed, not simulated: its size is the world's */
+    d->display_width = (int)sn_int_or(desc, "width", 0);
+    d->display_height = (int)sn_int_or(desc, "height", 0);
+  }
   d->noise = sn_double_or(desc, "noise", 0.0);
   d->channel = (int)sn_int_or(desc, "channel", 0);
   d->range = sn_double_or(desc, "range", -1.0);

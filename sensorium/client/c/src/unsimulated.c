@@ -76,14 +76,42 @@ bool wb_connector_is_locked(WbDeviceTag tag) {
 }
 
 /* ------------------------------------------------------------------ Display */
+/* A Display draws nothing, but its size is the world's and image references are usable (a handle
+ * of no pixels that paste, save and delete take); image_save says once per Display that it writes
+ * no file. */
+struct WbImageStructPrivate {
+  int id;
+};
+
+/* The Display of tag, without the "not simulated" line (Webots' error and NULL if it is none). */
+static sn_device *display(WbDeviceTag tag, const char *func) {
+  sn_device *d = sn_device_get(tag, SN_OTHER, func);
+  if (d != NULL && d->node_type != WB_NODE_DISPLAY) {
+    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
+    return NULL;
+  }
+  return d;
+}
+
+static WbImageRef image_ref(WbDeviceTag tag, const char *func) {
+  static int next_id;
+  if (display(tag, func) == NULL)
+    return NULL;
+  sn_unsimulated(tag, WB_NODE_DISPLAY, func);
+  WbImageRef ir = malloc(sizeof *ir);
+  if (ir != NULL)
+    ir->id = ++next_id;
+  return ir;
+}
+
 int wb_display_get_width(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_get_width");
-  return 0;
+  sn_device *d = display(tag, "wb_display_get_width");
+  return d != NULL ? d->display_width : 0;
 }
 
 int wb_display_get_height(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_get_height");
-  return 0;
+  sn_device *d = display(tag, "wb_display_get_height");
+  return d != NULL ? d->display_height : 0;
 }
 
 void wb_display_set_color(WbDeviceTag tag, int color) {
@@ -147,8 +175,7 @@ void wb_display_fill_polygon(WbDeviceTag tag, const int *x, const int *y, int si
 }
 
 WbImageRef wb_display_image_new(WbDeviceTag tag, int width, int height, const void *data, int format) {
-  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_new");
-  return NULL;
+  return image_ref(tag, "wb_display_image_new");
 }
 
 WbImageRef wb_display_image_load(WbDeviceTag tag, const char *filename) {
@@ -157,8 +184,7 @@ WbImageRef wb_display_image_load(WbDeviceTag tag, const char *filename) {
 }
 
 WbImageRef wb_display_image_copy(WbDeviceTag tag, int x, int y, int width, int height) {
-  sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_copy");
-  return NULL;
+  return image_ref(tag, "wb_display_image_copy");
 }
 
 void wb_display_image_paste(WbDeviceTag tag, WbImageRef ir, int x, int y, bool blend) {
@@ -166,11 +192,22 @@ void wb_display_image_paste(WbDeviceTag tag, WbImageRef ir, int x, int y, bool b
 }
 
 void wb_display_image_save(WbDeviceTag tag, WbImageRef ir, const char *filename) {
+  sn_device *d = display(tag, "wb_display_image_save");
+  if (d == NULL)
+    return;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_save");
+  if (!d->warned_image_save) {
+    d->warned_image_save = true;
+    fprintf(stderr, "Warning: wb_display_image_save(): Display '%s' draws no image here: '%s' is not written.\n",
+            d->name, filename ? filename : "");
+  }
 }
 
 void wb_display_image_delete(WbDeviceTag tag, WbImageRef ir) {
+  if (display(tag, "wb_display_image_delete") == NULL)
+    return;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_delete");
+  free(ir);
 }
 
 /* ------------------------------------------------------------------ Radar */

@@ -316,6 +316,12 @@ def pen(f: Fields) -> dict:
             "max_distance": f.num("maxDistance", 0.0), "write": f.flag("write", True)}
 
 
+def display(f: Fields) -> dict:
+    """A Display's size (Display.wrl: 64 × 64; below 1 set to 1 with a warning, as
+    WbRenderingDevice::updateWidth/updateHeight do)."""
+    return {"width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1)}
+
+
 DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light sensor", "Lidar": "lidar",
                 "RangeFinder": "range-finder", "Camera": "camera",
                 "PositionSensor": "position sensor", "LED": "led", "RotationalMotor": "rotational motor"}

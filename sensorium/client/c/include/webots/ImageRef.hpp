@@ -1,5 +1,5 @@
 // Sensorium C++ controller layer: ImageRef, a Display image handle (Display.hpp), in its own header as
-// in Webots. Sensorium's displays are listed only, so no image is ever made (Display::imageNew: NULL).
+// in Webots. Sensorium's displays draw nothing; imageNew and imageCopy give a handle of no pixels.
 #ifndef WEBOTS_IMAGEREF_HPP
 #define WEBOTS_IMAGEREF_HPP
 

@@ -1,7 +1,8 @@
 /* Sensorium C controller library: Display (Webots' wb_display_* functions).
  * Sensorium lists this device (name, model, type, index) but does not simulate it: every function
  * answers Webots' "no value" (NaN, a NaN vector, NULL, 0, "") and the first call per device prints one
- * warning line. */
+ * warning line, except that wb_display_get_width/height answer the world's size (no warning) and
+ * wb_display_image_new/copy return a usable handle of no pixels (image_save writes no file, says so once). */
 #ifndef WB_DISPLAY_H
 #define WB_DISPLAY_H
 
