@@ -37,13 +37,14 @@ CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene",
-               "supervisor_remove", "supervisor_import", "ignores_minus_one"]
+               "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
 CAR_WORLD = REPO / "tests" / "worlds" / "car.yaml"
 SCENE_WORLD = REPO / "tests" / "worlds" / "supervisor_scene.yaml"
 REMOVE_WORLD = REPO / "tests" / "worlds" / "supervisor_remove.yaml"
+ROOT_WORLD = REPO / "tests" / "worlds" / "root_children.wbt"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -478,7 +479,10 @@ def test_c_supervisor_walks_the_tree_switches_a_light_and_reads_velocities(cbin,
     checkpoints as the Python supervisor of tests/test_supervisor_scene.py, built with sanitizers."""
     code, out, err = finish(start([cbin["supervisor_scene"]], servers(SCENE_WORLD).url("judge")))
     assert code == 0, err
-    assert out[0] == "root 0 Group 1 1 5 MFNode"
+    assert out[0] == "root 0 Group 1 1 7 MFNode"
+    # Webots' WorldInfo and Viewpoint first (a YAML world's defaults, ids after its own nodes: no name field)
+    assert out[1:3] == ["node 6 WorldInfo WorldInfo '' (none) 0", "node 7 Viewpoint Viewpoint '' (none) 0"]
+    out = [out[0], *out[3:]]                     # then the robots, solids and lights, as without them
     assert out[1:6] == ["node 1 Robot Robot 'JUDGE' judge 0", "node 2 Robot Robot '' runner 0",
                         "node 3 Solid Solid 'CRATE' crate 0", "node 4 PointLight PointLight '' (none) 0",
                         "node 5 DirectionalLight DirectionalLight '' (none) 0"]     # lights have no name field
@@ -496,7 +500,7 @@ def test_c_supervisor_walks_the_tree_switches_a_light_and_reads_velocities(cbin,
                                                          abs=1e-12), key
     assert out[13] == "crate 0 0 0 0 0 0" and out[14] == "null nan nan nan nan nan nan"
     assert "wb_supervisor_field_get_sf_bool() called with wrong field type: SFFloat." in err
-    assert "has no field 'mass' in Sensorium" in err and "out-of-bound index: 5" in err
+    assert "has no field 'mass' in Sensorium" in err and "out-of-bound index: 7" in err
     assert "wb_supervisor_node_get_velocity() called with a NULL or invalid 'node' argument." in err
     from test_supervisor_scene import _pose_checks
     got = {line.split()[0]: [float(v) for v in line.split()[1:]] for line in out[15:]}
@@ -509,18 +513,18 @@ def test_c_supervisor_walks_the_tree_switches_a_light_and_reads_velocities(cbin,
 def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     """tests/c/supervisor_remove.c on tests/worlds/supervisor_remove.yaml (its closed forms), built with
     sanitizers: the distance sensor reads the crate at 1 m, then the wall at 3 m; the light sensor 3 + 4
-    (lamp and bulb), then 3; the root's 7 children become 5; the crate's id answers NULL, the gate keeps
+    (lamp and bulb), then 3; the root's 9 children (WorldInfo and Viewpoint first) become 7; the crate's id answers NULL, the gate keeps
     its id; a robot and the root are refused with one line each; a reset brings nothing back; the removed
     crate's type name, DEF and parent read Webots' "no value" with its line."""
     code, out, err = finish(start([cbin["supervisor_remove"]], servers(REMOVE_WORLD).url("boss")))
     assert code == 0, err
     key, *vals = out[0].split()
-    assert key == "before" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 7], abs=1e-9)
+    assert key == "before" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 9], abs=1e-9)
     key, *vals = out[1].split()
-    assert key == "after" and [float(v) for v in vals] == pytest.approx([3.0, 3.0, 5], abs=1e-9)
+    assert key == "after" and [float(v) for v in vals] == pytest.approx([3.0, 3.0, 7], abs=1e-9)
     assert out[2] == "gone 4 1 1 5"
     key, *vals = out[3].split()
-    assert key == "reset" and [float(v) for v in vals] == pytest.approx([3.0, 5], abs=1e-9)
+    assert key == "reset" and [float(v) for v in vals] == pytest.approx([3.0, 7], abs=1e-9)
     assert out[4] == "removed_pose nan nan nan nan nan nan"          # Webots' NaNs, never NULL
     assert out[5] == "custom_data []"                                   # the reset restored the world's (none)
     # the crate kept its type name "Solid" and DEF "CRATE" after remove(); Webots' libController drops a
@@ -537,21 +541,36 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
     assert "wb_supervisor_node_remove() called with a NULL or invalid 'node' argument." in err
 
 
+def test_c_supervisor_walks_the_roots_children_in_file_order(cbin, servers):
+    """tests/c/root_children.c on tests/worlds/root_children.wbt, built with sanitizers: the children's
+    type names and DEFs in file order (WorldInfo, Viewpoint, Background not simulated, then the solid
+    before the robot), WorldInfo first with its gravity and time step, the Viewpoint's position Webots'
+    "no value"; a solid imported at position 3 lands after the Background and leaves when removed."""
+    code, out, err = finish(start([cbin["root_children"]], servers(ROOT_WORLD).url("boss")))
+    assert code == 0, err
+    order = "WorldInfo:INFO Viewpoint:VIEW Background:SKY Solid:BOX Robot:BOSS PointLight:LAMP"
+    assert out[0] == f"children {order}"
+    assert out[1] == "info 1 3.71 16 WGS84"
+    assert out[2] == "view 1"
+    assert out[3] == "imported WorldInfo:INFO Viewpoint:VIEW Background:SKY Solid:BALL Solid:BOX Robot:BOSS PointLight:LAMP"
+    assert out[4] == f"removed {order}"
+
+
 def test_c_supervisor_imports_a_solid_and_a_light(cbin, servers):
     """tests/c/supervisor_import.c on tests/worlds/supervisor_remove.yaml (its closed forms), built with
     sanitizers: the distance sensor reads the crate at 1 m, then the imported box at 0.5 m; the light
-    sensor 7, then 7 + 16; the root's 7 children become 9 (the light first); the box is node 8 (DEF
-    BALL), the light 9; removing both restores 1 m, 7 and 7 children; a robot and a bad string are
+    sensor 7, then 7 + 16; the root's 9 children (WorldInfo and Viewpoint first) become 11 (the light first); the box is node 10
+    (DEF BALL: after the 9 nodes the world loaded with), the light 11; removing both restores 1 m, 7 and 9 children; a robot and a bad string are
     refused with the server's one line each, a NULL field with Webots' line."""
     code, out, err = finish(start([cbin["supervisor_import"]], servers(REMOVE_WORLD).url("boss")))
     assert code == 0, err
     key, *vals = out[0].split()
-    assert key == "before" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 7], abs=1e-9)
+    assert key == "before" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 9], abs=1e-9)
     key, *vals = out[1].split()
-    assert key == "after" and [float(v) for v in vals] == pytest.approx([0.5, 23.0, 9], abs=1e-9)
-    assert out[2] == "ids 8 9 BALL Solid"
+    assert key == "after" and [float(v) for v in vals] == pytest.approx([0.5, 23.0, 11], abs=1e-9)
+    assert out[2] == "ids 10 11 BALL Solid"
     key, *vals = out[3].split()
-    assert key == "removed" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 7, 1], abs=1e-9)
+    assert key == "removed" and [float(v) for v in vals] == pytest.approx([1.0, 7.0, 9, 1], abs=1e-9)
     assert ("Error: wb_supervisor_field_import_mf_node_from_string(): INVALID_ARGUMENT: import_node_from_string: "
             "node string:1:1: Robot: a robot cannot be imported here") in err
     assert ("Error: wb_supervisor_field_import_mf_node_from_string(): INVALID_ARGUMENT: import_node_from_string: "
@@ -567,7 +586,8 @@ def test_supervisor_through_the_cpp_classes(cbin, servers):
     assert float(lines[1]) == pytest.approx(6.28 * 0.016, abs=1e-12)   # position control at maxVelocity, one step
     assert lines[2] == "0 1 nan 0 0 NULL 0"                               # no contact points, no robot window
     assert lines[3] == "1 1 SFVec3f -1 1 1"       # getSelected unserved, getType served; one Field object per field
-    assert lines[4] == "6 PointLight buddy Group PointLight 0 1"    # rover, buddy, 3 solids, the lamp
+    # WorldInfo, Viewpoint (a YAML world's defaults), rover, buddy, 3 solids, the lamp
+    assert lines[4] == "8 PointLight buddy Group PointLight 0 1"
 
 
 def test_webots_cpp_camera_and_range_finder_names(cbin, servers):

@@ -19,7 +19,21 @@ import pytest
 from _protos import HEADER, proto_file
 from test_multiprocess import run_paused
 from test_supervisor import A, Live
-from test_supervisor_remove import BOSS, BULB, CRATE, GATE, LAMP, NULL, ROVER, WALL, WORLD, _live, boss, readings
+from test_supervisor_remove import (
+    BOSS,
+    BULB,
+    CRATE,
+    GATE,
+    LAMP,
+    NULL,
+    ROVER,
+    SCENERY,
+    WALL,
+    WORLD,
+    _live,
+    boss,
+    readings,
+)
 
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.sim.imports import ImportRefused
@@ -32,7 +46,7 @@ BOX = ("DEF BALL Solid { translation 1.6 0 0.25 name \"ball\" recognitionColors 
        "children [ Shape { geometry Box { size 0.2 4 0.5 } } ] boundingObject Box { size 0.2 4 0.5 } }")
 # a light on the sensors' axis, 0.25 m ahead: 1 / 0.25^2 = 16 (attenuation 0 0 1)
 LIGHT = "DEF SPARK PointLight { location 0.25 0 0.1 intensity 1 attenuation 0 0 1 }"
-FIRST = 8                                   # the first imported node's id: after the 7 the world loaded with
+FIRST = 10                                  # the first imported node's id: after the 9 the world loaded with
 
 
 def imports(lv: Live, text: str, position: int = -1) -> list[int]:
@@ -63,7 +77,7 @@ def test_every_ray_kind_sees_an_imported_box_from_the_next_step(precision):
     assert got["ds"] == pytest.approx(1.5, abs=1e-9)
     np.testing.assert_allclose(got["lidar"], 0.5 * before["lidar"], rtol=1e-6)    # the same rays, x = 1.5 not 3
     assert got["depth"] == pytest.approx(1.5, abs=1e-6)
-    assert got["seen"] == [FIRST]                                   # its recognition colour, as node 8
+    assert got["seen"] == [FIRST]                                   # its recognition colour, as node FIRST
     assert (got["eye"], got["shaded"]) == (pytest.approx(7.0), pytest.approx(4.0))   # the lamp now behind it
     boss(lv, "remove_node", {"node": FIRST})
     after = readings(lv)
@@ -89,9 +103,9 @@ def test_an_imported_light_is_counted_and_removed_again():
 
 def test_imported_nodes_have_new_ids_their_def_and_their_place_in_the_children():
     lv = _live()
-    assert children(lv) == [BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB]
+    assert children(lv) == [*SCENERY, BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB]
     assert imports(lv, BOX + "\n" + LIGHT, 0) == [FIRST, FIRST + 1]          # both nodes, in order, first
-    assert children(lv) == [FIRST, FIRST + 1, BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB]
+    assert children(lv) == [FIRST, FIRST + 1, *SCENERY, BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB]
     ball = boss(lv, "get_from_def", {"name": "BALL"})
     assert ball == {"node": FIRST, "type": "Solid", "name": "ball", "def_name": "BALL", "parent": 0}
     assert boss(lv, "get_from_id", {"id": FIRST}) == ball
@@ -102,7 +116,7 @@ def test_imported_nodes_have_new_ids_their_def_and_their_place_in_the_children()
     assert imports(lv, BOX, -2) == [FIRST + 2]                                # before the last
     again = boss(lv, "get_from_def", {"name": "BALL"})
     assert (again["node"], again["name"]) == (FIRST + 2, "ball(1)")
-    assert children(lv) == [FIRST + 1, BOSS, ROVER, WALL, CRATE, GATE, LAMP, FIRST + 2, BULB]
+    assert children(lv) == [FIRST + 1, *SCENERY, BOSS, ROVER, WALL, CRATE, GATE, LAMP, FIRST + 2, BULB]
     assert imports(lv, 'Solid { name "crate" }', 99) == [FIRST + 3]         # past the end: appended
     assert boss(lv, "get_from_id", {"id": FIRST + 3})["name"] == "crate(1)"  # the loaded crate keeps its name
     assert children(lv)[-1] == FIRST + 3
@@ -133,7 +147,7 @@ def test_simulation_reset_removes_imported_nodes():
     got = readings(lv)
     assert got["ds"] == pytest.approx(3.0, abs=1e-9)              # the box gone, the crate still removed
     assert got["eye"] == pytest.approx(7.0)                        # the imported light gone
-    assert children(lv) == [BOSS, ROVER, WALL, GATE, LAMP, BULB]
+    assert children(lv) == [*SCENERY, BOSS, ROVER, WALL, GATE, LAMP, BULB]
     assert boss(lv, "get_from_id", {"id": FIRST}) == NULL and boss(lv, "get_from_def", {"name": "SPARK"}) == NULL
     assert imports(lv, BOX) == [FIRST + 2]                         # ids go on after a reset
 
@@ -248,7 +262,8 @@ def test_a_proto_the_world_declares_is_imported_as_its_solid(tmp_path):
     ds.enable(16)
     sim.step()
     assert ds.value == pytest.approx(3.0, abs=1e-9)
-    assert sim.import_nodes("DEF C Crate { translation 1.6 0 0.25 }") == [("Solid", "crate", 3)]
+    # ids: boss 1, wall 2, the file's WorldInfo 3, the Viewpoint Webots adds 4: the crate is 5
+    assert sim.import_nodes("DEF C Crate { translation 1.6 0 0.25 }") == [("Solid", "crate", 5)]
     sim.step()
     assert ds.value == pytest.approx(1.5, abs=1e-9)
     with pytest.raises(ImportRefused, match=r"^node string:1:1: Drone \(a Robot\): a robot cannot be imported here"):
@@ -306,10 +321,10 @@ def test_a_webots_supervisor_controller_imports_nodes(tmp_path):
     """tests/controllers/supervisor_import.py through ``sensorium serve``: as written for Webots."""
     ctl = run_paused(WORLD, tmp_path, "supervisor_import.py", "boss")
     out = json.loads(ctl.out[-1])
-    assert out["before"] == [pytest.approx(1.0, abs=1e-9), 7]
-    assert out["imported"] == [pytest.approx(1.0, abs=1e-9), 8]          # the value of the last step
-    assert out["after"] == [pytest.approx(0.5, abs=1e-9), pytest.approx(23.0), 9, FIRST, FIRST + 1, "BALL"]
-    assert out["removed"] == [pytest.approx(1.0, abs=1e-9), pytest.approx(7.0), 7, True]
+    assert out["before"] == [pytest.approx(1.0, abs=1e-9), 9]
+    assert out["imported"] == [pytest.approx(1.0, abs=1e-9), 10]          # the value of the last step
+    assert out["after"] == [pytest.approx(0.5, abs=1e-9), pytest.approx(23.0), 11, FIRST, FIRST + 1, "BALL"]
+    assert out["removed"] == [pytest.approx(1.0, abs=1e-9), pytest.approx(7.0), 9, True]
     err = ctl.stderr()
     assert ("Error: wb_supervisor_field_import_mf_node_from_string(): import_node_from_string: node string:1:1: "
             "Robot: a robot cannot be imported here") in err

@@ -22,6 +22,10 @@ from sensorium.server.world.loader import load_world
 
 WORLD = REPO / "tests" / "worlds" / "supervisor_remove.yaml"
 BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB = range(1, 8)      # node ids: robots, solids, lights in world order
+# then the nodes Webots always has, which a YAML world gets by default (world/top_nodes.py), at the root's
+# children's first two places
+WORLD_INFO, VIEWPOINT = 8, 9
+SCENERY = [WORLD_INFO, VIEWPOINT]
 NULL = {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
 
 
@@ -79,10 +83,10 @@ def test_a_removed_light_is_no_longer_counted():
 def test_ids_stay_stable_and_a_removed_node_answers_null():
     lv = _live()
     children = boss(lv, "get_field", {"node": 0, "field": "children"})["value"]
-    assert children == [BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB]
+    assert children == [*SCENERY, BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB]
     boss(lv, "remove_node", {"node": CRATE})
     boss(lv, "remove_node", {"node": LAMP})
-    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == [BOSS, ROVER, WALL, GATE, BULB]
+    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == [*SCENERY, BOSS, ROVER, WALL, GATE, BULB]
     assert boss(lv, "get_from_id", {"id": CRATE}) == NULL
     assert boss(lv, "get_from_id", {"id": LAMP}) == NULL
     assert boss(lv, "get_from_def", {"name": "CRATE"}) == NULL
@@ -107,7 +111,7 @@ def test_robots_and_the_root_cannot_be_removed():
     lv.err(A, "/boss/robot/remove_node", {"node": BOSS}, ErrorCode.INVALID_ARGUMENT)
     assert lv.err(A, "/boss/robot/remove_node", {"node": 0}, ErrorCode.INVALID_ARGUMENT) == \
         "remove_node: the root node cannot be removed"
-    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == list(range(1, 8))
+    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == [*SCENERY, *range(1, 8)]
 
 
 def test_a_robot_blocked_by_a_box_drives_through_once_it_is_removed():
@@ -137,7 +141,7 @@ def test_simulation_reset_does_not_bring_removed_nodes_back():
     assert got["ds"] == pytest.approx(3.0, abs=1e-9)                      # the crate stays removed
     assert got["eye"] == pytest.approx(3.0)                               # lamp's intensity as loaded, no bulb
     assert boss(lv, "get_field", {"node": GATE, "field": "translation"})["value"] == [1.1, -2.0, 0.25]
-    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == [BOSS, ROVER, WALL, GATE, LAMP]
+    assert boss(lv, "get_field", {"node": 0, "field": "children"})["value"] == [*SCENERY, BOSS, ROVER, WALL, GATE, LAMP]
     assert boss(lv, "get_from_id", {"id": CRATE}) == NULL
 
 
@@ -155,13 +159,13 @@ def test_a_webots_supervisor_controller_removes_a_solid_and_a_light(tmp_path):
     """tests/controllers/supervisor_remove.py through ``sensorium serve``: ``node.remove()`` as in Webots."""
     ctl = run_paused(WORLD, tmp_path, "supervisor_remove.py", "boss")
     out = json.loads(ctl.out[-1])
-    assert out["before"] == [pytest.approx(1.0, abs=1e-9), pytest.approx(7.0), 7]
-    assert out["after"] == [pytest.approx(3.0, abs=1e-9), pytest.approx(3.0), 5]
+    assert out["before"] == [pytest.approx(1.0, abs=1e-9), pytest.approx(7.0), 9]
+    assert out["after"] == [pytest.approx(3.0, abs=1e-9), pytest.approx(3.0), 7]
     assert out["gone"] == [True, True, GATE, True]
     nan = [math.nan] * 3                                 # the removed crate, the refused intensity: no traceback
     assert out["refused"] == [pytest.approx(nan, nan_ok=True), pytest.approx(nan[:2], nan_ok=True),
                               pytest.approx(nan[:2], nan_ok=True), None, 3.0, [1.1, -2.0, 0.25], 0]
-    assert out["moved"] == [[3.2, 0.0, 0.25], [3.2, 0.0, 0.25], 5, 5, "SFVec3f"]
+    assert out["moved"] == [[3.2, 0.0, 0.25], [3.2, 0.0, 0.25], 7, 7, "SFVec3f"]
     assert out["stale"] == ["", "", 0, "", None, -1, "Solid"]    # it answered "Solid", "Solid", 24, "CRATE", root, 4
     for func in ("get_type_name", "get_base_type_name", "get_type", "get_def", "get_parent_node", "get_id"):
         assert f"Error: wb_supervisor_node_{func}() called with a NULL or invalid 'node' argument." in ctl.stderr()

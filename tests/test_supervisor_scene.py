@@ -39,13 +39,16 @@ def test_root_children_ids_defs_and_parents():
     lv = _live()
     assert judge(lv, "get_root") == {"node": 0, "type": "Group", "name": "", "def_name": "", "parent": -1}
     children = judge(lv, "get_field", {"node": 0, "field": "children"})
-    assert children == {"type": "MFNode", "value": [1, 2, 3, 4, 5]}       # robots, solids, lights
+    # Webots' WorldInfo and Viewpoint first (a YAML world's defaults: ids after its own nodes), then the
+    # robots, solids and lights
+    assert children == {"type": "MFNode", "value": [6, 7, 1, 2, 3, 4, 5]}
     nodes = [judge(lv, "get_from_id", {"id": i}) for i in children["value"]]
     assert [(n["type"], n["name"], n["def_name"], n["parent"]) for n in nodes] == [
+        ("WorldInfo", "", "", 0), ("Viewpoint", "", "", 0),
         ("Robot", "judge", "JUDGE", 0), ("Robot", "runner", "", 0), ("Solid", "crate", "CRATE", 0),
         ("PointLight", "lamp", "", 0), ("DirectionalLight", "sun", "", 0)]
     assert judge(lv, "get_from_id", {"id": 0})["type"] == "Group"
-    assert judge(lv, "get_from_id", {"id": 6}) == {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
+    assert judge(lv, "get_from_id", {"id": 8}) == {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
     assert judge(lv, "get_from_def", {"name": "CRATE"})["node"] == 3
     assert judge(lv, "get_from_def", {"name": "sun"})["node"] == 5     # a light by its world-file name
     assert judge(lv, "get_self")["def_name"] == "JUDGE"
@@ -160,9 +163,10 @@ def test_a_webots_supervisor_controller_walks_the_tree_switches_a_light_and_read
     ctl = run_paused(WORLD, tmp_path, "supervisor_scene.py", "judge")
     out = {d["tag"]: d for d in (json.loads(line) for line in ctl.out)}
     tree, lights, vel = out["tree"], out["lights"], out["velocity"]
-    assert tree["root"] == [0, "Group", True, True] and tree["count"] == 5 and tree["last"] == "DirectionalLight"
+    assert tree["root"] == [0, "Group", True, True] and tree["count"] == 7 and tree["last"] == "DirectionalLight"
     nodes = [(n["id"], n["type"], n["base"], n["def"], n["name"], n["parent"], n["is_robot"]) for n in tree["nodes"]]
-    assert nodes == [
+    assert nodes == [        # Webots' WorldInfo and Viewpoint first (a YAML world's defaults), no name field
+        (6, "WorldInfo", "WorldInfo", "", None, 0, False), (7, "Viewpoint", "Viewpoint", "", None, 0, False),
         (1, "Robot", "Robot", "JUDGE", "judge", 0, True), (2, "Robot", "Robot", "", "runner", 0, True),
         (3, "Solid", "Solid", "CRATE", "crate", 0, False), (4, "PointLight", "PointLight", "", None, 0, False),
         (5, "DirectionalLight", "DirectionalLight", "", None, 0, False)]       # lights have no name field (Webots)
@@ -182,7 +186,7 @@ def test_a_webots_supervisor_controller_walks_the_tree_switches_a_light_and_read
     assert vel["crate"] == [0.0] * 6 and vel["runner"] == [0.0] * 6
     err = ctl.stderr()
     assert "wb_supervisor_field_get_sf_bool() called with wrong field type: SFFloat." in err
-    assert "no field 'mass'" in err and "out-of-bound index: 5" in err
+    assert "no field 'mass'" in err and "out-of-bound index: 7" in err
 
 
 def test_a_camera_sees_a_light_switched_and_recoloured_at_its_next_image():

@@ -64,7 +64,7 @@ def same(a: list, b: list) -> None:
 
 def test_full_wbt_is_its_yaml_twin_bit_for_bit() -> None:
     wbt, yml = load_world(HERE / "full.wbt"), load_world(HERE / "full.yaml")
-    assert wbt.world == yml.world
+    assert wbt.world.model_copy(update={"top_nodes": []}) == yml.world    # a YAML world has no file order
     a, b = readings_run(Simulation(wbt)), readings_run(Simulation(yml))
     same(a, b)
     # the readings are real: the infra-red, sonar, lidar and both light sensors all saw something

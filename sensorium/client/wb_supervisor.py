@@ -167,8 +167,10 @@ def wb_supervisor_node_get_base_type_name(node: int | None) -> str:
 
 def wb_supervisor_node_get_type(node: int | None) -> int:
     info = _live_node_info(node, "wb_supervisor_node_get_type")
-    name = "WB_NODE_NO_NODE" if info is None else NODE_TYPES[info["type"]]
-    return nodes.WEBOTS_NODE_TYPES[name]
+    if info is None:
+        return nodes.WEBOTS_NODE_TYPES["WB_NODE_NO_NODE"]
+    name = NODE_TYPES.get(info["type"])     # else a top-level node not simulated: WorldInfo, Viewpoint, ...
+    return nodes.WEBOTS_NODE_TYPES[name] if name is not None else nodes.node_type(str(info["type"]))
 
 
 def wb_supervisor_node_get_def(node: int | None) -> str:

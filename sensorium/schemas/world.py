@@ -1006,6 +1006,19 @@ class Fog(Strict):
     _unit = field_validator("color")(_unit_colors)
 
 
+class TopNode(Strict):
+    """One top-level node of a ``.wbt`` world, in file order (the Supervisor's root ``children``):
+    a node Sensorium simulates counts the robots, solids and top-level lights it became (their
+    places in ``robots``, ``solids`` and ``lights`` follow the file); any other node (``WorldInfo``,
+    ``Viewpoint``, ``Background``, ...) keeps its type and DEF name only."""
+
+    type: str = Field(min_length=1, description="Webots node type (a PROTO instance: its base type)")
+    def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
+    robots: int = Field(default=0, ge=0, description="robots this node became")
+    solids: int = Field(default=0, ge=0, description="top-level solids this node became")
+    lights: int = Field(default=0, ge=0, description="top-level lights this node became")
+
+
 class World(Strict):
     """A whole world file.
 
@@ -1019,6 +1032,9 @@ class World(Strict):
     robots: list[Robot] = []
     background: Background = Background()
     fog: Fog | None = Field(default=None, description="Webots' Fog node (the first one of a .wbt world)")
+    top_nodes: list[TopNode] = Field(
+        default=[], description="a .wbt world's top-level nodes in file order (Supervisor root children); empty: "
+        "WorldInfo, Viewpoint, the robots, solids and lights (README 'Supervisor')")
 
 
 def json_schema() -> dict:

@@ -42,7 +42,7 @@ int main() {
   // the scene tree, identity and velocities through the C++ classes
   Field *children = supervisor->getRoot()->getField("children");
   std::printf("%d %s %s %s %s %g %d\n", children->getCount(), children->getMFNode(-1)->getTypeName().c_str(),
-              children->getMFNode(1)->getField("name")->getSFString().c_str(),
+              children->getMFNode(3)->getField("name")->getSFString().c_str(),
               buddy->getParentNode()->getTypeName().c_str(), supervisor->getFromId(6)->getBaseTypeName().c_str(),
               buddy->getVelocity()[0], supervisor->getFromId(6)->getField("on")->getSFBool());
   delete supervisor;

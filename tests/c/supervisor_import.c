@@ -37,11 +37,12 @@ int main(void) {
   printf("ids %d %d %s %s\n", wb_supervisor_node_get_id(ball),
          wb_supervisor_node_get_id(wb_supervisor_field_get_mf_node(children, 0)), wb_supervisor_node_get_def(ball),
          wb_supervisor_node_get_type_name(ball));
+  const int ball_id = wb_supervisor_node_get_id(ball);
   wb_supervisor_node_remove(ball);
   wb_supervisor_node_remove(wb_supervisor_node_get_from_def("SPARK"));
   wb_robot_step(dt);
   printf("removed %.17g %.17g %d %d\n", wb_distance_sensor_get_value(ds), wb_light_sensor_get_value(eye),
-         wb_supervisor_field_get_count(children), wb_supervisor_node_get_from_id(8) == NULL);
+         wb_supervisor_field_get_count(children), wb_supervisor_node_get_from_id(ball_id) == NULL);
   wb_robot_cleanup();
   return 0;
 }

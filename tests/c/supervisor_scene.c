@@ -45,7 +45,7 @@ int main(void) {
          (int)wb_supervisor_field_get_sf_bool(wb_supervisor_node_get_field(me, "supervisor")));
   printf("missing %d %d %d %d\n", wb_supervisor_node_get_from_def("NOPE") == NULL,
          wb_supervisor_node_get_from_id(99) == NULL, wb_supervisor_node_get_field(me, "mass") == NULL,
-         wb_supervisor_field_get_mf_node(children, 5) == NULL);
+         wb_supervisor_field_get_mf_node(children, 7) == NULL);
 
   WbNodeRef lamp = wb_supervisor_node_get_from_def("lamp");
   WbFieldRef on = wb_supervisor_node_get_field(lamp, "on");

@@ -34,7 +34,7 @@ emit("tree", root=[root.getId(), root.getTypeName(), root.getType() == Node.GROU
      custom=me.getField("customData").getSFString(), model=me.getField("model").getSFString(),
      crate_model=robot.getFromDef("CRATE").getField("model").getSFString(),
      missing=[robot.getFromDef("NOPE") is None, robot.getFromId(99) is None, me.getField("mass") is None,
-              children.getMFNode(5) is None],
+              children.getMFNode(7) is None],
      supervisor_field=me.getField("supervisor").getSFBool())
 
 # lights: read, switch, change; the LightSensor follows at the next step

@@ -26,6 +26,7 @@ from pydantic import ValidationError
 from sensorium.schemas import world as wm
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.world.poses import matrix_quaternion
+from sensorium.server.world.top_nodes import Scenery
 
 MODES = ("pause", "realtime", "fast")     # Webots WB_SUPERVISOR_SIMULATION_MODE_PAUSE = 0, REAL_TIME, FAST
 LIGHTS = ("PointLight", "SpotLight", "DirectionalLight")
@@ -37,16 +38,24 @@ class Node:
     type: str          # "Group" (the root) | "Robot" | "Solid" | "PointLight" | "SpotLight" | "DirectionalLight"
     name: str          # a robot's or solid's name; a light's world-file name ("" without one)
     def_name: str      # "" without one
-    key: str | int     # the robot's or solid's name, a light's index among the top-level lights; root: ""
+    key: str | int     # the robot's or solid's name, a light's index among the top-level lights, a scenery
+                       # node's index (world/top_nodes.py); root: ""
+    scenery: bool = False   # a top-level node Sensorium does not simulate (WorldInfo, Viewpoint, Background, ...)
 
 
 ROOT = Node(0, "Group", "", "", "")
 
 
+def _scenery(sim: Any) -> tuple[Scenery, ...]:
+    layout = getattr(sim, "top_level", None)
+    return layout.scenery if layout is not None else ()
+
+
 def _all_nodes(sim: Any) -> list[Node]:
     """Every node the world has had but the root, in id order (the robots, solids and lights it
-    loaded with, then the nodes a Supervisor imported, in import order), removed ones included: a
-    node's id is its place here, so it never changes and is never reused."""
+    loaded with, then its other top-level nodes — WorldInfo, Viewpoint, ... in file order, then
+    the ones Webots adds —, then the nodes a Supervisor imported, in import order), removed ones
+    included: a node's id is its place here, so it never changes and is never reused."""
     world = getattr(sim, "world", None)
 
     def def_of(models: list, k: int) -> str:
@@ -64,6 +73,8 @@ def _all_nodes(sim: Any) -> list[Node]:
     out += [Node(first + j, "Solid", names[j], def_of(solids_m, j), names[j]) for j in range(loaded_solids)]
     first = len(out) + 1
     out += [Node(first + k, top[k].type, top[k].name or "", def_of(top, k), k) for k in range(loaded_lights)]
+    first = len(out) + 1
+    out += [Node(first + x, s.type, "", s.def_name, x, scenery=True) for x, s in enumerate(_scenery(sim))]
     for kind, key in imported:
         if kind == "Solid":
             j = names.index(key)
@@ -75,6 +86,8 @@ def _all_nodes(sim: Any) -> list[Node]:
 
 
 def _removed(sim: Any, node: Node) -> bool:
+    if node.scenery:
+        return False
     if node.type == "Solid":
         return node.key not in sim.scene.solid_poses
     return node.type in LIGHTS and node.key in sim.scene.removed_lights
@@ -85,13 +98,24 @@ def _nodes(sim: Any) -> list[Node]:
     return [n for n in _all_nodes(sim) if not _removed(sim, n)]
 
 
+def _loaded_order(sim: Any, nodes: list[Node]) -> list[int]:
+    """The ids of the root's children as the world loaded: its top-level nodes in file order
+    (world/top_nodes.py); id order without a layout."""
+    layout = getattr(sim, "top_level", None)
+    if layout is None:
+        return [n.id for n in nodes]
+    imported = getattr(sim, "imported", [])
+    first = {"robots": 1, "solids": 1 + len(sim.robots)}
+    first["lights"] = first["solids"] + len(sim.scene.solid_names) - sum(k == "Solid" for k, _ in imported)
+    first["scenery"] = first["lights"] + len(sim.scene.top_lights()) - sum(k != "Solid" for k, _ in imported)
+    return [first[kind] + index for kind, index in layout.order]
+
+
 def root_children(sim: Any) -> list[Node]:
-    """The root's ``children`` in their order: id order, imported nodes where they were inserted."""
-    nodes = _nodes(sim)
-    order = getattr(sim, "root_order", None)
-    if not order:
-        return nodes
-    by_id = {n.id: n for n in nodes}
+    """The root's ``children`` in their order: the world file's top-level nodes in file order
+    (Webots' WorldInfo and Viewpoint added where missing), imported nodes where they were inserted."""
+    by_id = {n.id: n for n in _nodes(sim)}
+    order = getattr(sim, "root_order", None) or _loaded_order(sim, list(by_id.values()))
     return [by_id[i] for i in order if i in by_id]
 
 
@@ -254,22 +278,46 @@ FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
               "model": ("SFString", lambda sim, n: _solid_model(sim, n).model, None)},
     **{kind: _light_fields(kind) for kind in LIGHTS},
 }
+
+def _info(attr: str, convert: Callable[[Any], Any] = lambda v: v) -> Getter:
+    return lambda sim, n: convert(getattr(sim.world.world_info, attr))
+
+
+SCENERY_FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
+    # what the world model keeps of WorldInfo (read-only here); a .wbt world without a title: its file name
+    "WorldInfo": {"title": ("SFString", _info("name", str), None),
+                  "basicTimeStep": ("SFFloat", _info("basic_time_step", float), None),
+                  "randomSeed": ("SFInt32", _info("random_seed", int), None),
+                  "coordinateSystem": ("SFString", _info("coordinate_system", str), None),
+                  "gravity": ("SFFloat", _info("gravity", float), None),
+                  "gpsCoordinateSystem": ("SFString", _info("gps_coordinate_system", str), None),
+                  "gpsReference": ("SFVec3f", _info("gps_reference", lambda v: [float(c) for c in v]), None),
+                  "inkEvaporation": ("SFFloat", _info("ink_evaporation", float), None)},
+}
+"""Fields of the top-level nodes Sensorium does not simulate; any other field of theirs answers
+Webots' "no value" (Viewpoint, Background, ... have none here)."""
+
+
+def _fields(node: Node) -> dict[str, tuple[str, Getter, Setter]]:
+    return SCENERY_FIELDS.get(node.type, {}) if node.scenery else FIELDS[node.type]
+
+
 _VECTOR_SIZES = {"SFVec3f": 3, "SFColor": 3, "SFRotation": 4}
 
 
 def get_field(sim: Any, node: Node, field: str) -> dict:
     """``{"type", "value"}``; type '' (and value []) when the node has no such field here."""
-    entry = FIELDS[node.type].get(field)
+    entry = _fields(node).get(field)
     if entry is None:
         return {"type": "", "value": []}
     return {"type": entry[0], "value": entry[1](sim, node)}
 
 
 def set_field(sim: Any, node: Node, field: str, value: Any) -> None:
-    entry = FIELDS[node.type].get(field)
+    entry = _fields(node).get(field)
     what = f"{node.type} {node.name or node.id!r}"
     if entry is None:
-        raise ValueError(f"{what} has no field {field!r} here (fields: {', '.join(FIELDS[node.type])})")
+        raise ValueError(f"{what} has no field {field!r} here (fields: {', '.join(_fields(node)) or 'none'})")
     kind, _, setter = entry
     if setter is None:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here")
@@ -317,6 +365,9 @@ def remove_node(sim: Any, node: Node) -> None:
     """Webots' ``node.remove()`` for what is a node here: a top-level solid or light. The root and
     robots are refused (a robot's controller, devices and lockstep slot cannot leave a running
     server here; Webots removes a robot, the calling one at the end of the step)."""
+    if node.scenery:
+        raise ValueError(f"{node.type} (node {node.id}) cannot be removed here: only top-level solids and lights "
+                         "can (Sensorium does not simulate it)")
     if node.type == "Solid":
         sim.remove_solid(node.key)
     elif node.type in LIGHTS:
@@ -335,8 +386,7 @@ def _remove(sim: Any, ls: Any, robot: str, a: Any) -> dict:
 
 def insert_index(position: int, count: int) -> int:
     """Webots' import position in a list of ``count`` nodes: 0 the first place, -1 after the last,
-    -2 before the last, ...; a position past either end is the nearest end (the root's children
-    here leave out the nodes Sensorium does not simulate: WorldInfo, Viewpoint, Background, ...)."""
+    -2 before the last, ...; a position past either end is the nearest end."""
     index = position if position >= 0 else count + 1 + position
     return min(max(index, 0), count)
 

@@ -46,6 +46,7 @@ from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, from_model, load_world
 from sensorium.server.world.poses import moved_pose
 from sensorium.server.world.report import warn_losses
+from sensorium.server.world.top_nodes import top_level
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:
@@ -189,8 +190,9 @@ class Simulation:
         self.limits = limits or WorldLimits()
         self.allow_outside_meshes = allow_outside_meshes
         self.imported: list[tuple[str, str | int]] = []     # (node type, key) of each node a Supervisor imported
+        self.top_level = top_level(self.world)     # the root's children as loaded (world/top_nodes.py)
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
-                                                            # a node was imported (None: id order)
+                                                            # a node was imported (None: the loaded order)
         self._import_protos: Any = None                     # the world's EXTERNPROTO declarations, read once
         self.basic_time_step = self.world.world_info.basic_time_step
         self.seed = self.world.world_info.random_seed
@@ -373,8 +375,10 @@ class Simulation:
 
     def next_node_id(self) -> int:
         """The Supervisor id the next imported node gets: after every node the world has had (robots,
-        solids and top-level lights, removed ones included), so no id is ever reused."""
-        return 1 + len(self.robots) + len(self.scene.solid_names) + len(self.scene.top_lights())
+        solids and top-level lights, removed ones included, and the top-level nodes not simulated:
+        WorldInfo, Viewpoint, ...), so no id is ever reused."""
+        return (1 + len(self.robots) + len(self.scene.solid_names) + len(self.scene.top_lights())
+                + len(self.top_level.scenery))
 
     def import_nodes(self, text: str, warnings: list[str] | None = None) -> list[tuple[str, str | int, int]]:
         """Webots' ``importMFNodeFromString`` into the root's children: the string's nodes (solids,

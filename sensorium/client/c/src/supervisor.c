@@ -16,7 +16,7 @@
 struct WbNodeStructPrivate {
   int64_t id;
   WbNodeType type;
-  char type_name[24]; /* "Group", "Robot", "Solid", "PointLight", "SpotLight", "DirectionalLight" */
+  char type_name[64]; /* "Group", "Robot", "Solid", a light's, or a top-level node's not simulated ("WorldInfo") */
   char *def_name;     /* "" without one */
   int64_t parent;     /* 0 for a top-level node, -1 for the root */
   double position[3];
@@ -108,34 +108,42 @@ static const struct {
                   {"Solid", WB_NODE_SOLID},
                   {"PointLight", WB_NODE_POINT_LIGHT},
                   {"SpotLight", WB_NODE_SPOT_LIGHT},
-                  {"DirectionalLight", WB_NODE_DIRECTIONAL_LIGHT}};
+                  {"DirectionalLight", WB_NODE_DIRECTIONAL_LIGHT},
+                  /* top-level nodes Sensorium lists but does not simulate; any other type name: NO_NODE */
+                  {"WorldInfo", WB_NODE_WORLD_INFO},
+                  {"Viewpoint", WB_NODE_VIEWPOINT},
+                  {"Background", WB_NODE_BACKGROUND},
+                  {"Fog", WB_NODE_FOG},
+                  {"Transform", WB_NODE_TRANSFORM},
+                  {"Pose", WB_NODE_POSE},
+                  {"Shape", WB_NODE_SHAPE}};
 
 static bool str_is(const msgpack_object *o, const char *s) {
   return o != NULL && o->type == MSGPACK_OBJECT_STR && o->via.str.size == strlen(s) &&
          memcmp(o->via.str.ptr, s, o->via.str.size) == 0;
 }
 
-/* A node reply (PROTOCOL.md): the node's record, its identity refreshed; NULL for type "". */
+/* A node reply (PROTOCOL.md): the node's record, its identity refreshed; NULL for type "". A type
+   name outside NODE_TYPES (a top-level node not simulated) keeps its name, its type is NO_NODE. */
 static WbNodeRef node_from_reply(sn_robot *rb, sn_reply *rep) {
   const msgpack_object *type = sn_get(rep->result, "type");
   WbNodeRef n = NULL;
-  for (size_t i = 0; i < sizeof NODE_TYPES / sizeof NODE_TYPES[0]; i++)
-    if (str_is(type, NODE_TYPES[i].name)) {
-      n = node_ref(rb, sn_int_or(rep->result, "node", -1));
-      if (n == NULL)
-        break;
-      n->type = NODE_TYPES[i].type;
-      snprintf(n->type_name, sizeof n->type_name, "%s", NODE_TYPES[i].name);
-      char *def = sn_strdup_obj(sn_get(rep->result, "def_name"));
-      if (def != NULL && n->def_name != NULL && strcmp(def, n->def_name) == 0)
-        free(def); /* unchanged: the string a caller holds stays valid (the readers ask again each time) */
-      else {
-        free(n->def_name);
-        n->def_name = def;
-      }
-      n->parent = sn_int_or(rep->result, "parent", -1);
-      break;
+  if (type != NULL && type->type == MSGPACK_OBJECT_STR && type->via.str.size > 0 &&
+      (n = node_ref(rb, sn_int_or(rep->result, "node", -1))) != NULL) {
+    n->type = WB_NODE_NO_NODE;
+    snprintf(n->type_name, sizeof n->type_name, "%.*s", (int)type->via.str.size, type->via.str.ptr);
+    for (size_t i = 0; i < sizeof NODE_TYPES / sizeof NODE_TYPES[0]; i++)
+      if (str_is(type, NODE_TYPES[i].name))
+        n->type = NODE_TYPES[i].type;
+    char *def = sn_strdup_obj(sn_get(rep->result, "def_name"));
+    if (def != NULL && n->def_name != NULL && strcmp(def, n->def_name) == 0)
+      free(def); /* unchanged: the string a caller holds stays valid (the readers ask again each time) */
+    else {
+      free(n->def_name);
+      n->def_name = def;
     }
+    n->parent = sn_int_or(rep->result, "parent", -1);
+  }
   sn_reply_free(rep);
   return n;
 }

@@ -176,8 +176,14 @@ class Converter:
     def run(self) -> dict:
         world = Owner("world", {})
         self.world["world_info"] = {"name": Path(self.source).stem}
+        top_nodes = []     # the root's children in file order (schemas.world.TopNode)
         for node in self.wbt.nodes:
+            before = [len(self.world[k]) for k in ("robots", "solids", "lights")]
             self.visit(node, Frame.identity(), world, top=True)
+            became = {k: len(self.world[k]) - n for k, n in zip(("robots", "solids", "lights"), before)}
+            top_nodes.append({"type": node.type, **({"def_name": node.def_name} if node.def_name else {}),
+                              **{k: n for k, n in became.items() if n}})
+        self.world["top_nodes"] = top_nodes
         if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
             self.world["solids"].append(self.solid_dict(world, {"name": self.unique_name("shapes")}))
         if self.textured:   # textures not loaded: one line (world/textures.py says why each is refused)

@@ -1,0 +1,54 @@
+"""The root's ``children`` of a world: its top-level nodes in file order, as Webots loads them.
+
+Webots adds a world file's top-level nodes to the root in file order and then makes sure a
+``WorldInfo`` (at index 0) and a ``Viewpoint`` (at index 1) exist, adding a default one where the
+file has none. A ``.wbt`` world records its top-level nodes (``World.top_nodes``); a YAML or JSON
+world has none recorded: its root holds a default ``WorldInfo`` and ``Viewpoint``, then its robots,
+solids and lights in the lists' order. Nodes Sensorium does not simulate ("scenery": ``WorldInfo``,
+``Viewpoint``, ``Background``, ...) keep their type and DEF name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from sensorium.schemas import world as wm
+
+KINDS = ("robots", "solids", "lights")
+
+
+@dataclass(frozen=True, slots=True)
+class Scenery:
+    type: str
+    def_name: str      # "" without one
+
+
+@dataclass(frozen=True, slots=True)
+class TopLevel:
+    order: tuple[tuple[str, int], ...]   # ("robots" | "solids" | "lights" | "scenery", index) in root order
+    scenery: tuple[Scenery, ...]         # by index: file order, then the defaults Webots adds
+
+
+def top_level(world: wm.World) -> TopLevel:
+    sizes = {k: len(getattr(world, k)) for k in KINDS}
+    used = dict.fromkeys(KINDS, 0)
+    order: list[tuple[str, int]] = []
+    scenery: list[Scenery] = []
+    for node in world.top_nodes:
+        counts = {"robots": node.robots, "solids": node.solids, "lights": node.lights}
+        if not any(counts.values()):
+            order.append(("scenery", len(scenery)))
+            scenery.append(Scenery(node.type, node.def_name or ""))
+            continue
+        for kind in KINDS:
+            for _ in range(counts[kind]):
+                if used[kind] < sizes[kind]:
+                    order.append((kind, used[kind]))
+                    used[kind] += 1
+    for kind in KINDS:        # what no top-level node accounts for (a YAML world; shapes outside any solid)
+        order += [(kind, i) for i in range(used[kind], sizes[kind])]
+    for place, kind in ((0, "WorldInfo"), (1, "Viewpoint")):      # Webots adds the missing mandatory nodes
+        if not any(s.type == kind for s in scenery):
+            order.insert(min(place, len(order)), ("scenery", len(scenery)))
+            scenery.append(Scenery(kind, ""))
+    return TopLevel(tuple(order), tuple(scenery))

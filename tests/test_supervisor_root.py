@@ -1,0 +1,133 @@
+"""The root's ``children`` are the world file's top-level nodes in file order, as Webots' WbWorld
+adds them (tests/worlds/root_children.wbt): WorldInfo, Viewpoint and Background (not simulated:
+their type and DEF, WorldInfo's fields the model has, Webots' "no value" for the rest), then a
+solid before the robot, then a light. Ids are stable: the loaded robots, solids and lights first
+(as before), then the other top-level nodes in file order, then imports. A world without a
+WorldInfo or Viewpoint (a YAML world, or a .wbt one without them) gets Webots' defaults at places 0
+and 1 (WbWorld::checkPresenceOfMandatoryNodes)."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+import pytest
+from _protos import HEADER
+from test_multiprocess import REPO, run_paused
+from test_supervisor import A, Live
+
+from sensorium.schemas.wire import ErrorCode
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+WORLD = REPO / "tests" / "worlds" / "root_children.wbt"
+BOSS, BOX, LAMP, INFO, VIEW, SKY = range(1, 7)      # ids: robots, solids, lights, then the others in file order
+FILE_ORDER = [INFO, VIEW, SKY, BOX, BOSS, LAMP]
+TYPES_DEFS = [["WorldInfo", "INFO"], ["Viewpoint", "VIEW"], ["Background", "SKY"], ["Solid", "BOX"],
+              ["Robot", "BOSS"], ["PointLight", "LAMP"]]
+
+
+def _live() -> Live:
+    lv = Live(Simulation(load_world(WORLD)))
+    lv.ok(A, "attach", {"robot": "boss"})
+    return lv
+
+
+def boss(lv: Live, item: str, args: dict | None = None):
+    return lv.ok(A, f"/boss/robot/{item}", args)
+
+
+def children(lv: Live) -> list[int]:
+    return boss(lv, "get_field", {"node": 0, "field": "children"})["value"]
+
+
+def field(lv: Live, node: int, name: str) -> dict:
+    return boss(lv, "get_field", {"node": node, "field": name})
+
+
+def test_the_roots_children_are_the_files_top_level_nodes_in_file_order():
+    lv = _live()
+    assert children(lv) == FILE_ORDER
+    refs = [boss(lv, "get_from_id", {"id": i}) for i in FILE_ORDER]
+    assert [[r["type"], r["def_name"]] for r in refs] == TYPES_DEFS
+    assert all(r["parent"] == 0 for r in refs)
+    assert boss(lv, "get_from_def", {"name": "SKY"})["node"] == SKY
+    assert boss(lv, "get_from_id", {"id": SKY + 1})["type"] == ""              # no node past them
+
+
+def test_world_info_fields_answer_the_worlds_values():
+    lv = _live()
+    assert field(lv, INFO, "gravity") == {"type": "SFFloat", "value": 3.71}
+    assert field(lv, INFO, "basicTimeStep") == {"type": "SFFloat", "value": 16.0}
+    assert field(lv, INFO, "title") == {"type": "SFString", "value": "root order"}
+    assert field(lv, INFO, "coordinateSystem") == {"type": "SFString", "value": "ENU"}
+    assert field(lv, INFO, "gpsCoordinateSystem") == {"type": "SFString", "value": "WGS84"}
+    assert field(lv, INFO, "gpsReference") == {"type": "SFVec3f", "value": [46.5, 6.6, 372.0]}
+    assert field(lv, INFO, "randomSeed") == {"type": "SFInt32", "value": 0}
+    # what the model does not keep: Webots' "no value", never a crash
+    assert field(lv, INFO, "info") == {"type": "", "value": []}
+    assert field(lv, VIEW, "position") == {"type": "", "value": []}
+    assert field(lv, SKY, "skyColor") == {"type": "", "value": []}
+    pose = boss(lv, "get_node_pose", {"node": VIEW})
+    assert all(math.isnan(v) for v in pose["position"])
+    assert boss(lv, "get_node_velocity", {"node": SKY})["value"] == [0.0] * 6
+    msg = lv.err(A, "/boss/robot/set_field", {"node": INFO, "field": "gravity", "value": 1.0},
+                 ErrorCode.INVALID_ARGUMENT)
+    assert msg == "set_field: field 'gravity' (SFFloat) of WorldInfo 4 is read-only here"
+    msg = lv.err(A, "/boss/robot/set_field", {"node": VIEW, "field": "position", "value": [0, 0, 1]},
+                 ErrorCode.INVALID_ARGUMENT)
+    assert msg == "set_field: Viewpoint 5 has no field 'position' here (fields: none)"
+
+
+def test_nodes_not_simulated_cannot_be_removed_and_ids_stay_stable():
+    lv = _live()
+    for node in (INFO, VIEW, SKY):
+        msg = lv.err(A, "/boss/robot/remove_node", {"node": node}, ErrorCode.INVALID_ARGUMENT)
+        assert msg.startswith("remove_node: ") and "cannot be removed here" in msg
+    boss(lv, "remove_node", {"node": BOX})
+    assert children(lv) == [INFO, VIEW, SKY, BOSS, LAMP]
+    assert boss(lv, "get_from_id", {"id": SKY})["def_name"] == "SKY"
+
+
+def test_imports_take_their_webots_position_among_all_the_top_level_nodes():
+    lv = _live()
+    ball = boss(lv, "import_node_from_string", {"node": 0, "field": "children", "position": 3,
+                                                "node_string": 'DEF BALL Solid { name "ball" }'})["value"]
+    assert ball == [SKY + 1]                                     # after every node the world loaded with
+    assert children(lv) == [INFO, VIEW, SKY, SKY + 1, BOX, BOSS, LAMP]
+    spark = boss(lv, "import_node_from_string", {"node": 0, "field": "children", "position": -2,
+                                                 "node_string": "PointLight { }"})["value"]
+    assert children(lv) == [INFO, VIEW, SKY, SKY + 1, BOX, BOSS, *spark, LAMP]
+    boss(lv, "remove_node", {"node": SKY + 1})
+    assert children(lv) == [INFO, VIEW, SKY, BOX, BOSS, *spark, LAMP]
+    boss(lv, "simulation_reset")                                 # imported nodes go, the file's stay
+    assert children(lv) == FILE_ORDER
+
+
+def test_webots_adds_the_missing_world_info_and_viewpoint_at_places_0_and_1(tmp_path):
+    world = tmp_path / "bare.wbt"
+    world.write_text(HEADER + 'DEF SKY Background { }\nSolid { name "a" }\n'
+                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    lv = Live(Simulation(load_world(world)))
+    lv.ok(A, "attach", {"robot": "boss"})
+    refs = [boss(lv, "get_from_id", {"id": i}) for i in children(lv)]
+    assert [[r["node"], r["type"], r["def_name"]] for r in refs] == [
+        [4, "WorldInfo", ""], [5, "Viewpoint", ""], [3, "Background", "SKY"], [2, "Solid", ""], [1, "Robot", ""]]
+    assert field(lv, 4, "gravity") == {"type": "SFFloat", "value": 9.81}           # Webots' defaults
+    assert field(lv, 4, "basicTimeStep") == {"type": "SFFloat", "value": 32.0}
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_webots_supervisor_walks_the_roots_children(tmp_path):
+    """tests/controllers/root_children.py through ``sensorium serve``: getMFNode(0) is WorldInfo, its
+    gravity read, as Webots' samples do."""
+    ctl = run_paused(WORLD, tmp_path, "root_children.py", "boss")
+    out = json.loads(ctl.out[-1])
+    assert out["before"] == TYPES_DEFS
+    assert out["world_info"] == [True, pytest.approx(3.71), 16.0, "root order", "WGS84",
+                                 pytest.approx([46.5, 6.6, 372.0]), "ENU"]
+    assert out["no_value"] == [True, True]
+    assert out["imported"] == [*TYPES_DEFS[:3], ["Solid", "BALL"], *TYPES_DEFS[3:5], ["PointLight", "SPARK"],
+                               TYPES_DEFS[5]]
+    assert out["removed"] == TYPES_DEFS
