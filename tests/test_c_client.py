@@ -56,6 +56,23 @@ def _make(*args: str) -> str:
     return done.stdout
 
 
+def sanitized_controller(tmp_path_factory, src: Path) -> str:
+    """One test controller (C) linked to the library built with -fsanitize=address,undefined, for a
+    test file's own fixture; skipped without a C toolchain."""
+    if sys.platform == "win32" or shutil.which("cc") is None:
+        pytest.skip("needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
+    build = tmp_path_factory.mktemp("cbuild")
+    _make(f"BUILD={build}", "SANITIZE=1")
+    libs = _make("libs").split()
+    exe = build / src.stem
+    done = subprocess.run(["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+                           "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", f"-I{TESTS_C}", str(src),
+                           "-o", str(exe), str(build / "libController.a"), *libs, "-lm"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return str(exe)
+
+
 @pytest.fixture(scope="module")
 def cbin(tmp_path_factory) -> dict[str, str]:
     """The library built with -fsanitize=address,undefined and the test controllers linked to it."""

@@ -10,7 +10,7 @@ import sys
 
 import pytest
 from _serve import serve
-from test_c_client import CLIB, ENV, REPO, SAN_ENV, TESTS_C, _make, finish
+from test_c_client import ENV, REPO, SAN_ENV, TESTS_C, finish, sanitized_controller
 
 WORLD = REPO / "tests" / "worlds" / "images.yaml"
 
@@ -21,16 +21,7 @@ pytestmark = [pytest.mark.slow,
 
 @pytest.fixture(scope="module")
 def reader(tmp_path_factory) -> str:
-    build = tmp_path_factory.mktemp("cimages")
-    _make(f"BUILD={build}", "SANITIZE=1")
-    libs = _make("libs").split()
-    exe = build / "image_reader"
-    cmd = ["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
-           "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", f"-I{TESTS_C}", str(TESTS_C / "image_reader.c"),
-           "-o", str(exe), str(build / "libController.a"), *libs, "-lm"]
-    done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    return str(exe)
+    return sanitized_controller(tmp_path_factory, TESTS_C / "image_reader.c")
 
 
 def _run(cmd: list[str], url: str) -> tuple[list[str], str]:

@@ -7,13 +7,11 @@ references are usable, and image_save says once that it writes no file."""
 
 from __future__ import annotations
 
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 from _serve import Proc, sensorium, serve
+from test_c_client import sanitized_controller
 
 from sensorium.schemas import world as wm
 from sensorium.server.world.loader import load_world
@@ -39,20 +37,7 @@ def run_controller(world: Path, argv, env: dict[str, str] | None = None) -> tupl
 
 @pytest.fixture(scope="module")
 def c_controller(tmp_path_factory) -> str:
-    if sys.platform == "win32" or shutil.which("cc") is None:
-        pytest.skip("needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
-    build = tmp_path_factory.mktemp("cbuild")
-    done = subprocess.run(["make", "-s", "-C", str(CLIB), f"BUILD={build}", "SANITIZE=1"], capture_output=True,
-                          text=True, timeout=600)
-    assert done.returncode == 0, done.stdout + done.stderr
-    libs = subprocess.run(["make", "-s", "-C", str(CLIB), "libs"], capture_output=True, text=True).stdout.split()
-    exe = build / "display_size"
-    done = subprocess.run(["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
-                           "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", str(REPO / "tests" / "c" / "display_size.c"),
-                           "-o", str(exe), str(build / "libController.a"), *libs, "-lm"],
-                          capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    return str(exe)
+    return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "display_size.c")
 
 
 def test_both_world_formats_keep_the_display_size() -> None:

@@ -6,14 +6,12 @@ closed form, and the two languages read the same values, digit for digit."""
 from __future__ import annotations
 
 import math
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from _serve import Proc, sensorium, serve
+from test_c_client import sanitized_controller
 
 REPO = Path(__file__).resolve().parents[1]
 CLIB = REPO / "sensorium" / "client" / "c"
@@ -59,20 +57,7 @@ def check(lines: list[str]) -> list[str]:
 
 @pytest.fixture(scope="module")
 def c_controller(tmp_path_factory) -> str:
-    if sys.platform == "win32" or shutil.which("cc") is None:
-        pytest.skip("needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
-    build = tmp_path_factory.mktemp("cbuild")
-    done = subprocess.run(["make", "-s", "-C", str(CLIB), f"BUILD={build}", "SANITIZE=1"], capture_output=True,
-                          text=True, timeout=600)
-    assert done.returncode == 0, done.stdout + done.stderr
-    libs = subprocess.run(["make", "-s", "-C", str(CLIB), "libs"], capture_output=True, text=True).stdout.split()
-    exe = build / "pen_ink"
-    done = subprocess.run(["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
-                           "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", str(REPO / "tests" / "c" / "pen_ink.c"),
-                           "-o", str(exe), str(build / "libController.a"), *libs, "-lm"],
-                          capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    return str(exe)
+    return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "pen_ink.c")
 
 
 def test_a_c_and_a_python_controller_ink_and_read_the_same(c_controller: str) -> None:
