@@ -248,8 +248,8 @@ def test_a_warning_about_the_users_world_is_one_line(tmp_path):
     world.write_text(yaml.safe_dump({"solids": [ramp], "robots": [robot]}))
     r = run("probe", str(world))
     lines = r.stderr.splitlines()
-    assert lines[0] == (f"sensorium: warning: {world}: robot 'r' starts over no ground (no upright terrain or floor "
-                        "plane under its origin): it keeps its height, terrains do not lift it"), r.stderr
+    assert lines[0].startswith(f"sensorium: warning: {world}: robot 'r' starts over no ground ("), r.stderr
+    assert lines[0].endswith("): it keeps its height, terrains do not lift it"), r.stderr
     assert "GroundWarning" not in r.stderr and ".py:" not in r.stderr
 
 
