@@ -192,6 +192,18 @@ def _field_of_view(f: Fields, projection: str, default: float) -> float:
     return fov
 
 
+def _image(f: Fields, spherical_as: str) -> dict:
+    """What a Camera and a RangeFinder read alike (WbAbstractCamera): fieldOfView, width, height,
+    projection and near, each reset as Webots resets it; R2023's deprecated ``spherical TRUE`` on a
+    planar one reads as ``spherical_as`` (WbCamera::init / WbRangeFinder::init)."""
+    projection = _projection(f)
+    if f.flag("spherical", False) and projection == "planar":
+        projection = spherical_as
+    return {"field_of_view": _field_of_view(f, projection, 0.785398),
+            "width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1),
+            "projection": projection, "near": f.positive("near", 0.01, 0.01)}
+
+
 def _max_range(f: Fields, min_range: float, default: float) -> float:
     """A lidar's maxRange: one not above minRange is minRange + 1 (WbLidar::updateMaxRange)."""
     max_range = f.num("maxRange", default)
@@ -275,21 +287,11 @@ def device(node: Node, f: Fields) -> dict:
                 "default_frequency": f.positive("defaultFrequency", 10.0, min_frequency), "min_frequency": min_frequency,
                 "max_frequency": f.positive("maxFrequency", 25.0, min_frequency)}
     if t == "RangeFinder":
-        projection = _projection(f)
-        if f.flag("spherical", False) and projection == "planar":    # deprecated in R2023 (WbRangeFinder::init)
-            projection = "cylindrical"
-        return {"device": t, "field_of_view": _field_of_view(f, projection, 0.785398),
-                "width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1),
-                "projection": projection, "near": f.positive("near", 0.01, 0.01),
+        return {"device": t, **_image(f, "cylindrical"),
                 "min_range": f.positive("minRange", 0.01, 0.01), "max_range": f.num("maxRange", 1.0),
                 "noise": f.non_negative("noise", 0.0, 0.0), "resolution": f.num("resolution", -1.0)}
     if t == "Camera":
-        projection = _projection(f)
-        if f.flag("spherical", False) and projection == "planar":    # deprecated in R2023
-            projection = "spherical"
-        out = {"device": t, "field_of_view": _field_of_view(f, projection, 0.785398),
-               "width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1),
-               "projection": projection, "near": f.positive("near", 0.01, 0.01),
+        out = {"device": t, **_image(f, "spherical"),
                "far": f.non_negative("far", 0.0, 0.0), "exposure": f.non_negative("exposure", 1.0, 1.0),
                "anti_aliasing": f.flag("antiAliasing", False), "noise": f.non_negative("noise", 0.0, 0.0)}
         rec = f.node_("recognition")
