@@ -103,7 +103,6 @@ class CarriedLights:
                                      dtype=bool)
         self._oriented = self.shared.kind != light_math.LightKind.POINT
         self._n_fixed = len(self._fixed)
-        self._cast = np.array([bool(m.cast_shadows) for _, m in carried], dtype=bool)
 
     # ------------------------------------------------------------------ LEDs
     def switch_led(self, slot: int, name: str, copies: np.ndarray, on: bool, color: tuple[float, float, float]) -> None:
@@ -139,7 +138,8 @@ class CarriedLights:
                       for j, lt in enumerate(self._sensor_carried)]
             camera = [lt if colors[j] is None else replace(lt, color=colors[j]) for j, lt in enumerate(self._carried)]
             arrays = light_math.LightArrays.from_lights(self._sensor_fixed + [sensor[j] for j in sel])
-            got = self._groups[k] = (sel, arrays, [camera[j] for j in sel], self._cast[sel])
+            got = self._groups[k] = (sel, arrays, [camera[j] for j in sel],
+                                        self.cast_shadows[self._n_fixed:][sel])
         return got
 
     def shadows(self, copy: int, fixed: np.ndarray) -> np.ndarray:
