@@ -283,6 +283,20 @@ def serve(world: Path | str | None = None, *extra: str, rpc: str = ANY_PORT, pub
     return served.wait_ready() if wait else served
 
 
+def run_controller(world: Path, argv, env: dict[str, str] | None = None, robot: str = "bot") -> tuple[list[str], str]:
+    """``argv(url)`` run as ``robot``'s controller against a fresh ``sensorium serve WORLD --mode fast``
+    until it exits by itself (code 0 asserted): (its stdout lines, its stderr)."""
+    with serve(world, "--mode", "fast", env=env) as server:
+        url = server.url(robot)
+        proc = Proc(argv(url), env={**(env or {}), "SENSORIUM_CONTROLLER_URL": url})
+        try:
+            code = proc.wait(120)
+        finally:
+            proc.stop()
+        assert code == 0, proc.stderr()
+        return proc.stdout().splitlines(), proc.stderr()
+
+
 def run_example(world: str, example: str, robot: str, steps: int) -> tuple[dict, Proc]:
     """``sensorium controller example:EXAMPLE --url … STEPS`` against ``sensorium serve WORLD``: the
     world waits (pause) until the controller has attached, then runs fast until the controller exits

@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from _serve import Proc, sensorium, serve
+from _serve import run_controller, sensorium
 from test_c_client import sanitized_controller
 
 from sensorium.schemas import world as wm
@@ -21,18 +21,6 @@ CLIB = REPO / "sensorium" / "client" / "c"
 WORLDS = [REPO / "tests" / "worlds" / "display.yaml", REPO / "tests" / "worlds" / "display.wbt"]
 SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
 EXPECTED = ["screen 320 240", "small 64 64", "properties 320 240", "pixels 1920", "refs 1 1 1", "done"]
-
-
-def run_controller(world: Path, argv, env: dict[str, str] | None = None) -> tuple[list[str], str]:
-    with serve(world, "--mode", "fast", env=env) as server:
-        url = server.url("bot")
-        proc = Proc(argv(url), env={**(env or {}), "SENSORIUM_CONTROLLER_URL": url})
-        try:
-            code = proc.wait(120)
-        finally:
-            proc.stop()
-        assert code == 0, proc.stderr()
-        return proc.stdout().splitlines(), proc.stderr()
 
 
 @pytest.fixture(scope="module")

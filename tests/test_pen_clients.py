@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _serve import Proc, sensorium, serve
+from _serve import run_controller, sensorium
 from test_c_client import sanitized_controller
 
 REPO = Path(__file__).resolve().parents[1]
@@ -33,19 +33,6 @@ EXPECTED = [reading(1.0), reading(0.5 + 0.5 * channel(0x33)), reading(0.5 + 0.5 
             reading(channel(0x33) / 3.0)]
 
 
-def run_controller(argv, env: dict[str, str] | None = None) -> tuple[list[str], str]:
-    """``argv(url)`` run against a fresh server of the pen world: (stdout lines, stderr)."""
-    with serve(WORLD, "--mode", "fast", env=env) as server:
-        url = server.url("bot")
-        proc = Proc(argv(url), env={**(env or {}), "SENSORIUM_CONTROLLER_URL": url})
-        try:
-            code = proc.wait(120)
-        finally:
-            proc.stop()
-        assert code == 0, proc.stderr()
-        return proc.stdout().splitlines(), proc.stderr()
-
-
 def check(lines: list[str]) -> list[str]:
     ink = [line for line in lines if line.startswith("ink ")]
     assert [int(line.split()[1]) for line in ink] == [0, 1, 2, 3]
@@ -61,10 +48,10 @@ def c_controller(tmp_path_factory) -> str:
 
 
 def test_a_c_and_a_python_controller_ink_and_read_the_same(c_controller: str) -> None:
-    c_out, c_err = run_controller(lambda url: [c_controller], env=SAN_ENV)
+    c_out, c_err = run_controller(WORLD, lambda url: [c_controller], env=SAN_ENV)
     assert "Sanitizer" not in c_err and "runtime error" not in c_err, c_err
     py_out, py_err = run_controller(
-        lambda url: sensorium("controller", "--url", url, str(REPO / "tests" / "controllers" / "pen_ink.py")))
+        WORLD, lambda url: sensorium("controller", "--url", url, str(REPO / "tests" / "controllers" / "pen_ink.py")))
     assert check(c_out) == check(py_out)                         # the same 17 digits
     assert "class Pen" in py_out
     for err in (c_err, py_err):
