@@ -75,6 +75,7 @@ from sensorium.server.sim.scene import (
     _shape_info,
     infra_red_terms,
     primitive_from_model,
+    robot_bounding_parts,
     robot_parts,
     solid_parts,
 )
@@ -266,10 +267,8 @@ class BatchedSimulation:
         # the terrains robots ride (sim/ground.py; None in a world without one: heights never change)
         self.ground = Ground.from_world(w, self.scene.solid_poses, self.to_enu)
         # each robot's band bottom below its origin (its support ceiling's, ground.band_low; 0 without a ground)
-        self.band_low = np.array([band_low([(primitive_from_model(shape.geometry, base), local)
-                                            for _, local, shape in robot_parts(r) if shape.seen_by in ("both", "bounding")],
-                                           self.initial[i], self.to_enu) if self.ground is not None else 0.0
-                                  for i, r in enumerate(w.robots)], dtype=np.float64)
+        self.band_low = np.array([band_low(robot_bounding_parts(r, base), self.initial[i], self.to_enu)
+                                  if self.ground is not None else 0.0 for i, r in enumerate(w.robots)], dtype=np.float64)
         self._templates: list[PlanarState | None] = [
             DifferentialDrive(r.differential_drive, self.initial[i], up=up, ground=self.ground,
                               band_low=float(self.band_low[i])) if r.differential_drive
@@ -306,9 +305,7 @@ class BatchedSimulation:
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
             self.contact = Contact(solids, [], self.to_enu)
-            feet = [robot_footprint(enu_body([(primitive_from_model(shape.geometry, base), local)
-                                              for _, local, shape in robot_parts(r)
-                                              if shape.seen_by in ("both", "bounding")], self.initial[i], self.to_enu))
+            feet = [robot_footprint(enu_body(robot_bounding_parts(r, base), self.initial[i], self.to_enu))
                     for i, r in enumerate(w.robots)]
             self.feet = feet
             nan = math.nan

@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -148,6 +149,13 @@ def robot_parts(robot: wm.Robot) -> Iterator[tuple[str, Pose, wm.Shape]]:
         yield f"{robot.name}/body", Pose.identity(), robot.body
     for part in robot.shapes:
         yield f"{robot.name}/{part.name or 'body'}", pose_from_model(part.pose), part
+
+
+def robot_bounding_parts(robot: wm.Robot, base_dir: Path) -> list[tuple[Any, Pose]]:
+    """A robot's shapes that bound it (``seen_by`` both or bounding) as (primitive, pose in the robot
+    frame): what kinematic contact and the ground's support ceiling take its body to be."""
+    return [(primitive_from_model(shape.geometry, base_dir), local) for _, local, shape in robot_parts(robot)
+            if shape.seen_by in ("both", "bounding")]
 
 
 def place_light(model, pose: Pose):

@@ -30,7 +30,13 @@ from sensorium.server.sim.ground import Ground, GroundWarning, band_low
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
-from sensorium.server.sim.scene import Scene, light_from_model, primitive_from_model, robot_parts, solid_parts
+from sensorium.server.sim.scene import (
+    Scene,
+    light_from_model,
+    primitive_from_model,
+    robot_bounding_parts,
+    solid_parts,
+)
 from sensorium.server.sim.sensors import (
     GPS,
     LED,
@@ -237,10 +243,8 @@ class Simulation:
 
     def band_low(self, index: int) -> float:
         """Robot ``index``'s band bottom below its origin, as contact takes it (ground.band_low)."""
-        base = self.loaded.base_dir
-        parts = [(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(self.world.robots[index])
-                 if shape.seen_by in ("both", "bounding")]
-        return band_low(parts, self.scene.robot_poses[index], _TO_ENU[self.world.world_info.coordinate_system])
+        return band_low(robot_bounding_parts(self.world.robots[index], self.loaded.base_dir),
+                        self.scene.robot_poses[index], _TO_ENU[self.world.world_info.coordinate_system])
 
     def _build_contact(self) -> Contact:
         base = self.loaded.base_dir
@@ -249,9 +253,7 @@ class Simulation:
                   for s in self.world.solids for _, local, shape in solid_parts(s, Pose.identity())]
         # each robot at its world-file pose: its footprint is taken upright (enu_body), not tilted by
         # the slope it may start on (the batched simulation's feet, from the same poses)
-        robots = [([(primitive_from_model(shape.geometry, base), local) for _, local, shape in robot_parts(r)
-                    if shape.seen_by in ("both", "bounding")], self.robots[r.name].initial_pose)
-                  for r in self.world.robots]
+        robots = [(robot_bounding_parts(r, base), self.robots[r.name].initial_pose) for r in self.world.robots]
         return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system])
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
