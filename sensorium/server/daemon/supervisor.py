@@ -65,9 +65,8 @@ def _all_nodes(sim: Any) -> list[Node]:
     robots_m = world.robots if world is not None else None
     solids_m = world.solids if world is not None else None
     names = sim.scene.solid_names
-    loaded_solids = len(names) - sum(kind == "Solid" for kind, _ in imported)
     top = sim.scene.top_lights()
-    loaded_lights = len(top) - sum(kind != "Solid" for kind, _ in imported)
+    loaded_solids, loaded_lights = _loaded_counts(sim)
     out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name) for i, name in enumerate(sim.robots)]
     first = len(out) + 1
     out += [Node(first + j, "Solid", names[j], def_of(solids_m, j), names[j]) for j in range(loaded_solids)]
@@ -104,11 +103,18 @@ def _loaded_order(sim: Any, nodes: list[Node]) -> list[int]:
     layout = getattr(sim, "top_level", None)
     if layout is None:
         return [n.id for n in nodes]
-    imported = getattr(sim, "imported", [])
-    first = {"robots": 1, "solids": 1 + len(sim.robots)}
-    first["lights"] = first["solids"] + len(sim.scene.solid_names) - sum(k == "Solid" for k, _ in imported)
-    first["scenery"] = first["lights"] + len(sim.scene.top_lights()) - sum(k != "Solid" for k, _ in imported)
+    solids, lights = _loaded_counts(sim)
+    first = {"robots": 1, "solids": 1 + len(sim.robots)}           # ids as _all_nodes gives them
+    first["lights"] = first["solids"] + solids
+    first["scenery"] = first["lights"] + lights
     return [first[kind] + index for kind, index in layout.order]
+
+
+def _loaded_counts(sim: Any) -> tuple[int, int]:
+    """How many top-level solids and lights the world loaded with (those now, imported ones left out)."""
+    imported = getattr(sim, "imported", [])
+    return (len(sim.scene.solid_names) - sum(kind == "Solid" for kind, _ in imported),
+            len(sim.scene.top_lights()) - sum(kind != "Solid" for kind, _ in imported))
 
 
 def root_children(sim: Any) -> list[Node]:
