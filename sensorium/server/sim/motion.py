@@ -156,8 +156,7 @@ class PlanarState:
         self.z0 = self.z
         self.slope: tuple[float, float] | None = None
         if self.ground is not None:
-            ceiling = placing_ceiling(np.array([self.z]), np.array([self.band_low]))
-            under = self.ground.at(self.x, self.y, float(ceiling[0]))
+            under = self.ground.at(self.x, self.y, float(placing_ceiling(self.z, self.band_low)))
             if under is not None:
                 self.rest = under[0]
                 self.slope = under[1:] if (under[1] or under[2]) else None
@@ -166,9 +165,7 @@ class PlanarState:
         """Ride the ground after a planar move (nothing to do without one)."""
         if self.ground is None or self.rest is None:
             return
-        ceiling = support_ceiling(np.array([self.z]), np.array([self.band_low]), np.array([self.z0]),
-                                  np.array([self.rest]))
-        under = self.ground.at(self.x, self.y, float(ceiling[0]))
+        under = self.ground.at(self.x, self.y, float(support_ceiling(self.z, self.band_low, self.z0, self.rest)))
         if under is None:
             self.slope = None         # nothing under it: it keeps its height, upright
             return
