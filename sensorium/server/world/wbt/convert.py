@@ -741,7 +741,8 @@ class Converter:
             if n.type in ("Group", "Pose", "Transform", "Solid"):
                 return [lt for child in self.fields(n).nodes("children") for lt in inside(child)]
             return []
-        return inside(self.fields(node).nodes("children")[0]) if self.fields(node).nodes("children") else []
+        children = self.fields(node).nodes("children")
+        return inside(children[0]) if children else []
 
     # ------------------------------------------------------------ solids and robots
     def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> None:
