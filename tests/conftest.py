@@ -31,7 +31,7 @@ SLOW_TESTS = {
 
 
 # tests/_serve.py's helpers and test_multiprocess's (imported by other modules) start processes
-SPAWNS = re.compile(r"subprocess|Popen|\b(?:Proc|Served|serve|start_server|run_paused)\(")
+SPAWNS = re.compile(r"subprocess|Popen|\b(?:Proc|Served|serve|start_server|run_paused|run_controller|sanitized_controller)\(")
 
 
 @cache
