@@ -270,6 +270,9 @@ class Appearance(Strict):
 
 SeenBy = Literal["both", "bounding", "visual"]
 
+_CAST_SHADOWS = ("Webots' Shape.castShadows: false lets cameras' shadow rays through this shape (it still hides "
+                 "what is behind it, and other rays see it)")
+
 
 class Shape(Strict):
     """A geometry as seen by rays: bounding-object rays (generic/sonar/laser distance sensors,
@@ -278,6 +281,7 @@ class Shape(Strict):
     geometry: Geometry
     appearance: Appearance | None = None
     seen_by: SeenBy = "both"
+    cast_shadows: bool = Field(default=True, description=_CAST_SHADOWS)
 
     @model_validator(mode="after")
     def _cone_seen(self) -> Shape:
@@ -424,6 +428,7 @@ class Solid(Strict):
     geometry: Geometry | None = None
     appearance: Appearance | None = None
     seen_by: SeenBy = "both"
+    cast_shadows: bool = Field(default=True, description=_CAST_SHADOWS)
     shapes: list[Part] = []
     children: list[Solid] = []
     lights: list[Light] = []

@@ -175,7 +175,9 @@ __all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine", "Mount"
 
 
 # variants: which shapes a scene holds
-_V_VISUAL, _V_BOUNDING, _V_OPAQUE = "visual", "bounding", "bounding-opaque"
+_V_VISUAL, _V_BOUNDING, _V_OPAQUE, _V_SHADOW = "visual", "bounding", "bounding-opaque", "shadow"
+# a variant whose scenes are another's when no shape tells them apart (built once, shared)
+_NARROWS = {_V_OPAQUE: _V_BOUNDING, _V_SHADOW: _V_VISUAL}
 
 
 def _sees(e: ShapeEntry, variant: str) -> bool:
@@ -183,6 +185,8 @@ def _sees(e: ShapeEntry, variant: str) -> bool:
         return e.visual and not e.transparent
     if variant == _V_BOUNDING:
         return e.bounding
+    if variant == _V_SHADOW:
+        return e.visual and not e.transparent and e.casts_shadow
     return e.bounding and not e.transparent
 
 
@@ -285,6 +289,7 @@ class RayEngine(TierTracer):
     def _variant(self, kind: RayKind, skip_transparent: bool) -> str:
         if kind != RayKind.BOUNDING and kind != RayKind.VISUAL:
             RayKind(kind)  # raises ValueError for anything else (the enum call costs ~1 us: only here)
+            return _V_SHADOW
         if kind == RayKind.VISUAL:
             return _V_VISUAL
         return _V_OPAQUE if skip_transparent else _V_BOUNDING
@@ -310,15 +315,19 @@ class RayEngine(TierTracer):
                 out.append((sid - body.first, e.primitive, e.local_pose))
         return out
 
-    def _has_transparent(self, bodies) -> bool:
-        return any(self._entries[s].transparent and self._entries[s].bounding
-                   and not isinstance(self._entries[s].primitive, Plane) for b in bodies for s in b.shapes)
+    def _narrows(self, variant: str, bodies) -> bool:
+        """Whether ``variant`` sees fewer of these bodies' triangle shapes than the variant it narrows
+        (else it shares that variant's scenes): a bounding shape that is transparent, a visual one that
+        casts no shadow."""
+        wider = _NARROWS[variant]
+        return any(_sees(e, wider) and not _sees(e, variant) and not isinstance(e.primitive, Plane)
+                   for b in bodies for e in map(self._entries.__getitem__, b.shapes))
 
     def _static_tier(self, variant: str) -> _Tier | None:
         if variant not in self._static:
             statics = [b for b in self._bodies if not b.mover and not b.removed]
-            if variant == _V_OPAQUE and not self._has_transparent(statics):
-                self._static[variant] = self._static_tier(_V_BOUNDING)
+            if variant in _NARROWS and not self._narrows(variant, statics):
+                self._static[variant] = self._static_tier(_NARROWS[variant])
             else:
                 self._static[variant] = self._build([i for b in statics for i in self._items(b, variant, True)],
                                                     self._owner_of)
@@ -329,8 +338,8 @@ class RayEngine(TierTracer):
         local pose) seen by the variant.  Shared tiers carry no owner: exclusion is decided per
         (ray, mover) pair in the broad phase."""
         if variant not in body.tiers:
-            if variant == _V_OPAQUE and not self._has_transparent([body]):
-                body.tiers[variant] = self._mover_tier(body, _V_BOUNDING)
+            if variant in _NARROWS and not self._narrows(variant, [body]):
+                body.tiers[variant] = self._mover_tier(body, _NARROWS[variant])
             else:
                 items = self._items(body, variant, False)
                 key = (variant, tuple((i, prim, pose.rotation.tobytes(), pose.translation.tobytes())
@@ -366,7 +375,7 @@ class RayEngine(TierTracer):
         if variant not in self._planes:
             items = [(sid, b) for b in self._bodies if not b.removed for sid in b.shapes
                      if isinstance(self._entries[sid].primitive, Plane) and _sees(self._entries[sid], variant)]
-            self._planes[variant] = (_Planes(items, self._entries, self._owner_of, variant == _V_VISUAL)
+            self._planes[variant] = (_Planes(items, self._entries, self._owner_of, variant in (_V_VISUAL, _V_SHADOW))
                                      if items else None)
         return self._planes[variant]
 

@@ -13,6 +13,7 @@ from sensorium.server.world.geometry import Pose, Primitive
 class RayKind(IntEnum):
     BOUNDING = 0  # boundingObject rays: generic/sonar/laser distance sensors, light occlusion
     VISUAL = 1    # visual rays: infra-red distance sensors, lidar
+    SHADOW = 2    # a camera's shadow rays: the visual shapes that cast shadows (Webots' Shape.castShadows)
 
 
 class Precision(str, Enum):
@@ -27,6 +28,7 @@ class ShapeEntry:
     bounding: bool            # seen by BOUNDING rays
     visual: bool              # seen by VISUAL rays
     transparent: bool = False  # invisible to VISUAL rays and to casts with skip_transparent
+    casts_shadow: bool = True  # seen by SHADOW rays (when also visual and not transparent)
 
 
 @dataclass(slots=True)

@@ -253,7 +253,7 @@ class CameraDevices(PixelDevices):
                     i = i[near]
                 if len(i) == 0:
                     continue
-                h = sim.rays.cast(Pq[i], unit[i, j], 0.0, length[i, j], RayKind.VISUAL, np.full(len(i), q, dtype=np.int64),
+                h = sim.rays.cast(Pq[i], unit[i, j], 0.0, length[i, j], RayKind.SHADOW, np.full(len(i), q, dtype=np.int64),
                                   sim.rot, sim.pos, -1, -1, False, distance_only=True)
                 lit[rq[i], j] = ~(h.distance <= length[i, j])
         return lit

@@ -537,7 +537,7 @@ class Camera(Device):
                 i = i[near]
             if len(i) == 0:
                 continue
-            hits = self._scene.engine.cast(P[i], unit[i, j], 0.0, length[i, j], kind=RayKind.VISUAL, exclude_owner=-1,
+            hits = self._scene.engine.cast(P[i], unit[i, j], 0.0, length[i, j], kind=RayKind.SHADOW, exclude_owner=-1,
                                            distance_only=True)
             counters["rays_camera"] += len(i)
             counters["cast_calls"] += 1

@@ -85,6 +85,7 @@ def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None
         bounding=shape.seen_by in ("both", "bounding") and not isinstance(shape.geometry, wm.Cone),   # as Webots
         visual=shape.seen_by in ("both", "visual"),
         transparent=transparent,
+        casts_shadow=shape.cast_shadows,
     )
 
 

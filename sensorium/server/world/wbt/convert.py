@@ -497,6 +497,8 @@ class Converter:
                                 lambda n, u: self.asset(n, u, "texture"), self.field_reset)
             if app is not None:
                 part["appearance"] = app
+            if node.type == "Shape" and not f.flag("castShadows", True):
+                part["cast_shadows"] = False
             owner.keys[key] = part
         part["_at"] = self.at(gnode)
         owner.parts.append(part)

@@ -1,0 +1,152 @@
+"""Webots' ``Shape.castShadows``: a shape with ``castShadows FALSE`` casts no shadow in a camera's
+image (its light reaches what lies behind it), yet it is still seen: it hides what is behind it from
+the camera, and every other ray kind meets it. Closed forms from test_camera's lit wall; the batched
+camera is the single one's, byte for byte; a world where every shape casts shadows shares the
+visual scenes (no extra build)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _protos import world_file
+
+from sensorium.schemas import world as wm
+from sensorium.server.raycast.engine import RayEngine
+from sensorium.server.raycast.kinds import Precision, RayKind, ShapeEntry
+from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.geometry import Box, Pose
+from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_camera import ALBEDO, WALL, expected_bytes, ray_hits_box, rays, rgb, shoot, world
+
+CAM = {"width": 21, "height": 21, "field_of_view": 1.0}
+LAMP = {"type": "PointLight", "location": [0.3, 0.0, 1.2], "intensity": 1.0, "ambient_intensity": 0.2,
+        "cast_shadows": True}
+CENTRE, HALF = np.array([1.0, 0.0, 0.6]), np.array([0.05, 0.1, 0.1])
+
+
+def block(**extra) -> dict:
+    return {"name": "block", "pose": {"translation": CENTRE.tolist()}, "geometry": {"type": "box", "size": [0.1, 0.2, 0.2]},
+            **extra}
+
+
+def wall_light() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each pixel's wall radiance unshadowed, where the block shadows the wall from the lamp, and
+    which pixels see the block rather than the wall."""
+    d = rays(CAM)[0]
+    P = d * (1.95 / d[..., :1])
+    q = np.array(LAMP["location"])
+    shadow = np.zeros(P.shape[:2], dtype=bool)
+    for x in np.linspace(0.95, 1.05, 41):
+        s = (x - P[..., 0]) / (q[0] - P[..., 0])
+        y, z = P[..., 1] + s * (q[1] - P[..., 1]), P[..., 2] + s * (q[2] - P[..., 2])
+        shadow |= (np.abs(y) < 0.1) & (np.abs(z - 0.6) < 0.1)
+    v = q - P
+    direct = -v[..., 0] / np.linalg.norm(v, axis=-1)
+    return ALBEDO * (0.2 + direct)[..., None], shadow, ray_hits_box(d, CENTRE, HALF)
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_a_shape_without_cast_shadows_lets_the_light_through_and_is_still_seen(precision: str):
+    lit, shadow, sees_block = wall_light()
+    wall = ~sees_block
+    assert (shadow & wall).sum() >= 6
+    sim_on, on = shoot(world(CAM, [WALL, block()], [LAMP]), precision)
+    sim_off, off = shoot(world(CAM, [WALL, block(cast_shadows=False)], [LAMP]), precision)
+    np.testing.assert_array_equal(rgb(off)[wall], expected_bytes(lit)[wall])        # no shadow on the wall
+    assert (rgb(on)[shadow & wall] < rgb(off)[shadow & wall]).all()                 # which the casting block has
+    # the block itself (pixels well inside its outline) is drawn as before: it hides the wall
+    inside = ray_hits_box(rays(CAM)[0], CENTRE, 0.8 * HALF)
+    assert inside.sum() >= 3
+    np.testing.assert_array_equal(rgb(off)[inside], rgb(on)[inside])
+    assert (rgb(off)[inside] != expected_bytes(lit)[inside]).any(axis=-1).all()
+    assert sim_off.counters["rays_camera"] == sim_on.counters["rays_camera"] > 21 * 21   # shadow rays still cast
+
+
+def test_each_part_of_a_solid_keeps_its_own_flag():
+    # two halves of the block as parts of one solid: only the upper one (z > 0.6) casts its shadow
+    upper = {"pose": {"translation": [0, 0, 0.05]}, "geometry": {"type": "box", "size": [0.1, 0.2, 0.1]}}
+    lower = {"pose": {"translation": [0, 0, -0.05]}, "geometry": {"type": "box", "size": [0.1, 0.2, 0.1]},
+             "cast_shadows": False}
+    halves = {"name": "halves", "pose": {"translation": CENTRE.tolist()}, "shapes": [upper, lower]}
+    _, img = shoot(world(CAM, [WALL, halves], [LAMP]))
+    lit, _, sees_block = wall_light()
+    d = rays(CAM)[0]
+    P = d * (1.95 / d[..., :1])
+    q = np.array(LAMP["location"])
+    upper_shadow = np.zeros(P.shape[:2], dtype=bool)
+    for x in np.linspace(0.95, 1.05, 41):
+        s = (x - P[..., 0]) / (q[0] - P[..., 0])
+        y, z = P[..., 1] + s * (q[1] - P[..., 1]), P[..., 2] + s * (q[2] - P[..., 2])
+        upper_shadow |= (np.abs(y) < 0.1) & (z > 0.6) & (z < 0.7)
+    wall = ~sees_block & ~upper_shadow
+    np.testing.assert_array_equal(rgb(img)[wall], expected_bytes(lit)[wall])
+    shaded = ~sees_block & upper_shadow
+    assert shaded.sum() >= 3
+    np.testing.assert_array_equal(rgb(img)[shaded], np.broadcast_to(expected_bytes(ALBEDO * 0.2), (shaded.sum(), 3)))
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_a_batched_robot_without_cast_shadows_leaves_the_wall_lit_as_the_single_world_does(precision: str):
+    # the wall lit by a directional light along (1, 0.5, 0); a blocker robot in copy 0 stands between
+    # the wall's centre point and the light: its box casts no shadow, so both copies read the full term
+    from tests.test_batched_camera import _facing
+    data = _facing([1.0], fog=False).model_dump(mode="json", exclude_none=True)
+    data["lights"] = [{"type": "DirectionalLight", "direction": [1, 0.5, 0], "intensity": 0.7,
+                       "ambient_intensity": 0.2, "cast_shadows": True}]
+    data["robots"].append({"name": "blocker", "pose": {"translation": [5.0, 5.0, 0.0]},
+                           "shapes": [{"pose": {"translation": [0, 0, 0.1]}, "cast_shadows": False,
+                                       "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}}]})
+    lw = LoadedWorld(world=wm.World.model_validate(data), source="<test>", base_dir=Path.cwd())
+    bs = BatchedSimulation(lw, 2, precision=precision)
+    ref = bs.device("bot", "cam")
+    bs.enable(ref, 8)
+    singles = []
+    for c, t in enumerate([[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]]):
+        bs.set_pose(c, bs.slot("blocker"), translation=t)
+        single = Simulation(lw, precision=precision)
+        single.robot("blocker").set_pose(t)
+        single.robot("bot").device("cam").enable(8)
+        singles.append(single)
+    bs.step()
+    img = bs.image(ref)
+    for c, single in enumerate(singles):
+        single.step()
+        assert img[c].tobytes() == single.robot("bot").device("cam").image.tobytes(), c
+    full = np.floor(255.0 * (1.0 - np.exp(-np.array([0.6, 0.3, 0.15]) * (0.2 + 0.7 / math.sqrt(1.25)) * 1.3))
+                    ** (1.0 / 2.2) + 0.5)
+    assert (img[:, 2, 5, 2::-1] == full).all()
+
+
+def test_shadow_rays_pass_a_non_caster_that_every_other_ray_kind_meets():
+    eng = RayEngine(Precision.EXACT)
+    box = Box((1.0, 1.0, 1.0))
+    eng.add_body([ShapeEntry(box, Pose.identity(), True, True, casts_shadow=False)],
+                 Pose(np.eye(3), np.array([3.0, 0.0, 0.0])))
+    eng.add_body([ShapeEntry(box, Pose.identity(), True, True)], Pose(np.eye(3), np.array([6.0, 0.0, 0.0])))
+    o, d = np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0]])
+    for kind in (RayKind.BOUNDING, RayKind.VISUAL):
+        assert eng.cast(o, d, kind=kind).distance[0] == 2.5
+    assert eng.cast(o, d, kind=RayKind.SHADOW).distance[0] == 5.5
+
+
+def test_a_world_whose_shapes_all_cast_shadows_builds_no_scene_for_shadow_rays():
+    eng = RayEngine(Precision.EXACT)
+    eng.add_body([ShapeEntry(Box((1.0, 1.0, 1.0)), Pose.identity(), True, True)],
+                 Pose(np.eye(3), np.array([3.0, 0.0, 0.0])))
+    o, d = np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0]])
+    eng.cast(o, d, kind=RayKind.VISUAL)
+    builds = eng.counters["bvh_builds"]
+    assert eng.cast(o, d, kind=RayKind.SHADOW).distance[0] == 2.5
+    assert eng.counters["bvh_builds"] == builds
+
+
+def test_webots_cast_shadows_false_is_read_from_a_wbt(tmp_path: Path):
+    body = ('Solid { name "s" children [ Shape { castShadows FALSE geometry Box { size 1 1 1 } } '
+            'Pose { translation 0 0 2 children [ Shape { geometry Sphere { radius 0.5 } } ] } ] }\n')
+    loaded = load_world(world_file(tmp_path, body))
+    parts = loaded.world.solids[0].shapes
+    assert [p.cast_shadows for p in parts] == [False, True]
