@@ -150,3 +150,55 @@ def test_webots_cast_shadows_false_is_read_from_a_wbt(tmp_path: Path):
     loaded = load_world(world_file(tmp_path, body))
     parts = loaded.world.solids[0].shapes
     assert [p.cast_shadows for p in parts] == [False, True]
+
+
+# ---- translucent shapes (WREN draws them in its translucent pass: they cast no shadow and take none)
+
+def test_a_semi_transparent_or_alpha_textured_shape_casts_no_shadow(tmp_path: Path):
+    from PIL import Image
+    Image.new("RGBA", (2, 2), (200, 200, 200, 128)).save(tmp_path / "veil.png")
+    lit, shadow, sees_block = wall_light()
+    wall = ~sees_block
+    for appearance in ({"transparency": 0.5}, {"texture": {"url": "veil.png"}}):
+        _, img = shoot(world(CAM, [WALL, block(appearance=appearance)], [LAMP]), base_dir=tmp_path)
+        np.testing.assert_array_equal(rgb(img)[wall], expected_bytes(lit)[wall])
+    # the same image without alpha (every texel opaque) shadows the wall as an opaque block does
+    Image.new("RGBA", (2, 2), (200, 200, 200, 255)).save(tmp_path / "veil.png")
+    _, img = shoot(world(CAM, [WALL, block(appearance={"texture": {"url": "veil.png"}})], [LAMP]), base_dir=tmp_path)
+    assert (rgb(img)[shadow & wall] < expected_bytes(lit)[shadow & wall]).all()
+
+
+PANE_CAM = {"width": 5, "height": 5, "field_of_view": 0.3}
+SUN = {"type": "DirectionalLight", "direction": [1, 0, -1], "intensity": 0.6, "ambient_intensity": 0.2,
+       "cast_shadows": True}
+PANE_COLOUR = np.array([0.1, 0.9, 0.2])
+
+
+def pane_world(transparency: float) -> dict:
+    """The camera looks along +x at a pane (x = 1) before the wall (x = 2); the sun shines along
+    (1, 0, -1) over a blocker above the view (x = 0.5, z in [0.3, 0.7]) that stands between the
+    pane and the sun, never between the wall and the sun."""
+    pane = {"name": "pane", "pose": {"translation": [1.0, 0, 0]}, "geometry": {"type": "box", "size": [0.02, 1, 0.5]},
+            "appearance": {"base_color": PANE_COLOUR.tolist(), "transparency": transparency}}
+    blocker = {"name": "blocker", "pose": {"translation": [0.5, 0, 0.5]}, "geometry": {"type": "box", "size": [0.1, 2, 0.4]}}
+    return {"world_info": {"basic_time_step": 16, "random_seed": 5}, "solids": [WALL, pane, blocker], "lights": [SUN],
+            "robots": [{"name": "r", "devices": [{"device": "Camera", "name": "cam", **PANE_CAM}]}]}
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_a_semi_transparent_surface_takes_no_shadow_single_and_batched(precision: str):
+    direct = 0.2 + 0.6 / math.sqrt(2.0)               # ambient + intensity N.L, N.L = 1/sqrt(2) on both faces
+    data = pane_world(0.4)
+    _, img = shoot(wm.World.model_validate(data), precision)
+    want = expected_bytes(0.6 * PANE_COLOUR * direct + 0.4 * ALBEDO * direct)
+    np.testing.assert_array_equal(rgb(img), np.broadcast_to(want, (5, 5, 3)))
+    # an opaque pane in the same place takes the blocker's shadow: the ambient term alone
+    _, opaque = shoot(wm.World.model_validate(pane_world(0.0)), precision)
+    np.testing.assert_array_equal(rgb(opaque), np.broadcast_to(expected_bytes(PANE_COLOUR * 0.2), (5, 5, 3)))
+    lw = LoadedWorld(world=wm.World.model_validate(data), source="<test>", base_dir=Path.cwd())
+    bs = BatchedSimulation(lw, 2, precision=precision)
+    ref = bs.device("r", "cam")
+    bs.enable(ref, 16)
+    bs.step()
+    for c in range(2):
+        assert bs.image(ref)[c].tobytes() == img.tobytes(), c

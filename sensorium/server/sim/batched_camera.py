@@ -337,6 +337,11 @@ class CameraDevices(PixelDevices):
         flags[:m] = sampler.alpha[:m]
         return flags
 
+    def _receives_shadows(self, shape: np.ndarray, alpha_shapes: np.ndarray | None) -> np.ndarray:
+        """``Scene.receives_shadows`` in this camera's shape numbering."""
+        out = self.transparency[shape] <= 0.0
+        return out if alpha_shapes is None else out & ~alpha_shapes[shape]
+
     def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits,
                 alpha_shapes: np.ndarray | None = None) -> np.ndarray:
         """Camera._render of one copy's rays (``hits``: its first layer, from the copies' cast): the
@@ -359,7 +364,11 @@ class CameraDevices(PixelDevices):
         def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
             zeros = np.zeros(len(s), dtype=np.int64)
             albedo = self._albedo(s, origin[None, :], zeros, D, t, copy)
-            lit = self._shadows(P, N, zeros, copy) if self.shadows.any() else None
+            lit = None
+            if self.shadows.any():    # on opaque surfaces only, as Camera's surface
+                lit = np.ones((len(s), len(self.shadows)), dtype=bool)
+                on = self._receives_shadows(s, alpha_shapes).nonzero()[0]
+                lit[on] = self._shadows(P[on], N[on], zeros[on], copy)
             lights = self._lights_of(int(copy[0]))
             return _shade(P, N, albedo, lights, None if lit is None else lit[:, :lights.count], scene.engine.threads)
 

@@ -510,7 +510,11 @@ class Camera(Device):
 
         def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
             albedo = scene.surface_colors(s, np.broadcast_to(origin, (len(s), 3)), D, t)
-            lit = self._shadows(P, N, lights, shadows, counters) if shadows.any() else None
+            lit = None
+            if shadows.any():    # shadows fall on opaque surfaces only (Webots' translucent ones take none)
+                lit = np.ones((len(s), len(shadows)), dtype=bool)
+                on = scene.receives_shadows(s).nonzero()[0]
+                lit[on] = self._shadows(P[on], N[on], lights, shadows, counters)
             return _shade(P, N, albedo, lights, lit, engine.threads)
 
         alpha = None

@@ -27,7 +27,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.meshes import elevation_grid_mesh, load_mesh, triangles_mesh
 from sensorium.server.world.poses import pose_from_model
-from sensorium.server.world.textures import TextureSampler
+from sensorium.server.world.textures import TextureSampler, load_alpha, resolve_texture_url
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,6 +76,18 @@ def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
     return (1.0, 1.0, 1.0) if a is None else tuple(float(v) for v in a.base_color)  # type: ignore[return-value]
 
 
+def translucent(appearance: wm.Appearance | None, base_dir: Path) -> bool:
+    """Whether WREN draws a shape of this appearance as translucent: a transparency above 0 or a
+    base image with transparent texels (its material's opacity below 1 or its texture's alpha).
+    Webots casts no shadow from such a shape and shadows none on it."""
+    if appearance is None:
+        return False
+    if appearance.transparency > 0.0:
+        return True
+    t = appearance.texture
+    return t is not None and load_alpha(resolve_texture_url(t.url, base_dir, allow_outside=True), t.url) is not None
+
+
 def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None) -> ShapeEntry:
     transparent = shape.appearance is not None and shape.appearance.transparency >= 1.0
     assert shape.geometry is not None
@@ -85,7 +97,7 @@ def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None
         bounding=shape.seen_by in ("both", "bounding") and not isinstance(shape.geometry, wm.Cone),   # as Webots
         visual=shape.seen_by in ("both", "visual"),
         transparent=transparent,
-        casts_shadow=shape.cast_shadows,
+        casts_shadow=shape.cast_shadows and not translucent(shape.appearance, base_dir),
     )
 
 
@@ -578,6 +590,13 @@ class Scene:
         """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): see
         :func:`surface_colors`."""
         return surface_colors(self.colors, self.textures, self._world_to_shape, shape, origins, directions, distance)
+
+    def receives_shadows(self, shape: np.ndarray) -> np.ndarray:
+        """Per hit (shape −1: True): whether shadows fall on it -- not on a translucent shape
+        (:func:`translucent`), which WREN draws in its translucent pass, unshadowed."""
+        out = self.transparency[shape] <= 0.0
+        alpha = self.alpha_shapes
+        return out if alpha is None else out & ~alpha[shape]
 
     @property
     def alpha_shapes(self) -> np.ndarray | None:
