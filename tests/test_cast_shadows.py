@@ -33,20 +33,31 @@ def block(**extra) -> dict:
             **extra}
 
 
-def wall_light() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each pixel's wall radiance unshadowed, where the block shadows the wall from the lamp, and
-    which pixels see the block rather than the wall."""
+def wall_points() -> np.ndarray:
+    """Where each pixel's ray meets the wall's face (x = 1.95)."""
     d = rays(CAM)[0]
-    P = d * (1.95 / d[..., :1])
-    q = np.array(LAMP["location"])
+    return d * (1.95 / d[..., :1])
+
+
+def shadow_of(z_low: float, z_high: float) -> np.ndarray:
+    """The pixels whose wall point the block's slab z in (z_low, z_high) hides from the lamp: the
+    segment to the lamp crosses |y| < 0.1 there, for x across the block's depth."""
+    P, q = wall_points(), np.array(LAMP["location"])
     shadow = np.zeros(P.shape[:2], dtype=bool)
     for x in np.linspace(0.95, 1.05, 41):
         s = (x - P[..., 0]) / (q[0] - P[..., 0])
         y, z = P[..., 1] + s * (q[1] - P[..., 1]), P[..., 2] + s * (q[2] - P[..., 2])
-        shadow |= (np.abs(y) < 0.1) & (np.abs(z - 0.6) < 0.1)
-    v = q - P
+        shadow |= (np.abs(y) < 0.1) & (z > z_low) & (z < z_high)
+    return shadow
+
+
+def wall_light() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each pixel's wall radiance unshadowed, where the block shadows the wall from the lamp, and
+    which pixels see the block rather than the wall."""
+    P = wall_points()
+    v = np.array(LAMP["location"]) - P
     direct = -v[..., 0] / np.linalg.norm(v, axis=-1)
-    return ALBEDO * (0.2 + direct)[..., None], shadow, ray_hits_box(d, CENTRE, HALF)
+    return ALBEDO * (0.2 + direct)[..., None], shadow_of(0.5, 0.7), ray_hits_box(rays(CAM)[0], CENTRE, HALF)
 
 
 @pytest.mark.parametrize("precision", ["fast", "exact"])
@@ -74,14 +85,7 @@ def test_each_part_of_a_solid_keeps_its_own_flag():
     halves = {"name": "halves", "pose": {"translation": CENTRE.tolist()}, "shapes": [upper, lower]}
     _, img = shoot(world(CAM, [WALL, halves], [LAMP]))
     lit, _, sees_block = wall_light()
-    d = rays(CAM)[0]
-    P = d * (1.95 / d[..., :1])
-    q = np.array(LAMP["location"])
-    upper_shadow = np.zeros(P.shape[:2], dtype=bool)
-    for x in np.linspace(0.95, 1.05, 41):
-        s = (x - P[..., 0]) / (q[0] - P[..., 0])
-        y, z = P[..., 1] + s * (q[1] - P[..., 1]), P[..., 2] + s * (q[2] - P[..., 2])
-        upper_shadow |= (np.abs(y) < 0.1) & (z > 0.6) & (z < 0.7)
+    upper_shadow = shadow_of(0.6, 0.7)
     wall = ~sees_block & ~upper_shadow
     np.testing.assert_array_equal(rgb(img)[wall], expected_bytes(lit)[wall])
     shaded = ~sees_block & upper_shadow
