@@ -846,12 +846,23 @@ class DifferentialDrive(Strict):
     left_motor: str = Field(default="left wheel motor", min_length=1)
     right_motor: str = Field(default="right wheel motor", min_length=1)
     skid_steer: SkidSteer | None = Field(default=None, description="more wheels per side (skid steer)")
+    forward: tuple[float, float] = Field(
+        default=(1.0, 0.0), description="the direction (x, y) in the robot's frame that positive wheel speeds drive "
+        "it: the wheels' axis is along its left, z × forward (default x forward, wheels along y; a Webots robot "
+        "whose wheels turn about its x axis drives along y)")
 
     @property
     def motor_names(self) -> tuple[list[str], list[str]]:
         """(left side's motors, right side's motors), first the ``left_motor``/``right_motor``."""
         extra = self.skid_steer or SkidSteer()
         return [self.left_motor, *extra.left], [self.right_motor, *extra.right]
+
+    @field_validator("forward")
+    @classmethod
+    def _forward_nonzero(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if math.hypot(*v) == 0:
+            raise ValueError("forward must not be the zero vector")
+        return v
 
     @model_validator(mode="after")
     def _distinct(self) -> DifferentialDrive:
