@@ -90,6 +90,18 @@ def test_it_drives_along_y_at_wheel_radius_times_speed_and_turns_left_when_its_r
     assert r.device("rear_right_wheel sensor").value == pytest.approx(4.0 + 12.0, abs=1e-12)
 
 
+def test_it_stops_at_a_wall_ahead_along_its_y(tmp_path: Path) -> None:
+    wall = ('Solid { translation 0 1 0.1 children [ DEF WALL Shape { geometry Box { size 2 0.1 0.2 } } ] '
+            'boundingObject USE WALL }\n')
+    sim = Simulation(load_world(write(tmp_path, rover(), wall)), "fast")
+    go(sim, "rover", 6.0, 6.0)
+    sim.run(250)                                  # 4 s at 0.48 m/s: far beyond the wall, were it not there
+    # the body's enclosing disc (contact.py): the box's corner, or a wheel bounded by its sphere
+    footprint = max(math.hypot(0.1, 0.2), math.hypot(HX, HY) + math.hypot(R, 0.02))
+    assert sim.robot("rover").pose.translation[:2] == pytest.approx([0.0, 0.95 - footprint], abs=1e-9)
+    assert sim.counters["contacts"] > 0
+
+
 def test_two_wheels_about_plus_x_on_a_turned_robot_drive_along_its_minus_y(tmp_path: Path) -> None:
     """Axis +x: forward is +x × z = -y in the robot's frame; the robot turned by 0.5 rad about up
     drives toward the world's heading 0.5 - π/2."""
