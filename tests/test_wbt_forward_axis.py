@@ -194,3 +194,61 @@ def test_copies_drive_it_as_the_single_simulation_bit_for_bit(tmp_path: Path) ->
                 assert s.robot("rover").device(n).value == float(bs.value(bs.device("rover", n))[c]), (step, c, n)
     moved = bs.pos[:, slot, :2] - np.array([0.3, 0.1])
     assert (np.hypot(moved[:, 0], moved[:, 1]) > 0.05).all()          # they did drive
+
+
+# ---------------------------------------------------------------------- a car built along its y
+
+L, T = 0.3, 0.26                     # the car's wheelbase (along its y) and track (along its x)
+
+
+def steered(side: str, x: float) -> str:
+    """A front wheel on a Hinge2Joint: steering about -z (positive steers right, as Webots' cars), its
+    spin axis -x (not motorised)."""
+    return (f'Hinge2Joint {{ jointParameters HingeJointParameters {{ axis 0 0 -1 anchor {x} {L} 0 }}\n'
+            f'  jointParameters2 JointParameters {{ axis -1 0 0 }}\n'
+            f'  device [ RotationalMotor {{ name "{side}_steer" minPosition -0.6 maxPosition 0.6 maxVelocity 5 }} ]\n'
+            f'  endPoint Solid {{ translation {x} {L} 0 children [ USE TYRE ] boundingObject USE TYRE }} }}\n')
+
+
+def test_a_car_whose_wheels_turn_about_minus_x_drives_along_y_and_circles_right(tmp_path: Path) -> None:
+    rear = {"right_rear_wheel": (T / 2, 0.0), "left_rear_wheel": (-T / 2, 0.0)}
+    p = write(tmp_path, rover("car", wheels=rear, extra=steered("right", T / 2) + steered("left", -T / 2)))
+    w = load_world(p)
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive == wm.AckermannDrive(
+        wheelbase=L, track_front=T, track_rear=T, front_wheel_radius=R, rear_wheel_radius=R, type="propulsion",
+        max_wheel_speed=9.0, max_steering_angle=0.6, max_steering_speed=5.0, positive_steers="right",
+        forward=(0.0, 1.0))
+    sims = [Simulation(w), BatchedSimulation(w.world, 2)]
+    sim, bs = sims
+    r = sim.robot("car")
+    from sensorium.client.webots.vehicle.driver import ackermann_angles
+
+    delta = 0.2
+    right, left = ackermann_angles(delta, L, T)
+    r.motor("right_steer").set_position(right)
+    r.motor("left_steer").set_position(left)
+    for name in ("right_rear_wheel", "left_rear_wheel"):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(0.0)
+    assert bs.cars is not None
+    bs.cars.command(0, right, left, 0.0)
+    for _ in range(10):                           # the steering turns there; the car stands
+        sim.step()
+        bs.step()
+    assert r.pose.translation.tolist() == [0.0, 0.0, 0.08]
+    for name in ("right_rear_wheel", "left_rear_wheel"):
+        r.motor(name).set_velocity(8.0)
+    bs.cars.command(0, right, left, 8.0)
+    n = 300
+    for _ in range(n):
+        sim.step()
+        bs.step()
+        for c in range(2):
+            assert bs.pose(c, 0).translation.tobytes() == r.pose.translation.tobytes()
+            assert bs.pose(c, 0).rotation.tobytes() == r.pose.rotation.tobytes()
+    # clockwise (to its right, +x) on the circle of radius L / tan δ about (L / tan δ, 0)
+    radius = L / math.tan(delta)
+    phi = R * 8.0 * n * 0.016 / radius
+    assert r.pose.translation[:2] == pytest.approx([radius - radius * math.cos(phi), radius * math.sin(phi)], abs=1e-9)

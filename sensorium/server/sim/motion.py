@@ -319,7 +319,7 @@ class AckermannDrive(PlanarState):
         place = wheel_places(config)
         # each driven wheel: its motor, its (x, y) on the car, its radius
         self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
-        super().__init__(pose, up, ground, band_low)
+        super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
 
     @property
     def motors(self) -> dict[str, WheelMotor]:

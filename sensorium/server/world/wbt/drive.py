@@ -21,7 +21,8 @@ A robot whose wheels all turn about another axis that is horizontal in its frame
 its z: Webots' ``four_wheels`` how-to turns its wheels about -x and drives along +y) is judged the
 same way in the drive's own frame: x forward = axis × z (the way a positive wheel speed rolls the
 wheel: its centre moves at ω·r·(axis × up)), y its left, z the robot's; the drive then says which
-way is forward in the robot's frame (``forward``). Car-like robots still need their wheels along +y.
+way is forward in the robot's frame (``forward``). A car's frame is its driven wheels' (their axis
+taken within AXIS_TOL, as the car's other axes are).
 
 Anything else gets one sentence saying which of these failed.
 """
@@ -75,22 +76,23 @@ def _axis_off_y(wheels: list[dict], tol: float, why: str) -> str:
     return ""
 
 
-def drive_frame(wheels: list[dict]) -> tuple[np.ndarray | None, str]:
+def drive_frame(wheels: list[dict], tol: float = TOL) -> tuple[np.ndarray | None, str]:
     """The rotation from the robot's frame to its drive's (rows: forward, left, up), or None when a
-    wheel turns about the robot's +y (its frame is the drive's, as it always was); with the sentence
-    saying why there is none when the wheels turn about different or non-horizontal axes."""
+    wheel turns about the robot's +y within ``tol`` (its frame is the drive's, as it always was) or
+    there is no wheel; with the sentence saying why there is none when the wheels turn about
+    different or non-horizontal axes."""
     y = np.array([0.0, 1.0, 0.0])
     axes = [w["axis"] / np.linalg.norm(w["axis"]) for w in wheels]
-    if any(np.linalg.norm(a - y) <= TOL for a in axes):
+    if not axes or any(np.linalg.norm(a - y) <= tol for a in axes):
         return None, ""
     a0 = axes[0]
     first = wheels[0]["motor"]
-    if abs(a0[2]) > TOL:
+    if abs(a0[2]) > tol:
         return None, (f"wheel axis of motor {first!r} is {np.round(a0, 6).tolist()}, neither the robot's +y nor "
                       "horizontal in its frame (perpendicular to its z): the kinematic drive rolls on wheels whose "
                       "axis is horizontal")
     for w, a in zip(wheels[1:], axes[1:]):
-        if np.linalg.norm(a - a0) > TOL:
+        if np.linalg.norm(a - a0) > tol:
             return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not "
                           f"{np.round(a0, 6).tolist()}, the axis of motor {first!r} (the kinematic drive needs every "
                           "axis along one direction so that positive speeds drive forward)")
@@ -108,13 +110,26 @@ def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     frame, why = drive_frame(wheels)
     if why:
         return None, why
-    if frame is not None:   # judged in the drive's frame: its x forward, y left
-        wheels = [{**w, "axis": frame @ w["axis"], "anchor": frame @ w["anchor"], "centre": frame @ w["centre"]}
-                  for w in wheels]
+    wheels = _in_frame(wheels, frame)
     off = _axis_off_y(wheels, TOL, "the kinematic drive needs every axis along +y so that positive speeds drive forward")
     if off:
         return None, off
     drive, why = _two_wheels(wheels, conv) if len(wheels) == 2 else _skid_steer(wheels, conv)
+    return _framed(drive, why, frame)
+
+
+def _in_frame(wheels: list[dict], frame: np.ndarray | None) -> list[dict]:
+    """The wheels' axes and places in the drive's frame (x forward, y left), copies (the same
+    entries when the robot's frame is the drive's)."""
+    if frame is None:
+        return wheels
+    return [{**w, "axis": frame @ w["axis"], "anchor": frame @ w["anchor"], "centre": frame @ w["centre"]}
+            for w in wheels]
+
+
+def _framed(drive: dict | None, why: str, frame: np.ndarray | None) -> tuple[dict | None, str]:
+    """A drive judged in the drive's frame with its ``forward``, or the sentence saying in which
+    frame the geometry it names was judged."""
     if frame is None:
         return drive, why
     if drive is None:
@@ -198,7 +213,16 @@ below pi/2, where the bicycle model's turn radius reaches 0)."""
 
 
 def ackermann_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
-    """The kinematic Ackermann drive of a car's motorised hinges, or (None, the sentence why not)."""
+    """The kinematic Ackermann drive of a car's motorised hinges, or (None, the sentence why not);
+    judged in the drive's frame, its driven wheels' axis along its y (see the module docstring)."""
+    frame, why = drive_frame([w for w in wheels if not w["steers"]], AXIS_TOL)
+    if why:
+        return None, why
+    drive, why = _ackermann(_in_frame(wheels, frame), conv)
+    return _framed(drive, why, frame)
+
+
+def _ackermann(wheels: list[dict], conv) -> tuple[dict | None, str]:
     steering = [w for w in wheels if w["steers"]]
     driven = [w for w in wheels if not w["steers"]]
     names = ", ".join(repr(w["motor"]) for w in steering)
