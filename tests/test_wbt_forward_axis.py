@@ -1,7 +1,8 @@
 """Vehicles whose wheels turn about another horizontal axis than their +y keep their drive: Webots'
 ``four_wheels`` how-to turns its wheels about -x, so a positive wheel speed rolls it along its +y
 (a wheel's centre moves at ω·r·(axis × up)). The worlds here are our own, shaped like that how-to:
-a box body, four wheels at (±0.13, ±0.15) of radius 0.08 on hinges about -x. Closed-form checks."""
+a box body, four wheels at (±0.13, ±0.15) of radius 0.08 on hinges about -x; and a car built along its
+y the same way (the Ackermann drive). Closed-form checks, the batched copies bit for bit."""
 
 from __future__ import annotations
 
