@@ -556,6 +556,14 @@ class AckermannDescription(Result):
     left_front_wheel: str
     right_rear_wheel: str
     left_rear_wheel: str
+    forward: tuple[float, float] = Field(default=(1.0, 0.0), description="the drive's forward direction (x, y) "
+                                         "in the robot's frame; the geometry above is in the drive's axes")
+
+    @field_validator("forward", mode="before")
+    @classmethod
+    def _pair(cls, v: Any) -> Any:
+        """msgpack gives a list: the pair it is."""
+        return tuple(v) if isinstance(v, list) else v
 
 
 class AttachResult(Result):

@@ -840,6 +840,18 @@ class SkidSteer(Strict):
     right: list[str] = Field(default_factory=list, max_length=16)
 
 
+def _forward_field() -> Any:
+    return Field(default=(1.0, 0.0), description="the direction (x, y) in the robot's frame that positive wheel "
+                 "speeds drive it: the wheels' axis is along its left, z × forward (default x forward, wheels along "
+                 "y; a Webots robot whose wheels turn about its x axis drives along y)")
+
+
+def _nonzero_forward(v: tuple[float, float]) -> tuple[float, float]:
+    if math.hypot(*v) == 0:
+        raise ValueError("forward must not be the zero vector")
+    return v
+
+
 class DifferentialDrive(Strict):
     """Kinematic wheeled drive (no physics, no collision response): the robot moves in the world
     xy-plane from its wheel motors, controlled with Webots' motor API. Two wheels, or several per
@@ -851,12 +863,15 @@ class DifferentialDrive(Strict):
     left_motor: str = Field(default="left wheel motor", min_length=1)
     right_motor: str = Field(default="right wheel motor", min_length=1)
     skid_steer: SkidSteer | None = Field(default=None, description="more wheels per side (skid steer)")
+    forward: tuple[float, float] = _forward_field()
 
     @property
     def motor_names(self) -> tuple[list[str], list[str]]:
         """(left side's motors, right side's motors), first the ``left_motor``/``right_motor``."""
         extra = self.skid_steer or SkidSteer()
         return [self.left_motor, *extra.left], [self.right_motor, *extra.right]
+
+    _forward_nonzero = field_validator("forward")(_nonzero_forward)
 
     @model_validator(mode="after")
     def _distinct(self) -> DifferentialDrive:
@@ -873,7 +888,8 @@ class AckermannDrive(Strict):
     """Kinematic car-like drive (Webots' Car/AckermannVehicle geometry, no engine, no slip, no
     physics): two front wheels steered by position-controlled motors, driven wheels by velocity or
     position control, the robot turning about its origin, which is the centre of the rear axle
-    (x forward, y left). The car follows the bicycle model: its turn radius about the rear axle's
+    (x forward, y left; ``forward`` another direction of the robot's frame, its left then up ×
+    forward: the geometry below is in those axes). The car follows the bicycle model: its turn radius about the rear axle's
     centre is ``wheelbase`` times the mean of the front wheels' cotangents (exact for Ackermann
     angles), its speed the driven wheels' rolling speeds over their distances from the turn centre.
     Motor names default to Webots' vehicle library's."""
@@ -898,6 +914,9 @@ class AckermannDrive(Strict):
     left_front_wheel: str = Field(default="left_front_wheel", min_length=1)
     right_rear_wheel: str = Field(default="right_rear_wheel", min_length=1)
     left_rear_wheel: str = Field(default="left_rear_wheel", min_length=1)
+    forward: tuple[float, float] = _forward_field()
+
+    _forward_nonzero = field_validator("forward")(_nonzero_forward)
 
     @property
     def driven(self) -> list[tuple[str, str]]:

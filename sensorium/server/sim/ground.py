@@ -1,5 +1,5 @@
-"""The ground driven robots ride on: terrains (ElevationGrids) and the floor planes and box floors
-around them.
+"""The ground driven robots ride on: terrains (ElevationGrids) and the floor planes, box floors and
+cylinder tops around them.
 
 No physics: a driven robot keeps the clearance it was placed with above the ground under its
 origin. After each step's planar move its height is ``ground(x, y) + clearance`` and, over a
@@ -18,9 +18,12 @@ What counts as ground (seen by bounding rays, as kinematic contact reads the wor
 * the top of a Box whose faces are horizontal and vertical (one of its local axes the world's up,
   within UPRIGHT_TOL; turned about the vertical or not): a floor at its top over its closed
   footprint rectangle -- a slab used as the floor, a raised platform, a step -- but only *for a
-  robot whose support ceiling it does not exceed* (below).
+  robot whose support ceiling it does not exceed* (below);
+* the top of an upright Cylinder (its local z the world's up or down, within UPRIGHT_TOL): a floor
+  at its centre's height plus half its height (contact.obstacle's top of it) over its closed disc,
+  under the same support rule as a box top (what is said of box tops below holds for it).
 
-The support rule (box tops only). A box top is ground for a robot only if it is not above the
+The support rule (box and cylinder tops only). A box top is ground for a robot only if it is not above the
 robot's **support ceiling**, ``max(band bottom, the ground it rides) + contact.FLOOR``: its
 body's height band bottom (the bottom of the disc kinematic contact gives it, ``z + z_low``;
 its origin for a robot with no body) or the height of the ground it rides now (``z − clearance``),
@@ -84,12 +87,14 @@ class _Grid:
 @dataclass(slots=True)
 class _Surface:
     """One piece of ground placed in the world (ENU axes): a grid, a box's top (``half``: its half
-    sizes), or a floor plane (neither)."""
+    sizes), an upright cylinder's top (``disc``: its radius and half height), or a floor plane
+    (none of them)."""
 
     solid: str
     local: Pose                       # in the solid's frame
     grid: _Grid | None
     half: tuple[float, float, float] | None = None
+    disc: tuple[float, float] | None = None
     # a box: its top (tz) and its footprint, |u| <= hu and |v| <= hv with u = r00·ex + r10·ey and
     # v = r01·ex + r11·ey (its two horizontal local axes)
     hu: float = 0.0
@@ -145,6 +150,8 @@ class Ground:
                 elif isinstance(g, wm.Box):
                     sx, sy, sz = (float(v) / 2.0 for v in g.size)
                     surfaces.append(_Surface(s.name, local, None, (sx, sy, sz)))
+                elif isinstance(g, wm.Cylinder):
+                    surfaces.append(_Surface(s.name, local, None, disc=(float(g.radius), float(g.height) / 2.0)))
         if not any(s.grid is not None for s in surfaces):
             return None
         return cls(surfaces, solid_poses, to_enu)
@@ -160,6 +167,10 @@ class Ground:
             r, t = self._to_enu @ r, self._to_enu @ t
         if s.half is not None:
             self._place_box(s, r, t)
+            self._boxes_stale = True
+            return
+        if s.disc is not None:
+            self._place_disc(s, r, t)
             self._boxes_stale = True
             return
         s.upright = _is_upright(r)
@@ -184,6 +195,19 @@ class Ground:
         s.tz = float((corners @ r.T + t)[:, 2].max())
         s.r00, s.r10, s.r01, s.r11 = float(r[0, i]), float(r[1, i]), float(r[0, j]), float(r[1, j])
         s.hu, s.hv = s.half[i], s.half[j]
+
+    @staticmethod
+    def _place_disc(s: _Surface, r: np.ndarray, t: np.ndarray) -> None:
+        """A cylinder's top disc: ground only if its axis (local z) is the world's up or down. Its
+        top is its centre's height plus half its height, as contact.obstacle takes an upright
+        cylinder's, and its disc its radius about its axis, so both judge the same numbers."""
+        assert s.disc is not None
+        s.upright = (abs(r[0, 2]) <= UPRIGHT_TOL and abs(r[1, 2]) <= UPRIGHT_TOL
+                     and abs(r[2, 0]) <= UPRIGHT_TOL and abs(r[2, 1]) <= UPRIGHT_TOL)
+        if not s.upright:
+            return
+        s.tx, s.ty = float(t[0]), float(t[1])
+        s.tz = float(t[2] + s.disc[1])
 
     def update_solid(self, name: str, pose: Pose) -> None:
         """A solid moved (supervisor): its pieces of ground move with it."""
@@ -216,7 +240,7 @@ class Ground:
         found = np.zeros(x.shape, dtype=bool)
         first = np.full(x.shape, len(self._surfaces))     # the world-order index of each point's ground
         for i, s in enumerate(self._surfaces):
-            if not s.upright or s.half is not None:     # (box tops: all at once below)
+            if not s.upright or s.half is not None or s.disc is not None:    # (box and cylinder tops: below)
                 continue
             if s.grid is None:                   # an infinite floor
                 z = np.full(x.shape, s.tz)
@@ -246,14 +270,15 @@ class Ground:
             found[kk] = True
         boxes = self._box_table()
         if boxes is not None and x.size:
-            # every box top at every point (points x boxes): over its footprint and not above the
-            # point's ceiling; each point's highest, the first in world order on a tie (argmax), then
+            # every box or cylinder top at every point (points x tops): over its footprint (a box's
+            # rectangle; a cylinder's disc: the other's bounds are inf) and not above the point's
+            # ceiling; each point's highest, the first in world order on a tie (argmax), then
             # against the other surfaces' winner as the one loop in world order would have it
-            order, tx, ty, tz, a, b, c, d, hu, hv = boxes
+            order, tx, ty, tz, a, b, c, d, hu, hv, rr = boxes
             ex, ey = x[..., None] - tx, y[..., None] - ty
             u = a * ex + b * ey                  # the point in the box's horizontal axes
             v = c * ex + d * ey
-            ok = (np.abs(u) <= hu) & (np.abs(v) <= hv) & (tz <= ceiling[..., None])
+            ok = (np.abs(u) <= hu) & (np.abs(v) <= hv) & (ex * ex + ey * ey <= rr) & (tz <= ceiling[..., None])
             zb = np.where(ok, tz, -math.inf)
             j = np.argmax(zb, axis=-1)
             top = np.take_along_axis(zb, j[..., None], axis=-1)[..., 0]
@@ -265,12 +290,14 @@ class Ground:
         return found, best, gx, gy
 
     def _box_table(self) -> tuple[np.ndarray, ...] | None:
-        """The upright boxes' tops as arrays (world-order index, tx, ty, top, r00, r10, r01, r11,
-        hu, hv), made once per change of the surfaces; None without one."""
+        """The upright boxes' and cylinders' tops as arrays (world-order index, tx, ty, top, r00,
+        r10, r01, r11, hu, hv, squared radius; a box's radius and a cylinder's half sizes inf),
+        made once per change of the surfaces; None without one."""
         if self._boxes_stale:
             self._boxes_stale = False
-            rows = [(i, s.tx, s.ty, s.tz, s.r00, s.r10, s.r01, s.r11, s.hu, s.hv)
-                    for i, s in enumerate(self._surfaces) if s.half is not None and s.upright]
+            rows = [(i, s.tx, s.ty, s.tz, s.r00, s.r10, s.r01, s.r11, s.hu, s.hv, math.inf) if s.disc is None else
+                    (i, s.tx, s.ty, s.tz, 1.0, 0.0, 0.0, 1.0, math.inf, math.inf, s.disc[0] * s.disc[0])
+                    for i, s in enumerate(self._surfaces) if (s.half is not None or s.disc is not None) and s.upright]
             self._boxes = None if not rows else (np.array([r[0] for r in rows], dtype=np.int64),
                                                  *np.array([r[1:] for r in rows], dtype=np.float64).T)
         return self._boxes

@@ -129,19 +129,29 @@ class PlanarState:
     @ base`` (the ground's roll and pitch, the drive's yaw). A robot placed over nothing keeps its
     height wherever it goes, as without a ground. ``band_low``: the bottom of its body's height
     band below its origin (ground.band_low), which with its height makes its support ceiling: box
-    tops above it are not its ground (ground.py's support rule)."""
+    tops above it are not its ground (ground.py's support rule).
 
-    def __init__(self, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
+    ``forward``: the direction in the robot's own frame it drives along, (x, y); None is its x axis
+    (the heading is then read straight off the rotation's first column, as it always was). The
+    heading ``yaw`` is that direction's, and ``base`` what is left of the rotation, so the pose
+    ``Rz(yaw) @ base`` is the robot's own rotation whichever of its axes is forward."""
+
+    def __init__(self, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0,
+                 forward: tuple[float, float] | None = None):
         self._to_enu = _TO_ENU[up]
         self.ground = ground
         self.band_low = band_low
+        self._forward: np.ndarray | None = None
+        if forward is not None and tuple(forward) != (1.0, 0.0):
+            norm = math.hypot(forward[0], forward[1])
+            self._forward = np.array([forward[0] / norm, forward[1] / norm, 0.0])
         self.reset(pose)
 
     def reset(self, pose: Pose) -> None:
         """Take over a pose set from outside (initial pose, supervisor set_pose)."""
         if self._to_enu is not None:
             pose = Pose(self._to_enu @ pose.rotation, self._to_enu @ pose.translation)
-        forward = pose.rotation[:, 0]
+        forward = pose.rotation[:, 0] if self._forward is None else pose.rotation @ self._forward
         self.yaw = math.atan2(forward[1], forward[0])
         self.base = _rz(-self.yaw) @ pose.rotation
         self.x, self.y, self.z = (float(v) for v in pose.translation)
@@ -243,7 +253,7 @@ class DifferentialDrive(PlanarState):
         self.right = WheelMotor(config.right_motor, speed)
         self.lefts = [self.left, *(WheelMotor(name, speed) for name in (skid.left if skid else ()))]
         self.rights = [self.right, *(WheelMotor(name, speed) for name in (skid.right if skid else ()))]
-        super().__init__(pose, up, ground, band_low)
+        super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
 
     @property
     def motors(self) -> dict[str, WheelMotor]:
@@ -309,7 +319,7 @@ class AckermannDrive(PlanarState):
         place = wheel_places(config)
         # each driven wheel: its motor, its (x, y) on the car, its radius
         self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
-        super().__init__(pose, up, ground, band_low)
+        super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
 
     @property
     def motors(self) -> dict[str, WheelMotor]:

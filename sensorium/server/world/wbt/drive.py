@@ -17,6 +17,13 @@ driven wheels (motorised hinges with their axis along +y) in pairs either side o
 front pair at the steering joints' x, the rear pair on the robot's y axis (the origin is the centre
 of the rear axle, as in Webots' cars); each axle's wheels of one radius.
 
+A robot whose wheels all turn about another axis that is horizontal in its frame (perpendicular to
+its z: Webots' ``four_wheels`` how-to turns its wheels about -x and drives along +y) is judged the
+same way in the drive's own frame: x forward = axis × z (the way a positive wheel speed rolls the
+wheel: its centre moves at ω·r·(axis × up)), y its left, z the robot's; the drive then says which
+way is forward in the robot's frame (``forward``). A car's frame is its driven wheels' (their axis
+taken within AXIS_TOL, as the car's other axes are).
+
 Anything else gets one sentence saying which of these failed.
 """
 
@@ -69,17 +76,67 @@ def _axis_off_y(wheels: list[dict], tol: float, why: str) -> str:
     return ""
 
 
+def drive_frame(wheels: list[dict], tol: float = TOL) -> tuple[np.ndarray | None, str]:
+    """The rotation from the robot's frame to its drive's (rows: forward, left, up), or None when a
+    wheel turns about the robot's +y within ``tol`` (its frame is the drive's, as it always was) or
+    there is no wheel; with the sentence saying why there is none when the wheels turn about
+    different or non-horizontal axes."""
+    y = np.array([0.0, 1.0, 0.0])
+    axes = [w["axis"] / np.linalg.norm(w["axis"]) for w in wheels]
+    if not axes or any(np.linalg.norm(a - y) <= tol for a in axes):
+        return None, ""
+    a0 = axes[0]
+    first = wheels[0]["motor"]
+    if abs(a0[2]) > tol:
+        return None, (f"wheel axis of motor {first!r} is {np.round(a0, 6).tolist()}, neither the robot's +y nor "
+                      "horizontal in its frame (perpendicular to its z): the kinematic drive rolls on wheels whose "
+                      "axis is horizontal")
+    for w, a in zip(wheels[1:], axes[1:]):
+        if np.linalg.norm(a - a0) > tol:
+            return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not "
+                          f"{np.round(a0, 6).tolist()}, the axis of motor {first!r} (the kinematic drive needs every "
+                          "axis along one direction so that positive speeds drive forward)")
+    fx, fy = a0[1], -a0[0]                  # axis × z: where a positive speed rolls the wheel
+    n = float(np.hypot(fx, fy))
+    fx, fy = fx / n, fy / n
+    return np.array([[fx, fy, 0.0], [-fy, fx, 0.0], [0.0, 0.0, 1.0]]), ""
+
+
 def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     """The kinematic drive of a robot's motorised hinges (two wheels, or several per side: skid
     steer), or (None, the sentence saying why not)."""
     if len(wheels) < 2:
         return None, f"{len(wheels)} motorised hinge joint; a drive needs two wheels or more, on both sides"
+    frame, why = drive_frame(wheels)
+    if why:
+        return None, why
+    wheels = _in_frame(wheels, frame)
     off = _axis_off_y(wheels, TOL, "the kinematic drive needs every axis along +y so that positive speeds drive forward")
     if off:
         return None, off
-    if len(wheels) == 2:
-        return _two_wheels(wheels, conv)
-    return _skid_steer(wheels, conv)
+    drive, why = _two_wheels(wheels, conv) if len(wheels) == 2 else _skid_steer(wheels, conv)
+    return _framed(drive, why, frame)
+
+
+def _in_frame(wheels: list[dict], frame: np.ndarray | None) -> list[dict]:
+    """The wheels' axes and places in the drive's frame (x forward, y left), copies (the same
+    entries when the robot's frame is the drive's)."""
+    if frame is None:
+        return wheels
+    return [{**w, "axis": frame @ w["axis"], "anchor": frame @ w["anchor"], "centre": frame @ w["centre"]}
+            for w in wheels]
+
+
+def _framed(drive: dict | None, why: str, frame: np.ndarray | None) -> tuple[dict | None, str]:
+    """A drive judged in the drive's frame with its ``forward``, or the sentence saying in which
+    frame the geometry it names was judged."""
+    if frame is None:
+        return drive, why
+    if drive is None:
+        fwd = np.round(frame[0, :2], 6).tolist()
+        return None, f"{why}; in the drive's frame: x forward along {fwd} in the robot's, y its left"
+    drive["forward"] = [float(frame[0, 0]), float(frame[0, 1])]
+    return drive, ""
 
 
 def _radius(wheels: list[dict], conv) -> tuple[float | None, str]:
@@ -156,7 +213,16 @@ below pi/2, where the bicycle model's turn radius reaches 0)."""
 
 
 def ackermann_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
-    """The kinematic Ackermann drive of a car's motorised hinges, or (None, the sentence why not)."""
+    """The kinematic Ackermann drive of a car's motorised hinges, or (None, the sentence why not);
+    judged in the drive's frame, its driven wheels' axis along its y (see the module docstring)."""
+    frame, why = drive_frame([w for w in wheels if not w["steers"]], AXIS_TOL)
+    if why:
+        return None, why
+    drive, why = _ackermann(_in_frame(wheels, frame), conv)
+    return _framed(drive, why, frame)
+
+
+def _ackermann(wheels: list[dict], conv) -> tuple[dict | None, str]:
     steering = [w for w in wheels if w["steers"]]
     driven = [w for w in wheels if not w["steers"]]
     names = ", ".join(repr(w["motor"]) for w in steering)
