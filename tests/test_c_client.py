@@ -649,6 +649,25 @@ def test_infinite_velocity_is_clamped_alike_in_process_and_by_both_clients(cbin,
     assert python_script(servers(conformance.WORLD).url(conformance.ROBOT), *script) == expected
 
 
+def test_negative_velocity_in_position_control_is_ignored_alike_in_process_and_by_both_clients(cbin, servers):
+    """setVelocity(-3) while in position control: both clients print libController's line and ignore it;
+    the in-process API took it (the wheel then crept to its target at 3 rad/s instead of maxVelocity), so
+    the lines the simulation computes for this script differed from the clients'. In velocity control a
+    negative velocity is taken by all three."""
+    from sensorium.server.sim import conformance
+
+    script = ["enable", "left encoder", "16", "pos", "left wheel motor", "1", "vel", "left wheel motor", "-3",
+              "step", "16", "2", "pos", "left wheel motor", "inf", "vel", "left wheel motor", "-3", "step", "16", "2"]
+    expected = conformance.expected_lines(script=script)
+    server = servers(conformance.WORLD)
+    c_code, c_lines, c_err = finish(start([cbin["script"], *script], server.url(conformance.ROBOT)))
+    assert c_code == 0, c_err
+    assert c_lines == expected
+    assert ("Error: wb_motor_set_velocity() called with negative 'velocity' argument in position control mode "
+            "(1).") in c_err
+    assert python_script(servers(conformance.WORLD).url(conformance.ROBOT), *script) == expected
+
+
 def test_c_and_mixed_controllers_replay_the_radio_session(cbin, servers):
     """sensorium/schemas/conformance/radio.json: two C controllers, then a C rover and a Python buddy,
     talk by radio and print exactly the lines computed from the simulation (packets, signal
