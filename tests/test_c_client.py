@@ -37,7 +37,7 @@ CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene",
-               "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children"]
+               "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
@@ -45,6 +45,7 @@ CAR_WORLD = REPO / "tests" / "worlds" / "car.yaml"
 SCENE_WORLD = REPO / "tests" / "worlds" / "supervisor_scene.yaml"
 REMOVE_WORLD = REPO / "tests" / "worlds" / "supervisor_remove.yaml"
 ROOT_WORLD = REPO / "tests" / "worlds" / "root_children.wbt"
+PROTOS_WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_protos.wbt"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
@@ -561,16 +562,37 @@ def test_c_supervisor_removes_a_solid_and_a_light(cbin, servers):
 def test_c_supervisor_walks_the_roots_children_in_file_order(cbin, servers):
     """tests/c/root_children.c on tests/worlds/root_children.wbt, built with sanitizers: the children's
     type names and DEFs in file order (WorldInfo, Viewpoint, Background not simulated, then the solid
-    before the robot), WorldInfo first with its gravity and time step, the Viewpoint's position Webots'
-    "no value"; a solid imported at position 3 lands after the Background and leaves when removed."""
+    before the robot), WorldInfo first with its gravity and time step, the Viewpoint's position as the
+    file writes it; a solid imported at position 3 lands after the Background and leaves when removed."""
     code, out, err = finish(start([cbin["root_children"]], servers(ROOT_WORLD).url("boss")))
     assert code == 0, err
     order = "WorldInfo:INFO Viewpoint:VIEW Background:SKY Solid:BOX Robot:BOSS PointLight:LAMP"
     assert out[0] == f"children {order}"
     assert out[1] == "info 1 3.71 16 WGS84"
-    assert out[2] == "view 1"
+    assert out[2] == "view 0 -4 2"
     assert out[3] == "imported WorldInfo:INFO Viewpoint:VIEW Background:SKY Solid:BALL Solid:BOX Robot:BOSS PointLight:LAMP"
     assert out[4] == f"removed {order}"
+
+
+def test_c_supervisor_names_proto_instances_and_reads_scenery_values(cbin, servers):
+    """tests/c/supervisor_protos.c on tests/worlds/proto/supervisor_protos.wbt (tests/test_supervisor_protos.py
+    for Python), built with sanitizers: a PROTO instance's type name is its PROTO's (the outermost one),
+    its base type name the base node's, is_proto 1; the Viewpoint's and Background's written values
+    (skyColor an MFColor: index -1 the last, 2 out of bounds); tracking a field is accepted (a negative
+    period gets Webots' line) and its getter answers the value set."""
+    code, out, err = finish(start([cbin["supervisor_protos"]], servers(PROTOS_WORLD).url("boss")))
+    assert code == 0, err
+    assert out == ["names WorldInfo:WorldInfo:0 Viewpoint:Viewpoint:0 Sky:Background:1 Boss:Robot:1 Crate:Solid:1 "
+                   "BigCrate:Solid:1 Beacon:PointLight:1 Solid:Solid:0",
+                   "self Boss 1",
+                   "view 1 2 3 0 0 1 1.5 0.5 top",
+                   "sky MFColor 2 0.1 0.2 0.3 0.4 0.5 0.6 0.5 1",
+                   "seed 0",
+                   "tracked 0 0.5"]
+    assert "not served" not in err
+    assert "Error: wb_supervisor_field_enable_sf_tracking() called with negative sampling period." in err
+    assert ("Error: wb_supervisor_field_get_mf_color() called with an out-of-bound index: 2 (should be between -2 "
+            "and 1).") in err
 
 
 def test_c_supervisor_imports_a_solid_and_a_light(cbin, servers):
@@ -646,6 +668,25 @@ def test_infinite_velocity_is_clamped_alike_in_process_and_by_both_clients(cbin,
     assert c_lines == expected
     assert "The requested velocity inf exceeds 'maxVelocity'" in c_err
     assert "The requested velocity -inf exceeds 'maxVelocity'" in c_err
+    assert python_script(servers(conformance.WORLD).url(conformance.ROBOT), *script) == expected
+
+
+def test_negative_velocity_in_position_control_is_ignored_alike_in_process_and_by_both_clients(cbin, servers):
+    """setVelocity(-3) while in position control: both clients print libController's line and ignore it;
+    the in-process API took it (the wheel then crept to its target at 3 rad/s instead of maxVelocity), so
+    the lines the simulation computes for this script differed from the clients'. In velocity control a
+    negative velocity is taken by all three."""
+    from sensorium.server.sim import conformance
+
+    script = ["enable", "left encoder", "16", "pos", "left wheel motor", "1", "vel", "left wheel motor", "-3",
+              "step", "16", "2", "pos", "left wheel motor", "inf", "vel", "left wheel motor", "-3", "step", "16", "2"]
+    expected = conformance.expected_lines(script=script)
+    server = servers(conformance.WORLD)
+    c_code, c_lines, c_err = finish(start([cbin["script"], *script], server.url(conformance.ROBOT)))
+    assert c_code == 0, c_err
+    assert c_lines == expected
+    assert ("Error: wb_motor_set_velocity() called with negative 'velocity' argument in position control mode "
+            "(1).") in c_err
     assert python_script(servers(conformance.WORLD).url(conformance.ROBOT), *script) == expected
 
 

@@ -559,7 +559,7 @@ def test_motor_commands_are_buffered_and_sent_with_the_step(server, capsys):
         r2.set_motor_velocity(left, -1.0, "wb_motor_set_velocity")
         err_text = capsys.readouterr().err
         assert "invalid 'velocity' argument (NaN)" in err_text
-        assert "negative 'velocity' argument in position control mode" in err_text
+        assert "negative 'velocity' argument in position control mode (1.5)." in err_text     # the target
         assert r2.motor_commands == {LEFT: {"position": 1.5}} and left.velocity == 1.0
 
 

@@ -548,6 +548,28 @@ def test_velocity_clamped_and_position_control_stops_at_target() -> None:
         sim.robot("r").motor("x")
 
 
+def test_negative_velocity_in_position_control_is_ignored_with_webots_line_as_the_clients_do(capsys) -> None:
+    """Webots' libController (and both clients) print one error line and ignore setVelocity(v < 0)
+    while the motor is in position control; the in-process API took it and ran at |v|. The wheel
+    keeps maxVelocity (10 rad/s) as its speed limit: one 16 ms step towards target 1 rad turns it
+    0.16 rad (0.048 at 3 rad/s). In velocity control a negative velocity turns the wheel backwards."""
+    sim = _driven()
+    m = sim.robot("r").motor("left wheel motor")
+    m.set_position(1.0)
+    m.set_velocity(-3.0)
+    err = capsys.readouterr().err.splitlines()
+    assert err == ["Error: setVelocity() called with negative 'velocity' argument in position control mode (1): "
+                   "motor 'left wheel motor' keeps 10."]
+    assert m.velocity == 10.0
+    sim.run(1)
+    assert m.position == pytest.approx(0.16, abs=1e-12)
+    m.set_position(math.inf)
+    m.set_velocity(-3.0)
+    assert m.velocity == -3.0 and capsys.readouterr().err == ""
+    sim.run(1)
+    assert m.position == pytest.approx(0.16 - 0.048, abs=1e-12)
+
+
 def test_infinite_velocity_is_clamped_to_max_velocity_as_the_clients_do() -> None:
     """set_velocity(inf) raised ValueError in process where the Python and C clients clamp it to
     maxVelocity (Webots' WbMotor::setVelocity clamps any |v| > maxVelocity, inf included):

@@ -76,12 +76,12 @@ def test_supervisor_services_need_a_supervisor_robot_and_its_controller(live):
     live.err(B, "/pioneer/robot/get_self", {}, ErrorCode.NOT_ATTACHED)      # not pioneer's controller
     live.err(B, "/rover/robot/simulation_reset", {}, ErrorCode.NOT_SUPERVISOR)
     assert live.ok(A, "/pioneer/robot/get_self") == {"node": 1, "type": "Robot", "name": "pioneer", "def_name": "",
-                                                     "parent": 0}
+                                                     "parent": 0, "proto": ""}
     assert live.ok(A, "/pioneer/robot/get_from_def", {"name": "wall"}) == {"node": 4, "type": "Solid", "name": "wall",
-                                                                           "def_name": "", "parent": 0}
+                                                                           "def_name": "", "parent": 0, "proto": ""}
     assert live.ok(A, "/pioneer/robot/get_from_def", {"name": "rover"})["node"] == 2
     assert live.ok(A, "/pioneer/robot/get_from_def", {"name": "nothing"}) == {
-        "node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
+        "node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
     live.err(A, "/pioneer/robot/get_field", {"node": 99, "field": "translation"}, ErrorCode.INVALID_ARGUMENT)
     assert live.ok(A, "/pioneer/robot/get_field", {"node": 1, "field": "children"}) == {"type": "", "value": []}
     live.err(A, "/pioneer/robot/set_field", {"node": 1, "field": "rotation", "value": [0, 0, 1]},

@@ -107,7 +107,7 @@ def test_imported_nodes_have_new_ids_their_def_and_their_place_in_the_children()
     assert imports(lv, BOX + "\n" + LIGHT, 0) == [FIRST, FIRST + 1]          # both nodes, in order, first
     assert children(lv) == [FIRST, FIRST + 1, *SCENERY, BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB]
     ball = boss(lv, "get_from_def", {"name": "BALL"})
-    assert ball == {"node": FIRST, "type": "Solid", "name": "ball", "def_name": "BALL", "parent": 0}
+    assert ball == {"node": FIRST, "type": "Solid", "name": "ball", "def_name": "BALL", "parent": 0, "proto": ""}
     assert boss(lv, "get_from_id", {"id": FIRST}) == ball
     assert boss(lv, "get_field", {"node": FIRST, "field": "translation"})["value"] == [1.6, 0.0, 0.25]
     boss(lv, "remove_node", {"node": FIRST})

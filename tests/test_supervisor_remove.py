@@ -26,7 +26,7 @@ BOSS, ROVER, WALL, CRATE, GATE, LAMP, BULB = range(1, 8)      # node ids: robots
 # children's first two places
 WORLD_INFO, VIEWPOINT = 8, 9
 SCENERY = [WORLD_INFO, VIEWPOINT]
-NULL = {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
+NULL = {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
 
 
 def _live(precision: str = "exact", **kw) -> Live:

@@ -67,8 +67,10 @@ def test_world_info_fields_answer_the_worlds_values():
     assert field(lv, INFO, "randomSeed") == {"type": "SFInt32", "value": 0}
     # what the model does not keep: Webots' "no value", never a crash
     assert field(lv, INFO, "info") == {"type": "", "value": []}
-    assert field(lv, VIEW, "position") == {"type": "", "value": []}
-    assert field(lv, SKY, "skyColor") == {"type": "", "value": []}
+    assert field(lv, VIEW, "position") == {"type": "SFVec3f", "value": [0.0, -4.0, 2.0]}     # the file's
+    assert field(lv, VIEW, "orientation") == {"type": "SFRotation", "value": [0.0, 0.0, 1.0, 0.0]}   # Webots'
+    assert field(lv, SKY, "skyColor") == {"type": "MFColor", "value": [[0.2, 0.3, 0.4]]}
+    assert field(lv, VIEW, "lensFlare") == {"type": "", "value": []}
     pose = boss(lv, "get_node_pose", {"node": VIEW})
     assert all(math.isnan(v) for v in pose["position"])
     assert boss(lv, "get_node_velocity", {"node": SKY})["value"] == [0.0] * 6
@@ -77,7 +79,10 @@ def test_world_info_fields_answer_the_worlds_values():
     assert msg == "set_field: field 'gravity' (SFFloat) of WorldInfo 4 is read-only here"
     msg = lv.err(A, "/boss/robot/set_field", {"node": VIEW, "field": "position", "value": [0, 0, 1]},
                  ErrorCode.INVALID_ARGUMENT)
-    assert msg == "set_field: Viewpoint 5 has no field 'position' here (fields: none)"
+    assert msg == "set_field: field 'position' (SFVec3f) of Viewpoint 5 is read-only here"
+    msg = lv.err(A, "/boss/robot/set_field", {"node": SKY, "field": "fogColor", "value": [0, 0, 1]},
+                 ErrorCode.INVALID_ARGUMENT)
+    assert msg == "set_field: Background 6 has no field 'fogColor' here (fields: skyColor, luminosity)"
 
 
 def test_nodes_not_simulated_cannot_be_removed_and_ids_stay_stable():
@@ -127,7 +132,7 @@ def test_a_webots_supervisor_walks_the_roots_children(tmp_path):
     assert out["before"] == TYPES_DEFS
     assert out["world_info"] == [True, pytest.approx(3.71), 16.0, "root order", "WGS84",
                                  pytest.approx([46.5, 6.6, 372.0]), "ENU"]
-    assert out["no_value"] == [True, True]
+    assert out["no_value"] == [[0.0, -4.0, 2.0], True]
     assert out["imported"] == [*TYPES_DEFS[:3], ["Solid", "BALL"], *TYPES_DEFS[3:5], ["PointLight", "SPARK"],
                                TYPES_DEFS[5]]
     assert out["removed"] == TYPES_DEFS

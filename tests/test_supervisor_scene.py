@@ -37,7 +37,7 @@ def judge(lv: Live, item: str, args: dict | None = None):
 
 def test_root_children_ids_defs_and_parents():
     lv = _live()
-    assert judge(lv, "get_root") == {"node": 0, "type": "Group", "name": "", "def_name": "", "parent": -1}
+    assert judge(lv, "get_root") == {"node": 0, "type": "Group", "name": "", "def_name": "", "parent": -1, "proto": ""}
     children = judge(lv, "get_field", {"node": 0, "field": "children"})
     # Webots' WorldInfo and Viewpoint first (a YAML world's defaults: ids after its own nodes), then the
     # robots, solids and lights
@@ -48,7 +48,7 @@ def test_root_children_ids_defs_and_parents():
         ("Robot", "judge", "JUDGE", 0), ("Robot", "runner", "", 0), ("Solid", "crate", "CRATE", 0),
         ("PointLight", "lamp", "", 0), ("DirectionalLight", "sun", "", 0)]
     assert judge(lv, "get_from_id", {"id": 0})["type"] == "Group"
-    assert judge(lv, "get_from_id", {"id": 8}) == {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
+    assert judge(lv, "get_from_id", {"id": 8}) == {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
     assert judge(lv, "get_from_def", {"name": "CRATE"})["node"] == 3
     assert judge(lv, "get_from_def", {"name": "sun"})["node"] == 5     # a light by its world-file name
     assert judge(lv, "get_self")["def_name"] == "JUDGE"

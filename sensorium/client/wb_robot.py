@@ -522,7 +522,7 @@ class RobotClient:
             return
         if velocity < 0.0 and not math.isinf(dev.target_position):
             print(f"Error: {func}() called with negative 'velocity' argument in position control mode "
-                  f"({velocity:g}).", file=sys.stderr)
+                  f"({dev.target_position:g}).", file=sys.stderr)     # libController shows the target position
             return
         limit = dev.max_velocity
         if abs(velocity) > limit:

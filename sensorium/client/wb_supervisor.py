@@ -33,11 +33,12 @@ WB_SF_COLOR = 7
 WB_SF_STRING = 8
 WB_SF_NODE = 9
 WB_MF = 0x10
+WB_MF_COLOR = 0x17
 WB_MF_NODE = 0x19
 
 FIELD_TYPES = {"SFBool": WB_SF_BOOL, "SFInt32": WB_SF_INT32, "SFFloat": WB_SF_FLOAT, "SFVec2f": WB_SF_VEC2F,
                "SFVec3f": WB_SF_VEC3F, "SFRotation": WB_SF_ROTATION, "SFColor": WB_SF_COLOR,
-               "SFString": WB_SF_STRING, "SFNode": WB_SF_NODE, "MFNode": WB_MF_NODE}
+               "SFString": WB_SF_STRING, "SFNode": WB_SF_NODE, "MFColor": WB_MF_COLOR, "MFNode": WB_MF_NODE}
 _TYPE_NAMES = {v: k for k, v in FIELD_TYPES.items()}
 # Webots' node type constants of the node kinds Sensorium serves
 NODE_TYPES = {"Group": "WB_NODE_GROUP", "Robot": "WB_NODE_ROBOT", "Solid": "WB_NODE_SOLID",
@@ -155,14 +156,21 @@ def wb_supervisor_node_get_id(node: int | None) -> int:
 
 
 def wb_supervisor_node_get_type_name(node: int | None) -> str:
+    """Webots' type name: a PROTO instance's PROTO name ("MiniPuck"), else the node's type ("Solid")."""
     info = _live_node_info(node, "wb_supervisor_node_get_type_name")
-    return "" if info is None else str(info["type"])
+    return "" if info is None else str(info.get("proto") or info["type"])
 
 
 def wb_supervisor_node_get_base_type_name(node: int | None) -> str:
-    """Sensorium keeps no PROTO names: the base type is the type (Robot, Solid, PointLight, ...)."""
+    """The base node type (Robot, Solid, PointLight, Background, ...), a PROTO instance's too."""
     info = _live_node_info(node, "wb_supervisor_node_get_base_type_name")
     return "" if info is None else str(info["type"])
+
+
+def wb_supervisor_node_is_proto(node: int | None) -> bool:
+    """Whether the node is a PROTO instance (the world file writes it with a PROTO's name)."""
+    info = _live_node_info(node, "wb_supervisor_node_is_proto")
+    return info is not None and bool(info.get("proto"))
 
 
 def wb_supervisor_node_get_type(node: int | None) -> int:
@@ -390,6 +398,11 @@ def wb_supervisor_field_get_sf_bool(field: Field | None) -> bool:
     return False if v is None else bool(v)
 
 
+def wb_supervisor_field_get_sf_int32(field: Field | None) -> int:
+    v = _field_value(field, WB_SF_INT32, "wb_supervisor_field_get_sf_int32")
+    return 0 if v is None else int(v)
+
+
 def wb_supervisor_field_get_sf_float(field: Field | None) -> float:
     v = _field_value(field, WB_SF_FLOAT, "wb_supervisor_field_get_sf_float")
     return math.nan if v is None else float(v)
@@ -416,13 +429,12 @@ def wb_supervisor_field_get_sf_color(field: Field | None) -> list[float] | None:
     return _floats(_field_value(field, WB_SF_COLOR, "wb_supervisor_field_get_sf_color"), 3)
 
 
-def wb_supervisor_field_get_mf_node(field: Field | None, index: int) -> int | None:
-    """Item ``index`` of an MFNode field (negative counts from the end, as Webots)."""
-    func = "wb_supervisor_field_get_mf_node"
-    ids = _field_value(field, WB_MF_NODE, func)
-    if ids is None:
+def _mf_item(field: Field | None, want: int, index: int, func: str) -> Any:
+    """Item ``index`` of an MF field (negative counts from the end, as Webots); None after Webots' line."""
+    items = _field_value(field, want, func)
+    if items is None:
         return None
-    count = len(ids)
+    count = len(items)
     if isinstance(index, bool) or not isinstance(index, int) or not -count <= index < count:
         if count == 0:
             print(f"Error: {func}() called on an empty list.", file=sys.stderr)
@@ -430,7 +442,31 @@ def wb_supervisor_field_get_mf_node(field: Field | None, index: int) -> int | No
             print(f"Error: {func}() called with an out-of-bound index: {index} (should be between {-count} and "
                   f"{count - 1}).", file=sys.stderr)
         return None
-    return int(ids[index])
+    return items[index]
+
+
+def wb_supervisor_field_get_mf_node(field: Field | None, index: int) -> int | None:
+    """Item ``index`` of an MFNode field (negative counts from the end, as Webots)."""
+    node = _mf_item(field, WB_MF_NODE, index, "wb_supervisor_field_get_mf_node")
+    return None if node is None else int(node)
+
+
+def wb_supervisor_field_get_mf_color(field: Field | None, index: int) -> list[float] | None:
+    """Colour ``index`` of an MFColor field (a Background's ``skyColor``; negative counts from the end)."""
+    return _floats(_mf_item(field, WB_MF_COLOR, index, "wb_supervisor_field_get_mf_color"), 3)
+
+
+def wb_supervisor_field_enable_sf_tracking(field: Field | None, sampling_period: int) -> None:
+    """Webots sends a tracked field's value every sampling period so that its getters need no round
+    trip; here every getter asks the server and answers the value of now, which is what tracking
+    shows at each step: accepted after Webots' checks, nothing else to do."""
+    func = "wb_supervisor_field_enable_sf_tracking"
+    if _field_robot(field, None, func) is not None and sampling_period < 0:
+        print(f"Error: {func}() called with negative sampling period.", file=sys.stderr)
+
+
+def wb_supervisor_field_disable_sf_tracking(field: Field | None) -> None:
+    _field_robot(field, None, "wb_supervisor_field_disable_sf_tracking")
 
 
 def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:

@@ -701,18 +701,23 @@ class StringValue(Result):
 
 class NodeResult(Result):
     node: int = Field(description="node id (0: the root); with type '' there is no such node (Webots' NULL)")
-    type: Literal["Group", "Robot", "Solid", "PointLight", "SpotLight", "DirectionalLight", ""] = Field(
-        description="Webots' type (and base type) name; '' = no such node")
+    type: str = Field(description="Webots' base type name: Group (the root), Robot, Solid, PointLight, SpotLight, "
+                                  "DirectionalLight, or a top-level node's not simulated (WorldInfo, Viewpoint, ...); "
+                                  "'' = no such node")
+    proto: str = Field(default="", description="a PROTO instance: the PROTO's name (Webots' getTypeName; "
+                                               "isProto); '' for a base node")
     name: str = Field(description="the node's name (a robot's or solid's name field; a light's world-file name)")
     def_name: str = Field(description="its DEF name ('' without one)")
     parent: int = Field(description="the parent's node id (0 for a top-level node; -1 for the root and NULL)")
 
 
 class FieldValueResult(Result):
-    type: str = Field(description="Webots' field type name (SFVec3f, SFRotation, SFColor, SFFloat, SFBool, SFString, "
-                                  "MFNode); '' = the node has no such field here (the value is then [])")
-    value: bool | float | str | list[float] | list[int] = Field(
-        description="SFBool bool; SFFloat number; SFString str; SFVec3f/SFColor/SFRotation numbers; MFNode node ids")
+    type: str = Field(description="Webots' field type name (SFVec3f, SFRotation, SFColor, SFFloat, SFInt32, SFBool, "
+                                  "SFString, MFNode, MFColor); '' = the node has no such field here (the value is "
+                                  "then [])")
+    value: bool | float | str | list[float] | list[int] | list[list[float]] = Field(
+        description="SFBool bool; SFFloat/SFInt32 number; SFString str; SFVec3f/SFColor/SFRotation numbers; MFNode "
+                    "node ids; MFColor one list of 3 numbers per colour")
 
 
 class NodePoseResult(Result):

@@ -1037,7 +1037,12 @@ class TopNode(Strict):
     ``Viewpoint``, ``Background``, ...) keeps its type and DEF name only."""
 
     type: str = Field(min_length=1, description="Webots node type (a PROTO instance: its base type)")
+    proto: str | None = Field(default=None, min_length=1, description="a PROTO instance: the PROTO's name "
+                              "(Supervisor getTypeName; getBaseTypeName is type)")
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
+    fields: dict[str, float | str | list[float] | list[list[float]]] = Field(
+        default={}, description="a node not simulated (Viewpoint, Background): the world file's values of the fields "
+        "the Supervisor reads (README 'Supervisor')")
     robots: int = Field(default=0, ge=0, description="robots this node became")
     solids: int = Field(default=0, ge=0, description="top-level solids this node became")
     lights: int = Field(default=0, ge=0, description="top-level lights this node became")

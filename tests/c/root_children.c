@@ -26,7 +26,9 @@ int main(void) {
          wb_supervisor_field_get_sf_float(wb_supervisor_node_get_field(info, "gravity")),
          wb_supervisor_field_get_sf_float(wb_supervisor_node_get_field(info, "basicTimeStep")),
          wb_supervisor_field_get_sf_string(wb_supervisor_node_get_field(info, "gpsCoordinateSystem")));
-  printf("view %d\n", wb_supervisor_node_get_field(wb_supervisor_field_get_mf_node(children, 1), "position") == NULL);
+  const double *view = wb_supervisor_field_get_sf_vec3f(
+    wb_supervisor_node_get_field(wb_supervisor_field_get_mf_node(children, 1), "position"));
+  printf("view %g %g %g\n", view[0], view[1], view[2]);
   wb_supervisor_field_import_mf_node_from_string(children, 3, "DEF BALL Solid { name \"ball\" }");
   wb_robot_step(dt);
   walk("imported", children);

@@ -24,7 +24,7 @@ world_info = [info.getType() == Node.WORLD_INFO, info.getField("gravity").getSFF
               info.getField("gpsCoordinateSystem").getSFString(), info.getField("gpsReference").getSFVec3f(),
               info.getField("coordinateSystem").getSFString()]
 view = children.getMFNode(1)
-no_value = [view.getField("position") is None, view.getPosition()[0] != view.getPosition()[0]]   # NaN
+no_value = [view.getField("position").getSFVec3f(), view.getPosition()[0] != view.getPosition()[0]]   # NaN
 children.importMFNodeFromString(3, 'DEF BALL Solid { name "ball" }')       # after the Background
 children.importMFNodeFromString(-2, "DEF SPARK PointLight { }")             # before the last
 robot.step(timestep)

@@ -227,7 +227,7 @@ class DeviceServices:
         return {"success": True}
 
     def _motor_set_velocity(self, c: Call) -> dict:
-        c.motor.set_velocity(c.args.value)
+        c.motor.command_velocity(c.args.value)
         return {"success": True}
 
     def _motor_get_velocity(self, c: Call) -> dict:

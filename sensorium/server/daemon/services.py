@@ -644,7 +644,7 @@ class Core(DeviceServices):
             if cmd.position is not None:
                 motor.set_position(cmd.position)
             if cmd.velocity is not None:
-                motor.set_velocity(cmd.velocity)
+                motor.command_velocity(cmd.velocity)
 
     def _motor_commands(self, robot: str, motors: dict[str, Any]) -> list[tuple[Any, Any]]:
         """Resolve every named motor first, so that a bad name applies none of the commands."""

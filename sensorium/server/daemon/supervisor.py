@@ -41,6 +41,7 @@ class Node:
     key: str | int     # the robot's or solid's name, a light's index among the top-level lights, a scenery
                        # node's index (world/top_nodes.py); root: ""
     scenery: bool = False   # a top-level node Sensorium does not simulate (WorldInfo, Viewpoint, Background, ...)
+    proto: str = ""         # the PROTO it is an instance of (Webots' getTypeName; ``type`` is its base type)
 
 
 ROOT = Node(0, "Group", "", "", "")
@@ -67,20 +68,27 @@ def _all_nodes(sim: Any) -> list[Node]:
     names = sim.scene.solid_names
     top = sim.scene.top_lights()
     loaded_solids, loaded_lights = _loaded_counts(sim)
-    out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name) for i, name in enumerate(sim.robots)]
+    layout = getattr(sim, "top_level", None)
+    protos = layout.protos if layout is not None else {}
+    out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name, proto=protos.get(("robots", i), ""))
+           for i, name in enumerate(sim.robots)]
     first = len(out) + 1
-    out += [Node(first + j, "Solid", names[j], def_of(solids_m, j), names[j]) for j in range(loaded_solids)]
+    out += [Node(first + j, "Solid", names[j], def_of(solids_m, j), names[j], proto=protos.get(("solids", j), ""))
+            for j in range(loaded_solids)]
     first = len(out) + 1
-    out += [Node(first + k, top[k].type, top[k].name or "", def_of(top, k), k) for k in range(loaded_lights)]
+    out += [Node(first + k, top[k].type, top[k].name or "", def_of(top, k), k, proto=protos.get(("lights", k), ""))
+            for k in range(loaded_lights)]
     first = len(out) + 1
-    out += [Node(first + x, s.type, "", s.def_name, x, scenery=True) for x, s in enumerate(_scenery(sim))]
+    out += [Node(first + x, s.type, "", s.def_name, x, scenery=True, proto=s.proto) for x, s in enumerate(_scenery(sim))]
+    imported_protos = getattr(sim, "imported_protos", {})
     for kind, key in imported:
+        proto = imported_protos.get(key, "")
         if kind == "Solid":
             j = names.index(key)
-            out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key))
+            out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key, proto=proto))
         else:
             lt = top[int(key)]
-            out.append(Node(len(out) + 1, lt.type, lt.name or "", def_of(top, int(key)), key))
+            out.append(Node(len(out) + 1, lt.type, lt.name or "", def_of(top, int(key)), key, proto=proto))
     return out
 
 
@@ -163,9 +171,9 @@ def node_from_id(sim: Any, node: int) -> Node | None:
 
 def node_ref(sim: Any, node: Node | None) -> dict:
     if node is None:
-        return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1}
+        return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
     return {"node": node.id, "type": node.type, "name": node.name, "def_name": node.def_name,
-            "parent": -1 if node.id == 0 else 0}
+            "parent": -1 if node.id == 0 else 0, "proto": node.proto}
 
 
 def _pose(sim: Any, node: Node) -> Any:
@@ -289,6 +297,13 @@ def _info(attr: str, convert: Callable[[Any], Any] = lambda v: v) -> Getter:
     return lambda sim, n: convert(getattr(sim.world.world_info, attr))
 
 
+def _written(name: str, default: Any) -> Getter:
+    def get(sim: Any, n: Node) -> Any:
+        v = _scenery(sim)[int(n.key)].fields.get(name, default)
+        return [list(c) if isinstance(c, list | tuple) else c for c in v] if isinstance(v, list | tuple) else v
+    return get
+
+
 SCENERY_FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
     # what the world model keeps of WorldInfo (read-only here); a .wbt world without a title: its file name
     "WorldInfo": {"title": ("SFString", _info("name", str), None),
@@ -299,9 +314,21 @@ SCENERY_FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
                   "gpsCoordinateSystem": ("SFString", _info("gps_coordinate_system", str), None),
                   "gpsReference": ("SFVec3f", _info("gps_reference", lambda v: [float(c) for c in v]), None),
                   "inkEvaporation": ("SFFloat", _info("ink_evaporation", float), None)},
+    # the world file's values (wbt/convert.SCENERY_VALUES), else Webots' defaults (a Viewpoint Webots adds, a
+    # YAML world's); read-only here: Sensorium has no 3D view for a Viewpoint to move nor a sky to recolour
+    "Viewpoint": {"fieldOfView": ("SFFloat", _written("fieldOfView", 0.785398), None),
+                  "orientation": ("SFRotation", _written("orientation", [0.0, 0.0, 1.0, 0.0]), None),
+                  "position": ("SFVec3f", _written("position", [-10.0, 0.0, 0.0]), None),
+                  "near": ("SFFloat", _written("near", 0.05), None),
+                  "far": ("SFFloat", _written("far", 0.0), None),
+                  "exposure": ("SFFloat", _written("exposure", 1.0), None),
+                  "description": ("SFString", _written("description", ""), None),
+                  "follow": ("SFString", _written("follow", ""), None)},
+    "Background": {"skyColor": ("MFColor", _written("skyColor", [[0.0, 0.0, 0.0]]), None),
+                   "luminosity": ("SFFloat", _written("luminosity", 1.0), None)},
 }
-"""Fields of the top-level nodes Sensorium does not simulate; any other field of theirs answers
-Webots' "no value" (Viewpoint, Background, ... have none here)."""
+"""Fields of the top-level nodes Sensorium does not simulate; any other field of theirs (and any
+field of Fog, a Transform, ...) answers Webots' "no value"."""
 
 
 def _fields(node: Node) -> dict[str, tuple[str, Getter, Setter]]:

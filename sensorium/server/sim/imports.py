@@ -47,6 +47,7 @@ class ImportRefused(ValueError):
 class ImportedNode:
     type: str           # "Solid" or the light's type (PointLight, SpotLight, DirectionalLight)
     model: Any          # wm.Solid or the light model, validated and sanitised
+    proto: str = ""     # the PROTO the string's node is an instance of (Supervisor getTypeName), "" for a base node
 
 
 @dataclass
@@ -149,6 +150,7 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     conv.world["world_info"] = {"coordinate_system": world.world_info.coordinate_system}
     top = Owner("world", {})
     kinds: list[str] = []
+    protos: list[str] = []
     for written, node in zip(wbt.nodes, expansion.nodes):
         solids, lights = len(conv.world["solids"]), len(conv.world["lights"])
         what = written.type if written.type == node.type else f"{written.type} (a {node.type})"
@@ -169,6 +171,8 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
             raise ImportRefused(f"{at}: {what}: not importable here: a node string holds solids (Solid, or a PROTO "
                                 "that is one) and lights (PointLight, SpotLight, DirectionalLight) only")
         kinds.append(made[0][0])
+        entry = conv.top_node(node, {})          # the PROTO's name as a world file's top-level node keeps it
+        protos.append(entry.get("proto", "") if entry["type"] == made[0][0] else "")
     origin: dict[str, tuple[int, int, str]] = {}
     data = strip_origins({"solids": conv.world["solids"], "lights": conv.world["lights"]}, "", origin)
     data["world_info"] = {"coordinate_system": world.world_info.coordinate_system}
@@ -188,10 +192,10 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     warnings += [_wbt_warning(w, origin, LABEL) for w in parsed.warnings]
     queue: Counter[str] = Counter()
     out = []
-    for kind in kinds:
+    for kind, proto in zip(kinds, protos):
         group = "Solid" if kind == "Solid" else "light"
         models = fragment.solids if group == "Solid" else fragment.lights
-        out.append(ImportedNode(kind, models[queue[group]]))
+        out.append(ImportedNode(kind, models[queue[group]], proto))
         queue[group] += 1
     return out
 

@@ -9,6 +9,7 @@ in closed form, in float64, keeps a robot driven in a circle on its circle for m
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,11 +56,23 @@ class WheelMotor:
         self.target_position = float(value)
 
     def set_velocity(self, value: float) -> None:
-        """Webots' ``setVelocity``: a speed above ``maxVelocity``, infinite ones included, is clamped
-        to it (WbMotor warns; the clients print that warning, this API clamps silently); NaN raises."""
+        """Webots' ``setVelocity`` in the in-process API: a negative velocity while in position
+        control (a finite target) is ignored with Webots' error line on stderr, as libController
+        and the clients do; a speed above ``maxVelocity``, infinite ones included, is clamped to it
+        (WbMotor warns; the clients print that warning, this API clamps silently); NaN raises."""
         if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
             raise ValueError(f"motor {self.name!r}: velocity must be a number (inf is clamped to maxVelocity), "
                              f"got {value!r}")
+        if value < 0.0 and not math.isinf(self.target_position):
+            print(f"Error: setVelocity() called with negative 'velocity' argument in position control mode "
+                  f"({self.target_position:g}): motor {self.name!r} keeps {self.velocity:g}.", file=sys.stderr)
+            return
+        self.command_velocity(value)
+
+    def command_velocity(self, value: float) -> None:
+        """A velocity a controller's step (or a motor service) sends: clamped to ``maxVelocity``. The
+        clients already left out a negative one in position control when it was set; one sent with
+        the target that the same step changes applies as its magnitude (the speed towards the target)."""
         self.velocity = float(min(max(value, -self.max_velocity), self.max_velocity))
 
     def advance(self, dt_s: float) -> float:

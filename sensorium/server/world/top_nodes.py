@@ -5,28 +5,39 @@ Webots adds a world file's top-level nodes to the root in file order and then ma
 file has none. A ``.wbt`` world records its top-level nodes (``World.top_nodes``); a YAML or JSON
 world has none recorded: its root holds a default ``WorldInfo`` and ``Viewpoint``, then its robots,
 solids and lights in the lists' order. Nodes Sensorium does not simulate ("scenery": ``WorldInfo``,
-``Viewpoint``, ``Background``, ...) keep their type and DEF name.
+``Viewpoint``, ``Background``, ...) keep their type and DEF name (and a Viewpoint's or Background's
+written values). A PROTO instance keeps its PROTO's name: a scenery node's, and a robot's, solid's
+or light's when the top-level node became that node alone (a PROTO whose base is a Group holding
+several solids names none of them).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from sensorium.schemas import world as wm
 
 KINDS = ("robots", "solids", "lights")
 
 
+# the base types a simulated node of each kind has (a PROTO instance of another base is not named after it)
+BASES = {"robots": ("Robot",), "solids": ("Solid",), "lights": ("PointLight", "SpotLight", "DirectionalLight")}
+
+
 @dataclass(frozen=True, slots=True)
 class Scenery:
     type: str
     def_name: str      # "" without one
+    proto: str = ""    # the PROTO it is an instance of ("" for a base node)
+    fields: dict = field(default_factory=dict)   # a Viewpoint's or Background's written values (TopNode.fields)
 
 
 @dataclass(frozen=True, slots=True)
 class TopLevel:
     order: tuple[tuple[str, int], ...]   # ("robots" | "solids" | "lights" | "scenery", index) in root order
     scenery: tuple[Scenery, ...]         # by index: file order, then the defaults Webots adds
+    protos: dict = field(default_factory=dict)   # (kind, index) -> the PROTO a robot, solid or light is an
+                                                 # instance of (the top-level node it alone became)
 
 
 def top_level(world: wm.World) -> TopLevel:
@@ -34,12 +45,17 @@ def top_level(world: wm.World) -> TopLevel:
     used = dict.fromkeys(KINDS, 0)
     order: list[tuple[str, int]] = []
     scenery: list[Scenery] = []
+    protos: dict[tuple[str, int], str] = {}
     for node in world.top_nodes:
         counts = {"robots": node.robots, "solids": node.solids, "lights": node.lights}
         if not any(counts.values()):
             order.append(("scenery", len(scenery)))
-            scenery.append(Scenery(node.type, node.def_name or ""))
+            scenery.append(Scenery(node.type, node.def_name or "", node.proto or "", dict(node.fields)))
             continue
+        alone = [kind for kind in KINDS if counts[kind]]
+        if node.proto and sum(counts.values()) == 1 and node.type in BASES[alone[0]] \
+                and used[alone[0]] < sizes[alone[0]]:
+            protos[(alone[0], used[alone[0]])] = node.proto
         for kind in KINDS:
             for _ in range(counts[kind]):
                 if used[kind] < sizes[kind]:
@@ -51,4 +67,4 @@ def top_level(world: wm.World) -> TopLevel:
         if not any(s.type == kind for s in scenery):
             order.insert(min(place, len(order)), ("scenery", len(scenery)))
             scenery.append(Scenery(kind, ""))
-    return TopLevel(tuple(order), tuple(scenery))
+    return TopLevel(tuple(order), tuple(scenery), protos)

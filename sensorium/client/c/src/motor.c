@@ -34,7 +34,7 @@ void wb_motor_set_velocity(WbDeviceTag tag, double velocity) {
   if (velocity < 0.0 && !isinf(d->target_position)) {
     fprintf(stderr,
             "Error: wb_motor_set_velocity() called with negative 'velocity' argument in position control mode (%g).\n",
-            velocity);
+            d->target_position); /* libController shows the target position */
     return;
   }
   if (fabs(velocity) > d->max_velocity) {

@@ -18,6 +18,7 @@ struct WbNodeStructPrivate {
   WbNodeType type;
   char type_name[64]; /* "Group", "Robot", "Solid", a light's, or a top-level node's not simulated ("WorldInfo") */
   char *def_name;     /* "" without one */
+  char *proto;        /* a PROTO instance's PROTO name (wb_supervisor_node_get_type_name), "" for a base node */
   int64_t parent;     /* 0 for a top-level node, -1 for the root */
   double position[3];
   double orientation[9];
@@ -30,7 +31,7 @@ struct WbFieldStructPrivate {
   int64_t node;
   WbFieldType type;
   char *name;
-  double value[4];
+  double value[4]; /* an SF vector's or an MFColor item's last value */
   char *string; /* an SFString's last value */
   struct WbFieldStructPrivate *next;
 };
@@ -39,6 +40,7 @@ void sn_supervisor_free(sn_robot *rb) {
   for (struct WbNodeStructPrivate *n = rb->nodes, *next; n != NULL; n = next) {
     next = n->next;
     free(n->def_name);
+    free(n->proto);
     free(n);
   }
   for (struct WbFieldStructPrivate *f = rb->fields, *next; f != NULL; f = next) {
@@ -142,6 +144,14 @@ static WbNodeRef node_from_reply(sn_robot *rb, sn_reply *rep) {
       free(n->def_name);
       n->def_name = def;
     }
+    const msgpack_object *proto_obj = sn_get(rep->result, "proto");
+    char *proto = proto_obj != NULL && proto_obj->type == MSGPACK_OBJECT_STR ? sn_strdup_obj(proto_obj) : NULL;
+    if (proto != NULL && n->proto != NULL && strcmp(proto, n->proto) == 0)
+      free(proto); /* unchanged, as the DEF */
+    else {
+      free(n->proto);
+      n->proto = proto;
+    }
     n->parent = sn_int_or(rep->result, "parent", -1);
   }
   sn_reply_free(rep);
@@ -240,13 +250,20 @@ WbNodeType wb_supervisor_node_get_type(WbNodeRef node) {
   return live_node(node, "wb_supervisor_node_get_type") != NULL ? node->type : WB_NODE_NO_NODE;
 }
 
+/* a PROTO instance's PROTO name ("MiniPuck"), else the node's type ("Solid") */
 const char *wb_supervisor_node_get_type_name(WbNodeRef node) {
-  return live_node(node, "wb_supervisor_node_get_type_name") != NULL ? node->type_name : "";
+  if (live_node(node, "wb_supervisor_node_get_type_name") == NULL)
+    return "";
+  return node->proto != NULL && *node->proto != '\0' ? node->proto : node->type_name;
 }
 
-/* no PROTO names here: a node's type is its base type */
+/* the base node type (Robot, Solid, PointLight, Background, ...), a PROTO instance's too */
 const char *wb_supervisor_node_get_base_type_name(WbNodeRef node) {
   return live_node(node, "wb_supervisor_node_get_base_type_name") != NULL ? node->type_name : "";
+}
+
+bool wb_supervisor_node_is_proto(WbNodeRef node) {
+  return live_node(node, "wb_supervisor_node_is_proto") != NULL && node->proto != NULL && *node->proto != '\0';
 }
 
 const char *wb_supervisor_node_get_def(WbNodeRef node) {
@@ -425,9 +442,9 @@ void wb_supervisor_simulation_physics_reset(void) {
 static const struct {
   const char *name;
   WbFieldType type;
-} FIELD_TYPES[] = {{"SFBool", WB_SF_BOOL},     {"SFFloat", WB_SF_FLOAT},   {"SFVec3f", WB_SF_VEC3F},
-                   {"SFRotation", WB_SF_ROTATION}, {"SFColor", WB_SF_COLOR}, {"SFString", WB_SF_STRING},
-                   {"MFNode", WB_MF_NODE}};
+} FIELD_TYPES[] = {{"SFBool", WB_SF_BOOL},     {"SFInt32", WB_SF_INT32},   {"SFFloat", WB_SF_FLOAT},
+                   {"SFVec3f", WB_SF_VEC3F},     {"SFRotation", WB_SF_ROTATION}, {"SFColor", WB_SF_COLOR},
+                   {"SFString", WB_SF_STRING},   {"MFColor", WB_MF_COLOR},   {"MFNode", WB_MF_NODE}};
 
 typedef struct {
   int64_t node;
@@ -566,6 +583,31 @@ bool wb_supervisor_field_get_sf_bool(WbFieldRef field) {
   return out;
 }
 
+int wb_supervisor_field_get_sf_int32(WbFieldRef field) {
+  sn_reply rep;
+  const msgpack_object *v;
+  int64_t out = 0;
+  if (field_value(field, WB_SF_INT32, "wb_supervisor_field_get_sf_int32", &rep, &v) != 0)
+    return 0;
+  if (v == NULL || !sn_as_int64(v, &out))
+    out = 0;
+  sn_reply_free(&rep);
+  return (int)out;
+}
+
+/* Webots streams a tracked field's value every sampling period so that its getters need no round trip;
+   here every getter asks the server and answers the value of now, which is what tracking shows at each
+   step: accepted after Webots' checks, nothing else to do */
+void wb_supervisor_field_enable_sf_tracking(WbFieldRef field, int sampling_period) {
+  const char *func = "wb_supervisor_field_enable_sf_tracking";
+  if (field_robot(field, WB_NO_FIELD, func) != NULL && sampling_period < 0)
+    fprintf(stderr, "Error: %s() called with negative sampling period.\n", func);
+}
+
+void wb_supervisor_field_disable_sf_tracking(WbFieldRef field) {
+  field_robot(field, WB_NO_FIELD, "wb_supervisor_field_disable_sf_tracking");
+}
+
 double wb_supervisor_field_get_sf_float(WbFieldRef field) {
   sn_reply rep;
   const msgpack_object *v;
@@ -616,25 +658,46 @@ const double *wb_supervisor_field_get_sf_color(WbFieldRef field) {
   return field_numbers(field, WB_SF_COLOR, "wb_supervisor_field_get_sf_color");
 }
 
-/* item index of an MFNode field (negative counts from the end, as Webots) */
+/* item index of an MF field's value v (negative counts from the end, as Webots); NULL after Webots' line */
+static const msgpack_object *mf_item(const msgpack_object *v, int index, const char *func) {
+  int count = v != NULL && v->type == MSGPACK_OBJECT_ARRAY ? (int)v->via.array.size : 0;
+  if (index >= -count && index < count)
+    return &v->via.array.ptr[index < 0 ? index + count : index];
+  if (count == 0)
+    fprintf(stderr, "Error: %s() called on an empty list.\n", func);
+  else
+    fprintf(stderr, "Error: %s() called with an out-of-bound index: %d (should be between %d and %d).\n", func,
+            index, -count, count - 1);
+  return NULL;
+}
+
 WbNodeRef wb_supervisor_field_get_mf_node(WbFieldRef field, int index) {
   const char *func = "wb_supervisor_field_get_mf_node";
   sn_reply rep;
   const msgpack_object *v;
   if (field_value(field, WB_MF_NODE, func, &rep, &v) != 0)
     return NULL;
-  int count = v != NULL && v->type == MSGPACK_OBJECT_ARRAY ? (int)v->via.array.size : 0;
+  const msgpack_object *item = mf_item(v, index, func);
   int64_t id = -1;
-  if (index < -count || index >= count) {
-    if (count == 0)
-      fprintf(stderr, "Error: %s() called on an empty list.\n", func);
-    else
-      fprintf(stderr, "Error: %s() called with an out-of-bound index: %d (should be between %d and %d).\n", func,
-              index, -count, count - 1);
-  } else if (!sn_as_int64(&v->via.array.ptr[index < 0 ? index + count : index], &id))
+  if (item != NULL && !sn_as_int64(item, &id))
     id = -1;
   sn_reply_free(&rep);
   return id < 0 ? NULL : node_from_id(id, func);
+}
+
+/* colour index of an MFColor field (a Background's skyColor); valid until the next call on the field */
+const double *wb_supervisor_field_get_mf_color(WbFieldRef field, int index) {
+  const char *func = "wb_supervisor_field_get_mf_color";
+  sn_reply rep;
+  const msgpack_object *v;
+  if (field_value(field, WB_MF_COLOR, func, &rep, &v) != 0)
+    return NULL;
+  const msgpack_object *item = mf_item(v, index, func);
+  bool ok = item != NULL && copy_numbers(item, field->value, 3);
+  if (item != NULL && !ok)
+    fprintf(stderr, "Error: %s(): malformed reply\n", func);
+  sn_reply_free(&rep);
+  return ok ? field->value : NULL;
 }
 
 static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const char *func) {

@@ -126,10 +126,6 @@ WbProtoRef wb_supervisor_node_get_proto(WbNodeRef node) {
 
 
 
-bool wb_supervisor_node_is_proto(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return false;
-}
 
 const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
   SN_UNSUPPORTED();
@@ -178,19 +174,8 @@ WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
   return NULL;
 }
 
-void wb_supervisor_field_enable_sf_tracking(WbFieldRef field, int sampling_period) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_disable_sf_tracking(WbFieldRef field) {
-  SN_UNSUPPORTED();
-}
 
 
-int wb_supervisor_field_get_sf_int32(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return 0;
-}
 
 
 const double *wb_supervisor_field_get_sf_vec2f(WbFieldRef field) {
@@ -226,11 +211,6 @@ const double *wb_supervisor_field_get_mf_vec2f(WbFieldRef field, int index) {
 }
 
 const double *wb_supervisor_field_get_mf_vec3f(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
-
-const double *wb_supervisor_field_get_mf_color(WbFieldRef field, int index) {
   SN_UNSUPPORTED();
   return sn_no_values();
 }

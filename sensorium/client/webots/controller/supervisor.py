@@ -1,7 +1,8 @@
 """Webots' ``Supervisor``, ``Node`` and ``Field`` classes — what Sensorium serves: the root and its
-``children`` (robots, top-level solids and lights), nodes by DEF, id or name, their identity (type,
-DEF, parent), fields (``translation``/``rotation`` read and set, ``name``, ``model``, ``customData``,
-lights' ``on``/``intensity``/``color``/... read and set), world poses and velocities; reset the
+``children`` (robots, top-level solids and lights, WorldInfo, Viewpoint, ...), nodes by DEF, id or
+name, their identity (type and PROTO name, DEF, parent), fields (``translation``/``rotation`` read
+and set, ``name``, ``model``, ``customData``, lights' ``on``/``intensity``/``color``/... read and
+set, WorldInfo's, Viewpoint's and Background's values read), world poses and velocities; reset the
 simulation and change its mode. The robot's world entry needs ``supervisor: true``.
 ``simulationQuit`` ends this controller's steps (-1; the server runs on). Every other method of
 Webots' classes is there too: it does nothing, prints one error line the first time and answers
@@ -30,6 +31,7 @@ class Field:
     SF_COLOR = wb.WB_SF_COLOR
     SF_STRING = wb.WB_SF_STRING
     SF_NODE = wb.WB_SF_NODE
+    MF_COLOR = wb.WB_MF_COLOR
     MF_NODE = wb.WB_MF_NODE
 
     def __init__(self, ref: tuple[int, str, int]):
@@ -50,6 +52,9 @@ class Field:
     def getSFBool(self) -> bool:
         return wb.wb_supervisor_field_get_sf_bool(self._ref)
 
+    def getSFInt32(self) -> int:
+        return wb.wb_supervisor_field_get_sf_int32(self._ref)
+
     def getSFFloat(self) -> float:
         return wb.wb_supervisor_field_get_sf_float(self._ref)
 
@@ -67,6 +72,16 @@ class Field:
 
     def getMFNode(self, index: int) -> Node | None:
         return _node_of(wb.wb_supervisor_field_get_mf_node(self._ref, index))
+
+    def getMFColor(self, index: int) -> list[float] | None:
+        return wb.wb_supervisor_field_get_mf_color(self._ref, index)
+
+    def enableSFTracking(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
+        """Accepted: the getters ask the server at each call here (Webots streams tracked values)."""
+        wb.wb_supervisor_field_enable_sf_tracking(self._ref, samplingPeriod)
+
+    def disableSFTracking(self) -> None:
+        wb.wb_supervisor_field_disable_sf_tracking(self._ref)
 
     def setSFBool(self, value: bool) -> None:
         wb.wb_supervisor_field_set_sf_bool(self._ref, value)
@@ -86,7 +101,8 @@ class Field:
     def importMFNodeFromString(self, position: int, nodeString: str) -> None:  # noqa: N803 - Webots' name
         wb.wb_supervisor_field_import_mf_node_from_string(self._ref, position, nodeString)
 
-    _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_FLOAT: getSFFloat, wb.WB_SF_STRING: getSFString,
+    _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_INT32: getSFInt32, wb.WB_SF_FLOAT: getSFFloat,
+                wb.WB_SF_STRING: getSFString,
                 wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor}
 
     name = property(getName)
@@ -102,6 +118,8 @@ class Field:
         """Webots' ``Field.value``: an SF field's value; an MF field's items as a list."""
         if self._ref[2] == wb.WB_MF_NODE:
             return [self.getMFNode(i) for i in range(self.getCount())]
+        if self._ref[2] == wb.WB_MF_COLOR:
+            return [self.getMFColor(i) for i in range(self.getCount())]
         return Field._GETTERS[self._ref[2]](self)
 
     @value.setter
@@ -146,7 +164,10 @@ class Node:
         return wb.wb_supervisor_node_get_type_name(self._ref)
 
     def getBaseTypeName(self) -> str:
-        return wb.wb_supervisor_node_get_base_type_name(self._ref)  # no PROTO names here: the type
+        return wb.wb_supervisor_node_get_base_type_name(self._ref)
+
+    def isProto(self) -> bool:
+        return wb.wb_supervisor_node_is_proto(self._ref)
 
     def getType(self) -> int:
         return wb.wb_supervisor_node_get_type(self._ref)
@@ -332,7 +353,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3),
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9)},
     Node: {
-        "isProto": ("node_is_proto", False),
         "getProto": ("node_get_proto", None), "getFromProtoDef": ("node_get_from_proto_def", None),
         "getNumberOfFields": ("node_get_number_of_fields", -1),
         "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1),
@@ -351,8 +371,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "getParent": ("proto_get_parent", None), "getField": ("proto_get_field", None),
         "getFieldByIndex": ("proto_get_field_by_index", None), "getNumberOfFields": ("proto_get_number_of_fields", -1)},
     Field: {
-        "getActualField": ("field_get_actual_field", None), "enableSFTracking": ("field_enable_sf_tracking", None),
-        "disableSFTracking": ("field_disable_sf_tracking", None), "removeMF": ("field_remove_mf", None),
+        "getActualField": ("field_get_actual_field", None), "removeMF": ("field_remove_mf", None),
         "removeSF": ("field_remove_sf", None),
         # no node here has an SFNode field to import into (the root's children are its only node field)
         "importSFNodeFromString": ("field_import_sf_node_from_string", None)},
@@ -361,11 +380,11 @@ _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 
                     "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
 for _kind, _none in _FIELD_NO_VALUES.items():
     _c = _kind.lower()
-    if _kind != "Node":         # getMFNode is served (the root's children)
+    if _kind not in ("Node", "Color"):         # getMFNode (the root's children), getMFColor (skyColor) are served
         _UNSERVED[Field][f"getMF{_kind}"] = (f"field_get_mf_{_c}", _none)
         _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None)
         _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None)
-    if _kind in ("Int32", "Vec2f", "Node"):   # the SF field types no node here has
+    if _kind in ("Vec2f", "Node"):   # the SF field types no node here has
         _UNSERVED[Field][f"getSF{_kind}"] = (f"field_get_sf_{_c}", _none)
     if _kind in ("Int32", "Vec2f", "String"):  # SFString fields are read-only here
         _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None)

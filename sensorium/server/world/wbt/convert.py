@@ -34,6 +34,16 @@ from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
 
+# the fields of top-level nodes not simulated whose written values the Supervisor serves (daemon/supervisor.py)
+SCENERY_VALUES = {
+    "Viewpoint": {"fieldOfView": "SFFloat", "orientation": "SFRotation", "position": "SFVec3f", "near": "SFFloat",
+                  "far": "SFFloat", "exposure": "SFFloat", "description": "SFString", "follow": "SFString"},
+    "Background": {"skyColor": "MFColor", "luminosity": "SFFloat"},
+}
+# the base node type of Webots' PROTOs that Sensorium builds in (wbt/protos.py) or skips (TexturedBackground)
+# when their file is not at hand: the Supervisor names them as Webots does
+KNOWN_PROTO_BASES = {"RectangleArena": "Solid", "Floor": "Solid", "SolidBox": "Solid", "WoodenBox": "Solid",
+                     "TexturedBackgroundLight": "DirectionalLight", "TexturedBackground": "Background"}
 SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Physics", "ImmersionProperties",
            "ContactProperties", "Damping", "Muscle"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
@@ -181,8 +191,7 @@ class Converter:
             before = [len(self.world[k]) for k in ("robots", "solids", "lights")]
             self.visit(node, Frame.identity(), world, top=True)
             became = {k: len(self.world[k]) - n for k, n in zip(("robots", "solids", "lights"), before)}
-            top_nodes.append({"type": node.type, **({"def_name": node.def_name} if node.def_name else {}),
-                              **{k: n for k, n in became.items() if n}})
+            top_nodes.append(self.top_node(node, became))
         self.world["top_nodes"] = top_nodes
         if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
             self.world["solids"].append(self.solid_dict(world, {"name": self.unique_name("shapes")}))
@@ -195,6 +204,43 @@ class Converter:
             listed = ", ".join(f"{k} x{v}" if v > 1 else k for k, v in sorted(self.skipped.items()))
             self.warnings.append(f"{self.source}: skipped nodes that do not matter to these sensors: {listed}")
         return {k: v for k, v in self.world.items() if v}
+
+    def top_node(self, node: Node, became: dict[str, int]) -> dict:
+        """A top-level node as the Supervisor lists it (schemas.world.TopNode): its base type, the
+        PROTO it is an instance of (an expanded one, or one Sensorium builds in), its DEF, what it
+        became, and a Viewpoint's or Background's values the Supervisor reads."""
+        base = KNOWN_PROTO_BASES.get(node.type, node.type)
+        entry: dict[str, Any] = {"type": base}
+        proto = node.proto or (node.type if node.type in KNOWN_PROTO_BASES else None)
+        if proto:
+            entry["proto"] = proto
+        if node.def_name:
+            entry["def_name"] = node.def_name
+        if base in SCENERY_VALUES:
+            entry["fields"] = self.scenery_values(node, base)
+        return entry | {k: n for k, n in became.items() if n}
+
+    def scenery_values(self, node: Node, base: str) -> dict[str, Any]:
+        """The written values of a Viewpoint's or Background's fields the Supervisor serves (the
+        others answer Webots' defaults there); a value that does not read is left out with a warning
+        (these nodes change no sensor reading, so the world still loads)."""
+        f = self.fields(node)
+        out: dict[str, Any] = {}
+        for name, kind in SCENERY_VALUES[base].items():
+            if not f.has(name):
+                continue
+            try:
+                if kind == "SFFloat":
+                    out[name] = f.num(name, 0.0)
+                elif kind == "SFString":
+                    out[name] = f.string(name, "")
+                elif kind == "MFColor":
+                    out[name] = [list(c) for c in f.colors(name, [])]
+                else:
+                    out[name] = list(f.vec(name, (0.0,) * (4 if kind == "SFRotation" else 3)))
+            except WbtSyntaxError as e:
+                self.warn(node, f"{e.message}; the Supervisor reads Webots' default for it")
+        return out
 
     def unique_name(self, name: str) -> str:
         self.solid_names[name] += 1
