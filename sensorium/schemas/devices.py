@@ -249,7 +249,7 @@ register(DeviceKind(
 register(DeviceKind(
     "Display", wm.Display, "sensorium.server.sim.display:Display",
     services=("draw",),
-    topics=(TopicDecl("image", msgs.IMAGE, "image", sensor_qos=False),),
+    topics=(TopicDecl("image", msgs.IMAGE, "image"),),
     description="DisplayDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
