@@ -237,3 +237,83 @@ def test_an_attached_camera_is_under_the_display() -> None:
         world([{"device": "Camera", "name": "cam", "width": 4, "height": 3},
                {"device": "Display", "name": "s", "width": 5, "height": 3}]).robots["bot"].devices["s"].check(
                    [["attach", "cam"]])
+
+
+def test_the_image_topic_carries_each_change_once() -> None:
+    import msgpack
+
+    from sensorium.server.daemon.topics import Topics
+    sim = world([{"device": "Display", "name": "screen", "width": 5, "height": 4}])
+    d = sim.robots["bot"].devices["screen"]
+    topics = Topics(sim)
+    assert [t.type for t in topics.topics if t.name == "/bot/screen/image"] == ["sensor_msgs/msg/Image"]
+    got: list[tuple[str, dict]] = []
+    topics.set_recorder(lambda name, typ, env, body, ns, seq: got.append((name, msgpack.unpackb(body))),
+                        topics=["/bot/screen/image"])
+    sim.step()
+    topics.publish(sim.time_ms)
+    assert got == []                                  # nothing drawn yet: nothing new to show
+    draw(d, ["color", 0x123456], ["line", 0, 0, 4, 3])
+    sim.step()
+    topics.publish(sim.time_ms)
+    sim.step()
+    topics.publish(sim.time_ms)                       # unchanged: not again
+    assert len(got) == 1
+    msg = got[0][1]
+    assert (msg["width"], msg["height"], msg["encoding"], msg["step"]) == (5, 4, "bgra8", 20)
+    words = np.frombuffer(msg["data"], dtype="<u4").reshape(4, 5)
+    line = {(int(x), int(y)) for x, y in zip(*dmod.line_pixels(0, 0, 4, 3))}
+    assert all(int(words[y, x]) == (0xFF123456 if (x, y) in line else BLACK) for y in range(4) for x in range(5))
+    assert msg["header"]["frame_id"] == "bot/screen"
+
+
+def test_a_python_controller_loads_pastes_and_saves_over_the_wire(tmp_path, capsys) -> None:
+    """imageLoad of a PNG (Pillow), pasted with blend, saved as PNG: the server's pixels, over a
+    real server in this process; a format Webots does not write writes nothing; a bad request is
+    one line naming the display and the command."""
+    import yaml
+    from _inproc import inproc_server
+    from PIL import Image
+
+    from sensorium.client import wb
+    from sensorium.client.connection import SensoriumError
+    path = tmp_path / "w.yaml"
+    path.write_text(yaml.safe_dump({"world_info": {"basic_time_step": 16}, "robots": [
+        {"name": "bot", "devices": [{"device": "Display", "name": "screen", "width": 6, "height": 4}]}]}))
+    src = np.zeros((2, 3, 4), dtype=np.uint8)
+    src[0, 0] = (255, 0, 0, 255)
+    src[0, 1] = (0, 0, 255, 51)                       # a fifth opaque
+    src[1, 2] = (10, 20, 30, 255)
+    Image.fromarray(src, "RGBA").save(tmp_path / "in.png")
+    with inproc_server(heartbeat_ms=5000, world=path) as (core, transport):
+        wb.wb_robot_init(f"{transport.rpc_endpoint}/bot")
+        try:
+            tag = wb.wb_robot_get_device("screen")
+            ref = wb.wb_display_image_load(tag, str(tmp_path / "in.png"))
+            wb.wb_display_set_color(tag, 0xFFFFFF)
+            wb.wb_display_fill_rectangle(tag, 0, 0, 6, 4)
+            wb.wb_display_image_paste(tag, ref, 2, 1, True)
+            out = tmp_path / "out.png"
+            out.write_bytes(b"old")                   # Webots overwrites a file of that name: so does this
+            wb.wb_display_image_save(tag, None, str(out))
+            wb.wb_display_image_save(tag, ref, str(tmp_path / "ref.png"))
+            wb.wb_display_image_save(tag, None, str(tmp_path / "out.bmp"))
+            assert "unsupported file format" in capsys.readouterr().err
+            assert not (tmp_path / "out.bmp").exists()
+            wb.wb_display_draw_polygon(tag, list(range(2000)), [0] * 2000)
+            with pytest.raises(SensoriumError) as exc:
+                wb.wb_robot_step(16)
+            assert "step: displays: bot/screen: command 0 (polygon): 2000 vertices, at most 1024" in str(exc.value)
+        finally:
+            wb.wb_robot_cleanup()
+    with Image.open(out) as im:
+        got = np.asarray(im.convert("RGBA")).astype(int)
+    with Image.open(tmp_path / "ref.png") as im:
+        assert (np.asarray(im) == src).all()          # the loaded image as kept
+    white = np.array([255, 255, 255, 255])
+    assert (got[0] == white).all() and (got[:, 0:2] == white).all()
+    assert tuple(got[1, 2]) == (255, 0, 0, 255) and tuple(got[2, 4]) == (10, 20, 30, 255)
+    a = 51                                            # blue at alpha 51 over white, alpha capped at 255
+    assert tuple(got[1, 3]) == ((255 - a) * 255 // 255, (255 - a) * 255 // 255, ((255 - a) * 255 + a * 255) // 255,
+                                255)
+    assert tuple(got[2, 2]) == (255, 255, 255, 255)   # a transparent pixel leaves white
