@@ -221,7 +221,7 @@ def _to_bgra(data: bytes, fmt: int, n: int) -> bytes | None:
     return bytes(out)
 
 
-def wb_display_image_new(tag: int, width: int, height: int, data: Any, format: int = WB_IMAGE_RGB) -> ImageRef | None:
+def wb_display_image_new(tag: int, width: Any, height: Any, data: Any, format: int = WB_IMAGE_RGB) -> ImageRef | None:
     func = "wb_display_image_new"
     if data is None:
         _err(func, "'data' argument is NULL.")
