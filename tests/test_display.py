@@ -317,3 +317,19 @@ def test_a_python_controller_loads_pastes_and_saves_over_the_wire(tmp_path, caps
     assert tuple(got[1, 3]) == ((255 - a) * 255 // 255, (255 - a) * 255 // 255, ((255 - a) * 255 + a * 255) // 255,
                                 255)
     assert tuple(got[2, 2]) == (255, 255, 255, 255)   # a transparent pixel leaves white
+
+
+def test_a_reset_makes_the_display_black_again_and_a_batched_world_ignores_it() -> None:
+    from sensorium.server.sim.batched import BatchedSimulation
+    devices = [{"device": "Display", "name": "screen", "width": 4, "height": 4},
+               {"device": "LightSensor", "name": "ls"}]
+    sim = world(devices)
+    d = sim.robots["bot"].devices["screen"]
+    draw(d, ["color", 0x00FF00], ["alpha", 0.5], ["rectangle", 0, 0, 2, 2, True], ["copy", 1, 0, 0, 2, 2])
+    before = d.measurements
+    sim.reset()
+    assert (d.pixels == BLACK).all() and d.images == {} and (d.color, d.alpha, d.opacity) == (0xFFFFFF, 255, 255)
+    assert d.measurements == before + 1               # the black image is published
+    data = {"world_info": {"basic_time_step": 16}, "robots": [{"name": "bot", "devices": devices}]}
+    bs = BatchedSimulation(parse_world(data), 2)
+    bs.step()                                         # builds and steps; the display draws nothing here
