@@ -333,3 +333,31 @@ def test_a_reset_makes_the_display_black_again_and_a_batched_world_ignores_it() 
     data = {"world_info": {"basic_time_step": 16}, "robots": [{"name": "bot", "devices": devices}]}
     bs = BatchedSimulation(parse_world(data), 2)
     bs.step()                                         # builds and steps; the display draws nothing here
+
+
+def test_a_python_controller_drawing_more_than_a_request_carries_keeps_its_order(tmp_path) -> None:
+    """A full 160 x 120 map drawn pixel by pixel with a colour each (38,400 commands, beyond the
+    4,096 a request may carry per display): the client sends its list ahead in order, and the
+    image is the map. A too large image for one request is one error line, not a failed step."""
+    import yaml
+    from _inproc import inproc_server
+
+    from sensorium.client import wb
+    path = tmp_path / "w.yaml"
+    path.write_text(yaml.safe_dump({"world_info": {"basic_time_step": 16}, "robots": [
+        {"name": "bot", "devices": [{"device": "Display", "name": "map", "width": 160, "height": 120}]}]}))
+    with inproc_server(heartbeat_ms=5000, world=path) as (core, transport):
+        wb.wb_robot_init(f"{transport.rpc_endpoint}/bot")
+        try:
+            tag = wb.wb_robot_get_device("map")
+            for y in range(120):
+                for x in range(160):
+                    wb.wb_display_set_color(tag, (x << 16) | (y << 8) | ((x + y) & 0xFF))
+                    wb.wb_display_draw_pixel(tag, x, y)
+            assert wb.wb_display_image_new(tag, 600, 600, bytes(3 * 600 * 600), wb.WB_IMAGE_RGB) is None
+            assert wb.wb_robot_step(16) == 0
+            pixels = core.sim.robots["bot"].devices["map"].pixels
+        finally:
+            wb.wb_robot_cleanup()
+    ys, xs = np.mgrid[0:120, 0:160]
+    assert (pixels == (0xFF000000 | (xs << 16) | (ys << 8) | ((xs + ys) & 0xFF)).astype(np.uint32)).all()

@@ -95,10 +95,16 @@ def test_the_expected_sequence_draws_what_the_rules_say(expected) -> None:
     assert tuple(screen[221, 301]) == (0, 0, 0, 255)                   # a transparent pixel changes nothing
 
 
+def _small() -> np.ndarray:
+    """The small display's map, a colour per pixel (8,192 commands: sent in several requests)."""
+    ys, xs = np.mgrid[0:64, 0:64]
+    return np.stack([xs << 2, ys << 2, np.full_like(xs, 0x40), np.full_like(xs, 255)], axis=-1).astype(np.uint8)
+
+
 def _check(lines: list[str], err: str, out: Path, expected) -> None:
     assert lines == EXPECTED, (lines, err)
     assert "does not simulate Display" not in err and "Error" not in err, err
-    for name, want in zip(("screen.png", "copy.png"), expected):
+    for name, want in zip(("screen.png", "copy.png", "small.png"), (*expected, _small())):
         with Image.open(out / name) as im:
             assert im.mode == "RGBA"
             got = np.asarray(im)

@@ -35,6 +35,15 @@ __all__ = ["DISPLAY", "ImageRef", "WB_IMAGE_RGB", "WB_IMAGE_RGBA", "WB_IMAGE_ARG
            "wb_display_image_load", "wb_display_image_save", "wb_display_image_delete"]
 
 
+# What one request carries (the server's 4,096 commands per display; PROTOCOL's 1 MiB and 100,000
+# values per request): a Display's list goes ahead with the "draw" service, in order, when the next
+# command would pass these.
+FLUSH_COMMANDS = 4096
+FLUSH_ITEMS = 40_000
+FLUSH_BYTES = 512 * 1024
+MAX_IMAGE_BYTES = 1_000_000
+
+
 @dataclass(frozen=True)
 class ImageRef:
     """Webots' ``WbImageRef``: an image a Display keeps (``id`` >= 1), of the Display ``tag``."""
@@ -58,10 +67,38 @@ def _display(tag: int, func: str) -> DeviceState | None:
     return None if r.terminated else dev
 
 
+def _size(command: list[Any]) -> tuple[int, int]:
+    """About how many values and bytes a command adds to a request."""
+    items, size = len(command), 8 * len(command)
+    for v in command:
+        if isinstance(v, list):
+            items += len(v)
+            size += 5 * len(v)
+        elif isinstance(v, (bytes, str)):
+            size += len(v)
+    return items, size
+
+
+def _add(dev: DeviceState, command: list[Any]) -> None:
+    """Append a command to ``dev``'s list, sending the list ahead first if it would grow too large."""
+    items, size = _size(command)
+    pending = dev.drawing_size
+    if dev.drawing and (len(dev.drawing) >= FLUSH_COMMANDS or pending[0] + items > FLUSH_ITEMS
+                        or pending[1] + size > FLUSH_BYTES):
+        commands, dev.drawing = dev.drawing, []
+        current().rpc(dev, "draw", {"commands": commands})
+        pending[0] = pending[1] = 0
+    if not dev.drawing:
+        pending[0] = pending[1] = 0
+    dev.drawing.append(command)
+    pending[0] += items
+    pending[1] += size
+
+
 def _queue(tag: int, func: str, *command: Any) -> None:
     dev = _display(tag, func)
     if dev is not None:
-        dev.drawing.append(list(command))
+        _add(dev, list(command))
 
 
 def _int(v: Any, func: str, name: str) -> int:
@@ -126,7 +163,7 @@ def wb_display_attach_camera(tag: int, camera_tag: int) -> None:
     if dev.camera.get("attached"):
         return _err(func, "a camera is already attached to the display.")
     dev.camera["attached"] = cam.name
-    dev.drawing.append(["attach", cam.name])
+    _add(dev, ["attach", cam.name])
 
 
 def wb_display_detach_camera(tag: int) -> None:
@@ -137,7 +174,7 @@ def wb_display_detach_camera(tag: int) -> None:
     if not dev.camera.get("attached"):
         return _err(func, "no camera to detach.")
     dev.camera["attached"] = None
-    dev.drawing.append(["detach"])
+    _add(dev, ["detach"])
 
 
 def wb_display_draw_pixel(tag: int, x: int, y: int) -> None:
@@ -233,6 +270,10 @@ def wb_display_image_new(tag: int, width: Any, height: Any, data: Any, format: i
     if fmt not in (WB_IMAGE_RGB, WB_IMAGE_RGBA, WB_IMAGE_ARGB, WB_IMAGE_BGRA, WB_IMAGE_ABGR):
         _err(func, "'format' argument is invalid.")
         return None
+    if 4 * w * h > MAX_IMAGE_BYTES:
+        _err(func, f"a {w} x {h} image is {4 * w * h} bytes, more than one request carries ({MAX_IMAGE_BYTES}): "
+                   "send it in parts.")
+        return None
     raw = data.tobytes() if hasattr(data, "tobytes") else bytes(data)
     bgra = _to_bgra(raw, fmt, w * h)
     if bgra is None:
@@ -242,7 +283,7 @@ def wb_display_image_new(tag: int, width: Any, height: Any, data: Any, format: i
     if dev is None:
         return None
     ref = ImageRef(_next_id(dev), tag)
-    dev.drawing.append(["load", ref.id, w, h, bgra])
+    _add(dev, ["load", ref.id, w, h, bgra])
     return ref
 
 
@@ -287,7 +328,7 @@ def wb_display_image_copy(tag: int, x: int, y: int, width: int, height: int) -> 
     if dev is None:
         return None
     ref = ImageRef(_next_id(dev), tag)
-    dev.drawing.append(["copy", ref.id, a, b, w, h])
+    _add(dev, ["copy", ref.id, a, b, w, h])
     return ref
 
 

@@ -180,7 +180,7 @@ class DeviceState:
                  "value", "values", "speed", "speed_vector", "quaternion", "roll_pitch_yaw", "range_bytes",
                  "cloud_bytes", "point_cloud_enabled", "max_velocity", "target_position", "velocity",
                  "channel", "range", "queue", "queue_bytes", "bytes_to_send",
-                 "_consts", "_range", "_cloud", "_warned", "_warned_unsimulated", "camera", "drawing", "image_ids")
+                 "_consts", "_range", "_cloud", "_warned", "_warned_unsimulated", "camera", "drawing", "drawing_size", "image_ids")
 
     def __init__(self, index: int, desc: dict):
         self.index = index
@@ -219,6 +219,7 @@ class DeviceState:
         self.camera: dict[str, Any] = {}         # a camera's latest readings (wb_camera.py): image, recognition
         self._warned_unsimulated = False
         self.drawing: list[list[Any]] = []       # a Display's commands, sent with the next step (wb_display.py)
+        self.drawing_size = [0, 0]               # about how many values and bytes they hold
         self.image_ids = 0                       # a Display's image references given out
 
     def __repr__(self) -> str:

@@ -50,13 +50,19 @@ int main(void) {
   wb_display_image_paste(screen, ref, 300, 220, true);
   WbImageRef copy = wb_display_image_copy(screen, 60, 10, 30, 20);
   wb_display_image_paste(screen, copy, 0, 100, false);
-  wb_display_fill_rectangle(small, 0, 0, 8, 8);
+  for (int y = 0; y < 64; y++) /* a colour per pixel: more than one request carries */
+    for (int x = 0; x < 64; x++) {
+      wb_display_set_color(small, (x << 18) | (y << 10) | 0x40);
+      wb_display_draw_pixel(small, x, y);
+    }
   wb_robot_step(16);
   char path[4096];
   snprintf(path, sizeof path, "%s/screen.png", out);
   wb_display_image_save(screen, NULL, path);
   snprintf(path, sizeof path, "%s/copy.png", out);
   wb_display_image_save(screen, copy, path);
+  snprintf(path, sizeof path, "%s/small.png", out);
+  wb_display_image_save(small, NULL, path);
   printf("refs %d %d %d\n", ref != NULL, copy != NULL, ref != copy);
   wb_display_image_delete(screen, ref);
   wb_display_image_delete(screen, copy);

@@ -41,10 +41,14 @@ ref = screen.imageNew(bytes([255, 0, 0, 128, 0, 255, 0, 255, 0, 0, 255, 64, 255,
 screen.imagePaste(ref, 300, 220, True)
 copy = screen.imageCopy(60, 10, 30, 20)
 screen.imagePaste(copy, 0, 100, False)
-small.fillRectangle(0, 0, 8, 8)
+for y in range(64):                          # a colour per pixel: more than one request carries
+    for x in range(64):
+        small.setColor((x << 18) | (y << 10) | 0x40)
+        small.drawPixel(x, y)
 robot.step(16)
 screen.imageSave(None, os.path.join(out, "screen.png"))
 screen.imageSave(copy, os.path.join(out, "copy.png"))
+small.imageSave(None, os.path.join(out, "small.png"))
 screen.imageDelete(ref)
 screen.imageDelete(copy)
 print("refs", int(ref is not None), int(copy is not None), int(ref != copy))

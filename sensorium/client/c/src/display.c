@@ -19,9 +19,21 @@ struct WbImageStructPrivate {
   WbDeviceTag tag;
 };
 
+/* What one request carries (the server's bounds: 4,096 commands per display, PROTOCOL's 1 MiB and
+   100,000 values per request): a Display's list is sent ahead with the "draw" service when the next
+   command would pass these, keeping the order. */
+#define FLUSH_COMMANDS 4096
+#define FLUSH_ITEMS 40000
+#define FLUSH_BYTES (512u * 1024u)
+#define MAX_IMAGE_BYTES 1000000u
+
+static const char *g_func = "wb_display"; /* the drawing function being called (flush errors name it) */
+static void flush(sn_device *d);
+
 /* The Display of tag (Webots' error and NULL for another device; NULL after one warning when the
    server lists it only, or once the controller's steps are over). */
 static sn_device *display(WbDeviceTag tag, const char *func, bool drawing) {
+  g_func = func;
   sn_device *d = sn_device_get(tag, SN_OTHER, func);
   if (d == NULL)
     return NULL;
@@ -46,14 +58,23 @@ static sn_device *display(WbDeviceTag tag, const char *func, bool drawing) {
   return d;
 }
 
-/* Start a command of n items (its name first) in d's list. */
-static msgpack_packer *command(sn_device *d, const char *name, size_t n) {
+/* Start a command of n items (its name first) in d's list, of about items values and bytes more
+   (a polygon's vertices, a text, an image); the list goes ahead first if it would grow too large. */
+static msgpack_packer *command_sized(sn_device *d, const char *name, size_t n, size_t items, size_t bytes) {
+  if (d->draw_n > 0 && (d->draw_n >= FLUSH_COMMANDS || (size_t)d->draw_items + n + items > FLUSH_ITEMS ||
+                        d->draw_buf->size + 16 * n + bytes > FLUSH_BYTES))
+    flush(d);
   d->draw_n++;
+  d->draw_items += (int)(n + items);
   msgpack_pack_array(&d->draw_pk, n);
   size_t len = strlen(name);
   msgpack_pack_str(&d->draw_pk, len);
   msgpack_pack_str_body(&d->draw_pk, name, len);
   return &d->draw_pk;
+}
+
+static msgpack_packer *command(sn_device *d, const char *name, size_t n) {
+  return command_sized(d, name, n, 0, 0);
 }
 
 int sn_display_pending(const sn_robot *rb) {
@@ -70,7 +91,7 @@ static void pack_commands(sn_device *d, sn_req *r) {
     msgpack_sbuffer_write(&r->buf, d->draw_buf->data, d->draw_buf->size);
   if (d->draw_buf != NULL)
     msgpack_sbuffer_clear(d->draw_buf);
-  d->draw_n = 0;
+  d->draw_n = d->draw_items = 0;
 }
 
 void sn_display_pack(sn_robot *rb, sn_req *r) {
@@ -89,7 +110,7 @@ void sn_display_free(sn_device *d) {
   if (d->draw_buf != NULL)
     msgpack_sbuffer_free(d->draw_buf);
   d->draw_buf = NULL;
-  d->draw_n = 0;
+  d->draw_n = d->draw_items = 0;
 }
 
 int wb_display_get_width(WbDeviceTag tag) {
@@ -248,7 +269,7 @@ static void polygon(WbDeviceTag tag, const char *func, const int *x, const int *
   sn_device *d = display(tag, func, true);
   if (d == NULL)
     return;
-  msgpack_packer *pk = command(d, "polygon", 4);
+  msgpack_packer *pk = command_sized(d, "polygon", 4, 2 * (size_t)size, 10 * (size_t)size);
   msgpack_pack_array(pk, (size_t)size);
   ints(pk, x, size);
   msgpack_pack_array(pk, (size_t)size);
@@ -276,8 +297,8 @@ void wb_display_draw_text(WbDeviceTag tag, const char *text, int x, int y) {
   sn_device *d = display(tag, func, true);
   if (d == NULL)
     return;
-  msgpack_packer *pk = command(d, "text", 4);
   size_t len = strlen(text);
+  msgpack_packer *pk = command_sized(d, "text", 4, 0, len);
   msgpack_pack_str(pk, len);
   msgpack_pack_str_body(pk, text, len);
   ints(pk, (const int[]){x, y}, 2);
@@ -307,10 +328,15 @@ WbImageRef wb_display_image_new(WbDeviceTag tag, int width, int height, const vo
     fprintf(stderr, "Error: %s(): 'format' argument is invalid.\n", func);
     return NULL;
   }
+  size_t n = (size_t)width * (size_t)height;
+  if (n > MAX_IMAGE_BYTES / 4) {
+    fprintf(stderr, "Error: %s(): a %d x %d image is %zu bytes, more than one request carries (%u): send it in "
+                    "parts.\n", func, width, height, 4 * n, MAX_IMAGE_BYTES);
+    return NULL;
+  }
   sn_device *d = display(tag, func, true);
   if (d == NULL)
     return NULL;
-  size_t n = (size_t)width * (size_t)height;
   unsigned char *bgra = malloc(4 * n);
   WbImageRef ir = bgra != NULL ? new_ref(d, tag) : NULL;
   if (ir == NULL) {
@@ -340,7 +366,7 @@ WbImageRef wb_display_image_new(WbDeviceTag tag, int width, int height, const vo
         break;
     }
   }
-  msgpack_packer *pk = command(d, "load", 5);
+  msgpack_packer *pk = command_sized(d, "load", 5, 0, 4 * n);
   ints(pk, (const int[]){ir->id, width, height}, 3);
   msgpack_pack_bin(pk, 4 * n);
   msgpack_pack_bin_body(pk, bgra, 4 * n);
@@ -422,8 +448,21 @@ static void add_save(sn_req *r, const void *p) {
   const save_args *a = p;
   sn_req_key(r, "commands");
   pack_commands(a->d, r);
-  sn_req_key(r, "save");
-  msgpack_pack_int(&r->pk, a->id);
+  if (a->id >= 0) {
+    sn_req_key(r, "save");
+    msgpack_pack_int(&r->pk, a->id);
+  }
+}
+
+/* d's commands sent at once (the "draw" service), in order, before the one being added. */
+static void flush(sn_device *d) {
+  sn_robot *rb = sn_robot_get(g_func);
+  char item[512];
+  snprintf(item, sizeof item, "%s/draw", d->name);
+  save_args a = {d, -1};
+  sn_reply rep;
+  if (sn_robot_call(rb, item, 1, add_save, &a, g_func, &rep) == 0)
+    sn_reply_free(&rep);
 }
 
 static bool ends_with(const char *s, const char *ext) {

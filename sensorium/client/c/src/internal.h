@@ -180,7 +180,7 @@ typedef struct {
   int display_width, display_height;
   msgpack_sbuffer *draw_buf;
   msgpack_packer draw_pk;
-  int draw_n, image_ids;
+  int draw_n, draw_items, image_ids;
   bool camera_attached;
 } sn_device;
 
