@@ -361,3 +361,43 @@ def test_a_python_controller_drawing_more_than_a_request_carries_keeps_its_order
             wb.wb_robot_cleanup()
     ys, xs = np.mgrid[0:120, 0:160]
     assert (pixels == (0xFF000000 | (xs << 16) | (ys << 8) | ((xs + ys) & 0xFF)).astype(np.uint32)).all()
+
+
+def test_a_half_opaque_filled_oval_blends_each_pixel_as_often_as_webots_draws_it(disp) -> None:
+    # WbDisplay's fill: the middle row, then two rows per step of the loop whenever my2 changed;
+    # how often each pixel is drawn is counted here from the loop itself
+    cx, cy, a, b = 9, 6, 5, 3
+    counts: dict[tuple[int, int], int] = {}
+
+    def row(x0, x1, y):
+        for x in range(x0, x1 + 1):
+            counts[(x, y)] = counts.get((x, y), 0) + 1
+    row(cx - a, cx + a, cy)
+    mx1, my1, mx2, my2 = cx - a, cy, cx + a, cy
+    dx, dy, r = 2 * a * a, 2 * b * b, a * b * b
+    rx, ry, x, old = 2 * r, 0, a, -2
+    while x > 0:
+        if r > 0:
+            my1, my2, ry = my1 + 1, my2 - 1, ry + dx
+            r -= ry
+        if r <= 0:
+            x, mx1, mx2, rx = x - 1, mx1 + 1, mx2 - 1, rx - dy
+            r += rx
+        if old != my2:
+            row(mx1, mx2, my1)
+            row(mx1, mx2, my2)
+        old = my2
+    draw(disp, ["opacity", 0.5], ["oval", cx, cy, a, b, True])
+    op = int(0.5 * 255)
+
+    def blended(times):
+        v = 0                                             # a channel of black (the colour is white)
+        for _ in range(times):
+            v = ((255 - op) * v + op * 255) // 255
+        return v
+    for (px, py), n in counts.items():
+        c = blended(n)
+        assert int(disp.pixels[py, px]) == (0xFF << 24 | c << 16 | c << 8 | c), (px, py, n)
+    untouched = disp.pixels[[y for y in range(12) for x in range(20) if (x, y) not in counts],
+                            [x for y in range(12) for x in range(20) if (x, y) not in counts]]
+    assert (untouched == BLACK).all()

@@ -419,8 +419,12 @@ class Display(Device):
                     xs += [mx2, mx2]
                     ys += [my1, my2]
         drawn = False
-        for ln in lines:                         # each row a line of its own, as WbDisplay draws them
-            drawn |= self._op_line(*ln)
+        if lines:                                # each row a horizontal line, as WbDisplay draws them
+            span = np.array(lines, dtype=np.int64)
+            lengths = span[:, 2] - span[:, 0] + 1
+            first = np.repeat(np.cumsum(lengths) - lengths, lengths)
+            row_x = np.repeat(span[:, 0], lengths) + np.arange(int(lengths.sum())) - first
+            drawn |= self._blend(row_x, np.repeat(span[:, 1], lengths))
         if xs:
             drawn |= self._blend(np.array(xs, dtype=np.int64), np.array(ys, dtype=np.int64))
         return drawn
