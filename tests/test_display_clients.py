@@ -1,31 +1,71 @@
-"""A Display's size from a C controller (the C library built with AddressSanitizer and UBSan) and
-from a Webots Python controller against ``sensorium serve``, for the same robot written as YAML
-(tests/worlds/display.yaml) and as .wbt (tests/worlds/display.wbt): wb_display_get_width/height
-answer the world's size (Webots' 64 x 64 by default), so the drawing loops of Webots' samples run;
-the drawing calls answer like any unsimulated device's (one warning line per Display), image
-references are usable, and image_save says once that it writes no file."""
+"""The Display from a C controller (the C library built with AddressSanitizer and UBSan) and from
+a Webots Python controller against ``sensorium serve``, for the same robot written as YAML
+(tests/worlds/display.yaml) and as .wbt (tests/worlds/display.wbt): both draw the same sequence
+(lines, shapes, a blended polygon, text, images made, copied and pasted), which travels with their
+step requests; ``imageSave`` writes the server's pixels as PNG files, equal to what the server's
+rasteriser draws from the same commands in process (tests/test_display.py checks those pixels
+against Webots' rules in closed form)."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 from _serve import run_controller, sensorium
+from PIL import Image
 from test_c_client import sanitized_controller
 
 from sensorium.schemas import world as wm
+from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 
 REPO = Path(__file__).resolve().parents[1]
-CLIB = REPO / "sensorium" / "client" / "c"
 WORLDS = [REPO / "tests" / "worlds" / "display.yaml", REPO / "tests" / "worlds" / "display.wbt"]
 SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
 EXPECTED = ["screen 320 240", "small 64 64", "properties 320 240", "pixels 1920", "refs 1 1 1", "done"]
+
+RGBA_2x2 = bytes([255, 0, 0, 128, 0, 255, 0, 255, 0, 0, 255, 64, 255, 255, 255, 0])
+
+
+def _bgra(rgba: bytes) -> bytes:
+    out = bytearray(rgba)
+    out[0::4], out[2::4] = rgba[2::4], rgba[0::4]
+    return bytes(out)
+
+
+def expected_images() -> tuple[np.ndarray, np.ndarray]:
+    """What the controllers' sequence draws (the display, the copied image), in process: RGBA rows."""
+    sim = Simulation(load_world(WORLDS[0]))
+    d = sim.robots["bot"].devices["screen"]
+    cmds: list[list] = []
+    for x in range(320):
+        for y in range(0, 240, 40):
+            cmds += [["color", 0xFF0000], ["pixel", x, y]]
+    cmds += [["color", 0xFF0000], ["line", 0, 0, 50, 20], ["color", 0x00FF00], ["rectangle", 60, 10, 30, 20, True],
+             ["color", 0x0000FF], ["oval", 150, 100, 40, 25, False], ["oval", 250, 60, 20, 30, True],
+             ["alpha", 0.5], ["opacity", 0.6], ["color", 0xFFFF00],
+             ["polygon", [10, 100, 80, 30, 5], [150, 160, 230, 220, 190], True], ["opacity", 1.0], ["alpha", 1.0],
+             ["rectangle", 200, 150, 60, 40, False], ["polygon", [200, 230, 215], [60, 60, 90], False],
+             ["text", "Sensorium", 100, 200], ["load", 1, 2, 2, _bgra(RGBA_2x2)], ["paste", 1, 300, 220, True],
+             ["copy", 2, 60, 10, 30, 20], ["paste", 2, 0, 100, False]]
+    d.apply(d.check(cmds), 0)
+
+    def rgba(words: np.ndarray) -> np.ndarray:
+        b = words.astype("<u4").view(np.uint8).reshape(*words.shape, 4)
+        return b[..., [2, 1, 0, 3]]
+    return rgba(d.pixels), rgba(d.images[2])
 
 
 @pytest.fixture(scope="module")
 def c_controller(tmp_path_factory) -> str:
     return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "display_size.c")
+
+
+@pytest.fixture(scope="module")
+def expected() -> tuple[np.ndarray, np.ndarray]:
+    return expected_images()
 
 
 def test_both_world_formats_keep_the_display_size() -> None:
@@ -44,24 +84,44 @@ def test_a_display_size_below_one_is_one_as_in_webots(tmp_path: Path) -> None:
     assert any("width" in line for line in w.warnings) and any("height" in line for line in w.warnings)
 
 
-def _check(lines: list[str], err: str) -> None:
-    assert lines == EXPECTED, lines
-    warned = [line for line in err.splitlines() if "Sensorium does not simulate Display" in line]
-    assert len(warned) == 1 and "'screen'" in warned[0], err       # getWidth/getHeight say nothing
-    saved = [line for line in err.splitlines() if "wb_display_image_save()" in line and "not written" in line]
-    assert saved == ["Warning: wb_display_image_save(): Display 'screen' draws no image here: 'screen.png' is not "
-                     "written."], err
+def test_the_expected_sequence_draws_what_the_rules_say(expected) -> None:
+    screen, copy = expected
+    assert screen.shape == (240, 320, 4) and copy.shape == (20, 30, 4)
+    assert (copy == [0, 255, 0, 255]).all()                            # the green fill, copied
+    assert (screen[100:120, 0:30] == [0, 255, 0, 255]).all()          # and pasted
+    assert tuple(screen[0, 0]) == (255, 0, 0, 255) and tuple(screen[20, 50]) == (255, 0, 0, 255)   # line ends
+    # the 2 x 2 image blended over black: each channel a·c/255, alpha capped at 255
+    assert tuple(screen[220, 300]) == (128, 0, 0, 255) and tuple(screen[221, 300]) == (0, 0, 64, 255)
+    assert tuple(screen[221, 301]) == (0, 0, 0, 255)                   # a transparent pixel changes nothing
+
+
+def _small() -> np.ndarray:
+    """The small display's map, a colour per pixel (8,192 commands: sent in several requests)."""
+    ys, xs = np.mgrid[0:64, 0:64]
+    return np.stack([xs << 2, ys << 2, np.full_like(xs, 0x40), np.full_like(xs, 255)], axis=-1).astype(np.uint8)
+
+
+def _check(lines: list[str], err: str, out: Path, expected) -> None:
+    assert lines == EXPECTED, (lines, err)
+    assert "does not simulate Display" not in err and "Error" not in err, err
+    for name, want in zip(("screen.png", "copy.png", "small.png"), (*expected, _small())):
+        with Image.open(out / name) as im:
+            assert im.mode == "RGBA"
+            got = np.asarray(im)
+        assert got.shape == want.shape and (got == want).all(), name
 
 
 @pytest.mark.parametrize("world", WORLDS, ids=lambda p: p.suffix[1:])
-def test_a_python_controller_reads_the_display_size(world: Path) -> None:
+def test_a_python_controller_draws_and_saves(world: Path, tmp_path: Path, expected) -> None:
     lines, err = run_controller(world, lambda url: sensorium(
-        "controller", "--url", url, str(REPO / "tests" / "controllers" / "display_size.py")))
-    _check(lines, err)
+        "controller", "--url", url, str(REPO / "tests" / "controllers" / "display_size.py")),
+        env={"DISPLAY_OUT": str(tmp_path)})
+    _check(lines, err, tmp_path, expected)
 
 
 @pytest.mark.parametrize("world", WORLDS, ids=lambda p: p.suffix[1:])
-def test_a_c_controller_reads_the_display_size(world: Path, c_controller: str) -> None:
-    lines, err = run_controller(world, lambda url: [c_controller], env=SAN_ENV)
+def test_a_c_controller_draws_and_saves(world: Path, tmp_path: Path, c_controller: str, expected) -> None:
+    lines, err = run_controller(world, lambda url: [c_controller], env={**SAN_ENV, "DISPLAY_OUT": str(tmp_path)})
     assert "Sanitizer" not in err and "runtime error" not in err, err
-    _check(lines, err)
+    _check(lines, err, tmp_path, expected)
+    assert os.path.getsize(tmp_path / "screen.png") > 0

@@ -23,6 +23,16 @@ def png_bytes(rgb: bytes, width: int, height: int) -> bytes:
     return b"\x89PNG\r\n\x1a\n" + _chunk(b"IHDR", header) + _chunk(b"IDAT", zlib.compress(raw, 6)) + _chunk(b"IEND", b"")
 
 
+def png_rgba_bytes(bgra: bytes, width: int, height: int) -> bytes:
+    """An 8-bit RGBA PNG of ``bgra`` (``height`` rows of ``width`` × 4 bytes B, G, R, A, top row first)."""
+    rgba = bytearray(len(bgra))
+    rgba[0::4], rgba[1::4], rgba[2::4], rgba[3::4] = bgra[2::4], bgra[1::4], bgra[0::4], bgra[3::4]
+    row = 4 * width
+    raw = b"".join(b"\0" + bytes(rgba[y * row:(y + 1) * row]) for y in range(height))
+    header = struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + _chunk(b"IHDR", header) + _chunk(b"IDAT", zlib.compress(raw, 6)) + _chunk(b"IEND", b"")
+
+
 def bgra_to_rgb(bgra: bytes) -> bytes:
     out = bytearray(len(bgra) // 4 * 3)
     out[0::3] = bgra[2::4]

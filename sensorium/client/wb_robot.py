@@ -180,7 +180,7 @@ class DeviceState:
                  "value", "values", "speed", "speed_vector", "quaternion", "roll_pitch_yaw", "range_bytes",
                  "cloud_bytes", "point_cloud_enabled", "max_velocity", "target_position", "velocity",
                  "channel", "range", "queue", "queue_bytes", "bytes_to_send",
-                 "_consts", "_range", "_cloud", "_warned", "_warned_unsimulated", "camera")
+                 "_consts", "_range", "_cloud", "_warned", "_warned_unsimulated", "camera", "drawing", "drawing_size", "image_ids")
 
     def __init__(self, index: int, desc: dict):
         self.index = index
@@ -218,6 +218,9 @@ class DeviceState:
         self._warned = False
         self.camera: dict[str, Any] = {}         # a camera's latest readings (wb_camera.py): image, recognition
         self._warned_unsimulated = False
+        self.drawing: list[list[Any]] = []       # a Display's commands, sent with the next step (wb_display.py)
+        self.drawing_size = [0, 0]               # about how many values and bytes they hold
+        self.image_ids = 0                       # a Display's image references given out
 
     def __repr__(self) -> str:
         return f"<{self.kind} {self.name!r} tag={self.tag} period={self.sampling_period}>"
@@ -270,6 +273,7 @@ class RobotClient:
         self.devices = [DeviceState(i, d) for i, d in enumerate(reply.get("devices", []))]
         self.by_name = {d.name: d for d in self.devices}
         self._emitters = [d for d in self.devices if d.kind == EMITTER and d.simulated]
+        self._displays = [d for d in self.devices if d.kind == "Display" and d.simulated]
         self.motor_commands: dict[str, dict[str, float]] = {}   # sent with the next step request
         self._prefix = f"/{self.name}/"
         self.conn.start_heartbeat(self.session, self.heartbeat_ms, lost_after_s)
@@ -307,6 +311,11 @@ class RobotClient:
         packets = self._emitted(duration)
         if packets:
             args["emitters"] = packets
+        drawn = {d.name: d.drawing for d in self._displays if d.drawing}
+        if drawn:
+            args["displays"] = drawn
+            for d in self._displays:
+                d.drawing = []
         self.pending = self.conn.send(self._prefix + "robot/step", args)
         return 0
 

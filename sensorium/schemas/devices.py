@@ -246,6 +246,11 @@ register(DeviceKind(
     "Receiver", wm.Receiver, "sensorium.server.sim.radio:Receiver",
     services=(*_SENSOR, "get_channel", "set_channel", "get_buffer_size"),
     description="ReceiverDescription"))
+register(DeviceKind(
+    "Display", wm.Display, "sensorium.server.sim.display:Display",
+    services=("draw",),
+    topics=(TopicDecl("image", msgs.IMAGE, "image"),),
+    description="DisplayDescription"))
 # A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
 # any other is listed, not simulated (schemas.world.RotationalMotor).
 register(DeviceKind(
@@ -255,8 +260,6 @@ register(DeviceKind(
 
 # ---------------------------------------------------------------------- listed, not simulated (yet)
 
-# (a Display keeps its width and height: its model is schemas.world.Display, its attach entry a
-# DisplayDescription; still no implementation, so its functions answer "no value")
 for _t in wm.UNSIMULATED_DEVICE_TYPES:
     register(DeviceKind(_t, getattr(wm, _t) if _t in wm.LISTED_WITH_FIELDS else None,
                         description=f"{_t}Description" if _t in wm.LISTED_WITH_FIELDS else None))

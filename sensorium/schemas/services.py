@@ -25,6 +25,7 @@ __all__ = ["ErrorCode", "PROTOCOL_VERSION", "SERVICES", "ServiceSpec", "service_
 MAX_PERIOD_MS = (1 << 31) - 1
 MAX_MOTOR_COMMANDS = 256        # per step request (a robot has a handful of motors)
 MAX_EMITTERS = 256              # emitters named in one step request
+MAX_DISPLAYS = 64               # displays named in one step request
 Mode = Literal["fast", "realtime", "pause"]
 FieldName = Annotated[str, Field(min_length=1, max_length=64, description=(
     "a Webots field name (translation, rotation, name, children, on, intensity, color, ...: README "
@@ -147,6 +148,10 @@ class StepArgs(Args):
     emitters: dict[str, list[PacketOut]] | None = Field(
         default=None, description="emitter name -> the packets its controller sent since the previous step (as its "
                                   "baud rate let them leave), in order; they travel at the next basic step")
+    displays: dict[str, list[list[Any]]] | None = Field(
+        default=None, description="display name -> its drawing commands since the previous step, in order (README "
+                                  "'The Display' lists them: [\"line\", x1, y1, x2, y2], ...); drawn when the request "
+                                  f"arrives; at most {MAX_DISPLAYS} displays")
 
     @model_validator(mode="before")
     @classmethod
@@ -158,7 +163,18 @@ class StepArgs(Args):
         emitters = data.get("emitters") if isinstance(data, dict) else None
         if isinstance(emitters, dict) and len(emitters) > MAX_EMITTERS:
             raise ValueError(f"emitters: {len(emitters)} emitters, at most {MAX_EMITTERS} per step")
+        displays = data.get("displays") if isinstance(data, dict) else None
+        if isinstance(displays, dict) and len(displays) > MAX_DISPLAYS:
+            raise ValueError(f"displays: {len(displays)} displays, at most {MAX_DISPLAYS} per step")
         return data
+
+
+class DrawArgs(Args):
+    """A Display's drawing commands sent at once (``wb_display_image_save`` flushes them, as Webots'
+    libController does) and, with ``save``, the image to send back."""
+
+    commands: list[list[Any]] = Field(default_factory=list, description="as a step request's 'displays' entry")
+    save: int | None = Field(default=None, ge=0, lt=1 << 31, description="0: the display as shown; n: image n")
 
 
 class ChannelArgs(Args):
@@ -336,8 +352,8 @@ class UnsimulatedDescription(_Entry):
     simulated: bool = False
 
 
-class DisplayDescription(UnsimulatedDescription):
-    """A Display: listed, not simulated (nothing is drawn), its size the world's."""
+class DisplayDescription(_Entry):
+    """A Display: its size (the image it draws on)."""
 
     type: Literal["Display"]
     width: int = Field(description="pixels (wb_display_get_width)")
@@ -516,7 +532,7 @@ def _description_tag(v: Any) -> str:
     get = v.get if isinstance(v, dict) else (lambda k, d=None: getattr(v, k, d))
     if get("simulated", True):
         return str(get("type", ""))
-    return "unsimulated Display" if get("type", "") == "Display" else "unsimulated"
+    return "unsimulated"
 
 
 DeviceDescription = Annotated[
@@ -529,11 +545,10 @@ DeviceDescription = Annotated[
     | Annotated[TouchSensorDescription, Tag("TouchSensor")] | Annotated[PenDescription, Tag("Pen")]
     | Annotated[RangeFinderDescription, Tag("RangeFinder")] | Annotated[CameraDescription, Tag("Camera")]
     | Annotated[EmitterDescription, Tag("Emitter")] | Annotated[ReceiverDescription, Tag("Receiver")]
-    | Annotated[DisplayDescription, Tag("unsimulated Display")] | Annotated[UnsimulatedDescription, Tag("unsimulated")],
+    | Annotated[DisplayDescription, Tag("Display")] | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
-:class:`UnsimulatedDescription` for a device that is listed only (:class:`DisplayDescription`
-for a Display, which keeps its size)."""
+:class:`UnsimulatedDescription` for a device that is listed only."""
 
 
 class AckermannDescription(Result):
@@ -632,6 +647,14 @@ class SuccessResult(Result):
 
 class FloatValue(Result):
     value: float
+
+
+class DrawResult(Result):
+    """``draw``: the saved image when ``save`` was asked (BGRA bytes, rows top first), else none."""
+
+    width: int = Field(default=0, ge=0)
+    height: int = Field(default=0, ge=0)
+    data: bytes | None = Field(default=None, description="width x height x 4 bytes (B, G, R, A); null: no such image")
 
 
 class IntValue(Result):
@@ -866,6 +889,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_noise", "device", NoArgs, FloatValue),
     ServiceSpec("write", "device", BoolArgs, SuccessResult, attached=True),
     ServiceSpec("set_ink_color", "device", InkColorArgs, SuccessResult, attached=True),
+    ServiceSpec("draw", "device", DrawArgs, DrawResult, attached=True),
     ServiceSpec("set_exposure", "device", ExposureArgs, SuccessResult, attached=True),
     ServiceSpec("recognition_enable", "device", EnableArgs, SuccessResult, attached=True),
     ServiceSpec("get_recognition_sampling_period", "device", NoArgs, IntValue),

@@ -788,23 +788,24 @@ class RotationalMotor(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Connector", "Display", "LinearMotor", "Microphone", "Radar", "Radio", "Skin",
+    "Brake", "Connector", "LinearMotor", "Microphone", "Radar", "Radio", "Skin",
     "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
 
 
 class Display(_Device):
-    """Webots Display: listed, not simulated (no image is drawn), but its size is the world's, as
-    ``wb_display_get_width``/``get_height`` answer it (Webots' Display.wrl defaults; a size below 1
-    is set to 1 by Webots, WbRenderingDevice::updateWidth/updateHeight)."""
+    """Webots Display: an image of ``width`` x ``height`` pixels its controller draws on (lines,
+    shapes, text, images, an attached camera's image under it), published as
+    ``/<robot>/<display>/image`` (README "The Display"). Webots' Display.wrl defaults; a size below 1
+    is set to 1 by Webots (WbRenderingDevice::updateWidth/updateHeight)."""
 
     device: Literal["Display"]
     width: int = Field(default=64, ge=1, le=1 << 16, description="pixels (wb_display_get_width)")
     height: int = Field(default=64, ge=1, le=1 << 16, description="pixels (wb_display_get_height)")
 
 
-LISTED_WITH_FIELDS = ("Display",)
+LISTED_WITH_FIELDS: tuple[str, ...] = ()
 """Unsimulated types whose own fields a world file keeps (a model of their own, above): their
 ``attach`` description carries them."""
 _NO_FIELDS = tuple(t for t in UNSIMULATED_DEVICE_TYPES if t not in LISTED_WITH_FIELDS)
@@ -826,7 +827,7 @@ Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED |
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
                 "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "Emitter", "Receiver", "RotationalMotor", "Pen",
-                "RangeFinder", "Camera", *UNSIMULATED_DEVICE_TYPES)
+                "RangeFinder", "Camera", "Display", *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
 

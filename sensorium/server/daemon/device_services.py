@@ -114,6 +114,21 @@ class DeviceServices:
     def _dev_get_noise(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.config.noise)}
 
+    def _dev_draw(self, c: Call) -> dict:
+        """A Display's commands at once, and the image ``save`` asks for (``wb_display_image_save``)."""
+        dev = c.ctl.device
+        try:
+            commands = dev.check(c.args.commands)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"draw: {c.robot}/{dev.name}: {exc}") from None
+        dev.apply(commands, self.sim.time_ms)
+        if c.args.save is None:
+            return {}
+        img = dev.save_image(c.args.save)
+        if img is None:
+            return {"width": 0, "height": 0, "data": None}
+        return {"width": int(img.shape[1]), "height": int(img.shape[0]), "data": img.astype("<u4").tobytes()}
+
     def _dev_set_exposure(self, c: Call) -> dict:
         return _configured(c, "set_exposure", c.args.value)
 

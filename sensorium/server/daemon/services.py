@@ -597,6 +597,7 @@ class Core(DeviceServices):
             return _DEFERRED
         commands = self._motor_commands(c.robot, c.args.motors) if c.args.motors else []
         packets = self._emitter_packets(c.robot, c.args.emitters) if c.args.emitters else []
+        drawings = self._display_commands(c.robot, c.args.displays) if c.args.displays else []
         if c.args.duration == 0:
             # Webots' step(0): deliver the commands and the values not yet read, time stands still
             s = self._session(c)
@@ -604,6 +605,7 @@ class Core(DeviceServices):
                 raise ServiceError(ErrorCode.WRONG_STATE, f"robot {c.robot!r} already has a step pending")
             self._apply_motor_commands(commands)
             self._queue_packets(packets)
+            self._draw(drawings)
             return {"status": 0, "time_ms": self.sim.time_ms, "values": self._new_values(s)}
         done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.duration, c.now)
         if done is not None:                                 # quitting: -1 at once
@@ -611,7 +613,28 @@ class Core(DeviceServices):
         # the world has not advanced since the request arrived: Webots' "at the start of the step"
         self._apply_motor_commands(commands)
         self._queue_packets(packets)
+        self._draw(drawings)
         return _DEFERRED
+
+    def _display_commands(self, robot: str, displays: dict[str, Any]) -> list[tuple[Any, Any]]:
+        """(display, checked commands) of a step request; every display and command checked first,
+        so that a bad one draws none of them."""
+        r = self.sim.robots[robot]
+        out = []
+        for name, commands in displays.items():
+            dev = r.devices.get(name)
+            if dev is None or dev.kind != "Display":
+                what = f"is a {dev.kind}, not a display" if dev is not None else "is no device of the robot"
+                raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: displays: {robot}/{name} {what}")
+            try:
+                out.append((dev, dev.check(commands)))
+            except ValueError as exc:
+                raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"step: displays: {robot}/{name}: {exc}") from None
+        return out
+
+    def _draw(self, drawings: list[tuple[Any, Any]]) -> None:
+        for dev, commands in drawings:
+            dev.apply(commands, self.sim.time_ms)
 
     def _emitter_packets(self, robot: str, emitters: dict[str, Any]) -> list[tuple[Any, Any]]:
         """(emitter device, packets) of a step request; every name resolved first, so that a bad

@@ -270,7 +270,7 @@ class Simulation:
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
-        motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, pen ink cleared (the pens keep their
+        motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
         ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file, GPS speeds
         NaN at their next value (no previous position, as Webots' WbGps::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
@@ -288,6 +288,9 @@ class Simulation:
                     dev.set(0, self.time_ms)
                 elif isinstance(dev, GPS):
                     dev.restart()
+                elif dev.kind == "Display":      # WbDisplay::reset: black again, its images gone
+                    dev.reset()               # type: ignore[attr-defined]
+                    dev._mark(self.time_ms)
         self.radio.reset()
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
@@ -490,7 +493,9 @@ class Simulation:
                              [d for d in every if isinstance(d, Lidar)],
                              [d for d in every if d.kinematic])
             self._tracking = [d for d in every if d.tracks_motion]
-            self._capturing = [d for d in every if getattr(d, "captures", False)]
+            # cameras and range finders first: a display then sees its attached camera's new image
+            self._capturing = sorted((d for d in every if getattr(d, "captures", False)),
+                                     key=lambda d: d.kind == "Display")
         all_lights, all_distances, all_lidars, all_kinematic = self._by_kind
         for dev in self._tracking:    # devices that read the motion keep its last poses while enabled
             if dev.enabled:

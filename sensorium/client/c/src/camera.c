@@ -219,9 +219,12 @@ static int chunk(FILE *f, const char *kind, const unsigned char *data, size_t n)
   return fwrite(head, 1, 8, f) == 8 && (n == 0 || fwrite(data, 1, n, f) == n) && fwrite(tail, 1, 4, f) == 4 ? 0 : -1;
 }
 
-/* An 8-bit RGB PNG of rgb (height rows of 3*width bytes). 0 or -1. */
 static int write_png(const char *filename, const unsigned char *rgb, int width, int height) {
-  size_t row = 3 * (size_t)width + 1, raw_n = row * (size_t)height;
+  return sn_write_png(filename, rgb, width, height, 3);
+}
+
+int sn_write_png(const char *filename, const unsigned char *rgb, int width, int height, int channels) {
+  size_t row = (size_t)channels * (size_t)width + 1, raw_n = row * (size_t)height;
   size_t blocks = (raw_n + 65534) / 65535;
   size_t z_n = 2 + raw_n + 5 * (blocks ? blocks : 1) + 4;
   unsigned char *z = malloc(z_n);
@@ -259,7 +262,7 @@ static int write_png(const char *filename, const unsigned char *rgb, int width, 
   put32(ihdr, (uint32_t)width);
   put32(ihdr + 4, (uint32_t)height);
   ihdr[8] = 8;
-  ihdr[9] = 2;
+  ihdr[9] = channels == 4 ? 6 : 2; /* RGBA or RGB */
   ihdr[10] = ihdr[11] = ihdr[12] = 0;
   int ret = fwrite("\x89PNG\r\n\x1a\n", 1, 8, f) == 8 && chunk(f, "IHDR", ihdr, 13) == 0 &&
                     chunk(f, "IDAT", z, k) == 0 && chunk(f, "IEND", NULL, 0) == 0

@@ -9,6 +9,7 @@
  * kinematic.c - InertialUnit, Compass, Accelerometer, Gyro, Altimeter, TouchSensor;
  * radio.c   - Emitter and Receiver (packet queues, baud-rate pacing);
  * camera.c  - range finders and cameras;
+ * display.c - the Display (drawing buffered, sent with the next step request);
  * unsimulated.c - the devices Sensorium lists without simulating ("no value").
  */
 #ifndef SENSORIUM_INTERNAL_H
@@ -174,9 +175,13 @@ typedef struct {
   bool cmd_position, cmd_velocity; /* to send with the next step */
   bool warned_physics;             /* a physics-only motor function was called (one warning) */
   int force_feedback_period, torque_feedback_period;
-  /* Display (listed, not simulated): the world's size; whether image_save said it writes no file */
+  /* Display (display.c): the world's size; the drawing commands packed since the last step (an
+     array's items, draw_n of them), the image ids given out, whether a camera is attached */
   int display_width, display_height;
-  bool warned_image_save;
+  msgpack_sbuffer *draw_buf;
+  msgpack_packer draw_pk;
+  int draw_n, draw_items, image_ids;
+  bool camera_attached;
 } sn_device;
 
 /* A car-like robot's drive from the attach reply ("ackermann_drive"): what the vehicle library
@@ -265,7 +270,15 @@ int sn_radio_pace(sn_device *dev, int duration);
 void sn_radio_pack(sn_device *dev, sn_req *r);
 void sn_radio_free(sn_device *dev);
 
+/* ------------------------------------------------------------------ display.c */
+/* A Display's commands into a step request ("displays": {name: [commands]}), and its cleanup. */
+int sn_display_pending(const sn_robot *rb);
+void sn_display_pack(sn_robot *rb, sn_req *r);
+void sn_display_free(sn_device *d);
+
 /* ------------------------------------------------------------------ camera.c */
+/* An 8-bit PNG of data (height rows of channels*width bytes: RGB or RGBA); 0 or -1. */
+int sn_write_png(const char *filename, const unsigned char *data, int width, int height, int channels);
 /* A range finder's or camera's state from its attach description (0, or -1 on a bad one); its
  * readings from a step reply; freed at cleanup. No-ops for other devices. */
 int sn_imaging_describe(sn_device *d, const msgpack_object *desc);

@@ -124,7 +124,7 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
   for (int i = 0; i < 4; i++)
     d->quaternion[i] = NAN;
   d->gps_speed = NAN;
-  if (d->node_type == WB_NODE_DISPLAY) { /* listed, not simulated: its size is the world's */
+  if (d->node_type == WB_NODE_DISPLAY) { /* its size is the world's */
     d->display_width = (int)sn_int_or(desc, "width", 0);
     d->display_height = (int)sn_int_or(desc, "height", 0);
   }
@@ -208,6 +208,7 @@ static void free_robot(sn_robot *rb) {
     free(d->motor_name);
     sn_imaging_free(d);
     sn_radio_free(d);
+    sn_display_free(d);
   }
   sn_supervisor_free(rb);
   free(rb->devices);
@@ -504,9 +505,12 @@ int wb_robot_step_begin(int duration) {
   snprintf(service, sizeof service, "%srobot/step", rb->prefix);
   sn_req r;
   uint64_t id = sn_conn_next_id(rb->conn);
-  sn_req_begin(&r, id, service, 1 + (motors > 0) + (emitters > 0));
+  int displays = sn_display_pending(rb);
+  sn_req_begin(&r, id, service, 1 + (motors > 0) + (emitters > 0) + (displays > 0));
   sn_req_key(&r, "duration");
   msgpack_pack_int(&r.pk, duration);
+  if (displays)
+    sn_display_pack(rb, &r);
   if (emitters) {
     sn_req_key(&r, "emitters");
     msgpack_pack_map(&r.pk, (size_t)emitters);

@@ -1,5 +1,5 @@
-"""Webots' ``Display`` class (listed, not simulated: a headless server draws nothing, but the
-Display's size is the world's and image references are usable; see ``wb_unsimulated``)."""
+"""Webots' ``Display`` class: drawing buffered and sent with the next step, the server rasterises
+(see ``wb_display``); ``imageNew``/``imageCopy``/``imageLoad`` answer an image reference."""
 
 from __future__ import annotations
 
@@ -7,22 +7,15 @@ from typing import Any
 
 from sensorium.client import wb
 
-from .unsimulated import UnsimulatedDevice
+from .device import Device
 
 
-class Display(UnsimulatedDevice):
+class Display(Device):
     RGB = 3
     RGBA = 4
     ARGB = 5
     BGRA = 6
     ABGR = 7
-    _KIND = "Display"
-    _NO_VALUES = {"setColor": None, "setAlpha": None, "setOpacity": None,
-                  "setFont": None, "attachCamera": None, "detachCamera": None, "drawPixel": None, "drawLine": None,
-                  "drawRectangle": None, "drawOval": None, "drawPolygon": None, "drawText": None,
-                  "fillRectangle": None, "fillOval": None, "fillPolygon": None,
-                  "imageLoad": None, "imagePaste": None, "imageDelete": None}
-    _PROPERTIES = {"width": "getWidth", "height": "getHeight"}
 
     def getWidth(self) -> int:
         return wb.wb_display_get_width(self._tag)
@@ -30,11 +23,73 @@ class Display(UnsimulatedDevice):
     def getHeight(self) -> int:
         return wb.wb_display_get_height(self._tag)
 
-    def imageNew(self, data: Any, format: int, width: int, height: int) -> int | None:
-        return wb.wb_display_image_new(self._tag, int(width), int(height), data, format)
+    @property
+    def width(self) -> int:
+        return self.getWidth()
 
-    def imageCopy(self, x: int, y: int, width: int, height: int) -> int | None:
-        return wb.wb_display_image_copy(self._tag, int(x), int(y), int(width), int(height))
+    @property
+    def height(self) -> int:
+        return self.getHeight()
 
-    def imageSave(self, image: Any, filename: str) -> None:
-        wb.wb_display_image_save(self._tag, image, filename)
+    def setColor(self, color: int) -> None:
+        wb.wb_display_set_color(self._tag, color)
+
+    def setAlpha(self, alpha: float) -> None:
+        wb.wb_display_set_alpha(self._tag, alpha)
+
+    def setOpacity(self, opacity: float) -> None:
+        wb.wb_display_set_opacity(self._tag, opacity)
+
+    def setFont(self, font: str, size: int, antiAliasing: bool) -> None:
+        wb.wb_display_set_font(self._tag, font, size, antiAliasing)
+
+    def attachCamera(self, camera: Any) -> None:
+        wb.wb_display_attach_camera(self._tag, getattr(camera, "_tag", camera))
+
+    def detachCamera(self) -> None:
+        wb.wb_display_detach_camera(self._tag)
+
+    def drawPixel(self, x: int, y: int) -> None:
+        wb.wb_display_draw_pixel(self._tag, x, y)
+
+    def drawLine(self, x1: int, y1: int, x2: int, y2: int) -> None:
+        wb.wb_display_draw_line(self._tag, x1, y1, x2, y2)
+
+    def drawRectangle(self, x: int, y: int, width: int, height: int) -> None:
+        wb.wb_display_draw_rectangle(self._tag, x, y, width, height)
+
+    def drawOval(self, cx: int, cy: int, a: int, b: int) -> None:
+        wb.wb_display_draw_oval(self._tag, cx, cy, a, b)
+
+    def drawPolygon(self, x: Any, y: Any) -> None:
+        wb.wb_display_draw_polygon(self._tag, x, y)
+
+    def drawText(self, text: str, x: int, y: int) -> None:
+        wb.wb_display_draw_text(self._tag, text, x, y)
+
+    def fillRectangle(self, x: int, y: int, width: int, height: int) -> None:
+        wb.wb_display_fill_rectangle(self._tag, x, y, width, height)
+
+    def fillOval(self, cx: int, cy: int, a: int, b: int) -> None:
+        wb.wb_display_fill_oval(self._tag, cx, cy, a, b)
+
+    def fillPolygon(self, x: Any, y: Any) -> None:
+        wb.wb_display_fill_polygon(self._tag, x, y)
+
+    def imageNew(self, data: Any, format: int, width: int | None = None, height: int | None = None) -> Any:
+        return wb.wb_display_image_new(self._tag, width, height, data, format)
+
+    def imageCopy(self, x: int, y: int, width: int, height: int) -> Any:
+        return wb.wb_display_image_copy(self._tag, x, y, width, height)
+
+    def imagePaste(self, ir: Any, x: int, y: int, blend: bool = False) -> None:
+        wb.wb_display_image_paste(self._tag, ir, x, y, blend)
+
+    def imageLoad(self, filename: str) -> Any:
+        return wb.wb_display_image_load(self._tag, filename)
+
+    def imageSave(self, ir: Any, filename: str) -> None:
+        wb.wb_display_image_save(self._tag, ir, filename)
+
+    def imageDelete(self, ir: Any) -> None:
+        wb.wb_display_image_delete(self._tag, ir)

@@ -358,12 +358,11 @@ class Converter:
                     data = self.unsimulated(node, inner, owner)
                     if t == "Pen":             # a Pen keeps its fields (simulated: it inks)
                         data.update(fx.pen(f))
-                    elif t == "Display":       # listed, and its size answers wb_display_get_width/height
+                    elif t == "Display":       # its size (below 1: 1, as Webots sets it)
                         data.update(fx.display(f))
                     if t in wm.UNSIMULATED_DEVICE_TYPES:
                         self.warn(node, f"{t} {data['name']!r} of robot {owner.data['name']!r}: listed (a controller "
-                                        "finds it), not simulated here: its functions answer Webots' \"no value\""
-                                        + (" (its width and height are the world's)" if t == "Display" else ""))
+                                        "finds it), not simulated here: its functions answer Webots' \"no value\"")
                 elif t == "Track":           # a Solid whose device field holds its motor (and sensor, brake)
                     if f.node_("animatedGeometry") is not None:     # the belt Webots draws along its wheels
                         self.skipped["Track.animatedGeometry"] += 1

@@ -36,7 +36,10 @@ public:
   ImageRef *imageCopy(int x, int y, int width, int height) { return wrap(wb_display_image_copy(tag_, x, y, width, height)); }
   void imagePaste(ImageRef *ir, int x, int y, bool blend) { wb_display_image_paste(tag_, ir ? ir->getRef() : NULL, x, y, blend); }
   void imageSave(ImageRef *ir, const std::string &filename) { wb_display_image_save(tag_, ir ? ir->getRef() : NULL, filename.c_str()); }
-  void imageDelete(ImageRef *ir) { wb_display_image_delete(tag_, ir ? ir->getRef() : NULL); }
+  void imageDelete(ImageRef *ir) {  // the handle is gone with its image, as in Webots
+    wb_display_image_delete(tag_, ir ? ir->getRef() : NULL);
+    delete ir;
+  }
 
 private:
   static ImageRef *wrap(WbImageRef ref) { return ref ? new ImageRef(ref) : 0; }

@@ -1,5 +1,5 @@
 // Sensorium C++ controller layer: ImageRef, a Display image handle (Display.hpp), in its own header as
-// in Webots. Sensorium's displays draw nothing; imageNew and imageCopy give a handle of no pixels.
+// in Webots: an image the server keeps for the Display (imageNew, imageLoad, imageCopy).
 #ifndef WEBOTS_IMAGEREF_HPP
 #define WEBOTS_IMAGEREF_HPP
 
