@@ -1,5 +1,5 @@
 """Webots' functions of the devices Sensorium lists but does not simulate (Brake, Connector,
-Display, Radar, Skin, Speaker, VacuumGripper): each checks its tag names a device of its type,
+Display, Skin, Speaker, VacuumGripper): each checks its tag names a device of its type,
 prints the device's one warning line and answers Webots' "no value" (NaN, ``None`` for NULL, 0,
 False). Camera, RangeFinder and Pen have their own modules.
 
@@ -64,16 +64,6 @@ NO_VALUE: dict[str, tuple[str, Any]] = {
     "wb_display_image_load": ("Display", None),
     "wb_display_image_paste": ("Display", None),
     "wb_display_image_delete": ("Display", None),
-    # Radar
-    "wb_radar_enable": ("Radar", None),
-    "wb_radar_disable": ("Radar", None),
-    "wb_radar_get_sampling_period": ("Radar", 0),
-    "wb_radar_get_number_of_targets": ("Radar", 0),
-    "wb_radar_get_targets": ("Radar", None),
-    "wb_radar_get_min_range": ("Radar", _NAN),
-    "wb_radar_get_max_range": ("Radar", _NAN),
-    "wb_radar_get_horizontal_fov": ("Radar", _NAN),
-    "wb_radar_get_vertical_fov": ("Radar", _NAN),
     # Skin
     "wb_skin_set_bone_orientation": ("Skin", None),
     "wb_skin_set_bone_position": ("Skin", None),

@@ -432,6 +432,10 @@ class Solid(Strict):
         default=[], max_length=1024, description="Webots recognitionColors: cameras with a Recognition node report "
         "this solid (with its children); top-level solids only")
 
+    radar_cross_section: float = Field(
+        default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the solid a Radar target; "
+        "top-level solids only")
+
     _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
@@ -441,6 +445,9 @@ class Solid(Strict):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "
                                  "and robots only (give them to the top-level solid)")
+            if child.radar_cross_section > 0.0:
+                raise ValueError(f"children[{i}] ({child.name}): radar_cross_section is read on top-level solids "
+                                 "and robots only (give it to the top-level solid)")
         return self
 
 
@@ -782,8 +789,43 @@ class RotationalMotor(_Device):
     device: Literal["RotationalMotor"]
 
 
+class Radar(_Device):
+    """Webots Radar: the targets (solids and robots with ``radar_cross_section`` > 0) in its frustum
+    around its x axis, between ``min_range`` and ``max_range``, whose echo reaches
+    ``min_detectable_signal`` by the radar equation: each one's distance, received power (dBm),
+    radial speed and azimuth (README "Radar"). Webots' defaults (Radar.wrl)."""
+
+    device: Literal["Radar"]
+    min_range: float = Field(default=1.0, ge=0.0, description="m")
+    max_range: float = Field(default=50.0, gt=0.0, description="m, > min_range")
+    horizontal_field_of_view: float = Field(default=0.78, gt=0.0, lt=2 * math.pi, description="rad")
+    vertical_field_of_view: float = Field(default=0.1, gt=0.0, lt=math.pi / 2, description="rad")
+    min_absolute_radial_speed: float = Field(default=0.0, ge=0.0, description="m/s; 0: no limit")
+    min_radial_speed: float = Field(default=0.0, description="m/s; min and max both 0: no limits")
+    max_radial_speed: float = Field(default=0.0, description="m/s; min and max both 0: no limits")
+    cell_distance: float = Field(default=0.0, ge=0.0, description="m: targets nearer in distance merge; 0: none")
+    cell_speed: float = Field(default=0.0, ge=0.0, description="m/s: and nearer in speed (0: distance only)")
+    range_noise: float = Field(default=0.0, ge=0.0, description="σ of the distance (m)")
+    speed_noise: float = Field(default=0.0, ge=0.0, description="σ of the speed (m/s)")
+    angular_noise: float = Field(default=0.0, ge=0.0, description="σ of the azimuth (rad)")
+    antenna_gain: float = Field(default=20.0, description="dBi")
+    frequency: float = Field(default=24.0, gt=0.0, description="GHz")
+    transmitted_power: float = Field(default=20.0, description="dBm")
+    min_detectable_signal: float = Field(default=-100.0, description="dBm")
+    occlusion: bool = Field(default=False, description="a target hidden behind another shape is not seen")
+
+    @model_validator(mode="after")
+    def _ranges(self) -> Radar:
+        if self.max_range <= self.min_range:
+            raise ValueError(f"max_range {self.max_range} must be greater than min_range {self.min_range}")
+        if (self.min_radial_speed != 0.0 or self.max_radial_speed != 0.0) and self.max_radial_speed <= self.min_radial_speed:
+            raise ValueError(f"max_radial_speed {self.max_radial_speed} must be greater than min_radial_speed "
+                             f"{self.min_radial_speed} (or both 0: no limits)")
+        return self
+
+
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Connector", "Display", "LinearMotor", "Microphone", "Radar", "Radio", "Skin",
+    "Brake", "Connector", "Display", "LinearMotor", "Microphone", "Radio", "Skin",
     "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -816,12 +858,12 @@ class UnsimulatedDevice(_Device):
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
                    | Accelerometer | Gyro | Altimeter | TouchSensor | Emitter | Receiver | RotationalMotor | Pen
-                   | RangeFinder | Camera | Display | UnsimulatedDevice,
+                   | RangeFinder | Camera | Radar | Display | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
                 "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "Emitter", "Receiver", "RotationalMotor", "Pen",
-                "RangeFinder", "Camera", *UNSIMULATED_DEVICE_TYPES)
+                "RangeFinder", "Camera", "Radar", *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
 
@@ -942,6 +984,8 @@ class Robot(Strict):
     recognition_colors: list[Color] = Field(
         default=[], max_length=1024, description="Webots recognitionColors: other robots' cameras with a Recognition "
         "node report this robot")
+    radar_cross_section: float = Field(
+        default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the robot a Radar target")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 

@@ -29,6 +29,7 @@ from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.ground import Ground, GroundWarning, band_low
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
+from sensorium.server.sim.radar import Radar
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
 from sensorium.server.sim.scene import (
     Scene,
@@ -270,8 +271,8 @@ class Simulation:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file, GPS speeds
-        NaN at their next value (no previous position, as Webots' WbGps::reset).
+        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file, GPS and Radar speeds
+        NaN at their next value (no previous position, as Webots' WbGps::reset and WbRadar::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
         for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):
@@ -285,7 +286,7 @@ class Simulation:
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
                     dev.set(0, self.time_ms)
-                elif isinstance(dev, GPS):
+                elif isinstance(dev, (GPS, Radar)):      # no previous position: the next speeds are NaN
                     dev.restart()
         self.radio.reset()
         for name, pose in self._initial["solids"].items():

@@ -1,0 +1,238 @@
+"""The Radar (Webots' node) in the simulation, closed form: which solids and robots it detects and
+the distance, received power (the radar equation, by hand here), radial speed and azimuth it reads;
+its limits (frustum, ranges, detectable signal, radial speeds), occlusion, cell merging, seeded
+noise, its .wbt fields, its topic and ROS 2 export, and the batched simulation's refusal."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.schemas import messages as msgs
+from sensorium.schemas import world as wm
+from sensorium.server.daemon.services import Core
+from sensorium.server.devices import radar as rmath
+from sensorium.server.sim.batched import BatchedError, check_observable
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+STEP = 16
+
+
+def world(radar: dict | None = None, solids: list | None = None, robots: list | None = None, seed: int = 0) -> wm.World:
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": STEP, "random_seed": seed},
+        "robots": [{"name": "car", "devices": [{"device": "Radar", "name": "radar", **(radar or {})}]},
+                   *(robots or [])],
+        "solids": solids or []})
+
+
+def target(name: str, x: float, y: float, z: float = 0.0, rcs: float = 5.0, size: float = 0.5) -> dict:
+    return {"name": name, "pose": {"translation": [x, y, z]}, "radar_cross_section": rcs,
+            "geometry": {"type": "box", "size": [size, size, size]}}
+
+
+def by_hand_dbm(distance: float, rcs: float, pt_dbm: float = 20.0, gain_dbi: float = 20.0, f_ghz: float = 24.0) -> float:
+    """The radar equation: Pr = Pt G² λ² σ / ((4π)³ r⁴), in dBm."""
+    pt = 10.0 ** (pt_dbm / 10.0) / 1000.0                 # W
+    g = 10.0 ** (gain_dbi / 10.0)
+    lam = 299_792_458.0 / (f_ghz * 1e9)                   # m
+    pr = pt * g * g * lam * lam * rcs / ((4.0 * math.pi) ** 3 * distance ** 4)
+    return 10.0 * math.log10(pr / 0.001)
+
+
+def run(sim: Simulation, steps: int = 1, period: int = STEP, name: str = "car/radar"):
+    radar = sim.device(name)
+    if not radar.enabled:
+        radar.enable(period)
+    for _ in range(steps):
+        sim.step()
+    return radar.targets
+
+
+def test_a_target_ahead_reads_its_distance_power_and_azimuth() -> None:
+    # a target 10 m ahead and 2 m to the right (-y): azimuth positive (Webots' sign), atan(2/10)
+    sim = Simulation(world(solids=[target("truck", 10.0, -2.0, rcs=5.0)]))
+    [t] = run(sim)
+    d = math.sqrt(104.0)
+    assert t.distance == pytest.approx(d, rel=1e-14)
+    assert t.azimuth == pytest.approx(math.atan(0.2), rel=1e-14)
+    assert t.received_power == pytest.approx(by_hand_dbm(d, 5.0), abs=1e-12)
+    assert math.isnan(t.speed)                          # no previous position at the first value
+    [t] = run(sim)
+    assert t.speed == 0.0                               # at rest
+    # to the left: the azimuth's sign turns; other radar settings enter the equation as written
+    sim = Simulation(world({"transmitted_power": 30.0, "antenna_gain": 10.0, "frequency": 77.0},
+                           solids=[target("car2", 20.0, 3.0, rcs=2.0)]))
+    [t] = run(sim)
+    assert t.azimuth == pytest.approx(-math.atan(3.0 / 20.0), rel=1e-14)
+    assert t.received_power == pytest.approx(by_hand_dbm(math.hypot(20.0, 3.0), 2.0, 30.0, 10.0, 77.0), abs=1e-12)
+
+
+def test_the_radar_pose_on_its_robot_and_the_robot_pose_count() -> None:
+    # the radar 1 m forward and turned 90° left on a robot at (5, 0) facing +y: the target at (5, 11)
+    # is 10 m straight ahead of it
+    w = world({"pose": {"translation": [1.0, 0.0, 0.0], "rotation": [0, 0, 1, 0]}},
+              solids=[target("ahead", 5.0, 11.0)])
+    w = w.model_copy(update={"robots": [w.robots[0].model_copy(update={
+        "pose": wm.Pose(translation=(5.0, 0.0, 0.0), rotation=(0.0, 0.0, 1.0, math.pi / 2))})]})
+    [t] = run(Simulation(w))
+    assert t.distance == pytest.approx(10.0, abs=1e-12) and t.azimuth == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("radar, solid", [
+    ({}, target("wide", 10.0, -5.0)),                                   # |y| > x tan(0.39): outside the 0.78 rad cone
+    ({}, target("high", 10.0, 0.0, z=1.0)),                             # |z| > x tan(0.05)
+    ({}, target("behind", -10.0, 0.0)),
+    ({}, target("far", 50.5, 0.0)),                                     # beyond max_range (50 m)
+    ({}, target("near", 0.9, 0.0)),                                     # closer than min_range (1 m)
+    ({}, target("plain", 10.0, 0.0, rcs=0.0)),                          # no cross section: not a target
+    ({}, target("faint", 40.0, 0.0, rcs=0.001)),                       # echo weaker than -100 dBm
+    ({"min_detectable_signal": -60.0}, target("faint", 10.0, 0.0, rcs=0.01)),
+], ids=["azimuth", "elevation", "behind", "max_range", "min_range", "rcs0", "signal", "threshold"])
+def test_what_the_radar_does_not_see(radar: dict, solid: dict) -> None:
+    sim = Simulation(world(radar, solids=[solid, target("seen", 20.0, 0.0)]))
+    run(sim, 2)
+    assert [round(t.distance, 9) for t in sim.device("car/radar").targets] == [20.0]
+    # the thresholds, by hand: the faint echoes are below them, the seen one (5 m² at 20 m) above
+    assert by_hand_dbm(40.0, 0.001) < -100.0 and by_hand_dbm(10.0, 0.01) < -60.0 < by_hand_dbm(20.0, 5.0)
+
+
+def test_a_moving_robot_gives_its_radial_speed() -> None:
+    # a robot target 10 m ahead moved 0.25 m further each 16 ms step: +15.625 m/s (moving away);
+    # then the radar's own robot drives towards it faster: the relative speed turns negative
+    other = {"name": "lead", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 10.0,
+             "body": {"geometry": {"type": "box", "size": [4.0, 2.0, 1.5]}}}
+    sim = Simulation(world(robots=[other]))
+    run(sim)
+    lead, car = sim.robot("lead"), sim.robot("car")
+    lead.set_pose([10.25, 0.0, 0.0])
+    [t] = run(sim)
+    assert t.speed == pytest.approx(0.25 / 0.016, rel=1e-12)
+    assert t.received_power == pytest.approx(by_hand_dbm(10.25, 10.0), abs=1e-12)
+    lead.set_pose([10.5, 3.0, 0.0])                       # off axis: only the radial part counts
+    car.set_pose([1.0, 0.0, 0.0])
+    [t] = run(sim)
+    direction = np.array([9.5, 3.0, 0.0]) / math.hypot(9.5, 3.0)
+    relative = (np.array([0.25, 3.0, 0.0]) - np.array([1.0, 0.0, 0.0])) / 0.016
+    assert t.speed == pytest.approx(float(direction @ relative), rel=1e-12)
+    assert t.distance == pytest.approx(math.hypot(9.5, 3.0), rel=1e-14)
+    # radial speed limits: a window that leaves this speed out drops the target
+    sim = Simulation(world({"min_radial_speed": 1.0, "max_radial_speed": 20.0}, robots=[other]))
+    run(sim)
+    sim.robot("lead").set_pose([10.25, 0.0, 0.0])
+    assert len(run(sim)) == 1                            # 15.625 m/s: inside
+    sim.robot("lead").set_pose([10.25, 0.0, 0.0])
+    assert run(sim) == []                                # 0 m/s: below min_radial_speed
+    # and a minimum absolute radial speed above it drops it too
+    sim = Simulation(world({"min_absolute_radial_speed": 16.0}, robots=[other]))
+    run(sim)
+    sim.robot("lead").set_pose([10.25, 0.0, 0.0])
+    assert run(sim) == []
+
+
+def test_occlusion_hides_a_target_behind_a_wall() -> None:
+    wall = {"name": "wall", "pose": {"translation": [5.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.2, 1.0, 2.0]}}
+    solids = [target("hidden", 10.0, 0.0), target("clear", 10.0, -3.0), wall]
+    assert sorted(round(t.distance, 6) for t in run(Simulation(world(solids=solids)))) == [
+        10.0, round(math.hypot(10.0, 3.0), 6)]
+    [t] = run(Simulation(world({"occlusion": True}, solids=solids)))
+    assert t.distance == pytest.approx(math.hypot(10.0, 3.0), rel=1e-14)
+    # the target's own shape in the way does not hide it (a 2 m box around its origin)
+    [t] = run(Simulation(world({"occlusion": True}, solids=[target("big", 10.0, 0.0, size=2.0)])))
+    assert t.distance == pytest.approx(10.0, rel=1e-14)
+
+
+def test_targets_within_a_cell_merge_weighted_by_power() -> None:
+    solids = [target("a", 10.0, -1.0, rcs=4.0), target("b", 10.2, 1.0, rcs=1.0), target("c", 30.0, 0.0)]
+    sim = Simulation(world({"cell_distance": 0.5}, solids=solids))
+    merged, far = run(sim)
+    da, db = math.hypot(10.0, 1.0), math.hypot(10.2, 1.0)
+    pa, pb = (10.0 ** (by_hand_dbm(d, s) / 10.0) for d, s in ((da, 4.0), (db, 1.0)))    # mW
+    assert merged.received_power == pytest.approx(10.0 * math.log10(pa + pb), abs=1e-12)
+    assert merged.distance == pytest.approx((da * pa + db * pb) / (pa + pb), rel=1e-13)
+    assert merged.azimuth == pytest.approx((math.atan(0.1) * pa - math.atan(1.0 / 10.2) * pb) / (pa + pb), rel=1e-12)
+    assert far.distance == pytest.approx(30.0, rel=1e-14)
+    # the pure model: cell_speed > 0 keeps targets of different speeds apart
+    ts = [rmath.RadarTarget(10.0, 1.0, 0.0, 0.0), rmath.RadarTarget(10.1, 1.0, 5.0, 0.0)]
+    assert len(rmath.merge(ts, 0.5, 1.0)) == 2 and len(rmath.merge(ts, 0.5, 0.0)) == 1
+
+
+def test_noise_is_seeded_and_reproducible() -> None:
+    noisy = {"range_noise": 0.1, "speed_noise": 0.2, "angular_noise": 0.01}
+
+    def readings(seed: int) -> list:
+        sim = Simulation(world(noisy, solids=[target("a", 10.0, 0.0), target("b", 20.0, -2.0)], seed=seed))
+        return [[t.as_list() for t in run(sim)] for _ in range(4)]
+
+    a, b, c = (np.array(readings(seed)) for seed in (7, 7, 8))      # (steps, targets, 4)
+    assert np.array_equal(a, b, equal_nan=True) and not np.array_equal(a, c, equal_nan=True)
+    flat = a[1:].reshape(-1, 4)
+    assert np.all(flat[:, 0] != np.round(flat[:, 0])) and np.all(flat[:, 2] != 0.0)   # noise was drawn
+    assert np.all(np.abs(flat[:, 0] - np.tile([10.0, math.hypot(20.0, 2.0)], 3)) < 1.0)
+
+
+def test_wbt_fields_and_cross_sections_are_read(tmp_path: Path) -> None:
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+                 'Robot { name "car" radarCrossSection 2.5 children [\n'
+                 '  Radar { name "front radar" translation 0.5 0 0.2 minRange 0.5 maxRange 80 horizontalFieldOfView 0.5\n'
+                 '          verticalFieldOfView 0.2 occlusion TRUE speedNoise 0.1 cellDistance 1 transmittedPower 30\n'
+                 '          minRadialSpeed -5 maxRadialSpeed 40 minDetectableSignal -90 }\n] }\n'
+                 'Solid { translation 20 0 0.2 name "truck" radarCrossSection 10\n'
+                 '  children [ Solid { name "inner" radarCrossSection 3 } ] }\n'
+                 'Solid { translation 30 0 0 name "plain" }\n')
+    loaded = load_world(p)
+    w = loaded.world
+    r = w.robots[0].devices[0]
+    assert isinstance(r, wm.Radar) and r.name == "front radar"
+    assert (r.min_range, r.max_range, r.horizontal_field_of_view, r.vertical_field_of_view) == (0.5, 80.0, 0.5, 0.2)
+    assert (r.occlusion, r.speed_noise, r.cell_distance, r.transmitted_power) == (True, 0.1, 1.0, 30.0)
+    assert (r.min_radial_speed, r.max_radial_speed, r.min_detectable_signal) == (-5.0, 40.0, -90.0)
+    assert r.antenna_gain == 20.0 and r.frequency == 24.0          # Webots' defaults
+    assert w.robots[0].radar_cross_section == 2.5
+    assert [(s.name, s.radar_cross_section) for s in w.solids] == [("truck", 10.0), ("plain", 0.0)]
+    assert any("'inner'" in line and "radarCrossSection" in line for line in loaded.warnings)
+    assert not any("Radar" in line and "not simulated" in line for line in loaded.warnings)
+    [t] = run(Simulation(loaded), name="car/front radar")
+    assert t.distance == pytest.approx(19.5, rel=1e-14)
+    assert t.received_power == pytest.approx(by_hand_dbm(19.5, 10.0, pt_dbm=30.0), abs=1e-12)
+
+
+def test_bad_radar_fields_are_refused_in_one_line() -> None:
+    with pytest.raises(ValueError, match="max_range 1.0 must be greater than min_range 2.0"):
+        world({"min_range": 2.0, "max_range": 1.0})
+    with pytest.raises(ValueError, match="max_radial_speed"):
+        world({"min_radial_speed": 3.0, "max_radial_speed": 1.0})
+    with pytest.raises(ValueError, match="radar_cross_section is read on top-level solids"):
+        world(solids=[{"name": "s", "children": [{"name": "c", "radar_cross_section": 1.0}]}])
+
+
+def test_topic_get_targets_step_reading_and_ros2_export() -> None:
+    from sensorium.server.recording.export import to_ros, to_rosbags, typestore_for
+    sim = Simulation(world(solids=[target("truck", 10.0, -2.0)]))
+    core = Core(sim)
+    assert {"/car/radar/enable", "/car/radar/get_sampling_period", "/car/radar/get_targets"} <= set(core.routes)
+    assert {t.name: t.type for t in core.topics.topics}["/car/radar/targets"] == msgs.RADAR_SCAN
+    [t] = run(sim)
+    ctl = core.topics.controls["car/radar"]
+    scan = msgs.validate(msgs.RADAR_SCAN, core.topics.build(ctl, "targets", sim.time_ms))
+    [ret] = scan.returns
+    assert (ret.range, ret.azimuth, ret.amplitude) == (t.distance, -t.azimuth, t.received_power)   # REP 103: left +
+    assert core.topics.reading(ctl) == {"targets": t.as_list()}
+    store = typestore_for("jazzy")
+    body = core.topics.build(ctl, "targets", sim.time_ms)
+    ros = to_rosbags(store, msgs.RADAR_SCAN, to_ros(store, msgs.RADAR_SCAN, body))
+    raw = store.serialize_cdr(ros, msgs.RADAR_SCAN)
+    back = store.deserialize_cdr(raw, msgs.RADAR_SCAN)
+    assert back.returns[0].range == pytest.approx(t.distance, rel=1e-6)
+    assert back.header.frame_id == body["header"]["frame_id"]
+
+
+def test_the_batched_simulation_refuses_a_radar_in_one_line() -> None:
+    w = world(solids=[target("truck", 10.0, 0.0)])
+    with pytest.raises(BatchedError, match=r"device 'radar' is a Radar; the batched simulation measures"):
+        check_observable(w, "car", ["radar"])
