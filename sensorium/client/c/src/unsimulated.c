@@ -11,7 +11,6 @@
 #include <webots/connector.h>
 #include <webots/display.h>
 #include <webots/microphone.h>
-#include <webots/radar.h>
 #include <webots/radio.h>
 #include <webots/skin.h>
 #include <webots/speaker.h>
@@ -208,50 +207,6 @@ void wb_display_image_delete(WbDeviceTag tag, WbImageRef ir) {
     return;
   sn_unsimulated(tag, WB_NODE_DISPLAY, "wb_display_image_delete");
   free(ir);
-}
-
-/* ------------------------------------------------------------------ Radar */
-void wb_radar_enable(WbDeviceTag tag, int sampling_period) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_enable");
-}
-
-void wb_radar_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_disable");
-}
-
-int wb_radar_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_sampling_period");
-  return 0;
-}
-
-int wb_radar_get_number_of_targets(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_number_of_targets");
-  return 0;
-}
-
-const WbRadarTarget *wb_radar_get_targets(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_targets");
-  return NULL;
-}
-
-double wb_radar_get_min_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_min_range");
-  return NAN;
-}
-
-double wb_radar_get_max_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_max_range");
-  return NAN;
-}
-
-double wb_radar_get_horizontal_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_horizontal_fov");
-  return NAN;
-}
-
-double wb_radar_get_vertical_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_vertical_fov");
-  return NAN;
 }
 
 /* ------------------------------------------------------------------ Skin */
