@@ -8,7 +8,7 @@ from controller import Radar, Robot
 
 
 def h(v: float) -> str:
-    return "%016x" % struct.unpack("<Q", struct.pack("<d", v))[0]
+    return f"{struct.unpack('<Q', struct.pack('<d', v))[0]:016x}"
 
 
 robot = Robot()
