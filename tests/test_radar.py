@@ -230,9 +230,31 @@ def test_topic_get_targets_step_reading_and_ros2_export() -> None:
     back = store.deserialize_cdr(raw, msgs.RADAR_SCAN)
     assert back.returns[0].range == pytest.approx(t.distance, rel=1e-6)
     assert back.header.frame_id == body["header"]["frame_id"]
+    # the encoder of bag exports, Foxglove-ready recordings and the live viewer gives the same bytes
+    import msgpack
+
+    from sensorium.server.recording.export import CdrEncoder
+    for distro in ("humble", "jazzy"):
+        assert CdrEncoder(distro).encode(msgs.RADAR_SCAN, msgpack.packb(body)) == (msgs.RADAR_SCAN, bytes(raw))
 
 
 def test_the_batched_simulation_refuses_a_radar_in_one_line() -> None:
     w = world(solids=[target("truck", 10.0, 0.0)])
     with pytest.raises(BatchedError, match=r"device 'radar' is a Radar; the batched simulation measures"):
         check_observable(w, "car", ["radar"])
+
+
+def test_a_driven_robot_ahead_reads_its_wheel_speed() -> None:
+    # a two-wheel robot 10 m ahead driving away at ω r = 5 rad/s × 0.1 m = 0.5 m/s
+    lead = {"name": "lead", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 1.0,
+            "body": {"geometry": {"type": "box", "size": [0.4, 0.3, 0.2]}},
+            "differential_drive": {"wheel_radius": 0.1, "axle_length": 0.3, "max_wheel_speed": 10.0}}
+    sim = Simulation(world(robots=[lead]))
+    for motor in ("left wheel motor", "right wheel motor"):
+        sim.robot("lead").motor(motor).set_position(math.inf)
+        sim.robot("lead").motor(motor).set_velocity(5.0)
+    run(sim)
+    for k in range(2, 5):
+        [t] = run(sim)
+        assert t.speed == pytest.approx(0.5, rel=1e-9)
+        assert t.distance == pytest.approx(10.0 + 0.5 * k * STEP / 1000.0, rel=1e-12)
