@@ -258,3 +258,21 @@ def test_a_driven_robot_ahead_reads_its_wheel_speed() -> None:
         [t] = run(sim)
         assert t.speed == pytest.approx(0.5, rel=1e-9)
         assert t.distance == pytest.approx(10.0 + 0.5 * k * STEP / 1000.0, rel=1e-12)
+
+
+def test_a_supervisor_reads_and_sets_radar_cross_sections() -> None:
+    from sensorium.server.daemon.supervisor import find_node, get_field, set_field
+    sim = Simulation(world(solids=[target("truck", 10.0, 0.0, rcs=5.0), target("plain", 20.0, 0.0, rcs=0.0)]))
+    truck, plain, car = find_node(sim, "truck"), find_node(sim, "plain"), find_node(sim, "car")
+    assert truck is not None and plain is not None and car is not None
+    assert get_field(sim, truck, "radarCrossSection") == {"type": "SFFloat", "value": 5.0}
+    assert get_field(sim, car, "radarCrossSection")["value"] == 0.0
+    [t] = run(sim)
+    set_field(sim, plain, "radarCrossSection", 2.0)            # a new target, after the others
+    set_field(sim, truck, "radarCrossSection", 0.0)            # no longer one
+    [t] = run(sim)
+    assert t.distance == pytest.approx(20.0) and t.received_power == pytest.approx(by_hand_dbm(20.0, 2.0), abs=1e-12)
+    with pytest.raises(ValueError, match="must be >= 0"):
+        set_field(sim, plain, "radarCrossSection", -1.0)
+    sim.reset()                                                 # back to the world file's
+    assert [round(t.distance, 9) for t in run(sim)] == [10.0]
