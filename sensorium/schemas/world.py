@@ -798,8 +798,8 @@ class Radar(_Device):
     device: Literal["Radar"]
     min_range: float = Field(default=1.0, ge=0.0, description="m")
     max_range: float = Field(default=50.0, gt=0.0, description="m, > min_range")
-    horizontal_field_of_view: float = Field(default=0.78, gt=0.0, lt=2 * math.pi, description="rad")
-    vertical_field_of_view: float = Field(default=0.1, gt=0.0, lt=math.pi / 2, description="rad")
+    horizontal_field_of_view: float = Field(default=0.78, gt=0.0, le=2 * math.pi, description="rad")
+    vertical_field_of_view: float = Field(default=0.1, gt=0.0, lt=math.pi, description="rad")
     min_absolute_radial_speed: float = Field(default=0.0, ge=0.0, description="m/s; 0: no limit")
     min_radial_speed: float = Field(default=0.0, description="m/s; min and max both 0: no limits")
     max_radial_speed: float = Field(default=0.0, description="m/s; min and max both 0: no limits")
