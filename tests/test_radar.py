@@ -276,3 +276,12 @@ def test_a_supervisor_reads_and_sets_radar_cross_sections() -> None:
         set_field(sim, plain, "radarCrossSection", -1.0)
     sim.reset()                                                 # back to the world file's
     assert [round(t.distance, 9) for t in run(sim)] == [10.0]
+
+
+def test_a_radar_wider_than_a_half_turn_sees_beside_and_behind_it() -> None:
+    # h = 4 rad: a target at (-1, 5) is 1.768 rad to the left (inside ±2), one straight behind is not
+    sim = Simulation(world({"horizontal_field_of_view": 4.0, "vertical_field_of_view": 0.5},
+                           solids=[target("beside", -1.0, 5.0), target("behind", -10.0, 0.0)]))
+    [t] = run(sim)
+    assert t.azimuth == pytest.approx(-math.atan2(5.0, -1.0), rel=1e-14)
+    assert t.distance == pytest.approx(math.sqrt(26.0), rel=1e-14)
