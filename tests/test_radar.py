@@ -285,3 +285,13 @@ def test_a_radar_wider_than_a_half_turn_sees_beside_and_behind_it() -> None:
     [t] = run(sim)
     assert t.azimuth == pytest.approx(-math.atan2(5.0, -1.0), rel=1e-14)
     assert t.distance == pytest.approx(math.sqrt(26.0), rel=1e-14)
+
+
+def test_probe_prints_a_radar_s_targets(capsys) -> None:
+    from sensorium.cli import main
+    world_file = Path(__file__).parent / "worlds" / "radar.yaml"
+    assert main(["probe", str(world_file), "--enable", "bot/radar:16", "--steps", "1", "--json"]) == 0
+    import json
+    row = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert row["device"] == "radar" and row["targets"]["shape"] == [2, 4]
+    assert row["targets"]["max"] == pytest.approx(math.sqrt(404.0), rel=1e-14)     # the truck's distance

@@ -80,7 +80,8 @@ class Radar(Device):
         self._radar_before = None
 
     def readings(self) -> dict:
-        return {"targets": self.targets}
+        """(n, 4) float64: distance, received power, speed, azimuth of each target (``sensorium probe``)."""
+        return {"targets": np.array([t.as_list() for t in self.targets], dtype=np.float64).reshape(-1, 4)}
 
     def step_reading(self) -> dict:
         return {"targets": [v for t in self.targets for v in t.as_list()]}
