@@ -295,3 +295,33 @@ def test_probe_prints_a_radar_s_targets(capsys) -> None:
     row = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert row["device"] == "radar" and row["targets"]["shape"] == [2, 4]
     assert row["targets"]["max"] == pytest.approx(math.sqrt(404.0), rel=1e-14)     # the truck's distance
+
+
+@pytest.mark.parametrize("distro", ["humble", "jazzy"])
+def test_a_recorded_radar_scan_exports_to_a_ros2_bag(tmp_path: Path, distro: str) -> None:
+    """The radar's topic in a recording becomes radar_msgs/msg/RadarScan in a rosbag2 directory,
+    with its message definition, read back by mcap_ros2's decoder."""
+    from _recdata import make_recording
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    from sensorium.server.recording.export import export_ros2
+    sim = Simulation(world(solids=[target("truck", 10.0, -2.0), target("sign", 20.0, 3.0, rcs=1.0)]))
+    core = Core(sim)
+    run(sim)
+    ctl = core.topics.controls["car/radar"]
+    body = core.topics.build(ctl, "targets", sim.time_ms)
+    src = tmp_path / "rec.mcap"
+    make_recording(src, steps=3, topics={"/car/radar/targets": (msgs.RADAR_SCAN, lambda t_ns, i: body, 1)})
+    out = tmp_path / "bag"
+    report = export_ros2(src, out, distro=distro)
+    assert report.messages == 3 and not report.skipped
+    [bag] = out.glob("*.mcap")
+    with open(bag, "rb") as f:
+        decoded = [(schema.name, obj) for schema, _, _, obj in
+                   make_reader(f, decoder_factories=[DecoderFactory()]).iter_decoded_messages()]
+    assert len(decoded) == 3 and all(name == msgs.RADAR_SCAN for name, _ in decoded)
+    returns = decoded[0][1].returns
+    assert [r.range for r in returns] == pytest.approx([math.sqrt(104.0), math.sqrt(409.0)], rel=1e-6)
+    assert returns[0].azimuth == pytest.approx(-math.atan(0.2), rel=1e-6)      # REP 103: right is negative
+    assert returns[1].amplitude == pytest.approx(by_hand_dbm(math.sqrt(409.0), 1.0), rel=1e-6)
