@@ -202,11 +202,31 @@ def test_wbt_fields_and_cross_sections_are_read(tmp_path: Path) -> None:
     assert t.received_power == pytest.approx(by_hand_dbm(19.5, 10.0, pt_dbm=30.0), abs=1e-12)
 
 
-def test_bad_radar_fields_are_refused_in_one_line() -> None:
-    with pytest.raises(ValueError, match="max_range 1.0 must be greater than min_range 2.0"):
-        world({"min_range": 2.0, "max_range": 1.0})
-    with pytest.raises(ValueError, match="max_radial_speed"):
-        world({"min_radial_speed": 3.0, "max_radial_speed": 1.0})
+def test_bad_radar_fields_are_reset_as_webots_does(tmp_path: Path) -> None:
+    # WbRadar's update functions at load: each value reset with one warning naming the field
+    p = tmp_path / "w.yaml"
+    p.write_text("robots:\n  - name: car\n    devices:\n"
+                 "      - {device: Radar, name: a, min_range: 5, max_range: 2, horizontal_field_of_view: 4,\n"
+                 "         vertical_field_of_view: 2, min_radial_speed: 3, max_radial_speed: 1, range_noise: -1,\n"
+                 "         frequency: -3}\n"
+                 "      - {device: Radar, name: b, min_range: -1, max_range: 0}\n")
+    loaded = load_world(p)
+    a, b = loaded.world.robots[0].devices
+    assert (a.min_range, a.max_range) == (1.0, 2.0)              # max - 1 (updateMinRange)
+    assert (a.horizontal_field_of_view, a.vertical_field_of_view) == (0.78, 0.1)
+    assert (a.min_radial_speed, a.max_radial_speed, a.range_noise, a.frequency) == (3.0, 4.0, 0.0, 24.0)
+    assert (b.min_range, b.max_range) == (0.0, 1.0)
+    assert "robots[0].devices[0].min_range: not less than max_range, reset to 1" in loaded.warnings
+    assert "robots[0].devices[0].horizontal_field_of_view: outside (0, pi), reset to 0.78" in loaded.warnings
+    assert "robots[0].devices[1].max_range: not greater than min_range, reset to 1" in loaded.warnings
+    assert len([w for w in loaded.warnings if "devices[0]" in w]) == 6
+    # a .wbt radar too, at its line
+    q = tmp_path / "w.wbt"
+    q.write_text("#VRML_SIM R2023b utf8\nRobot { name \"car\" children [ Radar { horizontalFieldOfView 3.5 } ] }\n")
+    loaded = load_world(q)
+    assert loaded.world.robots[0].devices[0].horizontal_field_of_view == 0.78
+    assert any(w.endswith(":2:31: Radar (robots[0].devices[0].horizontal_field_of_view): outside (0, pi), reset to 0.78")
+               for w in loaded.warnings)
     with pytest.raises(ValueError, match="radar_cross_section is read on top-level solids"):
         world(solids=[{"name": "s", "children": [{"name": "c", "radar_cross_section": 1.0}]}])
 
@@ -276,15 +296,6 @@ def test_a_supervisor_reads_and_sets_radar_cross_sections() -> None:
         set_field(sim, plain, "radarCrossSection", -1.0)
     sim.reset()                                                 # back to the world file's
     assert [round(t.distance, 9) for t in run(sim)] == [10.0]
-
-
-def test_a_radar_wider_than_a_half_turn_sees_beside_and_behind_it() -> None:
-    # h = 4 rad: a target at (-1, 5) is 1.768 rad to the left (inside ±2), one straight behind is not
-    sim = Simulation(world({"horizontal_field_of_view": 4.0, "vertical_field_of_view": 0.5},
-                           solids=[target("beside", -1.0, 5.0), target("behind", -10.0, 0.0)]))
-    [t] = run(sim)
-    assert t.azimuth == pytest.approx(-math.atan2(5.0, -1.0), rel=1e-14)
-    assert t.distance == pytest.approx(math.sqrt(26.0), rel=1e-14)
 
 
 def test_probe_prints_a_radar_s_targets(capsys) -> None:

@@ -793,35 +793,27 @@ class Radar(_Device):
     """Webots Radar: the targets (solids and robots with ``radar_cross_section`` > 0) in its frustum
     around its x axis, between ``min_range`` and ``max_range``, whose echo reaches
     ``min_detectable_signal`` by the radar equation: each one's distance, received power (dBm),
-    radial speed and azimuth (README "Radar"). Webots' defaults (Radar.wrl)."""
+    radial speed and azimuth (README "Radar"). Webots' defaults (Radar.wrl); a value Webots resets
+    (WbRadar's update functions) is reset with its warning when the world loads."""
 
     device: Literal["Radar"]
-    min_range: float = Field(default=1.0, ge=0.0, description="m")
-    max_range: float = Field(default=50.0, gt=0.0, description="m, > min_range")
-    horizontal_field_of_view: float = Field(default=0.78, gt=0.0, le=2 * math.pi, description="rad")
-    vertical_field_of_view: float = Field(default=0.1, gt=0.0, lt=math.pi, description="rad")
-    min_absolute_radial_speed: float = Field(default=0.0, ge=0.0, description="m/s; 0: no limit")
+    min_range: float = Field(default=1.0, description="m, >= 0")
+    max_range: float = Field(default=50.0, description="m, > min_range")
+    horizontal_field_of_view: float = Field(default=0.78, description="rad, in (0, pi)")
+    vertical_field_of_view: float = Field(default=0.1, description="rad, in (0, pi/2)")
+    min_absolute_radial_speed: float = Field(default=0.0, description="m/s; 0: no limit")
     min_radial_speed: float = Field(default=0.0, description="m/s; min and max both 0: no limits")
-    max_radial_speed: float = Field(default=0.0, description="m/s; min and max both 0: no limits")
-    cell_distance: float = Field(default=0.0, ge=0.0, description="m: targets nearer in distance merge; 0: none")
-    cell_speed: float = Field(default=0.0, ge=0.0, description="m/s: and nearer in speed (0: distance only)")
-    range_noise: float = Field(default=0.0, ge=0.0, description="σ of the distance (m)")
-    speed_noise: float = Field(default=0.0, ge=0.0, description="σ of the speed (m/s)")
-    angular_noise: float = Field(default=0.0, ge=0.0, description="σ of the azimuth (rad)")
+    max_radial_speed: float = Field(default=0.0, description="m/s, > min_radial_speed; min and max both 0: no limits")
+    cell_distance: float = Field(default=0.0, description="m: targets nearer in distance merge; 0: none")
+    cell_speed: float = Field(default=0.0, description="m/s: and nearer in speed (0: distance only)")
+    range_noise: float = Field(default=0.0, description="σ of the distance (m)")
+    speed_noise: float = Field(default=0.0, description="σ of the speed (m/s)")
+    angular_noise: float = Field(default=0.0, description="σ of the azimuth (rad)")
     antenna_gain: float = Field(default=20.0, description="dBi")
-    frequency: float = Field(default=24.0, gt=0.0, description="GHz")
+    frequency: float = Field(default=24.0, description="GHz, >= 0")
     transmitted_power: float = Field(default=20.0, description="dBm")
     min_detectable_signal: float = Field(default=-100.0, description="dBm")
     occlusion: bool = Field(default=False, description="a target hidden behind another shape is not seen")
-
-    @model_validator(mode="after")
-    def _ranges(self) -> Radar:
-        if self.max_range <= self.min_range:
-            raise ValueError(f"max_range {self.max_range} must be greater than min_range {self.min_range}")
-        if (self.min_radial_speed != 0.0 or self.max_radial_speed != 0.0) and self.max_radial_speed <= self.min_radial_speed:
-            raise ValueError(f"max_radial_speed {self.max_radial_speed} must be greater than min_radial_speed "
-                             f"{self.min_radial_speed} (or both 0: no limits)")
-        return self
 
 
 UNSIMULATED_DEVICE_TYPES = (

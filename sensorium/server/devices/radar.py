@@ -4,9 +4,8 @@ A target is a solid or robot with a radar cross section σ > 0, taken as a point
 each candidate, in order (Webots' ``WbRadar``, its noise drawn in this order too):
 
 1. in the frustum: in front of the radar (x > 0 in its frame, x forward, y left, z up),
-   |y| ≤ x·tan(h/2) and |z| ≤ x·tan(v/2) (Webots' planar frustum; for h ≥ π, whose planes a
-   tangent cannot give, |atan2(y, x)| ≤ h/2 and |z| ≤ √(x²+y²)·tan(v/2)), and no farther than
-   ``max_range``;
+   |y| ≤ x·tan(h/2) and |z| ≤ x·tan(v/2) (Webots' planar frustum; h < π and v < π/2, as the
+   world loader resets them), and no farther than ``max_range``;
 2. distance r = |p| + N(0, range_noise); r < ``min_range`` drops it; r is clamped to at most
    ``max_range``;
 3. received power P = Pt·G²·λ²·σ / ((4π)³·r⁴) (W), with Pt = 10^(transmitted_power/10) mW,
@@ -63,17 +62,14 @@ def received_power_factor(transmitted_power_dbm: float, antenna_gain_dbi: float,
     """Pt·G²·λ²/(4π)³ (W·m²): the radar equation's part that depends on the radar alone; the received
     power of a target of cross section σ at distance r is this × σ / r⁴."""
     gain = 10.0 ** (antenna_gain_dbi / 10.0)
-    wavelength = LIGHT_SPEED_M_PER_NS / frequency_ghz
+    wavelength = LIGHT_SPEED_M_PER_NS / frequency_ghz if frequency_ghz != 0.0 else math.inf   # 0 GHz: as Webots
     return to_watts(transmitted_power_dbm) * gain * gain * wavelength * wavelength / (4.0 * math.pi) ** 3
 
 
 def in_frustum(p: np.ndarray, horizontal_fov: float, vertical_fov: float) -> bool:
     """Whether a point ``p`` in the radar frame is inside its detection frustum (module docstring, 1)."""
     x, y, z = float(p[0]), float(p[1]), float(p[2])
-    tan_v = math.tan(vertical_fov / 2.0)
-    if horizontal_fov < math.pi:
-        return x > 0.0 and abs(y) <= x * math.tan(horizontal_fov / 2.0) and abs(z) <= x * tan_v
-    return abs(math.atan2(y, x)) <= horizontal_fov / 2.0 and abs(z) <= math.hypot(x, y) * tan_v
+    return x > 0.0 and abs(y) <= x * math.tan(horizontal_fov / 2.0) and abs(z) <= x * math.tan(vertical_fov / 2.0)
 
 
 def azimuth(p: np.ndarray) -> float:
