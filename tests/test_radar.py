@@ -31,8 +31,9 @@ def world(radar: dict | None = None, solids: list | None = None, robots: list | 
 
 
 def target(name: str, x: float, y: float, z: float = 0.0, rcs: float = 5.0, size: float = 0.5) -> dict:
+    """A ball of diameter ``size``: wholly in view, its box's centre is its origin (closed forms)."""
     return {"name": name, "pose": {"translation": [x, y, z]}, "radar_cross_section": rcs,
-            "geometry": {"type": "box", "size": [size, size, size]}}
+            "geometry": {"type": "sphere", "radius": size / 2.0}}
 
 
 def by_hand_dbm(distance: float, rcs: float, pt_dbm: float = 20.0, gain_dbi: float = 20.0, f_ghz: float = 24.0) -> float:
@@ -88,7 +89,7 @@ def test_the_radar_pose_on_its_robot_and_the_robot_pose_count() -> None:
     ({}, target("high", 10.0, 0.0, z=1.0)),                             # |z| > x tan(0.05)
     ({}, target("behind", -10.0, 0.0)),
     ({}, target("far", 50.5, 0.0)),                                     # beyond max_range (50 m)
-    ({}, target("near", 0.9, 0.0)),                                     # closer than min_range (1 m)
+    ({}, target("near", 0.5, 0.0, size=0.2)),                           # nearer than min_range − 0.1 m
     ({}, target("plain", 10.0, 0.0, rcs=0.0)),                          # no cross section: not a target
     ({}, target("faint", 40.0, 0.0, rcs=0.001)),                       # echo weaker than -100 dBm
     ({"min_detectable_signal": -60.0}, target("faint", 10.0, 0.0, rcs=0.01)),
@@ -105,7 +106,7 @@ def test_a_moving_robot_gives_its_radial_speed() -> None:
     # a robot target 10 m ahead moved 0.25 m further each 16 ms step: +15.625 m/s (moving away);
     # then the radar's own robot drives towards it faster: the relative speed turns negative
     other = {"name": "lead", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 10.0,
-             "body": {"geometry": {"type": "box", "size": [4.0, 2.0, 1.5]}}}
+             "body": {"geometry": {"type": "sphere", "radius": 0.2}}}
     sim = Simulation(world(robots=[other]))
     run(sim)
     lead, car = sim.robot("lead"), sim.robot("car")
@@ -336,3 +337,42 @@ def test_a_recorded_radar_scan_exports_to_a_ros2_bag(tmp_path: Path, distro: str
     assert [r.range for r in returns] == pytest.approx([math.sqrt(104.0), math.sqrt(409.0)], rel=1e-6)
     assert returns[0].azimuth == pytest.approx(-math.atan(0.2), rel=1e-6)      # REP 103: right is negative
     assert returns[1].amplitude == pytest.approx(by_hand_dbm(math.sqrt(409.0), 1.0), rel=1e-6)
+
+
+def test_a_target_is_its_box_in_view_as_webots_places_it() -> None:
+    # Webots' WbObjectDetection: the distance is that of the centre of the target's box in view, the
+    # azimuth and speed those of its origin. A car whose shape sits 2 m ahead of its origin reads 12 m.
+    car = {"name": "car2", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 5.0,
+           "shapes": [{"pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "sphere", "radius": 0.5}}]}
+    [t] = run(Simulation(world(solids=[car])))
+    assert t.distance == pytest.approx(12.0, rel=1e-14) and t.azimuth == 0.0
+    assert t.received_power == pytest.approx(by_hand_dbm(12.0, 5.0), abs=1e-12)
+    # a ball of radius 3 whose origin is outside the frustum (atan(6/10) > 0.39) but part of it in
+    # view: its box is cut at the right plane, and the azimuth is clamped to h/2
+    th = math.tan(float(np.float32(0.39)))
+    n = math.hypot(th, 1.0)
+    d_right = (th * 10.0 - 6.0) / n                       # signed distance of the centre to the right plane
+    assert -3.0 < d_right < 0.0
+    centre_y = -6.0 + 0.5 * (3.0 - d_right)
+    [t] = run(Simulation(world(solids=[target("wall", 10.0, -6.0, size=6.0)])))
+    assert t.distance == pytest.approx(math.hypot(10.0, centre_y), rel=1e-14)
+    assert t.azimuth == pytest.approx(0.39, rel=1e-15)
+    # a box wholly in view: its centre (its origin here) whatever its size; and the near half of a
+    # box counts for min_range: a 1 m ball 1.4 m ahead is seen at min_range 1.8 (1.4 >= 1.8 − 0.5), clamped
+    [t] = run(Simulation(world({"min_range": 1.8}, solids=[target("ball", 1.4, 0.0, size=1.0)])))
+    assert t.distance == 1.8
+
+
+def test_occlusion_spares_a_wall_within_half_the_target_s_box() -> None:
+    # Webots' hasCollided: the ray to the origin must meet something more than half the target's box
+    # (along x) before the origin. The target: two balls beside its origin spanning x 8.8..11.2 (2.4 m).
+    pair = {"name": "pair", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 5.0,
+            "shapes": [{"pose": {"translation": [dx, 0.8, 0.0]}, "geometry": {"type": "sphere", "radius": 0.2}}
+                       for dx in (-1.0, 1.0)]}
+
+    def wall(x: float) -> dict:
+        return {"name": "wall", "pose": {"translation": [x, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 0.5, 0.5]}}
+
+    [t] = run(Simulation(world({"occlusion": True}, solids=[pair, wall(9.2)])))    # hit at 9.15: 0.85 <= 1.2
+    assert t.distance == pytest.approx(math.hypot(10.0, 0.8), rel=1e-14)
+    assert run(Simulation(world({"occlusion": True}, solids=[pair, wall(7.0)]))) == []   # 3.05 > 1.2: hidden

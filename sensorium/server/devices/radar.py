@@ -1,22 +1,23 @@
 """Radar (Webots' Radar node): which targets a radar sees and what it reads of each.
 
-A target is a solid or robot with a radar cross section σ > 0, taken as a point at its origin. For
-each candidate, in order (Webots' ``WbRadar``, its noise drawn in this order too):
+A target is a solid or robot with a radar cross section σ > 0. As Webots' ``WbObjectDetection``
+places it, a target has a box in the radar frame (x forward, y left, z up): the union of the boxes
+of its bounding shapes' parts inside the radar's frustum (:func:`frustum`, clipped as a camera's
+recognition clips, ``devices/recognition.py``), or, without shapes, its origin (a point, size 0).
+For each candidate in view, in order (Webots' ``WbRadar``, its noise drawn in this order too):
 
-1. in the frustum: in front of the radar (x > 0 in its frame, x forward, y left, z up),
-   |y| ≤ x·tan(h/2) and |z| ≤ x·tan(v/2) (Webots' planar frustum; h < π and v < π/2, as the
-   world loader resets them), and no farther than ``max_range``;
-2. distance r = |p| + N(0, range_noise); r < ``min_range`` drops it; r is clamped to at most
-   ``max_range``;
+1. the distance to the box's centre is at most ``max_range`` + half the box's x extent;
+2. distance r = |centre| + N(0, range_noise); below ``min_range`` − half the x extent the target is
+   dropped; r is clamped to [``min_range``, ``max_range``];
 3. received power P = Pt·G²·λ²·σ / ((4π)³·r⁴) (W), with Pt = 10^(transmitted_power/10) mW,
    G = 10^(antenna_gain/10), λ = 0.299792458 / frequency (GHz) m; P below
    10^(min_detectable_signal/10) mW drops it;
-4. radial speed: the target's velocity relative to the radar (both from their positions at the
-   previous measurement, over the time since) along the radar-to-target direction, positive when it
-   moves away, + N(0, speed_noise); outside [min_radial_speed, max_radial_speed] (unless both are 0)
-   or below ``min_absolute_radial_speed`` in magnitude (if > 0) drops it;
-5. azimuth: the angle from the x axis to the target in the radar's x-y plane, positive towards -y
-   (to the right: Webots' sign), clamped to ±h/2, + N(0, angular_noise).
+4. radial speed: the velocity of the target's origin relative to the radar (both from their positions
+   at the previous measurement, over the time since) along the radar-to-origin direction, positive
+   when it moves away, + N(0, speed_noise); outside [min_radial_speed, max_radial_speed] (unless both
+   are 0) or below ``min_absolute_radial_speed`` in magnitude (if > 0) drops it;
+5. azimuth: the angle from the x axis to the target's origin in the radar's x-y plane, positive
+   towards -y (to the right: Webots' sign), clamped to ±h/2, + N(0, angular_noise).
 
 Then targets closer than ``cell_distance`` in distance (and, with ``cell_speed`` > 0, closer than
 it in speed) merge into one whose distance, speed and azimuth are averages weighted by power and
@@ -31,7 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Candidate", "RadarTarget", "azimuth", "candidate_targets", "detect", "finish", "in_frustum", "merge", "radial_speed", "received_power_factor",
+from .recognition import Frustum
+
+__all__ = ["Candidate", "RadarTarget", "azimuth", "candidate_targets", "detect", "finish", "frustum", "in_frustum", "merge", "radial_speed", "received_power_factor",
            "to_dbm", "to_watts"]
 
 LIGHT_SPEED_M_PER_NS = 0.299792458     # λ (m) = this / frequency (GHz)
@@ -66,10 +69,20 @@ def received_power_factor(transmitted_power_dbm: float, antenna_gain_dbi: float,
     return to_watts(transmitted_power_dbm) * gain * gain * wavelength * wavelength / (4.0 * math.pi) ** 3
 
 
-def in_frustum(p: np.ndarray, horizontal_fov: float, vertical_fov: float) -> bool:
-    """Whether a point ``p`` in the radar frame is inside its detection frustum (module docstring, 1)."""
-    x, y, z = float(p[0]), float(p[1]), float(p[2])
-    return x > 0.0 and abs(y) <= x * math.tan(horizontal_fov / 2.0) and abs(z) <= x * math.tan(vertical_fov / 2.0)
+def frustum(horizontal_fov: float, vertical_fov: float) -> Frustum:
+    """The radar's view as Webots' ``computeFrustumPlanes`` makes it (half angles in float32): the
+    clipping planes of ``devices/recognition.py``; round shapes are cut to it up to h = π/2."""
+    th = math.tan(float(np.float32(horizontal_fov / 2.0)))
+    tv = math.tan(float(np.float32(vertical_fov / 2.0)))
+    n = np.array([[th, 1.0, 0.0], [tv, 0.0, 1.0], [th, -1.0, 0.0], [tv, 0.0, -1.0]], dtype=np.float64)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    return Frustum(n, horizontal_fov <= math.pi / 2.0)
+
+
+def in_frustum(p: np.ndarray, f: Frustum) -> bool:
+    """Whether a point ``p`` in the radar frame is inside the frustum ``f`` (a target without shapes)."""
+    q = np.asarray(p, dtype=np.float64)
+    return bool(q[0] > 0.0 and (f.normals @ q >= 0.0).all())
 
 
 def azimuth(p: np.ndarray) -> float:
@@ -91,10 +104,13 @@ def radial_speed(direction: np.ndarray, target_now: np.ndarray, target_before: n
 
 @dataclass(frozen=True, slots=True)
 class Candidate:
-    """A possible target: its position in the radar frame, its cross section (m²) and its radial
-    speed before noise (m/s, NaN when unknown)."""
+    """A target in view: the centre of its box and its origin in the radar frame, its box's extent
+    along x (0 for a point), its cross section (m²) and its radial speed before noise (m/s, NaN when
+    unknown)."""
 
-    local: np.ndarray
+    centre: np.ndarray
+    origin: np.ndarray
+    size: float
     rcs: float
     speed: float
 
@@ -107,8 +123,8 @@ def detect(candidates: list[Candidate], config, rng: np.random.Generator | None 
 
 def candidate_targets(candidates: list[Candidate], config,
                       rng: np.random.Generator | None = None) -> list[tuple[int, RadarTarget]]:
-    """Steps 1-5 of the module docstring: (candidate index, target with its power in W) of each
-    candidate that passes them, before any occlusion test and merging."""
+    """Steps 1-5 of the module docstring for candidates in view: (candidate index, target with its
+    power in W) of each that passes them, before any occlusion test and merging."""
     c = config
     factor = received_power_factor(c.transmitted_power, c.antenna_gain, c.frequency)
     threshold = to_watts(c.min_detectable_signal)
@@ -120,13 +136,13 @@ def candidate_targets(candidates: list[Candidate], config,
 
     found: list[tuple[int, RadarTarget]] = []
     for k, cand in enumerate(candidates):
-        d = float(np.linalg.norm(cand.local))
-        if not in_frustum(cand.local, c.horizontal_field_of_view, c.vertical_field_of_view) or d > c.max_range:
+        d = float(np.linalg.norm(cand.centre))
+        if d > c.max_range + cand.size / 2.0:
             continue
         d += noise(c.range_noise)
-        if d < c.min_range:
+        if d < c.min_range - cand.size / 2.0:
             continue
-        d = min(d, c.max_range)
+        d = min(max(d, c.min_range), c.max_range)
         power = factor * cand.rcs / d ** 4
         if power < threshold:
             continue
@@ -135,7 +151,7 @@ def candidate_targets(candidates: list[Candidate], config,
             continue
         if c.min_absolute_radial_speed > 0.0 and abs(speed) < c.min_absolute_radial_speed:
             continue
-        a = min(max(azimuth(cand.local), -half), half) + noise(c.angular_noise)
+        a = min(max(azimuth(cand.origin), -half), half) + noise(c.angular_noise)
         found.append((k, RadarTarget(d, power, speed, a)))
     return found
 
