@@ -34,8 +34,8 @@ import numpy as np
 
 from .recognition import Frustum
 
-__all__ = ["Candidate", "RadarTarget", "azimuth", "candidate_targets", "detect", "finish", "frustum", "in_frustum", "merge", "radial_speed", "received_power_factor",
-           "to_dbm", "to_watts"]
+__all__ = ["Candidate", "RadarTarget", "azimuth", "candidate_targets", "detect", "finish", "frustum", "in_frustum",
+           "merge", "radial_speed", "received_power_factor", "to_dbm", "to_watts"]
 
 LIGHT_SPEED_M_PER_NS = 0.299792458     # λ (m) = this / frequency (GHz)
 
