@@ -114,7 +114,7 @@ TOY = D.DeviceKind("Speaker", wm.UnsimulatedDevice, f"{__name__}:ToyAltimeter",
 WORLD = {
     "world_info": {"basic_time_step": 16},
     "robots": [{"name": "bot", "pose": {"translation": [0.0, 0.0, 0.25]},
-                "devices": [{"device": "Radar", "name": "radar", "model": "u-blox"},
+                "devices": [{"device": "Skin", "name": "skin", "model": "u-blox"},
                             {"device": "Speaker", "name": "alt", "model": "toy 1"},
                             {"device": "LightSensor", "name": "ls"}]}],
 }
@@ -134,15 +134,15 @@ def test_a_registered_kind_gets_routing_topics_and_its_place(monkeypatch):
     core = Core(sim)
     assert {"/bot/alt/enable", "/bot/alt/get_sampling_period", "/bot/alt/get_value"} <= set(core.routes)
     assert "/bot/alt/value" in core.topics.by_name
-    assert not any(r.startswith("/bot/radar/") for r in core.routes)        # listed, not simulated
+    assert not any(r.startswith("/bot/skin/") for r in core.routes)        # listed, not simulated
     info = call(core, "get_info")["result"]
     assert info["robots"][0]["devices"] == [
-        {"name": "radar", "type": "Radar", "model": "u-blox", "index": 0, "simulated": False},
+        {"name": "skin", "type": "Skin", "model": "u-blox", "index": 0, "simulated": False},
         {"name": "alt", "type": "Speaker", "model": "toy 1", "index": 1, "simulated": True},
         {"name": "ls", "type": "LightSensor", "model": "", "index": 2, "simulated": True}]
     attached = call(core, "attach", {"robot": "bot"})["result"]
     assert [(d["name"], d["index"], d["simulated"]) for d in attached["devices"]] == [
-        ("radar", 0, False), ("alt", 1, True), ("ls", 2, True)]
+        ("skin", 0, False), ("alt", 1, True), ("ls", 2, True)]
     # (the toy has no description model: a real kind adds one)
     described = TypeAdapter(S.DeviceDescription)
     assert isinstance(described.validate_python(attached["devices"][0]), S.UnsimulatedDescription)
@@ -153,7 +153,7 @@ def test_a_registered_kind_gets_routing_topics_and_its_place(monkeypatch):
         sim.step()
     assert call(core, "/bot/alt/get_value")["result"]["value"] == 0.25
     listed = {s["name"]: s for s in call(core, "get_services")["result"]["services"]}
-    assert listed["/bot/radar/*"]["simulated"] is False and listed["/bot/alt/get_value"]["simulated"] is True
+    assert listed["/bot/skin/*"]["simulated"] is False and listed["/bot/alt/get_value"]["simulated"] is True
 
 
 def test_limits_follow_the_declared_rays():

@@ -41,7 +41,8 @@ def test_documents_cover_every_type():
                                         "geometry_msgs/msg/PoseStamped", "sensor_msgs/msg/JointState", "std_msgs/msg/ColorRGBA",
                                         "geometry_msgs/msg/PointStamped", "geometry_msgs/msg/Vector3Stamped",
                                         "sensor_msgs/msg/NavSatFix", "std_msgs/msg/Float64", "sensor_msgs/msg/Imu",
-                                        "sensor_msgs/msg/MagneticField", "sensor_msgs/msg/CameraInfo"}
+                                        "sensor_msgs/msg/MagneticField", "sensor_msgs/msg/CameraInfo",
+                                        "radar_msgs/msg/RadarScan"}
     for ref in msgs["x-ros-types"].values():
         assert ref.split("/")[-1] in msgs["$defs"]
     svc = docs["services.schema.json"]

@@ -179,7 +179,7 @@ class DeviceState:
     __slots__ = ("tag", "index", "name", "kind", "desc", "simulated", "node_type", "model", "sampling_period",
                  "value", "values", "speed", "speed_vector", "quaternion", "roll_pitch_yaw", "range_bytes",
                  "cloud_bytes", "point_cloud_enabled", "max_velocity", "target_position", "velocity",
-                 "channel", "range", "queue", "queue_bytes", "bytes_to_send",
+                 "channel", "range", "queue", "queue_bytes", "bytes_to_send", "targets",
                  "_consts", "_range", "_cloud", "_warned", "_warned_unsimulated", "camera", "drawing", "drawing_size", "image_ids")
 
     def __init__(self, index: int, desc: dict):
@@ -211,6 +211,7 @@ class DeviceState:
         self.range = _float(desc.get("range"), -1.0)
         self.queue: deque[Any] = deque()
         self.queue_bytes = 0
+        self.targets: list[float] | None = None  # Radar: distance, power, speed, azimuth of each target in turn
         self.bytes_to_send = 0.0
         self._consts: dict[str, Any] = {}
         self._range: Any = None                  # decoded forms, rebuilt when new bytes arrive
@@ -401,6 +402,8 @@ class RobotClient:
                 dev.speed = math.nan if reading["speed"] is None else float(reading["speed"])
             if "packets" in reading:
                 self._received(dev, reading["packets"])
+            if "targets" in reading:
+                dev.targets = [math.nan if x is None else float(x) for x in reading["targets"] or ()]
             if "range_image" in reading:
                 dev.range_bytes = bytes(reading["range_image"])
                 dev._range = None

@@ -1,7 +1,7 @@
 """Webots' functions of the devices Sensorium lists but does not simulate (Brake, Connector,
-Radar, Skin, Speaker, VacuumGripper): each checks its tag names a device of its type,
+Skin, Speaker, VacuumGripper): each checks its tag names a device of its type,
 prints the device's one warning line and answers Webots' "no value" (NaN, ``None`` for NULL, 0,
-False). Camera, RangeFinder, Pen and Display have their own modules.
+False). Camera, RangeFinder, Pen, Display and Radar have their own modules.
 
 The functions are made from :data:`NO_VALUE` (C name -> (device type, answer)); a device of the
 type that the server does simulate (none today) would get real functions instead."""
@@ -33,16 +33,6 @@ NO_VALUE: dict[str, tuple[str, Any]] = {
     "wb_connector_lock": ("Connector", None),
     "wb_connector_unlock": ("Connector", None),
     "wb_connector_is_locked": ("Connector", False),
-    # Radar
-    "wb_radar_enable": ("Radar", None),
-    "wb_radar_disable": ("Radar", None),
-    "wb_radar_get_sampling_period": ("Radar", 0),
-    "wb_radar_get_number_of_targets": ("Radar", 0),
-    "wb_radar_get_targets": ("Radar", None),
-    "wb_radar_get_min_range": ("Radar", _NAN),
-    "wb_radar_get_max_range": ("Radar", _NAN),
-    "wb_radar_get_horizontal_fov": ("Radar", _NAN),
-    "wb_radar_get_vertical_fov": ("Radar", _NAN),
     # Skin
     "wb_skin_set_bone_orientation": ("Skin", None),
     "wb_skin_set_bone_position": ("Skin", None),

@@ -236,6 +236,11 @@ register(DeviceKind(
     rays=lambda cfg, lights: int(cfg.width) * int(cfg.height) * (4 if cfg.anti_aliasing else 1),
     ray_bound=("", "rays (width × height, × 4 anti-aliased):", "rays_per_image"),
     description="CameraDescription"))
+register(DeviceKind(
+    "Radar", wm.Radar, "sensorium.server.sim.radar:Radar",
+    services=(*_SENSOR, "get_targets"),
+    topics=(TopicDecl("targets", msgs.RADAR_SCAN, "targets"),),
+    description="RadarDescription"))
 # Emitter and Receiver (server/sim/radio.py): packets travel with step requests and replies, no topics
 # (a packet is the receiving controller's, taken from the receiver when it reads it).
 register(DeviceKind(

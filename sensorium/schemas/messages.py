@@ -257,6 +257,25 @@ class Float64(Msg):
     data: float
 
 
+class RadarReturn(Msg):
+    """``radar_msgs/msg/RadarReturn`` (ROS 2's radar_msgs): one Radar target. ``azimuth`` follows
+    REP 103 (positive to the left), so it is minus Webots' azimuth; ``amplitude`` is the received
+    power in dBm; Webots measures no elevation (0)."""
+
+    range: float = Field(description="m, the target's distance")
+    azimuth: float = Field(description="rad, positive to the left (-Webots' azimuth)")
+    elevation: float = Field(default=0.0, description="rad, always 0 (not measured)")
+    doppler_velocity: float = Field(description="m/s, the radial speed (positive: moving away)")
+    amplitude: float = Field(description="dBm, the received power")
+
+
+class RadarScan(Msg):
+    """``radar_msgs/msg/RadarScan`` for a Radar: its targets at one measurement."""
+
+    header: Header
+    returns: list[RadarReturn]
+
+
 class Envelope(Msg):
     """The second frame of every topic message."""
 
@@ -281,6 +300,7 @@ FLOAT64 = "std_msgs/msg/Float64"
 IMU = "sensor_msgs/msg/Imu"
 MAGNETIC_FIELD = "sensor_msgs/msg/MagneticField"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
+RADAR_SCAN = "radar_msgs/msg/RadarScan"
 
 MESSAGE_TYPES: dict[str, type[Msg]] = {
     ILLUMINANCE: Illuminance,
@@ -299,6 +319,7 @@ MESSAGE_TYPES: dict[str, type[Msg]] = {
     IMU: Imu,
     MAGNETIC_FIELD: MagneticField,
     CAMERA_INFO: CameraInfo,
+    RADAR_SCAN: RadarScan,
 }
 """ROS type name → model, for every topic the server publishes."""
 

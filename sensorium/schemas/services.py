@@ -488,6 +488,15 @@ class TouchSensorDescription(_Entry):
     lookup_table: list[float] = Field(description="flat [x0, y0, n0, x1, ...]")
 
 
+class RadarDescription(_Entry):
+    type: Literal["Radar"]
+    sampling_period: int
+    min_range: float = Field(description="m (wb_radar_get_min_range)")
+    max_range: float = Field(description="m (wb_radar_get_max_range)")
+    horizontal_fov: float = Field(description="rad (wb_radar_get_horizontal_fov)")
+    vertical_fov: float = Field(description="rad (wb_radar_get_vertical_fov)")
+
+
 class EmitterDescription(_Entry):
     type: Literal["Emitter"]
     medium: Literal["radio", "serial", "infra-red"]
@@ -545,6 +554,7 @@ DeviceDescription = Annotated[
     | Annotated[TouchSensorDescription, Tag("TouchSensor")] | Annotated[PenDescription, Tag("Pen")]
     | Annotated[RangeFinderDescription, Tag("RangeFinder")] | Annotated[CameraDescription, Tag("Camera")]
     | Annotated[EmitterDescription, Tag("Emitter")] | Annotated[ReceiverDescription, Tag("Receiver")]
+    | Annotated[RadarDescription, Tag("Radar")]
     | Annotated[DisplayDescription, Tag("Display")] | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -901,6 +911,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_range", "device", NoArgs, FloatValue),
     ServiceSpec("set_range", "device", RangeArgs, SuccessResult, attached=True),
     ServiceSpec("get_buffer_size", "device", NoArgs, IntValue),
+    ServiceSpec("get_targets", "device", NoArgs, FloatArrayValue),
 )
 
 

@@ -437,6 +437,10 @@ class Solid(Strict):
         default=[], max_length=1024, description="Webots recognitionColors: cameras with a Recognition node report "
         "this solid (with its children); top-level solids only")
 
+    radar_cross_section: float = Field(
+        default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the solid a Radar target; "
+        "top-level solids only")
+
     _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
@@ -446,6 +450,9 @@ class Solid(Strict):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "
                                  "and robots only (give them to the top-level solid)")
+            if child.radar_cross_section > 0.0:
+                raise ValueError(f"children[{i}] ({child.name}): radar_cross_section is read on top-level solids "
+                                 "and robots only (give it to the top-level solid)")
         return self
 
 
@@ -787,8 +794,35 @@ class RotationalMotor(_Device):
     device: Literal["RotationalMotor"]
 
 
+class Radar(_Device):
+    """Webots Radar: the targets (solids and robots with ``radar_cross_section`` > 0) in its frustum
+    around its x axis, between ``min_range`` and ``max_range``, whose echo reaches
+    ``min_detectable_signal`` by the radar equation: each one's distance, received power (dBm),
+    radial speed and azimuth (README "Radar"). Webots' defaults (Radar.wrl); a value Webots resets
+    (WbRadar's update functions) is reset with its warning when the world loads."""
+
+    device: Literal["Radar"]
+    min_range: float = Field(default=1.0, description="m, >= 0")
+    max_range: float = Field(default=50.0, description="m, > min_range")
+    horizontal_field_of_view: float = Field(default=0.78, description="rad, in (0, pi)")
+    vertical_field_of_view: float = Field(default=0.1, description="rad, in (0, pi/2)")
+    min_absolute_radial_speed: float = Field(default=0.0, description="m/s; 0: no limit")
+    min_radial_speed: float = Field(default=0.0, description="m/s; min and max both 0: no limits")
+    max_radial_speed: float = Field(default=0.0, description="m/s, > min_radial_speed; min and max both 0: no limits")
+    cell_distance: float = Field(default=0.0, description="m: targets nearer in distance merge; 0: none")
+    cell_speed: float = Field(default=0.0, description="m/s: and nearer in speed (0: distance only)")
+    range_noise: float = Field(default=0.0, description="σ of the distance (m)")
+    speed_noise: float = Field(default=0.0, description="σ of the speed (m/s)")
+    angular_noise: float = Field(default=0.0, description="σ of the azimuth (rad)")
+    antenna_gain: float = Field(default=20.0, description="dBi")
+    frequency: float = Field(default=24.0, description="GHz, >= 0")
+    transmitted_power: float = Field(default=20.0, description="dBm")
+    min_detectable_signal: float = Field(default=-100.0, description="dBm")
+    occlusion: bool = Field(default=False, description="a target hidden behind another shape is not seen")
+
+
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Connector", "LinearMotor", "Microphone", "Radar", "Radio", "Skin",
+    "Brake", "Connector", "LinearMotor", "Microphone", "Radio", "Skin",
     "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -822,12 +856,12 @@ class UnsimulatedDevice(_Device):
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
                    | Accelerometer | Gyro | Altimeter | TouchSensor | Emitter | Receiver | RotationalMotor | Pen
-                   | RangeFinder | Camera | Display | UnsimulatedDevice,
+                   | RangeFinder | Camera | Radar | Display | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
                 "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "Emitter", "Receiver", "RotationalMotor", "Pen",
-                "RangeFinder", "Camera", "Display", *UNSIMULATED_DEVICE_TYPES)
+                "RangeFinder", "Camera", "Display", "Radar", *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
 
@@ -967,6 +1001,8 @@ class Robot(Strict):
     recognition_colors: list[Color] = Field(
         default=[], max_length=1024, description="Webots recognitionColors: other robots' cameras with a Recognition "
         "node report this robot")
+    radar_cross_section: float = Field(
+        default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the robot a Radar target")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 

@@ -150,7 +150,7 @@ int main(void) {
   WbDeviceTag skin = wb_robot_get_device("skin"), speaker = wb_robot_get_device("speaker");
   WbDeviceTag gripper = wb_robot_get_device("gripper"), linear = wb_robot_get_device("linear motor");
   WbDeviceTag arm = wb_robot_get_device("arm motor");
-  wb_radar_enable(radar, 16);
+  wb_radar_enable(radar, 16); /* simulated: no target yet (NULL before the first value), its world range */
   printf("radar %d %d %d\n", wb_radar_get_number_of_targets(radar), wb_radar_get_targets(radar) == NULL ? 0 : -1,
          isnan(wb_radar_get_max_range(radar)) ? 1 : 0);
   printf("brake %d %d\n", (int)wb_brake_get_type(brake), wb_brake_get_motor(brake) == 0);

@@ -92,7 +92,7 @@ linear, arm = get("linear motor"), get("arm motor")
 assert isinstance(radar, Radar) and isinstance(brake, Brake) and isinstance(connector, Connector)
 assert isinstance(display, Display) and isinstance(skin, Skin) and isinstance(speaker, Speaker)
 assert isinstance(gripper, VacuumGripper) and isinstance(linear, Motor) and isinstance(arm, Motor)
-radar.enable(16)
+radar.enable(16)                    # simulated: no target yet (none before the first value), its world range
 print("radar", radar.getNumberOfTargets(), len(radar.getTargets()), b(math.isnan(radar.getMaxRange())))
 print("brake", brake.getType(), b(brake.getMotor() is None))
 print("connector", connector.getPresence(), b(connector.isLocked()))

@@ -147,6 +147,10 @@ class DeviceServices:
     def _dev_get_recognition_objects(self, c: Call) -> dict:
         return {"value": [o.as_dict() for o in c.ctl.device.objects]}
 
+    def _dev_get_targets(self, c: Call) -> dict:
+        """A Radar's targets, flat: distance, received power, speed, azimuth of each in turn."""
+        return {"value": [v for t in c.ctl.device.targets for v in t.as_list()]}
+
     def _dev_get_channel(self, c: Call) -> dict:
         return {"value": int(c.ctl.device.channel)}
 

@@ -227,6 +227,31 @@ def _light(sim: Any, node: Node) -> Any:
     return sim.scene.top_lights()[node.key]
 
 
+def _radar_key(sim: Any, node: Node) -> str | int:
+    """A robot's or solid's key among the scene's radar targets (robot index, solid name)."""
+    return sim.robots[node.key].index if node.type == "Robot" else node.key
+
+
+def _get_radar_cross_section(sim: Any, node: Node) -> float:
+    return float(sim.scene.radar_targets.get(_radar_key(sim, node), 0.0))
+
+
+def _set_radar_cross_section(sim: Any, node: Node, value: float) -> None:
+    """Webots' WbSolid::updateRadarCrossSection: above 0 the node is a radar target (a new one comes
+    after the others), 0 it is none; negative values are refused, as in a world file."""
+    if value < 0.0:
+        raise ValueError(f"field 'radarCrossSection': must be >= 0, got {value}")
+    key = _radar_key(sim, node)
+    if value > 0.0:
+        sim.scene.radar_targets[key] = float(value)
+    else:
+        sim.scene.radar_targets.pop(key, None)
+
+
+_RADAR_FIELD: dict[str, tuple[str, Getter, Setter]] = {
+    "radarCrossSection": ("SFFloat", _get_radar_cross_section, _set_radar_cross_section)}
+
+
 def _set_light(attr: str, kind: str) -> Setter:
     def setter(sim: Any, node: Node, value: Any) -> None:
         model = _light(sim, node)
@@ -286,10 +311,12 @@ FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
               "customData": ("SFString", lambda sim, n: sim.robots[n.key].custom_data, None),
               "controller": ("SFString", lambda sim, n: sim.robots[n.key].model.controller, None),
               "supervisor": ("SFBool", lambda sim, n: bool(sim.robots[n.key].supervisor), None),
-              "synchronization": ("SFBool", lambda sim, n: bool(sim.robots[n.key].synchronization), None)},
+              "synchronization": ("SFBool", lambda sim, n: bool(sim.robots[n.key].synchronization), None),
+              **_RADAR_FIELD},
     "Solid": {**_POSE_FIELDS,
               "name": ("SFString", lambda sim, n: n.name, None),
-              "model": ("SFString", lambda sim, n: _solid_model(sim, n).model, None)},
+              "model": ("SFString", lambda sim, n: _solid_model(sim, n).model, None),
+              **_RADAR_FIELD},
     **{kind: _light_fields(kind) for kind in LIGHTS},
 }
 

@@ -523,6 +523,11 @@ class Topics:
         return {"header": hdr, "magnetic_field": {"x": x, "y": y, "z": z},
                 "magnetic_field_covariance": bytes(72)}
 
+    def _radar_scan(self, ctl: Control, hdr: dict, reading: str) -> dict:
+        return {"header": hdr, "returns": [
+            {"range": t.distance, "azimuth": -t.azimuth, "elevation": 0.0, "doppler_velocity": t.speed,
+             "amplitude": t.received_power} for t in getattr(ctl.device, reading)]}
+
     # ------------------------------------------------------------------ step-reply readings
     def reading(self, ctl: Control) -> dict:
         """The device's latest reading for a step reply (PROTOCOL §3.6)."""
@@ -549,5 +554,6 @@ MESSAGE_BUILDERS: dict[str, Callable[[Topics, Control, dict, str], dict | None]]
     msgs.IMU: Topics._imu,
     msgs.MAGNETIC_FIELD: Topics._magnetic_field,
     msgs.CAMERA_INFO: Topics._camera_info,
+    msgs.RADAR_SCAN: Topics._radar_scan,
 }
 """Message type -> the builder of a device topic's body (a device kind's topics name their types)."""

@@ -123,9 +123,28 @@ def typestore_for(distro: str):
         raise ExportError("ROS 2 export needs the 'ros2' extra: pip install 'sensorium[ros2]'") from exc
     stores = {"humble": Stores.ROS2_HUMBLE, "jazzy": Stores.ROS2_JAZZY}
     try:
-        return get_typestore(stores[distro])
+        store = get_typestore(stores[distro])
     except KeyError:
         raise ExportError(f"unknown distro {distro!r} (choose from {', '.join(DISTROS)})") from None
+    store.register(_extra_types())
+    return store
+
+
+# Message types Sensorium publishes that rosbags' stores lack: ROS 2's radar_msgs (a Radar's
+# targets), defined here by their fields as that package defines them.
+_RADAR_MSGS = {
+    "radar_msgs/msg/RadarReturn": "float32 range\nfloat32 azimuth\nfloat32 elevation\nfloat32 doppler_velocity\n"
+                                  "float32 amplitude\n",
+    "radar_msgs/msg/RadarScan": "std_msgs/Header header\nradar_msgs/RadarReturn[] returns\n",
+}
+
+
+def _extra_types() -> dict:
+    from rosbags.typesys import get_types_from_msg
+    out: dict = {}
+    for name, text in _RADAR_MSGS.items():
+        out.update(get_types_from_msg(text, name))
+    return out
 
 
 # --------------------------------------------------------------------------------------------

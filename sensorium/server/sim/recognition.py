@@ -35,7 +35,7 @@ from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.world.geometry import Pose, tessellate
 from sensorium.server.world.poses import axis_angle
 
-__all__ = ["RecognisedObject", "Recognizer"]
+__all__ = ["RecognisedObject", "Recognizer", "shape_kind"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,7 +68,8 @@ class _Object:
     parts: tuple[tuple[Pose, str, tuple, np.ndarray | None], ...]   # the shapes its size is read from
 
 
-def _kind(g: Any, base_dir: Any) -> tuple[str, tuple, np.ndarray | None]:
+def shape_kind(g: Any, base_dir: Any) -> tuple[str, tuple, np.ndarray | None]:
+    """A geometry as ``devices/recognition.py`` bounds it: (kind, params, points in its frame)."""
     if isinstance(g, wm.Box):
         return "box", (tuple(g.size),), None
     if isinstance(g, wm.Sphere):
@@ -120,7 +121,7 @@ class Recognizer:
                 continue
             shapes = by_owner.get(key, [])
             bounding = [i for i in shapes if scene.part(i)[2].seen_by in ("both", "bounding")]
-            parts = tuple((scene.part(i)[1], *_kind(scene.part(i)[2].geometry, scene.base_dir))
+            parts = tuple((scene.part(i)[1], *shape_kind(scene.part(i)[2].geometry, scene.base_dir))
                           for i in (bounding or shapes))
             self.key_of[shapes] = len(objects)
             objects.append(_Object(key, node_id, tuple(colors), model, tuple(shapes), parts))  # type: ignore[arg-type]

@@ -301,6 +301,15 @@ def recognisable_owners(world) -> dict[str | int, tuple[int, list, str]]:
     return out
 
 
+def radar_targets(world) -> dict[str | int, float]:
+    """What radars detect: owner (robot index, top-level solid name) -> its radar cross section
+    (m², > 0), robots first in world order, then the solids (the Supervisor's node order)."""
+    out: dict[str | int, float] = {i: float(r.radar_cross_section) for i, r in enumerate(world.robots)
+                                   if r.radar_cross_section > 0.0}
+    out.update((sd.name, float(sd.radar_cross_section)) for sd in world.solids if sd.radar_cross_section > 0.0)
+    return out
+
+
 class Scene:
     """Geometry and poses of a world; the only owner of the ray engine."""
 
@@ -372,6 +381,7 @@ class Scene:
                         fog.fog_type)
         self.base_dir = Path(base_dir)
         self.recognisable = recognisable_owners(world)
+        self.radar_targets = radar_targets(world)
 
     def _shape_arrays(self) -> None:
         """The per-shape arrays devices index by hit shape (-1, no hit, reads the trailing entry)."""
@@ -460,6 +470,7 @@ class Scene:
             self.engine.remove_body(body)
         self.triangle_count -= self._solid_triangles.pop(name, 0)
         self.recognisable.pop(name, None)
+        self.radar_targets.pop(name, None)
         if name in self._attached:
             self._lights = [entry for entry in self._lights if entry[1] != name]
             self._attached.discard(name)
@@ -503,6 +514,8 @@ class Scene:
             self.lights_version += 1
         if solid.recognition_colors:
             self.recognisable[name] = (node_id, [tuple(c) for c in solid.recognition_colors], solid.model)
+        if solid.radar_cross_section > 0.0:
+            self.radar_targets[name] = float(solid.radar_cross_section)
 
     def add_top_light(self, model: object) -> int:
         """A top-level light a Supervisor imported: light sensors and cameras count it from their

@@ -29,6 +29,7 @@ from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.ground import Ground, GroundWarning, band_low
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
+from sensorium.server.sim.radar import Radar
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
 from sensorium.server.sim.scene import (
     Scene,
@@ -226,7 +227,8 @@ class Simulation:
         self.radio = Radio([d for d in every if isinstance(d, Emitter)], [d for d in every if isinstance(d, Receiver)],
                            self.scene, self._counters)
         self._initial: dict[str, Any] = {"robots": [(r.initial_pose, r.custom_data) for r in self.robots.values()],
-                         "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights()}
+                         "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights(),
+                         "radar_targets": dict(self.scene.radar_targets)}
 
     def _warn_ground(self) -> None:
         """One GroundWarning per thing a driven robot will not ride on: a tilted terrain, a robot
@@ -271,8 +273,8 @@ class Simulation:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data as in the world file, GPS speeds
-        NaN at their next value (no previous position, as Webots' WbGps::reset).
+        ``write`` and ink, as Webots' WbPen::reset), custom data and radar cross sections as in the world file, GPS and Radar speeds
+        NaN at their next value (no previous position, as Webots' WbGps::reset and WbRadar::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
         for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):
@@ -286,7 +288,7 @@ class Simulation:
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
                     dev.set(0, self.time_ms)
-                elif isinstance(dev, GPS):
+                elif isinstance(dev, (GPS, Radar)):      # no previous position: the next speeds are NaN
                     dev.restart()
                 elif dev.kind == "Display":      # WbDisplay::reset: black again, its images gone
                     dev.reset()               # type: ignore[attr-defined]
@@ -309,6 +311,9 @@ class Simulation:
             if self.scene.top_lights()[k] is not light:
                 self.scene.set_top_light(k, light)
         self.scene.clear_ink()          # WbPen::reset clears every paint texture
+        # radar cross sections a Supervisor set: back to the loaded ones (of the robots and solids still there)
+        self.scene.radar_targets = {k: v for k, v in self._initial["radar_targets"].items()
+                                    if isinstance(k, int) or k in self.scene.solid_poses}
         self._counters["resets"] += 1
 
     @classmethod

@@ -561,6 +561,46 @@ def _check_geometry(geom: Any, path: str, base_dir: Path) -> list[Problem]:
     return []      # mesh files: _check_meshes_and_work (url confined to the world's folder, size, triangles)
 
 
+def _radar_resets(p: str, dev: wm.Radar, warnings: list[str]) -> dict[str, Any]:
+    """WbRadar's update functions, in the order its postFinalize calls them: the values it resets."""
+    upd: dict[str, Any] = {}
+
+    def reset(field: str, value: float, why: str) -> None:
+        warnings.append(f"{p}.{field}: {why}, reset to {value:g}")
+        upd[field] = value
+
+    lo, hi = dev.min_range, dev.max_range
+    if lo < 0.0:                                             # updateMinRange
+        reset("min_range", 0.0, "negative")
+        lo = 0.0
+    if hi <= lo:
+        if hi == 0.0:
+            reset("max_range", lo + 1.0, "not greater than min_range")
+            hi = lo + 1.0
+        else:
+            reset("min_range", max(hi - 1.0, 0.0), "not less than max_range")
+            lo = max(hi - 1.0, 0.0)
+    if hi < 0.0:                                             # updateMaxRange
+        reset("max_range", lo + 1.0, "negative")
+        hi = lo + 1.0
+    if hi <= lo:
+        reset("max_range", lo + 1.0, "not greater than min_range")
+    if not 0.0 < dev.horizontal_field_of_view < math.pi:
+        reset("horizontal_field_of_view", 0.78, "outside (0, pi)")
+    if not 0.0 < dev.vertical_field_of_view < math.pi / 2:
+        reset("vertical_field_of_view", 0.1, "outside (0, pi/2)")
+    if dev.min_absolute_radial_speed < 0.0:
+        reset("min_absolute_radial_speed", 0.0, "negative")
+    if (dev.min_radial_speed != 0.0 or dev.max_radial_speed != 0.0) and dev.max_radial_speed <= dev.min_radial_speed:
+        reset("max_radial_speed", dev.min_radial_speed + 1.0, "not greater than min_radial_speed")
+    for name in ("cell_distance", "cell_speed", "range_noise", "speed_noise", "angular_noise"):
+        if getattr(dev, name) < 0.0:
+            reset(name, 0.0, "negative")
+    if dev.frequency < 0.0:
+        reset("frequency", 24.0, "negative")
+    return upd
+
+
 def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
     """Apply Webots' field sanitising (devices.md §2.1, §3.1, §4.1); return warnings for each change."""
     warnings: list[str] = []
@@ -652,6 +692,8 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
                 warnings.append(f"{p}.default_frequency: outside [min_frequency, max_frequency], clamped")
         if isinstance(dev, wm.LED) and dev.lights:
             upd["lights"] = [fix_light(f"{p}.lights[{i}]", lt) for i, lt in enumerate(dev.lights)]
+        if isinstance(dev, wm.Radar):
+            upd.update(_radar_resets(p, dev, warnings))
         return dev.model_copy(update=upd) if upd else dev
 
     def fix_solid(p: str, solid: wm.Solid) -> wm.Solid:

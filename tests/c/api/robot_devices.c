@@ -40,13 +40,14 @@ int main(void) {
   ts_assert_int_equal(wb_robot_get_device_by_index(5), 0, "no device past the last");
   ts_assert_int_equal(wb_robot_get_device("nothing"), 0, "no such device");
   ts_assert_string_equal(wb_device_get_model(wb_robot_get_device("radar")), "ARS 408", "a device's model");
-  /* listed only: Webots' "no value" */
+  /* the simulated radar: no target before its first value, its range the world's (Webots' default) */
   WbDeviceTag radar = wb_robot_get_device("radar"), display = wb_robot_get_device("display");
   WbDeviceTag lift = wb_robot_get_device("lift");
   wb_radar_enable(radar, 16);
   ts_assert_int_equal(wb_radar_get_number_of_targets(radar), 0, "no radar target");
   ts_assert_pointer_null(wb_radar_get_targets(radar), "no radar targets array");
-  ts_assert_double_equal(wb_radar_get_max_range(radar), NAN, "radar range: no value");
+  ts_assert_double_equal(wb_radar_get_max_range(radar), 50.0, "radar range: the world's");
+  /* listed only: Webots' "no value" */
   wb_display_draw_text(display, "hello", 0, 0);
   ts_assert_int_equal(wb_display_get_width(display), 64, "display width: the world's (Webots' default)");
   wb_motor_set_velocity(lift, 1.0);

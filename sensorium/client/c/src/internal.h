@@ -8,6 +8,7 @@
  *             sampling period and reading: sn_sensor_*); lidar.c; motor.c; gps.c;
  * kinematic.c - InertialUnit, Compass, Accelerometer, Gyro, Altimeter, TouchSensor;
  * radio.c   - Emitter and Receiver (packet queues, baud-rate pacing);
+ * radar.c   - Radar (the targets of the latest measurement);
  * camera.c  - range finders and cameras;
  * display.c - the Display (drawing buffered, sent with the next step request);
  * unsimulated.c - the devices Sensorium lists without simulating ("no value").
@@ -21,6 +22,7 @@
 #include <stdint.h>
 
 #include <webots/lidar_point.h>
+#include <webots/radar_target.h>
 #include <webots/types.h>
 
 /* ------------------------------------------------------------------ error codes (PROTOCOL.md 3.2) */
@@ -110,7 +112,7 @@ const char *sn_conn_endpoint(const sn_conn *c);
 /* ------------------------------------------------------------------ robot.c */
 typedef enum {
   SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_IMU, SN_COMPASS, SN_ACCELEROMETER,
-  SN_GYRO, SN_ALTIMETER, SN_TOUCH, SN_EMITTER, SN_RECEIVER, SN_RANGE_FINDER, SN_CAMERA, SN_OTHER
+  SN_GYRO, SN_ALTIMETER, SN_TOUCH, SN_EMITTER, SN_RECEIVER, SN_RANGE_FINDER, SN_CAMERA, SN_RADAR, SN_OTHER
 } sn_kind;
 
 struct sn_imaging; /* camera.c: a range finder's or camera's images and constants */
@@ -175,6 +177,10 @@ typedef struct {
   bool cmd_position, cmd_velocity; /* to send with the next step */
   bool warned_physics;             /* a physics-only motor function was called (one warning) */
   int force_feedback_period, torque_feedback_period;
+  /* Radar (radar.c): the latest targets (NULL before the first value, and when there are none);
+     its range and fields of view are min_range, max_range, fov and vertical_fov above */
+  WbRadarTarget *radar_targets;
+  int radar_count;
   /* Display (display.c): the world's size; the drawing commands packed since the last step (an
      array's items, draw_n of them), the image ids given out, whether a camera is attached */
   int display_width, display_height;
@@ -266,6 +272,8 @@ void sn_warn_disabled(sn_device *dev, const char *func, const char *enabler, con
    (sn_radio_pace counts those its baud rate lets leave with a step of duration ms, sn_radio_pack writes
    them as "name": [{"data", "channel", "range"}, ...] and drops them from the queue) */
 void sn_radio_receive(sn_device *dev, const msgpack_object *packets);
+/* radar.c: a step reply's targets (distance, power, speed, azimuth of each in turn) into the radar */
+void sn_radar_apply(sn_device *dev, const msgpack_object *targets);
 int sn_radio_pace(sn_device *dev, int duration);
 void sn_radio_pack(sn_device *dev, sn_req *r);
 void sn_radio_free(sn_device *dev);

@@ -79,6 +79,8 @@ static sn_kind kind_of(const char *type) {
     return SN_EMITTER;
   if (strcmp(type, "Receiver") == 0)
     return SN_RECEIVER;
+  if (strcmp(type, "Radar") == 0)
+    return SN_RADAR;
   return SN_OTHER;
 }
 
@@ -179,6 +181,12 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
     if (d->range_image == NULL || d->point_cloud == NULL)
       return -1;
   }
+  if (d->kind == SN_RADAR) { /* wb_radar_get_min_range ... vertical_fov: the world's fields */
+    d->min_range = sn_double_or(desc, "min_range", NAN);
+    d->max_range = sn_double_or(desc, "max_range", NAN);
+    d->fov = sn_double_or(desc, "horizontal_fov", NAN);
+    d->vertical_fov = sn_double_or(desc, "vertical_fov", NAN);
+  }
   if (sn_imaging_describe(d, desc) != 0)
     return -1;
   d->motor_name = sn_strdup_obj(sn_get(desc, "motor"));
@@ -206,6 +214,7 @@ static void free_robot(sn_robot *rb) {
     free(d->range_image);
     free(d->point_cloud);
     free(d->motor_name);
+    free(d->radar_targets);
     sn_imaging_free(d);
     sn_radio_free(d);
     sn_display_free(d);
@@ -441,6 +450,8 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
     sn_imaging_apply(dev, v);
     if (dev->kind == SN_RECEIVER)
       sn_radio_receive(dev, sn_get(v, "packets"));
+    if (dev->kind == SN_RADAR)
+      sn_radar_apply(dev, sn_get(v, "targets"));
     if (dev->kind != SN_LIDAR)
       continue;
     size_t n = (size_t)dev->width * (size_t)dev->layers;
@@ -693,6 +704,7 @@ static bool kind_accepts(sn_kind kind, int node) {
     case SN_TOUCH: return node == WB_NODE_TOUCH_SENSOR;
     case SN_EMITTER: return node == WB_NODE_EMITTER;
     case SN_RECEIVER: return node == WB_NODE_RECEIVER;
+    case SN_RADAR: return node == WB_NODE_RADAR;
     default: return false;
   }
 }

@@ -10,7 +10,6 @@
 #include <webots/brake.h>
 #include <webots/connector.h>
 #include <webots/microphone.h>
-#include <webots/radar.h>
 #include <webots/radio.h>
 #include <webots/skin.h>
 #include <webots/speaker.h>
@@ -72,50 +71,6 @@ void wb_connector_unlock(WbDeviceTag tag) {
 bool wb_connector_is_locked(WbDeviceTag tag) {
   sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_is_locked");
   return false;
-}
-
-/* ------------------------------------------------------------------ Radar */
-void wb_radar_enable(WbDeviceTag tag, int sampling_period) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_enable");
-}
-
-void wb_radar_disable(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_disable");
-}
-
-int wb_radar_get_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_sampling_period");
-  return 0;
-}
-
-int wb_radar_get_number_of_targets(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_number_of_targets");
-  return 0;
-}
-
-const WbRadarTarget *wb_radar_get_targets(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_targets");
-  return NULL;
-}
-
-double wb_radar_get_min_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_min_range");
-  return NAN;
-}
-
-double wb_radar_get_max_range(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_max_range");
-  return NAN;
-}
-
-double wb_radar_get_horizontal_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_horizontal_fov");
-  return NAN;
-}
-
-double wb_radar_get_vertical_fov(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_RADAR, "wb_radar_get_vertical_fov");
-  return NAN;
 }
 
 /* ------------------------------------------------------------------ Skin */

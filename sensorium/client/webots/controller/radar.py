@@ -1,31 +1,51 @@
-"""Webots' ``Radar`` and ``RadarTarget`` classes (listed, not simulated: no target is ever seen)."""
+"""Webots' ``Radar`` and ``RadarTarget`` classes: the targets a radar sees (distance, received
+power, radial speed, azimuth), read with the step."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
-from .unsimulated import UnsimulatedDevice
+from sensorium.client import wb
+
+from .device import Sensor
 
 
 @dataclass
 class RadarTarget:
+    """One target: ``distance`` (m), ``received_power`` (dBm), ``speed`` (m/s, positive moving
+    away), ``azimuth`` (rad, positive to the right, Webots' sign)."""
+
     distance: float
     received_power: float
     speed: float
     azimuth: float
 
 
-class Radar(UnsimulatedDevice):
-    _KIND = "Radar"
-    _NO_VALUES = {"enable": None, "disable": None, "getSamplingPeriod": 0, "getNumberOfTargets": 0,
-                  "getTargets": [], "getMinRange": math.nan, "getMaxRange": math.nan,
-                  "getHorizontalFov": math.nan, "getVerticalFov": math.nan}
-    _PROPERTIES = {"sampling_period": "getSamplingPeriod", "number_of_targets": "getNumberOfTargets",
-                   "min_range": "getMinRange", "max_range": "getMaxRange", "horizontal_fov": "getHorizontalFov",
-                   "vertical_fov": "getVerticalFov"}
+class Radar(Sensor):
+    _enable = staticmethod(wb.wb_radar_enable)
+    _get_sampling_period = staticmethod(wb.wb_radar_get_sampling_period)
 
-    def __init__(self, name: str | int, sampling_period: int | None = None):
-        super().__init__(name)
-        if sampling_period is not None:
-            self.enable(sampling_period)  # type: ignore[attr-defined]
+    def getNumberOfTargets(self) -> int:
+        return wb.wb_radar_get_number_of_targets(self._tag)
+
+    def getTargets(self) -> list[RadarTarget]:
+        return [RadarTarget(*t) for t in wb.wb_radar_get_targets(self._tag)]
+
+    def getMinRange(self) -> float:
+        return wb.wb_radar_get_min_range(self._tag)
+
+    def getMaxRange(self) -> float:
+        return wb.wb_radar_get_max_range(self._tag)
+
+    def getHorizontalFov(self) -> float:
+        return wb.wb_radar_get_horizontal_fov(self._tag)
+
+    def getVerticalFov(self) -> float:
+        return wb.wb_radar_get_vertical_fov(self._tag)
+
+    number_of_targets = property(getNumberOfTargets)
+    targets = property(getTargets)
+    min_range = property(getMinRange)
+    max_range = property(getMaxRange)
+    horizontal_fov = property(getHorizontalFov)
+    vertical_fov = property(getVerticalFov)

@@ -808,9 +808,13 @@ class Converter:
                 data["recognition_colors"] = [list(c) for c in colors]
             if f.string("model", ""):
                 data["model"] = f.string("model", "")
+            self.radar_cross_section(node, data)
         elif f.has("recognitionColors") and f.rows("recognitionColors", 3, []):
             self.warn(node, f"Solid {name!r}: recognitionColors of a nested solid are not read (give them to the "
                             "top-level solid); ignored")
+        if owner.kind != "world" and f.num("radarCrossSection", 0.0) > 0.0:
+            self.warn(node, f"Solid {name!r}: radarCrossSection of a nested solid is not read (radars detect "
+                            "top-level solids and robots); ignored")
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
@@ -823,6 +827,13 @@ class Converter:
             self.world["solids"].append(out)
         else:
             owner.data.setdefault("children", []).append(out)
+
+    def radar_cross_section(self, node: Node, data: dict) -> None:
+        """A top-level solid's or robot's radarCrossSection: > 0 makes it a Radar target (0 or less:
+        not one, as in Webots, which keeps a negative value and ignores it)."""
+        rcs = self.fields(node).num("radarCrossSection", 0.0)
+        if rcs > 0.0:
+            data["radar_cross_section"] = rcs
 
     def solid_contents(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
@@ -864,6 +875,7 @@ class Converter:
         colors = f.colors("recognitionColors", [])
         if colors:
             data["recognition_colors"] = [list(c) for c in colors]
+        self.radar_cross_section(node, data)
         if f.flag("selfCollision", False):    # its generic, sonar and laser sensors see its own bounding objects
             data["self_collision"] = True
         battery = f.numbers("battery") if "battery" in node.fields else []
