@@ -259,7 +259,7 @@ def test_a_world_files_lens_is_read_with_webots_defaults_and_resets(tmp_path: Pa
     """A YAML camera's lens takes Webots' defaults (centre 0.5 0.5, zero coefficients); a centre
     component outside [0, 1] is reset as WbLens::updateCenter does (negative: 0; y > 1 sets x to 1
     and keeps y, its slip), one warning each; a lens on a spherical image is one warning and no
-    distortion."""
+    distortion. Its CameraInfo stays the undistorted pinhole with ``d`` zeros."""
     p = tmp_path / "w.yaml"
     p.write_text(
         "robots:\n  - name: r\n    devices:\n"
@@ -277,6 +277,11 @@ def test_a_world_files_lens_is_read_with_webots_defaults_and_resets(tmp_path: Pa
         "sub-images before merging them; here only a planar image has a lens)"]
     sim = Simulation(lw)
     assert sim.robot("r").device("c").lens is None and sim.robot("r").device("a").lens == imaging.Lens()
+    # CameraInfo: the undistorted pinhole, d zeros (Webots' mapping is not plumb_bob: README "Lens distortion")
+    info = sim.robot("r").device("b").camera_info()
+    assert info["distortion_model"] == "plumb_bob" and info["d"] == bytes(40)
+    fx = 32.0 / math.tan(0.785398 / 2.0)
+    assert np.frombuffer(info["k"], "<f8").tolist() == [fx, 0.0, 31.5, 0.0, fx, 31.5, 0.0, 0.0, 1.0]
 
 
 def test_the_wbt_converter_reads_the_lens_node(tmp_path: Path):

@@ -108,7 +108,9 @@ def lens_of(config: Any) -> imaging.Lens | None:
 
 
 def camera_info(geometry: imaging.ImageGeometry) -> dict:
-    """The fields of a ``sensor_msgs/CameraInfo`` after its header (a planar image's exact pinhole)."""
+    """The fields of a ``sensor_msgs/CameraInfo`` after its header (a planar image's exact pinhole).
+    ``d`` stays zeros with a lens: Webots' distortion is not OpenCV's plumb_bob (image units per
+    axis, an approximate inverse; README "Lens distortion")."""
     fx, fy, cx, cy = imaging.pinhole_intrinsics(geometry)
     k = np.array([fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0], dtype="<f8")
     p = np.array([fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0], dtype="<f8")
