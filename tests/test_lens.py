@@ -75,6 +75,14 @@ def test_each_samples_ray_goes_through_webots_source_coordinate(samples):
                 np.testing.assert_allclose(dirs[0, 0, 0], imaging.pixel_directions(g)[0, 0, 0], rtol=0, atol=1e-15)
 
 
+def test_where_the_shaders_divisor_is_zero_a_pixel_keeps_its_own_ray():
+    """A 2 x 2 image's pixel centres lie at r = 2·0.25² = 0.125 from the centre: with k1 = −2 the
+    shader's divisor 1 + 4·k1·r is exactly 0 there (its source undefined, Webots' GPU divides by
+    zero); each pixel keeps its undistorted ray rather than an infinite or NaN one."""
+    g = imaging.ImageGeometry(2, 2, 1.0)
+    assert imaging.pixel_directions(g, lens=imaging.Lens(radial=(-2.0, 0.0))).tobytes() == imaging.pixel_directions(g).tobytes()
+
+
 def test_a_lens_distorts_planar_images_only():
     with pytest.raises(ValueError, match="planar image only"):
         imaging.pixel_directions(imaging.ImageGeometry(8, 8, 1.0, "spherical"), lens=imaging.Lens())
