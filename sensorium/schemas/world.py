@@ -645,8 +645,20 @@ class TouchSensor(_Device):
     resolution: float = -1.0
 
 
+class Lens(Strict):
+    """Webots' Lens node in a Camera's or RangeFinder's ``lens`` field: Brown's radial (k1, k2) and
+    tangential (p1, p2) distortion about ``center`` (image units: (0.5, 0.5) is the image's centre,
+    x across, y down), as Webots' shader applies it to a planar image (README "Lens distortion").
+    A ``center`` component outside [0, 1] is reset with a warning, as Webots does."""
+
+    center: tuple[float, float] = (0.5, 0.5)
+    radial_coefficients: tuple[float, float] = (0.0, 0.0)
+    tangential_coefficients: tuple[float, float] = (0.0, 0.0)
+
+
 class _Imager(_Device):
-    """What Webots' RangeFinder and Camera share: the image's size and projection, the near plane."""
+    """What Webots' RangeFinder and Camera share: the image's size and projection, the near plane,
+    the lens."""
 
     device: str
     field_of_view: float = Field(default=0.785398, gt=0.0, le=2 * math.pi)
@@ -654,6 +666,7 @@ class _Imager(_Device):
     height: int = Field(default=64, ge=1, le=1 << 16)
     projection: Literal["planar", "cylindrical", "spherical"] = "planar"
     near: float = Field(default=0.01, ge=0.0)
+    lens: Lens | None = Field(default=None, description="Webots' Lens node (NULL: none); planar images only here")
     _what: ClassVar[str]
 
     @model_validator(mode="after")

@@ -16,6 +16,19 @@ Projections (Webots' ``WbWrenCamera`` and its ``merge_spherical.frag``)
       direction ``(−dx, −dy)`` of the image plane: ``(cos ψ, −sin ψ·dx/ρ, −sin ψ·dy/ρ)``. A
       non-square spherical image therefore spans Φ vertically as well (the shader's choice).
 
+Lens distortion (Webots' ``Lens`` node, its ``lens_distortion.frag``; planar images only here)
+    Webots renders the pinhole image, then gives each output pixel the colour (or range) the
+    rendered image has at a *source* coordinate: with ``(x, y) = (u − cx, v − cy)`` (image units,
+    each axis its own: x in widths, y in heights; v down, as the rows), ``r = x² + y²``,
+    ``d1 = k1·r + k2·r²`` and ``d2 = 1/(1 + 4·k1·r + 6·k2·r² + 8·p1·y + 8·p2·x)``, the source is
+    ``us = u − d2·(d1·x + 2·p1·x·y + p2·(r + 2x²))``, ``vs = v − d2·(d1·y + 2·p2·x·y + p1·(r + 2y²))``
+    (one Newton-like step inverting Brown's model, the shader's own approximation). Webots samples
+    its rendered texels there bilinearly, clamped to the edge: a source outside the image reads its
+    edge pixel. Here the output sample's ray is the pinhole ray through ``(us, vs)``, each clamped to
+    the span of the image's own samples (the edge pixel's centre without anti-aliasing, Webots'
+    clamp exactly) — an exact ray where Webots interpolates between rendered pixels. With zero
+    coefficients ``(us, vs) = (u, v)`` exactly: the rays of no lens, bit for bit.
+
 Range values (``range_image``)
     ``planar``: the depth along +x (the distance to the plane x = 0 of the device, Webots' reference
     page), i.e. ``t·cos`` of the ray with +x; the other projections: the distance ``t`` along the
@@ -35,8 +48,8 @@ import numpy as np
 from .lookup import RESOLUTION_OFF, quantize_lidar
 from .noise import gaussian
 
-__all__ = ["PROJECTIONS", "ImageGeometry", "SAMPLES_CENTRE", "SAMPLES_2X2", "pixel_directions", "depth_factors",
-           "clip_limits", "range_values", "pinhole_intrinsics"]
+__all__ = ["PROJECTIONS", "ImageGeometry", "Lens", "SAMPLES_CENTRE", "SAMPLES_2X2", "lens_source", "pixel_directions",
+           "depth_factors", "clip_limits", "range_values", "pinhole_intrinsics"]
 
 PROJECTIONS = ("planar", "cylindrical", "spherical")
 SAMPLES_CENTRE = ((0.5, 0.5),)
@@ -80,6 +93,38 @@ class ImageGeometry:
         return fov
 
 
+@dataclass(frozen=True, slots=True)
+class Lens:
+    """Webots' Lens node: the distortion's ``center`` (image units, (½, ½) the image's centre),
+    ``radial`` (k1, k2) and ``tangential`` (p1, p2) coefficients (see the module docstring)."""
+
+    center: tuple[float, float] = (0.5, 0.5)
+    radial: tuple[float, float] = (0.0, 0.0)
+    tangential: tuple[float, float] = (0.0, 0.0)
+
+
+def lens_source(lens: Lens, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The source coordinates ``(us, vs)`` Webots' lens shader samples for the output coordinates
+    ``(u, v)`` (image units, v down), not clamped; where its divisor is 0 (no source: the shader
+    divides by zero) the output coordinate itself."""
+    cx, cy = (float(a) for a in lens.center)
+    k1, k2 = (float(a) for a in lens.radial)
+    p1, p2 = (float(a) for a in lens.tangential)
+    x = u - cx
+    y = v - cy
+    r = x * x + y * y
+    d1 = k1 * r + k2 * r * r
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        d2 = 1.0 / (4.0 * k1 * r + 6.0 * k2 * r * r + 8.0 * p1 * y + 8.0 * p2 * x + 1.0)
+        us = u - d2 * (d1 * x + 2.0 * p1 * x * y + p2 * (r + 2.0 * x * x))
+        vs = v - d2 * (d1 * y + 2.0 * p2 * x * y + p1 * (r + 2.0 * y * y))
+    bad = ~(np.isfinite(us) & np.isfinite(vs))
+    if bad.any():
+        us = np.where(bad, u, us)
+        vs = np.where(bad, v, vs)
+    return us, vs
+
+
 def _grid(g: ImageGeometry, samples) -> tuple[np.ndarray, np.ndarray]:
     """Image coordinates ``u`` (S, 1, W) and ``v`` (S, H, 1) of every sample."""
     W, H = int(g.width), int(g.height)
@@ -89,11 +134,19 @@ def _grid(g: ImageGeometry, samples) -> tuple[np.ndarray, np.ndarray]:
     return u, v
 
 
-def pixel_directions(g: ImageGeometry, samples=SAMPLES_CENTRE) -> np.ndarray:
-    """Unit ray directions (S, H, W, 3) in the device frame (FLU) for each sample of each pixel."""
+def pixel_directions(g: ImageGeometry, samples=SAMPLES_CENTRE, lens: Lens | None = None) -> np.ndarray:
+    """Unit ray directions (S, H, W, 3) in the device frame (FLU) for each sample of each pixel;
+    with a ``lens`` (a planar image only), each sample's ray through its lens source (module docstring)."""
     u, v = _grid(g, samples)
     fov = float(g.field_of_view)
     S, H, W = len(u), int(g.height), int(g.width)
+    if lens is not None:
+        if g.projection != "planar":
+            raise ValueError(f"a lens distorts a planar image only, not a {g.projection} one")
+        us, vs = lens_source(lens, np.broadcast_to(u, (S, H, W)), np.broadcast_to(v, (S, H, W)))
+        # Webots' clamp to the edge: to the span of the image's own samples
+        u = np.clip(us, u.min(), u.max())
+        v = np.clip(vs, v.min(), v.max())
     if g.projection == "planar":
         t = math.tan(fov / 2.0)
         y = np.broadcast_to((1.0 - 2.0 * u) * t, (S, H, W))

@@ -100,7 +100,7 @@ class _Device:
         c = template.config
         self.height, self.width = int(c.height), int(c.width)
         self.samples = len(template._samples)
-        dirs = imaging.pixel_directions(template.geometry, template._samples)
+        dirs = imaging.pixel_directions(template.geometry, template._samples, template.lens)
         self.dirs = np.ascontiguousarray(dirs.reshape(-1, 3))
         self.n = len(self.dirs)                      # rays per image: samples x pixels
         self.columns = tuple(np.ascontiguousarray(self.dirs[:, k]) for k in range(3))

@@ -101,7 +101,7 @@ class _Device:
         c = template.config
         self.height, self.width = int(c.height), int(c.width)
         self.n = self.height * self.width
-        dirs = imaging.pixel_directions(template.geometry)[0]
+        dirs = imaging.pixel_directions(template.geometry, lens=template.lens)[0]
         self.dirs = np.ascontiguousarray(dirs.reshape(-1, 3))
         self.columns = tuple(np.ascontiguousarray(self.dirs[:, k]) for k in range(3))
         self.factors = imaging.depth_factors(template.geometry, dirs)

@@ -27,7 +27,7 @@ from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info", "composite"]
+__all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info", "composite", "lens_of"]
 
 
 class MountedRays:
@@ -97,8 +97,20 @@ def _shade(P: np.ndarray, N: np.ndarray, albedo: np.ndarray, lights: light_math.
     return out
 
 
+def lens_of(config: Any) -> imaging.Lens | None:
+    """A Camera's or RangeFinder's lens as the image model takes it: None without a Lens node or for
+    an image that is not planar (the loader said so: Webots distorts a spherical or cylindrical
+    image's cube-face sub-images, which are not modelled here)."""
+    lens = config.lens
+    if lens is None or config.projection != "planar":
+        return None
+    return imaging.Lens(tuple(lens.center), tuple(lens.radial_coefficients), tuple(lens.tangential_coefficients))
+
+
 def camera_info(geometry: imaging.ImageGeometry) -> dict:
-    """The fields of a ``sensor_msgs/CameraInfo`` after its header (a planar image's exact pinhole)."""
+    """The fields of a ``sensor_msgs/CameraInfo`` after its header (a planar image's exact pinhole).
+    ``d`` stays zeros with a lens: Webots' distortion is not OpenCV's plumb_bob (image units per
+    axis, an approximate inverse; README "Lens distortion")."""
     fx, fy, cx, cy = imaging.pinhole_intrinsics(geometry)
     k = np.array([fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0], dtype="<f8")
     p = np.array([fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0], dtype="<f8")
@@ -118,6 +130,7 @@ class RangeFinder(Device):
         super().__post_init__()
         c = self.config
         self.geometry = imaging.ImageGeometry(c.width, c.height, c.field_of_view, c.projection)
+        self.lens = lens_of(c)
         self.range_image = np.zeros((c.height, c.width), dtype=np.float32)
         self._rays: MountedRays | None = None
         self._factors: np.ndarray | None = None
@@ -148,7 +161,7 @@ class RangeFinder(Device):
 
     def _prepare(self) -> MountedRays:
         if self._rays is None:
-            dirs = imaging.pixel_directions(self.geometry)[0]
+            dirs = imaging.pixel_directions(self.geometry, lens=self.lens)[0]
             self._factors = imaging.depth_factors(self.geometry, dirs)
             # rays need not reach beyond max_range (in depth for a planar image): nothing there counts
             self._limits = imaging.clip_limits(self.geometry, self._factors, self.config.near, self.config.max_range)
@@ -301,6 +314,7 @@ class Camera(Device):
         super().__post_init__()
         c = self.config
         self.geometry = imaging.ImageGeometry(c.width, c.height, c.field_of_view, c.projection)
+        self.lens = lens_of(c)     # the image's; recognition and segmentation are Webots' undistorted ones
         self.image = np.zeros((c.height, c.width, 4), dtype=np.uint8)
         self.image[:, :, 3] = 255
         self.exposure = float(c.exposure)
@@ -418,7 +432,7 @@ class Camera(Device):
     def _prepare(self) -> MountedRays:
         if self._rays is None:
             c = self.config
-            dirs = imaging.pixel_directions(self.geometry, self._samples)
+            dirs = imaging.pixel_directions(self.geometry, self._samples, self.lens)
             factors = imaging.depth_factors(self.geometry, dirs)
             self._limits = imaging.clip_limits(self.geometry, factors, c.near, c.far if c.far > 0 else math.inf)
             self._rays = _mounted(self, dirs, self._limits)

@@ -601,6 +601,29 @@ def _radar_resets(p: str, dev: wm.Radar, warnings: list[str]) -> dict[str, Any]:
     return upd
 
 
+def lens_center_reset(lens: wm.Lens) -> tuple[wm.Lens, list[str]]:
+    """A Lens' ``center`` as Webots' WbLens::updateCenter leaves it, and what was changed: a negative
+    component 0, an x above 1 set to 1 -- and a y above 1 sets x (not y) to 1, its code's slip, kept
+    here so the image is Webots' own."""
+    x, y = lens.center
+    told = []
+    if x < 0.0:
+        told.append(f"x {x:g} < 0, set to 0")
+        x = 0.0
+    if y < 0.0:
+        told.append(f"y {y:g} < 0, set to 0")
+        y = 0.0
+    if x > 1.0:
+        told.append(f"x {x:g} > 1, set to 1")
+        x = 1.0
+    if y > 1.0:
+        told.append(f"y {y:g} > 1: Webots sets x (not y) to 1 and keeps y {y:g}, done the same here")
+        x = 1.0
+    if not told:
+        return lens, []
+    return lens.model_copy(update={"center": (x, y)}), told
+
+
 def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
     """Apply Webots' field sanitising (devices.md §2.1, §3.1, §4.1); return warnings for each change."""
     warnings: list[str] = []
@@ -690,6 +713,14 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
             if not lo <= dev.default_frequency <= hi:
                 upd["default_frequency"] = min(max(dev.default_frequency, lo), hi)
                 warnings.append(f"{p}.default_frequency: outside [min_frequency, max_frequency], clamped")
+        if isinstance(dev, (wm.Camera, wm.RangeFinder)) and dev.lens is not None:
+            lens, lens_warnings = lens_center_reset(dev.lens)
+            warnings.extend(f"{p}.lens.center: {w}" for w in lens_warnings)
+            if lens is not dev.lens:
+                upd["lens"] = lens
+            if dev.projection != "planar":
+                warnings.append(f"{p}.lens: not applied to a {dev.projection} image (Webots distorts each of its "
+                                "cube-face sub-images before merging them; here only a planar image has a lens)")
         if isinstance(dev, wm.LED) and dev.lights:
             upd["lights"] = [fix_light(f"{p}.lights[{i}]", lt) for i, lt in enumerate(dev.lights)]
         if isinstance(dev, wm.Radar):

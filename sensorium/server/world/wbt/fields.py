@@ -194,14 +194,32 @@ def _field_of_view(f: Fields, projection: str, default: float) -> float:
 
 def _image(f: Fields, spherical_as: str) -> dict:
     """What a Camera and a RangeFinder read alike (WbAbstractCamera): fieldOfView, width, height,
-    projection and near, each reset as Webots resets it; R2023's deprecated ``spherical TRUE`` on a
+    projection, near and lens, each reset as Webots resets it; R2023's deprecated ``spherical TRUE`` on a
     planar one reads as ``spherical_as`` (WbCamera::init / WbRangeFinder::init)."""
     projection = _projection(f)
     if f.flag("spherical", False) and projection == "planar":
         projection = spherical_as
-    return {"field_of_view": _field_of_view(f, projection, 0.785398),
-            "width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1),
-            "projection": projection, "near": f.positive("near", 0.01, 0.01)}
+    out = {"field_of_view": _field_of_view(f, projection, 0.785398),
+           "width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1),
+           "projection": projection, "near": f.positive("near", 0.01, 0.01)}
+    lens = _lens(f)
+    if lens is not None:
+        out["lens"] = lens
+    return out
+
+
+def _lens(f: Fields) -> dict | None:
+    """A Camera's or RangeFinder's Lens node (Webots' defaults), or None (NULL). Its centre is
+    left to the loader, which resets it as Webots does (loader.lens_center_reset)."""
+    node = f.node_("lens")
+    if node is None:
+        return None
+    if node.type != "Lens":
+        raise f.error("lens", f"expected a Lens node or NULL, got a {node.type} node")
+    lf = f.sub(node)
+    return {"center": list(lf.vec("center", (0.5, 0.5))),
+            "radial_coefficients": list(lf.vec("radialCoefficients", (0.0, 0.0))),
+            "tangential_coefficients": list(lf.vec("tangentialCoefficients", (0.0, 0.0)))}
 
 
 def _max_range(f: Fields, min_range: float, default: float) -> float:

@@ -7,7 +7,7 @@
   shape"). Webots' own range-finder sample mounts its device 1.5 mm under the top of the robot's
   body cylinder: its image was the cylinder's wall, 14 mm away, with no word why.
 * The image fields of a Camera or RangeFinder that Webots' renderer uses and Sensorium does not
-  (lens distortion, motion blur, ...): the README lists them; the load report now names the ones a
+  (motion blur, depth of field, ...): the README lists them; the load report now names the ones a
   world writes.
 """
 
@@ -24,11 +24,11 @@ EPS = 1e-9
 
 # field -> (Webots' default, what it does there); a Node-valued field's default is None (NULL)
 UNREAD_IMAGE_FIELDS = {
-    "Camera": {"lens": (None, "lens distortion"), "focus": (None, "depth of field"), "zoom": (None, "zoom"),
+    "Camera": {"focus": (None, "depth of field"), "zoom": (None, "zoom"),
                "lensFlare": (None, "lens flares"), "motionBlur": (0.0, "motion blur"),
                "noiseMaskUrl": ("", "a noise mask image"), "bloomThreshold": (-1.0, "bloom"),
                "ambientOcclusionRadius": (0.0, "ambient occlusion")},
-    "RangeFinder": {"lens": (None, "lens distortion"), "motionBlur": (0.0, "motion blur")},
+    "RangeFinder": {"motionBlur": (0.0, "motion blur")},
 }
 
 

@@ -1,0 +1,312 @@
+"""Webots' Lens node on cameras and range finders (imaging.lens_source, pixel_directions' lens):
+each output pixel's ray goes through the source coordinate Webots' lens shader samples (its formula
+written out here, scalar by scalar), clamped to the image's edge pixels; zero coefficients give
+today's images bit for bit (single and batched); a straight edge bends the way Webots' pincushion
+bends it; a range finder's depths are the floor's closed form along the distorted rays; the batched
+simulation's images equal the single one's byte for byte; the world file and the .wbt converter read
+the node (Webots' centre resets, a non-planar image's lens said and not applied)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices import imaging
+from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_batched_sim import _enable_both, _wheels_both
+
+WORLDS = Path(__file__).parent / "worlds"
+BOTH = ["fast", "exact"]
+
+
+def webots_source(u: float, v: float, c: tuple[float, float], k: tuple[float, float], p: tuple[float, float]
+                  ) -> tuple[float, float]:
+    """The coordinate Webots' lens_distortion.frag samples for the output coordinate (u, v), one
+    scalar at a time: x, y about the centre, r their squared length, the radial factor d1 and the
+    divisor d2 = 1 / (1 + the trace of the model's Jacobian)."""
+    x, y = u - c[0], v - c[1]
+    r = x * x + y * y
+    d1 = k[0] * r + k[1] * r * r
+    d2 = 1.0 / (1.0 + 4.0 * k[0] * r + 6.0 * k[1] * r * r + 8.0 * p[0] * y + 8.0 * p[1] * x)
+    return (u - d2 * (d1 * x + 2.0 * p[0] * x * y + p[1] * (r + 2.0 * x * x)),
+            v - d2 * (d1 * y + 2.0 * p[1] * x * y + p[0] * (r + 2.0 * y * y)))
+
+
+def pinhole_ray(u: float, v: float, fov: float, w: int, h: int) -> np.ndarray:
+    """The unit planar ray through image coordinates (u, v) (v down), Webots' pinhole."""
+    t = math.tan(fov / 2.0)
+    d = np.array([1.0, (1.0 - 2.0 * u) * t, (1.0 - 2.0 * v) * t * h / w])
+    return d / np.linalg.norm(d)
+
+
+@pytest.mark.parametrize("samples", [imaging.SAMPLES_CENTRE, imaging.SAMPLES_2X2])
+def test_each_samples_ray_goes_through_webots_source_coordinate(samples):
+    """A 13 x 9 image (fov 1.1) through a lens with every coefficient (centre off the middle): every
+    sample's ray is the pinhole ray through the shader's source coordinate, clamped to the span of
+    the image's samples (Webots' clamp to the edge: a source beyond the image reads the edge pixel,
+    whose centre is the clamp without anti-aliasing). Strong barrel distortion sends the corners'
+    sources out of the image: they read exactly the edge's rays."""
+    W, H, fov = 13, 9, 1.1
+    g = imaging.ImageGeometry(W, H, fov)
+    for c, k, p in (((0.45, 0.55), (0.3, -0.2), (0.01, -0.02)), ((0.5, 0.5), (-0.4, 0.0), (0.0, 0.0))):
+        lens = imaging.Lens(c, k, p)
+        dirs = imaging.pixel_directions(g, samples, lens)
+        offs = [o[0] for o in samples]
+        lo_u, hi_u = min(offs) / W, (W - 1 + max(offs)) / W
+        offs_v = [o[1] for o in samples]
+        lo_v, hi_v = min(offs_v) / H, (H - 1 + max(offs_v)) / H
+        clamped = 0
+        for s, (ox, oy) in enumerate(samples):
+            for r in range(H):
+                for j in range(W):
+                    us, vs = webots_source((j + ox) / W, (r + oy) / H, c, k, p)
+                    cu, cv = min(max(us, lo_u), hi_u), min(max(vs, lo_v), hi_v)
+                    clamped += (cu, cv) != (us, vs)
+                    np.testing.assert_allclose(dirs[s, r, j], pinhole_ray(cu, cv, fov, W, H), rtol=0, atol=1e-14)
+        if k[0] < 0:
+            assert clamped > 0                        # the barrel's corners read the image's edge
+            if len(samples) == 1:                     # ... the corner pixel's own ray, exactly
+                np.testing.assert_allclose(dirs[0, 0, 0], imaging.pixel_directions(g)[0, 0, 0], rtol=0, atol=1e-15)
+
+
+def test_where_the_shaders_divisor_is_zero_a_pixel_keeps_its_own_ray():
+    """A 2 x 2 image's pixel centres lie at r = 2·0.25² = 0.125 from the centre: with k1 = −2 the
+    shader's divisor 1 + 4·k1·r is exactly 0 there (its source undefined, Webots' GPU divides by
+    zero); each pixel keeps its undistorted ray rather than an infinite or NaN one."""
+    g = imaging.ImageGeometry(2, 2, 1.0)
+    assert imaging.pixel_directions(g, lens=imaging.Lens(radial=(-2.0, 0.0))).tobytes() == imaging.pixel_directions(g).tobytes()
+
+
+def test_a_lens_distorts_planar_images_only():
+    with pytest.raises(ValueError, match="planar image only"):
+        imaging.pixel_directions(imaging.ImageGeometry(8, 8, 1.0, "spherical"), lens=imaging.Lens())
+
+
+def _with_lens(world: wm.World, lens: dict | None, names: set[str]) -> wm.World:
+    """``world`` with ``lens`` on the devices called ``names``."""
+    robots = []
+    for robot in world.robots:
+        devices = [d.model_copy(update={"lens": None if lens is None else wm.Lens.model_validate(lens)})
+                   if d.name in names else d for d in robot.devices]
+        robots.append(robot.model_copy(update={"devices": devices}))
+    return world.model_copy(update={"robots": robots})
+
+
+def _loaded(path: Path, seed: int, lens: dict | None, names: set[str], base: Path | None = None) -> LoadedWorld:
+    lw = load_world(path)
+    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
+    return LoadedWorld(world=_with_lens(w, lens, names), source=lw.source, base_dir=base or lw.base_dir)
+
+
+ZERO = {"center": [0.3, 0.7]}                                   # no coefficients: no distortion
+LENS = {"center": [0.48, 0.53], "radial_coefficients": [0.35, -0.4], "tangential_coefficients": [0.02, -0.015]}
+CAMERAS = {"rover": {"eye": 16, "housed": 16, "pano": 32}}     # eye: anti-aliasing, noise; pano: cylindrical
+DEPTHS = {"rover": {"depth": 16, "housed": 16, "wide": 32}}    # depth: noise, resolution; wide: cylindrical
+
+
+def _images(sim, periods: dict, kind: str) -> list[bytes]:
+    out = []
+    for robot, names in periods.items():
+        for n in names:
+            d = sim.robot(robot).device(n)
+            out.append((d.image if kind == "camera" else d.range_image).tobytes())
+    return out
+
+
+def _batched_images(bs, periods: dict, kind: str, c: int) -> list[bytes]:
+    out = []
+    for robot, names in periods.items():
+        for n in names:
+            ref = bs.device(robot, n)
+            out.append((bs.image(ref) if kind == "camera" else bs.range_image(ref))[c].tobytes())
+    return out
+
+
+@pytest.mark.parametrize("precision", BOTH)
+@pytest.mark.parametrize("kind", ["camera", "depth"])
+def test_batched_lens_images_equal_the_single_ones_and_zero_coefficients_change_nothing(kind: str, precision: str,
+                                                                                        texture_dir: Path):
+    """The camera world (textured floor, lights, shadows, fog) and the depth world, their robots
+    driving with random wheel commands: with a lens with every coefficient on the planar devices (a
+    camera with anti-aliasing and noise, a housed one; range finders with noise and resolution, a
+    housed one), every copy's images equal the single Simulation's with that copy's seed byte for
+    byte, and they differ from the undistorted ones; with a Lens of zero coefficients (and an
+    off-centre centre) the images are those without a lens, bit for bit, single and batched."""
+    path, periods, names, base = ((texture_dir / "camera.yaml", CAMERAS, {"eye", "housed", "pano"}, texture_dir)
+                                  if kind == "camera" else (WORLDS / "depth.yaml", DEPTHS, {"depth", "housed", "wide"}, None))
+    seeds = [5, 9]
+    runs = {}
+    for name, lens in (("none", None), ("zero", ZERO), ("lens", LENS)):
+        bs = BatchedSimulation(_loaded(path, 0, lens, names, base), len(seeds), precision=precision)
+        bs.reset(np.arange(len(seeds)), seeds)
+        sims = [Simulation(_loaded(path, s, lens, names, base), precision=precision) for s in seeds]
+        for c in range(len(seeds)):
+            _enable_both(bs, sims, periods, c)
+        rng = np.random.default_rng(2)
+        frames = []
+        for step in range(36):
+            if step % 12 == 0:
+                for robot in periods:
+                    vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
+                    _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            bs.step()
+            for c, s in enumerate(sims):
+                s.step()
+                want = _images(s, periods, kind)
+                assert _batched_images(bs, periods, kind, c) == want, (name, step, c)
+                frames.append(want)
+        runs[name] = frames
+    assert runs["zero"] == runs["none"]
+    lens_frames, plain = np.array(runs["lens"], dtype=object), np.array(runs["none"], dtype=object)
+    assert (lens_frames[:, :2] != plain[:, :2]).any()       # the distorted devices' images changed
+    assert (lens_frames[:, 2] == plain[:, 2]).all()         # a cylindrical image keeps no lens (said at load)
+
+
+def _edge_world(lens: dict | None) -> wm.World:
+    """A camera 0.5 m up (41 x 31, fov 1.2) facing a wide wall at x = 2 whose top edge (z = 1.1) is a
+    horizontal line above the image's centre, the sky (0.2, 0.4, 0.6) above it; a directional light."""
+    cam = {"device": "Camera", "name": "cam", "pose": {"translation": [0.0, 0.0, 0.5]}, "width": 41, "height": 31,
+           "field_of_view": 1.2}
+    if lens is not None:
+        cam["lens"] = lens
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 8, "contact": False},
+        "background": {"sky_color": [0.2, 0.4, 0.6]},
+        "lights": [{"type": "DirectionalLight", "direction": [1, 0, 0], "intensity": 0.8, "ambient_intensity": 0.2}],
+        "solids": [{"name": "wall", "pose": {"translation": [2.5, 0.0, 0.0]}, "geometry": {"type": "box", "size": [1.0, 40.0, 2.2]},
+                    "appearance": {"base_color": [0.9, 0.5, 0.1]}}],
+        "robots": [{"name": "bot", "devices": [cam]}]})
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_straight_edge_bends_as_webots_lens_bends_it(precision: str):
+    """Without a lens the wall's top edge is one row across the image. With k1 = 1 (pincushion: each
+    pixel samples nearer the centre) every pixel is sky exactly where its source coordinate lies
+    above the edge's line in the pinhole image (v_edge = (1 − (0.6/2)/(tan 0.6·31/41))/2), and the edge
+    lies farther from the centre at the image's sides than in its middle; k1 = −0.4 (barrel) bends it
+    the other way."""
+    W, H, fov = 41, 31, 1.2
+    t = math.tan(fov / 2.0)
+    v_edge = (1.0 - (0.6 / 2.0) / (t * H / W)) / 2.0
+    sky = None
+
+    def is_sky(lens: dict | None) -> np.ndarray:
+        nonlocal sky
+        sim = Simulation(LoadedWorld(world=_edge_world(lens), source="<test>", base_dir=Path.cwd()), precision=precision)
+        cam = sim.robot("bot").device("cam")
+        cam.enable(8)
+        sim.step()
+        img = cam.image[..., :3]
+        if sky is None:
+            sky = img[0, W // 2].copy()
+        return (img == sky).all(axis=-1)
+
+    plain = is_sky(None)
+    rows = plain.sum(axis=0)                  # sky rows per column: the edge's row
+    assert (rows == rows[0]).all() and 0 < rows[0] < H // 2
+    above = {}
+    for k1 in (1.0, -0.4):
+        got = is_sky({"radial_coefficients": [k1, 0.0]})
+        want = np.zeros((H, W), dtype=bool)
+        for r in range(H):
+            for j in range(W):
+                us, vs = webots_source((j + 0.5) / W, (r + 0.5) / H, (0.5, 0.5), (k1, 0.0), (0.0, 0.0))
+                vs = min(max(vs, 0.5 / H), (H - 0.5) / H)
+                assert abs(vs - v_edge) > 1e-6            # no pixel's source on the edge itself
+                want[r, j] = vs < v_edge
+        assert (got == want).all(), k1
+        above[k1] = got.sum(axis=0)
+    mid = W // 2
+    assert above[1.0][0] < above[1.0][mid] and above[1.0][-1] < above[1.0][mid]        # pincushion: sides farther up
+    assert above[-0.4][0] > above[-0.4][mid] and above[-0.4][-1] > above[-0.4][mid]    # barrel: sides nearer the centre
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_range_finders_depths_follow_the_distorted_rays(precision: str):
+    """A range finder 0.3 m above an endless floor (the plane z = 0), looking level (24 x 18, fov 1.0,
+    max_range 50): each pixel below the horizon reads the planar depth of the floor point its
+    distorted ray meets, 0.3/((2·vs − 1)·tan(0.5)·18/24) with vs the shader's source row (closed
+    form, float32), the pixels whose source is above the horizon +inf."""
+    W, H, fov, h = 24, 18, 1.0, 0.3
+    k, p = (0.25, 0.1), (0.01, 0.0)
+    rf = {"device": "RangeFinder", "name": "rf", "pose": {"translation": [0.0, 0.0, h]}, "width": W, "height": H,
+          "field_of_view": fov, "min_range": 0.01, "max_range": 50.0,
+          "lens": {"radial_coefficients": list(k), "tangential_coefficients": list(p)}}
+    world = wm.World.model_validate({
+        "world_info": {"basic_time_step": 8, "contact": False},
+        "solids": [{"name": "floor", "geometry": {"type": "plane", "size": [1000.0, 1000.0]}}],
+        "robots": [{"name": "bot", "devices": [rf]}]})
+    sim = Simulation(LoadedWorld(world=world, source="<test>", base_dir=Path.cwd()), precision=precision)
+    dev = sim.robot("bot").device("rf")
+    dev.enable(8)
+    sim.step()
+    got = dev.range_image
+    t = math.tan(fov / 2.0)
+    finite = 0
+    for r in range(H):
+        for j in range(W):
+            us, vs = webots_source((j + 0.5) / W, (r + 0.5) / H, (0.5, 0.5), k, p)
+            vs = min(max(vs, 0.5 / H), (H - 0.5) / H)
+            down = (2.0 * vs - 1.0) * t * H / W
+            depth = h / down if down > 0 else math.inf
+            if depth < 50.0:
+                finite += 1
+                assert got[r, j] == pytest.approx(depth, rel=2e-6), (r, j)
+            else:
+                assert got[r, j] == np.inf, (r, j)
+    assert finite > W * H // 3
+
+
+def test_a_world_files_lens_is_read_with_webots_defaults_and_resets(tmp_path: Path):
+    """A YAML camera's lens takes Webots' defaults (centre 0.5 0.5, zero coefficients); a centre
+    component outside [0, 1] is reset as WbLens::updateCenter does (negative: 0; y > 1 sets x to 1
+    and keeps y, its slip), one warning each; a lens on a spherical image is one warning and no
+    distortion. Its CameraInfo stays the undistorted pinhole with ``d`` zeros."""
+    p = tmp_path / "w.yaml"
+    p.write_text(
+        "robots:\n  - name: r\n    devices:\n"
+        "      - {device: Camera, name: a, lens: {}}\n"
+        "      - {device: Camera, name: b, lens: {center: [-0.2, 1.4], radial_coefficients: [0.1, 0.0]}}\n"
+        "      - {device: RangeFinder, name: c, projection: spherical, field_of_view: 2.0, lens: {}}\n")
+    lw = load_world(p)
+    a, b, c = lw.world.robots[0].devices
+    assert a.lens == wm.Lens() and a.lens.center == (0.5, 0.5) and a.lens.radial_coefficients == (0.0, 0.0)
+    assert b.lens is not None and b.lens.center == (1.0, 1.4)
+    assert lw.warnings == [
+        "robots[0].devices[1].lens.center: x -0.2 < 0, set to 0",
+        "robots[0].devices[1].lens.center: y 1.4 > 1: Webots sets x (not y) to 1 and keeps y 1.4, done the same here",
+        "robots[0].devices[2].lens: not applied to a spherical image (Webots distorts each of its cube-face "
+        "sub-images before merging them; here only a planar image has a lens)"]
+    sim = Simulation(lw)
+    assert sim.robot("r").device("c").lens is None and sim.robot("r").device("a").lens == imaging.Lens()
+    # CameraInfo: the undistorted pinhole, d zeros (Webots' mapping is not plumb_bob: README "Lens distortion")
+    info = sim.robot("r").device("b").camera_info()
+    assert info["distortion_model"] == "plumb_bob" and info["d"] == bytes(40)
+    fx = 32.0 / math.tan(0.785398 / 2.0)
+    assert np.frombuffer(info["k"], "<f8").tolist() == [fx, 0.0, 31.5, 0.0, fx, 31.5, 0.0, 0.0, 1.0]
+
+
+def test_the_wbt_converter_reads_the_lens_node(tmp_path: Path):
+    """A .wbt Camera's and RangeFinder's Lens nodes become the world's lens (absent fields Webots'
+    defaults); a NULL lens is none; another node type there is an error at the field."""
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nRobot { name \"r\" children [\n"
+                 "Camera { lens Lens { center 0.4 0.6 radialCoefficients 0.2 -0.05 tangentialCoefficients 0.01 0.02 } }\n"
+                 "RangeFinder { lens Lens { radialCoefficients -0.1 0 } }\n"
+                 "Camera { name \"plain\" lens NULL }\n] }\n")
+    lw = load_world(p)
+    cam, rf, plain = lw.world.robots[0].devices
+    assert cam.lens == wm.Lens(center=(0.4, 0.6), radial_coefficients=(0.2, -0.05), tangential_coefficients=(0.01, 0.02))
+    assert rf.lens == wm.Lens(radial_coefficients=(-0.1, 0.0))
+    assert plain.lens is None
+    assert lw.warnings == []
+    bad = tmp_path / "bad.wbt"
+    bad.write_text("#VRML_SIM R2023b utf8\nRobot { children [ Camera { lens Focus { } } ] }\n")
+    with pytest.raises(Exception, match=r"bad.wbt: line 2, column 29: Camera.lens: expected a Lens node or NULL, got a Focus node"):
+        load_world(bad)
