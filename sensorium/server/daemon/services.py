@@ -41,9 +41,9 @@ from sensorium.schemas.wire import (
 )
 from sensorium.server.daemon import roles, supervisor
 from sensorium.server.daemon.device_services import MOTOR, DeviceServices, ServiceError
-from sensorium.server.sim.joints import JointMotor
 from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
 from sensorium.server.daemon.topics import Control, Topics, pose_quaternion
+from sensorium.server.sim.joints import JointMotor
 from sensorium.server.sim.simulation import DeviceEntry
 
 __all__ = ["Core", "ServiceError"]
