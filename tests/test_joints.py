@@ -190,3 +190,53 @@ def test_drive_unchanged_by_an_arm_and_device_list() -> None:
 def test_bad_motor_fields_are_refused(fields: dict, message: str) -> None:
     with pytest.raises(Exception, match=message):
         _arm(*_hinge(**fields))
+
+
+def test_wbt_robot_keeps_its_drive_bit_identical_and_its_arm_joint_moves(tmp_path) -> None:
+    """A .wbt two-wheel robot with a tilt hinge (along the wheels' axis, but a box at its end: no
+    wheel; position 0.2, limits [-1, 0.5], maxVelocity 2, maxTorque 1000: full speed in one step)
+    and a slider (maxPosition 0.03 below its position 0.05,
+    which Webots widens to 0.05 with a warning): its drive turns exactly as the same robot without
+    them, the hinge's sensor reads 0.2 + k·2·dt up to 0.5, and the slider starts at 0.05."""
+    from test_wbt_drives import wheel, write
+
+    from sensorium.server.world.loader import load_world
+
+    arm = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0 0.2 position 0.2 }\n'
+           '  device [ RotationalMotor { name "tilt" maxVelocity 2 maxTorque 1000 minPosition -1 maxPosition 0.5 }\n'
+           '           PositionSensor { name "tilt sensor" } ]\n'
+           '  endPoint Solid { translation 0 0 0.2 children [ Shape { geometry Box { size 0.02 0.02 0.02 } }\n'
+           '    SliderJoint { jointParameters JointParameters { axis 0 0 1 position 0.05 }\n'
+           '      device [ LinearMotor { name "lift" maxPosition 0.03 } PositionSensor { name "lift sensor" } ]\n'
+           '      endPoint Solid { } } ] } }\n')
+    wheels = wheel("left wheel", 0, 0.1) + wheel("right wheel", 0, -0.1)
+    sims = []
+    for i, extra in enumerate(("", arm)):
+        folder = tmp_path / str(i)
+        folder.mkdir()
+        w = load_world(write(folder, 'Robot { name "rover" children [\n' + extra + wheels + '] }\n'))
+        sims.append(Simulation(w))
+    plain, armed = sims
+    assert any("LinearMotor.maxPosition: 0.03 is below the joint's position; using 0.05 (as Webots does)" in x
+               for x in w.warnings)
+    for sim in sims:
+        for name, v in (("left wheel", 4.0), ("right wheel", 6.0)):
+            m = sim.robot("rover").motor(name)
+            m.set_position(math.inf)
+            m.set_velocity(v)
+    robot = armed.robot("rover")
+    assert sorted(robot.joints) == ["lift", "tilt"]
+    tilt, lift = robot.motor("tilt"), robot.motor("lift")
+    assert (tilt.position, tilt.min_position, tilt.max_position, lift.position, lift.max_position) == (0.2, -1, 0.5, 0.05, 0.05)
+    armed.device("rover/tilt sensor").enable(DT_MS)
+    tilt.set_position(0.5)
+    got = []
+    for _ in range(12):
+        plain.step()
+        armed.step()
+        got.append(armed.device("rover/tilt sensor").value)
+        a, b = plain.robot("rover").pose, armed.robot("rover").pose
+        assert a.translation.tobytes() == b.translation.tobytes() and a.rotation.tobytes() == b.rotation.tobytes()
+    steps = math.ceil((0.5 - 0.2) / (2.0 * DT))          # 9.375: reached at step 10
+    assert got[:steps - 1] == pytest.approx([0.2 + k * 2.0 * DT for k in range(1, steps)], abs=1e-14)
+    assert got[steps - 1:] == [0.5] * (12 - steps + 1)
