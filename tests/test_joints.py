@@ -240,3 +240,13 @@ def test_wbt_robot_keeps_its_drive_bit_identical_and_its_arm_joint_moves(tmp_pat
     steps = math.ceil((0.5 - 0.2) / (2.0 * DT))          # 9.375: reached at step 10
     assert got[:steps - 1] == pytest.approx([0.2 + k * 2.0 * DT for k in range(1, steps)], abs=1e-14)
     assert got[steps - 1:] == [0.5] * (12 - steps + 1)
+
+
+def test_the_batched_simulation_refuses_a_joint_in_one_line() -> None:
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+
+    world = parse_world({"world_info": {"basic_time_step": DT_MS},
+                         "robots": [{"name": "arm", "devices": _hinge()}]})
+    with pytest.raises(BatchedError, match="robot 'arm': motor 'shoulder' moves a joint; the batched simulation "
+                                           r"moves drive wheels only \(use Simulation\)"):
+        BatchedSimulation(world, 2)

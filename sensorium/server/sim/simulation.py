@@ -17,7 +17,7 @@ from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -135,7 +135,8 @@ class RobotState:
         # every other motor moves its joint kinematically (sim/joints.py), in device-list order
         self.joints: dict[str, JointMotor] = {d.name: joint_motor(d) for d in model.devices
                                               if isinstance(d, wm._Motor) and d.name not in drive_motors}
-        self.motors: dict[str, WheelMotor | JointMotor] = {**drive_motors, **self.joints} if self.joints else drive_motors
+        self.motors: dict[str, WheelMotor | JointMotor] = (
+            {**drive_motors, **self.joints} if self.joints else cast("dict[str, WheelMotor | JointMotor]", drive_motors))
         for dev in self.devices.values():
             dev.bind(self)
         self.device_list = device_entries(model, self.devices, self.motors)
