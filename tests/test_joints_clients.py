@@ -50,7 +50,8 @@ def _check(lines: list[str], err: str) -> None:
     assert lines[0] == "-0.5 0.5 1 1000 1000 -1 0 10 100 1 0 0 0"
     assert lines[1] == "2 5"                   # libController keeps the requested target
     assert err.count('WARNING: RotationalMotor "shoulder": too big requested position: 2 > 0.5') == 1
-    rows = [dict(f.split("=") for f in line.split()[2:]) for line in lines[2:]]
+    assert lines[-1] == "reset 0.005 0.005 0"   # a reset: the joints back at their initial positions
+    rows = [dict(f.split("=") for f in line.split()[2:]) for line in lines[2:-1]]
     assert len(rows) == STEPS
     wrist = 0.0
     for k, row in enumerate(rows, start=1):
@@ -60,7 +61,7 @@ def _check(lines: list[str], err: str) -> None:
         else:
             assert shoulder == 0.5, k
         lift = _value(row["lift"])
-        assert lift == (pytest.approx(k * 0.05 * DT, abs=1e-15) if k < 13 else 0.01), k
+        assert lift == (pytest.approx(0.005 + k * 0.05 * DT, abs=1e-15) if k < 7 else 0.01), k   # 0.005 / 0.0008: 6.25
         # acceleration 5: the speed ramps by 0.08 rad/s a step, the joint stops at its target -1
         wrist = max(wrist - min(5.0 * DT * k, 10.0) * DT, -1.0)
         assert _value(row["wrist"]) == pytest.approx(wrist, rel=1e-12), k
@@ -77,4 +78,4 @@ def test_c_controller_reads_what_python_reads(cjoints) -> None:
     _check(c_lines, c_err)
     py_lines, _ = _run([sys.executable, "-m", "sensorium", "controller", str(JOINTS_PY), str(STEPS)])
     assert c_lines == py_lines
-    assert not math.isnan(_value(dict(f.split("=") for f in c_lines[-1].split()[2:])["shoulder"]))
+    assert not math.isnan(_value(dict(f.split("=") for f in c_lines[-2].split()[2:])["shoulder"]))

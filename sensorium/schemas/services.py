@@ -437,6 +437,8 @@ class JointMotorDescription(MotorDescription):
 
     acceleration: float = Field(description="rad/s² (m/s²); -1: bounded by the available torque/force only")
     maxForce: float = Field(description="maxTorque (N·m) of a RotationalMotor, maxForce (N) of a LinearMotor")
+    initialPosition: float = Field(description="the joint's position as loaded: where a simulation reset puts it "
+                                               "and its target")
 
 
 class PositionSensorDescription(_Entry):

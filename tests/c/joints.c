@@ -1,12 +1,14 @@
 /* Arm joints moved kinematically (tests/worlds/joints.yaml, robot arm); its Python twin is
  * tests/controllers/joints.py (same lines): joints STEPS. One line of the motors' answers, then per
- * step the float64 bits of the shoulder, wrist, lift and left wheel sensors. */
+ * step the float64 bits of the shoulder, wrist, lift and left wheel sensors; then a simulation
+ * reset and one more step: the lift's target and reading. */
 #include <math.h>
 #include <stdlib.h>
 
 #include <webots/motor.h>
 #include <webots/position_sensor.h>
 #include <webots/robot.h>
+#include <webots/supervisor.h>
 
 #include "common.h"
 
@@ -45,6 +47,11 @@ int main(int argc, char **argv) {
     if (status == -1)
       break;
   }
+  wb_supervisor_simulation_reset();
+  wb_robot_step(dt);
+  printf("reset %g %g %g\n", wb_motor_get_target_position(lift), wb_position_sensor_get_value(sensors[2]),
+         wb_motor_get_target_position(shoulder));
+  fflush(stdout);
   wb_robot_cleanup();
   return 0;
 }

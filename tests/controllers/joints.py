@@ -2,15 +2,16 @@
 
 One line of the motors' answers, then per step the float64 bits of the shoulder, wrist, lift and
 left wheel sensors: the shoulder commanded to 2 rad (clamped to 0.5 with Webots' warning), the
-wrist to -1 rad with acceleration 5, the lift to 0.01 m, the left wheel at 2 rad/s."""
+wrist to -1 rad with acceleration 5, the lift from 0.005 to 0.01 m, the left wheel at 2 rad/s; then
+a simulation reset and one more step: the lift's target and reading, back at 0.005."""
 
 import math
 import struct
 import sys
 
-from controller import Robot
+from controller import Supervisor
 
-robot = Robot()
+robot = Supervisor()
 steps = int(sys.argv[1]) if len(sys.argv) > 1 else 40
 dt = int(robot.getBasicTimeStep())
 shoulder, wrist, lift = robot.getDevice("shoulder"), robot.getDevice("wrist"), robot.getDevice("lift")
@@ -42,3 +43,6 @@ for _ in range(steps):
         bits(n, s.getValue()) for n, s in zip(("shoulder", "wrist", "lift", "wheel"), sensors)), flush=True)
     if status == -1:
         break
+robot.simulationReset()
+robot.step(dt)
+print(f"reset {lift.getTargetPosition():g} {sensors[2].getValue():g} {shoulder.getTargetPosition():g}", flush=True)

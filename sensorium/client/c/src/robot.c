@@ -194,6 +194,7 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
   d->joint = sn_get(desc, "maxForce") != NULL;
   d->max_force = sn_double_or(desc, "maxForce", NAN);
   d->available_force = d->max_force;
+  d->initial_position = sn_double_or(desc, "initialPosition", 0.0);
   return 0;
 }
 
