@@ -250,3 +250,9 @@ def test_the_batched_simulation_refuses_a_joint_in_one_line() -> None:
     with pytest.raises(BatchedError, match="robot 'arm': motor 'shoulder' moves a joint; the batched simulation "
                                            r"moves drive wheels only \(use Simulation\)"):
         BatchedSimulation(world, 2)
+
+
+def test_a_drive_motor_entry_with_joint_fields_is_refused_in_one_line() -> None:
+    with pytest.raises(Exception, match=r"devices\[0\] \(left wheel motor\)\.max_velocity: 'left wheel motor' is a motor of the robot's "
+                                        "drive, which sets its speed and limits: leave out max_velocity"):
+        _arm({"device": "RotationalMotor", "name": "left wheel motor", "max_velocity": 3.0}, drive=True)
