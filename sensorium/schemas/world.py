@@ -779,7 +779,7 @@ class Receiver(_Radio):
     direction_noise: float = Field(default=0.0, ge=0.0, description="σ of each direction component, times the distance")
 
 
-class _Motor(_Device):
+class Motor(_Device):
     """A Webots motor's fields (snake_case, Webots' defaults) and its joint's initial ``position``.
 
     A motor that is not one of the robot's drive motors moves its joint kinematically, as Webots
@@ -796,7 +796,7 @@ class _Motor(_Device):
                                                      "position), where the motor starts and holds")
 
     @model_validator(mode="after")
-    def _motor_limits(self) -> _Motor:
+    def _motor_limits(self) -> Motor:
         if self.acceleration < 0.0 and self.acceleration != -1.0:
             raise ValueError("acceleration must be >= 0, or -1 (limited by the available torque or force)")
         if self.min_position > self.max_position:
@@ -807,7 +807,7 @@ class _Motor(_Device):
         return self
 
 
-class RotationalMotor(_Motor):
+class RotationalMotor(Motor):
     """A RotationalMotor. An entry named like one of the robot's ``differential_drive``/``ackermann_drive``
     motors *is* that drive motor, at this index of the device list (a drive motor without an entry
     comes after the listed devices; the drive's own fields are used, not these). Any other is a
@@ -818,7 +818,7 @@ class RotationalMotor(_Motor):
                                                                 "(acceleration -1, or above it)")
 
 
-class LinearMotor(_Motor):
+class LinearMotor(Motor):
     """A SliderJoint's LinearMotor, moved kinematically (see the base class); positions in metres.
     ``pose`` is unused."""
 

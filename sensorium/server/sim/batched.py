@@ -327,7 +327,7 @@ class BatchedSimulation:
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
         for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
             drive = {m for _, m in r.drive_motors}
-            joints = [d.name for d in r.devices if isinstance(d, wm._Motor) and d.name not in drive]
+            joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]
             if joints:
                 raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: motor {joints[0]!r} moves a joint; the "
                                    "batched simulation moves drive wheels only (use Simulation)")

@@ -83,7 +83,7 @@ def device_entries(model: wm.Robot, devices: dict[str, Device],
                    motors: dict[str, WheelMotor | JointMotor]) -> list[DeviceEntry]:
     out: list[DeviceEntry] = []
     for d in model.devices:
-        simulated = d.name in (motors if isinstance(d, wm._Motor) else devices)
+        simulated = d.name in (motors if isinstance(d, wm.Motor) else devices)
         own = (tuple((k, getattr(d, k)) for k in type(d).model_fields if k not in _ENTRY_FIELDS)
                if d.device in wm.LISTED_WITH_FIELDS else ())
         out.append(DeviceEntry(len(out), d.device, d.name, getattr(d, "model", "") or "", simulated, own))
@@ -134,7 +134,7 @@ class RobotState:
         drive_motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
         # every other motor moves its joint kinematically (sim/joints.py), in device-list order
         self.joints: dict[str, JointMotor] = {d.name: joint_motor(d) for d in model.devices
-                                              if isinstance(d, wm._Motor) and d.name not in drive_motors}
+                                              if isinstance(d, wm.Motor) and d.name not in drive_motors}
         self.motors: dict[str, WheelMotor | JointMotor] = (
             {**drive_motors, **self.joints} if self.joints else cast("dict[str, WheelMotor | JointMotor]", drive_motors))
         for dev in self.devices.values():

@@ -464,7 +464,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                             f"lookup table inputs must be strictly increasing: input {table[k][0]} "
                             f"follows {table[k - 1][0]}"))
             if isinstance(dev, wm.RotationalMotor) and dev.name in {m for _, m in robot.drive_motors}:
-                joint = sorted(dev.model_fields_set & set(wm._Motor.model_fields) - set(wm._Device.model_fields)
+                joint = sorted(dev.model_fields_set & set(wm.Motor.model_fields) - set(wm._Device.model_fields)
                                | (dev.model_fields_set & {"max_torque"}))
                 if joint:
                     problems.append(Problem(f"{dp}.{joint[0]}", f"{dev.name!r} is a motor of the robot's drive, which "
@@ -473,7 +473,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
             if isinstance(dev, wm.PositionSensor) and dev.motor is not None:
                 # a drive's motor, or a RotationalMotor/LinearMotor entry (a joint moved kinematically)
                 motors = tuple(dict.fromkeys([*(m for _, m in robot.drive_motors),
-                                              *(d.name for d in robot.devices if isinstance(d, wm._Motor))]))
+                                              *(d.name for d in robot.devices if isinstance(d, wm.Motor))]))
                 if dev.motor not in motors:
                     problems.append(Problem(
                         f"{dp}.motor", f"{dev.motor!r} is not a motor of this robot "
