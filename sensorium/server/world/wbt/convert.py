@@ -908,13 +908,8 @@ class Converter:
     def unique_devices(self, robot: dict) -> None:
         """Device names address topics and services, so a repeated one gets a suffix (Webots warns
         and its getDevice returns the first); the wheel motors' names count too."""
-        drive = robot.get("differential_drive") or {}
         listed = {d["name"] for d in robot["devices"] if d["device"] == "RotationalMotor"}
-        skid = drive.get("skid_steer") or {}
-        motors = [v for k, v in drive.items() if k in ("left_motor", "right_motor")] + [
-            *skid.get("left", ()), *skid.get("right", ())]
-        motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
-        seen: Counter[str] = Counter(v for v in motors if v not in listed)
+        seen: Counter[str] = Counter(v for v in drive_motor_names(robot) if v not in listed)
         for dev in robot["devices"]:
             name = dev["name"]
             seen[name] += 1
@@ -1179,15 +1174,24 @@ class Converter:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return
             robot.data["differential_drive"] = drive
-        drive_motors = set()
         for w in wheels:    # the wheels' encoders measure the drive's wheels
-            drive_motors.add(w["motor"])
             for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]
+        drive_motors = set(drive_motor_names(robot.data))
         for entry in robot.data["devices"]:     # a drive's motor is the drive's: its joint fields are not used
             if entry["device"] == "RotationalMotor" and entry["name"] in drive_motors:
                 for key in JOINT_KEYS:
                     entry.pop(key, None)
+
+
+def drive_motor_names(robot: dict) -> list[str]:
+    """The motor names a converted robot's drive uses (a car's non-driven wheels have none)."""
+    drive = robot.get("differential_drive") or {}
+    skid = drive.get("skid_steer") or {}
+    motors = [v for k, v in drive.items() if k in ("left_motor", "right_motor")] + [
+        *skid.get("left", ()), *skid.get("right", ())]
+    motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
+    return [m for m in motors if isinstance(m, str)]
 
 
 def _limits(motor) -> tuple[float, float]:
