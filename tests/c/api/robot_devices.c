@@ -40,7 +40,7 @@ int main(void) {
   ts_assert_int_equal(wb_robot_get_device_by_index(5), 0, "no device past the last");
   ts_assert_int_equal(wb_robot_get_device("nothing"), 0, "no such device");
   ts_assert_string_equal(wb_device_get_model(wb_robot_get_device("radar")), "ARS 408", "a device's model");
-  /* listed only: Webots' "no value" */
+  /* listed only: Webots' "no value" (the linear motor moves its joint kinematically) */
   WbDeviceTag radar = wb_robot_get_device("radar"), display = wb_robot_get_device("display");
   WbDeviceTag lift = wb_robot_get_device("lift");
   wb_radar_enable(radar, 16);
@@ -51,7 +51,8 @@ int main(void) {
   ts_assert_int_equal(wb_display_get_width(display), 64, "display width: the world's (Webots' default)");
   wb_motor_set_velocity(lift, 1.0);
   ts_assert_int_equal(wb_motor_get_type(lift), WB_LINEAR, "a linear motor's type");
-  ts_assert_double_equal(wb_motor_get_velocity(lift), NAN, "linear motor velocity: no value");
+  ts_assert_double_equal(wb_motor_get_velocity(lift), 1.0, "a linear motor moves its slider: its velocity");
+  ts_assert_double_equal(wb_motor_get_max_force(lift), 10.0, "a linear motor's maxForce: Webots' default");
   /* the simulated LED */
   WbDeviceTag led = wb_robot_get_device("led");
   wb_led_set(led, 1);
