@@ -355,15 +355,15 @@ def test_a_propeller_lists_its_motor_and_shows_its_slow_helix(tmp_path: Path) ->
     w = load_world(p)
     assert not w.report.losses
     assert [x.split(": ", 1)[1] for x in w.warnings] == [
-        "Propeller: its motor is listed, its thrust and torque are not simulated (joints do not move here)"] * 2
+        "Propeller: its motor's position moves kinematically; its thrust and torque are not simulated"] * 2
     (robot,) = w.world.robots
     assert [(d.device, d.name) for d in robot.devices] == [
         ("RotationalMotor", "front propeller"), ("GPS", "gps"), ("RotationalMotor", "rear propeller")]
     assert [(s.geometry.type, s.pose.translation) for s in robot.shapes] == [
         ("box", (0.2, 0.0, 0.1)), ("box", (-0.2, 0.0, 0.1))]       # the slow helices (at rest), not the fast ones
-    entries = Simulation(w).robot("drone").device_list     # what a controller's getDevice finds (not simulated)
+    entries = Simulation(w).robot("drone").device_list     # what a controller's getDevice finds (kinematic motors)
     assert [(e.name, e.simulated) for e in entries if e.name.endswith("propeller")] == [
-        ("front propeller", False), ("rear propeller", False)]
+        ("front propeller", True), ("rear propeller", True)]
 
 
 @pytest.mark.parametrize("kwargs, why", [
@@ -604,7 +604,7 @@ def test_devices_are_listed_in_webots_tree_order(tmp_path: Path) -> None:
         ("PositionSensor", "arm sensor"), ("TouchSensor", "bumper"), ("LinearMotor", "linear motor"),
         ("Emitter", "emitter")]
     assert devs[0].model == "GP2D120" and devs[5].model == "tactile"
-    assert devs[4].motor is None      # on a joint nothing turns here: present, reads no value
+    assert devs[4].motor == "arm"     # the joint's sensor measures the joint its motor moves
 
 
 def test_named_controllers_become_extern(tmp_path: Path) -> None:
@@ -774,12 +774,14 @@ def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
         ("box", (0.0, 0.0, 0.0)), ("cylinder", (-0.15, 0.07, 0.0075)), ("sphere", (0.0925, 0.07, -0.044)),
         ("cylinder", (-0.15, -0.07, 0.0075)), ("sphere", (0.0925, -0.07, -0.044))]
     assert [x for x in w.warnings if "Track" in x] == [
-        f"{p}:4:1: Track 'left track': its devices are listed, not simulated (tracks do not move here)",
-        f"{p}:9:1: Track 'right track': its devices are listed, not simulated (tracks do not move here)",
+        f"{p}:4:1: Track 'left track': its motor's position moves kinematically (its sensor reads it); the belt "
+        "and its wheels do not move here",
+        f"{p}:9:1: Track 'right track': its motor's position moves kinematically (its sensor reads it); the belt "
+        "and its wheels do not move here",
         f"{p}: skipped nodes that do not matter to these sensors: Track.animatedGeometry x2"]
-    entries = Simulation(w).robot("tank").device_list     # what a controller's getDevice finds (not simulated)
+    entries = Simulation(w).robot("tank").device_list     # what a controller's getDevice finds (kinematic motors)
     assert [(e.name, e.simulated) for e in entries if e.name.endswith("motor")] == [
-        ("left motor", False), ("right motor", False)]
+        ("left motor", True), ("right motor", True)]
 
 
 def test_a_device_not_simulated_is_said_in_the_load_report(tmp_path: Path) -> None:

@@ -178,8 +178,9 @@ def test_a_devices_own_motorised_joints_are_no_wheels(tmp_path: Path) -> None:
 def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> None:
     """A gripper's lift arm (a motorised hinge along the robot's +y, like the wheels, its end point a
     box with slider fingers: nothing round to roll on) on a two-wheel robot: the robot keeps its
-    two-wheel drive (three "wheels", one on the x axis, made no drive at all), the arm's motor is
-    listed with one warning at its joint, the wheel encoders measure their wheels."""
+    two-wheel drive (three "wheels", one on the x axis, made no drive at all), the arm's motor moves
+    its joint kinematically with one warning at its joint, its sensor measures it and the wheel
+    encoders measure their wheels."""
     arm = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor -0.01 0 0.022 }\n'
            '  device [ RotationalMotor { name "lift" } PositionSensor { name "lift sensor" } ]\n'
            '  endPoint Solid { translation -0.01 0 0.022 children [\n'
@@ -195,8 +196,11 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
         wheel_radius=R, axle_length=0.052, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert [(d.name, d.device) for d in robot.devices][:3] == [
         ("lift", "RotationalMotor"), ("lift sensor", "PositionSensor"), ("grip", "LinearMotor")]
-    assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == [None, "left wheel", "right wheel"]
+    assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == ["lift", "left wheel", "right wheel"]
     assert not [x for x in w.warnings if "drive" in x]
     assert f"{p}:4:1: HingeJoint motor 'lift' is no wheel (its end point has no cylinder or sphere to roll on): " \
-           "listed, not simulated (joints do not move here)" in w.warnings
-    assert sorted(Simulation(w).robot("khepera").motors) == ["left wheel", "right wheel"]   # the lift is not one
+           "its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), the shapes " \
+           "and devices past the joint stay where they are" in w.warnings
+    sim = Simulation(w).robot("khepera")
+    assert sorted(sim.drive.motors) == ["left wheel", "right wheel"]    # the lift and the grip are no wheels
+    assert sorted(sim.joints) == ["grip", "lift"]

@@ -19,6 +19,7 @@ from sensorium.client.wb_robot import (
     answers,
     current,
     integer,
+    real,
 )
 
 _NAN = math.nan
@@ -93,61 +94,117 @@ def wb_motor_get_brake(tag: int) -> int:
     return 0
 
 
-# -- what needs physics: a kinematic wheel turns at its commanded speed at once. The setters are
-#    accepted and ignored, the getters answer Webots' default or NaN; one warning line per motor.
+# -- what needs physics. A drive's wheel turns at its commanded speed at once: its setters are
+#    accepted and ignored, its getters answer Webots' default or NaN. A joint's motor (its attach
+#    entry has ``maxForce``) moves as Webots moves it without physics: its acceleration and
+#    available torque/force bound the speed ramp (sent with the next step), PID gains, forces and
+#    torques are ignored (as Webots' kinematic control ignores them) and feedback reads NaN (Webots
+#    gives none without a Physics node). One warning line per motor for what is ignored.
+
+def _number(value: float, what: str, func: str) -> float:
+    number = real(value)
+    if number is None:
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): '{what}' must be a number, got {value!r}")
+    return number
+
+
+def _joint(dev: DeviceState) -> bool:
+    return "maxForce" in dev.desc
+
 
 def _physics(tag: int, func: str) -> DeviceState:
     dev = _motor(tag, func)
     if not dev._consts.get("physics_warned"):
         dev._consts["physics_warned"] = True
-        print(f"Warning: {func}(): {dev.kind} '{dev.name}' is a kinematic wheel: accelerations, forces, torques and "
-              "PID gains are ignored, force and torque feedback read NaN.", file=sys.stderr)
+        if _joint(dev):
+            print(f"Warning: {func}(): {dev.kind} '{dev.name}' moves its joint kinematically (no physics): PID gains, "
+                  "forces and torques are ignored, force and torque feedback read NaN.", file=sys.stderr)
+        else:
+            print(f"Warning: {func}(): {dev.kind} '{dev.name}' is a kinematic wheel: accelerations, forces, torques "
+                  "and PID gains are ignored, force and torque feedback read NaN.", file=sys.stderr)
     return dev
 
 
 @answers(None)
 def wb_motor_set_acceleration(tag: int, acceleration: float) -> None:
-    _physics(tag, "wb_motor_set_acceleration")._consts["acceleration"] = float(acceleration)
+    """A joint's motor: the bound of its speed ramp (>= 0, or -1: its available torque/force)."""
+    dev = _motor(tag, "wb_motor_set_acceleration")
+    if not _joint(dev):
+        _physics(tag, "wb_motor_set_acceleration")._consts["acceleration"] = float(acceleration)
+        return
+    value = _number(acceleration, "acceleration", "wb_motor_set_acceleration")
+    if value != value or (value < 0.0 and value != -1.0) or math.isinf(value):
+        print("Error: wb_motor_set_acceleration() called with negative 'acceleration' argument.", file=sys.stderr)
+        return
+    dev._consts["acceleration"] = value
+    current().set_motor_quantity(dev, "acceleration", value)
 
 
 @answers(_NAN)
 def wb_motor_get_acceleration(tag: int) -> float:
-    """-1 (unlimited, Webots' default) unless set."""
-    return float(_motor(tag, "wb_motor_get_acceleration")._consts.get("acceleration", -1.0))
+    """-1 (unlimited, Webots' default) unless set, or a joint motor's ``acceleration`` field."""
+    dev = _motor(tag, "wb_motor_get_acceleration")
+    return float(dev._consts.get("acceleration", _float(dev.desc.get("acceleration"), -1.0)))
+
+
+def _set_available(tag: int, value: float, func: str) -> None:
+    dev = _motor(tag, func)
+    if not _joint(dev):
+        _physics(tag, func)
+        return
+    number = _number(value, "torque" if "torque" in func else "force", func)
+    if number != number or number < 0.0 or math.isinf(number):
+        what = "torque" if "torque" in func else "force"
+        print(f"Error: {func}() called with negative '{what}' argument.", file=sys.stderr)
+        return
+    dev._consts["available"] = number          # (Webots clamps it to the maximum, with a warning)
+    current().set_motor_quantity(dev, "available_force", number)
+
+
+def _get_available(tag: int, func: str) -> float:
+    dev = _motor(tag, func)
+    if not _joint(dev):
+        _physics(tag, func)
+        return _NAN
+    return float(dev._consts.get("available", _float(dev.desc.get("maxForce"), _NAN)))
+
+
+def _get_max(tag: int, func: str) -> float:
+    dev = _motor(tag, func)
+    if not _joint(dev):
+        _physics(tag, func)
+        return _NAN
+    return _float(dev.desc.get("maxForce"), _NAN)
 
 
 @answers(None)
 def wb_motor_set_available_force(tag: int, force: float) -> None:
-    _physics(tag, "wb_motor_set_available_force")
+    _set_available(tag, force, "wb_motor_set_available_force")
 
 
 @answers(None)
 def wb_motor_set_available_torque(tag: int, torque: float) -> None:
-    _physics(tag, "wb_motor_set_available_torque")
+    _set_available(tag, torque, "wb_motor_set_available_torque")
 
 
 @answers(_NAN)
 def wb_motor_get_available_force(tag: int) -> float:
-    _physics(tag, "wb_motor_get_available_force")
-    return _NAN
+    return _get_available(tag, "wb_motor_get_available_force")
 
 
 @answers(_NAN)
 def wb_motor_get_available_torque(tag: int) -> float:
-    _physics(tag, "wb_motor_get_available_torque")
-    return _NAN
+    return _get_available(tag, "wb_motor_get_available_torque")
 
 
 @answers(_NAN)
 def wb_motor_get_max_force(tag: int) -> float:
-    _physics(tag, "wb_motor_get_max_force")
-    return _NAN
+    return _get_max(tag, "wb_motor_get_max_force")
 
 
 @answers(_NAN)
 def wb_motor_get_max_torque(tag: int) -> float:
-    _physics(tag, "wb_motor_get_max_torque")
-    return _NAN
+    return _get_max(tag, "wb_motor_get_max_torque")
 
 
 @answers(None)

@@ -519,8 +519,18 @@ class RobotClient:
         if math.isnan(position):
             print(f"Error: {func}() called with an invalid 'position' argument (NaN).", file=sys.stderr)
             return
+        lo, hi = _float(dev.desc.get("minPosition"), 0.0), _float(dev.desc.get("maxPosition"), 0.0)
+        if "maxForce" in dev.desc and lo != hi and not math.isinf(position) and not lo <= position <= hi:
+            # a joint's motor: Webots clamps the target to its limits with this warning (WbMotor);
+            # libController keeps the requested value as the target position, as here
+            print(f'WARNING: {dev.kind} "{dev.name}": too {"big" if position > hi else "low"} requested position: '
+                  f'{position:g} {">" if position > hi else "<"} {(hi if position > hi else lo):g}', file=sys.stderr)
         dev.target_position = position
         self.motor_commands.setdefault(dev.name, {})["position"] = position
+
+    def set_motor_quantity(self, dev: DeviceState, key: str, value: float) -> None:
+        """A joint motor's acceleration or available torque/force, sent with the next step."""
+        self.motor_commands.setdefault(dev.name, {})[key] = value
 
     def set_motor_velocity(self, dev: DeviceState, velocity: float, func: str) -> None:
         """Webots' ``setVelocity``: clamped to ``maxVelocity`` with Webots' warning; NaN, and a

@@ -551,15 +551,18 @@ def wb_supervisor_field_import_mf_node_from_string(field: Field | None, position
 # ---------------------------------------------------------------------- the simulation
 
 def wb_supervisor_simulation_reset() -> None:
-    """Robots and solids back to their initial poses, wheel motors to their initial commands,
+    """Robots and solids back to their initial poses, motors to their initial commands (joints to
+    their initial positions),
     top-level lights' fields as loaded, LEDs off, custom data as in the world file; the clock keeps
     running (see README)."""
     r = _supervisor("wb_supervisor_simulation_reset")
     if r is not None:
         _call(r, "simulation_reset")
         for dev in r.devices:                      # the server reset the motors' commands
-            if dev.kind == "RotationalMotor":
-                dev.target_position, dev.velocity = 0.0, dev.max_velocity
+            if dev.kind in ("RotationalMotor", "LinearMotor"):     # a joint's: back to its initial position
+                dev.target_position = float(dev.desc.get("initialPosition", 0.0))
+                dev.velocity = dev.max_velocity
+                dev._consts.pop("available", None)
             if dev.kind == "LED":
                 dev.value = 0
         r.motor_commands.clear()

@@ -256,12 +256,15 @@ register(DeviceKind(
     services=("draw",),
     topics=(TopicDecl("image", msgs.IMAGE, "image"),),
     description="DisplayDescription"))
-# A RotationalMotor is simulated when it is a differential drive's wheel (sim/motion.py owns it);
-# any other is listed, not simulated (schemas.world.RotationalMotor).
+# A RotationalMotor is a drive's wheel or steering motor (sim/motion.py owns it) or, any other, a
+# joint's motor moved kinematically (sim/joints.py); a LinearMotor is always a joint's.
+_MOTOR_SERVICES = ("set_position", "set_velocity", "get_velocity", "get_max_velocity", "get_target_position")
 register(DeviceKind(
     "RotationalMotor", wm.RotationalMotor, "sensorium.server.sim.motion:WheelMotor",
-    services=("set_position", "set_velocity", "get_velocity", "get_max_velocity", "get_target_position"),
-    description="MotorDescription", motor=True))
+    services=_MOTOR_SERVICES, description="MotorDescription", motor=True))
+register(DeviceKind(
+    "LinearMotor", wm.LinearMotor, "sensorium.server.sim.joints:JointMotor",
+    services=_MOTOR_SERVICES, description="JointMotorDescription", motor=True))
 
 # ---------------------------------------------------------------------- listed, not simulated (yet)
 

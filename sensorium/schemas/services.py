@@ -105,6 +105,24 @@ class MotorCommand(Args):
 
     position: float | None = Field(default=None, description="target position (rad); +inf/-inf = velocity control")
     velocity: float | None = Field(default=None, description="rad/s, finite; clamped to maxVelocity")
+    acceleration: float | None = Field(default=None, description="a joint motor's setAcceleration: >= 0, or -1 "
+                                                                 "(a drive's wheel ignores it)")
+    available_force: float | None = Field(default=None, description="a joint motor's setAvailableTorque/Force: >= 0, "
+                                                                    "clamped to its maximum (a drive's wheel ignores it)")
+
+    @field_validator("acceleration")
+    @classmethod
+    def _acceleration(cls, v: float | None) -> float | None:
+        if v is not None and not (v == -1.0 or 0.0 <= v < float("inf")):
+            raise ValueError("acceleration must be >= 0 and finite, or -1")
+        return v
+
+    @field_validator("available_force")
+    @classmethod
+    def _available(cls, v: float | None) -> float | None:
+        if v is not None and not 0.0 <= v < float("inf"):
+            raise ValueError("available torque/force must be >= 0 and finite")
+        return v
 
     @field_validator("position")
     @classmethod
@@ -422,12 +440,21 @@ class CameraDescription(_Entry):
 
 
 class MotorDescription(_Entry):
-    type: Literal["RotationalMotor"]
-    maxVelocity: float = Field(description="rad/s")
-    minPosition: float = Field(description="rad; minPosition = maxPosition = 0: no limits (Webots)")
+    type: Literal["RotationalMotor", "LinearMotor"]
+    maxVelocity: float = Field(description="rad/s (m/s for a LinearMotor)")
+    minPosition: float = Field(description="rad (m); minPosition = maxPosition = 0: no limits (Webots)")
     maxPosition: float
-    targetPosition: float = Field(description="rad, inf in velocity control (the motor's current command)")
-    velocity: float = Field(description="rad/s (the motor's current command)")
+    targetPosition: float = Field(description="rad (m), inf in velocity control (the motor's current command)")
+    velocity: float = Field(description="rad/s (m/s) (the motor's current command)")
+
+
+class JointMotorDescription(MotorDescription):
+    """A motor that is no drive's: its joint moves kinematically (Webots' rule without physics)."""
+
+    acceleration: float = Field(description="rad/s² (m/s²); -1: bounded by the available torque/force only")
+    maxForce: float = Field(description="maxTorque (N·m) of a RotationalMotor, maxForce (N) of a LinearMotor")
+    initialPosition: float = Field(description="the joint's position as loaded: where a simulation reset puts it "
+                                               "and its target")
 
 
 class PositionSensorDescription(_Entry):
@@ -540,6 +567,8 @@ class PenDescription(_Entry):
 def _description_tag(v: Any) -> str:
     get = v.get if isinstance(v, dict) else (lambda k, d=None: getattr(v, k, d))
     if get("simulated", True):
+        if get("maxForce") is not None:                # a joint's motor (a drive's wheel has no maxForce)
+            return "joint motor"
         return str(get("type", ""))
     return "unsimulated"
 
@@ -547,6 +576,7 @@ def _description_tag(v: Any) -> str:
 DeviceDescription = Annotated[
     Annotated[LightSensorDescription, Tag("LightSensor")] | Annotated[DistanceSensorDescription, Tag("DistanceSensor")]
     | Annotated[LidarDescription, Tag("Lidar")] | Annotated[MotorDescription, Tag("RotationalMotor")]
+    | Annotated[JointMotorDescription, Tag("joint motor")]
     | Annotated[PositionSensorDescription, Tag("PositionSensor")] | Annotated[LEDDescription, Tag("LED")]
     | Annotated[GPSDescription, Tag("GPS")] | Annotated[InertialUnitDescription, Tag("InertialUnit")]
     | Annotated[CompassDescription, Tag("Compass")] | Annotated[AccelerometerDescription, Tag("Accelerometer")]

@@ -517,13 +517,14 @@ class Lidar(_Device):
 
 
 class PositionSensor(_Device):
-    """A joint's encoder (Webots PositionSensor on the wheel's or steering HingeJoint): the angle, in
-    radians, of the drive's joint turned by ``motor``. ``pose`` is unused (kept for symmetry)."""
+    """A joint's encoder (Webots PositionSensor on a HingeJoint or SliderJoint): the position, in
+    radians (metres on a slider), of the joint turned by ``motor``: a drive's wheel or steering
+    motor, or a RotationalMotor/LinearMotor of the robot moved kinematically. ``pose`` is unused."""
 
     device: Literal["PositionSensor"]
     motor: str | None = Field(default=None, min_length=1,
-                              description="name of the drive's motor whose joint it measures; left out: a "
-                                          "sensor on a joint nothing turns here (present, not simulated)")
+                              description="name of the robot's motor whose joint it measures; left out: a "
+                                          "sensor on a joint nothing turns here (it reads 0)")
     noise: float = Field(default=0.0, ge=0.0, description="standard deviation of Gaussian noise (rad)")
     resolution: float = -1.0
 
@@ -798,13 +799,52 @@ class Receiver(_Radio):
     direction_noise: float = Field(default=0.0, ge=0.0, description="σ of each direction component, times the distance")
 
 
-class RotationalMotor(_Device):
-    """A drive motor in Webots' device order: an entry named like one of the robot's
-    ``differential_drive``/``ackermann_drive`` motors *is* that motor, at this index of the device list (a drive motor without an entry comes
-    after the listed devices). Any other RotationalMotor is present but not simulated (no joint moves
-    here). ``pose`` is unused."""
+class Motor(_Device):
+    """A Webots motor's fields (snake_case, Webots' defaults) and its joint's initial ``position``.
+
+    A motor that is not one of the robot's drive motors moves its joint kinematically, as Webots
+    does without physics (WbMotor's kinematic control, sim/joints.py): towards ``target`` at up to
+    ``max_velocity``, its speed changing by at most ``acceleration`` (or, -1, ``max_torque``/``max_force``)
+    per second; ``min_position`` = ``max_position`` = 0 means no limits. Only the joint's position
+    moves (its PositionSensor reads it): the shapes and devices past the joint stay where they are."""
+
+    max_velocity: float = Field(default=10.0, ge=0.0, description="rad/s (m/s for a LinearMotor)")
+    min_position: float = Field(default=0.0, description="rad (m); min = max = 0: no limits")
+    max_position: float = 0.0
+    acceleration: float = Field(default=-1.0, description="rad/s² (m/s²); -1: the available torque (force)")
+    position: float = Field(default=0.0, description="the joint's initial position (its jointParameters' "
+                                                     "position), where the motor starts and holds")
+
+    @model_validator(mode="after")
+    def _motor_limits(self) -> Motor:
+        if self.acceleration < 0.0 and self.acceleration != -1.0:
+            raise ValueError("acceleration must be >= 0, or -1 (limited by the available torque or force)")
+        if self.min_position > self.max_position:
+            raise ValueError(f"min_position {self.min_position} > max_position {self.max_position}")
+        if (self.min_position or self.max_position) and not self.min_position <= self.position <= self.max_position:
+            raise ValueError(f"position {self.position} outside [min_position, max_position] = "
+                             f"[{self.min_position}, {self.max_position}]")
+        return self
+
+
+class RotationalMotor(Motor):
+    """A RotationalMotor. An entry named like one of the robot's ``differential_drive``/``ackermann_drive``
+    motors *is* that drive motor, at this index of the device list (a drive motor without an entry
+    comes after the listed devices; the drive's own fields are used, not these). Any other is a
+    HingeJoint's motor moved kinematically (see the base class). ``pose`` is unused."""
 
     device: Literal["RotationalMotor"]
+    max_torque: float = Field(default=10.0, ge=0.0, description="N·m: the kinematic acceleration bound "
+                                                                "(acceleration -1, or above it)")
+
+
+class LinearMotor(Motor):
+    """A SliderJoint's LinearMotor, moved kinematically (see the base class); positions in metres.
+    ``pose`` is unused."""
+
+    device: Literal["LinearMotor"]
+    max_force: float = Field(default=10.0, ge=0.0, description="N: the kinematic acceleration bound "
+                                                               "(acceleration -1, or above it)")
 
 
 class Radar(_Device):
@@ -835,7 +875,7 @@ class Radar(_Device):
 
 
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Connector", "LinearMotor", "Microphone", "Radio", "Skin",
+    "Brake", "Connector", "Microphone", "Radio", "Skin",
     "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
@@ -868,13 +908,13 @@ class UnsimulatedDevice(_Device):
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
-                   | Accelerometer | Gyro | Altimeter | TouchSensor | Emitter | Receiver | RotationalMotor | Pen
-                   | RangeFinder | Camera | Radar | Display | UnsimulatedDevice,
+                   | Accelerometer | Gyro | Altimeter | TouchSensor | Emitter | Receiver | RotationalMotor | LinearMotor
+                   | Pen | RangeFinder | Camera | Radar | Display | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
-                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "Emitter", "Receiver", "RotationalMotor", "Pen",
-                "RangeFinder", "Camera", "Display", "Radar", *UNSIMULATED_DEVICE_TYPES)
+                "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "Emitter", "Receiver", "RotationalMotor",
+                "LinearMotor", "Pen", "RangeFinder", "Camera", "Display", "Radar", *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
 

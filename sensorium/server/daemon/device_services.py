@@ -11,11 +11,13 @@ from typing import TYPE_CHECKING, Any
 from sensorium.schemas.devices import KINDS
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.daemon.topics import Control, header, image_msg, point_cloud_msg
+from sensorium.server.sim.joints import JointMotor
 
 if TYPE_CHECKING:
     from sensorium.server.daemon.services import Call
 
 MOTOR = "RotationalMotor"
+MOTORS = (MOTOR, "LinearMotor")
 
 
 class ServiceError(Exception):
@@ -53,7 +55,7 @@ class DeviceServices:
         for e in self._device_entries(robot):            # type: ignore[attr-defined]
             if not e.simulated:
                 d: dict[str, Any] = {"name": e.name, "type": e.type, "simulated": False, **dict(e.fields)}
-            elif e.type == MOTOR:
+            elif e.type in MOTORS:
                 d = self._describe_motor(r.motors[e.name])
             else:
                 d = self._describe(self.topics.controls[f"{robot}/{e.name}"])
@@ -73,6 +75,12 @@ class DeviceServices:
 
     @staticmethod
     def _describe_motor(m: Any) -> dict:
+        if isinstance(m, JointMotor):                          # a joint moved kinematically
+            return {"name": m.name, "type": m.kind, "maxVelocity": float(m.max_velocity),
+                    "minPosition": float(m.min_position), "maxPosition": float(m.max_position),
+                    "targetPosition": float(m.target_position), "velocity": float(m.velocity),
+                    "acceleration": float(m.acceleration), "maxForce": float(m.max_force),
+                    "initialPosition": float(m.initial_position)}
         limit = float(getattr(m, "max_position", math.inf))      # a car's steering motor has limits
         limit = 0.0 if math.isinf(limit) else limit              # Webots: 0 and 0 mean none (a wheel)
         return {"name": m.name, "type": MOTOR, "maxVelocity": float(m.max_velocity), "minPosition": -limit if limit else 0.0,

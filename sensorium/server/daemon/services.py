@@ -43,6 +43,7 @@ from sensorium.server.daemon import roles, supervisor
 from sensorium.server.daemon.device_services import MOTOR, DeviceServices, ServiceError
 from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
 from sensorium.server.daemon.topics import Control, Topics, pose_quaternion
+from sensorium.server.sim.joints import JointMotor
 from sensorium.server.sim.simulation import DeviceEntry
 
 __all__ = ["Core", "ServiceError"]
@@ -664,6 +665,9 @@ class Core(DeviceServices):
     @staticmethod
     def _apply_motor_commands(commands: list[tuple[Any, Any]]) -> None:
         for motor, cmd in commands:
+            if isinstance(motor, JointMotor):         # (the client printed Webots' warnings)
+                motor.command(cmd.position, cmd.velocity, cmd.acceleration, cmd.available_force)
+                continue
             if cmd.position is not None:
                 motor.set_position(cmd.position)
             if cmd.velocity is not None:

@@ -325,6 +325,12 @@ class BatchedSimulation:
         if w.world_info.coordinate_system not in _TO_ENU:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
+        for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
+            drive = {m for _, m in r.drive_motors}
+            joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]
+            if joints:
+                raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: motor {joints[0]!r} moves a joint; the "
+                                   "batched simulation moves drive wheels only (use Simulation)")
         # pens lay no ink here: a world whose ink infra-red sensors or cameras would read is refused,
         # not run with readings that silently differ from the single simulation's
         pens = [(r.name, d.name) for r in w.robots for d in r.devices if d.device == "Pen" and d.write]

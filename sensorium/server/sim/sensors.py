@@ -516,11 +516,13 @@ def _rotate_columns(rotation: np.ndarray, columns: tuple[np.ndarray, np.ndarray,
 
 
 class PositionSensor(Device):
-    """A wheel encoder: the angle (rad) of the drive joint (a wheel, a car's steering) turned by ``config.motor``.
+    """A joint's encoder: the position (rad, or m on a slider) of the joint turned by ``config.motor``
+    (a drive's wheel or a car's steering, or a joint moved kinematically, sim/joints.py).
 
     Webots' timing (the first value one sampling period after ``enable``, NaN before), then
-    Gaussian ``noise`` (rad) and ``resolution`` as Webots applies them. The simulation binds
-    :attr:`wheel` to the drive's :class:`~sensorium.server.sim.motion.WheelMotor`.
+    Gaussian ``noise`` and ``resolution`` as Webots applies them. The simulation binds :attr:`wheel`
+    to the robot's motor (:class:`~sensorium.server.sim.motion.WheelMotor` or
+    :class:`~sensorium.server.sim.joints.JointMotor`).
     """
 
     kinematic = True

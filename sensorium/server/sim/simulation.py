@@ -17,7 +17,7 @@ from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -27,6 +27,7 @@ from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.ground import Ground, GroundWarning, band_low
+from sensorium.server.sim.joints import JointMotor
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radar import Radar
@@ -79,10 +80,11 @@ class DeviceEntry:
 _ENTRY_FIELDS = {"device", "name", "model", "pose"}
 
 
-def device_entries(model: wm.Robot, devices: dict[str, Device], motors: dict[str, WheelMotor]) -> list[DeviceEntry]:
+def device_entries(model: wm.Robot, devices: dict[str, Device],
+                   motors: dict[str, WheelMotor | JointMotor]) -> list[DeviceEntry]:
     out: list[DeviceEntry] = []
     for d in model.devices:
-        simulated = d.name in (motors if d.device == "RotationalMotor" else devices)
+        simulated = d.name in (motors if isinstance(d, wm.Motor) else devices)
         own = (tuple((k, getattr(d, k)) for k in type(d).model_fields if k not in _ENTRY_FIELDS)
                if d.device in wm.LISTED_WITH_FIELDS else ())
         out.append(DeviceEntry(len(out), d.device, d.name, getattr(d, "model", "") or "", simulated, own))
@@ -91,6 +93,13 @@ def device_entries(model: wm.Robot, devices: dict[str, Device], motors: dict[str
         if name not in listed:
             out.append(DeviceEntry(len(out), "RotationalMotor", name, "", True))
     return out
+
+
+def joint_motor(d: wm.RotationalMotor | wm.LinearMotor) -> JointMotor:
+    """The kinematic joint a motor entry that is no drive motor moves."""
+    force = d.max_torque if isinstance(d, wm.RotationalMotor) else d.max_force
+    return JointMotor(d.name, d.device, d.max_velocity, d.min_position, d.max_position, d.acceleration, force,
+                      d.position)
 
 
 class RobotState:
@@ -123,7 +132,12 @@ class RobotState:
                                         band_low=low)
         if self.drive is not None and self.drive.slope is not None:   # placed on a slope: its attitude
             sim.scene.set_robot_pose(index, self.drive.pose())
-        self.motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
+        drive_motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
+        # every other motor moves its joint kinematically (sim/joints.py), in device-list order
+        self.joints: dict[str, JointMotor] = {d.name: joint_motor(d) for d in model.devices
+                                              if isinstance(d, wm.Motor) and d.name not in drive_motors}
+        self.motors: dict[str, WheelMotor | JointMotor] = (
+            {**drive_motors, **self.joints} if self.joints else cast("dict[str, WheelMotor | JointMotor]", drive_motors))
         for dev in self.devices.values():
             dev.bind(self)
         self.device_list = device_entries(model, self.devices, self.motors)
@@ -163,7 +177,7 @@ class RobotState:
             pose = self.drive.placed(pose)
         self._sim.place_robot(self, pose)
 
-    def motor(self, name: str) -> WheelMotor:
+    def motor(self, name: str) -> WheelMotor | JointMotor:
         try:
             return self.motors[name]
         except KeyError:
@@ -212,6 +226,7 @@ class Simulation:
         self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
+        self._jointed = [j for r in self.robots.values() for j in r.joints.values()]
         if self.ground is not None:
             self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
@@ -272,7 +287,7 @@ class Simulation:
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
-        motors to their initial commands and angles, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
+        motors to their initial commands and angles, joints to their initial positions, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
         ``write`` and ink, as Webots' WbPen::reset), custom data and radar cross sections as in the world file, GPS and Radar speeds
         NaN at their next value (no previous position, as Webots' WbGps::reset and WbRadar::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
@@ -284,6 +299,8 @@ class Simulation:
                     m.target_position, m.velocity, m.position = 0.0, m.max_velocity, 0.0
                 robot.drive.reset(pose)
                 pose = robot.drive.placed(pose)
+            for joint in robot.joints.values():
+                joint.reset()
             self.place_robot(robot, pose)
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
@@ -461,6 +478,10 @@ class Simulation:
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
         moved: list[tuple[RobotState, DifferentialDrive | AckermannDrive, tuple[float, float], Pose]] = []
+        if self._jointed:             # joints move kinematically (sim/joints.py); nothing past them moves
+            dt_s = dt * 0.001
+            for joint in self._jointed:
+                joint.advance(dt_s)
         for robot in self._driven:
             drive = robot.drive
             assert drive is not None

@@ -463,13 +463,21 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                             f"{dp}.lookup_table[{k}]",
                             f"lookup table inputs must be strictly increasing: input {table[k][0]} "
                             f"follows {table[k - 1][0]}"))
+            if isinstance(dev, wm.RotationalMotor) and dev.name in {m for _, m in robot.drive_motors}:
+                joint = sorted(dev.model_fields_set & set(wm.Motor.model_fields) - set(wm._Device.model_fields)
+                               | (dev.model_fields_set & {"max_torque"}))
+                if joint:
+                    problems.append(Problem(f"{dp}.{joint[0]}", f"{dev.name!r} is a motor of the robot's drive, which "
+                                                                "sets its speed and limits: leave out "
+                                                                + ", ".join(joint)))
             if isinstance(dev, wm.PositionSensor) and dev.motor is not None:
-                motors = tuple(m for _, m in robot.drive_motors)
+                # a drive's motor, or a RotationalMotor/LinearMotor entry (a joint moved kinematically)
+                motors = tuple(dict.fromkeys([*(m for _, m in robot.drive_motors),
+                                              *(d.name for d in robot.devices if isinstance(d, wm.Motor))]))
                 if dev.motor not in motors:
-                    kind = ("ackermann_drive" if robot.ackermann_drive is not None else "differential_drive")
                     problems.append(Problem(
-                        f"{dp}.motor", f"{dev.motor!r} is not a motor of this robot's {kind} "
-                                       f"(motors: {', '.join(repr(m) for m in motors) or 'none: no drive'})"))
+                        f"{dp}.motor", f"{dev.motor!r} is not a motor of this robot "
+                                       f"(motors: {', '.join(repr(m) for m in motors) or 'none'})"))
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
     problems += _check_meshes_and_work(world, base_dir, limits or WorldLimits(), allow_outside_meshes, asset_files)

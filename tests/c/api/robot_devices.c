@@ -47,12 +47,13 @@ int main(void) {
   ts_assert_int_equal(wb_radar_get_number_of_targets(radar), 0, "no radar target");
   ts_assert_pointer_null(wb_radar_get_targets(radar), "no radar targets array");
   ts_assert_double_equal(wb_radar_get_max_range(radar), 50.0, "radar range: the world's");
-  /* listed only: Webots' "no value" */
+  /* the display draws (its size the world's); the linear motor moves its slider */
   wb_display_draw_text(display, "hello", 0, 0);
   ts_assert_int_equal(wb_display_get_width(display), 64, "display width: the world's (Webots' default)");
   wb_motor_set_velocity(lift, 1.0);
   ts_assert_int_equal(wb_motor_get_type(lift), WB_LINEAR, "a linear motor's type");
-  ts_assert_double_equal(wb_motor_get_velocity(lift), NAN, "linear motor velocity: no value");
+  ts_assert_double_equal(wb_motor_get_velocity(lift), 1.0, "a linear motor moves its slider: its velocity");
+  ts_assert_double_equal(wb_motor_get_max_force(lift), 10.0, "a linear motor's maxForce: Webots' default");
   /* the simulated LED */
   WbDeviceTag led = wb_robot_get_device("led");
   wb_led_set(led, 1);

@@ -174,7 +174,11 @@ typedef struct {
   long queue_bytes;
   /* motor */
   double max_velocity, min_position, max_position, target_position, velocity, acceleration;
-  bool cmd_position, cmd_velocity; /* to send with the next step */
+  bool joint;                        /* no drive's motor: its joint moves kinematically (maxForce known) */
+  double max_force, available_force; /* a joint motor's maxTorque/maxForce and setAvailableTorque/Force */
+  double initial_position;           /* where a simulation reset puts a joint (0 for a wheel) */
+  bool cmd_position, cmd_velocity;   /* to send with the next step */
+  bool cmd_acceleration, cmd_available;
   bool warned_physics;             /* a physics-only motor function was called (one warning) */
   int force_feedback_period, torque_feedback_period;
   /* Radar (radar.c): the latest targets (NULL before the first value, and when there are none);

@@ -19,6 +19,16 @@ void wb_motor_set_position(WbDeviceTag tag, double position) {
     fprintf(stderr, "Error: wb_motor_set_position() called with an invalid 'position' argument (NaN)\n");
     return;
   }
+  if (d->joint && d->min_position != d->max_position && !isinf(position)) {
+    /* a joint's motor: Webots clamps the target to its limits with this warning (WbMotor); the
+     * target position answered stays the one requested, as libController's */
+    if (position > d->max_position)
+      fprintf(stderr, "WARNING: %s \"%s\": too big requested position: %g > %g\n", d->type_name, d->name, position,
+              d->max_position);
+    else if (position < d->min_position)
+      fprintf(stderr, "WARNING: %s \"%s\": too low requested position: %g < %g\n", d->type_name, d->name, position,
+              d->min_position);
+  }
   d->target_position = position;
   d->cmd_position = true;
 }
@@ -104,48 +114,89 @@ WbDeviceTag wb_motor_get_brake(WbDeviceTag tag) {
 
 /* ------------------------------------------------------------------ what needs physics */
 
+/* A drive's wheel turns at its commanded speed at once: these are accepted and ignored. A joint's
+ * motor (maxForce in its description) moves as Webots moves it without physics: its acceleration
+ * and available torque/force bound the speed ramp (sent with the next step); PID gains, forces
+ * and torques are ignored and feedback reads NaN (Webots has none without a Physics node). */
 static sn_device *physics(WbDeviceTag tag, const char *func) {
   sn_device *d = sn_device_get(tag, SN_MOTOR, func);
   if (d != NULL && !d->warned_physics) {
     d->warned_physics = true;
-    fprintf(stderr, "Warning: %s(): %s '%s' is a kinematic wheel: accelerations, forces, torques and PID gains are "
-            "ignored, force and torque feedback read NaN.\n", func, d->type_name, d->name);
+    if (d->joint)
+      fprintf(stderr, "Warning: %s(): %s '%s' moves its joint kinematically (no physics): PID gains, forces and "
+              "torques are ignored, force and torque feedback read NaN.\n", func, d->type_name, d->name);
+    else
+      fprintf(stderr, "Warning: %s(): %s '%s' is a kinematic wheel: accelerations, forces, torques and PID gains "
+              "are ignored, force and torque feedback read NaN.\n", func, d->type_name, d->name);
+  }
+  return d;
+}
+
+static sn_device *joint_or_physics(WbDeviceTag tag, const char *func) {
+  sn_device *d = sn_device_get(tag, SN_MOTOR, func);
+  if (d != NULL && !d->joint) {
+    physics(tag, func);
+    return NULL;
   }
   return d;
 }
 
 void wb_motor_set_acceleration(WbDeviceTag tag, double acceleration) {
-  sn_device *d = physics(tag, "wb_motor_set_acceleration");
-  if (d != NULL)
+  sn_device *d = sn_device_get(tag, SN_MOTOR, "wb_motor_set_acceleration");
+  if (d == NULL)
+    return;
+  if (!d->joint) {
+    physics(tag, "wb_motor_set_acceleration");
     d->acceleration = acceleration;
+    return;
+  }
+  if (isnan(acceleration) || isinf(acceleration) || (acceleration < 0.0 && acceleration != -1.0)) {
+    fprintf(stderr, "Error: wb_motor_set_acceleration() called with negative 'acceleration' argument.\n");
+    return;
+  }
+  d->acceleration = acceleration;
+  d->cmd_acceleration = true;
+}
+
+static void set_available(WbDeviceTag tag, double value, const char *what, const char *func) {
+  sn_device *d = joint_or_physics(tag, func);
+  if (d == NULL)
+    return;
+  if (isnan(value) || isinf(value) || value < 0.0) {
+    fprintf(stderr, "Error: %s() called with negative '%s' argument.\n", func, what);
+    return;
+  }
+  d->available_force = value;
+  d->cmd_available = true;
+}
+
+static double get_joint(WbDeviceTag tag, bool available, const char *func) {
+  sn_device *d = joint_or_physics(tag, func);
+  if (d == NULL)
+    return NAN;
+  return available ? d->available_force : d->max_force;
 }
 double wb_motor_get_acceleration(WbDeviceTag tag) {
   MOTOR("wb_motor_get_acceleration");
   return d ? d->acceleration : NAN;
 }
 void wb_motor_set_available_force(WbDeviceTag tag, double force) {
-  (void)force;
-  physics(tag, "wb_motor_set_available_force");
+  set_available(tag, force, "force", "wb_motor_set_available_force");
 }
 double wb_motor_get_available_force(WbDeviceTag tag) {
-  physics(tag, "wb_motor_get_available_force");
-  return NAN;
+  return get_joint(tag, true, "wb_motor_get_available_force");
 }
 double wb_motor_get_max_force(WbDeviceTag tag) {
-  physics(tag, "wb_motor_get_max_force");
-  return NAN;
+  return get_joint(tag, false, "wb_motor_get_max_force");
 }
 void wb_motor_set_available_torque(WbDeviceTag tag, double torque) {
-  (void)torque;
-  physics(tag, "wb_motor_set_available_torque");
+  set_available(tag, torque, "torque", "wb_motor_set_available_torque");
 }
 double wb_motor_get_available_torque(WbDeviceTag tag) {
-  physics(tag, "wb_motor_get_available_torque");
-  return NAN;
+  return get_joint(tag, true, "wb_motor_get_available_torque");
 }
 double wb_motor_get_max_torque(WbDeviceTag tag) {
-  physics(tag, "wb_motor_get_max_torque");
-  return NAN;
+  return get_joint(tag, false, "wb_motor_get_max_torque");
 }
 void wb_motor_set_control_pid(WbDeviceTag tag, double p, double i, double d) {
   (void)p;

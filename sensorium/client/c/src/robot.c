@@ -51,7 +51,7 @@ static sn_kind kind_of(const char *type) {
     return SN_DISTANCE;
   if (strcmp(type, "Lidar") == 0)
     return SN_LIDAR;
-  if (strcmp(type, "RotationalMotor") == 0)
+  if (strcmp(type, "RotationalMotor") == 0 || strcmp(type, "LinearMotor") == 0)
     return SN_MOTOR;
   if (strcmp(type, "PositionSensor") == 0)
     return SN_POSITION;
@@ -198,7 +198,11 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
   d->max_position = sn_double_or(desc, "maxPosition", 0.0);
   d->target_position = sn_double_or(desc, "targetPosition", 0.0);
   d->velocity = sn_double_or(desc, "velocity", d->max_velocity);
-  d->acceleration = -1.0; /* Webots' default: unlimited */
+  d->acceleration = sn_double_or(desc, "acceleration", -1.0); /* Webots' default: unlimited */
+  d->joint = sn_get(desc, "maxForce") != NULL;
+  d->max_force = sn_double_or(desc, "maxForce", NAN);
+  d->available_force = d->max_force;
+  d->initial_position = sn_double_or(desc, "initialPosition", 0.0);
   return 0;
 }
 
@@ -508,7 +512,8 @@ int wb_robot_step_begin(int duration) {
   }
   int motors = 0, emitters = 0;
   for (int i = 0; i < rb->n_devices; i++) {
-    motors += rb->devices[i].kind == SN_MOTOR && (rb->devices[i].cmd_position || rb->devices[i].cmd_velocity);
+    motors += rb->devices[i].kind == SN_MOTOR && (rb->devices[i].cmd_position || rb->devices[i].cmd_velocity ||
+                                                  rb->devices[i].cmd_acceleration || rb->devices[i].cmd_available);
     if (rb->devices[i].kind == SN_EMITTER)
       emitters += sn_radio_pace(&rb->devices[i], duration) > 0; /* what the baud rate lets leave now */
   }
@@ -534,10 +539,11 @@ int wb_robot_step_begin(int duration) {
     msgpack_pack_map(&r.pk, (size_t)motors);
     for (int i = 0; i < rb->n_devices; i++) {
       sn_device *d = &rb->devices[i];
-      if (d->kind != SN_MOTOR || !(d->cmd_position || d->cmd_velocity))
+      if (d->kind != SN_MOTOR || !(d->cmd_position || d->cmd_velocity || d->cmd_acceleration || d->cmd_available))
         continue;
       sn_req_str(&r, d->name);
-      msgpack_pack_map(&r.pk, (size_t)d->cmd_position + (size_t)d->cmd_velocity);
+      msgpack_pack_map(&r.pk, (size_t)d->cmd_position + (size_t)d->cmd_velocity + (size_t)d->cmd_acceleration +
+                                  (size_t)d->cmd_available);
       if (d->cmd_position) {
         sn_req_key(&r, "position");
         msgpack_pack_double(&r.pk, d->target_position);
@@ -546,7 +552,15 @@ int wb_robot_step_begin(int duration) {
         sn_req_key(&r, "velocity");
         msgpack_pack_double(&r.pk, d->velocity);
       }
-      d->cmd_position = d->cmd_velocity = false;
+      if (d->cmd_acceleration) {
+        sn_req_key(&r, "acceleration");
+        msgpack_pack_double(&r.pk, d->acceleration);
+      }
+      if (d->cmd_available) {
+        sn_req_key(&r, "available_force");
+        msgpack_pack_double(&r.pk, d->available_force);
+      }
+      d->cmd_position = d->cmd_velocity = d->cmd_acceleration = d->cmd_available = false;
     }
   }
   int rc = sn_conn_send_retried(rb->conn, &r, id);

@@ -806,10 +806,11 @@ void wb_supervisor_simulation_reset(void) {
   sn_reply_free(&rep);
   for (int i = 0; i < rb->n_devices; i++) { /* the server reset the motors' commands and the LEDs */
     sn_device *d = &rb->devices[i];
-    if (d->kind == SN_MOTOR) {
-      d->target_position = 0.0;
+    if (d->kind == SN_MOTOR) { /* a joint's: back to its initial position, its full torque/force */
+      d->target_position = d->initial_position;
       d->velocity = d->max_velocity;
-      d->cmd_position = d->cmd_velocity = false;
+      d->available_force = d->max_force;
+      d->cmd_position = d->cmd_velocity = d->cmd_acceleration = d->cmd_available = false;
     } else if (d->kind == SN_LED)
       d->led_value = 0;
   }

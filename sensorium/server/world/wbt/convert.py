@@ -62,6 +62,10 @@ LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder", "Camera"}
 JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
 MOTORS = {"RotationalMotor", "LinearMotor"}
+OTHER_MOTOR_NAMES = {"RotationalMotor": "rotational motor", "LinearMotor": "linear motor"}
+JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "max_torque", "position")
+JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), the "
+               "shapes and devices past the joint stay where they are")
 # the fields every Solid has (a device's own fields are the others)
 SOLID_FIELDS = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
                 "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection",
@@ -368,8 +372,8 @@ class Converter:
                         self.skipped["Track.animatedGeometry"] += 1
                     motors, sensors = self.joint_devices(node, owner)
                     if motors or sensors or f.nodes("device"):
-                        self.warn(node, f"Track {f.string('name', 'solid')!r}: its devices are listed, not simulated "
-                                        "(tracks do not move here)")
+                        self.warn(node, f"Track {f.string('name', 'solid')!r}: its motor's position moves "
+                                        "kinematically (its sensor reads it); the belt and its wheels do not move here")
                 self.device_contents(node, inner, owner, data)
             else:     # a device outside a robot is still a Solid whose shapes rays see
                 self.warn(node, f"{t} outside a Robot: not a device here (devices belong to robots); its shapes "
@@ -382,8 +386,8 @@ class Converter:
             if owner.kind == "robot":
                 self.joint_devices(node, owner)
                 if f.node_("device") is not None:
-                    self.warn(node, "Propeller: its motor is listed, its thrust and torque are not simulated (joints "
-                                    "do not move here)")
+                    self.warn(node, "Propeller: its motor's position moves kinematically; its thrust and torque "
+                                    "are not simulated")
             helix = f.node_("slowHelix")     # what Webots shows below fastHelixThreshold (at rest)
             if helix is not None:
                 self.visit(helix, frame, owner)
@@ -915,13 +919,8 @@ class Converter:
     def unique_devices(self, robot: dict) -> None:
         """Device names address topics and services, so a repeated one gets a suffix (Webots warns
         and its getDevice returns the first); the wheel motors' names count too."""
-        drive = robot.get("differential_drive") or {}
         listed = {d["name"] for d in robot["devices"] if d["device"] == "RotationalMotor"}
-        skid = drive.get("skid_steer") or {}
-        motors = [v for k, v in drive.items() if k in ("left_motor", "right_motor")] + [
-            *skid.get("left", ()), *skid.get("right", ())]
-        motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
-        seen: Counter[str] = Counter(v for v in motors if v not in listed)
+        seen: Counter[str] = Counter(v for v in drive_motor_names(robot) if v not in listed)
         for dev in robot["devices"]:
             name = dev["name"]
             seen[name] += 1
@@ -1018,14 +1017,19 @@ class Converter:
 
     def joint_devices(self, node: Node, owner: Owner, field_name: str = "device") -> tuple[list[dict], list[dict]]:
         """A joint's devices in its ``device`` (or a Hinge2Joint's ``device2``) order (Webots lists
-        them before the end point's): (motor entries, position sensor entries)."""
+        them before the end point's): (motor entries, position sensor entries). A motor's entry
+        carries its fields and the joint's position (a drive keeps only its wheels' names, see
+        :meth:`drive`); the joint's sensors measure its motor."""
         motors, sensors = [], []
+        params = self.fields(node).node_("jointParameters2" if field_name == "device2" else "jointParameters") \
+            if node.type.endswith("Joint") else None
+        position = self.fields(params).num("position", 0.0) if params is not None else 0.0
         for d in self.fields(node).nodes(field_name):
             self.walk(d)
             self.tick(d)
-            if d.type == "RotationalMotor":
-                entry = {"name": self.fields(d).string("name", "rotational motor"), "device": "RotationalMotor",
-                         "_at": self.at(d)}
+            if d.type in MOTORS:
+                entry = {"name": self.fields(d).string("name", OTHER_MOTOR_NAMES[d.type]), "device": d.type,
+                         **self.motor_fields(d, position), "_at": self.at(d)}
                 owner.data["devices"].append(entry)
                 motors.append(entry)
             elif d.type == "PositionSensor":
@@ -1034,11 +1038,39 @@ class Converter:
                          "noise": sf.num("noise", 0.0), "resolution": sf.num("resolution", -1.0), "_at": self.at(d)}
                 owner.data["devices"].append(entry)
                 sensors.append(entry)
-            elif d.type in ("LinearMotor", "Brake"):
+            elif d.type == "Brake":
                 self.unsimulated(d, Frame.identity(), owner)
             else:
                 self.warn(d, f"{d.type} in a joint's device list: ignored")
+        if motors:
+            for entry in sensors:
+                entry["motor"] = motors[0]["name"]
         return motors, sensors
+
+    def motor_fields(self, d: Node, position: float) -> dict[str, float]:
+        """A motor's fields that differ from Webots' defaults, in the world file's names, with the
+        resets WbMotor applies (a negative maxVelocity made positive, a negative acceleration other
+        than -1 made -1, a negative maxTorque/maxForce 10, limits widened to the joint's position)."""
+        f = self.fields(d)
+        velocity = f.num("maxVelocity", 10.0)
+        if velocity < 0:
+            velocity = f.used("maxVelocity", velocity, -velocity, "is negative")
+        acceleration = f.num("acceleration", -1.0)
+        if acceleration < 0 and acceleration != -1:
+            acceleration = f.used("acceleration", acceleration, -1.0, "is negative")
+        force_field = "maxTorque" if d.type == "RotationalMotor" else "maxForce"
+        force = f.non_negative(force_field, 10.0, 10.0)
+        lo, hi = f.num("minPosition", 0.0), f.num("maxPosition", 0.0)
+        if lo or hi:                 # limited: they hold the joint's position (enforceMotorLimitsInsideJointLimits)
+            if hi < position:
+                hi = f.used("maxPosition", hi, position, "is below the joint's position")
+            if lo > position:
+                lo = f.used("minPosition", lo, position, "is above the joint's position")
+        out = {"max_velocity": velocity, "min_position": lo, "max_position": hi, "acceleration": acceleration,
+               "max_torque" if d.type == "RotationalMotor" else "max_force": force, "position": position}
+        defaults = {"max_velocity": 10.0, "min_position": 0.0, "max_position": 0.0, "acceleration": -1.0,
+                    "max_torque": 10.0, "max_force": 10.0, "position": 0.0}
+        return {k: v for k, v in out.items() if v != defaults[k]}
 
     def joint(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
@@ -1071,12 +1103,14 @@ class Converter:
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
-        elif motors and (node.type != "Hinge2Joint" or not wheeled):
-            self.warn(node, f"{node.type} motor(s) not part of a wheel{' (inside a device)' if owner.kind == 'robot' and not wheeled else ''}: "
-                            "listed, not simulated (joints do not move here)")
+        elif motors and (node.type != "Hinge2Joint" or not wheeled) and owner.kind == "robot":
+            self.warn(node, f"{node.type} motor(s) not part of a wheel{'' if wheeled else ' (inside a device)'}: "
+                            f"{JOINT_MOVES}")
+        elif motors:
+            self.warn(node, f"{node.type} motor(s) outside a robot: not simulated")
         # (a robot's Hinge2Joint: hinge2() said which of its axes has sensors but no motor)
-        if sensors and not (wheeled and (node.type == "Hinge2Joint" or (node.type == "HingeJoint" and motors))):
-            self.warn(node, "PositionSensor on a joint without a drive wheel motor: listed, reads no value")
+        if sensors and not motors and node.type != "Hinge2Joint":
+            self.warn(node, "PositionSensor on a joint without a motor: reads 0 (nothing turns the joint here)")
         if end is not None:
             if end.type == "SolidReference":
                 return
@@ -1145,8 +1179,7 @@ class Converter:
                     for w in wheels:
                         if not any(w is r for r in rolling):
                             self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel (its end point has no "
-                                                 "cylinder or sphere to roll on): listed, not simulated (joints do "
-                                                 "not move here)")
+                                                 f"cylinder or sphere to roll on): {JOINT_MOVES}")
                     wheels = rolling
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
@@ -1155,6 +1188,21 @@ class Converter:
         for w in wheels:    # the wheels' encoders measure the drive's wheels
             for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]
+        drive_motors = set(drive_motor_names(robot.data))
+        for entry in robot.data["devices"]:     # a drive's motor is the drive's: its joint fields are not used
+            if entry["device"] == "RotationalMotor" and entry["name"] in drive_motors:
+                for key in JOINT_KEYS:
+                    entry.pop(key, None)
+
+
+def drive_motor_names(robot: dict) -> list[str]:
+    """The motor names a converted robot's drive uses (a car's non-driven wheels have none)."""
+    drive = robot.get("differential_drive") or {}
+    skid = drive.get("skid_steer") or {}
+    motors = [v for k, v in drive.items() if k in ("left_motor", "right_motor")] + [
+        *skid.get("left", ()), *skid.get("right", ())]
+    motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
+    return [m for m in motors if isinstance(m, str)]
 
 
 def _limits(motor) -> tuple[float, float]:

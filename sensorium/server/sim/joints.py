@@ -1,0 +1,152 @@
+"""Joints moved by their motors without physics: Webots' kinematic motor control.
+
+A RotationalMotor (HingeJoint) or LinearMotor (SliderJoint) that is not part of a robot's drive
+moves its joint's position the way Webots moves it when the end point has no physics (WbMotor's
+kinematic control, run once per basic step):
+
+* nothing happens in position control once the joint is within 1e-6 of the target, nor in velocity
+  control (target ±inf) at a position limit it is pushing against; the speed drops to 0 then;
+* otherwise the speed moves towards the commanded velocity by at most ``a·dt`` (``a``: the motor's
+  ``acceleration``, or its available torque/force when that is -1 or larger), then the position
+  moves by ``speed·dt`` towards the target (up for +inf), never past a finite target.
+
+Only the position moves: the shapes and devices past the joint stay where the world put them.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+
+_POSITION_THRESHOLD = 1e-6       # Webots' TARGET_POSITION_THRESHOLD
+_VELOCITY_THRESHOLD = 1e-6       # Webots' TARGET_VELOCITY_THRESHOLD
+
+
+def position_warning(kind: str, name: str, target: float, lo: float, hi: float) -> str | None:
+    """WbMotor's warning for a target beyond the motor's limits (None within them)."""
+    if target > hi:
+        return f'WARNING: {kind} "{name}": too big requested position: {target:g} > {hi:g}'
+    if target < lo:
+        return f'WARNING: {kind} "{name}": too low requested position: {target:g} < {lo:g}'
+    return None
+
+
+@dataclass(slots=True)
+class JointMotor:
+    """A joint's motor as a controller commands it (``setPosition``, ``setVelocity``,
+    ``setAcceleration``, ``setAvailableTorque``/``Force``) and the joint position it moves.
+
+    The interface the drives' :class:`~sensorium.server.sim.motion.WheelMotor` has (``position``,
+    ``target_position``, ``velocity``, ``max_velocity``, ``set_position``, ``command_velocity``,
+    ``hold``), so the services, step commands and encoders treat both alike."""
+
+    name: str
+    kind: str                            # "RotationalMotor" or "LinearMotor"
+    max_velocity: float
+    min_position: float = 0.0
+    max_position: float = 0.0            # min = max = 0: no limits (Webots)
+    acceleration: float = -1.0           # -1: bounded by the available torque/force only
+    max_force: float = 10.0              # maxTorque (rotational) or maxForce (linear)
+    initial_position: float = 0.0
+    position: float = math.nan           # the joint's position (rad or m)
+    target_position: float = math.nan
+    velocity: float = math.nan           # the commanded velocity (Webots' target velocity)
+    speed: float = 0.0                   # the current velocity (Webots' mCurrentVelocity)
+    available_force: float = math.nan
+
+    def __post_init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """As loaded: at the joint's initial position, holding it at maxVelocity (WbMotor::reset)."""
+        self.position = self.initial_position
+        self.target_position = self.initial_position
+        self.velocity = self.max_velocity
+        self.speed = 0.0
+        self.available_force = self.max_force
+
+    @property
+    def limited(self) -> bool:
+        return self.min_position != self.max_position
+
+    def hold(self) -> None:
+        """Stop where the joint is (position control at its current position)."""
+        self.target_position = self.position
+
+    def set_position(self, value: float, warn: bool = True) -> None:
+        """Webots' setTargetPosition: a finite target beyond the limits is clamped to them, with
+        Webots' warning on stderr (``warn``); ±inf selects velocity control."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
+            raise ValueError(f"motor {self.name!r}: position must be a number or inf, got {value!r}")
+        target = float(value)
+        if self.limited and not math.isinf(target):
+            line = position_warning(self.kind, self.name, target, self.min_position, self.max_position)
+            if line is not None:
+                if warn:
+                    print(line, file=sys.stderr)
+                target = min(max(target, self.min_position), self.max_position)
+        self.target_position = target
+
+    def command(self, position: float | None, velocity: float | None, acceleration: float | None,
+                available_force: float | None) -> None:
+        """A controller step's commands (checked by the request's schema; the client printed
+        Webots' warnings): applied in libController's order, without printing."""
+        if position is not None:
+            self.set_position(position, warn=False)
+        if velocity is not None:
+            self.command_velocity(velocity)
+        if acceleration is not None:
+            self.set_acceleration(acceleration)
+        if available_force is not None:
+            self.set_available_force(available_force)
+
+    def set_velocity(self, value: float) -> None:
+        """In-process ``setVelocity``: NaN raises; beyond ``maxVelocity`` it is clamped."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
+            raise ValueError(f"motor {self.name!r}: velocity must be a number, got {value!r}")
+        self.command_velocity(value)
+
+    def command_velocity(self, value: float) -> None:
+        """A velocity a controller's step sends: clamped to ``±maxVelocity`` (WbMotor::setVelocity)."""
+        self.velocity = float(min(max(value, -self.max_velocity), self.max_velocity))
+
+    def set_acceleration(self, value: float) -> None:
+        """``setAcceleration``: >= 0, or -1 (bounded by the available torque/force only)."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value >= 0.0 or value == -1.0) \
+                or math.isinf(value):
+            raise ValueError(f"motor {self.name!r}: acceleration must be >= 0 and finite, or -1, got {value!r}")
+        self.acceleration = float(value)
+
+    def set_available_force(self, value: float) -> None:
+        """``setAvailableTorque``/``Force``: >= 0, at most ``maxTorque``/``maxForce`` (clamped to it)."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0.0:
+            raise ValueError(f"motor {self.name!r}: available torque/force must be >= 0, got {value!r}")
+        self.available_force = float(min(value, self.max_force))
+
+    def advance(self, dt_s: float) -> None:
+        """One basic step of Webots' kinematic control (WbMotor::runKinematicControl)."""
+        target = self.target_position
+        position = self.position
+        if math.isinf(target):
+            lo, hi = self.min_position, self.max_position
+            idle = lo != hi and ((position >= hi and self.velocity >= 0.0) or (position <= lo and self.velocity <= 0.0))
+        else:
+            idle = abs(target - position) < _POSITION_THRESHOLD
+        if idle:
+            self.speed = 0.0
+            return
+        acc = self.acceleration
+        if acc == -1.0 or acc > self.available_force:
+            acc = self.available_force
+        speed = self.speed
+        wanted = self.velocity
+        if abs(wanted - speed) > _VELOCITY_THRESHOLD:
+            speed = min(speed + acc * dt_s, wanted) if wanted > speed else max(speed - acc * dt_s, wanted)
+        self.speed = speed
+        if target > position:
+            position += speed * dt_s
+            self.position = min(position, target)
+        else:
+            position -= speed * dt_s
+            self.position = max(position, target)
