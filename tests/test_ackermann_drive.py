@@ -167,7 +167,8 @@ def test_world_file_checks_name_the_field() -> None:
     bad = car()
     bad["devices"] = [{"device": "PositionSensor", "name": "s", "motor": "right_front_wheel"}]
     with pytest.raises(WorldError, match=r"devices\[0\] \(s\)\.motor: 'right_front_wheel' is not a motor of this "
-                                         r"robot's ackermann_drive"):
+                                         r"robot \(motors: 'right_steer', 'left_steer', 'right_rear_wheel', "
+                                         r"'left_rear_wheel'\)"):
         parse_world({"robots": [bad]})     # propulsion: the front wheels have no motors
     clash = car()
     clash["devices"] = [{"device": "LED", "name": "left_steer"}]
