@@ -125,3 +125,26 @@ def test_a_c_controller_draws_and_saves(world: Path, tmp_path: Path, c_controlle
     assert "Sanitizer" not in err and "runtime error" not in err, err
     _check(lines, err, tmp_path, expected)
     assert os.path.getsize(tmp_path / "screen.png") > 0
+
+
+def test_python_coordinates_may_be_floats_truncated_as_webots_int_does(tmp_path: Path) -> None:
+    """Webots' display_supervisor sample draws at ``width / 2`` and at a robot's scaled position
+    (floats): Webots' Python Display passes each coordinate and size through ``int()``. Here too,
+    so the same pixels as the integer commands (truncated toward zero: -3.6 is -3)."""
+    lines, err = run_controller(WORLDS[0], lambda url: sensorium(
+        "controller", "--url", url, str(REPO / "tests" / "controllers" / "display_floats.py")),
+        env={"DISPLAY_OUT": str(tmp_path)})
+    assert lines == ["done"] and "Error" not in err, err
+    sim = Simulation(load_world(WORLDS[0]))
+    d = sim.robots["bot"].devices["screen"]
+    d.apply(d.check([["color", 0x505050], ["rectangle", 0, 0, 320, 240, True],
+                     ["color", 0xBB2222], ["line", 160, 0, 160, 239], ["text", "x", 149, 230],
+                     ["color", 0x22BB11], ["line", 0, 120, 319, 120],
+                     ["opacity", 0.5], ["color", 0x2222BB], ["oval", 100, 50, 4, 4, True],
+                     ["oval", -3, 200, 10, 6, False], ["opacity", 1.0],
+                     ["pixel", 310, 5], ["rectangle", 200, 100, 30, 20, False],
+                     ["copy", 1, 0, 0, 50, 40], ["paste", 1, 250, 180, False]]), 0)
+    want = d.pixels.astype("<u4").view(np.uint8).reshape(240, 320, 4)[..., [2, 1, 0, 3]]
+    with Image.open(tmp_path / "floats.png") as im:
+        got = np.asarray(im)
+    assert got.shape == want.shape and (got == want).all()
