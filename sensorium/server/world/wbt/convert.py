@@ -996,7 +996,12 @@ class Converter:
 
     def device_contents(self, node: Node, frame: Frame, owner: Owner, device: dict | None) -> None:
         """A device's own Solid contents: robot body shapes marked as the device's own (its visual
-        rays do not see them, sim/own_shapes.py), the innermost device's for nested ones."""
+        rays do not see them, sim/own_shapes.py), the innermost device's for nested ones. A device is a
+        Solid too: its radarCrossSection makes it a radar target its robot carries."""
+        rcs = self.fields(node).num("radarCrossSection", 0.0)
+        if rcs > 0.0:
+            name = device["name"] if device is not None else self.fields(node).string("name", node.type.lower())
+            owner.data.setdefault("_carried_rcs", []).append((name, rcs, node))
         start = len(owner.parts)
         self.device_depth += 1
         try:
