@@ -4,7 +4,8 @@
  * pixels converted to 8-bit RGBA: grey, grey + alpha, RGB, RGBA (8 or 16 bits a sample: 16-bit
  * samples keep their high byte) and palette images (1, 2, 4 or 8 bits, with tRNS alpha), grey of 1,
  * 2 or 4 bits, a tRNS colour key of grey and RGB images. Interlaced (Adam7) images are refused. Every
- * read is bounds-checked: a damaged file is a failure (a reason in `why`), never a crash. */
+ * read is bounds-checked and every chunk's CRC and the stream's Adler-32 checked, as libpng and zlib
+ * do: a damaged file is a failure (a reason in `why`), never a crash nor wrong pixels. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -231,6 +232,17 @@ static long zlib_inflate(const unsigned char *in, size_t size, unsigned char *ou
     if (r != 0)
       return -1;
   } while (!last);
+  size_t end = (s.pos + 7) >> 3; /* the Adler-32 of what was inflated follows, byte-aligned */
+  if (end + 4 > s.size)
+    return -1;
+  uint32_t a = 1, b = 0;
+  for (size_t i = 0; i < s.out_len; i++) {
+    a = (a + out[i]) % 65521u;
+    b = (b + a) % 65521u;
+  }
+  const unsigned char *q = s.in + end;
+  if (((uint32_t)q[0] << 24 | (uint32_t)q[1] << 16 | (uint32_t)q[2] << 8 | q[3]) != (b << 16 | a))
+    return -1;
   return (long)s.out_len;
 }
 
@@ -300,6 +312,10 @@ int sn_read_png(const char *filename, long max_pixels, int *width, int *height, 
     const unsigned char *type = file + at + 4, *data = file + at + 8;
     if (len > n - at - 12) {
       fail(why, why_len, "has a chunk longer than the file");
+      goto done;
+    }
+    if (sn_crc32(0, type, 4 + (size_t)len) != be32(data + len)) {
+      fail(why, why_len, "has a chunk whose CRC is wrong");
       goto done;
     }
     if (memcmp(type, "IHDR", 4) == 0) {
