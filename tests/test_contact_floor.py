@@ -17,6 +17,7 @@ import pytest
 from sensorium.server.raycast import packets
 from sensorium.server.sim import contact as C
 from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.scene import robot_bounding_parts
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, parse_world
 from tests.test_contact import drive, xy
@@ -200,3 +201,25 @@ def test_the_c_broad_phase_applies_the_floor_tolerance_as_numpy_does():
         assert g.tobytes() == w.tobytes()
     sunk = np.concatenate([[sinks[c], sinks[::-1][c]] for c in range(n)])
     assert want[0][:, floor].tolist() == (sunk > 1e-3).tolist()
+
+
+def test_wheels_lying_on_their_side_rest_on_a_floor_box_at_their_radius():
+    """A body with wheels among its bounding shapes (Webots' four_wheels how-to: each wheel a
+    Cylinder turned onto its side, radius 0.1 m, the robot at z = 0.1 on a Box floor): a turned
+    shape's height band is its exact extent, so a wheel reaches down exactly its radius, to the
+    floor's top. Bounded by its circumscribed sphere (sqrt(0.1² + 0.02²) m) it reached 2 mm into
+    the floor, which stopped the robot where it stood; it drives N * 0.016 m in N steps."""
+    wheel = {"geometry": {"type": "cylinder", "radius": 0.1, "height": 0.04}}
+    shapes = [{"geometry": {"type": "box", "size": [0.3, 0.2, 0.05]}, "pose": {"translation": [0.0, 0.0, 0.05]}},
+              *({**wheel, "pose": {"translation": [0.0, y, 0.0], "rotation": [1.0, 0.0, 0.0, math.pi / 2]}}
+                for y in (0.17, -0.17))]
+    bot = {**robot("r", -1.5, 0.3, 0.1), "shapes": shapes}
+    del bot["body"]
+    world = loaded([FLOOR_BOX], [bot])
+    foot = C.robot_footprint(robot_bounding_parts(world.world.robots[0], world.base_dir))
+    assert foot.z_low == pytest.approx(-0.1, abs=1e-15) and foot.z_high == pytest.approx(0.1, abs=1e-15)
+    sim = Simulation(world)
+    drive(sim, "r", 5.0)
+    sim.run(150)
+    assert xy(sim, "r") == pytest.approx([-1.5 + 150 * STEP, 0.3], abs=1e-9)
+    assert sim.counters["contacts"] == 0

@@ -125,3 +125,99 @@ def test_a_c_controller_draws_and_saves(world: Path, tmp_path: Path, c_controlle
     assert "Sanitizer" not in err and "runtime error" not in err, err
     _check(lines, err, tmp_path, expected)
     assert os.path.getsize(tmp_path / "screen.png") > 0
+
+
+def test_python_coordinates_may_be_floats_truncated_as_webots_int_does(tmp_path: Path) -> None:
+    """Webots' display_supervisor sample draws at ``width / 2`` and at a robot's scaled position
+    (floats): Webots' Python Display passes each coordinate and size through ``int()``. Here too,
+    so the same pixels as the integer commands (truncated toward zero: -3.6 is -3)."""
+    lines, err = run_controller(WORLDS[0], lambda url: sensorium(
+        "controller", "--url", url, str(REPO / "tests" / "controllers" / "display_floats.py")),
+        env={"DISPLAY_OUT": str(tmp_path)})
+    assert lines == ["done"] and "Error" not in err, err
+    sim = Simulation(load_world(WORLDS[0]))
+    d = sim.robots["bot"].devices["screen"]
+    d.apply(d.check([["color", 0x505050], ["rectangle", 0, 0, 320, 240, True],
+                     ["color", 0xBB2222], ["line", 160, 0, 160, 239], ["text", "x", 149, 230],
+                     ["color", 0x22BB11], ["line", 0, 120, 319, 120],
+                     ["opacity", 0.5], ["color", 0x2222BB], ["oval", 100, 50, 4, 4, True],
+                     ["oval", -3, 200, 10, 6, False], ["opacity", 1.0],
+                     ["pixel", 310, 5], ["rectangle", 200, 100, 30, 20, False],
+                     ["copy", 1, 0, 0, 50, 40], ["paste", 1, 250, 180, False]]), 0)
+    want = d.pixels.astype("<u4").view(np.uint8).reshape(240, 320, 4)[..., [2, 1, 0, 3]]
+    with Image.open(tmp_path / "floats.png") as im:
+        got = np.asarray(im)
+    assert got.shape == want.shape and (got == want).all()
+
+
+def _png_cases(folder: Path) -> dict[str, np.ndarray]:
+    """PNG files of every colour type and depth a controller's image may have, written by Pillow
+    (zlib's fixed and dynamic blocks; level 0: stored blocks), each 37 x 23 with every filter's
+    work to undo (a gradient, noise): name -> the RGBA rows the display must show."""
+    rng = np.random.default_rng(7)
+    ys, xs = np.mgrid[0:23, 0:37]
+    rgba = np.stack([xs * 6, ys * 11, (xs * ys) % 256, 255 - xs * 3], axis=-1).astype(np.uint8)
+    rgba[5:9, 10:20] = rng.integers(0, 256, (4, 10, 4), dtype=np.uint8)
+    grey = rgba[..., 0]
+    want: dict[str, np.ndarray] = {}
+
+    def keep(name: str, im: Image.Image, rows: np.ndarray, **kw) -> None:
+        im.save(folder / name, **kw)
+        want[name] = rows
+
+    keep("rgba.png", Image.fromarray(rgba, "RGBA"), rgba)
+    keep("stored.png", Image.fromarray(rgba, "RGBA"), rgba, compress_level=0)
+    opaque = rgba.copy()
+    opaque[..., 3] = 255
+    keep("rgb.png", Image.fromarray(rgba[..., :3], "RGB"), opaque)
+    g = np.stack([grey, grey, grey, np.full_like(grey, 255)], axis=-1)
+    keep("grey.png", Image.fromarray(grey, "L"), g)
+    keep("grey_alpha.png", Image.fromarray(np.stack([grey, rgba[..., 3]], axis=-1), "LA"),
+         np.stack([grey, grey, grey, rgba[..., 3]], axis=-1))
+    bits = (grey > 100).astype(np.uint8) * 255
+    keep("one_bit.png", Image.fromarray(bits, "L").convert("1"),
+         np.stack([bits, bits, bits, np.full_like(bits, 255)], axis=-1))
+    wide = grey.astype(np.uint16) * 256 + 3                       # 16-bit: the high byte is shown
+    keep("grey16.png", Image.fromarray(wide), g)
+    index = (xs + ys) % 5
+    colours = np.array([[255, 0, 0], [0, 255, 0], [0, 0, 255], [9, 99, 199], [250, 250, 0]], dtype=np.uint8)
+    pal = Image.fromarray(index.astype(np.uint8), "P")
+    pal.putpalette(colours.reshape(-1).tolist())
+    alpha = np.array([255, 128, 0, 255, 64], dtype=np.uint8)
+    keep("palette.png", pal, np.concatenate([colours[index], alpha[index][..., None]], axis=-1),
+         transparency=alpha.tobytes())
+    return want
+
+
+@pytest.fixture(scope="module")
+def load_controller(tmp_path_factory) -> str:
+    return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "display_load.c")
+
+
+def test_a_c_controller_loads_png_images_as_webots_display_sample_does(tmp_path: Path, load_controller: str) -> None:
+    """Webots' display sample (C) loads its emoticons with wb_display_image_load: the C library reads
+    PNG files itself (every colour type and depth Pillow writes; a JPEG is refused with one line, a
+    damaged or missing file is Webots' "unreadable" line with the reason, and NULL), so the pasted
+    pixels are the file's."""
+    exe = load_controller
+    src, out = tmp_path / "in", tmp_path / "out"
+    src.mkdir()
+    out.mkdir()
+    want = _png_cases(src)
+    good = (src / "rgba.png").read_bytes()
+    (src / "damaged.png").write_bytes(good[:60] + bytes(40) + good[100:])
+    (src / "photo.jpg").write_bytes(b"\xff\xd8\xff\xe0 not decoded")
+    names = [*want, "damaged.png", "photo.jpg", "missing.png"]
+    lines, err = run_controller(WORLDS[0], lambda url: [exe, *names],
+                                env={**SAN_ENV, "DISPLAY_IN": str(src), "DISPLAY_OUT": str(out)})
+    assert "Sanitizer" not in err and "runtime error" not in err, err
+    assert lines == [*(f"loaded {n}" for n in want), "unreadable damaged.png", "unreadable photo.jpg",
+                     "unreadable missing.png", "done"], err
+    for name, rows in want.items():
+        with Image.open(out / name) as im:
+            got = np.asarray(im)[:23, :37]
+        assert (got == rows).all(), name
+    errors = err.strip().splitlines()
+    assert len(errors) == 3 and all(e.startswith("Error: wb_display_image_load(): ") for e in errors), err
+    assert f'the "{src / "damaged.png"}" image is unreadable' in errors[0]
+    assert "reads no JPEG" in errors[1] and "missing.png\" image is unreadable (cannot be opened)" in errors[2]

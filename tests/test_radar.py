@@ -376,3 +376,32 @@ def test_occlusion_spares_a_wall_within_half_the_target_s_box() -> None:
     [t] = run(Simulation(world({"occlusion": True}, solids=[pair, wall(9.2)])))    # hit at 9.15: 0.85 <= 1.2
     assert t.distance == pytest.approx(math.hypot(10.0, 0.8), rel=1e-14)
     assert run(Simulation(world({"occlusion": True}, solids=[pair, wall(7.0)]))) == []   # 3.05 > 1.2: hidden
+
+
+def test_a_robot_carrying_a_radar_target_solid_is_a_target(tmp_path: Path) -> None:
+    """Webots' radar sample puts a small Solid with radarCrossSection 1 on each robot. Radars here
+    detect robots and top-level solids, so such a robot takes the solids' cross section (summed) with
+    one warning, its bounding box being the target's box; a robot with its own keeps it. A device is
+    a Solid too (the sample's Radar has radarCrossSection 1): its robot carries it likewise."""
+    p = tmp_path / "w.wbt"
+    carrier = ('Robot {{ translation {x} {y} 0 name "{name}" {own}children [\n'
+               '  Solid {{ translation 0 0 0.1 name "tag" radarCrossSection 1 children [ Shape {{ geometry Box {{ size 0.04 0.04 0.04 }} }} ] }}\n'
+               '  {more}] boundingObject Pose {{ translation 0 0 0.1 children [ Box {{ size 0.2 0.2 0.2 }} ] }} }}\n')
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+                 'Robot { name "car" children [ Radar { translation 0 0 0.1 minRange 0.01 maxRange 10 verticalFieldOfView 0.5\n'
+                 '                                     radarCrossSection 2 } ] }\n'
+                 + carrier.format(x=2, y=0, name="one", own="", more="")
+                 + carrier.format(x=4, y=0.5, name="two", own="",
+                                  more='Solid { name "tag2" translation 0 0 0.1 radarCrossSection 0.5 }\n')
+                 + carrier.format(x=6, y=-1, name="own", own="radarCrossSection 3 ", more=""))
+    loaded = load_world(p)
+    assert [r.radar_cross_section for r in loaded.world.robots] == [2.0, 1.0, 1.5, 3.0]
+    lines = [line for line in loaded.warnings if "radarCrossSection" in line]
+    assert len(lines) == 4 and "'car'" in lines.pop(0) and "'one'" in lines[0] and "'tag'" in lines[0] and "read as the robot's (1)" in lines[0]
+    assert "'tag2' (0.5)" in lines[1] and "(1.5)" in lines[1] and "not read" in lines[2] and "own 3" in lines[2]
+    t1, t2, t3 = run(Simulation(loaded), name="car/radar")
+    for t, (x, y, rcs) in zip((t1, t2, t3), ((2.0, 0.0, 1.0), (4.0, 0.5, 1.5), (6.0, -1.0, 3.0))):
+        r = math.hypot(x, y)            # the bounding box's centre is at the radar's height
+        assert t.distance == pytest.approx(r, rel=1e-12)
+        assert t.received_power == pytest.approx(by_hand_dbm(r, rcs), abs=1e-9)
+        assert t.azimuth == pytest.approx(-math.atan2(y, x), abs=1e-12)     # Webots: positive to the right

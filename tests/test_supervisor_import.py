@@ -166,7 +166,9 @@ def _unchanged(lv: Live) -> tuple:
     ("Solid {\n  translation 1 2\n}", "node string:2:3: Solid.translation: expected 3 numbers, got 2"),
     ("Solid { children [ Shape { geometry Box { size 1 1 1 } ]", "node string:1:"),
     ("Crate { }", "node string:1:1: Crate: not a built-in node or PROTO here."),
-    ("Transform { children [ Shape { geometry Box { } } ] }", "node string:1:1: Transform: not importable here"),
+    ("Transform { scale 2 2 2 children [ Shape { geometry Box { } } ] }",
+     "node string:1:1: Transform: not importable here"),
+    ("Group { children [ Shape { geometry Box { } } ] }", "node string:1:1: Group: not importable here"),
     ("WorldInfo { }", "node string:1:1: WorldInfo: not importable here"),
     ("Solid {\n children [ PointLight { attenuation 0 0 0 } ] }",
      "node string:2:13 (PointLight, converted as solids[0].lights[0].attenuation): attenuation 0 0 0 would give"),
@@ -182,6 +184,27 @@ def test_bad_strings_are_refused_with_one_line_and_nothing_changes(text, expecte
     assert refused(lv, text).startswith(expected)
     assert _unchanged(lv) == was
     assert imports(lv, BOX) == [FIRST + 1]
+
+
+@pytest.mark.parametrize("kind", ["Pose", "Transform"])
+def test_a_pose_of_shapes_is_imported_as_a_solid_that_moves(kind):
+    """Webots' supervisor sample imports ``Pose { children [ Shape { ... Sphere ... } ] }`` and then
+    moves it in a circle by its translation (the root's last child). It is imported as a Solid of
+    its shapes (one line in the server's log): here a 0.2 m cube, moved to (1.1, 0, 0.1) with the
+    crate removed, puts its face 1 m ahead of the range finder, which read the wall at 3 m."""
+    lv = _live()
+    logged: list[str] = []
+    lv.core.log = logged.append
+    boss(lv, "remove_node", {"node": CRATE})
+    assert readings(lv)["depth"] == pytest.approx(3.0, abs=1e-6)
+    (node,) = imports(lv, f"{kind} {{ children [ Shape {{ geometry Box {{ size 0.2 0.2 0.2 }} }} ] }}")
+    assert children(lv)[-1] == node
+    assert boss(lv, "get_from_id", {"id": node})["type"] == "Solid"
+    assert logged == [f"robot 'boss': import_node_from_string: node string:1:1: {kind} imported as a Solid of its "
+                      "shapes (getTypeName() answers 'Solid'): Sensorium imports solids and lights"]
+    boss(lv, "set_field", {"node": node, "field": "translation", "value": [1.1, 0.0, 0.1]})
+    assert readings(lv)["depth"] == pytest.approx(1.0, abs=1e-6)
+    assert boss(lv, "get_field", {"node": node, "field": "translation"})["value"] == [1.1, 0.0, 0.1]
 
 
 def test_a_value_webots_resets_is_reset_on_import_as_in_a_world_file():

@@ -135,6 +135,26 @@ def footprint(prim: geo.Primitive) -> Footprint | None:
     return None                                  # a plane body: no footprint
 
 
+def _z_extent(prim: geo.Primitive, rotation: np.ndarray) -> tuple[float, float]:
+    """The lowest and highest points of a centred shape turned by ``rotation``, along z (exact)."""
+    up = rotation[2]                              # the world z axis in the shape's frame
+    if isinstance(prim, geo.Box):
+        e = 0.5 * float(np.abs(up) @ np.asarray(prim.size, dtype=np.float64))
+    elif isinstance(prim, geo.Cylinder):
+        az = min(1.0, abs(float(up[2])))
+        e = prim.height / 2.0 * az + prim.radius * math.sqrt(1.0 - az * az)
+    elif isinstance(prim, geo.Capsule):
+        e = prim.height / 2.0 * abs(float(up[2])) + prim.radius
+    elif isinstance(prim, geo.Sphere):
+        e = prim.radius
+    elif isinstance(prim, geo.Mesh):
+        z = prim.vertices @ up
+        return float(z.min()), float(z.max())
+    else:
+        return -math.inf, math.inf
+    return -e, e
+
+
 def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None:
     """The disc (about the robot's origin) containing every body shape, each at its offset in the
     robot frame: conservative for off-centre shapes, exact for one centred upright shape."""
@@ -145,9 +165,12 @@ def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None
             continue
         x, y, z = (float(v) for v in local.translation)
         if not np.allclose(local.rotation, np.eye(3)):
-            # a tilted shape: bound it by its circumscribed sphere
+            # a tilted shape: its disc bounded by its circumscribed sphere, its height band exact (a
+            # wheel, a cylinder turned to lie on its side, reaches down exactly its radius: the
+            # sphere's band would sink it into the floor Box it rolls on)
             r = math.hypot(f.radius, max(abs(f.z_low), abs(f.z_high)))
-            f = Footprint(r, -r, r)
+            lo, hi = _z_extent(prim, np.asarray(local.rotation, dtype=np.float64))
+            f = Footprint(r, max(lo, -r), min(hi, r))
         feet.append(Footprint(math.hypot(x, y) + f.radius, z + f.z_low, z + f.z_high))
     if not feet:
         return None

@@ -10,14 +10,16 @@ As Webots, a PROTO instance must be of a PROTO the world file declares (``EXTERN
 ``IMPORTABLE EXTERNPROTO``; Sensorium's built-in stand-ins need none), a solid whose name is taken
 is renamed ``name(1)``, ``name(2)``, ... (Webots' name clash rule), and every node of the string is
 imported in order. Departures: a robot (a ``Robot`` or a PROTO that is one, or a solid holding
-one) is refused, as are nodes that are neither a solid nor a light (``Transform``, ``Group``,
-``Shape`` at the top, ``WorldInfo``, ...); a ``USE`` names a ``DEF`` of the string only.
+one) is refused, as are nodes that are neither a solid nor a light (``Group``, ``Shape`` at the
+top, ``WorldInfo``, a scaled ``Transform``, ...); a ``Pose`` (or a ``Transform`` of scale 1) is
+imported as a ``Solid`` of its shapes, with one warning; a ``USE`` names a ``DEF`` of the string
+only.
 """
 
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from sensorium.schemas import world as wm
@@ -155,6 +157,12 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
         solids, lights = len(conv.world["solids"]), len(conv.world["lights"])
         what = written.type if written.type == node.type else f"{written.type} (a {node.type})"
         at = f"{LABEL}:{written.line}:{written.col}"
+        if node.type in ("Pose", "Transform") and node.proto is None and _unscaled(node):
+            # a grouping node of shapes (Webots' supervisor sample imports a Pose holding a Sphere, then
+            # moves it by its translation): a Solid of the same frame and children, movable the same way
+            node = replace(node, type="Solid")
+            warnings.append(f"{at}: {written.type} imported as a Solid of its shapes (getTypeName() answers "
+                            "'Solid'): Sensorium imports solids and lights")
         conv.visit(node, Frame.identity(), top, top=True)
         if conv.world["robots"]:
             held = "" if node.type == "Robot" else f" (it holds robot {conv.world['robots'][0]['name']!r})"
@@ -198,6 +206,12 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
         out.append(ImportedNode(kind, models[queue[group]], proto))
         queue[group] += 1
     return out
+
+
+def _unscaled(node: Any) -> bool:
+    """A Transform without a scale other than 1 1 1 (a Pose has none): a Solid can stand for it."""
+    scale = node.fields.get("scale")
+    return scale is None or tuple(float(v) for v in scale) == (1.0, 1.0, 1.0)
 
 
 def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles_now: int, triangles_added: int,

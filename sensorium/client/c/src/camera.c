@@ -188,7 +188,7 @@ void sn_imaging_apply(sn_device *d, const msgpack_object *reading) {
 
 static uint32_t crc_table[256];
 
-static uint32_t crc32_of(uint32_t crc, const unsigned char *p, size_t n) {
+uint32_t sn_crc32(uint32_t crc, const unsigned char *p, size_t n) {
   if (crc_table[1] == 0)
     for (uint32_t i = 0; i < 256; i++) {
       uint32_t c = i;
@@ -213,7 +213,7 @@ static int chunk(FILE *f, const char *kind, const unsigned char *data, size_t n)
   unsigned char head[8];
   put32(head, (uint32_t)n);
   memcpy(head + 4, kind, 4);
-  uint32_t crc = crc32_of(crc32_of(0, (const unsigned char *)kind, 4), data, n);
+  uint32_t crc = sn_crc32(sn_crc32(0, (const unsigned char *)kind, 4), data, n);
   unsigned char tail[4];
   put32(tail, crc);
   return fwrite(head, 1, 8, f) == 8 && (n == 0 || fwrite(data, 1, n, f) == n) && fwrite(tail, 1, 4, f) == 4 ? 0 : -1;

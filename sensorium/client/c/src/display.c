@@ -3,8 +3,9 @@
  * with the next step request ("displays": {name: [commands]}, PROTOCOL.md), where the server draws
  * it. Image references are ids this library gives out. wb_display_image_save sends the pending
  * commands at once with the "draw" service and gets the pixels back, then writes a PNG (RGBA) here;
- * JPEG and wb_display_image_load need an image codec this library does not carry (an error line
- * each, NULL from image_load). Written from Webots' documented signatures and libController's rules. */
+ * wb_display_image_load reads a PNG file (png_read.c) and sends it as wb_display_image_new does; JPEG
+ * needs a codec this library does not carry (an error line, NULL from image_load, no file saved).
+ * Written from Webots' documented signatures and libController's rules. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -313,8 +314,14 @@ static WbImageRef new_ref(sn_device *d, WbDeviceTag tag) {
   return ir;
 }
 
+static WbImageRef image_new(const char *func, WbDeviceTag tag, int width, int height, const void *data, int format);
+
 WbImageRef wb_display_image_new(WbDeviceTag tag, int width, int height, const void *data, int format) {
-  const char *func = "wb_display_image_new";
+  return image_new("wb_display_image_new", tag, width, height, data, format);
+}
+
+/* wb_display_image_new's work, its error lines naming ``func`` */
+static WbImageRef image_new(const char *func, WbDeviceTag tag, int width, int height, const void *data, int format) {
   if (data == NULL) {
     fprintf(stderr, "Error: %s(): 'data' argument is NULL.\n", func);
     return NULL;
@@ -374,16 +381,31 @@ WbImageRef wb_display_image_new(WbDeviceTag tag, int width, int height, const vo
   return ir;
 }
 
+static bool ends_with(const char *s, const char *ext);
+
 WbImageRef wb_display_image_load(WbDeviceTag tag, const char *filename) {
   const char *func = "wb_display_image_load";
   if (filename == NULL || filename[0] == '\0') {
     fprintf(stderr, "Error: %s(): 'filename' argument is NULL or empty.\n", func);
     return NULL;
   }
-  if (display(tag, func, true) != NULL)
-    fprintf(stderr, "Error: %s(): this library reads no image files ('%s'): decode it yourself and use "
+  if (display(tag, func, true) == NULL)
+    return NULL;
+  if (ends_with(filename, ".jpg") || ends_with(filename, ".jpeg")) {
+    fprintf(stderr, "Error: %s(): this library reads no JPEG ('%s'): convert it to PNG, or decode it yourself and use "
                     "wb_display_image_new().\n", func, filename);
-  return NULL;
+    return NULL;
+  }
+  int width, height;
+  unsigned char *rgba;
+  char why[128];
+  if (sn_read_png(filename, (long)(MAX_IMAGE_BYTES / 4), &width, &height, &rgba, why, sizeof why) != 0) {
+    fprintf(stderr, "Error: %s(): the \"%s\" image is unreadable (%s).\n", func, filename, why);
+    return NULL;
+  }
+  WbImageRef ir = image_new(func, tag, width, height, rgba, WB_IMAGE_RGBA);
+  free(rgba);
+  return ir;
 }
 
 WbImageRef wb_display_image_copy(WbDeviceTag tag, int x, int y, int width, int height) {

@@ -291,6 +291,13 @@ void sn_display_free(sn_device *d);
 /* ------------------------------------------------------------------ camera.c */
 /* An 8-bit PNG of data (height rows of channels*width bytes: RGB or RGBA); 0 or -1. */
 int sn_write_png(const char *filename, const unsigned char *data, int width, int height, int channels);
+/* The CRC-32 of PNG chunks (and zlib's), continued from crc (0 to start). */
+uint32_t sn_crc32(uint32_t crc, const unsigned char *p, size_t n);
+/* ------------------------------------------------------------------ png_read.c */
+/* A PNG file as 8-bit RGBA rows (*rgba malloc'ed, the caller frees it), at most max_pixels; 0, or -1
+ * with the reason in why ("is not a PNG file", ...). */
+int sn_read_png(const char *filename, long max_pixels, int *width, int *height, unsigned char **rgba, char *why,
+                size_t why_len);
 /* A range finder's or camera's state from its attach description (0, or -1 on a bad one); its
  * readings from a step reply; freed at cleanup. No-ops for other devices. */
 int sn_imaging_describe(sn_device *d, const msgpack_object *desc);

@@ -1,5 +1,7 @@
 """Webots' ``Display`` class: drawing buffered and sent with the next step, the server rasterises
-(see ``wb_display``); ``imageNew``/``imageCopy``/``imageLoad`` answer an image reference."""
+(see ``wb_display``); ``imageNew``/``imageCopy``/``imageLoad`` answer an image reference. As Webots'
+Python class does, coordinates and sizes go through ``int()`` (a float such as ``width / 2`` is
+truncated toward zero); the flat ``wb_display_*`` functions take integers only."""
 
 from __future__ import annotations
 
@@ -50,40 +52,41 @@ class Display(Device):
         wb.wb_display_detach_camera(self._tag)
 
     def drawPixel(self, x: int, y: int) -> None:
-        wb.wb_display_draw_pixel(self._tag, x, y)
+        wb.wb_display_draw_pixel(self._tag, int(x), int(y))
 
     def drawLine(self, x1: int, y1: int, x2: int, y2: int) -> None:
-        wb.wb_display_draw_line(self._tag, x1, y1, x2, y2)
+        wb.wb_display_draw_line(self._tag, int(x1), int(y1), int(x2), int(y2))
 
     def drawRectangle(self, x: int, y: int, width: int, height: int) -> None:
-        wb.wb_display_draw_rectangle(self._tag, x, y, width, height)
+        wb.wb_display_draw_rectangle(self._tag, int(x), int(y), int(width), int(height))
 
     def drawOval(self, cx: int, cy: int, a: int, b: int) -> None:
-        wb.wb_display_draw_oval(self._tag, cx, cy, a, b)
+        wb.wb_display_draw_oval(self._tag, int(cx), int(cy), int(a), int(b))
 
     def drawPolygon(self, x: Any, y: Any) -> None:
         wb.wb_display_draw_polygon(self._tag, x, y)
 
     def drawText(self, text: str, x: int, y: int) -> None:
-        wb.wb_display_draw_text(self._tag, text, x, y)
+        wb.wb_display_draw_text(self._tag, text, int(x), int(y))
 
     def fillRectangle(self, x: int, y: int, width: int, height: int) -> None:
-        wb.wb_display_fill_rectangle(self._tag, x, y, width, height)
+        wb.wb_display_fill_rectangle(self._tag, int(x), int(y), int(width), int(height))
 
     def fillOval(self, cx: int, cy: int, a: int, b: int) -> None:
-        wb.wb_display_fill_oval(self._tag, cx, cy, a, b)
+        wb.wb_display_fill_oval(self._tag, int(cx), int(cy), int(a), int(b))
 
     def fillPolygon(self, x: Any, y: Any) -> None:
         wb.wb_display_fill_polygon(self._tag, x, y)
 
     def imageNew(self, data: Any, format: int, width: int | None = None, height: int | None = None) -> Any:
-        return wb.wb_display_image_new(self._tag, width, height, data, format)
+        return wb.wb_display_image_new(self._tag, None if width is None else int(width),
+                                       None if height is None else int(height), data, format)
 
     def imageCopy(self, x: int, y: int, width: int, height: int) -> Any:
-        return wb.wb_display_image_copy(self._tag, x, y, width, height)
+        return wb.wb_display_image_copy(self._tag, int(x), int(y), int(width), int(height))
 
     def imagePaste(self, ir: Any, x: int, y: int, blend: bool = False) -> None:
-        wb.wb_display_image_paste(self._tag, ir, x, y, blend)
+        wb.wb_display_image_paste(self._tag, ir, int(x), int(y), blend)
 
     def imageLoad(self, filename: str) -> Any:
         return wb.wb_display_image_load(self._tag, filename)

@@ -801,6 +801,9 @@ class Converter:
         f = self.fields(node)
         inner = self.child_frame(node, frame)
         if owner.kind == "robot":   # part of the robot's body
+            rcs = f.num("radarCrossSection", 0.0)
+            if rcs > 0.0:           # a radar target it carries (Webots' radar sample): read as the robot's
+                owner.data.setdefault("_carried_rcs", []).append((f.string("name", default), rcs, node))
             self.solid_contents(node, inner, owner)
             return
         name = f.string("name", default)
@@ -838,6 +841,27 @@ class Converter:
         rcs = self.fields(node).num("radarCrossSection", 0.0)
         if rcs > 0.0:
             data["radar_cross_section"] = rcs
+
+    def carried_radar_targets(self, robot: dict) -> None:
+        """Solids inside a robot with a radarCrossSection (Webots' radar sample: a small target box on
+        each robot). Radars here detect robots and top-level solids, so a robot without a cross section
+        of its own takes theirs (summed: the power of targets at one place adds up, as Webots merges
+        them), its bounding shapes being the target's box; one warning names them. A robot with its own
+        keeps it and theirs are not read."""
+        carried = robot.pop("_carried_rcs", [])
+        if not carried:
+            return
+        names = ", ".join(f"{name!r} ({rcs:g})" for name, rcs, _ in carried)
+        own = robot.get("radar_cross_section", 0.0)
+        if own > 0.0:
+            self.warn(carried[0][2], f"Robot {robot['name']!r}: radarCrossSection of its solid {names} not read "
+                                     f"(radars detect robots and top-level solids: the robot's own {own:g} counts)")
+            return
+        total = sum(rcs for _, rcs, _ in carried)
+        robot["radar_cross_section"] = total
+        self.warn(carried[0][2], f"Robot {robot['name']!r}: radarCrossSection of its solid {names} read as the "
+                                 f"robot's ({total:g}): radars here detect robots and top-level solids, the robot's "
+                                 "bounding shapes are its box")
 
     def solid_contents(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
@@ -889,6 +913,7 @@ class Converter:
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.solid_contents(node, Frame.identity(), mine)
+        self.carried_radar_targets(data)
         self.drive(node, mine)
         if mine.parts:
             data["shapes"] = [_clean_part(p) for p in mine.parts]
@@ -970,7 +995,12 @@ class Converter:
 
     def device_contents(self, node: Node, frame: Frame, owner: Owner, device: dict | None) -> None:
         """A device's own Solid contents: robot body shapes marked as the device's own (its visual
-        rays do not see them, sim/own_shapes.py), the innermost device's for nested ones."""
+        rays do not see them, sim/own_shapes.py), the innermost device's for nested ones. A device is a
+        Solid too: its radarCrossSection makes it a radar target its robot carries."""
+        rcs = self.fields(node).num("radarCrossSection", 0.0)
+        if rcs > 0.0:
+            name = device["name"] if device is not None else self.fields(node).string("name", node.type.lower())
+            owner.data.setdefault("_carried_rcs", []).append((name, rcs, node))
         start = len(owner.parts)
         self.device_depth += 1
         try:
