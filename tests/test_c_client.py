@@ -48,7 +48,7 @@ ROOT_WORLD = REPO / "tests" / "worlds" / "root_children.wbt"
 PROTOS_WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_protos.wbt"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
-                                reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
+                                reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev)")
 
 
 def _make(*args: str) -> str:
@@ -61,7 +61,7 @@ def sanitized_controller(tmp_path_factory, src: Path) -> str:
     """One test controller (C) linked to the library built with -fsanitize=address,undefined, for a
     test file's own fixture; skipped without a C toolchain."""
     if sys.platform == "win32" or shutil.which("cc") is None:
-        pytest.skip("needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")
+        pytest.skip("needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev)")
     build = tmp_path_factory.mktemp("cbuild")
     _make(f"BUILD={build}", "SANITIZE=1")
     libs = _make("libs").split()

@@ -16,7 +16,7 @@ WORLD = REPO / "tests" / "worlds" / "images.yaml"
 
 pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
-                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev)")]
+                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev)")]
 
 
 @pytest.fixture(scope="module")
