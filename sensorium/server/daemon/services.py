@@ -617,16 +617,20 @@ class Core(DeviceServices):
         self._draw(drawings)
         return _DEFERRED
 
+    def _step_device(self, robot: str, field: str, name: str, kind: str, noun: str) -> Any:
+        """The device a step request's ``field`` names: of the robot and of ``kind``, else the request's error."""
+        dev = self.sim.robots[robot].devices.get(name)
+        if dev is None or dev.kind != kind:
+            what = f"is a {dev.kind}, not {noun}" if dev is not None else "is no device of the robot"
+            raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: {field}: {robot}/{name} {what}")
+        return dev
+
     def _display_commands(self, robot: str, displays: dict[str, Any]) -> list[tuple[Any, Any]]:
         """(display, checked commands) of a step request; every display and command checked first,
         so that a bad one draws none of them."""
-        r = self.sim.robots[robot]
         out = []
         for name, commands in displays.items():
-            dev = r.devices.get(name)
-            if dev is None or dev.kind != "Display":
-                what = f"is a {dev.kind}, not a display" if dev is not None else "is no device of the robot"
-                raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: displays: {robot}/{name} {what}")
+            dev = self._step_device(robot, "displays", name, "Display", "a display")
             try:
                 out.append((dev, dev.check(commands)))
             except ValueError as exc:
@@ -640,13 +644,9 @@ class Core(DeviceServices):
     def _emitter_packets(self, robot: str, emitters: dict[str, Any]) -> list[tuple[Any, Any]]:
         """(emitter device, packets) of a step request; every name resolved first, so that a bad
         one queues none of them."""
-        r = self.sim.robots[robot]
         out = []
         for name, packets in emitters.items():
-            dev = r.devices.get(name)
-            if dev is None or dev.kind != "Emitter":
-                what = f"is a {dev.kind}, not an emitter" if dev is not None else "is no device of the robot"
-                raise ServiceError(ErrorCode.UNKNOWN_DEVICE, f"step: emitters: {robot}/{name} {what}")
+            dev = self._step_device(robot, "emitters", name, "Emitter", "an emitter")
             allowed = dev.config.allowed_channels
             for p in packets:
                 if allowed and p.channel not in allowed:
