@@ -198,20 +198,18 @@ def test_copies_never_see_each_others_robots(texture_dir: Path):
     assert magenta.any() and (magenta | shade).all()
 
 
-@pytest.mark.parametrize("precision", BOTH)
-def test_a_robot_shadows_the_wall_in_its_own_copy_only(precision: str):
-    """The lit matte wall, now under a directional light along (1, 0.5, 0) that casts shadows, and a
-    second robot, a 0.1 m box: in copy 0 it stands between the wall's centre point and the light
-    (out of the centre pixel's ray), in copy 1 far off. Copy 0's centre pixel reads the ambient term
-    alone, albedo x 0.2; copy 1's the full albedo x (0.2 + 0.7 N.L), N.L = 1/sqrt(1.25); each copy's
-    image is the single Simulation's with that robot where the copy has it, byte for byte."""
+def blocker_images(precision: str, **shape) -> np.ndarray:
+    """The lit matte wall under a directional light along (1, 0.5, 0) that casts shadows, and a
+    second robot, a 0.1 m box (``shape``: more of its fields): in copy 0 it stands between the wall's
+    centre point and the light (out of the centre pixel's ray), in copy 1 far off. Each copy's image,
+    checked to be the single Simulation's with that robot where the copy has it, byte for byte."""
     w = _facing([1.0], fog=False)
     data = w.model_dump(mode="json", exclude_none=True)
     data["lights"] = [{"type": "DirectionalLight", "direction": [1, 0.5, 0], "intensity": 0.7,
                        "ambient_intensity": 0.2, "cast_shadows": True}]
     data["robots"].append({"name": "blocker", "pose": {"translation": [5.0, 5.0, 0.0]},
                            "shapes": [{"pose": {"translation": [0, 0, 0.1]},
-                                       "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}}]})
+                                       "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}, **shape}]})
     lw = LoadedWorld(world=wm.World.model_validate(data), source="<test>", base_dir=Path.cwd())
     bs = BatchedSimulation(lw, 2, precision=precision)
     places = [[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]]
@@ -229,6 +227,14 @@ def test_a_robot_shadows_the_wall_in_its_own_copy_only(precision: str):
     for c, single in enumerate(singles):
         single.step()
         assert img[c].tobytes() == single.robot("bot").device("cam").image.tobytes(), c
+    return img
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_robot_shadows_the_wall_in_its_own_copy_only(precision: str):
+    """blocker_images: copy 0's centre pixel reads the ambient term alone, albedo x 0.2; copy 1's
+    the full albedo x (0.2 + 0.7 N.L), N.L = 1/sqrt(1.25)."""
+    img = blocker_images(precision)
     albedo = np.array([0.6, 0.3, 0.15])
 
     def byte(x: np.ndarray) -> np.ndarray:

@@ -17,7 +17,6 @@ from sensorium.schemas import world as wm
 from sensorium.server.raycast.engine import RayEngine
 from sensorium.server.raycast.kinds import Precision, RayKind, ShapeEntry
 from sensorium.server.sim.batched import BatchedSimulation
-from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.geometry import Box, Pose
 from sensorium.server.world.loader import LoadedWorld, load_world
 from tests.test_camera import ALBEDO, WALL, expected_bytes, ray_hits_box, rays, rgb, shoot, world
@@ -97,29 +96,8 @@ def test_each_part_of_a_solid_keeps_its_own_flag():
 def test_a_batched_robot_without_cast_shadows_leaves_the_wall_lit_as_the_single_world_does(precision: str):
     # the wall lit by a directional light along (1, 0.5, 0); a blocker robot in copy 0 stands between
     # the wall's centre point and the light: its box casts no shadow, so both copies read the full term
-    from tests.test_batched_camera import _facing
-    data = _facing([1.0], fog=False).model_dump(mode="json", exclude_none=True)
-    data["lights"] = [{"type": "DirectionalLight", "direction": [1, 0.5, 0], "intensity": 0.7,
-                       "ambient_intensity": 0.2, "cast_shadows": True}]
-    data["robots"].append({"name": "blocker", "pose": {"translation": [5.0, 5.0, 0.0]},
-                           "shapes": [{"pose": {"translation": [0, 0, 0.1]}, "cast_shadows": False,
-                                       "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}}]})
-    lw = LoadedWorld(world=wm.World.model_validate(data), source="<test>", base_dir=Path.cwd())
-    bs = BatchedSimulation(lw, 2, precision=precision)
-    ref = bs.device("bot", "cam")
-    bs.enable(ref, 8)
-    singles = []
-    for c, t in enumerate([[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]]):
-        bs.set_pose(c, bs.slot("blocker"), translation=t)
-        single = Simulation(lw, precision=precision)
-        single.robot("blocker").set_pose(t)
-        single.robot("bot").device("cam").enable(8)
-        singles.append(single)
-    bs.step()
-    img = bs.image(ref)
-    for c, single in enumerate(singles):
-        single.step()
-        assert img[c].tobytes() == single.robot("bot").device("cam").image.tobytes(), c
+    from tests.test_batched_camera import blocker_images
+    img = blocker_images(precision, cast_shadows=False)
     full = np.floor(255.0 * (1.0 - np.exp(-np.array([0.6, 0.3, 0.15]) * (0.2 + 0.7 / math.sqrt(1.25)) * 1.3))
                     ** (1.0 / 2.2) + 0.5)
     assert (img[:, 2, 5, 2::-1] == full).all()
