@@ -118,8 +118,9 @@ def _run_binary(path: Path, argv: list[str]) -> int:
 
 def controller(args: argparse.Namespace) -> int:
     """Run a Webots-style controller for one robot, as Webots' launcher does: the controller URL in
-    the environment; a Python script runs as ``__main__`` with ``controller`` importable, an
-    executable (a compiled C/C++ controller) is exec'd with the same environment."""
+    the environment, the controller's folder as the working directory; a Python script runs as
+    ``__main__`` with ``controller`` importable, an executable (a compiled C/C++ controller) is
+    exec'd with the same environment."""
     problem = _take_launcher_options(args)
     if problem:
         print(f"sensorium controller: {problem}", file=sys.stderr)
@@ -142,6 +143,10 @@ def controller(args: argparse.Namespace) -> int:
     if args.robot:
         url = url.with_robot(args.robot)
     os.environ[ENV_URL] = str(url)
+    # Webots starts a controller in its own folder: the files it opens or saves by a relative name
+    # (a display's images, a camera's saveImage) are found and written there
+    script = script.resolve()
+    os.chdir(script.parent)
     if binary:
         return _run_binary(script, args.args)
     # ``controller`` importable here and in any process the controller starts
