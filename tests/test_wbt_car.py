@@ -126,11 +126,14 @@ def test_vertical_steering_hinges_carrying_driven_wheels_make_a_front_wheel_driv
     (car(hinge2_front("right", -T / 2, axis="0 0 1") + hinge2_front("left", T / 2)),
      "the steering motors 'right_steer', 'left_steer' turn about opposite axes (one +z, one -z)"),
     (car(hinge2_front("right", -T / 2, x=-L) + hinge2_front("left", T / 2, x=-L)),
-     "the steering joints are at x=-2.6, not ahead of the robot's origin (the origin is the centre of the rear axle)"),
+     "the steering joints are at x=-2.6, not ahead of the rear axle (x=0, its driven wheels')"),
     (car(hinge2_front("right", -T / 2) + hinge2_front("left", T / 2),
-         rear_wheel("right_rear_wheel", -T / 2, x=-0.4) + rear_wheel("left_rear_wheel", T / 2, x=-0.4)),
-     "the driven wheels ('right_rear_wheel' at x=-0.4, 'left_rear_wheel' at x=-0.4) are not a pair on the front axle "
-     "(x=2.6), a pair on the rear axle under the robot's origin (x=0), or both"),
+         rear_wheel("right_rear_wheel", -T / 2, x=-0.4) + rear_wheel("left_rear_wheel", T / 2)),
+     "the driven wheels ('right_rear_wheel' at x=-0.4, 'left_rear_wheel' at x=0) are not a pair on the front axle "
+     "(x=2.6), a pair on one rear axle parallel to the robot's y axis, or both"),
+    (car(hinge2_front("right", -T / 2) + hinge2_front("left", T / 2),
+         rear_wheel("right_rear_wheel", -T / 2, x=3.0) + rear_wheel("left_rear_wheel", T / 2, x=3.0)),
+     "the steering joints are at x=2.6, not ahead of the rear axle (x=3, its driven wheels')"),
     (car(hinge2_front("right", -T / 2) + hinge2_front("left", T / 2),
          rear_wheel("right_rear_wheel", -T / 2, axis="0 -1 0") + rear_wheel("left_rear_wheel", T / 2)),
      "wheel axis of motor 'right_rear_wheel' is [0.0, -1.0, 0.0], not the robot's +y (positive wheel speeds must "

@@ -613,6 +613,8 @@ class AckermannDescription(Result):
     left_rear_wheel: str
     forward: tuple[float, float] = Field(default=(1.0, 0.0), description="the drive's forward direction (x, y) "
                                          "in the robot's frame; the geometry above is in the drive's axes")
+    rear_axle_offset: float = Field(default=0.0, description="m, the rear axle's centre along forward from the "
+                                    "robot's origin (0: the origin is on it, as in Webots' cars)")
 
     @field_validator("forward", mode="before")
     @classmethod

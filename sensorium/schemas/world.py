@@ -975,12 +975,14 @@ class DifferentialDrive(Strict):
 class AckermannDrive(Strict):
     """Kinematic car-like drive (Webots' Car/AckermannVehicle geometry, no engine, no slip, no
     physics): two front wheels steered by position-controlled motors, driven wheels by velocity or
-    position control, the robot turning about its origin, which is the centre of the rear axle
-    (x forward, y left; ``forward`` another direction of the robot's frame, its left then up ×
-    forward: the geometry below is in those axes). The car follows the bicycle model: its turn radius about the rear axle's
-    centre is ``wheelbase`` times the mean of the front wheels' cotangents (exact for Ackermann
-    angles), its speed the driven wheels' rolling speeds over their distances from the turn centre.
-    Motor names default to Webots' vehicle library's."""
+    position control, the car turning about a centre on its rear axle's line (x forward, y left;
+    ``forward`` another direction of the robot's frame, its left then up × forward: the geometry
+    below is in those axes). The rear axle's centre is the robot's origin (Webots' car PROTOs), or
+    ``rear_axle_offset`` from it along forward (a robot whose origin is its body's centre: the
+    origin then moves on its own circle about the turn centre). The car follows the bicycle model:
+    its turn radius about the rear axle's centre is ``wheelbase`` times the mean of the front
+    wheels' cotangents (exact for Ackermann angles), its speed the driven wheels' rolling speeds
+    over their distances from the turn centre. Motor names default to Webots' vehicle library's."""
 
     wheelbase: float = Field(gt=0, description="m, rear axle to front axle")
     track_front: float = Field(gt=0, description="m, between the front wheels")
@@ -1003,6 +1005,9 @@ class AckermannDrive(Strict):
     right_rear_wheel: str = Field(default="right_rear_wheel", min_length=1)
     left_rear_wheel: str = Field(default="left_rear_wheel", min_length=1)
     forward: tuple[float, float] = _forward_field()
+    rear_axle_offset: float = Field(default=0.0, description="m, where the rear axle's centre is along forward from "
+                                    "the robot's origin (negative: behind it); 0, the origin on the rear axle, as "
+                                    "Webots' car PROTOs have it")
 
     _forward_nonzero = field_validator("forward")(_nonzero_forward)
 

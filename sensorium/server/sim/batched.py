@@ -774,7 +774,10 @@ class BatchedSimulation:
             return
         x0, y0 = self.x[copies, slots], self.y[copies, slots]
         yaw0 = self.yaw[copies, slots]
-        x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
+        if self.cars is not None and self.cars.offset:    # a car's origin off its rear axle
+            x, y, yaw = _offset_arc_steps(x0, y0, yaw0, v, w, dt, self.cars.rear_axle[slots])
+        else:
+            x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
         cos, sin = kin.libm_cos_sin(yaw)
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
@@ -1523,6 +1526,24 @@ def _side_mean(w: np.ndarray, n: int) -> np.ndarray:
     for _ in range(n - 1):
         acc = acc + w
     return acc / n
+
+
+def _offset_arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float,
+                      a: np.ndarray):
+    """motion.offset_arc_step for many robots (``a``: each one's rear axle offset; 0 is
+    :func:`_arc_steps` of the robot itself), element by element the same float64 operations."""
+    k = (a != 0.0).nonzero()[0]
+    if not len(k):
+        return _arc_steps(x, y, yaw, v, w, dt)
+    ax, ay, ak = x.copy(), y.copy(), a[k]
+    c0, s0 = kin.libm_cos_sin(yaw[k])
+    ax[k] = x[k] + ak * c0
+    ay[k] = y[k] + ak * s0
+    x1, y1, yaw1 = _arc_steps(ax, ay, yaw, v, w, dt)
+    c1, s1 = kin.libm_cos_sin(yaw1[k])
+    x1[k] = x1[k] - ak * c1
+    y1[k] = y1[k] - ak * s1
+    return x1, y1, yaw1
 
 
 def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):

@@ -7,10 +7,11 @@ and an angle, as :class:`~sensorium.server.sim.motion.WheelMotor`. A step advanc
 control for the steering, velocity or position control for the wheels), works out each moving
 car's speed ``v`` and turn rate ``v·κ`` (``AckermannDrive.step``) and hands them to the batched
 simulation's shared arc, contact and placing (``BatchedSimulation._drive_numpy``), which treat a
-car as any other driven robot. The tangents and the wheels' distance factors go through
-``math.tan`` and ``math.hypot`` per element: the single simulation's calls (numpy's float64
-routines may round differently on this machine), and the same on every path (nothing here needs
-the C helper).
+car as any other driven robot (a car whose origin is off its rear axle, ``rear_axle``, moves its
+axle's centre on the arc and its origin after it, as ``motion.offset_arc_step``). The tangents and
+the wheels' distance factors go through ``math.tan`` and ``math.hypot`` per element: the single
+simulation's calls (numpy's float64 routines may round differently on this machine), and the same
+on every path (nothing here needs the C helper).
 """
 
 from __future__ import annotations
@@ -48,7 +49,9 @@ class CarDrives:
         self.wheel_x = np.zeros((K, MOTORS - 2))
         self.wheel_y = np.zeros((K, MOTORS - 2))
         self.wheel_r = np.zeros((K, MOTORS - 2))
-        for k, (_, r) in enumerate(cars):
+        # per robot slot: its rear axle's offset from its origin along forward (0 for every other robot)
+        self.rear_axle = np.zeros(len(world.robots))
+        for k, (i, r) in enumerate(cars):
             a = r.ackermann_drive
             assert a is not None
             place = wheel_places(a)
@@ -59,8 +62,11 @@ class CarDrives:
             self.limit[k] = float(a.max_steering_angle)
             self.sign[k] = 1.0 if a.positive_steers == "right" else -1.0
             self.wheelbase[k] = float(a.wheelbase)
+            self.rear_axle[i] = float(a.rear_axle_offset)
             for j, (field, _) in enumerate(a.driven):
                 self.wheel_x[k, j], self.wheel_y[k, j], self.wheel_r[k, j] = place[field]
+        self.offset = bool(self.rear_axle.any())
+        """Whether a car's origin is off its rear axle (its moves then go through the offset arc)."""
         self.target = np.zeros((copies, K, MOTORS))       # inf: velocity control
         self.velocity = np.zeros((copies, K, MOTORS))
         self.angle = np.zeros((copies, K, MOTORS))

@@ -169,7 +169,8 @@ class PlanarState:
         self.base = _rz(-self.yaw) @ pose.rotation
         self.x, self.y, self.z = (float(v) for v in pose.translation)
         # the last step's speed along the heading and turn rate (rad/s); ``linear`` (ENU x, y, m/s)
-        # when kinematic contact replaced the move (its actual displacement), else None
+        # when kinematic contact replaced the move (its actual displacement) or the origin does not
+        # move along the heading (a car's origin off its rear axle), else None
         self.speed = 0.0
         self.turn = 0.0
         self.linear: tuple[float, float] | None = None
@@ -301,8 +302,8 @@ def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float
 
 
 def wheel_places(config) -> dict[str, tuple[float, float, float]]:
-    """A car's wheels by drive field: (x, y) on the car (the rear axle's centre at the origin, x
-    forward, y left) and radius."""
+    """A car's wheels by drive field: (x, y) from the rear axle's centre (x forward, y left; the
+    robot's origin may be elsewhere: ``rear_axle_offset``) and radius."""
     L, tf, tr = float(config.wheelbase), float(config.track_front), float(config.track_rear)
     rf, rr = float(config.front_wheel_radius), float(config.rear_wheel_radius)
     return {"right_front_wheel": (L, -tf / 2, rf), "left_front_wheel": (L, tf / 2, rf),
@@ -311,7 +312,8 @@ def wheel_places(config) -> dict[str, tuple[float, float, float]]:
 
 class AckermannDrive(PlanarState):
     """A car-like robot: two steered front wheels, driven wheels at the front, the rear or both, the
-    robot's origin at the centre of the rear axle (x forward, y left).
+    rear axle's centre at the robot's origin or ``rear_axle_offset`` from it along forward (x
+    forward, y left).
 
     Bicycle model without slip: the turn centre lies on the rear axle's line at R = L·(cot δ_r +
     cot δ_l)/2 from its centre (δ: the front wheels' angles, positive to the right), so curvature
@@ -319,7 +321,12 @@ class AckermannDrive(PlanarState):
     for others. A wheel at (x_i, y_i) then rolls at v·s_i with s_i = |(1 - κ_l y_i, κ_l x_i)|
     (κ_l the curvature to the left), so the rear axle's centre moves at v = Σ r_i ω_i / Σ s_i over
     the driven wheels. The steering angles used for a step are the motors' at its end (they hold
-    their positions by position control, at most ``max_steering_speed`` fast)."""
+    their positions by position control, at most ``max_steering_speed`` fast).
+
+    With a ``rear_axle_offset`` a the rear axle's centre, a ahead of the origin along the heading,
+    follows the arc, and the origin, rigidly a behind it, then lies on its own circle about the turn
+    centre (radius √(R² + a²)) with the same change of heading (:func:`offset_arc_step`); a = 0 is
+    the arc of the origin itself, operation for operation."""
 
     def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
         self.wheelbase = float(config.wheelbase)
@@ -332,6 +339,7 @@ class AckermannDrive(PlanarState):
         place = wheel_places(config)
         # each driven wheel: its motor, its (x, y) on the car, its radius
         self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
+        self.rear_axle = float(getattr(config, "rear_axle_offset", 0.0))
         super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
 
     @property
@@ -360,6 +368,23 @@ class AckermannDrive(PlanarState):
             return None
         kl = -self.curvature()          # to the left, as yaw grows
         v = sum(u for u, _, _ in rolled) / sum(math.hypot(1.0 - kl * y, kl * x) for _, x, y in rolled)
-        self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, v * kl, dt)
-        self.moved(v, v * kl)
+        a = self.rear_axle
+        if a == 0.0:
+            self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, v * kl, dt)
+            self.moved(v, v * kl)
+        else:
+            self.x, self.y, self.yaw = offset_arc_step(self.x, self.y, self.yaw, v, v * kl, dt, a)
+            self.moved(v, v * kl)
+            # the origin's own velocity: the axle's v along the heading plus ω × (origin - axle)
+            c, s = math.cos(self.yaw), math.sin(self.yaw)
+            self.linear = (v * c + a * (v * kl) * s, v * s - a * (v * kl) * c)
         return self.pose()
+
+
+def offset_arc_step(x: float, y: float, yaw: float, v: float, w: float, dt: float,
+                    a: float) -> tuple[float, float, float]:
+    """:func:`arc_step` of the point ``a`` ahead of (x, y) along the heading (a car's rear axle
+    centre, its origin at (x, y)): the origin's pose after the move, the point ``a`` behind the
+    arc's end (sensorium/server/sim/batched.py's cars repeat these operations)."""
+    ax, ay, yaw1 = arc_step(x + a * math.cos(yaw), y + a * math.sin(yaw), yaw, v, w, dt)
+    return ax - a * math.cos(yaw1), ay - a * math.sin(yaw1), yaw1

@@ -11,11 +11,15 @@ every motorised hinge's axis along the robot's +y and wheels of one radius, and 
 
 A robot with steered wheels (a motorised hinge with a vertical axis, a Hinge2Joint's first axis: a
 car) maps onto the kinematic ``ackermann_drive`` when its geometry is a car's as the world format
-has it: two steering joints on one line parallel to y at x = wheelbase > 0, symmetric about the
-robot's x axis, turning about one vertical axis direction (+z: positive steers left, -z: right);
-driven wheels (motorised hinges with their axis along +y) in pairs either side of the x axis, the
-front pair at the steering joints' x, the rear pair on the robot's y axis (the origin is the centre
-of the rear axle, as in Webots' cars); each axle's wheels of one radius.
+has it: two steering joints on one line parallel to y, symmetric about the robot's x axis,
+turning about one vertical axis direction (+z: positive steers left, -z: right); driven wheels
+(motorised hinges with their axis along +y) in pairs either side of the x axis, the front pair at
+the steering joints' x, the rear pair on one line parallel to y behind them: the rear axle, whose
+centre is the robot's origin in Webots' cars and may be ahead of or behind it (Webots'
+``four_wheels`` how-to's ``ackerman`` has its origin at its body's centre): its x is the drive's
+``rear_axle_offset`` and the wheelbase the steering joints' x less it. A car without driven rear
+wheels (front-wheel drive) shows no rear axle: its origin is taken for the rear axle's centre.
+Each axle's wheels of one radius.
 
 A robot whose wheels all turn about another axis that is horizontal in its frame (perpendicular to
 its z: Webots' ``four_wheels`` how-to turns its wheels about -x and drives along +y) is judged the
@@ -243,20 +247,25 @@ def _ackermann(wheels: list[dict], conv) -> tuple[dict | None, str]:
     if abs(a0[0] - a1[0]) > TOL or abs(a0[1] + a1[1]) > TOL or abs(a0[1]) <= TOL:
         return None, (f"the steering joints of {names} are not on one front axle parallel to the robot's y axis, "
                       "symmetric about its x axis")
-    wheelbase = float(a0[0])
-    if wheelbase <= TOL:
-        return None, (f"the steering joints are at x={wheelbase:g}, not ahead of the robot's origin (the origin is "
-                      "the centre of the rear axle)")
+    front_x = float(a0[0])
     right_steer, left_steer = (steering[0], steering[1]) if a0[1] < 0 else (steering[1], steering[0])
     off = _axis_off_y(driven, AXIS_TOL, "positive wheel speeds must drive forward")
     if off:
         return None, off
-    front = [w for w in driven if abs(w["centre"][0] - wheelbase) <= TOL]
-    rear = [w for w in driven if abs(w["centre"][0]) <= TOL]
-    if len(front) + len(rear) != len(driven) or len(front) not in (0, 2) or len(rear) not in (0, 2) or not driven:
+    front = [w for w in driven if abs(w["centre"][0] - front_x) <= TOL]
+    rear = [w for w in driven if abs(w["centre"][0] - front_x) > TOL]
+    rear_x = float(rear[0]["centre"][0]) if rear else 0.0
+    rear_x = 0.0 if abs(rear_x) <= TOL else rear_x     # (on the origin within TOL: exactly, as it always was)
+    if (len(front) not in (0, 2) or len(rear) not in (0, 2) or not driven
+            or any(abs(w["centre"][0] - rear_x) > TOL for w in rear)):
         where = ", ".join(f"{w['motor']!r} at x={w['centre'][0]:g}" for w in driven) or "none"
-        return None, (f"the driven wheels ({where}) are not a pair on the front axle (x={wheelbase:g}), a pair on the "
-                      "rear axle under the robot's origin (x=0), or both")
+        return None, (f"the driven wheels ({where}) are not a pair on the front axle (x={front_x:g}), a pair on one "
+                      "rear axle parallel to the robot's y axis, or both")
+    wheelbase = front_x - rear_x
+    if wheelbase <= TOL:
+        where = (f"the rear axle (x={rear_x:g}, its driven wheels')" if rear else
+                 "the robot's origin (a car without driven rear wheels has its rear axle there)")
+        return None, f"the steering joints are at x={front_x:g}, not ahead of {where}"
     out: dict = {"wheelbase": wheelbase, "track_front": float(abs(a0[1] - a1[1])),
                  "type": "4x4" if front and rear else "traction" if front else "propulsion",
                  "positive_steers": "left" if signs[0] else "right",
@@ -287,4 +296,6 @@ def _ackermann(wheels: list[dict], conv) -> tuple[dict | None, str]:
     out["max_steering_angle"] = min([*limits, STEERING_UNLIMITED])
     if out["max_steering_angle"] == 0.0:
         return None, f"the steering motors {names} have a position limit of 0 (they cannot steer)"
+    if rear_x != 0.0:                   # (on the origin: the key left out, the entry as it always was)
+        out["rear_axle_offset"] = rear_x
     return out, ""
