@@ -229,3 +229,43 @@ def test_a_housed_sensor_on_a_joint_is_blind_to_its_housing_and_its_robot_keeps_
         assert float(sim.device("r/lidar").range_image[0, 1]) == pytest.approx(0.9, abs=1e-6)
         assert sim.device("r/body").value == pytest.approx(1.9, abs=1e-9)
     assert sim.scene.shape_pose(5).translation == pytest.approx([0.4, 0, 0.3], abs=1e-12)   # L (after B, the body's)
+
+
+def test_a_wbt_robot_keeps_its_joints_axes_anchors_and_what_rides_on_them(tmp_path) -> None:
+    """A .wbt robot with two wheels and, under a Pose turned a quarter about z, a pan HingeJoint
+    (axis 1 0 0, anchor 0 0.1 0.2 in the Pose's frame: in the robot's, axis (0, 1, 0) and anchor
+    (-0.1, 0, 0.2)) whose end point (translation 0.1 0 0.3: (0, 0.1, 0.3) in the robot) holds a
+    DistanceSensor, a box and a SliderJoint (axis 0 0 1) holding a sphere. Converted: the sensor,
+    the box and the slider's motor ride on "pan", the sphere on "lift", the wheels' shapes on the
+    body (no on_joint), the drive unchanged. Turned by pi/2 about (0, 1, 0) through the anchor the
+    sensor is at (-0.1, 0, 0.2) + R_y(pi/2)·(0.1, 0.1, 0.1) = (0, 0.1, 0.1)."""
+    from test_wbt_drives import wheel, write
+
+    from sensorium.server.world.loader import load_world
+
+    arm = ('Pose { rotation 0 0 1 1.5707963267948966 children [\n'
+           ' HingeJoint { jointParameters HingeJointParameters { axis 1 0 0 anchor 0 0.1 0.2 }\n'
+           '  device [ RotationalMotor { name "pan" maxVelocity 100 maxTorque 100000 } ]\n'
+           '  endPoint Solid { translation 0.1 0 0.3 children [\n'
+           '    DistanceSensor { name "ds" }\n'
+           '    Shape { geometry Box { size 0.02 0.02 0.02 } }\n'
+           '    SliderJoint { jointParameters JointParameters { axis 0 0 1 }\n'
+           '      device [ LinearMotor { name "lift" } ]\n'
+           '      endPoint Solid { children [ Shape { geometry Sphere { radius 0.01 } } ] } } ] } } ] }\n')
+    w = load_world(write(tmp_path, 'Robot { name "rover" children [\n' + arm + wheel("left wheel", 0, 0.1)
+                         + wheel("right wheel", 0, -0.1) + '] }\n'))
+    robot = w.world.robots[0]
+    assert robot.differential_drive is not None
+    devices = {d.name: d for d in robot.devices}
+    pan, lift = devices["pan"], devices["lift"]
+    assert pan.axis == pytest.approx((0, 1, 0), abs=1e-15) and pan.anchor == pytest.approx((-0.1, 0, 0.2), abs=1e-15)
+    assert (pan.on_joint, lift.on_joint, devices["ds"].on_joint) == (None, "pan", "pan")
+    assert lift.axis == pytest.approx((0, 0, 1), abs=1e-15)
+    rides = {s.geometry.type: s.on_joint for s in robot.shapes}
+    assert rides == {"box": "pan", "sphere": "lift", "cylinder": None}
+    assert all(d.on_joint is None for d in robot.devices if d.name.endswith("wheel"))
+    sim = Simulation(w)
+    sim.robot("rover").motor("pan").set_position(QUARTER)
+    sim.step()
+    pose = sim.device("rover/ds").world_pose(sim.robot("rover").pose)
+    assert pose.translation == pytest.approx([0.0, 0.1, 0.1], abs=1e-12)
