@@ -189,6 +189,9 @@ def test_nested_joints_compose_outward() -> None:
     ({"devices": [_pan(on_joint="elbow"), {**_pan(), "name": "elbow", "on_joint": "pan"}]},
      r"joint 'pan' rides on itself through 'pan'"),
     ({"devices": [_pan(axis=[0, 0, 0])]}, "axis must not be zero"),
+    ({"devices": [_pan(), _distance_sensor()],
+      "shapes": [{"geometry": {"type": "sphere"}, "of_device": "ds", "on_joint": "pan"}]},
+     r"shapes\[0\]\.on_joint: a shape of device 'ds' rides on its device's joint: None, not 'pan'"),
 ])
 def test_bad_joint_links_are_refused_in_one_line(robot: dict, message: str) -> None:
     with pytest.raises(Exception, match=message):
@@ -269,3 +272,20 @@ def test_a_wbt_robot_keeps_its_joints_axes_anchors_and_what_rides_on_them(tmp_pa
     sim.step()
     pose = sim.device("rover/ds").world_pose(sim.robot("rover").pose)
     assert pose.translation == pytest.approx([0.0, 0.1, 0.1], abs=1e-12)
+
+
+def test_a_joint_inside_a_wbt_device_turns_none_of_its_shapes(tmp_path) -> None:
+    """A Lidar whose children hold a motorised turret HingeJoint with a cylinder: the cylinder is
+    the lidar's own shape (``of_device``) and stays with the lidar (no on_joint), so the lidar stays
+    blind to it as before; the turret's motor is still a joint (it turns)."""
+    from test_wbt_drives import write
+
+    from sensorium.server.world.loader import load_world
+
+    lidar = ('Lidar { name "lidar" children [ HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 }\n'
+             '  device [ RotationalMotor { name "turret" } ]\n'
+             '  endPoint Solid { children [ Shape { geometry Cylinder { radius 0.03 height 0.02 } } ] } } ] }\n')
+    w = load_world(write(tmp_path, 'Robot { name "r" children [\n' + lidar + '] }\n'))
+    robot = w.world.robots[0]
+    assert [(s.of_device, s.on_joint) for s in robot.shapes] == [("lidar", None)]
+    assert {d.name: d.on_joint for d in robot.devices} == {"lidar": None, "turret": None}

@@ -502,6 +502,11 @@ def _check_joints(robot: wm.Robot, rp: str) -> list[Problem]:
         if name is not None and name not in joints:
             problems.append(Problem(path, f"{name!r} is not a joint motor of this robot (RotationalMotor or LinearMotor "
                                           f"entries, drives' excepted: {', '.join(repr(n) for n in joints) or 'none'})"))
+    on = {d.name: d.on_joint for d in robot.devices}
+    for i, part in enumerate(robot.shapes):
+        if part.of_device is not None and part.of_device in on and part.on_joint != on[part.of_device]:
+            problems.append(Problem(f"{rp}.shapes[{i}].on_joint", f"a shape of device {part.of_device!r} rides on "
+                                    f"its device's joint: {on[part.of_device]!r}, not {part.on_joint!r}"))
     if problems:
         return problems
     for i, d in enumerate(robot.devices):

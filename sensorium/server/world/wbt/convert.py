@@ -1267,12 +1267,21 @@ class Converter:
     def on_joints(self, robot: dict) -> None:
         """Each shape and device riding on a joint names its motor (``on_joint``), names final; what
         rides on a wheel (the drive's) rides on whatever the wheel rides on (the body, mostly)."""
-        for entry in [*robot["devices"], *robot.get("shapes", ())]:
-            joint = entry.pop("_on_joint", None)
+        def resolved(entry: dict) -> dict | None:
+            joint = entry.get("_on_joint")
             while joint is not None and joint.get("_wheel"):
                 joint = joint.get("_on_joint")
+            return joint
+
+        devices = {d["name"]: d for d in robot["devices"]}
+        for entry in [*robot["devices"], *robot.get("shapes", ())]:
+            joint = resolved(entry)
+            if "of_device" in entry:    # a device's own shapes move as the device does (a joint inside a
+                joint = resolved(devices[entry["of_device"]])   # device, a lidar's turret, turns none of them)
             if joint is not None:
                 entry["on_joint"] = joint["name"]
+        for entry in [*robot["devices"], *robot.get("shapes", ())]:
+            entry.pop("_on_joint", None)
         for entry in robot["devices"]:
             entry.pop("_wheel", None)
 
