@@ -173,16 +173,17 @@ class RobotState:
         return self._sim.basic_time_step
 
     def move_links(self) -> bool:
-        """The joints moved: their links' bodies and the devices on them follow (whether any moved)."""
+        """The joints moved: their links' bodies and the devices on them follow (whether a device moved)."""
         if self.links is None:
             return False
-        changed = self.links.update()
-        for joint in changed:
+        moved = False
+        for joint in self.links.update():
             displacement = self.links.poses[joint]
             self._sim.scene.set_link_pose(self.index, joint, displacement)
             for dev in self.riders.get(joint, ()):
                 dev.move_with(displacement)
-        return bool(changed)
+                moved = True
+        return moved
 
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
