@@ -289,3 +289,23 @@ def test_a_joint_inside_a_wbt_device_turns_none_of_its_shapes(tmp_path) -> None:
     robot = w.world.robots[0]
     assert [(s.of_device, s.on_joint) for s in robot.shapes] == [("lidar", None)]
     assert {d.name: d.on_joint for d in robot.devices} == {"lidar": None, "turret": None}
+
+
+def test_a_moved_robot_carries_its_turned_link() -> None:
+    """The arm of the "another robot" test turned by pi/2 (its cube centred at (0, 0.5, 0.1) in
+    its frame), then the robot set at (1, 0, 0) turned a quarter about z: the cube is centred at
+    (1, 0, 0) + R_z(pi/2)·(0, 0.5, 0.1) = (0.5, 0, 0.1), where the watcher at (0.5, 2) sees its far
+    face again: 2 - 0.1 = 1.9 (before the move, nothing: 5)."""
+    arm = {"name": "arm", "devices": [_pan()],
+           "shapes": [{"geometry": {"type": "box", "size": [0.2, 0.2, 0.2]}, "pose": {"translation": [0.5, 0, 0.1]},
+                       "on_joint": "pan"}]}
+    watcher = {"name": "watcher", "pose": {"translation": [0.5, 2, 0], "rotation": [0, 0, 1, -QUARTER]},
+               "devices": [_distance_sensor(lookup_table=[[0, 0, 0], [5, 5, 0]], pose={"translation": [0, 0, 0.1]})]}
+    sim = _sim(arm, [], (watcher,))
+    sim.device("watcher/ds").enable(DT_MS)
+    sim.robot("arm").motor("pan").set_position(QUARTER)
+    sim.step()
+    assert sim.device("watcher/ds").value == 5.0
+    sim.robot("arm").set_pose(translation=[1, 0, 0], rotation=[0, 0, 1, QUARTER])
+    sim.step()
+    assert sim.device("watcher/ds").value == pytest.approx(1.9, abs=1e-9)
