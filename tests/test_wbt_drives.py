@@ -199,8 +199,8 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == ["lift", "left wheel", "right wheel"]
     assert not [x for x in w.warnings if "drive" in x]
     assert f"{p}:4:1: HingeJoint motor 'lift' is no wheel (its end point has no cylinder or sphere to roll on): " \
-           "its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), the shapes " \
-           "and devices past the joint stay where they are" in w.warnings
+           "its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and the " \
+           "shapes and devices past the joint with it" in w.warnings
     sim = Simulation(w).robot("khepera")
     assert sorted(sim.drive.motors) == ["left wheel", "right wheel"]    # the lift and the grip are no wheels
     assert sorted(sim.joints) == ["grip", "lift"]

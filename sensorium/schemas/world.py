@@ -295,11 +295,16 @@ def _check_cone_seen(geometry: object, seen_by: str) -> None:
                          "seen_by bounding would hide it (use visual or both)")
 
 
+_ON_JOINT = ("on a robot: the motor (RotationalMotor or LinearMotor, not a drive's) whose joint this rides on, "
+             "the innermost one; it moves with that joint (README 'Joints'). Left out: the robot's body")
+
+
 class Part(Shape):
     """One shape of a body made of several shapes, placed by ``pose`` in its owner's frame."""
 
     name: str | None = None
     pose: Pose = Pose()
+    on_joint: str | None = Field(default=None, min_length=1, description=_ON_JOINT)
     of_device: str | None = Field(
         default=None, min_length=1,
         description="on a robot: the device whose own Solid this shape belongs to (a sensor's housing); that "
@@ -465,6 +470,7 @@ class _Device(Strict):
     name: str = Field(min_length=1)
     model: str = Field(default="", max_length=4096, description="Webots model (Device.getModel)")
     pose: Pose = Pose()
+    on_joint: str | None = Field(default=None, min_length=1, description=_ON_JOINT)
 
 
 class LightSensor(_Device):
@@ -805,8 +811,12 @@ class Motor(_Device):
     A motor that is not one of the robot's drive motors moves its joint kinematically, as Webots
     does without physics (WbMotor's kinematic control, sim/joints.py): towards ``target`` at up to
     ``max_velocity``, its speed changing by at most ``acceleration`` (or, -1, ``max_torque``/``max_force``)
-    per second; ``min_position`` = ``max_position`` = 0 means no limits. Only the joint's position
-    moves (its PositionSensor reads it): the shapes and devices past the joint stay where they are."""
+    per second; ``min_position`` = ``max_position`` = 0 means no limits. Its PositionSensor reads the
+    position; the shapes and devices that name it in ``on_joint`` move with it: a hinge turns them by
+    ``position - initial position`` about ``axis`` through ``anchor``, a slider moves them by that much
+    along ``axis`` (README 'Joints'). ``axis`` and ``anchor`` are in the robot frame with every joint at
+    its initial position (where the world file places everything); ``on_joint`` of a motor: the joint
+    this joint rides on (an arm's elbow on its shoulder)."""
 
     max_velocity: float = Field(default=10.0, ge=0.0, description="rad/s (m/s for a LinearMotor)")
     min_position: float = Field(default=0.0, description="rad (m); min = max = 0: no limits")
@@ -814,6 +824,17 @@ class Motor(_Device):
     acceleration: float = Field(default=-1.0, description="rad/s² (m/s²); -1: the available torque (force)")
     position: float = Field(default=0.0, description="the joint's initial position (its jointParameters' "
                                                      "position), where the motor starts and holds")
+    axis: Vec3 | None = Field(default=None, description="the joint's axis, robot frame (see the class); left "
+                              "out: Webots' default, 1 0 0 for a hinge, 0 0 1 for a slider")
+    anchor: Vec3 = Field(default=(0.0, 0.0, 0.0), description="a hinge's axis passes through it (robot frame, m); "
+                         "unused by a slider")
+
+    @property
+    def joint_axis(self) -> Vec3:
+        """The joint's axis, Webots' default when left out (HingeJointParameters: x; JointParameters: z)."""
+        if self.axis is not None:
+            return self.axis
+        return (0.0, 0.0, 1.0) if isinstance(self, LinearMotor) else (1.0, 0.0, 0.0)
 
     @model_validator(mode="after")
     def _motor_limits(self) -> Motor:
@@ -821,6 +842,8 @@ class Motor(_Device):
             raise ValueError("acceleration must be >= 0, or -1 (limited by the available torque or force)")
         if self.min_position > self.max_position:
             raise ValueError(f"min_position {self.min_position} > max_position {self.max_position}")
+        if self.axis is not None and math.hypot(*self.axis) == 0.0:
+            raise ValueError("axis must not be zero")
         if (self.min_position or self.max_position) and not self.min_position <= self.position <= self.max_position:
             raise ValueError(f"position {self.position} outside [min_position, max_position] = "
                              f"[{self.min_position}, {self.max_position}]")

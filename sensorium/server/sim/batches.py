@@ -165,6 +165,13 @@ class DistancePlan:
         self.robot = np.array([d.robot_index for d in devs], dtype=np.int64)
         self.local_rot = np.array([d.local_pose.rotation for d in devs])
         self.local_pos = np.array([d.local_pose.translation for d in devs])
+        # where each sensor sits on the body it is mounted on, and its link's rotation (None: no
+        # sensor rides a joint, every one is mounted on its robot's body where local_pose puts it)
+        self.mount_rot, self.mount_pos, self.link_rot = self.local_rot, self.local_pos, None
+        if any(d.link is not None for d in devs):
+            self.mount_rot = np.array([d.mount_pose.rotation for d in devs])
+            self.mount_pos = np.array([d.mount_pose.translation for d in devs])
+            self.link_rot = np.array([np.eye(3) if d.link is None else d.link.rotation for d in devs])
         # the same, component-major ([j, k, sensor], [j, sensor]): long inner axes for the per-step products
         self.local_rot_t = np.ascontiguousarray(self.local_rot.transpose(1, 2, 0))
         self.local_pos_t = np.ascontiguousarray(self.local_pos.T)
@@ -222,8 +229,9 @@ class _Group:
         self.mounted: Mount | None = None     # the same, kept by the engine between casts
         self.own_visible: np.ndarray | None = None
         if robot_bodies is not None:
-            body = np.array([-1 if robot_bodies[d.robot_index] is None else robot_bodies[d.robot_index]
-                             for d in devs], dtype=np.int64)
+            # each sensor's rays are mounted on the body it rides: its robot's, or its joint's link's
+            carriers = [robot_bodies[d.robot_index] if d.link is None else d.link_body for d in devs]
+            body = np.array([-1 if b is None else b for b in carriers], dtype=np.int64)
             if np.count_nonzero(body >= 0):
                 self.mount = np.repeat(body, n)
                 self.mounted = Mount(self.mount)
@@ -309,14 +317,17 @@ class DistanceBatch:
         for g, dirs, h in zip(plan.groups, self.dirs, hits):
             S, n = dirs.shape[:2]
             dist, shape, normal = h.distance, h.shape, h.normal
-            own = g.own_hits(self.engine, plan.local_rot, plan.local_pos) if self.engine is not None else None
+            own = g.own_hits(self.engine, plan.mount_rot, plan.mount_pos) if self.engine is not None else None
             if own is not None:   # the nearer of the cast and the ray's own-body hit
                 win = (own.distance < dist).nonzero()[0]
                 if len(win):
                     dist, shape, normal = dist.copy(), shape.copy(), normal.copy()
                     dist[win], shape[win] = own.distance[win], own.shape[win]
                     rr = plan.robot[np.repeat(g.idx, n)[win]]
-                    normal[win] = np.einsum("sij,sj->si", self.robot_rot[rr], own.normal[win])
+                    carrier = self.robot_rot[rr]
+                    if plan.link_rot is not None:    # sensors on a joint: their link's rotation too
+                        carrier = carrier @ plan.link_rot[np.repeat(g.idx, n)[win]]
+                    normal[win] = np.einsum("sij,sj->si", carrier, own.normal[win])
             dist = dist.reshape(S, n)
             reflection = None
             if g.kind == RayKind.VISUAL:

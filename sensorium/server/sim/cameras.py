@@ -63,8 +63,8 @@ class MountedRays:
 def _mounted(device: Any, dirs: np.ndarray, limits: tuple[Any, Any]) -> MountedRays:
     """A device's pixel rays (directions in its frame) and, when it has shapes of its own, their
     cast mounted on its robot's body, blind to those shapes (``own_shapes.py``, the lidar's way)."""
-    body = device._scene.robot_body(device.robot_index) if device.own_shapes else None
-    own = None if body is None else OwnBodyRays(body, device.local_pose, dirs.reshape(-1, 3), *limits, device.own_shapes)
+    body = device._scene.device_body(device.robot_index, device.on_joint) if device.own_shapes else None
+    own = None if body is None else OwnBodyRays(body, device.mount_pose, dirs.reshape(-1, 3), *limits, device.own_shapes)
     return MountedRays(dirs, own)
 
 
@@ -76,7 +76,8 @@ def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, 
     origins = np.broadcast_to(pose.translation, dirs.shape)
     engine = device._scene.engine
     if rays.own is not None:
-        return rays.own.cast(engine, origins, dirs, device._robot.pose.rotation, dirs32, distance_only)
+        return rays.own.cast(engine, origins, dirs, device.carrier_rotation(device._robot.pose), dirs32,
+                             distance_only)
     return engine.cast(origins, dirs, *limits, kind=RayKind.VISUAL, exclude_owner=-1, distance_only=distance_only,
                        directions32=dirs32)
 

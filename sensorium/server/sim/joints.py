@@ -10,7 +10,10 @@ kinematic control, run once per basic step):
   ``acceleration``, or its available torque/force when that is -1 or larger), then the position
   moves by ``speed·dt`` towards the target (up for +inf), never past a finite target.
 
-Only the position moves: the shapes and devices past the joint stay where the world put them.
+:class:`Links` moves what rides on the joints (``on_joint`` in the world file): a hinge at position
+``q`` turns its end point by ``q - q0`` (``q0``: its initial position, where the file places the end
+point) about its axis through its anchor, a slider moves it by ``q - q0`` along its axis (Webots'
+HingeJoint/SliderJoint end point rule), nested joints composed outward.
 """
 
 from __future__ import annotations
@@ -18,6 +21,11 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import dataclass
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.world.geometry import Pose
 
 _POSITION_THRESHOLD = 1e-6       # Webots' TARGET_POSITION_THRESHOLD
 _VELOCITY_THRESHOLD = 1e-6       # Webots' TARGET_VELOCITY_THRESHOLD
@@ -150,3 +158,58 @@ class JointMotor:
         else:
             position -= speed * dt_s
             self.position = max(position, target)
+
+
+class Links:
+    """A robot's links: for each of its joints, the displacement (robot frame) of what rides on it
+    from where the world file places it, composed through the joints it rides on. Axes and anchors
+    are in the robot frame with every joint at its initial position (schemas/world.py ``Motor``)."""
+
+    def __init__(self, model: wm.Robot, joints: dict[str, JointMotor]):
+        specs = {d.name: d for d in model.devices if isinstance(d, wm.Motor) and d.name in joints}
+        self._joints = joints
+        self.order: list[str] = []           # parents before children
+        placed: set[str] = set()
+
+        def visit(name: str) -> None:
+            if name in placed:
+                return
+            parent = specs[name].on_joint
+            if parent is not None:
+                visit(parent)
+            placed.add(name)
+            self.order.append(name)
+
+        for name in specs:
+            visit(name)
+        self._frames = {}
+        for name in self.order:
+            d = specs[name]
+            axis = np.asarray(d.joint_axis, dtype=np.float64)
+            axis = axis / np.max(np.abs(axis))
+            axis = axis / float(np.linalg.norm(axis))          # a unit axis (scaled first: no overflow)
+            self._frames[name] = (isinstance(d, wm.RotationalMotor), axis, np.asarray(d.anchor, dtype=np.float64),
+                                  d.on_joint)
+        self.poses: dict[str, Pose] = {name: Pose.identity() for name in self.order}
+        self._at: dict[str, float] = {name: self._joints[name].initial_position for name in self.order}
+
+    def update(self) -> list[str]:
+        """Recompute the links after the joints moved: the names of those whose pose changed."""
+        changed: list[str] = []
+        moved: set[str] = set()
+        for name in self.order:
+            hinge, axis, anchor, parent = self._frames[name]
+            q = self._joints[name].position
+            if q == self._at[name] and parent not in moved:
+                continue
+            self._at[name] = q
+            delta = q - self._joints[name].initial_position
+            if hinge:
+                own = Pose.from_axis_angle(axis, delta)
+                own = Pose._owned(own.rotation.copy(), anchor - own.rotation @ anchor)
+            else:
+                own = Pose(np.eye(3), axis * delta)
+            self.poses[name] = own if parent is None else self.poses[parent].compose(own)
+            moved.add(name)
+            changed.append(name)
+        return changed

@@ -29,6 +29,8 @@ from sensorium.server.world.meshes import elevation_grid_mesh, load_mesh, triang
 from sensorium.server.world.poses import pose_from_model
 from sensorium.server.world.textures import TextureSampler, load_alpha, resolve_texture_url
 
+_IDENTITY = Pose.identity()
+
 
 @dataclass(frozen=True, slots=True)
 class ShapeInfo:
@@ -339,6 +341,9 @@ class Scene:
         self.robot_names = [r.name for r in world.robots]
         self.robot_poses: list[Pose] = []
         self._robot_body: dict[int, int] = {}
+        self._link_body: dict[tuple[int, str], int] = {}       # (robot, joint) -> its link's body
+        self._shape_link: dict[int, tuple[int, str]] = {}      # shape -> (robot, joint) it rides on
+        self.link_poses: dict[tuple[int, str], Pose] = {}      # (robot, joint) -> its link's displacement now
         self._device_shapes: dict[tuple[int, str], frozenset[int]] = {}   # (robot, device) -> its own shapes
         for i, r in enumerate(world.robots):
             pose = pose_from_model(r.pose)
@@ -348,15 +353,25 @@ class Scene:
                 self._led_lights[(i, name)] = models
                 self._lights += [(m, i, Pose.identity()) for m in models]
             parts = list(robot_parts(r))
-            if parts:
+            # a joint's link (the shapes riding on it: ``on_joint``) is a movable body of its own, owned
+            # by the robot; every other shape is the robot's body, as in a robot without joints
+            links: dict[str | None, list] = {}
+            for part in parts:
+                links.setdefault(getattr(part[2], "on_joint", None), []).append(part)
+            owned: dict[str, set[int]] = {}
+            for joint, group in sorted(links.items(), key=lambda kv: kv[0] is not None):
                 first = len(self.shapes)
-                self._robot_body[i] = self._add_body(parts, base_dir, pose, owner=i, movable=True, key=i)
-                owned: dict[str, set[int]] = {}
-                for k, (_, _, shape) in enumerate(parts):
+                body = self._add_body(group, base_dir, pose, owner=i, movable=True, key=i)
+                if joint is None:
+                    self._robot_body[i] = body
+                else:
+                    self._link_body[(i, joint)] = body
+                    self._shape_link.update((first + k, (i, joint)) for k in range(len(group)))
+                for k, (_, _, shape) in enumerate(group):
                     device = getattr(shape, "of_device", None)
                     if device is not None:
                         owned.setdefault(device, set()).add(first + k)
-                self._device_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
+            self._device_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
         self._attached = {owner for _, owner, _ in self._lights if owner is not None}
         # textures: one sampler for the world's images (None without any), read by infra-red only
         self._base_dir = base_dir
@@ -365,6 +380,7 @@ class Scene:
                                  ink_evaporation=self._ink_evaporation)
         self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
+        self._link_frames: dict[tuple[int, str], tuple[Pose, Pose, Pose]] = {}   # link -> (robot, link, world)
         self.lights_version = 0        # changes whenever a light moves with its owner
         self.solids_version = 0        # changes whenever a top-level solid moves, is added or removed (gym's TopDown)
         self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
@@ -534,6 +550,11 @@ class Scene:
         """The engine body of robot ``index`` (None for a robot without a body)."""
         return self._robot_body.get(index)
 
+    def device_body(self, index: int, joint: str | None) -> int | None:
+        """The engine body a device of robot ``index`` is rigidly mounted on: its joint's link
+        (``joint``: the device's ``on_joint``; None when that link has no shapes), else the robot's."""
+        return self._robot_body.get(index) if joint is None else self._link_body.get((index, joint))
+
     def set_robot_pose(self, index: int, pose: Pose) -> None:
         self.robot_poses[index] = pose
         if index in self._attached:
@@ -541,6 +562,18 @@ class Scene:
         body = self._robot_body.get(index)
         if body is not None:
             self.engine.set_body_pose(body, pose)
+        if self._link_body:
+            for (r, joint), link in self._link_body.items():
+                if r == index:
+                    self.engine.set_body_pose(link, pose.compose(self.link_poses.get((r, joint), _IDENTITY)))
+
+    def set_link_pose(self, index: int, joint: str, displacement: Pose) -> None:
+        """Joint ``joint`` of robot ``index`` moved: what rides on it is ``displacement`` (robot frame)
+        from where the world file placed it (sim/joints.py ``Links``)."""
+        self.link_poses[(index, joint)] = displacement
+        body = self._link_body.get((index, joint))
+        if body is not None:
+            self.engine.set_body_pose(body, self.robot_poses[index].compose(displacement))
 
     def set_solid_pose(self, name: str, pose: Pose) -> None:
         if name not in self.solid_poses:
@@ -553,16 +586,27 @@ class Scene:
         if name in self._solid_body:
             self.engine.set_body_pose(self._solid_body[name], pose)
 
-    def shape_pose(self, shape: int) -> Pose:
-        """The world pose of a shape now (its owner's pose ∘ its frame in the owner)."""
-        key, local, _ = self._parts[shape]
+    def _carrier(self, shape: int, key: str | int) -> Pose:
+        """The pose a shape is fixed in: its owner's, or a robot's composed with its link's."""
         owner = self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
-        return owner.compose(local)
+        link = self._shape_link.get(shape) if self._shape_link else None
+        if link is not None and link in self.link_poses:
+            kept = self._link_frames.get(link)
+            displacement = self.link_poses[link]
+            if kept is None or kept[0] is not owner or kept[1] is not displacement:
+                kept = self._link_frames[link] = (owner, displacement, owner.compose(displacement))
+            return kept[2]
+        return owner
+
+    def shape_pose(self, shape: int) -> Pose:
+        """The world pose of a shape now (its owner's pose ∘ its link's, on a joint ∘ its frame)."""
+        key, local, _ = self._parts[shape]
+        return self._carrier(shape, key).compose(local)
 
     def _world_to_shape(self, shape: int) -> Pose:
         """The inverse of a shape's world pose, kept while its owner's pose object is the same."""
         key, local, _ = self._parts[shape]
-        owner = self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
+        owner = self._carrier(shape, key)
         kept = self._inverse.get(shape)
         if kept is None or kept[0] is not owner:
             kept = self._inverse[shape] = (owner, owner.compose(local).inverse())

@@ -99,6 +99,25 @@ class Device:
 
     def __post_init__(self) -> None:
         self.local_pose: Pose = pose_from_model(self.config.pose)
+        # on a joint (``on_joint``): its pose in its link's body frame (the robot frame with every joint
+        # at its initial position), the link's displacement now, and the link's engine body (None
+        # without shapes); local_pose is then displacement ∘ mount_pose, updated as the joint moves
+        self.mount_pose: Pose = self.local_pose
+        self.link: Pose | None = None
+        self.link_body: int | None = None
+
+    @property
+    def on_joint(self) -> str | None:
+        return getattr(self.config, "on_joint", None)
+
+    def move_with(self, displacement: Pose) -> None:
+        """Its joint's link moved: it is ``displacement`` (robot frame) from where the file placed it."""
+        self.link = displacement
+        self.local_pose = displacement.compose(self.mount_pose)
+
+    def carrier_rotation(self, robot_pose: Pose) -> np.ndarray:
+        """The world rotation of the body it is rigidly mounted on (its robot's, or its link's)."""
+        return robot_pose.rotation if self.link is None else robot_pose.rotation @ self.link.rotation
 
     @property
     def name(self) -> str:
@@ -255,7 +274,7 @@ class Lidar(Device):
     def bind(self, robot: Any) -> None:
         if self.own_shapes:
             scene = robot.scene
-            body = scene.robot_body(self.robot_index)
+            body = scene.device_body(self.robot_index, self.on_joint)
             if body is not None:
                 n = self.config.number_of_layers * self.config.horizontal_resolution
                 self._own_body = (scene, body, Mount(np.full(n, body, dtype=np.int64)))
@@ -267,8 +286,8 @@ class Lidar(Device):
         engine = scene.engine
         if self._own_hits is None or self._own_hits[0] != engine.precision:
             L, W = self.config.number_of_layers, self.config.horizontal_resolution
-            D = self._all_dirs.reshape(-1, 3) @ self.local_pose.rotation.T
-            O = np.broadcast_to(self.local_pose.translation, D.shape)
+            D = self._all_dirs.reshape(-1, 3) @ self.mount_pose.rotation.T
+            O = np.broadcast_to(self.mount_pose.translation, D.shape)
             far = self._t_far.reshape(-1) if isinstance(self._t_far, np.ndarray) else self._t_far
             h = cast_local_skipping(engine, body, np.ascontiguousarray(O), D, self.params.near, far, RayKind.VISUAL,
                                     False, [self.own_shapes] * (L * W))

@@ -27,7 +27,7 @@ from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.ground import Ground, GroundWarning, band_low
-from sensorium.server.sim.joints import JointMotor
+from sensorium.server.sim.joints import JointMotor, Links
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radar import Radar
@@ -138,6 +138,16 @@ class RobotState:
                                               if isinstance(d, wm.Motor) and d.name not in drive_motors}
         self.motors: dict[str, WheelMotor | JointMotor] = (
             {**drive_motors, **self.joints} if self.joints else cast("dict[str, WheelMotor | JointMotor]", drive_motors))
+        # what rides on the joints (``on_joint``): their links, and the devices on each (None: nothing rides)
+        self.links: Links | None = None
+        self.riders: dict[str, list[Device]] = {}
+        if any(getattr(x, "on_joint", None) is not None for x in (*model.shapes, *model.devices)):
+            self.links = Links(model, self.joints)
+            for dev in self.devices.values():
+                if dev.on_joint is not None:
+                    self.riders.setdefault(dev.on_joint, []).append(dev)
+                    dev.link_body = sim.scene.device_body(index, dev.on_joint)
+                    dev.move_with(self.links.poses[dev.on_joint])
         for dev in self.devices.values():
             dev.bind(self)
         self.device_list = device_entries(model, self.devices, self.motors)
@@ -161,6 +171,19 @@ class RobotState:
     @property
     def basic_time_step(self) -> int:
         return self._sim.basic_time_step
+
+    def move_links(self) -> bool:
+        """The joints moved: their links' bodies and the devices on them follow (whether a device moved)."""
+        if self.links is None:
+            return False
+        moved = False
+        for joint in self.links.update():
+            displacement = self.links.poses[joint]
+            self._sim.scene.set_link_pose(self.index, joint, displacement)
+            for dev in self.riders.get(joint, ()):
+                dev.move_with(displacement)
+                moved = True
+        return moved
 
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
@@ -227,6 +250,7 @@ class Simulation:
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
         self._jointed = [j for r in self.robots.values() for j in r.joints.values()]
+        self._linked = [r for r in self.robots.values() if r.links is not None]
         if self.ground is not None:
             self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
@@ -301,6 +325,8 @@ class Simulation:
                 pose = robot.drive.placed(pose)
             for joint in robot.joints.values():
                 joint.reset()
+            if robot.move_links():
+                self._distance_plans.clear()
             self.place_robot(robot, pose)
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
@@ -478,10 +504,15 @@ class Simulation:
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
         moved: list[tuple[RobotState, DifferentialDrive | AckermannDrive, tuple[float, float], Pose]] = []
-        if self._jointed:             # joints move kinematically (sim/joints.py); nothing past them moves
+        if self._jointed:             # joints move kinematically (sim/joints.py), and what rides on them
             dt_s = dt * 0.001
             for joint in self._jointed:
                 joint.advance(dt_s)
+            moved_links = False
+            for linked in self._linked:
+                moved_links = linked.move_links() or moved_links
+            if moved_links:           # distance sensors' stacked poses (and own-body hits) are made again
+                self._distance_plans.clear()
         for robot in self._driven:
             drive = robot.drive
             assert drive is not None
@@ -557,7 +588,8 @@ class Simulation:
                                    self._distance_plan(distances), self.scene.engine, self.scene)
             work.append((dbatch, dbatch.plan()))
         for lidar in lidars:
-            work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt, self.scene.robot_body(lidar.robot_index))))
+            work.append((lidar, lidar.plan(poses[lidar.robot_index], now, dt,
+                                           self.scene.device_body(lidar.robot_index, lidar.on_joint))))
         hits = self._cast_batched([req for _, reqs in work for req in reqs])
         k = 0
         for item, reqs in work:

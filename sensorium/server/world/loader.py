@@ -453,6 +453,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                 problems.append(Problem(f"{rp}.shapes[{s_i}].of_device",
                                         f"{part.of_device!r} is not a device of this robot "
                                         f"(devices: {', '.join(repr(n) for n in device_names) or 'none'})"))
+        problems += _check_joints(robot, rp)
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"
             table = getattr(dev, "lookup_table", None)
@@ -486,6 +487,39 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
 
         problems += [Problem(*p) for p in check_textures(world, base_dir, limits or WorldLimits(), allow_outside_meshes,
                                                          asset_files)]
+    return problems
+
+
+def _check_joints(robot: wm.Robot, rp: str) -> list[Problem]:
+    """``on_joint`` names one of the robot's joint motors (a RotationalMotor or LinearMotor that is
+    not its drive's), and joints riding on joints never loop back."""
+    problems: list[Problem] = []
+    drive = {m for _, m in robot.drive_motors}
+    joints = {d.name: d for d in robot.devices if isinstance(d, wm.Motor) and d.name not in drive}
+    riders = [(f"{rp}.shapes[{i}].on_joint", p.on_joint) for i, p in enumerate(robot.shapes)]
+    riders += [(f"{rp}.devices[{i}].on_joint", d.on_joint) for i, d in enumerate(robot.devices)]
+    for path, name in riders:
+        if name is not None and name not in joints:
+            problems.append(Problem(path, f"{name!r} is not a joint motor of this robot (RotationalMotor or LinearMotor "
+                                          f"entries, drives' excepted: {', '.join(repr(n) for n in joints) or 'none'})"))
+    on = {d.name: d.on_joint for d in robot.devices}
+    for i, part in enumerate(robot.shapes):
+        if part.of_device is not None and part.of_device in on and part.on_joint != on[part.of_device]:
+            problems.append(Problem(f"{rp}.shapes[{i}].on_joint", f"a shape of device {part.of_device!r} rides on "
+                                    f"its device's joint: {on[part.of_device]!r}, not {part.on_joint!r}"))
+    if problems:
+        return problems
+    for i, d in enumerate(robot.devices):
+        if d.name not in joints:
+            continue
+        seen, at = {d.name}, d.on_joint
+        while at is not None:
+            if at in seen:
+                problems.append(Problem(f"{rp}.devices[{i}].on_joint",
+                                        f"joint {d.name!r} rides on itself through {at!r} (joints must form a tree)"))
+                break
+            seen.add(at)
+            at = joints[at].on_joint
     return problems
 
 

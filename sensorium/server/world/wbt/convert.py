@@ -5,7 +5,9 @@ devices and lights; a top-level Solid becomes a world solid, a Solid inside it o
 ``children``; everything inside a Robot (nested Solids, joint end points, device bodies) becomes a
 body shape or a device of the robot, placed relative to the robot. Two motorised HingeJoint wheels
 on one axle become the robot's kinematic ``differential_drive``; steered front wheels (vertical
-hinges or Hinge2Joints) and driven wheels its ``ackermann_drive`` (wbt/drive.py).
+hinges or Hinge2Joints) and driven wheels its ``ackermann_drive`` (wbt/drive.py). Any other
+motorised HingeJoint or SliderJoint keeps its axis (and anchor) in the robot's frame on its motor,
+and what its end point holds names that motor in ``on_joint`` (it moves with the joint).
 
 Poses keep the file's exact axis-angle values when only one level rotates (so a converted world
 reads bit for bit like its hand-written twin); a pose composed of several rotations is written as
@@ -63,9 +65,10 @@ SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "R
 JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
 MOTORS = {"RotationalMotor", "LinearMotor"}
 OTHER_MOTOR_NAMES = {"RotationalMotor": "rotational motor", "LinearMotor": "linear motor"}
-JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "max_torque", "position")
-JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), the "
-               "shapes and devices past the joint stay where they are")
+JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "max_torque", "position", "axis",
+              "anchor")
+JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
+               "the shapes and devices past the joint with it")
 # the fields every Solid has (a device's own fields are the others)
 SOLID_FIELDS = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
                 "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection",
@@ -104,6 +107,7 @@ class Converter:
         self.robot_names: Counter[str] = Counter()
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.device_depth = 0              # > 0 while inside a device's children (its joints are no wheels)
+        self.riding: list[dict] = []       # the motor entries of the robot's joints being visited, innermost last
         self.device_where: dict[int, str] = {}   # id(device entry) -> where its node is written
         self.led_of: dict[int, tuple[dict, Frame]] = {}   # id(light node) -> (its LED's entry, the LED's frame)
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
@@ -550,6 +554,7 @@ class Converter:
                 part["cast_shadows"] = False
             owner.keys[key] = part
         part["_at"] = self.at(gnode)
+        self.ride(part)
         owner.parts.append(part)
 
     def bounding(self, node: Node | None, frame: Frame, owner: Owner) -> None:
@@ -912,6 +917,7 @@ class Converter:
                             "its battery sensor reads NaN, as a Webots robot without a battery")
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
+        self.riding = []
         self.solid_contents(node, Frame.identity(), mine)
         self.carried_radar_targets(data)
         self.drive(node, mine)
@@ -921,6 +927,7 @@ class Converter:
         for part in data.get("shapes", ()):      # the device's final name (after unique_devices)
             if "_device" in part:
                 part["of_device"] = part.pop("_device")["name"]
+        self.on_joints(data)
         self.devices_inside(data)
         if not data["devices"]:
             del data["devices"]
@@ -986,6 +993,7 @@ class Converter:
             for name, what in unread_image_fields(node.type, node.fields):
                 self.warn(node, f"{node.type} {data['name']!r} of robot {owner.data['name']!r}: {name} ({what}) is "
                                 "not rendered here; the image is Webots' without it")
+            self.ride(data)
             owner.data["devices"].append(data)
             if node.type == "LED":
                 self.led_of.update((id(lt), (data, inner)) for lt in self.led_lights(node))
@@ -1025,6 +1033,7 @@ class Converter:
         if t not in wm.UNSIMULATED_DEVICE_TYPES:       # a kind simulated here: its own fields, by their names
             data.update(self.device_fields(node))
         data["_at"] = self.at(node)
+        self.ride(data)
         owner.data["devices"].append(data)
         return data
 
@@ -1060,6 +1069,7 @@ class Converter:
             if d.type in MOTORS:
                 entry = {"name": self.fields(d).string("name", OTHER_MOTOR_NAMES[d.type]), "device": d.type,
                          **self.motor_fields(d, position), "_at": self.at(d)}
+                self.ride(entry)
                 owner.data["devices"].append(entry)
                 motors.append(entry)
             elif d.type == "PositionSensor":
@@ -1102,13 +1112,36 @@ class Converter:
                     "max_torque": 10.0, "max_force": 10.0, "position": 0.0}
         return {k: v for k, v in out.items() if v != defaults[k]}
 
+    def ride(self, entry: dict) -> None:
+        """A robot's shape or device (or a joint's motor) found inside a joint's end point rides on
+        that joint, the innermost one (its motor's entry, named once names are final: ``on_joints``)."""
+        if self.riding:
+            entry["_on_joint"] = self.riding[-1]
+
+    def joint_frame(self, node: Node, frame: Frame, entry: dict) -> None:
+        """A HingeJoint's axis and anchor, a SliderJoint's axis, from its parent Solid's frame into
+        the robot's (``frame``: the joint's place in the robot), on its motor's entry."""
+        params = self.fields(node).node_("jointParameters")
+        pf = self.fields(params) if params is not None else None
+        default = (1.0, 0.0, 0.0) if node.type == "HingeJoint" else (0.0, 0.0, 1.0)
+        axis = pf.vec("axis", default) if pf else default
+        entry["axis"] = [float(v) for v in frame.rotation @ np.asarray(axis, dtype=np.float64)]
+        if node.type == "HingeJoint":
+            anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
+            entry["anchor"] = [float(v) for v in frame.apply(anchor)]
+
     def joint(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
         end = f.node_("endPoint")
         motors = [d for d in f.nodes("device") if d.type in MOTORS]
         sensors: list[dict] = []
+        moving: list[dict] = []
         if owner.kind == "robot":
-            _, sensors = self.joint_devices(node, owner)
+            moving, sensors = self.joint_devices(node, owner)
+            if node.type not in ("HingeJoint", "SliderJoint"):
+                moving = []
+            elif moving:
+                self.joint_frame(node, frame, moving[0])
         # a joint inside a device (a lidar's spinning turret, a camera's pan-tilt) moves the device,
         # never the robot: it is no wheel, whatever its axis (Webots has no notion of a drive either)
         wheeled = owner.kind == "robot" and not self.device_depth
@@ -1144,7 +1177,13 @@ class Converter:
         if end is not None:
             if end.type == "SolidReference":
                 return
-            self.visit(end, frame, owner)
+            if moving:          # what the end point holds rides on this joint (its first motor's)
+                self.riding.append(moving[0])
+            try:
+                self.visit(end, frame, owner)
+            finally:
+                if moving:
+                    self.riding.pop()
 
     def slotted(self, end: Node | None) -> Node | None:
         """A joint's end point, through the Slots that hold it (a Slot adds no frame)."""
@@ -1223,6 +1262,28 @@ class Converter:
             if entry["device"] == "RotationalMotor" and entry["name"] in drive_motors:
                 for key in JOINT_KEYS:
                     entry.pop(key, None)
+                entry["_wheel"] = True
+
+    def on_joints(self, robot: dict) -> None:
+        """Each shape and device riding on a joint names its motor (``on_joint``), names final; what
+        rides on a wheel (the drive's) rides on whatever the wheel rides on (the body, mostly)."""
+        def resolved(entry: dict) -> dict | None:
+            joint = entry.get("_on_joint")
+            while joint is not None and joint.get("_wheel"):
+                joint = joint.get("_on_joint")
+            return joint
+
+        devices = {d["name"]: d for d in robot["devices"]}
+        for entry in [*robot["devices"], *robot.get("shapes", ())]:
+            joint = resolved(entry)
+            if "of_device" in entry:    # a device's own shapes move as the device does (a joint inside a
+                joint = resolved(devices[entry["of_device"]])   # device, a lidar's turret, turns none of them)
+            if joint is not None:
+                entry["on_joint"] = joint["name"]
+        for entry in [*robot["devices"], *robot.get("shapes", ())]:
+            entry.pop("_on_joint", None)
+        for entry in robot["devices"]:
+            entry.pop("_wheel", None)
 
 
 def drive_motor_names(robot: dict) -> list[str]:
