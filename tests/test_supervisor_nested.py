@@ -182,6 +182,21 @@ def test_a_removed_solids_nested_nodes_go_with_it():
     assert msg == f"get_node_pose: node {LID} (Solid 'lid') was removed with 'shelf'"
 
 
+def test_a_use_of_a_nested_def_is_a_copy_without_it(tmp_path):
+    """Webots' USE makes a copy that has no DEF: the DEF finds the node the file defines."""
+    (tmp_path / "w.wbt").write_text(
+        '#VRML_SIM R2023b utf8\nDEF BOT Robot { name "bot" supervisor TRUE children [\n'
+        '  Pose { translation 0 0 1 children [ DEF BOX Solid { translation 1 0 0 name "box" } ] }\n'
+        '  Pose { translation 0 0 2 children [ USE BOX ] }\n] }\n')
+    lv = Live(Simulation(load_world(tmp_path / "w.wbt")))
+    lv.ok(A, "attach", {"robot": "bot"})
+    box = lv.ok(A, "/bot/robot/get_from_def", {"name": "BOX"})["node"]
+    assert lv.ok(A, "/bot/robot/get_node_pose", {"node": box})["position"] == pytest.approx([1.0, 0.0, 1.0])
+    second = lv.ok(A, "/bot/robot/get_from_id", {"id": box + 2})
+    assert (second["type"], second["name"], second["def_name"]) == ("Solid", "box", "")
+    assert lv.ok(A, "/bot/robot/get_node_pose", {"node": box + 2})["position"] == pytest.approx([1.0, 0.0, 2.0])
+
+
 def test_proto_internal_defs_are_not_found(tmp_path):
     """A PROTO's internal DEF is not found (Webots); a node the world passes into a PROTO field is."""
     from _protos import HEADER
@@ -212,7 +227,7 @@ def test_a_webots_supervisor_finds_nested_nodes(tmp_path):
     out = json.loads(ctl.out[-1])
     assert out["found"] == [["Camera", "CAM", "cam"], ["Solid", "TIP", "tip"], ["Solid", "LID", "lid"]]
     assert out["parents"] == ["MAST", "ROVER", "ARM"]
-    assert out["device"] == [True, "RotationalMotor", "LEFT_JOINT"]
+    assert out["device"] == [True, "RotationalMotor", "LEFT_JOINT", True, True, True]
     assert out["children"] == ["Pose", "Solid", "DistanceSensor", "HingeJoint", "HingeJoint"]
     assert out["tip"] == pytest.approx([0.0, 0.0, 0.3], abs=1e-12)
     d = W * R * 10 * DT

@@ -42,10 +42,11 @@ FIELD_TYPES = {"SFBool": WB_SF_BOOL, "SFInt32": WB_SF_INT32, "SFFloat": WB_SF_FL
                "SFVec3f": WB_SF_VEC3F, "SFRotation": WB_SF_ROTATION, "SFColor": WB_SF_COLOR,
                "SFString": WB_SF_STRING, "SFNode": WB_SF_NODE, "MFColor": WB_MF_COLOR, "MFNode": WB_MF_NODE}
 _TYPE_NAMES = {v: k for k, v in FIELD_TYPES.items()}
-# Webots' node type constants of the node kinds Sensorium serves
+# Webots' node type constants by type name (any other type, a device's, a Pose's, a HingeJoint's:
+# nodes.node_type, which spells the constant from the name; Hinge2Joint's does not spell it)
 NODE_TYPES = {"Group": "WB_NODE_GROUP", "Robot": "WB_NODE_ROBOT", "Solid": "WB_NODE_SOLID",
               "PointLight": "WB_NODE_POINT_LIGHT", "SpotLight": "WB_NODE_SPOT_LIGHT",
-              "DirectionalLight": "WB_NODE_DIRECTIONAL_LIGHT"}
+              "DirectionalLight": "WB_NODE_DIRECTIONAL_LIGHT", "Hinge2Joint": "WB_NODE_HINGE_2_JOINT"}
 
 Field = tuple[int, str, int]
 _NAN3 = [math.nan] * 3

@@ -5,7 +5,7 @@ camera's world position before and after driving straight ahead. Written as for 
 import json
 import math
 
-from controller import Supervisor
+from controller import Node, Supervisor
 
 robot = Supervisor()
 timestep = int(robot.getBasicTimeStep())
@@ -19,7 +19,9 @@ parents = [cam.getParentNode().getDef(), robot.getFromDef("ARM").getParentNode()
            tip.getParentNode().getDef()]
 motor = robot.getDevice("left wheel")
 wheel = robot.getFromDevice(motor)
-device = [wheel is not None, wheel.getTypeName(), wheel.getParentNode().getDef()]
+device = [wheel is not None, wheel.getTypeName(), wheel.getParentNode().getDef(),
+          wheel.getType() == Node.ROTATIONAL_MOTOR, wheel.getParentNode().getType() == Node.HINGE_JOINT,
+          robot.getFromDevice(robot.getDevice("cam")).getType() == Node.CAMERA]
 children = robot.getSelf().getField("children")
 kinds = [children.getMFNode(i).getTypeName() for i in range(children.getCount())]
 cam_before = cam.getPosition()

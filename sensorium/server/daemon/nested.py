@@ -102,7 +102,8 @@ def build(sim: Any, loaded_solids: int) -> Table:
         owner = len(robots) + 1 + j
         solid = sim.world.solids[j]
 
-        def walk(s: wm.Solid, parent: int, at: Pose | None, solid_name: str = solid.name, owner: int = owner) -> None:
+        def walk(s: wm.Solid, parent: int, at: Pose | None, solid_name: str = sim.scene.solid_names[j],
+                 owner: int = owner) -> None:
             for child in s.children:
                 own = pose_from_model(child.pose)
                 local = own if at is None else at.compose(own)

@@ -123,6 +123,7 @@ class Converter:
         self.tree_stack: list[tuple[Node, int]] = []
         self.tree_field = "children"       # the field the next node walked sits in (a joint's endPoint, ...)
         self.builtin_proto: str | None = None   # a built-in PROTO being expanded (the expansion's node names it)
+        self.nested_defs: set[int] = set()      # nested nodes whose DEF is kept (a USE of one is a copy without it)
 
     # ------------------------------------------------------------ messages
     def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
@@ -360,7 +361,7 @@ class Converter:
         proto = node.proto or builtin
         if proto:
             entry["proto"] = proto
-        if node.def_name and self.written(node):
+        if self.nested_def(node):
             entry["def_name"] = node.def_name
         if node.type == "Solid" or node.type in SENSORS or node.type in OTHER_DEVICES or node.type in MOTORS:
             default = "solid" if node.type == "Solid" else fx.DEVICE_NAMES.get(
@@ -371,6 +372,14 @@ class Converter:
         if field != "children":
             entry["field"] = field
         self.tree.append(entry)
+
+    def nested_def(self, node: Node) -> bool:
+        """Whether a nested node keeps its DEF: the world file writes it, and this is the DEF's node,
+        not a USE of it (the parser hands the same node for both; Webots' USE copies have no DEF)."""
+        if not node.def_name or not self.written(node) or id(node) in self.nested_defs:
+            return False
+        self.nested_defs.add(id(node))
+        return True
 
     def written(self, node: Node) -> bool:
         """Whether the world file writes ``node`` (or the PROTO instance it is): a node of a PROTO's
@@ -883,7 +892,7 @@ class Converter:
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
             self.def_name(node, data)
-        elif node.def_name and self.written(node):     # a nested solid: found by DEF (a Supervisor walks it)
+        elif self.nested_def(node):     # a nested solid: found by DEF (a Supervisor walks it)
             data["def_name"] = node.def_name
         if owner.kind == "world":
             colors = f.colors("recognitionColors", [])        # what cameras with a Recognition node report
