@@ -37,7 +37,8 @@ CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene",
-               "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos"]
+               "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos",
+               "nested_nodes"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
@@ -46,6 +47,7 @@ SCENE_WORLD = REPO / "tests" / "worlds" / "supervisor_scene.yaml"
 REMOVE_WORLD = REPO / "tests" / "worlds" / "supervisor_remove.yaml"
 ROOT_WORLD = REPO / "tests" / "worlds" / "root_children.wbt"
 PROTOS_WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_protos.wbt"
+NESTED_WORLD = REPO / "tests" / "worlds" / "nested_nodes.wbt"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev)")
@@ -572,6 +574,29 @@ def test_c_supervisor_walks_the_roots_children_in_file_order(cbin, servers):
     assert out[2] == "view 0 -4 2"
     assert out[3] == "imported WorldInfo:INFO Viewpoint:VIEW Background:SKY Solid:BALL Solid:BOX Robot:BOSS PointLight:LAMP"
     assert out[4] == f"removed {order}"
+
+
+def test_c_supervisor_reaches_nested_nodes(cbin, servers):
+    """tests/c/nested_nodes.c on tests/worlds/nested_nodes.wbt (tests/test_supervisor_nested.py for
+    Python and its closed forms), built with sanitizers: nested DEFs and dotted paths, parents, a
+    device's node (a motor: no position), the robot's children; the camera at (1, 2.15, 0.3) moves
+    10 steps · 32 ms · 2 rad/s · 0.05 m along +y with the robot and stays at (0.15, 0, 0.3) in its
+    frame; setting a nested field gets the server's one line."""
+    code, out, err = finish(start([cbin["nested_nodes"]], servers(NESTED_WORLD).url("rover")))
+    assert code == 0, err
+    assert out[:6] == ["found Camera:CAM:cam Solid:TIP:tip Solid:LID:lid",
+                       "parents MAST ARM 1",
+                       "device 1 RotationalMotor LEFT_JOINT 1",
+                       "camera 1",
+                       "children Pose Solid DistanceSensor HingeJoint HingeJoint",
+                       "tip 0.000000000000 0.000000000000 0.300000000000"]
+    values = {line.split()[0]: [float(v) for v in line.split()[1:]] for line in out[6:]}
+    d = 2.0 * 0.05 * 10 * 0.032
+    assert values["before"] == pytest.approx([1.0, 2.15, 0.3], abs=1e-9)
+    assert values["after"] == pytest.approx([1.0, 2.15 + d, 0.3], abs=1e-9)
+    assert values["in_robot"] == pytest.approx([0.15, 0.0, 0.3], abs=1e-9)
+    assert "not served" not in err
+    assert "field 'translation' (SFVec3f) of Solid 'tip' is read-only here" in err
 
 
 def test_c_supervisor_names_proto_instances_and_reads_scenery_values(cbin, servers):

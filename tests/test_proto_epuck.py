@@ -50,7 +50,15 @@ def test_the_proto_robot_reads_bit_for_bit_like_its_base_node_twin() -> None:
     # the same world but for the robot's Supervisor type name (its PROTO's, the twin's base type)
     named = [n.model_copy(update={"proto": None}) if n.proto == "MiniPuck" else n for n in proto.world.top_nodes]
     assert [n.proto for n in proto.world.top_nodes if n.robots] == ["MiniPuck"]
-    assert proto.world.model_copy(update={"top_nodes": named}) == twin.world
+    # and for the DEF names and PROTOs inside it: the PROTO's DEFs are internal (not found by DEF), the
+    # twin's written in the world; its sensors are instances of the PROTO's own PROTOs
+    def undefined(world):
+        return [r.model_copy(update={"nodes": [n.model_copy(update={"def_name": None, "proto": None})
+                                               for n in r.nodes]}) for r in world.robots]
+
+    assert proto.world.model_copy(update={"top_nodes": named, "robots": undefined(proto.world)}) == \
+        twin.world.model_copy(update={"robots": undefined(twin.world)})
+    assert [n.def_name for n in proto.world.robots[0].nodes if n.def_name] == []
     (robot,) = proto.world.robots
     names = [d.name for d in robot.devices]
     assert names[:16] == [f"ps{i}" for i in range(8)] + [f"ls{i}" for i in range(8)]

@@ -2,8 +2,10 @@
 
 Only a controller of a robot whose world entry has ``supervisor: true`` may call them; any other
 prints Webots' error and gets the null answer (the server refuses too). Nodes are the world's root
-(Webots' root Group, id 0), robots, top-level solids and top-level lights, found by DEF name (else
-name), by id or through the root's ``children``; a node is its ``int`` id, ``None`` is Webots' NULL.
+(Webots' root Group, id 0), robots, top-level solids and top-level lights, and the nodes inside robots
+and solids (Solids, devices, Poses, Groups, joints), found by DEF name (a dotted path ``A.B``; else a
+top-level node's name), by id, by device or through ``children``; a node is its ``int`` id, ``None``
+is Webots' NULL.
 A field is a ``(node, name, type)`` tuple (``WB_SF_*``/``WB_MF_NODE``). Every call is one round trip,
 answered at once; setters take effect before the next measurement.
 """
@@ -40,10 +42,11 @@ FIELD_TYPES = {"SFBool": WB_SF_BOOL, "SFInt32": WB_SF_INT32, "SFFloat": WB_SF_FL
                "SFVec3f": WB_SF_VEC3F, "SFRotation": WB_SF_ROTATION, "SFColor": WB_SF_COLOR,
                "SFString": WB_SF_STRING, "SFNode": WB_SF_NODE, "MFColor": WB_MF_COLOR, "MFNode": WB_MF_NODE}
 _TYPE_NAMES = {v: k for k, v in FIELD_TYPES.items()}
-# Webots' node type constants of the node kinds Sensorium serves
+# Webots' node type constants by type name (any other type, a device's, a Pose's, a HingeJoint's:
+# nodes.node_type, which spells the constant from the name; Hinge2Joint's does not spell it)
 NODE_TYPES = {"Group": "WB_NODE_GROUP", "Robot": "WB_NODE_ROBOT", "Solid": "WB_NODE_SOLID",
               "PointLight": "WB_NODE_POINT_LIGHT", "SpotLight": "WB_NODE_SPOT_LIGHT",
-              "DirectionalLight": "WB_NODE_DIRECTIONAL_LIGHT"}
+              "DirectionalLight": "WB_NODE_DIRECTIONAL_LIGHT", "Hinge2Joint": "WB_NODE_HINGE_2_JOINT"}
 
 Field = tuple[int, str, int]
 _NAN3 = [math.nan] * 3
@@ -134,6 +137,20 @@ def wb_supervisor_node_get_from_def(name: str) -> int | None:
     return _node_id(_call(r, "get_from_def", {"name": name}))
 
 
+def wb_supervisor_node_get_from_device(tag: int) -> int | None:
+    """The node of this robot's device ``tag`` (Webots' getFromDevice): its world pose, parent and
+    fields as any node inside the robot; None (with Webots' line) for a tag that is no device."""
+    func = "wb_supervisor_node_get_from_device"
+    r = _supervisor(func)
+    if r is None:
+        return None
+    dev = next((d for d in r.devices if d.tag == tag), None) if isinstance(tag, int) else None
+    if dev is None:
+        print(f"Error: {func}() called with an invalid 'tag' argument.", file=sys.stderr)
+        return None
+    return _node_id(_call(r, "get_from_device", {"device": dev.name}))
+
+
 def wb_supervisor_node_get_self() -> int | None:
     r = _supervisor("wb_supervisor_node_get_self")
     return None if r is None else _node_id(_call(r, "get_self"))
@@ -187,7 +204,8 @@ def wb_supervisor_node_get_def(node: int | None) -> str:
 
 
 def wb_supervisor_node_get_parent_node(node: int | None) -> int | None:
-    """The root for a top-level node; None for the root."""
+    """The root for a top-level node, the node holding a nested one (a robot, a solid, a Pose, a
+    joint for its end point and devices); None for the root."""
     info = _live_node_info(node, "wb_supervisor_node_get_parent_node")
     if info is None or int(info["parent"]) < 0:
         return None

@@ -267,7 +267,13 @@ class StringArgs(Args):
 
 
 class NodeNameArgs(Args):
-    name: str = Field(min_length=1, max_length=4096, description="a robot's, solid's or light's DEF name, else its name")
+    name: str = Field(min_length=1, max_length=4096, description="a node's DEF name, or a dotted path of DEF names "
+                      "(A.B: B a direct child of A); else a robot's, solid's or light's name")
+
+
+class NodeDeviceArgs(Args):
+    device: str = Field(min_length=1, max_length=4096, description="the calling robot's device name (Webots "
+                        "wb_supervisor_node_get_from_device)")
 
 
 class NodeIdArgs(Args):
@@ -767,13 +773,14 @@ class StringValue(Result):
 class NodeResult(Result):
     node: int = Field(description="node id (0: the root); with type '' there is no such node (Webots' NULL)")
     type: str = Field(description="Webots' base type name: Group (the root), Robot, Solid, PointLight, SpotLight, "
-                                  "DirectionalLight, or a top-level node's not simulated (WorldInfo, Viewpoint, ...); "
-                                  "'' = no such node")
+                                  "DirectionalLight, a top-level node's not simulated (WorldInfo, Viewpoint, ...), "
+                                  "or a nested node's (Solid, Pose, Camera, HingeJoint, ...); '' = no such node")
     proto: str = Field(default="", description="a PROTO instance: the PROTO's name (Webots' getTypeName; "
                                                "isProto); '' for a base node")
     name: str = Field(description="the node's name (a robot's or solid's name field; a light's world-file name)")
     def_name: str = Field(description="its DEF name ('' without one)")
-    parent: int = Field(description="the parent's node id (0 for a top-level node; -1 for the root and NULL)")
+    parent: int = Field(description="the parent's node id (0 for a top-level node, the robot's or solid's id (or a "
+                                    "nested node's) for a nested node; -1 for the root and NULL)")
 
 
 class FieldValueResult(Result):
@@ -889,6 +896,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_model", "robot", NoArgs, StringValue),
     ServiceSpec("get_from_def", "robot", NodeNameArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_self", "robot", NoArgs, NodeResult, attached=True, supervisor=True),
+    ServiceSpec("get_from_device", "robot", NodeDeviceArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_root", "robot", NoArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_from_id", "robot", NodeIdArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_field", "robot", FieldArgs, FieldValueResult, attached=True, supervisor=True),

@@ -1056,6 +1056,28 @@ class AckermannDrive(Strict):
 
 # ---------------------------------------------------------------- robots and world
 
+class NestedNode(Strict):
+    """A node inside a robot as the Supervisor walks it (README "Supervisor"): a ``.wbt`` robot's
+    Solids, devices, Poses, Transforms, Groups, Slots and joints below it, depth first in file order
+    (its shapes, lights and geometries are no nodes here). Written by the ``.wbt`` import; a YAML
+    robot without ``nodes`` has one node per device, a child of the robot at the device's pose."""
+
+    type: str = Field(min_length=1, max_length=64, description="Webots' base node type (Solid, Pose, Camera, "
+                      "HingeJoint, ...)")
+    proto: str | None = Field(default=None, min_length=1, description="a PROTO instance: the PROTO's name")
+    def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef; "
+                                 "a PROTO's internal nodes have none: Webots does not find them by DEF)")
+    name: str | None = Field(default=None, description="a Solid's or device's name field")
+    parent: int = Field(default=-1, ge=-1, description="index of its parent in the robot's `nodes` (an earlier "
+                        "entry); -1: the robot")
+    field: Literal["children", "endPoint", "device", "device2"] = Field(
+        default="children", description="the parent's field that holds it")
+    pose: Pose | None = Field(default=None, description="its frame in the robot's frame as the world loads; "
+                              "none for a node that is no Pose (Group, joints, motors, position sensors)")
+    device: str | None = Field(default=None, min_length=1, description="the robot's device this node is "
+                               "(Supervisor getFromDevice)")
+
+
 class Robot(Strict):
     name: str = Field(min_length=1)
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
@@ -1085,12 +1107,20 @@ class Robot(Strict):
     radar_cross_section: float = Field(
         default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the robot a Radar target")
 
+    nodes: list[NestedNode] = Field(
+        default=[], max_length=200_000, description="the nodes inside the robot a Supervisor walks (getFromDef, "
+        "getFromDevice, children, parents, world poses); written by the .wbt import; empty: one per device")
+
     _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
     def _one_drive(self) -> Robot:
         if self.differential_drive is not None and self.ackermann_drive is not None:
             raise ValueError("a robot has one drive at most: give differential_drive or ackermann_drive, not both")
+        for i, node in enumerate(self.nodes):
+            if node.parent >= i:
+                raise ValueError(f"nodes[{i}] ({node.type}): parent {node.parent} must be an earlier node's index "
+                                 "(or -1: the robot)")
         return self
 
     @property

@@ -2,15 +2,16 @@
 
 Nodes are what the server simulates at the top of the world: the root (Webots' root Group, id 0,
 whose ``children`` lists the others), the robots (ids 1..R in world order), the top-level solids
-(R+1..R+S) and the world's top-level lights (then on). They are found by DEF name (``def_name``,
-set from a ``.wbt`` world's ``DEF``) or else by name. Ids are stable for the life of the server:
+(R+1..R+S) and the world's top-level lights (then on), and the nodes inside robots and top-level
+solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``nested.FIRST_ID``). They
+are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dotted path ``A.B`` walks
+direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
 a removed solid or light keeps its id, which then answers NULL and is never given to another node.
-Everything else of a Webots scene tree (shapes, devices, nested solids, lights carried by a solid
-or robot) is not a node here: Webots' NULL.
+Shapes, geometries and lights carried by a solid or robot are not nodes here: Webots' NULL.
 
-Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame (the world: nodes
-are not nested). Setting one field keeps the others (Webots). A field change applies at once; the
-next measurement sees it.
+Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame. Setting one field
+keeps the others (Webots). A field change applies at once; the next measurement sees it. A nested
+node's fields are read-only here.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import numpy as np
 from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
+from sensorium.server.daemon import nested
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.world.poses import matrix_quaternion
 from sensorium.server.world.top_nodes import Scenery
@@ -42,9 +44,29 @@ class Node:
                        # node's index (world/top_nodes.py); root: ""
     scenery: bool = False   # a top-level node Sensorium does not simulate (WorldInfo, Viewpoint, Background, ...)
     proto: str = ""         # the PROTO it is an instance of (Webots' getTypeName; ``type`` is its base type)
+    nested: bool = False    # inside a robot or top-level solid (nested.py; key: its id)
 
 
 ROOT = Node(0, "Group", "", "", "")
+
+
+def _table(sim: Any) -> nested.Table:
+    """The world's nested nodes, numbered once per simulation (they never change: imports add none)."""
+    table = getattr(sim, "_supervisor_nested", None)
+    if table is None:
+        table = nested.build(sim, _loaded_counts(sim)[0] if getattr(sim, "world", None) is not None else 0)
+        sim._supervisor_nested = table
+    return table
+
+
+def _nested_node(n: nested.Nested) -> Node:
+    return Node(n.id, n.type, n.name, n.def_name, n.id, proto=n.proto, nested=True)
+
+
+def _nested_of(sim: Any, node: Node) -> nested.Nested:
+    found = _table(sim).get(node.id)
+    assert found is not None
+    return found
 
 
 def _scenery(sim: Any) -> tuple[Scenery, ...]:
@@ -95,6 +117,9 @@ def _all_nodes(sim: Any) -> list[Node]:
 def _removed(sim: Any, node: Node) -> bool:
     if node.scenery:
         return False
+    if node.nested:                  # with its top-level solid
+        n = _nested_of(sim, node)
+        return n.owner_kind == "Solid" and n.owner_key not in sim.scene.solid_poses
     if node.type == "Solid":
         return node.key not in sim.scene.solid_poses
     return node.type in LIGHTS and node.key in sim.scene.removed_lights
@@ -133,16 +158,44 @@ def root_children(sim: Any) -> list[Node]:
     return [by_id[i] for i in order if i in by_id]
 
 
+def _scene_order(sim: Any) -> list[Node]:
+    """Every node in the world in Webots' scene order: the root's children, each followed by the nodes
+    inside it depth first."""
+    table = _table(sim)
+    out = []
+    for top in root_children(sim):
+        out.append(top)
+        out += [_nested_node(n) for n in table.by_owner.get(top.id, ())]
+    return out
+
+
 def find_node(sim: Any, name: str) -> Node | None:
-    """The robot, top-level solid or light whose DEF name (``def_name``) is ``name``, else whose name is."""
-    nodes = _nodes(sim)
-    for n in nodes:
-        if n.def_name == name:
-            return n
-    for n in nodes:
-        if n.name == name:
-            return n
-    return None
+    """Webots' getFromDef: the first node in scene order whose DEF name is ``name``'s first part, then
+    for each further dotted part (``ROBOT.ARM.CAMERA``) the direct child (in any node field) with that
+    DEF; for a name without a dot and no DEF: the robot, top-level solid or light of that name."""
+    first, *path = name.split(".")
+    if path and path[-1] == "":          # "A." is A (Webots reads nothing after the dot)
+        path.pop()
+    if not first or "" in path:          # a node without a DEF is never found by one
+        return None
+    found = next((n for n in _scene_order(sim) if n.def_name == first), None)
+    if found is None and not path:
+        found = next((n for n in _nodes(sim) if n.name == name), None)
+    table = _table(sim)
+    for part in path:
+        if found is None:
+            return None
+        sub = next((c for c in table.by_parent.get(found.id, ()) if c.def_name == part), None)
+        found = None if sub is None else _nested_node(sub)
+    return found
+
+
+def device_node(sim: Any, robot: str, device: str) -> Node | None:
+    """Webots' getFromDevice: the node of the calling robot's device of that name."""
+    me = robot_node(sim, robot)
+    table = _table(sim)
+    hit = None if me is None else next((n for n in table.by_owner.get(me.id, ()) if n.device == device), None)
+    return None if hit is None else _nested_node(hit)
 
 
 def robot_node(sim: Any, robot: str) -> Node | None:
@@ -152,6 +205,14 @@ def robot_node(sim: Any, robot: str) -> Node | None:
 def node_by_id(sim: Any, node: int) -> Node:
     if node == 0:
         return ROOT
+    if node >= nested.FIRST_ID:
+        inner = _table(sim).get(node)
+        if inner is None:
+            raise ValueError(f"no node with id {node}")
+        found = _nested_node(inner)
+        if _removed(sim, found):
+            raise ValueError(f"node {node} ({found.type} {found.name!r}) was removed with {inner.owner_key!r}")
+        return found
     nodes = _all_nodes(sim)
     if not 0 <= node <= len(nodes):
         raise ValueError(f"no node with id {node} (ids 0..{len(nodes)}: 0 the root)")
@@ -172,8 +233,9 @@ def node_from_id(sim: Any, node: int) -> Node | None:
 def node_ref(sim: Any, node: Node | None) -> dict:
     if node is None:
         return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
+    parent = _nested_of(sim, node).parent if node.nested else -1 if node.id == 0 else 0
     return {"node": node.id, "type": node.type, "name": node.name, "def_name": node.def_name,
-            "parent": -1 if node.id == 0 else 0, "proto": node.proto}
+            "parent": parent, "proto": node.proto}
 
 
 def _pose(sim: Any, node: Node) -> Any:
@@ -303,9 +365,15 @@ def _light_fields(kind: str) -> dict[str, tuple[str, Getter, Setter]]:
     return {name: (t, getter(attr), _set_light(attr, kind)) for name, (t, attr) in fields.items()}
 
 
+def _children(sim: Any, node: Node) -> list[int]:
+    """A robot's, solid's or nested node's ``children``: the nodes inside it (nested.py)."""
+    return nested.children(_table(sim), node.id)
+
+
 FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
     "Group": {"children": ("MFNode", lambda sim, n: [m.id for m in root_children(sim)], None)},
     "Robot": {**_POSE_FIELDS,
+              "children": ("MFNode", _children, None),
               "name": ("SFString", lambda sim, n: n.name, None),
               "model": ("SFString", lambda sim, n: sim.robots[n.key].model.model, None),
               "customData": ("SFString", lambda sim, n: sim.robots[n.key].custom_data, None),
@@ -314,6 +382,7 @@ FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
               "synchronization": ("SFBool", lambda sim, n: bool(sim.robots[n.key].synchronization), None),
               **_RADAR_FIELD},
     "Solid": {**_POSE_FIELDS,
+              "children": ("MFNode", _children, None),
               "name": ("SFString", lambda sim, n: n.name, None),
               "model": ("SFString", lambda sim, n: _solid_model(sim, n).model, None),
               **_RADAR_FIELD},
@@ -358,7 +427,32 @@ SCENERY_FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
 field of Fog, a Transform, ...) answers Webots' "no value"."""
 
 
-def _fields(node: Node) -> dict[str, tuple[str, Getter, Setter]]:
+def _own_pose(sim: Any, node: Node) -> Any:
+    own = _nested_of(sim, node).own
+    assert own is not None
+    return own
+
+
+_NESTED_POSE: dict[str, tuple[str, Getter, Setter]] = {
+    "translation": ("SFVec3f", lambda sim, n: [float(v) for v in _own_pose(sim, n).translation], None),
+    "rotation": ("SFRotation", lambda sim, n: matrix_axis_angle(_own_pose(sim, n).rotation), None),
+}
+
+
+def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
+    """A nested node's fields, all read-only here: its pose in its parent's frame, its name, its children."""
+    n = _nested_of(sim, node)
+    out = dict(_NESTED_POSE) if n.own is not None else {}
+    if n.name:
+        out["name"] = ("SFString", lambda sim, node: node.name, None)
+    if nested.has_children(n):
+        out["children"] = ("MFNode", _children, None)
+    return out
+
+
+def _fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
+    if node.nested:
+        return _nested_fields(sim, node)
     return SCENERY_FIELDS.get(node.type, {}) if node.scenery else FIELDS[node.type]
 
 
@@ -367,18 +461,21 @@ _VECTOR_SIZES = {"SFVec3f": 3, "SFColor": 3, "SFRotation": 4}
 
 def get_field(sim: Any, node: Node, field: str) -> dict:
     """``{"type", "value"}``; type '' (and value []) when the node has no such field here."""
-    entry = _fields(node).get(field)
+    entry = _fields(sim, node).get(field)
     if entry is None:
         return {"type": "", "value": []}
     return {"type": entry[0], "value": entry[1](sim, node)}
 
 
 def set_field(sim: Any, node: Node, field: str, value: Any) -> None:
-    entry = _fields(node).get(field)
+    entry = _fields(sim, node).get(field)
     what = f"{node.type} {node.name or node.id!r}"
     if entry is None:
-        raise ValueError(f"{what} has no field {field!r} here (fields: {', '.join(_fields(node)) or 'none'})")
+        raise ValueError(f"{what} has no field {field!r} here (fields: {', '.join(_fields(sim, node)) or 'none'})")
     kind, _, setter = entry
+    if setter is None and node.nested:
+        raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
+                         "top-level robots, solids and lights only, not the nodes inside them")
     if setter is None:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here")
     if kind == "SFBool":
@@ -396,16 +493,20 @@ def set_field(sim: Any, node: Node, field: str, value: Any) -> None:
 
 
 def node_pose(sim: Any, node: Node) -> dict:
-    if node.type not in ("Robot", "Solid"):          # Webots: NaN for a node that is no Transform
+    pose = nested.world_pose(sim, _nested_of(sim, node)) if node.nested else \
+        _pose(sim, node) if node.type in ("Robot", "Solid") else None
+    if pose is None:                                 # Webots: NaN for a node that is no Pose
         return {"position": [math.nan] * 3, "orientation": [math.nan] * 9}
-    pose = _pose(sim, node)
     return {"position": [float(v) for v in pose.translation],
             "orientation": [float(v) for v in np.asarray(pose.rotation).reshape(9)]}
 
 
 def node_velocity(sim: Any, node: Node) -> list[float]:
     """Webots' ``getVelocity``: a driven robot's from its kinematic drive's last step (world axes,
-    linear m/s then angular rad/s); anything else never moves by itself: zeros."""
+    linear m/s then angular rad/s), a node inside it moving with it; anything else never moves by
+    itself: zeros."""
+    if node.nested:
+        return nested.velocity(sim, _nested_of(sim, node))
     if node.type == "Robot":
         drive = sim.robots[node.key].drive
         if drive is not None:
@@ -428,6 +529,9 @@ def remove_node(sim: Any, node: Node) -> None:
     if node.scenery:
         raise ValueError(f"{node.type} (node {node.id}) cannot be removed here: only top-level solids and lights "
                          "can (Sensorium does not simulate it)")
+    if node.nested:
+        raise ValueError(f"{node.type} {node.name or node.def_name or node.id!r} (node {node.id}) cannot be removed "
+                         "here: only top-level solids and lights can, not the nodes inside a robot or solid")
     if node.type == "Solid":
         sim.remove_solid(node.key)
     elif node.type in LIGHTS:
@@ -495,6 +599,7 @@ def _set_mode(sim: Any, ls: Any, robot: str, a: Any) -> dict:
 HANDLERS = {
     "get_from_def": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, a.name)),
     "get_self": lambda sim, ls, robot, a: node_ref(sim, robot_node(sim, robot)),
+    "get_from_device": lambda sim, ls, robot, a: node_ref(sim, device_node(sim, robot, a.device)),
     "get_root": lambda sim, ls, robot, a: node_ref(sim, ROOT),
     "get_from_id": lambda sim, ls, robot, a: node_ref(sim, node_from_id(sim, a.id)),
     "get_field": lambda sim, ls, robot, a: get_field(sim, node_by_id(sim, a.node), a.field),

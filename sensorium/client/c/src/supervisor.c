@@ -2,7 +2,8 @@
  * WbFieldRef points to a small record kept until wb_robot_cleanup(); one record per node id and per
  * (node, field name), so the arrays and strings they hold stay valid between calls (until the next
  * call on the same node or field, as in Webots). Nodes are the root (id 0), robots, top-level solids
- * and top-level lights; a reply whose type is "" is Webots' NULL. */
+ * and top-level lights, and the nodes inside robots and solids (Solids, devices, Poses, Groups, joints);
+ * a reply whose type is "" is Webots' NULL. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,7 +20,7 @@ struct WbNodeStructPrivate {
   char type_name[64]; /* "Group", "Robot", "Solid", a light's, or a top-level node's not simulated ("WorldInfo") */
   char *def_name;     /* "" without one */
   char *proto;        /* a PROTO instance's PROTO name (wb_supervisor_node_get_type_name), "" for a base node */
-  int64_t parent;     /* 0 for a top-level node, -1 for the root */
+  int64_t parent;     /* 0 for a top-level node, the holding node's id for a nested one, -1 for the root */
   double position[3];
   double orientation[9];
   double velocity[6];
@@ -118,7 +119,13 @@ static const struct {
                   {"Fog", WB_NODE_FOG},
                   {"Transform", WB_NODE_TRANSFORM},
                   {"Pose", WB_NODE_POSE},
-                  {"Shape", WB_NODE_SHAPE}};
+                  {"Shape", WB_NODE_SHAPE},
+                  /* nodes inside a robot that are no devices (a device's type: sn_node_type_of) */
+                  {"HingeJoint", WB_NODE_HINGE_JOINT},
+                  {"Hinge2Joint", WB_NODE_HINGE_2_JOINT},
+                  {"SliderJoint", WB_NODE_SLIDER_JOINT},
+                  {"BallJoint", WB_NODE_BALL_JOINT},
+                  {"Slot", WB_NODE_SLOT}};
 
 static bool str_is(const msgpack_object *o, const char *s) {
   return o != NULL && o->type == MSGPACK_OBJECT_STR && o->via.str.size == strlen(s) &&
@@ -137,6 +144,8 @@ static WbNodeRef node_from_reply(sn_robot *rb, sn_reply *rep) {
     for (size_t i = 0; i < sizeof NODE_TYPES / sizeof NODE_TYPES[0]; i++)
       if (str_is(type, NODE_TYPES[i].name))
         n->type = NODE_TYPES[i].type;
+    if (n->type == WB_NODE_NO_NODE)
+      n->type = sn_node_type_of(n->type_name); /* a device inside a robot (Camera, RotationalMotor, ...) */
     char *def = sn_strdup_obj(sn_get(rep->result, "def_name"));
     if (def != NULL && n->def_name != NULL && strcmp(def, n->def_name) == 0)
       free(def); /* unchanged: the string a caller holds stays valid (the readers ask again each time) */
@@ -182,6 +191,24 @@ static WbNodeRef node_without_args(const char *item, const char *func) {
   sn_robot *rb = supervisor(func);
   sn_reply rep;
   if (rb == NULL || sn_robot_call(rb, item, 0, NULL, NULL, func, &rep) != 0)
+    return NULL;
+  return node_from_reply(rb, &rep);
+}
+
+static void args_device(sn_req *r, const void *arg) {
+  sn_req_key(r, "device");
+  sn_req_str(r, (const char *)arg);
+}
+
+/* the node of one of this robot's devices (its parent, pose and fields as any node inside the robot) */
+WbNodeRef wb_supervisor_node_get_from_device(WbDeviceTag tag) {
+  const char *func = "wb_supervisor_node_get_from_device";
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return NULL;
+  sn_device *d = sn_device_get(tag, SN_OTHER, func);
+  sn_reply rep;
+  if (d == NULL || sn_robot_call(rb, "robot/get_from_device", 1, args_device, d->name, func, &rep) != 0)
     return NULL;
   return node_from_reply(rb, &rep);
 }

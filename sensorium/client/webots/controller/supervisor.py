@@ -144,7 +144,8 @@ class Field:
 
 
 class Node:
-    """A node of the scene tree Sensorium has: the root (id 0), a robot, a top-level solid or light.
+    """A node of the scene tree Sensorium has: the root (id 0), a robot, a top-level solid or light, a
+    node inside a robot or solid (a Solid, device, Pose, Group, joint).
     ``type_name`` and ``name`` are what it was when found (its ``repr``); the getters ask again."""
 
     def __init__(self, ref: int, type_name: str = "", name: str = ""):
@@ -293,6 +294,11 @@ class Supervisor(Robot):
     def getFromId(self, id: int) -> Node | None:  # noqa: A002 - Webots' parameter name
         return _node_of(wb.wb_supervisor_node_get_from_id(id))
 
+    def getFromDevice(self, device: Any) -> Node | None:
+        """The node of one of this robot's devices (a Device object, as Webots takes)."""
+        tag = device.getTag() if hasattr(device, "getTag") else device
+        return _node_of(wb.wb_supervisor_node_get_from_device(tag))
+
     @staticmethod
     def _lookup(item: str, args: dict | None, func: str, name: str) -> dict | None:
         """The node reference (with its type, name, DEF and parent, which the flat API's int id lacks)."""
@@ -342,7 +348,7 @@ _NAN = math.nan
 # Webots' methods beyond the subset: Python name -> (the C function it stands for, its "no value")
 _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
     Supervisor: {
-        "getFromDevice": ("node_get_from_device", None), "getSelected": ("node_get_selected", None),
+        "getSelected": ("node_get_selected", None),
         "setLabel": ("set_label", None),
         "worldLoad": ("world_load", None), "worldSave": ("world_save", False), "worldReload": ("world_reload", None),
         "exportImage": ("export_image", None), "movieStartRecording": ("movie_start_recording", None),

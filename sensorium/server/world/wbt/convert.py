@@ -121,6 +121,13 @@ class Converter:
         self.asset_files: set[Path] = set()   # asset files outside the world's folder this world may read
         self.losses: list[Loss] = []      # robots, sensor devices and sensor-visible shapes lost (report.py)
         self.resets_said: set[str] = set()   # Webots' field resets told (a node USEd twice: once)
+        # the nodes inside the robot being converted, as a Supervisor walks them (schemas.world.NestedNode):
+        # None outside a robot; the stack holds (node, its entry's index) of the nodes being walked
+        self.tree: list[dict] | None = None
+        self.tree_stack: list[tuple[Node, int]] = []
+        self.tree_field = "children"       # the field the next node walked sits in (a joint's endPoint, ...)
+        self.builtin_proto: str | None = None   # a built-in PROTO being expanded (the expansion's node names it)
+        self.nested_defs: set[int] = set()      # nested nodes whose DEF is kept (a USE of one is a copy without it)
 
     # ------------------------------------------------------------ messages
     def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
@@ -317,14 +324,87 @@ class Converter:
 
     # ------------------------------------------------------------ the walk
     def visit(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
-        if node.proto is not None and node.instance_at is not None:
-            self.instances.append((node.proto, node.instance_at))
-            try:
+        pushed = self.tree_node(node, frame, owner)
+        try:
+            if node.proto is not None and node.instance_at is not None:
+                self.instances.append((node.proto, node.instance_at))
+                try:
+                    self.visit_node(node, frame, owner, top)
+                finally:
+                    self.instances.pop()
+            else:
                 self.visit_node(node, frame, owner, top)
-            finally:
-                self.instances.pop()
-        else:
-            self.visit_node(node, frame, owner, top)
+        finally:
+            if pushed:
+                self.tree_stack.pop()
+
+    # ------------------------------------------------------------ the nodes a Supervisor walks in a robot
+    def tree_node(self, node: Node, frame: Frame, owner: Owner) -> bool:
+        """Record a node inside the robot being converted (schemas.world.NestedNode) and make it the
+        parent of what is walked inside it; True when recorded (the caller pops it)."""
+        field, self.tree_field = self.tree_field, "children"
+        proto, self.builtin_proto = self.builtin_proto, None
+        t = node.type
+        if self.tree is None or owner.kind != "robot":
+            return False
+        posed = t in ("Pose", "Transform", "Solid") or t in SENSORS or t in OTHER_DEVICES
+        if not (posed or t in ("Group", "Slot") or t in JOINTS) or (posed and not frame.rigid) or t == "Charger":
+            return False
+        entry: dict[str, Any] = {"type": t}
+        if posed:
+            entry["pose"] = self.child_frame(node, frame).pose()
+        self.tree_entry(node, entry, field, proto)
+        self.tree_stack.append((node, len(self.tree) - 1))
+        return True
+
+    def tree_entry(self, node: Node, entry: dict, field: str, builtin: str | None = None) -> None:
+        """Add ``entry`` (type, pose) for ``node`` under the node being walked: its PROTO, its DEF
+        (one the world file writes: a PROTO's internal nodes are not found by DEF, as in Webots) and
+        its name."""
+        assert self.tree is not None
+        proto = node.proto or builtin
+        if proto:
+            entry["proto"] = proto
+        if self.nested_def(node):
+            entry["def_name"] = node.def_name
+        if node.type == "Solid" or node.type in SENSORS or node.type in OTHER_DEVICES or node.type in MOTORS:
+            default = "solid" if node.type == "Solid" else fx.DEVICE_NAMES.get(
+                node.type, OTHER_NAMES.get(node.type, OTHER_MOTOR_NAMES.get(node.type, node.type.lower())))
+            entry["name"] = self.fields(node).string("name", default)
+        if self.tree_stack:
+            entry["parent"] = self.tree_stack[-1][1]
+        if field != "children":
+            entry["field"] = field
+        self.tree.append(entry)
+
+    def nested_def(self, node: Node) -> bool:
+        """Whether a nested node keeps its DEF: the world file writes it, and this is the DEF's node,
+        not a USE of it (the parser hands the same node for both; Webots' USE copies have no DEF)."""
+        if not node.def_name or not self.written(node) or id(node) in self.nested_defs:
+            return False
+        self.nested_defs.add(id(node))
+        return True
+
+    def written(self, node: Node) -> bool:
+        """Whether the world file writes ``node`` (or the PROTO instance it is): a node of a PROTO's
+        body is the PROTO's internal node, which Webots' getFromDef does not find."""
+        return (node.source or self.source) == self.source or (
+            node.instance_at is not None and node.instance_at[0] == self.source)
+
+    def tree_device(self, node: Node, device: dict) -> None:
+        """The device entry of the node being walked (getFromDevice; its final name is resolved at the robot's end)."""
+        if self.tree is not None and self.tree_stack and self.tree_stack[-1][0] is node:
+            self.tree[self.tree_stack[-1][1]]["_device"] = device
+
+    def tree_done(self, robot: dict, tree: list[dict]) -> None:
+        """The robot's nodes with their devices' final names (after unique_devices)."""
+        for entry in tree:
+            device = entry.pop("_device", None)
+            if device is not None and any(d is device for d in robot["devices"]):
+                entry["device"] = device["name"]
+                entry.setdefault("name", device["name"])
+        if tree:
+            robot["nodes"] = tree
 
     def visit_node(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
         self.walk(node)
@@ -398,6 +478,7 @@ class Converter:
         elif t == "Slot":                # Webots' base node: its endPoint sits in the Slot's parent frame
             end = f.node_("endPoint")
             if end is not None:
+                self.tree_field = "endPoint"
                 self.visit(end, frame, owner)
         elif t in ("Pose", "Transform"):
             inner = self.child_frame(node, frame)
@@ -435,6 +516,7 @@ class Converter:
             system = self.world["world_info"].get("coordinate_system", "ENU")
             expanded = BUILTIN_PROTOS[t](node, f, system)
             expanded.def_name = node.def_name
+            self.builtin_proto = t
             self.visit(expanded, frame, owner, top)
         elif t in GEOMETRIES:
             self.warn(node, f"{t} outside a Shape or boundingObject: ignored")
@@ -815,6 +897,9 @@ class Converter:
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
             self.def_name(node, data)
+        elif self.nested_def(node):     # a nested solid: found by DEF (a Supervisor walks it)
+            data["def_name"] = node.def_name
+        if owner.kind == "world":
             colors = f.colors("recognitionColors", [])        # what cameras with a Recognition node report
             if colors:
                 data["recognition_colors"] = [list(c) for c in colors]
@@ -918,12 +1003,19 @@ class Converter:
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.riding = []
-        self.solid_contents(node, Frame.identity(), mine)
+        saved = self.tree, self.tree_stack
+        self.tree, self.tree_stack = [], []
+        try:
+            self.solid_contents(node, Frame.identity(), mine)
+            tree = self.tree
+        finally:
+            self.tree, self.tree_stack = saved
         self.carried_radar_targets(data)
         self.drive(node, mine)
         if mine.parts:
             data["shapes"] = [_clean_part(p) for p in mine.parts]
         self.unique_devices(data)
+        self.tree_done(data, tree)
         for part in data.get("shapes", ()):      # the device's final name (after unique_devices)
             if "_device" in part:
                 part["of_device"] = part.pop("_device")["name"]
@@ -995,6 +1087,7 @@ class Converter:
                                 "not rendered here; the image is Webots' without it")
             self.ride(data)
             owner.data["devices"].append(data)
+            self.tree_device(node, data)
             if node.type == "LED":
                 self.led_of.update((id(lt), (data, inner)) for lt in self.led_lights(node))
             self.device_contents(node, inner, owner, data)
@@ -1035,6 +1128,7 @@ class Converter:
         data["_at"] = self.at(node)
         self.ride(data)
         owner.data["devices"].append(data)
+        self.tree_device(node, data)
         return data
 
     def device_fields(self, node: Node) -> dict[str, Any]:
@@ -1066,6 +1160,7 @@ class Converter:
         for d in self.fields(node).nodes(field_name):
             self.walk(d)
             self.tick(d)
+            entry: dict | None = None
             if d.type in MOTORS:
                 entry = {"name": self.fields(d).string("name", OTHER_MOTOR_NAMES[d.type]), "device": d.type,
                          **self.motor_fields(d, position), "_at": self.at(d)}
@@ -1079,9 +1174,11 @@ class Converter:
                 owner.data["devices"].append(entry)
                 sensors.append(entry)
             elif d.type == "Brake":
-                self.unsimulated(d, Frame.identity(), owner)
+                entry = self.unsimulated(d, Frame.identity(), owner)
             else:
                 self.warn(d, f"{d.type} in a joint's device list: ignored")
+            if entry is not None and self.tree is not None and owner.kind == "robot":   # a node of the joint's
+                self.tree_entry(d, {"type": d.type, "_device": entry}, field_name)       # (no Pose: no position)
         if motors:
             for entry in sensors:
                 entry["motor"] = motors[0]["name"]
@@ -1177,6 +1274,7 @@ class Converter:
         if end is not None:
             if end.type == "SolidReference":
                 return
+            self.tree_field = "endPoint"
             if moving:          # what the end point holds rides on this joint (its first motor's)
                 self.riding.append(moving[0])
             try:

@@ -1,0 +1,153 @@
+"""The Supervisor's nested nodes: what is inside the robots and top-level solids (sans-IO).
+
+A robot's nodes are its world entry's ``nodes`` (the ``.wbt`` import keeps its Solids, devices,
+Poses, Transforms, Groups, Slots and joints, schemas.world.NestedNode), or one node per device of
+its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth. They are
+numbered once per simulation, in scene order (robots, then solids, each depth first), from
+:data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
+imports) are never shifted by them. A nested node is found by DEF (first in scene order, as
+Webots' DEF dictionary) or by a dotted path ``A.B.C`` (each name after the first a direct child's
+DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``).
+
+Its world pose is its owner's pose now (the robot as it drives, the solid as a Supervisor set it)
+composed with the node's frame in the owner as the world loaded (joints move no node here, as they
+move no shape). Its fields are read-only here: ``translation``/``rotation`` (in its parent's frame),
+``name`` (Solids and devices) and ``children``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.world.geometry import Pose
+from sensorium.server.world.poses import pose_from_model
+
+FIRST_ID = 1 << 24
+"""The first nested node's id (above any top-level node's: those count from 1)."""
+
+NOT_POSES = frozenset({"RotationalMotor", "LinearMotor", "PositionSensor", "Brake"})
+"""Devices Webots does not derive from Pose (no position): a joint's motors and sensors."""
+
+HAS_CHILDREN = frozenset({"Solid", "Pose", "Transform", "Group"})
+"""Node types with a ``children`` field besides devices that are Solids (Robot, top-level Solid: supervisor.py)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Nested:
+    id: int
+    type: str             # Webots' base type
+    proto: str            # "" for a base node
+    def_name: str
+    name: str             # a Solid's or device's name ("" for a Pose, Group, joint)
+    parent: int           # the parent's node id (a nested node's, or the robot's / top-level solid's)
+    field: str            # the parent's field holding it: children, endPoint, device, device2
+    local: Pose | None    # in the owner's frame (None: no Pose node)
+    own: Pose | None      # in its parent's frame (its translation and rotation fields)
+    device: str           # the robot's device it is ("" if none)
+    owner: int            # the top-level robot's or solid's node id
+    owner_kind: str       # "Robot" | "Solid"
+    owner_key: str        # the robot's or solid's name
+
+
+@dataclass(frozen=True, slots=True)
+class Table:
+    nodes: tuple[Nested, ...]
+    by_owner: dict[int, tuple[Nested, ...]]     # owner id -> its nodes, depth first
+    by_parent: dict[int, tuple[Nested, ...]]    # parent id -> its direct subnodes
+
+    def get(self, node_id: int) -> Nested | None:
+        k = node_id - FIRST_ID
+        return self.nodes[k] if 0 <= k < len(self.nodes) else None
+
+
+def _robot_entries(robot: Any) -> list[wm.NestedNode]:
+    """A robot's nodes: its world entry's, else one per device of its device list (a drive's wheel
+    motors too), at the device's pose."""
+    model = robot.model
+    if model.nodes:
+        return list(model.nodes)
+    poses = {d.name: d.pose for d in model.devices}
+    return [wm.NestedNode(type=e.type, name=e.name, device=e.name,
+                          pose=None if e.type in NOT_POSES else poses.get(e.name, wm.Pose()))
+            for e in robot.device_list]
+
+
+def _own(local: Pose | None, above: Pose | None) -> Pose | None:
+    """A node's pose in its parent's frame from both in the owner's frame (None: the owner's)."""
+    if local is None:
+        return None
+    return local if above is None else above.inverse().compose(local)
+
+
+def build(sim: Any, loaded_solids: int) -> Table:
+    out: list[Nested] = []
+    robots = list(sim.robots)
+    for i, name in enumerate(robots):
+        owner = i + 1
+        entries = _robot_entries(sim.robots[name])
+        first = FIRST_ID + len(out)
+        frames: list[Pose | None] = []       # each entry's nearest Pose frame in the robot (None: the robot's)
+        for k, e in enumerate(entries):
+            local = None if e.pose is None else pose_from_model(e.pose)
+            above = None if e.parent < 0 else frames[e.parent]
+            frames.append(local if local is not None else above)
+            out.append(Nested(first + k, e.type, e.proto or "", e.def_name or "", e.name or "",
+                              owner if e.parent < 0 else first + e.parent, e.field, local, _own(local, above),
+                              e.device or "", owner, "Robot", name))
+    for j in range(loaded_solids):
+        owner = len(robots) + 1 + j
+        solid = sim.world.solids[j]
+
+        def walk(s: wm.Solid, parent: int, at: Pose | None, solid_name: str = sim.scene.solid_names[j],
+                 owner: int = owner) -> None:
+            for child in s.children:
+                own = pose_from_model(child.pose)
+                local = own if at is None else at.compose(own)
+                node = Nested(FIRST_ID + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
+                              local, own, "", owner, "Solid", solid_name)
+                out.append(node)
+                walk(child, node.id, local)
+
+        walk(solid, owner, None)
+    by_owner: dict[int, list[Nested]] = {}
+    by_parent: dict[int, list[Nested]] = {}
+    for n in out:
+        by_owner.setdefault(n.owner, []).append(n)
+        by_parent.setdefault(n.parent, []).append(n)
+    return Table(tuple(out), {k: tuple(v) for k, v in by_owner.items()}, {k: tuple(v) for k, v in by_parent.items()})
+
+
+def owner_pose(sim: Any, n: Nested) -> Pose:
+    return sim.robots[n.owner_key].pose if n.owner_kind == "Robot" else sim.scene.solid_poses[n.owner_key]
+
+
+def world_pose(sim: Any, n: Nested) -> Pose | None:
+    """The node's pose in the world now; None for a node that is no Pose (Webots: NaN)."""
+    return None if n.local is None else owner_pose(sim, n).compose(n.local)
+
+
+def velocity(sim: Any, n: Nested) -> list[float]:
+    """A node of a driven robot moves with it: v + ω × r (r from the robot's origin), ω; else zeros."""
+    drive = sim.robots[n.owner_key].drive if n.owner_kind == "Robot" else None
+    if drive is None:
+        return [0.0] * 6
+    v = drive.velocity()
+    pose = world_pose(sim, n)
+    if pose is None:
+        return [float(x) for x in v]
+    r = pose.translation - owner_pose(sim, n).translation
+    linear = np.asarray(v[:3], dtype=np.float64) + np.cross(np.asarray(v[3:], dtype=np.float64), r)
+    return [float(x) for x in linear] + [float(x) for x in v[3:]]
+
+
+def has_children(n: Nested) -> bool:
+    return n.type in HAS_CHILDREN or (n.local is not None and n.type not in ("Pose", "Transform"))
+
+
+def children(table: Table, parent: int) -> list[int]:
+    """The ids of a node's ``children`` (not a joint's end point nor its devices)."""
+    return [c.id for c in table.by_parent.get(parent, ()) if c.field == "children"]
