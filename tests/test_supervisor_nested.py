@@ -235,3 +235,42 @@ def test_a_webots_supervisor_finds_nested_nodes(tmp_path):
     assert out["cam_after"] == pytest.approx([1.0, 2.15 + d, 0.3], abs=1e-9)
     assert out["pose_in_robot"] == pytest.approx([0.15, 0.0, 0.3], abs=1e-9)
     assert out["no_pose"] is True
+
+
+PAN_WORLD = """#VRML_SIM R2023b utf8
+Robot {
+  name "head" controller "<extern>" supervisor TRUE
+  children [
+    HingeJoint {
+      jointParameters HingeJointParameters { axis 0 0 1 anchor 0 0 0.2 }
+      device [ RotationalMotor { name "pan" maxVelocity 100 } ]
+      endPoint Solid { translation 0 0 0.2 children [ DEF CAM Camera { translation 0.1 0 0 } ] }
+    }
+  ]
+}
+"""
+
+
+def test_a_device_on_a_turned_joint_is_where_the_joint_put_it(tmp_path):
+    """A camera on a pan joint (vertical axis through (0, 0, 0.2)) 0.1 m ahead of it: turned a
+    quarter turn, its node's world position is 0.1 m to the robot's left and its orientation turned
+    with it (closed form), as the camera itself looks."""
+    p = tmp_path / "pan.wbt"
+    p.write_text(PAN_WORLD)
+    lv = Live(Simulation(load_world(p)))
+    lv.ok(A, "attach", {"robot": "head"})
+    cam = lv.ok(A, "/head/robot/get_from_def", {"name": "CAM"})["node"]
+
+    def pose() -> tuple[list[float], np.ndarray]:
+        got = lv.ok(A, "/head/robot/get_node_pose", {"node": cam})
+        return got["position"], np.array(got["orientation"]).reshape(3, 3)
+
+    assert pose()[0] == pytest.approx([0.1, 0.0, 0.2], abs=1e-12)
+    lv.sim.robot("head").motor("pan").set_position(HALF_PI)
+    for _ in range(20):                     # 100 rad/s and Webots' 10 rad/s^2 ramp: there well before
+        lv.step(A, "head")
+    assert lv.sim.robot("head").motor("pan").position == HALF_PI
+    where, turned = pose()
+    assert where == pytest.approx([0.0, 0.1, 0.2], abs=1e-12)
+    assert turned == pytest.approx(rz(HALF_PI), abs=1e-12)
+    assert turned == pytest.approx(lv.sim.device("head/camera").local_pose.rotation, abs=1e-12)

@@ -10,8 +10,8 @@ Webots' DEF dictionary) or by a dotted path ``A.B.C`` (each name after the first
 DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``).
 
 Its world pose is its owner's pose now (the robot as it drives, the solid as a Supervisor set it)
-composed with the node's frame in the owner as the world loaded (joints move no node here, as they
-move no shape). Its fields are read-only here: ``translation``/``rotation`` (in its parent's frame),
+composed with the node's frame in the owner as the world loaded; a device riding a joint is where
+its link has moved it (other nodes past a joint stay where the world loaded them). Its fields are read-only here: ``translation``/``rotation`` (in its parent's frame),
 ``name`` (Solids and devices) and ``children``.
 """
 
@@ -126,8 +126,16 @@ def owner_pose(sim: Any, n: Nested) -> Pose:
 
 
 def world_pose(sim: Any, n: Nested) -> Pose | None:
-    """The node's pose in the world now; None for a node that is no Pose (Webots: NaN)."""
-    return None if n.local is None else owner_pose(sim, n).compose(n.local)
+    """The node's pose in the world now; None for a node that is no Pose (Webots: NaN). A device on
+    a joint (``on_joint``) is where its joint's link has moved it."""
+    if n.local is None:
+        return None
+    local = n.local
+    if n.device and n.owner_kind == "Robot":
+        link = getattr(sim.robots[n.owner_key].devices.get(n.device), "link", None)
+        if link is not None:
+            local = link.compose(local)
+    return owner_pose(sim, n).compose(local)
 
 
 def velocity(sim: Any, n: Nested) -> list[float]:
