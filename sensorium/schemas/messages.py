@@ -168,13 +168,15 @@ class Clock(Msg):
 
 
 class JointState(Msg):
-    """``sensor_msgs/msg/JointState`` for a PositionSensor: one joint, named after the sensor, its
-    angle (rad) as the controller reads it; velocity and effort empty."""
+    """``sensor_msgs/msg/JointState``. A PositionSensor's ``value``: one joint, named after the
+    sensor, its angle (rad) as the controller reads it, velocity and effort empty. A robot's
+    ``/<robot>/joint_states``: its joint motors (those no drive owns, in device order), their
+    positions and velocities (the change over the last basic step ÷ its length), effort empty."""
 
     header: Header
     name: list[str]
-    position: bytes = Field(description="<f8[len(name)]: rad")
-    velocity: bytes = Field(default=b"", description="<f8[]: empty")
+    position: bytes = Field(description="<f8[len(name)]: rad (m for a slider)")
+    velocity: bytes = Field(default=b"", description="<f8[]: empty, or <f8[len(name)] rad/s (m/s) on joint_states")
     effort: bytes = Field(default=b"", description="<f8[]: empty")
 
 

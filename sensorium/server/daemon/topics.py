@@ -10,7 +10,8 @@ controller's own ``enable`` always wins and is never altered (its period, phase 
 controller enabled it or its ``point_cloud`` topic is demanded.
 
 After each basic step :meth:`Topics.publish` builds the messages of every demanded topic whose
-device produced a new value (plus ``/clock`` and each demanded ``/<robot>/pose``) as ready-to-send
+device produced a new value (plus ``/clock``, each demanded ``/<robot>/pose`` and, for a robot with
+joints, ``/<robot>/joint_states``) as ready-to-send
 frames, calls the recorder (and the viewer sink, sensorium.server.viewer) with the very same bytes,
 and counts ``seq`` per topic. A robot's pose
 is read and packed only while its pose topic is demanded (``work["poses_built"]`` counts them).
@@ -32,7 +33,7 @@ from sensorium.schemas.devices import KINDS
 from sensorium.schemas.wire import pack, stamp, topic_frame
 
 __all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "lidar_cloud_msg", "laser_scan_angles",
-           "pose_quaternion", "pose_msg"]
+           "pose_quaternion", "pose_msg", "joint_states_msg"]
 
 MAX_PREFIX = 1024     # bytes: longer subscriptions are refused (topic names are short)
 
@@ -52,7 +53,7 @@ _SONAR = 2
 class Topic:
     name: str
     type: str
-    kind: str                # value | range_image | laser_scan | point_cloud | clock | pose
+    kind: str                # value | range_image | laser_scan | point_cloud | clock | pose | joint_states
     path: str | None         # "robot/device"; the robot's name for pose; None for /clock
     frame: bytes             # name + NUL
 
@@ -175,6 +176,15 @@ def pose_msg(hdr: dict, pose: Any) -> dict:
                      "orientation": {"x": q[0], "y": q[1], "z": q[2], "w": q[3]}}}
 
 
+def joint_states_msg(hdr: dict, joints: dict[str, Any]) -> dict:
+    """``sensor_msgs/JointState`` of a robot's joints (its motors that are no drive's, in device
+    order): positions (rad or m) and velocities (over the last basic step, signed); effort empty."""
+    motors = list(joints.values())
+    return {"header": hdr, "name": [m.name for m in motors],
+            "position": np.array([m.position for m in motors], dtype="<f8").tobytes(),
+            "velocity": np.array([m.rate for m in motors], dtype="<f8").tobytes(), "effort": b""}
+
+
 def laser_scan_angles(cfg: Any) -> tuple[float, float, float] | None:
     """(angle_min, angle_max, angle_increment) of ranges in range-image order (left to right), or
     ``None`` when the lidar gets no LaserScan (several layers, or planar: unequal angles)."""
@@ -208,6 +218,7 @@ class Topics:
         self.controls: dict[str, Control] = {}
         self.topics: list[Topic] = [Topic(CLOCK, msgs.CLOCK, "clock", None, topic_frame(CLOCK))]
         self.pose_topics: dict[str, Topic] = {}      # robot -> its /<robot>/pose topic
+        self.joint_topics: dict[str, Topic] = {}     # robot with joints -> its /<robot>/joint_states topic
         world_info = getattr(getattr(sim, "world", None), "world_info", None)
         for robot_name, robot in sim.robots.items():
             for dev_name, dev in robot.devices.items():
@@ -220,6 +231,12 @@ class Topics:
             pose_topic = Topic(name, msgs.POSE_STAMPED, "pose", robot_name, topic_frame(name))
             self.topics.append(pose_topic)
             self.pose_topics[robot_name] = pose_topic
+            joints = getattr(robot, "joints", None)
+            if joints:                                # a robot with joints: their states (robot_state_publisher's input)
+                name = f"/{robot_name}/joint_states"
+                joint_topic = Topic(name, msgs.JOINT_STATE, "joint_states", robot_name, topic_frame(name))
+                self.topics.append(joint_topic)
+                self.joint_topics[robot_name] = joint_topic
         self.by_name = {t.name: t for t in self.topics}
         self.seq: dict[str, int] = {t.name: 0 for t in self.topics}
         self.prefixes: dict[bytes, int] = {}       # accepted subscription prefix -> subscriptions
@@ -234,6 +251,7 @@ class Topics:
         self._active: list[Control] = []             # controls with a demanded topic
         self._clock_demanded = False
         self._poses: list[Topic] = []                # demanded pose topics
+        self._joint_states: list[Topic] = []         # demanded joint_states topics
         self.work: Counter[str] = Counter()          # what publishing computed (poses_built)
 
     # ------------------------------------------------------------------ demand
@@ -317,6 +335,7 @@ class Topics:
         demanded = self.demanded
         self._clock_demanded = CLOCK in demanded
         self._poses = [t for t in self.pose_topics.values() if t.name in demanded]
+        self._joint_states = [t for t in self.joint_topics.values() if t.name in demanded]
         self._active = []
         for ctl in self.controls.values():
             was = bool(ctl.demanded)
@@ -378,11 +397,15 @@ class Topics:
     # ------------------------------------------------------------------ publishing
     def publish(self, time_ms: int) -> list[list[bytes]]:
         """After a basic step: the frames of every demanded topic with a new value, ``/clock``
-        first, then the demanded robot poses, then the devices' topics. The recorder gets the same
+        first, then the demanded joint states (every basic step while demanded), then the demanded
+        robot poses, then the devices' topics. The recorder gets the same
         bytes."""
         out: list[list[bytes]] = []
         if self._clock_demanded:
             self._emit(self.by_name[CLOCK], time_ms, {"clock": stamp(time_ms * 1_000_000)}, out)
+        for t in self._joint_states:
+            assert t.path is not None
+            self._emit(t, time_ms, joint_states_msg(header(t.path, time_ms), self.sim.robots[t.path].joints), out)
         if self._poses:
             hdr = header(WORLD_FRAME, time_ms)
             for t in self._poses:

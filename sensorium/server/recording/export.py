@@ -45,7 +45,7 @@ import numpy as np
 from sensorium.schemas.devices import KINDS
 from sensorium.server.recording import cdr
 from sensorium.server.recording.envelope import unmatched_topics
-from sensorium.server.recording.reader import Recording
+from sensorium.server.recording.reader import Recording, topic_matcher
 
 DISTROS = ("humble", "jazzy")
 POINT_CLOUD = "sensor_msgs/msg/PointCloud"
@@ -352,14 +352,23 @@ def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report
     """``(message, export type, message dict, added)`` in order; ``added`` marks the scene and
     transform messages of :mod:`.ros_views` (when ``views`` and the recorded world has them)."""
     from sensorium.server.recording import ros_views
+    from sensorium.server.recording.frames import JointFrames
 
     world, base_dir = ros_views.recorded_world(rec) if views else (None, Path("."))
     started = False
     tf_seq = 0
+    joint_frames: JointFrames | None = None
+    moving: frozenset[str] = frozenset()
+    if world is not None:               # devices riding joints: dynamic frames when the joints' states are exported
+        joint_frames = JointFrames(world)
+        match = topics if callable(topics) else topic_matcher(topics)
+        exported = {t.topic for t in rec.topics() if match(t.topic)}
+        moving = frozenset(f for r in joint_frames.robots if f"/{r}/joint_states" in exported
+                           for f in joint_frames.frames(r))
     for m, typename, msg in _iter_recorded(rec, typestore, topics, pointcloud2, report, start_ns, end_ns):
         if world is not None and not started:
             started = True
-            for topic, typ, value in (("/tf_static", ros_views.TF, ros_views.tf_static(world, m.stamp_ns)),
+            for topic, typ, value in (("/tf_static", ros_views.TF, ros_views.tf_static(world, m.stamp_ns, moving)),
                                       ("/scene", ros_views.MARKER_ARRAY,
                                        ros_views.marker_array(world, base_dir, m.stamp_ns))):
                 if value is not None:
@@ -370,6 +379,12 @@ def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report
         if robot is not None:
             report.topics.setdefault("/tf", ros_views.TF)
             value = ros_views.tf_pose(robot, m.data, m.stamp_ns)
+            yield _Added("/tf", m.stamp_ns, tf_seq), ros_views.TF, _convert(typestore, ros_views.TF, value), True
+            tf_seq += 1
+        robot = ros_views.joint_states_robot(m.topic, m.ros_type) if joint_frames is not None else None
+        if joint_frames is not None and robot is not None and robot in joint_frames.robots:
+            report.topics.setdefault("/tf", ros_views.TF)
+            value = ros_views.tf_joints(robot, joint_frames.update(robot, *ros_views.joint_positions(m.data)), m.stamp_ns)
             yield _Added("/tf", m.stamp_ns, tf_seq), ros_views.TF, _convert(typestore, ros_views.TF, value), True
             tf_seq += 1
 

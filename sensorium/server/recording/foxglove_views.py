@@ -11,7 +11,8 @@ Layout of a Foxglove-ready recording (``sensorium`` metadata ``format = "2"``):
 * ``<topic>`` — the same message as ROS 2 CDR with its ``ros2msg`` schema (the bytes of
   :class:`~sensorium.server.recording.export.CdrEncoder`, as ``sensorium export`` and the live
   viewer produce them; ``PointCloud`` as ``PointCloud2``): what Foxglove's panels plot and draw.
-* ``/tf`` — ``foxglove.FrameTransforms`` per robot pose (``world → robot`` and the device mounts);
+* ``/tf`` — ``foxglove.FrameTransforms`` per robot pose (``world → robot`` and the device mounts),
+  and per ``/<robot>/joint_states`` the mounts of the devices riding its joints, moved with them;
   ``/scene`` — one ``foxglove.SceneUpdate`` of the world at time 0 (robot bodies follow ``/tf``).
 
 Views need rosbags and foxglove-sdk (the ``foxglove`` extra); without them a recorder writes format 1
@@ -26,7 +27,7 @@ from typing import Any
 
 import msgpack
 
-from sensorium.server.recording.ros_views import pose_robot
+from sensorium.server.recording.ros_views import joint_positions, joint_states_robot, pose_robot
 
 __all__ = ["WIRE_PREFIX", "WIRE_SCHEMA", "WIRE_MSGDEF", "wire_wrap", "wire_unwrap", "available", "FoxgloveViews"]
 
@@ -69,13 +70,14 @@ class FoxgloveViews:
     def __init__(self, world: Any = None, base_dir: str | Path = ".", distro: str = "jazzy"):
         from sensorium.server.recording import scene3d as fxscene
         from sensorium.server.recording.export import CdrEncoder
-        from sensorium.server.recording.frames import mounts
+        from sensorium.server.recording.frames import JointFrames, mounts
 
         self._scene = fxscene
         self.encoder = CdrEncoder(distro, pointcloud2=True)
         self.world = world
         self.base_dir = Path(base_dir)
         self.mounts = mounts(world) if world is not None else {}
+        self.joint_frames = JointFrames(world) if world is not None else None
         self.errors: dict[str, str] = {}
         from foxglove.messages import FrameTransforms, SceneUpdate
         self._tf_schema = FrameTransforms.get_schema()
@@ -108,5 +110,17 @@ class FoxgloveViews:
             else:
                 s = self._tf_schema
                 data = self._scene.frame_transforms(robot, stamp_ns, t, q, self.mounts.get(robot, [])).encode()
+                out.append(("/tf", s.name, s.encoding, bytes(s.data), "protobuf", data))
+        robot = joint_states_robot(topic, ros_type)
+        if robot is not None and self.joint_frames is not None and robot in self.joint_frames.robots:
+            try:
+                moved = self.joint_frames.update(robot, *joint_positions(body))
+            except (KeyError, TypeError, ValueError) as exc:
+                self.errors.setdefault("/tf", f"{topic}: {type(exc).__name__}: {exc}")
+            else:        # the riding devices' frames move now, and the next poses' /tf carries them too
+                at = {m[0]: m for m in moved}
+                self.mounts[robot] = [at.get(m[0], m) for m in self.mounts[robot]]
+                s = self._tf_schema
+                data = self._scene.mount_transforms(robot, stamp_ns, moved).encode()
                 out.append(("/tf", s.name, s.encoding, bytes(s.data), "protobuf", data))
         return out

@@ -1,6 +1,8 @@
-"""Frame names and fixed transforms shared by the Foxglove scene and the ROS 2 export (no
-foxglove-sdk needed): ``world``; ``<robot>`` placed by the robot's pose; ``<robot>/<device>`` fixed
-on its robot by the device's ``pose``."""
+"""Frame names and transforms shared by the Foxglove scene and the ROS 2 export (no foxglove-sdk
+needed): ``world``; ``<robot>`` placed by the robot's pose; ``<robot>/<device>`` fixed on its robot
+by the device's ``pose``, or, for a device riding a joint (``on_joint``), moved with the joint from
+the recorded ``/<robot>/joint_states`` (:class:`JointFrames`, robot_state_publisher's job), as is
+``<robot>/<joint>/link``, the frame the shapes riding a joint are drawn in."""
 
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
-__all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "Mount", "mounts", "quat_from_x", "Body", "bodies", "lights",
+__all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "Mount", "mounts", "link_frame", "JointFrames", "quat_from_x", "Body", "bodies", "lights",
            "shape_rgba", "GHOST_ALPHA"]
 
 WORLD_FRAME = "world"
@@ -39,7 +41,8 @@ def shape_rgba(shape: Any, ghost: bool = False) -> tuple[float, float, float, fl
 
 
 def mounts(world: wm.World) -> dict[str, list[Mount]]:
-    """robot → [(device frame, translation, quaternion xyzw)] of the robot's devices."""
+    """robot → [(frame, translation, quaternion xyzw)] of the robot's devices, then of the links
+    its shapes ride on (:func:`link_frame`, at the joints' initial positions)."""
     out: dict[str, list[Mount]] = {}
     for r in world.robots:
         items: list[Mount] = []
@@ -47,8 +50,60 @@ def mounts(world: wm.World) -> dict[str, list[Mount]]:
             p = pose_from_model(d.pose)
             t = (float(p.translation[0]), float(p.translation[1]), float(p.translation[2]))
             items.append((f"{r.name}/{d.name}", t, matrix_quaternion(p.rotation)))
+        items.extend((link_frame(r.name, j), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)) for j in _shape_joints(r))
         out[r.name] = items
     return out
+
+
+def link_frame(robot: str, joint: str) -> str:
+    """The frame of the shapes riding a joint: the robot frame moved by the joint (identity with
+    every joint at its initial position, where the world file places the shapes)."""
+    return f"{robot}/{joint}/link"
+
+
+def _shape_joints(r: wm.Robot) -> list[str]:
+    """The joints shapes of ``r`` ride on, in order of first appearance."""
+    return list(dict.fromkeys(j for part in r.shapes if (j := getattr(part, "on_joint", None)) is not None))
+
+
+def _mount(frame: str, p: Pose) -> Mount:
+    t = (float(p.translation[0]), float(p.translation[1]), float(p.translation[2]))
+    return frame, t, matrix_quaternion(p.rotation)
+
+
+class JointFrames:
+    """The frames of devices riding joints, and of the links shapes ride (:func:`link_frame`),
+    placed from joint positions as the simulation places them (sim/joints.py ``Links``:
+    ``displacement ∘ pose``). ``robots``: those with such frames."""
+
+    def __init__(self, world: wm.World):
+        from sensorium.server.sim.joints import JointMotor, Links
+
+        self._robots: dict[str, tuple[Links, dict[str, JointMotor], list[tuple[str, str, Pose]]]] = {}
+        for r in world.robots:
+            riders = [(f"{r.name}/{d.name}", joint, pose_from_model(d.pose)) for d in r.devices
+                      if (joint := getattr(d, "on_joint", None)) is not None]
+            riders += [(link_frame(r.name, j), j, Pose.identity()) for j in _shape_joints(r)]
+            if not riders:
+                continue
+            joints = {d.name: JointMotor(d.name, d.device, d.max_velocity, initial_position=d.position)
+                      for d in r.devices if isinstance(d, wm.Motor)}
+            self._robots[r.name] = (Links(r, joints), joints, riders)
+        self.robots = frozenset(self._robots)
+
+    def frames(self, robot: str) -> frozenset[str]:
+        """The robot's frames that ride joints."""
+        return frozenset(f for f, _j, _p in self._robots[robot][2]) if robot in self._robots else frozenset()
+
+    def update(self, robot: str, names: list[str], positions: list[float]) -> list[Mount]:
+        """Joint positions (a JointState's ``name`` and ``position``; unknown names ignored): the
+        robot's riding frames (robot frame) with the joints there."""
+        links, joints, riders = self._robots[robot]
+        for name, q in zip(names, positions):
+            if name in joints:
+                joints[name].position = float(q)
+        links.update()
+        return [_mount(frame, links.poses[joint].compose(pose)) for frame, joint, pose in riders]
 
 
 def quat_from_x(d: np.ndarray) -> tuple[float, float, float, float]:
@@ -66,12 +121,14 @@ def quat_from_x(d: np.ndarray) -> tuple[float, float, float, float]:
 
 @dataclass(frozen=True)
 class Body:
-    """One drawn object: a top-level solid (all its shapes and children, world poses) or a robot's
-    body (its shapes, poses in the robot frame; ``frame_locked`` so it moves with the robot)."""
+    """One drawn object: a top-level solid (all its shapes and children, world poses), a robot's
+    body (its shapes, poses in the robot frame; ``frame_locked`` so it moves with the robot) or the
+    shapes riding one of its joints (poses in the link's frame, which is the robot frame moved by
+    the joint)."""
 
     entity_id: str
     frame_id: str
-    kind: str                                   # solid | robot
+    kind: str                                   # solid | robot | link
     frame_locked: bool
     parts: list[tuple[Any, Pose, bool]]         # (Shape-like model, pose in frame_id, ghost: bounding-only)
 
@@ -90,9 +147,14 @@ def bodies(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Itera
         if parts:
             yield Body(f"solid/{s.name}", WORLD_FRAME, "solid", False, parts)
     for r in world.robots:
-        parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in robot_parts(r)]
+        parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in robot_parts(r)
+                 if getattr(shape, "on_joint", None) is None]
         if parts:
             yield Body(f"robot/{r.name}", r.name, "robot", True, parts)
+        for joint in _shape_joints(r):        # a link: drawn in its frame, which its joint moves
+            parts = [(shape, pose, shape.seen_by == "bounding") for _n, pose, shape in robot_parts(r)
+                     if getattr(shape, "on_joint", None) == joint]
+            yield Body(f"robot/{r.name}/{joint}", link_frame(r.name, joint), "link", True, parts)
 
 
 def lights(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Iterator[tuple[str, str, bool, Any]]:

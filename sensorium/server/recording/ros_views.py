@@ -3,8 +3,10 @@
 ``sensorium export --ros2`` adds, next to the recorded topics (when the recording's world has them):
 
 * ``/tf_static`` — ``tf2_msgs/msg/TFMessage`` once at the first message time: ``<robot> →
-  <robot>/<device>`` for every device mount;
-* ``/tf`` — ``tf2_msgs/msg/TFMessage`` per recorded ``/<robot>/pose``: ``world → <robot>``;
+  <robot>/<device>`` for every fixed device mount;
+* ``/tf`` — ``tf2_msgs/msg/TFMessage`` per recorded ``/<robot>/pose``: ``world → <robot>``; and
+  per recorded ``/<robot>/joint_states``: ``<robot> → <robot>/<device>`` of each device riding a
+  joint (then dynamic, left out of ``/tf_static``, as robot_state_publisher does);
 * ``/scene`` — ``visualization_msgs/msg/MarkerArray`` once: solids (cube, sphere, cylinder markers;
   capsules and meshes as triangle lists; planes as flat cubes, an infinite one 50 m wide), robot
   bodies in their robot's frame (``frame_locked``), lights as spheres and arrows in their colour.
@@ -24,7 +26,8 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 
-__all__ = ["TF", "MARKER_ARRAY", "recorded_world", "tf_static", "tf_pose", "marker_array", "pose_robot"]
+__all__ = ["TF", "MARKER_ARRAY", "recorded_world", "tf_static", "tf_pose", "tf_joints", "marker_array", "pose_robot",
+           "joint_states_robot", "joint_positions"]
 
 TF = "tf2_msgs/msg/TFMessage"
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
@@ -59,6 +62,19 @@ def pose_robot(topic: str, ros_type: str) -> str | None:
     return None
 
 
+def joint_states_robot(topic: str, ros_type: str) -> str | None:
+    """The robot of a ``/<robot>/joint_states`` topic, else ``None``."""
+    if ros_type == "sensor_msgs/msg/JointState" and topic.endswith("/joint_states") and topic.count("/") == 2:
+        return topic[1:-len("/joint_states")]
+    return None
+
+
+def joint_positions(body: bytes) -> tuple[list[str], list[float]]:
+    """(names, positions) of a recorded JointState body."""
+    m = msgpack.unpackb(body, raw=False)
+    return [str(n) for n in m["name"]], np.frombuffer(m["position"], dtype="<f8").tolist()
+
+
 def _stamp(ns: int) -> dict:
     return {"sec": int(ns) // 1_000_000_000, "nanosec": int(ns) % 1_000_000_000}
 
@@ -69,12 +85,19 @@ def _tf(parent: str, child: str, ns: int, t, q) -> dict:
                           "rotation": dict(zip("xyzw", (float(v) for v in q)))}}
 
 
-def tf_static(world: wm.World, ns: int) -> dict | None:
-    """Every device mount, or ``None`` if the world has none."""
+def tf_static(world: wm.World, ns: int, moving: frozenset[str] = frozenset()) -> dict | None:
+    """Every device mount but the frames of ``moving`` (devices riding a joint whose states were
+    recorded: dynamic, on ``/tf``), or ``None`` if that leaves none."""
     from sensorium.server.recording.frames import mounts
 
-    items = [_tf(robot, frame, ns, t, q) for robot, ms in mounts(world).items() for frame, t, q in ms]
+    items = [_tf(robot, frame, ns, t, q) for robot, ms in mounts(world).items() for frame, t, q in ms
+             if frame not in moving]
     return {"transforms": items} if items else None
+
+
+def tf_joints(robot: str, robot_mounts: list, ns: int) -> dict:
+    """``robot → robot/device`` for the devices a joint moves (``frames.JointFrames.update``)."""
+    return {"transforms": [_tf(robot, frame, ns, t, q) for frame, t, q in robot_mounts]}
 
 
 def tf_pose(robot: str, pose_body: bytes, ns: int) -> dict:

@@ -5,7 +5,8 @@ Frames (the same names the topics' ``header.frame_id`` use):
 
 * ``world`` — the world frame (z up);
 * ``<robot>`` — a robot's body frame, placed by its pose (``/<robot>/pose``);
-* ``<robot>/<device>`` — a device's frame (FLU), fixed on its robot by the device's ``pose``.
+* ``<robot>/<device>`` — a device's frame (FLU), fixed on its robot by the device's ``pose`` (a
+  device riding a joint: moved with it, from ``/<robot>/joint_states``).
 
 The scene has one entity per static solid (frame ``world``), one per robot body (frame
 ``<robot>``, ``frame_locked`` so it moves with the robot's transform) and one per light (a small
@@ -63,7 +64,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.poses import matrix_quaternion
 
 __all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "MAX_SCENE_TRIANGLES", "scene_update", "mounts",
-           "frame_transforms", "timestamp"]
+           "frame_transforms", "mount_transforms", "timestamp"]
 
 MAX_SCENE_TRIANGLES = 200_000    # meshes beyond this budget (whole scene) are drawn as their bounding boxes
 _LIGHT_MARK = 0.05               # radius of the sphere drawn at a light's location (m)
@@ -196,8 +197,16 @@ def frame_transforms(robot: str, stamp_ns: int, translation: Iterable[float], qu
     items = [FrameTransform(timestamp=ts, parent_frame_id=WORLD_FRAME, child_frame_id=robot,
                             translation=Vector3(x=t[0], y=t[1], z=t[2]),
                             rotation=Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]))]
-    for frame, mt, mq in robot_mounts:
-        items.append(FrameTransform(timestamp=ts, parent_frame_id=robot, child_frame_id=frame,
-                                    translation=Vector3(x=mt[0], y=mt[1], z=mt[2]),
-                                    rotation=Quaternion(x=mq[0], y=mq[1], z=mq[2], w=mq[3])))
-    return FrameTransforms(transforms=items)
+    return FrameTransforms(transforms=items + _mount_items(robot, ts, robot_mounts))
+
+
+def mount_transforms(robot: str, stamp_ns: int, robot_mounts: list[tuple[str, Any, Any]]) -> FrameTransforms:
+    """``robot → robot/device`` for each mount only (the devices a joint moved)."""
+    return FrameTransforms(transforms=_mount_items(robot, timestamp(stamp_ns), robot_mounts))
+
+
+def _mount_items(robot: str, ts: Timestamp, robot_mounts: list[tuple[str, Any, Any]]) -> list[FrameTransform]:
+    return [FrameTransform(timestamp=ts, parent_frame_id=robot, child_frame_id=frame,
+                           translation=Vector3(x=mt[0], y=mt[1], z=mt[2]),
+                           rotation=Quaternion(x=mq[0], y=mq[1], z=mq[2], w=mq[3]))
+            for frame, mt, mq in robot_mounts]

@@ -62,6 +62,7 @@ class JointMotor:
     velocity: float = math.nan           # the commanded velocity (Webots' target velocity)
     speed: float = 0.0                   # the current velocity (Webots' mCurrentVelocity)
     available_force: float = math.nan
+    rate: float = 0.0                    # how fast the position moved over the last basic step (signed)
 
     def __post_init__(self) -> None:
         self.reset()
@@ -72,6 +73,7 @@ class JointMotor:
         self.target_position = self.initial_position
         self.velocity = self.max_velocity
         self.speed = 0.0
+        self.rate = 0.0
         self.available_force = self.max_force
 
     @property
@@ -143,6 +145,7 @@ class JointMotor:
             idle = abs(target - position) < _POSITION_THRESHOLD
         if idle:
             self.speed = 0.0
+            self.rate = 0.0
             return
         acc = self.acceleration
         if acc == -1.0 or acc > self.available_force:
@@ -153,11 +156,10 @@ class JointMotor:
             speed = min(speed + acc * dt_s, wanted) if wanted > speed else max(speed - acc * dt_s, wanted)
         self.speed = speed
         if target > position:
-            position += speed * dt_s
-            self.position = min(position, target)
+            self.position = min(position + speed * dt_s, target)
         else:
-            position -= speed * dt_s
-            self.position = max(position, target)
+            self.position = max(position - speed * dt_s, target)
+        self.rate = (self.position - position) / dt_s
 
 
 class Links:

@@ -7,7 +7,8 @@ Channels (all advertised at start):
   ``sensorium export``; a lidar's ``point_cloud`` is offered as ``sensor_msgs/msg/PointCloud2``
   (Foxglove's 3D panel does not draw the old ``PointCloud``);
 * ``/tf`` — ``foxglove.FrameTransforms`` (protobuf): ``world → <robot>`` at the robot's pose and
-  ``<robot> → <robot>/<device>`` mounts, one message per robot pose;
+  ``<robot> → <robot>/<device>`` mounts, one message per robot pose, and the mounts of devices
+  riding joints, one message per ``/<robot>/joint_states`` (demanded while ``/tf`` is subscribed);
 * ``/scene`` — ``foxglove.SceneUpdate`` (protobuf): the world (see :mod:`sensorium.server.recording.scene3d`), sent to each
   client when it subscribes (robot bodies follow ``/tf``).
 
@@ -50,7 +51,7 @@ import msgpack
 
 from sensorium.schemas import world as wm
 from sensorium.server.recording.export import CdrEncoder, ExportError
-from sensorium.server.recording.ros_views import pose_robot
+from sensorium.server.recording.ros_views import joint_positions, joint_states_robot, pose_robot
 
 __all__ = ["FoxgloveBridge", "ViewerError", "parse_address", "exposure_warning", "TF_TOPIC", "SCENE_TOPIC", "POSE_TYPE"]
 
@@ -239,7 +240,7 @@ class FoxgloveBridge:
         except ImportError as exc:  # pragma: no cover - depends on the environment
             raise ViewerError("the Foxglove viewer needs the 'foxglove' extra: pip install 'sensorium[foxglove]'") from exc
         from sensorium.server.recording import scene3d as fxscene
-        from sensorium.server.recording.frames import mounts
+        from sensorium.server.recording.frames import JointFrames, mounts
 
         self._scene_mod = fxscene
         self.encoder = CdrEncoder(distro, pointcloud2=True)
@@ -263,6 +264,10 @@ class FoxgloveBridge:
             self.types[topic] = typename
         self.pose_robot = {t: r for t, ty in topic_types.items() if (r := pose_robot(t, ty)) is not None}
         self.mounts = mounts(world) if world is not None else {}
+        # robots whose joints carry devices: /tf moves those frames from /<robot>/joint_states
+        self.joint_frames = JointFrames(world) if world is not None else None
+        self.joint_robot = {t: r for t, ty in topic_types.items() if (r := joint_states_robot(t, ty)) is not None
+                            and self.joint_frames is not None and r in self.joint_frames.robots}
         self.tf_channel = None
         if self.pose_robot:
             self.tf_channel = foxglove.Channel(TF_TOPIC, schema=FrameTransforms.get_schema(), message_encoding="protobuf",
@@ -419,6 +424,7 @@ class FoxgloveBridge:
         out = {t for t in subs if t in self.channels}
         if TF_TOPIC in subs:
             out.update(self.pose_robot)
+            out.update(self.joint_robot)
         return out
 
     # ------------------------------------------------------------------ step-loop thread
@@ -533,6 +539,19 @@ class FoxgloveBridge:
         if robot is not None and self.tf_channel is not None and subs.get(TF_TOPIC, 0) > 0:
             self.tf_channel.log(self.transforms_bytes(robot, body, ns), log_time=ns)
             self.sent += 1
+        robot = self.joint_robot.get(topic)
+        if robot is not None and self.tf_channel is not None and subs.get(TF_TOPIC, 0) > 0:
+            self.tf_channel.log(self.joint_transforms_bytes(robot, body, ns), log_time=ns)
+            self.sent += 1
+
+    def joint_transforms_bytes(self, robot: str, joint_body: bytes, ns: int) -> bytes:
+        """The ``/tf`` message of one JointState body: the frames of the devices riding the robot's
+        joints, which the robot's next poses carry too."""
+        assert self.joint_frames is not None
+        moved = self.joint_frames.update(robot, *joint_positions(joint_body))
+        at = {m[0]: m for m in moved}
+        self.mounts[robot] = [at.get(m[0], m) for m in self.mounts[robot]]
+        return self._scene_mod.mount_transforms(robot, ns, moved).encode()
 
     def transforms_bytes(self, robot: str, pose_body: bytes, ns: int) -> bytes:
         """The ``/tf`` message (encoded ``FrameTransforms``) of one PoseStamped body."""
