@@ -1,4 +1,4 @@
-"""What ROS and Foxglove users see of moving joints (README "Joints", "Transforms"): a robot with
+"""What ROS and Foxglove users see of moving joints (README "Joints", "See it in Foxglove"): a robot with
 joints publishes ``sensor_msgs/JointState`` on ``/<robot>/joint_states``; in a recording and in a
 ROS 2 export the frame of a device riding a joint, and the link frame its shapes are drawn in,
 follow the joint on ``/tf`` (dynamic, as robot_state_publisher publishes a non-fixed joint's child);
@@ -207,6 +207,9 @@ def test_ros2_export_publishes_the_riding_frames_on_tf(pan_recording, tmp_path):
         assert [cam.translation.x, cam.translation.y, cam.translation.z] == pytest.approx(t, abs=1e-12)
         assert [cam.rotation.x, cam.rotation.y, cam.rotation.z, cam.rotation.w] == pytest.approx(rot, abs=1e-12)
         assert frames["r/pan/link"].rotation.z == pytest.approx(math.sin(q / 2), abs=1e-12)
+    (scene,) = by_topic["/scene"]                          # RViz draws the head in the link frame
+    head = next(mk for mk in scene.markers if mk.ns == "robot/r/pan")
+    assert (head.header.frame_id, head.frame_locked, head.pose.position.x) == ("r/pan/link", True, 0.1)
     js = by_topic["/r/joint_states"][-1]
     assert list(js.name) == ["pan"] and js.position.tolist() == [QUARTER] and js.effort.tolist() == []
     # exported without the joint states, the riding frames stay static (there is nothing to move them)
