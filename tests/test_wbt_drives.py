@@ -179,8 +179,8 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     """A gripper's lift arm (a motorised hinge along the robot's +y, like the wheels, its end point a
     box with slider fingers: nothing round to roll on) on a two-wheel robot: the robot keeps its
     two-wheel drive (three "wheels", one on the x axis, made no drive at all), the arm's motor moves
-    its joint kinematically with one warning at its joint, its sensor measures it and the wheel
-    encoders measure their wheels."""
+    its joint kinematically with one warning at its joint (the slider's names its motor), its sensor
+    measures it and the wheel encoders measure their wheels."""
     arm = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor -0.01 0 0.022 }\n'
            '  device [ RotationalMotor { name "lift" } PositionSensor { name "lift sensor" } ]\n'
            '  endPoint Solid { translation -0.01 0 0.022 children [\n'
@@ -201,6 +201,10 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     assert f"{p}:4:1: HingeJoint motor 'lift' is no wheel (its end point has no cylinder or sphere to roll on): " \
            "its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and the " \
            "shapes and devices past the joint with it" in w.warnings
+    # the finger's slider, never a wheel, is named too (it used to read "SliderJoint motor(s) not part of a wheel")
+    assert [x.split(": ", 1)[1] for x in w.warnings if "SliderJoint" in x] == [
+        "SliderJoint motor 'grip': its joint moves kinematically (Webots' rule without physics; its PositionSensor "
+        "reads it), and the shapes and devices past the joint with it"]
     sim = Simulation(w).robot("khepera")
     assert sorted(sim.drive.motors) == ["left wheel", "right wheel"]    # the lift and the grip are no wheels
     assert sorted(sim.joints) == ["grip", "lift"]

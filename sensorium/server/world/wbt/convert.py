@@ -1179,9 +1179,11 @@ class Converter:
                 self.warn(d, f"{d.type} in a joint's device list: ignored")
             if entry is not None and self.tree is not None and owner.kind == "robot":   # a node of the joint's
                 self.tree_entry(d, {"type": d.type, "_device": entry}, field_name)       # (no Pose: no position)
-        if motors:
-            for entry in sensors:
+        for entry in sensors:       # with a motor, its joint's; without, the still joint's position
+            if motors:
                 entry["motor"] = motors[0]["name"]
+            elif position:
+                entry["position"] = position
         return motors, sensors
 
     def motor_fields(self, d: Node, position: float) -> dict[str, float]:
@@ -1264,13 +1266,17 @@ class Converter:
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
         elif motors and (node.type != "Hinge2Joint" or not wheeled) and owner.kind == "robot":
-            self.warn(node, f"{node.type} motor(s) not part of a wheel{'' if wheeled else ' (inside a device)'}: "
-                            f"{JOINT_MOVES}")
+            if wheeled:       # a slider or a ball joint is never a wheel: the motor by name, as a hinge's
+                names = ", ".join(repr(self.fields(m).string("name", OTHER_MOTOR_NAMES[m.type])) for m in motors)
+                self.warn(node, f"{node.type} motor {names}: {JOINT_MOVES}")
+            else:
+                self.warn(node, f"{node.type} motor(s) not part of a wheel (inside a device): {JOINT_MOVES}")
         elif motors:
             self.warn(node, f"{node.type} motor(s) outside a robot: not simulated")
         # (a robot's Hinge2Joint: hinge2() said which of its axes has sensors but no motor)
         if sensors and not motors and node.type != "Hinge2Joint":
-            self.warn(node, "PositionSensor on a joint without a motor: reads 0 (nothing turns the joint here)")
+            self.warn(node, f"PositionSensor on a joint without a motor: reads the joint's position, "
+                            f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)")
         if end is not None:
             if end.type == "SolidReference":
                 return
