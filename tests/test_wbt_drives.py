@@ -208,3 +208,43 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     sim = Simulation(w).robot("khepera")
     assert sorted(sim.drive.motors) == ["left wheel", "right wheel"]    # the lift and the grip are no wheels
     assert sorted(sim.joints) == ["grip", "lift"]
+
+
+def test_a_robot_whose_motorised_hinges_have_nothing_round_is_no_failed_vehicle(tmp_path: Path) -> None:
+    """A fixed pan-tilt head (a pan hinge about z, its end point a box holding a tilt hinge about y
+    whose end point holds a camera in a box) and a gripper's two finger hinges about z (Webots'
+    coupled_motors sample: motors "motor::left finger" and "motor::right finger", multiplier -1).
+    Nothing at any hinge's end is round, so there is no vehicle: each motor is said once as no wheel
+    and moves its joint kinematically. They used to be taken for a car's steering (the vertical axes)
+    and end in "no Ackermann drive (...); the robot will not move". The coupled names are said too:
+    Webots passes one command to the whole group; here each motor moves on its own commands."""
+    box = 'children [ Shape { geometry Box { size 0.05 0.05 0.05 } } ]'
+    head = ('Robot { name "head" children [\n'
+            ' HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 } device [ RotationalMotor { name "pan" '
+            f'maxVelocity 100 maxTorque 100000 }} ] endPoint Solid {{ translation 0 0 0.1 {box[:-2]}\n'
+            '  HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0 0.1 } device [ RotationalMotor '
+            '{ name "tilt" } ] endPoint Solid { translation 0 0 0.1 children [ Camera { translation 0.1 0 0 } ] } } ] } }\n'
+            '] }\n'
+            'Robot { name "gripper" translation 1 0 0 children [\n'
+            + "".join(f' HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor 0 {y} 0 }} device [ '
+                      f'RotationalMotor {{ name "motor::{side} finger" {m} }} ] endPoint Solid {{ translation 0 {y} 0 '
+                      f'{box} }} }}\n' for side, y, m in (("left", -0.008, ""), ("right", 0.008, "multiplier -1")))
+            + '] }\n')
+    p = write(tmp_path, head)
+    w = load_world(p)
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    for robot in w.world.robots:
+        assert robot.differential_drive is None and robot.ackermann_drive is None
+    said = sorted(x.split(": ", 1)[1].split(" (")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == ["HingeJoint motor 'motor::left finger' is no wheel", "HingeJoint motor 'motor::right finger' is no "
+                    "wheel", "HingeJoint motor 'pan' is no wheel", "HingeJoint motor 'tilt' is no wheel"]
+    coupled = [x.split(": ", 1)[1] for x in w.warnings if "coupled" in x]
+    assert coupled == [f"RotationalMotor 'motor::{side} finger': coupled motors (Webots passes a command to every "
+                       f"motor whose name shares the part before '::', scaled by its multiplier, here {m}) are not "
+                       "coupled here: it moves on its own commands only, and getMultiplier answers 1"
+                       for side, m in (("left", 1), ("right", -1))]
+    sim = Simulation(w)
+    sim.robot("head").motor("pan").set_position(math.pi / 2)
+    sim.step()
+    cam = sim.device("head/camera").world_pose(sim.robot("head").pose)
+    assert cam.translation == pytest.approx([0.0, 0.1, 0.2], abs=1e-12)   # (0.1, 0, 0.2) turned a quarter about z

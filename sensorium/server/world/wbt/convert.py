@@ -1167,6 +1167,11 @@ class Converter:
                 self.ride(entry)
                 owner.data["devices"].append(entry)
                 motors.append(entry)
+                if "::" in entry["name"]:      # Webots' coupled motors: one command moves the whole group
+                    self.warn(d, f"{d.type} {entry['name']!r}: coupled motors (Webots passes a command to every motor "
+                                 f"whose name shares the part before '::', scaled by its multiplier, here "
+                                 f"{self.fields(d).num('multiplier', 1.0):g}) are not coupled here: it moves on its "
+                                 "own commands only, and getMultiplier answers 1")
             elif d.type == "PositionSensor":
                 sf = self.fields(d)
                 entry = {"name": sf.string("name", "position sensor"), "device": "PositionSensor",
@@ -1334,6 +1339,13 @@ class Converter:
 
         wheels = robot.wheels
         if not wheels:
+            return
+        if all(wheel_radius(w["end"], self) is None for w in wheels):
+            # nothing round to roll on at any motorised hinge (an arm, a gripper's fingers, a pan-tilt
+            # head): no vehicle, so no drive to miss; each joint moves kinematically
+            for w in wheels:
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (its end point has no "
+                                     f"cylinder or sphere to roll on): {JOINT_MOVES}")
             return
         if any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
