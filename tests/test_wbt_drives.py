@@ -248,3 +248,28 @@ def test_a_robot_whose_motorised_hinges_have_nothing_round_is_no_failed_vehicle(
     sim.step()
     cam = sim.device("head/camera").world_pose(sim.robot("head").pose)
     assert cam.translation == pytest.approx([0.0, 0.1, 0.2], abs=1e-12)   # (0.1, 0, 0.2) turned a quarter about z
+
+
+def test_a_lone_motorised_turntable_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' motor sample: a robot whose one motorised hinge (axis z, position 1.5708) turns a disc
+    (a cylinder: round) with a pointer on it. One hinge makes no drive, so it is said once as no
+    wheel and turns kinematically; it used to be taken for a car's lone steering joint ("no
+    Ackermann drive ...; the robot will not move"). A distance sensor on the disc at (0.05, 0, 0.063)
+    rides it: at 1.5708 + pi/2 it is a quarter turn on, at (0, 0.05, 0.063)."""
+    p = write(tmp_path, 'Robot { name "turntable" children [\n'
+              ' HingeJoint { jointParameters HingeJointParameters { position 1.5708 axis 0 0 1 }\n'
+              '  device [ RotationalMotor { name "motor" maxVelocity 100 maxTorque 100000 } ]\n'
+              '  endPoint Solid { children [ Pose { translation 0 0 0.063 children [ Shape { geometry Cylinder { '
+              'radius 0.04 height 0.005 } } ] }\n'
+              '   DistanceSensor { translation 0.05 0 0.063 } ] } }\n] }\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    assert [x for x in w.warnings if "is no wheel" in x] == [
+        f"{p}:4:2: HingeJoint motor 'motor' is no wheel (the robot's only motorised hinge): its joint moves "
+        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
+        "the joint with it"]
+    sim = Simulation(w)
+    sim.robot("turntable").motor("motor").set_position(1.5708 + math.pi / 2)
+    sim.step()
+    ds = sim.device("turntable/distance sensor").world_pose(sim.robot("turntable").pose)
+    assert ds.translation == pytest.approx([0.0, 0.05, 0.063], abs=1e-12)

@@ -1340,12 +1340,14 @@ class Converter:
         wheels = robot.wheels
         if not wheels:
             return
-        if all(wheel_radius(w["end"], self) is None for w in wheels):
-            # nothing round to roll on at any motorised hinge (an arm, a gripper's fingers, a pan-tilt
-            # head): no vehicle, so no drive to miss; each joint moves kinematically
-            for w in wheels:
-                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (its end point has no "
-                                     f"cylinder or sphere to roll on): {JOINT_MOVES}")
+        round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
+        if len(wheels) == 1 or not any(round_):
+            # one motorised hinge (Webots' motor sample: a turntable), or nothing round to roll on at
+            # any (an arm, a gripper's fingers, a pan-tilt head): no vehicle, so no drive to miss;
+            # each joint moves kinematically
+            for w, rolls in zip(wheels, round_):
+                why = "the robot's only motorised hinge" if rolls else "its end point has no cylinder or sphere to roll on"
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): {JOINT_MOVES}")
             return
         if any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
