@@ -930,3 +930,15 @@ def test_robot_self_collision_is_read(tmp_path: Path) -> None:
         ds.enable(32)
         sim.step()
         assert ds.value == pytest.approx(expected)
+
+
+def test_an_open_cylinder_used_twice_is_said_once(tmp_path: Path) -> None:
+    """Webots' motor sample: the robot's base is a Group holding a Cylinder with ``bottom FALSE``,
+    USEd again as the robot's boundingObject. The warning that rays see it closed is about the one
+    node the file writes, so it is said once at its line (it was said twice, the same line)."""
+    p = write(tmp_path, 'Robot { name "r" children [ DEF BASE Group { children [ Pose { translation 0 0 0.019 '
+              'children [ Shape { geometry Cylinder { bottom FALSE height 0.04 radius 0.1 } } ] } ] } ]\n'
+              ' boundingObject USE BASE }\n')
+    w = load_world(p)
+    assert [x for x in w.warnings if "bottom/side/top" in x] == [
+        f"{p}:2:114: Cylinder with bottom/side/top FALSE: rays see the whole closed cylinder"]

@@ -160,6 +160,14 @@ class Converter:
     def warn(self, node: Node, message: str) -> None:
         self.warnings.append(f"{self.where(node)}: {message}")
 
+    def warn_once(self, node: Node, message: str) -> None:
+        """A warning about a node itself, said once however often the node is used (a DEF shape
+        USEd as its Solid's boundingObject too)."""
+        line = f"{self.where(node)}: {message}"
+        if line not in self.resets_said:
+            self.resets_said.add(line)
+            self.warnings.append(line)
+
     def field_reset(self, node: Node, name: str, message: str) -> None:
         """A field value Webots would not use, reset as Webots does (wbt/resets.py): one warning at
         the field's line, said once however often the node is used."""
@@ -737,7 +745,7 @@ class Converter:
             return {"type": "sphere", "radius": f.positive("radius", 1.0) * s}, ""
         if t in ("Cylinder", "Capsule"):
             if not all(f.flag(k, True) for k in ("bottom", "side", "top")):
-                self.warn(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
+                self.warn_once(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
             return {"type": t.lower(), "radius": f.positive("radius", 1.0) * s,
                     "height": f.positive("height", 2.0) * s}, ""
         if t == "Plane":
