@@ -273,3 +273,33 @@ def test_a_lone_motorised_turntable_is_no_failed_car(tmp_path: Path) -> None:
     sim.step()
     ds = sim.device("turntable/distance sensor").world_pose(sim.robot("turntable").pose)
     assert ds.translation == pytest.approx([0.0, 0.05, 0.063], abs=1e-12)
+
+
+def test_a_pan_head_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Path) -> None:
+    """A two-wheel robot with a pan head (a motorised hinge about z whose end point, a box, holds a
+    camera), as a TIAGo's head or an arm's base joint on a mobile robot: the vertical hinge was
+    taken for a car's steering and the robot lost its drive ("no Ackermann drive ...; the robot will
+    not move"). Its end point neither is nor carries a wheel, so it steers nothing: said once as no
+    wheel, it turns the camera, and the two wheels make the differential drive. A car's knuckle
+    (a vertical hinge whose end point holds its wheel's hinge) still steers (the four_wheels test)."""
+    head = ('HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 anchor 0 0 0.2 }\n'
+            '  device [ RotationalMotor { name "head pan" maxVelocity 100 maxTorque 100000 } ]\n'
+            '  endPoint Solid { translation 0 0 0.2 children [ Shape { geometry Box { size 0.05 0.05 0.05 } }\n'
+            '    Camera { translation 0.1 0 0 } ] } }\n')
+    p = write(tmp_path, 'Robot { name "rover" children [\n' + head + wheel("left wheel", 0, Y)
+              + wheel("right wheel", 0, -Y) + '] }\n')
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive is None and robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    assert [x.split(": ", 1)[1] for x in w.warnings if "head pan" in x] == [
+        "HingeJoint motor 'head pan' is no wheel and steers none (its end point holds no wheel): its joint moves "
+        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
+        "the joint with it"]
+    sim = Simulation(w)
+    rover = sim.robot("rover")
+    assert sorted(rover.drive.motors) == ["left wheel", "right wheel"] and sorted(rover.joints) == ["head pan"]
+    rover.motor("head pan").set_position(math.pi / 2)
+    sim.step()
+    assert sim.device("rover/camera").world_pose(rover.pose).translation == pytest.approx([0.0, 0.1, 0.2], abs=1e-12)

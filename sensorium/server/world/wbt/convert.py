@@ -1343,7 +1343,7 @@ class Converter:
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
     def drive(self, node: Node, robot: Owner) -> None:
-        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive, wheel_radius
+        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive, holds_wheel, wheel_radius
 
         wheels = robot.wheels
         if not wheels:
@@ -1357,6 +1357,14 @@ class Converter:
                 why = "the robot's only motorised hinge" if rolls else "its end point has no cylinder or sphere to roll on"
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): {JOINT_MOVES}")
             return
+        # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
+        # joint on a mobile robot) steers nothing: it is no wheel, and the others make the drive
+        pans = [w for w in wheels if w["steers"] and not holds_wheel(w["end"], self)]
+        if pans:
+            for w in pans:
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers none (its end "
+                                     f"point holds no wheel): {JOINT_MOVES}")
+            wheels = [w for w in wheels if not any(w is p for p in pans)]
         if any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
             if drive is None:
