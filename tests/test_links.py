@@ -309,3 +309,49 @@ def test_a_moved_robot_carries_its_turned_link() -> None:
     sim.robot("arm").set_pose(translation=[1, 0, 0], rotation=[0, 0, 1, QUARTER])
     sim.step()
     assert sim.device("watcher/ds").value == pytest.approx(1.9, abs=1e-9)
+
+
+def test_an_encoder_on_a_joint_without_a_motor_reads_the_joints_position(tmp_path) -> None:
+    """A .wbt robot (an inverted pendulum's structure: a motorised SliderJoint whose end point holds a
+    passive HingeJoint with only a PositionSensor, position 0.3, and beside it a passive SliderJoint
+    at 0.05 m). Webots' PositionSensor reads its joint's position; nothing turns these joints here,
+    so they read where the world file puts them, 0.3 rad and 0.05 m (they used to read 0), in the
+    simulation and the batched one alike, and stay there while the slider carries the hinge."""
+    from test_wbt_drives import write
+
+    from sensorium.server.sim.batched import BatchedSimulation
+    from sensorium.server.world.loader import load_world
+
+    w = load_world(write(tmp_path, (
+        'Robot { name "cart" children [\n'
+        ' SliderJoint { jointParameters JointParameters { axis 1 0 0 }\n'
+        '  device [ LinearMotor { name "rail" maxVelocity 100 maxForce 100000 } PositionSensor { name "rail sensor" } ]\n'
+        '  endPoint Solid { translation 0 0 0.06 children [\n'
+        '   HingeJoint { jointParameters HingeJointParameters { position 0.3 axis 0 1 0 anchor 0 0 0.03 }\n'
+        '    device [ PositionSensor { name "hip" } ]\n'
+        '    endPoint Solid { translation 0 0 0.33 children [ Shape { geometry Box { size 0.05 0.02 0.6 } } ] } } ] } }\n'
+        ' SliderJoint { jointParameters JointParameters { position 0.05 }\n'
+        '  device [ PositionSensor { name "idle" } ] endPoint Solid { translation 0 0 0.05 } }\n'
+        '] }\n')))
+    devices = {d.name: d for d in w.world.robots[0].devices}
+    assert (devices["hip"].motor, devices["hip"].position) == (None, 0.3)
+    assert (devices["idle"].motor, devices["idle"].position) == (None, 0.05)
+    assert any("reads the joint's position, 0.3" in m for m in w.warnings), w.warnings
+    sim = Simulation(w)
+    names = ("rail sensor", "hip", "idle")
+    for n in names:
+        sim.device(f"cart/{n}").enable(DT_MS)
+    sim.robot("cart").motor("rail").set_position(0.5)
+    sim.step()
+    assert [sim.device(f"cart/{n}").value for n in names] == [0.5, 0.3, 0.05]
+    still = load_world(write(tmp_path, (      # the batched simulation moves no joint: the passive ones alone
+        'Robot { name "cart" children [\n'
+        ' HingeJoint { jointParameters HingeJointParameters { position 0.3 } device [ PositionSensor { name "hip" } ] }\n'
+        ' SliderJoint { jointParameters JointParameters { position 0.05 } device [ PositionSensor { name "idle" } ] }\n'
+        '] }\n')))
+    bs = BatchedSimulation(still.world, 2)
+    for n in ("hip", "idle"):
+        bs.enable(bs.device("cart", n), DT_MS)
+    bs.step()
+    assert bs.value(bs.device("cart", "hip")).tolist() == [0.3, 0.3]
+    assert bs.value(bs.device("cart", "idle")).tolist() == [0.05, 0.05]

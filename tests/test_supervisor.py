@@ -275,4 +275,4 @@ def test_info_summary_names_an_encoder_on_a_joint_nothing_turns():
     from sensorium.server.sim.summary import device_line
 
     assert device_line(wm.PositionSensor(device="PositionSensor", name="arm sensor")) == \
-        "PositionSensor on a joint nothing turns here (present, reads 0 rad)"
+        "PositionSensor on a joint nothing turns here (present, reads its position, 0)"

@@ -846,6 +846,41 @@ def test_a_device_inside_its_robots_body_is_said(tmp_path: Path) -> None:
         "or make the shape part of the device's Solid"]
 
 
+def test_a_camera_in_a_shape_closer_than_its_near_plane_is_not_said(tmp_path: Path) -> None:
+    """Webots' binocular sample: each camera sits at the centre of its neighbouring distance sensor's
+    small housing (a cylinder of radius 8 mm, 4 mm high: every point within 8.25 mm of the camera,
+    under the camera's near of 1 cm). Its rays start at the near plane, here as in Webots, so the
+    image never shows the housing, yet the load report said the camera was "inside the robot's
+    cylinder". Now said only when the shape reaches past ``near``: not for the housing, still for the
+    same camera with ``near 0.005``, and for a range finder inside the 4.5 cm body."""
+    def robot(near: str, housing: bool = True) -> str:
+        return ('DirectionalLight { direction 0 0 -1 ambientIntensity 1 }\n'
+                'Solid { translation 0.5 0.02 0.063 children [ Shape { appearance PBRAppearance { baseColor 1 0 0 } '
+                'geometry Box { size 0.1 0.2 0.2 } } ] }\n'
+                'Robot { name "r" children [\n'
+                'DistanceSensor { translation 0.042 0.02 0.063 name "ds0" children [ Pose { rotation 1 0 0 1.5708 '
+                f'children [ Shape {{ geometry Cylinder {{ radius 0.008 height {0.004 if housing else 0.0001} }} }} ] }} ] }}\n'
+                f'Camera {{ translation 0.042 0.02 0.063 name "camera0" {near} }}\n'
+                'Pose { translation 0 0 0.0415 children [ Shape { geometry Cylinder { radius 0.045 height 0.08 } } ] }\n'
+                'RangeFinder { translation 0.031 0 0.05 }\n] }\n')
+
+    w = load_world(write(tmp_path, robot("")))
+    said = [x for x in w.warnings if "is inside the robot's" in x]
+    assert [x.split(": ", 1)[1].split(" is inside")[0] for x in said] == ["RangeFinder 'range-finder' of robot 'r'"]
+    images = []
+    for world in (w, load_world(write(tmp_path, robot("", housing=False)))):
+        sim = Simulation(world)
+        sim.device("r/camera0").enable(16)
+        sim.step()
+        sim.step()
+        images.append(np.asarray(sim.device("r/camera0").image))
+    assert np.array_equal(images[0], images[1])              # the housing is never in the image
+    assert np.any(images[0][..., 2] > 2 * images[0][..., 1].astype(int) + 20)   # the red box is (BGRA)
+    w = load_world(write(tmp_path, robot("near 0.005")))
+    said = [x.split(": ", 1)[1].split(" is inside")[0] for x in w.warnings if "is inside the robot's" in x]
+    assert said == ["Camera 'camera0' of robot 'r'", "RangeFinder 'range-finder' of robot 'r'"]
+
+
 def test_camera_fields_the_renderer_uses_and_rays_do_not_are_said(tmp_path: Path) -> None:
     """Motion blur and the other image effects of Webots' renderer (README: what a rasterising GPU
     gives that this does not) were dropped from a .wbt camera without a word; each one a world
@@ -895,3 +930,15 @@ def test_robot_self_collision_is_read(tmp_path: Path) -> None:
         ds.enable(32)
         sim.step()
         assert ds.value == pytest.approx(expected)
+
+
+def test_an_open_cylinder_used_twice_is_said_once(tmp_path: Path) -> None:
+    """Webots' motor sample: the robot's base is a Group holding a Cylinder with ``bottom FALSE``,
+    USEd again as the robot's boundingObject. The warning that rays see it closed is about the one
+    node the file writes, so it is said once at its line (it was said twice, the same line)."""
+    p = write(tmp_path, 'Robot { name "r" children [ DEF BASE Group { children [ Pose { translation 0 0 0.019 '
+              'children [ Shape { geometry Cylinder { bottom FALSE height 0.04 radius 0.1 } } ] } ] } ]\n'
+              ' boundingObject USE BASE }\n')
+    w = load_world(p)
+    assert [x for x in w.warnings if "bottom/side/top" in x] == [
+        f"{p}:2:114: Cylinder with bottom/side/top FALSE: rays see the whole closed cylinder"]

@@ -179,8 +179,8 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     """A gripper's lift arm (a motorised hinge along the robot's +y, like the wheels, its end point a
     box with slider fingers: nothing round to roll on) on a two-wheel robot: the robot keeps its
     two-wheel drive (three "wheels", one on the x axis, made no drive at all), the arm's motor moves
-    its joint kinematically with one warning at its joint, its sensor measures it and the wheel
-    encoders measure their wheels."""
+    its joint kinematically with one warning at its joint (the slider's names its motor), its sensor
+    measures it and the wheel encoders measure their wheels."""
     arm = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor -0.01 0 0.022 }\n'
            '  device [ RotationalMotor { name "lift" } PositionSensor { name "lift sensor" } ]\n'
            '  endPoint Solid { translation -0.01 0 0.022 children [\n'
@@ -201,6 +201,105 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     assert f"{p}:4:1: HingeJoint motor 'lift' is no wheel (its end point has no cylinder or sphere to roll on): " \
            "its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and the " \
            "shapes and devices past the joint with it" in w.warnings
+    # the finger's slider, never a wheel, is named too (it used to read "SliderJoint motor(s) not part of a wheel")
+    assert [x.split(": ", 1)[1] for x in w.warnings if "SliderJoint" in x] == [
+        "SliderJoint motor 'grip': its joint moves kinematically (Webots' rule without physics; its PositionSensor "
+        "reads it), and the shapes and devices past the joint with it"]
     sim = Simulation(w).robot("khepera")
     assert sorted(sim.drive.motors) == ["left wheel", "right wheel"]    # the lift and the grip are no wheels
     assert sorted(sim.joints) == ["grip", "lift"]
+
+
+def test_a_robot_whose_motorised_hinges_have_nothing_round_is_no_failed_vehicle(tmp_path: Path) -> None:
+    """A fixed pan-tilt head (a pan hinge about z, its end point a box holding a tilt hinge about y
+    whose end point holds a camera in a box) and a gripper's two finger hinges about z (Webots'
+    coupled_motors sample: motors "motor::left finger" and "motor::right finger", multiplier -1).
+    Nothing at any hinge's end is round, so there is no vehicle: each motor is said once as no wheel
+    and moves its joint kinematically. They used to be taken for a car's steering (the vertical axes)
+    and end in "no Ackermann drive (...); the robot will not move". The coupled names are said too:
+    Webots passes one command to the whole group; here each motor moves on its own commands."""
+    box = 'children [ Shape { geometry Box { size 0.05 0.05 0.05 } } ]'
+    head = ('Robot { name "head" children [\n'
+            ' HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 } device [ RotationalMotor { name "pan" '
+            f'maxVelocity 100 maxTorque 100000 }} ] endPoint Solid {{ translation 0 0 0.1 {box[:-2]}\n'
+            '  HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0 0.1 } device [ RotationalMotor '
+            '{ name "tilt" } ] endPoint Solid { translation 0 0 0.1 children [ Camera { translation 0.1 0 0 } ] } } ] } }\n'
+            '] }\n'
+            'Robot { name "gripper" translation 1 0 0 children [\n'
+            + "".join(f' HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor 0 {y} 0 }} device [ '
+                      f'RotationalMotor {{ name "motor::{side} finger" {m} }} ] endPoint Solid {{ translation 0 {y} 0 '
+                      f'{box} }} }}\n' for side, y, m in (("left", -0.008, ""), ("right", 0.008, "multiplier -1")))
+            + '] }\n')
+    p = write(tmp_path, head)
+    w = load_world(p)
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    for robot in w.world.robots:
+        assert robot.differential_drive is None and robot.ackermann_drive is None
+    said = sorted(x.split(": ", 1)[1].split(" (")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == ["HingeJoint motor 'motor::left finger' is no wheel", "HingeJoint motor 'motor::right finger' is no "
+                    "wheel", "HingeJoint motor 'pan' is no wheel", "HingeJoint motor 'tilt' is no wheel"]
+    coupled = [x.split(": ", 1)[1] for x in w.warnings if "coupled" in x]
+    assert coupled == [f"RotationalMotor 'motor::{side} finger': coupled motors (Webots passes a command to every "
+                       f"motor whose name shares the part before '::', scaled by its multiplier, here {m}) are not "
+                       "coupled here: it moves on its own commands only, and getMultiplier answers 1"
+                       for side, m in (("left", 1), ("right", -1))]
+    sim = Simulation(w)
+    sim.robot("head").motor("pan").set_position(math.pi / 2)
+    sim.step()
+    cam = sim.device("head/camera").world_pose(sim.robot("head").pose)
+    assert cam.translation == pytest.approx([0.0, 0.1, 0.2], abs=1e-12)   # (0.1, 0, 0.2) turned a quarter about z
+
+
+def test_a_lone_motorised_turntable_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' motor sample: a robot whose one motorised hinge (axis z, position 1.5708) turns a disc
+    (a cylinder: round) with a pointer on it. One hinge makes no drive, so it is said once as no
+    wheel and turns kinematically; it used to be taken for a car's lone steering joint ("no
+    Ackermann drive ...; the robot will not move"). A distance sensor on the disc at (0.05, 0, 0.063)
+    rides it: at 1.5708 + pi/2 it is a quarter turn on, at (0, 0.05, 0.063)."""
+    p = write(tmp_path, 'Robot { name "turntable" children [\n'
+              ' HingeJoint { jointParameters HingeJointParameters { position 1.5708 axis 0 0 1 }\n'
+              '  device [ RotationalMotor { name "motor" maxVelocity 100 maxTorque 100000 } ]\n'
+              '  endPoint Solid { children [ Pose { translation 0 0 0.063 children [ Shape { geometry Cylinder { '
+              'radius 0.04 height 0.005 } } ] }\n'
+              '   DistanceSensor { translation 0.05 0 0.063 } ] } }\n] }\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    assert [x for x in w.warnings if "is no wheel" in x] == [
+        f"{p}:4:2: HingeJoint motor 'motor' is no wheel (the robot's only motorised hinge): its joint moves "
+        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
+        "the joint with it"]
+    sim = Simulation(w)
+    sim.robot("turntable").motor("motor").set_position(1.5708 + math.pi / 2)
+    sim.step()
+    ds = sim.device("turntable/distance sensor").world_pose(sim.robot("turntable").pose)
+    assert ds.translation == pytest.approx([0.0, 0.05, 0.063], abs=1e-12)
+
+
+def test_a_pan_head_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Path) -> None:
+    """A two-wheel robot with a pan head (a motorised hinge about z whose end point, a box, holds a
+    camera), as a TIAGo's head or an arm's base joint on a mobile robot: the vertical hinge was
+    taken for a car's steering and the robot lost its drive ("no Ackermann drive ...; the robot will
+    not move"). Its end point neither is nor carries a wheel, so it steers nothing: said once as no
+    wheel, it turns the camera, and the two wheels make the differential drive. A car's knuckle
+    (a vertical hinge whose end point holds its wheel's hinge) still steers (the four_wheels test)."""
+    head = ('HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 anchor 0 0 0.2 }\n'
+            '  device [ RotationalMotor { name "head pan" maxVelocity 100 maxTorque 100000 } ]\n'
+            '  endPoint Solid { translation 0 0 0.2 children [ Shape { geometry Box { size 0.05 0.05 0.05 } }\n'
+            '    Camera { translation 0.1 0 0 } ] } }\n')
+    p = write(tmp_path, 'Robot { name "rover" children [\n' + head + wheel("left wheel", 0, Y)
+              + wheel("right wheel", 0, -Y) + '] }\n')
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive is None and robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    assert [x.split(": ", 1)[1] for x in w.warnings if "head pan" in x] == [
+        "HingeJoint motor 'head pan' is no wheel and steers none (its end point holds no wheel): its joint moves "
+        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
+        "the joint with it"]
+    sim = Simulation(w)
+    rover = sim.robot("rover")
+    assert sorted(rover.drive.motors) == ["left wheel", "right wheel"] and sorted(rover.joints) == ["head pan"]
+    rover.motor("head pan").set_position(math.pi / 2)
+    sim.step()
+    assert sim.device("rover/camera").world_pose(rover.pose).translation == pytest.approx([0.0, 0.1, 0.2], abs=1e-12)

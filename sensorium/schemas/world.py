@@ -530,7 +530,10 @@ class PositionSensor(_Device):
     device: Literal["PositionSensor"]
     motor: str | None = Field(default=None, min_length=1,
                               description="name of the robot's motor whose joint it measures; left out: a "
-                                          "sensor on a joint nothing turns here (it reads 0)")
+                                          "sensor on a joint nothing turns here (it reads ``position``)")
+    position: float = Field(default=0.0, allow_inf_nan=False,
+                            description="without a motor: the joint's position it reads (Webots jointParameters "
+                                        "position: rad, m on a slider); unused with a motor (the motor's own)")
     noise: float = Field(default=0.0, ge=0.0, description="standard deviation of Gaussian noise (rad)")
     resolution: float = -1.0
 

@@ -454,6 +454,7 @@ class BatchedSimulation:
                 wheel.append(self.wheel_side[d.robot_index].get(m, -1) if m is not None else -1)
             self._p_wheel = np.array(wheel, dtype=np.int64)
             self._p_slot = np.array([d.robot_index for d in self.position], dtype=np.int64)
+            self._p_still = np.array([float(d.config.position) for d in self.position])   # no motor: the joint's
             self._p_plain = np.array([float(d.config.noise) <= 0.0 and float(d.config.resolution) <= 0.0
                                       for d in self.position], dtype=bool)
 
@@ -978,7 +979,7 @@ class BatchedSimulation:
             return
         wheel = self._p_wheel[cols]
         slot = self._p_slot[cols]
-        v = np.where(wheel >= 0, self.wheel_angle[copies, slot, np.maximum(wheel, 0)], 0.0)
+        v = np.where(wheel >= 0, self.wheel_angle[copies, slot, np.maximum(wheel, 0)], self._p_still[cols])
         if self.cars is not None:     # a car's motor's encoder (its steering or a driven wheel)
             self.cars.read_encoders(self.position, copies, cols, v)
         plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself

@@ -555,7 +555,7 @@ class PositionSensor(Device):
         self.wheel = robot.motors.get(self.config.motor) if self.config.motor is not None else None
 
     def measure(self, now_ms: int) -> None:
-        v = float(self.wheel.position) if self.wheel is not None else 0.0  # type: ignore[attr-defined]
+        v = float(self.wheel.position) if self.wheel is not None else float(self.config.position)  # type: ignore[attr-defined]
         noise = float(self.config.noise)
         if noise > 0.0:
             v += float(self.rng.normal(0.0, noise))

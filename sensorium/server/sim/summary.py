@@ -22,7 +22,7 @@ def device_line(d) -> str:
         return f"LightSensor occlusion {'on' if d.occlusion else 'off'}"
     if isinstance(d, wm.PositionSensor):
         if d.motor is None:
-            return "PositionSensor on a joint nothing turns here (present, reads 0 rad)"
+            return f"PositionSensor on a joint nothing turns here (present, reads its position, {float(d.position):g})"
         return f"PositionSensor on {d.motor!r} noise {d.noise:g} resolution {d.resolution:g}"
     if isinstance(d, wm.LED):
         lights = f", {len(d.lights)} light(s) on while it is" if d.lights else ""

@@ -160,6 +160,14 @@ class Converter:
     def warn(self, node: Node, message: str) -> None:
         self.warnings.append(f"{self.where(node)}: {message}")
 
+    def warn_once(self, node: Node, message: str) -> None:
+        """A warning about a node itself, said once however often the node is used (a DEF shape
+        USEd as its Solid's boundingObject too)."""
+        line = f"{self.where(node)}: {message}"
+        if line not in self.resets_said:
+            self.resets_said.add(line)
+            self.warnings.append(line)
+
     def field_reset(self, node: Node, name: str, message: str) -> None:
         """A field value Webots would not use, reset as Webots does (wbt/resets.py): one warning at
         the field's line, said once however often the node is used."""
@@ -737,7 +745,7 @@ class Converter:
             return {"type": "sphere", "radius": f.positive("radius", 1.0) * s}, ""
         if t in ("Cylinder", "Capsule"):
             if not all(f.flag(k, True) for k in ("bottom", "side", "top")):
-                self.warn(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
+                self.warn_once(node, f"{t} with bottom/side/top FALSE: rays see the whole closed {t.lower()}")
             return {"type": t.lower(), "radius": f.positive("radius", 1.0) * s,
                     "height": f.positive("height", 2.0) * s}, ""
         if t == "Plane":
@@ -1167,6 +1175,11 @@ class Converter:
                 self.ride(entry)
                 owner.data["devices"].append(entry)
                 motors.append(entry)
+                if "::" in entry["name"]:      # Webots' coupled motors: one command moves the whole group
+                    self.warn(d, f"{d.type} {entry['name']!r}: coupled motors (Webots passes a command to every motor "
+                                 f"whose name shares the part before '::', scaled by its multiplier, here "
+                                 f"{self.fields(d).num('multiplier', 1.0):g}) are not coupled here: it moves on its "
+                                 "own commands only, and getMultiplier answers 1")
             elif d.type == "PositionSensor":
                 sf = self.fields(d)
                 entry = {"name": sf.string("name", "position sensor"), "device": "PositionSensor",
@@ -1179,9 +1192,11 @@ class Converter:
                 self.warn(d, f"{d.type} in a joint's device list: ignored")
             if entry is not None and self.tree is not None and owner.kind == "robot":   # a node of the joint's
                 self.tree_entry(d, {"type": d.type, "_device": entry}, field_name)       # (no Pose: no position)
-        if motors:
-            for entry in sensors:
+        for entry in sensors:       # with a motor, its joint's; without, the still joint's position
+            if motors:
                 entry["motor"] = motors[0]["name"]
+            elif position:
+                entry["position"] = position
         return motors, sensors
 
     def motor_fields(self, d: Node, position: float) -> dict[str, float]:
@@ -1264,13 +1279,17 @@ class Converter:
                                  "centre": np.asarray(frame.apply(centre)),
                                  "end": end, "frame": frame, "sensors": sensors})
         elif motors and (node.type != "Hinge2Joint" or not wheeled) and owner.kind == "robot":
-            self.warn(node, f"{node.type} motor(s) not part of a wheel{'' if wheeled else ' (inside a device)'}: "
-                            f"{JOINT_MOVES}")
+            if wheeled:       # a slider or a ball joint is never a wheel: the motor by name, as a hinge's
+                names = ", ".join(repr(self.fields(m).string("name", OTHER_MOTOR_NAMES[m.type])) for m in motors)
+                self.warn(node, f"{node.type} motor {names}: {JOINT_MOVES}")
+            else:
+                self.warn(node, f"{node.type} motor(s) not part of a wheel (inside a device): {JOINT_MOVES}")
         elif motors:
             self.warn(node, f"{node.type} motor(s) outside a robot: not simulated")
         # (a robot's Hinge2Joint: hinge2() said which of its axes has sensors but no motor)
         if sensors and not motors and node.type != "Hinge2Joint":
-            self.warn(node, "PositionSensor on a joint without a motor: reads 0 (nothing turns the joint here)")
+            self.warn(node, f"PositionSensor on a joint without a motor: reads the joint's position, "
+                            f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)")
         if end is not None:
             if end.type == "SolidReference":
                 return
@@ -1324,11 +1343,28 @@ class Converter:
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
     def drive(self, node: Node, robot: Owner) -> None:
-        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive, wheel_radius
+        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive, holds_wheel, wheel_radius
 
         wheels = robot.wheels
         if not wheels:
             return
+        round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
+        if len(wheels) == 1 or not any(round_):
+            # one motorised hinge (Webots' motor sample: a turntable), or nothing round to roll on at
+            # any (an arm, a gripper's fingers, a pan-tilt head): no vehicle, so no drive to miss;
+            # each joint moves kinematically
+            for w, rolls in zip(wheels, round_):
+                why = "the robot's only motorised hinge" if rolls else "its end point has no cylinder or sphere to roll on"
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): {JOINT_MOVES}")
+            return
+        # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
+        # joint on a mobile robot) steers nothing: it is no wheel, and the others make the drive
+        pans = [w for w in wheels if w["steers"] and not holds_wheel(w["end"], self)]
+        if pans:
+            for w in pans:
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers none (its end "
+                                     f"point holds no wheel): {JOINT_MOVES}")
+            wheels = [w for w in wheels if not any(w is p for p in pans)]
         if any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
             if drive is None:

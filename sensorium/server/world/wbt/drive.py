@@ -70,6 +70,28 @@ def wheel_radius(end: Node | None, conv) -> float | None:
     return find(f.node_("boundingObject"), 1.0) or find(end, 1.0)
 
 
+def holds_wheel(end: Node | None, conv) -> bool:
+    """Whether a steering-like (vertical) hinge's end point is or carries a wheel: something round
+    itself, or a hinge inside it whose end point is (a car's knuckle holding its wheel's joint).
+    A pan head's or an arm's end point is neither."""
+    if wheel_radius(end, conv) is not None:
+        return True
+
+    def find(node: Node | None) -> bool:
+        if node is None:
+            return False
+        conv.walk(node)
+        nf = conv.fields(node)
+        if node.type in ("HingeJoint", "Hinge2Joint"):
+            return wheel_radius(nf.node_("endPoint"), conv) is not None
+        if node.type in ("Pose", "Transform", "Group", "Solid", "Slot"):
+            kids = [nf.node_("endPoint")] if node.type == "Slot" else nf.nodes("children")
+            return any(find(child) for child in kids)
+        return False
+
+    return find(end)
+
+
 def _axis_off_y(wheels: list[dict], tol: float, why: str) -> str:
     """The sentence for the first wheel whose axis is not the robot's +y (within ``tol``), else ""."""
     y = np.array([0.0, 1.0, 0.0])

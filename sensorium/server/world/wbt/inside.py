@@ -20,6 +20,8 @@ from sensorium.server.world.poses import pose_from_values
 RENDERED = {"Camera", "RangeFinder", "Lidar"}        # rasterised in Webots: every closed shape is culled from inside
 PICKED = {"box", "sphere"}                           # Webots' infra-red picking: no hit from inside these
 CLOSED = {"box", "sphere", "cylinder", "capsule"}
+IMAGERS = {"Camera", "RangeFinder"}                  # their rays start at ``near`` (default NEAR)
+NEAR = 0.01
 EPS = 1e-9
 
 # field -> (Webots' default, what it does there); a Node-valued field's default is None (NULL)
@@ -74,9 +76,23 @@ def contains(geometry: dict, p: np.ndarray) -> bool:
     return False
 
 
+def reach(geometry: dict) -> float:
+    """How far the farthest point of a closed primitive is from its centre."""
+    t = geometry["type"]
+    if t == "box":
+        return float(np.linalg.norm(np.asarray(geometry["size"], dtype=np.float64))) / 2.0
+    if t == "cylinder":
+        return float(np.hypot(geometry["radius"], geometry["height"] / 2.0))
+    if t == "capsule":
+        return float(geometry["radius"] + geometry["height"] / 2.0)
+    return float(geometry["radius"])
+
+
 def enclosing_shapes(robot: dict, device: dict) -> list[dict]:
     """The robot's shapes (not the device's own, not bounding-only) that hold the device's origin
-    and that the device's rays would not see in Webots."""
+    and that the device's rays would not see in Webots. A camera's or a range finder's rays start at
+    its ``near`` distance, here as in Webots: a shape all within it (a sensor's housing the camera
+    sits in, as in Webots' binocular sample) is never seen, so it is not one."""
     kind = device["device"]
     if kind in RENDERED:
         kinds = CLOSED
@@ -92,6 +108,11 @@ def enclosing_shapes(robot: dict, device: dict) -> list[dict]:
             continue
         if part.get("of_device") == device["name"]:
             continue
-        if contains(geometry, _local(part["pose"], origin)):
-            out.append(part)
+        if not contains(geometry, _local(part["pose"], origin)):
+            continue
+        if kind in IMAGERS:           # clipped whole by the near plane: no ray meets it
+            centre = np.asarray(part["pose"]["translation"], dtype=np.float64)
+            if float(np.linalg.norm(centre - origin)) + reach(geometry) < device.get("near", NEAR) - EPS:
+                continue
+        out.append(part)
     return out
