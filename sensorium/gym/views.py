@@ -27,7 +27,6 @@ Anything else a callable reaches for raises AttributeError naming the view.
 from __future__ import annotations
 
 import math
-import sys
 from typing import Any
 
 import numpy as np
@@ -36,6 +35,7 @@ from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.batched_kinematic import READINGS
 from sensorium.server.sim.batched_lights import copy_world_lights
+from sensorium.server.sim.motion import velocity_accepted
 
 __all__ = ["CopySim", "CopyRobot"]
 
@@ -84,18 +84,10 @@ class _Motor:
         self._target[self._i] = float(min(max(value, -self._limit), self._limit))
 
     def set_velocity(self, value: float) -> None:
-        """``WheelMotor.set_velocity``'s rules, so a task callable's commands do in a copy what they do
-        in a Simulation: a negative velocity in position control is ignored with Webots' error line,
-        a speed above ``max_velocity`` (inf too) clamped, NaN refused."""
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
-            raise ValueError(f"motor {self.name!r}: velocity must be a number (inf is clamped to maxVelocity), "
-                             f"got {value!r}")
-        if value < 0.0 and not math.isinf(self.target_position):
-            print(f"Error: setVelocity() called with negative 'velocity' argument in position control mode "
-                  f"({self.target_position:g}): motor {self.name!r} keeps {self.velocity:g}.", file=sys.stderr)
-            return
-        self._velocity[self._i] = float(min(max(value, -self.max_velocity), self.max_velocity))
-
+        """``WheelMotor.set_velocity``'s rules (motion.velocity_accepted), so a task callable's commands
+        do in a copy what they do in a Simulation; clamped to ``max_velocity``."""
+        if velocity_accepted(self.name, value, self.target_position, self.velocity):
+            self._velocity[self._i] = float(min(max(value, -self.max_velocity), self.max_velocity))
 
 class _Drive:
     def __init__(self, sim: BatchedSimulation, copy: int, slot: int):

@@ -27,6 +27,21 @@ from sensorium.server.world.geometry import Pose
 _TWO_PI = 2.0 * math.pi
 
 
+
+def velocity_accepted(name: str, value: float, target_position: float, velocity: float) -> bool:
+    """Whether the in-process ``setVelocity(value)`` of motor ``name`` applies: NaN (and a bool)
+    raises; a negative velocity while in position control (a finite target) is ignored with
+    Webots' error line on stderr, as libController and the clients do. Infinite speeds apply (the
+    caller clamps them to ``maxVelocity``). Shared by the simulation's wheels and a batched copy's
+    motor view (gym/views.py), so both take the same commands alike."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
+        raise ValueError(f"motor {name!r}: velocity must be a number (inf is clamped to maxVelocity), got {value!r}")
+    if value < 0.0 and not math.isinf(target_position):
+        print(f"Error: setVelocity() called with negative 'velocity' argument in position control mode "
+              f"({target_position:g}): motor {name!r} keeps {velocity:g}.", file=sys.stderr)
+        return False
+    return True
+
 @dataclass(slots=True)
 class WheelMotor:
     """A RotationalMotor as a controller sees it (``setPosition``/``setVelocity``).
@@ -56,18 +71,10 @@ class WheelMotor:
         self.target_position = float(value)
 
     def set_velocity(self, value: float) -> None:
-        """Webots' ``setVelocity`` in the in-process API: a negative velocity while in position
-        control (a finite target) is ignored with Webots' error line on stderr, as libController
-        and the clients do; a speed above ``maxVelocity``, infinite ones included, is clamped to it
-        (WbMotor warns; the clients print that warning, this API clamps silently); NaN raises."""
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
-            raise ValueError(f"motor {self.name!r}: velocity must be a number (inf is clamped to maxVelocity), "
-                             f"got {value!r}")
-        if value < 0.0 and not math.isinf(self.target_position):
-            print(f"Error: setVelocity() called with negative 'velocity' argument in position control mode "
-                  f"({self.target_position:g}): motor {self.name!r} keeps {self.velocity:g}.", file=sys.stderr)
-            return
-        self.command_velocity(value)
+        """Webots' ``setVelocity`` in the in-process API (:func:`velocity_accepted`), clamped to
+        ``maxVelocity`` (WbMotor warns; the clients print that warning, this API clamps silently)."""
+        if velocity_accepted(self.name, value, self.target_position, self.velocity):
+            self.command_velocity(value)
 
     def command_velocity(self, value: float) -> None:
         """A velocity a controller's step (or a motor service) sends: clamped to ``maxVelocity``. The
