@@ -20,6 +20,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world, parse_world
+from tests.test_wbt_forward_axis import step_alike
 
 R_W, HX, HY = 0.08, 0.13, 0.15          # wheel radius; half track (along x) and half wheelbase (along y)
 WHEELS = ("right_front_wheel", "left_front_wheel", "right_rear_wheel", "left_rear_wheel")
@@ -110,21 +111,14 @@ def test_it_turns_on_the_closed_form_circle_and_the_copies_match_bit_for_bit(tmp
     right, left = left_turn_positions(delta, L, T)
     go(sim, right, left, 0.0)
     bs.cars.command(0, right, left, 0.0)
-    for _ in range(20):                              # the steering turns there; the car stands
-        sim.step()
-        bs.step()
+    step_alike(sim, bs, "ackerman", 20, compare=False)   # the steering turns there; the car stands
     r = sim.robot("ackerman")
     assert r.pose.translation.tolist() == [-0.5, 0.2, 0.1]
     assert (r.motor("right_steer").position, r.motor("left_steer").position) == (right, left)
     go(sim, right, left, omega)
     bs.cars.command(0, right, left, omega)
     n = 250
-    for _ in range(n):
-        sim.step()
-        bs.step()
-        for c in range(2):
-            assert bs.pose(c, 0).translation.tobytes() == r.pose.translation.tobytes()
-            assert bs.pose(c, 0).rotation.tobytes() == r.pose.rotation.tobytes()
+    step_alike(sim, bs, "ackerman", n)
     # the rear axle's centre circles the turn centre at R = L / tan δ on its left; each wheel rolls at
     # its distance from the centre over R times the axle's speed v, so four wheels at ω give v
     R = L / math.tan(delta)
@@ -177,18 +171,11 @@ def test_a_yaml_car_with_an_offset_circles_about_its_rear_axles_turn_centre(a: f
     right, left = math.atan(1.0 / (cot - half)), math.atan(1.0 / (cot + half))   # inner right, outer left
     steer_and_roll(sim, right, left, 0.0)
     bs.cars.command(0, right, left, 0.0)
-    for _ in range(10):
-        sim.step()
-        bs.step()
+    step_alike(sim, bs, "car", 10, compare=False)
     steer_and_roll(sim, right, left, wheel)
     bs.cars.command(0, right, left, wheel)
     n = 300
-    for _ in range(n):
-        sim.step()
-        bs.step()
-        for c in range(3):
-            assert bs.pose(c, 0).translation.tobytes() == sim.robot("car").pose.translation.tobytes()
-            assert bs.pose(c, 0).rotation.tobytes() == sim.robot("car").pose.rotation.tobytes()
+    step_alike(sim, bs, "car", n)
     R = L / math.tan(delta)
     # the rear wheels at (0, ±tr/2) from the axle's centre roll at (R ± tr/2)/R of its speed v
     v = 2 * 0.35 * wheel * R / ((R - 0.75) + (R + 0.75))

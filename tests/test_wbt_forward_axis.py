@@ -52,6 +52,19 @@ def go(sim: Simulation, robot: str, left: float, right: float) -> None:
         m.set_velocity(left if "left" in name else right)
 
 
+
+def step_alike(sim: Simulation, bs: BatchedSimulation, robot: str, steps: int, compare: bool = True) -> None:
+    """``steps`` basic steps of a single simulation and a batched one; with ``compare``, after each
+    step every copy's robot of slot 0 is at the single ``robot``'s pose, bit for bit."""
+    for _ in range(steps):
+        sim.step()
+        bs.step()
+        if compare:
+            pose = sim.robot(robot).pose
+            for c in range(bs.copies):
+                assert bs.pose(c, 0).translation.tobytes() == pose.translation.tobytes()
+                assert bs.pose(c, 0).rotation.tobytes() == pose.rotation.tobytes()
+
 def test_wheels_about_minus_x_make_a_drive_forward_along_y(tmp_path: Path) -> None:
     w = load_world(write(tmp_path, rover(place="translation 0 0 0.08")))
     assert w.warnings == []
@@ -235,20 +248,13 @@ def test_a_car_whose_wheels_turn_about_minus_x_drives_along_y_and_circles_right(
         r.motor(name).set_velocity(0.0)
     assert bs.cars is not None
     bs.cars.command(0, right, left, 0.0)
-    for _ in range(10):                           # the steering turns there; the car stands
-        sim.step()
-        bs.step()
+    step_alike(sim, bs, "car", 10, compare=False)    # the steering turns there; the car stands
     assert r.pose.translation.tolist() == [0.0, 0.0, 0.08]
     for name in ("right_rear_wheel", "left_rear_wheel"):
         r.motor(name).set_velocity(8.0)
     bs.cars.command(0, right, left, 8.0)
     n = 300
-    for _ in range(n):
-        sim.step()
-        bs.step()
-        for c in range(2):
-            assert bs.pose(c, 0).translation.tobytes() == r.pose.translation.tobytes()
-            assert bs.pose(c, 0).rotation.tobytes() == r.pose.rotation.tobytes()
+    step_alike(sim, bs, "car", n)
     # clockwise (to its right, +x) on the circle of radius L / tan δ about (L / tan δ, 0)
     radius = L / math.tan(delta)
     phi = R * 8.0 * n * 0.016 / radius
