@@ -269,5 +269,4 @@ register(DeviceKind(
 # ---------------------------------------------------------------------- listed, not simulated (yet)
 
 for _t in wm.UNSIMULATED_DEVICE_TYPES:
-    register(DeviceKind(_t, getattr(wm, _t) if _t in wm.LISTED_WITH_FIELDS else None,
-                        description=f"{_t}Description" if _t in wm.LISTED_WITH_FIELDS else None))
+    register(DeviceKind(_t, None))

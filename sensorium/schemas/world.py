@@ -918,10 +918,6 @@ class Display(_Device):
     height: int = Field(default=64, ge=1, le=1 << 16, description="pixels (wb_display_get_height)")
 
 
-LISTED_WITH_FIELDS: tuple[str, ...] = ()
-"""Unsimulated types whose own fields a world file keeps (a model of their own, above): their
-``attach`` description carries them."""
-_NO_FIELDS = tuple(t for t in UNSIMULATED_DEVICE_TYPES if t not in LISTED_WITH_FIELDS)
 
 
 class UnsimulatedDevice(_Device):
@@ -930,7 +926,7 @@ class UnsimulatedDevice(_Device):
     with one warning per device. Only ``device``, ``name``, ``model`` and ``pose`` are accepted: the
     device's other Webots fields come with its model (the .wbt converter leaves them out)."""
 
-    device: Literal[_NO_FIELDS]  # type: ignore[valid-type]
+    device: Literal[UNSIMULATED_DEVICE_TYPES]  # type: ignore[valid-type]
 
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass

@@ -49,12 +49,12 @@ class DeviceServices:
     # ------------------------------------------------------------------ device services
     def _describe_robot(self, robot: str) -> list[dict]:
         """``attach``'s device list: every device in Webots' tree order, each described by its kind
-        (an unsimulated one by its identity, and a Display by its size too)."""
+        (an unsimulated one by its identity)."""
         r = self.sim.robots[robot]
         out = []
         for e in self._device_entries(robot):            # type: ignore[attr-defined]
             if not e.simulated:
-                d: dict[str, Any] = {"name": e.name, "type": e.type, "simulated": False, **dict(e.fields)}
+                d: dict[str, Any] = {"name": e.name, "type": e.type, "simulated": False}
             elif e.type in MOTORS:
                 d = self._describe_motor(r.motors[e.name])
             else:

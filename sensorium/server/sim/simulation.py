@@ -66,18 +66,13 @@ def lights_from_models(models: list) -> light_math.LightArrays:
 class DeviceEntry:
     """One device of a robot as Webots lists it (``wb_robot_get_device_by_index``): its index in
     the robot's tree order (the world file's ``devices`` order, then the drive's motors that the
-    list leaves out), Webots node type, name, ``model`` field, and whether Sensorium simulates it;
-    ``fields``: a listed device's own world fields its attach entry carries (a Display's size)."""
+    list leaves out), Webots node type, name, ``model`` field, and whether Sensorium simulates it."""
 
     index: int
     type: str
     name: str
     model: str
     simulated: bool
-    fields: tuple[tuple[str, Any], ...] = ()
-
-
-_ENTRY_FIELDS = {"device", "name", "model", "pose"}
 
 
 def device_entries(model: wm.Robot, devices: dict[str, Device],
@@ -85,9 +80,7 @@ def device_entries(model: wm.Robot, devices: dict[str, Device],
     out: list[DeviceEntry] = []
     for d in model.devices:
         simulated = d.name in (motors if isinstance(d, wm.Motor) else devices)
-        own = (tuple((k, getattr(d, k)) for k in type(d).model_fields if k not in _ENTRY_FIELDS)
-               if d.device in wm.LISTED_WITH_FIELDS else ())
-        out.append(DeviceEntry(len(out), d.device, d.name, getattr(d, "model", "") or "", simulated, own))
+        out.append(DeviceEntry(len(out), d.device, d.name, getattr(d, "model", "") or "", simulated))
     listed = {e.name for e in out}
     for name in motors:
         if name not in listed:
