@@ -46,7 +46,7 @@ from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
 from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import _base_color, robot_parts, surface_colors, surface_opacity
+from sensorium.server.sim.scene import _base_color, receives_shadows, robot_parts, surface_colors, surface_opacity
 
 __all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera", "own_body_hits"]
 
@@ -337,11 +337,6 @@ class CameraDevices(PixelDevices):
         flags[:m] = sampler.alpha[:m]
         return flags
 
-    def _receives_shadows(self, shape: np.ndarray, alpha_shapes: np.ndarray | None) -> np.ndarray:
-        """``Scene.receives_shadows`` in this camera's shape numbering."""
-        out = self.transparency[shape] <= 0.0
-        return out if alpha_shapes is None else out & ~alpha_shapes[shape]
-
     def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits,
                 alpha_shapes: np.ndarray | None = None) -> np.ndarray:
         """Camera._render of one copy's rays (``hits``: its first layer, from the copies' cast): the
@@ -367,7 +362,7 @@ class CameraDevices(PixelDevices):
             lit = None
             if self.shadows.any():    # on opaque surfaces only, as Camera's surface
                 lit = np.ones((len(s), len(self.shadows)), dtype=bool)
-                on = self._receives_shadows(s, alpha_shapes).nonzero()[0]
+                on = receives_shadows(self.transparency, alpha_shapes, s).nonzero()[0]   # (this camera's numbering)
                 lit[on] = self._shadows(P[on], N[on], zeros[on], copy)
             lights = self._lights_of(int(copy[0]))
             return _shade(P, N, albedo, lights, None if lit is None else lit[:, :lights.count], scene.engine.threads)

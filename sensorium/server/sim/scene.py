@@ -90,6 +90,14 @@ def translucent(appearance: wm.Appearance | None, base_dir: Path) -> bool:
     return t is not None and load_alpha(resolve_texture_url(t.url, base_dir, allow_outside=True), t.url) is not None
 
 
+def receives_shadows(transparency: np.ndarray, alpha: np.ndarray | None, shape: np.ndarray) -> np.ndarray:
+    """Per hit (shape −1, the arrays' last entry: True): whether shadows fall on it -- not on a
+    translucent shape (:func:`translucent`: ``transparency`` above 0, or ``alpha``, its image's
+    transparent texels), which WREN draws in its translucent pass, unshadowed."""
+    out = transparency[shape] <= 0.0
+    return out if alpha is None else out & ~alpha[shape]
+
+
 def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None) -> ShapeEntry:
     transparent = shape.appearance is not None and shape.appearance.transparency >= 1.0
     assert shape.geometry is not None
@@ -649,11 +657,8 @@ class Scene:
         return surface_colors(self.colors, self.textures, self._world_to_shape, shape, origins, directions, distance)
 
     def receives_shadows(self, shape: np.ndarray) -> np.ndarray:
-        """Per hit (shape −1: True): whether shadows fall on it -- not on a translucent shape
-        (:func:`translucent`), which WREN draws in its translucent pass, unshadowed."""
-        out = self.transparency[shape] <= 0.0
-        alpha = self.alpha_shapes
-        return out if alpha is None else out & ~alpha[shape]
+        """:func:`receives_shadows` of hits on this scene's shapes."""
+        return receives_shadows(self.transparency, self.alpha_shapes, shape)
 
     @property
     def alpha_shapes(self) -> np.ndarray | None:
