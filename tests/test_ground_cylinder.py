@@ -13,6 +13,7 @@ import pytest
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
+from tests.test_batched_sim import _drive_single
 from tests.test_ground_box import BODY, HALF, _drive, _robot, _sim
 
 DRUM = 0.25 + 0.1 / 2          # the drum's top: its centre plus half its height
@@ -104,10 +105,7 @@ def test_copies_riding_a_drum_are_the_single_simulation_bit_for_bit() -> None:
                 lr = rng.uniform(-12.0, 12.0, (3, 2))
                 bs.set_wheels(bs.slot(robot), lr[:, 0], lr[:, 1])
                 for c, s in enumerate(sims):
-                    for m in s.robot(robot).motors.values():
-                        m.set_position(math.inf)
-                    s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
-                    s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
+                    _drive_single(s, robot, float(lr[c, 0]), float(lr[c, 1]))
         bs.step()
         for c, s in enumerate(sims):
             s.step()
