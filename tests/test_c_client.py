@@ -968,7 +968,8 @@ def test_unknown_robot_and_launcher_errors(cbin, servers, tmp_path):
 
 def test_a_curve_server_serves_a_c_controller_that_has_its_key(cbin, servers, tmp_path):
     """CURVE from the C library: SENSORIUM_CURVE_SERVERKEY (hex or Z85) as for the Python client;
-    without it the server does not answer; a malformed key is one clear line."""
+    without it, or with a wrong one, the server does not answer and the timeout says why (as the
+    Python client's does); a malformed key is one clear line."""
     keys = tmp_path / "keys"
     made = subprocess.run([sys.executable, "-m", "sensorium", "keys", str(keys)], capture_output=True, text=True,
                           env=ENV, cwd=str(REPO), timeout=60)
@@ -980,7 +981,14 @@ def test_a_curve_server_serves_a_c_controller_that_has_its_key(cbin, servers, tm
     assert code == 0 and [fields(x)["t"] for x in lines] == ["32", "64"], err
     code, lines, err = finish(start([cbin["script"], "step", "32", "1"], server.url("epuck"),
                                     SENSORIUM_CONTROLLER_TIMEOUT="2"))
-    assert code == 1 and lines == [] and "TIMEOUT" in err, err
+    # refused, however libzmq ends it (a reconnection loop or a connection it gives up), the error says why
+    assert code == 1 and lines == [] and "TIMEOUT" in err and "this client has no key" in err, err
+    assert "SENSORIUM_CURVE_SERVERKEY" in err and "running there" not in err, err
+    wrong = subprocess.run([sys.executable, "-c", "import zmq; print(zmq.curve_keypair()[0].decode())"],
+                           capture_output=True, text=True, timeout=60).stdout.strip()
+    code, lines, err = finish(start([cbin["script"], "step", "32", "1"], server.url("epuck"),
+                                    SENSORIUM_CURVE_SERVERKEY=wrong, SENSORIUM_CONTROLLER_TIMEOUT="2"))
+    assert code == 1 and lines == [] and "TIMEOUT" in err and "is wrong for this server" in err, err
     code, lines, err = finish(start([cbin["script"], "step", "32", "1"], server.url("epuck"),
                                     SENSORIUM_CURVE_SERVERKEY="not-a-key"))
     assert code == 1 and len(err.strip().splitlines()) == 1 and "CURVE key" in err, err

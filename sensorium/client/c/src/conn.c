@@ -294,6 +294,11 @@ struct sn_conn {
   size_t retry_size;
   uint64_t retry_id;
   int64_t retry_sent_ms;
+  /* handshake events (tcp only), so that a server that refuses this client's security handshake is
+     said as such rather than as "is the server running?"; dropped after the first reply */
+  void *monitor;
+  int handshake_failed; /* the last failed handshake's event, 0: none */
+  bool has_key;
 };
 
 #define RETRY_MS 1000
@@ -342,6 +347,84 @@ bad:
   return -1;
 }
 
+/* libzmq sends monitor events from its I/O thread with a blocking send: an unbounded receiving pipe
+   (RCVHWM 0, set before connecting) keeps a handshake failing at every reconnection from stalling
+   the context; the events are a few bytes each and read at the next wait. */
+static void start_monitor(sn_conn *c) {
+  char addr[64];
+  snprintf(addr, sizeof addr, "inproc://sensorium-handshake-%p", (void *)c);
+  if (zmq_socket_monitor(c->sock, addr, ZMQ_EVENT_HANDSHAKE_SUCCEEDED | ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |
+                                            ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL | ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) != 0)
+    return; /* no monitor: a refused handshake is then a plain timeout */
+  void *mon = zmq_socket(c->ctx, ZMQ_PAIR);
+  int zero = 0;
+  if (mon == NULL)
+    return;
+  zmq_setsockopt(mon, ZMQ_RCVHWM, &zero, sizeof zero);
+  zmq_setsockopt(mon, ZMQ_LINGER, &zero, sizeof zero);
+  if (zmq_connect(mon, addr) != 0) {
+    zmq_close(mon);
+    zmq_socket_monitor(c->sock, NULL, 0);
+    return;
+  }
+  c->monitor = mon;
+}
+
+static void stop_monitor(sn_conn *c) {
+  if (c->monitor == NULL)
+    return;
+  zmq_socket_monitor(c->sock, NULL, 0);
+  zmq_close(c->monitor);
+  c->monitor = NULL;
+}
+
+/* Reads the handshake events received so far (never blocks). */
+static void watch_handshakes(sn_conn *c) {
+  while (c->monitor != NULL) {
+    zmq_pollitem_t item = {c->monitor, 0, ZMQ_POLLIN, 0};
+    if (zmq_poll(&item, 1, 0) <= 0)
+      return;
+    int event = 0;
+    zmq_msg_t msg;
+    zmq_msg_init(&msg);
+    if (zmq_msg_recv(&msg, c->monitor, ZMQ_DONTWAIT) < 0) {
+      zmq_msg_close(&msg);
+      return;
+    }
+    if (zmq_msg_size(&msg) >= 2) {
+      const unsigned char *d = zmq_msg_data(&msg);
+      event = d[0] | (d[1] << 8); /* a 16-bit event number, little-endian, then a 32-bit value */
+    }
+    while (zmq_msg_more(&msg)) { /* the second frame: the endpoint */
+      zmq_msg_close(&msg);
+      zmq_msg_init(&msg);
+      if (zmq_msg_recv(&msg, c->monitor, ZMQ_DONTWAIT) < 0)
+        break;
+    }
+    zmq_msg_close(&msg);
+    if (event == ZMQ_EVENT_HANDSHAKE_SUCCEEDED) {
+      c->handshake_failed = 0;
+      stop_monitor(c);
+      return;
+    }
+    if (event != 0)
+      c->handshake_failed = event;
+  }
+}
+
+const char *sn_conn_handshake_problem(sn_conn *c) {
+  watch_handshakes(c);
+  if (c->handshake_failed == 0)
+    return NULL;
+  if (!c->has_key)
+    return "the server refused the connection's handshake: it uses CURVE encryption and this client has no key; "
+           "set SENSORIUM_CURVE_SERVERKEY to the key `sensorium serve --curve-keys` prints";
+  if (c->handshake_failed == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL)
+    return "the handshake failed: this client uses CURVE (SENSORIUM_CURVE_SERVERKEY) but the server does not "
+           "(started without --curve-keys?)";
+  return "the server did not accept the CURVE handshake: SENSORIUM_CURVE_SERVERKEY is wrong for this server";
+}
+
 sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen) {
   sn_conn *c = calloc(1, sizeof *c);
   if (c == NULL)
@@ -379,6 +462,10 @@ sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen) {
     sn_conn_close(c);
     return NULL;
   }
+  const char *key = getenv("SENSORIUM_CURVE_SERVERKEY");
+  c->has_key = key != NULL && *key != '\0';
+  if (strncmp(endpoint, "tcp://", 6) == 0)
+    start_monitor(c);
   if (zmq_connect(c->sock, endpoint) != 0) {
     snprintf(err, errlen, "cannot connect to %s: %s", endpoint, zmq_strerror(zmq_errno()));
     sn_conn_close(c);
@@ -393,6 +480,7 @@ void sn_conn_close(sn_conn *c) {
   if (c == NULL)
     return;
   sn_conn_stop_heartbeat(c);
+  stop_monitor(c);
   if (c->sock != NULL)
     zmq_close(c->sock);
   if (c->ctx != NULL)
@@ -507,6 +595,11 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
       int64_t left = deadline - now_ms();
       if (left <= 0) {
         forget(c, id);
+        const char *refused = sn_conn_handshake_problem(c);
+        if (refused != NULL) {
+          client_error(out, SN_TIMEOUT, "no reply from %s: %s", c->endpoint, refused);
+          return -1;
+        }
         char t[32];
         snprintf(t, sizeof t, "%g", timeout_ms / 1000.0);
         client_error(out, SN_TIMEOUT, "no reply from %s within %s s (is `sensorium serve` running there?)",
@@ -532,6 +625,11 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
              (without reconnecting) when a message breaks the protocol, e.g. a reply larger than
              MAX_REPLY (ZMQ_MAXMSGSIZE); a dropped network connection would still queue */
           forget(c, id);
+          const char *refused = sn_conn_handshake_problem(c);
+          if (refused != NULL) { /* libzmq gave up reconnecting after the handshake failed */
+            client_error(out, SN_TIMEOUT, "no reply from %s: %s", c->endpoint, refused);
+            return -1;
+          }
           char limit[32];
           snprintf(limit, sizeof limit, "%u MiB", MAX_REPLY >> 20);
           client_error(out, SN_CONNECTION_LOST,
@@ -542,6 +640,8 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
         }
         c->retry_sent_ms = now_ms();
       }
+      if (c->monitor != NULL)
+        watch_handshakes(c);
       char why[300];
       if (heartbeat_problem(c, why, sizeof why) != NULL) {
         forget(c, id);
@@ -576,6 +676,7 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
       }
       if (got == id) {
         forget(c, id);
+        stop_monitor(c); /* the handshake succeeded */
         *out = tmp;
         return 0;
       }

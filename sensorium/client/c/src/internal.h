@@ -95,6 +95,8 @@ void sn_conn_close(sn_conn *c);
 /* Send a built request (consumes nothing: the caller frees r). Returns its id, 0 on failure. */
 uint64_t sn_conn_next_id(sn_conn *c);
 int sn_conn_send(sn_conn *c, sn_req *r, uint64_t id);
+/* Why the server refuses this client's security handshake (a missing or wrong CURVE key), or NULL. */
+const char *sn_conn_handshake_problem(sn_conn *c);
 /* Like sn_conn_send, for a step request: re-sent with the same id every second while
    sn_conn_wait waits for it (a reply lost with a dropped connection is answered again). */
 int sn_conn_send_retried(sn_conn *c, sn_req *r, uint64_t id);

@@ -269,8 +269,10 @@ static int call(sn_conn *c, sn_req *r, uint64_t id, int timeout_ms, sn_reply *ou
   if (sn_conn_send(c, r, id) != 0) {
     sn_req_free(r);
     memset(out, 0, sizeof *out);
-    out->code = SN_CONNECTION_LOST;
-    snprintf(out->message, sizeof out->message, "cannot send to %s", sn_conn_endpoint(c));
+    const char *refused = sn_conn_handshake_problem(c);
+    out->code = refused != NULL ? SN_TIMEOUT : SN_CONNECTION_LOST;
+    snprintf(out->message, sizeof out->message, "%s %s%s%s", refused != NULL ? "no reply from" : "cannot send to",
+             sn_conn_endpoint(c), refused != NULL ? ": " : "", refused != NULL ? refused : "");
     return -1;
   }
   sn_req_free(r);
