@@ -189,3 +189,87 @@ def test_the_viewer_draws_a_light_on_a_joint_in_its_links_frame_which_the_joint_
     [(frame, translation, quaternion)] = frames.update("bot", ["pan"], [QUARTER])
     assert frame == link_frame("bot", "pan") and translation == pytest.approx((0, 0, 0), abs=1e-15)
     assert quaternion == pytest.approx((0, 0, math.sin(QUARTER / 2), math.cos(QUARTER / 2)), abs=1e-15)
+
+
+# ---------------------------------------------------------------- recognition and radar
+
+def _target(shape_pose: list[float], size: list[float], joint: dict, **robot) -> dict:
+    """Robot "arm" at (3, 0, 0) whose only shape, a box of ``size`` at ``shape_pose``, rides on ``joint``."""
+    return {"name": "arm", "pose": {"translation": [3, 0, 0]}, "devices": [joint],
+            "shapes": [{"geometry": {"type": "box", "size": size}, "pose": {"translation": shape_pose},
+                        "on_joint": joint["name"]}], **robot}
+
+
+def _seen(arm: dict) -> tuple[Simulation, object]:
+    sim = Simulation(parse_world({
+        "world_info": {"basic_time_step": DT_MS, "contact": False},
+        "robots": [{"name": "eye", "devices": [{"device": "Camera", "name": "cam", "width": 64, "height": 48,
+                                                "field_of_view": 1.0, "recognition": {}}]},
+                   {**arm, "recognition_colors": [[1, 0, 0]]}]}))
+    sim.device("eye/cam").recognition_enable(DT_MS)
+    return sim, sim.device("eye/cam")
+
+
+def _recognised(sim: Simulation, cam) -> object:
+    sim.step()
+    [obj] = cam.objects
+    return obj
+
+
+def test_a_recognised_robots_link_on_a_slider_that_moved_d_is_reported_d_further() -> None:
+    """The camera at the origin looks along +x at "arm" (3 m ahead), whose 0.2 m cube rides on a
+    slider along y: at rest it is reported at (3, 0, 0); moved by d = 0.5, at (3, 0.5, 0), its size
+    (0.2, 0.2) and the robot's orientation unchanged, its box on the image moved left."""
+    sim, cam = _seen(_target([0, 0, 0], [0.2, 0.2, 0.2], _slider(axis=[0, 1, 0])))
+    before = _recognised(sim, cam)
+    assert before.position == pytest.approx((3, 0, 0), abs=1e-12)
+    sim.robot("arm").motor("slide").set_position(0.5)
+    after = _recognised(sim, cam)
+    assert after.position == pytest.approx((3, 0.5, 0), abs=1e-12)
+    assert after.size == pytest.approx(before.size, abs=1e-12) == (0.2, 0.2)
+    assert after.orientation == before.orientation
+    assert after.position_on_image[0] < before.position_on_image[0]
+
+
+def test_a_recognised_robots_link_turned_by_a_hinge_is_reported_where_and_as_wide_as_it_now_is() -> None:
+    """"arm"'s 0.4 x 0.2 x 0.2 box centred 0.5 m to its -y, on a pan hinge through its origin: at rest
+    at (3, -0.5, 0), 0.2 wide (its y extent); turned by pi/2 it lies across the view at (3.5, 0, 0),
+    0.4 wide; the robot's orientation (its own, not the link's) unchanged."""
+    sim, cam = _seen(_target([0, -0.5, 0], [0.4, 0.2, 0.2], _pan()))
+    before = _recognised(sim, cam)
+    assert before.position == pytest.approx((3, -0.5, 0), abs=1e-12)
+    assert before.size == pytest.approx((0.2, 0.2), abs=1e-12)
+    sim.robot("arm").motor("pan").set_position(QUARTER)
+    after = _recognised(sim, cam)
+    assert after.position == pytest.approx((3.5, 0, 0), abs=1e-12)
+    assert after.size == pytest.approx((0.4, 0.2), abs=1e-12)
+    assert after.orientation == before.orientation
+
+
+def _radar_targets(arm: dict) -> tuple[Simulation, object]:
+    sim = Simulation(parse_world({
+        "world_info": {"basic_time_step": DT_MS, "contact": False},
+        "robots": [{"name": "car", "devices": [{"device": "Radar", "name": "radar"}]},
+                   {**arm, "pose": {"translation": [10, 0, 0]}, "radar_cross_section": 5.0}]}))
+    sim.device("car/radar").enable(DT_MS)
+    return sim, sim.device("car/radar")
+
+
+def _distance(sim: Simulation, radar) -> float:
+    sim.step()
+    [target] = radar.targets
+    return target.distance
+
+
+@pytest.mark.parametrize("joint, shape_pose, motor, q, far", [
+    (_slider(), [0, 0, 0], "slide", 1.5, 11.5),                        # moved 1.5 m away along the radar's axis
+    (_pan(), [0, 3, 0], "pan", -QUARTER, 13.0),                        # (0, 3, 0) turned to (3, 0, 0)
+], ids=["slider", "hinge"])
+def test_a_radar_finds_a_targets_link_where_its_joint_put_it(joint, shape_pose, motor, q, far) -> None:
+    """The radar at the origin looks along +x at robot "arm" 10 m ahead, whose only shape, a 0.2 m
+    cube, rides on a joint: the distance is that of the cube's centre (Webots: of the target's box),
+    10 (or sqrt(109), the cube 3 m to the side) at rest, ``far`` after the joint moved."""
+    sim, radar = _radar_targets(_target(shape_pose, [0.2, 0.2, 0.2], joint))
+    assert _distance(sim, radar) == pytest.approx(math.hypot(10.0, shape_pose[1]), abs=1e-12)
+    sim.robot("arm").motor(motor).set_position(q)
+    assert _distance(sim, radar) == pytest.approx(far, abs=1e-12)

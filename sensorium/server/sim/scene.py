@@ -629,6 +629,14 @@ class Scene:
             return kept[2]
         return owner
 
+    def on_link(self, shape: int) -> bool:
+        """Whether a shape rides on a joint's link (``on_joint``): ``carrier`` places it then."""
+        return shape in self._shape_link
+
+    def carrier(self, shape: int) -> Pose:
+        """The pose a shape is fixed in now: its owner's, on a joint its owner's ∘ its link's."""
+        return self._carrier(shape, self._parts[shape][0])  # type: ignore[arg-type]
+
     def shape_pose(self, shape: int) -> Pose:
         """The world pose of a shape now (its owner's pose ∘ its link's, on a joint ∘ its frame)."""
         key, local, _ = self._parts[shape]
