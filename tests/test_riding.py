@@ -76,6 +76,10 @@ def test_a_light_on_a_pan_joint_lights_the_sensor_as_a_light_placed_where_the_jo
     assert turned == pytest.approx(static, rel=1e-12)
     sim.robot("bot").motor("pan").set_position(0.0)
     assert _read(sim) == 0.0
+    sim.robot("bot").motor("pan").set_position(QUARTER)
+    assert _read(sim) == pytest.approx(static, rel=1e-12)
+    sim.reset()                                    # the joint back at its initial position, the light with it
+    assert _read(sim) == 0.0
 
 
 def test_an_leds_lights_ride_on_the_leds_joint() -> None:
