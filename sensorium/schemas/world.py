@@ -360,6 +360,11 @@ class _Light(Strict):
     color: Color = Field(default=(1.0, 1.0, 1.0), description="each component within [0, 1]")
     on: bool = True
     cast_shadows: bool = False  # rendering only in Webots; kept for file compatibility
+    on_joint: str | None = Field(
+        default=None, min_length=1,
+        description="on a robot's `lights` only: the motor (RotationalMotor or LinearMotor, not a drive's) whose "
+                    "joint carries this light, the innermost one; it moves with that joint (README 'Joints'). An "
+                    "LED's lights ride with the LED (its own `on_joint`). Left out: the robot's body")
 
     _unit = field_validator("color")(_unit_colors)
 

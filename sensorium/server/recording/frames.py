@@ -42,7 +42,7 @@ def shape_rgba(shape: Any, ghost: bool = False) -> tuple[float, float, float, fl
 
 def mounts(world: wm.World) -> dict[str, list[Mount]]:
     """robot → [(frame, translation, quaternion xyzw)] of the robot's devices, then of the links
-    its shapes ride on (:func:`link_frame`, at the joints' initial positions)."""
+    its shapes or lights ride on (:func:`link_frame`, at the joints' initial positions)."""
     out: dict[str, list[Mount]] = {}
     for r in world.robots:
         items: list[Mount] = []
@@ -50,7 +50,7 @@ def mounts(world: wm.World) -> dict[str, list[Mount]]:
             p = pose_from_model(d.pose)
             t = (float(p.translation[0]), float(p.translation[1]), float(p.translation[2]))
             items.append((f"{r.name}/{d.name}", t, matrix_quaternion(p.rotation)))
-        items.extend((link_frame(r.name, j), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)) for j in _shape_joints(r))
+        items.extend((link_frame(r.name, j), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)) for j in _link_joints(r))
         out[r.name] = items
     return out
 
@@ -64,6 +64,12 @@ def link_frame(robot: str, joint: str) -> str:
 def _shape_joints(r: wm.Robot) -> list[str]:
     """The joints shapes of ``r`` ride on, in order of first appearance."""
     return list(dict.fromkeys(j for part in r.shapes if (j := getattr(part, "on_joint", None)) is not None))
+
+
+def _link_joints(r: wm.Robot) -> list[str]:
+    """The joints that have a link frame: those shapes or lights of ``r`` (not directional) ride on."""
+    lit = (lt.on_joint for lt in r.lights if lt.on_joint is not None and lt.type != "DirectionalLight")
+    return list(dict.fromkeys([*_shape_joints(r), *lit]))
 
 
 def _mount(frame: str, p: Pose) -> Mount:
@@ -83,7 +89,7 @@ class JointFrames:
         for r in world.robots:
             riders = [(f"{r.name}/{d.name}", joint, pose_from_model(d.pose)) for d in r.devices
                       if (joint := getattr(d, "on_joint", None)) is not None]
-            riders += [(link_frame(r.name, j), j, Pose.identity()) for j in _shape_joints(r)]
+            riders += [(link_frame(r.name, j), j, Pose.identity()) for j in _link_joints(r)]
             if not riders:
                 continue
             joints = {d.name: JointMotor(d.name, d.device, d.max_velocity, initial_position=d.position)
@@ -160,7 +166,8 @@ def bodies(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Itera
 def lights(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Iterator[tuple[str, str, bool, Any]]:
     """Every light to draw: (entity id, frame, frame_locked, light model with location/direction in
     that frame). World and solid lights are in ``world``; a robot's lights ride in its frame (a
-    DirectionalLight's direction stays in world axes wherever it is attached, as in Webots)."""
+    DirectionalLight's direction stays in world axes wherever it is attached, as in Webots), one on a
+    joint in its link's frame (:func:`link_frame`)."""
     from sensorium.server.sim.scene import place_light, solid_lights
 
     seen: set[str] = set()
@@ -184,5 +191,6 @@ def lights(world: wm.World, solid_poses: dict[str, Pose] | None = None) -> Itera
             yield unique(lt.name or f"{s.name}/light{j}"), WORLD_FRAME, False, place_light(lt, top.compose(local))
     for r in world.robots:
         for j, lt in enumerate(r.lights):
-            frame = WORLD_FRAME if lt.type == "DirectionalLight" else r.name
+            frame = WORLD_FRAME if lt.type == "DirectionalLight" else \
+                r.name if lt.on_joint is None else link_frame(r.name, lt.on_joint)   # on a joint: its link's frame
             yield unique(lt.name or f"{r.name}/light{j}"), frame, frame != WORLD_FRAME, lt

@@ -53,6 +53,9 @@ class _CopyScene:
     def part(self, shape: int) -> tuple:
         return self._parts[shape]
 
+    def on_link(self, shape: int) -> bool:
+        return False                                  # (the batched simulation refuses joints)
+
     def owner_pose(self, key: str | int) -> Pose:
         if isinstance(key, str):
             return self.sim.scene.solid_poses[key]

@@ -1,7 +1,7 @@
 """The simulation's Radar (Webots' node; the model is ``server/devices/radar.py``): at each
 measurement it places the scene's radar targets (robots and top-level solids with a radar cross
 section, ``Scene.radar_targets``) in its frame — each one's box, from its bounding shapes (else all
-its shapes) clipped to the radar's frustum, as Webots' ``WbObjectDetection`` (the geometry a
+its shapes; a robot's shapes on its joints where the joints have put them) clipped to the radar's frustum, as Webots' ``WbObjectDetection`` (the geometry a
 camera's recognition uses, ``devices/recognition.py``), or its origin when it has no shape —,
 computes their radial speeds from their positions at its previous measurement, and, with
 ``occlusion``, casts one ray to each detected target's origin (Webots' ONE_RAY): a target is hidden
@@ -45,8 +45,9 @@ class Radar(Device):
         self._robot = robot
 
     def _target_parts(self, key: str | int) -> tuple:
-        """A target's shapes as (pose in its frame, kind, params, points): its bounding shapes, else
-        all of them (Webots: its bounding objects, else its bounding sphere); infinite planes left out."""
+        """A target's shapes as (the shape when it rides on a joint's link, else -1; pose in its owner's
+        frame, kind, params, points): its bounding shapes, else all of them (Webots: its bounding
+        objects, else its bounding sphere); infinite planes left out."""
         scene = self._robot.scene
         if self._parts_version != scene.shapes_version:          # a Supervisor imported shapes
             self._parts, self._parts_version = {}, scene.shapes_version
@@ -54,21 +55,22 @@ class Radar(Device):
         if parts is None:
             shapes = [i for i in range(len(scene.shapes)) if scene.part(i)[0] == key]
             bounding = [i for i in shapes if scene.part(i)[2].seen_by in ("both", "bounding")]
-            placed = ((scene.part(i)[1], *shape_kind(scene.part(i)[2].geometry, scene.base_dir))
-                      for i in (bounding or shapes))
-            parts = self._parts[key] = tuple(p for p in placed if p[1] != "unbounded")
+            placed = ((i if scene.on_link(i) else -1, scene.part(i)[1],
+                       *shape_kind(scene.part(i)[2].geometry, scene.base_dir)) for i in (bounding or shapes))
+            parts = self._parts[key] = tuple(p for p in placed if p[2] != "unbounded")
         return parts
 
     def _box(self, key: str | int, owner: Any, radar: Any, inverse: np.ndarray) -> tuple[np.ndarray, float] | None:
         """The centre and x extent of a target's box in view (radar frame), None when nothing of it is in
         view; the origin (size 0) for a target without shapes, if it is in view."""
+        scene = self._robot.scene
         parts = self._target_parts(key)
         if not parts:
             local = inverse @ (np.asarray(owner.translation, dtype=np.float64) - radar.translation)
             return (local, 0.0) if rmath.in_frustum(local, self._frustum) else None
         lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
-        for local_pose, kind, params, points in parts:
-            pose = owner.compose(local_pose)
+        for link, local_pose, kind, params, points in parts:
+            pose = (owner if link < 0 else scene.carrier(link)).compose(local_pose)   # on a joint: where it put it
             _, seen = geo.clipped_bounds(kind, params, inverse @ pose.rotation,
                                          inverse @ (pose.translation - radar.translation), points, self._frustum)
             if seen is not None:

@@ -10,7 +10,8 @@ occlusion test needs (Webots' ``occlusion`` field):
 * 2 — the image's pixel rays: recognised if at least one pixel sees it (exact at the image's
   resolution; Webots tests the object's outline).
 
-An object's box is, for a planar camera, that of its part in view (Webots clips each shape to the
+An object's box (a robot's shapes on its joints where the joints have put them, as Webots bounds
+the Solids past a joint where they are) is, for a planar camera, that of its part in view (Webots clips each shape to the
 view first; a non-planar camera's boxes are whole). An object is in range when that box reaches in
 front of the camera and starts before ``max_range`` (in depth). ``max_objects`` (> 0) keeps the biggest
 on the image (``size_on_image`` area), listed biggest first as Webots does (ties in id order); otherwise
@@ -65,7 +66,9 @@ class _Object:
     colors: tuple[tuple[float, float, float], ...]
     model: str
     shapes: tuple[int, ...]                                # every shape (occlusion, segmentation)
-    parts: tuple[tuple[Pose, str, tuple, np.ndarray | None], ...]   # the shapes its size is read from
+    # the shapes its size is read from: (the shape when it rides on a joint's link, else -1; its pose in its
+    # owner's frame, kind, params, points)
+    parts: tuple[tuple[int, Pose, str, tuple, np.ndarray | None], ...]
 
 
 def shape_kind(g: Any, base_dir: Any) -> tuple[str, tuple, np.ndarray | None]:
@@ -121,8 +124,8 @@ class Recognizer:
                 continue
             shapes = by_owner.get(key, [])
             bounding = [i for i in shapes if scene.part(i)[2].seen_by in ("both", "bounding")]
-            parts = tuple((scene.part(i)[1], *shape_kind(scene.part(i)[2].geometry, scene.base_dir))
-                          for i in (bounding or shapes))
+            parts = tuple((i if scene.on_link(i) else -1, scene.part(i)[1],
+                           *shape_kind(scene.part(i)[2].geometry, scene.base_dir)) for i in (bounding or shapes))
             self.key_of[shapes] = len(objects)
             objects.append(_Object(key, node_id, tuple(colors), model, tuple(shapes), parts))  # type: ignore[arg-type]
         self.objects = objects
@@ -137,10 +140,10 @@ class Recognizer:
         inv = cam.rotation.T
         lo, whole_lo = np.full(3, np.inf), np.full(3, np.inf)
         hi, whole_hi = np.full(3, -np.inf), np.full(3, -np.inf)
-        for local, kind, params, points in obj.parts:
+        for link, local, kind, params, points in obj.parts:
             if kind == "unbounded":
                 return None
-            pose = owner.compose(local)
+            pose = (owner if link < 0 else self.scene.carrier(link)).compose(local)   # on a joint: where it put it
             rotation, centre = inv @ pose.rotation, inv @ (pose.translation - cam.translation)
             whole, b = rmath.clipped_bounds(kind, params, rotation, centre, points, self.frustum)
             if whole is None:

@@ -159,6 +159,16 @@ def robot_led_lights(robot: wm.Robot) -> list[tuple[str, list]]:
     return out
 
 
+def link_aimed(model, displacement: Pose):
+    """A placed spot light riding on a joint, its light-sensor axis (``light_sensor_direction``, when
+    it has one) turned by the joint's displacement: Webots' LightSensor turns a spot light's
+    direction by the own rotation of the Solid holding it, the joint's end point, which the joint turns."""
+    if model.type != "SpotLight" or model.light_sensor_direction is None:
+        return model
+    aim = tuple(float(v) for v in displacement.apply_dirs(np.asarray(model.light_sensor_direction)))
+    return model.model_copy(update={"light_sensor_direction": aim})
+
+
 def for_light_sensors(model):
     """A placed light model (``place_light``) as light sensors see it: a spot light's
     ``light_sensor_direction``, when it has one, is its direction (world axes, fixed)."""
@@ -332,8 +342,10 @@ class Scene:
         self.triangle_count = 0            # of the bodies in the world now (a removed solid's leave the count)
         self._solid_triangles: dict[str, int] = {}
         self._parts: list[tuple[str | int | None, Pose, wm.Shape | wm.Solid]] = []   # per shape: owner, frame, model
-        # lights: (model, owner, pose in the owner's frame); owner None = world, str = solid, int = robot
-        self._lights: list[tuple[object, str | int | None, Pose]] = [(lt, None, Pose.identity()) for lt in world.lights]
+        # lights: (model, owner, pose in the owner's frame); owner None = world, str = solid, int = robot,
+        # (robot, joint) = a robot's light riding on that joint (``on_joint``; an LED's lights: the LED's)
+        self._lights: list[tuple[object, str | int | tuple[int, str] | None, Pose]] = [
+            (lt, None, Pose.identity()) for lt in world.lights]
         self._led_lights: dict[tuple[int, str], list] = {}   # (robot, LED) -> its lights' models now
         for s in world.solids:
             pose = pose_from_model(s.pose)
@@ -356,10 +368,12 @@ class Scene:
         for i, r in enumerate(world.robots):
             pose = pose_from_model(r.pose)
             self.robot_poses.append(pose)
-            self._lights += [(lt, i, Pose.identity()) for lt in r.lights]
+            self._lights += [(lt, i if lt.on_joint is None else (i, lt.on_joint), Pose.identity()) for lt in r.lights]
+            led_joint = {d.name: d.on_joint for d in r.devices if isinstance(d, wm.LED)}
             for name, models in robot_led_lights(r):    # off and black until the LED is set (WbLed)
                 self._led_lights[(i, name)] = models
-                self._lights += [(m, i, Pose.identity()) for m in models]
+                carrier = i if led_joint[name] is None else (i, led_joint[name])
+                self._lights += [(m, carrier, Pose.identity()) for m in models]
             parts = list(robot_parts(r))
             # a joint's link (the shapes riding on it: ``on_joint``) is a movable body of its own, owned
             # by the robot; every other shape is the robot's body, as in a robot without joints
@@ -380,7 +394,10 @@ class Scene:
                     if device is not None:
                         owned.setdefault(device, set()).add(first + k)
             self._device_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
-        self._attached = {owner for _, owner, _ in self._lights if owner is not None}
+        self._attached = {owner[0] if isinstance(owner, tuple) else owner for _, owner, _ in self._lights
+                          if owner is not None}
+        # the links carrying lights: light sensors and cameras recompute their lights when one moves
+        self._light_links = {owner for _, owner, _ in self._lights if isinstance(owner, tuple)}
         # textures: one sampler for the world's images (None without any), read by infra-red only
         self._base_dir = base_dir
         self._ink_evaporation = world.world_info.ink_evaporation
@@ -437,6 +454,10 @@ class Scene:
                 top += 1
                 if top not in self.removed_lights:
                     out.append(model)
+            elif isinstance(owner, tuple):      # on a joint: where its link has moved it
+                displacement = self.link_poses.get(owner, _IDENTITY)
+                placed = place_light(model, self.robot_poses[owner[0]].compose(displacement).compose(local))
+                out.append(link_aimed(placed, displacement))
             else:
                 frame = self.robot_poses[owner] if isinstance(owner, int) else self.solid_poses[owner]
                 out.append(place_light(model, frame.compose(local)))
@@ -579,6 +600,8 @@ class Scene:
         """Joint ``joint`` of robot ``index`` moved: what rides on it is ``displacement`` (robot frame)
         from where the world file placed it (sim/joints.py ``Links``)."""
         self.link_poses[(index, joint)] = displacement
+        if (index, joint) in self._light_links:
+            self.lights_version += 1
         body = self._link_body.get((index, joint))
         if body is not None:
             self.engine.set_body_pose(body, self.robot_poses[index].compose(displacement))
@@ -605,6 +628,14 @@ class Scene:
                 kept = self._link_frames[link] = (owner, displacement, owner.compose(displacement))
             return kept[2]
         return owner
+
+    def on_link(self, shape: int) -> bool:
+        """Whether a shape rides on a joint's link (``on_joint``): ``carrier`` places it then."""
+        return shape in self._shape_link
+
+    def carrier(self, shape: int) -> Pose:
+        """The pose a shape is fixed in now: its owner's, on a joint its owner's ∘ its link's."""
+        return self._carrier(shape, self._parts[shape][0])  # type: ignore[arg-type]
 
     def shape_pose(self, shape: int) -> Pose:
         """The world pose of a shape now (its owner's pose ∘ its link's, on a joint ∘ its frame)."""

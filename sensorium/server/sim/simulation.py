@@ -134,7 +134,7 @@ class RobotState:
         # what rides on the joints (``on_joint``): their links, and the devices on each (None: nothing rides)
         self.links: Links | None = None
         self.riders: dict[str, list[Device]] = {}
-        if any(getattr(x, "on_joint", None) is not None for x in (*model.shapes, *model.devices)):
+        if any(getattr(x, "on_joint", None) is not None for x in (*model.shapes, *model.devices, *model.lights)):
             self.links = Links(model, self.joints)
             for dev in self.devices.values():
                 if dev.on_joint is not None:

@@ -430,6 +430,11 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
     unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
     unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
     unique([(p, lt.name) for p, lt in all_lights(world)], "light")
+    for path, lt in all_lights(world):     # only a robot's own lights name a joint (an LED's ride with the LED)
+        if lt.on_joint is not None and not (path.startswith("robots[") and ".devices[" not in path):
+            where = "an LED's lights ride with the LED (give on_joint to the LED)" if ".devices[" in path else \
+                "only a robot's lights ride on its joints"
+            problems.append(Problem(f"{path}.on_joint", where))
     unique([(f"robots[{i}].def_name", r.def_name) for i, r in enumerate(world.robots)]
            + [(f"solids[{i}].def_name", s.def_name) for i, s in enumerate(world.solids)], "DEF")
 
@@ -498,6 +503,7 @@ def _check_joints(robot: wm.Robot, rp: str) -> list[Problem]:
     joints = {d.name: d for d in robot.devices if isinstance(d, wm.Motor) and d.name not in drive}
     riders = [(f"{rp}.shapes[{i}].on_joint", p.on_joint) for i, p in enumerate(robot.shapes)]
     riders += [(f"{rp}.devices[{i}].on_joint", d.on_joint) for i, d in enumerate(robot.devices)]
+    riders += [(f"{rp}.lights[{i}].on_joint", lt.on_joint) for i, lt in enumerate(robot.lights)]
     for path, name in riders:
         if name is not None and name not in joints:
             problems.append(Problem(path, f"{name!r} is not a joint motor of this robot (RotationalMotor or LinearMotor "

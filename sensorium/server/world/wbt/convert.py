@@ -875,6 +875,8 @@ class Converter:
                 data["direction"] = [float(v) for v in back @ np.asarray(data["direction"])]
             entry.setdefault("lights", []).append(data)
             return
+        if owner.kind == "robot":     # a robot's light past a joint rides on it (an LED's ride with the LED)
+            self.ride(data)
         owner.data.setdefault("lights", []).append(data) if owner.kind != "world" else self.world["lights"].append(data)
 
     def led_lights(self, node: Node) -> list[Node]:
@@ -1408,13 +1410,13 @@ class Converter:
             return joint
 
         devices = {d["name"]: d for d in robot["devices"]}
-        for entry in [*robot["devices"], *robot.get("shapes", ())]:
+        for entry in [*robot["devices"], *robot.get("shapes", ()), *robot.get("lights", ())]:
             joint = resolved(entry)
             if "of_device" in entry:    # a device's own shapes move as the device does (a joint inside a
                 joint = resolved(devices[entry["of_device"]])   # device, a lidar's turret, turns none of them)
             if joint is not None:
                 entry["on_joint"] = joint["name"]
-        for entry in [*robot["devices"], *robot.get("shapes", ())]:
+        for entry in [*robot["devices"], *robot.get("shapes", ()), *robot.get("lights", ())]:
             entry.pop("_on_joint", None)
         for entry in robot["devices"]:
             entry.pop("_wheel", None)
