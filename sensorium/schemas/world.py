@@ -831,6 +831,10 @@ class Motor(_Device):
                               "out: Webots' default, 1 0 0 for a hinge, 0 0 1 for a slider")
     anchor: Vec3 = Field(default=(0.0, 0.0, 0.0), description="a hinge's axis passes through it (robot frame, m); "
                          "unused by a slider")
+    multiplier: float = Field(default=1.0, description="scales every position and velocity command this motor takes "
+                              "(Webots' coupled motors: a command to one motor named 'group::part' reaches every "
+                              "joint motor of the robot named 'group::...', each scaled by its own multiplier); "
+                              "0 is reset to 1, as Webots does")
 
     @property
     def joint_axis(self) -> Vec3:
@@ -851,6 +855,14 @@ class Motor(_Device):
             raise ValueError(f"position {self.position} outside [min_position, max_position] = "
                              f"[{self.min_position}, {self.max_position}]")
         return self
+
+
+def coupling_group(name: str) -> str | None:
+    """The coupled-motor group a motor's name puts it in (Webots' WbMotor::inferMotorCouplings): the
+    part before ``::`` of a name made of exactly two parts (``"gripper::left"`` → ``"gripper"``);
+    None for any other name."""
+    parts = name.split("::")
+    return parts[0] if len(parts) == 2 else None
 
 
 class RotationalMotor(Motor):

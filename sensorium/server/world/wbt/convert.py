@@ -66,7 +66,7 @@ JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
 MOTORS = {"RotationalMotor", "LinearMotor"}
 OTHER_MOTOR_NAMES = {"RotationalMotor": "rotational motor", "LinearMotor": "linear motor"}
 JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "max_torque", "position", "axis",
-              "anchor")
+              "anchor", "multiplier")
 JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
                "the shapes and devices past the joint with it")
 # the fields every Solid has (a device's own fields are the others)
@@ -108,6 +108,7 @@ class Converter:
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.device_depth = 0              # > 0 while inside a device's children (its joints are no wheels)
         self.riding: list[dict] = []       # the motor entries of the robot's joints being visited, innermost last
+        self.coupled_nodes: dict[int, Node] = {}   # id(motor entry) -> its node, for a 'group::part' name
         self.device_where: dict[int, str] = {}   # id(device entry) -> where its node is written
         self.led_of: dict[int, tuple[dict, Frame]] = {}   # id(light node) -> (its LED's entry, the LED's frame)
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
@@ -1175,11 +1176,8 @@ class Converter:
                 self.ride(entry)
                 owner.data["devices"].append(entry)
                 motors.append(entry)
-                if "::" in entry["name"]:      # Webots' coupled motors: one command moves the whole group
-                    self.warn(d, f"{d.type} {entry['name']!r}: coupled motors (Webots passes a command to every motor "
-                                 f"whose name shares the part before '::', scaled by its multiplier, here "
-                                 f"{self.fields(d).num('multiplier', 1.0):g}) are not coupled here: it moves on its "
-                                 "own commands only, and getMultiplier answers 1")
+                if wm.coupling_group(entry["name"]) is not None:   # a drive's wheel is told (see drive())
+                    self.coupled_nodes[id(entry)] = d
             elif d.type == "PositionSensor":
                 sf = self.fields(d)
                 entry = {"name": sf.string("name", "position sensor"), "device": "PositionSensor",
@@ -1218,10 +1216,14 @@ class Converter:
                 hi = f.used("maxPosition", hi, position, "is below the joint's position")
             if lo > position:
                 lo = f.used("minPosition", lo, position, "is above the joint's position")
+        multiplier = f.num("multiplier", 1.0)
+        if multiplier == 0.0:         # WbMotor::updateMultiplier
+            multiplier = f.used("multiplier", multiplier, 1.0, "cannot be 0")
         out = {"max_velocity": velocity, "min_position": lo, "max_position": hi, "acceleration": acceleration,
-               "max_torque" if d.type == "RotationalMotor" else "max_force": force, "position": position}
+               "max_torque" if d.type == "RotationalMotor" else "max_force": force, "position": position,
+               "multiplier": multiplier}
         defaults = {"max_velocity": 10.0, "min_position": 0.0, "max_position": 0.0, "acceleration": -1.0,
-                    "max_torque": 10.0, "max_force": 10.0, "position": 0.0}
+                    "max_torque": 10.0, "max_force": 10.0, "position": 0.0, "multiplier": 1.0}
         return {k: v for k, v in out.items() if v != defaults[k]}
 
     def ride(self, entry: dict) -> None:
@@ -1394,9 +1396,16 @@ class Converter:
         drive_motors = set(drive_motor_names(robot.data))
         for entry in robot.data["devices"]:     # a drive's motor is the drive's: its joint fields are not used
             if entry["device"] == "RotationalMotor" and entry["name"] in drive_motors:
+                multiplier = entry.get("multiplier", 1.0)
                 for key in JOINT_KEYS:
                     entry.pop(key, None)
                 entry["_wheel"] = True
+                node_ = self.coupled_nodes.get(id(entry))
+                if node_ is not None:      # Webots couples wheels too; a drive here turns each on its own
+                    self.warn(node_, f"RotationalMotor {entry['name']!r}: a coupled motor (Webots passes a command "
+                                     f"to every motor whose name shares the part before '::', scaled by its "
+                                     f"multiplier, here {multiplier:g}) that is a wheel of the robot's drive: not "
+                                     "coupled here, it turns on its own commands and getMultiplier answers 1")
 
     def on_joints(self, robot: dict) -> None:
         """Each shape and device riding on a joint names its motor (``on_joint``), names final; what
