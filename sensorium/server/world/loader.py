@@ -824,11 +824,11 @@ def _coupled_resets(rp: str, robot: wm.Robot, devices: list[Any], warnings: list
                 lo, hi = min(lo, hi), max(lo, hi)
             else:
                 lo = hi = 0.0
-            for field, value in (("min_position", lo), ("max_position", hi)):
-                if getattr(dev, field) != value:
-                    upd[field] = value
-                    warnings.append(f"{p}.{field}: coupled with {ref.name!r}, whose limits set its own: "
-                                    f"{getattr(dev, field):g} set to {value:g}")
+            for key, value in (("min_position", lo), ("max_position", hi)):
+                if getattr(dev, key) != value:
+                    upd[key] = value
+                    warnings.append(f"{p}.{key}: coupled with {ref.name!r}, whose limits set its own: "
+                                    f"{getattr(dev, key):g} set to {value:g}")
             velocity = ref.max_velocity * abs(dev.multiplier) / abs(ref.multiplier)
             if dev.max_velocity != velocity:
                 upd["max_velocity"] = velocity
