@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.world.poses import axis_angle_matrix
 from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
 from sensorium.server.world.wbt.fields import Fields
@@ -1250,9 +1251,13 @@ class Converter:
         motors = [d for d in f.nodes("device") if d.type in MOTORS]
         sensors: list[dict] = []
         moving: list[dict] = []
+        spin_sensors: list[dict] = []
         if owner.kind == "robot":
             moving, sensors = self.joint_devices(node, owner)
-            if node.type not in ("HingeJoint", "SliderJoint"):
+            if node.type == "Hinge2Joint":      # its second axis's devices follow its first's (Webots' order)
+                spin, spin_sensors = self.joint_devices(node, owner, "device2")
+                moving = self.hinge2_frames(node, frame, moving[:1], spin[:1])
+            elif node.type not in ("HingeJoint", "SliderJoint"):
                 moving = []
             elif moving:
                 self.joint_frame(node, frame, moving[0])
@@ -1260,7 +1265,7 @@ class Converter:
         # never the robot: it is no wheel, whatever its axis (Webots has no notion of a drive either)
         wheeled = owner.kind == "robot" and not self.device_depth
         if wheeled and node.type == "Hinge2Joint":    # a steered wheel (a car)
-            self.hinge2(node, frame, owner, motors, sensors)
+            self.hinge2(node, frame, owner, motors, sensors, spin_sensors)
         elif wheeled and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
             if params is not None:
@@ -1296,8 +1301,8 @@ class Converter:
             if end.type == "SolidReference":
                 return
             self.tree_field = "endPoint"
-            if moving:          # what the end point holds rides on this joint (its first motor's)
-                self.riding.append(moving[0])
+            if moving:          # what the end point holds rides on this joint (its innermost motor's)
+                self.riding.append(moving[-1])
             try:
                 self.visit(end, frame, owner)
             finally:
@@ -1310,14 +1315,39 @@ class Converter:
             end = self.fields(end).node_("endPoint")
         return end
 
-    def hinge2(self, node: Node, frame: Frame, owner: Owner, motors: list[Node], sensors: list[dict]) -> None:
+    def hinge2_frames(self, node: Node, frame: Frame, first: list[dict], second: list[dict]) -> list[dict]:
+        """A Hinge2Joint's two axes as two hinges through its anchor, the second riding on the first
+        (Webots turns its end point by ``R(axis, q1) R(axis2, q2)`` about the anchor, axis2 given
+        with both positions at 0, so at the first axis's initial position ``q1₀`` the second axis is
+        ``R(axis, q1₀) axis2``, as the robot frame with every joint initial wants it): each motor's
+        entry gets its axis and anchor in the robot's frame; the motors that move the end point,
+        outermost first (empty without a motor)."""
+        f = self.fields(node)
+        p1, p2 = f.node_("jointParameters"), f.node_("jointParameters2")
+        f1 = self.fields(p1) if p1 is not None else None
+        f2 = self.fields(p2) if p2 is not None else None
+        axis = np.asarray(f1.vec("axis", (1.0, 0.0, 0.0)) if f1 else (1.0, 0.0, 0.0), dtype=np.float64)
+        axis2 = np.asarray(f2.vec("axis", (0.0, 0.0, 1.0)) if f2 else (0.0, 0.0, 1.0), dtype=np.float64)
+        anchor = [float(v) for v in frame.apply(f1.vec("anchor", (0.0, 0.0, 0.0)) if f1 else (0.0, 0.0, 0.0))]
+        q1 = f1.num("position", 0.0) if f1 else 0.0
+        if q1:
+            axis2 = axis_angle_matrix(axis, q1) @ axis2
+        for entry, a in ((first, axis), (second, axis2)):
+            for e in entry:
+                e["axis"] = [float(v) for v in frame.rotation @ a]
+                e["anchor"] = list(anchor)
+        if first and second:
+            second[0]["_on_joint"] = first[0]
+        return [*first, *second]
+
+    def hinge2(self, node: Node, frame: Frame, owner: Owner, motors: list[Node], sensors: list[dict],
+               spin_sensors: list[dict]) -> None:
         """A Hinge2Joint of a robot: its first axis (``jointParameters``, ``device``) steers, its
         second (``jointParameters2``, ``device2``) turns the wheel, its end point. Both become
         entries of the robot's motorised hinges (the drive mapping judges them)."""
         f = self.fields(node)
         end = f.node_("endPoint")
         spin_motors = [d for d in f.nodes("device2") if d.type in MOTORS]
-        _, spin_sensors = self.joint_devices(node, owner, "device2")
         centre_at = (0.0, 0.0, 0.0)
         wheel = self.slotted(end)
         if wheel is not None and wheel.type == "Solid":
