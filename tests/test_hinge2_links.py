@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 from test_wbt_drives import write
 
@@ -74,3 +75,47 @@ def test_a_hinge2_with_a_motor_on_its_second_axis_only_tilts(tmp_path: Path) -> 
     sim.step()
     pose = sim.device("head/ds").world_pose(sim.robot("head").pose)
     assert pose.translation == pytest.approx([0.1 * C, 0.0, 0.1 - 0.1 * C], abs=1e-12)
+
+
+def _rot(axis: tuple[float, float, float], angle: float) -> np.ndarray:
+    x, y, z = np.asarray(axis, dtype=np.float64) / np.linalg.norm(axis)
+    k = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * (k @ k)
+
+
+def _ball(params: str) -> str:
+    return ('Robot { name "wrist" children [\n'
+            f' BallJoint {{ jointParameters BallJointParameters {{ anchor 0 0 0.1 }} {params}\n'
+            + "".join(f'  {field} [ RotationalMotor {{ name "{name}" maxVelocity 100 maxTorque 100000 }} ]\n'
+                      for field, name in (("device", "one"), ("device2", "two"), ("device3", "three")))
+            + '  endPoint Solid { translation 0.1 0 0.1 children [\n'
+            '    DistanceSensor { name "ds" }\n'
+            '    Shape { geometry Box { size 0.02 0.02 0.02 } } ] } } ] }\n')
+
+
+@pytest.mark.parametrize(("params", "axes"), [
+    ("jointParameters2 JointParameters { axis 0 0 1 } jointParameters3 JointParameters { axis 1 0 0 }",
+     ((0, 0, 1), (0, -1, 0), (1, 0, 0))),                  # a2 = a3 × a1 = x × z = -y
+    ("", ((1, 0, 0), (0, 1, 0), (0, 0, 1)))],              # Webots' defaults: x, z × x = y, z
+    ids=["given axes", "default axes"])
+def test_a_ball_joint_turns_its_sensor_about_its_three_axes(tmp_path: Path, params: str, axes: tuple) -> None:
+    """A BallJoint (anchor (0, 0, 0.1)) with a motor on each axis: at (pi/2, pi/4, pi/3) the sensor,
+    0.1 m ahead of the anchor, is at a + R(a1, pi/2)·R(a2, pi/4)·R(a3, pi/3)·(0.1, 0, 0) and turned by
+    that rotation (WbBallJoint's axes: a1 from jointParameters2, a3 from jointParameters3,
+    a2 = a3 × a1). The second axis's motor is limited to [-pi/2, pi/2], as Webots limits it."""
+    w = load_world(write(tmp_path, _ball(params)))
+    devices = {d.name: d for d in w.world.robots[0].devices}
+    for name, axis in zip(("one", "two", "three"), axes):
+        assert devices[name].axis == pytest.approx(axis, abs=1e-15), name
+        assert devices[name].anchor == pytest.approx((0, 0, 0.1))
+    assert [devices[n].on_joint for n in ("one", "two", "three", "ds")] == [None, "one", "two", "three"]
+    assert (devices["two"].min_position, devices["two"].max_position) == (-math.pi / 2, math.pi / 2)
+    sim = Simulation(w)
+    angles = (math.pi / 2, math.pi / 4, math.pi / 3)
+    for name, q in zip(("one", "two", "three"), angles):
+        sim.robot("wrist").motor(name).set_position(q)
+    sim.step()
+    turn = _rot(axes[0], angles[0]) @ _rot(axes[1], angles[1]) @ _rot(axes[2], angles[2])
+    pose = sim.device("wrist/ds").world_pose(sim.robot("wrist").pose)
+    assert pose.translation == pytest.approx(np.array([0, 0, 0.1]) + turn @ [0.1, 0, 0], abs=1e-12)
+    assert pose.rotation == pytest.approx(turn, abs=1e-12)

@@ -1081,7 +1081,7 @@ class NestedNode(Strict):
     name: str | None = Field(default=None, description="a Solid's or device's name field")
     parent: int = Field(default=-1, ge=-1, description="index of its parent in the robot's `nodes` (an earlier "
                         "entry); -1: the robot")
-    field: Literal["children", "endPoint", "device", "device2"] = Field(
+    field: Literal["children", "endPoint", "device", "device2", "device3"] = Field(
         default="children", description="the parent's field that holds it")
     pose: Pose | None = Field(default=None, description="its frame in the robot's frame as the world loads; "
                               "none for a node that is no Pose (Group, joints, motors, position sensors)")

@@ -1159,13 +1159,14 @@ class Converter:
         return out
 
     def joint_devices(self, node: Node, owner: Owner, field_name: str = "device") -> tuple[list[dict], list[dict]]:
-        """A joint's devices in its ``device`` (or a Hinge2Joint's ``device2``) order (Webots lists
+        """A joint's devices in its ``device`` (or a Hinge2Joint's ``device2``, a BallJoint's ``device2``
+        and ``device3``) order (Webots lists
         them before the end point's): (motor entries, position sensor entries). A motor's entry
         carries its fields and the joint's position (a drive keeps only its wheels' names, see
         :meth:`drive`); the joint's sensors measure its motor."""
         motors, sensors = [], []
-        params = self.fields(node).node_("jointParameters2" if field_name == "device2" else "jointParameters") \
-            if node.type.endswith("Joint") else None
+        params_field = {"device2": "jointParameters2", "device3": "jointParameters3"}.get(field_name, "jointParameters")
+        params = self.fields(node).node_(params_field) if node.type.endswith("Joint") else None
         position = self.fields(params).num("position", 0.0) if params is not None else 0.0
         for d in self.fields(node).nodes(field_name):
             self.walk(d)
@@ -1257,6 +1258,11 @@ class Converter:
             if node.type == "Hinge2Joint":      # its second axis's devices follow its first's (Webots' order)
                 spin, spin_sensors = self.joint_devices(node, owner, "device2")
                 moving = self.hinge2_frames(node, frame, moving[:1], spin[:1])
+            elif node.type == "BallJoint":
+                second, _ = self.joint_devices(node, owner, "device2")
+                third, _ = self.joint_devices(node, owner, "device3")
+                motors += [d for field_ in ("device2", "device3") for d in f.nodes(field_) if d.type in MOTORS]
+                moving = self.ball_frames(node, frame, moving[:1], second[:1], third[:1])
             elif node.type not in ("HingeJoint", "SliderJoint"):
                 moving = []
             elif moving:
@@ -1316,29 +1322,80 @@ class Converter:
         return end
 
     def hinge2_frames(self, node: Node, frame: Frame, first: list[dict], second: list[dict]) -> list[dict]:
-        """A Hinge2Joint's two axes as two hinges through its anchor, the second riding on the first
-        (Webots turns its end point by ``R(axis, q1) R(axis2, q2)`` about the anchor, axis2 given
-        with both positions at 0, so at the first axis's initial position ``q1₀`` the second axis is
-        ``R(axis, q1₀) axis2``, as the robot frame with every joint initial wants it): each motor's
-        entry gets its axis and anchor in the robot's frame; the motors that move the end point,
-        outermost first (empty without a motor)."""
+        """A Hinge2Joint's two axes (``jointParameters``: axis, default x, anchor and position;
+        ``jointParameters2``: axis2, default z, position2) as two hinges through its anchor, the
+        second riding on the first (WbHinge2Joint turns its end point by ``R(axis, q1) R(axis2, q2)``
+        about the anchor): see :meth:`axis_chain`."""
         f = self.fields(node)
         p1, p2 = f.node_("jointParameters"), f.node_("jointParameters2")
         f1 = self.fields(p1) if p1 is not None else None
         f2 = self.fields(p2) if p2 is not None else None
-        axis = np.asarray(f1.vec("axis", (1.0, 0.0, 0.0)) if f1 else (1.0, 0.0, 0.0), dtype=np.float64)
-        axis2 = np.asarray(f2.vec("axis", (0.0, 0.0, 1.0)) if f2 else (0.0, 0.0, 1.0), dtype=np.float64)
-        anchor = [float(v) for v in frame.apply(f1.vec("anchor", (0.0, 0.0, 0.0)) if f1 else (0.0, 0.0, 0.0))]
-        q1 = f1.num("position", 0.0) if f1 else 0.0
-        if q1:
-            axis2 = axis_angle_matrix(axis, q1) @ axis2
-        for entry, a in ((first, axis), (second, axis2)):
-            for e in entry:
-                e["axis"] = [float(v) for v in frame.rotation @ a]
-                e["anchor"] = list(anchor)
-        if first and second:
-            second[0]["_on_joint"] = first[0]
-        return [*first, *second]
+        axes = [f1.vec("axis", (1.0, 0.0, 0.0)) if f1 else (1.0, 0.0, 0.0),
+                f2.vec("axis", (0.0, 0.0, 1.0)) if f2 else (0.0, 0.0, 1.0)]
+        positions = [f1.num("position", 0.0) if f1 else 0.0, f2.num("position", 0.0) if f2 else 0.0]
+        anchor = f1.vec("anchor", (0.0, 0.0, 0.0)) if f1 else (0.0, 0.0, 0.0)
+        return self.axis_chain(frame, anchor, axes, positions, [first, second])
+
+    def ball_frames(self, node: Node, frame: Frame, first: list[dict], second: list[dict],
+                    third: list[dict]) -> list[dict]:
+        """A BallJoint's three axes as three hinges through its anchor (``jointParameters``, a
+        BallJointParameters: anchor and the first position), each riding on the one before
+        (WbBallJoint turns its end point by ``R(a1, q1) R(a2, q2) R(a3, q3)`` about the anchor). WbBallJoint's
+        axes: a1 is ``jointParameters2``'s axis, a3 ``jointParameters3``'s, a2 = a3 × a1; one of them
+        missing, it is the other's cross product with z or x (x or z when that one lies along it);
+        both missing, x and z. The second axis's motor is limited to [-pi/2, pi/2] (checkMotorLimit)."""
+        f = self.fields(node)
+        fs = [self.fields(p) if p is not None else None
+              for p in (f.node_("jointParameters"), f.node_("jointParameters2"), f.node_("jointParameters3"))]
+        x, z = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+        given2 = np.asarray(fs[1].vec("axis", (0.0, 0.0, 1.0)), dtype=np.float64) if fs[1] else None
+        given3 = np.asarray(fs[2].vec("axis", (0.0, 0.0, 1.0)), dtype=np.float64) if fs[2] else None
+
+        def crossed(a: np.ndarray, first_: np.ndarray, other: np.ndarray) -> np.ndarray:
+            c = np.cross(a, first_)
+            return np.cross(a, other) if not np.any(c) else c
+
+        a1 = given2 if given2 is not None else (x if given3 is None else crossed(given3, z, x))
+        a3 = given3 if given3 is not None else (z if given2 is None else crossed(given2, x, z))
+        a2 = np.cross(a3, a1)
+        positions = [fp.num("position", 0.0) if fp else 0.0 for fp in fs]
+        anchor = fs[0].vec("anchor", (0.0, 0.0, 0.0)) if fs[0] else (0.0, 0.0, 0.0)
+        for e in second:      # WbBallJoint::checkMotorLimit (never narrower than the joint's position)
+            lo, hi = e.get("min_position", 0.0), e.get("max_position", 0.0)
+            q = e.get("position", 0.0)
+            if lo == hi == 0.0:
+                lo, hi = -math.pi / 2, math.pi / 2
+            elif lo < -math.pi / 2 or hi > math.pi / 2:
+                self.warn(node, f"BallJoint motor {e['name']!r}: the second axis's motor is limited to "
+                                "[-pi/2, pi/2] (as Webots limits it)")
+                lo, hi = max(lo, -math.pi / 2), min(hi, math.pi / 2)
+            e["min_position"], e["max_position"] = min(lo, q), max(hi, q)
+        return self.axis_chain(frame, anchor, [tuple(a) for a in (a1, a2, a3)], positions, [first, second, third])
+
+    @staticmethod
+    def axis_chain(frame: Frame, anchor: Any, axes: list[Any], positions: list[float],
+                   motors: list[list[dict]]) -> list[dict]:
+        """Several rotation axes through one anchor, in the joint's parent frame with every position
+        at 0, turning the end point by ``R(a1, q1) R(a2, q2) ...`` (Webots' Hinge2Joint and
+        BallJoint): as hinges each riding on the one before, every axis is written as it is with the
+        axes before it at their initial positions (``R(a1, q1₀) a2``, ...), in the robot's frame,
+        on its motor's entry (``motors``: one list per axis, empty without a motor), with the
+        anchor; a motor rides on the nearest motorised axis before its own. The motors that move
+        the end point, outermost first."""
+        turned = np.eye(3)
+        at = [float(v) for v in frame.apply(anchor)]
+        out: list[dict] = []
+        for axis, q0, entries in zip(axes, positions, motors):
+            a = np.asarray(axis, dtype=np.float64)
+            for e in entries:
+                e["axis"] = [float(v) for v in frame.rotation @ (turned @ a)]
+                e["anchor"] = list(at)
+                if out:
+                    e["_on_joint"] = out[-1]
+                out.append(e)
+            if q0:
+                turned = turned @ axis_angle_matrix(a, q0)
+        return out
 
     def hinge2(self, node: Node, frame: Frame, owner: Owner, motors: list[Node], sensors: list[dict],
                spin_sensors: list[dict]) -> None:
