@@ -156,3 +156,25 @@ def test_a_negative_velocity_in_position_control_is_refused_with_webots_line(cap
     motor.set_position(math.inf)
     motor.set_velocity(-1.0)                 # velocity control: taken
     assert motor.velocity == -1.0
+
+
+def test_a_negative_velocity_left_from_velocity_control_moves_the_joint_towards_its_new_target() -> None:
+    """Three steps at -1 rad/s in velocity control, then setPosition(0): the speed ramps to the
+    velocity's magnitude (maxTorque 1000: at once) and the joint goes back, 3 steps of dt, instead
+    of running away from its target (Webots' kinematic code; README "Joints", departure)."""
+    sim = Simulation(parse_world(_world(*_finger("elbow", 1.0, max_velocity=1.0))))
+    motor = sim.robot("hand").motor("elbow")
+    sim.device("hand/elbow sensor").enable(DT_MS)
+    motor.set_position(math.inf)
+    motor.set_velocity(-1.0)
+    got = []
+    for _ in range(3):
+        sim.step()
+        got.append(sim.device("hand/elbow sensor").value)
+    assert got == pytest.approx([-DT, -2 * DT, -3 * DT], abs=1e-15)
+    motor.set_position(0.0)
+    got = []
+    for _ in range(4):
+        sim.step()
+        got.append(sim.device("hand/elbow sensor").value)
+    assert got[:2] == pytest.approx([-2 * DT, -DT], abs=1e-15) and got[2:] == [0.0, 0.0]
