@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -60,7 +60,9 @@ class JointMotor:
     available_force: float = math.nan
     rate: float = 0.0                    # how fast the position moved over the last basic step (signed)
     multiplier: float = 1.0              # scales the position and velocity commands it takes (Webots)
-    coupled: tuple[JointMotor, ...] = ()  # the other motors of its coupled group ("group::part" names)
+    # the other motors of its coupled group ("group::part" names); out of repr and ==, which would
+    # go round the group for ever
+    coupled: tuple[JointMotor, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:
         self.reset()
