@@ -216,8 +216,8 @@ def test_a_robot_whose_motorised_hinges_have_nothing_round_is_no_failed_vehicle(
     coupled_motors sample: motors "motor::left finger" and "motor::right finger", multiplier -1).
     Nothing at any hinge's end is round, so there is no vehicle: each motor is said once as no wheel
     and moves its joint kinematically. They used to be taken for a car's steering (the vertical axes)
-    and end in "no Ackermann drive (...); the robot will not move". The coupled names are said too:
-    Webots passes one command to the whole group; here each motor moves on its own commands."""
+    and end in "no Ackermann drive (...); the robot will not move". The fingers are coupled as in
+    Webots: a command to one reaches both, each scaled by its multiplier."""
     box = 'children [ Shape { geometry Box { size 0.05 0.05 0.05 } } ]'
     head = ('Robot { name "head" children [\n'
             ' HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 } device [ RotationalMotor { name "pan" '
@@ -238,12 +238,12 @@ def test_a_robot_whose_motorised_hinges_have_nothing_round_is_no_failed_vehicle(
     said = sorted(x.split(": ", 1)[1].split(" (")[0] for x in w.warnings if "is no wheel" in x)
     assert said == ["HingeJoint motor 'motor::left finger' is no wheel", "HingeJoint motor 'motor::right finger' is no "
                     "wheel", "HingeJoint motor 'pan' is no wheel", "HingeJoint motor 'tilt' is no wheel"]
-    coupled = [x.split(": ", 1)[1] for x in w.warnings if "coupled" in x]
-    assert coupled == [f"RotationalMotor 'motor::{side} finger': coupled motors (Webots passes a command to every "
-                       f"motor whose name shares the part before '::', scaled by its multiplier, here {m}) are not "
-                       "coupled here: it moves on its own commands only, and getMultiplier answers 1"
-                       for side, m in (("left", 1), ("right", -1))]
+    assert not [x for x in w.warnings if "coupled" in x], w.warnings
     sim = Simulation(w)
+    left, right = (sim.robot("gripper").motor(f"motor::{side} finger") for side in ("left", "right"))
+    assert (left.multiplier, right.multiplier) == (1.0, -1.0)
+    left.set_position(0.01)                  # the whole group takes it, each scaled by its multiplier
+    assert (left.target_position, right.target_position) == (0.01, -0.01)
     sim.robot("head").motor("pan").set_position(math.pi / 2)
     sim.step()
     cam = sim.device("head/camera").world_pose(sim.robot("head").pose)
@@ -303,3 +303,35 @@ def test_a_pan_head_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Path) -> 
     rover.motor("head pan").set_position(math.pi / 2)
     sim.step()
     assert sim.device("rover/camera").world_pose(rover.pose).translation == pytest.approx([0.0, 0.1, 0.2], abs=1e-12)
+
+
+def test_coupled_drive_wheels_are_said_and_turn_on_their_own(tmp_path: Path) -> None:
+    """Two wheels named "wheel::left" and "wheel::right" (multiplier -1 on the right): Webots would
+    pass a command to both; the drive turns each wheel on its own commands, so the import says so
+    for each, and the drive stays the one the geometry makes (bit for bit the uncoupled wheels')."""
+    p = write(tmp_path, 'Robot { name "duo" children [\n' + wheel("wheel::left", 0, 0.08)
+              + wheel("wheel::right", 0, -0.08).replace('maxVelocity 12.3', 'maxVelocity 12.3 multiplier -1')
+              + '] }\n')
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=0.16, max_wheel_speed=12.3, left_motor="wheel::left", right_motor="wheel::right")
+    said = [x.split(": ", 1)[1] for x in w.warnings if "coupled" in x]
+    assert said == [f"RotationalMotor 'wheel::{side}': a coupled motor (Webots passes a command to every motor whose "
+                    f"name shares the part before '::', scaled by its multiplier, here {m}) that is a wheel of the "
+                    "robot's drive: not coupled here, it turns on its own commands and getMultiplier answers 1"
+                    for side, m in (("left", 1), ("right", -1))]
+    assert all(getattr(d, "multiplier", 1.0) == 1.0 for d in robot.devices)
+
+
+def test_a_joint_motors_multiplier_is_read_and_zero_is_reset_to_one(tmp_path: Path) -> None:
+    """A slider's LinearMotor with multiplier 0.5 keeps it; another with multiplier 0 gets 1, with
+    a line at its field (Webots: "The value of 'multiplier' cannot be 0")."""
+    body = 'Robot { name "lifter" children [\n' + "".join(
+        f' SliderJoint {{ device [ LinearMotor {{ name "{name}" multiplier {m} }} ] endPoint Solid {{ }} }}\n'
+        for name, m in (("lift", "0.5"), ("tilt", "0"))) + '] }\n'
+    w = load_world(write(tmp_path, body))
+    (robot,) = w.world.robots
+    assert [(d.name, d.multiplier) for d in robot.devices] == [("lift", 0.5), ("tilt", 1.0)]
+    assert [x.split(": ", 1)[1] for x in w.warnings if "cannot be 0" in x] == [
+        "LinearMotor.multiplier: 0 cannot be 0; using 1 (as Webots does)"]

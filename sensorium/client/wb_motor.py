@@ -214,8 +214,9 @@ def wb_motor_set_control_pid(tag: int, p: float, i: float, d: float) -> None:
 
 @answers(_NAN)
 def wb_motor_get_multiplier(tag: int) -> float:
-    _motor(tag, "wb_motor_get_multiplier")
-    return 1.0
+    """What the motor scales its position and velocity commands by (its ``multiplier``; 1 for a
+    drive's wheel)."""
+    return _float(_motor(tag, "wb_motor_get_multiplier").desc.get("multiplier"), 1.0)
 
 
 @answers(None)

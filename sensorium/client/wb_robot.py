@@ -509,9 +509,15 @@ class RobotClient:
         dev._consts["frequency"] = number
 
     # -- motors: buffered, sent with the next step request
+    def coupled(self, dev: DeviceState) -> list[DeviceState]:
+        """The other motors of a joint motor's coupled group (its attach entry's ``coupled``)."""
+        return [self.by_name[n] for n in dev.desc.get("coupled", ()) if n in self.by_name]
+
     def set_motor_position(self, dev: DeviceState, position: float, func: str) -> None:
         """Webots' ``setPosition``: a target (rad), or ±inf for velocity control; NaN is printed
-        and ignored (Webots)."""
+        and ignored (Webots). A coupled group's other motors take it too, each scaled by its
+        multiplier (libController's copy of their targets); each motor whose scaled target is beyond
+        its limits prints WbMotor's warning, which names the value asked for."""
         number = real(position)
         if number is None:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'position' must be a number, got {position!r}")
@@ -519,12 +525,17 @@ class RobotClient:
         if math.isnan(position):
             print(f"Error: {func}() called with an invalid 'position' argument (NaN).", file=sys.stderr)
             return
-        lo, hi = _float(dev.desc.get("minPosition"), 0.0), _float(dev.desc.get("maxPosition"), 0.0)
-        if "maxForce" in dev.desc and lo != hi and not math.isinf(position) and not lo <= position <= hi:
-            # a joint's motor: Webots clamps the target to its limits with this warning (WbMotor);
-            # libController keeps the requested value as the target position, as here
-            print(f'WARNING: {dev.kind} "{dev.name}": too {"big" if position > hi else "low"} requested position: '
-                  f'{position:g} {">" if position > hi else "<"} {(hi if position > hi else lo):g}', file=sys.stderr)
+        for motor in (dev, *self.coupled(dev)):
+            lo, hi = _float(motor.desc.get("minPosition"), 0.0), _float(motor.desc.get("maxPosition"), 0.0)
+            target = position * _float(motor.desc.get("multiplier"), 1.0)
+            if "maxForce" in motor.desc and lo != hi and not math.isinf(position) and not lo <= target <= hi:
+                # a joint's motor: Webots clamps the target to its limits with this warning (WbMotor);
+                # libController keeps the requested value as the target position, as here
+                print(f'WARNING: {motor.kind} "{motor.name}": too {"big" if target > hi else "low"} requested '
+                      f'position: {position:g} {">" if target > hi else "<"} {(hi if target > hi else lo):g}',
+                      file=sys.stderr)
+            if motor is not dev:
+                motor.target_position = position if math.isinf(position) else target
         dev.target_position = position
         self.motor_commands.setdefault(dev.name, {})["position"] = position
 
@@ -534,7 +545,8 @@ class RobotClient:
 
     def set_motor_velocity(self, dev: DeviceState, velocity: float, func: str) -> None:
         """Webots' ``setVelocity``: clamped to ``maxVelocity`` with Webots' warning; NaN, and a
-        negative velocity in position control, are printed and ignored (Webots)."""
+        negative velocity in position control, are printed and ignored (Webots). A coupled group's
+        other motors take it too, each scaled by its multiplier, with their own warnings."""
         number = real(velocity)
         if number is None:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'velocity' must be a number, got {velocity!r}")
@@ -546,13 +558,20 @@ class RobotClient:
             print(f"Error: {func}() called with negative 'velocity' argument in position control mode "
                   f"({dev.target_position:g}).", file=sys.stderr)     # libController shows the target position
             return
-        limit = dev.max_velocity
-        if abs(velocity) > limit:
-            print(f"WARNING: {dev.kind} \"{dev.name}\": The requested velocity {velocity:g} exceeds "
-                  f"'maxVelocity' = {limit:g}.", file=sys.stderr)
-            velocity = math.copysign(limit, velocity)
-        dev.velocity = velocity
-        self.motor_commands.setdefault(dev.name, {})["velocity"] = velocity
+        sent = velocity
+        for motor in (dev, *self.coupled(dev)):
+            multiplier = _float(motor.desc.get("multiplier"), 1.0)
+            wanted, limit = velocity * multiplier, motor.max_velocity
+            if abs(wanted) > limit:
+                print(f"WARNING: {motor.kind} \"{motor.name}\": The requested velocity {wanted:g} exceeds "
+                      f"'maxVelocity' = {limit:g}.", file=sys.stderr)
+                wanted = math.copysign(limit, wanted)
+                if motor is dev:
+                    sent = wanted / multiplier
+            if motor is not dev:
+                motor.velocity = wanted
+        dev.velocity = sent
+        self.motor_commands.setdefault(dev.name, {})["velocity"] = sent
 
     @staticmethod
     def _expect_success(result: dict, func: str) -> None:

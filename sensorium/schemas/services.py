@@ -461,6 +461,11 @@ class JointMotorDescription(MotorDescription):
     maxForce: float = Field(description="maxTorque (N·m) of a RotationalMotor, maxForce (N) of a LinearMotor")
     initialPosition: float = Field(description="the joint's position as loaded: where a simulation reset puts it "
                                                "and its target")
+    multiplier: float = Field(default=1.0, description="scales the position and velocity commands it takes "
+                                                       "(getMultiplier)")
+    coupled: list[str] = Field(default_factory=list, description="the other motors of its coupled group (names "
+                               "sharing the part before '::'): a position or velocity given to this motor reaches "
+                               "them, each scaled by its own multiplier")
 
 
 class PositionSensorDescription(_Entry):

@@ -836,6 +836,10 @@ class Motor(_Device):
                               "out: Webots' default, 1 0 0 for a hinge, 0 0 1 for a slider")
     anchor: Vec3 = Field(default=(0.0, 0.0, 0.0), description="a hinge's axis passes through it (robot frame, m); "
                          "unused by a slider")
+    multiplier: float = Field(default=1.0, description="scales every position and velocity command this motor takes "
+                              "(Webots' coupled motors: a command to one motor named 'group::part' reaches every "
+                              "joint motor of the robot named 'group::...', each scaled by its own multiplier); "
+                              "0 is reset to 1, as Webots does")
 
     @property
     def joint_axis(self) -> Vec3:
@@ -856,6 +860,14 @@ class Motor(_Device):
             raise ValueError(f"position {self.position} outside [min_position, max_position] = "
                              f"[{self.min_position}, {self.max_position}]")
         return self
+
+
+def coupling_group(name: str) -> str | None:
+    """The coupled-motor group a motor's name puts it in (Webots' WbMotor::inferMotorCouplings): the
+    part before ``::`` of a name made of exactly two parts (``"gripper::left"`` → ``"gripper"``);
+    None for any other name."""
+    parts = name.split("::")
+    return parts[0] if len(parts) == 2 else None
 
 
 class RotationalMotor(Motor):
@@ -1074,7 +1086,7 @@ class NestedNode(Strict):
     name: str | None = Field(default=None, description="a Solid's or device's name field")
     parent: int = Field(default=-1, ge=-1, description="index of its parent in the robot's `nodes` (an earlier "
                         "entry); -1: the robot")
-    field: Literal["children", "endPoint", "device", "device2"] = Field(
+    field: Literal["children", "endPoint", "device", "device2", "device3"] = Field(
         default="children", description="the parent's field that holds it")
     pose: Pose | None = Field(default=None, description="its frame in the robot's frame as the world loads; "
                               "none for a node that is no Pose (Group, joints, motors, position sensors)")

@@ -80,7 +80,8 @@ class DeviceServices:
                     "minPosition": float(m.min_position), "maxPosition": float(m.max_position),
                     "targetPosition": float(m.target_position), "velocity": float(m.velocity),
                     "acceleration": float(m.acceleration), "maxForce": float(m.max_force),
-                    "initialPosition": float(m.initial_position)}
+                    "initialPosition": float(m.initial_position), "multiplier": float(m.multiplier),
+                    "coupled": [c.name for c in m.coupled]}
         limit = float(getattr(m, "max_position", math.inf))      # a car's steering motor has limits
         limit = 0.0 if math.isinf(limit) else limit              # Webots: 0 and 0 mean none (a wheel)
         return {"name": m.name, "type": MOTOR, "maxVelocity": float(m.max_velocity), "minPosition": -limit if limit else 0.0,

@@ -44,7 +44,7 @@ class Nested:
     def_name: str
     name: str             # a Solid's or device's name ("" for a Pose, Group, joint)
     parent: int           # the parent's node id (a nested node's, or the robot's / top-level solid's)
-    field: str            # the parent's field holding it: children, endPoint, device, device2
+    field: str            # the parent's field holding it: children, endPoint, device, device2, device3
     local: Pose | None    # in the owner's frame (None: no Pose node)
     own: Pose | None      # in its parent's frame (its translation and rotation fields)
     device: str           # the robot's device it is ("" if none)

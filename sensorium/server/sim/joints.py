@@ -6,9 +6,13 @@ kinematic control, run once per basic step):
 
 * nothing happens in position control once the joint is within 1e-6 of the target, nor in velocity
   control (target ±inf) at a position limit it is pushing against; the speed drops to 0 then;
-* otherwise the speed moves towards the commanded velocity by at most ``a·dt`` (``a``: the motor's
-  ``acceleration``, or its available torque/force when that is -1 or larger), then the position
-  moves by ``speed·dt`` towards the target (up for +inf), never past a finite target.
+* otherwise the speed moves towards the commanded velocity (its magnitude in position control) by
+  at most ``a·dt`` (``a``: the motor's ``acceleration``, or its available torque/force when that is
+  -1 or larger), then the position moves by ``speed·dt`` towards the target (up for +inf), never
+  past a finite target.
+
+Coupled motors (names ``group::part``, WbMotor's couplings): a position or velocity command given
+to one reaches every motor of its group, each scaling it by its own ``multiplier``.
 
 :class:`Links` moves what rides on the joints (``on_joint`` in the world file): a hinge at position
 ``q`` turns its end point by ``q - q0`` (``q0``: its initial position, where the file places the end
@@ -20,24 +24,16 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.sim.motion import velocity_accepted
 from sensorium.server.world.geometry import Pose
 
 _POSITION_THRESHOLD = 1e-6       # Webots' TARGET_POSITION_THRESHOLD
 _VELOCITY_THRESHOLD = 1e-6       # Webots' TARGET_VELOCITY_THRESHOLD
-
-
-def position_warning(kind: str, name: str, target: float, lo: float, hi: float) -> str | None:
-    """WbMotor's warning for a target beyond the motor's limits (None within them)."""
-    if target > hi:
-        return f'WARNING: {kind} "{name}": too big requested position: {target:g} > {hi:g}'
-    if target < lo:
-        return f'WARNING: {kind} "{name}": too low requested position: {target:g} < {lo:g}'
-    return None
 
 
 @dataclass(slots=True)
@@ -63,6 +59,10 @@ class JointMotor:
     speed: float = 0.0                   # the current velocity (Webots' mCurrentVelocity)
     available_force: float = math.nan
     rate: float = 0.0                    # how fast the position moved over the last basic step (signed)
+    multiplier: float = 1.0              # scales the position and velocity commands it takes (Webots)
+    # the other motors of its coupled group ("group::part" names); out of repr and ==, which would
+    # go round the group for ever
+    coupled: tuple[JointMotor, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:
         self.reset()
@@ -85,23 +85,39 @@ class JointMotor:
         self.target_position = self.position
 
     def set_position(self, value: float, warn: bool = True) -> None:
-        """Webots' setTargetPosition: a finite target beyond the limits is clamped to them, with
-        Webots' warning on stderr (``warn``); ±inf selects velocity control."""
+        """Webots' setTargetPosition, given to this motor and every motor coupled with it
+        (WbMotor::handleMessage relays it): each one's target is ``value`` times its multiplier
+        (±inf, velocity control, as given), clamped to its limits with Webots' warning on stderr
+        (``warn``), which names the value asked for."""
         if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
             raise ValueError(f"motor {self.name!r}: position must be a number or inf, got {value!r}")
-        target = float(value)
-        if self.limited and not math.isinf(target):
-            line = position_warning(self.kind, self.name, target, self.min_position, self.max_position)
+        for motor in (self, *self.coupled):
+            motor._take_position(float(value), warn)
+
+    def _take_position(self, value: float, warn: bool) -> None:
+        if math.isinf(value):
+            self.target_position = value
+            return
+        target = value * self.multiplier
+        if self.limited:
+            hi, lo = self.max_position, self.min_position
+            line = None           # Webots judges the scaled target, and names the value asked for
+            if target > hi:
+                line = f'WARNING: {self.kind} "{self.name}": too big requested position: {value:g} > {hi:g}'
+            elif target < lo:
+                line = f'WARNING: {self.kind} "{self.name}": too low requested position: {value:g} < {lo:g}'
             if line is not None:
                 if warn:
                     print(line, file=sys.stderr)
-                target = min(max(target, self.min_position), self.max_position)
+                target = min(max(target, lo), hi)
         self.target_position = target
 
     def command(self, position: float | None, velocity: float | None, acceleration: float | None,
                 available_force: float | None) -> None:
         """A controller step's commands (checked by the request's schema; the client printed
-        Webots' warnings): applied in libController's order, without printing."""
+        Webots' warnings): applied in libController's order, without printing. A position and a
+        velocity reach the motors coupled with this one too; an acceleration and an available
+        torque/force only this one (as WbMotor relays them)."""
         if position is not None:
             self.set_position(position, warn=False)
         if velocity is not None:
@@ -112,14 +128,18 @@ class JointMotor:
             self.set_available_force(available_force)
 
     def set_velocity(self, value: float) -> None:
-        """In-process ``setVelocity``: NaN raises; beyond ``maxVelocity`` it is clamped."""
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
-            raise ValueError(f"motor {self.name!r}: velocity must be a number, got {value!r}")
-        self.command_velocity(value)
+        """In-process ``setVelocity``: NaN raises; a negative velocity in position control is
+        ignored with Webots' line (:func:`~sensorium.server.sim.motion.velocity_accepted`, the wheels'
+        rule); otherwise as :meth:`command_velocity`."""
+        if velocity_accepted(self.name, value, self.target_position, self.velocity):
+            self.command_velocity(value)
 
     def command_velocity(self, value: float) -> None:
-        """A velocity a controller's step sends: clamped to ``±maxVelocity`` (WbMotor::setVelocity)."""
-        self.velocity = float(min(max(value, -self.max_velocity), self.max_velocity))
+        """A velocity a controller sends, to this motor and every motor coupled with it: each one's
+        is ``value`` times its multiplier, clamped to ``±maxVelocity`` (WbMotor::setVelocity)."""
+        for motor in (self, *self.coupled):
+            wanted = float(value) * motor.multiplier
+            motor.velocity = float(min(max(wanted, -motor.max_velocity), motor.max_velocity))
 
     def set_acceleration(self, value: float) -> None:
         """``setAcceleration``: >= 0, or -1 (bounded by the available torque/force only)."""
@@ -151,7 +171,10 @@ class JointMotor:
         if acc == -1.0 or acc > self.available_force:
             acc = self.available_force
         speed = self.speed
-        wanted = self.velocity
+        # in position control, the velocity's magnitude (departure: Webots' kinematic control would
+        # carry a negative one -- left from velocity control, or a coupled motor's negative
+        # multiplier -- away from the target for ever; its physics, and its manual, take the magnitude)
+        wanted = self.velocity if math.isinf(target) else abs(self.velocity)
         if abs(wanted - speed) > _VELOCITY_THRESHOLD:
             speed = min(speed + acc * dt_s, wanted) if wanted > speed else max(speed - acc * dt_s, wanted)
         self.speed = speed

@@ -92,7 +92,20 @@ def joint_motor(d: wm.RotationalMotor | wm.LinearMotor) -> JointMotor:
     """The kinematic joint a motor entry that is no drive motor moves."""
     force = d.max_torque if isinstance(d, wm.RotationalMotor) else d.max_force
     return JointMotor(d.name, d.device, d.max_velocity, d.min_position, d.max_position, d.acceleration, force,
-                      d.position)
+                      d.position, multiplier=d.multiplier)
+
+
+def couple(joints: dict[str, JointMotor]) -> None:
+    """Webots' coupled motors among a robot's joint motors: those whose names share the part before
+    ``::`` (wm.coupling_group) each hold the others, to pass on the commands they take."""
+    groups: dict[str, list[JointMotor]] = {}
+    for name, motor in joints.items():
+        group = wm.coupling_group(name)
+        if group is not None:
+            groups.setdefault(group, []).append(motor)
+    for members in groups.values():
+        for motor in members:
+            motor.coupled = tuple(m for m in members if m is not motor)
 
 
 class RobotState:
@@ -129,6 +142,7 @@ class RobotState:
         # every other motor moves its joint kinematically (sim/joints.py), in device-list order
         self.joints: dict[str, JointMotor] = {d.name: joint_motor(d) for d in model.devices
                                               if isinstance(d, wm.Motor) and d.name not in drive_motors}
+        couple(self.joints)
         self.motors: dict[str, WheelMotor | JointMotor] = (
             {**drive_motors, **self.joints} if self.joints else cast("dict[str, WheelMotor | JointMotor]", drive_motors))
         # what rides on the joints (``on_joint``): their links, and the devices on each (None: nothing rides)

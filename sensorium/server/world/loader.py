@@ -787,6 +787,59 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
     robots = []
     for r_i, robot in enumerate(world.robots):
         devices = [fix_device(f"robots[{r_i}].devices[{d_i}]", d) for d_i, d in enumerate(robot.devices)]
+        devices = _coupled_resets(f"robots[{r_i}]", robot, devices, warnings)
         r_lights = [fix_light(f"robots[{r_i}].lights[{i}]", lt) for i, lt in enumerate(robot.lights)]
         robots.append(robot.model_copy(update={"devices": devices, "lights": r_lights}))
     return world.model_copy(update={"lights": lights, "solids": solids, "robots": robots}), warnings
+
+
+def _coupled_resets(rp: str, robot: wm.Robot, devices: list[Any], warnings: list[str]) -> list[Any]:
+    """Webots' checks of coupled motors as a robot loads (WbMotor::updateMultiplier,
+    inferMotorCouplings, checkMinAndMaxPositionAcrossCoupledMotors, checkMaxVelocityAcrossCoupledMotors):
+    a multiplier of 0 is reset to 1; in each group of joint motors named ``group::...`` the first in
+    device order sets the others' limits (its own scaled by the ratio of multipliers, ordered; none if
+    it has none) and maximum velocities (scaled by the ratio of the multipliers' magnitudes), each
+    change said; a ``group::part`` motor alone in its group is said. A drive's motors are no joints
+    and couple with nothing here."""
+    drive = {m for _, m in robot.drive_motors}
+    out = list(devices)
+    groups: dict[str, list[int]] = {}
+    for d_i, dev in enumerate(out):
+        if not isinstance(dev, wm.Motor) or dev.name in drive:
+            continue
+        if dev.multiplier == 0.0:
+            warnings.append(f"{rp}.devices[{d_i}].multiplier: 0, reset to 1 (Webots: it cannot be 0)")
+            out[d_i] = dev = dev.model_copy(update={"multiplier": 1.0})
+        group = wm.coupling_group(dev.name)
+        if group is not None:
+            groups.setdefault(group, []).append(d_i)
+    for group, members in groups.items():
+        if len(members) == 1:
+            warnings.append(f"{rp}.devices[{members[0]}] ({out[members[0]].name}): uses the coupled motor name "
+                            f"structure ('{group}::...') but has no sibling: not coupled")
+            continue
+        ref = out[members[0]]
+        limited = ref.min_position != ref.max_position
+        for d_i in members[1:]:
+            dev = out[d_i]
+            p = f"{rp}.devices[{d_i}] ({dev.name})"
+            upd: dict[str, Any] = {}
+            if limited:
+                lo = ref.min_position * dev.multiplier / ref.multiplier
+                hi = ref.max_position * dev.multiplier / ref.multiplier
+                lo, hi = min(lo, hi), max(lo, hi)
+            else:
+                lo = hi = 0.0
+            for key, value in (("min_position", lo), ("max_position", hi)):
+                if getattr(dev, key) != value:
+                    upd[key] = value
+                    warnings.append(f"{p}.{key}: coupled with {ref.name!r}, whose limits set its own: "
+                                    f"{getattr(dev, key):g} set to {value:g}")
+            velocity = ref.max_velocity * abs(dev.multiplier) / abs(ref.multiplier)
+            if dev.max_velocity != velocity:
+                upd["max_velocity"] = velocity
+                warnings.append(f"{p}.max_velocity: coupled with {ref.name!r}, whose maximum velocity sets its own: "
+                                f"{dev.max_velocity:g} set to {velocity:g}")
+            if upd:
+                out[d_i] = dev.model_copy(update=upd)
+    return out

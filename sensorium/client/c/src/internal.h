@@ -179,6 +179,9 @@ typedef struct {
   bool joint;                        /* no drive's motor: its joint moves kinematically (maxForce known) */
   double max_force, available_force; /* a joint motor's maxTorque/maxForce and setAvailableTorque/Force */
   double initial_position;           /* where a simulation reset puts a joint (0 for a wheel) */
+  double multiplier;                 /* scales the position and velocity commands it takes (1: a wheel) */
+  char **coupled;                    /* the other motors of its coupled group ("group::part" names) */
+  int n_coupled;
   bool cmd_position, cmd_velocity;   /* to send with the next step */
   bool cmd_acceleration, cmd_available;
   bool warned_physics;             /* a physics-only motor function was called (one warning) */

@@ -11,6 +11,30 @@
 
 #define MOTOR(func) sn_device *d = sn_device_get(tag, SN_MOTOR, func)
 
+/* The other motors of a joint motor's coupled group (Webots' "group::part" names), from its
+ * attach entry: the i-th one, NULL when it is not (or no more) there. */
+static sn_device *sibling(const sn_device *d, int i) {
+  sn_robot *rb = sn_robot_get("wb_motor_set_position");
+  for (int k = 0; rb != NULL && k < rb->n_devices; k++)
+    if (rb->devices[k].kind == SN_MOTOR && strcmp(rb->devices[k].name, d->coupled[i]) == 0)
+      return &rb->devices[k];
+  return NULL;
+}
+
+/* WbMotor's warning for a target beyond a joint motor's limits: judged on the scaled target,
+ * naming the value asked for. */
+static void position_warning(const sn_device *m, double position) {
+  double target = position * m->multiplier;
+  if (!m->joint || m->min_position == m->max_position || isinf(position))
+    return;
+  if (target > m->max_position)
+    fprintf(stderr, "WARNING: %s \"%s\": too big requested position: %g > %g\n", m->type_name, m->name, position,
+            m->max_position);
+  else if (target < m->min_position)
+    fprintf(stderr, "WARNING: %s \"%s\": too low requested position: %g < %g\n", m->type_name, m->name, position,
+            m->min_position);
+}
+
 void wb_motor_set_position(WbDeviceTag tag, double position) {
   MOTOR("wb_motor_set_position");
   if (d == NULL)
@@ -19,18 +43,31 @@ void wb_motor_set_position(WbDeviceTag tag, double position) {
     fprintf(stderr, "Error: wb_motor_set_position() called with an invalid 'position' argument (NaN)\n");
     return;
   }
-  if (d->joint && d->min_position != d->max_position && !isinf(position)) {
-    /* a joint's motor: Webots clamps the target to its limits with this warning (WbMotor); the
-     * target position answered stays the one requested, as libController's */
-    if (position > d->max_position)
-      fprintf(stderr, "WARNING: %s \"%s\": too big requested position: %g > %g\n", d->type_name, d->name, position,
-              d->max_position);
-    else if (position < d->min_position)
-      fprintf(stderr, "WARNING: %s \"%s\": too low requested position: %g < %g\n", d->type_name, d->name, position,
-              d->min_position);
+  /* a joint's motor: Webots clamps the target to its limits with a warning (WbMotor); the target
+   * position answered stays the one requested, as libController's. A coupled group's other motors
+   * take it too, each scaled by its multiplier (libController's copy of their targets). */
+  position_warning(d, position);
+  for (int i = 0; i < d->n_coupled; i++) {
+    sn_device *s = sibling(d, i);
+    if (s == NULL)
+      continue;
+    position_warning(s, position);
+    s->target_position = isinf(position) ? position : position * s->multiplier;
   }
   d->target_position = position;
   d->cmd_position = true;
+}
+
+/* One motor's share of a velocity: scaled by its multiplier, clamped to its maxVelocity with
+ * WbMotor's warning. */
+static double scaled_velocity(const sn_device *m, double velocity) {
+  double wanted = velocity * m->multiplier;
+  if (fabs(wanted) > m->max_velocity) {
+    fprintf(stderr, "WARNING: %s \"%s\": The requested velocity %g exceeds 'maxVelocity' = %g.\n", m->type_name,
+            m->name, wanted, m->max_velocity);
+    wanted = copysign(m->max_velocity, wanted);
+  }
+  return wanted;
 }
 
 void wb_motor_set_velocity(WbDeviceTag tag, double velocity) {
@@ -47,12 +84,14 @@ void wb_motor_set_velocity(WbDeviceTag tag, double velocity) {
             d->target_position); /* libController shows the target position */
     return;
   }
-  if (fabs(velocity) > d->max_velocity) {
-    fprintf(stderr, "WARNING: %s \"%s\": The requested velocity %g exceeds 'maxVelocity' = %g.\n", d->type_name,
-            d->name, velocity, d->max_velocity);
-    velocity = copysign(d->max_velocity, velocity);
+  double multiplier = d->multiplier != 0.0 ? d->multiplier : 1.0;
+  double sent = scaled_velocity(d, velocity) / multiplier;
+  for (int i = 0; i < d->n_coupled; i++) {
+    sn_device *s = sibling(d, i);
+    if (s != NULL)
+      s->velocity = scaled_velocity(s, velocity);
   }
-  d->velocity = velocity;
+  d->velocity = sent;
   d->cmd_velocity = true;
 }
 
@@ -206,7 +245,7 @@ void wb_motor_set_control_pid(WbDeviceTag tag, double p, double i, double d) {
 }
 double wb_motor_get_multiplier(WbDeviceTag tag) {
   MOTOR("wb_motor_get_multiplier");
-  return d ? 1.0 : NAN;
+  return d ? d->multiplier : NAN;
 }
 void wb_motor_set_force(WbDeviceTag tag, double force) {
   (void)force;

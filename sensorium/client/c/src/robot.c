@@ -203,6 +203,18 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
   d->max_force = sn_double_or(desc, "maxForce", NAN);
   d->available_force = d->max_force;
   d->initial_position = sn_double_or(desc, "initialPosition", 0.0);
+  d->multiplier = sn_double_or(desc, "multiplier", 1.0);
+  const msgpack_object *coupled = sn_get(desc, "coupled");
+  if (coupled != NULL && coupled->type == MSGPACK_OBJECT_ARRAY && coupled->via.array.size > 0) {
+    d->coupled = calloc(coupled->via.array.size, sizeof(char *));
+    if (d->coupled == NULL)
+      return -1;
+    for (uint32_t i = 0; i < coupled->via.array.size; i++) {
+      char *name = sn_strdup_obj(&coupled->via.array.ptr[i]);
+      if (name != NULL)
+        d->coupled[d->n_coupled++] = name;
+    }
+  }
   return 0;
 }
 
@@ -218,6 +230,9 @@ static void free_robot(sn_robot *rb) {
     free(d->range_image);
     free(d->point_cloud);
     free(d->motor_name);
+    for (int k = 0; k < d->n_coupled; k++)
+      free(d->coupled[k]);
+    free(d->coupled);
     free(d->radar_targets);
     sn_imaging_free(d);
     sn_radio_free(d);

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.world.poses import axis_angle_matrix
 from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
 from sensorium.server.world.wbt.fields import Fields
@@ -66,7 +67,7 @@ JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
 MOTORS = {"RotationalMotor", "LinearMotor"}
 OTHER_MOTOR_NAMES = {"RotationalMotor": "rotational motor", "LinearMotor": "linear motor"}
 JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "max_torque", "position", "axis",
-              "anchor")
+              "anchor", "multiplier")
 JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
                "the shapes and devices past the joint with it")
 # the fields every Solid has (a device's own fields are the others)
@@ -108,6 +109,7 @@ class Converter:
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.device_depth = 0              # > 0 while inside a device's children (its joints are no wheels)
         self.riding: list[dict] = []       # the motor entries of the robot's joints being visited, innermost last
+        self.coupled_nodes: dict[int, Node] = {}   # id(motor entry) -> its node, for a 'group::part' name
         self.device_where: dict[int, str] = {}   # id(device entry) -> where its node is written
         self.led_of: dict[int, tuple[dict, Frame]] = {}   # id(light node) -> (its LED's entry, the LED's frame)
         self.checked_scale: set[int] = set()   # Transforms whose scale was sanitised (warned once)
@@ -1159,13 +1161,14 @@ class Converter:
         return out
 
     def joint_devices(self, node: Node, owner: Owner, field_name: str = "device") -> tuple[list[dict], list[dict]]:
-        """A joint's devices in its ``device`` (or a Hinge2Joint's ``device2``) order (Webots lists
+        """A joint's devices in its ``device`` (or a Hinge2Joint's ``device2``, a BallJoint's ``device2``
+        and ``device3``) order (Webots lists
         them before the end point's): (motor entries, position sensor entries). A motor's entry
         carries its fields and the joint's position (a drive keeps only its wheels' names, see
         :meth:`drive`); the joint's sensors measure its motor."""
         motors, sensors = [], []
-        params = self.fields(node).node_("jointParameters2" if field_name == "device2" else "jointParameters") \
-            if node.type.endswith("Joint") else None
+        params_field = {"device2": "jointParameters2", "device3": "jointParameters3"}.get(field_name, "jointParameters")
+        params = self.fields(node).node_(params_field) if node.type.endswith("Joint") else None
         position = self.fields(params).num("position", 0.0) if params is not None else 0.0
         for d in self.fields(node).nodes(field_name):
             self.walk(d)
@@ -1177,11 +1180,8 @@ class Converter:
                 self.ride(entry)
                 owner.data["devices"].append(entry)
                 motors.append(entry)
-                if "::" in entry["name"]:      # Webots' coupled motors: one command moves the whole group
-                    self.warn(d, f"{d.type} {entry['name']!r}: coupled motors (Webots passes a command to every motor "
-                                 f"whose name shares the part before '::', scaled by its multiplier, here "
-                                 f"{self.fields(d).num('multiplier', 1.0):g}) are not coupled here: it moves on its "
-                                 "own commands only, and getMultiplier answers 1")
+                if wm.coupling_group(entry["name"]) is not None:   # a drive's wheel is told (see drive())
+                    self.coupled_nodes[id(entry)] = d
             elif d.type == "PositionSensor":
                 sf = self.fields(d)
                 entry = {"name": sf.string("name", "position sensor"), "device": "PositionSensor",
@@ -1220,10 +1220,14 @@ class Converter:
                 hi = f.used("maxPosition", hi, position, "is below the joint's position")
             if lo > position:
                 lo = f.used("minPosition", lo, position, "is above the joint's position")
+        multiplier = f.num("multiplier", 1.0)
+        if multiplier == 0.0:         # WbMotor::updateMultiplier
+            multiplier = f.used("multiplier", multiplier, 1.0, "cannot be 0")
         out = {"max_velocity": velocity, "min_position": lo, "max_position": hi, "acceleration": acceleration,
-               "max_torque" if d.type == "RotationalMotor" else "max_force": force, "position": position}
+               "max_torque" if d.type == "RotationalMotor" else "max_force": force, "position": position,
+               "multiplier": multiplier}
         defaults = {"max_velocity": 10.0, "min_position": 0.0, "max_position": 0.0, "acceleration": -1.0,
-                    "max_torque": 10.0, "max_force": 10.0, "position": 0.0}
+                    "max_torque": 10.0, "max_force": 10.0, "position": 0.0, "multiplier": 1.0}
         return {k: v for k, v in out.items() if v != defaults[k]}
 
     def ride(self, entry: dict) -> None:
@@ -1250,9 +1254,18 @@ class Converter:
         motors = [d for d in f.nodes("device") if d.type in MOTORS]
         sensors: list[dict] = []
         moving: list[dict] = []
+        spin_sensors: list[dict] = []
         if owner.kind == "robot":
             moving, sensors = self.joint_devices(node, owner)
-            if node.type not in ("HingeJoint", "SliderJoint"):
+            if node.type == "Hinge2Joint":      # its second axis's devices follow its first's (Webots' order)
+                spin, spin_sensors = self.joint_devices(node, owner, "device2")
+                moving = self.hinge2_frames(node, frame, moving[:1], spin[:1])
+            elif node.type == "BallJoint":
+                second, _ = self.joint_devices(node, owner, "device2")
+                third, _ = self.joint_devices(node, owner, "device3")
+                motors += [d for field_ in ("device2", "device3") for d in f.nodes(field_) if d.type in MOTORS]
+                moving = self.ball_frames(node, frame, moving[:1], second[:1], third[:1])
+            elif node.type not in ("HingeJoint", "SliderJoint"):
                 moving = []
             elif moving:
                 self.joint_frame(node, frame, moving[0])
@@ -1260,7 +1273,7 @@ class Converter:
         # never the robot: it is no wheel, whatever its axis (Webots has no notion of a drive either)
         wheeled = owner.kind == "robot" and not self.device_depth
         if wheeled and node.type == "Hinge2Joint":    # a steered wheel (a car)
-            self.hinge2(node, frame, owner, motors, sensors)
+            self.hinge2(node, frame, owner, motors, sensors, spin_sensors)
         elif wheeled and node.type == "HingeJoint" and motors:
             params = f.node_("jointParameters")
             if params is not None:
@@ -1296,8 +1309,8 @@ class Converter:
             if end.type == "SolidReference":
                 return
             self.tree_field = "endPoint"
-            if moving:          # what the end point holds rides on this joint (its first motor's)
-                self.riding.append(moving[0])
+            if moving:          # what the end point holds rides on this joint (its innermost motor's)
+                self.riding.append(moving[-1])
             try:
                 self.visit(end, frame, owner)
             finally:
@@ -1310,14 +1323,90 @@ class Converter:
             end = self.fields(end).node_("endPoint")
         return end
 
-    def hinge2(self, node: Node, frame: Frame, owner: Owner, motors: list[Node], sensors: list[dict]) -> None:
+    def hinge2_frames(self, node: Node, frame: Frame, first: list[dict], second: list[dict]) -> list[dict]:
+        """A Hinge2Joint's two axes (``jointParameters``: axis, default x, anchor and position;
+        ``jointParameters2``: axis2, default z, position2) as two hinges through its anchor, the
+        second riding on the first (WbHinge2Joint turns its end point by ``R(axis, q1) R(axis2, q2)``
+        about the anchor): see :meth:`axis_chain`."""
+        f = self.fields(node)
+        p1, p2 = f.node_("jointParameters"), f.node_("jointParameters2")
+        f1 = self.fields(p1) if p1 is not None else None
+        f2 = self.fields(p2) if p2 is not None else None
+        axes = [f1.vec("axis", (1.0, 0.0, 0.0)) if f1 else (1.0, 0.0, 0.0),
+                f2.vec("axis", (0.0, 0.0, 1.0)) if f2 else (0.0, 0.0, 1.0)]
+        positions = [f1.num("position", 0.0) if f1 else 0.0, f2.num("position", 0.0) if f2 else 0.0]
+        anchor = f1.vec("anchor", (0.0, 0.0, 0.0)) if f1 else (0.0, 0.0, 0.0)
+        return self.axis_chain(frame, anchor, axes, positions, [first, second])
+
+    def ball_frames(self, node: Node, frame: Frame, first: list[dict], second: list[dict],
+                    third: list[dict]) -> list[dict]:
+        """A BallJoint's three axes as three hinges through its anchor (``jointParameters``, a
+        BallJointParameters: anchor and the first position), each riding on the one before
+        (WbBallJoint turns its end point by ``R(a1, q1) R(a2, q2) R(a3, q3)`` about the anchor). WbBallJoint's
+        axes: a1 is ``jointParameters2``'s axis, a3 ``jointParameters3``'s, a2 = a3 × a1; one of them
+        missing, it is the other's cross product with z or x (x or z when that one lies along it);
+        both missing, x and z. The second axis's motor is limited to [-pi/2, pi/2] (checkMotorLimit)."""
+        f = self.fields(node)
+        fs = [self.fields(p) if p is not None else None
+              for p in (f.node_("jointParameters"), f.node_("jointParameters2"), f.node_("jointParameters3"))]
+        x, z = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+        given2 = np.asarray(fs[1].vec("axis", (0.0, 0.0, 1.0)), dtype=np.float64) if fs[1] else None
+        given3 = np.asarray(fs[2].vec("axis", (0.0, 0.0, 1.0)), dtype=np.float64) if fs[2] else None
+
+        def crossed(a: np.ndarray, first_: np.ndarray, other: np.ndarray) -> np.ndarray:
+            c = np.cross(a, first_)
+            return np.cross(a, other) if not np.any(c) else c
+
+        a1 = given2 if given2 is not None else (x if given3 is None else crossed(given3, z, x))
+        a3 = given3 if given3 is not None else (z if given2 is None else crossed(given2, x, z))
+        a2 = np.cross(a3, a1)
+        positions = [fp.num("position", 0.0) if fp else 0.0 for fp in fs]
+        anchor = fs[0].vec("anchor", (0.0, 0.0, 0.0)) if fs[0] else (0.0, 0.0, 0.0)
+        for e in second:      # WbBallJoint::checkMotorLimit (never narrower than the joint's position)
+            lo, hi = e.get("min_position", 0.0), e.get("max_position", 0.0)
+            q = e.get("position", 0.0)
+            if lo == hi == 0.0:
+                lo, hi = -math.pi / 2, math.pi / 2
+            elif lo < -math.pi / 2 or hi > math.pi / 2:
+                self.warn(node, f"BallJoint motor {e['name']!r}: the second axis's motor is limited to "
+                                "[-pi/2, pi/2] (as Webots limits it)")
+                lo, hi = max(lo, -math.pi / 2), min(hi, math.pi / 2)
+            e["min_position"], e["max_position"] = min(lo, q), max(hi, q)
+        return self.axis_chain(frame, anchor, [tuple(a) for a in (a1, a2, a3)], positions, [first, second, third])
+
+    @staticmethod
+    def axis_chain(frame: Frame, anchor: Any, axes: list[Any], positions: list[float],
+                   motors: list[list[dict]]) -> list[dict]:
+        """Several rotation axes through one anchor, in the joint's parent frame with every position
+        at 0, turning the end point by ``R(a1, q1) R(a2, q2) ...`` (Webots' Hinge2Joint and
+        BallJoint): as hinges each riding on the one before, every axis is written as it is with the
+        axes before it at their initial positions (``R(a1, q1₀) a2``, ...), in the robot's frame,
+        on its motor's entry (``motors``: one list per axis, empty without a motor), with the
+        anchor; a motor rides on the nearest motorised axis before its own. The motors that move
+        the end point, outermost first."""
+        turned = np.eye(3)
+        at = [float(v) for v in frame.apply(anchor)]
+        out: list[dict] = []
+        for axis, q0, entries in zip(axes, positions, motors):
+            a = np.asarray(axis, dtype=np.float64)
+            for e in entries:
+                e["axis"] = [float(v) for v in frame.rotation @ (turned @ a)]
+                e["anchor"] = list(at)
+                if out:
+                    e["_on_joint"] = out[-1]
+                out.append(e)
+            if q0:
+                turned = turned @ axis_angle_matrix(a, q0)
+        return out
+
+    def hinge2(self, node: Node, frame: Frame, owner: Owner, motors: list[Node], sensors: list[dict],
+               spin_sensors: list[dict]) -> None:
         """A Hinge2Joint of a robot: its first axis (``jointParameters``, ``device``) steers, its
         second (``jointParameters2``, ``device2``) turns the wheel, its end point. Both become
         entries of the robot's motorised hinges (the drive mapping judges them)."""
         f = self.fields(node)
         end = f.node_("endPoint")
         spin_motors = [d for d in f.nodes("device2") if d.type in MOTORS]
-        _, spin_sensors = self.joint_devices(node, owner, "device2")
         centre_at = (0.0, 0.0, 0.0)
         wheel = self.slotted(end)
         if wheel is not None and wheel.type == "Solid":
@@ -1396,9 +1485,16 @@ class Converter:
         drive_motors = set(drive_motor_names(robot.data))
         for entry in robot.data["devices"]:     # a drive's motor is the drive's: its joint fields are not used
             if entry["device"] == "RotationalMotor" and entry["name"] in drive_motors:
+                multiplier = entry.get("multiplier", 1.0)
                 for key in JOINT_KEYS:
                     entry.pop(key, None)
                 entry["_wheel"] = True
+                node_ = self.coupled_nodes.get(id(entry))
+                if node_ is not None:      # Webots couples wheels too; a drive here turns each on its own
+                    self.warn(node_, f"RotationalMotor {entry['name']!r}: a coupled motor (Webots passes a command "
+                                     f"to every motor whose name shares the part before '::', scaled by its "
+                                     f"multiplier, here {multiplier:g}) that is a wheel of the robot's drive: not "
+                                     "coupled here, it turns on its own commands and getMultiplier answers 1")
 
     def on_joints(self, robot: dict) -> None:
         """Each shape and device riding on a joint names its motor (``on_joint``), names final; what

@@ -22,8 +22,10 @@ WbDeviceTag wb_motor_get_position_sensor(WbDeviceTag tag);     /* 0 if the wheel
 WbDeviceTag wb_motor_get_brake(WbDeviceTag tag);               /* 0: no Brake devices */
 
 /* What needs physics: a kinematic wheel turns at its commanded speed at once. The setters are
- * accepted and ignored, the getters answer Webots' default (-1 acceleration, multiplier 1) or NaN;
- * one warning line per motor. */
+ * accepted and ignored, the getters answer Webots' default (-1 acceleration) or NaN; one warning
+ * line per motor. wb_motor_get_multiplier answers the motor's multiplier (1 for a wheel): a joint
+ * motor named "group::part" passes the positions and velocities it is given to the other joint
+ * motors of its group, each scaled by its own multiplier (Webots' coupled motors). */
 void wb_motor_set_acceleration(WbDeviceTag tag, double acceleration);
 double wb_motor_get_acceleration(WbDeviceTag tag);
 void wb_motor_set_available_force(WbDeviceTag tag, double force);
