@@ -89,6 +89,8 @@ def test_presence_needs_the_pump_on(sim: Simulation) -> None:
     g.set_on(True)                                           # type: ignore[attr-defined]
     sim.reset()                                              # Webots' reset: isOn as in the world file
     assert g.is_on is False                                  # type: ignore[attr-defined]
+    sim.step()                                               # and the next presence value says so
+    assert g.step_reading() == {"value": 0.0, "is_on": False}
 
 
 def test_presence_is_sampled_at_its_period(sim: Simulation) -> None:

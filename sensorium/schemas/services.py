@@ -690,6 +690,7 @@ class ModeResult(Result):
 
 class ScalarReading(Result):
     value: float = Field(description="NaN before the first measurement")
+    is_on: bool | None = Field(default=None, description="VacuumGripper: its pump when the presence was measured")
 
 
 class LidarReading(Result):

@@ -318,7 +318,7 @@ class Simulation:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, joints to their initial positions, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data and radar cross sections as in the world file, GPS and Radar speeds
+        ``write`` and ink, as Webots' WbPen::reset), custom data, radar cross sections and vacuum grippers' pumps as in the world file, speakers silent, GPS and Radar speeds
         NaN at their next value (no previous position, as Webots' WbGps::reset and WbRadar::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""

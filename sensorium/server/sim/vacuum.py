@@ -98,7 +98,8 @@ class VacuumGripper(Device):
         self.is_on = bool(on)
 
     def reset(self) -> None:
-        """Webots' WbVacuumGripper::reset: the pump as the world file has it, nothing held."""
+        """Webots' WbVacuumGripper::reset: the pump as the world file has it, nothing held (its
+        controller learns the pump's state with its next presence value, as Webots' C_CONFIGURE)."""
         self.is_on = bool(self.config.is_on)
 
     # -- measuring
@@ -155,6 +156,9 @@ class VacuumGripper(Device):
 
     def readings(self) -> dict:
         return {"value": self.value}
+
+    def step_reading(self) -> dict:
+        return {"value": float(self.value), "is_on": self.is_on}
 
     def describe(self) -> dict:
         c = self.config

@@ -467,6 +467,8 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
       sn_radar_apply(dev, sn_get(v, "targets"));
     if (dev->kind == SN_SPEAKER)
       sn_speaker_apply(dev, v);
+    if (dev->kind == SN_VACUUM) /* its pump, as measured (a simulation reset may change it) */
+      dev->pump_on = sn_bool_or(v, "is_on", dev->pump_on);
     if (dev->kind != SN_LIDAR)
       continue;
     size_t n = (size_t)dev->width * (size_t)dev->layers;
