@@ -25,6 +25,8 @@ class Speaker(Device):
         return wb.wb_speaker_set_engine(self._tag, engine)
 
     def setLanguage(self, language: str) -> bool:
+        """wb_speaker_set_language (Webots' Python class calls wb_speaker_set_engine here, so it answers
+        False for every language: a slip not copied, README "VacuumGripper and Speaker")."""
         return wb.wb_speaker_set_language(self._tag, language)
 
     def getEngine(self) -> str:
@@ -38,6 +40,3 @@ class Speaker(Device):
 
     def isSpeaking(self) -> bool:
         return wb.wb_speaker_is_speaking(self._tag)
-
-    engine = property(getEngine)
-    language = property(getLanguage)
