@@ -224,3 +224,30 @@ def test_a_wbt_with_a_vacuum_gripper_and_a_speaker_loads_them_simulated(tmp_path
     sim.step()
     assert g.value == 1.0                                    # type: ignore[attr-defined]   on, on the crate
     assert [(e.name, e.simulated) for e in sim.robot("r").device_list] == [("cup", True), ("voice", True)]
+
+
+def test_a_gripper_on_a_lift_joint_is_lowered_onto_the_crate(tmp_path: Path) -> None:
+    """The gripper (its shape and the device ``on_joint: lift``) rides a LinearMotor moving down
+    (axis -z): after each step the presence is 1 exactly when the lift's travel p leaves a gap
+    0.1 - p of at most 1 mm (the lift moved kinematically, Webots' rule without physics)."""
+    text = WORLD.read_text().replace(
+        "of_device: gripper, seen_by: bounding}",
+        "of_device: gripper, seen_by: bounding, on_joint: lift}").replace(
+        "- {device: VacuumGripper, name: gripper, pose: {translation: [0.0, 0.0, 0.5]}}",
+        "- {device: LinearMotor, name: lift, axis: [0, 0, -1], max_velocity: 0.05, max_force: 100.0, "
+        "min_position: 0.0, max_position: 0.2}\n"
+        "      - {device: VacuumGripper, name: gripper, pose: {translation: [0.0, 0.0, 0.5]}, on_joint: lift}")
+    p = tmp_path / "lift.yaml"
+    p.write_text(text)
+    sim = Simulation.from_file(p)
+    g, lift = sim.device("arm/gripper"), sim.robot("arm").motors["lift"]
+    g.set_on(True)                                           # type: ignore[attr-defined]
+    g.enable(STEP)
+    lift.set_position(0.1)
+    seen = set()
+    for _ in range(250):                                     # 0.1 m at 0.05 m/s: 2 s, 125 steps and the ramp
+        sim.step()
+        travel = float(lift.position)
+        assert g.value == (1.0 if 0.1 - travel <= GRIP_DISTANCE else 0.0), travel    # type: ignore[attr-defined]
+        seen.add(g.value)                                    # type: ignore[attr-defined]
+    assert seen == {0.0, 1.0} and float(lift.position) == pytest.approx(0.1)
