@@ -787,16 +787,17 @@ def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
 
 
 def test_a_device_not_simulated_is_said_in_the_load_report(tmp_path: Path) -> None:
-    """A Speaker is listed (a controller's getDevice finds it, its functions answer Webots' "no
+    """A Microphone is listed (a controller's getDevice finds it, its functions answer Webots' "no
     value") but not simulated: the load report says so, one line at the device's own place, so
-    `validate` no longer answers a plain OK for a world whose speaker plays nothing. A Radar and a
-    Display are simulated: nothing is said of them."""
+    `validate` no longer answers a plain OK for a world whose microphone hears nothing. A Radar, a
+    Display, a Speaker and a VacuumGripper are simulated: nothing is said of them."""
     p = write(tmp_path, 'Robot { name "r" children [\n'
-              'Radar { maxRange 1.5 }\nDisplay { name "screen" width 14 height 14 }\nGPS { }\nSpeaker { }\n] }\n')
+              'Radar { maxRange 1.5 }\nDisplay { name "screen" width 14 height 14 }\nGPS { }\nMicrophone { }\n'
+              'Speaker { }\nVacuumGripper { }\n] }\n')
     w = load_world(p)
     assert not w.report.losses
     assert w.warnings == [
-        f"{p}:6:1: Speaker 'speaker' of robot 'r': listed (a controller finds it), not simulated here: its functions "
+        f"{p}:6:1: Microphone 'microphone' of robot 'r': listed (a controller finds it), not simulated here: its functions "
         "answer Webots' \"no value\""]
 
 

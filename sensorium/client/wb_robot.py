@@ -404,6 +404,14 @@ class RobotClient:
                 self._received(dev, reading["packets"])
             if "targets" in reading:
                 dev.targets = [math.nan if x is None else float(x) for x in reading["targets"] or ()]
+            if "is_on" in reading:                # a VacuumGripper's pump (a simulation reset may change it)
+                dev.desc["is_on"] = bool(reading["is_on"])
+            if "sounds" in reading:               # a Speaker's: the sounds still playing (wb_speaker.py)
+                playing = set(reading["sounds"] or ())
+                for name, known in dev.desc.get("_sounds", {}).items():
+                    known[2] = known[2] and name in playing
+                if not reading.get("speaking", False):
+                    dev.desc["_speech"] = None
             if "range_image" in reading:
                 dev.range_bytes = bytes(reading["range_image"])
                 dev._range = None

@@ -1,7 +1,7 @@
 """Webots' functions of the devices Sensorium lists but does not simulate (Brake, Connector,
-Skin, Speaker, VacuumGripper): each checks its tag names a device of its type,
+Skin): each checks its tag names a device of its type,
 prints the device's one warning line and answers Webots' "no value" (NaN, ``None`` for NULL, 0,
-False). Camera, RangeFinder, Pen, Display and Radar have their own modules.
+False). Camera, RangeFinder, Pen, Display, Radar, Speaker and VacuumGripper have their own modules.
 
 The functions are made from :data:`NO_VALUE` (C name -> (device type, answer)); a device of the
 type that the server does simulate (none today) would get real functions instead."""
@@ -40,23 +40,6 @@ NO_VALUE: dict[str, tuple[str, Any]] = {
     "wb_skin_get_bone_name": ("Skin", ""),
     "wb_skin_get_bone_orientation": ("Skin", None),
     "wb_skin_get_bone_position": ("Skin", None),
-    # Speaker
-    "wb_speaker_stop": ("Speaker", None),
-    "wb_speaker_is_sound_playing": ("Speaker", False),
-    "wb_speaker_set_engine": ("Speaker", False),
-    "wb_speaker_set_language": ("Speaker", False),
-    "wb_speaker_get_engine": ("Speaker", ""),
-    "wb_speaker_get_language": ("Speaker", ""),
-    "wb_speaker_speak": ("Speaker", None),
-    "wb_speaker_is_speaking": ("Speaker", False),
-    # VacuumGripper
-    "wb_vacuum_gripper_enable_presence": ("VacuumGripper", None),
-    "wb_vacuum_gripper_disable_presence": ("VacuumGripper", None),
-    "wb_vacuum_gripper_get_presence_sampling_period": ("VacuumGripper", 0),
-    "wb_vacuum_gripper_get_presence": ("VacuumGripper", False),
-    "wb_vacuum_gripper_turn_on": ("VacuumGripper", None),
-    "wb_vacuum_gripper_turn_off": ("VacuumGripper", None),
-    "wb_vacuum_gripper_is_on": ("VacuumGripper", False),
 }
 
 
@@ -73,13 +56,4 @@ def no_value_function(name: str, kind: str, answer: Any) -> Callable[..., Any]:
 
 
 globals().update({name: no_value_function(name, kind, answer) for name, (kind, answer) in NO_VALUE.items()})
-
-
-@answers(None)
-def wb_speaker_play_sound(left: int, right: int, sound: str, volume: float, pitch: float, balance: float,
-                          loop: bool) -> None:
-    """No sound is played (a headless server)."""
-    current().device(left, "Speaker", "wb_speaker_play_sound")
-    if right and right != left:
-        current().device(right, "Speaker", "wb_speaker_play_sound")
 

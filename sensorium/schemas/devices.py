@@ -256,6 +256,18 @@ register(DeviceKind(
     services=("draw",),
     topics=(TopicDecl("image", msgs.IMAGE, "image"),),
     description="DisplayDescription"))
+# VacuumGripper and Speaker (server/sim/vacuum.py, server/sim/speaker.py): the pump and the sounds are
+# commands answered at once; the presence is a sensor; the speaker's playing sounds travel with step replies.
+register(DeviceKind(
+    "VacuumGripper", wm.VacuumGripper, "sensorium.server.sim.vacuum:VacuumGripper",
+    services=(*_SENSOR, "set_on"),
+    topics=(TopicDecl("presence", msgs.FLOAT64, "value"),),
+    description="VacuumGripperDescription"))
+register(DeviceKind(
+    "Speaker", wm.Speaker, "sensorium.server.sim.speaker:Speaker",
+    services=("play_sound", "stop", "speak"),
+    topics=(TopicDecl("playing", msgs.FLOAT64, "active"),),
+    description="SpeakerDescription"))
 # A RotationalMotor is a drive's wheel or steering motor (sim/motion.py owns it) or, any other, a
 # joint's motor moved kinematically (sim/joints.py); a LinearMotor is always a joint's.
 _MOTOR_SERVICES = ("set_position", "set_velocity", "get_velocity", "get_max_velocity", "get_target_position")

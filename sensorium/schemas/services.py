@@ -262,6 +262,26 @@ class InkColorArgs(Args):
     density: float = Field(description="0 transparent ... 1 opaque; clamped to [0, 1] (Webots)")
 
 
+class PlaySoundArgs(Args):
+    """``wb_speaker_play_sound`` on one speaker: the sound (its file name, the key of ``stop`` and of
+    the step reading), the WAV's frames and rate (the client reads the file: a sound plays
+    ``frames / (rate * pitch)`` s of simulated time), and Webots' volume, pitch, balance, loop and side."""
+
+    sound: str = Field(min_length=1, max_length=4096)
+    frames: int = Field(ge=0, lt=1 << 62, description="sample frames in the WAV file")
+    rate: int = Field(ge=1, lt=1 << 31, description="frames per second")
+    volume: float = Field(ge=0.0, le=1.0)
+    pitch: float = Field(ge=0.0, le=1e9, description="playback speed factor (0: OpenAL refuses it, 1 is kept)")
+    balance: float = Field(ge=-1.0, le=1.0)
+    loop: bool
+    side: int = Field(ge=-1, le=1, description="0: both channels, -1: left, 1: right (libController's side)")
+
+
+class SpeakArgs(Args):
+    text: str = Field(max_length=1 << 20)
+    volume: float = Field(ge=0.0, le=1.0)
+
+
 class StringArgs(Args):
     value: str = Field(max_length=1 << 20)
 
@@ -559,6 +579,21 @@ class ReceiverDescription(_Entry):
     direction_noise: float
 
 
+class VacuumGripperDescription(_Entry):
+    type: Literal["VacuumGripper"]
+    sampling_period: int
+    is_on: bool = Field(description="the pump now (wb_vacuum_gripper_is_on)")
+    tensile_strength: float = Field(description="N; -1 infinite")
+    shear_strength: float = Field(description="N; -1 infinite")
+    contact_points: int
+
+
+class SpeakerDescription(_Entry):
+    type: Literal["Speaker"]
+    sounds: list[str] = Field(description="the sounds playing now")
+    speaking: bool = Field(description="whether it is speaking now")
+
+
 class LEDDescription(_Entry):
     type: Literal["LED"]
     value: int = Field(description="the current value (0 off, colour index, or 0xRRGGBB when gradual)")
@@ -596,6 +631,7 @@ DeviceDescription = Annotated[
     | Annotated[RangeFinderDescription, Tag("RangeFinder")] | Annotated[CameraDescription, Tag("Camera")]
     | Annotated[EmitterDescription, Tag("Emitter")] | Annotated[ReceiverDescription, Tag("Receiver")]
     | Annotated[RadarDescription, Tag("Radar")]
+    | Annotated[VacuumGripperDescription, Tag("VacuumGripper")] | Annotated[SpeakerDescription, Tag("Speaker")]
     | Annotated[DisplayDescription, Tag("Display")] | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -659,6 +695,7 @@ class ModeResult(Result):
 
 class ScalarReading(Result):
     value: float = Field(description="NaN before the first measurement")
+    is_on: bool | None = Field(default=None, description="VacuumGripper: its pump when the presence was measured")
 
 
 class LidarReading(Result):
@@ -688,10 +725,17 @@ class ReceiverReading(Result):
     packets: list[PacketIn] = Field(description="the packets that became readable since the previous reply, oldest first")
 
 
+class SpeakerReading(Result):
+    """A Speaker's state, in the reply of every step that changed it (no enable needed)."""
+
+    sounds: list[str] = Field(description="the sounds still playing (a sound left out is over)")
+    speaking: bool = Field(description="whether its text is still being spoken")
+
+
 class StepResult(Result):
     status: int = Field(description="0; -1 when the server quits; the lateness dt (ms) for asynchronous robots")
     time_ms: int
-    values: dict[str, ScalarReading | LidarReading | VectorReading | ReceiverReading]
+    values: dict[str, ScalarReading | LidarReading | VectorReading | ReceiverReading | SpeakerReading]
 
 
 class SuccessResult(Result):
@@ -957,6 +1001,10 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("set_range", "device", RangeArgs, SuccessResult, attached=True),
     ServiceSpec("get_buffer_size", "device", NoArgs, IntValue),
     ServiceSpec("get_targets", "device", NoArgs, FloatArrayValue),
+    ServiceSpec("set_on", "device", BoolArgs, SuccessResult, attached=True),
+    ServiceSpec("play_sound", "device", PlaySoundArgs, SuccessResult, attached=True),
+    ServiceSpec("stop", "device", StringArgs, SuccessResult, attached=True),
+    ServiceSpec("speak", "device", SpeakArgs, SuccessResult, attached=True),
 )
 
 

@@ -919,7 +919,6 @@ class Radar(_Device):
 
 UNSIMULATED_DEVICE_TYPES = (
     "Brake", "Connector", "Microphone", "Radio", "Skin",
-    "Speaker", "VacuumGripper",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
 
@@ -935,6 +934,36 @@ class Display(_Device):
     height: int = Field(default=64, ge=1, le=1 << 16, description="pixels (wb_display_get_height)")
 
 
+class VacuumGripper(_Device):
+    """Webots VacuumGripper: a suction pump (``is_on``, wb_vacuum_gripper_turn_on/off) whose presence
+    sensor reads whether it holds a solid: on, and its own bounding shapes (the robot's shapes with
+    ``of_device`` naming it) touching another solid's or robot's bounding shapes (README "The
+    VacuumGripper"). Webots' VacuumGripper.wrl defaults; nothing is lifted (no physics), so the
+    strengths and ``contact_points`` are kept for the record and read by nothing."""
+
+    device: Literal["VacuumGripper"]
+    is_on: bool = Field(default=False, description="the pump is on at the start (Webots' isOn)")
+    tensile_strength: float = Field(default=-1.0, description="N; -1: infinite (Webots' tensileStrength)")
+    shear_strength: float = Field(default=-1.0, description="N; -1: infinite (Webots' shearStrength)")
+    contact_points: int = Field(default=3, ge=1, le=1 << 30, description="Webots' contactPoints")
+
+    @model_validator(mode="after")
+    def _strengths(self) -> VacuumGripper:
+        for key in ("tensile_strength", "shear_strength"):
+            v = getattr(self, key)
+            if not (v >= 0.0 or v == -1.0) or math.isinf(v):
+                raise ValueError(f"{key} {v} must be >= 0 or -1 (infinite)")
+        return self
+
+
+class Speaker(_Device):
+    """Webots Speaker: plays sound files and speaks text; headless, it produces no audio, but which
+    sounds are playing and whether it is speaking follow the simulated time (README "The
+    Speaker"). Webots' Speaker node has no fields of its own."""
+
+    device: Literal["Speaker"]
+
+
 
 
 class UnsimulatedDevice(_Device):
@@ -948,12 +977,13 @@ class UnsimulatedDevice(_Device):
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
                    | Accelerometer | Gyro | Altimeter | TouchSensor | Emitter | Receiver | RotationalMotor | LinearMotor
-                   | Pen | RangeFinder | Camera | Radar | Display | UnsimulatedDevice,
+                   | Pen | RangeFinder | Camera | Radar | Display | VacuumGripper | Speaker | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
                 "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "Emitter", "Receiver", "RotationalMotor",
-                "LinearMotor", "Pen", "RangeFinder", "Camera", "Display", "Radar", *UNSIMULATED_DEVICE_TYPES)
+                "LinearMotor", "Pen", "RangeFinder", "Camera", "Display", "Radar", "VacuumGripper", "Speaker",
+                *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 
 

@@ -158,8 +158,9 @@ int main(void) {
   wb_display_draw_text(display, "hi", 0, 0);
   printf("display %d %d\n", wb_display_get_width(display), wb_display_get_height(display));
   printf("skin %d %d\n", wb_skin_get_bone_count(skin), *wb_skin_get_bone_name(skin, 0) == 0);
-  wb_speaker_play_sound(speaker, speaker, "beep.wav", 1.0, 1.0, 0.0, false);
-  printf("speaker %d %d\n", (int)wb_speaker_is_speaking(speaker), *wb_speaker_get_engine(speaker) == 0);
+  wb_speaker_play_sound(speaker, speaker, "beep.wav", 1.0, 1.0, 0.0, false); /* simulated: no such file */
+  printf("speaker %d %d\n", (int)wb_speaker_is_speaking(speaker), strcmp(wb_speaker_get_engine(speaker), "pico") == 0);
+  wb_vacuum_gripper_enable_presence(gripper, 16); /* simulated: no value yet, the pump off */
   printf("gripper %d %d\n", (int)wb_vacuum_gripper_get_presence(gripper), (int)wb_vacuum_gripper_is_on(gripper));
   wb_motor_set_velocity(linear, 1.0);
   printf("linear %d", (int)wb_motor_get_type(linear));

@@ -99,8 +99,9 @@ print("connector", connector.getPresence(), b(connector.isLocked()))
 display.drawText("hi", 0, 0)
 print("display", display.getWidth(), display.getHeight())
 print("skin", skin.getBoneCount(), b(skin.getBoneName(0) == ""))
-Speaker.playSound(speaker, speaker, "beep.wav", 1.0, 1.0, 0.0, False)
-print("speaker", b(speaker.isSpeaking()), b(speaker.getEngine() == ""))
+Speaker.playSound(speaker, speaker, "beep.wav", 1.0, 1.0, 0.0, False)   # simulated: no such file, one line
+print("speaker", b(speaker.isSpeaking()), b(speaker.getEngine() == "pico"))
+gripper.enablePresence(16)          # simulated: no value yet (false), the pump off as the world has it
 print("gripper", b(gripper.getPresence()), b(gripper.isOn()))
 linear.setVelocity(1.0)
 print("linear", linear.getType(), h(linear.getVelocity()))

@@ -160,6 +160,20 @@ class DeviceServices:
         """A Radar's targets, flat: distance, received power, speed, azimuth of each in turn."""
         return {"value": [v for t in c.ctl.device.targets for v in t.as_list()]}
 
+    def _dev_set_on(self, c: Call) -> dict:         # a VacuumGripper's pump: on (true) or off
+        c.ctl.device.set_on(c.args.value)
+        return {"success": True}
+
+    def _dev_play_sound(self, c: Call) -> dict:     # a Speaker: the sound plays from now, in simulated time
+        a = c.args
+        return _configured(c, "play_sound", a.sound, a.frames, a.rate, a.pitch, a.loop, a.side)
+
+    def _dev_stop(self, c: Call) -> dict:           # a Speaker: one sound, or "" every sound and the speech
+        return _configured(c, "stop", c.args.value)
+
+    def _dev_speak(self, c: Call) -> dict:
+        return _configured(c, "speak", c.args.text)
+
     def _dev_get_channel(self, c: Call) -> dict:
         return {"value": int(c.ctl.device.channel)}
 

@@ -455,7 +455,8 @@ class Core(DeviceServices):
         for ctl in self._robot_controls(session.robot):
             # a camera's recognition has its own period (the controller enabled it with its own service)
             rec = getattr(ctl.device, "recognition_schedule", None)
-            if ctl.controller_period > 0 or (rec is not None and rec.period_ms > 0):
+            if (ctl.controller_period > 0 or (rec is not None and rec.period_ms > 0)
+                    or getattr(ctl.device, "reports_unasked", False)):     # a Speaker's state: no enable
                 m = ctl.device.measurements
                 if seen.get(ctl.path, 0) != m:
                     seen[ctl.path] = m

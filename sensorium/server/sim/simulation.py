@@ -49,6 +49,8 @@ from sensorium.server.sim.sensors import (
     RayRequest,
     device_class,
 )
+from sensorium.server.sim.speaker import Speaker
+from sensorium.server.sim.vacuum import VacuumGripper
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, from_model, load_world
@@ -179,6 +181,16 @@ class RobotState:
     def basic_time_step(self) -> int:
         return self._sim.basic_time_step
 
+    @property
+    def simulation(self) -> Simulation:
+        """The simulation the robot is in (a VacuumGripper reads the other solids and robots from it)."""
+        return self._sim
+
+    @property
+    def to_enu(self) -> np.ndarray | None:
+        """The world's axes to ENU (None in an ENU world), as kinematic contact takes them."""
+        return _TO_ENU[self._sim.world.world_info.coordinate_system]
+
     def move_links(self) -> bool:
         """The joints moved: their links' bodies and the devices on them follow (whether a device moved)."""
         if self.links is None:
@@ -261,6 +273,7 @@ class Simulation:
         if self.ground is not None:
             self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
+        self._speakers = [d for d in self.all_devices() if isinstance(d, Speaker)]
         self._counters: Counter[str] = Counter()
         self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[Device]] | None = None
         self._capturing: list[Any] = []     # devices that cast their own rays (cameras, range finders)
@@ -319,7 +332,7 @@ class Simulation:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, joints to their initial positions, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data and radar cross sections as in the world file, GPS and Radar speeds
+        ``write`` and ink, as Webots' WbPen::reset), custom data, radar cross sections and vacuum grippers' pumps as in the world file, speakers silent, GPS and Radar speeds
         NaN at their next value (no previous position, as Webots' WbGps::reset and WbRadar::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
@@ -343,6 +356,8 @@ class Simulation:
                 elif dev.kind == "Display":      # WbDisplay::reset: black again, its images gone
                     dev.reset()               # type: ignore[attr-defined]
                     dev._mark(self.time_ms)
+                elif isinstance(dev, (VacuumGripper, Speaker)):    # the pump as loaded; silence
+                    dev.reset()
         self.radio.reset()
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
@@ -510,6 +525,8 @@ class Simulation:
         if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
+        for speaker in self._speakers:     # sounds and speech played for this step (sim/speaker.py)
+            speaker.advance(dt, now)
         moved: list[tuple[RobotState, DifferentialDrive | AckermannDrive, tuple[float, float], Pose]] = []
         if self._jointed:             # joints move kinematically (sim/joints.py), and what rides on them
             dt_s = dt * 0.001

@@ -9,6 +9,7 @@
  * kinematic.c - InertialUnit, Compass, Accelerometer, Gyro, Altimeter, TouchSensor;
  * radio.c   - Emitter and Receiver (packet queues, baud-rate pacing);
  * radar.c   - Radar (the targets of the latest measurement);
+ * vacuum_gripper.c - VacuumGripper (the pump, the presence); speaker.c - Speaker (sounds, speech);
  * camera.c  - range finders and cameras;
  * display.c - the Display (drawing buffered, sent with the next step request);
  * unsimulated.c - the devices Sensorium lists without simulating ("no value").
@@ -114,10 +115,12 @@ const char *sn_conn_endpoint(const sn_conn *c);
 /* ------------------------------------------------------------------ robot.c */
 typedef enum {
   SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_IMU, SN_COMPASS, SN_ACCELEROMETER,
-  SN_GYRO, SN_ALTIMETER, SN_TOUCH, SN_EMITTER, SN_RECEIVER, SN_RANGE_FINDER, SN_CAMERA, SN_RADAR, SN_OTHER
+  SN_GYRO, SN_ALTIMETER, SN_TOUCH, SN_EMITTER, SN_RECEIVER, SN_RANGE_FINDER, SN_CAMERA, SN_RADAR, SN_VACUUM, SN_SPEAKER,
+  SN_OTHER
 } sn_kind;
 
 struct sn_imaging; /* camera.c: a range finder's or camera's images and constants */
+struct sn_sound;   /* speaker.c: a sound this controller played on a speaker */
 
 /* A packet in an emitter's queue (channel and range when sent) or a receiver's (signal strength,
  * emitter direction); data follows the struct. */
@@ -197,6 +200,13 @@ typedef struct {
   msgpack_packer draw_pk;
   int draw_n, draw_items, image_ids;
   bool camera_attached;
+  /* VacuumGripper (vacuum_gripper.c): the pump as this controller last set it (the world's isOn at
+     start); its presence is value above (1 or 0). Speaker (speaker.c): the sounds played here, the text
+     being spoken (NULL: none), libController's engine and language */
+  bool pump_on;
+  struct sn_sound *sounds;
+  char *speech;
+  char engine[10], language[6];
 } sn_device;
 
 /* A car-like robot's drive from the attach reply ("ackermann_drive"): what the vehicle library
@@ -283,6 +293,9 @@ void sn_warn_disabled(sn_device *dev, const char *func, const char *enabler, con
 void sn_radio_receive(sn_device *dev, const msgpack_object *packets);
 /* radar.c: a step reply's targets (distance, power, speed, azimuth of each in turn) into the radar */
 void sn_radar_apply(sn_device *dev, const msgpack_object *targets);
+/* speaker.c: a step reply's speaker state (the sounds still playing, whether it speaks); its cleanup */
+void sn_speaker_apply(sn_device *dev, const msgpack_object *reading);
+void sn_speaker_free(sn_device *dev);
 int sn_radio_pace(sn_device *dev, int duration);
 void sn_radio_pack(sn_device *dev, sn_req *r);
 void sn_radio_free(sn_device *dev);

@@ -81,6 +81,10 @@ static sn_kind kind_of(const char *type) {
     return SN_RECEIVER;
   if (strcmp(type, "Radar") == 0)
     return SN_RADAR;
+  if (strcmp(type, "VacuumGripper") == 0)
+    return SN_VACUUM;
+  if (strcmp(type, "Speaker") == 0)
+    return SN_SPEAKER;
   return SN_OTHER;
 }
 
@@ -187,6 +191,10 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
     d->fov = sn_double_or(desc, "horizontal_fov", NAN);
     d->vertical_fov = sn_double_or(desc, "vertical_fov", NAN);
   }
+  if (d->kind == SN_VACUUM)
+    d->pump_on = sn_bool_or(desc, "is_on", false);
+  snprintf(d->engine, sizeof d->engine, "pico"); /* libController's speaker_create */
+  snprintf(d->language, sizeof d->language, "en-US");
   if (sn_imaging_describe(d, desc) != 0)
     return -1;
   d->motor_name = sn_strdup_obj(sn_get(desc, "motor"));
@@ -237,6 +245,7 @@ static void free_robot(sn_robot *rb) {
     sn_imaging_free(d);
     sn_radio_free(d);
     sn_display_free(d);
+    sn_speaker_free(d);
   }
   sn_supervisor_free(rb);
   free(rb->devices);
@@ -473,6 +482,10 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
       sn_radio_receive(dev, sn_get(v, "packets"));
     if (dev->kind == SN_RADAR)
       sn_radar_apply(dev, sn_get(v, "targets"));
+    if (dev->kind == SN_SPEAKER)
+      sn_speaker_apply(dev, v);
+    if (dev->kind == SN_VACUUM) /* its pump, as measured (a simulation reset may change it) */
+      dev->pump_on = sn_bool_or(v, "is_on", dev->pump_on);
     if (dev->kind != SN_LIDAR)
       continue;
     size_t n = (size_t)dev->width * (size_t)dev->layers;
@@ -736,6 +749,8 @@ static bool kind_accepts(sn_kind kind, int node) {
     case SN_EMITTER: return node == WB_NODE_EMITTER;
     case SN_RECEIVER: return node == WB_NODE_RECEIVER;
     case SN_RADAR: return node == WB_NODE_RADAR;
+    case SN_VACUUM: return node == WB_NODE_VACUUM_GRIPPER;
+    case SN_SPEAKER: return node == WB_NODE_SPEAKER;
     default: return false;
   }
 }

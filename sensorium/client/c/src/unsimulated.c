@@ -12,8 +12,6 @@
 #include <webots/microphone.h>
 #include <webots/radio.h>
 #include <webots/skin.h>
-#include <webots/speaker.h>
-#include <webots/vacuum_gripper.h>
 #include <webots/nodes.h>
 
 #include "internal.h"
@@ -100,81 +98,6 @@ const double *wb_skin_get_bone_orientation(WbDeviceTag tag, int index, bool abso
 const double *wb_skin_get_bone_position(WbDeviceTag tag, int index, bool absolute) {
   sn_unsimulated(tag, WB_NODE_SKIN, "wb_skin_get_bone_position");
   return sn_no_values();
-}
-
-/* ------------------------------------------------------------------ Speaker */
-void wb_speaker_play_sound(WbDeviceTag left, WbDeviceTag right, const char *sound, double volume, double pitch, double balance, bool loop) {
-  sn_unsimulated(left, WB_NODE_SPEAKER, "wb_speaker_play_sound");
-}
-
-void wb_speaker_stop(WbDeviceTag tag, const char *sound) {
-  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_stop");
-}
-
-bool wb_speaker_is_sound_playing(WbDeviceTag tag, const char *sound) {
-  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_is_sound_playing");
-  return false;
-}
-
-bool wb_speaker_set_engine(WbDeviceTag tag, const char *engine) {
-  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_set_engine");
-  return false;
-}
-
-bool wb_speaker_set_language(WbDeviceTag tag, const char *language) {
-  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_set_language");
-  return false;
-}
-
-const char *wb_speaker_get_engine(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_get_engine");
-  return "";
-}
-
-const char *wb_speaker_get_language(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_get_language");
-  return "";
-}
-
-void wb_speaker_speak(WbDeviceTag tag, const char *text, double volume) {
-  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_speak");
-}
-
-bool wb_speaker_is_speaking(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_SPEAKER, "wb_speaker_is_speaking");
-  return false;
-}
-
-/* ------------------------------------------------------------------ VacuumGripper */
-void wb_vacuum_gripper_enable_presence(WbDeviceTag tag, int sampling_period) {
-  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_enable_presence");
-}
-
-void wb_vacuum_gripper_disable_presence(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_disable_presence");
-}
-
-int wb_vacuum_gripper_get_presence_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_get_presence_sampling_period");
-  return 0;
-}
-
-bool wb_vacuum_gripper_get_presence(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_get_presence");
-  return false;
-}
-
-void wb_vacuum_gripper_turn_on(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_turn_on");
-}
-
-void wb_vacuum_gripper_turn_off(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_turn_off");
-}
-
-bool wb_vacuum_gripper_is_on(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_VACUUM_GRIPPER, "wb_vacuum_gripper_is_on");
-  return false;
 }
 
 /* ------------------------------------------------------------------ Microphone */

@@ -458,6 +458,8 @@ class Converter:
                         data.update(fx.pen(f))
                     elif t == "Display":       # its size (below 1: 1, as Webots sets it)
                         data.update(fx.display(f))
+                    elif t == "VacuumGripper":     # its strengths and contact points, Webots' resets
+                        data.update(fx.vacuum_gripper(f))
                     if t in wm.UNSIMULATED_DEVICE_TYPES:
                         self.warn(node, f"{t} {data['name']!r} of robot {owner.data['name']!r}: listed (a controller "
                                         "finds it), not simulated here: its functions answer Webots' \"no value\"")

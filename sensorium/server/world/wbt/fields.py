@@ -342,6 +342,17 @@ def display(f: Fields) -> dict:
     return {"width": _positive_int(f, "width", 64, 1), "height": _positive_int(f, "height", 64, 1)}
 
 
+def vacuum_gripper(f: Fields) -> dict:
+    """A VacuumGripper's strengths and contact points as WbVacuumGripper resets them: a strength below 0
+    other than -1 (infinite) is -1, contactPoints below 1 is 3, each with its warning."""
+    out: dict[str, Any] = {}
+    for field, key in (("tensileStrength", "tensile_strength"), ("shearStrength", "shear_strength")):
+        v = f.num(field, -1.0)
+        out[key] = float(f.used(field, v, -1.0, "must be positive or -1 (infinite)") if v < 0.0 and v != -1.0 else v)
+    out["contact_points"] = _positive_int(f, "contactPoints", 3, 3)
+    return out
+
+
 DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light sensor", "Lidar": "lidar",
                 "RangeFinder": "range-finder", "Camera": "camera",
                 "PositionSensor": "position sensor", "LED": "led", "RotationalMotor": "rotational motor"}
