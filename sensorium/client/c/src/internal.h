@@ -9,6 +9,7 @@
  * kinematic.c - InertialUnit, Compass, Accelerometer, Gyro, Altimeter, TouchSensor;
  * radio.c   - Emitter and Receiver (packet queues, baud-rate pacing);
  * radar.c   - Radar (the targets of the latest measurement);
+ * connector.c - Connector (presence, lock state) and Brake (its joint's type and neighbours);
  * camera.c  - range finders and cameras;
  * display.c - the Display (drawing buffered, sent with the next step request);
  * unsimulated.c - the devices Sensorium lists without simulating ("no value").
@@ -112,7 +113,8 @@ const char *sn_conn_endpoint(const sn_conn *c);
 /* ------------------------------------------------------------------ robot.c */
 typedef enum {
   SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_IMU, SN_COMPASS, SN_ACCELEROMETER,
-  SN_GYRO, SN_ALTIMETER, SN_TOUCH, SN_EMITTER, SN_RECEIVER, SN_RANGE_FINDER, SN_CAMERA, SN_RADAR, SN_OTHER
+  SN_GYRO, SN_ALTIMETER, SN_TOUCH, SN_EMITTER, SN_RECEIVER, SN_RANGE_FINDER, SN_CAMERA, SN_RADAR, SN_CONNECTOR,
+  SN_BRAKE, SN_OTHER
 } sn_kind;
 
 struct sn_imaging; /* camera.c: a range finder's or camera's images and constants */
@@ -185,6 +187,12 @@ typedef struct {
      its range and fields of view are min_range, max_range, fov and vertical_fov above */
   WbRadarTarget *radar_targets;
   int radar_count;
+  /* Connector (connector.c): passive or not, the lock state the server answered; Brake: its joint's
+     type (WB_ROTATIONAL/WB_LINEAR), the motor (motor_name above) and position sensor on its joint */
+  bool connector_passive, is_locked;
+  int joint_type;
+  char *position_sensor_name;
+  bool warned_damping;
   /* Display (display.c): the world's size; the drawing commands packed since the last step (an
      array's items, draw_n of them), the image ids given out, whether a camera is attached */
   int display_width, display_height;
@@ -278,6 +286,8 @@ void sn_warn_disabled(sn_device *dev, const char *func, const char *enabler, con
 void sn_radio_receive(sn_device *dev, const msgpack_object *packets);
 /* radar.c: a step reply's targets (distance, power, speed, azimuth of each in turn) into the radar */
 void sn_radar_apply(sn_device *dev, const msgpack_object *targets);
+/* connector.c: the tag of the Brake on the joint of the motor (of_motor) or position sensor named name, 0 if none */
+WbDeviceTag sn_brake_of(const char *name, bool of_motor, const char *func);
 int sn_radio_pace(sn_device *dev, int duration);
 void sn_radio_pack(sn_device *dev, sn_req *r);
 void sn_radio_free(sn_device *dev);

@@ -81,6 +81,10 @@ static sn_kind kind_of(const char *type) {
     return SN_RECEIVER;
   if (strcmp(type, "Radar") == 0)
     return SN_RADAR;
+  if (strcmp(type, "Connector") == 0)
+    return SN_CONNECTOR;
+  if (strcmp(type, "Brake") == 0)
+    return SN_BRAKE;
   return SN_OTHER;
 }
 
@@ -187,6 +191,17 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
     d->fov = sn_double_or(desc, "horizontal_fov", NAN);
     d->vertical_fov = sn_double_or(desc, "vertical_fov", NAN);
   }
+  if (d->kind == SN_CONNECTOR) { /* presence -1 until the first value; the lock state as loaded */
+    d->value = -1.0;
+    const msgpack_object *t = sn_get(desc, "connector_type");
+    d->connector_passive = t != NULL && t->type == MSGPACK_OBJECT_STR && t->via.str.size == 7 &&
+                           memcmp(t->via.str.ptr, "passive", 7) == 0;
+    d->is_locked = sn_bool_or(desc, "is_locked", false);
+  }
+  if (d->kind == SN_BRAKE) {
+    d->joint_type = (int)sn_int_or(desc, "joint_type", 0);
+    d->position_sensor_name = sn_strdup_obj(sn_get(desc, "position_sensor"));
+  }
   if (sn_imaging_describe(d, desc) != 0)
     return -1;
   d->motor_name = sn_strdup_obj(sn_get(desc, "motor"));
@@ -218,6 +233,7 @@ static void free_robot(sn_robot *rb) {
     free(d->range_image);
     free(d->point_cloud);
     free(d->motor_name);
+    free(d->position_sensor_name);
     free(d->radar_targets);
     sn_imaging_free(d);
     sn_radio_free(d);
@@ -719,6 +735,8 @@ static bool kind_accepts(sn_kind kind, int node) {
     case SN_EMITTER: return node == WB_NODE_EMITTER;
     case SN_RECEIVER: return node == WB_NODE_RECEIVER;
     case SN_RADAR: return node == WB_NODE_RADAR;
+    case SN_CONNECTOR: return node == WB_NODE_CONNECTOR;
+    case SN_BRAKE: return node == WB_NODE_BRAKE;
     default: return false;
   }
 }

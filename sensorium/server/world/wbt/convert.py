@@ -456,6 +456,8 @@ class Converter:
                         data.update(fx.pen(f))
                     elif t == "Display":       # its size (below 1: 1, as Webots sets it)
                         data.update(fx.display(f))
+                    elif t == "Connector":     # its tolerances with WbConnector's resets
+                        data.update(fx.connector(f))
                     if t in wm.UNSIMULATED_DEVICE_TYPES:
                         self.warn(node, f"{t} {data['name']!r} of robot {owner.data['name']!r}: listed (a controller "
                                         "finds it), not simulated here: its functions answer Webots' \"no value\"")
@@ -1161,7 +1163,7 @@ class Converter:
         them before the end point's): (motor entries, position sensor entries). A motor's entry
         carries its fields and the joint's position (a drive keeps only its wheels' names, see
         :meth:`drive`); the joint's sensors measure its motor."""
-        motors, sensors = [], []
+        motors, sensors, brakes = [], [], []
         params = self.fields(node).node_("jointParameters2" if field_name == "device2" else "jointParameters") \
             if node.type.endswith("Joint") else None
         position = self.fields(params).num("position", 0.0) if params is not None else 0.0
@@ -1188,6 +1190,7 @@ class Converter:
                 sensors.append(entry)
             elif d.type == "Brake":
                 entry = self.unsimulated(d, Frame.identity(), owner)
+                brakes.append(entry)
             else:
                 self.warn(d, f"{d.type} in a joint's device list: ignored")
             if entry is not None and self.tree is not None and owner.kind == "robot":   # a node of the joint's
@@ -1197,6 +1200,14 @@ class Converter:
                 entry["motor"] = motors[0]["name"]
             elif position:
                 entry["position"] = position
+        for entry in brakes:        # a brake names its joint's motor and sensor; a slider's is linear
+            linear = node.type == "SliderJoint" or (motors and motors[0]["device"] == "LinearMotor")
+            if linear:
+                entry["joint_type"] = "linear"
+            if motors:
+                entry["motor"] = motors[0]["name"]
+            if sensors:
+                entry["position_sensor"] = sensors[0]["name"]
         return motors, sensors
 
     def motor_fields(self, d: Node, position: float) -> dict[str, float]:
