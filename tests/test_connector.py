@@ -272,3 +272,52 @@ def test_a_wbt_connector_and_brake_load_simulated_with_webots_resets(tmp_path: P
     br, sb = devs["br"], devs["slider brake"]
     assert isinstance(br, wm.Brake) and (br.joint_type, br.motor, br.position_sensor) == ("rotational", "m", "ps")
     assert isinstance(sb, wm.Brake) and (sb.joint_type, sb.motor, sb.position_sensor) == ("linear", None, None)
+
+
+def crate_world(eye: dict | None = None) -> wm.World:
+    """Robot a's active connector at (0.1, 0, 0) facing +x; a crate at (1, 0, 0) whose child (at -0.4
+    in its frame) carries a passive connector 0.5 m further back, turned to face -x: at (0.1, 0, 0)."""
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": STEP},
+        "robots": [{"name": "a", "devices": [{"device": "Connector", "name": "dock", "type": "active",
+                                              "pose": {"translation": [ARM, 0, 0]}}]}],
+        "solids": [{"name": "crate", "pose": {"translation": [1.0, 0.0, 0.0]}, "children": [
+            {"name": "handle", "pose": {"translation": [-0.4, 0.0, 0.0]}, "connectors": [
+                {"device": "Connector", "name": "eye", "type": "passive",
+                 "pose": {"translation": [-0.5, 0.0, 0.0], "rotation": [0, 0, 1, math.pi]}, **(eye or {})}]}]}]})
+
+
+def test_a_robot_connector_sees_a_connector_on_a_solid_as_the_solid_moves_and_goes() -> None:
+    sim = Simulation(crate_world())
+    dock = sim.device("a/dock")
+    dock.enable(STEP)
+    sim.step()
+    assert dock.value == 1
+    sim.set_solid_pose("crate", [1.0, 0.02, 0.0])          # 2 cm aside: beyond the 1 cm tolerance
+    sim.step()
+    assert dock.value == 0
+    sim.set_solid_pose("crate", [1.0, 0.009, 0.0])
+    sim.step()
+    assert dock.value == 1
+    sim.remove_solid("crate")
+    sim.step()
+    assert dock.value == 0
+    assert presence(crate_world({"type": "active"})) == 0                  # active-active: incompatible
+
+
+def test_a_wbt_connector_outside_a_robot_is_a_solid_s_connector(tmp_path: Path) -> None:
+    path = tmp_path / "crate.wbt"
+    path.write_text(WBT.replace('distanceTolerance -1 axisTolerance 4\n                numberOfRotations 2 ', "")
+                    + 'Solid { translation 1 0 0 name "crate" children [\n'
+                      '  Connector { translation -0.9 0 0 rotation 0 0 1 3.141592653589793 name "eye" type "passive"'
+                      ' model "M" } ] }\n')
+    loaded = load_world(path)
+    assert not [w for w in loaded.warnings if "Connector" in w], loaded.warnings
+    [eye] = loaded.world.solids[0].children[0].connectors
+    assert (eye.name, eye.type, eye.model) == ("eye", "passive", "M")
+    sim = Simulation(loaded)
+    dock = sim.device("a/dock")
+    dock.enable(STEP)
+    with pytest.warns(ConnectorWarning, match="'a/dock': locked with a peer present"):   # locked, auto-lock
+        sim.step()
+    assert dock.value == 1

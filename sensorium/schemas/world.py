@@ -445,12 +445,18 @@ class Solid(Strict):
     radar_cross_section: float = Field(
         default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the solid a Radar target; "
         "top-level solids only")
+    connectors: list[Connector] = Field(
+        default=[], max_length=1024, description="Webots Connectors on this solid (a passive object a robot's "
+        "connector docks with), each pose in the solid's frame: robots' connectors see them; they read nothing")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
     def _recognised_at_the_top(self) -> Solid:
         _check_cone_seen(self.geometry, self.seen_by)
+        for i, con in enumerate(self.connectors):
+            if con.on_joint is not None:
+                raise ValueError(f"connectors[{i}] ({con.name}): a solid has no joints (leave out on_joint)")
         for i, child in enumerate(self.children):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "

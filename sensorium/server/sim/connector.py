@@ -1,7 +1,8 @@
 """The simulation's Connector and Brake (Webots' nodes; the presence rule is ``server/devices/connector.py``).
 
 A Connector's presence is measured at its sampling period from the world poses of every other
-connector of the world's robots (``peers``, handed over by the simulation once the robots are made).
+connector of the world: the robots' and those of the solids (``Solid.connectors``, a passive object
+to dock with: :class:`SolidConnector`, which reads nothing), handed over by the simulation as ``peers``.
 Its lock state (``is_locked``) is the server's: ``lock``/``unlock`` set it (a passive connector
 cannot lock, as in Webots), a simulation reset restores the world file's. Nothing is ever joined:
 without physics Webots itself makes no link ("none of their parent nodes have Physics nodes"), so
@@ -21,8 +22,10 @@ import numpy as np
 
 from sensorium.server.devices import connector as cmath
 from sensorium.server.sim.sensors import Device
+from sensorium.server.world.geometry import Pose
+from sensorium.server.world.poses import pose_from_model
 
-__all__ = ["Brake", "Connector", "ConnectorWarning"]
+__all__ = ["Brake", "Connector", "ConnectorWarning", "SolidConnector", "solid_connectors"]
 
 
 class ConnectorWarning(UserWarning):
@@ -40,7 +43,7 @@ class Connector(Device):
         c = self.config
         self.value = -1
         self.is_locked = bool(c.is_locked)
-        self.peers: list[Connector] = []          # every connector of the world (itself included)
+        self.peers: list[Connector | SolidConnector] = []     # every connector of the world (itself included)
         self._robot: Any = None
         self._me = (c.type, c.model, float(c.distance_tolerance), float(c.axis_tolerance),
                     int(c.number_of_rotations), float(c.rotation_tolerance))
@@ -49,7 +52,7 @@ class Connector(Device):
     def bind(self, robot: Any) -> None:
         self._robot = robot
 
-    def placed(self) -> tuple[np.ndarray, np.ndarray]:
+    def placed(self) -> tuple[np.ndarray, np.ndarray] | None:
         """Its world rotation and origin now."""
         pose = self.world_pose(self._robot.pose)
         return np.asarray(pose.rotation, dtype=np.float64), np.asarray(pose.translation, dtype=np.float64)
@@ -58,13 +61,15 @@ class Connector(Device):
         """Webots' presence at the current poses (-1 passive, 1 a peer present, 0 none)."""
         if self.config.type == "passive":
             return -1
-        rotation, origin = self.placed()
+        me = self.placed()
+        assert me is not None
         others = []
         for p in self.peers:
             if p is not self:
-                r, o = p.placed()
-                others.append((p.config.type, p.config.model, r, o))
-        return cmath.presence(self._me, rotation, origin, others)
+                at = p.placed()
+                if at is not None:
+                    others.append((p.config.type, p.config.model, at[0], at[1]))
+        return cmath.presence(self._me, me[0], me[1], others)
 
     def measure(self, now_ms: int) -> None:
         self.value = self.presence_now()
@@ -106,6 +111,40 @@ class Connector(Device):
         return {"connector_type": c.type, "is_locked": self.is_locked, "auto_lock": bool(c.auto_lock),
                 "distance_tolerance": float(c.distance_tolerance), "axis_tolerance": float(c.axis_tolerance),
                 "rotation_tolerance": float(c.rotation_tolerance), "number_of_rotations": int(c.number_of_rotations)}
+
+
+class SolidConnector:
+    """A Connector on a solid (``Solid.connectors``): a peer the robots' connectors see, at its solid's
+    pose now (a Supervisor may move the solid; a removed solid's connectors are gone). It reads nothing."""
+
+    def __init__(self, config: Any, scene: Any, solid: str, local: Pose):
+        self.config = config
+        self._scene = scene
+        self._solid = solid          # the top-level solid it rides on
+        self._local = local          # its pose in that solid's frame (nested solids composed)
+
+    def placed(self) -> tuple[np.ndarray, np.ndarray] | None:
+        at = self._scene.solid_poses.get(self._solid)
+        if at is None:
+            return None
+        pose = at.compose(self._local)
+        return np.asarray(pose.rotation, dtype=np.float64), np.asarray(pose.translation, dtype=np.float64)
+
+
+def solid_connectors(solids: list[Any], scene: Any) -> list[SolidConnector]:
+    """The connectors of the world's solids and of their children, each with its pose in its
+    top-level solid's frame."""
+    out: list[SolidConnector] = []
+
+    def walk(top: str, solid: Any, frame: Pose) -> None:
+        for con in solid.connectors:
+            out.append(SolidConnector(con, scene, top, frame.compose(pose_from_model(con.pose))))
+        for child in solid.children:
+            walk(top, child, frame.compose(pose_from_model(child.pose)))
+
+    for s in solids:
+        walk(s.name, s, Pose.identity())
+    return out
 
 
 class Brake(Device):

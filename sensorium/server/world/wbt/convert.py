@@ -469,6 +469,14 @@ class Converter:
                         self.warn(node, f"Track {f.string('name', 'solid')!r}: its motor's position moves "
                                         "kinematically (its sensor reads it); the belt and its wheels do not move here")
                 self.device_contents(node, inner, owner, data)
+            elif t == "Connector":       # a solid that robots' connectors dock with (Webots allows it)
+                out = self.solid(node, frame, owner, "connector")
+                if out is not None:
+                    entry = {"name": out["name"], "device": "Connector", **self.device_fields(node),
+                             **fx.connector(f)}
+                    if f.string("model", ""):
+                        entry["model"] = f.string("model", "")
+                    out.setdefault("connectors", []).append(entry)
             else:     # a device outside a robot is still a Solid whose shapes rays see
                 self.warn(node, f"{t} outside a Robot: not a device here (devices belong to robots); its shapes "
                                 "are kept as a solid")
@@ -893,8 +901,9 @@ class Converter:
         return inside(children[0]) if children else []
 
     # ------------------------------------------------------------ solids and robots
-    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> None:
-        """A Solid (``default``: its name when it has none: a device's default name)."""
+    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> dict | None:
+        """A Solid (``default``: its name when it has none: a device's default name); its entry (None
+        when it is part of a robot's body)."""
         f = self.fields(node)
         inner = self.child_frame(node, frame)
         if owner.kind == "robot":   # part of the robot's body
@@ -902,7 +911,7 @@ class Converter:
             if rcs > 0.0:           # a radar target it carries (Webots' radar sample): read as the robot's
                 owner.data.setdefault("_carried_rcs", []).append((f.string("name", default), rcs, node))
             self.solid_contents(node, inner, owner)
-            return
+            return None
         name = f.string("name", default)
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
@@ -934,6 +943,7 @@ class Converter:
             self.world["solids"].append(out)
         else:
             owner.data.setdefault("children", []).append(out)
+        return out
 
     def radar_cross_section(self, node: Node, data: dict) -> None:
         """A top-level solid's or robot's radarCrossSection: > 0 makes it a Radar target (0 or less:
