@@ -25,7 +25,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
-from sensorium.server.sim.connector import Connector, solid_connectors
+from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.ground import Ground, GroundWarning, band_low
 from sensorium.server.sim.joints import JointMotor, Links
@@ -249,7 +249,7 @@ class Simulation:
             self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
         connectors = [d for d in self.all_devices() if isinstance(d, Connector)]
-        peers = [*connectors, *solid_connectors(self.world.solids, self.scene)]
+        peers: list[Connector | SolidConnector] = [*connectors, *solid_connectors(self.world.solids, self.scene)]
         for con in connectors:        # a connector's presence looks at every other one of the world
             con.peers = peers
         self._auto_locking = [c for c in connectors if c.config.auto_lock and c.config.type != "passive"]
