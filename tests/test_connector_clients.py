@@ -8,10 +8,12 @@ from both clients."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
-from _serve import run_controller, sensorium
+from _serve import run_controller, sensorium, serve
 from test_c_client import sanitized_controller
 
 REPO = Path(__file__).resolve().parents[1]
@@ -44,3 +46,15 @@ def test_a_c_controller_reads_the_same(c_controller: str) -> None:
     assert "Sanitizer" not in err and "runtime error" not in err, err
     assert lines == EXPECTED
     check_stderr(err)
+
+
+def test_sensorium_services_lists_connectors_and_brakes_as_simulated() -> None:
+    with serve(WORLD, "--mode", "pause") as server:
+        done = subprocess.run([sys.executable, "-m", "sensorium", "services", "--url", server.rpc, "--robot", "bot"],
+                              capture_output=True, text=True, timeout=60, cwd=str(REPO))
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
+    for line in ("bot/dock (Connector):", "/bot/dock/lock", "/bot/dock/is_locked", "bot/arm brake (Brake):",
+                 "/bot/arm brake/get_type"):
+        assert line in out, out
+    assert "not simulated" not in out, out
