@@ -321,3 +321,11 @@ def test_a_wbt_connector_outside_a_robot_is_a_solid_s_connector(tmp_path: Path) 
     with pytest.warns(ConnectorWarning, match="'a/dock': locked with a peer present"):   # locked, auto-lock
         sim.step()
     assert dock.value == 1
+
+
+def test_the_batched_simulation_refuses_a_connector_in_one_line() -> None:
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+
+    sim = BatchedSimulation(crate_world(), copies=2)
+    with pytest.raises(BatchedError, match="'dock' is a Connector; the batched simulation measures"):
+        sim.device("a", "dock")
