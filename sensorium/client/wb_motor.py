@@ -7,6 +7,7 @@ import math
 import sys
 
 from sensorium.client.connection import ErrorCode, SensoriumError
+from sensorium.client.wb_connector import brake_of
 from sensorium.client.wb_robot import (
     LED,
     LINEAR_MOTOR,
@@ -90,8 +91,8 @@ def wb_motor_get_position_sensor(tag: int) -> int:
 
 @answers(0)
 def wb_motor_get_brake(tag: int) -> int:
-    _motor(tag, "wb_motor_get_brake")
-    return 0
+    """The tag of the Brake on the motor's joint, 0 if it has none."""
+    return brake_of("motor", _motor(tag, "wb_motor_get_brake").name)
 
 
 # -- what needs physics. A drive's wheel turns at its commanded speed at once: its setters are

@@ -7,6 +7,7 @@ from typing import Any
 
 from sensorium.client import arrays
 from sensorium.client.connection import ErrorCode, SensoriumError
+from sensorium.client.wb_connector import brake_of
 from sensorium.client.wb_robot import (
     DISTANCE_SENSOR,
     LIDAR,
@@ -309,6 +310,5 @@ def wb_position_sensor_get_motor(tag: int) -> int:
 
 
 def wb_position_sensor_get_brake(tag: int) -> int:
-    """0: the wheels have no Brake device."""
-    _position_sensor(tag, "wb_position_sensor_get_brake")
-    return 0
+    """The tag of the Brake on the sensor's joint, 0 if it has none."""
+    return brake_of("position_sensor", _position_sensor(tag, "wb_position_sensor_get_brake").name)

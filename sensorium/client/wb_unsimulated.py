@@ -1,7 +1,8 @@
-"""Webots' functions of the devices Sensorium lists but does not simulate (Brake, Connector,
-Skin): each checks its tag names a device of its type,
+"""Webots' functions of the devices Sensorium lists but does not simulate (Skin;
+Microphone and Radio: wb_radio.py): each checks its tag names a device of its type,
 prints the device's one warning line and answers Webots' "no value" (NaN, ``None`` for NULL, 0,
-False). Camera, RangeFinder, Pen, Display, Radar, Speaker and VacuumGripper have their own modules.
+False). Camera, RangeFinder, Pen, Display, Radar, Speaker, VacuumGripper, Connector and Brake have their own
+modules.
 
 The functions are made from :data:`NO_VALUE` (C name -> (device type, answer)); a device of the
 type that the server does simulate (none today) would get real functions instead."""
@@ -14,25 +15,9 @@ from typing import Any
 
 from sensorium.client.wb_robot import answers, current
 
-WB_BRAKE_ROTATIONAL = 0
-WB_BRAKE_LINEAR = 1
-
 _NAN = math.nan
 
 NO_VALUE: dict[str, tuple[str, Any]] = {
-    # Brake
-    "wb_brake_set_damping_constant": ("Brake", None),
-    "wb_brake_get_type": ("Brake", 0),
-    "wb_brake_get_motor": ("Brake", 0),
-    "wb_brake_get_position_sensor": ("Brake", 0),
-    # Connector
-    "wb_connector_enable_presence": ("Connector", None),
-    "wb_connector_disable_presence": ("Connector", None),
-    "wb_connector_get_presence_sampling_period": ("Connector", 0),
-    "wb_connector_get_presence": ("Connector", -1),
-    "wb_connector_lock": ("Connector", None),
-    "wb_connector_unlock": ("Connector", None),
-    "wb_connector_is_locked": ("Connector", False),
     # Skin
     "wb_skin_set_bone_orientation": ("Skin", None),
     "wb_skin_set_bone_position": ("Skin", None),

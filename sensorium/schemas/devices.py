@@ -268,6 +268,17 @@ register(DeviceKind(
     services=("play_sound", "stop", "speak"),
     topics=(TopicDecl("playing", msgs.FLOAT64, "active"),),
     description="SpeakerDescription"))
+# Connector (server/sim/connector.py): presence at its sampling period, the lock state the server's;
+# Brake: its joint's type and neighbours (its damping constant needs physics: the clients warn).
+register(DeviceKind(
+    "Connector", wm.Connector, "sensorium.server.sim.connector:Connector",
+    services=(*_SENSOR, "get_value", "lock", "unlock", "is_locked"),
+    topics=(TopicDecl("presence", msgs.FLOAT64, "value"),),
+    description="ConnectorDescription"))
+register(DeviceKind(
+    "Brake", wm.Brake, "sensorium.server.sim.connector:Brake",
+    services=("get_type",),
+    description="BrakeDescription"))
 # A RotationalMotor is a drive's wheel or steering motor (sim/motion.py owns it) or, any other, a
 # joint's motor moved kinematically (sim/joints.py); a LinearMotor is always a joint's.
 _MOTOR_SERVICES = ("set_position", "set_velocity", "get_velocity", "get_max_velocity", "get_target_position")

@@ -555,6 +555,26 @@ class RadarDescription(_Entry):
     vertical_fov: float = Field(description="rad (wb_radar_get_vertical_fov)")
 
 
+class ConnectorDescription(_Entry):
+    type: Literal["Connector"]
+    sampling_period: int = Field(description="the presence's (wb_connector_get_presence_sampling_period)")
+    connector_type: Literal["symmetric", "active", "passive"]
+    is_locked: bool = Field(description="the lock state now (wb_connector_is_locked)")
+    auto_lock: bool
+    distance_tolerance: float = Field(description="m")
+    axis_tolerance: float = Field(description="rad")
+    rotation_tolerance: float = Field(description="rad")
+    number_of_rotations: int
+
+
+class BrakeDescription(_Entry):
+    type: Literal["Brake"]
+    joint_type: int = Field(description="wb_brake_get_type: 0 rotational (WB_ROTATIONAL), 1 linear (WB_LINEAR)")
+    motor: str | None = Field(description="the motor on the same joint (wb_brake_get_motor), none: null")
+    position_sensor: str | None = Field(description="the PositionSensor on the same joint "
+                                                    "(wb_brake_get_position_sensor), none: null")
+
+
 class EmitterDescription(_Entry):
     type: Literal["Emitter"]
     medium: Literal["radio", "serial", "infra-red"]
@@ -632,6 +652,7 @@ DeviceDescription = Annotated[
     | Annotated[EmitterDescription, Tag("Emitter")] | Annotated[ReceiverDescription, Tag("Receiver")]
     | Annotated[RadarDescription, Tag("Radar")]
     | Annotated[VacuumGripperDescription, Tag("VacuumGripper")] | Annotated[SpeakerDescription, Tag("Speaker")]
+    | Annotated[ConnectorDescription, Tag("Connector")] | Annotated[BrakeDescription, Tag("Brake")]
     | Annotated[DisplayDescription, Tag("Display")] | Annotated[UnsimulatedDescription, Tag("unsimulated")],
     Discriminator(_description_tag)]
 """An ``attach`` device entry: the kind's description (schemas.devices ``description``), or
@@ -1005,6 +1026,9 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("play_sound", "device", PlaySoundArgs, SuccessResult, attached=True),
     ServiceSpec("stop", "device", StringArgs, SuccessResult, attached=True),
     ServiceSpec("speak", "device", SpeakArgs, SuccessResult, attached=True),
+    ServiceSpec("lock", "device", NoArgs, StatusResult, attached=True),
+    ServiceSpec("unlock", "device", NoArgs, StatusResult, attached=True),
+    ServiceSpec("is_locked", "device", NoArgs, StatusResult),
 )
 
 

@@ -450,12 +450,18 @@ class Solid(Strict):
     radar_cross_section: float = Field(
         default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the solid a Radar target; "
         "top-level solids only")
+    connectors: list[Connector] = Field(
+        default=[], max_length=1024, description="Webots Connectors on this solid (a passive object a robot's "
+        "connector docks with), each pose in the solid's frame: robots' connectors see them; they read nothing")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
     def _recognised_at_the_top(self) -> Solid:
         _check_cone_seen(self.geometry, self.seen_by)
+        for i, con in enumerate(self.connectors):
+            if con.on_joint is not None:
+                raise ValueError(f"connectors[{i}] ({con.name}): a solid has no joints (leave out on_joint)")
         for i, child in enumerate(self.children):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "
@@ -917,8 +923,60 @@ class Radar(_Device):
     occlusion: bool = Field(default=False, description="a target hidden behind another shape is not seen")
 
 
+class Connector(_Device):
+    """Webots Connector: a docking device whose presence sensor reads 1 while a compatible peer
+    connector (another robot's) sits at its origin within ``distance_tolerance``, its x axis facing
+    this one's within ``axis_tolerance`` and its z axis at one of ``number_of_rotations`` angles within
+    ``rotation_tolerance`` (WbConnector's rule, each connector judging with its own tolerances), else
+    0, and -1 for a passive connector. ``lock``/``unlock`` set ``is_locked``; nothing is physically
+    joined here (README "Connector and Brake"). Webots' defaults (Connector.wrl)."""
+
+    device: Literal["Connector"]
+    type: Literal["symmetric", "active", "passive"] = Field(
+        default="symmetric", description="symmetric docks with symmetric, active with passive (same model)")
+    is_locked: bool = Field(default=False, description="the lock state at start (a passive connector: false)")
+    auto_lock: bool = Field(default=False, description="a locked connector attaches when a peer becomes present "
+                            "(no physical link here)")
+    unilateral_lock: bool = Field(default=True, description="kept for Webots; no physical link here")
+    unilateral_unlock: bool = Field(default=True, description="kept for Webots; no physical link here")
+    distance_tolerance: float = Field(default=0.01, ge=0.0, allow_inf_nan=False,
+                                      description="m: the origins at most this far apart")
+    axis_tolerance: float = Field(default=0.2, ge=0.0, le=math.pi, description="rad: the x axes opposed within it")
+    rotation_tolerance: float = Field(default=0.2, ge=0.0, le=math.pi,
+                                      description="rad: the z axes within it of an allowed docking rotation")
+    number_of_rotations: int = Field(default=4, ge=0, le=1 << 20,
+                                     description="allowed docking rotations in a full turn; 0: any rotation")
+    snap: bool = Field(default=True, description="kept for Webots; nothing is moved here")
+    tensile_strength: float = Field(default=-1.0, description="N, -1: unbreakable; kept for Webots (no forces here)")
+    shear_strength: float = Field(default=-1.0, description="N, -1: unbreakable; kept for Webots (no forces here)")
+
+    @model_validator(mode="after")
+    def _passive_unlocked(self) -> Connector:
+        if self.type == "passive" and self.is_locked:
+            raise ValueError("a passive connector cannot be locked: is_locked must be false (Webots)")
+        for f in ("tensile_strength", "shear_strength"):
+            v = getattr(self, f)
+            if v < 0.0 and v != -1.0:
+                raise ValueError(f"{f} must be >= 0, or -1 (unbreakable), got {v}")
+        return self
+
+
+class Brake(_Device):
+    """Webots Brake on a joint: ``getType`` is its joint's (rotational for a HingeJoint, linear for a
+    SliderJoint), ``getMotor``/``getPositionSensor`` the devices of the same joint, named here.
+    ``setDampingConstant`` is accepted and has no effect (no physics). ``pose`` is unused."""
+
+    device: Literal["Brake"]
+    joint_type: Literal["rotational", "linear"] = Field(
+        default="rotational", description="its joint's kind (a SliderJoint's brake: linear); with ``motor``, the "
+                                          "motor's (a LinearMotor: linear)")
+    motor: str | None = Field(default=None, min_length=1, description="the robot's motor on the same joint")
+    position_sensor: str | None = Field(default=None, min_length=1,
+                                        description="the robot's PositionSensor on the same joint")
+
+
 UNSIMULATED_DEVICE_TYPES = (
-    "Brake", "Connector", "Microphone", "Radio", "Skin",
+    "Microphone", "Radio", "Skin",
 )
 """Webots device node types that Sensorium lists but does not simulate yet (UnsimulatedDevice)."""
 
@@ -977,12 +1035,13 @@ class UnsimulatedDevice(_Device):
 
 Device = Annotated[LightSensor | DistanceSensor | Lidar | PositionSensor | LED | GPS | InertialUnit | Compass
                    | Accelerometer | Gyro | Altimeter | TouchSensor | Emitter | Receiver | RotationalMotor | LinearMotor
-                   | Pen | RangeFinder | Camera | Radar | Display | VacuumGripper | Speaker | UnsimulatedDevice,
+                   | Pen | RangeFinder | Camera | Radar | Display | VacuumGripper | Speaker | Connector | Brake
+                   | UnsimulatedDevice,
                    Field(discriminator="device")]
 
 DEVICE_TYPES = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "LED", "GPS", "InertialUnit", "Compass",
                 "Accelerometer", "Gyro", "Altimeter", "TouchSensor", "Emitter", "Receiver", "RotationalMotor",
-                "LinearMotor", "Pen", "RangeFinder", "Camera", "Display", "Radar", "VacuumGripper", "Speaker",
+                "LinearMotor", "Pen", "RangeFinder", "Camera", "Display", "Radar", "VacuumGripper", "Speaker", "Connector", "Brake",
                 *UNSIMULATED_DEVICE_TYPES)
 """Every Webots device node type a robot's ``devices`` list accepts."""
 

@@ -173,6 +173,14 @@ class DeviceServices:
 
     def _dev_speak(self, c: Call) -> dict:
         return _configured(c, "speak", c.args.text)
+    def _dev_lock(self, c: Call) -> dict:             # a Connector: the lock state after it (passive: unchanged)
+        return {"status": int(c.ctl.device.lock())}
+
+    def _dev_unlock(self, c: Call) -> dict:
+        return {"status": int(c.ctl.device.unlock())}
+
+    def _dev_is_locked(self, c: Call) -> dict:
+        return {"status": int(c.ctl.device.is_locked)}
 
     def _dev_get_channel(self, c: Call) -> dict:
         return {"value": int(c.ctl.device.channel)}
@@ -221,7 +229,7 @@ class DeviceServices:
     def _dev_get_aperture(self, c: Call) -> dict:
         return {"value": float(c.ctl.device.config.aperture)}
 
-    def _dev_get_type(self, c: Call) -> dict:  # DistanceSensor and TouchSensor: their type code
+    def _dev_get_type(self, c: Call) -> dict:  # DistanceSensor, TouchSensor, Brake: their type code
         return {"value": int(c.ctl.device.type_code)}
 
     def _dev_get_info(self, c: Call) -> dict:

@@ -25,6 +25,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
+from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.ground import Ground, GroundWarning, band_low
 from sensorium.server.sim.joints import JointMotor, Links
@@ -274,6 +275,11 @@ class Simulation:
             self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
         self._speakers = [d for d in self.all_devices() if isinstance(d, Speaker)]
+        connectors = [d for d in self.all_devices() if isinstance(d, Connector)]
+        peers: list[Connector | SolidConnector] = [*connectors, *solid_connectors(self.world.solids, self.scene)]
+        for con in connectors:        # a connector's presence looks at every other one of the world
+            con.peers = peers
+        self._auto_locking = [c for c in connectors if c.config.auto_lock and c.config.type != "passive"]
         self._counters: Counter[str] = Counter()
         self._by_kind: tuple[list[LightSensor], list[DistanceSensor], list[Lidar], list[Device]] | None = None
         self._capturing: list[Any] = []     # devices that cast their own rays (cameras, range finders)
@@ -332,7 +338,7 @@ class Simulation:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, joints to their initial positions, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data, radar cross sections and vacuum grippers' pumps as in the world file, speakers silent, GPS and Radar speeds
+        ``write`` and ink, as Webots' WbPen::reset), custom data, radar cross sections, vacuum grippers' pumps and connectors' lock states as in the world file, speakers silent, GPS and Radar speeds
         NaN at their next value (no previous position, as Webots' WbGps::reset and WbRadar::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
@@ -353,6 +359,8 @@ class Simulation:
                     dev.set(0, self.time_ms)
                 elif isinstance(dev, (GPS, Radar)):      # no previous position: the next speeds are NaN
                     dev.restart()
+                elif isinstance(dev, Connector):    # WbConnector::reset: the world file's lock state
+                    dev.reset()
                 elif dev.kind == "Display":      # WbDisplay::reset: black again, its images gone
                     dev.reset()               # type: ignore[attr-defined]
                     dev._mark(self.time_ms)
@@ -564,6 +572,9 @@ class Simulation:
                         self.contact.heights[robot.index] = drive.z    # (ENU, as contact works)
         for robot, _, _, pose in moved:
             self.scene.set_robot_pose(robot.index, pose)
+        for con in self._auto_locking:    # Webots attaches a locked auto-lock connector to a present peer
+            if con.is_locked:
+                con.attach_attempt()
         poses = self.scene.robot_poses
         if radio is not None:
             radio.deliver(poses)      # range, cones, line of sight and readings at the end-of-step poses

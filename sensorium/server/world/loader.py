@@ -484,6 +484,8 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                     problems.append(Problem(
                         f"{dp}.motor", f"{dev.motor!r} is not a motor of this robot "
                                        f"(motors: {', '.join(repr(m) for m in motors) or 'none'})"))
+            if isinstance(dev, wm.Brake):
+                problems += _check_brake(robot, dev, dp)
             if isinstance(dev, wm.Lidar) and dev.max_range <= dev.min_range:
                 pass  # Webots sanitises this (max_range := min_range + 1); see sanitize()
     problems += _check_meshes_and_work(world, base_dir, limits or WorldLimits(), allow_outside_meshes, asset_files)
@@ -492,6 +494,28 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
 
         problems += [Problem(*p) for p in check_textures(world, base_dir, limits or WorldLimits(), allow_outside_meshes,
                                                          asset_files)]
+    return problems
+
+
+def _check_brake(robot: wm.Robot, brake: wm.Brake, dp: str) -> list[Problem]:
+    """A Brake's ``motor`` and ``position_sensor`` name devices of its robot (of those kinds), and its
+    ``joint_type`` is its motor's."""
+    problems = []
+    motors: dict[str, wm.Motor | None] = {d.name: d for d in robot.devices if isinstance(d, wm.Motor)}
+    motors.update({m: None for _, m in robot.drive_motors if m not in motors})      # a drive's wheel: rotational
+    sensors = [d.name for d in robot.devices if isinstance(d, wm.PositionSensor)]
+    if brake.motor is not None:
+        if brake.motor not in motors:
+            problems.append(Problem(f"{dp}.motor", f"{brake.motor!r} is not a motor of this robot "
+                                    f"(motors: {', '.join(repr(m) for m in motors) or 'none'})"))
+        else:
+            kind = "linear" if isinstance(motors[brake.motor], wm.LinearMotor) else "rotational"
+            if brake.joint_type != kind:
+                problems.append(Problem(f"{dp}.joint_type", f"{brake.joint_type!r}, but its motor {brake.motor!r} "
+                                        f"is {kind} (a brake shares its motor's joint)"))
+    if brake.position_sensor is not None and brake.position_sensor not in sensors:
+        problems.append(Problem(f"{dp}.position_sensor", f"{brake.position_sensor!r} is not a PositionSensor of "
+                                f"this robot (position sensors: {', '.join(repr(n) for n in sensors) or 'none'})"))
     return problems
 
 

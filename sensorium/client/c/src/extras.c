@@ -44,8 +44,7 @@ WbDeviceTag wb_position_sensor_get_motor(WbDeviceTag tag) {
 
 WbDeviceTag wb_position_sensor_get_brake(WbDeviceTag tag) {
   POSITION("wb_position_sensor_get_brake");
-  (void)d;
-  return 0;
+  return d ? sn_brake_of(d->name, false, "wb_position_sensor_get_brake") : 0;
 }
 
 /* ------------------------------------------------------------------ LED */

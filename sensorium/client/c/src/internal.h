@@ -10,6 +10,7 @@
  * radio.c   - Emitter and Receiver (packet queues, baud-rate pacing);
  * radar.c   - Radar (the targets of the latest measurement);
  * vacuum_gripper.c - VacuumGripper (the pump, the presence); speaker.c - Speaker (sounds, speech);
+ * connector.c - Connector (presence, lock state) and Brake (its joint's type and neighbours);
  * camera.c  - range finders and cameras;
  * display.c - the Display (drawing buffered, sent with the next step request);
  * unsimulated.c - the devices Sensorium lists without simulating ("no value").
@@ -116,7 +117,7 @@ const char *sn_conn_endpoint(const sn_conn *c);
 typedef enum {
   SN_LIGHT, SN_DISTANCE, SN_LIDAR, SN_MOTOR, SN_POSITION, SN_LED, SN_GPS, SN_IMU, SN_COMPASS, SN_ACCELEROMETER,
   SN_GYRO, SN_ALTIMETER, SN_TOUCH, SN_EMITTER, SN_RECEIVER, SN_RANGE_FINDER, SN_CAMERA, SN_RADAR, SN_VACUUM, SN_SPEAKER,
-  SN_OTHER
+  SN_CONNECTOR, SN_BRAKE, SN_OTHER
 } sn_kind;
 
 struct sn_imaging; /* camera.c: a range finder's or camera's images and constants */
@@ -193,6 +194,12 @@ typedef struct {
      its range and fields of view are min_range, max_range, fov and vertical_fov above */
   WbRadarTarget *radar_targets;
   int radar_count;
+  /* Connector (connector.c): passive or not, the lock state the server answered; Brake: its joint's
+     type (WB_ROTATIONAL/WB_LINEAR), the motor (motor_name above) and position sensor on its joint */
+  bool connector_passive, is_locked;
+  int joint_type;
+  char *position_sensor_name;
+  bool warned_damping;
   /* Display (display.c): the world's size; the drawing commands packed since the last step (an
      array's items, draw_n of them), the image ids given out, whether a camera is attached */
   int display_width, display_height;
@@ -296,6 +303,8 @@ void sn_radar_apply(sn_device *dev, const msgpack_object *targets);
 /* speaker.c: a step reply's speaker state (the sounds still playing, whether it speaks); its cleanup */
 void sn_speaker_apply(sn_device *dev, const msgpack_object *reading);
 void sn_speaker_free(sn_device *dev);
+/* connector.c: the tag of the Brake on the joint of the motor (of_motor) or position sensor named name, 0 if none */
+WbDeviceTag sn_brake_of(const char *name, bool of_motor, const char *func);
 int sn_radio_pace(sn_device *dev, int duration);
 void sn_radio_pack(sn_device *dev, sn_req *r);
 void sn_radio_free(sn_device *dev);

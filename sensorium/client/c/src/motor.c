@@ -147,8 +147,7 @@ WbDeviceTag wb_motor_get_position_sensor(WbDeviceTag tag) {
 
 WbDeviceTag wb_motor_get_brake(WbDeviceTag tag) {
   MOTOR("wb_motor_get_brake");
-  (void)d;
-  return 0;
+  return d ? sn_brake_of(d->name, true, "wb_motor_get_brake") : 0;
 }
 
 /* ------------------------------------------------------------------ what needs physics */

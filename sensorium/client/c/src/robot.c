@@ -85,6 +85,10 @@ static sn_kind kind_of(const char *type) {
     return SN_VACUUM;
   if (strcmp(type, "Speaker") == 0)
     return SN_SPEAKER;
+  if (strcmp(type, "Connector") == 0)
+    return SN_CONNECTOR;
+  if (strcmp(type, "Brake") == 0)
+    return SN_BRAKE;
   return SN_OTHER;
 }
 
@@ -195,6 +199,17 @@ static int describe(sn_device *d, int index, const msgpack_object *desc) {
     d->pump_on = sn_bool_or(desc, "is_on", false);
   snprintf(d->engine, sizeof d->engine, "pico"); /* libController's speaker_create */
   snprintf(d->language, sizeof d->language, "en-US");
+  if (d->kind == SN_CONNECTOR) { /* presence -1 until the first value; the lock state as loaded */
+    d->value = -1.0;
+    const msgpack_object *t = sn_get(desc, "connector_type");
+    d->connector_passive = t != NULL && t->type == MSGPACK_OBJECT_STR && t->via.str.size == 7 &&
+                           memcmp(t->via.str.ptr, "passive", 7) == 0;
+    d->is_locked = sn_bool_or(desc, "is_locked", false);
+  }
+  if (d->kind == SN_BRAKE) {
+    d->joint_type = (int)sn_int_or(desc, "joint_type", 0);
+    d->position_sensor_name = sn_strdup_obj(sn_get(desc, "position_sensor"));
+  }
   if (sn_imaging_describe(d, desc) != 0)
     return -1;
   d->motor_name = sn_strdup_obj(sn_get(desc, "motor"));
@@ -241,6 +256,7 @@ static void free_robot(sn_robot *rb) {
     for (int k = 0; k < d->n_coupled; k++)
       free(d->coupled[k]);
     free(d->coupled);
+    free(d->position_sensor_name);
     free(d->radar_targets);
     sn_imaging_free(d);
     sn_radio_free(d);
@@ -751,6 +767,8 @@ static bool kind_accepts(sn_kind kind, int node) {
     case SN_RADAR: return node == WB_NODE_RADAR;
     case SN_VACUUM: return node == WB_NODE_VACUUM_GRIPPER;
     case SN_SPEAKER: return node == WB_NODE_SPEAKER;
+    case SN_CONNECTOR: return node == WB_NODE_CONNECTOR;
+    case SN_BRAKE: return node == WB_NODE_BRAKE;
     default: return false;
   }
 }

@@ -7,8 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <webots/brake.h>
-#include <webots/connector.h>
 #include <webots/microphone.h>
 #include <webots/radio.h>
 #include <webots/skin.h>
@@ -18,58 +16,6 @@
 
 /* a function here reads only its device tag, never its other arguments */
 #pragma GCC diagnostic ignored "-Wunused-parameter"
-
-/* ------------------------------------------------------------------ Brake */
-void wb_brake_set_damping_constant(WbDeviceTag tag, double damping_constant) {
-  sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_set_damping_constant");
-}
-
-WbJointType wb_brake_get_type(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_get_type");
-  return (WbJointType)0;
-}
-
-WbDeviceTag wb_brake_get_motor(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_get_motor");
-  return 0;
-}
-
-WbDeviceTag wb_brake_get_position_sensor(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_BRAKE, "wb_brake_get_position_sensor");
-  return 0;
-}
-
-/* ------------------------------------------------------------------ Connector */
-void wb_connector_enable_presence(WbDeviceTag tag, int sampling_period) {
-  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_enable_presence");
-}
-
-void wb_connector_disable_presence(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_disable_presence");
-}
-
-int wb_connector_get_presence_sampling_period(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_get_presence_sampling_period");
-  return 0;
-}
-
-int wb_connector_get_presence(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_get_presence");
-  return -1; /* Webots: -1 when no presence was measured */
-}
-
-void wb_connector_lock(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_lock");
-}
-
-void wb_connector_unlock(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_unlock");
-}
-
-bool wb_connector_is_locked(WbDeviceTag tag) {
-  sn_unsimulated(tag, WB_NODE_CONNECTOR, "wb_connector_is_locked");
-  return false;
-}
 
 /* ------------------------------------------------------------------ Skin */
 void wb_skin_set_bone_orientation(WbDeviceTag tag, int index, const double orientation[4], bool absolute) {

@@ -1,15 +1,35 @@
-"""Webots' ``Brake`` class (listed, not simulated: no joint has a brake here)."""
+"""Webots' ``Brake`` class: its joint's type and the motor and position sensor on its joint; its
+damping constant is accepted and has no effect (no physics)."""
 
 from __future__ import annotations
 
 from sensorium.client import wb
 
-from .unsimulated import UnsimulatedDevice
+from .device import Device
 
 
-class Brake(UnsimulatedDevice):
+class Brake(Device):
     ROTATIONAL = wb.WB_ROTATIONAL
     LINEAR = wb.WB_LINEAR
-    _KIND = "Brake"
-    _NO_VALUES = {"setDampingConstant": None, "getType": 0, "getMotor": None, "getPositionSensor": None}
-    _PROPERTIES = {"type": "getType", "motor": "getMotor", "position_sensor": "getPositionSensor"}
+
+    def setDampingConstant(self, dampingConstant: float) -> None:  # noqa: N803 - Webots' parameter name
+        wb.wb_brake_set_damping_constant(self._tag, dampingConstant)
+
+    def getType(self) -> int:
+        return wb.wb_brake_get_type(self._tag)
+
+    def getMotor(self):
+        """The motor on the brake's joint, ``None`` when it has none."""
+        from .robot import Robot
+
+        return Robot.device_by_tag(wb.wb_brake_get_motor(self._tag))
+
+    def getPositionSensor(self):
+        """The PositionSensor on the brake's joint, ``None`` when it has none."""
+        from .robot import Robot
+
+        return Robot.device_by_tag(wb.wb_brake_get_position_sensor(self._tag))
+
+    type = property(getType)
+    motor = property(getMotor)
+    position_sensor = property(getPositionSensor)

@@ -1,13 +1,36 @@
-"""Webots' ``Connector`` class (listed, not simulated: nothing docks without physics)."""
+"""Webots' ``Connector`` class: the presence of a peer connector, read with the step, and the lock
+state the server holds (nothing is physically joined: no physics)."""
 
 from __future__ import annotations
 
-from .unsimulated import UnsimulatedDevice
+from sensorium.client import wb
+
+from .device import Device
 
 
-class Connector(UnsimulatedDevice):
-    _KIND = "Connector"
-    _NO_VALUES = {"enablePresence": None, "disablePresence": None, "getPresenceSamplingPeriod": 0,
-                  "getPresence": -1, "lock": None, "unlock": None, "isLocked": False}
-    _PROPERTIES = {"presence": "getPresence", "presence_sampling_period": "getPresenceSamplingPeriod",
-                   "locked": "isLocked"}
+class Connector(Device):
+    def enablePresence(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
+        wb.wb_connector_enable_presence(self._tag, samplingPeriod)
+
+    def disablePresence(self) -> None:
+        wb.wb_connector_disable_presence(self._tag)
+
+    def getPresenceSamplingPeriod(self) -> int:
+        return wb.wb_connector_get_presence_sampling_period(self._tag)
+
+    def getPresence(self) -> int:
+        """1: a peer in position, 0: none, -1: passive (or no value yet)."""
+        return wb.wb_connector_get_presence(self._tag)
+
+    def lock(self) -> None:
+        wb.wb_connector_lock(self._tag)
+
+    def unlock(self) -> None:
+        wb.wb_connector_unlock(self._tag)
+
+    def isLocked(self) -> bool:
+        return wb.wb_connector_is_locked(self._tag)
+
+    presence = property(getPresence)
+    presence_sampling_period = property(getPresenceSamplingPeriod)
+    locked = property(isLocked)

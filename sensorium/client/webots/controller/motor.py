@@ -47,8 +47,11 @@ class Motor(Device):
 
         return Robot.device_by_tag(wb.wb_motor_get_position_sensor(self._tag))
 
-    def getBrake(self) -> None:
-        return None
+    def getBrake(self):
+        """The Brake on the same joint, ``None`` when it has none."""
+        from .robot import Robot
+
+        return Robot.device_by_tag(wb.wb_motor_get_brake(self._tag))
 
     # -- what needs physics (kinematic wheels: ignored, NaN; see sensorium.client.wb_motor)
     def setAcceleration(self, acceleration: float) -> None:

@@ -28,8 +28,11 @@ class PositionSensor(Sensor):
         tag = wb.wb_position_sensor_get_motor(self._tag)
         return Robot.device_by_tag(tag)
 
-    def getBrake(self) -> None:
-        return None
+    def getBrake(self):
+        """The Brake on the same joint, ``None`` when it has none."""
+        from .robot import Robot
+
+        return Robot.device_by_tag(wb.wb_position_sensor_get_brake(self._tag))
 
     value = property(getValue)
     type = property(getType)

@@ -460,6 +460,8 @@ class Converter:
                         data.update(fx.display(f))
                     elif t == "VacuumGripper":     # its strengths and contact points, Webots' resets
                         data.update(fx.vacuum_gripper(f))
+                    elif t == "Connector":     # its tolerances with WbConnector's resets
+                        data.update(fx.connector(f))
                     if t in wm.UNSIMULATED_DEVICE_TYPES:
                         self.warn(node, f"{t} {data['name']!r} of robot {owner.data['name']!r}: listed (a controller "
                                         "finds it), not simulated here: its functions answer Webots' \"no value\"")
@@ -471,6 +473,14 @@ class Converter:
                         self.warn(node, f"Track {f.string('name', 'solid')!r}: its motor's position moves "
                                         "kinematically (its sensor reads it); the belt and its wheels do not move here")
                 self.device_contents(node, inner, owner, data)
+            elif t == "Connector":       # a solid that robots' connectors dock with (Webots allows it)
+                out = self.solid(node, frame, owner, "connector")
+                if out is not None:
+                    entry = {"name": out["name"], "device": "Connector", **self.device_fields(node),
+                             **fx.connector(f)}
+                    if f.string("model", ""):
+                        entry["model"] = f.string("model", "")
+                    out.setdefault("connectors", []).append(entry)
             else:     # a device outside a robot is still a Solid whose shapes rays see
                 self.warn(node, f"{t} outside a Robot: not a device here (devices belong to robots); its shapes "
                                 "are kept as a solid")
@@ -897,8 +907,9 @@ class Converter:
         return inside(children[0]) if children else []
 
     # ------------------------------------------------------------ solids and robots
-    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> None:
-        """A Solid (``default``: its name when it has none: a device's default name)."""
+    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> dict | None:
+        """A Solid (``default``: its name when it has none: a device's default name); its entry (None
+        when it is part of a robot's body)."""
         f = self.fields(node)
         inner = self.child_frame(node, frame)
         if owner.kind == "robot":   # part of the robot's body
@@ -906,7 +917,7 @@ class Converter:
             if rcs > 0.0:           # a radar target it carries (Webots' radar sample): read as the robot's
                 owner.data.setdefault("_carried_rcs", []).append((f.string("name", default), rcs, node))
             self.solid_contents(node, inner, owner)
-            return
+            return None
         name = f.string("name", default)
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
@@ -938,6 +949,7 @@ class Converter:
             self.world["solids"].append(out)
         else:
             owner.data.setdefault("children", []).append(out)
+        return out
 
     def radar_cross_section(self, node: Node, data: dict) -> None:
         """A top-level solid's or robot's radarCrossSection: > 0 makes it a Radar target (0 or less:
@@ -1168,7 +1180,7 @@ class Converter:
         them before the end point's): (motor entries, position sensor entries). A motor's entry
         carries its fields and the joint's position (a drive keeps only its wheels' names, see
         :meth:`drive`); the joint's sensors measure its motor."""
-        motors, sensors = [], []
+        motors, sensors, brakes = [], [], []
         params_field = {"device2": "jointParameters2", "device3": "jointParameters3"}.get(field_name, "jointParameters")
         params = self.fields(node).node_(params_field) if node.type.endswith("Joint") else None
         position = self.fields(params).num("position", 0.0) if params is not None else 0.0
@@ -1192,6 +1204,7 @@ class Converter:
                 sensors.append(entry)
             elif d.type == "Brake":
                 entry = self.unsimulated(d, Frame.identity(), owner)
+                brakes.append(entry)
             else:
                 self.warn(d, f"{d.type} in a joint's device list: ignored")
             if entry is not None and self.tree is not None and owner.kind == "robot":   # a node of the joint's
@@ -1201,6 +1214,14 @@ class Converter:
                 entry["motor"] = motors[0]["name"]
             elif position:
                 entry["position"] = position
+        for entry in brakes:        # a brake names its joint's motor and sensor; a slider's is linear
+            linear = node.type == "SliderJoint" or (motors and motors[0]["device"] == "LinearMotor")
+            if linear:
+                entry["joint_type"] = "linear"
+            if motors:
+                entry["motor"] = motors[0]["name"]
+            if sensors:
+                entry["position_sensor"] = sensors[0]["name"]
         return motors, sensors
 
     def motor_fields(self, d: Node, position: float) -> dict[str, float]:

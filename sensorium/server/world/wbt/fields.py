@@ -353,6 +353,30 @@ def vacuum_gripper(f: Fields) -> dict:
     return out
 
 
+def connector(f: Fields) -> dict:
+    """A Connector's fields in the world format's names (Connector.wrl defaults), with the values
+    WbConnector resets said and replaced: a negative distance tolerance or number of rotations 0,
+    the axis and rotation tolerances clipped to [0, pi], a negative strength other than -1 made -1,
+    a locked passive connector unlocked."""
+    out: dict[str, Any] = {"type": f.string("type", "symmetric")}
+    out["distance_tolerance"] = f.non_negative("distanceTolerance", 0.01)
+    for name, key in (("axisTolerance", "axis_tolerance"), ("rotationTolerance", "rotation_tolerance")):
+        v = f.num(name, 0.2)
+        clipped = min(max(v, 0.0), math.pi)
+        out[key] = float(f.used(name, v, clipped, "is outside [0, pi]" if clipped != v else ""))
+    n = f.integer("numberOfRotations", 4)
+    out["number_of_rotations"] = int(f.used("numberOfRotations", n, max(n, 0), "is negative" if n < 0 else ""))
+    for name, key in (("tensileStrength", "tensile_strength"), ("shearStrength", "shear_strength")):
+        v = f.num(name, -1.0)
+        bad = v < 0.0 and v != -1.0
+        out[key] = float(f.used(name, v, -1.0 if bad else v, "is neither >= 0 nor -1" if bad else ""))
+    locked = f.flag("isLocked", False)
+    bad = locked and out["type"] == "passive"
+    out["is_locked"] = bool(f.used("isLocked", locked, locked and not bad,
+                                   "on a passive connector (it cannot lock)" if bad else ""))
+    return out
+
+
 DEVICE_NAMES = {"DistanceSensor": "distance sensor", "LightSensor": "light sensor", "Lidar": "lidar",
                 "RangeFinder": "range-finder", "Camera": "camera",
                 "PositionSensor": "position sensor", "LED": "led", "RotationalMotor": "rotational motor"}

@@ -1,7 +1,6 @@
 /* Sensorium C controller library: Brake (Webots' wb_brake_* functions).
- * Sensorium lists this device (name, model, type, index) but does not simulate it: every function
- * answers Webots' "no value" (NaN, a NaN vector, NULL, 0, "") and the first call per device prints one
- * warning line. */
+ * Its joint's type and the tags of the motor and position sensor on its joint (0 when none);
+ * wb_brake_set_damping_constant has no effect (no physics: one warning line per brake). */
 #ifndef WB_BRAKE_H
 #define WB_BRAKE_H
 

@@ -1,7 +1,6 @@
 /* Sensorium C controller library: Connector (Webots' wb_connector_* functions).
- * Sensorium lists this device (name, model, type, index) but does not simulate it: every function
- * answers Webots' "no value" (NaN, a NaN vector, NULL, 0, "") and the first call per device prints one
- * warning line. */
+ * The presence of a peer connector at the sampling period (1, 0; -1 passive or before the first
+ * value) and the lock state the server holds; nothing is physically joined (no physics). */
 #ifndef WB_CONNECTOR_H
 #define WB_CONNECTOR_H
 

@@ -19,7 +19,7 @@ double wb_motor_get_velocity(WbDeviceTag tag);
 double wb_motor_get_max_velocity(WbDeviceTag tag);
 WbJointType wb_motor_get_type(WbDeviceTag tag);
 WbDeviceTag wb_motor_get_position_sensor(WbDeviceTag tag);     /* 0 if the wheel has none */
-WbDeviceTag wb_motor_get_brake(WbDeviceTag tag);               /* 0: no Brake devices */
+WbDeviceTag wb_motor_get_brake(WbDeviceTag tag);               /* 0: no Brake on its joint */
 
 /* What needs physics: a kinematic wheel turns at its commanded speed at once. The setters are
  * accepted and ignored, the getters answer Webots' default (-1 acceleration) or NaN; one warning

@@ -15,7 +15,7 @@ int wb_position_sensor_get_sampling_period(WbDeviceTag tag);
 double wb_position_sensor_get_value(WbDeviceTag tag);
 WbJointType wb_position_sensor_get_type(WbDeviceTag tag);
 WbDeviceTag wb_position_sensor_get_motor(WbDeviceTag tag);
-WbDeviceTag wb_position_sensor_get_brake(WbDeviceTag tag); /* 0: Sensorium wheels have no Brake */
+WbDeviceTag wb_position_sensor_get_brake(WbDeviceTag tag); /* 0: no Brake on its joint */
 
 #ifdef __cplusplus
 }
