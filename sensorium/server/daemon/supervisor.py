@@ -428,7 +428,8 @@ field of Fog, a Transform, ...) answers Webots' "no value"."""
 
 
 def _own_pose(sim: Any, node: Node) -> Any:
-    own = _nested_of(sim, node).own
+    """A nested node's translation and rotation now (an end point's follow its joint: nested.py)."""
+    own = nested.own_pose(sim, _table(sim), _nested_of(sim, node))
     assert own is not None
     return own
 
