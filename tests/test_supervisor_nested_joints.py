@@ -18,6 +18,7 @@ import pytest
 from test_multiprocess import REPO, run_paused
 from test_supervisor import A, Live
 
+from sensorium.schemas.wire import ErrorCode
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 
@@ -147,6 +148,38 @@ def test_a_slid_slider_moves_its_end_point_along_its_axis_and_joints_compose():
     assert arm.field("CARRIAGE", "translation") == pytest.approx([0.1 + D, 0.0, 0.05], abs=1e-12)  # in the link
 
 
+def test_a_joints_parameters_hold_its_position_now():
+    """A moving joint's jointParameters (SFNode): a HingeJointParameters / JointParameters node whose
+    ``position`` reads the joint's position, loaded then moved; read-only, as the other nested fields."""
+    arm = Arm()
+
+    def parameters(joint: str) -> int:
+        got = arm.call("get_field", {"node": arm.node(joint), "field": "jointParameters"})
+        assert got["type"] == "SFNode"
+        return got["value"]
+
+    def position(params: int):
+        return arm.call("get_field", {"node": params, "field": "position"})
+
+    hinge, slider = parameters("SHOULDER"), parameters("SLIDE")
+    assert arm.call("get_from_id", {"id": hinge}) == {"node": hinge, "type": "HingeJointParameters", "name": "",
+                                                      "def_name": "", "parent": arm.node("SHOULDER"), "proto": ""}
+    assert arm.call("get_from_id", {"id": slider})["type"] == "JointParameters"
+    assert position(hinge) == {"type": "SFFloat", "value": 0.0}
+    assert position(slider) == {"type": "SFFloat", "value": SLIDE0}
+    assert all(math.isnan(v) for v in arm.call("get_node_pose", {"node": hinge})["position"])   # no Pose
+    arm.move("shoulder", HALF_PI)
+    arm.move("slide", SLIDE0 + D)
+    assert position(hinge)["value"] == HALF_PI
+    assert position(slider)["value"] == SLIDE0 + D
+    assert arm.call("get_field", {"node": arm.node("LINK"), "field": "jointParameters"})["type"] == ""
+    msg = arm.lv.err(A, "/armbot/robot/set_field", {"node": hinge, "field": "position", "value": 1.0},
+                     ErrorCode.INVALID_ARGUMENT)
+    assert "field 'position' (SFFloat) of HingeJointParameters" in msg and "read-only here" in msg
+    arm.lv.sim.reset()                      # a reset puts the joints back, and their positions
+    assert position(hinge)["value"] == 0.0 and position(slider)["value"] == SLIDE0
+
+
 SOLID_ONLY = """#VRML_SIM R2023b utf8
 Robot {
   name "bare" controller "<extern>" supervisor TRUE
@@ -155,6 +188,10 @@ Robot {
       jointParameters HingeJointParameters { axis 0 0 1 anchor 0.1 0 0 position 0.5 }
       device [ RotationalMotor { name "turn" maxVelocity 100 } ]
       endPoint DEF END Solid { translation 0.3 0 0 rotation 0 0 1 0.5 children [ DEF KNOB Solid { translation 0.1 0 0 } ] }
+    }
+    DEF FREE HingeJoint {
+      device [ RotationalMotor { name "free" } ]
+      endPoint DEF WING Solid { translation 0 0.2 0 }
     }
   ]
 }
@@ -177,6 +214,9 @@ def test_a_joint_that_carries_nothing_but_solids_moves_them_too(tmp_path):
     assert arm.field("END", "translation") == pytest.approx([0.1, 0.2, 0.0], abs=1e-12)
     assert arm.field("END", "rotation") == pytest.approx([0.0, 0.0, 1.0, 0.5 + HALF_PI], abs=1e-12)
     assert arm.lv.sim.robot("bare").links is None            # the simulation still moves no link
+    # a joint the world file gives no jointParameters: Webots' NULL
+    assert arm.call("get_field", {"node": arm.node("FREE"), "field": "jointParameters"}) == {"type": "SFNode",
+                                                                                           "value": 0}
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
@@ -196,5 +236,8 @@ def test_a_webots_supervisor_reads_its_arm_where_the_joints_put_it(tmp_path):
     assert after["link_translation"] == pytest.approx([0.1, 0.2, 0.2], abs=1e-12)
     assert after["link_rotation"] == pytest.approx([0.0, 0.0, 1.0, HALF_PI], abs=1e-12)
     assert after["carriage_translation"] == pytest.approx([0.1 + D, 0.0, 0.05], abs=1e-12)
+    assert out["parameters"] == [["HingeJointParameters", "SHOULDER"], ["JointParameters", "SLIDE"]]
+    assert before["positions"] == [0.0, SLIDE0]
+    assert after["positions"] == [HALF_PI, SLIDE0 + D]
     for seen in (before, after):            # getPose(link): the hand where the file puts it in the link
         assert seen["hand_in_link"] == pytest.approx([0.2, 0.0, 0.1], abs=1e-12)

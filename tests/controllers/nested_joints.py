@@ -1,6 +1,7 @@
 """A Webots-style supervisor reading its arm's nodes past the joints (tests/test_supervisor_nested_joints.py
 on tests/worlds/nested_joints.wbt): the link's, the hand's and the carriage's world poses and the
-end points' fields before and after the shoulder turned a quarter turn and the slider slid 0.25 m.
+end points' fields and the joints' parameters' positions before and after the shoulder turned a
+quarter turn and the slider slid 0.25 m.
 Written as for Webots; prints one JSON line."""
 
 import json
@@ -13,6 +14,7 @@ timestep = int(robot.getBasicTimeStep())
 robot.step(timestep)
 
 link, hand, carriage = (robot.getFromDef(name) for name in ("ARMBOT.SHOULDER.LINK", "HAND", "CARRIAGE"))
+parameters = [robot.getFromDef(name).getField("jointParameters").getSFNode() for name in ("SHOULDER", "SLIDE")]
 
 
 def read() -> dict:
@@ -20,7 +22,8 @@ def read() -> dict:
             "carriage": carriage.getPosition(), "link_translation": link.getField("translation").getSFVec3f(),
             "link_rotation": link.getField("rotation").getSFRotation(),
             "carriage_translation": carriage.getField("translation").getSFVec3f(),
-            "hand_in_link": [v for k, v in enumerate(hand.getPose(link)) if k in (3, 7, 11)]}
+            "hand_in_link": [v for k, v in enumerate(hand.getPose(link)) if k in (3, 7, 11)],
+            "positions": [p.getField("position").getSFFloat() for p in parameters]}
 
 
 before = read()
@@ -33,5 +36,5 @@ for name, target in targets.items():
 for _ in range(2000):           # a generous limit: the joints are there within a second
     if robot.step(timestep) == -1 or all(sensors[n].getValue() == t for n, t in targets.items()):
         break
-print(json.dumps({"before": before, "after": read(),
-                  "at": [sensors[n].getValue() for n in targets]}), flush=True)
+print(json.dumps({"before": before, "after": read(), "at": [sensors[n].getValue() for n in targets],
+                  "parameters": [[p.getTypeName(), p.getParentNode().getDef()] for p in parameters]}), flush=True)

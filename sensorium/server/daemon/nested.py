@@ -62,6 +62,7 @@ class Nested:
     owner_key: str        # the robot's or solid's name
     joint: str = ""       # the robot's joint motor whose link carries it (the innermost moving joint it is past)
     frame: int = -1       # the id of the nested node whose frame its ``own`` is in (-1: the owner's)
+    motor: str = ""       # a joint's JointParameters node: the joint motor whose position it holds
 
 
 @dataclass(frozen=True, slots=True)
@@ -69,6 +70,7 @@ class Table:
     nodes: tuple[Nested, ...]
     by_owner: dict[int, tuple[Nested, ...]]     # owner id -> its nodes, depth first
     by_parent: dict[int, tuple[Nested, ...]]    # parent id -> its direct subnodes
+    bare_joints: frozenset[int] = frozenset()   # motorised joints without jointParameters (NULL)
 
     def get(self, node_id: int) -> Nested | None:
         k = node_id - FIRST_ID
@@ -94,6 +96,15 @@ def _own(local: Pose | None, above: Pose | None) -> Pose | None:
     return local if above is None else above.inverse().compose(local)
 
 
+def _first_motors(entries: list[wm.NestedNode]) -> dict[int, str]:
+    """A joint entry's index -> its first motor's device name (Webots' rotationalMotor/linearMotor)."""
+    motor: dict[int, str] = {}
+    for e in entries:
+        if e.parent >= 0 and e.field == "device" and e.type in MOTORS and e.parent not in motor:
+            motor[e.parent] = e.device or ""
+    return motor
+
+
 def _riding(robot: Any, entries: list[wm.NestedNode]) -> list[str]:
     """Each entry's joint (the motor of the innermost joint whose end point holds it that the
     simulation moves, "" for none): a device's is its ``on_joint``, where the simulation moves it;
@@ -102,10 +113,7 @@ def _riding(robot: Any, entries: list[wm.NestedNode]) -> list[str]:
     what its end point holds rides with what the wheel rides on, as the import's ``on_joint``)."""
     on = {d.name: d.on_joint or "" for d in robot.model.devices}
     moved = set(robot.joints)
-    motor: dict[int, str] = {}                # a joint entry -> its first motor's device name
-    for e in entries:
-        if e.parent >= 0 and e.field == "device" and e.type in MOTORS and e.parent not in motor:
-            motor[e.parent] = e.device or ""
+    motor = _first_motors(entries)
     out: list[str] = []
     for e in entries:
         if e.device and e.device in on:
@@ -119,6 +127,31 @@ def _riding(robot: Any, entries: list[wm.NestedNode]) -> list[str]:
                 joint = motor[e.parent]
         out.append(joint)
     return out
+
+
+def _joint_parameters(sim: Any, robots: list[str], out: list[Nested]) -> tuple[list[Nested], frozenset[int]]:
+    """The JointParameters nodes of the robots' motorised HingeJoints and SliderJoints whose world
+    file gives one (numbered after every other nested node: the others' ids never move), each
+    holding its joint's position; and the ids of those joints whose file gives none (Webots' NULL)."""
+    added: list[Nested] = []
+    bare: set[int] = set()
+    first = 0
+    for i, name in enumerate(robots):
+        robot = sim.robots[name]
+        entries = _robot_entries(robot)
+        motors = _first_motors(entries)
+        for k, e in enumerate(entries):
+            motor = motors.get(k, "")
+            if e.type not in MOVING_JOINTS or motor not in robot.motors:
+                continue
+            if not e.joint_parameters:
+                bare.add(FIRST_ID + first + k)
+                continue
+            kind = "HingeJointParameters" if e.type == "HingeJoint" else "JointParameters"
+            added.append(Nested(FIRST_ID + len(out) + len(added), kind, "", "", "", FIRST_ID + first + k,
+                                "jointParameters", None, None, "", i + 1, "Robot", name, motor=motor))
+        first += len(entries)
+    return added, frozenset(bare)
 
 
 def build(sim: Any, loaded_solids: int) -> Table:
@@ -155,12 +188,15 @@ def build(sim: Any, loaded_solids: int) -> Table:
                 walk(child, node.id, local)
 
         walk(solid, owner, None)
+    parameters, bare = _joint_parameters(sim, robots, out)
+    out += parameters
     by_owner: dict[int, list[Nested]] = {}
     by_parent: dict[int, list[Nested]] = {}
     for n in out:
         by_owner.setdefault(n.owner, []).append(n)
         by_parent.setdefault(n.parent, []).append(n)
-    return Table(tuple(out), {k: tuple(v) for k, v in by_owner.items()}, {k: tuple(v) for k, v in by_parent.items()})
+    return Table(tuple(out), {k: tuple(v) for k, v in by_owner.items()}, {k: tuple(v) for k, v in by_parent.items()},
+                 bare)
 
 
 def owner_pose(sim: Any, n: Nested) -> Pose:
@@ -231,6 +267,19 @@ def velocity(sim: Any, n: Nested) -> list[float]:
     r = pose.translation - owner_pose(sim, n).translation
     linear = np.asarray(v[:3], dtype=np.float64) + np.cross(np.asarray(v[3:], dtype=np.float64), r)
     return [float(x) for x in linear] + [float(x) for x in v[3:]]
+
+
+def joint_parameters(table: Table, joint: int) -> int | None:
+    """A motorised joint's ``jointParameters``: its JointParameters node's id, 0 (NULL) when its
+    world file gives none; None: no such field here (no joint, or no motor moving it)."""
+    if joint in table.bare_joints:
+        return 0
+    return next((c.id for c in table.by_parent.get(joint, ()) if c.field == "jointParameters"), None)
+
+
+def joint_position(sim: Any, n: Nested) -> float:
+    """A JointParameters node's ``position``: its joint's position now (rad or m; a wheel's angle)."""
+    return float(sim.robots[n.owner_key].motors[n.motor].position)
 
 
 def has_children(n: Nested) -> bool:
