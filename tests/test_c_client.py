@@ -581,7 +581,8 @@ def test_c_supervisor_reaches_nested_nodes(cbin, servers):
     Python and its closed forms), built with sanitizers: nested DEFs and dotted paths, parents, a
     device's node (a motor: no position), the robot's children; the camera at (1, 2.15, 0.3) moves
     10 steps · 32 ms · 2 rad/s · 0.05 m along +y with the robot and stays at (0.15, 0, 0.3) in its
-    frame; setting a nested field gets the server's one line."""
+    frame; the left wheel's jointParameters (SFNode) hold its angle; setting a nested field gets the
+    server's one line."""
     code, out, err = finish(start([cbin["nested_nodes"]], servers(NESTED_WORLD).url("rover")))
     assert code == 0, err
     assert out[:6] == ["found Camera:CAM:cam Solid:TIP:tip Solid:LID:lid",
@@ -590,7 +591,10 @@ def test_c_supervisor_reaches_nested_nodes(cbin, servers):
                        "camera 1",
                        "children Pose Solid DistanceSensor HingeJoint HingeJoint",
                        "tip 0.000000000000 0.000000000000 0.300000000000"]
-    values = {line.split()[0]: [float(v) for v in line.split()[1:]] for line in out[6:]}
+    parameters = next(line for line in out if line.startswith("parameters")).split()
+    assert parameters[:3] == ["parameters", "HingeJointParameters", "1"]
+    assert float(parameters[3]) == pytest.approx(2.0 * 10 * 0.032, abs=1e-9)    # the wheel's angle: 2 rad/s, 10 steps
+    values = {line.split()[0]: [float(v) for v in line.split()[1:]] for line in out[6:] if line.split()[0] != "parameters"}
     d = 2.0 * 0.05 * 10 * 0.032
     assert values["before"] == pytest.approx([1.0, 2.15, 0.3], abs=1e-9)
     assert values["after"] == pytest.approx([1.0, 2.15 + d, 0.3], abs=1e-9)

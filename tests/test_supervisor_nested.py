@@ -25,6 +25,7 @@ WORLD = REPO / "tests" / "worlds" / "nested_nodes.wbt"
 ROVER, SHELF = 1, 2                                  # robots first, then the top-level solids
 MAST, CAM, ARM, TIP, DS, LEFT_JOINT, LEFT_MOTOR, LEFT_ENCODER, LEFT_WHEEL = range(FIRST_ID, FIRST_ID + 9)
 RIGHT_JOINT, RIGHT_MOTOR, RIGHT_WHEEL, LID = range(FIRST_ID + 9, FIRST_ID + 13)
+LEFT_PARAMETERS, RIGHT_PARAMETERS = FIRST_ID + 13, FIRST_ID + 14   # after every other nested node
 W, R, AXLE, DT = 2.0, 0.05, 0.2, 0.032               # wheel speed (rad/s), radius, axle (m), basic step (s)
 HALF_PI = math.pi / 2
 
@@ -137,7 +138,14 @@ def test_fields_are_read_in_the_parents_frame_and_refused_when_set():
     msg = lv.err(A, "/rover/robot/remove_node", {"node": CAM}, ErrorCode.INVALID_ARGUMENT)
     assert msg == (f"remove_node: Camera 'cam' (node {CAM}) cannot be removed here: only top-level solids and "
                    "lights can, not the nodes inside a robot or solid")
-    assert rover(lv, "get_from_id", {"id": FIRST_ID + 13})["type"] == ""         # past the last nested node
+    # a wheel's joint parameters (SFNode) hold its position: the wheel's angle
+    assert get(LEFT_JOINT, "jointParameters") == {"type": "SFNode", "value": LEFT_PARAMETERS}
+    assert get(RIGHT_JOINT, "jointParameters") == {"type": "SFNode", "value": RIGHT_PARAMETERS}
+    assert rover(lv, "get_from_id", {"id": LEFT_PARAMETERS})["parent"] == LEFT_JOINT
+    assert get(LEFT_PARAMETERS, "position") == {"type": "SFFloat", "value": 0.0}
+    drive(lv, W, W, 10)
+    assert get(LEFT_PARAMETERS, "position")["value"] == pytest.approx(W * 10 * DT, abs=1e-12)
+    assert rover(lv, "get_from_id", {"id": FIRST_ID + 15})["type"] == ""         # past the last nested node
 
 
 def test_world_poses_follow_the_robot_as_it_drives():

@@ -463,6 +463,12 @@ def _mf_item(field: Field | None, want: int, index: int, func: str) -> Any:
     return items[index]
 
 
+def wb_supervisor_field_get_sf_node(field: Field | None) -> int | None:
+    """The node of an SFNode field (a joint's ``jointParameters``); None for NULL."""
+    node = _field_value(field, WB_SF_NODE, "wb_supervisor_field_get_sf_node")
+    return None if node is None or isinstance(node, bool) or not isinstance(node, int) or node <= 0 else node
+
+
 def wb_supervisor_field_get_mf_node(field: Field | None, index: int) -> int | None:
     """Item ``index`` of an MFNode field (negative counts from the end, as Webots)."""
     node = _mf_item(field, WB_MF_NODE, index, "wb_supervisor_field_get_mf_node")

@@ -855,11 +855,11 @@ class NodeResult(Result):
 
 class FieldValueResult(Result):
     type: str = Field(description="Webots' field type name (SFVec3f, SFRotation, SFColor, SFFloat, SFInt32, SFBool, "
-                                  "SFString, MFNode, MFColor); '' = the node has no such field here (the value is "
-                                  "then [])")
-    value: bool | float | str | list[float] | list[int] | list[list[float]] = Field(
-        description="SFBool bool; SFFloat/SFInt32 number; SFString str; SFVec3f/SFColor/SFRotation numbers; MFNode "
-                    "node ids; MFColor one list of 3 numbers per colour")
+                                  "SFString, SFNode, MFNode, MFColor); '' = the node has no such field here (the value "
+                                  "is then [])")
+    value: bool | int | float | str | list[float] | list[int] | list[list[float]] = Field(
+        description="SFBool bool; SFFloat/SFInt32 number; SFString str; SFVec3f/SFColor/SFRotation numbers; SFNode "
+                    "the node's id; MFNode node ids; MFColor one list of 3 numbers per colour")
 
 
 class NodePoseResult(Result):

@@ -1181,6 +1181,8 @@ class NestedNode(Strict):
                               "none for a node that is no Pose (Group, joints, motors, position sensors)")
     device: str | None = Field(default=None, min_length=1, description="the robot's device this node is "
                                "(Supervisor getFromDevice)")
+    joint_parameters: bool = Field(default=False, description="a HingeJoint or SliderJoint whose world file gives "
+                                   "its jointParameters node (a Supervisor reads its position there)")
 
 
 class Robot(Strict):

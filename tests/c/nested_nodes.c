@@ -1,6 +1,7 @@
 /* A Webots-style C supervisor reaching the nodes inside its robot and a solid
  * (tests/worlds/nested_nodes.wbt): by DEF and dotted path, by device, through parents and children;
- * the camera's world position before and after driving straight ahead, and in the robot's frame.
+ * the camera's world position before and after driving straight ahead, and in the robot's frame;
+ * the left wheel's joint parameters (an SFNode) and their position after driving.
  * Prints "key values" lines for tests/test_c_client.py. */
 #include <math.h>
 #include <stdio.h>
@@ -53,6 +54,11 @@ int main(void) {
     wb_robot_step(dt);
   p = wb_supervisor_node_get_position(cam);
   printf("after %.12f %.12f %.12f\n", p[0], p[1], p[2]);
+  WbNodeRef joint = wb_supervisor_node_get_from_def("LEFT_JOINT");
+  WbNodeRef params = wb_supervisor_field_get_sf_node(wb_supervisor_node_get_field(joint, "jointParameters"));
+  printf("parameters %s %d %.12f\n", wb_supervisor_node_get_type_name(params),
+         wb_supervisor_node_get_parent_node(params) == joint,
+         wb_supervisor_field_get_sf_float(wb_supervisor_node_get_field(params, "position")));
   const double *m = wb_supervisor_node_get_pose(cam, wb_supervisor_node_get_self());
   printf("in_robot %.12f %.12f %.12f\n", m[3], m[7], m[11]);
   wb_supervisor_field_set_sf_vec3f(wb_supervisor_node_get_field(tip, "translation"), (double[3]){0, 0, 1});

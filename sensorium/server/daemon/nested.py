@@ -10,9 +10,12 @@ Webots' DEF dictionary) or by a dotted path ``A.B.C`` (each name after the first
 DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``).
 
 Its world pose is its owner's pose now (the robot as it drives, the solid as a Supervisor set it)
-composed with the node's frame in the owner as the world loaded; a device riding a joint is where
-its link has moved it (other nodes past a joint stay where the world loaded them). Its fields are read-only here: ``translation``/``rotation`` (in its parent's frame),
-``name`` (Solids and devices) and ``children``.
+composed with the node's frame in the owner as the world loaded, moved by the joints it is past: a
+node inside a moving joint's end point (the end point Solid, what that Solid holds, a device riding
+the joint) is where the joint's link has put it (sim/joints.py ``Links``: the joints' displacements
+composed outward), read when a Supervisor asks, never computed otherwise. Its fields are read-only
+here: ``translation``/``rotation`` (in its parent's frame: an end point's follow its joint, as
+Webots' HingeJoint/SliderJoint set them), ``name`` (Solids and devices) and ``children``.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.sim.joints import Links
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
@@ -31,6 +35,11 @@ FIRST_ID = 1 << 24
 
 NOT_POSES = frozenset({"RotationalMotor", "LinearMotor", "PositionSensor", "Brake"})
 """Devices Webots does not derive from Pose (no position): a joint's motors and sensors."""
+
+MOVING_JOINTS = frozenset({"HingeJoint", "SliderJoint"})
+"""The joints whose end point a motor moves here (a Hinge2Joint is a steered wheel's, a BallJoint has no motor)."""
+
+MOTORS = frozenset({"RotationalMotor", "LinearMotor"})
 
 HAS_CHILDREN = frozenset({"Solid", "Pose", "Transform", "Group"})
 """Node types with a ``children`` field besides devices that are Solids (Robot, top-level Solid: supervisor.py)."""
@@ -51,6 +60,9 @@ class Nested:
     owner: int            # the top-level robot's or solid's node id
     owner_kind: str       # "Robot" | "Solid"
     owner_key: str        # the robot's or solid's name
+    joint: str = ""       # the robot's joint motor whose link carries it (the innermost moving joint it is past)
+    frame: int = -1       # the id of the nested node whose frame its ``own`` is in (-1: the owner's)
+    motor: str = ""       # a joint's JointParameters node: the joint motor whose position it holds
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,6 +70,7 @@ class Table:
     nodes: tuple[Nested, ...]
     by_owner: dict[int, tuple[Nested, ...]]     # owner id -> its nodes, depth first
     by_parent: dict[int, tuple[Nested, ...]]    # parent id -> its direct subnodes
+    bare_joints: frozenset[int] = frozenset()   # motorised joints without jointParameters (NULL)
 
     def get(self, node_id: int) -> Nested | None:
         k = node_id - FIRST_ID
@@ -83,21 +96,83 @@ def _own(local: Pose | None, above: Pose | None) -> Pose | None:
     return local if above is None else above.inverse().compose(local)
 
 
+def _first_motors(entries: list[wm.NestedNode]) -> dict[int, str]:
+    """A joint entry's index -> its first motor's device name (Webots' rotationalMotor/linearMotor)."""
+    motor: dict[int, str] = {}
+    for e in entries:
+        if e.parent >= 0 and e.field == "device" and e.type in MOTORS and e.parent not in motor:
+            motor[e.parent] = e.device or ""
+    return motor
+
+
+def _riding(robot: Any, entries: list[wm.NestedNode]) -> list[str]:
+    """Each entry's joint (the motor of the innermost joint whose end point holds it that the
+    simulation moves, "" for none): a device's is its ``on_joint``, where the simulation moves it;
+    any other node's is its parent's, or, in a HingeJoint's or SliderJoint's ``endPoint``, the
+    joint's first motor when it is one of the robot's joint motors (a wheel's motor is the drive's:
+    what its end point holds rides with what the wheel rides on, as the import's ``on_joint``)."""
+    on = {d.name: d.on_joint or "" for d in robot.model.devices}
+    moved = set(robot.joints)
+    motor = _first_motors(entries)
+    out: list[str] = []
+    for e in entries:
+        if e.device and e.device in on:
+            joint = on[e.device]
+        elif e.parent < 0:
+            joint = ""
+        else:
+            joint = out[e.parent]
+            parent = entries[e.parent]
+            if e.field == "endPoint" and parent.type in MOVING_JOINTS and motor.get(e.parent, "") in moved:
+                joint = motor[e.parent]
+        out.append(joint)
+    return out
+
+
+def _joint_parameters(sim: Any, robots: list[str], out: list[Nested]) -> tuple[list[Nested], frozenset[int]]:
+    """The JointParameters nodes of the robots' motorised HingeJoints and SliderJoints whose world
+    file gives one (numbered after every other nested node: the others' ids never move), each
+    holding its joint's position; and the ids of those joints whose file gives none (Webots' NULL)."""
+    added: list[Nested] = []
+    bare: set[int] = set()
+    first = 0
+    for i, name in enumerate(robots):
+        robot = sim.robots[name]
+        entries = _robot_entries(robot)
+        motors = _first_motors(entries)
+        for k, e in enumerate(entries):
+            motor = motors.get(k, "")
+            if e.type not in MOVING_JOINTS or motor not in robot.motors:
+                continue
+            if not e.joint_parameters:
+                bare.add(FIRST_ID + first + k)
+                continue
+            kind = "HingeJointParameters" if e.type == "HingeJoint" else "JointParameters"
+            added.append(Nested(FIRST_ID + len(out) + len(added), kind, "", "", "", FIRST_ID + first + k,
+                                "jointParameters", None, None, "", i + 1, "Robot", name, motor=motor))
+        first += len(entries)
+    return added, frozenset(bare)
+
+
 def build(sim: Any, loaded_solids: int) -> Table:
     out: list[Nested] = []
     robots = list(sim.robots)
     for i, name in enumerate(robots):
         owner = i + 1
         entries = _robot_entries(sim.robots[name])
+        joints = _riding(sim.robots[name], entries)
         first = FIRST_ID + len(out)
         frames: list[Pose | None] = []       # each entry's nearest Pose frame in the robot (None: the robot's)
+        framed: list[int] = []               # its id (-1: the robot's)
         for k, e in enumerate(entries):
             local = None if e.pose is None else pose_from_model(e.pose)
             above = None if e.parent < 0 else frames[e.parent]
+            above_id = -1 if e.parent < 0 else framed[e.parent]
             frames.append(local if local is not None else above)
+            framed.append(first + k if local is not None else above_id)
             out.append(Nested(first + k, e.type, e.proto or "", e.def_name or "", e.name or "",
                               owner if e.parent < 0 else first + e.parent, e.field, local, _own(local, above),
-                              e.device or "", owner, "Robot", name))
+                              e.device or "", owner, "Robot", name, joints[k], above_id))
     for j in range(loaded_solids):
         owner = len(robots) + 1 + j
         solid = sim.world.solids[j]
@@ -113,29 +188,71 @@ def build(sim: Any, loaded_solids: int) -> Table:
                 walk(child, node.id, local)
 
         walk(solid, owner, None)
+    parameters, bare = _joint_parameters(sim, robots, out)
+    out += parameters
     by_owner: dict[int, list[Nested]] = {}
     by_parent: dict[int, list[Nested]] = {}
     for n in out:
         by_owner.setdefault(n.owner, []).append(n)
         by_parent.setdefault(n.parent, []).append(n)
-    return Table(tuple(out), {k: tuple(v) for k, v in by_owner.items()}, {k: tuple(v) for k, v in by_parent.items()})
+    return Table(tuple(out), {k: tuple(v) for k, v in by_owner.items()}, {k: tuple(v) for k, v in by_parent.items()},
+                 bare)
 
 
 def owner_pose(sim: Any, n: Nested) -> Pose:
     return sim.robots[n.owner_key].pose if n.owner_kind == "Robot" else sim.scene.solid_poses[n.owner_key]
 
 
-def world_pose(sim: Any, n: Nested) -> Pose | None:
-    """The node's pose in the world now; None for a node that is no Pose (Webots: NaN). A device on
-    a joint (``on_joint``) is where its joint's link has moved it."""
+def link(sim: Any, n: Nested) -> Pose | None:
+    """Where the joints it is past have moved it now: its joint's link (robot frame, from where the
+    world file places it), None when it rides on no joint. The simulation keeps the links of a
+    robot on whose joints shapes, lights or devices ride; a robot without them gets its links made
+    here, on the first request, and brought up to its joints' positions on each."""
+    if not n.joint:
+        return None
+    robot = sim.robots[n.owner_key]
+    links = robot.links
+    if links is None:
+        spare = getattr(sim, "_nested_links", None)
+        if spare is None:
+            spare = sim._nested_links = {}
+        links = spare.get(n.owner_key)
+        if links is None:
+            links = spare[n.owner_key] = Links(robot.model, robot.joints)
+        links.update()
+    pose: Pose = links.poses[n.joint]
+    return pose
+
+
+def robot_frame(sim: Any, n: Nested) -> Pose | None:
+    """The node's pose in its owner's frame now (None: no Pose)."""
     if n.local is None:
         return None
-    local = n.local
-    if n.device and n.owner_kind == "Robot":
-        link = getattr(sim.robots[n.owner_key].devices.get(n.device), "link", None)
-        if link is not None:
-            local = link.compose(local)
-    return owner_pose(sim, n).compose(local)
+    moved = link(sim, n)
+    return n.local if moved is None else moved.compose(n.local)
+
+
+def world_pose(sim: Any, n: Nested) -> Pose | None:
+    """The node's pose in the world now; None for a node that is no Pose (Webots: NaN). A node past
+    a moving joint is where the joint's link has put it."""
+    local = robot_frame(sim, n)
+    return None if local is None else owner_pose(sim, n).compose(local)
+
+
+def own_pose(sim: Any, table: Table, n: Nested) -> Pose | None:
+    """Its ``translation``/``rotation`` now (in its parent's frame; None: no Pose): as loaded, but
+    for a node a joint moves apart from the frame it is in (a joint's end point), which follow the
+    joint as Webots' HingeJoint and SliderJoint set their end point's fields (turned about the
+    axis through the anchor by the joint's displacement, slid along the axis)."""
+    if n.own is None:
+        return None
+    above = table.get(n.frame)
+    if n.joint == (above.joint if above is not None else ""):
+        return n.own                        # moved with its frame, or nothing moved
+    now = robot_frame(sim, n)
+    frame = None if above is None else robot_frame(sim, above)
+    assert now is not None
+    return now if frame is None else frame.inverse().compose(now)
 
 
 def velocity(sim: Any, n: Nested) -> list[float]:
@@ -150,6 +267,19 @@ def velocity(sim: Any, n: Nested) -> list[float]:
     r = pose.translation - owner_pose(sim, n).translation
     linear = np.asarray(v[:3], dtype=np.float64) + np.cross(np.asarray(v[3:], dtype=np.float64), r)
     return [float(x) for x in linear] + [float(x) for x in v[3:]]
+
+
+def joint_parameters(table: Table, joint: int) -> int | None:
+    """A motorised joint's ``jointParameters``: its JointParameters node's id, 0 (NULL) when its
+    world file gives none; None: no such field here (no joint, or no motor moving it)."""
+    if joint in table.bare_joints:
+        return 0
+    return next((c.id for c in table.by_parent.get(joint, ()) if c.field == "jointParameters"), None)
+
+
+def joint_position(sim: Any, n: Nested) -> float:
+    """A JointParameters node's ``position``: its joint's position now (rad or m; a wheel's angle)."""
+    return float(sim.robots[n.owner_key].motors[n.motor].position)
 
 
 def has_children(n: Nested) -> bool:

@@ -428,7 +428,8 @@ field of Fog, a Transform, ...) answers Webots' "no value"."""
 
 
 def _own_pose(sim: Any, node: Node) -> Any:
-    own = _nested_of(sim, node).own
+    """A nested node's translation and rotation now (an end point's follow its joint: nested.py)."""
+    own = nested.own_pose(sim, _table(sim), _nested_of(sim, node))
     assert own is not None
     return own
 
@@ -440,13 +441,19 @@ _NESTED_POSE: dict[str, tuple[str, Getter, Setter]] = {
 
 
 def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
-    """A nested node's fields, all read-only here: its pose in its parent's frame, its name, its children."""
+    """A nested node's fields, all read-only here: its pose in its parent's frame, its name, its
+    children; a moving joint's ``jointParameters`` and their ``position``."""
     n = _nested_of(sim, node)
     out = dict(_NESTED_POSE) if n.own is not None else {}
     if n.name:
         out["name"] = ("SFString", lambda sim, node: node.name, None)
     if nested.has_children(n):
         out["children"] = ("MFNode", _children, None)
+    parameters = nested.joint_parameters(_table(sim), n.id)
+    if parameters is not None:        # a motorised joint's (0: NULL), holding its position now
+        out["jointParameters"] = ("SFNode", lambda sim, node: parameters, None)
+    if n.motor:
+        out["position"] = ("SFFloat", lambda sim, node: nested.joint_position(sim, _nested_of(sim, node)), None)
     return out
 
 

@@ -471,7 +471,8 @@ static const struct {
   WbFieldType type;
 } FIELD_TYPES[] = {{"SFBool", WB_SF_BOOL},     {"SFInt32", WB_SF_INT32},   {"SFFloat", WB_SF_FLOAT},
                    {"SFVec3f", WB_SF_VEC3F},     {"SFRotation", WB_SF_ROTATION}, {"SFColor", WB_SF_COLOR},
-                   {"SFString", WB_SF_STRING},   {"MFColor", WB_MF_COLOR},   {"MFNode", WB_MF_NODE}};
+                   {"SFString", WB_SF_STRING},   {"SFNode", WB_SF_NODE},     {"MFColor", WB_MF_COLOR},
+                   {"MFNode", WB_MF_NODE}};
 
 typedef struct {
   int64_t node;
@@ -710,6 +711,20 @@ WbNodeRef wb_supervisor_field_get_mf_node(WbFieldRef field, int index) {
     id = -1;
   sn_reply_free(&rep);
   return id < 0 ? NULL : node_from_id(id, func);
+}
+
+/* the node of an SFNode field (a joint's jointParameters); NULL for Webots' NULL (id 0 on the wire) */
+WbNodeRef wb_supervisor_field_get_sf_node(WbFieldRef field) {
+  const char *func = "wb_supervisor_field_get_sf_node";
+  sn_reply rep;
+  const msgpack_object *v;
+  if (field_value(field, WB_SF_NODE, func, &rep, &v) != 0)
+    return NULL;
+  int64_t id = 0;
+  if (v == NULL || !sn_as_int64(v, &id))
+    id = 0;
+  sn_reply_free(&rep);
+  return id <= 0 ? NULL : node_from_id(id, func);
 }
 
 /* colour index of an MFColor field (a Background's skyColor); valid until the next call on the field */

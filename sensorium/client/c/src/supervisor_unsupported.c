@@ -180,11 +180,6 @@ const double *wb_supervisor_field_get_sf_vec2f(WbFieldRef field) {
 
 
 
-WbNodeRef wb_supervisor_field_get_sf_node(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
 bool wb_supervisor_field_get_mf_bool(WbFieldRef field, int index) {
   SN_UNSUPPORTED();
   return false;

@@ -70,6 +70,9 @@ class Field:
     def getSFColor(self) -> list[float] | None:
         return wb.wb_supervisor_field_get_sf_color(self._ref)
 
+    def getSFNode(self) -> Node | None:
+        return _node_of(wb.wb_supervisor_field_get_sf_node(self._ref))
+
     def getMFNode(self, index: int) -> Node | None:
         return _node_of(wb.wb_supervisor_field_get_mf_node(self._ref, index))
 
@@ -103,7 +106,8 @@ class Field:
 
     _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_INT32: getSFInt32, wb.WB_SF_FLOAT: getSFFloat,
                 wb.WB_SF_STRING: getSFString,
-                wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor}
+                wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor,
+                wb.WB_SF_NODE: getSFNode}
 
     name = property(getName)
     type = property(getType)
@@ -379,7 +383,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
     Field: {
         "getActualField": ("field_get_actual_field", None), "removeMF": ("field_remove_mf", None),
         "removeSF": ("field_remove_sf", None),
-        # no node here has an SFNode field to import into (the root's children are its only node field)
+        # no SFNode field here takes an import (a joint's jointParameters is read-only)
         "importSFNodeFromString": ("field_import_sf_node_from_string", None)},
 }
 _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 2, "Vec3f": [_NAN] * 3,
@@ -390,7 +394,7 @@ for _kind, _none in _FIELD_NO_VALUES.items():
         _UNSERVED[Field][f"getMF{_kind}"] = (f"field_get_mf_{_c}", _none)
         _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None)
         _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None)
-    if _kind in ("Vec2f", "Node"):   # the SF field types no node here has
+    if _kind == "Vec2f":             # the SF field type no node here has
         _UNSERVED[Field][f"getSF{_kind}"] = (f"field_get_sf_{_c}", _none)
     if _kind in ("Int32", "Vec2f", "String"):  # SFString fields are read-only here
         _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None)

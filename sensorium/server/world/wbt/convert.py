@@ -363,6 +363,8 @@ class Converter:
         entry: dict[str, Any] = {"type": t}
         if posed:
             entry["pose"] = self.child_frame(node, frame).pose()
+        if t in ("HingeJoint", "SliderJoint") and self.fields(node).node_("jointParameters") is not None:
+            entry["joint_parameters"] = True
         self.tree_entry(node, entry, field, proto)
         self.tree_stack.append((node, len(self.tree) - 1))
         return True

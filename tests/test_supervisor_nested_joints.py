@@ -1,0 +1,243 @@
+"""A Supervisor reads a robot's nodes past its joints where the joints have put them
+(tests/worlds/nested_joints.wbt, through the sans-IO core on a real simulation): the world pose of
+an arm's link Solid, of what it holds and of a slider's end point after the joints moved, the end
+points' ``translation``/``rotation`` fields following their joints as Webots' HingeJoint and
+SliderJoint set them, and before any motion the poses the world file gives. Closed forms: the robot
+stands at (1, 2, 0) turned a quarter turn about z; the shoulder turns about z through (0.1, 0, 0.2),
+the slider slides along the link's x from position 0.1. The same through a Python controller
+(``sensorium serve``)."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+import numpy as np
+import pytest
+from test_multiprocess import REPO, run_paused
+from test_supervisor import A, Live
+
+from sensorium.schemas.wire import ErrorCode
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+WORLD = REPO / "tests" / "worlds" / "nested_joints.wbt"
+HALF_PI = math.pi / 2
+ROBOT = np.array([1.0, 2.0, 0.0])         # the robot's translation; its rotation: rz(HALF_PI)
+ANCHOR = np.array([0.1, 0.0, 0.2])        # the shoulder's, robot frame
+SLIDE0, D = 0.1, 0.25                      # the slider's initial position, how far it is moved
+
+
+def rz(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rx(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def world(p) -> list[float]:
+    """A robot-frame point in the world."""
+    return list(rz(HALF_PI) @ np.asarray(p, dtype=np.float64) + ROBOT)
+
+
+def shoulder(p, q: float) -> np.ndarray:
+    """A robot-frame point past the shoulder turned by q."""
+    return rz(q) @ (np.asarray(p, dtype=np.float64) - ANCHOR) + ANCHOR
+
+
+class Arm:
+    def __init__(self, path=WORLD, robot: str = "armbot"):
+        self.robot = robot
+        self.lv = Live(Simulation(load_world(path)))
+        self.lv.ok(A, "attach", {"robot": robot})
+
+    def call(self, item: str, args: dict):
+        return self.lv.ok(A, f"/{self.robot}/robot/{item}", args)
+
+    def node(self, name: str) -> int:
+        return self.call("get_from_def", {"name": name})["node"]
+
+    def position(self, name: str) -> list[float]:
+        return self.call("get_node_pose", {"node": self.node(name)})["position"]
+
+    def orientation(self, name: str) -> np.ndarray:
+        return np.array(self.call("get_node_pose", {"node": self.node(name)})["orientation"]).reshape(3, 3)
+
+    def field(self, name: str, field: str) -> list[float]:
+        got = self.call("get_field", {"node": self.node(name), "field": field})
+        assert got["type"] in ("SFVec3f", "SFRotation"), got
+        return got["value"]
+
+    def move(self, motor: str, target: float) -> None:
+        """Command the joint and step until it is there (generous limit)."""
+        m = self.lv.sim.robot(self.robot).motor(motor)
+        m.set_position(target)
+        for _ in range(1000):
+            if m.position == target:
+                return
+            self.lv.step(A, self.robot)
+        raise AssertionError(f"{motor} did not reach {target}: {m.position}")
+
+
+def test_before_any_motion_the_nodes_are_where_the_world_file_puts_them():
+    arm = Arm()
+    assert arm.position("LINK") == pytest.approx(world([0.3, 0.0, 0.2]), abs=1e-12)
+    assert arm.orientation("LINK") == pytest.approx(rz(HALF_PI), abs=1e-12)
+    assert arm.position("HAND") == pytest.approx(world([0.5, 0.0, 0.3]), abs=1e-12)
+    assert arm.orientation("FINGER") == pytest.approx(rz(HALF_PI) @ rx(HALF_PI), abs=1e-12)
+    assert arm.position("CARRIAGE") == pytest.approx(world([0.4, 0.0, 0.25]), abs=1e-12)
+    assert arm.field("LINK", "translation") == pytest.approx([0.3, 0.0, 0.2], abs=1e-12)
+    assert arm.field("LINK", "rotation") == pytest.approx([0.0, 0.0, 1.0, 0.0], abs=1e-12)
+    assert arm.field("CARRIAGE", "translation") == pytest.approx([0.1, 0.0, 0.05], abs=1e-12)
+
+
+def test_a_turned_hinge_carries_its_link_and_what_the_link_holds():
+    arm = Arm()
+    arm.move("shoulder", HALF_PI)
+    turned = rz(HALF_PI) @ rz(HALF_PI)
+    # the link Solid: (0.3, 0, 0.2) turned a quarter turn about z through the anchor: (0.1, 0.2, 0.2)
+    assert list(shoulder([0.3, 0.0, 0.2], HALF_PI)) == pytest.approx([0.1, 0.2, 0.2], abs=1e-15)
+    assert arm.position("LINK") == pytest.approx(world([0.1, 0.2, 0.2]), abs=1e-12)
+    assert arm.position("LINK") == pytest.approx([0.8, 2.1, 0.2], abs=1e-12)
+    assert arm.orientation("LINK") == pytest.approx(turned, abs=1e-12)
+    # what it holds, at any depth (through a Pose), and a device on it
+    assert arm.position("HAND") == pytest.approx([0.6, 2.1, 0.3], abs=1e-12)
+    assert arm.orientation("HAND") == pytest.approx(turned, abs=1e-12)
+    assert arm.position("ELBOW") == pytest.approx(world(shoulder([0.5, 0.0, 0.2], HALF_PI)), abs=1e-12)
+    assert arm.position("FINGER") == pytest.approx(world(shoulder([0.5, 0.1, 0.2], HALF_PI)), abs=1e-12)
+    assert arm.orientation("FINGER") == pytest.approx(turned @ rx(HALF_PI), abs=1e-12)
+    assert arm.position("TOOL") == pytest.approx([0.6, 2.1, 0.2], abs=1e-12)
+    assert arm.position("CARRIAGE") == pytest.approx(world(shoulder([0.4, 0.0, 0.25], HALF_PI)), abs=1e-12)
+    # getPose(from): the hand in the link's frame is as the file places it
+    rel = arm.call("get_node_pose", {"node": arm.node("HAND")})
+    link = arm.call("get_node_pose", {"node": arm.node("LINK")})
+    r_link = np.array(link["orientation"]).reshape(3, 3)
+    assert list(r_link.T @ (np.array(rel["position"]) - np.array(link["position"]))) == \
+        pytest.approx([0.2, 0.0, 0.1], abs=1e-12)
+    # the end point's fields follow the joint (Webots' HingeJoint sets them); the others, in the
+    # link's frame, stay
+    assert arm.field("LINK", "translation") == pytest.approx([0.1, 0.2, 0.2], abs=1e-12)
+    assert arm.field("LINK", "rotation") == pytest.approx([0.0, 0.0, 1.0, HALF_PI], abs=1e-12)
+    assert arm.field("HAND", "translation") == pytest.approx([0.0, 0.0, 0.1], abs=1e-12)
+    assert arm.field("ELBOW", "translation") == pytest.approx([0.2, 0.0, 0.0], abs=1e-12)
+    assert arm.field("FINGER", "rotation") == pytest.approx([1.0, 0.0, 0.0, HALF_PI], abs=1e-12)
+    assert arm.field("CARRIAGE", "translation") == pytest.approx([0.1, 0.0, 0.05], abs=1e-12)
+    # back where it started: the loaded poses again
+    arm.move("shoulder", 0.0)
+    assert arm.position("HAND") == pytest.approx(world([0.5, 0.0, 0.3]), abs=1e-12)
+    assert arm.field("LINK", "translation") == pytest.approx([0.3, 0.0, 0.2], abs=1e-12)
+
+
+def test_a_slid_slider_moves_its_end_point_along_its_axis_and_joints_compose():
+    arm = Arm()
+    arm.move("slide", SLIDE0 + D)
+    assert arm.position("CARRIAGE") == pytest.approx(world([0.4 + D, 0.0, 0.25]), abs=1e-12)
+    assert arm.position("CARRIAGE") == pytest.approx([1.0, 2.65, 0.25], abs=1e-12)
+    assert arm.orientation("CARRIAGE") == pytest.approx(rz(HALF_PI), abs=1e-12)
+    assert arm.field("CARRIAGE", "translation") == pytest.approx([0.1 + D, 0.0, 0.05], abs=1e-12)
+    assert arm.field("CARRIAGE", "rotation") == pytest.approx([0.0, 0.0, 1.0, 0.0], abs=1e-12)
+    assert arm.position("LINK") == pytest.approx(world([0.3, 0.0, 0.2]), abs=1e-12)   # the shoulder did not turn
+    # the shoulder turned too: the slid carriage turns with the link
+    arm.move("shoulder", HALF_PI)
+    assert arm.position("CARRIAGE") == pytest.approx([0.45, 2.1, 0.25], abs=1e-12)
+    assert arm.orientation("CARRIAGE") == pytest.approx(rz(math.pi), abs=1e-12)
+    assert arm.field("CARRIAGE", "translation") == pytest.approx([0.1 + D, 0.0, 0.05], abs=1e-12)  # in the link
+
+
+def test_a_joints_parameters_hold_its_position_now():
+    """A moving joint's jointParameters (SFNode): a HingeJointParameters / JointParameters node whose
+    ``position`` reads the joint's position, loaded then moved; read-only, as the other nested fields."""
+    arm = Arm()
+
+    def parameters(joint: str) -> int:
+        got = arm.call("get_field", {"node": arm.node(joint), "field": "jointParameters"})
+        assert got["type"] == "SFNode"
+        return got["value"]
+
+    def position(params: int):
+        return arm.call("get_field", {"node": params, "field": "position"})
+
+    hinge, slider = parameters("SHOULDER"), parameters("SLIDE")
+    assert arm.call("get_from_id", {"id": hinge}) == {"node": hinge, "type": "HingeJointParameters", "name": "",
+                                                      "def_name": "", "parent": arm.node("SHOULDER"), "proto": ""}
+    assert arm.call("get_from_id", {"id": slider})["type"] == "JointParameters"
+    assert position(hinge) == {"type": "SFFloat", "value": 0.0}
+    assert position(slider) == {"type": "SFFloat", "value": SLIDE0}
+    assert all(math.isnan(v) for v in arm.call("get_node_pose", {"node": hinge})["position"])   # no Pose
+    arm.move("shoulder", HALF_PI)
+    arm.move("slide", SLIDE0 + D)
+    assert position(hinge)["value"] == HALF_PI
+    assert position(slider)["value"] == SLIDE0 + D
+    assert arm.call("get_field", {"node": arm.node("LINK"), "field": "jointParameters"})["type"] == ""
+    msg = arm.lv.err(A, "/armbot/robot/set_field", {"node": hinge, "field": "position", "value": 1.0},
+                     ErrorCode.INVALID_ARGUMENT)
+    assert "field 'position' (SFFloat) of HingeJointParameters" in msg and "read-only here" in msg
+    arm.lv.sim.reset()                      # a reset puts the joints back, and their positions
+    assert position(hinge)["value"] == 0.0 and position(slider)["value"] == SLIDE0
+
+
+SOLID_ONLY = """#VRML_SIM R2023b utf8
+Robot {
+  name "bare" controller "<extern>" supervisor TRUE
+  children [
+    HingeJoint {
+      jointParameters HingeJointParameters { axis 0 0 1 anchor 0.1 0 0 position 0.5 }
+      device [ RotationalMotor { name "turn" maxVelocity 100 } ]
+      endPoint DEF END Solid { translation 0.3 0 0 rotation 0 0 1 0.5 children [ DEF KNOB Solid { translation 0.1 0 0 } ] }
+    }
+    DEF FREE HingeJoint {
+      device [ RotationalMotor { name "free" } ]
+      endPoint DEF WING Solid { translation 0 0.2 0 }
+    }
+  ]
+}
+"""
+
+
+def test_a_joint_that_carries_nothing_but_solids_moves_them_too(tmp_path):
+    """Nothing but Solids past the joint (no shape, device or light rides it): the links are made
+    when the Supervisor asks. The joint starts at 0.5 (where the file places the end point)."""
+    path = tmp_path / "bare.wbt"
+    path.write_text(SOLID_ONLY)
+    arm = Arm(path, "bare")
+    assert arm.lv.sim.robot("bare").links is None
+    assert arm.position("KNOB") == pytest.approx([0.3 + 0.1 * math.cos(0.5), 0.1 * math.sin(0.5), 0.0], abs=1e-12)
+    arm.move("turn", 0.5 + HALF_PI)
+    assert arm.position("END") == pytest.approx([0.1, 0.2, 0.0], abs=1e-12)
+    assert arm.orientation("END") == pytest.approx(rz(0.5 + HALF_PI), abs=1e-12)
+    assert arm.position("KNOB") == pytest.approx([0.1 - 0.1 * math.sin(0.5), 0.2 + 0.1 * math.cos(0.5), 0.0],
+                                                 abs=1e-12)
+    assert arm.field("END", "translation") == pytest.approx([0.1, 0.2, 0.0], abs=1e-12)
+    assert arm.field("END", "rotation") == pytest.approx([0.0, 0.0, 1.0, 0.5 + HALF_PI], abs=1e-12)
+    assert arm.lv.sim.robot("bare").links is None            # the simulation still moves no link
+    # a joint the world file gives no jointParameters: Webots' NULL
+    assert arm.call("get_field", {"node": arm.node("FREE"), "field": "jointParameters"}) == {"type": "SFNode",
+                                                                                           "value": 0}
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_webots_supervisor_reads_its_arm_where_the_joints_put_it(tmp_path):
+    """tests/controllers/nested_joints.py through ``sensorium serve``, written as for Webots."""
+    ctl = run_paused(WORLD, tmp_path, "nested_joints.py", "armbot")
+    out = json.loads(ctl.out[-1])
+    before, after = out["before"], out["after"]
+    assert out["at"] == [HALF_PI, SLIDE0 + D]
+    assert before["link"] == pytest.approx(world([0.3, 0.0, 0.2]), abs=1e-12)
+    assert before["link_translation"] == pytest.approx([0.3, 0.0, 0.2], abs=1e-12)
+    assert before["carriage"] == pytest.approx(world([0.4, 0.0, 0.25]), abs=1e-12)
+    assert after["link"] == pytest.approx([0.8, 2.1, 0.2], abs=1e-12)
+    assert np.array(after["link_orientation"]).reshape(3, 3) == pytest.approx(rz(math.pi), abs=1e-12)
+    assert after["hand"] == pytest.approx([0.6, 2.1, 0.3], abs=1e-12)
+    assert after["carriage"] == pytest.approx(world(shoulder([0.4 + D, 0.0, 0.25], HALF_PI)), abs=1e-12)
+    assert after["link_translation"] == pytest.approx([0.1, 0.2, 0.2], abs=1e-12)
+    assert after["link_rotation"] == pytest.approx([0.0, 0.0, 1.0, HALF_PI], abs=1e-12)
+    assert after["carriage_translation"] == pytest.approx([0.1 + D, 0.0, 0.05], abs=1e-12)
+    assert out["parameters"] == [["HingeJointParameters", "SHOULDER"], ["JointParameters", "SLIDE"]]
+    assert before["positions"] == [0.0, SLIDE0]
+    assert after["positions"] == [HALF_PI, SLIDE0 + D]
+    for seen in (before, after):            # getPose(link): the hand where the file puts it in the link
+        assert seen["hand_in_link"] == pytest.approx([0.2, 0.0, 0.1], abs=1e-12)
