@@ -210,6 +210,38 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     assert sorted(sim.joints) == ["grip", "lift"]
 
 
+def test_an_arm_of_plain_cylinders_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> None:
+    """An arm whose shoulder turns about the robot's +y like the wheels and whose link is a plain
+    Cylinder standing up from the joint (along z, its centre 0.1 above the axis): something round, but
+    it does not turn about the hinge as a wheel does, so the robot keeps its two-wheel drive (three
+    "wheels", one on the x axis, made none) and the shoulder moves its joint with its one warning. A
+    link that is coaxial with its hinge (a roller) would still roll: it is judged a wheel as before."""
+    def body(link: str) -> str:
+        arm = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0.05 0 0.3 }\n'
+               '  device [ RotationalMotor { name "shoulder" } PositionSensor { name "shoulder sensor" } ]\n'
+               f'  endPoint Solid {{ translation 0.05 0 0.3 children [ {link} ] }} }}\n')
+        return ('Robot { name "armbot" children [\n' + wheel("left wheel", 0, 0.15) + wheel("right wheel", 0, -0.15)
+                + arm + '] }\n')
+
+    upright = 'Pose { translation 0 0 0.1 children [ Shape { geometry Cylinder { radius 0.02 height 0.2 } } ] }'
+    p = write(tmp_path, body(upright))
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert not [x for x in w.warnings if "drive" in x]
+    assert f"{p}:6:1: HingeJoint motor 'shoulder' is no wheel (nothing round at its end point turns about its " \
+           "axis as a wheel does): its joint moves kinematically (Webots' rule without physics; its PositionSensor " \
+           "reads it), and the shapes and devices past the joint with it" in w.warnings
+    sim = Simulation(w).robot("armbot")
+    assert sorted(sim.drive.motors) == ["left wheel", "right wheel"] and sorted(sim.joints) == ["shoulder"]
+    # the same link lying along the hinge's axis, centred on it, is a roller: no drive, as before
+    roller = 'Pose { rotation 1 0 0 1.5708 children [ Shape { geometry Cylinder { radius 0.02 height 0.2 } } ] }'
+    w = load_world(write(tmp_path, body(roller)))
+    assert w.world.robots[0].differential_drive is None
+    assert [x for x in w.warnings if "no differential drive" in x]
+
+
 def test_a_robot_whose_motorised_hinges_have_nothing_round_is_no_failed_vehicle(tmp_path: Path) -> None:
     """A fixed pan-tilt head (a pan hinge about z, its end point a box holding a tilt hinge about y
     whose end point holds a camera in a box) and a gripper's two finger hinges about z (Webots'

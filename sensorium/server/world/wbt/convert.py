@@ -1459,7 +1459,13 @@ class Converter:
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
     def drive(self, node: Node, robot: Owner) -> None:
-        from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive, holds_wheel, wheel_radius
+        from sensorium.server.world.wbt.drive import (
+            ackermann_drive,
+            differential_drive,
+            holds_wheel,
+            rolls_about_its_axis,
+            wheel_radius,
+        )
 
         wheels = robot.wheels
         if not wheels:
@@ -1500,6 +1506,18 @@ class Converter:
                             self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel (its end point has no "
                                                  f"cylinder or sphere to roll on): {JOINT_MOVES}")
                     wheels = rolling
+            if drive is None:
+                # then a hinge whose round part does not turn about its axis (an arm's link of a plain
+                # cylinder, across the axis or off it) is no wheel either
+                coaxial = [w for w in wheels if rolls_about_its_axis(w, self)]
+                if 2 <= len(coaxial) < len(wheels):
+                    drive, _ = differential_drive(coaxial, self)
+                    if drive is not None:
+                        for w in wheels:
+                            if not any(w is r for r in coaxial):
+                                self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel (nothing round at "
+                                                     f"its end point turns about its axis as a wheel does): {JOINT_MOVES}")
+                        wheels = coaxial
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return

@@ -33,6 +33,8 @@ Anything else gets one sentence saying which of these failed.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sensorium.server.world.wbt.parser import Node
@@ -68,6 +70,53 @@ def wheel_radius(end: Node | None, conv) -> float | None:
         return None
 
     return find(f.node_("boundingObject"), 1.0) or find(end, 1.0)
+
+
+def rolls_about_its_axis(w: dict, conv) -> bool:
+    """Whether a motorised hinge's end point turns something round as a wheel turns: its first
+    cylinder or capsule (boundingObject first, as :func:`wheel_radius` looks) lies along the hinge's
+    axis with its centre on it, or its first sphere is centred on the axis (within a quarter of the
+    radius, 5° of tilt). An arm's link of a plain cylinder, standing across the axis or off it, does
+    not: a robot with such an arm beside its wheels keeps its drive."""
+    end = w["end"]
+    while end is not None and end.type == "Slot":
+        end = conv.fields(end).node_("endPoint")
+    if end is None:
+        return False
+    axis = np.asarray(w["axis"], dtype=np.float64)
+    axis = axis / np.linalg.norm(axis)
+    anchor = np.asarray(w["anchor"], dtype=np.float64)
+
+    def judge(kind: str, radius: float, frame) -> bool:
+        centre = np.asarray(frame.translation, dtype=np.float64)
+        off = (centre - anchor) - axis * float(np.dot(centre - anchor, axis))
+        if float(np.linalg.norm(off)) > 0.25 * radius:
+            return False
+        if kind == "Sphere":
+            return True
+        along = np.asarray(frame.rotation, dtype=np.float64) @ np.array([0.0, 0.0, 1.0])
+        return abs(float(np.dot(along, axis))) >= math.cos(math.radians(5.0)) * float(np.linalg.norm(along))
+
+    def find(node: Node | None, frame) -> bool | None:
+        if node is None:
+            return None
+        conv.walk(node)
+        nf = conv.fields(node)
+        if node.type in ("Cylinder", "Sphere", "Capsule"):
+            return judge(node.type, nf.num("radius", 1.0) * frame.scale, frame)
+        if node.type == "Shape":
+            return find(nf.node_("geometry"), frame)
+        if node.type in ("Pose", "Transform", "Group", "Solid"):
+            inner = frame if node.type == "Group" else conv.child_frame(node, frame)
+            for child in nf.nodes("children"):
+                r = find(child, inner)
+                if r is not None:
+                    return r
+        return None
+
+    at = conv.child_frame(end, w["frame"])
+    found = find(conv.fields(end).node_("boundingObject"), at)
+    return bool(found if found is not None else find(end, w["frame"]))
 
 
 def holds_wheel(end: Node | None, conv) -> bool:
