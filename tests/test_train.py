@@ -34,14 +34,21 @@ def test_train_ppo_refuses_bad_counts_in_one_line(argv, why, capsys):
     assert e.value.code == 2 and why in capsys.readouterr().err
 
 
-def test_train_ppo_says_when_no_episode_ended_yet(capsys):
-    """A run too short for any episode to end printed a traceback (IndexError) instead of its summary."""
+def test_train_ppo_says_when_no_episode_ended_yet(capsys, monkeypatch, tmp_path):
+    """A run too short for any episode to end printed a traceback (IndexError) instead of its summary.
+    It leaves nothing in the temporary directory (SB3's default logger made an empty SB3-<date>
+    folder there at every run)."""
     pytest.importorskip("stable_baselines3")
     pytest.importorskip("torch")
+    import tempfile
+
     from sensorium.gym.examples.train_ppo import main
 
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    monkeypatch.delenv("SB3_LOGDIR", raising=False)
     assert main(["--steps", "256", "--envs", "4"]) == 0      # (one rollout: 4 x 256 steps, no episode ends)
     assert "no episode ended yet (train longer)" in capsys.readouterr().out
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith("SB3-")] == []
 
 
 def test_sb3_adapter_passes_sb3s_checker_and_hands_over_terminal_observations():

@@ -29,6 +29,7 @@ def train(steps: int = 150_000, envs: int = 16, seed: int = 0, precision: str = 
     import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.logger import Logger
 
     from sensorium.gym.sb3 import SB3VecEnv
     from sensorium.gym.tasks import reach_light_task
@@ -61,6 +62,9 @@ def train(steps: int = 150_000, envs: int = 16, seed: int = 0, precision: str = 
     model = PPO("MlpPolicy", venv, n_steps=256, batch_size=1024, n_epochs=5, learning_rate=1e-3, gamma=0.995,
                 gae_lambda=0.95, ent_coef=0.0, policy_kwargs={"net_arch": [64, 64]}, seed=seed, verbose=0,
                 device="cpu")
+    # a logger with no outputs: SB3's default (verbose 0) makes an empty SB3-<date> folder in the
+    # system's temporary directory at every run; the curve above is what this example reports
+    model.set_logger(Logger(folder=None, output_formats=[]))
     t0 = time.perf_counter()
     model.learn(total_timesteps=steps, callback=Curve())
     wall = time.perf_counter() - t0
