@@ -606,3 +606,17 @@ def test_single_file_channels_carry_the_qos(views_recording, tmp_path):
         (profile,) = rosbag2_qos_list(channel.metadata["offered_qos_profiles"], 8)
         assert (profile["reliability"], profile["durability"], profile["depth"]) == \
                expected_qos(topic, summary.schemas[channel.schema_id].name), topic
+
+
+def test_the_recorded_worlds_unpacked_files_are_removed_after_export(views_recording, tmp_path, monkeypatch):
+    """The attached world (and its meshes) are unpacked to a temporary folder for the scene and
+    transform views; it is removed once the export ends (each export used to leave a
+    sensorium-world-* folder behind)."""
+    import tempfile
+
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    report = export_ros2(views_recording, tmp_path / "bag", distro="jazzy")
+    assert {"/tf_static", "/scene"} <= set(report.topics)          # the world was unpacked and used
+    assert [p.name for p in scratch.iterdir() if p.name.startswith("sensorium-world-")] == []

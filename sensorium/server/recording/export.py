@@ -35,6 +35,7 @@ import struct
 import sys
 import tempfile
 from collections.abc import Callable
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,7 @@ from typing import Any
 import msgpack
 import numpy as np
 
+from sensorium.schemas import world as wm
 from sensorium.schemas.devices import KINDS
 from sensorium.server.recording import cdr
 from sensorium.server.recording.envelope import unmatched_topics
@@ -350,11 +352,19 @@ class _Added:
 def _iter_converted(rec: Recording, typestore, topics, pointcloud2: bool, report: ExportReport,
                     start_ns: int | None, end_ns: int | None, views: bool = True):
     """``(message, export type, message dict, added)`` in order; ``added`` marks the scene and
-    transform messages of :mod:`.ros_views` (when ``views`` and the recorded world has them)."""
+    transform messages of :mod:`.ros_views` (when ``views`` and the recorded world has them). The
+    recorded world's unpacked files live while the messages are converted."""
+    from sensorium.server.recording import ros_views
+
+    with ros_views.recorded_world(rec) if views else nullcontext((None, Path("."))) as (world, base_dir):
+        yield from _converted(rec, typestore, topics, pointcloud2, report, start_ns, end_ns, world, base_dir)
+
+
+def _converted(rec: Recording, typestore, topics, pointcloud2: bool, report: ExportReport,
+               start_ns: int | None, end_ns: int | None, world: wm.World | None, base_dir: Path):
     from sensorium.server.recording import ros_views
     from sensorium.server.recording.frames import JointFrames
 
-    world, base_dir = ros_views.recorded_world(rec) if views else (None, Path("."))
     started = False
     tf_seq = 0
     joint_frames: JointFrames | None = None

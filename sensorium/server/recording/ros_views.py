@@ -18,6 +18,8 @@ by :func:`sensorium.server.recording.export.to_ros`'s converter (fields not set 
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -35,24 +37,30 @@ _ARROW, _CUBE, _SPHERE, _CYLINDER, _TRIANGLE_LIST = 0, 1, 2, 3, 11
 _FLAT = 1e-3                      # thickness of a plane's cube marker (a zero scale is invalid in RViz)
 
 
-def recorded_world(rec: Any) -> tuple[wm.World | None, Path]:
-    """The world model attached to a recording (the attachments unpacked to a temporary directory so
-    that mesh files resolve), or ``(None, .)`` when it is missing or does not load."""
+@contextmanager
+def recorded_world(rec: Any) -> Iterator[tuple[wm.World | None, Path]]:
+    """The world model attached to a recording, with its attachments unpacked to a temporary
+    directory so that mesh files resolve (removed when the context ends), or ``(None, .)`` when it
+    is missing or does not load."""
     from sensorium.server.world.loader import WorldError, load_world
 
     found = rec.world()
     if found is None:
-        return None, Path(".")
-    tmp = Path(tempfile.mkdtemp(prefix="sensorium-world-"))
-    try:
-        for a in rec.attachments():
-            target = (tmp / a.name).resolve()
-            if tmp.resolve() in target.parents and not target.exists():
-                target.parent.mkdir(parents=True, exist_ok=True)
-                target.write_bytes(a.data)
-        return load_world(tmp / found[0]).world, tmp
-    except (WorldError, OSError, ValueError):
-        return None, Path(".")
+        yield None, Path(".")
+        return
+    with tempfile.TemporaryDirectory(prefix="sensorium-world-") as unpacked:
+        tmp = Path(unpacked)
+        world: wm.World | None
+        try:
+            for a in rec.attachments():
+                target = (tmp / a.name).resolve()
+                if tmp.resolve() in target.parents and not target.exists():
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                    target.write_bytes(a.data)
+            world = load_world(tmp / found[0]).world
+        except (WorldError, OSError, ValueError):
+            world = None
+        yield (world, tmp) if world is not None else (None, Path("."))
 
 
 def pose_robot(topic: str, ros_type: str) -> str | None:

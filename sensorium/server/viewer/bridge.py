@@ -44,6 +44,7 @@ import time
 from collections import Counter, deque
 from collections.abc import Callable, Iterable
 from collections.abc import Set as AbstractSet
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any, cast
 
@@ -242,6 +243,7 @@ class FoxgloveBridge:
         from sensorium.server.recording import scene3d as fxscene
         from sensorium.server.recording.frames import JointFrames, mounts
 
+        self._unpacked = ExitStack()        # a replay's unpacked world files (for_replay), removed at close
         self._scene_mod = fxscene
         self.encoder = CdrEncoder(distro, pointcloud2=True)
         self.world = world
@@ -352,9 +354,16 @@ class FoxgloveBridge:
         (and meshes) attached to the recording, when it loads."""
         from sensorium.server.recording.ros_views import recorded_world
 
-        world, base = recorded_world(replayer.recording)
-        bridge = cls(dict(replayer.topic_types), world, base, host=host, port=port,
-                     name=f"sensorium replay {Path(replayer.path).name}", largest_message=largest_message(world), **kw)
+        unpacked = ExitStack()                    # the recorded world's files, removed when the bridge closes
+        world, base = unpacked.enter_context(recorded_world(replayer.recording))
+        try:
+            bridge = cls(dict(replayer.topic_types), world, base, host=host, port=port,
+                         name=f"sensorium replay {Path(replayer.path).name}", largest_message=largest_message(world),
+                         **kw)
+        except BaseException:
+            unpacked.close()
+            raise
+        bridge._unpacked = unpacked
         replayer.viewer = bridge.record
         return bridge
 
@@ -595,6 +604,7 @@ class FoxgloveBridge:
             self.server.stop()
         except Exception:  # noqa: BLE001 - already stopped
             pass
+        self._unpacked.close()
 
     def __enter__(self) -> FoxgloveBridge:
         return self
