@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.sim.speaker import speech_frames
+from sensorium.server.sim.speaker import MAX_SOUNDS, speech_frames
 from sensorium.server.sim.vacuum import GRIP_DISTANCE, _shape_obstacle, prism_gap
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
@@ -170,6 +170,20 @@ def test_playing_a_sound_again_while_it_plays_does_not_restart_it(sim: Simulatio
     sim.run(3)                                               # 48 ms played
     spk.play_sound("s.wav", 3200, 32000, 1.0, False, 0)      # type: ignore[attr-defined]
     assert _playing_steps(sim) == 4                          # 52 ms left: 4 steps, not 7
+
+
+def test_one_speaker_plays_at_most_max_sounds_at_once(sim: Simulation) -> None:
+    """A bound on the work a controller can ask for: the 257th distinct sound playing at once is
+    refused in one line (the same name again only updates it, as before); one stopped, another plays."""
+    spk = sim.device("arm/speaker")
+    for k in range(MAX_SOUNDS):
+        spk.play_sound(f"s{k}.wav", 16000, 16000, 1.0, True, 0)   # type: ignore[attr-defined]
+    spk.play_sound("s0.wav", 16000, 16000, 1.0, False, 0)          # type: ignore[attr-defined]   an update
+    with pytest.raises(ValueError, match=f"{MAX_SOUNDS} sounds already play on this speaker"):
+        spk.play_sound("one.wav", 16000, 16000, 1.0, False, 0)     # type: ignore[attr-defined]
+    spk.stop("s1.wav")                                             # type: ignore[attr-defined]
+    spk.play_sound("one.wav", 16000, 16000, 1.0, False, 0)         # type: ignore[attr-defined]
+    assert len(spk.playing) == MAX_SOUNDS and spk.playing[-1] == "one.wav"   # type: ignore[attr-defined]
 
 
 def test_speech_lasts_its_words(sim: Simulation) -> None:

@@ -30,6 +30,9 @@ __all__ = ["SECONDS_PER_WORD", "Speaker", "speech_frames"]
 SECONDS_PER_WORD = Fraction(2, 5)
 """s per spoken word (150 words a minute)."""
 
+MAX_SOUNDS = 256
+"""Sounds one speaker plays at once (a bound of ours: each costs the server work every step)."""
+
 _MARKUP = re.compile(r"<[^>]*>")
 
 
@@ -78,6 +81,8 @@ class Speaker(Device):
         playing = self.sounds.get(key)
         if playing is not None:                   # still playing: WbSpeaker only updates it
             playing.loop, playing.pitch = bool(loop), p
+        elif len(self.sounds) >= MAX_SOUNDS:
+            raise ValueError(f"{MAX_SOUNDS} sounds already play on this speaker (the server's bound): stop one first")
         else:
             self.sounds[key] = _Sound(sound, int(frames), int(rate), p, bool(loop))
         self._mark(self.clock())
@@ -123,11 +128,7 @@ class Speaker(Device):
     @property
     def playing(self) -> list[str]:
         """The names of the sounds playing (a side's key without its suffix), in the order they started."""
-        out: list[str] = []
-        for s in self.sounds.values():
-            if s.name not in out:
-                out.append(s.name)
-        return out
+        return list(dict.fromkeys(s.name for s in self.sounds.values()))
 
     @property
     def speaking(self) -> bool:
