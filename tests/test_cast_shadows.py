@@ -144,10 +144,18 @@ def test_a_semi_transparent_or_alpha_textured_shape_casts_no_shadow(tmp_path: Pa
     for appearance in ({"transparency": 0.5}, {"texture": {"url": "veil.png"}}):
         _, img = shoot(world(CAM, [WALL, block(appearance=appearance)], [LAMP]), base_dir=tmp_path)
         np.testing.assert_array_equal(rgb(img)[wall], expected_bytes(lit)[wall])
-    # the same image without alpha (every texel opaque) shadows the wall as an opaque block does
-    Image.new("RGBA", (2, 2), (200, 200, 200, 255)).save(tmp_path / "veil.png")
-    _, img = shoot(world(CAM, [WALL, block(appearance={"texture": {"url": "veil.png"}})], [LAMP]), base_dir=tmp_path)
+    # an RGBA image whose alpha is 255 everywhere still makes the shape translucent (Webots tests
+    # the image's format, not its pixels): no shadow; the same pixels as RGB shadow the wall
+    Image.new("RGBA", (2, 2), (200, 200, 200, 255)).save(tmp_path / "opaque_rgba.png")
+    _, img = shoot(world(CAM, [WALL, block(appearance={"texture": {"url": "opaque_rgba.png"}})], [LAMP]),
+                   base_dir=tmp_path)
+    np.testing.assert_array_equal(rgb(img)[wall], expected_bytes(lit)[wall])
+    Image.new("RGB", (2, 2), (200, 200, 200)).save(tmp_path / "opaque_rgb.png")
+    _, img = shoot(world(CAM, [WALL, block(appearance={"texture": {"url": "opaque_rgb.png"}})], [LAMP]),
+                   base_dir=tmp_path)
+    assert shadow[wall].any()
     assert (rgb(img)[shadow & wall] < expected_bytes(lit)[shadow & wall]).all()
+    np.testing.assert_array_equal(rgb(img)[wall & ~shadow], expected_bytes(lit)[wall & ~shadow])
 
 
 PANE_CAM = {"width": 5, "height": 5, "field_of_view": 0.3}
@@ -184,3 +192,50 @@ def test_a_semi_transparent_surface_takes_no_shadow_single_and_batched(precision
     bs.step()
     for c in range(2):
         assert bs.image(ref)[c].tobytes() == img.tobytes(), c
+
+
+def textured_pane_world(url: str) -> dict:
+    """pane_world's opaque pane, white-textured (the texel is 1 in linear: the albedo stays its colour)."""
+    data = pane_world(0.0)
+    data["solids"][1]["appearance"]["texture"] = {"url": url}
+    return data
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_an_rgba_image_all_opaque_makes_its_surface_take_no_shadow_single_and_batched(precision: str, tmp_path: Path):
+    from PIL import Image
+    Image.new("RGBA", (2, 2), (255, 255, 255, 255)).save(tmp_path / "white_rgba.png")
+    Image.new("RGB", (2, 2), (255, 255, 255)).save(tmp_path / "white_rgb.png")
+    direct = 0.2 + 0.6 / math.sqrt(2.0)
+    # the RGBA pane: drawn as translucent (alpha 1: its own colour, no blend), lit by the sun unshadowed
+    data = textured_pane_world("white_rgba.png")
+    _, img = shoot(wm.World.model_validate(data), precision, base_dir=tmp_path)
+    np.testing.assert_array_equal(rgb(img), np.broadcast_to(expected_bytes(PANE_COLOUR * direct), (5, 5, 3)))
+    # the RGB pane of the same pixels takes the blocker's shadow: the ambient term alone
+    _, opaque = shoot(wm.World.model_validate(textured_pane_world("white_rgb.png")), precision, base_dir=tmp_path)
+    np.testing.assert_array_equal(rgb(opaque), np.broadcast_to(expected_bytes(PANE_COLOUR * 0.2), (5, 5, 3)))
+    for d, ref_img in ((data, img), (textured_pane_world("white_rgb.png"), opaque)):
+        lw = LoadedWorld(world=wm.World.model_validate(d), source="<test>", base_dir=tmp_path)
+        bs = BatchedSimulation(lw, 2, precision=precision)
+        ref = bs.device("r", "cam")
+        bs.enable(ref, 16)
+        bs.step()
+        for c in range(2):
+            assert bs.image(ref)[c].tobytes() == ref_img.tobytes(), c
+
+
+def test_only_the_image_format_decides_translucency(tmp_path: Path):
+    from PIL import Image
+
+    from sensorium.server.sim.scene import translucent
+    from sensorium.server.world.textures import load_alpha, load_image, uses_alpha
+    Image.new("RGBA", (2, 2), (10, 20, 30, 255)).save(tmp_path / "a.png")
+    Image.new("RGB", (2, 2), (10, 20, 30)).save(tmp_path / "b.png")
+    Image.new("LA", (2, 2), (10, 255)).save(tmp_path / "c.png")
+    assert uses_alpha(tmp_path / "a.png") and uses_alpha(tmp_path / "c.png") and not uses_alpha(tmp_path / "b.png")
+    # the colours are the RGB image's; no see-through texel to composite
+    assert load_alpha(tmp_path / "a.png") is None
+    np.testing.assert_array_equal(load_image(tmp_path / "a.png"), load_image(tmp_path / "b.png"))
+    rgba = wm.Appearance.model_validate({"texture": {"url": "a.png"}})
+    plain = wm.Appearance.model_validate({"texture": {"url": "b.png"}})
+    assert translucent(rgba, tmp_path) and not translucent(plain, tmp_path)

@@ -4,7 +4,10 @@ written out here, scalar by scalar), clamped to the image's edge pixels; zero co
 today's images bit for bit (single and batched); a straight edge bends the way Webots' pincushion
 bends it; a range finder's depths are the floor's closed form along the distorted rays; the batched
 simulation's images equal the single one's byte for byte; the world file and the .wbt converter read
-the node (Webots' centre resets, a non-planar image's lens said and not applied)."""
+the node (Webots' centre resets). A spherical or cylindrical image's lens acts on each cube-face
+sub-camera's image before the merge, as Webots renders it: the rays against the merge shader's face
+lookup written out, a horizon pixel's and a wall edge's turn in closed form, a range finder's merged
+face depths."""
 
 from __future__ import annotations
 
@@ -83,9 +86,180 @@ def test_where_the_shaders_divisor_is_zero_a_pixel_keeps_its_own_ray():
     assert imaging.pixel_directions(g, lens=imaging.Lens(radial=(-2.0, 0.0))).tobytes() == imaging.pixel_directions(g).tobytes()
 
 
-def test_a_lens_distorts_planar_images_only():
-    with pytest.raises(ValueError, match="planar image only"):
-        imaging.pixel_directions(imaging.ImageGeometry(8, 8, 1.0, "spherical"), lens=imaging.Lens())
+# ---- spherical and cylindrical images: the lens on each cube-face sub-camera's image, then the merge
+
+def nominal_ray(u: float, v: float, g: imaging.ImageGeometry) -> np.ndarray:
+    """The merge shader's direction for the image coordinate (u, v), scalar by scalar (FLU)."""
+    fov = g.field_of_view
+    if g.projection == "cylindrical":
+        a, e = (0.5 - u) * fov, (0.5 - v) * fov * g.height / g.width
+        return np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
+    dx, dy = u - 0.5, v - 0.5
+    rho = math.hypot(dx, dy)
+    psi = rho * fov
+    return np.array([math.cos(psi), -math.sin(psi) * dx / rho, -math.sin(psi) * dy / rho]) if rho else np.array([1.0, 0, 0])
+
+
+def face_coords(d: np.ndarray) -> tuple[str, float, float]:
+    """The merge shader's face and face coordinates ``coord`` (before its scaling) of a direction,
+    each face's case written out as the shader has it (FLU: x front, y left, z up)."""
+    x, y, z = d
+    m = max(abs(x), abs(y), abs(z))
+    if abs(x) == m:
+        return ("front", y / m, z / m) if x > 0 else ("back", -y / m, z / m)
+    if abs(y) == m:
+        return ("left", -x / m, z / m) if y > 0 else ("right", x / m, z / m)
+    return ("up", y / m, -x / m) if z > 0 else ("down", y / m, x / m)
+
+
+def face_ray(face: str, a: float, b: float) -> np.ndarray:
+    """The direction whose face coordinates on ``face`` are (a, b): face_coords' inverse."""
+    d = {"front": (1.0, a, b), "back": (-1.0, -a, b), "left": (-a, 1.0, b), "right": (a, -1.0, b),
+         "up": (-b, a, 1.0), "down": (b, a, -1.0)}[face]
+    v = np.array(d)
+    return v / np.linalg.norm(v)
+
+
+def expected_face_lens_ray(u: float, v: float, g: imaging.ImageGeometry, c, k, p, tx: float, ty: float) -> np.ndarray:
+    """The merged image's ray for (u, v) with a lens: the nominal ray's face and its pinhole
+    coordinates (s, t) on the face's sub-image, the shader's source there, clamped to the face
+    image's edge (a sample inside it), the face's ray through the source."""
+    face, a, b = face_coords(nominal_ray(u, v, g))
+    s, t = 0.5 * (1.0 - a / tx), 0.5 * (1.0 - b / ty)
+    ss, ts = webots_source(s, t, c, k, p)
+    if 0.0 <= s <= 1.0 and 0.0 <= t <= 1.0:
+        ss, ts = min(max(ss, 0.0), 1.0), min(max(ts, 0.0), 1.0)
+    return face_ray(face, (1.0 - 2.0 * ss) * tx, (1.0 - 2.0 * ts) * ty)
+
+
+def test_the_sub_cameras_are_webots_set_field_of_view():
+    """WbWrenCamera::setFieldOfView for a spherical camera: a field of view up to π/2 is the
+    sub-camera's, its vertical one from the image's aspect; beyond π/2 the sub-camera's is π/2 and
+    the aspect shrinks by (π/2)/fov; a vertical field beyond π/2 is π/2 with the aspect 1."""
+    ext = imaging.sub_camera_extents
+    assert ext(imaging.ImageGeometry(40, 20, 1.0, "cylindrical")) == pytest.approx((math.tan(0.5), math.tan(0.5) / 2), rel=1e-15)
+    assert ext(imaging.ImageGeometry(64, 16, 6.0, "cylindrical")) == pytest.approx((1.0, 6.0 * 16 / 64 / (math.pi / 2)), rel=1e-15)
+    assert ext(imaging.ImageGeometry(30, 30, 6.28, "spherical")) == pytest.approx((1.0, 1.0), rel=1e-15)
+    assert ext(imaging.ImageGeometry(10, 30, 1.2, "cylindrical")) == pytest.approx((1.0, 1.0), rel=1e-15)
+
+
+@pytest.mark.parametrize("projection, fov, W, H", [("spherical", 6.28, 30, 30), ("spherical", 3.0, 17, 13),
+                                                   ("cylindrical", 6.0, 64, 16), ("cylindrical", 1.0, 40, 20)])
+def test_each_sample_goes_through_its_cube_faces_lens_source(projection: str, fov: float, W: int, H: int):
+    """Spherical and cylindrical images (six, five, four and one cube faces): every anti-aliasing
+    sample's ray is the one the merge shader's face lookup gives through that face's lens pass —
+    the nominal ray's face and face coordinates (the shader's cases written out), the pinhole
+    coordinates on the face's sub-image, Webots' lens source about the face's own centre, clamped to
+    the face image, and back to a direction on that face. A Lens of zero coefficients gives the
+    rays of no lens, bit for bit."""
+    g = imaging.ImageGeometry(W, H, fov, projection)
+    tx, ty = imaging.sub_camera_extents(g)
+    c, k, p = (0.45, 0.55), (0.3, -0.2), (0.01, -0.02)
+    dirs = imaging.pixel_directions(g, imaging.SAMPLES_2X2, imaging.Lens(c, k, p))
+    plain = imaging.pixel_directions(g, imaging.SAMPLES_2X2)
+    faces = set()
+    for s, (ox, oy) in enumerate(imaging.SAMPLES_2X2):
+        for r in range(H):
+            for j in range(W):
+                u, v = (j + ox) / W, (r + oy) / H
+                faces.add(face_coords(nominal_ray(u, v, g))[0])
+                np.testing.assert_allclose(dirs[s, r, j], expected_face_lens_ray(u, v, g, c, k, p, tx, ty), rtol=0, atol=1e-14)
+    assert len(faces) == {6.28: 6, 3.0: 5, 6.0: 6, 1.0: 1}[fov], faces
+    assert imaging.pixel_directions(g, imaging.SAMPLES_2X2, imaging.Lens(c)).tobytes() == plain.tobytes()
+
+
+def test_a_horizon_pixel_turns_by_the_radial_formula_on_each_face():
+    """A cylindrical image spanning 2π (faces of half-extent 1 across), its middle row on the
+    horizon: a pixel at angle β from its face's axis (β = its azimuth less the face's: 0 front,
+    π/2 left, −π/2 right, π back) lies at x = −tan(β)/2 from the face image's centre, the shader's
+    source at x·(1 + 3·k1·x²)/(1 + 4·k1·x²) (k2 = 0), so the ray stays on the horizon at the
+    angle atan(tan β · (1 + 3·k1·tan²β/4)/(1 + k1·tan²β)) from the face's axis."""
+    W, H, fov, k1 = 72, 9, 2.0 * math.pi, 0.4
+    g = imaging.ImageGeometry(W, H, fov, "cylindrical")
+    dirs = imaging.pixel_directions(g, lens=imaging.Lens(radial=(k1, 0.0)))[0, H // 2]
+    for j in range(W):
+        az = (0.5 - (j + 0.5) / W) * fov
+        axis = min((0.0, math.pi / 2, -math.pi / 2, math.pi, -math.pi), key=lambda f: abs(az - f))
+        tb = math.tan(az - axis)
+        want = axis + math.atan(tb * (1.0 + 3.0 * k1 * tb * tb / 4.0) / (1.0 + k1 * tb * tb))
+        assert dirs[j, 2] == 0.0
+        assert math.atan2(dirs[j, 1], dirs[j, 0]) == pytest.approx(math.remainder(want, 2 * math.pi), abs=1e-13), j
+
+
+def _cylinder_world(lens: dict | None, device: str) -> wm.World:
+    """A cylindrical device (81 x 9, fov π) 0.5 m up, level, before a wall at x = 2 (2 m high) whose
+    right edge is y = −1.4: the horizon row sees the wall for azimuths above atan(−1.4/2), the sky
+    (0.2, 0.4, 0.6) beyond."""
+    dev = {"device": device, "name": "cam", "pose": {"translation": [0.0, 0.0, 0.5]}, "width": 81, "height": 9,
+           "field_of_view": math.pi, "projection": "cylindrical"}
+    if device == "RangeFinder":
+        dev.update(min_range=0.01, max_range=20.0)
+    if lens is not None:
+        dev["lens"] = lens
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 8, "contact": False},
+        "background": {"sky_color": [0.2, 0.4, 0.6]},
+        "lights": [{"type": "DirectionalLight", "direction": [1, 0, 0], "intensity": 0.8, "ambient_intensity": 0.2}],
+        "solids": [{"name": "wall", "pose": {"translation": [2.5, 8.6, 0.5]}, "geometry": {"type": "box", "size": [1.0, 20.0, 2.0]},
+                    "appearance": {"base_color": [0.9, 0.5, 0.1]}}],
+        "robots": [{"name": "bot", "devices": [dev]}]})
+
+
+def _shot(world: wm.World, precision: str, kind: str) -> np.ndarray:
+    sim = Simulation(LoadedWorld(world=world, source="<test>", base_dir=Path.cwd()), precision=precision)
+    dev = sim.robot("bot").device("cam")
+    dev.enable(8)
+    sim.step()
+    return dev.image.copy() if kind == "Camera" else dev.range_image.copy()
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_cylindrical_cameras_lens_moves_a_walls_edge_by_the_formula(precision: str):
+    """The wall's vertical edge at azimuth atan(−0.7) on the front face (the image spans π: its
+    middle half is the front face, its sides the left and right faces): without a lens the horizon
+    pixels left of the edge see the wall; with k1 = −1 (barrel) a horizon pixel at azimuth α sees
+    the wall exactly where its ray's angle atan(tan α·(1 + 3·k1·tan²α/4)/(1 + k1·tan²α)) (at most
+    the face's edge, 45°: the lens pass clamps to its image) is above the edge's, so the edge moves
+    towards the centre — here by one pixel."""
+    W, k1 = 81, -1.0
+    edge = math.atan(-0.7)
+
+    def wall_pixels(lens: dict | None) -> np.ndarray:
+        img = _shot(_cylinder_world(lens, "Camera"), precision, "Camera")[4, :, :3]
+        sky = img[-1].copy()                      # the far right: azimuth near −π/2, beyond the wall
+        return ~(img == sky).all(axis=-1)
+
+    plain, bent = wall_pixels(None), wall_pixels({"radial_coefficients": [k1, 0.0]})
+    az = np.array([(0.5 - (j + 0.5) / W) * math.pi for j in range(W)])
+    front = np.abs(az) < math.pi / 4
+    t = np.tan(az)
+    turned = np.arctan(np.clip(t * (1.0 + 3.0 * k1 * t * t / 4.0) / (1.0 + k1 * t * t), -1.0, 1.0))
+    assert (np.abs(turned[front] - edge) > 1e-3).all()        # no ray grazes the edge
+    np.testing.assert_array_equal(plain[front], az[front] > edge)
+    np.testing.assert_array_equal(bent[front], turned[front] > edge)
+    assert plain[front].sum() - bent[front].sum() == 1
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_cylindrical_range_finder_keeps_webots_merge_of_face_depths(precision: str):
+    """Webots' merge divides each face's planar depth by the nominal ray's cosine with the face's
+    axis: on the front face, the wall x = 2 has the planar depth 2 wherever the lens sends a ray, so
+    every horizon pixel there that sees the wall reads 2/cos(α) with its nominal azimuth α — the
+    lens's own image of a plane facing the camera — not the distance along its turned ray."""
+    W, k1 = 81, -1.0
+    got = _shot(_cylinder_world({"radial_coefficients": [k1, 0.0]}, "RangeFinder"), precision, "RangeFinder")[4]
+    plain = _shot(_cylinder_world(None, "RangeFinder"), precision, "RangeFinder")[4]
+    az = np.array([(0.5 - (j + 0.5) / W) * math.pi for j in range(W)])
+    t = np.tan(az)
+    turned = np.arctan(np.clip(t * (1.0 + 3.0 * k1 * t * t / 4.0) / (1.0 + k1 * t * t), -1.0, 1.0))
+    sees = (np.abs(az) < math.pi / 4) & (turned > math.atan(-0.7))
+    assert sees.sum() > 10
+    np.testing.assert_allclose(got[sees], 2.0 / np.cos(az[sees]), rtol=2e-7)
+    # ... where the distance along the turned ray, 2/cos(turned), is another value
+    assert (sees & (np.abs(2.0 / np.cos(turned) - 2.0 / np.cos(az)) > 1e-3)).sum() > 10
+    front = np.abs(az) < math.pi / 4
+    np.testing.assert_allclose(plain[front & (az > math.atan(-0.7))], 2.0 / np.cos(az[front & (az > math.atan(-0.7))]), rtol=2e-7)
+    assert np.isinf(got[front & ~sees]).all() and (front & ~sees & (az > math.atan(-0.7))).any()
 
 
 def _with_lens(world: wm.World, lens: dict | None, names: set[str]) -> wm.World:
@@ -164,8 +338,8 @@ def test_batched_lens_images_equal_the_single_ones_and_zero_coefficients_change_
         runs[name] = frames
     assert runs["zero"] == runs["none"]
     lens_frames, plain = np.array(runs["lens"], dtype=object), np.array(runs["none"], dtype=object)
-    assert (lens_frames[:, :2] != plain[:, :2]).any()       # the distorted devices' images changed
-    assert (lens_frames[:, 2] == plain[:, 2]).all()         # a cylindrical image keeps no lens (said at load)
+    assert (lens_frames[:, :2] != plain[:, :2]).any()       # the planar devices' images changed
+    assert (lens_frames[:, 2] != plain[:, 2]).any()         # and the cylindrical one's (its cube faces')
 
 
 def _edge_world(lens: dict | None) -> wm.World:
@@ -266,8 +440,8 @@ def test_a_range_finders_depths_follow_the_distorted_rays(precision: str):
 def test_a_world_files_lens_is_read_with_webots_defaults_and_resets(tmp_path: Path):
     """A YAML camera's lens takes Webots' defaults (centre 0.5 0.5, zero coefficients); a centre
     component outside [0, 1] is reset as WbLens::updateCenter does (negative: 0; y > 1 sets x to 1
-    and keeps y, its slip), one warning each; a lens on a spherical image is one warning and no
-    distortion. Its CameraInfo stays the undistorted pinhole with ``d`` zeros."""
+    and keeps y, its slip), one warning each; a spherical image takes its lens silently (on its cube
+    faces). Its CameraInfo stays the undistorted pinhole with ``d`` zeros."""
     p = tmp_path / "w.yaml"
     p.write_text(
         "robots:\n  - name: r\n    devices:\n"
@@ -280,11 +454,9 @@ def test_a_world_files_lens_is_read_with_webots_defaults_and_resets(tmp_path: Pa
     assert b.lens is not None and b.lens.center == (1.0, 1.4)
     assert lw.warnings == [
         "robots[0].devices[1].lens.center: x -0.2 < 0, set to 0",
-        "robots[0].devices[1].lens.center: y 1.4 > 1: Webots sets x (not y) to 1 and keeps y 1.4, done the same here",
-        "robots[0].devices[2].lens: not applied to a spherical image (Webots distorts each of its cube-face "
-        "sub-images before merging them; here only a planar image has a lens)"]
+        "robots[0].devices[1].lens.center: y 1.4 > 1: Webots sets x (not y) to 1 and keeps y 1.4, done the same here"]
     sim = Simulation(lw)
-    assert sim.robot("r").device("c").lens is None and sim.robot("r").device("a").lens == imaging.Lens()
+    assert sim.robot("r").device("c").lens == imaging.Lens() and sim.robot("r").device("a").lens == imaging.Lens()
     # CameraInfo: the undistorted pinhole, d zeros (Webots' mapping is not plumb_bob: README "Lens distortion")
     info = sim.robot("r").device("b").camera_info()
     assert info["distortion_model"] == "plumb_bob" and info["d"] == bytes(40)

@@ -669,7 +669,8 @@ class TouchSensor(_Device):
 class Lens(Strict):
     """Webots' Lens node in a Camera's or RangeFinder's ``lens`` field: Brown's radial (k1, k2) and
     tangential (p1, p2) distortion about ``center`` (image units: (0.5, 0.5) is the image's centre,
-    x across, y down), as Webots' shader applies it to a planar image (README "Lens distortion").
+    x across, y down), as Webots' shader applies it to a planar image, or to each cube-face
+    sub-image of a spherical or cylindrical one (README "Lens distortion").
     A ``center`` component outside [0, 1] is reset with a warning, as Webots does."""
 
     center: tuple[float, float] = (0.5, 0.5)
@@ -687,7 +688,7 @@ class _Imager(_Device):
     height: int = Field(default=64, ge=1, le=1 << 16)
     projection: Literal["planar", "cylindrical", "spherical"] = "planar"
     near: float = Field(default=0.01, ge=0.0)
-    lens: Lens | None = Field(default=None, description="Webots' Lens node (NULL: none); planar images only here")
+    lens: Lens | None = Field(default=None, description="Webots' Lens node (NULL: none); a spherical or cylindrical image's cube faces each take it")
     _what: ClassVar[str]
 
     @model_validator(mode="after")

@@ -16,7 +16,7 @@ Projections (Webots' ``WbWrenCamera`` and its ``merge_spherical.frag``)
       direction ``(−dx, −dy)`` of the image plane: ``(cos ψ, −sin ψ·dx/ρ, −sin ψ·dy/ρ)``. A
       non-square spherical image therefore spans Φ vertically as well (the shader's choice).
 
-Lens distortion (Webots' ``Lens`` node, its ``lens_distortion.frag``; planar images only here)
+Lens distortion (Webots' ``Lens`` node, its ``lens_distortion.frag``)
     Webots renders the pinhole image, then gives each output pixel the colour (or range) the
     rendered image has at a *source* coordinate: with ``(x, y) = (u − cx, v − cy)`` (image units,
     each axis its own: x in widths, y in heights; v down, as the rows), ``r = x² + y²``,
@@ -28,6 +28,22 @@ Lens distortion (Webots' ``Lens`` node, its ``lens_distortion.frag``; planar ima
     the span of the image's own samples (the edge pixel's centre without anti-aliasing, Webots'
     clamp exactly) — an exact ray where Webots interpolates between rendered pixels. With zero
     coefficients ``(us, vs) = (u, v)`` exactly: the rays of no lens, bit for bit.
+
+    A spherical or cylindrical image is Webots' merge of cube-face sub-cameras (``WbWrenCamera``:
+    front, and left/right, up/down, back as the field of view needs them), and the lens pass runs
+    on each sub-camera's own planar image before the merge reads it. So here a sample's nominal ray
+    (the projection above) picks its face (the largest component of the direction, the merge
+    shader's rule), its face-image coordinates are that face's pinhole coordinates ``(s, t)`` (the
+    same convention as ``(u, v)``: ``s = ½(1 − a/tx)``, ``t = ½(1 − b/ty)`` with ``(a, b)`` the ray's
+    tangents along the face image's left and up axes), the lens moves them to ``(ss, ts)`` in that
+    face's image units about that face's ``center``, clamped to the face image's edges, and the ray
+    is the face's pinhole ray through them. ``(tx, ty)``, every sub-camera's half-extents
+    (:func:`sub_camera_extents`), are ``WbWrenCamera::setFieldOfView``'s: the horizontal field
+    ``min(Φ, π/2)``, the aspect ``W/H`` (times ``(π/2)/Φ`` when Φ > π/2), the vertical field
+    ``2·atan(tan(fx/2)/aspect)``, at most π/2 (then the aspect 1). A sample the lens does not move
+    keeps its nominal ray bit for bit. A range finder then holds what Webots' merge computes: the
+    face's planar depth of the distorted ray's hit over the nominal ray's cosine with the face's
+    axis — the distance along the distorted ray times :func:`depth_factors`' ratio.
 
 Range values (``range_image``)
     ``planar``: the depth along +x (the distance to the plane x = 0 of the device, Webots' reference
@@ -49,6 +65,7 @@ from .lookup import RESOLUTION_OFF, quantize_lidar
 from .noise import gaussian
 
 __all__ = ["PROJECTIONS", "ImageGeometry", "Lens", "SAMPLES_CENTRE", "SAMPLES_2X2", "lens_source", "pixel_directions",
+           "FACES", "sub_camera_extents", "face_of",
            "depth_factors", "clip_limits", "range_values", "pinhole_intrinsics"]
 
 PROJECTIONS = ("planar", "cylindrical", "spherical")
@@ -136,17 +153,24 @@ def _grid(g: ImageGeometry, samples) -> tuple[np.ndarray, np.ndarray]:
 
 def pixel_directions(g: ImageGeometry, samples=SAMPLES_CENTRE, lens: Lens | None = None) -> np.ndarray:
     """Unit ray directions (S, H, W, 3) in the device frame (FLU) for each sample of each pixel;
-    with a ``lens`` (a planar image only), each sample's ray through its lens source (module docstring)."""
+    with a ``lens``, each sample's ray through its lens source: in the image itself for a planar
+    image, in its cube face's sub-image for the others (module docstring)."""
     u, v = _grid(g, samples)
-    fov = float(g.field_of_view)
     S, H, W = len(u), int(g.height), int(g.width)
-    if lens is not None:
-        if g.projection != "planar":
-            raise ValueError(f"a lens distorts a planar image only, not a {g.projection} one")
+    if lens is not None and g.projection == "planar":
         us, vs = lens_source(lens, np.broadcast_to(u, (S, H, W)), np.broadcast_to(v, (S, H, W)))
         # Webots' clamp to the edge: to the span of the image's own samples
         u = np.clip(us, u.min(), u.max())
         v = np.clip(vs, v.min(), v.max())
+    d = _nominal(g, u, v, S, H, W)
+    if lens is not None and g.projection != "planar":
+        d = _face_lens(g, lens, d)[0]
+    return d
+
+
+def _nominal(g: ImageGeometry, u: np.ndarray, v: np.ndarray, S: int, H: int, W: int) -> np.ndarray:
+    """The projection's unit rays (S, H, W, 3) through image coordinates ``(u, v)``."""
+    fov = float(g.field_of_view)
     if g.projection == "planar":
         t = math.tan(fov / 2.0)
         y = np.broadcast_to((1.0 - 2.0 * u) * t, (S, H, W))
@@ -167,23 +191,109 @@ def pixel_directions(g: ImageGeometry, samples=SAMPLES_CENTRE, lens: Lens | None
     return np.stack([np.cos(psi), -k * dx, -k * dy], axis=-1)
 
 
-def depth_factors(g: ImageGeometry, directions: np.ndarray) -> np.ndarray | None:
+FACES = ("front", "right", "back", "left", "up", "down")
+"""Webots' sub-cameras (``WbWrenCamera::CameraOrientation``'s order)."""
+_FACE_AXES = np.array([
+    # the face image's left axis, its up axis, the face's axis (FLU): the merge shader's face coordinates
+    [[0, 1, 0], [0, 0, 1], [1, 0, 0]],       # front (+x)
+    [[1, 0, 0], [0, 0, 1], [0, -1, 0]],      # right (−y)
+    [[0, -1, 0], [0, 0, 1], [-1, 0, 0]],     # back (−x)
+    [[-1, 0, 0], [0, 0, 1], [0, 1, 0]],      # left (+y)
+    [[0, 1, 0], [-1, 0, 0], [0, 0, 1]],      # up (+z)
+    [[0, 1, 0], [1, 0, 0], [0, 0, -1]],      # down (−z)
+], dtype=np.float64)
+
+
+def sub_camera_extents(g: ImageGeometry) -> tuple[float, float]:
+    """``(tx, ty)``: the half-width and half-height, in tangents, of the planar image of each of
+    the cube-face sub-cameras Webots renders a spherical or cylindrical image with
+    (``WbWrenCamera::setFieldOfView``: horizontal field ``min(Φ, π/2)``, aspect ``W/H`` shrunk by
+    ``(π/2)/Φ`` when Φ > π/2, vertical field ``2·atan(tan(fx/2)/aspect)`` at most π/2, where the
+    aspect becomes 1)."""
+    fov, aspect = float(g.field_of_view), int(g.width) / int(g.height)
+    if fov > math.pi / 2.0:
+        aspect *= (math.pi / 2.0) / fov
+        fov = math.pi / 2.0
+    fov_y = 2.0 * math.atan(math.tan(fov / 2.0) / aspect)
+    if fov_y > math.pi / 2.0:
+        fov_y, aspect = math.pi / 2.0, 1.0
+    ty = math.tan(fov_y / 2.0)
+    return ty * aspect, ty
+
+
+def face_of(d: np.ndarray) -> np.ndarray:
+    """Each direction's cube face (index into :data:`FACES`): its largest component by magnitude,
+    x before y before z on a tie (Webots' ``merge_spherical.frag``)."""
+    a = np.abs(d)
+    axis = np.zeros(d.shape[:-1], dtype=np.int64)
+    axis[a[..., 1] > a[..., 0]] = 1
+    best = np.take_along_axis(a, axis[..., None], axis=-1)[..., 0]
+    axis[a[..., 2] > best] = 2
+    negative = np.take_along_axis(d, axis[..., None], axis=-1)[..., 0] < 0.0
+    # (axis, sign) -> face: +x front, −x back, +y left, −y right, +z up, −z down
+    table = np.array([[0, 2], [3, 1], [4, 5]])
+    return table[axis, negative.astype(np.int64)]
+
+
+def _face_lens(g: ImageGeometry, lens: Lens, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rays (same shape as ``d``, unit) a lens gives the nominal rays ``d`` of a spherical or
+    cylindrical image (module docstring), each ray's face axis (…, 3) and whether the lens moved it."""
+    tx, ty = sub_camera_extents(g)
+    axes = _FACE_AXES[face_of(d)]                         # (..., 3 [left, up, axis], 3)
+    left, up, axis = axes[..., 0, :], axes[..., 1, :], axes[..., 2, :]
+    n = np.einsum("...k,...k->...", d, axis)
+    a = np.einsum("...k,...k->...", d, left) / n
+    b = np.einsum("...k,...k->...", d, up) / n
+    s = 0.5 * (1.0 - a / tx)
+    t = 0.5 * (1.0 - b / ty)
+    ss, ts = lens_source(lens, s, t)
+    inside = (s >= 0.0) & (s <= 1.0) & (t >= 0.0) & (t <= 1.0)
+    # Webots' lens pass reads its face image clamped to the edge; a sample outside its face's image
+    # (a corner Webots' merge reads out of the sub-image) keeps its source unclamped
+    ss = np.where(inside, np.clip(ss, 0.0, 1.0), ss)
+    ts = np.where(inside, np.clip(ts, 0.0, 1.0), ts)
+    moved = (ss != s) | (ts != t)
+    if not moved.any():
+        return d, axis, moved
+    a2 = ((1.0 - 2.0 * ss) * tx)[..., None]
+    b2 = ((1.0 - 2.0 * ts) * ty)[..., None]
+    out = a2 * left + b2 * up + axis
+    out /= np.linalg.norm(out, axis=-1, keepdims=True)
+    return np.where(moved[..., None], out, d), axis, moved
+
+
+def depth_factors(g: ImageGeometry, directions: np.ndarray, lens: Lens | None = None) -> np.ndarray | None:
     """The factor turning a ray's hit distance into the stored range: the ray's cosine with +x
-    for a planar image (depth), ``None`` (1) otherwise."""
-    if not g.planar:
+    for a planar image (depth); for a spherical or cylindrical image ``None`` (1), or, with a
+    ``lens`` that moves rays, Webots' merge of its distorted faces: the ray's cosine with its face's
+    axis over the nominal ray's (1 exactly where the lens moves nothing; ``directions``: the
+    lens's rays, one sample per pixel)."""
+    if g.planar:
+        return np.ascontiguousarray(directions[..., 0])
+    if lens is None:
         return None
-    return np.ascontiguousarray(directions[..., 0])
+    nominal = pixel_directions(g)
+    bent, axis, moved = _face_lens(g, lens, nominal)
+    if not moved.any():
+        return None
+    d = np.asarray(directions).reshape(bent.shape)
+    ratio = np.einsum("...k,...k->...", d, axis) / np.einsum("...k,...k->...", nominal, axis)
+    out = np.where(moved, ratio, 1.0)
+    return np.ascontiguousarray(out.reshape(np.asarray(directions).shape[:-1]))
 
 
 def clip_limits(g: ImageGeometry, factors: np.ndarray | None, near: float, far: float
                 ) -> tuple[np.ndarray | float, np.ndarray | float]:
     """Per-ray ``(t_near, t_far)`` of the clipping planes ``near`` and ``far`` (``far`` = inf: none):
     planes at those depths for a planar image (the OpenGL frustum), spheres of those radii for the
-    others (Webots: the near and far planes of a spherical camera are sphere parts)."""
+    others (Webots: the near and far planes of a spherical camera are sphere parts) — with a lens's
+    :func:`depth_factors` there, ``far`` bounds the stored value: the ray reaches ``far/factor``."""
     if factors is None:
         return float(near), float(far)
     f = factors.reshape(-1)
     with np.errstate(divide="ignore"):
+        if not g.planar:
+            return float(near), (float(far) / f if math.isfinite(far) else float(far))
         return float(near) / f, (float(far) / f if math.isfinite(far) else float(far))
 
 

@@ -300,7 +300,15 @@ class CameraDevices(PixelDevices):
                 N[bk] = np.negative(shading.take_rows(N, bk))
             s = shape.take(kk)
             albedo = self._albedo(s, org, row_copy, Dk, tk, copies)
-            lit = self._shadows(P, N, row_copy, copies) if self.shadows.any() else None
+            lit = None
+            if self.shadows.any():
+                translucent = self._translucent_shapes()
+                if translucent is None:
+                    lit = self._shadows(P, N, row_copy, copies)
+                else:              # shadows fall on opaque surfaces only, as in _layers
+                    lit = np.ones((len(kk), len(self.shadows)), dtype=bool)
+                    on = (~translucent[s]).nonzero()[0]
+                    lit[on] = self._shadows(P[on], N[on], row_copy[on], copies)
             L = self._shade_copies(P, N, albedo, lit, row_copy, copies)
             if scene.fog is not None:
                 L = shading.fog(L, tk, *scene.fog)
@@ -332,9 +340,20 @@ class CameraDevices(PixelDevices):
         sampler = self.sim.scene.textures
         if sampler is None or not sampler.has_alpha:
             return None
+        return self._per_hit_shape(sampler.alpha)
+
+    def _translucent_shapes(self) -> np.ndarray | None:
+        """Per hit shape, as :meth:`_alpha_shapes`: whether its image's pixel format has alpha, even
+        255 everywhere (``Scene.translucent_shapes``: no shadow falls on it); None without any."""
+        sampler = self.sim.scene.textures
+        if sampler is None or not sampler.has_translucent:
+            return None
+        return self._per_hit_shape(sampler.translucent)
+
+    def _per_hit_shape(self, of_sampler: np.ndarray) -> np.ndarray:
         flags = np.zeros(len(self.colors), dtype=bool)
-        m = min(len(sampler.alpha), len(flags)) - 1       # the sampler numbers the robots' shapes when textured
-        flags[:m] = sampler.alpha[:m]
+        m = min(len(of_sampler), len(flags)) - 1          # the sampler numbers the robots' shapes when textured
+        flags[:m] = of_sampler[:m]
         return flags
 
     def _layers(self, col: int, copy: np.ndarray, origin: np.ndarray, dirs: np.ndarray, hits: RayHits,
@@ -349,6 +368,7 @@ class CameraDevices(PixelDevices):
         dev = self.devices[col]
         engine = _CopyEngine(sim, int(copy[0]))
         own = frozenset(sim.rays.shape_offset + i for i in dev.template.own_shapes)
+        translucent = self._translucent_shapes()
 
         def cast_on(D: np.ndarray, tn: np.ndarray, tf: np.ndarray) -> RayHits:
             O = np.broadcast_to(origin, D.shape)
@@ -362,7 +382,7 @@ class CameraDevices(PixelDevices):
             lit = None
             if self.shadows.any():    # on opaque surfaces only, as Camera's surface
                 lit = np.ones((len(s), len(self.shadows)), dtype=bool)
-                on = receives_shadows(self.transparency, alpha_shapes, s).nonzero()[0]   # (this camera's numbering)
+                on = receives_shadows(self.transparency, translucent, s).nonzero()[0]   # (this camera's numbering)
                 lit[on] = self._shadows(P[on], N[on], zeros[on], copy)
             lights = self._lights_of(int(copy[0]))
             return _shade(P, N, albedo, lights, None if lit is None else lit[:, :lights.count], scene.engine.threads)

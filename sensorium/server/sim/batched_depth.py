@@ -104,7 +104,7 @@ class _Device:
         dirs = imaging.pixel_directions(template.geometry, lens=template.lens)[0]
         self.dirs = np.ascontiguousarray(dirs.reshape(-1, 3))
         self.columns = tuple(np.ascontiguousarray(self.dirs[:, k]) for k in range(3))
-        self.factors = imaging.depth_factors(template.geometry, dirs)
+        self.factors = imaging.depth_factors(template.geometry, dirs, template.lens)
         self.limits = imaging.clip_limits(template.geometry, self.factors, c.near, c.max_range)
         self.own: OwnBodyRays | None = None
         self.skip: np.ndarray | int | None = None       # per pixel: the mount slot where it never meets its robot

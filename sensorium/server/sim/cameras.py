@@ -99,11 +99,10 @@ def _shade(P: np.ndarray, N: np.ndarray, albedo: np.ndarray, lights: light_math.
 
 
 def lens_of(config: Any) -> imaging.Lens | None:
-    """A Camera's or RangeFinder's lens as the image model takes it: None without a Lens node or for
-    an image that is not planar (the loader said so: Webots distorts a spherical or cylindrical
-    image's cube-face sub-images, which are not modelled here)."""
+    """A Camera's or RangeFinder's lens as the image model takes it (None without a Lens node): a
+    planar image's own, or each cube face's of a spherical or cylindrical one (imaging's docstring)."""
     lens = config.lens
-    if lens is None or config.projection != "planar":
+    if lens is None:
         return None
     return imaging.Lens(tuple(lens.center), tuple(lens.radial_coefficients), tuple(lens.tangential_coefficients))
 
@@ -163,7 +162,7 @@ class RangeFinder(Device):
     def _prepare(self) -> MountedRays:
         if self._rays is None:
             dirs = imaging.pixel_directions(self.geometry, lens=self.lens)[0]
-            self._factors = imaging.depth_factors(self.geometry, dirs)
+            self._factors = imaging.depth_factors(self.geometry, dirs, self.lens)
             # rays need not reach beyond max_range (in depth for a planar image): nothing there counts
             self._limits = imaging.clip_limits(self.geometry, self._factors, self.config.near, self.config.max_range)
             self._rays = _mounted(self, dirs, self._limits)

@@ -27,7 +27,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.meshes import elevation_grid_mesh, load_mesh, triangles_mesh
 from sensorium.server.world.poses import pose_from_model
-from sensorium.server.world.textures import TextureSampler, load_alpha, resolve_texture_url
+from sensorium.server.world.textures import TextureSampler, resolve_texture_url, uses_alpha
 
 _IDENTITY = Pose.identity()
 
@@ -80,20 +80,21 @@ def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
 
 def translucent(appearance: wm.Appearance | None, base_dir: Path) -> bool:
     """Whether WREN draws a shape of this appearance as translucent: a transparency above 0 or a
-    base image with transparent texels (its material's opacity below 1 or its texture's alpha).
-    Webots casts no shadow from such a shape and shadows none on it."""
+    base image whose pixel format has alpha (an RGBA PNG even where every alpha is 255: Webots'
+    ``WbImageTexture`` tests the format, not the pixels). Webots casts no shadow from such a shape
+    and shadows none on it."""
     if appearance is None:
         return False
     if appearance.transparency > 0.0:
         return True
     t = appearance.texture
-    return t is not None and load_alpha(resolve_texture_url(t.url, base_dir, allow_outside=True), t.url) is not None
+    return t is not None and uses_alpha(resolve_texture_url(t.url, base_dir, allow_outside=True), t.url)
 
 
 def receives_shadows(transparency: np.ndarray, alpha: np.ndarray | None, shape: np.ndarray) -> np.ndarray:
     """Per hit (shape −1, the arrays' last entry: True): whether shadows fall on it -- not on a
     translucent shape (:func:`translucent`: ``transparency`` above 0, or ``alpha``, its image's
-    transparent texels), which WREN draws in its translucent pass, unshadowed."""
+    pixel format has alpha), which WREN draws in its translucent pass, unshadowed."""
     out = transparency[shape] <= 0.0
     return out if alpha is None else out & ~alpha[shape]
 
@@ -689,7 +690,14 @@ class Scene:
 
     def receives_shadows(self, shape: np.ndarray) -> np.ndarray:
         """:func:`receives_shadows` of hits on this scene's shapes."""
-        return receives_shadows(self.transparency, self.alpha_shapes, shape)
+        return receives_shadows(self.transparency, self.translucent_shapes, shape)
+
+    @property
+    def translucent_shapes(self) -> np.ndarray | None:
+        """Per shape (−1 last, False): whether its base image's pixel format has alpha (even 255
+        everywhere: WREN draws it translucent, without shadows); None in a world without any."""
+        t = self.textures
+        return t.translucent if t is not None and t.has_translucent else None
 
     @property
     def alpha_shapes(self) -> np.ndarray | None:

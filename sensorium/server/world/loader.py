@@ -790,9 +790,6 @@ def sanitize(world: wm.World) -> tuple[wm.World, list[str]]:
             warnings.extend(f"{p}.lens.center: {w}" for w in lens_warnings)
             if lens is not dev.lens:
                 upd["lens"] = lens
-            if dev.projection != "planar":
-                warnings.append(f"{p}.lens: not applied to a {dev.projection} image (Webots distorts each of its "
-                                "cube-face sub-images before merging them; here only a planar image has a lens)")
         if isinstance(dev, wm.LED) and dev.lights:
             upd["lights"] = [fix_light(f"{p}.lights[{i}]", lt) for i, lt in enumerate(dev.lights)]
         if isinstance(dev, wm.Radar):

@@ -45,7 +45,7 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.world import texcoords as tc
 
-__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "load_image", "load_alpha", "check_textures",
+__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "load_image", "load_alpha", "uses_alpha", "check_textures",
            "TextureImage", "transform_uv", "TextureSampler", "TriangleLocator", "texture_urls"]
 
 FORMATS = {"PNG": "PNG", "JPEG": "JPEG", "MPO": "JPEG"}     # Pillow's format → what Webots calls it
@@ -122,12 +122,20 @@ def load_image(path: Path, display: str | None = None) -> np.ndarray:
 
 def load_alpha(path: Path, display: str | None = None) -> np.ndarray | None:
     """The image's alpha channel as a read-only ``(h, w)`` uint8 array, top row first (cached with
-    :func:`load_image`), or None when it has none or every pixel's alpha is 255 (it then draws as an
-    RGB image would: what a camera sees of it is the same)."""
+    :func:`load_image`), or None when it has none or every pixel's alpha is 255 (its colours then
+    blend as an RGB image's would: see :func:`uses_alpha` for what such an image still changes)."""
     return _decoded(path, display)[1]
 
 
-def _decoded(path: Path, display: str | None) -> tuple[np.ndarray, np.ndarray | None]:
+def uses_alpha(path: Path, display: str | None = None) -> bool:
+    """Whether the image's pixel format has alpha (an RGBA, grey-alpha or palette PNG with
+    transparency, or a ``tRNS`` colour key), even if every pixel's alpha is 255: what Webots'
+    ``WbImageTexture`` tests (Qt's ``alphaUsage() == UsesAlpha``, the format, not the pixels) to
+    draw the shape as translucent — out of the shadow volumes (cached with :func:`load_image`)."""
+    return _decoded(path, display)[2]
+
+
+def _decoded(path: Path, display: str | None) -> tuple[np.ndarray, np.ndarray | None, bool]:
     path = Path(path).resolve()
     st = path.stat()
     try:
@@ -140,7 +148,7 @@ _ALPHA_MODES = ("RGBA", "LA", "PA", "RGBa", "La")
 
 
 @lru_cache(maxsize=16)
-def _decode(path: str, _mtime: int, _size: int) -> tuple[np.ndarray, np.ndarray | None]:
+def _decode(path: str, _mtime: int, _size: int) -> tuple[np.ndarray, np.ndarray | None, bool]:
     from PIL import Image
 
     old = Image.MAX_IMAGE_PIXELS       # the world limits were checked on the header; Pillow's own
@@ -151,6 +159,7 @@ def _decode(path: str, _mtime: int, _size: int) -> tuple[np.ndarray, np.ndarray 
             with Image.open(path) as im:
                 im.load()
                 alpha = None
+                has_alpha = False
                 if im.mode in ("I;16", "I;16B", "I;16L", "I"):    # 16-bit grey: rounded to 8 bits
                     a = np.clip(np.asarray(im, dtype=np.int64), 0, 65535)
                     grey = ((a * 255 + 32767) // 65535).astype(np.uint8)
@@ -160,6 +169,7 @@ def _decode(path: str, _mtime: int, _size: int) -> tuple[np.ndarray, np.ndarray 
                     # an alpha channel, or a palette's or colour key's transparency (PNG tRNS): what Qt
                     # reads as an image that uses alpha (WbImageTexture: the texture is then translucent)
                     if im.mode in _ALPHA_MODES or "transparency" in im.info:
+                        has_alpha = True
                         alpha = np.asarray(im.convert("RGBA"), dtype=np.uint8)[..., 3]
                         alpha = None if bool((alpha == 255).all()) else np.ascontiguousarray(alpha)
     except (OSError, ValueError, SyntaxError) as exc:
@@ -170,7 +180,7 @@ def _decode(path: str, _mtime: int, _size: int) -> tuple[np.ndarray, np.ndarray 
     rgb.flags.writeable = False
     if alpha is not None:
         alpha.flags.writeable = False
-    return rgb, alpha
+    return rgb, alpha, has_alpha
 
 
 # ------------------------------------------------------------------------------------ the world
@@ -265,6 +275,7 @@ class TextureImage:
     repeat_s: bool = True
     repeat_t: bool = True
     alpha: np.ndarray | None = None     # (h, w) uint8 where the image has transparent texels (load_alpha)
+    translucent: bool = False           # its pixel format has alpha, even all 255 (uses_alpha: Webots' test)
 
     def texel_index(self, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(row, column) of the nearest texel (WbImageTexture::pickColor's wrap and index)."""
@@ -700,11 +711,13 @@ class TextureSampler:
         self._uv: dict[tuple[int, bool], UvOf] = {}
         self._locators: dict[int, TriangleLocator] = {}
         self._meshes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        self._images: dict[Path, tuple[np.ndarray, np.ndarray | None]] = {}
+        self._images: dict[Path, tuple[np.ndarray, np.ndarray | None, bool]] = {}
         self.models: list[tuple[Any, wm.Appearance | None]] = []
         self.textured = np.zeros(1, dtype=bool)
         self.alpha = np.zeros(1, dtype=bool)
         self.has_alpha = False
+        self.translucent = np.zeros(1, dtype=bool)
+        self.has_translucent = False
         self.extend(shapes)
         self.lookups = 0
 
@@ -713,9 +726,9 @@ class TextureSampler:
             return None
         path = resolve_texture_url(t.url, self.base_dir, allow_outside=True)
         if path not in self._images:
-            self._images[path] = (load_image(path, t.url), load_alpha(path, t.url))
-        rgb, alpha = self._images[path]
-        return TextureImage(rgb, t.repeat_s, t.repeat_t, alpha)
+            self._images[path] = (load_image(path, t.url), load_alpha(path, t.url), uses_alpha(path, t.url))
+        rgb, alpha, translucent = self._images[path]
+        return TextureImage(rgb, t.repeat_s, t.repeat_t, alpha, translucent)
 
     def extend(self, shapes: list[tuple[Any, wm.Appearance | None]]) -> None:
         """Shapes numbered after the existing ones (a Supervisor's imported solid): their images
@@ -738,6 +751,12 @@ class TextureSampler:
         alpha[[s for s, st in self.shapes.items() if st.base.alpha is not None]] = True
         self.alpha = alpha
         self.has_alpha = bool(alpha.any())
+        # the shapes whose base image's format has alpha, even 255 everywhere: Webots draws them
+        # translucent, so they neither cast nor take shadows (WbImageTexture's test)
+        translucent = np.zeros(len(self.models) + 1, dtype=bool)
+        translucent[[s for s, st in self.shapes.items() if st.base.translucent]] = True
+        self.translucent = translucent
+        self.has_translucent = bool(translucent.any())
 
     def __bool__(self) -> bool:
         return bool(self.shapes) or bool(self.ink)
