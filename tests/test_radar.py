@@ -378,30 +378,98 @@ def test_occlusion_spares_a_wall_within_half_the_target_s_box() -> None:
     assert run(Simulation(world({"occlusion": True}, solids=[pair, wall(7.0)]))) == []   # 3.05 > 1.2: hidden
 
 
-def test_a_robot_carrying_a_radar_target_solid_is_a_target(tmp_path: Path) -> None:
-    """Webots' radar sample puts a small Solid with radarCrossSection 1 on each robot. Radars here
-    detect robots and top-level solids, so such a robot takes the solids' cross section (summed) with
-    one warning, its bounding box being the target's box; a robot with its own keeps it. A device is
-    a Solid too (the sample's Radar has radarCrossSection 1): its robot carries it likewise."""
+def test_occlusion_looks_past_the_target_s_own_first_surface() -> None:
+    # Webots' ONE_RAY occlusion counts every contact of the ray but the target's own: a target whose
+    # only shape is a thin plate 5 m before its origin (wholly in view: its box 0.02 m along x, centre 5 m away) is
+    # hidden by a wall between the plate and its origin (met at 7.45: 2.55 m > 0.01 m before the origin)
+    plate = {"name": "plate", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 5.0,
+             "shapes": [{"pose": {"translation": [-5.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.4, 0.4]}}]}
+    wall = {"name": "wall", "pose": {"translation": [7.5, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 0.5, 0.5]}}
+    [t] = run(Simulation(world({"occlusion": True}, solids=[plate])))
+    assert t.distance == pytest.approx(5.0, rel=1e-14) and t.azimuth == 0.0
+    [t] = run(Simulation(world(solids=[plate, wall])))
+    assert t.distance == pytest.approx(5.0, rel=1e-14)
+    assert run(Simulation(world({"occlusion": True}, solids=[plate, wall]))) == []
+
+
+def test_a_solid_a_robot_carries_is_a_target_of_its_own(tmp_path: Path) -> None:
+    """Webots: every Solid with radarCrossSection > 0 is a radar target, one a robot carries too: at
+    its own origin, its own shapes being its box, whatever its robot's cross section. A robot at
+    (5, 0) turned 90° about z carries a tag at (1, 2, 0.1) in its frame: (3, 1, 0.1) in the world."""
+    tag_wbt = ('Robot {{ translation 5 0 0 rotation 0 0 1 1.5707963267948966 name "other" {own}children [\n'
+               '  Solid {{ translation 1 2 0.1 name "tag" radarCrossSection 1.5\n'
+               '          boundingObject Box {{ size 0.2 0.2 0.2 }} }}\n'
+               '] boundingObject Box {{ size 1 1 1 }} }}\n')
+    head = ("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+            'Robot { name "car" children [ Radar { translation 0 0 0.1 maxRange 20 verticalFieldOfView 0.5 } ] }\n')
     p = tmp_path / "w.wbt"
-    carrier = ('Robot {{ translation {x} {y} 0 name "{name}" {own}children [\n'
+    p.write_text(head + tag_wbt.format(own=""))
+    loaded = load_world(p)
+    other = loaded.world.robots[1]
+    assert other.radar_cross_section == 0.0 and [(t.name, t.radar_cross_section) for t in other.radar_targets] == [
+        ("tag", 1.5)]
+    assert not any("radarCrossSection" in line for line in loaded.warnings)
+    yaml_robot = {"name": "other", "pose": {"translation": [5, 0, 0], "rotation": [0, 0, 1, math.pi / 2]},
+                  "shapes": [{"geometry": {"type": "box", "size": [1, 1, 1]}, "seen_by": "bounding"},
+                             {"pose": {"translation": [1, 2, 0.1]}, "geometry": {"type": "box", "size": [0.2, 0.2, 0.2]},
+                              "seen_by": "bounding"}],
+                  "radar_targets": [{"name": "tag", "pose": {"translation": [1, 2, 0.1]}, "radar_cross_section": 1.5,
+                                     "shapes": [1]}]}
+    yaml_world = world({"max_range": 20, "vertical_field_of_view": 0.5, "pose": {"translation": [0, 0, 0.1]}},
+                       robots=[yaml_robot])
+    for w in (loaded, yaml_world):
+        [t] = run(Simulation(w), name="car/radar")
+        assert t.distance == pytest.approx(math.sqrt(10.0), rel=1e-12)
+        assert t.azimuth == pytest.approx(-math.atan2(1.0, 3.0), rel=1e-12)       # to the left: negative
+        assert t.received_power == pytest.approx(by_hand_dbm(math.sqrt(10.0), 1.5), abs=1e-9)
+    # with a cross section of its own the robot is a second target, its box that of its solids' bounding
+    # objects, the tag's included (Webots' recursivelyCheckIfWithinBounds): in the radar frame x 2.9..5.5,
+    # y -0.5..1.1, z -0.6..0.4, centre (4.2, 0.3, -0.1); its azimuth that of its origin, straight ahead
+    p.write_text(head + tag_wbt.format(own="radarCrossSection 4 "))
+    robot, tag = run(Simulation(load_world(p)), name="car/radar")
+    assert robot.distance == pytest.approx(math.sqrt(4.2 ** 2 + 0.3 ** 2 + 0.1 ** 2), rel=1e-12) and robot.azimuth == 0.0
+    assert robot.received_power == pytest.approx(by_hand_dbm(robot.distance, 4.0), abs=1e-9)
+    assert tag.distance == pytest.approx(math.sqrt(10.0), rel=1e-12)
+
+
+def test_the_carrying_robot_hides_its_target_from_an_occlusion_ray() -> None:
+    # a tag 2 m behind its robot's 1 m cube, seen from the radar through that cube: the cube is not the
+    # tag's (Webots spares the target and its solid children only), 2.5 m before its origin: hidden
+    robot = {"name": "other", "pose": {"translation": [5, 0, 0]},
+             "shapes": [{"geometry": {"type": "box", "size": [1, 1, 1]}},
+                        {"pose": {"translation": [2, 0, 0]}, "geometry": {"type": "sphere", "radius": 0.1}}],
+             "radar_targets": [{"name": "tag", "pose": {"translation": [2, 0, 0]}, "radar_cross_section": 1.0,
+                                "shapes": [1]}]}
+    [t] = run(Simulation(world(robots=[robot])))
+    assert t.distance == pytest.approx(7.0, rel=1e-14)
+    assert run(Simulation(world({"occlusion": True}, robots=[robot]))) == []
+
+
+def test_a_carried_target_is_refused_in_one_line_when_its_shape_is_not_there() -> None:
+    with pytest.raises(ValueError, match=r"radar_targets\[0\] \(tag\): shape index 3"):
+        world(robots=[{"name": "other", "radar_targets": [{"name": "tag", "radar_cross_section": 1.0, "shapes": [3]}]}])
+
+
+def test_webots_radar_sample_s_target_boxes_are_targets_of_their_own(tmp_path: Path) -> None:
+    """Webots' radar sample puts a small Solid with radarCrossSection 1 on each robot (and its Radar,
+    a Solid too, has one): each is a target at its own place, the robots themselves none."""
+    p = tmp_path / "w.wbt"
+    carrier = ('Robot {{ translation {x} {y} 0 name "{name}" children [\n'
                '  Solid {{ translation 0 0 0.1 name "tag" radarCrossSection 1 children [ Shape {{ geometry Box {{ size 0.04 0.04 0.04 }} }} ] }}\n'
                '  {more}] boundingObject Pose {{ translation 0 0 0.1 children [ Box {{ size 0.2 0.2 0.2 }} ] }} }}\n')
     p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
                  'Robot { name "car" children [ Radar { translation 0 0 0.1 minRange 0.01 maxRange 10 verticalFieldOfView 0.5\n'
                  '                                     radarCrossSection 2 } ] }\n'
-                 + carrier.format(x=2, y=0, name="one", own="", more="")
-                 + carrier.format(x=4, y=0.5, name="two", own="",
-                                  more='Solid { name "tag2" translation 0 0 0.1 radarCrossSection 0.5 }\n')
-                 + carrier.format(x=6, y=-1, name="own", own="radarCrossSection 3 ", more=""))
+                 + carrier.format(x=2, y=0, name="one", more="")
+                 + carrier.format(x=4, y=0.5, name="two", more='Solid { name "tag2" translation 0 0 0.1 radarCrossSection 0.5 }\n'))
     loaded = load_world(p)
-    assert [r.radar_cross_section for r in loaded.world.robots] == [2.0, 1.0, 1.5, 3.0]
-    lines = [line for line in loaded.warnings if "radarCrossSection" in line]
-    assert len(lines) == 4 and "'car'" in lines.pop(0) and "'one'" in lines[0] and "'tag'" in lines[0] and "read as the robot's (1)" in lines[0]
-    assert "'tag2' (0.5)" in lines[1] and "(1.5)" in lines[1] and "not read" in lines[2] and "own 3" in lines[2]
-    t1, t2, t3 = run(Simulation(loaded), name="car/radar")
-    for t, (x, y, rcs) in zip((t1, t2, t3), ((2.0, 0.0, 1.0), (4.0, 0.5, 1.5), (6.0, -1.0, 3.0))):
-        r = math.hypot(x, y)            # the bounding box's centre is at the radar's height
+    assert [r.radar_cross_section for r in loaded.world.robots] == [0.0, 0.0, 0.0]
+    assert [[(t.name, t.radar_cross_section) for t in r.radar_targets] for r in loaded.world.robots] == [
+        [("radar", 2.0)], [("tag", 1.0)], [("tag", 1.0), ("tag2", 0.5)]]
+    targets = run(Simulation(loaded), name="car/radar")       # its own Radar, at its own place, is not one
+    assert len(targets) == 3
+    for t, (x, y, rcs) in zip(targets, ((2.0, 0.0, 1.0), (4.0, 0.5, 1.0), (4.0, 0.5, 0.5))):
+        r = math.hypot(x, y)            # each tag's box (a point for the shape-less tag2) at the radar's height
         assert t.distance == pytest.approx(r, rel=1e-12)
         assert t.received_power == pytest.approx(by_hand_dbm(r, rcs), abs=1e-9)
         assert t.azimuth == pytest.approx(-math.atan2(y, x), abs=1e-12)     # Webots: positive to the right

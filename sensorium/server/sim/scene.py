@@ -321,11 +321,18 @@ def recognisable_owners(world) -> dict[str | int, tuple[int, list, str]]:
     return out
 
 
-def radar_targets(world) -> dict[str | int, float]:
-    """What radars detect: owner (robot index, top-level solid name) -> its radar cross section
-    (m², > 0), robots first in world order, then the solids (the Supervisor's node order)."""
-    out: dict[str | int, float] = {i: float(r.radar_cross_section) for i, r in enumerate(world.robots)
-                                   if r.radar_cross_section > 0.0}
+TargetKey = str | int | tuple[int, int]      # a radar target: solid name, robot index, (robot, its carried target)
+
+
+def radar_targets(world) -> dict[TargetKey, float]:
+    """What radars detect: target (robot index, (robot index, k) for the robot's ``radar_targets[k]``,
+    top-level solid name) -> its radar cross section (m², > 0): each robot in world order followed by
+    the solids it carries, then the top-level solids (the Supervisor's node order)."""
+    out: dict[TargetKey, float] = {}
+    for i, r in enumerate(world.robots):
+        if r.radar_cross_section > 0.0:
+            out[i] = float(r.radar_cross_section)
+        out.update(((i, k), float(t.radar_cross_section)) for k, t in enumerate(r.radar_targets))
     out.update((sd.name, float(sd.radar_cross_section)) for sd in world.solids if sd.radar_cross_section > 0.0)
     return out
 
@@ -365,6 +372,8 @@ class Scene:
         self._shape_link: dict[int, tuple[int, str]] = {}      # shape -> (robot, joint) it rides on
         self.link_poses: dict[tuple[int, str], Pose] = {}      # (robot, joint) -> its link's displacement now
         self._device_shapes: dict[tuple[int, str], frozenset[int]] = {}   # (robot, device) -> its own shapes
+        # (robot, k) -> its radar_targets[k]: pose in the robot frame, the joint it rides on, its shapes
+        self.carried_targets: dict[tuple[int, int], tuple[Pose, str | None, tuple[int, ...]]] = {}
         for i, r in enumerate(world.robots):
             pose = pose_from_model(r.pose)
             self.robot_poses.append(pose)
@@ -381,6 +390,7 @@ class Scene:
             for part in parts:
                 links.setdefault(getattr(part[2], "on_joint", None), []).append(part)
             owned: dict[str, set[int]] = {}
+            placed: dict[int, int] = {}                      # id(shape model) -> its shape index
             for joint, group in sorted(links.items(), key=lambda kv: kv[0] is not None):
                 first = len(self.shapes)
                 body = self._add_body(group, base_dir, pose, owner=i, movable=True, key=i)
@@ -390,10 +400,14 @@ class Scene:
                     self._link_body[(i, joint)] = body
                     self._shape_link.update((first + k, (i, joint)) for k in range(len(group)))
                 for k, (_, _, shape) in enumerate(group):
+                    placed[id(shape)] = first + k
                     device = getattr(shape, "of_device", None)
                     if device is not None:
                         owned.setdefault(device, set()).add(first + k)
             self._device_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
+            for k, t in enumerate(r.radar_targets):          # solids it carries that radars detect apart
+                self.carried_targets[(i, k)] = (pose_from_model(t.pose), t.on_joint,
+                                                tuple(sorted({placed[id(r.shapes[j])] for j in t.shapes})))
         self._attached = {owner[0] if isinstance(owner, tuple) else owner for _, owner, _ in self._lights
                           if owner is not None}
         # the links carrying lights: light sensors and cameras recompute their lights when one moves
@@ -680,6 +694,24 @@ class Scene:
     def owner_pose(self, key: str | int) -> Pose:
         """The pose of a shape owner: a robot (index) or a top-level solid (name)."""
         return self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
+
+    def target_pose(self, key: TargetKey) -> Pose:
+        """A radar target's pose now: a robot's or top-level solid's, or that of a solid a robot carries
+        (on a joint, where the joint has put it)."""
+        if not isinstance(key, tuple):
+            return self.owner_pose(key)
+        local, joint, _ = self.carried_targets[key]
+        frame = self.robot_poses[key[0]]
+        if joint is not None:
+            frame = frame.compose(self.link_poses.get((key[0], joint), _IDENTITY))
+        return frame.compose(local)
+
+    def target_shapes(self, key: TargetKey) -> tuple[int, ...]:
+        """A radar target's shapes (``shapes`` indices): every shape of a robot or top-level solid, a
+        carried solid's own (and those of the solids inside it)."""
+        if isinstance(key, tuple):
+            return self.carried_targets[key][2]
+        return tuple(i for i in range(len(self.shapes)) if self._parts[i][0] == key)
 
     def surface_colors(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                        distance: np.ndarray) -> np.ndarray:

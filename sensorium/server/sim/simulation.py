@@ -386,7 +386,7 @@ class Simulation:
         self.scene.clear_ink()          # WbPen::reset clears every paint texture
         # radar cross sections a Supervisor set: back to the loaded ones (of the robots and solids still there)
         self.scene.radar_targets = {k: v for k, v in self._initial["radar_targets"].items()
-                                    if isinstance(k, int) or k in self.scene.solid_poses}
+                                    if not isinstance(k, str) or k in self.scene.solid_poses}
         self._counters["resets"] += 1
 
     @classmethod
