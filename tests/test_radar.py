@@ -16,6 +16,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.daemon.services import Core
 from sensorium.server.devices import radar as rmath
 from sensorium.server.sim.batched import BatchedError, check_observable
+from sensorium.server.sim.radar import geometry_sphere
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 
@@ -390,6 +391,36 @@ def test_occlusion_looks_past_the_target_s_own_first_surface() -> None:
     [t] = run(Simulation(world(solids=[plate, wall])))
     assert t.distance == pytest.approx(5.0, rel=1e-14)
     assert run(Simulation(world({"occlusion": True}, solids=[plate, wall]))) == []
+
+
+def test_a_target_without_bounding_shapes_is_its_bounding_sphere() -> None:
+    """Webots' WbObjectDetection bounds a target without bounding objects by its bounding sphere
+    (WbBoundingSphere: its shapes' spheres enclosed one after the other). Three visual balls of
+    radius 1 at (0, 0), (4, 0) and (0, 4) in the frame of a target 10 m ahead: the first two give the
+    sphere centred (2, 0) of radius 3; the third grows it to radius 2 + √5, its centre moved
+    √5 − 1 towards (0, 4), along (-1, 2)/√5. Wide fields of view keep that sphere wholly in view."""
+    balls = {"name": "balls", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 5.0,
+             "shapes": [{"pose": {"translation": [x, y, 0.0]}, "geometry": {"type": "sphere", "radius": 1.0},
+                         "seen_by": "visual"} for x, y in ((0, 0), (4, 0), (0, 4))]}
+    wide = {"horizontal_field_of_view": 1.5, "vertical_field_of_view": 1.5}
+    [t] = run(Simulation(world(wide, solids=[balls])))
+    k = (math.sqrt(5.0) - 1.0) / math.sqrt(5.0)
+    assert t.distance == pytest.approx(math.hypot(12.0 - k, 2.0 * k), rel=1e-13)      # not the boxes' (12, 2)
+    assert t.azimuth == 0.0                                                          # its origin's
+    # its x extent is the sphere's diameter: a visual 2 m cube 11.5 m ahead is within max_range 10 plus
+    # half its sphere's diameter (√3), read at max_range
+    cube = {"name": "cube", "pose": {"translation": [11.5, 0.0, 0.0]}, "radar_cross_section": 5.0,
+            "shapes": [{"geometry": {"type": "box", "size": [2, 2, 2]}, "seen_by": "visual"}]}
+    [t] = run(Simulation(world({"max_range": 10.0, "vertical_field_of_view": 0.5}, solids=[cube])))
+    assert t.distance == 10.0 and t.received_power == pytest.approx(by_hand_dbm(10.0, 5.0), abs=1e-12)
+    # Webots' sphere of each geometry, in its frame: a cone taller than wide, through apex and rim
+    centre, r = geometry_sphere(wm.Cone(type="cone", bottom_radius=1.0, height=4.0), Path("."))
+    assert r == pytest.approx(2.0 + 1.0 / 8.0) and centre == pytest.approx([0.0, 0.0, 2.0 - r])
+    assert geometry_sphere(wm.Cylinder(type="cylinder", radius=3.0, height=8.0), Path("."))[1] == 5.0
+    assert geometry_sphere(wm.Capsule(type="capsule", radius=1.0, height=2.0), Path("."))[1] == 2.0
+    # Ritter's sphere of a mesh's points: the two farthest from the first's farthest, then each enclosed
+    centre, r = rmath.ritter_sphere(np.array([[0.0, 0, 0], [2, 0, 0], [1, 1.5, 0]]))
+    assert r == pytest.approx((1.5 + 1.0) / 2.0) and centre == pytest.approx([1.0, 1.5 - r, 0.0])
 
 
 def test_a_solid_a_robot_carries_is_a_target_of_its_own(tmp_path: Path) -> None:

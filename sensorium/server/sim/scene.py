@@ -400,7 +400,8 @@ class Scene:
                     self._link_body[(i, joint)] = body
                     self._shape_link.update((first + k, (i, joint)) for k in range(len(group)))
                 for k, (_, _, shape) in enumerate(group):
-                    placed[id(shape)] = first + k
+                    if r.radar_targets:
+                        placed[id(shape)] = first + k
                     device = getattr(shape, "of_device", None)
                     if device is not None:
                         owned.setdefault(device, set()).add(first + k)
