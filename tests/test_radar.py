@@ -197,11 +197,13 @@ def test_wbt_fields_and_cross_sections_are_read(tmp_path: Path) -> None:
     assert r.antenna_gain == 20.0 and r.frequency == 24.0          # Webots' defaults
     assert w.robots[0].radar_cross_section == 2.5
     assert [(s.name, s.radar_cross_section) for s in w.solids] == [("truck", 10.0), ("plain", 0.0)]
-    assert any("'inner'" in line and "radarCrossSection" in line for line in loaded.warnings)
+    assert w.solids[0].children[0].radar_cross_section == 3.0        # a nested solid is a target too (Webots)
+    assert not any("radarCrossSection" in line for line in loaded.warnings)
     assert not any("Radar" in line and "not simulated" in line for line in loaded.warnings)
+    # the truck and its inner solid, both shape-less points 19.5 m ahead, merge in one 1 m cell
     [t] = run(Simulation(loaded), name="car/front radar")
     assert t.distance == pytest.approx(19.5, rel=1e-14)
-    assert t.received_power == pytest.approx(by_hand_dbm(19.5, 10.0, pt_dbm=30.0), abs=1e-12)
+    assert t.received_power == pytest.approx(by_hand_dbm(19.5, 13.0, pt_dbm=30.0), abs=1e-12)
 
 
 def test_bad_radar_fields_are_reset_as_webots_does(tmp_path: Path) -> None:
@@ -229,8 +231,6 @@ def test_bad_radar_fields_are_reset_as_webots_does(tmp_path: Path) -> None:
     assert loaded.world.robots[0].devices[0].horizontal_field_of_view == 0.78
     assert any(w.endswith(":2:31: Radar (robots[0].devices[0].horizontal_field_of_view): outside (0, pi), reset to 0.78")
                for w in loaded.warnings)
-    with pytest.raises(ValueError, match="radar_cross_section is read on top-level solids"):
-        world(solids=[{"name": "s", "children": [{"name": "c", "radar_cross_section": 1.0}]}])
 
 
 def test_topic_get_targets_step_reading_and_ros2_export() -> None:
@@ -479,6 +479,32 @@ def test_the_carrying_robot_hides_its_target_from_an_occlusion_ray() -> None:
 def test_a_carried_target_is_refused_in_one_line_when_its_shape_is_not_there() -> None:
     with pytest.raises(ValueError, match=r"radar_targets\[0\] \(tag\): shape index 3"):
         world(robots=[{"name": "other", "radar_targets": [{"name": "tag", "radar_cross_section": 1.0, "shapes": [3]}]}])
+
+
+def test_a_solid_inside_a_top_level_solid_is_a_target_of_its_own() -> None:
+    """Webots: a nested Solid with a cross section is a target at its own origin, its box its own
+    bounding shapes and those of the solids inside it. A shelf at (10, 0) turned 90° about z holds a
+    box at (2, 0) in its frame, (10, 2) in the world, holding in turn a ball 1 m further along its x
+    (the shelf's y), its own child: the box's target spans both, x 9.75..10.25 and y 1.8..3.25: centre
+    (10, 2.525); its azimuth that of its own origin, atan(2/10) to the left. A Supervisor removing
+    the shelf removes its nested target too; one importing it adds it."""
+    shelf = {"name": "shelf", "pose": {"translation": [10, 0, 0], "rotation": [0, 0, 1, math.pi / 2]},
+             "geometry": {"type": "box", "size": [1, 1, 1]},
+             "children": [{"name": "box", "pose": {"translation": [2, 0, 0]}, "radar_cross_section": 2.0,
+                           "geometry": {"type": "box", "size": [0.4, 0.4, 0.04]},
+                           "children": [{"name": "ball", "pose": {"translation": [1, 0, 0]},
+                                         "geometry": {"type": "sphere", "radius": 0.25}}]}]}
+    sim = Simulation(world({"max_range": 20, "horizontal_field_of_view": 1.0}, solids=[shelf]))
+    [t] = run(sim)
+    assert t.distance == pytest.approx(math.hypot(10.0, 2.525), rel=1e-12)
+    assert t.azimuth == pytest.approx(-math.atan2(2.0, 10.0), rel=1e-12)
+    assert t.received_power == pytest.approx(by_hand_dbm(t.distance, 2.0), abs=1e-9)
+    sim.scene.remove_solid("shelf")
+    assert run(sim) == []
+    # one a Supervisor imports brings its nested target along
+    sim.scene.add_solid(wm.Solid.model_validate({**shelf, "name": "shelf2"}), node_id=99)
+    [t] = run(sim)
+    assert t.distance == pytest.approx(math.hypot(10.0, 2.525), rel=1e-12)
 
 
 def test_webots_radar_sample_s_target_boxes_are_targets_of_their_own(tmp_path: Path) -> None:

@@ -448,8 +448,8 @@ class Solid(Strict):
         "this solid (with its children); top-level solids only")
 
     radar_cross_section: float = Field(
-        default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the solid a Radar target; "
-        "top-level solids only")
+        default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the solid a Radar target (a "
+        "nested one too: at its own origin, its own shapes and those of the solids inside it as its box)")
     connectors: list[Connector] = Field(
         default=[], max_length=1024, description="Webots Connectors on this solid (a passive object a robot's "
         "connector docks with), each pose in the solid's frame: robots' connectors see them; they read nothing")
@@ -466,9 +466,6 @@ class Solid(Strict):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "
                                  "and robots only (give them to the top-level solid)")
-            if child.radar_cross_section > 0.0:
-                raise ValueError(f"children[{i}] ({child.name}): radar_cross_section is read on top-level solids "
-                                 "and robots only (give it to the top-level solid)")
         return self
 
 

@@ -937,9 +937,8 @@ class Converter:
         elif f.has("recognitionColors") and f.rows("recognitionColors", 3, []):
             self.warn(node, f"Solid {name!r}: recognitionColors of a nested solid are not read (give them to the "
                             "top-level solid); ignored")
-        if owner.kind != "world" and f.num("radarCrossSection", 0.0) > 0.0:
-            self.warn(node, f"Solid {name!r}: radarCrossSection of a solid inside a top-level solid is not read "
-                            "(radars here detect robots, the solids robots carry and top-level solids); ignored")
+        if owner.kind != "world":       # a solid inside a top-level solid: a radar target of its own
+            self.radar_cross_section(node, data)
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
@@ -955,7 +954,7 @@ class Converter:
         return out
 
     def radar_cross_section(self, node: Node, data: dict) -> None:
-        """A top-level solid's or robot's radarCrossSection: > 0 makes it a Radar target (0 or less:
+        """A solid's or robot's radarCrossSection: > 0 makes it a Radar target (0 or less:
         not one, as in Webots, which keeps a negative value and ignores it)."""
         rcs = self.fields(node).num("radarCrossSection", 0.0)
         if rcs > 0.0:
