@@ -530,3 +530,26 @@ def test_webots_radar_sample_s_target_boxes_are_targets_of_their_own(tmp_path: P
         assert t.distance == pytest.approx(r, rel=1e-12)
         assert t.received_power == pytest.approx(by_hand_dbm(r, rcs), abs=1e-9)
         assert t.azimuth == pytest.approx(-math.atan2(y, x), abs=1e-12)     # Webots: positive to the right
+
+
+def test_a_wbt_target_solid_past_a_hinge_rides_on_its_joint(tmp_path: Path) -> None:
+    # the .wbt import gives a carried target found in a joint's end point that joint's motor: turned
+    # by -pi/2 about z, the tag 3 m to the robot's left comes to 3 m ahead of it (13 m from the radar)
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+                 'Robot { name "car" children [ Radar { } ] }\n'
+                 'Robot { translation 10 0 0 name "arm" children [\n'
+                 '  HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 }\n'
+                 '    device [ RotationalMotor { name "pan" maxVelocity 100 maxTorque 100000 } ]\n'
+                 '    endPoint Solid { translation 0 3 0 name "tag" radarCrossSection 1\n'
+                 '                     boundingObject Box { size 0.2 0.2 0.2 } } }\n'
+                 '] controller "<extern>" }\n')
+    loaded = load_world(p)
+    [tag] = loaded.world.robots[1].radar_targets
+    assert (tag.name, tag.on_joint, tag.radar_cross_section, tag.shapes) == ("tag", "pan", 1.0, [0])
+    sim = Simulation(loaded)
+    [t] = run(sim)
+    assert t.distance == pytest.approx(math.hypot(10.0, 3.0), abs=1e-12)
+    sim.robot("arm").motor("pan").set_position(-math.pi / 2)
+    [t] = run(sim)
+    assert t.distance == pytest.approx(13.0, abs=1e-12) and t.azimuth == pytest.approx(0.0, abs=1e-12)
