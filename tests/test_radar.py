@@ -16,6 +16,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.daemon.services import Core
 from sensorium.server.devices import radar as rmath
 from sensorium.server.sim.batched import BatchedError, check_observable
+from sensorium.server.sim.radar import geometry_sphere
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 
@@ -196,11 +197,13 @@ def test_wbt_fields_and_cross_sections_are_read(tmp_path: Path) -> None:
     assert r.antenna_gain == 20.0 and r.frequency == 24.0          # Webots' defaults
     assert w.robots[0].radar_cross_section == 2.5
     assert [(s.name, s.radar_cross_section) for s in w.solids] == [("truck", 10.0), ("plain", 0.0)]
-    assert any("'inner'" in line and "radarCrossSection" in line for line in loaded.warnings)
+    assert w.solids[0].children[0].radar_cross_section == 3.0        # a nested solid is a target too (Webots)
+    assert not any("radarCrossSection" in line for line in loaded.warnings)
     assert not any("Radar" in line and "not simulated" in line for line in loaded.warnings)
+    # the truck and its inner solid, both shape-less points 19.5 m ahead, merge in one 1 m cell
     [t] = run(Simulation(loaded), name="car/front radar")
     assert t.distance == pytest.approx(19.5, rel=1e-14)
-    assert t.received_power == pytest.approx(by_hand_dbm(19.5, 10.0, pt_dbm=30.0), abs=1e-12)
+    assert t.received_power == pytest.approx(by_hand_dbm(19.5, 13.0, pt_dbm=30.0), abs=1e-12)
 
 
 def test_bad_radar_fields_are_reset_as_webots_does(tmp_path: Path) -> None:
@@ -228,8 +231,6 @@ def test_bad_radar_fields_are_reset_as_webots_does(tmp_path: Path) -> None:
     assert loaded.world.robots[0].devices[0].horizontal_field_of_view == 0.78
     assert any(w.endswith(":2:31: Radar (robots[0].devices[0].horizontal_field_of_view): outside (0, pi), reset to 0.78")
                for w in loaded.warnings)
-    with pytest.raises(ValueError, match="radar_cross_section is read on top-level solids"):
-        world(solids=[{"name": "s", "children": [{"name": "c", "radar_cross_section": 1.0}]}])
 
 
 def test_topic_get_targets_step_reading_and_ros2_export() -> None:
@@ -378,30 +379,177 @@ def test_occlusion_spares_a_wall_within_half_the_target_s_box() -> None:
     assert run(Simulation(world({"occlusion": True}, solids=[pair, wall(7.0)]))) == []   # 3.05 > 1.2: hidden
 
 
-def test_a_robot_carrying_a_radar_target_solid_is_a_target(tmp_path: Path) -> None:
-    """Webots' radar sample puts a small Solid with radarCrossSection 1 on each robot. Radars here
-    detect robots and top-level solids, so such a robot takes the solids' cross section (summed) with
-    one warning, its bounding box being the target's box; a robot with its own keeps it. A device is
-    a Solid too (the sample's Radar has radarCrossSection 1): its robot carries it likewise."""
+def test_occlusion_looks_past_the_target_s_own_first_surface() -> None:
+    # Webots' ONE_RAY occlusion counts every contact of the ray but the target's own: a target whose
+    # only shape is a thin plate 5 m before its origin (wholly in view: its box 0.02 m along x, centre 5 m away) is
+    # hidden by a wall between the plate and its origin (met at 7.45: 2.55 m > 0.01 m before the origin)
+    plate = {"name": "plate", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 5.0,
+             "shapes": [{"pose": {"translation": [-5.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.4, 0.4]}}]}
+    wall = {"name": "wall", "pose": {"translation": [7.5, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 0.5, 0.5]}}
+    [t] = run(Simulation(world({"occlusion": True}, solids=[plate])))
+    assert t.distance == pytest.approx(5.0, rel=1e-14) and t.azimuth == 0.0
+    [t] = run(Simulation(world(solids=[plate, wall])))
+    assert t.distance == pytest.approx(5.0, rel=1e-14)
+    assert run(Simulation(world({"occlusion": True}, solids=[plate, wall]))) == []
+
+
+def test_a_target_without_bounding_shapes_is_its_bounding_sphere() -> None:
+    """Webots' WbObjectDetection bounds a target without bounding objects by its bounding sphere
+    (WbBoundingSphere: its shapes' spheres enclosed one after the other). Three visual balls of
+    radius 1 at (0, 0), (4, 0) and (0, 4) in the frame of a target 10 m ahead: the first two give the
+    sphere centred (2, 0) of radius 3; the third grows it to radius 2 + √5, its centre moved
+    √5 − 1 towards (0, 4), along (-1, 2)/√5. Wide fields of view keep that sphere wholly in view."""
+    balls = {"name": "balls", "pose": {"translation": [10.0, 0.0, 0.0]}, "radar_cross_section": 5.0,
+             "shapes": [{"pose": {"translation": [x, y, 0.0]}, "geometry": {"type": "sphere", "radius": 1.0},
+                         "seen_by": "visual"} for x, y in ((0, 0), (4, 0), (0, 4))]}
+    wide = {"horizontal_field_of_view": 1.5, "vertical_field_of_view": 1.5}
+    [t] = run(Simulation(world(wide, solids=[balls])))
+    k = (math.sqrt(5.0) - 1.0) / math.sqrt(5.0)
+    assert t.distance == pytest.approx(math.hypot(12.0 - k, 2.0 * k), rel=1e-13)      # not the boxes' (12, 2)
+    assert t.azimuth == 0.0                                                          # its origin's
+    # its x extent is the sphere's diameter: a visual 2 m cube 11.5 m ahead is within max_range 10 plus
+    # half its sphere's diameter (√3), read at max_range
+    cube = {"name": "cube", "pose": {"translation": [11.5, 0.0, 0.0]}, "radar_cross_section": 5.0,
+            "shapes": [{"geometry": {"type": "box", "size": [2, 2, 2]}, "seen_by": "visual"}]}
+    [t] = run(Simulation(world({"max_range": 10.0, "vertical_field_of_view": 0.5}, solids=[cube])))
+    assert t.distance == 10.0 and t.received_power == pytest.approx(by_hand_dbm(10.0, 5.0), abs=1e-12)
+    # Webots' sphere of each geometry, in its frame: a cone taller than wide, through apex and rim
+    centre, r = geometry_sphere(wm.Cone(type="cone", bottom_radius=1.0, height=4.0), Path("."))
+    assert r == pytest.approx(2.0 + 1.0 / 8.0) and centre == pytest.approx([0.0, 0.0, 2.0 - r])
+    assert geometry_sphere(wm.Cylinder(type="cylinder", radius=3.0, height=8.0), Path("."))[1] == 5.0
+    assert geometry_sphere(wm.Capsule(type="capsule", radius=1.0, height=2.0), Path("."))[1] == 2.0
+    # Ritter's sphere of a mesh's points: the two farthest from the first's farthest, then each enclosed
+    centre, r = rmath.ritter_sphere(np.array([[0.0, 0, 0], [2, 0, 0], [1, 1.5, 0]]))
+    assert r == pytest.approx((1.5 + 1.0) / 2.0) and centre == pytest.approx([1.0, 1.5 - r, 0.0])
+
+
+def test_a_solid_a_robot_carries_is_a_target_of_its_own(tmp_path: Path) -> None:
+    """Webots: every Solid with radarCrossSection > 0 is a radar target, one a robot carries too: at
+    its own origin, its own shapes being its box, whatever its robot's cross section. A robot at
+    (5, 0) turned 90° about z carries a tag at (1, 2, 0.1) in its frame: (3, 1, 0.1) in the world."""
+    tag_wbt = ('Robot {{ translation 5 0 0 rotation 0 0 1 1.5707963267948966 name "other" {own}children [\n'
+               '  Solid {{ translation 1 2 0.1 name "tag" radarCrossSection 1.5\n'
+               '          boundingObject Box {{ size 0.2 0.2 0.2 }} }}\n'
+               '] boundingObject Box {{ size 1 1 1 }} }}\n')
+    head = ("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+            'Robot { name "car" children [ Radar { translation 0 0 0.1 maxRange 20 verticalFieldOfView 0.5 } ] }\n')
     p = tmp_path / "w.wbt"
-    carrier = ('Robot {{ translation {x} {y} 0 name "{name}" {own}children [\n'
+    p.write_text(head + tag_wbt.format(own=""))
+    loaded = load_world(p)
+    other = loaded.world.robots[1]
+    assert other.radar_cross_section == 0.0 and [(t.name, t.radar_cross_section) for t in other.radar_targets] == [
+        ("tag", 1.5)]
+    assert not any("radarCrossSection" in line for line in loaded.warnings)
+    yaml_robot = {"name": "other", "pose": {"translation": [5, 0, 0], "rotation": [0, 0, 1, math.pi / 2]},
+                  "shapes": [{"geometry": {"type": "box", "size": [1, 1, 1]}, "seen_by": "bounding"},
+                             {"pose": {"translation": [1, 2, 0.1]}, "geometry": {"type": "box", "size": [0.2, 0.2, 0.2]},
+                              "seen_by": "bounding"}],
+                  "radar_targets": [{"name": "tag", "pose": {"translation": [1, 2, 0.1]}, "radar_cross_section": 1.5,
+                                     "shapes": [1]}]}
+    yaml_world = world({"max_range": 20, "vertical_field_of_view": 0.5, "pose": {"translation": [0, 0, 0.1]}},
+                       robots=[yaml_robot])
+    for w in (loaded, yaml_world):
+        [t] = run(Simulation(w), name="car/radar")
+        assert t.distance == pytest.approx(math.sqrt(10.0), rel=1e-12)
+        assert t.azimuth == pytest.approx(-math.atan2(1.0, 3.0), rel=1e-12)       # to the left: negative
+        assert t.received_power == pytest.approx(by_hand_dbm(math.sqrt(10.0), 1.5), abs=1e-9)
+    # with a cross section of its own the robot is a second target, its box that of its solids' bounding
+    # objects, the tag's included (Webots' recursivelyCheckIfWithinBounds): in the radar frame x 2.9..5.5,
+    # y -0.5..1.1, z -0.6..0.4, centre (4.2, 0.3, -0.1); its azimuth that of its origin, straight ahead
+    p.write_text(head + tag_wbt.format(own="radarCrossSection 4 "))
+    robot, tag = run(Simulation(load_world(p)), name="car/radar")
+    assert robot.distance == pytest.approx(math.sqrt(4.2 ** 2 + 0.3 ** 2 + 0.1 ** 2), rel=1e-12) and robot.azimuth == 0.0
+    assert robot.received_power == pytest.approx(by_hand_dbm(robot.distance, 4.0), abs=1e-9)
+    assert tag.distance == pytest.approx(math.sqrt(10.0), rel=1e-12)
+
+
+def test_the_carrying_robot_hides_its_target_from_an_occlusion_ray() -> None:
+    # a tag 2 m behind its robot's 1 m cube, seen from the radar through that cube: the cube is not the
+    # tag's (Webots spares the target and its solid children only), 2.5 m before its origin: hidden
+    robot = {"name": "other", "pose": {"translation": [5, 0, 0]},
+             "shapes": [{"geometry": {"type": "box", "size": [1, 1, 1]}},
+                        {"pose": {"translation": [2, 0, 0]}, "geometry": {"type": "sphere", "radius": 0.1}}],
+             "radar_targets": [{"name": "tag", "pose": {"translation": [2, 0, 0]}, "radar_cross_section": 1.0,
+                                "shapes": [1]}]}
+    [t] = run(Simulation(world(robots=[robot])))
+    assert t.distance == pytest.approx(7.0, rel=1e-14)
+    assert run(Simulation(world({"occlusion": True}, robots=[robot]))) == []
+
+
+def test_a_carried_target_is_refused_in_one_line_when_its_shape_is_not_there() -> None:
+    with pytest.raises(ValueError, match=r"radar_targets\[0\] \(tag\): shape index 3"):
+        world(robots=[{"name": "other", "radar_targets": [{"name": "tag", "radar_cross_section": 1.0, "shapes": [3]}]}])
+
+
+def test_a_solid_inside_a_top_level_solid_is_a_target_of_its_own() -> None:
+    """Webots: a nested Solid with a cross section is a target at its own origin, its box its own
+    bounding shapes and those of the solids inside it. A shelf at (10, 0) turned 90° about z holds a
+    box at (2, 0) in its frame, (10, 2) in the world, holding in turn a ball 1 m further along its x
+    (the shelf's y), its own child: the box's target spans both, x 9.75..10.25 and y 1.8..3.25: centre
+    (10, 2.525); its azimuth that of its own origin, atan(2/10) to the left. A Supervisor removing
+    the shelf removes its nested target too; one importing it adds it."""
+    shelf = {"name": "shelf", "pose": {"translation": [10, 0, 0], "rotation": [0, 0, 1, math.pi / 2]},
+             "geometry": {"type": "box", "size": [1, 1, 1]},
+             "children": [{"name": "box", "pose": {"translation": [2, 0, 0]}, "radar_cross_section": 2.0,
+                           "geometry": {"type": "box", "size": [0.4, 0.4, 0.04]},
+                           "children": [{"name": "ball", "pose": {"translation": [1, 0, 0]},
+                                         "geometry": {"type": "sphere", "radius": 0.25}}]}]}
+    sim = Simulation(world({"max_range": 20, "horizontal_field_of_view": 1.0}, solids=[shelf]))
+    [t] = run(sim)
+    assert t.distance == pytest.approx(math.hypot(10.0, 2.525), rel=1e-12)
+    assert t.azimuth == pytest.approx(-math.atan2(2.0, 10.0), rel=1e-12)
+    assert t.received_power == pytest.approx(by_hand_dbm(t.distance, 2.0), abs=1e-9)
+    sim.scene.remove_solid("shelf")
+    assert run(sim) == []
+    # one a Supervisor imports brings its nested target along
+    sim.scene.add_solid(wm.Solid.model_validate({**shelf, "name": "shelf2"}), node_id=99)
+    [t] = run(sim)
+    assert t.distance == pytest.approx(math.hypot(10.0, 2.525), rel=1e-12)
+
+
+def test_webots_radar_sample_s_target_boxes_are_targets_of_their_own(tmp_path: Path) -> None:
+    """Webots' radar sample puts a small Solid with radarCrossSection 1 on each robot (and its Radar,
+    a Solid too, has one): each is a target at its own place, the robots themselves none."""
+    p = tmp_path / "w.wbt"
+    carrier = ('Robot {{ translation {x} {y} 0 name "{name}" children [\n'
                '  Solid {{ translation 0 0 0.1 name "tag" radarCrossSection 1 children [ Shape {{ geometry Box {{ size 0.04 0.04 0.04 }} }} ] }}\n'
                '  {more}] boundingObject Pose {{ translation 0 0 0.1 children [ Box {{ size 0.2 0.2 0.2 }} ] }} }}\n')
     p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
                  'Robot { name "car" children [ Radar { translation 0 0 0.1 minRange 0.01 maxRange 10 verticalFieldOfView 0.5\n'
                  '                                     radarCrossSection 2 } ] }\n'
-                 + carrier.format(x=2, y=0, name="one", own="", more="")
-                 + carrier.format(x=4, y=0.5, name="two", own="",
-                                  more='Solid { name "tag2" translation 0 0 0.1 radarCrossSection 0.5 }\n')
-                 + carrier.format(x=6, y=-1, name="own", own="radarCrossSection 3 ", more=""))
+                 + carrier.format(x=2, y=0, name="one", more="")
+                 + carrier.format(x=4, y=0.5, name="two", more='Solid { name "tag2" translation 0 0 0.1 radarCrossSection 0.5 }\n'))
     loaded = load_world(p)
-    assert [r.radar_cross_section for r in loaded.world.robots] == [2.0, 1.0, 1.5, 3.0]
-    lines = [line for line in loaded.warnings if "radarCrossSection" in line]
-    assert len(lines) == 4 and "'car'" in lines.pop(0) and "'one'" in lines[0] and "'tag'" in lines[0] and "read as the robot's (1)" in lines[0]
-    assert "'tag2' (0.5)" in lines[1] and "(1.5)" in lines[1] and "not read" in lines[2] and "own 3" in lines[2]
-    t1, t2, t3 = run(Simulation(loaded), name="car/radar")
-    for t, (x, y, rcs) in zip((t1, t2, t3), ((2.0, 0.0, 1.0), (4.0, 0.5, 1.5), (6.0, -1.0, 3.0))):
-        r = math.hypot(x, y)            # the bounding box's centre is at the radar's height
+    assert [r.radar_cross_section for r in loaded.world.robots] == [0.0, 0.0, 0.0]
+    assert [[(t.name, t.radar_cross_section) for t in r.radar_targets] for r in loaded.world.robots] == [
+        [("radar", 2.0)], [("tag", 1.0)], [("tag", 1.0), ("tag2", 0.5)]]
+    targets = run(Simulation(loaded), name="car/radar")       # its own Radar, at its own place, is not one
+    assert len(targets) == 3
+    for t, (x, y, rcs) in zip(targets, ((2.0, 0.0, 1.0), (4.0, 0.5, 1.0), (4.0, 0.5, 0.5))):
+        r = math.hypot(x, y)            # each tag's box (a point for the shape-less tag2) at the radar's height
         assert t.distance == pytest.approx(r, rel=1e-12)
         assert t.received_power == pytest.approx(by_hand_dbm(r, rcs), abs=1e-9)
         assert t.azimuth == pytest.approx(-math.atan2(y, x), abs=1e-12)     # Webots: positive to the right
+
+
+def test_a_wbt_target_solid_past_a_hinge_rides_on_its_joint(tmp_path: Path) -> None:
+    # the .wbt import gives a carried target found in a joint's end point that joint's motor: turned
+    # by -pi/2 about z, the tag 3 m to the robot's left comes to 3 m ahead of it (13 m from the radar)
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+                 'Robot { name "car" children [ Radar { } ] }\n'
+                 'Robot { translation 10 0 0 name "arm" children [\n'
+                 '  HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 }\n'
+                 '    device [ RotationalMotor { name "pan" maxVelocity 100 maxTorque 100000 } ]\n'
+                 '    endPoint Solid { translation 0 3 0 name "tag" radarCrossSection 1\n'
+                 '                     boundingObject Box { size 0.2 0.2 0.2 } } }\n'
+                 '] controller "<extern>" }\n')
+    loaded = load_world(p)
+    [tag] = loaded.world.robots[1].radar_targets
+    assert (tag.name, tag.on_joint, tag.radar_cross_section, tag.shapes) == ("tag", "pan", 1.0, [0])
+    sim = Simulation(loaded)
+    [t] = run(sim)
+    assert t.distance == pytest.approx(math.hypot(10.0, 3.0), abs=1e-12)
+    sim.robot("arm").motor("pan").set_position(-math.pi / 2)
+    [t] = run(sim)
+    assert t.distance == pytest.approx(13.0, abs=1e-12) and t.azimuth == pytest.approx(0.0, abs=1e-12)

@@ -277,3 +277,26 @@ def test_a_radar_finds_a_targets_link_where_its_joint_put_it(joint, shape_pose, 
     assert _distance(sim, radar) == pytest.approx(math.hypot(10.0, shape_pose[1]), abs=1e-12)
     sim.robot("arm").motor(motor).set_position(q)
     assert _distance(sim, radar) == pytest.approx(far, abs=1e-12)
+
+
+def test_a_radar_target_solid_on_a_hinge_is_found_at_its_own_origin_where_the_hinge_put_it() -> None:
+    """Robot "arm" 10 m ahead (no cross section of its own) carries a target solid on a pan hinge, its
+    origin and 0.2 m cube 3 m to the left: at rest at distance sqrt(109), azimuth -atan(0.3) (left:
+    negative, Webots' sign); turned by -pi/2 to (13, 0, 0): 13 m straight ahead."""
+    arm = _target([0, 3, 0], [0.2, 0.2, 0.2], _pan())
+    arm["radar_targets"] = [{"name": "tag", "pose": {"translation": [0, 3, 0]}, "on_joint": "pan",
+                             "radar_cross_section": 1.0, "shapes": [0]}]
+    sim = Simulation(parse_world({
+        "world_info": {"basic_time_step": DT_MS, "contact": False},
+        "robots": [{"name": "car", "devices": [{"device": "Radar", "name": "radar"}]},
+                   {**arm, "pose": {"translation": [10, 0, 0]}}]}))
+    radar = sim.device("car/radar")
+    radar.enable(DT_MS)
+    sim.step()
+    [t] = radar.targets
+    assert t.distance == pytest.approx(math.hypot(10.0, 3.0), abs=1e-12)
+    assert t.azimuth == pytest.approx(-math.atan2(3.0, 10.0), abs=1e-12)
+    sim.robot("arm").motor("pan").set_position(-QUARTER)
+    sim.step()
+    [t] = radar.targets
+    assert t.distance == pytest.approx(13.0, abs=1e-12) and t.azimuth == pytest.approx(0.0, abs=1e-12)

@@ -448,8 +448,8 @@ class Solid(Strict):
         "this solid (with its children); top-level solids only")
 
     radar_cross_section: float = Field(
-        default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the solid a Radar target; "
-        "top-level solids only")
+        default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the solid a Radar target (a "
+        "nested one too: at its own origin, its own shapes and those of the solids inside it as its box)")
     connectors: list[Connector] = Field(
         default=[], max_length=1024, description="Webots Connectors on this solid (a passive object a robot's "
         "connector docks with), each pose in the solid's frame: robots' connectors see them; they read nothing")
@@ -466,9 +466,6 @@ class Solid(Strict):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "
                                  "and robots only (give them to the top-level solid)")
-            if child.radar_cross_section > 0.0:
-                raise ValueError(f"children[{i}] ({child.name}): radar_cross_section is read on top-level solids "
-                                 "and robots only (give it to the top-level solid)")
         return self
 
 
@@ -1186,6 +1183,28 @@ class NestedNode(Strict):
                                    "its jointParameters node (a Supervisor reads its position there)")
 
 
+class CarriedTarget(Strict):
+    """A Solid inside a robot with a radar cross section (Webots: any Solid with ``radarCrossSection``
+    > 0 is a Radar target, nested ones too): radars detect it apart from its robot, at its own origin,
+    its own shapes (and those of the solids inside it) being its box (README "Radar")."""
+
+    name: str = Field(min_length=1, description="the Solid's name (a device's name when the Solid is a device)")
+    pose: Pose = Field(default=Pose(), description="its origin in the robot frame as the world loads")
+    on_joint: str | None = Field(default=None, min_length=1, description=_ON_JOINT)
+    radar_cross_section: float = Field(gt=0.0, description="Webots radarCrossSection (m²)")
+    shapes: list[int] = Field(
+        default=[], max_length=100_000, description="indices in the robot's `shapes` of its own shapes and those of "
+        "the solids inside it: its box (its bounding ones; none of those: its bounding sphere), which do not hide it "
+        "from an occlusion ray. None: its origin is a point target")
+
+    @field_validator("shapes")
+    @classmethod
+    def _indices(cls, v: list[int]) -> list[int]:
+        if any(i < 0 for i in v):
+            raise ValueError("shape indices are >= 0")
+        return v
+
+
 class Robot(Strict):
     name: str = Field(min_length=1)
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
@@ -1214,6 +1233,9 @@ class Robot(Strict):
         "node report this robot")
     radar_cross_section: float = Field(
         default=0.0, ge=0.0, description="Webots radarCrossSection (m²): > 0 makes the robot a Radar target")
+    radar_targets: list[CarriedTarget] = Field(
+        default=[], max_length=10_000, description="the Solids inside the robot that are Radar targets of their own "
+        "(Webots' radar sample: a small target box on each robot); the .wbt import writes them")
 
     nodes: list[NestedNode] = Field(
         default=[], max_length=200_000, description="the nodes inside the robot a Supervisor walks (getFromDef, "
@@ -1225,6 +1247,11 @@ class Robot(Strict):
     def _one_drive(self) -> Robot:
         if self.differential_drive is not None and self.ackermann_drive is not None:
             raise ValueError("a robot has one drive at most: give differential_drive or ackermann_drive, not both")
+        for i, t in enumerate(self.radar_targets):
+            bad = [k for k in t.shapes if k >= len(self.shapes)]
+            if bad:
+                raise ValueError(f"radar_targets[{i}] ({t.name}): shape index {bad[0]} is past the robot's "
+                                 f"{len(self.shapes)} shapes")
         for i, node in enumerate(self.nodes):
             if node.parent >= i:
                 raise ValueError(f"nodes[{i}] ({node.type}): parent {node.parent} must be an earlier node's index "

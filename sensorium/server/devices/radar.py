@@ -3,7 +3,9 @@
 A target is a solid or robot with a radar cross section σ > 0. As Webots' ``WbObjectDetection``
 places it, a target has a box in the radar frame (x forward, y left, z up): the union of the boxes
 of its bounding shapes' parts inside the radar's frustum (:func:`frustum`, clipped as a camera's
-recognition clips, ``devices/recognition.py``), or, without shapes, its origin (a point, size 0).
+recognition clips, ``devices/recognition.py``), without any, that of its bounding sphere (its
+shapes' spheres joined by :func:`enclose_sphere`, a mesh's by :func:`ritter_sphere`) cut across the
+view, or, without shapes, its origin (a point, size 0).
 For each candidate in view, in order (Webots' ``WbRadar``, its noise drawn in this order too):
 
 1. the distance to the box's centre is at most ``max_range`` + half the box's x extent;
@@ -34,8 +36,9 @@ import numpy as np
 
 from .recognition import Frustum
 
-__all__ = ["Candidate", "RadarTarget", "azimuth", "candidate_targets", "detect", "finish", "frustum", "in_frustum",
-           "merge", "radial_speed", "received_power_factor", "to_dbm", "to_watts"]
+__all__ = ["Candidate", "RadarTarget", "azimuth", "candidate_targets", "detect", "enclose_point", "enclose_sphere",
+           "finish", "frustum", "in_frustum", "merge", "radial_speed", "received_power_factor", "ritter_sphere", "to_dbm",
+           "to_watts"]
 
 LIGHT_SPEED_M_PER_NS = 0.299792458     # λ (m) = this / frequency (GHz)
 
@@ -100,6 +103,63 @@ def radial_speed(direction: np.ndarray, target_now: np.ndarray, target_before: n
     scale = 1000.0 / elapsed_ms
     relative = (target_now - target_before) * scale - (radar_now - radar_before) * scale
     return float(direction @ relative)
+
+
+def ritter_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """Webots' bounding sphere of a point set (its meshes' and elevation grids'): Ritter's
+    approximation — from the first point, twice the farthest point from the last one found, the sphere
+    on the last two as diameter, then each point enclosed in turn (:func:`enclose_point`)."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(pts) == 0:
+        return np.zeros(3), 0.0
+    far, near = pts[0], pts[0]
+    farthest = 0.0
+    for _ in range(2):
+        near = far
+        d2 = ((pts - near) ** 2).sum(axis=1)
+        k = int(np.argmax(d2))
+        farthest = float(d2[k])
+        far = pts[k] if farthest > 0.0 else far
+    centre, radius = (far + near) * 0.5, math.sqrt(farthest) * 0.5
+    for p in pts:
+        centre, radius = enclose_point(centre, radius, p)
+    return centre, radius
+
+
+def _empty(centre: np.ndarray, radius: float) -> bool:
+    return radius == 0.0 and not centre.any()          # Webots' WbBoundingSphere::isEmpty
+
+
+def enclose_point(centre: np.ndarray, radius: float, p: np.ndarray) -> tuple[np.ndarray, float]:
+    """Webots' ``WbBoundingSphere::enclose(point)``: the sphere grown on the far side to take ``p``."""
+    if _empty(centre, radius):
+        return np.array(p, dtype=np.float64), 0.0
+    delta = centre - p
+    length = float(np.linalg.norm(delta))
+    if length <= radius:
+        return centre, radius
+    grown = (length + radius) / 2.0
+    return p + delta / length * grown, grown
+
+
+def enclose_sphere(centre: np.ndarray, radius: float, other: np.ndarray, other_radius: float) -> tuple[np.ndarray, float]:
+    """Webots' ``WbBoundingSphere::enclose(sphere)``: the smallest sphere on the line of both centres
+    holding this one and ``other`` (an empty one, radius 0 at the origin, takes ``other`` as it is)."""
+    if _empty(other, other_radius):
+        return centre, radius
+    if _empty(centre, radius):
+        return np.array(other, dtype=np.float64), other_radius
+    if np.array_equal(centre, other):
+        return centre, max(radius, other_radius)
+    offset = other - centre
+    distance = float(np.linalg.norm(offset))
+    total = radius + distance + other_radius
+    if total <= 2.0 * radius:
+        return centre, radius
+    if total <= 2.0 * other_radius:
+        return np.array(other, dtype=np.float64), other_radius
+    grown = total / 2.0
+    return centre + offset / distance * (grown - radius), grown
 
 
 @dataclass(frozen=True, slots=True)

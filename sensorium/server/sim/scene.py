@@ -322,12 +322,53 @@ def recognisable_owners(world) -> dict[str | int, tuple[int, list, str]]:
     return out
 
 
-def radar_targets(world) -> dict[str | int, float]:
-    """What radars detect: owner (robot index, top-level solid name) -> its radar cross section
-    (m², > 0), robots first in world order, then the solids (the Supervisor's node order)."""
-    out: dict[str | int, float] = {i: float(r.radar_cross_section) for i, r in enumerate(world.robots)
-                                   if r.radar_cross_section > 0.0}
-    out.update((sd.name, float(sd.radar_cross_section)) for sd in world.solids if sd.radar_cross_section > 0.0)
+# a radar target: robot index, top-level solid name, or (its robot or top-level solid, k): a solid inside it
+TargetKey = str | int | tuple[int, int] | tuple[str, int]
+
+
+def nested_radar_solids(solid: wm.Solid) -> list[tuple[Pose, float, range]]:
+    """The solids inside a top-level solid with a radar cross section > 0, in tree order (each before
+    those inside it): (pose in the top solid's frame, cross section, the indices of its shapes and of
+    those of the solids inside it among the top solid's shapes, in ``solid_parts`` order)."""
+    out: list[tuple[Pose, float, range]] = []
+    count = 0
+
+    def walk(s: wm.Solid, frame: Pose, nested: bool) -> None:
+        nonlocal count
+        start = count
+        count += (s.geometry is not None) + len(s.shapes)
+        k = len(out)
+        if nested and s.radar_cross_section > 0.0:
+            out.append((frame, float(s.radar_cross_section), range(0)))
+        for child in s.children:
+            walk(child, frame.compose(pose_from_model(child.pose)), True)
+        if nested and s.radar_cross_section > 0.0:
+            out[k] = (frame, float(s.radar_cross_section), range(start, count))
+
+    walk(solid, Pose.identity(), False)
+    return out
+
+
+def radar_targets(world) -> dict[TargetKey, float]:
+    """What radars detect: target (robot index, (robot index, k) for the robot's ``radar_targets[k]``,
+    top-level solid name, (its name, k) for the k-th solid inside it with a cross section) -> its
+    radar cross section (m², > 0): each robot in world order followed by the solids it carries, then
+    each top-level solid followed by those inside it (the Supervisor's node order)."""
+    out: dict[TargetKey, float] = {}
+    for i, r in enumerate(world.robots):
+        if r.radar_cross_section > 0.0:
+            out[i] = float(r.radar_cross_section)
+        out.update(((i, k), float(t.radar_cross_section)) for k, t in enumerate(r.radar_targets))
+    for sd in world.solids:
+        out.update(solid_radar_targets(sd))
+    return out
+
+
+def solid_radar_targets(solid: wm.Solid) -> dict[TargetKey, float]:
+    """A top-level solid's radar targets: itself (cross section > 0), then the solids inside it."""
+    out: dict[TargetKey, float] = {solid.name: float(solid.radar_cross_section)} if solid.radar_cross_section > 0.0 else {}
+    if any(child.children or child.radar_cross_section > 0.0 for child in solid.children):
+        out.update(((solid.name, k), rcs) for k, (_, rcs, _) in enumerate(nested_radar_solids(solid)))
     return out
 
 
@@ -348,10 +389,14 @@ class Scene:
         self._lights: list[tuple[object, str | int | tuple[int, str] | None, Pose]] = [
             (lt, None, Pose.identity()) for lt in world.lights]
         self._led_lights: dict[tuple[int, str], list] = {}   # (robot, LED) -> its lights' models now
+        # (robot, k) -> its radar_targets[k], (solid, k) -> the k-th solid inside it with a cross section:
+        # its pose in the robot's or solid's frame, the joint it rides on, its shapes
+        self.carried_targets: dict[tuple[int, int] | tuple[str, int], tuple[Pose, str | None, tuple[int, ...]]] = {}
         for s in world.solids:
             pose = pose_from_model(s.pose)
             self.solid_poses[s.name] = pose
             self._lights += [(lt, s.name, f) for lt, f in solid_lights(s, Pose.identity())]
+            self._nested_targets(s)
             parts = list(solid_parts(s, Pose.identity()))
             if parts:
                 # a solid holding a cone gets a tier of its own, as a moved solid does: packets.c (which
@@ -382,6 +427,7 @@ class Scene:
             for part in parts:
                 links.setdefault(getattr(part[2], "on_joint", None), []).append(part)
             owned: dict[str, set[int]] = {}
+            placed: dict[int, int] = {}                      # id(shape model) -> its shape index
             for joint, group in sorted(links.items(), key=lambda kv: kv[0] is not None):
                 first = len(self.shapes)
                 body = self._add_body(group, base_dir, pose, owner=i, movable=True, key=i)
@@ -391,10 +437,15 @@ class Scene:
                     self._link_body[(i, joint)] = body
                     self._shape_link.update((first + k, (i, joint)) for k in range(len(group)))
                 for k, (_, _, shape) in enumerate(group):
+                    if r.radar_targets:
+                        placed[id(shape)] = first + k
                     device = getattr(shape, "of_device", None)
                     if device is not None:
                         owned.setdefault(device, set()).add(first + k)
             self._device_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
+            for k, t in enumerate(r.radar_targets):          # solids it carries that radars detect apart
+                self.carried_targets[(i, k)] = (pose_from_model(t.pose), t.on_joint,
+                                                tuple(sorted({placed[id(r.shapes[j])] for j in t.shapes})))
         self._attached = {owner[0] if isinstance(owner, tuple) else owner for _, owner, _ in self._lights
                           if owner is not None}
         # the links carrying lights: light sensors and cameras recompute their lights when one moves
@@ -424,6 +475,13 @@ class Scene:
         self.base_dir = Path(base_dir)
         self.recognisable = recognisable_owners(world)
         self.radar_targets = radar_targets(world)
+
+    def _nested_targets(self, solid: wm.Solid) -> None:
+        """The radar targets inside a top-level solid about to join the scene (its shapes come next)."""
+        if any(child.children or child.radar_cross_section > 0.0 for child in solid.children):
+            first = len(self.shapes)
+            for k, (frame, _, shapes) in enumerate(nested_radar_solids(solid)):
+                self.carried_targets[(solid.name, k)] = (frame, None, tuple(first + i for i in shapes))
 
     def _shape_arrays(self) -> None:
         """The per-shape arrays devices index by hit shape (-1, no hit, reads the trailing entry)."""
@@ -516,7 +574,8 @@ class Scene:
             self.engine.remove_body(body)
         self.triangle_count -= self._solid_triangles.pop(name, 0)
         self.recognisable.pop(name, None)
-        self.radar_targets.pop(name, None)
+        for key in [k for k in self.radar_targets if k == name or (isinstance(k, tuple) and k[0] == name)]:
+            del self.radar_targets[key]
         if name in self._attached:
             self._lights = [entry for entry in self._lights if entry[1] != name]
             self._attached.discard(name)
@@ -538,6 +597,7 @@ class Scene:
             raise KeyError(f"a solid named {name!r} exists or existed")
         parts, entries = prepared if prepared is not None else self.solid_entries(solid)
         pose = pose_from_model(solid.pose)
+        self._nested_targets(solid)
         self.solid_names.append(name)
         self.solid_poses[name] = pose
         self.solids_version += 1
@@ -560,8 +620,7 @@ class Scene:
             self.lights_version += 1
         if solid.recognition_colors:
             self.recognisable[name] = (node_id, [tuple(c) for c in solid.recognition_colors], solid.model)
-        if solid.radar_cross_section > 0.0:
-            self.radar_targets[name] = float(solid.radar_cross_section)
+        self.radar_targets.update(solid_radar_targets(solid))
 
     def add_top_light(self, model: object) -> int:
         """A top-level light a Supervisor imported: light sensors and cameras count it from their
@@ -681,6 +740,24 @@ class Scene:
     def owner_pose(self, key: str | int) -> Pose:
         """The pose of a shape owner: a robot (index) or a top-level solid (name)."""
         return self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
+
+    def target_pose(self, key: TargetKey) -> Pose:
+        """A radar target's pose now: a robot's or top-level solid's, or that of a solid inside one (on a
+        robot's joint, where the joint has put it)."""
+        if not isinstance(key, tuple):
+            return self.owner_pose(key)
+        local, joint, _ = self.carried_targets[key]
+        frame = self.owner_pose(key[0])
+        if joint is not None:
+            frame = frame.compose(self.link_poses.get((key[0], joint), _IDENTITY))   # type: ignore[index]
+        return frame.compose(local)
+
+    def target_shapes(self, key: TargetKey) -> tuple[int, ...]:
+        """A radar target's shapes (``shapes`` indices): every shape of a robot or top-level solid, a
+        solid's inside one its own (and those of the solids inside it)."""
+        if isinstance(key, tuple):
+            return self.carried_targets[key][2]
+        return tuple(i for i in range(len(self.shapes)) if self._parts[i][0] == key)
 
     def surface_colors(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
                        distance: np.ndarray) -> np.ndarray:

@@ -385,8 +385,9 @@ class Simulation:
                 self.scene.set_top_light(k, light)
         self.scene.clear_ink()          # WbPen::reset clears every paint texture
         # radar cross sections a Supervisor set: back to the loaded ones (of the robots and solids still there)
+        owners = {k: k[0] if isinstance(k, tuple) else k for k in self._initial["radar_targets"]}
         self.scene.radar_targets = {k: v for k, v in self._initial["radar_targets"].items()
-                                    if isinstance(k, int) or k in self.scene.solid_poses}
+                                    if isinstance(owners[k], int) or owners[k] in self.scene.solid_poses}
         self._counters["resets"] += 1
 
     @classmethod

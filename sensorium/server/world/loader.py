@@ -528,6 +528,7 @@ def _check_joints(robot: wm.Robot, rp: str) -> list[Problem]:
     riders = [(f"{rp}.shapes[{i}].on_joint", p.on_joint) for i, p in enumerate(robot.shapes)]
     riders += [(f"{rp}.devices[{i}].on_joint", d.on_joint) for i, d in enumerate(robot.devices)]
     riders += [(f"{rp}.lights[{i}].on_joint", lt.on_joint) for i, lt in enumerate(robot.lights)]
+    riders += [(f"{rp}.radar_targets[{i}].on_joint", t.on_joint) for i, t in enumerate(robot.radar_targets)]
     for path, name in riders:
         if name is not None and name not in joints:
             problems.append(Problem(path, f"{name!r} is not a joint motor of this robot (RotationalMotor or LinearMotor "

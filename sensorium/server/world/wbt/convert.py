@@ -915,10 +915,11 @@ class Converter:
         f = self.fields(node)
         inner = self.child_frame(node, frame)
         if owner.kind == "robot":   # part of the robot's body
-            rcs = f.num("radarCrossSection", 0.0)
-            if rcs > 0.0:           # a radar target it carries (Webots' radar sample): read as the robot's
-                owner.data.setdefault("_carried_rcs", []).append((f.string("name", default), rcs, node))
+            target = self.carried_target(node, f.string("name", default), inner, owner)
+            start = len(owner.parts)
             self.solid_contents(node, inner, owner)
+            if target is not None:
+                target["_members"] = [id(p) for p in owner.parts[start:]]
             return None
         name = f.string("name", default)
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
@@ -936,9 +937,8 @@ class Converter:
         elif f.has("recognitionColors") and f.rows("recognitionColors", 3, []):
             self.warn(node, f"Solid {name!r}: recognitionColors of a nested solid are not read (give them to the "
                             "top-level solid); ignored")
-        if owner.kind != "world" and f.num("radarCrossSection", 0.0) > 0.0:
-            self.warn(node, f"Solid {name!r}: radarCrossSection of a nested solid is not read (radars detect "
-                            "top-level solids and robots); ignored")
+        if owner.kind != "world":       # a solid inside a top-level solid: a radar target of its own
+            self.radar_cross_section(node, data)
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
@@ -954,32 +954,31 @@ class Converter:
         return out
 
     def radar_cross_section(self, node: Node, data: dict) -> None:
-        """A top-level solid's or robot's radarCrossSection: > 0 makes it a Radar target (0 or less:
+        """A solid's or robot's radarCrossSection: > 0 makes it a Radar target (0 or less:
         not one, as in Webots, which keeps a negative value and ignores it)."""
         rcs = self.fields(node).num("radarCrossSection", 0.0)
         if rcs > 0.0:
             data["radar_cross_section"] = rcs
 
-    def carried_radar_targets(self, robot: dict) -> None:
-        """Solids inside a robot with a radarCrossSection (Webots' radar sample: a small target box on
-        each robot). Radars here detect robots and top-level solids, so a robot without a cross section
-        of its own takes theirs (summed: the power of targets at one place adds up, as Webots merges
-        them), its bounding shapes being the target's box; one warning names them. A robot with its own
-        keeps it and theirs are not read."""
-        carried = robot.pop("_carried_rcs", [])
-        if not carried:
-            return
-        names = ", ".join(f"{name!r} ({rcs:g})" for name, rcs, _ in carried)
-        own = robot.get("radar_cross_section", 0.0)
-        if own > 0.0:
-            self.warn(carried[0][2], f"Robot {robot['name']!r}: radarCrossSection of its solid {names} not read "
-                                     f"(radars detect robots and top-level solids: the robot's own {own:g} counts)")
-            return
-        total = sum(rcs for _, rcs, _ in carried)
-        robot["radar_cross_section"] = total
-        self.warn(carried[0][2], f"Robot {robot['name']!r}: radarCrossSection of its solid {names} read as the "
-                                 f"robot's ({total:g}): radars here detect robots and top-level solids, the robot's "
-                                 "bounding shapes are its box")
+    def carried_target(self, node: Node, name: str, frame: Frame, owner: Owner) -> dict | None:
+        """A Solid (or device) inside a robot with a radarCrossSection > 0: a radar target of its own, as
+        in Webots (its radar sample: a small target box on each robot), at its origin (``frame``, in the
+        robot's) on the joint it rides; its shapes are those found inside it (``_members``, made
+        indices by ``carried_shapes``)."""
+        rcs = self.fields(node).num("radarCrossSection", 0.0)
+        if rcs <= 0.0:
+            return None
+        target: dict[str, Any] = {"name": name, "pose": frame.pose(), "radar_cross_section": rcs, "_members": []}
+        self.ride(target)
+        owner.data.setdefault("radar_targets", []).append(target)
+        return target
+
+    @staticmethod
+    def carried_shapes(robot: dict, parts: list[dict]) -> None:
+        """Each carried radar target's shapes as indices in the robot's final ``shapes``."""
+        index = {id(p): k for k, p in enumerate(parts)}
+        for target in robot.get("radar_targets", ()):
+            target["shapes"] = sorted({index[m] for m in target.pop("_members") if m in index})
 
     def solid_contents(self, node: Node, frame: Frame, owner: Owner) -> None:
         f = self.fields(node)
@@ -1038,10 +1037,10 @@ class Converter:
             tree = self.tree
         finally:
             self.tree, self.tree_stack = saved
-        self.carried_radar_targets(data)
         self.drive(node, mine)
         if mine.parts:
             data["shapes"] = [_clean_part(p) for p in mine.parts]
+        self.carried_shapes(data, mine.parts)
         self.unique_devices(data)
         self.tree_done(data, tree)
         for part in data.get("shapes", ()):      # the device's final name (after unique_devices)
@@ -1126,16 +1125,16 @@ class Converter:
         """A device's own Solid contents: robot body shapes marked as the device's own (its visual
         rays do not see them, sim/own_shapes.py), the innermost device's for nested ones. A device is a
         Solid too: its radarCrossSection makes it a radar target its robot carries."""
-        rcs = self.fields(node).num("radarCrossSection", 0.0)
-        if rcs > 0.0:
-            name = device["name"] if device is not None else self.fields(node).string("name", node.type.lower())
-            owner.data.setdefault("_carried_rcs", []).append((name, rcs, node))
+        name = device["name"] if device is not None else self.fields(node).string("name", node.type.lower())
+        target = self.carried_target(node, name, frame, owner) if owner.kind == "robot" else None
         start = len(owner.parts)
         self.device_depth += 1
         try:
             self.solid_contents(node, frame, owner)
         finally:
             self.device_depth -= 1
+        if target is not None:
+            target["_members"] = [id(p) for p in owner.parts[start:]]
         if device is not None:
             for part in owner.parts[start:]:
                 part.setdefault("_device", device)
@@ -1549,13 +1548,15 @@ class Converter:
             return joint
 
         devices = {d["name"]: d for d in robot["devices"]}
-        for entry in [*robot["devices"], *robot.get("shapes", ()), *robot.get("lights", ())]:
+        for entry in [*robot["devices"], *robot.get("shapes", ()), *robot.get("lights", ()),
+                      *robot.get("radar_targets", ())]:
             joint = resolved(entry)
             if "of_device" in entry:    # a device's own shapes move as the device does (a joint inside a
                 joint = resolved(devices[entry["of_device"]])   # device, a lidar's turret, turns none of them)
             if joint is not None:
                 entry["on_joint"] = joint["name"]
-        for entry in [*robot["devices"], *robot.get("shapes", ()), *robot.get("lights", ())]:
+        for entry in [*robot["devices"], *robot.get("shapes", ()), *robot.get("lights", ()),
+                      *robot.get("radar_targets", ())]:
             entry.pop("_on_joint", None)
         for entry in robot["devices"]:
             entry.pop("_wheel", None)
