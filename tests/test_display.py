@@ -233,10 +233,44 @@ def test_an_attached_camera_is_under_the_display() -> None:
     shown = d.composed()
     assert int(shown[0, 0]) == 0xFFFFFFFF and int(shown[1, 1]) == int(bgra[1, 1]) | 0xFF000000
     assert d.measurements >= 2                      # the camera's new image is a new display image
-    with pytest.raises(ValueError, match="is 4 x 3 and the display 5 x 3"):
-        world([{"device": "Camera", "name": "cam", "width": 4, "height": 3},
-               {"device": "Display", "name": "s", "width": 5, "height": 3}]).robots["bot"].devices["s"].check(
-                   [["attach", "cam"]])
+
+
+def _camera_words(h: int, w: int) -> np.ndarray:
+    """A camera image (BGRA bytes) whose every pixel is its own: 0xFF000000 | row << 8 | column."""
+    ys, xs = np.mgrid[0:h, 0:w]
+    return (0xFF000000 | (ys << 8) | xs).astype("<u4").view(np.uint8).reshape(h, w, 4)
+
+
+@pytest.mark.parametrize("camera, display, rows, cols", [
+    ((12, 9), (4, 3), [1, 4, 7], [1, 4, 7, 10]),            # three times the display: each pixel's middle texel
+    ((2, 2), (4, 4), [0, 0, 1, 1], [0, 0, 1, 1]),            # half the display: each texel twice
+    ((5, 3), (4, 6), [0, 0, 1, 1, 2, 2], [0, 1, 3, 4]),      # 5/4 across, 1/2 down
+])
+def test_a_camera_of_another_size_is_stretched_to_the_display_nearest_texel(camera, display, rows, cols) -> None:
+    """Webots draws an attached camera's texture as the background of the display's overlay,
+    stretched to the display's size without interpolation: display pixel (x, y) shows the camera
+    texel under its centre, column floor((x + 1/2)·cw/dw), row floor((y + 1/2)·ch/dh)."""
+    (cw, ch), (dw, dh) = camera, display
+    sim = world([{"device": "Camera", "name": "cam", "width": cw, "height": ch},
+                 {"device": "Display", "name": "screen", "width": dw, "height": dh}])
+    d, cam = sim.robots["bot"].devices["screen"], sim.robots["bot"].devices["cam"]
+    draw(d, ["color", 0x0000FF], ["pixel", 1, 1], ["attach", "cam"])
+    cam.image = _camera_words(ch, cw)
+    shown = d.composed()
+    assert shown.shape == (dh, dw)
+    want = np.array([[0xFF000000 | (r << 8) | c for c in cols] for r in rows], dtype=np.uint32)
+    want[1, 1] = 0xFF0000FF                              # the display's own opaque pixel stays on top
+    assert (shown == want).all(), shown
+    assert (dmod.nearest_texels(ch, dh) == rows).all() and (dmod.nearest_texels(cw, dw) == cols).all()
+    draw(d, ["copy", 1, 0, 0, dw, dh])
+    assert (d.images[1] == want).all()                   # a copy (and imageSave) takes what is shown
+    cam.enable(16)                                       # and a rendered image goes through the same sampling
+    sim.step()
+    sim.step()
+    rendered = cam.image.view(np.uint32).reshape(ch, cw)
+    got = d.composed()
+    assert int(got[0, 0]) == int(rendered[rows[0], cols[0]]) | 0xFF000000
+    assert int(got[dh - 1, dw - 1]) == int(rendered[rows[-1], cols[-1]]) | 0xFF000000
 
 
 def test_the_image_topic_carries_each_change_once() -> None:

@@ -214,10 +214,105 @@ def test_a_c_controller_loads_png_images_as_webots_display_sample_does(tmp_path:
     assert lines == [*(f"loaded {n}" for n in want), "unreadable damaged.png", "unreadable photo.jpg",
                      "unreadable missing.png", "done"], err
     for name, rows in want.items():
-        with Image.open(out / name) as im:
+        with Image.open(out / f"{name}.png") as im:
             got = np.asarray(im)[:23, :37]
         assert (got == rows).all(), name
     errors = err.strip().splitlines()
     assert len(errors) == 3 and all(e.startswith("Error: wb_display_image_load(): ") for e in errors), err
     assert f'the "{src / "damaged.png"}" image is unreadable' in errors[0]
-    assert "reads no JPEG" in errors[1] and "missing.png\" image is unreadable (cannot be opened)" in errors[2]
+    assert 'photo.jpg" image is unreadable (Premature end of JPEG file)' in errors[1]
+    assert "missing.png\" image is unreadable (cannot be opened)" in errors[2]
+
+
+def _jpeg_cases(folder: Path) -> tuple[list[str], list[str]]:
+    """JPEG files Pillow writes (4:2:0 at quality 75, Pillow's default; 4:4:4; greyscale;
+    progressive 4:2:2; CMYK), a PNG under a .jpg name (the content decides, as in Webots), and three
+    files a controller cannot load: a JPEG cut in the middle of its scan, one whose markers are
+    damaged, and a BMP (not a type Webots reads): (loadable names, refused names)."""
+    ys, xs = np.mgrid[0:23, 0:37]
+    rgb = np.stack([xs * 6, ys * 11, (xs * ys) % 256], axis=-1).astype(np.uint8)
+    rgb[5:9, 10:20] = np.random.default_rng(3).integers(0, 256, (4, 10, 3), dtype=np.uint8)
+    im = Image.fromarray(rgb, "RGB")
+    im.save(folder / "colour.jpg")
+    im.save(folder / "fine.jpeg", quality=95, subsampling=0)
+    im.convert("L").save(folder / "grey.JPG")
+    im.save(folder / "progressive.jpg", progressive=True, subsampling=1)
+    im.convert("CMYK").save(folder / "cmyk.jpg")                  # Adobe's inverted inks
+    im.save(folder / "png_inside.jpg", format="PNG")
+    whole = (folder / "colour.jpg").read_bytes()
+    (folder / "truncated.jpg").write_bytes(whole[:len(whole) * 2 // 3])
+    huffman = whole.index(b"\xff\xc4") + 5                        # a Huffman table's 16 code counts
+    (folder / "damaged.jpg").write_bytes(whole[:huffman] + b"\xff" * 16 + whole[huffman + 16:])
+    im.save(folder / "image.bmp")
+    return ["colour.jpg", "fine.jpeg", "grey.JPG", "progressive.jpg", "cmyk.jpg", "png_inside.jpg"], \
+        ["truncated.jpg", "damaged.jpg", "image.bmp"]
+
+
+def _python_loads(src: Path, out: Path, names: list[str]) -> list[str]:
+    """The Python client's wb_display_image_load of each file, pasted at (0, 0) on "screen" and saved
+    as out/<name>.png and out/<name>.jpg, against a server in this process: "loaded NAME" or
+    "unreadable NAME"."""
+    from _inproc import inproc_server
+
+    from sensorium.client import wb
+    lines = []
+    with inproc_server(heartbeat_ms=5000, world=WORLDS[0]) as (_core, transport):
+        wb.wb_robot_init(f"{transport.rpc_endpoint}/bot")
+        try:
+            tag = wb.wb_robot_get_device("screen")
+            for name in names:
+                ref = wb.wb_display_image_load(tag, str(src / name))
+                if ref is None:
+                    lines.append(f"unreadable {name}")
+                    continue
+                wb.wb_display_image_paste(tag, ref, 0, 0, False)
+                wb.wb_display_image_save(tag, None, str(out / f"{name}.png"))
+                wb.wb_display_image_save(tag, None, str(out / f"{name}.jpg"))
+                wb.wb_display_image_delete(tag, ref)
+                lines.append(f"loaded {name}")
+        finally:
+            wb.wb_robot_cleanup()
+    return lines
+
+
+def test_c_and_python_controllers_load_jpeg_images_alike(tmp_path: Path, load_controller: str, capsys) -> None:
+    """wb_display_image_load of JPEG files from C (libjpeg) and from Python (Pillow, whose JPEG
+    decoder is libjpeg-turbo too): the pasted pixels are the same, byte for byte, and those Pillow
+    decodes from the file; a JPEG that ends early or whose markers are damaged, and a file of
+    another type, are one "unreadable" line each (with the reason) and NULL/None in both clients.
+    wb_display_image_save to a .jpg writes the display as a JPEG (RGB, quality 100, 4:4:4, as
+    libController writes it) that Pillow reads back at the display's size."""
+    from PIL import JpegImagePlugin
+    src, c_out, py_out = tmp_path / "in", tmp_path / "c", tmp_path / "py"
+    for d in (src, c_out, py_out):
+        d.mkdir()
+    good, bad = _jpeg_cases(src)
+    lines, err = run_controller(WORLDS[0], lambda url: [load_controller, *good, *bad],
+                                env={**SAN_ENV, "DISPLAY_IN": str(src), "DISPLAY_OUT": str(c_out)})
+    assert "Sanitizer" not in err and "runtime error" not in err, err
+    expected_lines = [*(f"loaded {n}" for n in good), *(f"unreadable {n}" for n in bad)]
+    assert lines == [*expected_lines, "done"], err
+    capsys.readouterr()
+    assert _python_loads(src, py_out, [*good, *bad]) == expected_lines
+    py_err = capsys.readouterr().err
+    for name in good:
+        with Image.open(c_out / f"{name}.png") as a, Image.open(py_out / f"{name}.png") as b, \
+                Image.open(src / name) as f:
+            c_px, py_px, file_px = (np.asarray(x.convert("RGBA"))[:23, :37] for x in (a, b, f))
+        assert (c_px == py_px).all() and (c_px == file_px).all(), name
+        assert (c_px[..., 3] == 255).all()
+    for errors in (err.strip().splitlines(), [e for e in py_err.splitlines() if e.startswith("Error")]):
+        assert len(errors) == 3, errors
+        for line, name in zip(errors, bad):
+            assert line.startswith(f'Error: wb_display_image_load(): the "{src / name}" image is unreadable ('), line
+        assert errors[2].endswith("(unsupported image type: a .png, .jpg or .jpeg file is read).")
+    assert "(Premature end of JPEG file)" in err.splitlines()[0] and "(Bogus Huffman table" in err.splitlines()[1], err
+
+    for out in (c_out, py_out):
+        with Image.open(out / "colour.jpg.png") as im:
+            shown = np.asarray(im.convert("RGB")).astype(int)
+        with Image.open(out / "colour.jpg.jpg") as im:
+            assert (im.format, im.mode, im.size) == ("JPEG", "RGB", (320, 240))
+            assert JpegImagePlugin.get_sampling(im) == 0               # 4:4:4
+            saved = np.asarray(im).astype(int)
+        assert np.abs(saved - shown).max() <= 2, out                   # quality 100: a unit or two of rounding

@@ -6,8 +6,10 @@ where the server draws it before the world advances (README "The Display"). An i
 (``wb_display_image_new``/``copy``/``load``) is a number this client gives out, as libController
 does. ``wb_display_image_save`` sends the buffered commands at once and gets the pixels back (the
 ``draw`` service; Webots flushes the same way) and writes the file here: ``.png`` (RGBA) or
-``.jpg``/``.jpeg`` (RGB, through Pillow), overwriting a file of that name as Webots does.
-``wb_display_image_load`` reads a PNG or JPEG through Pillow (Webots reads it in the controller too)."""
+``.jpg``/``.jpeg`` (RGB, quality 100 without chroma subsampling, as libController writes it; through
+Pillow), overwriting a file of that name as Webots does. ``wb_display_image_load`` reads a ``.png``,
+``.jpg`` or ``.jpeg`` file through Pillow (Webots reads it in the controller too), PNG or JPEG by its
+content, as the C library does."""
 
 from __future__ import annotations
 
@@ -42,6 +44,7 @@ FLUSH_COMMANDS = 4096
 FLUSH_ITEMS = 40_000
 FLUSH_BYTES = 512 * 1024
 MAX_IMAGE_BYTES = 1_000_000
+IMAGE_TYPES = (".png", ".jpg", ".jpeg")    # the names libController reads and writes (any case)
 
 
 @dataclass(frozen=True)
@@ -297,13 +300,19 @@ def wb_display_image_load(tag: int, filename: str) -> ImageRef | None:
     except ImportError:
         _err(func, f"reading {filename!r} needs Pillow here (pip install pillow).")
         return None
+    if not str(filename).lower().endswith(IMAGE_TYPES):
+        _err(func, f"the \"{filename}\" image is unreadable (unsupported image type: a .png, .jpg or .jpeg file is read).")
+        return None
     try:
-        with Image.open(filename) as im:
+        with Image.open(filename, formats=["PNG", "JPEG"]) as im:
             rgba = im.convert("RGBA")
             w, h = rgba.size
             data = rgba.tobytes()
-    except (OSError, ValueError):
-        _err(func, f"the \"{filename}\" image is unreadable.")
+    except FileNotFoundError:
+        _err(func, f"the \"{filename}\" image is unreadable (cannot be opened).")
+        return None
+    except (OSError, ValueError, SyntaxError) as exc:
+        _err(func, f"the \"{filename}\" image is unreadable ({exc}).")
         return None
     return wb_display_image_new(tag, w, h, data, WB_IMAGE_RGBA)
 
@@ -373,5 +382,18 @@ def wb_display_image_save(tag: int, ref: Any, filename: str) -> None:
     if lower.endswith(".png"):
         images.write_file(func, str(filename), images.png_rgba_bytes(bytes(data), w, h))
     else:
-        images.save_rgb(func, str(filename), 100, images.bgra_to_rgb(bytes(data)), w, h)
+        _save_jpeg(func, str(filename), images.bgra_to_rgb(bytes(data)), w, h)
+    return None
+
+
+def _save_jpeg(func: str, filename: str, rgb: bytes, width: int, height: int) -> None:
+    """libController's display JPEG: quality 100, the alpha dropped, no chroma subsampling (4:4:4)."""
+    try:
+        from PIL import Image
+    except ImportError:
+        return _err(func, "JPEG needs Pillow here (pip install pillow); save a .png instead.")
+    import io
+    buf = io.BytesIO()
+    Image.frombytes("RGB", (width, height), rgb).save(buf, format="JPEG", quality=100, subsampling=0)
+    images.write_file(func, filename, buf.getvalue())
     return None

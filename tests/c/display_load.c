@@ -1,7 +1,7 @@
-/* wb_display_image_load from C (tests/worlds/display.yaml): each PNG named on the command line
+/* wb_display_image_load from C (tests/worlds/display.yaml): each image named on the command line
  * (in $DISPLAY_IN) is loaded, pasted unblended at (0, 0) on "screen" and the display saved as
- * $DISPLAY_OUT/<name>; prints "loaded NAME W H" or "unreadable NAME", then "done". Webots' display
- * sample loads its emoticons this way. */
+ * $DISPLAY_OUT/<name>.png and $DISPLAY_OUT/<name>.jpg; prints "loaded NAME" or "unreadable NAME",
+ * then "done". Webots' display sample loads its emoticons this way. */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -24,7 +24,9 @@ int main(int argc, char **argv) {
       continue;
     }
     wb_display_image_paste(screen, ir, 0, 0, false);
-    snprintf(path, sizeof path, "%s/%s", out, argv[i]);
+    snprintf(path, sizeof path, "%s/%s.png", out, argv[i]);
+    wb_display_image_save(screen, NULL, path);
+    snprintf(path, sizeof path, "%s/%s.jpg", out, argv[i]);
     wb_display_image_save(screen, NULL, path);
     wb_display_image_delete(screen, ir);
     printf("loaded %s\n", argv[i]);

@@ -22,9 +22,12 @@ WbDisplay's rules, pixel for pixel where they are simple:
   attached), ``load`` keeps a client's pixels, ``paste`` puts one back (``blend``: "over" by the
   image's alpha, alpha channels added and capped at 255), ``delete`` forgets it; id 0 is the
   display itself (``save``).
-* ``attach`` a camera of the same robot and the display's size: its pixels still black and opaque
-  become transparent (WbDisplay's rule), and the image published is the display over the camera's
-  latest image, as Webots shows it.
+* ``attach`` a camera of the same robot: the display's pixels still black and opaque become
+  transparent (WbDisplay's rule), and the image published is the display over the camera's latest
+  image, as Webots shows it: Webots draws the camera's texture as the background of the display's
+  overlay, stretched to the display's size and sampled without interpolation (nearest texel), so a
+  camera of another size is scaled here the same way, display pixel x showing camera column
+  ``floor((x + 1/2) · camera width / display width)`` (rows alike).
 
 Commands come from the controller (the step request's ``displays``, or the ``draw`` service when
 ``imageSave`` needs the pixels back); a request's commands are all checked before any is drawn,
@@ -126,6 +129,8 @@ class Display(Device):
         self.camera: Any = None
         self._cameras: dict[str, Any] = {}
         self._camera_seen = -1
+        self._camera_rows: np.ndarray | None = None   # the camera's row and column each display pixel shows
+        self._camera_cols: np.ndarray | None = None   # (None: the camera is of the display's size)
         self._changed_at = -1       # measurements when the image last changed (image_data)
 
     def bind(self, robot: Any) -> None:
@@ -155,7 +160,9 @@ class Display(Device):
         cam = self.camera
         if cam is None:
             return self.pixels
-        bgra = cam.image.view(np.uint32).reshape(self.height, self.width)
+        bgra = cam.image.view(np.uint32).reshape(cam.image.shape[:2])
+        if self._camera_rows is not None:
+            bgra = bgra[self._camera_rows[:, None], self._camera_cols[None, :]]
         return _over_camera(self.pixels, bgra)
 
     def image_data(self, reading: str) -> tuple[int, int, str, bytes] | None:
@@ -260,10 +267,6 @@ class Display(Device):
             cam = self._cameras.get(name) if isinstance(name, str) else None
             if cam is None:
                 raise ValueError(f"{name!r} is no camera of robot {self.robot_name!r}")
-            cw, ch = int(cam.config.width), int(cam.config.height)
-            if (cw, ch) != (self.width, self.height):
-                raise ValueError(f"camera {name!r} is {cw} x {ch} and the display {self.width} x {self.height}: "
-                                 "Sensorium shows a camera of the display's size only")
             return (op, name), 0
         return (op,), 0
 
@@ -525,6 +528,12 @@ class Display(Device):
             return False
         self.camera = cam
         self._camera_seen = -1
+        ch, cw = cam.image.shape[:2]
+        if (cw, ch) == (self.width, self.height):
+            self._camera_rows = self._camera_cols = None
+        else:
+            self._camera_rows = nearest_texels(ch, self.height)
+            self._camera_cols = nearest_texels(cw, self.width)
         self.pixels[self.pixels == BLACK] = 0     # WbDisplay: untouched black becomes transparent
         return True
 
@@ -533,6 +542,14 @@ class Display(Device):
             return False
         self.camera = None
         return True
+
+
+def nearest_texels(texels: int, pixels: int) -> np.ndarray:
+    """The texel each of ``pixels`` shows when a texture of ``texels`` is stretched over them and
+    sampled at the pixel's centre without interpolation: ``floor((i + 1/2) · texels / pixels)``, in
+    integers (a centre exactly on a texel boundary takes the texel after it)."""
+    i = np.arange(pixels, dtype=np.int64)
+    return ((2 * i + 1) * texels) // (2 * pixels)
 
 
 def _over(old: np.ndarray, color: int, alpha: int, opacity: int) -> np.ndarray:

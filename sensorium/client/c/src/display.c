@@ -2,10 +2,11 @@
  * trip: each call is checked (Webots' error lines), packed into the Display's command list and sent
  * with the next step request ("displays": {name: [commands]}, PROTOCOL.md), where the server draws
  * it. Image references are ids this library gives out. wb_display_image_save sends the pending
- * commands at once with the "draw" service and gets the pixels back, then writes a PNG (RGBA) here;
- * wb_display_image_load reads a PNG file (png_read.c) and sends it as wb_display_image_new does; JPEG
- * needs a codec this library does not carry (an error line, NULL from image_load, no file saved).
- * Written from Webots' documented signatures and libController's rules. */
+ * commands at once with the "draw" service and gets the pixels back, then writes the file here: a
+ * .png (RGBA) or a .jpg/.jpeg (RGB, quality 100, as libController writes it; jpeg_io.c);
+ * wb_display_image_load reads a .png, .jpg or .jpeg file (by its content: png_read.c, jpeg_io.c) and
+ * sends it as wb_display_image_new does. Written from Webots' documented signatures and
+ * libController's rules. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -383,6 +384,32 @@ static WbImageRef image_new(const char *func, WbDeviceTag tag, int width, int he
 
 static bool ends_with(const char *s, const char *ext);
 
+/* An image file as RGBA rows: as libController, a name ending in .png, .jpg or .jpeg (any case),
+   whose content, PNG or JPEG, decides how it is read (the name's type need not match it). */
+static int read_image(const char *filename, int *width, int *height, unsigned char **rgba, char *why, size_t why_len) {
+  static const unsigned char PNG[4] = {0x89, 'P', 'N', 'G'}, JPEG[3] = {0xFF, 0xD8, 0xFF};
+  *rgba = NULL;
+  if (!ends_with(filename, ".png") && !ends_with(filename, ".jpg") && !ends_with(filename, ".jpeg")) {
+    snprintf(why, why_len, "unsupported image type: a .png, .jpg or .jpeg file is read");
+    return -1;
+  }
+  FILE *f = fopen(filename, "rb");
+  if (f == NULL) {
+    snprintf(why, why_len, "cannot be opened");
+    return -1;
+  }
+  unsigned char head[4] = {0};
+  size_t n = fread(head, 1, sizeof head, f);
+  fclose(f);
+  const long max_pixels = (long)(MAX_IMAGE_BYTES / 4);
+  if (n >= 3 && memcmp(head, JPEG, 3) == 0)
+    return sn_read_jpeg(filename, max_pixels, width, height, rgba, why, why_len);
+  if (n == 4 && memcmp(head, PNG, 4) == 0)
+    return sn_read_png(filename, max_pixels, width, height, rgba, why, why_len);
+  snprintf(why, why_len, "neither a PNG nor a JPEG file");
+  return -1;
+}
+
 WbImageRef wb_display_image_load(WbDeviceTag tag, const char *filename) {
   const char *func = "wb_display_image_load";
   if (filename == NULL || filename[0] == '\0') {
@@ -391,15 +418,10 @@ WbImageRef wb_display_image_load(WbDeviceTag tag, const char *filename) {
   }
   if (display(tag, func, true) == NULL)
     return NULL;
-  if (ends_with(filename, ".jpg") || ends_with(filename, ".jpeg")) {
-    fprintf(stderr, "Error: %s(): this library reads no JPEG ('%s'): convert it to PNG, or decode it yourself and use "
-                    "wb_display_image_new().\n", func, filename);
-    return NULL;
-  }
   int width, height;
   unsigned char *rgba;
-  char why[128];
-  if (sn_read_png(filename, (long)(MAX_IMAGE_BYTES / 4), &width, &height, &rgba, why, sizeof why) != 0) {
+  char why[256];
+  if (read_image(filename, &width, &height, &rgba, why, sizeof why) != 0) {
     fprintf(stderr, "Error: %s(): the \"%s\" image is unreadable (%s).\n", func, filename, why);
     return NULL;
   }
@@ -508,11 +530,8 @@ void wb_display_image_save(WbDeviceTag tag, WbImageRef ir, const char *filename)
   int id = 0;
   if (ir != NULL && (id = ref_id(tag, ir, func, "invalid WbImageRef.")) <= 0)
     return;
-  if (ends_with(filename, ".jpg") || ends_with(filename, ".jpeg")) {
-    fprintf(stderr, "Error: %s(): this library writes no JPEG ('%s'): save a .png instead.\n", func, filename);
-    return;
-  }
-  if (!ends_with(filename, ".png")) {
+  const bool jpeg = ends_with(filename, ".jpg") || ends_with(filename, ".jpeg");
+  if (!jpeg && !ends_with(filename, ".png")) {
     fprintf(stderr, "Error: %s(): unsupported file format. Supported file formats are \".jpg\" and \".png\".\n", func);
     return;
   }
@@ -535,19 +554,25 @@ void wb_display_image_save(WbDeviceTag tag, WbImageRef ir, const char *filename)
     sn_reply_free(&rep);
     return;
   }
-  size_t n = (size_t)w * (size_t)h;
-  unsigned char *rgba = malloc(4 * n);
-  if (rgba != NULL) {
+  /* B, G, R, A words to R, G, B, A rows (PNG), or R, G, B with the alpha dropped (JPEG, as libController) */
+  const size_t n = (size_t)w * (size_t)h, channels = jpeg ? 3 : 4;
+  unsigned char *out = malloc(channels * n);
+  if (out != NULL) {
     const unsigned char *s = (const unsigned char *)data->via.bin.ptr;
     for (size_t i = 0; i < n; i++) {
-      rgba[4 * i] = s[4 * i + 2];
-      rgba[4 * i + 1] = s[4 * i + 1];
-      rgba[4 * i + 2] = s[4 * i];
-      rgba[4 * i + 3] = s[4 * i + 3];
+      unsigned char *o = out + channels * i;
+      o[0] = s[4 * i + 2];
+      o[1] = s[4 * i + 1];
+      o[2] = s[4 * i];
+      if (!jpeg)
+        o[3] = s[4 * i + 3];
     }
-    if (sn_write_png(filename, rgba, w, h, 4) != 0)
-      fprintf(stderr, "Error: %s(): cannot write '%s'.\n", func, filename);
-    free(rgba);
+    char why[256] = "";
+    const int rc = jpeg ? sn_write_jpeg(filename, out, w, h, 100, why, sizeof why) : sn_write_png(filename, out, w, h, 4);
+    if (rc != 0)
+      fprintf(stderr, "Error: %s(): cannot write '%s'%s%s%s.\n", func, filename, why[0] ? " (" : "", why,
+              why[0] ? ")" : "");
+    free(out);
   }
   sn_reply_free(&rep);
 }

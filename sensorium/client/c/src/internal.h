@@ -325,6 +325,15 @@ uint32_t sn_crc32(uint32_t crc, const unsigned char *p, size_t n);
  * with the reason in why ("is not a PNG file", ...). */
 int sn_read_png(const char *filename, long max_pixels, int *width, int *height, unsigned char **rgba, char *why,
                 size_t why_len);
+/* ------------------------------------------------------------------ jpeg_io.c */
+/* A JPEG file as 8-bit RGBA rows, opaque (*rgba malloc'ed, the caller frees it), at most max_pixels;
+ * 0, or -1 with libjpeg's reason in why. */
+int sn_read_jpeg(const char *filename, long max_pixels, int *width, int *height, unsigned char **rgba, char *why,
+                 size_t why_len);
+/* rgb (height rows of 3*width bytes) as a JPEG file of that quality (1..100), no chroma subsampling;
+ * 0, or -1 with the reason in why. */
+int sn_write_jpeg(const char *filename, const unsigned char *rgb, int width, int height, int quality, char *why,
+                  size_t why_len);
 /* A range finder's or camera's state from its attach description (0, or -1 on a bad one); its
  * readings from a step reply; freed at cleanup. No-ops for other devices. */
 int sn_imaging_describe(sn_device *d, const msgpack_object *desc);
