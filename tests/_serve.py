@@ -284,14 +284,14 @@ def serve(world: Path | str | None = None, *extra: str, rpc: str = ANY_PORT, pub
 
 
 def run_controller(world: Path, argv, env: dict[str, str] | None = None, robot: str = "bot",
-                   cwd: Path | str = REPO) -> tuple[list[str], str]:
+                   cwd: Path | str = REPO, timeout: float = 120.0) -> tuple[list[str], str]:
     """``argv(url)`` run (in ``cwd``) as ``robot``'s controller against a fresh ``sensorium serve WORLD
     --mode fast`` until it exits by itself (code 0 asserted): (its stdout lines, its stderr)."""
     with serve(world, "--mode", "fast", env=env) as server:
         url = server.url(robot)
         proc = Proc(argv(url), env={**(env or {}), "SENSORIUM_CONTROLLER_URL": url}, cwd=cwd)
         try:
-            code = proc.wait(120)
+            code = proc.wait(timeout)
         finally:
             proc.stop()
         assert code == 0, proc.stderr()

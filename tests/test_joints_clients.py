@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from _serve import Proc, serve
+from _serve import run_controller
 from test_c_client import SAN_ENV, TESTS_C, sanitized_controller
 
 REPO = Path(__file__).resolve().parents[1]
@@ -29,14 +29,7 @@ def cjoints(tmp_path_factory) -> str:
 
 
 def _run(argv: list[str], env: dict[str, str] | None = None) -> tuple[list[str], str]:
-    with serve(WORLD, "--mode", "fast", env=env) as server:
-        proc = Proc(argv, env={**(env or {}), "SENSORIUM_CONTROLLER_URL": server.url("arm")})
-        try:
-            code = proc.wait(180)
-        finally:
-            proc.stop()
-        assert code == 0, proc.stderr()
-        return proc.stdout().splitlines(), proc.stderr()
+    return run_controller(WORLD, lambda _url: argv, env=env, robot="arm", timeout=180)
 
 
 def _value(bits: str) -> float:

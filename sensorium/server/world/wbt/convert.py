@@ -1495,28 +1495,24 @@ class Converter:
         else:
             drive, why = differential_drive(wheels, self)
             # a motorised hinge whose end point has nothing round to roll on (a gripper's lift arm, a
-            # flipper) is no wheel: the drive is the wheels without it, if they make one
-            rolling = [w for w in wheels if wheel_radius(w["end"], self) is not None] if drive is None else wheels
-            if 2 <= len(rolling) < len(wheels):
-                drive, _ = differential_drive(rolling, self)
+            # flipper) is no wheel, nor, that failing, one whose round part does not turn about its axis
+            # (an arm's link of a plain cylinder, across the axis or off it): the drive is the wheels
+            # without them, if they make one
+            for rolls, reason in ((lambda w: wheel_radius(w["end"], self) is not None,
+                                   "its end point has no cylinder or sphere to roll on"),
+                                  (lambda w: rolls_about_its_axis(w, self),
+                                   "nothing round at its end point turns about its axis as a wheel does")):
                 if drive is not None:
-                    for w in wheels:
-                        if not any(w is r for r in rolling):
-                            self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel (its end point has no "
-                                                 f"cylinder or sphere to roll on): {JOINT_MOVES}")
-                    wheels = rolling
-            if drive is None:
-                # then a hinge whose round part does not turn about its axis (an arm's link of a plain
-                # cylinder, across the axis or off it) is no wheel either
-                coaxial = [w for w in wheels if rolls_about_its_axis(w, self)]
-                if 2 <= len(coaxial) < len(wheels):
-                    drive, _ = differential_drive(coaxial, self)
+                    break
+                kept = [w for w in wheels if rolls(w)]
+                if 2 <= len(kept) < len(wheels):
+                    drive, _ = differential_drive(kept, self)
                     if drive is not None:
                         for w in wheels:
-                            if not any(w is r for r in coaxial):
-                                self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel (nothing round at "
-                                                     f"its end point turns about its axis as a wheel does): {JOINT_MOVES}")
-                        wheels = coaxial
+                            if not any(w is k for k in kept):
+                                self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel ({reason}): "
+                                                     f"{JOINT_MOVES}")
+                        wheels = kept
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return
