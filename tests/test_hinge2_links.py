@@ -119,3 +119,34 @@ def test_a_ball_joint_turns_its_sensor_about_its_three_axes(tmp_path: Path, para
     pose = sim.device("wrist/ds").world_pose(sim.robot("wrist").pose)
     assert pose.translation == pytest.approx(np.array([0, 0, 0.1]) + turn @ [0.1, 0, 0], abs=1e-12)
     assert pose.rotation == pytest.approx(turn, abs=1e-12)
+
+
+def test_a_supervisor_reads_a_hinge2_end_points_pose_where_both_axes_put_it(tmp_path: Path) -> None:
+    """The head's end point Solid (DEF TIP) read through the Supervisor (the sans-IO core): at pan
+    pi/2, tilt pi/4 its origin is at a + R_z(pi/2)·R_y(pi/4)·(0.1, 0, 0) and its orientation is
+    R_z(pi/2)·R_y(pi/4); before any motion, where the file puts it. (The nested nodes took only a
+    HingeJoint's and a SliderJoint's end points for moving.)"""
+    from test_supervisor import A, Live
+
+    text = _head(0.0, "0.1 0 0.1").replace("endPoint Solid {", "endPoint DEF TIP Solid {").replace(
+        'Robot { name "head"', 'Robot { name "head" supervisor TRUE')
+    lv = Live(Simulation(load_world(write(tmp_path, text))))
+    lv.ok(A, "attach", {"robot": "head"})
+
+    def pose() -> tuple[list[float], np.ndarray]:
+        node = lv.ok(A, "/head/robot/get_from_def", {"name": "TIP"})["node"]
+        got = lv.ok(A, "/head/robot/get_node_pose", {"node": node})
+        return got["position"], np.array(got["orientation"]).reshape(3, 3)
+
+    at, turned = pose()
+    assert at == pytest.approx([0.1, 0.0, 0.1], abs=1e-12) and turned == pytest.approx(np.eye(3), abs=1e-12)
+    head = lv.sim.robot("head")
+    head.motor("pan").set_position(math.pi / 2)
+    head.motor("tilt").set_position(Q)
+    for _ in range(1000):                          # until both are there (generous limit)
+        if head.motor("pan").position == math.pi / 2 and head.motor("tilt").position == Q:
+            break
+        lv.sim.step()
+    at, turned = pose()
+    assert at == pytest.approx([0.0, 0.1 * C, 0.1 - 0.1 * C], abs=1e-12)
+    assert turned == pytest.approx(_rot((0, 0, 1), math.pi / 2) @ _rot((0, 1, 0), Q), abs=1e-12)

@@ -37,7 +37,12 @@ NOT_POSES = frozenset({"RotationalMotor", "LinearMotor", "PositionSensor", "Brak
 """Devices Webots does not derive from Pose (no position): a joint's motors and sensors."""
 
 MOVING_JOINTS = frozenset({"HingeJoint", "SliderJoint"})
-"""The joints whose end point a motor moves here (a Hinge2Joint is a steered wheel's, a BallJoint has no motor)."""
+"""The joints whose ``jointParameters`` hold their motor's position here (a Hinge2Joint's and a
+BallJoint's end points move too, on their axes' chain: :func:`_end_point_motors`)."""
+
+CHAINS = {"Hinge2Joint": ("device2", "device"), "BallJoint": ("device3", "device2", "device")}
+"""A multi-axis joint's axis fields, innermost first: its end point rides on the innermost motorised
+axis (the import turns such a joint into a chain of hinges, each riding on the one before)."""
 
 MOTORS = frozenset({"RotationalMotor", "LinearMotor"})
 
@@ -105,15 +110,28 @@ def _first_motors(entries: list[wm.NestedNode]) -> dict[int, str]:
     return motor
 
 
+def _end_point_motors(entries: list[wm.NestedNode]) -> dict[int, str]:
+    """A joint entry's index -> the motor its end point rides on: a HingeJoint's or SliderJoint's
+    first motor, a Hinge2Joint's or BallJoint's innermost motorised axis's (:data:`CHAINS`)."""
+    motor = _first_motors(entries)
+    axes: dict[int, dict[str, str]] = {}
+    for e in entries:
+        if e.parent >= 0 and e.type in MOTORS and entries[e.parent].type in CHAINS:
+            axes.setdefault(e.parent, {}).setdefault(e.field, e.device or "")
+    for k, found in axes.items():
+        motor[k] = next(found[f] for f in CHAINS[entries[k].type] if f in found)
+    return motor
+
+
 def _riding(robot: Any, entries: list[wm.NestedNode]) -> list[str]:
     """Each entry's joint (the motor of the innermost joint whose end point holds it that the
     simulation moves, "" for none): a device's is its ``on_joint``, where the simulation moves it;
-    any other node's is its parent's, or, in a HingeJoint's or SliderJoint's ``endPoint``, the
-    joint's first motor when it is one of the robot's joint motors (a wheel's motor is the drive's:
-    what its end point holds rides with what the wheel rides on, as the import's ``on_joint``)."""
+    any other node's is its parent's, or, in a joint's ``endPoint``, the motor it rides on
+    (:func:`_end_point_motors`) when it is one of the robot's joint motors (a wheel's motor is the
+    drive's: what its end point holds rides with what the wheel rides on, as the import's ``on_joint``)."""
     on = {d.name: d.on_joint or "" for d in robot.model.devices}
     moved = set(robot.joints)
-    motor = _first_motors(entries)
+    motor = _end_point_motors(entries)
     out: list[str] = []
     for e in entries:
         if e.device and e.device in on:
@@ -122,8 +140,7 @@ def _riding(robot: Any, entries: list[wm.NestedNode]) -> list[str]:
             joint = ""
         else:
             joint = out[e.parent]
-            parent = entries[e.parent]
-            if e.field == "endPoint" and parent.type in MOVING_JOINTS and motor.get(e.parent, "") in moved:
+            if e.field == "endPoint" and motor.get(e.parent, "") in moved:
                 joint = motor[e.parent]
         out.append(joint)
     return out
