@@ -335,3 +335,35 @@ def test_a_joint_motors_multiplier_is_read_and_zero_is_reset_to_one(tmp_path: Pa
     assert [(d.name, d.multiplier) for d in robot.devices] == [("lift", 0.5), ("tilt", 1.0)]
     assert [x.split(": ", 1)[1] for x in w.warnings if "cannot be 0" in x] == [
         "LinearMotor.multiplier: 0 cannot be 0; using 1 (as Webots does)"]
+
+
+def test_vertical_finger_hinges_holding_their_axles_are_no_failed_car(tmp_path: Path) -> None:
+    """Webots' coupled_motors gripper: two finger hinges about z whose end points hold their axles,
+    cylinders coaxial with the hinge (round, but rolling on nothing), on a slider's carriage, and no
+    motor driving a wheel. That is no vehicle: each finger motor is said once as no wheel and moves
+    its joint (coupled, multiplier -1), the axle and what it holds with it. It used to be taken for
+    a car's steering and end in "no Ackermann drive (the driven wheels (none) ...); the robot will
+    not move"."""
+    fingers = "".join(
+        f' HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor 0 {y} 0 }} device [ '
+        f'RotationalMotor {{ name "motor::{side} finger" {m} }} ] endPoint Solid {{ translation 0 {y} 0 children [ '
+        f'Shape {{ geometry Cylinder {{ height 0.0125 radius 0.0025 }} }} Solid {{ translation 0.03 0 0 name "{side} tip" }} '
+        f'] name "{side} axle" }} }}\n' for side, y, m in (("left", -0.008, ""), ("right", 0.008, "multiplier -1")))
+    p = write(tmp_path, 'Robot { name "gripper" children [\n SliderJoint { device [ LinearMotor { } ] endPoint Solid { '
+                        'translation 0 0 0.01 children [\n' + fingers + '] } }\n] }\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
+    (robot,) = w.world.robots
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    why = ("is no wheel (it turns about a vertical axis and no motor of the robot drives a wheel): its joint moves "
+           "kinematically")
+    assert [x.split(": ", 1)[1].split(" (Webots")[0] for x in w.warnings if "HingeJoint motor" in x] == [
+        f"HingeJoint motor 'motor::left finger' {why}", f"HingeJoint motor 'motor::right finger' {why}"]
+    sim = Simulation(w)
+    left, right = (sim.robot("gripper").motor(f"motor::{side} finger") for side in ("left", "right"))
+    left.set_position(math.pi / 2)
+    for _ in range(200):                     # 10 rad/s: a quarter turn within 0.16 s (16 ms steps)
+        sim.step()
+    assert (left.position, right.position) == (math.pi / 2, -math.pi / 2)
+    tip = [e for e in robot.shapes + robot.devices if getattr(e, "on_joint", None) == "motor::left finger"]
+    assert tip, "the left finger's end point rides its joint"

@@ -1481,6 +1481,13 @@ class Converter:
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers none (its end "
                                      f"point holds no wheel): {JOINT_MOVES}")
             wheels = [w for w in wheels if not any(w is p for p in pans)]
+        if wheels and all(w["steers"] for w in wheels):
+            # vertical hinges only, none driving a wheel (a gripper's fingers whose end points hold
+            # their axles, coaxial cylinders that roll on nothing): no vehicle, no drive to miss
+            for w in wheels:
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (it turns about a vertical "
+                                     f"axis and no motor of the robot drives a wheel): {JOINT_MOVES}")
+            return
         if any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
             if drive is None:
