@@ -1458,6 +1458,21 @@ class Converter:
                                  "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
+    def _inside(self, end: Node | None) -> set[int]:
+        """The ids of every node inside the end point ``end`` (its children, its joints' end points
+        and devices, to any depth)."""
+        out: set[int] = set()
+        stack = [end] if end is not None else []
+        while stack:
+            n = stack.pop()
+            self.walk(n)
+            f = self.fields(n)
+            for c in [*f.nodes("children"), *f.nodes("device"), *f.nodes("device2"), f.node_("endPoint")]:
+                if c is not None:
+                    out.add(id(c))
+                    stack.append(c)
+        return out
+
     def drive(self, node: Node, robot: Owner) -> None:
         from sensorium.server.world.wbt.drive import ackermann_drive, differential_drive, holds_wheel, wheel_radius
 
@@ -1481,6 +1496,24 @@ class Converter:
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers none (its end "
                                      f"point holds no wheel): {JOINT_MOVES}")
             wheels = [w for w in wheels if not any(w is p for p in pans)]
+        # an arm's chain (a vacuum gripper's pitch and roll hinges): a wheel carries no motorised
+        # hinge and rides on none but its steering joint, so a hinge that does either is no wheel
+        inside = {id(w["node"]): self._inside(w["end"]) for w in wheels if not w["steers"]}
+        links = [w for w in wheels if not w["steers"] and
+                 (any(id(o["node"]) in inside[id(w["node"])] for o in wheels) or
+                  any(id(w["node"]) in held for held in inside.values()))]
+        if links:
+            for w in links:
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (a link of a chain of "
+                                     f"motorised joints, carrying one or carried by one): {JOINT_MOVES}")
+            wheels = [w for w in wheels if not any(w is k for k in links)]
+            if len(wheels) == 1 and not wheels[0]["steers"]:
+                w = wheels[0]
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (the robot's only other "
+                                     f"motorised hinge): {JOINT_MOVES}")
+                return
+            if not wheels:
+                return
         if wheels and all(w["steers"] for w in wheels):
             # vertical hinges only, none driving a wheel (a gripper's fingers whose end points hold
             # their axles, coaxial cylinders that roll on nothing): no vehicle, no drive to miss
