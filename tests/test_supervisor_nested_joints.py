@@ -241,3 +241,53 @@ def test_a_webots_supervisor_reads_its_arm_where_the_joints_put_it(tmp_path):
     assert after["positions"] == [HALF_PI, SLIDE0 + D]
     for seen in (before, after):            # getPose(link): the hand where the file puts it in the link
         assert seen["hand_in_link"] == pytest.approx([0.2, 0.0, 0.1], abs=1e-12)
+
+
+def test_a_joints_end_point_and_devices_are_its_fields():
+    """Webots' HingeJoint/SliderJoint ``endPoint`` (SFNode: the end point Solid) and ``device``
+    (MFNode: its motor and position sensor, in the world file's order), read-only, as a Supervisor
+    walks a robot's tree down past its joints (children, then each joint's endPoint); a joint with
+    no end point here answers NULL (0). Before, a walk stopped at the first joint ("no value")."""
+    arm = Arm()
+
+    def field(node: int, name: str):
+        return arm.call("get_field", {"node": node, "field": name})
+
+    def info(node: int) -> tuple[str, str, str]:
+        got = arm.call("get_from_id", {"id": node})
+        return got["type"], got["def_name"], got["name"]
+
+    shoulder, slide = arm.node("SHOULDER"), arm.node("SLIDE")
+    assert field(shoulder, "endPoint") == {"type": "SFNode", "value": arm.node("LINK")}
+    assert field(slide, "endPoint") == {"type": "SFNode", "value": arm.node("CARRIAGE")}
+    got = field(shoulder, "device")
+    assert got["type"] == "MFNode"
+    assert [info(d) for d in got["value"]] == [("RotationalMotor", "", "shoulder"),
+                                               ("PositionSensor", "", "shoulder sensor")]
+    assert [info(d) for d in field(slide, "device")["value"]] == [("LinearMotor", "", "slide"),
+                                                                  ("PositionSensor", "", "slide sensor")]
+    assert field(arm.node("LINK"), "endPoint")["type"] == ""           # a Solid has none
+    assert field(shoulder, "device2")["type"] == ""                    # a HingeJoint has one device field
+    msg = arm.lv.err(A, "/armbot/robot/set_field", {"node": shoulder, "field": "endPoint", "value": 0},
+                     ErrorCode.INVALID_ARGUMENT)
+    assert "read-only here" in msg
+
+    def walk(node: int, depth: int, out: list) -> None:     # as a Webots supervisor walks a robot's tree
+        kind, def_name, _ = info(node)
+        out.append((depth, kind, def_name))
+        for name in ("children", "device"):
+            kids = field(node, name)
+            if kids["type"] == "MFNode":
+                for kid in kids["value"]:
+                    walk(kid, depth + 1, out)
+        end = field(node, "endPoint")
+        if end["type"] == "SFNode" and end["value"]:
+            walk(end["value"], depth + 1, out)
+
+    seen: list = []
+    walk(arm.node("ARMBOT"), 0, seen)
+    assert [(d, k, n) for d, k, n in seen if n] == [
+        (0, "Robot", "ARMBOT"), (1, "HingeJoint", "SHOULDER"), (2, "Solid", "LINK"), (3, "Pose", "ELBOW"),
+        (4, "Solid", "HAND"), (3, "Solid", "FINGER"), (3, "DistanceSensor", "TOOL"), (3, "SliderJoint", "SLIDE"),
+        (4, "Solid", "CARRIAGE")]
+    assert sum(1 for _, k, _ in seen if k in ("RotationalMotor", "LinearMotor", "PositionSensor")) == 4

@@ -449,6 +449,10 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
         out["name"] = ("SFString", lambda sim, node: node.name, None)
     if nested.has_children(n):
         out["children"] = ("MFNode", _children, None)
+    if n.type in nested.JOINT_DEVICES:     # walked down as in Webots: the end point, the devices
+        out["endPoint"] = ("SFNode", lambda sim, node: nested.end_point(_table(sim), node.id), None)
+        for name in nested.JOINT_DEVICES[n.type]:
+            out[name] = ("MFNode", lambda sim, node, name=name: nested.joint_devices(_table(sim), node.id, name), None)
     parameters = nested.joint_parameters(_table(sim), n.id)
     if parameters is not None:        # a motorised joint's (0: NULL), holding its position now
         out["jointParameters"] = ("SFNode", lambda sim, node: parameters, None)
