@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
@@ -445,3 +446,46 @@ def test_an_arms_chain_of_round_hinges_is_no_failed_car(tmp_path: Path) -> None:
         sim.step()
     assert imu.roll_pitch_yaw == pytest.approx([roll, pitch, yaw], abs=1e-6)   # type: ignore[attr-defined]
     assert cup.value == 0.0                                  # type: ignore[attr-defined]   lifted off the crate
+
+
+def test_a_lone_hinge2_joint_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' motor2 sample (our own world): one Hinge2Joint on a post, first axis -x, second -y,
+    its end point a small cylinder (round) holding a distance sensor 5 cm out. One joint makes no
+    vehicle: its two motors are said once each as no wheel and move the end point by
+    R(a1, q1) R(a2, q2) about the anchor. It used to be taken for a car with one steered wheel
+    ("no Ackermann drive (a car-like robot needs two steered front wheels ...); the robot will not
+    move")."""
+    p = write(tmp_path, """Robot { name "post" translation 0.1 0 0 children [
+ Solid { translation 0 0 0.06 children [
+  Shape { geometry Cylinder { height 0.1 radius 0.02 } }
+  Hinge2Joint {
+   jointParameters HingeJointParameters { axis -1 0 0 anchor 0 0 0.07 }
+   jointParameters2 JointParameters { axis 0 -1 0 }
+   device [ RotationalMotor { name "motor 1" maxVelocity 1 } ]
+   device2 [ RotationalMotor { name "motor 2" maxVelocity 1 } ]
+   endPoint Solid { translation 0 0 0.07 children [ DEF C Shape { geometry Cylinder { height 0.03 radius 0.008 } }
+     DistanceSensor { translation 0 0 0.05 name "tip" } ] boundingObject USE C } } ] } ] }
+""")
+    w = load_world(p)
+    assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
+    assert [x.split(": ", 1)[1].split(": its joint")[0] for x in w.warnings if "is no wheel" in x] == [
+        "Hinge2Joint motor 'motor 1' is no wheel (the robot's only motorised joint)",
+        "Hinge2Joint motor 'motor 2' is no wheel (the robot's only motorised joint)"]
+    sim = Simulation(w)
+    robot = sim.robot("post")
+    q1, q2 = 1.0, -0.5
+    robot.motor("motor 1").set_position(q1)
+    robot.motor("motor 2").set_position(q2)
+    for _ in range(200):                     # 1 rad/s: 1 rad within 1 s and the ramp (16 ms steps)
+        sim.step()
+    assert (robot.motor("motor 1").position, robot.motor("motor 2").position) == (q1, q2)
+
+    def rot(axis: list[float], q: float) -> np.ndarray:
+        k = np.asarray(axis, dtype=np.float64)
+        kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        return np.eye(3) + math.sin(q) * kx + (1 - math.cos(q)) * kx @ kx
+
+    turn = rot([-1, 0, 0], q1) @ rot([0, -1, 0], q2)
+    tip = sim.device("post/tip").world_pose(robot.pose)
+    assert tip.translation == pytest.approx([0.1, 0.0, 0.13] + turn @ [0.0, 0.0, 0.05], abs=1e-12)
+    assert np.asarray(tip.rotation) == pytest.approx(turn, abs=1e-12)

@@ -1480,12 +1480,14 @@ class Converter:
         if not wheels:
             return
         round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
-        if len(wheels) == 1 or not any(round_):
-            # one motorised hinge (Webots' motor sample: a turntable), or nothing round to roll on at
+        if len({id(w["node"]) for w in wheels}) == 1 or not any(round_):
+            # one motorised hinge (Webots' motor sample: a turntable; motor2's one Hinge2Joint, its
+            # two axes the joint's), or nothing round to roll on at
             # any (an arm, a gripper's fingers, a pan-tilt head): no vehicle, so no drive to miss;
             # each joint moves kinematically
             for w, rolls in zip(wheels, round_):
-                why = "the robot's only motorised hinge" if rolls else "its end point has no cylinder or sphere to roll on"
+                only = "hinge" if w["node"].type == "HingeJoint" else "joint"
+                why = f"the robot's only motorised {only}" if rolls else "its end point has no cylinder or sphere to roll on"
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): {JOINT_MOVES}")
             return
         # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
