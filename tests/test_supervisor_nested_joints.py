@@ -15,7 +15,9 @@ import sys
 
 import numpy as np
 import pytest
-from test_multiprocess import REPO, run_paused
+from _serve import Proc, sensorium
+from test_c_client import SAN_ENV, TESTS_C, sanitized_controller
+from test_multiprocess import REPO, run_paused, start_server
 from test_supervisor import A, Live
 
 from sensorium.schemas.wire import ErrorCode
@@ -291,3 +293,67 @@ def test_a_joints_end_point_and_devices_are_its_fields():
         (4, "Solid", "HAND"), (3, "Solid", "FINGER"), (3, "DistanceSensor", "TOOL"), (3, "SliderJoint", "SLIDE"),
         (4, "Solid", "CARRIAGE")]
     assert sum(1 for _, k, _ in seen if k in ("RotationalMotor", "LinearMotor", "PositionSensor")) == 4
+
+
+def test_a_field_webots_lacks_too_is_absent_and_one_it_has_is_not():
+    """get_field of a field the node lacks here: ``absent`` when Webots' node of that type has none
+    either (a Solid's ``endPoint``, a joint's ``children``, a motor's pose): the clients then answer
+    NULL silently, as libController does; a field Webots has but Sensorium does not serve (a
+    Solid's ``boundingObject``, an unmotorised joint's ``jointParameters``) is not absent: the
+    clients say it is not served here."""
+    arm = Arm()
+    link, shoulder = arm.node("LINK"), arm.node("SHOULDER")
+    motor = arm.call("get_field", {"node": shoulder, "field": "device"})["value"][0]
+
+    def absent(node: int, field: str) -> bool:
+        got = arm.call("get_field", {"node": node, "field": field})
+        assert got["type"] == "" and got["value"] == [], got
+        return bool(got.get("absent", False))
+
+    for node, field in ((link, "endPoint"), (link, "device"), (link, "jointParameters"), (shoulder, "children"),
+                        (shoulder, "translation"), (shoulder, "name"), (shoulder, "device2"), (motor, "children"),
+                        (motor, "rotation"), (arm.node("ARMBOT"), "endPoint"), (arm.node("ELBOW"), "name")):
+        assert absent(node, field), (node, field)
+    for node, field in ((link, "boundingObject"), (link, "physics"), (motor, "maxVelocity"), (shoulder, "nonsense")):
+        assert not absent(node, field), (node, field)
+
+
+WALK = ["0 Robot ARMBOT", "1 HingeJoint SHOULDER 0.500", "2 RotationalMotor ", "2 PositionSensor ", "2 Solid LINK",
+        "3 Pose ELBOW", "4 Solid HAND", "3 Solid FINGER", "3 DistanceSensor TOOL", "3 SliderJoint SLIDE 0.100",
+        "4 LinearMotor ", "4 PositionSensor ", "4 Solid CARRIAGE"]
+
+
+def _no_field_lines(err: str) -> list[str]:
+    return [line for line in err.splitlines() if "has no field" in line]
+
+
+def test_a_webots_supervisor_walks_its_tree_past_the_joints_in_python(tmp_path):
+    """tests/controllers/tree_walker.py through ``sensorium serve``: it reaches every node past the
+    joints (their end points and devices), and its probes of fields the nodes lack in Webots too
+    print nothing; only the link's boundingObject (Webots has one) is said as not served."""
+    ctl = run_paused(WORLD, tmp_path, "tree_walker.py", "armbot")
+    assert [line.rstrip() for line in ctl.out[:-1]] == [w.rstrip() for w in WALK]
+    assert ctl.out[-1] == "boundingObject None"
+    (line,) = _no_field_lines(ctl.stderr())
+    assert "has no field 'boundingObject' in Sensorium" in line
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="needs a POSIX C toolchain")
+def test_a_webots_supervisor_walks_its_tree_past_the_joints_in_c(tmp_path, tmp_path_factory):
+    """tests/c/tree_walker.c (AddressSanitizer/UBSan): the same walk and the same one line."""
+    exe = sanitized_controller(tmp_path_factory, TESTS_C / "tree_walker.c")
+    server = start_server(WORLD, tmp_path, "--mode", "pause")
+    try:
+        ctl = Proc(sensorium("controller", exe, "--url", server.url("armbot")), env=SAN_ENV)
+        try:
+            server.wait_attached({"armbot"})
+            server.conn.call("set_mode", {"mode": "fast"})
+            assert ctl.wait(120) == 0, ctl.stderr()
+        finally:
+            ctl.kill()
+    finally:
+        server.stop()
+    assert [line.rstrip() for line in ctl.out[:-1]] == [w.rstrip() for w in WALK]
+    assert ctl.out[-1] == "boundingObject None"
+    (line,) = _no_field_lines(ctl.stderr())
+    assert "has no field 'boundingObject' in Sensorium" in line

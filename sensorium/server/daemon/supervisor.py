@@ -470,11 +470,32 @@ def _fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
 _VECTOR_SIZES = {"SFVec3f": 3, "SFColor": 3, "SFRotation": 4}
 
 
+_JOINT_FIELDS = {"endPoint": frozenset(nested.JOINT_DEVICES), "device": frozenset(nested.JOINT_DEVICES),
+                 "jointParameters": frozenset(nested.JOINT_DEVICES),
+                 "device2": frozenset({"Hinge2Joint", "BallJoint"}), "jointParameters2": frozenset({"Hinge2Joint", "BallJoint"}),
+                 "device3": frozenset({"BallJoint"}), "jointParameters3": frozenset({"BallJoint"})}
+_PARAMETERS = frozenset({"HingeJointParameters", "JointParameters", "BallJointParameters"})
+_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS
+_WEBOTS_LACKS = {"children": _NO_POSE, "translation": _NO_POSE | {"Group"}, "rotation": _NO_POSE | {"Group"},
+                 "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | {"Pose", "Transform", "Group"}}
+
+
+def webots_lacks(node_type: str, field: str) -> bool:
+    """Whether Webots' node of that base type has no such field either, for the fields a
+    Supervisor probes as it walks a robot's tree (a joint's ``endPoint``/``device``/
+    ``jointParameters``, ``children``, the pose, ``name``): libController then answers NULL
+    with no message. False when unsure (the clients then say the field is not served here)."""
+    if field in _JOINT_FIELDS:
+        return node_type not in _JOINT_FIELDS[field]
+    return node_type in _WEBOTS_LACKS.get(field, ())
+
+
 def get_field(sim: Any, node: Node, field: str) -> dict:
-    """``{"type", "value"}``; type '' (and value []) when the node has no such field here."""
+    """``{"type", "value"}``; type '' (and value []) when the node has no such field here, plus
+    ``absent: true`` when Webots' node has none either (``webots_lacks``)."""
     entry = _fields(sim, node).get(field)
     if entry is None:
-        return {"type": "", "value": []}
+        return {"type": "", "value": [], "absent": True} if webots_lacks(node.type, field) else {"type": "", "value": []}
     return {"type": entry[0], "value": entry[1](sim, node)}
 
 
