@@ -1466,11 +1466,12 @@ class Converter:
         while stack:
             n = stack.pop()
             self.walk(n)
-            f = self.fields(n)
-            for c in [*f.nodes("children"), *f.nodes("device"), *f.nodes("device2"), f.node_("endPoint")]:
-                if c is not None:
-                    out.add(id(c))
-                    stack.append(c)
+            for key in ("children", "device", "device2", "device3", "endPoint"):
+                held = n.fields.get(key)      # the raw value: a field of another meaning is no node
+                for c in held if isinstance(held, list) else [held]:
+                    if isinstance(c, Node):
+                        out.add(id(c))
+                        stack.append(c)
         return out
 
     def drive(self, node: Node, robot: Owner) -> None:
