@@ -357,3 +357,40 @@ def test_a_webots_supervisor_walks_its_tree_past_the_joints_in_c(tmp_path, tmp_p
     assert ctl.out[-1] == "boundingObject None"
     (line,) = _no_field_lines(ctl.stderr())
     assert "has no field 'boundingObject' in Sensorium" in line
+
+
+ROLLED = """#VRML_SIM R2023b utf8
+Robot {
+  name "roller" controller "<extern>" supervisor TRUE
+  children [
+    HingeJoint {
+      jointParameters HingeJointParameters { axis 0 0 1 position 2 }
+      device [ RotationalMotor { name "yaw" maxVelocity 100 } ]
+      endPoint Solid { rotation 0 0 1 2 children [
+        HingeJoint {
+          jointParameters HingeJointParameters { axis 1 0 0 anchor 0.3 0 0 position 0.5 }
+          device [ RotationalMotor { name "roll" maxVelocity 100 } ]
+          endPoint DEF LINK Solid { translation 0.3 0 0 rotation 1 0 0 0.5 children [ DEF CUP Solid { translation 0 0 -0.1 } ] }
+        }
+      ] }
+    }
+  ]
+}
+"""
+
+
+def test_an_end_point_turned_back_to_no_rotation_reads_webots_identity(tmp_path):
+    """A roll hinge that starts at 0.5 (its end point turned 0.5 about x, as the file writes it) on a
+    yaw hinge that starts at 2, both commanded to 0 (Webots' vacuum_gripper arm): the roll link's
+    rotation in its parent is then R(x, -0.5) R(x, 0.5),
+    the identity up to rounding, and reads Webots' identity 0 0 1 0 (WbRotation: an angle below
+    10000 machine epsilons is no turn), not an axis of rounding noise with an angle of ~1e-17."""
+    path = tmp_path / "rolled.wbt"
+    path.write_text(ROLLED)
+    arm = Arm(path, "roller")
+    arm.move("yaw", 0.0)
+    arm.move("roll", 0.0)
+    assert arm.field("LINK", "rotation") == [0.0, 0.0, 1.0, 0.0]
+    assert arm.position("CUP") == pytest.approx([0.3, 0.0, -0.1], abs=1e-12)
+    arm.move("roll", 0.25)                                   # a real turn keeps its axis and angle
+    assert arm.field("LINK", "rotation") == pytest.approx([1.0, 0.0, 0.0, 0.25], abs=1e-12)

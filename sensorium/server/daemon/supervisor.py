@@ -17,6 +17,7 @@ node's fields are read-only here.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -242,14 +243,21 @@ def _pose(sim: Any, node: Node) -> Any:
     return sim.robots[node.key].pose if node.type == "Robot" else sim.scene.solid_poses[node.key]
 
 
+NO_TURN = 10000 * sys.float_info.epsilon
+"""An angle below this is no turn (WbPrecision::DOUBLE_EQUALITY_TOLERANCE, WbRotation's)."""
+
+
 def matrix_axis_angle(r: np.ndarray) -> list[float]:
-    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, pi]); identity → 0 0 1 0.
-    Through the unit quaternion, which stays accurate near half turns."""
+    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, pi]); identity → 0 0 1 0, and so
+    is a turn by less than ``NO_TURN`` (as WbRotation: rounding, e.g. a joint turned back to where
+    the file placed its end point, leaves no axis of noise). Through the unit quaternion, which
+    stays accurate near half turns."""
     x, y, z, w = matrix_quaternion(r)             # w >= 0
     n = math.sqrt(x * x + y * y + z * z)
-    if n < 1e-300:
+    angle = 2.0 * math.atan2(n, w)
+    if n < 1e-300 or angle < NO_TURN:
         return [0.0, 0.0, 1.0, 0.0]
-    return [x / n, y / n, z / n, 2.0 * math.atan2(n, w)]
+    return [x / n, y / n, z / n, angle]
 
 
 # ---------------------------------------------------------------------- fields
