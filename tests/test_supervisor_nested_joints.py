@@ -316,6 +316,11 @@ def test_a_field_webots_lacks_too_is_absent_and_one_it_has_is_not():
         assert absent(node, field), (node, field)
     for node, field in ((link, "boundingObject"), (link, "physics"), (motor, "maxVelocity"), (shoulder, "nonsense")):
         assert not absent(node, field), (node, field)
+    top = {arm.call("get_from_id", {"id": n})["type"]: n for n in arm.call("get_field", {"node": 0, "field": "children"})["value"]}
+    assert {"WorldInfo", "Viewpoint"} <= set(top)
+    for kind in ("WorldInfo", "Viewpoint"):      # a walk down the whole scene probes them too
+        assert all(absent(top[kind], field) for field in ("children", "translation", "rotation", "name", "endPoint"))
+    assert not absent(top["WorldInfo"], "northDirection")       # Webots has it, not served here
 
 
 WALK = ["0 Robot ARMBOT", "1 HingeJoint SHOULDER 0.500", "2 RotationalMotor ", "2 PositionSensor ", "2 Solid LINK",

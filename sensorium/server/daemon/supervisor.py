@@ -483,9 +483,10 @@ _JOINT_FIELDS = {"endPoint": frozenset(nested.JOINT_DEVICES), "device": frozense
                  "device2": frozenset({"Hinge2Joint", "BallJoint"}), "jointParameters2": frozenset({"Hinge2Joint", "BallJoint"}),
                  "device3": frozenset({"BallJoint"}), "jointParameters3": frozenset({"BallJoint"})}
 _PARAMETERS = frozenset({"HingeJointParameters", "JointParameters", "BallJointParameters"})
-_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS
+_SCENERY = frozenset({"WorldInfo", "Viewpoint", "Background", "Fog", "PointLight", "SpotLight", "DirectionalLight"})
+_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS | _SCENERY
 _WEBOTS_LACKS = {"children": _NO_POSE, "translation": _NO_POSE | {"Group"}, "rotation": _NO_POSE | {"Group"},
-                 "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | {"Pose", "Transform", "Group"}}
+                 "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | _SCENERY | {"Pose", "Transform", "Group"}}
 
 
 def webots_lacks(node_type: str, field: str) -> bool:
