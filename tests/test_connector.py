@@ -329,3 +329,47 @@ def test_the_batched_simulation_refuses_a_connector_in_one_line() -> None:
     sim = BatchedSimulation(crate_world(), copies=2)
     with pytest.raises(BatchedError, match="'dock' is a Connector; the batched simulation measures"):
         sim.device("a", "dock")
+
+
+HOP = """#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 16 }
+""" + "".join(f"""Robot {{
+  name "{name}" translation {x} 0 0 rotation 0 0 1 {turn}
+  children [
+    HingeJoint {{
+      jointParameters HingeJointParameters {{ axis 0 -1 0 anchor 0 0 0.06 }}
+      device [ RotationalMotor {{ name "upper motor" maxVelocity 1 minPosition -1.57 maxPosition 1.57 }}
+               PositionSensor {{ name "upper sensor" }} ]
+      endPoint Solid {{ translation 0 0 0.06 children [
+        Connector {{ translation 0 0 0.055 rotation 0 -1 0 1.5707963267948966 model "magnetic" autoLock TRUE
+                    axisTolerance 3.14 rotationTolerance 3.14 }} ] }}
+    }}
+  ]
+  controller "<extern>"
+}}
+""" for name, x, turn in (("MyBot 1", 0.0, 0.0), ("MyBot 2", 0.11, math.pi)))
+
+
+def test_connectors_on_arms_dock_when_the_arms_turn_them_face_to_face(tmp_path: Path) -> None:
+    """Webots' connector sample's robots (our own world): each connector sits on a hinge about -y
+    through (0, 0, 0.06), 0.055 m above it, its x axis (docking axis) up. Joints at 0: both point up,
+    0.11 m apart: no peer. Both arms turned by -1.57 rad: each connector is 0.055 m in front of its
+    robot at 0.06 m height (sin 1.57 ≈ 1), the two 0.11 m apart robots facing each other: the
+    connectors meet (within 0.01 m) with opposed x axes, and each robot's presence is 1."""
+    path = tmp_path / "hop.wbt"
+    path.write_text(HOP)
+    sim = Simulation(load_world(path))
+    docks = [sim.device(f"MyBot {i}/connector") for i in (1, 2)]
+    for d in docks:
+        d.enable(STEP)
+    sim.step()
+    assert [d.value for d in docks] == [0, 0]
+    for i in (1, 2):
+        sim.robot(f"MyBot {i}").motor("upper motor").set_position(-1.57)
+    for _ in range(200):                         # 1.57 rad at 1 rad/s: 1.6 s and the ramp (16 ms steps)
+        sim.step()
+    assert [sim.robot(f"MyBot {i}").motor("upper motor").position for i in (1, 2)] == [-1.57, -1.57]
+    a, b = (d.placed() for d in docks)
+    assert a[1] == pytest.approx([0.055 * math.sin(1.57), 0.0, 0.06 + 0.055 * math.cos(1.57)], abs=1e-12)
+    assert float(np.dot(a[0][:, 0], b[0][:, 0])) == pytest.approx(math.cos(2 * 1.57), abs=1e-12)   # nearly opposed
+    assert [d.value for d in docks] == [1, 1]

@@ -15,7 +15,9 @@ import sys
 
 import numpy as np
 import pytest
-from test_multiprocess import REPO, run_paused
+from _serve import Proc, sensorium
+from test_c_client import SAN_ENV, TESTS_C, sanitized_controller
+from test_multiprocess import REPO, run_paused, start_server
 from test_supervisor import A, Live
 
 from sensorium.schemas.wire import ErrorCode
@@ -241,3 +243,159 @@ def test_a_webots_supervisor_reads_its_arm_where_the_joints_put_it(tmp_path):
     assert after["positions"] == [HALF_PI, SLIDE0 + D]
     for seen in (before, after):            # getPose(link): the hand where the file puts it in the link
         assert seen["hand_in_link"] == pytest.approx([0.2, 0.0, 0.1], abs=1e-12)
+
+
+def test_a_joints_end_point_and_devices_are_its_fields():
+    """Webots' HingeJoint/SliderJoint ``endPoint`` (SFNode: the end point Solid) and ``device``
+    (MFNode: its motor and position sensor, in the world file's order), read-only, as a Supervisor
+    walks a robot's tree down past its joints (children, then each joint's endPoint); a joint with
+    no end point here answers NULL (0). Before, a walk stopped at the first joint ("no value")."""
+    arm = Arm()
+
+    def field(node: int, name: str):
+        return arm.call("get_field", {"node": node, "field": name})
+
+    def info(node: int) -> tuple[str, str, str]:
+        got = arm.call("get_from_id", {"id": node})
+        return got["type"], got["def_name"], got["name"]
+
+    shoulder, slide = arm.node("SHOULDER"), arm.node("SLIDE")
+    assert field(shoulder, "endPoint") == {"type": "SFNode", "value": arm.node("LINK")}
+    assert field(slide, "endPoint") == {"type": "SFNode", "value": arm.node("CARRIAGE")}
+    got = field(shoulder, "device")
+    assert got["type"] == "MFNode"
+    assert [info(d) for d in got["value"]] == [("RotationalMotor", "", "shoulder"),
+                                               ("PositionSensor", "", "shoulder sensor")]
+    assert [info(d) for d in field(slide, "device")["value"]] == [("LinearMotor", "", "slide"),
+                                                                  ("PositionSensor", "", "slide sensor")]
+    assert field(arm.node("LINK"), "endPoint")["type"] == ""           # a Solid has none
+    assert field(shoulder, "device2")["type"] == ""                    # a HingeJoint has one device field
+    msg = arm.lv.err(A, "/armbot/robot/set_field", {"node": shoulder, "field": "endPoint", "value": 0},
+                     ErrorCode.INVALID_ARGUMENT)
+    assert "read-only here" in msg
+
+    def walk(node: int, depth: int, out: list) -> None:     # as a Webots supervisor walks a robot's tree
+        kind, def_name, _ = info(node)
+        out.append((depth, kind, def_name))
+        for name in ("children", "device"):
+            kids = field(node, name)
+            if kids["type"] == "MFNode":
+                for kid in kids["value"]:
+                    walk(kid, depth + 1, out)
+        end = field(node, "endPoint")
+        if end["type"] == "SFNode" and end["value"]:
+            walk(end["value"], depth + 1, out)
+
+    seen: list = []
+    walk(arm.node("ARMBOT"), 0, seen)
+    assert [(d, k, n) for d, k, n in seen if n] == [
+        (0, "Robot", "ARMBOT"), (1, "HingeJoint", "SHOULDER"), (2, "Solid", "LINK"), (3, "Pose", "ELBOW"),
+        (4, "Solid", "HAND"), (3, "Solid", "FINGER"), (3, "DistanceSensor", "TOOL"), (3, "SliderJoint", "SLIDE"),
+        (4, "Solid", "CARRIAGE")]
+    assert sum(1 for _, k, _ in seen if k in ("RotationalMotor", "LinearMotor", "PositionSensor")) == 4
+
+
+def test_a_field_webots_lacks_too_is_absent_and_one_it_has_is_not():
+    """get_field of a field the node lacks here: ``absent`` when Webots' node of that type has none
+    either (a Solid's ``endPoint``, a joint's ``children``, a motor's pose): the clients then answer
+    NULL silently, as libController does; a field Webots has but Sensorium does not serve (a
+    Solid's ``boundingObject``, an unmotorised joint's ``jointParameters``) is not absent: the
+    clients say it is not served here."""
+    arm = Arm()
+    link, shoulder = arm.node("LINK"), arm.node("SHOULDER")
+    motor = arm.call("get_field", {"node": shoulder, "field": "device"})["value"][0]
+
+    def absent(node: int, field: str) -> bool:
+        got = arm.call("get_field", {"node": node, "field": field})
+        assert got["type"] == "" and got["value"] == [], got
+        return bool(got.get("absent", False))
+
+    for node, field in ((link, "endPoint"), (link, "device"), (link, "jointParameters"), (shoulder, "children"),
+                        (shoulder, "translation"), (shoulder, "name"), (shoulder, "device2"), (motor, "children"),
+                        (motor, "rotation"), (arm.node("ARMBOT"), "endPoint"), (arm.node("ELBOW"), "name")):
+        assert absent(node, field), (node, field)
+    for node, field in ((link, "boundingObject"), (link, "physics"), (motor, "maxVelocity"), (shoulder, "nonsense")):
+        assert not absent(node, field), (node, field)
+    top = {arm.call("get_from_id", {"id": n})["type"]: n for n in arm.call("get_field", {"node": 0, "field": "children"})["value"]}
+    assert {"WorldInfo", "Viewpoint"} <= set(top)
+    for kind in ("WorldInfo", "Viewpoint"):      # a walk down the whole scene probes them too
+        assert all(absent(top[kind], field) for field in ("children", "translation", "rotation", "name", "endPoint"))
+    assert not absent(top["WorldInfo"], "northDirection")       # Webots has it, not served here
+
+
+WALK = ["0 Robot ARMBOT", "1 HingeJoint SHOULDER 0.500", "2 RotationalMotor ", "2 PositionSensor ", "2 Solid LINK",
+        "3 Pose ELBOW", "4 Solid HAND", "3 Solid FINGER", "3 DistanceSensor TOOL", "3 SliderJoint SLIDE 0.100",
+        "4 LinearMotor ", "4 PositionSensor ", "4 Solid CARRIAGE"]
+
+
+def _no_field_lines(err: str) -> list[str]:
+    return [line for line in err.splitlines() if "has no field" in line]
+
+
+def test_a_webots_supervisor_walks_its_tree_past_the_joints_in_python(tmp_path):
+    """tests/controllers/tree_walker.py through ``sensorium serve``: it reaches every node past the
+    joints (their end points and devices), and its probes of fields the nodes lack in Webots too
+    print nothing; only the link's boundingObject (Webots has one) is said as not served."""
+    ctl = run_paused(WORLD, tmp_path, "tree_walker.py", "armbot")
+    assert [line.rstrip() for line in ctl.out[:-1]] == [w.rstrip() for w in WALK]
+    assert ctl.out[-1] == "boundingObject None"
+    (line,) = _no_field_lines(ctl.stderr())
+    assert "has no field 'boundingObject' in Sensorium" in line
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="needs a POSIX C toolchain")
+def test_a_webots_supervisor_walks_its_tree_past_the_joints_in_c(tmp_path, tmp_path_factory):
+    """tests/c/tree_walker.c (AddressSanitizer/UBSan): the same walk and the same one line."""
+    exe = sanitized_controller(tmp_path_factory, TESTS_C / "tree_walker.c")
+    server = start_server(WORLD, tmp_path, "--mode", "pause")
+    try:
+        ctl = Proc(sensorium("controller", exe, "--url", server.url("armbot")), env=SAN_ENV)
+        try:
+            server.wait_attached({"armbot"})
+            server.conn.call("set_mode", {"mode": "fast"})
+            assert ctl.wait(120) == 0, ctl.stderr()
+        finally:
+            ctl.kill()
+    finally:
+        server.stop()
+    assert [line.rstrip() for line in ctl.out[:-1]] == [w.rstrip() for w in WALK]
+    assert ctl.out[-1] == "boundingObject None"
+    (line,) = _no_field_lines(ctl.stderr())
+    assert "has no field 'boundingObject' in Sensorium" in line
+
+
+ROLLED = """#VRML_SIM R2023b utf8
+Robot {
+  name "roller" controller "<extern>" supervisor TRUE
+  children [
+    HingeJoint {
+      jointParameters HingeJointParameters { axis 0 0 1 position 2 }
+      device [ RotationalMotor { name "yaw" maxVelocity 100 } ]
+      endPoint Solid { rotation 0 0 1 2 children [
+        HingeJoint {
+          jointParameters HingeJointParameters { axis 1 0 0 anchor 0.3 0 0 position 0.5 }
+          device [ RotationalMotor { name "roll" maxVelocity 100 } ]
+          endPoint DEF LINK Solid { translation 0.3 0 0 rotation 1 0 0 0.5 children [ DEF CUP Solid { translation 0 0 -0.1 } ] }
+        }
+      ] }
+    }
+  ]
+}
+"""
+
+
+def test_an_end_point_turned_back_to_no_rotation_reads_webots_identity(tmp_path):
+    """A roll hinge that starts at 0.5 (its end point turned 0.5 about x, as the file writes it) on a
+    yaw hinge that starts at 2, both commanded to 0 (Webots' vacuum_gripper arm): the roll link's
+    rotation in its parent is then R(x, -0.5) R(x, 0.5),
+    the identity up to rounding, and reads Webots' identity 0 0 1 0 (WbRotation: an angle below
+    10000 machine epsilons is no turn), not an axis of rounding noise with an angle of ~1e-17."""
+    path = tmp_path / "rolled.wbt"
+    path.write_text(ROLLED)
+    arm = Arm(path, "roller")
+    arm.move("yaw", 0.0)
+    arm.move("roll", 0.0)
+    assert arm.field("LINK", "rotation") == [0.0, 0.0, 1.0, 0.0]
+    assert arm.position("CUP") == pytest.approx([0.3, 0.0, -0.1], abs=1e-12)
+    arm.move("roll", 0.25)                                   # a real turn keeps its axis and angle
+    assert arm.field("LINK", "rotation") == pytest.approx([1.0, 0.0, 0.0, 0.25], abs=1e-12)

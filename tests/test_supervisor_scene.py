@@ -75,7 +75,9 @@ def test_fields_by_node_kind_and_their_types():
     assert field(5, "direction") == {"type": "SFVec3f", "value": [0.0, 0.0, -1.0]}
     assert field(5, "on") == {"type": "SFBool", "value": False}
     for node, name in ((5, "location"), (4, "direction"), (0, "translation"), (4, "name"), (3, "customData")):
-        assert field(node, name) == {"type": "", "value": []}, (node, name)      # not a field of that node kind
+        got = field(node, name)                                                # not a field of that node kind
+        assert (got["type"], got["value"]) == ("", []), (node, name)
+        assert got.get("absent", False) == (name in ("translation", "name")), (node, name)   # the root's, a light's
     # wrong value types and read-only fields: one line naming the field, nothing changes
     bad = [({"node": 4, "field": "on", "value": 1.0}, "SFBool"),
            ({"node": 4, "field": "intensity", "value": True}, "SFFloat"),

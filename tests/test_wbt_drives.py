@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
@@ -367,3 +368,156 @@ def test_a_joint_motors_multiplier_is_read_and_zero_is_reset_to_one(tmp_path: Pa
     assert [(d.name, d.multiplier) for d in robot.devices] == [("lift", 0.5), ("tilt", 1.0)]
     assert [x.split(": ", 1)[1] for x in w.warnings if "cannot be 0" in x] == [
         "LinearMotor.multiplier: 0 cannot be 0; using 1 (as Webots does)"]
+
+
+def test_vertical_finger_hinges_holding_their_axles_are_no_failed_car(tmp_path: Path) -> None:
+    """Webots' coupled_motors gripper: two finger hinges about z whose end points hold their axles,
+    cylinders coaxial with the hinge (round, but rolling on nothing), on a slider's carriage, and no
+    motor driving a wheel. That is no vehicle: each finger motor is said once as no wheel and moves
+    its joint (coupled, multiplier -1), the axle and what it holds with it. It used to be taken for
+    a car's steering and end in "no Ackermann drive (the driven wheels (none) ...); the robot will
+    not move"."""
+    fingers = "".join(
+        f' HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor 0 {y} 0 }} device [ '
+        f'RotationalMotor {{ name "motor::{side} finger" {m} }} ] endPoint Solid {{ translation 0 {y} 0 children [ '
+        f'Shape {{ geometry Cylinder {{ height 0.0125 radius 0.0025 }} }} Solid {{ translation 0.03 0 0 name "{side} tip" }} '
+        f'] name "{side} axle" }} }}\n' for side, y, m in (("left", -0.008, ""), ("right", 0.008, "multiplier -1")))
+    p = write(tmp_path, 'Robot { name "gripper" children [\n SliderJoint { device [ LinearMotor { } ] endPoint Solid { '
+                        'translation 0 0 0.01 children [\n' + fingers + '] } }\n] }\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
+    (robot,) = w.world.robots
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    why = ("is no wheel (it turns about a vertical axis and no motor of the robot drives a wheel): its joint moves "
+           "kinematically")
+    assert [x.split(": ", 1)[1].split(" (Webots")[0] for x in w.warnings if "HingeJoint motor" in x] == [
+        f"HingeJoint motor 'motor::left finger' {why}", f"HingeJoint motor 'motor::right finger' {why}"]
+    sim = Simulation(w)
+    left, right = (sim.robot("gripper").motor(f"motor::{side} finger") for side in ("left", "right"))
+    left.set_position(math.pi / 2)
+    for _ in range(200):                     # 10 rad/s: a quarter turn within 0.16 s (16 ms steps)
+        sim.step()
+    assert (left.position, right.position) == (math.pi / 2, -math.pi / 2)
+    tip = [e for e in robot.shapes + robot.devices if getattr(e, "on_joint", None) == "motor::left finger"]
+    assert tip, "the left finger's end point rides its joint"
+
+
+ARM = """Solid { translation 0.3 0 0.125 name "crate" children [ Shape { geometry DEF CRATE Box { size 0.2 0.2 0.25 } } ]
+  boundingObject USE CRATE }
+Robot { name "arm" children [
+ HingeJoint { jointParameters HingeJointParameters { position 2 axis 0 0 1 } device [ RotationalMotor { name "yaw motor" } ]
+  endPoint Solid { rotation 0 0 1 2 children [
+   Pose { translation 0 0 0.18 children [ Shape { geometry Cylinder { height 0.3 radius 0.04 } } ] }
+   HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0 0.33 } device [ RotationalMotor {
+     name "pitch motor" minPosition -2.3 maxPosition 1.5 } ]
+    endPoint Solid { translation 0 0 0.33 children [
+     Pose { rotation 1 0 0 1.5708 children [ Shape { geometry Cylinder { height 0.04 radius 0.06 } } ] }
+     HingeJoint { jointParameters HingeJointParameters { position 0.5 axis 1 0 0 anchor 0.3 0 0 } device [
+       RotationalMotor { name "roll motor" } ]
+      endPoint Solid { translation 0.3 0 0 rotation 1 0 0 0.5 children [
+       Pose { rotation 0 1 0 1.5708 children [ Shape { geometry Cylinder { height 0.02 radius 0.04 } } ] }
+       SliderJoint { jointParameters JointParameters { axis 0 0 -1 } device [ LinearMotor { name "gripper motor"
+         acceleration 1 maxVelocity 0.1 } ]
+        endPoint VacuumGripper { children [ InertialUnit { translation 0 0 -0.01 }
+          DEF CUP Pose { translation 0 0 -0.02 children [ Shape { geometry Cylinder { height 0.02 radius 0.042 } } ] } ]
+         boundingObject USE CUP } }
+      ] name "slider" } }
+    ] } }
+  ] } }
+] }
+"""
+
+
+def test_an_arms_chain_of_round_hinges_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' vacuum_gripper sample arm (our own world): a yaw hinge about z holding a pitch hinge
+    about y, holding a roll hinge, holding a slider whose end point is the VacuumGripper with an
+    InertialUnit; the pitch and roll links hold cylinders (round). No wheel drives anything: each
+    motor is said once as no wheel (the pitch and roll hinges as links of a chain, the yaw hinge
+    as vertical with nothing driven) and moves its joint. They used to be taken for a car (the yaw
+    hinge steering a "wheel", the pitch hinge) and end in "no Ackermann drive (...); the robot will
+    not move". As the sample does: with every joint at 0 the unit reads (0, 0, 0); lowering the
+    slider puts the cup (its bottom 0.30 m up at travel 0) on the crate's top (0.25 m) and the
+    presence turns 1 within 1 mm of it; any yaw, pitch and roll are read back as the unit's
+    roll, pitch and yaw (the links' axes are the world's x, y, z at 0)."""
+    w = load_world(write(tmp_path, ARM))
+    assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
+    (robot,) = w.world.robots
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    said = sorted(x.split(": ", 1)[1].split(": its joint")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == ["HingeJoint motor 'pitch motor' is no wheel (a link of a chain of motorised joints, carrying one "
+                    "or carried by one)", "HingeJoint motor 'roll motor' is no wheel (a link of a chain of motorised "
+                    "joints, carrying one or carried by one)", "HingeJoint motor 'yaw motor' is no wheel (it turns "
+                    "about a vertical axis and no motor of the robot drives a wheel)"]
+    sim = Simulation(w)
+    arm = sim.robot("arm")
+    imu, cup = sim.device("arm/inertial unit"), sim.device("arm/vacuum gripper")
+    imu.enable(16)
+    cup.set_on(True)                                         # type: ignore[attr-defined]
+    cup.enable(16)
+    for name in ("yaw motor", "pitch motor", "roll motor"):
+        arm.motor(name).set_position(0.0)
+    for _ in range(100):                                     # 2 rad at 10 rad/s: 0.2 s and the ramp
+        sim.step()
+    assert imu.roll_pitch_yaw == pytest.approx([0.0, 0.0, 0.0], abs=1e-6)      # type: ignore[attr-defined]
+    assert cup.value == 0.0                                  # type: ignore[attr-defined]   5 cm above the crate
+    slider = arm.motor("gripper motor")
+    slider.set_position(0.06)
+    seen = set()
+    for _ in range(100):                                     # 0.1 m/s: 0.05 m within 0.6 s with the ramp
+        sim.step()
+        gap = 0.05 - float(slider.position)
+        if abs(gap - 0.001) > 1e-9:
+            assert cup.value == (1.0 if gap <= 0.001 else 0.0), gap      # type: ignore[attr-defined]
+        seen.add(cup.value)                                  # type: ignore[attr-defined]
+    assert seen == {0.0, 1.0}
+    slider.set_position(0.0)
+    roll, pitch, yaw = 0.8097, -0.0316, 0.3391
+    for name, q in (("roll motor", roll), ("pitch motor", pitch), ("yaw motor", yaw)):
+        arm.motor(name).set_position(q)
+    for _ in range(100):
+        sim.step()
+    assert imu.roll_pitch_yaw == pytest.approx([roll, pitch, yaw], abs=1e-6)   # type: ignore[attr-defined]
+    assert cup.value == 0.0                                  # type: ignore[attr-defined]   lifted off the crate
+
+
+def test_a_lone_hinge2_joint_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' motor2 sample (our own world): one Hinge2Joint on a post, first axis -x, second -y,
+    its end point a small cylinder (round) holding a distance sensor 5 cm out. One joint makes no
+    vehicle: its two motors are said once each as no wheel and move the end point by
+    R(a1, q1) R(a2, q2) about the anchor. It used to be taken for a car with one steered wheel
+    ("no Ackermann drive (a car-like robot needs two steered front wheels ...); the robot will not
+    move")."""
+    p = write(tmp_path, """Robot { name "post" translation 0.1 0 0 children [
+ Solid { translation 0 0 0.06 children [
+  Shape { geometry Cylinder { height 0.1 radius 0.02 } }
+  Hinge2Joint {
+   jointParameters HingeJointParameters { axis -1 0 0 anchor 0 0 0.07 }
+   jointParameters2 JointParameters { axis 0 -1 0 }
+   device [ RotationalMotor { name "motor 1" maxVelocity 1 } ]
+   device2 [ RotationalMotor { name "motor 2" maxVelocity 1 } ]
+   endPoint Solid { translation 0 0 0.07 children [ DEF C Shape { geometry Cylinder { height 0.03 radius 0.008 } }
+     DistanceSensor { translation 0 0 0.05 name "tip" } ] boundingObject USE C } } ] } ] }
+""")
+    w = load_world(p)
+    assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
+    assert [x.split(": ", 1)[1].split(": its joint")[0] for x in w.warnings if "is no wheel" in x] == [
+        "Hinge2Joint motor 'motor 1' is no wheel (the robot's only motorised joint)",
+        "Hinge2Joint motor 'motor 2' is no wheel (the robot's only motorised joint)"]
+    sim = Simulation(w)
+    robot = sim.robot("post")
+    q1, q2 = 1.0, -0.5
+    robot.motor("motor 1").set_position(q1)
+    robot.motor("motor 2").set_position(q2)
+    for _ in range(200):                     # 1 rad/s: 1 rad within 1 s and the ramp (16 ms steps)
+        sim.step()
+    assert (robot.motor("motor 1").position, robot.motor("motor 2").position) == (q1, q2)
+
+    def rot(axis: list[float], q: float) -> np.ndarray:
+        k = np.asarray(axis, dtype=np.float64)
+        kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        return np.eye(3) + math.sin(q) * kx + (1 - math.cos(q)) * kx @ kx
+
+    turn = rot([-1, 0, 0], q1) @ rot([0, -1, 0], q2)
+    tip = sim.device("post/tip").world_pose(robot.pose)
+    assert tip.translation == pytest.approx([0.1, 0.0, 0.13] + turn @ [0.0, 0.0, 0.05], abs=1e-12)
+    assert np.asarray(tip.rotation) == pytest.approx(turn, abs=1e-12)

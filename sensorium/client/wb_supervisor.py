@@ -353,8 +353,9 @@ def wb_supervisor_node_get_field(node: int | None, field_name: str) -> Field | N
     if got is None:
         return None
     if not got["type"]:
-        print(f"Error: {func}(): node {node} has no field {field_name!r} in Sensorium (README \"Supervisor\" "
-              f"lists the fields of each node kind).", file=sys.stderr)
+        if not got.get("absent", False):     # absent: Webots' node has none either (NULL, no message)
+            print(f"Error: {func}(): node {node} has no field {field_name!r} in Sensorium (README \"Supervisor\" "
+                  f"lists the fields of each node kind).", file=sys.stderr)
         return None
     return (int(node), field_name, FIELD_TYPES[got["type"]])  # type: ignore[arg-type]
 

@@ -860,6 +860,9 @@ class FieldValueResult(Result):
     value: bool | int | float | str | list[float] | list[int] | list[list[float]] = Field(
         description="SFBool bool; SFFloat/SFInt32 number; SFString str; SFVec3f/SFColor/SFRotation numbers; SFNode "
                     "the node's id; MFNode node ids; MFColor one list of 3 numbers per colour")
+    absent: bool = Field(default=False, description="with type '': Webots' node of this type has no such field "
+                                                     "either (a Solid's endPoint, a motor's children): the clients "
+                                                     "answer NULL silently, as libController does")
 
 
 class NodePoseResult(Result):

@@ -15,7 +15,8 @@ node inside a moving joint's end point (the end point Solid, what that Solid hol
 the joint) is where the joint's link has put it (sim/joints.py ``Links``: the joints' displacements
 composed outward), read when a Supervisor asks, never computed otherwise. Its fields are read-only
 here: ``translation``/``rotation`` (in its parent's frame: an end point's follow its joint, as
-Webots' HingeJoint/SliderJoint set them), ``name`` (Solids and devices) and ``children``.
+Webots' HingeJoint/SliderJoint set them), ``name`` (Solids and devices), ``children``, and a
+joint's ``endPoint`` and ``device`` fields (``end_point``, ``joint_devices``).
 """
 
 from __future__ import annotations
@@ -45,6 +46,11 @@ CHAINS = {"Hinge2Joint": ("device2", "device"), "BallJoint": ("device3", "device
 axis (the import turns such a joint into a chain of hinges, each riding on the one before)."""
 
 MOTORS = frozenset({"RotationalMotor", "LinearMotor"})
+
+JOINT_DEVICES = {"HingeJoint": ("device",), "SliderJoint": ("device",), "Hinge2Joint": ("device", "device2"),
+                 "BallJoint": ("device", "device2", "device3")}
+"""Each joint type's MFNode device fields (Webots'): with its ``endPoint`` (SFNode), how a
+Supervisor walks down a robot's tree past its joints."""
 
 HAS_CHILDREN = frozenset({"Solid", "Pose", "Transform", "Group"})
 """Node types with a ``children`` field besides devices that are Solids (Robot, top-level Solid: supervisor.py)."""
@@ -306,3 +312,13 @@ def has_children(n: Nested) -> bool:
 def children(table: Table, parent: int) -> list[int]:
     """The ids of a node's ``children`` (not a joint's end point nor its devices)."""
     return [c.id for c in table.by_parent.get(parent, ()) if c.field == "children"]
+
+
+def end_point(table: Table, joint: int) -> int:
+    """A joint's ``endPoint``: its end point node's id, 0 (NULL) when it has none here."""
+    return next((c.id for c in table.by_parent.get(joint, ()) if c.field == "endPoint"), 0)
+
+
+def joint_devices(table: Table, joint: int, field: str) -> list[int]:
+    """The ids of a joint's motors, position sensors and brakes in its ``field`` (``device``, ...)."""
+    return [c.id for c in table.by_parent.get(joint, ()) if c.field == field]

@@ -17,6 +17,7 @@ node's fields are read-only here.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -242,14 +243,21 @@ def _pose(sim: Any, node: Node) -> Any:
     return sim.robots[node.key].pose if node.type == "Robot" else sim.scene.solid_poses[node.key]
 
 
+NO_TURN = 10000 * sys.float_info.epsilon
+"""An angle below this is no turn (WbPrecision::DOUBLE_EQUALITY_TOLERANCE, WbRotation's)."""
+
+
 def matrix_axis_angle(r: np.ndarray) -> list[float]:
-    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, pi]); identity → 0 0 1 0.
-    Through the unit quaternion, which stays accurate near half turns."""
+    """Rotation matrix → Webots axis-angle (unit axis, angle in [0, pi]); identity → 0 0 1 0, and so
+    is a turn by less than ``NO_TURN`` (as WbRotation: rounding, e.g. a joint turned back to where
+    the file placed its end point, leaves no axis of noise). Through the unit quaternion, which
+    stays accurate near half turns."""
     x, y, z, w = matrix_quaternion(r)             # w >= 0
     n = math.sqrt(x * x + y * y + z * z)
-    if n < 1e-300:
+    angle = 2.0 * math.atan2(n, w)
+    if n < 1e-300 or angle < NO_TURN:
         return [0.0, 0.0, 1.0, 0.0]
-    return [x / n, y / n, z / n, 2.0 * math.atan2(n, w)]
+    return [x / n, y / n, z / n, angle]
 
 
 # ---------------------------------------------------------------------- fields
@@ -449,6 +457,10 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
         out["name"] = ("SFString", lambda sim, node: node.name, None)
     if nested.has_children(n):
         out["children"] = ("MFNode", _children, None)
+    if n.type in nested.JOINT_DEVICES:     # walked down as in Webots: the end point, the devices
+        out["endPoint"] = ("SFNode", lambda sim, node: nested.end_point(_table(sim), node.id), None)
+        for name in nested.JOINT_DEVICES[n.type]:
+            out[name] = ("MFNode", lambda sim, node, name=name: nested.joint_devices(_table(sim), node.id, name), None)
     parameters = nested.joint_parameters(_table(sim), n.id)
     if parameters is not None:        # a motorised joint's (0: NULL), holding its position now
         out["jointParameters"] = ("SFNode", lambda sim, node: parameters, None)
@@ -466,11 +478,33 @@ def _fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
 _VECTOR_SIZES = {"SFVec3f": 3, "SFColor": 3, "SFRotation": 4}
 
 
+_JOINT_FIELDS = {"endPoint": frozenset(nested.JOINT_DEVICES), "device": frozenset(nested.JOINT_DEVICES),
+                 "jointParameters": frozenset(nested.JOINT_DEVICES),
+                 "device2": frozenset({"Hinge2Joint", "BallJoint"}), "jointParameters2": frozenset({"Hinge2Joint", "BallJoint"}),
+                 "device3": frozenset({"BallJoint"}), "jointParameters3": frozenset({"BallJoint"})}
+_PARAMETERS = frozenset({"HingeJointParameters", "JointParameters", "BallJointParameters"})
+_SCENERY = frozenset({"WorldInfo", "Viewpoint", "Background", "Fog", "PointLight", "SpotLight", "DirectionalLight"})
+_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS | _SCENERY
+_WEBOTS_LACKS = {"children": _NO_POSE, "translation": _NO_POSE | {"Group"}, "rotation": _NO_POSE | {"Group"},
+                 "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | _SCENERY | {"Pose", "Transform", "Group"}}
+
+
+def webots_lacks(node_type: str, field: str) -> bool:
+    """Whether Webots' node of that base type has no such field either, for the fields a
+    Supervisor probes as it walks a robot's tree (a joint's ``endPoint``/``device``/
+    ``jointParameters``, ``children``, the pose, ``name``): libController then answers NULL
+    with no message. False when unsure (the clients then say the field is not served here)."""
+    if field in _JOINT_FIELDS:
+        return node_type not in _JOINT_FIELDS[field]
+    return node_type in _WEBOTS_LACKS.get(field, ())
+
+
 def get_field(sim: Any, node: Node, field: str) -> dict:
-    """``{"type", "value"}``; type '' (and value []) when the node has no such field here."""
+    """``{"type", "value"}``; type '' (and value []) when the node has no such field here, plus
+    ``absent: true`` when Webots' node has none either (``webots_lacks``)."""
     entry = _fields(sim, node).get(field)
     if entry is None:
-        return {"type": "", "value": []}
+        return {"type": "", "value": [], "absent": True} if webots_lacks(node.type, field) else {"type": "", "value": []}
     return {"type": entry[0], "value": entry[1](sim, node)}
 
 

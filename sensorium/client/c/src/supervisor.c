@@ -525,7 +525,11 @@ WbFieldRef wb_supervisor_node_get_field(WbNodeRef node, const char *field_name) 
   for (size_t i = 0; i < sizeof FIELD_TYPES / sizeof FIELD_TYPES[0]; i++)
     if (str_is(type, FIELD_TYPES[i].name))
       t = FIELD_TYPES[i].type;
+  const msgpack_object *absent = sn_get(rep.result, "absent");   /* Webots' node has none either */
+  const bool silent = absent != NULL && absent->type == MSGPACK_OBJECT_BOOLEAN && absent->via.boolean;
   sn_reply_free(&rep);
+  if (t == WB_NO_FIELD && silent)
+    return NULL;
   if (t == WB_NO_FIELD) {
     fprintf(stderr, "Error: %s(): node %d (%s) has no field '%s' in Sensorium (README \"Supervisor\" lists the fields "
                     "of each node kind).\n", func, (int)node->id, node->type_name, field_name);

@@ -383,7 +383,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
     Field: {
         "getActualField": ("field_get_actual_field", None), "removeMF": ("field_remove_mf", None),
         "removeSF": ("field_remove_sf", None),
-        # no SFNode field here takes an import (a joint's jointParameters is read-only)
+        # no SFNode field here takes an import (a joint's jointParameters and endPoint are read-only)
         "importSFNodeFromString": ("field_import_sf_node_from_string", None)},
 }
 _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 2, "Vec3f": [_NAN] * 3,

@@ -1457,6 +1457,22 @@ class Converter:
                                  "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
+    def _inside(self, end: Node | None) -> set[int]:
+        """The ids of every node inside the end point ``end`` (its children, its joints' end points
+        and devices, to any depth)."""
+        out: set[int] = set()
+        stack = [end] if end is not None else []
+        while stack:
+            n = stack.pop()
+            self.walk(n)
+            for key in ("children", "device", "device2", "device3", "endPoint"):
+                held = n.fields.get(key)      # the raw value: a field of another meaning is no node
+                for c in held if isinstance(held, list) else [held]:
+                    if isinstance(c, Node):
+                        out.add(id(c))
+                        stack.append(c)
+        return out
+
     def drive(self, node: Node, robot: Owner) -> None:
         from sensorium.server.world.wbt.drive import (
             ackermann_drive,
@@ -1470,12 +1486,14 @@ class Converter:
         if not wheels:
             return
         round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
-        if len(wheels) == 1 or not any(round_):
-            # one motorised hinge (Webots' motor sample: a turntable), or nothing round to roll on at
+        if len({id(w["node"]) for w in wheels}) == 1 or not any(round_):
+            # one motorised hinge (Webots' motor sample: a turntable; motor2's one Hinge2Joint, its
+            # two axes the joint's), or nothing round to roll on at
             # any (an arm, a gripper's fingers, a pan-tilt head): no vehicle, so no drive to miss;
             # each joint moves kinematically
             for w, rolls in zip(wheels, round_):
-                why = "the robot's only motorised hinge" if rolls else "its end point has no cylinder or sphere to roll on"
+                only = "hinge" if w["node"].type == "HingeJoint" else "joint"
+                why = f"the robot's only motorised {only}" if rolls else "its end point has no cylinder or sphere to roll on"
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): {JOINT_MOVES}")
             return
         # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
@@ -1486,6 +1504,31 @@ class Converter:
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers none (its end "
                                      f"point holds no wheel): {JOINT_MOVES}")
             wheels = [w for w in wheels if not any(w is p for p in pans)]
+        # an arm's chain (a vacuum gripper's pitch and roll hinges): a wheel carries no motorised
+        # hinge and rides on none but its steering joint, so a hinge that does either is no wheel
+        inside = {id(w["node"]): self._inside(w["end"]) for w in wheels if not w["steers"]}
+        links = [w for w in wheels if not w["steers"] and
+                 (any(id(o["node"]) in inside[id(w["node"])] for o in wheels) or
+                  any(id(w["node"]) in held for held in inside.values()))]
+        if links:
+            for w in links:
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (a link of a chain of "
+                                     f"motorised joints, carrying one or carried by one): {JOINT_MOVES}")
+            wheels = [w for w in wheels if not any(w is k for k in links)]
+            if len(wheels) == 1 and not wheels[0]["steers"]:
+                w = wheels[0]
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (the robot's only other "
+                                     f"motorised hinge): {JOINT_MOVES}")
+                return
+            if not wheels:
+                return
+        if wheels and all(w["steers"] for w in wheels):
+            # vertical hinges only, none driving a wheel (a gripper's fingers whose end points hold
+            # their axles, coaxial cylinders that roll on nothing): no vehicle, no drive to miss
+            for w in wheels:
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (it turns about a vertical "
+                                     f"axis and no motor of the robot drives a wheel): {JOINT_MOVES}")
+            return
         if any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
             if drive is None:
