@@ -329,3 +329,25 @@ def test_the_batched_simulation_refuses_a_connector_in_one_line() -> None:
     sim = BatchedSimulation(crate_world(), copies=2)
     with pytest.raises(BatchedError, match="'dock' is a Connector; the batched simulation measures"):
         sim.device("a", "dock")
+
+
+def test_probe_reads_connectors_and_brakes(tmp_path) -> None:
+    """``sensorium probe --enable all:P`` on a world with connectors and a brake (Webots' connector.wbt
+    and brake.wbt samples): it ended in a traceback (AttributeError: 'Connector' object has no attribute
+    'readings'). Each now says what it reads: a connector its presence (the two face to face: 1) and
+    lock state, a brake its joint's type (whole numbers and flags as they are, not array summaries)."""
+    import json
+    import subprocess
+    import sys
+
+    w = world(0.0)
+    data = w.model_dump(mode="json", exclude_defaults=True)
+    data["robots"][0]["devices"].append({"device": "Brake", "name": "brake", "joint_type": "linear"})
+    (tmp_path / "w.json").write_text(json.dumps(data))
+    res = subprocess.run([sys.executable, "-m", "sensorium", "probe", str(tmp_path / "w.json"), "--steps", "2",
+                          "--json", "--enable", "all:32"], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    rows = {(r["robot"], r["device"]): r for r in map(json.loads, res.stdout.splitlines()) if r["step"] == 2}
+    assert rows[("a", "dock")]["presence"] == 1 and rows[("a", "dock")]["is_locked"] is False
+    assert rows[("b", "dock")]["presence"] == 1
+    assert rows[("a", "brake")]["type"] == 1
