@@ -367,3 +367,39 @@ def test_a_joint_motors_multiplier_is_read_and_zero_is_reset_to_one(tmp_path: Pa
     assert [(d.name, d.multiplier) for d in robot.devices] == [("lift", 0.5), ("tilt", 1.0)]
     assert [x.split(": ", 1)[1] for x in w.warnings if "cannot be 0" in x] == [
         "LinearMotor.multiplier: 0 cannot be 0; using 1 (as Webots does)"]
+
+
+def test_gripper_fingers_on_round_axles_are_no_failed_car(tmp_path: Path) -> None:
+    """Webots' coupled_motors sample as it is: each finger's end point holds its axle, a plain Cylinder
+    (radius 2.5 mm), and a passive hinge to the fingertip. Round end points on vertical hinges were
+    taken for a car's two steered wheels, and the gripper ended in "no Ackermann drive (the driven
+    wheels (none) ...); the robot will not move". No motorised hinge drives a wheel, so there is no
+    vehicle: each finger is said once as no wheel and moves its joint, coupled as in Webots."""
+    fingers = "".join(
+        f' HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor 0 {y} 0 }} device [ '
+        f'RotationalMotor {{ name "motor::{side} finger" {m} }} ] endPoint Solid {{ translation 0 {y} 0 children [ '
+        f'DEF AXLE Shape {{ geometry Cylinder {{ height 0.0125 radius 0.0025 }} }}\n'
+        f'  HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor 0.02869 {3.5 * y} 0 }} '
+        f'endPoint Solid {{ translation 0.02869 {3.5 * y} 0 name "{side} tip" children [ TouchSensor {{ name '
+        f'"{side} touch" }} ] }} }} ] name "{side} finger" boundingObject USE AXLE }} }}\n'
+        for side, y, m in (("left", -0.008, ""), ("right", 0.008, "multiplier -1")))
+    p = write(tmp_path, 'Robot { name "gripper" children [\n' + fingers + '] }\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    (robot,) = w.world.robots
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    said = sorted(x.split(": ", 1)[1].split(" (")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == ["HingeJoint motor 'motor::left finger' is no wheel",
+                    "HingeJoint motor 'motor::right finger' is no wheel"]
+    sim = Simulation(w)
+    gripper = sim.robot("gripper")
+    left, right = (gripper.motor(f"motor::{side} finger") for side in ("left", "right"))
+    left.set_position(math.pi / 2)           # the right finger takes -pi/2 (multiplier -1)
+    for _ in range(400):
+        sim.step()
+    assert (left.position, right.position) == (pytest.approx(math.pi / 2), pytest.approx(-math.pi / 2))
+    # each tip at (0.02869, 3.5 y) from its finger's anchor (0, y): a quarter turn about ±z puts it at
+    # (0, y) + Rz(±pi/2)·(0.02869, 3.5 y)
+    for side, y, s in (("left", -0.008, 1.0), ("right", 0.008, -1.0)):
+        at = sim.device(f"gripper/{side} touch").world_pose(gripper.pose).translation
+        assert at == pytest.approx([-s * 3.5 * y, y + s * 0.02869, 0.0], abs=1e-9)

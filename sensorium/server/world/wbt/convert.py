@@ -1486,6 +1486,13 @@ class Converter:
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers none (its end "
                                      f"point holds no wheel): {JOINT_MOVES}")
             wheels = [w for w in wheels if not any(w is p for p in pans)]
+        if len(wheels) >= 2 and all(w["steers"] for w in wheels):
+            # vertical hinges only, none turning a wheel about a horizontal axis (a gripper's fingers on
+            # their axles, Webots' coupled motors sample): nothing drives, so no vehicle to miss
+            for w in wheels:
+                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (it would steer, but no "
+                                     f"motorised hinge of the robot turns a wheel about a horizontal axis): {JOINT_MOVES}")
+            return
         if any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
             if drive is None:
