@@ -403,3 +403,30 @@ def test_gripper_fingers_on_round_axles_are_no_failed_car(tmp_path: Path) -> Non
     for side, y, s in (("left", -0.008, 1.0), ("right", 0.008, -1.0)):
         at = sim.device(f"gripper/{side} touch").world_pose(gripper.pose).translation
         assert at == pytest.approx([-s * 3.5 * y, y + s * 0.02869, 0.0], abs=1e-9)
+
+
+def test_a_lone_hinge2_joint_with_two_motors_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' hinge_2_joint_with_backlash (motor2) sample: a fixed robot whose one Hinge2Joint has a
+    motor on each axis (axis -x, then axis2 -y) and a round end point (a cylinder). Its first motor was
+    taken for a car's lone steering joint: "no Ackermann drive (... 1 steering motor(s) ...); the robot
+    will not move". One joint makes no vehicle: both motors are said once as no wheel and move the end
+    point. A distance sensor at (0, 0.05, 0) in the end point (anchor (0, 0, 0.07)) turned a quarter
+    about -x is at (0, 0, 0.07 - 0.05)."""
+    p = write(tmp_path, 'Robot { name "wrist" children [\n'
+              ' Hinge2Joint { jointParameters HingeJointParameters { axis -1 0 0 anchor 0 0 0.07 }\n'
+              '  jointParameters2 JointParameters { axis 0 -1 0 }\n'
+              '  device [ RotationalMotor { name "motor 1" maxVelocity 100 maxTorque 100000 } ]\n'
+              '  device2 [ RotationalMotor { name "motor 2" maxVelocity 100 maxTorque 100000 } ]\n'
+              '  endPoint Solid { translation 0 0 0.07 children [ DEF C Shape { geometry Cylinder { radius 0.008 '
+              'height 0.03 } }\n'
+              '   DistanceSensor { translation 0 0.05 0 } ] boundingObject USE C } }\n] }\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    said = sorted(x.split(": ", 1)[1].split(": ")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == ["Hinge2Joint motor 'motor 1' is no wheel (the robot's only motorised hinge)",
+                    "Hinge2Joint motor 'motor 2' is no wheel (the robot's only motorised hinge)"]
+    sim = Simulation(w)
+    sim.robot("wrist").motor("motor 1").set_position(math.pi / 2)
+    sim.step()
+    ds = sim.device("wrist/distance sensor").world_pose(sim.robot("wrist").pose)
+    assert ds.translation == pytest.approx([0.0, 0.0, 0.02], abs=1e-12)

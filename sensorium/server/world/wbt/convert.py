@@ -1470,10 +1470,11 @@ class Converter:
         if not wheels:
             return
         round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
-        if len(wheels) == 1 or not any(round_):
-            # one motorised hinge (Webots' motor sample: a turntable), or nothing round to roll on at
-            # any (an arm, a gripper's fingers, a pan-tilt head): no vehicle, so no drive to miss;
-            # each joint moves kinematically
+        joints = {id(w["node"]) for w in wheels}       # a Hinge2Joint's two motors are one joint's
+        if len(joints) == 1 or not any(round_):
+            # one motorised hinge (Webots' motor sample: a turntable; the motor2 sample's one Hinge2Joint
+            # with a motor on each axis), or nothing round to roll on at any (an arm, a gripper's fingers,
+            # a pan-tilt head): no vehicle, so no drive to miss; each joint moves kinematically
             for w, rolls in zip(wheels, round_):
                 why = "the robot's only motorised hinge" if rolls else "its end point has no cylinder or sphere to roll on"
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): {JOINT_MOVES}")
