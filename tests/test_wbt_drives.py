@@ -430,3 +430,36 @@ def test_a_lone_hinge2_joint_with_two_motors_is_no_failed_car(tmp_path: Path) ->
     sim.step()
     ds = sim.device("wrist/distance sensor").world_pose(sim.robot("wrist").pose)
     assert ds.translation == pytest.approx([0.0, 0.0, 0.02], abs=1e-12)
+
+
+def test_a_fixed_arm_of_round_links_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' vacuum_gripper sample: a fixed arm, yaw (axis z) holding pitch (axis y) holding roll,
+    each link made of cylinders. The vertical yaw hinge with round parts past it was taken for a car's
+    steering and the robot ended in "no Ackermann drive (wheel axis of motor 'roll motor' ...); the robot
+    will not move". Motorised hinges all past one of them are an arm: each is said once as no wheel and
+    moves its joint. A sensor 0.2 above the pitch anchor (0, 0, 0.33): pitch a quarter turn about y puts
+    it at (0.2, 0, 0.33), yaw a quarter about z then at (0, 0.2, 0.33)."""
+    link = 'Shape { geometry Cylinder { radius 0.04 height 0.3 } }'
+    p = write(tmp_path, 'Robot { name "arm" children [\n'
+              ' HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 }\n'
+              '  device [ RotationalMotor { name "yaw motor" maxVelocity 100 maxTorque 100000 } ]\n'
+              f'  endPoint Solid {{ children [ Pose {{ translation 0 0 0.18 rotation 1 0 0 1.5708 children [ {link} ] }}\n'
+              '   HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0 0.33 }\n'
+              '    device [ RotationalMotor { name "pitch motor" maxVelocity 100 maxTorque 100000 } ]\n'
+              f'    endPoint Solid {{ translation 0 0 0.33 children [ Pose {{ rotation 0 1 0 1.5708 children [ {link} ] }}\n'
+              '     DistanceSensor { translation 0 0 0.2 }\n'
+              '     HingeJoint { jointParameters HingeJointParameters { axis 0 -1 0 anchor 0 -0.3 0 }\n'
+              '      device [ RotationalMotor { name "roll motor" } ]\n'
+              f'      endPoint Solid {{ translation 0 -0.3 0 children [ {link} ] }} }} ] }} }} ] }} }}\n] }}\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    said = sorted(x.split(": ", 1)[1].split(" (")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == [f"HingeJoint motor '{m} motor' is no wheel" for m in ("pitch", "roll", "yaw")]
+    sim = Simulation(w)
+    arm = sim.robot("arm")
+    arm.motor("pitch motor").set_position(math.pi / 2)
+    sim.step()
+    assert sim.device("arm/distance sensor").world_pose(arm.pose).translation == pytest.approx([0.2, 0, 0.33], abs=1e-12)
+    arm.motor("yaw motor").set_position(math.pi / 2)
+    sim.step()
+    assert sim.device("arm/distance sensor").world_pose(arm.pose).translation == pytest.approx([0, 0.2, 0.33], abs=1e-12)

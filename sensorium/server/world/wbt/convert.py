@@ -1318,7 +1318,7 @@ class Converter:
                                  "max_velocity": m.num("maxVelocity", 10.0), "limits": _limits(m),
                                  "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                  "centre": np.asarray(frame.apply(centre)),
-                                 "end": end, "frame": frame, "sensors": sensors})
+                                 "end": end, "frame": frame, "sensors": sensors, "riding": bool(self.riding)})
         elif motors and (node.type != "Hinge2Joint" or not wheeled) and owner.kind == "robot":
             if wheeled:       # a slider or a ball joint is never a wheel: the motor by name, as a hinge's
                 names = ", ".join(repr(self.fields(m).string("name", OTHER_MOTOR_NAMES[m.type])) for m in motors)
@@ -1457,7 +1457,8 @@ class Converter:
             owner.wheels.append({"node": node, "motor": m.string("name", "rotational motor"), "steers": steers,
                                  "max_velocity": m.num("maxVelocity", 10.0), "limits": _limits(m), "axis": turn,
                                  "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
-                                 "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
+                                 "centre": centre, "end": end, "frame": frame, "sensors": found_sensors,
+                                 "riding": bool(self.riding)})
 
     def drive(self, node: Node, robot: Owner) -> None:
         from sensorium.server.world.wbt.drive import (
@@ -1473,12 +1474,18 @@ class Converter:
             return
         round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
         joints = {id(w["node"]) for w in wheels}       # a Hinge2Joint's two motors are one joint's
-        if len(joints) == 1 or not any(round_):
+        # the motorised hinges not inside another motorised joint's end point: one of them holding all
+        # the others is an arm (Webots' vacuum_gripper sample: yaw, then pitch, then roll)
+        tops = {id(w["node"]) for w in wheels if not w["riding"]}
+        arm = len(joints) > 1 and len(tops) == 1
+        if len(joints) == 1 or arm or not any(round_):
             # one motorised hinge (Webots' motor sample: a turntable; the motor2 sample's one Hinge2Joint
-            # with a motor on each axis), or nothing round to roll on at any (an arm, a gripper's fingers,
+            # with a motor on each axis), one arm, or nothing round to roll on at any (a gripper's fingers,
             # a pan-tilt head): no vehicle, so no drive to miss; each joint moves kinematically
             for w, rolls in zip(wheels, round_):
-                why = "the robot's only motorised hinge" if rolls else "its end point has no cylinder or sphere to roll on"
+                why = ("the robot's motorised hinges are one arm, each past the first one's joint" if arm
+                       else "the robot's only motorised hinge" if rolls
+                       else "its end point has no cylinder or sphere to roll on")
                 self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): {JOINT_MOVES}")
             return
         # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
