@@ -373,3 +373,25 @@ def test_connectors_on_arms_dock_when_the_arms_turn_them_face_to_face(tmp_path: 
     assert a[1] == pytest.approx([0.055 * math.sin(1.57), 0.0, 0.06 + 0.055 * math.cos(1.57)], abs=1e-12)
     assert float(np.dot(a[0][:, 0], b[0][:, 0])) == pytest.approx(math.cos(2 * 1.57), abs=1e-12)   # nearly opposed
     assert [d.value for d in docks] == [1, 1]
+
+
+def test_probe_reads_connectors_and_brakes(tmp_path) -> None:
+    """``sensorium probe --enable all:P`` on a world with connectors and a brake (Webots' connector.wbt
+    and brake.wbt samples): it ended in a traceback (AttributeError: 'Connector' object has no attribute
+    'readings'). Each now says what it reads: a connector its presence (the two face to face: 1) and
+    lock state, a brake its joint's type (whole numbers and flags as they are, not array summaries)."""
+    import json
+    import subprocess
+    import sys
+
+    w = world(0.0)
+    data = w.model_dump(mode="json", exclude_defaults=True)
+    data["robots"][0]["devices"].append({"device": "Brake", "name": "brake", "joint_type": "linear"})
+    (tmp_path / "w.json").write_text(json.dumps(data))
+    res = subprocess.run([sys.executable, "-m", "sensorium", "probe", str(tmp_path / "w.json"), "--steps", "2",
+                          "--json", "--enable", "all:32"], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    rows = {(r["robot"], r["device"]): r for r in map(json.loads, res.stdout.splitlines()) if r["step"] == 2}
+    assert rows[("a", "dock")]["presence"] == 1 and rows[("a", "dock")]["is_locked"] is False
+    assert rows[("b", "dock")]["presence"] == 1
+    assert rows[("a", "brake")]["type"] == 1

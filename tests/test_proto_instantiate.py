@@ -337,3 +337,20 @@ def test_unknown_hidden_state_in_instances_is_dropped(tmp_path: Path) -> None:
     w = world_file(tmp_path, "Wheelie { hidden position_0_0 0.5 hidden rotation_1 0 0 1 0 translation 1 2 3 }\n",
                    ["Wheelie.proto"])
     assert load_world(w).world.solids[0].pose.translation == (1.0, 2.0, 3.0)
+
+
+def test_a_bare_null_for_an_mfnode_is_no_nodes(tmp_path: Path) -> None:
+    """Webots' Hinge2JointWithBacklash declares ``field MFNode{...} startPoint NULL`` and Webots loads
+    it: a bare NULL for a whole MFNode (default or instance value) is no nodes. It was refused ("MFNode
+    expects nodes, got NULL") and every world using the PROTO failed. NULL inside brackets stays an error."""
+    proto_file(tmp_path, "Holder", """[
+  field MFNode{Group{}, Transform{}, Shape{}} extra NULL  field MFNode more [ ]
+]
+{ Group { children [ Group { children IS extra } Group { children IS more } ] } }""")
+    w = world_file(tmp_path, "Holder { }\nHolder { more NULL extra [ Shape { } ] }\n", ["Holder.proto"])
+    first, second = expanded(w).nodes
+    kids = [[len(g.fields["children"]) for g in n.fields["children"]] for n in (first, second)]
+    assert kids == [[0, 0], [1, 0]]
+    bad = world_file(tmp_path, "Holder { more [ NULL ] }\n", ["Holder.proto"], name="bad.wbt")
+    with pytest.raises(WorldError, match="Holder.more: MFNode expects nodes, got NULL"):
+        load_world(bad)

@@ -553,3 +553,25 @@ def test_a_wbt_target_solid_past_a_hinge_rides_on_its_joint(tmp_path: Path) -> N
     sim.robot("arm").motor("pan").set_position(-math.pi / 2)
     [t] = run(sim)
     assert t.distance == pytest.approx(13.0, abs=1e-12) and t.azimuth == pytest.approx(0.0, abs=1e-12)
+
+
+def test_target_boxes_named_empty_as_in_webots_radar_sample_load(tmp_path: Path) -> None:
+    """Webots' radar.wbt names its target boxes ``name ""``; the import refused the world ("robots[1].
+    radar_targets[0].name: String should have at least 1 character"), and a top-level or nested Solid
+    named "" the same. An empty Solid name is the default one ("solid"), as when none is given; the
+    boxes are targets at their places."""
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+                 'Robot { name "car" children [ Radar { translation 0 0 0.1 minRange 0.01 maxRange 10 '
+                 'verticalFieldOfView 0.5 } ] }\n'
+                 'Robot { translation 2 0 0 name "one" children [\n'
+                 '  Solid { translation 0 0 0.1 name "" radarCrossSection 1 children [ Shape { geometry Box { '
+                 'size 0.04 0.04 0.04 } } ] } ] }\n'
+                 'Solid { translation 4 1 0.1 name "" children [ Solid { name "" radarCrossSection 0.5 } ] }\n')
+    loaded = load_world(p)
+    assert [(t.name, t.radar_cross_section) for t in loaded.world.robots[1].radar_targets] == [("solid", 1.0)]
+    (top,) = loaded.world.solids
+    assert top.name == "solid" and [c.name for c in top.children] == ["solid"]
+    targets = run(Simulation(loaded), name="car/radar")
+    # each at its box's centre (a point for the shape-less nested one), at the radar's height
+    assert [t.distance for t in targets] == [pytest.approx(2.0, rel=1e-12), pytest.approx(math.hypot(4, 1), rel=1e-12)]

@@ -521,3 +521,99 @@ def test_a_lone_hinge2_joint_is_no_failed_car(tmp_path: Path) -> None:
     tip = sim.device("post/tip").world_pose(robot.pose)
     assert tip.translation == pytest.approx([0.1, 0.0, 0.13] + turn @ [0.0, 0.0, 0.05], abs=1e-12)
     assert np.asarray(tip.rotation) == pytest.approx(turn, abs=1e-12)
+
+
+def test_gripper_fingers_on_round_axles_are_no_failed_car(tmp_path: Path) -> None:
+    """Webots' coupled_motors sample as it is: each finger's end point holds its axle, a plain Cylinder
+    (radius 2.5 mm), and a passive hinge to the fingertip. Round end points on vertical hinges were
+    taken for a car's two steered wheels, and the gripper ended in "no Ackermann drive (the driven
+    wheels (none) ...); the robot will not move". No motorised hinge drives a wheel, so there is no
+    vehicle: each finger is said once as no wheel and moves its joint, coupled as in Webots."""
+    fingers = "".join(
+        f' HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor 0 {y} 0 }} device [ '
+        f'RotationalMotor {{ name "motor::{side} finger" {m} }} ] endPoint Solid {{ translation 0 {y} 0 children [ '
+        f'DEF AXLE Shape {{ geometry Cylinder {{ height 0.0125 radius 0.0025 }} }}\n'
+        f'  HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor 0.02869 {3.5 * y} 0 }} '
+        f'endPoint Solid {{ translation 0.02869 {3.5 * y} 0 name "{side} tip" children [ TouchSensor {{ name '
+        f'"{side} touch" }} ] }} }} ] name "{side} finger" boundingObject USE AXLE }} }}\n'
+        for side, y, m in (("left", -0.008, ""), ("right", 0.008, "multiplier -1")))
+    p = write(tmp_path, 'Robot { name "gripper" children [\n' + fingers + '] }\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
+    (robot,) = w.world.robots
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    said = sorted(x.split(": ", 1)[1].split(" (")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == ["HingeJoint motor 'motor::left finger' is no wheel",
+                    "HingeJoint motor 'motor::right finger' is no wheel"]
+    sim = Simulation(w)
+    gripper = sim.robot("gripper")
+    left, right = (gripper.motor(f"motor::{side} finger") for side in ("left", "right"))
+    left.set_position(math.pi / 2)           # the right finger takes -pi/2 (multiplier -1)
+    for _ in range(400):
+        sim.step()
+    assert (left.position, right.position) == (pytest.approx(math.pi / 2), pytest.approx(-math.pi / 2))
+    # each tip at (0.02869, 3.5 y) from its finger's anchor (0, y): a quarter turn about ±z puts it at
+    # (0, y) + Rz(±pi/2)·(0.02869, 3.5 y)
+    for side, y, s in (("left", -0.008, 1.0), ("right", 0.008, -1.0)):
+        at = sim.device(f"gripper/{side} touch").world_pose(gripper.pose).translation
+        assert at == pytest.approx([-s * 3.5 * y, y + s * 0.02869, 0.0], abs=1e-9)
+
+
+def test_a_lone_hinge2_joint_with_two_motors_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' hinge_2_joint_with_backlash (motor2) sample: a fixed robot whose one Hinge2Joint has a
+    motor on each axis (axis -x, then axis2 -y) and a round end point (a cylinder). Its first motor was
+    taken for a car's lone steering joint: "no Ackermann drive (... 1 steering motor(s) ...); the robot
+    will not move". One joint makes no vehicle: both motors are said once as no wheel and move the end
+    point. A distance sensor at (0, 0.05, 0) in the end point (anchor (0, 0, 0.07)) turned a quarter
+    about -x is at (0, 0, 0.07 - 0.05)."""
+    p = write(tmp_path, 'Robot { name "wrist" children [\n'
+              ' Hinge2Joint { jointParameters HingeJointParameters { axis -1 0 0 anchor 0 0 0.07 }\n'
+              '  jointParameters2 JointParameters { axis 0 -1 0 }\n'
+              '  device [ RotationalMotor { name "motor 1" maxVelocity 100 maxTorque 100000 } ]\n'
+              '  device2 [ RotationalMotor { name "motor 2" maxVelocity 100 maxTorque 100000 } ]\n'
+              '  endPoint Solid { translation 0 0 0.07 children [ DEF C Shape { geometry Cylinder { radius 0.008 '
+              'height 0.03 } }\n'
+              '   DistanceSensor { translation 0 0.05 0 } ] boundingObject USE C } }\n] }\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
+    said = sorted(x.split(": ", 1)[1].split(": ")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == ["Hinge2Joint motor 'motor 1' is no wheel (the robot's only motorised joint)",
+                    "Hinge2Joint motor 'motor 2' is no wheel (the robot's only motorised joint)"]
+    sim = Simulation(w)
+    sim.robot("wrist").motor("motor 1").set_position(math.pi / 2)
+    sim.step()
+    ds = sim.device("wrist/distance sensor").world_pose(sim.robot("wrist").pose)
+    assert ds.translation == pytest.approx([0.0, 0.0, 0.02], abs=1e-12)
+
+
+def test_a_fixed_arm_of_round_links_is_no_failed_car(tmp_path: Path) -> None:
+    """Webots' vacuum_gripper sample: a fixed arm, yaw (axis z) holding pitch (axis y) holding roll,
+    each link made of cylinders. The vertical yaw hinge with round parts past it was taken for a car's
+    steering and the robot ended in "no Ackermann drive (wheel axis of motor 'roll motor' ...); the robot
+    will not move". Motorised hinges all past one of them are an arm: each is said once as no wheel and
+    moves its joint. A sensor 0.2 above the pitch anchor (0, 0, 0.33): pitch a quarter turn about y puts
+    it at (0.2, 0, 0.33), yaw a quarter about z then at (0, 0.2, 0.33)."""
+    link = 'Shape { geometry Cylinder { radius 0.04 height 0.3 } }'
+    p = write(tmp_path, 'Robot { name "arm" children [\n'
+              ' HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 }\n'
+              '  device [ RotationalMotor { name "yaw motor" maxVelocity 100 maxTorque 100000 } ]\n'
+              f'  endPoint Solid {{ children [ Pose {{ translation 0 0 0.18 rotation 1 0 0 1.5708 children [ {link} ] }}\n'
+              '   HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0 0.33 }\n'
+              '    device [ RotationalMotor { name "pitch motor" maxVelocity 100 maxTorque 100000 } ]\n'
+              f'    endPoint Solid {{ translation 0 0 0.33 children [ Pose {{ rotation 0 1 0 1.5708 children [ {link} ] }}\n'
+              '     DistanceSensor { translation 0 0 0.2 }\n'
+              '     HingeJoint { jointParameters HingeJointParameters { axis 0 -1 0 anchor 0 -0.3 0 }\n'
+              '      device [ RotationalMotor { name "roll motor" } ]\n'
+              f'      endPoint Solid {{ translation 0 -0.3 0 children [ {link} ] }} }} ] }} }} ] }} }}\n] }}\n')
+    w = load_world(p)
+    assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
+    said = sorted(x.split(": ", 1)[1].split(" (")[0] for x in w.warnings if "is no wheel" in x)
+    assert said == [f"HingeJoint motor '{m} motor' is no wheel" for m in ("pitch", "roll", "yaw")]
+    sim = Simulation(w)
+    arm = sim.robot("arm")
+    arm.motor("pitch motor").set_position(math.pi / 2)
+    sim.step()
+    assert sim.device("arm/distance sensor").world_pose(arm.pose).translation == pytest.approx([0.2, 0, 0.33], abs=1e-12)
+    arm.motor("yaw motor").set_position(math.pi / 2)
+    sim.step()
+    assert sim.device("arm/distance sensor").world_pose(arm.pose).translation == pytest.approx([0, 0.2, 0.33], abs=1e-12)

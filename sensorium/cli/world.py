@@ -108,6 +108,8 @@ def _summary(value) -> object:
 
     if isinstance(value, float):
         return None if math.isnan(value) else value
+    if isinstance(value, (bool, int, str)) or value is None:      # a presence, a lock state, a joint type
+        return value
     arr = np.asarray(value)
     if arr.dtype.names:
         xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=-1)

@@ -75,6 +75,9 @@ class Connector(Device):
         self.value = self.presence_now()
         self._mark(now_ms)
 
+    def readings(self) -> dict:
+        return {"presence": int(self.value), "is_locked": self.is_locked}
+
     def step_reading(self) -> dict:
         return {"value": int(self.value)}
 
@@ -154,6 +157,10 @@ class Brake(Device):
     def __post_init__(self) -> None:
         super().__post_init__()
         self.type_code = 1 if self.config.joint_type == "linear" else 0
+
+    def readings(self) -> dict:
+        """Nothing is measured: its joint's type (``get_type``), what a probe shows."""
+        return {"type": self.type_code}
 
     def describe(self) -> dict:
         c = self.config

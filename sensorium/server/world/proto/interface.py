@@ -321,6 +321,10 @@ def check_value(ftype: str, v: Any) -> Any:
                 _int(x)
         return flat
     single = "SF" + ftype[2:]
+    if kind == "node" and v is None:
+        # a bare NULL for a whole MFNode value: no nodes, as Webots reads it (its Hinge2JointWithBacklash
+        # declares `field MFNode startPoint NULL`); NULL inside brackets stays an error
+        return []
     what = {"node": "nodes", "string": "strings", "bool": "TRUE or FALSE values"}[kind]
     out = []
     for x in items:

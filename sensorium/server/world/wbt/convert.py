@@ -914,14 +914,16 @@ class Converter:
         when it is part of a robot's body)."""
         f = self.fields(node)
         inner = self.child_frame(node, frame)
+        # an empty name (Webots' radar sample's target boxes: name "") is the default one: names here
+        # address solids and label radar targets
+        name = f.string("name", default) or default
         if owner.kind == "robot":   # part of the robot's body
-            target = self.carried_target(node, f.string("name", default), inner, owner)
+            target = self.carried_target(node, name, inner, owner)
             start = len(owner.parts)
             self.solid_contents(node, inner, owner)
             if target is not None:
                 target["_members"] = [id(p) for p in owner.parts[start:]]
             return None
-        name = f.string("name", default)
         data = {"name": self.unique_name(name) if owner.kind == "world" else name, "pose": inner.pose()}
         if owner.kind == "world":
             self.def_name(node, data)
