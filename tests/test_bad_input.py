@@ -1,0 +1,71 @@
+"""Bad input to the newer devices (Speaker, Brake, Connector, VacuumGripper, coupled motors) from a
+Webots Python controller and from a C controller (the C library built with AddressSanitizer and
+UBSan) against ``sensorium serve`` on tests/worlds/new_devices.yaml: tests/controllers/bad_input.py
+and tests/c/bad_input.c print the same lines for what both can pass, each bad value answered in one
+line (Webots' where it has one) with Webots' return value, never a traceback or a sanitizer report.
+
+The WAV is 3200 frames at 32 kHz (100 ms at pitch 1); at the greatest pitch the server takes (1e9,
+where an infinite or huger one is clamped with a warning) it is over at the first step."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from _serve import run_controller, sensorium
+from test_c_client import SAN_ENV, sanitized_controller
+from test_vacuum_speaker import write_wav
+
+REPO = Path(__file__).resolve().parents[1]
+WORLD = REPO / "tests" / "worlds" / "new_devices.yaml"
+BOTH = ["nan volume 0", "nan pitch 0", "nan balance 0", "nan speak 0",
+        "pitch inf 1 1", "pitch 1e+308 1 1",                 # clamped to 1e9 (a warning each): over at once
+        "empty sound 0", "empty speech 1 1", "presence 0"]
+PYTHON = ["nul sound 0", "huge period INVALID_ARGUMENT True", "surrogate speech INVALID_ARGUMENT True",
+          "surrogate stop INVALID_ARGUMENT True", "huge speech TOO_LARGE True", "still 16 0 0"]
+C_TAGS = [f"tag {t}: -1 0 0 0 0 0 0 0 0 0 0 0 0 NULL NULL nan" for t in (0, 999, 9)]
+C_OWN = [*C_TAGS, "nulls 0 0 0 0", "still 16 0 -2 0"]
+
+
+@pytest.fixture(scope="module")
+def c_controller(tmp_path_factory) -> str:
+    return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "bad_input.c")
+
+
+@pytest.fixture
+def wav(tmp_path: Path) -> Path:
+    return write_wav(tmp_path / "beep.wav", 3200, 32000)
+
+
+def check_both(err: str) -> None:
+    assert "Traceback" not in err and "Sanitizer" not in err and "runtime error" not in err, err
+    assert err.count("wb_speaker_play_sound() called with an invalid argument (a NULL sound or a NaN value).") >= 3, err
+    assert err.count("wb_speaker_speak() called with an invalid argument (a NULL text or a NaN volume).") >= 1, err
+    assert err.count("Error: wb_brake_set_damping_constant() called with an invalid 'damping_constant' argument "
+                     "(NaN).") == 1, err
+    for pitch in ("inf", "1e+308"):
+        assert (f"Warning: wb_speaker_play_sound() called with a pitch value greater than 1e+09: {pitch}. Setting "
+                "pitch to 1e+09.") in err, err
+    assert "Sound file '' not found." in err, err
+    assert "INVALID_ARGUMENT: /bot/speaker/play_sound" not in err, err
+
+
+def test_a_python_controller_gets_one_line_for_each_bad_value(wav: Path) -> None:
+    lines, err = run_controller(WORLD, lambda url: sensorium(
+        "controller", "--url", url, str(REPO / "tests" / "controllers" / "bad_input.py"), str(wav)))
+    assert lines == BOTH + PYTHON, err
+    check_both(err)
+    assert "Sound file 'be\\0ep.wav' not found." in err, err
+
+
+def test_a_c_controller_gets_the_same_lines_and_webots_answers_for_bad_tags(wav: Path, c_controller: str) -> None:
+    lines, err = run_controller(WORLD, lambda url: [c_controller, str(wav)], env=SAN_ENV)
+    assert lines == BOTH + C_OWN, err
+    check_both(err)
+    for t in (0, 999):
+        for func in ("wb_connector_enable_presence", "wb_connector_lock", "wb_brake_set_damping_constant",
+                     "wb_vacuum_gripper_turn_on", "wb_speaker_stop", "wb_speaker_speak", "wb_motor_get_multiplier"):
+            assert f"Error: {func}(): invalid device tag {t}\n" in err, (func, err)
+    assert "Error: wb_speaker_get_engine(): device tag 9 is 'ds', a DistanceSensor\n" in err, err
+    assert "Error: wb_speaker_play_sound(): invalid 'left' device tag." in err, err
+    assert "Error: wb_speaker_play_sound(): invalid 'right' device tag." in err, err
