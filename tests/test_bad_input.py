@@ -22,7 +22,8 @@ BOTH = ["nan volume 0", "nan pitch 0", "nan balance 0", "nan speak 0",
         "pitch inf 1 1", "pitch 1e+308 1 1",                 # clamped to 1e9 (a warning each): over at once
         "empty sound 0", "empty speech 1 1", "presence 0"]
 PYTHON = ["nul sound 0", "huge period INVALID_ARGUMENT True", "surrogate speech INVALID_ARGUMENT True",
-          "surrogate stop INVALID_ARGUMENT True", "huge speech TOO_LARGE True", "still 16 0 0"]
+          "surrogate stop INVALID_ARGUMENT True", "huge speech TOO_LARGE True", "list sound playing INVALID_ARGUMENT True", "list sound stop INVALID_ARGUMENT True",
+          "still 16 0 0"]
 C_TAGS = [f"tag {t}: -1 0 0 0 0 0 0 0 0 0 0 0 0 NULL NULL nan" for t in (0, 999, 9)]
 C_OWN = [*C_TAGS, "nulls 0 0 0 0", "still 16 0 -2 0"]
 

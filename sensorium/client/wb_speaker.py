@@ -154,6 +154,8 @@ def wb_speaker_stop(tag: int, sound: str | None) -> None:
     func = "wb_speaker_stop"
     r = current()
     dev = r.device(tag, SPEAKER, func)
+    if sound is not None and not isinstance(sound, str):
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'sound' must be a string or None, got {sound!r}")
     name = sound or ""
     if not r.terminated:
         r._expect_success(r.rpc(dev, "stop", {"value": name}), func)
@@ -167,7 +169,10 @@ def wb_speaker_stop(tag: int, sound: str | None) -> None:
 @answers(False)
 def wb_speaker_is_sound_playing(tag: int, sound: str | None) -> bool:
     """Whether ``sound`` plays; with None or "" whether anything plays or is spoken."""
-    dev = current().device(tag, SPEAKER, "wb_speaker_is_sound_playing")
+    func = "wb_speaker_is_sound_playing"
+    dev = current().device(tag, SPEAKER, func)
+    if sound is not None and not isinstance(sound, str):
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'sound' must be a string or None, got {sound!r}")
     mine = _sounds(dev)
     if not sound:
         return dev.desc.get("_speech") is not None or any(k[2] for k in mine.values())

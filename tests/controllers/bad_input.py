@@ -50,7 +50,9 @@ print("nul sound", int(speaker.isSoundPlaying("")))
 for label, call in (("huge period", lambda: dock.enablePresence(1e308)),
                     ("surrogate speech", lambda: speaker.speak("caf\udce9", 1.0)),
                     ("surrogate stop", lambda: speaker.stop("caf\udce9")),
-                    ("huge speech", lambda: speaker.speak("word " * 300_000, 1.0))):
+                    ("huge speech", lambda: speaker.speak("word " * 300_000, 1.0)),
+                    ("list sound playing", lambda: speaker.isSoundPlaying(["beep.wav"])),   # unhashable
+                    ("list sound stop", lambda: speaker.stop(["beep.wav"]))):
     try:
         call()
         print(label, "accepted")
