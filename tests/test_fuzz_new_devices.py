@@ -1,8 +1,9 @@
 """Hypothesis fuzz of the newer devices' services on the sans-IO core (the style of
 tests/test_fuzz_core.py): the Connector's lock/unlock/is_locked/enable, the Brake's get_type, the
 VacuumGripper's set_on, the Speaker's play_sound/stop/speak, a coupled motor pair's commands (its
-own services and a step's ``motors``) on tests/worlds/new_devices.yaml, and a Supervisor's
-get_field/set_field on the nested nodes and SFNode jointParameters of tests/worlds/nested_joints.wbt.
+own services and a step's ``motors``) on tests/worlds/new_devices.yaml, and a Supervisor's services
+(get_field/set_field, SFNode jointParameters included, node poses and velocities, get_from_def/id,
+remove_node) on the nested nodes of tests/worlds/nested_joints.wbt and nested_nodes.wbt.
 
 Arguments are mostly the service's own names with malformed types, out-of-range values (NaN, inf,
 huge numbers, huge strings), missing or extra fields. Every request gets one well-formed reply;
@@ -14,6 +15,7 @@ maxVelocity, targets within the limits or +-inf)."""
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import msgpack
@@ -148,34 +150,81 @@ def test_a_string_argument_that_is_not_utf8_is_one_error_and_no_change(attached:
 
 SUPERVISOR_FIELDS = ["jointParameters", "position", "endPoint", "translation", "rotation", "children", "name",
                      "device", "", "x" * 5000, "jointParameters2", "axis", "anchor"]
+GETTERS = {"get_field", "get_node_pose", "get_node_velocity", "get_from_def", "get_from_id"}
 
 
-def test_supervisor_fields_of_nested_nodes_answer_or_refuse_in_one_line() -> None:
-    """get_field and set_field on every node id (and ids that are none), SFNode jointParameters included."""
-    f = Fuzzed("nested_joints.wbt")
-    [reply] = send(f, "attach", {"robot": "armbot"})
+@pytest.mark.parametrize(("world", "robot"), [("nested_joints.wbt", "armbot"), ("nested_nodes.wbt", "rover")])
+def test_supervisor_services_on_nested_nodes_answer_or_refuse_in_one_line(world: str, robot: str) -> None:
+    """get_field and set_field (SFNode jointParameters included), get_node_pose/velocity, get_from_def
+    (DEF names, dotted paths, noise), get_from_id and remove_node on every node id and ids that are
+    none: one reply each; a refusal, or a getter's answer, changes nothing."""
+    f = Fuzzed(world)
+    [reply] = send(f, "attach", {"robot": robot})
     assert reply["ok"], reply
-    node_ids = st.integers(-2, 64) | st.sampled_from([1 << 31, (1 << 31) - 1, 1 << 63]) | values
+    defs = sorted(set(re.findall(r"DEF (\w+)", (WORLDS / world).read_text())))
+    real = sorted({0} | {r["result"]["node"] for d in defs for r in send(f, f"/{robot}/robot/get_from_def", {"name": d})
+                         if r["ok"]})
+    assert len(real) > len(defs) // 2, real
+    real_ids = st.sampled_from(real)                                   # mostly nodes that are there
+    node_ids = st.one_of(real_ids, real_ids, real_ids, st.integers(-2, 64) | st.integers(1 << 24, (1 << 24) + 64),
+                         st.sampled_from([1 << 31, 1 << 63]) | values)
+    names = st.one_of(st.sampled_from(defs), st.lists(st.sampled_from(defs), min_size=2, max_size=3).map(".".join),
+                      values)
+    fields = st.one_of(st.sampled_from(SUPERVISOR_FIELDS), st.sampled_from(SUPERVISOR_FIELDS), values)
+    item_args = st.one_of(
+        st.tuples(st.just("get_field"), st.fixed_dictionaries({"node": node_ids, "field": fields})),
+        st.tuples(st.just("set_field"), st.fixed_dictionaries({"node": node_ids, "field": fields, "value": values})),
+        st.tuples(st.sampled_from(["get_node_pose", "get_node_velocity", "remove_node"]),
+                  st.fixed_dictionaries({"node": node_ids})),
+        st.tuples(st.just("get_from_def"), st.fixed_dictionaries({"name": names})),
+        st.tuples(st.just("get_from_id"), st.fixed_dictionaries({"id": node_ids})),
+        st.tuples(st.sampled_from(sorted(GETTERS)), st.dictionaries(st.sampled_from(["node", "id", "name", "field"]),
+                                                                    values, max_size=3)))
 
     def state() -> tuple:
-        return repr(f.core._describe_robot("armbot")), f.sim.time_ms, repr(
-            [(m.name, m.position, m.target_position) for m in f.sim.robots["armbot"].motors.values()])
+        return repr(f.core._describe_robot(robot)), f.sim.time_ms, repr(
+            [(m.name, m.position, m.target_position) for m in f.sim.robots[robot].motors.values()]), \
+            repr(f.sim.root_order), repr(f.sim.world.solids)
+
+    # every node there (the jointParameters nodes SFNode fields answer included) x every field name,
+    # read, and written with values of every kind: answered, and a refusal changes nothing
+    seen, todo, kinds = set(), list(real), 0
+    while todo:
+        node = todo.pop()
+        if node in seen:
+            continue
+        seen.add(node)
+        for field in SUPERVISOR_FIELDS:
+            before = state()
+            [reply] = send(f, f"/{robot}/robot/get_field", {"node": node, "field": field})
+            assert reply["ok"] == (1 <= len(field) <= 64) and state() == before, (node, field, reply)
+            got = reply["result"] if reply["ok"] else {"type": ""}
+            kinds += got["type"] == "SFNode"
+            if got["type"] == "SFNode" and got["value"]:
+                todo.append(got["value"])
+            for value in (math.nan, math.inf, 1e308, True, [1.0, 2.0, 3.0], [math.nan] * 4, "x", None, []):
+                [reply] = send(f, f"/{robot}/robot/set_field", {"node": node, "field": field, "value": value})
+                if not reply["ok"]:
+                    assert state() == before, (node, field, value, reply)
+            f.assert_healthy()
+    assert len(seen) > len(real) or world != "nested_joints.wbt", seen      # jointParameters nodes reached
+    assert kinds or world != "nested_joints.wbt"
 
     @SETTINGS
-    @given(st.lists(st.tuples(st.sampled_from(["get_field", "set_field"]), node_ids,
-                              st.sampled_from(SUPERVISOR_FIELDS) | values, values), min_size=1, max_size=6))
+    @given(st.lists(item_args, min_size=1, max_size=6))
     def run(batch):
-        for item, node, field, value in batch:
-            args = {"node": node, "field": field} if item == "get_field" else {"node": node, "field": field, "value": value}
+        for item, args in batch:
             before = state()
-            [reply] = send(f, f"/armbot/robot/{item}", args)
+            [reply] = send(f, f"/{robot}/robot/{item}", args)
             if reply["ok"] and item == "get_field":
                 result = reply["result"]
                 assert isinstance(result.get("type"), str), reply
                 if result["type"] == "SFNode":                        # a node id, 0 for NULL
                     assert isinstance(result["value"], int) and result["value"] >= 0, reply
-            if not reply["ok"] or item == "get_field":
+            if not reply["ok"] or item in GETTERS:
                 assert state() == before, (item, args, reply)
             f.assert_healthy()
+        f.steps()
+        f.assert_healthy()
 
     run()
