@@ -5,7 +5,9 @@ and tests/c/bad_input.c print the same lines for what both can pass, each bad va
 line (Webots' where it has one) with Webots' return value, never a traceback or a sanitizer report.
 
 The WAV is 3200 frames at 32 kHz (100 ms at pitch 1); at the greatest pitch the server takes (1e9,
-where an infinite or huger one is clamped with a warning) it is over at the first step."""
+where an infinite or huger one is clamped with a warning) it is over at the first step. A WAV whose
+header says 3e9 frames/s (past the 2**31 the server takes) is a damaged file: WbSpeaker's "Impossible
+to play" line, where the server's refusal ended the Python controller."""
 
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ REPO = Path(__file__).resolve().parents[1]
 WORLD = REPO / "tests" / "worlds" / "new_devices.yaml"
 BOTH = ["nan volume 0", "nan pitch 0", "nan balance 0", "nan speak 0",
         "pitch inf 1 1", "pitch 1e+308 1 1",                 # clamped to 1e9 (a warning each): over at once
-        "empty sound 0", "empty speech 1 1", "presence 0"]
+        "empty sound 0", "damaged rate 0", "empty speech 1 1", "presence 0"]
 PYTHON = ["nul sound 0", "huge period INVALID_ARGUMENT True", "surrogate speech INVALID_ARGUMENT True",
           "surrogate stop INVALID_ARGUMENT True", "huge speech TOO_LARGE True", "list sound playing INVALID_ARGUMENT True", "list sound stop INVALID_ARGUMENT True",
           "still 16 0 0"]
@@ -34,8 +36,9 @@ def c_controller(tmp_path_factory) -> str:
 
 
 @pytest.fixture
-def wav(tmp_path: Path) -> Path:
-    return write_wav(tmp_path / "beep.wav", 3200, 32000)
+def wavs(tmp_path: Path) -> list[str]:
+    """The WAV, and one whose header says 3e9 frames/s (8 bit: its byte rate still fits the header)."""
+    return [str(write_wav(tmp_path / "beep.wav", 3200, 32000)), str(write_wav(tmp_path / "fast.wav", 10, 3_000_000_000, 1))]
 
 
 def check_both(err: str) -> None:
@@ -48,19 +51,20 @@ def check_both(err: str) -> None:
         assert (f"Warning: wb_speaker_play_sound() called with a pitch value greater than 1e+09: {pitch}. Setting "
                 "pitch to 1e+09.") in err, err
     assert "Sound file '' not found." in err, err
+    assert "Impossible to play '" in err and "fast.wav'. Make sure the file format is supported" in err, err
     assert "INVALID_ARGUMENT: /bot/speaker/play_sound" not in err, err
 
 
-def test_a_python_controller_gets_one_line_for_each_bad_value(wav: Path) -> None:
+def test_a_python_controller_gets_one_line_for_each_bad_value(wavs: list[str]) -> None:
     lines, err = run_controller(WORLD, lambda url: sensorium(
-        "controller", "--url", url, str(REPO / "tests" / "controllers" / "bad_input.py"), str(wav)))
+        "controller", "--url", url, str(REPO / "tests" / "controllers" / "bad_input.py"), *wavs))
     assert lines == BOTH + PYTHON, err
     check_both(err)
     assert "Sound file 'be\\0ep.wav' not found." in err, err
 
 
-def test_a_c_controller_gets_the_same_lines_and_webots_answers_for_bad_tags(wav: Path, c_controller: str) -> None:
-    lines, err = run_controller(WORLD, lambda url: [c_controller, str(wav)], env=SAN_ENV)
+def test_a_c_controller_gets_the_same_lines_and_webots_answers_for_bad_tags(wavs: list[str], c_controller: str) -> None:
+    lines, err = run_controller(WORLD, lambda url: [c_controller, *wavs], env=SAN_ENV)
     assert lines == BOTH + C_OWN, err
     check_both(err)
     for t in (0, 999):

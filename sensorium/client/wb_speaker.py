@@ -25,6 +25,8 @@ SPEAKER = "Speaker"
 ENGINES = ("pico",)
 LANGUAGES = ("en-US", "en-UK", "de-DE", "es-ES", "fr-FR", "it-IT")
 """What ``set_engine`` and ``set_language`` accept (libController's pico languages)."""
+MAX_RATE = 1 << 31
+"""A WAV's frame rate must be below this (a header's is 32 bits; past this one it is a damaged file)."""
 MAX_PITCH = 1e9
 """The greatest pitch the server takes (a sound faster than that lasts less than a nanosecond a
 second of audio); a greater one, +inf too, is clamped to it with a warning line (Webots sends it to OpenAL)."""
@@ -45,10 +47,10 @@ def _sounds(dev: DeviceState) -> dict[str, Any]:
 
 def sound_length(path: str) -> tuple[int, int] | str:
     """A WAV file's (frames, frames per second), or why it cannot be played: ``"missing"`` or ``"format"``
-    (WbSpeaker plays 8 or 16 bit mono or stereo waves)."""
+    (WbSpeaker plays 8 or 16 bit mono or stereo waves; a rate of 0 or of 2**31 frames/s or more is a damaged header)."""
     try:
         with wave.open(path, "rb") as w:
-            if w.getsampwidth() not in (1, 2) or w.getnchannels() not in (1, 2) or w.getframerate() <= 0:
+            if w.getsampwidth() not in (1, 2) or w.getnchannels() not in (1, 2) or not 0 < w.getframerate() < MAX_RATE:
                 return "format"
             return w.getnframes(), w.getframerate()
     except FileNotFoundError:

@@ -2,7 +2,7 @@
  * lines of tests/controllers/bad_input.py both clients print, then C's own: tags of no device, of
  * another kind of device and of 0 for every Connector, Brake, VacuumGripper, Speaker and coupled
  * motor function, and NULL strings, each answered with one error line and Webots' return value.
- * Argument: the WAV. */
+ * Arguments: the WAV, a WAV whose header says 3e9 frames/s. */
 #include <math.h>
 #include <stdio.h>
 
@@ -25,9 +25,9 @@ static int steps_playing(const char *sound) {
 }
 
 int main(int argc, char **argv) {
-  if (argc < 2)
+  if (argc < 3)
     return 2;
-  const char *wav = argv[1];
+  const char *wav = argv[1], *fast = argv[2];
   wb_robot_init();
   speaker = wb_robot_get_device("speaker");
   WbDeviceTag brake = wb_robot_get_device("arm brake"), dock = wb_robot_get_device("dock"),
@@ -49,6 +49,8 @@ int main(int argc, char **argv) {
   }
   wb_speaker_play_sound(speaker, speaker, "", 1.0, 1.0, 0.0, false);
   printf("empty sound %d\n", (int)wb_speaker_is_sound_playing(speaker, ""));
+  wb_speaker_play_sound(speaker, speaker, fast, 1.0, 1.0, 0.0, false);
+  printf("damaged rate %d\n", (int)wb_speaker_is_sound_playing(speaker, fast));
   wb_speaker_speak(speaker, "", 1.0);
   int speaking = wb_speaker_is_speaking(speaker);
   printf("empty speech %d %d\n", speaking, steps_playing(""));

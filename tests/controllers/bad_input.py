@@ -2,7 +2,8 @@
 NaN and infinite volumes, pitches, balances and damping constants, empty and impossible sound names
 and texts, a sampling period too large to send, a text too large for one request. The lines both
 clients print come first (the same as tests/c/bad_input.c's); then Python's own: what a C caller
-cannot pass (a NUL inside a name, a str that is no UTF-8), each refused in one line. Argument: the WAV."""
+cannot pass (a NUL inside a name, a str that is no UTF-8), each refused in one line. Arguments: the
+WAV, a WAV whose header says 3e9 frames/s."""
 
 import math
 import sys
@@ -12,7 +13,7 @@ from controller import Brake, Connector, Robot, Speaker
 from sensorium.client.connection import SensoriumError
 
 robot = Robot()
-wav = sys.argv[1]
+wav, fast = sys.argv[1:3]
 speaker = robot.getDevice("speaker")
 brake = robot.getDevice("arm brake")
 dock = robot.getDevice("dock")
@@ -38,6 +39,8 @@ for pitch in (math.inf, 1e308):
     print("pitch", pitch, int(speaker.isSoundPlaying(wav)), steps_playing(wav))
 Speaker.playSound(speaker, speaker, "", 1.0, 1.0, 0.0, False)
 print("empty sound", int(speaker.isSoundPlaying("")))
+Speaker.playSound(speaker, speaker, fast, 1.0, 1.0, 0.0, False)
+print("damaged rate", int(speaker.isSoundPlaying(fast)))
 speaker.speak("", 1.0)
 print("empty speech", int(speaker.isSpeaking()), steps_playing(""))
 dock.enablePresence(16)

@@ -65,7 +65,8 @@ static int wav_length(const char *path, int64_t *frames, int64_t *rate) {
       have_fmt = 1;
       size -= 16;
     } else if (memcmp(c, "data", 4) == 0) {
-      if (!have_fmt || (channels != 1 && channels != 2) || (bits != 8 && bits != 16) || sample_rate == 0)
+      if (!have_fmt || (channels != 1 && channels != 2) || (bits != 8 && bits != 16) || sample_rate == 0 ||
+          sample_rate >= UINT32_C(1) << 31) /* a damaged header: the server takes rates below 2^31 */
         goto done;
       *frames = (int64_t)size / (int64_t)(channels * (bits / 8));
       *rate = sample_rate;
