@@ -3,6 +3,9 @@ Webots Python controller and from a C controller (the C library built with Addre
 UBSan) against ``sensorium serve`` on tests/worlds/new_devices.yaml: tests/controllers/bad_input.py
 and tests/c/bad_input.c print the same lines for what both can pass, each bad value answered in one
 line (Webots' where it has one) with Webots' return value, never a traceback or a sanitizer report.
+Then the server stopped under a controller that has stepped (tests/controllers/after_server.py,
+tests/c/after_server.c): each call that needs it is one line, the getters answer the controller's
+copies, the step -1, and the setters after it keep a local state only.
 
 The WAV is 3200 frames at 32 kHz (100 ms at pitch 1); at the greatest pitch the server takes (1e9,
 where an infinite or huger one is clamped with a warning) it is over at the first step. A WAV whose
@@ -11,10 +14,11 @@ to play" line, where the server's refusal ended the Python controller."""
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 import pytest
-from _serve import run_controller, sensorium
+from _serve import Proc, run_controller, sensorium, serve
 from test_c_client import SAN_ENV, sanitized_controller
 from test_vacuum_speaker import write_wav
 
@@ -74,3 +78,44 @@ def test_a_c_controller_gets_the_same_lines_and_webots_answers_for_bad_tags(wavs
     assert "Error: wb_speaker_get_engine(): device tag 9 is 'ds', a DistanceSensor\n" in err, err
     assert "Error: wb_speaker_play_sound(): invalid 'left' device tag." in err, err
     assert "Error: wb_speaker_play_sound(): invalid 'right' device tag." in err, err
+
+
+AFTER = ["ready", "refused 4", "copies 0 0 0 0", "brake grip::a 0 -2", "step -1", "after 1 1 1 1"]
+
+
+def after_server(argv: list[str], env: dict[str, str] | None = None) -> tuple[list[str], str]:
+    """``argv`` as bot's controller: stepped once, then the server stopped under it, then let go on."""
+    with serve(WORLD, "--mode", "fast") as server:
+        proc = Proc(argv, env={**(env or {}), "SENSORIUM_CONTROLLER_URL": server.url("bot")}, stdin=subprocess.PIPE)
+        try:
+            assert proc.wait_line("ready") == "ready"
+            server.stop()
+            assert proc.p.stdin is not None
+            proc.p.stdin.write("go\n")
+            proc.p.stdin.flush()
+            code = proc.wait(120)
+        finally:
+            proc.stop()
+    assert code == 0, proc.stderr()
+    return ["ready", *proc.stdout().splitlines()[1:]], proc.stderr()
+
+
+def test_after_the_server_is_gone_each_call_is_one_line_and_the_copies_answer(wavs: list[str]) -> None:
+    lines, err = after_server(sensorium("controller", str(REPO / "tests" / "controllers" / "after_server.py"), wavs[0]))
+    assert lines[:-1] == [*AFTER[:3], "brake grip::a 0 -2.0", *AFTER[4:]], err
+    codes = lines[-1].split()
+    assert codes[0] == "codes" and set(codes[1:]) <= {"CONNECTION_LOST", "TIMEOUT"}, lines   # the server gone
+    assert "Traceback" not in err, err
+
+
+def test_after_the_server_is_gone_c_prints_one_line_a_call(wavs: list[str], c_after: str) -> None:
+    lines, err = after_server([c_after, wavs[0]], env=SAN_ENV)
+    assert lines == AFTER, err
+    assert "Sanitizer" not in err and "runtime error" not in err, err
+    for func in ("wb_connector_lock", "wb_vacuum_gripper_turn_on", "wb_speaker_speak", "wb_speaker_play_sound"):
+        assert sum(line.startswith(f"Error: {func}(): ") for line in err.splitlines()) == 1, (func, err)
+
+
+@pytest.fixture(scope="module")
+def c_after(tmp_path_factory) -> str:
+    return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "after_server.c")
