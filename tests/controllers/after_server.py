@@ -20,8 +20,8 @@ robot.step(16)
 print("ready", flush=True)
 sys.stdin.readline()
 refused = []
-for name, call in (("lock", dock.lock), ("turn_on", gripper.turnOn), ("speak", lambda: speaker.speak("hi", 1.0)),
-                   ("play", lambda: Speaker.playSound(speaker, speaker, wav, 1.0, 1.0, 0.0, False))):
+for call in (dock.lock, gripper.turnOn, lambda: speaker.speak("hi", 1.0),
+             lambda: Speaker.playSound(speaker, speaker, wav, 1.0, 1.0, 0.0, False)):
     try:
         call()
     except SensoriumError as exc:
