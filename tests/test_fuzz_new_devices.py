@@ -143,7 +143,7 @@ def test_a_string_argument_that_is_not_utf8_is_one_error_and_no_change(attached:
                 + packer.pack("args") + b"\x81" + packer.pack(key) + bad)
         [frames] = f.core.handle([PEER, body], f.now)
         reply = reply_of(frames)
-        assert reply["ok"] is False, reply
+        assert reply["ok"] is False and "is not UTF-8 text (at b'\\xff')" in reply["error"]["message"], reply
         assert snapshot(f) == before
     f.assert_healthy()
 
