@@ -32,6 +32,7 @@ SECONDS_PER_WORD = Fraction(2, 5)
 MAX_SOUNDS = 256
 """Sounds one speaker plays at once (a bound of ours: each costs the server work every step)."""
 
+
 def _without_markup(text: str) -> str:
     """``text`` with each ``<...>`` (from a ``<`` to the first ``>`` after it) made a space, in one
     pass: the regular expression ``<[^>]*>`` took quadratic time on a text of many ``<`` and no ``>``
