@@ -7,11 +7,17 @@ z = 0.4, sides at x, y = ±0.2). Lowering the robot by 0.1 m puts the gripper on
 from __future__ import annotations
 
 import math
+import os
+import re
+import subprocess
+import sys
 import wave
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.sim.speaker import MAX_SOUNDS, speech_frames
@@ -265,3 +271,24 @@ def test_a_gripper_on_a_lift_joint_is_lowered_onto_the_crate(tmp_path: Path) -> 
         assert g.value == (1.0 if 0.1 - travel <= GRIP_DISTANCE else 0.0), travel    # type: ignore[attr-defined]
         seen.add(g.value)                                    # type: ignore[attr-defined]
     assert seen == {0.0, 1.0} and float(lift.position) == pytest.approx(0.1)
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(st.text(alphabet="<> ab\t", max_size=40))
+def test_markup_is_read_as_a_regular_expression_reads_it(text: str) -> None:
+    """``<`` to the first ``>`` after it is markup (a space), a ``<`` with no ``>`` after it is text:
+    what ``re.sub(r"<[^>]*>", " ", text)`` does, on short texts of those characters."""
+    assert speech_frames(text) == len(re.sub(r"<[^>]*>", " ", text).split())
+
+
+def test_a_megabyte_of_unclosed_markup_is_counted_at_once() -> None:
+    """A text of 2**20 '<' and no '>' (the most a speak request carries) is two words after its
+    'a b', counted in one pass: the regular expression it replaces took minutes here (quadratic),
+    holding the server. Run in a child process with a generous limit (a few ms are expected)."""
+    code = ("from sensorium.server.sim.speaker import speech_frames as f\n"
+            "n = 1 << 20\n"
+            "print(f('<' * n + 'a b'), f('<' * n + '> a b'), f('<a ' * (n // 3)))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])})
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["2", "2", str((1 << 20) // 3)]

@@ -328,7 +328,12 @@ class Connection:
         if self.closed:
             raise SensoriumError(ErrorCode.WRONG_STATE, f"connection to {self.endpoint} is closed")
         rid = next(self._ids)
-        data = self._packer.pack({"id": rid, "service": service, "args": args or {}})
+        try:
+            data = self._packer.pack({"id": rid, "service": service, "args": args or {}})
+        except (UnicodeEncodeError, OverflowError, TypeError, ValueError) as exc:
+            # a str with lone surrogates (a file name os.fsdecode made), an int beyond 64 bits, an
+            # object msgpack does not know: the caller's bad argument, said in one line
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{service}: an argument cannot be sent: {exc}") from None
         try:
             # never blocks: a DEALER queues while (re)connecting and refuses only once ZeroMQ closed
             # its connection for good (see _resend_due) or 1000 requests wait unsent
@@ -347,7 +352,16 @@ class Connection:
         heartbeat found the server gone or the session dropped."""
         reply = self._replies.pop(rid, None) if self._replies else None
         if reply is None:
-            reply = self._receive(rid, self.timeout if timeout is _NO_TIMEOUT else timeout)
+            try:
+                reply = self._receive(rid, self.timeout if timeout is _NO_TIMEOUT else timeout)
+            except SensoriumError as exc:
+                # the server's id-less refusal of a request too large to read: ours when it is the
+                # only one outstanding (a controller's call), said with its service
+                if exc.code != ErrorCode.TOO_LARGE or list(self._outstanding) != [rid]:
+                    raise
+                service = self._outstanding.pop(rid)
+                self._retry.pop(rid, None)
+                raise SensoriumError(exc.code, f"{service}: {exc.message}") from None
         del self._outstanding[rid]
         if self._retry:
             self._retry.pop(rid, None)

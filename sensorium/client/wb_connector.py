@@ -88,13 +88,16 @@ def _brake(tag: int, func: str) -> DeviceState:
 
 @answers(None)
 def wb_brake_set_damping_constant(tag: int, damping_constant: float) -> None:
-    """Accepted, no effect: braking needs physics (one warning per brake). NaN is refused (Webots)."""
+    """Accepted, no effect: braking needs physics (one warning per brake). NaN is refused in Webots' line."""
     func = "wb_brake_set_damping_constant"
     dev = _brake(tag, func)
     value = real(damping_constant)
-    if value is None or math.isnan(value):
+    if value is None:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT,
                              f"{func}(): called with an invalid 'damping_constant' argument ({damping_constant!r})")
+    if math.isnan(value):                                    # Webots' line, and nothing else
+        print(f"Error: {func}() called with an invalid 'damping_constant' argument (NaN).", file=sys.stderr)
+        return
     if not dev._consts.get("physics_warned"):
         dev._consts["physics_warned"] = True
         print(f"Warning: {func}(): brake '{dev.name}': Sensorium has no physics, the damping constant has no "

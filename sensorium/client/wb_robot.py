@@ -33,6 +33,9 @@ WB_DISTANCE_SENSOR_SONAR = 2
 WB_DISTANCE_SENSOR_LASER = 3
 _DISTANCE_TYPES = {"generic": 0, "infra-red": 1, "infra_red": 1, "sonar": 2, "laser": 3}
 
+MAX_PERIOD_MS = (1 << 31) - 1
+"""The greatest sampling period (ms): Webots' C ``int``, the server's bound."""
+
 WB_ROTATIONAL = 0
 WB_LINEAR = 1
 
@@ -499,6 +502,9 @@ class RobotClient:
         period = whole
         if period < 0:
             raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): negative sampling period {period}")
+        if period > MAX_PERIOD_MS:                                  # Webots' C int; msgpack could not even send 1e308
+            raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): sampling period {period:.6g} ms is too large "
+                                                             f"(at most {MAX_PERIOD_MS})")
         self.device_set(dev, "enable", period, func)
         dev.sampling_period = period
         dev._warned = False

@@ -13,6 +13,7 @@ unreadable file is WbSpeaker's one warning line and plays nothing."""
 
 from __future__ import annotations
 
+import math
 import sys
 import wave
 from typing import Any
@@ -24,6 +25,11 @@ SPEAKER = "Speaker"
 ENGINES = ("pico",)
 LANGUAGES = ("en-US", "en-UK", "de-DE", "es-ES", "fr-FR", "it-IT")
 """What ``set_engine`` and ``set_language`` accept (libController's pico languages)."""
+MAX_RATE = 1 << 31
+"""A WAV's frame rate must be below this (a header's is 32 bits; past this one it is a damaged file)."""
+MAX_PITCH = 1e9
+"""The greatest pitch the server takes (a sound faster than that lasts less than a nanosecond a
+second of audio); a greater one, +inf too, is clamped to it with a warning line (Webots sends it to OpenAL)."""
 
 __all__ = ["ENGINES", "LANGUAGES", "SPEAKER", "wb_speaker_get_engine", "wb_speaker_get_language",
            "wb_speaker_is_sound_playing", "wb_speaker_is_speaking", "wb_speaker_play_sound", "wb_speaker_set_engine",
@@ -41,13 +47,15 @@ def _sounds(dev: DeviceState) -> dict[str, Any]:
 
 def sound_length(path: str) -> tuple[int, int] | str:
     """A WAV file's (frames, frames per second), or why it cannot be played: ``"missing"`` or ``"format"``
-    (WbSpeaker plays 8 or 16 bit mono or stereo waves)."""
+    (WbSpeaker plays 8 or 16 bit mono or stereo waves; a rate of 0 or of 2**31 frames/s or more is a damaged header)."""
     try:
         with wave.open(path, "rb") as w:
-            if w.getsampwidth() not in (1, 2) or w.getnchannels() not in (1, 2) or w.getframerate() <= 0:
+            if w.getsampwidth() not in (1, 2) or w.getnchannels() not in (1, 2) or not 0 < w.getframerate() < MAX_RATE:
                 return "format"
             return w.getnframes(), w.getframerate()
     except FileNotFoundError:
+        return "missing"
+    except ValueError:                                  # a NUL inside: no file has that name
         return "missing"
     except (OSError, EOFError, wave.Error):
         return "format"
@@ -66,8 +74,9 @@ def _clamped(func: str, name: str, value: float, lo: float | None, hi: float | N
 
 
 def _number(func: str, name: str, v: Any) -> float:
+    """``v`` as a float (NaN kept: the caller says it in Webots' way); not a number raises."""
     x = real(v)
-    if x is None or x != x:
+    if x is None:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): '{name}' must be a number, got {v!r}")
     return x
 
@@ -80,7 +89,8 @@ def _play(dev: DeviceState, sound: str, volume: float, pitch: float, balance: fl
     if known is None:
         length = sound_length(sound)
         if length == "missing":
-            _err(f"Warning: {func}(): Sound file '{sound}' not found. The sound file should be defined relatively to "
+            shown = sound.replace("\0", "\\0")                # a NUL inside, written as \0
+            _err(f"Warning: {func}(): Sound file '{shown}' not found. The sound file should be defined relatively to "
                  "the controller, the PROTO or absolutely.")
             return
         if isinstance(length, str):
@@ -120,9 +130,13 @@ def wb_speaker_play_sound(left: int, right: int, sound: str, volume: float, pitc
         right_dev = _tag(right, "right", func)
     except SensoriumError:
         return
-    volume = _clamped(func, "volume", _number(func, "volume", volume), 0.0, 1.0)
-    pitch = _clamped(func, "pitch", _number(func, "pitch", pitch), 0.0, None)
-    balance = _clamped(func, "balance", _number(func, "balance", balance), -1.0, 1.0)
+    numbers = [_number(func, "volume", volume), _number(func, "pitch", pitch), _number(func, "balance", balance)]
+    if any(math.isnan(x) for x in numbers):              # the C library's line; nothing plays
+        _err(f"Error: {func}() called with an invalid argument (a NULL sound or a NaN value).")
+        return
+    volume = _clamped(func, "volume", numbers[0], 0.0, 1.0)
+    pitch = _clamped(func, "pitch", numbers[1], 0.0, MAX_PITCH)
+    balance = _clamped(func, "balance", numbers[2], -1.0, 1.0)
     if balance <= 0.0:
         left_volume, right_volume = volume, volume * (1.0 + balance)
     else:
@@ -142,6 +156,8 @@ def wb_speaker_stop(tag: int, sound: str | None) -> None:
     func = "wb_speaker_stop"
     r = current()
     dev = r.device(tag, SPEAKER, func)
+    if sound is not None and not isinstance(sound, str):
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'sound' must be a string or None, got {sound!r}")
     name = sound or ""
     if not r.terminated:
         r._expect_success(r.rpc(dev, "stop", {"value": name}), func)
@@ -155,7 +171,10 @@ def wb_speaker_stop(tag: int, sound: str | None) -> None:
 @answers(False)
 def wb_speaker_is_sound_playing(tag: int, sound: str | None) -> bool:
     """Whether ``sound`` plays; with None or "" whether anything plays or is spoken."""
-    dev = current().device(tag, SPEAKER, "wb_speaker_is_sound_playing")
+    func = "wb_speaker_is_sound_playing"
+    dev = current().device(tag, SPEAKER, func)
+    if sound is not None and not isinstance(sound, str):
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'sound' must be a string or None, got {sound!r}")
     mine = _sounds(dev)
     if not sound:
         return dev.desc.get("_speech") is not None or any(k[2] for k in mine.values())
@@ -213,6 +232,9 @@ def wb_speaker_speak(tag: int, text: str, volume: float) -> None:
     if not isinstance(text, str):
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'text' must be a string, got {text!r}")
     x = _number(func, "volume", volume)
+    if math.isnan(x):                                    # the C library's line; nothing is spoken
+        _err(f"Error: {func}() called with an invalid argument (a NULL text or a NaN volume).")
+        return
     if x < 0.0:
         _err(f"Warning: {func}() called with negative volume value: {x:g}. Setting volume to 0.")
         x = 0.0

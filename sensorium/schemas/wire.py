@@ -104,6 +104,9 @@ def unpack(data: bytes | bytearray | memoryview, max_size: int | None = SOFT_LIM
             max_str_len=n, max_bin_len=n, max_array_len=n, max_map_len=n,
             max_ext_len=0,
         )
+    except UnicodeDecodeError as exc:             # a C caller's Latin-1 file name, say: a well-formed document
+        raise WireError(f"a string in the message is not UTF-8 text (at "
+                        f"{bytes(exc.object[max(0, exc.start - 30):exc.end])!r})") from None
     except (ValueError, OverflowError) as exc:   # every msgpack failure (ExtraData, StackError, ...)
         raise WireError(f"not a msgpack document: {type(exc).__name__}: {exc}".rstrip(": ")) from None
 

@@ -27,6 +27,7 @@ typedef struct sn_sound {
 
 static const char *const LANGUAGES[] = {"en-US", "en-UK", "de-DE", "es-ES", "fr-FR", "it-IT"};
 #define N_LANGUAGES (sizeof LANGUAGES / sizeof LANGUAGES[0])
+#define MAX_PITCH 1e9 /* the greatest pitch the server takes (wb_speaker.py MAX_PITCH) */
 
 static sn_sound *find(sn_device *d, const char *name) {
   for (sn_sound *s = d->sounds; s != NULL; s = s->next)
@@ -64,7 +65,8 @@ static int wav_length(const char *path, int64_t *frames, int64_t *rate) {
       have_fmt = 1;
       size -= 16;
     } else if (memcmp(c, "data", 4) == 0) {
-      if (!have_fmt || (channels != 1 && channels != 2) || (bits != 8 && bits != 16) || sample_rate == 0)
+      if (!have_fmt || (channels != 1 && channels != 2) || (bits != 8 && bits != 16) || sample_rate == 0 ||
+          sample_rate >= UINT32_C(1) << 31) /* a damaged header: the server takes rates below 2^31 */
         goto done;
       *frames = (int64_t)size / (int64_t)(channels * (bits / 8));
       *rate = sample_rate;
@@ -187,6 +189,11 @@ void wb_speaker_play_sound(WbDeviceTag left, WbDeviceTag right, const char *soun
   if (pitch < 0) {
     fprintf(stderr, "Warning: %s() called with a negative pitch value: %g. Setting pitch to 0.\n", func, pitch);
     pitch = 0;
+  }
+  if (pitch > MAX_PITCH) { /* ours: the server takes at most this (+inf too is clamped) */
+    fprintf(stderr, "Warning: %s() called with a pitch value greater than %g: %g. Setting pitch to %g.\n", func,
+            MAX_PITCH, pitch, MAX_PITCH);
+    pitch = MAX_PITCH;
   }
   if (balance < -1) {
     fprintf(stderr, "Warning: %s() called with a balance value less than -1: %g. Setting balance to -1.\n", func,
