@@ -146,6 +146,9 @@ def test_fields_are_read_in_the_parents_frame_and_refused_when_set():
     drive(lv, W, W, 10)
     assert get(LEFT_PARAMETERS, "position")["value"] == pytest.approx(W * 10 * DT, abs=1e-12)
     assert rover(lv, "get_from_id", {"id": FIRST_ID + 15})["type"] == ""         # past the last nested node
+    # a node id that is none says which ids there are, the nested ones too
+    msg = lv.err(A, "/rover/robot/get_node_pose", {"node": FIRST_ID + 15}, ErrorCode.INVALID_ARGUMENT)
+    assert msg.endswith(f"no node with id {FIRST_ID + 15} (ids 0..4: 0 the root, nested {FIRST_ID}..{FIRST_ID + 14})"), msg
 
 
 def test_world_poses_follow_the_robot_as_it_drives():

@@ -203,20 +203,27 @@ def robot_node(sim: Any, robot: str) -> Node | None:
     return next((n for n in _nodes(sim) if n.type == "Robot" and n.key == robot), None)
 
 
+def _known_ids(sim: Any) -> str:
+    """The node ids there are, for an error line: the top-level ones, then the nested ones."""
+    inner = len(_table(sim).nodes)
+    nested_ids = f", nested {nested.FIRST_ID}..{nested.FIRST_ID + inner - 1}" if inner else ""
+    return f"ids 0..{len(_all_nodes(sim))}: 0 the root{nested_ids}"
+
+
 def node_by_id(sim: Any, node: int) -> Node:
     if node == 0:
         return ROOT
     if node >= nested.FIRST_ID:
         inner = _table(sim).get(node)
         if inner is None:
-            raise ValueError(f"no node with id {node}")
+            raise ValueError(f"no node with id {node} ({_known_ids(sim)})")
         found = _nested_node(inner)
         if _removed(sim, found):
             raise ValueError(f"node {node} ({found.type} {found.name!r}) was removed with {inner.owner_key!r}")
         return found
     nodes = _all_nodes(sim)
     if not 0 <= node <= len(nodes):
-        raise ValueError(f"no node with id {node} (ids 0..{len(nodes)}: 0 the root)")
+        raise ValueError(f"no node with id {node} ({_known_ids(sim)})")
     found = nodes[node - 1]
     if _removed(sim, found):
         raise ValueError(f"node {node} ({found.type} {found.name or found.key!r}) was removed")
