@@ -40,13 +40,13 @@ def start_server(world: Path, tmp: Path, *extra: str) -> Served:
     return server
 
 
-def run_paused(world: Path, tmp: Path, script: str, robot: str) -> Proc:
-    """Serve ``world`` paused, run the controller ``tests/controllers/<script>`` on ``robot`` once
-    it is attached (the world then runs fast), and return its finished process (exit status 0
-    checked; its stdout in ``.out``)."""
+def run_paused(world: Path, tmp: Path, script: str, robot: str, env: dict[str, str] | None = None) -> Proc:
+    """Serve ``world`` paused, run the controller ``script`` (in ``tests/controllers/``, or a path:
+    a compiled one) on ``robot`` once it is attached (the world then runs fast), and return its
+    finished process (exit status 0 checked; its stdout in ``.out``)."""
     server = start_server(world, tmp, "--mode", "pause")
     try:
-        ctl = Proc(sensorium("controller", str(CONTROLLERS / script), "--url", server.url(robot)))
+        ctl = Proc(sensorium("controller", str(CONTROLLERS / script), "--url", server.url(robot)), env=env)
         try:
             server.wait_attached({robot})
             server.conn.call("set_mode", {"mode": "fast"})

@@ -15,9 +15,8 @@ import sys
 
 import numpy as np
 import pytest
-from _serve import Proc, sensorium
 from test_c_client import SAN_ENV, TESTS_C, sanitized_controller
-from test_multiprocess import REPO, run_paused, start_server
+from test_multiprocess import REPO, run_paused
 from test_supervisor import A, Live
 
 from sensorium.schemas.wire import ErrorCode
@@ -347,17 +346,7 @@ def test_a_webots_supervisor_walks_its_tree_past_the_joints_in_python(tmp_path):
 def test_a_webots_supervisor_walks_its_tree_past_the_joints_in_c(tmp_path, tmp_path_factory):
     """tests/c/tree_walker.c (AddressSanitizer/UBSan): the same walk and the same one line."""
     exe = sanitized_controller(tmp_path_factory, TESTS_C / "tree_walker.c")
-    server = start_server(WORLD, tmp_path, "--mode", "pause")
-    try:
-        ctl = Proc(sensorium("controller", exe, "--url", server.url("armbot")), env=SAN_ENV)
-        try:
-            server.wait_attached({"armbot"})
-            server.conn.call("set_mode", {"mode": "fast"})
-            assert ctl.wait(120) == 0, ctl.stderr()
-        finally:
-            ctl.kill()
-    finally:
-        server.stop()
+    ctl = run_paused(WORLD, tmp_path, exe, "armbot", env=SAN_ENV)        # (an absolute path: CONTROLLERS / exe is exe)
     assert [line.rstrip() for line in ctl.out[:-1]] == [w.rstrip() for w in WALK]
     assert ctl.out[-1] == "boundingObject None"
     (line,) = _no_field_lines(ctl.stderr())
