@@ -19,7 +19,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import radar as rmath
 from sensorium.server.devices import recognition as geo
 from sensorium.server.raycast.engine import RayKind
-from sensorium.server.sim.recognition import shape_kind
+from sensorium.server.sim.recognition import link_of, part_pose, shape_kind, shape_part
 from sensorium.server.sim.scene import TargetKey
 from sensorium.server.sim.sensors import Device
 
@@ -85,11 +85,9 @@ class Radar(Device):
         if parts is None:
             shapes = scene.target_shapes(key)
             bounding = [i for i in shapes if scene.part(i)[2].seen_by in ("both", "bounding")]
-            placed = ((i if scene.on_link(i) else -1, scene.part(i)[1],
-                       *shape_kind(scene.part(i)[2].geometry, scene.base_dir)) for i in bounding)
-            boxes = tuple(p for p in placed if p[2] != "unbounded")
+            boxes = tuple(p for p in (shape_part(scene, i) for i in bounding) if p[2] != "unbounded")
             spheres = () if bounding else tuple(
-                (i if scene.on_link(i) else -1, scene.part(i)[1], *sphere)
+                (link_of(scene, i), scene.part(i)[1], *sphere)
                 for i in shapes if (sphere := geometry_sphere(scene.part(i)[2].geometry, scene.base_dir)) is not None)
             parts = self._parts[key] = (boxes, spheres, frozenset(shapes))
         return parts
@@ -108,7 +106,7 @@ class Radar(Device):
             return (local, 0.0) if rmath.in_frustum(local, self._frustum) else None
         lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
         for link, local_pose, kind, params, points in boxes:
-            pose = (owner if link < 0 else scene.carrier(link)).compose(local_pose)   # on a joint: where it put it
+            pose = part_pose(scene, owner, link, local_pose)
             _, seen = geo.clipped_bounds(kind, params, inverse @ pose.rotation,
                                          inverse @ (pose.translation - radar.translation), points, self._frustum)
             if seen is not None:
@@ -126,7 +124,7 @@ class Radar(Device):
         to_target = at.inverse()
         centre, radius = np.zeros(3), 0.0
         for link, local_pose, c, r in spheres:
-            pose = (owner if link < 0 else scene.carrier(link)).compose(local_pose)
+            pose = part_pose(scene, owner, link, local_pose)
             centre, radius = rmath.enclose_sphere(centre, radius, to_target.apply(pose.apply(c)), r)
         local = inverse @ (at.apply(centre) - radar.translation)
         seen = geo.clip_round(local - radius, local + radius, self._frustum)

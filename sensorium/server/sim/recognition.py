@@ -93,6 +93,24 @@ def shape_kind(g: Any, base_dir: Any) -> tuple[str, tuple, np.ndarray | None]:
     return "points", (), np.asarray(primitive_from_model(g, base_dir).vertices, dtype=np.float64)
 
 
+def link_of(scene: Any, shape: int) -> int:
+    """The shape itself when it rides on a joint's link (``Scene.carrier`` places it then), else -1:
+    the first entry of the parts an object's or radar target's box is read from."""
+    return shape if scene.on_link(shape) else -1
+
+
+def shape_part(scene: Any, shape: int) -> tuple:
+    """A shape as an object's box is read from it: (:func:`link_of`, its pose in its owner's frame,
+    kind, params, points)."""
+    return (link_of(scene, shape), scene.part(shape)[1], *shape_kind(scene.part(shape)[2].geometry, scene.base_dir))
+
+
+def part_pose(scene: Any, owner: Pose, link: int, local: Pose) -> Pose:
+    """A part's pose now: ``local`` in its owner's frame (``owner``, its pose now), on a joint's
+    link where the joint has put it."""
+    return (owner if link < 0 else scene.carrier(link)).compose(local)
+
+
 def occlusion_ray(cam: Pose, centre: np.ndarray) -> tuple[np.ndarray, float] | None:
     """The occlusion ray (world direction, length) from the camera at ``cam`` to a camera-frame
     point, None when the point is the camera's own place (seen)."""
@@ -124,8 +142,7 @@ class Recognizer:
                 continue
             shapes = by_owner.get(key, [])
             bounding = [i for i in shapes if scene.part(i)[2].seen_by in ("both", "bounding")]
-            parts = tuple((i if scene.on_link(i) else -1, scene.part(i)[1],
-                           *shape_kind(scene.part(i)[2].geometry, scene.base_dir)) for i in (bounding or shapes))
+            parts = tuple(shape_part(scene, i) for i in (bounding or shapes))
             self.key_of[shapes] = len(objects)
             objects.append(_Object(key, node_id, tuple(colors), model, tuple(shapes), parts))  # type: ignore[arg-type]
         self.objects = objects
@@ -143,7 +160,7 @@ class Recognizer:
         for link, local, kind, params, points in obj.parts:
             if kind == "unbounded":
                 return None
-            pose = (owner if link < 0 else self.scene.carrier(link)).compose(local)   # on a joint: where it put it
+            pose = part_pose(self.scene, owner, link, local)
             rotation, centre = inv @ pose.rotation, inv @ (pose.translation - cam.translation)
             whole, b = rmath.clipped_bounds(kind, params, rotation, centre, points, self.frustum)
             if whole is None:
