@@ -331,6 +331,8 @@ def nested_radar_solids(solid: wm.Solid) -> list[tuple[Pose, float, range]]:
     those inside it): (pose in the top solid's frame, cross section, the indices of its shapes and of
     those of the solids inside it among the top solid's shapes, in ``solid_parts`` order)."""
     out: list[tuple[Pose, float, range]] = []
+    if not any(child.children or child.radar_cross_section > 0.0 for child in solid.children):
+        return out                                   # (most solids: no walk)
     count = 0
 
     def walk(s: wm.Solid, frame: Pose, nested: bool) -> None:
@@ -367,8 +369,7 @@ def radar_targets(world) -> dict[TargetKey, float]:
 def solid_radar_targets(solid: wm.Solid) -> dict[TargetKey, float]:
     """A top-level solid's radar targets: itself (cross section > 0), then the solids inside it."""
     out: dict[TargetKey, float] = {solid.name: float(solid.radar_cross_section)} if solid.radar_cross_section > 0.0 else {}
-    if any(child.children or child.radar_cross_section > 0.0 for child in solid.children):
-        out.update(((solid.name, k), rcs) for k, (_, rcs, _) in enumerate(nested_radar_solids(solid)))
+    out.update(((solid.name, k), rcs) for k, (_, rcs, _) in enumerate(nested_radar_solids(solid)))
     return out
 
 
@@ -478,10 +479,9 @@ class Scene:
 
     def _nested_targets(self, solid: wm.Solid) -> None:
         """The radar targets inside a top-level solid about to join the scene (its shapes come next)."""
-        if any(child.children or child.radar_cross_section > 0.0 for child in solid.children):
-            first = len(self.shapes)
-            for k, (frame, _, shapes) in enumerate(nested_radar_solids(solid)):
-                self.carried_targets[(solid.name, k)] = (frame, None, tuple(first + i for i in shapes))
+        first = len(self.shapes)
+        for k, (frame, _, shapes) in enumerate(nested_radar_solids(solid)):
+            self.carried_targets[(solid.name, k)] = (frame, None, tuple(first + i for i in shapes))
 
     def _shape_arrays(self) -> None:
         """The per-shape arrays devices index by hit shape (-1, no hit, reads the trailing entry)."""
