@@ -1488,6 +1488,7 @@ class Converter:
         if not wheels:
             return
         round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
+        rounded = {id(w): r for w, r in zip(wheels, round_)}       # read once: the fallback below asks again
         if len({id(w["node"]) for w in wheels}) == 1 or not any(round_):
             # one motorised hinge (Webots' motor sample: a turntable; motor2's one Hinge2Joint, its
             # two axes the joint's), or nothing round to roll on at
@@ -1543,7 +1544,7 @@ class Converter:
             # flipper) is no wheel, nor, that failing, one whose round part does not turn about its axis
             # (an arm's link of a plain cylinder, across the axis or off it): the drive is the wheels
             # without them, if they make one
-            for rolls, reason in ((lambda w: wheel_radius(w["end"], self) is not None,
+            for rolls, reason in ((lambda w: rounded[id(w)],
                                    "its end point has no cylinder or sphere to roll on"),
                                   (lambda w: rolls_about_its_axis(w, self),
                                    "nothing round at its end point turns about its axis as a wheel does")):
