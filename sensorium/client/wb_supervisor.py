@@ -314,6 +314,57 @@ def wb_supervisor_node_remove(node: int | None) -> None:
         print(f"Error: {func}(): {err.message}.", file=sys.stderr)
 
 
+def wb_supervisor_node_set_joint_position(node: int | None, position: float, index: int = 1) -> None:
+    """Webots' ``setJointPosition``: a joint node's axis ``index`` (1; a Hinge2Joint's 1 or 2, a
+    BallJoint's 1 to 3) at ``position`` (rad, or m) at once, with what rides on it; its motor then
+    targets that position (its multiplier and limits applied). A joint without a motor on that axis
+    does not move here (one line)."""
+    func = "wb_supervisor_node_set_joint_position"
+    r = _checked_node(node, func)
+    if r is None:
+        return
+    if isinstance(index, bool) or not isinstance(index, int) or index < 1:
+        print(f"Error: {func}() called with an invalid 'index'. Only values greater than or equal to 1 are "
+              "supported.", file=sys.stderr)
+        return
+    if isinstance(position, bool) or not isinstance(position, (int, float)) or not math.isfinite(position):
+        print(f"Error: {func}() called with a 'position' that is not a finite number: {position!r}.", file=sys.stderr)
+        return
+    _answer(r, "set_joint_position", {"node": int(node), "position": float(position),  # type: ignore[arg-type]
+                                      "index": min(index, 1 << 30)}, func)
+
+
+MAX_STATE_NAME = 1024
+"""The longest state name the server keeps (a longer one is refused with one line)."""
+
+
+def _node_state(node: Any, state_name: Any, item: str, func: str) -> None:
+    r = _checked_node(node, func)
+    if r is None:
+        return
+    if not isinstance(state_name, str):
+        print(f"Error: {func}() called with a NULL or invalid 'state_name' argument.", file=sys.stderr)
+        return
+    if len(state_name) > MAX_STATE_NAME:
+        print(f"Error: {func}() called with a 'state_name' of {len(state_name)} characters: at most "
+              f"{MAX_STATE_NAME} here.", file=sys.stderr)
+        return
+    _answer(r, item, {"node": int(node), "state": state_name}, func)
+
+
+def wb_supervisor_node_save_state(node: int | None, state_name: str) -> None:
+    """Keep the node's state under ``state_name``: a robot's pose and its joints' positions, a
+    top-level solid's pose, a nested node's joints (README "Supervisor"); at most 64 names per node."""
+    _node_state(node, state_name, "save_node_state", "wb_supervisor_node_save_state")
+
+
+def wb_supervisor_node_load_state(node: int | None, state_name: str) -> None:
+    """Put the node's state saved under ``state_name`` back (``"__init__"``: as the world loaded):
+    the pose bit for bit, each joint at its position with its motor holding it, LEDs off; the clock
+    keeps running. An unknown name is refused with one line, nothing changed."""
+    _node_state(node, state_name, "load_node_state", "wb_supervisor_node_load_state")
+
+
 _set_velocity_warned: list[bool] = []
 
 

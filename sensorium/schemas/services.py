@@ -320,6 +320,18 @@ class SetFieldArgs(Args):
         description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis x, y, z, angle")
 
 
+class SetJointPositionArgs(Args):
+    node: NodeId = Field(description="a joint node inside a robot: HingeJoint, SliderJoint, Hinge2Joint, BallJoint")
+    position: float = Field(description="the joint's new position (rad, or m on a slider): a finite number")
+    index: int = Field(default=1, ge=-(1 << 31), lt=1 << 31, description=(
+        "the joint's axis: 1 (HingeJoint, SliderJoint), 1 or 2 (Hinge2Joint), 1, 2 or 3 (BallJoint)"))
+
+
+class NodeStateArgs(Args):
+    node: NodeId = Field(description="a robot, a top-level solid, or a node inside one")
+    state: str = Field(max_length=1024, description="the state's name ('__init__': as the world loaded)")
+
+
 class ImportNodeArgs(Args):
     node: NodeId = Field(description="the node whose field takes the nodes: the root (0) here")
     field: FieldName = Field(description="its MFNode field: 'children'")
@@ -977,6 +989,9 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("remove_node", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("set_joint_position", "robot", SetJointPositionArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("save_node_state", "robot", NodeStateArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("load_node_state", "robot", NodeStateArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("import_node_from_string", "robot", ImportNodeArgs, IntArrayValue, attached=True, supervisor=True),
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),

@@ -28,6 +28,7 @@ from pydantic import ValidationError
 from sensorium.schemas import world as wm
 from sensorium.server.daemon import nested
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
+from sensorium.server.sim import states
 from sensorium.server.world.poses import matrix_quaternion
 from sensorium.server.world.top_nodes import Scenery
 
@@ -472,8 +473,21 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
     if parameters is not None:        # a motorised joint's (0: NULL), holding its position now
         out["jointParameters"] = ("SFNode", lambda sim, node: parameters, None)
     if n.motor:
-        out["position"] = ("SFFloat", lambda sim, node: nested.joint_position(sim, _nested_of(sim, node)), None)
+        out["position"] = ("SFFloat", lambda sim, node: nested.joint_position(sim, _nested_of(sim, node)),
+                           _set_parameter_position)
     return out
+
+
+def _set_parameter_position(sim: Any, node: Node, value: float) -> None:
+    """A joint's ``jointParameters.position`` set (WbHingeJoint/WbSliderJoint::updatePosition): the
+    joint is there at once, what rides on it with it; its motor keeps its target (Webots sets it only
+    before the robot's controller has configured its motors), so a motor holding a position brings
+    the joint back."""
+    n = _nested_of(sim, node)
+    robot = sim.robots[n.owner_key]
+    motor = robot.motors[n.motor]
+    motor.position = float(value)
+    sim.joints_moved(robot)
 
 
 def _fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
@@ -596,6 +610,99 @@ def _remove(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     return {"success": True}
 
 
+JOINT_AXES = {"HingeJoint": 1, "SliderJoint": 1, "Hinge2Joint": 2, "BallJoint": 3}
+"""Each joint type's axes, Webots' ``setJointPosition`` indices 1..n (its ``device``, ``device2``, ``device3``)."""
+_AXES_LINE = {1: "SliderJoint and HingeJoint only support index 1", 2: "Hinge2Joint only supports index 1 or 2",
+              3: "BallJoint only supports index 1, 2, or 3"}
+
+
+def _what(node: Node) -> str:
+    return f"{node.type} {node.def_name or node.name or str(node.key)!r} (node {node.id})"
+
+
+def set_joint_position(sim: Any, node: Node, position: float, index: int) -> list[str]:
+    """Webots' ``setJointPosition`` (WbJoint::setPosition): the joint's axis ``index`` at
+    ``position`` at once, what rides on it with it, the axis's motor targeting it (its
+    multiplier and limits applied: Webots' warning line returned when it clamps). A joint here moves
+    by its motor: an axis without one is refused (one line)."""
+    if index < 1:
+        raise ValueError("called with an invalid 'index'. Only values greater than or equal to 1 are supported")
+    axes = JOINT_AXES.get(node.type) if node.nested else None
+    if axes is None:
+        raise ValueError(f"called with a 'node' argument which is not a joint node ({_what(node)})")
+    if index > axes:
+        raise ValueError(f"called with an invalid 'index'. {_AXES_LINE[axes]}")
+    if not math.isfinite(position):
+        raise ValueError(f"'position' must be a finite number, got {position!r}")
+    n = _nested_of(sim, node)
+    field = ("device", "device2", "device3")[index - 1]
+    motor = next((c.device for c in _table(sim).by_parent.get(n.id, ())
+                  if c.field == field and c.type in nested.MOTORS and c.device), "")
+    robot = sim.robots.get(n.owner_key) if n.owner_kind == "Robot" else None
+    if robot is None or motor not in robot.motors:
+        raise ValueError(f"{_what(node)} has no motor on its axis {index} here: Sensorium moves a joint by its "
+                         "motor only (a joint without one stays where the world file puts it)")
+    line = robot.motors[motor].place(position)
+    sim.joints_moved(robot)
+    return [f"robot {robot.name!r}: wb_supervisor_node_set_joint_position(): {line}"] if line else []
+
+
+def _set_joint_position(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    return {"success": True, LOG: set_joint_position(sim, node_by_id(sim, a.node), a.position, a.index)}
+
+
+def _inside(table: nested.Table, n: nested.Nested) -> list[nested.Nested]:
+    """A nested node and every node inside it (children, end points, devices, parameters)."""
+    out, todo = [], [n]
+    while todo:
+        m = todo.pop()
+        out.append(m)
+        todo.extend(table.by_parent.get(m.id, ()))
+    return out
+
+
+def state_scope(sim: Any, node: Node) -> states.Scope:
+    """What ``saveState``/``loadState`` cover for a node: a robot's pose, joints and LEDs; a
+    top-level solid's pose; a node inside a robot, the joints and LEDs inside it (a node inside a
+    solid has nothing that moves here). The root, lights and the nodes not simulated are refused."""
+    what = _what(node)
+    if node.nested:
+        n = _nested_of(sim, node)
+        if n.owner_kind != "Robot":
+            return states.Scope(what)
+        robot = sim.robots[n.owner_key]
+        inside = _inside(_table(sim), n)
+        motors = tuple(dict.fromkeys(m.device or m.motor for m in inside if (m.device or m.motor) in robot.motors))
+        leds = tuple(m.device for m in inside if m.device in robot.devices and robot.devices[m.device].kind == "LED")
+        return states.Scope(what, robot=n.owner_key, motors=motors, leds=leds)
+    if node.type == "Robot":
+        robot = sim.robots[node.key]
+        leds = tuple(name for name, d in robot.devices.items() if d.kind == "LED")
+        return states.Scope(what, robot=node.key, own_pose=True, motors=tuple(robot.motors), leds=leds)
+    if node.type == "Solid" and not node.scenery:
+        return states.Scope(what, solid=str(node.key))
+    raise ValueError(f"{what} has no state here: robots, top-level solids and the nodes inside them have one")
+
+
+def _states(sim: Any) -> states.States:
+    kept = getattr(sim, "_node_states", None)
+    if kept is None:
+        kept = sim._node_states = states.States()
+    return kept
+
+
+def _save_state(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    node = node_by_id(sim, a.node)
+    _states(sim).save(sim, node.id, state_scope(sim, node), a.state)
+    return {"success": True}
+
+
+def _load_state(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    node = node_by_id(sim, a.node)
+    _states(sim).load(sim, node.id, state_scope(sim, node), a.state)
+    return {"success": True}
+
+
 def insert_index(position: int, count: int) -> int:
     """Webots' import position in a list of ``count`` nodes: 0 the first place, -1 after the last,
     -2 before the last, ...; a position past either end is the nearest end."""
@@ -655,6 +762,9 @@ HANDLERS = {
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},
     "remove_node": _remove,
+    "set_joint_position": _set_joint_position,
+    "save_node_state": _save_state,
+    "load_node_state": _load_state,
     "import_node_from_string": _import,
     "simulation_reset": _reset,
     "simulation_set_mode": _set_mode,

@@ -94,10 +94,11 @@ class JointMotor:
         for motor in (self, *self.coupled):
             motor._take_position(float(value), warn)
 
-    def _take_position(self, value: float, warn: bool) -> None:
+    def _take_position(self, value: float, warn: bool) -> str | None:
+        """Its target from a position asked for; Webots' warning line when it clamped it (None if not)."""
         if math.isinf(value):
             self.target_position = value
-            return
+            return None
         target = value * self.multiplier
         if self.limited:
             hi, lo = self.max_position, self.min_position
@@ -110,7 +111,28 @@ class JointMotor:
                 if warn:
                     print(line, file=sys.stderr)
                 target = min(max(target, lo), hi)
+            self.target_position = target
+            return line
         self.target_position = target
+        return None
+
+    def place(self, position: float) -> str | None:
+        """A Supervisor's ``setJointPosition`` (WbJoint::setPosition): the joint is at ``position``
+        at once, and this motor (not those coupled with it) targets it: ``position`` times its
+        multiplier, clamped to its limits (WbMotor::setTargetPosition), its speed 0. Returns Webots'
+        warning line when the target was clamped (the joint then moves back within the limits)."""
+        self.position = float(position)
+        self.speed = 0.0
+        self.rate = 0.0
+        return self._take_position(float(position), warn=False)
+
+    def restore(self, position: float) -> None:
+        """A loaded state (``loadState``: WbMotor::reset, then WbJoint::setPosition): the joint back at
+        ``position``, the motor targeting it as :meth:`place` does, at ``maxVelocity`` with its full
+        torque/force."""
+        self.velocity = self.max_velocity
+        self.available_force = self.max_force
+        self.place(position)
 
     def command(self, position: float | None, velocity: float | None, acceleration: float | None,
                 available_force: float | None) -> None:

@@ -70,6 +70,19 @@ class WheelMotor:
             raise ValueError(f"motor {self.name!r}: position must be a number or inf, got {value!r}")
         self.target_position = float(value)
 
+    def place(self, position: float) -> str | None:
+        """A Supervisor's ``setJointPosition``: the wheel (or steering) at ``position`` at once, its
+        motor holding it there (WbJoint::setPosition; a steering target within its limits): the
+        robot does not move for it. No warning line (None)."""
+        self.position = float(position)
+        self.set_position(position)
+        return None
+
+    def restore(self, position: float) -> None:
+        """A loaded state (``loadState``): at ``position``, holding it at ``maxVelocity``."""
+        self.velocity = self.max_velocity
+        self.place(position)
+
     def set_velocity(self, value: float) -> None:
         """Webots' ``setVelocity`` in the in-process API (:func:`velocity_accepted`), clamped to
         ``maxVelocity`` (WbMotor warns; the clients print that warning, this API clamps silently)."""

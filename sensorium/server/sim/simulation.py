@@ -294,6 +294,7 @@ class Simulation:
         self._initial: dict[str, Any] = {"robots": [(r.initial_pose, r.custom_data) for r in self.robots.values()],
                          "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights(),
                          "radar_targets": dict(self.scene.radar_targets)}
+        self._imported_poses: dict[str, Pose] = {}      # each imported solid's pose as imported
 
     def _warn_ground(self) -> None:
         """One GroundWarning per thing a driven robot will not ride on: a tilted terrain, a robot
@@ -351,8 +352,7 @@ class Simulation:
                 pose = robot.drive.placed(pose)
             for joint in robot.joints.values():
                 joint.reset()
-            if robot.move_links():
-                self._distance_plans.clear()
+            self.joints_moved(robot)
             self.place_robot(robot, pose)
             for dev in robot.devices.values():
                 if isinstance(dev, LED) and dev.value != 0:
@@ -370,11 +370,7 @@ class Simulation:
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
                 continue
-            self.scene.set_solid_pose(name, pose)
-            if self.contact is not None:
-                self.contact.update_solid(name, pose)
-            if self.ground is not None:
-                self.ground.update_solid(name, pose)
+            self.place_solid(name, pose)
         for kind, key in self.imported:         # Webots' reset removes the nodes a Supervisor imported
             if kind == "Solid" and key in self.scene.solid_poses:
                 self.remove_solid(str(key))
@@ -430,12 +426,27 @@ class Simulation:
         if name not in self.scene.solid_poses:
             raise KeyError(f"no solid {name!r}")
         check_pose(translation, rotation, quaternion)
-        pose = moved_pose(self.scene.solid_poses[name], translation, rotation, quaternion)
+        self.place_solid(name, moved_pose(self.scene.solid_poses[name], translation, rotation, quaternion))
+
+    def place_solid(self, name: str, pose: Pose) -> None:
+        """Put a top-level solid at ``pose`` (checked by the caller): the sensors, kinematic contact
+        and the terrains see it there from the next measurement."""
         self.scene.set_solid_pose(name, pose)
         if self.contact is not None:
             self.contact.update_solid(name, pose)
         if self.ground is not None:
             self.ground.update_solid(name, pose)
+
+    def initial_solid_pose(self, name: str) -> Pose:
+        """A top-level solid's pose as the world file (or its import) placed it."""
+        initial: dict[str, Pose] = self._initial["solids"]
+        return initial[name] if name in initial else self._imported_poses[name]
+
+    def joints_moved(self, robot: RobotState) -> None:
+        """A robot's joints were moved from outside (a reset, a Supervisor): what rides on them
+        follows, and the distance sensors' ray plans are made again when a device moved."""
+        if robot.move_links():
+            self._distance_plans.clear()
 
     def remove_solid(self, name: str) -> None:
         """Take a top-level solid out of the world for good (Webots' ``node.remove()``): from the
@@ -492,6 +503,7 @@ class Simulation:
                 solid = node.model
                 self.world.solids.append(solid)
                 self.scene.add_solid(solid, node_id, prep)
+                self._imported_poses[solid.name] = self.scene.solid_poses[solid.name]
                 if self.contact is not None:
                     pose = self.scene.solid_poses[solid.name]
                     self.contact.add_solid(solid.name, [(e.primitive, local, shape.seen_by in ("both", "bounding"))

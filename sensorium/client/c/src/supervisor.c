@@ -439,6 +439,105 @@ void wb_supervisor_node_remove(WbNodeRef node) {
   sn_reply_free(&rep);
 }
 
+typedef struct {
+  int64_t node;
+  double position;
+  int64_t index;
+} joint_args;
+
+static void args_joint(sn_req *r, const void *arg) {
+  const joint_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "position");
+  msgpack_pack_double(&r->pk, a->position);
+  sn_req_key(r, "index");
+  msgpack_pack_int64(&r->pk, a->index);
+}
+
+/* Webots' setJointPosition: the joint's axis index at position at once (what rides on it with it), the
+   axis's motor targeting it; Webots' checks of the index and node type first (libController's lines),
+   then the server's (a joint without a motor on that axis does not move here: its one line). */
+void wb_supervisor_node_set_joint_position(WbNodeRef node, double position, int index) {
+  const char *func = "wb_supervisor_node_set_joint_position";
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb == NULL)
+    return;
+  if (index < 1) {
+    fprintf(stderr, "Error: %s() called with an invalid 'index'. Only values greater than or equal to 1 are supported.\n",
+            func);
+    return;
+  }
+  int axes = node->type == WB_NODE_HINGE_JOINT || node->type == WB_NODE_SLIDER_JOINT ? 1
+             : node->type == WB_NODE_HINGE_2_JOINT                                  ? 2
+             : node->type == WB_NODE_BALL_JOINT                                     ? 3
+                                                                                    : 0;
+  static const char *const only[] = {"", "SliderJoint and HingeJoint only support index 1",
+                                     "Hinge2Joint only supports index 1 or 2", "BallJoint only supports index 1, 2, or 3"};
+  if (axes == 0) {
+    fprintf(stderr, "Error: %s() called with a 'node' argument which is not a joint node.\n", func);
+    return;
+  }
+  if (index > axes) {
+    fprintf(stderr, "Error: %s() called with an invalid 'index'. %s.\n", func, only[axes]);
+    return;
+  }
+  if (!isfinite(position)) {
+    fprintf(stderr, "Error: %s() called with a 'position' that is not a finite number: %g.\n", func, position);
+    return;
+  }
+  joint_args a = {node->id, position, index};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/set_joint_position", 3, args_joint, &a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
+#define MAX_STATE_NAME 1024 /* the longest state name the server keeps */
+
+typedef struct {
+  int64_t node;
+  const char *state;
+} state_args;
+
+static void args_state(sn_req *r, const void *arg) {
+  const state_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "state");
+  sn_req_str(r, a->state);
+}
+
+static void node_state(WbNodeRef node, const char *state_name, const char *item, const char *func) {
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb == NULL)
+    return;
+  if (state_name == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL 'state_name' argument.\n", func);
+    return;
+  }
+  size_t n = strlen(state_name);
+  if (n > MAX_STATE_NAME) {
+    fprintf(stderr, "Error: %s() called with a 'state_name' of %zu bytes: at most %d here.\n", func, n, MAX_STATE_NAME);
+    return;
+  }
+  state_args a = {node->id, state_name};
+  sn_reply rep;
+  if (sn_robot_call(rb, item, 2, args_state, &a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
+/* Webots' saveState: the node's state (a robot's pose and joints' positions, a top-level solid's pose,
+   a nested node's joints) kept under state_name; at most 64 names per node (the server's line beyond). */
+void wb_supervisor_node_save_state(WbNodeRef node, const char *state_name) {
+  node_state(node, state_name, "robot/save_node_state", "wb_supervisor_node_save_state");
+}
+
+/* Webots' loadState: the state saved under state_name put back ("__init__": as the world loaded); an
+   unknown name is refused with the server's one line, nothing changed. */
+void wb_supervisor_node_load_state(WbNodeRef node, const char *state_name) {
+  node_state(node, state_name, "robot/load_node_state", "wb_supervisor_node_load_state");
+}
+
 /* No physics: a robot moves by its wheels (which keep their commands), solids are static; a velocity
    set from outside has nothing to act on: one warning, ignored. */
 void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {

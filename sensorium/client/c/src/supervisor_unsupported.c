@@ -101,18 +101,6 @@ int wb_supervisor_node_get_number_of_base_node_fields(WbNodeRef node) {
   return -1;
 }
 
-void wb_supervisor_node_save_state(WbNodeRef node, const char *state_name) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_node_load_state(WbNodeRef node, const char *state_name) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_node_set_joint_position(WbNodeRef node, double position, int index) {
-  SN_UNSUPPORTED();
-}
-
 WbProtoRef wb_supervisor_node_get_proto(WbNodeRef node) {
   SN_UNSUPPORTED();
   return NULL;

@@ -214,6 +214,19 @@ class Node:
     def remove(self) -> None:
         wb.wb_supervisor_node_remove(self._ref)
 
+    def setJointPosition(self, position: float, index: int = 1) -> None:
+        """Webots' ``setJointPosition``: the joint (this node) at ``position`` on its axis ``index`` at
+        once, its motor targeting it (README "Supervisor": resets)."""
+        wb.wb_supervisor_node_set_joint_position(self._ref, position, index)
+
+    def saveState(self, stateName: str) -> None:  # noqa: N803
+        """Keep this node's state (pose, joints' positions) under ``stateName``."""
+        wb.wb_supervisor_node_save_state(self._ref, stateName)
+
+    def loadState(self, stateName: str) -> None:  # noqa: N803
+        """Put back the state saved under ``stateName`` (``"__init__"``: as the world loaded)."""
+        wb.wb_supervisor_node_load_state(self._ref, stateName)
+
     # -- contact points: Sensorium has no physics contacts, so a node touches nothing (as in the C client)
     def getContactPoints(self, includeDescendants: bool = False) -> list[ContactPoint]:  # noqa: N803
         return []
@@ -370,9 +383,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None),
         "exportString": ("node_export_string", ""),
         "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3),
-        "getStaticBalance": ("node_get_static_balance", False), "saveState": ("node_save_state", None),
-        "loadState": ("node_load_state", None),
-        "setJointPosition": ("node_set_joint_position", None),
+        "getStaticBalance": ("node_get_static_balance", False),
         "restartController": ("node_restart_controller", None), "moveViewpoint": ("node_move_viewpoint", None),
         "setVisibility": ("node_set_visibility", None), "addForce": ("node_add_force", None),
         "addForceWithOffset": ("node_add_force_with_offset", None), "addTorque": ("node_add_torque", None)},

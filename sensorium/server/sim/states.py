@@ -1,0 +1,119 @@
+"""Webots' ``saveState``/``loadState``: a node's state kept under a name, put back on demand (sans-IO).
+
+A node's state is what Webots' ``WbNode::save(id)`` keeps of the node and everything inside it, as
+far as Sensorium has it: the pose of a robot or top-level solid (a node inside one moves only with
+its joints), and the position of each joint in it (the joint motors' and a drive's wheels' and
+steering's). Loading a state puts each back: the pose bit for bit (a driven robot stops there, its
+GPS and radar speeds start over as after a jump), each joint at its saved position with its motor
+holding it there at ``maxVelocity`` with its full torque/force (WbMotor::reset, then
+WbJoint::setPosition), and the LEDs inside off (WbLed::reset). The clock keeps running.
+
+``"__init__"`` is every node's state as the world loaded (an imported solid's: as imported) until a
+Supervisor saves another under that name for that node. At most :data:`MAX_STATES` names are kept
+per node (overwriting one is always allowed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from sensorium.server.world.geometry import Pose
+
+INIT = "__init__"
+MAX_STATES = 64
+"""Saved state names per node (``__init__`` and overwritten names included in the count)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Scope:
+    """What of the simulation a node's state covers."""
+
+    what: str                     # the node, for error lines: ``robot 'rover'``, ``HingeJoint 'SHOULDER'``
+    robot: str | None = None      # the robot it is or is inside (None: a top-level solid or inside one)
+    solid: str | None = None      # the top-level solid it is (its pose is the state's)
+    own_pose: bool = False        # the robot's pose is the state's (the node is the robot)
+    motors: tuple[str, ...] = ()  # the robot's motors inside the node (joint motors, wheels, steering)
+    leds: tuple[str, ...] = ()    # the robot's LEDs inside the node
+
+
+@dataclass(frozen=True, slots=True)
+class State:
+    pose: Pose | None             # the robot's or solid's (None: the node has none of its own)
+    positions: tuple[float, ...]  # the joints' positions, in the scope's motor order
+
+
+class States:
+    """The states saved so far, per node id."""
+
+    def __init__(self, limit: int = MAX_STATES):
+        self.limit = limit
+        self._saved: dict[int, dict[str, State]] = {}
+
+    def names(self, node: int) -> list[str]:
+        return [INIT, *(n for n in self._saved.get(node, {}) if n != INIT)]
+
+    def save(self, sim: Any, node: int, scope: Scope, name: str) -> None:
+        saved = self._saved.setdefault(node, {})
+        if name not in saved and len(saved) >= self.limit:
+            raise ValueError(f"{scope.what} already has {self.limit} saved states, the most kept per node "
+                             f"here: save under one of its names again ({', '.join(list(saved)[:8])}, ...)")
+        saved[name] = _now(sim, scope)
+
+    def load(self, sim: Any, node: int, scope: Scope, name: str) -> None:
+        state = self._saved.get(node, {}).get(name)
+        if state is None:
+            if name != INIT:
+                shown = name if len(name) <= 64 else name[:64] + "..."
+                raise ValueError(f"{scope.what} has no saved state {shown!r} (saved: "
+                                 f"{', '.join(repr(n) for n in self.names(node)[:16])})")
+            state = _initial(sim, scope)
+        _restore(sim, scope, state)
+
+
+def _now(sim: Any, scope: Scope) -> State:
+    pose = None
+    if scope.solid is not None:
+        pose = sim.scene.solid_poses[scope.solid]
+    elif scope.own_pose:
+        robot = sim.robots[scope.robot]
+        drive = robot.drive
+        # a driven robot on a slope: its own pose (the ground's attitude is applied again on loading)
+        pose = drive.own_pose() if drive is not None and drive.slope is not None else robot.pose
+    motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
+    return State(pose, tuple(float(motors[m].position) for m in scope.motors))
+
+
+def _initial(sim: Any, scope: Scope) -> State:
+    pose = None
+    if scope.solid is not None:
+        pose = sim.initial_solid_pose(scope.solid)
+    elif scope.own_pose:
+        pose = sim.robots[scope.robot].initial_pose
+    motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
+    # a joint motor's initial position is the world file's; a wheel's angle starts at 0
+    return State(pose, tuple(float(getattr(motors[m], "initial_position", 0.0)) for m in scope.motors))
+
+
+def _restore(sim: Any, scope: Scope, state: State) -> None:
+    if scope.solid is not None and state.pose is not None:
+        sim.place_solid(scope.solid, state.pose)
+    if scope.robot is None:
+        return
+    robot = sim.robots[scope.robot]
+    for name, position in zip(scope.motors, state.positions):
+        robot.motors[name].restore(position)
+    sim.joints_moved(robot)
+    if scope.own_pose and state.pose is not None:
+        pose = state.pose
+        if robot.drive is not None:
+            robot.drive.reset(pose)
+            pose = robot.drive.placed(pose)
+        sim.place_robot(robot, pose)
+        for dev in robot.devices.values():
+            if dev.kind in ("GPS", "Radar"):       # no previous position: the next speeds are NaN
+                dev.restart()
+    for name in scope.leds:
+        led = robot.devices.get(name)
+        if led is not None and led.value != 0:
+            led.set(0, sim.time_ms)
