@@ -3,7 +3,8 @@ tests/test_fuzz_core.py): the Connector's lock/unlock/is_locked/enable, the Brak
 VacuumGripper's set_on, the Speaker's play_sound/stop/speak, a coupled motor pair's commands (its
 own services and a step's ``motors``) on tests/worlds/new_devices.yaml, and a Supervisor's services
 (get_field/set_field, SFNode jointParameters included, node poses and velocities, get_from_def/id,
-remove_node) on the nested nodes of tests/worlds/nested_joints.wbt and nested_nodes.wbt.
+remove_node, set_joint_position, save/load_node_state) on the nested nodes of
+tests/worlds/nested_joints.wbt and nested_nodes.wbt.
 
 Arguments are mostly the service's own names with malformed types, out-of-range values (NaN, inf,
 huge numbers, huge strings), missing or extra fields. Every request gets one well-formed reply;
@@ -156,8 +157,9 @@ GETTERS = {"get_field", "get_node_pose", "get_node_velocity", "get_from_def", "g
 @pytest.mark.parametrize(("world", "robot"), [("nested_joints.wbt", "armbot"), ("nested_nodes.wbt", "rover")])
 def test_supervisor_services_on_nested_nodes_answer_or_refuse_in_one_line(world: str, robot: str) -> None:
     """get_field and set_field (SFNode jointParameters included), get_node_pose/velocity, get_from_def
-    (DEF names, dotted paths, noise), get_from_id and remove_node on every node id and ids that are
-    none: one reply each; a refusal, or a getter's answer, changes nothing."""
+    (DEF names, dotted paths, noise), get_from_id, remove_node, set_joint_position and
+    save/load_node_state on every node id and ids that are none: one reply each; a refusal, or a
+    getter's answer, changes nothing."""
     f = Fuzzed(world)
     [reply] = send(f, "attach", {"robot": robot})
     assert reply["ok"], reply
@@ -178,6 +180,11 @@ def test_supervisor_services_on_nested_nodes_answer_or_refuse_in_one_line(world:
                   st.fixed_dictionaries({"node": node_ids})),
         st.tuples(st.just("get_from_def"), st.fixed_dictionaries({"name": names})),
         st.tuples(st.just("get_from_id"), st.fixed_dictionaries({"id": node_ids})),
+        st.tuples(st.just("set_joint_position"),
+                  st.fixed_dictionaries({"node": node_ids, "position": values | st.floats(-4.0, 4.0),
+                                         "index": st.integers(-1, 4) | values})),
+        st.tuples(st.sampled_from(["save_node_state", "load_node_state"]),
+                  st.fixed_dictionaries({"node": node_ids, "state": st.sampled_from(["__init__", "a", ""]) | values})),
         st.tuples(st.sampled_from(sorted(GETTERS)), st.dictionaries(st.sampled_from(["node", "id", "name", "field"]),
                                                                     values, max_size=3)))
 

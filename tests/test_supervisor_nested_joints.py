@@ -151,7 +151,7 @@ def test_a_slid_slider_moves_its_end_point_along_its_axis_and_joints_compose():
 
 def test_a_joints_parameters_hold_its_position_now():
     """A moving joint's jointParameters (SFNode): a HingeJointParameters / JointParameters node whose
-    ``position`` reads the joint's position, loaded then moved; read-only, as the other nested fields."""
+    ``position`` reads the joint's position, loaded then moved, and sets it."""
     arm = Arm()
 
     def parameters(joint: str) -> int:
@@ -174,9 +174,12 @@ def test_a_joints_parameters_hold_its_position_now():
     assert position(hinge)["value"] == HALF_PI
     assert position(slider)["value"] == SLIDE0 + D
     assert arm.call("get_field", {"node": arm.node("LINK"), "field": "jointParameters"})["type"] == ""
-    msg = arm.lv.err(A, "/armbot/robot/set_field", {"node": hinge, "field": "position", "value": 1.0},
-                     ErrorCode.INVALID_ARGUMENT)
-    assert "field 'position' (SFFloat) of HingeJointParameters" in msg and "read-only here" in msg
+    # settable, as in Webots: the joint is there at once (tests/test_supervisor_states.py)
+    arm.call("set_field", {"node": hinge, "field": "position", "value": 1.0})
+    assert position(hinge)["value"] == 1.0
+    msg = arm.lv.err(A, "/armbot/robot/set_field", {"node": arm.node("LINK"), "field": "translation",
+                                                    "value": [1.0, 0.0, 0.0]}, ErrorCode.INVALID_ARGUMENT)
+    assert "field 'translation' (SFVec3f) of Solid" in msg and "read-only here" in msg
     arm.lv.sim.reset()                      # a reset puts the joints back, and their positions
     assert position(hinge)["value"] == 0.0 and position(slider)["value"] == SLIDE0
 

@@ -120,6 +120,8 @@ def test_bad_joint_calls_get_webots_line_or_one_of_ours_and_change_nothing(tmp_p
                                                       {"node": arm.node(name), "position": 1.0, "index": 1})
     for bad in (math.nan, math.inf):
         refused(arm, "set_joint_position", {"node": arm.node("SHOULDER"), "position": bad, "index": 1})
+    msg = refused(arm, "set_joint_position", {"node": arm.node("SLIDE"), "position": 1e6, "index": 1})
+    assert "a joint's 'position' must be a finite number within ±100000, got 1000000.0" in msg
     assert arm.position("LINK") == before
     assert arm.lv.sim.robot("armbot").motor("shoulder").target_position == 0.0
 

@@ -483,6 +483,7 @@ def _set_parameter_position(sim: Any, node: Node, value: float) -> None:
     joint is there at once, what rides on it with it; its motor keeps its target (Webots sets it only
     before the robot's controller has configured its motors), so a motor holding a position brings
     the joint back."""
+    check_joint_position(value)
     n = _nested_of(sim, node)
     robot = sim.robots[n.owner_key]
     motor = robot.motors[n.motor]
@@ -632,8 +633,7 @@ def set_joint_position(sim: Any, node: Node, position: float, index: int) -> lis
         raise ValueError(f"called with a 'node' argument which is not a joint node ({_what(node)})")
     if index > axes:
         raise ValueError(f"called with an invalid 'index'. {_AXES_LINE[axes]}")
-    if not math.isfinite(position):
-        raise ValueError(f"'position' must be a finite number, got {position!r}")
+    check_joint_position(position)
     n = _nested_of(sim, node)
     field = ("device", "device2", "device3")[index - 1]
     motor = next((c.device for c in _table(sim).by_parent.get(n.id, ())
@@ -645,6 +645,14 @@ def set_joint_position(sim: Any, node: Node, position: float, index: int) -> lis
     line = robot.motors[motor].place(position)
     sim.joints_moved(robot)
     return [f"robot {robot.name!r}: wb_supervisor_node_set_joint_position(): {line}"] if line else []
+
+
+def check_joint_position(position: float) -> None:
+    """A joint position a Supervisor sets: finite, within ``MAX_COORDINATE_M`` (m or rad: a slider's
+    end point stays where a pose set at run time may be)."""
+    if not (math.isfinite(position) and abs(position) <= MAX_COORDINATE_M):
+        raise ValueError(f"a joint's 'position' must be a finite number within ±{MAX_COORDINATE_M:g}, "
+                         f"got {position!r}")
 
 
 def _set_joint_position(sim: Any, ls: Any, robot: str, a: Any) -> dict:
