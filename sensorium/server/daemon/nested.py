@@ -14,7 +14,7 @@ composed with the node's frame in the owner as the world loaded, moved by the jo
 node inside a moving joint's end point (the end point Solid, what that Solid holds, a device riding
 the joint) is where the joint's link has put it (sim/joints.py ``Links``: the joints' displacements
 composed outward), read when a Supervisor asks, never computed otherwise. Its fields are read-only
-here: ``translation``/``rotation`` (in its parent's frame: an end point's follow its joint, as
+here (but a joint's parameters' ``position``: supervisor.py): ``translation``/``rotation`` (in its parent's frame: an end point's follow its joint, as
 Webots' HingeJoint/SliderJoint set them), ``name`` (Solids and devices), ``children``, and a
 joint's ``endPoint`` and ``device`` fields (``end_point``, ``joint_devices``).
 """

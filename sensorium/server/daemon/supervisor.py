@@ -11,7 +11,8 @@ Shapes, geometries and lights carried by a solid or robot are not nodes here: We
 
 Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame. Setting one field
 keeps the others (Webots). A field change applies at once; the next measurement sees it. A nested
-node's fields are read-only here.
+node's fields are read-only here, but a joint's parameters' ``position``. A joint is set with
+``set_joint_position``; a node's state is saved and loaded by name (sim/states.py).
 """
 
 from __future__ import annotations
