@@ -232,6 +232,16 @@ def test_a_solids_state_is_its_pose(pioneer):
     assert live.sim.scene.solid_poses["wall"].translation.tolist() == [3.0, 1.0, 0.25]
 
 
+def test_an_imported_solids_init_state_is_where_it_was_imported(pioneer):
+    live = pioneer
+    (box,) = live.ok(A, "/pioneer/robot/import_node_from_string", {
+        "node": 0, "field": "children", "position": -1,
+        "node_string": "DEF BOX Solid { translation 1 2 0.5 name \"box\" }"})["value"]
+    live.ok(A, "/pioneer/robot/set_field", {"node": box, "field": "translation", "value": [5.0, 5.0, 0.5]})
+    state(live, "load_node_state", box, "__init__")
+    assert live.sim.scene.solid_poses["box"].translation.tolist() == [1.0, 2.0, 0.5]
+
+
 def test_an_arms_state_holds_its_joints_and_a_joints_own_state_only_what_is_inside_it():
     arm = Arm()
     set_joint(arm, "SHOULDER", HALF_PI)
