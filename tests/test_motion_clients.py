@@ -1,5 +1,6 @@
-"""Motion files played over the wire: a Python controller (Webots' ``Motion`` class) and a C
-controller (``wbu_motion_*``, built with AddressSanitizer and UBSan) play our own files on the leg of
+"""Motion files played over the wire: a Python controller (Webots' ``Motion`` class), a C controller
+(``wbu_motion_*``) and a C++ one (``webots::Motion``), both built with AddressSanitizer and UBSan,
+play our own files on the leg of
 tests/worlds/motion.yaml. The motors' target positions at each simulated time are the closed-form
 linear interpolation (forwards, in a loop with a second motion beside it, in reverse); the hip's
 sensor follows; a file that is not there, a damaged one and one naming motors the robot lacks print one line
@@ -7,13 +8,15 @@ each and the controller runs on; both clients print the same bits and the same l
 
 from __future__ import annotations
 
+import shutil
 import struct
+import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 from _serve import run_controller
-from test_c_client import SAN_ENV, TESTS_C, sanitized_controller
+from test_c_client import CLIB, SAN_ENV, TESTS_C, _make, sanitized_controller
 from test_motion import BAD, WAVE
 
 REPO = Path(__file__).resolve().parents[1]
@@ -41,6 +44,22 @@ def folder(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def cplayer(tmp_path_factory) -> str:
     return sanitized_controller(tmp_path_factory, TESTS_C / "motion_player.c")
+
+
+@pytest.fixture(scope="module")
+def cppplayer(tmp_path_factory) -> str:
+    """tests/c/motion_cpp.cpp (webots::Motion) linked to the sanitized library."""
+    if sys.platform == "win32" or shutil.which("c++") is None:
+        pytest.skip("needs a POSIX C++ toolchain")
+    build = tmp_path_factory.mktemp("cppbuild")
+    _make(f"BUILD={build}", "SANITIZE=1")
+    exe = build / "motion_cpp"
+    done = subprocess.run(["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+                           f"-I{CLIB / 'include'}", str(TESTS_C / "motion_cpp.cpp"), "-o", str(exe),
+                           str(build / "libController.a"), *_make("libs").split()],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return str(exe)
 
 
 def _run(argv: list[str], env: dict[str, str] | None = None) -> tuple[list[str], str]:
@@ -125,3 +144,12 @@ def test_c_controller_plays_them_alike(folder, cplayer) -> None:
     py_lines, py_err = _run([sys.executable, "-m", "sensorium", "controller", str(PLAYER_PY), str(folder), *NAMES])
     assert c_lines == py_lines
     assert _motion_lines(c_err) == _motion_lines(py_err)
+
+
+def test_cpp_motion_class_plays_them_alike(folder, cppplayer) -> None:
+    lines, err = _run([cppplayer, str(folder)], env=SAN_ENV)
+    assert lines[0] == "absent 0"
+    assert f"Error: wbu_motion_new(): could not open '{folder}/absent.motion' file." in err
+    py_lines, _ = _run([sys.executable, "-m", "sensorium", "controller", str(PLAYER_PY), str(folder)])
+    assert lines[1:] == [line for line in py_lines if line.startswith(("wave ", "forward "))]
+    assert len(lines) == 2 + 33
