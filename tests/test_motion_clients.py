@@ -1,10 +1,10 @@
 """Motion files played over the wire: a Python controller (Webots' ``Motion`` class), a C controller
 (``wbu_motion_*``) and a C++ one (``webots::Motion``), both built with AddressSanitizer and UBSan,
-play our own files on the leg of
-tests/worlds/motion.yaml. The motors' target positions at each simulated time are the closed-form
-linear interpolation (forwards, in a loop with a second motion beside it, in reverse); the hip's
-sensor follows; a file that is not there, a damaged one and one naming motors the robot lacks print one line
-each and the controller runs on; both clients print the same bits and the same lines."""
+play our own files on the leg of tests/worlds/motion.yaml. The motors' target positions at each
+simulated time are the closed-form linear interpolation (forwards, in a loop with a second motion
+beside it, in reverse); the hip's sensor follows; a file that is not there, a damaged one and one
+naming motors the robot lacks print one line each and the controller runs on; the clients print the
+same bits and the same lines."""
 
 from __future__ import annotations
 

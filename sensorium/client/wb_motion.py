@@ -237,7 +237,9 @@ def _hooked() -> RobotClient:
     global _robot
     r = current()
     if r is not _robot:
-        _motions.clear()                 # motions of an earlier session drive nothing now
+        for m in _motions:               # motions of an earlier session drive nothing now
+            m.deleted = True
+        _motions.clear()
         _robot = r
         r.step_hooks.append(_step_all)
     return r
