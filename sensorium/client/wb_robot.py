@@ -279,6 +279,8 @@ class RobotClient:
         self._emitters = [d for d in self.devices if d.kind == EMITTER and d.simulated]
         self._displays = [d for d in self.devices if d.kind == "Display" and d.simulated]
         self.motor_commands: dict[str, dict[str, float]] = {}   # sent with the next step request
+        # called with each step's duration before its request is built (wb_motion's playing motions)
+        self.step_hooks: list[Callable[[int], None]] = []
         self._prefix = f"/{self.name}/"
         self.conn.start_heartbeat(self.session, self.heartbeat_ms, lost_after_s)
 
@@ -309,6 +311,8 @@ class RobotClient:
             self._warned_duration = True
             print(f"Warning: the step duration {duration} ms of robot {self.name!r} is not a multiple of the basic "
                   f"time step ({self.basic_time_step} ms); the server rounds it up.", file=sys.stderr)
+        for hook in self.step_hooks:
+            hook(duration)
         args: dict[str, Any] = {"duration": duration}
         if self.motor_commands:
             args["motors"], self.motor_commands = self.motor_commands, {}

@@ -248,6 +248,9 @@ typedef struct {
   sn_car car;
 } sn_robot;
 
+/* The playing motions set their motors' target positions for their current time, then move it on
+ * by millis (motion.c; wb_robot_step_begin calls it before building the step request). */
+void sn_motion_step_all(int millis);
 /* The process's robot; exits with a message if wb_robot_init() was not called. */
 sn_robot *sn_robot_get(const char *func);
 /* The device of tag if it is of kind (SN_OTHER: any), else prints Webots' error and returns NULL. */

@@ -556,6 +556,7 @@ int wb_robot_step_begin(int duration) {
     fprintf(stderr, "Warning: the step duration %d ms of robot '%s' is not a multiple of the basic time step (%d ms); "
             "the server rounds it up.\n", duration, rb->name, rb->basic_time_step);
   }
+  sn_motion_step_all(duration); /* the playing motions set their motors' positions (motion.c) */
   int motors = 0, emitters = 0;
   for (int i = 0; i < rb->n_devices; i++) {
     motors += rb->devices[i].kind == SN_MOTOR && (rb->devices[i].cmd_position || rb->devices[i].cmd_velocity ||

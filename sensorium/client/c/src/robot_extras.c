@@ -1,5 +1,5 @@
 /* Sensorium C controller library: what Webots' robot API offers beyond the simulation (paths, URDF,
- * threads and mutexes, deprecated names) and the motion-file player, which has no joints to move. */
+ * threads and mutexes, deprecated names). */
 #define _POSIX_C_SOURCE 200809L
 #include <pthread.h>
 #include <stdio.h>
@@ -8,7 +8,6 @@
 #include <webots/device.h>
 #include <webots/plugins/robot_window/robot_wwi.h>
 #include <webots/robot.h>
-#include <webots/utils/motion.h>
 
 #include "internal.h"
 
@@ -119,43 +118,4 @@ void wb_robot_mutex_delete(WbMutexRef mutex) {
     pthread_mutex_destroy((pthread_mutex_t *)mutex);
     free(mutex);
   }
-}
-
-/* ------------------------------------------------------------------ motion files */
-
-WbMotionRef wbu_motion_new(const char *filename) {
-  static bool warned = false;
-  if (!warned) {
-    warned = true;
-    fprintf(stderr, "Warning: wbu_motion_new(\"%s\"): Sensorium does not play motion files (no joints to animate).\n",
-            filename ? filename : "");
-  }
-  return NULL;
-}
-void wbu_motion_delete(WbMotionRef motion) { (void)motion; }
-void wbu_motion_play(WbMotionRef motion) { (void)motion; }
-void wbu_motion_stop(WbMotionRef motion) { (void)motion; }
-void wbu_motion_set_loop(WbMotionRef motion, bool loop) {
-  (void)motion;
-  (void)loop;
-}
-void wbu_motion_set_reverse(WbMotionRef motion, bool reverse) {
-  (void)motion;
-  (void)reverse;
-}
-bool wbu_motion_is_over(WbMotionRef motion) {
-  (void)motion;
-  return true;
-}
-int wbu_motion_get_duration(WbMotionRef motion) {
-  (void)motion;
-  return -1;
-}
-int wbu_motion_get_time(WbMotionRef motion) {
-  (void)motion;
-  return -1;
-}
-void wbu_motion_set_time(WbMotionRef motion, int time) {
-  (void)motion;
-  (void)time;
 }

@@ -1,48 +1,50 @@
-"""Webots' ``Motion`` class (a ``.motion`` file played on a robot's motors). Sensorium's robots have
-no joints to animate: a motion loads nothing and never plays (one warning), its getters answer
-Webots' "no value"."""
+"""Webots' ``Motion`` class: a ``.motion`` file played on the robot's motors, one pose interpolation
+per ``robot.step`` (:mod:`sensorium.client.wb_motion`). A file that cannot be read or is damaged
+prints one line and gives a motion whose ``isValid()`` is False; dropping the object deletes the
+motion (it stops playing), as in Webots."""
 
 from __future__ import annotations
 
-import sys
+import os
+
+from sensorium.client import wb_motion
 
 
 class Motion:
-    _warned = False
+    def __init__(self, filename: str | os.PathLike[str]):
+        self._ref = wb_motion.wbu_motion_new(filename)
 
-    def __init__(self, filename: str):
-        self.filename = filename
-        if not Motion._warned:
-            Motion._warned = True
-            print(f"Warning: Motion({filename!r}): Sensorium does not play motion files (no joints to animate).",
-                  file=sys.stderr)
+    def __del__(self) -> None:
+        ref, self._ref = getattr(self, "_ref", None), None
+        if ref is not None:
+            wb_motion.wbu_motion_delete(ref)
 
     def isValid(self) -> bool:
-        return False
+        return self._ref is not None
 
     def play(self) -> None:
-        pass
+        wb_motion.wbu_motion_play(self._ref)
 
     def stop(self) -> None:
-        pass
+        wb_motion.wbu_motion_stop(self._ref)
 
     def setLoop(self, loop: bool) -> None:
-        pass
+        wb_motion.wbu_motion_set_loop(self._ref, loop)
 
     def setReverse(self, reverse: bool) -> None:
-        pass
+        wb_motion.wbu_motion_set_reverse(self._ref, reverse)
 
     def isOver(self) -> bool:
-        return True
+        return wb_motion.wbu_motion_is_over(self._ref)
 
     def getDuration(self) -> int:
-        return -1
+        return wb_motion.wbu_motion_get_duration(self._ref)
 
     def getTime(self) -> int:
-        return -1
+        return wb_motion.wbu_motion_get_time(self._ref)
 
     def setTime(self, time: int) -> None:
-        pass
+        wb_motion.wbu_motion_set_time(self._ref, time)
 
     duration = property(getDuration)
     time = property(getTime, setTime)

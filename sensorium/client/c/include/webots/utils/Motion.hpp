@@ -1,6 +1,6 @@
-// Sensorium C++ controller layer: Motion over utils/motion.h. Sensorium's robots have no joints to
-// animate: a motion file never loads (isValid() is false) and the other functions answer Webots'
-// "no value" (isOver() true, durations and times -1).
+// Sensorium C++ controller layer: Motion over utils/motion.h: a .motion file played on the robot's
+// motors, one pose interpolation per step; a file that cannot be read or is damaged prints one line
+// and gives a motion whose isValid() is false.
 #ifndef WEBOTS_MOTION_HPP
 #define WEBOTS_MOTION_HPP
 

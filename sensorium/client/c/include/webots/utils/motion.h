@@ -1,6 +1,7 @@
-/* Sensorium C controller library: Webots' motion files (utils/motion.h). Sensorium's robots have no
- * joints to animate: wbu_motion_new loads nothing and answers NULL (one warning); the other functions
- * accept NULL and answer Webots' "no value" (is_over: true, times and durations: -1). */
+/* Sensorium C controller library: Webots' motion files (utils/motion.h), played client side on the
+ * robot's motors, one pose interpolation per wb_robot_step (src/motion.c). wbu_motion_new prints one
+ * line and answers NULL for a file it cannot read or a damaged one; the other functions print
+ * Webots' line for NULL and answer its "no value" (is_over: false, times and durations: -1). */
 #ifndef WBU_MOTION_H
 #define WBU_MOTION_H
 
