@@ -17,6 +17,7 @@ a quaternion.
 from __future__ import annotations
 
 import math
+import posixpath
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -515,12 +516,8 @@ class Converter:
                 self.visit(child, inner, owner)
         elif t == "Shape":
             self.shape(node, frame, owner, seen_by="visual")
-        elif t == "CadShape":     # a visual mesh file (its own materials are not read: seen white)
-            urls = f.strings("url")
-            if urls:
-                mesh = Node("Mesh", {"url": urls[:1]}, node.line, node.col, source=node.source)
-                self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
-                           seen_by="visual")
+        elif t == "CadShape":     # a visual mesh file with its own materials (COLLADA's read)
+            self.cad_shape(node, frame, owner)
         elif t in LIGHTS:
             self.light(node, frame, owner)
         elif t == "Robot":
@@ -663,6 +660,73 @@ class Converter:
         self.ride(part)
         owner.parts.append(part)
 
+    def cad_shape(self, node: Node, frame: Frame, owner: Owner) -> None:
+        """A CadShape: its file as a visual mesh. A COLLADA file gives one shape per material its
+        triangles use (a Mesh of that materialIndex), seen in the material's diffuse colour, or its
+        diffuse texture through the file's texture coordinates (the image's path is relative to the
+        .dae, as in Webots); other files (their materials not read here) are seen white."""
+        urls = self.fields(node).strings("url")
+        if not urls:
+            return
+        url = urls[0].replace("\\", "/")
+        materials = self.dae_materials(node, url) if Path(url.split("?")[0]).suffix.lower() == ".dae" else None
+        if materials is None:
+            mesh = Node("Mesh", {"url": [url]}, node.line, node.col, source=node.source)
+            before = len(owner.parts)
+            self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
+                       seen_by="visual")
+            if len(owner.parts) > before:
+                owner.parts[-1]["_at"] = self.at(node)      # (a problem with its file names the CadShape)
+            return
+        where, found = materials
+        for index, m in found:
+            mesh = Node("Mesh", {"url": [url], "materialIndex": index}, node.line, node.col, source=node.source)
+            before = len(owner.parts)
+            self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
+                       seen_by="visual")
+            if len(owner.parts) == before:
+                return          # the file is lost (said once)
+            owner.parts[-1]["_at"] = self.at(node)
+            app: dict[str, Any] = {"base_color": list(m.diffuse), "transparency": m.transparency}
+            if m.texture is not None:
+                tex = m.texture.replace("\\", "/")
+                if tex.startswith("file://"):
+                    tex = tex[len("file://"):]
+                if where.is_absolute():       # a PROTO's or webots:// file: its image beside it, read only
+                    tex_url = str((where.parent / tex).resolve())
+                    if Path(tex_url).is_file():
+                        self.asset_files.add(Path(tex_url))
+                else:
+                    tex_url = posixpath.normpath(posixpath.join(posixpath.dirname(where.as_posix()), tex))
+                image = fx.image_texture(Node("ImageTexture", {"url": [tex_url]}, node.line, node.col,
+                                              source=node.source), self.source,
+                                         lambda _n, message: self.appearance_note(node, message))
+                if image is not None:
+                    app["texture"] = image
+            owner.parts[-1]["appearance"] = app
+
+    def dae_materials(self, node: Node, url: str) -> tuple[Path, list[tuple[int, Any]]] | None:
+        """(the file as the converted world names it, [(material index, DaeMaterial)] its triangles use)
+        of a CadShape's COLLADA file; None when it cannot be read here (then the Mesh it becomes says
+        why, as a loss or a problem naming the file)."""
+        from sensorium.server.world.dae import DaeError, read_dae
+        from sensorium.server.world.meshes import IN_PROCESS_BYTES
+
+        named, _ = self.asset(node, url)
+        if named is None:
+            return None
+        path = Path(named)
+        file = path if path.is_absolute() else Path(self.source).resolve().parent / path
+        try:
+            if file.stat().st_size > IN_PROCESS_BYTES:
+                self.warn_once(node, f"CadShape {url!r}: a COLLADA file larger than {IN_PROCESS_BYTES >> 20} MiB: "
+                                     "its materials are not read here (seen white)")
+                return None
+            dae = read_dae(str(file))
+        except (OSError, DaeError):
+            return None
+        return path, [(i, dae.materials[i]) for i in dae.used()]
+
     def bounding(self, node: Node | None, frame: Frame, owner: Owner) -> None:
         if node is None:
             return
@@ -780,7 +844,13 @@ class Converter:
             url, why = self.asset(node, urls[0].replace("\\", "/"))
             if url is None:
                 return None, why
-            return {"type": "mesh", "url": url, "scale": [s, s, s]}, ""
+            out = {"type": "mesh", "url": url, "scale": [s, s, s]}
+            if Path(url).suffix.lower() == ".dae":      # (Webots reads both for COLLADA files only)
+                if f.integer("materialIndex", -1) >= 0:
+                    out["material_index"] = f.integer("materialIndex", -1)
+                if f.string("name", ""):
+                    out["name"] = f.string("name", "")
+            return out, ""
         # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
         coord = f.node_("coord")
         points = self.fields(coord).rows("point", 3, []) if coord is not None else []
