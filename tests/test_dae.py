@@ -14,7 +14,7 @@ from PIL import Image
 from sensorium.cli import main
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world import meshes
-from sensorium.server.world.dae import read_dae
+from sensorium.server.world.cad import read_dae
 from sensorium.server.world.limits import WorldLimits
 from sensorium.server.world.loader import WorldError, load_world, parse_world
 
@@ -295,6 +295,19 @@ def test_a_large_dae_is_read_in_the_bounded_worker_with_the_same_triangles(tmp_p
         meshes.load_mesh(tmp_path / "bad.dae")
     with pytest.raises(meshes.MeshFileError, match=r"more than 5 triangles in its scene, the world's limit"):
         meshes.load_mesh(tmp_path / "cube.dae", (3.0, 3.0, 3.0), max_triangles=5)
+    # an OBJ file's faces of one material (a CadShape's) go through the same reader there
+    (tmp_path / "two.obj").write_text("mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                      "usemtl b\nf 1 2 3\nusemtl a\nf 1 3 4\nf 1 2 4\n")
+    (tmp_path / "two.mtl").write_text("newmtl a\nKd 1 0 0\nnewmtl b\nKd 0 1 0\n")
+    assert [len(meshes.load_mesh(tmp_path / "two.obj", material=i).faces) for i in (0, 1)] == [2, 1]
+    assert len(meshes.load_mesh(tmp_path / "two.obj").faces) == 3
+
+
+def test_a_dae_without_suffix_is_known_by_its_content(tmp_path: Path) -> None:
+    """Webots' asset cache names files by a hash, without a suffix."""
+    (tmp_path / "3f2a9c").write_text(cube_dae("Y_UP", 0.01))
+    assert meshes.mesh_format(tmp_path / "3f2a9c") == "dae"
+    assert meshes.load_mesh(tmp_path / "3f2a9c").vertices[:, 2].max() == pytest.approx(1.0)
 
 
 def test_fbx_stays_unread_and_said(tmp_path: Path) -> None:
@@ -302,3 +315,49 @@ def test_fbx_stays_unread_and_said(tmp_path: Path) -> None:
     p = wbt(tmp_path, 'Solid { name "s" children [ CadShape { url [ "part.fbx" ] } ] }\n')
     (loss,) = load_world(p).losses
     assert "the .fbx format is not read here" in loss.why
+
+
+# ------------------------------------------------------------------ OBJ + MTL materials (CadShape)
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_an_obj_cad_shape_takes_its_mtl_materials(tmp_path: Path, precision: str) -> None:
+    """A CadShape's OBJ file with an .mtl: one shape per material its faces use, Kd as the colour,
+    1 − d as the transparency, map_Kd (beside the file) through the file's vt; Kd multiplies the texel
+    (Webots' baseColor × baseColorMap)."""
+    (tmp_path / "img").mkdir()
+    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
+        tmp_path / "img" / "board.png")
+    (tmp_path / "two.obj").write_text("mtllib two.mtl\n"
+                                      "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\n"
+                                      "v 5 0 0\nv 6 0 0\nv 5 1 0\n"
+                                      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                      "usemtl red\nf 1/1 2/2 3/3\nusemtl tex\nf 1/1 3/3 4/4\n"
+                                      "usemtl glass\nf 5/1 6/2 7/3\n")
+    (tmp_path / "two.mtl").write_text("newmtl red\nKd 0.8 0.1 0.1\n\nnewmtl tex\nKd 0.5 0.5 0.5\n"
+                                      "map_Kd -s 1 1 1 img/board.png\nnewmtl glass\nKd 0.2 0.2 0.2\nd 0.4\n")
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "two.obj" ] } ] }\n'
+                      'Robot { name "r" children [\n'
+                      '  DistanceSensor { name "a" translation 0.3 -0.2 0.0625 rotation 0 1 0 1.5707963267948966 '
+                      'type "infra-red" lookupTable [ 0 0 0, 10 10000 0 ] }\n'
+                      '  DistanceSensor { name "b" translation -0.4 0.1 0.0625 rotation 0 1 0 1.5707963267948966 '
+                      'type "infra-red" lookupTable [ 0 0 0, 10 10000 0 ] } ] }\n')
+    w = load_world(p)
+    shapes = w.world.solids[0].shapes
+    assert [(s.geometry.material_index, s.appearance.base_color, s.appearance.transparency,
+             s.appearance.texture.url if s.appearance.texture else None) for s in shapes] == [
+        (0, (0.2, 0.2, 0.2), pytest.approx(0.6), None), (1, (0.8, 0.1, 0.1), 0.0, None),
+        (2, (0.5, 0.5, 0.5), 0.0, "img/board.png")]          # glass, red, tex: the names sorted
+    v = read_all(Simulation(w, precision=precision))
+    assert v["a"] == pytest.approx(expected(0.0625, 0.8), rel=1e-9)
+    # (x, y) = (-0.4, 0.1) → (s, t) = (0.1, 0.6) → column 0, row 1
+    assert v["b"] == pytest.approx(expected(0.0625, 0.5 * REDS[1, 0] / 255), rel=1e-9)
+
+
+def test_an_obj_without_materials_stays_one_white_mesh(tmp_path: Path) -> None:
+    """No .mtl (or one that is missing): the file as before, one mesh, white (as Webots draws it)."""
+    (tmp_path / "part.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    (tmp_path / "gone.obj").write_text("mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n")
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "part.obj" ] } CadShape { url [ "gone.obj" ] } ] }\n')
+    shapes = load_world(p).world.solids[0].shapes
+    assert [(s.geometry.url, s.geometry.material_index, s.appearance) for s in shapes] == [
+        ("part.obj", -1, None), ("gone.obj", -1, None)]

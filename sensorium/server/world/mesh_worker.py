@@ -8,8 +8,9 @@ reader fails (``MemoryError``) or the process dies, and the parent reports one l
 
 Run as ``python -I mesh_worker.py PATH SX SY SZ MEMORY_BYTES [FORMAT [MATERIAL NAME CAP]]`` (FORMAT:
 ``stl``, ``obj``, ``dae``, ...; by default the file's suffix; MATERIAL and NAME select a COLLADA file's
-triangles, as ``meshes.load_mesh``; CAP: the most triangles its scene may place, "" for dae.py's own). It imports numpy and trimesh, and for COLLADA ``dae.py`` by its
-path (numpy and pycollada), never the sensorium package. Reply on stdout: a 4-byte big-endian length and a JSON header — ``{"ok": true,
+triangles (an OBJ file's: MATERIAL), as ``meshes.load_mesh``; CAP: the most triangles its scene may
+place, "" for cad.py's own). It imports numpy and trimesh, and for those ``cad.py`` by its path
+(numpy, pycollada, trimesh), never the sensorium package. Reply on stdout: a 4-byte big-endian length and a JSON header — ``{"ok": true,
 "vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3 float64 and NF×3 int64 (native
 order), or ``{"ok": false, "kind": "memory" | "error", "error": "..."}``.
 """
@@ -29,12 +30,12 @@ def _reply(header, *arrays):
     out.flush()
 
 
-def _dae_module():
-    """``dae.py`` beside this file, loaded by its path (this process does not import sensorium)."""
+def _cad_module():
+    """``cad.py`` beside this file, loaded by its path (this process does not import sensorium)."""
     import importlib.util
     import os
 
-    spec = importlib.util.spec_from_file_location("_sensorium_dae", os.path.join(os.path.dirname(__file__), "dae.py"))
+    spec = importlib.util.spec_from_file_location("_sensorium_cad", os.path.join(os.path.dirname(__file__), "cad.py"))
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module          # (its dataclasses look their module up)
     spec.loader.exec_module(module)
@@ -50,15 +51,15 @@ def main():
         import numpy as np
         import trimesh
 
-        if kind == "dae":
-            dae = _dae_module()
-            material = int(sys.argv[7]) if len(sys.argv) > 7 else -1
+        material = int(sys.argv[7]) if len(sys.argv) > 7 else -1
+        if kind == "dae" or (kind == "obj" and material >= 0):
+            cad = _cad_module()
             name = sys.argv[8] if len(sys.argv) > 8 else ""
             cap = int(sys.argv[9]) if len(sys.argv) > 9 and sys.argv[9] else None
             try:
-                v, f, _ = dae.read_dae(path, cap).select(material, name)
-            except dae.DaeError as exc:
-                _reply({"ok": False, "kind": "dae", "error": str(exc)[:2000]})
+                v, f, _ = cad.read_cad(path, kind, cap).select(material, name)
+            except cad.CadError as exc:
+                _reply({"ok": False, "kind": "cad", "error": str(exc)[:2000]})
                 return
             vertices, faces = np.ascontiguousarray(v, dtype=np.float64), np.ascontiguousarray(f, dtype=np.int64)
         else:

@@ -1,4 +1,5 @@
-"""Mesh files (STL, OBJ, PLY, GLB via trimesh; COLLADA via :mod:`.dae`) → float64 triangle arrays.
+"""Mesh files (STL, OBJ, PLY, GLB via trimesh; COLLADA, and an OBJ file's faces of one material, via
+:mod:`.cad`) → float64 triangle arrays.
 
 Loaded meshes are cached by (resolved path, modification time, scale): validating a world and then
 building its scene reads each file once. A file larger than ``IN_PROCESS_BYTES`` is read in a
@@ -62,7 +63,8 @@ def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1
     ``memory``: what reading a large file may take (default ``DEFAULT_LOAD_MEMORY``);
     ``max_triangles``: refuse a larger mesh before its arrays are copied out of the worker;
     ``material``/``name``: a COLLADA file's triangles of that material index / geometry name only
-    (Webots' Mesh.materialIndex and Mesh.name; -1 and "": all)."""
+    (Webots' Mesh.materialIndex and Mesh.name; -1 and "": all); an OBJ file's of that material
+    (:mod:`.cad`'s numbering: a CadShape's materials)."""
     path = Path(path).resolve()
     shown = display if display is not None else str(path)
     if not path.is_file():
@@ -75,7 +77,7 @@ def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1
         raise MeshFileError(f"unsupported mesh format {path.suffix!r} (expected one of {sorted(SUPPORTED)})")
     try:
         stat = path.stat()
-        select = (int(material), str(name)) if kind == "dae" else (-1, "")
+        select = _selection(kind, material, name)
         key = (str(path), stat.st_mtime_ns, tuple(float(s) for s in scale), *select)
         mesh = _CACHE.get(key)
         if mesh is None:
@@ -89,6 +91,19 @@ def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1
         return mesh
     except MeshFileError as exc:
         raise MeshFileError(str(exc).replace(str(path), shown)) from None
+
+
+def _selection(kind: str, material: int, name: str) -> tuple[int, str]:
+    """The (material, geometry name) a file of ``kind`` is read by: COLLADA both, OBJ a material
+    (then through :mod:`.cad`), other formats neither."""
+    if kind == "dae":
+        return int(material), str(name)
+    return (int(material), "") if kind == "obj" and material >= 0 else (-1, "")
+
+
+def by_cad(kind: str, select: tuple[int, str]) -> bool:
+    """Whether a file of ``kind`` read by ``select`` is read through :mod:`.cad` (else trimesh)."""
+    return kind == "dae" or (kind == "obj" and select[0] >= 0)
 
 
 def mesh_format(path: Path) -> str | None:
@@ -142,13 +157,13 @@ def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: i
         return Mesh(vertices=vertices, faces=faces, closed=closed)
     import trimesh
 
-    if kind == "dae":
-        from sensorium.server.world.dae import DaeError, read_dae
+    if by_cad(kind, select):
+        from sensorium.server.world.cad import CadError, read_cad
 
         try:
-            vertices, faces, _ = read_dae(path, max_triangles).select(*select)
-        except DaeError as exc:
-            raise MeshFileError(f"cannot read COLLADA mesh {path}: {exc}") from None
+            vertices, faces, _ = read_cad(path, kind, max_triangles).select(*select)
+        except CadError as exc:
+            raise MeshFileError(f"cannot read {_FORMAT_NAMES[kind]} mesh {path}: {exc}") from None
         if len(faces) == 0:
             raise MeshFileError(f"mesh {path} has no triangles {_selected(select)}")
     else:
@@ -172,6 +187,9 @@ def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: i
     merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
     closed = bool(merged.is_watertight)
     return Mesh(vertices=np.ascontiguousarray(vertices), faces=np.ascontiguousarray(faces), closed=closed)
+
+
+_FORMAT_NAMES = {"dae": "COLLADA", "obj": "OBJ"}
 
 
 def _selected(select: tuple[int, str]) -> str:
@@ -232,9 +250,11 @@ def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
             raise MeshFileError(f"cannot read mesh {path}: reading it needs more than {limit} of memory "
                                 "(raise the limits with --allow-large)")
         if header.get("kind") == "no triangles":
-            raise MeshFileError(f"mesh {path} has no triangles" + (f" {_selected(select)}" if kind == "dae" else ""))
-        if header.get("kind") == "dae":
-            raise MeshFileError(f"cannot read COLLADA mesh {path}: {header.get('error', '?')}")
+            raise MeshFileError(f"mesh {path} has no triangles"
+                                + (f" {_selected(select)}" if kind is not None and by_cad(kind, select) else ""))
+        if header.get("kind") == "cad":
+            raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind or '', '')} mesh {path}: "
+                                f"{header.get('error', '?')}")
         raise MeshFileError(f"cannot read mesh {path}: {header.get('error', '?')}")
     if not np.isfinite(vertices).all():
         raise MeshFileError(f"mesh {path} has non-finite vertex coordinates")

@@ -510,17 +510,18 @@ def triangles_corner_uv(g: wm.Triangles) -> np.ndarray:
 def _mesh_file_uv(path: str, _mtime: int, material: int = -1, name: str = "") -> tuple[np.ndarray, np.ndarray,
                                                                                         np.ndarray]:
     """(vertices, faces, corner uv) of a mesh file as loaded for the scene (trimesh, unprocessed; a
-    COLLADA file through :mod:`.dae`, its ``material``/``name`` selection as the scene's):
+    COLLADA file, or an OBJ file's faces of one material, through :mod:`.cad`, selected as the scene's):
     the file's first UV set with ``v`` flipped (Webots' assimp ``FlipUVs``), ``(0.5, 0.5)`` for a
     file without UVs (WbMesh)."""
     import trimesh
 
-    from sensorium.server.world.meshes import mesh_format
+    from sensorium.server.world.meshes import by_cad, mesh_format
 
-    if mesh_format(Path(path)) == "dae":
-        from sensorium.server.world.dae import read_dae
+    kind = mesh_format(Path(path)) or ""
+    if by_cad(kind, (material, name)):
+        from sensorium.server.world.cad import read_cad
 
-        return read_dae(path).select(material, name)
+        return read_cad(path, kind).select(material, name)
 
     m = trimesh.load(path, force="mesh", process=False)
     vertices = np.asarray(m.vertices, dtype=np.float64)

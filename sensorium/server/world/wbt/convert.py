@@ -122,6 +122,7 @@ class Converter:
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
         self.instances: list[tuple[str, tuple[str, int, int]]] = []   # PROTO instances being walked (name, at)
         self.asset_files: set[Path] = set()   # asset files outside the world's folder this world may read
+        self.cad_meshes: set[int] = set()     # the Mesh nodes a CadShape's materials became (cad_shape)
         self.losses: list[Loss] = []      # robots, sensor devices and sensor-visible shapes lost (report.py)
         self.resets_said: set[str] = set()   # Webots' field resets told (a node USEd twice: once)
         # the nodes inside the robot being converted, as a Supervisor walks them (schemas.world.NestedNode):
@@ -661,15 +662,16 @@ class Converter:
         owner.parts.append(part)
 
     def cad_shape(self, node: Node, frame: Frame, owner: Owner) -> None:
-        """A CadShape: its file as a visual mesh. A COLLADA file gives one shape per material its
-        triangles use (a Mesh of that materialIndex), seen in the material's diffuse colour, or its
-        diffuse texture through the file's texture coordinates (the image's path is relative to the
-        .dae, as in Webots); other files (their materials not read here) are seen white."""
+        """A CadShape: its file as a visual mesh. A COLLADA file, or an OBJ file with .mtl materials,
+        gives one shape per material its triangles use (a Mesh of that material_index), seen in the
+        material's diffuse colour, or its diffuse texture through the file's texture coordinates (the
+        image's path is relative to the mesh file, as in Webots); other files are seen white."""
         urls = self.fields(node).strings("url")
         if not urls:
             return
         url = urls[0].replace("\\", "/")
-        materials = self.dae_materials(node, url) if Path(url.split("?")[0]).suffix.lower() == ".dae" else None
+        kind = Path(url.split("?")[0]).suffix.lower()[1:]
+        materials = self.cad_materials(node, url, kind) if kind in ("dae", "obj") else None
         if materials is None:
             mesh = Node("Mesh", {"url": [url]}, node.line, node.col, source=node.source)
             before = len(owner.parts)
@@ -681,6 +683,7 @@ class Converter:
         where, found = materials
         for index, m in found:
             mesh = Node("Mesh", {"url": [url], "materialIndex": index}, node.line, node.col, source=node.source)
+            self.cad_meshes.add(id(mesh))
             before = len(owner.parts)
             self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
                        seen_by="visual")
@@ -705,11 +708,11 @@ class Converter:
                     app["texture"] = image
             owner.parts[-1]["appearance"] = app
 
-    def dae_materials(self, node: Node, url: str) -> tuple[Path, list[tuple[int, Any]]] | None:
-        """(the file as the converted world names it, [(material index, DaeMaterial)] its triangles use)
-        of a CadShape's COLLADA file; None when it cannot be read here (then the Mesh it becomes says
-        why, as a loss or a problem naming the file)."""
-        from sensorium.server.world.dae import DaeError, read_dae
+    def cad_materials(self, node: Node, url: str, kind: str) -> tuple[Path, list[tuple[int, Any]]] | None:
+        """(the file as the converted world names it, [(material index, CadMaterial)] its triangles
+        use) of a CadShape's COLLADA or OBJ file; None when it cannot be read here (then the Mesh it
+        becomes says why, as a loss or a problem naming the file) or an OBJ file has no materials."""
+        from sensorium.server.world.cad import DEFAULT_MATERIAL, CadError, read_cad
         from sensorium.server.world.meshes import IN_PROCESS_BYTES
 
         named, _ = self.asset(node, url)
@@ -719,13 +722,16 @@ class Converter:
         file = path if path.is_absolute() else Path(self.source).resolve().parent / path
         try:
             if file.stat().st_size > IN_PROCESS_BYTES:
-                self.warn_once(node, f"CadShape {url!r}: a COLLADA file larger than {IN_PROCESS_BYTES >> 20} MiB: "
+                self.warn_once(node, f"CadShape {url!r}: a file larger than {IN_PROCESS_BYTES >> 20} MiB: "
                                      "its materials are not read here (seen white)")
                 return None
-            dae = read_dae(str(file))
-        except (OSError, DaeError):
+            cad = read_cad(str(file), kind)
+        except (OSError, CadError):
             return None
-        return path, [(i, dae.materials[i]) for i in dae.used()]
+        used = [(i, cad.materials[i]) for i in cad.used()]
+        if kind == "obj" and all(m.name == DEFAULT_MATERIAL for _, m in used):
+            return None         # no materials: the file as trimesh reads it, white
+        return path, used
 
     def bounding(self, node: Node | None, frame: Frame, owner: Owner) -> None:
         if node is None:
@@ -845,7 +851,8 @@ class Converter:
             if url is None:
                 return None, why
             out = {"type": "mesh", "url": url, "scale": [s, s, s]}
-            if Path(url).suffix.lower() == ".dae":      # (Webots reads both for COLLADA files only)
+            # Webots reads both for COLLADA files only; a CadShape's OBJ materials become Meshes of one material
+            if Path(url).suffix.lower() == ".dae" or id(node) in self.cad_meshes:
                 if f.integer("materialIndex", -1) >= 0:
                     out["material_index"] = f.integer("materialIndex", -1)
                 if f.string("name", ""):
