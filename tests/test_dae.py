@@ -361,3 +361,36 @@ def test_an_obj_without_materials_stays_one_white_mesh(tmp_path: Path) -> None:
     shapes = load_world(p).world.solids[0].shapes
     assert [(s.geometry.url, s.geometry.material_index, s.appearance) for s in shapes] == [
         ("part.obj", -1, None), ("gone.obj", -1, None)]
+
+
+def test_a_proto_and_a_webots_cad_shape_read_their_textures_beside_them(tmp_path: Path, monkeypatch) -> None:
+    """A PROTO's CadShape url is relative to the PROTO file, a webots:// one names the installation's
+    file; each material's image is relative to its .dae and read in place (read only), as the .dae."""
+    from _protos import proto_file, webots_home, world_file
+
+    quad = [[-0.1, -0.1, 0.0], [0.1, -0.1, 0.0], [0.1, 0.1, 0.0], [-0.1, 0.1, 0.0]]
+    home = webots_home(tmp_path / "webots", monkeypatch)
+    (home / "projects" / "meshes" / "tex").mkdir(parents=True)
+    Image.new("RGB", (4, 4), (51, 0, 0)).save(home / "projects" / "meshes" / "tex" / "dark.png")
+    (home / "projects" / "meshes" / "dark.dae").write_text(dae(
+        quad, [("m", [(0, 1, 2), (0, 2, 3)])], uv=[[0, 0], [1, 0], [1, 1], [0, 1]], materials={"m": ("d", "tex/dark.png")}))
+    protos = tmp_path / "project" / "protos"
+    (protos / "meshes").mkdir(parents=True)
+    Image.new("RGB", (4, 4), (153, 0, 0)).save(protos / "meshes" / "mid.png")
+    (protos / "meshes" / "mid.dae").write_text(dae(
+        quad, [("m", [(0, 1, 2), (0, 2, 3)])], uv=[[0, 0], [1, 0], [1, 1], [0, 1]], materials={"m": ("d", "mid.png")}))
+    proto_file(protos, "Tiles", """[ field SFString name "tiles" ]
+{ Solid { name IS name children [ CadShape { url [ "meshes/mid.dae" ] }
+    Pose { translation 0.5 0 0 children [ CadShape { url [ "webots://projects/meshes/dark.dae" ] } ] } ] } }""")
+    w = world_file(tmp_path / "project" / "worlds", """Tiles { }
+Robot { name "r" children [
+  DistanceSensor { translation 0 0 0.01 rotation 0 1 0 1.5707963267948966 name "a" type "infra-red" lookupTable [ 0 0 0, 1 1000 0 ] }
+  DistanceSensor { translation 0.5 0 0.01 rotation 0 1 0 1.5707963267948966 name "b" type "infra-red" lookupTable [ 0 0 0, 1 1000 0 ] } ] }
+""", ["../protos/Tiles.proto"])
+    loaded = load_world(w)
+    assert not [m for m in loaded.warnings if "texture" in m] and loaded.losses == ()
+    assert [p.appearance.texture.url for p in loaded.world.solids[0].shapes] == [
+        str((protos / "meshes" / "mid.png").resolve()), str((home / "projects/meshes/tex/dark.png").resolve())]
+    v = read_all(Simulation(loaded))
+    assert v["a"] == pytest.approx(1000 * 0.01 / (0.2 + 0.8 * 153 / 255), rel=1e-9)
+    assert v["b"] == pytest.approx(1000 * 0.01 / (0.2 + 0.8 * 51 / 255), rel=1e-9)
