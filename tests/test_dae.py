@@ -301,6 +301,13 @@ def test_a_large_dae_is_read_in_the_bounded_worker_with_the_same_triangles(tmp_p
     (tmp_path / "two.mtl").write_text("newmtl a\nKd 1 0 0\nnewmtl b\nKd 0 1 0\n")
     assert [len(meshes.load_mesh(tmp_path / "two.obj", material=i).faces) for i in (0, 1)] == [2, 1]
     assert len(meshes.load_mesh(tmp_path / "two.obj").faces) == 3
+    # a CadShape's materials are read there too
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "cube.dae" ] } CadShape { url [ "two.obj" ] } ] }\n')
+    assert [(s.geometry.url, s.geometry.material_index, s.appearance.base_color)
+            for s in load_world(p).world.solids[0].shapes] == [
+        ("cube.dae", 0, (0.5, 0.25, 1.0)), ("two.obj", 0, (1.0, 0.0, 0.0)), ("two.obj", 1, (0.0, 1.0, 0.0))]
+    with pytest.raises(meshes.MeshFileError, match=r"cannot read COLLADA mesh .*bad\.dae: XML Parsing Error"):
+        meshes.file_materials(tmp_path / "bad.dae", "dae")
 
 
 def test_a_dae_without_suffix_is_known_by_its_content(tmp_path: Path) -> None:

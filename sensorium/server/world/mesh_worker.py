@@ -9,7 +9,8 @@ reader fails (``MemoryError``) or the process dies, and the parent reports one l
 Run as ``python -I mesh_worker.py PATH SX SY SZ MEMORY_BYTES [FORMAT [MATERIAL NAME CAP]]`` (FORMAT:
 ``stl``, ``obj``, ``dae``, ...; by default the file's suffix; MATERIAL and NAME select a COLLADA file's
 triangles (an OBJ file's: MATERIAL), as ``meshes.load_mesh``; CAP: the most triangles its scene may
-place, "" for cad.py's own). It imports numpy and trimesh, and for those ``cad.py`` by its path
+place, "" for cad.py's own; MATERIAL -2: only the file's materials, ``{"ok": true, "materials": [[name,
+diffuse, transparency, texture], ...], "used": [index, ...]}``). It imports numpy and trimesh, and for those ``cad.py`` by its path
 (numpy, pycollada, trimesh), never the sensorium package. Reply on stdout: a 4-byte big-endian length and a JSON header — ``{"ok": true,
 "vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3 float64 and NF×3 int64 (native
 order), or ``{"ok": false, "kind": "memory" | "error", "error": "..."}``.
@@ -28,6 +29,9 @@ def _reply(header, *arrays):
     for a in arrays:
         out.write(memoryview(a).cast("B"))
     out.flush()
+
+
+MATERIALS_ONLY = -2      # MATERIAL: reply with the file's materials and the ones its triangles use, no arrays
 
 
 def _cad_module():
@@ -52,6 +56,16 @@ def main():
         import trimesh
 
         material = int(sys.argv[7]) if len(sys.argv) > 7 else -1
+        if material == MATERIALS_ONLY:
+            cad = _cad_module()
+            try:
+                read = cad.read_cad(path, kind)
+            except cad.CadError as exc:
+                _reply({"ok": False, "kind": "cad", "error": str(exc)[:2000]})
+                return
+            _reply({"ok": True, "materials": [[m.name, list(m.diffuse), m.transparency, m.texture]
+                                              for m in read.materials], "used": read.used()})
+            return
         if kind == "dae" or (kind == "obj" and material >= 0):
             cad = _cad_module()
             name = sys.argv[8] if len(sys.argv) > 8 else ""

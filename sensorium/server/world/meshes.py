@@ -200,6 +200,66 @@ def _selected(select: tuple[int, str]) -> str:
     return " ".join(said) if said else "in its scene"
 
 
+def file_materials(path: str | Path, kind: str, memory: int | None = None) -> tuple[list[Any], list[int]]:
+    """(materials, the indices its triangles use) of a COLLADA or OBJ file (:mod:`.cad`): a file over
+    ``IN_PROCESS_BYTES`` read by the worker within ``memory`` bytes (default ``DEFAULT_LOAD_MEMORY``).
+    MeshFileError: it cannot be read."""
+    from sensorium.server.world.cad import CadError, CadMaterial, read_cad
+
+    path = str(Path(path).resolve())
+    try:
+        size = Path(path).stat().st_size
+    except OSError as exc:
+        raise MeshFileError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
+    if size <= IN_PROCESS_BYTES:
+        try:
+            cad = read_cad(path, kind)
+        except CadError as exc:
+            raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind, '')} mesh {path}: {exc}") from None
+        return list(cad.materials), cad.used()
+    header = _worker_header(path, memory if memory is not None else DEFAULT_LOAD_MEMORY, kind, [str(MATERIALS_ONLY)])
+    if header is None or not header.get("ok"):
+        why = "its reader stopped" if header is None else header.get("error", "?")
+        raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind, '')} mesh {path}: {why}")
+    try:
+        materials = [CadMaterial(str(n), (float(d[0]), float(d[1]), float(d[2])), float(t),
+                                 None if x is None else str(x)) for n, d, t, x in header["materials"]]
+        used = [int(i) for i in header["used"] if 0 <= int(i) < len(materials)]
+    except (KeyError, TypeError, ValueError, IndexError):
+        raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind, '')} mesh {path}: a bad reply") from None
+    return materials, used
+
+
+MATERIALS_ONLY = -2       # (mesh_worker.MATERIALS_ONLY)
+
+
+def _worker_header(path: str, memory: int, kind: str, extra: list[str]) -> dict | None:
+    """Run :mod:`.mesh_worker` on ``path`` for a reply without arrays: its JSON header (None: it
+    stopped without one)."""
+    import json
+    import os
+    import struct
+    import subprocess
+    import sys
+
+    worker = Path(__file__).with_name("mesh_worker.py")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+    env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
+    proc = subprocess.Popen([sys.executable, "-I", str(worker), path, "1.0", "1.0", "1.0", str(memory), kind, *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=env,
+                            close_fds=True)
+    assert proc.stdout is not None
+    try:
+        head = proc.stdout.read(4)
+        header = json.loads(proc.stdout.read(struct.unpack(">I", head)[0])) if len(head) == 4 else None
+    except ValueError:       # (a reply that is not JSON)
+        header = None
+    finally:
+        proc.stdout.close()
+        proc.wait()
+    return header if isinstance(header, dict) else None
+
+
 def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
                     max_triangles: int | None = None, kind: str | None = None,
                     select: tuple[int, str] = (-1, "")) -> tuple[np.ndarray, np.ndarray, bool]:

@@ -712,8 +712,8 @@ class Converter:
         """(the file as the converted world names it, [(material index, CadMaterial)] its triangles
         use) of a CadShape's COLLADA or OBJ file; None when it cannot be read here (then the Mesh it
         becomes says why, as a loss or a problem naming the file) or an OBJ file has no materials."""
-        from sensorium.server.world.cad import DEFAULT_MATERIAL, CadError, read_cad
-        from sensorium.server.world.meshes import IN_PROCESS_BYTES
+        from sensorium.server.world.cad import DEFAULT_MATERIAL
+        from sensorium.server.world.meshes import MeshFileError, file_materials
 
         named, _ = self.asset(node, url)
         if named is None:
@@ -721,14 +721,10 @@ class Converter:
         path = Path(named)
         file = path if path.is_absolute() else Path(self.source).resolve().parent / path
         try:
-            if file.stat().st_size > IN_PROCESS_BYTES:
-                self.warn_once(node, f"CadShape {url!r}: a file larger than {IN_PROCESS_BYTES >> 20} MiB: "
-                                     "its materials are not read here (seen white)")
-                return None
-            cad = read_cad(str(file), kind)
-        except (OSError, CadError):
+            materials, indices = file_materials(file, kind)
+        except MeshFileError:
             return None
-        used = [(i, cad.materials[i]) for i in cad.used()]
+        used = [(i, materials[i]) for i in indices]
         if kind == "obj" and all(m.name == DEFAULT_MATERIAL for _, m in used):
             return None         # no materials: the file as trimesh reads it, white
         return path, used
