@@ -264,6 +264,23 @@ def test_a_damaged_dae_is_one_line_naming_the_file_and_validate_exits_1(tmp_path
     assert f"{p}: line 2, column 31 (CadShape, " in lines[0]
 
 
+def test_entity_bombs_and_external_entities_are_one_problem(tmp_path: Path) -> None:
+    """XML entities nested to a billion characters, or naming a file of the machine: one line, quickly."""
+    lol = '<?xml version="1.0"?>\n<!DOCTYPE COLLADA [\n<!ENTITY e0 "' + "a" * 80 + '">\n'
+    for i in range(1, 10):
+        lol += f'<!ENTITY e{i} "' + f"&e{i - 1};" * 10 + '">\n'
+    body = ('<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1"><asset><contributor>'
+            '<author>{}</author></contributor></asset></COLLADA>\n')
+    (tmp_path / "lol.dae").write_text(lol + "]>\n" + body.format("&e9;"))
+    (tmp_path / "xxe.dae").write_text('<?xml version="1.0"?>\n<!DOCTYPE COLLADA [<!ENTITY x SYSTEM "file:///etc/passwd">]>\n'
+                                      + body.format("&x;"))
+    for name in ("lol.dae", "xxe.dae"):
+        with pytest.raises(WorldError) as info:
+            parse_world({"solids": [{"name": "s", "geometry": {"type": "mesh", "url": name}}]}, base_dir=tmp_path)
+        (problem,) = info.value.problems
+        assert problem.message.startswith(f"cannot read COLLADA mesh {name}: ") and "root:" not in problem.message
+
+
 def test_validate_of_a_world_with_a_dae_cad_shape_exits_0(tmp_path: Path, capsys) -> None:
     (tmp_path / "cube.dae").write_text(cube_dae("Y_UP", 0.01))
     p = wbt(tmp_path, 'Solid { name "box" children [ CadShape { url [ "cube.dae" ] } ] }\n'
@@ -361,13 +378,18 @@ def test_an_obj_cad_shape_takes_its_mtl_materials(tmp_path: Path, precision: str
 
 
 def test_an_obj_without_materials_stays_one_white_mesh(tmp_path: Path) -> None:
-    """No .mtl (or one that is missing): the file as before, one mesh, white (as Webots draws it)."""
-    (tmp_path / "part.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
-    (tmp_path / "gone.obj").write_text("mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n")
-    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "part.obj" ] } CadShape { url [ "gone.obj" ] } ] }\n')
+    """No .mtl (or one that is missing, or outside the OBJ file's folder: not read): the file as before,
+    one mesh, white (as Webots draws it)."""
+    (tmp_path / "w").mkdir()
+    (tmp_path / "outside.mtl").write_text("newmtl x\nKd 1 0 0\n")
+    (tmp_path / "w" / "part.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    (tmp_path / "w" / "gone.obj").write_text("mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n")
+    (tmp_path / "w" / "out.obj").write_text("mtllib ../outside.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n")
+    p = wbt(tmp_path / "w", 'Solid { children [ CadShape { url [ "part.obj" ] } CadShape { url [ "gone.obj" ] } '
+                            'CadShape { url [ "out.obj" ] } ] }\n')
     shapes = load_world(p).world.solids[0].shapes
-    assert [(s.geometry.url, s.geometry.material_index, s.appearance) for s in shapes] == [
-        ("part.obj", -1, None), ("gone.obj", -1, None)]
+    assert [(s.geometry.url, s.geometry.material_index, s.appearance.base_color if s.appearance else None)
+            for s in shapes] == [("part.obj", -1, None), ("gone.obj", -1, None), ("out.obj", -1, None)]
 
 
 def test_a_proto_and_a_webots_cad_shape_read_their_textures_beside_them(tmp_path: Path, monkeypatch) -> None:

@@ -234,12 +234,14 @@ def _parse_obj(path: str, cap: int) -> CadFile:
 
 
 MTL_BYTES = 1 << 20       # an .mtl file larger than this is not read (its materials are white)
+MTL_FILES = 16            # the first this many distinct .mtl files an OBJ file names are read
 
 
 def _mtl_library(path: str) -> dict[str, CadMaterial]:
-    """The materials of the .mtl files an OBJ file names (``mtllib``, relative to it): ``Kd``, ``d``
-    and ``map_Kd`` (its last word: the file; options before it are not read). A missing or
-    unreadable .mtl gives no materials (Webots renders such faces white too)."""
+    """The materials of the .mtl files an OBJ file names (``mtllib``, relative to it, in its folder or
+    below: others are not read): ``Kd``, ``d`` and ``map_Kd`` (its last word: the file; options before
+    it are not read). A missing or unreadable .mtl gives no materials (Webots renders such faces white
+    too)."""
     import os
 
     libs: list[str] = []
@@ -247,10 +249,16 @@ def _mtl_library(path: str) -> dict[str, CadMaterial]:
         for raw in f:
             line = raw.strip()
             if line.startswith(b"mtllib"):
-                libs += [w.decode("utf-8", "replace") for w in line.split()[1:]]
+                for w in line.split()[1:]:
+                    lib = w.decode("utf-8", "replace").replace("\\", "/")
+                    if lib not in libs and len(libs) < MTL_FILES:
+                        libs.append(lib)
+    folder = os.path.realpath(os.path.dirname(path))
     out: dict[str, CadMaterial] = {}
     for lib in libs:
-        mtl = os.path.join(os.path.dirname(path), lib.replace("\\", "/"))
+        mtl = os.path.realpath(os.path.join(folder, lib))
+        if os.path.commonpath([folder, mtl]) != folder:
+            continue
         try:
             if os.path.getsize(mtl) > MTL_BYTES:
                 continue
