@@ -390,6 +390,11 @@ def test_an_obj_without_materials_stays_one_white_mesh(tmp_path: Path) -> None:
     shapes = load_world(p).world.solids[0].shapes
     assert [(s.geometry.url, s.geometry.material_index, s.appearance.base_color if s.appearance else None)
             for s in shapes] == [("part.obj", -1, None), ("gone.obj", -1, None), ("out.obj", -1, None)]
+    from sensorium.server.world.cad import _mtl_library
+
+    (tmp_path / "w" / "in.mtl").write_text("newmtl y\nKd 0 1 0\n")
+    (tmp_path / "w" / "both.obj").write_text("mtllib ../outside.mtl in.mtl\nv 0 0 0\n")
+    assert list(_mtl_library(str(tmp_path / "w" / "both.obj"))) == ["y"]
 
 
 def test_a_proto_and_a_webots_cad_shape_read_their_textures_beside_them(tmp_path: Path, monkeypatch) -> None:
