@@ -8,7 +8,7 @@ maps (x, y, z) → (x, −z, y), an X_UP one (x, y, z) → (−y, −z, x); all 
 
 COLLADA materials are numbered as assimp numbers them (Webots' ``Mesh.materialIndex``): the file's
 materials in the order of their ids, then, if a primitive is bound to none, a default white one.
-An OBJ file's (ours: Webots numbers none) are the names its faces use (``usemtl``) in order, the
+An OBJ file's (ours: Webots numbers none) are the names its faces use (``usemtl``), sorted, the
 faces without one a default white material after them; OBJ coordinates are kept as written.
 Each material keeps what Webots' PBRAppearance takes from it: the diffuse colour (COLLADA: white
 when the diffuse is a texture; OBJ: ``Kd``), the transparency (1 − opacity; OBJ: ``d``) and the
@@ -34,15 +34,15 @@ class CadError(Exception):
     """A file that cannot be read, or holds no triangles."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class CadMaterial:
-    name: str                                   # the material's id in the file
+    name: str                                   # the material's id in the file (OBJ: its newmtl name)
     diffuse: tuple[float, float, float]         # white when the diffuse is a texture
     transparency: float
     texture: str | None                         # the diffuse image's path as written (relative to the file)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class CadPart:
     """One primitive (a <triangles>, <polylist> or <polygons>) of one geometry instance; an OBJ file's
     faces of one material."""
@@ -54,7 +54,7 @@ class CadPart:
     uv: np.ndarray | None                       # (m, 3, 2) corner (s, t) of set 0, as written; None: none
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class CadFile:
     materials: tuple[CadMaterial, ...]
     parts: tuple[CadPart, ...]
