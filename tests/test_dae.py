@@ -428,3 +428,33 @@ Robot { name "r" children [
     v = read_all(Simulation(loaded))
     assert v["a"] == pytest.approx(1000 * 0.01 / (0.2 + 0.8 * 153 / 255), rel=1e-9)
     assert v["b"] == pytest.approx(1000 * 0.01 / (0.2 + 0.8 * 51 / 255), rel=1e-9)
+
+
+def test_a_file_of_many_materials_over_the_limit_is_one_problem(tmp_path: Path) -> None:
+    quad = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    (tmp_path / "two.dae").write_text(dae(quad, [("a", [(0, 1, 2)]), ("b", [(0, 2, 3)])], materials={
+        "a": ("m0", (1, 0, 0)), "b": ("m1", (0, 1, 0))}))
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "two.dae" ] } ] }\n')
+    assert len(load_world(p).world.solids[0].shapes) == 2
+    meshes._CACHE.clear()        # (read again under the limit, as a first load would)
+    with pytest.raises(WorldError) as info:
+        load_world(p, limits=WorldLimits(triangles=1))
+    (problem,) = info.value.problems
+    assert "cannot read COLLADA mesh two.dae: more than 1 triangles in its scene" in problem.message
+
+
+def test_a_material_texture_missing_or_outside_the_folder_is_a_note_not_a_problem(tmp_path: Path) -> None:
+    """Webots draws such a material without its image: the shape keeps its (white) colour, one summary
+    line says the texture was not loaded, validate passes."""
+    Image.new("RGB", (4, 4), (10, 0, 0)).save(tmp_path / "secret.png")
+    (tmp_path / "w").mkdir()
+    quad = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    (tmp_path / "w" / "q.dae").write_text(dae(quad, [("a", [(0, 1, 2)]), ("b", [(0, 2, 3)])], uv=[[0, 0], [1, 0], [1, 1], [0, 1]],
+                                              materials={"a": ("m0", "../secret.png"), "b": ("m1", "gone.png")}))
+    p = wbt(tmp_path / "w", 'Solid { children [ CadShape { url [ "q.dae" ] } ] }\n')
+    w = load_world(p)
+    assert [(s.appearance.base_color, s.appearance.texture) for s in w.world.solids[0].shapes] == [
+        ((1.0, 1.0, 1.0), None), ((1.0, 1.0, 1.0), None)]
+    said = [x for x in w.warnings if "texture" in x]
+    assert len(said) == 1 and "outside the world's folder" in said[0], said
+    assert w.losses == ()

@@ -562,11 +562,12 @@ def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
 
     problems: list[Problem] = []
     faces: dict[tuple[str, tuple[float, ...], int, str], int] = {}
+    failed: set[str] = set()      # a file that failed is said once (a CadShape's materials each name it)
     for path, geom in _walk(world):
         if not isinstance(geom, wm.Mesh):
             continue
         key = (geom.url, tuple(geom.scale), geom.material_index, geom.name)
-        if key in faces:
+        if key in faces or geom.url in failed:
             continue
         faces[key] = 0
         try:
@@ -577,6 +578,7 @@ def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
                                        name=geom.name).faces)
         except MeshFileError as exc:
             problems.append(Problem(f"{path}.url", str(exc)))
+            failed.add(geom.url)
     if problems:
         return problems
     for item in check_work(world, limits, lambda g: faces.get((g.url, tuple(g.scale), g.material_index, g.name), 0)):

@@ -123,6 +123,7 @@ class Converter:
         self.instances: list[tuple[str, tuple[str, int, int]]] = []   # PROTO instances being walked (name, at)
         self.asset_files: set[Path] = set()   # asset files outside the world's folder this world may read
         self.cad_meshes: set[int] = set()     # the Mesh nodes a CadShape's materials became (cad_shape)
+        self.cad_read: dict[tuple[Path, str], Any] = {}   # a CadShape file's materials, read once (DEF/USE)
         self.losses: list[Loss] = []      # robots, sensor devices and sensor-visible shapes lost (report.py)
         self.resets_said: set[str] = set()   # Webots' field resets told (a node USEd twice: once)
         # the nodes inside the robot being converted, as a Supervisor walks them (schemas.world.NestedNode):
@@ -692,21 +693,33 @@ class Converter:
             owner.parts[-1]["_at"] = self.at(node)
             app: dict[str, Any] = {"base_color": list(m.diffuse), "transparency": m.transparency}
             if m.texture is not None:
-                tex = m.texture.replace("\\", "/")
-                if tex.startswith("file://"):
-                    tex = tex[len("file://"):]
-                if where.is_absolute():       # a PROTO's or webots:// file: its image beside it, read only
-                    tex_url = str((where.parent / tex).resolve())
-                    if Path(tex_url).is_file():
-                        self.asset_files.add(Path(tex_url))
-                else:
-                    tex_url = posixpath.normpath(posixpath.join(posixpath.dirname(where.as_posix()), tex))
-                image = fx.image_texture(Node("ImageTexture", {"url": [tex_url]}, node.line, node.col,
-                                              source=node.source), self.source,
-                                         lambda _n, message: self.appearance_note(node, message))
+                image = self.cad_texture(node, where, m.texture)
                 if image is not None:
                     app["texture"] = image
             owner.parts[-1]["appearance"] = app
+
+    def cad_texture(self, node: Node, where: Path, texture: str) -> dict | None:
+        """A CadShape material's diffuse image (its path as the file writes it, relative to the file)
+        → the world's texture, or None (said once, as other textures not loaded): a PROTO's or
+        ``webots://`` file's image is read in place, read only; a world-folder file's must stay in
+        that folder."""
+        from urllib.parse import unquote
+
+        tex = unquote(texture.replace("\\", "/"))
+        tex = tex.removeprefix("file://")
+        if where.is_absolute():
+            tex_url = str((where.parent / tex).resolve())
+            if Path(tex_url).is_file():
+                self.asset_files.add(Path(tex_url))
+        else:
+            tex_url = posixpath.normpath(posixpath.join(posixpath.dirname(where.as_posix()), tex))
+            folder = Path(self.source).resolve().parent
+            if not (folder / tex_url).resolve().is_relative_to(folder):
+                self.appearance_note(node, f"texture: {texture!r} (of {where.as_posix()!r}) is outside the "
+                                           "world's folder")
+                return None
+        return fx.image_texture(Node("ImageTexture", {"url": [tex_url]}, node.line, node.col, source=node.source),
+                                self.source, lambda _n, message: self.appearance_note(node, message))
 
     def cad_materials(self, node: Node, url: str, kind: str) -> tuple[Path, list[tuple[int, Any]]] | None:
         """(the file as the converted world names it, [(material index, CadMaterial)] its triangles
@@ -720,10 +733,14 @@ class Converter:
             return None
         path = Path(named)
         file = path if path.is_absolute() else Path(self.source).resolve().parent / path
-        try:
-            materials, indices = file_materials(file, kind)
-        except MeshFileError:
+        if (file, kind) not in self.cad_read:
+            try:
+                self.cad_read[(file, kind)] = file_materials(file, kind)
+            except MeshFileError:
+                self.cad_read[(file, kind)] = None
+        if self.cad_read[(file, kind)] is None:
             return None
+        materials, indices = self.cad_read[(file, kind)]
         used = [(i, materials[i]) for i in indices]
         if kind == "obj" and all(m.name == DEFAULT_MATERIAL for _, m in used):
             return None         # no materials: the file as trimesh reads it, white
