@@ -9,11 +9,12 @@ reader fails (``MemoryError``) or the process dies, and the parent reports one l
 Run as ``python -I mesh_worker.py PATH SX SY SZ MEMORY_BYTES [FORMAT [MATERIAL NAME CAP]]`` (FORMAT:
 ``stl``, ``obj``, ``dae``, ...; by default the file's suffix; MATERIAL and NAME select a COLLADA file's
 triangles (an OBJ file's: MATERIAL), as ``meshes.load_mesh``; CAP: the most triangles its scene may
-place, "" for cad.py's own; MATERIAL -2: only the file's materials, ``{"ok": true, "materials": [[name,
-diffuse, transparency, texture], ...], "used": [index, ...]}``). It imports numpy and trimesh, and for those ``cad.py`` by its path
-(numpy, pycollada, trimesh), never the sensorium package. Reply on stdout: a 4-byte big-endian length and a JSON header — ``{"ok": true,
-"vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3 float64 and NF×3 int64 (native
-order), or ``{"ok": false, "kind": "memory" | "error", "error": "..."}``.
+place, "" for cad.py's own). It imports numpy and trimesh, and for those files ``cad.py`` by its path
+(numpy, pycollada, trimesh), never the sensorium package. Reply on stdout: a 4-byte big-endian length
+and a JSON header — ``{"ok": true, "vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3
+float64 and NF×3 int64 (native order), or ``{"ok": false, "kind": "memory" | "no triangles" | "cad" |
+"error", "error": "..."}``. MATERIAL -2 asks for a COLLADA or OBJ file's materials only: ``{"ok": true,
+"materials": [[name, diffuse, transparency, texture], ...], "used": [index, ...]}``, no arrays.
 """
 
 import json
