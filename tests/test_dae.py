@@ -458,3 +458,19 @@ def test_a_material_texture_missing_or_outside_the_folder_is_a_note_not_a_proble
     said = [x for x in w.warnings if "texture" in x]
     assert len(said) == 1 and "outside the world's folder" in said[0], said
     assert w.losses == ()
+
+
+@pytest.mark.parametrize(("effect", "want"), [
+    ("", 0.0),                                                                          # opaque
+    ('<transparent opaque="A_ONE"><color>1 1 1 0.25</color></transparent>', 0.75),      # alpha times 1
+    ('<transparent><color>0 0 0 1</color></transparent><transparency><float>0.4</float></transparency>', 0.6),
+    ('<transparent opaque="RGB_ZERO"><color>0.2 0.2 0.2 1</color></transparent>'
+     '<transparency><float>1</float></transparency>', 0.2),                              # 1 − luminance
+    ("<transparency><float>0.5</float></transparency>", 0.5),                          # alone
+])
+def test_transparency_as_assimp_reads_a_collada_effect(tmp_path: Path, effect: str, want: float) -> None:
+    quad = [[0, 0, 0], [1, 0, 0], [1, 1, 0]]
+    text = dae(quad, [("a", [(0, 1, 2)])], materials={"a": ("m", (0.5, 0.5, 0.5))})
+    (tmp_path / "t.dae").write_text(text.replace("</diffuse>", "</diffuse>" + effect))
+    (m,) = read_dae(str(tmp_path / "t.dae")).materials
+    assert (m.diffuse, m.transparency) == ((0.5, 0.5, 0.5), pytest.approx(want, abs=1e-6))

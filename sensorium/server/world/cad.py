@@ -305,18 +305,24 @@ def _material(m) -> CadMaterial:
             texture = None
     elif e.diffuse is not None:
         diffuse = tuple(min(1.0, max(0.0, float(c))) for c in tuple(e.diffuse)[:3])  # type: ignore[assignment]
-    # opacity as assimp reads it: only with a <transparent> colour, its alpha (A_ONE) or one minus its
-    # mean (RGB_ZERO), times <transparency>
+    # opacity as assimp's COLLADA reader gives it (Webots' transparency = 1 − opacity): <transparency>
+    # times the <transparent> colour's alpha (A_ONE, the default), or 1 − <transparency> times its
+    # luminance (RGB_ZERO); <transparency> alone when there is no <transparent> colour
     opacity = 1.0
-    t = e.transparent
-    if t is not None and not isinstance(t, collada.material.Map):
-        try:
-            f = float(e.transparency) if isinstance(e.transparency, (int, float)) else 1.0
-            c = [float(v) for v in tuple(t)]
-            opacity = (1.0 - sum(c[:3]) / 3.0) * f if e.opaque_mode == "RGB_ZERO" else c[3] * f if len(c) > 3 else f
-        except (TypeError, ValueError):
-            opacity = 1.0
-    transparency = min(1.0, max(0.0, 1.0 - opacity)) if np.isfinite(opacity) else 0.0
+    try:
+        f = float(e.transparency) if isinstance(e.transparency, (int, float)) else 1.0
+        t = e.transparent
+        if t is None or isinstance(t, collada.material.Map):
+            opacity = f
+        else:
+            c = [float(v) for v in tuple(t)] + [1.0] * 4
+            if e.opaque_mode == "RGB_ZERO":
+                opacity = 1.0 - f * (0.212671 * c[0] + 0.715160 * c[1] + 0.072169 * c[2])
+            else:
+                opacity = f * c[3]
+    except (TypeError, ValueError):
+        opacity = 1.0
+    transparency = min(1.0, max(0.0, 1.0 - opacity)) if math.isfinite(opacity) else 0.0
     return CadMaterial(m.id or "", diffuse, transparency, texture)  # type: ignore[arg-type]
 
 
