@@ -132,16 +132,17 @@ def test_a_device_outside_a_robot_keeps_its_shapes(tmp_path: Path) -> None:
 
 def test_cad_shapes_are_visual_meshes_or_said_lost(tmp_path: Path) -> None:
     """A CadShape (Webots' visual mesh) is seen by lidars and infra-red: read as a visual mesh when
-    its format is read here, else a loss naming it (it was once skipped as if it did not matter)."""
+    its format is read here, else a loss naming it (it was once skipped as if it did not matter).
+    (COLLADA files: tests/test_dae.py.)"""
     (tmp_path / "part.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
-    (tmp_path / "part.dae").write_text("<COLLADA/>")
-    p = write(tmp_path, 'Solid { name "s" children [ CadShape { url [ "part.obj" ] } CadShape { url [ "part.dae" ] } ] }\n')
+    (tmp_path / "part.fbx").write_bytes(b"Kaydara FBX Binary  \x00")
+    p = write(tmp_path, 'Solid { name "s" children [ CadShape { url [ "part.obj" ] } CadShape { url [ "part.fbx" ] } ] }\n')
     w = load_world(p)
     (shape,) = w.world.solids[0].shapes
     assert (shape.geometry.type, shape.geometry.url, shape.seen_by) == ("mesh", "part.obj", "visual")
     (loss,) = w.losses
     assert (loss.kind, loss.name, loss.where) == ("shape", "s", f"{p}:2:61")   # the second CadShape
-    assert "mesh 'part.dae': the .dae format is not read here" in loss.why
+    assert "mesh 'part.fbx': the .fbx format is not read here" in loss.why
 
 
 def test_a_wbt_load_times_each_stage() -> None:

@@ -622,13 +622,13 @@ def test_named_controllers_become_extern(tmp_path: Path) -> None:
 def test_mesh_losses_load_and_name_their_lines(tmp_path: Path) -> None:
     """A mesh Sensorium cannot read (a format it does not read, a missing file) is a loss naming the
     file and line; the world still loads (the rest of the solid too)."""
-    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.dae" ] } }\n'
+    p = write(tmp_path, 'Solid {\n  children [\n    Shape { geometry Mesh { url [ "robot.fbx" ] } }\n'
                         '    Shape { geometry Mesh { url [ "gone.stl" ] } }\n    Shape { geometry Box { } }\n  ]\n}\n')
-    (tmp_path / "robot.dae").write_text("<COLLADA/>")
+    (tmp_path / "robot.fbx").write_bytes(b"Kaydara FBX Binary  \x00")
     w = load_world(p)
     assert [s.geometry.type for s in w.world.solids[0].shapes] == ["box"]
     assert [(loss.kind, loss.where) for loss in w.losses] == [("shape", f"{p}:4:22"), ("shape", f"{p}:5:22")]
-    assert "the .dae format is not read here" in w.losses[0].why
+    assert "the .fbx format is not read here" in w.losses[0].why
     assert "mesh file 'gone.stl' not found (relative to the world file)" in w.losses[1].why
 
 

@@ -227,7 +227,8 @@ def _counts(loaded) -> tuple[int, int]:
     for path, v in _walk(loaded.world):
         kind = getattr(v, "type", None)
         if kind in ("box", "sphere", "cylinder", "capsule", "plane", "mesh", "triangles") and path.endswith("geometry"):
-            triangles += triangle_count(v, lambda g: len(load_mesh(loaded.base_dir / g.url, g.scale).faces))
+            triangles += triangle_count(v, lambda g: len(load_mesh(loaded.base_dir / g.url, g.scale, material=g.material_index,
+                                                                      name=g.name).faces))
         elif isinstance(kind, str) and kind.endswith("Light") and not path.endswith("geometry"):
             lights += 1
     rays = 0

@@ -184,11 +184,19 @@ class Triangles(Strict):
 
 
 class Mesh(Strict):
-    """Triangle mesh file (STL, OBJ, PLY, GLB) loaded with trimesh; path relative to the world file."""
+    """Triangle mesh file (STL, OBJ, PLY, glTF, OFF, COLLADA .dae); path relative to the world file. A
+    COLLADA file is placed as Webots places it: scaled by its ``<unit>``, its ``<up_axis>`` turned to +z."""
 
     type: Literal["mesh"]
     url: str
     scale: Vec3 = (1.0, 1.0, 1.0)
+    material_index: int = Field(default=-1, ge=-1, le=1_000_000, description=(
+        "COLLADA (Webots' Mesh.materialIndex): only the triangles of this material, the file's materials "
+        "numbered in the order of their ids (then a default one for triangles bound to none); OBJ (ours: "
+        "what a CadShape's materials become): the material names its faces use, sorted (then a default one "
+        "for faces without); -1: all"))
+    name: str = Field(default="", max_length=4096, description=(
+        "COLLADA only (Webots' Mesh.name): only the triangles of the geometry of this name (else id); \"\": all"))
 
 
 class ElevationGrid(Strict):

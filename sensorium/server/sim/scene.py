@@ -57,7 +57,7 @@ def primitive_from_model(g: wm.Box | wm.Sphere | wm.Cylinder | wm.Capsule | wm.C
     if isinstance(g, wm.Plane):
         return geo.Plane(size=None if g.size is None else tuple(g.size))
     if isinstance(g, wm.Mesh):
-        return load_mesh(base_dir / g.url, g.scale)
+        return load_mesh(base_dir / g.url, g.scale, material=g.material_index, name=g.name)
     if isinstance(g, wm.Triangles):
         return triangles_mesh(g.vertices, g.faces)
     if isinstance(g, wm.ElevationGrid):

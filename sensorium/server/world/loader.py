@@ -561,24 +561,27 @@ def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
     from sensorium.server.world.meshes import MeshFileError, load_mesh, resolve_mesh_url
 
     problems: list[Problem] = []
-    faces: dict[tuple[str, tuple[float, ...]], int] = {}
+    faces: dict[tuple[str, tuple[float, ...], int, str], int] = {}
+    failed: set[str] = set()      # a file that failed is said once (a CadShape's materials each name it)
     for path, geom in _walk(world):
         if not isinstance(geom, wm.Mesh):
             continue
-        key = (geom.url, tuple(geom.scale))
-        if key in faces:
+        key = (geom.url, tuple(geom.scale), geom.material_index, geom.name)
+        if key in faces or geom.url in failed:
             continue
         faces[key] = 0
         try:
             file = resolve_mesh_url(geom.url, base_dir, allow_outside=allow_outside_meshes,
                                     max_bytes=limits.mesh_file_bytes, allowed=asset_files)
             faces[key] = len(load_mesh(file, geom.scale, display=geom.url, memory=limits.mesh_load_bytes,
-                                       max_triangles=limits.triangles).faces)
+                                       max_triangles=limits.triangles, material=geom.material_index,
+                                       name=geom.name).faces)
         except MeshFileError as exc:
             problems.append(Problem(f"{path}.url", str(exc)))
+            failed.add(geom.url)
     if problems:
         return problems
-    for item in check_work(world, limits, lambda g: faces.get((g.url, tuple(g.scale)), 0)):
+    for item in check_work(world, limits, lambda g: faces.get((g.url, tuple(g.scale), g.material_index, g.name), 0)):
         problems.append(Problem(*item) if isinstance(item, tuple) else Problem("", item))
     return problems
 

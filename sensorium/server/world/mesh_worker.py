@@ -6,11 +6,15 @@ to judge watertightness included). A world file names its meshes, so a hostile o
 ``validate`` exhaust the machine. Here the reading runs under ``RLIMIT_AS``: past the limit the
 reader fails (``MemoryError``) or the process dies, and the parent reports one line.
 
-Run as ``python -I mesh_worker.py PATH SX SY SZ MEMORY_BYTES [FORMAT]`` (FORMAT: ``stl``, ``obj``, ...;
-by default the file's suffix). It imports numpy and trimesh,
-never sensorium. Reply on stdout: a 4-byte big-endian length and a JSON header — ``{"ok": true,
-"vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3 float64 and NF×3 int64 (native
-order), or ``{"ok": false, "kind": "memory" | "error", "error": "..."}``.
+Run as ``python -I mesh_worker.py PATH SX SY SZ MEMORY_BYTES [FORMAT [MATERIAL NAME CAP]]`` (FORMAT:
+``stl``, ``obj``, ``dae``, ...; by default the file's suffix; MATERIAL and NAME select a COLLADA file's
+triangles (an OBJ file's: MATERIAL), as ``meshes.load_mesh``; CAP: the most triangles its scene may
+place, "" for cad.py's own). It imports numpy and trimesh, and for those files ``cad.py`` by its path
+(numpy, pycollada, trimesh), never the sensorium package. Reply on stdout: a 4-byte big-endian length
+and a JSON header — ``{"ok": true, "vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3
+float64 and NF×3 int64 (native order), or ``{"ok": false, "kind": "memory" | "no triangles" | "cad" |
+"error", "error": "..."}``. MATERIAL -2 asks for a COLLADA or OBJ file's materials only: ``{"ok": true,
+"materials": [[name, diffuse, transparency, texture], ...], "used": [index, ...]}``, no arrays.
 """
 
 import json
@@ -28,6 +32,21 @@ def _reply(header, *arrays):
     out.flush()
 
 
+MATERIALS_ONLY = -2      # MATERIAL: reply with the file's materials and the ones its triangles use, no arrays
+
+
+def _cad_module():
+    """``cad.py`` beside this file, loaded by its path (this process does not import sensorium)."""
+    import importlib.util
+    import os
+
+    spec = importlib.util.spec_from_file_location("_sensorium_cad", os.path.join(os.path.dirname(__file__), "cad.py"))
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module          # (its dataclasses look their module up)
+    spec.loader.exec_module(module)
+    return module
+
+
 def main():
     path, sx, sy, sz, memory = sys.argv[1], *map(float, sys.argv[2:5]), int(sys.argv[5])
     kind = sys.argv[6] if len(sys.argv) > 6 and sys.argv[6] else None
@@ -37,10 +56,32 @@ def main():
         import numpy as np
         import trimesh
 
-        loaded = trimesh.load(path, file_type=kind, force="mesh", process=False)
-        vertices = np.ascontiguousarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
-        faces = np.ascontiguousarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
-        del loaded
+        material = int(sys.argv[7]) if len(sys.argv) > 7 else -1
+        if material == MATERIALS_ONLY:
+            cad = _cad_module()
+            try:
+                read = cad.read_cad(path, kind)
+            except cad.CadError as exc:
+                _reply({"ok": False, "kind": "cad", "error": str(exc)[:2000]})
+                return
+            _reply({"ok": True, "materials": [[m.name, list(m.diffuse), m.transparency, m.texture]
+                                              for m in read.materials], "used": read.used()})
+            return
+        if kind == "dae" or (kind == "obj" and material >= 0):
+            cad = _cad_module()
+            name = sys.argv[8] if len(sys.argv) > 8 else ""
+            cap = int(sys.argv[9]) if len(sys.argv) > 9 and sys.argv[9] else None
+            try:
+                v, f, _ = cad.read_cad(path, kind, cap).select(material, name)
+            except cad.CadError as exc:
+                _reply({"ok": False, "kind": "cad", "error": str(exc)[:2000]})
+                return
+            vertices, faces = np.ascontiguousarray(v, dtype=np.float64), np.ascontiguousarray(f, dtype=np.int64)
+        else:
+            loaded = trimesh.load(path, file_type=kind, force="mesh", process=False)
+            vertices = np.ascontiguousarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
+            faces = np.ascontiguousarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
+            del loaded
         if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0 or vertices.ndim != 2 or vertices.shape[1] != 3:
             _reply({"ok": False, "kind": "no triangles", "error": "no triangles"})
             return

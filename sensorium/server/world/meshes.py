@@ -1,4 +1,5 @@
-"""Mesh files (STL, OBJ, PLY, GLB) → float64 triangle arrays, via trimesh.
+"""Mesh files (STL, OBJ, PLY, GLB via trimesh; COLLADA, and an OBJ file's faces of one material, via
+:mod:`.cad`) → float64 triangle arrays.
 
 Loaded meshes are cached by (resolved path, modification time, scale): validating a world and then
 building its scene reads each file once. A file larger than ``IN_PROCESS_BYTES`` is read in a
@@ -15,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-SUPPORTED = {".stl", ".obj", ".ply", ".glb", ".gltf", ".off"}
+SUPPORTED = {".stl", ".obj", ".ply", ".glb", ".gltf", ".off", ".dae"}
 IN_PROCESS_BYTES = 1 << 20            # smaller files are read in process (a 1 MiB OBJ costs ~0.2 GB at worst)
 DEFAULT_LOAD_MEMORY = 2 << 30         # the worker's address space (WorldLimits.mesh_load_bytes)
 
@@ -57,27 +58,31 @@ def resolve_mesh_url(url: str, base_dir: Path, *, allow_outside: bool = False, m
 
 
 def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *, display: str | None = None,
-              memory: int | None = None, max_triangles: int | None = None):
+              memory: int | None = None, max_triangles: int | None = None, material: int = -1, name: str = ""):
     """Load and scale a mesh file (cached). ``display``: how errors name the file (default: its path);
     ``memory``: what reading a large file may take (default ``DEFAULT_LOAD_MEMORY``);
-    ``max_triangles``: refuse a larger mesh before its arrays are copied out of the worker."""
+    ``max_triangles``: refuse a larger mesh before its arrays are copied out of the worker;
+    ``material``/``name``: a COLLADA file's triangles of that material index / geometry name only
+    (Webots' Mesh.materialIndex and Mesh.name; -1 and "": all); an OBJ file's of that material
+    (:mod:`.cad`'s numbering: a CadShape's materials)."""
     path = Path(path).resolve()
-    name = display if display is not None else str(path)
+    shown = display if display is not None else str(path)
     if not path.is_file():
-        raise MeshFileError(f"mesh file not found: {name}")
+        raise MeshFileError(f"mesh file not found: {shown}")
     kind = mesh_format(path)
     if kind is None and not path.suffix:
-        raise MeshFileError(f"mesh file {name} has no suffix and is not a mesh format read here "
+        raise MeshFileError(f"mesh file {shown} has no suffix and is not a mesh format read here "
                             f"(expected one of {sorted(SUPPORTED)})")
     if kind is None:
         raise MeshFileError(f"unsupported mesh format {path.suffix!r} (expected one of {sorted(SUPPORTED)})")
     try:
         stat = path.stat()
-        key = (str(path), stat.st_mtime_ns, tuple(float(s) for s in scale))
+        select = _selection(kind, material, name)
+        key = (str(path), stat.st_mtime_ns, tuple(float(s) for s in scale), *select)
         mesh = _CACHE.get(key)
         if mesh is None:
-            mesh = _load(*key, memory if memory is not None else DEFAULT_LOAD_MEMORY, stat.st_size, max_triangles,
-                         kind)
+            mesh = _load(*key[:3], memory if memory is not None else DEFAULT_LOAD_MEMORY, stat.st_size, max_triangles,
+                         kind, select)
             _CACHE[key] = mesh
             while len(_CACHE) > 64:
                 _CACHE.popitem(last=False)
@@ -85,7 +90,20 @@ def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1
             _CACHE.move_to_end(key)
         return mesh
     except MeshFileError as exc:
-        raise MeshFileError(str(exc).replace(str(path), name)) from None
+        raise MeshFileError(str(exc).replace(str(path), shown)) from None
+
+
+def _selection(kind: str, material: int, name: str) -> tuple[int, str]:
+    """The (material, geometry name) a file of ``kind`` is read by: COLLADA both, OBJ a material
+    (then through :mod:`.cad`), other formats neither."""
+    if kind == "dae":
+        return int(material), str(name)
+    return (int(material), "") if kind == "obj" and material >= 0 else (-1, "")
+
+
+def by_cad(kind: str, select: tuple[int, str]) -> bool:
+    """Whether a file of ``kind`` read by ``select`` is read through :mod:`.cad` (else trimesh)."""
+    return kind == "dae" or (kind == "obj" and select[0] >= 0)
 
 
 def mesh_format(path: Path) -> str | None:
@@ -114,6 +132,8 @@ def mesh_format(path: Path) -> str | None:
         return "off"
     if text.startswith(b"{") and b'"asset"' in head:
         return "gltf"
+    if b"<COLLADA" in head:
+        return "dae"
     lines = text.splitlines() if size <= len(head) else text.splitlines()[:-1]    # (the last one may be cut)
     words = {line.split(maxsplit=1)[0] for line in lines if line.strip()}
     if words and words <= {b"#", b"v", b"vt", b"vn", b"vp", b"f", b"o", b"g", b"s", b"l", b"usemtl", b"mtllib"} \
@@ -122,29 +142,42 @@ def mesh_format(path: Path) -> str | None:
     return None
 
 
-# meshes read, by (resolved path, modification time, scale), the 64 most recently used (whatever
-# memory bound they were read under: validating and building read each file once)
-_CACHE: OrderedDict[tuple[str, int, tuple[float, ...]], Any] = OrderedDict()
+# meshes read, by (resolved path, modification time, scale, COLLADA material and geometry name), the 64
+# most recently used (whatever memory bound they were read under: validating and building read each file once)
+_CACHE: OrderedDict[tuple[str, int, tuple[float, ...], int, str], Any] = OrderedDict()
 
 
 def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: int, max_triangles: int | None,
-          kind: str):
+          kind: str, select: tuple[int, str] = (-1, "")):
     from sensorium.server.world.geometry import Mesh
 
     if size > IN_PROCESS_BYTES:
-        vertices, faces, closed = _read_in_worker(path, scale, memory, max_triangles, kind)
+        vertices, faces, closed = _read_in_worker(path, scale, memory, max_triangles, kind, select)
         vertices *= np.asarray(scale, dtype=np.float64)
         return Mesh(vertices=vertices, faces=faces, closed=closed)
     import trimesh
 
-    try:
-        loaded = trimesh.load(path, file_type=kind, force="mesh", process=False)
-    except Exception as exc:  # trimesh raises many types for bad files
-        raise MeshFileError(f"cannot read mesh {path}: {exc}") from None
-    vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
-    faces = np.asarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
+    if by_cad(kind, select):
+        from sensorium.server.world.cad import CadError, read_cad
+
+        try:
+            vertices, faces, _ = read_cad(path, kind, max_triangles).select(*select)
+        except CadError as exc:
+            raise MeshFileError(f"cannot read {_FORMAT_NAMES[kind]} mesh {path}: {exc}") from None
+        if len(faces) == 0:
+            raise MeshFileError(f"mesh {path} has no triangles {_selected(select)}")
+    else:
+        try:
+            loaded = trimesh.load(path, file_type=kind, force="mesh", process=False)
+        except Exception as exc:  # trimesh raises many types for bad files
+            raise MeshFileError(f"cannot read mesh {path}: {exc}") from None
+        vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=np.float64)
+        faces = np.asarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
     if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0:
         raise MeshFileError(f"mesh {path} has no triangles")
+    if max_triangles is not None and len(faces) > max_triangles:
+        raise MeshFileError(f"mesh {path} has {len(faces):,} triangles, more than the world's limit of "
+                            f"{max_triangles:,} (raise the limits with --allow-large)")
     if not np.isfinite(vertices).all():
         raise MeshFileError(f"mesh {path} has non-finite vertex coordinates")
     if faces.min() < 0 or faces.max() >= len(vertices):
@@ -156,8 +189,80 @@ def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: i
     return Mesh(vertices=np.ascontiguousarray(vertices), faces=np.ascontiguousarray(faces), closed=closed)
 
 
+_FORMAT_NAMES = {"dae": "COLLADA", "obj": "OBJ"}
+
+
+def _selected(select: tuple[int, str]) -> str:
+    """How an empty COLLADA selection is said."""
+    material, name = select
+    said = [f"of material index {material}"] if material >= 0 else []
+    said += [f"in geometry {name!r}"] if name else []
+    return " ".join(said) if said else "in its scene"
+
+
+def file_materials(path: str | Path, kind: str, memory: int | None = None) -> tuple[list[Any], list[int]]:
+    """(materials, the indices its triangles use) of a COLLADA or OBJ file (:mod:`.cad`): a file over
+    ``IN_PROCESS_BYTES`` read by the worker within ``memory`` bytes (default ``DEFAULT_LOAD_MEMORY``).
+    MeshFileError: it cannot be read."""
+    from sensorium.server.world.cad import CadError, CadMaterial, read_cad
+
+    path = str(Path(path).resolve())
+    try:
+        size = Path(path).stat().st_size
+    except OSError as exc:
+        raise MeshFileError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
+    if size <= IN_PROCESS_BYTES:
+        try:
+            cad = read_cad(path, kind)
+        except CadError as exc:
+            raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind, '')} mesh {path}: {exc}") from None
+        return list(cad.materials), cad.used()
+    header = _worker_header(path, memory if memory is not None else DEFAULT_LOAD_MEMORY, kind, [str(MATERIALS_ONLY)])
+    if header is None or not header.get("ok"):
+        why = "its reader stopped" if header is None else header.get("error", "?")
+        raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind, '')} mesh {path}: {why}")
+    try:
+        materials = [CadMaterial(str(n), (float(d[0]), float(d[1]), float(d[2])), float(t),
+                                 None if x is None else str(x)) for n, d, t, x in header["materials"]]
+        used = [int(i) for i in header["used"] if 0 <= int(i) < len(materials)]
+    except (KeyError, TypeError, ValueError, IndexError):
+        raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind, '')} mesh {path}: a bad reply") from None
+    return materials, used
+
+
+MATERIALS_ONLY = -2       # (mesh_worker.MATERIALS_ONLY)
+
+
+def _worker_header(path: str, memory: int, kind: str, extra: list[str]) -> dict | None:
+    """Run :mod:`.mesh_worker` on ``path`` for a reply without arrays: its JSON header (None: it
+    stopped without one)."""
+    import json
+    import os
+    import struct
+    import subprocess
+    import sys
+
+    worker = Path(__file__).with_name("mesh_worker.py")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+    env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
+    proc = subprocess.Popen([sys.executable, "-I", str(worker), path, "1.0", "1.0", "1.0", str(memory), kind, *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=env,
+                            close_fds=True)
+    assert proc.stdout is not None
+    try:
+        head = proc.stdout.read(4)
+        header = json.loads(proc.stdout.read(struct.unpack(">I", head)[0])) if len(head) == 4 else None
+    except ValueError:       # (a reply that is not JSON)
+        header = None
+    finally:
+        proc.stdout.close()
+        proc.wait()
+    return header if isinstance(header, dict) else None
+
+
 def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
-                    max_triangles: int | None = None, kind: str | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
+                    max_triangles: int | None = None, kind: str | None = None,
+                    select: tuple[int, str] = (-1, "")) -> tuple[np.ndarray, np.ndarray, bool]:
     """(vertices, faces, closed) of a mesh file read by :mod:`.mesh_worker` within ``memory`` bytes."""
     import json
     import os
@@ -169,7 +274,8 @@ def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
     env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
     env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
     proc = subprocess.Popen([sys.executable, "-I", str(worker), path, *map(repr, scale), str(memory),
-                             kind or Path(path).suffix.lower()[1:]],
+                             kind or Path(path).suffix.lower()[1:], str(select[0]), select[1],
+                             str(max_triangles) if max_triangles is not None else ""],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=env,
                             close_fds=True)
     assert proc.stdout is not None
@@ -204,7 +310,11 @@ def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
             raise MeshFileError(f"cannot read mesh {path}: reading it needs more than {limit} of memory "
                                 "(raise the limits with --allow-large)")
         if header.get("kind") == "no triangles":
-            raise MeshFileError(f"mesh {path} has no triangles")
+            raise MeshFileError(f"mesh {path} has no triangles"
+                                + (f" {_selected(select)}" if kind is not None and by_cad(kind, select) else ""))
+        if header.get("kind") == "cad":
+            raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind or '', '')} mesh {path}: "
+                                f"{header.get('error', '?')}")
         raise MeshFileError(f"cannot read mesh {path}: {header.get('error', '?')}")
     if not np.isfinite(vertices).all():
         raise MeshFileError(f"mesh {path} has non-finite vertex coordinates")

@@ -507,11 +507,21 @@ def triangles_corner_uv(g: wm.Triangles) -> np.ndarray:
 
 
 @lru_cache(maxsize=16)
-def _mesh_file_uv(path: str, _mtime: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(vertices, faces, corner uv) of a mesh file as loaded for the scene (trimesh, unprocessed):
+def _mesh_file_uv(path: str, _mtime: int, material: int = -1, name: str = "") -> tuple[np.ndarray, np.ndarray,
+                                                                                        np.ndarray]:
+    """(vertices, faces, corner uv) of a mesh file as loaded for the scene (trimesh, unprocessed; a
+    COLLADA file, or an OBJ file's faces of one material, through :mod:`.cad`, selected as the scene's):
     the file's first UV set with ``v`` flipped (Webots' assimp ``FlipUVs``), ``(0.5, 0.5)`` for a
     file without UVs (WbMesh)."""
     import trimesh
+
+    from sensorium.server.world.meshes import by_cad, mesh_format
+
+    kind = mesh_format(Path(path)) or ""
+    if by_cad(kind, (material, name)):
+        from sensorium.server.world.cad import read_cad
+
+        return read_cad(path, kind).select(material, name)
 
     m = trimesh.load(path, force="mesh", process=False)
     vertices = np.asarray(m.vertices, dtype=np.float64)
@@ -772,7 +782,7 @@ class TextureSampler:
                                        np.asarray(g.faces, dtype=np.int64), triangles_corner_uv(g))
             else:
                 file = (self.base_dir / g.url).resolve()
-                v, f, corners = _mesh_file_uv(str(file), file.stat().st_mtime_ns)
+                v, f, corners = _mesh_file_uv(str(file), file.stat().st_mtime_ns, g.material_index, g.name)
                 self._meshes[shape] = (v * np.asarray(g.scale, dtype=np.float64), f, corners)
         return self._meshes[shape]
 

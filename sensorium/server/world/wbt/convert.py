@@ -17,6 +17,7 @@ a quaternion.
 from __future__ import annotations
 
 import math
+import posixpath
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -121,6 +122,8 @@ class Converter:
         self.device_kinds = {k for k in SENSORS if hasattr(wm, k)}
         self.instances: list[tuple[str, tuple[str, int, int]]] = []   # PROTO instances being walked (name, at)
         self.asset_files: set[Path] = set()   # asset files outside the world's folder this world may read
+        self.cad_meshes: set[int] = set()     # the Mesh nodes a CadShape's materials became (cad_shape)
+        self.cad_read: dict[tuple[Path, str], Any] = {}   # a CadShape file's materials, read once (DEF/USE)
         self.losses: list[Loss] = []      # robots, sensor devices and sensor-visible shapes lost (report.py)
         self.resets_said: set[str] = set()   # Webots' field resets told (a node USEd twice: once)
         # the nodes inside the robot being converted, as a Supervisor walks them (schemas.world.NestedNode):
@@ -515,12 +518,8 @@ class Converter:
                 self.visit(child, inner, owner)
         elif t == "Shape":
             self.shape(node, frame, owner, seen_by="visual")
-        elif t == "CadShape":     # a visual mesh file (its own materials are not read: seen white)
-            urls = f.strings("url")
-            if urls:
-                mesh = Node("Mesh", {"url": urls[:1]}, node.line, node.col, source=node.source)
-                self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
-                           seen_by="visual")
+        elif t == "CadShape":     # a visual mesh file with its own materials (COLLADA's read)
+            self.cad_shape(node, frame, owner)
         elif t in LIGHTS:
             self.light(node, frame, owner)
         elif t == "Robot":
@@ -663,6 +662,90 @@ class Converter:
         self.ride(part)
         owner.parts.append(part)
 
+    def cad_shape(self, node: Node, frame: Frame, owner: Owner) -> None:
+        """A CadShape: its file as a visual mesh. A COLLADA file, or an OBJ file with .mtl materials,
+        gives one shape per material its triangles use (a Mesh of that material_index), seen in the
+        material's diffuse colour, or its diffuse texture through the file's texture coordinates (the
+        image's path is relative to the mesh file, as in Webots); other files are seen white."""
+        urls = self.fields(node).strings("url")
+        if not urls:
+            return
+        url = urls[0].replace("\\", "/")
+        kind = Path(url.split("?")[0]).suffix.lower()[1:]
+        materials = self.cad_materials(node, url, kind) if kind in ("dae", "obj") else None
+        if materials is None:
+            mesh = Node("Mesh", {"url": [url]}, node.line, node.col, source=node.source)
+            before = len(owner.parts)
+            self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
+                       seen_by="visual")
+            if len(owner.parts) > before:
+                owner.parts[-1]["_at"] = self.at(node)      # (a problem with its file names the CadShape)
+            return
+        where, found = materials
+        for index, m in found:
+            mesh = Node("Mesh", {"url": [url], "materialIndex": index}, node.line, node.col, source=node.source)
+            self.cad_meshes.add(id(mesh))
+            before = len(owner.parts)
+            self.shape(Node("Shape", {"geometry": mesh}, node.line, node.col, source=node.source), frame, owner,
+                       seen_by="visual")
+            if len(owner.parts) == before:
+                return          # the file is lost (said once)
+            owner.parts[-1]["_at"] = self.at(node)
+            app: dict[str, Any] = {"base_color": list(m.diffuse), "transparency": m.transparency}
+            if m.texture is not None:
+                image = self.cad_texture(node, where, m.texture)
+                if image is not None:
+                    app["texture"] = image
+            owner.parts[-1]["appearance"] = app
+
+    def cad_texture(self, node: Node, where: Path, texture: str) -> dict | None:
+        """A CadShape material's diffuse image (its path as the file writes it, relative to the file)
+        → the world's texture, or None (said once, as other textures not loaded): a PROTO's or
+        ``webots://`` file's image is read in place, read only; a world-folder file's must stay in
+        that folder."""
+        from urllib.parse import unquote
+
+        tex = unquote(texture.replace("\\", "/"))
+        tex = tex.removeprefix("file://")
+        if where.is_absolute():
+            tex_url = str((where.parent / tex).resolve())
+            if Path(tex_url).is_file():
+                self.asset_files.add(Path(tex_url))
+        else:
+            tex_url = posixpath.normpath(posixpath.join(posixpath.dirname(where.as_posix()), tex))
+            folder = Path(self.source).resolve().parent
+            if not (folder / tex_url).resolve().is_relative_to(folder):
+                self.appearance_note(node, f"texture: {texture!r} (of {where.as_posix()!r}) is outside the "
+                                           "world's folder")
+                return None
+        return fx.image_texture(Node("ImageTexture", {"url": [tex_url]}, node.line, node.col, source=node.source),
+                                self.source, lambda _n, message: self.appearance_note(node, message))
+
+    def cad_materials(self, node: Node, url: str, kind: str) -> tuple[Path, list[tuple[int, Any]]] | None:
+        """(the file as the converted world names it, [(material index, CadMaterial)] its triangles
+        use) of a CadShape's COLLADA or OBJ file; None when it cannot be read here (then the Mesh it
+        becomes says why, as a loss or a problem naming the file) or an OBJ file has no materials."""
+        from sensorium.server.world.cad import DEFAULT_MATERIAL
+        from sensorium.server.world.meshes import MeshFileError, file_materials
+
+        named, _ = self.asset(node, url)
+        if named is None:
+            return None
+        path = Path(named)
+        file = path if path.is_absolute() else Path(self.source).resolve().parent / path
+        if (file, kind) not in self.cad_read:
+            try:
+                self.cad_read[(file, kind)] = file_materials(file, kind)
+            except MeshFileError:
+                self.cad_read[(file, kind)] = None
+        if self.cad_read[(file, kind)] is None:
+            return None
+        materials, indices = self.cad_read[(file, kind)]
+        used = [(i, materials[i]) for i in indices]
+        if kind == "obj" and all(m.name == DEFAULT_MATERIAL for _, m in used):
+            return None         # no materials: the file as trimesh reads it, white
+        return path, used
+
     def bounding(self, node: Node | None, frame: Frame, owner: Owner) -> None:
         if node is None:
             return
@@ -780,7 +863,14 @@ class Converter:
             url, why = self.asset(node, urls[0].replace("\\", "/"))
             if url is None:
                 return None, why
-            return {"type": "mesh", "url": url, "scale": [s, s, s]}, ""
+            out = {"type": "mesh", "url": url, "scale": [s, s, s]}
+            # Webots reads both for COLLADA files only; a CadShape's OBJ materials become Meshes of one material
+            if Path(url).suffix.lower() == ".dae" or id(node) in self.cad_meshes:
+                if f.integer("materialIndex", -1) >= 0:
+                    out["material_index"] = f.integer("materialIndex", -1)
+                if f.string("name", ""):
+                    out["name"] = f.string("name", "")
+            return out, ""
         # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
         coord = f.node_("coord")
         points = self.fields(coord).rows("point", 3, []) if coord is not None else []
