@@ -474,3 +474,20 @@ def test_transparency_as_assimp_reads_a_collada_effect(tmp_path: Path, effect: s
     (tmp_path / "t.dae").write_text(text.replace("</diffuse>", "</diffuse>" + effect))
     (m,) = read_dae(str(tmp_path / "t.dae")).materials
     assert (m.diffuse, m.transparency) == ((0.5, 0.5, 0.5), pytest.approx(want, abs=1e-6))
+
+
+def test_materials_too_large_for_the_workers_memory_are_said_not_silently_white(tmp_path: Path, monkeypatch) -> None:
+    """A CadShape whose materials the worker could not read within its memory (its geometry may still
+    load under --allow-large) is converted with one note saying it is seen white; a damaged file is
+    said once, by the Mesh it becomes, not twice."""
+    (tmp_path / "cube.dae").write_text(cube_dae("Z_UP", 1.0))
+    monkeypatch.setattr(meshes, "IN_PROCESS_BYTES", 0)
+    monkeypatch.setattr(meshes, "_worker_header", lambda *a: {"ok": False, "kind": "memory", "error": "out of memory"})
+    with pytest.raises(meshes.MeshMemoryError, match="its materials take more than"):
+        meshes.file_materials(tmp_path / "cube.dae", "dae")
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "cube.dae" ] } ] }\n')
+    w = load_world(p)
+    said = [x for x in w.warnings if "materials" in x]
+    assert len(said) == 1 and "the materials of 'cube.dae' are not read (its materials take more than" in said[0], said
+    assert [s.appearance for s in w.world.solids[0].shapes] == [None]     # no appearance: seen white
+    assert w.losses == ()

@@ -25,6 +25,11 @@ class MeshFileError(Exception):
     """A mesh file that is missing, unreadable or not a triangle mesh."""
 
 
+class MeshMemoryError(MeshFileError):
+    """A file's materials did not fit in the reading worker's memory (its geometry may still load,
+    under raised limits)."""
+
+
 def resolve_mesh_url(url: str, base_dir: Path, *, allow_outside: bool = False, max_bytes: int | None = None,
                      allowed: frozenset[Path] = frozenset()) -> Path:
     """A world file's mesh ``url`` → the file it names, relative to the world's folder.
@@ -220,6 +225,9 @@ def file_materials(path: str | Path, kind: str, memory: int | None = None) -> tu
     header = _worker_header(path, memory if memory is not None else DEFAULT_LOAD_MEMORY, kind, [str(MATERIALS_ONLY)])
     if header is None or not header.get("ok"):
         why = "its reader stopped" if header is None else header.get("error", "?")
+        if header is not None and header.get("kind") == "memory":
+            raise MeshMemoryError(f"its materials take more than {memory if memory is not None else DEFAULT_LOAD_MEMORY:,} "
+                                  "bytes to read")
         raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind, '')} mesh {path}: {why}")
     try:
         materials = [CadMaterial(str(n), (float(d[0]), float(d[1]), float(d[2])), float(t),

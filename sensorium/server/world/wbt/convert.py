@@ -726,7 +726,7 @@ class Converter:
         use) of a CadShape's COLLADA or OBJ file; None when it cannot be read here (then the Mesh it
         becomes says why, as a loss or a problem naming the file) or an OBJ file has no materials."""
         from sensorium.server.world.cad import DEFAULT_MATERIAL
-        from sensorium.server.world.meshes import MeshFileError, file_materials
+        from sensorium.server.world.meshes import MeshFileError, MeshMemoryError, file_materials
 
         named, _ = self.asset(node, url)
         if named is None:
@@ -736,7 +736,11 @@ class Converter:
         if (file, kind) not in self.cad_read:
             try:
                 self.cad_read[(file, kind)] = file_materials(file, kind)
-            except MeshFileError:
+            except MeshMemoryError as exc:
+                # its geometry may still load (--allow-large): then it is seen white, and that is said
+                self.appearance_note(node, f"the materials of {url!r} are not read ({exc}): seen white")
+                self.cad_read[(file, kind)] = None
+            except MeshFileError:         # the Mesh it becomes says why, once
                 self.cad_read[(file, kind)] = None
         if self.cad_read[(file, kind)] is None:
             return None
