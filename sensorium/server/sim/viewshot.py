@@ -37,7 +37,8 @@ from sensorium.server.sim.cameras import Camera, MountedRays
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["EXPORT_SIZE", "MAX_PIXELS", "MAX_SIDE", "MAX_LABELS", "MAX_TEXT", "MAX_LABEL_ID", "Label", "Labels",
-           "Viewpoint", "viewpoint_of", "render", "draw_labels", "picture", "parse_size"]
+           "Viewpoint", "viewpoint_of", "render", "draw_labels", "picture", "parse_size", "FORMATS", "image_format",
+           "encode", "snapshot"]
 
 EXPORT_SIZE = (640, 480)
 """The size of a Supervisor's ``exportImage`` (Webots': its 3D window's, which a server has not)."""
@@ -243,3 +244,46 @@ def parse_size(text: str) -> tuple[int, int]:
     if len(parts) != 2 or not all(p.strip().isdigit() for p in parts):
         raise ValueError(f"size must be WIDTHxHEIGHT (e.g. 640x480), got {text!r}")
     return parse_size_values(int(parts[0]), int(parts[1]))
+
+
+# ------------------------------------------------------------------------------ files (sensorium snapshot)
+
+FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG"}
+
+
+def image_format(name: str) -> str:
+    """"PNG" or "JPEG" by a file name's extension (Webots' ``exportImage`` rule); another is one line."""
+    import os
+
+    ext = os.path.splitext(str(name))[1].lower()
+    if ext not in FORMATS:
+        raise ValueError(f"{name}: the picture must end in .png, .jpg or .jpeg")
+    return FORMATS[ext]
+
+
+def encode(rgb: np.ndarray, fmt: str, quality: int = 95) -> bytes:
+    """An RGB image (H, W, 3) uint8 as PNG or JPEG (``quality`` 1..100) bytes (Pillow)."""
+    import io
+
+    from PIL import Image
+    if isinstance(quality, bool) or not isinstance(quality, int) or not 1 <= quality <= 100:
+        raise ValueError(f"JPEG quality must be an integer in 1..100, got {quality!r}")
+    buf = io.BytesIO()
+    image = Image.fromarray(np.ascontiguousarray(rgb), "RGB")
+    if fmt == "JPEG":
+        image.save(buf, format="JPEG", quality=quality)
+    else:
+        image.save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def snapshot(sim: Any, width: int, height: int, steps: int = 0) -> np.ndarray:
+    """``sensorium snapshot``: ``steps`` basic steps of ``sim`` (its robots with no controller),
+    then the Viewpoint's view."""
+    if isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= 1_000_000:
+        raise ValueError(f"steps must be an integer in 0..1000000, got {steps!r}")
+    width, height = parse_size_values(width, height)
+    viewpoint_of(sim)                 # a Viewpoint that makes no picture: said before any step
+    for _ in range(steps):
+        sim.step()
+    return picture(sim, width, height)
