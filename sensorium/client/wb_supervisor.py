@@ -737,7 +737,7 @@ def wb_supervisor_export_image(filename: str, quality: int) -> None:
     r = _supervisor(func)
     if r is None:
         return
-    if not filename:
+    if not filename or not isinstance(filename, str | os.PathLike):
         print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
         return
     if isinstance(quality, bool) or not isinstance(quality, int) or not 1 <= quality <= 100:
