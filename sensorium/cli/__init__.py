@@ -45,6 +45,20 @@ def _info_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="machine-readable output")
 
 
+@command("snapshot", "picture a world from its Viewpoint on the CPU (PNG or JPEG), with no GPU and no server",
+         "sensorium.cli.snapshot:snapshot")
+def _snapshot_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.serve import add_world_options
+
+    p.add_argument("world", help="world file: YAML, JSON or Webots .wbt")
+    p.add_argument("out", help="the picture to write: .png, .jpg or .jpeg")
+    p.add_argument("--size", default="640x480", metavar="WxH", help="image size in pixels (default 640x480)")
+    p.add_argument("--steps", type=int, default=0, help="basic steps to run first (default 0)")
+    p.add_argument("--quality", type=int, default=95, help="JPEG quality 1..100 (default 95)")
+    p.add_argument("--force", action="store_true", help="overwrite OUT if it exists")
+    add_world_options(p)
+
+
 @command("probe", "run a world in-process and print what enabled devices read", "sensorium.cli.world:probe")
 def _probe_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("world", nargs="?", help="world file (default: the embedded arena world)")

@@ -683,3 +683,83 @@ def supervisor_unserved(func: str) -> None:
     print(f"Error: {func}(): not served by Sensorium (its Supervisor walks the root's children, reads nodes' "
           "identity, poses, velocities and fields (translation, rotation, name, lights' fields, ...), sets poses "
           "and lights, resets and sets the run mode): ignored, Webots' \"no value\" returned.", file=sys.stderr)
+
+
+# ---------------------------------------------------------------------- labels and pictures
+
+MAX_LABEL_ID = 65534       # Webots: 0..65534 (65535 is its movie caption's)
+
+
+def _unit_arg(func: str, name: str, value: Any) -> bool:
+    """Webots' range checks of a label's numbers ([0, 1]); NaN is refused too (Webots' C lets it by)."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value <= 1.0:
+        print(f"Error: {func}() called with {name} parameter outside of [0,1] range.", file=sys.stderr)
+        return False
+    return True
+
+
+def wb_supervisor_set_label(id: int, text: str, x: float, y: float, size: float, color: int,
+                            transparency: float = 0.0, font: str = "Arial") -> None:
+    """Webots' label over the 3D view: here over every ``wb_supervisor_export_image`` picture (and
+    kept by the server under ``id`` until it ends; README "Supervisor")."""
+    func = "wb_supervisor_set_label"
+    for name, value in (("x", x), ("y", y), ("size", size), ("transparency", transparency)):
+        if not _unit_arg(func, name, value):
+            return
+    r = _supervisor(func)
+    if r is None:
+        return
+    if text is None or not isinstance(text, str):
+        print(f"Error: {func}() called with NULL 'text' argument.", file=sys.stderr)
+        return
+    if font is None or not isinstance(font, str):
+        print(f"Error: {func}() called with NULL 'font' argument.", file=sys.stderr)
+        return
+    if isinstance(id, bool) or not isinstance(id, int) or not 0 <= id <= MAX_LABEL_ID:
+        print(f"Error: {func}() called with an 'id' outside of [0,{MAX_LABEL_ID}] ({id!r}).", file=sys.stderr)
+        return
+    if isinstance(color, bool) or not isinstance(color, int) or not 0 <= color <= 0xFFFFFF:
+        print(f"Error: {func}() called with a 'color' that is no 0xRRGGBB value ({color!r}).", file=sys.stderr)
+        return
+    _answer(r, "set_label", {"id": id, "text": text, "x": float(x), "y": float(y), "size": float(size),
+                             "color": color, "transparency": float(transparency), "font": font}, func)
+
+
+def wb_supervisor_export_image(filename: str, quality: int) -> None:
+    """Webots' ``exportImage``: the world seen from its Viewpoint (640 × 480 here) with the labels
+    over it, saved as ``filename`` (``.png``, or ``.jpg``/``.jpeg`` at ``quality`` 1..100, Pillow
+    needed for JPEG). The server sends the pixels; this client writes the file, through a
+    temporary file renamed onto ``filename`` (Webots' way: never a half-written picture)."""
+    import os
+
+    from sensorium.client import images
+    func = "wb_supervisor_export_image"
+    r = _supervisor(func)
+    if r is None:
+        return
+    if not filename or not isinstance(filename, str | os.PathLike):
+        print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
+        return
+    if isinstance(quality, bool) or not isinstance(quality, int) or not 1 <= quality <= 100:
+        print(f"Error: {func}(): 'quality' argument ({quality!r}) must be between 1 and 100.", file=sys.stderr)
+        return
+    name = os.fspath(filename)
+    ext = os.path.splitext(name)[1].lower()
+    if ext not in (".png", ".jpg", ".jpeg"):
+        print(f"Error: {func}(): unsupported image format of {name!r} (use .png, .jpg or .jpeg).", file=sys.stderr)
+        return
+    reply = _answer(r, "export_image", None, func)
+    if reply is None:
+        return
+    folder, base = os.path.split(name)
+    tmp = os.path.join(folder, f".{base}.{os.getpid()}.tmp{ext}")
+    if images.save_rgb(func, tmp, quality, bytes(reply["data"]), int(reply["width"]), int(reply["height"])) != 0:
+        return
+    try:
+        os.replace(tmp, name)
+    except OSError as exc:
+        print(f"Error: {func}(): cannot write {name!r}: {exc.strerror or exc}", file=sys.stderr)
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass

@@ -350,6 +350,19 @@ class SimulationModeArgs(Args):
     mode: int = Field(ge=0, le=2, description="Webots WB_SUPERVISOR_SIMULATION_MODE_*: 0 pause, 1 real time, 2 fast")
 
 
+class SetLabelArgs(Args):
+    """``wb_supervisor_set_label``: a text over the exported picture (README 'Supervisor')."""
+
+    id: int = Field(ge=0, le=65534, description="the label's id (Webots: 0..65534; setting it again replaces it)")
+    text: str = Field(max_length=1024, description="characters 32..127 (and newlines)")
+    x: float = Field(ge=0.0, le=1.0, description="its left edge, a fraction of the image's width")
+    y: float = Field(ge=0.0, le=1.0, description="its top edge, a fraction of the image's height")
+    size: float = Field(ge=0.0, le=1.0, description="its height, a fraction of the image's height")
+    color: int = Field(ge=0, le=0xFFFFFF, description="0xRRGGBB")
+    transparency: float = Field(ge=0.0, le=1.0, description="0 opaque, 1 invisible")
+    font: str = Field(max_length=256, description="Webots' font name (kept; one bitmap font draws every label here)")
+
+
 # ---------------------------------------------------------------------- results
 
 class Empty(Result):
@@ -787,6 +800,14 @@ class DrawResult(Result):
     data: bytes | None = Field(default=None, description="width x height x 4 bytes (B, G, R, A); null: no such image")
 
 
+class ImageResult(Result):
+    """``export_image``: the Viewpoint's picture with the labels over it; the client writes the file."""
+
+    width: int = Field(ge=1)
+    height: int = Field(ge=1)
+    data: bytes = Field(description="width x height x 3 bytes (R, G, B), rows top first")
+
+
 class IntValue(Result):
     value: int
 
@@ -996,6 +1017,8 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),
+    ServiceSpec("set_label", "robot", SetLabelArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("export_image", "robot", NoArgs, ImageResult, attached=True, supervisor=True),
     ServiceSpec("enable", "device", EnableArgs, SuccessResult, attached=True),
     ServiceSpec("get_sampling_period", "device", NoArgs, IntValue),
     ServiceSpec("get_lookup_table", "device", NoArgs, FloatArrayValue),

@@ -29,7 +29,7 @@ from pydantic import ValidationError
 from sensorium.schemas import world as wm
 from sensorium.server.daemon import nested
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
-from sensorium.server.sim import states
+from sensorium.server.sim import states, viewshot
 from sensorium.server.world.poses import matrix_quaternion
 from sensorium.server.world.top_nodes import Scenery
 
@@ -760,6 +760,26 @@ def _set_mode(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     return {"success": True}
 
 
+def _labels(sim: Any) -> viewshot.Labels:
+    kept = getattr(sim, "_labels", None)
+    if kept is None:
+        kept = sim._labels = viewshot.Labels()
+    return kept
+
+
+def _set_label(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    _labels(sim).set(a.id, a.text, a.x, a.y, a.size, a.color, a.transparency, a.font)
+    return {"success": True}
+
+
+def _export_image(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    """The Viewpoint's picture (``viewshot.EXPORT_SIZE``) with the labels: pixels only, the client
+    encodes and writes the file (the server never writes a path a client names)."""
+    w, h = viewshot.EXPORT_SIZE
+    rgb = viewshot.picture(sim, w, h, _labels(sim))
+    return {"width": w, "height": h, "data": rgb.tobytes()}
+
+
 HANDLERS = {
     "get_from_def": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, a.name)),
     "get_self": lambda sim, ls, robot, a: node_ref(sim, robot_node(sim, robot)),
@@ -778,4 +798,6 @@ HANDLERS = {
     "simulation_reset": _reset,
     "simulation_set_mode": _set_mode,
     "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},
+    "set_label": _set_label,
+    "export_image": _export_image,
 }

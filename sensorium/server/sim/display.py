@@ -64,6 +64,32 @@ def _font() -> Any:
     return _FONT
 
 
+def line_height() -> int:
+    """The pixels from one text line's top to the next one's (the font's "Ag" height + 2)."""
+    return int(_font().getbbox("Ag")[3]) + 2
+
+
+def text_lines(text: str) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The glyph pixels of each non-empty line of ``text`` (``\\n`` starts a new one), as column and
+    row offsets (int64) from the text's top-left corner; the Display's text and a Supervisor's
+    labels (``sim/viewshot.py``) are both drawn from them."""
+    from PIL import Image, ImageDraw
+    font = _font()
+    step = line_height()
+    out = []
+    for k, line in enumerate(text.split("\n")):
+        if not line:
+            continue
+        right, bottom = font.getbbox(line)[2:]
+        if right <= 0 or bottom <= 0:
+            continue
+        glyphs = Image.new("1", (right, bottom), 0)
+        ImageDraw.Draw(glyphs).text((0, 0), line, font=font, fill=1)
+        gy, gx = np.nonzero(np.asarray(glyphs, dtype=np.uint8))
+        out.append((gx.astype(np.int64), k * step + gy.astype(np.int64)))
+    return out
+
+
 def _cdiv(a: int, b: int) -> int:
     """C's integer division (truncation toward zero)."""
     q = abs(a) // abs(b)
@@ -465,20 +491,9 @@ class Display(Device):
     def _op_text(self, text: str, x: int, y: int) -> bool:
         if x >= self.width or y >= self.height:
             return False
-        from PIL import Image, ImageDraw
-        font = _font()
         drawn = False
-        line_height = font.getbbox("Ag")[3] + 2
-        for k, line in enumerate(text.split("\n")):
-            if not line:
-                continue
-            right, bottom = font.getbbox(line)[2:]
-            if right <= 0 or bottom <= 0:
-                continue
-            glyphs = Image.new("1", (right, bottom), 0)
-            ImageDraw.Draw(glyphs).text((0, 0), line, font=font, fill=1)
-            gy, gx = np.nonzero(np.asarray(glyphs, dtype=np.uint8))
-            drawn |= self._blend(x + gx.astype(np.int64), y + k * line_height + gy.astype(np.int64))
+        for gx, gy in text_lines(text):
+            drawn |= self._blend(x + gx, y + gy)
         return drawn
 
     def _op_copy(self, iid: int, x: int, y: int, w: int, h: int) -> bool:

@@ -1058,3 +1058,150 @@ void wb_supervisor_node_disable_contact_point_tracking(WbNodeRef node, bool incl
   (void)include_descendants;
   supervisor("wb_supervisor_node_disable_contact_point_tracking");
 }
+
+/* ------------------------------------------------------------------ labels and pictures */
+#define MAX_LABEL_ID 65534 /* Webots: 0..65534, 65535 is its movie caption's */
+#define MAX_LABEL_TEXT 1024
+#define MAX_LABEL_FONT 256
+
+typedef struct {
+  int id;
+  const char *text;
+  double x, y, size;
+  int color;
+  double transparency;
+  const char *font;
+} label_args;
+
+static void args_label(sn_req *r, const void *arg) {
+  const label_args *a = arg;
+  sn_req_key(r, "id");
+  msgpack_pack_int(&r->pk, a->id);
+  sn_req_key(r, "text");
+  sn_req_str(r, a->text);
+  sn_req_key(r, "x");
+  msgpack_pack_double(&r->pk, a->x);
+  sn_req_key(r, "y");
+  msgpack_pack_double(&r->pk, a->y);
+  sn_req_key(r, "size");
+  msgpack_pack_double(&r->pk, a->size);
+  sn_req_key(r, "color");
+  msgpack_pack_int(&r->pk, a->color);
+  sn_req_key(r, "transparency");
+  msgpack_pack_double(&r->pk, a->transparency);
+  sn_req_key(r, "font");
+  sn_req_str(r, a->font);
+}
+
+static bool unit_arg(const char *func, const char *name, double v) {
+  if (!(v >= 0.0 && v <= 1.0)) { /* NaN refused too (Webots' checks let it by) */
+    fprintf(stderr, "Error: %s() called with %s parameter outside of [0,1] range.\n", func, name);
+    return false;
+  }
+  return true;
+}
+
+/* Webots' label over the 3D view: here over every wb_supervisor_export_image picture, kept by the
+   server under id (README "Supervisor"). Webots' checks, then the id's and colour's ranges. */
+void wb_supervisor_set_label(int id, const char *text, double x, double y, double size, int color, double transparency,
+                             const char *font) {
+  const char *func = "wb_supervisor_set_label";
+  if (!unit_arg(func, "x", x) || !unit_arg(func, "y", y) || !unit_arg(func, "size", size) ||
+      !unit_arg(func, "transparency", transparency))
+    return;
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return;
+  if (text == NULL) {
+    fprintf(stderr, "Error: %s() called with NULL 'text' argument.\n", func);
+    return;
+  }
+  if (font == NULL) {
+    fprintf(stderr, "Error: %s() called with NULL 'font' argument.\n", func);
+    return;
+  }
+  if (id < 0 || id > MAX_LABEL_ID) {
+    fprintf(stderr, "Error: %s() called with an 'id' outside of [0,%d] (%d).\n", func, MAX_LABEL_ID, id);
+    return;
+  }
+  if (color < 0 || color > 0xFFFFFF) {
+    fprintf(stderr, "Error: %s() called with a 'color' that is no 0xRRGGBB value (%d).\n", func, color);
+    return;
+  }
+  if (strlen(text) > MAX_LABEL_TEXT || strlen(font) > MAX_LABEL_FONT) {
+    fprintf(stderr, "Error: %s() called with a 'text' over %d or a 'font' over %d characters.\n", func, MAX_LABEL_TEXT,
+            MAX_LABEL_FONT);
+    return;
+  }
+  label_args a = {id, text, x, y, size, color, transparency, font};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/set_label", 8, args_label, &a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
+static bool ends_with(const char *s, const char *suffix) {
+  size_t n = strlen(s), k = strlen(suffix);
+  if (n < k)
+    return false;
+  for (size_t i = 0; i < k; i++) {
+    char c = s[n - k + i];
+    if (c >= 'A' && c <= 'Z')
+      c = (char)(c - 'A' + 'a');
+    if (c != suffix[i])
+      return false;
+  }
+  return true;
+}
+
+/* Webots' exportImage: the world seen from its Viewpoint (640 x 480 here) with the labels over it.
+   The server sends the pixels; this library writes filename (.png, or .jpg/.jpeg at quality) through
+   a temporary file beside it renamed onto it (Webots' way: never a half-written picture). */
+void wb_supervisor_export_image(const char *filename, int quality) {
+  const char *func = "wb_supervisor_export_image";
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return;
+  if (filename == NULL || filename[0] == '\0') {
+    fprintf(stderr, "Error: %s() called with NULL or empty 'filename' argument.\n", func);
+    return;
+  }
+  if (quality < 1 || quality > 100) {
+    fprintf(stderr, "Error: %s(): 'quality' argument (%d) must be between 1 and 100.\n", func, quality);
+    return;
+  }
+  const bool png = ends_with(filename, ".png");
+  const char *ext = png ? ".png" : ends_with(filename, ".jpg") ? ".jpg" : ends_with(filename, ".jpeg") ? ".jpeg" : NULL;
+  if (ext == NULL) {
+    fprintf(stderr, "Error: %s(): unsupported image format of '%s' (use .png, .jpg or .jpeg).\n", func, filename);
+    return;
+  }
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/export_image", 0, NULL, NULL, func, &rep) != 0)
+    return;
+  const msgpack_object *data = sn_get(rep.result, "data");
+  int w = (int)sn_int_or(rep.result, "width", 0), h = (int)sn_int_or(rep.result, "height", 0);
+  if (data == NULL || data->type != MSGPACK_OBJECT_BIN || w < 1 || h < 1 ||
+      data->via.bin.size != 3 * (size_t)w * (size_t)h) {
+    fprintf(stderr, "Error: %s(): the server sent no picture: '%s' is not written.\n", func, filename);
+    sn_reply_free(&rep);
+    return;
+  }
+  size_t n = strlen(filename) + 16;
+  char *tmp = malloc(n);
+  if (tmp == NULL) {
+    sn_reply_free(&rep);
+    return;
+  }
+  snprintf(tmp, n, "%s.tmp%s", filename, ext);
+  const unsigned char *rgb = (const unsigned char *)data->via.bin.ptr;
+  char why[256] = "";
+  int rc = png ? sn_write_png(tmp, rgb, w, h, 3) : sn_write_jpeg(tmp, rgb, w, h, quality, why, sizeof why);
+  sn_reply_free(&rep);
+  if (rc == 0 && rename(tmp, filename) != 0)
+    rc = -1;
+  if (rc != 0) {
+    fprintf(stderr, "Error: %s(): cannot write '%s'%s%s%s.\n", func, filename, why[0] ? " (" : "", why, why[0] ? ")" : "");
+    remove(tmp);
+  }
+  free(tmp);
+}

@@ -26,14 +26,6 @@ void wb_supervisor_world_reload(void) {
 }
 
 
-void wb_supervisor_set_label(int id, const char *text, double x, double y, double size, int color, double transparency, const char *font) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_export_image(const char *filename, int quality) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_movie_start_recording(const char *filename, int width, int height, int codec, int quality, int acceleration, bool caption) {
   SN_UNSUPPORTED();
 }

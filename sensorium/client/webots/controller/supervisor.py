@@ -327,6 +327,13 @@ class Supervisor(Robot):
             return None
         return r.conn.call(f"/{r.name}/robot/{item}", args)
 
+    def setLabel(self, id: int, label: str, x: float, y: float, size: float, color: int,
+                 transparency: float = 0.0, font: str = "Arial") -> None:
+        wb.wb_supervisor_set_label(id, label, x, y, size, color, transparency, font)
+
+    def exportImage(self, file: str, quality: int) -> None:
+        wb.wb_supervisor_export_image(file, quality)
+
     def simulationReset(self) -> None:
         wb.wb_supervisor_simulation_reset()
 
@@ -366,9 +373,8 @@ _NAN = math.nan
 _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
     Supervisor: {
         "getSelected": ("node_get_selected", None),
-        "setLabel": ("set_label", None),
         "worldLoad": ("world_load", None), "worldSave": ("world_save", False), "worldReload": ("world_reload", None),
-        "exportImage": ("export_image", None), "movieStartRecording": ("movie_start_recording", None),
+        "movieStartRecording": ("movie_start_recording", None),
         "movieStopRecording": ("movie_stop_recording", None), "movieIsReady": ("movie_is_ready", True),
         "movieFailed": ("movie_failed", True), "animationStartRecording": ("animation_start_recording", False),
         "animationStopRecording": ("animation_stop_recording", False),
