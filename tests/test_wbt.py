@@ -105,7 +105,7 @@ def test_an_indexed_face_set_without_coord_says_so(tmp_path: Path) -> None:
 def test_skipped_nodes_summarised_once() -> None:
     w = load_world(HERE / "full.wbt")
     summary = [x for x in w.warnings if "skipped nodes that do not matter" in x]
-    assert summary == [f"{HERE / 'full.wbt'}: skipped nodes that do not matter to these sensors: TexturedBackground, Viewpoint"]
+    assert summary == [f"{HERE / 'full.wbt'}: skipped nodes that do not matter to these sensors: TexturedBackground"]
 
 
 def test_convert_round_trip(tmp_path: Path, capsys) -> None:

@@ -48,7 +48,7 @@ SCENERY_VALUES = {
 # when their file is not at hand: the Supervisor names them as Webots does
 KNOWN_PROTO_BASES = {"RectangleArena": "Solid", "Floor": "Solid", "SolidBox": "Solid", "WoodenBox": "Solid",
                      "TexturedBackgroundLight": "DirectionalLight", "TexturedBackground": "Background"}
-SKIPPED = {"Viewpoint", "Background", "TexturedBackground", "Physics", "ImmersionProperties",
+SKIPPED = {"Background", "TexturedBackground", "Physics", "ImmersionProperties",
            "ContactProperties", "Damping", "Muscle"}
 # devices not simulated here: listed in the robot's devices (Webots' indices) as UnsimulatedDevice;
 # the Solid ones keep their shapes as part of the robot's body (Charger and Track are Solids, not devices)
@@ -444,6 +444,8 @@ class Converter:
             else:
                 self.warn(node, "a Fog node counts only at the top level of a world (Webots allows it nowhere "
                                 "else); skipped")
+        elif t == "Viewpoint":           # its values are kept (top_node): the Supervisor's and snapshots' view
+            pass
         elif t in SKIPPED:
             self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
