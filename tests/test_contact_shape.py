@@ -1,0 +1,155 @@
+"""Kinematic contact with footprints that follow the robot's shape (sensorium/server/sim/contact.py):
+a box robot is its rectangle turned with its heading, not the disc around it, so its faces stop
+where they touch, it passes beside a wall its disc would have met, its corners cannot be turned
+into a wall, and robots meet face to face. Wheels of radius 0.1 m at w rad/s move a robot
+w * 0.1 m/s; every stopping point is a distance the geometry gives exactly."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensorium.server.sim import contact as C
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world import geometry as geo
+from sensorium.server.world.geometry import Pose
+from sensorium.server.world.loader import parse_world
+
+LONG, WIDE = 0.5, 0.2          # the box robot's length (along its heading) and width
+STEP = 32
+
+
+def box_robot(name, x, y, yaw=0.0, size=(LONG, WIDE), **extra):
+    return {"name": name, "pose": {"translation": [x, y, 0.1], "rotation": [0, 0, 1, yaw]},
+            "body": {"geometry": {"type": "box", "size": [size[0], size[1], 0.2]}},
+            "differential_drive": {"wheel_radius": 0.1, "axle_length": 0.3, "max_wheel_speed": 1000.0}, **extra}
+
+
+def world(solids=(), robots=(), contact=True):
+    return Simulation(parse_world({"world_info": {"basic_time_step": STEP, "contact": contact},
+                                   "solids": [{"name": "floor", "geometry": {"type": "plane", "size": None}},
+                                              *solids],
+                                   "robots": list(robots)}))
+
+
+def drive(sim, name, left, right=None):
+    for m, w in zip(sim.robot(name).motors.values(), (left, left if right is None else right)):
+        m.set_position(math.inf)
+        m.set_velocity(w)
+
+
+def xy(sim, name):
+    return sim.robot(name).pose.translation[:2].copy()
+
+
+def heading(sim, name):
+    r = sim.robot(name).pose.rotation
+    return math.atan2(r[1, 0], r[0, 0])
+
+
+def corners(sim, name, size=(LONG, WIDE)):
+    c, h = xy(sim, name), heading(sim, name)
+    u, v = np.array([math.cos(h), math.sin(h)]), np.array([-math.sin(h), math.cos(h)])
+    return np.array([c + sx * size[0] / 2 * u + sy * size[1] / 2 * v for sx in (-1, 1) for sy in (-1, 1)])
+
+
+def block(name, x0, x1, y0, y1):
+    """An upright box solid covering [x0, x1] x [y0, y1], 0.5 m tall."""
+    return {"name": name, "pose": {"translation": [(x0 + x1) / 2, (y0 + y1) / 2, 0.25]},
+            "geometry": {"type": "box", "size": [x1 - x0, y1 - y0, 0.5]}}
+
+
+def test_a_box_robot_is_its_rectangle_and_a_centred_cylinder_stays_a_disc():
+    foot = C.robot_footprint([(geo.Box((LONG, WIDE, 0.2)), Pose.identity())])
+    assert foot is not None and not foot.disc and foot.round == 0.0
+    assert sorted(map(tuple, foot.points.tolist())) == [(-0.25, -0.1), (-0.25, 0.1), (0.25, -0.1), (0.25, 0.1)]
+    assert foot.radius == math.hypot(LONG, WIDE) / 2.0               # its broad-phase disc, as before
+    disc = C.robot_footprint([(geo.Cylinder(0.2, 0.2), Pose.identity())])
+    assert disc is not None and disc.disc and disc.radius == 0.2
+    # a wheel inside a round body's disc adds nothing: the body's disc is the footprint
+    wheel = Pose(np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]), np.array([0.0, 0.1, 0.0]))
+    both = C.robot_footprint([(geo.Cylinder(0.2, 0.2), Pose.identity()), (geo.Cylinder(0.05, 0.01), wheel)])
+    assert both is not None and both.disc
+
+
+def test_driving_beside_a_wall_its_disc_would_touch_is_not_stopped():
+    # a wall from x = 1 to 3 whose face is 0.15 m from the robot's centre line: its side (0.1 m)
+    # passes clear; the disc of radius hypot(0.5, 0.2) / 2 = 0.269 m met the wall's corner and was
+    # pushed aside
+    wall = block("wall", 1.0, 3.0, 0.15, 0.35)
+    sim = world([wall], [box_robot("r", 0.0, 0.0)])
+    drive(sim, "r", 10.0)                                            # 1 m/s, 32 mm per step
+    for _ in range(100):
+        sim.step()
+    assert sim.counters["contacts"] == 0
+    x, y = xy(sim, "r")
+    assert x == pytest.approx(100 * 0.032, abs=1e-9) and y == 0.0
+
+
+@pytest.mark.parametrize("yaw", [0.0, math.pi / 2, 0.7])
+def test_driving_head_on_into_a_wall_stops_with_the_front_face_touching(yaw):
+    # the wall's face is 1.9 m ahead along the heading, square to it: the robot's front face stops
+    # on it, its centre LONG / 2 short of it
+    u = np.array([math.cos(yaw), math.sin(yaw)])
+    v = np.array([-u[1], u[0]])
+    centre = 2.0 * u
+    wall = {"name": "wall", "pose": {"translation": [*centre, 0.25], "rotation": [0, 0, 1, yaw]},
+            "geometry": {"type": "box", "size": [0.2, 4.0, 0.5]}}
+    sim = world([wall], [box_robot("r", 0.0, 0.0, yaw)])
+    drive(sim, "r", 10.0)
+    for _ in range(120):
+        sim.step()
+    p = xy(sim, "r")
+    assert float(p @ u) == pytest.approx(1.9 - LONG / 2.0, abs=1e-9)
+    assert float(p @ v) == pytest.approx(0.0, abs=1e-9)
+    assert sim.counters["contacts"] > 0
+
+
+def test_a_turning_long_robot_cannot_turn_its_corner_into_a_wall_and_can_turn_back():
+    # a wall 0.15 m from its centre line, along it: turning in place, a corner (0.25, ±0.1) reaches
+    # the wall's face at the heading t where 0.25 sin t + 0.1 cos t = 0.15
+    wall = block("wall", -3.0, 3.0, 0.15, 0.35)
+    sim = world([wall], [box_robot("r", 0.0, 0.0)])
+    t_touch = math.asin(0.15 / math.hypot(0.25, 0.1)) - math.atan2(0.1, 0.25)
+    per_step = 0.1 * 2 * 1.0 / 0.3 * STEP / 1000                      # wheels -1 and +1 rad/s: 0.0213 rad a step
+    drive(sim, "r", -1.0, 1.0)
+    for _ in range(60):                                               # 1.28 rad asked for
+        sim.step()
+        assert float(corners(sim, "r")[:, 1].max()) <= 0.15 + 1e-9
+    h = heading(sim, "r")
+    assert t_touch - 2 * per_step < h <= t_touch
+    assert np.allclose(xy(sim, "r"), 0.0, atol=1e-12)                # turning in place: it stays put
+    assert sim.robot("r").pressing
+    drive(sim, "r", 1.0, -1.0)                                        # the other way: free
+    sim.step()
+    assert heading(sim, "r") == pytest.approx(h - per_step, abs=1e-12)
+    assert not sim.robot("r").pressing
+
+
+def test_two_box_robots_meet_face_to_face_at_the_sum_of_their_half_lengths():
+    sim = world(robots=[box_robot("a", 0.0, 0.0), box_robot("b", 2.0, 0.0, math.pi, size=(0.3, 0.6))])
+    drive(sim, "a", 10.0)
+    drive(sim, "b", 10.0)
+    for _ in range(60):
+        sim.step()
+    assert xy(sim, "b")[0] - xy(sim, "a")[0] == pytest.approx(LONG / 2 + 0.3 / 2, abs=1e-9)
+    assert abs(xy(sim, "a")[1]) < 1e-12 and abs(xy(sim, "b")[1]) < 1e-12
+
+
+def test_wide_robots_drive_their_front_connectors_together_and_dock():
+    # Webots' connector sample in spirit: robots wider (0.6 m) than long (0.2 m), each with a
+    # connector on its front face; their discs (radius 0.316 m) met 0.43 m before the connectors
+    def bot(name, x, yaw):
+        return box_robot(name, x, 0.0, yaw, size=(0.2, 0.6),
+                         devices=[{"device": "Connector", "name": "dock", "pose": {"translation": [0.1, 0, 0]}}])
+    sim = world(robots=[bot("a", 0.0, 0.0), bot("b", 1.0, math.pi)])
+    dock = sim.device("a/dock")
+    dock.enable(STEP)
+    drive(sim, "a", 5.0)
+    drive(sim, "b", 5.0)
+    for _ in range(60):
+        sim.step()
+    assert xy(sim, "b")[0] - xy(sim, "a")[0] == pytest.approx(0.2, abs=1e-9)
+    assert dock.value == 1
