@@ -153,3 +153,53 @@ def test_wide_robots_drive_their_front_connectors_together_and_dock():
         sim.step()
     assert xy(sim, "b")[0] - xy(sim, "a")[0] == pytest.approx(0.2, abs=1e-9)
     assert dock.value == 1
+
+
+def _pen_world():
+    """Three box robots in a 2 m square pen (walls 0.1 m thick), one a cylinder-bodied disc."""
+    walls = [block("n", -1.1, 1.1, 1.0, 1.1), block("s", -1.1, 1.1, -1.1, -1.0),
+             block("e", 1.0, 1.1, -1.0, 1.0), block("w", -1.1, -1.0, -1.0, 1.0)]
+    disc = box_robot("c", 0.0, 0.5, 2.0)
+    disc["body"] = {"geometry": {"type": "cylinder", "radius": 0.15, "height": 0.2}}
+    return parse_world({"world_info": {"basic_time_step": STEP},
+                        "solids": [{"name": "floor", "geometry": {"type": "plane", "size": None}}, *walls],
+                        "robots": [box_robot("a", -0.4, 0.0, 0.3), box_robot("b", 0.4, -0.2, 2.5, size=(0.3, 0.6)),
+                                   disc]})
+
+
+@pytest.mark.parametrize("native", [True, False])
+def test_the_batched_engine_clips_and_refuses_turns_as_the_single_simulation_bit_for_bit(native):
+    """Shaped footprints in the batched engine (its numpy path and its C drive pass): every copy,
+    driven with its own random wheel speeds into the walls and one another, keeps the single
+    simulation's poses and pressing flags bit for bit, turns refused included."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.batched import BatchedSimulation
+    if native and packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    n = 3
+    bs = BatchedSimulation(_pen_world(), n)
+    if not native:
+        bs._drive_step = None
+    bs.reset(np.arange(n), [1] * n)
+    singles = [Simulation(_pen_world()) for _ in range(n)]
+    rng = np.random.default_rng(7)
+    refused = 0
+    for step in range(300):
+        if step % 25 == 0:
+            lr = rng.uniform(-12.0, 12.0, (3, n, 2))
+            for r, name in enumerate("abc"):
+                bs.set_wheels(r, lr[r, :, 0], lr[r, :, 1])
+                for c in range(n):
+                    drive(singles[c], name, lr[r, c, 0], lr[r, c, 1])
+        yaw_before = bs.yaw.copy()
+        bs.step()
+        for c, sim in enumerate(singles):
+            sim.step()
+            for r, name in enumerate("abc"):
+                pose = sim.robot(name).pose
+                assert bs.pos[c, r].tobytes() == pose.translation.tobytes(), (step, c, name)
+                assert bs.rot[c, r].tobytes() == pose.rotation.tobytes(), (step, c, name)
+                assert bool(bs.pressing[c, r]) == sim.robot(name).pressing, (step, c, name)
+        refused += int(np.count_nonzero((bs.yaw == yaw_before) & (bs.velocity[:, :, 0] != bs.velocity[:, :, 1])))
+    assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
+    assert refused > 10

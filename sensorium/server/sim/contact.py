@@ -98,9 +98,15 @@ class Footprint:
 
     @property
     def disc(self) -> bool:
-        """Whether the footprint is a disc about the origin: it turns freely (the old rule, bit for bit)."""
+        """Whether the footprint is a disc about the origin (of radius ``round``; ``radius`` with no
+        points): it turns freely, and a centred upright cylinder's is its radius, as it always was."""
         p = self.points
-        return p is None or (len(p) == 1 and p[0, 0] == 0.0 and p[0, 1] == 0.0 and self.round == self.radius)
+        return p is None or (len(p) == 1 and p[0, 0] == 0.0 and p[0, 1] == 0.0)
+
+    @property
+    def disc_radius(self) -> float:
+        """The radius of a :attr:`disc` footprint."""
+        return self.radius if self.points is None else self.round
 
 
 # ---------------------------------------------------------------------- shapes → 2D
@@ -724,7 +730,7 @@ class Contact:
                 for j in near_robots[m]:
                     cands.append(self._robot_obstacle(j))
             if foot.disc:                    # a disc turns freely
-                p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], float(R[m]), cands)
+                p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], foot.disc_radius, cands)
                 turned = True
             else:
                 p, clipped, turned = self._clip_shaped(foot, starts[m].copy(), ends[m] - starts[m], yaw0, yaw1, cands)
@@ -739,7 +745,7 @@ class Contact:
         assert foot is not None
         band = (float(self.heights[j] + self._z_low[j]), float(self.heights[j] + self._z_high[j]))
         if foot.disc:
-            return Obstacle(f"robot {j}", int(j), self.centres[j][None, :].copy(), float(self._radius[j]), band)
+            return Obstacle(f"robot {j}", int(j), self.centres[j][None, :].copy(), foot.disc_radius, band)
         assert foot.points is not None
         return shaped_obstacle(j, foot, self.centres[j], float(self.yaw[j]), band)
 
