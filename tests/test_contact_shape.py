@@ -107,9 +107,10 @@ def test_driving_head_on_into_a_wall_stops_with_the_front_face_touching(yaw):
     assert sim.counters["contacts"] > 0
 
 
-def test_a_turning_long_robot_cannot_turn_its_corner_into_a_wall_and_can_turn_back():
+def test_a_turning_long_robot_turns_until_its_corner_touches_a_wall_and_can_turn_back():
     # a wall 0.15 m from its centre line, along it: turning in place, a corner (0.25, ±0.1) reaches
-    # the wall's face at the heading t where 0.25 sin t + 0.1 cos t = 0.15
+    # the wall's face at the heading t where 0.25 sin t + 0.1 cos t = 0.15; the turn is cut short
+    # there, to 2^-12 of a step's turn (contact.TURN_HALVINGS)
     wall = block("wall", -3.0, 3.0, 0.15, 0.35)
     sim = world([wall], [box_robot("r", 0.0, 0.0)])
     t_touch = math.asin(0.15 / math.hypot(0.25, 0.1)) - math.atan2(0.1, 0.25)
@@ -119,7 +120,7 @@ def test_a_turning_long_robot_cannot_turn_its_corner_into_a_wall_and_can_turn_ba
         sim.step()
         assert float(corners(sim, "r")[:, 1].max()) <= 0.15 + 1e-9
     h = heading(sim, "r")
-    assert t_touch - 2 * per_step < h <= t_touch
+    assert t_touch - per_step * 2.0 ** -C.TURN_HALVINGS <= h <= t_touch
     assert np.allclose(xy(sim, "r"), 0.0, atol=1e-12)                # turning in place: it stays put
     assert sim.robot("r").pressing
     drive(sim, "r", 1.0, -1.0)                                        # the other way: free
@@ -183,7 +184,7 @@ def test_the_batched_engine_clips_and_refuses_turns_as_the_single_simulation_bit
     bs.reset(np.arange(n), [1] * n)
     singles = [Simulation(_pen_world()) for _ in range(n)]
     rng = np.random.default_rng(7)
-    refused = 0
+    held = 0                                  # steps a robot asked to turn and kept its heading
     for step in range(300):
         if step % 25 == 0:
             lr = rng.uniform(-12.0, 12.0, (3, n, 2))
@@ -200,6 +201,6 @@ def test_the_batched_engine_clips_and_refuses_turns_as_the_single_simulation_bit
                 assert bs.pos[c, r].tobytes() == pose.translation.tobytes(), (step, c, name)
                 assert bs.rot[c, r].tobytes() == pose.rotation.tobytes(), (step, c, name)
                 assert bool(bs.pressing[c, r]) == sim.robot(name).pressing, (step, c, name)
-        refused += int(np.count_nonzero((bs.yaw == yaw_before) & (bs.velocity[:, :, 0] != bs.velocity[:, :, 1])))
+        held += int(np.count_nonzero((bs.yaw == yaw_before) & (bs.velocity[:, :, 0] != bs.velocity[:, :, 1])))
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
-    assert refused > 10
+    assert held > 10

@@ -741,7 +741,7 @@ class BatchedSimulation:
                                       step.solid_hit[:k] if len(ct._obs) else None,
                                       step.robot_hit[:k] if self.R > 1 else None, step.near[:k])
             self.x[copies, slots], self.y[copies, slots] = x, y
-            if len(kept):     # turns refused: the heading they started with
+            if len(kept):     # turns cut short by contact: the heading they kept
                 _turn_back(kept, self.yaw[copies[kept], slots[kept]], step.cos, step.sin, step.rz)
         if ct is not None:
             self.foot_yaw[copies, slots] = self.yaw[copies, slots]
@@ -797,7 +797,7 @@ class BatchedSimulation:
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
             x, y, kept = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1), yaw0)
-            if len(kept):     # turns refused: the heading they started with
+            if len(kept):     # turns cut short by contact: the heading they kept
                 _turn_back(kept, self.yaw[copies[kept], slots[kept]], cos, sin, None)
             self.foot_yaw[copies, slots] = self.yaw[copies, slots]
         self.x[copies, slots], self.y[copies, slots] = x, y
@@ -864,7 +864,7 @@ class BatchedSimulation:
         """Contact.resolve_all per copy: robots in slot order, each against the solids and its own
         copy's other robots (where they are when its turn comes); the same broad phase, the same
         narrow phase (Contact._clip). ``yaw0``: the moves' headings at the start (self.yaw holds
-        the end's). Returns the final xy and the moves whose turn was refused (self.yaw put back)."""
+        the end's). Returns the final xy and the moves whose turn was cut short (self.yaw written)."""
         ct = self.contact
         assert ct is not None
         reach = np.hypot(*(ends - starts).T) + EPS
@@ -892,7 +892,7 @@ class BatchedSimulation:
                 solid_hit: np.ndarray | None, robot_hit: np.ndarray | None, near: np.ndarray):
         """The narrow phase of :meth:`_contact` once the broad phase found a move near something:
         Contact._clip (a shaped footprint: Contact._clip_shaped) of each near move (centres and
-        footprint headings written); returns the final xy and the moves whose turn was refused."""
+        footprint headings written); returns the final xy and the moves whose turn was cut short."""
         ct = self.contact
         assert ct is not None
         out = ends.copy()
@@ -942,10 +942,10 @@ class BatchedSimulation:
                         cands.append(Obstacle(f"robot {j}", int(j), centre[None, :].copy(), float(self.foot_disc[j]),
                                               band))
             if self._shaped[r]:
-                p, clipped, turned = ct._clip_shaped(self.feet[r], starts[m].copy(), ends[m] - starts[m],
-                                                     float(yaw0[m]), float(self.yaw[cm, r]), cands)
-                if not turned:
-                    self.yaw[cm, r] = yaw0[m]
+                p, clipped, heading_ = ct._clip_shaped(self.feet[r], starts[m].copy(), ends[m] - starts[m],
+                                                       float(yaw0[m]), float(self.yaw[cm, r]), cands)
+                if heading_ != self.yaw[cm, r]:      # the turn cut short
+                    self.yaw[cm, r] = heading_
                     kept.append(m)
             else:
                 p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(self.foot_disc[r]), cands)
@@ -1612,8 +1612,8 @@ def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: 
 
 
 def _turn_back(kept: np.ndarray, yaw: np.ndarray, cos: np.ndarray, sin: np.ndarray, rz: np.ndarray | None) -> None:
-    """The moves ``kept`` (their turns refused by contact) take back the heading ``yaw`` they
-    started with: their cos, sin (and Rz) rows, as the single simulation's pose of it."""
+    """The moves ``kept`` (their turns cut short by contact) take the heading ``yaw`` they kept:
+    their cos, sin (and Rz) rows, as the single simulation's pose of it."""
     c, s = kin.libm_cos_sin(np.ascontiguousarray(yaw, dtype=np.float64))
     cos[kept], sin[kept] = c, s
     if rz is not None:

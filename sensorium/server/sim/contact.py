@@ -49,6 +49,7 @@ EPS = 1e-9            # m: "touching" tolerance
 FLOOR = 1e-3          # m: a solid whose top is at most this above a robot band's bottom is its floor
 BACK_OFF = 1e-12      # m: contact points are placed this far outside, never on or inside
 MAX_SLIDES = 3
+TURN_HALVINGS = 12    # a turn cut short by contact is found to 2^-12 of the step's turn
 UPRIGHT = 1.0 - 1e-12
 
 
@@ -559,6 +560,11 @@ def shaped_obstacle(j: int, foot: Footprint, centre: np.ndarray, yaw: float, ban
     return Obstacle(f"robot {j}", int(j), _turned(foot.points, yaw) + centre[None, :], foot.round, band)
 
 
+def _wrap(a: float) -> float:
+    """``a`` in [-π, π), as the drives keep their heading (motion._wrap)."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
 def _turned(points: np.ndarray, yaw: float) -> np.ndarray:
     """``points`` (robot frame, heading out) turned by ``yaw`` about up."""
     c, s = math.cos(yaw), math.sin(yaw)
@@ -669,14 +675,14 @@ class Contact:
         self.heights[index] = pose.translation[2]
         self.yaw[index] = heading(pose) if yaw is None else yaw
 
-    def resolve(self, index: int, start, end, yaws=None) -> tuple[np.ndarray, bool, bool]:
+    def resolve(self, index: int, start, end, yaws=None) -> tuple[np.ndarray, bool, float]:
         """Clip robot ``index``'s move from ``start`` to ``end`` (xy), its heading going from
-        ``yaws[0]`` to ``yaws[1]`` (None: kept): ``(final xy, clipped, turned)``."""
+        ``yaws[0]`` to ``yaws[1]`` (None: kept): ``(final xy, clipped, final heading)``."""
         return self.resolve_all([index], np.asarray([start], dtype=np.float64), np.asarray([end], dtype=np.float64),
                                 None if yaws is None else np.asarray([yaws], dtype=np.float64))[0]
 
     def resolve_all(self, indices: list[int], starts: np.ndarray, ends: np.ndarray,
-                    yaws: np.ndarray | None = None) -> list[tuple[np.ndarray, bool, bool]]:
+                    yaws: np.ndarray | None = None) -> list[tuple[np.ndarray, bool, float]]:
         """Clip the moves of several robots (one basic step), in order: each sees the others where
         they are when its turn comes. ``yaws``: (k, 2), each one's heading at the start and the
         end of the step (None: headings kept). Returns (final xy, clipped, turned) per move: ``turned`` False when its turn
@@ -722,7 +728,7 @@ class Contact:
             if foot is None:
                 self.centres[i] = ends[m]
                 self.yaw[i] = yaw1
-                out.append((ends[m].copy(), False, True))
+                out.append((ends[m].copy(), False, yaw1))
                 continue
             cands: list[Obstacle] = [self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m]))
                                      for j in near_solids[m]]
@@ -731,12 +737,12 @@ class Contact:
                     cands.append(self._robot_obstacle(j))
             if foot.disc:                    # a disc turns freely
                 p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], foot.disc_radius, cands)
-                turned = True
+                kept = yaw1
             else:
-                p, clipped, turned = self._clip_shaped(foot, starts[m].copy(), ends[m] - starts[m], yaw0, yaw1, cands)
+                p, clipped, kept = self._clip_shaped(foot, starts[m].copy(), ends[m] - starts[m], yaw0, yaw1, cands)
             self.centres[i] = p
-            self.yaw[i] = yaw1 if turned else yaw0
-            out.append((p, clipped, turned))
+            self.yaw[i] = kept
+            out.append((p, clipped, kept))
         return out
 
     def _robot_obstacle(self, j: int) -> Obstacle:
@@ -764,40 +770,54 @@ class Contact:
         return self._sweep(p, d, [(ob, R) for ob in cands])
 
     def _clip_shaped(self, foot: Footprint, p: np.ndarray, d: np.ndarray, yaw: float, yaw1: float,
-                     cands: list[Obstacle]) -> tuple[np.ndarray, bool, bool]:
+                     cands: list[Obstacle]) -> tuple[np.ndarray, bool, float]:
         """The narrow phase of a shaped footprint turning from heading ``yaw`` to ``yaw1`` (the
-        short way): the turn first, in place at the start (kept only if the footprint sweeping through it overlaps nothing it did not
-        already, or deeper), then the move at the heading it ends with, as :meth:`_clip` with
-        each obstacle grown by the footprint turned (:func:`_grown`). ``(end, clipped, turned)``."""
+        short way): the turn first, in place at the start, as far as the footprint sweeping
+        through it overlaps nothing it did not already (or deeper: :meth:`_turn_clear`), then the
+        move at the heading it ends with, as :meth:`_clip` with each obstacle grown by the turned
+        footprint (:func:`_grown`). ``(end, clipped, heading)``: a turn cut short is clipped."""
         assert foot.points is not None
         if not cands:
-            return p + d, False, True
-        here = _turned(foot.points, yaw)
-        turned = True
+            return p + d, False, yaw1
+        kept = yaw1
         turn = math.remainder(yaw1 - yaw, math.tau)
         if turn != 0.0:
+            here = _turned(foot.points, yaw)
             now = [_gap(p, *_grown(ob, here, foot.round, p)) for ob in cands]
-            parts = max(1, math.ceil(abs(turn) / (math.pi / 4.0)))
-            for k in range(parts):
-                a, b = yaw + turn * k / parts, yaw + turn * (k + 1) / parts
-                half = (b - a) / 2.0
-                # every heading in [a, b] lies inside: each vertex's arc is inside the triangle of its
-                # ends and their tangents' crossing (the middle point pushed out by 1 / cos(half))
-                swept = _hull(np.concatenate([_turned(foot.points, a), _turned(foot.points, b),
-                                              _turned(foot.points, a + half) / math.cos(half)]))
-                for ob, gap in zip(cands, now):
-                    self.checks += 1
-                    if _gap(p, *_grown(ob, swept, foot.round, p)) < min(gap, 0.0) - EPS:
-                        turned = False
-                        break
-                if not turned:
-                    break
-            if turned:
-                here = _turned(foot.points, yaw1)
-        end, clipped = self._sweep(p, d, [_grown(ob, here, foot.round, p) for ob in cands])
-        if not turned and not clipped:
+            if not self._turn_clear(foot, p, yaw, turn, cands, now):
+                lo, hi = 0.0, 1.0              # the largest part of the turn that is clear (0 is)
+                for _ in range(TURN_HALVINGS):
+                    mid = 0.5 * (lo + hi)
+                    if self._turn_clear(foot, p, yaw, turn * mid, cands, now):
+                        lo = mid
+                    else:
+                        hi = mid
+                kept = _wrap(yaw + turn * lo) if lo > 0.0 else yaw
+        end, clipped = self._sweep(p, d, [_grown(ob, _turned(foot.points, kept), foot.round, p) for ob in cands])
+        if kept != yaw1 and not clipped:
             self.contacts += 1
-        return end, clipped or not turned, turned
+        return end, clipped or kept != yaw1, kept
+
+    def _turn_clear(self, foot: Footprint, p: np.ndarray, yaw: float, turn: float, cands: list[Obstacle],
+                    now: list[float]) -> bool:
+        """Whether the footprint at ``p`` turning from ``yaw`` by ``turn`` stays clear of every
+        candidate: at no heading of the turn nearer to it than ``now`` (each one's signed distance
+        at ``yaw``) if it overlaps, nor overlapping it (by more than EPS) if it does not. Closed
+        form and conservative: the turn in parts of at most 45°, each part's footprints inside
+        the hull of its two ends and its middle pushed out by 1 / cos(half the part) -- each
+        vertex's arc lies in the triangle of its ends and their tangents' crossing."""
+        assert foot.points is not None
+        parts = max(1, math.ceil(abs(turn) / (math.pi / 4.0)))
+        for k in range(parts):
+            a, b = yaw + turn * k / parts, yaw + turn * (k + 1) / parts
+            half = (b - a) / 2.0
+            swept = _hull(np.concatenate([_turned(foot.points, a), _turned(foot.points, b),
+                                          _turned(foot.points, a + half) / math.cos(half)]))
+            for ob, gap in zip(cands, now):
+                self.checks += 1
+                if _gap(p, *_grown(ob, swept, foot.round, p)) < min(gap, 0.0) - EPS:
+                    return False
+        return True
 
     def _sweep(self, p: np.ndarray, d: np.ndarray, cands: list[tuple[Obstacle, float]]) -> tuple[np.ndarray, bool]:
         """Move the point ``p`` by ``d`` among ``cands`` (each an obstacle and the radius it is

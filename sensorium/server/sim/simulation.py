@@ -12,6 +12,7 @@ Nothing is computed for a device that is disabled.
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections import Counter
 from collections.abc import Iterator
@@ -563,12 +564,13 @@ class Simulation:
             yaws = np.array([(yaw0, d.yaw) for (_, d, _, _), yaw0 in zip(moved, headings)])
             ends = self.contact.resolve_all([r.index for r, _, _, _ in moved], np.array([s for _, _, s, _ in moved]),
                                             np.array([(d.x, d.y) for _, d, _, _ in moved]), yaws)
-            for k, (end, clipped, turned) in enumerate(ends):
+            for k, (end, clipped, kept) in enumerate(ends):
                 if clipped:
                     robot, drive, start, _ = moved[k]
                     robot.pressing = True
-                    if not turned:    # its footprint would have turned into something: it keeps its heading
-                        drive.yaw, drive.turn = headings[k], 0.0
+                    if kept != drive.yaw:   # its footprint would have turned into something: the turn cut short
+                        drive.yaw = kept
+                        drive.turn = math.remainder(kept - headings[k], math.tau) * 1000.0 / dt
                     drive.x, drive.y = float(end[0]), float(end[1])
                     drive.linear = ((drive.x - start[0]) * 1000.0 / dt, (drive.y - start[1]) * 1000.0 / dt)
                     moved[k] = (robot, drive, start, drive.pose())
