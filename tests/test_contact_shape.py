@@ -204,3 +204,54 @@ def test_the_batched_engine_clips_and_refuses_turns_as_the_single_simulation_bit
         held += int(np.count_nonzero((bs.yaw == yaw_before) & (bs.velocity[:, :, 0] != bs.velocity[:, :, 1])))
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
     assert held > 10
+
+
+def test_a_drive_whose_forward_is_the_robot_s_y_axis_stops_with_the_face_along_y():
+    # the body is long along the robot's own y, and the drive's forward is y: the footprint turns
+    # with the drive's heading (its x axis's heading plus 90°), so the front face stops on the wall
+    bot = box_robot("r", 0.0, 0.0, size=(WIDE, LONG))
+    bot["differential_drive"]["forward"] = [0.0, 1.0]
+    sim = world([block("wall", -2.0, 2.0, 1.9, 2.1)], [bot])
+    drive(sim, "r", 10.0)
+    for _ in range(120):
+        sim.step()
+    x, y = xy(sim, "r")
+    assert y == pytest.approx(1.9 - LONG / 2.0, abs=1e-9) and abs(x) < 1e-12
+
+
+def test_in_a_nue_world_a_box_robot_stops_with_its_face_on_the_wall_in_both_engines():
+    # NUE (x north, y up, z east): a 0.5 m long box robot heading north at a wall whose face is at
+    # x = 0.55 stops with its centre at 0.55 - 0.25, the single simulation and the batched alike
+    from sensorium.schemas import world as wm
+    from sensorium.server.sim.batched import BatchedSimulation
+    w = wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "coordinate_system": "NUE"},
+        "solids": [{"name": "wall", "pose": {"translation": [0.6, 0.1, 0.0]},
+                    "geometry": {"type": "box", "size": [0.1, 0.2, 2.0]}}],
+        "robots": [{"name": "bot", "pose": {"translation": [0.0, 0.1, 0.0]},
+                    "body": {"geometry": {"type": "box", "size": [LONG, 0.2, WIDE]}},
+                    "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.05, "max_wheel_speed": 10.0}}]})
+    sim, bs = Simulation(w), BatchedSimulation(w, 2)
+    drive(sim, "bot", 10.0)
+    bs.set_wheels(0, np.full(2, 10.0), np.full(2, 10.0))
+    for _ in range(200):                                  # 0.64 m asked for
+        sim.step()
+        bs.step()
+    t = sim.robot("bot").pose.translation
+    assert t[0] == pytest.approx(0.55 - LONG / 2.0, abs=1e-9) and t[1] == 0.1 and abs(t[2]) < 1e-15
+    assert (bs.pos[:, 0] == t).all() and bs.pressing.all()
+
+
+def test_a_box_robot_placed_into_a_wall_goes_no_deeper_and_backs_out():
+    # its front face 5 cm inside the wall (placed so from outside): forward is refused, backward free
+    sim = world([block("wall", 1.9, 2.1, -2.0, 2.0)], [box_robot("r", 1.9 - LONG / 2 + 0.05, 0.0)])
+    start = xy(sim, "r")
+    drive(sim, "r", 10.0)
+    for _ in range(10):
+        sim.step()
+    assert (xy(sim, "r") == start).all() and sim.robot("r").pressing
+    drive(sim, "r", -10.0)
+    for _ in range(10):
+        sim.step()
+    assert xy(sim, "r")[0] == pytest.approx(start[0] - 10 * 0.032, abs=1e-9)
+    assert not sim.robot("r").pressing

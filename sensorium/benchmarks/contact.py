@@ -1,4 +1,4 @@
-"""Cost of kinematic contact: ``python -m sensorium.benchmarks.contact [--steps N]``.
+"""Cost of kinematic contact: ``python -m sensorium.benchmarks.contact [--steps N] [--body box]``.
 
 24 driven e-puck-sized robots among 100 random boxes, cylinders and spheres (fixed seed), no
 sensors enabled, so the step is the drive plus contact; prints ms per basic step with contact off
@@ -14,7 +14,6 @@ import time
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
-
 
 BODIES = {"cylinder": {"type": "cylinder", "radius": 0.035, "height": 0.05},
           "box": {"type": "box", "size": [0.07, 0.05, 0.05]}}

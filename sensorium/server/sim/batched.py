@@ -66,8 +66,16 @@ from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batched_lights import CarriedLights, has_carried_lights
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
-from sensorium.server.sim.contact import (EPS, FLOOR, Contact, Obstacle, drive_footprint, enu_pose, heading,
-                                          shaped_obstacle)
+from sensorium.server.sim.contact import (
+    EPS,
+    FLOOR,
+    Contact,
+    Obstacle,
+    drive_footprint,
+    enu_pose,
+    heading,
+    shaped_obstacle,
+)
 from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, support_ceiling
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, PlanarState, _rz
 from sensorium.server.sim.scene import (
