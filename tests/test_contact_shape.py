@@ -72,6 +72,13 @@ def test_a_box_robot_is_its_rectangle_and_a_centred_cylinder_stays_a_disc():
     wheel = Pose(np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]), np.array([0.0, 0.1, 0.0]))
     both = C.robot_footprint([(geo.Cylinder(0.2, 0.2), Pose.identity()), (geo.Cylinder(0.05, 0.01), wheel)])
     assert both is not None and both.disc
+    # a round body with a part outside its disc: the hull of the part and the body's circumscribed
+    # 16-gon, whose edges face ahead, behind and sideways (its front exactly the radius ahead)
+    bumper = Pose(np.eye(3), np.array([0.0, 0.25, 0.0]))
+    mixed = C.robot_footprint([(geo.Cylinder(0.2, 0.2), Pose.identity()), (geo.Box((0.1, 0.1, 0.1)), bumper)])
+    assert mixed is not None and not mixed.disc and mixed.round == 0.0
+    assert mixed.points[:, 0].max() == pytest.approx(0.2, abs=1e-15) and mixed.points[:, 1].max() == 0.3
+    assert mixed.radius >= float(np.hypot(*mixed.points.T).max())
 
 
 def test_driving_beside_a_wall_its_disc_would_touch_is_not_stopped():

@@ -205,8 +205,10 @@ ROUND_SIDES = 16      # a round part merged with others: its circumscribed 16-go
 
 
 def _polygon(rho: float) -> np.ndarray:
-    """The regular ROUND_SIDES-gon circumscribed about the disc of radius ``rho`` at the origin."""
-    k = np.arange(ROUND_SIDES) * (2.0 * math.pi / ROUND_SIDES)
+    """The regular ROUND_SIDES-gon circumscribed about the disc of radius ``rho`` at the origin,
+    its edges touching the disc straight ahead, behind and on each side (so a robot's round front
+    stops exactly ``rho`` ahead of its centre head-on)."""
+    k = (np.arange(ROUND_SIDES) + 0.5) * (2.0 * math.pi / ROUND_SIDES)
     return (rho / math.cos(math.pi / ROUND_SIDES)) * np.stack([np.cos(k), np.sin(k)], axis=1)
 
 
