@@ -3,8 +3,14 @@ other robots' bodies. No physics engine: a blocked robot *slides* along what it 
 
 Robots move in the world xy-plane, so contact is solved in 2D within each robot's height band:
 
-* a robot's footprint is the vertical disc of radius ``R`` around its origin that contains its
-  body (exact for an upright cylinder, capsule or sphere; the circumscribed circle of a box);
+* a robot's footprint follows its shape: one convex piece ``hull(points) ⊕ disc(r)`` in its
+  frame, turned with its heading -- an upright box its rectangle, an upright cylinder, capsule or
+  sphere its circle, a tilted box or mesh the outline of its projection, a tilted cylinder its end
+  discs' circumscribed 16-gons; several shapes the hull of their outlines, a part inside a round
+  part's disc dropped and a part rounder than the rest its circumscribed 16-gon
+  (:func:`robot_footprint`). A robot that is one centred upright cylinder is the disc it always
+  was, on the old path, bit for bit. The disc about the origin holding the piece at every heading
+  (``Footprint.radius``) is the broad phase's;
 * an obstacle is a convex 2D set ``hull(points) ⊕ disc(radius)``: an upright box is its 4
   corners, an upright cylinder or capsule a point with its radius, a sphere a point with the
   radius of its widest section inside the band, anything else the convex hull of its projected
@@ -19,20 +25,27 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   anything a robot's body should be stopped by; a solid rising more than that into the band is
   an obstacle. Robots' bodies meet one another without the tolerance (robots never stand on
   robots);
-* over one basic step the robot's centre moves along the chord from its start to its end pose
-  (poses are only observed at the end of steps, and the end point is the exact arc end unless
-  contact clips it). The chord is tested against every obstacle near it (an AABB broad phase)
-  in closed form — segment vs. offset edges and vertex circles of ``obstacle ⊕ disc(R)`` — so a
-  fast robot at a grazing angle cannot tunnel, whatever the step length. Features the chord
+* over one basic step a shaped robot first turns in place at its start, as far as the footprint
+  sweeping through the turn overlaps nothing it did not already overlap, or deeper (the sweep
+  bounded in closed form, :meth:`Contact._turn_clear`; a turn cut short is found by halving, to
+  2^-12 of the step's turn, and counts as a contact), then its centre moves along the chord from
+  its start to its end pose (poses are only observed at the end of steps, and the end point is
+  the exact arc end unless contact clips it) at the heading it kept. The chord is tested against
+  every obstacle near it (an AABB broad phase) in closed form — segment vs. offset edges and
+  vertex circles of the obstacle grown by the footprint: for a disc ``obstacle ⊕ disc(R)``, for a
+  piece ``hull(Q − P) ⊕ disc(ρ + r)`` with P the turned piece's points (the Minkowski sum of
+  convex sets, :func:`_grown`), for a wall line its reach toward the wall — so a fast robot at a
+  grazing angle cannot tunnel, whatever the step length. Features the chord
   certainly cannot reach (plain float screens, margins far above the tests' rounding) are not
   tested: the answer of testing them all, bit for bit.
 
 On contact the robot stops at the contact point and the rest of its displacement is projected on
 the contact's tangent (slide), up to three times per step (corners). A robot pushed straight into
 a wall therefore stops at the contact distance; one meeting it obliquely keeps the tangential
-part of its motion, as a Webots robot rubbing along a wall does. Its heading change is always
-applied (a disc turns freely), so a blocked robot can always turn away. Deterministic: robots are
-resolved in world order, each against the others' current positions. Float64 throughout.
+part of its motion, as a Webots robot rubbing along a wall does. A disc turns freely; a shaped
+robot can always back out along its heading (a move that goes no deeper is free) and turn the way
+that frees its corner. Deterministic: robots are resolved in world order, each against the others'
+current positions and headings. Float64 throughout.
 """
 
 from __future__ import annotations
@@ -175,8 +188,10 @@ def _z_extent(prim: geo.Primitive, rotation: np.ndarray) -> tuple[float, float]:
 
 
 def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None:
-    """The disc (about the robot's origin) containing every body shape, each at its offset in the
-    robot frame: conservative for off-centre shapes, exact for one centred upright shape."""
+    """A robot's footprint from its body shapes, each at its pose in the robot frame: the convex
+    piece holding their outlines (:func:`_section`, :func:`_body_section`), the height band, and
+    the disc about the origin holding the piece at any heading (the old footprint's radius, which
+    it always was, or wider where a tilted round part's circumscribed polygon reaches past it)."""
     feet = []
     for prim, local in parts:
         f = footprint(prim)
@@ -581,8 +596,54 @@ def _grown(ob: Obstacle, shape: np.ndarray, rnd: float, p: np.ndarray) -> tuple[
     if ob.normal is not None:
         side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
         return ob, float(np.max(shape @ (-side * ob.normal))) + rnd
-    pts = _hull((ob.points[:, None, :] - shape[None, :, :]).reshape(-1, 2))
+    q = ob.points
+    if len(q) == 1:                     # a point (a pillar, a round robot): the footprint turned over
+        pts = q[0] - shape
+    elif len(q) >= 3 and len(shape) >= 3:
+        pts = np.array(_minkowski(q.tolist(), (-shape).tolist()), dtype=np.float64)
+    else:
+        pts = _hull((q[:, None, :] - shape[None, :, :]).reshape(-1, 2))
     return Obstacle(ob.name, ob.owner, pts, ob.radius, ob.z_range, edge_normals=True), rnd
+
+
+def _minkowski(a: list, b: list) -> list:
+    """The Minkowski sum of two convex polygons (counter-clockwise vertex lists, 3 or more each):
+    their edges merged by direction, O(n + m). A vertex turning by less than 1e-12 rad, or within
+    1e-12 of the previous one (rounding of parallel edges), is dropped: at most 1e-12 of the
+    edges' lengths off the exact sum, where it would give an edge of no length or direction."""
+    def lowest(v: list) -> list:
+        k = min(range(len(v)), key=lambda i: (v[i][1], v[i][0]))
+        return v[k:] + v[:k]
+    a, b = lowest(a), lowest(b)
+    n, m = len(a), len(b)
+    a, b = a + a[:2], b + b[:2]
+    out: list = []
+    i = j = 0
+    while i < n or j < m:
+        out.append((a[i][0] + b[j][0], a[i][1] + b[j][1]))
+        c = ((a[i + 1][0] - a[i][0]) * (b[j + 1][1] - b[j][1])
+             - (a[i + 1][1] - a[i][1]) * (b[j + 1][0] - b[j][0]))
+        if j >= m or (i < n and c > 0.0):
+            i += 1
+        elif i >= n or c < 0.0:
+            j += 1
+        else:
+            i += 1
+            j += 1
+    dropped = True
+    while dropped and len(out) > 3:           # cyclic passes until none is dropped
+        dropped = False
+        k = 0
+        while k < len(out) and len(out) > 3:
+            (ox, oy), (px, py), (qx, qy) = out[k - 1], out[k], out[(k + 1) % len(out)]
+            ux, uy, vx, vy = px - ox, py - oy, qx - px, qy - py
+            lu, lv = math.hypot(ux, uy), math.hypot(vx, vy)
+            if lu <= 1e-12 * (1.0 + abs(px) + abs(py)) or ux * vy - uy * vx <= 1e-12 * lu * lv:
+                del out[k]
+                dropped = True
+            else:
+                k += 1
+    return out
 
 
 def _gap(p: np.ndarray, ob: Obstacle, rho: float) -> float:
@@ -787,13 +848,18 @@ class Contact:
             here = _turned(foot.points, yaw)
             now = [_gap(p, *_grown(ob, here, foot.round, p)) for ob in cands]
             if not self._turn_clear(foot, p, yaw, turn, cands, now):
-                lo, hi = 0.0, 1.0              # the largest part of the turn that is clear (0 is)
-                for _ in range(TURN_HALVINGS):
-                    mid = 0.5 * (lo + hi)
-                    if self._turn_clear(foot, p, yaw, turn * mid, cands, now):
-                        lo = mid
-                    else:
-                        hi = mid
+                # the largest part of the turn that is clear (none is), halving; a robot already
+                # touching where it turns (pressed on) is told by its first step, 2^-12 of the turn
+                lo, hi = 0.0, 1.0
+                least = 0.5 ** TURN_HALVINGS
+                if self._turn_clear(foot, p, yaw, turn * least, cands, now):
+                    lo = least
+                    for _ in range(TURN_HALVINGS):
+                        mid = 0.5 * (lo + hi)
+                        if self._turn_clear(foot, p, yaw, turn * mid, cands, now):
+                            lo = mid
+                        else:
+                            hi = mid
                 kept = _wrap(yaw + turn * lo) if lo > 0.0 else yaw
         end, clipped = self._sweep(p, d, [_grown(ob, _turned(foot.points, kept), foot.round, p) for ob in cands])
         if kept != yaw1 and not clipped:
