@@ -231,7 +231,10 @@ def _section(prim: geo.Primitive, local: Pose) -> tuple[np.ndarray, float] | Non
     """A body shape's footprint in the robot's xy plane, ``(points, r)``: ``hull(points) ⊕ disc(r)``
     contains the shape's vertical projection (exact for a box, sphere, capsule, mesh and an
     upright cylinder; a tilted cylinder's end discs as circumscribed polygons)."""
-    r, t = np.asarray(local.rotation, dtype=np.float64), np.asarray(local.translation, dtype=np.float64)
+    t = np.asarray(local.translation, dtype=np.float64)
+    # a shape not turned in the robot's frame up to rounding (a NUE robot's frame turned upright,
+    # enu_body) is taken as not turned, as robot_footprint takes its band: its ENU twin's bits
+    r = np.eye(3) if np.allclose(local.rotation, np.eye(3)) else np.asarray(local.rotation, dtype=np.float64)
     if isinstance(prim, geo.Sphere):
         return t[None, :2].copy(), float(prim.radius)
     if isinstance(prim, geo.Capsule):
