@@ -306,7 +306,7 @@ class BatchedSimulation:
         self.z0 = np.zeros((C, R))
         self.slope = np.zeros((C, R, 2))
         self.tilted = np.zeros((C, R), dtype=bool)
-        # -- kinematic contact: the solids' obstacles once, the robots' discs per copy
+        # -- kinematic contact: the solids' obstacles once, the robots' footprints (and headings) per copy
         use_contact = w.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = None
         if use_contact and (self.has_drive.any() or self.cars is not None):

@@ -659,7 +659,7 @@ def _gap(p: np.ndarray, ob: Obstacle, rho: float) -> float:
 # ---------------------------------------------------------------------- the resolver
 
 class Contact:
-    """The world's static obstacles plus the robots' discs; :meth:`resolve` clips one robot's move."""
+    """The world's static obstacles plus the robots' footprints; :meth:`resolve` clips one robot's move."""
 
     def __init__(self, solids: list[tuple[str, geo.Primitive, Pose, Pose, bool]],
                  robots: list[tuple[list[tuple[geo.Primitive, Pose]], Pose]], to_enu: np.ndarray | None = None,
