@@ -121,8 +121,8 @@ def _wall_world() -> wm.World:
 def test_a_robot_drives_straight_along_nue_x_at_r_omega_and_stops_at_a_wall():
     """Closed forms: wheels at omega move a NUE robot along its heading (+x, north) by r*omega*t,
     its height (y) and east (z) unchanged; pushed on, contact stops it where its footprint (the
-    circumscribed sphere of a shape turned into ENU: radius 0.04*sqrt(2)) meets the wall's face
-    at x = 0.55, in the single simulation and every batched copy alike."""
+    sphere's section, radius 0.04, however its frame is turned) meets the wall's face at x = 0.55,
+    in the single simulation and every batched copy alike."""
     r, omega, dt = 0.02, 5.0, 0.016
     world = _wall_world()
     bs = BatchedSimulation(world, 2)
@@ -141,7 +141,7 @@ def test_a_robot_drives_straight_along_nue_x_at_r_omega_and_stops_at_a_wall():
     for _ in range(400):                                  # 6.4 s more: far past the wall without contact
         bs.step()
         sim.step()
-    stop = 0.55 - 0.04 * math.sqrt(2.0)
+    stop = 0.55 - 0.04
     assert sim.robot("bot").pose.translation[0] == pytest.approx(stop, abs=1e-9)
     assert (bs.pos[:, 0, 0] == sim.robot("bot").pose.translation[0]).all() and bs.pressing.all()
 

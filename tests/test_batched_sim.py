@@ -132,12 +132,12 @@ def test_a_robot_in_one_copy_is_invisible_to_the_others_sensors_and_contact():
         assert seen > 200.0                    # the box 2.6 cm ahead: far above the no-hit level
         assert unseen == single.robot("epuck").device(ref.name).value   # exactly the world without it
         assert unseen < 130.0
-    # drive straight ahead at full speed for 2 s (0.26 m): copy 3 stops at the scout's disc (the
-    # kinematic contact's footprint of a box: its circumscribed circle, radius hypot(0.3, 0.2) / 2)
+    # drive straight ahead at full speed for 2 s (0.26 m): copy 3 stops at the scout's back face
+    # (the kinematic contact's footprint of a box: its rectangle, 0.3 m long)
     bs.set_pose(3, scout, [0.35, -1.0, 0.06], rotation=[0, 0, 1, 0.0])
     bs.set_wheels(epuck, np.full(n, 6.28), np.full(n, 6.28))
     bs.run(62)
-    assert bs.pos[3, epuck, 0] == pytest.approx(0.35 - math.hypot(0.3, 0.2) / 2 - 0.035, abs=1e-9)
+    assert bs.pos[3, epuck, 0] == pytest.approx(0.35 - 0.3 / 2 - 0.035, abs=1e-9)
     assert bs.pressing[3, epuck] or bs.counters["contacts"] > 0
     step_m = 6.28 * 0.0205 * 0.032
     for c in (0, 1, 2, 4, 5):

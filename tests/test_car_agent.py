@@ -179,7 +179,7 @@ def test_sub_env_i_is_the_single_env_with_seed_i_across_autoresets(robot, action
 
 
 def test_a_car_driving_into_a_wall_stops_there_in_both_engines():
-    """Straight at the east wall (inner face x = 2.4) from x = 0.3, clear of the other robots: the body's disc stops at the wall,
+    """Straight at the east wall (inner face x = 2.4) from x = 0.3, clear of the other robots: the body's front face stops at the wall,
     the bumper reads 1, the same bits on the rebuilt Simulation and the batched engine."""
     def put(sim, robot, rng):
         robot.set_pose(translation=[0.3, -0.45, 0.1], rotation=[0, 0, 1, 0])
@@ -191,8 +191,8 @@ def test_a_car_driving_into_a_wall_stops_there_in_both_engines():
         trace = [env.step(np.array([0.0, 1.0], dtype=np.float32)) for _ in range(40)]
         got.append(trace)
         x = trace[-1][4]["pose"][0]
-        radius = math.hypot(0.35, 0.2)                      # the box body's footprint disc
-        assert x == pytest.approx(2.4 - radius, abs=1e-6) and trace[-1][0]["bumper"][0] == 1.0
+        half = 0.35                                         # the box body's half length: its front face on the wall
+        assert x == pytest.approx(2.4 - half, abs=1e-9) and trace[-1][0]["bumper"][0] == 1.0
         assert trace[-1][4]["pose"][1] == -0.45
     for (o1, *_, i1), (o2, *_, i2) in zip(*got):
         assert _same(o1, o2) and _same(i1["pose"], i2["pose"])

@@ -103,9 +103,10 @@ def test_skid_steer_stops_at_a_wall_like_a_two_wheel_robot(tmp_path: Path) -> No
     drive(sim, "p3at", 5.0, 5.0)
     sim.run(250)
     x = sim.robot("p3at").pose.translation[0]
-    # the body's enclosing disc (contact.py): a turned wheel bounded by its sphere, off centre
-    footprint = max(math.hypot(0.25, 0.2), math.hypot(X, Y) + math.hypot(R, 0.095 / 2))
-    assert x == pytest.approx(0.95 - footprint, abs=1e-9)
+    # the footprint's front (contact.py: the body's outline): the body box's face or a wheel's
+    # outline, which reaches R ahead of its axle (its circumscribed 16-gon's edge faces ahead)
+    front = max(0.25, X + R)
+    assert x == pytest.approx(0.95 - front, abs=1e-9)
     assert sim.counters["contacts"] > 0
 
 

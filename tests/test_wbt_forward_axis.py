@@ -110,9 +110,11 @@ def test_it_stops_at_a_wall_ahead_along_its_y(tmp_path: Path) -> None:
     sim = Simulation(load_world(write(tmp_path, rover(), wall)), "fast")
     go(sim, "rover", 6.0, 6.0)
     sim.run(250)                                  # 4 s at 0.48 m/s: far beyond the wall, were it not there
-    # the body's enclosing disc (contact.py): the box's corner, or a wheel bounded by its sphere
-    footprint = max(math.hypot(0.1, 0.2), math.hypot(HX, HY) + math.hypot(R, 0.02))
-    assert sim.robot("rover").pose.translation[:2] == pytest.approx([0.0, 0.95 - footprint], abs=1e-9)
+    # the footprint's front along its y (contact.py: the body's outline, turned with the drive's
+    # heading): the body box's face or a wheel's outline, R ahead of its axle (its circumscribed
+    # 16-gon's edge faces ahead)
+    front = max(0.2, HY + R)
+    assert sim.robot("rover").pose.translation[:2] == pytest.approx([0.0, 0.95 - front], abs=1e-9)
     assert sim.counters["contacts"] > 0
 
 

@@ -96,8 +96,9 @@ def clearance(sim, robot, rays: int = 32, max_distance: float = 1.0) -> float:
 
 
 def body_radius(robot, base_dir=None, world=None) -> float:
-    """Horizontal radius of the disc about the robot's origin that contains its body shapes, as the
-    kinematic contact sees it (0 without a body): in a NUE ``world`` about the world's up (y), its
+    """Horizontal radius of the disc about the robot's origin that contains its body shapes at every
+    heading, the kinematic contact's broad-phase disc (its footprint, the body's turned outline,
+    lies inside; 0 without a body): in a NUE ``world`` about the world's up (y), its
     body turned as its world-file rotation stands it (contact.enu_body)."""
     from pathlib import Path
 

@@ -66,7 +66,16 @@ from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batched_lights import CarriedLights, has_carried_lights
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
-from sensorium.server.sim.contact import EPS, FLOOR, Contact, Obstacle, enu_body, enu_pose, robot_footprint
+from sensorium.server.sim.contact import (
+    EPS,
+    FLOOR,
+    Contact,
+    Obstacle,
+    drive_footprint,
+    enu_pose,
+    heading,
+    shaped_obstacle,
+)
 from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, support_ceiling
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, PlanarState, _rz
 from sensorium.server.sim.scene import (
@@ -297,7 +306,7 @@ class BatchedSimulation:
         self.z0 = np.zeros((C, R))
         self.slope = np.zeros((C, R, 2))
         self.tilted = np.zeros((C, R), dtype=bool)
-        # -- kinematic contact: the solids' obstacles once, the robots' discs per copy
+        # -- kinematic contact: the solids' obstacles once, the robots' footprints (and headings) per copy
         use_contact = w.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = None
         if use_contact and (self.has_drive.any() or self.cars is not None):
@@ -305,7 +314,8 @@ class BatchedSimulation:
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
             self.contact = Contact(solids, [], self.to_enu)
-            feet = [robot_footprint(enu_body(robot_bounding_parts(r, base), self.initial[i], self.to_enu))
+            feet = [drive_footprint(robot_bounding_parts(r, base), self.initial[i], self.to_enu,
+                                    None if (tpl := self._templates[i]) is None else tpl.yaw)
                     for i, r in enumerate(w.robots)]
             self.feet = feet
             nan = math.nan
@@ -314,6 +324,10 @@ class BatchedSimulation:
             self.foot_high = np.array([f.z_high if f else nan for f in feet])
             self.centres = np.zeros((C, R, 2))
             self.heights = np.zeros((C, R))
+            self.foot_yaw = np.zeros((C, R))       # each footprint's heading (Contact.yaw)
+            self._shaped = [f is not None and not f.disc for f in feet]
+            # a disc footprint's own radius (foot_radius, the broad phase's, may be wider)
+            self.foot_disc = np.array([f.disc_radius if f is not None and f.disc else nan for f in feet])
         # -- devices: one template object per device (its constants); values per copy
         self._build_devices()
         self.counters = {"steps": 0, "copy_steps": 0, "measurements": 0, "resets": 0, "contacts": 0}
@@ -565,9 +579,10 @@ class BatchedSimulation:
             self.rot[idx, r] = pose.rotation
             self.pos[idx, r] = pose.translation
             if self.contact is not None:
-                at = enu_pose(pose, self.to_enu).translation
-                self.centres[idx, r] = at[:2]
-                self.heights[idx, r] = at[2]
+                enu = enu_pose(pose, self.to_enu)
+                self.centres[idx, r] = enu.translation[:2]
+                self.heights[idx, r] = enu.translation[2]
+                self.foot_yaw[idx, r] = heading(enu) if tpl is None else tpl.yaw
         self.target[idx] = 0.0
         self.velocity[idx] = self.max_wheel
         self.wheel_angle[idx] = 0.0
@@ -603,17 +618,20 @@ class BatchedSimulation:
             current = Pose(own if self.to_enu is None else self.to_enu.T @ own, current.translation)
         pose = moved_pose(current, translation, rotation, quaternion)
         tpl = self._templates[slot]
+        yaw = None
         if tpl is not None:
             tpl.reset(pose)       # the single simulation's own arithmetic (yaw, base, the ground under it)
             self._take_template(np.array([copy]), slot, tpl)
             pose = tpl.placed(pose)
+            yaw = tpl.yaw
             tpl.reset(self.initial[slot])
         self.rot[copy, slot] = pose.rotation
         self.pos[copy, slot] = pose.translation
         if self.contact is not None:
-            at = enu_pose(pose, self.to_enu).translation
-            self.centres[copy, slot] = at[:2]
-            self.heights[copy, slot] = at[2]
+            enu = enu_pose(pose, self.to_enu)
+            self.centres[copy, slot] = enu.translation[:2]
+            self.heights[copy, slot] = enu.translation[2]
+            self.foot_yaw[copy, slot] = heading(enu) if yaw is None else yaw
         self.kinematic.placed(copy, slot)     # a jump, not motion, for its gyros and accelerometers
 
     def _take_template(self, idx: np.ndarray, slot: int, tpl: PlanarState) -> None:
@@ -727,10 +745,14 @@ class BatchedSimulation:
             kin.libm_cos_sin(_arc_steps(g[0][:k], g[1][:k], g[2][:k], step.v[:k], step.w[:k], dt)[2])
             raise ValueError("math domain error")
         if step.status[1]:   # a move near something: the narrow phase, slot by slot
-            x, y = self._narrow(copies, slots, step.starts[:k], step.ends[:k],
-                                step.solid_hit[:k] if len(ct._obs) else None, step.robot_hit[:k] if self.R > 1 else None,
-                                step.near[:k])
+            x, y, kept = self._narrow(copies, slots, step.starts[:k], step.ends[:k], step.gathered[2][:k],
+                                      step.solid_hit[:k] if len(ct._obs) else None,
+                                      step.robot_hit[:k] if self.R > 1 else None, step.near[:k])
             self.x[copies, slots], self.y[copies, slots] = x, y
+            if len(kept):     # turns cut short by contact: the heading they kept
+                _turn_back(kept, self.yaw[copies[kept], slots[kept]], step.cos, step.sin, step.rz)
+        if ct is not None:
+            self.foot_yaw[copies, slots] = self.yaw[copies, slots]
         self._place(copies, slots, step.rz[:k], step.base[:k], step.cos[:k], step.sin[:k], step.rot[:k])
         step.scatter(k)
 
@@ -782,7 +804,10 @@ class BatchedSimulation:
         cos, sin = kin.libm_cos_sin(yaw)
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
-            x, y = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1))
+            x, y, kept = self._contact(copies, slots, np.stack([x0, y0], axis=1), np.stack([x, y], axis=1), yaw0)
+            if len(kept):     # turns cut short by contact: the heading they kept
+                _turn_back(kept, self.yaw[copies[kept], slots[kept]], cos, sin, None)
+            self.foot_yaw[copies, slots] = self.yaw[copies, slots]
         self.x[copies, slots], self.y[copies, slots] = x, y
         rz = np.zeros((len(yaw), 3, 3))
         rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
@@ -842,10 +867,12 @@ class BatchedSimulation:
         w = rad * (wr - wl) / axle
         return copies, slots, v, w
 
-    def _contact(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray):
+    def _contact(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+                 yaw0: np.ndarray):
         """Contact.resolve_all per copy: robots in slot order, each against the solids and its own
         copy's other robots (where they are when its turn comes); the same broad phase, the same
-        narrow phase (Contact._clip). Returns the final xy."""
+        narrow phase (Contact._clip). ``yaw0``: the moves' headings at the start (self.yaw holds
+        the end's). Returns the final xy and the moves whose turn was cut short (self.yaw written)."""
         ct = self.contact
         assert ct is not None
         reach = np.hypot(*(ends - starts).T) + EPS
@@ -866,13 +893,14 @@ class BatchedSimulation:
             # nothing near any move: each ends where Contact._clip without candidates puts it (a
             # robot without a footprint: at its end), whatever the slot order
             self.centres[copies, slots] = np.where(np.isnan(Rr)[:, None], ends, starts + (ends - starts))
-            return ends[:, 0], ends[:, 1]
-        return self._narrow(copies, slots, starts, ends, solid_hit, robot_hit, near)
+            return ends[:, 0], ends[:, 1], _NONE
+        return self._narrow(copies, slots, starts, ends, yaw0, solid_hit, robot_hit, near)
 
-    def _narrow(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+    def _narrow(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray, yaw0: np.ndarray,
                 solid_hit: np.ndarray | None, robot_hit: np.ndarray | None, near: np.ndarray):
         """The narrow phase of :meth:`_contact` once the broad phase found a move near something:
-        Contact._clip of each near move (centres written); returns the final xy."""
+        Contact._clip (a shaped footprint: Contact._clip_shaped) of each near move (centres and
+        footprint headings written); returns the final xy and the moves whose turn was cut short."""
         ct = self.contact
         assert ct is not None
         out = ends.copy()
@@ -894,14 +922,17 @@ class BatchedSimulation:
         hot_list = hot.tolist()
         waiting = {(int(copies[m]), int(slots[m])): self.centres[copies[m], slots[m]].copy() for m in hot_list}
         self.centres[copies, slots] = moved
+        kept: list[int] = []
         for m in (hot[np.argsort(slots[hot], kind="stable")].tolist() if len(hot_list) > 1 else hot_list):
             cm, r = int(copies[m]), int(slots[m])
             del waiting[cm, r]
             if footless[m]:
                 self.centres[cm, r] = ends[m]
+                self.foot_yaw[cm, r] = self.yaw[cm, r]
                 continue
             if not near[m]:
                 self.centres[cm, r] = starts[m] + (ends[m] - starts[m])
+                self.foot_yaw[cm, r] = self.yaw[cm, r]
                 continue
             lo = float(self.heights[cm, r] + self.foot_low[r])
             hi = float(self.heights[cm, r] + self.foot_high[r])
@@ -911,17 +942,28 @@ class BatchedSimulation:
             if robot_hit is not None:
                 for j in robot_hit[m].nonzero()[0].tolist():
                     at = waiting.get((cm, j))
-                    cands.append(Obstacle(f"robot {j}", int(j), (self.centres[cm, j] if at is None else at)[None, :].copy(),
-                                          float(self.foot_radius[j]),
-                                          (float(self.heights[cm, j] + self.foot_low[j]),
-                                           float(self.heights[cm, j] + self.foot_high[j]))))
-            p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(Rr[m]), cands)
+                    centre = self.centres[cm, j] if at is None else at
+                    band = (float(self.heights[cm, j] + self.foot_low[j]), float(self.heights[cm, j] + self.foot_high[j]))
+                    if self._shaped[j]:    # (a waiting robot's foot_yaw is still its start's)
+                        cands.append(shaped_obstacle(j, self.feet[j], centre, float(self.foot_yaw[cm, j]), band))
+                    else:
+                        cands.append(Obstacle(f"robot {j}", int(j), centre[None, :].copy(), float(self.foot_disc[j]),
+                                              band))
+            if self._shaped[r]:
+                p, clipped, heading_ = ct._clip_shaped(self.feet[r], starts[m].copy(), ends[m] - starts[m],
+                                                       float(yaw0[m]), float(self.yaw[cm, r]), cands)
+                if heading_ != self.yaw[cm, r]:      # the turn cut short
+                    self.yaw[cm, r] = heading_
+                    kept.append(m)
+            else:
+                p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(self.foot_disc[r]), cands)
             self.centres[cm, r] = p
+            self.foot_yaw[cm, r] = self.yaw[cm, r]
             if clipped:
                 self.pressing[cm, r] = True
                 self.counters["contacts"] += 1
                 out[m] = p
-        return out[:, 0], out[:, 1]
+        return out[:, 0], out[:, 1], np.asarray(kept, dtype=np.int64)
 
     def _contact_near(self, copies, slots, starts, reach, grow):
         """The broad phase of :meth:`_contact` in numpy (packets.contact_near's fallback):
@@ -1576,3 +1618,11 @@ def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: 
         yo[t] = y[t] - r * (c1 - c0)
     return xo, yo, np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi
 
+
+def _turn_back(kept: np.ndarray, yaw: np.ndarray, cos: np.ndarray, sin: np.ndarray, rz: np.ndarray | None) -> None:
+    """The moves ``kept`` (their turns cut short by contact) take the heading ``yaw`` they kept:
+    their cos, sin (and Rz) rows, as the single simulation's pose of it."""
+    c, s = kin.libm_cos_sin(np.ascontiguousarray(yaw, dtype=np.float64))
+    cos[kept], sin[kept] = c, s
+    if rz is not None:
+        rz[kept, 0, 0], rz[kept, 0, 1], rz[kept, 1, 0], rz[kept, 1, 1] = c, -s, s, c

@@ -3,8 +3,14 @@ other robots' bodies. No physics engine: a blocked robot *slides* along what it 
 
 Robots move in the world xy-plane, so contact is solved in 2D within each robot's height band:
 
-* a robot's footprint is the vertical disc of radius ``R`` around its origin that contains its
-  body (exact for an upright cylinder, capsule or sphere; the circumscribed circle of a box);
+* a robot's footprint follows its shape: one convex piece ``hull(points) ⊕ disc(r)`` in its
+  frame, turned with its heading -- an upright box its rectangle, an upright cylinder, capsule or
+  sphere its circle, a tilted box or mesh the outline of its projection, a tilted cylinder its end
+  discs' circumscribed 16-gons; several shapes the hull of their outlines, a part inside a round
+  part's disc dropped and a part rounder than the rest its circumscribed 16-gon
+  (:func:`robot_footprint`). A robot that is one centred upright cylinder is the disc it always
+  was, on the old path, bit for bit. The disc about the origin holding the piece at every heading
+  (``Footprint.radius``) is the broad phase's;
 * an obstacle is a convex 2D set ``hull(points) ⊕ disc(radius)``: an upright box is its 4
   corners, an upright cylinder or capsule a point with its radius, a sphere a point with the
   radius of its widest section inside the band, anything else the convex hull of its projected
@@ -19,20 +25,27 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   anything a robot's body should be stopped by; a solid rising more than that into the band is
   an obstacle. Robots' bodies meet one another without the tolerance (robots never stand on
   robots);
-* over one basic step the robot's centre moves along the chord from its start to its end pose
-  (poses are only observed at the end of steps, and the end point is the exact arc end unless
-  contact clips it). The chord is tested against every obstacle near it (an AABB broad phase)
-  in closed form — segment vs. offset edges and vertex circles of ``obstacle ⊕ disc(R)`` — so a
-  fast robot at a grazing angle cannot tunnel, whatever the step length. Features the chord
+* over one basic step a shaped robot first turns in place at its start, as far as the footprint
+  sweeping through the turn overlaps nothing it did not already overlap, or deeper (the sweep
+  bounded in closed form, :meth:`Contact._turn_clear`; a turn cut short is found by halving, to
+  2^-12 of the step's turn, and counts as a contact), then its centre moves along the chord from
+  its start to its end pose (poses are only observed at the end of steps, and the end point is
+  the exact arc end unless contact clips it) at the heading it kept. The chord is tested against
+  every obstacle near it (an AABB broad phase) in closed form — segment vs. offset edges and
+  vertex circles of the obstacle grown by the footprint: for a disc ``obstacle ⊕ disc(R)``, for a
+  piece ``hull(Q − P) ⊕ disc(ρ + r)`` with P the turned piece's points (the Minkowski sum of
+  convex sets, :func:`_grown`), for a wall line its reach toward the wall — so a fast robot at a
+  grazing angle cannot tunnel, whatever the step length. Features the chord
   certainly cannot reach (plain float screens, margins far above the tests' rounding) are not
   tested: the answer of testing them all, bit for bit.
 
 On contact the robot stops at the contact point and the rest of its displacement is projected on
 the contact's tangent (slide), up to three times per step (corners). A robot pushed straight into
 a wall therefore stops at the contact distance; one meeting it obliquely keeps the tangential
-part of its motion, as a Webots robot rubbing along a wall does. Its heading change is always
-applied (a disc turns freely), so a blocked robot can always turn away. Deterministic: robots are
-resolved in world order, each against the others' current positions. Float64 throughout.
+part of its motion, as a Webots robot rubbing along a wall does. A disc turns freely; a shaped
+robot can always back out along its heading (a move that goes no deeper is free) and turn the way
+that frees its corner. Deterministic: robots are resolved in world order, each against the others'
+current positions and headings. Float64 throughout.
 """
 
 from __future__ import annotations
@@ -49,6 +62,7 @@ EPS = 1e-9            # m: "touching" tolerance
 FLOOR = 1e-3          # m: a solid whose top is at most this above a robot band's bottom is its floor
 BACK_OFF = 1e-12      # m: contact points are placed this far outside, never on or inside
 MAX_SLIDES = 3
+TURN_HALVINGS = 12    # a turn cut short by contact is found to 2^-12 of the step's turn
 UPRIGHT = 1.0 - 1e-12
 
 
@@ -65,6 +79,7 @@ class Obstacle:
     normal: np.ndarray | None = None        # wall line
     offset: float = 0.0
     sphere: bool = False                    # a sphere: its section depends on the height band
+    edge_normals: bool = False              # touching an edge, its normal is the edge's (_closest_on_list)
     lo: np.ndarray = field(default_factory=lambda: np.zeros(2))
     hi: np.ndarray = field(default_factory=lambda: np.zeros(2))
     # per grown radius: the vertices as floats and the edges offset by it (_hull_data; points never change)
@@ -84,11 +99,28 @@ class Obstacle:
 
 @dataclass(slots=True)
 class Footprint:
-    """A robot's disc: radius and height band relative to its origin."""
+    """A robot's footprint and height band relative to its origin (ENU axes, its heading taken
+    out: :func:`enu_body`): ``hull(points) ⊕ disc(round)`` (points counter-clockwise), and
+    ``radius`` a disc about the origin that contains it at every heading (the broad phase's).
+    ``points`` None: the disc of ``radius`` about the origin itself."""
 
     radius: float
     z_low: float
     z_high: float
+    points: np.ndarray | None = None
+    round: float = 0.0
+
+    @property
+    def disc(self) -> bool:
+        """Whether the footprint is a disc about the origin (of radius ``round``; ``radius`` with no
+        points): it turns freely, and a centred upright cylinder's is its radius, as it always was."""
+        p = self.points
+        return p is None or (len(p) == 1 and p[0, 0] == 0.0 and p[0, 1] == 0.0)
+
+    @property
+    def disc_radius(self) -> float:
+        """The radius of a :attr:`disc` footprint."""
+        return self.radius if self.points is None else self.round
 
 
 # ---------------------------------------------------------------------- shapes → 2D
@@ -156,8 +188,10 @@ def _z_extent(prim: geo.Primitive, rotation: np.ndarray) -> tuple[float, float]:
 
 
 def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None:
-    """The disc (about the robot's origin) containing every body shape, each at its offset in the
-    robot frame: conservative for off-centre shapes, exact for one centred upright shape."""
+    """A robot's footprint from its body shapes, each at its pose in the robot frame: the convex
+    piece holding their outlines (:func:`_section`, :func:`_body_section`), the height band, and
+    the disc about the origin holding the piece at any heading (the old footprint's radius, which
+    it always was, or wider where a tilted round part's circumscribed polygon reaches past it)."""
     feet = []
     for prim, local in parts:
         f = footprint(prim)
@@ -174,7 +208,69 @@ def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None
         feet.append(Footprint(math.hypot(x, y) + f.radius, z + f.z_low, z + f.z_high))
     if not feet:
         return None
-    return Footprint(max(f.radius for f in feet), min(f.z_low for f in feet), max(f.z_high for f in feet))
+    radius = max(f.radius for f in feet)
+    points, rnd = _body_section([sec for prim, local in parts if (sec := _section(prim, local)) is not None])
+    # the disc about the origin (the broad phase's) must hold the shape at every heading: the old
+    # radius does, but for a tilted round part's circumscribed polygon, which may reach past it
+    reach = float(np.max(np.hypot(points[:, 0], points[:, 1]))) + rnd
+    return Footprint(max(radius, reach), min(f.z_low for f in feet), max(f.z_high for f in feet), points, rnd)
+
+
+ROUND_SIDES = 16      # a round part merged with others: its circumscribed 16-gon (1.9 % wider)
+
+
+def _polygon(rho: float) -> np.ndarray:
+    """The regular ROUND_SIDES-gon circumscribed about the disc of radius ``rho`` at the origin,
+    its edges touching the disc straight ahead, behind and on each side (so a robot's round front
+    stops exactly ``rho`` ahead of its centre head-on)."""
+    k = (np.arange(ROUND_SIDES) + 0.5) * (2.0 * math.pi / ROUND_SIDES)
+    return (rho / math.cos(math.pi / ROUND_SIDES)) * np.stack([np.cos(k), np.sin(k)], axis=1)
+
+
+def _section(prim: geo.Primitive, local: Pose) -> tuple[np.ndarray, float] | None:
+    """A body shape's footprint in the robot's xy plane, ``(points, r)``: ``hull(points) ⊕ disc(r)``
+    contains the shape's vertical projection (exact for a box, sphere, capsule, mesh and an
+    upright cylinder; a tilted cylinder's end discs as circumscribed polygons)."""
+    t = np.asarray(local.translation, dtype=np.float64)
+    # a shape not turned in the robot's frame up to rounding (a NUE robot's frame turned upright,
+    # enu_body) is taken as not turned, as robot_footprint takes its band: its ENU twin's bits
+    r = np.eye(3) if np.allclose(local.rotation, np.eye(3)) else np.asarray(local.rotation, dtype=np.float64)
+    if isinstance(prim, geo.Sphere):
+        return t[None, :2].copy(), float(prim.radius)
+    if isinstance(prim, geo.Capsule):
+        ends = np.array([[0.0, 0.0, -prim.height / 2.0], [0.0, 0.0, prim.height / 2.0]]) @ r.T + t
+        return _hull(ends[:, :2]), float(prim.radius)
+    if isinstance(prim, geo.Cylinder):
+        if abs(r[2, 2]) >= UPRIGHT:
+            return t[None, :2].copy(), float(prim.radius)
+        ring = _polygon(prim.radius)
+        local_pts = np.concatenate([np.column_stack([ring, np.full(len(ring), z)])
+                                    for z in (-prim.height / 2.0, prim.height / 2.0)])
+        return _hull((local_pts @ r.T + t)[:, :2]), 0.0
+    if isinstance(prim, geo.Box):
+        sx, sy, sz = (v / 2.0 for v in prim.size)
+        corners = np.array([[x, y, z] for x in (-sx, sx) for y in (-sy, sy) for z in (-sz, sz)])
+        return _hull((corners @ r.T + t)[:, :2]), 0.0
+    if isinstance(prim, geo.Mesh):
+        if len(prim.vertices) == 0:
+            return None
+        return _hull((np.asarray(prim.vertices, dtype=np.float64) @ r.T + t)[:, :2]), 0.0
+    return None
+
+
+def _body_section(parts: list[tuple[np.ndarray, float]]) -> tuple[np.ndarray, float]:
+    """One convex piece ``hull(points) ⊕ disc(round)`` containing every part's: a part inside a
+    round part (a wheel inside a round body's disc) is dropped; ``round`` is the smallest part's
+    radius left, and a part rounder than that is its points ⊕ the circumscribed polygon of the
+    difference. Exact for one part, for boxes and meshes (round 0), for round parts of one radius."""
+    def inside(j: int, i: int) -> bool:
+        (pj, rj), (pi, ri) = parts[j], parts[i]
+        return (len(pi) == 1 and i != j and bool(np.all(np.hypot(pj[:, 0] - pi[0, 0], pj[:, 1] - pi[0, 1]) + rj <= ri))
+                and not (j < i and len(pj) == 1 and rj == ri and pj[0, 0] == pi[0, 0] and pj[0, 1] == pi[0, 1]))
+    kept = [parts[j] for j in range(len(parts)) if not any(inside(j, i) for i in range(len(parts)))]
+    rnd = min(r for _, r in kept)
+    pts = [p if r == rnd else (p[:, None, :] + _polygon(r - rnd)[None]).reshape(-1, 2) for p, r in kept]
+    return _hull(np.concatenate(pts)), rnd
 
 
 def enu_pose(pose: Pose, to_enu: np.ndarray | None) -> Pose:
@@ -246,8 +342,10 @@ def _closest_on_hull(p: np.ndarray, pts: np.ndarray) -> tuple[float, np.ndarray]
     return _closest_on_list(float(p[0]), float(p[1]), pts.tolist())
 
 
-def _closest_on_list(px: float, py: float, v: list) -> tuple[float, np.ndarray]:
-    """:func:`_closest_on_hull` of the point (px, py) and the hull's vertices as a list of [x, y]."""
+def _closest_on_list(px: float, py: float, v: list, edge_normals: bool = False) -> tuple[float, np.ndarray]:
+    """:func:`_closest_on_hull` of the point (px, py) and the hull's vertices as a list of [x, y].
+    ``edge_normals``: when the closest point is inside an edge, its normal is the edge's own, not
+    the direction from it (whose rounding, a robot 1e-12 m from the edge, turns it by 1e-4 rad)."""
     n = len(v)
     if n == 1:
         dx, dy = px - v[0][0], py - v[0][1]
@@ -267,7 +365,10 @@ def _closest_on_list(px: float, py: float, v: list) -> tuple[float, np.ndarray]:
         dx, dy = rx - t * ex, ry - t * ey
         L = math.hypot(dx, dy)
         if L < best:
-            best, best_n = L, ((dx / L, dy / L) if L > 0 else (ox, oy))
+            if edge_normals and 0.0 < t < 1.0:
+                best, best_n = L, ((ox, oy) if dx * ox + dy * oy >= 0.0 else (-ox, -oy))
+            else:
+                best, best_n = L, ((dx / L, dy / L) if L > 0 else (ox, oy))
         if n >= 3:
             side = rx * ox + ry * oy
             if side > 0.0:
@@ -332,7 +433,7 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
     if clear == _SWEPT_CLEAR:
         return math.inf, None
     if not clear:                                    # (clear: not touching, the distance not needed)
-        dist, normal = _closest_on_list(px, py, v)
+        dist, normal = _closest_on_list(px, py, v, ob.edge_normals)
         if dist - rad <= EPS:                        # touching (or overlapping) now
             # an impact when the move goes in by more than the tolerance; a slide's leftover (the
             # rounding of its projection, ~1e-19 m inward) is none: taken for one, it stalled the robot.
@@ -351,7 +452,8 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
     # never the answer) is skipped on a float test with margins far above its rounding (see
     # _circle_beyond, _edge_beyond); the others get the exact test, in the same order: the same
     # answer, bit for bit, for a few float operations instead of a dozen numpy calls per feature.
-    if a != 0.0:                                     # (a == 0: every circle test answers inf)
+    # (a == 0: every circle test answers inf; rad == 0: a vertex is no circle, its edges hold it)
+    if a != 0.0 and rad > 0.0:
         for i, (cx, cy) in enumerate(v):
             if _circle_beyond(px - cx, py - cy, dx, dy, a, rad):
                 continue
@@ -450,19 +552,126 @@ def _edge_beyond(wx: float, wy: float, dx: float, dy: float, ox: float, oy: floa
     return num < dn - (tol_num + tol_dn + 1e-12 * abs(dn))
 
 
+# ---------------------------------------------------------------------- shaped footprints
+
+def heading(pose: Pose) -> float:
+    """The turn about up of an (ENU) pose, as :func:`enu_body` takes it out of the body."""
+    r = pose.rotation
+    return math.atan2(r[1, 0], r[0, 0])
+
+
+def drive_footprint(parts: list[tuple[geo.Primitive, Pose]], pose: Pose, to_enu: np.ndarray | None,
+                    yaw: float | None = None) -> Footprint | None:
+    """A robot's footprint (:func:`robot_footprint` of :func:`enu_body`) about the heading its drive
+    keeps, ``yaw`` at ``pose`` (None: :func:`heading` of the pose, whose turn enu_body takes out):
+    a drive whose forward axis is not the robot's x axis has its heading off that one."""
+    foot = robot_footprint(enu_body(parts, pose, to_enu))
+    if foot is None or yaw is None or foot.points is None:
+        return foot
+    off = heading(enu_pose(pose, to_enu)) - yaw
+    if off == 0.0:
+        return foot
+    return Footprint(foot.radius, foot.z_low, foot.z_high, _turned(foot.points, off), foot.round)
+
+
+def shaped_obstacle(j: int, foot: Footprint, centre: np.ndarray, yaw: float, band: tuple[float, float]) -> Obstacle:
+    """Robot ``j``'s shaped footprint at ``centre``, heading ``yaw``, as an obstacle."""
+    assert foot.points is not None
+    return Obstacle(f"robot {j}", int(j), _turned(foot.points, yaw) + centre[None, :], foot.round, band)
+
+
+def _wrap(a: float) -> float:
+    """``a`` in [-π, π), as the drives keep their heading (motion._wrap)."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _turned(points: np.ndarray, yaw: float) -> np.ndarray:
+    """``points`` (robot frame, heading out) turned by ``yaw`` about up."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return points @ np.array([[c, s], [-s, c]])
+
+
+def _grown(ob: Obstacle, shape: np.ndarray, rnd: float, p: np.ndarray) -> tuple[Obstacle, float]:
+    """``ob`` grown by the footprint ``hull(shape) ⊕ disc(rnd)`` (relative to the robot's centre,
+    already turned): the set of centres where the footprint meets ``ob``, as (obstacle, radius) for
+    :func:`time_of_impact`. A convex ``hull(Q) ⊕ disc(ρ)`` grown so is ``hull(Q − shape) ⊕ disc(ρ +
+    rnd)``; a wall line, on the side of ``p``, is grown by the footprint's reach toward it."""
+    if ob.normal is not None:
+        side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
+        return ob, float(np.max(shape @ (-side * ob.normal))) + rnd
+    q = ob.points
+    if len(q) == 1:                     # a point (a pillar, a round robot): the footprint turned over
+        pts = q[0] - shape
+    elif len(q) >= 3 and len(shape) >= 3:
+        pts = np.array(_minkowski(q.tolist(), (-shape).tolist()), dtype=np.float64)
+    else:
+        pts = _hull((q[:, None, :] - shape[None, :, :]).reshape(-1, 2))
+    return Obstacle(ob.name, ob.owner, pts, ob.radius, ob.z_range, edge_normals=True), rnd
+
+
+def _minkowski(a: list, b: list) -> list:
+    """The Minkowski sum of two convex polygons (counter-clockwise vertex lists, 3 or more each):
+    their edges merged by direction, O(n + m). A vertex turning by less than 1e-12 rad, or within
+    1e-12 of the previous one (rounding of parallel edges), is dropped: at most 1e-12 of the
+    edges' lengths off the exact sum, where it would give an edge of no length or direction."""
+    def lowest(v: list) -> list:
+        k = min(range(len(v)), key=lambda i: (v[i][1], v[i][0]))
+        return v[k:] + v[:k]
+    a, b = lowest(a), lowest(b)
+    n, m = len(a), len(b)
+    a, b = a + a[:2], b + b[:2]
+    out: list = []
+    i = j = 0
+    while i < n or j < m:
+        out.append((a[i][0] + b[j][0], a[i][1] + b[j][1]))
+        c = ((a[i + 1][0] - a[i][0]) * (b[j + 1][1] - b[j][1])
+             - (a[i + 1][1] - a[i][1]) * (b[j + 1][0] - b[j][0]))
+        if j >= m or (i < n and c > 0.0):
+            i += 1
+        elif i >= n or c < 0.0:
+            j += 1
+        else:
+            i += 1
+            j += 1
+    dropped = True
+    while dropped and len(out) > 3:           # cyclic passes until none is dropped
+        dropped = False
+        k = 0
+        while k < len(out) and len(out) > 3:
+            (ox, oy), (px, py), (qx, qy) = out[k - 1], out[k], out[(k + 1) % len(out)]
+            ux, uy, vx, vy = px - ox, py - oy, qx - px, qy - py
+            lu, lv = math.hypot(ux, uy), math.hypot(vx, vy)
+            if lu <= 1e-12 * (1.0 + abs(px) + abs(py)) or ux * vy - uy * vx <= 1e-12 * lu * lv:
+                del out[k]
+                dropped = True
+            else:
+                k += 1
+    return out
+
+
+def _gap(p: np.ndarray, ob: Obstacle, rho: float) -> float:
+    """The signed distance from ``p`` to ``ob ⊕ disc(rho)`` (negative inside)."""
+    if ob.normal is not None:
+        return abs(float(ob.normal @ p) + ob.offset) - rho
+    return _closest_on_list(float(p[0]), float(p[1]), ob.points.tolist())[0] - (ob.radius + rho)
+
+
 # ---------------------------------------------------------------------- the resolver
 
 class Contact:
-    """The world's static obstacles plus the robots' discs; :meth:`resolve` clips one robot's move."""
+    """The world's static obstacles plus the robots' footprints; :meth:`resolve` clips one robot's move."""
 
     def __init__(self, solids: list[tuple[str, geo.Primitive, Pose, Pose, bool]],
-                 robots: list[tuple[list[tuple[geo.Primitive, Pose]], Pose]], to_enu: np.ndarray | None = None):
+                 robots: list[tuple[list[tuple[geo.Primitive, Pose]], Pose]], to_enu: np.ndarray | None = None,
+                 yaws: list[float | None] | None = None):
         """``solids``: one entry per shape — (solid name, primitive, pose in the solid's frame, the
         solid's world pose, seen by bounding rays); a solid made of several shapes (or with nested
         children) gives several entries under one name, moved together. ``robots``: (body shapes
         with their poses in the robot frame, initial pose) in world order. ``to_enu``: world axes to
         ENU (None in an ENU world): contact is solved in ENU, where the drives keep their planar
-        state, so every pose given (here, :meth:`update_solid`, :meth:`place`) is turned into it."""
+        state, so every pose given (here, :meth:`update_solid`, :meth:`place`) is turned into it.
+        ``yaws``: each robot's heading as its drive keeps it at its initial pose (None, or a robot
+        without a drive: :func:`heading` of its pose), the heading :meth:`resolve_all` is given."""
         self._to_enu = to_enu
         self.prims: dict[str, list[tuple[geo.Primitive, Pose]]] = {}
         first_pose: dict[str, Pose] = {}
@@ -473,7 +682,10 @@ class Contact:
         self.solids: dict[tuple[str, int], Obstacle] = {}
         for name, pose in first_pose.items():
             self.update_solid(name, pose)
-        self.feet: list[Footprint | None] = [robot_footprint(enu_body(parts, pose, to_enu)) for parts, pose in robots]
+        if yaws is None:
+            yaws = [None] * len(robots)
+        self.feet: list[Footprint | None] = [drive_footprint(parts, pose, to_enu, yaw)
+                                             for (parts, pose), yaw in zip(robots, yaws)]
         nan = math.nan                            # robots without a footprint never match the broad phase
         self._radius = np.array([f.radius if f else nan for f in self.feet], dtype=np.float64)
         self._z_low = np.array([f.z_low if f else nan for f in self.feet], dtype=np.float64)
@@ -481,6 +693,9 @@ class Contact:
         starts = [enu_pose(p, to_enu).translation for _, p in robots]
         self.centres = np.array([[t[0], t[1]] for t in starts], dtype=np.float64).reshape(-1, 2)
         self.heights = np.array([t[2] for t in starts], dtype=np.float64)
+        # each robot's heading (its drive's: the footprint is turned to match, drive_footprint)
+        self.yaw = np.array([heading(enu_pose(p, to_enu)) if y is None else y for (_, p), y in zip(robots, yaws)],
+                            dtype=np.float64)
         self.contacts = 0                         # robot-steps whose motion was clipped
         self.checks = 0                           # narrow-phase obstacle tests
         self._rebuild()
@@ -518,21 +733,28 @@ class Contact:
         self._zlo = np.array([o.z_range[0] for o in obs], dtype=np.float64)
         self._zhi = np.array([o.z_range[1] for o in obs], dtype=np.float64)
 
-    def place(self, index: int, pose: Pose) -> None:
-        """A robot was moved from outside (set_pose, reset): no contact check, as in Webots."""
+    def place(self, index: int, pose: Pose, yaw: float | None = None) -> None:
+        """A robot was moved from outside (set_pose, reset): no contact check, as in Webots.
+        ``yaw``: its drive's heading there (None: :func:`heading` of the pose)."""
         pose = enu_pose(pose, self._to_enu)
         self.centres[index] = pose.translation[:2]
         self.heights[index] = pose.translation[2]
+        self.yaw[index] = heading(pose) if yaw is None else yaw
 
-    def resolve(self, index: int, start, end) -> tuple[np.ndarray, bool]:
-        """Clip robot ``index``'s move from ``start`` to ``end`` (xy): ``(final xy, clipped)``."""
-        return self.resolve_all([index], np.asarray([start], dtype=np.float64),
-                                np.asarray([end], dtype=np.float64))[0]
+    def resolve(self, index: int, start, end, yaws=None) -> tuple[np.ndarray, bool, float]:
+        """Clip robot ``index``'s move from ``start`` to ``end`` (xy), its heading going from
+        ``yaws[0]`` to ``yaws[1]`` (None: kept): ``(final xy, clipped, final heading)``."""
+        return self.resolve_all([index], np.asarray([start], dtype=np.float64), np.asarray([end], dtype=np.float64),
+                                None if yaws is None else np.asarray([yaws], dtype=np.float64))[0]
 
-    def resolve_all(self, indices: list[int], starts: np.ndarray, ends: np.ndarray) -> list[tuple[np.ndarray, bool]]:
+    def resolve_all(self, indices: list[int], starts: np.ndarray, ends: np.ndarray,
+                    yaws: np.ndarray | None = None) -> list[tuple[np.ndarray, bool, float]]:
         """Clip the moves of several robots (one basic step), in order: each sees the others where
-        they are when its turn comes. One vectorised broad phase for all of them: a move (with its
-        slides) never leaves the disc of radius |end - start| around its start."""
+        they are when its turn comes. ``yaws``: (k, 2), each one's heading at the start and the
+        end of the step (None: headings kept). Returns (final xy, clipped, turned) per move: ``turned`` False when its turn
+        was refused (its heading stays), which counts as clipped. One vectorised broad phase for
+        all of them: a move (with its slides and its turn) never leaves the disc of radius
+        |end - start| + its footprint's radius around its start."""
         k = len(indices)
         idx = np.asarray(indices, dtype=np.int64)
         reach = np.hypot(*(ends - starts).T) + EPS
@@ -567,20 +789,37 @@ class Contact:
         out = []
         for m in range(k):
             i = int(idx[m])
-            if self.feet[i] is None:
+            yaw0, yaw1 = (float(self.yaw[i]),) * 2 if yaws is None else (float(yaws[m, 0]), float(yaws[m, 1]))
+            foot = self.feet[i]
+            if foot is None:
                 self.centres[i] = ends[m]
-                out.append((ends[m].copy(), False))
+                self.yaw[i] = yaw1
+                out.append((ends[m].copy(), False, yaw1))
                 continue
             cands: list[Obstacle] = [self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m]))
                                      for j in near_solids[m]]
             if near_robots[m]:
                 for j in near_robots[m]:
-                    cands.append(Obstacle(f"robot {j}", int(j), self.centres[j][None, :].copy(), float(self._radius[j]),
-                                          (float(self.heights[j] + self._z_low[j]), float(self.heights[j] + self._z_high[j]))))
-            p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], float(R[m]), cands)
+                    cands.append(self._robot_obstacle(j))
+            if foot.disc:                    # a disc turns freely
+                p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], foot.disc_radius, cands)
+                kept = yaw1
+            else:
+                p, clipped, kept = self._clip_shaped(foot, starts[m].copy(), ends[m] - starts[m], yaw0, yaw1, cands)
             self.centres[i] = p
-            out.append((p, clipped))
+            self.yaw[i] = kept
+            out.append((p, clipped, kept))
         return out
+
+    def _robot_obstacle(self, j: int) -> Obstacle:
+        """Robot ``j``'s footprint where it is now, as an obstacle."""
+        foot = self.feet[j]
+        assert foot is not None
+        band = (float(self.heights[j] + self._z_low[j]), float(self.heights[j] + self._z_high[j]))
+        if foot.disc:
+            return Obstacle(f"robot {j}", int(j), self.centres[j][None, :].copy(), foot.disc_radius, band)
+        assert foot.points is not None
+        return shaped_obstacle(j, foot, self.centres[j], float(self.yaw[j]), band)
 
     @staticmethod
     def _in_band(ob: Obstacle, low: float, high: float) -> Obstacle:
@@ -590,15 +829,76 @@ class Contact:
         return ob
 
     def _clip(self, p: np.ndarray, d: np.ndarray, R: float, cands: list[Obstacle]) -> tuple[np.ndarray, bool]:
-        """The narrow phase: stop at the first contact, slide on, at most MAX_SLIDES times."""
+        """The narrow phase of a disc of radius ``R``: stop at the first contact, slide on, at most
+        MAX_SLIDES times."""
         if not cands:
             return p + d, False
+        return self._sweep(p, d, [(ob, R) for ob in cands])
+
+    def _clip_shaped(self, foot: Footprint, p: np.ndarray, d: np.ndarray, yaw: float, yaw1: float,
+                     cands: list[Obstacle]) -> tuple[np.ndarray, bool, float]:
+        """The narrow phase of a shaped footprint turning from heading ``yaw`` to ``yaw1`` (the
+        short way): the turn first, in place at the start, as far as the footprint sweeping
+        through it overlaps nothing it did not already (or deeper: :meth:`_turn_clear`), then the
+        move at the heading it ends with, as :meth:`_clip` with each obstacle grown by the turned
+        footprint (:func:`_grown`). ``(end, clipped, heading)``: a turn cut short is clipped."""
+        assert foot.points is not None
+        if not cands:
+            return p + d, False, yaw1
+        kept = yaw1
+        turn = math.remainder(yaw1 - yaw, math.tau)
+        if turn != 0.0:
+            here = _turned(foot.points, yaw)
+            now = [_gap(p, *_grown(ob, here, foot.round, p)) for ob in cands]
+            if not self._turn_clear(foot, p, yaw, turn, cands, now):
+                # the largest part of the turn that is clear (none is), halving; a robot already
+                # touching where it turns (pressed on) is told by its first step, 2^-12 of the turn
+                lo, hi = 0.0, 1.0
+                least = 0.5 ** TURN_HALVINGS
+                if self._turn_clear(foot, p, yaw, turn * least, cands, now):
+                    lo = least
+                    for _ in range(TURN_HALVINGS):
+                        mid = 0.5 * (lo + hi)
+                        if self._turn_clear(foot, p, yaw, turn * mid, cands, now):
+                            lo = mid
+                        else:
+                            hi = mid
+                kept = _wrap(yaw + turn * lo) if lo > 0.0 else yaw
+        end, clipped = self._sweep(p, d, [_grown(ob, _turned(foot.points, kept), foot.round, p) for ob in cands])
+        if kept != yaw1 and not clipped:
+            self.contacts += 1
+        return end, clipped or kept != yaw1, kept
+
+    def _turn_clear(self, foot: Footprint, p: np.ndarray, yaw: float, turn: float, cands: list[Obstacle],
+                    now: list[float]) -> bool:
+        """Whether the footprint at ``p`` turning from ``yaw`` by ``turn`` stays clear of every
+        candidate: at no heading of the turn nearer to it than ``now`` (each one's signed distance
+        at ``yaw``) if it overlaps, nor overlapping it (by more than EPS) if it does not. Closed
+        form and conservative: the turn in parts of at most 45°, each part's footprints inside
+        the hull of its two ends and its middle pushed out by 1 / cos(half the part) -- each
+        vertex's arc lies in the triangle of its ends and their tangents' crossing."""
+        assert foot.points is not None
+        parts = max(1, math.ceil(abs(turn) / (math.pi / 4.0)))
+        for k in range(parts):
+            a, b = yaw + turn * k / parts, yaw + turn * (k + 1) / parts
+            half = (b - a) / 2.0
+            swept = _hull(np.concatenate([_turned(foot.points, a), _turned(foot.points, b),
+                                          _turned(foot.points, a + half) / math.cos(half)]))
+            for ob, gap in zip(cands, now):
+                self.checks += 1
+                if _gap(p, *_grown(ob, swept, foot.round, p)) < min(gap, 0.0) - EPS:
+                    return False
+        return True
+
+    def _sweep(self, p: np.ndarray, d: np.ndarray, cands: list[tuple[Obstacle, float]]) -> tuple[np.ndarray, bool]:
+        """Move the point ``p`` by ``d`` among ``cands`` (each an obstacle and the radius it is
+        grown by): stop at the first contact, slide on, at most MAX_SLIDES times."""
         clipped = False
         for _ in range(MAX_SLIDES + 1):
             if not (d[0] or d[1]):
                 break
             best, best_n = math.inf, None
-            for ob in cands:
+            for ob, R in cands:
                 self.checks += 1
                 s, n = time_of_impact(p, d, ob, R)
                 if s < best:

@@ -12,6 +12,7 @@ Nothing is computed for a device that is disabled.
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections import Counter
 from collections.abc import Iterator
@@ -323,14 +324,16 @@ class Simulation:
         # each robot at its world-file pose: its footprint is taken upright (enu_body), not tilted by
         # the slope it may start on (the batched simulation's feet, from the same poses)
         robots = [(robot_bounding_parts(r, base), self.robots[r.name].initial_pose) for r in self.world.robots]
-        return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system])
+        # each robot's heading as its drive keeps it (its footprint is turned to it: contact.drive_footprint)
+        yaws = [None if (d := self.robots[r.name].drive) is None else d.yaw for r in self.world.robots]
+        return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system], yaws)
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
         jump, not motion: their poses start over from there (_MotionSensor.placed)."""
         self.scene.set_robot_pose(robot.index, pose)
         if self.contact is not None:
-            self.contact.place(robot.index, pose)
+            self.contact.place(robot.index, pose, None if robot.drive is None else robot.drive.yaw)
         for dev in robot.devices.values():
             if dev.tracks_motion:
                 dev.placed()          # type: ignore[attr-defined]
@@ -558,21 +561,28 @@ class Simulation:
                 moved_links = linked.move_links() or moved_links
             if moved_links:           # distance sensors' stacked poses (and own-body hits) are made again
                 self._distance_plans.clear()
+        headings: list[float] = []
         for robot in self._driven:
             drive = robot.drive
             assert drive is not None
             robot.pressing = False
             start = (drive.x, drive.y)
+            yaw0 = drive.yaw
             pose = drive.step(dt)
             if pose is not None:
                 moved.append((robot, drive, start, pose))
+                headings.append(yaw0)
         if self.contact is not None and moved:
+            yaws = np.array([(yaw0, d.yaw) for (_, d, _, _), yaw0 in zip(moved, headings)])
             ends = self.contact.resolve_all([r.index for r, _, _, _ in moved], np.array([s for _, _, s, _ in moved]),
-                                            np.array([(d.x, d.y) for _, d, _, _ in moved]))
-            for k, (end, clipped) in enumerate(ends):
+                                            np.array([(d.x, d.y) for _, d, _, _ in moved]), yaws)
+            for k, (end, clipped, kept) in enumerate(ends):
                 if clipped:
                     robot, drive, start, _ = moved[k]
                     robot.pressing = True
+                    if kept != drive.yaw:   # its footprint would have turned into something: the turn cut short
+                        drive.yaw = kept
+                        drive.turn = math.remainder(kept - headings[k], math.tau) * 1000.0 / dt
                     drive.x, drive.y = float(end[0]), float(end[1])
                     drive.linear = ((drive.x - start[0]) * 1000.0 / dt, (drive.y - start[1]) * 1000.0 / dt)
                     moved[k] = (robot, drive, start, drive.pose())
