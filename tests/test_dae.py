@@ -491,3 +491,33 @@ def test_materials_too_large_for_the_workers_memory_are_said_not_silently_white(
     assert len(said) == 1 and "the materials of 'cube.dae' are not read (its materials take more than" in said[0], said
     assert [s.appearance for s in w.world.solids[0].shapes] == [None]     # no appearance: seen white
     assert w.losses == ()
+
+
+def test_a_large_cad_shape_of_many_materials_is_read_once_for_all_of_them(tmp_path: Path, monkeypatch) -> None:
+    """A CadShape asks for each material's triangles: a file read in the worker (Webots' Panda links
+    are ~1 MB of a dozen materials each) is read once for all of them, not once a material, with the
+    same triangles as in process; a material whose triangles are missing is still one line."""
+    colours = {f"m{i}": (f"paint{i}", (0.1 * i, 0.5, 0.5)) for i in range(3)}
+    groups = [(f"m{i}", CUBE[4 * i:4 * i + 4]) for i in range(3)]
+    (tmp_path / "three.dae").write_text(dae(CORNERS, groups, materials=colours))
+    inline = [meshes.load_mesh(tmp_path / "three.dae", (1.0, 2.0, 3.0), material=i) for i in range(3)]
+    meshes._CACHE.clear()
+    monkeypatch.setattr(meshes, "IN_PROCESS_BYTES", 0)
+    runs = []
+    real = meshes._run_worker
+    monkeypatch.setattr(meshes, "_run_worker", lambda *a: runs.append(a[-1]) or real(*a))
+    worker = [meshes.load_mesh(tmp_path / "three.dae", (1.0, 2.0, 3.0), material=i) for i in (2, 0, 1)]
+    assert runs == [(meshes.ALL_MATERIALS, "")]
+    for a, b in zip(inline, [worker[1], worker[2], worker[0]], strict=True):
+        np.testing.assert_array_equal(a.vertices, b.vertices)
+        np.testing.assert_array_equal(a.faces, b.faces)
+        assert a.closed is b.closed is False
+    with pytest.raises(meshes.MeshFileError, match=r"has no triangles of material index 3"):
+        meshes.load_mesh(tmp_path / "three.dae", (1.0, 1.0, 1.0), material=3)
+    meshes._CACHE.clear()
+    runs.clear()
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "three.dae" ] } ] }\n')
+    shapes = load_world(p).world.solids[0].shapes
+    assert [(s.geometry.material_index, s.appearance.base_color) for s in shapes] == [
+        (0, (0.0, 0.5, 0.5)), (1, (0.1, 0.5, 0.5)), (2, (0.2, 0.5, 0.5))]
+    assert runs == [(meshes.ALL_MATERIALS, "")]

@@ -14,7 +14,10 @@ place, "" for cad.py's own). It imports numpy and trimesh, and for those files `
 and a JSON header — ``{"ok": true, "vertices": NV, "faces": NF, "closed": bool}`` followed by NV×3
 float64 and NF×3 int64 (native order), or ``{"ok": false, "kind": "memory" | "no triangles" | "cad" |
 "error", "error": "..."}``. MATERIAL -2 asks for a COLLADA or OBJ file's materials only: ``{"ok": true,
-"materials": [[name, diffuse, transparency, texture], ...], "used": [index, ...]}``, no arrays.
+"materials": [[name, diffuse, transparency, texture], ...], "used": [index, ...]}``, no arrays. MATERIAL
+-3 asks for every used material's triangles from one reading (a CadShape of many materials reads a
+large file once, not once a material): ``{"ok": true, "groups": [[MATERIAL, NV, NF, closed], ...]}``
+followed by each group's NV×3 float64 and NF×3 int64, in that order.
 """
 
 import json
@@ -33,6 +36,16 @@ def _reply(header, *arrays):
 
 
 MATERIALS_ONLY = -2      # MATERIAL: reply with the file's materials and the ones its triangles use, no arrays
+ALL_MATERIALS = -3       # MATERIAL: reply with each used material's triangles, read once
+
+
+def _closed(np, trimesh, vertices, faces, scale):
+    """Whether the triangles close a volume, coincident vertices merged (judged on the topology, as
+    meshes.py does)."""
+    if not (np.isfinite(vertices).all() and faces.min() >= 0 and faces.max() < len(vertices)):
+        return False
+    scaled = vertices * np.asarray(scale, dtype=np.float64)
+    return bool(trimesh.Trimesh(vertices=scaled, faces=faces, process=True, validate=False).is_watertight)
 
 
 def _cad_module():
@@ -67,6 +80,22 @@ def main():
             _reply({"ok": True, "materials": [[m.name, list(m.diffuse), m.transparency, m.texture]
                                               for m in read.materials], "used": read.used()})
             return
+        if material == ALL_MATERIALS:
+            cad = _cad_module()
+            cap = int(sys.argv[9]) if len(sys.argv) > 9 and sys.argv[9] else None
+            try:
+                read = cad.read_cad(path, kind, cap)
+                groups = []
+                for m in read.used():
+                    v, f, _ = read.select(m)
+                    groups.append((m, np.ascontiguousarray(v, dtype=np.float64), np.ascontiguousarray(f, dtype=np.int64)))
+            except cad.CadError as exc:
+                _reply({"ok": False, "kind": "cad", "error": str(exc)[:2000]})
+                return
+            del read
+            heads = [[m, len(v), len(f), _closed(np, trimesh, v, f, (sx, sy, sz))] for m, v, f in groups]
+            _reply({"ok": True, "groups": heads}, *[a for _, v, f in groups for a in (v, f)])
+            return
         if kind == "dae" or (kind == "obj" and material >= 0):
             cad = _cad_module()
             name = sys.argv[8] if len(sys.argv) > 8 else ""
@@ -85,12 +114,7 @@ def main():
         if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0 or vertices.ndim != 2 or vertices.shape[1] != 3:
             _reply({"ok": False, "kind": "no triangles", "error": "no triangles"})
             return
-        closed = False
-        if np.isfinite(vertices).all() and faces.min() >= 0 and faces.max() < len(vertices):
-            scaled = vertices * np.asarray((sx, sy, sz), dtype=np.float64)
-            # merge coincident vertices so that watertightness is judged on the topology (as meshes.py)
-            closed = bool(trimesh.Trimesh(vertices=scaled, faces=faces, process=True, validate=False).is_watertight)
-            del scaled
+        closed = _closed(np, trimesh, vertices, faces, (sx, sy, sz))
     except MemoryError:
         _reply({"ok": False, "kind": "memory", "error": "out of memory"})
         return

@@ -85,17 +85,48 @@ def load_mesh(path: str | Path, scale: tuple[float, float, float] = (1.0, 1.0, 1
         select = _selection(kind, material, name)
         key = (str(path), stat.st_mtime_ns, tuple(float(s) for s in scale), *select)
         mesh = _CACHE.get(key)
-        if mesh is None:
+        if mesh is None and stat.st_size > IN_PROCESS_BYTES and by_cad(kind, select) and select[0] >= 0 \
+                and not select[1]:
+            # a CadShape asks for each of its materials in turn: a large file is read once for all of them
+            mesh = _load_materials(key, memory if memory is not None else DEFAULT_LOAD_MEMORY, max_triangles, kind)
+        elif mesh is None:
             mesh = _load(*key[:3], memory if memory is not None else DEFAULT_LOAD_MEMORY, stat.st_size, max_triangles,
                          kind, select)
-            _CACHE[key] = mesh
-            while len(_CACHE) > 64:
-                _CACHE.popitem(last=False)
+            _remember(key, mesh)
         else:
             _CACHE.move_to_end(key)
         return mesh
     except MeshFileError as exc:
         raise MeshFileError(str(exc).replace(str(path), shown)) from None
+
+
+def _remember(key: tuple, mesh: Any) -> None:
+    _CACHE[key] = mesh
+    while len(_CACHE) > CACHED_MESHES:
+        _CACHE.popitem(last=False)
+
+
+def _load_materials(key: tuple, memory: int, max_triangles: int | None, kind: str):
+    """The mesh of material ``key[3]`` of a large COLLADA or OBJ file, every other material its
+    triangles use cached on the way (one worker run for a CadShape's materials)."""
+    from sensorium.server.world.geometry import Mesh
+
+    path, mtime, scale, material, _ = key
+    groups = _read_materials_in_worker(path, scale, memory, max_triangles, kind)
+    if material not in groups:
+        raise MeshFileError(f"mesh {path} has no triangles {_selected((material, ''))}")
+    wanted = None
+    for m, (vertices, faces, closed) in groups.items():
+        if len(faces) == 0:
+            continue
+        vertices *= np.asarray(scale, dtype=np.float64)
+        mesh = Mesh(vertices=vertices, faces=faces, closed=closed)
+        _remember((path, mtime, scale, m, ""), mesh)
+        if m == material:
+            wanted = mesh
+    if wanted is None:
+        raise MeshFileError(f"mesh {path} has no triangles {_selected((material, ''))}")
+    return wanted
 
 
 def _selection(kind: str, material: int, name: str) -> tuple[int, str]:
@@ -147,9 +178,10 @@ def mesh_format(path: Path) -> str | None:
     return None
 
 
-# meshes read, by (resolved path, modification time, scale, COLLADA material and geometry name), the 64
-# most recently used (whatever memory bound they were read under: validating and building read each file once)
+# meshes read, by (resolved path, modification time, scale, COLLADA material and geometry name), the
+# CACHED_MESHES most recently used (whatever memory bound they were read under: validating and building read each file once)
 _CACHE: OrderedDict[tuple[str, int, tuple[float, ...], int, str], Any] = OrderedDict()
+CACHED_MESHES = 256       # (a robot arm of CAD files has ~10 links of ~10 materials each)
 
 
 def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: int, max_triangles: int | None,
@@ -268,10 +300,42 @@ def _worker_header(path: str, memory: int, kind: str, extra: list[str]) -> dict 
     return header if isinstance(header, dict) else None
 
 
+ALL_MATERIALS = -3        # (mesh_worker.ALL_MATERIALS)
+
+
 def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
                     max_triangles: int | None = None, kind: str | None = None,
                     select: tuple[int, str] = (-1, "")) -> tuple[np.ndarray, np.ndarray, bool]:
     """(vertices, faces, closed) of a mesh file read by :mod:`.mesh_worker` within ``memory`` bytes."""
+    header, arrays = _run_worker(path, scale, memory, max_triangles, kind, select)
+    (vertices, faces), = arrays
+    _check_arrays(path, vertices, faces)
+    return vertices, faces, bool(header["closed"])
+
+
+def _read_materials_in_worker(path: str, scale: tuple[float, ...], memory: int, max_triangles: int | None,
+                              kind: str) -> dict[int, tuple[np.ndarray, np.ndarray, bool]]:
+    """{material index: (vertices, faces, closed)} of every material a COLLADA or OBJ file's
+    triangles use, from one reading by :mod:`.mesh_worker` (a CadShape asks for each material)."""
+    header, arrays = _run_worker(path, scale, memory, max_triangles, kind, (ALL_MATERIALS, ""))
+    out = {}
+    for (m, _, _, closed), (vertices, faces) in zip(header["groups"], arrays, strict=True):
+        _check_arrays(path, vertices, faces)
+        out[int(m)] = (vertices, faces, bool(closed))
+    return out
+
+
+def _check_arrays(path: str, vertices: np.ndarray, faces: np.ndarray) -> None:
+    if not np.isfinite(vertices).all():
+        raise MeshFileError(f"mesh {path} has non-finite vertex coordinates")
+    if len(faces) and (faces.min() < 0 or faces.max() >= len(vertices)):
+        raise MeshFileError(f"mesh {path} has face indices outside its vertex list")
+
+
+def _run_worker(path: str, scale: tuple[float, ...], memory: int, max_triangles: int | None, kind: str | None,
+                select: tuple[int, str]) -> tuple[dict, list[tuple[np.ndarray, np.ndarray]]]:
+    """Run :mod:`.mesh_worker` for triangles: (its JSON header, the (vertices, faces) arrays it sent:
+    one pair, or one per group when ``select`` asks for every material). MeshFileError: it failed."""
     import json
     import os
     import struct
@@ -287,25 +351,38 @@ def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=env,
                             close_fds=True)
     assert proc.stdout is not None
+    arrays: list[tuple[np.ndarray, np.ndarray]] = []
     try:
         head = proc.stdout.read(4)
         header = json.loads(proc.stdout.read(struct.unpack(">I", head)[0])) if len(head) == 4 else None
-        if header is not None and header.get("ok") and max_triangles is not None and header["faces"] > max_triangles:
-            proc.kill()
-            raise MeshFileError(f"mesh {path} has {header['faces']:,} triangles, more than the world's limit of "
-                                f"{max_triangles:,} (raise the limits with --allow-large)")
+        if not isinstance(header, dict):
+            header = None
         if header is not None and header.get("ok"):
-            vertices = np.empty((header["vertices"], 3), dtype=np.float64)
-            faces = np.empty((header["faces"], 3), dtype=np.int64)
-            for a in (vertices, faces):
-                view = memoryview(a).cast("B")
-                got = 0
-                while got < len(view):
-                    n = proc.stdout.readinto(view[got:])
-                    if not n:
-                        header = None
+            sizes = [(int(g[1]), int(g[2])) for g in header["groups"]] if "groups" in header \
+                else [(int(header["vertices"]), int(header["faces"]))]
+            for _, nf in sizes:
+                if max_triangles is not None and nf > max_triangles:
+                    proc.kill()
+                    raise MeshFileError(f"mesh {path} has {nf:,} triangles, more than the world's limit of "
+                                        f"{max_triangles:,} (raise the limits with --allow-large)")
+            for nv, nf in sizes:
+                pair = (np.empty((nv, 3), dtype=np.float64), np.empty((nf, 3), dtype=np.int64))
+                for a in pair:
+                    view = memoryview(a).cast("B")
+                    got = 0
+                    while got < len(view):
+                        n = proc.stdout.readinto(view[got:])
+                        if not n:
+                            header = None
+                            break
+                        got += n
+                    if header is None:
                         break
-                    got += n
+                if header is None:
+                    break
+                arrays.append(pair)
+    except (ValueError, KeyError, TypeError, IndexError):       # (a reply that is not what was asked)
+        header = None
     finally:
         proc.stdout.close()
         code = proc.wait()
@@ -324,11 +401,7 @@ def _read_in_worker(path: str, scale: tuple[float, ...], memory: int,
             raise MeshFileError(f"cannot read {_FORMAT_NAMES.get(kind or '', '')} mesh {path}: "
                                 f"{header.get('error', '?')}")
         raise MeshFileError(f"cannot read mesh {path}: {header.get('error', '?')}")
-    if not np.isfinite(vertices).all():
-        raise MeshFileError(f"mesh {path} has non-finite vertex coordinates")
-    if faces.min() < 0 or faces.max() >= len(vertices):
-        raise MeshFileError(f"mesh {path} has face indices outside its vertex list")
-    return vertices, faces, bool(header["closed"])
+    return header, arrays
 
 
 def triangles_mesh(vertices, faces):
