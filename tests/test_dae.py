@@ -521,3 +521,29 @@ def test_a_large_cad_shape_of_many_materials_is_read_once_for_all_of_them(tmp_pa
     assert [(s.geometry.material_index, s.appearance.base_color) for s in shapes] == [
         (0, (0.0, 0.5, 0.5)), (1, (0.1, 0.5, 0.5)), (2, (0.2, 0.5, 0.5))]
     assert runs == [(meshes.ALL_MATERIALS, "")]
+
+
+def test_texture_coordinates_are_the_lowest_set_whatever_the_order_of_the_inputs(tmp_path: Path) -> None:
+    """A file with two TEXCOORD sets (a lightmap set 1 written before the texture's set 0, as some
+    exporters write them): the texture is mapped by set 0, assimp's channel 0 that Webots uses, not
+    by the first input written."""
+    (tmp_path / "img").mkdir()
+    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
+        tmp_path / "img" / "board.png")
+    quad = [[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.5, 0.0]]
+    text = dae(quad, [("m", [(0, 1, 2), (0, 2, 3)])], uv=[[0, 0], [1, 0], [1, 1], [0, 1]],
+               materials={"m": ("board", "img/board.png")})
+    lightmap = ('<source id="t1"><float_array id="t1a" count="8">0.9 0.1 0.9 0.1 0.9 0.1 0.9 0.1</float_array>'
+                '<technique_common><accessor source="#t1a" count="4" stride="2"><param name="S" type="float"/>'
+                '<param name="T" type="float"/></accessor></technique_common></source>')
+    set0 = '<input semantic="TEXCOORD" source="#t" offset="1" set="0"/>'
+    assert set0 in text and '<source id="t">' in text
+    text = text.replace('<source id="t">', lightmap + '<source id="t">').replace(
+        set0, '<input semantic="TEXCOORD" source="#t1" offset="1" set="1"/>' + set0)
+    (tmp_path / "quad.dae").write_text(text)
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "quad.dae" ] } ] }\n'
+                      'Robot { name "r" children [\n'
+                      '  DistanceSensor { name "a" translation 0.3 0.2 0.0625 rotation 0 1 0 1.5707963267948966 '
+                      'type "infra-red" lookupTable [ 0 0 0, 10 10000 0 ] } ] }\n')
+    v = read_all(Simulation(load_world(p), precision="exact"))
+    assert v["a"] == pytest.approx(expected(0.0625, REDS[1, 3] / 255), rel=1e-9)   # set 1 would read REDS[3, 3]

@@ -12,7 +12,8 @@ An OBJ file's (ours: Webots numbers none) are the names its faces use (``usemtl`
 faces without one a default white material after them; OBJ coordinates are kept as written.
 Each material keeps what Webots' PBRAppearance takes from it: the diffuse colour (COLLADA: white
 when the diffuse is a texture; OBJ: ``Kd``), the transparency (1 − opacity; OBJ: ``d``) and the
-diffuse image's path as written in the file (relative to it; OBJ: ``map_Kd``).
+diffuse image's path as written in the file (relative to it; OBJ: ``map_Kd``). Texture coordinates
+are the lowest-numbered TEXCOORD set's (assimp's channel 0, Webots' texture coordinates).
 
 This module imports numpy, pycollada and trimesh only (the mesh worker loads it by its path).
 """
@@ -159,8 +160,9 @@ def _parse(path: str, cap: int) -> CadFile:
                     raise CadError(f"geometry {name!r}: face indices outside its vertex list")
                 uv = None
                 if len(p.texcoordset) > 0 and len(p.texcoord_indexset) > 0:
-                    st = np.asarray(p.texcoordset[0], dtype=np.float64).reshape(-1, 2)
-                    ti = np.asarray(p.texcoord_indexset[0], dtype=np.int64)
+                    k = _first_uv_set(p)
+                    st = np.asarray(p.texcoordset[k], dtype=np.float64).reshape(-1, 2)
+                    ti = np.asarray(p.texcoord_indexset[k], dtype=np.int64)
                     if ti.shape == faces.shape and len(st) and ti.min() >= 0 and ti.max() < len(st):
                         uv = st[ti]
                 m = index.get(id(p.material)) if p.material is not None else None
@@ -182,6 +184,26 @@ def _parse(path: str, cap: int) -> CadFile:
         if not np.isfinite(p.vertices).all():
             raise CadError(f"geometry {p.geometry!r}: non-finite vertex coordinates")
     return CadFile(tuple(materials), tuple(parts))
+
+
+def _first_uv_set(p) -> int:
+    """Which of a primitive's TEXCOORD inputs is assimp's UV channel 0, the one Webots maps textures
+    with: assimp files each input under its ``set`` number (0 without one) and packs the sets in
+    ascending order, so the lowest set, whatever the order the inputs are written in (the first of
+    equal ones)."""
+    try:
+        inputs = p.original.sources["TEXCOORD"]
+    except (AttributeError, KeyError, TypeError):
+        return 0
+    sets = []
+    for entry in inputs:
+        try:
+            sets.append(int(entry[3]) if entry[3] not in (None, "") else 0)
+        except (TypeError, ValueError, IndexError):
+            sets.append(0)
+    if len(sets) != len(p.texcoordset):
+        return 0
+    return min(range(len(sets)), key=lambda i: (sets[i], i))
 
 
 def _parse_obj(path: str, cap: int) -> CadFile:
