@@ -547,3 +547,32 @@ def test_texture_coordinates_are_the_lowest_set_whatever_the_order_of_the_inputs
                       'type "infra-red" lookupTable [ 0 0 0, 10 10000 0 ] } ] }\n')
     v = read_all(Simulation(load_world(p), precision="exact"))
     assert v["a"] == pytest.approx(expected(0.0625, REDS[1, 3] / 255), rel=1e-9)   # set 1 would read REDS[3, 3]
+
+
+def test_mtl_files_as_blender_and_windows_tools_write_them(tmp_path: Path) -> None:
+    """What real .mtl files hold: a material Blender names ``None``, an image path with spaces after
+    texture options (a Windows export's ``My Textures/board 1.png``; the whole rest of the line is the
+    file, as assimp reads it), and ``Tr`` (1 − opacity) instead of ``d``: the texel under the sensor
+    is read and the glass is 25 % transparent."""
+    (tmp_path / "My Textures").mkdir()
+    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
+        tmp_path / "My Textures" / "board 1.png")
+    (tmp_path / "part.obj").write_text("mtllib part.mtl\n"
+                                       "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nv 5 0 0\nv 6 0 0\n"
+                                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                       "usemtl None\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\nusemtl glass\nf 5/1 6/2 7/3\n"
+                                       "v 5 1 0\n")
+    (tmp_path / "part.mtl").write_text("# Blender MTL File: 'None'\nnewmtl None\nKd 1 1 1\n"
+                                       "map_Kd -bm 1.0 -s 1 1 1 My Textures/board 1.png  \n"
+                                       "newmtl glass\nKd 0.2 0.2 0.2\nTr 0.25\n")
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "part.obj" ] } ] }\n'
+                      'Robot { name "r" children [\n'
+                      '  DistanceSensor { name "b" translation -0.4 0.1 0.0625 rotation 0 1 0 1.5707963267948966 '
+                      'type "infra-red" lookupTable [ 0 0 0, 10 10000 0 ] } ] }\n')
+    w = load_world(p)
+    assert [(s.appearance.base_color, s.appearance.transparency,
+             s.appearance.texture.url if s.appearance.texture else None) for s in w.world.solids[0].shapes] == [
+        ((1.0, 1.0, 1.0), 0.0, "My Textures/board 1.png"), ((0.2, 0.2, 0.2), pytest.approx(0.25), None)]
+    assert not [x for x in w.warnings if "texture" in x], w.warnings
+    v = read_all(Simulation(w, precision="exact"))
+    assert v["b"] == pytest.approx(expected(0.0625, REDS[1, 0] / 255), rel=1e-9)   # (s, t) = (0.1, 0.6)

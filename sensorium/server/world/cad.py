@@ -261,8 +261,8 @@ MTL_FILES = 16            # the first this many distinct .mtl files an OBJ file 
 
 def _mtl_library(path: str) -> dict[str, CadMaterial]:
     """The materials of the .mtl files an OBJ file names (``mtllib``, relative to it, in its folder or
-    below: others are not read): ``Kd``, ``d`` and ``map_Kd`` (its last word: the file; options before
-    it are not read). A missing or unreadable .mtl gives no materials (Webots renders such faces white
+    below: others are not read): ``Kd``, ``d`` (or ``Tr``, 1 − opacity) and ``map_Kd`` (the file after
+    its options, which are skipped as assimp skips them). A missing or unreadable .mtl gives no materials (Webots renders such faces white
     too)."""
     import os
 
@@ -303,15 +303,38 @@ def _mtl_library(path: str) -> dict[str, CadMaterial]:
                     values["Kd"] = tuple(min(1.0, max(0.0, float(w))) for w in words[1:4])
                 except ValueError:
                     pass
-            elif words[0] == "d" and len(words) >= 2:
-                try:
-                    d = float(words[1])
+            elif words[0] in ("d", "Tr") and len(words) >= 2:
+                try:       # opacity; Tr is its complement (assimp: the last of the two written wins)
+                    d = float(words[1]) if words[0] == "d" else 1.0 - float(words[1])
                     values["d"] = d if math.isfinite(d) else 1.0
                 except ValueError:
                     pass
             elif words[0] == "map_Kd" and len(words) >= 2:
-                values["map_Kd"] = words[-1]
+                image = _map_file(line.split(None, 1)[1])
+                if image:
+                    values["map_Kd"] = image
     return out
+
+
+# texture options before a map's file name and how many values each takes (as assimp skips them)
+_MAP_OPTIONS = {"-clamp": 1, "-type": 1, "-blendu": 1, "-blendv": 1, "-boost": 1, "-texres": 1, "-bm": 1,
+                "-imfchan": 1, "-cc": 1, "-mm": 2, "-o": 3, "-s": 3, "-t": 3}
+
+
+def _map_file(rest: str) -> str:
+    """A .mtl map statement's file name: what follows its options, spaces inside kept (a Windows
+    export's ``My Textures/wood 1.png``)."""
+    text = rest.strip()
+    while text.startswith("-"):
+        option, _, text = text.partition(" ")
+        count = _MAP_OPTIONS.get(option.lower())
+        if count is None:
+            text = f"{option} {text}".strip()
+            break
+        for _ in range(count):
+            text = text.lstrip().partition(" ")[2] if " " in text.lstrip() else ""
+        text = text.lstrip()
+    return text.strip()
 
 
 def _material(m) -> CadMaterial:
