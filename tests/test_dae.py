@@ -576,3 +576,21 @@ def test_mtl_files_as_blender_and_windows_tools_write_them(tmp_path: Path) -> No
     assert not [x for x in w.warnings if "texture" in x], w.warnings
     v = read_all(Simulation(w, precision="exact"))
     assert v["b"] == pytest.approx(expected(0.0625, REDS[1, 0] / 255), rel=1e-9)   # (s, t) = (0.1, 0.6)
+
+
+def test_convert_reads_a_large_cad_shapes_materials_once(tmp_path: Path, monkeypatch, capsys) -> None:
+    """`sensorium convert` converts a .wbt world twice (to check it, then to write it): a large
+    CadShape file's materials are read by the worker once, and its triangles once, not once a
+    conversion and once a material."""
+    colours = {f"m{i}": (f"paint{i}", (0.1 * i, 0.5, 0.5)) for i in range(3)}
+    (tmp_path / "three.dae").write_text(dae(CORNERS, [(f"m{i}", CUBE[4 * i:4 * i + 4]) for i in range(3)],
+                                            materials=colours))
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "three.dae" ] } ] }\n')
+    monkeypatch.setattr(meshes, "IN_PROCESS_BYTES", 0)
+    runs: list[str] = []
+    header, triangles = meshes._worker_header, meshes._run_worker
+    monkeypatch.setattr(meshes, "_worker_header", lambda *a: runs.append("materials") or header(*a))
+    monkeypatch.setattr(meshes, "_run_worker", lambda *a: runs.append("triangles") or triangles(*a))
+    assert main(["convert", str(p), str(tmp_path / "w.yaml")]) == 0
+    assert runs == ["materials", "triangles"]
+    assert (tmp_path / "w.yaml").read_text().count("material_index") == 3

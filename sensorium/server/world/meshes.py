@@ -240,14 +240,31 @@ def _selected(select: tuple[int, str]) -> str:
 def file_materials(path: str | Path, kind: str, memory: int | None = None) -> tuple[list[Any], list[int]]:
     """(materials, the indices its triangles use) of a COLLADA or OBJ file (:mod:`.cad`): a file over
     ``IN_PROCESS_BYTES`` read by the worker within ``memory`` bytes (default ``DEFAULT_LOAD_MEMORY``).
-    MeshFileError: it cannot be read."""
-    from sensorium.server.world.cad import CadError, CadMaterial, read_cad
-
+    MeshFileError: it cannot be read. Cached by path and modification time."""
     path = str(Path(path).resolve())
     try:
-        size = Path(path).stat().st_size
+        stat = Path(path).stat()
+        size = stat.st_size
     except OSError as exc:
         raise MeshFileError(f"cannot read mesh {path}: {exc.strerror or exc}") from None
+    key = (path, stat.st_mtime_ns, kind)
+    if key in _MATERIALS:       # (a .wbt world is converted twice by `sensorium convert`: read once)
+        _MATERIALS.move_to_end(key)
+        return list(_MATERIALS[key][0]), list(_MATERIALS[key][1])
+    materials, used = _file_materials(path, size, kind, memory)
+    _MATERIALS[key] = (tuple(materials), tuple(used))
+    while len(_MATERIALS) > CACHED_MESHES:
+        _MATERIALS.popitem(last=False)
+    return materials, used
+
+
+# the materials of the files read, by (resolved path, modification time, format)
+_MATERIALS: OrderedDict[tuple[str, int, str], tuple[tuple[Any, ...], tuple[int, ...]]] = OrderedDict()
+
+
+def _file_materials(path: str, size: int, kind: str, memory: int | None) -> tuple[list[Any], list[int]]:
+    from sensorium.server.world.cad import CadError, CadMaterial, read_cad
+
     if size <= IN_PROCESS_BYTES:
         try:
             cad = read_cad(path, kind)
