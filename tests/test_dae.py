@@ -594,3 +594,44 @@ def test_convert_reads_a_large_cad_shapes_materials_once(tmp_path: Path, monkeyp
     assert main(["convert", str(p), str(tmp_path / "w.yaml")]) == 0
     assert runs == ["materials", "triangles"]
     assert (tmp_path / "w.yaml").read_text().count("material_index") == 3
+
+
+def skinned(text: str, bind_shape) -> str:
+    """A ``dae()`` document whose geometry is instanced through a skin controller (an armature's
+    mesh, as Blender exports a rigged model), its bind shape matrix ``bind_shape``."""
+    m = " ".join(f"{v:.17g}" for v in np.asarray(bind_shape, dtype=float).ravel())
+    controller = (
+        f'<library_controllers><controller id="c"><skin source="#g"><bind_shape_matrix>{m}</bind_shape_matrix>'
+        '<source id="jn"><Name_array id="jna" count="1">bone</Name_array><technique_common><accessor source="#jna" '
+        'count="1" stride="1"><param name="JOINT" type="name"/></accessor></technique_common></source>'
+        '<source id="ib"><float_array id="iba" count="16">1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</float_array>'
+        '<technique_common><accessor source="#iba" count="1" stride="16"><param name="TRANSFORM" type="float4x4"/>'
+        '</accessor></technique_common></source><source id="sw"><float_array id="swa" count="1">1</float_array>'
+        '<technique_common><accessor source="#swa" count="1" stride="1"><param name="WEIGHT" type="float"/>'
+        '</accessor></technique_common></source><joints><input semantic="JOINT" source="#jn"/>'
+        '<input semantic="INV_BIND_MATRIX" source="#ib"/></joints><vertex_weights count="8">'
+        '<input semantic="JOINT" source="#jn" offset="0"/><input semantic="WEIGHT" source="#sw" offset="1"/>'
+        '<vcount>1 1 1 1 1 1 1 1</vcount><v>0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0</v></vertex_weights></skin>'
+        '</controller></library_controllers>')
+    assert text.count('<instance_geometry url="#g">') == 1
+    return (text.replace("<library_visual_scenes>", controller + "<library_visual_scenes>")
+            .replace('<instance_geometry url="#g">', '<instance_controller url="#c">')
+            .replace("</instance_geometry>", "</instance_controller>")
+            .replace('<visual_scene id="s">', '<visual_scene id="s"><node id="bone" sid="bone" type="JOINT"/>'))
+
+
+def test_a_skinned_mesh_is_seen_where_webots_draws_it(tmp_path: Path) -> None:
+    """A rigged model's mesh (<instance_controller> of a skin) is read, not lost: Webots draws assimp's
+    mesh without its bone weights, its geometry's vertices placed by the node that holds it (the
+    node's 2 m translation counts, the skin's bind shape matrix, here 10 m, does not), in its material's
+    colour."""
+    text = dae(CORNERS - [0.5, 0.5, 0.0], [("m", CUBE)], materials={"m": ("paint", (0.5, 0.25, 1.0))},
+               matrix=[[1, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+    (tmp_path / "rig.dae").write_text(skinned(text, [[1, 0, 0, 10], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]))
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "rig.dae" ] } ] }\n'
+                      'Robot { name "r" children [ DistanceSensor { name "ir" translation 2.2 0.1 2 '
+                      'rotation 0 1 0 1.5707963267948966 type "infra-red" lookupTable [ 0 0 0, 10 10000 0 ] } ] }\n')
+    w = load_world(p)
+    assert [(s.geometry.material_index, s.appearance.base_color) for s in w.world.solids[0].shapes] == [
+        (0, (0.5, 0.25, 1.0))]
+    assert read_all(Simulation(w, precision="exact"))["ir"] == pytest.approx(expected(1.0, 0.5), rel=1e-9)

@@ -141,9 +141,9 @@ def _parse(path: str, cap: int) -> CadFile:
     triangles = 0
     try:
         bound = list(doc.scene.objects("geometry")) if doc.scene is not None else []
-        for g in bound:
-            name = g.original.name or g.original.id or ""
-            for p in g.primitives():
+        skins = list(doc.scene.objects("controller")) if doc.scene is not None else []
+        for g in [*bound, *skins]:
+            for name, p in _primitives(g):
                 if type(p).__name__ in ("BoundPolylist", "BoundPolygons"):
                     p = p.triangleset()
                 if p.vertex is None or not hasattr(p, "vertex_index") or p.vertex_index is None:
@@ -184,6 +184,24 @@ def _parse(path: str, cap: int) -> CadFile:
         if not np.isfinite(p.vertices).all():
             raise CadError(f"geometry {p.geometry!r}: non-finite vertex coordinates")
     return CadFile(tuple(materials), tuple(parts))
+
+
+def _primitives(g):
+    """(geometry name, bound primitive) of a scene's geometry instance, or of a skinned mesh's
+    (<instance_controller>): as Webots draws one (assimp's mesh without its bone weights), its
+    geometry's own vertices placed by the node holding it — the skin's bind shape matrix and joints
+    move nothing."""
+    if hasattr(g, "original"):
+        name = g.original.name or g.original.id or ""
+        for p in g.primitives():
+            yield name, p
+        return
+    geometry = getattr(getattr(g, "skin", None), "geometry", None)
+    if geometry is None or not hasattr(geometry, "bind") or not hasattr(g, "matrix"):
+        return          # (a morph controller)
+    name = geometry.name or geometry.id or ""
+    for p in geometry.bind(g.matrix, g.materialnodebysymbol).primitives():
+        yield name, p
 
 
 def _first_uv_set(p) -> int:
