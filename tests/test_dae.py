@@ -635,3 +635,18 @@ def test_a_skinned_mesh_is_seen_where_webots_draws_it(tmp_path: Path) -> None:
     assert [(s.geometry.material_index, s.appearance.base_color) for s in w.world.solids[0].shapes] == [
         (0, (0.5, 0.25, 1.0))]
     assert read_all(Simulation(w, precision="exact"))["ir"] == pytest.approx(expected(1.0, 0.5), rel=1e-9)
+
+
+def test_an_mtl_library_whose_name_has_spaces_is_read(tmp_path: Path) -> None:
+    """``mtllib My Robot.mtl`` (Blender writes the file's name as it is): assimp reads the rest of the
+    line as one file, and so is it read here (so ``mtllib a.mtl b.mtl`` names no file there, and its
+    faces stay one white mesh, as in Webots)."""
+    (tmp_path / "My Robot.mtl").write_text("newmtl red\nKd 1 0 0\n")
+    (tmp_path / "a.mtl").write_text("newmtl blue\nKd 0 0 1\n")
+    (tmp_path / "b.mtl").write_text("newmtl green\nKd 0 1 0\n")
+    quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+    (tmp_path / "one.obj").write_text(f"mtllib My Robot.mtl\n{quad}usemtl red\nf 1 2 3\nf 1 3 4\n")
+    (tmp_path / "two.obj").write_text(f"mtllib a.mtl b.mtl\n{quad}usemtl blue\nf 1 2 3\nusemtl green\nf 1 3 4\n")
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "one.obj" ] } CadShape { url [ "two.obj" ] } ] }\n')
+    assert [(s.geometry.url, s.geometry.material_index, s.appearance.base_color if s.appearance else None)
+            for s in load_world(p).world.solids[0].shapes] == [("one.obj", 0, (1.0, 0.0, 0.0)), ("two.obj", -1, None)]

@@ -279,21 +279,26 @@ MTL_FILES = 16            # the first this many distinct .mtl files an OBJ file 
 
 def _mtl_library(path: str) -> dict[str, CadMaterial]:
     """The materials of the .mtl files an OBJ file names (``mtllib``, relative to it, in its folder or
-    below: others are not read): ``Kd``, ``d`` (or ``Tr``, 1 − opacity) and ``map_Kd`` (the file after
-    its options, which are skipped as assimp skips them). A missing or unreadable .mtl gives no materials (Webots renders such faces white
+    below: others are not read; a name with spaces is read whole, as assimp reads it): ``Kd``, ``d``
+    (or ``Tr``, 1 − opacity) and ``map_Kd`` (the file after its options, which are skipped as assimp
+    skips them). A missing or unreadable .mtl gives no materials (Webots renders such faces white
     too)."""
     import os
 
     libs: list[str] = []
+    folder = os.path.realpath(os.path.dirname(path))
     with open(path, "rb") as f:
         for raw in f:
             line = raw.strip()
             if line.startswith(b"mtllib"):
-                for w in line.split()[1:]:
-                    lib = w.decode("utf-8", "replace").replace("\\", "/")
+                # assimp reads the rest of the line as one file (``My Robot.mtl``); when no such file
+                # exists, each word is tried (trimesh, which groups the faces, then finds none either)
+                whole = line[len(b"mtllib"):].strip().decode("utf-8", "replace").replace("\\", "/")
+                words = [whole] if whole and os.path.isfile(os.path.join(folder, whole)) else \
+                    [w.decode("utf-8", "replace").replace("\\", "/") for w in line.split()[1:]]
+                for lib in words:
                     if lib not in libs and len(libs) < MTL_FILES:
                         libs.append(lib)
-    folder = os.path.realpath(os.path.dirname(path))
     out: dict[str, CadMaterial] = {}
     for lib in libs:
         mtl = os.path.realpath(os.path.join(folder, lib))
