@@ -650,3 +650,51 @@ def test_an_mtl_library_whose_name_has_spaces_is_read(tmp_path: Path) -> None:
     p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "one.obj" ] } CadShape { url [ "two.obj" ] } ] }\n')
     assert [(s.geometry.url, s.geometry.material_index, s.appearance.base_color if s.appearance else None)
             for s in load_world(p).world.solids[0].shapes] == [("one.obj", 0, (1.0, 0.0, 0.0)), ("two.obj", -1, None)]
+
+
+def test_a_concave_polygon_is_cut_into_ears_not_fanned(tmp_path: Path) -> None:
+    """A <polylist> face shaped as an L (CAD exporters write such n-gons): assimp's Triangulate cuts a
+    concave polygon into ears, so nothing is seen where the L has no material, though a fan from its
+    first corner would cover it; inside, the texel at the corner's texture coordinates is read."""
+    (tmp_path / "img").mkdir()
+    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
+        tmp_path / "img" / "board.png")
+    corners = [(2, 1), (1, 1), (1, 2), (0, 2), (0, 0), (2, 0)]     # a fan from the first or last corner leaves the L
+    positions = " ".join(f"{x} {y} 0" for x, y in corners)
+    uvs = " ".join(f"{x / 2} {y / 2}" for x, y in corners)
+    text = dae([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [("m", [(0, 1, 2)])], uv=[[0, 0], [1, 0], [0, 1]],
+               materials={"m": ("board", "img/board.png")})
+    text = text.replace('count="9">0 0 0 1 0 0 0 1 0</float_array>', f'count="18">{positions}</float_array>') \
+        .replace('accessor source="#pa" count="3"', 'accessor source="#pa" count="6"') \
+        .replace('count="6">0 0 1 0 0 1</float_array>', f'count="12">{uvs}</float_array>') \
+        .replace('accessor source="#ta" count="3"', 'accessor source="#ta" count="6"') \
+        .replace('<triangles material="m" count="1">', '<polylist material="m" count="1"><vcount>6</vcount>') \
+        .replace("<p>0 0 1 1 2 2</p></triangles>", "<p>0 0 1 1 2 2 3 3 4 4 5 5</p></polylist>")
+    assert "polylist" in text and 'count="18"' in text and 'count="12"' in text
+    (tmp_path / "L.dae").write_text(text)
+    down = 'rotation 0 1 0 1.5707963267948966 type "infra-red" lookupTable [ 0 0 0, 10 10000 0 ]'
+    p = wbt(tmp_path, 'Solid { children [ CadShape { url [ "L.dae" ] } ] }\n'
+                      f'Robot {{ name "r" children [ DistanceSensor {{ name "in" translation 0.5 1.5 0.0625 {down} }}\n'
+                      f'  DistanceSensor {{ name "out" translation 1.3 1.5 0.0625 {down} }} ] }}\n')
+    v = read_all(Simulation(load_world(p), precision="exact"))
+    # (x, y) = (0.5, 1.5) → (s, t) = (0.25, 0.75) → column 1, row 1
+    assert v["in"] == pytest.approx(expected(0.0625, REDS[1, 1] / 255), rel=1e-9)
+    assert v["out"] == pytest.approx(10000.0)
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_a_comb_shaped_face_is_cut_into_ears_that_cover_it_exactly(reverse: bool) -> None:
+    """A comb of 16 teeth (corners on the diagonals' lines, the case a naive ear test gets wrong): its
+    n − 2 ears cover exactly its area, 2·16 − 0.5 + 9·16 m², in the face's own winding."""
+    from sensorium.server.world.cad import _ear_clip
+
+    top = [c for i in range(16) for c in [(2 * i, 1), (2 * i, 10), (2 * i + 1, 10), (2 * i + 1, 1)]]
+    points = np.array([(x, y, 0.0) for x, y in [(0, 0), (32, 0), *top[::-1]]])
+    if reverse:
+        points = points[::-1].copy()
+    ears = _ear_clip(points)
+    assert ears is not None and len(ears) == len(points) - 2
+    a = points[ears]
+    turns = np.cross(a[:, 1] - a[:, 0], a[:, 2] - a[:, 0])[:, 2]
+    assert np.abs(turns).sum() / 2 == pytest.approx(11 * 16 - 0.5, abs=1e-9)
+    assert ((turns < 0) if reverse else (turns > 0)).all()

@@ -139,13 +139,14 @@ def _parse(path: str, cap: int) -> CadFile:
     default: int | None = None
     parts: list[CadPart] = []
     triangles = 0
+    budget = [EAR_CLIP_WORK]
     try:
         bound = list(doc.scene.objects("geometry")) if doc.scene is not None else []
         skins = list(doc.scene.objects("controller")) if doc.scene is not None else []
         for g in [*bound, *skins]:
             for name, p in _primitives(g):
                 if type(p).__name__ in ("BoundPolylist", "BoundPolygons"):
-                    p = p.triangleset()
+                    p = _triangulated(p, budget)
                 if p.vertex is None or not hasattr(p, "vertex_index") or p.vertex_index is None:
                     continue     # lines, or a primitive without positions
                 faces = np.asarray(p.vertex_index, dtype=np.int64)
@@ -202,6 +203,119 @@ def _primitives(g):
     name = geometry.name or geometry.id or ""
     for p in geometry.bind(g.matrix, g.materialnodebysymbol).primitives():
         yield name, p
+
+
+EAR_CLIP_CORNERS = 256      # a concave polygon of more corners is fanned (ear clipping is quadratic)
+EAR_CLIP_WORK = 4_000_000   # ... and so are the concave polygons past this sum of corners² in one file
+
+
+def _triangulated(p, budget: list[int]):
+    """A <polylist>'s or <polygons>' triangles, as assimp's Triangulate step cuts its polygons: a
+    convex polygon fanned from its first corner, a concave one cut into ears (so no triangle covers
+    what lies outside it), while ``budget[0]`` (corners² left for ear clipping in this file) lasts.
+    Returns an object with a triangle set's attributes."""
+    from types import SimpleNamespace
+
+    vcounts = np.asarray(p.original.vcounts, dtype=np.int64)
+    corners_index = np.asarray(p.vertex_index, dtype=np.int64).ravel()
+    if p.vertex is None or len(vcounts) == 0 or int(vcounts.sum()) != len(corners_index) or vcounts.min() < 1:
+        return p.triangleset()
+    starts = np.cumsum(vcounts) - vcounts
+    big = vcounts >= 3
+    # the fan of every polygon: corners (s, s+k, s+k+1) for k in 1 .. n-2
+    n_tri = np.where(big, vcounts - 2, 0)
+    first = np.repeat(starts, n_tri)
+    k = np.arange(int(n_tri.sum())) - np.repeat(np.cumsum(n_tri) - n_tri, n_tri) + 1
+    tris = np.stack([first, first + k, first + k + 1], axis=1)
+    positions = np.asarray(p.vertex, dtype=np.float64).reshape(-1, 3)
+    if (vcounts > 3).any() and corners_index.max(initial=0) < len(positions):
+        concave = _concave(positions[corners_index], vcounts, starts)
+        if concave.any():
+            tri_start = np.cumsum(n_tri) - n_tri
+            for poly in np.flatnonzero(concave & (vcounts <= EAR_CLIP_CORNERS)):
+                s, n = int(starts[poly]), int(vcounts[poly])
+                if budget[0] < n * n:
+                    break
+                budget[0] -= n * n
+                ears = _ear_clip(positions[corners_index[s:s + n]])
+                if ears is not None:
+                    tris[tri_start[poly]:tri_start[poly] + n - 2] = ears + s
+    return SimpleNamespace(vertex=p.vertex, vertex_index=corners_index[tris], material=p.material,
+                           texcoordset=p.texcoordset, original=p.original,
+                           texcoord_indexset=tuple(np.asarray(t, dtype=np.int64).ravel()[tris]
+                                                   for t in p.texcoord_indexset))
+
+
+def _concave(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """Per polygon (corner positions ``points``, grouped by ``vcounts``): whether a corner turns
+    against the polygon's normal (Newell's)."""
+    n = len(points)
+    poly = np.repeat(np.arange(len(vcounts)), vcounts)
+    local = np.arange(n) - np.repeat(starts, vcounts)
+    nxt = np.repeat(starts, vcounts) + (local + 1) % np.repeat(vcounts, vcounts)
+    prv = np.repeat(starts, vcounts) + (local - 1) % np.repeat(vcounts, vcounts)
+    a, b = points, points[nxt]
+    newell = np.stack([(a[:, 1] - b[:, 1]) * (a[:, 2] + b[:, 2]), (a[:, 2] - b[:, 2]) * (a[:, 0] + b[:, 0]),
+                       (a[:, 0] - b[:, 0]) * (a[:, 1] + b[:, 1])], axis=1)
+    normal = np.add.reduceat(newell, starts, axis=0) if len(starts) else np.empty((0, 3))
+    turn = np.cross(points - points[prv], points[nxt] - points)
+    along = np.einsum("ij,ij->i", turn, normal[poly])
+    size = np.linalg.norm(turn, axis=1) * np.linalg.norm(normal[poly], axis=1)
+    reflex = along < -1e-9 * size
+    out = np.zeros(len(vcounts), dtype=bool)
+    np.logical_or.at(out, poly, reflex)
+    return out & (vcounts > 3)
+
+
+def _ear_clip(points: np.ndarray) -> np.ndarray | None:
+    """Ears of a simple polygon (n, 3) as (n − 2, 3) local corner triples, in the polygon's own
+    winding; None when it has none to cut (self-crossing): then it stays fanned."""
+    n = len(points)
+    normal = np.zeros(3)
+    for i in range(n):
+        a, b = points[i], points[(i + 1) % n]
+        normal += ((a[1] - b[1]) * (a[2] + b[2]), (a[2] - b[2]) * (a[0] + b[0]), (a[0] - b[0]) * (a[1] + b[1]))
+    drop = int(np.argmax(np.abs(normal)))
+    if normal[drop] == 0.0:
+        return None
+    xy = np.delete(points, drop, axis=1)
+    if (drop == 1) == (normal[drop] > 0):      # keep (u, v) counter-clockwise seen along the normal
+        xy = xy[:, ::-1]
+    scale = float(np.ptp(xy, axis=0).max()) or 1.0
+    eps = 1e-12 * scale * scale
+    left = list(range(n))
+    out = []
+
+    def cross(o, p, q):
+        return (p[..., 0] - o[..., 0]) * (q[..., 1] - o[..., 1]) - (p[..., 1] - o[..., 1]) * (q[..., 0] - o[..., 0])
+
+    while len(left) > 3:
+        m = len(left)
+        cut = None
+        for strict in (True, False):
+            for t in range(m):
+                a, b, c = left[t - 1], left[t], left[(t + 1) % m]
+                turn = cross(xy[a], xy[b], xy[c])
+                if turn <= eps if strict else turn < -eps:
+                    continue
+                others = xy[[left[u] for u in range(m) if u not in ((t - 1) % m, t, (t + 1) % m)]]
+                # another corner inside the ear or on its edges blocks it (a diagonal through a corner
+                # may leave the polygon), unless it is one of the ear's own corners again
+                inside = (cross(xy[a], xy[b], others) >= -eps) & (cross(xy[b], xy[c], others) >= -eps) & \
+                    (cross(xy[c], xy[a], others) >= -eps)
+                for q in (a, b, c):
+                    inside &= ((others - xy[q]) ** 2).sum(axis=1) > eps
+                if not inside.any():
+                    cut = t
+                    break
+            if cut is not None:
+                break
+        if cut is None:
+            return None
+        out.append((left[cut - 1], left[cut], left[(cut + 1) % m]))
+        del left[cut]
+    out.append((left[0], left[1], left[2]))
+    return np.asarray(out, dtype=np.int64)
 
 
 def _first_uv_set(p) -> int:
