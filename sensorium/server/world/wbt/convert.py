@@ -68,6 +68,7 @@ MOTORS = {"RotationalMotor", "LinearMotor"}
 OTHER_MOTOR_NAMES = {"RotationalMotor": "rotational motor", "LinearMotor": "linear motor"}
 JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "max_torque", "position", "axis",
               "anchor", "multiplier")
+MANY_JOINTS = 4      # more motorised joints than this, none a wheel: one warning for the robot, naming the first few
 JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
                "the shapes and devices past the joint with it")
 # the fields every Solid has (a device's own fields are the others)
@@ -1494,6 +1495,16 @@ class Converter:
             # two axes the joint's), or nothing round to roll on at
             # any (an arm, a gripper's fingers, a pan-tilt head): no vehicle, so no drive to miss;
             # each joint moves kinematically
+            if len(wheels) > MANY_JOINTS:
+                # a humanoid, a legged robot, an arm (NAO: 40 joints): one line for the robot, not one per joint
+                names = [w["motor"] for w in wheels]
+                shown = ", ".join(repr(n) for n in names[:MANY_JOINTS])
+                more = f" and {len(names) - MANY_JOINTS} more" if len(names) > MANY_JOINTS else ""
+                self.warn(node, f"robot {robot.data['name']!r}: its {len(names)} motorised joints are no wheels (no "
+                                f"end point has a cylinder or sphere to roll on): they move kinematically (Webots' rule "
+                                f"without physics; their PositionSensors read them), and the shapes and devices past "
+                                f"each joint with it ({shown}{more})")
+                return
             for w, rolls in zip(wheels, round_):
                 only = "hinge" if w["node"].type == "HingeJoint" else "joint"
                 why = f"the robot's only motorised {only}" if rolls else "its end point has no cylinder or sphere to roll on"

@@ -1,0 +1,84 @@
+"""What Webots' robot-family controllers need of a world, on small worlds of our own: a NAO-like
+robot (device names holding '/', as NAO's 'Sonar/Left' and 'Ears/Led/Right'; forty joints that are
+no wheels) loads with one warning for its joints, and a Python controller reads its sonar's closed
+form and drives its LED by those names; names that would leave an empty topic segment are one line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from sensorium.server.world.loader import WorldError, load_world
+
+WALL_X = 1.0          # the wall's face is at x = 0.95 (a 0.1 m thick box centred on x = 1)
+SONAR_X = 0.05        # the sonar's origin, looking along +x: it reads 0.95 - 0.05 = 0.9 m
+
+
+def nao_like(tmp_path: Path, joints: int = 40, extra: str = "") -> Path:
+    hinges = "".join(
+        f'  HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 }} device [ RotationalMotor {{ '
+        f'name "J{k}" minPosition -1 maxPosition 1 }} PositionSensor {{ name "J{k}S" }} ] '
+        f'endPoint Solid {{ name "link{k}" translation 0 0 {0.01 * k} }} }}\n' for k in range(joints))
+    p = tmp_path / "nao_like.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 40 }\n"
+                 f'Solid {{ name "wall" translation {WALL_X} 0 0.3 children [ DEF B Shape {{ geometry Box {{ size 0.1 2 0.6 }} }} ] '
+                 "boundingObject USE B }\n"
+                 'Robot { name "nao" translation 0 0 0.3 controller "<extern>" children [\n' + hinges +
+                 f'  DistanceSensor {{ name "Sonar/Left" translation {SONAR_X} 0 0 lookupTable [ 0 0 0, 2.55 2.55 0 ] }}\n'
+                 '  LED { name "Ears/Led/Right" color [ 0 0 1 ] gradual TRUE }\n'
+                 '  TouchSensor { name "LFoot/Bumper/Left" translation 0 0 -0.29 boundingObject Box { size 0.01 0.01 0.01 } }\n'
+                 + extra + "] }\n")
+    return p
+
+
+def test_a_nao_like_robot_loads_with_one_warning_for_its_forty_joints(tmp_path) -> None:
+    loaded = load_world(nao_like(tmp_path))
+    names = [d.name for d in loaded.world.robots[0].devices]
+    assert {"Sonar/Left", "Ears/Led/Right", "LFoot/Bumper/Left"} <= set(names)
+    joints = [w for w in loaded.warnings if "no wheel" in w]
+    assert len(joints) == 1, joints
+    assert ":4:1: robot 'nao': its 40 motorised joints are no wheels" in joints[0]
+    assert "('J0', 'J1', 'J2', 'J3' and 36 more)" in joints[0]
+    few = load_world(nao_like(tmp_path, joints=3))          # a few joints: one line each, as before
+    assert len([w for w in few.warnings if "no wheel" in w]) == 3
+
+
+@pytest.mark.parametrize("bad, why", [("/Sonar", "must not start or end with '/' nor hold '//'"),
+                                      ("Sonar/", "must not start or end with '/' nor hold '//'"),
+                                      ("Sonar//Left", "must not start or end with '/' nor hold '//'"),
+                                      ("robot", "is reserved")])
+def test_a_device_name_that_would_leave_an_empty_topic_segment_is_one_line(tmp_path, bad, why) -> None:
+    with pytest.raises(WorldError) as err:
+        load_world(nao_like(tmp_path, joints=1, extra=f'  GPS {{ name "{bad}" }}\n'))
+    lines = str(err.value).strip().splitlines()
+    assert len(lines) == 1 and f"name '{bad}' {why}" in lines[0] and "nao_like.wbt:" in lines[0], lines
+
+
+def test_a_python_controller_reads_and_drives_devices_named_with_a_slash(tmp_path) -> None:
+    from _inproc import inproc_server
+
+    from sensorium.client import wb
+    with inproc_server(heartbeat_ms=5000, world=nao_like(tmp_path, joints=5)) as (core, transport):
+        assert "/nao/Sonar/Left/value" in {t.name for t in core.topics.topics}
+        wb.wb_robot_init(f"{transport.rpc_endpoint}/nao")
+        try:
+            from controller import Robot
+        except ImportError:
+            from sensorium.client.webots.controller import Robot
+        try:
+            robot = Robot()
+            sonar, ears = robot.getDevice("Sonar/Left"), robot.getDevice("Ears/Led/Right")
+            bumper = robot.getDevice("LFoot/Bumper/Left")
+            sonar.enable(40)
+            bumper.enable(40)
+            assert robot.step(40) != -1
+            assert sonar.getValue() == pytest.approx(WALL_X - 0.05 - SONAR_X, abs=1e-6)   # float32 rays (precision "fast")
+            assert bumper.getValue() == 0.0
+            ears.set(128)
+            robot.step(40)
+            assert ears.get() == 128
+        finally:
+            wb.wb_robot_cleanup()
+            from sensorium.client.webots.controller.robot import Robot as _R
+            _R.created = None
