@@ -280,10 +280,12 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
                       "radio 0 0 nan nan (null)",
                       "contacts 0 0 NULL nan NULL",          # no physics contacts
                       "wwi (null) (null) 0",                 # no robot window
+                      "default window (null)",               # its default window's functions: compile, run, no effect
                       "step 0",
                       "supervisor NULL 1 SFRotation -1 -1 nan  1 0",   # beyond the subset: "no value"
                       "after quit -1"]     # the simulation ended for this controller: the next step ends it
     warned = [line for line in err.splitlines() if "does not simulate" in line]
+    assert "wbu_default_robot_window" not in err, err
     assert len(warned) == 2 and "Microphone 'mic'" in warned[0] and "Radio 'radio'" in warned[1], err
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
     unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
