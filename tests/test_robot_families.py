@@ -82,3 +82,22 @@ def test_a_python_controller_reads_and_drives_devices_named_with_a_slash(tmp_pat
             wb.wb_robot_cleanup()
             from sensorium.client.webots.controller.robot import Robot as _R
             _R.created = None
+
+
+def test_a_recording_names_the_device_of_a_topic_whose_device_name_holds_a_slash(tmp_path) -> None:
+    import msgpack
+    from mcap.reader import make_reader
+
+    from sensorium.server.recording.envelope import pack_envelope
+    from sensorium.server.recording.writer import McapRecorder
+
+    path = tmp_path / "nao.mcap"
+    body = msgpack.packb({"range": 0.9})
+    with McapRecorder(path, foxglove=False, demand=False) as rec:
+        for topic in ("/nao/Sonar/Left/value", "/nao/gps/value", "/nao/pose"):
+            rec.record(topic, "sensor_msgs/msg/Range", pack_envelope("sensor_msgs/msg/Range", 0, 1000), body, 1000, 0)
+    with open(path, "rb") as f:
+        channels = {ch.topic: ch.metadata for ch in make_reader(f).get_summary().channels.values()}
+    assert (channels["/nao/Sonar/Left/value"]["robot"], channels["/nao/Sonar/Left/value"]["device"]) == ("nao", "Sonar/Left")
+    assert channels["/nao/gps/value"]["device"] == "gps"
+    assert "device" not in channels["/nao/pose"]
