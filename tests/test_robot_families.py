@@ -101,3 +101,33 @@ def test_a_recording_names_the_device_of_a_topic_whose_device_name_holds_a_slash
     assert (channels["/nao/Sonar/Left/value"]["robot"], channels["/nao/Sonar/Left/value"]["device"]) == ("nao", "Sonar/Left")
     assert channels["/nao/gps/value"]["device"] == "gps"
     assert "device" not in channels["/nao/pose"]
+
+
+def legged(tmp_path: Path, feet: str) -> Path:
+    """A hexapod of our own (Mantis-like): six legs of three chained hinges, its feet `feet`."""
+    legs = ""
+    for k, (x, y) in enumerate([(-0.25, -0.15), (0, -0.15), (0.25, -0.15), (-0.25, 0.15), (0, 0.15), (0.25, 0.15)]):
+        s = 1 if y > 0 else -1
+        legs += (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor {x} {y} 0 }} '
+                 f'device [ RotationalMotor {{ name "leg{k} base" }} ] endPoint Solid {{ translation {x} {y} 0 name "coxa{k}" children [ '
+                 f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 1 0 0 }} device [ RotationalMotor {{ name "leg{k} shoulder" }} ] '
+                 f'endPoint Solid {{ translation 0 {s * 0.05} 0 name "femur{k}" children [ '
+                 f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 1 0 0 anchor 0 {s * 0.2} 0 }} device [ RotationalMotor {{ name "leg{k} knee" }} ] '
+                 f'endPoint Solid {{ translation 0 {s * 0.2} 0 name "tibia{k}" children [ {feet} ] }} }} ] }} }} ] }} }}\n')
+    p = tmp_path / "legged.wbt"
+    p.write_text('#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n'
+                 'Robot { name "hexapod" translation 0 0 0.5 children [ Shape { geometry Box { size 0.6 0.3 0.1 } }\n' + legs + '] }\n')
+    return p
+
+
+@pytest.mark.parametrize("feet, why", [
+    ("Shape { geometry Box { size 0.03 0.03 0.3 } }", "(18 with no cylinder or sphere at their end point to roll on)"),
+    ("Pose { translation 0 0 -0.15 children [ Shape { geometry Sphere { radius 0.02 } } ] }",   # round feet: chains
+     "(6 steering none; 12 links of a chain of motorised joints)")])
+def test_a_legged_robot_gets_one_line_for_its_joints_whatever_its_feet(tmp_path, feet, why) -> None:
+    loaded = load_world(legged(tmp_path, feet))
+    said = [w for w in loaded.warnings if "no wheel" in w]
+    assert len(said) == 1, said
+    assert f"robot 'hexapod': its 18 motorised joints are no wheels {why}: they move kinematically" in said[0]
+    assert said[0].endswith("and 14 more)")
+    assert not loaded.world.robots[0].differential_drive
