@@ -863,6 +863,19 @@ def test_a_c_loop_that_ignores_minus_one_ends_at_the_next_step(cbin, servers):
     assert lines[-1] == "-1" and lines[:-1] and set(lines[:-1]) == {"0"}, lines
 
 
+def test_a_c_controller_that_cleans_up_at_minus_one_and_loops_on_ends_quietly(cbin, servers):
+    """Webots' nao_demo calls wb_robot_cleanup() when a step answers -1 and its loop goes on (reading
+    the keyboard, stepping): the first call after the cleanup ends the process, status 0, nothing said.
+    A cleanup while the simulation still runs, then a step: one line saying so, status 1."""
+    code, lines, err = finish(start([cbin["ignores_minus_one"], "cleanup"],
+                                    servers(ARENA, "--until", "160").url("epuck")), 60)
+    assert code == 0 and "Error" not in err, err
+    assert lines[-2:] == ["-1", "cleaned up"] and set(lines[:-2]) == {"0"}, lines
+    code, lines, err = finish(start([cbin["ignores_minus_one"], "early"], servers(ARENA).url("epuck")), 60)
+    assert code == 1 and lines == ["0"], (lines, err)
+    assert err.strip().splitlines()[-1] == "Error: wb_robot_step_begin(): no robot: called after wb_robot_cleanup()", err
+
+
 def test_c_controller_ends_its_loop_when_the_server_dies(cbin, servers):
     """A server SIGKILLed mid-run: the heartbeat notices, wb_robot_step returns -1, no hang."""
     server = servers(ARENA, "--heartbeat-ms", "200")
