@@ -280,10 +280,12 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
                       "radio 0 0 nan nan (null)",
                       "contacts 0 0 NULL nan NULL",          # no physics contacts
                       "wwi (null) (null) 0",                 # no robot window
+                      "default window (null)",               # its default window's functions: compile, run, no effect
                       "step 0",
                       "supervisor NULL 1 SFRotation -1 -1 nan  1 0",   # beyond the subset: "no value"
                       "after quit -1"]     # the simulation ended for this controller: the next step ends it
     warned = [line for line in err.splitlines() if "does not simulate" in line]
+    assert "wbu_default_robot_window" not in err, err
     assert len(warned) == 2 and "Microphone 'mic'" in warned[0] and "Radio 'radio'" in warned[1], err
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
     unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
@@ -859,6 +861,19 @@ def test_a_c_loop_that_ignores_minus_one_ends_at_the_next_step(cbin, servers):
     code, lines, err = finish(start([cbin["ignores_minus_one"]], servers(ARENA, "--until", "160").url("epuck")), 60)
     assert code == 0, err
     assert lines[-1] == "-1" and lines[:-1] and set(lines[:-1]) == {"0"}, lines
+
+
+def test_a_c_controller_that_cleans_up_at_minus_one_and_loops_on_ends_quietly(cbin, servers):
+    """Webots' nao_demo calls wb_robot_cleanup() when a step answers -1 and its loop goes on (reading
+    the keyboard, stepping): the first call after the cleanup ends the process, status 0, nothing said.
+    A cleanup while the simulation still runs, then a step: one line saying so, status 1."""
+    code, lines, err = finish(start([cbin["ignores_minus_one"], "cleanup"],
+                                    servers(ARENA, "--until", "160").url("epuck")), 60)
+    assert code == 0 and "Error" not in err, err
+    assert lines[-2:] == ["-1", "cleaned up"] and set(lines[:-2]) == {"0"}, lines
+    code, lines, err = finish(start([cbin["ignores_minus_one"], "early"], servers(ARENA).url("epuck")), 60)
+    assert code == 1 and lines == ["0"], (lines, err)
+    assert err.strip().splitlines()[-1] == "Error: wb_robot_step_begin(): no robot: called after wb_robot_cleanup()", err
 
 
 def test_c_controller_ends_its_loop_when_the_server_dies(cbin, servers):

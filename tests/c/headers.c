@@ -4,7 +4,8 @@
  *   headers            what needs no server: types, console, strings, system, radio messages, the
  *                      vehicle functions' "no value"
  *   headers online     then attaches to the server: Microphone and Radio (listed, not simulated), the
- *                      supervisor's contact points, the robot window's messages (none), Supervisor
+ *                      supervisor's contact points, the robot window's messages (none) and the default
+ *                      robot window's functions (Webots' Thymio II demo calls them: no window, no effect), Supervisor
  *                      functions Sensorium does not serve, wb_supervisor_simulation_quit() (its next
  *                      step answers -1, the one after ends the process with status 0)
  *   headers driver|car wbu_driver_init() / wbu_car_init(): one line, exit status 1 */
@@ -17,6 +18,7 @@
 #include <webots/contact_point.h>
 #include <webots/lidar_point.h>
 #include <webots/microphone.h>
+#include <webots/plugins/robot_window/default.h>
 #include <webots/plugins/robot_window/robot_wwi.h>
 #include <webots/radio.h>
 #include <webots/robot.h>
@@ -100,6 +102,10 @@ static void online(void) {
   size = -1;
   const char *received = wb_robot_wwi_receive(&size);
   printf("wwi %s %s %d\n", or_null(wb_robot_wwi_receive_text()), or_null(received), size);
+  wbu_default_robot_window_set_images_max_size(64, 48);
+  wbu_default_robot_window_configure();
+  wbu_default_robot_window_update();
+  printf("default window %s\n", or_null(wb_robot_wwi_receive_text()));
   printf("step %d\n", wb_robot_step(16));
   /* Supervisor functions beyond Sensorium's subset: declared, one error line each, "no value" */
   WbNodeRef selected = wb_supervisor_node_get_selected();

@@ -94,9 +94,11 @@ class _WriteThrough:
 
 
 def _topic_parts(topic: str) -> dict[str, str]:
+    """A device topic's channel metadata: ``/<robot>/<device>/<item>``, where a device's name may
+    itself hold '/' (NAO's ``Sonar/Left``) and a robot's may not."""
     parts = [p for p in topic.split("/") if p]
     if len(parts) >= 3:
-        return {"robot": parts[0], "device": parts[1]}
+        return {"robot": parts[0], "device": "/".join(parts[1:-1])}
     return {}
 
 

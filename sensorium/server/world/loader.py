@@ -417,16 +417,26 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                 first[name] = path
 
     def name_ok(path: str, name: str, reserved: tuple[str, ...] = ()) -> None:
-        # names become topic and service paths (/<robot>/<device>/value)
+        # names become topic and service paths (/<robot>/<device>/value): a robot's name is one
+        # segment; a device's may hold '/' as Webots' do (NAO: 'Sonar/Left'), one segment or more
         if "/" in name or "\0" in name:
             problems.append(Problem(path, f"name {name!r} must not contain '/' or NUL (names are used in topic paths)"))
         elif name in reserved:
             problems.append(Problem(path, f"name {name!r} is reserved (robot-level services live under /<robot>/robot/)"))
 
+    def device_name_ok(path: str, name: str) -> None:
+        if "\0" in name:
+            problems.append(Problem(path, f"name {name!r} must not contain NUL (names are used in topic paths)"))
+        elif "/" in name and ("" in name.split("/")):
+            problems.append(Problem(path, f"name {name!r} must not start or end with '/' nor hold '//' "
+                                          "(its topic path would have an empty segment)"))
+        elif name == "robot":
+            problems.append(Problem(path, f"name {name!r} is reserved (robot-level services live under /<robot>/robot/)"))
+
     for i, r in enumerate(world.robots):
         name_ok(f"robots[{i}].name", r.name)
         for d_i, d in enumerate(r.devices):
-            name_ok(f"robots[{i}].devices[{d_i}].name", d.name, ("robot",))
+            device_name_ok(f"robots[{i}].devices[{d_i}].name", d.name)
     unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
     unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
     unique([(p, lt.name) for p, lt in all_lights(world)], "light")

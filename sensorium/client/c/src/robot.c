@@ -12,6 +12,9 @@
 #include "internal.h"
 
 static sn_robot *g_robot = NULL;
+/* how the last robot was cleaned up: 0 never, 1 after the simulation had ended for it (a step
+   answered -1), 2 while it still ran */
+static int g_cleaned = 0;
 static bool g_atexit = false;
 static int g_timeout_ms = 10000; /* ordinary replies; steps wait as long as the lockstep needs */
 
@@ -23,7 +26,15 @@ static void fatal(const char *func, int code, const char *message) {
 
 sn_robot *sn_robot_get(const char *func) {
   if (g_robot == NULL) {
-    fprintf(stderr, "Error: %s(): no robot: call wb_robot_init() first\n", func);
+    /* a controller that cleans up once its step answered -1 and then goes on calling the API (Webots'
+       nao_demo: terminate() calls wb_robot_cleanup() and its loop steps on) ends there, quietly, with
+       status 0: the simulation ended for it, as the step after -1 ends it */
+    if (g_cleaned == 1)
+      exit(EXIT_SUCCESS);
+    if (g_cleaned == 2)
+      fprintf(stderr, "Error: %s(): no robot: called after wb_robot_cleanup()\n", func);
+    else
+      fprintf(stderr, "Error: %s(): no robot: call wb_robot_init() first\n", func);
     exit(1);
   }
   return g_robot;
@@ -415,6 +426,7 @@ int wb_robot_init(void) {
     fatal("wb_robot_init", SN_BAD_REPLY, "the attach reply lacks session, basic_time_step or device descriptions");
   }
   g_robot = rb;
+  g_cleaned = 0;
   if (sn_conn_start_heartbeat(c, rb->session, heartbeat_ms) != 0)
     fatal("wb_robot_init", SN_INTERNAL, "cannot start the heartbeat thread");
   if (!g_atexit) {
@@ -429,6 +441,7 @@ void wb_robot_cleanup(void) {
   if (rb == NULL)
     return;
   g_robot = NULL;
+  g_cleaned = rb->terminated ? 1 : 2;
   sn_conn_stop_heartbeat(rb->conn);
   if (rb->pending != 0) {
     sn_conn_discard(rb->conn, rb->pending);

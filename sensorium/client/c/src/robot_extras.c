@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include <webots/device.h>
+#include <webots/plugins/robot_window/default.h>
 #include <webots/plugins/robot_window/robot_wwi.h>
 #include <webots/robot.h>
 
@@ -49,6 +50,21 @@ const char *wb_robot_wwi_receive(int *size) {
 const char *wb_robot_wwi_receive_text(void) {
   sn_robot_get("wb_robot_wwi_receive_text");
   return NULL;
+}
+
+/* Webots' default robot window: nothing to configure or update without a window */
+void wbu_default_robot_window_configure(void) {
+  sn_robot_get("wbu_default_robot_window_configure");
+}
+
+void wbu_default_robot_window_update(void) {
+  sn_robot_get("wbu_default_robot_window_update");
+}
+
+void wbu_default_robot_window_set_images_max_size(int max_width, int max_height) {
+  (void)max_width;
+  (void)max_height;
+  sn_robot_get("wbu_default_robot_window_set_images_max_size");
 }
 
 const char *wb_robot_get_controller_name(void) {

@@ -69,6 +69,7 @@ MOTORS = {"RotationalMotor", "LinearMotor"}
 OTHER_MOTOR_NAMES = {"RotationalMotor": "rotational motor", "LinearMotor": "linear motor"}
 JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "max_torque", "position", "axis",
               "anchor", "multiplier")
+MANY_JOINTS = 4      # more motorised joints than this, none a wheel: one warning for the robot, naming the first few
 JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
                "the shapes and devices past the joint with it")
 # the fields every Solid has (a device's own fields are the others)
@@ -1572,6 +1573,32 @@ class Converter:
         return out
 
     def drive(self, node: Node, robot: Owner) -> None:
+        """The robot's drive from its motorised hinges; every motor found to be no wheel is said once
+        (one line each, or one line for the robot when it has more than MANY_JOINTS of them: a
+        humanoid's, a legged robot's or an arm's joints)."""
+        nowheel: list[tuple[Node, str, str, str]] = []      # (joint node, motor, its own line, the reason)
+        try:
+            self._drive(node, robot, nowheel)
+        finally:
+            self._say_no_wheels(node, robot, nowheel)
+
+    def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
+        if len(nowheel) <= MANY_JOINTS:
+            for joint, _motor, line, _why in nowheel:
+                self.warn(joint, line)
+            return
+        reasons: dict[str, int] = {}
+        for _joint, _motor, _line, why in nowheel:
+            reasons[why] = reasons.get(why, 0) + 1
+        why = "; ".join(f"{n} {r}" for r, n in reasons.items())
+        names = [motor for _joint, motor, _line, _why in nowheel]
+        shown = ", ".join(repr(n) for n in names[:MANY_JOINTS])
+        self.warn(node, f"robot {robot.data['name']!r}: its {len(names)} motorised joints are no wheels ({why}): "
+                        f"they move kinematically (Webots' rule without physics; their PositionSensors read them), "
+                        f"and the shapes and devices past each joint with it ({shown} and "
+                        f"{len(names) - MANY_JOINTS} more)")
+
+    def _drive(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         from sensorium.server.world.wbt.drive import (
             ackermann_drive,
             differential_drive,
@@ -1593,15 +1620,17 @@ class Converter:
             for w, rolls in zip(wheels, round_):
                 only = "hinge" if w["node"].type == "HingeJoint" else "joint"
                 why = f"the robot's only motorised {only}" if rolls else "its end point has no cylinder or sphere to roll on"
-                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): {JOINT_MOVES}")
+                nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel ({why}): "
+                                                       f"{JOINT_MOVES}", "with no cylinder or sphere at their end point to roll on"
+                                if not rolls else "the robot's only motorised joint"))
             return
         # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
         # joint on a mobile robot) steers nothing: it is no wheel, and the others make the drive
         pans = [w for w in wheels if w["steers"] and not holds_wheel(w["end"], self)]
         if pans:
             for w in pans:
-                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers none (its end "
-                                     f"point holds no wheel): {JOINT_MOVES}")
+                nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers "
+                                f"none (its end point holds no wheel): {JOINT_MOVES}", "steering none"))
             wheels = [w for w in wheels if not any(w is p for p in pans)]
         # an arm's chain (a vacuum gripper's pitch and roll hinges): a wheel carries no motorised
         # hinge and rides on none but its steering joint, so a hinge that does either is no wheel
@@ -1611,13 +1640,14 @@ class Converter:
                   any(id(w["node"]) in held for held in inside.values()))]
         if links:
             for w in links:
-                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (a link of a chain of "
-                                     f"motorised joints, carrying one or carried by one): {JOINT_MOVES}")
+                nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (a link "
+                                f"of a chain of motorised joints, carrying one or carried by one): {JOINT_MOVES}",
+                                "links of a chain of motorised joints"))
             wheels = [w for w in wheels if not any(w is k for k in links)]
             if len(wheels) == 1 and not wheels[0]["steers"]:
                 w = wheels[0]
-                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (the robot's only other "
-                                     f"motorised hinge): {JOINT_MOVES}")
+                nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (the "
+                                f"robot's only other motorised hinge): {JOINT_MOVES}", "the only other motorised hinge"))
                 return
             if not wheels:
                 return
@@ -1625,8 +1655,9 @@ class Converter:
             # vertical hinges only, none driving a wheel (a gripper's fingers whose end points hold
             # their axles, coaxial cylinders that roll on nothing): no vehicle, no drive to miss
             for w in wheels:
-                self.warn(w["node"], f"{w['node'].type} motor {w['motor']!r} is no wheel (it turns about a vertical "
-                                     f"axis and no motor of the robot drives a wheel): {JOINT_MOVES}")
+                nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (it turns "
+                                f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
+                                "turning about a vertical axis"))
             return
         if any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
@@ -1652,8 +1683,8 @@ class Converter:
                     if drive is not None:
                         for w in wheels:
                             if not any(w is k for k in kept):
-                                self.warn(w["node"], f"HingeJoint motor {w['motor']!r} is no wheel ({reason}): "
-                                                     f"{JOINT_MOVES}")
+                                nowheel.append((w["node"], w["motor"], f"HingeJoint motor {w['motor']!r} is no wheel "
+                                                f"({reason}): {JOINT_MOVES}", "not rolling as wheels"))
                         wheels = kept
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
