@@ -47,7 +47,8 @@ def test_a_nao_like_robot_loads_with_one_warning_for_its_forty_joints(tmp_path) 
 @pytest.mark.parametrize("bad, why", [("/Sonar", "must not start or end with '/' nor hold '//'"),
                                       ("Sonar/", "must not start or end with '/' nor hold '//'"),
                                       ("Sonar//Left", "must not start or end with '/' nor hold '//'"),
-                                      ("robot", "is reserved")])
+                                      ("robot", "is reserved"), ("robot/x", "is reserved"),
+                                      ("Sonar/Left/value", "lies under device 'Sonar/Left'")])
 def test_a_device_name_that_would_leave_an_empty_topic_segment_is_one_line(tmp_path, bad, why) -> None:
     with pytest.raises(WorldError) as err:
         load_world(nao_like(tmp_path, joints=1, extra=f'  GPS {{ name "{bad}" }}\n'))

@@ -430,13 +430,22 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
         elif "/" in name and ("" in name.split("/")):
             problems.append(Problem(path, f"name {name!r} must not start or end with '/' nor hold '//' "
                                           "(its topic path would have an empty segment)"))
-        elif name == "robot":
+        elif name.split("/")[0] == "robot":
             problems.append(Problem(path, f"name {name!r} is reserved (robot-level services live under /<robot>/robot/)"))
 
     for i, r in enumerate(world.robots):
         name_ok(f"robots[{i}].name", r.name)
         for d_i, d in enumerate(r.devices):
             device_name_ok(f"robots[{i}].devices[{d_i}].name", d.name)
+        # a device named like another's path below it ('Sonar' and 'Sonar/value') would share its topics
+        names = {d.name for d in r.devices}
+        for d_i, d in enumerate(r.devices):
+            parts = d.name.split("/")
+            above = next(("/".join(parts[:k]) for k in range(1, len(parts)) if "/".join(parts[:k]) in names), None)
+            if above is not None:
+                problems.append(Problem(f"robots[{i}].devices[{d_i}].name",
+                                        f"name {d.name!r} lies under device {above!r}'s topic and service paths "
+                                        f"(/{r.name}/{above}/...): rename one of them"))
     unique([(f"solids[{i}].name", s.name) for i, s in enumerate(world.solids)], "solid")
     unique([(f"robots[{i}].name", r.name) for i, r in enumerate(world.robots)], "robot")
     unique([(p, lt.name) for p, lt in all_lights(world)], "light")
