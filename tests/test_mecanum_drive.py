@@ -218,6 +218,32 @@ def test_wbt_youbot_like_robot_now_strafes(tmp_path: Path) -> None:
     assert pose2d(sim) == pytest.approx((0.0, 0.32, 0.0), abs=1e-12)
 
 
+ARM = ('Solid { translation 0.156 0 0 name "arm" children [ HingeJoint { jointParameters HingeJointParameters { '
+       'axis 0 0 1 anchor 0 0 0.077 } device [ RotationalMotor { name "arm1" } ] endPoint Solid { translation 0 0 0.077 '
+       'children [ HingeJoint { jointParameters HingeJointParameters { axis 0 -1 0 anchor 0.033 0 0.07 } device [ '
+       'RotationalMotor { name "arm2" } ] endPoint Solid { translation 0.033 0 0.07 boundingObject Box { size 0.07 0.06 '
+       '0.21 } } } ] boundingObject Pose { translation 0.032 0.023 0.07 rotation 1 0 0 -1.5708 children [ Cylinder { '
+       'height 0.046 radius 0.036 } ] } } } ] }\n')
+
+
+def test_wbt_mecanum_base_with_an_arm_keeps_its_drive(tmp_path: Path) -> None:
+    """A youBot's arm turns first about the vertical, its link a cylinder: taken for a steered wheel,
+    the robot was a failed car that did not move; the arm's joints are no wheels on a mecanum base."""
+    p = youbot_like(tmp_path)
+    p.write_text(p.read_text().replace('  GPS { name "gps" }\n', '  GPS { name "gps" }\n' + ARM))
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive is None and robot.mecanum_drive is not None
+    assert robot.mecanum_drive.rollers == (-1, 1, 1, -1)
+    assert [x.split(": ", 1)[1].split(":")[0] for x in w.warnings] == [
+        f"HingeJoint motor '{m}' is no wheel (an arm's joint on a mecanum base)" for m in ("arm1", "arm2")]
+    sim = Simulation(w, "fast")
+    roll(sim, {FR: 4.0, FL: -4.0, RR: -4.0, RL: 4.0})
+    sim.robot("yb").motor("arm1").set_position(0.5)
+    sim.run(100)
+    assert pose2d(sim) == pytest.approx((0.0, 0.32, 0.0), abs=1e-12)
+
+
 def test_wbt_wheels_out_of_place_say_why_in_one_line(tmp_path: Path) -> None:
     p = youbot_like(tmp_path)
     p.write_text(p.read_text().replace(f"anchor {-LX} {LY} 0", f"anchor {-LX - 0.1} {LY} 0")

@@ -1662,13 +1662,28 @@ class Converter:
                                 f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
                                 "turning about a vertical axis"))
             return
-        if any(w["steers"] for w in wheels):      # a car
+        turns = None                              # mecanum rollers: the wheels' friction turned (wbt/drive.py)
+        if any(w["steers"] for w in wheels):
+            # a mecanum base carrying an arm whose first joint turns about the vertical (a youBot): the
+            # arm's joints are no wheels (no car steers mecanum wheels), the base's wheels make the drive
+            carried: set[int] = set().union(*(self._inside(w["end"]) for w in wheels if w["steers"]))
+            base = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
+            turns = mecanum_turns(base, self) if base else None
+            if turns is not None:
+                for w in wheels:
+                    if not any(w is b for b in base):
+                        nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel "
+                                        f"(an arm's joint on a mecanum base): {JOINT_MOVES}", "an arm's joints"))
+                wheels = base
+        else:
+            turns = mecanum_turns(wheels, self)
+        if turns is None and any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no Ackermann drive ({why}); the robot will not move")
                 return
             robot.data["ackermann_drive"] = drive
-        elif (turns := mecanum_turns(wheels, self)) is not None:     # rollers: friction turned on the wheels
+        elif turns is not None:                   # rollers: friction turned on the wheels
             drive, why = mecanum_drive(wheels, turns, self)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no mecanum drive ({why}); the robot will not move")
