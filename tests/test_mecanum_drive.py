@@ -129,6 +129,15 @@ def test_forward_of_the_drive_turns_its_axes() -> None:
     assert pose2d(sim) == pytest.approx((-0.32, 0.0, 0.0), abs=1e-12)
 
 
+def test_nue_world_strafes_to_the_robots_left_on_its_ground_plane() -> None:
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 16, "coordinate_system": "NUE"},
+                                  "robots": [{"name": "yb", "mecanum_drive": {"wheel_radius": R, "lx": LX, "ly": LY}}]}))
+    roll(sim, {FR: 4.0, FL: -4.0, RR: -4.0, RL: 4.0})
+    sim.run(100)
+    # x north (the robot's forward), y up, z east: its left is west, -z
+    assert list(sim.robot("yb").pose.translation) == pytest.approx([0.0, 0.0, -0.32], abs=1e-12)
+
+
 def test_contact_stops_a_strafing_robot_at_a_wall() -> None:
     wall = {"name": "wall", "pose": {"translation": [0.0, 1.0, 0.25]}, "geometry": {"type": "box", "size": [4, 0.2, 0.5]}}
     sim = sim_of(bot(), solids=[wall], contact=True)
@@ -208,6 +217,13 @@ def test_wbt_wheels_without_contact_properties_stay_skid_steer(tmp_path: Path) -
     sym = ('contactProperties [ ContactProperties { material1 "inner rollers" coulombFriction 1 frictionRotation 0.785398 0 }'
            ' ContactProperties { material1 "outer rollers" coulombFriction 1 } ]')
     assert load_world(youbot_like(tmp_path, friction=sym)).world.robots[0].differential_drive is not None
+
+
+def test_wbt_rollers_at_another_angle_are_taken_at_45_degrees_with_one_line(tmp_path: Path) -> None:
+    w = load_world(youbot_like(tmp_path, friction=FRICTION.replace("-0.785398", "-0.6")))
+    assert w.world.robots[0].mecanum_drive is not None
+    assert [x.split(": ", 1)[1] for x in w.warnings] == [
+        f"mecanum wheel {FR!r}: its friction is turned by -0.6 rad; the kinematic drive takes its rollers at 45°"]
 
 
 def test_wbt_youbot_like_robot_now_strafes(tmp_path: Path) -> None:
