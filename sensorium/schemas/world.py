@@ -1165,6 +1165,59 @@ class AckermannDrive(Strict):
         return self
 
 
+MECANUM_WHEELS = ("front_left", "front_right", "rear_left", "rear_right")
+"""A mecanum drive's wheels, in the order of its ``rollers``."""
+
+
+class MecanumDrive(Strict):
+    """Kinematic omnidirectional drive on four mecanum wheels (a KUKA youBot's base; no physics, no
+    slip): the wheels at (±``lx``, ±``ly``) from the robot's origin (x forward, y left; ``forward``
+    another direction of the robot's frame), their rollers at 45°. A wheel at (x, y) with roller sign
+    s turning at ω rolls the robot with r·ω = vx + s·vy + (s·x − y)·ωz; the robot's velocity (vx, vy,
+    ωz) over a step is the least-squares solution for the four wheels' speeds (exact when they agree).
+    ``rollers`` gives s for the front left, front right, rear left and rear right wheels: diagonal
+    wheels alike, the two front ones opposite; the default is the youBot's (its library's base_move
+    formulas), with which every wheel at +ω drives forward at r·ω, (+, −, −, +)·ω on (front right,
+    front left, rear right, rear left) strafes left at r·ω, and (−, +, −, +) on (front left, front
+    right, rear left, rear right) turns left at r·ω/(lx + ly)."""
+
+    wheel_radius: float = Field(gt=0, description="m")
+    lx: float = Field(gt=0, description="m, half the wheelbase: the wheels' distance ahead of and behind the origin")
+    ly: float = Field(gt=0, description="m, half the track: the wheels' distance either side of the origin")
+    max_wheel_speed: float = Field(default=14.81, gt=0, description="rad/s, the wheel motors' maxVelocity")
+    front_left_motor: str = Field(default="wheel2", min_length=1)
+    front_right_motor: str = Field(default="wheel1", min_length=1)
+    rear_left_motor: str = Field(default="wheel4", min_length=1)
+    rear_right_motor: str = Field(default="wheel3", min_length=1)
+    rollers: tuple[int, int, int, int] = Field(
+        default=(-1, 1, 1, -1), description="roller sign s of the front left, front right, rear left, rear right "
+        "wheels (r·ω = vx + s·vy + (s·x − y)·ωz): diagonal wheels alike, the front two opposite; the default is "
+        "the youBot's")
+    forward: tuple[float, float] = _forward_field()
+
+    _forward_nonzero = field_validator("forward")(_nonzero_forward)
+
+    @property
+    def motor_fields(self) -> list[tuple[str, str]]:
+        """(field, motor name) of the four wheels, in the order of ``rollers``."""
+        return [(f"{w}_motor", getattr(self, f"{w}_motor")) for w in MECANUM_WHEELS]
+
+    @model_validator(mode="after")
+    def _valid(self) -> MecanumDrive:
+        names = [m for _, m in self.motor_fields]
+        if len(set(names)) != len(names):
+            raise ValueError(f"every wheel motor needs its own name, got {names}")
+        fl, fr, rl, rr = self.rollers
+        if any(s not in (-1, 1) for s in self.rollers) or fl != rr or fr != rl or fl == fr:
+            raise ValueError(f"rollers {list(self.rollers)} (front left, front right, rear left, rear right): each is "
+                             "1 or -1, diagonal wheels alike and the two front wheels opposite (else the wheels "
+                             "cannot strafe or turn)")
+        if fl == 1 and self.lx == self.ly:
+            raise ValueError(f"rollers {list(self.rollers)} with lx = ly: such wheels cannot turn the robot (their "
+                             "rollers all point at its centre)")
+        return self
+
+
 # ---------------------------------------------------------------- robots and world
 
 class NestedNode(Strict):
@@ -1234,6 +1287,8 @@ class Robot(Strict):
     differential_drive: DifferentialDrive | None = None
     ackermann_drive: AckermannDrive | None = Field(default=None, description="a car-like robot (steered front wheels); "
                                                    "a robot has one drive at most")
+    mecanum_drive: MecanumDrive | None = Field(default=None, description="an omnidirectional robot on four mecanum "
+                                               "wheels (a KUKA youBot); a robot has one drive at most")
     devices: list[Device] = Field(default=[], description="in Webots' tree order (the order of the device "
                                   "indices); every Webots device type is accepted, those not simulated as present")
     recognition_colors: list[Color] = Field(
@@ -1253,8 +1308,10 @@ class Robot(Strict):
 
     @model_validator(mode="after")
     def _one_drive(self) -> Robot:
-        if self.differential_drive is not None and self.ackermann_drive is not None:
-            raise ValueError("a robot has one drive at most: give differential_drive or ackermann_drive, not both")
+        given = [k for k in ("differential_drive", "ackermann_drive", "mecanum_drive") if getattr(self, k) is not None]
+        if len(given) > 1:
+            raise ValueError(f"a robot has one drive at most: give one of differential_drive, ackermann_drive and "
+                             f"mecanum_drive, not {' and '.join(given)}")
         for i, t in enumerate(self.radar_targets):
             bad = [k for k in t.shapes if k >= len(self.shapes)]
             if bad:
@@ -1276,6 +1333,8 @@ class Robot(Strict):
             return out + [(f"differential_drive.skid_steer.right[{i}]", m) for i, m in enumerate(right[1:])]
         if self.ackermann_drive is not None:
             return [(f"ackermann_drive.{f}", m) for f, m in self.ackermann_drive.motor_fields]
+        if self.mecanum_drive is not None:
+            return [(f"mecanum_drive.{f}", m) for f, m in self.mecanum_drive.motor_fields]
         return []
 
 

@@ -339,6 +339,10 @@ class BatchedSimulation:
         if w.world_info.coordinate_system not in _TO_ENU:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
+        for r in w.robots:            # a mecanum drive is not stepped here: refused, not left standing still
+            if r.mecanum_drive is not None:
+                raise BatchedError(f"{self.loaded.source}: robot {r.name!r} has a mecanum_drive; the batched "
+                                   "simulation drives two-wheel, skid-steer and car-like robots only (use Simulation)")
         for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
             drive = {m for _, m in r.drive_motors}
             joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]

@@ -1,5 +1,5 @@
-"""Kinematic wheeled drives (two wheels, skid steer, car-like Ackermann steering): Webots-style
-wheel motors and exact pose integration.
+"""Kinematic wheeled drives (two wheels, skid steer, car-like Ackermann steering, four mecanum
+wheels): Webots-style wheel motors and exact pose integration.
 
 No physics: wheels never slip and nothing collides. Over a basic step the wheel speeds are
 constant, so the robot follows an exact circular arc (or a straight segment); integrating the arc
@@ -308,6 +308,71 @@ class DifferentialDrive(PlanarState):
         w = self.wheel_radius * (wr - wl) / self.axle_length
         self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
         self.moved(v, w)
+        return self.pose()
+
+
+def twist_step(x: float, y: float, yaw: float, vx: float, vy: float, w: float,
+               dt: float) -> tuple[float, float, float]:
+    """Exact planar pose after moving ``dt`` seconds at the constant body twist (``vx`` ahead, ``vy``
+    to the left, turn rate ``w``): the displacement in the step's starting frame is (a·vx − b·vy,
+    b·vx + a·vy) with a = sin(w·dt)/w and b = (1 − cos(w·dt))/w = 2 sin²(w·dt/2)/w (a = dt, b = 0
+    when w is 0), turned by the starting heading."""
+    if w == 0.0:
+        a, b = dt, 0.0
+    else:
+        half = math.sin(0.5 * w * dt)
+        a, b = math.sin(w * dt) / w, 2.0 * half * half / w
+    dx, dy = a * vx - b * vy, b * vx + a * vy
+    c, s = math.cos(yaw), math.sin(yaw)
+    return x + c * dx - s * dy, y + s * dx + c * dy, _wrap(yaw + w * dt)
+
+
+class MecanumDrive(PlanarState):
+    """Four mecanum wheels at (±lx, ±ly) (x forward, y left), rollers at 45°, no slip.
+
+    A wheel at (x_i, y_i) with roller sign s_i turning at ω_i rolls the robot with r·ω_i = vx +
+    s_i·vy + c_i·ωz, c_i = s_i·x_i − y_i. With diagonal wheels alike and the front two opposite (the
+    schema's rule) the three columns (1, s_i, c_i) are orthogonal and every |c_i| is one c, so the
+    least-squares body twist of the four speeds is vx = r·Σω_i/4, vy = r·Σs_i·ω_i/4, ωz =
+    r·Σc_i·ω_i/(4c²): exact when the speeds agree with one twist, their best fit when they do not
+    (a real robot's wheels would slip). Over a basic step the twist is constant and
+    :func:`twist_step` moves the robot exactly."""
+
+    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
+        self.wheel_radius = float(config.wheel_radius)
+        lx, ly = float(config.lx), float(config.ly)
+        speed = float(config.max_wheel_speed)
+        places = ((lx, ly), (lx, -ly), (-lx, ly), (-lx, -ly))      # front left, front right, rear left, rear right
+        # each wheel: its motor, its roller sign, its c = s·x − y
+        self.wheels = [(WheelMotor(name, speed), float(s), float(s) * px - py)
+                       for (_, name), s, (px, py) in zip(config.motor_fields, config.rollers, places)]
+        self.c2 = 4.0 * self.wheels[0][2] ** 2
+        super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
+
+    @property
+    def motors(self) -> dict[str, WheelMotor]:
+        return {m.name: m for m, _, _ in self.wheels}
+
+    def twist(self, speeds: list[float]) -> tuple[float, float, float]:
+        """(vx, vy, ωz) in the drive's frame for the four wheels' speeds (rad/s, the wheels' order)."""
+        r = self.wheel_radius
+        vx = r * sum(speeds) / 4.0
+        vy = r * sum(s * u for u, (_, s, _) in zip(speeds, self.wheels)) / 4.0
+        w = r * sum(c * u for u, (_, _, c) in zip(speeds, self.wheels)) / self.c2
+        return vx, vy, w
+
+    def step(self, dt_ms: int) -> Pose | None:
+        """Advance one basic step; the new pose, or None when the wheels did not turn."""
+        dt = dt_ms / 1000.0
+        speeds = [m.advance(dt) for m, _, _ in self.wheels]
+        if all(u == 0.0 for u in speeds):
+            self.moved(0.0, 0.0)
+            return None
+        vx, vy, w = self.twist(speeds)
+        self.x, self.y, self.yaw = twist_step(self.x, self.y, self.yaw, vx, vy, w, dt)
+        self.moved(vx, w)
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        self.linear = (vx * c - vy * s, vx * s + vy * c)     # the origin's velocity at the step's end
         return self.pose()
 
 

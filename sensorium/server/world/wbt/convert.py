@@ -5,7 +5,8 @@ devices and lights; a top-level Solid becomes a world solid, a Solid inside it o
 ``children``; everything inside a Robot (nested Solids, joint end points, device bodies) becomes a
 body shape or a device of the robot, placed relative to the robot. Two motorised HingeJoint wheels
 on one axle become the robot's kinematic ``differential_drive``; steered front wheels (vertical
-hinges or Hinge2Joints) and driven wheels its ``ackermann_drive`` (wbt/drive.py). Any other
+hinges or Hinge2Joints) and driven wheels its ``ackermann_drive``; four wheels whose friction a
+ContactProperties turns (mecanum rollers, a youBot) its ``mecanum_drive`` (wbt/drive.py). Any other
 motorised HingeJoint or SliderJoint keeps its axis (and anchor) in the robot's frame on its motor,
 and what its end point holds names that motor in ``on_joint`` (it moves with the joint).
 
@@ -1603,6 +1604,8 @@ class Converter:
             ackermann_drive,
             differential_drive,
             holds_wheel,
+            mecanum_drive,
+            mecanum_turns,
             rolls_about_its_axis,
             wheel_radius,
         )
@@ -1659,12 +1662,33 @@ class Converter:
                                 f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
                                 "turning about a vertical axis"))
             return
-        if any(w["steers"] for w in wheels):      # a car
+        turns = None                              # mecanum rollers: the wheels' friction turned (wbt/drive.py)
+        if any(w["steers"] for w in wheels):
+            # a mecanum base carrying an arm whose first joint turns about the vertical (a youBot): the
+            # arm's joints are no wheels (no car steers mecanum wheels), the base's wheels make the drive
+            carried: set[int] = set().union(*(self._inside(w["end"]) for w in wheels if w["steers"]))
+            base = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
+            turns = mecanum_turns(base, self) if base else None
+            if turns is not None:
+                for w in wheels:
+                    if not any(w is b for b in base):
+                        nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel "
+                                        f"(an arm's joint on a mecanum base): {JOINT_MOVES}", "an arm's joints"))
+                wheels = base
+        else:
+            turns = mecanum_turns(wheels, self)
+        if turns is None and any(w["steers"] for w in wheels):      # a car
             drive, why = ackermann_drive(wheels, self)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no Ackermann drive ({why}); the robot will not move")
                 return
             robot.data["ackermann_drive"] = drive
+        elif turns is not None:                   # rollers: friction turned on the wheels
+            drive, why = mecanum_drive(wheels, turns, self)
+            if drive is None:
+                self.warn(node, f"robot {robot.data['name']!r}: no mecanum drive ({why}); the robot will not move")
+                return
+            robot.data["mecanum_drive"] = drive
         else:
             drive, why = differential_drive(wheels, self)
             # a motorised hinge whose end point has nothing round to roll on (a gripper's lift arm, a
@@ -1738,6 +1762,7 @@ def drive_motor_names(robot: dict) -> list[str]:
     motors = [v for k, v in drive.items() if k in ("left_motor", "right_motor")] + [
         *skid.get("left", ()), *skid.get("right", ())]
     motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
+    motors += [v for k, v in (robot.get("mecanum_drive") or {}).items() if k.endswith("_motor")]
     return [m for m in motors if isinstance(m, str)]
 
 

@@ -28,6 +28,12 @@ wheel: its centre moves at ω·r·(axis × up)), y its left, z the robot's; the 
 way is forward in the robot's frame (``forward``). A car's frame is its driven wheels' (their axis
 taken within AXIS_TOL, as the car's other axes are).
 
+Four wheels whose friction WorldInfo's ContactProperties makes asymmetric and turns
+(``frictionRotation``: a KUKA youBot's mecanum rollers, which Webots simulates so) map onto the
+kinematic ``mecanum_drive`` when they sit at the corners (±lx, ±ly) of a rectangle centred under
+the origin, of one radius; a wheel's roller sign is minus the sign of its friction's turn (the
+youBot's wheels turned by +0.785 are the ones its library's formulas give -1).
+
 Anything else gets one sentence saying which of these failed.
 """
 
@@ -369,4 +375,115 @@ def _ackermann(wheels: list[dict], conv) -> tuple[dict | None, str]:
         return None, f"the steering motors {names} have a position limit of 0 (they cannot steer)"
     if rear_x != 0.0:                   # (on the origin: the key left out, the entry as it always was)
         out["rear_axle_offset"] = rear_x
+    return out, ""
+
+
+# ---------------------------------------------------------------- mecanum wheels (a KUKA youBot)
+
+MECANUM_ANGLE = math.pi / 4
+"""rad: the rollers' angle the mecanum drive assumes (Webots' youBot turns its wheels' friction
+directions by ±0.785398)."""
+
+
+def contact_properties(conv) -> list[tuple[str, str, list[float], tuple[float, ...]]]:
+    """The world's ContactProperties (the first top-level WorldInfo's ``contactProperties``, in
+    order): (material1, material2, coulombFriction, frictionRotation) each, Webots' defaults filled in."""
+    cached = getattr(conv, "_contact_properties", None)
+    if cached is not None:
+        return cached
+    out: list[tuple[str, str, list[float], tuple[float, ...]]] = []
+    info = next((n for n in conv.wbt.nodes if n.type == "WorldInfo"), None)
+    if info is not None:
+        for cp in conv.fields(info).nodes("contactProperties"):
+            if cp.type != "ContactProperties":
+                continue
+            f = conv.fields(cp)
+            out.append((f.string("material1", "default"), f.string("material2", "default"),
+                        f.numbers("coulombFriction") or [1.0], f.vec("frictionRotation", (0.0, 0.0))))
+    conv._contact_properties = out
+    return out
+
+
+def roller_turn(w: dict, conv) -> float | None:
+    """How a wheel's rollers turn its friction, or None when it has no asymmetric friction: its end
+    point's ``contactMaterial`` in the first ContactProperties naming it (as material1 or material2),
+    whose ``coulombFriction`` is asymmetric for that solid (two different values; with three or four,
+    material1's are the first two, with four material2's the last two) and whose ``frictionRotation``'s
+    first value is not 0: that value (rad)."""
+    end = conv.slotted(w["end"])
+    if end is None or end.type != "Solid":
+        return None
+    material = conv.fields(end).string("contactMaterial", "default")
+    for m1, m2, friction, rotation in contact_properties(conv):
+        if material not in (m1, m2):
+            continue
+        if material == m1 and len(friction) >= 2:
+            pair = friction[:2]
+        elif len(friction) == 2 or len(friction) == 4:
+            pair = friction[-2:]
+        else:
+            return None
+        return float(rotation[0]) if pair[0] != pair[1] and rotation[0] != 0.0 else None
+    return None
+
+
+def mecanum_turns(wheels: list[dict], conv) -> list[float | None] | None:
+    """Each wheel's :func:`roller_turn`, or None when no wheel has asymmetric friction (no mecanum
+    robot)."""
+    turns = [roller_turn(w, conv) for w in wheels]
+    return turns if any(t is not None for t in turns) else None
+
+
+def mecanum_drive(wheels: list[dict], turns: list[float | None], conv) -> tuple[dict | None, str]:
+    """The kinematic mecanum drive of four wheels whose friction is turned (:func:`mecanum_turns`),
+    or (None, the sentence why not); judged in the drive's frame (x forward = the axis × z)."""
+    frame, why = drive_frame(wheels)
+    if why:
+        return None, why
+    drive, why = _mecanum(_in_frame(wheels, frame), turns, conv)
+    return _framed(drive, why, frame)
+
+
+def _mecanum(wheels: list[dict], turns: list[float | None], conv) -> tuple[dict | None, str]:
+    off = _axis_off_y(wheels, TOL, "the mecanum drive needs every axis along +y so that positive speeds drive forward")
+    if off:
+        return None, off
+    if len(wheels) != 4:
+        return None, f"{len(wheels)} motorised wheels with turned friction (rollers); a mecanum drive has four"
+    plain = [w["motor"] for w, t in zip(wheels, turns) if t is None]
+    if plain:
+        return None, (f"wheel {plain[0]!r} has no asymmetric friction turned by a ContactProperties' frictionRotation "
+                      "(its rollers), as the other wheels have")
+    centres = [w["centre"] for w in wheels]
+    lx, ly = abs(float(centres[0][0])), abs(float(centres[0][1]))
+    slots = {}
+    for w, c, t in zip(wheels, centres, turns):
+        if lx <= TOL or ly <= TOL or abs(abs(c[0]) - lx) > TOL or abs(abs(c[1]) - ly) > TOL:
+            where = ", ".join(f"{o['motor']!r} at ({o['centre'][0]:g}, {o['centre'][1]:g})" for o in wheels)
+            return None, (f"the wheels ({where}) are not at the corners (±lx, ±ly) of a rectangle centred under the "
+                          "robot's origin")
+        slots[("front" if c[0] > 0 else "rear", "left" if c[1] > 0 else "right")] = (w, t)
+    if len(slots) != 4:
+        return None, "two wheels are at the same corner of the robot"
+    r0, why = _radius(wheels, conv)
+    if r0 is None:
+        return None, why
+    order = [("front", "left"), ("front", "right"), ("rear", "left"), ("rear", "right")]
+    rollers = [-1 if slots[k][1] > 0 else 1 for k in order]      # the youBot's: friction turned by +π/4 ↔ s = -1
+    fl, fr, rl, rr = rollers
+    if fl != rr or fr != rl or fl == fr:
+        return None, (f"the rollers (friction turned by {', '.join(f'{slots[k][1]:g}' for k in order)} on the front "
+                      "left, front right, rear left and rear right wheels) are not alike on diagonal wheels and "
+                      "opposite on the front two")
+    if fl == 1 and abs(lx - ly) <= TOL:
+        return None, "the rollers all point at the robot's centre (lx = ly): such wheels cannot turn it"
+    odd = [(w, t) for w, t in zip(wheels, turns) if t is not None and abs(abs(t) - MECANUM_ANGLE) > 0.01]
+    if odd:
+        w, t = odd[0]
+        conv.warn(w["node"], f"mecanum wheel {w['motor']!r}: its friction is turned by {t:g} rad; the kinematic "
+                             "drive takes its rollers at 45°")
+    out: dict = {"wheel_radius": r0, "lx": lx, "ly": ly, "max_wheel_speed": _max_speed(wheels, conv),
+                 "rollers": rollers}
+    for (end_, side), key in zip(order, ("front_left", "front_right", "rear_left", "rear_right")):
+        out[f"{key}_motor"] = slots[(end_, side)][0]["motor"]
     return out, ""
