@@ -847,7 +847,7 @@ class Contact:
             return p + d, False, yaw1
         kept = yaw1
         turn = math.remainder(yaw1 - yaw, math.tau)
-        if turn != 0.0:
+        if turn != 0.0 and self._turn_may_meet(foot, p, turn, cands):
             here = _turned(foot.points, yaw)
             now = [_gap(p, *_grown(ob, here, foot.round, p)) for ob in cands]
             if not self._turn_clear(foot, p, yaw, turn, cands, now):
@@ -869,6 +869,18 @@ class Contact:
             self.contacts += 1
         return end, clipped or kept != yaw1, kept
 
+    @staticmethod
+    def _turn_may_meet(foot: Footprint, p: np.ndarray, turn: float, cands: list[Obstacle]) -> bool:
+        """False when no candidate comes within reach of the turn, which :meth:`_turn_clear` would
+        then find clear, without its hulls: at every heading the footprint lies in the disc of
+        ``foot.radius`` about ``p``, and each part's swept hull in that disc pushed out by 1 / cos(half
+        the part); a candidate farther than that (by more than the distances' rounding) is met by
+        none of them. Most robots near something are turning in its broad-phase reach, not this one."""
+        parts = max(1, math.ceil(abs(turn) / (math.pi / 4.0)))
+        reach = foot.radius / math.cos(abs(turn) / parts / 2.0)
+        margin = EPS + 1e-9 * (1.0 + abs(float(p[0])) + abs(float(p[1])) + reach)
+        return any(_gap(p, ob, reach) <= margin for ob in cands)
+
     def _turn_clear(self, foot: Footprint, p: np.ndarray, yaw: float, turn: float, cands: list[Obstacle],
                     now: list[float]) -> bool:
         """Whether the footprint at ``p`` turning from ``yaw`` by ``turn`` stays clear of every
@@ -879,6 +891,14 @@ class Contact:
         vertex's arc lies in the triangle of its ends and their tangents' crossing."""
         assert foot.points is not None
         parts = max(1, math.ceil(abs(turn) / (math.pi / 4.0)))
+        if parts == 1:
+            # the one part's hull lies within 2 r tan(|turn| / 2) of the footprint at ``yaw`` (r: its
+            # points' reach; each hull vertex is that near its corner there), so its distance to a
+            # candidate is at least ``now`` less that: where that already answers, no hull is built
+            delta = 2.0 * (foot.radius - foot.round) * math.tan(abs(turn) / 2.0)
+            margin = 1e-9 * (1.0 + abs(float(p[0])) + abs(float(p[1])) + foot.radius)
+            if all(g - delta - margin >= min(g, 0.0) - EPS for g in now):
+                return True
         for k in range(parts):
             a, b = yaw + turn * k / parts, yaw + turn * (k + 1) / parts
             half = (b - a) / 2.0
