@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -10,7 +11,7 @@ from sensorium.schemas import messages as msgs
 from sensorium.schemas import world as wm
 from sensorium.server.daemon.services import Core
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import sanitize
+from sensorium.server.world.loader import load_world, sanitize
 
 
 def make(kind="bumper"):
@@ -189,3 +190,35 @@ def test_a_bumper_without_shapes_of_its_own_keeps_the_body_rule():
     drive(sim, 0.0)
     sim.step()
     assert readings(sim) == {"left": 0.0, "right": 0.0, "rear": 0.0}
+
+
+def test_a_wbt_touch_sensor_bumper_reads_with_its_bounding_object(tmp_path: Path):
+    """A .wbt robot whose TouchSensors have their own boundingObject (a Box, one inside a Pose): the
+    converter keeps them as the robot's shapes of those devices, and driven into a wall at 30° to the
+    left the left bumper reads 1, the right one 0; a TouchSensor without a boundingObject keeps the
+    body's rule (1 while the move is clipped)."""
+    a = math.radians(30.0)
+    c, s = math.cos(a), math.sin(a)
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\n"
+                 f'Solid {{ name "wall" translation {0.55 * c} {0.55 * s} 0.1 rotation 0 0 1 {a} '
+                 "boundingObject Box { size 0.1 3 0.2 } }\n"
+                 'Robot { name "r" boundingObject Pose { translation 0 0 0.06 children [ Cylinder { radius 0.15 height 0.1 } ] }\n'
+                 " children [\n"
+                 f'  TouchSensor {{ name "left" translation {0.16 * math.cos(0.7)} {0.16 * math.sin(0.7)} 0.06 '
+                 "rotation 0 0 1 0.7 boundingObject Box { size 0.02 0.12 0.06 } }\n"
+                 f'  TouchSensor {{ name "right" translation {0.15 * math.cos(-0.7)} {0.15 * math.sin(-0.7)} 0.06 '
+                 "rotation 0 0 1 -0.7 boundingObject Pose { translation 0.01 0 0 children [ Box { size 0.02 0.12 0.06 } ] } }\n"
+                 '  TouchSensor { name "plain" } ] }\n')
+    lw = load_world(p)
+    assert {(sh.of_device, sh.seen_by) for sh in lw.world.robots[0].shapes} == {(None, "bounding"), ("left", "bounding"),
+                                                                               ("right", "bounding")}
+    robot = lw.world.robots[0].model_copy(update={"differential_drive": wm.DifferentialDrive.model_validate(
+        {"wheel_radius": 0.02, "axle_length": 0.3, "max_wheel_speed": 100})})
+    sim = Simulation(lw.world.model_copy(update={"robots": [robot]}), base_dir=lw.base_dir)
+    for n in ("left", "right", "plain"):
+        sim.device(f"r/{n}").enable(16)
+    drive(sim, 10.0)
+    for _ in range(150):
+        sim.step()
+    assert [sim.device(f"r/{n}").value for n in ("left", "right", "plain")] == [1.0, 0.0, 1.0]

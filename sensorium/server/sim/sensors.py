@@ -28,6 +28,7 @@ from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast import blocks, packets
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.sim.own_shapes import cast_local_skipping
+from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
@@ -941,7 +942,6 @@ class TouchSensor(Device):
         self._pieces: list | None = None       # as contact takes them (contact.device_pieces), made when first due
 
     def bind(self, robot: Any) -> None:
-        from sensorium.server.sim.scene import primitive_from_model      # (scene imports this module)
         self._robot = robot
         if self.type_code == 0:
             base = robot.simulation.loaded.base_dir
