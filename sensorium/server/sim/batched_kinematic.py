@@ -49,7 +49,7 @@ from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.raycast import packets
-from sensorium.server.sim.contact import Obstacle, device_pieces, pieces_touch, shaped_obstacle
+from sensorium.server.sim.contact import TOUCH, Obstacle, device_pieces, pieces_touch, shaped_obstacle
 from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.sim.sensors import (
     GPS,
@@ -351,6 +351,7 @@ class KinematicDevices:
                                     for p in robot.shapes
                                     if p.of_device == d.name and p.seen_by in ("both", "bounding")])
         self.bumper_pieces: dict[int, list] = {}
+        self.bumper_reach: dict[int, float] = {}
         self.enable_rot = {k: np.zeros((C, len(self.devices[k]), 3, 3)) for k in MOTION}
         self.enable_pos = {k: np.zeros((C, len(self.devices[k]), 3)) for k in MOTION}
 
@@ -586,9 +587,17 @@ class KinematicDevices:
             tpl = sim._templates[r]
             pieces = self.bumper_pieces[col] = device_pieces(self.bumper_own[col], sim.initial[r], sim.to_enu,
                                                              None if tpl is None else tpl.yaw)
+        reach = self.bumper_reach.get(col)
+        if reach is None:     # the disc about the robot's origin holding every piece at any heading
+            reach = self.bumper_reach[col] = max((float(np.max(np.hypot(p.points[:, 0], p.points[:, 1]))) + p.round
+                                                  for p in pieces if p.points is not None), default=0.0)
         robots = []
+        cx, cy = sim.centres[c, r].tolist()
         for j, foot in enumerate(sim.feet):
             if foot is None or j == r:
+                continue
+            jx, jy = sim.centres[c, j].tolist()   # (a robot farther than both discs and the tolerance: not built)
+            if math.hypot(jx - cx, jy - cy) > foot.radius + reach + 2.0 * TOUCH:
                 continue
             band = (float(sim.heights[c, j] + sim.foot_low[j]), float(sim.heights[c, j] + sim.foot_high[j]))
             if sim._shaped[j]:

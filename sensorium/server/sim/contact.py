@@ -685,12 +685,14 @@ def pieces_touch(pieces: list[Footprint], centre: np.ndarray, yaw: float, height
         assert piece.points is not None
         lo, hi = height + piece.z_low, height + piece.z_high
         shape = _turned(piece.points, yaw)
-        box_lo = shape.min(axis=0) + centre - (piece.round + TOUCH)
-        box_hi = shape.max(axis=0) + centre + (piece.round + TOUCH)
+        grow = piece.round + TOUCH
+        (x0, y0), (x1, y1) = (shape.min(axis=0) + centre).tolist(), (shape.max(axis=0) + centre).tolist()
+        x0, y0, x1, y1 = x0 - grow, y0 - grow, x1 + grow, y1 + grow
         for ob, floor in [(o, FLOOR) for o in solids] + [(o, EPS) for o in robots]:
             if not (ob.z_range[1] > lo + floor and ob.z_range[0] < hi - EPS):
                 continue
-            if bool(np.any(ob.lo > box_hi)) or bool(np.any(ob.hi < box_lo)):
+            (lx, ly), (hx, hy) = ob.lo.tolist(), ob.hi.tolist()
+            if lx > x1 or ly > y1 or hx < x0 or hy < y0:
                 continue
             if ob.sphere:
                 ob = Contact._in_band(ob, lo, hi)
