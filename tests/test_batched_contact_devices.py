@@ -102,6 +102,61 @@ def test_every_copy_reads_its_bumpers_and_altimeters_as_the_single_simulation(na
     assert len({float(v) for v in noisy}) == len(seeds)
 
 
+SHAPED = Path(__file__).parent / "worlds" / "shaped_bumpers.yaml"
+SHAPED_PERIODS = {"a": {"left": 16, "right": 16, "rear": 32}, "b": {"front": 16}, "c": {"nose": 48, "body_bumper": 16}}
+
+
+def test_bumpers_with_their_own_shapes_read_in_every_copy_as_the_single_simulation(native):  # noqa: F811
+    """Bumpers with bounding shapes of their own (a round robot's left, right and rear boxes, a box
+    robot's front bar, a small round nose beside a shapeless bumper), random per-copy wheel commands
+    that push the robots into the walls, the ball and one another, stops against them, a supervisor
+    move, a reset with a new seed: every bumper value of every copy equals that of a Simulation
+    built with that copy's seed, bit for bit, with the C helper and without it; the left and right
+    bumpers disagree on some steps (each reads where its robot was hit)."""
+    seeds = [5, 6, 7]
+    lw = load_world(SHAPED)
+
+    def world(seed: int) -> LoadedWorld:
+        w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
+        return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+
+    bs = BatchedSimulation(world(0), len(seeds))
+    bs.reset(np.arange(len(seeds)), seeds)
+    sims = [Simulation(world(s)) for s in seeds]
+    for c in range(len(seeds)):
+        _enable_both(bs, sims, SHAPED_PERIODS, c)
+    rng = np.random.default_rng(4)
+    seen = {"pressed": 0, "free": 0, "one_side": 0}
+    for step in range(300):
+        if step % 30 == 0:
+            for robot in SHAPED_PERIODS:
+                ahead, turn = rng.uniform(-14.0, 14.0, (len(seeds), 1)), rng.uniform(-3.0, 3.0, (len(seeds), 1))
+                stop = rng.uniform(size=(len(seeds), 1)) < 0.2          # some stand still where they are
+                lr = np.where(stop, 0.0, np.concatenate([ahead - turn, ahead + turn], axis=1))
+                _wheels_both(bs, sims, robot, lr)
+        if step == 70:
+            bs.set_pose(2, bs.slot("a"), [0.5, 0.3, 0.0])
+            sims[2].robot("a").set_pose([0.5, 0.3, 0.0])
+        if step == 120:
+            bs.reset([1], [42])
+            sims[1] = Simulation(world(42))
+            _enable_both(bs, sims, SHAPED_PERIODS, 1)
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot, names in SHAPED_PERIODS.items():
+                assert s.robot(robot).pose.translation.tobytes() == bs.pos[c, bs.slot(robot)].tobytes(), (step, c, robot)
+                for n in names:
+                    want = np.float64(s.robot(robot).device(n).value)
+                    got = bs.value(bs.device(robot, n))[c]
+                    assert want.tobytes() == got.tobytes(), (step, c, robot, n, want, got)
+                    seen["pressed"] += want == 1.0
+                    seen["free"] += want == 0.0
+            left, right = (s.robot("a").device(n).value for n in ("left", "right"))
+            seen["one_side"] += left != right and not (math.isnan(left) or math.isnan(right))
+    assert seen["pressed"] > 100 and seen["free"] > 1000 and seen["one_side"] > 20, seen
+
+
 def _walled(z: float = 0.05, wgs84: bool = False) -> wm.World:
     """A robot facing a wall 0.5 m ahead on a flat floor (no ramp), a bumper and an altimeter 4 cm
     above its origin."""

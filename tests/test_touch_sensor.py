@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -10,7 +11,7 @@ from sensorium.schemas import messages as msgs
 from sensorium.schemas import world as wm
 from sensorium.server.daemon.services import Core
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import sanitize
+from sensorium.server.world.loader import load_world, sanitize
 
 
 def make(kind="bumper"):
@@ -71,3 +72,153 @@ def test_services_and_topics():
     assert types["/r/bumper/value"] == msgs.FLOAT64 and "/r/bumper/values" not in types
     core3 = Core(make("force-3d"))
     assert {t.name: t.type for t in core3.topics.topics}["/r/bumper/values"] == msgs.VECTOR3_STAMPED
+
+
+# -- bumpers with bounding shapes of their own: a Create-like round robot (body radius 0.15) with a left
+# and a right bumper (boxes 0.02 deep and 0.12 wide whose centres are 0.16 m out at ±40°) and a rear
+# one (180°). Along a direction at angle a, the box at angle b reaches 0.17 cos(a - b) + 0.06 |sin(a - b)|
+# from the robot's centre; the body's circumscribed 16-gon at most 0.15 / cos(π/16) = 0.1529.
+BUMPERS = {"left": math.radians(40.0), "right": math.radians(-40.0), "rear": math.pi}
+
+
+def reach(a: float, b: float) -> float:
+    return 0.17 * math.cos(a - b) + 0.06 * abs(math.sin(a - b))
+
+
+def create_like(wall_angle: float, face: float = 0.5, bumper_shapes: bool = True, others=()) -> Simulation:
+    """The robot at the origin heading +x, a wall whose face, normal to the direction ``wall_angle``
+    (to the left of ahead when positive), is ``face`` m from the robot's centre."""
+    u = (math.cos(wall_angle), math.sin(wall_angle))
+    shapes = [{"name": "body", "pose": {"translation": [0, 0, 0.06]},
+               "geometry": {"type": "cylinder", "radius": 0.15, "height": 0.1}}]
+    devices = []
+    for name, b in BUMPERS.items():
+        if bumper_shapes:
+            shapes.append({"name": name, "of_device": name,
+                           "pose": {"translation": [0.16 * math.cos(b), 0.16 * math.sin(b), 0.06],
+                                    "rotation": [0, 0, 1, b]},
+                           "geometry": {"type": "box", "size": [0.02, 0.12, 0.06]}})
+        devices.append({"device": "TouchSensor", "name": name,
+                        "pose": {"translation": [0.16 * math.cos(b), 0.16 * math.sin(b), 0.06]}})
+    data = {"world_info": {"basic_time_step": 16},
+            "solids": [{"name": "wall", "pose": {"translation": [(face + 0.05) * u[0], (face + 0.05) * u[1], 0.1],
+                                                  "rotation": [0, 0, 1, wall_angle]},
+                        "geometry": {"type": "box", "size": [0.1, 3.0, 0.2]}}],
+            "robots": [{"name": "r", "shapes": shapes, "devices": devices,
+                        "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.3, "max_wheel_speed": 100}},
+                       *others]}
+    sim = Simulation(wm.World.model_validate(data))
+    for name in BUMPERS:
+        sim.device(f"r/{name}").enable(16)
+    return sim
+
+
+def readings(sim) -> dict[str, float]:
+    return {name: sim.device(f"r/{name}").value for name in BUMPERS}
+
+
+def test_a_bumper_with_its_own_shapes_reads_where_the_robot_was_hit():
+    """Driven at 0.2 m/s into a wall at 30° to the left, the left bumper (which reaches 0.1778 m
+    that way, farther than the body and the right bumper's 0.1145) touches it and reads 1, the right
+    and the rear ones 0, while the robot slides along the wall; stopped there, the left one still
+    touches (1); backed away, none does."""
+    a = math.radians(30.0)
+    sim = create_like(a)
+    drive(sim, 10.0)
+    first = None
+    for k in range(200):
+        sim.step()
+        if first is None and readings(sim)["left"] == 1.0:
+            first = k
+            break
+    assert first is not None
+    # the left bumper reaches the face (0.5 from the centre along u) after 0.5 - reach(a, 40°) m along u,
+    # i.e. (0.5 - 0.17784) / cos 30° = 0.3720 m along x: 1.86 s = 116.3 steps of 16 ms
+    assert 115 <= first <= 117
+    for _ in range(20):                                     # sliding along the wall, pressed on it
+        sim.step()
+        pose = sim.robot("r").pose.translation
+        along = pose[0] * math.cos(a) + pose[1] * math.sin(a)
+        assert abs(along - (0.5 - reach(a, BUMPERS["left"]))) < 1e-9
+        assert readings(sim) == {"left": 1.0, "right": 0.0, "rear": 0.0}
+    drive(sim, 0.0)                                         # standing still against the wall: still touching
+    for _ in range(5):
+        sim.step()
+        assert readings(sim) == {"left": 1.0, "right": 0.0, "rear": 0.0}
+    drive(sim, -10.0)
+    sim.step()
+    assert readings(sim) == {"left": 0.0, "right": 0.0, "rear": 0.0}
+
+
+def test_head_on_both_front_bumpers_read_one_and_the_rear_one_zero():
+    """Head-on into a wall 0.5 m ahead: the robot stops where both front bumpers' inner front corners
+    (0.17 cos 40° + 0.06 sin 40° = 0.16880 m ahead) touch it; both read 1, the rear one 0."""
+    sim = create_like(0.0)
+    drive(sim, 10.0)
+    for _ in range(150):
+        sim.step()
+    x = sim.robot("r").pose.translation[0]
+    assert abs(x - (0.5 - reach(0.0, BUMPERS["left"]))) < 1e-9
+    assert readings(sim) == {"left": 1.0, "right": 1.0, "rear": 0.0}
+
+
+def test_a_bumper_reads_another_robot_that_touches_it_and_not_one_it_misses():
+    """A standing robot (a post of radius 0.05, 0.12 m right of the path) is hit by the right bumper:
+    it reads 1, the left one 0; that robot's own shapeless bumper keeps the body's rule (it was not
+    driven, so never clipped: 0)."""
+    sim = create_like(0.0, face=3.0, others=[{
+        "name": "post", "pose": {"translation": [0.6, -0.12, 0.0]},
+        "shapes": [{"pose": {"translation": [0, 0, 0.06]}, "geometry": {"type": "cylinder", "radius": 0.05, "height": 0.1}}],
+        "devices": [{"device": "TouchSensor", "name": "bump"}]}])
+    sim.device("post/bump").enable(16)
+    drive(sim, 10.0)
+    for _ in range(140):                                    # it reaches the post after about 129 steps
+        sim.step()
+    assert 0.4 < sim.robot("r").pose.translation[0] < 0.6 and sim.robot("r").pose.translation[1] > 0.0
+    assert readings(sim) == {"left": 0.0, "right": 1.0, "rear": 0.0}
+    assert sim.device("post/bump").value == 0.0
+
+
+def test_a_bumper_without_shapes_of_its_own_keeps_the_body_rule():
+    """The same robot whose bumpers have no shapes: all three read 1 while the body is stopped by
+    the wall at 30° (its move clipped), and 0 once it stands still there."""
+    sim = create_like(math.radians(30.0), bumper_shapes=False)
+    drive(sim, 10.0)
+    for _ in range(150):
+        sim.step()
+    assert readings(sim) == {"left": 1.0, "right": 1.0, "rear": 1.0}
+    drive(sim, 0.0)
+    sim.step()
+    assert readings(sim) == {"left": 0.0, "right": 0.0, "rear": 0.0}
+
+
+def test_a_wbt_touch_sensor_bumper_reads_with_its_bounding_object(tmp_path: Path):
+    """A .wbt robot whose TouchSensors have their own boundingObject (a Box, one inside a Pose): the
+    converter keeps them as the robot's shapes of those devices, and driven into a wall at 30° to the
+    left the left bumper reads 1, the right one 0; a TouchSensor without a boundingObject keeps the
+    body's rule (1 while the move is clipped)."""
+    a = math.radians(30.0)
+    c, s = math.cos(a), math.sin(a)
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\n"
+                 f'Solid {{ name "wall" translation {0.55 * c} {0.55 * s} 0.1 rotation 0 0 1 {a} '
+                 "boundingObject Box { size 0.1 3 0.2 } }\n"
+                 'Robot { name "r" boundingObject Pose { translation 0 0 0.06 children [ Cylinder { radius 0.15 height 0.1 } ] }\n'
+                 " children [\n"
+                 f'  TouchSensor {{ name "left" translation {0.16 * math.cos(0.7)} {0.16 * math.sin(0.7)} 0.06 '
+                 "rotation 0 0 1 0.7 boundingObject Box { size 0.02 0.12 0.06 } }\n"
+                 f'  TouchSensor {{ name "right" translation {0.15 * math.cos(-0.7)} {0.15 * math.sin(-0.7)} 0.06 '
+                 "rotation 0 0 1 -0.7 boundingObject Pose { translation 0.01 0 0 children [ Box { size 0.02 0.12 0.06 } ] } }\n"
+                 '  TouchSensor { name "plain" } ] }\n')
+    lw = load_world(p)
+    assert {(sh.of_device, sh.seen_by) for sh in lw.world.robots[0].shapes} == {(None, "bounding"), ("left", "bounding"),
+                                                                               ("right", "bounding")}
+    robot = lw.world.robots[0].model_copy(update={"differential_drive": wm.DifferentialDrive.model_validate(
+        {"wheel_radius": 0.02, "axle_length": 0.3, "max_wheel_speed": 100})})
+    sim = Simulation(lw.world.model_copy(update={"robots": [robot]}), base_dir=lw.base_dir)
+    for n in ("left", "right", "plain"):
+        sim.device(f"r/{n}").enable(16)
+    drive(sim, 10.0)
+    for _ in range(150):
+        sim.step()
+    assert [sim.device(f"r/{n}").value for n in ("left", "right", "plain")] == [1.0, 0.0, 1.0]

@@ -661,8 +661,11 @@ class Altimeter(_Device):
 
 
 class TouchSensor(_Device):
-    """Webots TouchSensor. ``bumper``: 1 while the robot's body pushes against a solid or another
-    robot (kinematic contact clipped its motion in the last basic step), else 0. ``force`` and
+    """Webots TouchSensor. ``bumper`` with bounding shapes of its own (the robot's shapes whose
+    ``of_device`` names it: a .wbt TouchSensor's boundingObject): 1 when they touch a solid or
+    another robot at the end of the step (within 1e-6 m, as kinematic contact sees them), else 0;
+    ``bumper`` without: 1 while the robot's body pushes against a solid or another robot (kinematic
+    contact clipped its motion in the last basic step), else 0 (README "Bumpers"). ``force`` and
     ``force-3d`` need physics: they read NaN (Webots' "no value"), said once when the world loads."""
 
     device: Literal["TouchSensor"]

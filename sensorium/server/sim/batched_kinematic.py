@@ -49,6 +49,8 @@ from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.raycast import packets
+from sensorium.server.sim.contact import TOUCH, Obstacle, device_pieces, pieces_touch, shaped_obstacle
+from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.sim.sensors import (
     GPS,
     Accelerometer,
@@ -59,6 +61,7 @@ from sensorium.server.sim.sensors import (
     TouchSensor,
     altitude_offset,
 )
+from sensorium.server.world.poses import pose_from_model
 
 __all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal", "libm_each",
            "libm_cos_sin", "roll_pitch_yaw", "matrix_quaternions", "inertial_quaternions", "angular_velocities",
@@ -339,6 +342,16 @@ class KinematicDevices:
         self.last2_rot = np.zeros((C, R, 3, 3))
         self.last2_pos = np.zeros((C, R, 3))
         self.seen = {k: np.zeros((C, len(self.devices[k])), dtype=np.int64) for k in MOTION}
+        # bumpers with bounding shapes of their own: those shapes (primitive, pose in the robot frame),
+        # made into contact's pieces when first due (TouchSensor.bind and measure)
+        self.bumper_own: list[list] = []
+        for d in self.devices["TouchSensor"]:
+            robot = sim.world.robots[d.robot_index]
+            self.bumper_own.append([(primitive_from_model(p.geometry, sim.loaded.base_dir), pose_from_model(p.pose))
+                                    for p in robot.shapes
+                                    if p.of_device == d.name and p.seen_by in ("both", "bounding")])
+        self.bumper_pieces: dict[int, list] = {}
+        self.bumper_reach: dict[int, float] = {}
         self.enable_rot = {k: np.zeros((C, len(self.devices[k]), 3, 3)) for k in MOTION}
         self.enable_pos = {k: np.zeros((C, len(self.devices[k]), 3)) for k in MOTION}
 
@@ -553,9 +566,47 @@ class KinematicDevices:
         return roll_pitch_yaw(q, self.axes)
 
     def _bumper(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """TouchSensor.measure of a bumper: 1 where the copy's robot pushed against something in this
-        step (kinematic contact clipped its move: ``pressing``), else 0."""
-        return np.where(self.sim.pressing[copies, self.slot["TouchSensor"][cols]], 1.0, 0.0)
+        """TouchSensor.measure of a bumper: one without shapes of its own reads 1 where the copy's
+        robot pushed against something in this step (kinematic contact clipped its move:
+        ``pressing``); one with shapes reads 1 where they touch a solid or another robot of its copy
+        at the end of the step (contact.pieces_touch, from the copy's contact state as the single
+        simulation's Contact keeps it), else 0."""
+        sim = self.sim
+        slots = self.slot["TouchSensor"][cols]
+        out = np.where(sim.pressing[copies, slots], 1.0, 0.0)
+        shaped = [m for m, col in enumerate(cols.tolist()) if self.bumper_own[col]]
+        for m in shaped:
+            out[m] = 0.0 if sim.contact is None else self._bumper_touch(int(copies[m]), int(cols[m]))
+        return out
+
+    def _bumper_touch(self, c: int, col: int) -> float:
+        sim = self.sim
+        r = int(self.slot["TouchSensor"][col])
+        pieces = self.bumper_pieces.get(col)
+        if pieces is None:
+            tpl = sim._templates[r]
+            pieces = self.bumper_pieces[col] = device_pieces(self.bumper_own[col], sim.initial[r], sim.to_enu,
+                                                             None if tpl is None else tpl.yaw)
+        reach = self.bumper_reach.get(col)
+        if reach is None:     # the disc about the robot's origin holding every piece at any heading
+            reach = self.bumper_reach[col] = max((float(np.max(np.hypot(p.points[:, 0], p.points[:, 1]))) + p.round
+                                                  for p in pieces if p.points is not None), default=0.0)
+        robots = []
+        cx, cy = sim.centres[c, r].tolist()
+        for j, foot in enumerate(sim.feet):
+            if foot is None or j == r:
+                continue
+            jx, jy = sim.centres[c, j].tolist()   # (a robot farther than both discs and the tolerance: not built)
+            if math.hypot(jx - cx, jy - cy) > foot.radius + reach + 2.0 * TOUCH:
+                continue
+            band = (float(sim.heights[c, j] + sim.foot_low[j]), float(sim.heights[c, j] + sim.foot_high[j]))
+            if sim._shaped[j]:
+                robots.append(shaped_obstacle(j, foot, sim.centres[c, j], float(sim.foot_yaw[c, j]), band))
+            else:
+                robots.append(Obstacle(f"robot {j}", j, sim.centres[c, j][None, :].copy(), float(sim.foot_disc[j]), band))
+        touched = pieces_touch(pieces, sim.centres[c, r], float(sim.foot_yaw[c, r]), float(sim.heights[c, r]),
+                               sim.contact._obs, robots)
+        return 1.0 if touched else 0.0
 
     def _altimeter(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Altimeter.measure: the device's height (+ the reference altitude), its Gaussian

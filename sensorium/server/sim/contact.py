@@ -656,6 +656,51 @@ def _gap(p: np.ndarray, ob: Obstacle, rho: float) -> float:
     return _closest_on_list(float(p[0]), float(p[1]), ob.points.tolist())[0] - (ob.radius + rho)
 
 
+# ---------------------------------------------------------------------- bumpers
+
+TOUCH = 1e-6          # m: a bumper's own shapes this near what contact sees (or overlapping it) touch it
+
+
+def device_pieces(parts: list[tuple[geo.Primitive, Pose]], pose: Pose, to_enu: np.ndarray | None,
+                  yaw: float | None) -> list[Footprint]:
+    """A device's own bounding shapes (a bumper's), each as contact takes a robot's body: its piece
+    and height band in the footprint's frame (:func:`drive_footprint` of that one shape, at the
+    robot's world-file ``pose`` and drive heading ``yaw``), so it moves and turns with the footprint."""
+    out = []
+    for part in parts:
+        piece = drive_footprint([part], pose, to_enu, yaw)
+        if piece is not None and piece.points is not None:
+            out.append(piece)
+    return out
+
+
+def pieces_touch(pieces: list[Footprint], centre: np.ndarray, yaw: float, height: float,
+                 solids: list[Obstacle], robots: list[Obstacle]) -> bool:
+    """Whether any of a robot's ``pieces`` (:func:`device_pieces`), with the robot at ``centre``,
+    heading ``yaw`` and height ``height``, touches a solid's obstacle or another robot's footprint
+    (``robots``): their bands overlapping as contact's broad phase takes them (a solid rising more
+    than FLOOR into the band, a robot more than EPS), and the 2D gap between the piece and the
+    obstacle (contact's Minkowski sum, :func:`_grown`) at most :data:`TOUCH`."""
+    for piece in pieces:
+        assert piece.points is not None
+        lo, hi = height + piece.z_low, height + piece.z_high
+        shape = _turned(piece.points, yaw)
+        grow = piece.round + TOUCH
+        (x0, y0), (x1, y1) = (shape.min(axis=0) + centre).tolist(), (shape.max(axis=0) + centre).tolist()
+        x0, y0, x1, y1 = x0 - grow, y0 - grow, x1 + grow, y1 + grow
+        for ob, floor in [(o, FLOOR) for o in solids] + [(o, EPS) for o in robots]:
+            if not (ob.z_range[1] > lo + floor and ob.z_range[0] < hi - EPS):
+                continue
+            (lx, ly), (hx, hy) = ob.lo.tolist(), ob.hi.tolist()
+            if lx > x1 or ly > y1 or hx < x0 or hy < y0:
+                continue
+            if ob.sphere:
+                ob = Contact._in_band(ob, lo, hi)
+            if _gap(centre, *_grown(ob, shape, piece.round, centre)) <= TOUCH:
+                return True
+    return False
+
+
 # ---------------------------------------------------------------------- the resolver
 
 class Contact:
@@ -696,6 +741,7 @@ class Contact:
         # each robot's heading (its drive's: the footprint is turned to match, drive_footprint)
         self.yaw = np.array([heading(enu_pose(p, to_enu)) if y is None else y for (_, p), y in zip(robots, yaws)],
                             dtype=np.float64)
+        self.initial = [(p, y) for (_, p), y in zip(robots, yaws)]     # what the footprints were made from
         self.contacts = 0                         # robot-steps whose motion was clipped
         self.checks = 0                           # narrow-phase obstacle tests
         self._rebuild()
@@ -810,6 +856,19 @@ class Contact:
             self.yaw[i] = kept
             out.append((p, clipped, kept))
         return out
+
+    def pieces(self, index: int, parts: list[tuple[geo.Primitive, Pose]]) -> list[Footprint]:
+        """Robot ``index``'s device shapes ``parts`` (robot frame) as :func:`device_pieces`, made as its
+        footprint was."""
+        pose, yaw = self.initial[index]
+        return device_pieces(parts, pose, self._to_enu, yaw)
+
+    def touching(self, index: int, pieces: list[Footprint]) -> bool:
+        """Whether robot ``index``'s ``pieces`` touch a solid or another robot where they all are now
+        (:func:`pieces_touch`)."""
+        robots = [self._robot_obstacle(j) for j, f in enumerate(self.feet) if f is not None and j != index]
+        return pieces_touch(pieces, self.centres[index], float(self.yaw[index]), float(self.heights[index]),
+                            self._obs, robots)
 
     def _robot_obstacle(self, j: int) -> Obstacle:
         """Robot ``j``'s footprint where it is now, as an obstacle."""

@@ -28,6 +28,7 @@ from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast import blocks, packets
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.sim.own_shapes import cast_local_skipping
+from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
@@ -921,8 +922,11 @@ class Altimeter(Device):
 
 
 class TouchSensor(Device):
-    """Webots TouchSensor: a bumper reads 1 while its robot pushes against something (kinematic
-    contact), else 0; ``force`` and ``force-3d`` read NaN (they need physics)."""
+    """Webots TouchSensor. A bumper with bounding shapes of its own (the robot's shapes whose
+    ``of_device`` names it) reads 1 when, at the end of the step, one of them touches a solid or
+    another robot as kinematic contact sees them (contact.pieces_touch: a gap of at most
+    contact.TOUCH, bands overlapping), else 0; a bumper without any reads 1 when contact clipped its
+    robot's move in the step. ``force`` and ``force-3d`` read NaN (they need physics)."""
 
     kinematic = True
     TYPE_CODES: ClassVar[dict[str, int]] = {"bumper": 0, "force": 1, "force-3d": 2}
@@ -934,13 +938,29 @@ class TouchSensor(Device):
         self.value = math.nan
         self.values = np.full(3, math.nan)
         self._robot: Any = None
+        self._own: list = []                   # its own bounding shapes (primitive, pose in the robot frame)
+        self._pieces: list | None = None       # as contact takes them (contact.device_pieces), made when first due
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
+        if self.type_code == 0:
+            base = robot.simulation.loaded.base_dir
+            self._own = [(primitive_from_model(p.geometry, base), pose_from_model(p.pose))
+                         for p in robot.model.shapes if p.of_device == self.name and p.seen_by in ("both", "bounding")]
 
     def measure(self, now_ms: int) -> None:
         if self.type_code == 0:
-            self.value = 1.0 if self._robot.pressing else 0.0
+            robot = self._robot
+            if not self._own:                  # no shapes of its own: its robot's contact
+                self.value = 1.0 if robot.pressing else 0.0
+            else:
+                contact = robot.simulation.contact
+                if contact is None:            # contact off: nothing is touched
+                    self.value = 0.0
+                else:
+                    if self._pieces is None:
+                        self._pieces = contact.pieces(robot.index, self._own)
+                    self.value = 1.0 if contact.touching(robot.index, self._pieces) else 0.0
         self._mark(now_ms)
 
     def readings(self) -> dict:
