@@ -438,10 +438,10 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
         for d_i, d in enumerate(r.devices):
             device_name_ok(f"robots[{i}].devices[{d_i}].name", d.name)
         # a device named like another's path below it ('Sonar' and 'Sonar/value') would share its topics
-        names = {d.name for d in r.devices}
+        device_set = {d.name for d in r.devices}
         for d_i, d in enumerate(r.devices):
             parts = d.name.split("/")
-            above = next(("/".join(parts[:k]) for k in range(1, len(parts)) if "/".join(parts[:k]) in names), None)
+            above = next(("/".join(parts[:k]) for k in range(1, len(parts)) if "/".join(parts[:k]) in device_set), None)
             if above is not None:
                 problems.append(Problem(f"robots[{i}].devices[{d_i}].name",
                                         f"name {d.name!r} lies under device {above!r}'s topic and service paths "
