@@ -21,7 +21,7 @@ import math
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from pydantic import ValidationError
@@ -32,6 +32,8 @@ from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import states, viewshot
 from sensorium.server.world.poses import matrix_quaternion
 from sensorium.server.world.top_nodes import Scenery
+
+T = TypeVar("T")
 
 MODES = ("pause", "realtime", "fast")     # Webots WB_SUPERVISOR_SIMULATION_MODE_PAUSE = 0, REAL_TIME, FAST
 LIGHTS = ("PointLight", "SpotLight", "DirectionalLight")
@@ -693,11 +695,17 @@ def state_scope(sim: Any, node: Node) -> states.Scope:
     raise ValueError(f"{what} has no state here: robots, top-level solids and the nodes inside them have one")
 
 
-def _states(sim: Any) -> states.States:
-    kept = getattr(sim, "_node_states", None)
+def _kept(sim: Any, attribute: str, make: Callable[[], T]) -> T:
+    """What the Supervisor keeps for a simulation beside it (saved states, labels), made at first use."""
+    kept = getattr(sim, attribute, None)
     if kept is None:
-        kept = sim._node_states = states.States()
+        kept = make()
+        setattr(sim, attribute, kept)
     return kept
+
+
+def _states(sim: Any) -> states.States:
+    return _kept(sim, "_node_states", states.States)
 
 
 def _save_state(sim: Any, ls: Any, robot: str, a: Any) -> dict:
@@ -761,10 +769,7 @@ def _set_mode(sim: Any, ls: Any, robot: str, a: Any) -> dict:
 
 
 def _labels(sim: Any) -> viewshot.Labels:
-    kept = getattr(sim, "_labels", None)
-    if kept is None:
-        kept = sim._labels = viewshot.Labels()
-    return kept
+    return _kept(sim, "_labels", viewshot.Labels)
 
 
 def _set_label(sim: Any, ls: Any, robot: str, a: Any) -> dict:
