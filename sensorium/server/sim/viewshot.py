@@ -25,6 +25,7 @@ are cut to the image before they are filled (a label costs at most about the ima
 from __future__ import annotations
 
 import math
+import re
 from collections import Counter
 from dataclasses import dataclass
 from typing import Any
@@ -44,6 +45,7 @@ EXPORT_SIZE = (640, 480)
 """The size of a Supervisor's ``exportImage`` (Webots': its 3D window's, which a server has not)."""
 MAX_SIDE = 4096
 MAX_PIXELS = 1 << 22
+MAX_STEPS = 1_000_000          # basic steps `sensorium snapshot` runs first, at most
 MAX_LABELS = 256
 MAX_TEXT = 1024
 MAX_LABEL_ID = 65534          # Webots: ids 0..65534, 65535 is its movie caption's
@@ -241,7 +243,7 @@ def parse_size_values(width: Any, height: Any) -> tuple[int, int]:
 def parse_size(text: str) -> tuple[int, int]:
     """``"WxH"`` → (W, H), bounded as :func:`render` bounds them."""
     parts = str(text).lower().split("x")
-    if len(parts) != 2 or not all(p.strip().isdigit() for p in parts):
+    if len(parts) != 2 or not all(re.fullmatch(r"[0-9]{1,12}", p.strip()) for p in parts):
         raise ValueError(f"size must be WIDTHxHEIGHT (e.g. 640x480), got {text!r}")
     return parse_size_values(int(parts[0]), int(parts[1]))
 
@@ -280,8 +282,8 @@ def encode(rgb: np.ndarray, fmt: str, quality: int = 95) -> bytes:
 def snapshot(sim: Any, width: int, height: int, steps: int = 0) -> np.ndarray:
     """``sensorium snapshot``: ``steps`` basic steps of ``sim`` (its robots with no controller),
     then the Viewpoint's view."""
-    if isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= 1_000_000:
-        raise ValueError(f"steps must be an integer in 0..1000000, got {steps!r}")
+    if isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= MAX_STEPS:
+        raise ValueError(f"steps must be an integer in 0..{MAX_STEPS}, got {steps!r}")
     width, height = parse_size_values(width, height)
     viewpoint_of(sim)                 # a Viewpoint that makes no picture: said before any step
     for _ in range(steps):
