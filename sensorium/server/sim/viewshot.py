@@ -206,16 +206,20 @@ def draw_labels(rgb: np.ndarray, labels: Labels) -> np.ndarray:
     for _, lab in labels.items():
         k = label_scale(lab.size, h)
         x0, y0 = int(math.floor(lab.x * w)), int(math.floor(lab.y * h))
-        mask = np.zeros(h * w, dtype=bool)
+        if x0 >= w or y0 >= h:
+            continue
+        # the glyph pixels on the image, in glyph units, each then grown to its k x k square and the
+        # squares cut to the image: about the label's part of the picture in work, whatever k
+        nx, ny = -(-(w - x0) // k), -(-(h - y0) // k)
+        small = np.zeros((ny, nx), dtype=bool)
         for gx, gy in display.text_lines(lab.text):
-            px, py = x0 + k * gx, y0 + k * gy
-            on = (px < w) & (py < h)
-            px, py = px[on], py[on]
-            for dy in range(k):             # each glyph pixel's square, cut to the image
-                for dx in range(k):
-                    qx, qy = px + dx, py + dy
-                    keep = (qx < w) & (qy < h)
-                    mask[qy[keep] * w + qx[keep]] = True
+            on = (gx < nx) & (gy < ny)
+            small[gy[on], gx[on]] = True
+        if not small.any():
+            continue
+        mask2d = np.zeros((h, w), dtype=bool)
+        mask2d[y0:, x0:] = small.repeat(k, axis=0).repeat(k, axis=1)[: h - y0, : w - x0]
+        mask = mask2d.reshape(-1)
         if mask.any():
             opacity = 0xFF - int(lab.transparency * 0xFF)      # libController's transparency byte
             words[mask] = display._over(words[mask], lab.color, 0xFF, opacity)
