@@ -148,3 +148,17 @@ def test_random_motion_files_same_verdict_in_both_clients(harness, tmp_path, fil
 @example(files=[b"#WEBOTS_MOTION,V1.0,a\n0,P,1\n\n\n5,Q,2\n", b"#WEBOTS_MOTION,V1.0,a\n" + b"0" * 4093 + b"1,P,1\n"])
 def test_mutated_motion_files_same_verdict_in_both_clients(harness, tmp_path, files) -> None:
     same(harness, tmp_path, files)
+
+
+def test_a_folder_is_a_file_that_cannot_be_opened_in_both_clients(harness, tmp_path, monkeypatch, capsys) -> None:
+    """Found here: C's fopen opens a folder and read nothing from it ('is empty.'), where Python's
+    open refuses it ('could not open'); both now say the Python client's line."""
+    from sensorium.client import wb_motion
+
+    folder = tmp_path / "wave.motion"
+    folder.mkdir()
+    line = f"Error: wbu_motion_new(): could not open '{folder}' file."
+    assert c_verdicts(harness, [folder]) == [f"file {folder}", line]
+    monkeypatch.setattr(wb_motion, "_hooked", lambda: None)
+    assert wb_motion.wbu_motion_new(str(folder)) is None
+    assert capsys.readouterr().err.splitlines() == [line]
