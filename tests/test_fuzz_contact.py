@@ -251,3 +251,50 @@ def test_a_needle_thin_robot_far_from_the_origin_stops_at_a_post() -> None:
         check(sim, ["r0"], (1e5, -1e5), False)
     assert sim.robot("r0").pressing
     assert sim.contact.centres[0][0] - 1e5 == pytest.approx(1.0 - 0.25 - 0.125, abs=1e-9)
+
+
+STUCK_TURNS: list[int] = []
+
+
+@FUZZ
+@given(me=body, yaw=angle, spin=st.sampled_from([10.0, -10.0, 40.0, -40.0]), gap=st.floats(0.05, 0.95),
+       offset=st.sampled_from([(0.0, 0.0), (1e5, -1e5)]), nue=st.booleans())
+def test_a_turn_cut_short_by_a_corner_can_turn_back(me, yaw, spin, gap, offset, nue) -> None:
+    """Spun in place beside a long wall that its corners reach when it turns (the wall's face
+    between its footprint's reach ahead and the disc that holds it at every heading) until a corner
+    stops its turn, then spun the other way: the first step back turns it (README: a robot can
+    always turn the way that lifts its corner off)."""
+    robots = [{"name": "r0", "xy": (0.0, 0.0), "yaw": yaw, "body": me}]
+    sim = _world(robots, [], offset, nue, 32)
+    foot = sim.contact.feet[0]
+    if foot is None or foot.disc:
+        return                                   # a disc turns freely
+    pts, rnd = _robot_shape(sim, 0)
+    reach = float((pts[:, 0] - sim.contact.centres[0][0]).max()) + rnd
+    if foot.radius - reach < 0.005:
+        return                                   # round enough that no corner reaches out when turning
+    face = reach + gap * (foot.radius - reach)
+    wall = {"kind": "box", "xy": (round(face + 0.05, 9), 0.0), "yaw": 0.0, "half": (0.05, 1.5)}
+    sim = _world(robots, [wall], offset, nue, 32)
+    drive(sim, "r0", -spin, spin)
+    for _ in range(200):
+        before = float(sim.contact.yaw[0])
+        sim.step()
+        check(sim, ["r0"], offset, nue)
+        if float(sim.contact.yaw[0]) == before:   # a turn refused outright: the corner is on the wall
+            break
+    else:
+        return
+    STUCK_TURNS.append(1)
+    before = float(sim.contact.yaw[0])
+    drive(sim, "r0", spin, -spin)
+    sim.step()
+    check(sim, ["r0"], offset, nue)
+    turned = (float(sim.contact.yaw[0]) - before + math.pi) % (2 * math.pi) - math.pi
+    assert turned * spin < 0, (before, turned)
+
+
+def test_the_turn_fuzz_cut_turns_short() -> None:
+    """The examples above are not vacuous: most robots had a turn refused before turning back."""
+    if STUCK_TURNS:
+        assert len(STUCK_TURNS) >= 10, STUCK_TURNS
