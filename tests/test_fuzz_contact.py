@@ -120,7 +120,17 @@ def _overlap(p, rp, q, rq):
             depth = min(depth, min(pa.max() - pb.min(), pb.max() - pa.min()))
     if depth > 0 and len(p) >= 3 and len(q) >= 3:
         return depth + rp + rq      # the polygons themselves overlap
+    for a, b in ((p, q), (q, p)):   # a point or segment inside a polygon
+        if len(b) >= 3 and len(a) < 3 and any(_inside(x, b) for x in a):
+            return rp + rq + _edges_distance(a, b)
     return rp + rq - _edges_distance(p, q)
+
+
+def _inside(x, poly) -> bool:
+    """Whether the point x is inside the convex polygon (counter-clockwise)."""
+    e = np.roll(poly, -1, axis=0) - poly
+    w = x - poly
+    return bool((e[:, 0] * w[:, 1] - e[:, 1] * w[:, 0] > 0).all())
 
 
 def _robot_shape(sim, i):
