@@ -281,13 +281,34 @@ def test_snapshot_writes_png_or_jpeg_by_extension_and_never_overwrites_unasked(t
     (["x.png", "--size", "99999x2"], "snapshot: image width must be an integer in 1..4096, got 99999"),
     (["x.png", "--size", "big"], "snapshot: size must be WIDTHxHEIGHT (e.g. 640x480), got 'big'"),
     (["x.jpg", "--quality", "0"], "snapshot: --quality must be in 1..100, got 0"),
-    (["x.png", "--steps", "-1"], "snapshot: --steps must be >= 0, got -1"),
+    (["x.png", "--steps", "-1"], "snapshot: --steps must be in 0..1000000, got -1"),
 ])
 def test_snapshot_bad_input_is_one_line_and_exit_1(tmp_path: Path, args: list[str], line: str) -> None:
     done = _snapshot(str(WORLD), str(tmp_path / args[0]), *args[1:])
     assert done.returncode == 1
     assert done.stderr.strip().splitlines() == [line.replace("{tmp}", str(tmp_path))]
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("args", "line"), [
+    # found by the hardening pass: each was a traceback, a message naming Python's int() or a check
+    # made only after the world was loaded
+    (["{tmp}/" + "a" * 300 + ".png"], "snapshot: {tmp}/" + "a" * 300 + ".png: File name too long"),
+    (["{tmp}/d.png"], "snapshot: {tmp}/d.png: is a directory; give the picture's file name"),
+    (["{tmp}/d.png", "--force"], "snapshot: {tmp}/d.png: is a directory; give the picture's file name"),
+    (["{tmp}/x.png", "--size", "\u00b2x2"], "snapshot: size must be WIDTHxHEIGHT (e.g. 640x480), got '\u00b2x2'"),
+    (["{tmp}/x.png", "--size", "1" * 5000 + "x2"], "snapshot: size must be WIDTHxHEIGHT (e.g. 640x480), got '"
+                                                    + "1" * 5000 + "x2'"),
+    (["{tmp}/x.png", "--steps", "1000001"], "snapshot: --steps must be in 0..1000000, got 1000001"),
+    (["{tmp}/x", "--size", "1x1"], "snapshot: {tmp}/x: the picture must end in .png, .jpg or .jpeg"),
+])
+def test_snapshot_odd_paths_sizes_and_steps_are_one_line(tmp_path: Path, capsys, args: list[str], line: str) -> None:
+    from sensorium.cli import main
+
+    (tmp_path / "d.png").mkdir()
+    assert main(["snapshot", str(WORLD), *(a.replace("{tmp}", str(tmp_path)) for a in args)]) == 1
+    assert capsys.readouterr().err.splitlines() == [line.replace("{tmp}", str(tmp_path))]
+    assert [p.name for p in tmp_path.iterdir()] == ["d.png"]
 
 
 def test_a_viewpoint_that_makes_no_picture_is_one_line(tmp_path: Path) -> None:

@@ -22,13 +22,18 @@ def snapshot(args: argparse.Namespace) -> int:
         width, height = viewshot.parse_size(args.size)
         if not 1 <= args.quality <= 100:
             raise ValueError(f"--quality must be in 1..100, got {args.quality}")
-        if args.steps < 0:
-            raise ValueError(f"--steps must be >= 0, got {args.steps}")
+        if not 0 <= args.steps <= viewshot.MAX_STEPS:
+            raise ValueError(f"--steps must be in 0..{viewshot.MAX_STEPS}, got {args.steps}")
     except ValueError as exc:
         print(f"snapshot: {exc}", file=sys.stderr)
         return 1
-    if out.exists() and not args.force:
-        print(f"snapshot: {out}: exists; not overwriting it (use --force)", file=sys.stderr)
+    try:
+        if out.is_dir():
+            raise IsADirectoryError(0, "is a directory; give the picture's file name")
+        if out.exists() and not args.force:
+            raise FileExistsError(0, "exists; not overwriting it (use --force)")
+    except OSError as exc:       # also a name too long for the file system, a folder we may not see
+        print(f"snapshot: {out}: {exc.strerror or exc}", file=sys.stderr)
         return 1
     try:
         loaded = load_world(args.world, **world_options(args))

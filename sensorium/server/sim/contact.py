@@ -86,6 +86,13 @@ class Obstacle:
     grown: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        pts = self.points
+        if len(pts) > 1:
+            # vertices that coincide (a footprint 1e-12 m thin turned and moved 1e5 m from the origin
+            # rounds two corners to one point): one of them, never an edge of no length or direction
+            same = (pts == np.roll(pts, -1, axis=0)).all(axis=1)
+            if same.any():
+                self.points = pts[:1] if same.all() else pts[~same]
         if self.normal is not None:
             self.lo = np.full(2, -math.inf)
             self.hi = np.full(2, math.inf)

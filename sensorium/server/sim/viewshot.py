@@ -25,6 +25,7 @@ are cut to the image before they are filled (a label costs at most about the ima
 from __future__ import annotations
 
 import math
+import re
 from collections import Counter
 from dataclasses import dataclass
 from typing import Any
@@ -44,6 +45,7 @@ EXPORT_SIZE = (640, 480)
 """The size of a Supervisor's ``exportImage`` (Webots': its 3D window's, which a server has not)."""
 MAX_SIDE = 4096
 MAX_PIXELS = 1 << 22
+MAX_STEPS = 1_000_000          # basic steps `sensorium snapshot` runs first, at most
 MAX_LABELS = 256
 MAX_TEXT = 1024
 MAX_LABEL_ID = 65534          # Webots: ids 0..65534, 65535 is its movie caption's
@@ -204,16 +206,20 @@ def draw_labels(rgb: np.ndarray, labels: Labels) -> np.ndarray:
     for _, lab in labels.items():
         k = label_scale(lab.size, h)
         x0, y0 = int(math.floor(lab.x * w)), int(math.floor(lab.y * h))
-        mask = np.zeros(h * w, dtype=bool)
+        if x0 >= w or y0 >= h:
+            continue
+        # the glyph pixels on the image, in glyph units, each then grown to its k x k square and the
+        # squares cut to the image: about the label's part of the picture in work, whatever k
+        nx, ny = -(-(w - x0) // k), -(-(h - y0) // k)
+        small = np.zeros((ny, nx), dtype=bool)
         for gx, gy in display.text_lines(lab.text):
-            px, py = x0 + k * gx, y0 + k * gy
-            on = (px < w) & (py < h)
-            px, py = px[on], py[on]
-            for dy in range(k):             # each glyph pixel's square, cut to the image
-                for dx in range(k):
-                    qx, qy = px + dx, py + dy
-                    keep = (qx < w) & (qy < h)
-                    mask[qy[keep] * w + qx[keep]] = True
+            on = (gx < nx) & (gy < ny)
+            small[gy[on], gx[on]] = True
+        if not small.any():
+            continue
+        mask2d = np.zeros((h, w), dtype=bool)
+        mask2d[y0:, x0:] = small.repeat(k, axis=0).repeat(k, axis=1)[: h - y0, : w - x0]
+        mask = mask2d.reshape(-1)
         if mask.any():
             opacity = 0xFF - int(lab.transparency * 0xFF)      # libController's transparency byte
             words[mask] = display._over(words[mask], lab.color, 0xFF, opacity)
@@ -241,7 +247,7 @@ def parse_size_values(width: Any, height: Any) -> tuple[int, int]:
 def parse_size(text: str) -> tuple[int, int]:
     """``"WxH"`` → (W, H), bounded as :func:`render` bounds them."""
     parts = str(text).lower().split("x")
-    if len(parts) != 2 or not all(p.strip().isdigit() for p in parts):
+    if len(parts) != 2 or not all(re.fullmatch(r"[0-9]{1,12}", p.strip()) for p in parts):
         raise ValueError(f"size must be WIDTHxHEIGHT (e.g. 640x480), got {text!r}")
     return parse_size_values(int(parts[0]), int(parts[1]))
 
@@ -280,8 +286,8 @@ def encode(rgb: np.ndarray, fmt: str, quality: int = 95) -> bytes:
 def snapshot(sim: Any, width: int, height: int, steps: int = 0) -> np.ndarray:
     """``sensorium snapshot``: ``steps`` basic steps of ``sim`` (its robots with no controller),
     then the Viewpoint's view."""
-    if isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= 1_000_000:
-        raise ValueError(f"steps must be an integer in 0..1000000, got {steps!r}")
+    if isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= MAX_STEPS:
+        raise ValueError(f"steps must be an integer in 0..{MAX_STEPS}, got {steps!r}")
     width, height = parse_size_values(width, height)
     viewpoint_of(sim)                 # a Viewpoint that makes no picture: said before any step
     for _ in range(steps):

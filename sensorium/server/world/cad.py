@@ -21,9 +21,11 @@ This module imports numpy, pycollada and trimesh only (the mesh worker loads it 
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -112,7 +114,9 @@ def read_dae(path: str, max_triangles: int | None = None) -> CadFile:
 
 @lru_cache(maxsize=8)
 def _read(path: str, kind: str, _mtime: int, cap: int) -> CadFile:
-    with warnings.catch_warnings():     # (pycollada builds numpy.matrix objects)
+    # (pycollada builds numpy.matrix objects; NaN or huge numbers in a file are refused below, not
+    # printed as numpy's RuntimeWarnings beside the one line)
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore", PendingDeprecationWarning)
         return _parse(path, cap) if kind == "dae" else _parse_obj(path, cap)
 
@@ -156,6 +160,8 @@ def _parse(path: str, cap: int) -> CadFile:
                 if triangles > cap:         # counted before each instance's vertices are placed
                     raise CadError(f"more than {cap:,} triangles in its scene, the world's limit "
                                    "(raise the limits with --allow-large)")
+                if _nan_positions(p):
+                    raise CadError(f"geometry {name!r}: non-finite vertex coordinates")
                 vertices = np.asarray(p.vertex, dtype=np.float64).reshape(-1, 3) @ turn.T
                 if faces.min() < 0 or faces.max() >= len(vertices):
                     raise CadError(f"geometry {name!r}: face indices outside its vertex list")
@@ -508,8 +514,24 @@ def _material(m) -> CadMaterial:
     return CadMaterial(m.id or "", diffuse, transparency, texture)  # type: ignore[arg-type]
 
 
+_NAN = re.compile(rb"nan", re.IGNORECASE)
+
+
+def _nan_positions(p: Any) -> bool:
+    """Whether a primitive's positions say NaN, which pycollada reads as 0 (silently moving the
+    vertex to the origin; assimp, Webots' reader, keeps it NaN)."""
+    for entry in getattr(p.original, "sources", {}).get("VERTEX", ()):
+        node = getattr(entry[4], "xmlnode", None)
+        for child in node if node is not None else ():
+            if str(child.tag).endswith("float_array") and child.text and _NAN.search(child.text.encode()):
+                return True
+    return False
+
+
 def _why(exc: BaseException) -> str:
     """An exception's message on one line, bounded (without pycollada's class name in front)."""
+    if isinstance(exc, RecursionError):
+        return "its elements are nested too deeply"
     text = " ".join(str(exc).split()) or type(exc).__name__
     for prefix in ("DaeMalformedError: ", "DaeIncompleteError: ", "CadError: ", "DaeBrokenRefError: "):
         text = text.removeprefix(prefix)

@@ -53,7 +53,7 @@ typedef struct {
 } reader;
 
 /* The next line into r->buf (without its end of line): 1, 0 at the end of the file, -1 after
- * printing why it cannot be read (too long, a NUL character). */
+ * printing why it cannot be read (too long, a NUL character, a read error: a folder opened). */
 static int read_line(reader *r) {
   int c, n = 0;
   bool nul = false;
@@ -65,6 +65,10 @@ static int read_line(reader *r) {
     }
     nul = nul || c == '\0';
     r->buf[n++] = (char)c;
+  }
+  if (c == EOF && ferror(r->f)) { /* a folder, a read error: what the Python client says for its OSError */
+    fprintf(stderr, "Error: " NEW "(): could not open '%s' file.\n", r->filename);
+    return -1;
   }
   if (c == EOF && n == 0)
     return 0;
