@@ -208,6 +208,19 @@ def test_a_box_robot_that_drove_head_on_into_a_wall_turns_away_and_drives_off():
     assert not sim.robot("r").pressing
 
 
+def test_a_turn_whose_end_is_past_a_thin_post_is_not_pushed_through_it():
+    # a 0.5 x 0.04 rod turning 0.5 rad in one step past a post (radius 0.01) 0.2 m out at 0.49 rad:
+    # at its end heading the rod lies 0.002 m past the post's centre, and the least push (0.018 m
+    # along the rod's normal) would leave the post behind it, the rod through it: refused, the turn
+    # is cut short before its face reaches the post (0.2 sin(0.49 - h) = 0.03)
+    post = np.array([0.2 * math.cos(0.49), 0.2 * math.sin(0.49), 0.25])
+    c = C.Contact([("post", geo.Cylinder(0.01, 0.5), Pose.identity(), Pose(np.eye(3), post), True)],
+                  [([(geo.Box((0.5, 0.04, 0.2)), Pose.identity())], Pose(np.eye(3), np.array([0.0, 0.0, 0.1])))])
+    p, clipped, kept = c.resolve(0, (0.0, 0.0), (0.0, 0.0), (0.0, 0.5))
+    assert clipped and (p == 0.0).all()
+    assert 0.0 < kept <= 0.49 - math.asin(0.15)
+
+
 def test_in_a_corner_a_push_into_the_other_wall_falls_back_to_the_cut_short_turn():
     # flush against two walls at once (y = -0.1 below, x = -0.2 behind): either way its turn puts a
     # corner into both, and a push off one leaves it in the other: the turn is cut short, as before
