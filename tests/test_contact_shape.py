@@ -208,6 +208,19 @@ def test_a_box_robot_that_drove_head_on_into_a_wall_turns_away_and_drives_off():
     assert not sim.robot("r").pressing
 
 
+def test_a_box_robot_turning_beside_another_is_pushed_off_it_and_the_other_stays():
+    # two 0.4 x 0.2 robots side by side, long sides touching (y = 0.1): the first turns a quarter in
+    # one step and is pushed 0.1 m off the second (its footprint now 0.4 tall, 0.2 wide); the second
+    # does not move (robots push nothing: the turning one gives way)
+    body = [(geo.Box((0.4, 0.2, 0.2)), Pose.identity())]
+    c = C.Contact([], [(body, Pose(np.eye(3), np.array([0.0, 0.0, 0.1]))),
+                       (body, Pose(np.eye(3), np.array([0.0, 0.2, 0.1])))])
+    p, clipped, kept = c.resolve(0, (0.0, 0.0), (0.0, 0.0), (0.0, math.pi / 2))
+    assert clipped and kept == math.pi / 2
+    assert p[0] == 0.0 and p[1] == pytest.approx(-0.1, abs=1e-9) and p[1] <= -0.1
+    assert (c.centres[1] == (0.0, 0.2)).all() and c.yaw[1] == 0.0
+
+
 def test_a_turn_whose_end_is_past_a_thin_post_is_not_pushed_through_it():
     # a 0.5 x 0.04 rod turning 0.5 rad in one step past a post (radius 0.01) 0.2 m out at 0.49 rad:
     # at its end heading the rod lies 0.002 m past the post's centre, and the least push (0.018 m
