@@ -114,26 +114,149 @@ def test_driving_head_on_into_a_wall_stops_with_the_front_face_touching(yaw):
     assert sim.counters["contacts"] > 0
 
 
-def test_a_turning_long_robot_turns_until_its_corner_touches_a_wall_and_can_turn_back():
-    # a wall 0.15 m from its centre line, along it: turning in place, a corner (0.25, ±0.1) reaches
-    # the wall's face at the heading t where 0.25 sin t + 0.1 cos t = 0.15; the turn is cut short
-    # there, to 2^-12 of a step's turn (contact.TURN_HALVINGS)
+PER_STEP = 0.1 * 2 * 1.0 / 0.3 * STEP / 1000      # wheels -1 and +1 rad/s: 0.0213 rad a step
+
+
+def test_a_long_robot_turning_beside_a_wall_is_pushed_off_it_and_turns_on():
+    # a wall 0.15 m from its centre line, along it: turning in place, its corner (0.25, 0.1) reaches
+    # 0.25 sin h + 0.1 cos h toward the wall at heading h; once that passes 0.15 the wall pushes the
+    # centre off along its normal (-y), the corner left on the face, and the turn goes on (as a
+    # Webots robot pivots off a wall), where it used to stop with the corner on the face
     wall = block("wall", -3.0, 3.0, 0.15, 0.35)
     sim = world([wall], [box_robot("r", 0.0, 0.0)])
-    t_touch = math.asin(0.15 / math.hypot(0.25, 0.1)) - math.atan2(0.1, 0.25)
-    per_step = 0.1 * 2 * 1.0 / 0.3 * STEP / 1000                      # wheels -1 and +1 rad/s: 0.0213 rad a step
     drive(sim, "r", -1.0, 1.0)
-    for _ in range(60):                                               # 1.28 rad asked for
+    for k in range(1, 51):                        # to 1.07 rad, short of the corner's farthest (1.19 rad)
         sim.step()
+        h = heading(sim, "r")
+        assert h == pytest.approx(k * PER_STEP, abs=1e-12)
+        x, y = xy(sim, "r")
+        assert abs(x) <= 1e-12
+        assert y == pytest.approx(min(0.0, 0.15 - (0.25 * math.sin(h) + 0.1 * math.cos(h))), abs=1e-9)
         assert float(corners(sim, "r")[:, 1].max()) <= 0.15 + 1e-9
-    h = heading(sim, "r")
-    assert t_touch - per_step * 2.0 ** -C.TURN_HALVINGS <= h <= t_touch
-    assert np.allclose(xy(sim, "r"), 0.0, atol=1e-12)                # turning in place: it stays put
-    assert sim.robot("r").pressing
-    drive(sim, "r", 1.0, -1.0)                                        # the other way: free
+    assert y < -0.1 and sim.robot("r").pressing
+    drive(sim, "r", 1.0, -1.0)                    # the other way: free, from where it was pushed
     sim.step()
-    assert heading(sim, "r") == pytest.approx(h - per_step, abs=1e-12)
+    assert heading(sim, "r") == pytest.approx(h - PER_STEP, abs=1e-12)
+    assert (xy(sim, "r") == (x, y)).all() and not sim.robot("r").pressing
+
+
+def _flush_contact(walls):
+    """A Contact of a 0.4 x 0.2 box robot at the origin, heading 0, among upright box ``walls``
+    ((x0, x1, y0, y1) each)."""
+    solids = [(f"w{i}", geo.Box((x1 - x0, y1 - y0, 0.5)), Pose.identity(),
+               Pose(np.eye(3), np.array([(x0 + x1) / 2, (y0 + y1) / 2, 0.25])), True)
+              for i, (x0, x1, y0, y1) in enumerate(walls)]
+    return C.Contact(solids, [([(geo.Box((0.4, 0.2, 0.2)), Pose.identity())], Pose(np.eye(3), np.array([0.0, 0.0, 0.1])))])
+
+
+def test_a_box_robot_flush_against_a_wall_turned_a_quarter_in_one_step_ends_half_its_length_off():
+    # its long side on the wall's face y = 0.1: the whole quarter turn is kept and the centre pushed
+    # along the face's normal until its short side touches the face: 0.2 (half its length) from it
+    c = _flush_contact([(-3.0, 3.0, 0.1, 0.3)])
+    for turn in (math.pi / 2, -math.pi / 2):
+        c.place(0, Pose(np.eye(3), np.array([0.0, 0.0, 0.1])), 0.0)
+        p, clipped, kept = c.resolve(0, (0.0, 0.0), (0.0, 0.0), (0.0, turn))
+        assert kept == turn and clipped
+        assert p[0] == 0.0 and 0.1 - p[1] == pytest.approx(0.2, abs=1e-9)
+    assert c.contacts == 2
+
+
+def test_a_box_robot_flush_against_a_wall_turning_a_quarter_stays_where_its_corner_pushed_it():
+    # the same robot in a simulation, the quarter turn in 25 steps: each step's push leaves its corner
+    # on the face, so the centre ends as far off as the corner reached at any step's heading h_k
+    # (0.2 sin h_k + 0.1 cos h_k: up to hypot(0.2, 0.1) at 63.4°); nothing pulls it back afterwards
+    sim = world([block("wall", -3.0, 3.0, 0.1, 0.3)], [box_robot("r", 0.0, 0.0, size=(0.4, 0.2))])
+    w = (math.pi / 2 / 25) / PER_STEP
+    drive(sim, "r", -w, w)
+    reach = 0.1
+    for _ in range(25):
+        sim.step()
+        h = heading(sim, "r")
+        reach = max(reach, 0.2 * math.sin(h) + 0.1 * math.cos(h))
+        assert 0.1 - xy(sim, "r")[1] == pytest.approx(reach, abs=1e-9)
+        assert float(corners(sim, "r", (0.4, 0.2))[:, 1].max()) <= 0.1 + 1e-9
+    assert h == pytest.approx(math.pi / 2, abs=1e-9)
+    assert reach == pytest.approx(max(0.2 * math.sin(k * math.pi / 50) + 0.1 * math.cos(k * math.pi / 50)
+                                      for k in range(26)), abs=1e-12)
+    assert abs(xy(sim, "r")[0]) <= 1e-12
+
+
+def test_a_box_robot_that_drove_head_on_into_a_wall_turns_away_and_drives_off():
+    # its front face stops on the wall x = 1; turning in place both front corners would go in, so
+    # it used to be held there for good; now the wall pushes it back (its centre 1 - (0.25 cos h +
+    # 0.1 |sin h|) at most) while it turns a quarter, and it drives off along the wall
+    sim = world([block("wall", 1.0, 1.2, -3.0, 3.0)], [box_robot("r", 0.0, 0.0)])
+    drive(sim, "r", 10.0)
+    for _ in range(40):
+        sim.step()
+    assert xy(sim, "r")[0] == pytest.approx(1.0 - LONG / 2, abs=1e-9)
+    drive(sim, "r", 1.0, -1.0)                     # clockwise
+    reach = LONG / 2
+    for k in range(1, 75):
+        sim.step()
+        h = heading(sim, "r")
+        assert h == pytest.approx(-k * PER_STEP, abs=1e-12)
+        reach = max(reach, 0.25 * math.cos(h) + 0.1 * abs(math.sin(h)))
+        x, y = xy(sim, "r")
+        assert x == pytest.approx(1.0 - reach, abs=1e-9) and abs(y) <= 1e-12
+        assert float(corners(sim, "r")[:, 0].max()) <= 1.0 + 1e-9
+    assert h < -math.pi / 2
+    drive(sim, "r", 10.0)                          # 32 mm a step, heading just past -90°
+    for _ in range(20):
+        sim.step()
+    assert xy(sim, "r") == pytest.approx((x + 20 * 0.032 * math.cos(h), y + 20 * 0.032 * math.sin(h)), abs=1e-9)
     assert not sim.robot("r").pressing
+
+
+def test_a_box_robot_turning_beside_another_is_pushed_off_it_and_the_other_stays():
+    # two 0.4 x 0.2 robots side by side, long sides touching (y = 0.1): the first turns a quarter in
+    # one step and is pushed 0.1 m off the second (its footprint now 0.4 tall, 0.2 wide); the second
+    # does not move (robots push nothing: the turning one gives way)
+    body = [(geo.Box((0.4, 0.2, 0.2)), Pose.identity())]
+    c = C.Contact([], [(body, Pose(np.eye(3), np.array([0.0, 0.0, 0.1]))),
+                       (body, Pose(np.eye(3), np.array([0.0, 0.2, 0.1])))])
+    p, clipped, kept = c.resolve(0, (0.0, 0.0), (0.0, 0.0), (0.0, math.pi / 2))
+    assert clipped and kept == math.pi / 2
+    assert p[0] == 0.0 and p[1] == pytest.approx(-0.1, abs=1e-9) and p[1] <= -0.1
+    assert (c.centres[1] == (0.0, 0.2)).all() and c.yaw[1] == 0.0
+
+
+def test_a_turn_whose_end_is_past_a_thin_post_is_not_pushed_through_it():
+    # a 0.5 x 0.04 rod turning 0.5 rad in one step past a post (radius 0.01) 0.2 m out at 0.49 rad:
+    # at its end heading the rod lies 0.002 m past the post's centre, and the least push (0.018 m
+    # along the rod's normal) would leave the post behind it, the rod through it: refused, the turn
+    # is cut short before its face reaches the post (0.2 sin(0.49 - h) = 0.03)
+    post = np.array([0.2 * math.cos(0.49), 0.2 * math.sin(0.49), 0.25])
+    c = C.Contact([("post", geo.Cylinder(0.01, 0.5), Pose.identity(), Pose(np.eye(3), post), True)],
+                  [([(geo.Box((0.5, 0.04, 0.2)), Pose.identity())], Pose(np.eye(3), np.array([0.0, 0.0, 0.1])))])
+    p, clipped, kept = c.resolve(0, (0.0, 0.0), (0.0, 0.0), (0.0, 0.5))
+    assert clipped and (p == 0.0).all()
+    assert 0.0 < kept <= 0.49 - math.asin(0.15)
+
+
+def test_in_a_corner_a_push_into_the_other_wall_falls_back_to_the_cut_short_turn():
+    # flush against two walls at once (y = -0.1 below, x = -0.2 behind): either way its turn puts a
+    # corner into both, and a push off one leaves it in the other: the turn is cut short, as before
+    corner = [block("s", -3.0, 3.0, -0.3, -0.1), block("w", -0.4, -0.2, -3.0, 3.0)]
+    sim = world(corner, [box_robot("r", 0.0, 0.0, size=(0.4, 0.2))])
+    for left, right in ((-1.0, 1.0), (1.0, -1.0)):
+        drive(sim, "r", left, right)
+        for _ in range(5):
+            sim.step()
+            assert heading(sim, "r") == 0.0 and (xy(sim, "r") == 0.0).all() and sim.robot("r").pressing
+    # a corridor 0.21 m wide: the first step's push off the wall below (0.0043 m) fits, the next
+    # would push it into the wall above (the footprint 0.4 sin h + 0.2 cos h across): cut short
+    sim = world([block("s", -3.0, 3.0, -0.3, -0.1), block("n", -3.0, 3.0, 0.11, 0.3)],
+                [box_robot("r", 0.0, 0.0, size=(0.4, 0.2))])
+    drive(sim, "r", -1.0, 1.0)
+    t = PER_STEP
+    for _ in range(6):
+        sim.step()
+        assert heading(sim, "r") == pytest.approx(t, abs=1e-12)
+        assert xy(sim, "r")[1] == pytest.approx(0.2 * math.sin(t) + 0.1 * math.cos(t) - 0.1, abs=1e-9)
+        assert sim.robot("r").pressing
+        c = corners(sim, "r", (0.4, 0.2))
+        assert float(c[:, 1].min()) >= -0.1 - 1e-9 and float(c[:, 1].max()) <= 0.11 + 1e-9
 
 
 def test_two_box_robots_meet_face_to_face_at_the_sum_of_their_half_lengths():
@@ -211,6 +334,61 @@ def test_the_batched_engine_clips_and_refuses_turns_as_the_single_simulation_bit
         held += int(np.count_nonzero((bs.yaw == yaw_before) & (bs.velocity[:, :, 0] != bs.velocity[:, :, 1])))
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
     assert held > 10
+
+
+def _flush_pen_world():
+    """Box robots lying flat against the walls of a 2 m pen and in its corner, and one head-on."""
+    walls = [block("n", -1.1, 1.1, 1.0, 1.1), block("s", -1.1, 1.1, -1.1, -1.0),
+             block("e", 1.0, 1.1, -1.0, 1.0), block("w", -1.1, -1.0, -1.0, 1.0)]
+    return parse_world({"world_info": {"basic_time_step": STEP},
+                        "solids": [{"name": "floor", "geometry": {"type": "plane", "size": None}}, *walls],
+                        "robots": [box_robot("a", 0.0, 1.0 - WIDE / 2), box_robot("b", 1.0 - LONG / 2, 0.0),
+                                   box_robot("c", -1.0 + LONG / 2, -1.0 + WIDE / 2)]})
+
+
+@pytest.mark.parametrize("native", [True, False])
+def test_the_batched_engine_pushes_turning_robots_off_walls_as_the_single_simulation_bit_for_bit(native, monkeypatch):
+    """Robots flush against walls, head-on and in a corner, spun and driven at random: the batched
+    engine (its C drive pass and its numpy path, whose broad phases grow a turning move by what its
+    push may need) keeps the single simulation's poses, pressing flags and contacts bit for bit."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.batched import BatchedSimulation
+    if native and packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    pushes = []
+    push = C.Contact._push
+
+    def counted(self, *args):
+        got = push(self, *args)
+        pushes.append(got is not None)
+        return got
+    monkeypatch.setattr(C.Contact, "_push", counted)
+    n = 3
+    bs = BatchedSimulation(_flush_pen_world(), n)
+    if not native:
+        bs._drive_step = None
+    bs.reset(np.arange(n), [1] * n)
+    singles = [Simulation(_flush_pen_world()) for _ in range(n)]
+    rng = np.random.default_rng(11)
+    for step in range(200):
+        if step % 20 == 0:
+            lr = rng.uniform(-12.0, 12.0, (3, n, 2))
+            if step == 0:                     # first spin in place, against the walls
+                lr[:, :, 1] = -lr[:, :, 0]
+            for r, name in enumerate("abc"):
+                bs.set_wheels(r, lr[r, :, 0], lr[r, :, 1])
+                for c in range(n):
+                    drive(singles[c], name, lr[r, c, 0], lr[r, c, 1])
+        bs.step()
+        for c, sim in enumerate(singles):
+            sim.step()
+            for r, name in enumerate("abc"):
+                pose = sim.robot(name).pose
+                assert bs.pos[c, r].tobytes() == pose.translation.tobytes(), (step, c, name)
+                assert bs.rot[c, r].tobytes() == pose.rotation.tobytes(), (step, c, name)
+                assert bool(bs.pressing[c, r]) == sim.robot(name).pressing, (step, c, name)
+    assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
+    assert pushes.count(True) > 20 and pushes.count(False) > 0
 
 
 def test_a_drive_whose_forward_is_the_robot_s_y_axis_stops_with_the_face_along_y():

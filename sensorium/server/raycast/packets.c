@@ -1524,6 +1524,7 @@ size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, in
  * addresses in a[], see DriveStep in packets.py): the live copies' robots stop pressing; their
  * wheels and drives (sp_drive_wheels); the moving robots' arcs (sp_arc_steps, from x, y, yaw
  * gathered) and their new yaws written; with contact, each move's reach hypot(end - start) + eps
+ * + spin[slot] * fmin(|yaw1 - yaw0|, 2) (a shaped robot's push off what its turn goes into)
  * (np.hypot is libm's hypot), the grown discs (grow: 0, then the movers' reach) and the broad phase
  * (sp_contact_near). When no move is near anything, the moves end where Contact._clip without
  * candidates puts them (start + (end - start); a robot without a footprint: at its end): centres,
@@ -1591,9 +1592,11 @@ size_t sp_drive_step(size_t L, const int64_t* live, size_t D, const int64_t* dri
     double* grow = a[28];     /* (C, R) */
     const double* foot_radius = a[29];
     double* centres = a[33];  /* (C, R, 2) */
+    const double* spin = a[41];   /* (R,): contact.spin_reach */
     memset(grow, 0, C * R * sizeof(double));
     for (size_t m = 0; m < k; m++) {
-      reach[m] = hypot(x1[m] - x0[m], y1[m] - y0[m]) + eps;
+      /* a shaped robot's turn may push it off what it turns into (Contact.resolve_all's reach) */
+      reach[m] = hypot(x1[m] - x0[m], y1[m] - y0[m]) + eps + spin[ms[m]] * fmin(fabs(yaw1[m] - yaw0[m]), 2.0);
       grow[(size_t)mc[m] * R + (size_t)ms[m]] = reach[m];
     }
     status[1] = (int64_t)sp_contact_near(k, R, S, mc, ms, starts, reach, foot_radius, a[30], a[31], a[32], centres,

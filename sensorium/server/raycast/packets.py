@@ -944,7 +944,11 @@ class DriveStep:
                 _check_buffer("drive_step", contact[name], np.float64, shape)
             _check_buffer("drive_step", contact["centres"], np.float64, (C, R, 2), writes=True)
             arrays += [contact[k] for k in ("foot_radius", "foot_low", "foot_high", "heights", "centres")]
-        self.ptrs = (ctypes.c_void_p * 41)(*(a.ctypes.data for a in arrays))
+            _check_buffer("drive_step", contact["spin"], np.float64, (R,))
+        # a[34..40]: the solids' arrays and the broad phase's outputs (run); a[41]: the spin reach
+        spin = contact["spin"] if contact is not None else self.reach
+        self.ptrs = (ctypes.c_void_p * 42)(*(a.ctypes.data for a in arrays), *([0] * (41 - len(arrays))),
+                                           spin.ctypes.data)
         self._solids: tuple = ()
         self.p_status = self.status.ctypes.data
         self.p_scatter = [a.ctypes.data for a in (self.copies, self.slots, self.rot, state["x"], state["y"],

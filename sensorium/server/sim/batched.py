@@ -75,6 +75,7 @@ from sensorium.server.sim.contact import (
     enu_pose,
     heading,
     shaped_obstacle,
+    spin_reach,
 )
 from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, support_ceiling
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, PlanarState, _rz
@@ -326,6 +327,7 @@ class BatchedSimulation:
             self.heights = np.zeros((C, R))
             self.foot_yaw = np.zeros((C, R))       # each footprint's heading (Contact.yaw)
             self._shaped = [f is not None and not f.disc for f in feet]
+            self.foot_spin = spin_reach(feet)      # a turn's push off what it turns into (Contact._spin)
             # a disc footprint's own radius (foot_radius, the broad phase's, may be wider)
             self.foot_disc = np.array([f.disc_radius if f is not None and f.disc else nan for f in feet])
         # -- devices: one template object per device (its constants); values per copy
@@ -767,7 +769,7 @@ class BatchedSimulation:
             contact = None
             if self.contact is not None:
                 contact = {"foot_radius": self.foot_radius, "foot_low": self.foot_low, "foot_high": self.foot_high,
-                           "heights": self.heights, "centres": self.centres}
+                           "heights": self.heights, "centres": self.centres, "spin": self.foot_spin}
             got = self._drive_step = packets.drive_step(
                 {"target": self.target, "velocity": self.velocity, "angle": self.wheel_angle,
                  "sides": self.side_wheels, "radius": self.wheel_radius, "axle": self.axle, "x": self.x, "y": self.y,
@@ -879,7 +881,9 @@ class BatchedSimulation:
         the end's). Returns the final xy and the moves whose turn was cut short (self.yaw written)."""
         ct = self.contact
         assert ct is not None
-        reach = np.hypot(*(ends - starts).T) + EPS
+        # (Contact.resolve_all's reach: a shaped robot's turn may push it off what it turns into)
+        reach = np.hypot(*(ends - starts).T) + EPS + self.foot_spin[slots] * np.minimum(
+            np.abs(self.yaw[copies, slots] - yaw0), 2.0)
         Rr = self.foot_radius[slots]
         # where every robot may be during this step: its disc, grown by its own move if it moves
         grow = np.zeros((self.copies, self.R))

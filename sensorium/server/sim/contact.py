@@ -27,8 +27,10 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   robots);
 * over one basic step a shaped robot first turns in place at its start, as far as the footprint
   sweeping through the turn overlaps nothing it did not already overlap, or deeper (the sweep
-  bounded in closed form, :meth:`Contact._turn_clear`; a turn cut short is found by halving, to
-  2^-12 of the step's turn, and counts as a contact), then its centre moves along the chord from
+  bounded in closed form, :meth:`Contact._turn_clear`); where the turn would go into something,
+  the whole turn is kept and the centre pushed off it the least distance, to touching
+  (:meth:`Contact._push`, closed form), unless that push meets something else: then the turn is
+  cut short, found by halving to 2^-12 of the step's turn (either counts as a contact); then its centre moves along the chord from
   its start to its end pose (poses are only observed at the end of steps, and the end point is
   the exact arc end unless contact clips it) at the heading it kept. The chord is tested against
   every obstacle near it (an AABB broad phase) in closed form — segment vs. offset edges and
@@ -43,8 +45,9 @@ On contact the robot stops at the contact point and the rest of its displacement
 the contact's tangent (slide), up to three times per step (corners). A robot pushed straight into
 a wall therefore stops at the contact distance; one meeting it obliquely keeps the tangential
 part of its motion, as a Webots robot rubbing along a wall does. A disc turns freely; a shaped
-robot can always back out along its heading (a move that goes no deeper is free) and turn the way
-that frees its corner. Deterministic: robots are resolved in world order, each against the others'
+robot can always back out along its heading (a move that goes no deeper is free), turn the way
+that frees its corner, and turn the other way pushed off the wall but in a corner or a corridor
+too narrow for the push. Deterministic: robots are resolved in world order, each against the others'
 current positions and headings. Float64 throughout.
 """
 
@@ -587,6 +590,13 @@ def shaped_obstacle(j: int, foot: Footprint, centre: np.ndarray, yaw: float, ban
     return Obstacle(f"robot {j}", int(j), _turned(foot.points, yaw) + centre[None, :], foot.round, band)
 
 
+def spin_reach(feet: list[Footprint | None]) -> np.ndarray:
+    """Per robot, what the broad phase grows a move by per radian of its turn (up to 2 rad): a
+    shaped footprint's radius (a turn by t moves no point of it farther than radius·min(|t|, 2),
+    so no push off what it turns into is longer, :meth:`Contact._push`), 0 for a disc or no footprint."""
+    return np.array([f.radius if f is not None and not f.disc else 0.0 for f in feet], dtype=np.float64)
+
+
 def _wrap(a: float) -> float:
     """``a`` in [-π, π), as the drives keep their heading (motion._wrap)."""
     return (a + math.pi) % (2.0 * math.pi) - math.pi
@@ -654,6 +664,16 @@ def _minkowski(a: list, b: list) -> list:
             else:
                 k += 1
     return out
+
+
+def _gap_normal(p: np.ndarray, ob: Obstacle, rho: float) -> tuple[float, np.ndarray]:
+    """:func:`_gap` and the outward unit normal of the nearest feature (inside: the shallowest
+    edge's, the way out of a convex set that is shortest)."""
+    if ob.normal is not None:
+        dist = float(ob.normal @ p) + ob.offset
+        return abs(dist) - rho, (1.0 if dist >= 0.0 else -1.0) * ob.normal
+    d, n = _closest_on_list(float(p[0]), float(p[1]), ob.points.tolist(), ob.edge_normals)
+    return d - (ob.radius + rho), n
 
 
 def _gap(p: np.ndarray, ob: Obstacle, rho: float) -> float:
@@ -740,6 +760,7 @@ class Contact:
                                              for (parts, pose), yaw in zip(robots, yaws)]
         nan = math.nan                            # robots without a footprint never match the broad phase
         self._radius = np.array([f.radius if f else nan for f in self.feet], dtype=np.float64)
+        self._spin = spin_reach(self.feet)
         self._z_low = np.array([f.z_low if f else nan for f in self.feet], dtype=np.float64)
         self._z_high = np.array([f.z_high if f else nan for f in self.feet], dtype=np.float64)
         starts = [enu_pose(p, to_enu).translation for _, p in robots]
@@ -807,10 +828,14 @@ class Contact:
         end of the step (None: headings kept). Returns (final xy, clipped, turned) per move: ``turned`` False when its turn
         was refused (its heading stays), which counts as clipped. One vectorised broad phase for
         all of them: a move (with its slides and its turn) never leaves the disc of radius
-        |end - start| + its footprint's radius around its start."""
+        |end - start| + its footprint's radius around its start, grown for a shaped robot by
+        its radius times min(|yaw1 - yaw0|, 2), the farthest its turn can push it
+        (:meth:`_push`, :func:`spin_reach`)."""
         k = len(indices)
         idx = np.asarray(indices, dtype=np.int64)
         reach = np.hypot(*(ends - starts).T) + EPS
+        if yaws is not None:             # a shaped robot's turn may push it off what it turns into
+            reach = reach + self._spin[idx] * np.minimum(np.abs(yaws[:, 1] - yaws[:, 0]), 2.0)
         R = self._radius[idx]
         box_lo = starts - (reach + R)[:, None]
         box_hi = starts + (reach + R)[:, None]
@@ -907,7 +932,9 @@ class Contact:
         short way): the turn first, in place at the start, as far as the footprint sweeping
         through it overlaps nothing it did not already (or deeper: :meth:`_turn_clear`), then the
         move at the heading it ends with, as :meth:`_clip` with each obstacle grown by the turned
-        footprint (:func:`_grown`). ``(end, clipped, heading)``: a turn cut short is clipped."""
+        footprint (:func:`_grown`); a turn that would go into something pushes the robot off it
+        instead where it can (:meth:`_push`). ``(end, clipped, heading)``: a turn cut short or
+        pushed is clipped."""
         assert foot.points is not None
         if not cands:
             return p + d, False, yaw1
@@ -917,6 +944,15 @@ class Contact:
             here = _turned(foot.points, yaw)
             now = [_gap(p, *_grown(ob, here, foot.round, p)) for ob in cands]
             if not self._turn_clear(foot, p, yaw, turn, cands, now):
+                pushed = self._push(foot, p, yaw, yaw1, turn, cands, now)
+                if pushed is not None:
+                    # the whole turn, the centre pushed off what the footprint turned into, then the
+                    # move from there (the push is a contact: clipped, the drive's x, y written back)
+                    shape = _turned(foot.points, yaw1)
+                    end, clipped = self._sweep(pushed, d, [_grown(ob, shape, foot.round, pushed) for ob in cands])
+                    if not clipped:
+                        self.contacts += 1
+                    return end, True, yaw1
                 # the largest part of the turn that is clear (none is), halving; a robot already
                 # touching where it turns (pressed on) is told by its first step, 2^-12 of the turn
                 lo, hi = 0.0, 1.0
@@ -934,6 +970,56 @@ class Contact:
         if kept != yaw1 and not clipped:
             self.contacts += 1
         return end, clipped or kept != yaw1, kept
+
+    def _push(self, foot: Footprint, p: np.ndarray, yaw: float, yaw1: float, turn: float,
+              cands: list[Obstacle], now: list[float]) -> np.ndarray | None:
+        """Where rigid contact pushes the robot's centre when the whole turn from ``yaw`` to ``yaw1``
+        at ``p`` would put its footprint into a candidate (``now``: each one's signed distance at
+        ``yaw``), or None: the least move, out of the candidate it would go deepest into, along
+        the outward normal of the nearest feature of that candidate grown by the turned footprint
+        (:func:`_grown`, convex: the distance out is exact), to where the turned footprint touches
+        it (no deeper than at ``yaw`` if it overlapped already). Refused (None: the turn is cut
+        short as before) when the turn sweeps into any other candidate (:meth:`_turn_clear`), the
+        push goes back toward the side the robot came from, is longer than any footprint point
+        moved in the turn (``foot.radius`` times min(|turn|, 2): what the broad phase grew the move
+        by), or its path or end meets another candidate (deeper than it already was). Each
+        candidate the turn goes into is tried in turn, the deepest first: a wall of several
+        blocks pushes the robot off all of them at once, a corner of two walls does not."""
+        assert foot.points is not None
+        shape = _turned(foot.points, yaw1)
+        grown = [_grown(ob, shape, foot.round, p) for ob in cands]
+        pushes = []
+        for i, (g, before) in enumerate(zip(grown, now)):
+            self.checks += 1
+            gap, normal = _gap_normal(p, *g)
+            target = min(before, 0.0)
+            if gap < target - EPS:
+                pushes.append((target - gap, i, normal))
+        if not pushes:
+            return None
+        into = {i for _, i, _ in pushes}
+        rest = [j for j in range(len(cands)) if j not in into]
+        if rest and not self._turn_clear(foot, p, yaw, turn, [cands[j] for j in rest], [now[j] for j in rest]):
+            return None
+        limit = foot.radius * min(abs(turn), 2.0)
+        here = _turned(foot.points, yaw)
+        for dist, i, normal in sorted(pushes, key=lambda t: (-t[0], t[1])):
+            if dist > limit:
+                continue
+            _, back = _gap_normal(p, *_grown(cands[i], here, foot.round, p))
+            if float(normal @ back) <= 0.0:
+                continue
+            step = (dist + BACK_OFF) * normal
+            q = p + step
+            ok = True
+            for j, (g, before) in enumerate(zip(grown, now)):
+                self.checks += 1
+                if _gap(q, *g) < min(before, 0.0) - EPS or (j != i and time_of_impact(p, step, *g)[1] is not None):
+                    ok = False
+                    break
+            if ok:
+                return q
+        return None
 
     @staticmethod
     def _turn_may_meet(foot: Footprint, p: np.ndarray, turn: float, cands: list[Obstacle]) -> bool:
