@@ -323,3 +323,18 @@ def test_each_bundled_world_is_pictured_from_a_viewpoint_that_looks_down_at_it(n
     sky = viewshot.shading.to_bytes(viewshot.shading.tone_map(sim.scene.background.reshape(1, 3), 1.0))[0]
     middle = rgb[12:24, 16:32].reshape(-1, 3)
     assert np.mean(np.all(middle == sky, axis=1)) < 0.05, f"{name}: sky in the middle of the picture"
+
+
+def test_snapshot_of_a_world_without_a_viewpoint_says_so_in_one_line(tmp_path: Path) -> None:
+    """Webots' default Viewpoint stands at ground level 10 m away: a world without one of its own
+    (most hand-written YAML worlds) gave a black picture and no hint why."""
+    world = tmp_path / "w.yaml"
+    world.write_text("solids:\n  - {name: floor, geometry: {type: plane, size: [2.0, 2.0]}}\n")
+    done = _snapshot(str(world), str(tmp_path / "x.png"))
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.strip().splitlines() == [
+        f"snapshot: {world}: no Viewpoint placed: Webots' default one, at (-10, 0, 0) looking along +x at ground level, "
+        "which may show little; list one in the world (README 'World files')"]
+    assert (tmp_path / "x.png").exists()
+    done = _snapshot(str(WORLD), str(tmp_path / "y.png"))          # a world with its own: no such line
+    assert done.returncode == 0 and "Viewpoint" not in done.stderr, done.stderr
