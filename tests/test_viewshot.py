@@ -319,3 +319,43 @@ def test_a_viewpoint_that_makes_no_picture_is_one_line(tmp_path: Path) -> None:
     assert done.stderr.strip().splitlines()[-1] == (
         f"snapshot: {world}: Viewpoint fieldOfView must be in (0, pi) for a picture, got 3.5")
     assert not (tmp_path / "x.png").exists()
+
+
+BUNDLED = sorted(p.name for p in (REPO / "sensorium" / "worlds").iterdir() if p.suffix in (".yaml", ".wbt"))
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_each_bundled_world_is_pictured_from_a_viewpoint_that_looks_down_at_it(name: str) -> None:
+    """A bundled world's Viewpoint looks down at the world: its optical axis (the pose's x) meets
+    the ground z = 0 within 1 m of the box the solids' and robots' positions span, and the middle
+    third of a picture is (nearly) all geometry, not sky. Webots' default Viewpoint ((-10, 0, 0) looking along +x),
+    which the worlds without one had, showed a black picture with a speck or a wall edge-on."""
+    sim = Simulation.from_file(REPO / "sensorium" / "worlds" / name)
+    pose = viewshot.viewpoint_of(sim).pose()
+    rot = pose.rotation
+    eye, axis = np.asarray(pose.translation, float), rot[:, 0]
+    assert axis[2] < 0.0, f"{name}: the Viewpoint looks up or level ({axis})"
+    ground = eye + axis * (-eye[2] / axis[2])
+    xy = np.array([s.pose.translation[:2] for s in sim.world.solids]
+                  + [r.pose.translation[:2] for r in sim.world.robots])
+    lo, hi = xy.min(axis=0) - 1.0, xy.max(axis=0) + 1.0
+    assert np.all(lo <= ground[:2]) and np.all(ground[:2] <= hi), (name, ground, lo, hi)
+    rgb = viewshot.render(sim, 48, 36)
+    sky = viewshot.shading.to_bytes(viewshot.shading.tone_map(sim.scene.background.reshape(1, 3), 1.0))[0]
+    middle = rgb[12:24, 16:32].reshape(-1, 3)
+    assert np.mean(np.all(middle == sky, axis=1)) < 0.05, f"{name}: sky in the middle of the picture"
+
+
+def test_snapshot_of_a_world_without_a_viewpoint_says_so_in_one_line(tmp_path: Path) -> None:
+    """Webots' default Viewpoint stands at ground level 10 m away: a world without one of its own
+    (most hand-written YAML worlds) gave a black picture and no hint why."""
+    world = tmp_path / "w.yaml"
+    world.write_text("solids:\n  - {name: floor, geometry: {type: plane, size: [2.0, 2.0]}}\n")
+    done = _snapshot(str(world), str(tmp_path / "x.png"))
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.strip().splitlines() == [
+        f"snapshot: {world}: no Viewpoint placed: Webots' default one, at (-10, 0, 0) looking along +x at ground level, "
+        "which may show little; list one in the world (README 'World files')"]
+    assert (tmp_path / "x.png").exists()
+    done = _snapshot(str(WORLD), str(tmp_path / "y.png"))          # a world with its own: no such line
+    assert done.returncode == 0 and "Viewpoint" not in done.stderr, done.stderr

@@ -42,7 +42,11 @@ def snapshot(args: argparse.Namespace) -> int:
         return 1
     print_report(loaded)
     try:
-        rgb = viewshot.snapshot(Simulation(loaded), width, height, args.steps)
+        sim = Simulation(loaded)
+        if not viewshot.placed_viewpoint(sim):
+            print(f"snapshot: {args.world}: no Viewpoint placed: Webots' default one, at (-10, 0, 0) looking along +x at "
+                  "ground level, which may show little; list one in the world (README 'World files')", file=sys.stderr)
+        rgb = viewshot.snapshot(sim, width, height, args.steps)
         data = viewshot.encode(rgb, fmt, args.quality)
     except ValueError as exc:
         print(f"snapshot: {args.world}: {exc}", file=sys.stderr)

@@ -38,8 +38,8 @@ from sensorium.server.sim.cameras import Camera, MountedRays
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["EXPORT_SIZE", "MAX_PIXELS", "MAX_SIDE", "MAX_LABELS", "MAX_TEXT", "MAX_LABEL_ID", "Label", "Labels",
-           "Viewpoint", "viewpoint_of", "render", "draw_labels", "picture", "parse_size", "FORMATS", "image_format",
-           "encode", "snapshot"]
+           "Viewpoint", "placed_viewpoint", "viewpoint_of", "render", "draw_labels", "picture", "parse_size", "FORMATS",
+           "image_format", "encode", "snapshot"]
 
 EXPORT_SIZE = (640, 480)
 """The size of a Supervisor's ``exportImage`` (Webots': its 3D window's, which a server has not)."""
@@ -65,6 +65,15 @@ class Viewpoint:
     def pose(self) -> Pose:
         ax = self.orientation
         return Pose.from_axis_angle(ax[:3], ax[3], self.position)
+
+
+def placed_viewpoint(sim: Any) -> bool:
+    """Whether the world's Viewpoint has a position or orientation written (a world without one
+    gets Webots' default node, empty, as Webots adds it; :func:`viewpoint_of` then looks from
+    (-10, 0, 0) along +x)."""
+    layout = getattr(sim, "top_level", None)
+    return any(s.type == "Viewpoint" and ("position" in s.fields or "orientation" in s.fields)
+               for s in (layout.scenery if layout is not None else ()))
 
 
 def viewpoint_of(sim: Any) -> Viewpoint:
