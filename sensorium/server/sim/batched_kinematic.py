@@ -391,7 +391,7 @@ class KinematicDevices:
                                     for p in robot.shapes
                                     if p.of_device == d.name and p.seen_by in ("both", "bounding")])
         self.bumper_pieces: dict[int, list] = {}
-        self.bumper_reach: dict[int, np.ndarray] = {}    # per piece its disc (_bumper_shapes)
+        self.bumper_discs: dict[int, np.ndarray] = {}    # per piece its disc (_bumper_shapes)
         self.bumper_hulls: dict[int, list] = {}          # per piece its points and axes (_bumper_shapes)
         self._solid_cache: dict[int, tuple] = {}         # a solid's hull (_solid_hull)
         self.robot_hulls: dict[int, tuple] = {}          # a shaped robot's footprint hull, own frame
@@ -615,7 +615,7 @@ class KinematicDevices:
         at the end of the step (contact.pieces_touch, from the copy's contact state as the single
         simulation's Contact keeps it), else 0. Shaped bumpers go through a broad phase on every
         due copy at once (:meth:`_bumper_near`), and pieces_touch runs only on the pieces and
-        obstacles it leaves: the others are out of the reach pieces_touch's own screens allow, so
+        obstacles it leaves: the others are farther apart than pieces_touch could find touching, so
         the answer is that of pieces_touch on them all."""
         sim = self.sim
         slots = self.slot["TouchSensor"][cols]
@@ -649,9 +649,9 @@ class KinematicDevices:
                 radius = float(np.max(np.hypot(*(piece.points - centre).T))) + piece.round
                 discs.append((float(centre[0]), float(centre[1]), radius, piece.z_low, piece.z_high))
                 hulls.append((piece.points[:, 0].copy(), piece.points[:, 1].copy(), *_axes(piece.points)))
-            self.bumper_reach[col] = np.array(discs, dtype=np.float64).reshape(-1, 5)
+            self.bumper_discs[col] = np.array(discs, dtype=np.float64).reshape(-1, 5)
             self.bumper_hulls[col] = hulls
-        return pieces, self.bumper_reach[col], self.bumper_hulls[col]
+        return pieces, self.bumper_discs[col], self.bumper_hulls[col]
 
     def _solid_hull(self, ob: Obstacle) -> tuple:
         """A solid's hull as :func:`_placed` gives it (one row), kept while the solid's obstacle is
