@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
+from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.contact import pieces_touch
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
 from tests.test_batched_kinematic import native  # noqa: F401  (the fixture: C helper and math paths)
@@ -157,6 +159,103 @@ def test_bumpers_with_their_own_shapes_read_in_every_copy_as_the_single_simulati
             left, right = (s.robot("a").device(n).value for n in ("left", "right"))
             seen["one_side"] += left != right and not (math.isnan(left) or math.isnan(right))
     assert seen["pressed"] > 100 and seen["free"] > 1000 and seen["one_side"] > 20, seen
+
+
+def _placed_shaped(copies: int) -> tuple[BatchedSimulation, np.ndarray]:
+    """shaped_bumpers.yaml in ``copies`` copies with its shaped bumpers enabled every step, and
+    their columns."""
+    bs = BatchedSimulation(load_world(SHAPED), copies)
+    bs.reset(np.arange(copies), list(range(copies)))
+    for robot, names in SHAPED_PERIODS.items():
+        for n in names:
+            bs.enable(bs.device(robot, n), 16)
+    k = bs.kinematic
+    cols = np.array([col for col in range(len(k.bumper_own)) if k.bumper_own[col]])
+    return bs, cols
+
+
+def _touch_everything(bs: BatchedSimulation, c: int, col: int) -> float:
+    """contact.pieces_touch of bumper ``col`` of copy ``c`` on every solid and every other robot."""
+    k = bs.kinematic
+    r = int(k.slot["TouchSensor"][col])
+    pieces, _, _ = k._bumper_shapes(col)
+    robots = [k._robot_obstacle(c, j) for j, f in enumerate(bs.feet) if f is not None and j != r]
+    return 1.0 if pieces_touch(pieces, bs.centres[c, r], float(bs.foot_yaw[c, r]), float(bs.heights[c, r]),
+                               bs.contact._obs, robots) else 0.0
+
+
+def test_shaped_bumpers_read_what_every_pair_would_at_gaps_about_the_tolerance():
+    """Robot a's left bumper put 0, 0.5e-6, 0.99e-6, 1.01e-6, 2e-6, 1e-3 m and 0.05 m (and 1e-6 m
+    into it) from the east wall, turned, and the box robot b's bar as far from robot a, in 512
+    copies: every shaped bumper of every copy reads what contact.pieces_touch gives on every solid
+    and robot of its copy (the broad phase drops no touching pair), and the left bumper reads 1 up
+    to the 1e-6 m tolerance and 0 beyond."""
+    bs, cols = _placed_shaped(512)
+    rng = np.random.default_rng(9)
+    gaps = np.array([-1e-6, 0.0, 0.5e-6, 0.99e-6, 1.01e-6, 2e-6, 1e-3, 0.05])
+    a, b = bs.slot("a"), bs.slot("b")
+    left = next(col for col in cols.tolist() if int(bs.kinematic.slot["TouchSensor"][col]) == a
+                and bs.kinematic.bumper_own[col][0][1].translation[1] > 0.0)
+    pieces, _, _ = bs.kinematic._bumper_shapes(left)
+    east = 0.85                                     # the east wall's west face (x = 0.9 - 0.05)
+    want_left = np.full(512, np.nan)
+    for c in range(512):
+        yaw = float(rng.uniform(-0.6, 0.2))
+        shape = pieces[0].points @ np.array([[math.cos(yaw), math.sin(yaw)], [-math.sin(yaw), math.cos(yaw)]])
+        reach = float(np.max(shape[:, 0])) + pieces[0].round
+        gap = float(gaps[c % len(gaps)])
+        bs.centres[c, a] = [east - reach - gap, float(rng.uniform(-0.3, 0.3))]
+        bs.foot_yaw[c, a] = yaw
+        # robot b: its bar's front toward robot a's body in some copies, elsewhere far off
+        bs.centres[c, b] = [float(rng.uniform(-0.6, 0.2)), float(rng.uniform(-0.6, 0.6))]
+        bs.foot_yaw[c, b] = float(rng.uniform(-math.pi, math.pi))
+        if abs(gap) < 1e-3:
+            want_left[c] = 1.0 if gap <= 1e-6 - 1e-9 else (0.0 if gap >= 1e-6 + 1e-9 else np.nan)
+        elif gap > 2e-6:
+            want_left[c] = np.nan                     # robot b may touch it: no closed form
+    copies = np.repeat(np.arange(512), len(cols))
+    got = bs.kinematic._bumper(copies, np.tile(cols, 512)).reshape(512, len(cols))
+    for c in range(512):
+        for m, col in enumerate(cols.tolist()):
+            assert got[c, m] == _touch_everything(bs, c, col), (c, col)
+    m = cols.tolist().index(left)
+    sure = ~np.isnan(want_left)
+    assert np.array_equal(got[sure, m], want_left[sure])
+    assert got[:, :].sum() > 100 and (got == 0.0).sum() > 1000
+
+
+def test_shaped_bumpers_test_closely_only_the_copies_near_something(monkeypatch):
+    """64 copies with every robot in the middle of the arena, far from the walls, the ball and one
+    another, but copy 5's robot a turned 0.3 rad left with its right bumper (then its foremost) on
+    the east wall: only copy 5's bumpers run contact.pieces_touch (the others are out of reach in
+    the broad phase); its right bumper reads 1, every other 0."""
+    bs, cols = _placed_shaped(64)
+    a, b, c_ = bs.slot("a"), bs.slot("b"), bs.slot("c")
+    bs.centres[:, a] = [-0.35, 0.0]
+    bs.centres[:, b] = [0.35, 0.0]
+    bs.centres[:, c_] = [0.0, 0.4]
+    bs.foot_yaw[:, [a, b, c_]] = 0.0
+    k = bs.kinematic
+    right = next(col for col in cols.tolist() if int(k.slot["TouchSensor"][col]) == a
+                 and k.bumper_own[col][0][1].translation[1] < 0.0)
+    pieces, _, _ = k._bumper_shapes(right)
+    yaw = 0.3
+    shape = pieces[0].points @ np.array([[math.cos(yaw), math.sin(yaw)], [-math.sin(yaw), math.cos(yaw)]])
+    bs.centres[5, a] = [0.85 - float(np.max(shape[:, 0])) - pieces[0].round, 0.0]
+    bs.foot_yaw[5, a] = yaw
+    seen: list = []
+    real = kin.pieces_touch
+
+    def counted(pieces, centre, *rest):
+        seen.append(centre.tobytes())
+        return real(pieces, centre, *rest)
+    monkeypatch.setattr(kin, "pieces_touch", counted)
+    copies = np.repeat(np.arange(64), len(cols))
+    got = k._bumper(copies, np.tile(cols, 64)).reshape(64, len(cols))
+    assert seen and set(seen) == {bs.centres[5, a].tobytes()}
+    want = np.zeros((64, len(cols)))
+    want[5, cols.tolist().index(right)] = 1.0
+    assert np.array_equal(got, want), got[5]
 
 
 def _walled(z: float = 0.05, wgs84: bool = False) -> wm.World:

@@ -49,7 +49,7 @@ from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.raycast import packets
-from sensorium.server.sim.contact import TOUCH, Obstacle, device_pieces, pieces_touch, shaped_obstacle
+from sensorium.server.sim.contact import EPS, FLOOR, TOUCH, Obstacle, device_pieces, pieces_touch, shaped_obstacle
 from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.sim.sensors import (
     GPS,
@@ -76,6 +76,9 @@ SHAPES = {k: (3,) for k in ("GPS", "Compass", "InertialUnit", "Gyro", "Accelerom
 """The shape of one device's value (``BatchedSimulation.values[kind]`` is (copies, devices, *shape)):
 a GPS's position, a compass's north vector, an inertial unit's roll, pitch, yaw, a gyro's angular
 velocity, an accelerometer's specific force; a bumper's and an altimeter's value is one number."""
+# m: a shaped bumper's broad phase (_bumper_near) keeps pairs this much farther apart than pieces_touch
+# could find touching, far above the rounding of placing a piece two ways (turned points, turned disc)
+_SLACK = 1e-7
 READINGS = {"GPS": ("values", "speed", "speed_vector"), "Compass": ("values",),
             "InertialUnit": ("roll_pitch_yaw", "quaternion"), "Gyro": ("values",), "Accelerometer": ("values",),
             "TouchSensor": ("value",), "Altimeter": ("value",)}
@@ -286,6 +289,43 @@ def angular_velocities(r0: np.ndarray, r1: np.ndarray, dt_s: float, native: bool
     return np.where(small[:, None], v / 2.0 / dt_s, turned)
 
 
+def _axes(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A convex hull's (counter-clockwise points, as contact keeps them) edges' outward unit normals
+    (k, 2) and its support along each, ``max(points @ normal)`` (k,); none for a single point (a
+    hull of two points: the segment's two normals)."""
+    if len(points) < 2:
+        return np.zeros((0, 2)), np.zeros(0)
+    d = np.roll(points, -1, axis=0) - points
+    length = np.hypot(d[:, 0], d[:, 1])
+    keep = length > 0.0
+    normals = np.stack([d[keep, 1], -d[keep, 0]], axis=1) / length[keep, None]
+    return normals, np.max(points @ normals.T, axis=0)
+
+
+def _placed(hull: tuple, cx: np.ndarray, cy: np.ndarray, c: np.ndarray, s: np.ndarray) -> tuple:
+    """A hull (its points' x, y, :func:`_axes`' normals and supports, in its own frame) turned by
+    (cos, sin) = (``c``, ``s``) and moved to (``cx``, ``cy``), one row per copy: points' x, y
+    (n, V), normals' x, y and supports (n, F)."""
+    vx, vy, normals, support = hull
+    c, s, cx, cy = c[:, None], s[:, None], cx[:, None], cy[:, None]
+    mx = c * normals[None, :, 0] - s * normals[None, :, 1]
+    my = s * normals[None, :, 0] + c * normals[None, :, 1]
+    return (cx + (c * vx[None, :] - s * vy[None, :]), cy + (s * vx[None, :] + c * vy[None, :]),
+            mx, my, mx * cx + my * cy + support[None, :])
+
+
+def _hull_gap(a: tuple, b: tuple) -> np.ndarray:
+    """A lower bound of the distance between two convex hulls placed per copy (:func:`_placed`, or
+    with one row for all copies): the widest gap between their projections on an edge normal of
+    either (0 or less where they overlap on every one; -inf with no normals)."""
+    gap = -math.inf
+    for (x, y, _, _, _), (_, _, mx, my, sup) in ((a, b), (b, a)):
+        if mx.shape[1] and x.shape[1]:
+            proj = x[:, :, None] * mx[:, None, :] + y[:, :, None] * my[:, None, :]
+            gap = np.maximum(gap, np.max(np.min(proj, axis=1) - sup, axis=1))
+    return np.asarray(gap)
+
+
 class KinematicDevices:
     """The GPS, Compass, InertialUnit, Gyro, Accelerometer, TouchSensor and Altimeter devices of a
     batched simulation: their
@@ -351,7 +391,10 @@ class KinematicDevices:
                                     for p in robot.shapes
                                     if p.of_device == d.name and p.seen_by in ("both", "bounding")])
         self.bumper_pieces: dict[int, list] = {}
-        self.bumper_reach: dict[int, float] = {}
+        self.bumper_discs: dict[int, np.ndarray] = {}    # per piece its disc (_bumper_shapes)
+        self.bumper_hulls: dict[int, list] = {}          # per piece its points and axes (_bumper_shapes)
+        self._solid_cache: dict[int, tuple] = {}         # a solid's hull (_solid_hull)
+        self.robot_hulls: dict[int, tuple] = {}          # a shaped robot's footprint hull, own frame
         self.enable_rot = {k: np.zeros((C, len(self.devices[k]), 3, 3)) for k in MOTION}
         self.enable_pos = {k: np.zeros((C, len(self.devices[k]), 3)) for k in MOTION}
 
@@ -570,43 +613,145 @@ class KinematicDevices:
         robot pushed against something in this step (kinematic contact clipped its move:
         ``pressing``); one with shapes reads 1 where they touch a solid or another robot of its copy
         at the end of the step (contact.pieces_touch, from the copy's contact state as the single
-        simulation's Contact keeps it), else 0."""
+        simulation's Contact keeps it), else 0. Shaped bumpers go through a broad phase on every
+        due copy at once (:meth:`_bumper_near`), and pieces_touch runs only on the pieces and
+        obstacles it leaves: the others are farther apart than pieces_touch could find touching, so
+        the answer is that of pieces_touch on them all."""
         sim = self.sim
         slots = self.slot["TouchSensor"][cols]
         out = np.where(sim.pressing[copies, slots], 1.0, 0.0)
-        shaped = [m for m, col in enumerate(cols.tolist()) if self.bumper_own[col]]
-        for m in shaped:
-            out[m] = 0.0 if sim.contact is None else self._bumper_touch(int(copies[m]), int(cols[m]))
+        has = np.fromiter((bool(self.bumper_own[col]) for col in cols.tolist()), dtype=bool, count=len(cols))
+        if not has.any():
+            return out
+        if sim.contact is None:
+            out[has] = 0.0
+            return out
+        for col in np.unique(cols[has]).tolist():
+            rows = (cols == col).nonzero()[0]
+            out[rows] = self._bumper_near(copies[rows], int(col))
         return out
 
-    def _bumper_touch(self, c: int, col: int) -> float:
+    def _bumper_shapes(self, col: int) -> tuple[list, np.ndarray, list]:
+        """Bumper ``col``'s pieces (contact.device_pieces, made when first due), per piece a disc in
+        the footprint's frame holding it with its rounding: (centre x, centre y, radius, z_low,
+        z_high) rows, and per piece its points' x and y, its edges' outward unit normals and its
+        support along each (:func:`_axes`), as :func:`_placed` takes them."""
         sim = self.sim
-        r = int(self.slot["TouchSensor"][col])
         pieces = self.bumper_pieces.get(col)
         if pieces is None:
+            r = int(self.slot["TouchSensor"][col])
             tpl = sim._templates[r]
             pieces = self.bumper_pieces[col] = device_pieces(self.bumper_own[col], sim.initial[r], sim.to_enu,
                                                              None if tpl is None else tpl.yaw)
-        reach = self.bumper_reach.get(col)
-        if reach is None:     # the disc about the robot's origin holding every piece at any heading
-            reach = self.bumper_reach[col] = max((float(np.max(np.hypot(p.points[:, 0], p.points[:, 1]))) + p.round
-                                                  for p in pieces if p.points is not None), default=0.0)
-        robots = []
-        cx, cy = sim.centres[c, r].tolist()
-        for j, foot in enumerate(sim.feet):
-            if foot is None or j == r:
+            discs, hulls = [], []
+            for piece in pieces:
+                centre = (piece.points.min(axis=0) + piece.points.max(axis=0)) / 2.0
+                radius = float(np.max(np.hypot(*(piece.points - centre).T))) + piece.round
+                discs.append((float(centre[0]), float(centre[1]), radius, piece.z_low, piece.z_high))
+                hulls.append((piece.points[:, 0].copy(), piece.points[:, 1].copy(), *_axes(piece.points)))
+            self.bumper_discs[col] = np.array(discs, dtype=np.float64).reshape(-1, 5)
+            self.bumper_hulls[col] = hulls
+        return pieces, self.bumper_discs[col], self.bumper_hulls[col]
+
+    def _solid_hull(self, ob: Obstacle) -> tuple:
+        """A solid's hull as :func:`_placed` gives it (one row), kept while the solid's obstacle is
+        the same object (moving a solid makes a new one)."""
+        got = self._solid_cache.get(id(ob))
+        if got is None or got[0] is not ob:
+            one, zero = np.ones(1), np.zeros(1)
+            hull = (ob.points[:, 0].copy(), ob.points[:, 1].copy(), *_axes(ob.points))
+            got = self._solid_cache[id(ob)] = (ob, _placed(hull, zero, zero, one, zero))
+        return got[1]
+
+    def _bumper_near(self, copies: np.ndarray, col: int) -> np.ndarray:
+        """Shaped bumper ``col`` in ``copies``: 1.0 where contact.pieces_touch says its pieces touch.
+        The broad phase, on all copies at once: each piece (turned and moved with its robot) against
+        every solid and every other robot of its copy, with pieces_touch's height-band test and a
+        lower bound of their distance -- the piece's disc against the solid's box, a wall line or
+        the robot's disc, and for a solid the widest gap along an edge normal of either hull --
+        more than TOUCH plus a slack far above the rounding of the two ways of computing it; any
+        such pair is apart in pieces_touch too, which runs only on the pairs left."""
+        sim = self.sim
+        r = int(self.slot["TouchSensor"][col])
+        pieces, discs, hulls = self._bumper_shapes(col)
+        out = np.zeros(len(copies))
+        if not pieces:
+            return out
+        centres = sim.centres[copies, r]                      # (n, 2)
+        cx, cy = centres[:, 0:1], centres[:, 1:2]
+        yaw = sim.foot_yaw[copies, r]
+        height = sim.heights[copies, r]
+        c, s = np.cos(yaw)[:, None], np.sin(yaw)[:, None]
+        px = cx + (c * discs[None, :, 0] - s * discs[None, :, 1])    # (n, P): each piece's disc centre
+        py = cy + (s * discs[None, :, 0] + c * discs[None, :, 1])
+        reach = discs[None, :, 2] + (TOUCH + _SLACK)
+        lo, hi = height[:, None] + discs[None, :, 3], height[:, None] + discs[None, :, 4]      # (n, P)
+        solids = sim.contact._obs
+        near_solid = np.zeros((len(copies), len(pieces), len(solids)), dtype=bool)
+        for k, ob in enumerate(solids):
+            band = (ob.z_range[1] > lo + FLOOR) & (ob.z_range[0] < hi - EPS)
+            if not band.any():
                 continue
-            jx, jy = sim.centres[c, j].tolist()   # (a robot farther than both discs and the tolerance: not built)
-            if math.hypot(jx - cx, jy - cy) > foot.radius + reach + 2.0 * TOUCH:
+            if ob.normal is not None:     # a wall line: the piece's disc wholly on its robot's side
+                n0, n1 = float(ob.normal[0]), float(ob.normal[1])
+                at = n0 * centres[:, 0] + n1 * centres[:, 1] + ob.offset
+                side = np.where(at >= 0.0, 1.0, -1.0)[:, None]        # (a centre on the line: kept)
+                far = (side * (n0 * px + n1 * py + ob.offset) - reach > _SLACK * (1.0 + abs(ob.offset))) \
+                    & (np.abs(at) > _SLACK)[:, None]
+                near_solid[:, :, k] = band & ~far
                 continue
-            band = (float(sim.heights[c, j] + sim.foot_low[j]), float(sim.heights[c, j] + sim.foot_high[j]))
-            if sim._shaped[j]:
-                robots.append(shaped_obstacle(j, foot, sim.centres[c, j], float(sim.foot_yaw[c, j]), band))
-            else:
-                robots.append(Obstacle(f"robot {j}", j, sim.centres[c, j][None, :].copy(), float(sim.foot_disc[j]), band))
-        touched = pieces_touch(pieces, sim.centres[c, r], float(sim.foot_yaw[c, r]), float(sim.heights[c, r]),
-                               sim.contact._obs, robots)
-        return 1.0 if touched else 0.0
+            (lx, ly), (hx, hy) = ob.lo.tolist(), ob.hi.tolist()
+            far = (px - reach > hx) | (px + reach < lx) | (py - reach > hy) | (py + reach < ly)
+            near = band & ~far
+            hull = self._solid_hull(ob)
+            for q in range(len(pieces)):
+                rows = near[:, q].nonzero()[0]
+                if len(rows):
+                    gap = _hull_gap(_placed(hulls[q], cx[rows, 0], cy[rows, 0], c[rows, 0], s[rows, 0]), hull)
+                    near[rows, q] = gap - (ob.radius + pieces[q].round) <= TOUCH + _SLACK
+            near_solid[:, :, k] = near
+        others = [j for j, foot in enumerate(sim.feet) if foot is not None and j != r]
+        near_robot = np.zeros((len(copies), len(pieces), len(others)), dtype=bool)
+        for k, j in enumerate(others):
+            foot = sim.feet[j]
+            jc = sim.centres[copies, j]
+            jh = sim.heights[copies, j]
+            band = ((jh + sim.foot_high[j])[:, None] > lo + EPS) & ((jh + sim.foot_low[j])[:, None] < hi - EPS)
+            dist = np.hypot(px - jc[:, 0:1], py - jc[:, 1:2])
+            near = band & (dist <= reach + (foot.radius + _SLACK))
+            if sim._shaped[j]:            # its footprint's hull where it is in each copy
+                assert foot.points is not None
+                hull_j = self.robot_hulls.get(j)
+                if hull_j is None:
+                    hull_j = self.robot_hulls[j] = (foot.points[:, 0].copy(), foot.points[:, 1].copy(),
+                                                    *_axes(foot.points))
+                for q in range(len(pieces)):
+                    rows = near[:, q].nonzero()[0]
+                    if len(rows):
+                        yj = sim.foot_yaw[copies[rows], j]
+                        other = _placed(hull_j, jc[rows, 0], jc[rows, 1], np.cos(yj), np.sin(yj))
+                        gap = _hull_gap(_placed(hulls[q], cx[rows, 0], cy[rows, 0], c[rows, 0], s[rows, 0]), other)
+                        near[rows, q] = gap - (foot.round + pieces[q].round) <= TOUCH + _SLACK
+            near_robot[:, :, k] = near
+        rows = (near_solid.any(axis=(1, 2)) | near_robot.any(axis=(1, 2))).nonzero()[0]
+        for m in rows.tolist():
+            cc = int(copies[m])
+            for q, piece in enumerate(pieces):
+                obs = [solids[k] for k in near_solid[m, q].nonzero()[0].tolist()]
+                robots = [self._robot_obstacle(cc, others[k]) for k in near_robot[m, q].nonzero()[0].tolist()]
+                if (obs or robots) and pieces_touch([piece], sim.centres[cc, r], float(sim.foot_yaw[cc, r]),
+                                                    float(sim.heights[cc, r]), obs, robots):
+                    out[m] = 1.0
+                    break
+        return out
+
+    def _robot_obstacle(self, c: int, j: int) -> Obstacle:
+        """Robot ``j`` of copy ``c`` where it is now, as an obstacle (Contact._robot_obstacle)."""
+        sim = self.sim
+        band = (float(sim.heights[c, j] + sim.foot_low[j]), float(sim.heights[c, j] + sim.foot_high[j]))
+        if sim._shaped[j]:
+            return shaped_obstacle(j, sim.feet[j], sim.centres[c, j], float(sim.foot_yaw[c, j]), band)
+        return Obstacle(f"robot {j}", j, sim.centres[c, j][None, :].copy(), float(sim.foot_disc[j]), band)
 
     def _altimeter(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Altimeter.measure: the device's height (+ the reference altitude), its Gaussian
