@@ -72,7 +72,12 @@ def _world(robots, solids, offset, nue, step):
     for i, s in enumerate(solids):
         g = ({"type": "box", "size": _size(s["half"], nue)} if s["kind"] == "box"
              else {"type": "cylinder", "radius": s["half"][0], "height": 2.0})
-        ss.append({"name": f"s{i}", "pose": pose(*s["xy"], 1.0, s["yaw"]), "geometry": _upright(g, nue)})
+        at = pose(*s["xy"], 1.0, s["yaw"])
+        if nue and s["kind"] == "post":
+            # a post stands up in a NUE world too (its axis turned from z, east, onto y, up): lying
+            # along east it reached 1 m from its cell's centre, into the next cell's robot
+            at = {**at, "rotation": [1.0, 0.0, 0.0, -math.pi / 2]}
+        ss.append({"name": f"s{i}", "pose": at, "geometry": _upright(g, nue)})
     return Simulation(parse_world({"world_info": {"basic_time_step": step,
                                                   "coordinate_system": "NUE" if nue else "ENU"},
                                    "solids": ss, "robots": rs}))
@@ -261,6 +266,51 @@ def test_a_needle_thin_robot_far_from_the_origin_stops_at_a_post() -> None:
         check(sim, ["r0"], (1e5, -1e5), False)
     assert sim.robot("r0").pressing
     assert sim.contact.centres[0][0] - 1e5 == pytest.approx(1.0 - 0.25 - 0.125, abs=1e-9)
+
+
+def test_a_post_in_a_nue_world_stands_up_clear_of_the_next_cells_robot() -> None:
+    """Found by the crowd fuzz (its shrunk example): a post in a NUE world lay along east, 2 m long,
+    reaching 1 m from its cell's centre into the robot placed in the next cell 1.3 m away -- the
+    world started with the robot 0.0125 m inside it (no step taken). Standing up, its outline is
+    the disc of radius 0.25 at its centre, and the robot (two cylinders, lying along east too: the
+    rectangle x in [1.20625 - 0.09375 - 0.125, ...]) is 0.9875 - 0.25 = 0.7375 m clear of it."""
+    me = ({"type": "cylinder", "radius": 0.125, "height": 0.25},
+          [{"geometry": {"type": "cylinder", "radius": 0.125, "height": 0.25},
+            "pose": {"translation": [-0.09375, 0.0, 0.0], "rotation": [0.0, 0.0, 1.0, 0.0]}}])
+    sim = _world([{"name": "r0", "xy": (1.20625, 0.0), "yaw": 0.0, "body": me}],
+                 [{"kind": "post", "xy": (0.0, 0.0), "yaw": 0.0, "half": (0.25, 0.25)}], (0.0, 0.0), True, 16)
+    post = next(ob for ob in sim.contact._obs if ob.name == "s0")
+    assert post.points.tolist() == [[0.0, 0.0]] and post.radius == pytest.approx(0.25, abs=1e-12)
+    pts, rnd = _robot_shape(sim, 0)
+    assert float(pts[:, 0].min()) - rnd == pytest.approx(0.9875, abs=1e-12)
+    assert _overlap(pts, rnd, post.points, post.radius) == pytest.approx(-0.7375, abs=1e-12)
+    check(sim, ["r0"], (0.0, 0.0), True)
+
+
+def test_a_sliver_robot_far_from_the_origin_curving_into_a_box_stays_out() -> None:
+    """Found by the back-out fuzz (its shrunk example): a robot that is a point and a sphere 5e-7 m
+    in radius 0.0625 m to its left, 1e5 m from the origin, curving into a box. The box grown by its
+    footprint (their Minkowski sum) lost a vertex whose edge was 2e-7 m long -- within 1e-12 of
+    the coordinates (2e-7 m there) of the previous one -- tilting the long edge next to it: the
+    footprint's rounded end went 2.1e-8 m into the box's face y = 0.75. It now stops touching it."""
+    me = ({"type": "sphere", "radius": 5e-13},
+          [{"geometry": {"type": "sphere", "radius": 5e-07},
+            "pose": {"translation": [0.0, 0.0625, 0.0], "rotation": [0.0, 0.0, 1.0, 0.0]}}])
+    offset = (1e5, -1e5)
+    sim = _world([{"name": "r0", "xy": (0.0, 0.0), "yaw": 0.0, "body": me}],
+                 [{"kind": "box", "xy": (1.0, 1.0), "yaw": 0.0, "half": (0.25, 0.25)}], offset, False, 64)
+    drive(sim, "r0", 17.0, 23.0)
+    for _ in range(60):
+        sim.step()
+        check(sim, ["r0"], offset, False)
+        if sim.robot("r0").pressing:
+            break
+    assert sim.robot("r0").pressing
+    pts, rnd = _robot_shape(sim, 0)
+    box = sim.contact._obs[0].points
+    # touching the box's bottom face (y = 0.75 - 1e5), from below: no deeper than the 1e-9 tolerance
+    assert float(pts[:, 1].max()) + rnd - (0.75 - 1e5) == pytest.approx(0.0, abs=1e-9)
+    assert _overlap(pts, rnd, box, 0.0) <= 1e-9
 
 
 STUCK_TURNS: list[int] = []

@@ -628,9 +628,12 @@ def _grown(ob: Obstacle, shape: np.ndarray, rnd: float, p: np.ndarray) -> tuple[
 
 def _minkowski(a: list, b: list) -> list:
     """The Minkowski sum of two convex polygons (counter-clockwise vertex lists, 3 or more each):
-    their edges merged by direction, O(n + m). A vertex turning by less than 1e-12 rad, or within
-    1e-12 of the previous one (rounding of parallel edges), is dropped: at most 1e-12 of the
-    edges' lengths off the exact sum, where it would give an edge of no length or direction."""
+    their edges merged by direction, O(n + m). A vertex turning by less than 1e-12 rad (rounding
+    of parallel edges) is dropped: at most 1e-12 of the edges' lengths inside the exact sum. So is
+    one within 1e-15 of its coordinates of the previous one (a few ulps: an edge of no length or
+    direction), at most that far inside: dropping a vertex moves the hull in by up to the short
+    edge's length, whatever the long ones' (1e-12 of the coordinates, 2e-7 m 1e5 m from the
+    origin, let a footprint's 2e-7 m rounded end into a solid by 2e-8 m)."""
     def lowest(v: list) -> list:
         k = min(range(len(v)), key=lambda i: (v[i][1], v[i][0]))
         return v[k:] + v[:k]
@@ -658,7 +661,7 @@ def _minkowski(a: list, b: list) -> list:
             (ox, oy), (px, py), (qx, qy) = out[k - 1], out[k], out[(k + 1) % len(out)]
             ux, uy, vx, vy = px - ox, py - oy, qx - px, qy - py
             lu, lv = math.hypot(ux, uy), math.hypot(vx, vy)
-            if lu <= 1e-12 * (1.0 + abs(px) + abs(py)) or ux * vy - uy * vx <= 1e-12 * lu * lv:
+            if lu <= 1e-15 * (1.0 + abs(px) + abs(py)) or ux * vy - uy * vx <= 1e-12 * lu * lv:
                 del out[k]
                 dropped = True
             else:
