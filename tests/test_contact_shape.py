@@ -259,6 +259,54 @@ def test_in_a_corner_a_push_into_the_other_wall_falls_back_to_the_cut_short_turn
         assert float(c[:, 1].min()) >= -0.1 - 1e-9 and float(c[:, 1].max()) <= 0.11 + 1e-9
 
 
+def test_a_box_robot_whose_rear_face_rests_on_a_pane_s_end_turns_the_way_that_lifts_it():
+    # a 0.4 x 0.2 robot whose rear face (x = -0.2) rests on the end of a thin pane (y in [-0.06,
+    # -0.04], running back from x = -0.2): turning left swings that part of the face forward, off
+    # the pane (a face point (-0.2, y < 0) goes to x = -0.2 cos h - y sin h > -0.2), so it turns the
+    # whole step's turn each step and stays put; its other rear corner reaches the pane only past
+    # 0.6 rad. It used to be held: the swept footprint's hull lay behind the rear face by about
+    # lever x turn, "deeper" than touching, however small the turn
+    pane = block("pane", -0.5, -0.2, -0.06, -0.04)
+    sim = world([pane], [box_robot("r", 0.0, 0.0, size=(0.4, 0.2))])
+    drive(sim, "r", -1.0, 1.0)
+    for k in range(1, 11):
+        sim.step()
+        assert heading(sim, "r") == pytest.approx(k * PER_STEP, abs=1e-12)
+        assert (xy(sim, "r") == 0.0).all() and not sim.robot("r").pressing
+    # turning right swings it into the pane's corner (-0.2, -0.06): the pane pushes it off along the
+    # rear face's normal, the least push, 0.2 (1 - cos h) + 0.06 sin h, to touching (as before)
+    sim = world([pane], [box_robot("r", 0.0, 0.0, size=(0.4, 0.2))])
+    drive(sim, "r", 1.0, -1.0)
+    sim.step()
+    h = heading(sim, "r")
+    assert h == pytest.approx(-PER_STEP, abs=1e-12) and sim.robot("r").pressing
+    d = 0.2 * (1.0 - math.cos(h)) + 0.06 * math.sin(-h)
+    assert xy(sim, "r") == pytest.approx([d * math.cos(h), d * math.sin(h)], abs=1e-9)
+    c = corners(sim, "r", (0.4, 0.2))
+    rear = (c[0] + c[1]) / 2 - xy(sim, "r")
+    assert float((np.array([-0.2, -0.06]) - xy(sim, "r")) @ rear) / 0.2 == pytest.approx(0.2, abs=1e-9)
+
+
+def test_a_turn_is_tested_along_each_corner_s_arc_exactly():
+    # a 0.4 x 0.2 box at the origin turning left by t; a wall y >= w above it: its corner (0.2, 0.1)
+    # reaches 0.2 sin h + 0.1 cos h, largest at h = atan2(0.2, 0.1) (1.107 rad, 0.2236 m). A wall
+    # just above the largest reach lets the whole half-turn through, one just below stops it: the
+    # arc's top is found where it lies inside the turn, not only at its ends
+    top = math.hypot(0.2, 0.1)
+    for w, clear in ((top + 2e-9, True), (top - 1e-6, False)):
+        c = C.Contact([("wall", geo.Box((6.0, 0.2, 0.5)), Pose.identity(), Pose(np.eye(3), np.array([0.0, w + 0.1, 0.25])), True)],
+                      [([(geo.Box((0.4, 0.2, 0.2)), Pose.identity())], Pose(np.eye(3), np.array([0.0, 0.0, 0.1])))])
+        foot = c.feet[0]
+        ob = c._obs[0]
+        p = np.zeros(2)
+        now = [C._gap(p, *C._grown(ob, C._turned(foot.points, 0.0), foot.round, p))]
+        assert now[0] == pytest.approx(w - 0.1, abs=1e-12)
+        assert c._turn_clear(foot, p, 0.0, 2.0, [ob], now) is clear
+        # the same turn from its far end back (the arc's top inside it again)
+        back = [C._gap(p, *C._grown(ob, C._turned(foot.points, 2.0), foot.round, p))]
+        assert c._turn_clear(foot, p, 2.0, -2.0, [ob], back) is clear
+
+
 def test_two_box_robots_meet_face_to_face_at_the_sum_of_their_half_lengths():
     sim = world(robots=[box_robot("a", 0.0, 0.0), box_robot("b", 2.0, 0.0, math.pi, size=(0.3, 0.6))])
     drive(sim, "a", 10.0)

@@ -26,8 +26,8 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   an obstacle. Robots' bodies meet one another without the tolerance (robots never stand on
   robots);
 * over one basic step a shaped robot first turns in place at its start, as far as the footprint
-  sweeping through the turn overlaps nothing it did not already overlap, or deeper (the sweep
-  bounded in closed form, :meth:`Contact._turn_clear`); where the turn would go into something,
+  sweeping through the turn overlaps nothing it did not already overlap, or deeper (each vertex's
+  arc about the centre tested in closed form, :func:`turn_gap_holds`); where the turn would go into something,
   the whole turn is kept and the centre pushed off it the least distance, to touching
   (:meth:`Contact._push`, closed form), unless that push meets something else: then the turn is
   cut short, found by halving to 2^-12 of the step's turn (either counts as a contact); then its centre moves along the chord from
@@ -686,6 +686,154 @@ def _gap(p: np.ndarray, ob: Obstacle, rho: float) -> float:
     return _closest_on_list(float(p[0]), float(p[1]), ob.points.tolist())[0] - (ob.radius + rho)
 
 
+# ---------------------------------------------------------------------- turns in place (exact arcs)
+
+def _in_range(c: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """The candidate angles ``c`` (any turn) moved into [lo, hi] where they fall in it (mod 2π),
+    the others replaced by ``lo`` (a candidate already counted)."""
+    k = np.mod(c - lo, math.tau)
+    return np.where(k <= hi - lo, lo + k, lo)
+
+
+def _rotated(x: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points ``x`` (..., 2) turned counter-clockwise by the angles ``u`` (broadcast), as :func:`_turned`."""
+    c, s = np.cos(u), np.sin(u)
+    return x[..., 0] * c - x[..., 1] * s, x[..., 0] * s + x[..., 1] * c
+
+
+def _arc_to_segments(x: np.ndarray, lo: float, hi: float, a: np.ndarray, b: np.ndarray) -> float:
+    """The least distance from the points ``x`` (k, 2), each turning about the origin through every
+    angle of [lo, hi] (an arc), to the segments a→b (e, 2 each; a point where a = b): exact, the
+    distance of each arc to each segment taken at its candidate angles -- the arc's ends, where it
+    points at a segment's end (the nearest a segment's end gets), where it points along the
+    segment line's normal either way (the nearest it gets to the line) and where the circle crosses
+    that line. Between those the distance is monotone."""
+    if len(x) == 0 or len(a) == 0:
+        return math.inf
+    X = x[:, None, :]
+    A, B = a[None, :, :], b[None, :, :]
+    rx = np.hypot(X[..., 0], X[..., 1])                     # (k, 1)
+    px = np.arctan2(X[..., 1], X[..., 0])
+    e = B - A
+    el = np.hypot(e[..., 0], e[..., 1])
+    safe = np.where(el > 0.0, el, 1.0)
+    nx, ny = e[..., 1] / safe, -e[..., 0] / safe            # (1, e)
+    off = nx * A[..., 0] + ny * A[..., 1]                   # the line n·y = off
+    pn = np.arctan2(ny, nx)
+    ratio = np.clip(off / np.where(rx > 0.0, rx, 1.0), -1.0, 1.0)
+    cross = np.arccos(ratio)
+    cands = [np.full(rx.shape, lo) + 0.0 * pn, np.full(rx.shape, hi) + 0.0 * pn,
+             np.arctan2(A[..., 1], A[..., 0]) - px, np.arctan2(B[..., 1], B[..., 0]) - px,
+             pn - px, pn - px + math.pi, pn - px + cross, pn - px - cross]
+    u = np.stack([_in_range(c, lo, hi) for c in cands], axis=-1)        # (k, e, 8)
+    qx, qy = _rotated(x[:, None, None, :], u)
+    ax, ay = A[..., 0][..., None], A[..., 1][..., None]
+    ex, ey = e[..., 0][..., None], e[..., 1][..., None]
+    ee = (el * el)[..., None]
+    t = np.clip(((qx - ax) * ex + (qy - ay) * ey) / np.where(ee > 0.0, ee, 1.0), 0.0, 1.0)
+    return float(np.min(np.hypot(qx - ax - t * ex, qy - ay - t * ey)))
+
+
+def _least_along(x: np.ndarray, lo: float, hi: float, n: np.ndarray) -> np.ndarray:
+    """Per axis n (e, 2), the least of n·R(u)x over the points ``x`` (k, 2) and u in [lo, hi]:
+    each a sinusoid in u, least at the ends or where R(u)x points against n. Exact."""
+    X = x[:, None, :]
+    px = np.arctan2(X[..., 1], X[..., 0])
+    pn = np.arctan2(n[None, :, 1], n[None, :, 0])
+    u = np.stack([np.full(px.shape, lo) + 0.0 * pn, np.full(px.shape, hi) + 0.0 * pn,
+                  _in_range(pn - px + math.pi, lo, hi)], axis=-1)            # (k, e, 3)
+    qx, qy = _rotated(x[:, None, None, :], u)
+    return np.min(n[None, :, None, 0] * qx + n[None, :, None, 1] * qy, axis=(0, 2))
+
+
+def _edges(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A convex hull's edges a→b (counter-clockwise; a segment both ways, a point none) and their
+    outward unit normals."""
+    if len(pts) < 2:
+        return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros((0, 2))
+    a, b = pts, np.roll(pts, -1, axis=0)
+    e = b - a
+    el = np.hypot(e[:, 0], e[:, 1])
+    keep = el > 0.0
+    a, e, el = a[keep], e[keep], el[keep]
+    return a, a + e, np.stack([e[:, 1] / el, -e[:, 0] / el], axis=1)
+
+
+def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: np.ndarray,
+                   target: float) -> bool:
+    """Whether the footprint ``hull(shape) ⊕ disc(rnd)`` (turned to the turn's start, relative to
+    its centre ``p``) turning in place by ``turn`` stays at a signed distance of at least ``target``
+    from ``ob`` at every heading of the turn. Closed form, without sampling the turn: each vertex
+    of the footprint turns on an arc about ``p``, and each of the obstacle's, seen from the robot,
+    on an arc too (the other way).
+
+    * A wall line: the footprint's reach toward it, the largest of its vertices' sinusoids.
+    * ``target`` above the rounds' sum by more than EPS (the polygons kept apart by s): the least
+      distance between the two polygons over the turn is the least of every footprint vertex's arc
+      to the obstacle's edges and every obstacle vertex's arc to the footprint's edges
+      (:func:`_arc_to_segments`): exact; they start at least that far apart and, to come nearer,
+      would pass through that distance.
+    * Otherwise (touching or overlapping, rounds too small to matter: the polygons may overlap by
+      -s): one separating axis for the whole turn, an edge normal of either polygon (which turns
+      with its polygon), along which their separation, the least of sinusoids, stays at least s
+      (:func:`_least_along`): the signed distance is the largest such separation at each heading,
+      so this holds it (conservative only where the deepest axis changes within the turn). Or the
+      polygons start apart and the arcs above keep them more than EPS apart (far above the arcs'
+      rounding): they never overlap."""
+    lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
+    if ob.normal is not None:
+        side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
+        w = -side * ob.normal
+        reach = -float(np.min(_least_along(shape, lo, hi, -w[None, :]))) + rnd
+        return abs(float(ob.normal @ p) + ob.offset) - reach >= target
+    q = ob.points - p[None, :]
+    s = target + rnd + ob.radius
+    fa, fb, fn = _edges(shape)
+    qa, qb, qn = _edges(q)
+    if len(fa) == 0:
+        fa = fb = shape[:1]
+    if len(qa) == 0:
+        qa = qb = q[:1]
+
+    def apart() -> float:
+        return min(_arc_to_segments(shape, lo, hi, qa, qb), _arc_to_segments(q, -hi, -lo, fa, fb))
+
+    if s > EPS:
+        return apart() >= s
+    # degenerate pairs (a point, a segment with a point or a parallel one) never overlap as
+    # polygons: their distance is their vertices' to their edges'
+    if len(shape) + len(q) <= 3 or (len(shape) == 2 and len(q) == 2 and float(fn[0] @ np.array([-qn[0, 1], qn[0, 0]])) == 0.0):
+        return s <= 0.0 or apart() >= s
+    if len(qn):             # the obstacle's edge normals (fixed): sep = min n·R(u)f - max n·q
+        sep = _least_along(shape, lo, hi, qn) - np.max(qn @ q.T, axis=1)
+        if float(np.max(sep)) >= s:
+            return True
+    if len(fn):             # the footprint's (turning with it): sep = min m·R(-u)q - max m·f
+        sep = _least_along(q, -hi, -lo, fn) - np.max(fn @ shape.T, axis=1)
+        if float(np.max(sep)) >= s:
+            return True
+    # apart at the start and kept farther apart than the rounding (EPS) all through the turn
+    return _start_apart(shape, q) and apart() >= max(s, EPS)
+
+
+def _start_apart(shape: np.ndarray, q: np.ndarray) -> bool:
+    """Whether the polygons ``hull(shape)`` and ``hull(q)`` (the same frame) are apart: a separating
+    edge normal of either (two points or segments: their distance)."""
+    for pa, pb in ((shape, q), (q, shape)):
+        _, _, n = _edges(pa)
+        if len(n) and float(np.max(np.min(n @ pb.T, axis=1) - np.max(n @ pa.T, axis=1))) > 0.0:
+            return True
+    if len(shape) + len(q) <= 3 or (len(shape) == 2 and len(q) == 2):
+        fa, fb, _ = _edges(shape)
+        if len(fa) == 0:
+            fa = fb = shape[:1]
+        qa, qb, _ = _edges(q)
+        if len(qa) == 0:
+            qa = qb = q[:1]
+        return _arc_to_segments(shape, 0.0, 0.0, qa, qb) > 0.0 and _arc_to_segments(q, 0.0, 0.0, fa, fb) > 0.0
+    return False
+
+
 # ---------------------------------------------------------------------- bumpers
 
 TOUCH = 1e-6          # m: a bumper's own shapes this near what contact sees (or overlapping it) touch it
@@ -1027,12 +1175,10 @@ class Contact:
     @staticmethod
     def _turn_may_meet(foot: Footprint, p: np.ndarray, turn: float, cands: list[Obstacle]) -> bool:
         """False when no candidate comes within reach of the turn, which :meth:`_turn_clear` would
-        then find clear, without its hulls: at every heading the footprint lies in the disc of
-        ``foot.radius`` about ``p``, and each part's swept hull in that disc pushed out by 1 / cos(half
-        the part); a candidate farther than that (by more than the distances' rounding) is met by
-        none of them. Most robots near something are turning in its broad-phase reach, not this one."""
-        parts = max(1, math.ceil(abs(turn) / (math.pi / 4.0)))
-        reach = foot.radius / math.cos(abs(turn) / parts / 2.0)
+        then find clear: at every heading the footprint lies in the disc of ``foot.radius`` about
+        ``p``; a candidate farther than that (by more than the distances' rounding) is met at none.
+        Most robots near something are turning in its broad-phase reach, not this one."""
+        reach = foot.radius
         margin = EPS + 1e-9 * (1.0 + abs(float(p[0])) + abs(float(p[1])) + reach)
         return any(_gap(p, ob, reach) <= margin for ob in cands)
 
@@ -1040,29 +1186,21 @@ class Contact:
                     now: list[float]) -> bool:
         """Whether the footprint at ``p`` turning from ``yaw`` by ``turn`` stays clear of every
         candidate: at no heading of the turn nearer to it than ``now`` (each one's signed distance
-        at ``yaw``) if it overlaps, nor overlapping it (by more than EPS) if it does not. Closed
-        form and conservative: the turn in parts of at most 45°, each part's footprints inside
-        the hull of its two ends and its middle pushed out by 1 / cos(half the part) -- each
-        vertex's arc lies in the triangle of its ends and their tangents' crossing."""
+        at ``yaw``) if it overlaps, nor overlapping it (by more than EPS) if it does not
+        (:func:`turn_gap_holds`: each vertex's arc, closed form). A turn whose points move less
+        than every candidate's distance (each point moves at most the chord 2 r sin(|turn| / 2) of
+        its reach r, and a signed distance changes by no more than the footprint moves) is clear
+        without the arcs."""
         assert foot.points is not None
-        parts = max(1, math.ceil(abs(turn) / (math.pi / 4.0)))
-        if parts == 1:
-            # the one part's hull lies within 2 r tan(|turn| / 2) of the footprint at ``yaw`` (r: its
-            # points' reach; each hull vertex is that near its corner there), so its distance to a
-            # candidate is at least ``now`` less that: where that already answers, no hull is built
-            delta = 2.0 * (foot.radius - foot.round) * math.tan(abs(turn) / 2.0)
-            margin = 1e-9 * (1.0 + abs(float(p[0])) + abs(float(p[1])) + foot.radius)
-            if all(g - delta - margin >= min(g, 0.0) - EPS for g in now):
-                return True
-        for k in range(parts):
-            a, b = yaw + turn * k / parts, yaw + turn * (k + 1) / parts
-            half = (b - a) / 2.0
-            swept = _hull(np.concatenate([_turned(foot.points, a), _turned(foot.points, b),
-                                          _turned(foot.points, a + half) / math.cos(half)]))
-            for ob, gap in zip(cands, now):
-                self.checks += 1
-                if _gap(p, *_grown(ob, swept, foot.round, p)) < min(gap, 0.0) - EPS:
-                    return False
+        delta = 2.0 * (foot.radius - foot.round) * math.sin(min(abs(turn), math.pi) / 2.0)
+        margin = 1e-9 * (1.0 + abs(float(p[0])) + abs(float(p[1])) + foot.radius)
+        if all(g - delta - margin >= min(g, 0.0) - EPS for g in now):
+            return True
+        shape = _turned(foot.points, yaw)
+        for ob, gap in zip(cands, now):
+            self.checks += 1
+            if not turn_gap_holds(shape, foot.round, turn, ob, p, min(gap, 0.0) - EPS):
+                return False
         return True
 
     def _sweep(self, p: np.ndarray, d: np.ndarray, cands: list[tuple[Obstacle, float]]) -> tuple[np.ndarray, bool]:
