@@ -800,9 +800,9 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
 
     if s > EPS:
         return apart() >= s
-    # degenerate pairs (a point, a segment with a point or a parallel one) never overlap as
-    # polygons: their distance is their vertices' to their edges'
-    if len(shape) + len(q) <= 3 or (len(shape) == 2 and len(q) == 2 and float(fn[0] @ np.array([-qn[0, 1], qn[0, 0]])) == 0.0):
+    # a point with a point or a segment never overlaps it as polygons (at any heading): their
+    # distance is their vertices' to their edges'
+    if len(shape) + len(q) <= 3:
         return s <= 0.0 or apart() >= s
     if len(qn):             # the obstacle's edge normals (fixed): sep = min n·R(u)f - max n·q
         sep = _least_along(shape, lo, hi, qn) - np.max(qn @ q.T, axis=1)
@@ -818,12 +818,15 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
 
 def _start_apart(shape: np.ndarray, q: np.ndarray) -> bool:
     """Whether the polygons ``hull(shape)`` and ``hull(q)`` (the same frame) are apart: a separating
-    edge normal of either (two points or segments: their distance)."""
+    edge normal of either (exact but for a point with a point or a segment and two parallel
+    segments, whose distance answers)."""
     for pa, pb in ((shape, q), (q, shape)):
         _, _, n = _edges(pa)
         if len(n) and float(np.max(np.min(n @ pb.T, axis=1) - np.max(n @ pa.T, axis=1))) > 0.0:
             return True
-    if len(shape) + len(q) <= 3 or (len(shape) == 2 and len(q) == 2):
+    parallel = (len(shape) == 2 and len(q) == 2
+                and float((shape[1, 0] - shape[0, 0]) * (q[1, 1] - q[0, 1]) - (shape[1, 1] - shape[0, 1]) * (q[1, 0] - q[0, 0])) == 0.0)
+    if len(shape) + len(q) <= 3 or parallel:
         fa, fb, _ = _edges(shape)
         if len(fa) == 0:
             fa = fb = shape[:1]
