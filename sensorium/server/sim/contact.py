@@ -722,10 +722,12 @@ def _arc_to_segments(x: np.ndarray, lo: float, hi: float, a: np.ndarray, b: np.n
     pn = np.arctan2(ny, nx)
     ratio = np.clip(off / np.where(rx > 0.0, rx, 1.0), -1.0, 1.0)
     cross = np.arccos(ratio)
-    cands = [np.full(rx.shape, lo) + 0.0 * pn, np.full(rx.shape, hi) + 0.0 * pn,
-             np.arctan2(A[..., 1], A[..., 0]) - px, np.arctan2(B[..., 1], B[..., 0]) - px,
-             pn - px, pn - px + math.pi, pn - px + cross, pn - px - cross]
-    u = np.stack([_in_range(c, lo, hi) for c in cands], axis=-1)        # (k, e, 8)
+    shape = np.broadcast_shapes(rx.shape, pn.shape)
+    ends = np.broadcast_to(np.array([lo, hi]), (*shape, 2))
+    cands = np.stack(np.broadcast_arrays(
+        np.arctan2(A[..., 1], A[..., 0]) - px, np.arctan2(B[..., 1], B[..., 0]) - px,
+        pn - px, pn - px + math.pi, pn - px + cross, pn - px - cross), axis=-1)
+    u = np.concatenate([ends, _in_range(cands, lo, hi)], axis=-1)      # (k, e, 8)
     qx, qy = _rotated(x[:, None, None, :], u)
     ax, ay = A[..., 0][..., None], A[..., 1][..., None]
     ex, ey = e[..., 0][..., None], e[..., 1][..., None]
@@ -740,8 +742,8 @@ def _least_along(x: np.ndarray, lo: float, hi: float, n: np.ndarray) -> np.ndarr
     X = x[:, None, :]
     px = np.arctan2(X[..., 1], X[..., 0])
     pn = np.arctan2(n[None, :, 1], n[None, :, 0])
-    u = np.stack([np.full(px.shape, lo) + 0.0 * pn, np.full(px.shape, hi) + 0.0 * pn,
-                  _in_range(pn - px + math.pi, lo, hi)], axis=-1)            # (k, e, 3)
+    crit = _in_range(pn - px + math.pi, lo, hi)
+    u = np.concatenate([np.broadcast_to(np.array([lo, hi]), (*crit.shape, 2)), crit[..., None]], axis=-1)  # (k, e, 3)
     qx, qy = _rotated(x[:, None, None, :], u)
     return np.min(n[None, :, None, 0] * qx + n[None, :, None, 1] * qy, axis=(0, 2))
 
@@ -751,7 +753,7 @@ def _edges(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     outward unit normals."""
     if len(pts) < 2:
         return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros((0, 2))
-    a, b = pts, np.roll(pts, -1, axis=0)
+    a, b = pts, np.concatenate([pts[1:], pts[:1]])
     e = b - a
     el = np.hypot(e[:, 0], e[:, 1])
     keep = el > 0.0
@@ -768,18 +770,18 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
     on an arc too (the other way).
 
     * A wall line: the footprint's reach toward it, the largest of its vertices' sinusoids.
-    * ``target`` above the rounds' sum by more than EPS (the polygons kept apart by s): the least
-      distance between the two polygons over the turn is the least of every footprint vertex's arc
-      to the obstacle's edges and every obstacle vertex's arc to the footprint's edges
-      (:func:`_arc_to_segments`): exact; they start at least that far apart and, to come nearer,
-      would pass through that distance.
-    * Otherwise (touching or overlapping, rounds too small to matter: the polygons may overlap by
-      -s): one separating axis for the whole turn, an edge normal of either polygon (which turns
-      with its polygon), along which their separation, the least of sinusoids, stays at least s
-      (:func:`_least_along`): the signed distance is the largest such separation at each heading,
-      so this holds it (conservative only where the deepest axis changes within the turn). Or the
-      polygons start apart and the arcs above keep them more than EPS apart (far above the arcs'
-      rounding): they never overlap."""
+    * The polygons must keep a signed distance s (``target`` less the rounds). First one
+      separating axis for the whole turn, an edge normal of either polygon (turning with its
+      polygon), along which their separation, the least of sinusoids, stays at least s
+      (:func:`_least_along`): the signed distance is at least that at every heading (the largest
+      such separation, where they overlap). Touching or overlapping (s <= EPS), this is the answer
+      (conservative only where the deepest axis changes within the turn).
+    * Else, s above EPS (apart): the least distance between the two polygons over the turn is
+      the least of every footprint vertex's arc to the obstacle's edges and every obstacle
+      vertex's arc to the footprint's edges (:func:`_arc_to_segments`): exact; they start at
+      least that far apart and, to come nearer, would pass through that distance. Touching
+      polygons that start apart and whose arcs stay more than EPS apart (far above the arcs'
+      rounding) never overlap either."""
     lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
     if ob.normal is not None:
         side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
@@ -798,12 +800,13 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
     def apart() -> float:
         return min(_arc_to_segments(shape, lo, hi, qa, qb), _arc_to_segments(q, -hi, -lo, fa, fb))
 
-    if s > EPS:
-        return apart() >= s
     # a point with a point or a segment never overlaps it as polygons (at any heading): their
     # distance is their vertices' to their edges'
-    if len(shape) + len(q) <= 3:
-        return s <= 0.0 or apart() >= s
+    degenerate = len(shape) + len(q) <= 3
+    if degenerate and s <= 0.0:
+        return True
+    # one separating axis for the whole turn (a lower bound of the signed distance at every heading:
+    # cheaper than the arcs, and where they touch or overlap the only answer)
     if len(qn):             # the obstacle's edge normals (fixed): sep = min n·R(u)f - max n·q
         sep = _least_along(shape, lo, hi, qn) - np.max(qn @ q.T, axis=1)
         if float(np.max(sep)) >= s:
@@ -812,6 +815,8 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
         sep = _least_along(q, -hi, -lo, fn) - np.max(fn @ shape.T, axis=1)
         if float(np.max(sep)) >= s:
             return True
+    if s > EPS or degenerate:
+        return apart() >= s
     # apart at the start and kept farther apart than the rounding (EPS) all through the turn
     return _start_apart(shape, q) and apart() >= max(s, EPS)
 
@@ -1193,14 +1198,16 @@ class Contact:
         (:func:`turn_gap_holds`: each vertex's arc, closed form). A turn whose points move less
         than every candidate's distance (each point moves at most the chord 2 r sin(|turn| / 2) of
         its reach r, and a signed distance changes by no more than the footprint moves) is clear
-        without the arcs."""
+        of a candidate without its arcs."""
         assert foot.points is not None
         delta = 2.0 * (foot.radius - foot.round) * math.sin(min(abs(turn), math.pi) / 2.0)
         margin = 1e-9 * (1.0 + abs(float(p[0])) + abs(float(p[1])) + foot.radius)
-        if all(g - delta - margin >= min(g, 0.0) - EPS for g in now):
-            return True
-        shape = _turned(foot.points, yaw)
+        shape = None
         for ob, gap in zip(cands, now):
+            if gap - delta - margin >= min(gap, 0.0) - EPS:
+                continue
+            if shape is None:
+                shape = _turned(foot.points, yaw)
             self.checks += 1
             if not turn_gap_holds(shape, foot.round, turn, ob, p, min(gap, 0.0) - EPS):
                 return False
