@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from test_contact import drive, world, xy  # the same world, wheels and positions as the disc tests
 
 from sensorium.server.sim import contact as C
 from sensorium.server.sim.simulation import Simulation
@@ -25,23 +26,6 @@ def box_robot(name, x, y, yaw=0.0, size=(LONG, WIDE), **extra):
     return {"name": name, "pose": {"translation": [x, y, 0.1], "rotation": [0, 0, 1, yaw]},
             "body": {"geometry": {"type": "box", "size": [size[0], size[1], 0.2]}},
             "differential_drive": {"wheel_radius": 0.1, "axle_length": 0.3, "max_wheel_speed": 1000.0}, **extra}
-
-
-def world(solids=(), robots=(), contact=True):
-    return Simulation(parse_world({"world_info": {"basic_time_step": STEP, "contact": contact},
-                                   "solids": [{"name": "floor", "geometry": {"type": "plane", "size": None}},
-                                              *solids],
-                                   "robots": list(robots)}))
-
-
-def drive(sim, name, left, right=None):
-    for m, w in zip(sim.robot(name).motors.values(), (left, left if right is None else right)):
-        m.set_position(math.inf)
-        m.set_velocity(w)
-
-
-def xy(sim, name):
-    return sim.robot(name).pose.translation[:2].copy()
 
 
 def heading(sim, name):
