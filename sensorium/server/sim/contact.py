@@ -679,6 +679,20 @@ def _gap_normal(p: np.ndarray, ob: Obstacle, rho: float) -> tuple[float, np.ndar
     return d - (ob.radius + rho), n
 
 
+def _in_reach(cands: list[Obstacle], p: np.ndarray, d: np.ndarray, radius: float) -> list[Obstacle]:
+    """The candidates a footprint within ``radius`` of its centre can meet moving from ``p`` by ``d``
+    (sliding included: the path is no longer than ``|d|``): their boxes, then the shapes, within that
+    reach of ``p``, with a margin far above rounding. The others cannot stop the move, so their grown shapes are not
+    built (a turning robot's broad phase reaches further, for the push)."""
+    reach = radius + math.hypot(float(d[0]), float(d[1]))
+    x, y = float(p[0]), float(p[1])
+    m = reach + 1e-6 * (1.0 + abs(x) + abs(y) + reach)
+    margin = m - reach
+    return [ob for ob in cands
+            if not (ob.lo[0] > x + m or ob.hi[0] < x - m or ob.lo[1] > y + m or ob.hi[1] < y - m)
+            and _gap(p, ob, reach) <= margin]
+
+
 def _gap(p: np.ndarray, ob: Obstacle, rho: float) -> float:
     """The signed distance from ``p`` to ``ob ⊕ disc(rho)`` (negative inside)."""
     if ob.normal is not None:
@@ -1108,7 +1122,8 @@ class Contact:
                     # the whole turn, the centre pushed off what the footprint turned into, then the
                     # move from there (the push is a contact: clipped, the drive's x, y written back)
                     shape = _turned(foot.points, yaw1)
-                    end, clipped = self._sweep(pushed, d, [_grown(ob, shape, foot.round, pushed) for ob in cands])
+                    end, clipped = self._sweep(pushed, d, [_grown(ob, shape, foot.round, pushed)
+                                                           for ob in _in_reach(cands, pushed, d, foot.radius)])
                     if not clipped:
                         self.contacts += 1
                     return end, True, yaw1
@@ -1125,7 +1140,8 @@ class Contact:
                         else:
                             hi = mid
                 kept = _wrap(yaw + turn * lo) if lo > 0.0 else yaw
-        end, clipped = self._sweep(p, d, [_grown(ob, _turned(foot.points, kept), foot.round, p) for ob in cands])
+        shape = _turned(foot.points, kept)
+        end, clipped = self._sweep(p, d, [_grown(ob, shape, foot.round, p) for ob in _in_reach(cands, p, d, foot.radius)])
         if kept != yaw1 and not clipped:
             self.contacts += 1
         return end, clipped or kept != yaw1, kept
