@@ -679,6 +679,9 @@ def _gap_normal(p: np.ndarray, ob: Obstacle, rho: float) -> tuple[float, np.ndar
     return d - (ob.radius + rho), n
 
 
+_STILL = np.zeros(2)
+
+
 def _in_reach(cands: list[Obstacle], p: np.ndarray, d: np.ndarray, radius: float) -> list[Obstacle]:
     """The candidates a footprint within ``radius`` of its centre can meet moving from ``p`` by ``d``
     (sliding included: the path is no longer than ``|d|``): their boxes, then the shapes, within that
@@ -1113,11 +1116,14 @@ class Contact:
             return p + d, False, yaw1
         kept = yaw1
         turn = math.remainder(yaw1 - yaw, math.tau)
-        if turn != 0.0 and self._turn_may_meet(foot, p, turn, cands):
+        # what the turn, or a push of it (at most foot.radius * min(|turn|, 2)), can meet: the others
+        # are left out of the turn's tests, which they cannot change
+        near = _in_reach(cands, p, _STILL, foot.radius * (1.0 + min(abs(turn), 2.0))) if turn != 0.0 else []
+        if near and self._turn_may_meet(foot, p, turn, near):
             here = _turned(foot.points, yaw)
-            now = [_gap(p, *_grown(ob, here, foot.round, p)) for ob in cands]
-            if not self._turn_clear(foot, p, yaw, turn, cands, now):
-                pushed = self._push(foot, p, yaw, yaw1, turn, cands, now)
+            now = [_gap(p, *_grown(ob, here, foot.round, p)) for ob in near]
+            if not self._turn_clear(foot, p, yaw, turn, near, now):
+                pushed = self._push(foot, p, yaw, yaw1, turn, near, now)
                 if pushed is not None:
                     # the whole turn, the centre pushed off what the footprint turned into, then the
                     # move from there (the push is a contact: clipped, the drive's x, y written back)
@@ -1131,11 +1137,11 @@ class Contact:
                 # touching where it turns (pressed on) is told by its first step, 2^-12 of the turn
                 lo, hi = 0.0, 1.0
                 least = 0.5 ** TURN_HALVINGS
-                if self._turn_clear(foot, p, yaw, turn * least, cands, now):
+                if self._turn_clear(foot, p, yaw, turn * least, near, now):
                     lo = least
                     for _ in range(TURN_HALVINGS):
                         mid = 0.5 * (lo + hi)
-                        if self._turn_clear(foot, p, yaw, turn * mid, cands, now):
+                        if self._turn_clear(foot, p, yaw, turn * mid, near, now):
                             lo = mid
                         else:
                             hi = mid
