@@ -330,6 +330,19 @@ def _pen_world():
                                    disc]})
 
 
+def _step_both(bs, singles, step):
+    """One step of the batched simulation and of each copy's single one: the same poses, bit for
+    bit, and the same pressing flags (robots a, b, c)."""
+    bs.step()
+    for c, sim in enumerate(singles):
+        sim.step()
+        for r, name in enumerate("abc"):
+            pose = sim.robot(name).pose
+            assert bs.pos[c, r].tobytes() == pose.translation.tobytes(), (step, c, name)
+            assert bs.rot[c, r].tobytes() == pose.rotation.tobytes(), (step, c, name)
+            assert bool(bs.pressing[c, r]) == sim.robot(name).pressing, (step, c, name)
+
+
 @pytest.mark.parametrize("native", [True, False])
 def test_the_batched_engine_clips_and_refuses_turns_as_the_single_simulation_bit_for_bit(native):
     """Shaped footprints in the batched engine (its numpy path and its C drive pass): every copy,
@@ -355,14 +368,7 @@ def test_the_batched_engine_clips_and_refuses_turns_as_the_single_simulation_bit
                 for c in range(n):
                     drive(singles[c], name, lr[r, c, 0], lr[r, c, 1])
         yaw_before = bs.yaw.copy()
-        bs.step()
-        for c, sim in enumerate(singles):
-            sim.step()
-            for r, name in enumerate("abc"):
-                pose = sim.robot(name).pose
-                assert bs.pos[c, r].tobytes() == pose.translation.tobytes(), (step, c, name)
-                assert bs.rot[c, r].tobytes() == pose.rotation.tobytes(), (step, c, name)
-                assert bool(bs.pressing[c, r]) == sim.robot(name).pressing, (step, c, name)
+        _step_both(bs, singles, step)
         held += int(np.count_nonzero((bs.yaw == yaw_before) & (bs.velocity[:, :, 0] != bs.velocity[:, :, 1])))
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
     assert held > 10
@@ -411,14 +417,7 @@ def test_the_batched_engine_pushes_turning_robots_off_walls_as_the_single_simula
                 bs.set_wheels(r, lr[r, :, 0], lr[r, :, 1])
                 for c in range(n):
                     drive(singles[c], name, lr[r, c, 0], lr[r, c, 1])
-        bs.step()
-        for c, sim in enumerate(singles):
-            sim.step()
-            for r, name in enumerate("abc"):
-                pose = sim.robot(name).pose
-                assert bs.pos[c, r].tobytes() == pose.translation.tobytes(), (step, c, name)
-                assert bs.rot[c, r].tobytes() == pose.rotation.tobytes(), (step, c, name)
-                assert bool(bs.pressing[c, r]) == sim.robot(name).pressing, (step, c, name)
+        _step_both(bs, singles, step)
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
     assert pushes.count(True) > 20 and pushes.count(False) > 0
 
