@@ -201,13 +201,17 @@ def test_a_camera_sees_each_material_in_its_colour(tmp_path: Path) -> None:
 REDS = np.array([[0, 17, 34, 51], [68, 85, 102, 113], [136, 153, 170, 187], [204, 221, 238, 255]])
 
 
+def save_board(path: Path) -> None:
+    """The 4 x 4 test texture: red REDS, green 255 - REDS, blue 7."""
+    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(path)
+
+
 @pytest.mark.parametrize("precision", ["fast", "exact"])
 def test_a_textured_quad_reads_the_texel_under_each_hit(tmp_path: Path, precision: str) -> None:
     """A CadShape whose material's diffuse is an image beside the .dae (in a sub-folder): infra-red
     sensors read the texel at the file's texture coordinates (t up, as assimp's FlipUVs)."""
     (tmp_path / "parts" / "img").mkdir(parents=True)
-    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
-        tmp_path / "parts" / "img" / "board.png")
+    save_board(tmp_path / "parts" / "img" / "board.png")
     quad = [[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.5, 0.0]]
     (tmp_path / "parts" / "quad.dae").write_text(dae(quad, [("m", [(0, 1, 2), (0, 2, 3)])], uv=[[0, 0], [1, 0], [1, 1], [0, 1]],
                                                      materials={"m": ("board", "img/board.png")}))
@@ -357,8 +361,7 @@ def test_an_obj_cad_shape_takes_its_mtl_materials(tmp_path: Path, precision: str
     1 − d as the transparency, map_Kd (beside the file) through the file's vt; Kd multiplies the texel
     (Webots' baseColor × baseColorMap)."""
     (tmp_path / "img").mkdir()
-    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
-        tmp_path / "img" / "board.png")
+    save_board(tmp_path / "img" / "board.png")
     (tmp_path / "two.obj").write_text("mtllib two.mtl\n"
                                       "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\n"
                                       "v 5 0 0\nv 6 0 0\nv 5 1 0\n"
@@ -538,8 +541,7 @@ def test_texture_coordinates_are_the_lowest_set_whatever_the_order_of_the_inputs
     exporters write them): the texture is mapped by set 0, assimp's channel 0 that Webots uses, not
     by the first input written."""
     (tmp_path / "img").mkdir()
-    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
-        tmp_path / "img" / "board.png")
+    save_board(tmp_path / "img" / "board.png")
     quad = [[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.5, 0.0]]
     text = dae(quad, [("m", [(0, 1, 2), (0, 2, 3)])], uv=[[0, 0], [1, 0], [1, 1], [0, 1]],
                materials={"m": ("board", "img/board.png")})
@@ -565,8 +567,7 @@ def test_mtl_files_as_blender_and_windows_tools_write_them(tmp_path: Path) -> No
     file, as assimp reads it), and ``Tr`` (1 − opacity) instead of ``d``: the texel under the sensor
     is read and the glass is 25 % transparent."""
     (tmp_path / "My Textures").mkdir()
-    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
-        tmp_path / "My Textures" / "board 1.png")
+    save_board(tmp_path / "My Textures" / "board 1.png")
     (tmp_path / "part.obj").write_text("mtllib part.mtl\n"
                                        "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nv 5 0 0\nv 6 0 0\n"
                                        "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
@@ -668,8 +669,7 @@ def test_a_concave_polygon_is_cut_into_ears_not_fanned(tmp_path: Path) -> None:
     concave polygon into ears, so nothing is seen where the L has no material, though a fan from its
     first corner would cover it; inside, the texel at the corner's texture coordinates is read."""
     (tmp_path / "img").mkdir()
-    Image.fromarray(np.stack([REDS, 255 - REDS, np.full_like(REDS, 7)], axis=-1).astype(np.uint8)).save(
-        tmp_path / "img" / "board.png")
+    save_board(tmp_path / "img" / "board.png")
     corners = [(2, 1), (1, 1), (1, 2), (0, 2), (0, 0), (2, 0)]     # a fan from the first or last corner leaves the L
     positions = " ".join(f"{x} {y} 0" for x, y in corners)
     uvs = " ".join(f"{x / 2} {y / 2}" for x, y in corners)
